@@ -1,0 +1,12 @@
+"""serialspec: serial device protocols described in YAML, compiled to codecs, structs, messages and docs.
+
+The pipeline, one module per stage:
+
+    spec.loader   YAML text -> plain values, each remembered with its file:line:column
+    spec.resolve  plain values -> validated, fully resolved immutable model (spec.model)
+    emit.*        model -> generated files, one emitter per output
+    runtime       the small hand-written library that generated code imports
+    cli           one module per verb of the `serialspec` command
+"""
+
+__version__ = "0.1.0"

@@ -1,0 +1,1 @@
+"""The small hand-written runtime that generated packages import: checksums, errors, framing, hex input."""

@@ -1,0 +1,469 @@
+"""The spec language's shape, declared once as data.
+
+The same declaration checks a loaded spec's structure (unknown keys, wrong kinds of value, missing keys) and is
+exported as the JSON Schema that editors use to complete and check spec files. Meaning (types that exist,
+references that resolve, sizes that add up) is checked later, in resolve.py.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from typing import Any
+
+from serialspec.spec.loader import Path
+
+SCALAR_TYPES = ("u8", "i8", "u16", "i16", "u32", "i32", "f32")
+
+
+class Shape:
+    description = ""
+
+    def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
+        raise NotImplementedError
+
+    def json_schema(self) -> dict[str, Any]:
+        raise NotImplementedError
+
+
+@dataclass
+class Str(Shape):
+    description: str = ""
+    choices: tuple[str, ...] = ()
+
+    def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
+        if not isinstance(value, str):
+            yield path, f"expected text, got {_kind(value)}"
+        elif self.choices and value not in self.choices:
+            yield path, f"unknown value {value!r} (expected one of {', '.join(self.choices)})"
+
+    def json_schema(self) -> dict[str, Any]:
+        schema: dict[str, Any] = {"type": "string", "description": self.description}
+        if self.choices:
+            schema["enum"] = list(self.choices)
+        return schema
+
+
+@dataclass
+class Int(Shape):
+    description: str = ""
+
+    def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
+        if not isinstance(value, int) or isinstance(value, bool):
+            yield path, f"expected an integer, got {_kind(value)}"
+
+    def json_schema(self) -> dict[str, Any]:
+        return {"type": "integer", "description": self.description}
+
+
+@dataclass
+class Num(Shape):
+    description: str = ""
+
+    def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
+        if not isinstance(value, int | float) or isinstance(value, bool):
+            yield path, f"expected a number, got {_kind(value)}"
+
+    def json_schema(self) -> dict[str, Any]:
+        return {"type": "number", "description": self.description}
+
+
+@dataclass
+class Bool(Shape):
+    description: str = ""
+
+    def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
+        if not isinstance(value, bool):
+            yield path, f"expected true or false, got {_kind(value)}"
+
+    def json_schema(self) -> dict[str, Any]:
+        return {"type": "boolean", "description": self.description}
+
+
+@dataclass
+class Any_(Shape):
+    description: str = ""
+
+    def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
+        return iter(())
+
+    def json_schema(self) -> dict[str, Any]:
+        return {"description": self.description}
+
+
+@dataclass
+class ListOf(Shape):
+    item: Shape
+    description: str = ""
+    length: int | None = None
+
+    def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
+        if not isinstance(value, list):
+            yield path, f"expected a list, got {_kind(value)}"
+            return
+        if self.length is not None and len(value) != self.length:
+            yield path, f"expected a list of {self.length} items, got {len(value)}"
+        for index, item in enumerate(value):
+            yield from self.item.check(item, (*path, index))
+
+    def json_schema(self) -> dict[str, Any]:
+        schema: dict[str, Any] = {"type": "array", "items": self.item.json_schema(), "description": self.description}
+        if self.length is not None:
+            schema["minItems"] = schema["maxItems"] = self.length
+        return schema
+
+
+@dataclass
+class MapOf(Shape):
+    """A mapping from names (or numbers) chosen by the spec author to values of one shape."""
+
+    value: Shape
+    description: str = ""
+    int_keys: bool = False
+
+    def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
+        if not isinstance(value, dict):
+            yield path, f"expected a mapping, got {_kind(value)}"
+            return
+        for key, item in value.items():
+            if self.int_keys != isinstance(key, int):
+                yield (*path, key), "expected a number as key" if self.int_keys else "expected a name as key"
+                continue
+            yield from self.value.check(item, (*path, key))
+
+    def json_schema(self) -> dict[str, Any]:
+        return {"type": "object", "additionalProperties": self.value.json_schema(), "description": self.description}
+
+
+@dataclass
+class Obj(Shape):
+    keys: dict[str, Shape]
+    required: tuple[str, ...] = ()
+    description: str = ""
+
+    def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
+        if not isinstance(value, dict):
+            yield path, f"expected a mapping with keys {', '.join(self.keys)}, got {_kind(value)}"
+            return
+        for key in self.required:
+            if key not in value:
+                yield path, f"missing key {key!r}"
+        for key, item in value.items():
+            shape = self.keys.get(key) if isinstance(key, str) else None
+            if shape is None:
+                yield (*path, key), f"unknown key {key!r} (expected one of {', '.join(self.keys)})"
+            else:
+                yield from shape.check(item, (*path, key))
+
+    def json_schema(self) -> dict[str, Any]:
+        return {
+            "type": "object",
+            "description": self.description,
+            "properties": {key: shape.json_schema() for key, shape in self.keys.items()},
+            "required": list(self.required),
+            "additionalProperties": False,
+        }
+
+
+@dataclass
+class OneOf(Shape):
+    """Either a short form (e.g. a bare type name) or a long form; picked by the kind of value given."""
+
+    options: tuple[Shape, ...] = field(default_factory=tuple)
+    description: str = ""
+
+    def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
+        for option in self.options:
+            problems = list(option.check(value, path))
+            if not problems:
+                return
+            if _accepts_kind(option, value):
+                yield from problems
+                return
+        yield path, f"unexpected {_kind(value)}: {self.description}"
+
+    def json_schema(self) -> dict[str, Any]:
+        return {"anyOf": [option.json_schema() for option in self.options], "description": self.description}
+
+
+def _accepts_kind(shape: Shape, value: Any) -> bool:
+    kinds: dict[type[Shape], type | tuple[type, ...]] = {
+        Str: str, Int: int, Num: (int, float), Bool: bool, ListOf: list, MapOf: dict, Obj: dict
+    }
+    expected = kinds.get(type(shape))
+    return expected is not None and isinstance(value, expected)
+
+
+def _kind(value: Any) -> str:
+    if value is None:
+        return "nothing"
+    return {bool: "true/false", int: "a number", float: "a number", str: "text", list: "a list", dict: "a mapping"}.get(
+        type(value), type(value).__name__
+    )
+
+
+# --- the language -------------------------------------------------------------------------------------------------
+
+TEXT = Str("Free text (English); shown in docs and docstrings, never executed.")
+RANGE = ListOf(Num(), "Inclusive [min, max] of the value in wire units; checked before encoding.", length=2)
+HEX_BYTES = Str("Bytes as hex: '12 4c 08', '0x12 0x4c', '124c08' or '12:4c:08'.")
+
+_FIELD_LONG: dict[str, Shape] = {
+    "type": Str("Wire type: u8, i8, u16, i16, u32, i32, f32, bytes, array, group, table_value, table_block."),
+    "use": Str("Name of an entry in `fields:` (top level) to copy; keys given here override it."),
+    "description": TEXT,
+    "description_cn": Str("Description as printed in the (Chinese) document."),
+    "unit": Str("Unit of one wire step, e.g. mV, ms, 0.1°."),
+    "scale": Num("Engineering value = wire value × scale (e.g. 0.1 for 0.1° steps)."),
+    "range": RANGE,
+    "const": Int("The field always has this value (sub-command selectors, fixed addresses)."),
+    "default": Num("Value used when a message is built without this field."),
+    "enum": Str("Name of an entry in `enums:`; values decode to that enum."),
+    "flags": Str("Name of an entry in `flags:`; the value is a set of bit flags."),
+    "bits": MapOf(
+        Obj(
+            {"bits": OneOf((Int(), ListOf(Int(), length=2)), "a bit number or [high, low]"),
+             "enum": Str("Name of an entry in `enums:`."), "description": TEXT},
+            required=("bits",),
+        ),
+        "Sub-fields packed into this integer, by bit position (unlisted bits must be zero).",
+    ),
+    "encoding": Str("How the integer is stored.", choices=("plain", "sign_magnitude")),
+    "endian": Str("Override of the protocol's byte order for this field.", choices=("little", "big")),
+    "size": OneOf((Int(), Str()), "bytes: a number, `rest` (up to the end of the content) or a field name"),
+    "count": OneOf((Int(), Str()), "array/group: a number, `rest`, or the name of an earlier count field"),
+    "of": Str("array: the item type."),
+    "fields": Any_("group: the fields of each item (a mapping, like request/response)."),
+    "table": Str("table_value/table_block, or bytes holding registers: name of an entry in `tables:`."),
+    "key": Str("table_value: the earlier field holding the table key (e.g. data_id)."),
+    "start": Str("bytes holding registers: the field (or request.<field>) with the first register's key."),
+    "select": MapOf(Any_(), "table_block: entry attributes an entry must have to be in the block, e.g. {access: rw}."),
+    "expect_size": Int("table_block: the block's size in bytes, asserted by the generator."),
+    "inferred": TEXT,
+}
+FIELD = OneOf((Str("A wire type or the name of an entry in `fields:`"), Obj(_FIELD_LONG)), "a type name or a mapping")
+FIELDS = MapOf(FIELD, "Fields in wire order: name -> type or mapping.")
+
+MESSAGE = Obj(
+    {
+        "description": TEXT,
+        "fields": FIELDS,
+        "optional": TEXT,
+        "unsolicited": Bool("Sent by the device on its own, not as an answer."),
+        "answers": Str("For a response: the request (command or command.subcommand) it answers, if another."),
+        "source": TEXT,
+    },
+    description="One direction of a command: its content fields and how it is sent.",
+)
+
+SUBCOMMAND = Obj(
+    {
+        "code": Int("Selector value."),
+        "title": TEXT,
+        "title_cn": Str(),
+        "description": TEXT,
+        "request": MESSAGE,
+        "response": MESSAGE,
+        "source": TEXT,
+    },
+    required=("code",),
+)
+
+COMMAND = Obj(
+    {
+        "code": Int("Value of the frame's command field; omit for the one response of a protocol whose replies "
+                    "carry no command field."),
+        "title": TEXT,
+        "title_cn": Str(),
+        "description": TEXT,
+        "request": MESSAGE,
+        "response": MESSAGE,
+        "broadcast": TEXT,
+        "source": TEXT,
+        "selector": Obj(
+            {
+                "type": Str(choices=SCALAR_TYPES),
+                "name": Str(),
+                "offset": MapOf(Int(), "Byte offset of the selector in the content, by direction."),
+            },
+            required=("offset",),
+            description="Where the sub-command selector sits in the content, by direction.",
+        ),
+        "subcommands": MapOf(SUBCOMMAND),
+    },
+)
+
+ENUM = Obj(
+    {
+        "type": Str(choices=SCALAR_TYPES),
+        "description": TEXT,
+        "values": MapOf(
+            OneOf((Int(), Obj({"value": Int(), "text": TEXT, "text_cn": Str()}, required=("value",))),
+                  "a number or {value, text}"),
+            "Label -> wire value.",
+        ),
+    },
+    required=("values",),
+)
+
+FLAGS = Obj(
+    {
+        "type": Str(choices=SCALAR_TYPES),
+        "description": TEXT,
+        "bits": MapOf(
+            OneOf((Int(), Obj({"bit": Int(), "text": TEXT}, required=("bit",))), "a bit number or {bit, text}"),
+            "Flag name -> bit number.",
+        ),
+    },
+    required=("bits",),
+)
+
+TABLE_ENTRY = Obj(
+    {
+        "key": Int("data_id or register address."),
+        "type": Str(choices=SCALAR_TYPES),
+        "name_cn": Str(),
+        "description": TEXT,
+        "unit": Str(),
+        "scale": Num(),
+        "range": RANGE,
+        "default": OneOf((Num(), Str()), "a number, or text when the document gives none"),
+        "access": Str(choices=("r", "rw")),
+        "memory": Str(choices=("eeprom", "sram")),
+        "enum": Str(),
+        "flags": Str(),
+        "encoding": Str(choices=("plain", "sign_magnitude")),
+        "reserved": Bool("A slot the document reserves: no name of its own."),
+        "source": TEXT,
+    },
+    required=("key", "type"),
+)
+
+TABLE = Obj(
+    {
+        "title": TEXT,
+        "key": Str("What the key is called on the wire (data_id, address)."),
+        "description": TEXT,
+        "source": TEXT,
+        "entries": MapOf(TABLE_ENTRY),
+    },
+    required=("key", "entries"),
+)
+
+FRAME_ELEMENT = Obj(
+    {
+        "role": Str(
+            "What the element is.",
+            choices=("header", "command", "length", "content", "checksum", "address", "status"),
+        ),
+        "type": Str(choices=SCALAR_TYPES),
+        "value": OneOf((Str(), MapOf(Str())), "header: hex bytes, or a mapping direction -> hex bytes"),
+        "directions": ListOf(Str(choices=("request", "response"))),
+        "adds": Int("length: what the length counts beyond the content (SMS: 2 = instruction + checksum)."),
+        "description": TEXT,
+        "range": RANGE,
+        "broadcast": Int("address: the broadcast value."),
+        "flags": Str("status: name of an entry in `flags:`."),
+        "covers": ListOf(Str(), "checksum: first and last element covered.", length=2),
+        "algorithm": Str(choices=("sum", "crc")),
+        "invert": Bool("sum: bitwise NOT of the sum."),
+        "crc": Obj(
+            {
+                "name": Str(),
+                "width": Int(),
+                "poly": Int(),
+                "init": Int(),
+                "refin": Bool(),
+                "refout": Bool(),
+                "xorout": Int(),
+                "check": Int("The catalogue check value: the CRC of b'123456789'."),
+            },
+            required=("width", "poly", "init", "refin", "refout", "xorout", "check"),
+        ),
+    },
+    required=("role",),
+)
+
+EXAMPLE = Obj(
+    {
+        "source": Str("Document and section the frame is printed in."),
+        "description": TEXT,
+        "direction": Str(choices=("request", "response")),
+        "printed": Str("The frame exactly as the document prints it."),
+        "frame": HEX_BYTES,
+        "erratum": Str("Name of the erratum that explains why `frame` differs from `printed`."),
+        "command": Str(),
+        "subcommand": Str(),
+        "request": Str("Name of the example whose request this example answers."),
+        "fields": MapOf(Any_(), "The field values the frame carries (raw wire values)."),
+    },
+    required=("source", "direction", "printed", "command", "fields"),
+)
+
+ERRATUM = Obj(
+    {
+        "source": Str("Document and section."),
+        "printed": Str("What the document says."),
+        "correct": Str("What is right, and why."),
+        "check": Obj(
+            {
+                "kind": Str(
+                    choices=("frame_fails", "frame_decodes_as", "checksum_value", "crc_parameters", "prose"),
+                ),
+                "frame": HEX_BYTES,
+                "direction": Str(choices=("request", "response")),
+                "error": Str("frame_fails: words the one-line decode error contains."),
+                "command": Str(),
+                "subcommand": Str(),
+                "fields": MapOf(Any_()),
+                "claimed": Any_("checksum_value: the claimed value; crc_parameters: the claimed parameters."),
+                "actual": Int(),
+                "examples": ListOf(Str(), "Examples whose frames the check runs over."),
+            },
+            required=("kind",),
+            description="How a test pins the right reading.",
+        ),
+    },
+    required=("source", "printed", "correct", "check"),
+)
+
+SPEC = Obj(
+    {
+        "protocol": Str("Python package name of the generated code."),
+        "title": TEXT,
+        "description": TEXT,
+        "sources": MapOf(Str(), "Document id -> what it is."),
+        "byte_order": Str(choices=("little", "big")),
+        "serial": Obj(
+            {
+                "baudrate": Int(),
+                "bytesize": Int(),
+                "parity": Str(choices=("none", "even", "odd")),
+                "stopbits": Num(),
+                "notes": TEXT,
+            },
+            required=("baudrate",),
+        ),
+        "framing": Obj({"elements": MapOf(FRAME_ELEMENT), "description": TEXT}, required=("elements",)),
+        "matching": Obj(
+            {"by": ListOf(Str()), "description": TEXT},
+            description="How a reply is matched to its request.",
+        ),
+        "fields": FIELDS,
+        "enums": MapOf(ENUM),
+        "flags": MapOf(FLAGS),
+        "tables": MapOf(TABLE),
+        "commands": MapOf(COMMAND),
+        "examples": MapOf(EXAMPLE),
+        "errata": MapOf(ERRATUM),
+    },
+    required=("protocol", "title", "byte_order", "serial", "framing", "commands"),
+    description="A serialspec protocol spec.",
+)
+
+
+def json_schema() -> dict[str, Any]:
+    schema = SPEC.json_schema()
+    schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
+    schema["title"] = "serialspec protocol spec"
+    return schema

@@ -1,0 +1,396 @@
+"""The immutable, fully resolved protocol model that every emitter reads.
+
+Everything an emitter needs is computed here once: sizes, offsets, the content length bounds a stream parser
+uses to reject stray headers, class names, and which fields are derived (counts, lengths) rather than given.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import StrEnum
+from typing import Literal
+
+
+class Direction(StrEnum):
+    REQUEST = "request"
+    RESPONSE = "response"
+
+
+@dataclass(frozen=True)
+class ScalarType:
+    name: str
+    size: int
+    struct_char: str
+    signed: bool
+    is_float: bool
+    minimum: float
+    maximum: float
+
+
+SCALARS: dict[str, ScalarType] = {
+    "u8": ScalarType("u8", 1, "B", False, False, 0, 0xFF),
+    "i8": ScalarType("i8", 1, "b", True, False, -0x80, 0x7F),
+    "u16": ScalarType("u16", 2, "H", False, False, 0, 0xFFFF),
+    "i16": ScalarType("i16", 2, "h", True, False, -0x8000, 0x7FFF),
+    "u32": ScalarType("u32", 4, "I", False, False, 0, 0xFFFFFFFF),
+    "i32": ScalarType("i32", 4, "i", True, False, -0x80000000, 0x7FFFFFFF),
+    "f32": ScalarType("f32", 4, "f", True, True, -3.4028234663852886e38, 3.4028234663852886e38),
+}
+
+
+@dataclass(frozen=True)
+class EnumValue:
+    name: str
+    value: int
+    text: str
+
+
+@dataclass(frozen=True)
+class EnumDef:
+    name: str
+    class_name: str
+    type: ScalarType
+    description: str
+    values: tuple[EnumValue, ...]
+
+
+@dataclass(frozen=True)
+class FlagBit:
+    name: str
+    bit: int
+    text: str
+
+
+@dataclass(frozen=True)
+class FlagsDef:
+    name: str
+    class_name: str
+    type: ScalarType
+    description: str
+    bits: tuple[FlagBit, ...]
+
+
+@dataclass(frozen=True)
+class BitField:
+    name: str
+    high: int
+    low: int
+    enum: EnumDef | None
+    description: str
+
+    @property
+    def mask(self) -> int:
+        return (1 << (self.high - self.low + 1)) - 1
+
+
+@dataclass(frozen=True)
+class Common:
+    """What every field kind carries."""
+
+    name: str
+    description: str
+    description_cn: str
+    inferred: str
+
+
+@dataclass(frozen=True)
+class Scalar(Common):
+    type: ScalarType
+    endian: Literal["<", ">"]
+    unit: str
+    scale: float | None
+    minimum: float
+    maximum: float
+    const: int | None
+    default: float | None
+    enum: EnumDef | None
+    flags: FlagsDef | None
+    bits: tuple[BitField, ...]
+    bits_class: str
+    sign_magnitude: bool
+    # Derived fields are computed on encode and checked on decode, never given by the user:
+    # ("count", group) is the number of items of a group; ("size", group, field) the size of bytes in each item.
+    derived: tuple[str, ...] = ()
+
+    @property
+    def hidden(self) -> bool:
+        """Not a member of the message: constant or derived."""
+        return self.const is not None or bool(self.derived)
+
+
+@dataclass(frozen=True)
+class Array(Common):
+    item: ScalarType
+    endian: Literal["<", ">"]
+    count: int
+    unit: str
+    minimum: float
+    maximum: float
+
+
+@dataclass(frozen=True)
+class Bytes(Common):
+    size: int | str  # a number, "rest", or the name of a field holding it
+    table: Table | None = None  # when the bytes are a run of registers of this table
+    start: str = ""  # the field (or request.<field>) holding the first register's key
+
+
+@dataclass(frozen=True)
+class Group(Common):
+    class_name: str
+    count: int | str  # a number, "rest", or the name of a count field
+    fields: tuple[Field, ...]
+    item_size: int | None  # None when an item holds bytes sized by another field
+
+
+@dataclass(frozen=True)
+class TableValue(Common):
+    table: Table
+    key: str
+
+
+@dataclass(frozen=True)
+class TableBlock(Common):
+    table: Table
+    class_name: str
+    entries: tuple[TableEntry, ...]
+    endian: Literal["<", ">"]
+
+
+Field = Scalar | Array | Bytes | Group | TableValue | TableBlock
+
+
+@dataclass(frozen=True)
+class TableEntry:
+    name: str
+    key: int
+    type: ScalarType
+    name_cn: str
+    description: str
+    unit: str
+    scale: float | None
+    minimum: float
+    maximum: float
+    default: float | str | None
+    access: str
+    memory: str
+    enum: EnumDef | None
+    flags: FlagsDef | None
+    sign_magnitude: bool
+    reserved: bool
+    source: str
+
+
+@dataclass(frozen=True)
+class Table:
+    name: str
+    title: str
+    key_name: str
+    description: str
+    source: str
+    entries: tuple[TableEntry, ...]
+
+    def entry(self, key: int) -> TableEntry | None:
+        for entry in self.entries:
+            if entry.key == key:
+                return entry
+        return None
+
+
+@dataclass(frozen=True)
+class Message:
+    """One direction of a command or sub-command."""
+
+    command: str
+    subcommand: str | None
+    direction: Direction
+    class_name: str
+    title: str
+    description: str
+    fields: tuple[Field, ...]  # content fields in wire order, selector included
+    optional: str
+    unsolicited: bool
+    answers: str
+    min_size: int  # content length bounds, for decoding and stream plausibility
+    max_size: int | None
+    source: str
+
+    @property
+    def key(self) -> str:
+        return f"{self.command}.{self.subcommand}" if self.subcommand else self.command
+
+
+@dataclass(frozen=True)
+class Selector:
+    name: str
+    type: ScalarType
+    offsets: dict[Direction, int]
+
+
+@dataclass(frozen=True)
+class Subcommand:
+    name: str
+    code: int
+    title: str
+    title_cn: str
+    description: str
+    request: Message | None
+    response: Message | None
+    source: str
+
+
+@dataclass(frozen=True)
+class Command:
+    name: str
+    code: int | None
+    title: str
+    title_cn: str
+    description: str
+    broadcast: str
+    source: str
+    request: Message | None
+    response: Message | None
+    selector: Selector | None
+    subcommands: tuple[Subcommand, ...]
+
+    def messages(self) -> tuple[Message, ...]:
+        found = [m for m in (self.request, self.response) if m]
+        for sub in self.subcommands:
+            found.extend(m for m in (sub.request, sub.response) if m)
+        return tuple(found)
+
+
+@dataclass(frozen=True)
+class Crc:
+    name: str
+    width: int
+    poly: int
+    init: int
+    refin: bool
+    refout: bool
+    xorout: int
+    check: int
+
+
+@dataclass(frozen=True)
+class Checksum:
+    algorithm: Literal["sum", "crc"]
+    invert: bool
+    crc: Crc | None
+    first: str  # first frame element covered
+    last: str  # last frame element covered
+    type: ScalarType
+
+
+@dataclass(frozen=True)
+class FrameElement:
+    name: str
+    role: str
+    type: ScalarType | None
+    size: int | None  # None for content
+    directions: tuple[Direction, ...]
+    description: str
+    minimum: float
+    maximum: float
+    broadcast: int | None
+    flags: FlagsDef | None
+
+
+@dataclass(frozen=True)
+class FrameLayout:
+    """The frame in one direction: elements in order with their byte offsets (content's at its start)."""
+
+    direction: Direction
+    header: bytes
+    elements: tuple[FrameElement, ...]
+    offsets: dict[str, int]
+    overhead: int  # frame size minus content size
+    length_offset: int
+    length_adds: int
+    command_offset: int | None
+    checksum_offset_from_end: int
+    covered_from: int  # first covered byte
+    covered_to_end: int  # bytes after the last covered byte
+    value_elements: tuple[FrameElement, ...]  # address/status: frame-level values every message carries
+
+
+@dataclass(frozen=True)
+class Framing:
+    description: str
+    layouts: dict[Direction, FrameLayout]
+    checksum: Checksum
+    shared_header: bool
+
+
+@dataclass(frozen=True)
+class Serial:
+    baudrate: int
+    bytesize: int
+    parity: str
+    stopbits: float
+    notes: str
+
+
+@dataclass(frozen=True)
+class Example:
+    name: str
+    source: str
+    description: str
+    direction: Direction
+    printed: str
+    frame: bytes
+    erratum: str
+    command: str
+    subcommand: str | None
+    request: str
+    fields: dict[str, object]
+
+
+@dataclass(frozen=True)
+class ErratumCheck:
+    kind: str
+    frame: bytes | None
+    frame_text: str
+    direction: Direction | None
+    error: str
+    command: str
+    subcommand: str | None
+    fields: dict[str, object]
+    claimed: object
+    actual: int | None
+    examples: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class Erratum:
+    name: str
+    source: str
+    printed: str
+    correct: str
+    check: ErratumCheck
+
+
+@dataclass(frozen=True)
+class Protocol:
+    name: str
+    title: str
+    description: str
+    spec_path: str
+    sources: dict[str, str]
+    byte_order: Literal["little", "big"]
+    serial: Serial
+    framing: Framing
+    matching: tuple[str, ...]
+    matching_description: str
+    enums: tuple[EnumDef, ...]
+    flags: tuple[FlagsDef, ...]
+    tables: tuple[Table, ...]
+    commands: tuple[Command, ...]
+    examples: tuple[Example, ...]
+    errata: tuple[Erratum, ...]
+
+    def messages(self) -> tuple[Message, ...]:
+        return tuple(m for c in self.commands for m in c.messages())
+
+    def command(self, name: str) -> Command:
+        return next(c for c in self.commands if c.name == name)

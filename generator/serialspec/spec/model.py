@@ -7,13 +7,10 @@ uses to reject stray headers, class names, and which fields are derived (counts,
 from __future__ import annotations
 
 from dataclasses import dataclass
-from enum import StrEnum
 from typing import Literal
 
+from serialspec.runtime.message import Direction
 
-class Direction(StrEnum):
-    REQUEST = "request"
-    RESPONSE = "response"
 
 
 @dataclass(frozen=True)

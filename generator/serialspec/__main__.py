@@ -1,0 +1,5 @@
+import sys
+
+from serialspec.cli import main
+
+sys.exit(main())

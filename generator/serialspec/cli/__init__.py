@@ -1,0 +1,38 @@
+"""The `serialspec` command: one module per verb, each with `add_arguments(parser)` and `run(args) -> int`."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Sequence
+
+from serialspec.cli import check, decode, encode, generate
+from serialspec.runtime.errors import SerialspecError
+from serialspec.spec.errors import SpecErrors
+
+VERBS = {"generate": generate, "check": check, "decode": decode, "encode": encode}
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="serialspec", description=__doc__.split(":")[0] if __doc__ else None)
+    verbs = parser.add_subparsers(dest="verb", required=True, metavar="VERB")
+    for name, module in VERBS.items():
+        sub = verbs.add_parser(name, help=module.HELP, description=module.HELP)
+        module.add_arguments(sub)
+        sub.set_defaults(run=module.run)
+    args = parser.parse_args(argv)
+    try:
+        code: int = args.run(args)
+    except SpecErrors as exc:
+        print(exc, file=sys.stderr)
+        return 1
+    except SerialspecError as exc:
+        print(f"serialspec {args.verb}: {exc}", file=sys.stderr)
+        return 1
+    except BrokenPipeError:
+        return 0
+    return code
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,27 @@
+"""serialspec generate: regenerate generated/ (packages and docs) and the JSON Schema from specs/."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from serialspec.cli.project import expected_files, find_root
+
+HELP = "regenerate generated/ and specs/serialspec.schema.json from specs/*.yaml"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--root", type=Path, help="project root (default: the nearest folder holding specs/)")
+
+
+def run(args: argparse.Namespace) -> int:
+    root = args.root or find_root()
+    files = expected_files(root)
+    written = 0
+    for path, text in files.items():
+        if not path.exists() or path.read_text(encoding="utf-8") != text:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_text(text, encoding="utf-8")
+            written += 1
+    print(f"{len(files)} files generated, {written} changed")
+    return 0

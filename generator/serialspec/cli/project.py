@@ -1,0 +1,40 @@
+"""Where a project's specs and generated files live, and what generating them produces."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from serialspec.emit.docs import emit_docs
+from serialspec.emit.package import emit_package
+from serialspec.spec import SpecErrors, load_protocol
+from serialspec.spec.grammar import json_schema
+
+SCHEMA_NAME = "serialspec.schema.json"
+
+
+def find_root(start: Path | None = None) -> Path:
+    """The nearest folder holding specs/ (the project root), from the working directory up."""
+    here = (start or Path.cwd()).resolve()
+    for folder in (here, *here.parents):
+        if (folder / "specs").is_dir():
+            return folder
+    return here
+
+
+def expected_files(root: Path) -> dict[Path, str]:
+    """Every generated file, by path, from the specs under root; raises SpecErrors listing all spec mistakes."""
+    files: dict[Path, str] = {root / "specs" / SCHEMA_NAME: json.dumps(json_schema(), indent=2, ensure_ascii=False) + "\n"}
+    errors = []
+    for spec in sorted((root / "specs").glob("*.yaml")):
+        try:
+            protocol = load_protocol(str(spec), str(spec.relative_to(root)))
+        except SpecErrors as exc:
+            errors.extend(exc.errors)
+            continue
+        for name, text in emit_package(protocol).items():
+            files[root / "generated" / protocol.name / name] = text
+        files[root / "generated" / "docs" / f"{protocol.name}.md"] = emit_docs(protocol)
+    if errors:
+        raise SpecErrors(errors)
+    return files

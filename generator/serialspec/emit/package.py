@@ -1,0 +1,201 @@
+"""Emit one protocol's Python package: messages, codec, construct structs and the package's __init__."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from serialspec.emit.pycode import ClassCode, PackageCode, decoder_name, encoder_name, frame_lines, number, one_line
+from serialspec.emit.render import render
+from serialspec.emit.structs import structs_module
+from serialspec.spec.model import Command, Direction, Message, Protocol, Scalar, Table, TableValue
+
+
+def class_context(cls: ClassCode, where: str, keys: list[str], optional: list[str]) -> dict[str, Any]:
+    return {
+        "name": cls.name,
+        "doc": cls.doc,
+        "base": cls.base,
+        "attributes": cls.attributes,
+        "class_vars": cls.class_vars,
+        "to_fields": cls.to_fields,
+        "from_fields": cls.from_fields,
+        "where": where,
+        "keys": repr(tuple(keys)),
+        "optional_keys": repr(tuple(optional)),
+    }
+
+
+def _keys(cls: ClassCode) -> list[str]:
+    return [line.split(":")[0] for line in cls.attributes if not line.startswith("#")]
+
+
+def emit_package(protocol: Protocol) -> dict[str, str]:
+    """File name (relative to the package folder) -> text."""
+    code = PackageCode(protocol)
+    base = {"spec_path": protocol.spec_path, "title": one_line(protocol.title), "package": protocol.name}
+    messages = {m.class_name: m for m in protocol.messages()}
+    classes = []
+    for cls in [*code.helper_classes, *code.message_classes]:
+        message = messages.get(cls.name)
+        optional = [f.name for f in message.fields if isinstance(f, Scalar) and f.hidden] if message else []
+        where = f"{message.key} {message.direction.value}" if message else cls.name
+        if message:
+            cls.doc = one_line(message_doc(protocol, message))
+        classes.append(class_context(cls, where, _keys(cls), optional))
+    enums = [{"class_name": e.class_name, "doc": one_line(e.description or e.name.replace("_", " ")),
+              "values": [{"name": v.name, "value": v.value, "text": one_line(v.text)} for v in e.values]}
+             for e in protocol.enums]
+    flag_sets = [{"class_name": f.class_name, "doc": one_line(f.description or f.name.replace("_", " ")),
+                  "bits": [{"name": b.name, "bit": b.bit, "text": one_line(b.text)} for b in f.bits]}
+                 for f in protocol.flags]
+    exports = sorted([*(e["class_name"] for e in enums), *(f["class_name"] for f in flag_sets),
+                      *(c["name"] for c in classes), "MESSAGE_TYPES", "Direction", "Message"])
+    files = {
+        "messages.py": render("messages.py.j2", **base, enums=enums, flag_sets=flag_sets, classes=classes,
+                              message_classes=[c for c in classes if c["name"] in messages], exports=exports),
+        "codec.py": render("codec.py.j2", **base, **codec_context(protocol, code, exports)),
+        "structs.py": structs_module(protocol),
+        "__init__.py": render("init.py.j2", **base, description=one_line(protocol.description),
+                              baudrate=protocol.serial.baudrate),
+        "py.typed": "",
+    }
+    return files
+
+
+def message_doc(protocol: Protocol, message: Message) -> str:
+    command = protocol.command(message.command)
+    sub = next((s for s in command.subcommands if s.name == message.subcommand), None)
+    title = (sub.title if sub else command.title) or message.key
+    parts = [f"{title} ({message.direction.value})."]
+    if message.description:
+        parts.append(message.description)
+    if message.optional:
+        parts.append(f"Optional: {message.optional}")
+    if message.unsolicited:
+        parts.append("Sent by the device on its own.")
+    return " ".join(parts)
+
+
+def codec_context(protocol: Protocol, code: PackageCode, exports: list[str]) -> dict[str, Any]:
+    checksum = protocol.framing.checksum
+    if checksum.algorithm == "crc":
+        assert checksum.crc is not None
+        c = checksum.crc
+        checksum_import = "crc_function"
+        checksum_expr = (f"crc_function({c.width}, {c.poly:#x}, {c.init:#x}, {c.refin}, {c.refout}, {c.xorout:#x})"
+                         f"  # {one_line(c.name)}")
+    else:
+        checksum_import = "sum_function"
+        checksum_expr = f"sum_function({checksum.type.size * 8}, invert={checksum.invert})"
+    framers = []
+    directions = []
+    dispatchers = []
+    for direction, layout in protocol.framing.layouts.items():
+        params, lines = frame_lines(protocol, layout)
+        typed = ", ".join(f"{p}: bytes" if p == "content" else f"{p}: int" for p in params)
+        framers.append({"name": f"_frame_{direction.value}", "params": typed, "lines": lines})
+        dispatch = []
+        sizes = []
+        for command in protocol.commands:
+            entry = direction_entry(command, direction)
+            if entry is None:
+                continue
+            target, low, high, sub_dispatch = entry
+            key = "None" if command.code is None else f"{command.code:#04x}"
+            dispatch.append((key, target))
+            sizes.append((key, low, high))
+            if sub_dispatch:
+                dispatchers.append(sub_dispatch | {"extra": "".join(f", {e.name}: int" for e in layout.value_elements),
+                                                   "args": "".join(f", {e.name}" for e in layout.value_elements)})
+        trim = layout.covered_to_end
+        directions.append({
+            "name": direction.value,
+            "upper": direction.name,
+            "header": repr(layout.header),
+            "header_hex": layout.header.hex(" "),
+            "header_size": len(layout.header),
+            "overhead": layout.overhead,
+            "length_offset": layout.length_offset,
+            "length_adds": layout.length_adds,
+            "command_offset": layout.command_offset,
+            "code_expr": f"data[{layout.command_offset}]" if layout.command_offset is not None else "None",
+            "unknown_message": (f"f\"unknown command {{data[{layout.command_offset}]:#04x}}\""
+                                if layout.command_offset is not None else f"\"no {direction.value} is defined\""),
+            "covered_from": layout.covered_from,
+            "covered_end": f"-{trim}" if trim else "",
+            "checksum_size": layout.checksum_offset_from_end,
+            "content_offset": layout.offsets[next(e.name for e in layout.elements if e.role == "content")],
+            "after_content": layout.overhead - layout.offsets[next(e.name for e in layout.elements
+                                                                   if e.role == "content")],
+            "value_args": "".join(f", data[{layout.offsets[e.name]}]" for e in layout.value_elements),
+            "dispatch": dispatch,
+            "sizes": sizes,
+        })
+    layouts = protocol.framing.layouts
+    header_choices = " or ".join(layouts[d].header.hex(" ") for d in Direction)
+    encoder_table = [(m.class_name, encoder_name(m)) for m in protocol.messages()]
+    return {
+        "checksum_import": checksum_import,
+        "checksum_expr": checksum_expr,
+        "structs": sorted(code.structs.items()),
+        "tables": [table_context(t) for t in protocol.tables if any(uses_table(m, t.name) for m in protocol.messages())],
+        "framers": framers,
+        "decoders": [{"name": n, "returns": r, "extra": e, "lines": lines} for n, r, e, lines in code.decoders],
+        "encoders": [{"name": n, "type": t, "lines": lines} for n, t, lines in code.encoders],
+        "directions": directions,
+        "dispatchers": dispatchers,
+        "encoder_table": encoder_table,
+        "imports": sorted(n for n in exports if n not in ("Direction", "Message", "MESSAGE_TYPES")
+                          and used_in_codec(n, code)),
+        "shared_header": protocol.framing.shared_header,
+        "header_choices": header_choices,
+    }
+
+
+def used_in_codec(name: str, code: PackageCode) -> bool:
+    bodies = [line for _, _, _, lines in code.decoders for line in lines]
+    bodies += [line for _, _, lines in code.encoders for line in lines]
+    types = {r for _, r, _, _ in code.decoders} | {t for _, t, _ in code.encoders}
+    return name in types or any(name in line for line in bodies)
+
+
+def uses_table(message: Message, table: str) -> bool:
+    return any(isinstance(f, TableValue) and f.table.name == table for f in message.fields)
+
+
+def table_context(table: Table) -> dict[str, Any]:
+    entries = [e for e in table.entries if not e.reserved]
+    return {
+        "upper": table.name.upper(),
+        "structs": [(e.key, "<" + e.type.struct_char) for e in entries],
+        "ranges": [(e.key, number(e.minimum), number(e.maximum)) for e in entries],
+    }
+
+
+def direction_entry(command: Command, direction: Direction) -> tuple[str, int, int | None, dict[str, Any]] | None:
+    """The decoder a command code dispatches to in one direction, the content size bounds, any sub-dispatch."""
+    if command.selector is None:
+        message = command.request if direction == Direction.REQUEST else command.response
+        if message is None:
+            return None
+        return decoder_name(message), message.min_size, message.max_size, {}
+    messages = [m for s in command.subcommands
+                if (m := s.request if direction == Direction.REQUEST else s.response) is not None]
+    if not messages:
+        return None
+    low = min(m.min_size for m in messages)
+    high = None if any(m.max_size is None for m in messages) else max(m.max_size or 0 for m in messages)
+    name = f"_decode_{command.name}_{direction.value}"
+    table = f"_{command.name.upper()}_{direction.name}_SUBCOMMANDS"
+    entries = [(f"{s.code:#04x}", decoder_name(m)) for s in command.subcommands
+               if (m := s.request if direction == Direction.REQUEST else s.response) is not None]
+    sub = {"name": name, "offset": command.selector.offsets[direction], "table": table, "entries": entries,
+           "where": f"{command.name} {direction.value}"}
+    return name, low, high, sub
+
+
+def write_files(root: Path, files: dict[str, str]) -> None:
+    root.mkdir(parents=True, exist_ok=True)
+    for name, text in files.items():
+        (root / name).write_text(text, encoding="utf-8")

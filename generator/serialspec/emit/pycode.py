@@ -1,0 +1,620 @@
+"""Python source fragments computed from the model, which the package templates lay out.
+
+The decisions live here (how each field kind is read, written, range-checked and turned into JSON); the templates
+only place the fragments into modules. Every fragment is built from names the resolver has checked to be
+identifiers, and every piece of spec text reaches generated code through repr(), so no spec text can inject code.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from serialspec.spec.model import (
+    Array,
+    Bytes,
+    Direction,
+    FrameLayout,
+    Group,
+    Message,
+    Protocol,
+    Scalar,
+    TableBlock,
+    TableValue,
+)
+from serialspec.spec.model import Field as SpecField
+from serialspec.spec.resolve import fixed_size
+
+Lines = list[str]
+
+
+def decoder_name(message: Message) -> str:
+    return f"_decode_{message.key.replace('.', '_')}_{message.direction.value}"
+
+
+def encoder_name(message: Message) -> str:
+    return f"_encode_{message.key.replace('.', '_')}_{message.direction.value}"
+
+
+def one_line(text: str) -> str:
+    """Spec text made safe for a comment or docstring: one line, no backslashes or quotes that could close it."""
+    return " ".join(text.split()).replace("\\", "\\\\").replace('"', "'")
+
+
+def number(value: float) -> str:
+    return repr(int(value)) if float(value).is_integer() else repr(value)
+
+
+def struct_format(endian: str, fields: list[SpecField]) -> str:
+    """The struct format of a run of fixed-size fields."""
+    chars = []
+    for f in fields:
+        if isinstance(f, Scalar):
+            chars.append(f.type.struct_char)
+        elif isinstance(f, Array):
+            chars.append(f"{f.count}{f.item.struct_char}")
+        elif isinstance(f, Bytes):
+            chars.append(f"{f.size}s")
+        elif isinstance(f, TableBlock):
+            chars.extend(e.type.struct_char for e in f.entries)
+        elif isinstance(f, Group):
+            chars.extend(struct_format("", list(f.fields)) * int(f.count))  # type: ignore[call-overload]
+    return endian + "".join(chars)
+
+
+def is_fixed_run_member(f: SpecField) -> bool:
+    return isinstance(f, Scalar | Array | TableBlock) or (isinstance(f, Bytes) and isinstance(f.size, int))
+
+
+def annotation(f: SpecField) -> str:
+    if isinstance(f, Scalar):
+        if f.bits:
+            return f.bits_class
+        if f.enum:
+            return f"{f.enum.class_name} | int"
+        if f.flags:
+            return f.flags.class_name
+        return "float" if f.type.is_float else "int"
+    if isinstance(f, Array):
+        return "tuple[float, ...]" if f.item.is_float else "tuple[int, ...]"
+    if isinstance(f, Bytes):
+        return "bytes"
+    if isinstance(f, Group):
+        return f"tuple[{f.class_name}, ...]"
+    if isinstance(f, TableValue):
+        return "int | float"
+    return f.class_name
+
+
+def doc_line(f: SpecField) -> str:
+    parts = [f.description or f.name]
+    if isinstance(f, Scalar | Array) and f.unit:
+        parts.append(f"[{f.unit}]")
+    if isinstance(f, Scalar) and not f.bits and (f.minimum, f.maximum) != (f.type.minimum, f.type.maximum):
+        parts.append(f"range {number(f.minimum)}..{number(f.maximum)}")
+    if f.inferred:
+        parts.append("(layout inferred, not documented)")
+    return one_line(" ".join(parts))
+
+
+@dataclass
+class ClassCode:
+    """A generated dataclass: its name, docstring, attribute lines, to_fields and from_fields bodies."""
+
+    name: str
+    doc: str
+    base: str
+    attributes: Lines
+    class_vars: Lines = field(default_factory=list)
+    to_fields: Lines = field(default_factory=list)
+    from_fields: Lines = field(default_factory=list)
+
+
+class PackageCode:
+    """Every fragment of one protocol's generated package."""
+
+    def __init__(self, protocol: Protocol) -> None:
+        self.protocol = protocol
+        self.structs: dict[str, str] = {}  # constant name -> format
+        self.helper_classes: list[ClassCode] = []
+        self.message_classes: list[ClassCode] = []
+        self.decoders: list[tuple[str, str, str, Lines]] = []  # name, return type, extra parameters, body
+        self.encoders: list[tuple[str, str, Lines]] = []  # name, parameter type, body
+        self._seen_classes: set[str] = set()
+        for message in protocol.messages():
+            self.message(message)
+
+    # --- structs --------------------------------------------------------------------------------------------------
+
+    def struct(self, base_name: str, fmt: str) -> str:
+        for name, existing in self.structs.items():
+            if existing == fmt:
+                return name
+        name = f"_S_{base_name.upper()}"
+        suffix = 2
+        while name in self.structs:
+            name = f"_S_{base_name.upper()}_{suffix}"
+            suffix += 1
+        self.structs[name] = fmt
+        return name
+
+    # --- classes --------------------------------------------------------------------------------------------------
+
+    def value_fields(self, message: Message) -> list[SpecField]:
+        return [f for f in message.fields if not (isinstance(f, Scalar) and f.hidden)]
+
+    def frame_values(self, direction: Direction) -> list[Scalar]:
+        """Frame-level values (SMS id, error) every message of a direction carries, as scalar fields."""
+        layout = self.protocol.framing.layouts[direction]
+        values = []
+        for element in layout.value_elements:
+            assert element.type is not None
+            values.append(
+                Scalar(element.name, element.description, "", "", element.type, "<", "", None,
+                       element.minimum, element.maximum, None, None, None, element.flags, (), "", False)
+            )
+        return values
+
+    def attribute_lines(self, fields: list[SpecField], defaults: bool = True) -> Lines:
+        lines = []
+        # Defaults only on a trailing run of fields that all have one: dataclasses stay positional.
+        trailing_defaults: set[str] = set()
+        for f in reversed(fields):
+            if defaults and isinstance(f, Scalar) and f.default is not None and not f.enum and not f.bits:
+                trailing_defaults.add(f.name)
+            else:
+                break
+        for f in fields:
+            default = f" = {number(f.default)}" if isinstance(f, Scalar) and f.name in trailing_defaults else ""
+            assert default == "" or isinstance(f, Scalar) and f.default is not None
+            lines.append(f"{f.name}: {annotation(f)}{default}")
+            lines.append(f"#: {doc_line(f)}")
+        return lines
+
+    def helper(self, f: SpecField) -> None:
+        """Dataclasses for the nested values of a field: bit fields, group items, table blocks."""
+        if isinstance(f, Scalar) and f.bits and f.bits_class not in self._seen_classes:
+            self._seen_classes.add(f.bits_class)
+            attributes = []
+            for bit in f.bits:
+                kind = f"{bit.enum.class_name} | int" if bit.enum else "int"
+                where = f"bit {bit.low}" if bit.high == bit.low else f"bits {bit.high}..{bit.low}"
+                attributes += [f"{bit.name}: {kind}", f"#: {one_line(bit.description or bit.name)} ({where})"]
+            code = ClassCode(f.bits_class, f"Bit fields of {f.name}.", "", attributes)
+            code.to_fields = [f"{b.name!r}: int(self.{b.name})," for b in f.bits]
+            code.from_fields = [self.from_value_expr_bits(b.name, b.enum.class_name if b.enum else None) for b in f.bits]
+            self.helper_classes.append(code)
+        elif isinstance(f, Group) and f.class_name not in self._seen_classes:
+            self._seen_classes.add(f.class_name)
+            for inner in f.fields:
+                self.helper(inner)
+            inner_fields = [i for i in f.fields if not (isinstance(i, Scalar) and i.hidden)]
+            code = ClassCode(f.class_name, f"One item of {f.name}.", "", self.attribute_lines(inner_fields, False))
+            code.to_fields = [f"{i.name!r}: {self.to_json(i, 'self.' + i.name)}," for i in inner_fields]
+            code.from_fields = [f"{self.from_json(i)}," for i in inner_fields]
+            self.helper_classes.append(code)
+        elif isinstance(f, TableBlock) and f.class_name not in self._seen_classes:
+            self._seen_classes.add(f.class_name)
+            attributes = []
+            for e in f.entries:
+                kind = f"{e.enum.class_name} | int" if e.enum else ("float" if e.type.is_float else "int")
+                unit = f" [{e.unit}]" if e.unit else ""
+                attributes += [f"{e.name}: {kind}", f"#: {one_line(f'{f.table.key_name} {e.key}: {e.description or e.name}{unit}')}"]
+            code = ClassCode(f.class_name, one_line(f"{f.description or f.name} ({f.table.title})."), "", attributes)
+            code.to_fields = [f"{e.name!r}: {'int(self.' + e.name + ')' if e.enum else 'self.' + e.name}," for e in f.entries]
+            code.from_fields = [
+                f"_enum({e.enum.class_name}, _get(data, {e.name!r}, where))," if e.enum else f"_get(data, {e.name!r}, where),"
+                for e in f.entries
+            ]
+            self.helper_classes.append(code)
+
+    def from_value_expr_bits(self, name: str, enum: str | None) -> str:
+        return f"_enum({enum}, _get(data, {name!r}, where))," if enum else f"_get(data, {name!r}, where),"
+
+    def to_json(self, f: SpecField, expr: str) -> str:
+        if isinstance(f, Scalar):
+            if f.bits:
+                return f"{expr}.to_fields()"
+            return f"int({expr})" if (f.enum or f.flags) else expr
+        if isinstance(f, Array):
+            return f"list({expr})"
+        if isinstance(f, Bytes):
+            return f"{expr}.hex(' ')"
+        if isinstance(f, Group):
+            return f"[item.to_fields() for item in {expr}]"
+        if isinstance(f, TableBlock):
+            return f"{expr}.to_fields()"
+        return expr
+
+    def from_json(self, f: SpecField) -> str:
+        get = f"_get(data, {f.name!r}, where)"
+        if isinstance(f, Scalar):
+            if f.bits:
+                return f"{f.bits_class}.from_fields(_mapping({get}, {f.name!r}, where), where)"
+            if f.enum:
+                return f"_enum({f.enum.class_name}, {get})"
+            if f.flags:
+                return f"{f.flags.class_name}({get})"
+            if f.default is not None:
+                return f"data.get({f.name!r}, {number(f.default)})"
+            return get
+        if isinstance(f, Array):
+            return f"tuple({get})"
+        if isinstance(f, Bytes):
+            return f"_bytes({get}, {f.name!r}, where)"
+        if isinstance(f, Group):
+            return (f"tuple({f.class_name}.from_fields(_mapping(item, {f.name!r}, where), where) "
+                    f"for item in {get})")
+        if isinstance(f, TableBlock):
+            return f"{f.class_name}.from_fields(_mapping({get}, {f.name!r}, where), where)"
+        return get
+
+    def message(self, message: Message) -> None:
+        for f in message.fields:
+            self.helper(f)
+        fields = [*self.frame_values(message.direction), *self.value_fields(message)]
+        title = message.title or message.key.replace("_", " ")
+        doc = f"{message.command} {message.subcommand or ''} {message.direction.value}".replace("  ", " ")
+        code = ClassCode(message.class_name, doc, "Message", self.attribute_lines(fields))
+        code.class_vars = [
+            f"PROTOCOL: ClassVar[str] = {self.protocol.name!r}",
+            f"COMMAND: ClassVar[str] = {message.command!r}",
+            f"SUBCOMMAND: ClassVar[str | None] = {message.subcommand!r}",
+            f"DIRECTION: ClassVar[Direction] = Direction.{message.direction.name}",
+        ]
+        del title
+        code.to_fields = [f"{f.name!r}: {self.to_json(f, 'self.' + f.name)}," for f in fields]
+        code.from_fields = [f"{self.from_json(f)}," for f in fields]
+        self.message_classes.append(code)
+        frame_names = [f.name for f in self.frame_values(message.direction)]
+        extra = "".join(f", {name}: int" for name in frame_names)
+        self.decoders.append((decoder_name(message), message.class_name, extra, self.decoder(message, fields)))
+        self.encoders.append((encoder_name(message), message.class_name, self.encoder(message, fields)))
+
+    # --- decoding -------------------------------------------------------------------------------------------------
+
+    def where(self, message: Message) -> str:
+        return repr(f"{message.key} {message.direction.value}")
+
+    def decoder(self, message: Message, all_fields: list[SpecField]) -> Lines:
+        """Body of `_decode_X(buf, o, end, *frame_values)`: content bytes buf[o:end] -> message."""
+        lines: Lines = []
+        where = self.where(message)
+        low, high = message.min_size, message.max_size
+        if low == high:
+            lines.append(f"if end - o != {low}:")
+        elif high is None:
+            lines.append(f"if end - o < {low}:")
+        else:
+            lines.append(f"if not {low} <= end - o <= {high}:")
+        lines.append(f"    raise content_size_error({where}, end - o, {low}, {high})")
+        values = self.decode_fields(list(message.fields), message.class_name, lines, where, top=True)
+        frame_fields = all_fields[: len(all_fields) - len(self.value_fields(message))]
+        frame_values = [f"{f.flags.class_name}({f.name})" if isinstance(f, Scalar) and f.flags else f.name
+                        for f in frame_fields]
+        args = ", ".join([*frame_values, *values])
+        lines.append(f"return {message.class_name}({args})")
+        return lines
+
+    def decode_fields(self, fields: list[SpecField], base: str, lines: Lines, where: str, top: bool) -> list[str]:
+        """Append lines reading fields at cursor `o`; return the expressions of the non-hidden values."""
+        values: list[str] = []
+        index = 0
+        while index < len(fields):
+            run: list[SpecField] = []
+            while index < len(fields) and is_fixed_run_member(fields[index]):
+                run.append(fields[index])
+                index += 1
+            if run:
+                values += self.decode_run(run, base, lines, where)
+                continue
+            f = fields[index]
+            index += 1
+            values.append(self.decode_variable(f, fields, base, lines, where))
+        if top:
+            lines.append("if o != end:")
+            lines.append(f"    raise DecodeError({where} + f': {{end - o}} bytes left after the last field')")
+        return values
+
+    def decode_run(self, run: list[SpecField], base: str, lines: Lines, where: str) -> list[str]:
+        endian = next((f.endian for f in run if isinstance(f, Scalar | Array | TableBlock)), "<")
+        fmt = struct_format(endian, run)
+        const_name = self.struct(f"{base}_{run[0].name}", fmt)
+        size = sum(fixed_size(f) or 0 for f in run)
+        simple = all(isinstance(f, Scalar) or isinstance(f, Bytes) for f in run)
+        values: list[str] = []
+        if simple:
+            names = [self.local(f) for f in run]
+            target = ", ".join(names) + ("," if len(names) == 1 else "")
+            lines.append(f"{target} = {const_name}.unpack_from(buf, o)")
+            for f, name in zip(run, names, strict=True):
+                expr = self.after_unpack(f, name, lines, where)
+                if expr is not None:
+                    values.append(expr)
+        else:
+            lines.append(f"t = {const_name}.unpack_from(buf, o)")
+            position = 0
+            for f in run:
+                if isinstance(f, Array):
+                    values.append(f"t[{position}:{position + f.count}]")
+                    position += f.count
+                elif isinstance(f, TableBlock):
+                    items = []
+                    for e in f.entries:
+                        item = f"t[{position}]"
+                        items.append(f"_enum({e.enum.class_name}, {item})" if e.enum else item)
+                        position += 1
+                    values.append(f"{f.class_name}({', '.join(items)})")
+                else:
+                    name = self.local(f)
+                    lines.append(f"{name} = t[{position}]")
+                    position += 1
+                    expr = self.after_unpack(f, name, lines, where)
+                    if expr is not None:
+                        values.append(expr)
+        lines.append(f"o += {size}")
+        return values
+
+    @staticmethod
+    def local(f: SpecField) -> str:
+        return f"v_{f.name}"
+
+    def after_unpack(self, f: SpecField, name: str, lines: Lines, where: str) -> str | None:
+        """Checks and conversions after a scalar is unpacked; the value expression, or None if hidden."""
+        if not isinstance(f, Scalar):
+            return name
+        if f.const is not None:
+            lines.append(f"if {name} != {f.const}:")
+            lines.append(f"    raise DecodeError({where} + f': {f.name} is {{{name}:#x}}, expected {f.const:#x}')")
+            return None
+        if f.derived:
+            return None
+        if f.sign_magnitude:
+            top = 1 << (f.type.size * 8 - 1)
+            lines.append(f"if {name} & {top:#x}:")
+            lines.append(f"    {name} = -({name} & {top - 1:#x})")
+        if f.bits:
+            used = 0
+            parts = []
+            for bit in f.bits:
+                used |= bit.mask << bit.low
+                raw = f"({name} >> {bit.low}) & {bit.mask:#x}" if bit.low else f"{name} & {bit.mask:#x}"
+                parts.append(f"_enum({bit.enum.class_name}, {raw})" if bit.enum else raw)
+            unused = ((1 << (f.type.size * 8)) - 1) & ~used
+            if unused:
+                lines.append(f"if {name} & {unused:#x}:")
+                lines.append(f"    raise DecodeError({where} + f': unused bits of {f.name} are set ({{{name}:#04x}})')")
+            return f"{f.bits_class}({', '.join(parts)})"
+        if f.enum:
+            return f"_enum({f.enum.class_name}, {name})"
+        if f.flags:
+            return f"{f.flags.class_name}({name})"
+        return name
+
+    def decode_variable(self, f: SpecField, siblings: list[SpecField], base: str, lines: Lines, where: str) -> str:
+        if isinstance(f, Bytes):
+            if f.size == "rest":
+                lines.append(f"{self.local(f)} = buf[o:end]")
+                lines.append("o = end")
+            else:
+                size = self.local_named(str(f.size))
+                lines.append(f"if end - o < {size}:")
+                lines.append(f"    raise DecodeError({where} + f': {f.name} needs {{{size}}} bytes, {{end - o}} left')")
+                lines.append(f"{self.local(f)} = buf[o : o + {size}]")
+                lines.append(f"o += {size}")
+            return self.local(f)
+        if isinstance(f, TableValue):
+            table = f"_TABLE_{f.table.name.upper()}"
+            key = self.local_named(f.key)
+            lines.append(f"s = {table}.get({key})")
+            lines.append("if s is None:")
+            lines.append(f"    raise DecodeError({where} + f': unknown {f.table.key_name} {{{key}}}')")
+            lines.append("if end - o < s.size:")
+            lines.append(f"    raise DecodeError({where} + f': {f.name} needs {{s.size}} bytes for {f.table.key_name} {{{key}}}')")
+            lines.append(f"({self.local(f)},) = s.unpack_from(buf, o)")
+            lines.append("o += s.size")
+            return self.local(f)
+        assert isinstance(f, Group)
+        item_fields = list(f.fields)
+        value = self.local(f)
+        if f.item_size is not None:
+            item_fmt = struct_format(self.protocol_endian(), item_fields)
+            item_struct = self.struct(f"{f.class_name}", item_fmt)
+            if f.count == "rest":
+                lines.append(f"if (end - o) % {f.item_size}:")
+                lines.append(f"    raise DecodeError({where} + f': {{end - o}} bytes do not split into {f.name} items of {f.item_size}')")
+                lines.append("n = end - o")
+            else:
+                count = str(f.count) if isinstance(f.count, int) else self.local_named(f.count)
+                lines.append(f"n = {count} * {f.item_size}")
+                lines.append("if end - o < n:")
+                lines.append(f"    raise DecodeError({where} + f': content too short for its count ({{{count}}} {f.name})')")
+            names = [self.local(i) for i in item_fields]
+            item_lines: Lines = []
+            item_values = [self.after_unpack(i, n, item_lines, where) for i, n in zip(item_fields, names, strict=True)]
+            if item_lines:  # an item needs checks: decode it in a loop
+                lines.append(f"{value}_list = []")
+                lines.append(f"for {', '.join(names)}{',' if len(names) == 1 else ''} in {item_struct}.iter_unpack(buf[o : o + n]):")
+                lines.extend("    " + line for line in item_lines)
+                args = ", ".join(v for v in item_values if v is not None)
+                lines.append(f"    {value}_list.append({f.class_name}({args}))")
+                lines.append(f"{value} = tuple({value}_list)")
+            else:
+                target = ", ".join(names) + ("," if len(names) == 1 else "")
+                args = ", ".join(v for v in item_values if v is not None)
+                lines.append(f"{value} = tuple({f.class_name}({args}) for {target} in {item_struct}.iter_unpack(buf[o : o + n]))")
+            lines.append("o += n")
+            return value
+        # items of varying size: read them one by one
+        lines.append(f"{value}_list = []")
+        if f.count == "rest":
+            lines.append("while o < end:")
+        else:
+            count = str(f.count) if isinstance(f.count, int) else self.local_named(f.count)
+            lines.append(f"for _ in range({count}):")
+        inner: Lines = []
+        item_values = self.decode_fields(item_fields, f.class_name, inner, where, top=False)
+        lines.extend("    " + line for line in inner)
+        lines.append(f"    {value}_list.append({f.class_name}({', '.join(item_values)}))")
+        lines.append(f"{value} = tuple({value}_list)")
+        return value
+
+    def local_named(self, name: str) -> str:
+        return f"v_{name}"
+
+    def protocol_endian(self) -> str:
+        return ">" if self.protocol.byte_order == "big" else "<"
+
+    # --- encoding -------------------------------------------------------------------------------------------------
+
+    def encoder(self, message: Message, all_fields: list[SpecField]) -> Lines:
+        """Body of `_encode_X(m) -> bytes`: range checks, then the content bytes."""
+        lines: Lines = []
+        where = self.where(message)
+        frame_fields = all_fields[: len(all_fields) - len(self.value_fields(message))]
+        for f in frame_fields:
+            assert isinstance(f, Scalar)
+            self.check_scalar(f, f"m.{f.name}", lines, where)
+        parts = self.encode_fields(list(message.fields), message.class_name, "m", lines, where)
+        content = parts[0] if len(parts) == 1 else f"b''.join(({', '.join(parts)},))"
+        if not parts:
+            content = "b''"
+        code = self.protocol.command(message.command).code
+        values = "".join(f"m.{f.name}, " for f in frame_fields)
+        lines.append(f"return _frame_{message.direction.value}({code if code is not None else 0}, {values}{content})")
+        return lines
+
+    def check_scalar(self, f: Scalar, expr: str, lines: Lines, where: str) -> None:
+        lines.append(f"if not {number(f.minimum)} <= {expr} <= {number(f.maximum)}:")
+        lines.append(f"    raise out_of_range({where}, {f.name!r}, {expr}, {number(f.minimum)}, {number(f.maximum)})")
+
+    def encode_fields(self, fields: list[SpecField], base: str, obj: str, lines: Lines, where: str) -> list[str]:
+        """Append checks and local values; return expressions of the byte parts in order."""
+        parts: list[str] = []
+        index = 0
+        while index < len(fields):
+            run: list[SpecField] = []
+            while index < len(fields) and is_fixed_run_member(fields[index]):
+                run.append(fields[index])
+                index += 1
+            if run:
+                parts.append(self.encode_run(run, base, obj, fields, lines, where))
+                continue
+            f = fields[index]
+            index += 1
+            parts.append(self.encode_variable(f, obj, lines, where))
+        return parts
+
+    def wire_value(self, f: Scalar, obj: str, siblings: list[SpecField], lines: Lines, where: str) -> str:
+        if f.const is not None:
+            return number(f.const)
+        if f.derived:
+            kind, target = f.derived[0], f.derived[1]
+            if kind == "count":
+                value = f"len({obj}.{target})"
+            else:
+                group = next(s for s in siblings if isinstance(s, Group) and any(i.name == target for i in s.fields))
+                value = self.local_named(f.name)
+                lines.append(f"{value} = len({obj}.{group.name}[0].{target}) if {obj}.{group.name} else 0")
+                lines.append(f"if any(len(item.{target}) != {value} for item in {obj}.{group.name}):")
+                lines.append(f"    raise EncodeError({where} + ': every {target} of {group.name} must have the same length')")
+            lines.append(f"if {value} > {number(f.maximum)}:")
+            lines.append(f"    raise out_of_range({where}, {f.name!r}, {value}, {number(f.minimum)}, {number(f.maximum)})")
+            return value
+        expr = f"{obj}.{f.name}"
+        if f.bits:
+            packed = []
+            for bit in f.bits:
+                sub = f"{expr}.{bit.name}"
+                lines.append(f"if not 0 <= {sub} <= {bit.mask}:")
+                lines.append(f"    raise out_of_range({where}, {f.name + '.' + bit.name!r}, {sub}, 0, {bit.mask})")
+                packed.append(f"({sub} << {bit.low})" if bit.low else sub)
+            return " | ".join(packed)
+        self.check_scalar(f, expr, lines, where)
+        if f.sign_magnitude:
+            top = 1 << (f.type.size * 8 - 1)
+            return f"(-{expr} | {top:#x} if {expr} < 0 else {expr})"
+        return expr
+
+    def encode_run(self, run: list[SpecField], base: str, obj: str, siblings: list[SpecField], lines: Lines,
+                   where: str) -> str:
+        endian = next((f.endian for f in run if isinstance(f, Scalar | Array | TableBlock)), "<")
+        const_name = self.struct(f"{base}_{run[0].name}", struct_format(endian, run))
+        args: list[str] = []
+        for f in run:
+            if isinstance(f, Scalar):
+                args.append(self.wire_value(f, obj, siblings, lines, where))
+            elif isinstance(f, Array):
+                expr = f"{obj}.{f.name}"
+                lines.append(f"if len({expr}) != {f.count}:")
+                lines.append(f"    raise EncodeError({where} + f': {f.name} needs {f.count} items, got {{len({expr})}}')")
+                lines.append(f"if any(not {number(f.minimum)} <= x <= {number(f.maximum)} for x in {expr}):")
+                lines.append(f"    raise out_of_range({where}, {f.name!r}, {expr}, {number(f.minimum)}, {number(f.maximum)})")
+                args.append(f"*{expr}")
+            elif isinstance(f, Bytes):
+                expr = f"{obj}.{f.name}"
+                lines.append(f"if len({expr}) != {f.size}:")
+                lines.append(f"    raise EncodeError({where} + f': {f.name} needs {f.size} bytes, got {{len({expr})}}')")
+                args.append(expr)
+            elif isinstance(f, TableBlock):
+                for e in f.entries:
+                    expr = f"{obj}.{f.name}.{e.name}"
+                    lines.append(f"if not {number(e.minimum)} <= {expr} <= {number(e.maximum)}:")
+                    lines.append(f"    raise out_of_range({where}, {f.name + '.' + e.name!r}, {expr}, "
+                                 f"{number(e.minimum)}, {number(e.maximum)})")
+                    args.append(expr)
+        return f"{const_name}.pack({', '.join(args)})"
+
+    def encode_variable(self, f: SpecField, obj: str, lines: Lines, where: str) -> str:
+        expr = f"{obj}.{f.name}"
+        if isinstance(f, Bytes):
+            return f"bytes({expr})"
+        if isinstance(f, TableValue):
+            table = f"_TABLE_{f.table.name.upper()}"
+            key = f"{obj}.{f.key}"
+            lines.append(f"s = {table}.get({key})")
+            lines.append("if s is None:")
+            lines.append(f"    raise EncodeError({where} + f': unknown {f.table.key_name} {{{key}}}')")
+            lines.append(f"low, high = _TABLE_{f.table.name.upper()}_RANGES[{key}]")
+            lines.append(f"if not low <= {expr} <= high:")
+            lines.append(f"    raise out_of_range({where}, {f.name!r}, {expr}, low, high)")
+            return f"s.pack({expr})"
+        assert isinstance(f, Group)
+        if isinstance(f.count, int):
+            lines.append(f"if len({expr}) != {f.count}:")
+            lines.append(f"    raise EncodeError({where} + f': {f.name} needs {f.count} items, got {{len({expr})}}')")
+        item_lines: Lines = []
+        parts = self.encode_fields(list(f.fields), f.class_name, "item", item_lines, where)
+        function = f"_encode_{f.class_name}"
+        if all(name != function for name, _, _ in self.encoders):
+            body = f"b''.join(({', '.join(parts)},))" if len(parts) > 1 else parts[0]
+            self.encoders.append((function, f.class_name, [*item_lines, f"return {body}"]))
+        return f"b''.join([{function}(item) for item in {expr}])"
+
+
+def frame_lines(protocol: Protocol, layout: FrameLayout) -> tuple[list[str], Lines]:
+    """Parameters and body of `_frame_<direction>(code, <frame values>, content) -> bytes`."""
+    del protocol
+    params = ["code", *[e.name for e in layout.value_elements], "content"]
+    lines: Lines = []
+    parts: list[str] = []
+    for element in layout.elements:
+        if element.role == "header":
+            parts.append(repr(layout.header))
+        elif element.role == "command":
+            parts.append("bytes((code,))")
+        elif element.role == "length":
+            lines.append(f"n = len(content) + {layout.length_adds}")
+            assert element.type is not None
+            lines.append(f"if n > {int(element.type.maximum)}:")
+            lines.append("    raise EncodeError(f'content of {len(content)} bytes does not fit the length field')")
+            parts.append("bytes((n,))" if element.type.size == 1 else f"n.to_bytes({element.type.size}, 'little')")
+        elif element.role in ("address", "status"):
+            parts.append(f"bytes(({element.name},))")
+        elif element.role == "content":
+            parts.append("content")
+    lines.append(f"body = b''.join(({', '.join(parts)},))")
+    trim = layout.covered_to_end - layout.checksum_offset_from_end
+    covered = f"body[{layout.covered_from}:{-trim if trim else ''}]"
+    size = layout.checksum_offset_from_end
+    lines.append(f"return body + _checksum({covered}).to_bytes({size}, 'little')")
+    return params, lines

@@ -1,0 +1,151 @@
+"""Emit construct structs: each frame, each command's content in each direction, parameter values, blocks.
+
+construct is the declarative reference the fast codec is tested against; it is not on the hot path.
+"""
+
+from __future__ import annotations
+
+from serialspec.emit.pycode import one_line
+from serialspec.emit.render import render
+from serialspec.spec.model import (
+    Array,
+    Bytes,
+    Field,
+    FrameLayout,
+    Group,
+    Protocol,
+    Scalar,
+    ScalarType,
+    TableBlock,
+    TableValue,
+)
+
+_INT = {1: "Int8", 2: "Int16", 4: "Int32"}
+
+
+def primitive(scalar: ScalarType, endian: str) -> str:
+    suffix = "b" if endian == ">" else "l"
+    if scalar.is_float:
+        return f"Float32{suffix}"
+    if scalar.size == 1:
+        return "Int8sb" if scalar.signed else "Int8ub"
+    return f"{_INT[scalar.size]}{'s' if scalar.signed else 'u'}{suffix}"
+
+
+def field_expr(f: Field, parent: str = "this") -> str:
+    if isinstance(f, Scalar):
+        base = primitive(f.type, f.endian)
+        if f.const is not None:
+            return f"Const({f.const}, {base})"
+        if f.derived:
+            kind, target = f.derived[0], f.derived[1]
+            if kind == "count":
+                return f"Rebuild({base}, len_(this.{target}))"
+            return f"Rebuild({base}, _item_size(this, {target!r}))"
+        if f.bits:
+            return bits_expr(f)
+        if f.sign_magnitude:
+            return f"SignMagnitude({base}, {f.type.size * 8})"
+        return base
+    if isinstance(f, Array):
+        return f"Array({f.count}, {primitive(f.item, f.endian)})"
+    if isinstance(f, Bytes):
+        if f.size == "rest":
+            return "GreedyBytes"
+        if isinstance(f.size, int):
+            return f"Bytes({f.size})"
+        return f"Bytes(this._.{f.size})"
+    if isinstance(f, Group):
+        item = "Struct(" + ", ".join(f"{i.name!r} / {field_expr(i)}" for i in f.fields) + ")"
+        if f.count == "rest":
+            return f"GreedyRange({item})"
+        count = f.count if isinstance(f.count, int) else f"this.{f.count}"
+        return f"Array({count}, {item})"
+    if isinstance(f, TableValue):
+        return f"Switch(this.{f.key}, {table_name(f.table.name)})"
+    assert isinstance(f, TableBlock)
+    return block_name(f.class_name)
+
+
+def bits_expr(f: Scalar) -> str:
+    """A BitStruct from the most significant bit down; unlisted bits are constant zero."""
+    width = f.type.size * 8
+    parts = []
+    bit = width - 1
+    for field in sorted(f.bits, key=lambda b: -b.high):
+        if bit > field.high:
+            parts.append(f"'_unused_{bit}' / Const(0, BitsInteger({bit - field.high}))")
+        parts.append(f"{field.name!r} / BitsInteger({field.high - field.low + 1})")
+        bit = field.low - 1
+    if bit >= 0:
+        parts.append(f"'_unused_{bit}' / Const(0, BitsInteger({bit + 1}))")
+    inner = "BitStruct(" + ", ".join(parts) + ")"
+    return f"ByteSwapped({inner})" if f.type.size > 1 and f.endian == "<" else inner
+
+
+def table_name(name: str) -> str:
+    return f"{name.upper()}_VALUE"
+
+
+def block_name(class_name: str) -> str:
+    return f"{class_name}Block"
+
+
+def frame_expr(protocol: Protocol, layout: FrameLayout) -> str:
+    body = []
+    adds = layout.length_adds
+    for element in layout.elements:
+        if element.role == "header":
+            body.append(f"'{element.name}' / Const({layout.header!r})")
+        elif element.role == "length":
+            assert element.type is not None
+            size = f"len_(this.content) + {adds}" if adds else "len_(this.content)"
+            body.append(f"'{element.name}' / Rebuild({primitive(element.type, '<')}, {size})")
+        elif element.role == "content":
+            length = next(e.name for e in layout.elements if e.role == "length")
+            body.append(f"'content' / Bytes(this.{length}{f' - {adds}' if adds else ''})")
+        elif element.role != "checksum":
+            assert element.type is not None
+            body.append(f"'{element.name}' / {primitive(element.type, '<')}")
+    checksum = next(e for e in layout.elements if e.role == "checksum")
+    assert checksum.type is not None
+    trim = layout.covered_to_end - layout.checksum_offset_from_end
+    covered = f"this.body.data[{layout.covered_from}:{-trim if trim else ''}]"
+    del protocol
+    return (f"Struct('body' / RawCopy(Struct({', '.join(body)})), "
+            f"'{checksum.name}' / Checksum({primitive(checksum.type, '<')}, _checksum, {covered}))")
+
+
+def structs_module(protocol: Protocol) -> str:
+    contents = []
+    for message in protocol.messages():
+        fields = [f"{f.name!r} / {field_expr(f)}" for f in message.fields]
+        contents.append({"name": f"{message.class_name}Content", "fields": fields,
+                         "key": message.key, "direction": message.direction.value})
+    tables = [{"name": table_name(t.name), "entries": [(e.key, field_expr_entry(e.type, e.sign_magnitude))
+                                                        for e in t.entries if not e.reserved]}
+              for t in protocol.tables]
+    blocks = {}
+    for message in protocol.messages():
+        for f in message.fields:
+            if isinstance(f, TableBlock):
+                blocks[block_name(f.class_name)] = [
+                    f"{e.name!r} / {field_expr_entry(e.type, e.sign_magnitude, f.endian)}" for e in f.entries
+                ]
+    checksum = protocol.framing.checksum
+    if checksum.algorithm == "crc":
+        assert checksum.crc is not None
+        c = checksum.crc
+        checksum_expr = f"crc_function({c.width}, {c.poly:#x}, {c.init:#x}, {c.refin}, {c.refout}, {c.xorout:#x})"
+    else:
+        checksum_expr = f"sum_function({checksum.type.size * 8}, invert={checksum.invert})"
+    frames = [{"name": f"{d.name}_FRAME", "expr": frame_expr(protocol, layout)}
+              for d, layout in protocol.framing.layouts.items()]
+    return render("structs.py.j2", spec_path=protocol.spec_path, title=one_line(protocol.title),
+                  contents=contents, tables=tables, blocks=blocks, frames=frames, checksum_expr=checksum_expr,
+                  checksum_import="crc_function" if checksum.algorithm == "crc" else "sum_function")
+
+
+def field_expr_entry(scalar: ScalarType, sign_magnitude: bool, endian: str = "<") -> str:
+    base = primitive(scalar, endian)
+    return f"SignMagnitude({base}, {scalar.size * 8})" if sign_magnitude else base

@@ -17,8 +17,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     root = args.root or find_root()
-    files = expected_files(root)
-    problems = []
+    files, errors = expected_files(root)
+    problems = [str(error) for error in errors]
     for path, text in files.items():
         if not path.exists():
             problems.append(f"{path.relative_to(root)}: missing")
@@ -26,7 +26,8 @@ def run(args: argparse.Namespace) -> int:
             problems.append(f"{path.relative_to(root)}: stale")
     generated = root / "generated"
     for path in sorted(generated.rglob("*")) if generated.is_dir() else []:
-        if path.is_file() and "__pycache__" not in path.parts and path not in files:
+        failed_spec = any(part in {e.file for e in errors} for part in path.parts)
+        if path.is_file() and "__pycache__" not in path.parts and path not in files and not failed_spec:
             problems.append(f"{path.relative_to(root)}: not generated from any spec")
     for problem in problems:
         print(problem, file=sys.stderr)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
 from serialspec.cli.project import expected_files, find_root
@@ -16,7 +17,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     root = args.root or find_root()
-    files = expected_files(root)
+    files, errors = expected_files(root)
     written = 0
     for path, text in files.items():
         if not path.exists() or path.read_text(encoding="utf-8") != text:
@@ -24,4 +25,6 @@ def run(args: argparse.Namespace) -> int:
             path.write_text(text, encoding="utf-8")
             written += 1
     print(f"{len(files)} files generated, {written} changed")
-    return 0
+    for error in errors:
+        print(error, file=sys.stderr)
+    return 1 if errors else 0

@@ -1,9 +1,343 @@
-"""Emit the markdown reference of one protocol."""
+"""Emit the markdown reference of one protocol: frames, checksum, commands, tables, examples, errata.
+
+Every piece of spec text goes through `cell()` or `text()`, so a `|`, `<` or newline in a description can
+neither break a table nor inject HTML into the rendered page.
+"""
 
 from __future__ import annotations
 
-from serialspec.spec.model import Protocol
+from dataclasses import dataclass
+from typing import Any
+
+from serialspec.emit.pycode import number
+from serialspec.emit.render import render
+from serialspec.spec.model import (
+    Array,
+    Bytes,
+    Command,
+    Direction,
+    Example,
+    Field,
+    FrameLayout,
+    Group,
+    Message,
+    Protocol,
+    Scalar,
+    TableBlock,
+    TableValue,
+)
+from serialspec.spec.resolve import fixed_size
+
+
+def text(value: str) -> str:
+    """Spec text for a markdown paragraph: one line, HTML-significant characters escaped."""
+    return " ".join(value.split()).replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
+
+
+def cell(value: object) -> str:
+    """A value for a markdown table cell."""
+    return text(str(value)).replace("|", "\\|") or " "
+
+
+def anchor(*parts: str) -> str:
+    return "-".join(p.replace("_", "-").replace(".", "-") for p in parts if p).lower()
+
+
+def type_name(f: Field) -> str:
+    if isinstance(f, Scalar):
+        name = f.type.name + (" (sign-magnitude)" if f.sign_magnitude else "")
+        if f.enum:
+            name += f" enum [{f.enum.class_name}](#enum-{anchor(f.enum.name)})"
+        if f.flags:
+            name += f" flags [{f.flags.class_name}](#flags-{anchor(f.flags.name)})"
+        return name
+    if isinstance(f, Array):
+        return f"{f.item.name}[{f.count}]"
+    if isinstance(f, Bytes):
+        size = "rest of content" if f.size == "rest" else f.size
+        return f"bytes ({size})"
+    if isinstance(f, Group):
+        count = {"rest": "up to the end"}.get(str(f.count), f"× {f.count}")
+        return f"group {count}"
+    if isinstance(f, TableValue):
+        return f"typed by {f.key} ([{f.table.title}](#table-{anchor(f.table.name)}))"
+    return f"block of [{f.table.title}](#table-{anchor(f.table.name)})"
+
+
+def range_text(f: Field) -> str:
+    if isinstance(f, Scalar):
+        if f.const is not None:
+            return f"= {f.const:#04x}"
+        if f.derived:
+            return "derived: " + (f"number of {f.derived[1]}" if f.derived[0] == "count" else f"size of each {f.derived[1]}")
+        if f.bits:
+            return ""
+        return f"{number(f.minimum)}..{number(f.maximum)}"
+    if isinstance(f, Array):
+        return f"{number(f.minimum)}..{number(f.maximum)}"
+    return ""
+
+
+def meaning(f: Field) -> str:
+    parts = [f.description]
+    if isinstance(f, Scalar) and f.bits:
+        for bit in f.bits:
+            where = f"bit {bit.low}" if bit.high == bit.low else f"bits {bit.high}..{bit.low}"
+            enum = f" ({', '.join(f'{v.value}={v.name.lower()}' for v in bit.enum.values)})" if bit.enum else ""
+            parts.append(f"{where}: {bit.name}{enum}.")
+        parts.append("Other bits must be zero.")
+    if f.inferred:
+        parts.append(f"**Inferred layout:** {f.inferred}")
+    return " ".join(p for p in parts if p)
+
+
+@dataclass
+class Row:
+    offset: str
+    name: str
+    type: str
+    unit: str
+    range: str
+    meaning: str
+
+
+def field_rows(fields: tuple[Field, ...], start: int | None, prefix: str = "") -> list[Row]:
+    rows = []
+    offset = start
+    for f in fields:
+        size = fixed_size(f)
+        where = "" if offset is None else (str(offset) if size in (None, 1) else f"{offset}..{offset + size - 1}")
+        if offset is not None and size is None:
+            where = f"{offset}.."
+        unit = f.unit if isinstance(f, Scalar | Array) else ""
+        rows.append(Row(where, prefix + f.name, type_name(f), unit, range_text(f), meaning(f)))
+        if isinstance(f, Group):
+            rows += field_rows(f.fields, None, prefix + f.name + "[]." )
+        if isinstance(f, TableBlock):
+            rows += [Row("", f"{prefix}{f.name}.{e.name}", e.type.name, e.unit, f"{number(e.minimum)}..{number(e.maximum)}",
+                         f"{f.table.key_name} {e.key}: {e.description}") for e in f.entries]
+        offset = None if offset is None or size is None else offset + size
+    return rows
+
+
+def message_context(protocol: Protocol, message: Message | None) -> dict[str, Any] | None:
+    if message is None:
+        return None
+    layout = protocol.framing.layouts[message.direction]
+    content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
+    size = (str(message.min_size) if message.min_size == message.max_size
+            else f"{message.min_size}..{message.max_size if message.max_size is not None else ''}")
+    rows = [Row(str(layout.offsets[e.name]), e.name, e.type.name if e.type else "", "", "", text(e.description))
+            for e in layout.value_elements]
+    rows += field_rows(message.fields, content_offset)
+    return {
+        "direction": message.direction.value,
+        "rows": [{k: cell(v) for k, v in vars(r).items()} for r in rows],
+        "size": size,
+        "optional": text(message.optional),
+        "unsolicited": message.unsolicited,
+        "answers": message.answers,
+        "description": text(message.description),
+    }
+
+
+def command_context(protocol: Protocol, command: Command) -> dict[str, Any]:
+    subs = []
+    for sub in command.subcommands:
+        subs.append({
+            "name": sub.name, "code": f"{sub.code:#04x}", "title": text(sub.title), "title_cn": text(sub.title_cn),
+            "description": text(sub.description), "source": text(sub.source),
+            "anchor": anchor("command", command.name, sub.name),
+            "messages": [m for m in (message_context(protocol, sub.request), message_context(protocol, sub.response)) if m],
+            "examples": examples_for(protocol, command.name, sub.name),
+        })
+    return {
+        "name": command.name,
+        "code": f"{command.code:#04x}" if command.code is not None else "—",
+        "title": text(command.title),
+        "title_cn": text(command.title_cn),
+        "description": text(command.description),
+        "broadcast": text(command.broadcast),
+        "source": text(command.source),
+        "anchor": anchor("command", command.name),
+        "messages": [m for m in (message_context(protocol, command.request),
+                                 message_context(protocol, command.response)) if m],
+        "subcommands": subs,
+        "examples": examples_for(protocol, command.name, None),
+    }
+
+
+def examples_for(protocol: Protocol, command: str, subcommand: str | None) -> list[str]:
+    return [e.name for e in protocol.examples if (e.command, e.subcommand) == (command, subcommand)]
+
+
+def frame_context(protocol: Protocol, layout: FrameLayout) -> dict[str, Any]:
+    rows = []
+    packet = []
+    offset = 0
+    for e in layout.elements:
+        size = e.size
+        if e.role == "header":
+            description = f"{layout.header.hex(' ').upper()} — {e.description}"
+        elif e.role == "length":
+            adds = f" + {layout.length_adds}" if layout.length_adds else ""
+            description = f"n{adds}, where n is the number of content bytes. {e.description}"
+        else:
+            description = e.description
+        label = "content (n bytes)" if e.role == "content" else e.name
+        where = f"{offset}.." if size is None else (str(offset) if size == 1 else f"{offset}..{offset + size - 1}")
+        if e.role in ("checksum",) or (offset is None):
+            where = "last" if e.role == "checksum" else where
+        rows.append({"offset": cell(where), "name": cell(e.name), "role": e.role,
+                     "type": cell(e.type.name if e.type else ("bytes" if e.role == "header" else "n bytes")),
+                     "meaning": cell(description)})
+        width = (size or 4) * 8
+        packet.append(f'{offset * 8}-{offset * 8 + width - 1}: "{label}"')
+        offset += size or 4
+    return {"direction": layout.direction.value, "rows": rows, "packet": packet}
+
+
+def checksum_context(protocol: Protocol) -> dict[str, Any]:
+    checksum = protocol.framing.checksum
+    example = next(iter(protocol.examples), None)
+    worked = ""
+    if example is not None:
+        layout = protocol.framing.layouts[example.direction]
+        covered = example.frame[layout.covered_from : len(example.frame) - layout.covered_to_end]
+        if checksum.algorithm == "sum":
+            total = sum(covered)
+            invert = "~" if checksum.invert else ""
+            worked = (f"{invert}({' + '.join(f'0x{b:02X}' for b in covered)}) = {invert}{total:#x} "
+                      f"→ 0x{example.frame[-1]:02X} (example `{example.name}`)")
+        else:
+            worked = f"CRC of {covered.hex(' ').upper()} = 0x{example.frame[-1]:02X} (example `{example.name}`)"
+    if checksum.algorithm == "sum":
+        what = ("bitwise NOT of the sum" if checksum.invert else "sum") + f" of the covered bytes, modulo {1 << (checksum.type.size * 8)}"
+        params = []
+    else:
+        assert checksum.crc is not None
+        c = checksum.crc
+        what = f"{c.name or 'CRC'} over the covered bytes"
+        params = [("width", c.width), ("poly", f"{c.poly:#04x}"), ("init", f"{c.init:#04x}"), ("refin", c.refin),
+                  ("refout", c.refout), ("xorout", f"{c.xorout:#04x}"), ("check ('123456789')", f"{c.check:#04x}")]
+    return {"what": what, "first": checksum.first, "last": checksum.last, "worked": worked, "params": params}
+
+
+def breakdown(protocol: Protocol, example: Example) -> list[dict[str, str]]:
+    """Byte spans of an example frame, element by element and field by field, with the values."""
+    layout = protocol.framing.layouts[example.direction]
+    command = protocol.command(example.command)
+    sub = next((s for s in command.subcommands if s.name == example.subcommand), None)
+    holder = sub or command
+    message = holder.request if example.direction == Direction.REQUEST else holder.response
+    frame = example.frame
+    rows: list[dict[str, str]] = []
+    offset = 0
+    content_size = len(frame) - layout.overhead
+    for e in layout.elements:
+        size = content_size if e.role == "content" else (e.size or 0)
+        if e.role == "content" and message is not None:
+            rows += content_rows(message.fields, example.fields, frame, offset, offset + size)
+        else:
+            value = example.fields.get(e.name, "")
+            if e.role == "command":
+                value = f"{command.name}"
+            elif e.role == "length":
+                value = f"{frame[offset]} ({content_size} content bytes)"
+            elif e.role == "checksum":
+                value = "verifies"
+            rows.append({"bytes": frame[offset : offset + size].hex(" ").upper(), "field": e.name, "value": cell(value)})
+        offset += size
+    return rows
+
+
+def content_rows(fields: tuple[Field, ...], values: dict[str, Any], frame: bytes, start: int,
+                 end: int) -> list[dict[str, str]]:
+    rows = []
+    offset = start
+    for f in fields:
+        size = fixed_size(f)
+        value: Any = values.get(f.name, "")
+        if isinstance(f, Scalar) and f.const is not None:
+            value = f"{f.const:#04x} (selector)"
+        elif isinstance(f, Scalar) and f.derived:
+            target = values.get(f.derived[1], [])
+            value = f"{frame[offset] if offset < end else ''} (derived)" if f.derived[0] == "count" or not target else "derived"
+        if size is None:
+            if isinstance(f, Group):
+                count = len(values.get(f.name, []))
+                item = f.item_size
+                size = count * item if item is not None else end - offset
+            elif isinstance(f, TableValue):
+                size = end - offset
+            else:
+                size = end - offset
+        rows.append({"bytes": frame[offset : offset + size].hex(" ").upper(), "field": f.name,
+                     "value": cell(_show(value))})
+        offset += size
+    return rows
+
+
+def _show(value: Any) -> str:
+    if isinstance(value, dict):
+        return ", ".join(f"{k}={_show(v)}" for k, v in value.items())
+    if isinstance(value, list):
+        return "[" + "; ".join(_show(v) for v in value) + "]"
+    return str(value)
 
 
 def emit_docs(protocol: Protocol) -> str:
-    return f"# {protocol.title}\n"
+    commands = [command_context(protocol, c) for c in protocol.commands]
+    examples = [{
+        "name": e.name, "source": text(e.source), "description": text(e.description), "direction": e.direction.value,
+        "command": e.command + (f".{e.subcommand}" if e.subcommand else ""),
+        "anchor": anchor("command", e.command, e.subcommand or ""),
+        "printed": e.printed, "frame": e.frame.hex(" ").upper(), "erratum": e.erratum,
+        "rows": breakdown(protocol, e),
+    } for e in protocol.examples]
+    tables = [{
+        "name": t.name, "anchor": anchor("table", t.name), "title": text(t.title), "key": t.key_name,
+        "description": text(t.description), "source": text(t.source),
+        "has_memory": any(e.memory for e in t.entries),
+        "rows": [{
+            "key": f"{e.key}" if t.key_name != "address" else f"{e.key:#04x}",
+            "name": cell("(reserved)" if e.reserved else e.name), "name_cn": cell(e.name_cn),
+            "type": e.type.name + (" sign-magnitude" if e.sign_magnitude else ""), "unit": cell(e.unit),
+            "range": f"{number(e.minimum)}..{number(e.maximum)}",
+            "default": cell("" if e.default is None else e.default), "access": e.access, "memory": e.memory,
+            "meaning": cell(e.description + (f" Values: [{e.enum.class_name}](#enum-{anchor(e.enum.name)})." if e.enum else "")),
+        } for e in t.entries],
+    } for t in protocol.tables]
+    enums = [{"name": e.name, "class_name": e.class_name, "anchor": anchor("enum", e.name),
+              "description": text(e.description),
+              "values": [{"value": v.value, "name": v.name.lower(), "text": cell(v.text)} for v in e.values]}
+             for e in protocol.enums]
+    flags = [{"name": f.name, "class_name": f.class_name, "anchor": anchor("flags", f.name),
+              "description": text(f.description),
+              "bits": [{"bit": b.bit, "name": b.name.lower(), "text": cell(b.text)} for b in f.bits]}
+             for f in protocol.flags]
+    errata = [{"name": e.name, "source": text(e.source), "printed": cell(e.printed), "correct": text(e.correct),
+               "check": e.check.kind} for e in protocol.errata]
+    serial = protocol.serial
+    return render(
+        "docs.md.j2",
+        protocol=protocol,
+        title=text(protocol.title),
+        description=text(protocol.description),
+        sources=[(k, text(v)) for k, v in protocol.sources.items()],
+        serial=[("baud rate", serial.baudrate), ("data bits", serial.bytesize), ("parity", serial.parity),
+                ("stop bits", number(serial.stopbits)), ("byte order", protocol.byte_order + "-endian")],
+        serial_notes=text(serial.notes),
+        framing=text(protocol.framing.description),
+        frames=[frame_context(protocol, layout) for layout in protocol.framing.layouts.values()],
+        shared_header=protocol.framing.shared_header,
+        checksum=checksum_context(protocol),
+        matching=", ".join(protocol.matching),
+        matching_description=text(protocol.matching_description),
+        commands=commands,
+        tables=tables,
+        enums=enums,
+        flags=flags,
+        examples=examples,
+        errata=errata,
+    )

@@ -8,7 +8,6 @@ from pathlib import Path
 from types import ModuleType
 
 import pytest
-
 from serialspec.spec import load_protocol
 from serialspec.spec.model import Protocol
 

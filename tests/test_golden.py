@@ -9,7 +9,6 @@ from __future__ import annotations
 from typing import Any
 
 import pytest
-
 from conftest import ALL, Generated, by_protocol
 from serialspec.runtime.checksums import crc_function
 from serialspec.runtime.errors import DecodeError
@@ -30,7 +29,7 @@ def message_class(g: Generated, command: str, subcommand: str | None, direction:
 @pytest.mark.parametrize(("g", "example"), EXAMPLES)
 def test_example_decodes_to_its_documented_values(g: Generated, example: Example) -> None:
     message = g.package.decode(example.frame, example.direction.value)
-    assert (message.COMMAND, message.SUBCOMMAND) == (example.command, example.subcommand)
+    assert (example.command, example.subcommand) == (message.COMMAND, message.SUBCOMMAND)
     assert message.to_fields() == example.fields
 
 
@@ -64,20 +63,29 @@ def test_erratum_is_pinned(g: Generated, erratum: Erratum) -> None:
         assert "\n" not in str(failure.value)
     elif check.kind == "frame_decodes_as":
         message = g.package.decode(check.frame, direction)
-        assert (message.COMMAND, message.SUBCOMMAND) == (check.command, check.subcommand)
+        assert (check.command, check.subcommand) == (message.COMMAND, message.SUBCOMMAND)
         assert message.to_fields() == check.fields
     elif check.kind == "checksum_value":
         assert check.frame is not None
         assert check.frame[-1] == check.actual != check.claimed
         g.package.decode(check.frame, direction)  # the frame verifies with the actual value
-        wrong = check.frame[:-1] + bytes([int(str(check.claimed), 0) if isinstance(check.claimed, str) else check.claimed])
+        wrong = check.frame[:-1] + bytes(
+            [int(str(check.claimed), 0) if isinstance(check.claimed, str) else check.claimed]
+        )
         with pytest.raises(DecodeError, match="checksum"):
             g.package.decode(wrong, direction)
     elif check.kind == "crc_parameters":
         crc = g.protocol.framing.checksum.crc
         assert crc is not None and isinstance(check.claimed, dict)
-        claimed = {"width": crc.width, "poly": crc.poly, "init": crc.init, "refin": crc.refin, "refout": crc.refout,
-                   "xorout": crc.xorout, **check.claimed}
+        claimed = {
+            "width": crc.width,
+            "poly": crc.poly,
+            "init": crc.init,
+            "refin": crc.refin,
+            "refout": crc.refout,
+            "xorout": crc.xorout,
+            **check.claimed,
+        }
         claimed_crc = crc_function(**claimed)
         layout = g.protocol.framing.layouts
         examples = [e for e in g.protocol.examples if e.name in check.examples] or list(g.protocol.examples)

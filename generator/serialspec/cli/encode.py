@@ -1,15 +1,41 @@
-"""serialspec encode."""
+"""serialspec encode: a JSON object (the shape decode prints) to a frame as hex."""
 
 from __future__ import annotations
 
 import argparse
+import json
+from typing import Any
 
-HELP = "encode"
+from serialspec.cli.protocols import message_type, open_spec
+from serialspec.runtime.errors import EncodeError
+
+HELP = "encode a JSON object ({command, subcommand, direction, fields}) as a frame; prints hex"
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    pass
+    parser.add_argument("spec", help="the protocol's spec file")
+    parser.add_argument(
+        "--json",
+        required=True,
+        metavar="OBJ",
+        help="the object decode --json prints; length, checksum, counts and hex may be left out",
+    )
+    parser.add_argument("--direction", choices=("request", "response"), help="overrides the object's direction")
 
 
 def run(args: argparse.Namespace) -> int:
+    _, package = open_spec(args.spec)
+    try:
+        data: Any = json.loads(args.json)
+    except json.JSONDecodeError as exc:
+        raise EncodeError(f"--json is not valid JSON: {exc.msg} at column {exc.colno}") from None
+    if not isinstance(data, dict) or "command" not in data:
+        raise EncodeError("--json must be an object with at least `command` and `fields`")
+    direction = args.direction or data.get("direction") or "request"
+    cls = message_type(package, data["command"], data.get("subcommand"), direction)
+    fields = data.get("fields", {})
+    if not isinstance(fields, dict):
+        raise EncodeError("`fields` must be an object")
+    message = cls.from_fields(fields)  # type: ignore[attr-defined]
+    print(package.encode(message).hex(" "))
     return 0

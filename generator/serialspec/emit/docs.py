@@ -69,7 +69,9 @@ def range_text(f: Field) -> str:
         if f.const is not None:
             return f"= {f.const:#04x}"
         if f.derived:
-            return "derived: " + (f"number of {f.derived[1]}" if f.derived[0] == "count" else f"size of each {f.derived[1]}")
+            return "derived: " + (
+                f"number of {f.derived[1]}" if f.derived[0] == "count" else f"size of each {f.derived[1]}"
+            )
         if f.bits:
             return ""
         return f"{number(f.minimum)}..{number(f.maximum)}"
@@ -112,10 +114,19 @@ def field_rows(fields: tuple[Field, ...], start: int | None, prefix: str = "") -
         unit = f.unit if isinstance(f, Scalar | Array) else ""
         rows.append(Row(where, prefix + f.name, type_name(f), unit, range_text(f), meaning(f)))
         if isinstance(f, Group):
-            rows += field_rows(f.fields, None, prefix + f.name + "[]." )
+            rows += field_rows(f.fields, None, prefix + f.name + "[].")
         if isinstance(f, TableBlock):
-            rows += [Row("", f"{prefix}{f.name}.{e.name}", e.type.name, e.unit, f"{number(e.minimum)}..{number(e.maximum)}",
-                         f"{f.table.key_name} {e.key}: {e.description}") for e in f.entries]
+            rows += [
+                Row(
+                    "",
+                    f"{prefix}{f.name}.{e.name}",
+                    e.type.name,
+                    e.unit,
+                    f"{number(e.minimum)}..{number(e.maximum)}",
+                    f"{f.table.key_name} {e.key}: {e.description}",
+                )
+                for e in f.entries
+            ]
         offset = None if offset is None or size is None else offset + size
     return rows
 
@@ -125,10 +136,15 @@ def message_context(protocol: Protocol, message: Message | None) -> dict[str, An
         return None
     layout = protocol.framing.layouts[message.direction]
     content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
-    size = (str(message.min_size) if message.min_size == message.max_size
-            else f"{message.min_size}..{message.max_size if message.max_size is not None else ''}")
-    rows = [Row(str(layout.offsets[e.name]), e.name, e.type.name if e.type else "", "", "", text(e.description))
-            for e in layout.value_elements]
+    size = (
+        str(message.min_size)
+        if message.min_size == message.max_size
+        else f"{message.min_size}..{message.max_size if message.max_size is not None else ''}"
+    )
+    rows = [
+        Row(str(layout.offsets[e.name]), e.name, e.type.name if e.type else "", "", "", text(e.description))
+        for e in layout.value_elements
+    ]
     rows += field_rows(message.fields, content_offset)
     return {
         "direction": message.direction.value,
@@ -144,13 +160,21 @@ def message_context(protocol: Protocol, message: Message | None) -> dict[str, An
 def command_context(protocol: Protocol, command: Command) -> dict[str, Any]:
     subs = []
     for sub in command.subcommands:
-        subs.append({
-            "name": sub.name, "code": f"{sub.code:#04x}", "title": text(sub.title), "title_cn": text(sub.title_cn),
-            "description": text(sub.description), "source": text(sub.source),
-            "anchor": anchor("command", command.name, sub.name),
-            "messages": [m for m in (message_context(protocol, sub.request), message_context(protocol, sub.response)) if m],
-            "examples": examples_for(protocol, command.name, sub.name),
-        })
+        subs.append(
+            {
+                "name": sub.name,
+                "code": f"{sub.code:#04x}",
+                "title": text(sub.title),
+                "title_cn": text(sub.title_cn),
+                "description": text(sub.description),
+                "source": text(sub.source),
+                "anchor": anchor("command", command.name, sub.name),
+                "messages": [
+                    m for m in (message_context(protocol, sub.request), message_context(protocol, sub.response)) if m
+                ],
+                "examples": examples_for(protocol, command.name, sub.name),
+            }
+        )
     return {
         "name": command.name,
         "code": f"{command.code:#04x}" if command.code is not None else "—",
@@ -160,8 +184,9 @@ def command_context(protocol: Protocol, command: Command) -> dict[str, Any]:
         "broadcast": text(command.broadcast),
         "source": text(command.source),
         "anchor": anchor("command", command.name),
-        "messages": [m for m in (message_context(protocol, command.request),
-                                 message_context(protocol, command.response)) if m],
+        "messages": [
+            m for m in (message_context(protocol, command.request), message_context(protocol, command.response)) if m
+        ],
         "subcommands": subs,
         "examples": examples_for(protocol, command.name, None),
     }
@@ -188,9 +213,15 @@ def frame_context(protocol: Protocol, layout: FrameLayout) -> dict[str, Any]:
         where = f"{offset}.." if size is None else (str(offset) if size == 1 else f"{offset}..{offset + size - 1}")
         if e.role in ("checksum",) or (offset is None):
             where = "last" if e.role == "checksum" else where
-        rows.append({"offset": cell(where), "name": cell(e.name), "role": e.role,
-                     "type": cell(e.type.name if e.type else ("bytes" if e.role == "header" else "n bytes")),
-                     "meaning": cell(description)})
+        rows.append(
+            {
+                "offset": cell(where),
+                "name": cell(e.name),
+                "role": e.role,
+                "type": cell(e.type.name if e.type else ("bytes" if e.role == "header" else "n bytes")),
+                "meaning": cell(description),
+            }
+        )
         width = (size or 4) * 8
         packet.append(f'{offset * 8}-{offset * 8 + width - 1}: "{label}"')
         offset += size or 4
@@ -207,19 +238,30 @@ def checksum_context(protocol: Protocol) -> dict[str, Any]:
         if checksum.algorithm == "sum":
             total = sum(covered)
             invert = "~" if checksum.invert else ""
-            worked = (f"{invert}({' + '.join(f'0x{b:02X}' for b in covered)}) = {invert}{total:#x} "
-                      f"→ 0x{example.frame[-1]:02X} (example `{example.name}`)")
+            worked = (
+                f"{invert}({' + '.join(f'0x{b:02X}' for b in covered)}) = {invert}{total:#x} "
+                f"→ 0x{example.frame[-1]:02X} (example `{example.name}`)"
+            )
         else:
             worked = f"CRC of {covered.hex(' ').upper()} = 0x{example.frame[-1]:02X} (example `{example.name}`)"
     if checksum.algorithm == "sum":
-        what = ("bitwise NOT of the sum" if checksum.invert else "sum") + f" of the covered bytes, modulo {1 << (checksum.type.size * 8)}"
+        what = (
+            "bitwise NOT of the sum" if checksum.invert else "sum"
+        ) + f" of the covered bytes, modulo {1 << (checksum.type.size * 8)}"
         params = []
     else:
         assert checksum.crc is not None
         c = checksum.crc
         what = f"{c.name or 'CRC'} over the covered bytes"
-        params = [("width", c.width), ("poly", f"{c.poly:#04x}"), ("init", f"{c.init:#04x}"), ("refin", c.refin),
-                  ("refout", c.refout), ("xorout", f"{c.xorout:#04x}"), ("check ('123456789')", f"{c.check:#04x}")]
+        params = [
+            ("width", c.width),
+            ("poly", f"{c.poly:#04x}"),
+            ("init", f"{c.init:#04x}"),
+            ("refin", c.refin),
+            ("refout", c.refout),
+            ("xorout", f"{c.xorout:#04x}"),
+            ("check ('123456789')", f"{c.check:#04x}"),
+        ]
     return {"what": what, "first": checksum.first, "last": checksum.last, "worked": worked, "params": params}
 
 
@@ -246,13 +288,20 @@ def breakdown(protocol: Protocol, example: Example) -> list[dict[str, str]]:
                 value = f"{frame[offset]} ({content_size} content bytes)"
             elif e.role == "checksum":
                 value = "verifies"
-            rows.append({"bytes": frame[offset : offset + size].hex(" ").upper(), "field": e.name, "value": cell(value)})
+            rows.append(
+                {
+                    "bytes": frame[offset : offset + size].hex(" ").upper(),
+                    "field": e.name,
+                    "value": cell(value),
+                }
+            )
         offset += size
     return rows
 
 
-def content_rows(fields: tuple[Field, ...], values: dict[str, Any], frame: bytes, start: int,
-                 end: int) -> list[dict[str, str]]:
+def content_rows(
+    fields: tuple[Field, ...], values: dict[str, Any], frame: bytes, start: int, end: int
+) -> list[dict[str, str]]:
     rows = []
     offset = start
     for f in fields:
@@ -262,7 +311,11 @@ def content_rows(fields: tuple[Field, ...], values: dict[str, Any], frame: bytes
             value = f"{f.const:#04x} (selector)"
         elif isinstance(f, Scalar) and f.derived:
             target = values.get(f.derived[1], [])
-            value = f"{frame[offset] if offset < end else ''} (derived)" if f.derived[0] == "count" or not target else "derived"
+            value = (
+                f"{frame[offset] if offset < end else ''} (derived)"
+                if f.derived[0] == "count" or not target
+                else "derived"
+            )
         if size is None:
             if isinstance(f, Group):
                 count = len(values.get(f.name, []))
@@ -272,8 +325,13 @@ def content_rows(fields: tuple[Field, ...], values: dict[str, Any], frame: bytes
                 size = end - offset
             else:
                 size = end - offset
-        rows.append({"bytes": frame[offset : offset + size].hex(" ").upper(), "field": f.name,
-                     "value": cell(_show(value))})
+        rows.append(
+            {
+                "bytes": frame[offset : offset + size].hex(" ").upper(),
+                "field": f.name,
+                "value": cell(_show(value)),
+            }
+        )
         offset += size
     return rows
 
@@ -288,36 +346,81 @@ def _show(value: Any) -> str:
 
 def emit_docs(protocol: Protocol) -> str:
     commands = [command_context(protocol, c) for c in protocol.commands]
-    examples = [{
-        "name": e.name, "source": text(e.source), "description": text(e.description), "direction": e.direction.value,
-        "command": e.command + (f".{e.subcommand}" if e.subcommand else ""),
-        "anchor": anchor("command", e.command, e.subcommand or ""),
-        "printed": e.printed, "frame": e.frame.hex(" ").upper(), "erratum": e.erratum,
-        "rows": breakdown(protocol, e),
-    } for e in protocol.examples]
-    tables = [{
-        "name": t.name, "anchor": anchor("table", t.name), "title": text(t.title), "key": t.key_name,
-        "description": text(t.description), "source": text(t.source),
-        "has_memory": any(e.memory for e in t.entries),
-        "rows": [{
-            "key": f"{e.key}" if t.key_name != "address" else f"{e.key:#04x}",
-            "name": cell("(reserved)" if e.reserved else e.name), "name_cn": cell(e.name_cn),
-            "type": e.type.name + (" sign-magnitude" if e.sign_magnitude else ""), "unit": cell(e.unit),
-            "range": f"{number(e.minimum)}..{number(e.maximum)}",
-            "default": cell("" if e.default is None else e.default), "access": e.access, "memory": e.memory,
-            "meaning": cell(e.description + (f" Values: [{e.enum.class_name}](#enum-{anchor(e.enum.name)})." if e.enum else "")),
-        } for e in t.entries],
-    } for t in protocol.tables]
-    enums = [{"name": e.name, "class_name": e.class_name, "anchor": anchor("enum", e.name),
-              "description": text(e.description),
-              "values": [{"value": v.value, "name": v.name.lower(), "text": cell(v.text)} for v in e.values]}
-             for e in protocol.enums]
-    flags = [{"name": f.name, "class_name": f.class_name, "anchor": anchor("flags", f.name),
-              "description": text(f.description),
-              "bits": [{"bit": b.bit, "name": b.name.lower(), "text": cell(b.text)} for b in f.bits]}
-             for f in protocol.flags]
-    errata = [{"name": e.name, "source": text(e.source), "printed": cell(e.printed), "correct": text(e.correct),
-               "check": e.check.kind} for e in protocol.errata]
+    examples = [
+        {
+            "name": e.name,
+            "source": text(e.source),
+            "description": text(e.description),
+            "direction": e.direction.value,
+            "command": e.command + (f".{e.subcommand}" if e.subcommand else ""),
+            "anchor": anchor("command", e.command, e.subcommand or ""),
+            "printed": e.printed,
+            "frame": e.frame.hex(" ").upper(),
+            "erratum": e.erratum,
+            "rows": breakdown(protocol, e),
+        }
+        for e in protocol.examples
+    ]
+    tables = [
+        {
+            "name": t.name,
+            "anchor": anchor("table", t.name),
+            "title": text(t.title),
+            "key": t.key_name,
+            "description": text(t.description),
+            "source": text(t.source),
+            "has_memory": any(e.memory for e in t.entries),
+            "rows": [
+                {
+                    "key": f"{e.key}" if t.key_name != "address" else f"{e.key:#04x}",
+                    "name": cell("(reserved)" if e.reserved else e.name),
+                    "name_cn": cell(e.name_cn),
+                    "type": e.type.name + (" sign-magnitude" if e.sign_magnitude else ""),
+                    "unit": cell(e.unit),
+                    "range": f"{number(e.minimum)}..{number(e.maximum)}",
+                    "default": cell("" if e.default is None else e.default),
+                    "access": e.access,
+                    "memory": e.memory,
+                    "meaning": cell(
+                        e.description
+                        + (f" Values: [{e.enum.class_name}](#enum-{anchor(e.enum.name)})." if e.enum else "")
+                    ),
+                }
+                for e in t.entries
+            ],
+        }
+        for t in protocol.tables
+    ]
+    enums = [
+        {
+            "name": e.name,
+            "class_name": e.class_name,
+            "anchor": anchor("enum", e.name),
+            "description": text(e.description),
+            "values": [{"value": v.value, "name": v.name.lower(), "text": cell(v.text)} for v in e.values],
+        }
+        for e in protocol.enums
+    ]
+    flags = [
+        {
+            "name": f.name,
+            "class_name": f.class_name,
+            "anchor": anchor("flags", f.name),
+            "description": text(f.description),
+            "bits": [{"bit": b.bit, "name": b.name.lower(), "text": cell(b.text)} for b in f.bits],
+        }
+        for f in protocol.flags
+    ]
+    errata = [
+        {
+            "name": e.name,
+            "source": text(e.source),
+            "printed": cell(e.printed),
+            "correct": text(e.correct),
+            "check": e.check.kind,
+        }
+        for e in protocol.errata
+    ]
     serial = protocol.serial
     return render(
         "docs.md.j2",
@@ -325,8 +428,13 @@ def emit_docs(protocol: Protocol) -> str:
         title=text(protocol.title),
         description=text(protocol.description),
         sources=[(k, text(v)) for k, v in protocol.sources.items()],
-        serial=[("baud rate", serial.baudrate), ("data bits", serial.bytesize), ("parity", serial.parity),
-                ("stop bits", number(serial.stopbits)), ("byte order", protocol.byte_order + "-endian")],
+        serial=[
+            ("baud rate", serial.baudrate),
+            ("data bits", serial.bytesize),
+            ("parity", serial.parity),
+            ("stop bits", number(serial.stopbits)),
+            ("byte order", protocol.byte_order + "-endian"),
+        ],
         serial_notes=text(serial.notes),
         framing=text(protocol.framing.description),
         frames=[frame_context(protocol, layout) for layout in protocol.framing.layouts.values()],

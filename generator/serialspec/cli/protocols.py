@@ -1,0 +1,33 @@
+"""Loading a spec's generated package for the decode/encode verbs."""
+
+from __future__ import annotations
+
+import importlib
+from types import ModuleType
+
+from serialspec.runtime.errors import SerialspecError
+from serialspec.spec import load_protocol
+from serialspec.spec.model import Protocol
+
+
+def open_spec(path: str) -> tuple[Protocol, ModuleType]:
+    """The resolved spec and its generated package; errors are one line for the user."""
+    try:
+        protocol = load_protocol(path)
+    except FileNotFoundError:
+        raise SerialspecError(f"no such spec: {path}") from None
+    try:
+        package = importlib.import_module(protocol.name)
+    except ImportError:
+        raise SerialspecError(
+            f"package {protocol.name} is not generated or installed: run `serialspec generate`"
+        ) from None
+    return protocol, package
+
+
+def message_type(package: ModuleType, command: str, subcommand: str | None, direction: str) -> type:
+    for cls in package.MESSAGE_TYPES:
+        if (cls.COMMAND, cls.SUBCOMMAND, cls.DIRECTION.value) == (command, subcommand, direction):
+            return cls  # type: ignore[no-any-return]
+    what = f"{command}.{subcommand}" if subcommand else command
+    raise SerialspecError(f"{package.__name__} has no {direction} {what!r}")

@@ -1,0 +1,96 @@
+"""Views of a decoded message that need the spec: engineering units, and register runs by name."""
+
+from __future__ import annotations
+
+import struct
+from typing import Any
+
+from serialspec.runtime.message import Message
+from serialspec.spec.model import Bytes, Field, Protocol, Scalar, Table, TableValue
+from serialspec.spec.model import Message as MessageSpec
+
+
+def message_spec(protocol: Protocol, message: Message) -> MessageSpec:
+    for spec in protocol.messages():
+        if (spec.command, spec.subcommand, spec.direction) == (
+            message.COMMAND,
+            message.SUBCOMMAND,
+            message.DIRECTION,
+        ):
+            return spec
+    raise LookupError(f"{message.COMMAND} is not in {protocol.name}")
+
+
+def engineering(protocol: Protocol, message: Message, fields: dict[str, Any]) -> dict[str, Any]:
+    """Scaled values (wire × scale) and enum/flag names in place of raw numbers."""
+    spec = message_spec(protocol, message)
+    result = dict(fields)
+    for f in spec.fields:
+        if f.name in result:
+            result[f.name] = _field_units(f, result[f.name], fields)
+    for element in protocol.framing.layouts[message.DIRECTION].value_elements:
+        if element.flags and element.name in result:
+            result[element.name] = [b.name.lower() for b in element.flags.bits if result[element.name] >> b.bit & 1]
+    return result
+
+
+def _field_units(f: Field, value: Any, siblings: dict[str, Any]) -> Any:
+    if isinstance(f, Scalar):
+        if f.bits:
+            return {b.name: _enum_name(b.enum, value[b.name]) if b.enum else value[b.name] for b in f.bits}
+        if f.enum:
+            return _enum_name(f.enum, value)
+        if f.flags:
+            return [b.name.lower() for b in f.flags.bits if value >> b.bit & 1]
+        if f.scale is not None:
+            return round(value * f.scale, 6)
+    if isinstance(f, TableValue):
+        entry = f.table.entry(siblings[f.key])
+        if entry is not None and entry.enum:
+            return _enum_name(entry.enum, value)
+        if entry is not None and entry.scale is not None:
+            return round(value * entry.scale, 6)
+    return value
+
+
+def _enum_name(enum: Any, value: int) -> str | int:
+    return next((v.name.lower() for v in enum.values if v.value == value), value)
+
+
+def register_view(protocol: Protocol, message: Message, request: Message | None) -> dict[str, Any] | None:
+    """Bytes that hold a run of registers, by register name, when the first register's key is known."""
+    spec = message_spec(protocol, message)
+    for f in spec.fields:
+        if not isinstance(f, Bytes) or f.table is None or not f.start:
+            continue
+        source = message
+        start_name = f.start
+        if start_name.startswith("request."):
+            if request is None:
+                return None
+            source, start_name = request, start_name.removeprefix("request.")
+        start = source.to_fields().get(start_name)
+        if not isinstance(start, int):
+            return None
+        return registers(f.table, start, getattr(message, f.name), protocol.byte_order)
+    return None
+
+
+def registers(table: Table, start: int, data: bytes, byte_order: str) -> dict[str, Any]:
+    """Split bytes read or written from register `start` into named values (unknown bytes by address)."""
+    endian = ">" if byte_order == "big" else "<"
+    result: dict[str, Any] = {}
+    address, offset = start, 0
+    while offset < len(data):
+        entry = table.entry(address)
+        if entry is None or offset + entry.type.size > len(data):
+            result[f"{address:#04x}"] = data[offset]
+            address, offset = address + 1, offset + 1
+            continue
+        (value,) = struct.unpack_from(endian + entry.type.struct_char, data, offset)
+        if entry.sign_magnitude:
+            top = 1 << (entry.type.size * 8 - 1)
+            value = -(value & (top - 1)) if value & top else value
+        result[entry.name] = value
+        address, offset = address + entry.type.size, offset + entry.type.size
+    return result

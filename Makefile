@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: generate test check lint typecheck clean
+.PHONY: generate test check lint typecheck clean demo
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -30,3 +30,7 @@ test: $(STAMP) check lint typecheck
 
 clean:
 	rm -rf $(VENV) build *.egg-info
+
+# A virtual Fashion Star servo on a pseudo-terminal, driven by the generated client: no hardware needed.
+demo: $(STAMP)
+	$(BIN)/python examples/demo_fashionstar.py

@@ -8,14 +8,20 @@ Generated from specs/fashionstar_uart.yaml: `decode`/`encode` frames with the fa
 one dataclass per command and direction in `messages`, construct structs in `structs`.
 """
 
+from serialspec.runtime.transport import SerialSettings
+
 from fashionstar_uart.codec import StreamParser, decode, encode
 from fashionstar_uart.messages import *  # noqa: F403
 from fashionstar_uart.messages import MESSAGE_TYPES, Direction, Message
 from fashionstar_uart.messages import __all__ as _messages
 
-PROTOCOL = "fashionstar_uart"
-SPEC = "specs/fashionstar_uart.yaml"
+PROTOCOL = 'fashionstar_uart'
+SPEC = 'specs/fashionstar_uart.yaml'
 BAUDRATE = 115200
+#: The spec's serial settings: the defaults a Bus opens a port with.
+SERIAL = SerialSettings(baudrate=115200, bytesize=8, parity='none', stopbits=1.0)
+#: How a reply is matched to its request (the spec's `matching.by`).
+MATCH_BY: tuple[str, ...] = ('command', 'servo_id')
 
-__all__ = ["BAUDRATE", "MESSAGE_TYPES", "PROTOCOL", "SPEC", "Direction", "Message", "StreamParser", "decode", "encode",
+__all__ = ["BAUDRATE", "MATCH_BY", "MESSAGE_TYPES", "PROTOCOL", "SERIAL", "SPEC", "Direction", "Message", "StreamParser", "decode", "encode",
            *_messages]

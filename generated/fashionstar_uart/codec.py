@@ -49,42 +49,42 @@ from fashionstar_uart.messages import (
 
 __all__ = ["StreamParser", "decode", "encode"]
 
-_S_DAMPINGREQUEST_SERVO_ID = struct.Struct("\u003cBH")
-_S_PINGREQUEST_SERVO_ID = struct.Struct("\u003cB")
-_S_READANGLERESPONSE_SERVO_ID = struct.Struct("\u003cBh")
-_S_READBATCHDATARESPONSE_SERVO_ID = struct.Struct("\u003cBBBBBBBHHHHHHBBBBBBHhhh")
-_S_RESETUSERDATARESPONSE_SERVO_ID = struct.Struct("\u003cBB")
-_S_ROTATEREQUEST_SERVO_ID = struct.Struct("\u003cBhHH")
-_S_SPINREQUEST_SERVO_ID = struct.Struct("\u003cBBHH")
-_S_WRITEDATARESPONSE_SERVO_ID = struct.Struct("\u003cBBB")
+_S_READBATCHDATARESPONSE_SERVO_ID = struct.Struct('<BBBBBBBHHHHHHBBBBBBHhhh')
+_S_U8 = struct.Struct('<B')
+_S_U8_I16 = struct.Struct('<Bh')
+_S_U8_I16_U16_U16 = struct.Struct('<BhHH')
+_S_U8_U16 = struct.Struct('<BH')
+_S_U8_U8 = struct.Struct('<BB')
+_S_U8_U8_U16_U16 = struct.Struct('<BBHH')
+_S_U8_U8_U8 = struct.Struct('<BBB')
 _TABLE_PARAMETERS: dict[int, struct.Struct] = {
-    1: struct.Struct("\u003cH"),
-    2: struct.Struct("\u003cH"),
-    3: struct.Struct("\u003cH"),
-    4: struct.Struct("\u003cH"),
-    5: struct.Struct("\u003cB"),
-    6: struct.Struct("\u003cH"),
-    7: struct.Struct("\u003cH"),
-    8: struct.Struct("\u003cI"),
-    33: struct.Struct("\u003cB"),
-    34: struct.Struct("\u003cB"),
-    36: struct.Struct("\u003cB"),
-    37: struct.Struct("\u003cB"),
-    38: struct.Struct("\u003cH"),
-    39: struct.Struct("\u003cH"),
-    40: struct.Struct("\u003cH"),
-    41: struct.Struct("\u003cH"),
-    42: struct.Struct("\u003cH"),
-    43: struct.Struct("\u003cH"),
-    44: struct.Struct("\u003cB"),
-    46: struct.Struct("\u003cB"),
-    47: struct.Struct("\u003cB"),
-    48: struct.Struct("\u003cB"),
-    49: struct.Struct("\u003cB"),
-    50: struct.Struct("\u003cH"),
-    51: struct.Struct("\u003ch"),
-    52: struct.Struct("\u003ch"),
-    53: struct.Struct("\u003ch"),
+    1: struct.Struct('<H'),
+    2: struct.Struct('<H'),
+    3: struct.Struct('<H'),
+    4: struct.Struct('<H'),
+    5: struct.Struct('<B'),
+    6: struct.Struct('<H'),
+    7: struct.Struct('<H'),
+    8: struct.Struct('<I'),
+    33: struct.Struct('<B'),
+    34: struct.Struct('<B'),
+    36: struct.Struct('<B'),
+    37: struct.Struct('<B'),
+    38: struct.Struct('<H'),
+    39: struct.Struct('<H'),
+    40: struct.Struct('<H'),
+    41: struct.Struct('<H'),
+    42: struct.Struct('<H'),
+    43: struct.Struct('<H'),
+    44: struct.Struct('<B'),
+    46: struct.Struct('<B'),
+    47: struct.Struct('<B'),
+    48: struct.Struct('<B'),
+    49: struct.Struct('<B'),
+    50: struct.Struct('<H'),
+    51: struct.Struct('<h'),
+    52: struct.Struct('<h'),
+    53: struct.Struct('<h'),
 }
 _TABLE_PARAMETERS_RANGES: dict[int, tuple[float, float]] = {
     1: (0, 65535),
@@ -137,7 +137,7 @@ def _frame_response(code: int, content: bytes) -> bytes:
 def _decode_ping_request(buf: bytes, o: int, end: int) -> PingRequest:
     if end - o != 1:
         raise content_size_error('ping request', end - o, 1, 1)
-    v_servo_id, = _S_PINGREQUEST_SERVO_ID.unpack_from(buf, o)
+    v_servo_id, = _S_U8.unpack_from(buf, o)
     o += 1
     if o != end:
         raise DecodeError('ping request' + f': {end - o} bytes left after the last field')
@@ -147,7 +147,7 @@ def _decode_ping_request(buf: bytes, o: int, end: int) -> PingRequest:
 def _decode_ping_response(buf: bytes, o: int, end: int) -> PingResponse:
     if end - o != 1:
         raise content_size_error('ping response', end - o, 1, 1)
-    v_servo_id, = _S_PINGREQUEST_SERVO_ID.unpack_from(buf, o)
+    v_servo_id, = _S_U8.unpack_from(buf, o)
     o += 1
     if o != end:
         raise DecodeError('ping response' + f': {end - o} bytes left after the last field')
@@ -157,7 +157,7 @@ def _decode_ping_response(buf: bytes, o: int, end: int) -> PingResponse:
 def _decode_reset_user_data_request(buf: bytes, o: int, end: int) -> ResetUserDataRequest:
     if end - o != 1:
         raise content_size_error('reset_user_data request', end - o, 1, 1)
-    v_servo_id, = _S_PINGREQUEST_SERVO_ID.unpack_from(buf, o)
+    v_servo_id, = _S_U8.unpack_from(buf, o)
     o += 1
     if o != end:
         raise DecodeError('reset_user_data request' + f': {end - o} bytes left after the last field')
@@ -167,7 +167,7 @@ def _decode_reset_user_data_request(buf: bytes, o: int, end: int) -> ResetUserDa
 def _decode_reset_user_data_response(buf: bytes, o: int, end: int) -> ResetUserDataResponse:
     if end - o != 2:
         raise content_size_error('reset_user_data response', end - o, 2, 2)
-    v_servo_id, v_result = _S_RESETUSERDATARESPONSE_SERVO_ID.unpack_from(buf, o)
+    v_servo_id, v_result = _S_U8_U8.unpack_from(buf, o)
     o += 2
     if o != end:
         raise DecodeError('reset_user_data response' + f': {end - o} bytes left after the last field')
@@ -177,7 +177,7 @@ def _decode_reset_user_data_response(buf: bytes, o: int, end: int) -> ResetUserD
 def _decode_read_data_request(buf: bytes, o: int, end: int) -> ReadDataRequest:
     if end - o != 2:
         raise content_size_error('read_data request', end - o, 2, 2)
-    v_servo_id, v_data_id = _S_RESETUSERDATARESPONSE_SERVO_ID.unpack_from(buf, o)
+    v_servo_id, v_data_id = _S_U8_U8.unpack_from(buf, o)
     o += 2
     if o != end:
         raise DecodeError('read_data request' + f': {end - o} bytes left after the last field')
@@ -187,7 +187,7 @@ def _decode_read_data_request(buf: bytes, o: int, end: int) -> ReadDataRequest:
 def _decode_read_data_response(buf: bytes, o: int, end: int) -> ReadDataResponse:
     if not 3 <= end - o <= 6:
         raise content_size_error('read_data response', end - o, 3, 6)
-    v_servo_id, v_data_id = _S_RESETUSERDATARESPONSE_SERVO_ID.unpack_from(buf, o)
+    v_servo_id, v_data_id = _S_U8_U8.unpack_from(buf, o)
     o += 2
     s = _TABLE_PARAMETERS.get(v_data_id)
     if s is None:
@@ -204,7 +204,7 @@ def _decode_read_data_response(buf: bytes, o: int, end: int) -> ReadDataResponse
 def _decode_write_data_request(buf: bytes, o: int, end: int) -> WriteDataRequest:
     if not 3 <= end - o <= 6:
         raise content_size_error('write_data request', end - o, 3, 6)
-    v_servo_id, v_data_id = _S_RESETUSERDATARESPONSE_SERVO_ID.unpack_from(buf, o)
+    v_servo_id, v_data_id = _S_U8_U8.unpack_from(buf, o)
     o += 2
     s = _TABLE_PARAMETERS.get(v_data_id)
     if s is None:
@@ -221,7 +221,7 @@ def _decode_write_data_request(buf: bytes, o: int, end: int) -> WriteDataRequest
 def _decode_write_data_response(buf: bytes, o: int, end: int) -> WriteDataResponse:
     if end - o != 3:
         raise content_size_error('write_data response', end - o, 3, 3)
-    v_servo_id, v_data_id, v_result = _S_WRITEDATARESPONSE_SERVO_ID.unpack_from(buf, o)
+    v_servo_id, v_data_id, v_result = _S_U8_U8_U8.unpack_from(buf, o)
     o += 3
     if o != end:
         raise DecodeError('write_data response' + f': {end - o} bytes left after the last field')
@@ -231,7 +231,7 @@ def _decode_write_data_response(buf: bytes, o: int, end: int) -> WriteDataRespon
 def _decode_read_batch_data_request(buf: bytes, o: int, end: int) -> ReadBatchDataRequest:
     if end - o != 1:
         raise content_size_error('read_batch_data request', end - o, 1, 1)
-    v_servo_id, = _S_PINGREQUEST_SERVO_ID.unpack_from(buf, o)
+    v_servo_id, = _S_U8.unpack_from(buf, o)
     o += 1
     if o != end:
         raise DecodeError('read_batch_data request' + f': {end - o} bytes left after the last field')
@@ -263,7 +263,7 @@ def _decode_write_batch_data_request(buf: bytes, o: int, end: int) -> WriteBatch
 def _decode_write_batch_data_response(buf: bytes, o: int, end: int) -> WriteBatchDataResponse:
     if end - o != 2:
         raise content_size_error('write_batch_data response', end - o, 2, 2)
-    v_servo_id, v_result = _S_RESETUSERDATARESPONSE_SERVO_ID.unpack_from(buf, o)
+    v_servo_id, v_result = _S_U8_U8.unpack_from(buf, o)
     o += 2
     if o != end:
         raise DecodeError('write_batch_data response' + f': {end - o} bytes left after the last field')
@@ -273,7 +273,7 @@ def _decode_write_batch_data_response(buf: bytes, o: int, end: int) -> WriteBatc
 def _decode_spin_request(buf: bytes, o: int, end: int) -> SpinRequest:
     if end - o != 6:
         raise content_size_error('spin request', end - o, 6, 6)
-    v_servo_id, v_method, v_speed, v_value = _S_SPINREQUEST_SERVO_ID.unpack_from(buf, o)
+    v_servo_id, v_method, v_speed, v_value = _S_U8_U8_U16_U16.unpack_from(buf, o)
     if v_method & 0x7c:
         raise DecodeError('spin request' + f': unused bits of method are set ({v_method:#04x})')
     o += 6
@@ -285,7 +285,7 @@ def _decode_spin_request(buf: bytes, o: int, end: int) -> SpinRequest:
 def _decode_spin_response(buf: bytes, o: int, end: int) -> SpinResponse:
     if end - o != 2:
         raise content_size_error('spin response', end - o, 2, 2)
-    v_servo_id, v_result = _S_RESETUSERDATARESPONSE_SERVO_ID.unpack_from(buf, o)
+    v_servo_id, v_result = _S_U8_U8.unpack_from(buf, o)
     o += 2
     if o != end:
         raise DecodeError('spin response' + f': {end - o} bytes left after the last field')
@@ -295,7 +295,7 @@ def _decode_spin_response(buf: bytes, o: int, end: int) -> SpinResponse:
 def _decode_rotate_request(buf: bytes, o: int, end: int) -> RotateRequest:
     if end - o != 7:
         raise content_size_error('rotate request', end - o, 7, 7)
-    v_servo_id, v_angle, v_interval, v_power = _S_ROTATEREQUEST_SERVO_ID.unpack_from(buf, o)
+    v_servo_id, v_angle, v_interval, v_power = _S_U8_I16_U16_U16.unpack_from(buf, o)
     o += 7
     if o != end:
         raise DecodeError('rotate request' + f': {end - o} bytes left after the last field')
@@ -305,7 +305,7 @@ def _decode_rotate_request(buf: bytes, o: int, end: int) -> RotateRequest:
 def _decode_rotate_response(buf: bytes, o: int, end: int) -> RotateResponse:
     if end - o != 2:
         raise content_size_error('rotate response', end - o, 2, 2)
-    v_servo_id, v_result = _S_RESETUSERDATARESPONSE_SERVO_ID.unpack_from(buf, o)
+    v_servo_id, v_result = _S_U8_U8.unpack_from(buf, o)
     o += 2
     if o != end:
         raise DecodeError('rotate response' + f': {end - o} bytes left after the last field')
@@ -315,7 +315,7 @@ def _decode_rotate_response(buf: bytes, o: int, end: int) -> RotateResponse:
 def _decode_damping_request(buf: bytes, o: int, end: int) -> DampingRequest:
     if end - o != 3:
         raise content_size_error('damping request', end - o, 3, 3)
-    v_servo_id, v_power = _S_DAMPINGREQUEST_SERVO_ID.unpack_from(buf, o)
+    v_servo_id, v_power = _S_U8_U16.unpack_from(buf, o)
     o += 3
     if o != end:
         raise DecodeError('damping request' + f': {end - o} bytes left after the last field')
@@ -325,7 +325,7 @@ def _decode_damping_request(buf: bytes, o: int, end: int) -> DampingRequest:
 def _decode_damping_response(buf: bytes, o: int, end: int) -> DampingResponse:
     if end - o != 2:
         raise content_size_error('damping response', end - o, 2, 2)
-    v_servo_id, v_result = _S_RESETUSERDATARESPONSE_SERVO_ID.unpack_from(buf, o)
+    v_servo_id, v_result = _S_U8_U8.unpack_from(buf, o)
     o += 2
     if o != end:
         raise DecodeError('damping response' + f': {end - o} bytes left after the last field')
@@ -335,7 +335,7 @@ def _decode_damping_response(buf: bytes, o: int, end: int) -> DampingResponse:
 def _decode_read_angle_request(buf: bytes, o: int, end: int) -> ReadAngleRequest:
     if end - o != 1:
         raise content_size_error('read_angle request', end - o, 1, 1)
-    v_servo_id, = _S_PINGREQUEST_SERVO_ID.unpack_from(buf, o)
+    v_servo_id, = _S_U8.unpack_from(buf, o)
     o += 1
     if o != end:
         raise DecodeError('read_angle request' + f': {end - o} bytes left after the last field')
@@ -345,7 +345,7 @@ def _decode_read_angle_request(buf: bytes, o: int, end: int) -> ReadAngleRequest
 def _decode_read_angle_response(buf: bytes, o: int, end: int) -> ReadAngleResponse:
     if end - o != 3:
         raise content_size_error('read_angle response', end - o, 3, 3)
-    v_servo_id, v_angle = _S_READANGLERESPONSE_SERVO_ID.unpack_from(buf, o)
+    v_servo_id, v_angle = _S_U8_I16.unpack_from(buf, o)
     o += 3
     if o != end:
         raise DecodeError('read_angle response' + f': {end - o} bytes left after the last field')
@@ -355,19 +355,19 @@ def _decode_read_angle_response(buf: bytes, o: int, end: int) -> ReadAngleRespon
 def _encode_ping_request(m: PingRequest) -> bytes:
     if not 0 <= m.servo_id <= 254:
         raise out_of_range('ping request', 'servo_id', m.servo_id, 0, 254)
-    return _frame_request(1, _S_PINGREQUEST_SERVO_ID.pack(m.servo_id))
+    return _frame_request(1, _S_U8.pack(m.servo_id))
 
 
 def _encode_ping_response(m: PingResponse) -> bytes:
     if not 0 <= m.servo_id <= 254:
         raise out_of_range('ping response', 'servo_id', m.servo_id, 0, 254)
-    return _frame_response(1, _S_PINGREQUEST_SERVO_ID.pack(m.servo_id))
+    return _frame_response(1, _S_U8.pack(m.servo_id))
 
 
 def _encode_reset_user_data_request(m: ResetUserDataRequest) -> bytes:
     if not 0 <= m.servo_id <= 254:
         raise out_of_range('reset_user_data request', 'servo_id', m.servo_id, 0, 254)
-    return _frame_request(2, _S_PINGREQUEST_SERVO_ID.pack(m.servo_id))
+    return _frame_request(2, _S_U8.pack(m.servo_id))
 
 
 def _encode_reset_user_data_response(m: ResetUserDataResponse) -> bytes:
@@ -375,7 +375,7 @@ def _encode_reset_user_data_response(m: ResetUserDataResponse) -> bytes:
         raise out_of_range('reset_user_data response', 'servo_id', m.servo_id, 0, 254)
     if not 0 <= m.result <= 255:
         raise out_of_range('reset_user_data response', 'result', m.result, 0, 255)
-    return _frame_response(2, _S_RESETUSERDATARESPONSE_SERVO_ID.pack(m.servo_id, m.result))
+    return _frame_response(2, _S_U8_U8.pack(m.servo_id, m.result))
 
 
 def _encode_read_data_request(m: ReadDataRequest) -> bytes:
@@ -383,7 +383,7 @@ def _encode_read_data_request(m: ReadDataRequest) -> bytes:
         raise out_of_range('read_data request', 'servo_id', m.servo_id, 0, 254)
     if not 0 <= m.data_id <= 255:
         raise out_of_range('read_data request', 'data_id', m.data_id, 0, 255)
-    return _frame_request(3, _S_RESETUSERDATARESPONSE_SERVO_ID.pack(m.servo_id, m.data_id))
+    return _frame_request(3, _S_U8_U8.pack(m.servo_id, m.data_id))
 
 
 def _encode_read_data_response(m: ReadDataResponse) -> bytes:
@@ -397,7 +397,7 @@ def _encode_read_data_response(m: ReadDataResponse) -> bytes:
     low, high = _TABLE_PARAMETERS_RANGES[m.data_id]
     if not low <= m.data <= high:
         raise out_of_range('read_data response', 'data', m.data, low, high)
-    return _frame_response(3, b''.join((_S_RESETUSERDATARESPONSE_SERVO_ID.pack(m.servo_id, m.data_id), s.pack(m.data),)))
+    return _frame_response(3, b''.join((_S_U8_U8.pack(m.servo_id, m.data_id), s.pack(m.data),)))
 
 
 def _encode_write_data_request(m: WriteDataRequest) -> bytes:
@@ -411,7 +411,7 @@ def _encode_write_data_request(m: WriteDataRequest) -> bytes:
     low, high = _TABLE_PARAMETERS_RANGES[m.data_id]
     if not low <= m.data <= high:
         raise out_of_range('write_data request', 'data', m.data, low, high)
-    return _frame_request(4, b''.join((_S_RESETUSERDATARESPONSE_SERVO_ID.pack(m.servo_id, m.data_id), s.pack(m.data),)))
+    return _frame_request(4, b''.join((_S_U8_U8.pack(m.servo_id, m.data_id), s.pack(m.data),)))
 
 
 def _encode_write_data_response(m: WriteDataResponse) -> bytes:
@@ -421,13 +421,13 @@ def _encode_write_data_response(m: WriteDataResponse) -> bytes:
         raise out_of_range('write_data response', 'data_id', m.data_id, 0, 255)
     if not 0 <= m.result <= 255:
         raise out_of_range('write_data response', 'result', m.result, 0, 255)
-    return _frame_response(4, _S_WRITEDATARESPONSE_SERVO_ID.pack(m.servo_id, m.data_id, m.result))
+    return _frame_response(4, _S_U8_U8_U8.pack(m.servo_id, m.data_id, m.result))
 
 
 def _encode_read_batch_data_request(m: ReadBatchDataRequest) -> bytes:
     if not 0 <= m.servo_id <= 254:
         raise out_of_range('read_batch_data request', 'servo_id', m.servo_id, 0, 254)
-    return _frame_request(5, _S_PINGREQUEST_SERVO_ID.pack(m.servo_id))
+    return _frame_request(5, _S_U8.pack(m.servo_id))
 
 
 def _encode_read_batch_data_response(m: ReadBatchDataResponse) -> bytes:
@@ -535,7 +535,7 @@ def _encode_write_batch_data_response(m: WriteBatchDataResponse) -> bytes:
         raise out_of_range('write_batch_data response', 'servo_id', m.servo_id, 0, 254)
     if not 0 <= m.result <= 255:
         raise out_of_range('write_batch_data response', 'result', m.result, 0, 255)
-    return _frame_response(6, _S_RESETUSERDATARESPONSE_SERVO_ID.pack(m.servo_id, m.result))
+    return _frame_response(6, _S_U8_U8.pack(m.servo_id, m.result))
 
 
 def _encode_spin_request(m: SpinRequest) -> bytes:
@@ -549,7 +549,7 @@ def _encode_spin_request(m: SpinRequest) -> bytes:
         raise out_of_range('spin request', 'speed', m.speed, 0, 65535)
     if not 0 <= m.value <= 65535:
         raise out_of_range('spin request', 'value', m.value, 0, 65535)
-    return _frame_request(7, _S_SPINREQUEST_SERVO_ID.pack(m.servo_id, (m.method.direction << 7) | m.method.mode, m.speed, m.value))
+    return _frame_request(7, _S_U8_U8_U16_U16.pack(m.servo_id, (m.method.direction << 7) | m.method.mode, m.speed, m.value))
 
 
 def _encode_spin_response(m: SpinResponse) -> bytes:
@@ -557,7 +557,7 @@ def _encode_spin_response(m: SpinResponse) -> bytes:
         raise out_of_range('spin response', 'servo_id', m.servo_id, 0, 254)
     if not 0 <= m.result <= 255:
         raise out_of_range('spin response', 'result', m.result, 0, 255)
-    return _frame_response(7, _S_RESETUSERDATARESPONSE_SERVO_ID.pack(m.servo_id, m.result))
+    return _frame_response(7, _S_U8_U8.pack(m.servo_id, m.result))
 
 
 def _encode_rotate_request(m: RotateRequest) -> bytes:
@@ -569,7 +569,7 @@ def _encode_rotate_request(m: RotateRequest) -> bytes:
         raise out_of_range('rotate request', 'interval', m.interval, 0, 65535)
     if not 0 <= m.power <= 65535:
         raise out_of_range('rotate request', 'power', m.power, 0, 65535)
-    return _frame_request(8, _S_ROTATEREQUEST_SERVO_ID.pack(m.servo_id, m.angle, m.interval, m.power))
+    return _frame_request(8, _S_U8_I16_U16_U16.pack(m.servo_id, m.angle, m.interval, m.power))
 
 
 def _encode_rotate_response(m: RotateResponse) -> bytes:
@@ -577,7 +577,7 @@ def _encode_rotate_response(m: RotateResponse) -> bytes:
         raise out_of_range('rotate response', 'servo_id', m.servo_id, 0, 254)
     if not 0 <= m.result <= 255:
         raise out_of_range('rotate response', 'result', m.result, 0, 255)
-    return _frame_response(8, _S_RESETUSERDATARESPONSE_SERVO_ID.pack(m.servo_id, m.result))
+    return _frame_response(8, _S_U8_U8.pack(m.servo_id, m.result))
 
 
 def _encode_damping_request(m: DampingRequest) -> bytes:
@@ -585,7 +585,7 @@ def _encode_damping_request(m: DampingRequest) -> bytes:
         raise out_of_range('damping request', 'servo_id', m.servo_id, 0, 255)
     if not 0 <= m.power <= 65535:
         raise out_of_range('damping request', 'power', m.power, 0, 65535)
-    return _frame_request(9, _S_DAMPINGREQUEST_SERVO_ID.pack(m.servo_id, m.power))
+    return _frame_request(9, _S_U8_U16.pack(m.servo_id, m.power))
 
 
 def _encode_damping_response(m: DampingResponse) -> bytes:
@@ -593,13 +593,13 @@ def _encode_damping_response(m: DampingResponse) -> bytes:
         raise out_of_range('damping response', 'servo_id', m.servo_id, 0, 254)
     if not 0 <= m.result <= 255:
         raise out_of_range('damping response', 'result', m.result, 0, 255)
-    return _frame_response(9, _S_RESETUSERDATARESPONSE_SERVO_ID.pack(m.servo_id, m.result))
+    return _frame_response(9, _S_U8_U8.pack(m.servo_id, m.result))
 
 
 def _encode_read_angle_request(m: ReadAngleRequest) -> bytes:
     if not 0 <= m.servo_id <= 254:
         raise out_of_range('read_angle request', 'servo_id', m.servo_id, 0, 254)
-    return _frame_request(10, _S_PINGREQUEST_SERVO_ID.pack(m.servo_id))
+    return _frame_request(10, _S_U8.pack(m.servo_id))
 
 
 def _encode_read_angle_response(m: ReadAngleResponse) -> bytes:
@@ -607,7 +607,7 @@ def _encode_read_angle_response(m: ReadAngleResponse) -> bytes:
         raise out_of_range('read_angle response', 'servo_id', m.servo_id, 0, 254)
     if not -32768 <= m.angle <= 32767:
         raise out_of_range('read_angle response', 'angle', m.angle, -32768, 32767)
-    return _frame_response(10, _S_READANGLERESPONSE_SERVO_ID.pack(m.servo_id, m.angle))
+    return _frame_response(10, _S_U8_I16.pack(m.servo_id, m.angle))
 
 
 _REQUEST_DECODERS: dict[int | None, Callable[..., Message]] = {

@@ -5,10 +5,9 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
-from enum import IntEnum, IntFlag
+from enum import IntEnum
 from typing import Any, ClassVar, Self
 
-from serialspec.runtime.fields import as_bytes as _bytes
 from serialspec.runtime.fields import check_keys as _check_keys
 from serialspec.runtime.fields import get as _get
 from serialspec.runtime.fields import mapping as _mapping
@@ -16,40 +15,40 @@ from serialspec.runtime.message import Direction, Message
 from serialspec.runtime.message import enum_or_int as _enum
 
 __all__ = [
-    "BaudrateOption",
-    "DampingRequest",
-    "DampingResponse",
-    "Direction",
-    "LockOnPowerOn",
-    "MESSAGE_TYPES",
-    "Message",
-    "MethodBits",
-    "PingRequest",
-    "PingResponse",
-    "ReadAngleRequest",
-    "ReadAngleResponse",
-    "ReadBatchDataRequest",
-    "ReadBatchDataResponse",
-    "ReadDataRequest",
-    "ReadDataResponse",
-    "ResetUserDataRequest",
-    "ResetUserDataResponse",
-    "ResponseSwitch",
-    "Result",
-    "RotateRequest",
-    "RotateResponse",
-    "SpinDirection",
-    "SpinMode",
-    "SpinRequest",
-    "SpinResponse",
-    "StallProtectMode",
-    "Switch",
-    "UserData",
-    "WheelBrake",
-    "WriteBatchDataRequest",
-    "WriteBatchDataResponse",
-    "WriteDataRequest",
-    "WriteDataResponse",
+    'BaudrateOption',
+    'DampingRequest',
+    'DampingResponse',
+    'Direction',
+    'LockOnPowerOn',
+    'MESSAGE_TYPES',
+    'Message',
+    'MethodBits',
+    'PingRequest',
+    'PingResponse',
+    'ReadAngleRequest',
+    'ReadAngleResponse',
+    'ReadBatchDataRequest',
+    'ReadBatchDataResponse',
+    'ReadDataRequest',
+    'ReadDataResponse',
+    'ResetUserDataRequest',
+    'ResetUserDataResponse',
+    'ResponseSwitch',
+    'Result',
+    'RotateRequest',
+    'RotateResponse',
+    'SpinDirection',
+    'SpinMode',
+    'SpinRequest',
+    'SpinResponse',
+    'StallProtectMode',
+    'Switch',
+    'UserData',
+    'WheelBrake',
+    'WriteBatchDataRequest',
+    'WriteBatchDataResponse',
+    'WriteDataRequest',
+    'WriteDataResponse',
 ]
 
 
@@ -224,7 +223,7 @@ class UserData:
         }
 
     @classmethod
-    def from_fields(cls, data: Mapping[str, Any], where: str = "UserData") -> Self:
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'UserData') -> Self:
         _check_keys(data, ('reserved_32', 'response_switch', 'servo_id', 'reserved_35', 'baudrate', 'stall_protect_mode', 'stall_power_limit', 'over_volt_low', 'over_volt_high', 'over_temperature', 'over_power', 'over_current', 'accel_switch', 'reserved_45', 'po_lock_switch', 'wb_lock_switch', 'angle_limit_switch', 'soft_start_switch', 'soft_start_time', 'angle_limit_high', 'angle_limit_low', 'angle_mid_offset'), (), where)
         return cls(
             _get(data, 'reserved_32', where),
@@ -268,7 +267,7 @@ class MethodBits:
         }
 
     @classmethod
-    def from_fields(cls, data: Mapping[str, Any], where: str = "MethodBits") -> Self:
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'MethodBits') -> Self:
         _check_keys(data, ('direction', 'mode'), (), where)
         return cls(
             _enum(SpinDirection, _get(data, 'direction', where)),
@@ -293,7 +292,7 @@ class PingRequest(Message):
         }
 
     @classmethod
-    def from_fields(cls, data: Mapping[str, Any], where: str = "ping request") -> Self:
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'ping request') -> Self:
         _check_keys(data, ('servo_id',), (), where)
         return cls(
             _get(data, 'servo_id', where),
@@ -317,7 +316,7 @@ class PingResponse(Message):
         }
 
     @classmethod
-    def from_fields(cls, data: Mapping[str, Any], where: str = "ping response") -> Self:
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'ping response') -> Self:
         _check_keys(data, ('servo_id',), (), where)
         return cls(
             _get(data, 'servo_id', where),
@@ -341,7 +340,7 @@ class ResetUserDataRequest(Message):
         }
 
     @classmethod
-    def from_fields(cls, data: Mapping[str, Any], where: str = "reset_user_data request") -> Self:
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'reset_user_data request') -> Self:
         _check_keys(data, ('servo_id',), (), where)
         return cls(
             _get(data, 'servo_id', where),
@@ -368,7 +367,7 @@ class ResetUserDataResponse(Message):
         }
 
     @classmethod
-    def from_fields(cls, data: Mapping[str, Any], where: str = "reset_user_data response") -> Self:
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'reset_user_data response') -> Self:
         _check_keys(data, ('servo_id', 'result'), (), where)
         return cls(
             _get(data, 'servo_id', where),
@@ -396,7 +395,7 @@ class ReadDataRequest(Message):
         }
 
     @classmethod
-    def from_fields(cls, data: Mapping[str, Any], where: str = "read_data request") -> Self:
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'read_data request') -> Self:
         _check_keys(data, ('servo_id', 'data_id'), (), where)
         return cls(
             _get(data, 'servo_id', where),
@@ -427,7 +426,7 @@ class ReadDataResponse(Message):
         }
 
     @classmethod
-    def from_fields(cls, data: Mapping[str, Any], where: str = "read_data response") -> Self:
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'read_data response') -> Self:
         _check_keys(data, ('servo_id', 'data_id', 'data'), (), where)
         return cls(
             _get(data, 'servo_id', where),
@@ -459,7 +458,7 @@ class WriteDataRequest(Message):
         }
 
     @classmethod
-    def from_fields(cls, data: Mapping[str, Any], where: str = "write_data request") -> Self:
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'write_data request') -> Self:
         _check_keys(data, ('servo_id', 'data_id', 'data'), (), where)
         return cls(
             _get(data, 'servo_id', where),
@@ -491,7 +490,7 @@ class WriteDataResponse(Message):
         }
 
     @classmethod
-    def from_fields(cls, data: Mapping[str, Any], where: str = "write_data response") -> Self:
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'write_data response') -> Self:
         _check_keys(data, ('servo_id', 'data_id', 'result'), (), where)
         return cls(
             _get(data, 'servo_id', where),
@@ -517,7 +516,7 @@ class ReadBatchDataRequest(Message):
         }
 
     @classmethod
-    def from_fields(cls, data: Mapping[str, Any], where: str = "read_batch_data request") -> Self:
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'read_batch_data request') -> Self:
         _check_keys(data, ('servo_id',), (), where)
         return cls(
             _get(data, 'servo_id', where),
@@ -544,7 +543,7 @@ class ReadBatchDataResponse(Message):
         }
 
     @classmethod
-    def from_fields(cls, data: Mapping[str, Any], where: str = "read_batch_data response") -> Self:
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'read_batch_data response') -> Self:
         _check_keys(data, ('servo_id', 'user_data'), (), where)
         return cls(
             _get(data, 'servo_id', where),
@@ -572,7 +571,7 @@ class WriteBatchDataRequest(Message):
         }
 
     @classmethod
-    def from_fields(cls, data: Mapping[str, Any], where: str = "write_batch_data request") -> Self:
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'write_batch_data request') -> Self:
         _check_keys(data, ('servo_id', 'user_data'), (), where)
         return cls(
             _get(data, 'servo_id', where),
@@ -600,7 +599,7 @@ class WriteBatchDataResponse(Message):
         }
 
     @classmethod
-    def from_fields(cls, data: Mapping[str, Any], where: str = "write_batch_data response") -> Self:
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'write_batch_data response') -> Self:
         _check_keys(data, ('servo_id', 'result'), (), where)
         return cls(
             _get(data, 'servo_id', where),
@@ -634,7 +633,7 @@ class SpinRequest(Message):
         }
 
     @classmethod
-    def from_fields(cls, data: Mapping[str, Any], where: str = "spin request") -> Self:
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'spin request') -> Self:
         _check_keys(data, ('servo_id', 'method', 'speed', 'value'), (), where)
         return cls(
             _get(data, 'servo_id', where),
@@ -664,7 +663,7 @@ class SpinResponse(Message):
         }
 
     @classmethod
-    def from_fields(cls, data: Mapping[str, Any], where: str = "spin response") -> Self:
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'spin response') -> Self:
         _check_keys(data, ('servo_id', 'result'), (), where)
         return cls(
             _get(data, 'servo_id', where),
@@ -698,7 +697,7 @@ class RotateRequest(Message):
         }
 
     @classmethod
-    def from_fields(cls, data: Mapping[str, Any], where: str = "rotate request") -> Self:
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'rotate request') -> Self:
         _check_keys(data, ('servo_id', 'angle', 'interval', 'power'), (), where)
         return cls(
             _get(data, 'servo_id', where),
@@ -728,7 +727,7 @@ class RotateResponse(Message):
         }
 
     @classmethod
-    def from_fields(cls, data: Mapping[str, Any], where: str = "rotate response") -> Self:
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'rotate response') -> Self:
         _check_keys(data, ('servo_id', 'result'), (), where)
         return cls(
             _get(data, 'servo_id', where),
@@ -756,7 +755,7 @@ class DampingRequest(Message):
         }
 
     @classmethod
-    def from_fields(cls, data: Mapping[str, Any], where: str = "damping request") -> Self:
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'damping request') -> Self:
         _check_keys(data, ('servo_id', 'power'), (), where)
         return cls(
             _get(data, 'servo_id', where),
@@ -784,7 +783,7 @@ class DampingResponse(Message):
         }
 
     @classmethod
-    def from_fields(cls, data: Mapping[str, Any], where: str = "damping response") -> Self:
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'damping response') -> Self:
         _check_keys(data, ('servo_id', 'result'), (), where)
         return cls(
             _get(data, 'servo_id', where),
@@ -809,7 +808,7 @@ class ReadAngleRequest(Message):
         }
 
     @classmethod
-    def from_fields(cls, data: Mapping[str, Any], where: str = "read_angle request") -> Self:
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'read_angle request') -> Self:
         _check_keys(data, ('servo_id',), (), where)
         return cls(
             _get(data, 'servo_id', where),
@@ -836,7 +835,7 @@ class ReadAngleResponse(Message):
         }
 
     @classmethod
-    def from_fields(cls, data: Mapping[str, Any], where: str = "read_angle response") -> Self:
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'read_angle response') -> Self:
         _check_keys(data, ('servo_id', 'angle'), (), where)
         return cls(
             _get(data, 'servo_id', where),

@@ -34,7 +34,6 @@ from construct import (  # noqa: F401 - the set of names is the same for every p
     len_,
     this,
 )
-
 from serialspec.runtime.checksums import sum_function
 from serialspec.runtime.constructs import SignMagnitude  # noqa: F401
 
@@ -42,7 +41,9 @@ _checksum = sum_function(8, invert=False)
 
 
 def _item_size(context: Any, field: str) -> int:
-    """Size of the bytes `field` in every item of the group being built (they must all be equal)."""
+    """Size of the bytes `field`: beside the size field, or in every item of a group (they must all be equal)."""
+    if isinstance(context.get(field), bytes | bytearray):
+        return len(context[field])
     for value in context.values():
         if isinstance(value, list) and value and field in value[0]:
             return len(value[0][field])
@@ -210,24 +211,24 @@ ReadAngleResponseContent = Struct(
 )
 
 CONTENTS: dict[tuple[str, str], Any] = {
-    ("ping", "request"): PingRequestContent,
-    ("ping", "response"): PingResponseContent,
-    ("reset_user_data", "request"): ResetUserDataRequestContent,
-    ("reset_user_data", "response"): ResetUserDataResponseContent,
-    ("read_data", "request"): ReadDataRequestContent,
-    ("read_data", "response"): ReadDataResponseContent,
-    ("write_data", "request"): WriteDataRequestContent,
-    ("write_data", "response"): WriteDataResponseContent,
-    ("read_batch_data", "request"): ReadBatchDataRequestContent,
-    ("read_batch_data", "response"): ReadBatchDataResponseContent,
-    ("write_batch_data", "request"): WriteBatchDataRequestContent,
-    ("write_batch_data", "response"): WriteBatchDataResponseContent,
-    ("spin", "request"): SpinRequestContent,
-    ("spin", "response"): SpinResponseContent,
-    ("rotate", "request"): RotateRequestContent,
-    ("rotate", "response"): RotateResponseContent,
-    ("damping", "request"): DampingRequestContent,
-    ("damping", "response"): DampingResponseContent,
-    ("read_angle", "request"): ReadAngleRequestContent,
-    ("read_angle", "response"): ReadAngleResponseContent,
+    ('ping', 'request'): PingRequestContent,
+    ('ping', 'response'): PingResponseContent,
+    ('reset_user_data', 'request'): ResetUserDataRequestContent,
+    ('reset_user_data', 'response'): ResetUserDataResponseContent,
+    ('read_data', 'request'): ReadDataRequestContent,
+    ('read_data', 'response'): ReadDataResponseContent,
+    ('write_data', 'request'): WriteDataRequestContent,
+    ('write_data', 'response'): WriteDataResponseContent,
+    ('read_batch_data', 'request'): ReadBatchDataRequestContent,
+    ('read_batch_data', 'response'): ReadBatchDataResponseContent,
+    ('write_batch_data', 'request'): WriteBatchDataRequestContent,
+    ('write_batch_data', 'response'): WriteBatchDataResponseContent,
+    ('spin', 'request'): SpinRequestContent,
+    ('spin', 'response'): SpinResponseContent,
+    ('rotate', 'request'): RotateRequestContent,
+    ('rotate', 'response'): RotateResponseContent,
+    ('damping', 'request'): DampingRequestContent,
+    ('damping', 'response'): DampingResponseContent,
+    ('read_angle', 'request'): ReadAngleRequestContent,
+    ('read_angle', 'response'): ReadAngleResponseContent,
 }

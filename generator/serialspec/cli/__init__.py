@@ -6,11 +6,11 @@ import argparse
 import sys
 from collections.abc import Sequence
 
-from serialspec.cli import check, decode, encode, generate
+from serialspec.cli import check, decode, encode, generate, monitor, sim
 from serialspec.runtime.errors import SerialspecError
 from serialspec.spec.errors import SpecErrors
 
-VERBS = {"generate": generate, "check": check, "decode": decode, "encode": encode}
+VERBS = {"generate": generate, "check": check, "decode": decode, "encode": encode, "sim": sim, "monitor": monitor}
 
 
 def main(argv: Sequence[str] | None = None) -> int:

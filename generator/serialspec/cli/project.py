@@ -24,7 +24,9 @@ def find_root(start: Path | None = None) -> Path:
 
 def expected_files(root: Path) -> tuple[dict[Path, str], list[SpecError]]:
     """Every generated file, by path, from the valid specs under root; and every mistake in the others."""
-    files: dict[Path, str] = {root / "specs" / SCHEMA_NAME: json.dumps(json_schema(), indent=2, ensure_ascii=False) + "\n"}
+    files: dict[Path, str] = {
+        root / "specs" / SCHEMA_NAME: json.dumps(json_schema(), indent=2, ensure_ascii=False) + "\n"
+    }
     errors = []
     for spec in sorted((root / "specs").glob("*.yaml")):
         try:

@@ -5,8 +5,18 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from serialspec.emit.pycode import ClassCode, PackageCode, decoder_name, encoder_name, frame_lines, number, one_line
+from serialspec.emit.client import client_module
+from serialspec.emit.pycode import (
+    ClassCode,
+    PackageCode,
+    decoder_name,
+    encoder_name,
+    frame_lines,
+    number,
+    one_line,
+)
 from serialspec.emit.render import render
+from serialspec.emit.simulator import simulator_module
 from serialspec.emit.structs import structs_module
 from serialspec.spec.model import Command, Direction, Message, Protocol, Scalar, Table, TableValue
 
@@ -43,23 +53,63 @@ def emit_package(protocol: Protocol) -> dict[str, str]:
         if message:
             cls.doc = one_line(message_doc(protocol, message))
         classes.append(class_context(cls, where, _keys(cls), optional))
-    enums = [{"class_name": e.class_name, "doc": one_line(e.description or e.name.replace("_", " ")),
-              "values": [{"name": v.name, "value": v.value, "text": one_line(v.text)} for v in e.values]}
-             for e in protocol.enums]
-    flag_sets = [{"class_name": f.class_name, "doc": one_line(f.description or f.name.replace("_", " ")),
-                  "bits": [{"name": b.name, "bit": b.bit, "text": one_line(b.text)} for b in f.bits]}
-                 for f in protocol.flags]
-    exports = sorted([*(e["class_name"] for e in enums), *(f["class_name"] for f in flag_sets),
-                      *(c["name"] for c in classes), "MESSAGE_TYPES", "Direction", "Message"])
+    enums = [
+        {
+            "class_name": e.class_name,
+            "doc": one_line(e.description or e.name.replace("_", " ")),
+            "values": [{"name": v.name, "value": v.value, "text": one_line(v.text)} for v in e.values],
+        }
+        for e in protocol.enums
+    ]
+    flag_sets = [
+        {
+            "class_name": f.class_name,
+            "doc": one_line(f.description or f.name.replace("_", " ")),
+            "bits": [{"name": b.name, "bit": b.bit, "text": one_line(b.text)} for b in f.bits],
+        }
+        for f in protocol.flags
+    ]
+    exports = sorted(
+        [
+            *(e["class_name"] for e in enums),
+            *(f["class_name"] for f in flag_sets),
+            *(c["name"] for c in classes),
+            "MESSAGE_TYPES",
+            "Direction",
+            "Message",
+        ]
+    )
     files = {
-        "messages.py": render("messages.py.j2", **base, enums=enums, flag_sets=flag_sets, classes=classes,
-                              message_classes=[c for c in classes if c["name"] in messages], exports=exports),
-        "codec.py": render("codec.py.j2", **base, **codec_context(protocol, code, exports)),
+        "messages.py": render(
+            "messages.py.j2",
+            used="\n".join(line for c in classes for line in [*c["to_fields"], *c["from_fields"]]),
+            **base,
+            enums=enums,
+            flag_sets=flag_sets,
+            classes=classes,
+            message_classes=[c for c in classes if c["name"] in messages],
+            exports=exports,
+        ),
+        "codec.py": render(
+            "codec.py.j2",
+            **base,
+            **codec_context(protocol, code, exports),
+            used="\n".join(line for _, _, _, lines in code.decoders for line in lines),
+        ),
         "structs.py": structs_module(protocol),
-        "__init__.py": render("init.py.j2", **base, description=one_line(protocol.description),
-                              baudrate=protocol.serial.baudrate),
+        "__init__.py": render(
+            "init.py.j2",
+            **base,
+            description=one_line(protocol.description),
+            baudrate=protocol.serial.baudrate,
+            serial=protocol.serial,
+            match_by=repr(protocol.matching),
+        ),
+        "client.py": client_module(protocol),
         "py.typed": "",
     }
+    if protocol.device is not None:
+        files["simulator.py"] = simulator_module(protocol)
     return files
 
 
@@ -83,8 +133,10 @@ def codec_context(protocol: Protocol, code: PackageCode, exports: list[str]) -> 
         assert checksum.crc is not None
         c = checksum.crc
         checksum_import = "crc_function"
-        checksum_expr = (f"crc_function({c.width}, {c.poly:#x}, {c.init:#x}, {c.refin}, {c.refout}, {c.xorout:#x})"
-                         f"  # {one_line(c.name)}")
+        checksum_expr = (
+            f"crc_function({c.width}, {c.poly:#x}, {c.init:#x}, {c.refin}, {c.refout}, {c.xorout:#x})"
+            f"  # {one_line(c.name)}"
+        )
     else:
         checksum_import = "sum_function"
         checksum_expr = f"sum_function({checksum.type.size * 8}, invert={checksum.invert})"
@@ -106,32 +158,42 @@ def codec_context(protocol: Protocol, code: PackageCode, exports: list[str]) -> 
             dispatch.append((key, target))
             sizes.append((key, low, high))
             if sub_dispatch:
-                dispatchers.append(sub_dispatch | {"extra": "".join(f", {e.name}: int" for e in layout.value_elements),
-                                                   "args": "".join(f", {e.name}" for e in layout.value_elements)})
+                dispatchers.append(
+                    sub_dispatch
+                    | {
+                        "extra": "".join(f", {e.name}: int" for e in layout.value_elements),
+                        "args": "".join(f", {e.name}" for e in layout.value_elements),
+                    }
+                )
         trim = layout.covered_to_end
-        directions.append({
-            "name": direction.value,
-            "upper": direction.name,
-            "header": repr(layout.header),
-            "header_hex": layout.header.hex(" "),
-            "header_size": len(layout.header),
-            "overhead": layout.overhead,
-            "length_offset": layout.length_offset,
-            "length_adds": layout.length_adds,
-            "command_offset": layout.command_offset,
-            "code_expr": f"data[{layout.command_offset}]" if layout.command_offset is not None else "None",
-            "unknown_message": (f"f\"unknown command {{data[{layout.command_offset}]:#04x}}\""
-                                if layout.command_offset is not None else f"\"no {direction.value} is defined\""),
-            "covered_from": layout.covered_from,
-            "covered_end": f"-{trim}" if trim else "",
-            "checksum_size": layout.checksum_offset_from_end,
-            "content_offset": layout.offsets[next(e.name for e in layout.elements if e.role == "content")],
-            "after_content": layout.overhead - layout.offsets[next(e.name for e in layout.elements
-                                                                   if e.role == "content")],
-            "value_args": "".join(f", data[{layout.offsets[e.name]}]" for e in layout.value_elements),
-            "dispatch": dispatch,
-            "sizes": sizes,
-        })
+        directions.append(
+            {
+                "name": direction.value,
+                "upper": direction.name,
+                "header": repr(layout.header),
+                "header_hex": layout.header.hex(" "),
+                "header_size": len(layout.header),
+                "overhead": layout.overhead,
+                "length_offset": layout.length_offset,
+                "length_adds": layout.length_adds,
+                "command_offset": layout.command_offset,
+                "code_expr": f"data[{layout.command_offset}]" if layout.command_offset is not None else "None",
+                "unknown_message": (
+                    f'f"unknown command {{data[{layout.command_offset}]:#04x}}"'
+                    if layout.command_offset is not None
+                    else f'"no {direction.value} is defined"'
+                ),
+                "covered_from": layout.covered_from,
+                "covered_end": f"-{trim}" if trim else "",
+                "checksum_size": layout.checksum_offset_from_end,
+                "content_offset": layout.offsets[next(e.name for e in layout.elements if e.role == "content")],
+                "after_content": layout.overhead
+                - layout.offsets[next(e.name for e in layout.elements if e.role == "content")],
+                "value_args": "".join(f", data[{layout.offsets[e.name]}]" for e in layout.value_elements),
+                "dispatch": dispatch,
+                "sizes": sizes,
+            }
+        )
     layouts = protocol.framing.layouts
     header_choices = " or ".join(layouts[d].header.hex(" ") for d in Direction)
     encoder_table = [(m.class_name, encoder_name(m)) for m in protocol.messages()]
@@ -139,15 +201,19 @@ def codec_context(protocol: Protocol, code: PackageCode, exports: list[str]) -> 
         "checksum_import": checksum_import,
         "checksum_expr": checksum_expr,
         "structs": sorted(code.structs.items()),
-        "tables": [table_context(t) for t in protocol.tables if any(uses_table(m, t.name) for m in protocol.messages())],
+        "tables": [
+            table_context(t) for t in protocol.tables if any(uses_table(m, t.name) for m in protocol.messages())
+        ],
         "framers": framers,
         "decoders": [{"name": n, "returns": r, "extra": e, "lines": lines} for n, r, e, lines in code.decoders],
         "encoders": [{"name": n, "type": t, "lines": lines} for n, t, lines in code.encoders],
         "directions": directions,
         "dispatchers": dispatchers,
         "encoder_table": encoder_table,
-        "imports": sorted(n for n in exports if n not in ("Direction", "Message", "MESSAGE_TYPES")
-                          and used_in_codec(n, code)),
+        "imports": sorted(
+            (n for n in exports if n not in ("Direction", "Message", "MESSAGE_TYPES") and used_in_codec(n, code)),
+            key=str.lower,  # the order isort (ruff) expects
+        ),
         "shared_header": protocol.framing.shared_header,
         "header_choices": header_choices,
     }
@@ -180,18 +246,27 @@ def direction_entry(command: Command, direction: Direction) -> tuple[str, int, i
         if message is None:
             return None
         return decoder_name(message), message.min_size, message.max_size, {}
-    messages = [m for s in command.subcommands
-                if (m := s.request if direction == Direction.REQUEST else s.response) is not None]
+    messages = [
+        m for s in command.subcommands if (m := s.request if direction == Direction.REQUEST else s.response) is not None
+    ]
     if not messages:
         return None
     low = min(m.min_size for m in messages)
     high = None if any(m.max_size is None for m in messages) else max(m.max_size or 0 for m in messages)
     name = f"_decode_{command.name}_{direction.value}"
     table = f"_{command.name.upper()}_{direction.name}_SUBCOMMANDS"
-    entries = [(f"{s.code:#04x}", decoder_name(m)) for s in command.subcommands
-               if (m := s.request if direction == Direction.REQUEST else s.response) is not None]
-    sub = {"name": name, "offset": command.selector.offsets[direction], "table": table, "entries": entries,
-           "where": f"{command.name} {direction.value}"}
+    entries = [
+        (f"{s.code:#04x}", decoder_name(m))
+        for s in command.subcommands
+        if (m := s.request if direction == Direction.REQUEST else s.response) is not None
+    ]
+    sub = {
+        "name": name,
+        "offset": command.selector.offsets[direction],
+        "table": table,
+        "entries": entries,
+        "where": f"{command.name} {direction.value}",
+    }
     return name, low, high, sub
 
 

@@ -7,6 +7,7 @@ identifiers, and every piece of spec text reaches generated code through repr(),
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 
 from serialspec.spec.model import (
@@ -25,6 +26,7 @@ from serialspec.spec.model import Field as SpecField
 from serialspec.spec.resolve import fixed_size
 
 Lines = list[str]
+_STRUCT_NAMES = {"B": "U8", "b": "I8", "H": "U16", "h": "I16", "I": "U32", "i": "I32", "f": "F32"}
 
 
 def decoder_name(message: Message) -> str:
@@ -57,7 +59,8 @@ def struct_format(endian: str, fields: list[SpecField]) -> str:
         elif isinstance(f, TableBlock):
             chars.extend(e.type.struct_char for e in f.entries)
         elif isinstance(f, Group):
-            chars.extend(struct_format("", list(f.fields)) * int(f.count))  # type: ignore[call-overload]
+            assert isinstance(f.count, int)
+            chars.append(struct_format("", list(f.fields)) * f.count)
     return endian + "".join(chars)
 
 
@@ -126,14 +129,16 @@ class PackageCode:
     # --- structs --------------------------------------------------------------------------------------------------
 
     def struct(self, base_name: str, fmt: str) -> str:
+        """A shared struct.Struct constant for a format, named after its layout (e.g. _S_U8_I16_U16_U16)."""
         for name, existing in self.structs.items():
             if existing == fmt:
                 return name
-        name = f"_S_{base_name.upper()}"
-        suffix = 2
-        while name in self.structs:
-            name = f"_S_{base_name.upper()}_{suffix}"
-            suffix += 1
+        tokens = []
+        for count, char in re.findall(r"(\d*)([a-zA-Z?])", fmt):
+            token = _STRUCT_NAMES.get(char, char.upper())
+            tokens.append(f"{token}X{count}" if count and char != "s" else (f"B{count}" if char == "s" else token))
+        layout = "_".join(tokens) if len(tokens) <= 6 else base_name.upper()
+        name = "_S_" + ("BE_" if fmt.startswith(">") else "") + layout
         self.structs[name] = fmt
         return name
 
@@ -149,8 +154,25 @@ class PackageCode:
         for element in layout.value_elements:
             assert element.type is not None
             values.append(
-                Scalar(element.name, element.description, "", "", element.type, "<", "", None,
-                       element.minimum, element.maximum, None, None, None, element.flags, (), "", False)
+                Scalar(
+                    element.name,
+                    element.description,
+                    "",
+                    "",
+                    element.type,
+                    "<",
+                    "",
+                    None,
+                    element.minimum,
+                    element.maximum,
+                    None,
+                    None,
+                    None,
+                    element.flags,
+                    (),
+                    "",
+                    False,
+                )
             )
         return values
 
@@ -164,8 +186,9 @@ class PackageCode:
             else:
                 break
         for f in fields:
-            default = f" = {number(f.default)}" if isinstance(f, Scalar) and f.name in trailing_defaults else ""
-            assert default == "" or isinstance(f, Scalar) and f.default is not None
+            default = ""
+            if isinstance(f, Scalar) and f.default is not None and f.name in trailing_defaults:
+                default = f" = {number(f.default)}"
             lines.append(f"{f.name}: {annotation(f)}{default}")
             lines.append(f"#: {doc_line(f)}")
         return lines
@@ -181,7 +204,9 @@ class PackageCode:
                 attributes += [f"{bit.name}: {kind}", f"#: {one_line(bit.description or bit.name)} ({where})"]
             code = ClassCode(f.bits_class, f"Bit fields of {f.name}.", "", attributes)
             code.to_fields = [f"{b.name!r}: int(self.{b.name})," for b in f.bits]
-            code.from_fields = [self.from_value_expr_bits(b.name, b.enum.class_name if b.enum else None) for b in f.bits]
+            code.from_fields = [
+                self.from_value_expr_bits(b.name, b.enum.class_name if b.enum else None) for b in f.bits
+            ]
             self.helper_classes.append(code)
         elif isinstance(f, Group) and f.class_name not in self._seen_classes:
             self._seen_classes.add(f.class_name)
@@ -198,11 +223,18 @@ class PackageCode:
             for e in f.entries:
                 kind = f"{e.enum.class_name} | int" if e.enum else ("float" if e.type.is_float else "int")
                 unit = f" [{e.unit}]" if e.unit else ""
-                attributes += [f"{e.name}: {kind}", f"#: {one_line(f'{f.table.key_name} {e.key}: {e.description or e.name}{unit}')}"]
+                attributes += [
+                    f"{e.name}: {kind}",
+                    f"#: {one_line(f'{f.table.key_name} {e.key}: {e.description or e.name}{unit}')}",
+                ]
             code = ClassCode(f.class_name, one_line(f"{f.description or f.name} ({f.table.title})."), "", attributes)
-            code.to_fields = [f"{e.name!r}: {'int(self.' + e.name + ')' if e.enum else 'self.' + e.name}," for e in f.entries]
+            code.to_fields = [
+                f"{e.name!r}: {'int(self.' + e.name + ')' if e.enum else 'self.' + e.name}," for e in f.entries
+            ]
             code.from_fields = [
-                f"_enum({e.enum.class_name}, _get(data, {e.name!r}, where))," if e.enum else f"_get(data, {e.name!r}, where),"
+                f"_enum({e.enum.class_name}, _get(data, {e.name!r}, where)),"
+                if e.enum
+                else f"_get(data, {e.name!r}, where),"
                 for e in f.entries
             ]
             self.helper_classes.append(code)
@@ -242,8 +274,7 @@ class PackageCode:
         if isinstance(f, Bytes):
             return f"_bytes({get}, {f.name!r}, where)"
         if isinstance(f, Group):
-            return (f"tuple({f.class_name}.from_fields(_mapping(item, {f.name!r}, where), where) "
-                    f"for item in {get})")
+            return f"tuple({f.class_name}.from_fields(_mapping(item, {f.name!r}, where), where) for item in {get})"
         if isinstance(f, TableBlock):
             return f"{f.class_name}.from_fields(_mapping({get}, {f.name!r}, where), where)"
         return get
@@ -289,8 +320,9 @@ class PackageCode:
         lines.append(f"    raise content_size_error({where}, end - o, {low}, {high})")
         values = self.decode_fields(list(message.fields), message.class_name, lines, where, top=True)
         frame_fields = all_fields[: len(all_fields) - len(self.value_fields(message))]
-        frame_values = [f"{f.flags.class_name}({f.name})" if isinstance(f, Scalar) and f.flags else f.name
-                        for f in frame_fields]
+        frame_values = [
+            f"{f.flags.class_name}({f.name})" if isinstance(f, Scalar) and f.flags else f.name for f in frame_fields
+        ]
         args = ", ".join([*frame_values, *values])
         lines.append(f"return {message.class_name}({args})")
         return lines
@@ -320,7 +352,7 @@ class PackageCode:
         fmt = struct_format(endian, run)
         const_name = self.struct(f"{base}_{run[0].name}", fmt)
         size = sum(fixed_size(f) or 0 for f in run)
-        simple = all(isinstance(f, Scalar) or isinstance(f, Bytes) for f in run)
+        simple = all(isinstance(f, Scalar | Bytes) for f in run)
         values: list[str] = []
         if simple:
             names = [self.local(f) for f in run]
@@ -409,7 +441,8 @@ class PackageCode:
             lines.append("if s is None:")
             lines.append(f"    raise DecodeError({where} + f': unknown {f.table.key_name} {{{key}}}')")
             lines.append("if end - o < s.size:")
-            lines.append(f"    raise DecodeError({where} + f': {f.name} needs {{s.size}} bytes for {f.table.key_name} {{{key}}}')")
+            reason = f"{f.name} needs {{s.size}} bytes for {f.table.key_name} {{{key}}}"
+            lines.append(f"    raise DecodeError({where} + f': {reason}')")
             lines.append(f"({self.local(f)},) = s.unpack_from(buf, o)")
             lines.append("o += s.size")
             return self.local(f)
@@ -421,19 +454,23 @@ class PackageCode:
             item_struct = self.struct(f"{f.class_name}", item_fmt)
             if f.count == "rest":
                 lines.append(f"if (end - o) % {f.item_size}:")
-                lines.append(f"    raise DecodeError({where} + f': {{end - o}} bytes do not split into {f.name} items of {f.item_size}')")
+                reason = f"{{end - o}} bytes do not split into {f.name} items of {f.item_size}"
+                lines.append(f"    raise DecodeError({where} + f': {reason}')")
                 lines.append("n = end - o")
             else:
                 count = str(f.count) if isinstance(f.count, int) else self.local_named(f.count)
                 lines.append(f"n = {count} * {f.item_size}")
                 lines.append("if end - o < n:")
-                lines.append(f"    raise DecodeError({where} + f': content too short for its count ({{{count}}} {f.name})')")
+                lines.append(
+                    f"    raise DecodeError({where} + f': content too short for its count ({{{count}}} {f.name})')"
+                )
             names = [self.local(i) for i in item_fields]
             item_lines: Lines = []
             item_values = [self.after_unpack(i, n, item_lines, where) for i, n in zip(item_fields, names, strict=True)]
             if item_lines:  # an item needs checks: decode it in a loop
                 lines.append(f"{value}_list = []")
-                lines.append(f"for {', '.join(names)}{',' if len(names) == 1 else ''} in {item_struct}.iter_unpack(buf[o : o + n]):")
+                target = ", ".join(names) + ("," if len(names) == 1 else "")
+                lines.append(f"for {target} in {item_struct}.iter_unpack(buf[o : o + n]):")
                 lines.extend("    " + line for line in item_lines)
                 args = ", ".join(v for v in item_values if v is not None)
                 lines.append(f"    {value}_list.append({f.class_name}({args}))")
@@ -441,7 +478,9 @@ class PackageCode:
             else:
                 target = ", ".join(names) + ("," if len(names) == 1 else "")
                 args = ", ".join(v for v in item_values if v is not None)
-                lines.append(f"{value} = tuple({f.class_name}({args}) for {target} in {item_struct}.iter_unpack(buf[o : o + n]))")
+                lines.append(
+                    f"{value} = tuple({f.class_name}({args}) for {target} in {item_struct}.iter_unpack(buf[o : o + n]))"
+                )
             lines.append("o += n")
             return value
         # items of varying size: read them one by one
@@ -452,9 +491,9 @@ class PackageCode:
             count = str(f.count) if isinstance(f.count, int) else self.local_named(f.count)
             lines.append(f"for _ in range({count}):")
         inner: Lines = []
-        item_values = self.decode_fields(item_fields, f.class_name, inner, where, top=False)
+        item_args = self.decode_fields(item_fields, f.class_name, inner, where, top=False)
         lines.extend("    " + line for line in inner)
-        lines.append(f"    {value}_list.append({f.class_name}({', '.join(item_values)}))")
+        lines.append(f"    {value}_list.append({f.class_name}({', '.join(item_args)}))")
         lines.append(f"{value} = tuple({value}_list)")
         return value
 
@@ -471,9 +510,10 @@ class PackageCode:
         lines: Lines = []
         where = self.where(message)
         frame_fields = all_fields[: len(all_fields) - len(self.value_fields(message))]
+        elements = {e.name: e for e in self.protocol.framing.layouts[message.direction].value_elements}
         for f in frame_fields:
             assert isinstance(f, Scalar)
-            self.check_scalar(f, f"m.{f.name}", lines, where)
+            self.check_scalar(f, f"m.{f.name}", lines, where, also=elements[f.name].broadcast)
         parts = self.encode_fields(list(message.fields), message.class_name, "m", lines, where)
         content = parts[0] if len(parts) == 1 else f"b''.join(({', '.join(parts)},))"
         if not parts:
@@ -483,8 +523,12 @@ class PackageCode:
         lines.append(f"return _frame_{message.direction.value}({code if code is not None else 0}, {values}{content})")
         return lines
 
-    def check_scalar(self, f: Scalar, expr: str, lines: Lines, where: str) -> None:
-        lines.append(f"if not {number(f.minimum)} <= {expr} <= {number(f.maximum)}:")
+    def check_scalar(self, f: Scalar, expr: str, lines: Lines, where: str, also: int | None = None) -> None:
+        """Range check; `also` is one more value allowed outside the range (an address's broadcast value)."""
+        if also is not None and not f.minimum <= also <= f.maximum:
+            lines.append(f"if not ({number(f.minimum)} <= {expr} <= {number(f.maximum)} or {expr} == {also}):")
+        else:
+            lines.append(f"if not {number(f.minimum)} <= {expr} <= {number(f.maximum)}:")
         lines.append(f"    raise out_of_range({where}, {f.name!r}, {expr}, {number(f.minimum)}, {number(f.maximum)})")
 
     def encode_fields(self, fields: list[SpecField], base: str, obj: str, lines: Lines, where: str) -> list[str]:
@@ -509,16 +553,20 @@ class PackageCode:
             return number(f.const)
         if f.derived:
             kind, target = f.derived[0], f.derived[1]
-            if kind == "count":
+            if kind == "count" or any(s.name == target for s in siblings):  # a count, or bytes beside their size
                 value = f"len({obj}.{target})"
             else:
                 group = next(s for s in siblings if isinstance(s, Group) and any(i.name == target for i in s.fields))
                 value = self.local_named(f.name)
                 lines.append(f"{value} = len({obj}.{group.name}[0].{target}) if {obj}.{group.name} else 0")
                 lines.append(f"if any(len(item.{target}) != {value} for item in {obj}.{group.name}):")
-                lines.append(f"    raise EncodeError({where} + ': every {target} of {group.name} must have the same length')")
+                lines.append(
+                    f"    raise EncodeError({where} + ': every {target} of {group.name} must have the same length')"
+                )
             lines.append(f"if {value} > {number(f.maximum)}:")
-            lines.append(f"    raise out_of_range({where}, {f.name!r}, {value}, {number(f.minimum)}, {number(f.maximum)})")
+            lines.append(
+                f"    raise out_of_range({where}, {f.name!r}, {value}, {number(f.minimum)}, {number(f.maximum)})"
+            )
             return value
         expr = f"{obj}.{f.name}"
         if f.bits:
@@ -535,8 +583,9 @@ class PackageCode:
             return f"(-{expr} | {top:#x} if {expr} < 0 else {expr})"
         return expr
 
-    def encode_run(self, run: list[SpecField], base: str, obj: str, siblings: list[SpecField], lines: Lines,
-                   where: str) -> str:
+    def encode_run(
+        self, run: list[SpecField], base: str, obj: str, siblings: list[SpecField], lines: Lines, where: str
+    ) -> str:
         endian = next((f.endian for f in run if isinstance(f, Scalar | Array | TableBlock)), "<")
         const_name = self.struct(f"{base}_{run[0].name}", struct_format(endian, run))
         args: list[str] = []
@@ -546,21 +595,29 @@ class PackageCode:
             elif isinstance(f, Array):
                 expr = f"{obj}.{f.name}"
                 lines.append(f"if len({expr}) != {f.count}:")
-                lines.append(f"    raise EncodeError({where} + f': {f.name} needs {f.count} items, got {{len({expr})}}')")
+                lines.append(
+                    f"    raise EncodeError({where} + f': {f.name} needs {f.count} items, got {{len({expr})}}')"
+                )
                 lines.append(f"if any(not {number(f.minimum)} <= x <= {number(f.maximum)} for x in {expr}):")
-                lines.append(f"    raise out_of_range({where}, {f.name!r}, {expr}, {number(f.minimum)}, {number(f.maximum)})")
+                lines.append(
+                    f"    raise out_of_range({where}, {f.name!r}, {expr}, {number(f.minimum)}, {number(f.maximum)})"
+                )
                 args.append(f"*{expr}")
             elif isinstance(f, Bytes):
                 expr = f"{obj}.{f.name}"
                 lines.append(f"if len({expr}) != {f.size}:")
-                lines.append(f"    raise EncodeError({where} + f': {f.name} needs {f.size} bytes, got {{len({expr})}}')")
+                lines.append(
+                    f"    raise EncodeError({where} + f': {f.name} needs {f.size} bytes, got {{len({expr})}}')"
+                )
                 args.append(expr)
             elif isinstance(f, TableBlock):
                 for e in f.entries:
                     expr = f"{obj}.{f.name}.{e.name}"
                     lines.append(f"if not {number(e.minimum)} <= {expr} <= {number(e.maximum)}:")
-                    lines.append(f"    raise out_of_range({where}, {f.name + '.' + e.name!r}, {expr}, "
-                                 f"{number(e.minimum)}, {number(e.maximum)})")
+                    lines.append(
+                        f"    raise out_of_range({where}, {f.name + '.' + e.name!r}, {expr}, "
+                        f"{number(e.minimum)}, {number(e.maximum)})"
+                    )
                     args.append(expr)
         return f"{const_name}.pack({', '.join(args)})"
 
@@ -583,7 +640,8 @@ class PackageCode:
             lines.append(f"if len({expr}) != {f.count}:")
             lines.append(f"    raise EncodeError({where} + f': {f.name} needs {f.count} items, got {{len({expr})}}')")
         item_lines: Lines = []
-        parts = self.encode_fields(list(f.fields), f.class_name, "item", item_lines, where)
+        # the item encoder's parameter is `m`, like every encoder's (see codec.py.j2)
+        parts = self.encode_fields(list(f.fields), f.class_name, "m", item_lines, where)
         function = f"_encode_{f.class_name}"
         if all(name != function for name, _, _ in self.encoders):
             body = f"b''.join(({', '.join(parts)},))" if len(parts) > 1 else parts[0]

@@ -10,14 +10,16 @@ import jinja2
 
 @cache
 def environment() -> jinja2.Environment:
-    return jinja2.Environment(
+    env = jinja2.Environment(
         loader=jinja2.PackageLoader("serialspec.emit", "templates"),
         trim_blocks=True,
         lstrip_blocks=True,
         keep_trailing_newline=True,
         undefined=jinja2.StrictUndefined,
-        autoescape=False,  # noqa: S701 - we emit Python and markdown; text is escaped by the emitters
+        autoescape=False,  # we emit Python and markdown; emitters escape spec text for each
     )
+    env.filters["pyrepr"] = repr  # a Python literal, safe whatever the text holds
+    return env
 
 
 def render(template: str, **context: Any) -> str:

@@ -41,7 +41,8 @@ def field_expr(f: Field, parent: str = "this") -> str:
             kind, target = f.derived[0], f.derived[1]
             if kind == "count":
                 return f"Rebuild({base}, len_(this.{target}))"
-            return f"Rebuild({base}, _item_size(this, {target!r}))"
+            # evaluated while building: a lambda, so the context is the one being built, not `this` itself
+            return f"Rebuild({base}, lambda ctx: _item_size(ctx, {target!r}))"
         if f.bits:
             return bits_expr(f)
         if f.sign_magnitude:
@@ -54,9 +55,10 @@ def field_expr(f: Field, parent: str = "this") -> str:
             return "GreedyBytes"
         if isinstance(f.size, int):
             return f"Bytes({f.size})"
-        return f"Bytes(this._.{f.size})"
+        # inside a group item the size field sits in the enclosing content (this._), else beside the bytes
+        return f"Bytes({'this._' if parent == 'item' else 'this'}.{f.size})"
     if isinstance(f, Group):
-        item = "Struct(" + ", ".join(f"{i.name!r} / {field_expr(i)}" for i in f.fields) + ")"
+        item = "Struct(" + ", ".join(f"{i.name!r} / {field_expr(i, 'item')}" for i in f.fields) + ")"
         if f.count == "rest":
             return f"GreedyRange({item})"
         count = f.count if isinstance(f.count, int) else f"this.{f.count}"
@@ -112,19 +114,31 @@ def frame_expr(protocol: Protocol, layout: FrameLayout) -> str:
     trim = layout.covered_to_end - layout.checksum_offset_from_end
     covered = f"this.body.data[{layout.covered_from}:{-trim if trim else ''}]"
     del protocol
-    return (f"Struct('body' / RawCopy(Struct({', '.join(body)})), "
-            f"'{checksum.name}' / Checksum({primitive(checksum.type, '<')}, _checksum, {covered}))")
+    return (
+        f"Struct('body' / RawCopy(Struct({', '.join(body)})), "
+        f"'{checksum.name}' / Checksum({primitive(checksum.type, '<')}, _checksum, {covered}))"
+    )
 
 
 def structs_module(protocol: Protocol) -> str:
     contents = []
     for message in protocol.messages():
         fields = [f"{f.name!r} / {field_expr(f)}" for f in message.fields]
-        contents.append({"name": f"{message.class_name}Content", "fields": fields,
-                         "key": message.key, "direction": message.direction.value})
-    tables = [{"name": table_name(t.name), "entries": [(e.key, field_expr_entry(e.type, e.sign_magnitude))
-                                                        for e in t.entries if not e.reserved]}
-              for t in protocol.tables]
+        contents.append(
+            {
+                "name": f"{message.class_name}Content",
+                "fields": fields,
+                "key": message.key,
+                "direction": message.direction.value,
+            }
+        )
+    tables = [
+        {
+            "name": table_name(t.name),
+            "entries": [(e.key, field_expr_entry(e.type, e.sign_magnitude)) for e in t.entries if not e.reserved],
+        }
+        for t in protocol.tables
+    ]
     blocks = {}
     for message in protocol.messages():
         for f in message.fields:
@@ -139,11 +153,21 @@ def structs_module(protocol: Protocol) -> str:
         checksum_expr = f"crc_function({c.width}, {c.poly:#x}, {c.init:#x}, {c.refin}, {c.refout}, {c.xorout:#x})"
     else:
         checksum_expr = f"sum_function({checksum.type.size * 8}, invert={checksum.invert})"
-    frames = [{"name": f"{d.name}_FRAME", "expr": frame_expr(protocol, layout)}
-              for d, layout in protocol.framing.layouts.items()]
-    return render("structs.py.j2", spec_path=protocol.spec_path, title=one_line(protocol.title),
-                  contents=contents, tables=tables, blocks=blocks, frames=frames, checksum_expr=checksum_expr,
-                  checksum_import="crc_function" if checksum.algorithm == "crc" else "sum_function")
+    frames = [
+        {"name": f"{d.name}_FRAME", "expr": frame_expr(protocol, layout)}
+        for d, layout in protocol.framing.layouts.items()
+    ]
+    return render(
+        "structs.py.j2",
+        spec_path=protocol.spec_path,
+        title=one_line(protocol.title),
+        contents=contents,
+        tables=tables,
+        blocks=blocks,
+        frames=frames,
+        checksum_expr=checksum_expr,
+        checksum_import="crc_function" if checksum.algorithm == "crc" else "sum_function",
+    )
 
 
 def field_expr_entry(scalar: ScalarType, sign_magnitude: bool, endian: str = "<") -> str:

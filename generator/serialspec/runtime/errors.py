@@ -39,3 +39,36 @@ def content_size_error(where: str, got: int, low: int, high: int | None) -> Deco
 
 def _number(value: float) -> str:
     return str(int(value)) if float(value).is_integer() else str(value)
+
+
+# --- talking to devices -----------------------------------------------------------------------------------------
+
+
+class TransportError(SerialspecError):
+    """A transaction with a device failed; the bus stays usable."""
+
+
+class Timeout(TransportError, TimeoutError):
+    """No reply arrived before the deadline; names the command and the device it was sent to."""
+
+    def __init__(self, command: str, device: str, timeout: float) -> None:
+        super().__init__(f"no reply to {command} from {device or 'the device'} within {timeout * 1000:.0f} ms")
+        self.command = command
+        self.device = device
+        self.timeout = timeout
+
+
+class CorruptReply(TransportError):
+    """Bytes arrived where a reply was expected, but they are not a valid frame (bad checksum, bad content)."""
+
+
+class DeviceError(TransportError):
+    """The device answered with an error status (e.g. FEETECH error flags); `reply` is the decoded answer."""
+
+    def __init__(self, text: str, reply: object) -> None:
+        super().__init__(text)
+        self.reply = reply
+
+
+class PortError(TransportError, OSError):
+    """The port could not be opened, read or written."""

@@ -107,7 +107,11 @@ class ListOf(Shape):
             yield from self.item.check(item, (*path, index))
 
     def json_schema(self) -> dict[str, Any]:
-        schema: dict[str, Any] = {"type": "array", "items": self.item.json_schema(), "description": self.description}
+        schema: dict[str, Any] = {
+            "type": "array",
+            "items": self.item.json_schema(),
+            "description": self.description,
+        }
         if self.length is not None:
             schema["minItems"] = schema["maxItems"] = self.length
         return schema
@@ -132,7 +136,11 @@ class MapOf(Shape):
             yield from self.value.check(item, (*path, key))
 
     def json_schema(self) -> dict[str, Any]:
-        return {"type": "object", "additionalProperties": self.value.json_schema(), "description": self.description}
+        return {
+            "type": "object",
+            "additionalProperties": self.value.json_schema(),
+            "description": self.description,
+        }
 
 
 @dataclass
@@ -188,7 +196,13 @@ class OneOf(Shape):
 
 def _accepts_kind(shape: Shape, value: Any) -> bool:
     kinds: dict[type[Shape], type | tuple[type, ...]] = {
-        Str: str, Int: int, Num: (int, float), Bool: bool, ListOf: list, MapOf: dict, Obj: dict
+        Str: str,
+        Int: int,
+        Num: (int, float),
+        Bool: bool,
+        ListOf: list,
+        MapOf: dict,
+        Obj: dict,
     }
     expected = kinds.get(type(shape))
     return expected is not None and isinstance(value, expected)
@@ -197,9 +211,14 @@ def _accepts_kind(shape: Shape, value: Any) -> bool:
 def _kind(value: Any) -> str:
     if value is None:
         return "nothing"
-    return {bool: "true/false", int: "a number", float: "a number", str: "text", list: "a list", dict: "a mapping"}.get(
-        type(value), type(value).__name__
-    )
+    return {
+        bool: "true/false",
+        int: "a number",
+        float: "a number",
+        str: "text",
+        list: "a list",
+        dict: "a mapping",
+    }.get(type(value), type(value).__name__)
 
 
 # --- the language -------------------------------------------------------------------------------------------------
@@ -222,8 +241,11 @@ _FIELD_LONG: dict[str, Shape] = {
     "flags": Str("Name of an entry in `flags:`; the value is a set of bit flags."),
     "bits": MapOf(
         Obj(
-            {"bits": OneOf((Int(), ListOf(Int(), length=2)), "a bit number or [high, low]"),
-             "enum": Str("Name of an entry in `enums:`."), "description": TEXT},
+            {
+                "bits": OneOf((Int(), ListOf(Int(), length=2)), "a bit number or [high, low]"),
+                "enum": Str("Name of an entry in `enums:`."),
+                "description": TEXT,
+            },
             required=("bits",),
         ),
         "Sub-fields packed into this integer, by bit position (unlisted bits must be zero).",
@@ -251,6 +273,15 @@ MESSAGE = Obj(
         "optional": TEXT,
         "unsolicited": Bool("Sent by the device on its own, not as an answer."),
         "answers": Str("For a response: the request (command or command.subcommand) it answers, if another."),
+        "optional_when": Obj(
+            {
+                "parameter": Str("A table entry: `entry` or `table.entry` (e.g. response_switch)."),
+                "equals": Int("The value of the parameter with which the device answers."),
+            },
+            required=("parameter", "equals"),
+            description="For a response: sent only while a device parameter has this value.",
+        ),
+        "after": Str("For a response: the request field (in ms) after which the device answers, e.g. a move's time."),
         "source": TEXT,
     },
     description="One direction of a command: its content fields and how it is sent.",
@@ -271,8 +302,10 @@ SUBCOMMAND = Obj(
 
 COMMAND = Obj(
     {
-        "code": Int("Value of the frame's command field; omit for the one response of a protocol whose replies "
-                    "carry no command field."),
+        "code": Int(
+            "Value of the frame's command field; omit for the one response of a protocol whose replies "
+            "carry no command field."
+        ),
         "title": TEXT,
         "title_cn": Str(),
         "description": TEXT,
@@ -298,8 +331,10 @@ ENUM = Obj(
         "type": Str(choices=SCALAR_TYPES),
         "description": TEXT,
         "values": MapOf(
-            OneOf((Int(), Obj({"value": Int(), "text": TEXT, "text_cn": Str()}, required=("value",))),
-                  "a number or {value, text}"),
+            OneOf(
+                (Int(), Obj({"value": Int(), "text": TEXT, "text_cn": Str()}, required=("value",))),
+                "a number or {value, text}",
+            ),
             "Label -> wire value.",
         ),
     },
@@ -427,6 +462,43 @@ ERRATUM = Obj(
     required=("source", "printed", "correct", "check"),
 )
 
+DEVICE_COMMAND = Obj(
+    {
+        "description": TEXT,
+        "reads": ListOf(Str(), "Response fields filled from memory: table_value by its key, table_block entries."),
+        "writes": ListOf(Str(), "Request fields stored in memory: table_value by its key, table_block entries."),
+        "resets": Bool("Memory goes back to its defaults."),
+        "reports": MapOf(Str(), "Response field -> the state variable or memory entry it reports."),
+        "moves": Obj(
+            {
+                "state": Str("The state variable (or memory entry) that moves."),
+                "target": Str("The request field with the target."),
+                "duration": Str("The request field with the time to reach the target, in ms."),
+                "speed": Str("The request field with the speed, in state units per second."),
+            },
+            required=("state", "target"),
+        ),
+        "broadcast_reply": Bool("Answers even when addressed by broadcast (default: silent)."),
+    },
+    description="What the device does with one command (command or command.subcommand).",
+)
+
+DEVICE = Obj(
+    {
+        "description": TEXT,
+        "memory": Str("The table the device keeps, initialised from its defaults."),
+        "initial": MapOf(Num(), "Memory entry -> value the simulator starts with where the table gives no default."),
+        "address": Str("The field holding the device id (default: the frame's address element)."),
+        "id_entry": Str("The memory entry holding the device's own id (writing it changes the address)."),
+        "broadcast": Int("The address every device obeys (default: the address element's broadcast)."),
+        "state": MapOf(Num(), "State variables beyond memory -> initial value (e.g. the present angle)."),
+        "reply": MapOf(Num(), "Response field -> value when no behaviour sets it (e.g. result: 1)."),
+        "refused": MapOf(Num(), "Response field -> value when a write is refused (read-only or unknown entry)."),
+        "commands": MapOf(DEVICE_COMMAND, "Command (or command.subcommand) -> behaviour; others just answer."),
+    },
+    description="How the device behaves: what the generated simulator does, and the address rule the client uses.",
+)
+
 SPEC = Obj(
     {
         "protocol": Str("Python package name of the generated code."),
@@ -456,6 +528,7 @@ SPEC = Obj(
         "commands": MapOf(COMMAND),
         "examples": MapOf(EXAMPLE),
         "errata": MapOf(ERRATUM),
+        "device": DEVICE,
     },
     required=("protocol", "title", "byte_order", "serial", "framing", "commands"),
     description="A serialspec protocol spec.",

@@ -84,9 +84,7 @@ def _convert(node: yaml.Node, path: Path, located: Located, errors: list[SpecErr
                 continue
             if key in result:
                 line, column = _position(key_node)
-                errors.append(
-                    SpecError(located.file, line, column, dotted((*path, key)), f"duplicate key {key!r}")
-                )
+                errors.append(SpecError(located.file, line, column, dotted((*path, key)), f"duplicate key {key!r}"))
                 continue
             located.key_marks[(*path, key)] = _position(key_node)
             result[key] = _convert(value_node, (*path, key), located, errors)

@@ -9,8 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Literal
 
-from serialspec.runtime.message import Direction
-
+from serialspec.runtime.message import Direction as Direction  # the model and the runtime share it
 
 
 @dataclass(frozen=True)
@@ -195,6 +194,16 @@ class Table:
 
 
 @dataclass(frozen=True)
+class OptionalWhen:
+    """A response the device sends only while one of its parameters (a table entry) holds a value."""
+
+    table: str
+    entry: str
+    key: int
+    equals: int
+
+
+@dataclass(frozen=True)
 class Message:
     """One direction of a command or sub-command."""
 
@@ -211,6 +220,8 @@ class Message:
     min_size: int  # content length bounds, for decoding and stream plausibility
     max_size: int | None
     source: str
+    optional_when: OptionalWhen | None = None  # a response sent only when a device parameter has a value
+    after: str = ""  # a response sent once the request's field of this name (ms) has elapsed
 
     @property
     def key(self) -> str:
@@ -368,6 +379,48 @@ class Erratum:
 
 
 @dataclass(frozen=True)
+class Motion:
+    """A move: the state value goes to the request's target over a duration (ms) or at a speed (units/s)."""
+
+    state: str
+    target: str
+    duration: str
+    speed: str
+
+
+@dataclass(frozen=True)
+class Behaviour:
+    """What a device does with one command's request, besides answering it."""
+
+    command: str  # command or command.subcommand
+    reads: tuple[str, ...]  # response fields filled from memory (table_value by its key, table_block)
+    writes: tuple[str, ...]  # request fields stored in memory
+    resets: bool  # memory back to its defaults
+    reports: dict[str, str]  # response field -> state variable or memory entry
+    moves: Motion | None
+    broadcast_reply: bool  # answers even when addressed by broadcast
+
+
+@dataclass(frozen=True)
+class Device:
+    """How a device behaves, for the simulator (and the address/broadcast rule, for the client)."""
+
+    description: str
+    memory: Table | None
+    initial: dict[str, float]  # memory entry -> value, where the table gives no default
+    address: str  # the field holding the device id in every message
+    id_entry: str  # the memory entry holding the device's own id
+    broadcast: int | None
+    state: dict[str, float]  # state variables beyond memory -> initial value
+    reply: dict[str, float]  # response field -> value when no behaviour sets it
+    refused: dict[str, float]  # response field -> value when a write is refused
+    behaviours: tuple[Behaviour, ...]
+
+    def behaviour(self, key: str) -> Behaviour | None:
+        return next((b for b in self.behaviours if b.command == key), None)
+
+
+@dataclass(frozen=True)
 class Protocol:
     name: str
     title: str
@@ -385,6 +438,7 @@ class Protocol:
     commands: tuple[Command, ...]
     examples: tuple[Example, ...]
     errata: tuple[Erratum, ...]
+    device: Device | None = None
 
     def messages(self) -> tuple[Message, ...]:
         return tuple(m for c in self.commands for m in c.messages())

@@ -19,11 +19,13 @@ from serialspec.spec.loader import Located, Path, dotted, load_file
 from serialspec.spec.model import (
     SCALARS,
     Array,
+    Behaviour,
     BitField,
     Bytes,
     Checksum,
     Command,
     Crc,
+    Device,
     Direction,
     EnumDef,
     EnumValue,
@@ -38,6 +40,8 @@ from serialspec.spec.model import (
     Framing,
     Group,
     Message,
+    Motion,
+    OptionalWhen,
     Protocol,
     Scalar,
     ScalarType,
@@ -95,7 +99,10 @@ class Resolver:
 
     def name(self, value: str, path: Path, what: str = "name") -> str:
         if not isinstance(value, str) or not NAME.match(value):
-            self.error(path, f"{what} {value!r} must be a lower-case identifier (a-z, 0-9, _; starting with a letter)")
+            self.error(
+                path,
+                f"{what} {value!r} must be a lower-case identifier (a-z, 0-9, _; starting with a letter)",
+            )
         elif keyword.iskeyword(value) or value in RESERVED_NAMES:
             self.error(path, f"{what} {value!r} is reserved (a Python keyword or a name generated code uses)")
         return str(value)
@@ -143,11 +150,13 @@ class Resolver:
         if framing:
             self.check_codes(commands, framing)
         errata = tuple(
-            e for key, value in (data.get("errata") or {}).items()
+            e
+            for key, value in (data.get("errata") or {}).items()
             if (e := self.guard(self.erratum, key, value, ("errata", key), commands))
         )
         examples = tuple(
-            e for key, value in (data.get("examples") or {}).items()
+            e
+            for key, value in (data.get("examples") or {}).items()
             if (e := self.guard(self.example, key, value, ("examples", key), commands, errata))
         )
         for erratum in errata:
@@ -158,6 +167,7 @@ class Resolver:
         matching = data.get("matching") or {}
         if framing is None or not isinstance(serial, dict):
             return None
+        device = self.guard(self.device, data["device"], ("device",), commands, framing) if "device" in data else None
         return Protocol(
             name=name,
             title=str(data.get("title", "")),
@@ -181,6 +191,7 @@ class Resolver:
             commands=tuple(commands),
             examples=examples,
             errata=errata,
+            device=device,
         )
 
     def guard(self, function: Any, *args: Any) -> Any:
@@ -220,8 +231,9 @@ class Resolver:
                 self.error(item_path, f"value {number} does not fit {scalar.name}")
             seen[number] = str(label)
             values.append(EnumValue(str(label).upper(), number, text))
-        self.enums[key] = EnumDef(key, self.class_name(camel(key), path), scalar, str(value.get("description", "")),
-                                  tuple(values))
+        self.enums[key] = EnumDef(
+            key, self.class_name(camel(key), path), scalar, str(value.get("description", "")), tuple(values)
+        )
 
     def flag_set(self, key: str, value: dict[str, Any], path: Path) -> None:
         self.name(key, path, "flags name")
@@ -235,8 +247,9 @@ class Resolver:
                 self.error((*path, "bits", label), f"bit {bit} is outside a {scalar.name}")
             text = "" if isinstance(item, int) else str(item.get("text", ""))
             bits.append(FlagBit(str(label).upper(), bit, text))
-        self.flags[key] = FlagsDef(key, self.class_name(camel(key), path), scalar, str(value.get("description", "")),
-                                   tuple(bits))
+        self.flags[key] = FlagsDef(
+            key, self.class_name(camel(key), path), scalar, str(value.get("description", "")), tuple(bits)
+        )
 
     def reference(self, kind: str, registry: dict[str, Any], value: Any, path: Path) -> Any:
         if value is None:
@@ -282,8 +295,14 @@ class Resolver:
             )
         if value.get("key_type") is None:
             self.check_table_layout(entries, path)
-        self.tables[key] = Table(key, str(value.get("title", key)), str(value["key"]),
-                                 str(value.get("description", "")), str(value.get("source", "")), tuple(entries))
+        self.tables[key] = Table(
+            key,
+            str(value.get("title", key)),
+            str(value["key"]),
+            str(value.get("description", "")),
+            str(value.get("source", "")),
+            tuple(entries),
+        )
 
     def check_table_layout(self, entries: list[TableEntry], path: Path) -> None:
         """Register tables (keys are byte addresses) must not overlap."""
@@ -292,9 +311,11 @@ class Resolver:
         ordered = sorted(entries, key=lambda e: e.key)
         for before, after in zip(ordered, ordered[1:], strict=False):
             if before.key + before.type.size > after.key:
-                self.error((*path, "entries", after.name, "key"),
-                           f"register {after.name} at {after.key:#04x} overlaps {before.name} "
-                           f"({before.key:#04x}..{before.key + before.type.size - 1:#04x})")
+                self.error(
+                    (*path, "entries", after.name, "key"),
+                    f"register {after.name} at {after.key:#04x} overlaps {before.name} "
+                    f"({before.key:#04x}..{before.key + before.type.size - 1:#04x})",
+                )
 
     def bounds(self, scalar: ScalarType, sign_magnitude: bool, given: Any, path: Path) -> tuple[float, float]:
         if sign_magnitude:
@@ -368,41 +389,59 @@ class Resolver:
                 checksum = self.checksum(item, name, scalar, item_path, list(raw))
         if checksum is None:
             raise self.fail((*path, "elements"), "framing needs one element with role checksum")
-        layouts = {d: self.layout(d, headers, [e for _, e in elements], checksum, length_adds, path)
-                   for d in Direction}
+        layouts = {d: self.layout(d, headers, [e for _, e in elements], checksum, length_adds, path) for d in Direction}
         shared = headers.get(Direction.REQUEST) == headers.get(Direction.RESPONSE)
         return Framing(str(value.get("description", "")), layouts, checksum, shared)
 
-    def checksum(self, item: dict[str, Any], name: str, scalar: ScalarType, path: Path,
-                 names: list[str]) -> Checksum:
+    def checksum(self, item: dict[str, Any], name: str, scalar: ScalarType, path: Path, names: list[str]) -> Checksum:
         covers = item.get("covers")
         if not covers:
             raise self.fail(path, "a checksum needs `covers: [first, last]` (frame element names)")
         for covered in covers:
             if covered not in names:
-                self.error((*path, "covers"), f"unknown frame element {covered!r} (expected one of {', '.join(names)})")
+                self.error(
+                    (*path, "covers"),
+                    f"unknown frame element {covered!r} (expected one of {', '.join(names)})",
+                )
         algorithm = item.get("algorithm")
         crc = None
         if algorithm == "crc":
             params = item.get("crc")
             if not params:
                 raise self.fail(path, "algorithm crc needs `crc:` with width, poly, init, refin, refout, xorout, check")
-            crc = Crc(str(params.get("name", "")), params["width"], params["poly"], params["init"], params["refin"],
-                      params["refout"], params["xorout"], params["check"])
+            crc = Crc(
+                str(params.get("name", "")),
+                params["width"],
+                params["poly"],
+                params["init"],
+                params["refin"],
+                params["refout"],
+                params["xorout"],
+                params["check"],
+            )
             from serialspec.runtime.checksums import crc_function
 
             computed = crc_function(crc.width, crc.poly, crc.init, crc.refin, crc.refout, crc.xorout)(b"123456789")
             if computed != crc.check:
-                self.error((*path, "crc", "check"),
-                           f"these parameters give {computed:#x} for '123456789', not the check value {crc.check:#x}")
+                self.error(
+                    (*path, "crc", "check"),
+                    f"these parameters give {computed:#x} for '123456789', not the check value {crc.check:#x}",
+                )
             if crc.width != scalar.size * 8:
                 self.error((*path, "crc", "width"), f"a {crc.width}-bit CRC does not fill a {scalar.name}")
         elif algorithm != "sum":
             raise self.fail(path, "a checksum needs `algorithm: sum` or `algorithm: crc`")
         return Checksum(algorithm, bool(item.get("invert", False)), crc, covers[0], covers[1], scalar)
 
-    def layout(self, direction: Direction, headers: dict[Direction, bytes], all_elements: list[FrameElement],
-               checksum: Checksum, length_adds: int, path: Path) -> FrameLayout:
+    def layout(
+        self,
+        direction: Direction,
+        headers: dict[Direction, bytes],
+        all_elements: list[FrameElement],
+        checksum: Checksum,
+        length_adds: int,
+        path: Path,
+    ) -> FrameLayout:
         elements = tuple(e for e in all_elements if direction in e.directions)
         roles = [e.role for e in elements]
         for role in ("header", "length", "content", "checksum"):
@@ -419,13 +458,16 @@ class Resolver:
             offsets[element.name] = position
             position += element.size or 0
         offsets[elements[content_index].name] = position
-        after = sum(e.size or 0 for e in elements[content_index + 1:])
+        after = sum(e.size or 0 for e in elements[content_index + 1 :])
         overhead = position + after
         names = [e.name for e in elements]
         if checksum.first not in names or checksum.last not in names:
-            raise self.fail((*path, "elements"), f"the checksum covers an element missing from the {direction.value} frame")
+            raise self.fail(
+                (*path, "elements"),
+                f"the checksum covers an element missing from the {direction.value} frame",
+            )
         last_index = names.index(checksum.last)
-        covered_to_end = sum(e.size or 0 for e in elements[last_index + 1:])
+        covered_to_end = sum(e.size or 0 for e in elements[last_index + 1 :])
         checksum_element = elements[roles.index("checksum")]
         if roles.index("checksum") != len(roles) - 1:
             raise self.fail((*path, "elements"), "the checksum must be the frame's last element")
@@ -458,7 +500,9 @@ class Resolver:
         if "subcommands" in value:
             raw_selector = value.get("selector")
             if raw_selector is None:
-                raise self.fail(path, "a command with subcommands needs `selector: {type, offset: {request, response}}`")
+                raise self.fail(
+                    path, "a command with subcommands needs `selector: {type, offset: {request, response}}`"
+                )
             selector = Selector(
                 name=self.name(raw_selector.get("name", "subcommand_code"), (*path, "selector", "name")),
                 type=self.scalar_type(raw_selector.get("type", "u8"), (*path, "selector", "type"), False),
@@ -469,20 +513,45 @@ class Resolver:
                 sub_path = (*path, "subcommands", sub_name)
                 self.name(sub_name, sub_path, "subcommand name")
                 if sub["code"] in codes:
-                    self.error((*sub_path, "code"), f"code {sub['code']:#04x} is already used by {codes[sub['code']]!r}")
+                    self.error(
+                        (*sub_path, "code"),
+                        f"code {sub['code']:#04x} is already used by {codes[sub['code']]!r}",
+                    )
                 codes[sub["code"]] = sub_name
-                messages = {d: self.guard(self.message, name, sub_name, d, sub[d.value], (*sub_path, d.value),
-                                          selector, sub["code"])
-                            for d in Direction if d.value in sub}
-                subcommands.append(Subcommand(sub_name, sub["code"], str(sub.get("title", "")),
-                                              str(sub.get("title_cn", "")), str(sub.get("description", "")),
-                                              messages.get(Direction.REQUEST), messages.get(Direction.RESPONSE),
-                                              str(sub.get("source", ""))))
+                messages = {
+                    d: self.guard(
+                        self.message,
+                        name,
+                        sub_name,
+                        d,
+                        sub[d.value],
+                        (*sub_path, d.value),
+                        selector,
+                        sub["code"],
+                    )
+                    for d in Direction
+                    if d.value in sub
+                }
+                subcommands.append(
+                    Subcommand(
+                        sub_name,
+                        sub["code"],
+                        str(sub.get("title", "")),
+                        str(sub.get("title_cn", "")),
+                        str(sub.get("description", "")),
+                        messages.get(Direction.REQUEST),
+                        messages.get(Direction.RESPONSE),
+                        str(sub.get("source", "")),
+                    )
+                )
             for direction in ("request", "response"):
                 if direction in value:
                     self.error((*path, direction), "a command with subcommands describes content in each subcommand")
-        messages = {d: self.guard(self.message, name, None, d, value[d.value], (*path, d.value), None, None)
-                    for d in Direction if d.value in value and "subcommands" not in value}
+        messages = {
+            d: self.guard(self.message, name, None, d, value[d.value], (*path, d.value), None, None)
+            for d in Direction
+            if d.value in value and "subcommands" not in value
+        }
         return Command(
             name=name,
             code=value.get("code"),
@@ -516,8 +585,16 @@ class Resolver:
                     self.error(path, f"{what} in {direction.value} frames is already used by {other!r}")
                 seen[command.code] = command.name
 
-    def message(self, command: str, subcommand: str | None, direction: Direction, value: dict[str, Any],
-                path: Path, selector: Selector | None, code: int | None) -> Message:
+    def message(
+        self,
+        command: str,
+        subcommand: str | None,
+        direction: Direction,
+        value: dict[str, Any],
+        path: Path,
+        selector: Selector | None,
+        code: int | None,
+    ) -> Message:
         fields = self.fields(value.get("fields") or {}, (*path, "fields"), parent=None)
         if selector is not None and code is not None:
             fields = self.insert_selector(fields, selector, direction, code, path)
@@ -538,15 +615,58 @@ class Resolver:
             min_size=low,
             max_size=high,
             source=str(value.get("source", "")),
+            optional_when=self.optional_when(value.get("optional_when"), (*path, "optional_when")),
+            after=self.after(value.get("after"), fields, direction, path),
         )
 
-    def insert_selector(self, fields: tuple[Field, ...], selector: Selector, direction: Direction, code: int,
-                        path: Path) -> tuple[Field, ...]:
+    def table_entry(self, text: str, path: Path) -> tuple[Table, TableEntry]:
+        """A table entry named `entry` (searched in every table) or `table.entry`."""
+        table_name, _, entry_name = text.rpartition(".")
+        tables = [self.tables[table_name]] if table_name in self.tables else list(self.tables.values())
+        for table in tables:
+            for entry in table.entries:
+                if entry.name == entry_name:
+                    return table, entry
+        raise self.fail(path, f"unknown table entry {text!r}")
+
+    def optional_when(self, value: Any, path: Path) -> OptionalWhen | None:
+        if value is None:
+            return None
+        table, entry = self.table_entry(value["parameter"], (*path, "parameter"))
+        return OptionalWhen(table.name, entry.name, entry.key, int(value["equals"]))
+
+    def after(self, value: Any, fields: tuple[Field, ...], direction: Direction, path: Path) -> str:
+        if value is None:
+            return ""
+        if direction != Direction.RESPONSE:
+            self.error((*path, "after"), "`after` describes when a response is sent")
+        return str(value)
+
+    def insert_selector(
+        self, fields: tuple[Field, ...], selector: Selector, direction: Direction, code: int, path: Path
+    ) -> tuple[Field, ...]:
         offset = selector.offsets.get(direction)
         if offset is None:
             raise self.fail(path, f"the selector has no offset for {direction.value}")
-        const = Scalar(selector.name, "sub-command selector", "", "", selector.type, self.endian, "", None,
-                       selector.type.minimum, selector.type.maximum, code, None, None, None, (), "", False)
+        const = Scalar(
+            selector.name,
+            "sub-command selector",
+            "",
+            "",
+            selector.type,
+            self.endian,
+            "",
+            None,
+            selector.type.minimum,
+            selector.type.maximum,
+            code,
+            None,
+            None,
+            None,
+            (),
+            "",
+            False,
+        )
         position = 0
         for index, field in enumerate(fields):
             if position == offset:
@@ -586,8 +706,10 @@ class Resolver:
                 return {"type": item}
             if item in self.shared_fields:
                 return self.expand(self.shared_fields[item], ("fields", item))
-            raise self.fail(path, f"unknown type {item!r} (expected one of {', '.join(FIELD_KINDS)}, "
-                                  f"or a field from `fields:`)")
+            raise self.fail(
+                path,
+                f"unknown type {item!r} (expected one of {', '.join(FIELD_KINDS)}, or a field from `fields:`)",
+            )
         spec = dict(item)
         if "use" in spec:
             base_name = spec.pop("use")
@@ -602,8 +724,12 @@ class Resolver:
     def field(self, name: str, item: Any, path: Path, siblings: list[Field], parent: list[Field] | None) -> Field:
         spec = self.expand(item, path)
         kind = spec["type"]
-        common = dict(name=name, description=str(spec.get("description", "")),
-                      description_cn=str(spec.get("description_cn", "")), inferred=str(spec.get("inferred", "")))
+        common = dict(
+            name=name,
+            description=str(spec.get("description", "")),
+            description_cn=str(spec.get("description_cn", "")),
+            inferred=str(spec.get("inferred", "")),
+        )
         endian: Literal["<", ">"] = {"little": "<", "big": ">"}.get(spec.get("endian", ""), self.endian)  # type: ignore[assignment]
         if kind in SCALARS:
             return self.scalar(common, spec, path, endian)
@@ -621,8 +747,15 @@ class Resolver:
             if not isinstance(count, int) or count < 1:
                 raise self.fail((*path, "count"), "an array needs a fixed `count` (use a group for counted items)")
             low, high = self.bounds(item_type, False, spec.get("range"), (*path, "range"))
-            return Array(**common, item=item_type, endian=endian, count=count, unit=str(spec.get("unit", "")),
-                         minimum=low, maximum=high)
+            return Array(
+                **common,
+                item=item_type,
+                endian=endian,
+                count=count,
+                unit=str(spec.get("unit", "")),
+                minimum=low,
+                maximum=high,
+            )
         if kind == "group":
             count = spec.get("count")
             if count is None:
@@ -646,8 +779,9 @@ class Resolver:
             if table is None:
                 raise self.fail(path, "a table_block needs `table:`")
             select = spec.get("select") or {}
-            entries = tuple(e for e in table.entries
-                            if all(str(getattr(e, k, None)) == str(v) for k, v in select.items()))
+            entries = tuple(
+                e for e in table.entries if all(str(getattr(e, k, None)) == str(v) for k, v in select.items())
+            )
             size = sum(e.type.size for e in entries)
             expected = spec.get("expect_size")
             if expected is not None and size != expected:
@@ -717,6 +851,88 @@ class Resolver:
         else:
             self.derive(size, ("size", name), siblings, path)
 
+    # --- device behaviour ---------------------------------------------------------------------------------------
+
+    def device(self, value: dict[str, Any], path: Path, commands: list[Command], framing: Framing) -> Device:
+        memory = self.reference("table", self.tables, value.get("memory"), (*path, "memory"))
+        entries = {e.name: e for e in memory.entries} if memory else {}
+        for name in value.get("initial") or {}:
+            if name not in entries:
+                self.error((*path, "initial", name), f"unknown memory entry {name!r}")
+        address_element = next(
+            (e for layout in framing.layouts.values() for e in layout.value_elements if e.role == "address"), None
+        )
+        address = str(value.get("address") or (address_element.name if address_element else ""))
+        if not address:
+            self.error(path, "name the field holding the device id with `address:`")
+        broadcast = value.get("broadcast", address_element.broadcast if address_element else None)
+        id_entry = str(value.get("id_entry", ""))
+        if id_entry and id_entry not in entries:
+            self.error((*path, "id_entry"), f"unknown memory entry {id_entry!r}")
+        state = {str(k): float(v) for k, v in (value.get("state") or {}).items()}
+        requests = {m.key: m for c in commands for m in c.messages() if m.direction == Direction.REQUEST}
+        responses = [m for c in commands for m in c.messages() if m.direction == Direction.RESPONSE]
+        behaviours = []
+        for key, item in (value.get("commands") or {}).items():
+            item_path = (*path, "commands", key)
+            request = requests.get(key)
+            if request is None:
+                self.error(item_path, f"unknown command {key!r} (or it has no request)")
+                continue
+            response = next((m for m in responses if (m.answers or m.key) == key), None)
+            request_names = {f.name for f in request.fields}
+            response_names = {f.name for f in response.fields} if response else set()
+            for name in item.get("reads") or ():
+                if name not in response_names:
+                    self.error((*item_path, "reads"), f"{key} has no response field {name!r}")
+            for name in item.get("writes") or ():
+                if name not in request_names:
+                    self.error((*item_path, "writes"), f"{key} has no request field {name!r}")
+            reports = {str(k): str(v) for k, v in (item.get("reports") or {}).items()}
+            for field_name, source in reports.items():
+                if field_name not in response_names:
+                    self.error((*item_path, "reports", field_name), f"{key} has no response field {field_name!r}")
+                if source not in state and source not in entries:
+                    self.error((*item_path, "reports", field_name), f"unknown state variable {source!r}")
+            motion = None
+            if "moves" in item:
+                moves = item["moves"]
+                motion = Motion(
+                    str(moves["state"]),
+                    str(moves["target"]),
+                    str(moves.get("duration", "")),
+                    str(moves.get("speed", "")),
+                )
+                if motion.state not in state and motion.state not in entries:
+                    self.error((*item_path, "moves", "state"), f"unknown state variable {motion.state!r}")
+                for role in ("target", "duration", "speed"):
+                    name = getattr(motion, role)
+                    if name and name not in request_names:
+                        self.error((*item_path, "moves", role), f"{key} has no request field {name!r}")
+            behaviours.append(
+                Behaviour(
+                    key,
+                    tuple(item.get("reads") or ()),
+                    tuple(item.get("writes") or ()),
+                    bool(item.get("resets", False)),
+                    reports,
+                    motion,
+                    bool(item.get("broadcast_reply", False)),
+                )
+            )
+        return Device(
+            description=str(value.get("description", "")),
+            memory=memory,
+            initial={str(k): float(v) for k, v in (value.get("initial") or {}).items()},
+            address=address,
+            id_entry=id_entry,
+            broadcast=broadcast,
+            state=state,
+            reply={str(k): float(v) for k, v in (value.get("reply") or {}).items()},
+            refused={str(k): float(v) for k, v in (value.get("refused") or {}).items()},
+            behaviours=tuple(behaviours),
+        )
+
     # --- examples and errata --------------------------------------------------------------------------------------
 
     def frame_bytes(self, text: str, path: Path) -> bytes:
@@ -725,8 +941,9 @@ class Resolver:
         except ValueError as exc:
             raise self.fail(path, f"not a frame: {exc}") from None
 
-    def find_message(self, commands: list[Command], command: str, subcommand: str | None, direction: Direction,
-                     path: Path) -> None:
+    def find_message(
+        self, commands: list[Command], command: str, subcommand: str | None, direction: Direction, path: Path
+    ) -> None:
         found = next((c for c in commands if c.name == command), None)
         if found is None:
             raise self.fail((*path, "command"), f"unknown command {command!r}")
@@ -742,8 +959,14 @@ class Resolver:
         if message is None:
             raise self.fail(path, f"{command} has no {direction.value}")
 
-    def example(self, name: str, value: dict[str, Any], path: Path, commands: list[Command],
-                errata: tuple[Erratum, ...]) -> Example:
+    def example(
+        self,
+        name: str,
+        value: dict[str, Any],
+        path: Path,
+        commands: list[Command],
+        errata: tuple[Erratum, ...],
+    ) -> Example:
         self.name(name, path, "example name")
         direction = Direction(value["direction"])
         self.find_message(commands, value["command"], value.get("subcommand"), direction, path)
@@ -759,9 +982,19 @@ class Resolver:
             self.error(path, "`frame` differs from `printed`: name the erratum that explains it")
         if erratum and erratum not in {e.name for e in errata}:
             self.error((*path, "erratum"), f"unknown erratum {erratum!r}")
-        return Example(name, str(value["source"]), str(value.get("description", "")), direction, printed, frame,
-                       erratum, value["command"], value.get("subcommand"), str(value.get("request", "")),
-                       dict(value["fields"]))
+        return Example(
+            name,
+            str(value["source"]),
+            str(value.get("description", "")),
+            direction,
+            printed,
+            frame,
+            erratum,
+            value["command"],
+            value.get("subcommand"),
+            str(value.get("request", "")),
+            dict(value["fields"]),
+        )
 
     def erratum(self, name: str, value: dict[str, Any], path: Path, commands: list[Command]) -> Erratum:
         self.name(name, path, "erratum name")
@@ -783,14 +1016,18 @@ class Resolver:
         if kind == "frame_decodes_as":
             if "command" not in check or "fields" not in check:
                 raise self.fail(check_path, "a frame_decodes_as check needs `command:` and `fields:`")
-            self.find_message(commands, check["command"], check.get("subcommand"), Direction(check["direction"]),
-                              check_path)
+            self.find_message(
+                commands, check["command"], check.get("subcommand"), Direction(check["direction"]), check_path
+            )
         if kind == "checksum_value" and ("claimed" not in check or "actual" not in check):
             self.error(check_path, "a checksum_value check needs `claimed:` and `actual:`")
         if kind == "crc_parameters" and not isinstance(check.get("claimed"), dict):
             self.error(check_path, "a crc_parameters check needs `claimed:` with the claimed parameters")
         return Erratum(
-            name, str(value["source"]), str(value["printed"]), str(value["correct"]),
+            name,
+            str(value["source"]),
+            str(value["printed"]),
+            str(value["correct"]),
             ErratumCheck(
                 kind=kind,
                 frame=frame,
@@ -862,4 +1099,3 @@ def content_bounds(fields: tuple[Field, ...]) -> tuple[int, int | None]:
         else:
             high = None
     return low, high
-

@@ -1,0 +1,97 @@
+"""Emit a protocol's virtual device: the spec's `device:` section, tables and commands as data for runtime.device."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from serialspec.emit.pycode import number, one_line
+from serialspec.emit.render import render
+from serialspec.spec.model import Direction, Message, Protocol, TableBlock, TableValue
+
+
+def request_response_pairs(protocol: Protocol) -> list[tuple[Message, Message | None]]:
+    """Every request with the response that answers it (None where the device stays silent)."""
+    messages = protocol.messages()
+    responses = [m for m in messages if m.direction == Direction.RESPONSE and not m.unsolicited]
+    pairs = []
+    for request in (m for m in messages if m.direction == Direction.REQUEST):
+        response = next((r for r in responses if (r.answers or r.key) == request.key), None)
+        pairs.append((request, response))
+    return pairs
+
+
+def table_fields(*messages: Message | None) -> dict[str, tuple[str, ...]]:
+    found: dict[str, tuple[str, ...]] = {}
+    for message in messages:
+        for f in message.fields if message else ():
+            if isinstance(f, TableValue):
+                found[f.name] = ("value", f.key)
+            elif isinstance(f, TableBlock):
+                found[f.name] = ("block", *(e.name for e in f.entries))
+    return found
+
+
+def import_order(name: str) -> tuple[int, str]:
+    """The order ruff's isort gives names in one `from` import: constants, classes, others; case-insensitive."""
+    return (0 if name.isupper() else 1 if name[:1].isupper() else 2, name.lower())
+
+
+def simulator_module(protocol: Protocol) -> str:
+    device = protocol.device
+    assert device is not None
+    entries = []
+    for entry in device.memory.entries if device.memory else ():
+        default = entry.default if isinstance(entry.default, int | float) else 0
+        value = device.initial.get(entry.name, default)
+        entries.append(
+            f"EntrySpec({entry.name!r}, {entry.key}, {number(value)}, {entry.access!r}, "
+            f"{number(entry.minimum)}, {number(entry.maximum)}),"
+        )
+    commands: list[dict[str, Any]] = []
+    imports: set[str] = set()
+    for request, response in request_response_pairs(protocol):
+        behaviour = device.behaviour(request.key)
+        args = [request.class_name, response.class_name if response else "None"]
+        imports.add(request.class_name)
+        if response:
+            imports.add(response.class_name)
+        if behaviour:
+            if behaviour.reads:
+                args.append(f"reads={behaviour.reads!r}")
+            if behaviour.writes:
+                args.append(f"writes={behaviour.writes!r}")
+            if behaviour.resets:
+                args.append("resets=True")
+            if behaviour.reports:
+                args.append(f"reports={behaviour.reports!r}")
+            if behaviour.moves:
+                m = behaviour.moves
+                args.append(f"moves={(m.state, m.target, m.duration, m.speed)!r}")
+            if behaviour.broadcast_reply:
+                args.append("broadcast_reply=True")
+        if response and response.optional_when:
+            args.append(f"optional_when=({response.optional_when.key}, {response.optional_when.equals})")
+        if response and response.after:
+            args.append(f"after={response.after!r}")
+        tables = table_fields(request, response)
+        if tables:
+            args.append(f"tables={tables!r}")
+        commands.append({"key": request.key, "args": args})
+    return render(
+        "simulator.py.j2",
+        spec_path=protocol.spec_path,
+        title=one_line(protocol.title),
+        package=protocol.name,
+        description=one_line(device.description),
+        class_name="".join(w.capitalize() for w in protocol.name.split("_")) + "Simulator",
+        address=repr(device.address),
+        id_entry=repr(device.id_entry),
+        broadcast=repr(device.broadcast),
+        state=repr(device.state),
+        reply=repr(device.reply),
+        refused=repr(device.refused),
+        entries=entries,
+        commands=commands,
+        imports=sorted(imports | {"Direction"}, key=import_order),
+        default_id=0,
+    )

@@ -1,0 +1,32 @@
+"""A real `serialspec sim` subprocess serving virtual devices on a pseudo-terminal, for the device tests."""
+
+from __future__ import annotations
+
+import signal
+import subprocess
+import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+@contextmanager
+def serve(spec: str, *ids: int) -> Iterator[str]:
+    """Start `serialspec sim SPEC --id N...`, yield the device path it prints first, stop it with SIGTERM."""
+    args = [sys.executable, "-m", "serialspec", "sim", str(ROOT / "specs" / spec), "--quiet"]
+    for device_id in ids:
+        args += ["--id", str(device_id)]
+    process = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        assert process.stdout is not None
+        path = process.stdout.readline().strip()
+        assert path.startswith("/dev/"), (
+            f"sim printed {path!r}; stderr: {process.stderr.read() if process.stderr else ''}"
+        )
+        yield path
+    finally:
+        process.send_signal(signal.SIGTERM)
+        code = process.wait(5)
+        assert code == 0, f"sim exited with {code}"

@@ -1,0 +1,96 @@
+"""Hypothesis strategies for valid field values of any message, built from the spec model."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from hypothesis import strategies as st
+from serialspec.spec.model import (
+    Array,
+    Bytes,
+    Field,
+    Group,
+    Message,
+    Protocol,
+    Scalar,
+    ScalarType,
+    TableBlock,
+    TableValue,
+)
+
+MAX_ITEMS = 4  # items per group: enough to cover counts, small enough to fit a length byte
+
+
+def number(scalar: ScalarType, low: float, high: float) -> st.SearchStrategy[Any]:
+    if scalar.is_float:
+        return st.floats(low, high, width=32, allow_nan=False, allow_infinity=False)
+    return st.integers(int(low), int(high))
+
+
+def scalar_value(f: Scalar) -> st.SearchStrategy[Any]:
+    if f.bits:
+        return st.fixed_dictionaries({b.name: st.integers(0, b.mask) for b in f.bits})
+    return number(f.type, f.minimum, f.maximum)
+
+
+def fields_values(fields: tuple[Field, ...], rest_budget: int) -> st.SearchStrategy[dict[str, Any]]:
+    @st.composite
+    def build(draw: st.DrawFn) -> dict[str, Any]:
+        values: dict[str, Any] = {}
+        sizes: dict[str, int] = {}
+        for f in fields:
+            if isinstance(f, Scalar):
+                if f.hidden:
+                    continue
+                values[f.name] = draw(scalar_value(f))
+            elif isinstance(f, Array):
+                values[f.name] = draw(
+                    st.lists(number(f.item, f.minimum, f.maximum), min_size=f.count, max_size=f.count)
+                )
+            elif isinstance(f, Bytes):
+                if isinstance(f.size, int):
+                    size = f.size
+                elif f.size == "rest":
+                    size = draw(st.integers(0, rest_budget))
+                else:
+                    size = sizes.setdefault(f.size, draw(st.integers(0, 6)))
+                values[f.name] = draw(st.binary(min_size=size, max_size=size)).hex(" ")
+            elif isinstance(f, Group):
+                count = f.count if isinstance(f.count, int) else draw(st.integers(0, MAX_ITEMS))
+                item = fields_values(f.fields, 0)
+                shared: dict[str, int] = {}
+                items = []
+                for _ in range(count):
+                    items.append(draw(item))
+                del shared
+                # bytes sized by an outer field must have one size in every item
+                sized = [
+                    i.name for i in f.fields if isinstance(i, Bytes) and isinstance(i.size, str) and i.size != "rest"
+                ]
+                for name in sized:
+                    for it in items[1:]:
+                        it[name] = items[0][name] if len(it[name]) != len(items[0][name]) else it[name]
+                values[f.name] = items
+            elif isinstance(f, TableValue):
+                entries = [e for e in f.table.entries if not e.reserved]
+                key = values.get(f.key)
+                entry = f.table.entry(key) if isinstance(key, int) else None
+                if entry is None or entry.reserved:
+                    entry = draw(st.sampled_from(entries))
+                    values[f.key] = entry.key
+                values[f.name] = draw(number(entry.type, entry.minimum, entry.maximum))
+            elif isinstance(f, TableBlock):
+                values[f.name] = draw(
+                    st.fixed_dictionaries({e.name: number(e.type, e.minimum, e.maximum) for e in f.entries})
+                )
+        return values
+
+    return build()
+
+
+def message_fields(protocol: Protocol, message: Message) -> st.SearchStrategy[dict[str, Any]]:
+    frame = protocol.framing.layouts[message.direction].value_elements
+    frame_values = st.fixed_dictionaries(
+        {e.name: st.integers(int(e.minimum), int(e.maximum)) for e in frame if e.type is not None}
+    )
+    return st.tuples(frame_values, fields_values(message.fields, 8)).map(lambda pair: {**pair[0], **pair[1]})

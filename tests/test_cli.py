@@ -1,0 +1,97 @@
+"""The command line contract (design-notes §4), run as a real process."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from conftest import ALL, ROOT, Generated
+from serialspec.cli import main
+
+FS = str(ROOT / "specs" / "fashionstar_uart.yaml")
+
+
+def serialspec(*args: str, cwd: Path = ROOT) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-m", "serialspec", *args], capture_output=True, text=True, cwd=cwd)
+
+
+def test_decode_rotate_as_json_then_encode_gives_the_same_bytes() -> None:
+    frame = "12 4c 08 07 02 84 03 f4 01 00 00 eb"
+    decoded = serialspec("decode", FS, frame, "--json")
+    assert decoded.returncode == 0, decoded.stderr
+    obj = json.loads(decoded.stdout)
+    assert obj == {
+        "protocol": "fashionstar_uart",
+        "direction": "request",
+        "command": "rotate",
+        "subcommand": None,
+        "fields": {"servo_id": 2, "angle": 900, "interval": 500, "power": 0},
+        "checksum_ok": True,
+        "hex": frame,
+    }
+    encoded = serialspec("encode", FS, "--json", decoded.stdout)
+    assert encoded.stdout.strip() == frame
+
+
+@pytest.mark.parametrize(
+    "form", ["12 4c 01 01 03 63", "0x12 0x4c 0x01 0x01 0x03 0x63", "124c01010363", "12:4c:01:01:03:63"]
+)
+def test_decode_accepts_the_hex_forms_people_paste(form: str) -> None:
+    result = serialspec("decode", FS, form, "--json")
+    assert json.loads(result.stdout)["command"] == "ping"
+
+
+@pytest.mark.parametrize(
+    ("frame", "reason"),
+    [
+        ("12 4c 08 07 02 84 03 f4 01 00 00 ec", "bad checksum"),
+        ("12 4c 0b 01 00 6a", "unknown command 0x0b"),
+        ("12 4c 08 03 02 84 03 f2", "content is 3 bytes, expected 7"),
+        ("x12 0x4c", "not a hex byte"),
+    ],
+)
+def test_a_frame_that_does_not_decode_exits_non_zero_with_one_line(frame: str, reason: str) -> None:
+    result = serialspec("decode", FS, frame, "--json")
+    assert result.returncode != 0
+    assert reason in result.stderr
+    assert len(result.stderr.strip().splitlines()) == 1
+    assert "Traceback" not in result.stderr
+
+
+def test_readable_view_and_units() -> None:
+    result = serialspec("decode", FS, "05 1c 0a 03 00 86 03 b7", "--units")
+    assert "read_angle" in result.stdout and "90.2" in result.stdout
+
+
+def test_encode_refuses_out_of_range_naming_field_and_range() -> None:
+    result = serialspec(
+        "encode", FS, "--json", '{"command": "rotate", "fields": {"servo_id": 300, "angle": 0, "interval": 0}}'
+    )
+    assert result.returncode != 0
+    assert "servo_id = 300 is outside its range 0..254" in result.stderr
+
+
+@pytest.mark.parametrize("g", ALL, ids=[g.protocol.name for g in ALL])
+def test_every_example_round_trips_through_the_cli(g: Generated, capsys: pytest.CaptureFixture[str]) -> None:
+    # In-process for speed: the subprocess tests above cover the console script itself.
+    spec = str(ROOT / g.protocol.spec_path)
+    for example in g.protocol.examples:
+        assert main(["decode", spec, example.frame.hex(" "), "--json", "--direction", example.direction.value]) == 0
+        decoded = capsys.readouterr().out
+        assert main(["encode", spec, "--json", decoded]) == 0, example.name
+        assert capsys.readouterr().out.strip() == example.frame.hex(" "), example.name
+
+
+def test_check_fails_when_a_generated_file_is_stale(tmp_path: Path) -> None:
+    shutil.copytree(ROOT / "specs", tmp_path / "specs")
+    shutil.copytree(ROOT / "generated", tmp_path / "generated", ignore=shutil.ignore_patterns("__pycache__"))
+    assert serialspec("check", "--root", str(tmp_path)).returncode == 0
+    docs = tmp_path / "generated" / "docs" / "fashionstar_uart.md"
+    docs.write_text(docs.read_text(encoding="utf-8") + "edited by hand\n", encoding="utf-8")
+    result = serialspec("check", "--root", str(tmp_path))
+    assert result.returncode == 1
+    assert "generated/docs/fashionstar_uart.md: stale" in result.stderr

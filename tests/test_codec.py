@@ -1,0 +1,110 @@
+"""The fast codec against construct's interpreted structs, and round trips of random valid messages."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import pytest
+from conftest import ALL, Generated, by_protocol
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from serialspec.runtime.errors import DecodeError, RangeError
+from serialspec.spec.model import Example, Message, Scalar
+from strategies import message_fields
+
+MESSAGES = by_protocol([(g, m) for g in ALL for m in g.protocol.messages()])
+EXAMPLES = by_protocol([(g, e) for g in ALL for e in g.protocol.examples])
+
+
+def plain(value: Any) -> Any:
+    """construct's containers as plain data, bytes as the codec's hex text, private keys dropped."""
+    if isinstance(value, dict):
+        return {k: plain(v) for k, v in value.items() if not k.startswith("_")}
+    if isinstance(value, list):
+        return [plain(v) for v in value]
+    if isinstance(value, bytes):
+        return value.hex(" ")
+    return value
+
+
+def content_bounds(g: Generated, frame: bytes, direction: str) -> tuple[int, int]:
+    layout = next(lay for d, lay in g.protocol.framing.layouts.items() if d.value == direction)
+    start = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
+    return start, len(frame) - (layout.overhead - start)
+
+
+def message_type(g: Generated, spec: Message) -> Any:
+    return next(c for c in g.package.MESSAGE_TYPES if c.__name__ == spec.class_name)
+
+
+def check_against_construct(g: Generated, spec: Message, frame: bytes, fields: dict[str, Any]) -> None:
+    start, end = content_bounds(g, frame, spec.direction.value)
+    content_struct = g.structs.CONTENTS[(spec.key, spec.direction.value)]
+    parsed = plain(content_struct.parse(frame[start:end]))
+    frame_names = {e.name for e in g.protocol.framing.layouts[spec.direction].value_elements}
+    for name, value in fields.items():
+        if name in frame_names:
+            continue
+        assert parsed[name] == pytest.approx(value) if isinstance(value, float) else parsed[name] == value, name
+    frame_struct = getattr(g.structs, f"{spec.direction.name}_FRAME")
+    rebuilt = frame_struct.parse(frame)
+    assert rebuilt.body.value.content == frame[start:end]
+
+
+@pytest.mark.parametrize(("g", "example"), EXAMPLES)
+def test_construct_struct_agrees_on_every_example(g: Generated, example: Example) -> None:
+    message = g.package.decode(example.frame, example.direction.value)
+    spec = next(m for m in g.protocol.messages() if m.class_name == type(message).__name__)
+    check_against_construct(g, spec, example.frame, message.to_fields())
+
+
+@pytest.mark.parametrize(("g", "spec"), MESSAGES)
+def test_random_valid_messages_round_trip_and_agree_with_construct(g: Generated, spec: Message) -> None:
+    cls = message_type(g, spec)
+
+    @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+    @given(message_fields(g.protocol, spec))
+    def round_trip(fields: dict[str, Any]) -> None:
+        frame = g.package.encode(cls.from_fields(fields))
+        decoded = g.package.decode(frame, spec.direction.value)
+        assert type(decoded) is cls
+        assert decoded.to_fields() == fields
+        check_against_construct(g, spec, frame, fields)
+        start, end = content_bounds(g, frame, spec.direction.value)
+        content_struct = g.structs.CONTENTS[(spec.key, spec.direction.value)]
+        assert content_struct.build(content_struct.parse(frame[start:end])) == frame[start:end]
+
+    round_trip()
+
+
+@pytest.mark.parametrize(("g", "spec"), MESSAGES)
+def test_out_of_range_values_are_refused_naming_field_and_range(g: Generated, spec: Message) -> None:
+    cls = message_type(g, spec)
+    scalars = [f for f in spec.fields if isinstance(f, Scalar) and not f.hidden and not f.bits and not f.type.is_float]
+    bounded = [f for f in scalars if f.maximum < 2 ** (8 * f.type.size) - 1 or f.minimum > f.type.minimum]
+
+    @settings(max_examples=20, deadline=None)
+    @given(message_fields(g.protocol, spec), st.data())
+    def refused(fields: dict[str, Any], data: st.DataObject) -> None:
+        if not bounded:
+            return
+        target = data.draw(st.sampled_from(bounded))
+        too_big = data.draw(st.booleans()) and target.maximum < target.type.maximum
+        bad = int(target.maximum) + 1 if too_big or target.minimum <= target.type.minimum else int(target.minimum) - 1
+        with pytest.raises(RangeError) as refused:
+            g.package.encode(cls.from_fields({**fields, target.name: bad}))
+        text = str(refused.value)
+        assert target.name in text and f"{int(target.minimum)}..{int(target.maximum)}" in text
+
+    refused()
+
+
+@pytest.mark.parametrize("g", ALL, ids=[g.protocol.name for g in ALL])
+def test_damaged_frames_fail_with_one_line(g: Generated) -> None:
+    for example in g.protocol.examples:
+        direction = example.direction.value
+        frame = example.frame
+        for damaged in (frame[:-1], frame[:-1] + bytes([(frame[-1] + 1) & 0xFF]), b"\x00" + frame[1:], frame + b"\x00"):
+            with pytest.raises(DecodeError) as failure:
+                g.package.decode(damaged, direction)
+            assert "\n" not in str(failure.value) and str(failure.value)

@@ -1,0 +1,148 @@
+"""Bad specs get one line per mistake with file:line:column and what was expected; never a traceback."""
+
+from __future__ import annotations
+
+import ast
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+import yaml
+from serialspec.emit.docs import emit_docs
+from serialspec.emit.package import emit_package
+from serialspec.spec import SpecErrors, load_protocol
+
+MINIMAL = """\
+protocol: tiny
+title: Tiny
+byte_order: little
+serial: {baudrate: 9600}
+framing:
+  elements:
+    header: {role: header, value: "AA 55"}
+    code: {role: command, type: u8}
+    length: {role: length, type: u8}
+    content: {role: content}
+    checksum: {role: checksum, type: u8, algorithm: sum, covers: [code, content]}
+commands:
+  move:
+    code: 1
+    title: Move
+    request:
+      fields:
+        servo_id: {type: u8, range: [0, 10]}
+        angle: i16
+"""
+LINE = re.compile(r"^(?P<file>[^:]+):(?P<line>\d+):(?P<column>\d+): (?P<rest>.+)$")
+
+
+def errors_of(tmp_path: Path, text: str) -> list[str]:
+    spec = tmp_path / "tiny.yaml"
+    spec.write_text(text, encoding="utf-8")
+    with pytest.raises(SpecErrors) as failure:
+        load_protocol(str(spec), "tiny.yaml")
+    lines = str(failure.value).splitlines()
+    for line in lines:
+        assert LINE.match(line), line
+    return lines
+
+
+def test_minimal_spec_is_valid(tmp_path: Path) -> None:
+    spec = tmp_path / "tiny.yaml"
+    spec.write_text(MINIMAL, encoding="utf-8")
+    assert load_protocol(str(spec)).commands[0].request is not None
+
+
+def test_three_mistakes_give_three_lines(tmp_path: Path) -> None:
+    text = (
+        MINIMAL.replace("angle: i16", "angle: int17")
+        .replace("code: 1", "code: one")
+        .replace("range: [0, 10]", "range: [0, 300]")
+    )
+    lines = errors_of(tmp_path, text)
+    assert len(lines) == 3, lines
+    assert any("tiny.yaml:19:16: commands.move.request.fields.angle: unknown type 'int17'" in x for x in lines), lines
+    assert any("commands.move.code: expected an integer" in x for x in lines)
+    assert any("range [0, 300] does not fit u8" in x for x in lines)
+
+
+@pytest.mark.parametrize(
+    ("change", "expected"),
+    [
+        (("title: Move", "title: Move\n    colour: red"), "unknown key 'colour'"),
+        (("angle: i16", "angle: i16\n        angle: u8"), "duplicate key 'angle'"),
+        (("angle: i16", "class: i16"), "reserved"),
+        (("angle: i16", "Angle: i16"), "lower-case identifier"),
+        (("angle: i16", "angle: {type: u8, enum: colours}"), "unknown enum 'colours'"),
+        (("covers: [code, content]", "covers: [code, body]"), "unknown frame element 'body'"),
+        (('value: "AA 55"', 'value: "AA 5Z"'), "not a hex byte"),
+        (("angle: i16", "angle: [i16"), "YAML syntax error"),
+        (("angle: i16", "angle: {type: group, count: n, fields: {x: u8}}"), "unknown field 'n'"),
+        (("angle: i16", "data: {type: bytes, size: rest}\n        after: u8"), "only the last field"),
+    ],
+)
+def test_each_mistake_is_named_with_its_position(tmp_path: Path, change: tuple[str, str], expected: str) -> None:
+    lines = errors_of(tmp_path, MINIMAL.replace(*change))
+    assert any(expected in line for line in lines), lines
+
+
+def test_duplicate_command_codes_and_overlapping_registers(tmp_path: Path) -> None:
+    text = (
+        MINIMAL
+        + """\
+  stop:
+    code: 1
+    request: {fields: {servo_id: u8}}
+tables:
+  regs:
+    key: address
+    entries:
+      position: {key: 0x2A, type: u16}
+      speed: {key: 0x2B, type: u16}
+"""
+    )
+    lines = errors_of(tmp_path, text)
+    assert any("code 0x01 in request frames is already used by 'move'" in x for x in lines), lines
+    assert any("register speed at 0x2b overlaps position" in x for x in lines), lines
+
+
+def test_wrong_crc_parameters_are_caught_by_the_check_value(tmp_path: Path) -> None:
+    text = MINIMAL.replace(
+        "algorithm: sum,",
+        "algorithm: crc, crc: {width: 8, poly: 0x31, init: 0xFF, refin: true, refout: true, xorout: 0, check: 0xA1},",
+    )
+    lines = errors_of(tmp_path, text)
+    assert any("not the check value 0xa1" in x for x in lines), lines
+
+
+def test_hostile_text_never_reaches_generated_code_unescaped(tmp_path: Path) -> None:
+    hostile = '"""\n\nimport os; os.system("echo pwned")  # \u2028 \\ </td><script>alert(1)</script>'
+    spec_data = yaml.safe_load(MINIMAL)
+    move = spec_data["commands"]["move"]
+    move["title"] = move["description"] = hostile
+    move["request"]["fields"]["angle"] = {"type": "i16", "description": hostile, "unit": hostile}
+    spec_data["enums"] = {"mode": {"description": hostile, "values": {"fast": {"value": 1, "text": hostile}}}}
+    spec = tmp_path / "tiny.yaml"
+    spec.write_text(yaml.safe_dump(spec_data, allow_unicode=True, sort_keys=False), encoding="utf-8")
+    protocol = load_protocol(str(spec))
+    for name, source in emit_package(protocol).items():
+        if name.endswith(".py"):
+            tree = ast.parse(source, name)  # still valid Python, and the text stayed text:
+            imported = {alias.name for node in ast.walk(tree) if isinstance(node, ast.Import) for alias in node.names}
+            assert "os" not in imported, name
+            assert not any(isinstance(node, ast.Attribute) and node.attr == "system" for node in ast.walk(tree)), name
+    docs = emit_docs(protocol)
+    assert "<script>" not in docs and "</td>" not in docs
+
+
+def test_cli_reports_spec_errors_without_traceback(tmp_path: Path) -> None:
+    (tmp_path / "specs").mkdir()
+    (tmp_path / "specs" / "tiny.yaml").write_text(MINIMAL.replace("angle: i16", "angle: int17"), encoding="utf-8")
+    result = subprocess.run(
+        [sys.executable, "-m", "serialspec", "check", "--root", str(tmp_path)], capture_output=True, text=True
+    )
+    assert result.returncode == 1
+    assert "Traceback" not in result.stderr
+    assert "specs/tiny.yaml:19:16: commands.move.request.fields.angle: unknown type 'int17'" in result.stderr

@@ -58,11 +58,9 @@ def fields_values(fields: tuple[Field, ...], rest_budget: int) -> st.SearchStrat
             elif isinstance(f, Group):
                 count = f.count if isinstance(f.count, int) else draw(st.integers(0, MAX_ITEMS))
                 item = fields_values(f.fields, 0)
-                shared: dict[str, int] = {}
                 items = []
                 for _ in range(count):
                     items.append(draw(item))
-                del shared
                 # bytes sized by an outer field must have one size in every item
                 sized = [
                     i.name for i in f.fields if isinstance(i, Bytes) and isinstance(i.size, str) and i.size != "rest"

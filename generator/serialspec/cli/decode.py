@@ -9,7 +9,7 @@ from typing import Any
 
 from serialspec.cli.protocols import open_spec
 from serialspec.cli.views import engineering, register_view
-from serialspec.runtime.errors import ChecksumError, DecodeError, SerialspecError
+from serialspec.runtime.errors import DecodeError, SerialspecError
 from serialspec.runtime.hexbytes import parse_hex
 from serialspec.runtime.message import Message
 from serialspec.spec.model import Protocol
@@ -94,6 +94,3 @@ def _value(value: Any) -> str:
     if isinstance(value, dict | list):
         return json.dumps(value, ensure_ascii=False)
     return str(value)
-
-
-__all__ = ["ChecksumError", "describe"]

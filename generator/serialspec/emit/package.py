@@ -144,7 +144,7 @@ def codec_context(protocol: Protocol, code: PackageCode, exports: list[str]) -> 
     directions = []
     dispatchers = []
     for direction, layout in protocol.framing.layouts.items():
-        params, lines = frame_lines(protocol, layout)
+        params, lines = frame_lines(layout)
         typed = ", ".join(f"{p}: bytes" if p == "content" else f"{p}: int" for p in params)
         framers.append({"name": f"_frame_{direction.value}", "params": typed, "lines": lines})
         dispatch = []

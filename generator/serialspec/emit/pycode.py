@@ -283,7 +283,6 @@ class PackageCode:
         for f in message.fields:
             self.helper(f)
         fields = [*self.frame_values(message.direction), *self.value_fields(message)]
-        title = message.title or message.key.replace("_", " ")
         doc = f"{message.command} {message.subcommand or ''} {message.direction.value}".replace("  ", " ")
         code = ClassCode(message.class_name, doc, "Message", self.attribute_lines(fields))
         code.class_vars = [
@@ -292,7 +291,6 @@ class PackageCode:
             f"SUBCOMMAND: ClassVar[str | None] = {message.subcommand!r}",
             f"DIRECTION: ClassVar[Direction] = Direction.{message.direction.name}",
         ]
-        del title
         code.to_fields = [f"{f.name!r}: {self.to_json(f, 'self.' + f.name)}," for f in fields]
         code.from_fields = [f"{self.from_json(f)}," for f in fields]
         self.message_classes.append(code)
@@ -649,9 +647,8 @@ class PackageCode:
         return f"b''.join([{function}(item) for item in {expr}])"
 
 
-def frame_lines(protocol: Protocol, layout: FrameLayout) -> tuple[list[str], Lines]:
+def frame_lines(layout: FrameLayout) -> tuple[list[str], Lines]:
     """Parameters and body of `_frame_<direction>(code, <frame values>, content) -> bytes`."""
-    del protocol
     params = ["code", *[e.name for e in layout.value_elements], "content"]
     lines: Lines = []
     parts: list[str] = []

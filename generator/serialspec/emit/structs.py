@@ -93,7 +93,7 @@ def block_name(class_name: str) -> str:
     return f"{class_name}Block"
 
 
-def frame_expr(protocol: Protocol, layout: FrameLayout) -> str:
+def frame_expr(layout: FrameLayout) -> str:
     body = []
     adds = layout.length_adds
     for element in layout.elements:
@@ -113,7 +113,6 @@ def frame_expr(protocol: Protocol, layout: FrameLayout) -> str:
     assert checksum.type is not None
     trim = layout.covered_to_end - layout.checksum_offset_from_end
     covered = f"this.body.data[{layout.covered_from}:{-trim if trim else ''}]"
-    del protocol
     return (
         f"Struct('body' / RawCopy(Struct({', '.join(body)})), "
         f"'{checksum.name}' / Checksum({primitive(checksum.type, '<')}, _checksum, {covered}))"
@@ -153,10 +152,7 @@ def structs_module(protocol: Protocol) -> str:
         checksum_expr = f"crc_function({c.width}, {c.poly:#x}, {c.init:#x}, {c.refin}, {c.refout}, {c.xorout:#x})"
     else:
         checksum_expr = f"sum_function({checksum.type.size * 8}, invert={checksum.invert})"
-    frames = [
-        {"name": f"{d.name}_FRAME", "expr": frame_expr(protocol, layout)}
-        for d, layout in protocol.framing.layouts.items()
-    ]
+    frames = [{"name": f"{d.name}_FRAME", "expr": frame_expr(layout)} for d, layout in protocol.framing.layouts.items()]
     return render(
         "structs.py.j2",
         spec_path=protocol.spec_path,

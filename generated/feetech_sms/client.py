@@ -14,26 +14,31 @@ byte is written (RangeError names the field and the range).
 
 from __future__ import annotations
 
+from collections.abc import Iterable, Mapping
 from typing import Any
 
 import serial
-from serialspec.runtime.transport import Binding, Bus, ClientBase
+from serialspec.runtime.errors import EncodeError, Timeout
+from serialspec.runtime.transport import Binding, Bus, ClientBase, flag_names
 
 from feetech_sms import MATCH_BY, SERIAL
 from feetech_sms.codec import StreamParser, encode
 from feetech_sms.messages import (
     ActionRequest,
     Direction,
+    ErrorStatus,
     IdsItem,
     PingRequest,
     ReadRequest,
     RegWriteRequest,
+    ReplyResponse,
     ResetRequest,
     ServosItem,
     SyncReadRequest,
     SyncWriteRequest,
     WriteRequest,
 )
+from feetech_sms.registers import CONTROL_TABLE, ControlTableName
 
 __all__ = ["BINDING", "FeetechSmsClient"]
 
@@ -45,6 +50,7 @@ BINDING = Binding(
     parser=lambda: StreamParser(Direction.RESPONSE),
     match_by=MATCH_BY,
     status=('error',),
+    describe_status=flag_names({'error': ErrorStatus}),
 )
 
 
@@ -75,7 +81,7 @@ class FeetechSmsClient(ClientBase):
     def __enter__(self) -> FeetechSmsClient:
         return self
 
-    def ping(self, id: int) -> None:
+    def ping(self, id: int) -> bool:
         """Query a servo's working status.
 
         Broadcast: A servo answers a PING sent to the broadcast id too, so a broadcast PING finds the id of a single servo; with several servos on the bus their replies collide (004 §1.1).
@@ -83,12 +89,16 @@ class FeetechSmsClient(ClientBase):
         Args:
             id: Servo id 0..253; 254 (0xFE) is the broadcast id: every servo takes the instruction and none answers, except to PING. (0..253)
 
-        The device does not answer.
+        Returns: True if the device answered, False if it stayed silent (timeout).
         """
         request = PingRequest(id=id)
-        self.bus.send(request)
+        try:
+            self._ask(request, ReplyResponse)
+        except Timeout:
+            return False
+        return True
 
-    def read(self, id: int, address: int, length: int) -> None:
+    def read_raw(self, id: int, address: int, length: int) -> bytes:
         """Read from the control table.
 
         Reads `length` bytes of the control table from `address`; the reply holds them.
@@ -98,12 +108,13 @@ class FeetechSmsClient(ClientBase):
             address: First register address to read.
             length: Number of bytes to read. (1..250)
 
-        The device does not answer.
+        Returns: data: The bytes read, register by register from the request's address (empty except for READ).
         """
         request = ReadRequest(id=id, address=address, length=length)
-        self.bus.send(request)
+        reply = self._ask(request, ReplyResponse)
+        return reply.data
 
-    def write(self, id: int, address: int, data: bytes) -> None:
+    def write_raw(self, id: int, address: int, data: bytes) -> bool | None:
         """Write to the control table.
 
         Writes the data bytes to the control table from `address` on; they take effect at once.
@@ -115,12 +126,19 @@ class FeetechSmsClient(ClientBase):
             address: First register address to write.
             data: The bytes written, register by register from `address` on.
 
-        The device does not answer.
+        Returns: True if the device answered, False if it stayed silent (timeout).
+        None when no reply is due (broadcast gets no reply).
         """
         request = WriteRequest(id=id, address=address, data=data)
-        self.bus.send(request)
+        try:
+            reply = self._maybe(request, ReplyResponse, (8, 1))
+        except Timeout:
+            return False
+        if reply is None:
+            return None
+        return True
 
-    def reg_write(self, id: int, address: int, data: bytes) -> None:
+    def reg_write_raw(self, id: int, address: int, data: bytes) -> bool | None:
         """Buffered write, run on ACTION.
 
         Like WRITE, but the servo keeps the data in a buffer (and sets its async write flag, 0x40) until an ACTION arrives.
@@ -132,12 +150,19 @@ class FeetechSmsClient(ClientBase):
             address: First register address to write.
             data: The bytes to write when ACTION arrives.
 
-        The device does not answer.
+        Returns: True if the device answered, False if it stayed silent (timeout).
+        None when no reply is due (broadcast gets no reply).
         """
         request = RegWriteRequest(id=id, address=address, data=data)
-        self.bus.send(request)
+        try:
+            reply = self._maybe(request, ReplyResponse, (8, 1))
+        except Timeout:
+            return False
+        if reply is None:
+            return None
+        return True
 
-    def action(self, id: int) -> None:
+    def action(self, id: int) -> bool | None:
         """Run the buffered REG WRITEs.
 
         Sent to the broadcast id, makes every servo run its buffered REG WRITE at the same moment.
@@ -147,12 +172,19 @@ class FeetechSmsClient(ClientBase):
         Args:
             id: Servo id 0..253; 254 (0xFE) is the broadcast id: every servo takes the instruction and none answers, except to PING. (0..253)
 
-        The device does not answer.
+        Returns: True if the device answered, False if it stayed silent (timeout).
+        None when no reply is due (broadcast gets no reply).
         """
         request = ActionRequest(id=id)
-        self.bus.send(request)
+        try:
+            reply = self._maybe(request, ReplyResponse, (8, 1))
+        except Timeout:
+            return False
+        if reply is None:
+            return None
+        return True
 
-    def reset(self, id: int) -> None:
+    def reset(self, id: int) -> bool | None:
         """Reset the control table to its factory values.
 
         Resets (particular) control table data to the factory values; only some models support it.
@@ -160,12 +192,19 @@ class FeetechSmsClient(ClientBase):
         Args:
             id: Servo id 0..253; 254 (0xFE) is the broadcast id: every servo takes the instruction and none answers, except to PING. (0..253)
 
-        The device does not answer.
+        Returns: True if the device answered, False if it stayed silent (timeout).
+        None when no reply is due (broadcast gets no reply).
         """
         request = ResetRequest(id=id)
-        self.bus.send(request)
+        try:
+            reply = self._maybe(request, ReplyResponse, (8, 1))
+        except Timeout:
+            return False
+        if reply is None:
+            return None
+        return True
 
-    def sync_read(self, id: int, address: int, length: int, ids: tuple[IdsItem, ...]) -> None:
+    def sync_read_raw(self, id: int, address: int, length: int, ids: tuple[IdsItem, ...]) -> dict[int, bytes]:
         """Read the same registers of several servos.
 
         Sent to the broadcast id; every listed servo answers in turn with an ordinary reply holding `length` bytes from `address`. The length byte is the number of ids + 4, as for any request.
@@ -176,12 +215,13 @@ class FeetechSmsClient(ClientBase):
             length: Number of bytes each servo returns. (1..250)
             ids: The servos to read, in the order they answer.
 
-        The device does not answer.
+        Returns: id -> data of every listed device, in the order they answer.
         """
         request = SyncReadRequest(id=id, address=address, length=length, ids=ids)
-        self.bus.send(request)
+        replies = self.bus.request_each(request, ReplyResponse, [{'id': item.id} for item in ids])
+        return {reply.id: reply.data for reply in replies}
 
-    def sync_write(self, id: int, address: int, servos: tuple[ServosItem, ...]) -> None:
+    def sync_write_raw(self, id: int, address: int, servos: tuple[ServosItem, ...] | Mapping[int, bytes]) -> None:
         """Write the same registers of several servos at once.
 
         Sent to the broadcast id 0xFE; one packet writes L bytes from the same address to each listed servo. The length byte is (L + 1) × N + 4, which example 7 bears out: (6 + 1) × 4 + 4 = 32 = 0x20.
@@ -192,8 +232,83 @@ class FeetechSmsClient(ClientBase):
             id: Servo id 0..253; 254 (0xFE) is the broadcast id: every servo takes the instruction and none answers, except to PING. (0..253)
             address: First register address to write.
             servos: One item per servo.
+            (servos also takes a mapping {id: data}, one entry per item.)
 
         The device does not answer.
         """
+        if isinstance(servos, Mapping):
+            servos = tuple(ServosItem(id=key, data=value) for key, value in servos.items())
         request = SyncWriteRequest(id=id, address=address, servos=servos)
         self.bus.send(request)
+
+    def read(self, id: int, name: ControlTableName) -> int:
+        """Read from the control table: one register by name, e.g. `read(1, "present_position")`, in wire units."""
+        return self.read_many(id, name)[name]
+
+    def read_many(self, id: int, *names: ControlTableName) -> dict[str, int]:
+        """Read from the control table: several registers by name, in one transaction that spans them all."""
+        start, size = CONTROL_TABLE.span(names)
+        if id == 254:
+            raise EncodeError("read: name one device; the broadcast id 254 gets no reply")
+        data = self.read_raw(id, start, size)
+        values = CONTROL_TABLE.unpack(start, data or b"")
+        return {name: values[name] for name in names}
+
+    def _read_key(self, address: int, key: int) -> float:
+        register = CONTROL_TABLE.by_address[key]
+        data = self.read_raw(address, register.address, register.size)
+        return CONTROL_TABLE.from_wire(register, data or b"")
+
+    def write(self, id: int, **values: int) -> bool | None:
+        """Write to the control table, by register name: `write(id, goal_position=2048, goal_time=0)`.
+
+        The named registers must follow each other in the table (one run of bytes); each value is checked
+        against its register's range and access before a byte is written. `write_raw` takes raw bytes.
+        """
+        start, data = CONTROL_TABLE.pack(values)
+        result = self.write_raw(id, start, data)
+        for name, value in values.items():
+            self._remember(id, CONTROL_TABLE[name].address, value)
+        return result
+
+    def reg_write(self, id: int, **values: int) -> bool | None:
+        """Buffered write, run on ACTION, by register name: `reg_write(id, goal_position=2048, goal_time=0)`.
+
+        The named registers must follow each other in the table (one run of bytes); each value is checked
+        against its register's range and access before a byte is written. `reg_write_raw` takes raw bytes.
+        """
+        start, data = CONTROL_TABLE.pack(values)
+        result = self.reg_write_raw(id, start, data)
+        for name, value in values.items():
+            self._remember(id, CONTROL_TABLE[name].address, value)
+        return result
+
+    def sync_read(
+        self, ids: Iterable[int], *names: ControlTableName, id: int = 254
+    ) -> dict[int, dict[str, int]]:
+        """Read the same registers of several servos, by register name: `sync_read([1, 2], "present_position")` -> {1: {...}, 2: {...}}.
+
+        One request; every listed device answers in turn. `sync_read_raw` takes raw addresses and returns bytes.
+        """
+        start, size = CONTROL_TABLE.span(names)
+        items = tuple(IdsItem(id=device) for device in ids)
+        replies = self.sync_read_raw(id, start, size, items)
+        return {
+            device: {name: value for name, value in CONTROL_TABLE.unpack(start, data).items() if name in names}
+            for device, data in replies.items()
+        }
+
+    def sync_write(self, values: Mapping[int, Mapping[str, int]], id: int = 254) -> None:
+        """Write the same registers of several servos at once, by register name: `sync_write({1: {"goal_position": 100}, 2: {"goal_position": 300}})`.
+
+        Every device gets the same registers (one run, the same for all); values are checked before sending.
+        `sync_write_raw` takes raw bytes.
+        """
+        runs = {device: CONTROL_TABLE.pack(registers) for device, registers in values.items()}
+        if len({(start, len(data)) for start, data in runs.values()}) > 1:
+            raise EncodeError("sync_write: every device must get the same registers")
+        if not runs:
+            raise EncodeError("sync_write: name at least one device")
+        start, data = next(iter(runs.values()))
+        items = tuple(ServosItem(id=device, data=data) for device, (_, data) in runs.items())
+        return self.sync_write_raw(id, start, items)

@@ -13,9 +13,13 @@ byte is written (RangeError names the field and the range).
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterator, Mapping
+from enum import IntEnum
 from typing import Any
 
 import serial
+from serialspec.runtime.errors import DeviceError
+from serialspec.runtime.message import Message
 from serialspec.runtime.transport import Binding, Bus, ClientBase
 
 from hiwonder_rrc import MATCH_BY, SERIAL
@@ -49,6 +53,9 @@ from hiwonder_rrc.messages import (
     BusServoUnloadRequest,
     BuzzerRequest,
     Direction,
+    GamepadResponse,
+    ImuResponse,
+    KeyResponse,
     LedRequest,
     MotorMask,
     MotorSetSpeedRequest,
@@ -64,9 +71,10 @@ from hiwonder_rrc.messages import (
     PwmServoSetPositionRequest,
     PwmServoSetPositionsRequest,
     PwmServosItem,
+    SbusResponse,
 )
 
-__all__ = ["BINDING", "HiwonderRrcClient"]
+__all__ = ["BINDING", "HiwonderRrcClient", "MotorCommands", "PwmServoCommands", "BusServoCommands"]
 
 #: What a Bus needs of this protocol: serial defaults, codec, and the reply-matching rule.
 BINDING = Binding(
@@ -79,6 +87,403 @@ BINDING = Binding(
 )
 
 
+class MotorCommands:
+    """Encoder motors: the sub-commands, as `client.motor.<sub-command>(...)`."""
+
+    def __init__(self, client: HiwonderRrcClient) -> None:
+        self._client = client
+
+    def set_speed(self, motor_id: int, speed: float) -> None:
+        """Run one motor at a speed.
+
+        Args:
+            motor_id: Encoder motor id; bit n of the stop mask is motor_id n (the board has four motor ports).
+            speed: Motor speed in revolutions per second; the sign gives the direction. [r/s]
+
+        The device does not answer.
+        """
+        request = MotorSetSpeedRequest(motor_id=motor_id, speed=speed)
+        self._client.bus.send(request)
+
+    def set_speeds(self, motors: tuple[MotorsItem, ...] | Mapping[int, float]) -> None:
+        """Run several motors, each at its speed.
+
+        Data is 5N+2 bytes for N motors.
+
+        Args:
+            motors: One (motor_id, speed) pair per motor.
+            (motors also takes a mapping {motor_id: speed}, one entry per item.)
+
+        The device does not answer.
+        """
+        if isinstance(motors, Mapping):
+            motors = tuple(MotorsItem(motor_id=key, speed=value) for key, value in motors.items())
+        request = MotorSetSpeedsRequest(motors=motors)
+        self._client.bus.send(request)
+
+    def stop(self, motor_id: int) -> None:
+        """Stop one motor.
+
+        Args:
+            motor_id: Encoder motor id; bit n of the stop mask is motor_id n (the board has four motor ports).
+
+        The device does not answer.
+        """
+        request = MotorStopRequest(motor_id=motor_id)
+        self._client.bus.send(request)
+
+    def stop_mask(self, mask: MotorMask) -> None:
+        """Stop the motors of a bit mask.
+
+        Args:
+            mask: Motors to stop (电机掩码), bit n for motor n.
+
+        The device does not answer.
+        """
+        request = MotorStopMaskRequest(mask=mask)
+        self._client.bus.send(request)
+
+
+class PwmServoCommands:
+    """PWM servos: the sub-commands, as `client.pwm_servo.<sub-command>(...)`."""
+
+    def __init__(self, client: HiwonderRrcClient) -> None:
+        self._client = client
+
+    def set_positions(self, duration: int, pwm_servos: tuple[PwmServosItem, ...] | Mapping[int, int]) -> None:
+        """Move several PWM servos in one duration.
+
+        Data is 3N+4 bytes for N servos: sub-command, duration, count, then (servo_id, pulse) per servo, as the vendor SDK sends it. 002 prints 3N+3 and no count (erratum pwm_positions_count_missing).
+
+        Args:
+            duration: Time to complete the move (运动时间). [ms]
+            pwm_servos: One (servo_id, pulse) pair per servo.
+            (pwm_servos also takes a mapping {servo_id: pulse}, one entry per item.)
+
+        The device does not answer.
+        """
+        if isinstance(pwm_servos, Mapping):
+            pwm_servos = tuple(PwmServosItem(servo_id=key, pulse=value) for key, value in pwm_servos.items())
+        request = PwmServoSetPositionsRequest(duration=duration, pwm_servos=pwm_servos)
+        self._client.bus.send(request)
+
+    def set_position(self, duration: int, servo_id: int, pulse: int) -> None:
+        """Move one PWM servo.
+
+        Args:
+            duration: Time to complete the move (运动时间). [ms]
+            servo_id: PWM servo id.
+            pulse: PWM pulse width (脉冲宽度); 500..2500 is 0°..180°. [µs] (500..2500)
+
+        The device does not answer.
+        """
+        request = PwmServoSetPositionRequest(duration=duration, servo_id=servo_id, pulse=pulse)
+        self._client.bus.send(request)
+
+    def read_position(self, servo_id: int) -> int:
+        """Read a PWM servo's pulse width.
+
+        Args:
+            servo_id: PWM servo id.
+
+        Returns: pulse: The servo's current pulse width (not range-checked in a report). [µs]
+        """
+        request = PwmServoReadPositionRequest(servo_id=servo_id)
+        reply = self._client._ask(request, PwmServoReadPositionResponse)
+        return reply.pulse
+
+    def set_offset(self, servo_id: int, offset: int) -> None:
+        """Set a PWM servo's offset.
+
+        Args:
+            servo_id: PWM servo id.
+            offset: PWM servo offset (偏差), an int8 from -100 to +100. [µs] (-100..100)
+
+        The device does not answer.
+        """
+        request = PwmServoSetOffsetRequest(servo_id=servo_id, offset=offset)
+        self._client.bus.send(request)
+
+    def read_offset(self, servo_id: int) -> int:
+        """Read a PWM servo's offset.
+
+        Args:
+            servo_id: PWM servo id.
+
+        Returns: offset: The servo's offset (int8; -100..100 when set through 0x07). [µs]
+        """
+        request = PwmServoReadOffsetRequest(servo_id=servo_id)
+        reply = self._client._ask(request, PwmServoReadOffsetResponse)
+        return reply.offset
+
+
+class BusServoCommands:
+    """Bus servos: the sub-commands, as `client.bus_servo.<sub-command>(...)`."""
+
+    def __init__(self, client: HiwonderRrcClient) -> None:
+        self._client = client
+
+    def set_positions(self, duration: int, bus_servos: tuple[BusServosItem, ...] | Mapping[int, int]) -> None:
+        """Move several bus servos in one duration.
+
+        Data is 3N+4 bytes for N servos.
+
+        Broadcast: Servo id 0xFE reaches every servo; only the ID read (0x12) uses it, with a single servo on the bus.
+
+        Args:
+            duration: Time to complete the move (运动时间). [ms]
+            bus_servos: One (servo_id, position) pair per servo.
+            (bus_servos also takes a mapping {servo_id: position}, one entry per item.)
+
+        The device does not answer.
+        """
+        if isinstance(bus_servos, Mapping):
+            bus_servos = tuple(BusServosItem(servo_id=key, position=value) for key, value in bus_servos.items())
+        request = BusServoSetPositionsRequest(duration=duration, bus_servos=bus_servos)
+        self._client.bus.send(request)
+
+    def read_position(self, servo_id: int) -> int:
+        """Read a bus servo's position.
+
+        Broadcast: Servo id 0xFE reaches every servo; only the ID read (0x12) uses it, with a single servo on the bus.
+
+        Args:
+            servo_id: Bus servo id (0xFE is the broadcast id).
+
+        Returns: position: Current position (0..1000 is 0°..240°).
+        Raises DeviceError when the reply's success is not 0.
+        """
+        request = BusServoReadPositionRequest(servo_id=servo_id)
+        reply = self._client._ask(request, BusServoReadPositionResponse)
+        _check_status(request, reply, 'success', 0)
+        return reply.position
+
+    def read_voltage(self, servo_id: int) -> int:
+        """Read a bus servo's input voltage.
+
+        Broadcast: Servo id 0xFE reaches every servo; only the ID read (0x12) uses it, with a single servo on the bus.
+
+        Args:
+            servo_id: Bus servo id (0xFE is the broadcast id).
+
+        Returns: voltage: Input voltage. [mV]
+        Raises DeviceError when the reply's success is not 0.
+        """
+        request = BusServoReadVoltageRequest(servo_id=servo_id)
+        reply = self._client._ask(request, BusServoReadVoltageResponse)
+        _check_status(request, reply, 'success', 0)
+        return reply.voltage
+
+    def read_temperature(self, servo_id: int) -> int:
+        """Read a bus servo's temperature.
+
+        Broadcast: Servo id 0xFE reaches every servo; only the ID read (0x12) uses it, with a single servo on the bus.
+
+        Args:
+            servo_id: Bus servo id (0xFE is the broadcast id).
+
+        Returns: temperature: Temperature. [°C]
+        Raises DeviceError when the reply's success is not 0.
+        """
+        request = BusServoReadTemperatureRequest(servo_id=servo_id)
+        reply = self._client._ask(request, BusServoReadTemperatureResponse)
+        _check_status(request, reply, 'success', 0)
+        return reply.temperature
+
+    def unload(self, servo_id: int) -> None:
+        """Release a bus servo's torque.
+
+        Broadcast: Servo id 0xFE reaches every servo; only the ID read (0x12) uses it, with a single servo on the bus.
+
+        Args:
+            servo_id: Bus servo id (0xFE is the broadcast id).
+
+        The device does not answer.
+        """
+        request = BusServoUnloadRequest(servo_id=servo_id)
+        self._client.bus.send(request)
+
+    def load(self, servo_id: int) -> None:
+        """Apply a bus servo's torque.
+
+        Broadcast: Servo id 0xFE reaches every servo; only the ID read (0x12) uses it, with a single servo on the bus.
+
+        Args:
+            servo_id: Bus servo id (0xFE is the broadcast id).
+
+        The device does not answer.
+        """
+        request = BusServoLoadRequest(servo_id=servo_id)
+        self._client.bus.send(request)
+
+    def set_id(self, servo_id: int, new_id: int) -> None:
+        """Change a bus servo's id.
+
+        Broadcast: Servo id 0xFE reaches every servo; only the ID read (0x12) uses it, with a single servo on the bus.
+
+        Args:
+            servo_id: The servo's current id.
+            new_id: The id to store (save_id).
+
+        The device does not answer.
+        """
+        request = BusServoSetIdRequest(servo_id=servo_id, new_id=new_id)
+        self._client.bus.send(request)
+
+    def read_id(self, servo_id: int = 254) -> int:
+        """Read the id of the only servo on the bus.
+
+        Sent to the broadcast id 0xFE; only one servo may be on the bus, or the replies collide.
+
+        Broadcast: Servo id 0xFE reaches every servo; only the ID read (0x12) uses it, with a single servo on the bus.
+
+        Args:
+            servo_id: 0xFE (broadcast query, 查询广播).
+
+        Returns: id: The id read from the servo.
+        Raises DeviceError when the reply's success is not 0.
+        """
+        request = BusServoReadIdRequest(servo_id=servo_id)
+        reply = self._client._ask(request, BusServoReadIdResponse)
+        _check_status(request, reply, 'success', 0)
+        return reply.id
+
+    def set_offset(self, servo_id: int, offset: int) -> None:
+        """Set a bus servo's offset.
+
+        Broadcast: Servo id 0xFE reaches every servo; only the ID read (0x12) uses it, with a single servo on the bus.
+
+        Args:
+            servo_id: Bus servo id (0xFE is the broadcast id).
+            offset: Bus servo offset (偏差), an int8 from -100 to +100. (-100..100)
+
+        The device does not answer.
+        """
+        request = BusServoSetOffsetRequest(servo_id=servo_id, offset=offset)
+        self._client.bus.send(request)
+
+    def read_offset(self, servo_id: int) -> int:
+        """Read a bus servo's offset.
+
+        Broadcast: Servo id 0xFE reaches every servo; only the ID read (0x12) uses it, with a single servo on the bus.
+
+        Args:
+            servo_id: Bus servo id (0xFE is the broadcast id).
+
+        Returns: offset: The servo's offset (int8; -100..100 when set through 0x20).
+        Raises DeviceError when the reply's success is not 0.
+        """
+        request = BusServoReadOffsetRequest(servo_id=servo_id)
+        reply = self._client._ask(request, BusServoReadOffsetResponse)
+        _check_status(request, reply, 'success', 0)
+        return reply.offset
+
+    def save_offset(self, servo_id: int) -> None:
+        """Store a bus servo's current offset.
+
+        Broadcast: Servo id 0xFE reaches every servo; only the ID read (0x12) uses it, with a single servo on the bus.
+
+        Args:
+            servo_id: Bus servo id (0xFE is the broadcast id).
+
+        The device does not answer.
+        """
+        request = BusServoSaveOffsetRequest(servo_id=servo_id)
+        self._client.bus.send(request)
+
+    def set_position_limit(self, servo_id: int, low: int, high: int) -> None:
+        """Set a bus servo's position limits.
+
+        Broadcast: Servo id 0xFE reaches every servo; only the ID read (0x12) uses it, with a single servo on the bus.
+
+        Args:
+            servo_id: Bus servo id (0xFE is the broadcast id).
+            low: Low position limit (低限位), 0..1000. (0..1000)
+            high: High position limit (高限位), 0..1000. (0..1000)
+
+        The device does not answer.
+        """
+        request = BusServoSetPositionLimitRequest(servo_id=servo_id, low=low, high=high)
+        self._client.bus.send(request)
+
+    def read_position_limit(self, servo_id: int) -> BusServoReadPositionLimitResponse:
+        """Read a bus servo's position limits.
+
+        Broadcast: Servo id 0xFE reaches every servo; only the ID read (0x12) uses it, with a single servo on the bus.
+
+        Args:
+            servo_id: Bus servo id (0xFE is the broadcast id).
+
+        Returns: the BusServoReadPositionLimitResponse reply.
+        Raises DeviceError when the reply's success is not 0.
+        """
+        request = BusServoReadPositionLimitRequest(servo_id=servo_id)
+        reply = self._client._ask(request, BusServoReadPositionLimitResponse)
+        _check_status(request, reply, 'success', 0)
+        return reply
+
+    def set_voltage_limit(self, servo_id: int, low: int, high: int) -> None:
+        """Set a bus servo's voltage limits.
+
+        Broadcast: Servo id 0xFE reaches every servo; only the ID read (0x12) uses it, with a single servo on the bus.
+
+        Args:
+            servo_id: Bus servo id (0xFE is the broadcast id).
+            low: Low voltage limit (低限位), at least 4500 mV. [mV] (4500..14000)
+            high: High voltage limit (高限位), at most 14000 mV. [mV] (4500..14000)
+
+        The device does not answer.
+        """
+        request = BusServoSetVoltageLimitRequest(servo_id=servo_id, low=low, high=high)
+        self._client.bus.send(request)
+
+    def read_voltage_limit(self, servo_id: int) -> BusServoReadVoltageLimitResponse:
+        """Read a bus servo's voltage limits.
+
+        Broadcast: Servo id 0xFE reaches every servo; only the ID read (0x12) uses it, with a single servo on the bus.
+
+        Args:
+            servo_id: Bus servo id (0xFE is the broadcast id).
+
+        Returns: the BusServoReadVoltageLimitResponse reply.
+        Raises DeviceError when the reply's success is not 0.
+        """
+        request = BusServoReadVoltageLimitRequest(servo_id=servo_id)
+        reply = self._client._ask(request, BusServoReadVoltageLimitResponse)
+        _check_status(request, reply, 'success', 0)
+        return reply
+
+    def set_temperature_limit(self, servo_id: int, limit: int) -> None:
+        """Set a bus servo's temperature limit.
+
+        Broadcast: Servo id 0xFE reaches every servo; only the ID read (0x12) uses it, with a single servo on the bus.
+
+        Args:
+            servo_id: Bus servo id (0xFE is the broadcast id).
+            limit: Over-temperature threshold (高温阈值); must be less than 100 °C. [°C] (0..99)
+
+        The device does not answer.
+        """
+        request = BusServoSetTemperatureLimitRequest(servo_id=servo_id, limit=limit)
+        self._client.bus.send(request)
+
+    def read_temperature_limit(self, servo_id: int) -> int:
+        """Read a bus servo's temperature limit.
+
+        Broadcast: Servo id 0xFE reaches every servo; only the ID read (0x12) uses it, with a single servo on the bus.
+
+        Args:
+            servo_id: Bus servo id (0xFE is the broadcast id).
+
+        Returns: limit: Over-temperature threshold. [°C]
+        Raises DeviceError when the reply's success is not 0.
+        """
+        request = BusServoReadTemperatureLimitRequest(servo_id=servo_id)
+        reply = self._client._ask(request, BusServoReadTemperatureLimitResponse)
+        _check_status(request, reply, 'success', 0)
+        return reply.limit
+
+
 class HiwonderRrcClient(ClientBase):
     """Hiwonder RRC controller board protocol client over a serial port or pyserial URL; a context manager.
 
@@ -88,8 +493,11 @@ class HiwonderRrcClient(ClientBase):
     Broadcast requests never wait for a reply.
     """
 
-    ADDRESS = ''
-    BROADCAST = None
+    ADDRESS = 'servo_id'
+    BROADCAST = 254
+    motor: MotorCommands
+    pwm_servo: PwmServoCommands
+    bus_servo: BusServoCommands
 
     def __init__(
         self,
@@ -102,6 +510,9 @@ class HiwonderRrcClient(ClientBase):
     ) -> None:
         bus = port if isinstance(port, Bus) else Bus(port, BINDING, timeout=timeout, baudrate=baudrate, **serial_options)
         super().__init__(bus, optional_replies)
+        self.motor = MotorCommands(self)
+        self.pwm_servo = PwmServoCommands(self)
+        self.bus_servo = BusServoCommands(self)
 
     def __enter__(self) -> HiwonderRrcClient:
         return self
@@ -134,353 +545,49 @@ class HiwonderRrcClient(ClientBase):
         request = BuzzerRequest(frequency=frequency, on_time=on_time, off_time=off_time, repeat=repeat)
         self.bus.send(request)
 
-    def motor_set_speed(self, motor_id: int, speed: float) -> None:
-        """Run one motor at a speed.
+    def reports(self, timeout: float | None = None) -> Iterator[KeyResponse | ImuResponse | GamepadResponse | SbusResponse]:
+        """Messages the device sends on its own, as they come, typed; stops after `timeout` seconds without one.
 
-        Args:
-            motor_id: Encoder motor id; bit n of the stop mask is motor_id n (the board has four motor ports).
-            speed: Motor speed in revolutions per second; the sign gives the direction. [r/s]
-
-        The device does not answer.
+        `timeout` defaults to the bus timeout. Stray replies to earlier requests are skipped.
         """
-        request = MotorSetSpeedRequest(motor_id=motor_id, speed=speed)
-        self.bus.send(request)
+        for message in self.bus.messages(timeout):
+            if isinstance(message, (KeyResponse, ImuResponse, GamepadResponse, SbusResponse)):
+                yield message
 
-    def motor_set_speeds(self, motors: tuple[MotorsItem, ...]) -> None:
-        """Run several motors, each at its speed.
+    def on_key(self, callback: Callable[[KeyResponse], None]) -> Callable[[], None]:
+        """Call `callback` with every KeyResponse (Key event); returns a function that unsubscribes.
 
-        Data is 5N+2 bytes for N motors.
-
-        Args:
-            motors: One (motor_id, speed) pair per motor.
-
-        The device does not answer.
+        Callbacks run in the thread that reads the bus: during any request of this client, or while reports() runs.
         """
-        request = MotorSetSpeedsRequest(motors=motors)
-        self.bus.send(request)
+        return self.bus.subscribe(lambda message: callback(message) if isinstance(message, KeyResponse) else None)
 
-    def motor_stop(self, motor_id: int) -> None:
-        """Stop one motor.
+    def on_imu(self, callback: Callable[[ImuResponse], None]) -> Callable[[], None]:
+        """Call `callback` with every ImuResponse (IMU data); returns a function that unsubscribes.
 
-        Args:
-            motor_id: Encoder motor id; bit n of the stop mask is motor_id n (the board has four motor ports).
-
-        The device does not answer.
+        Callbacks run in the thread that reads the bus: during any request of this client, or while reports() runs.
         """
-        request = MotorStopRequest(motor_id=motor_id)
-        self.bus.send(request)
+        return self.bus.subscribe(lambda message: callback(message) if isinstance(message, ImuResponse) else None)
 
-    def motor_stop_mask(self, mask: MotorMask) -> None:
-        """Stop the motors of a bit mask.
+    def on_gamepad(self, callback: Callable[[GamepadResponse], None]) -> Callable[[], None]:
+        """Call `callback` with every GamepadResponse (Gamepad data); returns a function that unsubscribes.
 
-        Args:
-            mask: Motors to stop (电机掩码), bit n for motor n.
-
-        The device does not answer.
+        Callbacks run in the thread that reads the bus: during any request of this client, or while reports() runs.
         """
-        request = MotorStopMaskRequest(mask=mask)
-        self.bus.send(request)
+        return self.bus.subscribe(lambda message: callback(message) if isinstance(message, GamepadResponse) else None)
 
-    def pwm_servo_set_positions(self, duration: int, pwm_servos: tuple[PwmServosItem, ...]) -> None:
-        """Move several PWM servos in one duration.
+    def on_sbus(self, callback: Callable[[SbusResponse], None]) -> Callable[[], None]:
+        """Call `callback` with every SbusResponse (SBUS radio-control receiver data); returns a function that unsubscribes.
 
-        Data is 3N+4 bytes for N servos: sub-command, duration, count, then (servo_id, pulse) per servo, as the vendor SDK sends it. 002 prints 3N+3 and no count (erratum pwm_positions_count_missing).
-
-        Args:
-            duration: Time to complete the move (运动时间). [ms]
-            pwm_servos: One (servo_id, pulse) pair per servo.
-
-        The device does not answer.
+        Callbacks run in the thread that reads the bus: during any request of this client, or while reports() runs.
         """
-        request = PwmServoSetPositionsRequest(duration=duration, pwm_servos=pwm_servos)
-        self.bus.send(request)
-
-    def pwm_servo_set_position(self, duration: int, servo_id: int, pulse: int) -> None:
-        """Move one PWM servo.
-
-        Args:
-            duration: Time to complete the move (运动时间). [ms]
-            servo_id: PWM servo id.
-            pulse: PWM pulse width (脉冲宽度); 500..2500 is 0°..180°. [µs] (500..2500)
-
-        The device does not answer.
-        """
-        request = PwmServoSetPositionRequest(duration=duration, servo_id=servo_id, pulse=pulse)
-        self.bus.send(request)
-
-    def pwm_servo_read_position(self, servo_id: int) -> int:
-        """Read a PWM servo's pulse width.
-
-        Args:
-            servo_id: PWM servo id.
-
-        Returns: pulse: The servo's current pulse width (not range-checked in a report). [µs]
-        """
-        request = PwmServoReadPositionRequest(servo_id=servo_id)
-        reply = self._ask(request, PwmServoReadPositionResponse)
-        return reply.pulse
-
-    def pwm_servo_set_offset(self, servo_id: int, offset: int) -> None:
-        """Set a PWM servo's offset.
-
-        Args:
-            servo_id: PWM servo id.
-            offset: PWM servo offset (偏差), an int8 from -100 to +100. [µs] (-100..100)
-
-        The device does not answer.
-        """
-        request = PwmServoSetOffsetRequest(servo_id=servo_id, offset=offset)
-        self.bus.send(request)
-
-    def pwm_servo_read_offset(self, servo_id: int) -> int:
-        """Read a PWM servo's offset.
-
-        Args:
-            servo_id: PWM servo id.
-
-        Returns: offset: The servo's offset (int8; -100..100 when set through 0x07). [µs]
-        """
-        request = PwmServoReadOffsetRequest(servo_id=servo_id)
-        reply = self._ask(request, PwmServoReadOffsetResponse)
-        return reply.offset
-
-    def bus_servo_set_positions(self, duration: int, bus_servos: tuple[BusServosItem, ...]) -> None:
-        """Move several bus servos in one duration.
-
-        Data is 3N+4 bytes for N servos.
-
-        Broadcast: Servo id 0xFE reaches every servo; only the ID read (0x12) uses it, with a single servo on the bus.
-
-        Args:
-            duration: Time to complete the move (运动时间). [ms]
-            bus_servos: One (servo_id, position) pair per servo.
-
-        The device does not answer.
-        """
-        request = BusServoSetPositionsRequest(duration=duration, bus_servos=bus_servos)
-        self.bus.send(request)
-
-    def bus_servo_read_position(self, servo_id: int) -> BusServoReadPositionResponse:
-        """Read a bus servo's position.
-
-        Broadcast: Servo id 0xFE reaches every servo; only the ID read (0x12) uses it, with a single servo on the bus.
-
-        Args:
-            servo_id: Bus servo id (0xFE is the broadcast id).
-
-        Returns: the BusServoReadPositionResponse reply.
-        """
-        request = BusServoReadPositionRequest(servo_id=servo_id)
-        reply = self._ask(request, BusServoReadPositionResponse)
-        return reply
-
-    def bus_servo_read_voltage(self, servo_id: int) -> BusServoReadVoltageResponse:
-        """Read a bus servo's input voltage.
-
-        Broadcast: Servo id 0xFE reaches every servo; only the ID read (0x12) uses it, with a single servo on the bus.
-
-        Args:
-            servo_id: Bus servo id (0xFE is the broadcast id).
-
-        Returns: the BusServoReadVoltageResponse reply.
-        """
-        request = BusServoReadVoltageRequest(servo_id=servo_id)
-        reply = self._ask(request, BusServoReadVoltageResponse)
-        return reply
-
-    def bus_servo_read_temperature(self, servo_id: int) -> BusServoReadTemperatureResponse:
-        """Read a bus servo's temperature.
-
-        Broadcast: Servo id 0xFE reaches every servo; only the ID read (0x12) uses it, with a single servo on the bus.
-
-        Args:
-            servo_id: Bus servo id (0xFE is the broadcast id).
-
-        Returns: the BusServoReadTemperatureResponse reply.
-        """
-        request = BusServoReadTemperatureRequest(servo_id=servo_id)
-        reply = self._ask(request, BusServoReadTemperatureResponse)
-        return reply
-
-    def bus_servo_unload(self, servo_id: int) -> None:
-        """Release a bus servo's torque.
-
-        Broadcast: Servo id 0xFE reaches every servo; only the ID read (0x12) uses it, with a single servo on the bus.
-
-        Args:
-            servo_id: Bus servo id (0xFE is the broadcast id).
-
-        The device does not answer.
-        """
-        request = BusServoUnloadRequest(servo_id=servo_id)
-        self.bus.send(request)
-
-    def bus_servo_load(self, servo_id: int) -> None:
-        """Apply a bus servo's torque.
-
-        Broadcast: Servo id 0xFE reaches every servo; only the ID read (0x12) uses it, with a single servo on the bus.
-
-        Args:
-            servo_id: Bus servo id (0xFE is the broadcast id).
-
-        The device does not answer.
-        """
-        request = BusServoLoadRequest(servo_id=servo_id)
-        self.bus.send(request)
-
-    def bus_servo_set_id(self, servo_id: int, new_id: int) -> None:
-        """Change a bus servo's id.
-
-        Broadcast: Servo id 0xFE reaches every servo; only the ID read (0x12) uses it, with a single servo on the bus.
-
-        Args:
-            servo_id: The servo's current id.
-            new_id: The id to store (save_id).
-
-        The device does not answer.
-        """
-        request = BusServoSetIdRequest(servo_id=servo_id, new_id=new_id)
-        self.bus.send(request)
-
-    def bus_servo_read_id(self, servo_id: int = 254) -> BusServoReadIdResponse:
-        """Read the id of the only servo on the bus.
-
-        Sent to the broadcast id 0xFE; only one servo may be on the bus, or the replies collide.
-
-        Broadcast: Servo id 0xFE reaches every servo; only the ID read (0x12) uses it, with a single servo on the bus.
-
-        Args:
-            servo_id: 0xFE (broadcast query, 查询广播).
-
-        Returns: the BusServoReadIdResponse reply.
-        """
-        request = BusServoReadIdRequest(servo_id=servo_id)
-        reply = self._ask(request, BusServoReadIdResponse)
-        return reply
-
-    def bus_servo_set_offset(self, servo_id: int, offset: int) -> None:
-        """Set a bus servo's offset.
-
-        Broadcast: Servo id 0xFE reaches every servo; only the ID read (0x12) uses it, with a single servo on the bus.
-
-        Args:
-            servo_id: Bus servo id (0xFE is the broadcast id).
-            offset: Bus servo offset (偏差), an int8 from -100 to +100. (-100..100)
-
-        The device does not answer.
-        """
-        request = BusServoSetOffsetRequest(servo_id=servo_id, offset=offset)
-        self.bus.send(request)
-
-    def bus_servo_read_offset(self, servo_id: int) -> BusServoReadOffsetResponse:
-        """Read a bus servo's offset.
-
-        Broadcast: Servo id 0xFE reaches every servo; only the ID read (0x12) uses it, with a single servo on the bus.
-
-        Args:
-            servo_id: Bus servo id (0xFE is the broadcast id).
-
-        Returns: the BusServoReadOffsetResponse reply.
-        """
-        request = BusServoReadOffsetRequest(servo_id=servo_id)
-        reply = self._ask(request, BusServoReadOffsetResponse)
-        return reply
-
-    def bus_servo_save_offset(self, servo_id: int) -> None:
-        """Store a bus servo's current offset.
-
-        Broadcast: Servo id 0xFE reaches every servo; only the ID read (0x12) uses it, with a single servo on the bus.
-
-        Args:
-            servo_id: Bus servo id (0xFE is the broadcast id).
-
-        The device does not answer.
-        """
-        request = BusServoSaveOffsetRequest(servo_id=servo_id)
-        self.bus.send(request)
-
-    def bus_servo_set_position_limit(self, servo_id: int, low: int, high: int) -> None:
-        """Set a bus servo's position limits.
-
-        Broadcast: Servo id 0xFE reaches every servo; only the ID read (0x12) uses it, with a single servo on the bus.
-
-        Args:
-            servo_id: Bus servo id (0xFE is the broadcast id).
-            low: Low position limit (低限位), 0..1000. (0..1000)
-            high: High position limit (高限位), 0..1000. (0..1000)
-
-        The device does not answer.
-        """
-        request = BusServoSetPositionLimitRequest(servo_id=servo_id, low=low, high=high)
-        self.bus.send(request)
-
-    def bus_servo_read_position_limit(self, servo_id: int) -> BusServoReadPositionLimitResponse:
-        """Read a bus servo's position limits.
-
-        Broadcast: Servo id 0xFE reaches every servo; only the ID read (0x12) uses it, with a single servo on the bus.
-
-        Args:
-            servo_id: Bus servo id (0xFE is the broadcast id).
-
-        Returns: the BusServoReadPositionLimitResponse reply.
-        """
-        request = BusServoReadPositionLimitRequest(servo_id=servo_id)
-        reply = self._ask(request, BusServoReadPositionLimitResponse)
-        return reply
-
-    def bus_servo_set_voltage_limit(self, servo_id: int, low: int, high: int) -> None:
-        """Set a bus servo's voltage limits.
-
-        Broadcast: Servo id 0xFE reaches every servo; only the ID read (0x12) uses it, with a single servo on the bus.
-
-        Args:
-            servo_id: Bus servo id (0xFE is the broadcast id).
-            low: Low voltage limit (低限位), at least 4500 mV. [mV] (4500..14000)
-            high: High voltage limit (高限位), at most 14000 mV. [mV] (4500..14000)
-
-        The device does not answer.
-        """
-        request = BusServoSetVoltageLimitRequest(servo_id=servo_id, low=low, high=high)
-        self.bus.send(request)
-
-    def bus_servo_read_voltage_limit(self, servo_id: int) -> BusServoReadVoltageLimitResponse:
-        """Read a bus servo's voltage limits.
-
-        Broadcast: Servo id 0xFE reaches every servo; only the ID read (0x12) uses it, with a single servo on the bus.
-
-        Args:
-            servo_id: Bus servo id (0xFE is the broadcast id).
-
-        Returns: the BusServoReadVoltageLimitResponse reply.
-        """
-        request = BusServoReadVoltageLimitRequest(servo_id=servo_id)
-        reply = self._ask(request, BusServoReadVoltageLimitResponse)
-        return reply
-
-    def bus_servo_set_temperature_limit(self, servo_id: int, limit: int) -> None:
-        """Set a bus servo's temperature limit.
-
-        Broadcast: Servo id 0xFE reaches every servo; only the ID read (0x12) uses it, with a single servo on the bus.
-
-        Args:
-            servo_id: Bus servo id (0xFE is the broadcast id).
-            limit: Over-temperature threshold (高温阈值); must be less than 100 °C. [°C] (0..99)
-
-        The device does not answer.
-        """
-        request = BusServoSetTemperatureLimitRequest(servo_id=servo_id, limit=limit)
-        self.bus.send(request)
-
-    def bus_servo_read_temperature_limit(self, servo_id: int) -> BusServoReadTemperatureLimitResponse:
-        """Read a bus servo's temperature limit.
-
-        Broadcast: Servo id 0xFE reaches every servo; only the ID read (0x12) uses it, with a single servo on the bus.
-
-        Args:
-            servo_id: Bus servo id (0xFE is the broadcast id).
-
-        Returns: the BusServoReadTemperatureLimitResponse reply.
-        """
-        request = BusServoReadTemperatureLimitRequest(servo_id=servo_id)
-        reply = self._ask(request, BusServoReadTemperatureLimitResponse)
-        return reply
+        return self.bus.subscribe(lambda message: callback(message) if isinstance(message, SbusResponse) else None)
+
+
+def _check_status(request: Message, reply: Message, name: str, ok: int) -> None:
+    """A reply whose status field (the spec's `status: {ok: N}`) does not hold N is a device error."""
+    value = getattr(reply, name)
+    if value != ok:
+        shown = f"{value.name.lower()} ({int(value)})" if isinstance(value, IntEnum) else str(value)
+        command = ".".join(part for part in (reply.COMMAND, reply.SUBCOMMAND) if part)
+        ids = " ".join(f"{n}={getattr(request, n)}" for n in MATCH_BY if hasattr(request, n))
+        raise DeviceError(f"{command}{' to ' + ids if ids else ''}: the device reports {name} = {shown}", reply)

@@ -612,7 +612,7 @@ class BusServoReadPositionResponse(Message):
     servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
     success: ReadResult | int
-    #: Whether the board could read the servo (是否读取成功).
+    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
     position: int
     #: Current position (0..1000 is 0°..240°).
 
@@ -668,7 +668,7 @@ class BusServoReadVoltageResponse(Message):
     servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
     success: ReadResult | int
-    #: Whether the board could read the servo (是否读取成功).
+    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
     voltage: int
     #: Input voltage. [mV]
 
@@ -724,7 +724,7 @@ class BusServoReadTemperatureResponse(Message):
     servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
     success: ReadResult | int
-    #: Whether the board could read the servo (是否读取成功).
+    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
     temperature: int
     #: Temperature. [°C]
 
@@ -856,7 +856,7 @@ class BusServoReadIdResponse(Message):
     servo_id: int
     #: The id the request was sent to (0xFE for the broadcast).
     success: ReadResult | int
-    #: Whether the board could read the servo (是否读取成功).
+    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
     id: int
     #: The id read from the servo.
 
@@ -940,7 +940,7 @@ class BusServoReadOffsetResponse(Message):
     servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
     success: ReadResult | int
-    #: Whether the board could read the servo (是否读取成功).
+    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
     offset: int
     #: The servo's offset (int8; -100..100 when set through 0x20).
 
@@ -1052,7 +1052,7 @@ class BusServoReadPositionLimitResponse(Message):
     servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
     success: ReadResult | int
-    #: Whether the board could read the servo (是否读取成功).
+    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
     low: int
     #: Low position limit.
     high: int
@@ -1144,7 +1144,7 @@ class BusServoReadVoltageLimitResponse(Message):
     servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
     success: ReadResult | int
-    #: Whether the board could read the servo (是否读取成功).
+    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
     low: int
     #: Low voltage limit. [mV]
     high: int
@@ -1232,7 +1232,7 @@ class BusServoReadTemperatureLimitResponse(Message):
     servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
     success: ReadResult | int
-    #: Whether the board could read the servo (是否读取成功).
+    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
     limit: int
     #: Over-temperature threshold. [°C]
 

@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-import struct
 from typing import Any
 
 from serialspec.runtime.message import Message
+from serialspec.runtime.registers import Register, RegisterMap
 from serialspec.spec.model import Bytes, Field, Protocol, Scalar, Table, TableValue
 from serialspec.spec.model import Message as MessageSpec
 
@@ -76,21 +76,16 @@ def register_view(protocol: Protocol, message: Message, request: Message | None)
     return None
 
 
+def register_map(table: Table, byte_order: str) -> RegisterMap:
+    """The runtime's register map of a model table (what generated `registers.py` holds, built from the spec)."""
+    registers = (
+        Register(e.name, e.key, e.type.struct_char, e.minimum, e.maximum, e.access, e.sign_bit)
+        for e in table.entries
+        if not e.reserved
+    )
+    return RegisterMap(table.name, registers, byte_order)
+
+
 def registers(table: Table, start: int, data: bytes, byte_order: str) -> dict[str, Any]:
     """Split bytes read or written from register `start` into named values (unknown bytes by address)."""
-    endian = ">" if byte_order == "big" else "<"
-    result: dict[str, Any] = {}
-    address, offset = start, 0
-    while offset < len(data):
-        entry = table.entry(address)
-        if entry is None or offset + entry.type.size > len(data):
-            result[f"{address:#04x}"] = data[offset]
-            address, offset = address + 1, offset + 1
-            continue
-        (value,) = struct.unpack_from(endian + entry.type.struct_char, data, offset)
-        if entry.sign_magnitude:
-            top = 1 << (entry.type.size * 8 - 1)
-            value = -(value & (top - 1)) if value & top else value
-        result[entry.name] = value
-        address, offset = address + entry.type.size, offset + entry.type.size
-    return result
+    return dict(register_map(table, byte_order).unpack(start, data))

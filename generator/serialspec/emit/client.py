@@ -6,7 +6,12 @@ Decisions made here, the same for every protocol:
   several, and True/False (answered or not) when there are none;
 - a reply that can be absent (broadcast address, `optional_when`) makes the method return None then;
 - a table that one command reads by key and another writes by key gets read_<entry>/write_<entry> by name:
-  `read_parameter(id, "voltage")`.
+  `read_parameter(id, "voltage")`;
+- a command with sub-commands becomes an attribute holding a generated group class, one method per sub-command:
+  `client.bus_servo.read_position(5)`;
+- a response field with `status: {ok: N}` is checked (DeviceError unless it holds N) and left out of the result;
+- a group whose items have exactly two fields also takes a mapping {first: second}: `set_speeds({1: -1.0})`;
+- messages the device sends on its own come from `reports(timeout)` (an iterator) or `on_<report>(callback)`.
 """
 
 from __future__ import annotations
@@ -14,9 +19,11 @@ from __future__ import annotations
 from typing import Any
 
 from serialspec.emit.pycode import annotation, number, one_line
+from serialspec.emit.registers import map_name, names_alias
 from serialspec.emit.render import render
 from serialspec.emit.simulator import import_order, request_response_pairs
 from serialspec.spec.model import (
+    Bytes,
     Direction,
     Field,
     Group,
@@ -26,13 +33,19 @@ from serialspec.spec.model import (
     Table,
     TableBlock,
     TableValue,
+    reply_condition,
 )
 
-RESERVED = {"bus", "close", "subscribe", "optional_replies"}
+RESERVED = {"bus", "close", "subscribe", "optional_replies", "reports"}
 
 
-def address_of(protocol: Protocol) -> tuple[str, int | None]:
+def address_of(protocol: Protocol, request: Message | None = None) -> tuple[str, int | None]:
+    """The field holding the device id and its broadcast value (for `request`: those of the kind it addresses)."""
     if protocol.device is not None:
+        behaviour = protocol.device.behaviour(request.key) if request else None
+        kind = next((k for k in protocol.device.kinds if behaviour and k.name == behaviour.kind), None)
+        if kind is not None:
+            return kind.address, kind.broadcast
         return protocol.device.address, protocol.device.broadcast
     for layout in protocol.framing.layouts.values():
         for element in layout.value_elements:
@@ -114,6 +127,22 @@ def method_name(message: Message) -> str:
     return f"{name}_command" if name in RESERVED else name
 
 
+def attribute_name(name: str) -> str:
+    return f"{name}_command" if name in RESERVED else name
+
+
+def pair_group(f: Field) -> tuple[Field, Field] | None:
+    """The two fields of a group item that a mapping {first: second} can give, if the item has exactly two."""
+    if not isinstance(f, Group):
+        return None
+    members = [g for g in f.fields if not (isinstance(g, Scalar) and g.hidden)]
+    return (members[0], members[1]) if len(members) == 2 else None
+
+
+def status_fields(message: Message) -> list[Scalar]:
+    return [f for f in message.fields if isinstance(f, Scalar) and f.status_ok is not None]
+
+
 def table_context(
     protocol: Protocol, table: Table, reader: tuple[Message, TableValue], writer: tuple[Message, TableValue]
 ) -> dict[str, Any]:
@@ -131,18 +160,114 @@ def table_context(
     }
 
 
+def unused_fields(protocol: Protocol, request: Message, response: Message) -> set[str]:
+    """Reply fields that carry nothing for this request: frame status (checked by the bus, DeviceError) and a run
+    of registers read from a request field this request does not have (a shared reply's `data` to a PING)."""
+    unused = {e.name for e in protocol.framing.layouts[Direction.RESPONSE].value_elements if e.role == "status"}
+    names = {f.name for f in request.fields}
+    for f in response.fields:
+        if isinstance(f, Bytes) and f.table is not None:
+            needed = [n.removeprefix("request.") for n in (f.start, f.size_from) if n.startswith("request.")]
+            if not all(n in names for n in needed):
+                unused.add(f.name)
+    return unused
+
+
+def status_flags(protocol: Protocol) -> str:
+    """The reply's frame status elements that have flags, as a literal {name: flags class} (empty if none)."""
+    pairs = [
+        f"{e.name!r}: {e.flags.class_name}"
+        for e in protocol.framing.layouts[Direction.RESPONSE].value_elements
+        if e.role == "status" and e.flags is not None
+    ]
+    return "{" + ", ".join(pairs) + "}" if pairs else ""
+
+
+def register_commands(protocol: Protocol, methods: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Commands that carry a run of registers get a method by register name; the raw one keeps `<name>_raw`.
+
+    A request with `bytes` of a table from its own start field writes (`write(id, goal_position=2048)`), a request
+    whose reply holds such bytes from the request's start and size reads (`read(id, "present_position")`), and a
+    request group whose items each hold such bytes for one device writes to several (`sync_write({1: {...}})`).
+    """
+    found = []
+    by_name = {m["name"]: m for m in methods}
+    for request, response in request_response_pairs(protocol):
+        method = by_name.get(method_name(request))
+        if method is None:
+            continue
+        address, broadcast = address_of(protocol, request)
+        context = {
+            "name": method["name"],
+            "raw": method["name"] + "_raw",
+            "returns": method["returns"],
+            "address": address,
+            "broadcast": broadcast,
+            "title": method["doc"][0].rstrip("."),
+        }
+        run = next(
+            (f for f in request.fields if isinstance(f, Bytes) and f.table and f.start and f.size == "rest"), None
+        )
+        group = next((f for f in request.fields if isinstance(f, Group)), None)
+        item_run = (
+            next((f for f in group.fields if isinstance(f, Bytes) and f.table and f.start), None) if group else None
+        )
+        replied = response.fields if response else ()
+        read = next((f for f in replied if isinstance(f, Bytes) and f.table and f.size_from), None)
+        fields = [f.name for f in value_fields(protocol, request)]
+        if run is not None and run.table is not None and fields == [address, run.start, run.name]:
+            context.update(kind="write", map=map_name(run.table), alias=names_alias(run.table))
+        elif read is not None and read.table is not None and group is None and len(fields) == 3:
+            start, size = (read.start.removeprefix("request."), read.size_from.removeprefix("request."))
+            if fields != [address, start, size]:
+                continue
+            context.update(kind="read", map=map_name(read.table), alias=names_alias(read.table), returns="int")
+        elif group is not None and read is not None and read.table is not None and method["kind"] == "each":
+            start, size = (read.start.removeprefix("request."), read.size_from.removeprefix("request."))
+            if fields != [address, start, size, group.name] or [f.name for f in group.fields] != [address]:
+                continue
+            context.update(kind="each_read", map=map_name(read.table), alias=names_alias(read.table), group=group.name)
+            context.update(item=group.class_name, item_address=address)
+        elif group is not None and item_run is not None and item_run.table is not None and response is None:
+            size = item_run.size if isinstance(item_run.size, str) else ""
+            if fields != [address, item_run.start, *([size] if size in fields else []), group.name]:
+                continue
+            item_address = next(f.name for f in group.fields if f.name == address)
+            context.update(
+                kind="each_write",
+                map=map_name(item_run.table),
+                alias=names_alias(item_run.table),
+                group=group.name,
+                item=group.class_name,
+                item_address=item_address,
+                field=item_run.name,
+                size=size if size in fields else "",
+            )
+        else:
+            continue
+        method["name"] = context["raw"]
+        found.append(context)
+    return found
+
+
+def camel(name: str) -> str:
+    return "".join(w.capitalize() for w in name.split("_"))
+
+
 def client_module(protocol: Protocol) -> str:
-    address, broadcast = address_of(protocol)
     imports: set[str] = set()
     methods = []
     optional_keys: set[int] = set()
     tables = table_commands(protocol)
     writers = {t["writer"]: t for t in tables}
+    groups: dict[str, dict[str, Any]] = {}
     for request, response in request_response_pairs(protocol):
         command = protocol.command(request.command)
         sub = next((s for s in command.subcommands if s.name == request.subcommand), None)
         fields = value_fields(protocol, request)
         imports.add(request.class_name)
+        address, broadcast = address_of(protocol, request)
+        behaviour = protocol.device.behaviour(request.key) if protocol.device else None
         params = []
         trailing = True
         defaults: dict[str, str] = {}
@@ -151,10 +276,21 @@ def client_module(protocol: Protocol) -> str:
                 defaults[f.name] = number(f.default)
             else:
                 trailing = False
+        pairs = []
         for f in fields:
             imports.update(type_names(f))
             default = f" = {defaults[f.name]}" if f.name in defaults else ""
-            params.append(f"{f.name}: {annotation(f)}{default}")
+            pair = pair_group(f)
+            if pair is not None:
+                assert isinstance(f, Group)
+                first, second = pair
+                imports.update(type_names(first) + type_names(second))
+                params.append(
+                    f"{f.name}: {annotation(f)} | Mapping[{annotation(first)}, {annotation(second)}]{default}"
+                )
+                pairs.append({"name": f.name, "item": f.class_name, "first": first.name, "second": second.name})
+            else:
+                params.append(f"{f.name}: {annotation(f)}{default}")
         title = (sub.title if sub else command.title) or request.key.replace("_", " ")
         doc = [one_line(title) + ("" if title.endswith(".") else ".")]
         description = (sub.description if sub else command.description) or request.description
@@ -167,20 +303,26 @@ def client_module(protocol: Protocol) -> str:
         doc.append("")
         doc.append("Args:")
         doc.extend(f"    {f.name}: {describe(f)}" for f in fields)
-        may_broadcast = any(
+        doc.extend(
+            f"    ({p['name']} also takes a mapping {{{p['first']}: {p['second']}}}, one entry per item.)"
+            for p in pairs
+        )
+        # An address that can hold the broadcast value makes the reply optional, unless the device answers it anyway.
+        may_broadcast = not (behaviour and behaviour.broadcast_reply) and any(
             f.name == address and isinstance(f, Scalar) and broadcast is not None and f.maximum >= broadcast
             for f in fields
         )
-        optional = response.optional_when if response else None
+        optional = reply_condition(request, response)
         if optional:
             optional_keys.add(optional.key)
         silent = response is None or optional is not None or may_broadcast
         kind = "send"
         returns = "None"
         result_expr = ""
+        statuses = status_fields(response) if response else []
         if response is not None:
             imports.add(response.class_name)
-            echoes = {f.name for f in fields}
+            echoes = {f.name for f in fields} | {f.name for f in statuses} | unused_fields(protocol, request, response)
             rest = [f for f in value_fields(protocol, response) if f.name not in echoes]
             if not rest:
                 kind, returns = ("bool", "bool")
@@ -189,7 +331,7 @@ def client_module(protocol: Protocol) -> str:
                 kind, returns, result_expr = "value", annotation(rest[0]), f"reply.{rest[0].name}"
             else:
                 kind, returns, result_expr = "message", response.class_name, "reply"
-            if silent and kind != "bool":
+            if silent:
                 returns = f"{returns} | None"
             doc.append("")
             if kind == "bool":
@@ -201,32 +343,75 @@ def client_module(protocol: Protocol) -> str:
             if silent:
                 why = one_line(response.optional) if response.optional else "broadcast gets no reply"
                 doc.append(f"None when no reply is due ({why}).")
+            for f in statuses:
+                doc.append(f"Raises DeviceError when the reply's {f.name} is not {f.status_ok}.")
         else:
             doc.append("")
             doc.append("The device does not answer.")
+        each_keys = ""
+        each_name = behaviour.each if behaviour else ""
+        each = next((f for f in request.fields if isinstance(f, Group) and f.name == each_name), None)
+        if each is not None and response is not None and kind == "value":
+            # Every listed device answers in turn (SYNC READ): one reply per item, matched by its address.
+            kind, silent = "each", False
+            value = result_expr.removeprefix("reply.")
+            returns = f"dict[int, {annotation(rest[0])}]"
+            result_expr = f"{{reply.{address}: reply.{value} for reply in replies}}"
+            each_keys = f"[{{{address!r}: item.{address}}} for item in {each.name}]"
+            doc[-1] = f"Returns: {address} -> {value} of every listed device, in the order they answer."
         table = writers.get(method_name(request))
-        methods.append(
-            {
-                "name": method_name(request),
-                "params": ", ".join(params),
-                "returns": returns,
-                "doc": doc,
-                "request": request.class_name,
-                "response": response.class_name if response else "",
-                "build": ", ".join(f"{f.name}={f.name}" for f in fields),
-                "kind": kind,
-                "silent": silent,
-                "optional": f"({optional.key}, {optional.equals})" if optional else "None",
-                "after": repr(response.after) if response and response.after else "",
-                "result": result_expr,
-                "remember": (
-                    f"self._remember({address}, {table['key']}, "
-                    f"{next(f.name for f in request.fields if isinstance(f, TableValue))})"
-                )
-                if table
-                else "",
-            }
-        )
+        method = {
+            "name": method_name(request),
+            "params": ", ".join(params),
+            "returns": returns,
+            "doc": doc,
+            "request": request.class_name,
+            "response": response.class_name if response else "",
+            "build": ", ".join(f"{f.name}={f.name}" for f in fields),
+            "kind": kind,
+            "silent": silent,
+            "optional": f"({optional.key}, {optional.equals})" if optional else "None",
+            "after": repr(response.after) if response and response.after else "",
+            "result": result_expr,
+            "remember": (
+                f"_remember({address}, {table['key']}, "
+                f"{next(f.name for f in request.fields if isinstance(f, TableValue))})"
+            )
+            if table
+            else "",
+            "pairs": pairs,
+            "statuses": [(f.name, f.status_ok) for f in statuses],
+            "each_keys": each_keys,
+        }
+        if sub is not None:
+            group = groups.setdefault(
+                command.name,
+                {
+                    "attribute": attribute_name(command.name),
+                    "class_name": camel(command.name) + "Commands",
+                    "title": one_line(command.title or command.name.replace("_", " ")),
+                    "methods": [],
+                },
+            )
+            method["name"] = sub.name
+            group["methods"].append(method)
+        else:
+            methods.append(method)
+    reports = []
+    for message in protocol.messages():
+        if message.direction == Direction.RESPONSE and message.unsolicited:
+            imports.add(message.class_name)
+            title = message.title or protocol.command(message.command).title or message.key
+            reports.append({"name": method_name(message), "class_name": message.class_name, "title": one_line(title)})
+    registers = register_commands(protocol, methods)
+    flags_literal = status_flags(protocol)
+    imports.update(
+        e.flags.class_name
+        for e in protocol.framing.layouts[Direction.RESPONSE].value_elements
+        if e.role == "status" and e.flags is not None
+    )
+    everything = [*methods, *(m for g in groups.values() for m in g["methods"])]
+    address, broadcast = address_of(protocol)
     class_name = "".join(w.capitalize() for w in protocol.name.split("_")) + "Client"
     return render(
         "client.py.j2",
@@ -246,12 +431,30 @@ def client_module(protocol: Protocol) -> str:
             )
         ),
         methods=methods,
+        groups=list(groups.values()),
+        registers=registers,
+        status_flags=flags_literal,
+        register_imports=sorted({r["map"] for r in registers} | {r["alias"] for r in registers}, key=import_order),
+        reports=reports,
         tables=tables,
         optional_keys=sorted(optional_keys),
         imports=sorted(imports | {"Direction"}, key=import_order),
         error_imports=[
             name
-            for name, used in (("EncodeError", bool(tables)), ("Timeout", any(m["kind"] == "bool" for m in methods)))
+            for name, used in (
+                ("DeviceError", any(m["statuses"] for m in everything)),
+                ("EncodeError", bool(tables) or any(r["kind"] != "write" for r in registers)),
+                ("Timeout", any(m["kind"] == "bool" for m in everything)),
+            )
             if used
         ],
+        uses_status=any(m["statuses"] for m in everything),
+        abc_imports=sorted(
+            {
+                *(["Callable", "Iterator"] if reports else []),
+                *(["Mapping"] if any(m["pairs"] for m in everything) else []),
+                *(["Mapping"] if any(r["kind"] == "each_write" for r in registers) else []),
+                *(["Iterable"] if any(r["kind"] == "each_read" for r in registers) else []),
+            }
+        ),
     )

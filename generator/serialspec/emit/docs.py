@@ -24,6 +24,7 @@ from serialspec.spec.model import (
     Protocol,
     Scalar,
     TableBlock,
+    TableEntry,
     TableValue,
 )
 from serialspec.spec.resolve import fixed_size
@@ -88,6 +89,8 @@ def meaning(f: Field) -> str:
             enum = f" ({', '.join(f'{v.value}={v.name.lower()}' for v in bit.enum.values)})" if bit.enum else ""
             parts.append(f"{where}: {bit.name}{enum}.")
         parts.append("Other bits must be zero.")
+    if isinstance(f, Scalar) and f.status_ok is not None:
+        parts.append(f"**Status:** {f.status_ok} is success; any other value is a device error (DeviceError).")
     if f.inferred:
         parts.append(f"**Inferred layout:** {f.inferred}")
     return " ".join(p for p in parts if p)
@@ -153,8 +156,18 @@ def message_context(protocol: Protocol, message: Message | None) -> dict[str, An
         "optional": text(message.optional),
         "unsolicited": message.unsolicited,
         "answers": message.answers,
+        "reply": reply_text(message),
         "description": text(message.description),
     }
+
+
+def reply_text(message: Message) -> str:
+    """For a request answered by another command's response: which, and the parameter that switches it."""
+    if not message.answered_by:
+        return ""
+    switch = message.reply_when
+    when = f", sent only while `{switch.entry}` = {switch.equals}" if switch else ""
+    return f"answered by the `{message.answered_by}` response{when}"
 
 
 def command_context(protocol: Protocol, command: Command) -> dict[str, Any]:
@@ -375,7 +388,7 @@ def emit_docs(protocol: Protocol) -> str:
                     "key": f"{e.key}" if t.key_name != "address" else f"{e.key:#04x}",
                     "name": cell("(reserved)" if e.reserved else e.name),
                     "name_cn": cell(e.name_cn),
-                    "type": e.type.name + (" sign-magnitude" if e.sign_magnitude else ""),
+                    "type": e.type.name + sign_note(e),
                     "unit": cell(e.unit),
                     "range": f"{number(e.minimum)}..{number(e.maximum)}",
                     "default": cell("" if e.default is None else e.default),
@@ -449,3 +462,10 @@ def emit_docs(protocol: Protocol) -> str:
         examples=examples,
         errata=errata,
     )
+
+
+def sign_note(entry: TableEntry) -> str:
+    if not entry.sign_magnitude:
+        return ""
+    top = entry.type.size * 8 - 1
+    return " sign-magnitude" + ("" if entry.sign_bit in (None, top) else f" (sign in bit {entry.sign_bit})")

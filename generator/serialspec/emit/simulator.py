@@ -5,29 +5,44 @@ from __future__ import annotations
 from typing import Any
 
 from serialspec.emit.pycode import number, one_line
+from serialspec.emit.registers import map_name, register_tables
 from serialspec.emit.render import render
-from serialspec.spec.model import Direction, Message, Protocol, TableBlock, TableValue
+from serialspec.spec.model import (
+    Bytes,
+    Direction,
+    Group,
+    Message,
+    Protocol,
+    TableBlock,
+    TableValue,
+    replies_by_request,
+    reply_condition,
+    reply_to,
+)
 
 
 def request_response_pairs(protocol: Protocol) -> list[tuple[Message, Message | None]]:
     """Every request with the response that answers it (None where the device stays silent)."""
     messages = protocol.messages()
-    responses = [m for m in messages if m.direction == Direction.RESPONSE and not m.unsolicited]
-    pairs = []
-    for request in (m for m in messages if m.direction == Direction.REQUEST):
-        response = next((r for r in responses if (r.answers or r.key) == request.key), None)
-        pairs.append((request, response))
-    return pairs
+    replies = replies_by_request(messages)
+    return [(m, reply_to(m, replies)) for m in messages if m.direction == Direction.REQUEST]
 
 
 def table_fields(*messages: Message | None) -> dict[str, tuple[str, ...]]:
+    """Fields (group items' too) that hold table entries: by key, as a block, or as a run of registers."""
     found: dict[str, tuple[str, ...]] = {}
-    for message in messages:
-        for f in message.fields if message else ():
-            if isinstance(f, TableValue):
-                found[f.name] = ("value", f.key)
-            elif isinstance(f, TableBlock):
-                found[f.name] = ("block", *(e.name for e in f.entries))
+    stack = [f for message in messages if message for f in reversed(message.fields)]
+    while stack:
+        f = stack.pop()
+        if isinstance(f, TableValue):
+            found[f.name] = ("value", f.key)
+        elif isinstance(f, TableBlock):
+            found[f.name] = ("block", *(e.name for e in f.entries))
+        elif isinstance(f, Bytes) and f.table is not None and f.start:
+            # the request's fields are the device's `given` values, so `request.address` is `address` there
+            found[f.name] = ("run", f.start.removeprefix("request."), f.size_from.removeprefix("request."))
+        elif isinstance(f, Group):
+            stack.extend(reversed(f.fields))
     return found
 
 
@@ -69,8 +84,12 @@ def simulator_module(protocol: Protocol) -> str:
                 args.append(f"moves={(m.state, m.target, m.duration, m.speed)!r}")
             if behaviour.broadcast_reply:
                 args.append("broadcast_reply=True")
-        if response and response.optional_when:
-            args.append(f"optional_when=({response.optional_when.key}, {response.optional_when.equals})")
+            for name in ("kind", "each", "stores", "sets", "absent", "buffered", "commits"):
+                if getattr(behaviour, name):
+                    args.append(f"{name}={getattr(behaviour, name)!r}")
+        condition = reply_condition(request, response)
+        if response and condition:
+            args.append(f"optional_when=({condition.key}, {condition.equals})")
         if response and response.after:
             args.append(f"after={response.after!r}")
         tables = table_fields(request, response)
@@ -92,6 +111,10 @@ def simulator_module(protocol: Protocol) -> str:
         refused=repr(device.refused),
         entries=entries,
         commands=commands,
+        registers=map_name(device.memory) if device.memory in register_tables(protocol) else "",
+        status=repr(device.status) if device.status else "",
+        echo_address=device.echo_address,
+        kinds=[f"KindSpec({k.name!r}, {k.address!r}, {k.ids!r}, {k.broadcast!r}, {k.state!r})," for k in device.kinds],
         imports=sorted(imports | {"Direction"}, key=import_order),
         default_id=0,
     )

@@ -134,7 +134,7 @@ def structs_module(protocol: Protocol) -> str:
     tables = [
         {
             "name": table_name(t.name),
-            "entries": [(e.key, field_expr_entry(e.type, e.sign_magnitude)) for e in t.entries if not e.reserved],
+            "entries": [(e.key, field_expr_entry(e.type, e.sign_bit)) for e in t.entries if not e.reserved],
         }
         for t in protocol.tables
     ]
@@ -143,7 +143,7 @@ def structs_module(protocol: Protocol) -> str:
         for f in message.fields:
             if isinstance(f, TableBlock):
                 blocks[block_name(f.class_name)] = [
-                    f"{e.name!r} / {field_expr_entry(e.type, e.sign_magnitude, f.endian)}" for e in f.entries
+                    f"{e.name!r} / {field_expr_entry(e.type, e.sign_bit, f.endian)}" for e in f.entries
                 ]
     checksum = protocol.framing.checksum
     if checksum.algorithm == "crc":
@@ -166,6 +166,7 @@ def structs_module(protocol: Protocol) -> str:
     )
 
 
-def field_expr_entry(scalar: ScalarType, sign_magnitude: bool, endian: str = "<") -> str:
+def field_expr_entry(scalar: ScalarType, sign_bit: int | None, endian: str = "<") -> str:
+    """A table entry's construct: plain, or sign-magnitude with the sign in `sign_bit`."""
     base = primitive(scalar, endian)
-    return f"SignMagnitude({base}, {scalar.size * 8})" if sign_magnitude else base
+    return f"SignMagnitude({base}, {sign_bit + 1})" if sign_bit is not None else base

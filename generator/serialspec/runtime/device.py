@@ -12,7 +12,12 @@ its commands); everything a device does is here and is the same for every protoc
   once the request's field of that name (ms) has elapsed;
 - `moves` makes a state variable go linearly from where it is to the request's target, over a duration or at a
   speed; reading it meanwhile gives the value on the way;
-- faults can be injected for the next replies: drop, corrupt (checksum), late, garbage.
+- faults can be injected for the next replies: drop, corrupt (checksum), late, garbage, truncate, other_id;
+- `each` applies a command to every item of a request group, each item addressing its own device;
+- further `kinds` of device (a board's PWM servo ports, its motors) have their own ids, address field and state;
+  a command names its kind; a request for an id no device has is answered with `absent` values if the command
+  gives them (a board answering for a servo that is not there), else not at all;
+- `emit()` sends a message on the device's own initiative (reports, key events) for tests.
 """
 
 from __future__ import annotations
@@ -25,12 +30,14 @@ import select
 import threading
 import time
 import tty
+from collections import deque
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from typing import Any
 
 from serialspec.runtime.errors import EncodeError
 from serialspec.runtime.message import Message
+from serialspec.runtime.registers import RegisterMap
 from serialspec.runtime.stream import StreamParser
 
 
@@ -62,6 +69,24 @@ class CommandSpec:
     after: str = ""  # request field: the response is sent after that many ms
     # table fields of the request and response: name -> ("value", key field) or ("block", entry names...)
     tables: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    kind: str = ""  # the KindSpec addressed; "" for the default devices
+    each: str = ""  # a request group whose items each address one device (item fields override the request's)
+    stores: dict[str, str] = field(default_factory=dict)  # request field -> state variable
+    sets: dict[str, float] = field(default_factory=dict)  # state variable -> value
+    absent: dict[str, float] = field(default_factory=dict)  # response values when no device has the id
+    buffered: bool = False  # the writes wait for a command that commits (REG WRITE)
+    commits: bool = False  # carries out the buffered writes (ACTION)
+
+
+@dataclass(frozen=True)
+class KindSpec:
+    """Devices of another kind on the same bus, with ids fixed by the hardware (not by --id)."""
+
+    name: str
+    address: str
+    ids: tuple[int, ...]
+    broadcast: int | None
+    state: dict[str, float]
 
 
 @dataclass(frozen=True)
@@ -75,6 +100,10 @@ class DeviceSpec:
     reply: dict[str, float]
     refused: dict[str, float]
     commands: tuple[CommandSpec, ...]
+    kinds: tuple[KindSpec, ...] = ()
+    echo_address: bool = False  # replies carry the id the request named, not the answering device's own
+    registers: RegisterMap | None = None  # memory as registers at byte addresses, for run reads/writes
+    status: dict[str, str] = field(default_factory=dict)  # response field -> memory entry every reply reports
 
 
 @dataclass
@@ -101,13 +130,16 @@ class VirtualDevice:
         self.memory: dict[int, float] = {}
         self.state: dict[str, float] = dict(spec.state)
         self.motions: dict[str, _Motion] = {}
+        self.buffered: list[tuple[CommandSpec, str, dict[str, Any]]] = []  # writes held until a commit
         self.reset()
         self.id = device_id
-        if spec.id_entry:
+        if spec.id_entry in self.by_name:
             self.memory[self.by_name[spec.id_entry].key] = device_id
+        elif spec.id_entry in self.state:
+            self.state[spec.id_entry] = device_id
 
     def reset(self) -> None:
-        keep = self.memory.get(self.by_name[self.spec.id_entry].key) if self.spec.id_entry else None
+        keep = self.memory.get(self.by_name[self.spec.id_entry].key) if self.spec.id_entry in self.by_name else None
         self.memory = {e.key: e.default for e in self.spec.entries}
         if keep is not None:
             self.memory[self.by_name[self.spec.id_entry].key] = keep
@@ -149,8 +181,24 @@ class VirtualDevice:
 
 @dataclass
 class Fault:
-    kind: str  # drop, corrupt, late, garbage
+    kind: str  # one of FAULTS
     delay: float = 0.0
+    answer_as: int | None = None  # other_id: the id to answer as (None: the next id up, or down at the top)
+
+    def other_id(self, address: int, broadcast: int | None) -> int:
+        if self.answer_as is not None:
+            return self.answer_as
+        return address + 1 if address + 1 != broadcast and address < 0xFF else address - 1
+
+
+FAULTS = {
+    "drop": "no reply",
+    "corrupt": "the reply with a bad checksum",
+    "late": "the reply `delay` s late",
+    "garbage": "random bytes before the reply",
+    "truncate": "only the first half of the reply",
+    "other_id": "the reply as if from another id (`answer_as`)",
+}
 
 
 @dataclass(order=True)
@@ -177,6 +225,16 @@ class Simulator:
         self.clock = clock
         self.parser = parser()
         self.devices: dict[int, VirtualDevice] = {i: VirtualDevice(spec, i, clock) for i in ids}
+        # Each further kind: its devices, built from a DeviceSpec holding that kind's address and state.
+        self.kinds: dict[str, dict[int, VirtualDevice]] = {}
+        self._kind_specs: dict[str, DeviceSpec] = {}
+        for kind in spec.kinds:
+            kind_spec = dataclasses.replace(
+                spec, address=kind.address, id_entry="", broadcast=kind.broadcast, entries=(), state=kind.state
+            )
+            self._kind_specs[kind.name] = kind_spec
+            self.kinds[kind.name] = {i: VirtualDevice(kind_spec, i, clock) for i in kind.ids}
+        self._emitted: deque[bytes] = deque()  # frames emit() hands to the serving thread
         self.commands = {c.request: c for c in spec.commands}
         self.faults: list[Fault] = []
         self.log: list[Message] = []  # every request received, in order
@@ -185,15 +243,17 @@ class Simulator:
         self._seq = 0
         self._wake_r, self._wake_w = os.pipe()
         self._stop = threading.Event()
+        self._answering_as: Fault | None = None  # an other_id fault while the reply it spoils is built
+        self._released = False  # close() has closed the pseudo-terminal and the wake-up pipe
 
     # --- fault injection ------------------------------------------------------------------------------------------
 
-    def inject(self, kind: str, count: int = 1, delay: float = 0.5) -> None:
-        """Spoil the next `count` replies: drop, corrupt (bad checksum), late (by `delay` s), garbage (before it)."""
-        if kind not in ("drop", "corrupt", "late", "garbage"):
-            raise ValueError(f"unknown fault {kind!r} (expected drop, corrupt, late or garbage)")
+    def inject(self, kind: str, count: int = 1, delay: float = 0.5, answer_as: int | None = None) -> None:
+        """Spoil the next `count` replies, one fault each, with a fault of FAULTS; `delay` for late ones."""
+        if kind not in FAULTS:
+            raise ValueError(f"unknown fault {kind!r} (expected one of {', '.join(FAULTS)})")
         with self._lock:
-            self.faults.extend(Fault(kind, delay) for _ in range(count))
+            self.faults.extend(Fault(kind, delay, answer_as) for _ in range(count))
 
     # --- requests -------------------------------------------------------------------------------------------------
 
@@ -203,60 +263,106 @@ class Simulator:
         with self._lock:
             for request in self.parser.feed(data):
                 self.log.append(request)
-                for when, frame in self.handle(request):
-                    out.extend(self._spoil(when, frame))
+                # Answering as another id changes what the reply says, so it applies while the reply is built.
+                if self.faults and self.faults[0].kind == "other_id":
+                    self._answering_as = self.faults.pop(0)
+                try:
+                    replies = self.handle(request)
+                finally:
+                    answered_as, self._answering_as = self._answering_as, None
+                if answered_as is not None and not replies:
+                    self.faults.insert(0, answered_as)  # no reply to spoil: keep the fault for the next one
+                for when, frame in replies:
+                    out.extend([(when, frame)] if answered_as is not None else self._spoil(when, frame))
         return out
 
     def handle(self, request: Message) -> list[tuple[float, bytes]]:
         command = self.commands.get(type(request))
         if command is None:
             return []
-        address = getattr(request, self.spec.address, None)
-        broadcast = address is not None and address == self.spec.broadcast
-        if address is None:
-            targets = list(self.devices.values())[:1]
-        elif broadcast:
-            targets = list(self.devices.values())
-        else:
-            targets = [self.devices[address]] if address in self.devices else []
+        spec = self._kind_specs[command.kind] if command.kind else self.spec
+        devices = self.kinds[command.kind] if command.kind else self.devices
+        fields = request.to_fields()
+        # `each`: every item of the group addresses its own device, with the item's fields over the request's.
+        items = [{**fields, **item} for item in fields[command.each]] if command.each else [fields]
         replies = []
-        for device in targets:
-            frame = self.act(device, command, request)
-            if frame is not None and (not broadcast or command.broadcast_reply):
-                delay = float(getattr(request, command.after, 0)) / 1000 if command.after else 0.0
-                replies.append((self.clock() + delay, frame))
+        for given in items:
+            address = given.get(spec.address)
+            broadcast = address is not None and address == spec.broadcast
+            if address is None:
+                targets = list(devices.values())[:1]
+            elif broadcast:
+                targets = list(devices.values())
+            else:
+                targets = [devices[address]] if address in devices else []
+            frames = [self.act(device, command, request, given) for device in targets]
+            if not targets and command.absent:
+                frames = [self._absent(command, given)]
+            for frame in frames:
+                if frame is not None and (not broadcast or command.broadcast_reply):
+                    delay = float(getattr(request, command.after, 0)) / 1000 if command.after else 0.0
+                    replies.append((self.clock() + delay, frame))
         return replies
 
-    def act(self, device: VirtualDevice, command: CommandSpec, request: Message) -> bytes | None:
-        """Carry out a request on one device; the reply frame, or None for silence."""
-        given = request.to_fields()
+    def _absent(self, command: CommandSpec, given: dict[str, Any]) -> bytes | None:
+        """The reply a bus master gives for an id no device has: the request's fields, `absent` values, else 0."""
+        if command.response is None:
+            return None
+        values = {
+            a.name: command.absent.get(a.name, given.get(a.name, 0))
+            for a in dataclasses.fields(command.response)  # type: ignore[arg-type]
+        }
+        return self._encode_reply(command.response, values)
+
+    def _encode_reply(self, response: type[Message], values: dict[str, Any]) -> bytes | None:
+        if self._answering_as is not None and isinstance(values.get(self.spec.address), int | float):
+            address = int(values[self.spec.address])
+            values = {**values, self.spec.address: self._answering_as.other_id(address, self.spec.broadcast)}
+        values = {k: int(v) if isinstance(v, float) and v.is_integer() else v for k, v in values.items()}
+        try:
+            return self.encode(response.from_fields(values))  # type: ignore[attr-defined]
+        except EncodeError:
+            return None
+
+    def act(
+        self, device: VirtualDevice, command: CommandSpec, request: Message, given: dict[str, Any] | None = None
+    ) -> bytes | None:
+        """Carry out a request on one device (`given`: its fields, an `each` item's merged in); the reply or None."""
+        given = request.to_fields() if given is None else given
         refused = False
+        # Whether an optional reply is due is decided on the switch as the request finds it (a write that turns
+        # replies off is still answered), which is also what a client that remembers the switch expects.
+        switch = command.optional_when
+        answers = switch is None or device.memory.get(switch[0]) == switch[1]
         if command.resets:
             device.reset()
-        for name in command.writes:
-            refused |= not self._write(device, command, name, given)
+        written: set[str] = set()
+        if command.buffered:
+            device.buffered.extend((command, name, given) for name in command.writes)
+        else:
+            for name in command.writes:
+                refused |= not self._write(device, command, name, given, written)
+        if command.commits:
+            buffered, device.buffered = device.buffered, []
+            for held_command, name, held in buffered:
+                self._write(device, held_command, name, held, written)
         if command.moves:
-            state, target, duration_field, speed_field = command.moves
-            goal = float(given[target])
-            if duration_field:
-                duration = float(given[duration_field]) / 1000
-            elif speed_field and float(given[speed_field]):
-                duration = abs(goal - device.get(state)) / float(given[speed_field])
-            else:
-                duration = 0.0
-            device.move(state, goal, duration)
-        if self.spec.id_entry and self.spec.id_entry in device.by_name:
-            new_id = int(device.memory[device.by_name[self.spec.id_entry].key])
+            self._move(device, command.moves, given, written)
+        for name, state in command.stores.items():
+            device.set(state, given[name])
+        for state, value in command.sets.items():
+            device.set(state, value)
+        id_entry = device.spec.id_entry
+        if id_entry in device.by_name or id_entry in device.state:
+            new_id = int(device.get(id_entry))
             if new_id != device.id and new_id not in self.devices:
                 del self.devices[device.id]
                 device.id = new_id
                 self.devices[new_id] = device
         if command.response is None:
             return None
-        if command.optional_when is not None:
-            key, value = command.optional_when
-            if device.memory.get(key) != value:
-                return None
+        if not answers:
+            return None
         values: dict[str, Any] = {}
         for attribute in dataclasses.fields(command.response):  # type: ignore[arg-type]
             name = attribute.name
@@ -267,6 +373,12 @@ class Simulator:
                 values[name] = value
             elif name in command.reports:
                 values[name] = device.get(command.reports[name])
+            elif name == device.spec.address and not device.spec.echo_address:
+                values[name] = device.id  # a device answers with its own id, also to a broadcast
+            elif name in device.spec.status:
+                values[name] = device.get(device.spec.status[name])
+            elif command.tables.get(name, ())[:1] == ("run",):
+                values[name] = b""  # a run of registers in a reply holds what was read: nothing here
             elif name in given:
                 values[name] = given[name]
             elif name in self.spec.reply:
@@ -275,15 +387,32 @@ class Simulator:
                 values[name] = 0
         if refused:
             values.update(self.spec.refused)
-        values = {k: int(v) if isinstance(v, float) and v.is_integer() else v for k, v in values.items()}
-        try:
-            reply = command.response.from_fields(values)  # type: ignore[attr-defined]
-            return self.encode(reply)
-        except EncodeError:
-            return None
+        return self._encode_reply(command.response, values)
+
+    def _move(
+        self, device: VirtualDevice, moves: tuple[str, str, str, str], given: dict[str, Any], written: set[str]
+    ) -> None:
+        """Start a move to the target: a request field, or a memory entry this command has just written."""
+        state, target, duration_name, speed_name = moves
+        if target not in given and target not in written:
+            return
+
+        def value(name: str) -> float:
+            return float(given[name] if name in given else device.get(name))
+
+        goal = value(target)
+        if duration_name and value(duration_name):
+            duration = value(duration_name) / 1000
+        elif speed_name and value(speed_name):
+            duration = abs(goal - device.get(state)) / value(speed_name)
+        else:
+            duration = 0.0
+        device.move(state, goal, duration)
 
     def _read(self, device: VirtualDevice, command: CommandSpec, name: str, given: dict[str, Any]) -> Any:
         table = command.tables.get(name, ())
+        if table[:1] == ("run",) and self.spec.registers is not None:
+            return self._read_run(device, self.spec.registers, int(given[table[1]]), int(given[table[2]]))
         if table[:1] == ("value",):
             entry = device.by_key.get(int(given[table[1]]))
             return None if entry is None else device.get(entry.name)
@@ -291,8 +420,49 @@ class Simulator:
             return {n: device.get(n) for n in table[1:]}
         return device.get(name)
 
-    def _write(self, device: VirtualDevice, command: CommandSpec, name: str, given: dict[str, Any]) -> bool:
+    def _read_run(self, device: VirtualDevice, registers: RegisterMap, start: int, size: int) -> bytes:
+        """`size` bytes of memory from register `start` on; bytes of no register read as 0."""
+        data = bytearray()
+        address = start
+        while address < start + size:
+            register = registers.by_address.get(address)
+            if register is None:
+                data.append(0)
+                address += 1
+                continue
+            data += registers.to_wire(register, int(device.get(register.name)))
+            address += register.size
+        return bytes(data[:size])
+
+    def _write_run(
+        self, device: VirtualDevice, registers: RegisterMap, start: int, data: bytes, written: set[str]
+    ) -> bool:
+        """Store bytes written from register `start` on; refused whole unless every register is writable, in range."""
+        try:
+            values = registers.split(start, data)
+        except EncodeError:
+            return False
+        if not all(device.writable(device.by_name.get(name), value) for name, value in values.items()):
+            return False
+        for name, value in values.items():
+            device.set(name, value)
+        written.update(values)
+        return True
+
+    def _write(
+        self,
+        device: VirtualDevice,
+        command: CommandSpec,
+        name: str,
+        given: dict[str, Any],
+        written: set[str] | None = None,
+    ) -> bool:
         table = command.tables.get(name, ())
+        if table[:1] == ("run",) and self.spec.registers is not None:
+            start = int(given[table[1]])
+            data = given[name]  # a message's to_fields() gives bytes as hex text
+            data = bytes.fromhex(data) if isinstance(data, str) else bytes(data)
+            return self._write_run(device, self.spec.registers, start, data, set() if written is None else written)
         if table[:1] == ("value",):
             entry = device.by_key.get(int(given[table[1]]))
             if not device.writable(entry, given[name]):
@@ -323,8 +493,15 @@ class Simulator:
             return [(when, frame[:-1] + bytes([(frame[-1] + 1) & 0xFF]))]
         if fault.kind == "late":
             return [(when + fault.delay, frame)]
+        if fault.kind == "truncate":
+            return [(when, frame[: len(frame) // 2])]
         garbage = bytes(random.randrange(256) for _ in range(7))
         return [(when, garbage + frame)]
+
+    def emit(self, message: Message) -> None:
+        """Send a message on the device's own initiative (a report, a key event) as soon as possible."""
+        self._emitted.append(self.encode(message))  # encoding checks every value here, in the caller's thread
+        os.write(self._wake_w, b"x")
 
     # --- serving on a file descriptor (a pseudo-terminal) ---------------------------------------------------------
 
@@ -338,6 +515,10 @@ class Simulator:
             readable, _, _ = select.select([fd, self._wake_r], [], [], wait)
             if self._wake_r in readable:
                 os.read(self._wake_r, 64)
+            # Before any request read now: what emit() queued before the request was sent goes out before its reply.
+            while self._emitted:
+                self._seq += 1
+                heapq.heappush(self._outbox, _Scheduled(self.clock(), self._seq, self._emitted.popleft()))
             if fd in readable:
                 try:
                     data = os.read(fd, 4096)
@@ -352,7 +533,8 @@ class Simulator:
 
     def stop(self) -> None:
         self._stop.set()
-        os.write(self._wake_w, b"x")
+        if not self._released:
+            os.write(self._wake_w, b"x")
 
     def open_pty(self) -> tuple[int, str]:
         """A pseudo-terminal pair in raw mode: the controller fd this simulator serves and the device path."""
@@ -366,12 +548,23 @@ class Simulator:
     def start(self) -> str:
         """Serve on a new pseudo-terminal from a background thread; returns the device path."""
         controller, path = self.open_pty()
+        self._controller_fd = controller
         self._thread = threading.Thread(target=self.serve, args=(controller,), daemon=True, name="serialspec-sim")
         self._thread.start()
         return path
 
     def close(self) -> None:
+        """Stop serving and release the pseudo-terminal: its path goes away and clients on it see a hang-up."""
+        if self._released:
+            return
         self.stop()
         thread = getattr(self, "_thread", None)
         if thread is not None:
             thread.join(2)
+            if thread.is_alive():
+                return  # still serving (stuck in a write): never close descriptors under it
+        self._released = True
+        pty = (getattr(self, "_controller_fd", None), getattr(self, "_device_fd", None))
+        for fd in (*pty, self._wake_r, self._wake_w):
+            if fd is not None:
+                os.close(fd)

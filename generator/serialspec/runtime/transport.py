@@ -4,16 +4,22 @@
 with the protocol's serial settings as defaults. Reads block on the port with a deadline (pyserial's read
 timeout: no sleeping, no polling) and return as soon as the generated stream parser holds a complete reply that
 matches the request. Frames that answer nothing meanwhile go to subscribers. Every failure is a typed exception
-(Timeout, CorruptReply, DeviceError, PortError) after which the bus is ready for the next transaction.
+(Timeout, CorruptReply, DeviceError, PortError) after which the bus is ready for the next transaction: a port that
+failed (the device went away) or was closed under the bus is reopened by the next transaction, so a USB adapter
+unplugged and plugged back in (or a symlink such as /dev/serial/by-id/... pointed at a new device) just works.
 """
 
 from __future__ import annotations
 
+import os
+import select
 import threading
 import time
 from collections import deque
 from collections.abc import Callable, Iterator
+from contextlib import suppress
 from dataclasses import dataclass, field
+from enum import IntFlag
 from typing import Any, TypeVar
 
 import serial
@@ -25,6 +31,21 @@ from serialspec.runtime.stream import StreamParser
 M = TypeVar("M", bound=Message)
 
 _PARITY = {"none": serial.PARITY_NONE, "even": serial.PARITY_EVEN, "odd": serial.PARITY_ODD}
+
+# What pyserial raises when the device goes away: termios.error (not an OSError) comes from setting the read
+# timeout on a hung-up POSIX port.
+_PORT_FAILURES: tuple[type[Exception], ...]
+try:
+    import termios
+
+    _PORT_FAILURES = (serial.SerialException, OSError, termios.error)
+except ImportError:  # Windows
+    _PORT_FAILURES = (serial.SerialException, OSError)
+_POSIX_SERIAL: tuple[type, ...] = tuple(
+    cls for cls in (getattr(getattr(serial, "serialposix", None), "Serial", None),) if cls is not None
+)
+_OPEN_FAILURES: tuple[type[Exception], ...] = (*_PORT_FAILURES, ValueError)  # ValueError: a bad setting
+_RESET_FAILURES: tuple[type[Exception], ...] = (*_PORT_FAILURES, NotImplementedError)  # URLs without a buffer
 
 
 @dataclass(frozen=True)
@@ -50,6 +71,17 @@ class Binding:
     describe_status: Callable[[str, int], str] = field(default=lambda name, value: f"{name} = {value:#04x}")
 
 
+def flag_names(flags: dict[str, type[IntFlag]]) -> Callable[[str, int], str]:
+    """A `describe_status` that names a status byte's set bits by the spec's flags: `error = overheat (0x04)`."""
+
+    def describe(name: str, value: int) -> str:
+        kind = flags.get(name)
+        names = [f.name.lower() for f in kind if f.name and value & f] if kind else []
+        return f"{name} = {'|'.join(names) or 'unnamed bits'} ({value:#04x})"
+
+    return describe
+
+
 Subscriber = Callable[[Message], None]
 
 
@@ -67,9 +99,11 @@ class Bus:
     ) -> None:
         self.binding = binding
         self.timeout = timeout
+        self._closed = False  # by close(): no transaction reopens the port after that
         self._lock = threading.RLock()
         self._subscribers: list[Subscriber] = []
         self._unsolicited: deque[Message] = deque(maxlen=1024)
+        self._backlog: deque[Message] = deque()  # frames read after a reply within the same transaction
         self._parser = binding.parser()
         self._port: Any  # a pyserial port; the stubs' SerialBase lacks in_waiting and reset_input_buffer
         if isinstance(port, serial.SerialBase):
@@ -94,8 +128,21 @@ class Bus:
 
     def close(self) -> None:
         with self._lock:
+            self._closed = True
             if self._port.is_open:
                 self._port.close()
+
+    def _ensure_open(self) -> None:
+        """Reopen the port if it failed or was closed under the bus; refuse once the bus itself is closed."""
+        if self._closed:
+            raise PortError(f"{self.port_name}: the bus is closed")
+        if self._port.is_open:
+            return
+        try:
+            self._port.open()
+        except _OPEN_FAILURES as exc:
+            raise PortError(f"cannot reopen {self.port_name}: {exc}") from None
+        self._parser = self.binding.parser()
 
     def __enter__(self) -> Bus:
         return self
@@ -121,6 +168,7 @@ class Bus:
         """Encode (checking every value first) and write a request that expects no reply."""
         frame = self.binding.encode(request)  # raises EncodeError/RangeError before a byte is written
         with self._lock:
+            self._ensure_open()
             self._drain()
             self._write(frame)
 
@@ -129,12 +177,43 @@ class Bus:
         frame = self.binding.encode(request)
         wait = self.timeout if timeout is None else timeout
         with self._lock:
+            self._ensure_open()
             self._drain()
             self._write(frame)
             reply = self._read_until(lambda m: isinstance(m, expect) and self.matches(request, m), wait, request)
+            self._flush_backlog()
         assert isinstance(reply, expect)
         self._check_status(reply)
         return reply
+
+    def request_each(
+        self, request: Message, expect: type[M], answers: list[dict[str, Any]], *, timeout: float | None = None
+    ) -> list[M]:
+        """Send one request that several devices answer in turn (FEETECH SYNC READ): one reply per entry of
+        `answers`, in order, each the first frame of type `expect` whose attributes equal the entry's values.
+        Each reply has the whole timeout; a missing one raises Timeout naming it."""
+        frame = self.binding.encode(request)
+        wait = self.timeout if timeout is None else timeout
+        replies: list[M] = []
+        with self._lock:
+            self._ensure_open()
+            self._drain()
+            self._write(frame)
+            for key in answers:
+
+                def wanted(message: Message, key: dict[str, Any] = key) -> bool:
+                    return isinstance(message, expect) and all(getattr(message, k, None) == v for k, v in key.items())
+
+                try:
+                    reply = self._read_until(wanted, wait, request)
+                except Timeout:
+                    raise Timeout(request.COMMAND, " ".join(f"{k}={v}" for k, v in key.items()), wait) from None
+                assert isinstance(reply, expect)
+                replies.append(reply)
+            self._flush_backlog()
+        for reply in replies:
+            self._check_status(reply)
+        return replies
 
     def matches(self, request: Message, reply: Message) -> bool:
         """The spec's matching rule: the named attributes are equal where both messages have them."""
@@ -154,10 +233,12 @@ class Bus:
         with self._lock:
             if self._unsolicited:
                 return self._unsolicited.popleft()
+            self._ensure_open()
             try:
                 self._read_until(lambda m: True, self.timeout if timeout is None else timeout, None, keep=True)
             except Timeout:
                 return None
+            self._flush_backlog()
             return self._unsolicited.popleft() if self._unsolicited else None
 
     def messages(self, timeout: float | None = None) -> Iterator[Message]:
@@ -167,25 +248,66 @@ class Bus:
 
     # --- reading and writing --------------------------------------------------------------------------------------
 
+    def _port_failures(self, doing: str) -> _PortFailures:
+        """Whatever pyserial raises when the device goes away or the port is closed under the bus, as PortError."""
+        return _PortFailures(self, doing)
+
+    def _port_failed(self, doing: str, exc: Exception) -> None:
+        """Raise PortError for a port failure; anything else propagates as it is.
+
+        A port closed by another thread while a read waits makes pyserial fail with TypeError (its descriptor is
+        None by then): that is a closed port too, not a bug. The failed port is closed so that the next
+        transaction reopens it.
+        """
+        closed_under_the_bus = not self._port.is_open
+        if not closed_under_the_bus and not isinstance(exc, _PORT_FAILURES):
+            return
+        reason = "the port was closed" if closed_under_the_bus else str(exc) or type(exc).__name__
+        self._parser = self.binding.parser()
+        with suppress(*_PORT_FAILURES):
+            self._port.close()
+        raise PortError(f"{self.port_name}: {doing} failed: {reason}") from None
+
     def _write(self, frame: bytes) -> None:
-        try:
+        with self._port_failures("write"):
             self._port.write(frame)
-        except (serial.SerialException, OSError) as exc:
-            self._reset()
-            raise PortError(f"{self.port_name}: write failed: {exc}") from None
 
     def _drain(self) -> None:
         """Hand bytes that arrived between transactions (late replies, reports) to subscribers, without waiting."""
-        try:
+        self._flush_backlog()
+        with self._port_failures("read"):
             waiting = self._port.in_waiting
             if waiting:
                 self._port.timeout = 0
-                for message in self._parser.feed(self._port.read(waiting)):
-                    self._unmatched(message)
-        except (serial.SerialException, OSError) as exc:
-            self._reset()
-            raise PortError(f"{self.port_name}: read failed: {exc}") from None
+                chunk = self._port.read(waiting)
+        if waiting:
+            for message in self._parser.feed(chunk):
+                self._unmatched(message)
         self._parser.errors = 0
+
+    def _read_some(self, wait: float) -> bytes:
+        """Whatever has arrived, blocking up to `wait` seconds for the first byte (no sleeping, no polling)."""
+        fd = getattr(self._port, "fd", None) if isinstance(self._port, _POSIX_SERIAL) else None
+        if isinstance(fd, int):
+            # A device file: wait on the descriptor and read it directly. pyserial keeps no buffer of its own
+            # there, and this avoids setting its timeout (a tcsetattr per transaction) and a second read call.
+            if not select.select([fd], [], [], wait)[0]:
+                return b""
+            data = os.read(fd, 4096)
+            if not data:  # readable but empty: the other end hung up
+                raise serial.SerialException("device disconnected")
+            return data
+        if self._port.timeout != wait:
+            self._port.timeout = wait
+        # Blocks until the first byte or the deadline; then takes whatever else has arrived.
+        chunk: bytes = self._port.read(1)
+        waiting = self._port.in_waiting if chunk else 0
+        return chunk + self._port.read(waiting) if waiting else chunk
+
+    def _flush_backlog(self) -> None:
+        """Frames that came with a reply but answer nothing go to subscribers now, not at the next transaction."""
+        while self._backlog:
+            self._unmatched(self._backlog.popleft())
 
     def _read_until(
         self, wanted: Callable[[Message], bool], wait: float, request: Message | None, keep: bool = False
@@ -194,22 +316,15 @@ class Bus:
         errors = self._parser.errors
         while True:
             remaining = deadline - time.monotonic()
-            try:
-                if remaining <= 0:
-                    chunk = b""
-                else:
-                    self._port.timeout = remaining
-                    # Blocks until the first byte or the deadline; then takes whatever else has arrived.
-                    chunk = self._port.read(1)
-                    waiting = self._port.in_waiting if chunk else 0
-                    if waiting:
-                        chunk += self._port.read(waiting)
-            except (serial.SerialException, OSError) as exc:
-                self._reset()
-                raise PortError(f"{self.port_name}: read failed: {exc}") from None
+            held = list(self._backlog)  # frames that came with the previous reply of this transaction
+            self._backlog.clear()
+            with self._port_failures("read"):
+                chunk = b"" if held or remaining <= 0 else self._read_some(remaining)
             found = None
-            for message in self._parser.feed(chunk) if chunk else []:
-                if found is None and wanted(message):
+            for message in held + (self._parser.feed(chunk) if chunk else []):
+                if found is not None:
+                    self._backlog.append(message)  # maybe the next reply of a request_each
+                elif wanted(message):
                     found = message
                     if keep:
                         self._unmatched(message)
@@ -217,6 +332,8 @@ class Bus:
                     self._unmatched(message)
             if found is not None:
                 return found
+            if held:
+                continue
             if self._parser.errors > errors:
                 bad = self._parser.errors - errors
                 self._reset()
@@ -250,8 +367,25 @@ class Bus:
         try:
             if self._port.is_open:
                 self._port.reset_input_buffer()
-        except (serial.SerialException, OSError, NotImplementedError):
-            pass
+        except _RESET_FAILURES:
+            pass  # a port that has failed reports it on the next read or write
+
+
+class _PortFailures:
+    """The context manager behind Bus._port_failures: a class, as it runs three times per transaction."""
+
+    __slots__ = ("bus", "doing")
+
+    def __init__(self, bus: Bus, doing: str) -> None:
+        self.bus = bus
+        self.doing = doing
+
+    def __enter__(self) -> None:
+        return None
+
+    def __exit__(self, kind: type[BaseException] | None, exc: BaseException | None, trace: object) -> None:
+        if isinstance(exc, Exception):
+            self.bus._port_failed(self.doing, exc)
 
 
 class ClientBase:

@@ -259,12 +259,30 @@ _FIELD_LONG: dict[str, Shape] = {
     "table": Str("table_value/table_block, or bytes holding registers: name of an entry in `tables:`."),
     "key": Str("table_value: the earlier field holding the table key (e.g. data_id)."),
     "start": Str("bytes holding registers: the field (or request.<field>) with the first register's key."),
+    "size_from": Str("bytes of a response, size `rest`: the request field giving its size (request.<field>)."),
     "select": MapOf(Any_(), "table_block: entry attributes an entry must have to be in the block, e.g. {access: rw}."),
     "expect_size": Int("table_block: the block's size in bytes, asserted by the generator."),
     "inferred": TEXT,
+    "status": Obj(
+        {"ok": Int("The value that means success; any other value is a device error.")},
+        required=("ok",),
+        description=(
+            "A response field that says whether the device could do it (RRC `success`): the client raises "
+            "DeviceError unless it holds `ok`, and returns the other fields."
+        ),
+    ),
 }
 FIELD = OneOf((Str("A wire type or the name of an entry in `fields:`"), Obj(_FIELD_LONG)), "a type name or a mapping")
 FIELDS = MapOf(FIELD, "Fields in wire order: name -> type or mapping.")
+
+OPTIONAL_WHEN = Obj(
+    {
+        "parameter": Str("A table entry: `entry` or `table.entry` (e.g. response_switch)."),
+        "equals": Int("The value of the parameter with which the device answers."),
+    },
+    required=("parameter", "equals"),
+    description="The reply is sent only while a device parameter has this value.",
+)
 
 MESSAGE = Obj(
     {
@@ -273,15 +291,16 @@ MESSAGE = Obj(
         "optional": TEXT,
         "unsolicited": Bool("Sent by the device on its own, not as an answer."),
         "answers": Str("For a response: the request (command or command.subcommand) it answers, if another."),
-        "optional_when": Obj(
-            {
-                "parameter": Str("A table entry: `entry` or `table.entry` (e.g. response_switch)."),
-                "equals": Int("The value of the parameter with which the device answers."),
-            },
-            required=("parameter", "equals"),
-            description="For a response: sent only while a device parameter has this value.",
-        ),
+        "optional_when": OPTIONAL_WHEN,
         "after": Str("For a response: the request field (in ms) after which the device answers, e.g. a move's time."),
+        "answered_by": Obj(
+            {
+                "command": Str("The command whose response answers this request (one reply layout for many)."),
+                "optional_when": OPTIONAL_WHEN,
+            },
+            required=("command",),
+            description="For a request: answered by another command's response (FEETECH's one status packet).",
+        ),
         "source": TEXT,
     },
     description="One direction of a command: its content fields and how it is sent.",
@@ -368,6 +387,7 @@ TABLE_ENTRY = Obj(
         "enum": Str(),
         "flags": Str(),
         "encoding": Str(choices=("plain", "sign_magnitude")),
+        "sign_bit": Int("sign_magnitude: the bit holding the sign when it is not the top bit (FEETECH load: 10)."),
         "reserved": Bool("A slot the document reserves: no name of its own."),
         "source": TEXT,
     },
@@ -472,13 +492,24 @@ DEVICE_COMMAND = Obj(
         "moves": Obj(
             {
                 "state": Str("The state variable (or memory entry) that moves."),
-                "target": Str("The request field with the target."),
-                "duration": Str("The request field with the time to reach the target, in ms."),
-                "speed": Str("The request field with the speed, in state units per second."),
+                "target": Str("The request field (or memory entry, once written) with the target."),
+                "duration": Str("The request field (or memory entry) with the time to reach the target, in ms."),
+                "speed": Str("The request field (or memory entry) with the speed, in state units per second."),
             },
             required=("state", "target"),
         ),
         "broadcast_reply": Bool("Answers even when addressed by broadcast (default: silent)."),
+        "each": Str("A group field of the request whose items address one device each (by the address field)."),
+        "buffered": Bool("The writes are held until a command that `commits` (FEETECH REG WRITE)."),
+        "commits": Bool("Carries out the writes held by `buffered` commands (FEETECH ACTION)."),
+        "kind": Str("The entry of `kinds:` whose devices the command addresses (default: the devices of --id)."),
+        "stores": MapOf(Str(), "Request field -> the state variable it is stored in (where names differ)."),
+        "sets": MapOf(Num(), "State variable -> the value the command sets it to."),
+        "absent": MapOf(
+            Num(),
+            "Response field -> value when no device has the addressed id and the bus master answers for it "
+            "(RRC: the board reports success -1); without it, silence.",
+        ),
     },
     description="What the device does with one command (command or command.subcommand).",
 )
@@ -489,12 +520,30 @@ DEVICE = Obj(
         "memory": Str("The table the device keeps, initialised from its defaults."),
         "initial": MapOf(Num(), "Memory entry -> value the simulator starts with where the table gives no default."),
         "address": Str("The field holding the device id (default: the frame's address element)."),
-        "id_entry": Str("The memory entry holding the device's own id (writing it changes the address)."),
+        "id_entry": Str("The memory entry or state variable holding the device's id (writing it changes the address)."),
         "broadcast": Int("The address every device obeys (default: the address element's broadcast)."),
         "state": MapOf(Num(), "State variables beyond memory -> initial value (e.g. the present angle)."),
         "reply": MapOf(Num(), "Response field -> value when no behaviour sets it (e.g. result: 1)."),
         "refused": MapOf(Num(), "Response field -> value when a write is refused (read-only or unknown entry)."),
+        "status": MapOf(Str(), "Response field -> the memory entry every response reports in it (a status byte)."),
+        "echo_address": Bool(
+            "Replies carry the id the request named (RRC: 0xFE for a broadcast read), not the answering device's own."
+        ),
         "commands": MapOf(DEVICE_COMMAND, "Command (or command.subcommand) -> behaviour; others just answer."),
+        "kinds": MapOf(
+            Obj(
+                {
+                    "description": TEXT,
+                    "address": Str("The request field holding this kind's id."),
+                    "ids": ListOf(Int(), "The ids the simulator creates (fixed by the hardware, not by --id)."),
+                    "broadcast": Int("The id every device of this kind obeys."),
+                    "state": MapOf(Num(), "State variables of each device of this kind -> initial value."),
+                },
+                required=("address", "ids"),
+            ),
+            "Further kinds of device behind the same port, each with its own ids (a board's PWM servo ports, its "
+            "motors); a command names its kind with `kind:`. The devices --id creates are the default kind.",
+        ),
     },
     description="How the device behaves: what the generated simulator does, and the address rule the client uses.",
 )

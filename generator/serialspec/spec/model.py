@@ -6,7 +6,9 @@ uses to reject stray headers, class names, and which fields are derived (counts,
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Literal
 
 from serialspec.runtime.message import Direction as Direction  # the model and the runtime share it
@@ -107,6 +109,8 @@ class Scalar(Common):
     # Derived fields are computed on encode and checked on decode, never given by the user:
     # ("count", group) is the number of items of a group; ("size", group, field) the size of bytes in each item.
     derived: tuple[str, ...] = ()
+    # A response field reporting success: any value but this one is a device error (the client raises DeviceError).
+    status_ok: int | None = None
 
     @property
     def hidden(self) -> bool:
@@ -129,6 +133,7 @@ class Bytes(Common):
     size: int | str  # a number, "rest", or the name of a field holding it
     table: Table | None = None  # when the bytes are a run of registers of this table
     start: str = ""  # the field (or request.<field>) holding the first register's key
+    size_from: str = ""  # a response's `rest` bytes: the request field giving their number (request.<field>)
 
 
 @dataclass(frozen=True)
@@ -175,6 +180,7 @@ class TableEntry:
     sign_magnitude: bool
     reserved: bool
     source: str
+    sign_bit: int | None = None  # sign_magnitude: the sign's bit (the top bit unless the spec says otherwise)
 
 
 @dataclass(frozen=True)
@@ -222,10 +228,31 @@ class Message:
     source: str
     optional_when: OptionalWhen | None = None  # a response sent only when a device parameter has a value
     after: str = ""  # a response sent once the request's field of this name (ms) has elapsed
+    answered_by: str = ""  # a request answered by another command's response (its key)
+    reply_when: OptionalWhen | None = None  # a request whose reply is sent only when a device parameter has a value
 
     @property
     def key(self) -> str:
         return f"{self.command}.{self.subcommand}" if self.subcommand else self.command
+
+
+def replies_by_request(responses: Iterable[Message]) -> dict[str, Message]:
+    """Responses by the request they answer: their own command's, or the one they say they `answers`."""
+    index: dict[str, Message] = {}
+    for response in responses:
+        if response.direction == Direction.RESPONSE and not response.unsolicited:
+            index.setdefault(response.answers or response.key, response)
+    return index
+
+
+def reply_to(request: Message, replies: dict[str, Message]) -> Message | None:
+    """The response that answers a request (from `replies_by_request`), or the one it is `answered_by`."""
+    return replies.get(request.answered_by or request.key)
+
+
+def reply_condition(request: Message, response: Message | None) -> OptionalWhen | None:
+    """The device parameter that switches a request's reply on and off, if any."""
+    return request.reply_when or (response.optional_when if response else None)
 
 
 @dataclass(frozen=True)
@@ -399,6 +426,25 @@ class Behaviour:
     reports: dict[str, str]  # response field -> state variable or memory entry
     moves: Motion | None
     broadcast_reply: bool  # answers even when addressed by broadcast
+    each: str = ""  # a request group whose items each address one device (SYNC WRITE)
+    buffered: bool = False  # writes held until a command that commits (REG WRITE)
+    commits: bool = False  # carries out the held writes (ACTION)
+    kind: str = ""  # the device kind addressed (a `kinds:` entry); "" for the default devices
+    stores: dict[str, str] = field(default_factory=dict)  # request field -> state variable
+    sets: dict[str, float] = field(default_factory=dict)  # state variable -> value
+    absent: dict[str, float] = field(default_factory=dict)  # response values when no device has the id
+
+
+@dataclass(frozen=True)
+class DeviceKind:
+    """Devices of another kind behind the same port, with their own ids and state (a board's PWM servo ports)."""
+
+    name: str
+    description: str
+    address: str
+    ids: tuple[int, ...]
+    broadcast: int | None
+    state: dict[str, float]
 
 
 @dataclass(frozen=True)
@@ -415,6 +461,9 @@ class Device:
     reply: dict[str, float]  # response field -> value when no behaviour sets it
     refused: dict[str, float]  # response field -> value when a write is refused
     behaviours: tuple[Behaviour, ...]
+    status: dict[str, str] = field(default_factory=dict)  # response field -> memory entry every reply reports
+    kinds: tuple[DeviceKind, ...] = ()
+    echo_address: bool = False  # replies carry the id the request named, not the answering device's own
 
     def behaviour(self, key: str) -> Behaviour | None:
         return next((b for b in self.behaviours if b.command == key), None)
@@ -444,4 +493,8 @@ class Protocol:
         return tuple(m for c in self.commands for m in c.messages())
 
     def command(self, name: str) -> Command:
-        return next(c for c in self.commands if c.name == name)
+        return self._commands_by_name[name]
+
+    @cached_property
+    def _commands_by_name(self) -> dict[str, Command]:  # emitters look commands up per message
+        return {c.name: c for c in self.commands}

@@ -26,6 +26,7 @@ from serialspec.spec.model import (
     Command,
     Crc,
     Device,
+    DeviceKind,
     Direction,
     EnumDef,
     EnumValue,
@@ -52,6 +53,8 @@ from serialspec.spec.model import (
     TableBlock,
     TableEntry,
     TableValue,
+    replies_by_request,
+    reply_to,
 )
 
 NAME = re.compile(r"^[a-z][a-z0-9_]*$")
@@ -149,6 +152,7 @@ class Resolver:
                 commands.append(command)
         if framing:
             self.check_codes(commands, framing)
+        self.check_answered_by(commands)
         errata = tuple(
             e
             for key, value in (data.get("errata") or {}).items()
@@ -271,7 +275,8 @@ class Resolver:
                 self.error((*entry_path, "key"), f"key {item['key']} is already used by {keys[item['key']]!r}")
             keys[item["key"]] = entry_name
             sign_magnitude = item.get("encoding") == "sign_magnitude"
-            low, high = self.bounds(scalar, sign_magnitude, item.get("range"), (*entry_path, "range"))
+            sign_bit = self.sign_bit(scalar, sign_magnitude, item.get("sign_bit"), (*entry_path, "sign_bit"))
+            low, high = self.bounds(scalar, sign_magnitude, item.get("range"), (*entry_path, "range"), sign_bit)
             entries.append(
                 TableEntry(
                     name=entry_name,
@@ -291,6 +296,7 @@ class Resolver:
                     sign_magnitude=sign_magnitude,
                     reserved=bool(item.get("reserved", False)),
                     source=str(item.get("source", "")),
+                    sign_bit=sign_bit,
                 )
             )
         if value.get("key_type") is None:
@@ -317,9 +323,24 @@ class Resolver:
                     f"({before.key:#04x}..{before.key + before.type.size - 1:#04x})",
                 )
 
-    def bounds(self, scalar: ScalarType, sign_magnitude: bool, given: Any, path: Path) -> tuple[float, float]:
+    def sign_bit(self, scalar: ScalarType, sign_magnitude: bool, given: Any, path: Path) -> int | None:
+        if not sign_magnitude:
+            if given is not None:
+                self.error(path, "`sign_bit` needs `encoding: sign_magnitude`")
+            return None
+        top = scalar.size * 8 - 1
+        if given is None:
+            return top
+        if not 0 < given <= top:
+            self.error(path, f"sign bit {given} is outside {scalar.name}'s bits 1..{top}")
+            return top
+        return int(given)
+
+    def bounds(
+        self, scalar: ScalarType, sign_magnitude: bool, given: Any, path: Path, sign_bit: int | None = None
+    ) -> tuple[float, float]:
         if sign_magnitude:
-            limit = (1 << (scalar.size * 8 - 1)) - 1
+            limit = (1 << (sign_bit if sign_bit is not None else scalar.size * 8 - 1)) - 1
             low, high = float(-limit), float(limit)
         else:
             low, high = scalar.minimum, scalar.maximum
@@ -566,6 +587,16 @@ class Resolver:
             subcommands=tuple(subcommands),
         )
 
+    def check_answered_by(self, commands: list[Command]) -> None:
+        responses = {m.key: m for c in commands for m in c.messages() if m.direction == Direction.RESPONSE}
+        for command in commands:
+            for message in command.messages():
+                if message.answered_by and message.answered_by not in responses:
+                    self.error(
+                        ("commands", command.name, "request", "answered_by", "command"),
+                        f"{message.answered_by!r} is not a command with a response",
+                    )
+
     def check_codes(self, commands: list[Command], framing: Framing) -> None:
         for direction, layout in framing.layouts.items():
             seen: dict[int | None, str] = {}
@@ -601,6 +632,13 @@ class Resolver:
         self.check_rest(fields, (*path, "fields"))
         low, high = content_bounds(fields)
         class_name = self.class_name(camel(command, subcommand or "", direction.value), path)
+        answered_by = value.get("answered_by") or {}
+        if direction == Direction.REQUEST:
+            for field in fields:
+                if isinstance(field, Scalar) and field.status_ok is not None:
+                    self.error((*path, "fields", field.name, "status"), "a status is reported in a response")
+        if answered_by and direction != Direction.REQUEST:
+            self.error((*path, "answered_by"), "`answered_by` names the response that answers a request")
         return Message(
             command=command,
             subcommand=subcommand,
@@ -617,6 +655,8 @@ class Resolver:
             source=str(value.get("source", "")),
             optional_when=self.optional_when(value.get("optional_when"), (*path, "optional_when")),
             after=self.after(value.get("after"), fields, direction, path),
+            answered_by=str(answered_by.get("command", "")),
+            reply_when=self.optional_when(answered_by.get("optional_when"), (*path, "answered_by", "optional_when")),
         )
 
     def table_entry(self, text: str, path: Path) -> tuple[Table, TableEntry]:
@@ -740,7 +780,10 @@ class Resolver:
             table = self.reference("table", self.tables, spec.get("table"), (*path, "table"))
             if isinstance(size, str) and size != "rest":
                 self.size_field(size, name, siblings, parent, path)
-            return Bytes(**common, size=size, table=table, start=str(spec.get("start", "")))
+            size_from = str(spec.get("size_from", ""))
+            if size_from and (size != "rest" or not size_from.startswith("request.")):
+                self.error((*path, "size_from"), "`size_from: request.<field>` goes with `size: rest`")
+            return Bytes(**common, size=size, table=table, start=str(spec.get("start", "")), size_from=size_from)
         if kind == "array":
             item_type = self.scalar_type(spec.get("of"), (*path, "of"))
             count = spec.get("count")
@@ -833,7 +876,18 @@ class Resolver:
             bits=tuple(bits),
             bits_class=self.class_name(camel(common["name"], "bits"), path) if bits else "",
             sign_magnitude=sign_magnitude,
+            status_ok=self.status_ok(spec.get("status"), scalar, low, high, (*path, "status")),
         )
+
+    def status_ok(self, status: Any, scalar: ScalarType, low: float, high: float, path: Path) -> int | None:
+        if status is None:
+            return None
+        ok = int(status["ok"])
+        if scalar.is_float:
+            self.error(path, "a status needs an integer type")
+        elif not low <= ok <= high:
+            self.error((*path, "ok"), f"{ok} is outside the field's range {low:g}..{high:g}")
+        return ok
 
     def derive(self, name: str, derivation: tuple[str, ...], siblings: list[Field], path: Path) -> None:
         for index, field in enumerate(siblings):
@@ -867,11 +921,22 @@ class Resolver:
             self.error(path, "name the field holding the device id with `address:`")
         broadcast = value.get("broadcast", address_element.broadcast if address_element else None)
         id_entry = str(value.get("id_entry", ""))
-        if id_entry and id_entry not in entries:
-            self.error((*path, "id_entry"), f"unknown memory entry {id_entry!r}")
+        if id_entry and id_entry not in entries and id_entry not in (value.get("state") or {}):
+            self.error((*path, "id_entry"), f"unknown memory entry or state variable {id_entry!r}")
         state = {str(k): float(v) for k, v in (value.get("state") or {}).items()}
         requests = {m.key: m for c in commands for m in c.messages() if m.direction == Direction.REQUEST}
-        responses = [m for c in commands for m in c.messages() if m.direction == Direction.RESPONSE]
+        replies = replies_by_request(m for c in commands for m in c.messages())
+        kinds = {
+            str(name): DeviceKind(
+                str(name),
+                str(kind.get("description", "")),
+                str(kind["address"]),
+                tuple(int(i) for i in kind["ids"]),
+                kind.get("broadcast"),
+                {str(k): float(v) for k, v in (kind.get("state") or {}).items()},
+            )
+            for name, kind in (value.get("kinds") or {}).items()
+        }
         behaviours = []
         for key, item in (value.get("commands") or {}).items():
             item_path = (*path, "commands", key)
@@ -879,8 +944,17 @@ class Resolver:
             if request is None:
                 self.error(item_path, f"unknown command {key!r} (or it has no request)")
                 continue
-            response = next((m for m in responses if (m.answers or m.key) == key), None)
-            request_names = {f.name for f in request.fields}
+            kind_name = str(item.get("kind", ""))
+            if kind_name and kind_name not in kinds:
+                self.error((*item_path, "kind"), f"unknown device kind {kind_name!r} (not in `kinds:`)")
+            known_state = kinds[kind_name].state if kind_name in kinds else state
+            response = reply_to(request, replies)
+            each = str(item.get("each", ""))
+            group = next((f for f in request.fields if isinstance(f, Group) and f.name == each), None)
+            if each and group is None:
+                self.error((*item_path, "each"), f"{key} has no group field {each!r}")
+            item_fields = group.fields if group else ()
+            request_names = {f.name for f in (*request.fields, *item_fields)}
             response_names = {f.name for f in response.fields} if response else set()
             for name in item.get("reads") or ():
                 if name not in response_names:
@@ -892,7 +966,7 @@ class Resolver:
             for field_name, source in reports.items():
                 if field_name not in response_names:
                     self.error((*item_path, "reports", field_name), f"{key} has no response field {field_name!r}")
-                if source not in state and source not in entries:
+                if source not in known_state and source not in entries:
                     self.error((*item_path, "reports", field_name), f"unknown state variable {source!r}")
             motion = None
             if "moves" in item:
@@ -903,12 +977,26 @@ class Resolver:
                     str(moves.get("duration", "")),
                     str(moves.get("speed", "")),
                 )
-                if motion.state not in state and motion.state not in entries:
+                if motion.state not in known_state and motion.state not in entries:
                     self.error((*item_path, "moves", "state"), f"unknown state variable {motion.state!r}")
                 for role in ("target", "duration", "speed"):
                     name = getattr(motion, role)
-                    if name and name not in request_names:
-                        self.error((*item_path, "moves", role), f"{key} has no request field {name!r}")
+                    if name and name not in request_names and name not in entries:
+                        self.error((*item_path, "moves", role), f"{key} has no request field or memory entry {name!r}")
+            stores = {str(k): str(v) for k, v in (item.get("stores") or {}).items()}
+            sets = {str(k): float(v) for k, v in (item.get("sets") or {}).items()}
+            absent = {str(k): float(v) for k, v in (item.get("absent") or {}).items()}
+            for field_name, target in stores.items():
+                if field_name not in request_names:
+                    self.error((*item_path, "stores", field_name), f"{key} has no request field {field_name!r}")
+                if target not in known_state and target not in entries:
+                    self.error((*item_path, "stores", field_name), f"unknown state variable {target!r}")
+            for target in sets:
+                if target not in known_state and target not in entries:
+                    self.error((*item_path, "sets", target), f"unknown state variable {target!r}")
+            for field_name in absent:
+                if field_name not in response_names:
+                    self.error((*item_path, "absent", field_name), f"{key} has no response field {field_name!r}")
             behaviours.append(
                 Behaviour(
                     key,
@@ -918,8 +1006,19 @@ class Resolver:
                     reports,
                     motion,
                     bool(item.get("broadcast_reply", False)),
+                    each,
+                    bool(item.get("buffered", False)),
+                    bool(item.get("commits", False)),
+                    kind_name,
+                    stores,
+                    sets,
+                    absent,
                 )
             )
+        status = {str(k): str(v) for k, v in (value.get("status") or {}).items()}
+        for field_name, entry_name in status.items():
+            if entry_name not in entries:
+                self.error((*path, "status", field_name), f"unknown memory entry {entry_name!r}")
         return Device(
             description=str(value.get("description", "")),
             memory=memory,
@@ -931,6 +1030,9 @@ class Resolver:
             reply={str(k): float(v) for k, v in (value.get("reply") or {}).items()},
             refused={str(k): float(v) for k, v in (value.get("refused") or {}).items()},
             behaviours=tuple(behaviours),
+            status=status,
+            kinds=tuple(kinds.values()),
+            echo_address=bool(value.get("echo_address", False)),
         )
 
     # --- examples and errata --------------------------------------------------------------------------------------

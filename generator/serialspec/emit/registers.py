@@ -1,0 +1,66 @@
+"""Emit a protocol's register maps: the tables whose registers READ/WRITE carry as runs of bytes from an address."""
+
+from __future__ import annotations
+
+from serialspec.emit.pycode import number, one_line
+from serialspec.emit.render import render
+from serialspec.spec.model import Bytes, Group, Protocol, Table
+
+
+def register_tables(protocol: Protocol) -> list[Table]:
+    """Tables that some message carries as a run of registers (`bytes` with `table:`), in spec order."""
+    used: set[str] = set()
+    for message in protocol.messages():
+        stack = list(message.fields)
+        while stack:
+            f = stack.pop()
+            if isinstance(f, Bytes) and f.table is not None:
+                used.add(f.table.name)
+            elif isinstance(f, Group):
+                stack.extend(f.fields)
+    return [t for t in protocol.tables if t.name in used]
+
+
+def map_name(table: Table) -> str:
+    return table.name.upper()
+
+
+def names_alias(table: Table) -> str:
+    return "".join(w.capitalize() for w in table.name.split("_")) + "Name"
+
+
+def registers_module(protocol: Protocol) -> str:
+    tables = []
+    for table in register_tables(protocol):
+        registers = []
+        for entry in table.entries:
+            if entry.reserved:
+                continue
+            args = [
+                repr(entry.name),
+                f"{entry.key:#04x}",
+                repr(entry.type.struct_char),
+                number(entry.minimum),
+                number(entry.maximum),
+                repr(entry.access),
+            ]
+            if entry.sign_magnitude:
+                args.append(f"sign_bit={entry.sign_bit}")
+            registers.append(f"Register({', '.join(args)}),  # {one_line(entry.unit) or '-'}")
+        tables.append(
+            {
+                "name": table.name,
+                "constant": map_name(table),
+                "alias": names_alias(table),
+                "title": one_line(table.title),
+                "names": [e.name for e in table.entries if not e.reserved],
+                "registers": registers,
+            }
+        )
+    return render(
+        "registers.py.j2",
+        spec_path=protocol.spec_path,
+        title=one_line(protocol.title),
+        byte_order=protocol.byte_order,
+        tables=tables,
+    )

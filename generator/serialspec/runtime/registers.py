@@ -1,0 +1,121 @@
+"""Register maps: named registers at byte addresses, packed into and out of the runs of bytes a device reads and writes.
+
+A protocol whose READ and WRITE carry raw bytes "from address N on" (FEETECH's control table) gets a generated
+`RegisterMap` per table; clients use it to read and write registers by name, the virtual device to keep its
+memory, and both refuse a bad name, a read-only register or an out-of-range value before a byte is sent.
+"""
+
+from __future__ import annotations
+
+import struct
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+
+from serialspec.runtime.errors import EncodeError, out_of_range
+
+
+@dataclass(frozen=True, slots=True)
+class Register:
+    """One register: its address, wire type (a struct format character), range and access."""
+
+    name: str
+    address: int
+    format: str  # struct character of the wire type, e.g. "H"
+    minimum: float
+    maximum: float
+    access: str = "rw"  # "r" (read-only) or "rw"
+    sign_bit: int | None = None  # sign-magnitude: the bit holding the sign
+
+    @property
+    def size(self) -> int:
+        return struct.calcsize(self.format)
+
+    @property
+    def end(self) -> int:
+        return self.address + self.size
+
+
+class RegisterMap:
+    """The registers of one table, by name and by address, with the table's byte order."""
+
+    def __init__(self, table: str, registers: Iterable[Register], byte_order: str) -> None:
+        self.table = table
+        self.registers = tuple(sorted(registers, key=lambda r: r.address))
+        self.by_name = {r.name: r for r in self.registers}
+        self.by_address = {r.address: r for r in self.registers}
+        self._endian = ">" if byte_order == "big" else "<"
+        self._structs = {r.name: struct.Struct(self._endian + r.format) for r in self.registers}
+
+    def __getitem__(self, name: str) -> Register:
+        register = self.by_name.get(name)
+        if register is None:
+            raise EncodeError(f"{self.table}: unknown register {name!r}")
+        return register
+
+    def __contains__(self, name: object) -> bool:
+        return name in self.by_name
+
+    def span(self, names: Iterable[str]) -> tuple[int, int]:
+        """The first address and the byte count of one read that covers every named register."""
+        chosen = [self[name] for name in names]
+        if not chosen:
+            raise EncodeError(f"{self.table}: name at least one register")
+        start = min(r.address for r in chosen)
+        return start, max(r.end for r in chosen) - start
+
+    # --- values <-> bytes -----------------------------------------------------------------------------------------
+
+    def to_wire(self, register: Register, value: int) -> bytes:
+        """One value as the register's bytes, refused (naming the register and its range) when it does not fit."""
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise EncodeError(f"{register.name} must be an integer, got {value!r}")
+        if not register.minimum <= value <= register.maximum:
+            raise out_of_range(self.table, register.name, value, register.minimum, register.maximum)
+        if register.sign_bit is not None and value < 0:
+            value = -value | 1 << register.sign_bit
+        return self._structs[register.name].pack(value)
+
+    def from_wire(self, register: Register, data: bytes, offset: int = 0) -> int:
+        (value,) = self._structs[register.name].unpack_from(data, offset)
+        if register.sign_bit is not None and value >> register.sign_bit & 1:
+            return -int(value & ((1 << register.sign_bit) - 1))
+        return int(value)
+
+    def unpack(self, start: int, data: bytes) -> dict[str, int]:
+        """Bytes read from address `start` on, by register name; bytes that belong to no whole register by address."""
+        values: dict[str, int] = {}
+        address, offset = start, 0
+        while offset < len(data):
+            register = self.by_address.get(address)
+            if register is None or offset + register.size > len(data):
+                values[f"{address:#04x}"] = data[offset]
+                address, offset = address + 1, offset + 1
+                continue
+            values[register.name] = self.from_wire(register, data, offset)
+            address, offset = address + register.size, offset + register.size
+        return values
+
+    def pack(self, values: Mapping[str, int], *, writable: bool = True) -> tuple[int, bytes]:
+        """Named values as one run of bytes and its first address; the registers must follow each other."""
+        chosen = sorted((self[name] for name in values), key=lambda r: r.address)
+        if not chosen:
+            raise EncodeError(f"{self.table}: name at least one register to write")
+        data = bytearray()
+        for before, register in zip([None, *chosen], chosen, strict=False):
+            if writable and register.access == "r":
+                raise EncodeError(f"{register.name} is read-only")
+            if before is not None and before.end != register.address:
+                raise EncodeError(
+                    f"{before.name} ({before.address:#04x}) and {register.name} ({register.address:#04x}) are not "
+                    f"adjacent registers: one write takes one run of registers, so write them separately"
+                )
+            data += self.to_wire(register, values[register.name])
+        return chosen[0].address, bytes(data)
+
+    def split(self, start: int, data: bytes) -> dict[str, int]:
+        """Bytes written from address `start` on as register values; refused unless they cover whole registers."""
+        values = self.unpack(start, data)
+        stray = [name for name in values if name not in self.by_name]
+        if stray:
+            raise EncodeError(f"{self.table}: bytes at {', '.join(stray)} are not whole registers")
+        return values

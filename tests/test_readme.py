@@ -1,0 +1,32 @@
+"""The README's client session runs as printed, against a real `serialspec sim` process."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import re
+
+import pytest
+from serialspec.runtime.errors import RangeError
+from sim_process import ROOT, serve
+
+PRINTED_PORT = "/dev/pts/5"
+
+
+def session_block() -> str:
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    blocks = re.findall(r"```python\n(.*?)```", text, flags=re.S)
+    return next(b for b in blocks if "FeetechSmsClient" in b and PRINTED_PORT in b)
+
+
+def test_the_readme_session_runs_as_printed() -> None:
+    code = session_block()
+    output = io.StringIO()
+    refused = pytest.raises(RangeError, match=r"torque_limit = 1001 is outside its range 0\.\.1000")
+    with serve("feetech_sms.yaml", 1, 2) as port, contextlib.redirect_stdout(output), refused:
+        exec(compile(code.replace(PRINTED_PORT, port), "README.md", "exec"), {})
+    lines = output.getvalue().splitlines()
+    assert lines[0] == "True False"
+    assert lines[1] == "1000"
+    assert 0 <= int(lines[2]) < 2048
+    assert lines[3] == "{1: {'goal_position': 100}, 2: {'goal_position': 300}}"

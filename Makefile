@@ -3,8 +3,9 @@ PYTHON ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
+BENCH_STAMP := $(VENV)/.installed-bench
 
-.PHONY: generate test check lint typecheck clean demo
+.PHONY: generate test check lint typecheck clean demo stress bench
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -27,6 +28,26 @@ typecheck: $(STAMP)
 
 test: $(STAMP) check lint typecheck
 	$(BIN)/pytest -q
+
+# The long robustness runs: 100,000 frames per protocol and direction through the stream parsers (with garbage,
+# truncated frame starts, corrupt checksums, random read sizes), the fault matrix, and 8 threads x 5,000
+# transactions on one bus. `make test` runs the same tests in a short form (5,000 frames, 8 x 1,000 transactions).
+STRESS_FRAMES ?= 100000
+STRESS_TRANSACTIONS ?= 5000
+
+stress: $(STAMP)
+	@echo "stress: $(STRESS_FRAMES) frames per stream parser, 8 threads x $(STRESS_TRANSACTIONS) transactions"
+	SERIALSPEC_STRESS_FRAMES=$(STRESS_FRAMES) SERIALSPEC_STRESS_TRANSACTIONS=$(STRESS_TRANSACTIONS) \
+		$(BIN)/pytest -q -s tests/test_stress.py tests/test_faults.py
+
+# Benchmarks (bench/README.md): codec, stream parsing, pseudo-terminal latency, generation; about 3 minutes on a
+# quiet machine. Prints one table per family and writes them all to bench/results.md.
+$(BENCH_STAMP): $(STAMP) pyproject.toml
+	$(BIN)/pip install --quiet -e '.[test,bench]'
+	touch $(BENCH_STAMP)
+
+bench: $(BENCH_STAMP)
+	$(BIN)/python -m bench.run
 
 clean:
 	rm -rf $(VENV) build *.egg-info

@@ -6,10 +6,9 @@ from __future__ import annotations
 import struct
 from collections.abc import Callable
 
-from serialspec.runtime.checksums import sum_function
+from serialspec.runtime.checksums import BYTE_VALUES as _BYTES
 from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError, content_size_error, out_of_range
-from serialspec.runtime.message import Direction, Message
-from serialspec.runtime.message import enum_or_int as _enum
+from serialspec.runtime.message import Direction, Message, members, slot_setters
 from serialspec.runtime.stream import FrameFormat
 from serialspec.runtime.stream import StreamParser as _StreamParser
 
@@ -49,6 +48,15 @@ from fashionstar_uart.messages import (
 
 __all__ = ["StreamParser", "decode", "encode"]
 
+_S_B2_U8_U8 = struct.Struct('<2sBB')
+_S_B2_U8_U8_U8 = struct.Struct('<2sBBB')
+_S_B2_U8_U8_U8_I16 = struct.Struct('<2sBBBh')
+_S_B2_U8_U8_U8_U16 = struct.Struct('<2sBBBH')
+_S_B2_U8_U8_U8_U8 = struct.Struct('<2sBBBB')
+_S_B2_U8_U8_U8_U8_U8 = struct.Struct('<2sBBBBB')
+_S_FRAME_READBATCHDATARESPONSE = struct.Struct('<2sBBBBBBBBBHHHHHHBBBBBBHhhh')
+_S_FRAME_ROTATEREQUEST = struct.Struct('<2sBBBhHH')
+_S_FRAME_SPINREQUEST = struct.Struct('<2sBBBBHH')
 _S_READBATCHDATARESPONSE_SERVO_ID = struct.Struct('<BBBBBBBHHHHHHBBBBBBHhhh')
 _S_U8 = struct.Struct('<B')
 _S_U8_I16 = struct.Struct('<Bh')
@@ -115,73 +123,121 @@ _TABLE_PARAMETERS_RANGES: dict[int, tuple[float, float]] = {
     52: (-32768, 32767),
     53: (-32768, 32767),
 }
-_checksum: Callable[[bytes], int] = sum_function(8, invert=False)
 
-
-def _frame_request(code: int, content: bytes) -> bytes:
-    n = len(content) + 0
-    if n > 255:
-        raise EncodeError(f'content of {len(content)} bytes does not fit the length field')
-    body = b''.join((b'\x12L', bytes((code,)), bytes((n,)), content,))
-    return body + _checksum(body[0:]).to_bytes(1, 'little')
-
-
-def _frame_response(code: int, content: bytes) -> bytes:
-    n = len(content) + 0
-    if n > 255:
-        raise EncodeError(f'content of {len(content)} bytes does not fit the length field')
-    body = b''.join((b'\x05\x1c', bytes((code,)), bytes((n,)), content,))
-    return body + _checksum(body[0:]).to_bytes(1, 'little')
+# Decoders build messages with object.__new__ and store each value straight into its slot: the dataclass __init__
+# of a frozen class goes through object.__setattr__ per field, which costs more than unpacking the whole frame.
+_new = object.__new__
+_set_DampingRequest_servo_id, _set_DampingRequest_power = slot_setters(DampingRequest)
+_set_DampingResponse_servo_id, _set_DampingResponse_result = slot_setters(DampingResponse)
+_set_MethodBits_direction, _set_MethodBits_mode = slot_setters(MethodBits)
+(_set_PingRequest_servo_id,) = slot_setters(PingRequest)
+(_set_PingResponse_servo_id,) = slot_setters(PingResponse)
+(_set_ReadAngleRequest_servo_id,) = slot_setters(ReadAngleRequest)
+_set_ReadAngleResponse_servo_id, _set_ReadAngleResponse_angle = slot_setters(ReadAngleResponse)
+(_set_ReadBatchDataRequest_servo_id,) = slot_setters(ReadBatchDataRequest)
+_set_ReadBatchDataResponse_servo_id, _set_ReadBatchDataResponse_user_data = slot_setters(ReadBatchDataResponse)
+_set_ReadDataRequest_servo_id, _set_ReadDataRequest_data_id = slot_setters(ReadDataRequest)
+_set_ReadDataResponse_servo_id, _set_ReadDataResponse_data_id, _set_ReadDataResponse_data = slot_setters(ReadDataResponse)
+(_set_ResetUserDataRequest_servo_id,) = slot_setters(ResetUserDataRequest)
+_set_ResetUserDataResponse_servo_id, _set_ResetUserDataResponse_result = slot_setters(ResetUserDataResponse)
+(
+    _set_RotateRequest_servo_id,
+    _set_RotateRequest_angle,
+    _set_RotateRequest_interval,
+    _set_RotateRequest_power,
+) = slot_setters(RotateRequest)
+_set_RotateResponse_servo_id, _set_RotateResponse_result = slot_setters(RotateResponse)
+(
+    _set_SpinRequest_servo_id,
+    _set_SpinRequest_method,
+    _set_SpinRequest_speed,
+    _set_SpinRequest_value,
+) = slot_setters(SpinRequest)
+_set_SpinResponse_servo_id, _set_SpinResponse_result = slot_setters(SpinResponse)
+(
+    _set_UserData_reserved_32,
+    _set_UserData_response_switch,
+    _set_UserData_servo_id,
+    _set_UserData_reserved_35,
+    _set_UserData_baudrate,
+    _set_UserData_stall_protect_mode,
+    _set_UserData_stall_power_limit,
+    _set_UserData_over_volt_low,
+    _set_UserData_over_volt_high,
+    _set_UserData_over_temperature,
+    _set_UserData_over_power,
+    _set_UserData_over_current,
+    _set_UserData_accel_switch,
+    _set_UserData_reserved_45,
+    _set_UserData_po_lock_switch,
+    _set_UserData_wb_lock_switch,
+    _set_UserData_angle_limit_switch,
+    _set_UserData_soft_start_switch,
+    _set_UserData_soft_start_time,
+    _set_UserData_angle_limit_high,
+    _set_UserData_angle_limit_low,
+    _set_UserData_angle_mid_offset,
+) = slot_setters(UserData)
+_set_WriteBatchDataRequest_servo_id, _set_WriteBatchDataRequest_user_data = slot_setters(WriteBatchDataRequest)
+_set_WriteBatchDataResponse_servo_id, _set_WriteBatchDataResponse_result = slot_setters(WriteBatchDataResponse)
+_set_WriteDataRequest_servo_id, _set_WriteDataRequest_data_id, _set_WriteDataRequest_data = slot_setters(WriteDataRequest)
+_set_WriteDataResponse_servo_id, _set_WriteDataResponse_data_id, _set_WriteDataResponse_result = slot_setters(WriteDataResponse)
+_MEMBERS_BaudrateOption = members(BaudrateOption)
+_MEMBERS_LockOnPowerOn = members(LockOnPowerOn)
+_MEMBERS_ResponseSwitch = members(ResponseSwitch)
+_MEMBERS_Result = members(Result)
+_MEMBERS_SpinDirection = members(SpinDirection)
+_MEMBERS_SpinMode = members(SpinMode)
+_MEMBERS_StallProtectMode = members(StallProtectMode)
+_MEMBERS_Switch = members(Switch)
+_MEMBERS_WheelBrake = members(WheelBrake)
 
 
 def _decode_ping_request(buf: bytes, o: int, end: int) -> PingRequest:
     if end - o != 1:
         raise content_size_error('ping request', end - o, 1, 1)
     v_servo_id, = _S_U8.unpack_from(buf, o)
-    o += 1
-    if o != end:
-        raise DecodeError('ping request' + f': {end - o} bytes left after the last field')
-    return PingRequest(v_servo_id)
+    m = _new(PingRequest)
+    _set_PingRequest_servo_id(m, v_servo_id)
+    return m
 
 
 def _decode_ping_response(buf: bytes, o: int, end: int) -> PingResponse:
     if end - o != 1:
         raise content_size_error('ping response', end - o, 1, 1)
     v_servo_id, = _S_U8.unpack_from(buf, o)
-    o += 1
-    if o != end:
-        raise DecodeError('ping response' + f': {end - o} bytes left after the last field')
-    return PingResponse(v_servo_id)
+    m = _new(PingResponse)
+    _set_PingResponse_servo_id(m, v_servo_id)
+    return m
 
 
 def _decode_reset_user_data_request(buf: bytes, o: int, end: int) -> ResetUserDataRequest:
     if end - o != 1:
         raise content_size_error('reset_user_data request', end - o, 1, 1)
     v_servo_id, = _S_U8.unpack_from(buf, o)
-    o += 1
-    if o != end:
-        raise DecodeError('reset_user_data request' + f': {end - o} bytes left after the last field')
-    return ResetUserDataRequest(v_servo_id)
+    m = _new(ResetUserDataRequest)
+    _set_ResetUserDataRequest_servo_id(m, v_servo_id)
+    return m
 
 
 def _decode_reset_user_data_response(buf: bytes, o: int, end: int) -> ResetUserDataResponse:
     if end - o != 2:
         raise content_size_error('reset_user_data response', end - o, 2, 2)
     v_servo_id, v_result = _S_U8_U8.unpack_from(buf, o)
-    o += 2
-    if o != end:
-        raise DecodeError('reset_user_data response' + f': {end - o} bytes left after the last field')
-    return ResetUserDataResponse(v_servo_id, _enum(Result, v_result))
+    m = _new(ResetUserDataResponse)
+    _set_ResetUserDataResponse_servo_id(m, v_servo_id)
+    _set_ResetUserDataResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
+    return m
 
 
 def _decode_read_data_request(buf: bytes, o: int, end: int) -> ReadDataRequest:
     if end - o != 2:
         raise content_size_error('read_data request', end - o, 2, 2)
     v_servo_id, v_data_id = _S_U8_U8.unpack_from(buf, o)
-    o += 2
-    if o != end:
-        raise DecodeError('read_data request' + f': {end - o} bytes left after the last field')
-    return ReadDataRequest(v_servo_id, v_data_id)
+    m = _new(ReadDataRequest)
+    _set_ReadDataRequest_servo_id(m, v_servo_id)
+    _set_ReadDataRequest_data_id(m, v_data_id)
+    return m
 
 
 def _decode_read_data_response(buf: bytes, o: int, end: int) -> ReadDataResponse:
@@ -198,7 +254,11 @@ def _decode_read_data_response(buf: bytes, o: int, end: int) -> ReadDataResponse
     o += s.size
     if o != end:
         raise DecodeError('read_data response' + f': {end - o} bytes left after the last field')
-    return ReadDataResponse(v_servo_id, v_data_id, v_data)
+    m = _new(ReadDataResponse)
+    _set_ReadDataResponse_servo_id(m, v_servo_id)
+    _set_ReadDataResponse_data_id(m, v_data_id)
+    _set_ReadDataResponse_data(m, v_data)
+    return m
 
 
 def _decode_write_data_request(buf: bytes, o: int, end: int) -> WriteDataRequest:
@@ -215,27 +275,31 @@ def _decode_write_data_request(buf: bytes, o: int, end: int) -> WriteDataRequest
     o += s.size
     if o != end:
         raise DecodeError('write_data request' + f': {end - o} bytes left after the last field')
-    return WriteDataRequest(v_servo_id, v_data_id, v_data)
+    m = _new(WriteDataRequest)
+    _set_WriteDataRequest_servo_id(m, v_servo_id)
+    _set_WriteDataRequest_data_id(m, v_data_id)
+    _set_WriteDataRequest_data(m, v_data)
+    return m
 
 
 def _decode_write_data_response(buf: bytes, o: int, end: int) -> WriteDataResponse:
     if end - o != 3:
         raise content_size_error('write_data response', end - o, 3, 3)
     v_servo_id, v_data_id, v_result = _S_U8_U8_U8.unpack_from(buf, o)
-    o += 3
-    if o != end:
-        raise DecodeError('write_data response' + f': {end - o} bytes left after the last field')
-    return WriteDataResponse(v_servo_id, v_data_id, _enum(Result, v_result))
+    m = _new(WriteDataResponse)
+    _set_WriteDataResponse_servo_id(m, v_servo_id)
+    _set_WriteDataResponse_data_id(m, v_data_id)
+    _set_WriteDataResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
+    return m
 
 
 def _decode_read_batch_data_request(buf: bytes, o: int, end: int) -> ReadBatchDataRequest:
     if end - o != 1:
         raise content_size_error('read_batch_data request', end - o, 1, 1)
     v_servo_id, = _S_U8.unpack_from(buf, o)
-    o += 1
-    if o != end:
-        raise DecodeError('read_batch_data request' + f': {end - o} bytes left after the last field')
-    return ReadBatchDataRequest(v_servo_id)
+    m = _new(ReadBatchDataRequest)
+    _set_ReadBatchDataRequest_servo_id(m, v_servo_id)
+    return m
 
 
 def _decode_read_batch_data_response(buf: bytes, o: int, end: int) -> ReadBatchDataResponse:
@@ -243,10 +307,33 @@ def _decode_read_batch_data_response(buf: bytes, o: int, end: int) -> ReadBatchD
         raise content_size_error('read_batch_data response', end - o, 33, 33)
     t = _S_READBATCHDATARESPONSE_SERVO_ID.unpack_from(buf, o)
     v_servo_id = t[0]
-    o += 33
-    if o != end:
-        raise DecodeError('read_batch_data response' + f': {end - o} bytes left after the last field')
-    return ReadBatchDataResponse(v_servo_id, UserData(t[1], _enum(ResponseSwitch, t[2]), t[3], t[4], _enum(BaudrateOption, t[5]), _enum(StallProtectMode, t[6]), t[7], t[8], t[9], t[10], t[11], t[12], _enum(Switch, t[13]), t[14], _enum(LockOnPowerOn, t[15]), _enum(WheelBrake, t[16]), _enum(Switch, t[17]), _enum(Switch, t[18]), t[19], t[20], t[21], t[22]))
+    v_user_data = _new(UserData)
+    _set_UserData_reserved_32(v_user_data, t[1])
+    _set_UserData_response_switch(v_user_data, _MEMBERS_ResponseSwitch.get(t[2], t[2]))
+    _set_UserData_servo_id(v_user_data, t[3])
+    _set_UserData_reserved_35(v_user_data, t[4])
+    _set_UserData_baudrate(v_user_data, _MEMBERS_BaudrateOption.get(t[5], t[5]))
+    _set_UserData_stall_protect_mode(v_user_data, _MEMBERS_StallProtectMode.get(t[6], t[6]))
+    _set_UserData_stall_power_limit(v_user_data, t[7])
+    _set_UserData_over_volt_low(v_user_data, t[8])
+    _set_UserData_over_volt_high(v_user_data, t[9])
+    _set_UserData_over_temperature(v_user_data, t[10])
+    _set_UserData_over_power(v_user_data, t[11])
+    _set_UserData_over_current(v_user_data, t[12])
+    _set_UserData_accel_switch(v_user_data, _MEMBERS_Switch.get(t[13], t[13]))
+    _set_UserData_reserved_45(v_user_data, t[14])
+    _set_UserData_po_lock_switch(v_user_data, _MEMBERS_LockOnPowerOn.get(t[15], t[15]))
+    _set_UserData_wb_lock_switch(v_user_data, _MEMBERS_WheelBrake.get(t[16], t[16]))
+    _set_UserData_angle_limit_switch(v_user_data, _MEMBERS_Switch.get(t[17], t[17]))
+    _set_UserData_soft_start_switch(v_user_data, _MEMBERS_Switch.get(t[18], t[18]))
+    _set_UserData_soft_start_time(v_user_data, t[19])
+    _set_UserData_angle_limit_high(v_user_data, t[20])
+    _set_UserData_angle_limit_low(v_user_data, t[21])
+    _set_UserData_angle_mid_offset(v_user_data, t[22])
+    m = _new(ReadBatchDataResponse)
+    _set_ReadBatchDataResponse_servo_id(m, v_servo_id)
+    _set_ReadBatchDataResponse_user_data(m, v_user_data)
+    return m
 
 
 def _decode_write_batch_data_request(buf: bytes, o: int, end: int) -> WriteBatchDataRequest:
@@ -254,120 +341,154 @@ def _decode_write_batch_data_request(buf: bytes, o: int, end: int) -> WriteBatch
         raise content_size_error('write_batch_data request', end - o, 33, 33)
     t = _S_READBATCHDATARESPONSE_SERVO_ID.unpack_from(buf, o)
     v_servo_id = t[0]
-    o += 33
-    if o != end:
-        raise DecodeError('write_batch_data request' + f': {end - o} bytes left after the last field')
-    return WriteBatchDataRequest(v_servo_id, UserData(t[1], _enum(ResponseSwitch, t[2]), t[3], t[4], _enum(BaudrateOption, t[5]), _enum(StallProtectMode, t[6]), t[7], t[8], t[9], t[10], t[11], t[12], _enum(Switch, t[13]), t[14], _enum(LockOnPowerOn, t[15]), _enum(WheelBrake, t[16]), _enum(Switch, t[17]), _enum(Switch, t[18]), t[19], t[20], t[21], t[22]))
+    v_user_data = _new(UserData)
+    _set_UserData_reserved_32(v_user_data, t[1])
+    _set_UserData_response_switch(v_user_data, _MEMBERS_ResponseSwitch.get(t[2], t[2]))
+    _set_UserData_servo_id(v_user_data, t[3])
+    _set_UserData_reserved_35(v_user_data, t[4])
+    _set_UserData_baudrate(v_user_data, _MEMBERS_BaudrateOption.get(t[5], t[5]))
+    _set_UserData_stall_protect_mode(v_user_data, _MEMBERS_StallProtectMode.get(t[6], t[6]))
+    _set_UserData_stall_power_limit(v_user_data, t[7])
+    _set_UserData_over_volt_low(v_user_data, t[8])
+    _set_UserData_over_volt_high(v_user_data, t[9])
+    _set_UserData_over_temperature(v_user_data, t[10])
+    _set_UserData_over_power(v_user_data, t[11])
+    _set_UserData_over_current(v_user_data, t[12])
+    _set_UserData_accel_switch(v_user_data, _MEMBERS_Switch.get(t[13], t[13]))
+    _set_UserData_reserved_45(v_user_data, t[14])
+    _set_UserData_po_lock_switch(v_user_data, _MEMBERS_LockOnPowerOn.get(t[15], t[15]))
+    _set_UserData_wb_lock_switch(v_user_data, _MEMBERS_WheelBrake.get(t[16], t[16]))
+    _set_UserData_angle_limit_switch(v_user_data, _MEMBERS_Switch.get(t[17], t[17]))
+    _set_UserData_soft_start_switch(v_user_data, _MEMBERS_Switch.get(t[18], t[18]))
+    _set_UserData_soft_start_time(v_user_data, t[19])
+    _set_UserData_angle_limit_high(v_user_data, t[20])
+    _set_UserData_angle_limit_low(v_user_data, t[21])
+    _set_UserData_angle_mid_offset(v_user_data, t[22])
+    m = _new(WriteBatchDataRequest)
+    _set_WriteBatchDataRequest_servo_id(m, v_servo_id)
+    _set_WriteBatchDataRequest_user_data(m, v_user_data)
+    return m
 
 
 def _decode_write_batch_data_response(buf: bytes, o: int, end: int) -> WriteBatchDataResponse:
     if end - o != 2:
         raise content_size_error('write_batch_data response', end - o, 2, 2)
     v_servo_id, v_result = _S_U8_U8.unpack_from(buf, o)
-    o += 2
-    if o != end:
-        raise DecodeError('write_batch_data response' + f': {end - o} bytes left after the last field')
-    return WriteBatchDataResponse(v_servo_id, _enum(Result, v_result))
+    m = _new(WriteBatchDataResponse)
+    _set_WriteBatchDataResponse_servo_id(m, v_servo_id)
+    _set_WriteBatchDataResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
+    return m
 
 
 def _decode_spin_request(buf: bytes, o: int, end: int) -> SpinRequest:
     if end - o != 6:
         raise content_size_error('spin request', end - o, 6, 6)
     v_servo_id, v_method, v_speed, v_value = _S_U8_U8_U16_U16.unpack_from(buf, o)
+    v_method_direction = (v_method >> 7) & 0x1
+    v_method_mode = v_method & 0x3
     if v_method & 0x7c:
         raise DecodeError('spin request' + f': unused bits of method are set ({v_method:#04x})')
-    o += 6
-    if o != end:
-        raise DecodeError('spin request' + f': {end - o} bytes left after the last field')
-    return SpinRequest(v_servo_id, MethodBits(_enum(SpinDirection, (v_method >> 7) & 0x1), _enum(SpinMode, v_method & 0x3)), v_speed, v_value)
+    v_method_bits = _new(MethodBits)
+    _set_MethodBits_direction(v_method_bits, _MEMBERS_SpinDirection.get(v_method_direction, v_method_direction))
+    _set_MethodBits_mode(v_method_bits, _MEMBERS_SpinMode.get(v_method_mode, v_method_mode))
+    m = _new(SpinRequest)
+    _set_SpinRequest_servo_id(m, v_servo_id)
+    _set_SpinRequest_method(m, v_method_bits)
+    _set_SpinRequest_speed(m, v_speed)
+    _set_SpinRequest_value(m, v_value)
+    return m
 
 
 def _decode_spin_response(buf: bytes, o: int, end: int) -> SpinResponse:
     if end - o != 2:
         raise content_size_error('spin response', end - o, 2, 2)
     v_servo_id, v_result = _S_U8_U8.unpack_from(buf, o)
-    o += 2
-    if o != end:
-        raise DecodeError('spin response' + f': {end - o} bytes left after the last field')
-    return SpinResponse(v_servo_id, _enum(Result, v_result))
+    m = _new(SpinResponse)
+    _set_SpinResponse_servo_id(m, v_servo_id)
+    _set_SpinResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
+    return m
 
 
 def _decode_rotate_request(buf: bytes, o: int, end: int) -> RotateRequest:
     if end - o != 7:
         raise content_size_error('rotate request', end - o, 7, 7)
     v_servo_id, v_angle, v_interval, v_power = _S_U8_I16_U16_U16.unpack_from(buf, o)
-    o += 7
-    if o != end:
-        raise DecodeError('rotate request' + f': {end - o} bytes left after the last field')
-    return RotateRequest(v_servo_id, v_angle, v_interval, v_power)
+    m = _new(RotateRequest)
+    _set_RotateRequest_servo_id(m, v_servo_id)
+    _set_RotateRequest_angle(m, v_angle)
+    _set_RotateRequest_interval(m, v_interval)
+    _set_RotateRequest_power(m, v_power)
+    return m
 
 
 def _decode_rotate_response(buf: bytes, o: int, end: int) -> RotateResponse:
     if end - o != 2:
         raise content_size_error('rotate response', end - o, 2, 2)
     v_servo_id, v_result = _S_U8_U8.unpack_from(buf, o)
-    o += 2
-    if o != end:
-        raise DecodeError('rotate response' + f': {end - o} bytes left after the last field')
-    return RotateResponse(v_servo_id, _enum(Result, v_result))
+    m = _new(RotateResponse)
+    _set_RotateResponse_servo_id(m, v_servo_id)
+    _set_RotateResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
+    return m
 
 
 def _decode_damping_request(buf: bytes, o: int, end: int) -> DampingRequest:
     if end - o != 3:
         raise content_size_error('damping request', end - o, 3, 3)
     v_servo_id, v_power = _S_U8_U16.unpack_from(buf, o)
-    o += 3
-    if o != end:
-        raise DecodeError('damping request' + f': {end - o} bytes left after the last field')
-    return DampingRequest(v_servo_id, v_power)
+    m = _new(DampingRequest)
+    _set_DampingRequest_servo_id(m, v_servo_id)
+    _set_DampingRequest_power(m, v_power)
+    return m
 
 
 def _decode_damping_response(buf: bytes, o: int, end: int) -> DampingResponse:
     if end - o != 2:
         raise content_size_error('damping response', end - o, 2, 2)
     v_servo_id, v_result = _S_U8_U8.unpack_from(buf, o)
-    o += 2
-    if o != end:
-        raise DecodeError('damping response' + f': {end - o} bytes left after the last field')
-    return DampingResponse(v_servo_id, _enum(Result, v_result))
+    m = _new(DampingResponse)
+    _set_DampingResponse_servo_id(m, v_servo_id)
+    _set_DampingResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
+    return m
 
 
 def _decode_read_angle_request(buf: bytes, o: int, end: int) -> ReadAngleRequest:
     if end - o != 1:
         raise content_size_error('read_angle request', end - o, 1, 1)
     v_servo_id, = _S_U8.unpack_from(buf, o)
-    o += 1
-    if o != end:
-        raise DecodeError('read_angle request' + f': {end - o} bytes left after the last field')
-    return ReadAngleRequest(v_servo_id)
+    m = _new(ReadAngleRequest)
+    _set_ReadAngleRequest_servo_id(m, v_servo_id)
+    return m
 
 
 def _decode_read_angle_response(buf: bytes, o: int, end: int) -> ReadAngleResponse:
     if end - o != 3:
         raise content_size_error('read_angle response', end - o, 3, 3)
     v_servo_id, v_angle = _S_U8_I16.unpack_from(buf, o)
-    o += 3
-    if o != end:
-        raise DecodeError('read_angle response' + f': {end - o} bytes left after the last field')
-    return ReadAngleResponse(v_servo_id, v_angle)
+    m = _new(ReadAngleResponse)
+    _set_ReadAngleResponse_servo_id(m, v_servo_id)
+    _set_ReadAngleResponse_angle(m, v_angle)
+    return m
 
 
 def _encode_ping_request(m: PingRequest) -> bytes:
     if not 0 <= m.servo_id <= 254:
         raise out_of_range('ping request', 'servo_id', m.servo_id, 0, 254)
-    return _frame_request(1, _S_U8.pack(m.servo_id))
+    body = _S_B2_U8_U8_U8.pack(b'\x12L', 1, 1, m.servo_id)
+    return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_ping_response(m: PingResponse) -> bytes:
     if not 0 <= m.servo_id <= 254:
         raise out_of_range('ping response', 'servo_id', m.servo_id, 0, 254)
-    return _frame_response(1, _S_U8.pack(m.servo_id))
+    body = _S_B2_U8_U8_U8.pack(b'\x05\x1c', 1, 1, m.servo_id)
+    return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_reset_user_data_request(m: ResetUserDataRequest) -> bytes:
     if not 0 <= m.servo_id <= 254:
         raise out_of_range('reset_user_data request', 'servo_id', m.servo_id, 0, 254)
-    return _frame_request(2, _S_U8.pack(m.servo_id))
+    body = _S_B2_U8_U8_U8.pack(b'\x12L', 2, 1, m.servo_id)
+    return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_reset_user_data_response(m: ResetUserDataResponse) -> bytes:
@@ -375,7 +496,8 @@ def _encode_reset_user_data_response(m: ResetUserDataResponse) -> bytes:
         raise out_of_range('reset_user_data response', 'servo_id', m.servo_id, 0, 254)
     if not 0 <= m.result <= 255:
         raise out_of_range('reset_user_data response', 'result', m.result, 0, 255)
-    return _frame_response(2, _S_U8_U8.pack(m.servo_id, m.result))
+    body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 2, 2, m.servo_id, m.result)
+    return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_read_data_request(m: ReadDataRequest) -> bytes:
@@ -383,7 +505,8 @@ def _encode_read_data_request(m: ReadDataRequest) -> bytes:
         raise out_of_range('read_data request', 'servo_id', m.servo_id, 0, 254)
     if not 0 <= m.data_id <= 255:
         raise out_of_range('read_data request', 'data_id', m.data_id, 0, 255)
-    return _frame_request(3, _S_U8_U8.pack(m.servo_id, m.data_id))
+    body = _S_B2_U8_U8_U8_U8.pack(b'\x12L', 3, 2, m.servo_id, m.data_id)
+    return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_read_data_response(m: ReadDataResponse) -> bytes:
@@ -397,7 +520,12 @@ def _encode_read_data_response(m: ReadDataResponse) -> bytes:
     low, high = _TABLE_PARAMETERS_RANGES[m.data_id]
     if not low <= m.data <= high:
         raise out_of_range('read_data response', 'data', m.data, low, high)
-    return _frame_response(3, b''.join((_S_U8_U8.pack(m.servo_id, m.data_id), s.pack(m.data),)))
+    content = b''.join((_S_U8_U8.pack(m.servo_id, m.data_id), s.pack(m.data),))
+    n = len(content)
+    if n > 255:
+        raise EncodeError(f'content of {len(content)} bytes does not fit the length field')
+    body = _S_B2_U8_U8.pack(b'\x05\x1c', 3, n) + content
+    return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_write_data_request(m: WriteDataRequest) -> bytes:
@@ -411,7 +539,12 @@ def _encode_write_data_request(m: WriteDataRequest) -> bytes:
     low, high = _TABLE_PARAMETERS_RANGES[m.data_id]
     if not low <= m.data <= high:
         raise out_of_range('write_data request', 'data', m.data, low, high)
-    return _frame_request(4, b''.join((_S_U8_U8.pack(m.servo_id, m.data_id), s.pack(m.data),)))
+    content = b''.join((_S_U8_U8.pack(m.servo_id, m.data_id), s.pack(m.data),))
+    n = len(content)
+    if n > 255:
+        raise EncodeError(f'content of {len(content)} bytes does not fit the length field')
+    body = _S_B2_U8_U8.pack(b'\x12L', 4, n) + content
+    return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_write_data_response(m: WriteDataResponse) -> bytes:
@@ -421,13 +554,15 @@ def _encode_write_data_response(m: WriteDataResponse) -> bytes:
         raise out_of_range('write_data response', 'data_id', m.data_id, 0, 255)
     if not 0 <= m.result <= 255:
         raise out_of_range('write_data response', 'result', m.result, 0, 255)
-    return _frame_response(4, _S_U8_U8_U8.pack(m.servo_id, m.data_id, m.result))
+    body = _S_B2_U8_U8_U8_U8_U8.pack(b'\x05\x1c', 4, 3, m.servo_id, m.data_id, m.result)
+    return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_read_batch_data_request(m: ReadBatchDataRequest) -> bytes:
     if not 0 <= m.servo_id <= 254:
         raise out_of_range('read_batch_data request', 'servo_id', m.servo_id, 0, 254)
-    return _frame_request(5, _S_U8.pack(m.servo_id))
+    body = _S_B2_U8_U8_U8.pack(b'\x12L', 5, 1, m.servo_id)
+    return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_read_batch_data_response(m: ReadBatchDataResponse) -> bytes:
@@ -477,7 +612,8 @@ def _encode_read_batch_data_response(m: ReadBatchDataResponse) -> bytes:
         raise out_of_range('read_batch_data response', 'user_data.angle_limit_low', m.user_data.angle_limit_low, -32768, 32767)
     if not -32768 <= m.user_data.angle_mid_offset <= 32767:
         raise out_of_range('read_batch_data response', 'user_data.angle_mid_offset', m.user_data.angle_mid_offset, -32768, 32767)
-    return _frame_response(5, _S_READBATCHDATARESPONSE_SERVO_ID.pack(m.servo_id, m.user_data.reserved_32, m.user_data.response_switch, m.user_data.servo_id, m.user_data.reserved_35, m.user_data.baudrate, m.user_data.stall_protect_mode, m.user_data.stall_power_limit, m.user_data.over_volt_low, m.user_data.over_volt_high, m.user_data.over_temperature, m.user_data.over_power, m.user_data.over_current, m.user_data.accel_switch, m.user_data.reserved_45, m.user_data.po_lock_switch, m.user_data.wb_lock_switch, m.user_data.angle_limit_switch, m.user_data.soft_start_switch, m.user_data.soft_start_time, m.user_data.angle_limit_high, m.user_data.angle_limit_low, m.user_data.angle_mid_offset))
+    body = _S_FRAME_READBATCHDATARESPONSE.pack(b'\x05\x1c', 5, 33, m.servo_id, m.user_data.reserved_32, m.user_data.response_switch, m.user_data.servo_id, m.user_data.reserved_35, m.user_data.baudrate, m.user_data.stall_protect_mode, m.user_data.stall_power_limit, m.user_data.over_volt_low, m.user_data.over_volt_high, m.user_data.over_temperature, m.user_data.over_power, m.user_data.over_current, m.user_data.accel_switch, m.user_data.reserved_45, m.user_data.po_lock_switch, m.user_data.wb_lock_switch, m.user_data.angle_limit_switch, m.user_data.soft_start_switch, m.user_data.soft_start_time, m.user_data.angle_limit_high, m.user_data.angle_limit_low, m.user_data.angle_mid_offset)
+    return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_write_batch_data_request(m: WriteBatchDataRequest) -> bytes:
@@ -527,7 +663,8 @@ def _encode_write_batch_data_request(m: WriteBatchDataRequest) -> bytes:
         raise out_of_range('write_batch_data request', 'user_data.angle_limit_low', m.user_data.angle_limit_low, -32768, 32767)
     if not -32768 <= m.user_data.angle_mid_offset <= 32767:
         raise out_of_range('write_batch_data request', 'user_data.angle_mid_offset', m.user_data.angle_mid_offset, -32768, 32767)
-    return _frame_request(6, _S_READBATCHDATARESPONSE_SERVO_ID.pack(m.servo_id, m.user_data.reserved_32, m.user_data.response_switch, m.user_data.servo_id, m.user_data.reserved_35, m.user_data.baudrate, m.user_data.stall_protect_mode, m.user_data.stall_power_limit, m.user_data.over_volt_low, m.user_data.over_volt_high, m.user_data.over_temperature, m.user_data.over_power, m.user_data.over_current, m.user_data.accel_switch, m.user_data.reserved_45, m.user_data.po_lock_switch, m.user_data.wb_lock_switch, m.user_data.angle_limit_switch, m.user_data.soft_start_switch, m.user_data.soft_start_time, m.user_data.angle_limit_high, m.user_data.angle_limit_low, m.user_data.angle_mid_offset))
+    body = _S_FRAME_READBATCHDATARESPONSE.pack(b'\x12L', 6, 33, m.servo_id, m.user_data.reserved_32, m.user_data.response_switch, m.user_data.servo_id, m.user_data.reserved_35, m.user_data.baudrate, m.user_data.stall_protect_mode, m.user_data.stall_power_limit, m.user_data.over_volt_low, m.user_data.over_volt_high, m.user_data.over_temperature, m.user_data.over_power, m.user_data.over_current, m.user_data.accel_switch, m.user_data.reserved_45, m.user_data.po_lock_switch, m.user_data.wb_lock_switch, m.user_data.angle_limit_switch, m.user_data.soft_start_switch, m.user_data.soft_start_time, m.user_data.angle_limit_high, m.user_data.angle_limit_low, m.user_data.angle_mid_offset)
+    return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_write_batch_data_response(m: WriteBatchDataResponse) -> bytes:
@@ -535,7 +672,8 @@ def _encode_write_batch_data_response(m: WriteBatchDataResponse) -> bytes:
         raise out_of_range('write_batch_data response', 'servo_id', m.servo_id, 0, 254)
     if not 0 <= m.result <= 255:
         raise out_of_range('write_batch_data response', 'result', m.result, 0, 255)
-    return _frame_response(6, _S_U8_U8.pack(m.servo_id, m.result))
+    body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 6, 2, m.servo_id, m.result)
+    return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_spin_request(m: SpinRequest) -> bytes:
@@ -549,7 +687,8 @@ def _encode_spin_request(m: SpinRequest) -> bytes:
         raise out_of_range('spin request', 'speed', m.speed, 0, 65535)
     if not 0 <= m.value <= 65535:
         raise out_of_range('spin request', 'value', m.value, 0, 65535)
-    return _frame_request(7, _S_U8_U8_U16_U16.pack(m.servo_id, (m.method.direction << 7) | m.method.mode, m.speed, m.value))
+    body = _S_FRAME_SPINREQUEST.pack(b'\x12L', 7, 6, m.servo_id, (m.method.direction << 7) | m.method.mode, m.speed, m.value)
+    return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_spin_response(m: SpinResponse) -> bytes:
@@ -557,7 +696,8 @@ def _encode_spin_response(m: SpinResponse) -> bytes:
         raise out_of_range('spin response', 'servo_id', m.servo_id, 0, 254)
     if not 0 <= m.result <= 255:
         raise out_of_range('spin response', 'result', m.result, 0, 255)
-    return _frame_response(7, _S_U8_U8.pack(m.servo_id, m.result))
+    body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 7, 2, m.servo_id, m.result)
+    return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_rotate_request(m: RotateRequest) -> bytes:
@@ -569,7 +709,8 @@ def _encode_rotate_request(m: RotateRequest) -> bytes:
         raise out_of_range('rotate request', 'interval', m.interval, 0, 65535)
     if not 0 <= m.power <= 65535:
         raise out_of_range('rotate request', 'power', m.power, 0, 65535)
-    return _frame_request(8, _S_U8_I16_U16_U16.pack(m.servo_id, m.angle, m.interval, m.power))
+    body = _S_FRAME_ROTATEREQUEST.pack(b'\x12L', 8, 7, m.servo_id, m.angle, m.interval, m.power)
+    return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_rotate_response(m: RotateResponse) -> bytes:
@@ -577,7 +718,8 @@ def _encode_rotate_response(m: RotateResponse) -> bytes:
         raise out_of_range('rotate response', 'servo_id', m.servo_id, 0, 254)
     if not 0 <= m.result <= 255:
         raise out_of_range('rotate response', 'result', m.result, 0, 255)
-    return _frame_response(8, _S_U8_U8.pack(m.servo_id, m.result))
+    body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 8, 2, m.servo_id, m.result)
+    return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_damping_request(m: DampingRequest) -> bytes:
@@ -585,7 +727,8 @@ def _encode_damping_request(m: DampingRequest) -> bytes:
         raise out_of_range('damping request', 'servo_id', m.servo_id, 0, 255)
     if not 0 <= m.power <= 65535:
         raise out_of_range('damping request', 'power', m.power, 0, 65535)
-    return _frame_request(9, _S_U8_U16.pack(m.servo_id, m.power))
+    body = _S_B2_U8_U8_U8_U16.pack(b'\x12L', 9, 3, m.servo_id, m.power)
+    return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_damping_response(m: DampingResponse) -> bytes:
@@ -593,13 +736,15 @@ def _encode_damping_response(m: DampingResponse) -> bytes:
         raise out_of_range('damping response', 'servo_id', m.servo_id, 0, 254)
     if not 0 <= m.result <= 255:
         raise out_of_range('damping response', 'result', m.result, 0, 255)
-    return _frame_response(9, _S_U8_U8.pack(m.servo_id, m.result))
+    body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 9, 2, m.servo_id, m.result)
+    return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_read_angle_request(m: ReadAngleRequest) -> bytes:
     if not 0 <= m.servo_id <= 254:
         raise out_of_range('read_angle request', 'servo_id', m.servo_id, 0, 254)
-    return _frame_request(10, _S_U8.pack(m.servo_id))
+    body = _S_B2_U8_U8_U8.pack(b'\x12L', 10, 1, m.servo_id)
+    return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_read_angle_response(m: ReadAngleResponse) -> bytes:
@@ -607,7 +752,8 @@ def _encode_read_angle_response(m: ReadAngleResponse) -> bytes:
         raise out_of_range('read_angle response', 'servo_id', m.servo_id, 0, 254)
     if not -32768 <= m.angle <= 32767:
         raise out_of_range('read_angle response', 'angle', m.angle, -32768, 32767)
-    return _frame_response(10, _S_U8_I16.pack(m.servo_id, m.angle))
+    body = _S_B2_U8_U8_U8_I16.pack(b'\x05\x1c', 10, 3, m.servo_id, m.angle)
+    return body + _BYTES[sum(body) & 0xff]
 
 
 _REQUEST_DECODERS: dict[int | None, Callable[..., Message]] = {
@@ -636,26 +782,33 @@ _REQUEST_SIZES: dict[int | None, tuple[int, int | None]] = {
 }
 
 
-def _checksum_ok_request(frame: bytes) -> bool:
-    return _checksum(frame[0:-1]) == int.from_bytes(frame[-1:], "little")
-
-
 def _decode_request(data: bytes) -> Message:
     n = len(data)
     if n < 5:
         raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (5 bytes)")
     if data[:2] != b'\x12L':
         raise DecodeError(f"request header is {data[:2].hex(' ')}, expected 12 4c")
-    size = data[3] - 0
-    if size < 0 or n != 5 + size:
+    size = data[3]
+    if n != 5 + size:
         raise DecodeError(f"length byte says {size} content bytes but the frame holds {n - 5}")
-    expected = _checksum(data[0:-1])
-    if expected != int.from_bytes(data[-1:], "little"):
+    expected = sum(data[:-1]) & 0xff
+    if expected != data[-1]:
         raise ChecksumError(f"bad checksum: the frame has {data[-1]:#04x}, its bytes give {expected:#04x}")
     decoder = _REQUEST_DECODERS.get(data[2])
     if decoder is None:
         raise DecodeError(f"unknown command {data[2]:#04x}")
     return decoder(data, 4, n - 1)
+
+
+def _decode_request_at(buf: bytes, start: int, stop: int) -> Message:
+    """The frame buf[start:stop], whose header and length byte the stream parser has checked."""
+    expected = sum(buf[start : stop - 1]) & 0xff
+    if expected != buf[stop - 1]:
+        raise ChecksumError(f"bad checksum: the frame has {buf[stop - 1]:#04x}, its bytes give {expected:#04x}")
+    decoder = _REQUEST_DECODERS.get(buf[start + 2])
+    if decoder is None:
+        raise DecodeError(f"unknown command {buf[start + 2]:#04x}")
+    return decoder(buf, start + 4, stop - 1)
 
 
 _RESPONSE_DECODERS: dict[int | None, Callable[..., Message]] = {
@@ -684,26 +837,34 @@ _RESPONSE_SIZES: dict[int | None, tuple[int, int | None]] = {
 }
 
 
-def _checksum_ok_response(frame: bytes) -> bool:
-    return _checksum(frame[0:-1]) == int.from_bytes(frame[-1:], "little")
-
-
 def _decode_response(data: bytes) -> Message:
     n = len(data)
     if n < 5:
         raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (5 bytes)")
     if data[:2] != b'\x05\x1c':
         raise DecodeError(f"response header is {data[:2].hex(' ')}, expected 05 1c")
-    size = data[3] - 0
-    if size < 0 or n != 5 + size:
+    size = data[3]
+    if n != 5 + size:
         raise DecodeError(f"length byte says {size} content bytes but the frame holds {n - 5}")
-    expected = _checksum(data[0:-1])
-    if expected != int.from_bytes(data[-1:], "little"):
+    expected = sum(data[:-1]) & 0xff
+    if expected != data[-1]:
         raise ChecksumError(f"bad checksum: the frame has {data[-1]:#04x}, its bytes give {expected:#04x}")
     decoder = _RESPONSE_DECODERS.get(data[2])
     if decoder is None:
         raise DecodeError(f"unknown command {data[2]:#04x}")
     return decoder(data, 4, n - 1)
+
+
+def _decode_response_at(buf: bytes, start: int, stop: int) -> Message:
+    """The frame buf[start:stop], whose header and length byte the stream parser has checked."""
+    expected = sum(buf[start : stop - 1]) & 0xff
+    if expected != buf[stop - 1]:
+        raise ChecksumError(f"bad checksum: the frame has {buf[stop - 1]:#04x}, its bytes give {expected:#04x}")
+    decoder = _RESPONSE_DECODERS.get(buf[start + 2])
+    if decoder is None:
+        raise DecodeError(f"unknown command {buf[start + 2]:#04x}")
+    return decoder(buf, start + 4, stop - 1)
+
 
 _ENCODERS: dict[type[Message], Callable[..., bytes]] = {
     PingRequest: _encode_ping_request,
@@ -735,8 +896,7 @@ REQUEST_FORMAT = FrameFormat(
     length_adds=0,
     command_offset=2,
     content_sizes=_REQUEST_SIZES,
-    checksum_ok=_checksum_ok_request,
-    decode=_decode_request,
+    decode_at=_decode_request_at,
 )
 RESPONSE_FORMAT = FrameFormat(
     header=b'\x05\x1c',
@@ -745,23 +905,22 @@ RESPONSE_FORMAT = FrameFormat(
     length_adds=0,
     command_offset=2,
     content_sizes=_RESPONSE_SIZES,
-    checksum_ok=_checksum_ok_response,
-    decode=_decode_response,
+    decode_at=_decode_response_at,
 )
 
 
 def decode(data: bytes, direction: Direction | str | None = None) -> Message:
     """Decode one complete frame into its message; raises DecodeError with a one-line reason."""
+    if direction == 'request':  # a Direction or its value
+        return _decode_request(data)
+    if direction == 'response':  # a Direction or its value
+        return _decode_response(data)
     if direction is None:
         if data[:2] == b'\x12L':
             return _decode_request(data)
         if data[:2] == b'\x05\x1c':
             return _decode_response(data)
         raise DecodeError(f"header is {data[:2].hex(' ')}, expected 12 4c or 05 1c")
-    if direction == Direction.REQUEST:
-        return _decode_request(data)
-    if direction == Direction.RESPONSE:
-        return _decode_response(data)
     raise ValueError(f"direction must be request or response, not {direction!r}")
 
 

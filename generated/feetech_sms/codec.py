@@ -6,9 +6,9 @@ from __future__ import annotations
 import struct
 from collections.abc import Callable
 
-from serialspec.runtime.checksums import sum_function
+from serialspec.runtime.checksums import BYTE_VALUES as _BYTES
 from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError, content_size_error, out_of_range
-from serialspec.runtime.message import Direction, Message
+from serialspec.runtime.message import Direction, Message, members, slot_setters
 from serialspec.runtime.stream import FrameFormat
 from serialspec.runtime.stream import StreamParser as _StreamParser
 
@@ -29,43 +29,50 @@ from feetech_sms.messages import (
 
 __all__ = ["StreamParser", "decode", "encode"]
 
+_S_B2_U8_U8_U8 = struct.Struct('<2sBBB')
+_S_B2_U8_U8_U8_U8_U8 = struct.Struct('<2sBBBBB')
 _S_U8 = struct.Struct('<B')
 _S_U8_U8 = struct.Struct('<BB')
-_checksum: Callable[[bytes], int] = sum_function(8, invert=True)
 
-
-def _frame_request(code: int, id: int, content: bytes) -> bytes:
-    n = len(content) + 2
-    if n > 255:
-        raise EncodeError(f'content of {len(content)} bytes does not fit the length field')
-    body = b''.join((b'\xff\xff', bytes((id,)), bytes((n,)), bytes((code,)), content,))
-    return body + _checksum(body[2:]).to_bytes(1, 'little')
-
-
-def _frame_response(code: int, id: int, error: int, content: bytes) -> bytes:
-    n = len(content) + 2
-    if n > 255:
-        raise EncodeError(f'content of {len(content)} bytes does not fit the length field')
-    body = b''.join((b'\xff\xff', bytes((id,)), bytes((n,)), bytes((error,)), content,))
-    return body + _checksum(body[2:]).to_bytes(1, 'little')
+# Decoders build messages with object.__new__ and store each value straight into its slot: the dataclass __init__
+# of a frozen class goes through object.__setattr__ per field, which costs more than unpacking the whole frame.
+_new = object.__new__
+(_set_ActionRequest_id,) = slot_setters(ActionRequest)
+(_set_IdsItem_id,) = slot_setters(IdsItem)
+(_set_PingRequest_id,) = slot_setters(PingRequest)
+_set_ReadRequest_id, _set_ReadRequest_address, _set_ReadRequest_length = slot_setters(ReadRequest)
+_set_RegWriteRequest_id, _set_RegWriteRequest_address, _set_RegWriteRequest_data = slot_setters(RegWriteRequest)
+_set_ReplyResponse_id, _set_ReplyResponse_error, _set_ReplyResponse_data = slot_setters(ReplyResponse)
+(_set_ResetRequest_id,) = slot_setters(ResetRequest)
+_set_ServosItem_id, _set_ServosItem_data = slot_setters(ServosItem)
+(
+    _set_SyncReadRequest_id,
+    _set_SyncReadRequest_address,
+    _set_SyncReadRequest_length,
+    _set_SyncReadRequest_ids,
+) = slot_setters(SyncReadRequest)
+_set_SyncWriteRequest_id, _set_SyncWriteRequest_address, _set_SyncWriteRequest_servos = slot_setters(SyncWriteRequest)
+_set_WriteRequest_id, _set_WriteRequest_address, _set_WriteRequest_data = slot_setters(WriteRequest)
+_MEMBERS_ErrorStatus = members(ErrorStatus)
 
 
 def _decode_ping_request(buf: bytes, o: int, end: int, id: int) -> PingRequest:
     if end - o != 0:
         raise content_size_error('ping request', end - o, 0, 0)
-    if o != end:
-        raise DecodeError('ping request' + f': {end - o} bytes left after the last field')
-    return PingRequest(id)
+    m = _new(PingRequest)
+    _set_PingRequest_id(m, id)
+    return m
 
 
 def _decode_read_request(buf: bytes, o: int, end: int, id: int) -> ReadRequest:
     if end - o != 2:
         raise content_size_error('read request', end - o, 2, 2)
     v_address, v_length = _S_U8_U8.unpack_from(buf, o)
-    o += 2
-    if o != end:
-        raise DecodeError('read request' + f': {end - o} bytes left after the last field')
-    return ReadRequest(id, v_address, v_length)
+    m = _new(ReadRequest)
+    _set_ReadRequest_id(m, id)
+    _set_ReadRequest_address(m, v_address)
+    _set_ReadRequest_length(m, v_length)
+    return m
 
 
 def _decode_write_request(buf: bytes, o: int, end: int, id: int) -> WriteRequest:
@@ -74,10 +81,11 @@ def _decode_write_request(buf: bytes, o: int, end: int, id: int) -> WriteRequest
     v_address, = _S_U8.unpack_from(buf, o)
     o += 1
     v_data = buf[o:end]
-    o = end
-    if o != end:
-        raise DecodeError('write request' + f': {end - o} bytes left after the last field')
-    return WriteRequest(id, v_address, v_data)
+    m = _new(WriteRequest)
+    _set_WriteRequest_id(m, id)
+    _set_WriteRequest_address(m, v_address)
+    _set_WriteRequest_data(m, v_data)
+    return m
 
 
 def _decode_reg_write_request(buf: bytes, o: int, end: int, id: int) -> RegWriteRequest:
@@ -86,26 +94,27 @@ def _decode_reg_write_request(buf: bytes, o: int, end: int, id: int) -> RegWrite
     v_address, = _S_U8.unpack_from(buf, o)
     o += 1
     v_data = buf[o:end]
-    o = end
-    if o != end:
-        raise DecodeError('reg_write request' + f': {end - o} bytes left after the last field')
-    return RegWriteRequest(id, v_address, v_data)
+    m = _new(RegWriteRequest)
+    _set_RegWriteRequest_id(m, id)
+    _set_RegWriteRequest_address(m, v_address)
+    _set_RegWriteRequest_data(m, v_data)
+    return m
 
 
 def _decode_action_request(buf: bytes, o: int, end: int, id: int) -> ActionRequest:
     if end - o != 0:
         raise content_size_error('action request', end - o, 0, 0)
-    if o != end:
-        raise DecodeError('action request' + f': {end - o} bytes left after the last field')
-    return ActionRequest(id)
+    m = _new(ActionRequest)
+    _set_ActionRequest_id(m, id)
+    return m
 
 
 def _decode_reset_request(buf: bytes, o: int, end: int, id: int) -> ResetRequest:
     if end - o != 0:
         raise content_size_error('reset request', end - o, 0, 0)
-    if o != end:
-        raise DecodeError('reset request' + f': {end - o} bytes left after the last field')
-    return ResetRequest(id)
+    m = _new(ResetRequest)
+    _set_ResetRequest_id(m, id)
+    return m
 
 
 def _decode_sync_read_request(buf: bytes, o: int, end: int, id: int) -> SyncReadRequest:
@@ -113,14 +122,21 @@ def _decode_sync_read_request(buf: bytes, o: int, end: int, id: int) -> SyncRead
         raise content_size_error('sync_read request', end - o, 2, None)
     v_address, v_length = _S_U8_U8.unpack_from(buf, o)
     o += 2
+    v_ids_list = []
     if (end - o) % 1:
         raise DecodeError('sync_read request' + f': {end - o} bytes do not split into ids items of 1')
     n = end - o
-    v_ids = tuple(IdsItem(v_id) for v_id, in _S_U8.iter_unpack(buf[o : o + n]))
-    o += n
-    if o != end:
-        raise DecodeError('sync_read request' + f': {end - o} bytes left after the last field')
-    return SyncReadRequest(id, v_address, v_length, v_ids)
+    for v_id, in _S_U8.iter_unpack(buf[o : o + n]):
+        item = _new(IdsItem)
+        _set_IdsItem_id(item, v_id)
+        v_ids_list.append(item)
+    v_ids = tuple(v_ids_list)
+    m = _new(SyncReadRequest)
+    _set_SyncReadRequest_id(m, id)
+    _set_SyncReadRequest_address(m, v_address)
+    _set_SyncReadRequest_length(m, v_length)
+    _set_SyncReadRequest_ids(m, v_ids)
+    return m
 
 
 def _decode_sync_write_request(buf: bytes, o: int, end: int, id: int) -> SyncWriteRequest:
@@ -136,27 +152,37 @@ def _decode_sync_write_request(buf: bytes, o: int, end: int, id: int) -> SyncWri
             raise DecodeError('sync_write request' + f': data needs {v_data_length} bytes, {end - o} left')
         v_data = buf[o : o + v_data_length]
         o += v_data_length
-        v_servos_list.append(ServosItem(v_id, v_data))
+        item = _new(ServosItem)
+        _set_ServosItem_id(item, v_id)
+        _set_ServosItem_data(item, v_data)
+        v_servos_list.append(item)
     v_servos = tuple(v_servos_list)
     if o != end:
         raise DecodeError('sync_write request' + f': {end - o} bytes left after the last field')
-    return SyncWriteRequest(id, v_address, v_servos)
+    m = _new(SyncWriteRequest)
+    _set_SyncWriteRequest_id(m, id)
+    _set_SyncWriteRequest_address(m, v_address)
+    _set_SyncWriteRequest_servos(m, v_servos)
+    return m
 
 
 def _decode_reply_response(buf: bytes, o: int, end: int, id: int, error: int) -> ReplyResponse:
-    if end - o < 0:
-        raise content_size_error('reply response', end - o, 0, None)
     v_data = buf[o:end]
-    o = end
-    if o != end:
-        raise DecodeError('reply response' + f': {end - o} bytes left after the last field')
-    return ReplyResponse(id, ErrorStatus(error), v_data)
+    error_flags = _MEMBERS_ErrorStatus.get(error)
+    if error_flags is None:
+        error_flags = ErrorStatus(error)
+    m = _new(ReplyResponse)
+    _set_ReplyResponse_id(m, id)
+    _set_ReplyResponse_error(m, error_flags)
+    _set_ReplyResponse_data(m, v_data)
+    return m
 
 
 def _encode_ping_request(m: PingRequest) -> bytes:
     if not (0 <= m.id <= 253 or m.id == 254):
         raise out_of_range('ping request', 'id', m.id, 0, 253)
-    return _frame_request(1, m.id, b'')
+    body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m.id, 2, 1)
+    return body + _BYTES[~sum(body[2:]) & 0xff]
 
 
 def _encode_read_request(m: ReadRequest) -> bytes:
@@ -166,7 +192,8 @@ def _encode_read_request(m: ReadRequest) -> bytes:
         raise out_of_range('read request', 'address', m.address, 0, 255)
     if not 1 <= m.length <= 250:
         raise out_of_range('read request', 'length', m.length, 1, 250)
-    return _frame_request(2, m.id, _S_U8_U8.pack(m.address, m.length))
+    body = _S_B2_U8_U8_U8_U8_U8.pack(b'\xff\xff', m.id, 4, 2, m.address, m.length)
+    return body + _BYTES[~sum(body[2:]) & 0xff]
 
 
 def _encode_write_request(m: WriteRequest) -> bytes:
@@ -174,7 +201,12 @@ def _encode_write_request(m: WriteRequest) -> bytes:
         raise out_of_range('write request', 'id', m.id, 0, 253)
     if not 0 <= m.address <= 255:
         raise out_of_range('write request', 'address', m.address, 0, 255)
-    return _frame_request(3, m.id, b''.join((_S_U8.pack(m.address), bytes(m.data),)))
+    content = b''.join((_S_U8.pack(m.address), bytes(m.data),))
+    n = len(content) + 2
+    if n > 255:
+        raise EncodeError(f'content of {len(content)} bytes does not fit the length field')
+    body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m.id, n, 3) + content
+    return body + _BYTES[~sum(body[2:]) & 0xff]
 
 
 def _encode_reg_write_request(m: RegWriteRequest) -> bytes:
@@ -182,25 +214,26 @@ def _encode_reg_write_request(m: RegWriteRequest) -> bytes:
         raise out_of_range('reg_write request', 'id', m.id, 0, 253)
     if not 0 <= m.address <= 255:
         raise out_of_range('reg_write request', 'address', m.address, 0, 255)
-    return _frame_request(4, m.id, b''.join((_S_U8.pack(m.address), bytes(m.data),)))
+    content = b''.join((_S_U8.pack(m.address), bytes(m.data),))
+    n = len(content) + 2
+    if n > 255:
+        raise EncodeError(f'content of {len(content)} bytes does not fit the length field')
+    body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m.id, n, 4) + content
+    return body + _BYTES[~sum(body[2:]) & 0xff]
 
 
 def _encode_action_request(m: ActionRequest) -> bytes:
     if not (0 <= m.id <= 253 or m.id == 254):
         raise out_of_range('action request', 'id', m.id, 0, 253)
-    return _frame_request(5, m.id, b'')
+    body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m.id, 2, 5)
+    return body + _BYTES[~sum(body[2:]) & 0xff]
 
 
 def _encode_reset_request(m: ResetRequest) -> bytes:
     if not (0 <= m.id <= 253 or m.id == 254):
         raise out_of_range('reset request', 'id', m.id, 0, 253)
-    return _frame_request(6, m.id, b'')
-
-
-def _encode_IdsItem(m: IdsItem) -> bytes:
-    if not 0 <= m.id <= 253:
-        raise out_of_range('sync_read request', 'id', m.id, 0, 253)
-    return _S_U8.pack(m.id)
+    body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m.id, 2, 6)
+    return body + _BYTES[~sum(body[2:]) & 0xff]
 
 
 def _encode_sync_read_request(m: SyncReadRequest) -> bytes:
@@ -210,13 +243,17 @@ def _encode_sync_read_request(m: SyncReadRequest) -> bytes:
         raise out_of_range('sync_read request', 'address', m.address, 0, 255)
     if not 1 <= m.length <= 250:
         raise out_of_range('sync_read request', 'length', m.length, 1, 250)
-    return _frame_request(130, m.id, b''.join((_S_U8_U8.pack(m.address, m.length), b''.join([_encode_IdsItem(item) for item in m.ids]),)))
-
-
-def _encode_ServosItem(m: ServosItem) -> bytes:
-    if not 0 <= m.id <= 253:
-        raise out_of_range('sync_write request', 'id', m.id, 0, 253)
-    return b''.join((_S_U8.pack(m.id), bytes(m.data),))
+    parts_ids = []
+    for item in m.ids:
+        if not 0 <= item.id <= 253:
+            raise out_of_range('sync_read request', 'id', item.id, 0, 253)
+        parts_ids.append(_S_U8.pack(item.id))
+    content = b''.join((_S_U8_U8.pack(m.address, m.length), b''.join(parts_ids),))
+    n = len(content) + 2
+    if n > 255:
+        raise EncodeError(f'content of {len(content)} bytes does not fit the length field')
+    body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m.id, n, 130) + content
+    return body + _BYTES[~sum(body[2:]) & 0xff]
 
 
 def _encode_sync_write_request(m: SyncWriteRequest) -> bytes:
@@ -229,7 +266,17 @@ def _encode_sync_write_request(m: SyncWriteRequest) -> bytes:
         raise EncodeError('sync_write request' + ': every data of servos must have the same length')
     if v_data_length > 255:
         raise out_of_range('sync_write request', 'data_length', v_data_length, 0, 255)
-    return _frame_request(131, m.id, b''.join((_S_U8_U8.pack(m.address, v_data_length), b''.join([_encode_ServosItem(item) for item in m.servos]),)))
+    parts_servos = []
+    for item in m.servos:
+        if not 0 <= item.id <= 253:
+            raise out_of_range('sync_write request', 'id', item.id, 0, 253)
+        parts_servos.append(b''.join((_S_U8.pack(item.id), bytes(item.data),)))
+    content = b''.join((_S_U8_U8.pack(m.address, v_data_length), b''.join(parts_servos),))
+    n = len(content) + 2
+    if n > 255:
+        raise EncodeError(f'content of {len(content)} bytes does not fit the length field')
+    body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m.id, n, 131) + content
+    return body + _BYTES[~sum(body[2:]) & 0xff]
 
 
 def _encode_reply_response(m: ReplyResponse) -> bytes:
@@ -237,7 +284,12 @@ def _encode_reply_response(m: ReplyResponse) -> bytes:
         raise out_of_range('reply response', 'id', m.id, 0, 253)
     if not 0 <= m.error <= 255:
         raise out_of_range('reply response', 'error', m.error, 0, 255)
-    return _frame_response(0, m.id, m.error, bytes(m.data))
+    content = bytes(m.data)
+    n = len(content) + 2
+    if n > 255:
+        raise EncodeError(f'content of {len(content)} bytes does not fit the length field')
+    body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m.id, n, m.error) + content
+    return body + _BYTES[~sum(body[2:]) & 0xff]
 
 
 _REQUEST_DECODERS: dict[int | None, Callable[..., Message]] = {
@@ -262,10 +314,6 @@ _REQUEST_SIZES: dict[int | None, tuple[int, int | None]] = {
 }
 
 
-def _checksum_ok_request(frame: bytes) -> bool:
-    return _checksum(frame[2:-1]) == int.from_bytes(frame[-1:], "little")
-
-
 def _decode_request(data: bytes) -> Message:
     n = len(data)
     if n < 6:
@@ -275,13 +323,24 @@ def _decode_request(data: bytes) -> Message:
     size = data[3] - 2
     if size < 0 or n != 6 + size:
         raise DecodeError(f"length byte says {size} content bytes but the frame holds {n - 6}")
-    expected = _checksum(data[2:-1])
-    if expected != int.from_bytes(data[-1:], "little"):
+    expected = ~sum(data[2:-1]) & 0xff
+    if expected != data[-1]:
         raise ChecksumError(f"bad checksum: the frame has {data[-1]:#04x}, its bytes give {expected:#04x}")
     decoder = _REQUEST_DECODERS.get(data[4])
     if decoder is None:
         raise DecodeError(f"unknown command {data[4]:#04x}")
     return decoder(data, 5, n - 1, data[2])
+
+
+def _decode_request_at(buf: bytes, start: int, stop: int) -> Message:
+    """The frame buf[start:stop], whose header and length byte the stream parser has checked."""
+    expected = ~sum(buf[start + 2 : stop - 1]) & 0xff
+    if expected != buf[stop - 1]:
+        raise ChecksumError(f"bad checksum: the frame has {buf[stop - 1]:#04x}, its bytes give {expected:#04x}")
+    decoder = _REQUEST_DECODERS.get(buf[start + 4])
+    if decoder is None:
+        raise DecodeError(f"unknown command {buf[start + 4]:#04x}")
+    return decoder(buf, start + 5, stop - 1, buf[start + 2])
 
 
 _RESPONSE_DECODERS: dict[int | None, Callable[..., Message]] = {
@@ -290,10 +349,6 @@ _RESPONSE_DECODERS: dict[int | None, Callable[..., Message]] = {
 _RESPONSE_SIZES: dict[int | None, tuple[int, int | None]] = {
     None: (0, None),
 }
-
-
-def _checksum_ok_response(frame: bytes) -> bool:
-    return _checksum(frame[2:-1]) == int.from_bytes(frame[-1:], "little")
 
 
 def _decode_response(data: bytes) -> Message:
@@ -305,13 +360,19 @@ def _decode_response(data: bytes) -> Message:
     size = data[3] - 2
     if size < 0 or n != 6 + size:
         raise DecodeError(f"length byte says {size} content bytes but the frame holds {n - 6}")
-    expected = _checksum(data[2:-1])
-    if expected != int.from_bytes(data[-1:], "little"):
+    expected = ~sum(data[2:-1]) & 0xff
+    if expected != data[-1]:
         raise ChecksumError(f"bad checksum: the frame has {data[-1]:#04x}, its bytes give {expected:#04x}")
-    decoder = _RESPONSE_DECODERS.get(None)
-    if decoder is None:
-        raise DecodeError("no response is defined")
-    return decoder(data, 5, n - 1, data[2], data[4])
+    return _decode_reply_response(data, 5, n - 1, data[2], data[4])
+
+
+def _decode_response_at(buf: bytes, start: int, stop: int) -> Message:
+    """The frame buf[start:stop], whose header and length byte the stream parser has checked."""
+    expected = ~sum(buf[start + 2 : stop - 1]) & 0xff
+    if expected != buf[stop - 1]:
+        raise ChecksumError(f"bad checksum: the frame has {buf[stop - 1]:#04x}, its bytes give {expected:#04x}")
+    return _decode_reply_response(buf, start + 5, stop - 1, buf[start + 2], buf[start + 4])
+
 
 _ENCODERS: dict[type[Message], Callable[..., bytes]] = {
     PingRequest: _encode_ping_request,
@@ -332,8 +393,7 @@ REQUEST_FORMAT = FrameFormat(
     length_adds=2,
     command_offset=4,
     content_sizes=_REQUEST_SIZES,
-    checksum_ok=_checksum_ok_request,
-    decode=_decode_request,
+    decode_at=_decode_request_at,
 )
 RESPONSE_FORMAT = FrameFormat(
     header=b'\xff\xff',
@@ -342,19 +402,18 @@ RESPONSE_FORMAT = FrameFormat(
     length_adds=2,
     command_offset=None,
     content_sizes=_RESPONSE_SIZES,
-    checksum_ok=_checksum_ok_response,
-    decode=_decode_response,
+    decode_at=_decode_response_at,
 )
 
 
 def decode(data: bytes, direction: Direction | str | None = None) -> Message:
     """Decode one complete frame into its message; raises DecodeError with a one-line reason."""
+    if direction == 'request':  # a Direction or its value
+        return _decode_request(data)
+    if direction == 'response':  # a Direction or its value
+        return _decode_response(data)
     if direction is None:
         raise DecodeError("give the direction: requests and responses share the header ff ff")
-    if direction == Direction.REQUEST:
-        return _decode_request(data)
-    if direction == Direction.RESPONSE:
-        return _decode_response(data)
     raise ValueError(f"direction must be request or response, not {direction!r}")
 
 

@@ -6,10 +6,10 @@ from __future__ import annotations
 import struct
 from collections.abc import Callable
 
-from serialspec.runtime.checksums import crc_function
+from serialspec.runtime.checksums import BYTE_VALUES as _BYTES
+from serialspec.runtime.checksums import crc_table
 from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError, content_size_error, out_of_range
-from serialspec.runtime.message import Direction, Message
-from serialspec.runtime.message import enum_or_int as _enum
+from serialspec.runtime.message import Direction, Message, members, slot_setters
 from serialspec.runtime.stream import FrameFormat
 from serialspec.runtime.stream import StreamParser as _StreamParser
 
@@ -66,7 +66,25 @@ from hiwonder_rrc.messages import (
 
 __all__ = ["StreamParser", "decode", "encode"]
 
+_S_B2_U8_U8 = struct.Struct('<2sBB')
+_S_B2_U8_U8_U8_U8 = struct.Struct('<2sBBBB')
+_S_B2_U8_U8_U8_U8_F32 = struct.Struct('<2sBBBBf')
+_S_B2_U8_U8_U8_U8_I8 = struct.Struct('<2sBBBBb')
+_S_B2_U8_U8_U8_U8_U16 = struct.Struct('<2sBBBBH')
+_S_B2_U8_U8_U8_U8_U8 = struct.Struct('<2sBBBBB')
 _S_F32_F32_F32_F32_F32_F32 = struct.Struct('<ffffff')
+_S_FRAME_BUSSERVOREADOFFSETRESPONSE = struct.Struct('<2sBBBBbb')
+_S_FRAME_BUSSERVOREADPOSITIONLIMITRESPONSE = struct.Struct('<2sBBBBbHH')
+_S_FRAME_BUSSERVOREADPOSITIONRESPONSE = struct.Struct('<2sBBBBbh')
+_S_FRAME_BUSSERVOREADTEMPERATURERESPONSE = struct.Struct('<2sBBBBbB')
+_S_FRAME_BUSSERVOREADVOLTAGERESPONSE = struct.Struct('<2sBBBBbH')
+_S_FRAME_BUSSERVOSETPOSITIONLIMITREQUEST = struct.Struct('<2sBBBBHH')
+_S_FRAME_BUZZERREQUEST = struct.Struct('<2sBBHHHH')
+_S_FRAME_GAMEPADRESPONSE = struct.Struct('<2sBBHBbbbb')
+_S_FRAME_IMURESPONSE = struct.Struct('<2sBBffffff')
+_S_FRAME_LEDREQUEST = struct.Struct('<2sBBBHHH')
+_S_FRAME_PWMSERVOSETPOSITIONREQUEST = struct.Struct('<2sBBBHBH')
+_S_FRAME_SBUSRESPONSE = struct.Struct('<2sBB16hBBBB')
 _S_I16X16_U8_U8_U8_U8 = struct.Struct('<16hBBBB')
 _S_U16_U16_U16_U16 = struct.Struct('<HHHH')
 _S_U16_U8_I8_I8_I8_I8 = struct.Struct('<HBbbbb')
@@ -86,43 +104,123 @@ _S_U8_U8_I8_U8 = struct.Struct('<BBbB')
 _S_U8_U8_U16 = struct.Struct('<BBH')
 _S_U8_U8_U16_U16 = struct.Struct('<BBHH')
 _S_U8_U8_U8 = struct.Struct('<BBB')
-_checksum: Callable[[bytes], int] = crc_function(8, 0x31, 0x0, True, True, 0x0)  # CRC-8/MAXIM
+_CRC_TABLE = crc_table(8, 0x31, True)  # CRC-8/MAXIM
 
-
-def _frame_request(code: int, content: bytes) -> bytes:
-    n = len(content) + 0
-    if n > 255:
-        raise EncodeError(f'content of {len(content)} bytes does not fit the length field')
-    body = b''.join((b'\xaaU', bytes((code,)), bytes((n,)), content,))
-    return body + _checksum(body[2:]).to_bytes(1, 'little')
-
-
-def _frame_response(code: int, content: bytes) -> bytes:
-    n = len(content) + 0
-    if n > 255:
-        raise EncodeError(f'content of {len(content)} bytes does not fit the length field')
-    body = b''.join((b'\xaaU', bytes((code,)), bytes((n,)), content,))
-    return body + _checksum(body[2:]).to_bytes(1, 'little')
+# Decoders build messages with object.__new__ and store each value straight into its slot: the dataclass __init__
+# of a frozen class goes through object.__setattr__ per field, which costs more than unpacking the whole frame.
+_new = object.__new__
+(_set_BusServoLoadRequest_servo_id,) = slot_setters(BusServoLoadRequest)
+(_set_BusServoReadIdRequest_servo_id,) = slot_setters(BusServoReadIdRequest)
+_set_BusServoReadIdResponse_servo_id, _set_BusServoReadIdResponse_success, _set_BusServoReadIdResponse_id = slot_setters(BusServoReadIdResponse)
+(_set_BusServoReadOffsetRequest_servo_id,) = slot_setters(BusServoReadOffsetRequest)
+_set_BusServoReadOffsetResponse_servo_id, _set_BusServoReadOffsetResponse_success, _set_BusServoReadOffsetResponse_offset = slot_setters(BusServoReadOffsetResponse)
+(_set_BusServoReadPositionLimitRequest_servo_id,) = slot_setters(BusServoReadPositionLimitRequest)
+(
+    _set_BusServoReadPositionLimitResponse_servo_id,
+    _set_BusServoReadPositionLimitResponse_success,
+    _set_BusServoReadPositionLimitResponse_low,
+    _set_BusServoReadPositionLimitResponse_high,
+) = slot_setters(BusServoReadPositionLimitResponse)
+(_set_BusServoReadPositionRequest_servo_id,) = slot_setters(BusServoReadPositionRequest)
+_set_BusServoReadPositionResponse_servo_id, _set_BusServoReadPositionResponse_success, _set_BusServoReadPositionResponse_position = slot_setters(BusServoReadPositionResponse)
+(_set_BusServoReadTemperatureLimitRequest_servo_id,) = slot_setters(BusServoReadTemperatureLimitRequest)
+_set_BusServoReadTemperatureLimitResponse_servo_id, _set_BusServoReadTemperatureLimitResponse_success, _set_BusServoReadTemperatureLimitResponse_limit = slot_setters(BusServoReadTemperatureLimitResponse)
+(_set_BusServoReadTemperatureRequest_servo_id,) = slot_setters(BusServoReadTemperatureRequest)
+_set_BusServoReadTemperatureResponse_servo_id, _set_BusServoReadTemperatureResponse_success, _set_BusServoReadTemperatureResponse_temperature = slot_setters(BusServoReadTemperatureResponse)
+(_set_BusServoReadVoltageLimitRequest_servo_id,) = slot_setters(BusServoReadVoltageLimitRequest)
+(
+    _set_BusServoReadVoltageLimitResponse_servo_id,
+    _set_BusServoReadVoltageLimitResponse_success,
+    _set_BusServoReadVoltageLimitResponse_low,
+    _set_BusServoReadVoltageLimitResponse_high,
+) = slot_setters(BusServoReadVoltageLimitResponse)
+(_set_BusServoReadVoltageRequest_servo_id,) = slot_setters(BusServoReadVoltageRequest)
+_set_BusServoReadVoltageResponse_servo_id, _set_BusServoReadVoltageResponse_success, _set_BusServoReadVoltageResponse_voltage = slot_setters(BusServoReadVoltageResponse)
+(_set_BusServoSaveOffsetRequest_servo_id,) = slot_setters(BusServoSaveOffsetRequest)
+_set_BusServoSetIdRequest_servo_id, _set_BusServoSetIdRequest_new_id = slot_setters(BusServoSetIdRequest)
+_set_BusServoSetOffsetRequest_servo_id, _set_BusServoSetOffsetRequest_offset = slot_setters(BusServoSetOffsetRequest)
+_set_BusServoSetPositionLimitRequest_servo_id, _set_BusServoSetPositionLimitRequest_low, _set_BusServoSetPositionLimitRequest_high = slot_setters(BusServoSetPositionLimitRequest)
+_set_BusServoSetPositionsRequest_duration, _set_BusServoSetPositionsRequest_bus_servos = slot_setters(BusServoSetPositionsRequest)
+_set_BusServoSetTemperatureLimitRequest_servo_id, _set_BusServoSetTemperatureLimitRequest_limit = slot_setters(BusServoSetTemperatureLimitRequest)
+_set_BusServoSetVoltageLimitRequest_servo_id, _set_BusServoSetVoltageLimitRequest_low, _set_BusServoSetVoltageLimitRequest_high = slot_setters(BusServoSetVoltageLimitRequest)
+(_set_BusServoUnloadRequest_servo_id,) = slot_setters(BusServoUnloadRequest)
+_set_BusServosItem_servo_id, _set_BusServosItem_position = slot_setters(BusServosItem)
+(
+    _set_BuzzerRequest_frequency,
+    _set_BuzzerRequest_on_time,
+    _set_BuzzerRequest_off_time,
+    _set_BuzzerRequest_repeat,
+) = slot_setters(BuzzerRequest)
+(
+    _set_GamepadResponse_buttons,
+    _set_GamepadResponse_hat,
+    _set_GamepadResponse_left_x,
+    _set_GamepadResponse_left_y,
+    _set_GamepadResponse_right_x,
+    _set_GamepadResponse_right_y,
+) = slot_setters(GamepadResponse)
+(
+    _set_ImuResponse_accel_x,
+    _set_ImuResponse_accel_y,
+    _set_ImuResponse_accel_z,
+    _set_ImuResponse_gyro_x,
+    _set_ImuResponse_gyro_y,
+    _set_ImuResponse_gyro_z,
+) = slot_setters(ImuResponse)
+_set_KeyResponse_button_id, _set_KeyResponse_event = slot_setters(KeyResponse)
+(
+    _set_LedRequest_led_id,
+    _set_LedRequest_on_time,
+    _set_LedRequest_off_time,
+    _set_LedRequest_repeat,
+) = slot_setters(LedRequest)
+_set_MotorSetSpeedRequest_motor_id, _set_MotorSetSpeedRequest_speed = slot_setters(MotorSetSpeedRequest)
+(_set_MotorSetSpeedsRequest_motors,) = slot_setters(MotorSetSpeedsRequest)
+(_set_MotorStopMaskRequest_mask,) = slot_setters(MotorStopMaskRequest)
+(_set_MotorStopRequest_motor_id,) = slot_setters(MotorStopRequest)
+_set_MotorsItem_motor_id, _set_MotorsItem_speed = slot_setters(MotorsItem)
+(_set_PwmServoReadOffsetRequest_servo_id,) = slot_setters(PwmServoReadOffsetRequest)
+_set_PwmServoReadOffsetResponse_servo_id, _set_PwmServoReadOffsetResponse_offset = slot_setters(PwmServoReadOffsetResponse)
+(_set_PwmServoReadPositionRequest_servo_id,) = slot_setters(PwmServoReadPositionRequest)
+_set_PwmServoReadPositionResponse_servo_id, _set_PwmServoReadPositionResponse_pulse = slot_setters(PwmServoReadPositionResponse)
+_set_PwmServoSetOffsetRequest_servo_id, _set_PwmServoSetOffsetRequest_offset = slot_setters(PwmServoSetOffsetRequest)
+_set_PwmServoSetPositionRequest_duration, _set_PwmServoSetPositionRequest_servo_id, _set_PwmServoSetPositionRequest_pulse = slot_setters(PwmServoSetPositionRequest)
+_set_PwmServoSetPositionsRequest_duration, _set_PwmServoSetPositionsRequest_pwm_servos = slot_setters(PwmServoSetPositionsRequest)
+_set_PwmServosItem_servo_id, _set_PwmServosItem_pulse = slot_setters(PwmServosItem)
+(
+    _set_SbusResponse_channels,
+    _set_SbusResponse_ch17,
+    _set_SbusResponse_ch18,
+    _set_SbusResponse_signal_loss,
+    _set_SbusResponse_fail_safe,
+) = slot_setters(SbusResponse)
+_MEMBERS_ButtonEvent = members(ButtonEvent)
+_MEMBERS_MotorMask = members(MotorMask)
+_MEMBERS_ReadResult = members(ReadResult)
 
 
 def _decode_led_request(buf: bytes, o: int, end: int) -> LedRequest:
     if end - o != 7:
         raise content_size_error('led request', end - o, 7, 7)
     v_led_id, v_on_time, v_off_time, v_repeat = _S_U8_U16_U16_U16.unpack_from(buf, o)
-    o += 7
-    if o != end:
-        raise DecodeError('led request' + f': {end - o} bytes left after the last field')
-    return LedRequest(v_led_id, v_on_time, v_off_time, v_repeat)
+    m = _new(LedRequest)
+    _set_LedRequest_led_id(m, v_led_id)
+    _set_LedRequest_on_time(m, v_on_time)
+    _set_LedRequest_off_time(m, v_off_time)
+    _set_LedRequest_repeat(m, v_repeat)
+    return m
 
 
 def _decode_buzzer_request(buf: bytes, o: int, end: int) -> BuzzerRequest:
     if end - o != 8:
         raise content_size_error('buzzer request', end - o, 8, 8)
     v_frequency, v_on_time, v_off_time, v_repeat = _S_U16_U16_U16_U16.unpack_from(buf, o)
-    o += 8
-    if o != end:
-        raise DecodeError('buzzer request' + f': {end - o} bytes left after the last field')
-    return BuzzerRequest(v_frequency, v_on_time, v_off_time, v_repeat)
+    m = _new(BuzzerRequest)
+    _set_BuzzerRequest_frequency(m, v_frequency)
+    _set_BuzzerRequest_on_time(m, v_on_time)
+    _set_BuzzerRequest_off_time(m, v_off_time)
+    _set_BuzzerRequest_repeat(m, v_repeat)
+    return m
 
 
 def _decode_motor_set_speed_request(buf: bytes, o: int, end: int) -> MotorSetSpeedRequest:
@@ -131,10 +229,10 @@ def _decode_motor_set_speed_request(buf: bytes, o: int, end: int) -> MotorSetSpe
     v_subcommand_code, v_motor_id, v_speed = _S_U8_U8_F32.unpack_from(buf, o)
     if v_subcommand_code != 0:
         raise DecodeError('motor.set_speed request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x0')
-    o += 6
-    if o != end:
-        raise DecodeError('motor.set_speed request' + f': {end - o} bytes left after the last field')
-    return MotorSetSpeedRequest(v_motor_id, v_speed)
+    m = _new(MotorSetSpeedRequest)
+    _set_MotorSetSpeedRequest_motor_id(m, v_motor_id)
+    _set_MotorSetSpeedRequest_speed(m, v_speed)
+    return m
 
 
 def _decode_motor_set_speeds_request(buf: bytes, o: int, end: int) -> MotorSetSpeedsRequest:
@@ -144,14 +242,22 @@ def _decode_motor_set_speeds_request(buf: bytes, o: int, end: int) -> MotorSetSp
     if v_subcommand_code != 1:
         raise DecodeError('motor.set_speeds request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x1')
     o += 2
+    v_motors_list = []
     n = v_count * 5
     if end - o < n:
         raise DecodeError('motor.set_speeds request' + f': content too short for its count ({v_count} motors)')
-    v_motors = tuple(MotorsItem(v_motor_id, v_speed) for v_motor_id, v_speed in _S_U8_F32.iter_unpack(buf[o : o + n]))
+    for v_motor_id, v_speed in _S_U8_F32.iter_unpack(buf[o : o + n]):
+        item = _new(MotorsItem)
+        _set_MotorsItem_motor_id(item, v_motor_id)
+        _set_MotorsItem_speed(item, v_speed)
+        v_motors_list.append(item)
+    v_motors = tuple(v_motors_list)
     o += n
     if o != end:
         raise DecodeError('motor.set_speeds request' + f': {end - o} bytes left after the last field')
-    return MotorSetSpeedsRequest(v_motors)
+    m = _new(MotorSetSpeedsRequest)
+    _set_MotorSetSpeedsRequest_motors(m, v_motors)
+    return m
 
 
 def _decode_motor_stop_request(buf: bytes, o: int, end: int) -> MotorStopRequest:
@@ -160,10 +266,9 @@ def _decode_motor_stop_request(buf: bytes, o: int, end: int) -> MotorStopRequest
     v_subcommand_code, v_motor_id = _S_U8_U8.unpack_from(buf, o)
     if v_subcommand_code != 2:
         raise DecodeError('motor.stop request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x2')
-    o += 2
-    if o != end:
-        raise DecodeError('motor.stop request' + f': {end - o} bytes left after the last field')
-    return MotorStopRequest(v_motor_id)
+    m = _new(MotorStopRequest)
+    _set_MotorStopRequest_motor_id(m, v_motor_id)
+    return m
 
 
 def _decode_motor_stop_mask_request(buf: bytes, o: int, end: int) -> MotorStopMaskRequest:
@@ -172,10 +277,12 @@ def _decode_motor_stop_mask_request(buf: bytes, o: int, end: int) -> MotorStopMa
     v_subcommand_code, v_mask = _S_U8_U8.unpack_from(buf, o)
     if v_subcommand_code != 3:
         raise DecodeError('motor.stop_mask request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x3')
-    o += 2
-    if o != end:
-        raise DecodeError('motor.stop_mask request' + f': {end - o} bytes left after the last field')
-    return MotorStopMaskRequest(MotorMask(v_mask))
+    v_mask_flags = _MEMBERS_MotorMask.get(v_mask)
+    if v_mask_flags is None:
+        v_mask_flags = MotorMask(v_mask)
+    m = _new(MotorStopMaskRequest)
+    _set_MotorStopMaskRequest_mask(m, v_mask_flags)
+    return m
 
 
 def _decode_pwm_servo_set_positions_request(buf: bytes, o: int, end: int) -> PwmServoSetPositionsRequest:
@@ -185,14 +292,23 @@ def _decode_pwm_servo_set_positions_request(buf: bytes, o: int, end: int) -> Pwm
     if v_subcommand_code != 1:
         raise DecodeError('pwm_servo.set_positions request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x1')
     o += 4
+    v_pwm_servos_list = []
     n = v_count * 3
     if end - o < n:
         raise DecodeError('pwm_servo.set_positions request' + f': content too short for its count ({v_count} pwm_servos)')
-    v_pwm_servos = tuple(PwmServosItem(v_servo_id, v_pulse) for v_servo_id, v_pulse in _S_U8_U16.iter_unpack(buf[o : o + n]))
+    for v_servo_id, v_pulse in _S_U8_U16.iter_unpack(buf[o : o + n]):
+        item = _new(PwmServosItem)
+        _set_PwmServosItem_servo_id(item, v_servo_id)
+        _set_PwmServosItem_pulse(item, v_pulse)
+        v_pwm_servos_list.append(item)
+    v_pwm_servos = tuple(v_pwm_servos_list)
     o += n
     if o != end:
         raise DecodeError('pwm_servo.set_positions request' + f': {end - o} bytes left after the last field')
-    return PwmServoSetPositionsRequest(v_duration, v_pwm_servos)
+    m = _new(PwmServoSetPositionsRequest)
+    _set_PwmServoSetPositionsRequest_duration(m, v_duration)
+    _set_PwmServoSetPositionsRequest_pwm_servos(m, v_pwm_servos)
+    return m
 
 
 def _decode_pwm_servo_set_position_request(buf: bytes, o: int, end: int) -> PwmServoSetPositionRequest:
@@ -201,10 +317,11 @@ def _decode_pwm_servo_set_position_request(buf: bytes, o: int, end: int) -> PwmS
     v_subcommand_code, v_duration, v_servo_id, v_pulse = _S_U8_U16_U8_U16.unpack_from(buf, o)
     if v_subcommand_code != 3:
         raise DecodeError('pwm_servo.set_position request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x3')
-    o += 6
-    if o != end:
-        raise DecodeError('pwm_servo.set_position request' + f': {end - o} bytes left after the last field')
-    return PwmServoSetPositionRequest(v_duration, v_servo_id, v_pulse)
+    m = _new(PwmServoSetPositionRequest)
+    _set_PwmServoSetPositionRequest_duration(m, v_duration)
+    _set_PwmServoSetPositionRequest_servo_id(m, v_servo_id)
+    _set_PwmServoSetPositionRequest_pulse(m, v_pulse)
+    return m
 
 
 def _decode_pwm_servo_read_position_request(buf: bytes, o: int, end: int) -> PwmServoReadPositionRequest:
@@ -213,10 +330,9 @@ def _decode_pwm_servo_read_position_request(buf: bytes, o: int, end: int) -> Pwm
     v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, o)
     if v_subcommand_code != 5:
         raise DecodeError('pwm_servo.read_position request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x5')
-    o += 2
-    if o != end:
-        raise DecodeError('pwm_servo.read_position request' + f': {end - o} bytes left after the last field')
-    return PwmServoReadPositionRequest(v_servo_id)
+    m = _new(PwmServoReadPositionRequest)
+    _set_PwmServoReadPositionRequest_servo_id(m, v_servo_id)
+    return m
 
 
 def _decode_pwm_servo_read_position_response(buf: bytes, o: int, end: int) -> PwmServoReadPositionResponse:
@@ -225,10 +341,10 @@ def _decode_pwm_servo_read_position_response(buf: bytes, o: int, end: int) -> Pw
     v_servo_id, v_subcommand_code, v_pulse = _S_U8_U8_U16.unpack_from(buf, o)
     if v_subcommand_code != 5:
         raise DecodeError('pwm_servo.read_position response' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x5')
-    o += 4
-    if o != end:
-        raise DecodeError('pwm_servo.read_position response' + f': {end - o} bytes left after the last field')
-    return PwmServoReadPositionResponse(v_servo_id, v_pulse)
+    m = _new(PwmServoReadPositionResponse)
+    _set_PwmServoReadPositionResponse_servo_id(m, v_servo_id)
+    _set_PwmServoReadPositionResponse_pulse(m, v_pulse)
+    return m
 
 
 def _decode_pwm_servo_set_offset_request(buf: bytes, o: int, end: int) -> PwmServoSetOffsetRequest:
@@ -237,10 +353,10 @@ def _decode_pwm_servo_set_offset_request(buf: bytes, o: int, end: int) -> PwmSer
     v_subcommand_code, v_servo_id, v_offset = _S_U8_U8_I8.unpack_from(buf, o)
     if v_subcommand_code != 7:
         raise DecodeError('pwm_servo.set_offset request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x7')
-    o += 3
-    if o != end:
-        raise DecodeError('pwm_servo.set_offset request' + f': {end - o} bytes left after the last field')
-    return PwmServoSetOffsetRequest(v_servo_id, v_offset)
+    m = _new(PwmServoSetOffsetRequest)
+    _set_PwmServoSetOffsetRequest_servo_id(m, v_servo_id)
+    _set_PwmServoSetOffsetRequest_offset(m, v_offset)
+    return m
 
 
 def _decode_pwm_servo_read_offset_request(buf: bytes, o: int, end: int) -> PwmServoReadOffsetRequest:
@@ -249,10 +365,9 @@ def _decode_pwm_servo_read_offset_request(buf: bytes, o: int, end: int) -> PwmSe
     v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, o)
     if v_subcommand_code != 9:
         raise DecodeError('pwm_servo.read_offset request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x9')
-    o += 2
-    if o != end:
-        raise DecodeError('pwm_servo.read_offset request' + f': {end - o} bytes left after the last field')
-    return PwmServoReadOffsetRequest(v_servo_id)
+    m = _new(PwmServoReadOffsetRequest)
+    _set_PwmServoReadOffsetRequest_servo_id(m, v_servo_id)
+    return m
 
 
 def _decode_pwm_servo_read_offset_response(buf: bytes, o: int, end: int) -> PwmServoReadOffsetResponse:
@@ -261,10 +376,10 @@ def _decode_pwm_servo_read_offset_response(buf: bytes, o: int, end: int) -> PwmS
     v_servo_id, v_subcommand_code, v_offset = _S_U8_U8_I8.unpack_from(buf, o)
     if v_subcommand_code != 9:
         raise DecodeError('pwm_servo.read_offset response' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x9')
-    o += 3
-    if o != end:
-        raise DecodeError('pwm_servo.read_offset response' + f': {end - o} bytes left after the last field')
-    return PwmServoReadOffsetResponse(v_servo_id, v_offset)
+    m = _new(PwmServoReadOffsetResponse)
+    _set_PwmServoReadOffsetResponse_servo_id(m, v_servo_id)
+    _set_PwmServoReadOffsetResponse_offset(m, v_offset)
+    return m
 
 
 def _decode_bus_servo_set_positions_request(buf: bytes, o: int, end: int) -> BusServoSetPositionsRequest:
@@ -274,14 +389,23 @@ def _decode_bus_servo_set_positions_request(buf: bytes, o: int, end: int) -> Bus
     if v_subcommand_code != 1:
         raise DecodeError('bus_servo.set_positions request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x1')
     o += 4
+    v_bus_servos_list = []
     n = v_count * 3
     if end - o < n:
         raise DecodeError('bus_servo.set_positions request' + f': content too short for its count ({v_count} bus_servos)')
-    v_bus_servos = tuple(BusServosItem(v_servo_id, v_position) for v_servo_id, v_position in _S_U8_U16.iter_unpack(buf[o : o + n]))
+    for v_servo_id, v_position in _S_U8_U16.iter_unpack(buf[o : o + n]):
+        item = _new(BusServosItem)
+        _set_BusServosItem_servo_id(item, v_servo_id)
+        _set_BusServosItem_position(item, v_position)
+        v_bus_servos_list.append(item)
+    v_bus_servos = tuple(v_bus_servos_list)
     o += n
     if o != end:
         raise DecodeError('bus_servo.set_positions request' + f': {end - o} bytes left after the last field')
-    return BusServoSetPositionsRequest(v_duration, v_bus_servos)
+    m = _new(BusServoSetPositionsRequest)
+    _set_BusServoSetPositionsRequest_duration(m, v_duration)
+    _set_BusServoSetPositionsRequest_bus_servos(m, v_bus_servos)
+    return m
 
 
 def _decode_bus_servo_read_position_request(buf: bytes, o: int, end: int) -> BusServoReadPositionRequest:
@@ -290,10 +414,9 @@ def _decode_bus_servo_read_position_request(buf: bytes, o: int, end: int) -> Bus
     v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, o)
     if v_subcommand_code != 5:
         raise DecodeError('bus_servo.read_position request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x5')
-    o += 2
-    if o != end:
-        raise DecodeError('bus_servo.read_position request' + f': {end - o} bytes left after the last field')
-    return BusServoReadPositionRequest(v_servo_id)
+    m = _new(BusServoReadPositionRequest)
+    _set_BusServoReadPositionRequest_servo_id(m, v_servo_id)
+    return m
 
 
 def _decode_bus_servo_read_position_response(buf: bytes, o: int, end: int) -> BusServoReadPositionResponse:
@@ -302,10 +425,11 @@ def _decode_bus_servo_read_position_response(buf: bytes, o: int, end: int) -> Bu
     v_servo_id, v_subcommand_code, v_success, v_position = _S_U8_U8_I8_I16.unpack_from(buf, o)
     if v_subcommand_code != 5:
         raise DecodeError('bus_servo.read_position response' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x5')
-    o += 5
-    if o != end:
-        raise DecodeError('bus_servo.read_position response' + f': {end - o} bytes left after the last field')
-    return BusServoReadPositionResponse(v_servo_id, _enum(ReadResult, v_success), v_position)
+    m = _new(BusServoReadPositionResponse)
+    _set_BusServoReadPositionResponse_servo_id(m, v_servo_id)
+    _set_BusServoReadPositionResponse_success(m, _MEMBERS_ReadResult.get(v_success, v_success))
+    _set_BusServoReadPositionResponse_position(m, v_position)
+    return m
 
 
 def _decode_bus_servo_read_voltage_request(buf: bytes, o: int, end: int) -> BusServoReadVoltageRequest:
@@ -314,10 +438,9 @@ def _decode_bus_servo_read_voltage_request(buf: bytes, o: int, end: int) -> BusS
     v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, o)
     if v_subcommand_code != 7:
         raise DecodeError('bus_servo.read_voltage request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x7')
-    o += 2
-    if o != end:
-        raise DecodeError('bus_servo.read_voltage request' + f': {end - o} bytes left after the last field')
-    return BusServoReadVoltageRequest(v_servo_id)
+    m = _new(BusServoReadVoltageRequest)
+    _set_BusServoReadVoltageRequest_servo_id(m, v_servo_id)
+    return m
 
 
 def _decode_bus_servo_read_voltage_response(buf: bytes, o: int, end: int) -> BusServoReadVoltageResponse:
@@ -326,10 +449,11 @@ def _decode_bus_servo_read_voltage_response(buf: bytes, o: int, end: int) -> Bus
     v_servo_id, v_subcommand_code, v_success, v_voltage = _S_U8_U8_I8_U16.unpack_from(buf, o)
     if v_subcommand_code != 7:
         raise DecodeError('bus_servo.read_voltage response' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x7')
-    o += 5
-    if o != end:
-        raise DecodeError('bus_servo.read_voltage response' + f': {end - o} bytes left after the last field')
-    return BusServoReadVoltageResponse(v_servo_id, _enum(ReadResult, v_success), v_voltage)
+    m = _new(BusServoReadVoltageResponse)
+    _set_BusServoReadVoltageResponse_servo_id(m, v_servo_id)
+    _set_BusServoReadVoltageResponse_success(m, _MEMBERS_ReadResult.get(v_success, v_success))
+    _set_BusServoReadVoltageResponse_voltage(m, v_voltage)
+    return m
 
 
 def _decode_bus_servo_read_temperature_request(buf: bytes, o: int, end: int) -> BusServoReadTemperatureRequest:
@@ -338,10 +462,9 @@ def _decode_bus_servo_read_temperature_request(buf: bytes, o: int, end: int) -> 
     v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, o)
     if v_subcommand_code != 9:
         raise DecodeError('bus_servo.read_temperature request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x9')
-    o += 2
-    if o != end:
-        raise DecodeError('bus_servo.read_temperature request' + f': {end - o} bytes left after the last field')
-    return BusServoReadTemperatureRequest(v_servo_id)
+    m = _new(BusServoReadTemperatureRequest)
+    _set_BusServoReadTemperatureRequest_servo_id(m, v_servo_id)
+    return m
 
 
 def _decode_bus_servo_read_temperature_response(buf: bytes, o: int, end: int) -> BusServoReadTemperatureResponse:
@@ -350,10 +473,11 @@ def _decode_bus_servo_read_temperature_response(buf: bytes, o: int, end: int) ->
     v_servo_id, v_subcommand_code, v_success, v_temperature = _S_U8_U8_I8_U8.unpack_from(buf, o)
     if v_subcommand_code != 9:
         raise DecodeError('bus_servo.read_temperature response' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x9')
-    o += 4
-    if o != end:
-        raise DecodeError('bus_servo.read_temperature response' + f': {end - o} bytes left after the last field')
-    return BusServoReadTemperatureResponse(v_servo_id, _enum(ReadResult, v_success), v_temperature)
+    m = _new(BusServoReadTemperatureResponse)
+    _set_BusServoReadTemperatureResponse_servo_id(m, v_servo_id)
+    _set_BusServoReadTemperatureResponse_success(m, _MEMBERS_ReadResult.get(v_success, v_success))
+    _set_BusServoReadTemperatureResponse_temperature(m, v_temperature)
+    return m
 
 
 def _decode_bus_servo_unload_request(buf: bytes, o: int, end: int) -> BusServoUnloadRequest:
@@ -362,10 +486,9 @@ def _decode_bus_servo_unload_request(buf: bytes, o: int, end: int) -> BusServoUn
     v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, o)
     if v_subcommand_code != 11:
         raise DecodeError('bus_servo.unload request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0xb')
-    o += 2
-    if o != end:
-        raise DecodeError('bus_servo.unload request' + f': {end - o} bytes left after the last field')
-    return BusServoUnloadRequest(v_servo_id)
+    m = _new(BusServoUnloadRequest)
+    _set_BusServoUnloadRequest_servo_id(m, v_servo_id)
+    return m
 
 
 def _decode_bus_servo_load_request(buf: bytes, o: int, end: int) -> BusServoLoadRequest:
@@ -374,10 +497,9 @@ def _decode_bus_servo_load_request(buf: bytes, o: int, end: int) -> BusServoLoad
     v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, o)
     if v_subcommand_code != 12:
         raise DecodeError('bus_servo.load request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0xc')
-    o += 2
-    if o != end:
-        raise DecodeError('bus_servo.load request' + f': {end - o} bytes left after the last field')
-    return BusServoLoadRequest(v_servo_id)
+    m = _new(BusServoLoadRequest)
+    _set_BusServoLoadRequest_servo_id(m, v_servo_id)
+    return m
 
 
 def _decode_bus_servo_set_id_request(buf: bytes, o: int, end: int) -> BusServoSetIdRequest:
@@ -386,10 +508,10 @@ def _decode_bus_servo_set_id_request(buf: bytes, o: int, end: int) -> BusServoSe
     v_subcommand_code, v_servo_id, v_new_id = _S_U8_U8_U8.unpack_from(buf, o)
     if v_subcommand_code != 16:
         raise DecodeError('bus_servo.set_id request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x10')
-    o += 3
-    if o != end:
-        raise DecodeError('bus_servo.set_id request' + f': {end - o} bytes left after the last field')
-    return BusServoSetIdRequest(v_servo_id, v_new_id)
+    m = _new(BusServoSetIdRequest)
+    _set_BusServoSetIdRequest_servo_id(m, v_servo_id)
+    _set_BusServoSetIdRequest_new_id(m, v_new_id)
+    return m
 
 
 def _decode_bus_servo_read_id_request(buf: bytes, o: int, end: int) -> BusServoReadIdRequest:
@@ -398,10 +520,9 @@ def _decode_bus_servo_read_id_request(buf: bytes, o: int, end: int) -> BusServoR
     v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, o)
     if v_subcommand_code != 18:
         raise DecodeError('bus_servo.read_id request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x12')
-    o += 2
-    if o != end:
-        raise DecodeError('bus_servo.read_id request' + f': {end - o} bytes left after the last field')
-    return BusServoReadIdRequest(v_servo_id)
+    m = _new(BusServoReadIdRequest)
+    _set_BusServoReadIdRequest_servo_id(m, v_servo_id)
+    return m
 
 
 def _decode_bus_servo_read_id_response(buf: bytes, o: int, end: int) -> BusServoReadIdResponse:
@@ -410,10 +531,11 @@ def _decode_bus_servo_read_id_response(buf: bytes, o: int, end: int) -> BusServo
     v_servo_id, v_subcommand_code, v_success, v_id = _S_U8_U8_I8_U8.unpack_from(buf, o)
     if v_subcommand_code != 18:
         raise DecodeError('bus_servo.read_id response' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x12')
-    o += 4
-    if o != end:
-        raise DecodeError('bus_servo.read_id response' + f': {end - o} bytes left after the last field')
-    return BusServoReadIdResponse(v_servo_id, _enum(ReadResult, v_success), v_id)
+    m = _new(BusServoReadIdResponse)
+    _set_BusServoReadIdResponse_servo_id(m, v_servo_id)
+    _set_BusServoReadIdResponse_success(m, _MEMBERS_ReadResult.get(v_success, v_success))
+    _set_BusServoReadIdResponse_id(m, v_id)
+    return m
 
 
 def _decode_bus_servo_set_offset_request(buf: bytes, o: int, end: int) -> BusServoSetOffsetRequest:
@@ -422,10 +544,10 @@ def _decode_bus_servo_set_offset_request(buf: bytes, o: int, end: int) -> BusSer
     v_subcommand_code, v_servo_id, v_offset = _S_U8_U8_I8.unpack_from(buf, o)
     if v_subcommand_code != 32:
         raise DecodeError('bus_servo.set_offset request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x20')
-    o += 3
-    if o != end:
-        raise DecodeError('bus_servo.set_offset request' + f': {end - o} bytes left after the last field')
-    return BusServoSetOffsetRequest(v_servo_id, v_offset)
+    m = _new(BusServoSetOffsetRequest)
+    _set_BusServoSetOffsetRequest_servo_id(m, v_servo_id)
+    _set_BusServoSetOffsetRequest_offset(m, v_offset)
+    return m
 
 
 def _decode_bus_servo_read_offset_request(buf: bytes, o: int, end: int) -> BusServoReadOffsetRequest:
@@ -434,10 +556,9 @@ def _decode_bus_servo_read_offset_request(buf: bytes, o: int, end: int) -> BusSe
     v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, o)
     if v_subcommand_code != 34:
         raise DecodeError('bus_servo.read_offset request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x22')
-    o += 2
-    if o != end:
-        raise DecodeError('bus_servo.read_offset request' + f': {end - o} bytes left after the last field')
-    return BusServoReadOffsetRequest(v_servo_id)
+    m = _new(BusServoReadOffsetRequest)
+    _set_BusServoReadOffsetRequest_servo_id(m, v_servo_id)
+    return m
 
 
 def _decode_bus_servo_read_offset_response(buf: bytes, o: int, end: int) -> BusServoReadOffsetResponse:
@@ -446,10 +567,11 @@ def _decode_bus_servo_read_offset_response(buf: bytes, o: int, end: int) -> BusS
     v_servo_id, v_subcommand_code, v_success, v_offset = _S_U8_U8_I8_I8.unpack_from(buf, o)
     if v_subcommand_code != 34:
         raise DecodeError('bus_servo.read_offset response' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x22')
-    o += 4
-    if o != end:
-        raise DecodeError('bus_servo.read_offset response' + f': {end - o} bytes left after the last field')
-    return BusServoReadOffsetResponse(v_servo_id, _enum(ReadResult, v_success), v_offset)
+    m = _new(BusServoReadOffsetResponse)
+    _set_BusServoReadOffsetResponse_servo_id(m, v_servo_id)
+    _set_BusServoReadOffsetResponse_success(m, _MEMBERS_ReadResult.get(v_success, v_success))
+    _set_BusServoReadOffsetResponse_offset(m, v_offset)
+    return m
 
 
 def _decode_bus_servo_save_offset_request(buf: bytes, o: int, end: int) -> BusServoSaveOffsetRequest:
@@ -458,10 +580,9 @@ def _decode_bus_servo_save_offset_request(buf: bytes, o: int, end: int) -> BusSe
     v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, o)
     if v_subcommand_code != 36:
         raise DecodeError('bus_servo.save_offset request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x24')
-    o += 2
-    if o != end:
-        raise DecodeError('bus_servo.save_offset request' + f': {end - o} bytes left after the last field')
-    return BusServoSaveOffsetRequest(v_servo_id)
+    m = _new(BusServoSaveOffsetRequest)
+    _set_BusServoSaveOffsetRequest_servo_id(m, v_servo_id)
+    return m
 
 
 def _decode_bus_servo_set_position_limit_request(buf: bytes, o: int, end: int) -> BusServoSetPositionLimitRequest:
@@ -470,10 +591,11 @@ def _decode_bus_servo_set_position_limit_request(buf: bytes, o: int, end: int) -
     v_subcommand_code, v_servo_id, v_low, v_high = _S_U8_U8_U16_U16.unpack_from(buf, o)
     if v_subcommand_code != 48:
         raise DecodeError('bus_servo.set_position_limit request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x30')
-    o += 6
-    if o != end:
-        raise DecodeError('bus_servo.set_position_limit request' + f': {end - o} bytes left after the last field')
-    return BusServoSetPositionLimitRequest(v_servo_id, v_low, v_high)
+    m = _new(BusServoSetPositionLimitRequest)
+    _set_BusServoSetPositionLimitRequest_servo_id(m, v_servo_id)
+    _set_BusServoSetPositionLimitRequest_low(m, v_low)
+    _set_BusServoSetPositionLimitRequest_high(m, v_high)
+    return m
 
 
 def _decode_bus_servo_read_position_limit_request(buf: bytes, o: int, end: int) -> BusServoReadPositionLimitRequest:
@@ -482,10 +604,9 @@ def _decode_bus_servo_read_position_limit_request(buf: bytes, o: int, end: int) 
     v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, o)
     if v_subcommand_code != 50:
         raise DecodeError('bus_servo.read_position_limit request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x32')
-    o += 2
-    if o != end:
-        raise DecodeError('bus_servo.read_position_limit request' + f': {end - o} bytes left after the last field')
-    return BusServoReadPositionLimitRequest(v_servo_id)
+    m = _new(BusServoReadPositionLimitRequest)
+    _set_BusServoReadPositionLimitRequest_servo_id(m, v_servo_id)
+    return m
 
 
 def _decode_bus_servo_read_position_limit_response(buf: bytes, o: int, end: int) -> BusServoReadPositionLimitResponse:
@@ -494,10 +615,12 @@ def _decode_bus_servo_read_position_limit_response(buf: bytes, o: int, end: int)
     v_servo_id, v_subcommand_code, v_success, v_low, v_high = _S_U8_U8_I8_U16_U16.unpack_from(buf, o)
     if v_subcommand_code != 50:
         raise DecodeError('bus_servo.read_position_limit response' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x32')
-    o += 7
-    if o != end:
-        raise DecodeError('bus_servo.read_position_limit response' + f': {end - o} bytes left after the last field')
-    return BusServoReadPositionLimitResponse(v_servo_id, _enum(ReadResult, v_success), v_low, v_high)
+    m = _new(BusServoReadPositionLimitResponse)
+    _set_BusServoReadPositionLimitResponse_servo_id(m, v_servo_id)
+    _set_BusServoReadPositionLimitResponse_success(m, _MEMBERS_ReadResult.get(v_success, v_success))
+    _set_BusServoReadPositionLimitResponse_low(m, v_low)
+    _set_BusServoReadPositionLimitResponse_high(m, v_high)
+    return m
 
 
 def _decode_bus_servo_set_voltage_limit_request(buf: bytes, o: int, end: int) -> BusServoSetVoltageLimitRequest:
@@ -506,10 +629,11 @@ def _decode_bus_servo_set_voltage_limit_request(buf: bytes, o: int, end: int) ->
     v_subcommand_code, v_servo_id, v_low, v_high = _S_U8_U8_U16_U16.unpack_from(buf, o)
     if v_subcommand_code != 52:
         raise DecodeError('bus_servo.set_voltage_limit request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x34')
-    o += 6
-    if o != end:
-        raise DecodeError('bus_servo.set_voltage_limit request' + f': {end - o} bytes left after the last field')
-    return BusServoSetVoltageLimitRequest(v_servo_id, v_low, v_high)
+    m = _new(BusServoSetVoltageLimitRequest)
+    _set_BusServoSetVoltageLimitRequest_servo_id(m, v_servo_id)
+    _set_BusServoSetVoltageLimitRequest_low(m, v_low)
+    _set_BusServoSetVoltageLimitRequest_high(m, v_high)
+    return m
 
 
 def _decode_bus_servo_read_voltage_limit_request(buf: bytes, o: int, end: int) -> BusServoReadVoltageLimitRequest:
@@ -518,10 +642,9 @@ def _decode_bus_servo_read_voltage_limit_request(buf: bytes, o: int, end: int) -
     v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, o)
     if v_subcommand_code != 54:
         raise DecodeError('bus_servo.read_voltage_limit request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x36')
-    o += 2
-    if o != end:
-        raise DecodeError('bus_servo.read_voltage_limit request' + f': {end - o} bytes left after the last field')
-    return BusServoReadVoltageLimitRequest(v_servo_id)
+    m = _new(BusServoReadVoltageLimitRequest)
+    _set_BusServoReadVoltageLimitRequest_servo_id(m, v_servo_id)
+    return m
 
 
 def _decode_bus_servo_read_voltage_limit_response(buf: bytes, o: int, end: int) -> BusServoReadVoltageLimitResponse:
@@ -530,10 +653,12 @@ def _decode_bus_servo_read_voltage_limit_response(buf: bytes, o: int, end: int) 
     v_servo_id, v_subcommand_code, v_success, v_low, v_high = _S_U8_U8_I8_U16_U16.unpack_from(buf, o)
     if v_subcommand_code != 54:
         raise DecodeError('bus_servo.read_voltage_limit response' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x36')
-    o += 7
-    if o != end:
-        raise DecodeError('bus_servo.read_voltage_limit response' + f': {end - o} bytes left after the last field')
-    return BusServoReadVoltageLimitResponse(v_servo_id, _enum(ReadResult, v_success), v_low, v_high)
+    m = _new(BusServoReadVoltageLimitResponse)
+    _set_BusServoReadVoltageLimitResponse_servo_id(m, v_servo_id)
+    _set_BusServoReadVoltageLimitResponse_success(m, _MEMBERS_ReadResult.get(v_success, v_success))
+    _set_BusServoReadVoltageLimitResponse_low(m, v_low)
+    _set_BusServoReadVoltageLimitResponse_high(m, v_high)
+    return m
 
 
 def _decode_bus_servo_set_temperature_limit_request(buf: bytes, o: int, end: int) -> BusServoSetTemperatureLimitRequest:
@@ -542,10 +667,10 @@ def _decode_bus_servo_set_temperature_limit_request(buf: bytes, o: int, end: int
     v_subcommand_code, v_servo_id, v_limit = _S_U8_U8_U8.unpack_from(buf, o)
     if v_subcommand_code != 56:
         raise DecodeError('bus_servo.set_temperature_limit request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x38')
-    o += 3
-    if o != end:
-        raise DecodeError('bus_servo.set_temperature_limit request' + f': {end - o} bytes left after the last field')
-    return BusServoSetTemperatureLimitRequest(v_servo_id, v_limit)
+    m = _new(BusServoSetTemperatureLimitRequest)
+    _set_BusServoSetTemperatureLimitRequest_servo_id(m, v_servo_id)
+    _set_BusServoSetTemperatureLimitRequest_limit(m, v_limit)
+    return m
 
 
 def _decode_bus_servo_read_temperature_limit_request(buf: bytes, o: int, end: int) -> BusServoReadTemperatureLimitRequest:
@@ -554,10 +679,9 @@ def _decode_bus_servo_read_temperature_limit_request(buf: bytes, o: int, end: in
     v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, o)
     if v_subcommand_code != 58:
         raise DecodeError('bus_servo.read_temperature_limit request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x3a')
-    o += 2
-    if o != end:
-        raise DecodeError('bus_servo.read_temperature_limit request' + f': {end - o} bytes left after the last field')
-    return BusServoReadTemperatureLimitRequest(v_servo_id)
+    m = _new(BusServoReadTemperatureLimitRequest)
+    _set_BusServoReadTemperatureLimitRequest_servo_id(m, v_servo_id)
+    return m
 
 
 def _decode_bus_servo_read_temperature_limit_response(buf: bytes, o: int, end: int) -> BusServoReadTemperatureLimitResponse:
@@ -566,40 +690,49 @@ def _decode_bus_servo_read_temperature_limit_response(buf: bytes, o: int, end: i
     v_servo_id, v_subcommand_code, v_success, v_limit = _S_U8_U8_I8_U8.unpack_from(buf, o)
     if v_subcommand_code != 58:
         raise DecodeError('bus_servo.read_temperature_limit response' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x3a')
-    o += 4
-    if o != end:
-        raise DecodeError('bus_servo.read_temperature_limit response' + f': {end - o} bytes left after the last field')
-    return BusServoReadTemperatureLimitResponse(v_servo_id, _enum(ReadResult, v_success), v_limit)
+    m = _new(BusServoReadTemperatureLimitResponse)
+    _set_BusServoReadTemperatureLimitResponse_servo_id(m, v_servo_id)
+    _set_BusServoReadTemperatureLimitResponse_success(m, _MEMBERS_ReadResult.get(v_success, v_success))
+    _set_BusServoReadTemperatureLimitResponse_limit(m, v_limit)
+    return m
 
 
 def _decode_key_response(buf: bytes, o: int, end: int) -> KeyResponse:
     if end - o != 2:
         raise content_size_error('key response', end - o, 2, 2)
     v_button_id, v_event = _S_U8_U8.unpack_from(buf, o)
-    o += 2
-    if o != end:
-        raise DecodeError('key response' + f': {end - o} bytes left after the last field')
-    return KeyResponse(v_button_id, _enum(ButtonEvent, v_event))
+    m = _new(KeyResponse)
+    _set_KeyResponse_button_id(m, v_button_id)
+    _set_KeyResponse_event(m, _MEMBERS_ButtonEvent.get(v_event, v_event))
+    return m
 
 
 def _decode_imu_response(buf: bytes, o: int, end: int) -> ImuResponse:
     if end - o != 24:
         raise content_size_error('imu response', end - o, 24, 24)
     v_accel_x, v_accel_y, v_accel_z, v_gyro_x, v_gyro_y, v_gyro_z = _S_F32_F32_F32_F32_F32_F32.unpack_from(buf, o)
-    o += 24
-    if o != end:
-        raise DecodeError('imu response' + f': {end - o} bytes left after the last field')
-    return ImuResponse(v_accel_x, v_accel_y, v_accel_z, v_gyro_x, v_gyro_y, v_gyro_z)
+    m = _new(ImuResponse)
+    _set_ImuResponse_accel_x(m, v_accel_x)
+    _set_ImuResponse_accel_y(m, v_accel_y)
+    _set_ImuResponse_accel_z(m, v_accel_z)
+    _set_ImuResponse_gyro_x(m, v_gyro_x)
+    _set_ImuResponse_gyro_y(m, v_gyro_y)
+    _set_ImuResponse_gyro_z(m, v_gyro_z)
+    return m
 
 
 def _decode_gamepad_response(buf: bytes, o: int, end: int) -> GamepadResponse:
     if end - o != 7:
         raise content_size_error('gamepad response', end - o, 7, 7)
     v_buttons, v_hat, v_left_x, v_left_y, v_right_x, v_right_y = _S_U16_U8_I8_I8_I8_I8.unpack_from(buf, o)
-    o += 7
-    if o != end:
-        raise DecodeError('gamepad response' + f': {end - o} bytes left after the last field')
-    return GamepadResponse(v_buttons, v_hat, v_left_x, v_left_y, v_right_x, v_right_y)
+    m = _new(GamepadResponse)
+    _set_GamepadResponse_buttons(m, v_buttons)
+    _set_GamepadResponse_hat(m, v_hat)
+    _set_GamepadResponse_left_x(m, v_left_x)
+    _set_GamepadResponse_left_y(m, v_left_y)
+    _set_GamepadResponse_right_x(m, v_right_x)
+    _set_GamepadResponse_right_y(m, v_right_y)
+    return m
 
 
 def _decode_sbus_response(buf: bytes, o: int, end: int) -> SbusResponse:
@@ -610,10 +743,13 @@ def _decode_sbus_response(buf: bytes, o: int, end: int) -> SbusResponse:
     v_ch18 = t[17]
     v_signal_loss = t[18]
     v_fail_safe = t[19]
-    o += 36
-    if o != end:
-        raise DecodeError('sbus response' + f': {end - o} bytes left after the last field')
-    return SbusResponse(t[0:16], v_ch17, v_ch18, v_signal_loss, v_fail_safe)
+    m = _new(SbusResponse)
+    _set_SbusResponse_channels(m, t[0:16])
+    _set_SbusResponse_ch17(m, v_ch17)
+    _set_SbusResponse_ch18(m, v_ch18)
+    _set_SbusResponse_signal_loss(m, v_signal_loss)
+    _set_SbusResponse_fail_safe(m, v_fail_safe)
+    return m
 
 
 def _encode_led_request(m: LedRequest) -> bytes:
@@ -625,7 +761,11 @@ def _encode_led_request(m: LedRequest) -> bytes:
         raise out_of_range('led request', 'off_time', m.off_time, 0, 65535)
     if not 0 <= m.repeat <= 65535:
         raise out_of_range('led request', 'repeat', m.repeat, 0, 65535)
-    return _frame_request(1, _S_U8_U16_U16_U16.pack(m.led_id, m.on_time, m.off_time, m.repeat))
+    body = _S_FRAME_LEDREQUEST.pack(b'\xaaU', 1, 7, m.led_id, m.on_time, m.off_time, m.repeat)
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
 
 
 def _encode_buzzer_request(m: BuzzerRequest) -> bytes:
@@ -637,7 +777,11 @@ def _encode_buzzer_request(m: BuzzerRequest) -> bytes:
         raise out_of_range('buzzer request', 'off_time', m.off_time, 0, 65535)
     if not 0 <= m.repeat <= 65535:
         raise out_of_range('buzzer request', 'repeat', m.repeat, 0, 65535)
-    return _frame_request(2, _S_U16_U16_U16_U16.pack(m.frequency, m.on_time, m.off_time, m.repeat))
+    body = _S_FRAME_BUZZERREQUEST.pack(b'\xaaU', 2, 8, m.frequency, m.on_time, m.off_time, m.repeat)
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
 
 
 def _encode_motor_set_speed_request(m: MotorSetSpeedRequest) -> bytes:
@@ -645,41 +789,52 @@ def _encode_motor_set_speed_request(m: MotorSetSpeedRequest) -> bytes:
         raise out_of_range('motor.set_speed request', 'motor_id', m.motor_id, 0, 255)
     if not -340282346638528859811704183484516925440 <= m.speed <= 340282346638528859811704183484516925440:
         raise out_of_range('motor.set_speed request', 'speed', m.speed, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
-    return _frame_request(3, _S_U8_U8_F32.pack(0, m.motor_id, m.speed))
-
-
-def _encode_MotorsItem(m: MotorsItem) -> bytes:
-    if not 0 <= m.motor_id <= 255:
-        raise out_of_range('motor.set_speeds request', 'motor_id', m.motor_id, 0, 255)
-    if not -340282346638528859811704183484516925440 <= m.speed <= 340282346638528859811704183484516925440:
-        raise out_of_range('motor.set_speeds request', 'speed', m.speed, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
-    return _S_U8_F32.pack(m.motor_id, m.speed)
+    body = _S_B2_U8_U8_U8_U8_F32.pack(b'\xaaU', 3, 6, 0, m.motor_id, m.speed)
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
 
 
 def _encode_motor_set_speeds_request(m: MotorSetSpeedsRequest) -> bytes:
     if len(m.motors) > 255:
         raise out_of_range('motor.set_speeds request', 'count', len(m.motors), 0, 255)
-    return _frame_request(3, b''.join((_S_U8_U8.pack(1, len(m.motors)), b''.join([_encode_MotorsItem(item) for item in m.motors]),)))
+    parts_motors = []
+    for item in m.motors:
+        if not 0 <= item.motor_id <= 255:
+            raise out_of_range('motor.set_speeds request', 'motor_id', item.motor_id, 0, 255)
+        if not -340282346638528859811704183484516925440 <= item.speed <= 340282346638528859811704183484516925440:
+            raise out_of_range('motor.set_speeds request', 'speed', item.speed, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
+        parts_motors.append(_S_U8_F32.pack(item.motor_id, item.speed))
+    content = b''.join((_S_U8_U8.pack(1, len(m.motors)), b''.join(parts_motors),))
+    n = len(content)
+    if n > 255:
+        raise EncodeError(f'content of {len(content)} bytes does not fit the length field')
+    body = _S_B2_U8_U8.pack(b'\xaaU', 3, n) + content
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
 
 
 def _encode_motor_stop_request(m: MotorStopRequest) -> bytes:
     if not 0 <= m.motor_id <= 255:
         raise out_of_range('motor.stop request', 'motor_id', m.motor_id, 0, 255)
-    return _frame_request(3, _S_U8_U8.pack(2, m.motor_id))
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 3, 2, 2, m.motor_id)
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
 
 
 def _encode_motor_stop_mask_request(m: MotorStopMaskRequest) -> bytes:
     if not 0 <= m.mask <= 255:
         raise out_of_range('motor.stop_mask request', 'mask', m.mask, 0, 255)
-    return _frame_request(3, _S_U8_U8.pack(3, m.mask))
-
-
-def _encode_PwmServosItem(m: PwmServosItem) -> bytes:
-    if not 0 <= m.servo_id <= 255:
-        raise out_of_range('pwm_servo.set_positions request', 'servo_id', m.servo_id, 0, 255)
-    if not 500 <= m.pulse <= 2500:
-        raise out_of_range('pwm_servo.set_positions request', 'pulse', m.pulse, 500, 2500)
-    return _S_U8_U16.pack(m.servo_id, m.pulse)
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 3, 2, 3, m.mask)
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
 
 
 def _encode_pwm_servo_set_positions_request(m: PwmServoSetPositionsRequest) -> bytes:
@@ -687,7 +842,22 @@ def _encode_pwm_servo_set_positions_request(m: PwmServoSetPositionsRequest) -> b
         raise out_of_range('pwm_servo.set_positions request', 'duration', m.duration, 0, 65535)
     if len(m.pwm_servos) > 255:
         raise out_of_range('pwm_servo.set_positions request', 'count', len(m.pwm_servos), 0, 255)
-    return _frame_request(4, b''.join((_S_U8_U16_U8.pack(1, m.duration, len(m.pwm_servos)), b''.join([_encode_PwmServosItem(item) for item in m.pwm_servos]),)))
+    parts_pwm_servos = []
+    for item in m.pwm_servos:
+        if not 0 <= item.servo_id <= 255:
+            raise out_of_range('pwm_servo.set_positions request', 'servo_id', item.servo_id, 0, 255)
+        if not 500 <= item.pulse <= 2500:
+            raise out_of_range('pwm_servo.set_positions request', 'pulse', item.pulse, 500, 2500)
+        parts_pwm_servos.append(_S_U8_U16.pack(item.servo_id, item.pulse))
+    content = b''.join((_S_U8_U16_U8.pack(1, m.duration, len(m.pwm_servos)), b''.join(parts_pwm_servos),))
+    n = len(content)
+    if n > 255:
+        raise EncodeError(f'content of {len(content)} bytes does not fit the length field')
+    body = _S_B2_U8_U8.pack(b'\xaaU', 4, n) + content
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
 
 
 def _encode_pwm_servo_set_position_request(m: PwmServoSetPositionRequest) -> bytes:
@@ -697,13 +867,21 @@ def _encode_pwm_servo_set_position_request(m: PwmServoSetPositionRequest) -> byt
         raise out_of_range('pwm_servo.set_position request', 'servo_id', m.servo_id, 0, 255)
     if not 500 <= m.pulse <= 2500:
         raise out_of_range('pwm_servo.set_position request', 'pulse', m.pulse, 500, 2500)
-    return _frame_request(4, _S_U8_U16_U8_U16.pack(3, m.duration, m.servo_id, m.pulse))
+    body = _S_FRAME_PWMSERVOSETPOSITIONREQUEST.pack(b'\xaaU', 4, 6, 3, m.duration, m.servo_id, m.pulse)
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
 
 
 def _encode_pwm_servo_read_position_request(m: PwmServoReadPositionRequest) -> bytes:
     if not 0 <= m.servo_id <= 255:
         raise out_of_range('pwm_servo.read_position request', 'servo_id', m.servo_id, 0, 255)
-    return _frame_request(4, _S_U8_U8.pack(5, m.servo_id))
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 4, 2, 5, m.servo_id)
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
 
 
 def _encode_pwm_servo_read_position_response(m: PwmServoReadPositionResponse) -> bytes:
@@ -711,7 +889,11 @@ def _encode_pwm_servo_read_position_response(m: PwmServoReadPositionResponse) ->
         raise out_of_range('pwm_servo.read_position response', 'servo_id', m.servo_id, 0, 255)
     if not 0 <= m.pulse <= 65535:
         raise out_of_range('pwm_servo.read_position response', 'pulse', m.pulse, 0, 65535)
-    return _frame_response(4, _S_U8_U8_U16.pack(m.servo_id, 5, m.pulse))
+    body = _S_B2_U8_U8_U8_U8_U16.pack(b'\xaaU', 4, 4, m.servo_id, 5, m.pulse)
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
 
 
 def _encode_pwm_servo_set_offset_request(m: PwmServoSetOffsetRequest) -> bytes:
@@ -719,13 +901,21 @@ def _encode_pwm_servo_set_offset_request(m: PwmServoSetOffsetRequest) -> bytes:
         raise out_of_range('pwm_servo.set_offset request', 'servo_id', m.servo_id, 0, 255)
     if not -100 <= m.offset <= 100:
         raise out_of_range('pwm_servo.set_offset request', 'offset', m.offset, -100, 100)
-    return _frame_request(4, _S_U8_U8_I8.pack(7, m.servo_id, m.offset))
+    body = _S_B2_U8_U8_U8_U8_I8.pack(b'\xaaU', 4, 3, 7, m.servo_id, m.offset)
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
 
 
 def _encode_pwm_servo_read_offset_request(m: PwmServoReadOffsetRequest) -> bytes:
     if not 0 <= m.servo_id <= 255:
         raise out_of_range('pwm_servo.read_offset request', 'servo_id', m.servo_id, 0, 255)
-    return _frame_request(4, _S_U8_U8.pack(9, m.servo_id))
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 4, 2, 9, m.servo_id)
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
 
 
 def _encode_pwm_servo_read_offset_response(m: PwmServoReadOffsetResponse) -> bytes:
@@ -733,15 +923,11 @@ def _encode_pwm_servo_read_offset_response(m: PwmServoReadOffsetResponse) -> byt
         raise out_of_range('pwm_servo.read_offset response', 'servo_id', m.servo_id, 0, 255)
     if not -128 <= m.offset <= 127:
         raise out_of_range('pwm_servo.read_offset response', 'offset', m.offset, -128, 127)
-    return _frame_response(4, _S_U8_U8_I8.pack(m.servo_id, 9, m.offset))
-
-
-def _encode_BusServosItem(m: BusServosItem) -> bytes:
-    if not 0 <= m.servo_id <= 255:
-        raise out_of_range('bus_servo.set_positions request', 'servo_id', m.servo_id, 0, 255)
-    if not 0 <= m.position <= 1000:
-        raise out_of_range('bus_servo.set_positions request', 'position', m.position, 0, 1000)
-    return _S_U8_U16.pack(m.servo_id, m.position)
+    body = _S_B2_U8_U8_U8_U8_I8.pack(b'\xaaU', 4, 3, m.servo_id, 9, m.offset)
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
 
 
 def _encode_bus_servo_set_positions_request(m: BusServoSetPositionsRequest) -> bytes:
@@ -749,13 +935,32 @@ def _encode_bus_servo_set_positions_request(m: BusServoSetPositionsRequest) -> b
         raise out_of_range('bus_servo.set_positions request', 'duration', m.duration, 0, 65535)
     if len(m.bus_servos) > 255:
         raise out_of_range('bus_servo.set_positions request', 'count', len(m.bus_servos), 0, 255)
-    return _frame_request(5, b''.join((_S_U8_U16_U8.pack(1, m.duration, len(m.bus_servos)), b''.join([_encode_BusServosItem(item) for item in m.bus_servos]),)))
+    parts_bus_servos = []
+    for item in m.bus_servos:
+        if not 0 <= item.servo_id <= 255:
+            raise out_of_range('bus_servo.set_positions request', 'servo_id', item.servo_id, 0, 255)
+        if not 0 <= item.position <= 1000:
+            raise out_of_range('bus_servo.set_positions request', 'position', item.position, 0, 1000)
+        parts_bus_servos.append(_S_U8_U16.pack(item.servo_id, item.position))
+    content = b''.join((_S_U8_U16_U8.pack(1, m.duration, len(m.bus_servos)), b''.join(parts_bus_servos),))
+    n = len(content)
+    if n > 255:
+        raise EncodeError(f'content of {len(content)} bytes does not fit the length field')
+    body = _S_B2_U8_U8.pack(b'\xaaU', 5, n) + content
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
 
 
 def _encode_bus_servo_read_position_request(m: BusServoReadPositionRequest) -> bytes:
     if not 0 <= m.servo_id <= 255:
         raise out_of_range('bus_servo.read_position request', 'servo_id', m.servo_id, 0, 255)
-    return _frame_request(5, _S_U8_U8.pack(5, m.servo_id))
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 5, m.servo_id)
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
 
 
 def _encode_bus_servo_read_position_response(m: BusServoReadPositionResponse) -> bytes:
@@ -765,13 +970,21 @@ def _encode_bus_servo_read_position_response(m: BusServoReadPositionResponse) ->
         raise out_of_range('bus_servo.read_position response', 'success', m.success, -128, 127)
     if not -32768 <= m.position <= 32767:
         raise out_of_range('bus_servo.read_position response', 'position', m.position, -32768, 32767)
-    return _frame_response(5, _S_U8_U8_I8_I16.pack(m.servo_id, 5, m.success, m.position))
+    body = _S_FRAME_BUSSERVOREADPOSITIONRESPONSE.pack(b'\xaaU', 5, 5, m.servo_id, 5, m.success, m.position)
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
 
 
 def _encode_bus_servo_read_voltage_request(m: BusServoReadVoltageRequest) -> bytes:
     if not 0 <= m.servo_id <= 255:
         raise out_of_range('bus_servo.read_voltage request', 'servo_id', m.servo_id, 0, 255)
-    return _frame_request(5, _S_U8_U8.pack(7, m.servo_id))
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 7, m.servo_id)
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
 
 
 def _encode_bus_servo_read_voltage_response(m: BusServoReadVoltageResponse) -> bytes:
@@ -781,13 +994,21 @@ def _encode_bus_servo_read_voltage_response(m: BusServoReadVoltageResponse) -> b
         raise out_of_range('bus_servo.read_voltage response', 'success', m.success, -128, 127)
     if not 0 <= m.voltage <= 65535:
         raise out_of_range('bus_servo.read_voltage response', 'voltage', m.voltage, 0, 65535)
-    return _frame_response(5, _S_U8_U8_I8_U16.pack(m.servo_id, 7, m.success, m.voltage))
+    body = _S_FRAME_BUSSERVOREADVOLTAGERESPONSE.pack(b'\xaaU', 5, 5, m.servo_id, 7, m.success, m.voltage)
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
 
 
 def _encode_bus_servo_read_temperature_request(m: BusServoReadTemperatureRequest) -> bytes:
     if not 0 <= m.servo_id <= 255:
         raise out_of_range('bus_servo.read_temperature request', 'servo_id', m.servo_id, 0, 255)
-    return _frame_request(5, _S_U8_U8.pack(9, m.servo_id))
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 9, m.servo_id)
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
 
 
 def _encode_bus_servo_read_temperature_response(m: BusServoReadTemperatureResponse) -> bytes:
@@ -797,19 +1018,31 @@ def _encode_bus_servo_read_temperature_response(m: BusServoReadTemperatureRespon
         raise out_of_range('bus_servo.read_temperature response', 'success', m.success, -128, 127)
     if not 0 <= m.temperature <= 255:
         raise out_of_range('bus_servo.read_temperature response', 'temperature', m.temperature, 0, 255)
-    return _frame_response(5, _S_U8_U8_I8_U8.pack(m.servo_id, 9, m.success, m.temperature))
+    body = _S_FRAME_BUSSERVOREADTEMPERATURERESPONSE.pack(b'\xaaU', 5, 4, m.servo_id, 9, m.success, m.temperature)
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
 
 
 def _encode_bus_servo_unload_request(m: BusServoUnloadRequest) -> bytes:
     if not 0 <= m.servo_id <= 255:
         raise out_of_range('bus_servo.unload request', 'servo_id', m.servo_id, 0, 255)
-    return _frame_request(5, _S_U8_U8.pack(11, m.servo_id))
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 11, m.servo_id)
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
 
 
 def _encode_bus_servo_load_request(m: BusServoLoadRequest) -> bytes:
     if not 0 <= m.servo_id <= 255:
         raise out_of_range('bus_servo.load request', 'servo_id', m.servo_id, 0, 255)
-    return _frame_request(5, _S_U8_U8.pack(12, m.servo_id))
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 12, m.servo_id)
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
 
 
 def _encode_bus_servo_set_id_request(m: BusServoSetIdRequest) -> bytes:
@@ -817,13 +1050,21 @@ def _encode_bus_servo_set_id_request(m: BusServoSetIdRequest) -> bytes:
         raise out_of_range('bus_servo.set_id request', 'servo_id', m.servo_id, 0, 255)
     if not 0 <= m.new_id <= 255:
         raise out_of_range('bus_servo.set_id request', 'new_id', m.new_id, 0, 255)
-    return _frame_request(5, _S_U8_U8_U8.pack(16, m.servo_id, m.new_id))
+    body = _S_B2_U8_U8_U8_U8_U8.pack(b'\xaaU', 5, 3, 16, m.servo_id, m.new_id)
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
 
 
 def _encode_bus_servo_read_id_request(m: BusServoReadIdRequest) -> bytes:
     if not 0 <= m.servo_id <= 255:
         raise out_of_range('bus_servo.read_id request', 'servo_id', m.servo_id, 0, 255)
-    return _frame_request(5, _S_U8_U8.pack(18, m.servo_id))
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 18, m.servo_id)
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
 
 
 def _encode_bus_servo_read_id_response(m: BusServoReadIdResponse) -> bytes:
@@ -833,7 +1074,11 @@ def _encode_bus_servo_read_id_response(m: BusServoReadIdResponse) -> bytes:
         raise out_of_range('bus_servo.read_id response', 'success', m.success, -128, 127)
     if not 0 <= m.id <= 255:
         raise out_of_range('bus_servo.read_id response', 'id', m.id, 0, 255)
-    return _frame_response(5, _S_U8_U8_I8_U8.pack(m.servo_id, 18, m.success, m.id))
+    body = _S_FRAME_BUSSERVOREADTEMPERATURERESPONSE.pack(b'\xaaU', 5, 4, m.servo_id, 18, m.success, m.id)
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
 
 
 def _encode_bus_servo_set_offset_request(m: BusServoSetOffsetRequest) -> bytes:
@@ -841,13 +1086,21 @@ def _encode_bus_servo_set_offset_request(m: BusServoSetOffsetRequest) -> bytes:
         raise out_of_range('bus_servo.set_offset request', 'servo_id', m.servo_id, 0, 255)
     if not -100 <= m.offset <= 100:
         raise out_of_range('bus_servo.set_offset request', 'offset', m.offset, -100, 100)
-    return _frame_request(5, _S_U8_U8_I8.pack(32, m.servo_id, m.offset))
+    body = _S_B2_U8_U8_U8_U8_I8.pack(b'\xaaU', 5, 3, 32, m.servo_id, m.offset)
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
 
 
 def _encode_bus_servo_read_offset_request(m: BusServoReadOffsetRequest) -> bytes:
     if not 0 <= m.servo_id <= 255:
         raise out_of_range('bus_servo.read_offset request', 'servo_id', m.servo_id, 0, 255)
-    return _frame_request(5, _S_U8_U8.pack(34, m.servo_id))
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 34, m.servo_id)
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
 
 
 def _encode_bus_servo_read_offset_response(m: BusServoReadOffsetResponse) -> bytes:
@@ -857,13 +1110,21 @@ def _encode_bus_servo_read_offset_response(m: BusServoReadOffsetResponse) -> byt
         raise out_of_range('bus_servo.read_offset response', 'success', m.success, -128, 127)
     if not -128 <= m.offset <= 127:
         raise out_of_range('bus_servo.read_offset response', 'offset', m.offset, -128, 127)
-    return _frame_response(5, _S_U8_U8_I8_I8.pack(m.servo_id, 34, m.success, m.offset))
+    body = _S_FRAME_BUSSERVOREADOFFSETRESPONSE.pack(b'\xaaU', 5, 4, m.servo_id, 34, m.success, m.offset)
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
 
 
 def _encode_bus_servo_save_offset_request(m: BusServoSaveOffsetRequest) -> bytes:
     if not 0 <= m.servo_id <= 255:
         raise out_of_range('bus_servo.save_offset request', 'servo_id', m.servo_id, 0, 255)
-    return _frame_request(5, _S_U8_U8.pack(36, m.servo_id))
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 36, m.servo_id)
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
 
 
 def _encode_bus_servo_set_position_limit_request(m: BusServoSetPositionLimitRequest) -> bytes:
@@ -873,13 +1134,21 @@ def _encode_bus_servo_set_position_limit_request(m: BusServoSetPositionLimitRequ
         raise out_of_range('bus_servo.set_position_limit request', 'low', m.low, 0, 1000)
     if not 0 <= m.high <= 1000:
         raise out_of_range('bus_servo.set_position_limit request', 'high', m.high, 0, 1000)
-    return _frame_request(5, _S_U8_U8_U16_U16.pack(48, m.servo_id, m.low, m.high))
+    body = _S_FRAME_BUSSERVOSETPOSITIONLIMITREQUEST.pack(b'\xaaU', 5, 6, 48, m.servo_id, m.low, m.high)
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
 
 
 def _encode_bus_servo_read_position_limit_request(m: BusServoReadPositionLimitRequest) -> bytes:
     if not 0 <= m.servo_id <= 255:
         raise out_of_range('bus_servo.read_position_limit request', 'servo_id', m.servo_id, 0, 255)
-    return _frame_request(5, _S_U8_U8.pack(50, m.servo_id))
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 50, m.servo_id)
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
 
 
 def _encode_bus_servo_read_position_limit_response(m: BusServoReadPositionLimitResponse) -> bytes:
@@ -891,7 +1160,11 @@ def _encode_bus_servo_read_position_limit_response(m: BusServoReadPositionLimitR
         raise out_of_range('bus_servo.read_position_limit response', 'low', m.low, 0, 65535)
     if not 0 <= m.high <= 65535:
         raise out_of_range('bus_servo.read_position_limit response', 'high', m.high, 0, 65535)
-    return _frame_response(5, _S_U8_U8_I8_U16_U16.pack(m.servo_id, 50, m.success, m.low, m.high))
+    body = _S_FRAME_BUSSERVOREADPOSITIONLIMITRESPONSE.pack(b'\xaaU', 5, 7, m.servo_id, 50, m.success, m.low, m.high)
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
 
 
 def _encode_bus_servo_set_voltage_limit_request(m: BusServoSetVoltageLimitRequest) -> bytes:
@@ -901,13 +1174,21 @@ def _encode_bus_servo_set_voltage_limit_request(m: BusServoSetVoltageLimitReques
         raise out_of_range('bus_servo.set_voltage_limit request', 'low', m.low, 4500, 14000)
     if not 4500 <= m.high <= 14000:
         raise out_of_range('bus_servo.set_voltage_limit request', 'high', m.high, 4500, 14000)
-    return _frame_request(5, _S_U8_U8_U16_U16.pack(52, m.servo_id, m.low, m.high))
+    body = _S_FRAME_BUSSERVOSETPOSITIONLIMITREQUEST.pack(b'\xaaU', 5, 6, 52, m.servo_id, m.low, m.high)
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
 
 
 def _encode_bus_servo_read_voltage_limit_request(m: BusServoReadVoltageLimitRequest) -> bytes:
     if not 0 <= m.servo_id <= 255:
         raise out_of_range('bus_servo.read_voltage_limit request', 'servo_id', m.servo_id, 0, 255)
-    return _frame_request(5, _S_U8_U8.pack(54, m.servo_id))
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 54, m.servo_id)
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
 
 
 def _encode_bus_servo_read_voltage_limit_response(m: BusServoReadVoltageLimitResponse) -> bytes:
@@ -919,7 +1200,11 @@ def _encode_bus_servo_read_voltage_limit_response(m: BusServoReadVoltageLimitRes
         raise out_of_range('bus_servo.read_voltage_limit response', 'low', m.low, 0, 65535)
     if not 0 <= m.high <= 65535:
         raise out_of_range('bus_servo.read_voltage_limit response', 'high', m.high, 0, 65535)
-    return _frame_response(5, _S_U8_U8_I8_U16_U16.pack(m.servo_id, 54, m.success, m.low, m.high))
+    body = _S_FRAME_BUSSERVOREADPOSITIONLIMITRESPONSE.pack(b'\xaaU', 5, 7, m.servo_id, 54, m.success, m.low, m.high)
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
 
 
 def _encode_bus_servo_set_temperature_limit_request(m: BusServoSetTemperatureLimitRequest) -> bytes:
@@ -927,13 +1212,21 @@ def _encode_bus_servo_set_temperature_limit_request(m: BusServoSetTemperatureLim
         raise out_of_range('bus_servo.set_temperature_limit request', 'servo_id', m.servo_id, 0, 255)
     if not 0 <= m.limit <= 99:
         raise out_of_range('bus_servo.set_temperature_limit request', 'limit', m.limit, 0, 99)
-    return _frame_request(5, _S_U8_U8_U8.pack(56, m.servo_id, m.limit))
+    body = _S_B2_U8_U8_U8_U8_U8.pack(b'\xaaU', 5, 3, 56, m.servo_id, m.limit)
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
 
 
 def _encode_bus_servo_read_temperature_limit_request(m: BusServoReadTemperatureLimitRequest) -> bytes:
     if not 0 <= m.servo_id <= 255:
         raise out_of_range('bus_servo.read_temperature_limit request', 'servo_id', m.servo_id, 0, 255)
-    return _frame_request(5, _S_U8_U8.pack(58, m.servo_id))
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 58, m.servo_id)
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
 
 
 def _encode_bus_servo_read_temperature_limit_response(m: BusServoReadTemperatureLimitResponse) -> bytes:
@@ -943,7 +1236,11 @@ def _encode_bus_servo_read_temperature_limit_response(m: BusServoReadTemperature
         raise out_of_range('bus_servo.read_temperature_limit response', 'success', m.success, -128, 127)
     if not 0 <= m.limit <= 255:
         raise out_of_range('bus_servo.read_temperature_limit response', 'limit', m.limit, 0, 255)
-    return _frame_response(5, _S_U8_U8_I8_U8.pack(m.servo_id, 58, m.success, m.limit))
+    body = _S_FRAME_BUSSERVOREADTEMPERATURERESPONSE.pack(b'\xaaU', 5, 4, m.servo_id, 58, m.success, m.limit)
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
 
 
 def _encode_key_response(m: KeyResponse) -> bytes:
@@ -951,7 +1248,11 @@ def _encode_key_response(m: KeyResponse) -> bytes:
         raise out_of_range('key response', 'button_id', m.button_id, 0, 255)
     if not 0 <= m.event <= 255:
         raise out_of_range('key response', 'event', m.event, 0, 255)
-    return _frame_response(6, _S_U8_U8.pack(m.button_id, m.event))
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 6, 2, m.button_id, m.event)
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
 
 
 def _encode_imu_response(m: ImuResponse) -> bytes:
@@ -967,7 +1268,11 @@ def _encode_imu_response(m: ImuResponse) -> bytes:
         raise out_of_range('imu response', 'gyro_y', m.gyro_y, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
     if not -340282346638528859811704183484516925440 <= m.gyro_z <= 340282346638528859811704183484516925440:
         raise out_of_range('imu response', 'gyro_z', m.gyro_z, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
-    return _frame_response(7, _S_F32_F32_F32_F32_F32_F32.pack(m.accel_x, m.accel_y, m.accel_z, m.gyro_x, m.gyro_y, m.gyro_z))
+    body = _S_FRAME_IMURESPONSE.pack(b'\xaaU', 7, 24, m.accel_x, m.accel_y, m.accel_z, m.gyro_x, m.gyro_y, m.gyro_z)
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
 
 
 def _encode_gamepad_response(m: GamepadResponse) -> bytes:
@@ -983,7 +1288,11 @@ def _encode_gamepad_response(m: GamepadResponse) -> bytes:
         raise out_of_range('gamepad response', 'right_x', m.right_x, -128, 127)
     if not -128 <= m.right_y <= 127:
         raise out_of_range('gamepad response', 'right_y', m.right_y, -128, 127)
-    return _frame_response(8, _S_U16_U8_I8_I8_I8_I8.pack(m.buttons, m.hat, m.left_x, m.left_y, m.right_x, m.right_y))
+    body = _S_FRAME_GAMEPADRESPONSE.pack(b'\xaaU', 8, 7, m.buttons, m.hat, m.left_x, m.left_y, m.right_x, m.right_y)
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
 
 
 def _encode_sbus_response(m: SbusResponse) -> bytes:
@@ -999,7 +1308,11 @@ def _encode_sbus_response(m: SbusResponse) -> bytes:
         raise out_of_range('sbus response', 'signal_loss', m.signal_loss, 0, 255)
     if not 0 <= m.fail_safe <= 255:
         raise out_of_range('sbus response', 'fail_safe', m.fail_safe, 0, 255)
-    return _frame_response(9, _S_I16X16_U8_U8_U8_U8.pack(*m.channels, m.ch17, m.ch18, m.signal_loss, m.fail_safe))
+    body = _S_FRAME_SBUSRESPONSE.pack(b'\xaaU', 9, 36, *m.channels, m.ch17, m.ch18, m.signal_loss, m.fail_safe)
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
 
 
 def _decode_motor_request(buf: bytes, o: int, end: int) -> Message:
@@ -1119,26 +1432,37 @@ _REQUEST_SIZES: dict[int | None, tuple[int, int | None]] = {
 }
 
 
-def _checksum_ok_request(frame: bytes) -> bool:
-    return _checksum(frame[2:-1]) == int.from_bytes(frame[-1:], "little")
-
-
 def _decode_request(data: bytes) -> Message:
     n = len(data)
     if n < 5:
         raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (5 bytes)")
     if data[:2] != b'\xaaU':
         raise DecodeError(f"request header is {data[:2].hex(' ')}, expected aa 55")
-    size = data[3] - 0
-    if size < 0 or n != 5 + size:
+    size = data[3]
+    if n != 5 + size:
         raise DecodeError(f"length byte says {size} content bytes but the frame holds {n - 5}")
-    expected = _checksum(data[2:-1])
-    if expected != int.from_bytes(data[-1:], "little"):
+    expected = 0x0
+    for byte in data[2:-1]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != data[-1]:
         raise ChecksumError(f"bad checksum: the frame has {data[-1]:#04x}, its bytes give {expected:#04x}")
     decoder = _REQUEST_DECODERS.get(data[2])
     if decoder is None:
         raise DecodeError(f"unknown command {data[2]:#04x}")
     return decoder(data, 4, n - 1)
+
+
+def _decode_request_at(buf: bytes, start: int, stop: int) -> Message:
+    """The frame buf[start:stop], whose header and length byte the stream parser has checked."""
+    expected = 0x0
+    for byte in buf[start + 2 : stop - 1]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[stop - 1]:
+        raise ChecksumError(f"bad checksum: the frame has {buf[stop - 1]:#04x}, its bytes give {expected:#04x}")
+    decoder = _REQUEST_DECODERS.get(buf[start + 2])
+    if decoder is None:
+        raise DecodeError(f"unknown command {buf[start + 2]:#04x}")
+    return decoder(buf, start + 4, stop - 1)
 
 
 _RESPONSE_DECODERS: dict[int | None, Callable[..., Message]] = {
@@ -1159,26 +1483,38 @@ _RESPONSE_SIZES: dict[int | None, tuple[int, int | None]] = {
 }
 
 
-def _checksum_ok_response(frame: bytes) -> bool:
-    return _checksum(frame[2:-1]) == int.from_bytes(frame[-1:], "little")
-
-
 def _decode_response(data: bytes) -> Message:
     n = len(data)
     if n < 5:
         raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (5 bytes)")
     if data[:2] != b'\xaaU':
         raise DecodeError(f"response header is {data[:2].hex(' ')}, expected aa 55")
-    size = data[3] - 0
-    if size < 0 or n != 5 + size:
+    size = data[3]
+    if n != 5 + size:
         raise DecodeError(f"length byte says {size} content bytes but the frame holds {n - 5}")
-    expected = _checksum(data[2:-1])
-    if expected != int.from_bytes(data[-1:], "little"):
+    expected = 0x0
+    for byte in data[2:-1]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != data[-1]:
         raise ChecksumError(f"bad checksum: the frame has {data[-1]:#04x}, its bytes give {expected:#04x}")
     decoder = _RESPONSE_DECODERS.get(data[2])
     if decoder is None:
         raise DecodeError(f"unknown command {data[2]:#04x}")
     return decoder(data, 4, n - 1)
+
+
+def _decode_response_at(buf: bytes, start: int, stop: int) -> Message:
+    """The frame buf[start:stop], whose header and length byte the stream parser has checked."""
+    expected = 0x0
+    for byte in buf[start + 2 : stop - 1]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[stop - 1]:
+        raise ChecksumError(f"bad checksum: the frame has {buf[stop - 1]:#04x}, its bytes give {expected:#04x}")
+    decoder = _RESPONSE_DECODERS.get(buf[start + 2])
+    if decoder is None:
+        raise DecodeError(f"unknown command {buf[start + 2]:#04x}")
+    return decoder(buf, start + 4, stop - 1)
+
 
 _ENCODERS: dict[type[Message], Callable[..., bytes]] = {
     LedRequest: _encode_led_request,
@@ -1232,8 +1568,7 @@ REQUEST_FORMAT = FrameFormat(
     length_adds=0,
     command_offset=2,
     content_sizes=_REQUEST_SIZES,
-    checksum_ok=_checksum_ok_request,
-    decode=_decode_request,
+    decode_at=_decode_request_at,
 )
 RESPONSE_FORMAT = FrameFormat(
     header=b'\xaaU',
@@ -1242,19 +1577,18 @@ RESPONSE_FORMAT = FrameFormat(
     length_adds=0,
     command_offset=2,
     content_sizes=_RESPONSE_SIZES,
-    checksum_ok=_checksum_ok_response,
-    decode=_decode_response,
+    decode_at=_decode_response_at,
 )
 
 
 def decode(data: bytes, direction: Direction | str | None = None) -> Message:
     """Decode one complete frame into its message; raises DecodeError with a one-line reason."""
+    if direction == 'request':  # a Direction or its value
+        return _decode_request(data)
+    if direction == 'response':  # a Direction or its value
+        return _decode_response(data)
     if direction is None:
         raise DecodeError("give the direction: requests and responses share the header aa 55")
-    if direction == Direction.REQUEST:
-        return _decode_request(data)
-    if direction == Direction.RESPONSE:
-        return _decode_response(data)
     raise ValueError(f"direction must be request or response, not {direction!r}")
 
 

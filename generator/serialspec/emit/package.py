@@ -2,23 +2,30 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 from typing import Any
 
 from serialspec.emit.client import client_module
 from serialspec.emit.pycode import (
     ClassCode,
+    Lines,
     PackageCode,
+    checksum_lines,
+    crc_setup,
     decoder_name,
     encoder_name,
-    frame_lines,
     number,
     one_line,
+    setter_name,
 )
+from serialspec.emit.registers import register_tables, registers_module
 from serialspec.emit.render import render
 from serialspec.emit.simulator import simulator_module
 from serialspec.emit.structs import structs_module
-from serialspec.spec.model import Command, Direction, Message, Protocol, Scalar, Table, TableValue
+from serialspec.spec.model import Command, Direction, FrameLayout, Message, Protocol, Scalar, Table, TableValue
+
+_IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 
 
 def class_context(cls: ClassCode, where: str, keys: list[str], optional: list[str]) -> dict[str, Any]:
@@ -94,7 +101,6 @@ def emit_package(protocol: Protocol) -> dict[str, str]:
             "codec.py.j2",
             **base,
             **codec_context(protocol, code, exports),
-            used="\n".join(line for _, _, _, lines in code.decoders for line in lines),
         ),
         "structs.py": structs_module(protocol),
         "__init__.py": render(
@@ -108,6 +114,8 @@ def emit_package(protocol: Protocol) -> dict[str, str]:
         "client.py": client_module(protocol),
         "py.typed": "",
     }
+    if register_tables(protocol):
+        files["registers.py"] = registers_module(protocol)
     if protocol.device is not None:
         files["simulator.py"] = simulator_module(protocol)
     return files
@@ -128,25 +136,10 @@ def message_doc(protocol: Protocol, message: Message) -> str:
 
 
 def codec_context(protocol: Protocol, code: PackageCode, exports: list[str]) -> dict[str, Any]:
-    checksum = protocol.framing.checksum
-    if checksum.algorithm == "crc":
-        assert checksum.crc is not None
-        c = checksum.crc
-        checksum_import = "crc_function"
-        checksum_expr = (
-            f"crc_function({c.width}, {c.poly:#x}, {c.init:#x}, {c.refin}, {c.refout}, {c.xorout:#x})"
-            f"  # {one_line(c.name)}"
-        )
-    else:
-        checksum_import = "sum_function"
-        checksum_expr = f"sum_function({checksum.type.size * 8}, invert={checksum.invert})"
-    framers = []
+    checksum_import, checksum_definition = crc_setup(protocol.framing.checksum)
     directions = []
     dispatchers = []
     for direction, layout in protocol.framing.layouts.items():
-        params, lines = frame_lines(layout)
-        typed = ", ".join(f"{p}: bytes" if p == "content" else f"{p}: int" for p in params)
-        framers.append({"name": f"_frame_{direction.value}", "params": typed, "lines": lines})
         dispatch = []
         sizes = []
         for command in protocol.commands:
@@ -165,7 +158,6 @@ def codec_context(protocol: Protocol, code: PackageCode, exports: list[str]) -> 
                         "args": "".join(f", {e.name}" for e in layout.value_elements),
                     }
                 )
-        trim = layout.covered_to_end
         directions.append(
             {
                 "name": direction.value,
@@ -177,41 +169,32 @@ def codec_context(protocol: Protocol, code: PackageCode, exports: list[str]) -> 
                 "length_offset": layout.length_offset,
                 "length_adds": layout.length_adds,
                 "command_offset": layout.command_offset,
-                "code_expr": f"data[{layout.command_offset}]" if layout.command_offset is not None else "None",
-                "unknown_message": (
-                    f'f"unknown command {{data[{layout.command_offset}]:#04x}}"'
-                    if layout.command_offset is not None
-                    else f'"no {direction.value} is defined"'
-                ),
-                "covered_from": layout.covered_from,
-                "covered_end": f"-{trim}" if trim else "",
-                "checksum_size": layout.checksum_offset_from_end,
-                "content_offset": layout.offsets[next(e.name for e in layout.elements if e.role == "content")],
-                "after_content": layout.overhead
-                - layout.offsets[next(e.name for e in layout.elements if e.role == "content")],
-                "value_args": "".join(f", data[{layout.offsets[e.name]}]" for e in layout.value_elements),
                 "dispatch": dispatch,
                 "sizes": sizes,
+                "whole": frame_decode_lines(protocol, layout, dispatch, "data", None),
+                "at": frame_decode_lines(protocol, layout, dispatch, "buf", "start"),
             }
         )
     layouts = protocol.framing.layouts
     header_choices = " or ".join(layouts[d].header.hex(" ") for d in Direction)
     encoder_table = [(m.class_name, encoder_name(m)) for m in protocol.messages()]
+    codec_names = names_used_in_codec(code)
     return {
         "checksum_import": checksum_import,
-        "checksum_expr": checksum_expr,
+        "checksum_definition": checksum_definition,
         "structs": sorted(code.structs.items()),
         "tables": [
             table_context(t) for t in protocol.tables if any(uses_table(m, t.name) for m in protocol.messages())
         ],
-        "framers": framers,
+        "setters": [(cls, setter_targets(cls, names)) for cls, names in sorted(code.built.items()) if names],
+        "member_maps": sorted(code.member_maps),
         "decoders": [{"name": n, "returns": r, "extra": e, "lines": lines} for n, r, e, lines in code.decoders],
         "encoders": [{"name": n, "type": t, "lines": lines} for n, t, lines in code.encoders],
         "directions": directions,
         "dispatchers": dispatchers,
         "encoder_table": encoder_table,
         "imports": sorted(
-            (n for n in exports if n not in ("Direction", "Message", "MESSAGE_TYPES") and used_in_codec(n, code)),
+            (n for n in exports if n not in ("Direction", "Message", "MESSAGE_TYPES") and n in codec_names),
             key=str.lower,  # the order isort (ruff) expects
         ),
         "shared_header": protocol.framing.shared_header,
@@ -219,11 +202,70 @@ def codec_context(protocol: Protocol, code: PackageCode, exports: list[str]) -> 
     }
 
 
-def used_in_codec(name: str, code: PackageCode) -> bool:
+def names_used_in_codec(code: PackageCode) -> set[str]:
+    """Every identifier the codec's bodies mention, and the types they return or take.
+
+    Collected once per package: testing each exported name against every body line was quadratic in the number
+    of commands (minutes for a few thousand).
+    """
     bodies = [line for _, _, _, lines in code.decoders for line in lines]
     bodies += [line for _, _, lines in code.encoders for line in lines]
     types = {r for _, r, _, _ in code.decoders} | {t for _, t, _ in code.encoders}
-    return name in types or any(name in line for line in bodies)
+    types |= set(code.built) | code.member_maps  # built through their slots; enums and flags looked up
+    return types | set(_IDENTIFIER.findall("\n".join(bodies)))
+
+
+def setter_targets(cls: str, names: list[str]) -> str:
+    """The assignment target for a class's slot setters: one per line when there are more than a few."""
+    setters = [setter_name(cls, n) for n in names]
+    if len(setters) == 1:
+        return f"({setters[0]},)"
+    if len(setters) <= 3:
+        return ", ".join(setters)
+    return "(\n" + "".join(f"    {s},\n" for s in setters) + ")"
+
+
+def frame_decode_lines(
+    protocol: Protocol, layout: FrameLayout, dispatch: list[tuple[str, str]], buf: str, start: str | None
+) -> Lines:
+    """Checksum check, then dispatch to the content decoder, of a frame whose header and length are checked.
+
+    `start` None: the frame is the whole of `buf` (whose length is `n`); else it is buf[start:stop].
+    """
+    size = layout.checksum_offset_from_end
+    offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
+    after = layout.overhead - offset
+
+    def at(position: int) -> str:
+        return f"{buf}[{position}]" if start is None else f"{buf}[{start} + {position}]"
+
+    if start is None:
+        covered = f"{buf}[{layout.covered_from or ''}:-{layout.covered_to_end}]"
+        stored = f"{buf}[-1]" if size == 1 else f"int.from_bytes({buf}[-{size}:], 'little')"
+        content = f"{offset}, n - {after}"
+    else:
+        first = f"{start} + {layout.covered_from}" if layout.covered_from else start
+        covered = f"{buf}[{first} : stop - {layout.covered_to_end}]"
+        stored = f"{buf}[stop - 1]" if size == 1 else f"int.from_bytes({buf}[stop - {size} : stop], 'little')"
+        content = f"{start} + {offset}, stop - {after}"
+    args = f"{buf}, {content}" + "".join(f", {at(layout.offsets[e.name])}" for e in layout.value_elements)
+    lines = checksum_lines(protocol.framing.checksum, covered, "expected")
+    lines += [
+        f"if expected != {stored}:",
+        f'    raise ChecksumError(f"bad checksum: the frame has {{{stored}:#04x}}, its bytes give {{expected:#04x}}")',
+    ]
+    if layout.command_offset is None:  # the one codeless command of this direction, if any
+        if not dispatch:
+            return [*lines, f'raise DecodeError("no {layout.direction.value} is defined")']
+        return [*lines, f"return {dispatch[0][1]}({args})"]
+    code = at(layout.command_offset)
+    return [
+        *lines,
+        f"decoder = _{layout.direction.name}_DECODERS.get({code})",
+        "if decoder is None:",
+        f'    raise DecodeError(f"unknown command {{{code}:#04x}}")',
+        f"return decoder({args})",
+    ]
 
 
 def uses_table(message: Message, table: str) -> bool:

@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 from serialspec.spec.model import (
     Array,
     Bytes,
+    Checksum,
     Direction,
     FrameLayout,
     Group,
@@ -35,6 +36,16 @@ def decoder_name(message: Message) -> str:
 
 def encoder_name(message: Message) -> str:
     return f"_encode_{message.key.replace('.', '_')}_{message.direction.value}"
+
+
+def setter_name(class_name: str, field_name: str) -> str:
+    """The codec's module-level slot setter of one field of a message class (see PackageCode.build)."""
+    return f"_set_{class_name}_{field_name}"
+
+
+def members_name(class_name: str) -> str:
+    """The codec's module-level value -> member map of an enum or flag class."""
+    return f"_MEMBERS_{class_name}"
 
 
 def one_line(text: str) -> str:
@@ -62,6 +73,16 @@ def struct_format(endian: str, fields: list[SpecField]) -> str:
             assert isinstance(f.count, int)
             chars.append(struct_format("", list(f.fields)) * f.count)
     return endian + "".join(chars)
+
+
+def takes_the_rest(f: SpecField | None) -> bool:
+    """A field that reads exactly up to the end of the content, whatever its size.
+
+    Not a group of varying-size items: its last item may overrun `end`, which the check after it must catch.
+    """
+    if isinstance(f, Group):
+        return f.count == "rest" and f.item_size is not None
+    return isinstance(f, Bytes) and f.size == "rest"
 
 
 def is_fixed_run_member(f: SpecField) -> bool:
@@ -122,6 +143,9 @@ class PackageCode:
         self.message_classes: list[ClassCode] = []
         self.decoders: list[tuple[str, str, str, Lines]] = []  # name, return type, extra parameters, body
         self.encoders: list[tuple[str, str, Lines]] = []  # name, parameter type, body
+        # classes the decoders build through their slots (see `build`): class name -> field names in order
+        self.built: dict[str, list[str]] = {}
+        self.member_maps: set[str] = set()  # enum and flag classes whose value -> member map the decoders use
         self._seen_classes: set[str] = set()
         for message in protocol.messages():
             self.message(message)
@@ -316,14 +340,48 @@ class PackageCode:
         else:
             lines.append(f"if not {low} <= end - o <= {high}:")
         lines.append(f"    raise content_size_error({where}, end - o, {low}, {high})")
-        values = self.decode_fields(list(message.fields), message.class_name, lines, where, top=True)
+        if low == 0 and high is None:
+            del lines[-2:]  # any size will do
+        # Where the layout alone says the fields end at `end` (one fixed size, checked above, or a last field that
+        # takes the rest), no check that they do is emitted, and nothing reads the cursor after the last field.
+        exact = low == high and all(fixed_size(f) is not None for f in message.fields)
+        exact = exact or takes_the_rest(message.fields[-1] if message.fields else None)
+        values = self.decode_fields(list(message.fields), message.class_name, lines, where, top=not exact)
+        if exact and (lines[-1].startswith("o += ") or lines[-1] == "o = end"):
+            lines.pop()
         frame_fields = all_fields[: len(all_fields) - len(self.value_fields(message))]
         frame_values = [
-            f"{f.flags.class_name}({f.name})" if isinstance(f, Scalar) and f.flags else f.name for f in frame_fields
+            self.flags_value(f.flags.class_name, f.name, lines) if isinstance(f, Scalar) and f.flags else f.name
+            for f in frame_fields
         ]
-        args = ", ".join([*frame_values, *values])
-        lines.append(f"return {message.class_name}({args})")
+        self.build(message.class_name, [f.name for f in all_fields], [*frame_values, *values], "m", lines)
+        lines.append("return m")
         return lines
+
+    def build(self, class_name: str, names: list[str], values: list[str], target: str, lines: Lines) -> None:
+        """Lines that make an instance of a frozen dataclass in `target`, storing each value into its slot.
+
+        The dataclass __init__ would store each one through object.__setattr__ (that is how frozen works), which
+        costs more than the rest of decoding; decoded values need none of __init__'s work.
+        """
+        assert len(names) == len(values), (class_name, names, values)
+        self.built[class_name] = names
+        lines.append(f"{target} = _new({class_name})")
+        lines.extend(f"{setter_name(class_name, n)}({target}, {v})" for n, v in zip(names, values, strict=True))
+
+    def enum_value(self, enum: str, raw: str) -> str:
+        """The member for a wire value, or the value itself when the spec names none (as enum_or_int does)."""
+        self.member_maps.add(enum)
+        return f"{members_name(enum)}.get({raw}, {raw})"
+
+    def flags_value(self, flags: str, raw: str, lines: Lines) -> str:
+        """A flags member for a wire value: looked up, made by the flag class only the first time it is seen."""
+        self.member_maps.add(flags)
+        name = f"{raw}_flags"
+        lines.append(f"{name} = {members_name(flags)}.get({raw})")
+        lines.append(f"if {name} is None:")
+        lines.append(f"    {name} = {flags}({raw})")
+        return name
 
     def decode_fields(self, fields: list[SpecField], base: str, lines: Lines, where: str, top: bool) -> list[str]:
         """Append lines reading fields at cursor `o`; return the expressions of the non-hidden values."""
@@ -371,9 +429,10 @@ class PackageCode:
                     items = []
                     for e in f.entries:
                         item = f"t[{position}]"
-                        items.append(f"_enum({e.enum.class_name}, {item})" if e.enum else item)
+                        items.append(self.enum_value(e.enum.class_name, item) if e.enum else item)
                         position += 1
-                    values.append(f"{f.class_name}({', '.join(items)})")
+                    self.build(f.class_name, [e.name for e in f.entries], items, self.local(f), lines)
+                    values.append(self.local(f))
                 else:
                     name = self.local(f)
                     lines.append(f"{name} = t[{position}]")
@@ -408,16 +467,21 @@ class PackageCode:
             for bit in f.bits:
                 used |= bit.mask << bit.low
                 raw = f"({name} >> {bit.low}) & {bit.mask:#x}" if bit.low else f"{name} & {bit.mask:#x}"
-                parts.append(f"_enum({bit.enum.class_name}, {raw})" if bit.enum else raw)
+                if bit.enum:
+                    lines.append(f"{name}_{bit.name} = {raw}")
+                    parts.append(self.enum_value(bit.enum.class_name, f"{name}_{bit.name}"))
+                else:
+                    parts.append(raw)
             unused = ((1 << (f.type.size * 8)) - 1) & ~used
             if unused:
                 lines.append(f"if {name} & {unused:#x}:")
                 lines.append(f"    raise DecodeError({where} + f': unused bits of {f.name} are set ({{{name}:#04x}})')")
-            return f"{f.bits_class}({', '.join(parts)})"
+            self.build(f.bits_class, [b.name for b in f.bits], parts, f"{name}_bits", lines)
+            return f"{name}_bits"
         if f.enum:
-            return f"_enum({f.enum.class_name}, {name})"
+            return self.enum_value(f.enum.class_name, name)
         if f.flags:
-            return f"{f.flags.class_name}({name})"
+            return self.flags_value(f.flags.class_name, name, lines)
         return name
 
     def decode_variable(self, f: SpecField, siblings: list[SpecField], base: str, lines: Lines, where: str) -> str:
@@ -447,6 +511,8 @@ class PackageCode:
         assert isinstance(f, Group)
         item_fields = list(f.fields)
         value = self.local(f)
+        item_names = [i.name for i in item_fields if not (isinstance(i, Scalar) and i.hidden)]
+        lines.append(f"{value}_list = []")
         if f.item_size is not None:
             item_fmt = struct_format(self.protocol_endian(), item_fields)
             item_struct = self.struct(f"{f.class_name}", item_fmt)
@@ -465,24 +531,16 @@ class PackageCode:
             names = [self.local(i) for i in item_fields]
             item_lines: Lines = []
             item_values = [self.after_unpack(i, n, item_lines, where) for i, n in zip(item_fields, names, strict=True)]
-            if item_lines:  # an item needs checks: decode it in a loop
-                lines.append(f"{value}_list = []")
-                target = ", ".join(names) + ("," if len(names) == 1 else "")
-                lines.append(f"for {target} in {item_struct}.iter_unpack(buf[o : o + n]):")
-                lines.extend("    " + line for line in item_lines)
-                args = ", ".join(v for v in item_values if v is not None)
-                lines.append(f"    {value}_list.append({f.class_name}({args}))")
-                lines.append(f"{value} = tuple({value}_list)")
-            else:
-                target = ", ".join(names) + ("," if len(names) == 1 else "")
-                args = ", ".join(v for v in item_values if v is not None)
-                lines.append(
-                    f"{value} = tuple({f.class_name}({args}) for {target} in {item_struct}.iter_unpack(buf[o : o + n]))"
-                )
+            values = [v for v in item_values if v is not None]
+            self.build(f.class_name, item_names, values, "item", item_lines)
+            target = ", ".join(names) + ("," if len(names) == 1 else "")
+            lines.append(f"for {target} in {item_struct}.iter_unpack(buf[o : o + n]):")
+            lines.extend("    " + line for line in item_lines)
+            lines.append(f"    {value}_list.append(item)")
+            lines.append(f"{value} = tuple({value}_list)")
             lines.append("o += n")
             return value
         # items of varying size: read them one by one
-        lines.append(f"{value}_list = []")
         if f.count == "rest":
             lines.append("while o < end:")
         else:
@@ -490,8 +548,9 @@ class PackageCode:
             lines.append(f"for _ in range({count}):")
         inner: Lines = []
         item_args = self.decode_fields(item_fields, f.class_name, inner, where, top=False)
+        self.build(f.class_name, item_names, item_args, "item", inner)
         lines.extend("    " + line for line in inner)
-        lines.append(f"    {value}_list.append({f.class_name}({', '.join(item_args)}))")
+        lines.append(f"    {value}_list.append(item)")
         lines.append(f"{value} = tuple({value}_list)")
         return value
 
@@ -504,21 +563,97 @@ class PackageCode:
     # --- encoding -------------------------------------------------------------------------------------------------
 
     def encoder(self, message: Message, all_fields: list[SpecField]) -> Lines:
-        """Body of `_encode_X(m) -> bytes`: range checks, then the content bytes."""
+        """Body of `_encode_X(m) -> bytes`: range checks, then the frame's bytes."""
         lines: Lines = []
         where = self.where(message)
         frame_fields = all_fields[: len(all_fields) - len(self.value_fields(message))]
-        elements = {e.name: e for e in self.protocol.framing.layouts[message.direction].value_elements}
+        layout = self.protocol.framing.layouts[message.direction]
+        elements = {e.name: e for e in layout.value_elements}
         for f in frame_fields:
             assert isinstance(f, Scalar)
             self.check_scalar(f, f"m.{f.name}", lines, where, also=elements[f.name].broadcast)
-        parts = self.encode_fields(list(message.fields), message.class_name, "m", lines, where)
+        fields = list(message.fields)
+        command_code = self.protocol.command(message.command).code
+        code = str(command_code if command_code is not None else 0)
+        frame_values = [f"m.{f.name}" for f in frame_fields]
+        if all(is_fixed_run_member(f) for f in fields):
+            # one fixed size: the whole frame but its checksum is one struct, the length byte a constant
+            endian, content_format, args = self.encode_run_format(fields, "m", fields, lines, where)
+            head = self.head_format(layout, endian, code, f"{message.min_size + layout.length_adds}", frame_values)
+            if head is not None:
+                head_format, head_args = head
+                name = self.struct(f"frame_{message.class_name}", endian + head_format + content_format)
+                lines.append(f"body = {name}.pack({', '.join([*head_args, *args])})")
+                lines.extend(self.checksum_append(layout, "body"))
+                return lines
+            parts = []
+            if fields:
+                name = self.struct(f"{message.class_name}_{fields[0].name}", endian + content_format)
+                parts.append(f"{name}.pack({', '.join(args)})")
+        else:
+            parts = self.encode_fields(fields, message.class_name, "m", lines, where)
         content = parts[0] if len(parts) == 1 else f"b''.join(({', '.join(parts)},))"
-        if not parts:
-            content = "b''"
-        code = self.protocol.command(message.command).code
-        values = "".join(f"m.{f.name}, " for f in frame_fields)
-        lines.append(f"return _frame_{message.direction.value}({code if code is not None else 0}, {values}{content})")
+        lines.append(f"content = {content if parts else repr(b'')}")
+        lines.extend(self.frame_lines(layout, code, frame_values))
+        return lines
+
+    def head_format(
+        self, layout: FrameLayout, endian: str, code: str, length: str, values: list[str]
+    ) -> tuple[str, list[str]] | None:
+        """Struct format (no byte order) and arguments of the frame elements before the content.
+
+        None when the head cannot share the content's struct: a multi-byte frame element in a big-endian content
+        (frame elements are little-endian), or a constant length that does not fit its element.
+        """
+        assert [e.role for e in layout.elements[-2:]] == ["content", "checksum"]  # the resolver checks both
+        chars: list[str] = []
+        args: list[str] = []
+        remaining = iter(values)
+        for element in layout.elements[:-2]:
+            if element.role == "header":
+                chars.append(f"{len(layout.header)}s")
+                args.append(repr(layout.header))
+                continue
+            assert element.type is not None
+            if element.type.size > 1 and endian != "<":
+                return None
+            chars.append(element.type.struct_char)
+            if element.role == "command":
+                args.append(code)
+            elif element.role == "length":
+                if length.isdigit() and int(length) > element.type.maximum:
+                    return None
+                args.append(length)
+            else:  # address, status: the message's frame values, in element order
+                args.append(next(remaining))
+        return "".join(chars), args
+
+    def checksum_append(self, layout: FrameLayout, body: str) -> Lines:
+        """Lines that return `body` (the frame without its checksum) with its checksum appended."""
+        covered = f"{body}[{layout.covered_from}:]" if layout.covered_from else body
+        size = layout.checksum_offset_from_end
+        lines = checksum_lines(self.protocol.framing.checksum, covered, "check")
+        if len(lines) == 1:  # a single expression: append it directly
+            value = lines[0].removeprefix("check = ")
+            lines = []
+        else:
+            value = "check"
+        tail = f"_BYTES[{value}]" if size == 1 else f"({value}).to_bytes({size}, 'little')"
+        return [*lines, f"return {body} + {tail}"]
+
+    def frame_lines(self, layout: FrameLayout, code: str, values: list[str]) -> Lines:
+        """Lines that return the frame around the bytes in `content`: inline in each encoder, not a call per frame."""
+        lines: Lines = [f"n = len(content) + {layout.length_adds}" if layout.length_adds else "n = len(content)"]
+        length = next(e for e in layout.elements if e.role == "length")
+        assert length.type is not None
+        lines.append(f"if n > {int(length.type.maximum)}:")
+        lines.append("    raise EncodeError(f'content of {len(content)} bytes does not fit the length field')")
+        head = self.head_format(layout, "<", code, "n", values)
+        assert head is not None  # little-endian and a length computed at run time: always possible
+        head_format, head_args = head
+        name = self.struct(f"head_{layout.direction.value}", "<" + head_format)
+        lines.append(f"body = {name}.pack({', '.join(head_args)}) + content")
+        lines.extend(self.checksum_append(layout, "body"))
         return lines
 
     def check_scalar(self, f: Scalar, expr: str, lines: Lines, where: str, also: int | None = None) -> None:
@@ -584,8 +719,15 @@ class PackageCode:
     def encode_run(
         self, run: list[SpecField], base: str, obj: str, siblings: list[SpecField], lines: Lines, where: str
     ) -> str:
+        endian, fmt, args = self.encode_run_format(run, obj, siblings, lines, where)
+        const_name = self.struct(f"{base}_{run[0].name}", endian + fmt)
+        return f"{const_name}.pack({', '.join(args)})"
+
+    def encode_run_format(
+        self, run: list[SpecField], obj: str, siblings: list[SpecField], lines: Lines, where: str
+    ) -> tuple[str, str, list[str]]:
+        """Byte order, struct format (without it) and pack arguments of a run of fixed-size fields; checks to lines."""
         endian = next((f.endian for f in run if isinstance(f, Scalar | Array | TableBlock)), "<")
-        const_name = self.struct(f"{base}_{run[0].name}", struct_format(endian, run))
         args: list[str] = []
         for f in run:
             if isinstance(f, Scalar):
@@ -617,7 +759,7 @@ class PackageCode:
                         f"{number(e.minimum)}, {number(e.maximum)})"
                     )
                     args.append(expr)
-        return f"{const_name}.pack({', '.join(args)})"
+        return endian, struct_format("", run), args
 
     def encode_variable(self, f: SpecField, obj: str, lines: Lines, where: str) -> str:
         expr = f"{obj}.{f.name}"
@@ -637,39 +779,54 @@ class PackageCode:
         if isinstance(f.count, int):
             lines.append(f"if len({expr}) != {f.count}:")
             lines.append(f"    raise EncodeError({where} + f': {f.name} needs {f.count} items, got {{len({expr})}}')")
+        # the items are checked and packed in a loop here, not by a function called per item
+        item = "item" if obj == "m" else f"{obj}_item"
         item_lines: Lines = []
-        # the item encoder's parameter is `m`, like every encoder's (see codec.py.j2)
-        parts = self.encode_fields(list(f.fields), f.class_name, "m", item_lines, where)
-        function = f"_encode_{f.class_name}"
-        if all(name != function for name, _, _ in self.encoders):
-            body = f"b''.join(({', '.join(parts)},))" if len(parts) > 1 else parts[0]
-            self.encoders.append((function, f.class_name, [*item_lines, f"return {body}"]))
-        return f"b''.join([{function}(item) for item in {expr}])"
+        parts = self.encode_fields(list(f.fields), f.class_name, item, item_lines, where)
+        packed = f"b''.join(({', '.join(parts)},))" if len(parts) > 1 else parts[0]
+        lines.append(f"parts_{f.name} = []")
+        lines.append(f"for {item} in {expr}:")
+        lines.extend("    " + line for line in item_lines)
+        lines.append(f"    parts_{f.name}.append({packed})")
+        return f"b''.join(parts_{f.name})"
 
 
-def frame_lines(layout: FrameLayout) -> tuple[list[str], Lines]:
-    """Parameters and body of `_frame_<direction>(code, <frame values>, content) -> bytes`."""
-    params = ["code", *[e.name for e in layout.value_elements], "content"]
-    lines: Lines = []
-    parts: list[str] = []
-    for element in layout.elements:
-        if element.role == "header":
-            parts.append(repr(layout.header))
-        elif element.role == "command":
-            parts.append("bytes((code,))")
-        elif element.role == "length":
-            lines.append(f"n = len(content) + {layout.length_adds}")
-            assert element.type is not None
-            lines.append(f"if n > {int(element.type.maximum)}:")
-            lines.append("    raise EncodeError(f'content of {len(content)} bytes does not fit the length field')")
-            parts.append("bytes((n,))" if element.type.size == 1 else f"n.to_bytes({element.type.size}, 'little')")
-        elif element.role in ("address", "status"):
-            parts.append(f"bytes(({element.name},))")
-        elif element.role == "content":
-            parts.append("content")
-    lines.append(f"body = b''.join(({', '.join(parts)},))")
-    trim = layout.covered_to_end - layout.checksum_offset_from_end
-    covered = f"body[{layout.covered_from}:{-trim if trim else ''}]"
-    size = layout.checksum_offset_from_end
-    lines.append(f"return body + _checksum({covered}).to_bytes({size}, 'little')")
-    return params, lines
+def reflect(value: int, width: int) -> int:
+    return int(f"{value:0{width}b}"[::-1], 2)
+
+
+def checksum_lines(checksum: Checksum, covered: str, target: str) -> Lines:
+    """Lines that compute a frame's checksum over the bytes `covered` (an expression) into `target`.
+
+    A sum is one expression; an 8-bit CRC a loop over a 256-entry table (`_CRC_TABLE`, which the codec defines) with
+    no call per frame; any other CRC the runtime's table-driven function (`_crc`).
+    """
+    mask = (1 << (checksum.type.size * 8)) - 1
+    if checksum.algorithm == "sum":
+        return [f"{target} = {'~' if checksum.invert else ''}sum({covered}) & {mask:#x}"]
+    crc = checksum.crc
+    assert crc is not None
+    if crc.width != 8 or crc.refin != crc.refout:
+        return [f"{target} = _crc({covered})"]
+    # With 8 bits the table-driven step is table[crc ^ byte] whether the CRC is reflected or not.
+    lines = [
+        f"{target} = {reflect(crc.init, 8) if crc.refin else crc.init:#x}",
+        f"for byte in {covered}:",
+        f"    {target} = _CRC_TABLE[{target} ^ byte]",
+    ]
+    if crc.xorout:
+        lines.append(f"{target} ^= {crc.xorout:#x}")
+    return lines
+
+
+def crc_setup(checksum: Checksum) -> tuple[str, str]:
+    """The runtime import and the module-level definition that `checksum_lines` relies on ('' for sums)."""
+    crc = checksum.crc
+    if checksum.algorithm == "sum" or crc is None:
+        return "", ""
+    if crc.width != 8 or crc.refin != crc.refout:
+        definition = (
+            f"crc_function({crc.width}, {crc.poly:#x}, {crc.init:#x}, {crc.refin}, {crc.refout}, {crc.xorout:#x})"
+        )
+        return "crc_function", f"_crc: Callable[[bytes], int] = {definition}  # {one_line(crc.name)}"
+    return "crc_table", f"_CRC_TABLE = crc_table(8, {crc.poly:#x}, {crc.refin})  # {one_line(crc.name)}"

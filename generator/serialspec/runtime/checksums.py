@@ -67,3 +67,7 @@ def sum_function(width: int, invert: bool) -> Callable[[bytes], int]:
     if invert:
         return lambda data: ~sum(data) & mask
     return lambda data: sum(data) & mask
+
+
+# Each byte value as a one-byte bytes object: appending a 1-byte checksum is an index, not a bytes((x,)) call.
+BYTE_VALUES: tuple[bytes, ...] = tuple(bytes((value,)) for value in range(256))

@@ -25,8 +25,32 @@ class FrameFormat:
     command_offset: int | None
     # content size bounds by command code (None: the one codeless command); max None = unbounded
     content_sizes: dict[int | None, tuple[int, int | None]]
-    checksum_ok: Callable[[bytes], bool]
-    decode: Callable[[bytes], Message]
+    # decode_at(buffer, start, stop): the frame buffer[start:stop], whose header and length byte the parser has
+    # checked: verifies the checksum and decodes; raises DecodeError (ChecksumError) for a corrupt frame.
+    decode_at: Callable[[bytes, int, int], Message]
+
+
+class _Candidate:
+    """A FrameFormat as the scanning loop reads it: the size of every plausible frame, by command and length byte."""
+
+    __slots__ = ("header", "prefix", "command_offset", "length_offset", "frame_sizes", "decode")
+
+    def __init__(self, frame_format: FrameFormat) -> None:
+        self.header = frame_format.header
+        # bytes needed before the command code and the length byte can be read
+        self.prefix = max(frame_format.length_offset, frame_format.command_offset or 0) + 1
+        self.command_offset = frame_format.command_offset
+        self.length_offset = frame_format.length_offset
+        self.decode = frame_format.decode_at
+        # One lookup per candidate instead of a range check: the length byte has only 256 values, so every
+        # (command, length byte) pair whose content size the command allows maps to its frame size.
+        self.frame_sizes: dict[int, int] = {}
+        for code, (low, high) in frame_format.content_sizes.items():
+            for length_byte in range(256):
+                content = length_byte - frame_format.length_adds
+                if low <= content and (high is None or content <= high):
+                    key = length_byte if code is None else code << 8 | length_byte
+                    self.frame_sizes[key] = frame_format.overhead + content
 
 
 class StreamParser:
@@ -38,76 +62,84 @@ class StreamParser:
     def __init__(self, *formats: FrameFormat) -> None:
         if not formats:
             raise ValueError("a stream parser needs at least one frame format")
-        self._formats = formats
-        self._buffer = bytearray()
+        self._candidates = tuple(_Candidate(f) for f in formats)
+        self._pending = b""
+        self._keep = max(len(f.header) for f in formats) - 1  # a tail that could be the start of a header
         self.errors = 0
         self.garbage = 0  # bytes skipped that belonged to no accepted frame
-        self._prefix = min(f.overhead for f in formats)
 
-    def feed(self, data: bytes) -> list[Message]:
-        buffer = self._buffer
-        buffer += data
+    def feed(self, data: bytes | bytearray | memoryview) -> list[Message]:
+        # Work on immutable bytes: decoders slice their `bytes` fields straight out of the buffer.
+        buffer = self._pending + data if self._pending else bytes(data)
+        end = len(buffer)
         found: list[Message] = []
-        start = 0
+        append = found.append
+        find = buffer.find
+        candidates = self._candidates
+        single = len(candidates) == 1
+        # one frame format (the usual case): its parameters stay in locals for the whole scan
+        current = candidates[0]
+        header, prefix, command_offset, length_offset = (
+            current.header,
+            current.prefix,
+            current.command_offset,
+            current.length_offset,
+        )
+        frame_sizes, decode = current.frame_sizes, current.decode
+        garbage = errors = start = 0
         while True:
-            position, frame_format = self._next_header(buffer, start)
-            if frame_format is None:
-                # keep a tail that could be the start of a header
-                keep = max(len(f.header) for f in self._formats) - 1
-                cut = max(start, len(buffer) - keep)
-                self.garbage += cut - start
-                del buffer[:cut]
-                return found
-            self.garbage += position - start
-            size = self._candidate_size(buffer, position, frame_format)
-            if size == 0:  # implausible: not a frame start
+            if single:
+                position = find(header, start)
+            else:
+                position, current = self._next_header(buffer, start)
+                header, prefix, command_offset, length_offset = (
+                    current.header,
+                    current.prefix,
+                    current.command_offset,
+                    current.length_offset,
+                )
+                frame_sizes, decode = current.frame_sizes, current.decode
+            if position < 0:
+                cut = max(start, end - self._keep)
+                garbage += cut - start
+                self._pending = buffer[cut:]
+                break
+            garbage += position - start
+            if end - position < prefix:  # plausible so far but incomplete: wait for more bytes
+                self._pending = buffer[position:]
+                break
+            if command_offset is None:
+                size = frame_sizes.get(buffer[position + length_offset])
+            else:
+                size = frame_sizes.get(buffer[position + command_offset] << 8 | buffer[position + length_offset])
+            if size is None:  # implausible (unknown command, or a content size it never has): not a frame start
                 start = position + 1
-                self.garbage += 1
+                garbage += 1
                 continue
-            if size < 0:  # plausible but incomplete: wait for more bytes
-                del buffer[:position]
-                return found
-            frame = bytes(buffer[position : position + size])
-            if not frame_format.checksum_ok(frame):
-                self.errors += 1
-                start = position + 1
-                self.garbage += 1
-                continue
+            stop = position + size
+            if stop > end:
+                self._pending = buffer[position:]
+                break
             try:
-                found.append(frame_format.decode(frame))
+                append(decode(buffer, position, stop))
             except DecodeError:
-                self.errors += 1
+                errors += 1
                 start = position + 1
-                self.garbage += 1
+                garbage += 1
                 continue
-            start = position + size
+            start = stop
+        self.garbage += garbage
+        self.errors += errors
+        return found
 
-    def _next_header(self, buffer: bytearray, start: int) -> tuple[int, FrameFormat | None]:
-        best, best_format = -1, None
-        for frame_format in self._formats:
-            position = buffer.find(frame_format.header, start)
+    def _next_header(self, buffer: bytes, start: int) -> tuple[int, _Candidate]:
+        best, best_candidate = -1, self._candidates[0]
+        for candidate in self._candidates:
+            position = buffer.find(candidate.header, start)
             if position >= 0 and (best < 0 or position < best):
-                best, best_format = position, frame_format
-        return best, best_format
-
-    @staticmethod
-    def _candidate_size(buffer: bytearray, position: int, frame_format: FrameFormat) -> int:
-        """Frame size if plausible and complete; -1 if plausible so far but incomplete; 0 if implausible."""
-        available = len(buffer) - position
-        needed = max(frame_format.length_offset, frame_format.command_offset or 0) + 1
-        if available < needed:
-            return -1
-        code = buffer[position + frame_format.command_offset] if frame_format.command_offset is not None else None
-        sizes = frame_format.content_sizes.get(code)
-        if sizes is None:
-            return 0
-        content = buffer[position + frame_format.length_offset] - frame_format.length_adds
-        low, high = sizes
-        if content < low or (high is not None and content > high):
-            return 0
-        size = frame_format.overhead + content
-        return size if available >= size else -1
+                best, best_candidate = position, candidate
+        return best, best_candidate
 
     def pending(self) -> bytes:
         """Bytes held back, waiting to complete a frame."""
-        return bytes(self._buffer)
+        return self._pending

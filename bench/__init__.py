@@ -1,0 +1,1 @@
+"""Benchmarks of the generated code and generator; `make bench` (python -m bench.run) runs them all."""

@@ -1,0 +1,307 @@
+"""Hand-written `struct` codecs for the benchmarked frames: the baseline the generated codec is measured against.
+
+Written the way a competent engineer writes them for one device: precompiled struct.Struct for the whole frame
+where it has a fixed size, every check the generated codec makes (header, length byte, checksum, command code,
+sub-command, counts, the ranges it checks before encoding), and a small slotted dataclass as the result. Enum and
+flag bytes become enum members as in the generated messages. Nothing here is generated or imported from the
+generated packages: these are the frames as a person would code them from the documents.
+"""
+
+from __future__ import annotations
+
+import struct
+from dataclasses import dataclass
+from enum import IntEnum, IntFlag
+
+# --- Fashion Star: header 12 4C (request) / 05 1C (response), cmd, length, content, sum mod 256 -----------------
+
+FS_REQUEST_HEADER = b"\x12\x4c"
+FS_RESPONSE_HEADER = b"\x05\x1c"
+FS_ROTATE = 8
+FS_READ_ANGLE = 10
+
+
+@dataclass(slots=True)
+class FsRotate:
+    servo_id: int
+    angle: int  # 0.1°
+    interval: int  # ms
+    power: int = 0  # mW
+
+
+@dataclass(slots=True)
+class FsReadAngleReply:
+    servo_id: int
+    angle: int  # 0.1°
+
+
+_FS_ROTATE_FRAME = struct.Struct("<2sBBBhHHB")  # header, cmd, length, servo_id, angle, interval, power, checksum
+_FS_ROTATE_BODY = struct.Struct("<2sBBBhHH")
+_FS_READ_ANGLE_FRAME = struct.Struct("<2sBBBhB")  # header, cmd, length, servo_id, angle, checksum
+_FS_READ_ANGLE_BODY = struct.Struct("<2sBBBh")
+
+
+def fs_decode_rotate(frame: bytes) -> FsRotate:
+    if len(frame) != _FS_ROTATE_FRAME.size:
+        raise ValueError(f"rotate frame is {len(frame)} bytes, expected {_FS_ROTATE_FRAME.size}")
+    header, code, length, servo_id, angle, interval, power, checksum = _FS_ROTATE_FRAME.unpack(frame)
+    if header != FS_REQUEST_HEADER:
+        raise ValueError(f"bad header {header.hex(' ')}")
+    if code != FS_ROTATE:
+        raise ValueError(f"command {code} is not ROTATE")
+    if length != 7:
+        raise ValueError(f"length byte {length}, expected 7")
+    if sum(frame[:-1]) & 0xFF != checksum:
+        raise ValueError("bad checksum")
+    return FsRotate(servo_id, angle, interval, power)
+
+
+def fs_encode_rotate(message: FsRotate) -> bytes:
+    if not 0 <= message.servo_id <= 254:
+        raise ValueError(f"servo_id {message.servo_id} outside 0..254")
+    if not -32768 <= message.angle <= 32767:
+        raise ValueError(f"angle {message.angle} outside -32768..32767")
+    if not 0 <= message.interval <= 65535:
+        raise ValueError(f"interval {message.interval} outside 0..65535")
+    if not 0 <= message.power <= 65535:
+        raise ValueError(f"power {message.power} outside 0..65535")
+    body = _FS_ROTATE_BODY.pack(
+        FS_REQUEST_HEADER, FS_ROTATE, 7, message.servo_id, message.angle, message.interval, message.power
+    )
+    return body + bytes((sum(body) & 0xFF,))
+
+
+def fs_decode_read_angle_reply(frame: bytes) -> FsReadAngleReply:
+    if len(frame) != _FS_READ_ANGLE_FRAME.size:
+        raise ValueError(f"read-angle reply is {len(frame)} bytes, expected {_FS_READ_ANGLE_FRAME.size}")
+    header, code, length, servo_id, angle, checksum = _FS_READ_ANGLE_FRAME.unpack(frame)
+    if header != FS_RESPONSE_HEADER:
+        raise ValueError(f"bad header {header.hex(' ')}")
+    if code != FS_READ_ANGLE:
+        raise ValueError(f"command {code} is not READ_ANGLE")
+    if length != 3:
+        raise ValueError(f"length byte {length}, expected 3")
+    if sum(frame[:-1]) & 0xFF != checksum:
+        raise ValueError("bad checksum")
+    return FsReadAngleReply(servo_id, angle)
+
+
+def fs_encode_read_angle_reply(message: FsReadAngleReply) -> bytes:
+    if not 0 <= message.servo_id <= 254:
+        raise ValueError(f"servo_id {message.servo_id} outside 0..254")
+    if not -32768 <= message.angle <= 32767:
+        raise ValueError(f"angle {message.angle} outside -32768..32767")
+    body = _FS_READ_ANGLE_BODY.pack(FS_RESPONSE_HEADER, FS_READ_ANGLE, 3, message.servo_id, message.angle)
+    return body + bytes((sum(body) & 0xFF,))
+
+
+# --- Hiwonder RRC: AA 55, function, length, data, CRC-8/MAXIM over function..data ---------------------------------
+
+RRC_HEADER = b"\xaa\x55"
+RRC_MOTOR = 3
+RRC_BUS_SERVO = 5
+RRC_SET_SPEEDS = 1
+RRC_READ_POSITION = 5
+FLOAT32_MAX = 3.4028234663852886e38
+
+
+def _crc8_maxim_table() -> tuple[int, ...]:
+    table = []
+    for byte in range(256):
+        crc = byte
+        for _ in range(8):
+            crc = (crc >> 1) ^ 0x8C if crc & 1 else crc >> 1
+        table.append(crc)
+    return tuple(table)
+
+
+_CRC8_MAXIM = _crc8_maxim_table()
+
+
+def crc8_maxim(data: bytes) -> int:
+    crc = 0
+    for byte in data:
+        crc = _CRC8_MAXIM[crc ^ byte]
+    return crc
+
+
+class RrcReadResult(IntEnum):
+    OK = 0
+    FAILED = -1
+
+
+@dataclass(slots=True)
+class RrcPositionReport:
+    servo_id: int
+    success: RrcReadResult | int
+    position: int
+
+
+@dataclass(slots=True)
+class RrcMotorSpeed:
+    motor_id: int
+    speed: float  # r/s
+
+
+@dataclass(slots=True)
+class RrcSetSpeeds:
+    motors: tuple[RrcMotorSpeed, ...]
+
+
+_RRC_REPORT_FRAME = struct.Struct("<2sBBBBbhB")  # header, function, length, servo_id, sub, success, position, crc
+_RRC_REPORT_BODY = struct.Struct("<2sBBBBbh")
+_RRC_SPEEDS_HEAD = struct.Struct("<2sBBBB")  # header, function, length, sub, count
+_RRC_MOTOR_ITEM = struct.Struct("<Bf")
+_RRC_READ_RESULTS = {member.value: member for member in RrcReadResult}
+
+
+def rrc_decode_position_report(frame: bytes) -> RrcPositionReport:
+    if len(frame) != _RRC_REPORT_FRAME.size:
+        raise ValueError(f"position report is {len(frame)} bytes, expected {_RRC_REPORT_FRAME.size}")
+    header, function, length, servo_id, sub, success, position, crc = _RRC_REPORT_FRAME.unpack(frame)
+    if header != RRC_HEADER:
+        raise ValueError(f"bad header {header.hex(' ')}")
+    if function != RRC_BUS_SERVO:
+        raise ValueError(f"function {function} is not BUS_SERVO")
+    if length != 5:
+        raise ValueError(f"length byte {length}, expected 5")
+    if crc8_maxim(frame[2:-1]) != crc:
+        raise ValueError("bad CRC")
+    if sub != RRC_READ_POSITION:
+        raise ValueError(f"sub-command {sub} is not READ_POSITION")
+    return RrcPositionReport(servo_id, _RRC_READ_RESULTS.get(success, success), position)
+
+
+def rrc_encode_position_report(message: RrcPositionReport) -> bytes:
+    if not 0 <= message.servo_id <= 255:
+        raise ValueError(f"servo_id {message.servo_id} outside 0..255")
+    if not -128 <= message.success <= 127:
+        raise ValueError(f"success {message.success} outside -128..127")
+    if not -32768 <= message.position <= 32767:
+        raise ValueError(f"position {message.position} outside -32768..32767")
+    body = _RRC_REPORT_BODY.pack(
+        RRC_HEADER, RRC_BUS_SERVO, 5, message.servo_id, RRC_READ_POSITION, message.success, message.position
+    )
+    return body + bytes((crc8_maxim(body[2:]),))
+
+
+def rrc_decode_set_speeds(frame: bytes) -> RrcSetSpeeds:
+    size = len(frame)
+    if size < _RRC_SPEEDS_HEAD.size + 1:
+        raise ValueError(f"set-speeds frame of {size} bytes is too short")
+    header, function, length, sub, count = _RRC_SPEEDS_HEAD.unpack_from(frame)
+    if header != RRC_HEADER:
+        raise ValueError(f"bad header {header.hex(' ')}")
+    if function != RRC_MOTOR:
+        raise ValueError(f"function {function} is not MOTOR")
+    if length != size - 5:
+        raise ValueError(f"length byte {length}, but the frame holds {size - 5}")
+    if crc8_maxim(frame[2:-1]) != frame[-1]:
+        raise ValueError("bad CRC")
+    if sub != RRC_SET_SPEEDS:
+        raise ValueError(f"sub-command {sub} is not SET_SPEEDS")
+    if length != 2 + _RRC_MOTOR_ITEM.size * count:
+        raise ValueError(f"{length} content bytes do not hold {count} motors")
+    items = _RRC_MOTOR_ITEM.iter_unpack(frame[_RRC_SPEEDS_HEAD.size : -1])
+    return RrcSetSpeeds(tuple(RrcMotorSpeed(motor_id, speed) for motor_id, speed in items))
+
+
+def rrc_encode_set_speeds(message: RrcSetSpeeds) -> bytes:
+    count = len(message.motors)
+    if count > 50:  # 2 + 5 * count content bytes must fit the length byte
+        raise ValueError(f"{count} motors do not fit one frame")
+    parts = []
+    for motor in message.motors:
+        if not 0 <= motor.motor_id <= 255:
+            raise ValueError(f"motor_id {motor.motor_id} outside 0..255")
+        if not -FLOAT32_MAX <= motor.speed <= FLOAT32_MAX:
+            raise ValueError(f"speed {motor.speed} is not a finite float32")
+        parts.append(_RRC_MOTOR_ITEM.pack(motor.motor_id, motor.speed))
+    body = _RRC_SPEEDS_HEAD.pack(RRC_HEADER, RRC_MOTOR, 2 + 5 * count, RRC_SET_SPEEDS, count) + b"".join(parts)
+    return body + bytes((crc8_maxim(body[2:]),))
+
+
+# --- FEETECH SMS: FF FF, id, length (params + 2), instruction|error, params, ~sum(id..params) ----------------------
+
+SMS_HEADER = b"\xff\xff"
+SMS_WRITE = 3
+
+
+class SmsError(IntFlag):
+    NONE = 0
+    VOLTAGE = 1 << 0
+    ANGLE_SENSOR = 1 << 1
+    OVERHEAT = 1 << 2
+    OVERCURRENT = 1 << 3
+    OVERLOAD = 1 << 5
+
+
+@dataclass(slots=True)
+class SmsReply:
+    servo_id: int
+    error: SmsError
+    data: bytes
+
+
+@dataclass(slots=True)
+class SmsWrite:
+    servo_id: int
+    address: int
+    data: bytes
+
+
+_SMS_HEAD = struct.Struct("<2sBBB")  # header, id, length, error (reply) or instruction (request)
+_SMS_WRITE_HEAD = struct.Struct("<2sBBBB")  # header, id, length, instruction, address
+
+
+def sms_decode_reply(frame: bytes) -> SmsReply:
+    size = len(frame)
+    if size < _SMS_HEAD.size + 1:
+        raise ValueError(f"reply of {size} bytes is too short")
+    header, servo_id, length, error = _SMS_HEAD.unpack_from(frame)
+    if header != SMS_HEADER:
+        raise ValueError(f"bad header {header.hex(' ')}")
+    if length != size - 4:
+        raise ValueError(f"length byte {length}, but the frame holds {size - 4}")
+    if ~sum(frame[2:-1]) & 0xFF != frame[-1]:
+        raise ValueError("bad checksum")
+    return SmsReply(servo_id, SmsError(error), frame[_SMS_HEAD.size : -1])
+
+
+def sms_encode_reply(message: SmsReply) -> bytes:
+    if not 0 <= message.servo_id <= 254:
+        raise ValueError(f"id {message.servo_id} outside 0..254")
+    if not 0 <= message.error <= 255:
+        raise ValueError(f"error {message.error} outside 0..255")
+    if len(message.data) > 253:
+        raise ValueError(f"{len(message.data)} data bytes do not fit one frame")
+    body = _SMS_HEAD.pack(SMS_HEADER, message.servo_id, len(message.data) + 2, message.error) + message.data
+    return body + bytes((~sum(body[2:]) & 0xFF,))
+
+
+def sms_decode_write(frame: bytes) -> SmsWrite:
+    size = len(frame)
+    if size < _SMS_WRITE_HEAD.size + 1:
+        raise ValueError(f"write frame of {size} bytes is too short")
+    header, servo_id, length, instruction, address = _SMS_WRITE_HEAD.unpack_from(frame)
+    if header != SMS_HEADER:
+        raise ValueError(f"bad header {header.hex(' ')}")
+    if length != size - 4:
+        raise ValueError(f"length byte {length}, but the frame holds {size - 4}")
+    if ~sum(frame[2:-1]) & 0xFF != frame[-1]:
+        raise ValueError("bad checksum")
+    if instruction != SMS_WRITE:
+        raise ValueError(f"instruction {instruction} is not WRITE")
+    return SmsWrite(servo_id, address, frame[_SMS_WRITE_HEAD.size : -1])
+
+
+def sms_encode_write(message: SmsWrite) -> bytes:
+    if not 0 <= message.servo_id <= 254:
+        raise ValueError(f"id {message.servo_id} outside 0..254")
+    if not 0 <= message.address <= 255:
+        raise ValueError(f"address {message.address} outside 0..255")
+    if len(message.data) > 252:
+        raise ValueError(f"{len(message.data)} data bytes do not fit one frame")
+    head = _SMS_WRITE_HEAD.pack(SMS_HEADER, message.servo_id, len(message.data) + 3, SMS_WRITE, message.address)
+    body = head + message.data
+    return body + bytes((~sum(body[2:]) & 0xFF,))

@@ -1,0 +1,93 @@
+"""The codec's fast paths against the plain ones they replace.
+
+Decoders build messages through their slots instead of the dataclass __init__, the stream parser decodes frames in
+place (`decode_at`) instead of through `decode`, checksums are inlined expressions and loops instead of runtime
+calls, and fixed-size frames are packed by one struct. Each must agree with the plain way of doing the same.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any
+
+import pytest
+from conftest import ALL, Generated, by_protocol
+from hypothesis import HealthCheck, given, settings
+from serialspec.runtime.checksums import crc_function, sum_function
+from serialspec.runtime.errors import ChecksumError
+from serialspec.runtime.message import slot_setters
+from serialspec.spec.model import Message
+from strategies import message_fields
+
+MESSAGES = by_protocol([(g, m) for g in ALL for m in g.protocol.messages()])
+
+
+def message_type(g: Generated, spec: Message) -> Any:
+    return next(c for c in g.package.MESSAGE_TYPES if c.__name__ == spec.class_name)
+
+
+def checksum(g: Generated, covered: bytes) -> int:
+    """The frame checksum by the runtime's reference functions, which the generated codec no longer calls."""
+    c = g.protocol.framing.checksum
+    if c.algorithm == "crc":
+        assert c.crc is not None
+        return crc_function(c.crc.width, c.crc.poly, c.crc.init, c.crc.refin, c.crc.refout, c.crc.xorout)(covered)
+    return sum_function(c.type.size * 8, c.invert)(covered)
+
+
+@pytest.mark.parametrize(("g", "spec"), MESSAGES)
+def test_fast_paths_agree_with_the_plain_ones(g: Generated, spec: Message) -> None:
+    cls = message_type(g, spec)
+    layout = g.protocol.framing.layouts[spec.direction]
+    direction = spec.direction.value
+
+    @settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+    @given(message_fields(g.protocol, spec))
+    def agree(fields: dict[str, Any]) -> None:
+        built = cls.from_fields(fields)  # through the dataclass __init__
+        frame = g.package.encode(built)
+        # the checksum the inlined code appended is the reference function's
+        covered = frame[layout.covered_from : len(frame) - layout.covered_to_end]
+        size = layout.checksum_offset_from_end
+        assert int.from_bytes(frame[-size:], "little") == checksum(g, covered)
+        # built through its slots: equal, same hash, every field set, still frozen
+        decoded = g.package.decode(frame, direction)
+        assert type(decoded) is cls
+        assert decoded == built and hash(decoded) == hash(built)
+        assert all(hasattr(decoded, f.name) for f in dataclasses.fields(decoded))
+        with pytest.raises(dataclasses.FrozenInstanceError):
+            decoded.__setattr__(dataclasses.fields(decoded)[0].name, 0)
+        # the stream parser decodes in place, between other bytes, to the same message
+        parser = g.package.StreamParser(direction)
+        assert parser.feed(b"\x00" + frame + frame[: len(layout.header)]) == [decoded]
+        assert parser.errors == 0 and parser.pending() == frame[: len(layout.header)]
+        # a frame with a wrong checksum fails both ways
+        damaged = frame[:-1] + bytes([frame[-1] ^ 0x01])
+        with pytest.raises(ChecksumError):
+            g.package.decode(damaged, direction)
+        parser = g.package.StreamParser(direction)
+        assert parser.feed(damaged) == [] and parser.errors == 1
+
+    agree()
+
+
+def test_slot_setters_refuse_a_class_without_slots() -> None:
+    @dataclasses.dataclass(frozen=True)
+    class NoSlots:
+        value: int
+
+    with pytest.raises(TypeError, match="NoSlots.value is not a slot"):
+        slot_setters(NoSlots)
+
+
+def test_slot_setters_store_into_a_frozen_slotted_dataclass() -> None:
+    @dataclasses.dataclass(frozen=True, slots=True)
+    class Pair:
+        first: int
+        second: str
+
+    set_first, set_second = slot_setters(Pair)
+    pair = object.__new__(Pair)
+    set_first(pair, 1)
+    set_second(pair, "two")
+    assert pair == Pair(1, "two") and hash(pair) == hash(Pair(1, "two"))

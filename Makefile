@@ -20,8 +20,8 @@ check: $(STAMP)
 	$(BIN)/serialspec check
 
 lint: $(STAMP)
-	$(BIN)/ruff check generator generated tests
-	$(BIN)/ruff format --check generator tests
+	$(BIN)/ruff check generator generated tests bench examples
+	$(BIN)/ruff format --check generator tests bench examples
 
 typecheck: $(STAMP)
 	$(BIN)/mypy generator/serialspec generated

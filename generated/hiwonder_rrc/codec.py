@@ -1432,26 +1432,6 @@ _REQUEST_SIZES: dict[int | None, tuple[int, int | None]] = {
 }
 
 
-def _decode_request(data: bytes) -> Message:
-    n = len(data)
-    if n < 5:
-        raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (5 bytes)")
-    if data[:2] != b'\xaaU':
-        raise DecodeError(f"request header is {data[:2].hex(' ')}, expected aa 55")
-    size = data[3]
-    if n != 5 + size:
-        raise DecodeError(f"length byte says {size} content bytes but the frame holds {n - 5}")
-    expected = 0x0
-    for byte in data[2:-1]:
-        expected = _CRC_TABLE[expected ^ byte]
-    if expected != data[-1]:
-        raise ChecksumError(f"bad checksum: the frame has {data[-1]:#04x}, its bytes give {expected:#04x}")
-    decoder = _REQUEST_DECODERS.get(data[2])
-    if decoder is None:
-        raise DecodeError(f"unknown command {data[2]:#04x}")
-    return decoder(data, 4, n - 1)
-
-
 def _decode_request_at(buf: bytes, start: int, stop: int) -> Message:
     """The frame buf[start:stop], whose header and length byte the stream parser has checked."""
     expected = 0x0
@@ -1481,26 +1461,6 @@ _RESPONSE_SIZES: dict[int | None, tuple[int, int | None]] = {
     0x08: (7, 7),
     0x09: (36, 36),
 }
-
-
-def _decode_response(data: bytes) -> Message:
-    n = len(data)
-    if n < 5:
-        raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (5 bytes)")
-    if data[:2] != b'\xaaU':
-        raise DecodeError(f"response header is {data[:2].hex(' ')}, expected aa 55")
-    size = data[3]
-    if n != 5 + size:
-        raise DecodeError(f"length byte says {size} content bytes but the frame holds {n - 5}")
-    expected = 0x0
-    for byte in data[2:-1]:
-        expected = _CRC_TABLE[expected ^ byte]
-    if expected != data[-1]:
-        raise ChecksumError(f"bad checksum: the frame has {data[-1]:#04x}, its bytes give {expected:#04x}")
-    decoder = _RESPONSE_DECODERS.get(data[2])
-    if decoder is None:
-        raise DecodeError(f"unknown command {data[2]:#04x}")
-    return decoder(data, 4, n - 1)
 
 
 def _decode_response_at(buf: bytes, start: int, stop: int) -> Message:
@@ -1582,13 +1542,48 @@ RESPONSE_FORMAT = FrameFormat(
 
 
 def decode(data: bytes, direction: Direction | str | None = None) -> Message:
-    """Decode one complete frame into its message; raises DecodeError with a one-line reason."""
-    if direction == 'request':  # a Direction or its value
-        return _decode_request(data)
-    if direction == 'response':  # a Direction or its value
-        return _decode_response(data)
+    """Decode one complete frame into its message; raises DecodeError with a one-line reason.
+
+    Each direction's checks are inline here rather than in a function per direction: one call less per frame.
+    """
     if direction is None:
         raise DecodeError("give the direction: requests and responses share the header aa 55")
+    if direction == 'request':  # a Direction or its value
+        n = len(data)
+        if n < 5:
+            raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (5 bytes)")
+        if data[:2] != b'\xaaU':
+            raise DecodeError(f"request header is {data[:2].hex(' ')}, expected aa 55")
+        size = data[3]
+        if n != 5 + size:
+            raise DecodeError(f"length byte says {size} content bytes but the frame holds {n - 5}")
+        expected = 0x0
+        for byte in data[2:-1]:
+            expected = _CRC_TABLE[expected ^ byte]
+        if expected != data[-1]:
+            raise ChecksumError(f"bad checksum: the frame has {data[-1]:#04x}, its bytes give {expected:#04x}")
+        decoder = _REQUEST_DECODERS.get(data[2])
+        if decoder is None:
+            raise DecodeError(f"unknown command {data[2]:#04x}")
+        return decoder(data, 4, n - 1)
+    if direction == 'response':  # a Direction or its value
+        n = len(data)
+        if n < 5:
+            raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (5 bytes)")
+        if data[:2] != b'\xaaU':
+            raise DecodeError(f"response header is {data[:2].hex(' ')}, expected aa 55")
+        size = data[3]
+        if n != 5 + size:
+            raise DecodeError(f"length byte says {size} content bytes but the frame holds {n - 5}")
+        expected = 0x0
+        for byte in data[2:-1]:
+            expected = _CRC_TABLE[expected ^ byte]
+        if expected != data[-1]:
+            raise ChecksumError(f"bad checksum: the frame has {data[-1]:#04x}, its bytes give {expected:#04x}")
+        decoder = _RESPONSE_DECODERS.get(data[2])
+        if decoder is None:
+            raise DecodeError(f"unknown command {data[2]:#04x}")
+        return decoder(data, 4, n - 1)
     raise ValueError(f"direction must be request or response, not {direction!r}")
 
 

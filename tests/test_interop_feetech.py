@@ -8,13 +8,14 @@ from collections.abc import Iterator
 from typing import Any
 
 import pytest
+from feetech_sms.registers import CONTROL_TABLE
 from sim_process import serve
 
 scservo_sdk = pytest.importorskip("scservo_sdk")
 
 SUCCESS = scservo_sdk.COMM_SUCCESS
 GOAL_POSITION = importlib.import_module("scservo_sdk.sms_sts").SMS_STS_GOAL_POSITION_L
-TORQUE_LIMIT = 0x30  # the memory table's address; the SDK names no constant for it
+TORQUE_LIMIT = CONTROL_TABLE["torque_limit"].address  # from the spec: the SDK names no constant for it
 
 
 @pytest.fixture(scope="module")

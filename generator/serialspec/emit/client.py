@@ -26,6 +26,7 @@ from serialspec.spec.model import (
     Bytes,
     Direction,
     Field,
+    FrameElement,
     Group,
     Message,
     Protocol,
@@ -160,10 +161,15 @@ def table_context(
     }
 
 
+def status_elements(protocol: Protocol) -> list[FrameElement]:
+    """The reply's frame-level status values (FEETECH `error`): the bus raises DeviceError when one is non-zero."""
+    return [e for e in protocol.framing.layouts[Direction.RESPONSE].value_elements if e.role == "status"]
+
+
 def unused_fields(protocol: Protocol, request: Message, response: Message) -> set[str]:
     """Reply fields that carry nothing for this request: frame status (checked by the bus, DeviceError) and a run
     of registers read from a request field this request does not have (a shared reply's `data` to a PING)."""
-    unused = {e.name for e in protocol.framing.layouts[Direction.RESPONSE].value_elements if e.role == "status"}
+    unused = {e.name for e in status_elements(protocol)}
     names = {f.name for f in request.fields}
     for f in response.fields:
         if isinstance(f, Bytes) and f.table is not None:
@@ -175,11 +181,7 @@ def unused_fields(protocol: Protocol, request: Message, response: Message) -> se
 
 def status_flags(protocol: Protocol) -> str:
     """The reply's frame status elements that have flags, as a literal {name: flags class} (empty if none)."""
-    pairs = [
-        f"{e.name!r}: {e.flags.class_name}"
-        for e in protocol.framing.layouts[Direction.RESPONSE].value_elements
-        if e.role == "status" and e.flags is not None
-    ]
+    pairs = [f"{e.name!r}: {e.flags.class_name}" for e in status_elements(protocol) if e.flags is not None]
     return "{" + ", ".join(pairs) + "}" if pairs else ""
 
 
@@ -190,7 +192,7 @@ def register_commands(protocol: Protocol, methods: list[dict[str, Any]]) -> list
     whose reply holds such bytes from the request's start and size reads (`read(id, "present_position")`), and a
     request group whose items each hold such bytes for one device writes to several (`sync_write({1: {...}})`).
     """
-    found = []
+    found: list[dict[str, Any]] = []
     by_name = {m["name"]: m for m in methods}
     for request, response in request_response_pairs(protocol):
         method = by_name.get(method_name(request))
@@ -221,7 +223,10 @@ def register_commands(protocol: Protocol, methods: list[dict[str, Any]]) -> list
             start, size = (read.start.removeprefix("request."), read.size_from.removeprefix("request."))
             if fields != [address, start, size]:
                 continue
+            # the first register read also reads the parameters that switch optional replies (one _read_key)
+            first = not any(c["kind"] == "read" for c in found)
             context.update(kind="read", map=map_name(read.table), alias=names_alias(read.table), returns="int")
+            context.update(read_key=first)
         elif group is not None and read is not None and read.table is not None and method["kind"] == "each":
             start, size = (read.start.removeprefix("request."), read.size_from.removeprefix("request."))
             if fields != [address, start, size, group.name] or [f.name for f in group.fields] != [address]:
@@ -405,11 +410,7 @@ def client_module(protocol: Protocol) -> str:
             reports.append({"name": method_name(message), "class_name": message.class_name, "title": one_line(title)})
     registers = register_commands(protocol, methods)
     flags_literal = status_flags(protocol)
-    imports.update(
-        e.flags.class_name
-        for e in protocol.framing.layouts[Direction.RESPONSE].value_elements
-        if e.role == "status" and e.flags is not None
-    )
+    imports.update(e.flags.class_name for e in status_elements(protocol) if e.flags is not None)
     everything = [*methods, *(m for g in groups.values() for m in g["methods"])]
     address, broadcast = address_of(protocol)
     class_name = "".join(w.capitalize() for w in protocol.name.split("_")) + "Client"
@@ -422,14 +423,7 @@ def client_module(protocol: Protocol) -> str:
         description=one_line(protocol.description),
         address=repr(address),
         broadcast=repr(broadcast),
-        status=repr(
-            tuple(
-                e.name
-                for layout in [protocol.framing.layouts[Direction.RESPONSE]]
-                for e in layout.value_elements
-                if e.role == "status"
-            )
-        ),
+        status=repr(tuple(e.name for e in status_elements(protocol))),
         methods=methods,
         groups=list(groups.values()),
         registers=registers,

@@ -8,6 +8,7 @@ identifiers, and every piece of spec text reaches generated code through repr(),
 from __future__ import annotations
 
 import re
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 
 from serialspec.spec.model import (
@@ -87,6 +88,21 @@ def takes_the_rest(f: SpecField | None) -> bool:
 
 def is_fixed_run_member(f: SpecField) -> bool:
     return isinstance(f, Scalar | Array | TableBlock) or (isinstance(f, Bytes) and isinstance(f.size, int))
+
+
+def fixed_runs(fields: list[SpecField]) -> Iterator[list[SpecField] | SpecField]:
+    """Fields in order, each run of fixed-size fields as one list (one struct call), other fields alone."""
+    run: list[SpecField] = []
+    for f in fields:
+        if is_fixed_run_member(f):
+            run.append(f)
+            continue
+        if run:
+            yield run
+            run = []
+        yield f
+    if run:
+        yield run
 
 
 def annotation(f: SpecField) -> str:
@@ -386,18 +402,11 @@ class PackageCode:
     def decode_fields(self, fields: list[SpecField], base: str, lines: Lines, where: str, top: bool) -> list[str]:
         """Append lines reading fields at cursor `o`; return the expressions of the non-hidden values."""
         values: list[str] = []
-        index = 0
-        while index < len(fields):
-            run: list[SpecField] = []
-            while index < len(fields) and is_fixed_run_member(fields[index]):
-                run.append(fields[index])
-                index += 1
-            if run:
-                values += self.decode_run(run, base, lines, where)
-                continue
-            f = fields[index]
-            index += 1
-            values.append(self.decode_variable(f, fields, base, lines, where))
+        for item in fixed_runs(fields):
+            if isinstance(item, list):
+                values += self.decode_run(item, base, lines, where)
+            else:
+                values.append(self.decode_variable(item, fields, base, lines, where))
         if top:
             lines.append("if o != end:")
             lines.append(f"    raise DecodeError({where} + f': {{end - o}} bytes left after the last field')")
@@ -667,18 +676,11 @@ class PackageCode:
     def encode_fields(self, fields: list[SpecField], base: str, obj: str, lines: Lines, where: str) -> list[str]:
         """Append checks and local values; return expressions of the byte parts in order."""
         parts: list[str] = []
-        index = 0
-        while index < len(fields):
-            run: list[SpecField] = []
-            while index < len(fields) and is_fixed_run_member(fields[index]):
-                run.append(fields[index])
-                index += 1
-            if run:
-                parts.append(self.encode_run(run, base, obj, fields, lines, where))
-                continue
-            f = fields[index]
-            index += 1
-            parts.append(self.encode_variable(f, obj, lines, where))
+        for item in fixed_runs(fields):
+            if isinstance(item, list):
+                parts.append(self.encode_run(item, base, obj, fields, lines, where))
+            else:
+                parts.append(self.encode_variable(item, obj, lines, where))
         return parts
 
     def wire_value(self, f: Scalar, obj: str, siblings: list[SpecField], lines: Lines, where: str) -> str:

@@ -41,9 +41,9 @@ try:
     _PORT_FAILURES = (serial.SerialException, OSError, termios.error)
 except ImportError:  # Windows
     _PORT_FAILURES = (serial.SerialException, OSError)
-_POSIX_SERIAL: tuple[type, ...] = tuple(
-    cls for cls in (getattr(getattr(serial, "serialposix", None), "Serial", None),) if cls is not None
-)
+# The one port class whose reads and writes the bus may do itself on the descriptor (see FdLink): pyserial's own
+# POSIX port. Subclasses (spy://, other URL handlers) override read/write and so keep going through pyserial.
+_POSIX_SERIAL: type | None = getattr(getattr(serial, "serialposix", None), "Serial", None)
 _OPEN_FAILURES: tuple[type[Exception], ...] = (*_PORT_FAILURES, ValueError)  # ValueError: a bad setting
 _RESET_FAILURES: tuple[type[Exception], ...] = (*_PORT_FAILURES, NotImplementedError)  # URLs without a buffer
 
@@ -85,6 +85,109 @@ def flag_names(flags: dict[str, type[IntFlag]]) -> Callable[[str, int], str]:
 Subscriber = Callable[[Message], None]
 
 
+class Link:
+    """How a bus moves bytes through a port: pyserial's own calls, for any port or URL pyserial opens.
+
+    Three operations make a transaction: `write` a frame, `read_waiting` (what arrived between transactions,
+    without waiting) and `read` (whatever arrives, blocking up to a deadline for the first byte: no sleeping, no
+    polling). Port failures propagate as pyserial raises them; the bus turns them into PortError.
+    """
+
+    __slots__ = ("port",)
+
+    def __init__(self, port: Any) -> None:
+        self.port = port
+
+    def write(self, data: bytes) -> None:
+        self.port.write(data)
+
+    def read_waiting(self) -> bytes:
+        port = self.port
+        waiting = port.in_waiting
+        if not waiting:
+            return b""
+        port.timeout = 0
+        data: bytes = port.read(waiting)
+        return data
+
+    def read(self, wait: float) -> bytes:
+        port = self.port
+        if port.timeout != wait:
+            port.timeout = wait
+        # Blocks until the first byte or the deadline; then takes whatever else has arrived.
+        chunk: bytes = port.read(1)
+        waiting = port.in_waiting if chunk else 0
+        return chunk + port.read(waiting) if waiting else chunk
+
+
+class FdLink(Link):
+    """pyserial's POSIX port (a tty, a pty), driven on its descriptor: one `os.write` per frame, one `poll` and one
+    `os.read` per chunk read. pyserial keeps no buffer of its own there and opens the descriptor non-blocking, so
+    this sees exactly the bytes it would, without a `select` after every write, an `in_waiting` ioctl per
+    transaction, or a `tcsetattr` to change the read timeout. The descriptor is taken from the port at every call:
+    a port closed under the bus fails its next call (fd None) instead of reading a stale descriptor.
+    """
+
+    __slots__ = ("_fd", "_poll")
+
+    def __init__(self, port: Any) -> None:
+        super().__init__(port)
+        self._fd = -1
+        self._poll = select.poll()
+
+    def write(self, data: bytes) -> None:
+        try:
+            written = os.write(self.port.fd, data)
+        except BlockingIOError:
+            written = 0
+        if written < len(data):  # the output buffer is full: pyserial waits for room (and keeps its write_timeout)
+            self.port.write(data[written:])
+
+    def read_waiting(self) -> bytes:
+        # pyserial sets VMIN = VTIME = 0: a read with nothing there returns b"" at once (one syscall, the usual
+        # case). A device that went away fails here or at the write that follows.
+        fd = self.port.fd
+        try:
+            data = os.read(fd, 4096)
+        except BlockingIOError:
+            return b""
+        while len(data) % 4096 == 0 and data:  # more may be waiting (a read that fills the buffer is rare)
+            try:
+                more = os.read(fd, 4096)
+            except BlockingIOError:
+                break
+            if not more:
+                break
+            data += more
+        return data
+
+    def read(self, wait: float) -> bytes:
+        fd = self.port.fd
+        if fd != self._fd:  # first read, or the port was reopened
+            if fd is None:
+                raise serial.SerialException("the port is closed")
+            if self._fd >= 0:
+                self._poll.unregister(self._fd)
+            self._poll.register(fd, select.POLLIN)
+            self._fd = fd
+        if not self._poll.poll(wait * 1000):  # milliseconds, rounded up: never returns before the deadline
+            if self.port.fd is None:  # closed by another thread while this one waited
+                raise serial.SerialException("the port is closed")
+            return b""
+        try:
+            data = os.read(fd, 4096)
+        except BlockingIOError:  # woken, but another reader took the bytes
+            return b""
+        if not data:  # readable but empty: the other end hung up
+            raise serial.SerialException("device disconnected")
+        return data
+
+
+def link(port: Any) -> Link:
+    """The fastest link that sees exactly what pyserial would for this port."""
+    return FdLink(port) if _POSIX_SERIAL is not None and type(port) is _POSIX_SERIAL else Link(port)
+
+
 class Bus:
     """A serial port shared by every device on it; one lock, so transactions from threads never interleave."""
 
@@ -123,6 +226,12 @@ class Bus:
             except (serial.SerialException, OSError, ValueError) as exc:
                 raise PortError(f"cannot open {port}: {exc}") from None
         self.port_name = str(getattr(self._port, "name", None) or getattr(self._port, "port", "") or port)
+        self._link = link(self._port)
+        # the spec's matching rule, split once: compare the command, the sub-command, then these fields
+        match_by = binding.match_by
+        self._match_command = "command" in match_by
+        self._match_subcommand = "subcommand" in match_by
+        self._match_fields = tuple(name for name in match_by if name not in ("command", "subcommand"))
 
     # --- lifetime -------------------------------------------------------------------------------------------------
 
@@ -143,6 +252,7 @@ class Bus:
         except _OPEN_FAILURES as exc:
             raise PortError(f"cannot reopen {self.port_name}: {exc}") from None
         self._parser = self.binding.parser()
+        self._link = link(self._port)
 
     def __enter__(self) -> Bus:
         return self
@@ -180,10 +290,11 @@ class Bus:
             self._ensure_open()
             self._drain()
             self._write(frame)
-            reply = self._read_until(lambda m: isinstance(m, expect) and self.matches(request, m), wait, request)
-            self._flush_backlog()
-        assert isinstance(reply, expect)
-        self._check_status(reply)
+            reply = self._read_until(wait, request, expect)
+            if self._backlog:
+                self._flush_backlog()
+        if self.binding.status:
+            self._check_status(reply)
         return reply
 
     def request_each(
@@ -200,15 +311,10 @@ class Bus:
             self._drain()
             self._write(frame)
             for key in answers:
-
-                def wanted(message: Message, key: dict[str, Any] = key) -> bool:
-                    return isinstance(message, expect) and all(getattr(message, k, None) == v for k, v in key.items())
-
                 try:
-                    reply = self._read_until(wanted, wait, request)
+                    reply = self._read_until(wait, request, expect, key)
                 except Timeout:
                     raise Timeout(request.COMMAND, " ".join(f"{k}={v}" for k, v in key.items()), wait) from None
-                assert isinstance(reply, expect)
                 replies.append(reply)
             self._flush_backlog()
         for reply in replies:
@@ -217,14 +323,12 @@ class Bus:
 
     def matches(self, request: Message, reply: Message) -> bool:
         """The spec's matching rule: the named attributes are equal where both messages have them."""
-        for name in self.binding.match_by:
-            if name == "command":
-                if reply.COMMAND != request.COMMAND:
-                    return False
-            elif name == "subcommand":
-                if reply.SUBCOMMAND != request.SUBCOMMAND:
-                    return False
-            elif hasattr(request, name) and hasattr(reply, name) and getattr(request, name) != getattr(reply, name):
+        if self._match_command and reply.COMMAND != request.COMMAND:
+            return False
+        if self._match_subcommand and reply.SUBCOMMAND != request.SUBCOMMAND:
+            return False
+        for name in self._match_fields:
+            if hasattr(request, name) and hasattr(reply, name) and getattr(request, name) != getattr(reply, name):
                 return False
         return True
 
@@ -235,7 +339,7 @@ class Bus:
                 return self._unsolicited.popleft()
             self._ensure_open()
             try:
-                self._read_until(lambda m: True, self.timeout if timeout is None else timeout, None, keep=True)
+                self._read_until(self.timeout if timeout is None else timeout, None, Message, keep=True)
             except Timeout:
                 return None
             self._flush_backlog()
@@ -248,12 +352,8 @@ class Bus:
 
     # --- reading and writing --------------------------------------------------------------------------------------
 
-    def _port_failures(self, doing: str) -> _PortFailures:
-        """Whatever pyserial raises when the device goes away or the port is closed under the bus, as PortError."""
-        return _PortFailures(self, doing)
-
     def _port_failed(self, doing: str, exc: Exception) -> None:
-        """Raise PortError for a port failure; anything else propagates as it is.
+        """Raise PortError for a port failure; anything else is left for the caller to re-raise as it is.
 
         A port closed by another thread while a read waits makes pyserial fail with TypeError (its descriptor is
         None by then): that is a closed port too, not a bug. The failed port is closed so that the next
@@ -269,78 +369,93 @@ class Bus:
         raise PortError(f"{self.port_name}: {doing} failed: {reason}") from None
 
     def _write(self, frame: bytes) -> None:
-        with self._port_failures("write"):
-            self._port.write(frame)
+        try:
+            self._link.write(frame)
+        except Exception as exc:
+            self._port_failed("write", exc)
+            raise
 
     def _drain(self) -> None:
         """Hand bytes that arrived between transactions (late replies, reports) to subscribers, without waiting."""
-        self._flush_backlog()
-        with self._port_failures("read"):
-            waiting = self._port.in_waiting
-            if waiting:
-                self._port.timeout = 0
-                chunk = self._port.read(waiting)
-        if waiting:
+        if self._backlog:
+            self._flush_backlog()
+        try:
+            chunk = self._link.read_waiting()
+        except Exception as exc:
+            self._port_failed("read", exc)
+            raise
+        if chunk:
             for message in self._parser.feed(chunk):
                 self._unmatched(message)
         self._parser.errors = 0
-
-    def _read_some(self, wait: float) -> bytes:
-        """Whatever has arrived, blocking up to `wait` seconds for the first byte (no sleeping, no polling)."""
-        fd = getattr(self._port, "fd", None) if isinstance(self._port, _POSIX_SERIAL) else None
-        if isinstance(fd, int):
-            # A device file: wait on the descriptor and read it directly. pyserial keeps no buffer of its own
-            # there, and this avoids setting its timeout (a tcsetattr per transaction) and a second read call.
-            if not select.select([fd], [], [], wait)[0]:
-                return b""
-            data = os.read(fd, 4096)
-            if not data:  # readable but empty: the other end hung up
-                raise serial.SerialException("device disconnected")
-            return data
-        if self._port.timeout != wait:
-            self._port.timeout = wait
-        # Blocks until the first byte or the deadline; then takes whatever else has arrived.
-        chunk: bytes = self._port.read(1)
-        waiting = self._port.in_waiting if chunk else 0
-        return chunk + self._port.read(waiting) if waiting else chunk
 
     def _flush_backlog(self) -> None:
         """Frames that came with a reply but answer nothing go to subscribers now, not at the next transaction."""
         while self._backlog:
             self._unmatched(self._backlog.popleft())
 
+    def _wanted(self, message: Message, request: Message | None, expect: type[M], key: dict[str, Any] | None) -> bool:
+        """Whether `message` is what the transaction waits for: the reply to `request` (or, with `key`, the reply
+        whose attributes equal the key's values); any frame when there is no request."""
+        if not isinstance(message, expect):
+            return False
+        if key is not None:
+            return all(getattr(message, k, None) == v for k, v in key.items())
+        return request is None or self.matches(request, message)
+
     def _read_until(
-        self, wanted: Callable[[Message], bool], wait: float, request: Message | None, keep: bool = False
-    ) -> Message:
-        deadline = time.monotonic() + wait
-        errors = self._parser.errors
-        while True:
-            remaining = deadline - time.monotonic()
-            held = list(self._backlog)  # frames that came with the previous reply of this transaction
-            self._backlog.clear()
-            with self._port_failures("read"):
-                chunk = b"" if held or remaining <= 0 else self._read_some(remaining)
-            found = None
-            for message in held + (self._parser.feed(chunk) if chunk else []):
-                if found is not None:
-                    self._backlog.append(message)  # maybe the next reply of a request_each
-                elif wanted(message):
-                    found = message
-                    if keep:
-                        self._unmatched(message)
-                else:
+        self,
+        wait: float,
+        request: Message | None,
+        expect: type[M],
+        key: dict[str, Any] | None = None,
+        keep: bool = False,
+    ) -> M:
+        """Read until the wanted frame (see _wanted) has come, for up to `wait` seconds. Frames that came after it
+        in the same read stay in the backlog (the next reply of a request_each); every other frame goes to
+        subscribers, and to them too the wanted one when `keep`."""
+        backlog = self._backlog
+        while backlog:  # frames that came with the previous reply of this transaction
+            message = backlog.popleft()
+            if self._wanted(message, request, expect, key):
+                if keep:
                     self._unmatched(message)
-            if found is not None:
-                return found
-            if held:
-                continue
-            if self._parser.errors > errors:
-                bad = self._parser.errors - errors
+                return message  # type: ignore[return-value]  # _wanted checked its type
+            self._unmatched(message)
+        monotonic = time.monotonic
+        deadline = monotonic() + wait
+        parser = self._parser
+        errors = parser.errors
+        read = self._link.read
+        while True:
+            remaining = deadline - monotonic()
+            chunk = b""
+            if remaining > 0:
+                try:
+                    chunk = read(remaining)
+                except Exception as exc:
+                    self._port_failed("read", exc)
+                    raise
+            if chunk:
+                found = None
+                for message in parser.feed(chunk):
+                    if found is not None:
+                        backlog.append(message)  # maybe the next reply of a request_each
+                    elif self._wanted(message, request, expect, key):
+                        found = message
+                        if keep:
+                            self._unmatched(message)
+                    else:
+                        self._unmatched(message)
+                if found is not None:
+                    return found  # type: ignore[return-value]  # _wanted checked its type
+            if parser.errors > errors:
+                bad = parser.errors - errors
                 self._reset()
                 what = f" to {request.COMMAND} from {self._device(request)}" if request else ""
                 raise CorruptReply(f"corrupt reply{what}: {bad} frame(s) failed their checksum or content check")
-            if remaining <= 0 or (not chunk and time.monotonic() >= deadline):
-                pending = self._parser.pending()
+            if remaining <= 0 or (not chunk and monotonic() >= deadline):
+                pending = parser.pending()
                 self._reset()
                 if request is None:
                     raise Timeout("", "", wait)
@@ -369,23 +484,6 @@ class Bus:
                 self._port.reset_input_buffer()
         except _RESET_FAILURES:
             pass  # a port that has failed reports it on the next read or write
-
-
-class _PortFailures:
-    """The context manager behind Bus._port_failures: a class, as it runs three times per transaction."""
-
-    __slots__ = ("bus", "doing")
-
-    def __init__(self, bus: Bus, doing: str) -> None:
-        self.bus = bus
-        self.doing = doing
-
-    def __enter__(self) -> None:
-        return None
-
-    def __exit__(self, kind: type[BaseException] | None, exc: BaseException | None, trace: object) -> None:
-        if isinstance(exc, Exception):
-            self.bus._port_failed(self.doing, exc)
 
 
 class ClientBase:

@@ -33,9 +33,10 @@ class FrameFormat:
 class _Candidate:
     """A FrameFormat as the scanning loop reads it: the size of every plausible frame, by command and length byte."""
 
-    __slots__ = ("header", "prefix", "command_offset", "length_offset", "frame_sizes", "decode")
+    __slots__ = ("frame_format", "header", "prefix", "command_offset", "length_offset", "frame_sizes", "decode")
 
     def __init__(self, frame_format: FrameFormat) -> None:
+        self.frame_format = frame_format  # kept alive: the cache below is keyed by its id
         self.header = frame_format.header
         # bytes needed before the command code and the length byte can be read
         self.prefix = max(frame_format.length_offset, frame_format.command_offset or 0) + 1
@@ -53,6 +54,18 @@ class _Candidate:
                     self.frame_sizes[key] = frame_format.overhead + content
 
 
+# Candidates are immutable and built once per frame format (a size table is thousands of entries): a parser is
+# created on every reset and reopen of a bus, so creating one must cost next to nothing.
+_CANDIDATES: dict[int, _Candidate] = {}
+
+
+def _candidate(frame_format: FrameFormat) -> _Candidate:
+    found = _CANDIDATES.get(id(frame_format))
+    if found is None or found.frame_format is not frame_format:
+        found = _CANDIDATES[id(frame_format)] = _Candidate(frame_format)
+    return found
+
+
 class StreamParser:
     """Feed bytes as they arrive; get back the complete messages found so far, in order.
 
@@ -62,7 +75,8 @@ class StreamParser:
     def __init__(self, *formats: FrameFormat) -> None:
         if not formats:
             raise ValueError("a stream parser needs at least one frame format")
-        self._candidates = tuple(_Candidate(f) for f in formats)
+        self._candidates = tuple(_candidate(f) for f in formats)
+        self._single = self._candidates[0] if len(self._candidates) == 1 else None
         self._pending = b""
         self._keep = max(len(f.header) for f in formats) - 1  # a tail that could be the start of a header
         self.errors = 0
@@ -70,13 +84,25 @@ class StreamParser:
 
     def feed(self, data: bytes | bytearray | memoryview) -> list[Message]:
         # Work on immutable bytes: decoders slice their `bytes` fields straight out of the buffer.
-        buffer = self._pending + data if self._pending else bytes(data)
+        buffer = self._pending + data if self._pending else data if type(data) is bytes else bytes(data)
         end = len(buffer)
+        single = self._single
+        if single is not None and single.command_offset is not None and end >= single.prefix:
+            # A transaction's read is usually one whole frame, first byte on: decode it without the scan. A frame
+            # that fails goes through the scan below, which counts it and resynchronises.
+            key = buffer[single.command_offset] << 8 | buffer[single.length_offset]
+            if single.frame_sizes.get(key) == end and buffer.startswith(single.header):
+                try:
+                    message = single.decode(buffer, 0, end)
+                except DecodeError:
+                    pass
+                else:
+                    self._pending = b""
+                    return [message]
         found: list[Message] = []
         append = found.append
         find = buffer.find
         candidates = self._candidates
-        single = len(candidates) == 1
         # one frame format (the usual case): its parameters stay in locals for the whole scan
         current = candidates[0]
         header, prefix, command_offset, length_offset = (
@@ -88,7 +114,7 @@ class StreamParser:
         frame_sizes, decode = current.frame_sizes, current.decode
         garbage = errors = start = 0
         while True:
-            if single:
+            if single is not None:
                 position = find(header, start)
             else:
                 position, current = self._next_header(buffer, start)

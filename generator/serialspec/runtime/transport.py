@@ -11,6 +11,7 @@ unplugged and plugged back in (or a symlink such as /dev/serial/by-id/... pointe
 
 from __future__ import annotations
 
+import operator
 import os
 import select
 import threading
@@ -83,6 +84,7 @@ def flag_names(flags: dict[str, type[IntFlag]]) -> Callable[[str, int], str]:
 
 
 Subscriber = Callable[[Message], None]
+_ABSENT = object()  # an attribute a message does not have
 
 
 class Link:
@@ -232,6 +234,7 @@ class Bus:
         self._match_command = "command" in match_by
         self._match_subcommand = "subcommand" in match_by
         self._match_fields = tuple(name for name in match_by if name not in ("command", "subcommand"))
+        self._rules: dict[tuple[type, type], tuple[bool, Callable[[Any], Any] | None]] = {}
 
     # --- lifetime -------------------------------------------------------------------------------------------------
 
@@ -287,7 +290,8 @@ class Bus:
         frame = self.binding.encode(request)
         wait = self.timeout if timeout is None else timeout
         with self._lock:
-            self._ensure_open()
+            if self._closed or not self._port.is_open:
+                self._ensure_open()
             self._drain()
             self._write(frame)
             reply = self._read_until(wait, request, expect)
@@ -328,9 +332,25 @@ class Bus:
         if self._match_subcommand and reply.SUBCOMMAND != request.SUBCOMMAND:
             return False
         for name in self._match_fields:
-            if hasattr(request, name) and hasattr(reply, name) and getattr(request, name) != getattr(reply, name):
+            mine = getattr(request, name, _ABSENT)
+            if mine is not _ABSENT and getattr(reply, name, mine) != mine:
                 return False
         return True
+
+    def _rule(self, request_type: type, reply_type: type) -> tuple[bool, Callable[[Any], Any] | None]:
+        """The matching rule for a reply of exactly `reply_type` to a request of `request_type`, worked out once:
+        whether it can answer at all (command, sub-command), and a getter of the fields both have (None: none)."""
+        rule = self._rules.get((request_type, reply_type))
+        if rule is None:
+            possible = not (
+                self._match_command and getattr(reply_type, "COMMAND", None) != getattr(request_type, "COMMAND", None)
+            ) and not (
+                self._match_subcommand
+                and getattr(reply_type, "SUBCOMMAND", None) != getattr(request_type, "SUBCOMMAND", None)
+            )
+            names = [n for n in self._match_fields if hasattr(request_type, n) and hasattr(reply_type, n)]
+            rule = self._rules[(request_type, reply_type)] = (possible, operator.attrgetter(*names) if names else None)
+        return rule
 
     def receive(self, timeout: float | None = None) -> Message | None:
         """The next frame that answered no request (the device's own reports), or None after the timeout."""
@@ -384,10 +404,11 @@ class Bus:
         except Exception as exc:
             self._port_failed("read", exc)
             raise
+        parser = self._parser
         if chunk:
-            for message in self._parser.feed(chunk):
+            for message in parser.feed(chunk):
                 self._unmatched(message)
-        self._parser.errors = 0
+        parser.errors = 0
 
     def _flush_backlog(self) -> None:
         """Frames that came with a reply but answer nothing go to subscribers now, not at the next transaction."""
@@ -424,11 +445,19 @@ class Bus:
             self._unmatched(message)
         monotonic = time.monotonic
         deadline = monotonic() + wait
+        remaining = wait
         parser = self._parser
         errors = parser.errors
         read = self._link.read
+        wanted = self._wanted
+        # a reply of exactly the expected type (the usual case) is checked by the rule worked out for its type
+        exact: type | None = None
+        possible, getter, value = False, None, None
+        if request is not None and key is None:
+            exact = expect
+            possible, getter = self._rule(type(request), expect)
+            value = getter(request) if getter is not None else None
         while True:
-            remaining = deadline - monotonic()
             chunk = b""
             if remaining > 0:
                 try:
@@ -441,7 +470,11 @@ class Bus:
                 for message in parser.feed(chunk):
                     if found is not None:
                         backlog.append(message)  # maybe the next reply of a request_each
-                    elif self._wanted(message, request, expect, key):
+                    elif (
+                        possible and (getter is None or getter(message) == value)
+                        if type(message) is exact
+                        else wanted(message, request, expect, key)
+                    ):
                         found = message
                         if keep:
                             self._unmatched(message)
@@ -454,7 +487,8 @@ class Bus:
                 self._reset()
                 what = f" to {request.COMMAND} from {self._device(request)}" if request else ""
                 raise CorruptReply(f"corrupt reply{what}: {bad} frame(s) failed their checksum or content check")
-            if remaining <= 0 or (not chunk and monotonic() >= deadline):
+            now = monotonic()
+            if remaining <= 0 or (not chunk and now >= deadline):
                 pending = parser.pending()
                 self._reset()
                 if request is None:
@@ -464,6 +498,7 @@ class Bus:
                         f"incomplete reply to {request.COMMAND} from {self._device(request)}: {pending.hex(' ')}"
                     )
                 raise Timeout(request.COMMAND, self._device(request), wait)
+            remaining = deadline - now
 
     def _device(self, request: Message) -> str:
         parts = [f"{n}={getattr(request, n)}" for n in self.binding.match_by if hasattr(request, n)]

@@ -87,10 +87,12 @@ class StreamParser:
         buffer = self._pending + data if self._pending else data if type(data) is bytes else bytes(data)
         end = len(buffer)
         single = self._single
-        if single is not None and single.command_offset is not None and end >= single.prefix:
+        if single is not None and end >= single.prefix:
             # A transaction's read is usually one whole frame, first byte on: decode it without the scan. A frame
             # that fails goes through the scan below, which counts it and resynchronises.
-            key = buffer[single.command_offset] << 8 | buffer[single.length_offset]
+            key = buffer[single.length_offset]
+            if single.command_offset is not None:
+                key |= buffer[single.command_offset] << 8
             if single.frame_sizes.get(key) == end and buffer.startswith(single.header):
                 try:
                     message = single.decode(buffer, 0, end)

@@ -1,4 +1,4 @@
-"""The jinja2 environment shared by every emitter: templates hold layout only."""
+"""The jinja2 environments the targets render with: templates hold layout only."""
 
 from __future__ import annotations
 
@@ -49,19 +49,21 @@ class _QuietCache(jinja2.FileSystemBytecodeCache):
 
 
 @cache
-def environment() -> jinja2.Environment:
+def environment(package: str) -> jinja2.Environment:
+    """The environment of one target package (its templates live in its `templates/` folder)."""
     env = jinja2.Environment(
-        loader=jinja2.PackageLoader("serialspec.emit", "templates"),
+        loader=jinja2.PackageLoader(package, "templates"),
         trim_blocks=True,
         lstrip_blocks=True,
         keep_trailing_newline=True,
         undefined=jinja2.StrictUndefined,
-        autoescape=False,  # we emit Python and markdown; emitters escape spec text for each
+        autoescape=False,  # targets escape spec text themselves, for where it lands
         bytecode_cache=_bytecode_cache(),
     )
     env.filters["pyrepr"] = repr  # a Python literal, safe whatever the text holds
     return env
 
 
-def render(template: str, **context: Any) -> str:
-    return environment().get_template(template).render(**context)
+def render(target: str, template: str, /, **context: Any) -> str:
+    """Render one template of a target package (`serialspec.emit.<target>`)."""
+    return environment(target).get_template(template).render(**context)

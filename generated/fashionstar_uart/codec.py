@@ -61,10 +61,14 @@ _S_READBATCHDATARESPONSE_SERVO_ID = struct.Struct('<BBBBBBBHHHHHHBBBBBBHhhh')
 _S_U8 = struct.Struct('<B')
 _S_U8_I16 = struct.Struct('<Bh')
 _S_U8_I16_U16_U16 = struct.Struct('<BhHH')
+_S_U8_I16_U16_U16_U8 = struct.Struct('<BhHHB')
+_S_U8_I16_U8 = struct.Struct('<BhB')
 _S_U8_U16 = struct.Struct('<BH')
+_S_U8_U16_U8 = struct.Struct('<BHB')
 _S_U8_U8 = struct.Struct('<BB')
 _S_U8_U8_U16_U16 = struct.Struct('<BBHH')
 _S_U8_U8_U8 = struct.Struct('<BBB')
+_S_U8_U8_U8_U8 = struct.Struct('<BBBB')
 _TABLE_PARAMETERS: dict[int, struct.Struct] = {
     1: struct.Struct('<H'),
     2: struct.Struct('<H'),
@@ -470,6 +474,241 @@ def _decode_read_angle_response(buf: bytes, o: int, end: int) -> ReadAngleRespon
     return m
 
 
+def _frame_ping_request(buf: bytes, start: int) -> PingRequest | None:
+    """A whole ping request frame at buf[start:], size and header known: None if its checksum fails."""
+    v_servo_id, check = _S_U8_U8.unpack_from(buf, start + 4)
+    if (0x60 + v_servo_id) & 0xff != check:
+        return None
+    m = _new(PingRequest)
+    _set_PingRequest_servo_id(m, v_servo_id)
+    return m
+
+
+def _frame_reset_user_data_request(buf: bytes, start: int) -> ResetUserDataRequest | None:
+    """A whole reset_user_data request frame at buf[start:], size and header known: None if its checksum fails."""
+    v_servo_id, check = _S_U8_U8.unpack_from(buf, start + 4)
+    if (0x61 + v_servo_id) & 0xff != check:
+        return None
+    m = _new(ResetUserDataRequest)
+    _set_ResetUserDataRequest_servo_id(m, v_servo_id)
+    return m
+
+
+def _frame_read_data_request(buf: bytes, start: int) -> ReadDataRequest | None:
+    """A whole read_data request frame at buf[start:], size and header known: None if its checksum fails."""
+    v_servo_id, v_data_id, check = _S_U8_U8_U8.unpack_from(buf, start + 4)
+    if (0x63 + v_servo_id + v_data_id) & 0xff != check:
+        return None
+    m = _new(ReadDataRequest)
+    _set_ReadDataRequest_servo_id(m, v_servo_id)
+    _set_ReadDataRequest_data_id(m, v_data_id)
+    return m
+
+
+def _frame_read_batch_data_request(buf: bytes, start: int) -> ReadBatchDataRequest | None:
+    """A whole read_batch_data request frame at buf[start:], size and header known: None if its checksum fails."""
+    v_servo_id, check = _S_U8_U8.unpack_from(buf, start + 4)
+    if (0x64 + v_servo_id) & 0xff != check:
+        return None
+    m = _new(ReadBatchDataRequest)
+    _set_ReadBatchDataRequest_servo_id(m, v_servo_id)
+    return m
+
+
+def _frame_write_batch_data_request(buf: bytes, start: int) -> WriteBatchDataRequest | None:
+    """A whole write_batch_data request frame at buf[start:], size and header known: None if its checksum fails."""
+    expected = sum(buf[start + 0 : start + 37]) & 0xff
+    if expected != buf[start + 37]:
+        return None
+    t = _S_READBATCHDATARESPONSE_SERVO_ID.unpack_from(buf, start + 4)
+    v_servo_id = t[0]
+    v_user_data = _new(UserData)
+    _set_UserData_reserved_32(v_user_data, t[1])
+    _set_UserData_response_switch(v_user_data, _MEMBERS_ResponseSwitch.get(t[2], t[2]))
+    _set_UserData_servo_id(v_user_data, t[3])
+    _set_UserData_reserved_35(v_user_data, t[4])
+    _set_UserData_baudrate(v_user_data, _MEMBERS_BaudrateOption.get(t[5], t[5]))
+    _set_UserData_stall_protect_mode(v_user_data, _MEMBERS_StallProtectMode.get(t[6], t[6]))
+    _set_UserData_stall_power_limit(v_user_data, t[7])
+    _set_UserData_over_volt_low(v_user_data, t[8])
+    _set_UserData_over_volt_high(v_user_data, t[9])
+    _set_UserData_over_temperature(v_user_data, t[10])
+    _set_UserData_over_power(v_user_data, t[11])
+    _set_UserData_over_current(v_user_data, t[12])
+    _set_UserData_accel_switch(v_user_data, _MEMBERS_Switch.get(t[13], t[13]))
+    _set_UserData_reserved_45(v_user_data, t[14])
+    _set_UserData_po_lock_switch(v_user_data, _MEMBERS_LockOnPowerOn.get(t[15], t[15]))
+    _set_UserData_wb_lock_switch(v_user_data, _MEMBERS_WheelBrake.get(t[16], t[16]))
+    _set_UserData_angle_limit_switch(v_user_data, _MEMBERS_Switch.get(t[17], t[17]))
+    _set_UserData_soft_start_switch(v_user_data, _MEMBERS_Switch.get(t[18], t[18]))
+    _set_UserData_soft_start_time(v_user_data, t[19])
+    _set_UserData_angle_limit_high(v_user_data, t[20])
+    _set_UserData_angle_limit_low(v_user_data, t[21])
+    _set_UserData_angle_mid_offset(v_user_data, t[22])
+    m = _new(WriteBatchDataRequest)
+    _set_WriteBatchDataRequest_servo_id(m, v_servo_id)
+    _set_WriteBatchDataRequest_user_data(m, v_user_data)
+    return m
+
+
+def _frame_rotate_request(buf: bytes, start: int) -> RotateRequest | None:
+    """A whole rotate request frame at buf[start:], size and header known: None if its checksum fails."""
+    v_servo_id, v_angle, v_interval, v_power, check = _S_U8_I16_U16_U16_U8.unpack_from(buf, start + 4)
+    if (0x6d + v_servo_id + (v_angle & 0xff) + (v_angle >> 8 & 0xff) + (v_interval & 0xff) + (v_interval >> 8 & 0xff) + (v_power & 0xff) + (v_power >> 8 & 0xff)) & 0xff != check:
+        return None
+    m = _new(RotateRequest)
+    _set_RotateRequest_servo_id(m, v_servo_id)
+    _set_RotateRequest_angle(m, v_angle)
+    _set_RotateRequest_interval(m, v_interval)
+    _set_RotateRequest_power(m, v_power)
+    return m
+
+
+def _frame_damping_request(buf: bytes, start: int) -> DampingRequest | None:
+    """A whole damping request frame at buf[start:], size and header known: None if its checksum fails."""
+    v_servo_id, v_power, check = _S_U8_U16_U8.unpack_from(buf, start + 4)
+    if (0x6a + v_servo_id + (v_power & 0xff) + (v_power >> 8 & 0xff)) & 0xff != check:
+        return None
+    m = _new(DampingRequest)
+    _set_DampingRequest_servo_id(m, v_servo_id)
+    _set_DampingRequest_power(m, v_power)
+    return m
+
+
+def _frame_read_angle_request(buf: bytes, start: int) -> ReadAngleRequest | None:
+    """A whole read_angle request frame at buf[start:], size and header known: None if its checksum fails."""
+    v_servo_id, check = _S_U8_U8.unpack_from(buf, start + 4)
+    if (0x69 + v_servo_id) & 0xff != check:
+        return None
+    m = _new(ReadAngleRequest)
+    _set_ReadAngleRequest_servo_id(m, v_servo_id)
+    return m
+
+
+def _frame_ping_response(buf: bytes, start: int) -> PingResponse | None:
+    """A whole ping response frame at buf[start:], size and header known: None if its checksum fails."""
+    v_servo_id, check = _S_U8_U8.unpack_from(buf, start + 4)
+    if (0x23 + v_servo_id) & 0xff != check:
+        return None
+    m = _new(PingResponse)
+    _set_PingResponse_servo_id(m, v_servo_id)
+    return m
+
+
+def _frame_reset_user_data_response(buf: bytes, start: int) -> ResetUserDataResponse | None:
+    """A whole reset_user_data response frame at buf[start:], size and header known: None if its checksum fails."""
+    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, start + 4)
+    if (0x25 + v_servo_id + v_result) & 0xff != check:
+        return None
+    m = _new(ResetUserDataResponse)
+    _set_ResetUserDataResponse_servo_id(m, v_servo_id)
+    _set_ResetUserDataResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
+    return m
+
+
+def _frame_write_data_response(buf: bytes, start: int) -> WriteDataResponse | None:
+    """A whole write_data response frame at buf[start:], size and header known: None if its checksum fails."""
+    v_servo_id, v_data_id, v_result, check = _S_U8_U8_U8_U8.unpack_from(buf, start + 4)
+    if (0x28 + v_servo_id + v_data_id + v_result) & 0xff != check:
+        return None
+    m = _new(WriteDataResponse)
+    _set_WriteDataResponse_servo_id(m, v_servo_id)
+    _set_WriteDataResponse_data_id(m, v_data_id)
+    _set_WriteDataResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
+    return m
+
+
+def _frame_read_batch_data_response(buf: bytes, start: int) -> ReadBatchDataResponse | None:
+    """A whole read_batch_data response frame at buf[start:], size and header known: None if its checksum fails."""
+    expected = sum(buf[start + 0 : start + 37]) & 0xff
+    if expected != buf[start + 37]:
+        return None
+    t = _S_READBATCHDATARESPONSE_SERVO_ID.unpack_from(buf, start + 4)
+    v_servo_id = t[0]
+    v_user_data = _new(UserData)
+    _set_UserData_reserved_32(v_user_data, t[1])
+    _set_UserData_response_switch(v_user_data, _MEMBERS_ResponseSwitch.get(t[2], t[2]))
+    _set_UserData_servo_id(v_user_data, t[3])
+    _set_UserData_reserved_35(v_user_data, t[4])
+    _set_UserData_baudrate(v_user_data, _MEMBERS_BaudrateOption.get(t[5], t[5]))
+    _set_UserData_stall_protect_mode(v_user_data, _MEMBERS_StallProtectMode.get(t[6], t[6]))
+    _set_UserData_stall_power_limit(v_user_data, t[7])
+    _set_UserData_over_volt_low(v_user_data, t[8])
+    _set_UserData_over_volt_high(v_user_data, t[9])
+    _set_UserData_over_temperature(v_user_data, t[10])
+    _set_UserData_over_power(v_user_data, t[11])
+    _set_UserData_over_current(v_user_data, t[12])
+    _set_UserData_accel_switch(v_user_data, _MEMBERS_Switch.get(t[13], t[13]))
+    _set_UserData_reserved_45(v_user_data, t[14])
+    _set_UserData_po_lock_switch(v_user_data, _MEMBERS_LockOnPowerOn.get(t[15], t[15]))
+    _set_UserData_wb_lock_switch(v_user_data, _MEMBERS_WheelBrake.get(t[16], t[16]))
+    _set_UserData_angle_limit_switch(v_user_data, _MEMBERS_Switch.get(t[17], t[17]))
+    _set_UserData_soft_start_switch(v_user_data, _MEMBERS_Switch.get(t[18], t[18]))
+    _set_UserData_soft_start_time(v_user_data, t[19])
+    _set_UserData_angle_limit_high(v_user_data, t[20])
+    _set_UserData_angle_limit_low(v_user_data, t[21])
+    _set_UserData_angle_mid_offset(v_user_data, t[22])
+    m = _new(ReadBatchDataResponse)
+    _set_ReadBatchDataResponse_servo_id(m, v_servo_id)
+    _set_ReadBatchDataResponse_user_data(m, v_user_data)
+    return m
+
+
+def _frame_write_batch_data_response(buf: bytes, start: int) -> WriteBatchDataResponse | None:
+    """A whole write_batch_data response frame at buf[start:], size and header known: None if its checksum fails."""
+    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, start + 4)
+    if (0x29 + v_servo_id + v_result) & 0xff != check:
+        return None
+    m = _new(WriteBatchDataResponse)
+    _set_WriteBatchDataResponse_servo_id(m, v_servo_id)
+    _set_WriteBatchDataResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
+    return m
+
+
+def _frame_spin_response(buf: bytes, start: int) -> SpinResponse | None:
+    """A whole spin response frame at buf[start:], size and header known: None if its checksum fails."""
+    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, start + 4)
+    if (0x2a + v_servo_id + v_result) & 0xff != check:
+        return None
+    m = _new(SpinResponse)
+    _set_SpinResponse_servo_id(m, v_servo_id)
+    _set_SpinResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
+    return m
+
+
+def _frame_rotate_response(buf: bytes, start: int) -> RotateResponse | None:
+    """A whole rotate response frame at buf[start:], size and header known: None if its checksum fails."""
+    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, start + 4)
+    if (0x2b + v_servo_id + v_result) & 0xff != check:
+        return None
+    m = _new(RotateResponse)
+    _set_RotateResponse_servo_id(m, v_servo_id)
+    _set_RotateResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
+    return m
+
+
+def _frame_damping_response(buf: bytes, start: int) -> DampingResponse | None:
+    """A whole damping response frame at buf[start:], size and header known: None if its checksum fails."""
+    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, start + 4)
+    if (0x2c + v_servo_id + v_result) & 0xff != check:
+        return None
+    m = _new(DampingResponse)
+    _set_DampingResponse_servo_id(m, v_servo_id)
+    _set_DampingResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
+    return m
+
+
+def _frame_read_angle_response(buf: bytes, start: int) -> ReadAngleResponse | None:
+    """A whole read_angle response frame at buf[start:], size and header known: None if its checksum fails."""
+    v_servo_id, v_angle, check = _S_U8_I16_U8.unpack_from(buf, start + 4)
+    if (0x2e + v_servo_id + (v_angle & 0xff) + (v_angle >> 8 & 0xff)) & 0xff != check:
+        return None
+    m = _new(ReadAngleResponse)
+    _set_ReadAngleResponse_servo_id(m, v_servo_id)
+    _set_ReadAngleResponse_angle(m, v_angle)
+    return m
+
+
 def _encode_ping_request(m: PingRequest) -> bytes:
     if not 0 <= m.servo_id <= 254:
         raise out_of_range('ping request', 'servo_id', m.servo_id, 0, 254)
@@ -780,6 +1019,17 @@ _REQUEST_SIZES: dict[int | None, tuple[int, int | None]] = {
     0x09: (3, 3),
     0x0a: (1, 1),
 }
+# Frames of one size decoded whole, by size key (command code << 8 | length byte): frame size, decoder.
+_REQUEST_FIXED: dict[int, tuple[int, Callable[[bytes, int], Message | None]]] = {
+    0x0101: (6, _frame_ping_request),
+    0x0201: (6, _frame_reset_user_data_request),
+    0x0302: (7, _frame_read_data_request),
+    0x0501: (6, _frame_read_batch_data_request),
+    0x0621: (38, _frame_write_batch_data_request),
+    0x0807: (12, _frame_rotate_request),
+    0x0903: (8, _frame_damping_request),
+    0x0a01: (6, _frame_read_angle_request),
+}
 
 
 def _decode_request_at(buf: bytes, start: int, stop: int) -> Message:
@@ -816,6 +1066,18 @@ _RESPONSE_SIZES: dict[int | None, tuple[int, int | None]] = {
     0x08: (2, 2),
     0x09: (2, 2),
     0x0a: (3, 3),
+}
+# Frames of one size decoded whole, by size key (command code << 8 | length byte): frame size, decoder.
+_RESPONSE_FIXED: dict[int, tuple[int, Callable[[bytes, int], Message | None]]] = {
+    0x0101: (6, _frame_ping_response),
+    0x0202: (7, _frame_reset_user_data_response),
+    0x0403: (8, _frame_write_data_response),
+    0x0521: (38, _frame_read_batch_data_response),
+    0x0602: (7, _frame_write_batch_data_response),
+    0x0702: (7, _frame_spin_response),
+    0x0802: (7, _frame_rotate_response),
+    0x0902: (7, _frame_damping_response),
+    0x0a03: (8, _frame_read_angle_response),
 }
 
 
@@ -861,6 +1123,7 @@ REQUEST_FORMAT = FrameFormat(
     command_offset=2,
     content_sizes=_REQUEST_SIZES,
     decode_at=_decode_request_at,
+    fixed=_REQUEST_FIXED,
 )
 RESPONSE_FORMAT = FrameFormat(
     header=b'\x05\x1c',
@@ -870,6 +1133,7 @@ RESPONSE_FORMAT = FrameFormat(
     command_offset=2,
     content_sizes=_RESPONSE_SIZES,
     decode_at=_decode_response_at,
+    fixed=_RESPONSE_FIXED,
 )
 
 
@@ -889,6 +1153,11 @@ def decode(data: bytes, direction: Direction | str | None = None) -> Message:
         n = len(data)
         if n < 5:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (5 bytes)")
+        fixed = _REQUEST_FIXED.get(data[2] << 8 | data[3])
+        if fixed is not None and fixed[0] == n and data[:2] == b'\x12L':
+            message = fixed[1](data, 0)
+            if message is not None:
+                return message
         if data[:2] != b'\x12L':
             raise DecodeError(f"request header is {data[:2].hex(' ')}, expected 12 4c")
         size = data[3]
@@ -905,6 +1174,11 @@ def decode(data: bytes, direction: Direction | str | None = None) -> Message:
         n = len(data)
         if n < 5:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (5 bytes)")
+        fixed = _RESPONSE_FIXED.get(data[2] << 8 | data[3])
+        if fixed is not None and fixed[0] == n and data[:2] == b'\x05\x1c':
+            message = fixed[1](data, 0)
+            if message is not None:
+                return message
         if data[:2] != b'\x05\x1c':
             raise DecodeError(f"response header is {data[:2].hex(' ')}, expected 05 1c")
         size = data[3]

@@ -14,6 +14,7 @@ from typing import Any
 
 import yaml
 
+from serialspec.collection import without_cycle_collection
 from serialspec.spec.errors import SpecError, SpecErrors
 
 Path = tuple[str | int, ...]
@@ -65,6 +66,7 @@ def load_file(path: str, display_name: str | None = None) -> Located:
     return load_text(text, display_name or path)
 
 
+@without_cycle_collection
 def load_text(text: str, file: str) -> Located:
     located = Located(file, None)
     try:

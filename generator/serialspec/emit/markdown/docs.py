@@ -9,6 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
+from serialspec.collection import without_cycle_collection
 from serialspec.emit.common import render as common
 from serialspec.emit.common.numbers import number
 from serialspec.emit.common.text import collapse
@@ -358,6 +359,7 @@ def _show(value: Any) -> str:
     return str(value)
 
 
+@without_cycle_collection
 def emit_docs(protocol: Protocol) -> str:
     commands = [command_context(protocol, c) for c in protocol.commands]
     examples = [

@@ -6,6 +6,7 @@ import re
 from pathlib import Path
 from typing import Any
 
+from serialspec.collection import without_cycle_collection
 from serialspec.emit.common.numbers import number
 from serialspec.emit.python.client import client_module
 from serialspec.emit.python.pycode import (
@@ -47,6 +48,7 @@ def _keys(cls: ClassCode) -> list[str]:
     return [line.split(":")[0] for line in cls.attributes if not line.startswith("#")]
 
 
+@without_cycle_collection
 def emit_package(protocol: Protocol) -> dict[str, str]:
     """File name (relative to the package folder) -> text."""
     code = PackageCode(protocol)

@@ -7,6 +7,7 @@ table, or that holds a `specs/` folder. The table may set:
     specs = ["specs/*.yaml"]                  # spec files (glob patterns), relative to the project
     out = "generated"                         # where DIR/<protocol>/ and DIR/docs/<protocol>.md are written
     schema = "specs/serialspec.schema.json"   # the language's JSON Schema, for editors ("" for none)
+    reference = "docs/language.md"            # the language reference, examples from the specs (default: none)
 
 Spec paths and `--out` given on the command line replace `specs` and `out`.
 """
@@ -26,6 +27,8 @@ from serialspec.emit.docs import emit_docs
 from serialspec.emit.package import emit_package
 from serialspec.spec import SpecError, SpecErrors, load_protocol
 from serialspec.spec.grammar import json_schema
+from serialspec.spec.loader import load_file
+from serialspec.spec.reference import reference_markdown
 
 SCHEMA_NAME = "serialspec.schema.json"
 #: The first line of every generated text file names the spec it came from.
@@ -39,6 +42,7 @@ class Project:
     specs: tuple[Path, ...]
     out: Path
     schema: Path | None
+    reference: Path | None
     chosen: bool  # the specs were named on the command line (not the project's whole set)
 
     def display(self, path: Path) -> str:
@@ -85,7 +89,8 @@ def project(root: Path | None, specs: Sequence[str] = (), out: str | None = None
         schema: Path | None = root / "specs" / SCHEMA_NAME if (root / "specs").is_dir() else out_dir / SCHEMA_NAME
     else:
         schema = root / str(schema_setting) if schema_setting else None
-    return Project(root, tuple(files), out_dir, schema, bool(specs))
+    reference = config.get("reference")
+    return Project(root, tuple(files), out_dir, schema, root / str(reference) if reference else None, bool(specs))
 
 
 def expected_files(proj: Project) -> tuple[dict[Path, str], list[SpecError]]:
@@ -94,12 +99,15 @@ def expected_files(proj: Project) -> tuple[dict[Path, str], list[SpecError]]:
     if proj.schema is not None:
         files[proj.schema] = json.dumps(json_schema(), indent=2, ensure_ascii=False) + "\n"
     errors = []
+    examples = []
     for spec in proj.specs:
         if not spec.is_file():
             errors.append(SpecError(proj.display(spec), 1, 1, "", "no such spec file"))
             continue
         try:
             protocol = load_protocol(str(spec), proj.display(spec))
+            if proj.reference is not None:
+                examples.append(load_file(str(spec)).data)
         except SpecErrors as exc:
             errors.extend(exc.errors)
             continue
@@ -107,6 +115,8 @@ def expected_files(proj: Project) -> tuple[dict[Path, str], list[SpecError]]:
             files[proj.out / protocol.name / name] = text
         files[proj.out / protocol.name / SHIPPED_SPEC] = shipped_spec(protocol.spec_path, spec)
         files[proj.out / "docs" / f"{protocol.name}.md"] = emit_docs(protocol)
+    if proj.reference is not None:
+        files[proj.reference] = reference_markdown(examples)
     return files, errors
 
 

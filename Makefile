@@ -5,7 +5,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 BENCH_STAMP := $(VENV)/.installed-bench
 
-.PHONY: generate test check lint typecheck clean demo stress bench wheel runtime-wheel
+.PHONY: generate test check lint typecheck clean demo stress bench wheel runtime-wheel docs
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -22,8 +22,8 @@ check: $(STAMP)
 	$(BIN)/serialspec check
 
 lint: $(STAMP)
-	$(BIN)/ruff check generator generated tests bench examples packaging
-	$(BIN)/ruff format --check generator tests bench examples packaging
+	$(BIN)/ruff check generator generated tests bench examples packaging tools
+	$(BIN)/ruff format --check generator tests bench examples packaging tools
 
 typecheck: $(STAMP)
 	$(BIN)/mypy generator/serialspec generated
@@ -51,6 +51,10 @@ $(BENCH_STAMP): $(STAMP) pyproject.toml
 bench: $(BENCH_STAMP)
 	$(BIN)/python -m bench.run
 
+# The documentation site in site/: README, tutorial, language reference and every protocol's reference (mkdocs, strict).
+docs: $(STAMP)
+	$(BIN)/python tools/docsite.py site
+
 # The two distributions, into dist/: serialspec (generator, CLI, runtime and the shipped protocols) and
 # serialspec-runtime (only what generated packages import, for a robot that runs generated code: pyserial only).
 wheel: $(STAMP)
@@ -60,7 +64,7 @@ runtime-wheel: $(STAMP)
 	$(BIN)/python packaging/runtime/build.py dist
 
 clean:
-	rm -rf $(VENV) build dist *.egg-info
+	rm -rf $(VENV) build dist site *.egg-info
 
 # A virtual Fashion Star servo on a pseudo-terminal, driven by the generated client: no hardware needed.
 demo: $(STAMP)

@@ -40,6 +40,12 @@ def cell(value: object) -> str:
     return text(str(value)).replace("|", "\\|") or " "
 
 
+def code_span(value: str) -> str:
+    """Text shown as printed (an erratum's quote of a document): a code span, so nothing in it is markup."""
+    value = " ".join(value.split())
+    return f"`` {value} ``" if "`" in value else f"`{value}`"
+
+
 def anchor(*parts: str) -> str:
     return "-".join(p.replace("_", "-").replace(".", "-") for p in parts if p).lower()
 
@@ -428,7 +434,7 @@ def emit_docs(protocol: Protocol) -> str:
         {
             "name": e.name,
             "source": text(e.source),
-            "printed": cell(e.printed),
+            "printed": code_span(e.printed),
             "correct": text(e.correct),
             "check": e.check.kind,
         }

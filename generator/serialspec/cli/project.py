@@ -23,8 +23,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from serialspec.emit.docs import emit_docs
-from serialspec.emit.package import emit_package
+from serialspec.emit import emitters
 from serialspec.spec import SpecError, SpecErrors, load_protocol
 from serialspec.spec.grammar import json_schema
 from serialspec.spec.loader import load_file
@@ -111,10 +110,10 @@ def expected_files(proj: Project) -> tuple[dict[Path, str], list[SpecError]]:
         except SpecErrors as exc:
             errors.extend(exc.errors)
             continue
-        for name, text in emit_package(protocol).items():
-            files[proj.out / protocol.name / name] = text
+        for emitter in emitters():
+            for name, text in emitter.files(protocol).items():
+                files[proj.out / name] = text
         files[proj.out / protocol.name / SHIPPED_SPEC] = shipped_spec(protocol.spec_path, spec)
-        files[proj.out / "docs" / f"{protocol.name}.md"] = emit_docs(protocol)
     if proj.reference is not None:
         files[proj.reference] = reference_markdown(examples)
     return files, errors

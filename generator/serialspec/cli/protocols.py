@@ -112,7 +112,7 @@ def _only(finder: _Sources) -> Iterator[None]:
 
 def package_in_memory(protocol: Protocol) -> ModuleType:
     """The protocol's package generated from the resolved spec and imported from memory (nothing on disk)."""
-    from serialspec.emit.package import emit_package
+    from serialspec.emit.python.package import emit_package
 
     finder = _Sources(protocol.name, emit_package(protocol), protocol.spec_path)
     with _only(finder):

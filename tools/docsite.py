@@ -26,7 +26,7 @@ LINK = re.compile(r"(\]\()([^)#:\s]+)((?:#[^)\s]*)?\))")
 # CJK text breaks between words, never between every character.
 CSS = """\
 .wy-nav-content { max-width: 1200px; }
-.rst-content table.docutils, .md-typeset table, table { display: block; overflow-x: auto; }
+table { display: block; overflow-x: auto; width: fit-content; max-width: 100%; }
 td, th { word-break: keep-all; overflow-wrap: normal; vertical-align: top; }
 td code { white-space: nowrap; }
 .wy-table-responsive table td, .wy-table-responsive table th { white-space: normal; }

@@ -227,9 +227,11 @@ def _default(shape: Shape) -> str:
     return f"default `{_flow(default)}`" if default is not None else "optional"
 
 
-def _yaml_lines(path: Sequence[str], example: dict[str, Any], limit: int = 12) -> list[str]:
-    name = next((p for p in reversed(path) if p != NAME), "")
-    body = [f"{key}: {inline(value, 100)}" for key, value in example.items()]
-    if len(body) > limit:
-        body = [*body[:limit], "# ..."]
-    return [f"{name}:", *("  " + line for line in body)] if name and path[-1] != NAME else body
+def _yaml_lines(path: Sequence[str], example: dict[str, Any], limit: int = 16) -> list[str]:
+    """The example as block YAML under its key (a NAME key shows as the name the spec chose), cut at `limit` lines."""
+    import yaml
+
+    name = path[-1] if path else ""
+    shown: Any = {name: example} if name and name != NAME else example
+    lines = yaml.safe_dump(shown, allow_unicode=True, sort_keys=False, width=100, default_flow_style=False).splitlines()
+    return [*lines[:limit], "# ..."] if len(lines) > limit else lines

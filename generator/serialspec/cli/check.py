@@ -6,7 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from serialspec.cli.project import expected_files, orphans, project
+from serialspec.cli.project import expected_files, orphans, project, strangers
 
 HELP = "check the specs and that the generated files match them (exit 1 naming each stale or orphaned file)"
 
@@ -28,6 +28,8 @@ def run(args: argparse.Namespace) -> int:
             problems.append(f"{proj.display(path)}: stale")
     for path in orphans(proj, files, {e.file for e in errors}):
         problems.append(f"{proj.display(path)}: orphaned (no spec generates it any more)")
+    for path in strangers(files):
+        problems.append(f"{proj.display(path)}: not generated from any spec (move it out of the generated package)")
     for problem in problems:
         print(problem, file=sys.stderr)
     if problems:

@@ -155,3 +155,14 @@ def orphans(proj: Project, files: dict[Path, str], failed: set[str]) -> list[Pat
     packages = {p.parent for p in found if p.name == "__init__.py"}
     found += [p for pkg in packages for p in sorted(pkg.glob("py.typed")) if p not in files and not p.read_bytes()]
     return sorted(found)
+
+
+def strangers(files: dict[Path, str]) -> list[Path]:
+    """Files without the generated header inside generated packages (hand-written files that would be lost)."""
+    packages = {path.parent for path in files if path.name == "__init__.py"}
+    return sorted(
+        path
+        for package in packages
+        for path in package.glob("*")
+        if path.is_file() and path not in files and generated_from(path) is None
+    )

@@ -211,9 +211,9 @@ def command_context(protocol: Protocol, command: Command) -> dict[str, Any]:
                 "description": text(sub.description),
                 "source": text(sub.source),
                 "anchor": anchor("command", command.name, sub.name),
-                "messages": [
-                    m for m in (message_context(protocol, sub.request), message_context(protocol, sub.response)) if m
-                ],
+                "messages": same_once(
+                    [m for m in (message_context(protocol, sub.request), message_context(protocol, sub.response)) if m]
+                ),
                 "examples": examples_for(protocol, command.name, sub.name),
             }
         )
@@ -226,12 +226,19 @@ def command_context(protocol: Protocol, command: Command) -> dict[str, Any]:
         "broadcast": text(command.broadcast),
         "source": text(command.source),
         "anchor": anchor("command", command.name),
-        "messages": [
-            m for m in (message_context(protocol, command.request), message_context(protocol, command.response)) if m
-        ],
+        "messages": same_once(
+            [m for m in (message_context(protocol, command.request), message_context(protocol, command.response)) if m]
+        ),
         "subcommands": subs,
         "examples": examples_for(protocol, command.name, None),
     }
+
+
+def same_once(parts: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """A request and a response (or two frames) that read exactly alike are shown once, for both directions."""
+    if len(parts) == 2 and {**parts[0], "direction": ""} == {**parts[1], "direction": ""}:
+        return [{**parts[0], "direction": f"{parts[0]['direction']} and {parts[1]['direction']}"}]
+    return parts
 
 
 def examples_for(protocol: Protocol, command: str, subcommand: str | None) -> list[str]:
@@ -492,7 +499,7 @@ def emit_docs(protocol: Protocol) -> str:
         ],
         serial_notes=text(serial.notes),
         framing=text(protocol.framing.description),
-        frames=[frame_context(protocol, layout) for layout in protocol.framing.layouts.values()],
+        frames=same_once([frame_context(protocol, layout) for layout in protocol.framing.layouts.values()]),
         frame_picture=frame_picture(protocol),
         shared_header=protocol.framing.shared_header,
         checksum=checksum_context(protocol),

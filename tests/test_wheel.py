@@ -165,6 +165,24 @@ def test_a_renamed_protocol_leaves_no_orphans(user: User) -> None:
     assert user.serialspec("check", "renamed.yaml", "--out", "renamed").returncode == 0
 
 
+def test_a_project_table_in_pyproject_sets_specs_and_output(user: User) -> None:
+    project = user.home / "robot"
+    (project / "protocols").mkdir(parents=True)
+    shutil.copy(TINYLAMP, project / "protocols" / "tinylamp.yaml")
+    (project / "pyproject.toml").write_text(
+        '[project]\nname = "robot"\n\n[tool.serialspec]\nspecs = ["protocols/*.yaml"]\nout = "src"\n', encoding="utf-8"
+    )
+    robot = User(project / "protocols", user.python)  # run from a sub-folder: the project is found upwards
+    robot.serialspec("generate")
+    assert (project / "src" / "tinylamp" / "codec.py").is_file() and (
+        project / "src" / "docs" / "tinylamp.md"
+    ).is_file()
+    assert robot.serialspec("check").stdout.startswith("10 generated files match")
+    (project / "src" / "tinylamp" / "codec.py").write_text("edited\n", encoding="utf-8")
+    stale = robot.serialspec("check", check=False)
+    assert stale.returncode == 1 and "src/tinylamp/codec.py: stale" in stale.stderr
+
+
 def test_a_shipped_protocol_decodes_by_name(user: User) -> None:
     result = user.serialspec("decode", "feetech_sms", "ff ff 01 02 01 fb", "--direction", "request", "--json")
     assert json.loads(result.stdout)["command"] == "ping"

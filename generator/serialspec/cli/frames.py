@@ -13,7 +13,7 @@ from typing import Any
 
 from serialspec.runtime.errors import DecodeError
 from serialspec.runtime.message import Message
-from serialspec.runtime.stream import _Candidate
+from serialspec.runtime.stream import FrameFormat
 
 
 @dataclass(frozen=True)
@@ -58,11 +58,29 @@ class Frames:
         return self._paired.buffer if self._paired is not None else bytes(self._parser.pending())
 
 
+class _Direction:
+    """One direction's frame format as the pairing splitter reads it: the frame size a header position implies."""
+
+    def __init__(self, frame_format: FrameFormat) -> None:
+        self.format = frame_format
+        self.prefix = max(frame_format.length_offset, frame_format.command_offset or 0) + 1  # bytes to size a frame
+
+    def size(self, buffer: bytes, position: int) -> int | None:
+        """The frame's size if the bytes at `position` start a plausible frame (known command, fitting length)."""
+        f = self.format
+        content = buffer[position + f.length_offset] - f.length_adds
+        code = None if f.command_offset is None else buffer[position + f.command_offset]
+        bounds = f.content_sizes.get(code)
+        if bounds is None or content < bounds[0] or (bounds[1] is not None and content > bounds[1]):
+            return None
+        return f.overhead + content
+
+
 class _Paired:
     """Both directions of a shared-header protocol in one stream, requests paired with their replies."""
 
-    def __init__(self, request: Any, response: Any, address: str | None) -> None:
-        self.request, self.response = _Candidate(request), _Candidate(response)
+    def __init__(self, request: FrameFormat, response: FrameFormat, address: str | None) -> None:
+        self.request, self.response = _Direction(request), _Direction(response)
         self.header = request.header
         self.address = address
         self.buffer = b""
@@ -102,15 +120,13 @@ class _Paired:
         for candidate in order:
             if len(buffer) - position < candidate.prefix:
                 return "wait"
-            length = buffer[position + candidate.length_offset]
-            offset = candidate.command_offset
-            size = candidate.frame_sizes.get(length if offset is None else buffer[position + offset] << 8 | length)
+            size = candidate.size(buffer, position)
             if size is None:
                 continue
             if position + size > len(buffer):
                 return "wait"
             try:
-                message = candidate.decode(buffer, position, position + size)
+                message = candidate.format.decode_at(buffer, position, position + size)
             except DecodeError:
                 failed = True
                 continue

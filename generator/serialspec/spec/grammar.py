@@ -31,6 +31,7 @@ class Str(Shape):
     description: str = ""
     choices: tuple[str, ...] = ()
     default: Any = None  # the value a spec gets when it leaves the key out (for the reference and the schema)
+    example: Any = None  # shown in the reference where no spec uses the key
 
     def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
         if not isinstance(value, str):
@@ -49,6 +50,7 @@ class Str(Shape):
 class Int(Shape):
     description: str = ""
     default: Any = None  # the value a spec gets when it leaves the key out (for the reference and the schema)
+    example: Any = None  # shown in the reference where no spec uses the key
 
     def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
         if not isinstance(value, int) or isinstance(value, bool):
@@ -62,6 +64,7 @@ class Int(Shape):
 class Num(Shape):
     description: str = ""
     default: Any = None  # the value a spec gets when it leaves the key out (for the reference and the schema)
+    example: Any = None  # shown in the reference where no spec uses the key
 
     def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
         if not isinstance(value, int | float) or isinstance(value, bool):
@@ -75,6 +78,7 @@ class Num(Shape):
 class Bool(Shape):
     description: str = ""
     default: Any = None  # the value a spec gets when it leaves the key out (for the reference and the schema)
+    example: Any = None  # shown in the reference where no spec uses the key
 
     def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
         if not isinstance(value, bool):
@@ -256,7 +260,10 @@ def _kind(value: Any) -> str:
 
 # --- the language -------------------------------------------------------------------------------------------------
 
-TEXT = Str("Free text (English); shown in docs and docstrings, never executed.")
+TEXT = Str(
+    "Free text (English); shown in docs and docstrings, never executed.",
+    example="Sets the goal position; the servo starts moving at once.",
+)
 TITLE = Str("A one-line title (free text), shown in the reference and as the docstring's first line.")
 TITLE_CN = Str("The title as printed in the (Chinese) document.")
 SOURCE = Str("Where the fact comes from: a document id from `sources:` and its section (free text).")
@@ -272,7 +279,7 @@ _FIELD_LONG: dict[str, Shape] = {
     "unit": Str("Unit of one wire step, e.g. mV, ms, 0.1°."),
     "scale": Num("Engineering value = wire value × scale (e.g. 0.1 for 0.1° steps)."),
     "range": RANGE,
-    "const": Int("The field always has this value (sub-command selectors, fixed addresses)."),
+    "const": Int("The field always has this value (sub-command selectors, fixed addresses).", example=1),
     "default": Num("Value used when a message is built without this field."),
     "enum": Str("Name of an entry in `enums:`; values decode to that enum."),
     "flags": Str("Name of an entry in `flags:`; the value is a set of bit flags."),
@@ -292,8 +299,9 @@ _FIELD_LONG: dict[str, Shape] = {
         "How the integer is stored: plain two's complement, or sign_magnitude (top bit the sign, the rest the size).",
         choices=("plain", "sign_magnitude"),
         default="plain",
+        example="sign_magnitude",
     ),
-    "endian": Str("Override of the protocol's byte order for this field.", choices=("little", "big")),
+    "endian": Str("Override of the protocol's byte order for this field.", choices=("little", "big"), example="big"),
     "size": OneOf((Int(), Str()), "bytes: a number, `rest` (up to the end of the content) or a field name"),
     "count": OneOf((Int(), Str()), "array/group: a number, `rest`, or the name of an earlier count field"),
     "of": Str("array: the item type."),
@@ -407,7 +415,7 @@ ENUM = Obj(
                         {
                             "value": Int("The wire value."),
                             "text": Str("What the value means (free text)."),
-                            "text_cn": Str("The meaning as printed in the (Chinese) document."),
+                            "text_cn": Str("The meaning as printed in the (Chinese) document.", example="释放"),
                         },
                         required=("value",),
                     ),
@@ -423,7 +431,7 @@ ENUM = Obj(
 
 FLAGS = Obj(
     {
-        "type": Str("Wire type of fields holding the flags.", choices=SCALAR_TYPES, default="u8"),
+        "type": Str("Wire type of fields holding the flags.", choices=SCALAR_TYPES, default="u8", example="u16"),
         "description": TEXT,
         "bits": MapOf(
             OneOf(
@@ -629,7 +637,7 @@ DEVICE = Obj(
                     "description": TEXT,
                     "address": Str("The request field holding this kind's id."),
                     "ids": ListOf(Int(), "The ids the simulator creates (fixed by the hardware, not by --id)."),
-                    "broadcast": Int("The id every device of this kind obeys."),
+                    "broadcast": Int("The id every device of this kind obeys.", example=255),
                     "state": MapOf(Num(), "State variables of each device of this kind -> initial value."),
                 },
                 required=("address", "ids"),

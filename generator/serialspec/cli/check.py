@@ -14,7 +14,9 @@ HELP = "check the specs and that the generated files match them (exit 1 naming e
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("specs", nargs="*", metavar="SPEC", help="spec files (default: the project's specs)")
     parser.add_argument("--out", metavar="DIR", help="output folder (default: the project's, else generated/)")
-    parser.add_argument("--root", type=Path, help="project root (default: the nearest folder holding specs/)")
+    parser.add_argument(
+        "--root", type=Path, help="project root (default: the nearest folder with a [tool.serialspec] table or specs/)"
+    )
 
 
 def run(args: argparse.Namespace) -> int:

@@ -15,7 +15,9 @@ HELP = "generate DIR/<protocol>/ and DIR/docs/<protocol>.md from specs (default:
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("specs", nargs="*", metavar="SPEC", help="spec files (default: the project's specs)")
     parser.add_argument("--out", metavar="DIR", help="output folder (default: the project's, else generated/)")
-    parser.add_argument("--root", type=Path, help="project root (default: the nearest folder holding specs/)")
+    parser.add_argument(
+        "--root", type=Path, help="project root (default: the nearest folder with a [tool.serialspec] table or specs/)"
+    )
 
 
 def run(args: argparse.Namespace) -> int:

@@ -43,7 +43,7 @@ class Str(Shape):
         schema: dict[str, Any] = {"type": "string", "description": self.description}
         if self.choices:
             schema["enum"] = list(self.choices)
-        return _with_default(schema, self.default)
+        return _with_default(schema, self.default, self.example)
 
 
 @dataclass
@@ -57,7 +57,7 @@ class Int(Shape):
             yield path, f"expected an integer, got {_kind(value)}"
 
     def json_schema(self) -> dict[str, Any]:
-        return _with_default({"type": "integer", "description": self.description}, self.default)
+        return _with_default({"type": "integer", "description": self.description}, self.default, self.example)
 
 
 @dataclass
@@ -71,7 +71,7 @@ class Num(Shape):
             yield path, f"expected a number, got {_kind(value)}"
 
     def json_schema(self) -> dict[str, Any]:
-        return _with_default({"type": "number", "description": self.description}, self.default)
+        return _with_default({"type": "number", "description": self.description}, self.default, self.example)
 
 
 @dataclass
@@ -85,12 +85,14 @@ class Bool(Shape):
             yield path, f"expected true or false, got {_kind(value)}"
 
     def json_schema(self) -> dict[str, Any]:
-        return _with_default({"type": "boolean", "description": self.description}, self.default)
+        return _with_default({"type": "boolean", "description": self.description}, self.default, self.example)
 
 
-def _with_default(schema: dict[str, Any], default: Any) -> dict[str, Any]:
+def _with_default(schema: dict[str, Any], default: Any, example: Any = None) -> dict[str, Any]:
     if default is not None:
         schema["default"] = default
+    if example is not None:
+        schema["examples"] = [example]
     return schema
 
 
@@ -260,10 +262,7 @@ def _kind(value: Any) -> str:
 
 # --- the language -------------------------------------------------------------------------------------------------
 
-TEXT = Str(
-    "Free text (English); shown in docs and docstrings, never executed.",
-    example="Sets the goal position; the servo starts moving at once.",
-)
+TEXT = Str("Free text (English); shown in docs and docstrings, never executed.")
 TITLE = Str("A one-line title (free text), shown in the reference and as the docstring's first line.")
 TITLE_CN = Str("The title as printed in the (Chinese) document.")
 SOURCE = Str("Where the fact comes from: a document id from `sources:` and its section (free text).")
@@ -342,7 +341,7 @@ OPTIONAL_WHEN = Obj(
 
 MESSAGE = Obj(
     {
-        "description": TEXT,
+        "description": Str(TEXT.description, example="Sent once the move has finished."),
         "fields": FIELDS,
         "optional": TEXT,
         "unsolicited": Bool("Sent by the device on its own, not as an answer.", default=False),
@@ -583,7 +582,7 @@ ERRATUM = Obj(
 
 DEVICE_COMMAND = Obj(
     {
-        "description": TEXT,
+        "description": Str(TEXT.description, example="The servo moves to the goal position over goal_time."),
         "reads": ListOf(Str(), "Response fields filled from memory: table_value by its key, table_block entries."),
         "writes": ListOf(Str(), "Request fields stored in memory: table_value by its key, table_block entries."),
         "resets": Bool("Memory goes back to its defaults.", default=False),

@@ -42,8 +42,8 @@ try:
     _PORT_FAILURES = (serial.SerialException, OSError, termios.error)
 except ImportError:  # Windows
     _PORT_FAILURES = (serial.SerialException, OSError)
-# The one port class whose reads and writes the bus may do itself on the descriptor (see FdLink): pyserial's own
-# POSIX port. Subclasses (spy://, other URL handlers) override read/write and so keep going through pyserial.
+# The port class whose reads and writes the bus may do itself on the descriptor (see FdLink): pyserial's own POSIX
+# port, and spy:// (which only logs around it). Other subclasses override read/write and keep going through pyserial.
 _POSIX_SERIAL: type | None = getattr(getattr(serial, "serialposix", None), "Serial", None)
 _OPEN_FAILURES: tuple[type[Exception], ...] = (*_PORT_FAILURES, ValueError)  # ValueError: a bad setting
 _RESET_FAILURES: tuple[type[Exception], ...] = (*_PORT_FAILURES, NotImplementedError)  # URLs without a buffer
@@ -127,23 +127,28 @@ class FdLink(Link):
     `os.read` per chunk read. pyserial keeps no buffer of its own there and opens the descriptor non-blocking, so
     this sees exactly the bytes it would, without a `select` after every write, an `in_waiting` ioctl per
     transaction, or a `tcsetattr` to change the read timeout. The descriptor is taken from the port at every call:
-    a port closed under the bus fails its next call (fd None) instead of reading a stale descriptor.
+    a port closed under the bus fails its next call (fd None) instead of reading a stale descriptor. A spy://
+    port (pyserial's logging subclass) keeps this path: its logger is handed the bytes as its own read and write
+    would hand them.
     """
 
-    __slots__ = ("_fd", "_poll")
+    __slots__ = ("_fd", "_poll", "_spy")
 
-    def __init__(self, port: Any) -> None:
+    def __init__(self, port: Any, spy: Any = None) -> None:
         super().__init__(port)
         self._fd = -1
         self._poll = select.poll()
+        self._spy = spy  # spy://'s formatter (its tx and rx log the bytes), or None
 
     def write(self, data: bytes) -> None:
+        if self._spy is not None:
+            self._spy.tx(data)
         try:
             written = os.write(self.port.fd, data)
         except BlockingIOError:
             written = 0
         if written < len(data):  # the output buffer is full: pyserial waits for room (and keeps its write_timeout)
-            self.port.write(data[written:])
+            _POSIX_SERIAL.write(self.port, data[written:])  # type: ignore[union-attr]  # not spy's: logged above
 
     def read_waiting(self) -> bytes:
         # pyserial sets VMIN = VTIME = 0: a read with nothing there returns b"" at once (one syscall, the usual
@@ -161,6 +166,8 @@ class FdLink(Link):
             if not more:
                 break
             data += more
+        if data and self._spy is not None:
+            self._spy.rx(data)
         return data
 
     def read(self, wait: float) -> bytes:
@@ -182,12 +189,20 @@ class FdLink(Link):
             return b""
         if not data:  # readable but empty: the other end hung up
             raise serial.SerialException("device disconnected")
+        if self._spy is not None:
+            self._spy.rx(data)
         return data
 
 
 def link(port: Any) -> Link:
-    """The fastest link that sees exactly what pyserial would for this port."""
-    return FdLink(port) if _POSIX_SERIAL is not None and type(port) is _POSIX_SERIAL else Link(port)
+    """The fastest link that sees (and, for spy://, logs) exactly what pyserial would for this port."""
+    if _POSIX_SERIAL is not None and isinstance(port, _POSIX_SERIAL):
+        if type(port) is _POSIX_SERIAL:
+            return FdLink(port)
+        spy = getattr(port, "formatter", None)
+        if type(port).__module__ == "serial.urlhandler.protocol_spy" and spy is not None:
+            return FdLink(port, spy)
+    return Link(port)
 
 
 class Bus:

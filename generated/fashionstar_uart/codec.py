@@ -1032,6 +1032,19 @@ _REQUEST_FIXED: dict[int, tuple[int, Callable[[bytes, int], Message | None]]] = 
 }
 
 
+# The same frames for decode(), by their first bytes (header, command code, length byte).
+_REQUEST_WHOLE: dict[bytes, tuple[int, Callable[[bytes, int], Message | None]]] = {
+    b'\x12L\x01\x01': (6, _frame_ping_request),
+    b'\x12L\x02\x01': (6, _frame_reset_user_data_request),
+    b'\x12L\x03\x02': (7, _frame_read_data_request),
+    b'\x12L\x05\x01': (6, _frame_read_batch_data_request),
+    b'\x12L\x06!': (38, _frame_write_batch_data_request),
+    b'\x12L\x08\x07': (12, _frame_rotate_request),
+    b'\x12L\t\x03': (8, _frame_damping_request),
+    b'\x12L\n\x01': (6, _frame_read_angle_request),
+}
+
+
 def _decode_request_at(buf: bytes, start: int, stop: int) -> Message:
     """The frame buf[start:stop], whose header and length byte the stream parser has checked."""
     expected = sum(buf[start : stop - 1]) & 0xff
@@ -1078,6 +1091,20 @@ _RESPONSE_FIXED: dict[int, tuple[int, Callable[[bytes, int], Message | None]]] =
     0x0802: (7, _frame_rotate_response),
     0x0902: (7, _frame_damping_response),
     0x0a03: (8, _frame_read_angle_response),
+}
+
+
+# The same frames for decode(), by their first bytes (header, command code, length byte).
+_RESPONSE_WHOLE: dict[bytes, tuple[int, Callable[[bytes, int], Message | None]]] = {
+    b'\x05\x1c\x01\x01': (6, _frame_ping_response),
+    b'\x05\x1c\x02\x02': (7, _frame_reset_user_data_response),
+    b'\x05\x1c\x04\x03': (8, _frame_write_data_response),
+    b'\x05\x1c\x05!': (38, _frame_read_batch_data_response),
+    b'\x05\x1c\x06\x02': (7, _frame_write_batch_data_response),
+    b'\x05\x1c\x07\x02': (7, _frame_spin_response),
+    b'\x05\x1c\x08\x02': (7, _frame_rotate_response),
+    b'\x05\x1c\t\x02': (7, _frame_damping_response),
+    b'\x05\x1c\n\x03': (8, _frame_read_angle_response),
 }
 
 
@@ -1153,8 +1180,8 @@ def decode(data: bytes, direction: Direction | str | None = None) -> Message:
         n = len(data)
         if n < 5:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (5 bytes)")
-        fixed = _REQUEST_FIXED.get(data[2] << 8 | data[3])
-        if fixed is not None and fixed[0] == n and data[:2] == b'\x12L':
+        fixed = _REQUEST_WHOLE.get(data[:4])
+        if fixed is not None and fixed[0] == n:
             message = fixed[1](data, 0)
             if message is not None:
                 return message
@@ -1174,8 +1201,8 @@ def decode(data: bytes, direction: Direction | str | None = None) -> Message:
         n = len(data)
         if n < 5:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (5 bytes)")
-        fixed = _RESPONSE_FIXED.get(data[2] << 8 | data[3])
-        if fixed is not None and fixed[0] == n and data[:2] == b'\x05\x1c':
+        fixed = _RESPONSE_WHOLE.get(data[:4])
+        if fixed is not None and fixed[0] == n:
             message = fixed[1](data, 0)
             if message is not None:
                 return message

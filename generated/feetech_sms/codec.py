@@ -368,6 +368,8 @@ _REQUEST_FIXED: dict[int, tuple[int, Callable[[bytes, int], Message | None]]] = 
 }
 
 
+
+
 def _decode_request_at(buf: bytes, start: int, stop: int) -> Message:
     """The frame buf[start:stop], whose header and length byte the stream parser has checked."""
     expected = ~sum(buf[start + 2 : stop - 1]) & 0xff
@@ -388,6 +390,8 @@ _RESPONSE_SIZES: dict[int | None, tuple[int, int | None]] = {
 # Frames of one size decoded whole, by size key (command code << 8 | length byte): frame size, decoder.
 _RESPONSE_FIXED: dict[int, tuple[int, Callable[[bytes, int], Message | None]]] = {
 }
+
+
 
 
 def _decode_response_at(buf: bytes, start: int, stop: int) -> Message:

@@ -1540,6 +1540,13 @@ _REQUEST_FIXED: dict[int, tuple[int, Callable[[bytes, int], Message | None]]] = 
 }
 
 
+# The same frames for decode(), by their first bytes (header, command code, length byte).
+_REQUEST_WHOLE: dict[bytes, tuple[int, Callable[[bytes, int], Message | None]]] = {
+    b'\xaaU\x01\x07': (12, _frame_led_request),
+    b'\xaaU\x02\x08': (13, _frame_buzzer_request),
+}
+
+
 def _decode_request_at(buf: bytes, start: int, stop: int) -> Message:
     """The frame buf[start:stop], whose header and length byte the stream parser has checked."""
     expected = 0x0
@@ -1575,6 +1582,15 @@ _RESPONSE_FIXED: dict[int, tuple[int, Callable[[bytes, int], Message | None]]] =
     0x0718: (29, _frame_imu_response),
     0x0807: (12, _frame_gamepad_response),
     0x0924: (41, _frame_sbus_response),
+}
+
+
+# The same frames for decode(), by their first bytes (header, command code, length byte).
+_RESPONSE_WHOLE: dict[bytes, tuple[int, Callable[[bytes, int], Message | None]]] = {
+    b'\xaaU\x06\x02': (7, _frame_key_response),
+    b'\xaaU\x07\x18': (29, _frame_imu_response),
+    b'\xaaU\x08\x07': (12, _frame_gamepad_response),
+    b'\xaaU\t$': (41, _frame_sbus_response),
 }
 
 
@@ -1669,8 +1685,8 @@ def decode(data: bytes, direction: Direction | str | None = None) -> Message:
         n = len(data)
         if n < 5:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (5 bytes)")
-        fixed = _REQUEST_FIXED.get(data[2] << 8 | data[3])
-        if fixed is not None and fixed[0] == n and data[:2] == b'\xaaU':
+        fixed = _REQUEST_WHOLE.get(data[:4])
+        if fixed is not None and fixed[0] == n:
             message = fixed[1](data, 0)
             if message is not None:
                 return message
@@ -1692,8 +1708,8 @@ def decode(data: bytes, direction: Direction | str | None = None) -> Message:
         n = len(data)
         if n < 5:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (5 bytes)")
-        fixed = _RESPONSE_FIXED.get(data[2] << 8 | data[3])
-        if fixed is not None and fixed[0] == n and data[:2] == b'\xaaU':
+        fixed = _RESPONSE_WHOLE.get(data[:4])
+        if fixed is not None and fixed[0] == n:
             message = fixed[1](data, 0)
             if message is not None:
                 return message

@@ -167,6 +167,8 @@ def codec_context(protocol: Protocol, code: PackageCode, exports: list[str]) -> 
         directions.append(
             {
                 "fixed": [(key, size, function["name"]) for key, size, function in fixed],
+                "whole_frames": whole_frames(layout, fixed),
+                "whole_size": max(layout.length_offset, layout.command_offset or 0) + 1,
                 "key": frame_key(layout, "data"),
                 "name": direction.value,
                 "upper": direction.name,
@@ -221,6 +223,23 @@ def frame_key(layout: FrameLayout, buf: str, start: str = "") -> str:
     if layout.command_offset is None:
         return length
     return f"{buf}[{at}{layout.command_offset}] << 8 | {length}"
+
+
+def whole_frames(layout: FrameLayout, fixed: list[tuple[str, int, dict[str, Any]]]) -> list[tuple[str, int, str]]:
+    """decode()'s table of the frames decoded whole, keyed by their first bytes when those are the header, command
+    code and length byte (one slice, one lookup, and the header is checked with them); [] where they are not."""
+    width = len(layout.header)
+    offsets = sorted(o for o in (layout.command_offset, layout.length_offset) if o is not None)
+    if offsets != list(range(width, width + len(offsets))):
+        return []
+    entries = []
+    for key, size, function in fixed:
+        value = int(key, 16)
+        bytes_at = {layout.length_offset: value & 0xFF}
+        if layout.command_offset is not None:
+            bytes_at[layout.command_offset] = value >> 8
+        entries.append((repr(layout.header + bytes(bytes_at[o] for o in offsets)), size, function["name"]))
+    return entries
 
 
 def fixed_frames(

@@ -14,6 +14,7 @@ from __future__ import annotations
 import operator
 import os
 import select
+import sys
 import threading
 import time
 from collections import deque
@@ -137,7 +138,8 @@ class FdLink(Link):
     def __init__(self, port: Any, spy: Any = None) -> None:
         super().__init__(port)
         self._fd = -1
-        self._poll = select.poll()
+        # poll() is the cheaper wait; macOS's does not work on terminal devices, so there it is select()
+        self._poll = select.poll() if sys.platform.startswith("linux") else None
         self._spy = spy  # spy://'s formatter (its tx and rx log the bytes), or None
 
     def write(self, data: bytes) -> None:
@@ -172,14 +174,18 @@ class FdLink(Link):
 
     def read(self, wait: float) -> bytes:
         fd = self.port.fd
-        if fd != self._fd:  # first read, or the port was reopened
-            if fd is None:
-                raise serial.SerialException("the port is closed")
-            if self._fd >= 0:
-                self._poll.unregister(self._fd)
-            self._poll.register(fd, select.POLLIN)
-            self._fd = fd
-        if not self._poll.poll(wait * 1000):  # milliseconds, rounded up: never returns before the deadline
+        if fd is None:
+            raise serial.SerialException("the port is closed")
+        if self._poll is None:
+            ready = bool(select.select([fd], [], [], wait)[0])
+        else:
+            if fd != self._fd:  # first read, or the port was reopened
+                if self._fd >= 0:
+                    self._poll.unregister(self._fd)
+                self._poll.register(fd, select.POLLIN)
+                self._fd = fd
+            ready = bool(self._poll.poll(wait * 1000))  # milliseconds, rounded up: never before the deadline
+        if not ready:
             if self.port.fd is None:  # closed by another thread while this one waited
                 raise serial.SerialException("the port is closed")
             return b""

@@ -11,7 +11,7 @@ import struct
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 
-from serialspec.runtime.errors import EncodeError, out_of_range
+from serialspec.runtime.errors import DecodeError, EncodeError, out_of_range
 
 
 @dataclass(frozen=True, slots=True)
@@ -83,6 +83,16 @@ class RegisterMap:
         if register.sign_bit is not None and value >> register.sign_bit & 1:
             return -int(value & ((1 << register.sign_bit) - 1))
         return int(value)
+
+    def size(self, register: Register) -> int:
+        """The register's size in bytes (without working it out from its format again)."""
+        return self._structs[register.name].size
+
+    def value(self, register: Register, data: bytes) -> int:
+        """The register's value from the bytes read for it alone; fewer bytes than it holds is a DecodeError."""
+        if len(data) < self._structs[register.name].size:
+            raise DecodeError(f"{register.name}: {len(data)} bytes read, {self._structs[register.name].size} needed")
+        return self.from_wire(register, data)
 
     def unpack(self, start: int, data: bytes) -> dict[str, int]:
         """Bytes read from address `start` on, by register name; bytes that belong to no whole register by address."""

@@ -547,7 +547,7 @@ class Bus:
     def _check_status(self, reply: Message) -> None:
         for name in self.binding.status:
             value = getattr(reply, name, 0)
-            if value:
+            if value != 0:  # not `if value`: a flag's truth is a Python call, its comparison is int's
                 text = self.binding.describe_status(name, int(value))
                 raise DeviceError(f"{reply.COMMAND}: the device reports {text}", reply)
 

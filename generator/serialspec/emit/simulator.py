@@ -9,6 +9,7 @@ from serialspec.emit.registers import map_name, register_tables
 from serialspec.emit.render import render
 from serialspec.spec.model import (
     Bytes,
+    DeviceModel,
     Direction,
     Group,
     Message,
@@ -49,6 +50,16 @@ def table_fields(*messages: Message | None) -> dict[str, tuple[str, ...]]:
 def import_order(name: str) -> tuple[int, str]:
     """The order ruff's isort gives names in one `from` import: constants, classes, others; case-insensitive."""
     return (0 if name.isupper() else 1 if name[:1].isupper() else 2, name.lower())
+
+
+def model_data(model: DeviceModel) -> dict[str, Any]:
+    """A model as the template's ModelSpec: its values, and its ranges where they differ from the table's."""
+    return {
+        "name": repr(model.name),
+        "number": model.number,
+        "values": [(repr(k), number(v)) for k, v in model.initial.items()],
+        "ranges": [(repr(e.name), number(e.minimum), number(e.maximum)) for e in model.entries],
+    }
 
 
 def simulator_module(protocol: Protocol) -> str:
@@ -114,7 +125,10 @@ def simulator_module(protocol: Protocol) -> str:
         registers=map_name(device.memory) if device.memory in register_tables(protocol) else "",
         status=repr(device.status) if device.status else "",
         echo_address=device.echo_address,
+        models=[model_data(m) for m in device.models],
         kinds=[f"KindSpec({k.name!r}, {k.address!r}, {k.ids!r}, {k.broadcast!r}, {k.state!r})," for k in device.kinds],
         imports=sorted(imports | {"Direction"}, key=import_order),
         default_id=0,
+        model_names=", ".join(m.name for m in device.models),
+        default_model=device.models[0].name if device.models else "",
     )

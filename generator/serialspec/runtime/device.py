@@ -31,7 +31,7 @@ import threading
 import time
 import tty
 from collections import deque
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -90,6 +90,16 @@ class KindSpec:
 
 
 @dataclass(frozen=True)
+class ModelSpec:
+    """One device model: its factory values and the ranges where they differ from the table's."""
+
+    name: str
+    number: int
+    values: dict[str, float]  # memory entry or state variable -> value at power-on (and after a reset)
+    ranges: dict[str, tuple[float, float]] = field(default_factory=dict)  # memory entry -> its writable range
+
+
+@dataclass(frozen=True)
 class DeviceSpec:
     protocol: str
     address: str
@@ -104,6 +114,17 @@ class DeviceSpec:
     echo_address: bool = False  # replies carry the id the request named, not the answering device's own
     registers: RegisterMap | None = None  # memory as registers at byte addresses, for run reads/writes
     status: dict[str, str] = field(default_factory=dict)  # response field -> memory entry every reply reports
+    models: tuple[ModelSpec, ...] = ()  # the first is the default model
+
+    def model(self, name: str | None) -> ModelSpec | None:
+        """The model of this name (None: the default one); a ValueError names the known models."""
+        if name is None:
+            return self.models[0] if self.models else None
+        for model in self.models:
+            if model.name == name:
+                return model
+        known = ", ".join(m.name for m in self.models) or "none"
+        raise ValueError(f"unknown model {name!r} (expected one of: {known})")
 
 
 @dataclass
@@ -122,13 +143,28 @@ class _Motion:
 class VirtualDevice:
     """One device on the virtual bus: its memory and state variables."""
 
-    def __init__(self, spec: DeviceSpec, device_id: int, clock: Callable[[], float] = time.monotonic) -> None:
+    def __init__(
+        self,
+        spec: DeviceSpec,
+        device_id: int,
+        clock: Callable[[], float] = time.monotonic,
+        model: ModelSpec | None = None,
+    ) -> None:
         self.spec = spec
         self.clock = clock
-        self.by_name = {e.name: e for e in spec.entries}
-        self.by_key = {e.key: e for e in spec.entries}
+        self.model = model
+        values = model.values if model else {}
+        ranges = model.ranges if model else {}
+        # The model's factory values and ranges replace the table's where it gives them.
+        entries = [
+            dataclasses.replace(e, default=values.get(e.name, e.default), minimum=low, maximum=high)
+            for e in spec.entries
+            for low, high in [ranges.get(e.name, (e.minimum, e.maximum))]
+        ]
+        self.by_name = {e.name: e for e in entries}
+        self.by_key = {e.key: e for e in entries}
         self.memory: dict[int, float] = {}
-        self.state: dict[str, float] = dict(spec.state)
+        self.state: dict[str, float] = {k: values.get(k, v) for k, v in spec.state.items()}
         self.motions: dict[str, _Motion] = {}
         self.buffered: list[tuple[CommandSpec, str, dict[str, Any]]] = []  # writes held until a commit
         self.reset()
@@ -140,7 +176,7 @@ class VirtualDevice:
 
     def reset(self) -> None:
         keep = self.memory.get(self.by_name[self.spec.id_entry].key) if self.spec.id_entry in self.by_name else None
-        self.memory = {e.key: e.default for e in self.spec.entries}
+        self.memory = {e.key: e.default for e in self.by_name.values()}
         if keep is not None:
             self.memory[self.by_name[self.spec.id_entry].key] = keep
 
@@ -219,12 +255,22 @@ class Simulator:
         encode: Callable[[Message], bytes],
         parser: Callable[[], StreamParser],
         clock: Callable[[], float] = time.monotonic,
+        model: str | Mapping[int, str] | None = None,
     ) -> None:
+        """`model`: the model of every device (a name of `spec.models`), or id -> name (others: the default)."""
         self.spec = spec
         self.encode = encode
         self.clock = clock
         self.parser = parser()
-        self.devices: dict[int, VirtualDevice] = {i: VirtualDevice(spec, i, clock) for i in ids}
+        ids = list(ids)
+        per_id: Mapping[int, str] = model if isinstance(model, Mapping) else {}
+        every = None if isinstance(model, Mapping) else model
+        unknown = set(per_id) - set(ids)
+        if unknown:
+            raise ValueError(f"a model is given for id {min(unknown)}, which is not on the bus")
+        self.devices: dict[int, VirtualDevice] = {
+            i: VirtualDevice(spec, i, clock, spec.model(per_id.get(i, every))) for i in ids
+        }
         # Each further kind: its devices, built from a DeviceSpec holding that kind's address and state.
         self.kinds: dict[str, dict[int, VirtualDevice]] = {}
         self._kind_specs: dict[str, DeviceSpec] = {}

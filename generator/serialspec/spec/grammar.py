@@ -514,9 +514,43 @@ DEVICE_COMMAND = Obj(
     description="What the device does with one command (command or command.subcommand).",
 )
 
+MODEL = Obj(
+    {
+        "number": Int("The model number the device reports (in `model_entry`), e.g. 777 for the FEETECH STS3215."),
+        "title": TEXT,
+        "description": TEXT,
+        "source": TEXT,
+        "initial": MapOf(
+            Num(),
+            "Memory entry or state variable -> the value this model starts with (its factory value), over the "
+            "table's default and the device's `initial`.",
+        ),
+        "entries": MapOf(
+            Obj(
+                {
+                    "range": RANGE,
+                    "unit": Str("This model's unit of one wire step, where it differs from the table's."),
+                    "scale": Num("This model's engineering value per wire step, where it differs."),
+                    "description": TEXT,
+                }
+            ),
+            "Memory entry -> where this model's range, unit or scale differs from the table's.",
+        ),
+    },
+    required=("number",),
+    description="One device model: its model number, factory values and where its table differs.",
+)
+
 DEVICE = Obj(
     {
         "description": TEXT,
+        "models": MapOf(
+            MODEL,
+            "Device models sharing the protocol and table (FEETECH STS3215, SM8512BL; DYNAMIXEL XM430, XL330): "
+            "`serialspec sim --model NAME` (or `--model ID=NAME`) picks one; the docs list them.",
+        ),
+        "default_model": Str("The model the simulator uses when none is named (default: the first of `models`)."),
+        "model_entry": Str("The memory entry holding the model number (set from the model's `number`)."),
         "memory": Str("The table the device keeps, initialised from its defaults."),
         "initial": MapOf(Num(), "Memory entry -> value the simulator starts with where the table gives no default."),
         "address": Str("The field holding the device id (default: the frame's address element)."),

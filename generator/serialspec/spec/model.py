@@ -448,6 +448,34 @@ class DeviceKind:
 
 
 @dataclass(frozen=True)
+class ModelEntry:
+    """Where one model's memory entry differs from the table: its range, unit, scale or description."""
+
+    name: str
+    minimum: float
+    maximum: float
+    unit: str
+    scale: float | None
+    description: str
+
+
+@dataclass(frozen=True)
+class DeviceModel:
+    """One model of the device: its model number, its factory values and where its table differs."""
+
+    name: str
+    number: int
+    title: str
+    description: str
+    source: str
+    initial: dict[str, float]  # memory entry or state variable -> this model's value (over the device's initial)
+    entries: tuple[ModelEntry, ...] = ()
+
+    def entry(self, name: str) -> ModelEntry | None:
+        return next((e for e in self.entries if e.name == name), None)
+
+
+@dataclass(frozen=True)
 class Device:
     """How a device behaves, for the simulator (and the address/broadcast rule, for the client)."""
 
@@ -464,6 +492,8 @@ class Device:
     status: dict[str, str] = field(default_factory=dict)  # response field -> memory entry every reply reports
     kinds: tuple[DeviceKind, ...] = ()
     echo_address: bool = False  # replies carry the id the request named, not the answering device's own
+    models: tuple[DeviceModel, ...] = ()  # the first is the default model
+    model_entry: str = ""  # the memory entry holding the model number
 
     def behaviour(self, key: str) -> Behaviour | None:
         return next((b for b in self.behaviours if b.command == key), None)

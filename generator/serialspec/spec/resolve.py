@@ -27,6 +27,7 @@ from serialspec.spec.model import (
     Crc,
     Device,
     DeviceKind,
+    DeviceModel,
     Direction,
     EnumDef,
     EnumValue,
@@ -41,6 +42,7 @@ from serialspec.spec.model import (
     Framing,
     Group,
     Message,
+    ModelEntry,
     Motion,
     OptionalWhen,
     Protocol,
@@ -1033,7 +1035,86 @@ class Resolver:
             status=status,
             kinds=tuple(kinds.values()),
             echo_address=bool(value.get("echo_address", False)),
+            models=self.models(value, path, entries, state),
+            model_entry=str(value.get("model_entry", "")),
         )
+
+    def models(
+        self, value: dict[str, Any], path: Path, entries: dict[str, TableEntry], state: dict[str, float]
+    ) -> tuple[DeviceModel, ...]:
+        """The device's models, the default first; each value checked against the model's (or the table's) range."""
+        model_entry = str(value.get("model_entry", ""))
+        if model_entry and model_entry not in entries:
+            self.error((*path, "model_entry"), f"unknown memory entry {model_entry!r}")
+        models: list[DeviceModel] = []
+        numbers: dict[int, str] = {}
+        for name, item in (value.get("models") or {}).items():
+            model_path = (*path, "models", name)
+            self.name(name, model_path, "model name")
+            number = int(item["number"])
+            if number in numbers:
+                self.error((*model_path, "number"), f"model number {number} is already used by {numbers[number]!r}")
+            numbers[number] = name
+            overrides = []
+            for entry_name, override in (item.get("entries") or {}).items():
+                entry = entries.get(entry_name)
+                if entry is None:
+                    self.error((*model_path, "entries", entry_name), f"unknown memory entry {entry_name!r}")
+                    continue
+                range_path = (*model_path, "entries", entry_name, "range")
+                low, high = (
+                    self.bounds(entry.type, entry.sign_magnitude, override["range"], range_path, entry.sign_bit)
+                    if "range" in override
+                    else (entry.minimum, entry.maximum)
+                )
+                overrides.append(
+                    ModelEntry(
+                        entry_name,
+                        low,
+                        high,
+                        str(override.get("unit", entry.unit)),
+                        override.get("scale", entry.scale),
+                        str(override.get("description", "")),
+                    )
+                )
+            by_name = {o.name: o for o in overrides}
+            initial = {str(k): float(v) for k, v in (item.get("initial") or {}).items()}
+            if model_entry:
+                initial[model_entry] = float(number)
+            for entry_name, number_value in initial.items():
+                entry_path = (*model_path, "initial", entry_name)
+                if entry_name in state:
+                    continue
+                entry = entries.get(entry_name)
+                if entry is None:
+                    self.error(entry_path, f"unknown memory entry or state variable {entry_name!r}")
+                    continue
+                bounds = by_name.get(entry_name, entry)
+                low, high = bounds.minimum, bounds.maximum
+                if not low <= number_value <= high:
+                    where = (*model_path, "number") if entry_name == model_entry else entry_path
+                    self.error(where, f"{entry_name} = {number_value:g} is outside its range {low:g}..{high:g}")
+            models.append(
+                DeviceModel(
+                    name=name,
+                    number=number,
+                    title=str(item.get("title", "")),
+                    description=str(item.get("description", "")),
+                    source=str(item.get("source", "")),
+                    initial=initial,
+                    entries=tuple(overrides),
+                )
+            )
+        default = value.get("default_model")
+        if default is not None:
+            found = next((m for m in models if m.name == default), None)
+            if found is None:
+                known = ", ".join(m.name for m in models) or "none defined"
+                self.error((*path, "default_model"), f"unknown model {default!r} (expected one of: {known})")
+            else:
+                models.remove(found)
+                models.insert(0, found)
+        return tuple(models)
 
     # --- examples and errata --------------------------------------------------------------------------------------
 

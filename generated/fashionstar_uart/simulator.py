@@ -17,9 +17,23 @@ from serialspec.runtime.device import CommandSpec, DeviceSpec, EntrySpec, Simula
 
 from fashionstar_uart.codec import StreamParser, encode
 from fashionstar_uart.messages import (
+    BeginAsyncRequest,
     DampingRequest,
     DampingResponse,
     Direction,
+    EndAsyncRequest,
+    MonitorRequest,
+    MonitorResponse,
+    MoveByIntervalRequest,
+    MoveByIntervalResponse,
+    MoveByVelocityRequest,
+    MoveByVelocityResponse,
+    MoveMturnByIntervalRequest,
+    MoveMturnByIntervalResponse,
+    MoveMturnByVelocityRequest,
+    MoveMturnByVelocityResponse,
+    MoveMturnRequest,
+    MoveMturnResponse,
     PingRequest,
     PingResponse,
     ReadAngleRequest,
@@ -28,16 +42,47 @@ from fashionstar_uart.messages import (
     ReadBatchDataResponse,
     ReadDataRequest,
     ReadDataResponse,
+    ReadMturnAngleRequest,
+    ReadMturnAngleResponse,
+    ResetMturnAngleRequest,
     ResetUserDataRequest,
     ResetUserDataResponse,
     RotateRequest,
     RotateResponse,
+    SetOriginPointRequest,
     SpinRequest,
     SpinResponse,
+    StopOnControlModeRequest,
+    SyncCommandRequest,
     WriteBatchDataRequest,
     WriteBatchDataResponse,
     WriteDataRequest,
     WriteDataResponse,
+)
+from fashionstar_uart.structs import (
+    BeginAsyncRequestContent,
+    DampingRequestContent,
+    EndAsyncRequestContent,
+    MonitorRequestContent,
+    MoveByIntervalRequestContent,
+    MoveByVelocityRequestContent,
+    MoveMturnByIntervalRequestContent,
+    MoveMturnByVelocityRequestContent,
+    MoveMturnRequestContent,
+    PingRequestContent,
+    ReadAngleRequestContent,
+    ReadBatchDataRequestContent,
+    ReadDataRequestContent,
+    ReadMturnAngleRequestContent,
+    ResetMturnAngleRequestContent,
+    ResetUserDataRequestContent,
+    RotateRequestContent,
+    SetOriginPointRequestContent,
+    SpinRequestContent,
+    StopOnControlModeRequestContent,
+    SyncCommandRequestContent,
+    WriteBatchDataRequestContent,
+    WriteDataRequestContent,
 )
 
 __all__ = ["DEVICE", "SIMULATOR", "FashionstarUartSimulator"]
@@ -79,7 +124,7 @@ DEVICE = DeviceSpec(
         EntrySpec('angle_limit_low', 52, -1800, 'rw', -32768, 32767),
         EntrySpec('angle_mid_offset', 53, 0, 'rw', -32768, 32767),
     ),
-    state={'angle': 0.0},
+    state={'angle': 0.0, 'holding': 0.0},
     reply={'result': 1.0},
     refused={'result': 0.0},
     commands=(
@@ -98,12 +143,63 @@ DEVICE = DeviceSpec(
         # spin
         CommandSpec(SpinRequest, SpinResponse, optional_when=(33, 1)),
         # rotate
-        CommandSpec(RotateRequest, RotateResponse, moves=('angle', 'angle', 'interval', ''), optional_when=(33, 1), after='interval'),
+        CommandSpec(RotateRequest, RotateResponse, moves=('angle', 'angle', 'interval', ''), held_while='holding', optional_when=(33, 1), after='interval'),
         # damping
         CommandSpec(DampingRequest, DampingResponse, optional_when=(33, 1)),
         # read_angle
         CommandSpec(ReadAngleRequest, ReadAngleResponse, reports={'angle': 'angle'}),
+        # move_by_interval
+        CommandSpec(MoveByIntervalRequest, MoveByIntervalResponse, moves=('angle', 'angle', 'interval', ''), ramp=('t_acc', 't_dec'), held_while='holding', optional_when=(33, 1)),
+        # move_by_velocity
+        CommandSpec(MoveByVelocityRequest, MoveByVelocityResponse, moves=('angle', 'angle', '', 'velocity'), ramp=('t_acc', 't_dec'), held_while='holding', optional_when=(33, 1)),
+        # move_mturn
+        CommandSpec(MoveMturnRequest, MoveMturnResponse, moves=('angle', 'angle', 'interval', ''), held_while='holding', optional_when=(33, 1)),
+        # move_mturn_by_interval
+        CommandSpec(MoveMturnByIntervalRequest, MoveMturnByIntervalResponse, moves=('angle', 'angle', 'interval', ''), ramp=('t_acc', 't_dec'), held_while='holding', optional_when=(33, 1)),
+        # move_mturn_by_velocity
+        CommandSpec(MoveMturnByVelocityRequest, MoveMturnByVelocityResponse, moves=('angle', 'angle', '', 'velocity'), ramp=('t_acc', 't_dec'), held_while='holding', optional_when=(33, 1)),
+        # read_mturn_angle
+        CommandSpec(ReadMturnAngleRequest, ReadMturnAngleResponse, reports={'angle': 'angle'}, counts={'turns': ('angle', 3600.0)}),
+        # reset_mturn_angle
+        CommandSpec(ResetMturnAngleRequest, None, wraps={'angle': 3600.0}),
+        # begin_async
+        CommandSpec(BeginAsyncRequest, None, sets={'holding': 1.0}, every_device=True),
+        # end_async
+        CommandSpec(EndAsyncRequest, None, every_device=True, releases='holding', cancel_when={'mode': 1.0}),
+        # monitor
+        CommandSpec(MonitorRequest, MonitorResponse, reports={'voltage': 'voltage', 'current': 'current', 'power': 'power', 'temperature': 'temperature', 'status': 'servo_status', 'angle': 'angle'}, counts={'turns': ('angle', 3600.0)}),
+        # set_origin_point
+        CommandSpec(SetOriginPointRequest, None, sets={'angle': 0.0}),
+        # stop_on_control_mode
+        CommandSpec(StopOnControlModeRequest, None, stops=('angle',)),
+        # sync_command
+        CommandSpec(SyncCommandRequest, None, each='blocks', carries=('command', 'content')),
     ),
+    carried={
+        1: (PingRequest, PingRequestContent),
+        2: (ResetUserDataRequest, ResetUserDataRequestContent),
+        3: (ReadDataRequest, ReadDataRequestContent),
+        4: (WriteDataRequest, WriteDataRequestContent),
+        5: (ReadBatchDataRequest, ReadBatchDataRequestContent),
+        6: (WriteBatchDataRequest, WriteBatchDataRequestContent),
+        7: (SpinRequest, SpinRequestContent),
+        8: (RotateRequest, RotateRequestContent),
+        9: (DampingRequest, DampingRequestContent),
+        10: (ReadAngleRequest, ReadAngleRequestContent),
+        11: (MoveByIntervalRequest, MoveByIntervalRequestContent),
+        12: (MoveByVelocityRequest, MoveByVelocityRequestContent),
+        13: (MoveMturnRequest, MoveMturnRequestContent),
+        14: (MoveMturnByIntervalRequest, MoveMturnByIntervalRequestContent),
+        15: (MoveMturnByVelocityRequest, MoveMturnByVelocityRequestContent),
+        16: (ReadMturnAngleRequest, ReadMturnAngleRequestContent),
+        17: (ResetMturnAngleRequest, ResetMturnAngleRequestContent),
+        18: (BeginAsyncRequest, BeginAsyncRequestContent),
+        19: (EndAsyncRequest, EndAsyncRequestContent),
+        22: (MonitorRequest, MonitorRequestContent),
+        23: (SetOriginPointRequest, SetOriginPointRequestContent),
+        24: (StopOnControlModeRequest, StopOnControlModeRequestContent),
+        25: (SyncCommandRequest, SyncCommandRequestContent),
+    },
 )
 
 

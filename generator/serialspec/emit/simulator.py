@@ -21,6 +21,37 @@ from serialspec.spec.model import (
     reply_to,
 )
 
+#: Behaviour attributes passed to CommandSpec under the same name when they are set.
+BEHAVIOUR_ARGUMENTS = (
+    "kind",
+    "each",
+    "stores",
+    "sets",
+    "absent",
+    "buffered",
+    "commits",
+    "stops",
+    "wraps",
+    "counts",
+    "every_device",
+    "held_while",
+    "releases",
+    "cancel_when",
+    "carries",
+)
+
+
+def carried_requests(protocol: Protocol) -> list[tuple[int, str, str]]:
+    """(code, request class, construct content) of every request a `carries` behaviour may carry."""
+    device = protocol.device
+    if device is None or not any(b.carries for b in device.behaviours):
+        return []
+    return [
+        (c.code, c.request.class_name, c.request.class_name + "Content")
+        for c in protocol.commands
+        if c.code is not None and c.request is not None and not c.subcommands
+    ]
+
 
 def request_response_pairs(protocol: Protocol) -> list[tuple[Message, Message | None]]:
     """Every request with the response that answers it (None where the device stays silent)."""
@@ -93,9 +124,11 @@ def simulator_module(protocol: Protocol) -> str:
             if behaviour.moves:
                 m = behaviour.moves
                 args.append(f"moves={(m.state, m.target, m.duration, m.speed)!r}")
+                if m.accel or m.decel:
+                    args.append(f"ramp={(m.accel, m.decel)!r}")
             if behaviour.broadcast_reply:
                 args.append("broadcast_reply=True")
-            for name in ("kind", "each", "stores", "sets", "absent", "buffered", "commits"):
+            for name in BEHAVIOUR_ARGUMENTS:
                 if getattr(behaviour, name):
                     args.append(f"{name}={getattr(behaviour, name)!r}")
         condition = reply_condition(request, response)
@@ -126,6 +159,7 @@ def simulator_module(protocol: Protocol) -> str:
         status=repr(device.status) if device.status else "",
         echo_address=device.echo_address,
         models=[model_data(m) for m in device.models],
+        carried=carried_requests(protocol),
         kinds=[f"KindSpec({k.name!r}, {k.address!r}, {k.ids!r}, {k.broadcast!r}, {k.state!r})," for k in device.kinds],
         imports=sorted(imports | {"Direction"}, key=import_order),
         default_id=0,

@@ -495,8 +495,48 @@ DEVICE_COMMAND = Obj(
                 "target": Str("The request field (or memory entry, once written) with the target."),
                 "duration": Str("The request field (or memory entry) with the time to reach the target, in ms."),
                 "speed": Str("The request field (or memory entry) with the speed, in state units per second."),
+                "accel": Str("The request field with the acceleration time (ms) at the start of the move."),
+                "decel": Str("The request field with the deceleration time (ms) at the end of the move."),
             },
             required=("state", "target"),
+        ),
+        "stops": ListOf(Str(), "State variables whose move in progress stops where it is now."),
+        "wraps": MapOf(
+            Num(),
+            "State variable -> a period: the variable keeps only its remainder, toward zero (an angle within one "
+            "turn, 3600 in 0.1°).",
+        ),
+        "counts": MapOf(
+            Obj(
+                {"state": Str("The state variable (or memory entry)."), "per": Num("The size of one whole unit.")},
+                required=("state", "per"),
+            ),
+            "Response field -> how many whole `per` the state variable holds, toward zero (turns of an angle).",
+        ),
+        "every_device": Bool(
+            "A request without an address reaches every device on the bus (default: the first one only)."
+        ),
+        "held_while": Str(
+            "A state variable: while it is not 0, the device keeps this request instead of carrying it out, until "
+            "a command that `releases` the variable."
+        ),
+        "releases": Str(
+            "A state variable: the command sets it to 0 and carries out the requests held while it was set, in "
+            "order (or drops them, see `cancel_when`)."
+        ),
+        "cancel_when": MapOf(
+            Num(), "With `releases`: request field -> the value with which the held requests are dropped."
+        ),
+        "carries": Obj(
+            {
+                "command": Str("The request field (or `each` item field) holding the code of the command carried."),
+                "content": Str("The bytes field holding that command's request content."),
+            },
+            required=("command", "content"),
+            description=(
+                "The request (or each item of its `each` group) carries another command's request content; the "
+                "devices act on it as on that request, and answer as they would (a sync command)."
+            ),
         ),
         "broadcast_reply": Bool("Answers even when addressed by broadcast (default: silent)."),
         "each": Str("A group field of the request whose items address one device each (by the address field)."),

@@ -413,6 +413,8 @@ class Motion:
     target: str
     duration: str
     speed: str
+    accel: str = ""  # request field: acceleration time (ms) at the start
+    decel: str = ""  # request field: deceleration time (ms) at the end
 
 
 @dataclass(frozen=True)
@@ -433,6 +435,14 @@ class Behaviour:
     stores: dict[str, str] = field(default_factory=dict)  # request field -> state variable
     sets: dict[str, float] = field(default_factory=dict)  # state variable -> value
     absent: dict[str, float] = field(default_factory=dict)  # response values when no device has the id
+    stops: tuple[str, ...] = ()  # state variables whose move stops where it is
+    wraps: dict[str, float] = field(default_factory=dict)  # state variable -> period it is kept within
+    counts: dict[str, tuple[str, float]] = field(default_factory=dict)  # response field -> (state, per)
+    every_device: bool = False  # a request without an address reaches every device
+    held_while: str = ""  # state variable: while set, the request is held
+    releases: str = ""  # state variable: cleared, and the held requests carried out
+    cancel_when: dict[str, float] = field(default_factory=dict)  # with releases: field -> value that drops them
+    carries: tuple[str, str] | None = None  # (command code field, content field) of a carried request
 
 
 @dataclass(frozen=True)

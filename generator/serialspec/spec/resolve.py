@@ -978,10 +978,12 @@ class Resolver:
                     str(moves["target"]),
                     str(moves.get("duration", "")),
                     str(moves.get("speed", "")),
+                    str(moves.get("accel", "")),
+                    str(moves.get("decel", "")),
                 )
                 if motion.state not in known_state and motion.state not in entries:
                     self.error((*item_path, "moves", "state"), f"unknown state variable {motion.state!r}")
-                for role in ("target", "duration", "speed"):
+                for role in ("target", "duration", "speed", "accel", "decel"):
                     name = getattr(motion, role)
                     if name and name not in request_names and name not in entries:
                         self.error((*item_path, "moves", role), f"{key} has no request field or memory entry {name!r}")
@@ -1015,6 +1017,9 @@ class Resolver:
                     stores,
                     sets,
                     absent,
+                    **self.behaviour_extras(
+                        item, item_path, key, request_names, response_names, {**entries, **known_state}
+                    ),
                 )
             )
         status = {str(k): str(v) for k, v in (value.get("status") or {}).items()}
@@ -1038,6 +1043,48 @@ class Resolver:
             models=self.models(value, path, entries, state),
             model_entry=str(value.get("model_entry", "")),
         )
+
+    def behaviour_extras(
+        self,
+        item: dict[str, Any],
+        path: Path,
+        key: str,
+        request_names: set[str],
+        response_names: set[str],
+        variables: dict[str, Any],
+    ) -> dict[str, Any]:
+        """The behaviours that stop, wrap, count, hold, release and carry, each name checked."""
+
+        def known(name: str, where: Path) -> str:
+            if name not in variables:
+                self.error(where, f"unknown state variable {name!r}")
+            return name
+
+        counts = {}
+        for field_name, count in (item.get("counts") or {}).items():
+            if field_name not in response_names:
+                self.error((*path, "counts", field_name), f"{key} has no response field {field_name!r}")
+            counts[str(field_name)] = (known(str(count["state"]), (*path, "counts", field_name)), float(count["per"]))
+        for field_name in item.get("cancel_when") or {}:
+            if field_name not in request_names:
+                self.error((*path, "cancel_when", field_name), f"{key} has no request field {field_name!r}")
+        if "cancel_when" in item and "releases" not in item:
+            self.error((*path, "cancel_when"), "`cancel_when` needs `releases`")
+        carries = item.get("carries")
+        if carries:
+            for role in ("command", "content"):
+                if carries[role] not in request_names:
+                    self.error((*path, "carries", role), f"{key} has no request field {carries[role]!r}")
+        return {
+            "stops": tuple(known(str(n), (*path, "stops")) for n in item.get("stops") or ()),
+            "wraps": {known(str(n), (*path, "wraps", n)): float(p) for n, p in (item.get("wraps") or {}).items()},
+            "counts": counts,
+            "every_device": bool(item.get("every_device", False)),
+            "held_while": known(str(item["held_while"]), (*path, "held_while")) if "held_while" in item else "",
+            "releases": known(str(item["releases"]), (*path, "releases")) if "releases" in item else "",
+            "cancel_when": {str(k): float(v) for k, v in (item.get("cancel_when") or {}).items()},
+            "carries": (str(carries["command"]), str(carries["content"])) if carries else None,
+        }
 
     def models(
         self, value: dict[str, Any], path: Path, entries: dict[str, TableEntry], state: dict[str, float]

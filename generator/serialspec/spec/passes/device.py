@@ -1,0 +1,290 @@
+"""The `device:` section: how a virtual device behaves, checked against the commands it answers."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from serialspec.spec.errors import SpecError
+from serialspec.spec.loader import Path
+from serialspec.spec.model import (
+    Behaviour,
+    Command,
+    Device,
+    DeviceKind,
+    DeviceModel,
+    Direction,
+    Framing,
+    Group,
+    ModelEntry,
+    Motion,
+    TableEntry,
+    replies_by_request,
+    reply_to,
+)
+from serialspec.spec.passes.base import Pass
+
+
+class DevicePass(Pass):
+    """Resolve `device:` (when the framing resolved: the device's address defaults to a frame element)."""
+
+    def run(self) -> list[SpecError]:
+        data, framing = self.ctx.data, self.ctx.framing
+        if "device" in data and framing is not None and isinstance(data.get("serial") or {}, dict):
+            self.ctx.device = self.guard(
+                ("device",), self.device, data["device"], ("device",), self.ctx.commands, framing
+            )
+        return self.problems
+
+    def device(self, value: dict[str, Any], path: Path, commands: list[Command], framing: Framing) -> Device:
+        memory = self.reference("table", self.tables, value.get("memory"), (*path, "memory"))
+        entries = {e.name: e for e in memory.entries} if memory else {}
+        for name in value.get("initial") or {}:
+            if name not in entries:
+                self.error((*path, "initial", name), f"unknown memory entry {name!r}")
+        address_element = next(
+            (e for layout in framing.layouts.values() for e in layout.value_elements if e.role == "address"), None
+        )
+        address = str(value.get("address") or (address_element.name if address_element else ""))
+        if not address:
+            self.error(path, "name the field holding the device id with `address:`")
+        broadcast = value.get("broadcast", address_element.broadcast if address_element else None)
+        id_entry = str(value.get("id_entry", ""))
+        if id_entry and id_entry not in entries and id_entry not in (value.get("state") or {}):
+            self.error((*path, "id_entry"), f"unknown memory entry or state variable {id_entry!r}")
+        state = {str(k): float(v) for k, v in (value.get("state") or {}).items()}
+        requests = {m.key: m for c in commands for m in c.messages() if m.direction == Direction.REQUEST}
+        replies = replies_by_request(m for c in commands for m in c.messages())
+        kinds = {
+            str(name): DeviceKind(
+                str(name),
+                str(kind.get("description", "")),
+                str(kind["address"]),
+                tuple(int(i) for i in kind["ids"]),
+                kind.get("broadcast"),
+                {str(k): float(v) for k, v in (kind.get("state") or {}).items()},
+            )
+            for name, kind in (value.get("kinds") or {}).items()
+        }
+        behaviours = []
+        for key, item in (value.get("commands") or {}).items():
+            item_path = (*path, "commands", key)
+            request = requests.get(key)
+            if request is None:
+                self.error(item_path, f"unknown command {key!r} (or it has no request)")
+                continue
+            kind_name = str(item.get("kind", ""))
+            if kind_name and kind_name not in kinds:
+                self.error((*item_path, "kind"), f"unknown device kind {kind_name!r} (not in `kinds:`)")
+            known_state = kinds[kind_name].state if kind_name in kinds else state
+            response = reply_to(request, replies)
+            each = str(item.get("each", ""))
+            group = next((f for f in request.fields if isinstance(f, Group) and f.name == each), None)
+            if each and group is None:
+                self.error((*item_path, "each"), f"{key} has no group field {each!r}")
+            item_fields = group.fields if group else ()
+            request_names = {f.name for f in (*request.fields, *item_fields)}
+            response_names = {f.name for f in response.fields} if response else set()
+            for name in item.get("reads") or ():
+                if name not in response_names:
+                    self.error((*item_path, "reads"), f"{key} has no response field {name!r}")
+            for name in item.get("writes") or ():
+                if name not in request_names:
+                    self.error((*item_path, "writes"), f"{key} has no request field {name!r}")
+            reports = {str(k): str(v) for k, v in (item.get("reports") or {}).items()}
+            for field_name, source in reports.items():
+                if field_name not in response_names:
+                    self.error((*item_path, "reports", field_name), f"{key} has no response field {field_name!r}")
+                if source not in known_state and source not in entries:
+                    self.error((*item_path, "reports", field_name), f"unknown state variable {source!r}")
+            motion = None
+            if "moves" in item:
+                moves = item["moves"]
+                motion = Motion(
+                    str(moves["state"]),
+                    str(moves["target"]),
+                    str(moves.get("duration", "")),
+                    str(moves.get("speed", "")),
+                    str(moves.get("accel", "")),
+                    str(moves.get("decel", "")),
+                )
+                if motion.state not in known_state and motion.state not in entries:
+                    self.error((*item_path, "moves", "state"), f"unknown state variable {motion.state!r}")
+                for role in ("target", "duration", "speed", "accel", "decel"):
+                    name = getattr(motion, role)
+                    if name and name not in request_names and name not in entries:
+                        self.error((*item_path, "moves", role), f"{key} has no request field or memory entry {name!r}")
+            stores = {str(k): str(v) for k, v in (item.get("stores") or {}).items()}
+            sets = {str(k): float(v) for k, v in (item.get("sets") or {}).items()}
+            absent = {str(k): float(v) for k, v in (item.get("absent") or {}).items()}
+            for field_name, target in stores.items():
+                if field_name not in request_names:
+                    self.error((*item_path, "stores", field_name), f"{key} has no request field {field_name!r}")
+                if target not in known_state and target not in entries:
+                    self.error((*item_path, "stores", field_name), f"unknown state variable {target!r}")
+            for target in sets:
+                if target not in known_state and target not in entries:
+                    self.error((*item_path, "sets", target), f"unknown state variable {target!r}")
+            for field_name in absent:
+                if field_name not in response_names:
+                    self.error((*item_path, "absent", field_name), f"{key} has no response field {field_name!r}")
+            behaviours.append(
+                Behaviour(
+                    key,
+                    tuple(item.get("reads") or ()),
+                    tuple(item.get("writes") or ()),
+                    bool(item.get("resets", False)),
+                    reports,
+                    motion,
+                    bool(item.get("broadcast_reply", False)),
+                    each,
+                    bool(item.get("buffered", False)),
+                    bool(item.get("commits", False)),
+                    kind_name,
+                    stores,
+                    sets,
+                    absent,
+                    **self.behaviour_extras(
+                        item, item_path, key, request_names, response_names, {**entries, **known_state}
+                    ),
+                )
+            )
+        status = {str(k): str(v) for k, v in (value.get("status") or {}).items()}
+        for field_name, entry_name in status.items():
+            if entry_name not in entries:
+                self.error((*path, "status", field_name), f"unknown memory entry {entry_name!r}")
+        return Device(
+            description=str(value.get("description", "")),
+            memory=memory,
+            initial={str(k): float(v) for k, v in (value.get("initial") or {}).items()},
+            address=address,
+            id_entry=id_entry,
+            broadcast=broadcast,
+            state=state,
+            reply={str(k): float(v) for k, v in (value.get("reply") or {}).items()},
+            refused={str(k): float(v) for k, v in (value.get("refused") or {}).items()},
+            behaviours=tuple(behaviours),
+            status=status,
+            kinds=tuple(kinds.values()),
+            echo_address=bool(value.get("echo_address", False)),
+            models=self.models(value, path, entries, state),
+            model_entry=str(value.get("model_entry", "")),
+        )
+
+    def behaviour_extras(
+        self,
+        item: dict[str, Any],
+        path: Path,
+        key: str,
+        request_names: set[str],
+        response_names: set[str],
+        variables: dict[str, Any],
+    ) -> dict[str, Any]:
+        """The behaviours that stop, wrap, count, hold, release and carry, each name checked."""
+
+        def known(name: str, where: Path) -> str:
+            if name not in variables:
+                self.error(where, f"unknown state variable {name!r}")
+            return name
+
+        counts = {}
+        for field_name, count in (item.get("counts") or {}).items():
+            if field_name not in response_names:
+                self.error((*path, "counts", field_name), f"{key} has no response field {field_name!r}")
+            counts[str(field_name)] = (known(str(count["state"]), (*path, "counts", field_name)), float(count["per"]))
+        for field_name in item.get("cancel_when") or {}:
+            if field_name not in request_names:
+                self.error((*path, "cancel_when", field_name), f"{key} has no request field {field_name!r}")
+        if "cancel_when" in item and "releases" not in item:
+            self.error((*path, "cancel_when"), "`cancel_when` needs `releases`")
+        carries = item.get("carries")
+        if carries:
+            for role in ("command", "content"):
+                if carries[role] not in request_names:
+                    self.error((*path, "carries", role), f"{key} has no request field {carries[role]!r}")
+        return {
+            "stops": tuple(known(str(n), (*path, "stops")) for n in item.get("stops") or ()),
+            "wraps": {known(str(n), (*path, "wraps", n)): float(p) for n, p in (item.get("wraps") or {}).items()},
+            "counts": counts,
+            "every_device": bool(item.get("every_device", False)),
+            "held_while": known(str(item["held_while"]), (*path, "held_while")) if "held_while" in item else "",
+            "releases": known(str(item["releases"]), (*path, "releases")) if "releases" in item else "",
+            "cancel_when": {str(k): float(v) for k, v in (item.get("cancel_when") or {}).items()},
+            "carries": (str(carries["command"]), str(carries["content"])) if carries else None,
+        }
+
+    def models(
+        self, value: dict[str, Any], path: Path, entries: dict[str, TableEntry], state: dict[str, float]
+    ) -> tuple[DeviceModel, ...]:
+        """The device's models, the default first; each value checked against the model's (or the table's) range."""
+        model_entry = str(value.get("model_entry", ""))
+        if model_entry and model_entry not in entries:
+            self.error((*path, "model_entry"), f"unknown memory entry {model_entry!r}")
+        models: list[DeviceModel] = []
+        numbers: dict[int, str] = {}
+        for name, item in (value.get("models") or {}).items():
+            model_path = (*path, "models", name)
+            self.name(name, model_path, "model name")
+            number = int(item["number"])
+            if number in numbers:
+                self.error((*model_path, "number"), f"model number {number} is already used by {numbers[number]!r}")
+            numbers[number] = name
+            overrides = []
+            for entry_name, override in (item.get("entries") or {}).items():
+                entry = entries.get(entry_name)
+                if entry is None:
+                    self.error((*model_path, "entries", entry_name), f"unknown memory entry {entry_name!r}")
+                    continue
+                range_path = (*model_path, "entries", entry_name, "range")
+                low, high = (
+                    self.bounds(entry.type, entry.sign_magnitude, override["range"], range_path, entry.sign_bit)
+                    if "range" in override
+                    else (entry.minimum, entry.maximum)
+                )
+                overrides.append(
+                    ModelEntry(
+                        entry_name,
+                        low,
+                        high,
+                        str(override.get("unit", entry.unit)),
+                        override.get("scale", entry.scale),
+                        str(override.get("description", "")),
+                    )
+                )
+            by_name = {o.name: o for o in overrides}
+            initial = {str(k): float(v) for k, v in (item.get("initial") or {}).items()}
+            if model_entry:
+                initial[model_entry] = float(number)
+            for entry_name, number_value in initial.items():
+                entry_path = (*model_path, "initial", entry_name)
+                if entry_name in state:
+                    continue
+                entry = entries.get(entry_name)
+                if entry is None:
+                    self.error(entry_path, f"unknown memory entry or state variable {entry_name!r}")
+                    continue
+                bounds = by_name.get(entry_name, entry)
+                low, high = bounds.minimum, bounds.maximum
+                if not low <= number_value <= high:
+                    where = (*model_path, "number") if entry_name == model_entry else entry_path
+                    self.error(where, f"{entry_name} = {number_value:g} is outside its range {low:g}..{high:g}")
+            models.append(
+                DeviceModel(
+                    name=name,
+                    number=number,
+                    title=str(item.get("title", "")),
+                    description=str(item.get("description", "")),
+                    source=str(item.get("source", "")),
+                    initial=initial,
+                    entries=tuple(overrides),
+                )
+            )
+        default = value.get("default_model")
+        if default is not None:
+            found = next((m for m in models if m.name == default), None)
+            if found is None:
+                known = ", ".join(m.name for m in models) or "none defined"
+                self.error((*path, "default_model"), f"unknown model {default!r} (expected one of: {known})")
+            else:
+                models.remove(found)
+                models.insert(0, found)
+        return tuple(models)

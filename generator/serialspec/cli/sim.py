@@ -31,6 +31,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="NAME|ID=NAME",
         help="the device model (a name from the spec's `device.models`) of every device, or of one id (repeat)",
     )
+    parser.add_argument(
+        "--echo",
+        action="store_true",
+        help="echo every byte received before answering, like a one-wire half-duplex adapter (clients: echo=True)",
+    )
     parser.add_argument("--quiet", action="store_true", help="do not log requests on stderr")
 
 
@@ -63,6 +68,7 @@ def run(args: argparse.Namespace) -> int:
         simulator = module.SIMULATOR(args.ids or [0], model=model_choice(args.models))
     except ValueError as exc:
         raise SerialspecError(f"--model: {exc}") from None
+    simulator.echo = args.echo
     controller, path = simulator.open_pty()
 
     def stop(signum: int, frame: FrameType | None) -> None:

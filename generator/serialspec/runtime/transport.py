@@ -95,10 +95,14 @@ class Bus:
         *,
         timeout: float = 0.1,
         baudrate: int | None = None,
+        echo: bool = False,
         **serial_options: Any,
     ) -> None:
+        """`echo`: a one-wire half-duplex adapter that hears its own transmission; every frame written is read
+        back and checked before any reply is looked for (a mismatch or a missing echo is a PortError)."""
         self.binding = binding
         self.timeout = timeout
+        self.echo = echo
         self._closed = False  # by close(): no transaction reopens the port after that
         self._lock = threading.RLock()
         self._subscribers: list[Subscriber] = []
@@ -271,6 +275,33 @@ class Bus:
     def _write(self, frame: bytes) -> None:
         with self._port_failures("write"):
             self._port.write(frame)
+        if self.echo:
+            self._check_echo(frame)
+
+    def _check_echo(self, frame: bytes) -> None:
+        """Read back the echo of a frame just written; bytes after it (the reply's start) go to the parser."""
+        deadline = time.monotonic() + self.timeout
+        echoed = b""
+        while len(echoed) < len(frame):
+            remaining = deadline - time.monotonic()
+            with self._port_failures("read"):
+                chunk = self._read_some(remaining) if remaining > 0 else b""
+            if not chunk:
+                self._reset()
+                raise PortError(
+                    f"{self.port_name}: no echo of the {len(frame)} bytes written within {self.timeout:g} s "
+                    f"(got {len(echoed)}: {echoed.hex(' ') or 'nothing'}); is echo=True right for this adapter?"
+                )
+            echoed += chunk
+        if echoed[: len(frame)] != frame:
+            self._reset()
+            raise PortError(
+                f"{self.port_name}: the echo differs from the bytes written: wrote {frame.hex(' ')}, "
+                f"read back {echoed[: len(frame)].hex(' ')}"
+            )
+        rest = echoed[len(frame) :]
+        if rest:
+            self._backlog.extend(self._parser.feed(rest))
 
     def _drain(self) -> None:
         """Hand bytes that arrived between transactions (late replies, reports) to subscribers, without waiting."""

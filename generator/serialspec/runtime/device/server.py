@@ -44,6 +44,8 @@ class Simulator(Engine):
         self._wake_r, self._wake_w = os.pipe()
         self._stop = threading.Event()
         self._released = False  # close() has closed the pseudo-terminal and the wake-up pipe
+        # Like a one-wire half-duplex adapter: every byte the client sends comes back to it before any reply.
+        self.echo = False
 
     def emit(self, message: Message) -> None:
         """Send a message on the device's own initiative (a report, a key event) as soon as possible."""
@@ -74,6 +76,8 @@ class Simulator(Engine):
                 if not data:
                     self._stop.wait(0.01)
                     continue
+                if self.echo:
+                    os.write(fd, data)
                 for when, frame in self.feed(data):
                     self._seq += 1
                     heapq.heappush(self._outbox, _Scheduled(when, self._seq, frame))

@@ -258,7 +258,7 @@ class FashionstarUartClient(ClientBase):
             servo_id: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). (0..254)
             angle: Angle in 0.1° steps; the sign gives the direction (900 is 90°). [0.1°]
             interval: Time to reach the target angle. [ms]
-            power: Power; 0 or more than the power limit means the power limit. [mW]
+            power: Power; 0 or more than the power limit means the power limit (000's 功率保持值, read as data_id 42: erratum power_hold_value_undefined). [mW]
 
         Returns: result: Outcome of the command.
         None when no reply is due (Sent only when response_switch (data_id 33) is 1, once the target angle is reached.).

@@ -773,7 +773,7 @@ class RotateRequest(Message):
     interval: int
     #: Time to reach the target angle. [ms]
     power: int = 0
-    #: Power; 0 or more than the power limit means the power limit. [mW]
+    #: Power; 0 or more than the power limit means the power limit (000's 功率保持值, read as data_id 42: erratum power_hold_value_undefined). [mW]
 
     def to_fields(self) -> dict[str, Any]:
         return {

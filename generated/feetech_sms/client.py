@@ -90,7 +90,7 @@ class FeetechSmsClient(ClientBase):
     def ping(self, id: int) -> bool:
         """Query a servo's working status.
 
-        Broadcast: A servo answers a PING sent to the broadcast id too, so a broadcast PING finds the id of a single servo; with several servos on the bus their replies collide (004 §1.1).
+        Broadcast: A servo answers a PING sent to the broadcast id too (004 §1.3.1: PING 指令使用广播地址，舵机同样返回应答信息, 'when PING uses the broadcast address, the servo answers as well'), so a broadcast PING finds the id of a single servo; with several servos on the bus their replies collide (004 §1.1).
 
         Args:
             id: Servo id 0..253; 254 (0xFE) is the broadcast id: every servo takes the instruction and none answers, except to PING. (0..253)

@@ -447,6 +447,10 @@ EXAMPLE = Obj(
         "printed": Str("The frame exactly as the document prints it."),
         "frame": HEX_BYTES,
         "erratum": Str("Name of the erratum that explains why `frame` differs from `printed`."),
+        "completed": Str(
+            "The document prints no complete frame here (a placeholder such as `CRC` for the check byte, or the "
+            "values as a table): how `frame` completes it. A printing convention, not an erratum."
+        ),
         "command": Str(),
         "subcommand": Str(),
         "request": Str("Name of the example whose request this example answers."),

@@ -380,6 +380,7 @@ class Example:
     subcommand: str | None
     request: str
     fields: dict[str, object]
+    completed: str = ""  # the document prints no complete frame: how `frame` completes it (not an erratum)
 
 
 @dataclass(frozen=True)

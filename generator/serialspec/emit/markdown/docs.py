@@ -373,6 +373,7 @@ def emit_docs(protocol: Protocol) -> str:
             "printed": e.printed,
             "frame": e.frame.hex(" ").upper(),
             "erratum": e.erratum,
+            "completed": text(e.completed),
             "rows": breakdown(protocol, e),
         }
         for e in protocol.examples

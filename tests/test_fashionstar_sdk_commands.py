@@ -16,7 +16,7 @@ import pytest
 import serial
 from fashionstar_uart.client import FashionstarUartClient
 from fashionstar_uart.simulator import FashionstarUartSimulator
-from serialspec.runtime.errors import RangeError
+from serialspec.runtime.errors import EncodeError, RangeError
 from sim_process import serve
 
 uservo = pytest.importorskip("fashionstar_uart_sdk.uservo")
@@ -272,3 +272,17 @@ def test_a_ramped_move_starts_and_ends_slowly() -> None:
     assert device.get("angle") == 0
     now[0] = 1.3
     assert 0 < device.get("angle") < 1000
+
+
+def test_our_client_carries_typed_requests_in_one_sync_command(port: str) -> None:
+    with FashionstarUartClient(port, timeout=1.0) as client:
+        moves = [fs.MoveByIntervalRequest(servo_id=i, angle=-100 * i, interval=20) for i in (0, 1)]
+        assert client.sync_command_of(moves) == []  # moves answer only when the response switch is on
+        for i in (0, 1):
+            assert settle(lambda i=i: client.read_angle(i), -100 * i) == -100 * i
+        replies = client.sync_command_of([fs.MonitorRequest(servo_id=i) for i in (1, 0)])
+        assert [(r.servo_id, r.angle) for r in replies] == [(1, -100), (0, 0)]  # type: ignore[attr-defined]
+        with pytest.raises(EncodeError, match="one type"):
+            client.sync_command_of([moves[0], fs.MonitorRequest(servo_id=1)])
+        with pytest.raises(EncodeError, match="PingRequest cannot be carried"):
+            client.sync_command_of([fs.PingRequest(servo_id=1)])

@@ -11,10 +11,12 @@ byte is written (RangeError names the field and the range).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any
 
 import serial
 from serialspec.runtime.errors import EncodeError, Timeout
+from serialspec.runtime.message import Message
 from serialspec.runtime.transport import Binding, Bus, ClientBase
 
 from fashionstar_uart import MATCH_BY, SERIAL
@@ -70,6 +72,17 @@ from fashionstar_uart.messages import (
 )
 
 __all__ = ["BINDING", "FashionstarUartClient"]
+
+#: What sync_command_of() can carry: request class -> (its command code, the reply each device sends, or None).
+SYNC_COMMAND_CARRIES: dict[type[Message], tuple[int, type[Message] | None]] = {
+    RotateRequest: (8, None),
+    MoveByIntervalRequest: (11, None),
+    MoveByVelocityRequest: (12, None),
+    MoveMturnRequest: (13, None),
+    MoveMturnByIntervalRequest: (14, None),
+    MoveMturnByVelocityRequest: (15, None),
+    MonitorRequest: (22, MonitorResponse),
+}
 
 #: What a Bus needs of this protocol: serial defaults, codec, and the reply-matching rule.
 BINDING = Binding(
@@ -496,6 +509,20 @@ class FashionstarUartClient(ClientBase):
         """
         request = SyncCommandRequest(command=command, blocks=blocks)
         self.bus.send(request)
+
+    def sync_command_of(self, requests: Sequence[Message]) -> list[Message]:
+        """One command for several servos at once, from the requests it carries: one per device, all of one command.
+
+        Each request's content becomes one item of `blocks`; the command's replies (one per request, in order) are returned, or [] when that command answers only when a parameter allows it or not at all.
+        """
+        return self._carry(
+            requests,
+            SYNC_COMMAND_CARRIES,
+            slice(4, -1),
+            lambda code, blocks: SyncCommandRequest(
+                command=code, blocks=tuple(BlocksItem(content=b) for b in blocks)
+            ),
+        )
 
     def read_parameter(self, servo_id: int, name: str) -> int | float:
         """Read one entry of servo parameters by data_id by name, e.g. `read_parameter(1, 'voltage')`."""

@@ -16,7 +16,7 @@ import select
 import threading
 import time
 from collections import deque
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import suppress
 from dataclasses import dataclass, field
 from enum import IntFlag
@@ -24,7 +24,7 @@ from typing import Any, TypeVar
 
 import serial
 
-from serialspec.runtime.errors import CorruptReply, DeviceError, PortError, Timeout
+from serialspec.runtime.errors import CorruptReply, DeviceError, EncodeError, PortError, Timeout
 from serialspec.runtime.message import Message
 from serialspec.runtime.stream import StreamParser
 
@@ -466,6 +466,33 @@ class ClientBase:
         if (address, key) not in self._parameters:
             self._parameters[(address, key)] = self._read_key(address, key)
         return self._parameters[(address, key)] == value
+
+    def _carry(
+        self,
+        requests: Sequence[Message],
+        carried: Mapping[type[Message], tuple[int, type[Message] | None]],
+        content: slice,
+        build: Callable[[int, list[bytes]], Message],
+    ) -> list[Message]:
+        """Send requests of one command inside one carrier request (a sync command); the replies, if any are due.
+
+        `carried`: request class -> (its command code, the reply class each device answers with, or None);
+        `content`: where a request's content sits in its encoded frame; `build`: the carrier from code and contents.
+        """
+        kinds = {type(r) for r in requests}
+        if len(kinds) != 1:
+            raise EncodeError("a sync command carries requests of one command: give one or more, all of one type")
+        kind = kinds.pop()
+        if kind not in carried:
+            raise EncodeError(
+                f"{kind.__name__} cannot be carried (expected one of {', '.join(c.__name__ for c in carried)})"
+            )
+        code, reply = carried[kind]
+        request = build(code, [self.bus.binding.encode(r)[content] for r in requests])
+        if reply is None:
+            self.bus.send(request)
+            return []
+        return list(self.bus.request_each(request, reply, [{self.ADDRESS: getattr(r, self.ADDRESS)} for r in requests]))
 
     def _read_key(self, address: int, key: int) -> float:
         """Read one table entry by key (generated clients whose spec can read entries override this)."""

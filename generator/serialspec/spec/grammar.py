@@ -535,6 +535,7 @@ DEVICE_COMMAND = Obj(
             {
                 "command": Str("The request field (or `each` item field) holding the code of the command carried."),
                 "content": Str("The bytes field holding that command's request content."),
+                "commands": ListOf(Str(), "The commands it can carry (default: every command with a code)."),
             },
             required=("command", "content"),
             description=(

@@ -445,6 +445,7 @@ class Behaviour:
     releases: str = ""  # state variable: cleared, and the held requests carried out
     cancel_when: dict[str, float] = field(default_factory=dict)  # with releases: field -> value that drops them
     carries: tuple[str, str] | None = None  # (command code field, content field) of a carried request
+    carried: tuple[str, ...] = ()  # the commands it can carry (empty: every command with a code)
 
 
 @dataclass(frozen=True)

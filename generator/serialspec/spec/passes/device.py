@@ -197,10 +197,16 @@ class DevicePass(Pass):
         if "cancel_when" in item and "releases" not in item:
             self.error((*path, "cancel_when"), "`cancel_when` needs `releases`")
         carries = item.get("carries")
+        carried: list[str] = []
         if carries:
             for role in ("command", "content"):
                 if carries[role] not in request_names:
                     self.error((*path, "carries", role), f"{key} has no request field {carries[role]!r}")
+            coded = {c.name for c in self.ctx.commands if c.code is not None and c.request and not c.subcommands}
+            for name in carries.get("commands") or ():
+                if name not in coded:
+                    self.error((*path, "carries", "commands"), f"unknown command {name!r} (or it has no code)")
+                carried.append(str(name))
         return {
             "stops": tuple(known(str(n), (*path, "stops")) for n in item.get("stops") or ()),
             "wraps": {known(str(n), (*path, "wraps", n)): float(p) for n, p in (item.get("wraps") or {}).items()},
@@ -210,6 +216,7 @@ class DevicePass(Pass):
             "releases": known(str(item["releases"]), (*path, "releases")) if "releases" in item else "",
             "cancel_when": {str(k): float(v) for k, v in (item.get("cancel_when") or {}).items()},
             "carries": (str(carries["command"]), str(carries["content"])) if carries else None,
+            "carried": tuple(carried),
         }
 
     def models(

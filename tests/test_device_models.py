@@ -157,3 +157,25 @@ def test_model_mistakes_are_spec_errors(tmp_path: Path) -> None:
     assert any("cw_dead_band = 99 is outside its range 0..32" in line for line in lines), lines
     assert any("unknown model 'sts9999'" in line for line in lines), lines
     assert all(line.startswith("feetech_sms.yaml:") for line in lines), lines
+
+
+def test_behaviour_mistakes_are_spec_errors(tmp_path: Path) -> None:
+    text = (ROOT / "specs" / "fashionstar_uart.yaml").read_text(encoding="utf-8")
+    text = text.replace("stop_on_control_mode: {stops: [angle]}", "stop_on_control_mode: {stops: [angel]}")
+    text = text.replace("begin_async: {every_device: true, sets: {holding: 1}}", "begin_async: {cancel_when: {x: 1}}")
+    text = text.replace("        commands: [rotate, move_by_interval,", "        commands: [rotat, move_by_interval,")
+    text = text.replace("counts: {turns: {state: angle, per: 3600}}}", "counts: {turn: {state: angle, per: 3600}}}")
+    spec = tmp_path / "fashionstar_uart.yaml"
+    spec.write_text(text, encoding="utf-8")
+    with pytest.raises(SpecErrors) as failure:
+        load_protocol(str(spec), "fashionstar_uart.yaml")
+    lines = str(failure.value).splitlines()
+    for expected in (
+        "stops: unknown state variable 'angel'",
+        "cancel_when: `cancel_when` needs `releases`",
+        "cancel_when.x: begin_async has no request field 'x'",
+        "carries.commands: unknown command 'rotat'",
+        "counts.turn: read_mturn_angle has no response field 'turn'",
+    ):
+        assert any(expected in line for line in lines), (expected, lines)
+    assert all(line.startswith("fashionstar_uart.yaml:") for line in lines), lines

@@ -427,7 +427,7 @@ class FashionstarUartClient(ClientBase):
     def reset_mturn_angle(self, servo_id: int) -> None:
         """Reset the multi-turn angle.
 
-        The multi-turn count starts again from the angle within one turn. The SDK waits for no reply.
+        The multi-turn count starts again from the angle within one turn (inferred from the name: the SDK sends it and waits for no reply).
 
         Args:
             servo_id: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). (0..254)

@@ -179,3 +179,15 @@ def test_behaviour_mistakes_are_spec_errors(tmp_path: Path) -> None:
     ):
         assert any(expected in line for line in lines), (expected, lines)
     assert all(line.startswith("fashionstar_uart.yaml:") for line in lines), lines
+
+
+def test_moving_reads_1_on_the_way_and_0_on_arrival() -> None:
+    now = [0.0]
+    simulator = FeetechSmsSimulator([1], clock=lambda: now[0])
+    goal = CONTROL_TABLE["goal_position"].address
+    simulator.handle(WriteRequest(id=1, address=goal, data=bytes([0x00, 0x08, 0xF4, 0x01])))  # 2048 in 500 ms
+    device = simulator.devices[1]
+    now[0] = 0.25
+    assert (device.get("moving"), device.get("present_position")) == (1, 1024)
+    now[0] = 0.5
+    assert (device.get("moving"), device.get("present_position")) == (0, 2048)

@@ -286,3 +286,14 @@ def test_our_client_carries_typed_requests_in_one_sync_command(port: str) -> Non
             client.sync_command_of([moves[0], fs.MonitorRequest(servo_id=1)])
         with pytest.raises(EncodeError, match="PingRequest cannot be carried"):
             client.sync_command_of([fs.PingRequest(servo_id=1)])
+
+
+def test_the_executing_bit_is_set_while_the_servo_moves() -> None:
+    now = [0.0]
+    simulator = FashionstarUartSimulator([1], clock=lambda: now[0])
+    device = simulator.devices[1]
+    simulator.handle(fs.RotateRequest(servo_id=1, angle=900, interval=1000))
+    now[0] = 0.5
+    assert device.get("servo_status") == fs.ServoStatus.EXECUTING
+    now[0] = 1.0
+    assert device.get("servo_status") == 0

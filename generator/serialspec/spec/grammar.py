@@ -605,6 +605,17 @@ DEVICE = Obj(
         "reply": MapOf(Num(), "Response field -> value when no behaviour sets it (e.g. result: 1)."),
         "refused": MapOf(Num(), "Response field -> value when a write is refused (read-only or unknown entry)."),
         "status": MapOf(Str(), "Response field -> the memory entry every response reports in it (a status byte)."),
+        "moving": MapOf(
+            Obj(
+                {
+                    "state": Str("The state variable (or memory entry) whose move it reports."),
+                    "bit": Int("Only this bit of the entry reports it (the others keep their value)."),
+                },
+                required=("state",),
+            ),
+            "Memory entry -> the move it reports: 1 while the state variable moves, 0 once it has arrived (FEETECH "
+            "`moving`); with `bit`, one bit of the entry (Fashion Star servo_status bit 0, executing).",
+        ),
         "echo_address": Bool(
             "Replies carry the id the request named (RRC: 0xFE for a broadcast read), not the answering device's own."
         ),

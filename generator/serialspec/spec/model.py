@@ -506,6 +506,7 @@ class Device:
     kinds: tuple[DeviceKind, ...] = ()
     echo_address: bool = False  # replies carry the id the request named, not the answering device's own
     models: tuple[DeviceModel, ...] = ()  # the first is the default model
+    moving: dict[str, tuple[str, int | None]] = field(default_factory=dict)  # entry -> (state variable, bit)
     model_entry: str = ""  # the memory entry holding the model number
 
     def behaviour(self, key: str) -> Behaviour | None:

@@ -151,6 +151,7 @@ def simulator_module(protocol: Protocol) -> str:
         commands=commands,
         registers=map_name(device.memory) if device.memory in register_tables(protocol) else "",
         status=repr(device.status) if device.status else "",
+        moving=repr(device.moving) if device.moving else "",
         echo_address=device.echo_address,
         models=[model_data(m) for m in device.models],
         carried=carried_requests(protocol),

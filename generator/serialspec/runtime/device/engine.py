@@ -100,6 +100,7 @@ class DeviceSpec:
     registers: RegisterMap | None = None  # memory as registers at byte addresses, for run reads/writes
     status: dict[str, str] = field(default_factory=dict)  # response field -> memory entry every reply reports
     models: tuple[ModelSpec, ...] = ()  # the first is the default model
+    moving: dict[str, tuple[str, int | None]] = field(default_factory=dict)  # entry -> (state variable, bit)
     # command code -> (request class, its construct content struct), for requests carried by another one
     carried: dict[int, tuple[type[Message], Any]] = field(default_factory=dict)
 
@@ -124,6 +125,9 @@ class _Motion:
     duration: float
     accel: float = 0.0
     decel: float = 0.0
+
+    def active(self, now: float) -> bool:
+        return now < self.began + self.duration
 
     def value(self, now: float) -> float:
         t, total = now - self.began, self.duration
@@ -190,9 +194,15 @@ class VirtualDevice:
         if motion is not None:
             value = motion.value(self.clock())
             return round(value)
-        if name in self.state:
-            return self.state[name]
-        return self.memory[self.by_name[name].key]
+        value = self.state[name] if name in self.state else self.memory[self.by_name[name].key]
+        reports = self.spec.moving.get(name)
+        if reports is None:
+            return value
+        state, bit = reports
+        on_its_way = state in self.motions and self.motions[state].active(self.clock())
+        if bit is None:
+            return float(on_its_way)
+        return float(int(value) | 1 << bit if on_its_way else int(value) & ~(1 << bit))
 
     def set(self, name: str, value: float) -> None:
         self.motions.pop(name, None)

@@ -297,3 +297,13 @@ def test_the_executing_bit_is_set_while_the_servo_moves() -> None:
     assert device.get("servo_status") == fs.ServoStatus.EXECUTING
     now[0] = 1.0
     assert device.get("servo_status") == 0
+
+
+def test_a_sync_command_block_that_is_not_a_carried_request_is_ignored() -> None:
+    simulator = FashionstarUartSimulator([1])
+    short = fs.SyncCommandRequest(command=11, blocks=(fs.BlocksItem(content=b"\x01\x02"),))  # 2 of 11 bytes
+    ping = fs.SyncCommandRequest(command=1, blocks=(fs.BlocksItem(content=b"\x01"),))  # not one it carries
+    assert simulator.handle(short) == [] and simulator.handle(ping) == []
+    assert simulator.devices[1].get("angle") == 0
+    monitor = fs.SyncCommandRequest(command=22, blocks=(fs.BlocksItem(content=b"\x01"),))
+    assert [fs.decode(frame, "response").COMMAND for _, frame in simulator.handle(monitor)] == ["monitor"]

@@ -10,6 +10,8 @@ from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
+from construct import ConstructError
+
 from serialspec.runtime.device.faults import Fault, FaultInjection
 from serialspec.runtime.errors import EncodeError
 from serialspec.runtime.message import Message
@@ -336,8 +338,8 @@ class Engine(FaultInjection):
             parsed = content.parse(bytes.fromhex(data) if isinstance(data, str) else bytes(data))
             names = [f.name for f in dataclasses.fields(request)]  # type: ignore[arg-type]
             return request.from_fields({n: parsed[n] for n in names})  # type: ignore[attr-defined, no-any-return]
-        except Exception:  # noqa: BLE001 - a block that does not parse as that request is ignored, like a bad frame
-            return None
+        except (ConstructError, EncodeError, KeyError, TypeError, ValueError):
+            return None  # a block that does not parse as that request is ignored, like a bad frame
 
     def _absent(self, command: CommandSpec, given: dict[str, Any]) -> bytes | None:
         """The reply a bus master gives for an id no device has: the request's fields, `absent` values, else 0."""

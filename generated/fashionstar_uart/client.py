@@ -496,7 +496,7 @@ class FashionstarUartClient(ClientBase):
         request = StopOnControlModeRequest(servo_id=servo_id, method=method, power=power)
         self.bus.send(request)
 
-    def sync_command(self, command: int, blocks: tuple[BlocksItem, ...]) -> None:
+    def sync_command(self, command: int, blocks: tuple[BlocksItem, ...] | Sequence[bytes]) -> None:
         """One command for several servos at once.
 
         Carries one command (8, 11..15 or 22) to several servos: its code, the size of one servo's block, the number of servos, then one block per servo holding that command's request content (servo_id first). Each servo acts as if it had got the command alone, and answers as it would: a sync monitor (22) gets one monitor reply per servo, in block order.
@@ -504,9 +504,11 @@ class FashionstarUartClient(ClientBase):
         Args:
             command: The command carried (8, 11..15, or 22 for the monitor).
             blocks: One block per servo.
+            (blocks also takes a plain sequence of content values.)
 
         The device does not answer.
         """
+        blocks = tuple(v if isinstance(v, BlocksItem) else BlocksItem(content=v) for v in blocks)
         request = SyncCommandRequest(command=command, blocks=blocks)
         self.bus.send(request)
 

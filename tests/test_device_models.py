@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from feetech_sms import MODELS
 from feetech_sms.client import FeetechSmsClient
 from feetech_sms.codec import StreamParser, encode
 from feetech_sms.messages import Direction, ResetRequest, WriteRequest
@@ -51,6 +52,7 @@ def test_an_arm_driver_connects_to_six_virtual_sts3215(sdk: Any) -> None:
         assert (result, error) == (SUCCESS, 0)
         model, result, error = sdk.read2ByteTxRx(servo, sms_sts.SMS_STS_MODEL_L)
         assert (model, result, error) == (777, SUCCESS, 0)  # the STS3215's model number
+        assert MODELS[model] == "sts3215"  # the generated package names the models by number
         major, result, _ = sdk.read1ByteTxRx(servo, CONTROL_TABLE["firmware_major"].address)
         minor, _, _ = sdk.read1ByteTxRx(servo, CONTROL_TABLE["firmware_minor"].address)
         assert (major, minor, result) == (3, 10, SUCCESS)

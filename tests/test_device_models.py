@@ -108,6 +108,13 @@ def test_sim_refuses_a_bad_model_in_one_line(options: list[str], message: str) -
     assert "Traceback" not in result.stderr and len(result.stderr.strip().splitlines()) == 1
 
 
+def test_a_spec_without_models_says_so() -> None:
+    args = [sys.executable, "-m", "serialspec", "sim", str(ROOT / "specs" / "fashionstar_uart.yaml"), "--model", "x"]
+    result = subprocess.run(args, capture_output=True, text=True, timeout=30)
+    assert result.returncode != 0
+    assert result.stderr.strip() == "serialspec sim: --model: unknown model 'x': the spec lists no device models"
+
+
 def test_reset_goes_back_to_the_models_factory_values() -> None:
     simulator = FeetechSmsSimulator([1], model="sts3250")
     device = simulator.devices[1]

@@ -113,8 +113,9 @@ class DeviceSpec:
         for model in self.models:
             if model.name == name:
                 return model
-        known = ", ".join(m.name for m in self.models) or "none"
-        raise ValueError(f"unknown model {name!r} (expected one of: {known})")
+        if not self.models:
+            raise ValueError(f"unknown model {name!r}: the spec lists no device models")
+        raise ValueError(f"unknown model {name!r} (expected one of: {', '.join(m.name for m in self.models)})")
 
 
 @dataclass

@@ -179,37 +179,40 @@ def test_sdk_moves_by_interval_and_by_velocity(sdk: Any) -> None:
 
 
 def test_sdk_multi_turn_angle_turns_and_reset(sdk: Any) -> None:
+    # The SDK's reads wait a fixed 100 ms and keep the last value they saw, so each is polled until it holds the
+    # expected value (a reply that came late is taken by the next read).
     sdk.set_servo_angle(1, 740.5, is_mturn=True, interval=200)
     assert settle(lambda: sdk.query_servo_mturn_angle(1), 740.5) == pytest.approx(740.5)
-    info = sdk.query_servo_monitor(1)
+    assert settle(lambda: sdk.query_servo_monitor(1, realtime=True).turn, 2) == 2
+    info = sdk.servos[1]
     assert (info.angle_monitor, info.turn, info.voltage) == (740.5, 2, 7400)
     sdk.reset_multi_turn_angle(1)
-    assert sdk.query_servo_mturn_angle(1) == pytest.approx(20.5)  # 740.5° less two whole turns
+    assert settle(lambda: sdk.query_servo_mturn_angle(1), 20.5) == pytest.approx(20.5)  # less two whole turns
     sdk.set_origin_point(1)
-    assert sdk.query_servo_mturn_angle(1) == 0.0
+    assert settle(lambda: sdk.query_servo_mturn_angle(1), 0.0) == 0.0
 
 
-def test_sdk_async_holds_moves_until_end_and_cancel_drops_them(sdk: Any) -> None:
-    start = sdk.query_servo_angle(2)
-    sdk.begin_async()
-    sdk.set_servo_angle(2, 10.0, interval=50)
-    time.sleep(0.2)
-    assert sdk.query_servo_angle(2) == start  # held
-    sdk.end_async(0)
-    assert settle(lambda: sdk.query_servo_angle(2), 10.0) == pytest.approx(10.0)
-    sdk.begin_async()
-    sdk.set_servo_angle(2, 20.0, interval=50)
-    sdk.end_async(1)  # cancel
-    time.sleep(0.2)
-    assert sdk.query_servo_angle(2) == pytest.approx(10.0)
+def test_sdk_async_holds_moves_until_end_and_cancel_drops_them(sdk: Any, port: str) -> None:
+    with FashionstarUartClient(port, timeout=1.0) as client:  # reads that wait for their reply
+        start = client.read_angle(2)
+        sdk.begin_async()
+        sdk.set_servo_angle(2, 10.0, interval=50)
+        time.sleep(0.2)
+        assert client.read_angle(2) == start  # held
+        sdk.end_async(0)
+        assert settle(lambda: client.read_angle(2), 100) == 100
+        sdk.begin_async()
+        sdk.set_servo_angle(2, 20.0, interval=50)
+        sdk.end_async(1)  # cancel
+        time.sleep(0.2)
+        assert client.read_angle(2) == 100
 
 
 def test_sdk_sync_monitor_gets_one_reply_per_servo(sdk: Any) -> None:
     sdk.set_servo_angle(3, -12.5, interval=20)
     settle(lambda: sdk.query_servo_angle(3), -12.5)
-    data = sdk.send_sync_servo_monitor([0, 3], realtime=True)
-    assert data[3].angle_monitor == pytest.approx(-12.5)
-    assert (data[0].voltage, data[3].voltage) == (7400, 7400)
+    assert settle(lambda: sdk.send_sync_servo_monitor([0, 3], realtime=True)[3].angle_monitor, -12.5) == -12.5
+    assert (sdk.servos[0].voltage, sdk.servos[3].voltage) == (7400, 7400)
 
 
 def test_sdk_sync_move_reaches_every_listed_servo(port: str) -> None:
@@ -229,16 +232,17 @@ def test_sdk_sync_move_reaches_every_listed_servo(port: str) -> None:
         arm.closePort()
 
 
-def test_sdk_stop_on_control_mode_stops_where_it_is(sdk: Any) -> None:
-    sdk.set_servo_angle(2, 0.0, interval=20)
-    settle(lambda: sdk.query_servo_angle(2), 0.0)
-    sdk.set_servo_angle(2, 170.0, interval=20000)
-    time.sleep(0.2)
-    sdk.stop_on_control_mode(2, 0x11, 500)
-    stopped = sdk.query_servo_angle(2)
-    time.sleep(0.2)
-    assert sdk.query_servo_angle(2) == stopped
-    assert 0.0 < stopped < 170.0
+def test_sdk_stop_on_control_mode_stops_where_it_is(sdk: Any, port: str) -> None:
+    with FashionstarUartClient(port, timeout=1.0) as client:
+        sdk.set_servo_angle(2, 0.0, interval=20)
+        settle(lambda: client.read_angle(2), 0)
+        sdk.set_servo_angle(2, 170.0, interval=20000)
+        time.sleep(0.2)
+        sdk.stop_on_control_mode(2, 0x11, 500)
+        stopped = client.read_angle(2)
+        time.sleep(0.2)
+        assert client.read_angle(2) == stopped
+        assert 0 < stopped < 1700
 
 
 def test_our_client_has_typed_methods_for_the_new_commands(port: str) -> None:

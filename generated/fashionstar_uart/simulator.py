@@ -19,7 +19,7 @@ from collections.abc import Callable, Iterable, Mapping
 
 from serialspec.runtime.device import CommandSpec, DeviceSpec, EntrySpec, Simulator
 
-from fashionstar_uart.codec import StreamParser, encode
+from fashionstar_uart.codec import _REQUEST_DECODERS, StreamParser, encode
 from fashionstar_uart.messages import (
     BeginAsyncRequest,
     DampingRequest,
@@ -62,15 +62,6 @@ from fashionstar_uart.messages import (
     WriteBatchDataResponse,
     WriteDataRequest,
     WriteDataResponse,
-)
-from fashionstar_uart.structs import (
-    MonitorRequestContent,
-    MoveByIntervalRequestContent,
-    MoveByVelocityRequestContent,
-    MoveMturnByIntervalRequestContent,
-    MoveMturnByVelocityRequestContent,
-    MoveMturnRequestContent,
-    RotateRequestContent,
 )
 
 __all__ = ["DEVICE", "SIMULATOR", "FashionstarUartSimulator"]
@@ -165,13 +156,13 @@ DEVICE = DeviceSpec(
     ),
     moving={'servo_status': ('angle', 0)},
     carried={
-        8: (RotateRequest, RotateRequestContent),
-        11: (MoveByIntervalRequest, MoveByIntervalRequestContent),
-        12: (MoveByVelocityRequest, MoveByVelocityRequestContent),
-        13: (MoveMturnRequest, MoveMturnRequestContent),
-        14: (MoveMturnByIntervalRequest, MoveMturnByIntervalRequestContent),
-        15: (MoveMturnByVelocityRequest, MoveMturnByVelocityRequestContent),
-        22: (MonitorRequest, MonitorRequestContent),
+        8: _REQUEST_DECODERS[8],  # RotateRequest
+        11: _REQUEST_DECODERS[11],  # MoveByIntervalRequest
+        12: _REQUEST_DECODERS[12],  # MoveByVelocityRequest
+        13: _REQUEST_DECODERS[13],  # MoveMturnRequest
+        14: _REQUEST_DECODERS[14],  # MoveMturnByIntervalRequest
+        15: _REQUEST_DECODERS[15],  # MoveMturnByVelocityRequest
+        22: _REQUEST_DECODERS[22],  # MonitorRequest
     },
 )
 

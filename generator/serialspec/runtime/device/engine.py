@@ -4,16 +4,15 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import struct
 import threading
 import time
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from construct import ConstructError
-
 from serialspec.runtime.device.faults import Fault, FaultInjection
-from serialspec.runtime.errors import EncodeError
+from serialspec.runtime.errors import DecodeError, EncodeError
 from serialspec.runtime.message import Message
 from serialspec.runtime.registers import RegisterMap
 from serialspec.runtime.stream import StreamParser
@@ -103,8 +102,8 @@ class DeviceSpec:
     status: dict[str, str] = field(default_factory=dict)  # response field -> memory entry every reply reports
     models: tuple[ModelSpec, ...] = ()  # the first is the default model
     moving: dict[str, tuple[str, int | None]] = field(default_factory=dict)  # entry -> (state variable, bit)
-    # command code -> (request class, its construct content struct), for requests carried by another one
-    carried: dict[int, tuple[type[Message], Any]] = field(default_factory=dict)
+    # command code -> the codec's decoder of that request's content (buf, start, end), for requests carried by another
+    carried: dict[int, Callable[[bytes, int, int], Message]] = field(default_factory=dict)
 
     def model(self, name: str | None) -> ModelSpec | None:
         """The model of this name (None: the default one); a ValueError names the known models."""
@@ -330,16 +329,14 @@ class Engine(FaultInjection):
 
     def _carried(self, given: dict[str, Any], code_field: str, content_field: str) -> Message | None:
         """The request a sync command carries for one device: its content parsed as that command's request."""
-        found = self.spec.carried.get(int(given[code_field]))
-        if found is None:
+        decoder = self.spec.carried.get(int(given[code_field]))
+        if decoder is None:
             return None  # a command the device does not know: ignored, as a frame of an unknown command would be
-        request, content = found
         data = given[content_field]
+        content = bytes.fromhex(data) if isinstance(data, str) else bytes(data)
         try:
-            parsed = content.parse(bytes.fromhex(data) if isinstance(data, str) else bytes(data))
-            names = [f.name for f in dataclasses.fields(request)]  # type: ignore[arg-type]
-            return request.from_fields({n: parsed[n] for n in names})  # type: ignore[attr-defined, no-any-return]
-        except (ConstructError, EncodeError, KeyError, TypeError, ValueError):
+            return decoder(content, 0, len(content))
+        except (DecodeError, ValueError, struct.error):
             return None  # a block that does not parse as that request is ignored, like a bad frame
 
     def _absent(self, command: CommandSpec, given: dict[str, Any]) -> bytes | None:

@@ -463,6 +463,8 @@ class FashionstarUartClient(ClientBase):
     def monitor(self, servo_id: int) -> MonitorResponse:
         """Read voltage, current, power, temperature, status and multi-turn angle at once.
 
+        The SDK ignores a reply whose angle is -235929599 with turns 0 (outside the multi-turn range: a value that means 'no data', as its sync monitor treats it).
+
         Args:
             servo_id: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). (0..254)
 

@@ -200,3 +200,26 @@ def test_moving_reads_1_on_the_way_and_0_on_arrival() -> None:
     assert (device.get("moving"), device.get("present_position")) == (1, 1024)
     now[0] = 0.5
     assert (device.get("moving"), device.get("present_position")) == (0, 2048)
+
+
+def test_a_models_entries_reach_the_docs_and_the_simulator(tmp_path: Path) -> None:
+    """Per-model ranges and units (DYNAMIXEL's XL330 counts current in 1 mA, the XM430 in 2.69 mA) end to end."""
+    from serialspec.emit.markdown.docs import emit_docs
+    from serialspec.emit.python.simulator import simulator_module
+
+    text = (ROOT / "specs" / "feetech_sms.yaml").read_text(encoding="utf-8")
+    text = text.replace(
+        "    sm8512bl:\n      number: 11272\n",
+        "    sm8512bl:\n      number: 11272\n      entries:\n"
+        "        protection_current: {range: [0, 300], unit: 10 mA, scale: 10, description: Its own current steps.}\n",
+    )
+    spec = tmp_path / "feetech_sms.yaml"
+    spec.write_text(text, encoding="utf-8")
+    protocol = load_protocol(str(spec), "feetech_sms.yaml")
+    docs = emit_docs(protocol)
+    assert "| protection_current |  | 0..300 | 10 mA | Its own current steps. |" in docs
+    assert "'protection_current': (0, 300)," in simulator_module(protocol)
+    bad = text.replace("range: [0, 300]", "range: [0, 70000]")
+    spec.write_text(bad, encoding="utf-8")
+    with pytest.raises(SpecErrors, match=r"range \[0, 70000\] does not fit u16"):
+        load_protocol(str(spec), "feetech_sms.yaml")

@@ -319,6 +319,8 @@ class BusServoCommands:
     def stop(self, servos: tuple[ServosItem, ...] | Sequence[int]) -> None:
         """Stop bus servos where they are.
 
+        That each listed servo stops where it is (and keeps its torque) is inferred from the SDK's name.
+
         Broadcast: Servo id 0xFE reaches every servo; only the ID read (0x12) uses it, with a single servo on the bus.
 
         Args:

@@ -18,7 +18,7 @@ import sys
 import threading
 import time
 from collections import deque
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import suppress
 from dataclasses import dataclass, field
 from enum import IntFlag
@@ -26,7 +26,7 @@ from typing import Any, TypeVar
 
 import serial
 
-from serialspec.runtime.errors import CorruptReply, DeviceError, PortError, Timeout
+from serialspec.runtime.errors import CorruptReply, DeviceError, EncodeError, PortError, Timeout
 from serialspec.runtime.message import Message
 from serialspec.runtime.stream import StreamParser
 
@@ -221,10 +221,14 @@ class Bus:
         *,
         timeout: float = 0.1,
         baudrate: int | None = None,
+        echo: bool = False,
         **serial_options: Any,
     ) -> None:
+        """`echo`: a one-wire half-duplex adapter that hears its own transmission; every frame written is read
+        back and checked before any reply is looked for (a mismatch or a missing echo is a PortError)."""
         self.binding = binding
         self.timeout = timeout
+        self.echo = echo
         self._closed = False  # by close(): no transaction reopens the port after that
         self._lock = threading.RLock()
         self._subscribers: list[Subscriber] = []
@@ -329,7 +333,7 @@ class Bus:
             started = time.monotonic()
             rule = self._rules.get((type(request), expect)) or self._rule(type(request), expect)
             try:
-                chunk = link.read(wait)
+                chunk = b"" if self._backlog else link.read(wait)  # an echo check may have read the reply
             except Exception as exc:
                 self._port_failed("read", exc)
                 raise
@@ -443,6 +447,37 @@ class Bus:
         except Exception as exc:
             self._port_failed("write", exc)
             raise
+        if self.echo:
+            self._check_echo(frame)
+
+    def _check_echo(self, frame: bytes) -> None:
+        """Read back the echo of a frame just written; frames in the bytes after it (the reply) go to the backlog,
+        which the read that follows takes first."""
+        deadline = time.monotonic() + self.timeout
+        echoed = b""
+        while len(echoed) < len(frame):
+            remaining = deadline - time.monotonic()
+            try:
+                chunk = self._link.read(remaining) if remaining > 0 else b""
+            except Exception as exc:
+                self._port_failed("read", exc)
+                raise
+            if not chunk:
+                self._reset()
+                raise PortError(
+                    f"{self.port_name}: no echo of the {len(frame)} bytes written within {self.timeout:g} s "
+                    f"(got {len(echoed)}: {echoed.hex(' ') or 'nothing'}); is echo=True right for this adapter?"
+                )
+            echoed += chunk
+        if echoed[: len(frame)] != frame:
+            self._reset()
+            raise PortError(
+                f"{self.port_name}: the echo differs from the bytes written: wrote {frame.hex(' ')}, "
+                f"read back {echoed[: len(frame)].hex(' ')}"
+            )
+        rest = echoed[len(frame) :]
+        if rest:
+            self._backlog.extend(self._parser.feed(rest))
 
     def _drain(self) -> None:
         """Hand bytes that arrived between transactions (late replies, reports) to subscribers, without waiting."""
@@ -609,6 +644,33 @@ class ClientBase:
         if (address, key) not in self._parameters:
             self._parameters[(address, key)] = self._read_key(address, key)
         return self._parameters[(address, key)] == value
+
+    def _carry(
+        self,
+        requests: Sequence[Message],
+        carried: Mapping[type[Message], tuple[int, type[Message] | None]],
+        content: slice,
+        build: Callable[[int, list[bytes]], Message],
+    ) -> list[Message]:
+        """Send requests of one command inside one carrier request (a sync command); the replies, if any are due.
+
+        `carried`: request class -> (its command code, the reply class each device answers with, or None);
+        `content`: where a request's content sits in its encoded frame; `build`: the carrier from code and contents.
+        """
+        kinds = {type(r) for r in requests}
+        if len(kinds) != 1:
+            raise EncodeError("a sync command carries requests of one command: give one or more, all of one type")
+        kind = kinds.pop()
+        if kind not in carried:
+            raise EncodeError(
+                f"{kind.__name__} cannot be carried (expected one of {', '.join(c.__name__ for c in carried)})"
+            )
+        code, reply = carried[kind]
+        request = build(code, [self.bus.binding.encode(r)[content] for r in requests])
+        if reply is None:
+            self.bus.send(request)
+            return []
+        return list(self.bus.request_each(request, reply, [{self.ADDRESS: getattr(r, self.ADDRESS)} for r in requests]))
 
     def _read_key(self, address: int, key: int) -> float:
         """Read one table entry by key (generated clients whose spec can read entries override this)."""

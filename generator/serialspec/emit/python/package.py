@@ -112,6 +112,8 @@ def emit_package(protocol: Protocol) -> dict[str, str]:
             baudrate=protocol.serial.baudrate,
             serial=protocol.serial,
             match_by=repr(protocol.matching),
+            models=[(m.number, m.name) for m in protocol.device.models] if protocol.device else [],
+            model_entry=protocol.device.model_entry if protocol.device else "",
         ),
         "client.py": client_module(protocol),
         "py.typed": "",
@@ -344,7 +346,7 @@ def summed_frame(
             terms.append(target if char == "B" else f"({target} & 0xff)")
         else:
             terms += [f"({target} & 0xff)", *(f"({target} >> {8 * i} & 0xff)" for i in range(1, width))]
-    with_check = code.struct(match["struct"].removeprefix("_S_"), fmt + "B")
+    with_check = code.struct(match["struct"].removeprefix("_S_") + "_and_check", fmt + "B")
     total = " + ".join([f"{constant:#x}", *terms])
     invert = "~" if checksum.invert else ""
     return [

@@ -89,23 +89,16 @@ _S_FRAME_READBATCHDATARESPONSE = struct.Struct('<2sBBBBBBBBBHHHHHHBBBBBBHhhh')
 _S_FRAME_ROTATEREQUEST = struct.Struct('<2sBBBhHH')
 _S_FRAME_SPINREQUEST = struct.Struct('<2sBBBBHH')
 _S_MONITORRESPONSE_SERVO_ID = struct.Struct('<BHHHHBih')
-_S_MONITORRESPONSE_SERVO_ID_AND_CHECK = struct.Struct('<BHHHHBihB')
 _S_READBATCHDATARESPONSE_SERVO_ID = struct.Struct('<BBBBBBBHHHHHHBBBBBBHhhh')
 _S_U8 = struct.Struct('<B')
 _S_U8_I16 = struct.Struct('<Bh')
 _S_U8_I16_U16_U16 = struct.Struct('<BhHH')
 _S_U8_I16_U16_U16_U16_U16 = struct.Struct('<BhHHHH')
-_S_U8_I16_U16_U16_U16_U16_AND_CHECK = struct.Struct('<BhHHHHB')
-_S_U8_I16_U16_U16_U8 = struct.Struct('<BhHHB')
 _S_U8_I16_U8 = struct.Struct('<BhB')
 _S_U8_I32_I16 = struct.Struct('<Bih')
-_S_U8_I32_I16_U8 = struct.Struct('<BihB')
 _S_U8_I32_U16_U16_U16_U16 = struct.Struct('<BiHHHH')
-_S_U8_I32_U16_U16_U16_U16_AND_CHECK = struct.Struct('<BiHHHHB')
 _S_U8_I32_U32_U16 = struct.Struct('<BiIH')
 _S_U8_I32_U32_U16_U16_U16 = struct.Struct('<BiIHHH')
-_S_U8_I32_U32_U16_U16_U16_AND_CHECK = struct.Struct('<BiIHHHB')
-_S_U8_I32_U32_U16_U8 = struct.Struct('<BiIHB')
 _S_U8_U16 = struct.Struct('<BH')
 _S_U8_U16_U8 = struct.Struct('<BHB')
 _S_U8_U8 = struct.Struct('<BB')
@@ -899,9 +892,10 @@ def _frame_write_batch_data_request(buf: bytes, start: int) -> WriteBatchDataReq
 
 def _frame_rotate_request(buf: bytes, start: int) -> RotateRequest | None:
     """A whole rotate request frame at buf[start:], size and header known: None if its checksum fails."""
-    v_servo_id, v_angle, v_interval, v_power, check = _S_U8_I16_U16_U16_U8.unpack_from(buf, start + 4)
-    if (0x6d + v_servo_id + (v_angle & 0xff) + (v_angle >> 8 & 0xff) + (v_interval & 0xff) + (v_interval >> 8 & 0xff) + (v_power & 0xff) + (v_power >> 8 & 0xff)) & 0xff != check:
+    expected = sum(buf[start + 0 : start + 11]) & 0xff
+    if expected != buf[start + 11]:
         return None
+    v_servo_id, v_angle, v_interval, v_power = _S_U8_I16_U16_U16.unpack_from(buf, start + 4)
     m = _new(RotateRequest)
     _set_RotateRequest_servo_id(m, v_servo_id)
     _set_RotateRequest_angle(m, v_angle)
@@ -933,9 +927,10 @@ def _frame_read_angle_request(buf: bytes, start: int) -> ReadAngleRequest | None
 
 def _frame_move_by_interval_request(buf: bytes, start: int) -> MoveByIntervalRequest | None:
     """A whole move_by_interval request frame at buf[start:], size and header known: None if its checksum fails."""
-    v_servo_id, v_angle, v_interval, v_t_acc, v_t_dec, v_power, check = _S_U8_I16_U16_U16_U16_U16_AND_CHECK.unpack_from(buf, start + 4)
-    if (0x74 + v_servo_id + (v_angle & 0xff) + (v_angle >> 8 & 0xff) + (v_interval & 0xff) + (v_interval >> 8 & 0xff) + (v_t_acc & 0xff) + (v_t_acc >> 8 & 0xff) + (v_t_dec & 0xff) + (v_t_dec >> 8 & 0xff) + (v_power & 0xff) + (v_power >> 8 & 0xff)) & 0xff != check:
+    expected = sum(buf[start + 0 : start + 15]) & 0xff
+    if expected != buf[start + 15]:
         return None
+    v_servo_id, v_angle, v_interval, v_t_acc, v_t_dec, v_power = _S_U8_I16_U16_U16_U16_U16.unpack_from(buf, start + 4)
     m = _new(MoveByIntervalRequest)
     _set_MoveByIntervalRequest_servo_id(m, v_servo_id)
     _set_MoveByIntervalRequest_angle(m, v_angle)
@@ -948,9 +943,10 @@ def _frame_move_by_interval_request(buf: bytes, start: int) -> MoveByIntervalReq
 
 def _frame_move_by_velocity_request(buf: bytes, start: int) -> MoveByVelocityRequest | None:
     """A whole move_by_velocity request frame at buf[start:], size and header known: None if its checksum fails."""
-    v_servo_id, v_angle, v_velocity, v_t_acc, v_t_dec, v_power, check = _S_U8_I16_U16_U16_U16_U16_AND_CHECK.unpack_from(buf, start + 4)
-    if (0x75 + v_servo_id + (v_angle & 0xff) + (v_angle >> 8 & 0xff) + (v_velocity & 0xff) + (v_velocity >> 8 & 0xff) + (v_t_acc & 0xff) + (v_t_acc >> 8 & 0xff) + (v_t_dec & 0xff) + (v_t_dec >> 8 & 0xff) + (v_power & 0xff) + (v_power >> 8 & 0xff)) & 0xff != check:
+    expected = sum(buf[start + 0 : start + 15]) & 0xff
+    if expected != buf[start + 15]:
         return None
+    v_servo_id, v_angle, v_velocity, v_t_acc, v_t_dec, v_power = _S_U8_I16_U16_U16_U16_U16.unpack_from(buf, start + 4)
     m = _new(MoveByVelocityRequest)
     _set_MoveByVelocityRequest_servo_id(m, v_servo_id)
     _set_MoveByVelocityRequest_angle(m, v_angle)
@@ -963,9 +959,10 @@ def _frame_move_by_velocity_request(buf: bytes, start: int) -> MoveByVelocityReq
 
 def _frame_move_mturn_request(buf: bytes, start: int) -> MoveMturnRequest | None:
     """A whole move_mturn request frame at buf[start:], size and header known: None if its checksum fails."""
-    v_servo_id, v_angle, v_interval, v_power, check = _S_U8_I32_U32_U16_U8.unpack_from(buf, start + 4)
-    if (0x76 + v_servo_id + (v_angle & 0xff) + (v_angle >> 8 & 0xff) + (v_angle >> 16 & 0xff) + (v_angle >> 24 & 0xff) + (v_interval & 0xff) + (v_interval >> 8 & 0xff) + (v_interval >> 16 & 0xff) + (v_interval >> 24 & 0xff) + (v_power & 0xff) + (v_power >> 8 & 0xff)) & 0xff != check:
+    expected = sum(buf[start + 0 : start + 15]) & 0xff
+    if expected != buf[start + 15]:
         return None
+    v_servo_id, v_angle, v_interval, v_power = _S_U8_I32_U32_U16.unpack_from(buf, start + 4)
     m = _new(MoveMturnRequest)
     _set_MoveMturnRequest_servo_id(m, v_servo_id)
     _set_MoveMturnRequest_angle(m, v_angle)
@@ -976,9 +973,10 @@ def _frame_move_mturn_request(buf: bytes, start: int) -> MoveMturnRequest | None
 
 def _frame_move_mturn_by_interval_request(buf: bytes, start: int) -> MoveMturnByIntervalRequest | None:
     """A whole move_mturn_by_interval request frame at buf[start:], size and header known: None if its checksum fails."""
-    v_servo_id, v_angle, v_interval, v_t_acc, v_t_dec, v_power, check = _S_U8_I32_U32_U16_U16_U16_AND_CHECK.unpack_from(buf, start + 4)
-    if (0x7b + v_servo_id + (v_angle & 0xff) + (v_angle >> 8 & 0xff) + (v_angle >> 16 & 0xff) + (v_angle >> 24 & 0xff) + (v_interval & 0xff) + (v_interval >> 8 & 0xff) + (v_interval >> 16 & 0xff) + (v_interval >> 24 & 0xff) + (v_t_acc & 0xff) + (v_t_acc >> 8 & 0xff) + (v_t_dec & 0xff) + (v_t_dec >> 8 & 0xff) + (v_power & 0xff) + (v_power >> 8 & 0xff)) & 0xff != check:
+    expected = sum(buf[start + 0 : start + 19]) & 0xff
+    if expected != buf[start + 19]:
         return None
+    v_servo_id, v_angle, v_interval, v_t_acc, v_t_dec, v_power = _S_U8_I32_U32_U16_U16_U16.unpack_from(buf, start + 4)
     m = _new(MoveMturnByIntervalRequest)
     _set_MoveMturnByIntervalRequest_servo_id(m, v_servo_id)
     _set_MoveMturnByIntervalRequest_angle(m, v_angle)
@@ -991,9 +989,10 @@ def _frame_move_mturn_by_interval_request(buf: bytes, start: int) -> MoveMturnBy
 
 def _frame_move_mturn_by_velocity_request(buf: bytes, start: int) -> MoveMturnByVelocityRequest | None:
     """A whole move_mturn_by_velocity request frame at buf[start:], size and header known: None if its checksum fails."""
-    v_servo_id, v_angle, v_velocity, v_t_acc, v_t_dec, v_power, check = _S_U8_I32_U16_U16_U16_U16_AND_CHECK.unpack_from(buf, start + 4)
-    if (0x7a + v_servo_id + (v_angle & 0xff) + (v_angle >> 8 & 0xff) + (v_angle >> 16 & 0xff) + (v_angle >> 24 & 0xff) + (v_velocity & 0xff) + (v_velocity >> 8 & 0xff) + (v_t_acc & 0xff) + (v_t_acc >> 8 & 0xff) + (v_t_dec & 0xff) + (v_t_dec >> 8 & 0xff) + (v_power & 0xff) + (v_power >> 8 & 0xff)) & 0xff != check:
+    expected = sum(buf[start + 0 : start + 17]) & 0xff
+    if expected != buf[start + 17]:
         return None
+    v_servo_id, v_angle, v_velocity, v_t_acc, v_t_dec, v_power = _S_U8_I32_U16_U16_U16_U16.unpack_from(buf, start + 4)
     m = _new(MoveMturnByVelocityRequest)
     _set_MoveMturnByVelocityRequest_servo_id(m, v_servo_id)
     _set_MoveMturnByVelocityRequest_angle(m, v_angle)
@@ -1246,9 +1245,10 @@ def _frame_move_mturn_by_velocity_response(buf: bytes, start: int) -> MoveMturnB
 
 def _frame_read_mturn_angle_response(buf: bytes, start: int) -> ReadMturnAngleResponse | None:
     """A whole read_mturn_angle response frame at buf[start:], size and header known: None if its checksum fails."""
-    v_servo_id, v_angle, v_turns, check = _S_U8_I32_I16_U8.unpack_from(buf, start + 4)
-    if (0x38 + v_servo_id + (v_angle & 0xff) + (v_angle >> 8 & 0xff) + (v_angle >> 16 & 0xff) + (v_angle >> 24 & 0xff) + (v_turns & 0xff) + (v_turns >> 8 & 0xff)) & 0xff != check:
+    expected = sum(buf[start + 0 : start + 11]) & 0xff
+    if expected != buf[start + 11]:
         return None
+    v_servo_id, v_angle, v_turns = _S_U8_I32_I16.unpack_from(buf, start + 4)
     m = _new(ReadMturnAngleResponse)
     _set_ReadMturnAngleResponse_servo_id(m, v_servo_id)
     _set_ReadMturnAngleResponse_angle(m, v_angle)
@@ -1258,9 +1258,10 @@ def _frame_read_mturn_angle_response(buf: bytes, start: int) -> ReadMturnAngleRe
 
 def _frame_monitor_response(buf: bytes, start: int) -> MonitorResponse | None:
     """A whole monitor response frame at buf[start:], size and header known: None if its checksum fails."""
-    v_servo_id, v_voltage, v_current, v_power, v_temperature, v_status, v_angle, v_turns, check = _S_MONITORRESPONSE_SERVO_ID_AND_CHECK.unpack_from(buf, start + 4)
-    if (0x47 + v_servo_id + (v_voltage & 0xff) + (v_voltage >> 8 & 0xff) + (v_current & 0xff) + (v_current >> 8 & 0xff) + (v_power & 0xff) + (v_power >> 8 & 0xff) + (v_temperature & 0xff) + (v_temperature >> 8 & 0xff) + v_status + (v_angle & 0xff) + (v_angle >> 8 & 0xff) + (v_angle >> 16 & 0xff) + (v_angle >> 24 & 0xff) + (v_turns & 0xff) + (v_turns >> 8 & 0xff)) & 0xff != check:
+    expected = sum(buf[start + 0 : start + 20]) & 0xff
+    if expected != buf[start + 20]:
         return None
+    v_servo_id, v_voltage, v_current, v_power, v_temperature, v_status, v_angle, v_turns = _S_MONITORRESPONSE_SERVO_ID.unpack_from(buf, start + 4)
     v_status_flags = _MEMBERS_ServoStatus.get(v_status)
     if v_status_flags is None:
         v_status_flags = ServoStatus(v_status)

@@ -298,6 +298,7 @@ def fixed_frames(
 
 _UNPACK = re.compile(r"^(?P<targets>.+) = (?P<struct>_S_\w+)\.unpack_from\(buf, o\)$")
 _BYTES_OF = {"B": 1, "b": 1, "H": 2, "h": 2, "I": 4, "i": 4, "Q": 8, "q": 8}
+_MOST_TERMS = 4  # byte terms of a checksum computed from the values; beyond it the frame's bytes are summed
 
 
 def summed_frame(
@@ -346,6 +347,8 @@ def summed_frame(
             terms.append(target if char == "B" else f"({target} & 0xff)")
         else:
             terms += [f"({target} & 0xff)", *(f"({target} >> {8 * i} & 0xff)" for i in range(1, width))]
+    if len(terms) > _MOST_TERMS:
+        return None  # summing a slice of the frame in C is cheaper than this many terms in Python
     with_check = code.struct(match["struct"].removeprefix("_S_") + "_and_check", fmt + "B")
     total = " + ".join([f"{constant:#x}", *terms])
     invert = "~" if checksum.invert else ""

@@ -13,7 +13,7 @@ byte is written (RangeError names the field and the range).
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from typing import Any
 
 import serial
@@ -117,7 +117,7 @@ class DynamixelP2Client(ClientBase):
         None when no reply is due (broadcast gets no reply).
         """
         request = ReadRequest(id=id, address=address, length=length)
-        reply = self._maybe(request, StatusResponse, (68, 1))
+        reply = self._maybe(request, StatusResponse, (68, 1, '>='))
         if reply is None:
             return None
         return reply.data
@@ -139,7 +139,7 @@ class DynamixelP2Client(ClientBase):
         """
         request = WriteRequest(id=id, address=address, data=data)
         try:
-            reply = self._maybe(request, StatusResponse, (68, 2))
+            reply = self._maybe(request, StatusResponse, (68, 2, '>='))
         except Timeout:
             return False
         if reply is None:
@@ -163,7 +163,7 @@ class DynamixelP2Client(ClientBase):
         """
         request = RegWriteRequest(id=id, address=address, data=data)
         try:
-            reply = self._maybe(request, StatusResponse, (68, 2))
+            reply = self._maybe(request, StatusResponse, (68, 2, '>='))
         except Timeout:
             return False
         if reply is None:
@@ -185,7 +185,7 @@ class DynamixelP2Client(ClientBase):
         """
         request = ActionRequest(id=id)
         try:
-            reply = self._maybe(request, StatusResponse, (68, 2))
+            reply = self._maybe(request, StatusResponse, (68, 2, '>='))
         except Timeout:
             return False
         if reply is None:
@@ -208,7 +208,7 @@ class DynamixelP2Client(ClientBase):
         """
         request = FactoryResetRequest(id=id, option=option)
         try:
-            reply = self._maybe(request, StatusResponse, (68, 2))
+            reply = self._maybe(request, StatusResponse, (68, 2, '>='))
         except Timeout:
             return False
         if reply is None:
@@ -226,7 +226,7 @@ class DynamixelP2Client(ClientBase):
         """
         request = RebootRequest(id=id)
         try:
-            reply = self._maybe(request, StatusResponse, (68, 2))
+            reply = self._maybe(request, StatusResponse, (68, 2, '>='))
         except Timeout:
             return False
         if reply is None:
@@ -247,14 +247,14 @@ class DynamixelP2Client(ClientBase):
         """
         request = ClearRequest(id=id, option=option)
         try:
-            reply = self._maybe(request, StatusResponse, (68, 2))
+            reply = self._maybe(request, StatusResponse, (68, 2, '>='))
         except Timeout:
             return False
         if reply is None:
             return None
         return True
 
-    def sync_read(self, id: int, address: int, length: int, ids: tuple[IdsItem, ...]) -> bytes:
+    def sync_read_raw(self, id: int, address: int, length: int, ids: tuple[IdsItem, ...]) -> dict[int, bytes]:
         """Read the same items of several servos.
 
         Sent to the broadcast id; each listed servo answers in turn, in the order of the ids, with a status packet holding `length` bytes from `address`.
@@ -265,11 +265,11 @@ class DynamixelP2Client(ClientBase):
             length: Number of bytes each servo returns. (1..1024)
             ids: The servos to read, in the order they answer.
 
-        Returns: data: The bytes read, item by item from the request's address (empty but for reads).
+        Returns: id -> data of every listed device, in the order they answer.
         """
         request = SyncReadRequest(id=id, address=address, length=length, ids=ids)
-        reply = self._ask(request, StatusResponse)
-        return reply.data
+        replies = self.bus.request_each(request, StatusResponse, [{'id': item.id} for item in ids])
+        return {reply.id: reply.data for reply in replies}
 
     def sync_write_raw(self, id: int, address: int, servos: tuple[ServosItem, ...] | Mapping[int, bytes]) -> None:
         """Write the same items of several servos at once.
@@ -366,6 +366,21 @@ class DynamixelP2Client(ClientBase):
         for name, value in values.items():
             self._remember(id, CONTROL_TABLE[name].address, value)
         return result
+
+    def sync_read(
+        self, ids: Iterable[int], *names: ControlTableName, id: int = 254
+    ) -> dict[int, dict[str, int]]:
+        """Read the same items of several servos, by register name: `sync_read([1, 2], "present_position")` -> {1: {...}, 2: {...}}.
+
+        One request; every listed device answers in turn. `sync_read_raw` takes raw addresses and returns bytes.
+        """
+        start, size = CONTROL_TABLE.span(names)
+        items = tuple(IdsItem(id=device) for device in ids)
+        replies = self.sync_read_raw(id, start, size, items)
+        return {
+            device: {name: value for name, value in CONTROL_TABLE.unpack(start, data).items() if name in names}
+            for device, data in replies.items()
+        }
 
     def sync_write(self, values: Mapping[int, Mapping[str, int]], id: int = 254) -> None:
         """Write the same items of several servos at once, by register name: `sync_write({1: {"goal_position": 100}, 2: {"goal_position": 300}})`.

@@ -217,7 +217,7 @@ class FashionstarUartClient(ClientBase):
         None when no reply is due (Sent only when response_switch (data_id 33) is 1, once the spin has finished.).
         """
         request = SpinRequest(servo_id=servo_id, method=method, speed=speed, value=value)
-        reply = self._maybe(request, SpinResponse, (33, 1))
+        reply = self._maybe(request, SpinResponse, (33, 1, '=='))
         if reply is None:
             return None
         return reply.result
@@ -235,7 +235,7 @@ class FashionstarUartClient(ClientBase):
         None when no reply is due (Sent only when response_switch (data_id 33) is 1, once the target angle is reached.).
         """
         request = RotateRequest(servo_id=servo_id, angle=angle, interval=interval, power=power)
-        reply = self._maybe(request, RotateResponse, (33, 1), 'interval')
+        reply = self._maybe(request, RotateResponse, (33, 1, '=='), 'interval')
         if reply is None:
             return None
         return reply.result
@@ -253,7 +253,7 @@ class FashionstarUartClient(ClientBase):
         None when no reply is due (Sent only when response_switch (data_id 33) is 1.).
         """
         request = DampingRequest(servo_id=servo_id, power=power)
-        reply = self._maybe(request, DampingResponse, (33, 1))
+        reply = self._maybe(request, DampingResponse, (33, 1, '=='))
         if reply is None:
             return None
         return reply.result

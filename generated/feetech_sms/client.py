@@ -131,7 +131,7 @@ class FeetechSmsClient(ClientBase):
         """
         request = WriteRequest(id=id, address=address, data=data)
         try:
-            reply = self._maybe(request, ReplyResponse, (8, 1))
+            reply = self._maybe(request, ReplyResponse, (8, 1, '=='))
         except Timeout:
             return False
         if reply is None:
@@ -155,7 +155,7 @@ class FeetechSmsClient(ClientBase):
         """
         request = RegWriteRequest(id=id, address=address, data=data)
         try:
-            reply = self._maybe(request, ReplyResponse, (8, 1))
+            reply = self._maybe(request, ReplyResponse, (8, 1, '=='))
         except Timeout:
             return False
         if reply is None:
@@ -177,7 +177,7 @@ class FeetechSmsClient(ClientBase):
         """
         request = ActionRequest(id=id)
         try:
-            reply = self._maybe(request, ReplyResponse, (8, 1))
+            reply = self._maybe(request, ReplyResponse, (8, 1, '=='))
         except Timeout:
             return False
         if reply is None:
@@ -197,7 +197,7 @@ class FeetechSmsClient(ClientBase):
         """
         request = ResetRequest(id=id)
         try:
-            reply = self._maybe(request, ReplyResponse, (8, 1))
+            reply = self._maybe(request, ReplyResponse, (8, 1, '=='))
         except Timeout:
             return False
         if reply is None:

@@ -567,7 +567,15 @@ DEVICE_COMMAND = Obj(
         "description": TEXT,
         "reads": ListOf(Str(), "Response fields filled from memory: table_value by its key, table_block entries."),
         "writes": ListOf(Str(), "Request fields stored in memory: table_value by its key, table_block entries."),
-        "resets": Bool("Memory goes back to its defaults."),
+        "resets": Bool("Memory goes back to its defaults (all but the device's id, unless `keeps` says otherwise)."),
+        "keeps": Obj(
+            {
+                "field": Str("The request field that chooses (DYNAMIXEL FACTORY RESET `option`)."),
+                "entries": MapOf(ListOf(Str()), "Field value -> the memory entries a reset keeps.", int_keys=True),
+            },
+            required=("field", "entries"),
+            description="resets: the entries kept, chosen by a request field (0xFF: none, 0x01: id, ...).",
+        ),
         "reports": MapOf(Str(), "Response field -> the state variable or memory entry it reports."),
         "moves": Obj(
             {
@@ -575,6 +583,13 @@ DEVICE_COMMAND = Obj(
                 "target": Str("The request field (or memory entry, once written) with the target."),
                 "duration": Str("The request field (or memory entry) with the time to reach the target, in ms."),
                 "speed": Str("The request field (or memory entry) with the speed, in state units per second."),
+                "speed_scale": Num(
+                    "State units per second for one unit of `speed` (DYNAMIXEL: 0.229 rev/min x 4096 / 60 = 15.63)."
+                ),
+                "enabled_by": Str(
+                    "A memory entry (or state variable): the move happens only while it is non-zero (torque_enable); "
+                    "otherwise the target is only stored."
+                ),
             },
             required=("state", "target"),
         ),
@@ -604,8 +619,21 @@ DEVICE = Obj(
         "broadcast": Int("The address every device obeys (default: the address element's broadcast)."),
         "state": MapOf(Num(), "State variables beyond memory -> initial value (e.g. the present angle)."),
         "reply": MapOf(Num(), "Response field -> value when no behaviour sets it (e.g. result: 1)."),
-        "refused": MapOf(Num(), "Response field -> value when a write is refused (read-only or unknown entry)."),
-        "status": MapOf(Str(), "Response field -> the memory entry every response reports in it (a status byte)."),
+        "refused": MapOf(
+            Num(),
+            "Response field (or field.bit_field) -> value when a write is refused (read-only or unknown entry; "
+            "DYNAMIXEL error.number: 7, access error).",
+        ),
+        "out_of_range": MapOf(
+            Num(),
+            "Response field (or field.bit_field) -> value when a write is refused for a value outside the entry's "
+            "range (DYNAMIXEL error.number: 4, data range error); default: `refused`.",
+        ),
+        "status": MapOf(
+            Str(),
+            "Response field -> the memory entry every response reports in it (a status byte); field.bit_field -> "
+            "an entry whose being non-zero sets that bit field (DYNAMIXEL error.alert: hardware_error_status).",
+        ),
         "echo_address": Bool(
             "Replies carry the id the request named (RRC: 0xFE for a broadcast read), not the answering device's own."
         ),

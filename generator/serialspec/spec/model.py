@@ -209,19 +209,10 @@ class OptionalWhen:
     equals: int  # the value compared with
     op: Literal["==", "!=", ">=", "<="] = "=="
 
-    def holds(self, value: float) -> bool:
-        return {
-            "==": value == self.equals,
-            "!=": value != self.equals,
-            ">=": value >= self.equals,
-            "<=": value <= self.equals,
-        }[self.op]
-
     @property
-    def text(self) -> str:
-        """The condition as people read it: `status_return_level ≥ 1`."""
-        symbol = {"==": "=", "!=": "≠", ">=": "≥", "<=": "≤"}[self.op]
-        return f"{self.entry} {symbol} {self.equals}"
+    def symbol(self) -> str:
+        """The comparison as people write it: =, ≠, ≥ or ≤."""
+        return {"==": "=", "!=": "≠", ">=": "≥", "<=": "≤"}[self.op]
 
 
 @dataclass(frozen=True)
@@ -487,6 +478,8 @@ class Motion:
     target: str
     duration: str
     speed: str
+    speed_scale: float = 1.0  # state units per second for one unit of `speed`
+    enabled_by: str = ""  # a memory entry (or state variable): the move happens only while it is non-zero
 
 
 @dataclass(frozen=True)
@@ -507,6 +500,7 @@ class Behaviour:
     stores: dict[str, str] = field(default_factory=dict)  # request field -> state variable
     sets: dict[str, float] = field(default_factory=dict)  # state variable -> value
     absent: dict[str, float] = field(default_factory=dict)  # response values when no device has the id
+    keeps: tuple[str, dict[int, tuple[str, ...]]] | None = None  # resets: request field, its value -> entries kept
 
 
 @dataclass(frozen=True)
@@ -538,6 +532,7 @@ class Device:
     status: dict[str, str] = field(default_factory=dict)  # response field -> memory entry every reply reports
     kinds: tuple[DeviceKind, ...] = ()
     echo_address: bool = False  # replies carry the id the request named, not the answering device's own
+    out_of_range: dict[str, float] = field(default_factory=dict)  # response values when a value is out of range
 
     def behaviour(self, key: str) -> Behaviour | None:
         return next((b for b in self.behaviours if b.command == key), None)

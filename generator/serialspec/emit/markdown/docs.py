@@ -169,7 +169,7 @@ def reply_text(message: Message) -> str:
     if not message.answered_by:
         return ""
     switch = message.reply_when
-    when = f", sent only while `{switch.entry}` = {switch.equals}" if switch else ""
+    when = f", sent only while `{switch.entry}` {switch.symbol} {switch.equals}" if switch else ""
     return f"answered by the `{message.answered_by}` response{when}"
 
 

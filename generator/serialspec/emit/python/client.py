@@ -373,7 +373,7 @@ def client_module(protocol: Protocol) -> str:
             "build": ", ".join(f"{f.name}={f.name}" for f in fields),
             "kind": kind,
             "silent": silent,
-            "optional": f"({optional.key}, {optional.equals})" if optional else "None",
+            "optional": f"({optional.key}, {optional.equals}, {optional.op!r})" if optional else "None",
             "after": repr(response.after) if response and response.after else "",
             "result": result_expr,
             "remember": (

@@ -152,3 +152,22 @@ def test_reboot_and_factory_reset(port: str) -> None:
             assert packet.read1ByteTxRx(handler, 7, ADDRESS["baud_rate"]) == (1, SUCCESS, 0)
         finally:
             handler.closePort()
+
+
+def test_models_by_id_report_their_numbers_and_limits() -> None:
+    # `serialspec sim --model`: XM430-W350 by default, other models per id, each with its factory values
+    with serve("dynamixel_p2.yaml", 1, 2, 3, options=["--model", "2=xl430_w250", "--model", "3=xl330_m288"]) as path:
+        handler = dxl.PortHandler(path)
+        assert handler.openPort()
+        packet = dxl.PacketHandler(2.0)
+        try:
+            found, result = packet.broadcastPing(handler)
+            assert result == SUCCESS
+            assert {servo: model for servo, (model, _) in found.items()} == {1: 1020, 2: 1060, 3: 1200}
+            assert packet.read2ByteTxRx(handler, 3, ADDRESS["current_limit"]) == (1750, SUCCESS, 0)
+            assert packet.read1ByteTxRx(handler, 2, ADDRESS["temperature_limit"]) == (72, SUCCESS, 0)
+            # a model's own range: 1500 is within the XL330's current limit range, not the XM430's
+            assert packet.write2ByteTxRx(handler, 3, ADDRESS["current_limit"], 1500) == (SUCCESS, 0)
+            assert packet.write2ByteTxRx(handler, 1, ADDRESS["current_limit"], 1500) == (SUCCESS, 4)
+        finally:
+            handler.closePort()

@@ -79,9 +79,15 @@ class DynamixelP2Client(ClientBase):
         timeout: float = 0.1,
         baudrate: int | None = None,
         optional_replies: bool | None = None,
+        echo: bool = False,
         **serial_options: Any,
     ) -> None:
-        bus = port if isinstance(port, Bus) else Bus(port, BINDING, timeout=timeout, baudrate=baudrate, **serial_options)
+        """`echo=True` for a one-wire half-duplex adapter that echoes every byte sent (see Bus)."""
+        bus = (
+            port
+            if isinstance(port, Bus)
+            else Bus(port, BINDING, timeout=timeout, baudrate=baudrate, echo=echo, **serial_options)
+        )
         super().__init__(bus, optional_replies)
 
     def __enter__(self) -> DynamixelP2Client:
@@ -343,7 +349,7 @@ class DynamixelP2Client(ClientBase):
         data = self.read_raw(address, register.address, register.size)
         return CONTROL_TABLE.from_wire(register, data or b"")
 
-    def write(self, id: int, **values: int) -> bool | None:
+    def write(self, id: int, /, **values: int) -> bool | None:
         """Write to the control table, by register name: `write(id, goal_position=2048, goal_time=0)`.
 
         The named registers must follow each other in the table (one run of bytes); each value is checked
@@ -355,7 +361,7 @@ class DynamixelP2Client(ClientBase):
             self._remember(id, CONTROL_TABLE[name].address, value)
         return result
 
-    def reg_write(self, id: int, **values: int) -> bool | None:
+    def reg_write(self, id: int, /, **values: int) -> bool | None:
         """Buffered write, carried out on ACTION, by register name: `reg_write(id, goal_position=2048, goal_time=0)`.
 
         The named registers must follow each other in the table (one run of bytes); each value is checked

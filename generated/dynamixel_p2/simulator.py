@@ -7,7 +7,8 @@ READ). PING is always answered; READ while status_return_level ≥ 1; every othe
 2. Writing a read-only or unknown item gives the access error (7), a value outside an item's range the data
 range error (4); the alert bit reports a non-zero hardware_error_status. REG WRITE holds its data (and sets
 registered_instruction) until ACTION; writing the id moves the servo to its new id. With the torque on, a new
-goal_position moves present_position at profile_velocity (at once when it is 0).
+goal_position moves present_position at profile_velocity (at once when it is 0). The firmware version 52 is an
+example, not a documented value.
 
 `DynamixelP2Simulator(ids=[1, 2]).start()` serves the devices on a new pseudo-terminal and returns its path;
 `serialspec sim specs/dynamixel_p2.yaml --id 1 --id 2` does the same from the shell. Values are wire units.
@@ -15,9 +16,9 @@ goal_position moves present_position at profile_velocity (at once when it is 0).
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Mapping
 
-from serialspec.runtime.device import CommandSpec, DeviceSpec, EntrySpec, Simulator
+from serialspec.runtime.device import CommandSpec, DeviceSpec, EntrySpec, ModelSpec, Simulator
 
 from dynamixel_p2.codec import StreamParser, encode
 from dynamixel_p2.messages import (
@@ -189,15 +190,73 @@ DEVICE = DeviceSpec(
     ),
     registers=CONTROL_TABLE,
     status={'error.alert': 'hardware_error_status'},
+    models=(
+        ModelSpec(
+            'xm430_w350',
+            1020,
+            {
+                'model_number': 1020,
+            },
+        ),
+        ModelSpec(
+            'xl430_w250',
+            1060,
+            {
+                'temperature_limit': 72,
+                'max_voltage_limit': 140,
+                'min_voltage_limit': 60,
+                'velocity_limit': 265,
+                'current_limit': 0,
+                'model_number': 1060,
+            },
+            {
+                'max_voltage_limit': (60, 140),
+                'min_voltage_limit': (60, 140),
+                'current_limit': (0, 0),
+                'goal_current': (0, 0),
+                'present_current': (-32768, 32767),
+            },
+        ),
+        ModelSpec(
+            'xl330_m288',
+            1200,
+            {
+                'temperature_limit': 70,
+                'max_voltage_limit': 70,
+                'min_voltage_limit': 35,
+                'current_limit': 1750,
+                'velocity_limit': 445,
+                'present_input_voltage': 50,
+                'model_number': 1200,
+            },
+            {
+                'max_voltage_limit': (31, 70),
+                'min_voltage_limit': (31, 70),
+                'current_limit': (0, 1750),
+                'goal_current': (-1750, 1750),
+                'present_current': (-32768, 32767),
+                'velocity_limit': (0, 2047),
+                'goal_velocity': (-2047, 2047),
+            },
+        ),
+    ),
 )
 
 
 class DynamixelP2Simulator(Simulator):
     """Virtual devices with the given ids on one bus; see serialspec.runtime.device for what they do."""
 
-    def __init__(self, ids: Iterable[int] = (0,), clock: Callable[[], float] | None = None) -> None:
+    def __init__(
+        self,
+        ids: Iterable[int] = (0,),
+        clock: Callable[[], float] | None = None,
+        model: str | Mapping[int, str] | None = None,
+    ) -> None:
+        """`model`: xm430_w350, xl430_w250, xl330_m288 (default xm430_w350) for every device, or id -> model."""
         kwargs = {"clock": clock} if clock is not None else {}
-        super().__init__(DEVICE, ids, encode=encode, parser=lambda: StreamParser(Direction.REQUEST), **kwargs)
+        super().__init__(
+            DEVICE, ids, encode=encode, parser=lambda: StreamParser(Direction.REQUEST), model=model, **kwargs
+        )
 
 
 #: The simulator class, under a name every generated package shares (serialspec sim uses it).

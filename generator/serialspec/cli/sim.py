@@ -24,7 +24,38 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="N",
         help="a device id on the bus (repeat for several; default 0)",
     )
+    parser.add_argument(
+        "--model",
+        dest="models",
+        action="append",
+        metavar="NAME|ID=NAME",
+        help="the device model (a name from the spec's `device.models`) of every device, or of one id (repeat)",
+    )
+    parser.add_argument(
+        "--echo",
+        action="store_true",
+        help="echo every byte received before answering, like a one-wire half-duplex adapter (clients: echo=True)",
+    )
     parser.add_argument("--quiet", action="store_true", help="do not log requests on stderr")
+
+
+def model_choice(given: list[str] | None) -> str | dict[int, str] | None:
+    """--model NAME (every device) or --model ID=NAME (one device), as the simulator's `model` argument."""
+    if not given:
+        return None
+    per_id: dict[int, str] = {}
+    every: str | None = None
+    for item in given:
+        key, sep, name = item.partition("=")
+        if not sep:
+            every = item
+        elif key.strip().isdigit():
+            per_id[int(key)] = name.strip()
+        else:
+            raise SerialspecError(f"--model {item}: expected NAME or ID=NAME (e.g. 3=sts3215)")
+    if every is not None and per_id:
+        raise SerialspecError("--model: give either one NAME for every device or ID=NAME for each, not both")
+    return per_id or every
 
 
 def run(args: argparse.Namespace) -> int:
@@ -33,7 +64,11 @@ def run(args: argparse.Namespace) -> int:
         module = importlib.import_module(f"{protocol.name}.simulator")
     except ImportError:
         raise SerialspecError(f"{args.spec} has no `device:` section, so no simulator is generated") from None
-    simulator = module.SIMULATOR(args.ids or [0])
+    try:
+        simulator = module.SIMULATOR(args.ids or [0], model=model_choice(args.models))
+    except ValueError as exc:
+        raise SerialspecError(f"--model: {exc}") from None
+    simulator.echo = args.echo
     controller, path = simulator.open_pty()
 
     def stop(signum: int, frame: FrameType | None) -> None:
@@ -42,7 +77,7 @@ def run(args: argparse.Namespace) -> int:
     signal.signal(signal.SIGINT, stop)
     signal.signal(signal.SIGTERM, stop)
     print(path, flush=True)
-    ids = ", ".join(str(i) for i in simulator.devices)
+    ids = ", ".join(f"{i} ({d.model.name})" if d.model else str(i) for i, d in simulator.devices.items())
     print(f"serialspec sim: {protocol.name} device(s) {ids} on {path}; Ctrl-C to stop", file=sys.stderr, flush=True)
     simulator.serve(controller)
     return 0

@@ -21,7 +21,15 @@ pseudo-terminal) and is the same for every protocol:
 - `emit()` sends a message on the device's own initiative (reports, key events) for tests.
 """
 
-from serialspec.runtime.device.engine import CommandSpec, DeviceSpec, Engine, EntrySpec, KindSpec, VirtualDevice
+from serialspec.runtime.device.engine import (
+    CommandSpec,
+    DeviceSpec,
+    Engine,
+    EntrySpec,
+    KindSpec,
+    ModelSpec,
+    VirtualDevice,
+)
 from serialspec.runtime.device.faults import FAULTS, Fault
 from serialspec.runtime.device.server import Simulator
 
@@ -33,6 +41,7 @@ __all__ = [
     "EntrySpec",
     "Fault",
     "KindSpec",
+    "ModelSpec",
     "Simulator",
     "VirtualDevice",
 ]

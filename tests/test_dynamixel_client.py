@@ -88,3 +88,12 @@ def test_id_change_moves_the_servo(client: DynamixelP2Client) -> None:
     assert client.ping(12).model_number == 1020
     with pytest.raises(Timeout):
         client.ping(2)
+
+
+def test_bulk_read_and_write_by_name(client: DynamixelP2Client) -> None:
+    client.bulk_write({1: {"position_p_gain": 850}, 2: {"led": 1}})
+    assert client.bulk_read({1: "position_p_gain", 2: ("led",), 3: ("model_number", "model_information")}) == {
+        1: {"position_p_gain": 850},
+        2: {"led": 1},
+        3: {"model_number": 1020, "model_information": 0},
+    }

@@ -13,7 +13,7 @@ byte is written (RangeError names the field and the range).
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from typing import Any
 
 import serial
@@ -297,7 +297,7 @@ class DynamixelP2Client(ClientBase):
         request = SyncWriteRequest(id=id, address=address, servos=servos)
         self.bus.send(request)
 
-    def bulk_read(self, id: int, reads: tuple[ReadsItem, ...]) -> bool:
+    def bulk_read_raw(self, id: int, reads: tuple[ReadsItem, ...]) -> dict[int, bytes]:
         """Read different items of several servos.
 
         Sent to the broadcast id; each listed servo (once at most) answers in turn, in the order listed, with its own address and length.
@@ -306,16 +306,13 @@ class DynamixelP2Client(ClientBase):
             id: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. (0..252)
             reads: One item per servo.
 
-        Returns: True if the device answered, False if it stayed silent (timeout).
+        Returns: id -> data of every listed device, in the order they answer.
         """
         request = BulkReadRequest(id=id, reads=reads)
-        try:
-            self._ask(request, StatusResponse)
-        except Timeout:
-            return False
-        return True
+        replies = self.bus.request_each(request, StatusResponse, [{'id': item.id} for item in reads])
+        return {reply.id: reply.data for reply in replies}
 
-    def bulk_write(self, id: int, writes: tuple[WritesItem, ...]) -> None:
+    def bulk_write_raw(self, id: int, writes: tuple[WritesItem, ...]) -> None:
         """Write different items of several servos at once.
 
         Sent to the broadcast id; each listed servo (once at most) takes its own address and data.
@@ -402,3 +399,38 @@ class DynamixelP2Client(ClientBase):
         start, data = next(iter(runs.values()))
         items = tuple(ServosItem(id=device, data=data) for device, (_, data) in runs.items())
         return self.sync_write_raw(id, start, items)
+
+    def bulk_read(
+        self, reads: Mapping[int, ControlTableName | Sequence[ControlTableName]], id: int = 254
+    ) -> dict[int, dict[str, int]]:
+        """Read different items of several servos, by register name, each device its own: `bulk_read({1: "present_position", 2: ("led",)})`.
+
+        One request; every listed device answers in turn. `bulk_read_raw` takes raw addresses and returns bytes.
+        """
+        wanted = {device: (names,) if isinstance(names, str) else tuple(names) for device, names in reads.items()}
+        spans = {device: CONTROL_TABLE.span(names) for device, names in wanted.items()}
+        items = tuple(
+            ReadsItem(id=device, address=start, length=size) for device, (start, size) in spans.items()
+        )
+        replies = self.bulk_read_raw(id, items)
+        return {
+            device: {
+                name: value
+                for name, value in CONTROL_TABLE.unpack(spans[device][0], data).items()
+                if name in wanted[device]
+            }
+            for device, data in replies.items()
+        }
+
+    def bulk_write(self, values: Mapping[int, Mapping[str, int]], id: int = 254) -> None:
+        """Write different items of several servos at once, by register name, each device its own run: `bulk_write({1: {"goal_position": 100}, 2: {"led": 1}})`.
+
+        Values are checked before sending. `bulk_write_raw` takes raw bytes.
+        """
+        items = []
+        for device, registers in values.items():
+            start, data = CONTROL_TABLE.pack(registers)
+            items.append(WritesItem(id=device, address=start, data=data))
+        if not items:
+            raise EncodeError("bulk_write: name at least one device")
+        return self.bulk_write_raw(id, tuple(items))

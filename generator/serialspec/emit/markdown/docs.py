@@ -161,18 +161,51 @@ def message_context(protocol: Protocol, message: Message | None) -> dict[str, An
         "optional": text(message.optional),
         "unsolicited": message.unsolicited,
         "answers": message.answers,
-        "reply": reply_text(message),
+        "reply": reply_text(message, protocol),
         "description": text(message.description),
     }
 
 
-def reply_text(message: Message) -> str:
-    """For a request answered by another command's response: which, and the parameter that switches it."""
+def reply_text(message: Message, protocol: Protocol | None = None) -> str:
+    """For a request answered by another command's response: which, and the parameter that switches it; for a
+    response that shares its code with other replies: how a reply is told to have this layout."""
+    if message.direction == Direction.RESPONSE and protocol is not None:
+        return shared_reply_text(protocol, message)
     if not message.answered_by:
         return ""
     switch = message.reply_when
     when = f", sent only while `{switch.entry}` {switch.symbol} {switch.equals}" if switch else ""
     return f"answered by the `{message.answered_by}` response{when}"
+
+
+def shared_reply_text(protocol: Protocol, message: Message) -> str:
+    """A reply layout that shares its code (or its having none) with others: chosen by the request it answers."""
+    layout = protocol.framing.layouts[Direction.RESPONSE]
+    code = protocol.command(message.command).code if layout.has_command else None
+    sharing = [
+        m
+        for m in protocol.messages()
+        if m.direction == Direction.RESPONSE
+        and not m.unsolicited
+        and (protocol.command(m.command).code if layout.has_command else None) == code
+        and not protocol.command(m.command).subcommands
+    ]
+    if len(sharing) < 2:
+        return ""
+    askers = sorted(
+        {
+            r.command
+            for r in protocol.messages()
+            if r.direction == Direction.REQUEST and (r.answered_by or r.key) == message.key
+        }
+    )
+    answers = ", ".join(f"`{a}`" for a in askers) or "no request"
+    default = (
+        "; a reply decoded without its request is read with this layout"
+        if message.default_reply
+        else "; chosen by the request it answers (the replies share their code)"
+    )
+    return f"the layout of the replies to {answers}{default}"
 
 
 def command_context(protocol: Protocol, command: Command) -> dict[str, Any]:

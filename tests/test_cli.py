@@ -95,3 +95,13 @@ def test_check_fails_when_a_generated_file_is_stale(tmp_path: Path) -> None:
     result = serialspec("check", "--root", str(tmp_path))
     assert result.returncode == 1
     assert "generated/docs/fashionstar_uart.md: stale" in result.stderr
+
+
+def test_decode_picks_the_reply_layout_by_the_request() -> None:
+    spec = "specs/dynamixel_p2.yaml"
+    status = "FF FF FD 00 01 07 00 55 00 06 04 26 65 5D"  # PING's reply, or a 3-byte READ's: the request decides
+    alone = json.loads(serialspec("decode", spec, status, "--direction", "response", "--json").stdout)
+    assert alone["command"] == "status" and alone["fields"]["data"] == "06 04 26"
+    ping = "FF FF FD 00 01 03 00 01 19 4E"
+    answered = serialspec("decode", spec, status, "--direction", "response", "--request", ping, "--json")
+    assert json.loads(answered.stdout)["fields"]["model_number"] == 1030

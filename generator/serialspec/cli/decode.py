@@ -8,11 +8,11 @@ import sys
 from typing import Any
 
 from serialspec.cli.protocols import open_spec
-from serialspec.cli.views import engineering, register_view
+from serialspec.cli.views import engineering, message_spec, register_view
 from serialspec.runtime.errors import DecodeError, SerialspecError
 from serialspec.runtime.hexbytes import parse_hex
 from serialspec.runtime.message import Message
-from serialspec.spec.model import Protocol
+from serialspec.spec.model import Protocol, replies_by_request, reply_to
 
 HELP = "decode frames given as hex ('12 4c 08', '0x12 0x4c', '124c08', '12:4c:08'); one frame per argument"
 
@@ -33,13 +33,16 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     protocol, package = open_spec(args.spec)
     request = None
+    expect = None  # the reply layout the request gets, where replies share a code
     if args.request:
         request = package.decode(_hex(args.request), "request")
+        reply = reply_to(message_spec(protocol, request), replies_by_request(protocol.messages()))
+        expect = next((c for c in package.MESSAGE_TYPES if reply and c.__name__ == reply.class_name), None)
     failed = 0
     for text in args.hex:
         try:
             frame = _hex(text)
-            message = package.decode(frame, args.direction)
+            message = package.decode(frame, args.direction, expect)
         except (DecodeError, SerialspecError) as exc:
             print(f"serialspec decode: {text.strip()}: {exc}", file=sys.stderr)
             failed += 1

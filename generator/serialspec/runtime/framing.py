@@ -13,6 +13,8 @@ lies inside it or outside it.
 
 from __future__ import annotations
 
+import functools
+import re
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from typing import Literal
@@ -69,25 +71,19 @@ class Transparency:
 
 
 def _rewrite(data: bytes, pairs: tuple[tuple[bytes, bytes], ...]) -> bytes:
-    """Each `old` sequence of `data` replaced by its `new`, scanning left to right (the leftmost match first)."""
-    out = bytearray()
-    i, n = 0, len(data)
-    firsts = {old[0] for old, _ in pairs}
-    while i < n:
-        byte = data[i]
-        if byte in firsts:
-            for old, new in pairs:
-                if data.startswith(old, i):
-                    out += new
-                    i += len(old)
-                    break
-            else:
-                out.append(byte)
-                i += 1
-        else:
-            out.append(byte)
-            i += 1
-    return bytes(out)
+    """Each `old` sequence of `data` replaced by its `new`, scanning left to right (the leftmost match first, the
+    pairs tried in order at each position): one bytes.replace for one pair, else one regular expression."""
+    if len(pairs) == 1:
+        old, new = pairs[0]
+        return data.replace(old, new)
+    return _rewriter(pairs)(data)
+
+
+@functools.cache
+def _rewriter(pairs: tuple[tuple[bytes, bytes], ...]) -> Callable[[bytes], bytes]:
+    table = dict(pairs)
+    pattern = re.compile(b"|".join(re.escape(old) for old, _ in pairs))
+    return lambda data: pattern.sub(lambda match: table[match.group()], data)
 
 
 @dataclass(frozen=True)

@@ -480,9 +480,14 @@ FRAME_ELEMENT = Obj(
                 "check": Int("The catalogue check value: the CRC of b'123456789'."),
             },
             required=("width", "poly", "init", "refin", "refout", "xorout", "check"),
+            description=(
+                "crc: the CRC by its catalogue parameters (reveng's CRC catalogue); the generator checks `check` "
+                "against the CRC of '123456789'."
+            ),
         ),
     },
     required=("role",),
+    description="One element of the frame, in wire order.",
 )
 
 FRAME_ELEMENTS = MapOf(FRAME_ELEMENT, "The frame's elements in wire order: name -> element.")

@@ -494,3 +494,29 @@ class FrameStreamParser(StreamParser):
 
     def pending(self) -> bytes:
         return self._pending
+
+
+@dataclass(frozen=True)
+class EngineFormat:
+    """One direction's frames as code that splits a stream of both directions reads them (serialspec monitor)."""
+
+    codec: FrameCodec
+    decode: Decode
+
+    @property
+    def header(self) -> bytes:
+        return self.codec.layouts[0].header
+
+    def size(self, buffer: bytes, position: int) -> int | None:
+        """The size of a plausible frame at `position`; None if none starts there; past the buffer: wait."""
+        waiting = False
+        for layout in self.codec.layouts:
+            size = self.codec.probe(layout, buffer, position, len(buffer))
+            if size is None:
+                waiting = True
+            elif size >= 0:
+                return size
+        return len(buffer) - position + 1 if waiting else None
+
+    def decode_at(self, buffer: bytes, start: int, stop: int) -> Message:
+        return self.decode(buffer[start:stop], None)

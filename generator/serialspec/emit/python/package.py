@@ -185,7 +185,9 @@ def general_codec_context(protocol: Protocol) -> dict[str, Any]:
     headers = [h for d in directions for h in d["headers"]]
     return {
         "classic": False,
-        "framing_imports": framing_imports([line for d in directions for line in d["frames"]]),
+        "framing_imports": sorted(
+            {"EngineFormat", *framing_imports([line for d in directions for line in d["frames"]])}, key=str.lower
+        ),
         "checksum_imports": imports,
         "checksum_definitions": definitions,
         "directions": directions,

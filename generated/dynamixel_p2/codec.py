@@ -612,6 +612,11 @@ def encode(message: Message) -> bytes:
 REQUEST_FORMAT = EngineFormat(_REQUEST_FRAMES, _decode_request)
 RESPONSE_FORMAT = EngineFormat(_RESPONSE_FRAMES, _decode_response)
 
+# The reply layout a request gets where it is not the default one of replies that share a code.
+REPLY_LAYOUTS: dict[type[Message], type[Message]] = {
+    PingRequest: PingResponse,
+}
+
 
 class StreamParser(_FrameStreamParser):
     """Splits a byte stream into messages; see serialspec.runtime.framing for how it resynchronises."""

@@ -193,6 +193,7 @@ DEVICE = DeviceSpec(
     ),
     registers=CONTROL_TABLE,
     status={'error.alert': 'hardware_error_status'},
+    moving={'moving': ('present_position', None)},
     models=(
         ModelSpec(
             'xm430_w350',

@@ -518,5 +518,5 @@ class EngineFormat:
                 return size
         return len(buffer) - position + 1 if waiting else None
 
-    def decode_at(self, buffer: bytes, start: int, stop: int) -> Message:
-        return self.decode(buffer[start:stop], None)
+    def decode_at(self, buffer: bytes, start: int, stop: int, expect: type[Message] | None = None) -> Message:
+        return self.decode(buffer[start:stop], expect)

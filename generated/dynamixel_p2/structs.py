@@ -56,7 +56,8 @@ _REQUEST_FRAMES = FrameCodec(
             ((b'\xff\xff\xfd', b'\xff\xff\xfd\xfd'),),
         )),
     ),
-    {},
+    {
+    },
 )
 
 _RESPONSE_FRAMES = FrameCodec(
@@ -75,7 +76,8 @@ _RESPONSE_FRAMES = FrameCodec(
             ((b'\xff\xff\xfd', b'\xff\xff\xfd\xfd'),),
         )),
     ),
-    {},
+    {
+    },
 )
 
 

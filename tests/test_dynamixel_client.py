@@ -98,3 +98,10 @@ def test_bulk_read_and_write_by_name(client: DynamixelP2Client) -> None:
         2: {"led": 1},
         3: {"model_number": 1020, "model_information": 0},
     }
+
+
+def test_action_without_reg_write_is_an_instruction_error(client: DynamixelP2Client) -> None:
+    with pytest.raises(DeviceError, match="instruction_error"):
+        client.action(2)
+    assert client.reg_write(2, led=1) is True
+    assert client.action(2) is True

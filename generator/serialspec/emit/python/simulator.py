@@ -37,6 +37,7 @@ BEHAVIOUR_ARGUMENTS = (
     "releases",
     "cancel_when",
     "carries",
+    "nothing_held",
 )
 
 

@@ -104,9 +104,15 @@ class DevicePass(Pass):
                     str(moves["target"]),
                     str(moves.get("duration", "")),
                     str(moves.get("speed", "")),
+                    float(moves.get("speed_scale", 1.0)),
+                    str(moves.get("enabled_by", "")),
                     str(moves.get("accel", "")),
                     str(moves.get("decel", "")),
                 )
+                if motion.speed_scale <= 0:
+                    self.error((*item_path, "moves", "speed_scale"), "must be positive")
+                if motion.enabled_by and motion.enabled_by not in known_state and motion.enabled_by not in entries:
+                    self.error((*item_path, "moves", "enabled_by"), f"unknown memory entry {motion.enabled_by!r}")
                 if motion.state not in known_state and motion.state not in entries:
                     self.error((*item_path, "moves", "state"), f"unknown state variable {motion.state!r}")
                 for role in ("target", "duration", "speed", "accel", "decel"):
@@ -143,9 +149,11 @@ class DevicePass(Pass):
                     stores,
                     sets,
                     absent,
+                    self.keeps(item.get("keeps"), request_names, entries, (*item_path, "keeps")),
                     **self.behaviour_extras(
                         item, item_path, key, request_names, response_names, {**entries, **known_state}
                     ),
+                    nothing_held={str(k): float(v) for k, v in (item.get("nothing_held") or {}).items()},
                 )
             )
         status = {str(k): str(v) for k, v in (value.get("status") or {}).items()}
@@ -162,6 +170,7 @@ class DevicePass(Pass):
             state=state,
             reply={str(k): float(v) for k, v in (value.get("reply") or {}).items()},
             refused={str(k): float(v) for k, v in (value.get("refused") or {}).items()},
+            out_of_range={str(k): float(v) for k, v in (value.get("out_of_range") or {}).items()},
             behaviours=tuple(behaviours),
             status=status,
             kinds=tuple(kinds.values()),
@@ -170,6 +179,22 @@ class DevicePass(Pass):
             moving=self.moving(value, path, entries, state),
             model_entry=str(value.get("model_entry", "")),
         )
+
+    def keeps(
+        self, value: Any, request_names: Any, entries: Any, path: Path
+    ) -> tuple[str, dict[int, tuple[str, ...]]] | None:
+        """`keeps`: the request field choosing what a reset keeps, and the entries for each of its values."""
+        if value is None:
+            return None
+        field_name = str(value["field"])
+        if field_name not in request_names:
+            self.error((*path, "field"), f"no request field {field_name!r}")
+        table = {int(k): tuple(str(n) for n in names) for k, names in (value.get("entries") or {}).items()}
+        for key, names in table.items():
+            for name in names:
+                if name not in entries:
+                    self.error((*path, "entries", key), f"unknown memory entry {name!r}")
+        return field_name, table
 
     def moving(
         self, value: dict[str, Any], path: Path, entries: dict[str, TableEntry], state: dict[str, float]

@@ -217,11 +217,12 @@ def run() -> Table:
             f"Per-command time at {sizes[-1]:,} commands ÷ at {sizes[1]:,}: {growth:.2f}× "
             f"({'linear' if linear else 'super-linear'}: 1.0× is linear; above {LINEAR_LIMIT}× is super-linear)."
             + cause,
-            f"The {len(REAL_SPECS)} shipped specs, every stage: {shipped:.3f} s "
+            f"The {len(REAL_SPECS)} servo specs above, every stage: {shipped:.3f} s "
             f"(≤ {GENERATE_TARGET} s: {verdict(shipped <= GENERATE_TARGET)}).",
             f"YAML composition of the {COMPOSE_SIZE:,}-command spec: {compiled:.2f} s with libyaml's CSafeLoader "
             f"(what the loader uses where PyYAML has libyaml), {pure:.2f} s with PyYAML's pure-Python SafeLoader.",
-            f"`serialspec generate` on a copy of the 3 specs, fresh process (startup, imports, schema, writes), "
+            f"`serialspec generate` on a copy of specs/ ({len(list((ROOT / 'specs').glob('*.yaml')))} specs), fresh "
+            "process (startup, imports, schema, writes), "
             f"warm .pyc and template caches, best of {CLI_RUNS}: {cli:.2f} s CPU (≤ {GENERATE_TARGET} s: "
             f"{verdict(cli <= GENERATE_TARGET)}), {cli_wall:.2f} s wall; the first run, with the caches as the "
             f"project left them: {cli_first:.2f} s CPU.",

@@ -118,10 +118,7 @@ class Bus:
                 "timeout": timeout,
             }
             options.update(serial_options)
-            try:
-                self._port = serial.serial_for_url(port, **options)
-            except (serial.SerialException, OSError, ValueError) as exc:
-                raise PortError(f"cannot open {port}: {exc}") from None
+            self._port = _open_port(port, options)
         self.port_name = str(getattr(self._port, "name", None) or getattr(self._port, "port", "") or port)
 
     # --- lifetime -------------------------------------------------------------------------------------------------
@@ -141,7 +138,8 @@ class Bus:
         try:
             self._port.open()
         except _OPEN_FAILURES as exc:
-            raise PortError(f"cannot reopen {self.port_name}: {exc}") from None
+            reason = _refused_setting(self._port.port, _settings_of(self._port)) or _reason(exc)
+            raise PortError(f"cannot reopen {self.port_name}: {reason}") from None
         self._parser = self.binding.parser()
 
     def __enter__(self) -> Bus:
@@ -369,6 +367,52 @@ class Bus:
                 self._port.reset_input_buffer()
         except _RESET_FAILURES:
             pass  # a port that has failed reports it on the next read or write
+
+
+# The serial settings a port may refuse, in the order they are tried when opening fails.
+_SETTINGS = ("baudrate", "bytesize", "parity", "stopbits")
+_PARITY_NAMES = {value: name for name, value in _PARITY.items()}
+
+
+def _reason(exc: BaseException) -> str:
+    return str(exc) or type(exc).__name__
+
+
+def _settings_of(port: Any) -> dict[str, Any]:
+    return {name: getattr(port, name) for name in _SETTINGS if hasattr(port, name)}
+
+
+def _open_port(url: str, options: dict[str, Any]) -> Any:
+    """Open a port with its settings; a failure is a PortError naming the setting the port refused, if one was."""
+    try:
+        return serial.serial_for_url(url, **options)
+    except _OPEN_FAILURES as exc:  # termios.error among them: never a raw one
+        reason = _refused_setting(url, options) or _reason(exc)
+        raise PortError(f"cannot open {url}: {reason}") from None
+
+
+def _refused_setting(url: str, options: dict[str, Any]) -> str:
+    """Which serial setting a port refuses: open it with pyserial's defaults, then apply the settings one at a
+    time. "" when even that open fails (the port itself is the problem) or every setting is accepted alone."""
+    try:
+        port: Any = serial.serial_for_url(url, do_not_open=True)
+        port.open()
+    except _OPEN_FAILURES:
+        return ""
+    try:
+        for name in _SETTINGS:
+            if name not in options:
+                continue
+            value = options[name]
+            try:
+                setattr(port, name, value)
+            except _OPEN_FAILURES as exc:
+                shown = _PARITY_NAMES.get(value, value) if name == "parity" else value
+                return f"the port refuses {name} = {shown} ({_reason(exc)})"
+        return ""
+    finally:
+        with suppress(*_PORT_FAILURES):
+            port.close()
 
 
 class _PortFailures:

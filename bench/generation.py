@@ -23,11 +23,11 @@ from pathlib import Path
 from typing import Any
 
 import yaml
-from serialspec.emit.docs import emit_docs
-from serialspec.emit.package import emit_package
+from serialspec.emit.markdown.docs import emit_docs
+from serialspec.emit.python.package import emit_package
 from serialspec.spec.loader import load_file
 from serialspec.spec.model import Protocol
-from serialspec.spec.resolve import Resolver
+from serialspec.spec.resolve import resolve
 
 from bench.synthetic import synthetic_yaml
 from bench.timing import Table
@@ -53,7 +53,7 @@ def generate_once(spec: Path, output: Path) -> tuple[dict[str, float], Protocol]
         return result
 
     located = timed("load", lambda: load_file(str(spec), spec.name))
-    protocol = timed("resolve", lambda: Resolver(located).resolve())
+    protocol = timed("resolve", lambda: resolve(located))
     package = timed("emit package", lambda: emit_package(protocol))
     docs = timed("emit docs", lambda: emit_docs(protocol))
 

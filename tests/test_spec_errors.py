@@ -10,8 +10,8 @@ from pathlib import Path
 
 import pytest
 import yaml
-from serialspec.emit.docs import emit_docs
-from serialspec.emit.package import emit_package
+from serialspec.emit.markdown.docs import emit_docs
+from serialspec.emit.python.package import emit_package
 from serialspec.spec import SpecErrors, load_protocol
 
 MINIMAL = """\

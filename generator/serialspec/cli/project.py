@@ -5,8 +5,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from serialspec.emit.docs import emit_docs
-from serialspec.emit.package import emit_package
+from serialspec.emit import emitters
 from serialspec.spec import SpecError, SpecErrors, load_protocol
 from serialspec.spec.grammar import json_schema
 
@@ -34,7 +33,7 @@ def expected_files(root: Path) -> tuple[dict[Path, str], list[SpecError]]:
         except SpecErrors as exc:
             errors.extend(exc.errors)
             continue
-        for name, text in emit_package(protocol).items():
-            files[root / "generated" / protocol.name / name] = text
-        files[root / "generated" / "docs" / f"{protocol.name}.md"] = emit_docs(protocol)
+        for emitter in emitters():
+            for name, text in emitter.files(protocol).items():
+                files[root / "generated" / name] = text
     return files, errors

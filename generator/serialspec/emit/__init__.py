@@ -1,1 +1,31 @@
-"""Emitters: one module per output, each turning the model into files under generated/."""
+"""Emitters: each target is a sub-package exporting `EMITTER`; `generate` and `check` run every one of them.
+
+A new target is one new folder here with an `__init__.py` that defines `EMITTER = Emitter(name, files)`.
+"""
+
+from __future__ import annotations
+
+import importlib
+import pkgutil
+from collections.abc import Callable
+from dataclasses import dataclass
+from functools import cache
+
+from serialspec.spec.model import Protocol
+
+
+@dataclass(frozen=True)
+class Emitter:
+    name: str
+    files: Callable[[Protocol], dict[str, str]]  # path relative to generated/ -> text
+
+
+@cache
+def emitters() -> tuple[Emitter, ...]:
+    """Every target under serialspec.emit, in name order (common/ is the shared layer, not a target)."""
+    found = []
+    for info in sorted(pkgutil.iter_modules(__path__), key=lambda i: i.name):
+        if info.ispkg and info.name != "common":
+            module = importlib.import_module(f"{__name__}.{info.name}")
+            found.append(module.EMITTER)
+    return tuple(found)

@@ -287,6 +287,7 @@ class Command:
     response: Message | None
     selector: Selector | None
     subcommands: tuple[Subcommand, ...]
+    group_class: str = ""  # the client's class grouping the sub-commands' methods ("" without sub-commands)
 
     def messages(self) -> tuple[Message, ...]:
         found = [m for m in (self.request, self.response) if m]
@@ -498,3 +499,60 @@ class Protocol:
     @cached_property
     def _commands_by_name(self) -> dict[str, Command]:  # emitters look commands up per message
         return {c.name: c for c in self.commands}
+
+
+# --- sizes: computed from fields by the resolver and every emitter ----------------------------------------------------
+
+
+def fixed_size(field: Field) -> int | None:
+    if isinstance(field, Scalar):
+        return field.type.size
+    if isinstance(field, Array):
+        return field.item.size * field.count
+    if isinstance(field, Bytes):
+        return field.size if isinstance(field.size, int) else None
+    if isinstance(field, Group):
+        if isinstance(field.count, int) and field.item_size is not None:
+            return field.count * field.item_size
+        return None
+    if isinstance(field, TableBlock):
+        return sum(e.type.size for e in field.entries)
+    return None
+
+
+def sum_sizes(fields: tuple[Field, ...]) -> int | None:
+    total = 0
+    for item in fields:
+        size = fixed_size(item)
+        if size is None:
+            return None
+        total += size
+    return total
+
+
+def content_bounds(fields: tuple[Field, ...]) -> tuple[int, int | None]:
+    """Smallest and largest content size (None: unbounded) the fields allow."""
+    low = 0
+    high: int | None = 0
+    by_name = {f.name: f for f in fields}
+    for item in fields:
+        size = fixed_size(item)
+        if size is not None:
+            low += size
+            high = None if high is None else high + size
+            continue
+        if isinstance(item, TableValue):
+            sizes = [e.type.size for e in item.table.entries if not e.reserved]
+            low += min(sizes)
+            high = None if high is None else high + max(sizes)
+        elif isinstance(item, Group) and isinstance(item.count, str) and item.count != "rest" and item.item_size:
+            counter = by_name.get(item.count)
+            most = int(counter.maximum) if isinstance(counter, Scalar) else None
+            high = None if high is None or most is None else high + most * item.item_size
+        elif isinstance(item, Bytes) and isinstance(item.size, str) and item.size != "rest":
+            counter = by_name.get(item.size)
+            most = int(counter.maximum) if isinstance(counter, Scalar) else None
+            high = None if high is None or most is None else high + most
+        else:
+            high = None
+    return low, high

@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
-from serialspec.emit.pycode import number, one_line
-from serialspec.emit.render import render
+from serialspec.emit.common.numbers import number
+from serialspec.emit.python.pycode import one_line
+from serialspec.emit.python.render import render
 from serialspec.spec.model import Bytes, Group, Protocol, Table
 
 

@@ -5,8 +5,8 @@ construct is the declarative reference the fast codec is tested against; it is n
 
 from __future__ import annotations
 
-from serialspec.emit.pycode import one_line
-from serialspec.emit.render import render
+from serialspec.emit.python.pycode import one_line
+from serialspec.emit.python.render import render
 from serialspec.spec.model import (
     Array,
     Bytes,

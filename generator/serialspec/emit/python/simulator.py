@@ -4,28 +4,20 @@ from __future__ import annotations
 
 from typing import Any
 
-from serialspec.emit.pycode import number, one_line
-from serialspec.emit.registers import map_name, register_tables
-from serialspec.emit.render import render
+from serialspec.emit.common.numbers import number
+from serialspec.emit.common.pairing import request_response_pairs
+from serialspec.emit.python.pycode import one_line
+from serialspec.emit.python.registers import map_name, register_tables
+from serialspec.emit.python.render import render
 from serialspec.spec.model import (
     Bytes,
-    Direction,
     Group,
     Message,
     Protocol,
     TableBlock,
     TableValue,
-    replies_by_request,
     reply_condition,
-    reply_to,
 )
-
-
-def request_response_pairs(protocol: Protocol) -> list[tuple[Message, Message | None]]:
-    """Every request with the response that answers it (None where the device stays silent)."""
-    messages = protocol.messages()
-    replies = replies_by_request(messages)
-    return [(m, reply_to(m, replies)) for m in messages if m.direction == Direction.REQUEST]
 
 
 def table_fields(*messages: Message | None) -> dict[str, tuple[str, ...]]:

@@ -1,40 +1,15 @@
-"""The engine of generated virtual devices: memory, motion, replies and faults, driven by data from the spec.
-
-A generated `simulator.py` holds only data (a `DeviceSpec` built from the spec's `device:` section, its tables and
-its commands); everything a device does is here and is the same for every protocol:
-
-- memory: the spec's table, initialised from its defaults (and the device section's `initial` values);
-- a request whose address is a device's id is answered by that device, one whose address is the broadcast value is
-  obeyed by every device, which stay silent unless the command says `broadcast_reply`;
-- a response is built field by field: `reads` from memory, `reports` of a state variable or memory entry,
-  then the request's field of the same name, then the device section's `reply` values, then 0;
-- a response with `optional_when` is sent only while that parameter holds the value, and one with `after`
-  once the request's field of that name (ms) has elapsed;
-- `moves` makes a state variable go linearly from where it is to the request's target, over a duration or at a
-  speed; reading it meanwhile gives the value on the way;
-- faults can be injected for the next replies: drop, corrupt (checksum), late, garbage, truncate, other_id;
-- `each` applies a command to every item of a request group, each item addressing its own device;
-- further `kinds` of device (a board's PWM servo ports, its motors) have their own ids, address field and state;
-  a command names its kind; a request for an id no device has is answered with `absent` values if the command
-  gives them (a board answering for a servo that is not there), else not at all;
-- `emit()` sends a message on the device's own initiative (reports, key events) for tests.
-"""
+"""The device engine: virtual devices' memory, motion and replies, driven by data from the spec (see the package)."""
 
 from __future__ import annotations
 
 import dataclasses
-import heapq
-import os
-import random
-import select
 import threading
 import time
-import tty
-from collections import deque
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from typing import Any
 
+from serialspec.runtime.device.faults import Fault, FaultInjection
 from serialspec.runtime.errors import EncodeError
 from serialspec.runtime.message import Message
 from serialspec.runtime.registers import RegisterMap
@@ -179,36 +154,7 @@ class VirtualDevice:
         )
 
 
-@dataclass
-class Fault:
-    kind: str  # one of FAULTS
-    delay: float = 0.0
-    answer_as: int | None = None  # other_id: the id to answer as (None: the next id up, or down at the top)
-
-    def other_id(self, address: int, broadcast: int | None) -> int:
-        if self.answer_as is not None:
-            return self.answer_as
-        return address + 1 if address + 1 != broadcast and address < 0xFF else address - 1
-
-
-FAULTS = {
-    "drop": "no reply",
-    "corrupt": "the reply with a bad checksum",
-    "late": "the reply `delay` s late",
-    "garbage": "random bytes before the reply",
-    "truncate": "only the first half of the reply",
-    "other_id": "the reply as if from another id (`answer_as`)",
-}
-
-
-@dataclass(order=True)
-class _Scheduled:
-    when: float
-    seq: int
-    data: bytes = field(compare=False)
-
-
-class Simulator:
+class Engine(FaultInjection):
     """Several virtual devices on one bus: feed request bytes, get reply bytes (with their send times)."""
 
     def __init__(
@@ -234,26 +180,11 @@ class Simulator:
             )
             self._kind_specs[kind.name] = kind_spec
             self.kinds[kind.name] = {i: VirtualDevice(kind_spec, i, clock) for i in kind.ids}
-        self._emitted: deque[bytes] = deque()  # frames emit() hands to the serving thread
         self.commands = {c.request: c for c in spec.commands}
-        self.faults: list[Fault] = []
         self.log: list[Message] = []  # every request received, in order
         self._lock = threading.Lock()
-        self._outbox: list[_Scheduled] = []
-        self._seq = 0
-        self._wake_r, self._wake_w = os.pipe()
-        self._stop = threading.Event()
         self._answering_as: Fault | None = None  # an other_id fault while the reply it spoils is built
-        self._released = False  # close() has closed the pseudo-terminal and the wake-up pipe
-
-    # --- fault injection ------------------------------------------------------------------------------------------
-
-    def inject(self, kind: str, count: int = 1, delay: float = 0.5, answer_as: int | None = None) -> None:
-        """Spoil the next `count` replies, one fault each, with a fault of FAULTS; `delay` for late ones."""
-        if kind not in FAULTS:
-            raise ValueError(f"unknown fault {kind!r} (expected one of {', '.join(FAULTS)})")
-        with self._lock:
-            self.faults.extend(Fault(kind, delay, answer_as) for _ in range(count))
+        FaultInjection.__init__(self)
 
     # --- requests -------------------------------------------------------------------------------------------------
 
@@ -482,89 +413,3 @@ class Simulator:
             return ok
         device.set(name, given[name])
         return True
-
-    def _spoil(self, when: float, frame: bytes) -> list[tuple[float, bytes]]:
-        if not self.faults:
-            return [(when, frame)]
-        fault = self.faults.pop(0)
-        if fault.kind == "drop":
-            return []
-        if fault.kind == "corrupt":
-            return [(when, frame[:-1] + bytes([(frame[-1] + 1) & 0xFF]))]
-        if fault.kind == "late":
-            return [(when + fault.delay, frame)]
-        if fault.kind == "truncate":
-            return [(when, frame[: len(frame) // 2])]
-        garbage = bytes(random.randrange(256) for _ in range(7))
-        return [(when, garbage + frame)]
-
-    def emit(self, message: Message) -> None:
-        """Send a message on the device's own initiative (a report, a key event) as soon as possible."""
-        self._emitted.append(self.encode(message))  # encoding checks every value here, in the caller's thread
-        os.write(self._wake_w, b"x")
-
-    # --- serving on a file descriptor (a pseudo-terminal) ---------------------------------------------------------
-
-    def serve(self, fd: int) -> None:
-        """Answer requests read from `fd` until stop(); replies are written at their time (no polling)."""
-        while not self._stop.is_set():
-            now = self.clock()
-            while self._outbox and self._outbox[0].when <= now:
-                os.write(fd, heapq.heappop(self._outbox).data)
-            wait = max(0.0, self._outbox[0].when - now) if self._outbox else None
-            readable, _, _ = select.select([fd, self._wake_r], [], [], wait)
-            if self._wake_r in readable:
-                os.read(self._wake_r, 64)
-            # Before any request read now: what emit() queued before the request was sent goes out before its reply.
-            while self._emitted:
-                self._seq += 1
-                heapq.heappush(self._outbox, _Scheduled(self.clock(), self._seq, self._emitted.popleft()))
-            if fd in readable:
-                try:
-                    data = os.read(fd, 4096)
-                except OSError:  # the other side closed (EIO on a pty): wait for a new peer
-                    data = b""
-                if not data:
-                    self._stop.wait(0.01)
-                    continue
-                for when, frame in self.feed(data):
-                    self._seq += 1
-                    heapq.heappush(self._outbox, _Scheduled(when, self._seq, frame))
-
-    def stop(self) -> None:
-        self._stop.set()
-        if not self._released:
-            os.write(self._wake_w, b"x")
-
-    def open_pty(self) -> tuple[int, str]:
-        """A pseudo-terminal pair in raw mode: the controller fd this simulator serves and the device path."""
-        controller, device = os.openpty()
-        tty.setraw(device)
-        tty.setraw(controller)
-        path = os.ttyname(device)
-        self._device_fd = device  # kept open so the pty survives clients that come and go
-        return controller, path
-
-    def start(self) -> str:
-        """Serve on a new pseudo-terminal from a background thread; returns the device path."""
-        controller, path = self.open_pty()
-        self._controller_fd = controller
-        self._thread = threading.Thread(target=self.serve, args=(controller,), daemon=True, name="serialspec-sim")
-        self._thread.start()
-        return path
-
-    def close(self) -> None:
-        """Stop serving and release the pseudo-terminal: its path goes away and clients on it see a hang-up."""
-        if self._released:
-            return
-        self.stop()
-        thread = getattr(self, "_thread", None)
-        if thread is not None:
-            thread.join(2)
-            if thread.is_alive():
-                return  # still serving (stuck in a write): never close descriptors under it
-        self._released = True
-        pty = (getattr(self, "_controller_fd", None), getattr(self, "_device_fd", None))
-        for fd in (*pty, self._wake_r, self._wake_w):
-            if fd is not None:
-                os.close(fd)

@@ -9,8 +9,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from serialspec.emit.pycode import number
-from serialspec.emit.render import render
+from serialspec.emit.common import render as common
+from serialspec.emit.common.numbers import number
+from serialspec.emit.common.text import collapse
 from serialspec.spec.model import (
     Array,
     Bytes,
@@ -26,13 +27,13 @@ from serialspec.spec.model import (
     TableBlock,
     TableEntry,
     TableValue,
+    fixed_size,
 )
-from serialspec.spec.resolve import fixed_size
 
 
 def text(value: str) -> str:
     """Spec text for a markdown paragraph: one line, HTML-significant characters escaped."""
-    return " ".join(value.split()).replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
+    return collapse(value).replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
 
 
 def cell(value: object) -> str:
@@ -435,7 +436,8 @@ def emit_docs(protocol: Protocol) -> str:
         for e in protocol.errata
     ]
     serial = protocol.serial
-    return render(
+    return common.render(
+        "serialspec.emit.markdown",
         "docs.md.j2",
         protocol=protocol,
         title=text(protocol.title),

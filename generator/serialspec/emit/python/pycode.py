@@ -11,6 +11,8 @@ import re
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 
+from serialspec.emit.common.numbers import number
+from serialspec.emit.common.text import collapse
 from serialspec.spec.model import (
     Array,
     Bytes,
@@ -23,9 +25,9 @@ from serialspec.spec.model import (
     Scalar,
     TableBlock,
     TableValue,
+    fixed_size,
 )
 from serialspec.spec.model import Field as SpecField
-from serialspec.spec.resolve import fixed_size
 
 Lines = list[str]
 _STRUCT_NAMES = {"B": "U8", "b": "I8", "H": "U16", "h": "I16", "I": "U32", "i": "I32", "f": "F32"}
@@ -51,11 +53,7 @@ def members_name(class_name: str) -> str:
 
 def one_line(text: str) -> str:
     """Spec text made safe for a comment or docstring: one line, no backslashes or quotes that could close it."""
-    return " ".join(text.split()).replace("\\", "\\\\").replace('"', "'")
-
-
-def number(value: float) -> str:
-    return repr(int(value)) if float(value).is_integer() else repr(value)
+    return collapse(text).replace("\\", "\\\\").replace('"', "'")
 
 
 def struct_format(endian: str, fields: list[SpecField]) -> str:

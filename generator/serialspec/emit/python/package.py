@@ -6,8 +6,9 @@ import re
 from pathlib import Path
 from typing import Any
 
-from serialspec.emit.client import client_module
-from serialspec.emit.pycode import (
+from serialspec.emit.common.numbers import number
+from serialspec.emit.python.client import client_module
+from serialspec.emit.python.pycode import (
     ClassCode,
     Lines,
     PackageCode,
@@ -15,14 +16,13 @@ from serialspec.emit.pycode import (
     crc_setup,
     decoder_name,
     encoder_name,
-    number,
     one_line,
     setter_name,
 )
-from serialspec.emit.registers import register_tables, registers_module
-from serialspec.emit.render import render
-from serialspec.emit.simulator import simulator_module
-from serialspec.emit.structs import structs_module
+from serialspec.emit.python.registers import register_tables, registers_module
+from serialspec.emit.python.render import render
+from serialspec.emit.python.simulator import simulator_module
+from serialspec.emit.python.structs import structs_module
 from serialspec.spec.model import Command, Direction, FrameLayout, Message, Protocol, Scalar, Table, TableValue
 
 _IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")

@@ -18,10 +18,12 @@ from __future__ import annotations
 
 from typing import Any
 
-from serialspec.emit.pycode import annotation, number, one_line
-from serialspec.emit.registers import map_name, names_alias
-from serialspec.emit.render import render
-from serialspec.emit.simulator import import_order, request_response_pairs
+from serialspec.emit.common.numbers import number
+from serialspec.emit.common.pairing import request_response_pairs
+from serialspec.emit.python.pycode import annotation, one_line
+from serialspec.emit.python.registers import map_name, names_alias
+from serialspec.emit.python.render import render
+from serialspec.emit.python.simulator import import_order
 from serialspec.spec.model import (
     Bytes,
     Direction,
@@ -255,10 +257,6 @@ def register_commands(protocol: Protocol, methods: list[dict[str, Any]]) -> list
     return found
 
 
-def camel(name: str) -> str:
-    return "".join(w.capitalize() for w in name.split("_"))
-
-
 def client_module(protocol: Protocol) -> str:
     imports: set[str] = set()
     methods = []
@@ -393,7 +391,7 @@ def client_module(protocol: Protocol) -> str:
                 command.name,
                 {
                     "attribute": attribute_name(command.name),
-                    "class_name": camel(command.name) + "Commands",
+                    "class_name": command.group_class,
                     "title": one_line(command.title or command.name.replace("_", " ")),
                     "methods": [],
                 },

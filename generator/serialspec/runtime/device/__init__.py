@@ -1,0 +1,38 @@
+"""Generated virtual devices: memory, motion, replies and faults, driven by data from the spec.
+
+A generated `simulator.py` holds only data (a `DeviceSpec` built from the spec's `device:` section, its tables and
+its commands); everything a device does is in this package (engine.py; faults.py; server.py serves it on a
+pseudo-terminal) and is the same for every protocol:
+
+- memory: the spec's table, initialised from its defaults (and the device section's `initial` values);
+- a request whose address is a device's id is answered by that device, one whose address is the broadcast value is
+  obeyed by every device, which stay silent unless the command says `broadcast_reply`;
+- a response is built field by field: `reads` from memory, `reports` of a state variable or memory entry,
+  then the request's field of the same name, then the device section's `reply` values, then 0;
+- a response with `optional_when` is sent only while that parameter holds the value, and one with `after`
+  once the request's field of that name (ms) has elapsed;
+- `moves` makes a state variable go linearly from where it is to the request's target, over a duration or at a
+  speed; reading it meanwhile gives the value on the way;
+- faults can be injected for the next replies: drop, corrupt (checksum), late, garbage, truncate, other_id;
+- `each` applies a command to every item of a request group, each item addressing its own device;
+- further `kinds` of device (a board's PWM servo ports, its motors) have their own ids, address field and state;
+  a command names its kind; a request for an id no device has is answered with `absent` values if the command
+  gives them (a board answering for a servo that is not there), else not at all;
+- `emit()` sends a message on the device's own initiative (reports, key events) for tests.
+"""
+
+from serialspec.runtime.device.engine import CommandSpec, DeviceSpec, Engine, EntrySpec, KindSpec, VirtualDevice
+from serialspec.runtime.device.faults import FAULTS, Fault
+from serialspec.runtime.device.server import Simulator
+
+__all__ = [
+    "FAULTS",
+    "CommandSpec",
+    "DeviceSpec",
+    "Engine",
+    "EntrySpec",
+    "Fault",
+    "KindSpec",
+    "Simulator",
+    "VirtualDevice",
+]

@@ -1,0 +1,246 @@
+"""Commands, their sub-commands and messages; command codes; which response answers which request."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from serialspec.spec.errors import SpecError
+from serialspec.spec.loader import Path
+from serialspec.spec.model import (
+    Command,
+    Direction,
+    Field,
+    Framing,
+    Message,
+    OptionalWhen,
+    Scalar,
+    Selector,
+    Subcommand,
+    Table,
+    TableEntry,
+    content_bounds,
+    fixed_size,
+)
+from serialspec.spec.passes.base import camel
+from serialspec.spec.passes.fields import FieldResolver
+
+
+class Commands(FieldResolver):
+    """Resolve `commands:` and check their codes against the framing and their `answered_by` references."""
+
+    def run(self) -> list[SpecError]:
+        for key, value in (self.ctx.data.get("commands") or {}).items():
+            command = self.guard(("commands", key), self.command, key, value, ("commands", key))
+            if command:
+                self.ctx.commands.append(command)
+        if self.ctx.framing:
+            self.check_codes(self.ctx.commands, self.ctx.framing)
+        self.check_answered_by(self.ctx.commands)
+        return self.problems
+
+    def command(self, name: str, value: dict[str, Any], path: Path) -> Command:
+        self.name(name, path, "command name")
+        selector = None
+        subcommands: list[Subcommand] = []
+        if "subcommands" in value:
+            raw_selector = value.get("selector")
+            if raw_selector is None:
+                raise self.fail(
+                    path, "a command with subcommands needs `selector: {type, offset: {request, response}}`"
+                )
+            selector = Selector(
+                name=self.name(raw_selector.get("name", "subcommand_code"), (*path, "selector", "name")),
+                type=self.scalar_type(raw_selector.get("type", "u8"), (*path, "selector", "type"), False),
+                offsets={Direction(k): v for k, v in raw_selector["offset"].items() if k in ("request", "response")},
+            )
+            codes: dict[int, str] = {}
+            for sub_name, sub in value["subcommands"].items():
+                sub_path = (*path, "subcommands", sub_name)
+                self.name(sub_name, sub_path, "subcommand name")
+                if sub["code"] in codes:
+                    self.error(
+                        (*sub_path, "code"),
+                        f"code {sub['code']:#04x} is already used by {codes[sub['code']]!r}",
+                    )
+                codes[sub["code"]] = sub_name
+                messages = {
+                    d: self.guard(
+                        (*sub_path, d.value),
+                        self.message,
+                        name,
+                        sub_name,
+                        d,
+                        sub[d.value],
+                        (*sub_path, d.value),
+                        selector,
+                        sub["code"],
+                    )
+                    for d in Direction
+                    if d.value in sub
+                }
+                subcommands.append(
+                    Subcommand(
+                        sub_name,
+                        sub["code"],
+                        str(sub.get("title", "")),
+                        str(sub.get("title_cn", "")),
+                        str(sub.get("description", "")),
+                        messages.get(Direction.REQUEST),
+                        messages.get(Direction.RESPONSE),
+                        str(sub.get("source", "")),
+                    )
+                )
+            for direction in ("request", "response"):
+                if direction in value:
+                    self.error((*path, direction), "a command with subcommands describes content in each subcommand")
+        messages = {
+            d: self.guard((*path, d.value), self.message, name, None, d, value[d.value], (*path, d.value), None, None)
+            for d in Direction
+            if d.value in value and "subcommands" not in value
+        }
+        return Command(
+            name=name,
+            code=value.get("code"),
+            title=str(value.get("title", "")),
+            title_cn=str(value.get("title_cn", "")),
+            description=str(value.get("description", "")),
+            broadcast=str(value.get("broadcast", "")),
+            source=str(value.get("source", "")),
+            request=messages.get(Direction.REQUEST),
+            response=messages.get(Direction.RESPONSE),
+            selector=selector,
+            subcommands=tuple(subcommands),
+            group_class=self.class_name(camel(name, "commands"), path) if subcommands else "",
+        )
+
+    def check_answered_by(self, commands: list[Command]) -> None:
+        responses = {m.key: m for c in commands for m in c.messages() if m.direction == Direction.RESPONSE}
+        for command in commands:
+            for message in command.messages():
+                if message.answered_by and message.answered_by not in responses:
+                    self.error(
+                        ("commands", command.name, "request", "answered_by", "command"),
+                        f"{message.answered_by!r} is not a command with a response",
+                    )
+
+    def check_codes(self, commands: list[Command], framing: Framing) -> None:
+        for direction, layout in framing.layouts.items():
+            seen: dict[int | None, str] = {}
+            for command in commands:
+                has = any(m.direction == direction for m in command.messages())
+                if not has:
+                    continue
+                path: Path = ("commands", command.name)
+                if layout.command_offset is None:
+                    if command.code is not None:
+                        self.error((*path, "code"), f"{direction.value} frames have no command field, so no code")
+                elif command.code is None:
+                    self.error(path, f"missing key 'code' ({direction.value} frames carry a command field)")
+                if command.code in seen:
+                    other = seen[command.code]
+                    what = f"code {command.code:#04x}" if command.code is not None else "a codeless reply"
+                    self.error(path, f"{what} in {direction.value} frames is already used by {other!r}")
+                seen[command.code] = command.name
+
+    def message(
+        self,
+        command: str,
+        subcommand: str | None,
+        direction: Direction,
+        value: dict[str, Any],
+        path: Path,
+        selector: Selector | None,
+        code: int | None,
+    ) -> Message:
+        fields = self.fields(value.get("fields") or {}, (*path, "fields"), parent=None)
+        if selector is not None and code is not None:
+            fields = self.insert_selector(fields, selector, direction, code, path)
+        self.check_rest(fields, (*path, "fields"))
+        low, high = content_bounds(fields)
+        class_name = self.class_name(camel(command, subcommand or "", direction.value), path)
+        answered_by = value.get("answered_by") or {}
+        if direction == Direction.REQUEST:
+            for field in fields:
+                if isinstance(field, Scalar) and field.status_ok is not None:
+                    self.error((*path, "fields", field.name, "status"), "a status is reported in a response")
+        if answered_by and direction != Direction.REQUEST:
+            self.error((*path, "answered_by"), "`answered_by` names the response that answers a request")
+        return Message(
+            command=command,
+            subcommand=subcommand,
+            direction=direction,
+            class_name=class_name,
+            title=str(value.get("title", "")),
+            description=str(value.get("description", "")),
+            fields=fields,
+            optional=str(value.get("optional", "")),
+            unsolicited=bool(value.get("unsolicited", False)),
+            answers=str(value.get("answers", "")),
+            min_size=low,
+            max_size=high,
+            source=str(value.get("source", "")),
+            optional_when=self.optional_when(value.get("optional_when"), (*path, "optional_when")),
+            after=self.after(value.get("after"), fields, direction, path),
+            answered_by=str(answered_by.get("command", "")),
+            reply_when=self.optional_when(answered_by.get("optional_when"), (*path, "answered_by", "optional_when")),
+        )
+
+    def table_entry(self, text: str, path: Path) -> tuple[Table, TableEntry]:
+        """A table entry named `entry` (searched in every table) or `table.entry`."""
+        table_name, _, entry_name = text.rpartition(".")
+        tables = [self.tables[table_name]] if table_name in self.tables else list(self.tables.values())
+        for table in tables:
+            for entry in table.entries:
+                if entry.name == entry_name:
+                    return table, entry
+        raise self.fail(path, f"unknown table entry {text!r}")
+
+    def optional_when(self, value: Any, path: Path) -> OptionalWhen | None:
+        if value is None:
+            return None
+        table, entry = self.table_entry(value["parameter"], (*path, "parameter"))
+        return OptionalWhen(table.name, entry.name, entry.key, int(value["equals"]))
+
+    def after(self, value: Any, fields: tuple[Field, ...], direction: Direction, path: Path) -> str:
+        if value is None:
+            return ""
+        if direction != Direction.RESPONSE:
+            self.error((*path, "after"), "`after` describes when a response is sent")
+        return str(value)
+
+    def insert_selector(
+        self, fields: tuple[Field, ...], selector: Selector, direction: Direction, code: int, path: Path
+    ) -> tuple[Field, ...]:
+        offset = selector.offsets.get(direction)
+        if offset is None:
+            raise self.fail(path, f"the selector has no offset for {direction.value}")
+        const = Scalar(
+            selector.name,
+            "sub-command selector",
+            "",
+            "",
+            selector.type,
+            self.endian,
+            "",
+            None,
+            selector.type.minimum,
+            selector.type.maximum,
+            code,
+            None,
+            None,
+            None,
+            (),
+            "",
+            False,
+        )
+        position = 0
+        for index, field in enumerate(fields):
+            if position == offset:
+                return (*fields[:index], const, *fields[index:])
+            size = fixed_size(field)
+            if size is None:
+                break
+            position += size
+        if position == offset:
+            return (*fields, const)
+        raise self.fail(path, f"the selector's offset {offset} does not fall between fixed-size fields")

@@ -1,0 +1,33 @@
+"""The protocol's own settings: its name, byte order, serial line, shared fields and how replies are matched."""
+
+from __future__ import annotations
+
+from serialspec.spec.errors import SpecError
+from serialspec.spec.model import Serial
+from serialspec.spec.passes.base import Pass
+
+
+class Settings(Pass):
+    """Resolve `protocol`, `byte_order`, `fields:` (kept for the commands pass to expand), `serial:`, `matching:`."""
+
+    def run(self) -> list[SpecError]:
+        data = self.ctx.data
+        self.ctx.name = self.name(data.get("protocol", ""), ("protocol",), "protocol")
+        self.ctx.endian = ">" if data.get("byte_order") == "big" else "<"
+        self.ctx.shared_fields = data.get("fields") or {}
+        serial = data.get("serial") or {}
+        if isinstance(serial, dict):
+            self.ctx.serial = self.guard(("serial",), self.serial, serial)
+        matching = data.get("matching") or {}
+        self.ctx.matching = tuple(matching.get("by") or ())
+        self.ctx.matching_description = str(matching.get("description", ""))
+        return self.problems
+
+    def serial(self, serial: dict[str, object]) -> Serial:
+        return Serial(
+            baudrate=int(serial.get("baudrate", 0)),  # type: ignore[call-overload]
+            bytesize=int(serial.get("bytesize", 8)),  # type: ignore[call-overload]
+            parity=str(serial.get("parity", "none")),
+            stopbits=float(serial.get("stopbits", 1)),  # type: ignore[arg-type]
+            notes=str(serial.get("notes", "")),
+        )

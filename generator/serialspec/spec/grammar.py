@@ -228,7 +228,10 @@ RANGE = ListOf(Num(), "Inclusive [min, max] of the value in wire units; checked 
 HEX_BYTES = Str("Bytes as hex: '12 4c 08', '0x12 0x4c', '124c08' or '12:4c:08'.")
 
 _FIELD_LONG: dict[str, Shape] = {
-    "type": Str("Wire type: u8, i8, u16, i16, u32, i32, f32, bytes, array, group, table_value, table_block."),
+    "type": Str(
+        "Wire type: u8, i8, u16, i16, u32, i32, f32, bytes, string, cstring (NUL-terminated text), array, group, "
+        "table_value, table_block."
+    ),
     "use": Str("Name of an entry in `fields:` (top level) to copy; keys given here override it."),
     "description": TEXT,
     "description_cn": Str("Description as printed in the (Chinese) document."),
@@ -252,9 +255,17 @@ _FIELD_LONG: dict[str, Shape] = {
     ),
     "encoding": Str("How the integer is stored.", choices=("plain", "sign_magnitude")),
     "endian": Str("Override of the protocol's byte order for this field.", choices=("little", "big")),
-    "size": OneOf((Int(), Str()), "bytes: a number, `rest` (up to the end of the content) or a field name"),
+    "size": OneOf(
+        (Int(), Str()),
+        "bytes, string: a number, `rest` (up to the end of the content) or a field name; array: the earlier field "
+        "holding the array's size in bytes (Modbus byte_count)",
+    ),
     "count": OneOf((Int(), Str()), "array/group: a number, `rest`, or the name of an earlier count field"),
-    "of": Str("array: the item type."),
+    "of": Str("array: the item type (a scalar type, or `bit`: bools packed 8 to a byte, lowest bit first)."),
+    "value": Str(
+        "An integer field derived from the others by an expression, computed on encode and checked on decode: "
+        "`2 * count`, `ceil(len(coils) / 8)` (names of fields, len(), ceil(a / b), min, max, + - * / % & | << >>)."
+    ),
     "fields": Any_("group: the fields of each item (a mapping, like request/response)."),
     "table": Str("table_value/table_block, or bytes holding registers: name of an entry in `tables:`."),
     "key": Str("table_value: the earlier field holding the table key (e.g. data_id)."),
@@ -291,6 +302,11 @@ MESSAGE = Obj(
         "optional": TEXT,
         "unsolicited": Bool("Sent by the device on its own, not as an answer."),
         "answers": Str("For a response: the request (command or command.subcommand) it answers, if another."),
+        "error_reply": Bool(
+            "For a response: the reply a device sends instead of any request's own when it cannot carry it out, "
+            "under the request's code plus the command element's `error_flag` (Modbus exception replies). Its "
+            "message carries the code of the refused request in a value named after the command element."
+        ),
         "optional_when": OPTIONAL_WHEN,
         "after": Str("For a response: the request field (in ms) after which the device answers, e.g. a move's time."),
         "answered_by": Obj(
@@ -414,6 +430,10 @@ FRAME_ELEMENT = Obj(
         "type": Str(choices=SCALAR_TYPES),
         "value": OneOf((Str(), MapOf(Str())), "header: hex bytes, or a mapping direction -> hex bytes"),
         "directions": ListOf(Str(choices=("request", "response"))),
+        "error_flag": Int(
+            "command: a bit a device sets in the code of a reply that refuses the request (Modbus: 0x80); such a "
+            "reply has the layout of the command whose response is the `error_reply`."
+        ),
         "adds": Int("length: what the length counts beyond the content (SMS: 2 = instruction + checksum)."),
         "description": TEXT,
         "range": RANGE,
@@ -445,6 +465,12 @@ EXAMPLE = Obj(
         "description": TEXT,
         "direction": Str(choices=("request", "response")),
         "printed": Str("The frame exactly as the document prints it."),
+        "printed_span": ListOf(
+            Str(),
+            "When the document prints only part of the frame (Modbus prints the PDU: function and data), the first "
+            "and last frame element it prints; `frame` is then the whole frame.",
+            length=2,
+        ),
         "frame": HEX_BYTES,
         "erratum": Str("Name of the erratum that explains why `frame` differs from `printed`."),
         "command": Str(),

@@ -12,6 +12,7 @@ from functools import cached_property
 from typing import Literal
 
 from serialspec.runtime.message import Direction as Direction  # the model and the runtime share it
+from serialspec.spec.expression import Expr
 
 
 @dataclass(frozen=True)
@@ -111,11 +112,13 @@ class Scalar(Common):
     derived: tuple[str, ...] = ()
     # A response field reporting success: any value but this one is a device error (the client raises DeviceError).
     status_ok: int | None = None
+    # Derived by an expression over the other fields (`byte_count = 2 * count`): computed on encode, checked on decode.
+    value: Expr | None = None
 
     @property
     def hidden(self) -> bool:
         """Not a member of the message: constant or derived."""
-        return self.const is not None or bool(self.derived)
+        return self.const is not None or bool(self.derived) or self.value is not None
 
 
 @dataclass(frozen=True)
@@ -126,6 +129,42 @@ class Array(Common):
     unit: str
     minimum: float
     maximum: float
+
+
+@dataclass(frozen=True)
+class List(Common):
+    """A list of numbers or bits whose count varies: from a count field, from a byte-size field, or the rest.
+
+    `item` None means bits packed 8 to a byte, the first in the lowest bit, the last byte padded with zeros
+    (Modbus coils). The count comes from `count` (a number, `rest`, or a field) or, when that is "", from the
+    byte size in the field named by `size`.
+    """
+
+    item: ScalarType | None
+    endian: Literal["<", ">"]
+    count: int | str
+    size: str
+    unit: str
+    minimum: float
+    maximum: float
+
+    @property
+    def bits(self) -> bool:
+        return self.item is None
+
+    def byte_size(self, count: int) -> int:
+        return -(-count // 8) if self.item is None else count * self.item.size
+
+
+@dataclass(frozen=True)
+class Text(Common):
+    """Text: NUL-terminated (`size` None; the NUL is not part of the value), or sized like bytes."""
+
+    size: int | str | None  # a number, "rest", a field name, or None for NUL-terminated
+
+    @property
+    def terminated(self) -> bool:
+        return self.size is None
 
 
 @dataclass(frozen=True)
@@ -158,7 +197,7 @@ class TableBlock(Common):
     endian: Literal["<", ">"]
 
 
-Field = Scalar | Array | Bytes | Group | TableValue | TableBlock
+Field = Scalar | Array | List | Text | Bytes | Group | TableValue | TableBlock
 
 
 @dataclass(frozen=True)
@@ -229,6 +268,7 @@ class Message:
     optional_when: OptionalWhen | None = None  # a response sent only when a device parameter has a value
     after: str = ""  # a response sent once the request's field of this name (ms) has elapsed
     answered_by: str = ""  # a request answered by another command's response (its key)
+    error_reply: bool = False  # the reply a device sends instead of any other (Modbus exceptions: code | flag)
     reply_when: OptionalWhen | None = None  # a request whose reply is sent only when a device parameter has a value
 
     @property
@@ -359,6 +399,16 @@ class Framing:
 
 
 @dataclass(frozen=True)
+class ErrorReply:
+    """Replies that refuse a request: its code with `flag` set in the command element, laid out as `command`'s
+    response (Modbus exception replies: function | 0x80, then an exception code)."""
+
+    flag: int
+    element: str  # the command element; the error reply's message carries the refused code under this name
+    command: str  # the command whose response is the error reply
+
+
+@dataclass(frozen=True)
 class Serial:
     baudrate: int
     bytesize: int
@@ -380,6 +430,14 @@ class Example:
     subcommand: str | None
     request: str
     fields: dict[str, object]
+    # bytes of the frame before and after the part the document prints (`printed_span`; (0, 0): the whole frame)
+    printed_span: tuple[int, int] = (0, 0)
+
+    @property
+    def printed_part(self) -> bytes:
+        """The bytes of the frame that the document prints."""
+        before, after = self.printed_span
+        return self.frame[before : len(self.frame) - after]
 
 
 @dataclass(frozen=True)
@@ -489,6 +547,7 @@ class Protocol:
     examples: tuple[Example, ...]
     errata: tuple[Erratum, ...]
     device: Device | None = None
+    error_reply: ErrorReply | None = None
 
     def messages(self) -> tuple[Message, ...]:
         return tuple(m for c in self.commands for m in c.messages())
@@ -509,8 +568,10 @@ def fixed_size(field: Field) -> int | None:
         return field.type.size
     if isinstance(field, Array):
         return field.item.size * field.count
-    if isinstance(field, Bytes):
+    if isinstance(field, Bytes | Text):
         return field.size if isinstance(field.size, int) else None
+    if isinstance(field, List):
+        return field.byte_size(field.count) if isinstance(field.count, int) else None
     if isinstance(field, Group):
         if isinstance(field.count, int) and field.item_size is not None:
             return field.count * field.item_size
@@ -549,7 +610,14 @@ def content_bounds(fields: tuple[Field, ...]) -> tuple[int, int | None]:
             counter = by_name.get(item.count)
             most = int(counter.maximum) if isinstance(counter, Scalar) else None
             high = None if high is None or most is None else high + most * item.item_size
-        elif isinstance(item, Bytes) and isinstance(item.size, str) and item.size != "rest":
+        elif isinstance(item, List) and (item.size or item.count not in ("", "rest")):
+            counter = by_name.get(item.size or str(item.count))
+            most = int(counter.maximum) if isinstance(counter, Scalar) else None
+            high = None if high is None or most is None else high + (most if item.size else item.byte_size(most))
+        elif isinstance(item, Text) and item.terminated:
+            low += 1
+            high = None
+        elif isinstance(item, Bytes | Text) and isinstance(item.size, str) and item.size != "rest":
             counter = by_name.get(item.size)
             most = int(counter.maximum) if isinstance(counter, Scalar) else None
             high = None if high is None or most is None else high + most

@@ -12,6 +12,7 @@ from typing import Any
 from serialspec.emit.common import render as common
 from serialspec.emit.common.numbers import number
 from serialspec.emit.common.text import collapse
+from serialspec.spec import expression
 from serialspec.spec.model import (
     Array,
     Bytes,
@@ -21,12 +22,14 @@ from serialspec.spec.model import (
     Field,
     FrameLayout,
     Group,
+    List,
     Message,
     Protocol,
     Scalar,
     TableBlock,
     TableEntry,
     TableValue,
+    Text,
     fixed_size,
 )
 
@@ -55,6 +58,15 @@ def type_name(f: Field) -> str:
         return name
     if isinstance(f, Array):
         return f"{f.item.name}[{f.count}]"
+    if isinstance(f, List):
+        item = "bits (8 per byte, first in bit 0)" if f.item is None else f"{f.item.name} list"
+        if f.size:
+            return f"{item}, {f.size} bytes"
+        return f"{item}, up to the end" if f.count == "rest" else f"{item} × {f.count}"
+    if isinstance(f, Text):
+        if f.size is None:
+            return "text, NUL-terminated"
+        return "text (rest of content)" if f.size == "rest" else f"text ({f.size} bytes)"
     if isinstance(f, Bytes):
         size = "rest of content" if f.size == "rest" else f.size
         return f"bytes ({size})"
@@ -70,6 +82,8 @@ def range_text(f: Field) -> str:
     if isinstance(f, Scalar):
         if f.const is not None:
             return f"= {f.const:#04x}"
+        if f.value is not None:
+            return f"= {expression.show(f.value)}"
         if f.derived:
             return "derived: " + (
                 f"number of {f.derived[1]}" if f.derived[0] == "count" else f"size of each {f.derived[1]}"
@@ -77,7 +91,7 @@ def range_text(f: Field) -> str:
         if f.bits:
             return ""
         return f"{number(f.minimum)}..{number(f.maximum)}"
-    if isinstance(f, Array):
+    if isinstance(f, Array) or (isinstance(f, List) and f.item is not None):
         return f"{number(f.minimum)}..{number(f.maximum)}"
     return ""
 
@@ -115,7 +129,7 @@ def field_rows(fields: tuple[Field, ...], start: int | None, prefix: str = "") -
         where = "" if offset is None else (str(offset) if size in (None, 1) else f"{offset}..{offset + size - 1}")
         if offset is not None and size is None:
             where = f"{offset}.."
-        unit = f.unit if isinstance(f, Scalar | Array) else ""
+        unit = f.unit if isinstance(f, Scalar | Array | List) else ""
         rows.append(Row(where, prefix + f.name, type_name(f), unit, range_text(f), meaning(f)))
         if isinstance(f, Group):
             rows += field_rows(f.fields, None, prefix + f.name + "[].")

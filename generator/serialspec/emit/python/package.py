@@ -179,7 +179,11 @@ def codec_context(protocol: Protocol, code: PackageCode, exports: list[str]) -> 
     header_choices = " or ".join(layouts[d].header.hex(" ") for d in Direction)
     encoder_table = [(m.class_name, encoder_name(m)) for m in protocol.messages()]
     codec_names = names_used_in_codec(code)
+    used = "\n".join(line for _, _, _, lines in code.decoders for line in lines)
+    used += "\n".join(line for _, _, lines in code.encoders for line in lines)
+    packing = [f"{n} as _{n}" for n in ("decode_text", "encode_text", "pack_bits", "unpack_bits") if f"_{n}(" in used]
     return {
+        "packing_import": ", ".join(packing),
         "checksum_import": checksum_import,
         "checksum_definition": checksum_definition,
         "structs": sorted(code.structs.items()),

@@ -128,8 +128,8 @@ class Commands(FieldResolver):
             seen: dict[int | None, str] = {}
             for command in commands:
                 has = any(m.direction == direction for m in command.messages())
-                if not has:
-                    continue
+                if not has or any(m.error_reply for m in command.messages()):
+                    continue  # an error reply has the code of the request it refuses (see passes/errors.py)
                 path: Path = ("commands", command.name)
                 if layout.command_offset is None:
                     if command.code is not None:
@@ -165,6 +165,8 @@ class Commands(FieldResolver):
                     self.error((*path, "fields", field.name, "status"), "a status is reported in a response")
         if answered_by and direction != Direction.REQUEST:
             self.error((*path, "answered_by"), "`answered_by` names the response that answers a request")
+        if value.get("error_reply") and direction != Direction.RESPONSE:
+            self.error((*path, "error_reply"), "an error reply is a response")
         return Message(
             command=command,
             subcommand=subcommand,
@@ -183,6 +185,7 @@ class Commands(FieldResolver):
             after=self.after(value.get("after"), fields, direction, path),
             answered_by=str(answered_by.get("command", "")),
             reply_when=self.optional_when(answered_by.get("optional_when"), (*path, "answered_by", "optional_when")),
+            error_reply=bool(value.get("error_reply", False)),
         )
 
     def table_entry(self, text: str, path: Path) -> tuple[Table, TableEntry]:

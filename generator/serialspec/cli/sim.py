@@ -22,7 +22,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         type=int,
         action="append",
         metavar="N",
-        help="a device id on the bus (repeat for several; default 0)",
+        help="a device id on the bus (repeat for several; default: the spec's `device.ids`, else 0)",
+    )
+    parser.add_argument(
+        "--size",
+        dest="sizes",
+        action="append",
+        metavar="SPACE=N",
+        help="number of items of a data space (repeat for several; Modbus: coils=20000)",
     )
     parser.add_argument("--quiet", action="store_true", help="do not log requests on stderr")
 
@@ -33,7 +40,17 @@ def run(args: argparse.Namespace) -> int:
         module = importlib.import_module(f"{protocol.name}.simulator")
     except ImportError:
         raise SerialspecError(f"{args.spec} has no `device:` section, so no simulator is generated") from None
-    simulator = module.SIMULATOR(args.ids or [0])
+    sizes: dict[str, int] = {}
+    for text in args.sizes or ():
+        name, _, count = text.partition("=")
+        if not count.isdigit() or int(count) < 1:
+            raise SerialspecError(f"--size {text}: expected SPACE=N with N a positive number")
+        sizes[name] = int(count)
+    options: dict[str, object] = {"sizes": sizes} if sizes else {}
+    try:
+        simulator = module.SIMULATOR(args.ids, **options) if args.ids else module.SIMULATOR(**options)
+    except (TypeError, ValueError) as exc:  # sizes for a device without data spaces, or an unknown space
+        raise SerialspecError(f"{args.spec}: {exc}") from None
     controller, path = simulator.open_pty()
 
     def stop(signum: int, frame: FrameType | None) -> None:

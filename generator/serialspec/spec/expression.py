@@ -60,6 +60,13 @@ class BinOp:
 
 
 @dataclass(frozen=True)
+class Invert:
+    """`~a`: every bit flipped (a Python int's ~, so -a - 1; whoever stores it masks it to its width)."""
+
+    operand: Expr
+
+
+@dataclass(frozen=True)
 class Ceil:
     """`ceil(numerator / denominator)`: integer division rounding up."""
 
@@ -73,7 +80,7 @@ class MinMax:
     args: tuple[Expr, ...]
 
 
-Expr = Const | Name | Length | BinOp | Ceil | MinMax
+Expr = Const | Name | Length | BinOp | Invert | Ceil | MinMax
 
 
 def parse(text: str) -> Expr:
@@ -94,6 +101,8 @@ def _convert(node: ast.expr, text: str) -> Expr:
         return Name(node.id)
     if isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.USub):
         return BinOp("-", Const(0), _convert(node.operand, text))
+    if isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.Invert):
+        return Invert(_convert(node.operand, text))
     if isinstance(node, ast.BinOp) and type(node.op) in _OPERATORS:
         return BinOp(_OPERATORS[type(node.op)], _convert(node.left, text), _convert(node.right, text))
     if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and not node.keywords:
@@ -113,7 +122,7 @@ def _convert(node: ast.expr, text: str) -> Expr:
     shown = ast.get_source_segment(text, node) or type(node).__name__
     raise ExpressionError(
         f"{text!r}: {shown!r} is not allowed (integers, field names, len(), ceil(a / b), min(), max(), "
-        "+ - * / % & | << >>)"
+        "+ - * / % & | << >> ~)"
     )
 
 
@@ -124,6 +133,8 @@ def names(expr: Expr) -> Iterator[str]:
     elif isinstance(expr, BinOp):
         yield from names(expr.left)
         yield from names(expr.right)
+    elif isinstance(expr, Invert):
+        yield from names(expr.operand)
     elif isinstance(expr, Ceil):
         yield from names(expr.numerator)
         yield from names(expr.denominator)
@@ -144,6 +155,8 @@ def render(expr: Expr, name: Callable[[str], str]) -> str:
     if isinstance(expr, BinOp):
         op = "//" if expr.op == "/" else expr.op
         return f"({render(expr.left, name)} {op} {render(expr.right, name)})"
+    if isinstance(expr, Invert):
+        return f"(~{render(expr.operand, name)})"
     if isinstance(expr, Ceil):
         return f"(-(-{render(expr.numerator, name)} // {render(expr.denominator, name)}))"
     return f"{expr.function}({', '.join(render(arg, name) for arg in expr.args)})"
@@ -159,6 +172,8 @@ def show(expr: Expr) -> str:
         return f"len({expr.name})"
     if isinstance(expr, BinOp):
         return f"{_operand(expr.left)} {expr.op} {_operand(expr.right)}"
+    if isinstance(expr, Invert):
+        return f"~{_operand(expr.operand)}"
     if isinstance(expr, Ceil):
         return f"ceil({_operand(expr.numerator)} / {_operand(expr.denominator)})"
     return f"{expr.function}({', '.join(show(arg) for arg in expr.args)})"
@@ -183,6 +198,8 @@ def evaluate(expr: Expr, values: Mapping[str, object]) -> int:
     if isinstance(expr, BinOp):
         left, right = evaluate(expr.left, values), evaluate(expr.right, values)
         return _APPLY[expr.op](left, right)
+    if isinstance(expr, Invert):
+        return ~evaluate(expr.operand, values)
     if isinstance(expr, Ceil):
         return -(-evaluate(expr.numerator, values) // evaluate(expr.denominator, values))
     found = [evaluate(arg, values) for arg in expr.args]

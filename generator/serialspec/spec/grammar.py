@@ -508,11 +508,37 @@ ERRATUM = Obj(
     required=("source", "printed", "correct", "check"),
 )
 
+SPACE_ACCESS = Obj(
+    {
+        "space": Str("The data space (an entry of the device's `spaces:`)."),
+        "start": Str("The request field holding the first item's address."),
+        "count": Str("reads: the request field holding how many items are read."),
+        "value": Str(
+            "writes: what is stored, as an expression of the request's fields and `current` (the item's present "
+            "value), e.g. Modbus Mask Write `(current & and_mask) | (or_mask & ~and_mask)`; default: the field."
+        ),
+    },
+    required=("space", "start"),
+    description="A run of items of a data space, from the address a request field gives.",
+)
+
 DEVICE_COMMAND = Obj(
     {
         "description": TEXT,
-        "reads": ListOf(Str(), "Response fields filled from memory: table_value by its key, table_block entries."),
-        "writes": ListOf(Str(), "Request fields stored in memory: table_value by its key, table_block entries."),
+        "reads": OneOf(
+            (
+                ListOf(Str(), "Response fields filled from memory: table_value by its key, table_block entries."),
+                MapOf(SPACE_ACCESS, "Response field -> the run of a data space it holds (Modbus registers)."),
+            ),
+            "a list of response fields read from memory, or a mapping response field -> data space run",
+        ),
+        "writes": OneOf(
+            (
+                ListOf(Str(), "Request fields stored in memory: table_value by its key, table_block entries."),
+                MapOf(SPACE_ACCESS, "Request field -> the run of a data space it is stored in (a value or a list)."),
+            ),
+            "a list of request fields stored in memory, or a mapping request field -> data space run",
+        ),
         "resets": Bool("Memory goes back to its defaults."),
         "reports": MapOf(Str(), "Response field -> the state variable or memory entry it reports."),
         "moves": Obj(
@@ -556,6 +582,32 @@ DEVICE = Obj(
             "Replies carry the id the request named (RRC: 0xFE for a broadcast read), not the answering device's own."
         ),
         "commands": MapOf(DEVICE_COMMAND, "Command (or command.subcommand) -> behaviour; others just answer."),
+        "ids": ListOf(Int(), "The device ids the simulator serves when none are given (default: 0)."),
+        "spaces": MapOf(
+            Obj(
+                {
+                    "type": Str(
+                        "The item type: `bit`, or an unsigned integer type.", choices=("bit", "u8", "u16", "u32")
+                    ),
+                    "size": Int("Number of items, addressed 0..size-1 (the simulator can be given other sizes)."),
+                    "access": Str(choices=("r", "rw")),
+                    "description": TEXT,
+                },
+                required=("type", "size"),
+            ),
+            "Data spaces the device keeps besides its table: runs of items addressed by number, all zero at "
+            "first (Modbus coils, discrete inputs, holding and input registers).",
+        ),
+        "errors": Obj(
+            {
+                "field": Str("The error reply's field that says why (Modbus exception_code)."),
+                "out_of_space": Int("Value when a run reaches beyond its data space (Modbus 2)."),
+                "out_of_range": Int("Value when a request value is outside its range or enum (Modbus 3)."),
+                "read_only": Int("Value when a write reaches a data space that is read-only."),
+            },
+            required=("field",),
+            description="How the device refuses a request with the protocol's error reply (`error_reply:`).",
+        ),
         "kinds": MapOf(
             Obj(
                 {

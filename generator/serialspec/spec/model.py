@@ -475,6 +475,37 @@ class Motion:
 
 
 @dataclass(frozen=True)
+class Space:
+    """A data space a device keeps: `size` items addressed 0..size-1, bits or unsigned integers, all 0 at first."""
+
+    name: str
+    item: ScalarType | None  # None: bits
+    size: int
+    access: str
+    description: str
+
+
+@dataclass(frozen=True)
+class SpaceAccess:
+    """A run of a data space from the address in the request field `start` (`count` items, for reads)."""
+
+    space: str
+    start: str
+    count: str = ""
+    value: Expr | None = None  # writes: what is stored, from the request's fields and `current`
+
+
+@dataclass(frozen=True)
+class DeviceErrors:
+    """How a device refuses a request with the protocol's error reply: the field saying why, and its values."""
+
+    field: str
+    out_of_space: int | None
+    out_of_range: int | None
+    read_only: int | None
+
+
+@dataclass(frozen=True)
 class Behaviour:
     """What a device does with one command's request, besides answering it."""
 
@@ -492,6 +523,8 @@ class Behaviour:
     stores: dict[str, str] = field(default_factory=dict)  # request field -> state variable
     sets: dict[str, float] = field(default_factory=dict)  # state variable -> value
     absent: dict[str, float] = field(default_factory=dict)  # response values when no device has the id
+    space_reads: dict[str, SpaceAccess] = field(default_factory=dict)  # response field -> run read
+    space_writes: dict[str, SpaceAccess] = field(default_factory=dict)  # request field -> run written
 
 
 @dataclass(frozen=True)
@@ -523,6 +556,9 @@ class Device:
     status: dict[str, str] = field(default_factory=dict)  # response field -> memory entry every reply reports
     kinds: tuple[DeviceKind, ...] = ()
     echo_address: bool = False  # replies carry the id the request named, not the answering device's own
+    ids: tuple[int, ...] = (0,)  # the ids the simulator serves by default
+    spaces: tuple[Space, ...] = ()
+    errors: DeviceErrors | None = None
 
     def behaviour(self, key: str) -> Behaviour | None:
         return next((b for b in self.behaviours if b.command == key), None)

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Iterator
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from serialspec.emit.common.numbers import number
 from serialspec.emit.common.text import collapse
@@ -194,11 +194,17 @@ class PackageCode:
     def value_fields(self, message: Message) -> list[SpecField]:
         return [f for f in message.fields if not (isinstance(f, Scalar) and f.hidden)]
 
-    def frame_values(self, direction: Direction) -> list[Scalar]:
-        """Frame-level values (SMS id, error) every message of a direction carries, as scalar fields."""
+    def frame_values(self, direction: Direction, message: Message | None = None) -> list[Scalar]:
+        """Frame-level values (SMS id, error) every message of a direction carries, as scalar fields; an error reply
+        (Modbus exception) also carries the code of the request it refuses, named after the command element."""
         layout = self.protocol.framing.layouts[direction]
         values = []
-        for element in layout.value_elements:
+        elements = list(layout.value_elements)
+        error = self.protocol.error_reply
+        if message is not None and message.error_reply and error is not None:
+            element = next(e for e in layout.elements if e.name == error.element)
+            elements.append(replace(element, minimum=0, maximum=error.flag - 1, flags=None))
+        for element in elements:
             assert element.type is not None
             values.append(
                 Scalar(
@@ -335,7 +341,7 @@ class PackageCode:
     def message(self, message: Message) -> None:
         for f in message.fields:
             self.helper(f)
-        fields = [*self.frame_values(message.direction), *self.value_fields(message)]
+        fields = [*self.frame_values(message.direction, message), *self.value_fields(message)]
         doc = f"{message.command} {message.subcommand or ''} {message.direction.value}".replace("  ", " ")
         code = ClassCode(message.class_name, doc, "Message", self.attribute_lines(fields))
         code.class_vars = [
@@ -347,7 +353,7 @@ class PackageCode:
         code.to_fields = [f"{f.name!r}: {self.to_json(f, 'self.' + f.name)}," for f in fields]
         code.from_fields = [f"{self.from_json(f)}," for f in fields]
         self.message_classes.append(code)
-        frame_names = [f.name for f in self.frame_values(message.direction)]
+        frame_names = [f.name for f in self.frame_values(message.direction, message)]
         extra = "".join(f", {name}: int" for name in frame_names)
         self.decoders.append((decoder_name(message), message.class_name, extra, self.decoder(message, fields)))
         self.encoders.append((encoder_name(message), message.class_name, self.encoder(message, fields)))

@@ -9,11 +9,15 @@ from serialspec.emit.common.pairing import request_response_pairs
 from serialspec.emit.python.pycode import one_line
 from serialspec.emit.python.registers import map_name, register_tables
 from serialspec.emit.python.render import render
+from serialspec.spec import expression
 from serialspec.spec.model import (
     Bytes,
     Group,
+    List,
     Message,
     Protocol,
+    Scalar,
+    SpaceAccess,
     TableBlock,
     TableValue,
     reply_condition,
@@ -36,6 +40,34 @@ def table_fields(*messages: Message | None) -> dict[str, tuple[str, ...]]:
         elif isinstance(f, Group):
             stack.extend(reversed(f.fields))
     return found
+
+
+def limits(request: Message) -> dict[str, tuple[float, float, tuple[int, ...]]]:
+    """The request values a device checks before it acts (Modbus: quantities, coil values): every scalar whose
+    range is narrower than its type's or that has an enum, and the number of items of a list whose count field
+    has a range."""
+    found: dict[str, tuple[float, float, tuple[int, ...]]] = {}
+    counted = {f.count: f.name for f in request.fields if isinstance(f, List) and isinstance(f.count, str)}
+    for f in request.fields:
+        if not isinstance(f, Scalar) or f.const is not None or f.bits:
+            continue
+        narrower = (f.minimum, f.maximum) != (f.type.minimum, f.type.maximum)
+        if f.hidden and f.name in counted and narrower:
+            found[counted[f.name]] = (f.minimum, f.maximum, ())
+        elif not f.hidden and (narrower or f.enum):
+            allowed = tuple(v.value for v in f.enum.values) if f.enum else ()
+            found[f.name] = (f.minimum, f.maximum, allowed)
+    return found
+
+
+def run_spec(run: SpaceAccess) -> str:
+    args = [repr(run.space), repr(run.start)]
+    if run.count:
+        args.append(f"count={run.count!r}")
+    if run.value is not None:
+        body = expression.render(run.value, lambda n: "current" if n == "current" else f"fields[{n!r}]")
+        args.append(f"value=lambda current, fields: {body}")
+    return f"RunSpec({', '.join(args)})"
 
 
 def import_order(name: str) -> tuple[int, str]:
@@ -79,6 +111,17 @@ def simulator_module(protocol: Protocol) -> str:
             for name in ("kind", "each", "stores", "sets", "absent", "buffered", "commits"):
                 if getattr(behaviour, name):
                     args.append(f"{name}={getattr(behaviour, name)!r}")
+            for name in ("space_reads", "space_writes"):
+                runs = getattr(behaviour, name)
+                if runs:
+                    args.append(f"{name}={{{', '.join(f'{k!r}: {run_spec(r)}' for k, r in runs.items())}}}")
+        if device.errors is not None:
+            code = protocol.command(request.command).code
+            args.append(f"code={code!r}")
+            checked = limits(request)
+            if checked:
+                shown = ", ".join(f"{k!r}: ({number(lo)}, {number(hi)}, {v!r})" for k, (lo, hi, v) in checked.items())
+                args.append(f"limits={{{shown}}}")
         condition = reply_condition(request, response)
         if response and condition:
             args.append(f"optional_when=({condition.key}, {condition.equals})")
@@ -88,8 +131,33 @@ def simulator_module(protocol: Protocol) -> str:
         if tables:
             args.append(f"tables={tables!r}")
         commands.append({"key": request.key, "args": args})
+    spaces = [
+        f"SpaceSpec({s.name!r}, {s.size}, {s.item is None}, {1 if s.item is None else int(s.item.maximum)}, "
+        f"{s.access!r}),"
+        for s in device.spaces
+    ]
+    error = ""
+    if device.errors is not None and protocol.error_reply is not None:
+        reply = protocol.command(protocol.error_reply.command).response
+        assert reply is not None
+        imports.add(reply.class_name)
+        e = device.errors
+        error = (
+            f"ErrorSpec({reply.class_name}, {protocol.error_reply.element!r}, {e.field!r}, "
+            f"out_of_space={e.out_of_space!r}, out_of_range={e.out_of_range!r}, read_only={e.read_only!r})"
+        )
+    runtime = ["CommandSpec", "DeviceSpec"]
+    runtime += ["EntrySpec"] if entries else []
+    runtime += ["ErrorSpec"] if error else []
+    runtime += ["KindSpec"] if device.kinds else []
+    runtime += ["RunSpec"] if any(b.space_reads or b.space_writes for b in device.behaviours) else []
+    runtime += ["Simulator"]
+    runtime += ["SpaceSpec"] if spaces else []
     return render(
         "simulator.py.j2",
+        runtime_imports=", ".join(runtime),
+        spaces=spaces,
+        error=error,
         spec_path=protocol.spec_path,
         title=one_line(protocol.title),
         package=protocol.name,
@@ -108,5 +176,5 @@ def simulator_module(protocol: Protocol) -> str:
         echo_address=device.echo_address,
         kinds=[f"KindSpec({k.name!r}, {k.address!r}, {k.ids!r}, {k.broadcast!r}, {k.state!r})," for k in device.kinds],
         imports=sorted(imports | {"Direction"}, key=import_order),
-        default_id=0,
+        default_ids=repr(device.ids) if len(device.ids) > 1 else f"({device.ids[0]},)",
     )

@@ -18,10 +18,23 @@ pseudo-terminal) and is the same for every protocol:
 - further `kinds` of device (a board's PWM servo ports, its motors) have their own ids, address field and state;
   a command names its kind; a request for an id no device has is answered with `absent` values if the command
   gives them (a board answering for a servo that is not there), else not at all;
+- data `spaces` (Modbus coils and registers): runs of items read into a response field or written from a request
+  field; a request whose values the device does not accept (`limits`), whose run reaches beyond its space, or
+  that writes a read-only space gets the protocol's error reply (Modbus exceptions 3 and 2);
 - `emit()` sends a message on the device's own initiative (reports, key events) for tests.
 """
 
-from serialspec.runtime.device.engine import CommandSpec, DeviceSpec, Engine, EntrySpec, KindSpec, VirtualDevice
+from serialspec.runtime.device.engine import (
+    CommandSpec,
+    DeviceSpec,
+    Engine,
+    EntrySpec,
+    ErrorSpec,
+    KindSpec,
+    RunSpec,
+    SpaceSpec,
+    VirtualDevice,
+)
 from serialspec.runtime.device.faults import FAULTS, Fault
 from serialspec.runtime.device.server import Simulator
 
@@ -31,8 +44,11 @@ __all__ = [
     "DeviceSpec",
     "Engine",
     "EntrySpec",
+    "ErrorSpec",
     "Fault",
     "KindSpec",
+    "RunSpec",
     "Simulator",
+    "SpaceSpec",
     "VirtualDevice",
 ]

@@ -29,6 +29,41 @@ class EntrySpec:
 
 
 @dataclass(frozen=True)
+class SpaceSpec:
+    """A data space: `size` items (bits, or unsigned integers up to `maximum`) addressed 0..size-1, all 0 at first."""
+
+    name: str
+    size: int
+    bits: bool
+    maximum: int
+    access: str = "rw"
+
+
+@dataclass(frozen=True)
+class RunSpec:
+    """A run of a data space from the address in the request field `start`; `count` items for reads; for writes,
+    `value(current, fields)` computes what is stored (default: the request field's value)."""
+
+    space: str
+    start: str
+    count: str = ""
+    value: Callable[[int, dict[str, Any]], int] | None = None
+
+
+@dataclass(frozen=True)
+class ErrorSpec:
+    """The protocol's error reply: its class, the member holding the refused request's code, the member saying why
+    and the reasons' values (Modbus: function | 0x80, exception_code 2 / 3)."""
+
+    response: type[Message]
+    code_field: str
+    field: str
+    out_of_space: int | None = None
+    out_of_range: int | None = None
+    read_only: int | None = None
+
+
+@dataclass(frozen=True)
 class CommandSpec:
     """What a device does with one request type."""
 
@@ -51,6 +86,11 @@ class CommandSpec:
     absent: dict[str, float] = field(default_factory=dict)  # response values when no device has the id
     buffered: bool = False  # the writes wait for a command that commits (REG WRITE)
     commits: bool = False  # carries out the buffered writes (ACTION)
+    code: int | None = None  # the request's code, for an error reply that refuses it
+    # request value -> (lowest, highest, allowed values or ()) the device accepts; for a list, its number of items
+    limits: dict[str, tuple[float, float, tuple[int, ...]]] = field(default_factory=dict)
+    space_reads: dict[str, RunSpec] = field(default_factory=dict)  # response field -> run of a data space
+    space_writes: dict[str, RunSpec] = field(default_factory=dict)  # request field -> run of a data space
 
 
 @dataclass(frozen=True)
@@ -79,6 +119,8 @@ class DeviceSpec:
     echo_address: bool = False  # replies carry the id the request named, not the answering device's own
     registers: RegisterMap | None = None  # memory as registers at byte addresses, for run reads/writes
     status: dict[str, str] = field(default_factory=dict)  # response field -> memory entry every reply reports
+    spaces: tuple[SpaceSpec, ...] = ()
+    error: ErrorSpec | None = None
 
 
 @dataclass
@@ -97,9 +139,16 @@ class _Motion:
 class VirtualDevice:
     """One device on the virtual bus: its memory and state variables."""
 
-    def __init__(self, spec: DeviceSpec, device_id: int, clock: Callable[[], float] = time.monotonic) -> None:
+    def __init__(
+        self,
+        spec: DeviceSpec,
+        device_id: int,
+        clock: Callable[[], float] = time.monotonic,
+        sizes: dict[str, int] | None = None,
+    ) -> None:
         self.spec = spec
         self.clock = clock
+        self.spaces: dict[str, list[int]] = {s.name: [0] * (sizes or {}).get(s.name, s.size) for s in spec.spaces}
         self.by_name = {e.name: e for e in spec.entries}
         self.by_key = {e.key: e for e in spec.entries}
         self.memory: dict[int, float] = {}
@@ -165,12 +214,17 @@ class Engine(FaultInjection):
         encode: Callable[[Message], bytes],
         parser: Callable[[], StreamParser],
         clock: Callable[[], float] = time.monotonic,
+        sizes: dict[str, int] | None = None,
     ) -> None:
         self.spec = spec
         self.encode = encode
         self.clock = clock
         self.parser = parser()
-        self.devices: dict[int, VirtualDevice] = {i: VirtualDevice(spec, i, clock) for i in ids}
+        unknown = set(sizes or {}) - {s.name for s in spec.spaces}
+        if unknown:
+            known = ", ".join(s.name for s in spec.spaces) or "none"
+            raise ValueError(f"unknown data space(s) {', '.join(sorted(unknown))} (this device has: {known})")
+        self.devices: dict[int, VirtualDevice] = {i: VirtualDevice(spec, i, clock, sizes) for i in ids}
         # Each further kind: its devices, built from a DeviceSpec holding that kind's address and state.
         self.kinds: dict[str, dict[int, VirtualDevice]] = {}
         self._kind_specs: dict[str, DeviceSpec] = {}
@@ -260,6 +314,10 @@ class Engine(FaultInjection):
     ) -> bytes | None:
         """Carry out a request on one device (`given`: its fields, an `each` item's merged in); the reply or None."""
         given = request.to_fields() if given is None else given
+        if command.limits or command.space_reads or command.space_writes:
+            reason = self._refusal(device, command, given)
+            if reason is not None:
+                return self._error_reply(device, command, reason)
         refused = False
         # Whether an optional reply is due is decided on the switch as the request finds it (a write that turns
         # replies off is still answered), which is also what a client that remembers the switch expects.
@@ -277,6 +335,8 @@ class Engine(FaultInjection):
             buffered, device.buffered = device.buffered, []
             for held_command, name, held in buffered:
                 self._write(device, held_command, name, held, written)
+        for name, run in command.space_writes.items():
+            self._write_space(device, run, given[name], given)
         if command.moves:
             self._move(device, command.moves, given, written)
         for name, state in command.stores.items():
@@ -297,7 +357,9 @@ class Engine(FaultInjection):
         values: dict[str, Any] = {}
         for attribute in dataclasses.fields(command.response):  # type: ignore[arg-type]
             name = attribute.name
-            if name in command.reads:
+            if name in command.space_reads:
+                values[name] = self._read_space(device, command.space_reads[name], given)
+            elif name in command.reads:
                 value = self._read(device, command, name, given)
                 if value is None:
                     return None  # an unknown key: a device stays silent
@@ -319,6 +381,56 @@ class Engine(FaultInjection):
         if refused:
             values.update(self.spec.refused)
         return self._encode_reply(command.response, values)
+
+    # --- data spaces and error replies ------------------------------------------------------------------------------
+
+    def _refusal(self, device: VirtualDevice, command: CommandSpec, given: dict[str, Any]) -> int | None:
+        """Why the device refuses a request (the error reply's reason), or None: values outside what the device
+        accepts first, then runs beyond their data space, then writes to a read-only space."""
+        error = self.spec.error
+        if error is None:
+            return None
+        for name, (low, high, allowed) in command.limits.items():
+            value = given.get(name)
+            value = len(value) if isinstance(value, list | tuple) else value
+            if isinstance(value, int | float) and (not low <= value <= high or (allowed and value not in allowed)):
+                return error.out_of_range
+        spaces = {s.name: s for s in self.spec.spaces}
+        runs = [(run, int(given[run.count]) if run.count else 1) for run in command.space_reads.values()]
+        runs += [(run, _items(given[name])) for name, run in command.space_writes.items()]
+        for run, count in runs:
+            start = int(given[run.start])
+            if start + count > len(device.spaces[run.space]):
+                return error.out_of_space
+        for run in command.space_writes.values():
+            if spaces[run.space].access == "r":
+                return error.read_only
+        return None
+
+    def _error_reply(self, device: VirtualDevice, command: CommandSpec, reason: int | None) -> bytes | None:
+        error = self.spec.error
+        if error is None or reason is None:
+            return None
+        values = {error.code_field: command.code or 0, error.field: reason}
+        if self.spec.address:
+            values[self.spec.address] = device.id
+        return self._encode_reply(error.response, values)
+
+    def _read_space(self, device: VirtualDevice, run: RunSpec, given: dict[str, Any]) -> list[Any]:
+        start = int(given[run.start])
+        items = device.spaces[run.space][start : start + (int(given[run.count]) if run.count else 1)]
+        space = next(s for s in self.spec.spaces if s.name == run.space)
+        return [bool(v) for v in items] if space.bits else list(items)
+
+    def _write_space(self, device: VirtualDevice, run: RunSpec, value: Any, given: dict[str, Any]) -> None:
+        space = next(s for s in self.spec.spaces if s.name == run.space)
+        items = device.spaces[run.space]
+        start = int(given[run.start])
+        values = list(value) if isinstance(value, list | tuple) else [value]
+        for offset, item in enumerate(values):
+            current = items[start + offset]
+            stored = run.value(current, given) if run.value is not None else int(item)
+            items[start + offset] = (1 if stored else 0) if space.bits else stored & space.maximum
 
     def _move(
         self, device: VirtualDevice, moves: tuple[str, str, str, str], given: dict[str, Any], written: set[str]
@@ -413,3 +525,8 @@ class Engine(FaultInjection):
             return ok
         device.set(name, given[name])
         return True
+
+
+def _items(value: Any) -> int:
+    """How many items of a data space a written value covers: a list's length, else one."""
+    return len(value) if isinstance(value, list | tuple) else 1

@@ -35,8 +35,9 @@ class Simulator(Engine):
         encode: Callable[[Message], bytes],
         parser: Callable[[], StreamParser],
         clock: Callable[[], float] = time.monotonic,
+        sizes: dict[str, int] | None = None,
     ) -> None:
-        super().__init__(spec, ids, encode=encode, parser=parser, clock=clock)
+        super().__init__(spec, ids, encode=encode, parser=parser, clock=clock, sizes=sizes)
         self._emitted: deque[bytes] = deque()  # frames emit() hands to the serving thread
         self._outbox: list[_Scheduled] = []
         self._seq = 0

@@ -4,17 +4,23 @@ from __future__ import annotations
 
 from typing import Any
 
+from serialspec.spec import expression
 from serialspec.spec.errors import SpecError
 from serialspec.spec.loader import Path
 from serialspec.spec.model import (
+    SCALARS,
     Behaviour,
     Command,
     Device,
+    DeviceErrors,
     DeviceKind,
     Direction,
     Framing,
     Group,
+    Message,
     Motion,
+    Space,
+    SpaceAccess,
     replies_by_request,
     reply_to,
 )
@@ -42,14 +48,15 @@ class DevicePass(Pass):
             (e for layout in framing.layouts.values() for e in layout.value_elements if e.role == "address"), None
         )
         address = str(value.get("address") or (address_element.name if address_element else ""))
-        if not address:
-            self.error(path, "name the field holding the device id with `address:`")
+        # a protocol without an address element (VESC) has one device per port: then no address is needed
         broadcast = value.get("broadcast", address_element.broadcast if address_element else None)
         id_entry = str(value.get("id_entry", ""))
         if id_entry and id_entry not in entries and id_entry not in (value.get("state") or {}):
             self.error((*path, "id_entry"), f"unknown memory entry or state variable {id_entry!r}")
         state = {str(k): float(v) for k, v in (value.get("state") or {}).items()}
         requests = {m.key: m for c in commands for m in c.messages() if m.direction == Direction.REQUEST}
+        spaces = self.spaces(value.get("spaces") or {}, (*path, "spaces"))
+        errors = self.errors(value.get("errors"), (*path, "errors"), commands)
         replies = replies_by_request(m for c in commands for m in c.messages())
         kinds = {
             str(name): DeviceKind(
@@ -81,10 +88,12 @@ class DevicePass(Pass):
             item_fields = group.fields if group else ()
             request_names = {f.name for f in (*request.fields, *item_fields)}
             response_names = {f.name for f in response.fields} if response else set()
-            for name in item.get("reads") or ():
+            space_reads = self.space_runs(item.get("reads"), response_names, request, spaces, (*item_path, "reads"))
+            space_writes = self.space_runs(item.get("writes"), request_names, request, spaces, (*item_path, "writes"))
+            for name in item.get("reads") or () if not space_reads else ():
                 if name not in response_names:
                     self.error((*item_path, "reads"), f"{key} has no response field {name!r}")
-            for name in item.get("writes") or ():
+            for name in item.get("writes") or () if not space_writes else ():
                 if name not in request_names:
                     self.error((*item_path, "writes"), f"{key} has no request field {name!r}")
             reports = {str(k): str(v) for k, v in (item.get("reports") or {}).items()}
@@ -125,8 +134,8 @@ class DevicePass(Pass):
             behaviours.append(
                 Behaviour(
                     key,
-                    tuple(item.get("reads") or ()),
-                    tuple(item.get("writes") or ()),
+                    () if space_reads else tuple(item.get("reads") or ()),
+                    () if space_writes else tuple(item.get("writes") or ()),
                     bool(item.get("resets", False)),
                     reports,
                     motion,
@@ -138,6 +147,8 @@ class DevicePass(Pass):
                     stores,
                     sets,
                     absent,
+                    space_reads,
+                    space_writes,
                 )
             )
         status = {str(k): str(v) for k, v in (value.get("status") or {}).items()}
@@ -158,4 +169,64 @@ class DevicePass(Pass):
             status=status,
             kinds=tuple(kinds.values()),
             echo_address=bool(value.get("echo_address", False)),
+            ids=tuple(int(i) for i in value.get("ids") or (0,)),
+            spaces=tuple(spaces.values()),
+            errors=errors,
         )
+
+    def spaces(self, value: dict[str, Any], path: Path) -> dict[str, Space]:
+        found = {}
+        for name, item in value.items():
+            self.name(name, (*path, name), "data space name")
+            if item["size"] < 1:
+                self.error((*path, name, "size"), "a data space holds at least one item")
+            kind = item["type"]
+            found[name] = Space(
+                name,
+                None if kind == "bit" else SCALARS[kind],
+                int(item["size"]),
+                str(item.get("access", "rw")),
+                str(item.get("description", "")),
+            )
+        return found
+
+    def errors(self, value: Any, path: Path, commands: list[Command]) -> DeviceErrors | None:
+        if value is None:
+            return None
+        reply = next((m for c in commands for m in c.messages() if m.error_reply), None)
+        if reply is None:
+            raise self.fail(path, "`errors:` needs a command whose response is the `error_reply`")
+        field = str(value["field"])
+        if not any(f.name == field for f in reply.fields):
+            self.error((*path, "field"), f"the error reply {reply.command} has no field {field!r}")
+        return DeviceErrors(field, value.get("out_of_space"), value.get("out_of_range"), value.get("read_only"))
+
+    def space_runs(
+        self, value: Any, names: set[str], request: Message, spaces: dict[str, Space], path: Path
+    ) -> dict[str, SpaceAccess]:
+        """`reads:`/`writes:` given as field -> run of a data space (a list of names is memory, handled above)."""
+        if not isinstance(value, dict):
+            return {}
+        request_names = {f.name for f in request.fields}
+        runs = {}
+        for name, item in value.items():
+            item_path = (*path, name)
+            if name not in names:
+                self.error(item_path, f"{request.command} has no such field {name!r}")
+            if item["space"] not in spaces:
+                self.error((*item_path, "space"), f"unknown data space {item['space']!r} (not in `spaces:`)")
+            for role in ("start", "count"):
+                if item.get(role) and item[role] not in request_names:
+                    self.error((*item_path, role), f"{request.command} request has no field {item[role]!r}")
+            stored = None
+            if "value" in item:
+                try:
+                    stored = expression.parse(item["value"])
+                except expression.ExpressionError as exc:
+                    self.error((*item_path, "value"), str(exc))
+                else:
+                    for used in expression.names(stored):
+                        if used != "current" and used not in request_names:
+                            self.error((*item_path, "value"), f"unknown request field {used!r}")
+            runs[str(name)] = SpaceAccess(str(item["space"]), str(item["start"]), str(item.get("count", "")), stored)
+        return runs

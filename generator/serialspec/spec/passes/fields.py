@@ -340,6 +340,8 @@ def _nodes(expr: expression.Expr) -> list[expression.Expr]:
     elif isinstance(expr, expression.MinMax):
         for arg in expr.args:
             found += _nodes(arg)
+    elif isinstance(expr, expression.Invert):
+        found += _nodes(expr.operand)
     return found
 
 

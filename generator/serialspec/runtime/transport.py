@@ -19,7 +19,7 @@ from collections import deque
 from collections.abc import Callable, Iterator
 from contextlib import suppress
 from dataclasses import dataclass, field
-from enum import IntFlag
+from enum import Enum, IntFlag
 from typing import Any, TypeVar
 
 import serial
@@ -59,6 +59,26 @@ class SerialSettings:
 
 
 @dataclass(frozen=True)
+class ErrorReplies:
+    """A protocol's error reply (Modbus exception): its class, the member holding the code of the request it
+    refuses, the member saying why, and each command's code. The bus raises DeviceError when one answers."""
+
+    response: type[Message]
+    code_field: str
+    reason_field: str
+    codes: dict[str, int]  # command name -> code
+
+    def refuses(self, request: Message, reply: Message) -> bool:
+        code = self.codes.get(request.COMMAND)
+        return isinstance(reply, self.response) and code is not None and getattr(reply, self.code_field) == code
+
+    def describe(self, request: Message, reply: Message) -> str:
+        reason: Any = getattr(reply, self.reason_field)
+        name = f"{reason.name.lower()} ({reason.value})" if isinstance(reason, Enum) else str(reason)
+        return f"{request.COMMAND}: the device refuses it: {self.reason_field} = {name}"
+
+
+@dataclass(frozen=True)
 class Binding:
     """What a bus needs of one generated protocol package (the generated client builds it)."""
 
@@ -69,6 +89,7 @@ class Binding:
     match_by: tuple[str, ...]  # `command`, `subcommand` or field names, from the spec's `matching.by`
     status: tuple[str, ...] = ()  # reply fields whose non-zero value is a device error (frame status elements)
     describe_status: Callable[[str, int], str] = field(default=lambda name, value: f"{name} = {value:#04x}")
+    errors: ErrorReplies | None = None  # the protocol's error reply, if it has one
 
 
 def flag_names(flags: dict[str, type[IntFlag]]) -> Callable[[str, int], str]:
@@ -178,11 +199,27 @@ class Bus:
             self._ensure_open()
             self._drain()
             self._write(frame)
-            reply = self._read_until(lambda m: isinstance(m, expect) and self.matches(request, m), wait, request)
+            reply = self._read_until(lambda m: self._answers(request, expect, m), wait, request)
             self._flush_backlog()
+        errors = self.binding.errors
+        if errors is not None and errors.refuses(request, reply):
+            raise DeviceError(errors.describe(request, reply), reply)
         assert isinstance(reply, expect)
         self._check_status(reply)
         return reply
+
+    def _answers(self, request: Message, expect: type[Message], reply: Message) -> bool:
+        """The reply of the expected type that matches the request, or an error reply that refuses it."""
+        if isinstance(reply, expect):
+            return self.matches(request, reply)
+        errors = self.binding.errors
+        if errors is None or not errors.refuses(request, reply):
+            return False
+        return all(
+            getattr(request, name) == getattr(reply, name)
+            for name in self.binding.match_by
+            if name not in ("command", "subcommand") and hasattr(request, name) and hasattr(reply, name)
+        )
 
     def request_each(
         self, request: Message, expect: type[M], answers: list[dict[str, Any]], *, timeout: float | None = None

@@ -262,6 +262,10 @@ _FIELD_LONG: dict[str, Shape] = {
     ),
     "count": OneOf((Int(), Str()), "array/group: a number, `rest`, or the name of an earlier count field"),
     "of": Str("array: the item type (a scalar type, or `bit`: bools packed 8 to a byte, lowest bit first)."),
+    "count_from": Str(
+        "array of a response: the request field (request.<field>) saying how many items are meant, when the array "
+        "holds more (Modbus coils padded to a multiple of 8): clients keep that many."
+    ),
     "value": Str(
         "An integer field derived from the others by an expression, computed on encode and checked on decode: "
         "`2 * count`, `ceil(len(coils) / 8)` (names of fields, len(), ceil(a / b), min, max, + - * / % & | << >>)."

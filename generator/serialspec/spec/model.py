@@ -147,6 +147,7 @@ class List(Common):
     unit: str
     minimum: float
     maximum: float
+    count_from: str = ""  # a response's: the request field saying how many items are meant (the rest is padding)
 
     @property
     def bits(self) -> bool:

@@ -231,7 +231,15 @@ class FieldResolver(Pass):
             unit=str(spec.get("unit", "")),
             minimum=low,
             maximum=high,
+            count_from=self.count_from(spec.get("count_from"), (*path, "count_from")),
         )
+
+    def count_from(self, value: Any, path: Path) -> str:
+        if value is None:
+            return ""
+        if not str(value).startswith("request."):
+            self.error(path, "`count_from` names a field of the request: request.<field>")
+        return str(value).removeprefix("request.")
 
     def value_expression(self, text: Any, path: Path) -> expression.Expr | None:
         if text is None:

@@ -544,7 +544,11 @@ DEVICE_COMMAND = Obj(
             "a list of request fields stored in memory, or a mapping request field -> data space run",
         ),
         "resets": Bool("Memory goes back to its defaults."),
-        "reports": MapOf(Str(), "Response field -> the state variable or memory entry it reports."),
+        "reports": MapOf(
+            Str(),
+            "Response field -> the state variable or memory entry it reports, or an expression of them where the "
+            "units differ (VESC duty_now in 0.001 from a duty in 0.00001: `duty / 100`).",
+        ),
         "moves": Obj(
             {
                 "state": Str("The state variable (or memory entry) that moves."),
@@ -579,7 +583,10 @@ DEVICE = Obj(
         "id_entry": Str("The memory entry or state variable holding the device's id (writing it changes the address)."),
         "broadcast": Int("The address every device obeys (default: the address element's broadcast)."),
         "state": MapOf(Num(), "State variables beyond memory -> initial value (e.g. the present angle)."),
-        "reply": MapOf(Num(), "Response field -> value when no behaviour sets it (e.g. result: 1)."),
+        "reply": MapOf(
+            OneOf((Num(), Str()), "a number, or text for text and bytes fields (bytes as hex)"),
+            "Response field -> value when no behaviour sets it (e.g. result: 1; VESC hw_name: '60').",
+        ),
         "refused": MapOf(Num(), "Response field -> value when a write is refused (read-only or unknown entry)."),
         "status": MapOf(Str(), "Response field -> the memory entry every response reports in it (a status byte)."),
         "echo_address": Bool(
@@ -587,6 +594,16 @@ DEVICE = Obj(
         ),
         "commands": MapOf(DEVICE_COMMAND, "Command (or command.subcommand) -> behaviour; others just answer."),
         "ids": ListOf(Int(), "The device ids the simulator serves when none are given (default: 0)."),
+        "timeout": Obj(
+            {
+                "after": Int("Milliseconds without one of the `kept_by` commands after which the device gives up."),
+                "kept_by": ListOf(Str(), "The commands that restart the timeout (VESC: every setpoint, and ALIVE)."),
+                "sets": MapOf(Num(), "State variable -> its value once the timeout has expired (the motor released)."),
+                "description": TEXT,
+            },
+            required=("after", "kept_by", "sets"),
+            description="A command timeout: the device stops unless commands keep coming (VESC, 1 s by default).",
+        ),
         "spaces": MapOf(
             Obj(
                 {

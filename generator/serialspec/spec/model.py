@@ -529,6 +529,16 @@ class Behaviour:
 
 
 @dataclass(frozen=True)
+class DeviceTimeout:
+    """The device gives up (sets state variables) when none of `kept_by` arrives for `after` ms."""
+
+    after: int
+    kept_by: tuple[str, ...]
+    sets: dict[str, float]
+    description: str = ""
+
+
+@dataclass(frozen=True)
 class DeviceKind:
     """Devices of another kind behind the same port, with their own ids and state (a board's PWM servo ports)."""
 
@@ -551,7 +561,7 @@ class Device:
     id_entry: str  # the memory entry holding the device's own id
     broadcast: int | None
     state: dict[str, float]  # state variables beyond memory -> initial value
-    reply: dict[str, float]  # response field -> value when no behaviour sets it
+    reply: dict[str, float | str]  # response field -> value when no behaviour sets it
     refused: dict[str, float]  # response field -> value when a write is refused
     behaviours: tuple[Behaviour, ...]
     status: dict[str, str] = field(default_factory=dict)  # response field -> memory entry every reply reports
@@ -560,6 +570,7 @@ class Device:
     ids: tuple[int, ...] = (0,)  # the ids the simulator serves by default
     spaces: tuple[Space, ...] = ()
     errors: DeviceErrors | None = None
+    timeout: DeviceTimeout | None = None
 
     def behaviour(self, key: str) -> Behaviour | None:
         return next((b for b in self.behaviours if b.command == key), None)

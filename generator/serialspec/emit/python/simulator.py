@@ -60,6 +60,14 @@ def limits(request: Message) -> dict[str, tuple[float, float, tuple[int, ...]]]:
     return found
 
 
+def report_source(text: str) -> str:
+    """A reported state variable by name, or a conversion of state variables as a function of `get`."""
+    parsed = expression.parse(text)
+    if isinstance(parsed, expression.Name):
+        return repr(parsed.name)
+    return f"lambda get: {expression.render(parsed, lambda n: f'get({n!r})')}"
+
+
 def run_spec(run: SpaceAccess) -> str:
     args = [repr(run.space), repr(run.start)]
     if run.count:
@@ -102,7 +110,9 @@ def simulator_module(protocol: Protocol) -> str:
             if behaviour.resets:
                 args.append("resets=True")
             if behaviour.reports:
-                args.append(f"reports={behaviour.reports!r}")
+                args.append(
+                    f"reports={{{', '.join(f'{k!r}: {report_source(v)}' for k, v in behaviour.reports.items())}}}"
+                )
             if behaviour.moves:
                 m = behaviour.moves
                 args.append(f"moves={(m.state, m.target, m.duration, m.speed)!r}")
@@ -153,11 +163,19 @@ def simulator_module(protocol: Protocol) -> str:
     runtime += ["RunSpec"] if any(b.space_reads or b.space_writes for b in device.behaviours) else []
     runtime += ["Simulator"]
     runtime += ["SpaceSpec"] if spaces else []
+    runtime += ["TimeoutSpec"] if device.timeout else []
+    timeout = ""
+    if device.timeout is not None:
+        kept = [protocol.command(name).request for name in device.timeout.kept_by]
+        classes = ", ".join(m.class_name for m in kept if m is not None)
+        imports.update(m.class_name for m in kept if m is not None)
+        timeout = f"TimeoutSpec({device.timeout.after / 1000!r}, ({classes},), {device.timeout.sets!r})"
     return render(
         "simulator.py.j2",
         runtime_imports=", ".join(runtime),
         spaces=spaces,
         error=error,
+        timeout=timeout,
         spec_path=protocol.spec_path,
         title=one_line(protocol.title),
         package=protocol.name,

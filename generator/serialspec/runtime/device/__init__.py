@@ -21,6 +21,8 @@ pseudo-terminal) and is the same for every protocol:
 - data `spaces` (Modbus coils and registers): runs of items read into a response field or written from a request
   field; a request whose values the device does not accept (`limits`), whose run reaches beyond its space, or
   that writes a read-only space gets the protocol's error reply (Modbus exceptions 3 and 2);
+- a `timeout`: a device that has had none of its keep-alive requests for a while sets state variables (VESC
+  releases its motor when setpoints stop coming);
 - `emit()` sends a message on the device's own initiative (reports, key events) for tests.
 """
 
@@ -33,6 +35,7 @@ from serialspec.runtime.device.engine import (
     KindSpec,
     RunSpec,
     SpaceSpec,
+    TimeoutSpec,
     VirtualDevice,
 )
 from serialspec.runtime.device.faults import FAULTS, Fault
@@ -50,5 +53,6 @@ __all__ = [
     "RunSpec",
     "Simulator",
     "SpaceSpec",
+    "TimeoutSpec",
     "VirtualDevice",
 ]

@@ -72,7 +72,8 @@ class CommandSpec:
     reads: tuple[str, ...] = ()
     writes: tuple[str, ...] = ()
     resets: bool = False
-    reports: dict[str, str] = field(default_factory=dict)
+    # response field -> the state variable or memory entry it reports, or a function of `get` (a unit conversion)
+    reports: dict[str, str | Callable[[Callable[[str], float]], float]] = field(default_factory=dict)
     moves: tuple[str, str, str, str] | None = None  # state, target field, duration field (ms), speed field (/s)
     broadcast_reply: bool = False
     optional_when: tuple[int, int] | None = None  # (memory key, value) with which the response is sent
@@ -105,6 +106,16 @@ class KindSpec:
 
 
 @dataclass(frozen=True)
+class TimeoutSpec:
+    """The device sets `sets` once none of the `kept_by` requests has come for `after` seconds (VESC releases the
+    motor); checked whenever a request arrives, and by Engine.tick()."""
+
+    after: float
+    kept_by: tuple[type[Message], ...]
+    sets: dict[str, float]
+
+
+@dataclass(frozen=True)
 class DeviceSpec:
     protocol: str
     address: str
@@ -112,7 +123,7 @@ class DeviceSpec:
     broadcast: int | None
     entries: tuple[EntrySpec, ...]
     state: dict[str, float]
-    reply: dict[str, float]
+    reply: dict[str, Any]
     refused: dict[str, float]
     commands: tuple[CommandSpec, ...]
     kinds: tuple[KindSpec, ...] = ()
@@ -121,6 +132,7 @@ class DeviceSpec:
     status: dict[str, str] = field(default_factory=dict)  # response field -> memory entry every reply reports
     spaces: tuple[SpaceSpec, ...] = ()
     error: ErrorSpec | None = None
+    timeout: TimeoutSpec | None = None
 
 
 @dataclass
@@ -155,6 +167,8 @@ class VirtualDevice:
         self.state: dict[str, float] = dict(spec.state)
         self.motions: dict[str, _Motion] = {}
         self.buffered: list[tuple[CommandSpec, str, dict[str, Any]]] = []  # writes held until a commit
+        self.kept = clock()  # when a request last restarted the timeout
+        self.timed_out = False
         self.reset()
         self.id = device_id
         if spec.id_entry in self.by_name:
@@ -261,7 +275,25 @@ class Engine(FaultInjection):
                     out.extend([(when, frame)] if answered_as is not None else self._spoil(when, frame))
         return out
 
+    def tick(self) -> None:
+        """Let the timeout of every device expire that is due (requests do this too, as they arrive)."""
+        timeout = self.spec.timeout
+        if timeout is None:
+            return
+        now = self.clock()
+        for device in self.devices.values():
+            if not device.timed_out and now - device.kept > timeout.after:
+                device.timed_out = True
+                for name, value in timeout.sets.items():
+                    device.set(name, value)
+
     def handle(self, request: Message) -> list[tuple[float, bytes]]:
+        timeout = self.spec.timeout
+        if timeout is not None:
+            self.tick()
+            if isinstance(request, timeout.kept_by):
+                for device in self.devices.values():
+                    device.kept, device.timed_out = self.clock(), False
         command = self.commands.get(type(request))
         if command is None:
             return []
@@ -365,7 +397,8 @@ class Engine(FaultInjection):
                     return None  # an unknown key: a device stays silent
                 values[name] = value
             elif name in command.reports:
-                values[name] = device.get(command.reports[name])
+                source = command.reports[name]
+                values[name] = source(device.get) if callable(source) else device.get(source)
             elif name == device.spec.address and not device.spec.echo_address:
                 values[name] = device.id  # a device answers with its own id, also to a broadcast
             elif name in device.spec.status:

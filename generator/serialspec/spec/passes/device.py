@@ -14,6 +14,7 @@ from serialspec.spec.model import (
     Device,
     DeviceErrors,
     DeviceKind,
+    DeviceTimeout,
     Direction,
     Framing,
     Group,
@@ -100,8 +101,13 @@ class DevicePass(Pass):
             for field_name, source in reports.items():
                 if field_name not in response_names:
                     self.error((*item_path, "reports", field_name), f"{key} has no response field {field_name!r}")
-                if source not in known_state and source not in entries:
-                    self.error((*item_path, "reports", field_name), f"unknown state variable {source!r}")
+                try:
+                    used = set(expression.names(expression.parse(source)))
+                except expression.ExpressionError as exc:
+                    self.error((*item_path, "reports", field_name), str(exc))
+                    continue
+                for name in sorted(used - set(known_state) - set(entries)):
+                    self.error((*item_path, "reports", field_name), f"unknown state variable {name!r}")
             motion = None
             if "moves" in item:
                 moves = item["moves"]
@@ -163,15 +169,36 @@ class DevicePass(Pass):
             id_entry=id_entry,
             broadcast=broadcast,
             state=state,
-            reply={str(k): float(v) for k, v in (value.get("reply") or {}).items()},
+            reply={str(k): v if isinstance(v, str) else float(v) for k, v in (value.get("reply") or {}).items()},
             refused={str(k): float(v) for k, v in (value.get("refused") or {}).items()},
             behaviours=tuple(behaviours),
             status=status,
             kinds=tuple(kinds.values()),
             echo_address=bool(value.get("echo_address", False)),
             ids=tuple(int(i) for i in value.get("ids") or (0,)),
+            timeout=self.timeout(value.get("timeout"), (*path, "timeout"), requests, state),
             spaces=tuple(spaces.values()),
             errors=errors,
+        )
+
+    def timeout(
+        self, value: Any, path: Path, requests: dict[str, Message], state: dict[str, float]
+    ) -> DeviceTimeout | None:
+        if value is None:
+            return None
+        for index, name in enumerate(value["kept_by"]):
+            if name not in requests:
+                self.error((*path, "kept_by", index), f"unknown command {name!r} (or it has no request)")
+        for name in value["sets"]:
+            if name not in state:
+                self.error((*path, "sets", name), f"unknown state variable {name!r}")
+        if value["after"] < 1:
+            self.error((*path, "after"), "the timeout must be at least 1 ms")
+        return DeviceTimeout(
+            int(value["after"]),
+            tuple(str(n) for n in value["kept_by"]),
+            {str(k): float(v) for k, v in value["sets"].items()},
+            str(value.get("description", "")),
         )
 
     def spaces(self, value: dict[str, Any], path: Path) -> dict[str, Space]:

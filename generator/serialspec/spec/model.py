@@ -12,6 +12,7 @@ from functools import cached_property
 from typing import Literal
 
 from serialspec.runtime.message import Direction as Direction  # the model and the runtime share it
+from serialspec.spec import expression
 from serialspec.spec.expression import Expr
 
 
@@ -672,3 +673,49 @@ def content_bounds(fields: tuple[Field, ...]) -> tuple[int, int | None]:
         else:
             high = None
     return low, high
+
+
+def byte_size_expression(item: List) -> Expr | None:
+    """The size in bytes of a list counted by a field, as an expression of that field (ceil(n / 8), n * 2)."""
+    if not isinstance(item.count, str) or item.count in ("", "rest"):
+        return None
+    count = expression.Name(item.count)
+    if item.item is None:
+        return expression.Ceil(count, expression.Const(8))
+    return count if item.item.size == 1 else expression.BinOp("*", expression.Const(item.item.size), count)
+
+
+def size_terms(fields: tuple[Field, ...]) -> tuple[int, tuple[tuple[int, int, str, int], ...]] | None:
+    """A content's size from its own leading fields, for frames that carry no length (Modbus RTU): fixed bytes
+    plus, for each part sized by an earlier field at a fixed offset, (offset, size, byte order, bytes per unit).
+    None when the size cannot be told that way (a part that takes the rest, a NUL-terminated text)."""
+    fixed = 0
+    terms: list[tuple[int, int, str, int]] = []
+    offsets: dict[str, tuple[int, Scalar]] = {}
+    offset: int | None = 0
+    for item in fields:
+        if isinstance(item, Scalar) and offset is not None:
+            offsets[item.name] = (offset, item)
+        size = fixed_size(item)
+        if size is not None:
+            fixed += size
+            offset = None if offset is None else offset + size
+            continue
+        offset = None
+        sizer: str = ""
+        factor = 1
+        if isinstance(item, List):
+            wanted = byte_size_expression(item)
+            same = next((name for name, (_, f) in offsets.items() if wanted is not None and f.value == wanted), "")
+            sizer = item.size or same
+            if not sizer and isinstance(item.count, str) and item.count not in ("", "rest") and item.item is not None:
+                sizer, factor = item.count, item.item.size
+        elif isinstance(item, Bytes | Text) and isinstance(item.size, str) and item.size != "rest":
+            sizer = item.size
+        elif isinstance(item, Group) and isinstance(item.count, str) and item.count != "rest" and item.item_size:
+            sizer, factor = item.count, item.item_size
+        if sizer not in offsets:
+            return None
+        where, scalar = offsets[sizer]
+        terms.append((where, scalar.type.size, "big" if scalar.endian == ">" else "little", factor))
+    return fixed, tuple(terms)

@@ -24,12 +24,15 @@ class ErrorReplies(Pass):
                     "an error reply needs `error_flag` on the framing's command element",
                 )
             return self.problems
+        for name, element in flagged:
+            if element.get("role") != "command":
+                self.error(("framing", "elements", name, "error_flag"), "`error_flag` goes on the command element")
+        flagged = [(name, e) for name, e in flagged if e.get("role") == "command"]
+        if not flagged:
+            return self.problems
         element_name, element = flagged[0]
         path = ("framing", "elements", element_name, "error_flag")
         flag = element["error_flag"]
-        if element.get("role") != "command":
-            self.error(path, "`error_flag` goes on the command element")
-            return self.problems
         kind = str(element.get("type", "u8"))
         width = int(kind[1:]) if kind[1:].isdigit() else 8
         if not isinstance(flag, int) or flag <= 0 or flag >= 1 << width:

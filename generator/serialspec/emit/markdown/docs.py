@@ -385,6 +385,7 @@ def emit_docs(protocol: Protocol) -> str:
             "printed": e.printed,
             "frame": e.frame.hex(" ").upper(),
             "erratum": e.erratum,
+            "partial": e.printed_span != (0, 0),
             "rows": breakdown(protocol, e),
         }
         for e in protocol.examples

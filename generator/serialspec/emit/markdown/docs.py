@@ -171,7 +171,7 @@ def message_context(protocol: Protocol, message: Message | None) -> dict[str, An
         "optional": text(message.optional),
         "unsolicited": message.unsolicited,
         "answers": message.answers,
-        "reply": reply_text(message),
+        "reply": reply_text(message) or error_reply_text(protocol, message),
         "description": text(message.description),
     }
 
@@ -183,6 +183,17 @@ def reply_text(message: Message) -> str:
     switch = message.reply_when
     when = f", sent only while `{switch.entry}` = {switch.equals}" if switch else ""
     return f"answered by the `{message.answered_by}` response{when}"
+
+
+def error_reply_text(protocol: Protocol, message: Message) -> str:
+    """For the error reply: the code it is sent under, and what it carries besides its fields."""
+    error = protocol.error_reply
+    if not message.error_reply or error is None:
+        return ""
+    return (
+        f"sent instead of any request's reply, with `{error.element}` = the request's code | {error.flag:#04x} "
+        f"(the message holds the request's code as `{error.element}`)"
+    )
 
 
 def command_context(protocol: Protocol, command: Command) -> dict[str, Any]:

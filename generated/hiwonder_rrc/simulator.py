@@ -147,8 +147,7 @@ class HiwonderRrcSimulator(Simulator):
     """Virtual devices with the given ids on one bus; see serialspec.runtime.device for what they do."""
 
     def __init__(self, ids: Iterable[int] = (0,), clock: Callable[[], float] | None = None) -> None:
-        kwargs = {"clock": clock} if clock is not None else {}
-        super().__init__(DEVICE, ids, encode=encode, parser=lambda: StreamParser(Direction.REQUEST), **kwargs)
+        super().__init__(DEVICE, ids, encode=encode, parser=lambda: StreamParser(Direction.REQUEST), clock=clock)
 
 
 #: The simulator class, under a name every generated package shares (serialspec sim uses it).

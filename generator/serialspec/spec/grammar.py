@@ -227,6 +227,22 @@ TEXT = Str("Free text (English); shown in docs and docstrings, never executed.")
 RANGE = ListOf(Num(), "Inclusive [min, max] of the value in wire units; checked before encoding.", length=2)
 HEX_BYTES = Str("Bytes as hex: '12 4c 08', '0x12 0x4c', '124c08' or '12:4c:08'.")
 
+
+def bit_fields(description: str) -> MapOf:
+    """Sub-fields of an integer by bit position: a field's or a frame element's `bits`."""
+    return MapOf(
+        Obj(
+            {
+                "bits": OneOf((Int(), ListOf(Int(), length=2)), "a bit number or [high, low]"),
+                "enum": Str("Name of an entry in `enums:`."),
+                "description": TEXT,
+            },
+            required=("bits",),
+        ),
+        description,
+    )
+
+
 _FIELD_LONG: dict[str, Shape] = {
     "type": Str(
         "Wire type: u8, i8, u16, i16, u32, i32, f32, bytes, string, cstring (NUL-terminated text), array, group, "
@@ -242,17 +258,7 @@ _FIELD_LONG: dict[str, Shape] = {
     "default": Num("Value used when a message is built without this field."),
     "enum": Str("Name of an entry in `enums:`; values decode to that enum."),
     "flags": Str("Name of an entry in `flags:`; the value is a set of bit flags."),
-    "bits": MapOf(
-        Obj(
-            {
-                "bits": OneOf((Int(), ListOf(Int(), length=2)), "a bit number or [high, low]"),
-                "enum": Str("Name of an entry in `enums:`."),
-                "description": TEXT,
-            },
-            required=("bits",),
-        ),
-        "Sub-fields packed into this integer, by bit position (unlisted bits must be zero).",
-    ),
+    "bits": bit_fields("Sub-fields packed into this integer, by bit position (unlisted bits must be zero)."),
     "encoding": Str("How the integer is stored.", choices=("plain", "sign_magnitude")),
     "endian": Str("Override of the protocol's byte order for this field.", choices=("little", "big")),
     "size": OneOf(
@@ -293,10 +299,13 @@ FIELDS = MapOf(FIELD, "Fields in wire order: name -> type or mapping.")
 OPTIONAL_WHEN = Obj(
     {
         "parameter": Str("A table entry: `entry` or `table.entry` (e.g. response_switch)."),
-        "equals": Int("The value of the parameter with which the device answers."),
+        "equals": Int("The device answers while the parameter has this value."),
+        "not_equals": Int("The device answers while the parameter has any other value."),
+        "at_least": Int("The device answers while the parameter is at least this (status_return_level ≥ 1)."),
+        "at_most": Int("The device answers while the parameter is at most this."),
     },
-    required=("parameter", "equals"),
-    description="The reply is sent only while a device parameter has this value.",
+    required=("parameter",),
+    description="The reply is sent only while a device parameter compares true (give one comparison).",
 )
 
 MESSAGE = Obj(
@@ -320,6 +329,10 @@ MESSAGE = Obj(
             },
             required=("command",),
             description="For a request: answered by another command's response (FEETECH's one status packet).",
+        ),
+        "default": Bool(
+            "Among replies that share a code (or that all have none), the one a frame is decoded as when the "
+            "request it answers is unknown; the others are chosen by the request they answer."
         ),
         "source": TEXT,
     },
@@ -425,26 +438,59 @@ TABLE = Obj(
     required=("key", "entries"),
 )
 
+
+def span(description: str) -> OneOf:
+    """A span of frame elements: [first, last] (inclusive), or a mapping direction -> [first, last]."""
+    return OneOf(
+        (ListOf(Str(), length=2), MapOf(ListOf(Str(), length=2))),
+        f"{description} [first, last] frame element names, or a mapping direction -> [first, last].",
+    )
+
+
 FRAME_ELEMENT = Obj(
     {
         "role": Str(
-            "What the element is.",
-            choices=("header", "command", "length", "content", "checksum", "address", "status"),
+            "What the element is: constant bytes (header first, trailer last, constant anywhere, e.g. a reserved "
+            "byte), a frame-level value (address, command, status), the length, the content or a checksum.",
+            choices=("header", "trailer", "constant", "command", "length", "content", "checksum", "address", "status"),
         ),
-        "type": Str(choices=SCALAR_TYPES),
-        "value": OneOf((Str(), MapOf(Str())), "header: hex bytes, or a mapping direction -> hex bytes"),
-        "directions": ListOf(Str(choices=("request", "response"))),
+        "type": Str("Wire type of a value, length or checksum (default u8).", choices=SCALAR_TYPES),
+        "endian": Str(
+            "Byte order of a multi-byte element (default little, whatever the protocol's byte_order).",
+            choices=("little", "big"),
+        ),
+        "value": OneOf(
+            (Str(), MapOf(Str())),
+            "Constant bytes as hex, or a mapping direction -> hex bytes. On a header, trailer or constant: its "
+            "bytes. On any other element: in the directions given, the element is these constant bytes instead "
+            "(DYNAMIXEL status packets carry 55 where requests carry the instruction).",
+        ),
+        "directions": ListOf(
+            Str(choices=("request", "response")), "The directions whose frames have it (default both)."
+        ),
         "error_flag": Int(
             "command: a bit a device sets in the code of a reply that refuses the request (Modbus: 0x80); such a "
             "reply has the layout of the command whose response is the `error_reply`."
         ),
-        "adds": Int("length: what the length counts beyond the content (SMS: 2 = instruction + checksum)."),
+        "counts": span(
+            "length: the span of elements it counts, on the wire (after stuffing); default the content only.",
+        ),
+        "adds": Int("length: added to the counted size (SMS: 2 = instruction + checksum); may be negative."),
         "description": TEXT,
         "range": RANGE,
         "broadcast": Int("address: the broadcast value."),
         "flags": Str("status: name of an entry in `flags:`."),
-        "covers": ListOf(Str(), "checksum: first and last element covered.", length=2),
-        "algorithm": Str(choices=("sum", "crc")),
+        "bits": bit_fields(
+            "status (or address): bit fields packed into the element (DYNAMIXEL: alert bit 7, error number 6..0)."
+        ),
+        "covers": span(
+            "checksum: the span of elements covered. Outside a transparency span it sees the wire bytes, inside "
+            "it the bytes before stuffing.",
+        ),
+        "algorithm": Str(
+            "checksum: sum (of the bytes, modulo the width), xor (of the bytes) or crc.",
+            choices=("sum", "crc", "xor"),
+        ),
         "invert": Bool("sum: bitwise NOT of the sum."),
         "crc": Obj(
             {
@@ -461,6 +507,40 @@ FRAME_ELEMENT = Obj(
         ),
     },
     required=("role",),
+)
+
+FRAME_ELEMENTS = MapOf(FRAME_ELEMENT, "The frame's elements in wire order: name -> element.")
+
+TRANSPARENCY = Obj(
+    {
+        "span": span("The elements whose bytes are stuffed or escaped."),
+        "replace": MapOf(
+            HEX_BYTES,
+            "Plain hex bytes -> the hex bytes sent instead, leftmost match first (DYNAMIXEL: 'FF FF FD' -> "
+            "'FF FF FD FD'; SLIP: 'C0' -> 'DB DC', 'DB' -> 'DB DD').",
+        ),
+        "description": TEXT,
+    },
+    required=("span", "replace"),
+    description=(
+        "Byte stuffing or escaping over a span, applied by encode and removed by decode and the stream parser. "
+        "Lengths count the bytes as sent."
+    ),
+)
+
+FRAMING = Obj(
+    {
+        "elements": FRAME_ELEMENTS,
+        "layouts": MapOf(
+            Obj({"description": TEXT, "elements": FRAME_ELEMENTS}, required=("elements",)),
+            "Alternative layouts (instead of `elements`), told apart by their headers; encode uses the first "
+            "whose length can count the frame (VESC: 02 + u8 length, 03 + u16 length).",
+        ),
+        "transparency": TRANSPARENCY,
+        "gap": Num("Silence between frames, in character times (Modbus RTU: 3.5)."),
+        "description": TEXT,
+    },
+    description="The frame around every message.",
 )
 
 EXAMPLE = Obj(
@@ -664,7 +744,7 @@ SPEC = Obj(
             },
             required=("baudrate",),
         ),
-        "framing": Obj({"elements": MapOf(FRAME_ELEMENT), "description": TEXT}, required=("elements",)),
+        "framing": FRAMING,
         "matching": Obj(
             {"by": ListOf(Str()), "description": TEXT},
             description="How a reply is matched to its request.",

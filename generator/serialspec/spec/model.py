@@ -242,12 +242,27 @@ class Table:
 
 @dataclass(frozen=True)
 class OptionalWhen:
-    """A response the device sends only while one of its parameters (a table entry) holds a value."""
+    """A response the device sends only while one of its parameters (a table entry) compares true with a value."""
 
     table: str
     entry: str
     key: int
-    equals: int
+    equals: int  # the value compared with
+    op: Literal["==", "!=", ">=", "<="] = "=="
+
+    def holds(self, value: float) -> bool:
+        return {
+            "==": value == self.equals,
+            "!=": value != self.equals,
+            ">=": value >= self.equals,
+            "<=": value <= self.equals,
+        }[self.op]
+
+    @property
+    def text(self) -> str:
+        """The condition as people read it: `status_return_level ≥ 1`."""
+        symbol = {"==": "=", "!=": "≠", ">=": "≥", "<=": "≤"}[self.op]
+        return f"{self.entry} {symbol} {self.equals}"
 
 
 @dataclass(frozen=True)
@@ -272,6 +287,7 @@ class Message:
     answered_by: str = ""  # a request answered by another command's response (its key)
     error_reply: bool = False  # the reply a device sends instead of any other (Modbus exceptions: code | flag)
     reply_when: OptionalWhen | None = None  # a request whose reply is sent only when a device parameter has a value
+    default_reply: bool = False  # among replies sharing a code: the one a frame is decoded as without its request
 
     @property
     def key(self) -> str:
@@ -352,18 +368,20 @@ class Crc:
 
 @dataclass(frozen=True)
 class Checksum:
-    algorithm: Literal["sum", "crc"]
+    algorithm: Literal["sum", "crc", "xor"]
     invert: bool
     crc: Crc | None
     first: str  # first frame element covered
     last: str  # last frame element covered
     type: ScalarType
+    endian: Literal["<", ">"] = "<"
+    name: str = ""  # the frame element holding it
 
 
 @dataclass(frozen=True)
 class FrameElement:
     name: str
-    role: str
+    role: str  # header, trailer, constant, address, command, status, length, content, checksum
     type: ScalarType | None
     size: int | None  # None for content
     directions: tuple[Direction, ...]
@@ -372,17 +390,44 @@ class FrameElement:
     maximum: float
     broadcast: int | None
     flags: FlagsDef | None
+    endian: Literal["<", ">"] = "<"
+    constant: bytes = b""  # header, trailer, constant: the bytes in this direction
+    bits: tuple[BitField, ...] = ()  # a status (or address, command) made of bit fields
+    bits_class: str = ""
+    counts: tuple[str, str] = ("", "")  # length: the first and last element counted
+    adds: int = 0  # length: added to the counted size
+    checksum: Checksum | None = None  # checksum: what it is and what it covers
+
+    @property
+    def fixed(self) -> bool:
+        """Constant bytes: a header, a trailer, a reserved byte, or a command's constant in this direction."""
+        return self.role in ("header", "trailer", "constant")
+
+
+@dataclass(frozen=True)
+class Transparency:
+    """Byte stuffing or escaping over a span of elements: each plain sequence is sent as its wire sequence."""
+
+    first: str
+    last: str
+    replace: tuple[tuple[bytes, bytes], ...]
+    description: str = ""
 
 
 @dataclass(frozen=True)
 class FrameLayout:
-    """The frame in one direction: elements in order with their byte offsets (content's at its start)."""
+    """The frame in one direction: elements in order with their byte offsets (content's at its start).
+
+    The offsets and the classic fields (length_offset .. covered_to_end) describe frames of the classic shape (a
+    header, a one-byte length before the content, one final checksum, no transparency); `classic` says whether this
+    layout has it. Every layout is fully described by its elements, `transparency` and `checksums`.
+    """
 
     direction: Direction
     header: bytes
     elements: tuple[FrameElement, ...]
     offsets: dict[str, int]
-    overhead: int  # frame size minus content size
+    overhead: int  # frame size minus content size (on the wire, before stuffing)
     length_offset: int
     length_adds: int
     command_offset: int | None
@@ -390,14 +435,42 @@ class FrameLayout:
     covered_from: int  # first covered byte
     covered_to_end: int  # bytes after the last covered byte
     value_elements: tuple[FrameElement, ...]  # address/status: frame-level values every message carries
+    name: str = ""  # the layout's name among alternatives ("" for the one layout)
+    transparency: Transparency | None = None
+    checksums: tuple[Checksum, ...] = ()
+    classic: bool = True
+
+    def index(self, name: str) -> int:
+        return next(i for i, e in enumerate(self.elements) if e.name == name)
+
+    @property
+    def has_command(self) -> bool:
+        """Frames of this direction carry a command code (else every message of it is codeless)."""
+        return any(e.role == "command" for e in self.elements)
+
+    @property
+    def length(self) -> FrameElement | None:
+        return next((e for e in self.elements if e.role == "length"), None)
+
+    @property
+    def trailer(self) -> bytes:
+        last = self.elements[-1]
+        return last.constant if last.role == "trailer" else b""
 
 
 @dataclass(frozen=True)
 class Framing:
     description: str
-    layouts: dict[Direction, FrameLayout]
-    checksum: Checksum
+    layouts: dict[Direction, FrameLayout]  # the (first) layout of each direction
+    checksum: Checksum | None  # the first layout's first checksum
     shared_header: bool
+    alternatives: dict[Direction, tuple[FrameLayout, ...]] = field(default_factory=dict)  # every layout, in order
+    gap: float = 0.0  # silence between frames, in character times (0: none defined)
+
+    @property
+    def classic(self) -> bool:
+        """Every layout has the classic shape (see FrameLayout): generated codecs use straight-line code."""
+        return all(layout.classic for layouts in self.alternatives.values() for layout in layouts)
 
 
 @dataclass(frozen=True)

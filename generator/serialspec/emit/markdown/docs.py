@@ -10,12 +10,14 @@ from dataclasses import dataclass
 from typing import Any
 
 from serialspec.emit.common import render as common
+from serialspec.emit.common.frames import runtime_layouts
 from serialspec.emit.common.numbers import number
 from serialspec.emit.common.text import collapse
 from serialspec.spec import expression
 from serialspec.spec.model import (
     Array,
     Bytes,
+    Checksum,
     Command,
     Direction,
     Example,
@@ -239,39 +241,83 @@ def frame_context(protocol: Protocol, layout: FrameLayout) -> dict[str, Any]:
     rows = []
     packet = []
     offset = 0
+    variable = False  # past the content (or the stuffed span): offsets vary from frame to frame
+    first_variable = layout.transparency.first if layout.transparency else None
     for e in layout.elements:
         size = e.size
-        if e.role == "header":
+        variable = variable or e.name == first_variable
+        if e.role == "header" and layout.classic:
             description = f"{layout.header.hex(' ').upper()} — {e.description}"
-        elif e.role == "length":
+        elif e.fixed:
+            description = f"{e.constant.hex(' ').upper()} — {e.description}"
+        elif e.role == "length" and layout.classic:
             adds = f" + {layout.length_adds}" if layout.length_adds else ""
             description = f"n{adds}, where n is the number of content bytes. {e.description}"
+        elif e.role == "length":
+            adds = f" {'+' if e.adds > 0 else '-'} {abs(e.adds)}" if e.adds else ""
+            endian = ", big-endian" if e.endian == ">" and (e.size or 0) > 1 else ""
+            description = f"bytes from `{e.counts[0]}` to `{e.counts[1]}` as sent{adds}{endian}. {e.description}"
+        elif e.role == "checksum" and not layout.classic and e.checksum is not None:
+            endian = "big-endian" if e.endian == ">" else "little-endian"
+            description = f"over `{e.checksum.first}`..`{e.checksum.last}`, {endian}. {e.description}"
         else:
             description = e.description
         label = "content (n bytes)" if e.role == "content" else e.name
         where = f"{offset}.." if size is None else (str(offset) if size == 1 else f"{offset}..{offset + size - 1}")
         if e.role in ("checksum",) or (offset is None):
             where = "last" if e.role == "checksum" else where
+        if variable and e.role not in ("content", "checksum"):
+            where = "after the content" if e.role == "trailer" or layout.offsets.get(e.name) is None else where
         rows.append(
             {
                 "offset": cell(where),
                 "name": cell(e.name),
                 "role": e.role,
-                "type": cell(e.type.name if e.type else ("bytes" if e.role == "header" else "n bytes")),
+                "type": cell(e.type.name if e.type else ("bytes" if e.fixed else "n bytes")),
                 "meaning": cell(description),
             }
         )
         width = (size or 4) * 8
         packet.append(f'{offset * 8}-{offset * 8 + width - 1}: "{label}"')
         offset += size or 4
-    return {"direction": layout.direction.value, "rows": rows, "packet": packet}
+    title = layout.direction.value.capitalize() + (f" frame, layout `{layout.name}`" if layout.name else " frame")
+    return {"direction": layout.direction.value, "title": title, "rows": rows, "packet": packet}
 
 
-def checksum_context(protocol: Protocol) -> dict[str, Any]:
-    checksum = protocol.framing.checksum
+def transparency_text(protocol: Protocol) -> str:
+    """The byte stuffing or escaping rule, if the frames have one."""
+    rules = {layout.transparency for layouts in protocol.framing.alternatives.values() for layout in layouts}
+    found = [t for t in rules if t is not None]
+    if not found:
+        return ""
+    t = found[0]
+    pairs = ", ".join(f"{plain.hex(' ').upper()} is sent as {wire.hex(' ').upper()}" for plain, wire in t.replace)
+    return text(
+        f"From `{t.first}` to `{t.last}`, {pairs}: encode applies it, decode and the stream parser remove it. "
+        f"Lengths count the bytes as sent; checksums outside the span cover them as sent. {t.description}"
+    )
+
+
+def checksums_context(protocol: Protocol) -> list[dict[str, Any]]:
+    """Every checksum of the (first) layouts; a classic frame's one with a worked example."""
+    if protocol.framing.classic:
+        return [checksum_context(protocol)]
+    found: dict[str, Checksum] = {}
+    for layouts in protocol.framing.alternatives.values():
+        for layout in layouts:
+            for checksum in layout.checksums:
+                found.setdefault(checksum.name, checksum)
+    return [checksum_context(protocol, checksum) for checksum in found.values()]
+
+
+def checksum_context(protocol: Protocol, general: Checksum | None = None) -> dict[str, Any]:
+    checksum = general or protocol.framing.checksum
+    assert checksum is not None
     example = next(iter(protocol.examples), None)
     worked = ""
-    if example is not None:
+    if general is not None and example is not None:
+        worked = f"every example's `{checksum.name}` verifies (e.g. `{example.name}`)"
+    elif example is not None:
         layout = protocol.framing.layouts[example.direction]
         covered = example.frame[layout.covered_from : len(example.frame) - layout.covered_to_end]
         if checksum.algorithm == "sum":
@@ -301,11 +347,48 @@ def checksum_context(protocol: Protocol) -> dict[str, Any]:
             ("xorout", f"{c.xorout:#04x}"),
             ("check ('123456789')", f"{c.check:#04x}"),
         ]
-    return {"what": what, "first": checksum.first, "last": checksum.last, "worked": worked, "params": params}
+    if checksum.algorithm == "xor":
+        what = f"XOR of the covered bytes ({checksum.type.size * 8} bits)"
+    label = f" `{checksum.name}`" if general is not None else ""
+    return {
+        "label": label,
+        "what": what,
+        "first": checksum.first,
+        "last": checksum.last,
+        "worked": worked,
+        "params": params,
+    }
+
+
+def general_breakdown(protocol: Protocol, example: Example, message: Message | None) -> list[dict[str, str]]:
+    """An example frame of any layout, element by element (unstuffed) and field by field, by the frame engine."""
+    layouts = runtime_layouts(protocol, example.direction)
+    layout = next((lay for lay in layouts if example.frame.startswith(lay.header)), layouts[0])
+    unwrapped = layout.unwrap(example.frame)
+    rows: list[dict[str, str]] = []
+    for e, part in zip(layout.elements, unwrapped.parts, strict=True):
+        if e.kind == "content" and message is not None:
+            rows += content_rows(message.fields, example.fields, part, 0, len(part))
+            continue
+        value: Any = example.fields.get(e.name, "")
+        if e.kind == "command":
+            value = example.command
+        elif e.kind == "length":
+            value = f"{e.unpack(part)} (bytes `{layout.elements[e.span[0]].name}`..`{layout.elements[e.span[1]].name}`)"
+        elif e.kind == "checksum":
+            value = "verifies"
+        rows.append({"bytes": part.hex(" ").upper(), "field": e.name, "value": cell(value)})
+    return rows
 
 
 def breakdown(protocol: Protocol, example: Example) -> list[dict[str, str]]:
     """Byte spans of an example frame, element by element and field by field, with the values."""
+    if not protocol.framing.classic:
+        command = protocol.command(example.command)
+        holder = next((s for s in command.subcommands if s.name == example.subcommand), None) or command
+        return general_breakdown(
+            protocol, example, holder.request if example.direction == Direction.REQUEST else holder.response
+        )
     layout = protocol.framing.layouts[example.direction]
     command = protocol.command(example.command)
     sub = next((s for s in command.subcommands if s.name == example.subcommand), None)
@@ -478,9 +561,10 @@ def emit_docs(protocol: Protocol) -> str:
         ],
         serial_notes=text(serial.notes),
         framing=text(protocol.framing.description),
-        frames=[frame_context(protocol, layout) for layout in protocol.framing.layouts.values()],
+        frames=[frame_context(protocol, lay) for lays in protocol.framing.alternatives.values() for lay in lays],
+        transparency=transparency_text(protocol),
         shared_header=protocol.framing.shared_header,
-        checksum=checksum_context(protocol),
+        checksums=checksums_context(protocol),
         matching=", ".join(protocol.matching),
         matching_description=text(protocol.matching_description),
         commands=commands,

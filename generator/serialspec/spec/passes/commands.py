@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, Literal
 
 from serialspec.spec.errors import SpecError
 from serialspec.spec.loader import Path
@@ -23,6 +23,13 @@ from serialspec.spec.model import (
 )
 from serialspec.spec.passes.base import camel
 from serialspec.spec.passes.fields import FieldResolver
+
+OPTIONAL_WHEN_OPS: dict[str, Literal["==", "!=", ">=", "<="]] = {
+    "equals": "==",
+    "not_equals": "!=",
+    "at_least": ">=",
+    "at_most": "<=",
+}
 
 
 class Commands(FieldResolver):
@@ -124,23 +131,45 @@ class Commands(FieldResolver):
                     )
 
     def check_codes(self, commands: list[Command], framing: Framing) -> None:
+        for command in commands:
+            directions = {m.direction for m in command.messages()}
+            if command.code is not None and not any(framing.layouts[d].has_command for d in directions):
+                self.error(
+                    ("commands", command.name, "code"),
+                    "its frames have no command field, so no code",
+                )
         for direction, layout in framing.layouts.items():
-            seen: dict[int | None, str] = {}
+            sharing: dict[int | None, list[tuple[Command, Message]]] = {}
             for command in commands:
-                has = any(m.direction == direction for m in command.messages())
-                if not has or any(m.error_reply for m in command.messages()):
+                messages = [m for m in command.messages() if m.direction == direction]
+                if not messages or any(m.error_reply for m in messages):
                     continue  # an error reply has the code of the request it refuses (see passes/errors.py)
-                path: Path = ("commands", command.name)
-                if layout.command_offset is None:
-                    if command.code is not None:
-                        self.error((*path, "code"), f"{direction.value} frames have no command field, so no code")
-                elif command.code is None:
-                    self.error(path, f"missing key 'code' ({direction.value} frames carry a command field)")
-                if command.code in seen:
-                    other = seen[command.code]
-                    what = f"code {command.code:#04x}" if command.code is not None else "a codeless reply"
-                    self.error(path, f"{what} in {direction.value} frames is already used by {other!r}")
-                seen[command.code] = command.name
+                if layout.has_command and command.code is None:
+                    self.error(
+                        ("commands", command.name),
+                        f"missing key 'code' ({direction.value} frames carry a command field)",
+                    )
+                code = command.code if layout.has_command else None
+                sharing.setdefault(code, []).append((command, messages[0]))
+            for code, users in sharing.items():
+                if len(users) < 2:
+                    continue
+                what = f"code {code:#04x}" if code is not None else "a codeless reply"
+                if direction == Direction.REQUEST or any(c.selector for c, _ in users):
+                    for command, _ in users[1:]:
+                        self.error(
+                            ("commands", command.name),
+                            f"{what} in {direction.value} frames is already used by {users[0][0].name!r}",
+                        )
+                    continue
+                defaults = [c.name for c, m in users if m.default_reply]
+                if len(defaults) != 1:
+                    names = ", ".join(c.name for c, _ in users)
+                    self.error(
+                        ("commands", users[-1][0].name, "response"),
+                        f"{what} is shared by the replies of {names}: mark one of them `default: true` (the "
+                        "layout a reply is decoded as when its request is unknown)",
+                    )
 
     def message(
         self,
@@ -184,6 +213,7 @@ class Commands(FieldResolver):
             optional_when=self.optional_when(value.get("optional_when"), (*path, "optional_when")),
             after=self.after(value.get("after"), fields, direction, path),
             answered_by=str(answered_by.get("command", "")),
+            default_reply=bool(value.get("default", False)),
             reply_when=self.optional_when(answered_by.get("optional_when"), (*path, "answered_by", "optional_when")),
             error_reply=bool(value.get("error_reply", False)),
         )
@@ -202,7 +232,11 @@ class Commands(FieldResolver):
         if value is None:
             return None
         table, entry = self.table_entry(value["parameter"], (*path, "parameter"))
-        return OptionalWhen(table.name, entry.name, entry.key, int(value["equals"]))
+        given = [(key, op) for key, op in OPTIONAL_WHEN_OPS.items() if key in value]
+        if len(given) != 1:
+            raise self.fail(path, f"give one comparison: {', '.join(OPTIONAL_WHEN_OPS)}")
+        key, op = given[0]
+        return OptionalWhen(table.name, entry.name, entry.key, int(value[key]), op)
 
     def after(self, value: Any, fields: tuple[Field, ...], direction: Direction, path: Path) -> str:
         if value is None:

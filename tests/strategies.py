@@ -124,5 +124,14 @@ def message_fields(protocol: Protocol, message: Message) -> st.SearchStrategy[di
             for e in frame
             if e.type is not None
         }
+        | refused_code(protocol, message)
     )
     return st.tuples(frame_values, fields_values(message.fields, 8)).map(lambda pair: {**pair[0], **pair[1]})
+
+
+def refused_code(protocol: Protocol, message: Message) -> dict[str, st.SearchStrategy[int]]:
+    """An error reply also carries the code of the request it refuses (any code without the error flag)."""
+    error = protocol.error_reply
+    if not message.error_reply or error is None:
+        return {}
+    return {error.element: st.integers(0, error.flag - 1)}

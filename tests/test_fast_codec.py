@@ -60,7 +60,7 @@ def test_fast_paths_agree_with_the_plain_ones(g: Generated, spec: Message) -> No
         # the stream parser decodes in place, between other bytes, to the same message
         parser = g.package.StreamParser(direction)
         parser.expect(cls)  # the reply layout, where replies share a code
-        assert parser.feed(b"\x00" + frame + frame[: len(layout.header)]) == [decoded]
+        assert parser.feed(stray_byte(layout) + frame + frame[: len(layout.header)]) == [decoded]
         assert parser.errors == 0 and parser.pending() == frame[: len(layout.header)]
         # a frame with a wrong checksum fails both ways
         damaged = frame[:-1] + bytes([frame[-1] ^ 0x01])
@@ -68,9 +68,19 @@ def test_fast_paths_agree_with_the_plain_ones(g: Generated, spec: Message) -> No
             g.package.decode(damaged, direction)
         parser = g.package.StreamParser(direction)
         parser.expect(cls)  # the reply layout, where replies share a code
-        assert parser.feed(damaged) == [] and parser.errors == 1
+        assert parser.feed(damaged) == []
+        # without a header every byte is a candidate: one inside the damaged frame may fail its checksum too
+        assert parser.errors == 1 if layout.header else parser.errors >= 1
 
     agree()
+
+
+def stray_byte(layout: Any) -> bytes:
+    """A byte that cannot start a frame: not a header's first byte, nor a value a leading address can hold."""
+    first = layout.elements[0]
+    if first.role == "header":
+        return b"\x00" if first.constant[:1] != b"\x00" else b"\xff"
+    return bytes([next(b for b in range(256) if not (first.minimum <= b <= first.maximum or b == first.broadcast))])
 
 
 def test_slot_setters_refuse_a_class_without_slots() -> None:

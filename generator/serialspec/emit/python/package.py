@@ -172,10 +172,17 @@ def general_codec_context(protocol: Protocol) -> dict[str, Any]:
             if len(users) == 1 and users[0][0] is not None:
                 single[key] = users[0][0]
             expected += [(m.class_name, key, target) for m, target, _, _ in users if m is not None and len(users) > 1]
+        error = None
+        if protocol.error_reply is not None and direction == Direction.RESPONSE:
+            element = next(e for e in layout.elements if e.name == protocol.error_reply.element)
+            assert element.type is not None
+            mask = (1 << (8 * element.type.size)) - 1
+            error = {"flag": f"{protocol.error_reply.flag:#04x}", "keep": f"{mask & ~protocol.error_reply.flag:#04x}"}
         directions.append(
             {
                 "name": direction.value,
                 "upper": direction.name,
+                "error": error,
                 "dispatch": dispatch,
                 "expected": expected,
                 "frames": codec_lines(protocol, direction, sizes, single),
@@ -256,9 +263,9 @@ def common_codec_context(protocol: Protocol, code: PackageCode, exports: list[st
     codec_names = names_used_in_codec(code)
     used = "\n".join(line for _, _, _, lines in code.decoders for line in lines)
     used += "\n".join(line for _, _, lines in code.encoders for line in lines)
-    packing = [f"{n} as _{n}" for n in ("decode_text", "encode_text", "pack_bits", "unpack_bits") if f"_{n}(" in used]
+    packing = [n for n in ("decode_text", "encode_text", "pack_bits", "unpack_bits") if f"_{n}(" in used]
     return {
-        "packing_import": ", ".join(packing),
+        "packing_imports": packing,
         "structs": sorted(code.structs.items()),
         "tables": [
             table_context(t) for t in protocol.tables if any(uses_table(m, t.name) for m in protocol.messages())

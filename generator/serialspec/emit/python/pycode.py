@@ -659,10 +659,14 @@ class PackageCode:
         layout = self.protocol.framing.layouts[message.direction]
         elements = {e.name: e for e in layout.value_elements}
         frame_values = []
+        error = self.protocol.error_reply if message.error_reply else None
         for f in frame_fields:
             assert isinstance(f, Scalar)
             if f.bits:
                 frame_values.append(self.wire_value(f, "m", [], lines, where))
+                continue
+            if error is not None and f.name == error.element:  # the refused request's code: sent with the flag
+                self.check_scalar(f, f"m.{f.name}", lines, where)
                 continue
             self.check_scalar(f, f"m.{f.name}", lines, where, also=elements[f.name].broadcast)
             frame_values.append(f"m.{f.name}")
@@ -673,6 +677,8 @@ class PackageCode:
             parts = self.encode_fields(fields, message.class_name, "m", lines, where)
             content = parts[0] if len(parts) == 1 else f"b''.join(({', '.join(parts)},))" if parts else "b''"
             code = str(command_code) if command_code is not None and layout.has_command else "None"
+            if error is not None:
+                code = f"m.{error.element} | {error.flag:#04x}"
             values = f"({frame_values[0]},)" if len(frame_values) == 1 else f"({', '.join(frame_values)})"
             lines.append(f"return _{message.direction.name}_FRAMES.wrap({content}, {code}, {values})")
             return lines

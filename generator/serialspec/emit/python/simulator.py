@@ -68,6 +68,22 @@ def report_source(text: str) -> str:
     return f"lambda get: {expression.render(parsed, lambda n: f'get({n!r})')}"
 
 
+def derived_values(request: Message, response: Message | None) -> dict[str, str]:
+    """Request values its message does not hold (derived counts), for a reply to echo: name -> a function of the
+    request's fields (and the values derived before it)."""
+    if response is None:
+        return {}
+    found = {}
+    for f in request.fields:  # in order: a value may use one derived before it
+        if not isinstance(f, Scalar) or f.const is not None:
+            continue
+        if f.value is not None:
+            found[f.name] = f"lambda fields: {expression.render(f.value, lambda n: f'fields[{n!r}]')}"
+        elif f.derived and f.derived[0] == "count":
+            found[f.name] = f"lambda fields: len(fields[{f.derived[1]!r}])"
+    return found
+
+
 def run_spec(run: SpaceAccess) -> str:
     args = [repr(run.space), repr(run.start)]
     if run.count:
@@ -125,6 +141,9 @@ def simulator_module(protocol: Protocol) -> str:
                 runs = getattr(behaviour, name)
                 if runs:
                     args.append(f"{name}={{{', '.join(f'{k!r}: {run_spec(r)}' for k, r in runs.items())}}}")
+        derived = derived_values(request, response)
+        if derived:
+            args.append(f"derived={{{', '.join(f'{k!r}: {v}' for k, v in derived.items())}}}")
         if device.errors is not None:
             code = protocol.command(request.command).code
             args.append(f"code={code!r}")

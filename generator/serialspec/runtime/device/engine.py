@@ -92,6 +92,9 @@ class CommandSpec:
     limits: dict[str, tuple[float, float, tuple[int, ...]]] = field(default_factory=dict)
     space_reads: dict[str, RunSpec] = field(default_factory=dict)  # response field -> run of a data space
     space_writes: dict[str, RunSpec] = field(default_factory=dict)  # request field -> run of a data space
+    # values a request carries that its message does not hold (counts, byte counts), from its fields: a reply
+    # field of the same name echoes them like any other request field
+    derived: dict[str, Callable[[dict[str, Any]], int]] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -346,6 +349,10 @@ class Engine(FaultInjection):
     ) -> bytes | None:
         """Carry out a request on one device (`given`: its fields, an `each` item's merged in); the reply or None."""
         given = request.to_fields() if given is None else given
+        if command.derived:
+            given = dict(given)
+            for name, derive in command.derived.items():
+                given[name] = derive(given)
         if command.limits or command.space_reads or command.space_writes:
             reason = self._refusal(device, command, given)
             if reason is not None:

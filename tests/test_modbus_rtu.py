@@ -243,3 +243,53 @@ def test_broadcast_writes_reach_every_server_and_get_no_reply() -> None:
     assert ask(server, mb.ReadHoldingRegistersRequest(unit=1, address=5, count=1)).registers == (42,)
     assert ask(server, mb.ReadHoldingRegistersRequest(unit=2, address=5, count=1)).registers == (42,)
     assert ask(server, mb.ReadHoldingRegistersRequest(unit=3, address=5, count=1)) is None  # nobody at 3
+
+
+# --- the generated client against the virtual server, over a pseudo-terminal ----------------------------------------
+
+
+def test_the_client_reads_writes_and_names_exceptions() -> None:
+    from modbus_rtu.client import ModbusRtuClient
+    from serialspec.runtime.errors import DeviceError, Timeout
+
+    server = ModbusRtuSimulator(ids=[1, 2], sizes={"holding_registers": 200})
+    path = server.start()
+    try:
+        # no parity and 2 stop bits: some kernels' pseudo-terminals refuse the default even parity
+        with ModbusRtuClient(path, timeout=1.0, parity="N", stopbits=2) as client:
+            assert client.write_registers(1, 10, [7, 8, 9]) == 3
+            assert client.read_holding_registers(1, 9, 5) == [0, 7, 8, 9, 0]
+            assert client.write_coils(2, 0, [True, False, True]) == 3
+            assert client.read_coils(2, 0, 3) == [True, False, True]  # not padded to 8
+            assert client.read_discrete_inputs(1, 0, 2) == [False, False]
+            assert client.mask_write_register(1, 10, 0xF2, 0x25) is True
+            assert client.read_write_registers(1, 10, 2, 100, [1]) == [7, 8]  # (7 & 0xF2) | (0x25 & ~0xF2) = 7
+            with pytest.raises(DeviceError, match="read_holding_registers: .* illegal_data_address \\(2\\)"):
+                client.read_holding_registers(1, 199, 2)
+            with pytest.raises(RangeError, match="count = 126"):
+                client.read_holding_registers(1, 0, 126)  # refused before a byte is written
+            with pytest.raises(Timeout):
+                client.read_holding_registers(3, 0, 1)  # no server 3
+            assert client.write_register(0, 5, 99) is None  # broadcast: both servers, no reply
+            assert client.read_holding_registers(2, 5, 1) == [99]
+    finally:
+        server.close()
+
+
+def test_a_port_that_refuses_even_parity_is_a_port_error_naming_it() -> None:
+    """The serial line specification's default is even parity; where a port refuses it, the error says so."""
+    from modbus_rtu.client import ModbusRtuClient
+    from serialspec.runtime.errors import PortError
+
+    server = ModbusRtuSimulator()
+    path = server.start()
+    try:
+        try:
+            client = ModbusRtuClient(path, timeout=1.0)
+        except PortError as refused:  # pseudo-terminals of some kernels (gVisor's among them)
+            assert "parity = even" in str(refused)
+        else:
+            with client:
+                assert client.read_holding_registers(1, 0, 1) == [0]
+    finally:
+        server.close()

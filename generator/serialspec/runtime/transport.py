@@ -56,6 +56,7 @@ class SerialSettings:
     bytesize: int = 8
     parity: str = "none"
     stopbits: float = 1
+    gap: float = 0.0  # silence the protocol needs between frames, in character times (Modbus RTU: 3.5)
 
 
 @dataclass(frozen=True)
@@ -141,6 +142,8 @@ class Bus:
             options.update(serial_options)
             self._port = _open_port(port, options)
         self.port_name = str(getattr(self._port, "name", None) or getattr(self._port, "port", "") or port)
+        self._gap = _gap_seconds(binding.serial.gap, self._port)
+        self._last_io = 0.0  # when a byte was last written or read (for the inter-frame gap)
 
     # --- lifetime -------------------------------------------------------------------------------------------------
 
@@ -304,8 +307,14 @@ class Bus:
         raise PortError(f"{self.port_name}: {doing} failed: {reason}") from None
 
     def _write(self, frame: bytes) -> None:
+        if self._gap:
+            # the one wait the bus makes: the silence a protocol needs before a frame (3.5 characters for Modbus)
+            wait = self._last_io + self._gap - time.monotonic()
+            if wait > 0:
+                time.sleep(wait)
         with self._port_failures("write"):
             self._port.write(frame)
+        self._last_io = time.monotonic()
 
     def _drain(self) -> None:
         """Hand bytes that arrived between transactions (late replies, reports) to subscribers, without waiting."""
@@ -355,6 +364,8 @@ class Bus:
             self._backlog.clear()
             with self._port_failures("read"):
                 chunk = b"" if held or remaining <= 0 else self._read_some(remaining)
+            if chunk:
+                self._last_io = time.monotonic()
             found = None
             for message in held + (self._parser.feed(chunk) if chunk else []):
                 if found is not None:
@@ -409,6 +420,17 @@ class Bus:
 # The serial settings a port may refuse, in the order they are tried when opening fails.
 _SETTINGS = ("baudrate", "bytesize", "parity", "stopbits")
 _PARITY_NAMES = {value: name for name, value in _PARITY.items()}
+
+
+def _gap_seconds(characters: float, port: Any) -> float:
+    """A silence of `characters` character times at the port's settings (start, data, parity and stop bits)."""
+    if not characters:
+        return 0.0
+    baudrate = getattr(port, "baudrate", 0) or 0
+    if baudrate <= 0:
+        return 0.0
+    bits = 1 + int(getattr(port, "bytesize", 8)) + (getattr(port, "parity", "N") != "N") + float(port.stopbits)
+    return characters * bits / baudrate
 
 
 def _reason(exc: BaseException) -> str:

@@ -110,6 +110,7 @@ def emit_package(protocol: Protocol) -> dict[str, str]:
             description=one_line(protocol.description),
             baudrate=protocol.serial.baudrate,
             serial=protocol.serial,
+            gap=repr(protocol.framing.gap) if protocol.framing.gap else "",
             match_by=repr(protocol.matching),
         ),
         "client.py": client_module(protocol),

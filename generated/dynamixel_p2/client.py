@@ -13,7 +13,7 @@ byte is written (RangeError names the field and the range).
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from typing import Any
 
 import serial
@@ -79,9 +79,15 @@ class DynamixelP2Client(ClientBase):
         timeout: float = 0.1,
         baudrate: int | None = None,
         optional_replies: bool | None = None,
+        echo: bool = False,
         **serial_options: Any,
     ) -> None:
-        bus = port if isinstance(port, Bus) else Bus(port, BINDING, timeout=timeout, baudrate=baudrate, **serial_options)
+        """`echo=True` for a one-wire half-duplex adapter that echoes every byte sent (see Bus)."""
+        bus = (
+            port
+            if isinstance(port, Bus)
+            else Bus(port, BINDING, timeout=timeout, baudrate=baudrate, echo=echo, **serial_options)
+        )
         super().__init__(bus, optional_replies)
 
     def __enter__(self) -> DynamixelP2Client:
@@ -117,7 +123,7 @@ class DynamixelP2Client(ClientBase):
         None when no reply is due (broadcast gets no reply).
         """
         request = ReadRequest(id=id, address=address, length=length)
-        reply = self._maybe(request, StatusResponse, (68, 1))
+        reply = self._maybe(request, StatusResponse, (68, 1, '>='))
         if reply is None:
             return None
         return reply.data
@@ -139,7 +145,7 @@ class DynamixelP2Client(ClientBase):
         """
         request = WriteRequest(id=id, address=address, data=data)
         try:
-            reply = self._maybe(request, StatusResponse, (68, 2))
+            reply = self._maybe(request, StatusResponse, (68, 2, '>='))
         except Timeout:
             return False
         if reply is None:
@@ -163,7 +169,7 @@ class DynamixelP2Client(ClientBase):
         """
         request = RegWriteRequest(id=id, address=address, data=data)
         try:
-            reply = self._maybe(request, StatusResponse, (68, 2))
+            reply = self._maybe(request, StatusResponse, (68, 2, '>='))
         except Timeout:
             return False
         if reply is None:
@@ -185,7 +191,7 @@ class DynamixelP2Client(ClientBase):
         """
         request = ActionRequest(id=id)
         try:
-            reply = self._maybe(request, StatusResponse, (68, 2))
+            reply = self._maybe(request, StatusResponse, (68, 2, '>='))
         except Timeout:
             return False
         if reply is None:
@@ -208,7 +214,7 @@ class DynamixelP2Client(ClientBase):
         """
         request = FactoryResetRequest(id=id, option=option)
         try:
-            reply = self._maybe(request, StatusResponse, (68, 2))
+            reply = self._maybe(request, StatusResponse, (68, 2, '>='))
         except Timeout:
             return False
         if reply is None:
@@ -226,7 +232,7 @@ class DynamixelP2Client(ClientBase):
         """
         request = RebootRequest(id=id)
         try:
-            reply = self._maybe(request, StatusResponse, (68, 2))
+            reply = self._maybe(request, StatusResponse, (68, 2, '>='))
         except Timeout:
             return False
         if reply is None:
@@ -247,14 +253,14 @@ class DynamixelP2Client(ClientBase):
         """
         request = ClearRequest(id=id, option=option)
         try:
-            reply = self._maybe(request, StatusResponse, (68, 2))
+            reply = self._maybe(request, StatusResponse, (68, 2, '>='))
         except Timeout:
             return False
         if reply is None:
             return None
         return True
 
-    def sync_read(self, id: int, address: int, length: int, ids: tuple[IdsItem, ...]) -> bytes:
+    def sync_read_raw(self, id: int, address: int, length: int, ids: tuple[IdsItem, ...]) -> dict[int, bytes]:
         """Read the same items of several servos.
 
         Sent to the broadcast id; each listed servo answers in turn, in the order of the ids, with a status packet holding `length` bytes from `address`.
@@ -265,11 +271,11 @@ class DynamixelP2Client(ClientBase):
             length: Number of bytes each servo returns. (1..1024)
             ids: The servos to read, in the order they answer.
 
-        Returns: data: The bytes read, item by item from the request's address (empty but for reads).
+        Returns: id -> data of every listed device, in the order they answer.
         """
         request = SyncReadRequest(id=id, address=address, length=length, ids=ids)
-        reply = self._ask(request, StatusResponse)
-        return reply.data
+        replies = self.bus.request_each(request, StatusResponse, [{'id': item.id} for item in ids])
+        return {reply.id: reply.data for reply in replies}
 
     def sync_write_raw(self, id: int, address: int, servos: tuple[ServosItem, ...] | Mapping[int, bytes]) -> None:
         """Write the same items of several servos at once.
@@ -291,7 +297,7 @@ class DynamixelP2Client(ClientBase):
         request = SyncWriteRequest(id=id, address=address, servos=servos)
         self.bus.send(request)
 
-    def bulk_read(self, id: int, reads: tuple[ReadsItem, ...]) -> bool:
+    def bulk_read_raw(self, id: int, reads: tuple[ReadsItem, ...]) -> dict[int, bytes]:
         """Read different items of several servos.
 
         Sent to the broadcast id; each listed servo (once at most) answers in turn, in the order listed, with its own address and length.
@@ -300,16 +306,13 @@ class DynamixelP2Client(ClientBase):
             id: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. (0..252)
             reads: One item per servo.
 
-        Returns: True if the device answered, False if it stayed silent (timeout).
+        Returns: id -> data of every listed device, in the order they answer.
         """
         request = BulkReadRequest(id=id, reads=reads)
-        try:
-            self._ask(request, StatusResponse)
-        except Timeout:
-            return False
-        return True
+        replies = self.bus.request_each(request, StatusResponse, [{'id': item.id} for item in reads])
+        return {reply.id: reply.data for reply in replies}
 
-    def bulk_write(self, id: int, writes: tuple[WritesItem, ...]) -> None:
+    def bulk_write_raw(self, id: int, writes: tuple[WritesItem, ...]) -> None:
         """Write different items of several servos at once.
 
         Sent to the broadcast id; each listed servo (once at most) takes its own address and data.
@@ -343,7 +346,7 @@ class DynamixelP2Client(ClientBase):
         data = self.read_raw(address, register.address, register.size)
         return CONTROL_TABLE.from_wire(register, data or b"")
 
-    def write(self, id: int, **values: int) -> bool | None:
+    def write(self, id: int, /, **values: int) -> bool | None:
         """Write to the control table, by register name: `write(id, goal_position=2048, goal_time=0)`.
 
         The named registers must follow each other in the table (one run of bytes); each value is checked
@@ -355,7 +358,7 @@ class DynamixelP2Client(ClientBase):
             self._remember(id, CONTROL_TABLE[name].address, value)
         return result
 
-    def reg_write(self, id: int, **values: int) -> bool | None:
+    def reg_write(self, id: int, /, **values: int) -> bool | None:
         """Buffered write, carried out on ACTION, by register name: `reg_write(id, goal_position=2048, goal_time=0)`.
 
         The named registers must follow each other in the table (one run of bytes); each value is checked
@@ -366,6 +369,21 @@ class DynamixelP2Client(ClientBase):
         for name, value in values.items():
             self._remember(id, CONTROL_TABLE[name].address, value)
         return result
+
+    def sync_read(
+        self, ids: Iterable[int], *names: ControlTableName, id: int = 254
+    ) -> dict[int, dict[str, int]]:
+        """Read the same items of several servos, by register name: `sync_read([1, 2], "present_position")` -> {1: {...}, 2: {...}}.
+
+        One request; every listed device answers in turn. `sync_read_raw` takes raw addresses and returns bytes.
+        """
+        start, size = CONTROL_TABLE.span(names)
+        items = tuple(IdsItem(id=device) for device in ids)
+        replies = self.sync_read_raw(id, start, size, items)
+        return {
+            device: {name: value for name, value in CONTROL_TABLE.unpack(start, data).items() if name in names}
+            for device, data in replies.items()
+        }
 
     def sync_write(self, values: Mapping[int, Mapping[str, int]], id: int = 254) -> None:
         """Write the same items of several servos at once, by register name: `sync_write({1: {"goal_position": 100}, 2: {"goal_position": 300}})`.
@@ -381,3 +399,38 @@ class DynamixelP2Client(ClientBase):
         start, data = next(iter(runs.values()))
         items = tuple(ServosItem(id=device, data=data) for device, (_, data) in runs.items())
         return self.sync_write_raw(id, start, items)
+
+    def bulk_read(
+        self, reads: Mapping[int, ControlTableName | Sequence[ControlTableName]], id: int = 254
+    ) -> dict[int, dict[str, int]]:
+        """Read different items of several servos, by register name, each device its own: `bulk_read({1: "present_position", 2: ("led",)})`.
+
+        One request; every listed device answers in turn. `bulk_read_raw` takes raw addresses and returns bytes.
+        """
+        wanted = {device: (names,) if isinstance(names, str) else tuple(names) for device, names in reads.items()}
+        spans = {device: CONTROL_TABLE.span(names) for device, names in wanted.items()}
+        items = tuple(
+            ReadsItem(id=device, address=start, length=size) for device, (start, size) in spans.items()
+        )
+        replies = self.bulk_read_raw(id, items)
+        return {
+            device: {
+                name: value
+                for name, value in CONTROL_TABLE.unpack(spans[device][0], data).items()
+                if name in wanted[device]
+            }
+            for device, data in replies.items()
+        }
+
+    def bulk_write(self, values: Mapping[int, Mapping[str, int]], id: int = 254) -> None:
+        """Write different items of several servos at once, by register name, each device its own run: `bulk_write({1: {"goal_position": 100}, 2: {"led": 1}})`.
+
+        Values are checked before sending. `bulk_write_raw` takes raw bytes.
+        """
+        items = []
+        for device, registers in values.items():
+            start, data = CONTROL_TABLE.pack(registers)
+            items.append(WritesItem(id=device, address=start, data=data))
+        if not items:
+            raise EncodeError("bulk_write: name at least one device")
+        return self.bulk_write_raw(id, tuple(items))

@@ -73,9 +73,15 @@ class FeetechSmsClient(ClientBase):
         timeout: float = 0.1,
         baudrate: int | None = None,
         optional_replies: bool | None = None,
+        echo: bool = False,
         **serial_options: Any,
     ) -> None:
-        bus = port if isinstance(port, Bus) else Bus(port, BINDING, timeout=timeout, baudrate=baudrate, **serial_options)
+        """`echo=True` for a one-wire half-duplex adapter that echoes every byte sent (see Bus)."""
+        bus = (
+            port
+            if isinstance(port, Bus)
+            else Bus(port, BINDING, timeout=timeout, baudrate=baudrate, echo=echo, **serial_options)
+        )
         super().__init__(bus, optional_replies)
 
     def __enter__(self) -> FeetechSmsClient:
@@ -84,7 +90,7 @@ class FeetechSmsClient(ClientBase):
     def ping(self, id: int) -> bool:
         """Query a servo's working status.
 
-        Broadcast: A servo answers a PING sent to the broadcast id too, so a broadcast PING finds the id of a single servo; with several servos on the bus their replies collide (004 §1.1).
+        Broadcast: A servo answers a PING sent to the broadcast id too (004 §1.3.1: PING 指令使用广播地址，舵机同样返回应答信息, 'when PING uses the broadcast address, the servo answers as well'), so a broadcast PING finds the id of a single servo; with several servos on the bus their replies collide (004 §1.1).
 
         Args:
             id: Servo id 0..253; 254 (0xFE) is the broadcast id: every servo takes the instruction and none answers, except to PING. (0..253)
@@ -131,7 +137,7 @@ class FeetechSmsClient(ClientBase):
         """
         request = WriteRequest(id=id, address=address, data=data)
         try:
-            reply = self._maybe(request, ReplyResponse, (8, 1))
+            reply = self._maybe(request, ReplyResponse, (8, 1, '=='))
         except Timeout:
             return False
         if reply is None:
@@ -155,7 +161,7 @@ class FeetechSmsClient(ClientBase):
         """
         request = RegWriteRequest(id=id, address=address, data=data)
         try:
-            reply = self._maybe(request, ReplyResponse, (8, 1))
+            reply = self._maybe(request, ReplyResponse, (8, 1, '=='))
         except Timeout:
             return False
         if reply is None:
@@ -177,7 +183,7 @@ class FeetechSmsClient(ClientBase):
         """
         request = ActionRequest(id=id)
         try:
-            reply = self._maybe(request, ReplyResponse, (8, 1))
+            reply = self._maybe(request, ReplyResponse, (8, 1, '=='))
         except Timeout:
             return False
         if reply is None:
@@ -197,7 +203,7 @@ class FeetechSmsClient(ClientBase):
         """
         request = ResetRequest(id=id)
         try:
-            reply = self._maybe(request, ReplyResponse, (8, 1))
+            reply = self._maybe(request, ReplyResponse, (8, 1, '=='))
         except Timeout:
             return False
         if reply is None:
@@ -259,7 +265,7 @@ class FeetechSmsClient(ClientBase):
         data = self.read_raw(address, register.address, register.size)
         return CONTROL_TABLE.from_wire(register, data or b"")
 
-    def write(self, id: int, **values: int) -> bool | None:
+    def write(self, id: int, /, **values: int) -> bool | None:
         """Write to the control table, by register name: `write(id, goal_position=2048, goal_time=0)`.
 
         The named registers must follow each other in the table (one run of bytes); each value is checked
@@ -271,7 +277,7 @@ class FeetechSmsClient(ClientBase):
             self._remember(id, CONTROL_TABLE[name].address, value)
         return result
 
-    def reg_write(self, id: int, **values: int) -> bool | None:
+    def reg_write(self, id: int, /, **values: int) -> bool | None:
         """Buffered write, run on ACTION, by register name: `reg_write(id, goal_position=2048, goal_time=0)`.
 
         The named registers must follow each other in the table (one run of bytes); each value is checked

@@ -13,9 +13,9 @@ or at goal_speed (steps/s) when goal_time is 0.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Mapping
 
-from serialspec.runtime.device import CommandSpec, DeviceSpec, EntrySpec, Simulator
+from serialspec.runtime.device import CommandSpec, DeviceSpec, EntrySpec, ModelSpec, Simulator
 
 from feetech_sms.codec import StreamParser, encode
 from feetech_sms.messages import (
@@ -98,13 +98,13 @@ DEVICE = DeviceSpec(
         # read
         CommandSpec(ReadRequest, ReplyResponse, reads=('data',), tables={'data': ('run', 'address', 'length')}),
         # write
-        CommandSpec(WriteRequest, ReplyResponse, writes=('data',), moves=('present_position', 'goal_position', 'goal_time', 'goal_speed'), optional_when=(8, 1), tables={'data': ('run', 'address', '')}),
+        CommandSpec(WriteRequest, ReplyResponse, writes=('data',), moves=('present_position', 'goal_position', 'goal_time', 'goal_speed'), optional_when=(8, 1, '=='), tables={'data': ('run', 'address', '')}),
         # reg_write
-        CommandSpec(RegWriteRequest, ReplyResponse, writes=('data',), buffered=True, optional_when=(8, 1), tables={'data': ('run', 'address', '')}),
+        CommandSpec(RegWriteRequest, ReplyResponse, writes=('data',), buffered=True, optional_when=(8, 1, '=='), tables={'data': ('run', 'address', '')}),
         # action
-        CommandSpec(ActionRequest, ReplyResponse, moves=('present_position', 'goal_position', 'goal_time', 'goal_speed'), commits=True, optional_when=(8, 1), tables={'data': ('run', 'address', 'length')}),
+        CommandSpec(ActionRequest, ReplyResponse, moves=('present_position', 'goal_position', 'goal_time', 'goal_speed'), commits=True, optional_when=(8, 1, '=='), tables={'data': ('run', 'address', 'length')}),
         # reset
-        CommandSpec(ResetRequest, ReplyResponse, resets=True, optional_when=(8, 1), tables={'data': ('run', 'address', 'length')}),
+        CommandSpec(ResetRequest, ReplyResponse, resets=True, optional_when=(8, 1, '=='), tables={'data': ('run', 'address', 'length')}),
         # sync_read
         CommandSpec(SyncReadRequest, ReplyResponse, reads=('data',), each='ids', tables={'data': ('run', 'address', 'length')}),
         # sync_write
@@ -112,14 +112,54 @@ DEVICE = DeviceSpec(
     ),
     registers=CONTROL_TABLE,
     status={'error': 'status'},
+    models=(
+        ModelSpec(
+            'sts3215',
+            777,
+            {
+                'firmware_major': 3,
+                'firmware_minor': 10,
+                'cw_dead_band': 2,
+                'ccw_dead_band': 2,
+                'model_number': 777,
+            },
+        ),
+        ModelSpec(
+            'sts3250',
+            2825,
+            {
+                'firmware_major': 3,
+                'firmware_minor': 10,
+                'cw_dead_band': 2,
+                'ccw_dead_band': 2,
+                'model_number': 2825,
+            },
+        ),
+        ModelSpec(
+            'sm8512bl',
+            11272,
+            {
+                'firmware_major': 3,
+                'firmware_minor': 10,
+                'model_number': 11272,
+            },
+        ),
+    ),
 )
 
 
 class FeetechSmsSimulator(Simulator):
     """Virtual devices with the given ids on one bus; see serialspec.runtime.device for what they do."""
 
-    def __init__(self, ids: Iterable[int] = (0,), clock: Callable[[], float] | None = None) -> None:
-        super().__init__(DEVICE, ids, encode=encode, parser=lambda: StreamParser(Direction.REQUEST), clock=clock)
+    def __init__(
+        self,
+        ids: Iterable[int] = (0,),
+        clock: Callable[[], float] | None = None,
+        model: str | Mapping[int, str] | None = None,
+    ) -> None:
+        """`model`: sts3215, sts3250, sm8512bl (default sts3215) for every device, or id -> model."""
+        super().__init__(
+            DEVICE, ids, encode=encode, parser=lambda: StreamParser(Direction.REQUEST), clock=clock, model=model        )
 
 
 #: The simulator class, under a name every generated package shares (serialspec sim uses it).

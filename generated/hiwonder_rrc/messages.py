@@ -8,6 +8,7 @@ from dataclasses import dataclass
 from enum import IntEnum, IntFlag
 from typing import Any, ClassVar, Self
 
+from serialspec.runtime.fields import as_bytes as _bytes
 from serialspec.runtime.fields import check_keys as _check_keys
 from serialspec.runtime.fields import get as _get
 from serialspec.runtime.fields import mapping as _mapping
@@ -28,6 +29,8 @@ __all__ = [
     'BusServoReadTemperatureLimitResponse',
     'BusServoReadTemperatureRequest',
     'BusServoReadTemperatureResponse',
+    'BusServoReadTorqueRequest',
+    'BusServoReadTorqueResponse',
     'BusServoReadVoltageLimitRequest',
     'BusServoReadVoltageLimitResponse',
     'BusServoReadVoltageRequest',
@@ -39,11 +42,14 @@ __all__ = [
     'BusServoSetPositionsRequest',
     'BusServoSetTemperatureLimitRequest',
     'BusServoSetVoltageLimitRequest',
+    'BusServoStopRequest',
     'BusServoUnloadRequest',
     'BusServosItem',
     'ButtonEvent',
     'BuzzerRequest',
     'Direction',
+    'DutiesItem',
+    'GamepadButtons',
     'GamepadResponse',
     'ImuResponse',
     'KeyResponse',
@@ -51,11 +57,14 @@ __all__ = [
     'MESSAGE_TYPES',
     'Message',
     'MotorMask',
+    'MotorSetDutiesRequest',
     'MotorSetSpeedRequest',
     'MotorSetSpeedsRequest',
     'MotorStopMaskRequest',
     'MotorStopRequest',
     'MotorsItem',
+    'OledRequest',
+    'PixelsItem',
     'PwmServoReadOffsetRequest',
     'PwmServoReadOffsetResponse',
     'PwmServoReadPositionRequest',
@@ -65,7 +74,10 @@ __all__ = [
     'PwmServoSetPositionsRequest',
     'PwmServosItem',
     'ReadResult',
+    'RgbSetPixelsRequest',
     'SbusResponse',
+    'ServosItem',
+    'SystemBatteryResponse',
 ]
 
 
@@ -79,16 +91,54 @@ class ReadResult(IntEnum):
 
 
 class ButtonEvent(IntEnum):
-    """Key event values. 002 lists these as '部分按键事件回调值' (some of the event values); other values decode as plain numbers."""
+    """Key event values. 002 lists four as '部分按键事件回调值' (some of the event values); the SDK's PacketReportKeyEvents adds the other four (one bit each)."""
 
     PRESSED = 1
     #: button pressed (BUTTON_EVENT_PRESSED)
     LONG_PRESS = 2
     #: button held down (BUTTON_EVENT_LONGPRESS)
+    LONG_PRESS_REPEAT = 4
+    #: button still held, repeated (KEY_EVENT_LONGPRESS_REPEAT; sdk)
+    RELEASE_FROM_LONG_PRESS = 8
+    #: button released after a long press (KEY_EVENT_RELEASE_FROM_LP; sdk)
+    RELEASE_FROM_SHORT_PRESS = 16
+    #: button released after a short press (KEY_EVENT_RELEASE_FROM_SP; sdk)
     CLICK = 32
     #: button clicked (BUTTON_EVENT_CLICK)
     DOUBLE_CLICK = 64
     #: button double-clicked (BUTTON_EVENT_DOUBLE_CLICK)
+    TRIPLE_CLICK = 128
+    #: button triple-clicked (KEY_EVENT_TRIPLE_CLICK; sdk)
+
+
+class GamepadButtons(IntFlag):
+    """Gamepad buttons held, one bit each (sdk Board.buttons_map GAMEPAD_BUTTON_MASK_*; 002 names none)."""
+
+    NONE = 0
+    L2 = 1 << 0
+    #: L2
+    R2 = 1 << 1
+    #: R2
+    SELECT = 1 << 2
+    #: SELECT
+    START = 1 << 3
+    #: START
+    L3 = 1 << 5
+    #: L3 (left stick pressed)
+    R3 = 1 << 6
+    #: R3 (right stick pressed)
+    CROSS = 1 << 8
+    #: CROSS
+    CIRCLE = 1 << 9
+    #: CIRCLE
+    SQUARE = 1 << 11
+    #: SQUARE
+    TRIANGLE = 1 << 12
+    #: TRIANGLE
+    L1 = 1 << 14
+    #: L1
+    R1 = 1 << 15
+    #: R1
 
 
 class MotorMask(IntFlag):
@@ -138,6 +188,30 @@ class MotorsItem:
 
 
 @dataclass(frozen=True, slots=True)
+class DutiesItem:
+    """One item of duties."""
+
+    motor_id: int
+    #: Encoder motor id; bit n of the stop mask is motor_id n (the board has four motor ports).
+    duty: float
+    #: Duty cycle; the sign gives the direction (the SDK's example uses ±50). [%]
+
+    def to_fields(self) -> dict[str, Any]:
+        return {
+            'motor_id': self.motor_id,
+            'duty': self.duty,
+        }
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'DutiesItem') -> Self:
+        _check_keys(data, ('motor_id', 'duty'), (), where)
+        return cls(
+            _get(data, 'motor_id', where),
+            _get(data, 'duty', where),
+        )
+
+
+@dataclass(frozen=True, slots=True)
 class PwmServosItem:
     """One item of pwm_servos."""
 
@@ -182,6 +256,58 @@ class BusServosItem:
         return cls(
             _get(data, 'servo_id', where),
             _get(data, 'position', where),
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class ServosItem:
+    """One item of servos."""
+
+    servo_id: int
+    #: Bus servo id (0xFE is the broadcast id).
+
+    def to_fields(self) -> dict[str, Any]:
+        return {
+            'servo_id': self.servo_id,
+        }
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'ServosItem') -> Self:
+        _check_keys(data, ('servo_id',), (), where)
+        return cls(
+            _get(data, 'servo_id', where),
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class PixelsItem:
+    """One item of pixels."""
+
+    index: int
+    #: LED index from 0 (the SDK takes 1.. and sends it less one).
+    red: int
+    #: Red 0..255.
+    green: int
+    #: Green 0..255.
+    blue: int
+    #: Blue 0..255.
+
+    def to_fields(self) -> dict[str, Any]:
+        return {
+            'index': self.index,
+            'red': self.red,
+            'green': self.green,
+            'blue': self.blue,
+        }
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'PixelsItem') -> Self:
+        _check_keys(data, ('index', 'red', 'green', 'blue'), (), where)
+        return cls(
+            _get(data, 'index', where),
+            _get(data, 'red', where),
+            _get(data, 'green', where),
+            _get(data, 'blue', where),
         )
 
 
@@ -330,6 +456,30 @@ class MotorStopRequest(Message):
         _check_keys(data, ('motor_id',), ('subcommand_code',), where)
         return cls(
             _get(data, 'motor_id', where),
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class MotorSetDutiesRequest(Message):
+    """Drive several motors at a duty cycle (open loop) (request)."""
+
+    PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
+    COMMAND: ClassVar[str] = 'motor'
+    SUBCOMMAND: ClassVar[str | None] = 'set_duties'
+    DIRECTION: ClassVar[Direction] = Direction.REQUEST
+    duties: tuple[DutiesItem, ...]
+    #: One (motor_id, duty) pair per motor.
+
+    def to_fields(self) -> dict[str, Any]:
+        return {
+            'duties': [item.to_fields() for item in self.duties],
+        }
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'motor.set_duties request') -> Self:
+        _check_keys(data, ('duties',), ('subcommand_code', 'count'), where)
+        return cls(
+            tuple(DutiesItem.from_fields(_mapping(item, 'duties', where), where) for item in _get(data, 'duties', where)),
         )
 
 
@@ -746,6 +896,86 @@ class BusServoReadTemperatureResponse(Message):
 
 
 @dataclass(frozen=True, slots=True)
+class BusServoStopRequest(Message):
+    """Stop bus servos where they are (request)."""
+
+    PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
+    COMMAND: ClassVar[str] = 'bus_servo'
+    SUBCOMMAND: ClassVar[str | None] = 'stop'
+    DIRECTION: ClassVar[Direction] = Direction.REQUEST
+    servos: tuple[ServosItem, ...]
+    #: The servos to stop.
+
+    def to_fields(self) -> dict[str, Any]:
+        return {
+            'servos': [item.to_fields() for item in self.servos],
+        }
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.stop request') -> Self:
+        _check_keys(data, ('servos',), ('subcommand_code', 'count'), where)
+        return cls(
+            tuple(ServosItem.from_fields(_mapping(item, 'servos', where), where) for item in _get(data, 'servos', where)),
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class BusServoReadTorqueRequest(Message):
+    """Read whether a bus servo's torque is on (request)."""
+
+    PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
+    COMMAND: ClassVar[str] = 'bus_servo'
+    SUBCOMMAND: ClassVar[str | None] = 'read_torque'
+    DIRECTION: ClassVar[Direction] = Direction.REQUEST
+    servo_id: int
+    #: Bus servo id (0xFE is the broadcast id).
+
+    def to_fields(self) -> dict[str, Any]:
+        return {
+            'servo_id': self.servo_id,
+        }
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_torque request') -> Self:
+        _check_keys(data, ('servo_id',), ('subcommand_code',), where)
+        return cls(
+            _get(data, 'servo_id', where),
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class BusServoReadTorqueResponse(Message):
+    """Read whether a bus servo's torque is on (response)."""
+
+    PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
+    COMMAND: ClassVar[str] = 'bus_servo'
+    SUBCOMMAND: ClassVar[str | None] = 'read_torque'
+    DIRECTION: ClassVar[Direction] = Direction.RESPONSE
+    servo_id: int
+    #: Bus servo id (0xFE is the broadcast id).
+    success: ReadResult | int
+    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
+    torque: int
+    #: 1 while the torque is on (after load, 0x0C), 0 after unload (0x0B).
+
+    def to_fields(self) -> dict[str, Any]:
+        return {
+            'servo_id': self.servo_id,
+            'success': int(self.success),
+            'torque': self.torque,
+        }
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_torque response') -> Self:
+        _check_keys(data, ('servo_id', 'success', 'torque'), ('subcommand_code',), where)
+        return cls(
+            _get(data, 'servo_id', where),
+            _enum(ReadResult, _get(data, 'success', where)),
+            _get(data, 'torque', where),
+        )
+
+
+@dataclass(frozen=True, slots=True)
 class BusServoUnloadRequest(Message):
     """Release a bus servo's torque (request)."""
 
@@ -888,7 +1118,7 @@ class BusServoSetOffsetRequest(Message):
     servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
     offset: int
-    #: Bus servo offset (偏差), an int8 from -100 to +100. range -100..100
+    #: Bus servo offset (偏差), an int8 from -125 to +125 (about -30°..30°); 002 and 003 give the PWM offset's -100..+100 (erratum bus_offset_range). range -125..125
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -942,7 +1172,7 @@ class BusServoReadOffsetResponse(Message):
     success: ReadResult | int
     #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
     offset: int
-    #: The servo's offset (int8; -100..100 when set through 0x20).
+    #: The servo's offset (int8; -125..125 when set through 0x20).
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1333,10 +1563,10 @@ class GamepadResponse(Message):
     COMMAND: ClassVar[str] = 'gamepad'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    buttons: int
-    #: Button states (按键), one bit per button (bits not documented).
+    buttons: GamepadButtons
+    #: Buttons held (按键), one bit per button (bits from the SDK).
     hat: int
-    #: Hat (direction pad) value.
+    #: Direction pad (hat) value; the SDK reads 9 as right (hat x +1), 13 as left (-1), 11 as up (hat y -1) and 15 as down (+1) in its axes; other values are not documented.
     left_x: int
     #: Left stick x.
     left_y: int
@@ -1348,7 +1578,7 @@ class GamepadResponse(Message):
 
     def to_fields(self) -> dict[str, Any]:
         return {
-            'buttons': self.buttons,
+            'buttons': int(self.buttons),
             'hat': self.hat,
             'left_x': self.left_x,
             'left_y': self.left_y,
@@ -1360,7 +1590,7 @@ class GamepadResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'gamepad response') -> Self:
         _check_keys(data, ('buttons', 'hat', 'left_x', 'left_y', 'right_x', 'right_y'), (), where)
         return cls(
-            _get(data, 'buttons', where),
+            GamepadButtons(_get(data, 'buttons', where)),
             _get(data, 'hat', where),
             _get(data, 'left_x', where),
             _get(data, 'left_y', where),
@@ -1409,12 +1639,89 @@ class SbusResponse(Message):
         )
 
 
+@dataclass(frozen=True, slots=True)
+class SystemBatteryResponse(Message):
+    """Battery voltage (response). Sent by the device on its own."""
+
+    PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
+    COMMAND: ClassVar[str] = 'system'
+    SUBCOMMAND: ClassVar[str | None] = 'battery'
+    DIRECTION: ClassVar[Direction] = Direction.RESPONSE
+    voltage: int
+    #: Battery voltage. [mV]
+
+    def to_fields(self) -> dict[str, Any]:
+        return {
+            'voltage': self.voltage,
+        }
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'system.battery response') -> Self:
+        _check_keys(data, ('voltage',), ('subcommand_code',), where)
+        return cls(
+            _get(data, 'voltage', where),
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class OledRequest(Message):
+    """Show a line of text on the OLED display (request)."""
+
+    PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
+    COMMAND: ClassVar[str] = 'oled'
+    SUBCOMMAND: ClassVar[str | None] = None
+    DIRECTION: ClassVar[Direction] = Direction.REQUEST
+    line: int
+    #: Display line (1 or 2 in the SDK's example).
+    text: bytes
+    #: The text (UTF-8).
+
+    def to_fields(self) -> dict[str, Any]:
+        return {
+            'line': self.line,
+            'text': self.text.hex(' '),
+        }
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'oled request') -> Self:
+        _check_keys(data, ('line', 'text'), ('length',), where)
+        return cls(
+            _get(data, 'line', where),
+            _bytes(_get(data, 'text', where), 'text', where),
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class RgbSetPixelsRequest(Message):
+    """Set the colour of several RGB LEDs (request)."""
+
+    PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
+    COMMAND: ClassVar[str] = 'rgb'
+    SUBCOMMAND: ClassVar[str | None] = 'set_pixels'
+    DIRECTION: ClassVar[Direction] = Direction.REQUEST
+    pixels: tuple[PixelsItem, ...]
+    #: One (index, red, green, blue) per LED.
+
+    def to_fields(self) -> dict[str, Any]:
+        return {
+            'pixels': [item.to_fields() for item in self.pixels],
+        }
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'rgb.set_pixels request') -> Self:
+        _check_keys(data, ('pixels',), ('subcommand_code', 'count'), where)
+        return cls(
+            tuple(PixelsItem.from_fields(_mapping(item, 'pixels', where), where) for item in _get(data, 'pixels', where)),
+        )
+
+
 MESSAGE_TYPES: tuple[type[Message], ...] = (
     LedRequest,
     BuzzerRequest,
     MotorSetSpeedRequest,
     MotorSetSpeedsRequest,
     MotorStopRequest,
+    MotorSetDutiesRequest,
     MotorStopMaskRequest,
     PwmServoSetPositionsRequest,
     PwmServoSetPositionRequest,
@@ -1430,6 +1737,9 @@ MESSAGE_TYPES: tuple[type[Message], ...] = (
     BusServoReadVoltageResponse,
     BusServoReadTemperatureRequest,
     BusServoReadTemperatureResponse,
+    BusServoStopRequest,
+    BusServoReadTorqueRequest,
+    BusServoReadTorqueResponse,
     BusServoUnloadRequest,
     BusServoLoadRequest,
     BusServoSetIdRequest,
@@ -1452,4 +1762,7 @@ MESSAGE_TYPES: tuple[type[Message], ...] = (
     ImuResponse,
     GamepadResponse,
     SbusResponse,
+    SystemBatteryResponse,
+    OledRequest,
+    RgbSetPixelsRequest,
 )

@@ -15,7 +15,7 @@ address), as app §6 prescribes in that order.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Mapping
 
 from serialspec.runtime.device import CommandSpec, DeviceSpec, ErrorSpec, RunSpec, Simulator, SpaceSpec
 
@@ -96,12 +96,12 @@ class ModbusRtuSimulator(Simulator):
         self,
         ids: Iterable[int] = (1,),
         clock: Callable[[], float] | None = None,
+        model: str | Mapping[int, str] | None = None,
         sizes: dict[str, int] | None = None,
     ) -> None:
-        """`sizes`: data space name -> number of items, where the spec's sizes will not do."""
+        """`model`: the spec lists no models, so only None. `sizes`: data space -> number of items, where the spec's will not do."""
         super().__init__(
-            DEVICE, ids, encode=encode, parser=lambda: StreamParser(Direction.REQUEST), clock=clock, sizes=sizes
-        )
+            DEVICE, ids, encode=encode, parser=lambda: StreamParser(Direction.REQUEST), clock=clock, model=model, sizes=sizes        )
 
 
 #: The simulator class, under a name every generated package shares (serialspec sim uses it).

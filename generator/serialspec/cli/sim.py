@@ -7,6 +7,7 @@ import importlib
 import signal
 import sys
 from types import FrameType
+from typing import Any
 
 from serialspec.cli.protocols import open_spec
 from serialspec.runtime.errors import SerialspecError
@@ -31,7 +32,38 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="SPACE=N",
         help="number of items of a data space (repeat for several; Modbus: coils=20000)",
     )
+    parser.add_argument(
+        "--model",
+        dest="models",
+        action="append",
+        metavar="NAME|ID=NAME",
+        help="the device model (a name from the spec's `device.models`) of every device, or of one id (repeat)",
+    )
+    parser.add_argument(
+        "--echo",
+        action="store_true",
+        help="echo every byte received before answering, like a one-wire half-duplex adapter (clients: echo=True)",
+    )
     parser.add_argument("--quiet", action="store_true", help="do not log requests on stderr")
+
+
+def model_choice(given: list[str] | None) -> str | dict[int, str] | None:
+    """--model NAME (every device) or --model ID=NAME (one device), as the simulator's `model` argument."""
+    if not given:
+        return None
+    per_id: dict[int, str] = {}
+    every: str | None = None
+    for item in given:
+        key, sep, name = item.partition("=")
+        if not sep:
+            every = item
+        elif key.strip().isdigit():
+            per_id[int(key)] = name.strip()
+        else:
+            raise SerialspecError(f"--model {item}: expected NAME or ID=NAME (e.g. 3=sts3215)")
+    if every is not None and per_id:
+        raise SerialspecError("--model: give either one NAME for every device or ID=NAME for each, not both")
+    return per_id or every
 
 
 def run(args: argparse.Namespace) -> int:
@@ -46,11 +78,16 @@ def run(args: argparse.Namespace) -> int:
         if not count.isdigit() or int(count) < 1:
             raise SerialspecError(f"--size {text}: expected SPACE=N with N a positive number")
         sizes[name] = int(count)
-    options: dict[str, object] = {"sizes": sizes} if sizes else {}
+    options: dict[str, Any] = {"model": model_choice(args.models)}
+    if sizes:
+        options["sizes"] = sizes
     try:
         simulator = module.SIMULATOR(args.ids, **options) if args.ids else module.SIMULATOR(**options)
-    except (TypeError, ValueError) as exc:  # sizes for a device without data spaces, or an unknown space
-        raise SerialspecError(f"{args.spec}: {exc}") from None
+    except TypeError:  # a simulator without data spaces takes no sizes
+        raise SerialspecError(f"--size: {protocol.name} devices keep no data spaces") from None
+    except ValueError as exc:  # an unknown model or data space, or a model for an id not on the bus
+        raise SerialspecError(f"--model/--size: {exc}") from None
+    simulator.echo = args.echo
     controller, path = simulator.open_pty()
 
     def stop(signum: int, frame: FrameType | None) -> None:
@@ -59,7 +96,7 @@ def run(args: argparse.Namespace) -> int:
     signal.signal(signal.SIGINT, stop)
     signal.signal(signal.SIGTERM, stop)
     print(path, flush=True)
-    ids = ", ".join(str(i) for i in simulator.devices)
+    ids = ", ".join(f"{i} ({d.model.name})" if d.model else str(i) for i, d in simulator.devices.items())
     print(f"serialspec sim: {protocol.name} device(s) {ids} on {path}; Ctrl-C to stop", file=sys.stderr, flush=True)
     simulator.serve(controller)
     return 0

@@ -11,12 +11,13 @@ unplugged and plugged back in (or a symlink such as /dev/serial/by-id/... pointe
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import select
 import threading
 import time
 from collections import deque
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import suppress
 from dataclasses import dataclass, field
 from enum import Enum, IntFlag
@@ -24,8 +25,8 @@ from typing import Any, TypeVar
 
 import serial
 
-from serialspec.runtime.errors import CorruptReply, DeviceError, PortError, Timeout
-from serialspec.runtime.message import Message
+from serialspec.runtime.errors import CorruptReply, DeviceError, EncodeError, PortError, Timeout
+from serialspec.runtime.message import Message, compare
 from serialspec.runtime.stream import StreamParser
 
 M = TypeVar("M", bound=Message)
@@ -117,10 +118,14 @@ class Bus:
         *,
         timeout: float = 0.1,
         baudrate: int | None = None,
+        echo: bool = False,
         **serial_options: Any,
     ) -> None:
+        """`echo`: a one-wire half-duplex adapter that hears its own transmission; every frame written is read
+        back and checked before any reply is looked for (a mismatch or a missing echo is a PortError)."""
         self.binding = binding
         self.timeout = timeout
+        self.echo = echo
         self._closed = False  # by close(): no transaction reopens the port after that
         self._lock = threading.RLock()
         self._subscribers: list[Subscriber] = []
@@ -201,6 +206,7 @@ class Bus:
         with self._lock:
             self._ensure_open()
             self._drain()
+            self._parser.expect(expect)  # where replies share a code, the layout this request's reply has
             self._write(frame)
             reply = self._read_until(lambda m: self._answers(request, expect, m), wait, request)
             self._flush_backlog()
@@ -236,6 +242,7 @@ class Bus:
         with self._lock:
             self._ensure_open()
             self._drain()
+            self._parser.expect(expect)
             self._write(frame)
             for key in answers:
 
@@ -315,6 +322,33 @@ class Bus:
         with self._port_failures("write"):
             self._port.write(frame)
         self._last_io = time.monotonic()
+        if self.echo:
+            self._check_echo(frame)
+
+    def _check_echo(self, frame: bytes) -> None:
+        """Read back the echo of a frame just written; bytes after it (the reply's start) go to the parser."""
+        deadline = time.monotonic() + self.timeout
+        echoed = b""
+        while len(echoed) < len(frame):
+            remaining = deadline - time.monotonic()
+            with self._port_failures("read"):
+                chunk = self._read_some(remaining) if remaining > 0 else b""
+            if not chunk:
+                self._reset()
+                raise PortError(
+                    f"{self.port_name}: no echo of the {len(frame)} bytes written within {self.timeout:g} s "
+                    f"(got {len(echoed)}: {echoed.hex(' ') or 'nothing'}); is echo=True right for this adapter?"
+                )
+            echoed += chunk
+        if echoed[: len(frame)] != frame:
+            self._reset()
+            raise PortError(
+                f"{self.port_name}: the echo differs from the bytes written: wrote {frame.hex(' ')}, "
+                f"read back {echoed[: len(frame)].hex(' ')}"
+            )
+        rest = echoed[len(frame) :]
+        if rest:
+            self._backlog.extend(self._parser.feed(rest))
 
     def _drain(self) -> None:
         """Hand bytes that arrived between transactions (late replies, reports) to subscribers, without waiting."""
@@ -403,7 +437,12 @@ class Bus:
     def _check_status(self, reply: Message) -> None:
         for name in self.binding.status:
             value = getattr(reply, name, 0)
-            if value:
+            if dataclasses.is_dataclass(value):  # a status made of bit fields: an error when any is non-zero
+                parts = {f.name: getattr(value, f.name) for f in dataclasses.fields(value)}
+                if any(parts.values()):
+                    text = ", ".join(f"{k} = {v.name.lower() if isinstance(v, Enum) else v}" for k, v in parts.items())
+                    raise DeviceError(f"{reply.COMMAND}: the device reports {name} {text}", reply)
+            elif value:
                 text = self.binding.describe_status(name, int(value))
                 raise DeviceError(f"{reply.COMMAND}: the device reports {text}", reply)
 
@@ -500,7 +539,7 @@ class ClientBase:
     def __init__(self, bus: Bus, optional_replies: bool | None) -> None:
         self.bus = bus
         self.optional_replies = optional_replies
-        self._parameters: dict[tuple[int, int], float] = {}
+        self._parameters: dict[tuple[int, int], float | None] = {}  # None while being read
 
     def close(self) -> None:
         self.bus.close()
@@ -522,7 +561,9 @@ class ClientBase:
         extra = float(getattr(request, after)) / 1000 if after else 0.0
         return self.bus.request(request, expect, timeout=self.bus.timeout + extra)
 
-    def _maybe(self, request: Message, expect: type[M], optional: tuple[int, int] | None, after: str = "") -> M | None:
+    def _maybe(
+        self, request: Message, expect: type[M], optional: tuple[int, int, str] | None, after: str = ""
+    ) -> M | None:
         """A reply unless the device stays silent: broadcast, or an optional reply its parameter switches off."""
         self.bus.binding.encode(request)  # check every value before any byte (even a parameter read) is written
         if self._is_broadcast(request) or (optional is not None and not self._answers(request, optional)):
@@ -530,14 +571,49 @@ class ClientBase:
             return None
         return self._ask(request, expect, after)
 
-    def _answers(self, request: Message, optional: tuple[int, int]) -> bool:
+    def _answers(self, request: Message, optional: tuple[int, int, str]) -> bool:
         if self.optional_replies is not None:
             return self.optional_replies
-        key, value = optional
+        key, value, op = optional
         address = int(getattr(request, self.ADDRESS, 0))
         if (address, key) not in self._parameters:
-            self._parameters[(address, key)] = self._read_key(address, key)
-        return self._parameters[(address, key)] == value
+            # While the parameter is read, that read is asked as if it were answered (the read may itself be an
+            # optional reply: DYNAMIXEL READ at status_return_level 0); no answer means no optional replies.
+            self._parameters[(address, key)] = None
+            try:
+                self._parameters[(address, key)] = self._read_key(address, key)
+            except Timeout:
+                del self._parameters[(address, key)]
+                return False
+        current = self._parameters[(address, key)]
+        return True if current is None else compare(current, op, value)
+
+    def _carry(
+        self,
+        requests: Sequence[Message],
+        carried: Mapping[type[Message], tuple[int, type[Message] | None]],
+        content: slice,
+        build: Callable[[int, list[bytes]], Message],
+    ) -> list[Message]:
+        """Send requests of one command inside one carrier request (a sync command); the replies, if any are due.
+
+        `carried`: request class -> (its command code, the reply class each device answers with, or None);
+        `content`: where a request's content sits in its encoded frame; `build`: the carrier from code and contents.
+        """
+        kinds = {type(r) for r in requests}
+        if len(kinds) != 1:
+            raise EncodeError("a sync command carries requests of one command: give one or more, all of one type")
+        kind = kinds.pop()
+        if kind not in carried:
+            raise EncodeError(
+                f"{kind.__name__} cannot be carried (expected one of {', '.join(c.__name__ for c in carried)})"
+            )
+        code, reply = carried[kind]
+        request = build(code, [self.bus.binding.encode(r)[content] for r in requests])
+        if reply is None:
+            self.bus.send(request)
+            return []
+        return list(self.bus.request_each(request, reply, [{self.ADDRESS: getattr(r, self.ADDRESS)} for r in requests]))
 
     def _read_key(self, address: int, key: int) -> float:
         """Read one table entry by key (generated clients whose spec can read entries override this)."""

@@ -557,6 +557,10 @@ EXAMPLE = Obj(
         ),
         "frame": HEX_BYTES,
         "erratum": Str("Name of the erratum that explains why `frame` differs from `printed`."),
+        "completed": Str(
+            "The document prints no complete frame here (a placeholder such as `CRC` for the check byte, or the "
+            "values as a table): how `frame` completes it. A printing convention, not an erratum."
+        ),
         "command": Str(),
         "subcommand": Str(),
         "request": Str("Name of the example whose request this example answers."),
@@ -623,7 +627,15 @@ DEVICE_COMMAND = Obj(
             ),
             "a list of request fields stored in memory, or a mapping request field -> data space run",
         ),
-        "resets": Bool("Memory goes back to its defaults."),
+        "resets": Bool("Memory goes back to its defaults (all but the device's id, unless `keeps` says otherwise)."),
+        "keeps": Obj(
+            {
+                "field": Str("The request field that chooses (DYNAMIXEL FACTORY RESET `option`)."),
+                "entries": MapOf(ListOf(Str()), "Field value -> the memory entries a reset keeps.", int_keys=True),
+            },
+            required=("field", "entries"),
+            description="resets: the entries kept, chosen by a request field (0xFF: none, 0x01: id, ...).",
+        ),
         "reports": MapOf(
             Str(),
             "Response field -> the state variable or memory entry it reports, or an expression of them where the "
@@ -635,8 +647,56 @@ DEVICE_COMMAND = Obj(
                 "target": Str("The request field (or memory entry, once written) with the target."),
                 "duration": Str("The request field (or memory entry) with the time to reach the target, in ms."),
                 "speed": Str("The request field (or memory entry) with the speed, in state units per second."),
+                "speed_scale": Num(
+                    "State units per second for one unit of `speed` (DYNAMIXEL: 0.229 rev/min x 4096 / 60 = 15.63)."
+                ),
+                "enabled_by": Str(
+                    "A memory entry (or state variable): the move happens only while it is non-zero (torque_enable); "
+                    "otherwise the target is only stored."
+                ),
+                "accel": Str("The request field with the acceleration time (ms) at the start of the move."),
+                "decel": Str("The request field with the deceleration time (ms) at the end of the move."),
             },
             required=("state", "target"),
+        ),
+        "stops": ListOf(Str(), "State variables whose move in progress stops where it is now."),
+        "wraps": MapOf(
+            Num(),
+            "State variable -> a period: the variable keeps only its remainder, toward zero (an angle within one "
+            "turn, 3600 in 0.1°).",
+        ),
+        "counts": MapOf(
+            Obj(
+                {"state": Str("The state variable (or memory entry)."), "per": Num("The size of one whole unit.")},
+                required=("state", "per"),
+            ),
+            "Response field -> how many whole `per` the state variable holds, toward zero (turns of an angle).",
+        ),
+        "every_device": Bool(
+            "A request without an address reaches every device on the bus (default: the first one only)."
+        ),
+        "held_while": Str(
+            "A state variable: while it is not 0, the device keeps this request instead of carrying it out, until "
+            "a command that `releases` the variable."
+        ),
+        "releases": Str(
+            "A state variable: the command sets it to 0 and carries out the requests held while it was set, in "
+            "order (or drops them, see `cancel_when`)."
+        ),
+        "cancel_when": MapOf(
+            Num(), "With `releases`: request field -> the value with which the held requests are dropped."
+        ),
+        "carries": Obj(
+            {
+                "command": Str("The request field (or `each` item field) holding the code of the command carried."),
+                "content": Str("The bytes field holding that command's request content."),
+                "commands": ListOf(Str(), "The commands it can carry (default: every command with a code)."),
+            },
+            required=("command", "content"),
+            description=(
+                "The request (or each item of its `each` group) carries another command's request content; the "
+                "devices act on it as on that request, and answer as they would (a sync command)."
+            ),
         ),
         "broadcast_reply": Bool("Answers even when addressed by broadcast (default: silent)."),
         "each": Str("A group field of the request whose items address one device each (by the address field)."),
@@ -654,9 +714,43 @@ DEVICE_COMMAND = Obj(
     description="What the device does with one command (command or command.subcommand).",
 )
 
+MODEL = Obj(
+    {
+        "number": Int("The model number the device reports (in `model_entry`), e.g. 777 for the FEETECH STS3215."),
+        "title": TEXT,
+        "description": TEXT,
+        "source": TEXT,
+        "initial": MapOf(
+            Num(),
+            "Memory entry or state variable -> the value this model starts with (its factory value), over the "
+            "table's default and the device's `initial`.",
+        ),
+        "entries": MapOf(
+            Obj(
+                {
+                    "range": RANGE,
+                    "unit": Str("This model's unit of one wire step, where it differs from the table's."),
+                    "scale": Num("This model's engineering value per wire step, where it differs."),
+                    "description": TEXT,
+                }
+            ),
+            "Memory entry -> where this model's range, unit or scale differs from the table's.",
+        ),
+    },
+    required=("number",),
+    description="One device model: its model number, factory values and where its table differs.",
+)
+
 DEVICE = Obj(
     {
         "description": TEXT,
+        "models": MapOf(
+            MODEL,
+            "Device models sharing the protocol and table (FEETECH STS3215, SM8512BL; DYNAMIXEL XM430, XL330): "
+            "`serialspec sim --model NAME` (or `--model ID=NAME`) picks one; the docs list them.",
+        ),
+        "default_model": Str("The model the simulator uses when none is named (default: the first of `models`)."),
+        "model_entry": Str("The memory entry holding the model number (set from the model's `number`)."),
         "memory": Str("The table the device keeps, initialised from its defaults."),
         "initial": MapOf(Num(), "Memory entry -> value the simulator starts with where the table gives no default."),
         "address": Str("The field holding the device id (default: the frame's address element)."),
@@ -667,8 +761,21 @@ DEVICE = Obj(
             OneOf((Num(), Str()), "a number, or text for text and bytes fields (bytes as hex)"),
             "Response field -> value when no behaviour sets it (e.g. result: 1; VESC hw_name: '60').",
         ),
-        "refused": MapOf(Num(), "Response field -> value when a write is refused (read-only or unknown entry)."),
-        "status": MapOf(Str(), "Response field -> the memory entry every response reports in it (a status byte)."),
+        "refused": MapOf(
+            Num(),
+            "Response field (or field.bit_field) -> value when a write is refused (read-only or unknown entry; "
+            "DYNAMIXEL error.number: 7, access error).",
+        ),
+        "out_of_range": MapOf(
+            Num(),
+            "Response field (or field.bit_field) -> value when a write is refused for a value outside the entry's "
+            "range (DYNAMIXEL error.number: 4, data range error); default: `refused`.",
+        ),
+        "status": MapOf(
+            Str(),
+            "Response field -> the memory entry every response reports in it (a status byte); field.bit_field -> "
+            "an entry whose being non-zero sets that bit field (DYNAMIXEL error.alert: hardware_error_status).",
+        ),
         "echo_address": Bool(
             "Replies carry the id the request named (RRC: 0xFE for a broadcast read), not the answering device's own."
         ),

@@ -250,19 +250,10 @@ class OptionalWhen:
     equals: int  # the value compared with
     op: Literal["==", "!=", ">=", "<="] = "=="
 
-    def holds(self, value: float) -> bool:
-        return {
-            "==": value == self.equals,
-            "!=": value != self.equals,
-            ">=": value >= self.equals,
-            "<=": value <= self.equals,
-        }[self.op]
-
     @property
-    def text(self) -> str:
-        """The condition as people read it: `status_return_level ≥ 1`."""
-        symbol = {"==": "=", "!=": "≠", ">=": "≥", "<=": "≤"}[self.op]
-        return f"{self.entry} {symbol} {self.equals}"
+    def symbol(self) -> str:
+        """The comparison as people write it: =, ≠, ≥ or ≤."""
+        return {"==": "=", "!=": "≠", ">=": "≥", "<=": "≤"}[self.op]
 
 
 @dataclass(frozen=True)
@@ -505,6 +496,7 @@ class Example:
     subcommand: str | None
     request: str
     fields: dict[str, object]
+    completed: str = ""  # the document prints no complete frame: how `frame` completes it (not an erratum)
     # bytes of the frame before and after the part the document prints (`printed_span`; (0, 0): the whole frame)
     printed_span: tuple[int, int] = (0, 0)
 
@@ -547,6 +539,10 @@ class Motion:
     target: str
     duration: str
     speed: str
+    speed_scale: float = 1.0  # state units per second for one unit of `speed`
+    enabled_by: str = ""  # a memory entry (or state variable): the move happens only while it is non-zero
+    accel: str = ""  # request field: acceleration time (ms) at the start
+    decel: str = ""  # request field: deceleration time (ms) at the end
 
 
 @dataclass(frozen=True)
@@ -600,6 +596,16 @@ class Behaviour:
     absent: dict[str, float] = field(default_factory=dict)  # response values when no device has the id
     space_reads: dict[str, SpaceAccess] = field(default_factory=dict)  # response field -> run read
     space_writes: dict[str, SpaceAccess] = field(default_factory=dict)  # request field -> run written
+    keeps: tuple[str, dict[int, tuple[str, ...]]] | None = None  # resets: request field, its value -> entries kept
+    stops: tuple[str, ...] = ()  # state variables whose move stops where it is
+    wraps: dict[str, float] = field(default_factory=dict)  # state variable -> period it is kept within
+    counts: dict[str, tuple[str, float]] = field(default_factory=dict)  # response field -> (state, per)
+    every_device: bool = False  # a request without an address reaches every device
+    held_while: str = ""  # state variable: while set, the request is held
+    releases: str = ""  # state variable: cleared, and the held requests carried out
+    cancel_when: dict[str, float] = field(default_factory=dict)  # with releases: field -> value that drops them
+    carries: tuple[str, str] | None = None  # (command code field, content field) of a carried request
+    carried: tuple[str, ...] = ()  # the commands it can carry (empty: every command with a code)
 
 
 @dataclass(frozen=True)
@@ -625,6 +631,34 @@ class DeviceKind:
 
 
 @dataclass(frozen=True)
+class ModelEntry:
+    """Where one model's memory entry differs from the table: its range, unit, scale or description."""
+
+    name: str
+    minimum: float
+    maximum: float
+    unit: str
+    scale: float | None
+    description: str
+
+
+@dataclass(frozen=True)
+class DeviceModel:
+    """One model of the device: its model number, its factory values and where its table differs."""
+
+    name: str
+    number: int
+    title: str
+    description: str
+    source: str
+    initial: dict[str, float]  # memory entry or state variable -> this model's value (over the device's initial)
+    entries: tuple[ModelEntry, ...] = ()
+
+    def entry(self, name: str) -> ModelEntry | None:
+        return next((e for e in self.entries if e.name == name), None)
+
+
+@dataclass(frozen=True)
 class Device:
     """How a device behaves, for the simulator (and the address/broadcast rule, for the client)."""
 
@@ -645,6 +679,9 @@ class Device:
     spaces: tuple[Space, ...] = ()
     errors: DeviceErrors | None = None
     timeout: DeviceTimeout | None = None
+    out_of_range: dict[str, float] = field(default_factory=dict)  # response values when a value is out of range
+    models: tuple[DeviceModel, ...] = ()  # the first is the default model
+    model_entry: str = ""  # the memory entry holding the model number
 
     def behaviour(self, key: str) -> Behaviour | None:
         return next((b for b in self.behaviours if b.command == key), None)

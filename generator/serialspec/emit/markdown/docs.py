@@ -19,6 +19,8 @@ from serialspec.spec.model import (
     Bytes,
     Checksum,
     Command,
+    Device,
+    DeviceModel,
     Direction,
     Example,
     Field,
@@ -173,17 +175,20 @@ def message_context(protocol: Protocol, message: Message | None) -> dict[str, An
         "optional": text(message.optional),
         "unsolicited": message.unsolicited,
         "answers": message.answers,
-        "reply": reply_text(message) or error_reply_text(protocol, message),
+        "reply": reply_text(message, protocol) or error_reply_text(protocol, message),
         "description": text(message.description),
     }
 
 
-def reply_text(message: Message) -> str:
-    """For a request answered by another command's response: which, and the parameter that switches it."""
+def reply_text(message: Message, protocol: Protocol | None = None) -> str:
+    """For a request answered by another command's response: which, and the parameter that switches it; for a
+    response that shares its code with other replies: how a reply is told to have this layout."""
+    if message.direction == Direction.RESPONSE and protocol is not None:
+        return shared_reply_text(protocol, message)
     if not message.answered_by:
         return ""
     switch = message.reply_when
-    when = f", sent only while `{switch.entry}` = {switch.equals}" if switch else ""
+    when = f", sent only while `{switch.entry}` {switch.symbol} {switch.equals}" if switch else ""
     return f"answered by the `{message.answered_by}` response{when}"
 
 
@@ -196,6 +201,36 @@ def error_reply_text(protocol: Protocol, message: Message) -> str:
         f"sent instead of any request's reply, with `{error.element}` = the request's code | {error.flag:#04x} "
         f"(the message holds the request's code as `{error.element}`)"
     )
+
+
+def shared_reply_text(protocol: Protocol, message: Message) -> str:
+    """A reply layout that shares its code (or its having none) with others: chosen by the request it answers."""
+    layout = protocol.framing.layouts[Direction.RESPONSE]
+    code = protocol.command(message.command).code if layout.has_command else None
+    sharing = [
+        m
+        for m in protocol.messages()
+        if m.direction == Direction.RESPONSE
+        and not m.unsolicited
+        and (protocol.command(m.command).code if layout.has_command else None) == code
+        and not protocol.command(m.command).subcommands
+    ]
+    if len(sharing) < 2:
+        return ""
+    askers = sorted(
+        {
+            r.command
+            for r in protocol.messages()
+            if r.direction == Direction.REQUEST and (r.answered_by or r.key) == message.key
+        }
+    )
+    answers = ", ".join(f"`{a}`" for a in askers) or "no request"
+    default = (
+        "; a reply decoded without its request is read with this layout"
+        if message.default_reply
+        else "; chosen by the request it answers (the replies share their code)"
+    )
+    return f"the layout of the replies to {answers}{default}"
 
 
 def command_context(protocol: Protocol, command: Command) -> dict[str, Any]:
@@ -480,6 +515,7 @@ def emit_docs(protocol: Protocol) -> str:
             "frame": e.frame.hex(" ").upper(),
             "erratum": e.erratum,
             "partial": e.printed_span != (0, 0),
+            "completed": text(e.completed),
             "rows": breakdown(protocol, e),
         }
         for e in protocol.examples
@@ -545,9 +581,12 @@ def emit_docs(protocol: Protocol) -> str:
         for e in protocol.errata
     ]
     serial = protocol.serial
+    device = protocol.device
     return common.render(
         "serialspec.emit.markdown",
         "docs.md.j2",
+        models=[model_context(device, m) for m in device.models] if device else [],
+        model_entry=device.model_entry if device else "",
         protocol=protocol,
         title=text(protocol.title),
         description=text(protocol.description),
@@ -574,6 +613,35 @@ def emit_docs(protocol: Protocol) -> str:
         examples=examples,
         errata=errata,
     )
+
+
+def model_context(device: Device, model: DeviceModel) -> dict[str, Any]:
+    """One model: its values and where its entries differ from the table, one row per entry, in table order."""
+    table = {e.name: e for e in device.memory.entries} if device.memory else {}
+    names = [n for n in table if n in model.initial or model.entry(n)]
+    names += [n for n in model.initial if n not in table]  # state variables
+    rows = []
+    for name in names:
+        entry, override = table.get(name), model.entry(name)
+        bounds = override or entry
+        rows.append(
+            {
+                "name": name,
+                "value": number(model.initial[name]) if name in model.initial else "",
+                "range": f"{number(bounds.minimum)}..{number(bounds.maximum)}" if bounds else "",
+                "unit": cell(override.unit if override else entry.unit if entry else ""),
+                "note": cell(override.description if override else ""),
+            }
+        )
+    return {
+        "name": model.name,
+        "number": model.number,
+        "anchor": anchor("model", model.name),
+        "title": cell(model.title),
+        "description": text(model.description),
+        "source": text(model.source),
+        "rows": rows,
+    }
 
 
 def sign_note(entry: TableEntry) -> str:

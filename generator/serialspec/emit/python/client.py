@@ -174,6 +174,7 @@ def unused_fields(protocol: Protocol, request: Message, response: Message) -> se
     of registers read from a request field this request does not have (a shared reply's `data` to a PING)."""
     unused = {e.name for e in status_elements(protocol)}
     names = {f.name for f in request.fields}
+    names |= {f.name for g in request.fields if isinstance(g, Group) for f in g.fields}  # per-item (BULK READ)
     for f in response.fields:
         if isinstance(f, Bytes) and f.table is not None:
             needed = [n.removeprefix("request.") for n in (f.start, f.size_from) if n.startswith("request.")]
@@ -232,10 +233,29 @@ def register_commands(protocol: Protocol, methods: list[dict[str, Any]]) -> list
             context.update(read_key=first)
         elif group is not None and read is not None and read.table is not None and method["kind"] == "each":
             start, size = (read.start.removeprefix("request."), read.size_from.removeprefix("request."))
-            if fields != [address, start, size, group.name] or [f.name for f in group.fields] != [address]:
+            items = [f.name for f in group.fields]
+            if fields == [address, start, size, group.name] and items == [address]:
+                context.update(kind="each_read", map=map_name(read.table), alias=names_alias(read.table))
+                context.update(group=group.name, item=group.class_name, item_address=address)
+            elif fields == [address, group.name] and items == [address, start, size]:
+                # every item names its own device and run (BULK READ)
+                context.update(kind="items_read", map=map_name(read.table), alias=names_alias(read.table))
+                context.update(group=group.name, item=group.class_name, item_address=address, start=start, size=size)
+            else:
                 continue
-            context.update(kind="each_read", map=map_name(read.table), alias=names_alias(read.table), group=group.name)
-            context.update(item=group.class_name, item_address=address)
+        elif (
+            group is not None
+            and item_run is not None
+            and item_run.table is not None
+            and response is None
+            and item_run.start in {f.name for f in group.fields}
+        ):
+            if fields != [address, group.name]:
+                continue
+            # every item writes its own run to its own device (BULK WRITE)
+            context.update(kind="items_write", map=map_name(item_run.table), alias=names_alias(item_run.table))
+            context.update(group=group.name, item=group.class_name)
+            context.update(item_address=address, start=item_run.start, field=item_run.name)
         elif group is not None and item_run is not None and item_run.table is not None and response is None:
             size = item_run.size if isinstance(item_run.size, str) else ""
             if fields != [address, item_run.start, *([size] if size in fields else []), group.name]:
@@ -256,6 +276,59 @@ def register_commands(protocol: Protocol, methods: list[dict[str, Any]]) -> list
         method["name"] = context["raw"]
         found.append(context)
     return found
+
+
+def carry_method(protocol: Protocol, request: Message, imports: set[str]) -> dict[str, Any] | None:
+    """For a request that `carries` other requests (a sync command): a method that takes those requests.
+
+    It encodes each, takes its content as one item of the carrier's group, and collects the replies the carried
+    command gets (one per request, matched by address) unless that command's reply is optional or absent.
+    """
+    behaviour = protocol.device.behaviour(request.key) if protocol.device else None
+    if behaviour is None or behaviour.carries is None:
+        return None
+    group = next((f for f in request.fields if isinstance(f, Group) and f.name == behaviour.each), None)
+    if group is None:
+        return None
+    code_field, content_field = behaviour.carries
+    layout = protocol.framing.layouts[Direction.REQUEST]
+    start, trailing = layout.offsets["content"], layout.overhead - layout.offsets["content"]
+    replies = dict(request_response_pairs(protocol))
+    carried = []
+    for command in protocol.commands:
+        inner = command.request
+        if command.code is None or inner is None or command.subcommands or inner is request:
+            continue
+        if behaviour.carried and command.name not in behaviour.carried:
+            continue
+        reply = replies.get(inner)
+        expected = reply if reply is not None and reply_condition(inner, reply) is None else None
+        imports.update(n for n in (inner.class_name, expected.class_name if expected else "") if n)
+        carried.append((inner.class_name, command.code, expected.class_name if expected else "None"))
+    imports.add(group.class_name)
+    title = protocol.command(request.command).title or request.key
+    return {
+        "name": method_name(request) + "_of",
+        "params": "requests: Sequence[Message]",
+        "returns": "list[Message]",
+        "doc": [
+            one_line(title) + ", from the requests it carries: one per device, all of one command.",
+            "",
+            f"Each request's content becomes one item of `{group.name}`; the command's replies (one per request, in"
+            " order) are returned, or [] when that command answers only when a parameter allows it or not at all.",
+        ],
+        "kind": "carry",
+        "carried": carried,
+        "carried_name": method_name(request).upper() + "_CARRIES",
+        "content": f"slice({start}, {-trailing if trailing else None})",
+        "carrier": request.class_name,
+        "code_field": code_field,
+        "group": group.name,
+        "item": group.class_name,
+        "content_field": content_field,
+        "pairs": [],
+        "statuses": [],
+    }
 
 
 def client_module(protocol: Protocol) -> str:
@@ -380,7 +453,7 @@ def client_module(protocol: Protocol) -> str:
             "build": ", ".join(f"{f.name}={f.name}" for f in fields),
             "kind": kind,
             "silent": silent,
-            "optional": f"({optional.key}, {optional.equals})" if optional else "None",
+            "optional": f"({optional.key}, {optional.equals}, {optional.op!r})" if optional else "None",
             "after": repr(response.after) if response and response.after else "",
             "result": result_expr,
             "remember": (
@@ -407,6 +480,9 @@ def client_module(protocol: Protocol) -> str:
             group["methods"].append(method)
         else:
             methods.append(method)
+        carrier = carry_method(protocol, request, imports)
+        if carrier is not None:
+            methods.append(carrier)
     reports = []
     for message in protocol.messages():
         if message.direction == Direction.RESPONSE and message.unsolicited:
@@ -444,6 +520,7 @@ def client_module(protocol: Protocol) -> str:
         broadcast=repr(broadcast),
         status=repr(tuple(e.name for e in status_elements(protocol))),
         methods=methods,
+        carriers=[m for m in methods if m["kind"] == "carry"],
         groups=list(groups.values()),
         registers=registers,
         status_flags=flags_literal,
@@ -462,12 +539,19 @@ def client_module(protocol: Protocol) -> str:
             if used
         ],
         uses_status=any(m["statuses"] for m in everything),
+        uses_message=any(m["statuses"] or m["kind"] == "carry" for m in everything),
         abc_imports=sorted(
             {
                 *(["Callable", "Iterator"] if reports else []),
                 *(["Mapping"] if any(m["pairs"] for m in everything) else []),
-                *(["Mapping"] if any(r["kind"] == "each_write" for r in registers) else []),
+                *(
+                    ["Mapping"]
+                    if any(r["kind"] in ("each_write", "items_read", "items_write") for r in registers)
+                    else []
+                ),
+                *(["Sequence"] if any(r["kind"] == "items_read" for r in registers) else []),
                 *(["Iterable"] if any(r["kind"] == "each_read" for r in registers) else []),
+                *(["Sequence"] if any(m["kind"] == "carry" for m in everything) else []),
             }
         ),
     )

@@ -12,6 +12,7 @@ from serialspec.emit.python.render import render
 from serialspec.spec import expression
 from serialspec.spec.model import (
     Bytes,
+    DeviceModel,
     Group,
     List,
     Message,
@@ -22,6 +23,39 @@ from serialspec.spec.model import (
     TableValue,
     reply_condition,
 )
+
+#: Behaviour attributes passed to CommandSpec under the same name when they are set.
+BEHAVIOUR_ARGUMENTS = (
+    "kind",
+    "each",
+    "stores",
+    "sets",
+    "absent",
+    "buffered",
+    "commits",
+    "stops",
+    "wraps",
+    "counts",
+    "every_device",
+    "held_while",
+    "releases",
+    "cancel_when",
+    "carries",
+)
+
+
+def carried_requests(protocol: Protocol) -> list[tuple[int, str, str]]:
+    """(code, request class, construct content) of every request a `carries` behaviour may carry."""
+    device = protocol.device
+    carriers = [b for b in device.behaviours if b.carries] if device else []
+    if not carriers:
+        return []
+    named = {name for b in carriers for name in b.carried}
+    return [
+        (c.code, c.request.class_name, c.request.class_name + "Content")
+        for c in protocol.commands
+        if c.code is not None and c.request is not None and not c.subcommands and (not named or c.name in named)
+    ]
 
 
 def table_fields(*messages: Message | None) -> dict[str, tuple[str, ...]]:
@@ -99,6 +133,16 @@ def import_order(name: str) -> tuple[int, str]:
     return (0 if name.isupper() else 1 if name[:1].isupper() else 2, name.lower())
 
 
+def model_data(model: DeviceModel) -> dict[str, Any]:
+    """A model as the template's ModelSpec: its values, and its ranges where they differ from the table's."""
+    return {
+        "name": repr(model.name),
+        "number": model.number,
+        "values": [(repr(k), number(v)) for k, v in model.initial.items()],
+        "ranges": [(repr(e.name), number(e.minimum), number(e.maximum)) for e in model.entries],
+    }
+
+
 def simulator_module(protocol: Protocol) -> str:
     device = protocol.device
     assert device is not None
@@ -125,6 +169,8 @@ def simulator_module(protocol: Protocol) -> str:
                 args.append(f"writes={behaviour.writes!r}")
             if behaviour.resets:
                 args.append("resets=True")
+            if behaviour.keeps:
+                args.append(f"keeps={behaviour.keeps!r}")
             if behaviour.reports:
                 args.append(
                     f"reports={{{', '.join(f'{k!r}: {report_source(v)}' for k, v in behaviour.reports.items())}}}"
@@ -132,9 +178,15 @@ def simulator_module(protocol: Protocol) -> str:
             if behaviour.moves:
                 m = behaviour.moves
                 args.append(f"moves={(m.state, m.target, m.duration, m.speed)!r}")
+                if m.speed_scale != 1.0:
+                    args.append(f"speed_scale={m.speed_scale!r}")
+                if m.enabled_by:
+                    args.append(f"move_enabled_by={m.enabled_by!r}")
+                if m.accel or m.decel:
+                    args.append(f"ramp={(m.accel, m.decel)!r}")
             if behaviour.broadcast_reply:
                 args.append("broadcast_reply=True")
-            for name in ("kind", "each", "stores", "sets", "absent", "buffered", "commits"):
+            for name in BEHAVIOUR_ARGUMENTS:
                 if getattr(behaviour, name):
                     args.append(f"{name}={getattr(behaviour, name)!r}")
             for name in ("space_reads", "space_writes"):
@@ -153,7 +205,7 @@ def simulator_module(protocol: Protocol) -> str:
                 args.append(f"limits={{{shown}}}")
         condition = reply_condition(request, response)
         if response and condition:
-            args.append(f"optional_when=({condition.key}, {condition.equals})")
+            args.append(f"optional_when=({condition.key}, {condition.equals}, {condition.op!r})")
         if response and response.after:
             args.append(f"after={response.after!r}")
         tables = table_fields(request, response)
@@ -179,6 +231,7 @@ def simulator_module(protocol: Protocol) -> str:
     runtime += ["EntrySpec"] if entries else []
     runtime += ["ErrorSpec"] if error else []
     runtime += ["KindSpec"] if device.kinds else []
+    runtime += ["ModelSpec"] if device.models else []
     runtime += ["RunSpec"] if any(b.space_reads or b.space_writes for b in device.behaviours) else []
     runtime += ["Simulator"]
     runtime += ["SpaceSpec"] if spaces else []
@@ -206,12 +259,17 @@ def simulator_module(protocol: Protocol) -> str:
         state=repr(device.state),
         reply=repr(device.reply),
         refused=repr(device.refused),
+        out_of_range=repr(device.out_of_range) if device.out_of_range else "",
         entries=entries,
         commands=commands,
         registers=map_name(device.memory) if device.memory in register_tables(protocol) else "",
         status=repr(device.status) if device.status else "",
         echo_address=device.echo_address,
+        models=[model_data(m) for m in device.models],
+        carried=carried_requests(protocol),
         kinds=[f"KindSpec({k.name!r}, {k.address!r}, {k.ids!r}, {k.broadcast!r}, {k.state!r})," for k in device.kinds],
         imports=sorted(imports | {"Direction"}, key=import_order),
         default_ids=repr(device.ids) if len(device.ids) > 1 else f"({device.ids[0]},)",
+        model_names=", ".join(m.name for m in device.models),
+        default_model=device.models[0].name if device.models else "",
     )

@@ -3,15 +3,16 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 import threading
 import time
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
 from serialspec.runtime.device.faults import Fault, FaultInjection
 from serialspec.runtime.errors import EncodeError
-from serialspec.runtime.message import Message
+from serialspec.runtime.message import Message, compare
 from serialspec.runtime.registers import RegisterMap
 from serialspec.runtime.stream import StreamParser
 
@@ -72,11 +73,12 @@ class CommandSpec:
     reads: tuple[str, ...] = ()
     writes: tuple[str, ...] = ()
     resets: bool = False
+    keeps: tuple[str, dict[int, tuple[str, ...]]] | None = None  # resets: request field, its value -> entries kept
     # response field -> the state variable or memory entry it reports, or a function of `get` (a unit conversion)
     reports: dict[str, str | Callable[[Callable[[str], float]], float]] = field(default_factory=dict)
     moves: tuple[str, str, str, str] | None = None  # state, target field, duration field (ms), speed field (/s)
     broadcast_reply: bool = False
-    optional_when: tuple[int, int] | None = None  # (memory key, value) with which the response is sent
+    optional_when: tuple[int, int, str] | None = None  # (memory key, value, comparison): when the response is sent
     after: str = ""  # request field: the response is sent after that many ms
     # table fields of the request and response: name -> ("value", key field) or ("block", entry names...)
     tables: dict[str, tuple[str, ...]] = field(default_factory=dict)
@@ -84,6 +86,8 @@ class CommandSpec:
     each: str = ""  # a request group whose items each address one device (item fields override the request's)
     stores: dict[str, str] = field(default_factory=dict)  # request field -> state variable
     sets: dict[str, float] = field(default_factory=dict)  # state variable -> value
+    speed_scale: float = 1.0  # moves: state units per second for one unit of the speed field
+    move_enabled_by: str = ""  # moves: only while this memory entry (or state variable) is non-zero
     absent: dict[str, float] = field(default_factory=dict)  # response values when no device has the id
     buffered: bool = False  # the writes wait for a command that commits (REG WRITE)
     commits: bool = False  # carries out the buffered writes (ACTION)
@@ -95,6 +99,15 @@ class CommandSpec:
     # values a request carries that its message does not hold (counts, byte counts), from its fields: a reply
     # field of the same name echoes them like any other request field
     derived: dict[str, Callable[[dict[str, Any]], int]] = field(default_factory=dict)
+    ramp: tuple[str, str] | None = None  # request fields: acceleration and deceleration time (ms) of the move
+    stops: tuple[str, ...] = ()  # state variables whose move stops where it is
+    wraps: dict[str, float] = field(default_factory=dict)  # state variable -> the period it is kept within
+    counts: dict[str, tuple[str, float]] = field(default_factory=dict)  # response field -> (state, per)
+    every_device: bool = False  # a request without an address reaches every device, not only the first
+    held_while: str = ""  # state variable: while it is set, the device holds the request
+    releases: str = ""  # state variable: cleared, and the requests held meanwhile carried out
+    cancel_when: dict[str, float] = field(default_factory=dict)  # with releases: the values that drop them
+    carries: tuple[str, str] | None = None  # (code field, content field): another command's request content
 
 
 @dataclass(frozen=True)
@@ -119,6 +132,16 @@ class TimeoutSpec:
 
 
 @dataclass(frozen=True)
+class ModelSpec:
+    """One device model: its factory values and the ranges where they differ from the table's."""
+
+    name: str
+    number: int
+    values: dict[str, float]  # memory entry or state variable -> value at power-on (and after a reset)
+    ranges: dict[str, tuple[float, float]] = field(default_factory=dict)  # memory entry -> its writable range
+
+
+@dataclass(frozen=True)
 class DeviceSpec:
     protocol: str
     address: str
@@ -136,19 +159,49 @@ class DeviceSpec:
     spaces: tuple[SpaceSpec, ...] = ()
     error: ErrorSpec | None = None
     timeout: TimeoutSpec | None = None
+    out_of_range: dict[str, float] = field(default_factory=dict)  # reply values for an out-of-range write
+    models: tuple[ModelSpec, ...] = ()  # the first is the default model
+    # command code -> (request class, its construct content struct), for requests carried by another one
+    carried: dict[int, tuple[type[Message], Any]] = field(default_factory=dict)
+
+    def model(self, name: str | None) -> ModelSpec | None:
+        """The model of this name (None: the default one); a ValueError names the known models."""
+        if name is None:
+            return self.models[0] if self.models else None
+        for model in self.models:
+            if model.name == name:
+                return model
+        known = ", ".join(m.name for m in self.models) or "none"
+        raise ValueError(f"unknown model {name!r} (expected one of: {known})")
 
 
 @dataclass
 class _Motion:
+    """A move from start to target over `duration` s: linear, or trapezoidal with ramps up and down (s)."""
+
     start: float
     target: float
     began: float
     duration: float
+    accel: float = 0.0
+    decel: float = 0.0
 
     def value(self, now: float) -> float:
-        if self.duration <= 0 or now >= self.began + self.duration:
+        t, total = now - self.began, self.duration
+        if total <= 0 or t >= total:
             return self.target
-        return self.start + (self.target - self.start) * (now - self.began) / self.duration
+        ramps = self.accel + self.decel
+        up, down = (
+            (self.accel, self.decel) if ramps <= total else (total * self.accel / ramps, total * self.decel / ramps)
+        )
+        peak = 1 / (total - up / 2 - down / 2)  # the cruise speed, as a fraction of the distance per second
+        if t < up:
+            done = peak * t * t / (2 * up)
+        elif t <= total - down:
+            done = peak * (t - up / 2)
+        else:
+            done = 1 - peak * (total - t) ** 2 / (2 * down)
+        return self.start + (self.target - self.start) * done
 
 
 class VirtualDevice:
@@ -159,19 +212,30 @@ class VirtualDevice:
         spec: DeviceSpec,
         device_id: int,
         clock: Callable[[], float] = time.monotonic,
+        model: ModelSpec | None = None,
         sizes: dict[str, int] | None = None,
     ) -> None:
         self.spec = spec
         self.clock = clock
+        self.model = model
         self.spaces: dict[str, list[int]] = {s.name: [0] * (sizes or {}).get(s.name, s.size) for s in spec.spaces}
-        self.by_name = {e.name: e for e in spec.entries}
-        self.by_key = {e.key: e for e in spec.entries}
+        values = model.values if model else {}
+        ranges = model.ranges if model else {}
+        # The model's factory values and ranges replace the table's where it gives them.
+        entries = [
+            dataclasses.replace(e, default=values.get(e.name, e.default), minimum=low, maximum=high)
+            for e in spec.entries
+            for low, high in [ranges.get(e.name, (e.minimum, e.maximum))]
+        ]
+        self.by_name = {e.name: e for e in entries}
+        self.by_key = {e.key: e for e in entries}
         self.memory: dict[int, float] = {}
-        self.state: dict[str, float] = dict(spec.state)
+        self.state: dict[str, float] = {k: values.get(k, v) for k, v in spec.state.items()}
         self.motions: dict[str, _Motion] = {}
         self.buffered: list[tuple[CommandSpec, str, dict[str, Any]]] = []  # writes held until a commit
         self.kept = clock()  # when a request last restarted the timeout
         self.timed_out = False
+        self.held: list[tuple[CommandSpec, Message, dict[str, Any]]] = []  # requests held until a release
         self.reset()
         self.id = device_id
         if spec.id_entry in self.by_name:
@@ -179,11 +243,14 @@ class VirtualDevice:
         elif spec.id_entry in self.state:
             self.state[spec.id_entry] = device_id
 
-    def reset(self) -> None:
-        keep = self.memory.get(self.by_name[self.spec.id_entry].key) if self.spec.id_entry in self.by_name else None
-        self.memory = {e.key: e.default for e in self.spec.entries}
-        if keep is not None:
-            self.memory[self.by_name[self.spec.id_entry].key] = keep
+    def reset(self, keep: tuple[str, ...] | None = None) -> None:
+        """Memory back to its defaults, but for the entries in `keep` (default: the device's id)."""
+        if keep is None:
+            keep = (self.spec.id_entry,) if self.spec.id_entry in self.by_name else ()
+        keys = [self.by_name[n].key for n in keep if n in self.by_name]
+        kept = {key: self.memory[key] for key in keys if key in self.memory}
+        self.memory = {e.key: e.default for e in self.by_name.values()}
+        self.memory.update(kept)
 
     def get(self, name: str) -> float:
         """A state variable or memory entry, with any motion in progress taken into account."""
@@ -202,22 +269,23 @@ class VirtualDevice:
         else:
             self.memory[self.by_name[name].key] = value
 
-    def move(self, name: str, target: float, duration: float) -> None:
+    def move(self, name: str, target: float, duration: float, accel: float = 0.0, decel: float = 0.0) -> None:
         now = self.clock()
         start = self.get(name)
-        self.motions[name] = _Motion(start, target, now, max(0.0, duration))
+        self.motions[name] = _Motion(start, target, now, max(0.0, duration), max(0.0, accel), max(0.0, decel))
         if name in self.state:
             self.state[name] = target
         else:
             self.memory[self.by_name[name].key] = target
 
     def writable(self, entry: EntrySpec | None, value: Any) -> bool:
-        return (
-            entry is not None
-            and entry.access != "r"
-            and isinstance(value, int | float)
-            and entry.minimum <= value <= entry.maximum
-        )
+        return not self.refusal(entry, value)
+
+    def refusal(self, entry: EntrySpec | None, value: Any) -> str:
+        """Why a write is refused: "access" (read-only, unknown entry), "range" (out of range), or "" (it is not)."""
+        if entry is None or entry.access == "r" or not isinstance(value, int | float):
+            return "access"
+        return "" if entry.minimum <= value <= entry.maximum else "range"
 
 
 class Engine(FaultInjection):
@@ -231,17 +299,27 @@ class Engine(FaultInjection):
         encode: Callable[[Message], bytes],
         parser: Callable[[], StreamParser],
         clock: Callable[[], float] = time.monotonic,
+        model: str | Mapping[int, str] | None = None,
         sizes: dict[str, int] | None = None,
     ) -> None:
+        """`model`: the model of every device (a name of `spec.models`), or id -> name (others: the default)."""
         self.spec = spec
         self.encode = encode
         self.clock = clock
         self.parser = parser()
-        unknown = set(sizes or {}) - {s.name for s in spec.spaces}
-        if unknown:
+        unknown_spaces = set(sizes or {}) - {s.name for s in spec.spaces}
+        if unknown_spaces:
             known = ", ".join(s.name for s in spec.spaces) or "none"
-            raise ValueError(f"unknown data space(s) {', '.join(sorted(unknown))} (this device has: {known})")
-        self.devices: dict[int, VirtualDevice] = {i: VirtualDevice(spec, i, clock, sizes) for i in ids}
+            raise ValueError(f"unknown data space(s) {', '.join(sorted(unknown_spaces))} (this device has: {known})")
+        ids = list(ids)
+        per_id: Mapping[int, str] = model if isinstance(model, Mapping) else {}
+        every = None if isinstance(model, Mapping) else model
+        unknown = set(per_id) - set(ids)
+        if unknown:
+            raise ValueError(f"a model is given for id {min(unknown)}, which is not on the bus")
+        self.devices: dict[int, VirtualDevice] = {
+            i: VirtualDevice(spec, i, clock, spec.model(per_id.get(i, every)), sizes) for i in ids
+        }
         # Each further kind: its devices, built from a DeviceSpec holding that kind's address and state.
         self.kinds: dict[str, dict[int, VirtualDevice]] = {}
         self._kind_specs: dict[str, DeviceSpec] = {}
@@ -306,11 +384,16 @@ class Engine(FaultInjection):
         # `each`: every item of the group addresses its own device, with the item's fields over the request's.
         items = [{**fields, **item} for item in fields[command.each]] if command.each else [fields]
         replies = []
+        if command.carries:  # each item holds another command's request: the devices act on that one
+            for given in items:
+                carried = self._carried(given, *command.carries)
+                replies.extend(self.handle(carried) if carried is not None else [])
+            return replies
         for given in items:
             address = given.get(spec.address)
             broadcast = address is not None and address == spec.broadcast
             if address is None:
-                targets = list(devices.values())[:1]
+                targets = list(devices.values()) if command.every_device else list(devices.values())[:1]
             elif broadcast:
                 targets = list(devices.values())
             else:
@@ -323,6 +406,20 @@ class Engine(FaultInjection):
                     delay = float(getattr(request, command.after, 0)) / 1000 if command.after else 0.0
                     replies.append((self.clock() + delay, frame))
         return replies
+
+    def _carried(self, given: dict[str, Any], code_field: str, content_field: str) -> Message | None:
+        """The request a sync command carries for one device: its content parsed as that command's request."""
+        found = self.spec.carried.get(int(given[code_field]))
+        if found is None:
+            return None  # a command the device does not know: ignored, as a frame of an unknown command would be
+        request, content = found
+        data = given[content_field]
+        try:
+            parsed = content.parse(bytes.fromhex(data) if isinstance(data, str) else bytes(data))
+            names = [f.name for f in dataclasses.fields(request)]  # type: ignore[arg-type]
+            return request.from_fields({n: parsed[n] for n in names})  # type: ignore[attr-defined, no-any-return]
+        except Exception:  # noqa: BLE001 - a block that does not parse as that request is ignored, like a bad frame
+            return None
 
     def _absent(self, command: CommandSpec, given: dict[str, Any]) -> bytes | None:
         """The reply a bus master gives for an id no device has: the request's fields, `absent` values, else 0."""
@@ -349,39 +446,54 @@ class Engine(FaultInjection):
     ) -> bytes | None:
         """Carry out a request on one device (`given`: its fields, an `each` item's merged in); the reply or None."""
         given = request.to_fields() if given is None else given
+        if command.held_while and device.get(command.held_while):
+            device.held.append((command, request, given))  # carried out (or dropped) by a command that releases
+            return None
+        if command.releases:
+            device.set(command.releases, 0)
+            waiting, device.held = device.held, []
+            if not any(given.get(name) == value for name, value in command.cancel_when.items()):
+                for waiting_command, waiting_request, waiting_given in waiting:
+                    self.act(device, waiting_command, waiting_request, waiting_given)
         if command.derived:
             given = dict(given)
             for name, derive in command.derived.items():
                 given[name] = derive(given)
         if command.limits or command.space_reads or command.space_writes:
-            reason = self._refusal(device, command, given)
-            if reason is not None:
-                return self._error_reply(device, command, reason)
-        refused = False
+            refusal = self._refusal(device, command, given)
+            if refusal is not None:
+                return self._error_reply(device, command, refusal)
+        refused = ""
         # Whether an optional reply is due is decided on the switch as the request finds it (a write that turns
         # replies off is still answered), which is also what a client that remembers the switch expects.
         switch = command.optional_when
-        answers = switch is None or device.memory.get(switch[0]) == switch[1]
+        answers = switch is None or compare(device.memory.get(switch[0]), switch[2], switch[1])
         if command.resets:
-            device.reset()
+            field_name, kept = command.keeps or ("", {})
+            device.reset(kept.get(int(given.get(field_name, -1)), None) if command.keeps else None)
         written: set[str] = set()
         if command.buffered:
             device.buffered.extend((command, name, given) for name in command.writes)
         else:
             for name in command.writes:
-                refused |= not self._write(device, command, name, given, written)
+                reason = self._write(device, command, name, given, written)
+                refused = refused or reason
         if command.commits:
             buffered, device.buffered = device.buffered, []
             for held_command, name, held in buffered:
                 self._write(device, held_command, name, held, written)
         for name, run in command.space_writes.items():
             self._write_space(device, run, given[name], given)
-        if command.moves:
-            self._move(device, command.moves, given, written)
+        if command.moves and (not command.move_enabled_by or device.get(command.move_enabled_by)):
+            self._move(device, command.moves, given, written, command.ramp, command.speed_scale)
         for name, state in command.stores.items():
             device.set(state, given[name])
         for state, value in command.sets.items():
             device.set(state, value)
+        for state in command.stops:
+            device.set(state, device.get(state))
+        for state, period in command.wraps.items():
+            device.set(state, math.fmod(device.get(state), period))
         id_entry = device.spec.id_entry
         if id_entry in device.by_name or id_entry in device.state:
             new_id = int(device.get(id_entry))
@@ -406,10 +518,15 @@ class Engine(FaultInjection):
             elif name in command.reports:
                 source = command.reports[name]
                 values[name] = source(device.get) if callable(source) else device.get(source)
+            elif name in command.counts:
+                state, per = command.counts[name]
+                values[name] = int(device.get(state) / per)
             elif name == device.spec.address and not device.spec.echo_address:
                 values[name] = device.id  # a device answers with its own id, also to a broadcast
             elif name in device.spec.status:
                 values[name] = device.get(device.spec.status[name])
+            elif any(key.startswith(name + ".") for key in (*self.spec.reply, *device.spec.status)):
+                values[name] = {}  # bit fields, filled in below
             elif command.tables.get(name, ())[:1] == ("run",):
                 values[name] = b""  # a run of registers in a reply holds what was read: nothing here
             elif name in given:
@@ -418,8 +535,10 @@ class Engine(FaultInjection):
                 values[name] = self.spec.reply[name]
             else:
                 values[name] = 0
+        nest(values, {k: v for k, v in self.spec.reply.items() if "." in k})
+        nest(values, {k: int(bool(device.get(e))) for k, e in device.spec.status.items() if "." in k})
         if refused:
-            values.update(self.spec.refused)
+            nest(values, self.spec.out_of_range if refused == "range" and self.spec.out_of_range else self.spec.refused)
         return self._encode_reply(command.response, values)
 
     # --- data spaces and error replies ------------------------------------------------------------------------------
@@ -473,9 +592,19 @@ class Engine(FaultInjection):
             items[start + offset] = (1 if stored else 0) if space.bits else stored & space.maximum
 
     def _move(
-        self, device: VirtualDevice, moves: tuple[str, str, str, str], given: dict[str, Any], written: set[str]
+        self,
+        device: VirtualDevice,
+        moves: tuple[str, str, str, str],
+        given: dict[str, Any],
+        written: set[str],
+        ramp: tuple[str, str] | None = None,
+        speed_scale: float = 1.0,
     ) -> None:
-        """Start a move to the target: a request field, or a memory entry this command has just written."""
+        """Start a move to the target: a request field, or a memory entry this command has just written.
+
+        With a ramp, the speed rises over the acceleration time and falls over the deceleration time; a move at a
+        speed then lasts distance / speed plus half of each ramp, so that it cruises at that speed.
+        """
         state, target, duration_name, speed_name = moves
         if target not in given and target not in written:
             return
@@ -483,14 +612,15 @@ class Engine(FaultInjection):
         def value(name: str) -> float:
             return float(given[name] if name in given else device.get(name))
 
+        accel, decel = (value(ramp[0]) / 1000, value(ramp[1]) / 1000) if ramp else (0.0, 0.0)
         goal = value(target)
         if duration_name and value(duration_name):
             duration = value(duration_name) / 1000
         elif speed_name and value(speed_name):
-            duration = abs(goal - device.get(state)) / value(speed_name)
+            duration = abs(goal - device.get(state)) / (value(speed_name) * speed_scale) + (accel + decel) / 2
         else:
             duration = 0.0
-        device.move(state, goal, duration)
+        device.move(state, goal, duration, accel, decel)
 
     def _read(self, device: VirtualDevice, command: CommandSpec, name: str, given: dict[str, Any]) -> Any:
         table = command.tables.get(name, ())
@@ -513,24 +643,26 @@ class Engine(FaultInjection):
                 data.append(0)
                 address += 1
                 continue
-            data += registers.to_wire(register, int(device.get(register.name)))
+            data += registers.to_wire(register, int(device.get(register.name)), checked=False)
             address += register.size
         return bytes(data[:size])
 
     def _write_run(
         self, device: VirtualDevice, registers: RegisterMap, start: int, data: bytes, written: set[str]
-    ) -> bool:
-        """Store bytes written from register `start` on; refused whole unless every register is writable, in range."""
+    ) -> str:
+        """Store bytes written from register `start` on; refused whole (the reason) unless every register is
+        writable and in range."""
         try:
             values = registers.split(start, data)
         except EncodeError:
-            return False
-        if not all(device.writable(device.by_name.get(name), value) for name, value in values.items()):
-            return False
+            return "access"
+        reasons = [device.refusal(device.by_name.get(name), value) for name, value in values.items()]
+        if any(reasons):
+            return "access" if "access" in reasons else "range"
         for name, value in values.items():
             device.set(name, value)
         written.update(values)
-        return True
+        return ""
 
     def _write(
         self,
@@ -539,7 +671,8 @@ class Engine(FaultInjection):
         name: str,
         given: dict[str, Any],
         written: set[str] | None = None,
-    ) -> bool:
+    ) -> str:
+        """Store one request field in memory; why it was refused ("access", "range"), or "" when it was not."""
         table = command.tables.get(name, ())
         if table[:1] == ("run",) and self.spec.registers is not None:
             start = int(given[table[1]])
@@ -548,11 +681,12 @@ class Engine(FaultInjection):
             return self._write_run(device, self.spec.registers, start, data, set() if written is None else written)
         if table[:1] == ("value",):
             entry = device.by_key.get(int(given[table[1]]))
-            if not device.writable(entry, given[name]):
-                return False
+            reason = device.refusal(entry, given[name])
+            if reason:
+                return reason
             assert entry is not None
             device.set(entry.name, given[name])
-            return True
+            return ""
         if table[:1] == ("block",):
             block = given[name]
             ok = all(
@@ -562,11 +696,21 @@ class Engine(FaultInjection):
                 for n in table[1:]:
                     if device.by_name[n].access != "r":
                         device.set(n, block[n])
-            return ok
+            return "" if ok else "range"
         device.set(name, given[name])
-        return True
+        return ""
 
 
 def _items(value: Any) -> int:
     """How many items of a data space a written value covers: a list's length, else one."""
     return len(value) if isinstance(value, list | tuple) else 1
+
+
+def nest(values: dict[str, Any], overlay: dict[str, Any]) -> None:
+    """Apply reply values, where `field.bit_field` names one bit field of a field made of bit fields."""
+    for key, value in overlay.items():
+        name, _, bit = key.partition(".")
+        if not bit:
+            values[name] = value
+        elif isinstance(values.get(name), dict):
+            values[name] = {**values[name], bit: value}

@@ -182,6 +182,14 @@ class Commands(FieldResolver):
         code: int | None,
     ) -> Message:
         fields = self.fields(value.get("fields") or {}, (*path, "fields"), parent=None)
+        framing = self.ctx.framing
+        frame_values = {e.name for e in framing.layouts[direction].value_elements} if framing else set()
+        for field in fields:
+            if field.name in frame_values:
+                self.error(
+                    (*path, "fields", field.name),
+                    f"{field.name!r} is already a frame element of every {direction.value}; name the field otherwise",
+                )
         if selector is not None and code is not None:
             fields = self.insert_selector(fields, selector, direction, code, path)
         self.check_rest(fields, (*path, "fields"))

@@ -14,14 +14,17 @@ from serialspec.spec.model import (
     Device,
     DeviceErrors,
     DeviceKind,
+    DeviceModel,
     DeviceTimeout,
     Direction,
     Framing,
     Group,
     Message,
+    ModelEntry,
     Motion,
     Space,
     SpaceAccess,
+    TableEntry,
     replies_by_request,
     reply_to,
 )
@@ -116,10 +119,18 @@ class DevicePass(Pass):
                     str(moves["target"]),
                     str(moves.get("duration", "")),
                     str(moves.get("speed", "")),
+                    float(moves.get("speed_scale", 1.0)),
+                    str(moves.get("enabled_by", "")),
+                    str(moves.get("accel", "")),
+                    str(moves.get("decel", "")),
                 )
+                if motion.speed_scale <= 0:
+                    self.error((*item_path, "moves", "speed_scale"), "must be positive")
+                if motion.enabled_by and motion.enabled_by not in known_state and motion.enabled_by not in entries:
+                    self.error((*item_path, "moves", "enabled_by"), f"unknown memory entry {motion.enabled_by!r}")
                 if motion.state not in known_state and motion.state not in entries:
                     self.error((*item_path, "moves", "state"), f"unknown state variable {motion.state!r}")
-                for role in ("target", "duration", "speed"):
+                for role in ("target", "duration", "speed", "accel", "decel"):
                     name = getattr(motion, role)
                     if name and name not in request_names and name not in entries:
                         self.error((*item_path, "moves", role), f"{key} has no request field or memory entry {name!r}")
@@ -155,6 +166,10 @@ class DevicePass(Pass):
                     absent,
                     space_reads,
                     space_writes,
+                    self.keeps(item.get("keeps"), request_names, entries, (*item_path, "keeps")),
+                    **self.behaviour_extras(
+                        item, item_path, key, request_names, response_names, {**entries, **known_state}
+                    ),
                 )
             )
         status = {str(k): str(v) for k, v in (value.get("status") or {}).items()}
@@ -171,6 +186,7 @@ class DevicePass(Pass):
             state=state,
             reply={str(k): v if isinstance(v, str) else float(v) for k, v in (value.get("reply") or {}).items()},
             refused={str(k): float(v) for k, v in (value.get("refused") or {}).items()},
+            out_of_range={str(k): float(v) for k, v in (value.get("out_of_range") or {}).items()},
             behaviours=tuple(behaviours),
             status=status,
             kinds=tuple(kinds.values()),
@@ -179,6 +195,8 @@ class DevicePass(Pass):
             timeout=self.timeout(value.get("timeout"), (*path, "timeout"), requests, state),
             spaces=tuple(spaces.values()),
             errors=errors,
+            models=self.models(value, path, entries, state),
+            model_entry=str(value.get("model_entry", "")),
         )
 
     def timeout(
@@ -257,3 +275,145 @@ class DevicePass(Pass):
                             self.error((*item_path, "value"), f"unknown request field {used!r}")
             runs[str(name)] = SpaceAccess(str(item["space"]), str(item["start"]), str(item.get("count", "")), stored)
         return runs
+
+    def keeps(
+        self, value: Any, request_names: Any, entries: Any, path: Path
+    ) -> tuple[str, dict[int, tuple[str, ...]]] | None:
+        """`keeps`: the request field choosing what a reset keeps, and the entries for each of its values."""
+        if value is None:
+            return None
+        field_name = str(value["field"])
+        if field_name not in request_names:
+            self.error((*path, "field"), f"no request field {field_name!r}")
+        table = {int(k): tuple(str(n) for n in names) for k, names in (value.get("entries") or {}).items()}
+        for key, names in table.items():
+            for name in names:
+                if name not in entries:
+                    self.error((*path, "entries", key), f"unknown memory entry {name!r}")
+        return field_name, table
+
+    def behaviour_extras(
+        self,
+        item: dict[str, Any],
+        path: Path,
+        key: str,
+        request_names: set[str],
+        response_names: set[str],
+        variables: dict[str, Any],
+    ) -> dict[str, Any]:
+        """The behaviours that stop, wrap, count, hold, release and carry, each name checked."""
+
+        def known(name: str, where: Path) -> str:
+            if name not in variables:
+                self.error(where, f"unknown state variable {name!r}")
+            return name
+
+        counts = {}
+        for field_name, count in (item.get("counts") or {}).items():
+            if field_name not in response_names:
+                self.error((*path, "counts", field_name), f"{key} has no response field {field_name!r}")
+            counts[str(field_name)] = (known(str(count["state"]), (*path, "counts", field_name)), float(count["per"]))
+        for field_name in item.get("cancel_when") or {}:
+            if field_name not in request_names:
+                self.error((*path, "cancel_when", field_name), f"{key} has no request field {field_name!r}")
+        if "cancel_when" in item and "releases" not in item:
+            self.error((*path, "cancel_when"), "`cancel_when` needs `releases`")
+        carries = item.get("carries")
+        carried: list[str] = []
+        if carries:
+            for role in ("command", "content"):
+                if carries[role] not in request_names:
+                    self.error((*path, "carries", role), f"{key} has no request field {carries[role]!r}")
+            coded = {c.name for c in self.ctx.commands if c.code is not None and c.request and not c.subcommands}
+            for name in carries.get("commands") or ():
+                if name not in coded:
+                    self.error((*path, "carries", "commands"), f"unknown command {name!r} (or it has no code)")
+                carried.append(str(name))
+        return {
+            "stops": tuple(known(str(n), (*path, "stops")) for n in item.get("stops") or ()),
+            "wraps": {known(str(n), (*path, "wraps", n)): float(p) for n, p in (item.get("wraps") or {}).items()},
+            "counts": counts,
+            "every_device": bool(item.get("every_device", False)),
+            "held_while": known(str(item["held_while"]), (*path, "held_while")) if "held_while" in item else "",
+            "releases": known(str(item["releases"]), (*path, "releases")) if "releases" in item else "",
+            "cancel_when": {str(k): float(v) for k, v in (item.get("cancel_when") or {}).items()},
+            "carries": (str(carries["command"]), str(carries["content"])) if carries else None,
+            "carried": tuple(carried),
+        }
+
+    def models(
+        self, value: dict[str, Any], path: Path, entries: dict[str, TableEntry], state: dict[str, float]
+    ) -> tuple[DeviceModel, ...]:
+        """The device's models, the default first; each value checked against the model's (or the table's) range."""
+        model_entry = str(value.get("model_entry", ""))
+        if model_entry and model_entry not in entries:
+            self.error((*path, "model_entry"), f"unknown memory entry {model_entry!r}")
+        models: list[DeviceModel] = []
+        numbers: dict[int, str] = {}
+        for name, item in (value.get("models") or {}).items():
+            model_path = (*path, "models", name)
+            self.name(name, model_path, "model name")
+            number = int(item["number"])
+            if number in numbers:
+                self.error((*model_path, "number"), f"model number {number} is already used by {numbers[number]!r}")
+            numbers[number] = name
+            overrides = []
+            for entry_name, override in (item.get("entries") or {}).items():
+                entry = entries.get(entry_name)
+                if entry is None:
+                    self.error((*model_path, "entries", entry_name), f"unknown memory entry {entry_name!r}")
+                    continue
+                range_path = (*model_path, "entries", entry_name, "range")
+                low, high = (
+                    self.bounds(entry.type, entry.sign_magnitude, override["range"], range_path, entry.sign_bit)
+                    if "range" in override
+                    else (entry.minimum, entry.maximum)
+                )
+                overrides.append(
+                    ModelEntry(
+                        entry_name,
+                        low,
+                        high,
+                        str(override.get("unit", entry.unit)),
+                        override.get("scale", entry.scale),
+                        str(override.get("description", "")),
+                    )
+                )
+            by_name = {o.name: o for o in overrides}
+            initial = {str(k): float(v) for k, v in (item.get("initial") or {}).items()}
+            if model_entry:
+                initial[model_entry] = float(number)
+            for entry_name, number_value in initial.items():
+                entry_path = (*model_path, "initial", entry_name)
+                if entry_name in state:
+                    continue
+                entry = entries.get(entry_name)
+                if entry is None:
+                    self.error(entry_path, f"unknown memory entry or state variable {entry_name!r}")
+                    continue
+                bounds = by_name.get(entry_name, entry)
+                low, high = bounds.minimum, bounds.maximum
+                if not low <= number_value <= high:
+                    where = (*model_path, "number") if entry_name == model_entry else entry_path
+                    self.error(where, f"{entry_name} = {number_value:g} is outside its range {low:g}..{high:g}")
+            models.append(
+                DeviceModel(
+                    name=name,
+                    number=number,
+                    title=str(item.get("title", "")),
+                    description=str(item.get("description", "")),
+                    source=str(item.get("source", "")),
+                    initial=initial,
+                    entries=tuple(overrides),
+                )
+            )
+        default = value.get("default_model")
+        if default is not None:
+            found = next((m for m in models if m.name == default), None)
+            if found is None:
+                known = ", ".join(m.name for m in models) or "none defined"
+                self.error((*path, "default_model"), f"unknown model {default!r} (expected one of: {known})")
+            else:
+                models.remove(found)
+                models.insert(0, found)
+        return tuple(models)

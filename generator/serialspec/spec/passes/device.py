@@ -132,8 +132,11 @@ class DevicePass(Pass):
                     self.error((*item_path, "moves", "state"), f"unknown state variable {motion.state!r}")
                 for role in ("target", "duration", "speed", "accel", "decel"):
                     name = getattr(motion, role)
-                    if name and name not in request_names and name not in entries:
-                        self.error((*item_path, "moves", role), f"{key} has no request field or memory entry {name!r}")
+                    if name and name not in request_names and name not in entries and name not in known_state:
+                        self.error(
+                            (*item_path, "moves", role),
+                            f"{key} has no request field, memory entry or state variable {name!r}",
+                        )
             stores = {str(k): str(v) for k, v in (item.get("stores") or {}).items()}
             sets = {str(k): float(v) for k, v in (item.get("sets") or {}).items()}
             absent = {str(k): float(v) for k, v in (item.get("absent") or {}).items()}

@@ -81,6 +81,8 @@ def test_pymodbus_gets_exceptions(peer_client: Any) -> None:
     coils = peer_client.write_coils(9999, [True, True], device_id=1)
     assert isinstance(coils, ExceptionResponse) and coils.exception_code == 2
     # pymodbus refuses to send an illegal quantity itself; test_modbus_rtu.py sends one (exception 3)
+    identification = peer_client.read_device_information(device_id=1)  # function 0x2B: not in the spec
+    assert isinstance(identification, ExceptionResponse) and identification.exception_code == 1
 
 
 def test_pymodbus_broadcast_reaches_both_servers(peer_client: Any) -> None:

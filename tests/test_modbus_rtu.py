@@ -237,6 +237,19 @@ def test_the_server_refuses_with_the_specifications_exceptions() -> None:
     assert mb.decode(frame, "response").exception_code == mb.ExceptionCode.ILLEGAL_DATA_VALUE
 
 
+def test_an_unsupported_function_is_refused_with_exception_1() -> None:
+    """Function 0x2B (read device identification) is in no command: whole and with a good CRC, it is refused."""
+    server = ModbusRtuSimulator(ids=[1])
+    unknown = bytes.fromhex("01 2B 0E 01 00")
+    ((when, frame),) = server.feed(unknown + CRC(unknown).to_bytes(2, "little"))
+    assert mb.decode(frame, "response") == mb.ExceptionResponse(
+        unit=1, function=0x2B, exception_code=mb.ExceptionCode.ILLEGAL_FUNCTION
+    )
+    assert server.feed(unknown + bytes(2)) == []  # a bad CRC: silence
+    other = bytes.fromhex("07 2B 0E 01 00")
+    assert server.feed(other + CRC(other).to_bytes(2, "little")) == []  # another server's
+
+
 def test_broadcast_writes_reach_every_server_and_get_no_reply() -> None:
     server = ModbusRtuSimulator(ids=[1, 2])
     assert ask(server, mb.WriteRegisterRequest(unit=0, address=5, value=42)) is None

@@ -19,7 +19,7 @@ from collections.abc import Callable, Iterable, Mapping
 
 from serialspec.runtime.device import CommandSpec, DeviceSpec, ErrorSpec, RunSpec, Simulator, SpaceSpec
 
-from modbus_rtu.codec import StreamParser, encode
+from modbus_rtu.codec import _REQUEST_FRAMES, StreamParser, encode
 from modbus_rtu.messages import (
     Direction,
     ExceptionResponse,
@@ -46,6 +46,13 @@ from modbus_rtu.messages import (
 )
 
 __all__ = ["DEVICE", "SIMULATOR", "ModbusRtuSimulator"]
+
+
+def _unwrap_request(frame: bytes) -> tuple[int | None, tuple[int, ...]]:
+    """The code and frame values of a whole request frame whose checksum verifies, whatever its code."""
+    unwrapped = _REQUEST_FRAMES.unwrap(frame)
+    return unwrapped.code, unwrapped.values
+
 
 DEVICE = DeviceSpec(
     protocol='modbus_rtu',
@@ -85,7 +92,7 @@ DEVICE = DeviceSpec(
         SpaceSpec('holding_registers', 10000, False, 65535, 'rw'),
         SpaceSpec('input_registers', 10000, False, 65535, 'r'),
     ),
-    error=ErrorSpec(ExceptionResponse, 'function', 'exception_code', out_of_space=2, out_of_range=3, read_only=2),
+    error=ErrorSpec(ExceptionResponse, 'function', 'exception_code', out_of_space=2, out_of_range=3, read_only=2, unsupported=1, unwrap=_unwrap_request),
 )
 
 

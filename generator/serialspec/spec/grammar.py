@@ -812,6 +812,10 @@ DEVICE = Obj(
                 "out_of_space": Int("Value when a run reaches beyond its data space (Modbus 2)."),
                 "out_of_range": Int("Value when a request value is outside its range or enum (Modbus 3)."),
                 "read_only": Int("Value when a write reaches a data space that is read-only."),
+                "unsupported": Int(
+                    "Value for a request whose code no command has, recognised when it arrives whole and its "
+                    "checksum verifies (Modbus 1, illegal function); frames without a header only."
+                ),
             },
             required=("field",),
             description="How the device refuses a request with the protocol's error reply (`error_reply:`).",

@@ -574,6 +574,7 @@ class DeviceErrors:
     out_of_space: int | None
     out_of_range: int | None
     read_only: int | None
+    unsupported: int | None = None
 
 
 @dataclass(frozen=True)

@@ -223,9 +223,10 @@ def simulator_module(protocol: Protocol) -> str:
         assert reply is not None
         imports.add(reply.class_name)
         e = device.errors
+        unwrap = f", unsupported={e.unsupported!r}, unwrap=_unwrap_request" if e.unsupported is not None else ""
         error = (
             f"ErrorSpec({reply.class_name}, {protocol.error_reply.element!r}, {e.field!r}, "
-            f"out_of_space={e.out_of_space!r}, out_of_range={e.out_of_range!r}, read_only={e.read_only!r})"
+            f"out_of_space={e.out_of_space!r}, out_of_range={e.out_of_range!r}, read_only={e.read_only!r}{unwrap})"
         )
     runtime = ["CommandSpec", "DeviceSpec"]
     runtime += ["EntrySpec"] if entries else []
@@ -247,6 +248,7 @@ def simulator_module(protocol: Protocol) -> str:
         runtime_imports=", ".join(runtime),
         spaces=spaces,
         error=error,
+        unwrap="unwrap=_unwrap_request" in error,
         timeout=timeout,
         spec_path=protocol.spec_path,
         title=one_line(protocol.title),

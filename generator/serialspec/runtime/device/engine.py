@@ -62,6 +62,10 @@ class ErrorSpec:
     out_of_space: int | None = None
     out_of_range: int | None = None
     read_only: int | None = None
+    unsupported: int | None = None  # a request whose code no command has (Modbus exception 1)
+    # unwrap(frame) -> (code, frame values) of a whole request frame whose checksum verifies (the frame engine's),
+    # for requests the codec cannot decode because their code is unknown
+    unwrap: Callable[[bytes], tuple[int | None, tuple[int, ...]]] | None = None
 
 
 @dataclass(frozen=True)
@@ -307,6 +311,7 @@ class Engine(FaultInjection):
         self.encode = encode
         self.clock = clock
         self.parser = parser()
+        self._new_parser = parser
         unknown_spaces = set(sizes or {}) - {s.name for s in spec.spaces}
         if unknown_spaces:
             known = ", ".join(s.name for s in spec.spaces) or "none"
@@ -341,7 +346,13 @@ class Engine(FaultInjection):
         """Handle request bytes; returns (send time, bytes) for every reply they cause, faults applied."""
         out: list[tuple[float, bytes]] = []
         with self._lock:
-            for request in self.parser.feed(data):
+            requests = self.parser.feed(data)
+            if not requests:
+                refused = self._unsupported(data)
+                if refused:
+                    self.parser = self._new_parser()  # the bytes were that frame: nothing of them is pending
+                out.extend(refused)
+            for request in requests:
                 self.log.append(request)
                 # Answering as another id changes what the reply says, so it applies while the reply is built.
                 if self.faults and self.faults[0].kind == "other_id":
@@ -565,6 +576,26 @@ class Engine(FaultInjection):
             if spaces[run.space].access == "r":
                 return error.read_only
         return None
+
+    def _unsupported(self, data: bytes) -> list[tuple[float, bytes]]:
+        """Bytes that arrived together and that the parser took for no frame: if they are one whole request whose
+        checksum verifies but whose code no command has, the addressed device refuses it (Modbus exception 1)."""
+        error = self.spec.error
+        if error is None or error.unsupported is None or error.unwrap is None:
+            return []
+        try:
+            code, values = error.unwrap(data)
+        except ValueError:  # DecodeError: not a whole frame
+            return []
+        known = {c.code for c in self.spec.commands}
+        if code is None or code in known:
+            return []
+        device = self.devices.get(values[0]) if self.spec.address and values else None
+        if device is None:
+            return []  # another device's, or broadcast: no reply
+        refusal = CommandSpec(error.response, None, code=code)
+        frame = self._error_reply(device, refusal, error.unsupported)
+        return [] if frame is None else self._spoil(self.clock(), frame)
 
     def _error_reply(self, device: VirtualDevice, command: CommandSpec, reason: int | None) -> bytes | None:
         error = self.spec.error

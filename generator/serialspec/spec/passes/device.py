@@ -247,7 +247,10 @@ class DevicePass(Pass):
         field = str(value["field"])
         if not any(f.name == field for f in reply.fields):
             self.error((*path, "field"), f"the error reply {reply.command} has no field {field!r}")
-        return DeviceErrors(field, value.get("out_of_space"), value.get("out_of_range"), value.get("read_only"))
+        if value.get("unsupported") is not None and self.ctx.framing is not None and self.ctx.framing.classic:
+            self.error((*path, "unsupported"), "`unsupported` needs frames the frame engine takes apart (not classic)")
+        reasons = [value.get(k) for k in ("out_of_space", "out_of_range", "read_only", "unsupported")]
+        return DeviceErrors(field, *reasons)
 
     def space_runs(
         self, value: Any, names: set[str], request: Message, spaces: dict[str, Space], path: Path

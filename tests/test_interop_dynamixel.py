@@ -10,6 +10,7 @@ import time
 from collections.abc import Iterator
 from typing import Any
 
+import dynamixel_p2
 import pytest
 from dynamixel_p2.registers import CONTROL_TABLE
 from sim_process import serve
@@ -171,3 +172,45 @@ def test_models_by_id_report_their_numbers_and_limits() -> None:
             assert packet.write2ByteTxRx(handler, 1, ADDRESS["current_limit"], 1500) == (SUCCESS, 4)
         finally:
             handler.closePort()
+
+
+def test_the_sdk_sends_unstuffed_packets(sdk: tuple[Any, Any]) -> None:
+    # erratum sdk_tx_stuffing: goal_position -131073 is FF FF FD FF; dynamixel_sdk 4.1.0 sends it unstuffed, which
+    # no servo can take for a packet (the simulator, like a servo, finds no valid packet and stays silent)
+    handler, packet = sdk
+    assert packet.write1ByteTxRx(handler, 2, ADDRESS["torque_enable"], 0) == (SUCCESS, 0)
+    result, _ = packet.write4ByteTxRx(handler, 2, ADDRESS["goal_position"], (-131073) & 0xFFFFFFFF)
+    assert result == dxl.COMM_RX_TIMEOUT
+    assert packet.read4ByteTxRx(handler, 2, ADDRESS["goal_position"])[0] != (-131073) & 0xFFFFFFFF
+
+
+class _CapturingPort:
+    """Just enough of a PortHandler for the SDK to send a packet: the bytes it writes are kept."""
+
+    is_using = False
+
+    def __init__(self) -> None:
+        self.written = b""
+
+    def clearPort(self) -> None:
+        pass
+
+    def writePort(self, packet: list[int]) -> int:
+        self.written += bytes(packet)
+        return len(packet)
+
+    def setPacketTimeout(self, length: int) -> None:
+        pass
+
+
+def test_fast_sync_read_packet_is_the_sdks() -> None:
+    port = _CapturingPort()
+    group = dxl.GroupSyncRead(port, dxl.PacketHandler(2.0), ADDRESS["present_position"], 4)
+    for servo in (1, 2):
+        assert group.addParam(servo)
+    assert group.fastSyncReadTxPacket() == SUCCESS
+    request = dynamixel_p2.FastSyncReadRequest(
+        id=254, address=132, length=4, servo_ids=(dynamixel_p2.ServoIdsItem(id=1), dynamixel_p2.ServoIdsItem(id=2))
+    )
+    assert port.written == dynamixel_p2.encode(request)
+    assert dynamixel_p2.decode(port.written, "request") == request

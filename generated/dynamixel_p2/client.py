@@ -30,6 +30,7 @@ from dynamixel_p2.messages import (
     ClearRequest,
     Direction,
     FactoryResetRequest,
+    FastSyncReadRequest,
     IdsItem,
     PingRequest,
     PingResponse,
@@ -38,6 +39,7 @@ from dynamixel_p2.messages import (
     RebootRequest,
     RegWriteRequest,
     ResetOption,
+    ServoIdsItem,
     ServosItem,
     StatusResponse,
     SyncReadRequest,
@@ -276,6 +278,22 @@ class DynamixelP2Client(ClientBase):
         request = SyncReadRequest(id=id, address=address, length=length, ids=ids)
         replies = self.bus.request_each(request, StatusResponse, [{'id': item.id} for item in ids])
         return {reply.id: reply.data for reply in replies}
+
+    def fast_sync_read(self, id: int, address: int, length: int, servo_ids: tuple[ServoIdsItem, ...]) -> None:
+        """Read the same items of several servos, answered in one packet.
+
+        Like SYNC READ, but the servos answer together in one status packet from the broadcast id: after 0x55 come, for each servo in turn, its error byte, its id, its `length` bytes and two CRC bytes, the last servo's CRC being the packet's. That packet decodes as a `status` whose error byte is the first servo's and whose data holds the rest (id, data, CRC, error, id, data, ...); the simulator does not answer FAST SYNC READ.
+
+        Args:
+            id: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. (0..252)
+            address: First control table address to read.
+            length: Number of bytes each servo returns. (1..1024)
+            servo_ids: The servos to read, in the order their parts follow each other.
+
+        The device does not answer.
+        """
+        request = FastSyncReadRequest(id=id, address=address, length=length, servo_ids=servo_ids)
+        self.bus.send(request)
 
     def sync_write_raw(self, id: int, address: int, servos: tuple[ServosItem, ...] | Mapping[int, bytes]) -> None:
         """Write the same items of several servos at once.

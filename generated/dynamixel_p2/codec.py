@@ -8,7 +8,7 @@ from collections.abc import Callable
 
 from serialspec.runtime.checksums import crc_function
 from serialspec.runtime.errors import DecodeError, EncodeError, content_size_error, out_of_range
-from serialspec.runtime.framing import Element, FrameCodec, Layout, Transparency
+from serialspec.runtime.framing import Element, EngineFormat, FrameCodec, Layout, Transparency
 from serialspec.runtime.framing import FrameStreamParser as _FrameStreamParser
 from serialspec.runtime.message import Direction, Message, members, slot_setters
 
@@ -21,6 +21,7 @@ from dynamixel_p2.messages import (
     ErrorBits,
     ErrorNumber,
     FactoryResetRequest,
+    FastSyncReadRequest,
     IdsItem,
     PingRequest,
     PingResponse,
@@ -29,6 +30,7 @@ from dynamixel_p2.messages import (
     RebootRequest,
     RegWriteRequest,
     ResetOption,
+    ServoIdsItem,
     ServosItem,
     StatusResponse,
     SyncReadRequest,
@@ -56,6 +58,12 @@ _set_BulkWriteRequest_id, _set_BulkWriteRequest_writes = slot_setters(BulkWriteR
 _set_ClearRequest_id, _set_ClearRequest_option = slot_setters(ClearRequest)
 _set_ErrorBits_alert, _set_ErrorBits_number = slot_setters(ErrorBits)
 _set_FactoryResetRequest_id, _set_FactoryResetRequest_option = slot_setters(FactoryResetRequest)
+(
+    _set_FastSyncReadRequest_id,
+    _set_FastSyncReadRequest_address,
+    _set_FastSyncReadRequest_length,
+    _set_FastSyncReadRequest_servo_ids,
+) = slot_setters(FastSyncReadRequest)
 (_set_IdsItem_id,) = slot_setters(IdsItem)
 (_set_PingRequest_id,) = slot_setters(PingRequest)
 (
@@ -68,6 +76,7 @@ _set_ReadRequest_id, _set_ReadRequest_address, _set_ReadRequest_length = slot_se
 _set_ReadsItem_id, _set_ReadsItem_address, _set_ReadsItem_length = slot_setters(ReadsItem)
 (_set_RebootRequest_id,) = slot_setters(RebootRequest)
 _set_RegWriteRequest_id, _set_RegWriteRequest_address, _set_RegWriteRequest_data = slot_setters(RegWriteRequest)
+(_set_ServoIdsItem_id,) = slot_setters(ServoIdsItem)
 _set_ServosItem_id, _set_ServosItem_data = slot_setters(ServosItem)
 _set_StatusResponse_id, _set_StatusResponse_error, _set_StatusResponse_data = slot_setters(StatusResponse)
 (
@@ -202,6 +211,28 @@ def _decode_sync_read_request(buf: bytes, o: int, end: int, id: int) -> SyncRead
     _set_SyncReadRequest_address(m, v_address)
     _set_SyncReadRequest_length(m, v_length)
     _set_SyncReadRequest_ids(m, v_ids)
+    return m
+
+
+def _decode_fast_sync_read_request(buf: bytes, o: int, end: int, id: int) -> FastSyncReadRequest:
+    if end - o < 4:
+        raise content_size_error('fast_sync_read request', end - o, 4, None)
+    v_address, v_length = _S_U16_U16.unpack_from(buf, o)
+    o += 4
+    v_servo_ids_list = []
+    if (end - o) % 1:
+        raise DecodeError('fast_sync_read request' + f': {end - o} bytes do not split into servo_ids items of 1')
+    n = end - o
+    for v_id, in _S_U8.iter_unpack(buf[o : o + n]):
+        item = _new(ServoIdsItem)
+        _set_ServoIdsItem_id(item, v_id)
+        v_servo_ids_list.append(item)
+    v_servo_ids = tuple(v_servo_ids_list)
+    m = _new(FastSyncReadRequest)
+    _set_FastSyncReadRequest_id(m, id)
+    _set_FastSyncReadRequest_address(m, v_address)
+    _set_FastSyncReadRequest_length(m, v_length)
+    _set_FastSyncReadRequest_servo_ids(m, v_servo_ids)
     return m
 
 
@@ -375,6 +406,21 @@ def _encode_sync_read_request(m: SyncReadRequest) -> bytes:
     return _REQUEST_FRAMES.wrap(b''.join((_S_U16_U16.pack(m.address, m.length), b''.join(parts_ids),)), 130, (m.id,))
 
 
+def _encode_fast_sync_read_request(m: FastSyncReadRequest) -> bytes:
+    if not (0 <= m.id <= 252 or m.id == 254):
+        raise out_of_range('fast_sync_read request', 'id', m.id, 0, 252)
+    if not 0 <= m.address <= 65535:
+        raise out_of_range('fast_sync_read request', 'address', m.address, 0, 65535)
+    if not 1 <= m.length <= 1024:
+        raise out_of_range('fast_sync_read request', 'length', m.length, 1, 1024)
+    parts_servo_ids = []
+    for item in m.servo_ids:
+        if not 0 <= item.id <= 252:
+            raise out_of_range('fast_sync_read request', 'id', item.id, 0, 252)
+        parts_servo_ids.append(_S_U8.pack(item.id))
+    return _REQUEST_FRAMES.wrap(b''.join((_S_U16_U16.pack(m.address, m.length), b''.join(parts_servo_ids),)), 138, (m.id,))
+
+
 def _encode_sync_write_request(m: SyncWriteRequest) -> bytes:
     if not (0 <= m.id <= 252 or m.id == 254):
         raise out_of_range('sync_write request', 'id', m.id, 0, 252)
@@ -443,6 +489,7 @@ _REQUEST_DECODERS: dict[int | None, Callable[..., Message]] = {
     0x08: _decode_reboot_request,
     0x10: _decode_clear_request,
     0x82: _decode_sync_read_request,
+    0x8a: _decode_fast_sync_read_request,
     0x83: _decode_sync_write_request,
     0x92: _decode_bulk_read_request,
     0x93: _decode_bulk_write_request,
@@ -462,7 +509,7 @@ _REQUEST_FRAMES = FrameCodec(
             ((b'\xff\xff\xfd', b'\xff\xff\xfd\xfd'),),
         )),
     ),
-    {0x01: (0, 0), 0x02: (4, 4), 0x03: (2, None), 0x04: (2, None), 0x05: (0, 0), 0x06: (1, 1), 0x08: (0, 0), 0x10: (5, 5), 0x82: (4, None), 0x83: (4, None), 0x92: (0, None), 0x93: (0, None)},
+    {0x01: (0, 0), 0x02: (4, 4), 0x03: (2, None), 0x04: (2, None), 0x05: (0, 0), 0x06: (1, 1), 0x08: (0, 0), 0x10: (5, 5), 0x82: (4, None), 0x8a: (4, None), 0x83: (4, None), 0x92: (0, None), 0x93: (0, None)},
 )
 
 
@@ -529,6 +576,7 @@ _ENCODERS: dict[type[Message], Callable[..., bytes]] = {
     RebootRequest: _encode_reboot_request,
     ClearRequest: _encode_clear_request,
     SyncReadRequest: _encode_sync_read_request,
+    FastSyncReadRequest: _encode_fast_sync_read_request,
     SyncWriteRequest: _encode_sync_write_request,
     BulkReadRequest: _encode_bulk_read_request,
     BulkWriteRequest: _encode_bulk_write_request,
@@ -558,6 +606,11 @@ def encode(message: Message) -> bytes:
         return encoder(message)
     except (TypeError, AttributeError, struct.error) as exc:
         raise EncodeError(f"{message.COMMAND} {message.DIRECTION.value}: {exc}") from None
+
+
+# Each direction's frames for code that splits a stream of both directions (serialspec monitor).
+REQUEST_FORMAT = EngineFormat(_REQUEST_FRAMES, _decode_request)
+RESPONSE_FORMAT = EngineFormat(_RESPONSE_FRAMES, _decode_response)
 
 
 class StreamParser(_FrameStreamParser):

@@ -26,6 +26,7 @@ __all__ = [
     'ErrorBits',
     'ErrorNumber',
     'FactoryResetRequest',
+    'FastSyncReadRequest',
     'HardwareError',
     'IdsItem',
     'MESSAGE_TYPES',
@@ -39,6 +40,7 @@ __all__ = [
     'RebootRequest',
     'RegWriteRequest',
     'ResetOption',
+    'ServoIdsItem',
     'ServosItem',
     'StatusResponse',
     'StatusReturnLevel',
@@ -210,6 +212,26 @@ class IdsItem:
 
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'IdsItem') -> Self:
+        _check_keys(data, ('id',), (), where)
+        return cls(
+            _get(data, 'id', where),
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class ServoIdsItem:
+    """One item of servo_ids."""
+
+    id: int
+    #: A servo id. range 0..252
+
+    def to_fields(self) -> dict[str, Any]:
+        return {
+            'id': self.id,
+        }
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'ServoIdsItem') -> Self:
         _check_keys(data, ('id',), (), where)
         return cls(
             _get(data, 'id', where),
@@ -593,6 +615,42 @@ class SyncReadRequest(Message):
 
 
 @dataclass(frozen=True, slots=True)
+class FastSyncReadRequest(Message):
+    """Read the same items of several servos, answered in one packet (request)."""
+
+    PROTOCOL: ClassVar[str] = 'dynamixel_p2'
+    COMMAND: ClassVar[str] = 'fast_sync_read'
+    SUBCOMMAND: ClassVar[str | None] = None
+    DIRECTION: ClassVar[Direction] = Direction.REQUEST
+    id: int
+    #: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. range 0..252
+    address: int
+    #: First control table address to read.
+    length: int
+    #: Number of bytes each servo returns. range 1..1024
+    servo_ids: tuple[ServoIdsItem, ...]
+    #: The servos to read, in the order their parts follow each other.
+
+    def to_fields(self) -> dict[str, Any]:
+        return {
+            'id': self.id,
+            'address': self.address,
+            'length': self.length,
+            'servo_ids': [item.to_fields() for item in self.servo_ids],
+        }
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'fast_sync_read request') -> Self:
+        _check_keys(data, ('id', 'address', 'length', 'servo_ids'), (), where)
+        return cls(
+            _get(data, 'id', where),
+            _get(data, 'address', where),
+            _get(data, 'length', where),
+            tuple(ServoIdsItem.from_fields(_mapping(item, 'servo_ids', where), where) for item in _get(data, 'servo_ids', where)),
+        )
+
+
+@dataclass(frozen=True, slots=True)
 class SyncWriteRequest(Message):
     """Write the same items of several servos at once (request)."""
 
@@ -723,6 +781,7 @@ MESSAGE_TYPES: tuple[type[Message], ...] = (
     RebootRequest,
     ClearRequest,
     SyncReadRequest,
+    FastSyncReadRequest,
     SyncWriteRequest,
     BulkReadRequest,
     BulkWriteRequest,

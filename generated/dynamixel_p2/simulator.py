@@ -28,6 +28,7 @@ from dynamixel_p2.messages import (
     ClearRequest,
     Direction,
     FactoryResetRequest,
+    FastSyncReadRequest,
     PingRequest,
     PingResponse,
     ReadRequest,
@@ -181,6 +182,8 @@ DEVICE = DeviceSpec(
         CommandSpec(ClearRequest, StatusResponse, optional_when=(68, 2, '>='), tables={'data': ('run', 'address', 'length')}),
         # sync_read
         CommandSpec(SyncReadRequest, StatusResponse, reads=('data',), each='ids', tables={'data': ('run', 'address', 'length')}),
+        # fast_sync_read
+        CommandSpec(FastSyncReadRequest, None),
         # sync_write
         CommandSpec(SyncWriteRequest, None, writes=('data',), moves=('present_position', 'goal_position', '', 'profile_velocity'), speed_scale=15.6331, move_enabled_by='torque_enable', each='servos', tables={'data': ('run', 'address', '')}),
         # bulk_read

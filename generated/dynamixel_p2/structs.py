@@ -249,6 +249,12 @@ SyncReadRequestContent = Struct(
     'ids' / GreedyRange(Struct('id' / Int8ub)),
 )
 
+FastSyncReadRequestContent = Struct(
+    'address' / Int16ul,
+    'length' / Int16ul,
+    'servo_ids' / GreedyRange(Struct('id' / Int8ub)),
+)
+
 SyncWriteRequestContent = Struct(
     'address' / Int16ul,
     'length' / Rebuild(Int16ul, lambda ctx: _item_size(ctx, 'data')),
@@ -278,6 +284,7 @@ CONTENTS: dict[tuple[str, str], Any] = {
     ('reboot', 'request'): RebootRequestContent,
     ('clear', 'request'): ClearRequestContent,
     ('sync_read', 'request'): SyncReadRequestContent,
+    ('fast_sync_read', 'request'): FastSyncReadRequestContent,
     ('sync_write', 'request'): SyncWriteRequestContent,
     ('bulk_read', 'request'): BulkReadRequestContent,
     ('bulk_write', 'request'): BulkWriteRequestContent,

@@ -8,7 +8,7 @@ from collections.abc import Callable
 
 from serialspec.runtime.checksums import crc_function
 from serialspec.runtime.errors import DecodeError, EncodeError, content_size_error, out_of_range
-from serialspec.runtime.framing import Element, FrameCodec, Layout
+from serialspec.runtime.framing import Element, EngineFormat, FrameCodec, Layout
 from serialspec.runtime.framing import FrameStreamParser as _FrameStreamParser
 from serialspec.runtime.message import Direction, Message, members, slot_setters
 from serialspec.runtime.packing import decode_text as _decode_text
@@ -551,6 +551,11 @@ def encode(message: Message) -> bytes:
         return encoder(message)
     except (TypeError, AttributeError, struct.error) as exc:
         raise EncodeError(f"{message.COMMAND} {message.DIRECTION.value}: {exc}") from None
+
+
+# Each direction's frames for code that splits a stream of both directions (serialspec monitor).
+REQUEST_FORMAT = EngineFormat(_REQUEST_FRAMES, _decode_request)
+RESPONSE_FORMAT = EngineFormat(_RESPONSE_FRAMES, _decode_response)
 
 
 class StreamParser(_FrameStreamParser):

@@ -13,9 +13,11 @@ lies inside it or outside it.
 
 from __future__ import annotations
 
+import functools
+import re
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import Any, Literal
 
 from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError
 from serialspec.runtime.message import Message
@@ -69,25 +71,19 @@ class Transparency:
 
 
 def _rewrite(data: bytes, pairs: tuple[tuple[bytes, bytes], ...]) -> bytes:
-    """Each `old` sequence of `data` replaced by its `new`, scanning left to right (the leftmost match first)."""
-    out = bytearray()
-    i, n = 0, len(data)
-    firsts = {old[0] for old, _ in pairs}
-    while i < n:
-        byte = data[i]
-        if byte in firsts:
-            for old, new in pairs:
-                if data.startswith(old, i):
-                    out += new
-                    i += len(old)
-                    break
-            else:
-                out.append(byte)
-                i += 1
-        else:
-            out.append(byte)
-            i += 1
-    return bytes(out)
+    """Each `old` sequence of `data` replaced by its `new`, scanning left to right (the leftmost match first, the
+    pairs tried in order at each position): one bytes.replace for one pair, else one regular expression."""
+    if len(pairs) == 1:
+        old, new = pairs[0]
+        return data.replace(old, new)
+    return _rewriter(pairs)(data)
+
+
+@functools.cache
+def _rewriter(pairs: tuple[tuple[bytes, bytes], ...]) -> Callable[[bytes], bytes]:
+    table = dict(pairs)
+    pattern = re.compile(b"|".join(re.escape(old) for old, _ in pairs))
+    return lambda data: pattern.sub(lambda match: table[match.group()], data)
 
 
 @dataclass(frozen=True)
@@ -109,6 +105,31 @@ class Layout:
         object.__setattr__(self, "values", tuple(i for i, k in enumerate(kinds) if k == "value"))
         object.__setattr__(self, "command", kinds.index("command") if "command" in kinds else None)
         object.__setattr__(self, "length", kinds.index("length") if "length" in kinds else None)
+        # How unwrap cuts a frame, worked out once: fixed slices before and after the variable part, then the
+        # variable part's own elements (fixed but for the content); the checks by kind, in element order.
+        first, last = self._inner()
+        head, position = [], 0
+        for index in range(first):
+            head.append((index, position, position + self.elements[index].size))
+            position += self.elements[index].size
+        tail, position = [], 0
+        for index in range(len(self.elements) - 1, last, -1):
+            tail.append((index, position + self.elements[index].size, position))
+            position += self.elements[index].size
+        inner = self.elements[first : last + 1] if first <= last else ()
+        plan = {
+            "before": sum(e.size for e in self.elements[:first]),
+            "after": position,
+            "head": tuple(head),
+            "tail": tuple(tail),
+            "inner_fixed": sum(e.size for e in inner),
+            "variable": self.content - first if first <= self.content <= last else -1,
+            "inner": tuple((first + i, e.size) for i, e in enumerate(inner)),
+            "constants": tuple((i, e) for i, e in enumerate(self.elements) if e.kind == "constant"),
+            "lengths": tuple((i, e) for i, e in enumerate(self.elements) if e.kind == "length"),
+            "checksums": tuple((i, e) for i, e in enumerate(self.elements) if e.kind == "checksum"),
+        }
+        object.__setattr__(self, "_plan", plan)
 
     @property
     def header(self) -> bytes:
@@ -202,68 +223,54 @@ class Layout:
 
     def unwrap(self, frame: bytes) -> Unwrapped:
         """Check a complete frame (constants, lengths, stuffing, checksums) and take it apart."""
-        first, last = self._inner()
-        before = sum(e.size for e in self.elements[:first])
-        after = sum(e.size for e in self.elements[last + 1 :])
+        plan: dict[str, Any] = self._plan  # type: ignore[attr-defined]
+        before, after = plan["before"], plan["after"]
         n = len(frame)
         if n < before + after:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest {self.name} frame ({self.overhead})")
-        plain: list[bytes] = [b""] * len(self.elements)
-        position = 0
-        for index in range(first):
-            size = self.elements[index].size
-            plain[index] = frame[position : position + size]
-            position += size
-        position = n
-        for index in range(len(self.elements) - 1, last, -1):
-            size = self.elements[index].size
-            plain[index] = frame[position - size : position]
-            position -= size
+        elements = self.elements
+        plain: list[bytes] = [b""] * len(elements)
+        for index, start, stop in plan["head"]:
+            plain[index] = frame[start:stop]
+        for index, start, stop in plan["tail"]:
+            plain[index] = frame[n - start : n - stop]
         wire: dict[int, bytes] = {}
         middle = frame[before : n - after]
         if self.transparency is not None:
-            wire[first] = middle
+            wire[self.transparency.span[0]] = middle
             middle = self.transparency.decode(middle)
-        if first <= last:
-            inner = self.elements[first : last + 1]
-            variable = self.content - first if first <= self.content <= last else -1
-            fixed = sum(e.size for e in inner)
+        if plan["inner"]:
+            fixed, variable = plan["inner_fixed"], plan["variable"]
             if variable < 0 and len(middle) != fixed or len(middle) < fixed:
                 raise DecodeError(f"{self.name} frame: {len(middle)} bytes where at least {fixed} belong")
             position = 0
-            for offset, element in enumerate(inner):
-                size = element.size if offset != variable else len(middle) - fixed
-                plain[first + offset] = middle[position : position + size]
+            for offset, (index, size) in enumerate(plan["inner"]):
+                if offset == variable:
+                    size = len(middle) - fixed
+                plain[index] = middle[position : position + size]
                 position += size
-        code: int | None = None
-        values: list[int] = []
-        for index, element in enumerate(self.elements):
-            data = plain[index]
-            kind = element.kind
-            if kind == "constant":
-                if data != element.constant:
-                    raise DecodeError(f"{element.name} is {data.hex(' ')}, expected {element.constant.hex(' ')}")
-            elif kind == "command":
-                code = element.unpack(data)
-            elif kind == "value":
-                values.append(element.unpack(data))
-            elif kind == "length":
-                counted = len(self._wire(plain, wire, *element.span)) + element.adds
-                value = element.unpack(data)
-                if value != counted:
-                    raise DecodeError(f"{element.name} says {value} but the frame holds {counted}")
-        for index, element in enumerate(self.elements):
-            if element.kind == "checksum":
-                assert element.checksum is not None
-                expected = element.checksum(self._wire(plain, wire, *element.span))
-                stored = element.unpack(plain[index])
-                if expected != stored:
-                    raise ChecksumError(
-                        f"bad {element.name}: the frame has {stored:#0{2 + 2 * element.size}x}, "
-                        f"its bytes give {expected:#0{2 + 2 * element.size}x}"
-                    )
+        for index, element in plan["constants"]:
+            if plain[index] != element.constant:
+                data = plain[index]
+                raise DecodeError(f"{element.name} is {data.hex(' ')}, expected {element.constant.hex(' ')}")
+        command = self.command
+        code = elements[command].unpack(plain[command]) if command is not None else None
+        values = tuple(elements[i].unpack(plain[i]) for i in self.values)
+        for index, element in plan["lengths"]:
+            counted = len(self._wire(plain, wire, *element.span)) + element.adds
+            value = element.unpack(plain[index])
+            if value != counted:
+                raise DecodeError(f"{element.name} says {value} but the frame holds {counted}")
+        for index, element in plan["checksums"]:
+            expected = element.checksum(self._wire(plain, wire, *element.span))
+            stored = element.unpack(plain[index])
+            if expected != stored:
+                raise ChecksumError(
+                    f"bad {element.name}: the frame has {stored:#0{2 + 2 * element.size}x}, "
+                    f"its bytes give {expected:#0{2 + 2 * element.size}x}"
+                )
         content = plain[self.content] if self.content >= 0 else b""
-        return Unwrapped(self, code, tuple(values), content, tuple(plain))
+        return Unwrapped(self, code, values, content, tuple(plain))
 
 
 def _pack(element: Element, value: int) -> bytes:
@@ -504,3 +511,29 @@ class FrameStreamParser(StreamParser):
 
     def pending(self) -> bytes:
         return self._pending
+
+
+@dataclass(frozen=True)
+class EngineFormat:
+    """One direction's frames as code that splits a stream of both directions reads them (serialspec monitor)."""
+
+    codec: FrameCodec
+    decode: Decode
+
+    @property
+    def header(self) -> bytes:
+        return self.codec.layouts[0].header
+
+    def size(self, buffer: bytes, position: int) -> int | None:
+        """The size of a plausible frame at `position`; None if none starts there; past the buffer: wait."""
+        waiting = False
+        for layout in self.codec.layouts:
+            size = self.codec.probe(layout, buffer, position, len(buffer))
+            if size is None:
+                waiting = True
+            elif size >= 0:
+                return size
+        return len(buffer) - position + 1 if waiting else None
+
+    def decode_at(self, buffer: bytes, start: int, stop: int) -> Message:
+        return self.decode(buffer[start:stop], None)

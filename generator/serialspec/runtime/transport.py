@@ -149,6 +149,8 @@ class Bus:
         self.port_name = str(getattr(self._port, "name", None) or getattr(self._port, "port", "") or port)
         self._gap = _gap_seconds(binding.serial.gap, self._port)
         self._last_io = 0.0  # when a byte was last written or read (for the inter-frame gap)
+        # spy:// logs in its read(); the fast path below reads the descriptor itself, so it tells the logger
+        self._spy = getattr(self._port, "formatter", None)
 
     # --- lifetime -------------------------------------------------------------------------------------------------
 
@@ -374,6 +376,8 @@ class Bus:
             data = os.read(fd, 4096)
             if not data:  # readable but empty: the other end hung up
                 raise serial.SerialException("device disconnected")
+            if self._spy is not None:
+                self._spy.rx(data)
             return data
         if self._port.timeout != wait:
             self._port.timeout = wait

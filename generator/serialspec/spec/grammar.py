@@ -30,6 +30,8 @@ class Shape:
 class Str(Shape):
     description: str = ""
     choices: tuple[str, ...] = ()
+    default: Any = None  # the value a spec gets when it leaves the key out (for the reference and the schema)
+    example: Any = None  # shown in the reference where no spec uses the key
 
     def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
         if not isinstance(value, str):
@@ -41,43 +43,63 @@ class Str(Shape):
         schema: dict[str, Any] = {"type": "string", "description": self.description}
         if self.choices:
             schema["enum"] = list(self.choices)
-        return schema
+        return _with_default(schema, self.default, self.example)
 
 
 @dataclass
 class Int(Shape):
     description: str = ""
+    default: Any = None  # the value a spec gets when it leaves the key out (for the reference and the schema)
+    example: Any = None  # shown in the reference where no spec uses the key
 
     def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
         if not isinstance(value, int) or isinstance(value, bool):
             yield path, f"expected an integer, got {_kind(value)}"
 
     def json_schema(self) -> dict[str, Any]:
-        return {"type": "integer", "description": self.description}
+        return _with_default({"type": "integer", "description": self.description}, self.default, self.example)
 
 
 @dataclass
 class Num(Shape):
     description: str = ""
+    default: Any = None  # the value a spec gets when it leaves the key out (for the reference and the schema)
+    example: Any = None  # shown in the reference where no spec uses the key
 
     def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
         if not isinstance(value, int | float) or isinstance(value, bool):
             yield path, f"expected a number, got {_kind(value)}"
 
     def json_schema(self) -> dict[str, Any]:
-        return {"type": "number", "description": self.description}
+        return _with_default({"type": "number", "description": self.description}, self.default, self.example)
 
 
 @dataclass
 class Bool(Shape):
     description: str = ""
+    default: Any = None  # the value a spec gets when it leaves the key out (for the reference and the schema)
+    example: Any = None  # shown in the reference where no spec uses the key
 
     def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
         if not isinstance(value, bool):
             yield path, f"expected true or false, got {_kind(value)}"
 
     def json_schema(self) -> dict[str, Any]:
-        return {"type": "boolean", "description": self.description}
+        return _with_default({"type": "boolean", "description": self.description}, self.default, self.example)
+
+
+def _with_default(schema: dict[str, Any], default: Any, example: Any = None) -> dict[str, Any]:
+    if default is not None:
+        schema["default"] = default
+    if example is not None:
+        schema["examples"] = [example]
+    return schema
+
+
+def value_description(shape: Shape, parent: str) -> str:
+    """A shape's own description, or its parent's for a part that needs none of its own (a map's value, a list's
+    item, an option of a OneOf: `Document id -> what it is.` describes the values of `sources:`)."""
+    return shape.description or parent
 
 
 @dataclass
@@ -109,7 +131,7 @@ class ListOf(Shape):
     def json_schema(self) -> dict[str, Any]:
         schema: dict[str, Any] = {
             "type": "array",
-            "items": self.item.json_schema(),
+            "items": _described(self.item, self.description),
             "description": self.description,
         }
         if self.length is not None:
@@ -138,7 +160,7 @@ class MapOf(Shape):
     def json_schema(self) -> dict[str, Any]:
         return {
             "type": "object",
-            "additionalProperties": self.value.json_schema(),
+            "additionalProperties": _described(self.value, self.description),
             "description": self.description,
         }
 
@@ -191,7 +213,24 @@ class OneOf(Shape):
         yield path, f"unexpected {_kind(value)}: {self.description}"
 
     def json_schema(self) -> dict[str, Any]:
-        return {"anyOf": [option.json_schema() for option in self.options], "description": self.description}
+        options = [_described(option, self.description) for option in self.options]
+        return {"anyOf": options, "description": self.description}
+
+
+def _described(shape: Shape, parent: str) -> dict[str, Any]:
+    return _fill(shape.json_schema(), parent)
+
+
+def _fill(schema: dict[str, Any], parent: str) -> dict[str, Any]:
+    """Give every part without a description of its own (an option, a list's items) its parent's."""
+    if not schema.get("description"):
+        schema["description"] = parent
+    for part in ("items", "additionalProperties"):
+        if isinstance(schema.get(part), dict):
+            _fill(schema[part], schema["description"])
+    for option in schema.get("anyOf", []):
+        _fill(option, schema["description"])
+    return schema
 
 
 def _accepts_kind(shape: Shape, value: Any) -> bool:
@@ -224,6 +263,10 @@ def _kind(value: Any) -> str:
 # --- the language -------------------------------------------------------------------------------------------------
 
 TEXT = Str("Free text (English); shown in docs and docstrings, never executed.")
+TITLE = Str("A one-line title (free text), shown in the reference and as the docstring's first line.")
+TITLE_CN = Str("The title as printed in the (Chinese) document.")
+SOURCE = Str("Where the fact comes from: a document id from `sources:` and its section (free text).")
+SCALAR_TYPE = Str("Wire type of the value.", choices=SCALAR_TYPES, default="u8")
 RANGE = ListOf(Num(), "Inclusive [min, max] of the value in wire units; checked before encoding.", length=2)
 HEX_BYTES = Str("Bytes as hex: '12 4c 08', '0x12 0x4c', '124c08' or '12:4c:08'.")
 
@@ -233,11 +276,12 @@ def bit_fields(description: str) -> MapOf:
     return MapOf(
         Obj(
             {
-                "bits": OneOf((Int(), ListOf(Int(), length=2)), "a bit number or [high, low]"),
+                "bits": OneOf((Int(), ListOf(Int(), length=2)), "A bit number, or [high, low] for several bits."),
                 "enum": Str("Name of an entry in `enums:`."),
                 "description": TEXT,
             },
             required=("bits",),
+            description="One sub-field: its bit (or bits) and optionally the enum its value belongs to.",
         ),
         description,
     )
@@ -254,13 +298,18 @@ _FIELD_LONG: dict[str, Shape] = {
     "unit": Str("Unit of one wire step, e.g. mV, ms, 0.1°."),
     "scale": Num("Engineering value = wire value × scale (e.g. 0.1 for 0.1° steps)."),
     "range": RANGE,
-    "const": Int("The field always has this value (sub-command selectors, fixed addresses)."),
+    "const": Int("The field always has this value (sub-command selectors, fixed addresses).", example=1),
     "default": Num("Value used when a message is built without this field."),
     "enum": Str("Name of an entry in `enums:`; values decode to that enum."),
     "flags": Str("Name of an entry in `flags:`; the value is a set of bit flags."),
     "bits": bit_fields("Sub-fields packed into this integer, by bit position (unlisted bits must be zero)."),
-    "encoding": Str("How the integer is stored.", choices=("plain", "sign_magnitude")),
-    "endian": Str("Override of the protocol's byte order for this field.", choices=("little", "big")),
+    "encoding": Str(
+        "How the integer is stored: plain two's complement, or sign_magnitude (top bit the sign, the rest the size).",
+        choices=("plain", "sign_magnitude"),
+        default="plain",
+        example="sign_magnitude",
+    ),
+    "endian": Str("Override of the protocol's byte order for this field.", choices=("little", "big"), example="big"),
     "size": OneOf(
         (Int(), Str()),
         "bytes, string: a number, `rest` (up to the end of the content) or a field name; array: the earlier field "
@@ -293,16 +342,22 @@ _FIELD_LONG: dict[str, Shape] = {
         ),
     ),
 }
-FIELD = OneOf((Str("A wire type or the name of an entry in `fields:`"), Obj(_FIELD_LONG)), "a type name or a mapping")
+FIELD = OneOf(
+    (
+        Str("A wire type or the name of an entry in `fields:`"),
+        Obj(_FIELD_LONG, description="A field in full: its type, and its unit, range, enum... where it has them."),
+    ),
+    "A field: a wire type or the name of a shared field (short form), or a mapping (long form).",
+)
 FIELDS = MapOf(FIELD, "Fields in wire order: name -> type or mapping.")
 
 OPTIONAL_WHEN = Obj(
     {
         "parameter": Str("A table entry: `entry` or `table.entry` (e.g. response_switch)."),
         "equals": Int("The device answers while the parameter has this value."),
-        "not_equals": Int("The device answers while the parameter has any other value."),
+        "not_equals": Int("The device answers while the parameter has any other value.", example=0),
         "at_least": Int("The device answers while the parameter is at least this (status_return_level ≥ 1)."),
-        "at_most": Int("The device answers while the parameter is at most this."),
+        "at_most": Int("The device answers while the parameter is at most this.", example=1),
     },
     required=("parameter",),
     description="The reply is sent only while a device parameter compares true (give one comparison).",
@@ -310,10 +365,10 @@ OPTIONAL_WHEN = Obj(
 
 MESSAGE = Obj(
     {
-        "description": TEXT,
+        "description": Str(TEXT.description, example="Sent once the move has finished."),
         "fields": FIELDS,
         "optional": TEXT,
-        "unsolicited": Bool("Sent by the device on its own, not as an answer."),
+        "unsolicited": Bool("Sent by the device on its own, not as an answer.", default=False),
         "answers": Str("For a response: the request (command or command.subcommand) it answers, if another."),
         "error_reply": Bool(
             "For a response: the reply a device sends instead of any request's own when it cannot carry it out, "
@@ -332,9 +387,11 @@ MESSAGE = Obj(
         ),
         "default": Bool(
             "Among replies that share a code (or that all have none), the one a frame is decoded as when the "
-            "request it answers is unknown; the others are chosen by the request they answer."
+            "request it answers is unknown; the others are chosen by the request they answer.",
+            default=False,
+            example=True,
         ),
-        "source": TEXT,
+        "source": SOURCE,
     },
     description="One direction of a command: its content fields and how it is sent.",
 )
@@ -342,14 +399,15 @@ MESSAGE = Obj(
 SUBCOMMAND = Obj(
     {
         "code": Int("Selector value."),
-        "title": TEXT,
-        "title_cn": Str(),
+        "title": TITLE,
+        "title_cn": TITLE_CN,
         "description": TEXT,
         "request": MESSAGE,
         "response": MESSAGE,
-        "source": TEXT,
+        "source": SOURCE,
     },
     required=("code",),
+    description="A sub-command: its selector value and the fields of its request and response.",
 )
 
 COMMAND = Obj(
@@ -358,91 +416,122 @@ COMMAND = Obj(
             "Value of the frame's command field; omit for the one response of a protocol whose replies "
             "carry no command field."
         ),
-        "title": TEXT,
-        "title_cn": Str(),
+        "title": TITLE,
+        "title_cn": TITLE_CN,
         "description": TEXT,
         "request": MESSAGE,
         "response": MESSAGE,
         "broadcast": TEXT,
-        "source": TEXT,
+        "source": SOURCE,
         "selector": Obj(
             {
-                "type": Str(choices=SCALAR_TYPES),
-                "name": Str(),
+                "type": Str("Wire type of the selector.", choices=SCALAR_TYPES, default="u8"),
+                "name": Str("The selector's field name, as messages show it."),
                 "offset": MapOf(Int(), "Byte offset of the selector in the content, by direction."),
             },
             required=("offset",),
             description="Where the sub-command selector sits in the content, by direction.",
         ),
-        "subcommands": MapOf(SUBCOMMAND),
+        "subcommands": MapOf(SUBCOMMAND, "Sub-commands the selector picks: name -> sub-command."),
     },
+    description="A command: its code, and the fields of its request and response.",
 )
 
 ENUM = Obj(
     {
-        "type": Str(choices=SCALAR_TYPES),
+        "type": Str("Wire type of fields holding the enum.", choices=SCALAR_TYPES, default="u8"),
         "description": TEXT,
         "values": MapOf(
             OneOf(
-                (Int(), Obj({"value": Int(), "text": TEXT, "text_cn": Str()}, required=("value",))),
-                "a number or {value, text}",
+                (
+                    Int(),
+                    Obj(
+                        {
+                            "value": Int("The wire value."),
+                            "text": Str("What the value means (free text)."),
+                            "text_cn": Str("The meaning as printed in the (Chinese) document.", example="释放"),
+                        },
+                        required=("value",),
+                    ),
+                ),
+                "The wire value, or {value, text}.",
             ),
             "Label -> wire value.",
         ),
     },
     required=("values",),
+    description="Names for the values of a field; decoded values become members of a generated IntEnum.",
 )
 
 FLAGS = Obj(
     {
-        "type": Str(choices=SCALAR_TYPES),
+        "type": Str("Wire type of fields holding the flags.", choices=SCALAR_TYPES, default="u8", example="u16"),
         "description": TEXT,
         "bits": MapOf(
-            OneOf((Int(), Obj({"bit": Int(), "text": TEXT}, required=("bit",))), "a bit number or {bit, text}"),
+            OneOf(
+                (
+                    Int(),
+                    Obj(
+                        {"bit": Int("Bit number (0 is the least significant)."), "text": TEXT},
+                        required=("bit",),
+                    ),
+                ),
+                "A bit number, or {bit, text}.",
+            ),
             "Flag name -> bit number.",
         ),
     },
     required=("bits",),
+    description="Names for the bits of a field; decoded values become a generated IntFlag.",
 )
 
 TABLE_ENTRY = Obj(
     {
         "key": Int("data_id or register address."),
-        "type": Str(choices=SCALAR_TYPES),
-        "name_cn": Str(),
+        "type": Str("Wire type of the value.", choices=SCALAR_TYPES),
+        "name_cn": Str("The name as printed in the (Chinese) document."),
         "description": TEXT,
-        "unit": Str(),
-        "scale": Num(),
+        "unit": Str("Unit of one wire step, e.g. mV, 0.1°."),
+        "scale": Num("Engineering value = wire value × scale."),
         "range": RANGE,
-        "default": OneOf((Num(), Str()), "a number, or text when the document gives none"),
-        "access": Str(choices=("r", "rw")),
-        "memory": Str(choices=("eeprom", "sram")),
-        "enum": Str(),
-        "flags": Str(),
-        "encoding": Str(choices=("plain", "sign_magnitude")),
+        "default": OneOf((Num(), Str()), "The value after a reset: a number, or text when the document gives none."),
+        "access": Str("r (read-only) or rw (readable and writable).", choices=("r", "rw"), default="rw"),
+        "memory": Str("Where the device keeps it: eeprom (kept over power-off) or sram.", choices=("eeprom", "sram")),
+        "enum": Str("Name of an entry in `enums:`."),
+        "flags": Str("Name of an entry in `flags:`."),
+        "encoding": Str(
+            "How the integer is stored (see a field's `encoding`).",
+            choices=("plain", "sign_magnitude"),
+            default="plain",
+        ),
         "sign_bit": Int("sign_magnitude: the bit holding the sign when it is not the top bit (FEETECH load: 10)."),
-        "reserved": Bool("A slot the document reserves: no name of its own."),
-        "source": TEXT,
+        "reserved": Bool("A slot the document reserves: no name of its own.", default=False),
+        "source": SOURCE,
     },
     required=("key", "type"),
+    description="One parameter or register of the table.",
 )
 
 TABLE = Obj(
     {
-        "title": TEXT,
+        "title": TITLE,
         "key": Str("What the key is called on the wire (data_id, address)."),
         "description": TEXT,
-        "source": TEXT,
-        "entries": MapOf(TABLE_ENTRY),
+        "source": SOURCE,
+        "entries": MapOf(TABLE_ENTRY, "The table's entries: name -> entry."),
     },
     required=("key", "entries"),
+    description="Parameters or registers addressed by a key (a data_id, a register address).",
 )
 
 
 def span(description: str) -> OneOf:
     """A span of frame elements: [first, last] (inclusive), or a mapping direction -> [first, last]."""
     return OneOf(
-        (ListOf(Str(), length=2), MapOf(ListOf(Str(), length=2))),
+        (
+            ListOf(Str(), "[first, last] frame element names", length=2),
+            MapOf(ListOf(Str(), "[first, last] frame element names", length=2), "direction -> [first, last]"),
+        ),
         f"{description} [first, last] frame element names, or a mapping direction -> [first, last].",
     )
 
@@ -458,9 +547,11 @@ FRAME_ELEMENT = Obj(
         "endian": Str(
             "Byte order of a multi-byte element (default little, whatever the protocol's byte_order).",
             choices=("little", "big"),
+            default="little",
+            example="big",
         ),
         "value": OneOf(
-            (Str(), MapOf(Str())),
+            (Str(), MapOf(Str(), "direction -> hex bytes")),
             "Constant bytes as hex, or a mapping direction -> hex bytes. On a header, trailer or constant: its "
             "bytes. On any other element: in the directions given, the element is these constant bytes instead "
             "(DYNAMIXEL status packets carry 55 where requests carry the instruction).",
@@ -475,7 +566,7 @@ FRAME_ELEMENT = Obj(
         "counts": span(
             "length: the span of elements it counts, on the wire (after stuffing); default the content only.",
         ),
-        "adds": Int("length: added to the counted size (SMS: 2 = instruction + checksum); may be negative."),
+        "adds": Int("length: added to the counted size (SMS: 2 = instruction + checksum); may be negative.", default=0),
         "description": TEXT,
         "range": RANGE,
         "broadcast": Int("address: the broadcast value."),
@@ -491,22 +582,27 @@ FRAME_ELEMENT = Obj(
             "checksum: sum (of the bytes, modulo the width), xor (of the bytes) or crc.",
             choices=("sum", "crc", "xor"),
         ),
-        "invert": Bool("sum: bitwise NOT of the sum."),
+        "invert": Bool("sum: bitwise NOT of the sum.", default=False),
         "crc": Obj(
             {
-                "name": Str(),
-                "width": Int(),
-                "poly": Int(),
-                "init": Int(),
-                "refin": Bool(),
-                "refout": Bool(),
-                "xorout": Int(),
+                "name": Str("Catalogue name, e.g. CRC-16/MODBUS."),
+                "width": Int("Bits of the CRC."),
+                "poly": Int("Generator polynomial, normal form without the top bit (0x8005)."),
+                "init": Int("Register value before the first byte."),
+                "refin": Bool("Each input byte is reflected (least significant bit first)."),
+                "refout": Bool("The result is reflected before `xorout`."),
+                "xorout": Int("Value XORed into the result."),
                 "check": Int("The catalogue check value: the CRC of b'123456789'."),
             },
             required=("width", "poly", "init", "refin", "refout", "xorout", "check"),
+            description=(
+                "crc: the CRC by its catalogue parameters (reveng's CRC catalogue); the generator checks `check` "
+                "against the CRC of '123456789'."
+            ),
         ),
     },
     required=("role",),
+    description="One element of the frame, in wire order.",
 )
 
 FRAME_ELEMENTS = MapOf(FRAME_ELEMENT, "The frame's elements in wire order: name -> element.")
@@ -532,22 +628,29 @@ FRAMING = Obj(
     {
         "elements": FRAME_ELEMENTS,
         "layouts": MapOf(
-            Obj({"description": TEXT, "elements": FRAME_ELEMENTS}, required=("elements",)),
+            Obj(
+                {
+                    "description": Str(TEXT.description, example="Payloads of up to 255 bytes."),
+                    "elements": FRAME_ELEMENTS,
+                },
+                required=("elements",),
+                description="One alternative layout: its elements in wire order.",
+            ),
             "Alternative layouts (instead of `elements`), told apart by their headers; encode uses the first "
             "whose length can count the frame (VESC: 02 + u8 length, 03 + u16 length).",
         ),
         "transparency": TRANSPARENCY,
-        "gap": Num("Silence between frames, in character times (Modbus RTU: 3.5)."),
+        "gap": Num("Silence between frames, in character times (Modbus RTU: 3.5).", example=3.5),
         "description": TEXT,
     },
-    description="The frame around every message.",
+    description="The frame every command travels in: `elements` (one layout) or `layouts` (alternatives).",
 )
 
 EXAMPLE = Obj(
     {
         "source": Str("Document and section the frame is printed in."),
         "description": TEXT,
-        "direction": Str(choices=("request", "response")),
+        "direction": Str("The direction the frame travels in.", choices=("request", "response")),
         "printed": Str("The frame exactly as the document prints it."),
         "printed_span": ListOf(
             Str(),
@@ -561,12 +664,13 @@ EXAMPLE = Obj(
             "The document prints no complete frame here (a placeholder such as `CRC` for the check byte, or the "
             "values as a table): how `frame` completes it. A printing convention, not an erratum."
         ),
-        "command": Str(),
-        "subcommand": Str(),
+        "command": Str("The command the frame decodes as."),
+        "subcommand": Str("Its sub-command, where the command has them."),
         "request": Str("Name of the example whose request this example answers."),
         "fields": MapOf(Any_(), "The field values the frame carries (raw wire values)."),
     },
     required=("source", "direction", "printed", "command", "fields"),
+    description="A frame as a document prints it, with the fields it carries; the tests decode and encode it.",
 )
 
 ERRATUM = Obj(
@@ -577,16 +681,18 @@ ERRATUM = Obj(
         "check": Obj(
             {
                 "kind": Str(
+                    "The test: the printed frame fails to decode, decodes as given, a checksum's real value, "
+                    "CRC parameters that contradict their check value, or prose (no test).",
                     choices=("frame_fails", "frame_decodes_as", "checksum_value", "crc_parameters", "prose"),
                 ),
                 "frame": HEX_BYTES,
-                "direction": Str(choices=("request", "response")),
+                "direction": Str("The direction of `frame`.", choices=("request", "response")),
                 "error": Str("frame_fails: words the one-line decode error contains."),
-                "command": Str(),
-                "subcommand": Str(),
-                "fields": MapOf(Any_()),
+                "command": Str("frame_decodes_as: the command the frame decodes as."),
+                "subcommand": Str("frame_decodes_as: its sub-command."),
+                "fields": MapOf(Any_(), "frame_decodes_as: the field values it decodes to."),
                 "claimed": Any_("checksum_value: the claimed value; crc_parameters: the claimed parameters."),
-                "actual": Int(),
+                "actual": Int("checksum_value: the value the bytes really give."),
                 "examples": ListOf(Str(), "Examples whose frames the check runs over."),
             },
             required=("kind",),
@@ -594,6 +700,12 @@ ERRATUM = Obj(
         ),
     },
     required=("source", "printed", "correct", "check"),
+    description="A mistake in a document: what it prints, what is right, and the test that pins the right reading.",
+)
+
+REPLY_VALUES = (
+    "Response field -> value when no behaviour sets it (e.g. result: 1; text for text and bytes fields, bytes as "
+    "hex: VESC hw_name: '60')."
 )
 
 SPACE_ACCESS = Obj(
@@ -612,7 +724,7 @@ SPACE_ACCESS = Obj(
 
 DEVICE_COMMAND = Obj(
     {
-        "description": TEXT,
+        "description": Str(TEXT.description, example="The servo moves to the goal position over goal_time."),
         "reads": OneOf(
             (
                 ListOf(Str(), "Response fields filled from memory: table_value by its key, table_block entries."),
@@ -627,11 +739,17 @@ DEVICE_COMMAND = Obj(
             ),
             "a list of request fields stored in memory, or a mapping request field -> data space run",
         ),
-        "resets": Bool("Memory goes back to its defaults (all but the device's id, unless `keeps` says otherwise)."),
+        "resets": Bool(
+            "Memory goes back to its defaults (all but the device's id, unless `keeps` says otherwise).", default=False
+        ),
         "keeps": Obj(
             {
                 "field": Str("The request field that chooses (DYNAMIXEL FACTORY RESET `option`)."),
-                "entries": MapOf(ListOf(Str()), "Field value -> the memory entries a reset keeps.", int_keys=True),
+                "entries": MapOf(
+                    ListOf(Str(), "the memory entries a reset keeps"),
+                    "Field value -> the memory entries a reset keeps.",
+                    int_keys=True,
+                ),
             },
             required=("field", "entries"),
             description="resets: the entries kept, chosen by a request field (0xFF: none, 0x01: id, ...).",
@@ -658,6 +776,7 @@ DEVICE_COMMAND = Obj(
                 "decel": Str("The request field with the deceleration time (ms) at the end of the move."),
             },
             required=("state", "target"),
+            description="The device moves a state variable to a target, over a duration or at a speed.",
         ),
         "stops": ListOf(Str(), "State variables whose move in progress stops where it is now."),
         "wraps": MapOf(
@@ -669,6 +788,7 @@ DEVICE_COMMAND = Obj(
             Obj(
                 {"state": Str("The state variable (or memory entry)."), "per": Num("The size of one whole unit.")},
                 required=("state", "per"),
+                description="The state variable counted and the size of one whole unit.",
             ),
             "Response field -> how many whole `per` the state variable holds, toward zero (turns of an angle).",
         ),
@@ -698,10 +818,10 @@ DEVICE_COMMAND = Obj(
                 "devices act on it as on that request, and answer as they would (a sync command)."
             ),
         ),
-        "broadcast_reply": Bool("Answers even when addressed by broadcast (default: silent)."),
+        "broadcast_reply": Bool("Answers even when addressed by broadcast (default: silent).", default=False),
         "each": Str("A group field of the request whose items address one device each (by the address field)."),
-        "buffered": Bool("The writes are held until a command that `commits` (FEETECH REG WRITE)."),
-        "commits": Bool("Carries out the writes held by `buffered` commands (FEETECH ACTION)."),
+        "buffered": Bool("The writes are held until a command that `commits` (FEETECH REG WRITE).", default=False),
+        "commits": Bool("Carries out the writes held by `buffered` commands (FEETECH ACTION).", default=False),
         "kind": Str("The entry of `kinds:` whose devices the command addresses (default: the devices of --id)."),
         "stores": MapOf(Str(), "Request field -> the state variable it is stored in (where names differ)."),
         "sets": MapOf(Num(), "State variable -> the value the command sets it to."),
@@ -732,7 +852,8 @@ MODEL = Obj(
                     "unit": Str("This model's unit of one wire step, where it differs from the table's."),
                     "scale": Num("This model's engineering value per wire step, where it differs."),
                     "description": TEXT,
-                }
+                },
+                description="Where this model's entry differs from the table's.",
             ),
             "Memory entry -> where this model's range, unit or scale differs from the table's.",
         ),
@@ -758,8 +879,8 @@ DEVICE = Obj(
         "broadcast": Int("The address every device obeys (default: the address element's broadcast)."),
         "state": MapOf(Num(), "State variables beyond memory -> initial value (e.g. the present angle)."),
         "reply": MapOf(
-            OneOf((Num(), Str()), "a number, or text for text and bytes fields (bytes as hex)"),
-            "Response field -> value when no behaviour sets it (e.g. result: 1; VESC hw_name: '60').",
+            OneOf((Num(), Str()), REPLY_VALUES),
+            REPLY_VALUES,
         ),
         "refused": MapOf(
             Num(),
@@ -777,7 +898,8 @@ DEVICE = Obj(
             "an entry whose being non-zero sets that bit field (DYNAMIXEL error.alert: hardware_error_status).",
         ),
         "echo_address": Bool(
-            "Replies carry the id the request named (RRC: 0xFE for a broadcast read), not the answering device's own."
+            "Replies carry the id the request named (RRC: 0xFE for a broadcast read), not the answering device's own.",
+            default=False,
         ),
         "commands": MapOf(DEVICE_COMMAND, "Command (or command.subcommand) -> behaviour; others just answer."),
         "ids": ListOf(Int(), "The device ids the simulator serves when none are given (default: 0)."),
@@ -798,10 +920,11 @@ DEVICE = Obj(
                         "The item type: `bit`, or an unsigned integer type.", choices=("bit", "u8", "u16", "u32")
                     ),
                     "size": Int("Number of items, addressed 0..size-1 (the simulator can be given other sizes)."),
-                    "access": Str(choices=("r", "rw")),
+                    "access": Str("r: requests only read it; rw: they read and write it.", choices=("r", "rw")),
                     "description": TEXT,
                 },
                 required=("type", "size"),
+                description="One data space: its item type, its size and whether requests may write it.",
             ),
             "Data spaces the device keeps besides its table: runs of items addressed by number, all zero at "
             "first (Modbus coils, discrete inputs, holding and input registers).",
@@ -826,10 +949,11 @@ DEVICE = Obj(
                     "description": TEXT,
                     "address": Str("The request field holding this kind's id."),
                     "ids": ListOf(Int(), "The ids the simulator creates (fixed by the hardware, not by --id)."),
-                    "broadcast": Int("The id every device of this kind obeys."),
+                    "broadcast": Int("The id every device of this kind obeys.", example=255),
                     "state": MapOf(Num(), "State variables of each device of this kind -> initial value."),
                 },
                 required=("address", "ids"),
+                description="One further kind of device: the field with its id, its ids and its state.",
             ),
             "Further kinds of device behind the same port, each with its own ids (a board's PWM servo ports, its "
             "motors); a command names its kind with `kind:`. The devices --id creates are the default kind.",
@@ -841,32 +965,38 @@ DEVICE = Obj(
 SPEC = Obj(
     {
         "protocol": Str("Python package name of the generated code."),
-        "title": TEXT,
+        "title": TITLE,
         "description": TEXT,
         "sources": MapOf(Str(), "Document id -> what it is."),
-        "byte_order": Str(choices=("little", "big")),
+        "byte_order": Str(
+            "Byte order of every multi-byte value, unless a field's `endian` says otherwise.", choices=("little", "big")
+        ),
         "serial": Obj(
             {
-                "baudrate": Int(),
-                "bytesize": Int(),
-                "parity": Str(choices=("none", "even", "odd")),
-                "stopbits": Num(),
+                "baudrate": Int("Bits per second."),
+                "bytesize": Int("Data bits per character.", default=8),
+                "parity": Str("Parity bit.", choices=("none", "even", "odd"), default="none"),
+                "stopbits": Num("Stop bits.", default=1),
                 "notes": TEXT,
             },
             required=("baudrate",),
+            description="The serial line's settings: what clients, simulators and `monitor` open a port with.",
         ),
         "framing": FRAMING,
         "matching": Obj(
-            {"by": ListOf(Str()), "description": TEXT},
+            {
+                "by": ListOf(Str(), "What a reply shares with its request: `command` and field names (servo_id)."),
+                "description": TEXT,
+            },
             description="How a reply is matched to its request.",
         ),
         "fields": FIELDS,
-        "enums": MapOf(ENUM),
-        "flags": MapOf(FLAGS),
-        "tables": MapOf(TABLE),
-        "commands": MapOf(COMMAND),
-        "examples": MapOf(EXAMPLE),
-        "errata": MapOf(ERRATUM),
+        "enums": MapOf(ENUM, "Value sets: name -> enum; fields refer to them with `enum:`."),
+        "flags": MapOf(FLAGS, "Bit sets: name -> flags; fields refer to them with `flags:`."),
+        "tables": MapOf(TABLE, "Parameter or register tables: name -> table."),
+        "commands": MapOf(COMMAND, "The protocol's commands: name -> command."),
+        "examples": MapOf(EXAMPLE, "Frames printed in the documents, each decoded and encoded by the tests."),
+        "errata": MapOf(ERRATUM, "Mistakes in the documents, each pinned by a test."),
         "device": DEVICE,
     },
     required=("protocol", "title", "byte_order", "serial", "framing", "commands"),

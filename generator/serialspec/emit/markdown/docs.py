@@ -48,6 +48,12 @@ def cell(value: object) -> str:
     return text(str(value)).replace("|", "\\|") or " "
 
 
+def code_span(value: str) -> str:
+    """Text shown as printed (an erratum's quote of a document): a code span, so nothing in it is markup."""
+    value = " ".join(value.split())
+    return f"`` {value} ``" if "`" in value else f"`{value}`"
+
+
 def anchor(*parts: str) -> str:
     return "-".join(p.replace("_", "-").replace(".", "-") for p in parts if p).lower()
 
@@ -82,6 +88,18 @@ def type_name(f: Field) -> str:
     return f"block of [{f.table.title}](#table-{anchor(f.table.name)})"
 
 
+def value_range(minimum: float, maximum: float, is_float: bool, type_min: float, type_max: float) -> str:
+    """A range as people read it: `any` for a float's whole range, never a 39-digit number."""
+    if is_float and (minimum, maximum) == (type_min, type_max):
+        return "any"
+    show = (lambda v: f"{v:g}") if is_float else number
+    return f"{show(minimum)}..{show(maximum)}"
+
+
+def scalar_range(type_: Any, minimum: float, maximum: float) -> str:
+    return value_range(minimum, maximum, type_.is_float, type_.minimum, type_.maximum)
+
+
 def range_text(f: Field) -> str:
     if isinstance(f, Scalar):
         if f.const is not None:
@@ -94,9 +112,11 @@ def range_text(f: Field) -> str:
             )
         if f.bits:
             return ""
-        return f"{number(f.minimum)}..{number(f.maximum)}"
-    if isinstance(f, Array) or (isinstance(f, List) and f.item is not None):
-        return f"{number(f.minimum)}..{number(f.maximum)}"
+        return scalar_range(f.type, f.minimum, f.maximum)
+    if isinstance(f, Array):
+        return scalar_range(f.item, f.minimum, f.maximum)
+    if isinstance(f, List) and f.item is not None:
+        return scalar_range(f.item, f.minimum, f.maximum)
     return ""
 
 
@@ -144,7 +164,7 @@ def field_rows(fields: tuple[Field, ...], start: int | None, prefix: str = "") -
                     f"{prefix}{f.name}.{e.name}",
                     e.type.name,
                     e.unit,
-                    f"{number(e.minimum)}..{number(e.maximum)}",
+                    scalar_range(e.type, e.minimum, e.maximum),
                     f"{f.table.key_name} {e.key}: {e.description}",
                 )
                 for e in f.entries
@@ -158,11 +178,7 @@ def message_context(protocol: Protocol, message: Message | None) -> dict[str, An
         return None
     layout = protocol.framing.layouts[message.direction]
     content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
-    size = (
-        str(message.min_size)
-        if message.min_size == message.max_size
-        else f"{message.min_size}..{message.max_size if message.max_size is not None else ''}"
-    )
+    size = size_text(message.min_size, message.max_size, content_limit(layout))
     rows = [
         Row(str(layout.offsets[e.name]), e.name, e.type.name if e.type else "", "", "", text(e.description))
         for e in layout.value_elements
@@ -178,6 +194,20 @@ def message_context(protocol: Protocol, message: Message | None) -> dict[str, An
         "reply": reply_text(message, protocol) or error_reply_text(protocol, message),
         "description": text(message.description),
     }
+
+
+def content_limit(layout: FrameLayout) -> int | None:
+    """The most content bytes the frame's length element can count (None: no length element)."""
+    length = next((e for e in layout.elements if e.role == "length" and e.type is not None), None)
+    return None if length is None or length.type is None else (1 << 8 * length.type.size) - 1 - layout.length_adds
+
+
+def size_text(low: int, high: int | None, limit: int | None) -> str:
+    if limit is not None and (high is None or high > limit):
+        high = limit
+    if high == low:
+        return f"{low} byte" + ("" if low == 1 else "s")
+    return f"{low}..{high} bytes" if high is not None else f"{low} bytes or more"
 
 
 def reply_text(message: Message, protocol: Protocol | None = None) -> str:
@@ -245,9 +275,9 @@ def command_context(protocol: Protocol, command: Command) -> dict[str, Any]:
                 "description": text(sub.description),
                 "source": text(sub.source),
                 "anchor": anchor("command", command.name, sub.name),
-                "messages": [
-                    m for m in (message_context(protocol, sub.request), message_context(protocol, sub.response)) if m
-                ],
+                "messages": same_once(
+                    [m for m in (message_context(protocol, sub.request), message_context(protocol, sub.response)) if m]
+                ),
                 "examples": examples_for(protocol, command.name, sub.name),
             }
         )
@@ -260,21 +290,49 @@ def command_context(protocol: Protocol, command: Command) -> dict[str, Any]:
         "broadcast": text(command.broadcast),
         "source": text(command.source),
         "anchor": anchor("command", command.name),
-        "messages": [
-            m for m in (message_context(protocol, command.request), message_context(protocol, command.response)) if m
-        ],
+        "messages": same_once(
+            [m for m in (message_context(protocol, command.request), message_context(protocol, command.response)) if m]
+        ),
         "subcommands": subs,
         "examples": examples_for(protocol, command.name, None),
     }
+
+
+def same_once(parts: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """A request and a response (or two frames) that read exactly alike are shown once, for both directions."""
+    if len(parts) == 2 and {**parts[0], "direction": ""} == {**parts[1], "direction": ""}:
+        return [{**parts[0], "direction": f"{parts[0]['direction']} and {parts[1]['direction']}"}]
+    return parts
 
 
 def examples_for(protocol: Protocol, command: str, subcommand: str | None) -> list[str]:
     return [e.name for e in protocol.examples if (e.command, e.subcommand) == (command, subcommand)]
 
 
+def frame_picture(protocol: Protocol) -> list[str]:
+    """The frame of each direction on one line, columns aligned: `12 4C | cmd_id | length | content (n) | checksum`."""
+    lines = []
+    for layout in (lay for lays in protocol.framing.alternatives.values() for lay in lays):
+        parts = []
+        for e in layout.elements:
+            if e.fixed:
+                parts.append(e.constant.hex(" ").upper())
+            elif e.role == "content":
+                parts.append(f"{e.name} (n bytes)")
+            else:
+                parts.append(e.name + (f" ({e.type.size} bytes)" if e.type and e.type.size > 1 else ""))
+        lines.append((layout.direction.value + (f" {layout.name}" if layout.name else ""), parts))
+    columns = max(len(parts) for _, parts in lines)
+    widths = [max(len(p[i]) for _, p in lines if i < len(p)) for i in range(columns)]
+    label = max(9, *(len(direction) for direction, _ in lines))
+    return [
+        direction.ljust(label) + " " + " | ".join(part.ljust(widths[i]) for i, part in enumerate(parts)).rstrip()
+        for direction, parts in lines
+    ]
+
+
 def frame_context(protocol: Protocol, layout: FrameLayout) -> dict[str, Any]:
     rows = []
-    packet = []
     offset = 0
     variable = False  # past the content (or the stuffed span): offsets vary from frame to frame
     first_variable = layout.transparency.first if layout.transparency else None
@@ -285,19 +343,18 @@ def frame_context(protocol: Protocol, layout: FrameLayout) -> dict[str, Any]:
             description = f"{layout.header.hex(' ').upper()} — {e.description}"
         elif e.fixed:
             description = f"{e.constant.hex(' ').upper()} — {e.description}"
-        elif e.role == "length" and layout.classic:
-            adds = f" + {layout.length_adds}" if layout.length_adds else ""
-            description = f"n{adds}, where n is the number of content bytes. {e.description}"
-        elif e.role == "length":
-            adds = f" {'+' if e.adds > 0 else '-'} {abs(e.adds)}" if e.adds else ""
-            endian = ", big-endian" if e.endian == ">" and (e.size or 0) > 1 else ""
-            description = f"bytes from `{e.counts[0]}` to `{e.counts[1]}` as sent{adds}{endian}. {e.description}"
         elif e.role == "checksum" and not layout.classic and e.checksum is not None:
             endian = "big-endian" if e.endian == ">" else "little-endian"
             description = f"over `{e.checksum.first}`..`{e.checksum.last}`, {endian}. {e.description}"
         else:
             description = e.description
-        label = "content (n bytes)" if e.role == "content" else e.name
+        kind = e.type.name if e.type else ("bytes" if e.fixed else "n bytes")
+        if e.role == "length" and layout.classic:
+            kind += f" = n + {layout.length_adds}" if layout.length_adds else " = n"
+        elif e.role == "length":
+            adds = f" {'+' if e.adds > 0 else '-'} {abs(e.adds)}" if e.adds else ""
+            endian = ", big-endian" if e.endian == ">" and (e.size or 0) > 1 else ""
+            kind += f" = bytes `{e.counts[0]}`..`{e.counts[1]}` as sent{adds}{endian}"
         where = f"{offset}.." if size is None else (str(offset) if size == 1 else f"{offset}..{offset + size - 1}")
         if e.role in ("checksum",) or (offset is None):
             where = "last" if e.role == "checksum" else where
@@ -308,15 +365,13 @@ def frame_context(protocol: Protocol, layout: FrameLayout) -> dict[str, Any]:
                 "offset": cell(where),
                 "name": cell(e.name),
                 "role": e.role,
-                "type": cell(e.type.name if e.type else ("bytes" if e.fixed else "n bytes")),
+                "type": cell(kind),
                 "meaning": cell(description),
             }
         )
-        width = (size or 4) * 8
-        packet.append(f'{offset * 8}-{offset * 8 + width - 1}: "{label}"')
-        offset += size or 4
+        offset += size or 0
     title = layout.direction.value.capitalize() + (f" frame, layout `{layout.name}`" if layout.name else " frame")
-    return {"direction": layout.direction.value, "title": title, "rows": rows, "packet": packet}
+    return {"direction": layout.direction.value, "title": title, "rows": rows}
 
 
 def transparency_text(protocol: Protocol) -> str:
@@ -528,18 +583,15 @@ def emit_docs(protocol: Protocol) -> str:
             "key": t.key_name,
             "description": text(t.description),
             "source": text(t.source),
-            "has_memory": any(e.memory for e in t.entries),
             "rows": [
                 {
                     "key": f"{e.key}" if t.key_name != "address" else f"{e.key:#04x}",
-                    "name": cell("(reserved)" if e.reserved else e.name),
-                    "name_cn": cell(e.name_cn),
-                    "type": e.type.name + sign_note(e),
-                    "unit": cell(e.unit),
-                    "range": f"{number(e.minimum)}..{number(e.maximum)}",
+                    "name": cell("(reserved)" if e.reserved else e.name)
+                    + (f"<br>{cell(e.name_cn)}" if e.name_cn else ""),
+                    "type": e.type.name + sign_note(e) + (f", {cell(e.unit)}" if e.unit else ""),
+                    "range": scalar_range(e.type, e.minimum, e.maximum),
                     "default": cell("" if e.default is None else e.default),
-                    "access": e.access,
-                    "memory": e.memory,
+                    "access": e.access + (f", {e.memory}" if e.memory else ""),
                     "meaning": cell(
                         e.description
                         + (f" Values: [{e.enum.class_name}](#enum-{anchor(e.enum.name)})." if e.enum else "")
@@ -555,8 +607,8 @@ def emit_docs(protocol: Protocol) -> str:
             "name": e.name,
             "class_name": e.class_name,
             "anchor": anchor("enum", e.name),
-            "description": text(e.description),
-            "values": [{"value": v.value, "name": v.name.lower(), "text": cell(v.text)} for v in e.values],
+            "description": text(e.description) or used_by(protocol, e),
+            "values": [{"value": v.value, "name": v.name.lower(), "text": cell(v.text) or "—"} for v in e.values],
         }
         for e in protocol.enums
     ]
@@ -565,8 +617,8 @@ def emit_docs(protocol: Protocol) -> str:
             "name": f.name,
             "class_name": f.class_name,
             "anchor": anchor("flags", f.name),
-            "description": text(f.description),
-            "bits": [{"bit": b.bit, "name": b.name.lower(), "text": cell(b.text)} for b in f.bits],
+            "description": text(f.description) or used_by(protocol, f),
+            "bits": [{"bit": b.bit, "name": b.name.lower(), "text": cell(b.text) or "—"} for b in f.bits],
         }
         for f in protocol.flags
     ]
@@ -574,7 +626,7 @@ def emit_docs(protocol: Protocol) -> str:
         {
             "name": e.name,
             "source": text(e.source),
-            "printed": cell(e.printed),
+            "printed": code_span(e.printed),
             "correct": text(e.correct),
             "check": e.check.kind,
         }
@@ -600,7 +652,10 @@ def emit_docs(protocol: Protocol) -> str:
         ],
         serial_notes=text(serial.notes),
         framing=text(protocol.framing.description),
-        frames=[frame_context(protocol, lay) for lays in protocol.framing.alternatives.values() for lay in lays],
+        frames=same_once(
+            [frame_context(protocol, lay) for lays in protocol.framing.alternatives.values() for lay in lays]
+        ),
+        frame_picture=frame_picture(protocol),
         transparency=transparency_text(protocol),
         shared_header=protocol.framing.shared_header,
         checksums=checksums_context(protocol),
@@ -642,6 +697,20 @@ def model_context(device: Device, model: DeviceModel) -> dict[str, Any]:
         "source": text(model.source),
         "rows": rows,
     }
+
+
+def used_by(protocol: Protocol, values: Any) -> str:
+    """Where an enum or flag set is used, for one that has no description of its own."""
+    users = dict.fromkeys(
+        [
+            f"`{m.key}` {m.direction.value} `{f.name}`"
+            for m in protocol.messages()
+            for f in m.fields
+            if isinstance(f, Scalar) and values in (f.enum, f.flags)
+        ]
+        + [f"`{t.name}` entry `{e.name}`" for t in protocol.tables for e in t.entries if values in (e.enum, e.flags)]
+    )
+    return ("Values of " + ", ".join(users) + ".") if users else ""
 
 
 def sign_note(entry: TableEntry) -> str:

@@ -22,7 +22,7 @@ from serialspec.emit.python.pycode import (
 )
 from serialspec.emit.python.registers import register_tables, registers_module
 from serialspec.emit.python.render import render
-from serialspec.emit.python.simulator import simulator_module
+from serialspec.emit.python.simulator import import_order, simulator_module
 from serialspec.emit.python.structs import structs_module
 from serialspec.spec.model import Command, Direction, FrameLayout, Message, Protocol, Scalar, Table, TableValue
 
@@ -193,7 +193,9 @@ def general_codec_context(protocol: Protocol) -> dict[str, Any]:
     headers = [h for d in directions for h in d["headers"]]
     return {
         "classic": False,
-        "framing_imports": framing_imports([line for d in directions for line in d["frames"]]),
+        "framing_imports": sorted(
+            {"EngineFormat", *framing_imports([line for d in directions for line in d["frames"]])}, key=import_order
+        ),
         "checksum_imports": imports,
         "checksum_definitions": definitions,
         "directions": directions,

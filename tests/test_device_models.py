@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from feetech_sms import MODELS
 from feetech_sms.client import FeetechSmsClient
 from feetech_sms.codec import StreamParser, encode
 from feetech_sms.messages import Direction, ResetRequest, WriteRequest
@@ -51,6 +52,7 @@ def test_an_arm_driver_connects_to_six_virtual_sts3215(sdk: Any) -> None:
         assert (result, error) == (SUCCESS, 0)
         model, result, error = sdk.read2ByteTxRx(servo, sms_sts.SMS_STS_MODEL_L)
         assert (model, result, error) == (777, SUCCESS, 0)  # the STS3215's model number
+        assert MODELS[model] == "sts3215"  # the generated package names the models by number
         major, result, _ = sdk.read1ByteTxRx(servo, CONTROL_TABLE["firmware_major"].address)
         minor, _, _ = sdk.read1ByteTxRx(servo, CONTROL_TABLE["firmware_minor"].address)
         assert (major, minor, result) == (3, 10, SUCCESS)
@@ -106,6 +108,13 @@ def test_sim_refuses_a_bad_model_in_one_line(options: list[str], message: str) -
     assert "Traceback" not in result.stderr and len(result.stderr.strip().splitlines()) == 1
 
 
+def test_a_spec_without_models_says_so() -> None:
+    args = [sys.executable, "-m", "serialspec", "sim", str(ROOT / "specs" / "fashionstar_uart.yaml"), "--model", "x"]
+    result = subprocess.run(args, capture_output=True, text=True, timeout=30)
+    assert result.returncode != 0
+    assert result.stderr.strip() == "serialspec sim: --model: unknown model 'x': the spec lists no device models"
+
+
 def test_reset_goes_back_to_the_models_factory_values() -> None:
     simulator = FeetechSmsSimulator([1], model="sts3250")
     device = simulator.devices[1]
@@ -157,3 +166,60 @@ def test_model_mistakes_are_spec_errors(tmp_path: Path) -> None:
     assert any("cw_dead_band = 99 is outside its range 0..32" in line for line in lines), lines
     assert any("unknown model 'sts9999'" in line for line in lines), lines
     assert all(line.startswith("feetech_sms.yaml:") for line in lines), lines
+
+
+def test_behaviour_mistakes_are_spec_errors(tmp_path: Path) -> None:
+    text = (ROOT / "specs" / "fashionstar_uart.yaml").read_text(encoding="utf-8")
+    text = text.replace("stop_on_control_mode: {stops: [angle]}", "stop_on_control_mode: {stops: [angel]}")
+    text = text.replace("begin_async: {every_device: true, sets: {holding: 1}}", "begin_async: {cancel_when: {x: 1}}")
+    text = text.replace("        commands: [rotate, move_by_interval,", "        commands: [rotat, move_by_interval,")
+    text = text.replace("counts: {turns: {state: angle, per: 3600}}}", "counts: {turn: {state: angle, per: 3600}}}")
+    spec = tmp_path / "fashionstar_uart.yaml"
+    spec.write_text(text, encoding="utf-8")
+    with pytest.raises(SpecErrors) as failure:
+        load_protocol(str(spec), "fashionstar_uart.yaml")
+    lines = str(failure.value).splitlines()
+    for expected in (
+        "stops: unknown state variable 'angel'",
+        "cancel_when: `cancel_when` needs `releases`",
+        "cancel_when.x: begin_async has no request field 'x'",
+        "carries.commands: unknown command 'rotat'",
+        "counts.turn: read_mturn_angle has no response field 'turn'",
+    ):
+        assert any(expected in line for line in lines), (expected, lines)
+    assert all(line.startswith("fashionstar_uart.yaml:") for line in lines), lines
+
+
+def test_moving_reads_1_on_the_way_and_0_on_arrival() -> None:
+    now = [0.0]
+    simulator = FeetechSmsSimulator([1], clock=lambda: now[0])
+    goal = CONTROL_TABLE["goal_position"].address
+    simulator.handle(WriteRequest(id=1, address=goal, data=bytes([0x00, 0x08, 0xF4, 0x01])))  # 2048 in 500 ms
+    device = simulator.devices[1]
+    now[0] = 0.25
+    assert (device.get("moving"), device.get("present_position")) == (1, 1024)
+    now[0] = 0.5
+    assert (device.get("moving"), device.get("present_position")) == (0, 2048)
+
+
+def test_a_models_entries_reach_the_docs_and_the_simulator(tmp_path: Path) -> None:
+    """Per-model ranges and units (DYNAMIXEL's XL330 counts current in 1 mA, the XM430 in 2.69 mA) end to end."""
+    from serialspec.emit.markdown.docs import emit_docs
+    from serialspec.emit.python.simulator import simulator_module
+
+    text = (ROOT / "specs" / "feetech_sms.yaml").read_text(encoding="utf-8")
+    text = text.replace(
+        "    sm8512bl:\n      number: 11272\n",
+        "    sm8512bl:\n      number: 11272\n      entries:\n"
+        "        protection_current: {range: [0, 300], unit: 10 mA, scale: 10, description: Its own current steps.}\n",
+    )
+    spec = tmp_path / "feetech_sms.yaml"
+    spec.write_text(text, encoding="utf-8")
+    protocol = load_protocol(str(spec), "feetech_sms.yaml")
+    docs = emit_docs(protocol)
+    assert "| protection_current |  | 0..300 | 10 mA | Its own current steps. |" in docs
+    assert "'protection_current': (0, 300)," in simulator_module(protocol)
+    bad = text.replace("range: [0, 300]", "range: [0, 70000]")
+    spec.write_text(bad, encoding="utf-8")
+    with pytest.raises(SpecErrors, match=r"range \[0, 70000\] does not fit u16"):
+        load_protocol(str(spec), "feetech_sms.yaml")

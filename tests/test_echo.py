@@ -37,7 +37,7 @@ def test_an_echo_client_talks_to_an_echoing_bus(echoing_feetech: str) -> None:
 
 
 def test_a_missing_reply_after_the_echo_is_a_timeout(echoing_feetech: str) -> None:
-    with FeetechSmsClient(echoing_feetech, timeout=0.2, echo=True) as servos:
+    with FeetechSmsClient(echoing_feetech, timeout=0.5, echo=True) as servos:
         with pytest.raises(Timeout):
             servos.read(7, "model_number")  # the echo comes back, no servo 7 answers
         assert servos.ping(1)  # and the bus is fine afterwards
@@ -51,11 +51,12 @@ def test_without_echo_the_client_reads_its_own_request_as_the_reply(echoing_feet
 
 
 def test_the_echo_is_checked_byte_for_byte(plain_feetech: str) -> None:
-    with FeetechSmsClient(plain_feetech, timeout=0.3, echo=True) as servos:
-        with pytest.raises(PortError, match="the echo differs from the bytes written: wrote ff ff 01 04 02 03 02"):
-            servos.read(1, "model_number")  # the reply arrives where the echo should be
-        with pytest.raises(PortError, match="no echo of the 8 bytes written within 0.3 s"):
-            servos.read(9, "model_number")  # nobody answers, nothing echoes
+    differs = pytest.raises(PortError, match="the echo differs from the bytes written: wrote ff ff 01 04 02 03 02")
+    with FeetechSmsClient(plain_feetech, timeout=1.0, echo=True) as servos, differs:
+        servos.read(1, "model_number")  # the reply arrives where the echo should be
+    no_echo = pytest.raises(PortError, match="no echo of the 8 bytes written within 0.3 s")
+    with FeetechSmsClient(plain_feetech, timeout=0.3, echo=True) as servos, no_echo:
+        servos.read(9, "model_number")  # nobody answers, nothing echoes
 
 
 def test_fashion_star_client_with_echo() -> None:

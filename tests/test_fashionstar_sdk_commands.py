@@ -179,37 +179,40 @@ def test_sdk_moves_by_interval_and_by_velocity(sdk: Any) -> None:
 
 
 def test_sdk_multi_turn_angle_turns_and_reset(sdk: Any) -> None:
+    # The SDK's reads wait a fixed 100 ms and keep the last value they saw, so each is polled until it holds the
+    # expected value (a reply that came late is taken by the next read).
     sdk.set_servo_angle(1, 740.5, is_mturn=True, interval=200)
     assert settle(lambda: sdk.query_servo_mturn_angle(1), 740.5) == pytest.approx(740.5)
-    info = sdk.query_servo_monitor(1)
+    assert settle(lambda: sdk.query_servo_monitor(1, realtime=True).turn, 2) == 2
+    info = sdk.servos[1]
     assert (info.angle_monitor, info.turn, info.voltage) == (740.5, 2, 7400)
     sdk.reset_multi_turn_angle(1)
-    assert sdk.query_servo_mturn_angle(1) == pytest.approx(20.5)  # 740.5° less two whole turns
+    assert settle(lambda: sdk.query_servo_mturn_angle(1), 20.5) == pytest.approx(20.5)  # less two whole turns
     sdk.set_origin_point(1)
-    assert sdk.query_servo_mturn_angle(1) == 0.0
+    assert settle(lambda: sdk.query_servo_mturn_angle(1), 0.0) == 0.0
 
 
-def test_sdk_async_holds_moves_until_end_and_cancel_drops_them(sdk: Any) -> None:
-    start = sdk.query_servo_angle(2)
-    sdk.begin_async()
-    sdk.set_servo_angle(2, 10.0, interval=50)
-    time.sleep(0.2)
-    assert sdk.query_servo_angle(2) == start  # held
-    sdk.end_async(0)
-    assert settle(lambda: sdk.query_servo_angle(2), 10.0) == pytest.approx(10.0)
-    sdk.begin_async()
-    sdk.set_servo_angle(2, 20.0, interval=50)
-    sdk.end_async(1)  # cancel
-    time.sleep(0.2)
-    assert sdk.query_servo_angle(2) == pytest.approx(10.0)
+def test_sdk_async_holds_moves_until_end_and_cancel_drops_them(sdk: Any, port: str) -> None:
+    with FashionstarUartClient(port, timeout=1.0) as client:  # reads that wait for their reply
+        start = client.read_angle(2)
+        sdk.begin_async()
+        sdk.set_servo_angle(2, 10.0, interval=50)
+        time.sleep(0.2)
+        assert client.read_angle(2) == start  # held
+        sdk.end_async(0)
+        assert settle(lambda: client.read_angle(2), 100) == 100
+        sdk.begin_async()
+        sdk.set_servo_angle(2, 20.0, interval=50)
+        sdk.end_async(1)  # cancel
+        time.sleep(0.2)
+        assert client.read_angle(2) == 100
 
 
 def test_sdk_sync_monitor_gets_one_reply_per_servo(sdk: Any) -> None:
     sdk.set_servo_angle(3, -12.5, interval=20)
     settle(lambda: sdk.query_servo_angle(3), -12.5)
-    data = sdk.send_sync_servo_monitor([0, 3], realtime=True)
-    assert data[3].angle_monitor == pytest.approx(-12.5)
-    assert (data[0].voltage, data[3].voltage) == (7400, 7400)
+    assert settle(lambda: sdk.send_sync_servo_monitor([0, 3], realtime=True)[3].angle_monitor, -12.5) == -12.5
+    assert (sdk.servos[0].voltage, sdk.servos[3].voltage) == (7400, 7400)
 
 
 def test_sdk_sync_move_reaches_every_listed_servo(port: str) -> None:
@@ -229,16 +232,17 @@ def test_sdk_sync_move_reaches_every_listed_servo(port: str) -> None:
         arm.closePort()
 
 
-def test_sdk_stop_on_control_mode_stops_where_it_is(sdk: Any) -> None:
-    sdk.set_servo_angle(2, 0.0, interval=20)
-    settle(lambda: sdk.query_servo_angle(2), 0.0)
-    sdk.set_servo_angle(2, 170.0, interval=20000)
-    time.sleep(0.2)
-    sdk.stop_on_control_mode(2, 0x11, 500)
-    stopped = sdk.query_servo_angle(2)
-    time.sleep(0.2)
-    assert sdk.query_servo_angle(2) == stopped
-    assert 0.0 < stopped < 170.0
+def test_sdk_stop_on_control_mode_stops_where_it_is(sdk: Any, port: str) -> None:
+    with FashionstarUartClient(port, timeout=1.0) as client:
+        sdk.set_servo_angle(2, 0.0, interval=20)
+        settle(lambda: client.read_angle(2), 0)
+        sdk.set_servo_angle(2, 170.0, interval=20000)
+        time.sleep(0.2)
+        sdk.stop_on_control_mode(2, 0x11, 500)
+        stopped = client.read_angle(2)
+        time.sleep(0.2)
+        assert client.read_angle(2) == stopped
+        assert 0 < stopped < 1700
 
 
 def test_our_client_has_typed_methods_for_the_new_commands(port: str) -> None:
@@ -286,3 +290,24 @@ def test_our_client_carries_typed_requests_in_one_sync_command(port: str) -> Non
             client.sync_command_of([moves[0], fs.MonitorRequest(servo_id=1)])
         with pytest.raises(EncodeError, match="PingRequest cannot be carried"):
             client.sync_command_of([fs.PingRequest(servo_id=1)])
+
+
+def test_the_executing_bit_is_set_while_the_servo_moves() -> None:
+    now = [0.0]
+    simulator = FashionstarUartSimulator([1], clock=lambda: now[0])
+    device = simulator.devices[1]
+    simulator.handle(fs.RotateRequest(servo_id=1, angle=900, interval=1000))
+    now[0] = 0.5
+    assert device.get("servo_status") == fs.ServoStatus.EXECUTING
+    now[0] = 1.0
+    assert device.get("servo_status") == 0
+
+
+def test_a_sync_command_block_that_is_not_a_carried_request_is_ignored() -> None:
+    simulator = FashionstarUartSimulator([1])
+    short = fs.SyncCommandRequest(command=11, blocks=(fs.BlocksItem(content=b"\x01\x02"),))  # 2 of 11 bytes
+    ping = fs.SyncCommandRequest(command=1, blocks=(fs.BlocksItem(content=b"\x01"),))  # not one it carries
+    assert simulator.handle(short) == [] and simulator.handle(ping) == []
+    assert simulator.devices[1].get("angle") == 0
+    monitor = fs.SyncCommandRequest(command=22, blocks=(fs.BlocksItem(content=b"\x01"),))
+    assert [fs.decode(frame, "response").COMMAND for _, frame in simulator.handle(monitor)] == ["monitor"]

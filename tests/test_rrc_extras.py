@@ -119,7 +119,7 @@ def test_stop_and_torque_state_on_the_virtual_board(board: tuple[HiwonderRrcSimu
     assert client.bus_servo.read_torque(1) == 0
     client.bus_servo.set_positions(20000, {1: 900, 2: 100})
     time.sleep(0.2)
-    client.bus_servo.stop((rrc.ServosItem(1),))
+    client.bus_servo.stop([1])  # a plain list of ids for a group of single-field items
     stopped = client.bus_servo.read_position(1)
     time.sleep(0.2)
     assert client.bus_servo.read_position(1) == stopped and 500 < stopped < 900

@@ -24,6 +24,12 @@ BAUDRATE = 57600
 SERIAL = SerialSettings(baudrate=57600, bytesize=8, parity='none', stopbits=1.0)
 #: How a reply is matched to its request (the spec's `matching.by`).
 MATCH_BY: tuple[str, ...] = ('id',)
+#: Device models by the model number they report in `model_number` (the spec's `device.models`).
+MODELS: dict[int, str] = {
+    1020: 'xm430_w350',
+    1060: 'xl430_w250',
+    1200: 'xl330_m288',
+}
 
-__all__ = ["BAUDRATE", "MATCH_BY", "MESSAGE_TYPES", "PROTOCOL", "SERIAL", "SPEC", "Direction", "Message", "StreamParser", "decode", "encode",
+__all__ = ["BAUDRATE", "MATCH_BY", "MESSAGE_TYPES", "MODELS", "PROTOCOL", "SERIAL", "SPEC", "Direction", "Message", "StreamParser", "decode", "encode",
            *_messages]

@@ -262,7 +262,7 @@ class DynamixelP2Client(ClientBase):
             return None
         return True
 
-    def sync_read_raw(self, id: int, address: int, length: int, ids: tuple[IdsItem, ...]) -> dict[int, bytes]:
+    def sync_read_raw(self, id: int, address: int, length: int, ids: tuple[IdsItem, ...] | Sequence[int]) -> dict[int, bytes]:
         """Read the same items of several servos.
 
         Sent to the broadcast id; each listed servo answers in turn, in the order of the ids, with a status packet holding `length` bytes from `address`.
@@ -272,14 +272,16 @@ class DynamixelP2Client(ClientBase):
             address: First control table address to read.
             length: Number of bytes each servo returns. (1..1024)
             ids: The servos to read, in the order they answer.
+            (ids also takes a plain sequence of id values.)
 
         Returns: id -> data of every listed device, in the order they answer.
         """
+        ids = tuple(v if isinstance(v, IdsItem) else IdsItem(id=v) for v in ids)
         request = SyncReadRequest(id=id, address=address, length=length, ids=ids)
         replies = self.bus.request_each(request, StatusResponse, [{'id': item.id} for item in ids])
         return {reply.id: reply.data for reply in replies}
 
-    def fast_sync_read(self, id: int, address: int, length: int, servo_ids: tuple[ServoIdsItem, ...]) -> None:
+    def fast_sync_read(self, id: int, address: int, length: int, servo_ids: tuple[ServoIdsItem, ...] | Sequence[int]) -> None:
         """Read the same items of several servos, answered in one packet.
 
         Like SYNC READ, but the servos answer together in one status packet from the broadcast id: after 0x55 come, for each servo in turn, its error byte, its id, its `length` bytes and two CRC bytes, the last servo's CRC being the packet's. That packet decodes as a `status` whose error byte is the first servo's and whose data holds the rest (id, data, CRC, error, id, data, ...); the simulator does not answer FAST SYNC READ.
@@ -289,9 +291,11 @@ class DynamixelP2Client(ClientBase):
             address: First control table address to read.
             length: Number of bytes each servo returns. (1..1024)
             servo_ids: The servos to read, in the order their parts follow each other.
+            (servo_ids also takes a plain sequence of id values.)
 
         The device does not answer.
         """
+        servo_ids = tuple(v if isinstance(v, ServoIdsItem) else ServoIdsItem(id=v) for v in servo_ids)
         request = FastSyncReadRequest(id=id, address=address, length=length, servo_ids=servo_ids)
         self.bus.send(request)
 

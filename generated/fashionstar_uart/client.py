@@ -427,7 +427,7 @@ class FashionstarUartClient(ClientBase):
     def reset_mturn_angle(self, servo_id: int) -> None:
         """Reset the multi-turn angle.
 
-        The multi-turn count starts again from the angle within one turn. The SDK waits for no reply.
+        The multi-turn count starts again from the angle within one turn (inferred from the name: the SDK sends it and waits for no reply).
 
         Args:
             servo_id: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). (0..254)
@@ -463,6 +463,8 @@ class FashionstarUartClient(ClientBase):
     def monitor(self, servo_id: int) -> MonitorResponse:
         """Read voltage, current, power, temperature, status and multi-turn angle at once.
 
+        The SDK ignores a reply whose angle is -235929599 with turns 0 (outside the multi-turn range: a value that means 'no data', as its sync monitor treats it).
+
         Args:
             servo_id: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). (0..254)
 
@@ -496,7 +498,7 @@ class FashionstarUartClient(ClientBase):
         request = StopOnControlModeRequest(servo_id=servo_id, method=method, power=power)
         self.bus.send(request)
 
-    def sync_command(self, command: int, blocks: tuple[BlocksItem, ...]) -> None:
+    def sync_command(self, command: int, blocks: tuple[BlocksItem, ...] | Sequence[bytes]) -> None:
         """One command for several servos at once.
 
         Carries one command (8, 11..15 or 22) to several servos: its code, the size of one servo's block, the number of servos, then one block per servo holding that command's request content (servo_id first). Each servo acts as if it had got the command alone, and answers as it would: a sync monitor (22) gets one monitor reply per servo, in block order.
@@ -504,9 +506,11 @@ class FashionstarUartClient(ClientBase):
         Args:
             command: The command carried (8, 11..15, or 22 for the monitor).
             blocks: One block per servo.
+            (blocks also takes a plain sequence of content values.)
 
         The device does not answer.
         """
+        blocks = tuple(v if isinstance(v, BlocksItem) else BlocksItem(content=v) for v in blocks)
         request = SyncCommandRequest(command=command, blocks=blocks)
         self.bus.send(request)
 

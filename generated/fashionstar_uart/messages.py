@@ -1319,7 +1319,7 @@ class ReadMturnAngleResponse(Message):
     angle: int
     #: Multi-turn angle in 0.1° steps, up to ±1024 turns (the SDK clamps to ±368640.0°). [0.1°] range -3686400..3686400
     turns: int
-    #: Whole turns in the multi-turn angle (toward zero).
+    #: Whole turns in the multi-turn angle (toward zero). (layout inferred, not documented)
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1453,7 +1453,7 @@ class MonitorResponse(Message):
     angle: int
     #: Multi-turn angle in 0.1° steps, up to ±1024 turns (the SDK clamps to ±368640.0°). [0.1°] range -3686400..3686400
     turns: int
-    #: Whole turns in the multi-turn angle (toward zero).
+    #: Whole turns in the multi-turn angle (toward zero). (layout inferred, not documented)
 
     def to_fields(self) -> dict[str, Any]:
         return {

@@ -4,9 +4,10 @@
 A servo keeps the parameter table in memory (user parameters from their defaults; read-only values from
 `initial`), answers on its servo_id, and moves its present angle linearly to the target of ROTATE over the
 interval (with the commands from the SDK, over a trapezoid of acceleration and deceleration times, or at a
-speed). While BEGIN_ASYNC holds, move commands wait for END_ASYNC. Inferred, not documented: a servo obeys the
-broadcast id 255 for every command without answering (000 only says DAMPING takes 255), and the values the
-simulator starts with (7.4 V, 120 mA, 25 °C and the limits below) are its own choice.
+speed), with servo_status bit 0 (executing) set on the way. While BEGIN_ASYNC holds, move commands wait for
+END_ASYNC. Inferred, not documented: a servo obeys the broadcast id 255 for every command without answering
+(000 only says DAMPING takes 255), and the values the simulator starts with (7.4 V, 120 mA, 25 °C and the
+limits below) are its own choice.
 
 `FashionstarUartSimulator(ids=[1, 2]).start()` serves the devices on a new pseudo-terminal and returns its path;
 `serialspec sim specs/fashionstar_uart.yaml --id 1 --id 2` does the same from the shell. Values are wire units.
@@ -18,7 +19,7 @@ from collections.abc import Callable, Iterable, Mapping
 
 from serialspec.runtime.device import CommandSpec, DeviceSpec, EntrySpec, Simulator
 
-from fashionstar_uart.codec import StreamParser, encode
+from fashionstar_uart.codec import _REQUEST_DECODERS, StreamParser, encode
 from fashionstar_uart.messages import (
     BeginAsyncRequest,
     DampingRequest,
@@ -61,15 +62,6 @@ from fashionstar_uart.messages import (
     WriteBatchDataResponse,
     WriteDataRequest,
     WriteDataResponse,
-)
-from fashionstar_uart.structs import (
-    MonitorRequestContent,
-    MoveByIntervalRequestContent,
-    MoveByVelocityRequestContent,
-    MoveMturnByIntervalRequestContent,
-    MoveMturnByVelocityRequestContent,
-    MoveMturnRequestContent,
-    RotateRequestContent,
 )
 
 __all__ = ["DEVICE", "SIMULATOR", "FashionstarUartSimulator"]
@@ -162,14 +154,15 @@ DEVICE = DeviceSpec(
         # sync_command
         CommandSpec(SyncCommandRequest, None, each='blocks', carries=('command', 'content')),
     ),
+    moving={'servo_status': ('angle', 0)},
     carried={
-        8: (RotateRequest, RotateRequestContent),
-        11: (MoveByIntervalRequest, MoveByIntervalRequestContent),
-        12: (MoveByVelocityRequest, MoveByVelocityRequestContent),
-        13: (MoveMturnRequest, MoveMturnRequestContent),
-        14: (MoveMturnByIntervalRequest, MoveMturnByIntervalRequestContent),
-        15: (MoveMturnByVelocityRequest, MoveMturnByVelocityRequestContent),
-        22: (MonitorRequest, MonitorRequestContent),
+        8: _REQUEST_DECODERS[8],  # RotateRequest
+        11: _REQUEST_DECODERS[11],  # MoveByIntervalRequest
+        12: _REQUEST_DECODERS[12],  # MoveByVelocityRequest
+        13: _REQUEST_DECODERS[13],  # MoveMturnRequest
+        14: _REQUEST_DECODERS[14],  # MoveMturnByIntervalRequest
+        15: _REQUEST_DECODERS[15],  # MoveMturnByVelocityRequest
+        22: _REQUEST_DECODERS[22],  # MonitorRequest
     },
 )
 

@@ -14,7 +14,7 @@ byte is written (RangeError names the field and the range).
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from typing import Any
 
 import serial
@@ -210,7 +210,7 @@ class FeetechSmsClient(ClientBase):
             return None
         return True
 
-    def sync_read_raw(self, id: int, address: int, length: int, ids: tuple[IdsItem, ...]) -> dict[int, bytes]:
+    def sync_read_raw(self, id: int, address: int, length: int, ids: tuple[IdsItem, ...] | Sequence[int]) -> dict[int, bytes]:
         """Read the same registers of several servos.
 
         Sent to the broadcast id; every listed servo answers in turn with an ordinary reply holding `length` bytes from `address`. The length byte is the number of ids + 4, as for any request.
@@ -220,9 +220,11 @@ class FeetechSmsClient(ClientBase):
             address: First register address to read.
             length: Number of bytes each servo returns. (1..250)
             ids: The servos to read, in the order they answer.
+            (ids also takes a plain sequence of id values.)
 
         Returns: id -> data of every listed device, in the order they answer.
         """
+        ids = tuple(v if isinstance(v, IdsItem) else IdsItem(id=v) for v in ids)
         request = SyncReadRequest(id=id, address=address, length=length, ids=ids)
         replies = self.bus.request_each(request, ReplyResponse, [{'id': item.id} for item in ids])
         return {reply.id: reply.data for reply in replies}

@@ -5,7 +5,7 @@ A servo keeps the control table (registers from their defaults, read-only values
 its id, obeys broadcast (254) without answering except to PING, reports its status register (0x41) in the
 error byte of every reply, holds REG WRITE data until ACTION, answers instructions other than READ and PING
 only while response_level is 1, and moves its present position to a written goal position over goal_time (ms),
-or at goal_speed (steps/s) when goal_time is 0.
+or at goal_speed (steps/s) when goal_time is 0; moving (0x42) reads 1 on the way.
 
 `FeetechSmsSimulator(ids=[1, 2]).start()` serves the devices on a new pseudo-terminal and returns its path;
 `serialspec sim specs/feetech_sms.yaml --id 1 --id 2` does the same from the shell. Values are wire units.
@@ -112,6 +112,7 @@ DEVICE = DeviceSpec(
     ),
     registers=CONTROL_TABLE,
     status={'error': 'status'},
+    moving={'moving': ('present_position', None)},
     models=(
         ModelSpec(
             'sts3215',

@@ -13,7 +13,7 @@ byte is written (RangeError names the field and the range).
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from enum import IntEnum
 from typing import Any
 
@@ -316,16 +316,20 @@ class BusServoCommands:
         _check_status(request, reply, 'success', 0)
         return reply.temperature
 
-    def stop(self, servos: tuple[ServosItem, ...]) -> None:
+    def stop(self, servos: tuple[ServosItem, ...] | Sequence[int]) -> None:
         """Stop bus servos where they are.
+
+        That each listed servo stops where it is (and keeps its torque) is inferred from the SDK's name.
 
         Broadcast: Servo id 0xFE reaches every servo; only the ID read (0x12) uses it, with a single servo on the bus.
 
         Args:
             servos: The servos to stop.
+            (servos also takes a plain sequence of servo_id values.)
 
         The device does not answer.
         """
+        servos = tuple(v if isinstance(v, ServosItem) else ServosItem(servo_id=v) for v in servos)
         request = BusServoStopRequest(servos=servos)
         self._client.bus.send(request)
 

@@ -111,7 +111,8 @@ def run(args: argparse.Namespace) -> int:
     try:
         simulator = module.SIMULATOR(ids, **options)
     except ValueError as exc:  # an unknown model or data space, or a model for an id not on the bus
-        raise SerialspecError(f"--model/--size: {exc}") from None
+        option = "--size" if "data space" in str(exc) else "--model"
+        raise SerialspecError(f"{option}: {exc}") from None
     simulator.echo = args.echo
     tap = None
     if args.tap:

@@ -118,6 +118,7 @@ class ListOf(Shape):
     item: Shape
     description: str = ""
     length: int | None = None
+    example: Any = None  # shown in the reference where no spec uses the key
 
     def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
         if not isinstance(value, list):
@@ -136,7 +137,7 @@ class ListOf(Shape):
         }
         if self.length is not None:
             schema["minItems"] = schema["maxItems"] = self.length
-        return schema
+        return _with_default(schema, None, self.example)
 
 
 @dataclass
@@ -788,7 +789,7 @@ DEVICE_COMMAND = Obj(
             Obj(
                 {"state": Str("The state variable (or memory entry)."), "per": Num("The size of one whole unit.")},
                 required=("state", "per"),
-                description="The state variable counted and the size of one whole unit.",
+                description="The state variable counted and the size of one whole unit of it.",
             ),
             "Response field -> how many whole `per` the state variable holds, toward zero (turns of an angle).",
         ),
@@ -848,12 +849,17 @@ MODEL = Obj(
         "entries": MapOf(
             Obj(
                 {
-                    "range": RANGE,
-                    "unit": Str("This model's unit of one wire step, where it differs from the table's."),
-                    "scale": Num("This model's engineering value per wire step, where it differs."),
-                    "description": TEXT,
+                    "range": ListOf(
+                        Num(),
+                        "This model's inclusive [min, max] in wire units, where it differs from the table's.",
+                        length=2,
+                        example=[0, 2000],
+                    ),
+                    "unit": Str("This model's unit of one wire step, where it differs from the table's.", example="mA"),
+                    "scale": Num("This model's engineering value per wire step, where it differs.", example=1),
+                    "description": Str(TEXT.description, example="XL330: 1 mA steps, up to 1750 mA."),
                 },
-                description="Where this model's entry differs from the table's.",
+                description="Where one memory entry of this model differs from the table.",
             ),
             "Memory entry -> where this model's range, unit or scale differs from the table's.",
         ),
@@ -896,6 +902,18 @@ DEVICE = Obj(
             Str(),
             "Response field -> the memory entry every response reports in it (a status byte); field.bit_field -> "
             "an entry whose being non-zero sets that bit field (DYNAMIXEL error.alert: hardware_error_status).",
+        ),
+        "moving": MapOf(
+            Obj(
+                {
+                    "state": Str("The state variable (or memory entry) whose move it reports."),
+                    "bit": Int("Only this bit of the entry reports it (the others keep their value)."),
+                },
+                required=("state",),
+                description="The move an entry reports, as the whole entry or as one bit of it.",
+            ),
+            "Memory entry -> the move it reports: 1 while the state variable moves, 0 once it has arrived (FEETECH "
+            "`moving`); with `bit`, one bit of the entry (Fashion Star servo_status bit 0, executing).",
         ),
         "echo_address": Bool(
             "Replies carry the id the request named (RRC: 0xFE for a broadcast read), not the answering device's own.",

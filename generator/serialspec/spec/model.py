@@ -682,6 +682,7 @@ class Device:
     timeout: DeviceTimeout | None = None
     out_of_range: dict[str, float] = field(default_factory=dict)  # response values when a value is out of range
     models: tuple[DeviceModel, ...] = ()  # the first is the default model
+    moving: dict[str, tuple[str, int | None]] = field(default_factory=dict)  # entry -> (state variable, bit)
     model_entry: str = ""  # the memory entry holding the model number
 
     def behaviour(self, key: str) -> Behaviour | None:

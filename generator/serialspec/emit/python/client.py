@@ -143,6 +143,14 @@ def pair_group(f: Field) -> tuple[Field, Field] | None:
     return (members[0], members[1]) if len(members) == 2 else None
 
 
+def single_group(f: Field) -> Field | None:
+    """The one field of a group item that a plain sequence of values can give, if the item has exactly one."""
+    if not isinstance(f, Group):
+        return None
+    members = [g for g in f.fields if not (isinstance(g, Scalar) and g.hidden)]
+    return members[0] if len(members) == 1 else None
+
+
 def status_fields(message: Message) -> list[Scalar]:
     return [f for f in message.fields if isinstance(f, Scalar) and f.status_ok is not None]
 
@@ -327,6 +335,7 @@ def carry_method(protocol: Protocol, request: Message, imports: set[str]) -> dic
         "item": group.class_name,
         "content_field": content_field,
         "pairs": [],
+        "singles": [],
         "statuses": [],
     }
 
@@ -354,11 +363,18 @@ def client_module(protocol: Protocol) -> str:
             else:
                 trailing = False
         pairs = []
+        singles = []
         for f in fields:
             imports.update(type_names(f))
             default = f" = {defaults[f.name]}" if f.name in defaults else ""
             pair = pair_group(f)
-            if pair is not None:
+            single = single_group(f)
+            if single is not None:
+                assert isinstance(f, Group)
+                imports.update(type_names(single))
+                params.append(f"{f.name}: {annotation(f)} | Sequence[{annotation(single)}]{default}")
+                singles.append({"name": f.name, "item": f.class_name, "field": single.name})
+            elif pair is not None:
                 assert isinstance(f, Group)
                 first, second = pair
                 imports.update(type_names(first) + type_names(second))
@@ -384,6 +400,7 @@ def client_module(protocol: Protocol) -> str:
             f"    ({p['name']} also takes a mapping {{{p['first']}: {p['second']}}}, one entry per item.)"
             for p in pairs
         )
+        doc.extend(f"    ({p['name']} also takes a plain sequence of {p['field']} values.)" for p in singles)
         # An address that can hold the broadcast value makes the reply optional, unless the device answers it anyway.
         may_broadcast = not (behaviour and behaviour.broadcast_reply) and any(
             f.name == address and isinstance(f, Scalar) and broadcast is not None and f.maximum >= broadcast
@@ -463,6 +480,7 @@ def client_module(protocol: Protocol) -> str:
             if table
             else "",
             "pairs": pairs,
+            "singles": singles,
             "statuses": [(f.name, f.status_ok) for f in statuses],
             "each_keys": each_keys,
         }
@@ -551,7 +569,7 @@ def client_module(protocol: Protocol) -> str:
                 ),
                 *(["Sequence"] if any(r["kind"] == "items_read" for r in registers) else []),
                 *(["Iterable"] if any(r["kind"] == "each_read" for r in registers) else []),
-                *(["Sequence"] if any(m["kind"] == "carry" for m in everything) else []),
+                *(["Sequence"] if any(m["kind"] == "carry" or m["singles"] for m in everything) else []),
             }
         ),
     )

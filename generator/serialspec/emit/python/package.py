@@ -112,6 +112,8 @@ def emit_package(protocol: Protocol) -> dict[str, str]:
             serial=protocol.serial,
             gap=repr(protocol.framing.gap) if protocol.framing.gap else "",
             match_by=repr(protocol.matching),
+            models=[(m.number, m.name) for m in protocol.device.models] if protocol.device else [],
+            model_entry=protocol.device.model_entry if protocol.device else "",
         ),
         "client.py": client_module(protocol),
         "py.typed": "",

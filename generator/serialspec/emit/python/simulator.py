@@ -44,15 +44,15 @@ BEHAVIOUR_ARGUMENTS = (
 )
 
 
-def carried_requests(protocol: Protocol) -> list[tuple[int, str, str]]:
-    """(code, request class, construct content) of every request a `carries` behaviour may carry."""
+def carried_requests(protocol: Protocol) -> list[tuple[int, str]]:
+    """(code, request class) of every request a `carries` behaviour may carry."""
     device = protocol.device
     carriers = [b for b in device.behaviours if b.carries] if device else []
     if not carriers:
         return []
     named = {name for b in carriers for name in b.carried}
     return [
-        (c.code, c.request.class_name, c.request.class_name + "Content")
+        (c.code, c.request.class_name)
         for c in protocol.commands
         if c.code is not None and c.request is not None and not c.subcommands and (not named or c.name in named)
     ]
@@ -266,6 +266,7 @@ def simulator_module(protocol: Protocol) -> str:
         commands=commands,
         registers=map_name(device.memory) if device.memory in register_tables(protocol) else "",
         status=repr(device.status) if device.status else "",
+        moving=repr(device.moving) if device.moving else "",
         echo_address=device.echo_address,
         models=[model_data(m) for m in device.models],
         carried=carried_requests(protocol),

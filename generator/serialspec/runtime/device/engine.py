@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import struct
 import threading
 import time
 from collections.abc import Callable, Iterable, Mapping
@@ -11,7 +12,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from serialspec.runtime.device.faults import Fault, FaultInjection
-from serialspec.runtime.errors import EncodeError
+from serialspec.runtime.errors import DecodeError, EncodeError
 from serialspec.runtime.message import Message, compare
 from serialspec.runtime.registers import RegisterMap
 from serialspec.runtime.stream import StreamParser
@@ -165,8 +166,9 @@ class DeviceSpec:
     timeout: TimeoutSpec | None = None
     out_of_range: dict[str, float] = field(default_factory=dict)  # reply values for an out-of-range write
     models: tuple[ModelSpec, ...] = ()  # the first is the default model
-    # command code -> (request class, its construct content struct), for requests carried by another one
-    carried: dict[int, tuple[type[Message], Any]] = field(default_factory=dict)
+    moving: dict[str, tuple[str, int | None]] = field(default_factory=dict)  # entry -> (state variable, bit)
+    # command code -> the codec's decoder of that request's content (buf, start, end), for requests carried by another
+    carried: dict[int, Callable[[bytes, int, int], Message]] = field(default_factory=dict)
 
     def model(self, name: str | None) -> ModelSpec | None:
         """The model of this name (None: the default one); a ValueError names the known models."""
@@ -175,8 +177,9 @@ class DeviceSpec:
         for model in self.models:
             if model.name == name:
                 return model
-        known = ", ".join(m.name for m in self.models) or "none"
-        raise ValueError(f"unknown model {name!r} (expected one of: {known})")
+        if not self.models:
+            raise ValueError(f"unknown model {name!r}: the spec lists no device models")
+        raise ValueError(f"unknown model {name!r} (expected one of: {', '.join(m.name for m in self.models)})")
 
 
 @dataclass
@@ -189,6 +192,9 @@ class _Motion:
     duration: float
     accel: float = 0.0
     decel: float = 0.0
+
+    def active(self, now: float) -> bool:
+        return now < self.began + self.duration
 
     def value(self, now: float) -> float:
         t, total = now - self.began, self.duration
@@ -262,9 +268,15 @@ class VirtualDevice:
         if motion is not None:
             value = motion.value(self.clock())
             return round(value)
-        if name in self.state:
-            return self.state[name]
-        return self.memory[self.by_name[name].key]
+        value = self.state[name] if name in self.state else self.memory[self.by_name[name].key]
+        reports = self.spec.moving.get(name)
+        if reports is None:
+            return value
+        state, bit = reports
+        on_its_way = state in self.motions and self.motions[state].active(self.clock())
+        if bit is None:
+            return float(on_its_way)
+        return float(int(value) | 1 << bit if on_its_way else int(value) & ~(1 << bit))
 
     def set(self, name: str, value: float) -> None:
         self.motions.pop(name, None)
@@ -420,17 +432,15 @@ class Engine(FaultInjection):
 
     def _carried(self, given: dict[str, Any], code_field: str, content_field: str) -> Message | None:
         """The request a sync command carries for one device: its content parsed as that command's request."""
-        found = self.spec.carried.get(int(given[code_field]))
-        if found is None:
+        decoder = self.spec.carried.get(int(given[code_field]))
+        if decoder is None:
             return None  # a command the device does not know: ignored, as a frame of an unknown command would be
-        request, content = found
         data = given[content_field]
+        content = bytes.fromhex(data) if isinstance(data, str) else bytes(data)
         try:
-            parsed = content.parse(bytes.fromhex(data) if isinstance(data, str) else bytes(data))
-            names = [f.name for f in dataclasses.fields(request)]  # type: ignore[arg-type]
-            return request.from_fields({n: parsed[n] for n in names})  # type: ignore[attr-defined, no-any-return]
-        except Exception:  # noqa: BLE001 - a block that does not parse as that request is ignored, like a bad frame
-            return None
+            return decoder(content, 0, len(content))
+        except (DecodeError, ValueError, struct.error):
+            return None  # a block that does not parse as that request is ignored, like a bad frame
 
     def _absent(self, command: CommandSpec, given: dict[str, Any]) -> bytes | None:
         """The reply a bus master gives for an id no device has: the request's fields, `absent` values, else 0."""

@@ -199,6 +199,7 @@ class DevicePass(Pass):
             spaces=tuple(spaces.values()),
             errors=errors,
             models=self.models(value, path, entries, state),
+            moving=self.moving(value, path, entries, state),
             model_entry=str(value.get("model_entry", "")),
         )
 
@@ -297,6 +298,24 @@ class DevicePass(Pass):
                 if name not in entries:
                     self.error((*path, "entries", key), f"unknown memory entry {name!r}")
         return field_name, table
+
+    def moving(
+        self, value: dict[str, Any], path: Path, entries: dict[str, TableEntry], state: dict[str, float]
+    ) -> dict[str, tuple[str, int | None]]:
+        """Entries that report whether a state variable is on its way (a whole entry, or one bit of it)."""
+        found: dict[str, tuple[str, int | None]] = {}
+        for name, item in (value.get("moving") or {}).items():
+            where = (*path, "moving", name)
+            if name not in entries and name not in state:
+                self.error(where, f"unknown memory entry or state variable {name!r}")
+            if item["state"] not in entries and item["state"] not in state:
+                self.error((*where, "state"), f"unknown state variable {item['state']!r}")
+            bit = item.get("bit")
+            entry = entries.get(name)
+            if bit is not None and entry is not None and not 0 <= bit < entry.type.size * 8:
+                self.error((*where, "bit"), f"bit {bit} is outside {name}'s {entry.type.size * 8} bits")
+            found[str(name)] = (str(item["state"]), None if bit is None else int(bit))
+        return found
 
     def behaviour_extras(
         self,

@@ -65,13 +65,14 @@ def test_goal_position_moves_with_torque_and_profile_velocity(client: DynamixelP
     assert client.write(1, torque_enable=1) is True
     assert client.write(1, goal_position=1000) is True
     assert client.read(1, "present_position") == 1000  # profile velocity 0: at once
-    assert client.write(1, profile_velocity=1000) is True  # 1000 x 0.229 rev/min: about 15,600 pulses/s
+    assert client.write(1, profile_velocity=100) is True  # 100 x 0.229 rev/min: about 1,560 pulses/s
     assert client.write(1, goal_position=4000) is True
-    first = client.read(1, "present_position")
-    deadline = time.monotonic() + 3
+    first = client.read_many(1, "moving", "moving_status")["moving"]
+    deadline = time.monotonic() + 6
     while client.read(1, "present_position") != 4000 and time.monotonic() < deadline:
         time.sleep(0.02)
-    assert 1000 <= first <= 4000 and client.read(1, "present_position") == 4000
+    assert client.read(1, "present_position") == 4000
+    assert (first, client.read(1, "moving")) == (1, 0)  # 1 on the way (about 2 s), 0 once there
 
 
 def test_sync_read_and_write_by_name(client: DynamixelP2Client) -> None:
@@ -97,3 +98,10 @@ def test_bulk_read_and_write_by_name(client: DynamixelP2Client) -> None:
         2: {"led": 1},
         3: {"model_number": 1020, "model_information": 0},
     }
+
+
+def test_action_without_reg_write_is_an_instruction_error(client: DynamixelP2Client) -> None:
+    with pytest.raises(DeviceError, match="instruction_error"):
+        client.action(2)
+    assert client.reg_write(2, led=1) is True
+    assert client.action(2) is True

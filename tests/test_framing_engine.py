@@ -243,3 +243,17 @@ def test_escaped_frames_round_trip(data: bytes, code: int) -> None:
 def test_lone_escape_is_refused() -> None:
     with pytest.raises(DecodeError, match="stuffing"):
         SLIP.unwrap(b"\x01\xdb\x00\x01\xc0")
+
+
+def test_monitor_pairs_requests_with_the_reply_layout_they_get() -> None:
+    from serialspec.cli.frames import Frames
+
+    frames = Frames(dynamixel_p2, None, "id")  # both directions in one stream, shared header: paired
+    ping, reply = (
+        bytes.fromhex("FF FF FD 00 01 03 00 01 19 4E"),
+        bytes.fromhex("FF FF FD 00 01 07 00 55 00 06 04 26 65 5D"),
+    )
+    read = bytes.fromhex("FF FF FD 00 01 07 00 02 84 00 04 00 1D 15")
+    status = bytes.fromhex("FF FF FD 00 01 08 00 55 00 A6 00 00 00 8C C0")
+    seen = frames.feed(ping + reply + read[:5]) + frames.feed(read[5:] + status)
+    assert [type(s.message).__name__ for s in seen] == ["PingRequest", "PingResponse", "ReadRequest", "StatusResponse"]

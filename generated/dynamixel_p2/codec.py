@@ -320,7 +320,7 @@ def _decode_status_response(buf: bytes, o: int, end: int, id: int, error: int) -
 def _encode_ping_request(m: PingRequest) -> bytes:
     if not (0 <= m.id <= 252 or m.id == 254):
         raise out_of_range('ping request', 'id', m.id, 0, 252)
-    return _REQUEST_FRAMES.wrap(b'', 1, (m.id,))
+    return _REQUEST_FRAMES.wrap(b'', 0x01, (m.id,))
 
 
 def _encode_ping_response(m: PingResponse) -> bytes:
@@ -344,7 +344,7 @@ def _encode_read_request(m: ReadRequest) -> bytes:
         raise out_of_range('read request', 'address', m.address, 0, 65535)
     if not 1 <= m.length <= 1024:
         raise out_of_range('read request', 'length', m.length, 1, 1024)
-    return _REQUEST_FRAMES.wrap(_S_U16_U16.pack(m.address, m.length), 2, (m.id,))
+    return _REQUEST_FRAMES.wrap(_S_U16_U16.pack(m.address, m.length), 0x02, (m.id,))
 
 
 def _encode_write_request(m: WriteRequest) -> bytes:
@@ -352,7 +352,7 @@ def _encode_write_request(m: WriteRequest) -> bytes:
         raise out_of_range('write request', 'id', m.id, 0, 252)
     if not 0 <= m.address <= 65535:
         raise out_of_range('write request', 'address', m.address, 0, 65535)
-    return _REQUEST_FRAMES.wrap(b''.join((_S_U16.pack(m.address), bytes(m.data),)), 3, (m.id,))
+    return _REQUEST_FRAMES.wrap(b''.join((_S_U16.pack(m.address), bytes(m.data),)), 0x03, (m.id,))
 
 
 def _encode_reg_write_request(m: RegWriteRequest) -> bytes:
@@ -360,13 +360,13 @@ def _encode_reg_write_request(m: RegWriteRequest) -> bytes:
         raise out_of_range('reg_write request', 'id', m.id, 0, 252)
     if not 0 <= m.address <= 65535:
         raise out_of_range('reg_write request', 'address', m.address, 0, 65535)
-    return _REQUEST_FRAMES.wrap(b''.join((_S_U16.pack(m.address), bytes(m.data),)), 4, (m.id,))
+    return _REQUEST_FRAMES.wrap(b''.join((_S_U16.pack(m.address), bytes(m.data),)), 0x04, (m.id,))
 
 
 def _encode_action_request(m: ActionRequest) -> bytes:
     if not (0 <= m.id <= 252 or m.id == 254):
         raise out_of_range('action request', 'id', m.id, 0, 252)
-    return _REQUEST_FRAMES.wrap(b'', 5, (m.id,))
+    return _REQUEST_FRAMES.wrap(b'', 0x05, (m.id,))
 
 
 def _encode_factory_reset_request(m: FactoryResetRequest) -> bytes:
@@ -374,13 +374,13 @@ def _encode_factory_reset_request(m: FactoryResetRequest) -> bytes:
         raise out_of_range('factory_reset request', 'id', m.id, 0, 252)
     if not 0 <= m.option <= 255:
         raise out_of_range('factory_reset request', 'option', m.option, 0, 255)
-    return _REQUEST_FRAMES.wrap(_S_U8.pack(m.option), 6, (m.id,))
+    return _REQUEST_FRAMES.wrap(_S_U8.pack(m.option), 0x06, (m.id,))
 
 
 def _encode_reboot_request(m: RebootRequest) -> bytes:
     if not (0 <= m.id <= 252 or m.id == 254):
         raise out_of_range('reboot request', 'id', m.id, 0, 252)
-    return _REQUEST_FRAMES.wrap(b'', 8, (m.id,))
+    return _REQUEST_FRAMES.wrap(b'', 0x08, (m.id,))
 
 
 def _encode_clear_request(m: ClearRequest) -> bytes:
@@ -388,7 +388,7 @@ def _encode_clear_request(m: ClearRequest) -> bytes:
         raise out_of_range('clear request', 'id', m.id, 0, 252)
     if not 0 <= m.option <= 255:
         raise out_of_range('clear request', 'option', m.option, 0, 255)
-    return _REQUEST_FRAMES.wrap(_S_U8_U32.pack(m.option, 575428676), 16, (m.id,))
+    return _REQUEST_FRAMES.wrap(_S_U8_U32.pack(m.option, 575428676), 0x10, (m.id,))
 
 
 def _encode_sync_read_request(m: SyncReadRequest) -> bytes:
@@ -403,7 +403,7 @@ def _encode_sync_read_request(m: SyncReadRequest) -> bytes:
         if not 0 <= item.id <= 252:
             raise out_of_range('sync_read request', 'id', item.id, 0, 252)
         parts_ids.append(_S_U8.pack(item.id))
-    return _REQUEST_FRAMES.wrap(b''.join((_S_U16_U16.pack(m.address, m.length), b''.join(parts_ids),)), 130, (m.id,))
+    return _REQUEST_FRAMES.wrap(b''.join((_S_U16_U16.pack(m.address, m.length), b''.join(parts_ids),)), 0x82, (m.id,))
 
 
 def _encode_fast_sync_read_request(m: FastSyncReadRequest) -> bytes:
@@ -418,7 +418,7 @@ def _encode_fast_sync_read_request(m: FastSyncReadRequest) -> bytes:
         if not 0 <= item.id <= 252:
             raise out_of_range('fast_sync_read request', 'id', item.id, 0, 252)
         parts_servo_ids.append(_S_U8.pack(item.id))
-    return _REQUEST_FRAMES.wrap(b''.join((_S_U16_U16.pack(m.address, m.length), b''.join(parts_servo_ids),)), 138, (m.id,))
+    return _REQUEST_FRAMES.wrap(b''.join((_S_U16_U16.pack(m.address, m.length), b''.join(parts_servo_ids),)), 0x8a, (m.id,))
 
 
 def _encode_sync_write_request(m: SyncWriteRequest) -> bytes:
@@ -436,7 +436,7 @@ def _encode_sync_write_request(m: SyncWriteRequest) -> bytes:
         if not 0 <= item.id <= 252:
             raise out_of_range('sync_write request', 'id', item.id, 0, 252)
         parts_servos.append(b''.join((_S_U8.pack(item.id), bytes(item.data),)))
-    return _REQUEST_FRAMES.wrap(b''.join((_S_U16_U16.pack(m.address, v_length), b''.join(parts_servos),)), 131, (m.id,))
+    return _REQUEST_FRAMES.wrap(b''.join((_S_U16_U16.pack(m.address, v_length), b''.join(parts_servos),)), 0x83, (m.id,))
 
 
 def _encode_bulk_read_request(m: BulkReadRequest) -> bytes:
@@ -451,7 +451,7 @@ def _encode_bulk_read_request(m: BulkReadRequest) -> bytes:
         if not 1 <= item.length <= 1024:
             raise out_of_range('bulk_read request', 'length', item.length, 1, 1024)
         parts_reads.append(_S_U8_U16_U16.pack(item.id, item.address, item.length))
-    return _REQUEST_FRAMES.wrap(b''.join(parts_reads), 146, (m.id,))
+    return _REQUEST_FRAMES.wrap(b''.join(parts_reads), 0x92, (m.id,))
 
 
 def _encode_bulk_write_request(m: BulkWriteRequest) -> bytes:
@@ -466,7 +466,7 @@ def _encode_bulk_write_request(m: BulkWriteRequest) -> bytes:
         if len(item.data) > 65535:
             raise out_of_range('bulk_write request', 'length', len(item.data), 0, 65535)
         parts_writes.append(b''.join((_S_U8_U16_U16.pack(item.id, item.address, len(item.data)), bytes(item.data),)))
-    return _REQUEST_FRAMES.wrap(b''.join(parts_writes), 147, (m.id,))
+    return _REQUEST_FRAMES.wrap(b''.join(parts_writes), 0x93, (m.id,))
 
 
 def _encode_status_response(m: StatusResponse) -> bytes:
@@ -509,7 +509,21 @@ _REQUEST_FRAMES = FrameCodec(
             ((b'\xff\xff\xfd', b'\xff\xff\xfd\xfd'),),
         )),
     ),
-    {0x01: (0, 0), 0x02: (4, 4), 0x03: (2, None), 0x04: (2, None), 0x05: (0, 0), 0x06: (1, 1), 0x08: (0, 0), 0x10: (5, 5), 0x82: (4, None), 0x8a: (4, None), 0x83: (4, None), 0x92: (0, None), 0x93: (0, None)},
+    {
+        0x01: (0, 0),
+        0x02: (4, 4),
+        0x03: (2, None),
+        0x04: (2, None),
+        0x05: (0, 0),
+        0x06: (1, 1),
+        0x08: (0, 0),
+        0x10: (5, 5),
+        0x82: (4, None),
+        0x8a: (4, None),
+        0x83: (4, None),
+        0x92: (0, None),
+        0x93: (0, None),
+    },
 )
 
 
@@ -547,7 +561,9 @@ _RESPONSE_FRAMES = FrameCodec(
             ((b'\xff\xff\xfd', b'\xff\xff\xfd\xfd'),),
         )),
     ),
-    {None: (0, None)},
+    {
+        None: (0, None),
+    },
 )
 
 
@@ -611,6 +627,11 @@ def encode(message: Message) -> bytes:
 # Each direction's frames for code that splits a stream of both directions (serialspec monitor).
 REQUEST_FORMAT = EngineFormat(_REQUEST_FRAMES, _decode_request)
 RESPONSE_FORMAT = EngineFormat(_RESPONSE_FRAMES, _decode_response)
+
+# The reply layout a request gets where it is not the default one of replies that share a code.
+REPLY_LAYOUTS: dict[type[Message], type[Message]] = {
+    PingRequest: PingResponse,
+}
 
 
 class StreamParser(_FrameStreamParser):

@@ -6,9 +6,9 @@ id and obeys the broadcast id 254 without answering, except to PING (and, item b
 READ). PING is always answered; READ while status_return_level ≥ 1; every other instruction only while it is
 2. Writing a read-only or unknown item gives the access error (7), a value outside an item's range the data
 range error (4); the alert bit reports a non-zero hardware_error_status. REG WRITE holds its data (and sets
-registered_instruction) until ACTION; writing the id moves the servo to its new id. With the torque on, a new
-goal_position moves present_position at profile_velocity (at once when it is 0). The firmware version 52 is an
-example, not a documented value.
+registered_instruction) until ACTION (an ACTION with nothing held gets the instruction error, 2); writing the
+id moves the servo to its new id. With the torque on, a new goal_position moves present_position at
+profile_velocity (at once when it is 0). The firmware version 52 is an example, not a documented value.
 
 `DynamixelP2Simulator(ids=[1, 2]).start()` serves the devices on a new pseudo-terminal and returns its path;
 `serialspec sim specs/dynamixel_p2.yaml --id 1 --id 2` does the same from the shell. Values are wire units.
@@ -173,7 +173,7 @@ DEVICE = DeviceSpec(
         # reg_write
         CommandSpec(RegWriteRequest, StatusResponse, writes=('data',), sets={'registered_instruction': 1.0}, buffered=True, optional_when=(68, 2, '>='), tables={'data': ('run', 'address', '')}),
         # action
-        CommandSpec(ActionRequest, StatusResponse, moves=('present_position', 'goal_position', '', 'profile_velocity'), speed_scale=15.6331, move_enabled_by='torque_enable', sets={'registered_instruction': 0.0}, commits=True, optional_when=(68, 2, '>='), tables={'data': ('run', 'address', 'length')}),
+        CommandSpec(ActionRequest, StatusResponse, moves=('present_position', 'goal_position', '', 'profile_velocity'), speed_scale=15.6331, move_enabled_by='torque_enable', sets={'registered_instruction': 0.0}, commits=True, nothing_held={'error.number': 2.0}, optional_when=(68, 2, '>='), tables={'data': ('run', 'address', 'length')}),
         # factory_reset
         CommandSpec(FactoryResetRequest, StatusResponse, resets=True, keeps=('option', {1: ('id',), 2: ('id', 'baud_rate'), 255: ()}), optional_when=(68, 2, '>='), tables={'data': ('run', 'address', 'length')}),
         # reboot
@@ -193,6 +193,7 @@ DEVICE = DeviceSpec(
     ),
     registers=CONTROL_TABLE,
     status={'error.alert': 'hardware_error_status'},
+    moving={'moving': ('present_position', None)},
     models=(
         ModelSpec(
             'xm430_w350',

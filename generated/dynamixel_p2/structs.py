@@ -57,7 +57,8 @@ _REQUEST_FRAMES = FrameCodec(
             ((b'\xff\xff\xfd', b'\xff\xff\xfd\xfd'),),
         )),
     ),
-    {},
+    {
+    },
 )
 
 _RESPONSE_FRAMES = FrameCodec(
@@ -76,7 +77,8 @@ _RESPONSE_FRAMES = FrameCodec(
             ((b'\xff\xff\xfd', b'\xff\xff\xfd\xfd'),),
         )),
     ),
-    {},
+    {
+    },
 )
 
 

@@ -424,7 +424,7 @@ def _encode_read_coils_request(m: ReadCoilsRequest) -> bytes:
         raise out_of_range('read_coils request', 'address', m.address, 0, 65535)
     if not 1 <= m.count <= 2000:
         raise out_of_range('read_coils request', 'count', m.count, 1, 2000)
-    return _REQUEST_FRAMES.wrap(_S_BE_U16_U16.pack(m.address, m.count), 1, (m.unit,))
+    return _REQUEST_FRAMES.wrap(_S_BE_U16_U16.pack(m.address, m.count), 0x01, (m.unit,))
 
 
 def _encode_read_coils_response(m: ReadCoilsResponse) -> bytes:
@@ -433,7 +433,7 @@ def _encode_read_coils_response(m: ReadCoilsResponse) -> bytes:
     v_byte_count = (-(-len(m.coils) // 8))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('read_coils response', 'byte_count', v_byte_count, 0, 255)
-    return _RESPONSE_FRAMES.wrap(b''.join((_S_BE_U8.pack(v_byte_count), _pack_bits(m.coils, 'coils', 'read_coils response'),)), 1, (m.unit,))
+    return _RESPONSE_FRAMES.wrap(b''.join((_S_BE_U8.pack(v_byte_count), _pack_bits(m.coils, 'coils', 'read_coils response'),)), 0x01, (m.unit,))
 
 
 def _encode_read_discrete_inputs_request(m: ReadDiscreteInputsRequest) -> bytes:
@@ -443,7 +443,7 @@ def _encode_read_discrete_inputs_request(m: ReadDiscreteInputsRequest) -> bytes:
         raise out_of_range('read_discrete_inputs request', 'address', m.address, 0, 65535)
     if not 1 <= m.count <= 2000:
         raise out_of_range('read_discrete_inputs request', 'count', m.count, 1, 2000)
-    return _REQUEST_FRAMES.wrap(_S_BE_U16_U16.pack(m.address, m.count), 2, (m.unit,))
+    return _REQUEST_FRAMES.wrap(_S_BE_U16_U16.pack(m.address, m.count), 0x02, (m.unit,))
 
 
 def _encode_read_discrete_inputs_response(m: ReadDiscreteInputsResponse) -> bytes:
@@ -452,7 +452,7 @@ def _encode_read_discrete_inputs_response(m: ReadDiscreteInputsResponse) -> byte
     v_byte_count = (-(-len(m.inputs) // 8))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('read_discrete_inputs response', 'byte_count', v_byte_count, 0, 255)
-    return _RESPONSE_FRAMES.wrap(b''.join((_S_BE_U8.pack(v_byte_count), _pack_bits(m.inputs, 'inputs', 'read_discrete_inputs response'),)), 2, (m.unit,))
+    return _RESPONSE_FRAMES.wrap(b''.join((_S_BE_U8.pack(v_byte_count), _pack_bits(m.inputs, 'inputs', 'read_discrete_inputs response'),)), 0x02, (m.unit,))
 
 
 def _encode_read_holding_registers_request(m: ReadHoldingRegistersRequest) -> bytes:
@@ -462,7 +462,7 @@ def _encode_read_holding_registers_request(m: ReadHoldingRegistersRequest) -> by
         raise out_of_range('read_holding_registers request', 'address', m.address, 0, 65535)
     if not 1 <= m.count <= 125:
         raise out_of_range('read_holding_registers request', 'count', m.count, 1, 125)
-    return _REQUEST_FRAMES.wrap(_S_BE_U16_U16.pack(m.address, m.count), 3, (m.unit,))
+    return _REQUEST_FRAMES.wrap(_S_BE_U16_U16.pack(m.address, m.count), 0x03, (m.unit,))
 
 
 def _encode_read_holding_registers_response(m: ReadHoldingRegistersResponse) -> bytes:
@@ -473,7 +473,7 @@ def _encode_read_holding_registers_response(m: ReadHoldingRegistersResponse) -> 
         raise out_of_range('read_holding_registers response', 'byte_count', v_byte_count, 0, 255)
     if any(not 0 <= x <= 65535 for x in m.registers):
         raise out_of_range('read_holding_registers response', 'registers', m.registers, 0, 65535)
-    return _RESPONSE_FRAMES.wrap(b''.join((_S_BE_U8.pack(v_byte_count), struct.pack(f'>{len(m.registers)}H', *m.registers),)), 3, (m.unit,))
+    return _RESPONSE_FRAMES.wrap(b''.join((_S_BE_U8.pack(v_byte_count), struct.pack(f'>{len(m.registers)}H', *m.registers),)), 0x03, (m.unit,))
 
 
 def _encode_read_input_registers_request(m: ReadInputRegistersRequest) -> bytes:
@@ -483,7 +483,7 @@ def _encode_read_input_registers_request(m: ReadInputRegistersRequest) -> bytes:
         raise out_of_range('read_input_registers request', 'address', m.address, 0, 65535)
     if not 1 <= m.count <= 125:
         raise out_of_range('read_input_registers request', 'count', m.count, 1, 125)
-    return _REQUEST_FRAMES.wrap(_S_BE_U16_U16.pack(m.address, m.count), 4, (m.unit,))
+    return _REQUEST_FRAMES.wrap(_S_BE_U16_U16.pack(m.address, m.count), 0x04, (m.unit,))
 
 
 def _encode_read_input_registers_response(m: ReadInputRegistersResponse) -> bytes:
@@ -494,7 +494,7 @@ def _encode_read_input_registers_response(m: ReadInputRegistersResponse) -> byte
         raise out_of_range('read_input_registers response', 'byte_count', v_byte_count, 0, 255)
     if any(not 0 <= x <= 65535 for x in m.registers):
         raise out_of_range('read_input_registers response', 'registers', m.registers, 0, 65535)
-    return _RESPONSE_FRAMES.wrap(b''.join((_S_BE_U8.pack(v_byte_count), struct.pack(f'>{len(m.registers)}H', *m.registers),)), 4, (m.unit,))
+    return _RESPONSE_FRAMES.wrap(b''.join((_S_BE_U8.pack(v_byte_count), struct.pack(f'>{len(m.registers)}H', *m.registers),)), 0x04, (m.unit,))
 
 
 def _encode_write_coil_request(m: WriteCoilRequest) -> bytes:
@@ -504,7 +504,7 @@ def _encode_write_coil_request(m: WriteCoilRequest) -> bytes:
         raise out_of_range('write_coil request', 'address', m.address, 0, 65535)
     if not 0 <= m.value <= 65535:
         raise out_of_range('write_coil request', 'value', m.value, 0, 65535)
-    return _REQUEST_FRAMES.wrap(_S_BE_U16_U16.pack(m.address, m.value), 5, (m.unit,))
+    return _REQUEST_FRAMES.wrap(_S_BE_U16_U16.pack(m.address, m.value), 0x05, (m.unit,))
 
 
 def _encode_write_coil_response(m: WriteCoilResponse) -> bytes:
@@ -514,7 +514,7 @@ def _encode_write_coil_response(m: WriteCoilResponse) -> bytes:
         raise out_of_range('write_coil response', 'address', m.address, 0, 65535)
     if not 0 <= m.value <= 65535:
         raise out_of_range('write_coil response', 'value', m.value, 0, 65535)
-    return _RESPONSE_FRAMES.wrap(_S_BE_U16_U16.pack(m.address, m.value), 5, (m.unit,))
+    return _RESPONSE_FRAMES.wrap(_S_BE_U16_U16.pack(m.address, m.value), 0x05, (m.unit,))
 
 
 def _encode_write_register_request(m: WriteRegisterRequest) -> bytes:
@@ -524,7 +524,7 @@ def _encode_write_register_request(m: WriteRegisterRequest) -> bytes:
         raise out_of_range('write_register request', 'address', m.address, 0, 65535)
     if not 0 <= m.value <= 65535:
         raise out_of_range('write_register request', 'value', m.value, 0, 65535)
-    return _REQUEST_FRAMES.wrap(_S_BE_U16_U16.pack(m.address, m.value), 6, (m.unit,))
+    return _REQUEST_FRAMES.wrap(_S_BE_U16_U16.pack(m.address, m.value), 0x06, (m.unit,))
 
 
 def _encode_write_register_response(m: WriteRegisterResponse) -> bytes:
@@ -534,7 +534,7 @@ def _encode_write_register_response(m: WriteRegisterResponse) -> bytes:
         raise out_of_range('write_register response', 'address', m.address, 0, 65535)
     if not 0 <= m.value <= 65535:
         raise out_of_range('write_register response', 'value', m.value, 0, 65535)
-    return _RESPONSE_FRAMES.wrap(_S_BE_U16_U16.pack(m.address, m.value), 6, (m.unit,))
+    return _RESPONSE_FRAMES.wrap(_S_BE_U16_U16.pack(m.address, m.value), 0x06, (m.unit,))
 
 
 def _encode_write_coils_request(m: WriteCoilsRequest) -> bytes:
@@ -548,7 +548,7 @@ def _encode_write_coils_request(m: WriteCoilsRequest) -> bytes:
     v_byte_count = (-(-(len(m.values)) // 8))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('write_coils request', 'byte_count', v_byte_count, 0, 255)
-    return _REQUEST_FRAMES.wrap(b''.join((_S_BE_U16_U16_U8.pack(m.address, v_count, v_byte_count), _pack_bits(m.values, 'values', 'write_coils request'),)), 15, (m.unit,))
+    return _REQUEST_FRAMES.wrap(b''.join((_S_BE_U16_U16_U8.pack(m.address, v_count, v_byte_count), _pack_bits(m.values, 'values', 'write_coils request'),)), 0x0f, (m.unit,))
 
 
 def _encode_write_coils_response(m: WriteCoilsResponse) -> bytes:
@@ -558,7 +558,7 @@ def _encode_write_coils_response(m: WriteCoilsResponse) -> bytes:
         raise out_of_range('write_coils response', 'address', m.address, 0, 65535)
     if not 0 <= m.count <= 65535:
         raise out_of_range('write_coils response', 'count', m.count, 0, 65535)
-    return _RESPONSE_FRAMES.wrap(_S_BE_U16_U16.pack(m.address, m.count), 15, (m.unit,))
+    return _RESPONSE_FRAMES.wrap(_S_BE_U16_U16.pack(m.address, m.count), 0x0f, (m.unit,))
 
 
 def _encode_write_registers_request(m: WriteRegistersRequest) -> bytes:
@@ -574,7 +574,7 @@ def _encode_write_registers_request(m: WriteRegistersRequest) -> bytes:
         raise out_of_range('write_registers request', 'byte_count', v_byte_count, 0, 255)
     if any(not 0 <= x <= 65535 for x in m.values):
         raise out_of_range('write_registers request', 'values', m.values, 0, 65535)
-    return _REQUEST_FRAMES.wrap(b''.join((_S_BE_U16_U16_U8.pack(m.address, v_count, v_byte_count), struct.pack(f'>{len(m.values)}H', *m.values),)), 16, (m.unit,))
+    return _REQUEST_FRAMES.wrap(b''.join((_S_BE_U16_U16_U8.pack(m.address, v_count, v_byte_count), struct.pack(f'>{len(m.values)}H', *m.values),)), 0x10, (m.unit,))
 
 
 def _encode_write_registers_response(m: WriteRegistersResponse) -> bytes:
@@ -584,7 +584,7 @@ def _encode_write_registers_response(m: WriteRegistersResponse) -> bytes:
         raise out_of_range('write_registers response', 'address', m.address, 0, 65535)
     if not 0 <= m.count <= 65535:
         raise out_of_range('write_registers response', 'count', m.count, 0, 65535)
-    return _RESPONSE_FRAMES.wrap(_S_BE_U16_U16.pack(m.address, m.count), 16, (m.unit,))
+    return _RESPONSE_FRAMES.wrap(_S_BE_U16_U16.pack(m.address, m.count), 0x10, (m.unit,))
 
 
 def _encode_mask_write_register_request(m: MaskWriteRegisterRequest) -> bytes:
@@ -596,7 +596,7 @@ def _encode_mask_write_register_request(m: MaskWriteRegisterRequest) -> bytes:
         raise out_of_range('mask_write_register request', 'and_mask', m.and_mask, 0, 65535)
     if not 0 <= m.or_mask <= 65535:
         raise out_of_range('mask_write_register request', 'or_mask', m.or_mask, 0, 65535)
-    return _REQUEST_FRAMES.wrap(_S_BE_U16_U16_U16.pack(m.address, m.and_mask, m.or_mask), 22, (m.unit,))
+    return _REQUEST_FRAMES.wrap(_S_BE_U16_U16_U16.pack(m.address, m.and_mask, m.or_mask), 0x16, (m.unit,))
 
 
 def _encode_mask_write_register_response(m: MaskWriteRegisterResponse) -> bytes:
@@ -608,7 +608,7 @@ def _encode_mask_write_register_response(m: MaskWriteRegisterResponse) -> bytes:
         raise out_of_range('mask_write_register response', 'and_mask', m.and_mask, 0, 65535)
     if not 0 <= m.or_mask <= 65535:
         raise out_of_range('mask_write_register response', 'or_mask', m.or_mask, 0, 65535)
-    return _RESPONSE_FRAMES.wrap(_S_BE_U16_U16_U16.pack(m.address, m.and_mask, m.or_mask), 22, (m.unit,))
+    return _RESPONSE_FRAMES.wrap(_S_BE_U16_U16_U16.pack(m.address, m.and_mask, m.or_mask), 0x16, (m.unit,))
 
 
 def _encode_read_write_registers_request(m: ReadWriteRegistersRequest) -> bytes:
@@ -628,7 +628,7 @@ def _encode_read_write_registers_request(m: ReadWriteRegistersRequest) -> bytes:
         raise out_of_range('read_write_registers request', 'byte_count', v_byte_count, 0, 255)
     if any(not 0 <= x <= 65535 for x in m.values):
         raise out_of_range('read_write_registers request', 'values', m.values, 0, 65535)
-    return _REQUEST_FRAMES.wrap(b''.join((_S_BE_U16_U16_U16_U16_U8.pack(m.read_address, m.read_count, m.write_address, v_write_count, v_byte_count), struct.pack(f'>{len(m.values)}H', *m.values),)), 23, (m.unit,))
+    return _REQUEST_FRAMES.wrap(b''.join((_S_BE_U16_U16_U16_U16_U8.pack(m.read_address, m.read_count, m.write_address, v_write_count, v_byte_count), struct.pack(f'>{len(m.values)}H', *m.values),)), 0x17, (m.unit,))
 
 
 def _encode_read_write_registers_response(m: ReadWriteRegistersResponse) -> bytes:
@@ -639,7 +639,7 @@ def _encode_read_write_registers_response(m: ReadWriteRegistersResponse) -> byte
         raise out_of_range('read_write_registers response', 'byte_count', v_byte_count, 0, 255)
     if any(not 0 <= x <= 65535 for x in m.registers):
         raise out_of_range('read_write_registers response', 'registers', m.registers, 0, 65535)
-    return _RESPONSE_FRAMES.wrap(b''.join((_S_BE_U8.pack(v_byte_count), struct.pack(f'>{len(m.registers)}H', *m.registers),)), 23, (m.unit,))
+    return _RESPONSE_FRAMES.wrap(b''.join((_S_BE_U8.pack(v_byte_count), struct.pack(f'>{len(m.registers)}H', *m.registers),)), 0x17, (m.unit,))
 
 
 def _encode_exception_response(m: ExceptionResponse) -> bytes:
@@ -673,7 +673,18 @@ _REQUEST_FRAMES = FrameCodec(
             Element('crc', 'checksum', 2, span=(0, 2), checksum=_CHECK_CRC),
         )),
     ),
-    {0x01: (4, 4), 0x02: (4, 4), 0x03: (4, 4), 0x04: (4, 4), 0x05: (4, 4), 0x06: (4, 4), 0x0f: (5, 251), 0x10: (5, 251), 0x16: (6, 6), 0x17: (9, 251)},
+    {
+        0x01: (4, 4),
+        0x02: (4, 4),
+        0x03: (4, 4),
+        0x04: (4, 4),
+        0x05: (4, 4),
+        0x06: (4, 4),
+        0x0f: (5, 251),
+        0x10: (5, 251),
+        0x16: (6, 6),
+        0x17: (9, 251),
+    },
     {0x01: SizeRule(4), 0x02: SizeRule(4), 0x03: SizeRule(4), 0x04: SizeRule(4), 0x05: SizeRule(4), 0x06: SizeRule(4), 0x0f: SizeRule(5, ((4, 1, 'big', 1),)), 0x10: SizeRule(5, ((4, 1, 'big', 1),)), 0x16: SizeRule(6), 0x17: SizeRule(9, ((8, 1, 'big', 1),))},
 )
 
@@ -710,7 +721,19 @@ _RESPONSE_FRAMES = FrameCodec(
             Element('crc', 'checksum', 2, span=(0, 2), checksum=_CHECK_CRC),
         )),
     ),
-    {0x01: (1, 256), 0x02: (1, 256), 0x03: (1, 256), 0x04: (1, 256), 0x05: (4, 4), 0x06: (4, 4), 0x0f: (4, 4), 0x10: (4, 4), 0x16: (6, 6), 0x17: (1, 256), ERROR_REPLY: (1, 1)},
+    {
+        0x01: (1, 256),
+        0x02: (1, 256),
+        0x03: (1, 256),
+        0x04: (1, 256),
+        0x05: (4, 4),
+        0x06: (4, 4),
+        0x0f: (4, 4),
+        0x10: (4, 4),
+        0x16: (6, 6),
+        0x17: (1, 256),
+        ERROR_REPLY: (1, 1),
+    },
     {0x01: SizeRule(1, ((0, 1, 'big', 1),)), 0x02: SizeRule(1, ((0, 1, 'big', 1),)), 0x03: SizeRule(1, ((0, 1, 'big', 1),)), 0x04: SizeRule(1, ((0, 1, 'big', 1),)), 0x05: SizeRule(4), 0x06: SizeRule(4), 0x0f: SizeRule(4), 0x10: SizeRule(4), 0x16: SizeRule(6), 0x17: SizeRule(1, ((0, 1, 'big', 1),)), ERROR_REPLY: SizeRule(1)},
     error_flag=0x80,
 )
@@ -782,6 +805,10 @@ def encode(message: Message) -> bytes:
 # Each direction's frames for code that splits a stream of both directions (serialspec monitor).
 REQUEST_FORMAT = EngineFormat(_REQUEST_FRAMES, _decode_request)
 RESPONSE_FORMAT = EngineFormat(_RESPONSE_FRAMES, _decode_response)
+
+# The reply layout a request gets where it is not the default one of replies that share a code.
+REPLY_LAYOUTS: dict[type[Message], type[Message]] = {
+}
 
 
 class StreamParser(_FrameStreamParser):

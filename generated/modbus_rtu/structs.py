@@ -51,7 +51,8 @@ _REQUEST_FRAMES = FrameCodec(
             Element('crc', 'checksum', 2, span=(0, 2), checksum=_CHECK_CRC),
         )),
     ),
-    {},
+    {
+    },
     {},
 )
 
@@ -64,7 +65,8 @@ _RESPONSE_FRAMES = FrameCodec(
             Element('crc', 'checksum', 2, span=(0, 2), checksum=_CHECK_CRC),
         )),
     ),
-    {},
+    {
+    },
     {},
     error_flag=0x80,
 )

@@ -284,7 +284,7 @@ def _decode_forward_can_request(buf: bytes, o: int, end: int) -> ForwardCanReque
 
 
 def _encode_fw_version_request(m: FwVersionRequest) -> bytes:
-    return _REQUEST_FRAMES.wrap(b'', 0, ())
+    return _REQUEST_FRAMES.wrap(b'', 0x00, ())
 
 
 def _encode_fw_version_response(m: FwVersionResponse) -> bytes:
@@ -312,11 +312,11 @@ def _encode_fw_version_response(m: FwVersionResponse) -> bytes:
         raise out_of_range('fw_version response', 'nrf_flags', m.nrf_flags, 0, 255)
     if not 0 <= m.hw_crc <= 4294967295:
         raise out_of_range('fw_version response', 'hw_crc', m.hw_crc, 0, 4294967295)
-    return _RESPONSE_FRAMES.wrap(b''.join((_S_BE_U8_U8.pack(m.major, m.minor), _encode_text(m.hw_name, 'hw_name', 'fw_version response', True), _S_BE_FWVERSIONRESPONSE_UUID.pack(m.uuid, m.pairing_done, m.test_version, m.hw_type, m.custom_config_count, m.phase_filters, m.qml_hw, m.qml_app, m.nrf_flags), _encode_text(m.fw_name, 'fw_name', 'fw_version response', True), _S_BE_U32.pack(m.hw_crc),)), 0, ())
+    return _RESPONSE_FRAMES.wrap(b''.join((_S_BE_U8_U8.pack(m.major, m.minor), _encode_text(m.hw_name, 'hw_name', 'fw_version response', True), _S_BE_FWVERSIONRESPONSE_UUID.pack(m.uuid, m.pairing_done, m.test_version, m.hw_type, m.custom_config_count, m.phase_filters, m.qml_hw, m.qml_app, m.nrf_flags), _encode_text(m.fw_name, 'fw_name', 'fw_version response', True), _S_BE_U32.pack(m.hw_crc),)), 0x00, ())
 
 
 def _encode_get_values_request(m: GetValuesRequest) -> bytes:
-    return _REQUEST_FRAMES.wrap(b'', 4, ())
+    return _REQUEST_FRAMES.wrap(b'', 0x04, ())
 
 
 def _encode_get_values_response(m: GetValuesResponse) -> bytes:
@@ -368,63 +368,63 @@ def _encode_get_values_response(m: GetValuesResponse) -> bytes:
         raise out_of_range('get_values response', 'avg_vq', m.avg_vq, -2147483648, 2147483647)
     if not 0 <= m.status <= 255:
         raise out_of_range('get_values response', 'status', m.status, 0, 255)
-    return _RESPONSE_FRAMES.wrap(_S_BE_GETVALUESRESPONSE_TEMP_FET.pack(m.temp_fet, m.temp_motor, m.avg_motor_current, m.avg_input_current, m.avg_id, m.avg_iq, m.duty_now, m.rpm, m.v_in, m.amp_hours, m.amp_hours_charged, m.watt_hours, m.watt_hours_charged, m.tachometer, m.tachometer_abs, m.fault, m.pid_pos, m.controller_id, m.temp_mos1, m.temp_mos2, m.temp_mos3, m.avg_vd, m.avg_vq, m.status), 4, ())
+    return _RESPONSE_FRAMES.wrap(_S_BE_GETVALUESRESPONSE_TEMP_FET.pack(m.temp_fet, m.temp_motor, m.avg_motor_current, m.avg_input_current, m.avg_id, m.avg_iq, m.duty_now, m.rpm, m.v_in, m.amp_hours, m.amp_hours_charged, m.watt_hours, m.watt_hours_charged, m.tachometer, m.tachometer_abs, m.fault, m.pid_pos, m.controller_id, m.temp_mos1, m.temp_mos2, m.temp_mos3, m.avg_vd, m.avg_vq, m.status), 0x04, ())
 
 
 def _encode_set_duty_request(m: SetDutyRequest) -> bytes:
     if not -100000 <= m.duty <= 100000:
         raise out_of_range('set_duty request', 'duty', m.duty, -100000, 100000)
-    return _REQUEST_FRAMES.wrap(_S_BE_I32.pack(m.duty), 5, ())
+    return _REQUEST_FRAMES.wrap(_S_BE_I32.pack(m.duty), 0x05, ())
 
 
 def _encode_set_current_request(m: SetCurrentRequest) -> bytes:
     if not -2147483648 <= m.current <= 2147483647:
         raise out_of_range('set_current request', 'current', m.current, -2147483648, 2147483647)
-    return _REQUEST_FRAMES.wrap(_S_BE_I32.pack(m.current), 6, ())
+    return _REQUEST_FRAMES.wrap(_S_BE_I32.pack(m.current), 0x06, ())
 
 
 def _encode_set_current_brake_request(m: SetCurrentBrakeRequest) -> bytes:
     if not -2147483648 <= m.current <= 2147483647:
         raise out_of_range('set_current_brake request', 'current', m.current, -2147483648, 2147483647)
-    return _REQUEST_FRAMES.wrap(_S_BE_I32.pack(m.current), 7, ())
+    return _REQUEST_FRAMES.wrap(_S_BE_I32.pack(m.current), 0x07, ())
 
 
 def _encode_set_rpm_request(m: SetRpmRequest) -> bytes:
     if not -2147483648 <= m.rpm <= 2147483647:
         raise out_of_range('set_rpm request', 'rpm', m.rpm, -2147483648, 2147483647)
-    return _REQUEST_FRAMES.wrap(_S_BE_I32.pack(m.rpm), 8, ())
+    return _REQUEST_FRAMES.wrap(_S_BE_I32.pack(m.rpm), 0x08, ())
 
 
 def _encode_set_pos_request(m: SetPosRequest) -> bytes:
     if not -2147483648 <= m.position <= 2147483647:
         raise out_of_range('set_pos request', 'position', m.position, -2147483648, 2147483647)
-    return _REQUEST_FRAMES.wrap(_S_BE_I32.pack(m.position), 9, ())
+    return _REQUEST_FRAMES.wrap(_S_BE_I32.pack(m.position), 0x09, ())
 
 
 def _encode_set_handbrake_request(m: SetHandbrakeRequest) -> bytes:
     if not -2147483648 <= m.current <= 2147483647:
         raise out_of_range('set_handbrake request', 'current', m.current, -2147483648, 2147483647)
-    return _REQUEST_FRAMES.wrap(_S_BE_I32.pack(m.current), 10, ())
+    return _REQUEST_FRAMES.wrap(_S_BE_I32.pack(m.current), 0x0a, ())
 
 
 def _encode_print_response(m: PrintResponse) -> bytes:
-    return _RESPONSE_FRAMES.wrap(_encode_text(m.text, 'text', 'print response', False), 21, ())
+    return _RESPONSE_FRAMES.wrap(_encode_text(m.text, 'text', 'print response', False), 0x15, ())
 
 
 def _encode_rotor_position_response(m: RotorPositionResponse) -> bytes:
     if not -2147483648 <= m.position <= 2147483647:
         raise out_of_range('rotor_position response', 'position', m.position, -2147483648, 2147483647)
-    return _RESPONSE_FRAMES.wrap(_S_BE_I32.pack(m.position), 22, ())
+    return _RESPONSE_FRAMES.wrap(_S_BE_I32.pack(m.position), 0x16, ())
 
 
 def _encode_alive_request(m: AliveRequest) -> bytes:
-    return _REQUEST_FRAMES.wrap(b'', 30, ())
+    return _REQUEST_FRAMES.wrap(b'', 0x1e, ())
 
 
 def _encode_forward_can_request(m: ForwardCanRequest) -> bytes:
     if not 0 <= m.can_id <= 255:
         raise out_of_range('forward_can request', 'can_id', m.can_id, 0, 255)
-    return _REQUEST_FRAMES.wrap(b''.join((_S_BE_U8.pack(m.can_id), bytes(m.payload),)), 34, ())
+    return _REQUEST_FRAMES.wrap(b''.join((_S_BE_U8.pack(m.can_id), bytes(m.payload),)), 0x22, ())
 
 
 _REQUEST_DECODERS: dict[int | None, Callable[..., Message]] = {
@@ -458,7 +458,18 @@ _REQUEST_FRAMES = FrameCodec(
             Element('end', 'constant', 1, constant=b'\x03'),
         )),
     ),
-    {0x00: (0, 0), 0x04: (0, 0), 0x05: (4, 4), 0x06: (4, 4), 0x07: (4, 4), 0x08: (4, 4), 0x09: (4, 4), 0x0a: (4, 4), 0x1e: (0, 0), 0x22: (1, None)},
+    {
+        0x00: (0, 0),
+        0x04: (0, 0),
+        0x05: (4, 4),
+        0x06: (4, 4),
+        0x07: (4, 4),
+        0x08: (4, 4),
+        0x09: (4, 4),
+        0x0a: (4, 4),
+        0x1e: (0, 0),
+        0x22: (1, None),
+    },
 )
 
 
@@ -497,7 +508,12 @@ _RESPONSE_FRAMES = FrameCodec(
             Element('end', 'constant', 1, constant=b'\x03'),
         )),
     ),
-    {0x00: (28, None), 0x04: (73, 73), 0x15: (0, None), 0x16: (4, 4)},
+    {
+        0x00: (28, None),
+        0x04: (73, 73),
+        0x15: (0, None),
+        0x16: (4, 4),
+    },
 )
 
 
@@ -556,6 +572,10 @@ def encode(message: Message) -> bytes:
 # Each direction's frames for code that splits a stream of both directions (serialspec monitor).
 REQUEST_FORMAT = EngineFormat(_REQUEST_FRAMES, _decode_request)
 RESPONSE_FORMAT = EngineFormat(_RESPONSE_FRAMES, _decode_response)
+
+# The reply layout a request gets where it is not the default one of replies that share a code.
+REPLY_LAYOUTS: dict[type[Message], type[Message]] = {
+}
 
 
 class StreamParser(_FrameStreamParser):

@@ -61,7 +61,8 @@ _REQUEST_FRAMES = FrameCodec(
             Element('end', 'constant', 1, constant=b'\x03'),
         )),
     ),
-    {},
+    {
+    },
 )
 
 _RESPONSE_FRAMES = FrameCodec(
@@ -83,7 +84,8 @@ _RESPONSE_FRAMES = FrameCodec(
             Element('end', 'constant', 1, constant=b'\x03'),
         )),
     ),
-    {},
+    {
+    },
 )
 
 

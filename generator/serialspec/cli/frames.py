@@ -36,6 +36,7 @@ class Frames:
         except ValueError:
             codec = package.codec
             self._paired = _Paired(codec.REQUEST_FORMAT, codec.RESPONSE_FORMAT, address)
+            self._paired.reply_layouts = getattr(codec, "REPLY_LAYOUTS", {})
             self._parser = self._paired
         self._after_error = False
 
@@ -93,6 +94,7 @@ class _Paired:
         self.address = address
         self.buffer = b""
         self.awaiting: Message | None = None  # the last request, until a reply comes
+        self.reply_layouts: dict[type[Message], type[Message]] = {}  # request -> reply class, where codes are shared
         self.errors = 0
         self.garbage = 0
 
@@ -134,7 +136,12 @@ class _Paired:
             if position + size > len(buffer):
                 return "wait"
             try:
-                message = candidate.format.decode_at(buffer, position, position + size)
+                if isinstance(candidate.format, EngineFormat) and candidate is self.response:
+                    # where replies share a code, the layout the request waiting for its reply gets
+                    expect = self.reply_layouts.get(type(self.awaiting)) if self.awaiting else None
+                    message = candidate.format.decode_at(buffer, position, position + size, expect)
+                else:
+                    message = candidate.format.decode_at(buffer, position, position + size)
             except DecodeError:
                 failed = True
                 continue

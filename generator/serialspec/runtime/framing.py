@@ -117,7 +117,7 @@ class Layout:
             tail.append((index, position + self.elements[index].size, position))
             position += self.elements[index].size
         inner = self.elements[first : last + 1] if first <= last else ()
-        plan = {
+        plan: dict[str, Any] = {
             "before": sum(e.size for e in self.elements[:first]),
             "after": position,
             "head": tuple(head),
@@ -128,7 +128,14 @@ class Layout:
             "constants": tuple((i, e) for i, e in enumerate(self.elements) if e.kind == "constant"),
             "lengths": tuple((i, e) for i, e in enumerate(self.elements) if e.kind == "length"),
             "checksums": tuple((i, e) for i, e in enumerate(self.elements) if e.kind == "checksum"),
+            "template": tuple(e.constant if e.kind == "constant" else bytes(e.size) for e in self.elements),
         }
+        t = self.transparency
+        inside = tuple(
+            (i, e) for i, e in plan["checksums"] if t is not None and t.span[0] <= e.span[0] and e.span[1] <= t.span[1]
+        )
+        plan["inner_checksums"] = inside
+        plan["outer_checksums"] = tuple(c for c in plan["checksums"] if c not in inside)
         object.__setattr__(self, "_plan", plan)
 
     @property
@@ -169,41 +176,30 @@ class Layout:
 
     def wrap(self, content: bytes, code: int | None, values: tuple[int, ...]) -> bytes:
         """The frame around `content`; EncodeError when a value does not fit its element (the length, say)."""
-        plain: list[bytes] = []
-        given = iter(values)
-        for element in self.elements:
-            kind = element.kind
-            if kind == "constant":
-                plain.append(element.constant)
-            elif kind == "content":
-                plain.append(content)
-            elif kind == "command":
-                plain.append(_pack(element, code or 0))
-            elif kind == "value":
-                plain.append(_pack(element, next(given)))
-            else:
-                plain.append(bytes(element.size))
+        plan: dict[str, Any] = self._plan  # type: ignore[attr-defined]
+        elements = self.elements
+        plain: list[bytes] = list(plan["template"])  # constants in place, zeros for what is computed below
+        if self.content >= 0:
+            plain[self.content] = content
+        if self.command is not None:
+            plain[self.command] = _pack(elements[self.command], code or 0)
+        for index, value in zip(self.values, values, strict=True):
+            plain[index] = _pack(elements[index], value)
         wire: dict[int, bytes] = {}
         t = self.transparency
-        done: set[int] = set()
+        for index, element in plan["inner_checksums"]:  # inside the stuffed span: over the bytes before stuffing
+            plain[index] = self._checksum(element, b"".join(plain[element.span[0] : element.span[1] + 1]))
         if t is not None:
             first, last = t.span
-            for index, element in enumerate(self.elements):
-                if element.kind == "checksum" and first <= element.span[0] and element.span[1] <= last:
-                    plain[index] = self._checksum(element, b"".join(plain[element.span[0] : element.span[1] + 1]))
-                    done.add(index)
             wire[first] = t.encode(b"".join(plain[first : last + 1]))
-        for index, element in enumerate(self.elements):
-            if element.kind == "length":
-                counted = self._wire(plain, wire, *element.span)
-                value = len(counted) + element.adds
-                if not 0 <= value < 1 << (8 * element.size):
-                    raise EncodeError(f"{self.name} frame: length {value} does not fit its {element.size}-byte field")
-                plain[index] = element.pack(value)
-        for index, element in enumerate(self.elements):
-            if element.kind == "checksum" and index not in done:
-                plain[index] = self._checksum(element, self._wire(plain, wire, *element.span))
-        return self._wire(plain, wire, 0, len(self.elements) - 1)
+        for index, element in plan["lengths"]:
+            value = len(self._wire(plain, wire, *element.span)) + element.adds
+            if not 0 <= value < 1 << (8 * element.size):
+                raise EncodeError(f"{self.name} frame: length {value} does not fit its {element.size}-byte field")
+            plain[index] = element.pack(value)
+        for index, element in plan["outer_checksums"]:
+            plain[index] = self._checksum(element, self._wire(plain, wire, *element.span))
+        return self._wire(plain, wire, 0, len(elements) - 1)
 
     def _wire(self, plain: list[bytes], wire: dict[int, bytes], first: int, last: int) -> bytes:
         """Wire bytes of elements first..last (plain bytes when the transparency span is not in play)."""
@@ -535,5 +531,5 @@ class EngineFormat:
                 return size
         return len(buffer) - position + 1 if waiting else None
 
-    def decode_at(self, buffer: bytes, start: int, stop: int) -> Message:
-        return self.decode(buffer[start:stop], None)
+    def decode_at(self, buffer: bytes, start: int, stop: int, expect: type[Message] | None = None) -> Message:
+        return self.decode(buffer[start:stop], expect)

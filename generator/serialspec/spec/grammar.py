@@ -823,6 +823,11 @@ DEVICE_COMMAND = Obj(
         "each": Str("A group field of the request whose items address one device each (by the address field)."),
         "buffered": Bool("The writes are held until a command that `commits` (FEETECH REG WRITE).", default=False),
         "commits": Bool("Carries out the writes held by `buffered` commands (FEETECH ACTION).", default=False),
+        "nothing_held": MapOf(
+            Num(),
+            "commits: response field (or field.bit_field) -> value when no write is held (DYNAMIXEL ACTION without "
+            "REG WRITE: error.number 2, instruction error).",
+        ),
         "kind": Str("The entry of `kinds:` whose devices the command addresses (default: the devices of --id)."),
         "stores": MapOf(Str(), "Request field -> the state variable it is stored in (where names differ)."),
         "sets": MapOf(Num(), "State variable -> the value the command sets it to."),

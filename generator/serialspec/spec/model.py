@@ -607,6 +607,7 @@ class Behaviour:
     cancel_when: dict[str, float] = field(default_factory=dict)  # with releases: field -> value that drops them
     carries: tuple[str, str] | None = None  # (command code field, content field) of a carried request
     carried: tuple[str, ...] = ()  # the commands it can carry (empty: every command with a code)
+    nothing_held: dict[str, float] = field(default_factory=dict)  # commits: reply values when nothing is held
 
 
 @dataclass(frozen=True)

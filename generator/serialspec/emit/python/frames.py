@@ -116,7 +116,10 @@ def codec_lines(
     for layout in layouts:
         lines += [f"        {line}" for line in layout_lines(layout)]
     lines.append("    ),")
-    lines.append("    {" + ", ".join(f"{code}: ({low}, {high})" for code, low, high in sizes) + "},")
+    # content size bounds by command code (None: unbounded)
+    lines.append("    {")
+    lines += [f"        {code}: ({low}, {high})," for code, low, high in sizes]
+    lines.append("    },")
     if any(layout.length is None for layout in layouts):
         rules = [(code, rule) for code, message in messages.items() if (rule := size_rule(message))]
         lines.append("    {" + ", ".join(f"{code}: {rule}" for code, rule in rules) + "},")

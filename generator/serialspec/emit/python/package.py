@@ -24,7 +24,18 @@ from serialspec.emit.python.registers import register_tables, registers_module
 from serialspec.emit.python.render import render
 from serialspec.emit.python.simulator import import_order, simulator_module
 from serialspec.emit.python.structs import structs_module
-from serialspec.spec.model import Command, Direction, FrameLayout, Message, Protocol, Scalar, Table, TableValue
+from serialspec.spec.model import (
+    Command,
+    Direction,
+    FrameLayout,
+    Message,
+    Protocol,
+    Scalar,
+    Table,
+    TableValue,
+    replies_by_request,
+    reply_to,
+)
 
 _IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 
@@ -193,8 +204,19 @@ def general_codec_context(protocol: Protocol) -> dict[str, Any]:
             }
         )
     headers = [h for d in directions for h in d["headers"]]
+    shared = {cls for d in directions for cls, _, _ in d["expected"]}
+    replies = replies_by_request(protocol.messages())
+    reply_layouts = [
+        (m.class_name, reply.class_name)
+        for m in protocol.messages()
+        if m.direction == Direction.REQUEST
+        and (reply := reply_to(m, replies)) is not None
+        and reply.class_name in shared
+        and not reply.default_reply
+    ]
     return {
         "classic": False,
+        "reply_layouts": reply_layouts,
         "framing_imports": sorted(
             {"EngineFormat", *framing_imports([line for d in directions for line in d["frames"]])}, key=import_order
         ),

@@ -676,7 +676,7 @@ class PackageCode:
             # the runtime's frame engine wraps the content (see emit/python/frames.py)
             parts = self.encode_fields(fields, message.class_name, "m", lines, where)
             content = parts[0] if len(parts) == 1 else f"b''.join(({', '.join(parts)},))" if parts else "b''"
-            code = str(command_code) if command_code is not None and layout.has_command else "None"
+            code = f"{command_code:#04x}" if command_code is not None and layout.has_command else "None"
             if error is not None:
                 code = f"m.{error.element} | {error.flag:#04x}"
             values = f"({frame_values[0]},)" if len(frame_values) == 1 else f"({', '.join(frame_values)})"

@@ -41,6 +41,7 @@ BEHAVIOUR_ARGUMENTS = (
     "releases",
     "cancel_when",
     "carries",
+    "nothing_held",
 )
 
 

@@ -104,6 +104,7 @@ class CommandSpec:
     # values a request carries that its message does not hold (counts, byte counts), from its fields: a reply
     # field of the same name echoes them like any other request field
     derived: dict[str, Callable[[dict[str, Any]], int]] = field(default_factory=dict)
+    nothing_held: dict[str, float] = field(default_factory=dict)  # commits: reply values when nothing is held
     ramp: tuple[str, str] | None = None  # request fields: acceleration and deceleration time (ms) of the move
     stops: tuple[str, ...] = ()  # state variables whose move stops where it is
     wraps: dict[str, float] = field(default_factory=dict)  # state variable -> the period it is kept within
@@ -500,6 +501,8 @@ class Engine(FaultInjection):
                 reason = self._write(device, command, name, given, written)
                 refused = refused or reason
         if command.commits:
+            if not device.buffered and command.nothing_held:
+                refused = refused or "held"
             buffered, device.buffered = device.buffered, []
             for held_command, name, held in buffered:
                 self._write(device, held_command, name, held, written)
@@ -558,7 +561,9 @@ class Engine(FaultInjection):
                 values[name] = 0
         nest(values, {k: v for k, v in self.spec.reply.items() if "." in k})
         nest(values, {k: int(bool(device.get(e))) for k, e in device.spec.status.items() if "." in k})
-        if refused:
+        if refused == "held":
+            nest(values, command.nothing_held)
+        elif refused:
             nest(values, self.spec.out_of_range if refused == "range" and self.spec.out_of_range else self.spec.refused)
         return self._encode_reply(command.response, values)
 

@@ -173,6 +173,7 @@ class DevicePass(Pass):
                     **self.behaviour_extras(
                         item, item_path, key, request_names, response_names, {**entries, **known_state}
                     ),
+                    nothing_held={str(k): float(v) for k, v in (item.get("nothing_held") or {}).items()},
                 )
             )
         status = {str(k): str(v) for k, v in (value.get("status") or {}).items()}

@@ -658,6 +658,8 @@ def emit_docs(protocol: Protocol) -> str:
         frame_picture=frame_picture(protocol),
         transparency=transparency_text(protocol),
         shared_header=protocol.framing.shared_header,
+        has_header=any(layout.header for layout in protocol.framing.layouts.values()),
+        gap=number(protocol.framing.gap) if protocol.framing.gap else "",
         checksums=checksums_context(protocol),
         matching=", ".join(protocol.matching),
         matching_description=text(protocol.matching_description),

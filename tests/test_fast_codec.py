@@ -13,6 +13,7 @@ from typing import Any
 import pytest
 from conftest import ALL, Generated, by_protocol
 from hypothesis import HealthCheck, given, settings
+from serialspec.emit.python.pycode import PackageCode
 from serialspec.runtime.checksums import crc_function, sum_function
 from serialspec.runtime.errors import ChecksumError
 from serialspec.runtime.message import slot_setters
@@ -113,3 +114,14 @@ def test_slot_setters_store_into_a_frozen_slotted_dataclass() -> None:
     set_first(pair, 1)
     set_second(pair, "two")
     assert pair == Pair(1, "two") and hash(pair) == hash(Pair(1, "two"))
+
+
+def test_two_formats_never_share_a_struct_constant() -> None:
+    """Formats of more than six items are named after their message; two such formats for one name get two names
+    (the second used to replace the first silently, so a decoder would unpack with another message's layout)."""
+    code = PackageCode(ALL[0].protocol)
+    long_a, long_b = "<BBBBBBBB", "<HHHHHHHH"
+    first, second = code.struct("same", long_a), code.struct("same", long_b)
+    assert first != second
+    assert code.structs[first] == long_a and code.structs[second] == long_b
+    assert code.struct("other", long_b) == second  # one format, one constant

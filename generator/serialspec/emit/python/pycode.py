@@ -186,6 +186,9 @@ class PackageCode:
             tokens.append(f"{token}X{count}" if count and char != "s" else (f"B{count}" if char == "s" else token))
         layout = "_".join(tokens) if len(tokens) <= 6 else base_name.upper()
         name = "_S_" + ("BE_" if fmt.startswith(">") else "") + layout
+        if name in self.structs:  # another format got the same name (a long layout named after its message, ...)
+            taken = name
+            name = next(f"{taken}_{n}" for n in range(2, len(self.structs) + 3) if f"{taken}_{n}" not in self.structs)
         self.structs[name] = fmt
         return name
 

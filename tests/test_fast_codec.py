@@ -8,6 +8,7 @@ calls, and fixed-size frames are packed by one struct. Each must agree with the 
 from __future__ import annotations
 
 import dataclasses
+import pickle
 from typing import Any
 
 import pytest
@@ -16,7 +17,7 @@ from hypothesis import HealthCheck, given, settings
 from serialspec.emit.python.pycode import PackageCode
 from serialspec.runtime.checksums import crc_function, sum_function
 from serialspec.runtime.errors import ChecksumError
-from serialspec.runtime.message import slot_setters
+from serialspec.runtime.message import field_names, slot_setters
 from serialspec.spec.model import Message
 from strategies import message_fields
 
@@ -56,10 +57,11 @@ def test_fast_paths_agree_with_the_plain_ones(g: Generated, spec: Message) -> No
         decoded = g.package.decode(frame, direction, cls)
         assert type(decoded) is cls
         assert decoded == built and hash(decoded) == hash(built)
-        assert all(hasattr(decoded, f.name) for f in dataclasses.fields(decoded))
-        if dataclasses.fields(decoded):  # a message with no fields (Fashion Star BEGIN_ASYNC) has none to set
+        assert all(hasattr(decoded, name) for name in field_names(decoded))
+        assert repr(decoded) == repr(built) and pickle.loads(pickle.dumps(decoded)) == decoded
+        if field_names(decoded):  # a message with no fields (Fashion Star BEGIN_ASYNC) has none to set
             with pytest.raises(dataclasses.FrozenInstanceError):
-                decoded.__setattr__(dataclasses.fields(decoded)[0].name, 0)
+                decoded.__setattr__(field_names(decoded)[0], 0)
         # the stream parser decodes in place, between other bytes, to the same message
         parser = g.package.StreamParser(direction)
         parser.expect(cls)  # the reply layout, where replies share a code

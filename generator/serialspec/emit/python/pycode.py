@@ -144,13 +144,23 @@ def doc_line(f: SpecField) -> str:
 
 
 @dataclass
+class Attribute:
+    """One field of a generated class: its name, annotation, default (Python source, or "" for none) and doc line."""
+
+    name: str
+    annotation: str
+    doc: str
+    default: str = ""
+
+
+@dataclass
 class ClassCode:
-    """A generated dataclass: its name, docstring, attribute lines, to_fields and from_fields bodies."""
+    """A generated value class: its name, docstring, fields, to_fields and from_fields bodies."""
 
     name: str
     doc: str
     base: str
-    attributes: Lines
+    attributes: list[Attribute]
     class_vars: Lines = field(default_factory=list)
     to_fields: Lines = field(default_factory=list)
     from_fields: Lines = field(default_factory=list)
@@ -232,22 +242,25 @@ class PackageCode:
             )
         return values
 
-    def attribute_lines(self, fields: list[SpecField], defaults: bool = True) -> Lines:
-        lines = []
-        # Defaults only on a trailing run of fields that all have one: dataclasses stay positional.
+    def attributes(self, fields: list[SpecField], defaults: bool = True) -> list[Attribute]:
+        # Defaults only on a trailing run of fields that all have one: classes stay positional.
         trailing_defaults: set[str] = set()
         for f in reversed(fields):
             if defaults and isinstance(f, Scalar) and f.default is not None and not f.enum and not f.bits:
                 trailing_defaults.add(f.name)
             else:
                 break
-        for f in fields:
-            default = ""
-            if isinstance(f, Scalar) and f.default is not None and f.name in trailing_defaults:
-                default = f" = {number(f.default)}"
-            lines.append(f"{f.name}: {annotation(f)}{default}")
-            lines.append(f"#: {doc_line(f)}")
-        return lines
+        return [
+            Attribute(
+                f.name,
+                annotation(f),
+                doc_line(f),
+                number(f.default)
+                if isinstance(f, Scalar) and f.name in trailing_defaults and f.default is not None
+                else "",
+            )
+            for f in fields
+        ]
 
     def helper(self, f: SpecField) -> None:
         """Dataclasses for the nested values of a field: bit fields, group items, table blocks."""
@@ -257,7 +270,7 @@ class PackageCode:
             for bit in f.bits:
                 kind = f"{bit.enum.class_name} | int" if bit.enum else "int"
                 where = f"bit {bit.low}" if bit.high == bit.low else f"bits {bit.high}..{bit.low}"
-                attributes += [f"{bit.name}: {kind}", f"#: {one_line(bit.description or bit.name)} ({where})"]
+                attributes.append(Attribute(bit.name, kind, f"{one_line(bit.description or bit.name)} ({where})"))
             code = ClassCode(f.bits_class, f"Bit fields of {f.name}.", "", attributes)
             code.to_fields = [f"{b.name!r}: int(self.{b.name})," for b in f.bits]
             code.from_fields = [
@@ -269,7 +282,7 @@ class PackageCode:
             for inner in f.fields:
                 self.helper(inner)
             inner_fields = [i for i in f.fields if not (isinstance(i, Scalar) and i.hidden)]
-            code = ClassCode(f.class_name, f"One item of {f.name}.", "", self.attribute_lines(inner_fields, False))
+            code = ClassCode(f.class_name, f"One item of {f.name}.", "", self.attributes(inner_fields, False))
             code.to_fields = [f"{i.name!r}: {self.to_json(i, 'self.' + i.name)}," for i in inner_fields]
             code.from_fields = [f"{self.from_json(i)}," for i in inner_fields]
             self.helper_classes.append(code)
@@ -279,10 +292,8 @@ class PackageCode:
             for e in f.entries:
                 kind = f"{e.enum.class_name} | int" if e.enum else ("float" if e.type.is_float else "int")
                 unit = f" [{e.unit}]" if e.unit else ""
-                attributes += [
-                    f"{e.name}: {kind}",
-                    f"#: {one_line(f'{f.table.key_name} {e.key}: {e.description or e.name}{unit}')}",
-                ]
+                doc = one_line(f"{f.table.key_name} {e.key}: {e.description or e.name}{unit}")
+                attributes.append(Attribute(e.name, kind, doc))
             code = ClassCode(f.class_name, one_line(f"{f.description or f.name} ({f.table.title})."), "", attributes)
             code.to_fields = [
                 f"{e.name!r}: {'int(self.' + e.name + ')' if e.enum else 'self.' + e.name}," for e in f.entries
@@ -346,7 +357,7 @@ class PackageCode:
             self.helper(f)
         fields = [*self.frame_values(message.direction, message), *self.value_fields(message)]
         doc = f"{message.command} {message.subcommand or ''} {message.direction.value}".replace("  ", " ")
-        code = ClassCode(message.class_name, doc, "Message", self.attribute_lines(fields))
+        code = ClassCode(message.class_name, doc, "Message", self.attributes(fields))
         code.class_vars = [
             f"PROTOCOL: ClassVar[str] = {self.protocol.name!r}",
             f"COMMAND: ClassVar[str] = {message.command!r}",

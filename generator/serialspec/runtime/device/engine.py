@@ -447,10 +447,8 @@ class Engine(FaultInjection):
         """The reply a bus master gives for an id no device has: the request's fields, `absent` values, else 0."""
         if command.response is None:
             return None
-        values = {
-            a.name: command.absent.get(a.name, given.get(a.name, 0))
-            for a in dataclasses.fields(command.response)  # type: ignore[arg-type]
-        }
+        names: tuple[str, ...] = command.response.__match_args__
+        values = {name: command.absent.get(name, given.get(name, 0)) for name in names}
         return self._encode_reply(command.response, values)
 
     def _encode_reply(self, response: type[Message], values: dict[str, Any]) -> bytes | None:
@@ -530,8 +528,7 @@ class Engine(FaultInjection):
         if not answers:
             return None
         values: dict[str, Any] = {}
-        for attribute in dataclasses.fields(command.response):  # type: ignore[arg-type]
-            name = attribute.name
+        for name in command.response.__match_args__:
             if name in command.space_reads:
                 values[name] = self._read_space(device, command.space_reads[name], given)
             elif name in command.reads:

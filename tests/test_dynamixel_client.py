@@ -47,8 +47,14 @@ def test_values_out_of_range_are_refused_before_sending(client: DynamixelP2Clien
 
 
 def test_device_errors_name_the_error_number(client: DynamixelP2Client) -> None:
+    # the spec's `errors:`, one reply value per reason
     with pytest.raises(DeviceError, match="access_error"):
         client.write_raw(1, 144, b"\x05\x00")  # present_input_voltage is read-only
+    with pytest.raises(DeviceError, match="access_error"):
+        client.write_raw(1, 1, b"\x05")  # the second byte of model_number: no whole register
+    with pytest.raises(DeviceError, match="data_range_error"):
+        client.write_raw(1, 68, b"\x03")  # status_return_level 3: outside 0..2
+    assert client.read(1, "status_return_level") == 2  # a refused write changes nothing
 
 
 def test_status_return_level_switches_replies(client: DynamixelP2Client) -> None:

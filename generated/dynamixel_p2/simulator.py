@@ -161,8 +161,7 @@ DEVICE = DeviceSpec(
     ),
     state={},
     reply={'error.alert': 0.0, 'error.number': 0.0},
-    refused={'error.number': 7.0},
-    out_of_range={'error.number': 4.0},
+    errors={'out_of_space': {'error.number': 7.0}, 'out_of_range': {'error.number': 4.0}, 'read_only': {'error.number': 7.0}},
     commands=(
         # ping
         CommandSpec(PingRequest, PingResponse, reports={'model_number': 'model_number', 'firmware_version': 'firmware_version'}, broadcast_reply=True),

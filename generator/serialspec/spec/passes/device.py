@@ -189,8 +189,6 @@ class DevicePass(Pass):
             broadcast=broadcast,
             state=state,
             reply={str(k): v if isinstance(v, str) else float(v) for k, v in (value.get("reply") or {}).items()},
-            refused={str(k): float(v) for k, v in (value.get("refused") or {}).items()},
-            out_of_range={str(k): float(v) for k, v in (value.get("out_of_range") or {}).items()},
             behaviours=tuple(behaviours),
             status=status,
             kinds=tuple(kinds.values()),
@@ -241,18 +239,24 @@ class DevicePass(Pass):
         return found
 
     def errors(self, value: Any, path: Path, commands: list[Command]) -> DeviceErrors | None:
+        """`errors:` reason -> reply values, each field checked against the error reply (when there is one)."""
         if value is None:
             return None
         reply = next((m for c in commands for m in c.messages() if m.error_reply), None)
-        if reply is None:
-            raise self.fail(path, "`errors:` needs a command whose response is the `error_reply`")
-        field = str(value["field"])
-        if not any(f.name == field for f in reply.fields):
-            self.error((*path, "field"), f"the error reply {reply.command} has no field {field!r}")
-        if value.get("unsupported") is not None and self.ctx.framing is not None and self.ctx.framing.classic:
-            self.error((*path, "unsupported"), "`unsupported` needs frames the frame engine takes apart (not classic)")
-        reasons = [value.get(k) for k in ("out_of_space", "out_of_range", "read_only", "unsupported")]
-        return DeviceErrors(field, *reasons)
+        reasons = {}
+        for reason, values in value.items():
+            for key in values:
+                if reply is not None and key.partition(".")[0] not in {f.name for f in reply.fields}:
+                    self.error((*path, reason, key), f"the error reply {reply.command} has no field {key!r}")
+            reasons[str(reason)] = {str(k): float(v) for k, v in values.items()}
+        if "unsupported" in reasons:
+            if reply is None:
+                self.error((*path, "unsupported"), "`unsupported` needs a command whose response is the `error_reply`")
+            elif self.ctx.framing is not None and self.ctx.framing.classic:
+                self.error(
+                    (*path, "unsupported"), "`unsupported` needs frames the frame engine takes apart (not classic)"
+                )
+        return DeviceErrors(**reasons)
 
     def space_runs(
         self, value: Any, names: set[str], request: Message, spaces: dict[str, Space], path: Path

@@ -175,9 +175,14 @@ device:
     out_of_range: {reason: 3}
     read_only: {why: 2}
     unsupported: {reason: 1}
+  commands:
+    move: {restores: {memory: sram, except: [speed]}, broadcast_ignores: {option: 255}, modulo: {angle: 4096}}
 """
     )
     lines = errors_of(tmp_path, text)
+    assert any("restores.except[0]: unknown state variable 'speed'" in x for x in lines), lines
+    assert any("broadcast_ignores.option: move has no request field 'option'" in x for x in lines), lines
+    assert any("modulo.angle: unknown state variable 'angle'" in x for x in lines), lines
     assert any("device.errors.read_only.why: the error reply refusal has no field 'why'" in x for x in lines), lines
     assert any("device.errors.unsupported:" in x and "not classic" in x for x in lines), lines
     assert not any("out_of_range" in x for x in lines), lines

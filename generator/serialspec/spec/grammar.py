@@ -785,6 +785,27 @@ DEVICE_COMMAND = Obj(
             "State variable -> a period: the variable keeps only its remainder, toward zero (an angle within one "
             "turn, 3600 in 0.1°).",
         ),
+        "modulo": MapOf(
+            Num(),
+            "State variable -> a period: the variable keeps its remainder in 0..period-1, also below zero (an "
+            "absolute position within one turn: DYNAMIXEL CLEAR, 4096).",
+        ),
+        "restores": Obj(
+            {
+                "memory": Str("The memory whose entries go back to their initial values.", choices=("eeprom", "sram")),
+                "except": ListOf(Str(), "Entries of that memory left as they are (measured values)."),
+            },
+            required=("memory",),
+            description=(
+                "The entries kept in one memory go back to their initial values (the model's, where it gives them) "
+                "and stop moving: a reboot clears RAM and keeps EEPROM (DYNAMIXEL REBOOT)."
+            ),
+        ),
+        "broadcast_ignores": MapOf(
+            Num(),
+            "Request field -> a value with which a broadcast request is ignored by every device (DYNAMIXEL "
+            "FACTORY RESET of everything, option 0xFF, sent to the broadcast id).",
+        ),
         "counts": MapOf(
             Obj(
                 {"state": Str("The state variable (or memory entry)."), "per": Num("The size of one whole unit.")},

@@ -605,6 +605,9 @@ class Behaviour:
     keeps: tuple[str, dict[int, tuple[str, ...]]] | None = None  # resets: request field, its value -> entries kept
     stops: tuple[str, ...] = ()  # state variables whose move stops where it is
     wraps: dict[str, float] = field(default_factory=dict)  # state variable -> period it is kept within
+    modulo: dict[str, float] = field(default_factory=dict)  # state variable -> period: kept in 0..period-1
+    restores: tuple[str, ...] = ()  # memory entries back to their initial values (a reboot's RAM)
+    broadcast_ignores: dict[str, float] = field(default_factory=dict)  # request field -> value: broadcast ignored
     counts: dict[str, tuple[str, float]] = field(default_factory=dict)  # response field -> (state, per)
     every_device: bool = False  # a request without an address reaches every device
     held_while: str = ""  # state variable: while set, the request is held

@@ -104,6 +104,9 @@ class CommandSpec:
     ramp: tuple[str, str] | None = None  # request fields: acceleration and deceleration time (ms) of the move
     stops: tuple[str, ...] = ()  # state variables whose move stops where it is
     wraps: dict[str, float] = field(default_factory=dict)  # state variable -> the period it is kept within
+    modulo: dict[str, float] = field(default_factory=dict)  # state variable -> period: kept in 0..period-1
+    restores: tuple[str, ...] = ()  # memory entries back to their initial values, their moves stopped (a reboot)
+    broadcast_ignores: dict[str, float] = field(default_factory=dict)  # request field -> value: broadcast ignored
     counts: dict[str, tuple[str, float]] = field(default_factory=dict)  # response field -> (state, per)
     every_device: bool = False  # a request without an address reaches every device, not only the first
     held_while: str = ""  # state variable: while it is set, the device holds the request
@@ -418,6 +421,8 @@ class Engine(FaultInjection):
         for given in items:
             address = given.get(spec.address)
             broadcast = address is not None and address == spec.broadcast
+            if broadcast and any(given.get(k) == v for k, v in command.broadcast_ignores.items()):
+                continue
             if address is None:
                 targets = list(devices.values()) if command.every_device else list(devices.values())[:1]
             elif broadcast:
@@ -522,6 +527,10 @@ class Engine(FaultInjection):
             device.set(state, device.get(state))
         for state, period in command.wraps.items():
             device.set(state, math.fmod(device.get(state), period))
+        for state, period in command.modulo.items():
+            device.set(state, device.get(state) % period)
+        for name in command.restores:
+            device.set(name, device.by_name[name].default)
         id_entry = device.spec.id_entry
         if id_entry in device.by_name or id_entry in device.state:
             new_id = int(device.get(id_entry))

@@ -348,6 +348,19 @@ class DevicePass(Pass):
                 self.error((*path, "cancel_when", field_name), f"{key} has no request field {field_name!r}")
         if "cancel_when" in item and "releases" not in item:
             self.error((*path, "cancel_when"), "`cancel_when` needs `releases`")
+        for field_name in item.get("broadcast_ignores") or {}:
+            if field_name not in request_names:
+                self.error((*path, "broadcast_ignores", field_name), f"{key} has no request field {field_name!r}")
+        restores: tuple[str, ...] = ()
+        if "restores" in item:
+            area, kept = item["restores"]["memory"], item["restores"].get("except") or ()
+            for index, name in enumerate(kept):
+                known(str(name), (*path, "restores", "except", index))
+            restores = tuple(
+                name
+                for name, entry in variables.items()
+                if isinstance(entry, TableEntry) and entry.memory == area and name not in kept
+            )
         carries = item.get("carries")
         carried: list[str] = []
         if carries:
@@ -362,6 +375,9 @@ class DevicePass(Pass):
         return {
             "stops": tuple(known(str(n), (*path, "stops")) for n in item.get("stops") or ()),
             "wraps": {known(str(n), (*path, "wraps", n)): float(p) for n, p in (item.get("wraps") or {}).items()},
+            "modulo": {known(str(n), (*path, "modulo", n)): float(p) for n, p in (item.get("modulo") or {}).items()},
+            "restores": restores,
+            "broadcast_ignores": {str(k): float(v) for k, v in (item.get("broadcast_ignores") or {}).items()},
             "counts": counts,
             "every_device": bool(item.get("every_device", False)),
             "held_while": known(str(item["held_while"]), (*path, "held_while")) if "held_while" in item else "",

@@ -121,6 +121,10 @@ def test_clear_keeps_the_position_within_one_turn(client: DynamixelP2Client) -> 
     assert client.write(1, goal_position=-5000) is True
     assert client.clear(1, 1) is True
     assert client.read(1, "present_position") == 3192  # -5000 + 2 x 4096: within 0..4095, not toward zero
+    assert client.write(1, profile_velocity=1, goal_position=100000) is True  # about 16 pulses/s: hours away
+    with pytest.raises(DeviceError, match="result_fail"):
+        client.clear(1, 1)  # only while stopped
+    assert client.read(1, "moving") == 1  # the move goes on
 
 
 def test_reboot_restores_ram_and_keeps_eeprom(client: DynamixelP2Client) -> None:

@@ -801,6 +801,10 @@ DEVICE_COMMAND = Obj(
                 "and stop moving: a reboot clears RAM and keeps EEPROM (DYNAMIXEL REBOOT)."
             ),
         ),
+        "refused_while_moving": Str(
+            "A state variable (or memory entry): while it moves, the request is refused (`errors.busy`) and "
+            "changes nothing (DYNAMIXEL CLEAR works only while the servo is stopped)."
+        ),
         "broadcast_ignores": MapOf(
             Num(),
             "Request field -> a value with which a broadcast request is ignored by every device (DYNAMIXEL "
@@ -978,6 +982,11 @@ DEVICE = Obj(
                 "read_only": MapOf(
                     Num(),
                     "Reply values when a write reaches a read-only entry or data space (DYNAMIXEL error.number: 7).",
+                ),
+                "busy": MapOf(
+                    Num(),
+                    "Reply values when a command that is `refused_while_moving` arrives during the move (DYNAMIXEL "
+                    "CLEAR: error.number: 1, result fail).",
                 ),
                 "unsupported": MapOf(
                     Num(),

@@ -575,10 +575,11 @@ class DeviceErrors:
     out_of_range: dict[str, float] = field(default_factory=dict)
     read_only: dict[str, float] = field(default_factory=dict)
     unsupported: dict[str, float] = field(default_factory=dict)
+    busy: dict[str, float] = field(default_factory=dict)
 
     def by_reason(self) -> dict[str, dict[str, float]]:
         """The reasons given, by name (the device runtime's reasons)."""
-        reasons = ("out_of_space", "out_of_range", "read_only", "unsupported")
+        reasons = ("out_of_space", "out_of_range", "read_only", "unsupported", "busy")
         return {reason: getattr(self, reason) for reason in reasons if getattr(self, reason)}
 
 
@@ -608,6 +609,7 @@ class Behaviour:
     modulo: dict[str, float] = field(default_factory=dict)  # state variable -> period: kept in 0..period-1
     restores: tuple[str, ...] = ()  # memory entries back to their initial values (a reboot's RAM)
     broadcast_ignores: dict[str, float] = field(default_factory=dict)  # request field -> value: broadcast ignored
+    refused_while_moving: str = ""  # state variable: while it moves, the request is refused (errors.busy)
     counts: dict[str, tuple[str, float]] = field(default_factory=dict)  # response field -> (state, per)
     every_device: bool = False  # a request without an address reaches every device
     held_while: str = ""  # state variable: while set, the request is held

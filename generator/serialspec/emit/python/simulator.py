@@ -38,6 +38,7 @@ BEHAVIOUR_ARGUMENTS = (
     "modulo",
     "restores",
     "broadcast_ignores",
+    "refused_while_moving",
     "counts",
     "every_device",
     "held_while",

@@ -107,6 +107,7 @@ class CommandSpec:
     modulo: dict[str, float] = field(default_factory=dict)  # state variable -> period: kept in 0..period-1
     restores: tuple[str, ...] = ()  # memory entries back to their initial values, their moves stopped (a reboot)
     broadcast_ignores: dict[str, float] = field(default_factory=dict)  # request field -> value: broadcast ignored
+    refused_while_moving: str = ""  # state variable: while it moves, the request is refused ("busy")
     counts: dict[str, tuple[str, float]] = field(default_factory=dict)  # response field -> (state, per)
     every_device: bool = False  # a request without an address reaches every device, not only the first
     held_while: str = ""  # state variable: while it is set, the device holds the request
@@ -492,7 +493,7 @@ class Engine(FaultInjection):
         # replies off is still answered), which is also what a client that remembers the switch expects.
         switch = command.optional_when
         answers = switch is None or compare(device.memory.get(switch[0]), switch[2], switch[1])
-        if command.limits or command.space_reads or command.space_writes:
+        if command.limits or command.space_reads or command.space_writes or command.refused_while_moving:
             refusal = self._refusal(device, command, given)
             if refusal is not None:
                 if self.spec.error is not None:
@@ -583,7 +584,11 @@ class Engine(FaultInjection):
 
     def _refusal(self, device: VirtualDevice, command: CommandSpec, given: dict[str, Any]) -> str | None:
         """Why the device refuses a request before it acts, or None: values outside what the device accepts first,
-        then runs beyond their data space, then writes to a read-only space."""
+        then runs beyond their data space, then writes to a read-only space; a move in progress that the command
+        waits for ("busy")."""
+        moving = device.motions.get(command.refused_while_moving)
+        if moving is not None and moving.active(self.clock()):
+            return "busy"
         for name, (low, high, allowed) in command.limits.items():
             value = given.get(name)
             value = len(value) if isinstance(value, list | tuple) else value

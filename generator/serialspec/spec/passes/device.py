@@ -377,6 +377,11 @@ class DevicePass(Pass):
             "wraps": {known(str(n), (*path, "wraps", n)): float(p) for n, p in (item.get("wraps") or {}).items()},
             "modulo": {known(str(n), (*path, "modulo", n)): float(p) for n, p in (item.get("modulo") or {}).items()},
             "restores": restores,
+            "refused_while_moving": (
+                known(str(item["refused_while_moving"]), (*path, "refused_while_moving"))
+                if "refused_while_moving" in item
+                else ""
+            ),
             "broadcast_ignores": {str(k): float(v) for k, v in (item.get("broadcast_ignores") or {}).items()},
             "counts": counts,
             "every_device": bool(item.get("every_device", False)),

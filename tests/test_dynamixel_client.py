@@ -132,7 +132,11 @@ def test_reboot_restores_ram_and_keeps_eeprom(client: DynamixelP2Client) -> None
     assert client.write(2, torque_enable=1, led=1) is True  # RAM
     assert client.write(2, goal_position=5000) is True  # profile velocity 0: there at once
     assert client.read(2, "present_position") == 5000
+    assert client.reg_write_raw(2, 65, b"\x01") is True  # led = 1 on ACTION; the reboot drops it
+    assert client.write(2, led=0) is True
     assert client.reboot(2) is True
+    with pytest.raises(DeviceError, match="instruction_error"):
+        client.action(2)  # nothing held any more
     ram = client.read_many(2, "torque_enable", "led", "goal_position", "present_position")
     assert ram == {"torque_enable": 0, "led": 0, "goal_position": 0, "present_position": 5000 - 4096}
     assert client.read(2, "return_delay_time") == 5

@@ -798,7 +798,8 @@ DEVICE_COMMAND = Obj(
             required=("memory",),
             description=(
                 "The entries kept in one memory go back to their initial values (the model's, where it gives them) "
-                "and stop moving: a reboot clears RAM and keeps EEPROM (DYNAMIXEL REBOOT)."
+                "and stop moving, and writes held for a command that `commits` are dropped: a reboot clears RAM "
+                "and keeps EEPROM (DYNAMIXEL REBOOT)."
             ),
         ),
         "refused_while_moving": Str(

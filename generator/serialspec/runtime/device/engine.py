@@ -532,6 +532,8 @@ class Engine(FaultInjection):
             device.set(state, device.get(state) % period)
         for name in command.restores:
             device.set(name, device.by_name[name].default)
+        if command.restores:
+            device.buffered = []  # held writes live in the memory a restore clears
         id_entry = device.spec.id_entry
         if id_entry in device.by_name or id_entry in device.state:
             new_id = int(device.get(id_entry))

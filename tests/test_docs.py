@@ -111,3 +111,13 @@ def test_the_documentation_site_builds_strictly(tmp_path: Path) -> None:
     assert {"index.html", "tutorial.html", "language.html", "protocols/feetech_sms.html"} <= built
     index = (tmp_path / "site" / "index.html").read_text(encoding="utf-8")
     assert 'href="protocols/feetech_sms.html"' in index and 'href="tutorial.html"' in index
+
+
+@pytest.mark.parametrize("spec", sorted((ROOT / "specs").glob("*.yaml")), ids=lambda p: p.stem)
+def test_example_breakdowns_show_values_as_people_write_them(spec: Path) -> None:
+    """A bit-field status in an example's breakdown reads `alert=0, number=0`, never a Python dict's repr."""
+    from serialspec.emit.markdown.docs import emit_docs
+    from serialspec.spec import load_protocol
+
+    docs = emit_docs(load_protocol(str(spec), spec.name))
+    assert not re.findall(r"\{'|\['|<[A-Z]\w+\.", docs)

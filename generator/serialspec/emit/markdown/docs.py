@@ -440,7 +440,7 @@ def general_breakdown(protocol: Protocol, example: Example, message: Message | N
             value = f"{e.unpack(part)} (bytes `{layout.elements[e.span[0]].name}`..`{layout.elements[e.span[1]].name}`)"
         elif e.kind == "checksum":
             value = "verifies"
-        rows.append({"bytes": part.hex(" ").upper(), "field": e.name, "value": cell(value)})
+        rows.append({"bytes": part.hex(" ").upper(), "field": e.name, "value": cell(_show(value))})
     return rows
 
 
@@ -477,7 +477,7 @@ def breakdown(protocol: Protocol, example: Example) -> list[dict[str, str]]:
                 {
                     "bytes": frame[offset : offset + size].hex(" ").upper(),
                     "field": e.name,
-                    "value": cell(value),
+                    "value": cell(_show(value)),
                 }
             )
         offset += size

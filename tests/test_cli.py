@@ -97,6 +97,22 @@ def test_check_fails_when_a_generated_file_is_stale(tmp_path: Path) -> None:
     assert "generated/docs/fashionstar_uart.md: stale" in result.stderr
 
 
+def test_a_mistake_in_one_spec_leaves_the_language_reference_alone(tmp_path: Path) -> None:
+    """The reference's examples come from every spec: a spec that fails to load must not rewrite it (or make check
+    call it stale and send the user to `generate`, which cannot help)."""
+    for folder in ("specs", "generated", "docs"):
+        shutil.copytree(ROOT / folder, tmp_path / folder, ignore=shutil.ignore_patterns("__pycache__"))
+    shutil.copy(ROOT / "pyproject.toml", tmp_path / "pyproject.toml")
+    reference = (tmp_path / "docs" / "language.md").read_text(encoding="utf-8")
+    spec = tmp_path / "specs" / "fashionstar_uart.yaml"
+    spec.write_text(spec.read_text(encoding="utf-8").replace("type: u8", "type: int17", 1), encoding="utf-8")
+    checked = serialspec("check", "--root", str(tmp_path))
+    assert checked.returncode == 1 and "'int17'" in checked.stderr
+    assert "language.md" not in checked.stderr and "run `serialspec generate`" not in checked.stderr
+    assert serialspec("generate", "--root", str(tmp_path)).returncode == 1
+    assert (tmp_path / "docs" / "language.md").read_text(encoding="utf-8") == reference
+
+
 def test_decode_picks_the_reply_layout_by_the_request() -> None:
     spec = "specs/dynamixel_p2.yaml"
     status = "FF FF FD 00 01 07 00 55 00 06 04 26 65 5D"  # PING's reply, or a 3-byte READ's: the request decides

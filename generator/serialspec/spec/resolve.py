@@ -49,4 +49,5 @@ def resolve(located: Located) -> Protocol:
         examples=ctx.examples,
         errata=ctx.errata,
         device=ctx.device,
+        error_reply=ctx.error_reply,
     )

@@ -135,9 +135,12 @@ def test_the_documentation_site_builds_strictly(tmp_path: Path) -> None:
 
 @pytest.mark.parametrize("spec", sorted((ROOT / "specs").glob("*.yaml")), ids=lambda p: p.stem)
 def test_example_breakdowns_show_values_as_people_write_them(spec: Path) -> None:
-    """A bit-field status in an example's breakdown reads `alert=0, number=0`, never a Python dict's repr."""
+    """A bit-field status in an example's breakdown reads `alert=0, number=0`, coils `[1; 0; 1]`: never Python's repr,
+    and a protocol without errata says so under its Errata heading."""
     from serialspec.emit.markdown.docs import emit_docs
     from serialspec.spec import load_protocol
 
     docs = emit_docs(load_protocol(str(spec), spec.name))
-    assert not re.findall(r"\{'|\['|<[A-Z]\w+\.", docs)
+    assert not re.findall(r"\{'|\['|<[A-Z]\w+\.|\[(?:True|False);", docs)
+    errata = docs.split("\n## Errata\n")[1]
+    assert errata.strip() and ("### " in errata or "None recorded" in errata)

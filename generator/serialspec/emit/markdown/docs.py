@@ -549,6 +549,8 @@ def content_rows(
 
 
 def _show(value: Any) -> str:
+    if isinstance(value, bool):  # coils and other single bits, as the documents print them
+        return str(int(value))
     if isinstance(value, dict):
         return ", ".join(f"{k}={_show(v)}" for k, v in value.items())
     if isinstance(value, list):

@@ -166,8 +166,8 @@ _TABLE_PARAMETERS_RANGES: dict[int, tuple[float, float]] = {
     53: (-32768, 32767),
 }
 
-# Decoders build messages with object.__new__ and store each value straight into its slot: the dataclass __init__
-# of a frozen class goes through object.__setattr__ per field, which costs more than unpacking the whole frame.
+# Decoders build messages with object.__new__ and store each value straight into its slot: a message's __init__
+# (frozen) goes through object.__setattr__ per field, which costs more than unpacking the whole frame.
 _new = object.__new__
 (_set_BlocksItem_content,) = slot_setters(BlocksItem)
 _set_DampingRequest_servo_id, _set_DampingRequest_power = slot_setters(DampingRequest)

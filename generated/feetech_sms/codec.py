@@ -35,8 +35,8 @@ _S_U8 = struct.Struct('<B')
 _S_U8_U8 = struct.Struct('<BB')
 _S_U8_U8_U8 = struct.Struct('<BBB')
 
-# Decoders build messages with object.__new__ and store each value straight into its slot: the dataclass __init__
-# of a frozen class goes through object.__setattr__ per field, which costs more than unpacking the whole frame.
+# Decoders build messages with object.__new__ and store each value straight into its slot: a message's __init__
+# (frozen) goes through object.__setattr__ per field, which costs more than unpacking the whole frame.
 _new = object.__new__
 (_set_ActionRequest_id,) = slot_setters(ActionRequest)
 (_set_IdsItem_id,) = slot_setters(IdsItem)

@@ -120,8 +120,8 @@ _S_U8_U8_U8 = struct.Struct('<BBB')
 _S_U8_U8_U8_U8 = struct.Struct('<BBBB')
 _CRC_TABLE = crc_table(8, 0x31, True)  # CRC-8/MAXIM
 
-# Decoders build messages with object.__new__ and store each value straight into its slot: the dataclass __init__
-# of a frozen class goes through object.__setattr__ per field, which costs more than unpacking the whole frame.
+# Decoders build messages with object.__new__ and store each value straight into its slot: a message's __init__
+# (frozen) goes through object.__setattr__ per field, which costs more than unpacking the whole frame.
 _new = object.__new__
 (_set_BusServoLoadRequest_servo_id,) = slot_setters(BusServoLoadRequest)
 (_set_BusServoReadIdRequest_servo_id,) = slot_setters(BusServoReadIdRequest)

@@ -49,8 +49,8 @@ _S_BE_U16_U16_U8 = struct.Struct('>HHB')
 _S_BE_U8 = struct.Struct('>B')
 _CHECK_CRC: Callable[[bytes], int] = crc_function(16, 0x8005, 0xffff, True, True, 0x0)  # CRC-16/MODBUS
 
-# Decoders build messages with object.__new__ and store each value straight into its slot: the dataclass __init__
-# of a frozen class goes through object.__setattr__ per field, which costs more than unpacking the whole frame.
+# Decoders build messages with object.__new__ and store each value straight into its slot: a message's __init__
+# (frozen) goes through object.__setattr__ per field, which costs more than unpacking the whole frame.
 _new = object.__new__
 _set_ExceptionResponse_unit, _set_ExceptionResponse_function, _set_ExceptionResponse_exception_code = slot_setters(ExceptionResponse)
 (

@@ -418,7 +418,7 @@ def _decode_exception_response(buf: bytes, o: int, end: int, unit: int, function
 
 
 def _encode_read_coils_request(m: ReadCoilsRequest) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0):
+    if not 0 <= m.unit <= 247:
         raise out_of_range('read_coils request', 'unit', m.unit, 1, 247)
     if not 0 <= m.address <= 65535:
         raise out_of_range('read_coils request', 'address', m.address, 0, 65535)
@@ -428,7 +428,7 @@ def _encode_read_coils_request(m: ReadCoilsRequest) -> bytes:
 
 
 def _encode_read_coils_response(m: ReadCoilsResponse) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0):
+    if not 0 <= m.unit <= 247:
         raise out_of_range('read_coils response', 'unit', m.unit, 1, 247)
     v_byte_count = (-(-len(m.coils) // 8))
     if not 0 <= v_byte_count <= 255:
@@ -437,7 +437,7 @@ def _encode_read_coils_response(m: ReadCoilsResponse) -> bytes:
 
 
 def _encode_read_discrete_inputs_request(m: ReadDiscreteInputsRequest) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0):
+    if not 0 <= m.unit <= 247:
         raise out_of_range('read_discrete_inputs request', 'unit', m.unit, 1, 247)
     if not 0 <= m.address <= 65535:
         raise out_of_range('read_discrete_inputs request', 'address', m.address, 0, 65535)
@@ -447,7 +447,7 @@ def _encode_read_discrete_inputs_request(m: ReadDiscreteInputsRequest) -> bytes:
 
 
 def _encode_read_discrete_inputs_response(m: ReadDiscreteInputsResponse) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0):
+    if not 0 <= m.unit <= 247:
         raise out_of_range('read_discrete_inputs response', 'unit', m.unit, 1, 247)
     v_byte_count = (-(-len(m.inputs) // 8))
     if not 0 <= v_byte_count <= 255:
@@ -456,7 +456,7 @@ def _encode_read_discrete_inputs_response(m: ReadDiscreteInputsResponse) -> byte
 
 
 def _encode_read_holding_registers_request(m: ReadHoldingRegistersRequest) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0):
+    if not 0 <= m.unit <= 247:
         raise out_of_range('read_holding_registers request', 'unit', m.unit, 1, 247)
     if not 0 <= m.address <= 65535:
         raise out_of_range('read_holding_registers request', 'address', m.address, 0, 65535)
@@ -466,7 +466,7 @@ def _encode_read_holding_registers_request(m: ReadHoldingRegistersRequest) -> by
 
 
 def _encode_read_holding_registers_response(m: ReadHoldingRegistersResponse) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0):
+    if not 0 <= m.unit <= 247:
         raise out_of_range('read_holding_registers response', 'unit', m.unit, 1, 247)
     v_byte_count = (2 * len(m.registers))
     if not 0 <= v_byte_count <= 255:
@@ -477,7 +477,7 @@ def _encode_read_holding_registers_response(m: ReadHoldingRegistersResponse) -> 
 
 
 def _encode_read_input_registers_request(m: ReadInputRegistersRequest) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0):
+    if not 0 <= m.unit <= 247:
         raise out_of_range('read_input_registers request', 'unit', m.unit, 1, 247)
     if not 0 <= m.address <= 65535:
         raise out_of_range('read_input_registers request', 'address', m.address, 0, 65535)
@@ -487,7 +487,7 @@ def _encode_read_input_registers_request(m: ReadInputRegistersRequest) -> bytes:
 
 
 def _encode_read_input_registers_response(m: ReadInputRegistersResponse) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0):
+    if not 0 <= m.unit <= 247:
         raise out_of_range('read_input_registers response', 'unit', m.unit, 1, 247)
     v_byte_count = (2 * len(m.registers))
     if not 0 <= v_byte_count <= 255:
@@ -498,7 +498,7 @@ def _encode_read_input_registers_response(m: ReadInputRegistersResponse) -> byte
 
 
 def _encode_write_coil_request(m: WriteCoilRequest) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0):
+    if not 0 <= m.unit <= 247:
         raise out_of_range('write_coil request', 'unit', m.unit, 1, 247)
     if not 0 <= m.address <= 65535:
         raise out_of_range('write_coil request', 'address', m.address, 0, 65535)
@@ -508,7 +508,7 @@ def _encode_write_coil_request(m: WriteCoilRequest) -> bytes:
 
 
 def _encode_write_coil_response(m: WriteCoilResponse) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0):
+    if not 0 <= m.unit <= 247:
         raise out_of_range('write_coil response', 'unit', m.unit, 1, 247)
     if not 0 <= m.address <= 65535:
         raise out_of_range('write_coil response', 'address', m.address, 0, 65535)
@@ -518,7 +518,7 @@ def _encode_write_coil_response(m: WriteCoilResponse) -> bytes:
 
 
 def _encode_write_register_request(m: WriteRegisterRequest) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0):
+    if not 0 <= m.unit <= 247:
         raise out_of_range('write_register request', 'unit', m.unit, 1, 247)
     if not 0 <= m.address <= 65535:
         raise out_of_range('write_register request', 'address', m.address, 0, 65535)
@@ -528,7 +528,7 @@ def _encode_write_register_request(m: WriteRegisterRequest) -> bytes:
 
 
 def _encode_write_register_response(m: WriteRegisterResponse) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0):
+    if not 0 <= m.unit <= 247:
         raise out_of_range('write_register response', 'unit', m.unit, 1, 247)
     if not 0 <= m.address <= 65535:
         raise out_of_range('write_register response', 'address', m.address, 0, 65535)
@@ -538,7 +538,7 @@ def _encode_write_register_response(m: WriteRegisterResponse) -> bytes:
 
 
 def _encode_write_coils_request(m: WriteCoilsRequest) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0):
+    if not 0 <= m.unit <= 247:
         raise out_of_range('write_coils request', 'unit', m.unit, 1, 247)
     if not 0 <= m.address <= 65535:
         raise out_of_range('write_coils request', 'address', m.address, 0, 65535)
@@ -552,7 +552,7 @@ def _encode_write_coils_request(m: WriteCoilsRequest) -> bytes:
 
 
 def _encode_write_coils_response(m: WriteCoilsResponse) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0):
+    if not 0 <= m.unit <= 247:
         raise out_of_range('write_coils response', 'unit', m.unit, 1, 247)
     if not 0 <= m.address <= 65535:
         raise out_of_range('write_coils response', 'address', m.address, 0, 65535)
@@ -562,7 +562,7 @@ def _encode_write_coils_response(m: WriteCoilsResponse) -> bytes:
 
 
 def _encode_write_registers_request(m: WriteRegistersRequest) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0):
+    if not 0 <= m.unit <= 247:
         raise out_of_range('write_registers request', 'unit', m.unit, 1, 247)
     if not 0 <= m.address <= 65535:
         raise out_of_range('write_registers request', 'address', m.address, 0, 65535)
@@ -578,7 +578,7 @@ def _encode_write_registers_request(m: WriteRegistersRequest) -> bytes:
 
 
 def _encode_write_registers_response(m: WriteRegistersResponse) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0):
+    if not 0 <= m.unit <= 247:
         raise out_of_range('write_registers response', 'unit', m.unit, 1, 247)
     if not 0 <= m.address <= 65535:
         raise out_of_range('write_registers response', 'address', m.address, 0, 65535)
@@ -588,7 +588,7 @@ def _encode_write_registers_response(m: WriteRegistersResponse) -> bytes:
 
 
 def _encode_mask_write_register_request(m: MaskWriteRegisterRequest) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0):
+    if not 0 <= m.unit <= 247:
         raise out_of_range('mask_write_register request', 'unit', m.unit, 1, 247)
     if not 0 <= m.address <= 65535:
         raise out_of_range('mask_write_register request', 'address', m.address, 0, 65535)
@@ -600,7 +600,7 @@ def _encode_mask_write_register_request(m: MaskWriteRegisterRequest) -> bytes:
 
 
 def _encode_mask_write_register_response(m: MaskWriteRegisterResponse) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0):
+    if not 0 <= m.unit <= 247:
         raise out_of_range('mask_write_register response', 'unit', m.unit, 1, 247)
     if not 0 <= m.address <= 65535:
         raise out_of_range('mask_write_register response', 'address', m.address, 0, 65535)
@@ -612,7 +612,7 @@ def _encode_mask_write_register_response(m: MaskWriteRegisterResponse) -> bytes:
 
 
 def _encode_read_write_registers_request(m: ReadWriteRegistersRequest) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0):
+    if not 0 <= m.unit <= 247:
         raise out_of_range('read_write_registers request', 'unit', m.unit, 1, 247)
     if not 0 <= m.read_address <= 65535:
         raise out_of_range('read_write_registers request', 'read_address', m.read_address, 0, 65535)
@@ -632,7 +632,7 @@ def _encode_read_write_registers_request(m: ReadWriteRegistersRequest) -> bytes:
 
 
 def _encode_read_write_registers_response(m: ReadWriteRegistersResponse) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0):
+    if not 0 <= m.unit <= 247:
         raise out_of_range('read_write_registers response', 'unit', m.unit, 1, 247)
     v_byte_count = (2 * len(m.registers))
     if not 0 <= v_byte_count <= 255:
@@ -643,7 +643,7 @@ def _encode_read_write_registers_response(m: ReadWriteRegistersResponse) -> byte
 
 
 def _encode_exception_response(m: ExceptionResponse) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0):
+    if not 0 <= m.unit <= 247:
         raise out_of_range('exception response', 'unit', m.unit, 1, 247)
     if not 0 <= m.function <= 127:
         raise out_of_range('exception response', 'function', m.function, 0, 127)

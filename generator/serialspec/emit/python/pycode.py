@@ -8,6 +8,7 @@ identifiers, and every piece of spec text reaches generated code through repr(),
 from __future__ import annotations
 
 import re
+import struct
 from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
 
@@ -89,6 +90,9 @@ def takes_the_rest(f: SpecField | None) -> bool:
 
 def is_fixed_run_member(f: SpecField) -> bool:
     return isinstance(f, Scalar | Array | TableBlock) or (isinstance(f, Bytes) and isinstance(f.size, int))
+
+
+_SINGLE_BYTES = re.compile(r"(\d*[bBxs?c])*")  # a struct format whose byte order changes nothing
 
 
 def fixed_runs(fields: list[SpecField]) -> Iterator[list[SpecField] | SpecField]:
@@ -712,6 +716,24 @@ class PackageCode:
                 name = self.struct(f"{message.class_name}_{fields[0].name}", endian + content_format)
                 parts.append(f"{name}.pack({', '.join(args)})")
         else:
+            runs = list(fixed_runs(fields))
+            run_lines: Lines = []
+            if len(runs) > 1 and isinstance(runs[0], list):
+                # a leading run of fixed fields is packed with the frame's head: one struct call and one bytes
+                # object less per frame (the head is little-endian, so the run must be too, or all single bytes)
+                endian, run_format, run_args = self.encode_run_format(runs[0], "m", fields, run_lines, where)
+                if endian == "<" or _SINGLE_BYTES.fullmatch(run_format):
+                    lines.extend(run_lines)
+                    rest = [
+                        self.encode_run(item, message.class_name, "m", fields, lines, where)
+                        if isinstance(item, list)
+                        else self.encode_variable(item, "m", lines, where)
+                        for item in runs[1:]
+                    ]
+                    content = rest[0] if len(rest) == 1 else f"b''.join(({', '.join(rest)},))"
+                    lines.append(f"content = {content}")
+                    lines.extend(self.frame_lines(layout, code, frame_values, (run_format, run_args)))
+                    return lines
             parts = self.encode_fields(fields, message.class_name, "m", lines, where)
         content = parts[0] if len(parts) == 1 else f"b''.join(({', '.join(parts)},))"
         lines.append(f"content = {content if parts else repr(b'')}")
@@ -763,24 +785,36 @@ class PackageCode:
         tail = f"_BYTES[{value}]" if size == 1 else f"({value}).to_bytes({size}, 'little')"
         return [*lines, f"return {body} + {tail}"]
 
-    def frame_lines(self, layout: FrameLayout, code: str, values: list[str]) -> Lines:
-        """Lines that return the frame around the bytes in `content`: inline in each encoder, not a call per frame."""
-        lines: Lines = [f"n = len(content) + {layout.length_adds}" if layout.length_adds else "n = len(content)"]
+    def frame_lines(
+        self, layout: FrameLayout, code: str, values: list[str], prefix: tuple[str, list[str]] | None = None
+    ) -> Lines:
+        """Lines that return the frame around the bytes in `content`: inline in each encoder, not a call per frame.
+
+        `prefix`: struct format (little-endian) and arguments of the content's first fields, packed with the head.
+        """
+        prefix_format, prefix_args = prefix or ("", [])
+        adds = layout.length_adds + struct.calcsize("<" + prefix_format)
+        lines: Lines = [f"n = len(content) + {adds}" if adds else "n = len(content)"]
         length = next(e for e in layout.elements if e.role == "length")
         assert length.type is not None
         lines.append(f"if n > {int(length.type.maximum)}:")
-        lines.append("    raise EncodeError(f'content of {len(content)} bytes does not fit the length field')")
+        size = f"n - {layout.length_adds}" if layout.length_adds else "n"
+        lines.append(f"    raise EncodeError(f'content of {{{size}}} bytes does not fit the length field')")
         head = self.head_format(layout, "<", code, "n", values)
         assert head is not None  # little-endian and a length computed at run time: always possible
         head_format, head_args = head
-        name = self.struct(f"head_{layout.direction.value}", "<" + head_format)
-        lines.append(f"body = {name}.pack({', '.join(head_args)}) + content")
+        base = f"head_{layout.direction.value}" + (f"_{prefix_format}" if prefix_format else "")
+        name = self.struct(base, "<" + head_format + prefix_format)
+        lines.append(f"body = {name}.pack({', '.join([*head_args, *prefix_args])}) + content")
         lines.extend(self.checksum_append(layout, "body"))
         return lines
 
     def check_scalar(self, f: Scalar, expr: str, lines: Lines, where: str, also: int | None = None) -> None:
         """Range check; `also` is one more value allowed outside the range (an address's broadcast value)."""
-        if also is not None and not f.minimum <= also <= f.maximum:
+        if also is not None and also in (f.minimum - 1, f.maximum + 1):  # next to the range: one comparison
+            low, high = min(also, f.minimum), max(also, f.maximum)
+            lines.append(f"if not {number(low)} <= {expr} <= {number(high)}:")
+        elif also is not None and not f.minimum <= also <= f.maximum:
             lines.append(f"if not ({number(f.minimum)} <= {expr} <= {number(f.maximum)} or {expr} == {also}):")
         else:
             lines.append(f"if not {number(f.minimum)} <= {expr} <= {number(f.maximum)}:")

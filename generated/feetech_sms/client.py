@@ -259,7 +259,7 @@ class FeetechSmsClient(ClientBase):
         data = self.read_raw(address, register.address, register.size)
         return CONTROL_TABLE.from_wire(register, data or b"")
 
-    def write(self, id: int, **values: int) -> bool | None:
+    def write(self, id: int, /, **values: int) -> bool | None:
         """Write to the control table, by register name: `write(id, goal_position=2048, goal_time=0)`.
 
         The named registers must follow each other in the table (one run of bytes); each value is checked
@@ -271,7 +271,7 @@ class FeetechSmsClient(ClientBase):
             self._remember(id, CONTROL_TABLE[name].address, value)
         return result
 
-    def reg_write(self, id: int, **values: int) -> bool | None:
+    def reg_write(self, id: int, /, **values: int) -> bool | None:
         """Buffered write, run on ACTION, by register name: `reg_write(id, goal_position=2048, goal_time=0)`.
 
         The named registers must follow each other in the table (one run of bytes); each value is checked

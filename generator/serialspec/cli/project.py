@@ -34,6 +34,9 @@ def expected_files(root: Path) -> tuple[dict[Path, str], list[SpecError]]:
             errors.extend(exc.errors)
             continue
         for emitter in emitters():
-            for name, text in emitter.files(protocol).items():
+            emitted = emitter.files(protocol)
+            for name, text in emitted.items():
                 files[root / "generated" / name] = text
+            if emitter.verify is not None:
+                errors.extend(emitter.verify(protocol, emitted))
     return files, errors

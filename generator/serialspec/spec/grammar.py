@@ -7,11 +7,12 @@ references that resolve, sizes that add up) is checked later, in resolve.py.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from typing import Any
 
-from serialspec.spec.loader import Path
+from serialspec.spec.loader import CONTROL, Path
 
 SCALAR_TYPES = ("u8", "i8", "u16", "i16", "u32", "i32", "f32")
 
@@ -34,6 +35,8 @@ class Str(Shape):
     def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
         if not isinstance(value, str):
             yield path, f"expected text, got {_kind(value)}"
+        elif bad := CONTROL.search(value):
+            yield path, f"control character U+{ord(bad.group()):04X} in text (not allowed in a spec)"
         elif self.choices and value not in self.choices:
             yield path, f"unknown value {value!r} (expected one of {', '.join(self.choices)})"
 
@@ -47,25 +50,50 @@ class Str(Shape):
 @dataclass
 class Int(Shape):
     description: str = ""
+    minimum: int | None = None
+    maximum: int | None = None
 
     def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
         if not isinstance(value, int) or isinstance(value, bool):
             yield path, f"expected an integer, got {_kind(value)}"
+        elif (self.minimum is not None and value < self.minimum) or (self.maximum is not None and value > self.maximum):
+            yield path, f"{value} is outside {_bounds(self.minimum, self.maximum)}"
 
     def json_schema(self) -> dict[str, Any]:
-        return {"type": "integer", "description": self.description}
+        schema: dict[str, Any] = {"type": "integer", "description": self.description}
+        if self.minimum is not None:
+            schema["minimum"] = self.minimum
+        if self.maximum is not None:
+            schema["maximum"] = self.maximum
+        return schema
 
 
 @dataclass
 class Num(Shape):
+    """A finite number (NaN and infinities are never a protocol fact)."""
+
     description: str = ""
+    choices: tuple[float, ...] = ()
 
     def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
         if not isinstance(value, int | float) or isinstance(value, bool):
             yield path, f"expected a number, got {_kind(value)}"
+        elif not math.isfinite(value):
+            yield path, f"expected a finite number, got {value}"
+        elif self.choices and value not in self.choices:
+            yield path, f"unknown value {value} (expected one of {', '.join(f'{c:g}' for c in self.choices)})"
 
     def json_schema(self) -> dict[str, Any]:
-        return {"type": "number", "description": self.description}
+        schema: dict[str, Any] = {"type": "number", "description": self.description}
+        if self.choices:
+            schema["enum"] = list(self.choices)
+        return schema
+
+
+def _bounds(minimum: int | None, maximum: int | None) -> str:
+    if minimum is not None and maximum is not None:
+        return f"{minimum}..{maximum}"
+    return f"the minimum {minimum}" if minimum is not None else f"the maximum {maximum}"
 
 
 @dataclass
@@ -557,10 +585,10 @@ SPEC = Obj(
         "byte_order": Str(choices=("little", "big")),
         "serial": Obj(
             {
-                "baudrate": Int(),
-                "bytesize": Int(),
+                "baudrate": Int("Bits per second.", minimum=1),
+                "bytesize": Int("Data bits per character.", minimum=5, maximum=8),
                 "parity": Str(choices=("none", "even", "odd")),
-                "stopbits": Num(),
+                "stopbits": Num(choices=(1, 1.5, 2)),
                 "notes": TEXT,
             },
             required=("baudrate",),

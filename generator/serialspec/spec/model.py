@@ -132,8 +132,9 @@ class Array(Common):
 class Bytes(Common):
     size: int | str  # a number, "rest", or the name of a field holding it
     table: Table | None = None  # when the bytes are a run of registers of this table
-    start: str = ""  # the field (or request.<field>) holding the first register's key
-    size_from: str = ""  # a response's `rest` bytes: the request field giving their number (request.<field>)
+    start: str = ""  # the field holding the first register's key: a field of this content, or of the request
+    start_in_request: bool = False  # `start: request.<field>`: the field is the request's (the resolver checked it)
+    size_from: str = ""  # a response's `rest` bytes: the request field giving their number (`request.<field>`)
 
 
 @dataclass(frozen=True)
@@ -380,6 +381,7 @@ class Example:
     subcommand: str | None
     request: str
     fields: dict[str, object]
+    position: tuple[int, int] = (1, 1)  # line and column in the spec, for errors found after resolution
 
 
 @dataclass(frozen=True)
@@ -404,6 +406,7 @@ class Erratum:
     printed: str
     correct: str
     check: ErratumCheck
+    position: tuple[int, int] = (1, 1)  # line and column of its check in the spec
 
 
 @dataclass(frozen=True)

@@ -175,7 +175,7 @@ def unused_fields(protocol: Protocol, request: Message, response: Message) -> se
     names = {f.name for f in request.fields}
     for f in response.fields:
         if isinstance(f, Bytes) and f.table is not None:
-            needed = [n.removeprefix("request.") for n in (f.start, f.size_from) if n.startswith("request.")]
+            needed = [*([f.start] if f.start_in_request else []), *([f.size_from] if f.size_from else [])]
             if not all(n in names for n in needed):
                 unused.add(f.name)
     return unused
@@ -222,7 +222,7 @@ def register_commands(protocol: Protocol, methods: list[dict[str, Any]]) -> list
         if run is not None and run.table is not None and fields == [address, run.start, run.name]:
             context.update(kind="write", map=map_name(run.table), alias=names_alias(run.table))
         elif read is not None and read.table is not None and group is None and len(fields) == 3:
-            start, size = (read.start.removeprefix("request."), read.size_from.removeprefix("request."))
+            start, size = read.start, read.size_from
             if fields != [address, start, size]:
                 continue
             # the first register read also reads the parameters that switch optional replies (one _read_key)
@@ -230,7 +230,7 @@ def register_commands(protocol: Protocol, methods: list[dict[str, Any]]) -> list
             context.update(kind="read", map=map_name(read.table), alias=names_alias(read.table), returns="int")
             context.update(read_key=first)
         elif group is not None and read is not None and read.table is not None and method["kind"] == "each":
-            start, size = (read.start.removeprefix("request."), read.size_from.removeprefix("request."))
+            start, size = read.start, read.size_from
             if fields != [address, start, size, group.name] or [f.name for f in group.fields] != [address]:
                 continue
             context.update(kind="each_read", map=map_name(read.table), alias=names_alias(read.table), group=group.name)

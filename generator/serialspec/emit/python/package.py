@@ -93,6 +93,7 @@ def emit_package(protocol: Protocol) -> dict[str, str]:
             **base,
             enums=enums,
             flag_sets=flag_sets,
+            enum_imports=[name for name, used in (("IntEnum", enums), ("IntFlag", flag_sets)) if used],
             classes=classes,
             message_classes=[c for c in classes if c["name"] in messages],
             exports=exports,

@@ -32,7 +32,7 @@ def table_fields(*messages: Message | None) -> dict[str, tuple[str, ...]]:
             found[f.name] = ("block", *(e.name for e in f.entries))
         elif isinstance(f, Bytes) and f.table is not None and f.start:
             # the request's fields are the device's `given` values, so `request.address` is `address` there
-            found[f.name] = ("run", f.start.removeprefix("request."), f.size_from.removeprefix("request."))
+            found[f.name] = ("run", f.start, f.size_from)
         elif isinstance(f, Group):
             stack.extend(reversed(f.fields))
     return found

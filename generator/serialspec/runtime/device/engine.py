@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import logging
 import threading
 import time
 from collections.abc import Callable, Iterable
@@ -14,6 +15,8 @@ from serialspec.runtime.errors import EncodeError
 from serialspec.runtime.message import Message
 from serialspec.runtime.registers import RegisterMap
 from serialspec.runtime.stream import StreamParser
+
+LOG = logging.getLogger("serialspec.sim")
 
 
 @dataclass(frozen=True)
@@ -252,7 +255,9 @@ class Engine(FaultInjection):
         values = {k: int(v) if isinstance(v, float) and v.is_integer() else v for k, v in values.items()}
         try:
             return self.encode(response.from_fields(values))  # type: ignore[attr-defined]
-        except EncodeError:
+        except (EncodeError, TypeError, ValueError, KeyError) as exc:
+            # never silent: the reply is not sent, and one line says why
+            LOG.warning("simulator: no %s reply: %s", response.__name__, str(exc).splitlines()[0] if str(exc) else exc)
             return None
 
     def act(

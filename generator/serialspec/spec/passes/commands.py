@@ -7,6 +7,7 @@ from typing import Any
 from serialspec.spec.errors import SpecError
 from serialspec.spec.loader import Path
 from serialspec.spec.model import (
+    Bytes,
     Command,
     Direction,
     Field,
@@ -20,6 +21,8 @@ from serialspec.spec.model import (
     TableEntry,
     content_bounds,
     fixed_size,
+    replies_by_request,
+    reply_to,
 )
 from serialspec.spec.passes.base import camel
 from serialspec.spec.passes.fields import FieldResolver
@@ -35,8 +38,75 @@ class Commands(FieldResolver):
                 self.ctx.commands.append(command)
         if self.ctx.framing:
             self.check_codes(self.ctx.commands, self.ctx.framing)
+            self.check_lengths(self.ctx.commands, self.ctx.framing)
         self.check_answered_by(self.ctx.commands)
+        self.check_request_references(self.ctx.commands)
+        self.check_matching(self.ctx.commands, self.ctx.framing)
         return self.problems
+
+    def check_lengths(self, commands: list[Command], framing: Framing) -> None:
+        """Every message's smallest content must be countable by its frame's length element."""
+        for command in commands:
+            for message in command.messages():
+                layout = framing.layouts[message.direction]
+                length = next(e for e in layout.elements if e.role == "length")
+                assert length.type is not None
+                countable = int(length.type.maximum) - layout.length_adds
+                if message.min_size > countable:
+                    self.error(
+                        message_path(message),
+                        f"content of at least {message.min_size} bytes is more than the {length.type.name} length "
+                        f"element {length.name!r} can count ({countable})",
+                    )
+
+    def check_request_references(self, commands: list[Command]) -> None:
+        """A response's `after`, `start: request.<field>` and `size_from` name fields of the requests it answers."""
+        messages = [m for c in commands for m in c.messages()]
+        replies = replies_by_request(messages)
+        requests = {m.key: m for m in messages if m.direction == Direction.REQUEST}
+        answered: dict[str, list[Message]] = {}
+        for request in requests.values():
+            response = reply_to(request, replies)
+            if response is not None:
+                answered.setdefault(response.key, []).append(request)
+        for message in messages:
+            if message.direction != Direction.RESPONSE:
+                continue
+            path = message_path(message)
+            if message.answers and message.answers not in requests:
+                known = ", ".join(requests) or "none"
+                self.error((*path, "answers"), f"unknown request {message.answers!r} (expected one of: {known})")
+            asked = answered.get(message.key, [])
+            wanted: list[tuple[Path, str]] = []
+            if message.after:
+                wanted.append(((*path, "after"), message.after))
+            for f in message.fields:
+                if isinstance(f, Bytes) and f.start_in_request:
+                    wanted.append(((*path, "fields", f.name, "start"), f.start))
+                if isinstance(f, Bytes) and f.size_from:
+                    wanted.append(((*path, "fields", f.name, "size_from"), f.size_from))
+            for where, name in wanted:
+                if name in self.ctx.broken:
+                    continue
+                if not any(integer_field(r, name) for r in asked):
+                    names = sorted({f.name for r in asked for f in r.fields if isinstance(f, Scalar)})
+                    known = ", ".join(names) or "none"
+                    self.error(
+                        where,
+                        f"no request this response answers has an integer field {name!r} (they have: {known})",
+                    )
+
+    def check_matching(self, commands: list[Command], framing: Framing | None) -> None:
+        """`matching.by` names frame elements or fields that requests and their replies carry."""
+        names = {e.name for layout in (framing.layouts.values() if framing else ()) for e in layout.value_elements}
+        names |= {f.name for c in commands for m in c.messages() for f in m.fields}
+        names |= {"command", "subcommand"}  # the message's own command and sub-command
+        if framing is None:
+            return  # the frame's elements are unknown: its problems are reported
+        names |= self.ctx.broken
+        for index, name in enumerate(self.ctx.matching):
+            if name not in names:
+                self.error(("matching", "by", index), f"unknown field {name!r} (no frame element or field has it)")
 
     def command(self, name: str, value: dict[str, Any], path: Path) -> Command:
         self.name(name, path, "command name")
@@ -63,6 +133,12 @@ class Commands(FieldResolver):
                         f"code {sub['code']:#04x} is already used by {codes[sub['code']]!r}",
                     )
                 codes[sub["code"]] = sub_name
+                if not selector.type.minimum <= sub["code"] <= selector.type.maximum:
+                    self.error(
+                        (*sub_path, "code"),
+                        f"code {sub['code']} does not fit the {selector.type.name} selector "
+                        f"({selector.type.minimum:g}..{selector.type.maximum:g})",
+                    )
                 messages = {
                     d: self.guard(
                         (*sub_path, d.value),
@@ -124,6 +200,23 @@ class Commands(FieldResolver):
                     )
 
     def check_codes(self, commands: list[Command], framing: Framing) -> None:
+        for command in commands:
+            element = next(
+                (
+                    e
+                    for d, layout in framing.layouts.items()
+                    for e in layout.elements
+                    if e.role == "command" and any(m.direction == d for m in command.messages())
+                ),
+                None,
+            )
+            if element is not None and element.type is not None and isinstance(command.code, int):
+                low, high = element.type.minimum, element.type.maximum
+                if not low <= command.code <= high:
+                    self.error(
+                        ("commands", command.name, "code"),
+                        f"code {command.code} does not fit the {element.type.name} command element ({low:g}..{high:g})",
+                    )
         for direction, layout in framing.layouts.items():
             seen: dict[int | None, str] = {}
             for command in commands:
@@ -131,6 +224,8 @@ class Commands(FieldResolver):
                 if not has:
                     continue
                 path: Path = ("commands", command.name)
+                if command.code is not None and not isinstance(command.code, int):
+                    continue  # not a number: the structural check has said so
                 if layout.command_offset is None:
                     if command.code is not None:
                         self.error((*path, "code"), f"{direction.value} frames have no command field, so no code")
@@ -244,3 +339,14 @@ class Commands(FieldResolver):
         if position == offset:
             return (*fields, const)
         raise self.fail(path, f"the selector's offset {offset} does not fall between fixed-size fields")
+
+
+def message_path(message: Message) -> Path:
+    """Where a message is in the spec."""
+    if message.subcommand is not None:
+        return ("commands", message.command, "subcommands", message.subcommand, message.direction.value)
+    return ("commands", message.command, message.direction.value)
+
+
+def integer_field(message: Message, name: str) -> bool:
+    return any(isinstance(f, Scalar) and not f.type.is_float and f.name == name for f in message.fields)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Container
 from typing import Any
 
 from serialspec.spec.errors import SpecError
@@ -12,13 +13,25 @@ from serialspec.spec.model import (
     Device,
     DeviceKind,
     Direction,
+    Field,
     Framing,
     Group,
     Motion,
+    Scalar,
     replies_by_request,
     reply_to,
 )
 from serialspec.spec.passes.base import Pass
+
+
+class _Everything:
+    """Contains every name: what an unknown kind or group is checked against (it is reported once itself)."""
+
+    def __contains__(self, name: object) -> bool:
+        return True
+
+
+EVERYTHING = _Everything()
 
 
 class DevicePass(Pass):
@@ -35,9 +48,15 @@ class DevicePass(Pass):
     def device(self, value: dict[str, Any], path: Path, commands: list[Command], framing: Framing) -> Device:
         memory = self.reference("table", self.tables, value.get("memory"), (*path, "memory"))
         entries = {e.name: e for e in memory.entries} if memory else {}
-        for name in value.get("initial") or {}:
+        for name, initial in (value.get("initial") or {}).items():
             if name not in entries:
                 self.error((*path, "initial", name), f"unknown memory entry {name!r}")
+            elif not entries[name].minimum <= initial <= entries[name].maximum:
+                entry = entries[name]
+                self.error(
+                    (*path, "initial", name),
+                    f"initial value {initial} is outside {name}'s range {entry.minimum:g}..{entry.maximum:g}",
+                )
         address_element = next(
             (e for layout in framing.layouts.values() for e in layout.value_elements if e.role == "address"), None
         )
@@ -62,25 +81,34 @@ class DevicePass(Pass):
             )
             for name, kind in (value.get("kinds") or {}).items()
         }
+        self.check_ids(value, path, commands, framing)
+        broken = self.ctx.broken
         behaviours = []
         for key, item in (value.get("commands") or {}).items():
             item_path = (*path, "commands", key)
             request = requests.get(key)
+            if request is None and key in self.ctx.broken:
+                continue  # the command failed to resolve: its problem is reported
             if request is None:
                 self.error(item_path, f"unknown command {key!r} (or it has no request)")
                 continue
             kind_name = str(item.get("kind", ""))
             if kind_name and kind_name not in kinds:
                 self.error((*item_path, "kind"), f"unknown device kind {kind_name!r} (not in `kinds:`)")
-            known_state = kinds[kind_name].state if kind_name in kinds else state
+            # an unknown kind or group is reported once: the names that depend on it are not checked
+            known_state: Container[str] = (
+                kinds[kind_name].state if kind_name in kinds else EVERYTHING if kind_name else state
+            )
             response = reply_to(request, replies)
             each = str(item.get("each", ""))
             group = next((f for f in request.fields if isinstance(f, Group) and f.name == each), None)
             if each and group is None:
                 self.error((*item_path, "each"), f"{key} has no group field {each!r}")
             item_fields = group.fields if group else ()
-            request_names = {f.name for f in (*request.fields, *item_fields)}
-            response_names = {f.name for f in response.fields} if response else set()
+            request_names: Container[str] = (
+                EVERYTHING if each and group is None else {f.name for f in (*request.fields, *item_fields)} | broken
+            )
+            response_names = ({f.name for f in response.fields} if response else set()) | broken
             for name in item.get("reads") or ():
                 if name not in response_names:
                     self.error((*item_path, "reads"), f"{key} has no response field {name!r}")
@@ -159,3 +187,33 @@ class DevicePass(Pass):
             kinds=tuple(kinds.values()),
             echo_address=bool(value.get("echo_address", False)),
         )
+
+    def check_ids(self, value: dict[str, Any], path: Path, commands: list[Command], framing: Framing) -> None:
+        """`address` (and each kind's) names an integer the requests carry; `reply`, `refused`, `status` name what
+        the responses carry."""
+        elements = {e.name: e for layout in framing.layouts.values() for e in layout.value_elements}
+        carried: dict[Direction, dict[str, Field]] = {Direction.REQUEST: {}, Direction.RESPONSE: {}}
+        for command in commands:
+            for message in command.messages():
+                stack = list(message.fields)
+                while stack:
+                    f = stack.pop()
+                    carried[message.direction].setdefault(f.name, f)
+                    if isinstance(f, Group):
+                        stack.extend(f.fields)
+        wanted = [((*path, "address"), value.get("address"))]
+        wanted += [
+            ((*path, "kinds", k, "address"), kind.get("address")) for k, kind in (value.get("kinds") or {}).items()
+        ]
+        for where, name in wanted:
+            if name is None or name in elements:
+                continue
+            found = carried[Direction.REQUEST].get(name)
+            if found is None:
+                self.error(where, f"unknown field {name!r}: no request carries it (nor the frame)")
+            elif not isinstance(found, Scalar) or found.type.is_float:
+                self.error(where, f"{name!r} is no integer field, so it cannot hold a device id")
+        for key in ("reply", "refused", "status"):
+            for name in value.get(key) or {}:
+                if name not in elements and name not in carried[Direction.RESPONSE]:
+                    self.error((*path, key, name), f"unknown response field {name!r}: no response carries it")

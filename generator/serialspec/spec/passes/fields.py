@@ -86,13 +86,31 @@ class FieldResolver(Pass):
             size = spec.get("size")
             if size is None:
                 raise self.fail(path, "bytes need `size`: a number, `rest`, or a field name")
+            if isinstance(size, int) and size < 1:
+                raise self.fail((*path, "size"), f"size {size}: bytes of a fixed size hold at least one byte")
             table = self.reference("table", self.tables, spec.get("table"), (*path, "table"))
             if isinstance(size, str) and size != "rest":
                 self.size_field(size, name, siblings, parent, path)
             size_from = str(spec.get("size_from", ""))
             if size_from and (size != "rest" or not size_from.startswith("request.")):
                 self.error((*path, "size_from"), "`size_from: request.<field>` goes with `size: rest`")
-            return Bytes(**common, size=size, table=table, start=str(spec.get("start", "")), size_from=size_from)
+            start = str(spec.get("start", ""))
+            if start and table is None:
+                self.error((*path, "start"), "`start` goes with `table:` (the bytes are a run of its registers)")
+            if start and not start.startswith("request."):
+                earlier = [f for f in (*siblings, *(parent or ())) if f.name == start]
+                if not earlier or not isinstance(earlier[0], Scalar) or earlier[0].type.is_float:
+                    raise self.fail(
+                        (*path, "start"), f"unknown field {start!r}: `start` names an earlier integer field"
+                    )
+            return Bytes(
+                **common,
+                size=size,
+                table=table,
+                start=start.removeprefix("request."),
+                start_in_request=start.startswith("request."),
+                size_from=size_from.removeprefix("request."),
+            )
         if kind == "array":
             item_type = self.scalar_type(spec.get("of"), (*path, "of"))
             count = spec.get("count")
@@ -149,6 +167,8 @@ class FieldResolver(Pass):
         const = spec.get("const")
         if const is not None and not low <= const <= high:
             self.error((*path, "const"), f"constant {const} is outside {low:g}..{high:g}")
+        if spec.get("scale") == 0:
+            self.error((*path, "scale"), "scale 0 would make every value 0 (give the size of one wire step)")
         default = spec.get("default")
         if default is not None and not low <= default <= high:
             self.error((*path, "default"), f"default {default} is outside the range {low:g}..{high:g}")

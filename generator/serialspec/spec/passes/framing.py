@@ -49,6 +49,8 @@ class FramingPass(Pass):
                         raise self.fail((*item_path, "value"), f"no header given for {direction.value}")
                     try:
                         headers[direction] = parse_hex(text)
+                        if not headers[direction]:
+                            raise ValueError("a header needs at least one byte")
                     except ValueError as exc:
                         raise self.fail((*item_path, "value"), str(exc)) from None
                 sizes = {len(headers[d]) for d in directions}
@@ -63,6 +65,9 @@ class FramingPass(Pass):
             low, high = (scalar.minimum, scalar.maximum) if scalar else (0, 0)
             if "range" in item and scalar:
                 low, high = self.bounds(scalar, False, item["range"], (*item_path, "range"))
+            broadcast = item.get("broadcast")
+            if broadcast is not None and scalar is not None and not scalar.minimum <= broadcast <= scalar.maximum:
+                self.error((*item_path, "broadcast"), f"broadcast {broadcast} does not fit {scalar.name}")
             element = FrameElement(
                 name=name,
                 role=role,
@@ -89,12 +94,12 @@ class FramingPass(Pass):
         covers = item.get("covers")
         if not covers:
             raise self.fail(path, "a checksum needs `covers: [first, last]` (frame element names)")
-        for covered in covers:
-            if covered not in names:
-                self.error(
-                    (*path, "covers"),
-                    f"unknown frame element {covered!r} (expected one of {', '.join(names)})",
-                )
+        unknown = [covered for covered in covers if covered not in names]
+        if unknown:
+            raise self.fail(
+                (*path, "covers"),
+                f"unknown frame element {unknown[0]!r} (expected one of {', '.join(names)})",
+            )
         algorithm = item.get("algorithm")
         crc = None
         if algorithm == "crc":

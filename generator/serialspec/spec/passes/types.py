@@ -48,6 +48,12 @@ class Types(Pass):
             if not scalar.minimum <= number <= scalar.maximum:
                 self.error(item_path, f"value {number} does not fit {scalar.name}")
             seen[number] = str(label)
+            same = next(
+                (other for other in value["values"] if other != label and str(other).upper() == str(label).upper()),
+                None,
+            )
+            if same is not None and any(v.name == str(label).upper() for v in values):
+                self.error(item_path, f"enum label {label!r} is the same as {same!r} once upper-cased")
             values.append(EnumValue(str(label).upper(), number, text))
         self.enums[key] = EnumDef(
             key, self.class_name(camel(key), path), scalar, str(value.get("description", "")), tuple(values)
@@ -64,6 +70,9 @@ class Types(Pass):
             if not 0 <= bit < scalar.size * 8:
                 self.error((*path, "bits", label), f"bit {bit} is outside a {scalar.name}")
             text = "" if isinstance(item, int) else str(item.get("text", ""))
+            if any(b.name == str(label).upper() for b in bits):
+                same = next(other for other in value["bits"] if str(other).upper() == str(label).upper())
+                self.error((*path, "bits", label), f"flag name {label!r} is the same as {same!r} once upper-cased")
             bits.append(FlagBit(str(label).upper(), bit, text))
         self.flags[key] = FlagsDef(
             key, self.class_name(camel(key), path), scalar, str(value.get("description", "")), tuple(bits)
@@ -83,6 +92,11 @@ class Types(Pass):
             sign_magnitude = item.get("encoding") == "sign_magnitude"
             sign_bit = self.sign_bit(scalar, sign_magnitude, item.get("sign_bit"), (*entry_path, "sign_bit"))
             low, high = self.bounds(scalar, sign_magnitude, item.get("range"), (*entry_path, "range"), sign_bit)
+            if item.get("scale") == 0:
+                self.error((*entry_path, "scale"), "scale 0 would make every value 0 (give the size of one wire step)")
+            default = item.get("default")
+            if isinstance(default, int | float) and not low <= default <= high:
+                self.error((*entry_path, "default"), f"default {default} is outside the range {low:g}..{high:g}")
             entries.append(
                 TableEntry(
                     name=entry_name,
@@ -105,6 +119,10 @@ class Types(Pass):
                     sign_bit=sign_bit,
                 )
             )
+        # the generated register map, table values and register-name alias are named after the table
+        self.class_name(key.upper(), path)
+        self.class_name(f"{key.upper()}_VALUE", path)
+        self.class_name(camel(key, "name"), path)
         if value.get("key_type") is None:
             self.check_table_layout(entries, path)
         self.tables[key] = Table(
@@ -122,7 +140,7 @@ class Types(Pass):
             return
         ordered = sorted(entries, key=lambda e: e.key)
         for before, after in zip(ordered, ordered[1:], strict=False):
-            if before.key + before.type.size > after.key:
+            if before.key < after.key < before.key + before.type.size:
                 self.error(
                     (*path, "entries", after.name, "key"),
                     f"register {after.name} at {after.key:#04x} overlaps {before.name} "

@@ -8,6 +8,7 @@ from collections.abc import Callable
 
 from serialspec.runtime.checksums import BYTE_VALUES as _BYTES
 from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError, content_size_error, out_of_range
+from serialspec.runtime.fields import wrong_type
 from serialspec.runtime.message import Direction, Message, members, slot_setters
 from serialspec.runtime.stream import FrameFormat
 from serialspec.runtime.stream import StreamParser as _StreamParser
@@ -471,48 +472,48 @@ def _decode_read_angle_response(buf: bytes, o: int, end: int) -> ReadAngleRespon
 
 
 def _encode_ping_request(m: PingRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('ping request', 'servo_id', m.servo_id, 0, 254)
     body = _S_B2_U8_U8_U8.pack(b'\x12L', 1, 1, m.servo_id)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_ping_response(m: PingResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('ping response', 'servo_id', m.servo_id, 0, 254)
     body = _S_B2_U8_U8_U8.pack(b'\x05\x1c', 1, 1, m.servo_id)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_reset_user_data_request(m: ResetUserDataRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('reset_user_data request', 'servo_id', m.servo_id, 0, 254)
     body = _S_B2_U8_U8_U8.pack(b'\x12L', 2, 1, m.servo_id)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_reset_user_data_response(m: ResetUserDataResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('reset_user_data response', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.result <= 255:
+    if not 0 <= m.result <= 255 or m.result.__class__ is bool:
         raise out_of_range('reset_user_data response', 'result', m.result, 0, 255)
     body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 2, 2, m.servo_id, m.result)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_read_data_request(m: ReadDataRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('read_data request', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.data_id <= 255:
+    if not 0 <= m.data_id <= 255 or m.data_id.__class__ is bool:
         raise out_of_range('read_data request', 'data_id', m.data_id, 0, 255)
     body = _S_B2_U8_U8_U8_U8.pack(b'\x12L', 3, 2, m.servo_id, m.data_id)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_read_data_response(m: ReadDataResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('read_data response', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.data_id <= 255:
+    if not 0 <= m.data_id <= 255 or m.data_id.__class__ is bool:
         raise out_of_range('read_data response', 'data_id', m.data_id, 0, 255)
     s = _TABLE_PARAMETERS.get(m.data_id)
     if s is None:
@@ -529,9 +530,9 @@ def _encode_read_data_response(m: ReadDataResponse) -> bytes:
 
 
 def _encode_write_data_request(m: WriteDataRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('write_data request', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.data_id <= 255:
+    if not 0 <= m.data_id <= 255 or m.data_id.__class__ is bool:
         raise out_of_range('write_data request', 'data_id', m.data_id, 0, 255)
     s = _TABLE_PARAMETERS.get(m.data_id)
     if s is None:
@@ -548,25 +549,25 @@ def _encode_write_data_request(m: WriteDataRequest) -> bytes:
 
 
 def _encode_write_data_response(m: WriteDataResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('write_data response', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.data_id <= 255:
+    if not 0 <= m.data_id <= 255 or m.data_id.__class__ is bool:
         raise out_of_range('write_data response', 'data_id', m.data_id, 0, 255)
-    if not 0 <= m.result <= 255:
+    if not 0 <= m.result <= 255 or m.result.__class__ is bool:
         raise out_of_range('write_data response', 'result', m.result, 0, 255)
     body = _S_B2_U8_U8_U8_U8_U8.pack(b'\x05\x1c', 4, 3, m.servo_id, m.data_id, m.result)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_read_batch_data_request(m: ReadBatchDataRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('read_batch_data request', 'servo_id', m.servo_id, 0, 254)
     body = _S_B2_U8_U8_U8.pack(b'\x12L', 5, 1, m.servo_id)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_read_batch_data_response(m: ReadBatchDataResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('read_batch_data response', 'servo_id', m.servo_id, 0, 254)
     if not 0 <= m.user_data.reserved_32 <= 255:
         raise out_of_range('read_batch_data response', 'user_data.reserved_32', m.user_data.reserved_32, 0, 255)
@@ -617,7 +618,7 @@ def _encode_read_batch_data_response(m: ReadBatchDataResponse) -> bytes:
 
 
 def _encode_write_batch_data_request(m: WriteBatchDataRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('write_batch_data request', 'servo_id', m.servo_id, 0, 254)
     if not 0 <= m.user_data.reserved_32 <= 255:
         raise out_of_range('write_batch_data request', 'user_data.reserved_32', m.user_data.reserved_32, 0, 255)
@@ -668,89 +669,89 @@ def _encode_write_batch_data_request(m: WriteBatchDataRequest) -> bytes:
 
 
 def _encode_write_batch_data_response(m: WriteBatchDataResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('write_batch_data response', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.result <= 255:
+    if not 0 <= m.result <= 255 or m.result.__class__ is bool:
         raise out_of_range('write_batch_data response', 'result', m.result, 0, 255)
     body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 6, 2, m.servo_id, m.result)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_spin_request(m: SpinRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('spin request', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.method.direction <= 1:
+    if not 0 <= m.method.direction <= 1 or m.method.direction.__class__ is bool:
         raise out_of_range('spin request', 'method.direction', m.method.direction, 0, 1)
-    if not 0 <= m.method.mode <= 3:
+    if not 0 <= m.method.mode <= 3 or m.method.mode.__class__ is bool:
         raise out_of_range('spin request', 'method.mode', m.method.mode, 0, 3)
-    if not 0 <= m.speed <= 65535:
+    if not 0 <= m.speed <= 65535 or m.speed.__class__ is bool:
         raise out_of_range('spin request', 'speed', m.speed, 0, 65535)
-    if not 0 <= m.value <= 65535:
+    if not 0 <= m.value <= 65535 or m.value.__class__ is bool:
         raise out_of_range('spin request', 'value', m.value, 0, 65535)
     body = _S_FRAME_SPINREQUEST.pack(b'\x12L', 7, 6, m.servo_id, (m.method.direction << 7) | m.method.mode, m.speed, m.value)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_spin_response(m: SpinResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('spin response', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.result <= 255:
+    if not 0 <= m.result <= 255 or m.result.__class__ is bool:
         raise out_of_range('spin response', 'result', m.result, 0, 255)
     body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 7, 2, m.servo_id, m.result)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_rotate_request(m: RotateRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('rotate request', 'servo_id', m.servo_id, 0, 254)
-    if not -32768 <= m.angle <= 32767:
+    if not -32768 <= m.angle <= 32767 or m.angle.__class__ is bool:
         raise out_of_range('rotate request', 'angle', m.angle, -32768, 32767)
-    if not 0 <= m.interval <= 65535:
+    if not 0 <= m.interval <= 65535 or m.interval.__class__ is bool:
         raise out_of_range('rotate request', 'interval', m.interval, 0, 65535)
-    if not 0 <= m.power <= 65535:
+    if not 0 <= m.power <= 65535 or m.power.__class__ is bool:
         raise out_of_range('rotate request', 'power', m.power, 0, 65535)
     body = _S_FRAME_ROTATEREQUEST.pack(b'\x12L', 8, 7, m.servo_id, m.angle, m.interval, m.power)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_rotate_response(m: RotateResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('rotate response', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.result <= 255:
+    if not 0 <= m.result <= 255 or m.result.__class__ is bool:
         raise out_of_range('rotate response', 'result', m.result, 0, 255)
     body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 8, 2, m.servo_id, m.result)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_damping_request(m: DampingRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('damping request', 'servo_id', m.servo_id, 0, 255)
-    if not 0 <= m.power <= 65535:
+    if not 0 <= m.power <= 65535 or m.power.__class__ is bool:
         raise out_of_range('damping request', 'power', m.power, 0, 65535)
     body = _S_B2_U8_U8_U8_U16.pack(b'\x12L', 9, 3, m.servo_id, m.power)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_damping_response(m: DampingResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('damping response', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.result <= 255:
+    if not 0 <= m.result <= 255 or m.result.__class__ is bool:
         raise out_of_range('damping response', 'result', m.result, 0, 255)
     body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 9, 2, m.servo_id, m.result)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_read_angle_request(m: ReadAngleRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('read_angle request', 'servo_id', m.servo_id, 0, 254)
     body = _S_B2_U8_U8_U8.pack(b'\x12L', 10, 1, m.servo_id)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_read_angle_response(m: ReadAngleResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('read_angle response', 'servo_id', m.servo_id, 0, 254)
-    if not -32768 <= m.angle <= 32767:
+    if not -32768 <= m.angle <= 32767 or m.angle.__class__ is bool:
         raise out_of_range('read_angle response', 'angle', m.angle, -32768, 32767)
     body = _S_B2_U8_U8_U8_I16.pack(b'\x05\x1c', 10, 3, m.servo_id, m.angle)
     return body + _BYTES[sum(body) & 0xff]
@@ -927,8 +928,10 @@ def encode(message: Message) -> bytes:
         raise EncodeError(f"{type(message).__name__} is not a fashionstar_uart message")
     try:
         return encoder(message)
-    except (TypeError, AttributeError, struct.error) as exc:
-        raise EncodeError(f"{message.COMMAND} {message.DIRECTION.value}: {exc}") from None
+    except EncodeError:
+        raise
+    except (TypeError, AttributeError, ValueError, OverflowError, struct.error) as exc:
+        raise wrong_type(message, exc) from None  # one line naming the field, not Python's words
 
 
 class StreamParser(_StreamParser):

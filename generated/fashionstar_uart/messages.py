@@ -9,10 +9,11 @@ from enum import IntEnum
 from typing import Any, ClassVar, Self
 
 from serialspec.runtime.fields import check_keys as _check_keys
+from serialspec.runtime.fields import enum as _as_enum
 from serialspec.runtime.fields import get as _get
+from serialspec.runtime.fields import integer as _integer
 from serialspec.runtime.fields import mapping as _mapping
 from serialspec.runtime.message import Direction, Message
-from serialspec.runtime.message import enum_or_int as _enum
 
 __all__ = [
     'BaudrateOption',
@@ -226,28 +227,28 @@ class UserData:
     def from_fields(cls, data: Mapping[str, Any], where: str = 'UserData') -> Self:
         _check_keys(data, ('reserved_32', 'response_switch', 'servo_id', 'reserved_35', 'baudrate', 'stall_protect_mode', 'stall_power_limit', 'over_volt_low', 'over_volt_high', 'over_temperature', 'over_power', 'over_current', 'accel_switch', 'reserved_45', 'po_lock_switch', 'wb_lock_switch', 'angle_limit_switch', 'soft_start_switch', 'soft_start_time', 'angle_limit_high', 'angle_limit_low', 'angle_mid_offset'), (), where)
         return cls(
-            _get(data, 'reserved_32', where),
-            _enum(ResponseSwitch, _get(data, 'response_switch', where)),
-            _get(data, 'servo_id', where),
-            _get(data, 'reserved_35', where),
-            _enum(BaudrateOption, _get(data, 'baudrate', where)),
-            _enum(StallProtectMode, _get(data, 'stall_protect_mode', where)),
-            _get(data, 'stall_power_limit', where),
-            _get(data, 'over_volt_low', where),
-            _get(data, 'over_volt_high', where),
-            _get(data, 'over_temperature', where),
-            _get(data, 'over_power', where),
-            _get(data, 'over_current', where),
-            _enum(Switch, _get(data, 'accel_switch', where)),
-            _get(data, 'reserved_45', where),
-            _enum(LockOnPowerOn, _get(data, 'po_lock_switch', where)),
-            _enum(WheelBrake, _get(data, 'wb_lock_switch', where)),
-            _enum(Switch, _get(data, 'angle_limit_switch', where)),
-            _enum(Switch, _get(data, 'soft_start_switch', where)),
-            _get(data, 'soft_start_time', where),
-            _get(data, 'angle_limit_high', where),
-            _get(data, 'angle_limit_low', where),
-            _get(data, 'angle_mid_offset', where),
+            _integer(_get(data, 'reserved_32', where), 'reserved_32', where),
+            _as_enum(ResponseSwitch, _get(data, 'response_switch', where), 'response_switch', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'reserved_35', where), 'reserved_35', where),
+            _as_enum(BaudrateOption, _get(data, 'baudrate', where), 'baudrate', where),
+            _as_enum(StallProtectMode, _get(data, 'stall_protect_mode', where), 'stall_protect_mode', where),
+            _integer(_get(data, 'stall_power_limit', where), 'stall_power_limit', where),
+            _integer(_get(data, 'over_volt_low', where), 'over_volt_low', where),
+            _integer(_get(data, 'over_volt_high', where), 'over_volt_high', where),
+            _integer(_get(data, 'over_temperature', where), 'over_temperature', where),
+            _integer(_get(data, 'over_power', where), 'over_power', where),
+            _integer(_get(data, 'over_current', where), 'over_current', where),
+            _as_enum(Switch, _get(data, 'accel_switch', where), 'accel_switch', where),
+            _integer(_get(data, 'reserved_45', where), 'reserved_45', where),
+            _as_enum(LockOnPowerOn, _get(data, 'po_lock_switch', where), 'po_lock_switch', where),
+            _as_enum(WheelBrake, _get(data, 'wb_lock_switch', where), 'wb_lock_switch', where),
+            _as_enum(Switch, _get(data, 'angle_limit_switch', where), 'angle_limit_switch', where),
+            _as_enum(Switch, _get(data, 'soft_start_switch', where), 'soft_start_switch', where),
+            _integer(_get(data, 'soft_start_time', where), 'soft_start_time', where),
+            _integer(_get(data, 'angle_limit_high', where), 'angle_limit_high', where),
+            _integer(_get(data, 'angle_limit_low', where), 'angle_limit_low', where),
+            _integer(_get(data, 'angle_mid_offset', where), 'angle_mid_offset', where),
         )
 
 
@@ -270,8 +271,8 @@ class MethodBits:
     def from_fields(cls, data: Mapping[str, Any], where: str = 'MethodBits') -> Self:
         _check_keys(data, ('direction', 'mode'), (), where)
         return cls(
-            _enum(SpinDirection, _get(data, 'direction', where)),
-            _enum(SpinMode, _get(data, 'mode', where)),
+            _as_enum(SpinDirection, _get(data, 'direction', where), 'direction', where),
+            _as_enum(SpinMode, _get(data, 'mode', where), 'mode', where),
         )
 
 
@@ -295,7 +296,7 @@ class PingRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'ping request') -> Self:
         _check_keys(data, ('servo_id',), (), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -319,7 +320,7 @@ class PingResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'ping response') -> Self:
         _check_keys(data, ('servo_id',), (), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -343,7 +344,7 @@ class ResetUserDataRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'reset_user_data request') -> Self:
         _check_keys(data, ('servo_id',), (), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -370,8 +371,8 @@ class ResetUserDataResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'reset_user_data response') -> Self:
         _check_keys(data, ('servo_id', 'result'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _enum(Result, _get(data, 'result', where)),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(Result, _get(data, 'result', where), 'result', where),
         )
 
 
@@ -398,8 +399,8 @@ class ReadDataRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'read_data request') -> Self:
         _check_keys(data, ('servo_id', 'data_id'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'data_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'data_id', where), 'data_id', where),
         )
 
 
@@ -429,8 +430,8 @@ class ReadDataResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'read_data response') -> Self:
         _check_keys(data, ('servo_id', 'data_id', 'data'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'data_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'data_id', where), 'data_id', where),
             _get(data, 'data', where),
         )
 
@@ -461,8 +462,8 @@ class WriteDataRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'write_data request') -> Self:
         _check_keys(data, ('servo_id', 'data_id', 'data'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'data_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'data_id', where), 'data_id', where),
             _get(data, 'data', where),
         )
 
@@ -493,9 +494,9 @@ class WriteDataResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'write_data response') -> Self:
         _check_keys(data, ('servo_id', 'data_id', 'result'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'data_id', where),
-            _enum(Result, _get(data, 'result', where)),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'data_id', where), 'data_id', where),
+            _as_enum(Result, _get(data, 'result', where), 'result', where),
         )
 
 
@@ -519,7 +520,7 @@ class ReadBatchDataRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'read_batch_data request') -> Self:
         _check_keys(data, ('servo_id',), (), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -546,7 +547,7 @@ class ReadBatchDataResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'read_batch_data response') -> Self:
         _check_keys(data, ('servo_id', 'user_data'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
             UserData.from_fields(_mapping(_get(data, 'user_data', where), 'user_data', where), where),
         )
 
@@ -574,7 +575,7 @@ class WriteBatchDataRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'write_batch_data request') -> Self:
         _check_keys(data, ('servo_id', 'user_data'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
             UserData.from_fields(_mapping(_get(data, 'user_data', where), 'user_data', where), where),
         )
 
@@ -602,8 +603,8 @@ class WriteBatchDataResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'write_batch_data response') -> Self:
         _check_keys(data, ('servo_id', 'result'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _enum(Result, _get(data, 'result', where)),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(Result, _get(data, 'result', where), 'result', where),
         )
 
 
@@ -636,10 +637,10 @@ class SpinRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'spin request') -> Self:
         _check_keys(data, ('servo_id', 'method', 'speed', 'value'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
             MethodBits.from_fields(_mapping(_get(data, 'method', where), 'method', where), where),
-            _get(data, 'speed', where),
-            _get(data, 'value', where),
+            _integer(_get(data, 'speed', where), 'speed', where),
+            _integer(_get(data, 'value', where), 'value', where),
         )
 
 
@@ -666,8 +667,8 @@ class SpinResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'spin response') -> Self:
         _check_keys(data, ('servo_id', 'result'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _enum(Result, _get(data, 'result', where)),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(Result, _get(data, 'result', where), 'result', where),
         )
 
 
@@ -700,10 +701,10 @@ class RotateRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'rotate request') -> Self:
         _check_keys(data, ('servo_id', 'angle', 'interval', 'power'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'angle', where),
-            _get(data, 'interval', where),
-            data.get('power', 0),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'angle', where), 'angle', where),
+            _integer(_get(data, 'interval', where), 'interval', where),
+            _integer(data.get('power', 0), 'power', where),
         )
 
 
@@ -730,8 +731,8 @@ class RotateResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'rotate response') -> Self:
         _check_keys(data, ('servo_id', 'result'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _enum(Result, _get(data, 'result', where)),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(Result, _get(data, 'result', where), 'result', where),
         )
 
 
@@ -758,8 +759,8 @@ class DampingRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'damping request') -> Self:
         _check_keys(data, ('servo_id', 'power'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'power', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'power', where), 'power', where),
         )
 
 
@@ -786,8 +787,8 @@ class DampingResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'damping response') -> Self:
         _check_keys(data, ('servo_id', 'result'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _enum(Result, _get(data, 'result', where)),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(Result, _get(data, 'result', where), 'result', where),
         )
 
 
@@ -811,7 +812,7 @@ class ReadAngleRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'read_angle request') -> Self:
         _check_keys(data, ('servo_id',), (), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -838,8 +839,8 @@ class ReadAngleResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'read_angle response') -> Self:
         _check_keys(data, ('servo_id', 'angle'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'angle', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'angle', where), 'angle', where),
         )
 
 

@@ -10,7 +10,10 @@ from typing import Any, ClassVar, Self
 
 from serialspec.runtime.fields import as_bytes as _bytes
 from serialspec.runtime.fields import check_keys as _check_keys
+from serialspec.runtime.fields import flags as _as_flags
 from serialspec.runtime.fields import get as _get
+from serialspec.runtime.fields import integer as _integer
+from serialspec.runtime.fields import items as _items
 from serialspec.runtime.fields import mapping as _mapping
 from serialspec.runtime.message import Direction, Message
 
@@ -133,7 +136,7 @@ class IdsItem:
     def from_fields(cls, data: Mapping[str, Any], where: str = 'IdsItem') -> Self:
         _check_keys(data, ('id',), (), where)
         return cls(
-            _get(data, 'id', where),
+            _integer(_get(data, 'id', where), 'id', where),
         )
 
 
@@ -156,7 +159,7 @@ class ServosItem:
     def from_fields(cls, data: Mapping[str, Any], where: str = 'ServosItem') -> Self:
         _check_keys(data, ('id', 'data'), (), where)
         return cls(
-            _get(data, 'id', where),
+            _integer(_get(data, 'id', where), 'id', where),
             _bytes(_get(data, 'data', where), 'data', where),
         )
 
@@ -181,7 +184,7 @@ class PingRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'ping request') -> Self:
         _check_keys(data, ('id',), (), where)
         return cls(
-            _get(data, 'id', where),
+            _integer(_get(data, 'id', where), 'id', where),
         )
 
 
@@ -211,9 +214,9 @@ class ReadRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'read request') -> Self:
         _check_keys(data, ('id', 'address', 'length'), (), where)
         return cls(
-            _get(data, 'id', where),
-            _get(data, 'address', where),
-            _get(data, 'length', where),
+            _integer(_get(data, 'id', where), 'id', where),
+            _integer(_get(data, 'address', where), 'address', where),
+            _integer(_get(data, 'length', where), 'length', where),
         )
 
 
@@ -243,8 +246,8 @@ class WriteRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'write request') -> Self:
         _check_keys(data, ('id', 'address', 'data'), (), where)
         return cls(
-            _get(data, 'id', where),
-            _get(data, 'address', where),
+            _integer(_get(data, 'id', where), 'id', where),
+            _integer(_get(data, 'address', where), 'address', where),
             _bytes(_get(data, 'data', where), 'data', where),
         )
 
@@ -275,8 +278,8 @@ class RegWriteRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'reg_write request') -> Self:
         _check_keys(data, ('id', 'address', 'data'), (), where)
         return cls(
-            _get(data, 'id', where),
-            _get(data, 'address', where),
+            _integer(_get(data, 'id', where), 'id', where),
+            _integer(_get(data, 'address', where), 'address', where),
             _bytes(_get(data, 'data', where), 'data', where),
         )
 
@@ -301,7 +304,7 @@ class ActionRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'action request') -> Self:
         _check_keys(data, ('id',), (), where)
         return cls(
-            _get(data, 'id', where),
+            _integer(_get(data, 'id', where), 'id', where),
         )
 
 
@@ -325,7 +328,7 @@ class ResetRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'reset request') -> Self:
         _check_keys(data, ('id',), (), where)
         return cls(
-            _get(data, 'id', where),
+            _integer(_get(data, 'id', where), 'id', where),
         )
 
 
@@ -358,10 +361,10 @@ class SyncReadRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'sync_read request') -> Self:
         _check_keys(data, ('id', 'address', 'length', 'ids'), (), where)
         return cls(
-            _get(data, 'id', where),
-            _get(data, 'address', where),
-            _get(data, 'length', where),
-            tuple(IdsItem.from_fields(_mapping(item, 'ids', where), where) for item in _get(data, 'ids', where)),
+            _integer(_get(data, 'id', where), 'id', where),
+            _integer(_get(data, 'address', where), 'address', where),
+            _integer(_get(data, 'length', where), 'length', where),
+            tuple(IdsItem.from_fields(_mapping(item, 'ids', where), where) for item in _items(_get(data, 'ids', where), 'ids', where)),
         )
 
 
@@ -391,9 +394,9 @@ class SyncWriteRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'sync_write request') -> Self:
         _check_keys(data, ('id', 'address', 'servos'), ('data_length',), where)
         return cls(
-            _get(data, 'id', where),
-            _get(data, 'address', where),
-            tuple(ServosItem.from_fields(_mapping(item, 'servos', where), where) for item in _get(data, 'servos', where)),
+            _integer(_get(data, 'id', where), 'id', where),
+            _integer(_get(data, 'address', where), 'address', where),
+            tuple(ServosItem.from_fields(_mapping(item, 'servos', where), where) for item in _items(_get(data, 'servos', where), 'servos', where)),
         )
 
 
@@ -423,8 +426,8 @@ class ReplyResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'reply response') -> Self:
         _check_keys(data, ('id', 'error', 'data'), (), where)
         return cls(
-            _get(data, 'id', where),
-            ErrorStatus(_get(data, 'error', where)),
+            _integer(_get(data, 'id', where), 'id', where),
+            _as_flags(ErrorStatus, _get(data, 'error', where), 255, 'error', where),
             _bytes(_get(data, 'data', where), 'data', where),
         )
 

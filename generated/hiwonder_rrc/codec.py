@@ -9,6 +9,7 @@ from collections.abc import Callable
 from serialspec.runtime.checksums import BYTE_VALUES as _BYTES
 from serialspec.runtime.checksums import crc_table
 from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError, content_size_error, out_of_range
+from serialspec.runtime.fields import wrong_type
 from serialspec.runtime.message import Direction, Message, members, slot_setters
 from serialspec.runtime.stream import FrameFormat
 from serialspec.runtime.stream import StreamParser as _StreamParser
@@ -753,13 +754,13 @@ def _decode_sbus_response(buf: bytes, o: int, end: int) -> SbusResponse:
 
 
 def _encode_led_request(m: LedRequest) -> bytes:
-    if not 0 <= m.led_id <= 255:
+    if not 0 <= m.led_id <= 255 or m.led_id.__class__ is bool:
         raise out_of_range('led request', 'led_id', m.led_id, 0, 255)
-    if not 0 <= m.on_time <= 65535:
+    if not 0 <= m.on_time <= 65535 or m.on_time.__class__ is bool:
         raise out_of_range('led request', 'on_time', m.on_time, 0, 65535)
-    if not 0 <= m.off_time <= 65535:
+    if not 0 <= m.off_time <= 65535 or m.off_time.__class__ is bool:
         raise out_of_range('led request', 'off_time', m.off_time, 0, 65535)
-    if not 0 <= m.repeat <= 65535:
+    if not 0 <= m.repeat <= 65535 or m.repeat.__class__ is bool:
         raise out_of_range('led request', 'repeat', m.repeat, 0, 65535)
     body = _S_FRAME_LEDREQUEST.pack(b'\xaaU', 1, 7, m.led_id, m.on_time, m.off_time, m.repeat)
     check = 0x0
@@ -769,13 +770,13 @@ def _encode_led_request(m: LedRequest) -> bytes:
 
 
 def _encode_buzzer_request(m: BuzzerRequest) -> bytes:
-    if not 0 <= m.frequency <= 65535:
+    if not 0 <= m.frequency <= 65535 or m.frequency.__class__ is bool:
         raise out_of_range('buzzer request', 'frequency', m.frequency, 0, 65535)
-    if not 0 <= m.on_time <= 65535:
+    if not 0 <= m.on_time <= 65535 or m.on_time.__class__ is bool:
         raise out_of_range('buzzer request', 'on_time', m.on_time, 0, 65535)
-    if not 0 <= m.off_time <= 65535:
+    if not 0 <= m.off_time <= 65535 or m.off_time.__class__ is bool:
         raise out_of_range('buzzer request', 'off_time', m.off_time, 0, 65535)
-    if not 0 <= m.repeat <= 65535:
+    if not 0 <= m.repeat <= 65535 or m.repeat.__class__ is bool:
         raise out_of_range('buzzer request', 'repeat', m.repeat, 0, 65535)
     body = _S_FRAME_BUZZERREQUEST.pack(b'\xaaU', 2, 8, m.frequency, m.on_time, m.off_time, m.repeat)
     check = 0x0
@@ -785,7 +786,7 @@ def _encode_buzzer_request(m: BuzzerRequest) -> bytes:
 
 
 def _encode_motor_set_speed_request(m: MotorSetSpeedRequest) -> bytes:
-    if not 0 <= m.motor_id <= 255:
+    if not 0 <= m.motor_id <= 255 or m.motor_id.__class__ is bool:
         raise out_of_range('motor.set_speed request', 'motor_id', m.motor_id, 0, 255)
     if not -340282346638528859811704183484516925440 <= m.speed <= 340282346638528859811704183484516925440:
         raise out_of_range('motor.set_speed request', 'speed', m.speed, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
@@ -801,7 +802,7 @@ def _encode_motor_set_speeds_request(m: MotorSetSpeedsRequest) -> bytes:
         raise out_of_range('motor.set_speeds request', 'count', len(m.motors), 0, 255)
     parts_motors = []
     for item in m.motors:
-        if not 0 <= item.motor_id <= 255:
+        if not 0 <= item.motor_id <= 255 or item.motor_id.__class__ is bool:
             raise out_of_range('motor.set_speeds request', 'motor_id', item.motor_id, 0, 255)
         if not -340282346638528859811704183484516925440 <= item.speed <= 340282346638528859811704183484516925440:
             raise out_of_range('motor.set_speeds request', 'speed', item.speed, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
@@ -818,7 +819,7 @@ def _encode_motor_set_speeds_request(m: MotorSetSpeedsRequest) -> bytes:
 
 
 def _encode_motor_stop_request(m: MotorStopRequest) -> bytes:
-    if not 0 <= m.motor_id <= 255:
+    if not 0 <= m.motor_id <= 255 or m.motor_id.__class__ is bool:
         raise out_of_range('motor.stop request', 'motor_id', m.motor_id, 0, 255)
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 3, 2, 2, m.motor_id)
     check = 0x0
@@ -828,7 +829,7 @@ def _encode_motor_stop_request(m: MotorStopRequest) -> bytes:
 
 
 def _encode_motor_stop_mask_request(m: MotorStopMaskRequest) -> bytes:
-    if not 0 <= m.mask <= 255:
+    if not 0 <= m.mask <= 255 or isinstance(m.mask, bool):
         raise out_of_range('motor.stop_mask request', 'mask', m.mask, 0, 255)
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 3, 2, 3, m.mask)
     check = 0x0
@@ -838,15 +839,15 @@ def _encode_motor_stop_mask_request(m: MotorStopMaskRequest) -> bytes:
 
 
 def _encode_pwm_servo_set_positions_request(m: PwmServoSetPositionsRequest) -> bytes:
-    if not 0 <= m.duration <= 65535:
+    if not 0 <= m.duration <= 65535 or m.duration.__class__ is bool:
         raise out_of_range('pwm_servo.set_positions request', 'duration', m.duration, 0, 65535)
     if len(m.pwm_servos) > 255:
         raise out_of_range('pwm_servo.set_positions request', 'count', len(m.pwm_servos), 0, 255)
     parts_pwm_servos = []
     for item in m.pwm_servos:
-        if not 0 <= item.servo_id <= 255:
+        if not 0 <= item.servo_id <= 255 or item.servo_id.__class__ is bool:
             raise out_of_range('pwm_servo.set_positions request', 'servo_id', item.servo_id, 0, 255)
-        if not 500 <= item.pulse <= 2500:
+        if not 500 <= item.pulse <= 2500 or item.pulse.__class__ is bool:
             raise out_of_range('pwm_servo.set_positions request', 'pulse', item.pulse, 500, 2500)
         parts_pwm_servos.append(_S_U8_U16.pack(item.servo_id, item.pulse))
     content = b''.join((_S_U8_U16_U8.pack(1, m.duration, len(m.pwm_servos)), b''.join(parts_pwm_servos),))
@@ -861,11 +862,11 @@ def _encode_pwm_servo_set_positions_request(m: PwmServoSetPositionsRequest) -> b
 
 
 def _encode_pwm_servo_set_position_request(m: PwmServoSetPositionRequest) -> bytes:
-    if not 0 <= m.duration <= 65535:
+    if not 0 <= m.duration <= 65535 or m.duration.__class__ is bool:
         raise out_of_range('pwm_servo.set_position request', 'duration', m.duration, 0, 65535)
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('pwm_servo.set_position request', 'servo_id', m.servo_id, 0, 255)
-    if not 500 <= m.pulse <= 2500:
+    if not 500 <= m.pulse <= 2500 or m.pulse.__class__ is bool:
         raise out_of_range('pwm_servo.set_position request', 'pulse', m.pulse, 500, 2500)
     body = _S_FRAME_PWMSERVOSETPOSITIONREQUEST.pack(b'\xaaU', 4, 6, 3, m.duration, m.servo_id, m.pulse)
     check = 0x0
@@ -875,7 +876,7 @@ def _encode_pwm_servo_set_position_request(m: PwmServoSetPositionRequest) -> byt
 
 
 def _encode_pwm_servo_read_position_request(m: PwmServoReadPositionRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('pwm_servo.read_position request', 'servo_id', m.servo_id, 0, 255)
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 4, 2, 5, m.servo_id)
     check = 0x0
@@ -885,9 +886,9 @@ def _encode_pwm_servo_read_position_request(m: PwmServoReadPositionRequest) -> b
 
 
 def _encode_pwm_servo_read_position_response(m: PwmServoReadPositionResponse) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('pwm_servo.read_position response', 'servo_id', m.servo_id, 0, 255)
-    if not 0 <= m.pulse <= 65535:
+    if not 0 <= m.pulse <= 65535 or m.pulse.__class__ is bool:
         raise out_of_range('pwm_servo.read_position response', 'pulse', m.pulse, 0, 65535)
     body = _S_B2_U8_U8_U8_U8_U16.pack(b'\xaaU', 4, 4, m.servo_id, 5, m.pulse)
     check = 0x0
@@ -897,9 +898,9 @@ def _encode_pwm_servo_read_position_response(m: PwmServoReadPositionResponse) ->
 
 
 def _encode_pwm_servo_set_offset_request(m: PwmServoSetOffsetRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('pwm_servo.set_offset request', 'servo_id', m.servo_id, 0, 255)
-    if not -100 <= m.offset <= 100:
+    if not -100 <= m.offset <= 100 or m.offset.__class__ is bool:
         raise out_of_range('pwm_servo.set_offset request', 'offset', m.offset, -100, 100)
     body = _S_B2_U8_U8_U8_U8_I8.pack(b'\xaaU', 4, 3, 7, m.servo_id, m.offset)
     check = 0x0
@@ -909,7 +910,7 @@ def _encode_pwm_servo_set_offset_request(m: PwmServoSetOffsetRequest) -> bytes:
 
 
 def _encode_pwm_servo_read_offset_request(m: PwmServoReadOffsetRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('pwm_servo.read_offset request', 'servo_id', m.servo_id, 0, 255)
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 4, 2, 9, m.servo_id)
     check = 0x0
@@ -919,9 +920,9 @@ def _encode_pwm_servo_read_offset_request(m: PwmServoReadOffsetRequest) -> bytes
 
 
 def _encode_pwm_servo_read_offset_response(m: PwmServoReadOffsetResponse) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('pwm_servo.read_offset response', 'servo_id', m.servo_id, 0, 255)
-    if not -128 <= m.offset <= 127:
+    if not -128 <= m.offset <= 127 or m.offset.__class__ is bool:
         raise out_of_range('pwm_servo.read_offset response', 'offset', m.offset, -128, 127)
     body = _S_B2_U8_U8_U8_U8_I8.pack(b'\xaaU', 4, 3, m.servo_id, 9, m.offset)
     check = 0x0
@@ -931,15 +932,15 @@ def _encode_pwm_servo_read_offset_response(m: PwmServoReadOffsetResponse) -> byt
 
 
 def _encode_bus_servo_set_positions_request(m: BusServoSetPositionsRequest) -> bytes:
-    if not 0 <= m.duration <= 65535:
+    if not 0 <= m.duration <= 65535 or m.duration.__class__ is bool:
         raise out_of_range('bus_servo.set_positions request', 'duration', m.duration, 0, 65535)
     if len(m.bus_servos) > 255:
         raise out_of_range('bus_servo.set_positions request', 'count', len(m.bus_servos), 0, 255)
     parts_bus_servos = []
     for item in m.bus_servos:
-        if not 0 <= item.servo_id <= 255:
+        if not 0 <= item.servo_id <= 255 or item.servo_id.__class__ is bool:
             raise out_of_range('bus_servo.set_positions request', 'servo_id', item.servo_id, 0, 255)
-        if not 0 <= item.position <= 1000:
+        if not 0 <= item.position <= 1000 or item.position.__class__ is bool:
             raise out_of_range('bus_servo.set_positions request', 'position', item.position, 0, 1000)
         parts_bus_servos.append(_S_U8_U16.pack(item.servo_id, item.position))
     content = b''.join((_S_U8_U16_U8.pack(1, m.duration, len(m.bus_servos)), b''.join(parts_bus_servos),))
@@ -954,7 +955,7 @@ def _encode_bus_servo_set_positions_request(m: BusServoSetPositionsRequest) -> b
 
 
 def _encode_bus_servo_read_position_request(m: BusServoReadPositionRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.read_position request', 'servo_id', m.servo_id, 0, 255)
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 5, m.servo_id)
     check = 0x0
@@ -964,11 +965,11 @@ def _encode_bus_servo_read_position_request(m: BusServoReadPositionRequest) -> b
 
 
 def _encode_bus_servo_read_position_response(m: BusServoReadPositionResponse) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.read_position response', 'servo_id', m.servo_id, 0, 255)
-    if not -128 <= m.success <= 127:
+    if not -128 <= m.success <= 127 or m.success.__class__ is bool:
         raise out_of_range('bus_servo.read_position response', 'success', m.success, -128, 127)
-    if not -32768 <= m.position <= 32767:
+    if not -32768 <= m.position <= 32767 or m.position.__class__ is bool:
         raise out_of_range('bus_servo.read_position response', 'position', m.position, -32768, 32767)
     body = _S_FRAME_BUSSERVOREADPOSITIONRESPONSE.pack(b'\xaaU', 5, 5, m.servo_id, 5, m.success, m.position)
     check = 0x0
@@ -978,7 +979,7 @@ def _encode_bus_servo_read_position_response(m: BusServoReadPositionResponse) ->
 
 
 def _encode_bus_servo_read_voltage_request(m: BusServoReadVoltageRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.read_voltage request', 'servo_id', m.servo_id, 0, 255)
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 7, m.servo_id)
     check = 0x0
@@ -988,11 +989,11 @@ def _encode_bus_servo_read_voltage_request(m: BusServoReadVoltageRequest) -> byt
 
 
 def _encode_bus_servo_read_voltage_response(m: BusServoReadVoltageResponse) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.read_voltage response', 'servo_id', m.servo_id, 0, 255)
-    if not -128 <= m.success <= 127:
+    if not -128 <= m.success <= 127 or m.success.__class__ is bool:
         raise out_of_range('bus_servo.read_voltage response', 'success', m.success, -128, 127)
-    if not 0 <= m.voltage <= 65535:
+    if not 0 <= m.voltage <= 65535 or m.voltage.__class__ is bool:
         raise out_of_range('bus_servo.read_voltage response', 'voltage', m.voltage, 0, 65535)
     body = _S_FRAME_BUSSERVOREADVOLTAGERESPONSE.pack(b'\xaaU', 5, 5, m.servo_id, 7, m.success, m.voltage)
     check = 0x0
@@ -1002,7 +1003,7 @@ def _encode_bus_servo_read_voltage_response(m: BusServoReadVoltageResponse) -> b
 
 
 def _encode_bus_servo_read_temperature_request(m: BusServoReadTemperatureRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.read_temperature request', 'servo_id', m.servo_id, 0, 255)
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 9, m.servo_id)
     check = 0x0
@@ -1012,11 +1013,11 @@ def _encode_bus_servo_read_temperature_request(m: BusServoReadTemperatureRequest
 
 
 def _encode_bus_servo_read_temperature_response(m: BusServoReadTemperatureResponse) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.read_temperature response', 'servo_id', m.servo_id, 0, 255)
-    if not -128 <= m.success <= 127:
+    if not -128 <= m.success <= 127 or m.success.__class__ is bool:
         raise out_of_range('bus_servo.read_temperature response', 'success', m.success, -128, 127)
-    if not 0 <= m.temperature <= 255:
+    if not 0 <= m.temperature <= 255 or m.temperature.__class__ is bool:
         raise out_of_range('bus_servo.read_temperature response', 'temperature', m.temperature, 0, 255)
     body = _S_FRAME_BUSSERVOREADTEMPERATURERESPONSE.pack(b'\xaaU', 5, 4, m.servo_id, 9, m.success, m.temperature)
     check = 0x0
@@ -1026,7 +1027,7 @@ def _encode_bus_servo_read_temperature_response(m: BusServoReadTemperatureRespon
 
 
 def _encode_bus_servo_unload_request(m: BusServoUnloadRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.unload request', 'servo_id', m.servo_id, 0, 255)
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 11, m.servo_id)
     check = 0x0
@@ -1036,7 +1037,7 @@ def _encode_bus_servo_unload_request(m: BusServoUnloadRequest) -> bytes:
 
 
 def _encode_bus_servo_load_request(m: BusServoLoadRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.load request', 'servo_id', m.servo_id, 0, 255)
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 12, m.servo_id)
     check = 0x0
@@ -1046,9 +1047,9 @@ def _encode_bus_servo_load_request(m: BusServoLoadRequest) -> bytes:
 
 
 def _encode_bus_servo_set_id_request(m: BusServoSetIdRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.set_id request', 'servo_id', m.servo_id, 0, 255)
-    if not 0 <= m.new_id <= 255:
+    if not 0 <= m.new_id <= 255 or m.new_id.__class__ is bool:
         raise out_of_range('bus_servo.set_id request', 'new_id', m.new_id, 0, 255)
     body = _S_B2_U8_U8_U8_U8_U8.pack(b'\xaaU', 5, 3, 16, m.servo_id, m.new_id)
     check = 0x0
@@ -1058,7 +1059,7 @@ def _encode_bus_servo_set_id_request(m: BusServoSetIdRequest) -> bytes:
 
 
 def _encode_bus_servo_read_id_request(m: BusServoReadIdRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.read_id request', 'servo_id', m.servo_id, 0, 255)
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 18, m.servo_id)
     check = 0x0
@@ -1068,11 +1069,11 @@ def _encode_bus_servo_read_id_request(m: BusServoReadIdRequest) -> bytes:
 
 
 def _encode_bus_servo_read_id_response(m: BusServoReadIdResponse) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.read_id response', 'servo_id', m.servo_id, 0, 255)
-    if not -128 <= m.success <= 127:
+    if not -128 <= m.success <= 127 or m.success.__class__ is bool:
         raise out_of_range('bus_servo.read_id response', 'success', m.success, -128, 127)
-    if not 0 <= m.id <= 255:
+    if not 0 <= m.id <= 255 or m.id.__class__ is bool:
         raise out_of_range('bus_servo.read_id response', 'id', m.id, 0, 255)
     body = _S_FRAME_BUSSERVOREADTEMPERATURERESPONSE.pack(b'\xaaU', 5, 4, m.servo_id, 18, m.success, m.id)
     check = 0x0
@@ -1082,9 +1083,9 @@ def _encode_bus_servo_read_id_response(m: BusServoReadIdResponse) -> bytes:
 
 
 def _encode_bus_servo_set_offset_request(m: BusServoSetOffsetRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.set_offset request', 'servo_id', m.servo_id, 0, 255)
-    if not -100 <= m.offset <= 100:
+    if not -100 <= m.offset <= 100 or m.offset.__class__ is bool:
         raise out_of_range('bus_servo.set_offset request', 'offset', m.offset, -100, 100)
     body = _S_B2_U8_U8_U8_U8_I8.pack(b'\xaaU', 5, 3, 32, m.servo_id, m.offset)
     check = 0x0
@@ -1094,7 +1095,7 @@ def _encode_bus_servo_set_offset_request(m: BusServoSetOffsetRequest) -> bytes:
 
 
 def _encode_bus_servo_read_offset_request(m: BusServoReadOffsetRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.read_offset request', 'servo_id', m.servo_id, 0, 255)
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 34, m.servo_id)
     check = 0x0
@@ -1104,11 +1105,11 @@ def _encode_bus_servo_read_offset_request(m: BusServoReadOffsetRequest) -> bytes
 
 
 def _encode_bus_servo_read_offset_response(m: BusServoReadOffsetResponse) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.read_offset response', 'servo_id', m.servo_id, 0, 255)
-    if not -128 <= m.success <= 127:
+    if not -128 <= m.success <= 127 or m.success.__class__ is bool:
         raise out_of_range('bus_servo.read_offset response', 'success', m.success, -128, 127)
-    if not -128 <= m.offset <= 127:
+    if not -128 <= m.offset <= 127 or m.offset.__class__ is bool:
         raise out_of_range('bus_servo.read_offset response', 'offset', m.offset, -128, 127)
     body = _S_FRAME_BUSSERVOREADOFFSETRESPONSE.pack(b'\xaaU', 5, 4, m.servo_id, 34, m.success, m.offset)
     check = 0x0
@@ -1118,7 +1119,7 @@ def _encode_bus_servo_read_offset_response(m: BusServoReadOffsetResponse) -> byt
 
 
 def _encode_bus_servo_save_offset_request(m: BusServoSaveOffsetRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.save_offset request', 'servo_id', m.servo_id, 0, 255)
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 36, m.servo_id)
     check = 0x0
@@ -1128,11 +1129,11 @@ def _encode_bus_servo_save_offset_request(m: BusServoSaveOffsetRequest) -> bytes
 
 
 def _encode_bus_servo_set_position_limit_request(m: BusServoSetPositionLimitRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.set_position_limit request', 'servo_id', m.servo_id, 0, 255)
-    if not 0 <= m.low <= 1000:
+    if not 0 <= m.low <= 1000 or m.low.__class__ is bool:
         raise out_of_range('bus_servo.set_position_limit request', 'low', m.low, 0, 1000)
-    if not 0 <= m.high <= 1000:
+    if not 0 <= m.high <= 1000 or m.high.__class__ is bool:
         raise out_of_range('bus_servo.set_position_limit request', 'high', m.high, 0, 1000)
     body = _S_FRAME_BUSSERVOSETPOSITIONLIMITREQUEST.pack(b'\xaaU', 5, 6, 48, m.servo_id, m.low, m.high)
     check = 0x0
@@ -1142,7 +1143,7 @@ def _encode_bus_servo_set_position_limit_request(m: BusServoSetPositionLimitRequ
 
 
 def _encode_bus_servo_read_position_limit_request(m: BusServoReadPositionLimitRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.read_position_limit request', 'servo_id', m.servo_id, 0, 255)
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 50, m.servo_id)
     check = 0x0
@@ -1152,13 +1153,13 @@ def _encode_bus_servo_read_position_limit_request(m: BusServoReadPositionLimitRe
 
 
 def _encode_bus_servo_read_position_limit_response(m: BusServoReadPositionLimitResponse) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.read_position_limit response', 'servo_id', m.servo_id, 0, 255)
-    if not -128 <= m.success <= 127:
+    if not -128 <= m.success <= 127 or m.success.__class__ is bool:
         raise out_of_range('bus_servo.read_position_limit response', 'success', m.success, -128, 127)
-    if not 0 <= m.low <= 65535:
+    if not 0 <= m.low <= 65535 or m.low.__class__ is bool:
         raise out_of_range('bus_servo.read_position_limit response', 'low', m.low, 0, 65535)
-    if not 0 <= m.high <= 65535:
+    if not 0 <= m.high <= 65535 or m.high.__class__ is bool:
         raise out_of_range('bus_servo.read_position_limit response', 'high', m.high, 0, 65535)
     body = _S_FRAME_BUSSERVOREADPOSITIONLIMITRESPONSE.pack(b'\xaaU', 5, 7, m.servo_id, 50, m.success, m.low, m.high)
     check = 0x0
@@ -1168,11 +1169,11 @@ def _encode_bus_servo_read_position_limit_response(m: BusServoReadPositionLimitR
 
 
 def _encode_bus_servo_set_voltage_limit_request(m: BusServoSetVoltageLimitRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.set_voltage_limit request', 'servo_id', m.servo_id, 0, 255)
-    if not 4500 <= m.low <= 14000:
+    if not 4500 <= m.low <= 14000 or m.low.__class__ is bool:
         raise out_of_range('bus_servo.set_voltage_limit request', 'low', m.low, 4500, 14000)
-    if not 4500 <= m.high <= 14000:
+    if not 4500 <= m.high <= 14000 or m.high.__class__ is bool:
         raise out_of_range('bus_servo.set_voltage_limit request', 'high', m.high, 4500, 14000)
     body = _S_FRAME_BUSSERVOSETPOSITIONLIMITREQUEST.pack(b'\xaaU', 5, 6, 52, m.servo_id, m.low, m.high)
     check = 0x0
@@ -1182,7 +1183,7 @@ def _encode_bus_servo_set_voltage_limit_request(m: BusServoSetVoltageLimitReques
 
 
 def _encode_bus_servo_read_voltage_limit_request(m: BusServoReadVoltageLimitRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.read_voltage_limit request', 'servo_id', m.servo_id, 0, 255)
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 54, m.servo_id)
     check = 0x0
@@ -1192,13 +1193,13 @@ def _encode_bus_servo_read_voltage_limit_request(m: BusServoReadVoltageLimitRequ
 
 
 def _encode_bus_servo_read_voltage_limit_response(m: BusServoReadVoltageLimitResponse) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.read_voltage_limit response', 'servo_id', m.servo_id, 0, 255)
-    if not -128 <= m.success <= 127:
+    if not -128 <= m.success <= 127 or m.success.__class__ is bool:
         raise out_of_range('bus_servo.read_voltage_limit response', 'success', m.success, -128, 127)
-    if not 0 <= m.low <= 65535:
+    if not 0 <= m.low <= 65535 or m.low.__class__ is bool:
         raise out_of_range('bus_servo.read_voltage_limit response', 'low', m.low, 0, 65535)
-    if not 0 <= m.high <= 65535:
+    if not 0 <= m.high <= 65535 or m.high.__class__ is bool:
         raise out_of_range('bus_servo.read_voltage_limit response', 'high', m.high, 0, 65535)
     body = _S_FRAME_BUSSERVOREADPOSITIONLIMITRESPONSE.pack(b'\xaaU', 5, 7, m.servo_id, 54, m.success, m.low, m.high)
     check = 0x0
@@ -1208,9 +1209,9 @@ def _encode_bus_servo_read_voltage_limit_response(m: BusServoReadVoltageLimitRes
 
 
 def _encode_bus_servo_set_temperature_limit_request(m: BusServoSetTemperatureLimitRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.set_temperature_limit request', 'servo_id', m.servo_id, 0, 255)
-    if not 0 <= m.limit <= 99:
+    if not 0 <= m.limit <= 99 or m.limit.__class__ is bool:
         raise out_of_range('bus_servo.set_temperature_limit request', 'limit', m.limit, 0, 99)
     body = _S_B2_U8_U8_U8_U8_U8.pack(b'\xaaU', 5, 3, 56, m.servo_id, m.limit)
     check = 0x0
@@ -1220,7 +1221,7 @@ def _encode_bus_servo_set_temperature_limit_request(m: BusServoSetTemperatureLim
 
 
 def _encode_bus_servo_read_temperature_limit_request(m: BusServoReadTemperatureLimitRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.read_temperature_limit request', 'servo_id', m.servo_id, 0, 255)
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 58, m.servo_id)
     check = 0x0
@@ -1230,11 +1231,11 @@ def _encode_bus_servo_read_temperature_limit_request(m: BusServoReadTemperatureL
 
 
 def _encode_bus_servo_read_temperature_limit_response(m: BusServoReadTemperatureLimitResponse) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.read_temperature_limit response', 'servo_id', m.servo_id, 0, 255)
-    if not -128 <= m.success <= 127:
+    if not -128 <= m.success <= 127 or m.success.__class__ is bool:
         raise out_of_range('bus_servo.read_temperature_limit response', 'success', m.success, -128, 127)
-    if not 0 <= m.limit <= 255:
+    if not 0 <= m.limit <= 255 or m.limit.__class__ is bool:
         raise out_of_range('bus_servo.read_temperature_limit response', 'limit', m.limit, 0, 255)
     body = _S_FRAME_BUSSERVOREADTEMPERATURERESPONSE.pack(b'\xaaU', 5, 4, m.servo_id, 58, m.success, m.limit)
     check = 0x0
@@ -1244,9 +1245,9 @@ def _encode_bus_servo_read_temperature_limit_response(m: BusServoReadTemperature
 
 
 def _encode_key_response(m: KeyResponse) -> bytes:
-    if not 0 <= m.button_id <= 255:
+    if not 0 <= m.button_id <= 255 or m.button_id.__class__ is bool:
         raise out_of_range('key response', 'button_id', m.button_id, 0, 255)
-    if not 0 <= m.event <= 255:
+    if not 0 <= m.event <= 255 or m.event.__class__ is bool:
         raise out_of_range('key response', 'event', m.event, 0, 255)
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 6, 2, m.button_id, m.event)
     check = 0x0
@@ -1276,17 +1277,17 @@ def _encode_imu_response(m: ImuResponse) -> bytes:
 
 
 def _encode_gamepad_response(m: GamepadResponse) -> bytes:
-    if not 0 <= m.buttons <= 65535:
+    if not 0 <= m.buttons <= 65535 or m.buttons.__class__ is bool:
         raise out_of_range('gamepad response', 'buttons', m.buttons, 0, 65535)
-    if not 0 <= m.hat <= 255:
+    if not 0 <= m.hat <= 255 or m.hat.__class__ is bool:
         raise out_of_range('gamepad response', 'hat', m.hat, 0, 255)
-    if not -128 <= m.left_x <= 127:
+    if not -128 <= m.left_x <= 127 or m.left_x.__class__ is bool:
         raise out_of_range('gamepad response', 'left_x', m.left_x, -128, 127)
-    if not -128 <= m.left_y <= 127:
+    if not -128 <= m.left_y <= 127 or m.left_y.__class__ is bool:
         raise out_of_range('gamepad response', 'left_y', m.left_y, -128, 127)
-    if not -128 <= m.right_x <= 127:
+    if not -128 <= m.right_x <= 127 or m.right_x.__class__ is bool:
         raise out_of_range('gamepad response', 'right_x', m.right_x, -128, 127)
-    if not -128 <= m.right_y <= 127:
+    if not -128 <= m.right_y <= 127 or m.right_y.__class__ is bool:
         raise out_of_range('gamepad response', 'right_y', m.right_y, -128, 127)
     body = _S_FRAME_GAMEPADRESPONSE.pack(b'\xaaU', 8, 7, m.buttons, m.hat, m.left_x, m.left_y, m.right_x, m.right_y)
     check = 0x0
@@ -1300,13 +1301,13 @@ def _encode_sbus_response(m: SbusResponse) -> bytes:
         raise EncodeError('sbus response' + f': channels needs 16 items, got {len(m.channels)}')
     if any(not -32768 <= x <= 32767 for x in m.channels):
         raise out_of_range('sbus response', 'channels', m.channels, -32768, 32767)
-    if not 0 <= m.ch17 <= 255:
+    if not 0 <= m.ch17 <= 255 or m.ch17.__class__ is bool:
         raise out_of_range('sbus response', 'ch17', m.ch17, 0, 255)
-    if not 0 <= m.ch18 <= 255:
+    if not 0 <= m.ch18 <= 255 or m.ch18.__class__ is bool:
         raise out_of_range('sbus response', 'ch18', m.ch18, 0, 255)
-    if not 0 <= m.signal_loss <= 255:
+    if not 0 <= m.signal_loss <= 255 or m.signal_loss.__class__ is bool:
         raise out_of_range('sbus response', 'signal_loss', m.signal_loss, 0, 255)
-    if not 0 <= m.fail_safe <= 255:
+    if not 0 <= m.fail_safe <= 255 or m.fail_safe.__class__ is bool:
         raise out_of_range('sbus response', 'fail_safe', m.fail_safe, 0, 255)
     body = _S_FRAME_SBUSRESPONSE.pack(b'\xaaU', 9, 36, *m.channels, m.ch17, m.ch18, m.signal_loss, m.fail_safe)
     check = 0x0
@@ -1594,8 +1595,10 @@ def encode(message: Message) -> bytes:
         raise EncodeError(f"{type(message).__name__} is not a hiwonder_rrc message")
     try:
         return encoder(message)
-    except (TypeError, AttributeError, struct.error) as exc:
-        raise EncodeError(f"{message.COMMAND} {message.DIRECTION.value}: {exc}") from None
+    except EncodeError:
+        raise
+    except (TypeError, AttributeError, ValueError, OverflowError, struct.error) as exc:
+        raise wrong_type(message, exc) from None  # one line naming the field, not Python's words
 
 
 class StreamParser(_StreamParser):

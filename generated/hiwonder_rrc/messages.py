@@ -9,10 +9,15 @@ from enum import IntEnum, IntFlag
 from typing import Any, ClassVar, Self
 
 from serialspec.runtime.fields import check_keys as _check_keys
+from serialspec.runtime.fields import enum as _as_enum
+from serialspec.runtime.fields import flags as _as_flags
 from serialspec.runtime.fields import get as _get
+from serialspec.runtime.fields import integer as _integer
+from serialspec.runtime.fields import integers as _integers
+from serialspec.runtime.fields import items as _items
 from serialspec.runtime.fields import mapping as _mapping
+from serialspec.runtime.fields import number as _number
 from serialspec.runtime.message import Direction, Message
-from serialspec.runtime.message import enum_or_int as _enum
 
 __all__ = [
     'BusServoLoadRequest',
@@ -132,8 +137,8 @@ class MotorsItem:
     def from_fields(cls, data: Mapping[str, Any], where: str = 'MotorsItem') -> Self:
         _check_keys(data, ('motor_id', 'speed'), (), where)
         return cls(
-            _get(data, 'motor_id', where),
-            _get(data, 'speed', where),
+            _integer(_get(data, 'motor_id', where), 'motor_id', where),
+            _number(_get(data, 'speed', where), 'speed', where),
         )
 
 
@@ -156,8 +161,8 @@ class PwmServosItem:
     def from_fields(cls, data: Mapping[str, Any], where: str = 'PwmServosItem') -> Self:
         _check_keys(data, ('servo_id', 'pulse'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'pulse', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'pulse', where), 'pulse', where),
         )
 
 
@@ -180,8 +185,8 @@ class BusServosItem:
     def from_fields(cls, data: Mapping[str, Any], where: str = 'BusServosItem') -> Self:
         _check_keys(data, ('servo_id', 'position'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'position', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'position', where), 'position', where),
         )
 
 
@@ -214,10 +219,10 @@ class LedRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'led request') -> Self:
         _check_keys(data, ('led_id', 'on_time', 'off_time', 'repeat'), (), where)
         return cls(
-            _get(data, 'led_id', where),
-            _get(data, 'on_time', where),
-            _get(data, 'off_time', where),
-            _get(data, 'repeat', where),
+            _integer(_get(data, 'led_id', where), 'led_id', where),
+            _integer(_get(data, 'on_time', where), 'on_time', where),
+            _integer(_get(data, 'off_time', where), 'off_time', where),
+            _integer(_get(data, 'repeat', where), 'repeat', where),
         )
 
 
@@ -250,10 +255,10 @@ class BuzzerRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'buzzer request') -> Self:
         _check_keys(data, ('frequency', 'on_time', 'off_time', 'repeat'), (), where)
         return cls(
-            _get(data, 'frequency', where),
-            _get(data, 'on_time', where),
-            _get(data, 'off_time', where),
-            _get(data, 'repeat', where),
+            _integer(_get(data, 'frequency', where), 'frequency', where),
+            _integer(_get(data, 'on_time', where), 'on_time', where),
+            _integer(_get(data, 'off_time', where), 'off_time', where),
+            _integer(_get(data, 'repeat', where), 'repeat', where),
         )
 
 
@@ -280,8 +285,8 @@ class MotorSetSpeedRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'motor.set_speed request') -> Self:
         _check_keys(data, ('motor_id', 'speed'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'motor_id', where),
-            _get(data, 'speed', where),
+            _integer(_get(data, 'motor_id', where), 'motor_id', where),
+            _number(_get(data, 'speed', where), 'speed', where),
         )
 
 
@@ -305,7 +310,7 @@ class MotorSetSpeedsRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'motor.set_speeds request') -> Self:
         _check_keys(data, ('motors',), ('subcommand_code', 'count'), where)
         return cls(
-            tuple(MotorsItem.from_fields(_mapping(item, 'motors', where), where) for item in _get(data, 'motors', where)),
+            tuple(MotorsItem.from_fields(_mapping(item, 'motors', where), where) for item in _items(_get(data, 'motors', where), 'motors', where)),
         )
 
 
@@ -329,7 +334,7 @@ class MotorStopRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'motor.stop request') -> Self:
         _check_keys(data, ('motor_id',), ('subcommand_code',), where)
         return cls(
-            _get(data, 'motor_id', where),
+            _integer(_get(data, 'motor_id', where), 'motor_id', where),
         )
 
 
@@ -353,7 +358,7 @@ class MotorStopMaskRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'motor.stop_mask request') -> Self:
         _check_keys(data, ('mask',), ('subcommand_code',), where)
         return cls(
-            MotorMask(_get(data, 'mask', where)),
+            _as_flags(MotorMask, _get(data, 'mask', where), 255, 'mask', where),
         )
 
 
@@ -380,8 +385,8 @@ class PwmServoSetPositionsRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'pwm_servo.set_positions request') -> Self:
         _check_keys(data, ('duration', 'pwm_servos'), ('subcommand_code', 'count'), where)
         return cls(
-            _get(data, 'duration', where),
-            tuple(PwmServosItem.from_fields(_mapping(item, 'pwm_servos', where), where) for item in _get(data, 'pwm_servos', where)),
+            _integer(_get(data, 'duration', where), 'duration', where),
+            tuple(PwmServosItem.from_fields(_mapping(item, 'pwm_servos', where), where) for item in _items(_get(data, 'pwm_servos', where), 'pwm_servos', where)),
         )
 
 
@@ -411,9 +416,9 @@ class PwmServoSetPositionRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'pwm_servo.set_position request') -> Self:
         _check_keys(data, ('duration', 'servo_id', 'pulse'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'duration', where),
-            _get(data, 'servo_id', where),
-            _get(data, 'pulse', where),
+            _integer(_get(data, 'duration', where), 'duration', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'pulse', where), 'pulse', where),
         )
 
 
@@ -437,7 +442,7 @@ class PwmServoReadPositionRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'pwm_servo.read_position request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -464,8 +469,8 @@ class PwmServoReadPositionResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'pwm_servo.read_position response') -> Self:
         _check_keys(data, ('servo_id', 'pulse'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'pulse', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'pulse', where), 'pulse', where),
         )
 
 
@@ -492,8 +497,8 @@ class PwmServoSetOffsetRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'pwm_servo.set_offset request') -> Self:
         _check_keys(data, ('servo_id', 'offset'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'offset', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'offset', where), 'offset', where),
         )
 
 
@@ -517,7 +522,7 @@ class PwmServoReadOffsetRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'pwm_servo.read_offset request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -544,8 +549,8 @@ class PwmServoReadOffsetResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'pwm_servo.read_offset response') -> Self:
         _check_keys(data, ('servo_id', 'offset'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'offset', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'offset', where), 'offset', where),
         )
 
 
@@ -572,8 +577,8 @@ class BusServoSetPositionsRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.set_positions request') -> Self:
         _check_keys(data, ('duration', 'bus_servos'), ('subcommand_code', 'count'), where)
         return cls(
-            _get(data, 'duration', where),
-            tuple(BusServosItem.from_fields(_mapping(item, 'bus_servos', where), where) for item in _get(data, 'bus_servos', where)),
+            _integer(_get(data, 'duration', where), 'duration', where),
+            tuple(BusServosItem.from_fields(_mapping(item, 'bus_servos', where), where) for item in _items(_get(data, 'bus_servos', where), 'bus_servos', where)),
         )
 
 
@@ -597,7 +602,7 @@ class BusServoReadPositionRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_position request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -627,9 +632,9 @@ class BusServoReadPositionResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_position response') -> Self:
         _check_keys(data, ('servo_id', 'success', 'position'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _enum(ReadResult, _get(data, 'success', where)),
-            _get(data, 'position', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(ReadResult, _get(data, 'success', where), 'success', where),
+            _integer(_get(data, 'position', where), 'position', where),
         )
 
 
@@ -653,7 +658,7 @@ class BusServoReadVoltageRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_voltage request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -683,9 +688,9 @@ class BusServoReadVoltageResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_voltage response') -> Self:
         _check_keys(data, ('servo_id', 'success', 'voltage'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _enum(ReadResult, _get(data, 'success', where)),
-            _get(data, 'voltage', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(ReadResult, _get(data, 'success', where), 'success', where),
+            _integer(_get(data, 'voltage', where), 'voltage', where),
         )
 
 
@@ -709,7 +714,7 @@ class BusServoReadTemperatureRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_temperature request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -739,9 +744,9 @@ class BusServoReadTemperatureResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_temperature response') -> Self:
         _check_keys(data, ('servo_id', 'success', 'temperature'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _enum(ReadResult, _get(data, 'success', where)),
-            _get(data, 'temperature', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(ReadResult, _get(data, 'success', where), 'success', where),
+            _integer(_get(data, 'temperature', where), 'temperature', where),
         )
 
 
@@ -765,7 +770,7 @@ class BusServoUnloadRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.unload request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -789,7 +794,7 @@ class BusServoLoadRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.load request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -816,8 +821,8 @@ class BusServoSetIdRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.set_id request') -> Self:
         _check_keys(data, ('servo_id', 'new_id'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'new_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'new_id', where), 'new_id', where),
         )
 
 
@@ -841,7 +846,7 @@ class BusServoReadIdRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_id request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
         return cls(
-            data.get('servo_id', 254),
+            _integer(data.get('servo_id', 254), 'servo_id', where),
         )
 
 
@@ -871,9 +876,9 @@ class BusServoReadIdResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_id response') -> Self:
         _check_keys(data, ('servo_id', 'success', 'id'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _enum(ReadResult, _get(data, 'success', where)),
-            _get(data, 'id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(ReadResult, _get(data, 'success', where), 'success', where),
+            _integer(_get(data, 'id', where), 'id', where),
         )
 
 
@@ -900,8 +905,8 @@ class BusServoSetOffsetRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.set_offset request') -> Self:
         _check_keys(data, ('servo_id', 'offset'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'offset', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'offset', where), 'offset', where),
         )
 
 
@@ -925,7 +930,7 @@ class BusServoReadOffsetRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_offset request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -955,9 +960,9 @@ class BusServoReadOffsetResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_offset response') -> Self:
         _check_keys(data, ('servo_id', 'success', 'offset'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _enum(ReadResult, _get(data, 'success', where)),
-            _get(data, 'offset', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(ReadResult, _get(data, 'success', where), 'success', where),
+            _integer(_get(data, 'offset', where), 'offset', where),
         )
 
 
@@ -981,7 +986,7 @@ class BusServoSaveOffsetRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.save_offset request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -1011,9 +1016,9 @@ class BusServoSetPositionLimitRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.set_position_limit request') -> Self:
         _check_keys(data, ('servo_id', 'low', 'high'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'low', where),
-            _get(data, 'high', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'low', where), 'low', where),
+            _integer(_get(data, 'high', where), 'high', where),
         )
 
 
@@ -1037,7 +1042,7 @@ class BusServoReadPositionLimitRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_position_limit request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -1070,10 +1075,10 @@ class BusServoReadPositionLimitResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_position_limit response') -> Self:
         _check_keys(data, ('servo_id', 'success', 'low', 'high'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _enum(ReadResult, _get(data, 'success', where)),
-            _get(data, 'low', where),
-            _get(data, 'high', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(ReadResult, _get(data, 'success', where), 'success', where),
+            _integer(_get(data, 'low', where), 'low', where),
+            _integer(_get(data, 'high', where), 'high', where),
         )
 
 
@@ -1103,9 +1108,9 @@ class BusServoSetVoltageLimitRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.set_voltage_limit request') -> Self:
         _check_keys(data, ('servo_id', 'low', 'high'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'low', where),
-            _get(data, 'high', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'low', where), 'low', where),
+            _integer(_get(data, 'high', where), 'high', where),
         )
 
 
@@ -1129,7 +1134,7 @@ class BusServoReadVoltageLimitRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_voltage_limit request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -1162,10 +1167,10 @@ class BusServoReadVoltageLimitResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_voltage_limit response') -> Self:
         _check_keys(data, ('servo_id', 'success', 'low', 'high'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _enum(ReadResult, _get(data, 'success', where)),
-            _get(data, 'low', where),
-            _get(data, 'high', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(ReadResult, _get(data, 'success', where), 'success', where),
+            _integer(_get(data, 'low', where), 'low', where),
+            _integer(_get(data, 'high', where), 'high', where),
         )
 
 
@@ -1192,8 +1197,8 @@ class BusServoSetTemperatureLimitRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.set_temperature_limit request') -> Self:
         _check_keys(data, ('servo_id', 'limit'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'limit', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'limit', where), 'limit', where),
         )
 
 
@@ -1217,7 +1222,7 @@ class BusServoReadTemperatureLimitRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_temperature_limit request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -1247,9 +1252,9 @@ class BusServoReadTemperatureLimitResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_temperature_limit response') -> Self:
         _check_keys(data, ('servo_id', 'success', 'limit'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _enum(ReadResult, _get(data, 'success', where)),
-            _get(data, 'limit', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(ReadResult, _get(data, 'success', where), 'success', where),
+            _integer(_get(data, 'limit', where), 'limit', where),
         )
 
 
@@ -1276,8 +1281,8 @@ class KeyResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'key response') -> Self:
         _check_keys(data, ('button_id', 'event'), (), where)
         return cls(
-            _get(data, 'button_id', where),
-            _enum(ButtonEvent, _get(data, 'event', where)),
+            _integer(_get(data, 'button_id', where), 'button_id', where),
+            _as_enum(ButtonEvent, _get(data, 'event', where), 'event', where),
         )
 
 
@@ -1316,12 +1321,12 @@ class ImuResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'imu response') -> Self:
         _check_keys(data, ('accel_x', 'accel_y', 'accel_z', 'gyro_x', 'gyro_y', 'gyro_z'), (), where)
         return cls(
-            _get(data, 'accel_x', where),
-            _get(data, 'accel_y', where),
-            _get(data, 'accel_z', where),
-            _get(data, 'gyro_x', where),
-            _get(data, 'gyro_y', where),
-            _get(data, 'gyro_z', where),
+            _number(_get(data, 'accel_x', where), 'accel_x', where),
+            _number(_get(data, 'accel_y', where), 'accel_y', where),
+            _number(_get(data, 'accel_z', where), 'accel_z', where),
+            _number(_get(data, 'gyro_x', where), 'gyro_x', where),
+            _number(_get(data, 'gyro_y', where), 'gyro_y', where),
+            _number(_get(data, 'gyro_z', where), 'gyro_z', where),
         )
 
 
@@ -1360,12 +1365,12 @@ class GamepadResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'gamepad response') -> Self:
         _check_keys(data, ('buttons', 'hat', 'left_x', 'left_y', 'right_x', 'right_y'), (), where)
         return cls(
-            _get(data, 'buttons', where),
-            _get(data, 'hat', where),
-            _get(data, 'left_x', where),
-            _get(data, 'left_y', where),
-            _get(data, 'right_x', where),
-            _get(data, 'right_y', where),
+            _integer(_get(data, 'buttons', where), 'buttons', where),
+            _integer(_get(data, 'hat', where), 'hat', where),
+            _integer(_get(data, 'left_x', where), 'left_x', where),
+            _integer(_get(data, 'left_y', where), 'left_y', where),
+            _integer(_get(data, 'right_x', where), 'right_x', where),
+            _integer(_get(data, 'right_y', where), 'right_y', where),
         )
 
 
@@ -1401,11 +1406,11 @@ class SbusResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'sbus response') -> Self:
         _check_keys(data, ('channels', 'ch17', 'ch18', 'signal_loss', 'fail_safe'), (), where)
         return cls(
-            tuple(_get(data, 'channels', where)),
-            _get(data, 'ch17', where),
-            _get(data, 'ch18', where),
-            _get(data, 'signal_loss', where),
-            _get(data, 'fail_safe', where),
+            _integers(_get(data, 'channels', where), 'channels', where),
+            _integer(_get(data, 'ch17', where), 'ch17', where),
+            _integer(_get(data, 'ch18', where), 'ch18', where),
+            _integer(_get(data, 'signal_loss', where), 'signal_loss', where),
+            _integer(_get(data, 'fail_safe', where), 'fail_safe', where),
         )
 
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import importlib
+import os
 from types import ModuleType
 
 from serialspec.runtime.errors import SerialspecError
@@ -12,10 +13,7 @@ from serialspec.spec.model import Protocol
 
 def open_spec(path: str) -> tuple[Protocol, ModuleType]:
     """The resolved spec and its generated package; errors are one line for the user."""
-    try:
-        protocol = load_protocol(path)
-    except FileNotFoundError:
-        raise SerialspecError(f"no such spec: {path}") from None
+    protocol = _load(path)
     try:
         package = importlib.import_module(protocol.name)
     except ImportError:
@@ -23,6 +21,21 @@ def open_spec(path: str) -> tuple[Protocol, ModuleType]:
             f"package {protocol.name} is not generated or installed: run `serialspec generate`"
         ) from None
     return protocol, package
+
+
+def _load(path: str) -> Protocol:
+    """Load a spec, once per version of the file (tools that decode many frames in one process call this often)."""
+    try:
+        stat = os.stat(path)
+        key = (os.path.abspath(path), stat.st_mtime_ns, stat.st_size)
+    except OSError:
+        return load_protocol(path)  # the loader says what is wrong with the path, in one line
+    if key not in _LOADED:
+        _LOADED[key] = load_protocol(path)
+    return _LOADED[key]
+
+
+_LOADED: dict[tuple[str, int, int], Protocol] = {}
 
 
 def message_type(package: ModuleType, command: str, subcommand: str | None, direction: str) -> type:

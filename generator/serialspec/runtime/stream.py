@@ -1,17 +1,23 @@
 """Splitting a byte stream into frames, for every protocol the spec language describes.
 
 A candidate frame starts at a header. Before it is accepted it must be plausible: a known command whose content
-size fits the length byte; then its checksum must verify. Whenever a candidate fails, scanning resumes one byte
-after its header, so a stray header or a truncated frame never swallows the intact frame that follows it.
+size fits the length byte, frame-level values (an address) within their declared range; then its checksum must
+verify. Whenever a candidate fails, scanning resumes one byte after its header, so a stray header or a truncated
+frame never swallows the intact frame that follows it. A candidate still waiting for bytes never hides a complete,
+valid frame that starts inside it: that frame is delivered, and the candidate counted as garbage.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Literal
 
 from serialspec.runtime.errors import DecodeError
 from serialspec.runtime.message import Message
+
+# frame-level values with a declared range: (offset, size, byte order, signed, low, high, also allowed or None)
+ValueRanges = tuple[tuple[int, int, Literal["little", "big"], bool, int, int, int | None], ...]
 
 
 @dataclass(frozen=True)
@@ -28,17 +34,26 @@ class FrameFormat:
     # decode_at(buffer, start, stop): the frame buffer[start:stop], whose header and length byte the parser has
     # checked: verifies the checksum and decodes; raises DecodeError (ChecksumError) for a corrupt frame.
     decode_at: Callable[[bytes, int, int], Message]
+    value_ranges: ValueRanges = ()  # a candidate with a value outside its range is no frame
 
 
 class _Candidate:
     """A FrameFormat as the scanning loop reads it: the size of every plausible frame, by command and length byte."""
 
-    __slots__ = ("header", "prefix", "command_offset", "length_offset", "frame_sizes", "decode")
+    __slots__ = ("header", "prefix", "command_offset", "length_offset", "frame_sizes", "decode", "ranges")
 
     def __init__(self, frame_format: FrameFormat) -> None:
         self.header = frame_format.header
         # bytes needed before the command code and the length byte can be read
-        self.prefix = max(frame_format.length_offset, frame_format.command_offset or 0) + 1
+        self.prefix = (
+            max(
+                frame_format.length_offset,
+                frame_format.command_offset or 0,
+                *(offset + size - 1 for offset, size, *_ in frame_format.value_ranges),
+            )
+            + 1
+        )
+        self.ranges = frame_format.value_ranges
         self.command_offset = frame_format.command_offset
         self.length_offset = frame_format.length_offset
         self.decode = frame_format.decode_at
@@ -112,14 +127,20 @@ class StreamParser:
                 size = frame_sizes.get(buffer[position + length_offset])
             else:
                 size = frame_sizes.get(buffer[position + command_offset] << 8 | buffer[position + length_offset])
-            if size is None:  # implausible (unknown command, or a content size it never has): not a frame start
+            if size is None or (current.ranges and not _in_range(buffer, position, current.ranges)):
+                # implausible (unknown command, a content size it never has, a value out of range): no frame start
                 start = position + 1
                 garbage += 1
                 continue
             stop = position + size
             if stop > end:
-                self._pending = buffer[position:]
-                break
+                inner = self._complete_frame_after(buffer, position + 1)
+                if inner < 0:
+                    self._pending = buffer[position:]
+                    break
+                garbage += inner - position  # a stray header: the complete frame inside it is the real one
+                start = inner
+                continue
             try:
                 append(decode(buffer, position, stop))
             except DecodeError:
@@ -132,6 +153,28 @@ class StreamParser:
         self.errors += errors
         return found
 
+    def _complete_frame_after(self, buffer: bytes, start: int) -> int:
+        """Where the first complete frame that decodes starts at or after `start`; -1 if there is none."""
+        end = len(buffer)
+        while True:
+            position, candidate = self._next_header(buffer, start)
+            if position < 0 or end - position < candidate.prefix:
+                return -1
+            if candidate.command_offset is None:
+                size = candidate.frame_sizes.get(buffer[position + candidate.length_offset])
+            else:
+                key = buffer[position + candidate.command_offset] << 8 | buffer[position + candidate.length_offset]
+                size = candidate.frame_sizes.get(key)
+            plausible = size is not None and (not candidate.ranges or _in_range(buffer, position, candidate.ranges))
+            if plausible and size is not None and position + size <= end:
+                try:
+                    candidate.decode(buffer, position, position + size)
+                except DecodeError:
+                    pass
+                else:
+                    return position
+            start = position + 1
+
     def _next_header(self, buffer: bytes, start: int) -> tuple[int, _Candidate]:
         best, best_candidate = -1, self._candidates[0]
         for candidate in self._candidates:
@@ -143,3 +186,16 @@ class StreamParser:
     def pending(self) -> bytes:
         """Bytes held back, waiting to complete a frame."""
         return self._pending
+
+
+def _in_range(buffer: bytes, position: int, ranges: ValueRanges) -> bool:
+    for offset, size, byte_order, signed, low, high, also in ranges:
+        at = position + offset
+        value = (
+            buffer[at]
+            if size == 1 and not signed
+            else int.from_bytes(buffer[at : at + size], byte_order, signed=signed)
+        )
+        if not low <= value <= high and value != also:
+            return False
+    return True

@@ -56,146 +56,146 @@ __all__ = [
 class Result(IntEnum):
     """Outcome reported by the servo."""
 
-    FAILURE = 0
     #: failed
-    SUCCESS = 1
+    FAILURE = 0
     #: succeeded
+    SUCCESS = 1
 
 
 class Switch(IntEnum):
     """An on/off parameter."""
 
-    OFF = 0
     #: disabled
-    ON = 1
+    OFF = 0
     #: enabled
+    ON = 1
 
 
 class ResponseSwitch(IntEnum):
     """Whether control commands can be interrupted and whether they answer."""
 
-    INTERRUPTIBLE_SILENT = 0
     #: a new command replaces the running one; no response
-    QUEUED_WITH_RESPONSE = 1
+    INTERRUPTIBLE_SILENT = 0
     #: commands run to the end (queue of 1) and then send a response
+    QUEUED_WITH_RESPONSE = 1
 
 
 class BaudrateOption(IntEnum):
     """Serial baud rate option; takes effect at once."""
 
-    BAUD_9600 = 1
     #: 9600
-    BAUD_19200 = 2
+    BAUD_9600 = 1
     #: 19200
-    BAUD_38400 = 3
+    BAUD_19200 = 2
     #: 38400
-    BAUD_57600 = 4
+    BAUD_38400 = 3
     #: 57600
-    BAUD_115200 = 5
+    BAUD_57600 = 4
     #: 115200
-    BAUD_250000 = 6
+    BAUD_115200 = 5
     #: 250000
-    BAUD_500000 = 7
+    BAUD_250000 = 6
     #: 500000
+    BAUD_500000 = 7
 
 
 class StallProtectMode(IntEnum):
     """What the servo does when it stalls."""
 
-    LIMIT_POWER = 1
     #: lower the power to the stall power limit
-    RELEASE = 2
+    LIMIT_POWER = 1
     #: release the holding torque
+    RELEASE = 2
 
 
 class LockOnPowerOn(IntEnum):
     """lock on power on"""
 
-    RELEASE = 0
     #: torque released at power-on
-    HOLD = 1
+    RELEASE = 0
     #: holds its current angle at power-on
+    HOLD = 1
 
 
 class WheelBrake(IntEnum):
     """wheel brake"""
 
-    RELEASE = 0
     #: torque released when the wheel stops
-    HOLD = 1
+    RELEASE = 0
     #: holds when the wheel stops
+    HOLD = 1
 
 
 class SpinDirection(IntEnum):
     """spin direction"""
 
-    COUNTERCLOCKWISE = 0
     #: counter-clockwise
-    CLOCKWISE = 1
+    COUNTERCLOCKWISE = 0
     #: clockwise
+    CLOCKWISE = 1
 
 
 class SpinMode(IntEnum):
     """spin mode"""
 
-    STOP = 0
     #: stop
-    CONTINUOUS = 1
+    STOP = 0
     #: turn without stopping
-    TURNS = 2
+    CONTINUOUS = 1
     #: turn `value` turns, then stop
-    TIMED = 3
+    TURNS = 2
     #: turn for `value` ms, then stop
+    TIMED = 3
 
 
 @dataclass(frozen=True, slots=True)
 class UserData:
     """The user parameters 32..53 in data_id order. (Servo parameters by data_id)."""
 
-    reserved_32: int
     #: data_id 32: Reserved.
-    response_switch: ResponseSwitch | int
+    reserved_32: int
     #: data_id 33: Whether ROTATE, SPIN and DAMPING can be interrupted and whether they answer.
-    servo_id: int
+    response_switch: ResponseSwitch | int
     #: data_id 34: The servo's id; 255 is the broadcast address and cannot be assigned.
-    reserved_35: int
+    servo_id: int
     #: data_id 35: Reserved.
-    baudrate: BaudrateOption | int
+    reserved_35: int
     #: data_id 36: Baud rate option (not the rate itself); takes effect at once.
-    stall_protect_mode: StallProtectMode | int
+    baudrate: BaudrateOption | int
     #: data_id 37: Strategy when the servo stalls.
-    stall_power_limit: int
+    stall_protect_mode: StallProtectMode | int
     #: data_id 38: Power limit while stalled. [mW]
-    over_volt_low: int
+    stall_power_limit: int
     #: data_id 39: Low voltage limit. [mV]
-    over_volt_high: int
+    over_volt_low: int
     #: data_id 40: High voltage limit. [mV]
-    over_temperature: int
+    over_volt_high: int
     #: data_id 41: Temperature limit (the document spells it `over_temprature`). [°C]
-    over_power: int
+    over_temperature: int
     #: data_id 42: Power limit. [mW]
-    over_current: int
+    over_power: int
     #: data_id 43: Current limit. [mA]
-    accel_switch: Switch | int
+    over_current: int
     #: data_id 44: Acceleration planning (t/4 accelerate, t/2 constant, t/4 decelerate); must be 1.
-    reserved_45: int
+    accel_switch: Switch | int
     #: data_id 45: Reserved.
-    po_lock_switch: LockOnPowerOn | int
+    reserved_45: int
     #: data_id 46: Whether the servo holds its angle at power-on.
-    wb_lock_switch: WheelBrake | int
+    po_lock_switch: LockOnPowerOn | int
     #: data_id 47: Whether the servo holds when a wheel-mode spin stops.
-    angle_limit_switch: Switch | int
+    wb_lock_switch: WheelBrake | int
     #: data_id 48: Angle limits (51, 52) apply only when this is on.
-    soft_start_switch: Switch | int
+    angle_limit_switch: Switch | int
     #: data_id 49: Run the first angle command after power-on slowly (over soft_start_time).
-    soft_start_time: int
+    soft_start_switch: Switch | int
     #: data_id 50: Duration of the first move after power-on. [ms]
-    angle_limit_high: int
+    soft_start_time: int
     #: data_id 51: Upper angle limit. [0.1°]
-    angle_limit_low: int
+    angle_limit_high: int
     #: data_id 52: Lower angle limit. [0.1°]
-    angle_mid_offset: int
+    angle_limit_low: int
     #: data_id 53: Offset of the middle position. [0.1°]
+    angle_mid_offset: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -256,10 +256,10 @@ class UserData:
 class MethodBits:
     """Bit fields of method."""
 
-    direction: SpinDirection | int
     #: Rotation direction. (bit 7)
-    mode: SpinMode | int
+    direction: SpinDirection | int
     #: How long to spin. (bits 1..0)
+    mode: SpinMode | int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -284,8 +284,8 @@ class PingRequest(Message):
     COMMAND: ClassVar[str] = 'ping'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
+    servo_id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -308,8 +308,8 @@ class PingResponse(Message):
     COMMAND: ClassVar[str] = 'ping'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
+    servo_id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -332,8 +332,8 @@ class ResetUserDataRequest(Message):
     COMMAND: ClassVar[str] = 'reset_user_data'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
+    servo_id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -356,10 +356,10 @@ class ResetUserDataResponse(Message):
     COMMAND: ClassVar[str] = 'reset_user_data'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
-    result: Result | int
+    servo_id: int
     #: Outcome of the command.
+    result: Result | int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -384,10 +384,10 @@ class ReadDataRequest(Message):
     COMMAND: ClassVar[str] = 'read_data'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
-    data_id: int
+    servo_id: int
     #: Parameter to read (see the parameter table).
+    data_id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -412,12 +412,12 @@ class ReadDataResponse(Message):
     COMMAND: ClassVar[str] = 'read_data'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
-    data_id: int
+    servo_id: int
     #: The parameter read.
-    data: int | float
+    data_id: int
     #: The value, typed by data_id.
+    data: int | float
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -444,12 +444,12 @@ class WriteDataRequest(Message):
     COMMAND: ClassVar[str] = 'write_data'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
-    data_id: int
+    servo_id: int
     #: User parameter to write (32..53).
-    data: int | float
+    data_id: int
     #: The value, typed by data_id.
+    data: int | float
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -476,12 +476,12 @@ class WriteDataResponse(Message):
     COMMAND: ClassVar[str] = 'write_data'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
-    data_id: int
+    servo_id: int
     #: The parameter written.
-    result: Result | int
+    data_id: int
     #: Outcome of the command.
+    result: Result | int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -508,8 +508,8 @@ class ReadBatchDataRequest(Message):
     COMMAND: ClassVar[str] = 'read_batch_data'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
+    servo_id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -532,10 +532,10 @@ class ReadBatchDataResponse(Message):
     COMMAND: ClassVar[str] = 'read_batch_data'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
-    user_data: UserData
+    servo_id: int
     #: The user parameters 32..53 in data_id order. (layout inferred, not documented)
+    user_data: UserData
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -560,10 +560,10 @@ class WriteBatchDataRequest(Message):
     COMMAND: ClassVar[str] = 'write_batch_data'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
-    user_data: UserData
+    servo_id: int
     #: The user parameters 32..53 in data_id order. (layout inferred, not documented)
+    user_data: UserData
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -588,10 +588,10 @@ class WriteBatchDataResponse(Message):
     COMMAND: ClassVar[str] = 'write_batch_data'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
-    result: Result | int
+    servo_id: int
     #: Outcome of the command. (layout inferred, not documented)
+    result: Result | int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -616,14 +616,14 @@ class SpinRequest(Message):
     COMMAND: ClassVar[str] = 'spin'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
-    method: MethodBits
+    servo_id: int
     #: Execution method and direction; the other bits are unused and must be zero.
-    speed: int
+    method: MethodBits
     #: Angular speed. [°/s]
-    value: int
+    speed: int
     #: Turns (mode turns) or ms (mode timed); ignored by stop and continuous.
+    value: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -652,10 +652,10 @@ class SpinResponse(Message):
     COMMAND: ClassVar[str] = 'spin'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
-    result: Result | int
+    servo_id: int
     #: Outcome of the command.
+    result: Result | int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -680,14 +680,14 @@ class RotateRequest(Message):
     COMMAND: ClassVar[str] = 'rotate'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
-    angle: int
+    servo_id: int
     #: Angle in 0.1° steps; the sign gives the direction (900 is 90°). [0.1°]
-    interval: int
+    angle: int
     #: Time to reach the target angle. [ms]
-    power: int = 0
+    interval: int
     #: Power; 0 or more than the power limit means the power limit. [mW]
+    power: int = 0
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -716,10 +716,10 @@ class RotateResponse(Message):
     COMMAND: ClassVar[str] = 'rotate'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
-    result: Result | int
+    servo_id: int
     #: Outcome of the command.
+    result: Result | int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -744,10 +744,10 @@ class DampingRequest(Message):
     COMMAND: ClassVar[str] = 'damping'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Servo id; 255 sets every servo (broadcast).
-    power: int
+    servo_id: int
     #: Holding power; 0 or more than the power limit means the limit. [mW]
+    power: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -772,10 +772,10 @@ class DampingResponse(Message):
     COMMAND: ClassVar[str] = 'damping'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
-    result: Result | int
+    servo_id: int
     #: Outcome of the command.
+    result: Result | int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -800,8 +800,8 @@ class ReadAngleRequest(Message):
     COMMAND: ClassVar[str] = 'read_angle'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
+    servo_id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -824,10 +824,10 @@ class ReadAngleResponse(Message):
     COMMAND: ClassVar[str] = 'read_angle'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
-    angle: int
+    servo_id: int
     #: Angle in 0.1° steps; the sign gives the direction (900 is 90°). [0.1°]
+    angle: int
 
     def to_fields(self) -> dict[str, Any]:
         return {

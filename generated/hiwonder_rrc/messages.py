@@ -77,55 +77,55 @@ __all__ = [
 class ReadResult(IntEnum):
     """Outcome of a bus-servo read, as reported by the board."""
 
-    OK = 0
     #: read succeeded
-    FAILED = -1
+    OK = 0
     #: read failed (the value that follows is not valid)
+    FAILED = -1
 
 
 class ButtonEvent(IntEnum):
     """Key event values. 002 lists these as '部分按键事件回调值' (some of the event values); other values decode as plain numbers."""
 
-    PRESSED = 1
     #: button pressed (BUTTON_EVENT_PRESSED)
-    LONG_PRESS = 2
+    PRESSED = 1
     #: button held down (BUTTON_EVENT_LONGPRESS)
-    CLICK = 32
+    LONG_PRESS = 2
     #: button clicked (BUTTON_EVENT_CLICK)
-    DOUBLE_CLICK = 64
+    CLICK = 32
     #: button double-clicked (BUTTON_EVENT_DOUBLE_CLICK)
+    DOUBLE_CLICK = 64
 
 
 class MotorMask(IntFlag):
     """Motors to stop; bit n stops the motor with motor_id n (002/003 example 0x05 stops motors 0 and 2)."""
 
     NONE = 0
-    MOTOR_0 = 1 << 0
     #: motor 0
-    MOTOR_1 = 1 << 1
+    MOTOR_0 = 1 << 0
     #: motor 1
-    MOTOR_2 = 1 << 2
+    MOTOR_1 = 1 << 1
     #: motor 2
-    MOTOR_3 = 1 << 3
+    MOTOR_2 = 1 << 2
     #: motor 3
-    MOTOR_4 = 1 << 4
+    MOTOR_3 = 1 << 3
     #: motor 4
-    MOTOR_5 = 1 << 5
+    MOTOR_4 = 1 << 4
     #: motor 5
-    MOTOR_6 = 1 << 6
+    MOTOR_5 = 1 << 5
     #: motor 6
-    MOTOR_7 = 1 << 7
+    MOTOR_6 = 1 << 6
     #: motor 7
+    MOTOR_7 = 1 << 7
 
 
 @dataclass(frozen=True, slots=True)
 class MotorsItem:
     """One item of motors."""
 
-    motor_id: int
     #: Encoder motor id; bit n of the stop mask is motor_id n (the board has four motor ports).
-    speed: float
+    motor_id: int
     #: Motor speed in revolutions per second; the sign gives the direction. [r/s]
+    speed: float
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -146,10 +146,10 @@ class MotorsItem:
 class PwmServosItem:
     """One item of pwm_servos."""
 
-    servo_id: int
     #: PWM servo id.
-    pulse: int
+    servo_id: int
     #: PWM pulse width (脉冲宽度); 500..2500 is 0°..180°. [µs] range 500..2500
+    pulse: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -170,10 +170,10 @@ class PwmServosItem:
 class BusServosItem:
     """One item of bus_servos."""
 
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
-    position: int
+    servo_id: int
     #: Bus servo position (002 calls it 脉冲宽度, pulse width); 0..1000 is 0°..240°. range 0..1000
+    position: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -198,14 +198,14 @@ class LedRequest(Message):
     COMMAND: ClassVar[str] = 'led'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    led_id: int
     #: LED id.
-    on_time: int
+    led_id: int
     #: Time on (亮的时间). [ms]
-    off_time: int
+    on_time: int
     #: Time off (灭的时间). [ms]
-    repeat: int
+    off_time: int
     #: Number of blinks (循环次数).
+    repeat: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -234,14 +234,14 @@ class BuzzerRequest(Message):
     COMMAND: ClassVar[str] = 'buzzer'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    frequency: int
     #: Tone frequency (频率). [Hz]
-    on_time: int
+    frequency: int
     #: Time sounding (响的时间). [ms]
-    off_time: int
+    on_time: int
     #: Time silent (不响的时间). [ms]
-    repeat: int
+    off_time: int
     #: Number of beeps (循环次数).
+    repeat: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -270,10 +270,10 @@ class MotorSetSpeedRequest(Message):
     COMMAND: ClassVar[str] = 'motor'
     SUBCOMMAND: ClassVar[str | None] = 'set_speed'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    motor_id: int
     #: Encoder motor id; bit n of the stop mask is motor_id n (the board has four motor ports).
-    speed: float
+    motor_id: int
     #: Motor speed in revolutions per second; the sign gives the direction. [r/s]
+    speed: float
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -298,8 +298,8 @@ class MotorSetSpeedsRequest(Message):
     COMMAND: ClassVar[str] = 'motor'
     SUBCOMMAND: ClassVar[str | None] = 'set_speeds'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    motors: tuple[MotorsItem, ...]
     #: One (motor_id, speed) pair per motor.
+    motors: tuple[MotorsItem, ...]
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -322,8 +322,8 @@ class MotorStopRequest(Message):
     COMMAND: ClassVar[str] = 'motor'
     SUBCOMMAND: ClassVar[str | None] = 'stop'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    motor_id: int
     #: Encoder motor id; bit n of the stop mask is motor_id n (the board has four motor ports).
+    motor_id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -346,8 +346,8 @@ class MotorStopMaskRequest(Message):
     COMMAND: ClassVar[str] = 'motor'
     SUBCOMMAND: ClassVar[str | None] = 'stop_mask'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    mask: MotorMask
     #: Motors to stop (电机掩码), bit n for motor n.
+    mask: MotorMask
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -370,10 +370,10 @@ class PwmServoSetPositionsRequest(Message):
     COMMAND: ClassVar[str] = 'pwm_servo'
     SUBCOMMAND: ClassVar[str | None] = 'set_positions'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    duration: int
     #: Time to complete the move (运动时间). [ms]
-    pwm_servos: tuple[PwmServosItem, ...]
+    duration: int
     #: One (servo_id, pulse) pair per servo.
+    pwm_servos: tuple[PwmServosItem, ...]
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -398,12 +398,12 @@ class PwmServoSetPositionRequest(Message):
     COMMAND: ClassVar[str] = 'pwm_servo'
     SUBCOMMAND: ClassVar[str | None] = 'set_position'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    duration: int
     #: Time to complete the move (运动时间). [ms]
-    servo_id: int
+    duration: int
     #: PWM servo id.
-    pulse: int
+    servo_id: int
     #: PWM pulse width (脉冲宽度); 500..2500 is 0°..180°. [µs] range 500..2500
+    pulse: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -430,8 +430,8 @@ class PwmServoReadPositionRequest(Message):
     COMMAND: ClassVar[str] = 'pwm_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_position'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: PWM servo id.
+    servo_id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -454,10 +454,10 @@ class PwmServoReadPositionResponse(Message):
     COMMAND: ClassVar[str] = 'pwm_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_position'
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: PWM servo id.
-    pulse: int
+    servo_id: int
     #: The servo's current pulse width (not range-checked in a report). [µs]
+    pulse: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -482,10 +482,10 @@ class PwmServoSetOffsetRequest(Message):
     COMMAND: ClassVar[str] = 'pwm_servo'
     SUBCOMMAND: ClassVar[str | None] = 'set_offset'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: PWM servo id.
-    offset: int
+    servo_id: int
     #: PWM servo offset (偏差), an int8 from -100 to +100. [µs] range -100..100
+    offset: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -510,8 +510,8 @@ class PwmServoReadOffsetRequest(Message):
     COMMAND: ClassVar[str] = 'pwm_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_offset'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: PWM servo id.
+    servo_id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -534,10 +534,10 @@ class PwmServoReadOffsetResponse(Message):
     COMMAND: ClassVar[str] = 'pwm_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_offset'
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: PWM servo id.
-    offset: int
+    servo_id: int
     #: The servo's offset (int8; -100..100 when set through 0x07). [µs]
+    offset: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -562,10 +562,10 @@ class BusServoSetPositionsRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'set_positions'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    duration: int
     #: Time to complete the move (运动时间). [ms]
-    bus_servos: tuple[BusServosItem, ...]
+    duration: int
     #: One (servo_id, position) pair per servo.
+    bus_servos: tuple[BusServosItem, ...]
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -590,8 +590,8 @@ class BusServoReadPositionRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_position'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -614,12 +614,12 @@ class BusServoReadPositionResponse(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_position'
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
-    success: ReadResult | int
+    servo_id: int
     #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
-    position: int
+    success: ReadResult | int
     #: Current position (0..1000 is 0°..240°).
+    position: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -646,8 +646,8 @@ class BusServoReadVoltageRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_voltage'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -670,12 +670,12 @@ class BusServoReadVoltageResponse(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_voltage'
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
-    success: ReadResult | int
+    servo_id: int
     #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
-    voltage: int
+    success: ReadResult | int
     #: Input voltage. [mV]
+    voltage: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -702,8 +702,8 @@ class BusServoReadTemperatureRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_temperature'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -726,12 +726,12 @@ class BusServoReadTemperatureResponse(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_temperature'
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
-    success: ReadResult | int
+    servo_id: int
     #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
-    temperature: int
+    success: ReadResult | int
     #: Temperature. [°C]
+    temperature: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -758,8 +758,8 @@ class BusServoUnloadRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'unload'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -782,8 +782,8 @@ class BusServoLoadRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'load'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -806,10 +806,10 @@ class BusServoSetIdRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'set_id'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: The servo's current id.
-    new_id: int
+    servo_id: int
     #: The id to store (save_id).
+    new_id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -834,8 +834,8 @@ class BusServoReadIdRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_id'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int = 254
     #: 0xFE (broadcast query, 查询广播).
+    servo_id: int = 254
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -858,12 +858,12 @@ class BusServoReadIdResponse(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_id'
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: The id the request was sent to (0xFE for the broadcast).
-    success: ReadResult | int
+    servo_id: int
     #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
-    id: int
+    success: ReadResult | int
     #: The id read from the servo.
+    id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -890,10 +890,10 @@ class BusServoSetOffsetRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'set_offset'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
-    offset: int
+    servo_id: int
     #: Bus servo offset (偏差), an int8 from -100 to +100. range -100..100
+    offset: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -918,8 +918,8 @@ class BusServoReadOffsetRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_offset'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -942,12 +942,12 @@ class BusServoReadOffsetResponse(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_offset'
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
-    success: ReadResult | int
+    servo_id: int
     #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
-    offset: int
+    success: ReadResult | int
     #: The servo's offset (int8; -100..100 when set through 0x20).
+    offset: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -974,8 +974,8 @@ class BusServoSaveOffsetRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'save_offset'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -998,12 +998,12 @@ class BusServoSetPositionLimitRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'set_position_limit'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
-    low: int
+    servo_id: int
     #: Low position limit (低限位), 0..1000. range 0..1000
-    high: int
+    low: int
     #: High position limit (高限位), 0..1000. range 0..1000
+    high: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1030,8 +1030,8 @@ class BusServoReadPositionLimitRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_position_limit'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1054,14 +1054,14 @@ class BusServoReadPositionLimitResponse(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_position_limit'
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
-    success: ReadResult | int
+    servo_id: int
     #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
-    low: int
+    success: ReadResult | int
     #: Low position limit.
-    high: int
+    low: int
     #: High position limit.
+    high: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1090,12 +1090,12 @@ class BusServoSetVoltageLimitRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'set_voltage_limit'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
-    low: int
+    servo_id: int
     #: Low voltage limit (低限位), at least 4500 mV. [mV] range 4500..14000
-    high: int
+    low: int
     #: High voltage limit (高限位), at most 14000 mV. [mV] range 4500..14000
+    high: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1122,8 +1122,8 @@ class BusServoReadVoltageLimitRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_voltage_limit'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1146,14 +1146,14 @@ class BusServoReadVoltageLimitResponse(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_voltage_limit'
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
-    success: ReadResult | int
+    servo_id: int
     #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
-    low: int
+    success: ReadResult | int
     #: Low voltage limit. [mV]
-    high: int
+    low: int
     #: High voltage limit. [mV]
+    high: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1182,10 +1182,10 @@ class BusServoSetTemperatureLimitRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'set_temperature_limit'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
-    limit: int
+    servo_id: int
     #: Over-temperature threshold (高温阈值); must be less than 100 °C. [°C] range 0..99
+    limit: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1210,8 +1210,8 @@ class BusServoReadTemperatureLimitRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_temperature_limit'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1234,12 +1234,12 @@ class BusServoReadTemperatureLimitResponse(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_temperature_limit'
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
-    success: ReadResult | int
+    servo_id: int
     #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
-    limit: int
+    success: ReadResult | int
     #: Over-temperature threshold. [°C]
+    limit: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1266,10 +1266,10 @@ class KeyResponse(Message):
     COMMAND: ClassVar[str] = 'key'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    button_id: int
     #: Button id.
-    event: ButtonEvent | int
+    button_id: int
     #: What happened to the button (按键事件).
+    event: ButtonEvent | int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1294,18 +1294,18 @@ class ImuResponse(Message):
     COMMAND: ClassVar[str] = 'imu'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    accel_x: float
     #: Acceleration along x.
-    accel_y: float
+    accel_x: float
     #: Acceleration along y.
-    accel_z: float
+    accel_y: float
     #: Acceleration along z.
-    gyro_x: float
+    accel_z: float
     #: Angular rate about x.
-    gyro_y: float
+    gyro_x: float
     #: Angular rate about y.
-    gyro_z: float
+    gyro_y: float
     #: Angular rate about z.
+    gyro_z: float
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1338,18 +1338,18 @@ class GamepadResponse(Message):
     COMMAND: ClassVar[str] = 'gamepad'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    buttons: int
     #: Button states (按键), one bit per button (bits not documented).
-    hat: int
+    buttons: int
     #: Hat (direction pad) value.
-    left_x: int
+    hat: int
     #: Left stick x.
-    left_y: int
+    left_x: int
     #: Left stick y.
-    right_x: int
+    left_y: int
     #: Right stick x.
-    right_y: int
+    right_x: int
     #: Right stick y.
+    right_y: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1382,16 +1382,16 @@ class SbusResponse(Message):
     COMMAND: ClassVar[str] = 'sbus'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    channels: tuple[int, ...]
     #: The 16 proportional channels.
-    ch17: int
+    channels: tuple[int, ...]
     #: Digital channel 17.
-    ch18: int
+    ch17: int
     #: Digital channel 18.
-    signal_loss: int
+    ch18: int
     #: Set when the receiver has lost the signal.
-    fail_safe: int
+    signal_loss: int
     #: Set when the receiver is in fail-safe.
+    fail_safe: int
 
     def to_fields(self) -> dict[str, Any]:
         return {

@@ -35,6 +35,7 @@ from serialspec.spec.model import (
     Scalar,
     Table,
     TableBlock,
+    TableEntry,
     TableValue,
     reply_condition,
 )
@@ -187,11 +188,28 @@ def status_flags(protocol: Protocol) -> str:
     return "{" + ", ".join(pairs) + "}" if pairs else ""
 
 
+def register_examples(table: Table) -> dict[str, str]:
+    """Docstring examples from the table's own registers (never another protocol's)."""
+    entries = [e for e in table.entries if not e.reserved]
+    writable = [e for e in entries if e.access == "rw"][:2] or entries[:1]
+
+    def value(e: TableEntry) -> str:
+        return number(e.default if isinstance(e.default, int | float) else e.minimum)
+
+    return {
+        "write_example": ", ".join(f"{e.name}={value(e)}" for e in writable),
+        "read_example": entries[0].name if entries else "",
+        "each_example": ", ".join(f'{i}: {{"{writable[0].name}": {value(writable[0])}}}' for i in (1, 2))
+        if writable
+        else "",
+    }
+
+
 def register_commands(protocol: Protocol, methods: list[dict[str, Any]]) -> list[dict[str, Any]]:
     """Commands that carry a run of registers get a method by register name; the raw one keeps `<name>_raw`.
 
-    A request with `bytes` of a table from its own start field writes (`write(id, goal_position=2048)`), a request
-    whose reply holds such bytes from the request's start and size reads (`read(id, "present_position")`), and a
+    A request with `bytes` of a table from its own start field writes (`write(id, position=100)`), a request
+    whose reply holds such bytes from the request's start and size reads (`read(id, "position")`), and a
     request group whose items each hold such bytes for one device writes to several (`sync_write({1: {...}})`).
     """
     found: list[dict[str, Any]] = []
@@ -252,6 +270,8 @@ def register_commands(protocol: Protocol, methods: list[dict[str, Any]]) -> list
             )
         else:
             continue
+        table = next(t for t in protocol.tables if map_name(t) == context["map"])
+        context.update(register_examples(table))
         method["name"] = context["raw"]
         found.append(context)
     return found

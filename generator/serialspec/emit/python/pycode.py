@@ -227,8 +227,8 @@ class PackageCode:
             default = ""
             if isinstance(f, Scalar) and f.default is not None and f.name in trailing_defaults:
                 default = f" = {number(f.default)}"
+            lines.append(f"#: {doc_line(f)}")  # before the attribute: documentation tools attach it to the next line
             lines.append(f"{f.name}: {annotation(f)}{default}")
-            lines.append(f"#: {doc_line(f)}")
         return lines
 
     def helper(self, f: SpecField) -> None:
@@ -239,7 +239,7 @@ class PackageCode:
             for bit in f.bits:
                 kind = f"{bit.enum.class_name} | int" if bit.enum else "int"
                 where = f"bit {bit.low}" if bit.high == bit.low else f"bits {bit.high}..{bit.low}"
-                attributes += [f"{bit.name}: {kind}", f"#: {one_line(bit.description or bit.name)} ({where})"]
+                attributes += [f"#: {one_line(bit.description or bit.name)} ({where})", f"{bit.name}: {kind}"]
             code = ClassCode(f.bits_class, f"Bit fields of {f.name}.", "", attributes)
             code.to_fields = [f"{b.name!r}: int(self.{b.name})," for b in f.bits]
             code.from_fields = [self.from_value_expr(b.name, b.enum.class_name if b.enum else None) for b in f.bits]
@@ -260,8 +260,8 @@ class PackageCode:
                 kind = f"{e.enum.class_name} | int" if e.enum else ("float" if e.type.is_float else "int")
                 unit = f" [{e.unit}]" if e.unit else ""
                 attributes += [
-                    f"{e.name}: {kind}",
                     f"#: {one_line(f'{f.table.key_name} {e.key}: {e.description or e.name}{unit}')}",
+                    f"{e.name}: {kind}",
                 ]
             code = ClassCode(f.class_name, one_line(f"{f.description or f.name} ({f.table.title})."), "", attributes)
             code.to_fields = [

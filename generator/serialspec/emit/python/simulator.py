@@ -81,7 +81,7 @@ def simulator_module(protocol: Protocol) -> str:
                     args.append(f"{name}={getattr(behaviour, name)!r}")
         condition = reply_condition(request, response)
         if response and condition:
-            args.append(f"optional_when=({condition.key}, {condition.equals})")
+            args.append(f"optional_when=({condition.entry!r}, {condition.equals})")
         if response and response.after:
             args.append(f"after={response.after!r}")
         tables = table_fields(request, response)

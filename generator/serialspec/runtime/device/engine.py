@@ -43,7 +43,7 @@ class CommandSpec:
     reports: dict[str, str] = field(default_factory=dict)
     moves: tuple[str, str, str, str] | None = None  # state, target field, duration field (ms), speed field (/s)
     broadcast_reply: bool = False
-    optional_when: tuple[int, int] | None = None  # (memory key, value) with which the response is sent
+    optional_when: tuple[str, int] | None = None  # (memory entry, value) with which the response is sent
     after: str = ""  # request field: the response is sent after that many ms
     # table fields of the request and response: name -> ("value", key field) or ("block", entry names...)
     tables: dict[str, tuple[str, ...]] = field(default_factory=dict)
@@ -269,7 +269,7 @@ class Engine(FaultInjection):
         # Whether an optional reply is due is decided on the switch as the request finds it (a write that turns
         # replies off is still answered), which is also what a client that remembers the switch expects.
         switch = command.optional_when
-        answers = switch is None or device.memory.get(switch[0]) == switch[1]
+        answers = switch is None or device.get(switch[0]) == switch[1]
         if command.resets:
             device.reset()
         written: set[str] = set()

@@ -805,6 +805,30 @@ CASES: list[tuple[str, str, Mutation | Text, str | None]] = [
         "commands.move.request.fields.to_fields: field name 'to_fields' is reserved (a Python keyword or a name generated code uses)",
     ),
     (
+        "field named reply",
+        "tiny",
+        rename("commands/move/request/fields/mode", "reply"),
+        "commands.move.request.fields.reply: field name 'reply' is reserved (a Python keyword or a name generated code uses)",
+    ),
+    (
+        "field named request",
+        "tiny",
+        rename("commands/move/request/fields/mode", "request"),
+        "commands.move.request.fields.request: field name 'request' is reserved (a Python keyword or a name generated code uses)",
+    ),
+    (
+        "enum named like the simulator",
+        "tiny",
+        put("enums/tiny_simulator", {"values": {"a": 0}}),
+        "enums.tiny_simulator: generated class name TinySimulator is already used by protocol",
+    ),
+    (
+        "enum named like a struct",
+        "tiny",
+        put("enums/move_request_content", {"values": {"a": 0}}),
+        "commands.move.request: generated class name MoveRequestContent is already used by enums.move_request_content",
+    ),
+    (
         "field named with capitals",
         "tiny",
         rename("commands/move/request/fields/mode", "Mode"),

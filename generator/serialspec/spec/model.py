@@ -157,6 +157,7 @@ class TableBlock(Common):
     class_name: str
     entries: tuple[TableEntry, ...]
     endian: Literal["<", ">"]
+    struct_name: str = ""  # the construct struct of the block
 
 
 Field = Scalar | Array | Bytes | Group | TableValue | TableBlock
@@ -192,6 +193,10 @@ class Table:
     description: str
     source: str
     entries: tuple[TableEntry, ...]
+    # generated names: the register map (or the table's constant), the switch of its values by key, the name alias
+    constant: str = ""
+    value_constant: str = ""
+    names_class: str = ""
 
     def entry(self, key: int) -> TableEntry | None:
         for entry in self.entries:
@@ -231,6 +236,7 @@ class Message:
     after: str = ""  # a response sent once the request's field of this name (ms) has elapsed
     answered_by: str = ""  # a request answered by another command's response (its key)
     reply_when: OptionalWhen | None = None  # a request whose reply is sent only when a device parameter has a value
+    struct_name: str = ""  # the construct struct of its content
 
     @property
     def key(self) -> str:
@@ -492,6 +498,8 @@ class Protocol:
     examples: tuple[Example, ...]
     errata: tuple[Erratum, ...]
     device: Device | None = None
+    client_class: str = ""  # the generated client's and simulator's class names
+    simulator_class: str = ""
 
     def messages(self) -> tuple[Message, ...]:
         return tuple(m for c in self.commands for m in c.messages())

@@ -49,4 +49,6 @@ def resolve(located: Located) -> Protocol:
         examples=ctx.examples,
         errata=ctx.errata,
         device=ctx.device,
+        client_class=ctx.client_class,
+        simulator_class=ctx.simulator_class,
     )

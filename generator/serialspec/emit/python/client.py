@@ -431,7 +431,7 @@ def client_module(protocol: Protocol) -> str:
     imports.update(e.flags.class_name for e in status_elements(protocol) if e.flags is not None)
     everything = [*methods, *(m for g in groups.values() for m in g["methods"])]
     address, broadcast = address_of(protocol)
-    class_name = "".join(w.capitalize() for w in protocol.name.split("_")) + "Client"
+    class_name = protocol.client_class
     return render(
         "client.py.j2",
         spec_path=protocol.spec_path,

@@ -94,7 +94,7 @@ def simulator_module(protocol: Protocol) -> str:
         title=one_line(protocol.title),
         package=protocol.name,
         description=one_line(device.description),
-        class_name="".join(w.capitalize() for w in protocol.name.split("_")) + "Simulator",
+        class_name=protocol.simulator_class,
         address=repr(device.address),
         id_entry=repr(device.id_entry),
         broadcast=repr(device.broadcast),

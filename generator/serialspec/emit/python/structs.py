@@ -64,9 +64,9 @@ def field_expr(f: Field, parent: str = "this") -> str:
         count = f.count if isinstance(f.count, int) else f"this.{f.count}"
         return f"Array({count}, {item})"
     if isinstance(f, TableValue):
-        return f"Switch(this.{f.key}, {table_name(f.table.name)})"
+        return f"Switch(this.{f.key}, {f.table.value_constant})"
     assert isinstance(f, TableBlock)
-    return block_name(f.class_name)
+    return f.struct_name
 
 
 def bits_expr(f: Scalar) -> str:
@@ -83,14 +83,6 @@ def bits_expr(f: Scalar) -> str:
         parts.append(f"'_unused_{bit}' / Const(0, BitsInteger({bit + 1}))")
     inner = "BitStruct(" + ", ".join(parts) + ")"
     return f"ByteSwapped({inner})" if f.type.size > 1 and f.endian == "<" else inner
-
-
-def table_name(name: str) -> str:
-    return f"{name.upper()}_VALUE"
-
-
-def block_name(class_name: str) -> str:
-    return f"{class_name}Block"
 
 
 def frame_expr(layout: FrameLayout) -> str:
@@ -125,7 +117,7 @@ def structs_module(protocol: Protocol) -> str:
         fields = [f"{f.name!r} / {field_expr(f)}" for f in message.fields]
         contents.append(
             {
-                "name": f"{message.class_name}Content",
+                "name": message.struct_name,
                 "fields": fields,
                 "key": message.key,
                 "direction": message.direction.value,
@@ -133,7 +125,7 @@ def structs_module(protocol: Protocol) -> str:
         )
     tables = [
         {
-            "name": table_name(t.name),
+            "name": t.value_constant,
             "entries": [(e.key, field_expr_entry(e.type, e.sign_bit)) for e in t.entries if not e.reserved],
         }
         for t in protocol.tables
@@ -142,7 +134,7 @@ def structs_module(protocol: Protocol) -> str:
     for message in protocol.messages():
         for f in message.fields:
             if isinstance(f, TableBlock):
-                blocks[block_name(f.class_name)] = [
+                blocks[f.struct_name] = [
                     f"{e.name!r} / {field_expr_entry(e.type, e.sign_bit, f.endian)}" for e in f.entries
                 ]
     checksum = protocol.framing.checksum

@@ -36,6 +36,8 @@ LABEL = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
 
 # Attribute and parameter names the generated classes and methods use themselves.
 RESERVED_NAMES = frozenset({"to_fields", "from_fields", "self"})
+# A field is also a parameter of a client method, whose body has these locals.
+RESERVED_FIELD_NAMES = RESERVED_NAMES | {"request", "reply", "replies"}
 # Names the generated modules (messages, codec, client, simulator, registers, __init__) import or define next to
 # the classes a spec names, and Python's capitalised builtins: a generated class of the same name would shadow one.
 GENERATED_CLASS_NAMES = frozenset(
@@ -125,6 +127,8 @@ class Context:
     endian: Literal["<", ">"] = "<"
     shared_fields: dict[str, Any] = field(default_factory=dict)
     name: str = ""
+    client_class: str = ""
+    simulator_class: str = ""
     serial: Serial | None = None
     matching: tuple[str, ...] = ()
     matching_description: str = ""
@@ -224,13 +228,13 @@ class Pass:
 
     # --- names and references -------------------------------------------------------------------------------------
 
-    def name(self, value: str, path: Path, what: str = "name") -> str:
+    def name(self, value: str, path: Path, what: str = "name", reserved: frozenset[str] = RESERVED_NAMES) -> str:
         if not isinstance(value, str) or not NAME.match(value):
             self.error(
                 path,
                 f"{what} {value!r} must be a lower-case identifier (a-z, 0-9, _; starting with a letter)",
             )
-        elif keyword.iskeyword(value) or value in RESERVED_NAMES:
+        elif keyword.iskeyword(value) or value in reserved:
             self.error(path, f"{what} {value!r} is reserved (a Python keyword or a name generated code uses)")
         return str(value)
 

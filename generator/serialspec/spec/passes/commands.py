@@ -253,6 +253,7 @@ class Commands(FieldResolver):
         self.check_rest(fields, (*path, "fields"))
         low, high = content_bounds(fields)
         class_name = self.class_name(camel(command, subcommand or "", direction.value), path)
+        struct_name = self.class_name(f"{class_name}Content", path)
         answered_by = value.get("answered_by") or {}
         if direction == Direction.REQUEST:
             for field in fields:
@@ -278,6 +279,7 @@ class Commands(FieldResolver):
             after=self.after(value.get("after"), fields, direction, path),
             answered_by=str(answered_by.get("command", "")),
             reply_when=self.optional_when(answered_by.get("optional_when"), (*path, "answered_by", "optional_when")),
+            struct_name=struct_name,
         )
 
     def table_entry(self, text: str, path: Path) -> tuple[Table, TableEntry]:

@@ -20,7 +20,7 @@ from serialspec.spec.model import (
     TableValue,
     sum_sizes,
 )
-from serialspec.spec.passes.base import Pass, camel
+from serialspec.spec.passes.base import RESERVED_FIELD_NAMES, Pass, camel
 
 FIELD_KINDS = (*grammar.SCALAR_TYPES, "bytes", "array", "group", "table_value", "table_block")
 
@@ -40,7 +40,7 @@ class FieldResolver(Pass):
         resolved: list[Field] = []
         for name, item in raw.items():
             field_path = (*path, name)
-            self.name(name, field_path, "field name")
+            self.name(name, field_path, "field name", RESERVED_FIELD_NAMES)
             if any(f.name == name for f in resolved):
                 self.error(field_path, f"duplicate field {name!r}")
             field = self.guard(field_path, self.field, name, item, field_path, resolved, parent)
@@ -157,7 +157,10 @@ class FieldResolver(Pass):
             if expected is not None and size != expected:
                 self.error((*path, "expect_size"), f"the selected entries take {size} bytes, not {expected}")
             class_name = self.class_name(camel(name), path, identity=("table_block", table.name, entries))
-            return TableBlock(**common, table=table, class_name=class_name, entries=entries, endian=endian)
+            struct_name = self.class_name(f"{class_name}Block", path, identity=("table_block", table.name, entries))
+            return TableBlock(
+                **common, table=table, class_name=class_name, entries=entries, endian=endian, struct_name=struct_name
+            )
         raise self.fail((*path, "type"), f"unknown type {kind!r} (expected one of {', '.join(FIELD_KINDS)})")
 
     def scalar(self, common: dict[str, Any], spec: dict[str, Any], path: Path, endian: Literal["<", ">"]) -> Scalar:

@@ -119,10 +119,6 @@ class Types(Pass):
                     sign_bit=sign_bit,
                 )
             )
-        # the generated register map, table values and register-name alias are named after the table
-        self.class_name(key.upper(), path)
-        self.class_name(f"{key.upper()}_VALUE", path)
-        self.class_name(camel(key, "name"), path)
         if value.get("key_type") is None:
             self.check_table_layout(entries, path)
         self.tables[key] = Table(
@@ -132,6 +128,10 @@ class Types(Pass):
             str(value.get("description", "")),
             str(value.get("source", "")),
             tuple(entries),
+            # the generated register map, table values and register-name alias are named after the table
+            constant=self.class_name(key.upper(), path),
+            value_constant=self.class_name(f"{key.upper()}_VALUE", path),
+            names_class=self.class_name(camel(key, "name"), path),
         )
 
     def check_table_layout(self, entries: list[TableEntry], path: Path) -> None:

@@ -8,7 +8,7 @@ references that resolve, sizes that add up) is checked later, in resolve.py.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -202,6 +202,21 @@ class Obj(Shape):
 
 
 @dataclass
+class Ref(Shape):
+    """A shape defined later, or by itself (group fields are fields): checked as it, a $ref in the JSON Schema."""
+
+    name: str
+    target: Callable[[], Shape]
+    description: str = ""
+
+    def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
+        yield from self.target().check(value, path)
+
+    def json_schema(self) -> dict[str, Any]:
+        return {"$ref": f"#/$defs/{self.name}", "description": self.description}
+
+
+@dataclass
 class OneOf(Shape):
     """Either a short form (e.g. a bare type name) or a long form; picked by the kind of value given."""
 
@@ -283,7 +298,7 @@ _FIELD_LONG: dict[str, Shape] = {
     "size": OneOf((Int(), Str()), "bytes: a number, `rest` (up to the end of the content) or a field name"),
     "count": OneOf((Int(), Str()), "array/group: a number, `rest`, or the name of an earlier count field"),
     "of": Str("array: the item type."),
-    "fields": Any_("group: the fields of each item (a mapping, like request/response)."),
+    "fields": Ref("fields", lambda: FIELDS, "group: the fields of each item (a mapping, like request/response)."),
     "table": Str("table_value/table_block, or bytes holding registers: name of an entry in `tables:`."),
     "key": Str("table_value: the earlier field holding the table key (e.g. data_id)."),
     "start": Str("bytes holding registers: the field (or request.<field>) with the first register's key."),
@@ -301,7 +316,7 @@ _FIELD_LONG: dict[str, Shape] = {
     ),
 }
 FIELD = OneOf((Str("A wire type or the name of an entry in `fields:`"), Obj(_FIELD_LONG)), "a type name or a mapping")
-FIELDS = MapOf(FIELD, "Fields in wire order: name -> type or mapping.")
+FIELDS: Shape = MapOf(FIELD, "Fields in wire order: name -> type or mapping.")
 
 OPTIONAL_WHEN = Obj(
     {
@@ -615,5 +630,6 @@ SPEC = Obj(
 def json_schema() -> dict[str, Any]:
     schema = SPEC.json_schema()
     schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
+    schema["$defs"] = {"fields": FIELDS.json_schema()}
     schema["title"] = "serialspec protocol spec"
     return schema

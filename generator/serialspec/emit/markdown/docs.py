@@ -332,7 +332,8 @@ def content_rows(
             )
         if size is None:
             if isinstance(f, Group):
-                count = len(values.get(f.name, []))
+                items = values.get(f.name)  # recorded values; a malformed record is a spec error of its own
+                count = len(items) if isinstance(items, list) else 0
                 item = f.item_size
                 size = count * item if item is not None else end - offset
             elif isinstance(f, TableValue):

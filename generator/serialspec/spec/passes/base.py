@@ -196,6 +196,11 @@ class Pass:
     def shared_fields(self) -> dict[str, Any]:
         return self.ctx.shared_fields
 
+    def section(self, key: str) -> dict[Any, Any]:
+        """A top-level mapping of the spec; empty when missing or malformed (the structural check reports that)."""
+        value = self.ctx.data.get(key)
+        return value if isinstance(value, dict) else {}
+
     # --- reporting ------------------------------------------------------------------------------------------------
 
     def error(self, path: Path, message: str) -> None:
@@ -217,7 +222,7 @@ class Pass:
             return function(*args)
         except Bad:
             pass
-        except (TypeError, AttributeError, ValueError, KeyError):
+        except (TypeError, AttributeError, ValueError, KeyError, OverflowError):
             if not self.ctx.malformed_near(path):
                 raise
         if len(path) >= 2 and path[-2] in DEFINITIONS and isinstance(path[-1], str):

@@ -32,7 +32,7 @@ class Commands(FieldResolver):
     """Resolve `commands:` and check their codes against the framing and their `answered_by` references."""
 
     def run(self) -> list[SpecError]:
-        for key, value in (self.ctx.data.get("commands") or {}).items():
+        for key, value in self.section("commands").items():
             command = self.guard(("commands", key), self.command, key, value, ("commands", key))
             if command:
                 self.ctx.commands.append(command)

@@ -21,15 +21,15 @@ class Examples(Pass):
     """Resolve `errata:` then `examples:` (an example may name an erratum; an erratum may check examples)."""
 
     def run(self) -> list[SpecError]:
-        data, commands = self.ctx.data, self.ctx.commands
+        commands = self.ctx.commands
         errata = tuple(
             e
-            for key, value in (data.get("errata") or {}).items()
+            for key, value in self.section("errata").items()
             if (e := self.guard(("errata", key), self.erratum, key, value, ("errata", key), commands))
         )
         examples = tuple(
             e
-            for key, value in (data.get("examples") or {}).items()
+            for key, value in self.section("examples").items()
             if (e := self.guard(("examples", key), self.example, key, value, ("examples", key), commands, errata))
         )
         names = {e.name for e in examples} | self.ctx.broken
@@ -38,7 +38,7 @@ class Examples(Pass):
                 self.error(("examples", example.name, "request"), f"unknown example {example.request!r}")
         for erratum in errata:
             for example_name in erratum.check.examples:
-                if example_name not in names:
+                if isinstance(example_name, str) and example_name not in names:
                     self.error(("errata", erratum.name, "check", "examples"), f"unknown example {example_name!r}")
         self.ctx.errata, self.ctx.examples = errata, examples
         return self.problems

@@ -20,7 +20,7 @@ from serialspec.spec.model import (
     TableValue,
     sum_sizes,
 )
-from serialspec.spec.passes.base import RESERVED_FIELD_NAMES, Pass, camel
+from serialspec.spec.passes.base import RESERVED_FIELD_NAMES, Bad, Pass, camel
 
 FIELD_KINDS = (*grammar.SCALAR_TYPES, "bytes", "array", "group", "table_value", "table_block")
 
@@ -59,6 +59,8 @@ class FieldResolver(Pass):
                 path,
                 f"unknown type {item!r} (expected one of {', '.join(FIELD_KINDS)}, or a field from `fields:`)",
             )
+        if not isinstance(item, dict):
+            raise Bad  # neither a type name nor a mapping: the structural check has said so
         spec = dict(item)
         if "use" in spec:
             base_name = spec.pop("use")
@@ -132,6 +134,8 @@ class FieldResolver(Pass):
                 raise self.fail(path, "a group needs `count`: a number, `rest`, or the name of an earlier count field")
             if not isinstance(spec.get("fields"), dict):
                 raise self.fail(path, "a group needs `fields:` (a mapping of its item's fields)")
+            if not spec["fields"]:
+                raise self.fail((*path, "fields"), "a group needs at least one field in each item")
             inner = self.fields(spec["fields"], (*path, "fields"), parent=siblings)
             if isinstance(count, str) and count != "rest":
                 self.derive(count, ("count", name), siblings, path)

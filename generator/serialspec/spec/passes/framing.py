@@ -23,7 +23,7 @@ class FramingPass(Pass):
     """Resolve `framing:` into a layout per direction."""
 
     def run(self) -> list[SpecError]:
-        self.ctx.framing = self.guard(("framing",), self.framing, self.ctx.data.get("framing") or {}, ("framing",))
+        self.ctx.framing = self.guard(("framing",), self.framing, self.section("framing"), ("framing",))
         return self.problems
 
     def framing(self, value: dict[str, Any], path: Path) -> Framing:
@@ -116,6 +116,11 @@ class FramingPass(Pass):
                 params["xorout"],
                 params["check"],
             )
+            if crc.width != scalar.size * 8:
+                raise self.fail((*path, "crc", "width"), f"a {crc.width}-bit CRC does not fill a {scalar.name}")
+            for key in ("poly", "init", "xorout", "check"):
+                if not 0 <= params[key] < 1 << crc.width:
+                    raise self.fail((*path, "crc", key), f"{key} {params[key]} does not fit {crc.width} bits")
             from serialspec.runtime.checksums import crc_function
 
             computed = crc_function(crc.width, crc.poly, crc.init, crc.refin, crc.refout, crc.xorout)(b"123456789")
@@ -124,8 +129,6 @@ class FramingPass(Pass):
                     (*path, "crc", "check"),
                     f"these parameters give {computed:#x} for '123456789', not the check value {crc.check:#x}",
                 )
-            if crc.width != scalar.size * 8:
-                self.error((*path, "crc", "width"), f"a {crc.width}-bit CRC does not fill a {scalar.name}")
         elif algorithm != "sum":
             raise self.fail(path, "a checksum needs `algorithm: sum` or `algorithm: crc`")
         return Checksum(algorithm, bool(item.get("invert", False)), crc, covers[0], covers[1], scalar)

@@ -19,12 +19,13 @@ class Settings(Pass):
         self.ctx.client_class = self.class_name(camel(name, "client"), ("protocol",))
         self.ctx.simulator_class = self.class_name(camel(name, "simulator"), ("protocol",))
         self.ctx.endian = ">" if data.get("byte_order") == "big" else "<"
-        self.ctx.shared_fields = data.get("fields") or {}
+        self.ctx.shared_fields = self.section("fields")
         serial = data.get("serial") or {}
         if isinstance(serial, dict):
             self.ctx.serial = self.guard(("serial",), self.serial, serial)
-        matching = data.get("matching") or {}
-        self.ctx.matching = tuple(matching.get("by") or ())
+        matching = self.section("matching")
+        by = matching.get("by")
+        self.ctx.matching = tuple(name for name in by if isinstance(name, str)) if isinstance(by, list) else ()
         self.ctx.matching_description = str(matching.get("description", ""))
         return self.problems
 

@@ -23,12 +23,11 @@ class Types(Pass):
     """Resolve `enums:`, `flags:` and `tables:` into the context, in that order (tables use both)."""
 
     def run(self) -> list[SpecError]:
-        data = self.ctx.data
-        for key, value in (data.get("enums") or {}).items():
+        for key, value in self.section("enums").items():
             self.guard(("enums", key), self.enum, key, value, ("enums", key))
-        for key, value in (data.get("flags") or {}).items():
+        for key, value in self.section("flags").items():
             self.guard(("flags", key), self.flag_set, key, value, ("flags", key))
-        for key, value in (data.get("tables") or {}).items():
+        for key, value in self.section("tables").items():
             self.guard(("tables", key), self.table, key, value, ("tables", key))
         return self.problems
 

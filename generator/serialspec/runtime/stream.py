@@ -100,7 +100,7 @@ class StreamParser:
             current.command_offset,
             current.length_offset,
         )
-        frame_sizes, decode = current.frame_sizes, current.decode
+        frame_sizes, decode, ranges = current.frame_sizes, current.decode, current.ranges
         garbage = errors = start = 0
         while True:
             if single:
@@ -113,7 +113,7 @@ class StreamParser:
                     current.command_offset,
                     current.length_offset,
                 )
-                frame_sizes, decode = current.frame_sizes, current.decode
+                frame_sizes, decode, ranges = current.frame_sizes, current.decode, current.ranges
             if position < 0:
                 cut = max(start, end - self._keep)
                 garbage += cut - start
@@ -127,7 +127,7 @@ class StreamParser:
                 size = frame_sizes.get(buffer[position + length_offset])
             else:
                 size = frame_sizes.get(buffer[position + command_offset] << 8 | buffer[position + length_offset])
-            if size is None or (current.ranges and not _in_range(buffer, position, current.ranges)):
+            if size is None or (ranges and not _in_range(buffer, position, ranges)):
                 # implausible (unknown command, a content size it never has, a value out of range): no frame start
                 start = position + 1
                 garbage += 1

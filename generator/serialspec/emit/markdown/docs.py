@@ -41,6 +41,15 @@ def cell(value: object) -> str:
     return text(str(value)).replace("|", "\\|") or " "
 
 
+def code(value: str) -> str:
+    """Spec text as an inline code span, whatever backticks it holds (the fence is longer than any run inside)."""
+    value = collapse(value)
+    runs = [len(run) for run in "".join(c if c == "`" else " " for c in value).split()]
+    fence = "`" * (max(runs, default=0) + 1)
+    padded = f" {value} " if value.startswith("`") or value.endswith("`") else value
+    return f"{fence}{padded or ' '}{fence}"
+
+
 def anchor(*parts: str) -> str:
     return "-".join(p.replace("_", "-").replace(".", "-") for p in parts if p).lower()
 
@@ -369,7 +378,7 @@ def emit_docs(protocol: Protocol) -> str:
             "direction": e.direction.value,
             "command": e.command + (f".{e.subcommand}" if e.subcommand else ""),
             "anchor": anchor("command", e.command, e.subcommand or ""),
-            "printed": e.printed,
+            "printed": code(e.printed),
             "frame": e.frame.hex(" ").upper(),
             "erratum": e.erratum,
             "rows": breakdown(protocol, e),

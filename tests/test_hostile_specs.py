@@ -160,3 +160,19 @@ def test_the_base_specs_are_valid() -> None:
         data = copy.deepcopy(base(name).data)
         assert data["protocol"]
         assert outcome(name, lambda _data: None)[0] == []
+
+
+def test_sim_refuses_ids_no_device_can_have() -> None:
+    for argv, words in (
+        (["--id", "300"], "--id 300 is outside feetech_sms's device ids 0..253"),
+        (["--id", "254"], "--id 254 is outside feetech_sms's device ids 0..253"),  # the broadcast id
+        (["--id", "-1"], "--id -1 is outside"),
+    ):
+        result = subprocess.run(
+            [sys.executable, "-m", "serialspec", "sim", str(ROOT / "specs" / "feetech_sms.yaml"), *argv],
+            capture_output=True,
+            text=True,
+            timeout=60,
+        )
+        assert result.returncode == 1 and result.stdout == ""
+        assert result.stderr.strip().splitlines() == [result.stderr.strip()] and words in result.stderr

@@ -332,7 +332,7 @@ CASES: list[tuple[str, str, Mutation | Text, str | None]] = [
         "const outside type",
         "tiny",
         put("commands/move/request/fields/mode/const", 300),
-        "commands.move.request.fields.mode.const: constant 300 is outside 0..255",
+        "commands.move.request.fields.mode.const: constant 300 is outside 0..1",
     ),
     (
         "bytes of 300",

@@ -119,3 +119,12 @@ def test_feetech_client_writes_a_register_named_like_its_address_parameter(line:
         with pytest.raises(EncodeError):
             client.write(1, id=True)
         assert nothing_written(controller)
+
+
+def test_an_enum_value_without_a_range_takes_only_its_declared_span() -> None:
+    """Fashion Star's response_switch is 0 or 1 (enum response_switch, no `range:`): 7 never reaches the wire."""
+    fs = next(g for g in ALL if g.protocol.name == "fashionstar_uart")
+    request = fs.package.messages.WriteDataRequest
+    with pytest.raises(EncodeError, match="data = 7 is outside its range 0..1"):
+        fs.package.encode(request.from_fields({"servo_id": 1, "data_id": 33, "data": 7}))
+    assert fs.package.encode(request.from_fields({"servo_id": 1, "data_id": 33, "data": 1}))

@@ -141,7 +141,7 @@ class FashionstarUartClient(ClientBase):
         Args:
             servo_id: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). (0..254)
 
-        Returns: result: Outcome of the command.
+        Returns: result: Outcome of the command. (0..1)
         """
         request = ResetUserDataRequest(servo_id=servo_id)
         reply = self._ask(request, ResetUserDataResponse)
@@ -170,7 +170,7 @@ class FashionstarUartClient(ClientBase):
             data_id: User parameter to write (32..53).
             data: The value, typed by data_id.
 
-        Returns: result: Outcome of the command.
+        Returns: result: Outcome of the command. (0..1)
         """
         request = WriteDataRequest(servo_id=servo_id, data_id=data_id, data=data)
         reply = self._ask(request, WriteDataResponse)
@@ -196,7 +196,7 @@ class FashionstarUartClient(ClientBase):
             servo_id: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). (0..254)
             user_data: The user parameters 32..53 in data_id order.
 
-        Returns: result: Outcome of the command.
+        Returns: result: Outcome of the command. (0..1)
         """
         request = WriteBatchDataRequest(servo_id=servo_id, user_data=user_data)
         reply = self._ask(request, WriteBatchDataResponse)
@@ -213,7 +213,7 @@ class FashionstarUartClient(ClientBase):
             speed: Angular speed. [°/s]
             value: Turns (mode turns) or ms (mode timed); ignored by stop and continuous.
 
-        Returns: result: Outcome of the command.
+        Returns: result: Outcome of the command. (0..1)
         None when no reply is due (Sent only when response_switch (data_id 33) is 1, once the spin has finished.).
         """
         request = SpinRequest(servo_id=servo_id, method=method, speed=speed, value=value)
@@ -231,7 +231,7 @@ class FashionstarUartClient(ClientBase):
             interval: Time to reach the target angle. [ms]
             power: Power; 0 or more than the power limit means the power limit. [mW]
 
-        Returns: result: Outcome of the command.
+        Returns: result: Outcome of the command. (0..1)
         None when no reply is due (Sent only when response_switch (data_id 33) is 1, once the target angle is reached.).
         """
         request = RotateRequest(servo_id=servo_id, angle=angle, interval=interval, power=power)
@@ -249,7 +249,7 @@ class FashionstarUartClient(ClientBase):
             servo_id: Servo id; 255 sets every servo (broadcast).
             power: Holding power; 0 or more than the power limit means the limit. [mW]
 
-        Returns: result: Outcome of the command.
+        Returns: result: Outcome of the command. (0..1)
         None when no reply is due (Sent only when response_switch (data_id 33) is 1.).
         """
         request = DampingRequest(servo_id=servo_id, power=power)

@@ -104,21 +104,21 @@ _TABLE_PARAMETERS_RANGES: dict[int, tuple[float, float]] = {
     6: (0, 65535),
     7: (0, 65535),
     8: (0, 4294967295),
-    33: (0, 255),
+    33: (0, 1),
     34: (0, 254),
     36: (1, 7),
-    37: (0, 255),
+    37: (1, 2),
     38: (0, 65535),
     39: (0, 65535),
     40: (0, 65535),
     41: (0, 65535),
     42: (0, 65535),
     43: (0, 65535),
-    44: (0, 255),
-    46: (0, 255),
-    47: (0, 255),
-    48: (0, 255),
-    49: (0, 255),
+    44: (0, 1),
+    46: (0, 1),
+    47: (0, 1),
+    48: (0, 1),
+    49: (0, 1),
     50: (0, 65535),
     51: (-32768, 32767),
     52: (-32768, 32767),
@@ -495,8 +495,8 @@ def _encode_reset_user_data_request(m: ResetUserDataRequest) -> bytes:
 def _encode_reset_user_data_response(m: ResetUserDataResponse) -> bytes:
     if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('reset_user_data response', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.result <= 255 or m.result.__class__ is bool:
-        raise out_of_range('reset_user_data response', 'result', m.result, 0, 255)
+    if not 0 <= m.result <= 1 or m.result.__class__ is bool:
+        raise out_of_range('reset_user_data response', 'result', m.result, 0, 1)
     body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 2, 2, m.servo_id, m.result)
     return body + _BYTES[sum(body) & 0xff]
 
@@ -553,8 +553,8 @@ def _encode_write_data_response(m: WriteDataResponse) -> bytes:
         raise out_of_range('write_data response', 'servo_id', m.servo_id, 0, 254)
     if not 0 <= m.data_id <= 255 or m.data_id.__class__ is bool:
         raise out_of_range('write_data response', 'data_id', m.data_id, 0, 255)
-    if not 0 <= m.result <= 255 or m.result.__class__ is bool:
-        raise out_of_range('write_data response', 'result', m.result, 0, 255)
+    if not 0 <= m.result <= 1 or m.result.__class__ is bool:
+        raise out_of_range('write_data response', 'result', m.result, 0, 1)
     body = _S_B2_U8_U8_U8_U8_U8.pack(b'\x05\x1c', 4, 3, m.servo_id, m.data_id, m.result)
     return body + _BYTES[sum(body) & 0xff]
 
@@ -571,16 +571,16 @@ def _encode_read_batch_data_response(m: ReadBatchDataResponse) -> bytes:
         raise out_of_range('read_batch_data response', 'servo_id', m.servo_id, 0, 254)
     if not 0 <= m.user_data.reserved_32 <= 255:
         raise out_of_range('read_batch_data response', 'user_data.reserved_32', m.user_data.reserved_32, 0, 255)
-    if not 0 <= m.user_data.response_switch <= 255:
-        raise out_of_range('read_batch_data response', 'user_data.response_switch', m.user_data.response_switch, 0, 255)
+    if not 0 <= m.user_data.response_switch <= 1:
+        raise out_of_range('read_batch_data response', 'user_data.response_switch', m.user_data.response_switch, 0, 1)
     if not 0 <= m.user_data.servo_id <= 254:
         raise out_of_range('read_batch_data response', 'user_data.servo_id', m.user_data.servo_id, 0, 254)
     if not 0 <= m.user_data.reserved_35 <= 255:
         raise out_of_range('read_batch_data response', 'user_data.reserved_35', m.user_data.reserved_35, 0, 255)
     if not 1 <= m.user_data.baudrate <= 7:
         raise out_of_range('read_batch_data response', 'user_data.baudrate', m.user_data.baudrate, 1, 7)
-    if not 0 <= m.user_data.stall_protect_mode <= 255:
-        raise out_of_range('read_batch_data response', 'user_data.stall_protect_mode', m.user_data.stall_protect_mode, 0, 255)
+    if not 1 <= m.user_data.stall_protect_mode <= 2:
+        raise out_of_range('read_batch_data response', 'user_data.stall_protect_mode', m.user_data.stall_protect_mode, 1, 2)
     if not 0 <= m.user_data.stall_power_limit <= 65535:
         raise out_of_range('read_batch_data response', 'user_data.stall_power_limit', m.user_data.stall_power_limit, 0, 65535)
     if not 0 <= m.user_data.over_volt_low <= 65535:
@@ -593,18 +593,18 @@ def _encode_read_batch_data_response(m: ReadBatchDataResponse) -> bytes:
         raise out_of_range('read_batch_data response', 'user_data.over_power', m.user_data.over_power, 0, 65535)
     if not 0 <= m.user_data.over_current <= 65535:
         raise out_of_range('read_batch_data response', 'user_data.over_current', m.user_data.over_current, 0, 65535)
-    if not 0 <= m.user_data.accel_switch <= 255:
-        raise out_of_range('read_batch_data response', 'user_data.accel_switch', m.user_data.accel_switch, 0, 255)
+    if not 0 <= m.user_data.accel_switch <= 1:
+        raise out_of_range('read_batch_data response', 'user_data.accel_switch', m.user_data.accel_switch, 0, 1)
     if not 0 <= m.user_data.reserved_45 <= 255:
         raise out_of_range('read_batch_data response', 'user_data.reserved_45', m.user_data.reserved_45, 0, 255)
-    if not 0 <= m.user_data.po_lock_switch <= 255:
-        raise out_of_range('read_batch_data response', 'user_data.po_lock_switch', m.user_data.po_lock_switch, 0, 255)
-    if not 0 <= m.user_data.wb_lock_switch <= 255:
-        raise out_of_range('read_batch_data response', 'user_data.wb_lock_switch', m.user_data.wb_lock_switch, 0, 255)
-    if not 0 <= m.user_data.angle_limit_switch <= 255:
-        raise out_of_range('read_batch_data response', 'user_data.angle_limit_switch', m.user_data.angle_limit_switch, 0, 255)
-    if not 0 <= m.user_data.soft_start_switch <= 255:
-        raise out_of_range('read_batch_data response', 'user_data.soft_start_switch', m.user_data.soft_start_switch, 0, 255)
+    if not 0 <= m.user_data.po_lock_switch <= 1:
+        raise out_of_range('read_batch_data response', 'user_data.po_lock_switch', m.user_data.po_lock_switch, 0, 1)
+    if not 0 <= m.user_data.wb_lock_switch <= 1:
+        raise out_of_range('read_batch_data response', 'user_data.wb_lock_switch', m.user_data.wb_lock_switch, 0, 1)
+    if not 0 <= m.user_data.angle_limit_switch <= 1:
+        raise out_of_range('read_batch_data response', 'user_data.angle_limit_switch', m.user_data.angle_limit_switch, 0, 1)
+    if not 0 <= m.user_data.soft_start_switch <= 1:
+        raise out_of_range('read_batch_data response', 'user_data.soft_start_switch', m.user_data.soft_start_switch, 0, 1)
     if not 0 <= m.user_data.soft_start_time <= 65535:
         raise out_of_range('read_batch_data response', 'user_data.soft_start_time', m.user_data.soft_start_time, 0, 65535)
     if not -32768 <= m.user_data.angle_limit_high <= 32767:
@@ -622,16 +622,16 @@ def _encode_write_batch_data_request(m: WriteBatchDataRequest) -> bytes:
         raise out_of_range('write_batch_data request', 'servo_id', m.servo_id, 0, 254)
     if not 0 <= m.user_data.reserved_32 <= 255:
         raise out_of_range('write_batch_data request', 'user_data.reserved_32', m.user_data.reserved_32, 0, 255)
-    if not 0 <= m.user_data.response_switch <= 255:
-        raise out_of_range('write_batch_data request', 'user_data.response_switch', m.user_data.response_switch, 0, 255)
+    if not 0 <= m.user_data.response_switch <= 1:
+        raise out_of_range('write_batch_data request', 'user_data.response_switch', m.user_data.response_switch, 0, 1)
     if not 0 <= m.user_data.servo_id <= 254:
         raise out_of_range('write_batch_data request', 'user_data.servo_id', m.user_data.servo_id, 0, 254)
     if not 0 <= m.user_data.reserved_35 <= 255:
         raise out_of_range('write_batch_data request', 'user_data.reserved_35', m.user_data.reserved_35, 0, 255)
     if not 1 <= m.user_data.baudrate <= 7:
         raise out_of_range('write_batch_data request', 'user_data.baudrate', m.user_data.baudrate, 1, 7)
-    if not 0 <= m.user_data.stall_protect_mode <= 255:
-        raise out_of_range('write_batch_data request', 'user_data.stall_protect_mode', m.user_data.stall_protect_mode, 0, 255)
+    if not 1 <= m.user_data.stall_protect_mode <= 2:
+        raise out_of_range('write_batch_data request', 'user_data.stall_protect_mode', m.user_data.stall_protect_mode, 1, 2)
     if not 0 <= m.user_data.stall_power_limit <= 65535:
         raise out_of_range('write_batch_data request', 'user_data.stall_power_limit', m.user_data.stall_power_limit, 0, 65535)
     if not 0 <= m.user_data.over_volt_low <= 65535:
@@ -644,18 +644,18 @@ def _encode_write_batch_data_request(m: WriteBatchDataRequest) -> bytes:
         raise out_of_range('write_batch_data request', 'user_data.over_power', m.user_data.over_power, 0, 65535)
     if not 0 <= m.user_data.over_current <= 65535:
         raise out_of_range('write_batch_data request', 'user_data.over_current', m.user_data.over_current, 0, 65535)
-    if not 0 <= m.user_data.accel_switch <= 255:
-        raise out_of_range('write_batch_data request', 'user_data.accel_switch', m.user_data.accel_switch, 0, 255)
+    if not 0 <= m.user_data.accel_switch <= 1:
+        raise out_of_range('write_batch_data request', 'user_data.accel_switch', m.user_data.accel_switch, 0, 1)
     if not 0 <= m.user_data.reserved_45 <= 255:
         raise out_of_range('write_batch_data request', 'user_data.reserved_45', m.user_data.reserved_45, 0, 255)
-    if not 0 <= m.user_data.po_lock_switch <= 255:
-        raise out_of_range('write_batch_data request', 'user_data.po_lock_switch', m.user_data.po_lock_switch, 0, 255)
-    if not 0 <= m.user_data.wb_lock_switch <= 255:
-        raise out_of_range('write_batch_data request', 'user_data.wb_lock_switch', m.user_data.wb_lock_switch, 0, 255)
-    if not 0 <= m.user_data.angle_limit_switch <= 255:
-        raise out_of_range('write_batch_data request', 'user_data.angle_limit_switch', m.user_data.angle_limit_switch, 0, 255)
-    if not 0 <= m.user_data.soft_start_switch <= 255:
-        raise out_of_range('write_batch_data request', 'user_data.soft_start_switch', m.user_data.soft_start_switch, 0, 255)
+    if not 0 <= m.user_data.po_lock_switch <= 1:
+        raise out_of_range('write_batch_data request', 'user_data.po_lock_switch', m.user_data.po_lock_switch, 0, 1)
+    if not 0 <= m.user_data.wb_lock_switch <= 1:
+        raise out_of_range('write_batch_data request', 'user_data.wb_lock_switch', m.user_data.wb_lock_switch, 0, 1)
+    if not 0 <= m.user_data.angle_limit_switch <= 1:
+        raise out_of_range('write_batch_data request', 'user_data.angle_limit_switch', m.user_data.angle_limit_switch, 0, 1)
+    if not 0 <= m.user_data.soft_start_switch <= 1:
+        raise out_of_range('write_batch_data request', 'user_data.soft_start_switch', m.user_data.soft_start_switch, 0, 1)
     if not 0 <= m.user_data.soft_start_time <= 65535:
         raise out_of_range('write_batch_data request', 'user_data.soft_start_time', m.user_data.soft_start_time, 0, 65535)
     if not -32768 <= m.user_data.angle_limit_high <= 32767:
@@ -671,8 +671,8 @@ def _encode_write_batch_data_request(m: WriteBatchDataRequest) -> bytes:
 def _encode_write_batch_data_response(m: WriteBatchDataResponse) -> bytes:
     if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('write_batch_data response', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.result <= 255 or m.result.__class__ is bool:
-        raise out_of_range('write_batch_data response', 'result', m.result, 0, 255)
+    if not 0 <= m.result <= 1 or m.result.__class__ is bool:
+        raise out_of_range('write_batch_data response', 'result', m.result, 0, 1)
     body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 6, 2, m.servo_id, m.result)
     return body + _BYTES[sum(body) & 0xff]
 
@@ -695,8 +695,8 @@ def _encode_spin_request(m: SpinRequest) -> bytes:
 def _encode_spin_response(m: SpinResponse) -> bytes:
     if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('spin response', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.result <= 255 or m.result.__class__ is bool:
-        raise out_of_range('spin response', 'result', m.result, 0, 255)
+    if not 0 <= m.result <= 1 or m.result.__class__ is bool:
+        raise out_of_range('spin response', 'result', m.result, 0, 1)
     body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 7, 2, m.servo_id, m.result)
     return body + _BYTES[sum(body) & 0xff]
 
@@ -717,8 +717,8 @@ def _encode_rotate_request(m: RotateRequest) -> bytes:
 def _encode_rotate_response(m: RotateResponse) -> bytes:
     if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('rotate response', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.result <= 255 or m.result.__class__ is bool:
-        raise out_of_range('rotate response', 'result', m.result, 0, 255)
+    if not 0 <= m.result <= 1 or m.result.__class__ is bool:
+        raise out_of_range('rotate response', 'result', m.result, 0, 1)
     body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 8, 2, m.servo_id, m.result)
     return body + _BYTES[sum(body) & 0xff]
 
@@ -735,8 +735,8 @@ def _encode_damping_request(m: DampingRequest) -> bytes:
 def _encode_damping_response(m: DampingResponse) -> bytes:
     if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('damping response', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.result <= 255 or m.result.__class__ is bool:
-        raise out_of_range('damping response', 'result', m.result, 0, 255)
+    if not 0 <= m.result <= 1 or m.result.__class__ is bool:
+        raise out_of_range('damping response', 'result', m.result, 0, 1)
     body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 9, 2, m.servo_id, m.result)
     return body + _BYTES[sum(body) & 0xff]
 

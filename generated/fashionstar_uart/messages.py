@@ -358,7 +358,7 @@ class ResetUserDataResponse(Message):
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
     servo_id: int
-    #: Outcome of the command.
+    #: Outcome of the command. range 0..1
     result: Result | int
 
     def to_fields(self) -> dict[str, Any]:
@@ -480,7 +480,7 @@ class WriteDataResponse(Message):
     servo_id: int
     #: The parameter written.
     data_id: int
-    #: Outcome of the command.
+    #: Outcome of the command. range 0..1
     result: Result | int
 
     def to_fields(self) -> dict[str, Any]:
@@ -590,7 +590,7 @@ class WriteBatchDataResponse(Message):
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
     servo_id: int
-    #: Outcome of the command. (layout inferred, not documented)
+    #: Outcome of the command. range 0..1 (layout inferred, not documented)
     result: Result | int
 
     def to_fields(self) -> dict[str, Any]:
@@ -654,7 +654,7 @@ class SpinResponse(Message):
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
     servo_id: int
-    #: Outcome of the command.
+    #: Outcome of the command. range 0..1
     result: Result | int
 
     def to_fields(self) -> dict[str, Any]:
@@ -718,7 +718,7 @@ class RotateResponse(Message):
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
     servo_id: int
-    #: Outcome of the command.
+    #: Outcome of the command. range 0..1
     result: Result | int
 
     def to_fields(self) -> dict[str, Any]:
@@ -774,7 +774,7 @@ class DampingResponse(Message):
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
     servo_id: int
-    #: Outcome of the command.
+    #: Outcome of the command. range 0..1
     result: Result | int
 
     def to_fields(self) -> dict[str, Any]:

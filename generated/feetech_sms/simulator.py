@@ -72,7 +72,7 @@ DEVICE = DeviceSpec(
         EntrySpec('speed_p_coefficient', 37, 10, 'rw', 0, 100),
         EntrySpec('overcurrent_time', 38, 200, 'rw', 0, 254),
         EntrySpec('velocity_i_coefficient', 39, 200, 'rw', 0, 254),
-        EntrySpec('torque_enable', 40, 0, 'rw', 0, 255),
+        EntrySpec('torque_enable', 40, 0, 'rw', 0, 128),
         EntrySpec('acceleration', 41, 0, 'rw', 0, 254),
         EntrySpec('goal_position', 42, 0, 'rw', -32767, 32767),
         EntrySpec('goal_time', 44, 0, 'rw', 0, 65535),

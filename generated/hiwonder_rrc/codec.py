@@ -967,8 +967,8 @@ def _encode_bus_servo_read_position_request(m: BusServoReadPositionRequest) -> b
 def _encode_bus_servo_read_position_response(m: BusServoReadPositionResponse) -> bytes:
     if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.read_position response', 'servo_id', m.servo_id, 0, 255)
-    if not -128 <= m.success <= 127 or m.success.__class__ is bool:
-        raise out_of_range('bus_servo.read_position response', 'success', m.success, -128, 127)
+    if not -1 <= m.success <= 0 or m.success.__class__ is bool:
+        raise out_of_range('bus_servo.read_position response', 'success', m.success, -1, 0)
     if not -32768 <= m.position <= 32767 or m.position.__class__ is bool:
         raise out_of_range('bus_servo.read_position response', 'position', m.position, -32768, 32767)
     body = _S_FRAME_BUSSERVOREADPOSITIONRESPONSE.pack(b'\xaaU', 5, 5, m.servo_id, 5, m.success, m.position)
@@ -991,8 +991,8 @@ def _encode_bus_servo_read_voltage_request(m: BusServoReadVoltageRequest) -> byt
 def _encode_bus_servo_read_voltage_response(m: BusServoReadVoltageResponse) -> bytes:
     if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.read_voltage response', 'servo_id', m.servo_id, 0, 255)
-    if not -128 <= m.success <= 127 or m.success.__class__ is bool:
-        raise out_of_range('bus_servo.read_voltage response', 'success', m.success, -128, 127)
+    if not -1 <= m.success <= 0 or m.success.__class__ is bool:
+        raise out_of_range('bus_servo.read_voltage response', 'success', m.success, -1, 0)
     if not 0 <= m.voltage <= 65535 or m.voltage.__class__ is bool:
         raise out_of_range('bus_servo.read_voltage response', 'voltage', m.voltage, 0, 65535)
     body = _S_FRAME_BUSSERVOREADVOLTAGERESPONSE.pack(b'\xaaU', 5, 5, m.servo_id, 7, m.success, m.voltage)
@@ -1015,8 +1015,8 @@ def _encode_bus_servo_read_temperature_request(m: BusServoReadTemperatureRequest
 def _encode_bus_servo_read_temperature_response(m: BusServoReadTemperatureResponse) -> bytes:
     if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.read_temperature response', 'servo_id', m.servo_id, 0, 255)
-    if not -128 <= m.success <= 127 or m.success.__class__ is bool:
-        raise out_of_range('bus_servo.read_temperature response', 'success', m.success, -128, 127)
+    if not -1 <= m.success <= 0 or m.success.__class__ is bool:
+        raise out_of_range('bus_servo.read_temperature response', 'success', m.success, -1, 0)
     if not 0 <= m.temperature <= 255 or m.temperature.__class__ is bool:
         raise out_of_range('bus_servo.read_temperature response', 'temperature', m.temperature, 0, 255)
     body = _S_FRAME_BUSSERVOREADTEMPERATURERESPONSE.pack(b'\xaaU', 5, 4, m.servo_id, 9, m.success, m.temperature)
@@ -1071,8 +1071,8 @@ def _encode_bus_servo_read_id_request(m: BusServoReadIdRequest) -> bytes:
 def _encode_bus_servo_read_id_response(m: BusServoReadIdResponse) -> bytes:
     if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.read_id response', 'servo_id', m.servo_id, 0, 255)
-    if not -128 <= m.success <= 127 or m.success.__class__ is bool:
-        raise out_of_range('bus_servo.read_id response', 'success', m.success, -128, 127)
+    if not -1 <= m.success <= 0 or m.success.__class__ is bool:
+        raise out_of_range('bus_servo.read_id response', 'success', m.success, -1, 0)
     if not 0 <= m.id <= 255 or m.id.__class__ is bool:
         raise out_of_range('bus_servo.read_id response', 'id', m.id, 0, 255)
     body = _S_FRAME_BUSSERVOREADTEMPERATURERESPONSE.pack(b'\xaaU', 5, 4, m.servo_id, 18, m.success, m.id)
@@ -1107,8 +1107,8 @@ def _encode_bus_servo_read_offset_request(m: BusServoReadOffsetRequest) -> bytes
 def _encode_bus_servo_read_offset_response(m: BusServoReadOffsetResponse) -> bytes:
     if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.read_offset response', 'servo_id', m.servo_id, 0, 255)
-    if not -128 <= m.success <= 127 or m.success.__class__ is bool:
-        raise out_of_range('bus_servo.read_offset response', 'success', m.success, -128, 127)
+    if not -1 <= m.success <= 0 or m.success.__class__ is bool:
+        raise out_of_range('bus_servo.read_offset response', 'success', m.success, -1, 0)
     if not -128 <= m.offset <= 127 or m.offset.__class__ is bool:
         raise out_of_range('bus_servo.read_offset response', 'offset', m.offset, -128, 127)
     body = _S_FRAME_BUSSERVOREADOFFSETRESPONSE.pack(b'\xaaU', 5, 4, m.servo_id, 34, m.success, m.offset)
@@ -1155,8 +1155,8 @@ def _encode_bus_servo_read_position_limit_request(m: BusServoReadPositionLimitRe
 def _encode_bus_servo_read_position_limit_response(m: BusServoReadPositionLimitResponse) -> bytes:
     if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.read_position_limit response', 'servo_id', m.servo_id, 0, 255)
-    if not -128 <= m.success <= 127 or m.success.__class__ is bool:
-        raise out_of_range('bus_servo.read_position_limit response', 'success', m.success, -128, 127)
+    if not -1 <= m.success <= 0 or m.success.__class__ is bool:
+        raise out_of_range('bus_servo.read_position_limit response', 'success', m.success, -1, 0)
     if not 0 <= m.low <= 65535 or m.low.__class__ is bool:
         raise out_of_range('bus_servo.read_position_limit response', 'low', m.low, 0, 65535)
     if not 0 <= m.high <= 65535 or m.high.__class__ is bool:
@@ -1195,8 +1195,8 @@ def _encode_bus_servo_read_voltage_limit_request(m: BusServoReadVoltageLimitRequ
 def _encode_bus_servo_read_voltage_limit_response(m: BusServoReadVoltageLimitResponse) -> bytes:
     if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.read_voltage_limit response', 'servo_id', m.servo_id, 0, 255)
-    if not -128 <= m.success <= 127 or m.success.__class__ is bool:
-        raise out_of_range('bus_servo.read_voltage_limit response', 'success', m.success, -128, 127)
+    if not -1 <= m.success <= 0 or m.success.__class__ is bool:
+        raise out_of_range('bus_servo.read_voltage_limit response', 'success', m.success, -1, 0)
     if not 0 <= m.low <= 65535 or m.low.__class__ is bool:
         raise out_of_range('bus_servo.read_voltage_limit response', 'low', m.low, 0, 65535)
     if not 0 <= m.high <= 65535 or m.high.__class__ is bool:
@@ -1233,8 +1233,8 @@ def _encode_bus_servo_read_temperature_limit_request(m: BusServoReadTemperatureL
 def _encode_bus_servo_read_temperature_limit_response(m: BusServoReadTemperatureLimitResponse) -> bytes:
     if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.read_temperature_limit response', 'servo_id', m.servo_id, 0, 255)
-    if not -128 <= m.success <= 127 or m.success.__class__ is bool:
-        raise out_of_range('bus_servo.read_temperature_limit response', 'success', m.success, -128, 127)
+    if not -1 <= m.success <= 0 or m.success.__class__ is bool:
+        raise out_of_range('bus_servo.read_temperature_limit response', 'success', m.success, -1, 0)
     if not 0 <= m.limit <= 255 or m.limit.__class__ is bool:
         raise out_of_range('bus_servo.read_temperature_limit response', 'limit', m.limit, 0, 255)
     body = _S_FRAME_BUSSERVOREADTEMPERATURERESPONSE.pack(b'\xaaU', 5, 4, m.servo_id, 58, m.success, m.limit)
@@ -1247,8 +1247,8 @@ def _encode_bus_servo_read_temperature_limit_response(m: BusServoReadTemperature
 def _encode_key_response(m: KeyResponse) -> bytes:
     if not 0 <= m.button_id <= 255 or m.button_id.__class__ is bool:
         raise out_of_range('key response', 'button_id', m.button_id, 0, 255)
-    if not 0 <= m.event <= 255 or m.event.__class__ is bool:
-        raise out_of_range('key response', 'event', m.event, 0, 255)
+    if not 1 <= m.event <= 64 or m.event.__class__ is bool:
+        raise out_of_range('key response', 'event', m.event, 1, 64)
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 6, 2, m.button_id, m.event)
     check = 0x0
     for byte in body[2:]:

@@ -616,7 +616,7 @@ class BusServoReadPositionResponse(Message):
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
     #: Bus servo id (0xFE is the broadcast id).
     servo_id: int
-    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
+    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0. range -1..0
     success: ReadResult | int
     #: Current position (0..1000 is 0°..240°).
     position: int
@@ -672,7 +672,7 @@ class BusServoReadVoltageResponse(Message):
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
     #: Bus servo id (0xFE is the broadcast id).
     servo_id: int
-    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
+    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0. range -1..0
     success: ReadResult | int
     #: Input voltage. [mV]
     voltage: int
@@ -728,7 +728,7 @@ class BusServoReadTemperatureResponse(Message):
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
     #: Bus servo id (0xFE is the broadcast id).
     servo_id: int
-    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
+    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0. range -1..0
     success: ReadResult | int
     #: Temperature. [°C]
     temperature: int
@@ -860,7 +860,7 @@ class BusServoReadIdResponse(Message):
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
     #: The id the request was sent to (0xFE for the broadcast).
     servo_id: int
-    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
+    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0. range -1..0
     success: ReadResult | int
     #: The id read from the servo.
     id: int
@@ -944,7 +944,7 @@ class BusServoReadOffsetResponse(Message):
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
     #: Bus servo id (0xFE is the broadcast id).
     servo_id: int
-    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
+    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0. range -1..0
     success: ReadResult | int
     #: The servo's offset (int8; -100..100 when set through 0x20).
     offset: int
@@ -1056,7 +1056,7 @@ class BusServoReadPositionLimitResponse(Message):
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
     #: Bus servo id (0xFE is the broadcast id).
     servo_id: int
-    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
+    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0. range -1..0
     success: ReadResult | int
     #: Low position limit.
     low: int
@@ -1148,7 +1148,7 @@ class BusServoReadVoltageLimitResponse(Message):
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
     #: Bus servo id (0xFE is the broadcast id).
     servo_id: int
-    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
+    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0. range -1..0
     success: ReadResult | int
     #: Low voltage limit. [mV]
     low: int
@@ -1236,7 +1236,7 @@ class BusServoReadTemperatureLimitResponse(Message):
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
     #: Bus servo id (0xFE is the broadcast id).
     servo_id: int
-    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
+    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0. range -1..0
     success: ReadResult | int
     #: Over-temperature threshold. [°C]
     limit: int
@@ -1268,7 +1268,7 @@ class KeyResponse(Message):
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
     #: Button id.
     button_id: int
-    #: What happened to the button (按键事件).
+    #: What happened to the button (按键事件). range 1..64
     event: ButtonEvent | int
 
     def to_fields(self) -> dict[str, Any]:

@@ -110,6 +110,12 @@ RESERVED_PACKAGES = frozenset(sys.stdlib_module_names) | {
 }
 
 
+def enum_span(enum: EnumDef, low: float, high: float) -> tuple[float, float]:
+    """The range of a value an enum names when the spec gives none: its declared values' span (within the type)."""
+    values = [v.value for v in enum.values]
+    return (max(low, min(values)), min(high, max(values))) if values else (low, high)
+
+
 def camel(*parts: str) -> str:
     return "".join(word.capitalize() for part in parts for word in part.split("_") if word)
 
@@ -222,7 +228,7 @@ class Pass:
             return function(*args)
         except Bad:
             pass
-        except (TypeError, AttributeError, ValueError, KeyError, OverflowError):
+        except (TypeError, AttributeError, ValueError, LookupError, OverflowError):
             if not self.ctx.malformed_near(path):
                 raise
         if len(path) >= 2 and path[-2] in DEFINITIONS and isinstance(path[-1], str):

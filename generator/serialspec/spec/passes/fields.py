@@ -20,7 +20,7 @@ from serialspec.spec.model import (
     TableValue,
     sum_sizes,
 )
-from serialspec.spec.passes.base import RESERVED_FIELD_NAMES, Bad, Pass, camel
+from serialspec.spec.passes.base import RESERVED_FIELD_NAMES, Bad, Pass, camel, enum_span
 
 FIELD_KINDS = (*grammar.SCALAR_TYPES, "bytes", "array", "group", "table_value", "table_block")
 
@@ -171,6 +171,9 @@ class FieldResolver(Pass):
         scalar = SCALARS[spec["type"]]
         sign_magnitude = spec.get("encoding") == "sign_magnitude"
         low, high = self.bounds(scalar, sign_magnitude, spec.get("range"), (*path, "range"))
+        value_enum = self.reference("enum", self.enums, spec.get("enum"), (*path, "enum"))
+        if value_enum is not None and spec.get("range") is None:
+            low, high = enum_span(value_enum, low, high)
         const = spec.get("const")
         if const is not None and not low <= const <= high:
             self.error((*path, "const"), f"constant {const} is outside {low:g}..{high:g}")
@@ -207,7 +210,7 @@ class FieldResolver(Pass):
             maximum=high,
             const=const,
             default=default,
-            enum=self.reference("enum", self.enums, spec.get("enum"), (*path, "enum")),
+            enum=value_enum,
             flags=self.reference("flags", self.flags, spec.get("flags"), (*path, "flags")),
             bits=tuple(bits),
             bits_class=self.class_name(camel(common["name"], "bits"), path) if bits else "",

@@ -16,7 +16,7 @@ from serialspec.spec.model import (
     Table,
     TableEntry,
 )
-from serialspec.spec.passes.base import LABEL, Pass, camel
+from serialspec.spec.passes.base import LABEL, Pass, camel, enum_span
 
 
 class Types(Pass):
@@ -91,6 +91,9 @@ class Types(Pass):
             sign_magnitude = item.get("encoding") == "sign_magnitude"
             sign_bit = self.sign_bit(scalar, sign_magnitude, item.get("sign_bit"), (*entry_path, "sign_bit"))
             low, high = self.bounds(scalar, sign_magnitude, item.get("range"), (*entry_path, "range"), sign_bit)
+            enum = self.reference("enum", self.enums, item.get("enum"), (*entry_path, "enum"))
+            if enum is not None and item.get("range") is None:
+                low, high = enum_span(enum, low, high)
             if item.get("scale") == 0:
                 self.error((*entry_path, "scale"), "scale 0 would make every value 0 (give the size of one wire step)")
             default = item.get("default")
@@ -110,7 +113,7 @@ class Types(Pass):
                     default=item.get("default"),
                     access=str(item.get("access", "rw")),
                     memory=str(item.get("memory", "")),
-                    enum=self.reference("enum", self.enums, item.get("enum"), (*entry_path, "enum")),
+                    enum=enum,
                     flags=self.reference("flags", self.flags, item.get("flags"), (*entry_path, "flags")),
                     sign_magnitude=sign_magnitude,
                     reserved=bool(item.get("reserved", False)),

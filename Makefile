@@ -5,12 +5,14 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 BENCH_STAMP := $(VENV)/.installed-bench
 
-.PHONY: generate test check lint typecheck clean demo stress bench
+.PHONY: generate test check lint typecheck clean demo stress bench wheel runtime-wheel docs
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install --quiet --upgrade pip
 	$(BIN)/pip install --quiet -e '.[test]'
+	@# generated/ on the path: a package generated after the install imports at once, without a reinstall
+	echo "$(CURDIR)/generated" > "$$($(BIN)/python -c "import sysconfig; print(sysconfig.get_paths()['purelib'])")/serialspec-generated.pth"
 	touch $(STAMP)
 
 generate: $(STAMP)
@@ -20,8 +22,8 @@ check: $(STAMP)
 	$(BIN)/serialspec check
 
 lint: $(STAMP)
-	$(BIN)/ruff check generator generated tests bench examples
-	$(BIN)/ruff format --check generator tests bench examples
+	$(BIN)/ruff check generator generated tests bench examples packaging tools
+	$(BIN)/ruff format --check generator tests bench examples packaging tools
 
 typecheck: $(STAMP)
 	$(BIN)/mypy generator/serialspec generated
@@ -49,8 +51,20 @@ $(BENCH_STAMP): $(STAMP) pyproject.toml
 bench: $(BENCH_STAMP)
 	$(BIN)/python -m bench.run
 
+# The documentation site in site/: README, tutorial, language reference and every protocol's reference (mkdocs, strict).
+docs: $(STAMP)
+	$(BIN)/python tools/docsite.py site
+
+# The two distributions, into dist/: serialspec (generator, CLI, runtime and the shipped protocols) and
+# serialspec-runtime (only what generated packages import, for a robot that runs generated code: pyserial only).
+wheel: $(STAMP)
+	$(BIN)/python -m pip wheel --no-build-isolation --no-deps --quiet -w dist .
+
+runtime-wheel: $(STAMP)
+	$(BIN)/python packaging/runtime/build.py dist
+
 clean:
-	rm -rf $(VENV) build *.egg-info
+	rm -rf $(VENV) build dist site *.egg-info
 
 # A virtual Fashion Star servo on a pseudo-terminal, driven by the generated client: no hardware needed.
 demo: $(STAMP)

@@ -95,3 +95,29 @@ def test_check_fails_when_a_generated_file_is_stale(tmp_path: Path) -> None:
     result = serialspec("check", "--root", str(tmp_path))
     assert result.returncode == 1
     assert "generated/docs/fashionstar_uart.md: stale" in result.stderr
+
+
+def test_check_names_a_hand_written_file_inside_a_generated_package(tmp_path: Path) -> None:
+    shutil.copytree(ROOT / "specs", tmp_path / "specs")
+    shutil.copytree(ROOT / "generated", tmp_path / "generated", ignore=shutil.ignore_patterns("__pycache__"))
+    (tmp_path / "generated" / "feetech_sms" / "mine.py").write_text("x = 1\n", encoding="utf-8")
+    result = serialspec("check", "--root", str(tmp_path))
+    assert result.returncode == 1
+    assert "generated/feetech_sms/mine.py: not generated from any spec" in result.stderr
+    assert serialspec("generate", "--root", str(tmp_path)).returncode == 0
+    assert (tmp_path / "generated" / "feetech_sms" / "mine.py").exists()  # generate never removes it
+
+
+def test_a_spec_path_uses_the_generated_package_only_when_it_was_generated_from_that_very_text(tmp_path: Path) -> None:
+    from serialspec.cli.protocols import open_spec
+
+    _, package = open_spec(FS)
+    assert package.__file__ == str(ROOT / "generated" / "fashionstar_uart" / "__init__.py")
+    edited = tmp_path / "fashionstar_uart.yaml"
+    edited.write_text(Path(FS).read_text(encoding="utf-8").replace("range: [0, 254]", "range: [0, 255]", 1))
+    _, live = open_spec(str(edited))
+    assert live is not package and "generated in memory" in str(live.__spec__.origin if live.__spec__ else "")
+    request = live.RotateRequest(servo_id=255, angle=0, interval=0)  # the edited range, not the generated one
+    assert live.encode(request)[:5] == bytes.fromhex("12 4c 08 07 ff")
+    with pytest.raises(Exception, match="servo_id = 255 is outside its range 0..254"):
+        package.encode(package.RotateRequest(servo_id=255, angle=0, interval=0))

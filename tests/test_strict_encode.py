@@ -4,9 +4,7 @@ of range is refused with one line naming the field, before a byte is written; Tr
 from __future__ import annotations
 
 import dataclasses
-import os
 import select
-import tty
 from collections.abc import Iterator
 from typing import Any
 
@@ -14,6 +12,7 @@ import pytest
 from conftest import ALL, Generated, by_protocol
 from serialspec.runtime.errors import EncodeError
 from serialspec.spec.model import Example, Scalar
+from test_captures import pty_pair
 
 BAD = [True, False, 1.5, float("nan"), float("inf"), "1", None, [1], {"a": 1}, 10**40, -(10**40)]
 
@@ -82,13 +81,8 @@ def test_flags_take_members_or_in_range_integers() -> None:
 @pytest.fixture
 def line() -> Iterator[tuple[int, str]]:
     """A pseudo-terminal: the controller end (to see what a client writes) and the device path it opens."""
-    controller, device = os.openpty()
-    tty.setraw(controller)
-    try:
-        yield controller, os.ttyname(device)
-    finally:
-        os.close(controller)
-        os.close(device)
+    with pty_pair() as pair:
+        yield pair
 
 
 def nothing_written(controller: int) -> bool:

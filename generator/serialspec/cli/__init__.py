@@ -6,6 +6,7 @@ import argparse
 import sys
 from collections.abc import Sequence
 
+from serialspec import __version__
 from serialspec.cli import check, decode, encode, generate, monitor, sim
 from serialspec.runtime.errors import SerialspecError
 from serialspec.spec.errors import SpecErrors
@@ -15,6 +16,7 @@ VERBS = {"generate": generate, "check": check, "decode": decode, "encode": encod
 
 def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="serialspec", description=__doc__.split(":")[0] if __doc__ else None)
+    parser.add_argument("--version", action="version", version=f"serialspec {__version__}")
     verbs = parser.add_subparsers(dest="verb", required=True, metavar="VERB")
     for name, module in VERBS.items():
         sub = verbs.add_parser(name, help=module.HELP, description=module.HELP)

@@ -1,4 +1,4 @@
-"""serialspec check: fail when a spec has an error or a generated file is stale, missing or unexpected."""
+"""serialspec check: fail when a spec has an error or a generated file is stale, missing or orphaned."""
 
 from __future__ import annotations
 
@@ -6,33 +6,36 @@ import argparse
 import sys
 from pathlib import Path
 
-from serialspec.cli.project import expected_files, find_root
+from serialspec.cli.project import expected_files, orphans, project, strangers
 
-HELP = "check the specs and that generated/ matches them (exit 1 if not)"
+HELP = "check the specs and that the generated files match them (exit 1 naming each stale or orphaned file)"
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--root", type=Path, help="project root (default: the nearest folder holding specs/)")
+    parser.add_argument("specs", nargs="*", metavar="SPEC", help="spec files (default: the project's specs)")
+    parser.add_argument("--out", metavar="DIR", help="output folder (default: the project's, else generated/)")
+    parser.add_argument(
+        "--root", type=Path, help="project root (default: the nearest folder with a [tool.serialspec] table or specs/)"
+    )
 
 
 def run(args: argparse.Namespace) -> int:
-    root = args.root or find_root()
-    files, errors = expected_files(root)
+    proj = project(args.root, args.specs, args.out)
+    files, errors = expected_files(proj)
     problems = [str(error) for error in errors]
     for path, text in files.items():
         if not path.exists():
-            problems.append(f"{path.relative_to(root)}: missing")
+            problems.append(f"{proj.display(path)}: missing")
         elif path.read_text(encoding="utf-8") != text:
-            problems.append(f"{path.relative_to(root)}: stale")
-    generated = root / "generated"
-    for path in sorted(generated.rglob("*")) if generated.is_dir() else []:
-        failed_spec = any(part in {e.file for e in errors} for part in path.parts)
-        if path.is_file() and "__pycache__" not in path.parts and path not in files and not failed_spec:
-            problems.append(f"{path.relative_to(root)}: not generated from any spec")
+            problems.append(f"{proj.display(path)}: stale")
+    for path in orphans(proj, files, {e.file for e in errors}):
+        problems.append(f"{proj.display(path)}: orphaned (no spec generates it any more)")
+    for path in strangers(files):
+        problems.append(f"{proj.display(path)}: not generated from any spec (move it out of the generated package)")
     for problem in problems:
         print(problem, file=sys.stderr)
     if problems:
-        print("run `serialspec generate` to bring generated/ up to date", file=sys.stderr)
+        print("run `serialspec generate` to bring the generated files up to date", file=sys.stderr)
         return 1
     print(f"{len(files)} generated files match the specs")
     return 0

@@ -5,21 +5,30 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from typing import Any
+from types import ModuleType
+from typing import Any, TextIO
 
-from serialspec.cli.protocols import open_spec
-from serialspec.cli.views import engineering, register_view
+from serialspec.cli import capture
+from serialspec.cli.frames import Frames
+from serialspec.cli.protocols import SPEC_HELP, open_spec
+from serialspec.cli.views import engineering, register_view, unit_symbols, with_unit
 from serialspec.runtime.errors import DecodeError, SerialspecError
 from serialspec.runtime.hexbytes import parse_hex
 from serialspec.runtime.message import Message
 from serialspec.spec.model import Protocol
 
-HELP = "decode frames given as hex ('12 4c 08', '0x12 0x4c', '124c08', '12:4c:08'); one frame per argument"
+HELP = (
+    "decode frames given as hex ('12 4c 08', '0x12 0x4c', '124c08', '12:4c:08'), one frame per argument "
+    "('-': one per line from stdin), or a capture with --file"
+)
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("spec", help="the protocol's spec file, e.g. specs/fashionstar_uart.yaml")
-    parser.add_argument("hex", nargs="+", help="one frame per argument")
+    parser.add_argument("spec", help=SPEC_HELP)
+    parser.add_argument("hex", nargs="*", help="one frame per argument; - reads frames from stdin, one per line")
+    parser.add_argument(
+        "--file", metavar="FILE", help="a capture (monitor --save, sim --tap) or hex lines to replay; - for stdin"
+    )
     parser.add_argument("--json", action="store_true", help="one JSON object per frame")
     parser.add_argument(
         "--direction",
@@ -31,12 +40,17 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    if not args.hex and not args.file:
+        raise SerialspecError("give frames as hex arguments, - to read them from stdin, or --file CAPTURE")
     protocol, package = open_spec(args.spec)
     request = None
     if args.request:
         request = package.decode(_hex(args.request), "request")
+    if args.file:
+        return replay(args, protocol, package)
+    frames = [line for line in sys.stdin if line.strip()] if args.hex == ["-"] else args.hex
     failed = 0
-    for text in args.hex:
+    for text in frames:
         try:
             frame = _hex(text)
             message = package.decode(frame, args.direction)
@@ -44,12 +58,49 @@ def run(args: argparse.Namespace) -> int:
             print(f"serialspec decode: {text.strip()}: {exc}", file=sys.stderr)
             failed += 1
             continue
-        result = describe(protocol, message, frame, args.units, request)
-        if args.json:
-            print(json.dumps(result, ensure_ascii=False))
-        else:
-            print(readable(result))
+        show(describe(protocol, message, frame, args.units, request), args.json)
     return 1 if failed else 0
+
+
+def show(result: dict[str, Any], as_json: bool) -> None:
+    print(json.dumps(result, ensure_ascii=False) if as_json else readable(result), flush=True)
+
+
+def replay(args: argparse.Namespace, protocol: Protocol, package: ModuleType) -> int:
+    """Decode a capture: each direction's bytes joined again and split into frames; bad bytes reported."""
+    address = protocol.device.address if protocol.device else None
+    streams: dict[str | None, Frames] = {}
+    failed = 0
+    stream = sys.stdin if args.file == "-" else _open(args.file)
+    with stream:
+        try:
+            for number, chunk in capture.read(stream):
+                direction = chunk.direction or args.direction
+                frames = streams.get(direction) or streams.setdefault(direction, Frames(package, direction, address))
+                for seen in frames.feed(chunk.data):
+                    if seen.message is None:
+                        failed += 1
+                        print(
+                            f"serialspec decode: line {number}: {seen.reason} in [{seen.data.hex(' ')}]",
+                            file=sys.stderr,
+                        )
+                        continue
+                    result = describe(protocol, seen.message, seen.data, args.units, None)
+                    show({"time": chunk.when, **result} if chunk.when else result, args.json)
+        except ValueError as exc:
+            raise SerialspecError(f"{args.file}: {exc}") from None
+    for frames in streams.values():
+        if frames.pending():
+            failed += 1
+            print(f"serialspec decode: {args.file} ends inside a frame: [{frames.pending().hex(' ')}]", file=sys.stderr)
+    return 1 if failed else 0
+
+
+def _open(path: str) -> TextIO:
+    try:
+        return open(path, encoding="utf-8")
+    except OSError as exc:
+        raise SerialspecError(f"cannot read {path}: {exc.strerror}") from None
 
 
 def _hex(text: str) -> bytes:
@@ -63,8 +114,10 @@ def describe(
     protocol: Protocol, message: Message, frame: bytes, units: bool, request: Message | None
 ) -> dict[str, Any]:
     fields = message.to_fields()
+    symbols = {}
     if units:
         fields = engineering(protocol, message, fields)
+        symbols = unit_symbols(protocol, message)
     result: dict[str, Any] = {
         "protocol": protocol.name,
         "direction": message.DIRECTION.value,
@@ -74,6 +127,8 @@ def describe(
         "checksum_ok": True,  # a frame whose checksum fails does not decode
         "hex": frame.hex(" "),
     }
+    if symbols:
+        result["units"] = symbols
     registers = register_view(protocol, message, request)
     if registers is not None:
         result["registers"] = registers
@@ -82,9 +137,12 @@ def describe(
 
 def readable(result: dict[str, Any]) -> str:
     title = result["command"] + (f".{result['subcommand']}" if result["subcommand"] else "")
-    lines = [f"{result['protocol']} {result['direction']} {title}  [{result['hex']}]"]
+    when = f"{result['time']} " if result.get("time") else ""
+    lines = [f"{when}{result['protocol']} {result['direction']} {title}  [{result['hex']}]"]
+    units = result.get("units", {})
     for name, value in result["fields"].items():
-        lines.append(f"  {name:<20} {_value(value)}")
+        text = with_unit(_value(value), units[name]) if name in units else _value(value)
+        lines.append(f"  {name:<20} {text}")
     for name, value in (result.get("registers") or {}).items():
         lines.append(f"  register {name:<11} {_value(value)}")
     return "\n".join(lines)

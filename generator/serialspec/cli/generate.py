@@ -1,24 +1,29 @@
-"""serialspec generate: regenerate generated/ (packages and docs) and the JSON Schema from specs/."""
+"""serialspec generate: write each spec's package and reference, and the JSON Schema; remove orphaned files."""
 
 from __future__ import annotations
 
 import argparse
+import shutil
 import sys
 from pathlib import Path
 
-from serialspec.cli.project import expected_files, find_root
+from serialspec.cli.project import expected_files, orphans, project
 from serialspec.runtime.errors import SerialspecError
 
-HELP = "regenerate generated/ and specs/serialspec.schema.json from specs/*.yaml"
+HELP = "generate DIR/<protocol>/ and DIR/docs/<protocol>.md from specs (default: the project's, see [tool.serialspec])"
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--root", type=Path, help="project root (default: the nearest folder holding specs/)")
+    parser.add_argument("specs", nargs="*", metavar="SPEC", help="spec files (default: the project's specs)")
+    parser.add_argument("--out", metavar="DIR", help="output folder (default: the project's, else generated/)")
+    parser.add_argument(
+        "--root", type=Path, help="project root (default: the nearest folder with a [tool.serialspec] table or specs/)"
+    )
 
 
 def run(args: argparse.Namespace) -> int:
-    root = args.root or find_root()
-    files, errors = expected_files(root)
+    proj = project(args.root, args.specs, args.out)
+    files, errors = expected_files(proj)
     written = 0
     for path, text in files.items():
         try:
@@ -28,7 +33,15 @@ def run(args: argparse.Namespace) -> int:
                 written += 1
         except OSError as exc:
             raise SerialspecError(f"cannot write {path}: {exc.strerror or exc}") from None
-    print(f"{len(files)} files generated, {written} changed")
+    removed = orphans(proj, files, {e.file for e in errors})
+    for path in removed:
+        path.unlink()
+        print(f"removed {proj.display(path)} (no spec generates it any more)", file=sys.stderr)
+    for folder in {p.parent for p in removed}:
+        shutil.rmtree(folder / "__pycache__", ignore_errors=True)
+        if folder.is_dir() and not any(folder.iterdir()):
+            folder.rmdir()
+    print(f"{len(files)} files generated in {proj.display(proj.out)}, {written} changed, {len(removed)} removed")
     for error in errors:
         print(error, file=sys.stderr)
     return 1 if errors else 0

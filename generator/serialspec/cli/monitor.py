@@ -3,47 +3,92 @@
 from __future__ import annotations
 
 import argparse
-import datetime
 import json
 import signal
 import sys
 import time
 from types import FrameType
-from typing import Any
+from typing import Any, TextIO
 
 import serial
 
-from serialspec.cli.protocols import open_spec
+from serialspec.cli import capture
+from serialspec.cli.frames import Frames, Seen
+from serialspec.cli.protocols import SPEC_HELP, open_spec
+from serialspec.cli.views import engineering, unit_symbols, with_unit
 from serialspec.runtime.errors import PortError, SerialspecError
+from serialspec.spec.model import Protocol
 
 HELP = "print every frame seen on a port (device path or pyserial URL), one line each with a timestamp"
+COLOURS = {"request": "\033[36m", "response": "\033[32m", "BAD": "\033[31m"}
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("spec", help="the protocol spec (YAML)")
+    parser.add_argument("spec", help=SPEC_HELP)
     parser.add_argument("--port", required=True, help="device path or pyserial URL (loop://, socket://, spy://...)")
     parser.add_argument("--baudrate", type=int, help="default: the spec's")
     parser.add_argument(
         "--direction",
         choices=("request", "response"),
-        help="only this direction (needed when requests and responses share a header)",
+        help="only this direction (default: both; where they share a header, replies are paired with requests)",
     )
     parser.add_argument("--duration", type=float, help="stop after this many seconds")
     parser.add_argument("--count", type=int, help="stop after this many frames")
+    parser.add_argument("--save", metavar="FILE", help="also write every chunk read to a capture file")
+    parser.add_argument("--units", action="store_true", help="engineering units (with symbols) and enum names")
+    parser.add_argument("--command", dest="commands", action="append", metavar="NAME", help="only this command")
+    parser.add_argument("--id", dest="ids", type=int, action="append", metavar="N", help="only this device id")
+    parser.add_argument(
+        "--color", choices=("auto", "always", "never"), default="auto", help="colour lines (auto: on a terminal)"
+    )
 
 
-def _line(kind: str, text: str) -> None:
-    stamp = datetime.datetime.now().isoformat(timespec="microseconds")
-    print(f"{stamp} {kind} {text}", flush=True)
+class Printer:
+    """One line per frame, filtered by command and id, coloured on a terminal."""
+
+    def __init__(self, args: argparse.Namespace, protocol: Protocol, out: TextIO = sys.stdout) -> None:
+        self.args = args
+        self.protocol = protocol
+        self.out = out
+        self.colour = args.color == "always" or (args.color == "auto" and out.isatty())
+        self.address = protocol.device.address if protocol.device else None
+
+    def wanted(self, seen: Seen) -> bool:
+        message = seen.message
+        if message is None:
+            return not (self.args.commands or self.args.ids)
+        if self.args.direction and message.DIRECTION.value != self.args.direction:
+            return False
+        if self.args.commands and not {message.COMMAND, f"{message.COMMAND}.{message.SUBCOMMAND}"} & set(
+            self.args.commands
+        ):
+            return False
+        return not self.args.ids or message.to_fields().get(self.address or "") in self.args.ids
+
+    def line(self, seen: Seen) -> None:
+        message = seen.message
+        if message is None:
+            kind, text = "BAD", f"{seen.reason} in [{seen.data.hex(' ')}]"
+        else:
+            kind = message.DIRECTION.value
+            fields: dict[str, Any] = message.to_fields()
+            if self.args.units:
+                symbols = unit_symbols(self.protocol, message)
+                fields = {
+                    name: with_unit(value, symbols[name]) if name in symbols else value
+                    for name, value in engineering(self.protocol, message, fields).items()
+                }
+            what = message.COMMAND + (f".{message.SUBCOMMAND}" if message.SUBCOMMAND else "")
+            text = f"{what} {json.dumps(fields, ensure_ascii=False)} [{seen.data.hex(' ')}]"
+        label = f"{COLOURS[kind]}{kind}\033[0m" if self.colour else kind
+        print(f"{capture.stamp()} {label} {text}", file=self.out, flush=True)
 
 
 def run(args: argparse.Namespace) -> int:
     protocol, package = open_spec(args.spec)
     settings = package.SERIAL
-    try:
-        parser = package.StreamParser(args.direction)
-    except ValueError as exc:
-        raise SerialspecError(str(exc)) from None
+    address = protocol.device.address if protocol.device else None
+    frames = Frames(package, args.direction, address)
     try:
         port = serial.serial_for_url(
             args.port,
@@ -55,6 +100,11 @@ def run(args: argparse.Namespace) -> int:
         )
     except (serial.SerialException, OSError, ValueError) as exc:
         raise PortError(f"cannot open {args.port}: {exc}") from None
+    try:
+        save = open(args.save, "w", encoding="utf-8") if args.save else None  # noqa: SIM115 (closed below)
+    except OSError as exc:
+        raise SerialspecError(f"cannot write {args.save}: {exc.strerror}") from None
+    writer = capture.Writer(save, protocol.name) if save else None
     stopping = False
 
     def stop(signum: int, frame: FrameType | None) -> None:
@@ -64,8 +114,8 @@ def run(args: argparse.Namespace) -> int:
     signal.signal(signal.SIGINT, stop)
     signal.signal(signal.SIGTERM, stop)
     end = time.monotonic() + args.duration if args.duration else None
+    printer = Printer(args, protocol)
     seen = 0
-    after_error = False
     print(f"serialspec monitor: {protocol.name} on {args.port}; Ctrl-C to stop", file=sys.stderr, flush=True)
     with port:
         while not stopping and (end is None or time.monotonic() < end) and (args.count is None or seen < args.count):
@@ -80,25 +130,13 @@ def run(args: argparse.Namespace) -> int:
                 raise PortError(f"{args.port}: {exc}") from None
             if not chunk:
                 continue
-            errors, garbage = parser.errors, parser.garbage
-            for message in parser.feed(chunk):
-                seen += 1
-                fields: dict[str, Any] = message.to_fields()
-                what = message.COMMAND + (f".{message.SUBCOMMAND}" if message.SUBCOMMAND else "")
-                _line(
-                    message.DIRECTION.value,
-                    f"{what} {json.dumps(fields, ensure_ascii=False)} [{package.encode(message).hex(' ')}]",
-                )
-            if parser.errors > errors:
-                after_error = True  # the rest of a bad frame is skipped as garbage: not reported twice
-                seen += parser.errors - errors
-                _line(
-                    "BAD",
-                    f"{parser.errors - errors} frame(s) failed their checksum or content check in [{chunk.hex(' ')}]",
-                )
-            elif parser.garbage > garbage and not after_error:
-                _line("BAD", f"{parser.garbage - garbage} byte(s) outside any frame in [{chunk.hex(' ')}]")
-            else:
-                after_error = False
+            if writer is not None:
+                writer.write(args.direction, chunk)
+            for item in frames.feed(chunk):
+                if printer.wanted(item):
+                    seen += 1
+                    printer.line(item)
+    if save is not None:
+        save.close()
     print(f"{protocol.name}: {seen} frame(s)", file=sys.stderr)
     return 0

@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 import argparse
-import importlib
+import json
 import signal
 import sys
+import time
 from types import FrameType
-from typing import Any
 
-from serialspec.cli.protocols import open_spec
+from serialspec.cli import capture
+from serialspec.cli.protocols import SPEC_HELP, open_spec
 from serialspec.runtime.errors import SerialspecError
 from serialspec.spec.model import Protocol, Scalar
 
@@ -17,30 +18,70 @@ HELP = "serve virtual devices on a pseudo-terminal; prints the device path first
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("spec", help="the protocol spec (YAML)")
+    parser.add_argument("spec", help=SPEC_HELP)
     parser.add_argument(
         "--id",
         dest="ids",
         type=int,
         action="append",
         metavar="N",
-        help="a device id on the bus (repeat for several; default 0)",
+        help="a device id on the bus (repeat for several; default 0); checked against the spec's id range",
     )
-    parser.add_argument("--quiet", action="store_true", help="do not log requests on stderr")
+    parser.add_argument("--quiet", action="store_true", help="do not log requests and replies on stderr")
+    parser.add_argument("--tap", metavar="FILE", help="record both directions of the session to a capture file")
+
+
+def id_range(protocol: Protocol) -> tuple[int, int, int | None]:
+    """The ids a device may have (from its id entry's range, else its address field's) and the broadcast id."""
+    assert protocol.device is not None
+    device = protocol.device
+    low, high = 0, 255
+    fields = (f for m in protocol.messages() for f in m.fields if f.name == device.address)
+    address = next(fields, None)
+    if isinstance(address, Scalar):
+        low, high = int(address.minimum), int(address.maximum)
+    entry = next((e for e in device.memory.entries if e.name == device.id_entry), None) if device.memory else None
+    if entry is not None:
+        low, high = max(low, int(entry.minimum)), min(high, int(entry.maximum))
+    return low, high, device.broadcast
 
 
 def run(args: argparse.Namespace) -> int:
-    protocol, _ = open_spec(args.spec)
-    try:
-        module = importlib.import_module(f"{protocol.name}.simulator")
-    except ImportError:
-        raise SerialspecError(f"{args.spec} has no `device:` section, so no simulator is generated") from None
+    protocol, package = open_spec(args.spec)
+    module = getattr(package, "simulator", None)
+    if module is None or protocol.device is None:
+        raise SerialspecError(f"{args.spec} has no `device:` section, so no simulator is generated")
     ids = args.ids or [0]
-    low, high = id_range(protocol)
+    low, high, broadcast = id_range(protocol)
     for device_id in ids:
-        if not low <= device_id <= high or (protocol.device and device_id == protocol.device.broadcast):
-            raise SerialspecError(f"--id {device_id} is outside {protocol.name}'s device ids {low}..{high}")
+        if not low <= device_id <= high or device_id == broadcast:
+            also = f" ({broadcast} is the broadcast id)" if device_id == broadcast else ""
+            raise SerialspecError(f"--id {device_id} is outside the spec's id range {low}..{high}{also}")
     simulator = module.SIMULATOR(ids)
+    tap = None
+    if args.tap:
+        try:
+            tap = open(args.tap, "w", encoding="utf-8")  # noqa: SIM115 (closed below)
+        except OSError as exc:
+            raise SerialspecError(f"cannot write {args.tap}: {exc.strerror}") from None
+    writer = capture.Writer(tap, protocol.name) if tap else None
+    feed = simulator.feed
+
+    def logged(data: bytes) -> list[tuple[float, bytes]]:
+        before, moment, offset = len(simulator.log), time.time(), time.time() - simulator.clock()
+        replies: list[tuple[float, bytes]] = feed(data)
+        if writer is not None:
+            writer.write("request", data, moment)
+            for when, frame in replies:
+                writer.write("response", frame, max(moment, when + offset))
+        if not args.quiet:
+            for request in simulator.log[before:]:
+                print(f"request  {_text(request)}", file=sys.stderr, flush=True)
+            for _, frame in replies:
+                print(f"response [{frame.hex(' ')}]", file=sys.stderr, flush=True)
+        return replies
+
+    simulator.feed = logged
     controller, path = simulator.open_pty()
 
     def stop(signum: int, frame: FrameType | None) -> None:
@@ -49,16 +90,16 @@ def run(args: argparse.Namespace) -> int:
     signal.signal(signal.SIGINT, stop)
     signal.signal(signal.SIGTERM, stop)
     print(path, flush=True)
-    ids = ", ".join(str(i) for i in simulator.devices)
-    print(f"serialspec sim: {protocol.name} device(s) {ids} on {path}; Ctrl-C to stop", file=sys.stderr, flush=True)
-    simulator.serve(controller)
+    shown = ", ".join(str(i) for i in simulator.devices)
+    print(f"serialspec sim: {protocol.name} device(s) {shown} on {path}; Ctrl-C to stop", file=sys.stderr, flush=True)
+    try:
+        simulator.serve(controller)
+    finally:
+        if tap is not None:
+            tap.close()
     return 0
 
 
-def id_range(protocol: Protocol) -> tuple[int, int]:
-    """The ids a device may have: the range of the field that carries the address (the spec's device.address)."""
-    name = protocol.device.address if protocol.device else ""
-    candidates: list[Any] = [e for layout in protocol.framing.layouts.values() for e in layout.value_elements]
-    candidates += [f for m in protocol.messages() for f in m.fields if isinstance(f, Scalar)]
-    found = next((c for c in candidates if c.name == name), None)
-    return (int(found.minimum), int(found.maximum)) if found is not None else (0, 255)
+def _text(message: object) -> str:
+    what = message.COMMAND + (f".{message.SUBCOMMAND}" if message.SUBCOMMAND else "")  # type: ignore[attr-defined]
+    return f"{what} {json.dumps(message.to_fields(), ensure_ascii=False)}"  # type: ignore[attr-defined]

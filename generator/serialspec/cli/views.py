@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from typing import Any
 
 from serialspec.runtime.message import Message
@@ -32,6 +33,33 @@ def engineering(protocol: Protocol, message: Message, fields: dict[str, Any]) ->
         if element.flags and element.name in result:
             result[element.name] = [b.name.lower() for b in element.flags.bits if result[element.name] >> b.bit & 1]
     return result
+
+
+def unit_symbols(protocol: Protocol, message: Message) -> dict[str, str]:
+    """The unit of every field that has one (of the value `engineering` gives: wire value x scale)."""
+    spec = message_spec(protocol, message)
+    fields = message.to_fields()
+    symbols = {}
+    for f in spec.fields:
+        unit = engineering_unit(f.unit, f.scale) if isinstance(f, Scalar) and not (f.enum or f.flags or f.bits) else ""
+        if isinstance(f, TableValue):
+            entry = f.table.entry(fields.get(f.key, -1))
+            unit = engineering_unit(entry.unit, entry.scale) if entry is not None and entry.enum is None else ""
+        if unit:
+            symbols[f.name] = unit
+    return symbols
+
+
+_STEP = re.compile(r"^\s*[0-9]+(\.[0-9]+)?\s*")
+
+
+def engineering_unit(unit: str, scale: float | None) -> str:
+    """The unit of wire value x scale: a wire unit of `0.1°` with scale 0.1 is `°`, `6.5 mA` with 6.5 is `mA`."""
+    return _STEP.sub("", unit) if scale is not None else unit
+
+
+def with_unit(value: Any, unit: str) -> str:
+    return f"{value}{unit}" if unit == "°" else f"{value} {unit}"
 
 
 def _field_units(f: Field, value: Any, siblings: dict[str, Any]) -> Any:

@@ -123,6 +123,8 @@ class Bus:
             except (serial.SerialException, OSError, ValueError) as exc:
                 raise PortError(f"cannot open {port}: {exc}") from None
         self.port_name = str(getattr(self._port, "name", None) or getattr(self._port, "port", "") or port)
+        # spy:// logs in its read(); the fast path below reads the descriptor itself, so it tells the logger
+        self._spy = getattr(self._port, "formatter", None)
 
     # --- lifetime -------------------------------------------------------------------------------------------------
 
@@ -296,6 +298,8 @@ class Bus:
             data = os.read(fd, 4096)
             if not data:  # readable but empty: the other end hung up
                 raise serial.SerialException("device disconnected")
+            if self._spy is not None:
+                self._spy.rx(data)
             return data
         if self._port.timeout != wait:
             self._port.timeout = wait

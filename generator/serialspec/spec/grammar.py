@@ -31,6 +31,8 @@ class Shape:
 class Str(Shape):
     description: str = ""
     choices: tuple[str, ...] = ()
+    default: Any = None  # the value a spec gets when it leaves the key out (for the reference and the schema)
+    example: Any = None  # shown in the reference where no spec uses the key
 
     def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
         if not isinstance(value, str):
@@ -44,12 +46,14 @@ class Str(Shape):
         schema: dict[str, Any] = {"type": "string", "description": self.description}
         if self.choices:
             schema["enum"] = list(self.choices)
-        return schema
+        return _with_default(schema, self.default, self.example)
 
 
 @dataclass
 class Int(Shape):
     description: str = ""
+    default: Any = None  # the value a spec gets when it leaves the key out (for the reference and the schema)
+    example: Any = None  # shown in the reference where no spec uses the key
     minimum: int | None = None
     maximum: int | None = None
 
@@ -65,7 +69,7 @@ class Int(Shape):
             schema["minimum"] = self.minimum
         if self.maximum is not None:
             schema["maximum"] = self.maximum
-        return schema
+        return _with_default(schema, self.default, self.example)
 
 
 @dataclass
@@ -73,6 +77,8 @@ class Num(Shape):
     """A finite number (NaN and infinities are never a protocol fact)."""
 
     description: str = ""
+    default: Any = None  # the value a spec gets when it leaves the key out (for the reference and the schema)
+    example: Any = None  # shown in the reference where no spec uses the key
     choices: tuple[float, ...] = ()
 
     def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
@@ -87,7 +93,7 @@ class Num(Shape):
         schema: dict[str, Any] = {"type": "number", "description": self.description}
         if self.choices:
             schema["enum"] = list(self.choices)
-        return schema
+        return _with_default(schema, self.default, self.example)
 
 
 def _bounds(minimum: int | None, maximum: int | None) -> str:
@@ -99,13 +105,29 @@ def _bounds(minimum: int | None, maximum: int | None) -> str:
 @dataclass
 class Bool(Shape):
     description: str = ""
+    default: Any = None  # the value a spec gets when it leaves the key out (for the reference and the schema)
+    example: Any = None  # shown in the reference where no spec uses the key
 
     def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
         if not isinstance(value, bool):
             yield path, f"expected true or false, got {_kind(value)}"
 
     def json_schema(self) -> dict[str, Any]:
-        return {"type": "boolean", "description": self.description}
+        return _with_default({"type": "boolean", "description": self.description}, self.default, self.example)
+
+
+def _with_default(schema: dict[str, Any], default: Any, example: Any = None) -> dict[str, Any]:
+    if default is not None:
+        schema["default"] = default
+    if example is not None:
+        schema["examples"] = [example]
+    return schema
+
+
+def value_description(shape: Shape, parent: str) -> str:
+    """A shape's own description, or its parent's for a part that needs none of its own (a map's value, a list's
+    item, an option of a OneOf: `Document id -> what it is.` describes the values of `sources:`)."""
+    return shape.description or parent
 
 
 @dataclass
@@ -137,7 +159,7 @@ class ListOf(Shape):
     def json_schema(self) -> dict[str, Any]:
         schema: dict[str, Any] = {
             "type": "array",
-            "items": self.item.json_schema(),
+            "items": _described(self.item, self.description),
             "description": self.description,
         }
         if self.length is not None:
@@ -166,7 +188,7 @@ class MapOf(Shape):
     def json_schema(self) -> dict[str, Any]:
         return {
             "type": "object",
-            "additionalProperties": self.value.json_schema(),
+            "additionalProperties": _described(self.value, self.description),
             "description": self.description,
         }
 
@@ -234,7 +256,24 @@ class OneOf(Shape):
         yield path, f"unexpected {_kind(value)}: {self.description}"
 
     def json_schema(self) -> dict[str, Any]:
-        return {"anyOf": [option.json_schema() for option in self.options], "description": self.description}
+        options = [_described(option, self.description) for option in self.options]
+        return {"anyOf": options, "description": self.description}
+
+
+def _described(shape: Shape, parent: str) -> dict[str, Any]:
+    return _fill(shape.json_schema(), parent)
+
+
+def _fill(schema: dict[str, Any], parent: str) -> dict[str, Any]:
+    """Give every part without a description of its own (an option, a list's items) its parent's."""
+    if not schema.get("description"):
+        schema["description"] = parent
+    for part in ("items", "additionalProperties"):
+        if isinstance(schema.get(part), dict):
+            _fill(schema[part], schema["description"])
+    for option in schema.get("anyOf", []):
+        _fill(option, schema["description"])
+    return schema
 
 
 def _accepts_kind(shape: Shape, value: Any) -> bool:
@@ -267,6 +306,10 @@ def _kind(value: Any) -> str:
 # --- the language -------------------------------------------------------------------------------------------------
 
 TEXT = Str("Free text (English); shown in docs and docstrings, never executed.")
+TITLE = Str("A one-line title (free text), shown in the reference and as the docstring's first line.")
+TITLE_CN = Str("The title as printed in the (Chinese) document.")
+SOURCE = Str("Where the fact comes from: a document id from `sources:` and its section (free text).")
+SCALAR_TYPE = Str("Wire type of the value.", choices=SCALAR_TYPES, default="u8")
 RANGE = ListOf(Num(), "Inclusive [min, max] of the value in wire units; checked before encoding.", length=2)
 HEX_BYTES = Str("Bytes as hex: '12 4c 08', '0x12 0x4c', '124c08' or '12:4c:08'.")
 
@@ -278,23 +321,29 @@ _FIELD_LONG: dict[str, Shape] = {
     "unit": Str("Unit of one wire step, e.g. mV, ms, 0.1°."),
     "scale": Num("Engineering value = wire value × scale (e.g. 0.1 for 0.1° steps)."),
     "range": RANGE,
-    "const": Int("The field always has this value (sub-command selectors, fixed addresses)."),
+    "const": Int("The field always has this value (sub-command selectors, fixed addresses).", example=1),
     "default": Num("Value used when a message is built without this field."),
     "enum": Str("Name of an entry in `enums:`; values decode to that enum."),
     "flags": Str("Name of an entry in `flags:`; the value is a set of bit flags."),
     "bits": MapOf(
         Obj(
             {
-                "bits": OneOf((Int(), ListOf(Int(), length=2)), "a bit number or [high, low]"),
+                "bits": OneOf((Int(), ListOf(Int(), length=2)), "A bit number, or [high, low] for several bits."),
                 "enum": Str("Name of an entry in `enums:`."),
                 "description": TEXT,
             },
             required=("bits",),
+            description="One sub-field: its bit (or bits) and optionally the enum its value belongs to.",
         ),
         "Sub-fields packed into this integer, by bit position (unlisted bits must be zero).",
     ),
-    "encoding": Str("How the integer is stored.", choices=("plain", "sign_magnitude")),
-    "endian": Str("Override of the protocol's byte order for this field.", choices=("little", "big")),
+    "encoding": Str(
+        "How the integer is stored: plain two's complement, or sign_magnitude (top bit the sign, the rest the size).",
+        choices=("plain", "sign_magnitude"),
+        default="plain",
+        example="sign_magnitude",
+    ),
+    "endian": Str("Override of the protocol's byte order for this field.", choices=("little", "big"), example="big"),
     "size": OneOf((Int(), Str()), "bytes: a number, `rest` (up to the end of the content) or a field name"),
     "count": OneOf((Int(), Str()), "array/group: a number, `rest`, or the name of an earlier count field"),
     "of": Str("array: the item type."),
@@ -315,7 +364,13 @@ _FIELD_LONG: dict[str, Shape] = {
         ),
     ),
 }
-FIELD = OneOf((Str("A wire type or the name of an entry in `fields:`"), Obj(_FIELD_LONG)), "a type name or a mapping")
+FIELD = OneOf(
+    (
+        Str("A wire type or the name of an entry in `fields:`"),
+        Obj(_FIELD_LONG, description="A field in full: its type, and its unit, range, enum... where it has them."),
+    ),
+    "A field: a wire type or the name of a shared field (short form), or a mapping (long form).",
+)
 FIELDS: Shape = MapOf(FIELD, "Fields in wire order: name -> type or mapping.")
 
 OPTIONAL_WHEN = Obj(
@@ -329,10 +384,10 @@ OPTIONAL_WHEN = Obj(
 
 MESSAGE = Obj(
     {
-        "description": TEXT,
+        "description": Str(TEXT.description, example="Sent once the move has finished."),
         "fields": FIELDS,
         "optional": TEXT,
-        "unsolicited": Bool("Sent by the device on its own, not as an answer."),
+        "unsolicited": Bool("Sent by the device on its own, not as an answer.", default=False),
         "answers": Str("For a response: the request (command or command.subcommand) it answers, if another."),
         "optional_when": OPTIONAL_WHEN,
         "after": Str("For a response: the request field (in ms) after which the device answers, e.g. a move's time."),
@@ -344,7 +399,7 @@ MESSAGE = Obj(
             required=("command",),
             description="For a request: answered by another command's response (FEETECH's one status packet).",
         ),
-        "source": TEXT,
+        "source": SOURCE,
     },
     description="One direction of a command: its content fields and how it is sent.",
 )
@@ -352,14 +407,15 @@ MESSAGE = Obj(
 SUBCOMMAND = Obj(
     {
         "code": Int("Selector value."),
-        "title": TEXT,
-        "title_cn": Str(),
+        "title": TITLE,
+        "title_cn": TITLE_CN,
         "description": TEXT,
         "request": MESSAGE,
         "response": MESSAGE,
-        "source": TEXT,
+        "source": SOURCE,
     },
     required=("code",),
+    description="A sub-command: its selector value and the fields of its request and response.",
 )
 
 COMMAND = Obj(
@@ -368,84 +424,112 @@ COMMAND = Obj(
             "Value of the frame's command field; omit for the one response of a protocol whose replies "
             "carry no command field."
         ),
-        "title": TEXT,
-        "title_cn": Str(),
+        "title": TITLE,
+        "title_cn": TITLE_CN,
         "description": TEXT,
         "request": MESSAGE,
         "response": MESSAGE,
         "broadcast": TEXT,
-        "source": TEXT,
+        "source": SOURCE,
         "selector": Obj(
             {
-                "type": Str(choices=SCALAR_TYPES),
-                "name": Str(),
+                "type": Str("Wire type of the selector.", choices=SCALAR_TYPES, default="u8"),
+                "name": Str("The selector's field name, as messages show it."),
                 "offset": MapOf(Int(), "Byte offset of the selector in the content, by direction."),
             },
             required=("offset",),
             description="Where the sub-command selector sits in the content, by direction.",
         ),
-        "subcommands": MapOf(SUBCOMMAND),
+        "subcommands": MapOf(SUBCOMMAND, "Sub-commands the selector picks: name -> sub-command."),
     },
+    description="A command: its code, and the fields of its request and response.",
 )
 
 ENUM = Obj(
     {
-        "type": Str(choices=SCALAR_TYPES),
+        "type": Str("Wire type of fields holding the enum.", choices=SCALAR_TYPES, default="u8"),
         "description": TEXT,
         "values": MapOf(
             OneOf(
-                (Int(), Obj({"value": Int(), "text": TEXT, "text_cn": Str()}, required=("value",))),
-                "a number or {value, text}",
+                (
+                    Int(),
+                    Obj(
+                        {
+                            "value": Int("The wire value."),
+                            "text": Str("What the value means (free text)."),
+                            "text_cn": Str("The meaning as printed in the (Chinese) document.", example="释放"),
+                        },
+                        required=("value",),
+                    ),
+                ),
+                "The wire value, or {value, text}.",
             ),
             "Label -> wire value.",
         ),
     },
     required=("values",),
+    description="Names for the values of a field; decoded values become members of a generated IntEnum.",
 )
 
 FLAGS = Obj(
     {
-        "type": Str(choices=SCALAR_TYPES),
+        "type": Str("Wire type of fields holding the flags.", choices=SCALAR_TYPES, default="u8", example="u16"),
         "description": TEXT,
         "bits": MapOf(
-            OneOf((Int(), Obj({"bit": Int(), "text": TEXT}, required=("bit",))), "a bit number or {bit, text}"),
+            OneOf(
+                (
+                    Int(),
+                    Obj(
+                        {"bit": Int("Bit number (0 is the least significant)."), "text": TEXT},
+                        required=("bit",),
+                    ),
+                ),
+                "A bit number, or {bit, text}.",
+            ),
             "Flag name -> bit number.",
         ),
     },
     required=("bits",),
+    description="Names for the bits of a field; decoded values become a generated IntFlag.",
 )
 
 TABLE_ENTRY = Obj(
     {
         "key": Int("data_id or register address."),
-        "type": Str(choices=SCALAR_TYPES),
-        "name_cn": Str(),
+        "type": Str("Wire type of the value.", choices=SCALAR_TYPES),
+        "name_cn": Str("The name as printed in the (Chinese) document."),
         "description": TEXT,
-        "unit": Str(),
-        "scale": Num(),
+        "unit": Str("Unit of one wire step, e.g. mV, 0.1°."),
+        "scale": Num("Engineering value = wire value × scale."),
         "range": RANGE,
-        "default": OneOf((Num(), Str()), "a number, or text when the document gives none"),
-        "access": Str(choices=("r", "rw")),
-        "memory": Str(choices=("eeprom", "sram")),
-        "enum": Str(),
-        "flags": Str(),
-        "encoding": Str(choices=("plain", "sign_magnitude")),
+        "default": OneOf((Num(), Str()), "The value after a reset: a number, or text when the document gives none."),
+        "access": Str("r (read-only) or rw (readable and writable).", choices=("r", "rw"), default="rw"),
+        "memory": Str("Where the device keeps it: eeprom (kept over power-off) or sram.", choices=("eeprom", "sram")),
+        "enum": Str("Name of an entry in `enums:`."),
+        "flags": Str("Name of an entry in `flags:`."),
+        "encoding": Str(
+            "How the integer is stored (see a field's `encoding`).",
+            choices=("plain", "sign_magnitude"),
+            default="plain",
+        ),
         "sign_bit": Int("sign_magnitude: the bit holding the sign when it is not the top bit (FEETECH load: 10)."),
-        "reserved": Bool("A slot the document reserves: no name of its own."),
-        "source": TEXT,
+        "reserved": Bool("A slot the document reserves: no name of its own.", default=False),
+        "source": SOURCE,
     },
     required=("key", "type"),
+    description="One parameter or register of the table.",
 )
 
 TABLE = Obj(
     {
-        "title": TEXT,
+        "title": TITLE,
         "key": Str("What the key is called on the wire (data_id, address)."),
         "description": TEXT,
-        "source": TEXT,
-        "entries": MapOf(TABLE_ENTRY),
+        "source": SOURCE,
+        "entries": MapOf(TABLE_ENTRY, "The table's entries: name -> entry."),
     },
     required=("key", "entries"),
+    description="Parameters or registers addressed by a key (a data_id, a register address).",
 )
 
 FRAME_ELEMENT = Obj(
@@ -454,48 +538,59 @@ FRAME_ELEMENT = Obj(
             "What the element is.",
             choices=("header", "command", "length", "content", "checksum", "address", "status"),
         ),
-        "type": Str(choices=SCALAR_TYPES),
-        "value": OneOf((Str(), MapOf(Str())), "header: hex bytes, or a mapping direction -> hex bytes"),
-        "directions": ListOf(Str(choices=("request", "response"))),
+        "type": Str("Wire type of the element (command, length, address, status, checksum).", choices=SCALAR_TYPES),
+        "value": OneOf(
+            (Str(), MapOf(Str(), "direction -> hex bytes")),
+            "header: hex bytes, or a mapping direction -> hex bytes",
+        ),
+        "directions": ListOf(
+            Str(choices=("request", "response")), "The directions whose frames have the element (default: both)."
+        ),
         "adds": Int("length: what the length counts beyond the content (SMS: 2 = instruction + checksum)."),
         "description": TEXT,
         "range": RANGE,
         "broadcast": Int("address: the broadcast value."),
         "flags": Str("status: name of an entry in `flags:`."),
         "covers": ListOf(Str(), "checksum: first and last element covered.", length=2),
-        "algorithm": Str(choices=("sum", "crc")),
-        "invert": Bool("sum: bitwise NOT of the sum."),
+        "algorithm": Str(
+            "checksum: `sum` of the covered bytes (modulo 2^bits of its type), or `crc` with the parameters in `crc`.",
+            choices=("sum", "crc"),
+        ),
+        "invert": Bool("sum: bitwise NOT of the sum.", default=False),
         "crc": Obj(
             {
-                "name": Str(),
-                "width": Int(),
-                "poly": Int(),
-                "init": Int(),
-                "refin": Bool(),
-                "refout": Bool(),
-                "xorout": Int(),
+                "name": Str("Catalogue name, e.g. CRC-16/MODBUS."),
+                "width": Int("Bits of the CRC."),
+                "poly": Int("Generator polynomial, normal form without the top bit (0x8005)."),
+                "init": Int("Register value before the first byte."),
+                "refin": Bool("Each input byte is reflected (least significant bit first)."),
+                "refout": Bool("The result is reflected before `xorout`."),
+                "xorout": Int("Value XORed into the result."),
                 "check": Int("The catalogue check value: the CRC of b'123456789'."),
             },
             required=("width", "poly", "init", "refin", "refout", "xorout", "check"),
+            description="crc: the CRC's catalogue parameters, checked against the catalogue check value.",
         ),
     },
     required=("role",),
+    description="One element of the frame: header, command, length, content, checksum, address or status.",
 )
 
 EXAMPLE = Obj(
     {
         "source": Str("Document and section the frame is printed in."),
         "description": TEXT,
-        "direction": Str(choices=("request", "response")),
+        "direction": Str("The direction the frame travels in.", choices=("request", "response")),
         "printed": Str("The frame exactly as the document prints it."),
         "frame": HEX_BYTES,
         "erratum": Str("Name of the erratum that explains why `frame` differs from `printed`."),
-        "command": Str(),
-        "subcommand": Str(),
+        "command": Str("The command the frame decodes as."),
+        "subcommand": Str("Its sub-command, where the command has them."),
         "request": Str("Name of the example whose request this example answers."),
         "fields": MapOf(Any_(), "The field values the frame carries (raw wire values)."),
     },
     required=("source", "direction", "printed", "command", "fields"),
+    description="A frame as a document prints it, with the fields it carries; the tests decode and encode it.",
 )
 
 ERRATUM = Obj(
@@ -506,16 +601,18 @@ ERRATUM = Obj(
         "check": Obj(
             {
                 "kind": Str(
+                    "The test: the printed frame fails to decode, decodes as given, a checksum's real value, "
+                    "CRC parameters that contradict their check value, or prose (no test).",
                     choices=("frame_fails", "frame_decodes_as", "checksum_value", "crc_parameters", "prose"),
                 ),
                 "frame": HEX_BYTES,
-                "direction": Str(choices=("request", "response")),
+                "direction": Str("The direction of `frame`.", choices=("request", "response")),
                 "error": Str("frame_fails: words the one-line decode error contains."),
-                "command": Str(),
-                "subcommand": Str(),
-                "fields": MapOf(Any_()),
+                "command": Str("frame_decodes_as: the command the frame decodes as."),
+                "subcommand": Str("frame_decodes_as: its sub-command."),
+                "fields": MapOf(Any_(), "frame_decodes_as: the field values it decodes to."),
                 "claimed": Any_("checksum_value: the claimed value; crc_parameters: the claimed parameters."),
-                "actual": Int(),
+                "actual": Int("checksum_value: the value the bytes really give."),
                 "examples": ListOf(Str(), "Examples whose frames the check runs over."),
             },
             required=("kind",),
@@ -523,14 +620,15 @@ ERRATUM = Obj(
         ),
     },
     required=("source", "printed", "correct", "check"),
+    description="A mistake in a document: what it prints, what is right, and the test that pins the right reading.",
 )
 
 DEVICE_COMMAND = Obj(
     {
-        "description": TEXT,
+        "description": Str(TEXT.description, example="The servo moves to the goal position over goal_time."),
         "reads": ListOf(Str(), "Response fields filled from memory: table_value by its key, table_block entries."),
         "writes": ListOf(Str(), "Request fields stored in memory: table_value by its key, table_block entries."),
-        "resets": Bool("Memory goes back to its defaults."),
+        "resets": Bool("Memory goes back to its defaults.", default=False),
         "reports": MapOf(Str(), "Response field -> the state variable or memory entry it reports."),
         "moves": Obj(
             {
@@ -540,11 +638,12 @@ DEVICE_COMMAND = Obj(
                 "speed": Str("The request field (or memory entry) with the speed, in state units per second."),
             },
             required=("state", "target"),
+            description="The device moves a state variable to a target, over a duration or at a speed.",
         ),
-        "broadcast_reply": Bool("Answers even when addressed by broadcast (default: silent)."),
+        "broadcast_reply": Bool("Answers even when addressed by broadcast (default: silent).", default=False),
         "each": Str("A group field of the request whose items address one device each (by the address field)."),
-        "buffered": Bool("The writes are held until a command that `commits` (FEETECH REG WRITE)."),
-        "commits": Bool("Carries out the writes held by `buffered` commands (FEETECH ACTION)."),
+        "buffered": Bool("The writes are held until a command that `commits` (FEETECH REG WRITE).", default=False),
+        "commits": Bool("Carries out the writes held by `buffered` commands (FEETECH ACTION).", default=False),
         "kind": Str("The entry of `kinds:` whose devices the command addresses (default: the devices of --id)."),
         "stores": MapOf(Str(), "Request field -> the state variable it is stored in (where names differ)."),
         "sets": MapOf(Num(), "State variable -> the value the command sets it to."),
@@ -570,7 +669,8 @@ DEVICE = Obj(
         "refused": MapOf(Num(), "Response field -> value when a write is refused (read-only or unknown entry)."),
         "status": MapOf(Str(), "Response field -> the memory entry every response reports in it (a status byte)."),
         "echo_address": Bool(
-            "Replies carry the id the request named (RRC: 0xFE for a broadcast read), not the answering device's own."
+            "Replies carry the id the request named (RRC: 0xFE for a broadcast read), not the answering device's own.",
+            default=False,
         ),
         "commands": MapOf(DEVICE_COMMAND, "Command (or command.subcommand) -> behaviour; others just answer."),
         "kinds": MapOf(
@@ -579,10 +679,11 @@ DEVICE = Obj(
                     "description": TEXT,
                     "address": Str("The request field holding this kind's id."),
                     "ids": ListOf(Int(), "The ids the simulator creates (fixed by the hardware, not by --id)."),
-                    "broadcast": Int("The id every device of this kind obeys."),
+                    "broadcast": Int("The id every device of this kind obeys.", example=255),
                     "state": MapOf(Num(), "State variables of each device of this kind -> initial value."),
                 },
                 required=("address", "ids"),
+                description="One further kind of device: the field with its id, its ids and its state.",
             ),
             "Further kinds of device behind the same port, each with its own ids (a board's PWM servo ports, its "
             "motors); a command names its kind with `kind:`. The devices --id creates are the default kind.",
@@ -594,32 +695,45 @@ DEVICE = Obj(
 SPEC = Obj(
     {
         "protocol": Str("Python package name of the generated code."),
-        "title": TEXT,
+        "title": TITLE,
         "description": TEXT,
         "sources": MapOf(Str(), "Document id -> what it is."),
-        "byte_order": Str(choices=("little", "big")),
+        "byte_order": Str(
+            "Byte order of every multi-byte value, unless a field's `endian` says otherwise.", choices=("little", "big")
+        ),
         "serial": Obj(
             {
                 "baudrate": Int("Bits per second.", minimum=1),
-                "bytesize": Int("Data bits per character.", minimum=5, maximum=8),
-                "parity": Str(choices=("none", "even", "odd")),
-                "stopbits": Num(choices=(1, 1.5, 2)),
+                "bytesize": Int("Data bits per character.", default=8, minimum=5, maximum=8),
+                "parity": Str("Parity bit.", choices=("none", "even", "odd"), default="none"),
+                "stopbits": Num("Stop bits.", default=1, choices=(1, 1.5, 2)),
                 "notes": TEXT,
             },
             required=("baudrate",),
+            description="The serial line's settings: what clients, simulators and `monitor` open a port with.",
         ),
-        "framing": Obj({"elements": MapOf(FRAME_ELEMENT), "description": TEXT}, required=("elements",)),
+        "framing": Obj(
+            {
+                "elements": MapOf(FRAME_ELEMENT, "The frame's elements in wire order: name -> element."),
+                "description": TEXT,
+            },
+            required=("elements",),
+            description="The frame every command travels in.",
+        ),
         "matching": Obj(
-            {"by": ListOf(Str()), "description": TEXT},
+            {
+                "by": ListOf(Str(), "What a reply shares with its request: `command` and field names (servo_id)."),
+                "description": TEXT,
+            },
             description="How a reply is matched to its request.",
         ),
         "fields": FIELDS,
-        "enums": MapOf(ENUM),
-        "flags": MapOf(FLAGS),
-        "tables": MapOf(TABLE),
-        "commands": MapOf(COMMAND),
-        "examples": MapOf(EXAMPLE),
-        "errata": MapOf(ERRATUM),
+        "enums": MapOf(ENUM, "Value sets: name -> enum; fields refer to them with `enum:`."),
+        "flags": MapOf(FLAGS, "Bit sets: name -> flags; fields refer to them with `flags:`."),
+        "tables": MapOf(TABLE, "Parameter or register tables: name -> table."),
+        "commands": MapOf(COMMAND, "The protocol's commands: name -> command."),
+        "examples": MapOf(EXAMPLE, "Frames printed in the documents, each decoded and encoded by the tests."),
+        "errata": MapOf(ERRATUM, "Mistakes in the documents, each pinned by a test."),
         "device": DEVICE,
     },
     required=("protocol", "title", "byte_order", "serial", "framing", "commands"),

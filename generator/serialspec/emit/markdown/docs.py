@@ -41,8 +41,9 @@ def cell(value: object) -> str:
     return text(str(value)).replace("|", "\\|") or " "
 
 
-def code(value: str) -> str:
-    """Spec text as an inline code span, whatever backticks it holds (the fence is longer than any run inside)."""
+def code_span(value: str) -> str:
+    """Text shown as printed (an erratum's quote of a document): a code span, so nothing in it is markup, whatever
+    backticks it holds (the fence is longer than any run of them inside)."""
     value = collapse(value)
     runs = [len(run) for run in "".join(c if c == "`" else " " for c in value).split()]
     fence = "`" * (max(runs, default=0) + 1)
@@ -75,6 +76,18 @@ def type_name(f: Field) -> str:
     return f"block of [{f.table.title}](#table-{anchor(f.table.name)})"
 
 
+def value_range(minimum: float, maximum: float, is_float: bool, type_min: float, type_max: float) -> str:
+    """A range as people read it: `any` for a float's whole range, never a 39-digit number."""
+    if is_float and (minimum, maximum) == (type_min, type_max):
+        return "any"
+    show = (lambda v: f"{v:g}") if is_float else number
+    return f"{show(minimum)}..{show(maximum)}"
+
+
+def scalar_range(type_: Any, minimum: float, maximum: float) -> str:
+    return value_range(minimum, maximum, type_.is_float, type_.minimum, type_.maximum)
+
+
 def range_text(f: Field) -> str:
     if isinstance(f, Scalar):
         if f.const is not None:
@@ -85,9 +98,9 @@ def range_text(f: Field) -> str:
             )
         if f.bits:
             return ""
-        return f"{number(f.minimum)}..{number(f.maximum)}"
+        return scalar_range(f.type, f.minimum, f.maximum)
     if isinstance(f, Array):
-        return f"{number(f.minimum)}..{number(f.maximum)}"
+        return scalar_range(f.item, f.minimum, f.maximum)
     return ""
 
 
@@ -135,7 +148,7 @@ def field_rows(fields: tuple[Field, ...], start: int | None, prefix: str = "") -
                     f"{prefix}{f.name}.{e.name}",
                     e.type.name,
                     e.unit,
-                    f"{number(e.minimum)}..{number(e.maximum)}",
+                    scalar_range(e.type, e.minimum, e.maximum),
                     f"{f.table.key_name} {e.key}: {e.description}",
                 )
                 for e in f.entries
@@ -149,11 +162,7 @@ def message_context(protocol: Protocol, message: Message | None) -> dict[str, An
         return None
     layout = protocol.framing.layouts[message.direction]
     content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
-    size = (
-        str(message.min_size)
-        if message.min_size == message.max_size
-        else f"{message.min_size}..{message.max_size if message.max_size is not None else ''}"
-    )
+    size = size_text(message.min_size, message.max_size, content_limit(layout))
     rows = [
         Row(str(layout.offsets[e.name]), e.name, e.type.name if e.type else "", "", "", text(e.description))
         for e in layout.value_elements
@@ -169,6 +178,20 @@ def message_context(protocol: Protocol, message: Message | None) -> dict[str, An
         "reply": reply_text(message),
         "description": text(message.description),
     }
+
+
+def content_limit(layout: FrameLayout) -> int | None:
+    """The most content bytes the frame's length element can count (None: no length element)."""
+    length = next((e for e in layout.elements if e.role == "length" and e.type is not None), None)
+    return None if length is None or length.type is None else (1 << 8 * length.type.size) - 1 - layout.length_adds
+
+
+def size_text(low: int, high: int | None, limit: int | None) -> str:
+    if limit is not None and (high is None or high > limit):
+        high = limit
+    if high == low:
+        return f"{low} byte" + ("" if low == 1 else "s")
+    return f"{low}..{high} bytes" if high is not None else f"{low} bytes or more"
 
 
 def reply_text(message: Message) -> str:
@@ -192,9 +215,9 @@ def command_context(protocol: Protocol, command: Command) -> dict[str, Any]:
                 "description": text(sub.description),
                 "source": text(sub.source),
                 "anchor": anchor("command", command.name, sub.name),
-                "messages": [
-                    m for m in (message_context(protocol, sub.request), message_context(protocol, sub.response)) if m
-                ],
+                "messages": same_once(
+                    [m for m in (message_context(protocol, sub.request), message_context(protocol, sub.response)) if m]
+                ),
                 "examples": examples_for(protocol, command.name, sub.name),
             }
         )
@@ -207,32 +230,56 @@ def command_context(protocol: Protocol, command: Command) -> dict[str, Any]:
         "broadcast": text(command.broadcast),
         "source": text(command.source),
         "anchor": anchor("command", command.name),
-        "messages": [
-            m for m in (message_context(protocol, command.request), message_context(protocol, command.response)) if m
-        ],
+        "messages": same_once(
+            [m for m in (message_context(protocol, command.request), message_context(protocol, command.response)) if m]
+        ),
         "subcommands": subs,
         "examples": examples_for(protocol, command.name, None),
     }
+
+
+def same_once(parts: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """A request and a response (or two frames) that read exactly alike are shown once, for both directions."""
+    if len(parts) == 2 and {**parts[0], "direction": ""} == {**parts[1], "direction": ""}:
+        return [{**parts[0], "direction": f"{parts[0]['direction']} and {parts[1]['direction']}"}]
+    return parts
 
 
 def examples_for(protocol: Protocol, command: str, subcommand: str | None) -> list[str]:
     return [e.name for e in protocol.examples if (e.command, e.subcommand) == (command, subcommand)]
 
 
+def frame_picture(protocol: Protocol) -> list[str]:
+    """The frame of each direction on one line, columns aligned: `12 4C | cmd_id | length | content (n) | checksum`."""
+    lines = []
+    for layout in protocol.framing.layouts.values():
+        parts = []
+        for e in layout.elements:
+            if e.role == "header":
+                parts.append(layout.header.hex(" ").upper())
+            elif e.role == "content":
+                parts.append(f"{e.name} (n bytes)")
+            else:
+                parts.append(e.name + (f" ({e.type.size} bytes)" if e.type and e.type.size > 1 else ""))
+        lines.append((layout.direction.value, parts))
+    columns = max(len(parts) for _, parts in lines)
+    widths = [max(len(p[i]) for _, p in lines if i < len(p)) for i in range(columns)]
+    return [
+        f"{direction:<9} " + " | ".join(part.ljust(widths[i]) for i, part in enumerate(parts)).rstrip()
+        for direction, parts in lines
+    ]
+
+
 def frame_context(protocol: Protocol, layout: FrameLayout) -> dict[str, Any]:
     rows = []
-    packet = []
     offset = 0
     for e in layout.elements:
         size = e.size
-        if e.role == "header":
-            description = f"{layout.header.hex(' ').upper()} — {e.description}"
-        elif e.role == "length":
-            adds = f" + {layout.length_adds}" if layout.length_adds else ""
-            description = f"n{adds}, where n is the number of content bytes. {e.description}"
-        else:
-            description = e.description
-        label = "content (n bytes)" if e.role == "content" else e.name
+        header = e.role == "header"
+        description = f"{layout.header.hex(' ').upper()} — {e.description}" if header else e.description
+        kind = e.type.name if e.type else ("bytes" if e.role == "header" else "n bytes")
+        if e.role == "length":
+            kind += f" = n + {layout.length_adds}" if layout.length_adds else " = n"
         where = f"{offset}.." if size is None else (str(offset) if size == 1 else f"{offset}..{offset + size - 1}")
         if e.role in ("checksum",) or (offset is None):
             where = "last" if e.role == "checksum" else where
@@ -241,14 +288,12 @@ def frame_context(protocol: Protocol, layout: FrameLayout) -> dict[str, Any]:
                 "offset": cell(where),
                 "name": cell(e.name),
                 "role": e.role,
-                "type": cell(e.type.name if e.type else ("bytes" if e.role == "header" else "n bytes")),
+                "type": cell(kind),
                 "meaning": cell(description),
             }
         )
-        width = (size or 4) * 8
-        packet.append(f'{offset * 8}-{offset * 8 + width - 1}: "{label}"')
-        offset += size or 4
-    return {"direction": layout.direction.value, "rows": rows, "packet": packet}
+        offset += size or 0
+    return {"direction": layout.direction.value, "rows": rows}
 
 
 def checksum_context(protocol: Protocol) -> dict[str, Any]:
@@ -378,7 +423,7 @@ def emit_docs(protocol: Protocol) -> str:
             "direction": e.direction.value,
             "command": e.command + (f".{e.subcommand}" if e.subcommand else ""),
             "anchor": anchor("command", e.command, e.subcommand or ""),
-            "printed": code(e.printed),
+            "printed": code_span(e.printed),
             "frame": e.frame.hex(" ").upper(),
             "erratum": e.erratum,
             "rows": breakdown(protocol, e),
@@ -393,18 +438,15 @@ def emit_docs(protocol: Protocol) -> str:
             "key": t.key_name,
             "description": text(t.description),
             "source": text(t.source),
-            "has_memory": any(e.memory for e in t.entries),
             "rows": [
                 {
                     "key": f"{e.key}" if t.key_name != "address" else f"{e.key:#04x}",
-                    "name": cell("(reserved)" if e.reserved else e.name),
-                    "name_cn": cell(e.name_cn),
-                    "type": e.type.name + sign_note(e),
-                    "unit": cell(e.unit),
-                    "range": f"{number(e.minimum)}..{number(e.maximum)}",
+                    "name": cell("(reserved)" if e.reserved else e.name)
+                    + (f"<br>{cell(e.name_cn)}" if e.name_cn else ""),
+                    "type": e.type.name + sign_note(e) + (f", {cell(e.unit)}" if e.unit else ""),
+                    "range": scalar_range(e.type, e.minimum, e.maximum),
                     "default": cell("" if e.default is None else e.default),
-                    "access": e.access,
-                    "memory": e.memory,
+                    "access": e.access + (f", {e.memory}" if e.memory else ""),
                     "meaning": cell(
                         e.description
                         + (f" Values: [{e.enum.class_name}](#enum-{anchor(e.enum.name)})." if e.enum else "")
@@ -420,8 +462,8 @@ def emit_docs(protocol: Protocol) -> str:
             "name": e.name,
             "class_name": e.class_name,
             "anchor": anchor("enum", e.name),
-            "description": text(e.description),
-            "values": [{"value": v.value, "name": v.name.lower(), "text": cell(v.text)} for v in e.values],
+            "description": text(e.description) or used_by(protocol, e),
+            "values": [{"value": v.value, "name": v.name.lower(), "text": cell(v.text) or "—"} for v in e.values],
         }
         for e in protocol.enums
     ]
@@ -430,8 +472,8 @@ def emit_docs(protocol: Protocol) -> str:
             "name": f.name,
             "class_name": f.class_name,
             "anchor": anchor("flags", f.name),
-            "description": text(f.description),
-            "bits": [{"bit": b.bit, "name": b.name.lower(), "text": cell(b.text)} for b in f.bits],
+            "description": text(f.description) or used_by(protocol, f),
+            "bits": [{"bit": b.bit, "name": b.name.lower(), "text": cell(b.text) or "—"} for b in f.bits],
         }
         for f in protocol.flags
     ]
@@ -439,7 +481,7 @@ def emit_docs(protocol: Protocol) -> str:
         {
             "name": e.name,
             "source": text(e.source),
-            "printed": cell(e.printed),
+            "printed": code_span(e.printed),
             "correct": text(e.correct),
             "check": e.check.kind,
         }
@@ -462,7 +504,8 @@ def emit_docs(protocol: Protocol) -> str:
         ],
         serial_notes=text(serial.notes),
         framing=text(protocol.framing.description),
-        frames=[frame_context(protocol, layout) for layout in protocol.framing.layouts.values()],
+        frames=same_once([frame_context(protocol, layout) for layout in protocol.framing.layouts.values()]),
+        frame_picture=frame_picture(protocol),
         shared_header=protocol.framing.shared_header,
         checksum=checksum_context(protocol),
         matching=", ".join(protocol.matching),
@@ -474,6 +517,20 @@ def emit_docs(protocol: Protocol) -> str:
         examples=examples,
         errata=errata,
     )
+
+
+def used_by(protocol: Protocol, values: Any) -> str:
+    """Where an enum or flag set is used, for one that has no description of its own."""
+    users = dict.fromkeys(
+        [
+            f"`{m.key}` {m.direction.value} `{f.name}`"
+            for m in protocol.messages()
+            for f in m.fields
+            if isinstance(f, Scalar) and values in (f.enum, f.flags)
+        ]
+        + [f"`{t.name}` entry `{e.name}`" for t in protocol.tables for e in t.entries if values in (e.enum, e.flags)]
+    )
+    return ("Values of " + ", ".join(users) + ".") if users else ""
 
 
 def sign_note(entry: TableEntry) -> str:

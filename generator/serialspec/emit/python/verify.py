@@ -2,80 +2,20 @@
 
 `generate` and `check` report an example that does not decode to its recorded values (or whose values do not encode
 back to its bytes), and an erratum whose check does not hold, as spec errors at the example's or check's line.
-The package is imported from the generated text in memory; any package of the same name already imported (the
-committed one, in tests) is set aside meanwhile and put back.
+The package is imported from the generated text in memory (serialspec.emit.python.memory).
 """
 
 from __future__ import annotations
 
-import importlib
-import importlib.abc
-import importlib.machinery
-import importlib.util
-import sys
-from collections.abc import Iterator, Sequence
-from contextlib import contextmanager
 from types import ModuleType
 from typing import Any
 
+from serialspec.emit.python.memory import imported
 from serialspec.runtime.checksums import crc_function
 from serialspec.runtime.errors import SerialspecError
 from serialspec.runtime.hexbytes import parse_hex
 from serialspec.spec.errors import SpecError
 from serialspec.spec.model import Erratum, Example, Protocol
-
-
-class _Source(importlib.abc.Loader):
-    def __init__(self, source: str, filename: str) -> None:
-        self.source = source
-        self.filename = filename
-
-    def create_module(self, spec: importlib.machinery.ModuleSpec) -> ModuleType | None:
-        return None
-
-    def exec_module(self, module: ModuleType) -> None:
-        exec(compile(self.source, self.filename, "exec"), module.__dict__)
-
-
-class _Finder(importlib.abc.MetaPathFinder):
-    def __init__(self, package: str, files: dict[str, str]) -> None:
-        self.package = package
-        self.files = files
-
-    def find_spec(
-        self, fullname: str, path: Sequence[str] | None, target: ModuleType | None = None
-    ) -> importlib.machinery.ModuleSpec | None:
-        if fullname == self.package:
-            name, is_package = "__init__.py", True
-        elif fullname.startswith(self.package + ".") and fullname.count(".") == 1:
-            name, is_package = fullname.partition(".")[2] + ".py", False
-        else:
-            return None
-        if name not in self.files:
-            return None
-        loader = _Source(self.files[name], f"<generated {self.package}/{name}>")
-        return importlib.util.spec_from_loader(fullname, loader, is_package=is_package)
-
-
-def _ours(name: str, package: str) -> bool:
-    return name == package or name.startswith(package + ".")
-
-
-@contextmanager
-def imported(package: str, files: dict[str, str]) -> Iterator[ModuleType]:
-    """The package made of `files` (module file name -> text), imported for the duration of the block."""
-    saved = {name: module for name, module in sys.modules.items() if _ours(name, package)}
-    for name in saved:
-        del sys.modules[name]
-    finder = _Finder(package, files)
-    sys.meta_path.insert(0, finder)
-    try:
-        yield importlib.import_module(package)
-    finally:
-        sys.meta_path.remove(finder)
-        for name in [name for name in sys.modules if _ours(name, package)]:
-            del sys.modules[name]
-        sys.modules.update(saved)
 
 
 def _difference(found: dict[str, Any], recorded: dict[str, object]) -> str:
@@ -187,7 +127,7 @@ def verify(protocol: Protocol, files: dict[str, str]) -> list[SpecError]:
     if not protocol.examples and not protocol.errata:
         return []
     problems: list[SpecError] = []
-    with imported(protocol.name, files) as package:  # a package that does not import is a serialspec bug: raised
+    with imported(protocol.name, files, protocol.spec_path) as package:  # one that does not import: a bug, raised
         checker = _Checker(protocol, package)
         for example in protocol.examples:
             if wrong := checker.example(example):

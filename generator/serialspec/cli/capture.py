@@ -1,0 +1,70 @@
+"""The capture format `monitor --save` and `sim --tap` write and `decode --file` reads.
+
+A capture is UTF-8 text, one line per chunk of bytes as it was seen on the port:
+
+    # serialspec capture: fashionstar_uart
+    2026-11-22T09:40:01.123456+00:00 request 12 4c 01 01 03 63
+    2026-11-22T09:40:01.124013+00:00 response 05 1c 01 01 00 23
+
+Each line holds a timestamp (ISO 8601, UTC), the direction (`request`, `response`, or `-` where the bytes' direction
+is not known) and the raw bytes in hex. A chunk need not hold whole frames: `decode --file` joins each direction's
+bytes again and splits them into frames. Lines starting with `#` are comments; a line of hex alone is a chunk of
+unknown direction, so a file of frames in hex, one per line, is a capture too.
+"""
+
+from __future__ import annotations
+
+import datetime
+from collections.abc import Iterable, Iterator
+from dataclasses import dataclass
+from typing import TextIO
+
+from serialspec.runtime.hexbytes import parse_hex
+
+DIRECTIONS = ("request", "response", "-")
+
+
+@dataclass(frozen=True)
+class Chunk:
+    when: str  # the timestamp as written, "" when the line had none
+    direction: str | None  # "request", "response", or None when unknown
+    data: bytes
+
+
+def stamp(moment: float | None = None) -> str:
+    at = (
+        datetime.datetime.now(datetime.UTC) if moment is None else datetime.datetime.fromtimestamp(moment, datetime.UTC)
+    )
+    return at.isoformat(timespec="microseconds")
+
+
+class Writer:
+    """Appends chunks to a capture file as they are seen (flushed at once, so a capture survives a kill)."""
+
+    def __init__(self, stream: TextIO, protocol: str) -> None:
+        self.stream = stream
+        stream.write(f"# serialspec capture: {protocol}\n")
+        stream.flush()
+
+    def write(self, direction: str | None, data: bytes, moment: float | None = None) -> None:
+        if data:
+            self.stream.write(f"{stamp(moment)} {direction or '-'} {data.hex(' ')}\n")
+            self.stream.flush()
+
+
+def read(lines: Iterable[str]) -> Iterator[tuple[int, Chunk]]:
+    """(line number, chunk) for every line that holds bytes; raises ValueError naming a line that does not parse."""
+    for number, line in enumerate(lines, 1):
+        text = line.strip()
+        if not text or text.startswith("#"):
+            continue
+        words = text.split(maxsplit=2)
+        if len(words) == 3 and "T" in words[0] and words[1] in DIRECTIONS:
+            when, direction, rest = words
+        else:
+            when, direction, rest = "", "-", text
+        try:
+            data = parse_hex(rest)
+        except ValueError as exc:
+            raise ValueError(f"line {number}: {exc}") from None
+        yield number, Chunk(when, None if direction == "-" else direction, data)

@@ -1,0 +1,145 @@
+"""Splitting the bytes seen on a port into frames of both directions, for `monitor` and `decode --file`.
+
+Where requests and responses have different headers the generated StreamParser takes both at once. Where they
+share one (RRC, SMS) a frame is tried as both: after a request, first as its reply (a reply that names the same
+device as the request), otherwise first as a request; so a session's requests and replies are told apart.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from types import ModuleType
+from typing import Any
+
+from serialspec.runtime.errors import DecodeError
+from serialspec.runtime.message import Message
+from serialspec.runtime.stream import FrameFormat
+
+
+@dataclass(frozen=True)
+class Seen:
+    """What a chunk of bytes held: a frame (message and bytes), or bad bytes (message None) with a reason."""
+
+    message: Message | None
+    data: bytes
+    reason: str = ""
+
+
+class Frames:
+    def __init__(self, package: ModuleType, direction: str | None, address: str | None = None) -> None:
+        self.package = package
+        self.address = address
+        self._paired: _Paired | None = None
+        try:
+            self._parser: Any = package.StreamParser(direction)
+        except ValueError:
+            codec = package.codec
+            self._paired = _Paired(codec.REQUEST_FORMAT, codec.RESPONSE_FORMAT, address)
+            self._parser = self._paired
+        self._after_error = False
+
+    def feed(self, chunk: bytes) -> list[Seen]:
+        errors, garbage = self._parser.errors, self._parser.garbage
+        if self._paired is not None:
+            seen = [Seen(message, data) for message, data in self._paired.feed(chunk)]
+        else:
+            seen = [Seen(message, self.package.encode(message)) for message in self._parser.feed(chunk)]
+        if self._parser.errors > errors:
+            self._after_error = True  # the rest of a bad frame is skipped as garbage: not reported twice
+            count = self._parser.errors - errors
+            seen.append(Seen(None, chunk, f"{count} frame(s) failed their checksum or content check"))
+        elif self._parser.garbage > garbage and not self._after_error:
+            seen.append(Seen(None, chunk, f"{self._parser.garbage - garbage} byte(s) outside any frame"))
+        else:
+            self._after_error = False
+        return seen
+
+    def pending(self) -> bytes:
+        return self._paired.buffer if self._paired is not None else bytes(self._parser.pending())
+
+
+class _Direction:
+    """One direction's frame format as the pairing splitter reads it: the frame size a header position implies."""
+
+    def __init__(self, frame_format: FrameFormat) -> None:
+        self.format = frame_format
+        self.prefix = max(frame_format.length_offset, frame_format.command_offset or 0) + 1  # bytes to size a frame
+
+    def size(self, buffer: bytes, position: int) -> int | None:
+        """The frame's size if the bytes at `position` start a plausible frame (known command, fitting length)."""
+        f = self.format
+        content = buffer[position + f.length_offset] - f.length_adds
+        code = None if f.command_offset is None else buffer[position + f.command_offset]
+        bounds = f.content_sizes.get(code)
+        if bounds is None or content < bounds[0] or (bounds[1] is not None and content > bounds[1]):
+            return None
+        return f.overhead + content
+
+
+class _Paired:
+    """Both directions of a shared-header protocol in one stream, requests paired with their replies."""
+
+    def __init__(self, request: FrameFormat, response: FrameFormat, address: str | None) -> None:
+        self.request, self.response = _Direction(request), _Direction(response)
+        self.header = request.header
+        self.address = address
+        self.buffer = b""
+        self.awaiting: Message | None = None  # the last request, until a reply comes
+        self.errors = 0
+        self.garbage = 0
+
+    def feed(self, data: bytes) -> list[tuple[Message, bytes]]:
+        buffer = self.buffer + data
+        found: list[tuple[Message, bytes]] = []
+        start = 0
+        while True:
+            position = buffer.find(self.header, start)
+            if position < 0:
+                cut = max(start, len(buffer) - len(self.header) + 1)
+                self.garbage += cut - start
+                self.buffer = buffer[cut:]
+                return found
+            self.garbage += position - start
+            result = self._frame(buffer, position)
+            if isinstance(result, str):  # "wait": plausible so far, incomplete
+                self.buffer = buffer[position:]
+                return found
+            if result is None:
+                start = position + 1
+                self.garbage += 1
+                continue
+            message, stop = result
+            found.append((message, buffer[position:stop]))
+            self.awaiting = message if message.DIRECTION.value == "request" else None
+            start = stop
+
+    def _frame(self, buffer: bytes, position: int) -> tuple[Message, int] | str | None:
+        order = (self.response, self.request) if self.awaiting is not None else (self.request, self.response)
+        failed = False
+        fallback: tuple[Message, int] | None = None
+        for candidate in order:
+            if len(buffer) - position < candidate.prefix:
+                return "wait"
+            size = candidate.size(buffer, position)
+            if size is None:
+                continue
+            if position + size > len(buffer):
+                return "wait"
+            try:
+                message = candidate.format.decode_at(buffer, position, position + size)
+            except DecodeError:
+                failed = True
+                continue
+            if candidate is self.response and not self._answers(message):
+                fallback = fallback or (message, position + size)
+                continue
+            return message, position + size
+        if fallback is None and failed:
+            self.errors += 1
+        return fallback
+
+    def _answers(self, reply: Message) -> bool:
+        if self.awaiting is None or not self.address:
+            return True
+        asked, answered = self.awaiting.to_fields().get(self.address), reply.to_fields().get(self.address)
+        return asked is None or answered is None or asked == answered

@@ -1,0 +1,113 @@
+"""The README's and the tutorial's commands run as printed and print what the pages say they print."""
+
+from __future__ import annotations
+
+import os
+import re
+import shlex
+import shutil
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+TUTORIAL = ROOT / "docs" / "tutorial.md"
+TINYLAMP = ROOT / "examples" / "tinylamp" / "tinylamp.yaml"
+PRINTED_PORT = "/dev/pts/5"
+SERVERS = ("sim", "monitor")  # run until stopped: their sessions are checked below and in test_readme.py
+
+
+def blocks(page: Path, language: str) -> list[str]:
+    return re.findall(rf"```{language}\n(.*?)```", page.read_text(encoding="utf-8"), flags=re.S)
+
+
+def commands(page: Path) -> list[tuple[str, list[str]]]:
+    """Every `$ command` of the page's console blocks with the lines printed after it."""
+    found: list[tuple[str, list[str]]] = []
+    for block in blocks(page, "console"):
+        current: list[tuple[str, list[str]]] = []
+        for line in block.splitlines():
+            if line.startswith("$ "):
+                current.append((line[2:], []))
+            elif current:
+                current[-1][1].append(line)
+        found += current
+    return found
+
+
+def run(command: str, cwd: Path) -> list[str]:
+    env = dict(os.environ, PATH=f"{Path(sys.executable).parent}{os.pathsep}{os.environ.get('PATH', '')}")
+    result = subprocess.run(shlex.split(command), cwd=cwd, env=env, capture_output=True, text=True)
+    assert "Traceback" not in result.stderr, result.stderr
+    return (result.stdout + result.stderr).splitlines()
+
+
+def check_page(page: Path, cwd: Path) -> int:
+    ran = 0
+    for command, printed in commands(page):
+        program = shlex.split(command)
+        if program[1] in SERVERS:
+            continue
+        assert run(command, cwd) == printed, command
+        ran += 1
+    return ran
+
+
+def test_the_readme_commands_print_what_the_readme_shows() -> None:
+    assert check_page(ROOT / "README.md", ROOT) >= 4
+    for command, _ in commands(ROOT / "README.md"):
+        assert command.startswith(".venv/bin/serialspec "), "README commands work right after `make generate`"
+
+
+def test_every_yaml_block_of_the_tutorial_is_part_of_its_spec() -> None:
+    spec = TINYLAMP.read_text(encoding="utf-8")
+    yaml_blocks = blocks(TUTORIAL, "yaml")
+    assert len(yaml_blocks) >= 4
+    for block in yaml_blocks:
+        assert block in spec, block[:60]
+
+
+def test_the_tutorial_commands_and_client_session_run_as_printed(tmp_path: Path) -> None:
+    shutil.copy(TINYLAMP, tmp_path / "tinylamp.yaml")
+    assert check_page(TUTORIAL, tmp_path) >= 5
+    sim = next(c for c, _ in commands(TUTORIAL) if shlex.split(c)[1] == "sim")
+    env = dict(os.environ, PATH=f"{Path(sys.executable).parent}{os.pathsep}{os.environ.get('PATH', '')}")
+    process = subprocess.Popen(
+        shlex.split(sim), cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+    )
+    try:
+        assert process.stdout is not None
+        port = process.stdout.readline().strip()
+        session = next(b for b in blocks(TUTORIAL, "python") if PRINTED_PORT in b)
+        result = subprocess.run(
+            [sys.executable, "-c", session.replace(PRINTED_PORT, port)], cwd=tmp_path, capture_output=True, text=True
+        )
+    finally:
+        process.send_signal(signal.SIGTERM)
+        process.wait(5)
+    assert result.stdout.splitlines() == ["True False", "80"]
+    assert "RangeError: set_brightness request: brightness = 300 is outside its range 0..100" in result.stderr
+    replay = run(f"serialspec decode tinylamp.yaml --file {tmp_path / 'session.capture'}", tmp_path)
+    assert sum("tinylamp response" in line for line in replay) == 3
+
+
+@pytest.mark.parametrize("page", ["README.md", "docs/tutorial.md"])
+def test_the_pages_link_only_to_files_that_exist(page: str) -> None:
+    path = ROOT / page
+    for target in re.findall(r"\]\(([^)#:]+)(?:#[^)]*)?\)", path.read_text(encoding="utf-8")):
+        assert (path.parent / target).exists(), target
+
+
+def test_the_documentation_site_builds_strictly(tmp_path: Path) -> None:
+    # mkdocs in strict mode: a broken link or anchor fails the build (tools/docsite.py; `make docs`)
+    result = subprocess.run(
+        [sys.executable, str(ROOT / "tools" / "docsite.py"), str(tmp_path / "site")], capture_output=True, text=True
+    )
+    assert result.returncode == 0, result.stderr
+    built = {p.relative_to(tmp_path / "site").as_posix() for p in (tmp_path / "site").rglob("*.html")}
+    assert {"index.html", "tutorial.html", "language.html", "protocols/feetech_sms.html"} <= built
+    index = (tmp_path / "site" / "index.html").read_text(encoding="utf-8")
+    assert 'href="protocols/feetech_sms.html"' in index and 'href="tutorial.html"' in index

@@ -40,7 +40,7 @@ class FrameFormat:
 class _Candidate:
     """A FrameFormat as the scanning loop reads it: the size of every plausible frame, by command and length byte."""
 
-    __slots__ = ("header", "prefix", "command_offset", "length_offset", "frame_sizes", "decode", "ranges")
+    __slots__ = ("header", "prefix", "command_offset", "length_offset", "frame_sizes", "decode", "ranges", "byte")
 
     def __init__(self, frame_format: FrameFormat) -> None:
         self.header = frame_format.header
@@ -53,7 +53,14 @@ class _Candidate:
             )
             + 1
         )
+        # The usual case, one unsigned byte (an address 0..253 with broadcast 254), is checked inline by the scanning
+        # loop as (offset, low, high, also); any other ranges go through _in_range.
+        self.byte = (-1, 0, 0, -1)
         self.ranges = frame_format.value_ranges
+        if len(self.ranges) == 1 and self.ranges[0][1] == 1 and not self.ranges[0][3]:
+            offset, _, _, _, lowest, highest, broadcast = self.ranges[0]
+            self.byte = (offset, lowest, highest, -1 if broadcast is None else broadcast)
+            self.ranges = ()
         self.command_offset = frame_format.command_offset
         self.length_offset = frame_format.length_offset
         self.decode = frame_format.decode_at
@@ -101,6 +108,7 @@ class StreamParser:
             current.length_offset,
         )
         frame_sizes, decode, ranges = current.frame_sizes, current.decode, current.ranges
+        byte_offset, byte_low, byte_high, byte_also = current.byte
         garbage = errors = start = 0
         while True:
             if single:
@@ -114,6 +122,7 @@ class StreamParser:
                     current.length_offset,
                 )
                 frame_sizes, decode, ranges = current.frame_sizes, current.decode, current.ranges
+                byte_offset, byte_low, byte_high, byte_also = current.byte
             if position < 0:
                 cut = max(start, end - self._keep)
                 garbage += cut - start
@@ -127,7 +136,15 @@ class StreamParser:
                 size = frame_sizes.get(buffer[position + length_offset])
             else:
                 size = frame_sizes.get(buffer[position + command_offset] << 8 | buffer[position + length_offset])
-            if size is None or (ranges and not _in_range(buffer, position, ranges)):
+            if (
+                size is None
+                or (
+                    byte_offset >= 0
+                    and not byte_low <= buffer[position + byte_offset] <= byte_high
+                    and buffer[position + byte_offset] != byte_also
+                )
+                or (ranges and not _in_range(buffer, position, ranges))
+            ):
                 # implausible (unknown command, a content size it never has, a value out of range): no frame start
                 start = position + 1
                 garbage += 1
@@ -165,7 +182,12 @@ class StreamParser:
             else:
                 key = buffer[position + candidate.command_offset] << 8 | buffer[position + candidate.length_offset]
                 size = candidate.frame_sizes.get(key)
-            plausible = size is not None and (not candidate.ranges or _in_range(buffer, position, candidate.ranges))
+            offset, low, high, also = candidate.byte
+            plausible = (
+                size is not None
+                and (offset < 0 or low <= buffer[position + offset] <= high or buffer[position + offset] == also)
+                and (not candidate.ranges or _in_range(buffer, position, candidate.ranges))
+            )
             if plausible and size is not None and position + size <= end:
                 try:
                     candidate.decode(buffer, position, position + size)

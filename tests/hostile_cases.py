@@ -805,6 +805,18 @@ CASES: list[tuple[str, str, Mutation | Text, str | None]] = [
         "commands.move.request.fields.to_fields: field name 'to_fields' is reserved (a Python keyword or a name generated code uses)",
     ),
     (
+        "field named isinstance",
+        "tiny",
+        rename("commands/move/request/fields/mode", "isinstance"),
+        "commands.move.request.fields.isinstance: field name 'isinstance' is reserved (a Python keyword or a name generated code uses)",
+    ),
+    (
+        "field named len",
+        "tiny",
+        rename("commands/move/request/fields/mode", "len"),
+        "commands.move.request.fields.len: field name 'len' is reserved (a Python keyword or a name generated code uses)",
+    ),
+    (
         "field named reply",
         "tiny",
         rename("commands/move/request/fields/mode", "reply"),

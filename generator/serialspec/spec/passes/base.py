@@ -36,8 +36,36 @@ LABEL = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
 
 # Attribute and parameter names the generated classes and methods use themselves.
 RESERVED_NAMES = frozenset({"to_fields", "from_fields", "self"})
-# A field is also a parameter of a client method, whose body has these locals.
-RESERVED_FIELD_NAMES = RESERVED_NAMES | {"request", "reply", "replies"}
+# A field is also a parameter of a client method, whose body has these locals and calls these builtins (a parameter
+# of the same name would shadow them); `id`, a usual address field, is a builtin generated code never calls.
+RESERVED_FIELD_NAMES = (
+    RESERVED_NAMES
+    | {"request", "reply", "replies"}
+    | {
+        "any",
+        "bool",
+        "bytearray",
+        "bytes",
+        "classmethod",
+        "dict",
+        "float",
+        "frozenset",
+        "getattr",
+        "hasattr",
+        "int",
+        "isinstance",
+        "iter",
+        "len",
+        "list",
+        "next",
+        "object",
+        "str",
+        "sum",
+        "super",
+        "tuple",
+        "type",
+    }
+)
 # Names the generated modules (messages, codec, client, simulator, registers, __init__) import or define next to
 # the classes a spec names, and Python's capitalised builtins: a generated class of the same name would shadow one.
 GENERATED_CLASS_NAMES = frozenset(

@@ -15,7 +15,7 @@ from typing import Any
 
 import serial
 from serialspec.runtime.errors import EncodeError, Timeout
-from serialspec.runtime.transport import Binding, Bus, ClientBase
+from serialspec.runtime.transport import Binding, Bus, ClientBase, table_key
 
 from fashionstar_uart import MATCH_BY, SERIAL
 from fashionstar_uart.codec import StreamParser, encode
@@ -272,20 +272,13 @@ class FashionstarUartClient(ClientBase):
 
     def read_parameter(self, servo_id: int, name: str) -> int | float:
         """Read one entry of servo parameters by data_id by name, e.g. `read_parameter(1, 'voltage')`."""
-        return self.read_data(servo_id, _key(PARAMETERS, name))
+        return self.read_data(servo_id, table_key(PARAMETERS, name))
 
     def write_parameter(self, servo_id: int, name: str, value: int | float) -> Any:
         """Write one entry of servo parameters by data_id by name; read-only entries are refused before sending."""
         if name in PARAMETERS_READ_ONLY:
             raise EncodeError(f"{name} is read-only")
-        return self.write_data(servo_id, _key(PARAMETERS, name), value)
+        return self.write_data(servo_id, table_key(PARAMETERS, name), value)
 
     def _read_key(self, address: int, key: int) -> float:
         return self.read_data(address, key)
-
-
-def _key(table: dict[str, int], name: str) -> int:
-    try:
-        return table[name]
-    except KeyError:
-        raise EncodeError(f"unknown entry {name!r} (expected one of {', '.join(table)})") from None

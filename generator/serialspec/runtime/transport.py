@@ -19,12 +19,12 @@ from collections import deque
 from collections.abc import Callable, Iterator
 from contextlib import suppress
 from dataclasses import dataclass, field
-from enum import IntFlag
+from enum import IntEnum, IntFlag
 from typing import Any, TypeVar
 
 import serial
 
-from serialspec.runtime.errors import CorruptReply, DeviceError, PortError, Timeout
+from serialspec.runtime.errors import CorruptReply, DeviceError, EncodeError, PortError, Timeout
 from serialspec.runtime.message import Message
 from serialspec.runtime.stream import StreamParser
 
@@ -69,6 +69,24 @@ class Binding:
     match_by: tuple[str, ...]  # `command`, `subcommand` or field names, from the spec's `matching.by`
     status: tuple[str, ...] = ()  # reply fields whose non-zero value is a device error (frame status elements)
     describe_status: Callable[[str, int], str] = field(default=lambda name, value: f"{name} = {value:#04x}")
+
+
+def check_status(request: Message, reply: Message, name: str, ok: int, match_by: tuple[str, ...]) -> None:
+    """A reply whose status field (the spec's `status: {ok: N}`) does not hold N is a device error."""
+    value = getattr(reply, name)
+    if value != ok:
+        shown = f"{value.name.lower()} ({int(value)})" if isinstance(value, IntEnum) else str(value)
+        command = ".".join(part for part in (reply.COMMAND, reply.SUBCOMMAND) if part)
+        ids = " ".join(f"{n}={getattr(request, n)}" for n in match_by if hasattr(request, n))
+        raise DeviceError(f"{command}{' to ' + ids if ids else ''}: the device reports {name} = {shown}", reply)
+
+
+def table_key(table: dict[str, int], name: str) -> int:
+    """The key of a table entry given by name (a client's parameters by name)."""
+    try:
+        return table[name]
+    except KeyError:
+        raise EncodeError(f"unknown entry {name!r} (expected one of {', '.join(table)})") from None
 
 
 def flag_names(flags: dict[str, type[IntFlag]]) -> Callable[[str, int], str]:

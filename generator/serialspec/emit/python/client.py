@@ -454,13 +454,19 @@ def client_module(protocol: Protocol) -> str:
         error_imports=[
             name
             for name, used in (
-                ("DeviceError", any(m["statuses"] for m in everything)),
                 ("EncodeError", bool(tables) or any(r["kind"] != "write" for r in registers)),
                 ("Timeout", any(m["kind"] == "bool" for m in everything)),
             )
             if used
         ],
-        uses_status=any(m["statuses"] for m in everything),
+        transport_imports=[
+            "Binding",
+            "Bus",
+            "ClientBase",
+            *(["check_status"] if any(m["statuses"] for m in everything) else []),
+            *(["flag_names"] if status_flags(protocol) else []),
+            *(["table_key"] if tables else []),
+        ],
         abc_imports=sorted(
             {
                 *(["Callable", "Iterator"] if reports else []),

@@ -1095,8 +1095,8 @@ CASES: list[tuple[str, str, Mutation | Text, str | None]] = [
     (
         "erratum decodes otherwise",
         "feetech",
-        put("errata/ping_broadcast_prose/check/fields", {"id": 2}),
-        "errata.ping_broadcast_prose.check: the frame decodes to other values: id is 1, not 2",
+        put("errata/write_length_formula/check/fields", {"id": 2, "address": 0x2A, "data": "00 08 00 00 e8 03"}),
+        "errata.write_length_formula.check: the frame decodes to other values: id is 1, not 2",
     ),
     (
         "erratum checksum actual wrong",

@@ -5,7 +5,7 @@ from __future__ import annotations
 import signal
 import subprocess
 import sys
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -13,9 +13,9 @@ ROOT = Path(__file__).resolve().parent.parent
 
 
 @contextmanager
-def serve(spec: str, *ids: int) -> Iterator[str]:
-    """Start `serialspec sim SPEC --id N...`, yield the device path it prints first, stop it with SIGTERM."""
-    args = [sys.executable, "-m", "serialspec", "sim", str(ROOT / "specs" / spec), "--quiet"]
+def serve(spec: str, *ids: int, options: Sequence[str] = ()) -> Iterator[str]:
+    """Start `serialspec sim SPEC --id N... OPTIONS`, yield the device path it prints first, stop it with SIGTERM."""
+    args = [sys.executable, "-m", "serialspec", "sim", str(ROOT / "specs" / spec), "--quiet", *options]
     for device_id in ids:
         args += ["--id", str(device_id)]
     process = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)

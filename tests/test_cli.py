@@ -49,7 +49,7 @@ def test_decode_accepts_the_hex_forms_people_paste(form: str) -> None:
     ("frame", "reason"),
     [
         ("12 4c 08 07 02 84 03 f4 01 00 00 ec", "bad checksum"),
-        ("12 4c 0b 01 00 6a", "unknown command 0x0b"),
+        ("12 4c 14 01 00 73", "unknown command 0x14"),  # 20: between 19 and 22, unused
         ("12 4c 08 03 02 84 03 f2", "content is 3 bytes, expected 7"),
         ("x12 0x4c", "not a hex byte"),
     ],

@@ -55,8 +55,9 @@ def test_fast_paths_agree_with_the_plain_ones(g: Generated, spec: Message) -> No
         assert type(decoded) is cls
         assert decoded == built and hash(decoded) == hash(built)
         assert all(hasattr(decoded, f.name) for f in dataclasses.fields(decoded))
-        with pytest.raises(dataclasses.FrozenInstanceError):
-            decoded.__setattr__(dataclasses.fields(decoded)[0].name, 0)
+        if dataclasses.fields(decoded):  # a message with no fields (Fashion Star BEGIN_ASYNC) has none to set
+            with pytest.raises(dataclasses.FrozenInstanceError):
+                decoded.__setattr__(dataclasses.fields(decoded)[0].name, 0)
         # the stream parser decodes in place, between other bytes, to the same message
         parser = g.package.StreamParser(direction)
         assert parser.feed(b"\x00" + frame + frame[: len(layout.header)]) == [decoded]

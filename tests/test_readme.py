@@ -28,5 +28,6 @@ def test_the_readme_session_runs_as_printed() -> None:
     lines = output.getvalue().splitlines()
     assert lines[0] == "True False"
     assert lines[1] == "1000"
-    assert 0 <= int(lines[2]) < 2048
-    assert lines[3] == "{1: {'goal_position': 100}, 2: {'goal_position': 300}}"
+    assert lines[2] == "777"
+    assert 0 <= int(lines[3]) < 2048
+    assert lines[4] == "{1: {'goal_position': 100}, 2: {'goal_position': 300}}"

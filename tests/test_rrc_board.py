@@ -172,8 +172,8 @@ def test_arguments_are_refused_before_a_byte_is_written(board: tuple[HiwonderRrc
         client.bus_servo.set_positions(1000, {1: 1500})
     with pytest.raises(RangeError, match="pulse = 3000"):
         client.pwm_servo.set_position(100, 1, 3000)
-    with pytest.raises(RangeError, match="offset = 120"):
-        client.bus_servo.set_offset(1, 120)
+    with pytest.raises(RangeError, match="offset = 126"):
+        client.bus_servo.set_offset(1, 126)  # -125..125 (erratum bus_offset_range)
     with pytest.raises(RangeError, match="servo_id = 300"):
         client.bus_servo.read_position(300)
     assert client.bus_servo.read_position(1) == 500

@@ -11,19 +11,37 @@ byte is written (RangeError names the field and the range).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any
 
 import serial
 from serialspec.runtime.errors import EncodeError, Timeout
+from serialspec.runtime.message import Message
 from serialspec.runtime.transport import Binding, Bus, ClientBase, table_key
 
 from fashionstar_uart import MATCH_BY, SERIAL
 from fashionstar_uart.codec import StreamParser, encode
 from fashionstar_uart.messages import (
+    AsyncEnd,
+    BeginAsyncRequest,
+    BlocksItem,
     DampingRequest,
     DampingResponse,
     Direction,
+    EndAsyncRequest,
     MethodBits,
+    MonitorRequest,
+    MonitorResponse,
+    MoveByIntervalRequest,
+    MoveByIntervalResponse,
+    MoveByVelocityRequest,
+    MoveByVelocityResponse,
+    MoveMturnByIntervalRequest,
+    MoveMturnByIntervalResponse,
+    MoveMturnByVelocityRequest,
+    MoveMturnByVelocityResponse,
+    MoveMturnRequest,
+    MoveMturnResponse,
     PingRequest,
     PingResponse,
     ReadAngleRequest,
@@ -32,13 +50,20 @@ from fashionstar_uart.messages import (
     ReadBatchDataResponse,
     ReadDataRequest,
     ReadDataResponse,
+    ReadMturnAngleRequest,
+    ReadMturnAngleResponse,
+    ResetMturnAngleRequest,
     ResetUserDataRequest,
     ResetUserDataResponse,
     Result,
     RotateRequest,
     RotateResponse,
+    SetOriginPointRequest,
     SpinRequest,
     SpinResponse,
+    StopMethod,
+    StopOnControlModeRequest,
+    SyncCommandRequest,
     UserData,
     WriteBatchDataRequest,
     WriteBatchDataResponse,
@@ -47,6 +72,17 @@ from fashionstar_uart.messages import (
 )
 
 __all__ = ["BINDING", "FashionstarUartClient"]
+
+#: What sync_command_of() can carry: request class -> (its command code, the reply each device sends, or None).
+SYNC_COMMAND_CARRIES: dict[type[Message], tuple[int, type[Message] | None]] = {
+    RotateRequest: (8, None),
+    MoveByIntervalRequest: (11, None),
+    MoveByVelocityRequest: (12, None),
+    MoveMturnRequest: (13, None),
+    MoveMturnByIntervalRequest: (14, None),
+    MoveMturnByVelocityRequest: (15, None),
+    MonitorRequest: (22, MonitorResponse),
+}
 
 #: What a Bus needs of this protocol: serial defaults, codec, and the reply-matching rule.
 BINDING = Binding(
@@ -110,9 +146,15 @@ class FashionstarUartClient(ClientBase):
         timeout: float = 0.1,
         baudrate: int | None = None,
         optional_replies: bool | None = None,
+        echo: bool = False,
         **serial_options: Any,
     ) -> None:
-        bus = port if isinstance(port, Bus) else Bus(port, BINDING, timeout=timeout, baudrate=baudrate, **serial_options)
+        """`echo=True` for a one-wire half-duplex adapter that echoes every byte sent (see Bus)."""
+        bus = (
+            port
+            if isinstance(port, Bus)
+            else Bus(port, BINDING, timeout=timeout, baudrate=baudrate, echo=echo, **serial_options)
+        )
         super().__init__(bus, optional_replies)
 
     def __enter__(self) -> FashionstarUartClient:
@@ -229,7 +271,7 @@ class FashionstarUartClient(ClientBase):
             servo_id: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). (0..254)
             angle: Angle in 0.1° steps; the sign gives the direction (900 is 90°). [0.1°]
             interval: Time to reach the target angle. [ms]
-            power: Power; 0 or more than the power limit means the power limit. [mW]
+            power: Power; 0 or more than the power limit means the power limit (000's 功率保持值, read as data_id 42: erratum power_hold_value_undefined). [mW]
 
         Returns: result: Outcome of the command. (0..1)
         None when no reply is due (Sent only when response_switch (data_id 33) is 1, once the target angle is reached.).
@@ -269,6 +311,222 @@ class FashionstarUartClient(ClientBase):
         request = ReadAngleRequest(servo_id=servo_id)
         reply = self._ask(request, ReadAngleResponse)
         return reply.angle
+
+    def move_by_interval(self, servo_id: int, angle: int, interval: int, t_acc: int = 20, t_dec: int = 20, power: int = 0) -> Result | int | None:
+        """Move to an angle in a time, with acceleration and deceleration times.
+
+        Like ROTATE, with a trapezoidal speed profile (t_acc up, constant, t_dec down) over `interval`.
+
+        Args:
+            servo_id: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). (0..254)
+            angle: Target angle in 0.1° steps, -180.0°..180.0° (the SDK clamps to this range). [0.1°] (-1800..1800)
+            interval: Time to reach the target angle. [ms]
+            t_acc: Acceleration time at the start of the move (the SDK sends at least 20 ms). [ms]
+            t_dec: Deceleration time at the end of the move (the SDK sends at least 20 ms). [ms]
+            power: Power limit of the move; 0 (or more than the power limit, data_id 42) means the power limit. [mW]
+
+        Returns: result: Outcome of the command. (0..1)
+        None when no reply is due (Inferred from ROTATE (the SDK waits for no reply): sent only when response_switch (data_id 33) is 1, once the target is reached.).
+        """
+        request = MoveByIntervalRequest(servo_id=servo_id, angle=angle, interval=interval, t_acc=t_acc, t_dec=t_dec, power=power)
+        reply = self._maybe(request, MoveByIntervalResponse, (33, 1))
+        if reply is None:
+            return None
+        return reply.result
+
+    def move_by_velocity(self, servo_id: int, angle: int, velocity: int, t_acc: int = 20, t_dec: int = 20, power: int = 0) -> Result | int | None:
+        """Move to an angle at a speed, with acceleration and deceleration times.
+
+        Args:
+            servo_id: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). (0..254)
+            angle: Target angle in 0.1° steps, -180.0°..180.0° (the SDK clamps to this range). [0.1°] (-1800..1800)
+            velocity: Target speed in 0.1°/s (the SDK clamps to 1.0..750.0 °/s). [0.1°/s] (10..7500)
+            t_acc: Acceleration time at the start of the move (the SDK sends at least 20 ms). [ms]
+            t_dec: Deceleration time at the end of the move (the SDK sends at least 20 ms). [ms]
+            power: Power limit of the move; 0 (or more than the power limit, data_id 42) means the power limit. [mW]
+
+        Returns: result: Outcome of the command. (0..1)
+        None when no reply is due (Inferred from ROTATE (the SDK waits for no reply): sent only when response_switch (data_id 33) is 1, once the target is reached.).
+        """
+        request = MoveByVelocityRequest(servo_id=servo_id, angle=angle, velocity=velocity, t_acc=t_acc, t_dec=t_dec, power=power)
+        reply = self._maybe(request, MoveByVelocityResponse, (33, 1))
+        if reply is None:
+            return None
+        return reply.result
+
+    def move_mturn(self, servo_id: int, angle: int, interval: int, power: int = 0) -> Result | int | None:
+        """Multi-turn move to an angle in a time.
+
+        Args:
+            servo_id: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). (0..254)
+            angle: Multi-turn angle in 0.1° steps, up to ±1024 turns (the SDK clamps to ±368640.0°). [0.1°] (-3686400..3686400)
+            interval: Time to reach the target angle. [ms] (0..4096000)
+            power: Power limit of the move; 0 (or more than the power limit, data_id 42) means the power limit. [mW]
+
+        Returns: result: Outcome of the command. (0..1)
+        None when no reply is due (Inferred from ROTATE (the SDK waits for no reply): sent only when response_switch (data_id 33) is 1, once the target is reached.).
+        """
+        request = MoveMturnRequest(servo_id=servo_id, angle=angle, interval=interval, power=power)
+        reply = self._maybe(request, MoveMturnResponse, (33, 1))
+        if reply is None:
+            return None
+        return reply.result
+
+    def move_mturn_by_interval(self, servo_id: int, angle: int, interval: int, t_acc: int = 20, t_dec: int = 20, power: int = 0) -> Result | int | None:
+        """Multi-turn move in a time, with acceleration and deceleration times.
+
+        Args:
+            servo_id: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). (0..254)
+            angle: Multi-turn angle in 0.1° steps, up to ±1024 turns (the SDK clamps to ±368640.0°). [0.1°] (-3686400..3686400)
+            interval: Time to reach the target (at least t_acc + t_dec). [ms] (0..4096000)
+            t_acc: Acceleration time at the start of the move (the SDK sends at least 20 ms). [ms]
+            t_dec: Deceleration time at the end of the move (the SDK sends at least 20 ms). [ms]
+            power: Power limit of the move; 0 (or more than the power limit, data_id 42) means the power limit. [mW]
+
+        Returns: result: Outcome of the command. (0..1)
+        None when no reply is due (Inferred from ROTATE (the SDK waits for no reply): sent only when response_switch (data_id 33) is 1, once the target is reached.).
+        """
+        request = MoveMturnByIntervalRequest(servo_id=servo_id, angle=angle, interval=interval, t_acc=t_acc, t_dec=t_dec, power=power)
+        reply = self._maybe(request, MoveMturnByIntervalResponse, (33, 1))
+        if reply is None:
+            return None
+        return reply.result
+
+    def move_mturn_by_velocity(self, servo_id: int, angle: int, velocity: int, t_acc: int = 20, t_dec: int = 20, power: int = 0) -> Result | int | None:
+        """Multi-turn move at a speed, with acceleration and deceleration times.
+
+        Args:
+            servo_id: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). (0..254)
+            angle: Multi-turn angle in 0.1° steps, up to ±1024 turns (the SDK clamps to ±368640.0°). [0.1°] (-3686400..3686400)
+            velocity: Target speed in 0.1°/s (the SDK clamps to 1.0..750.0 °/s). [0.1°/s] (10..7500)
+            t_acc: Acceleration time at the start of the move (the SDK sends at least 20 ms). [ms]
+            t_dec: Deceleration time at the end of the move (the SDK sends at least 20 ms). [ms]
+            power: Power limit of the move; 0 (or more than the power limit, data_id 42) means the power limit. [mW]
+
+        Returns: result: Outcome of the command. (0..1)
+        None when no reply is due (Inferred from ROTATE (the SDK waits for no reply): sent only when response_switch (data_id 33) is 1, once the target is reached.).
+        """
+        request = MoveMturnByVelocityRequest(servo_id=servo_id, angle=angle, velocity=velocity, t_acc=t_acc, t_dec=t_dec, power=power)
+        reply = self._maybe(request, MoveMturnByVelocityResponse, (33, 1))
+        if reply is None:
+            return None
+        return reply.result
+
+    def read_mturn_angle(self, servo_id: int) -> ReadMturnAngleResponse:
+        """Read the multi-turn angle and turn count.
+
+        Args:
+            servo_id: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). (0..254)
+
+        Returns: the ReadMturnAngleResponse reply.
+        """
+        request = ReadMturnAngleRequest(servo_id=servo_id)
+        reply = self._ask(request, ReadMturnAngleResponse)
+        return reply
+
+    def reset_mturn_angle(self, servo_id: int) -> None:
+        """Reset the multi-turn angle.
+
+        The multi-turn count starts again from the angle within one turn (inferred from the name: the SDK sends it and waits for no reply).
+
+        Args:
+            servo_id: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). (0..254)
+
+        The device does not answer.
+        """
+        request = ResetMturnAngleRequest(servo_id=servo_id)
+        self.bus.send(request)
+
+    def begin_async(self) -> None:
+        """Begin holding move commands.
+
+        Every servo on the bus holds the move commands it gets from now on until END_ASYNC, which runs them all at once (or drops them). The content is empty: it addresses every servo.
+
+        Args:
+
+        The device does not answer.
+        """
+        request = BeginAsyncRequest()
+        self.bus.send(request)
+
+    def end_async(self, mode: AsyncEnd | int) -> None:
+        """Run (or drop) the held move commands.
+
+        Args:
+            mode: 0 runs the held commands, 1 drops them. (0..1)
+
+        The device does not answer.
+        """
+        request = EndAsyncRequest(mode=mode)
+        self.bus.send(request)
+
+    def monitor(self, servo_id: int) -> MonitorResponse:
+        """Read voltage, current, power, temperature, status and multi-turn angle at once.
+
+        The SDK ignores a reply whose angle is -235929599 with turns 0 (outside the multi-turn range: a value that means 'no data', as its sync monitor treats it).
+
+        Args:
+            servo_id: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). (0..254)
+
+        Returns: the MonitorResponse reply.
+        """
+        request = MonitorRequest(servo_id=servo_id)
+        reply = self._ask(request, MonitorResponse)
+        return reply
+
+    def set_origin_point(self, servo_id: int) -> None:
+        """Make the present position the origin.
+
+        Args:
+            servo_id: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). (0..254)
+
+        The device does not answer.
+        """
+        request = SetOriginPointRequest(servo_id=servo_id)
+        self.bus.send(request)
+
+    def stop_on_control_mode(self, servo_id: int, method: StopMethod | int, power: int) -> None:
+        """Stop the move, then release, hold or damp.
+
+        Args:
+            servo_id: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). (0..254)
+            method: What the servo does after stopping. (16..18)
+            power: Holding power (hold and damping). [mW]
+
+        The device does not answer.
+        """
+        request = StopOnControlModeRequest(servo_id=servo_id, method=method, power=power)
+        self.bus.send(request)
+
+    def sync_command(self, command: int, blocks: tuple[BlocksItem, ...] | Sequence[bytes]) -> None:
+        """One command for several servos at once.
+
+        Carries one command (8, 11..15 or 22) to several servos: its code, the size of one servo's block, the number of servos, then one block per servo holding that command's request content (servo_id first). Each servo acts as if it had got the command alone, and answers as it would: a sync monitor (22) gets one monitor reply per servo, in block order.
+
+        Args:
+            command: The command carried (8, 11..15, or 22 for the monitor).
+            blocks: One block per servo.
+            (blocks also takes a plain sequence of content values.)
+
+        The device does not answer.
+        """
+        blocks = tuple(v if isinstance(v, BlocksItem) else BlocksItem(content=v) for v in blocks)
+        request = SyncCommandRequest(command=command, blocks=blocks)
+        self.bus.send(request)
+
+    def sync_command_of(self, requests: Sequence[Message]) -> list[Message]:
+        """One command for several servos at once, from the requests it carries: one per device, all of one command.
+
+        Each request's content becomes one item of `blocks`; the command's replies (one per request, in order) are returned, or [] when that command answers only when a parameter allows it or not at all.
+        """
+        return self._carry(
+            requests,
+            SYNC_COMMAND_CARRIES,
+            slice(4, -1),
+            lambda code, blocks: SyncCommandRequest(
+                command=code, blocks=tuple(BlocksItem(content=b) for b in blocks)
+            ),
+        )
 
     def read_parameter(self, servo_id: int, name: str) -> int | float:
         """Read one entry of servo parameters by data_id by name, e.g. `read_parameter(1, 'voltage')`."""

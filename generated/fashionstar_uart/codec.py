@@ -14,11 +14,27 @@ from serialspec.runtime.stream import FrameFormat
 from serialspec.runtime.stream import StreamParser as _StreamParser
 
 from fashionstar_uart.messages import (
+    AsyncEnd,
     BaudrateOption,
+    BeginAsyncRequest,
+    BlocksItem,
     DampingRequest,
     DampingResponse,
+    EndAsyncRequest,
     LockOnPowerOn,
     MethodBits,
+    MonitorRequest,
+    MonitorResponse,
+    MoveByIntervalRequest,
+    MoveByIntervalResponse,
+    MoveByVelocityRequest,
+    MoveByVelocityResponse,
+    MoveMturnByIntervalRequest,
+    MoveMturnByIntervalResponse,
+    MoveMturnByVelocityRequest,
+    MoveMturnByVelocityResponse,
+    MoveMturnRequest,
+    MoveMturnResponse,
     PingRequest,
     PingResponse,
     ReadAngleRequest,
@@ -27,18 +43,26 @@ from fashionstar_uart.messages import (
     ReadBatchDataResponse,
     ReadDataRequest,
     ReadDataResponse,
+    ReadMturnAngleRequest,
+    ReadMturnAngleResponse,
+    ResetMturnAngleRequest,
     ResetUserDataRequest,
     ResetUserDataResponse,
     ResponseSwitch,
     Result,
     RotateRequest,
     RotateResponse,
+    ServoStatus,
+    SetOriginPointRequest,
     SpinDirection,
     SpinMode,
     SpinRequest,
     SpinResponse,
     StallProtectMode,
+    StopMethod,
+    StopOnControlModeRequest,
     Switch,
+    SyncCommandRequest,
     UserData,
     WheelBrake,
     WriteBatchDataRequest,
@@ -52,18 +76,32 @@ __all__ = ["StreamParser", "decode", "encode"]
 _S_B2_U8_U8 = struct.Struct('<2sBB')
 _S_B2_U8_U8_U8 = struct.Struct('<2sBBB')
 _S_B2_U8_U8_U8_I16 = struct.Struct('<2sBBBh')
+_S_B2_U8_U8_U8_I32_I16 = struct.Struct('<2sBBBih')
 _S_B2_U8_U8_U8_U16 = struct.Struct('<2sBBBH')
 _S_B2_U8_U8_U8_U8 = struct.Struct('<2sBBBB')
+_S_B2_U8_U8_U8_U8_U16 = struct.Struct('<2sBBBBH')
 _S_B2_U8_U8_U8_U8_U8 = struct.Struct('<2sBBBBB')
+_S_FRAME_MONITORRESPONSE = struct.Struct('<2sBBBHHHHBih')
+_S_FRAME_MOVEBYINTERVALREQUEST = struct.Struct('<2sBBBhHHHH')
+_S_FRAME_MOVEMTURNBYINTERVALREQUEST = struct.Struct('<2sBBBiIHHH')
+_S_FRAME_MOVEMTURNBYVELOCITYREQUEST = struct.Struct('<2sBBBiHHHH')
+_S_FRAME_MOVEMTURNREQUEST = struct.Struct('<2sBBBiIH')
 _S_FRAME_READBATCHDATARESPONSE = struct.Struct('<2sBBBBBBBBBHHHHHHBBBBBBHhhh')
 _S_FRAME_ROTATEREQUEST = struct.Struct('<2sBBBhHH')
 _S_FRAME_SPINREQUEST = struct.Struct('<2sBBBBHH')
+_S_MONITORRESPONSE_SERVO_ID = struct.Struct('<BHHHHBih')
 _S_READBATCHDATARESPONSE_SERVO_ID = struct.Struct('<BBBBBBBHHHHHHBBBBBBHhhh')
 _S_U8 = struct.Struct('<B')
 _S_U8_I16 = struct.Struct('<Bh')
 _S_U8_I16_U16_U16 = struct.Struct('<BhHH')
+_S_U8_I16_U16_U16_U16_U16 = struct.Struct('<BhHHHH')
+_S_U8_I32_I16 = struct.Struct('<Bih')
+_S_U8_I32_U16_U16_U16_U16 = struct.Struct('<BiHHHH')
+_S_U8_I32_U32_U16 = struct.Struct('<BiIH')
+_S_U8_I32_U32_U16_U16_U16 = struct.Struct('<BiIHHH')
 _S_U8_U16 = struct.Struct('<BH')
 _S_U8_U8 = struct.Struct('<BB')
+_S_U8_U8_U16 = struct.Struct('<BBH')
 _S_U8_U8_U16_U16 = struct.Struct('<BBHH')
 _S_U8_U8_U8 = struct.Struct('<BBB')
 _TABLE_PARAMETERS: dict[int, struct.Struct] = {
@@ -128,9 +166,65 @@ _TABLE_PARAMETERS_RANGES: dict[int, tuple[float, float]] = {
 # Decoders build messages with object.__new__ and store each value straight into its slot: the dataclass __init__
 # of a frozen class goes through object.__setattr__ per field, which costs more than unpacking the whole frame.
 _new = object.__new__
+(_set_BlocksItem_content,) = slot_setters(BlocksItem)
 _set_DampingRequest_servo_id, _set_DampingRequest_power = slot_setters(DampingRequest)
 _set_DampingResponse_servo_id, _set_DampingResponse_result = slot_setters(DampingResponse)
+(_set_EndAsyncRequest_mode,) = slot_setters(EndAsyncRequest)
 _set_MethodBits_direction, _set_MethodBits_mode = slot_setters(MethodBits)
+(_set_MonitorRequest_servo_id,) = slot_setters(MonitorRequest)
+(
+    _set_MonitorResponse_servo_id,
+    _set_MonitorResponse_voltage,
+    _set_MonitorResponse_current,
+    _set_MonitorResponse_power,
+    _set_MonitorResponse_temperature,
+    _set_MonitorResponse_status,
+    _set_MonitorResponse_angle,
+    _set_MonitorResponse_turns,
+) = slot_setters(MonitorResponse)
+(
+    _set_MoveByIntervalRequest_servo_id,
+    _set_MoveByIntervalRequest_angle,
+    _set_MoveByIntervalRequest_interval,
+    _set_MoveByIntervalRequest_t_acc,
+    _set_MoveByIntervalRequest_t_dec,
+    _set_MoveByIntervalRequest_power,
+) = slot_setters(MoveByIntervalRequest)
+_set_MoveByIntervalResponse_servo_id, _set_MoveByIntervalResponse_result = slot_setters(MoveByIntervalResponse)
+(
+    _set_MoveByVelocityRequest_servo_id,
+    _set_MoveByVelocityRequest_angle,
+    _set_MoveByVelocityRequest_velocity,
+    _set_MoveByVelocityRequest_t_acc,
+    _set_MoveByVelocityRequest_t_dec,
+    _set_MoveByVelocityRequest_power,
+) = slot_setters(MoveByVelocityRequest)
+_set_MoveByVelocityResponse_servo_id, _set_MoveByVelocityResponse_result = slot_setters(MoveByVelocityResponse)
+(
+    _set_MoveMturnByIntervalRequest_servo_id,
+    _set_MoveMturnByIntervalRequest_angle,
+    _set_MoveMturnByIntervalRequest_interval,
+    _set_MoveMturnByIntervalRequest_t_acc,
+    _set_MoveMturnByIntervalRequest_t_dec,
+    _set_MoveMturnByIntervalRequest_power,
+) = slot_setters(MoveMturnByIntervalRequest)
+_set_MoveMturnByIntervalResponse_servo_id, _set_MoveMturnByIntervalResponse_result = slot_setters(MoveMturnByIntervalResponse)
+(
+    _set_MoveMturnByVelocityRequest_servo_id,
+    _set_MoveMturnByVelocityRequest_angle,
+    _set_MoveMturnByVelocityRequest_velocity,
+    _set_MoveMturnByVelocityRequest_t_acc,
+    _set_MoveMturnByVelocityRequest_t_dec,
+    _set_MoveMturnByVelocityRequest_power,
+) = slot_setters(MoveMturnByVelocityRequest)
+_set_MoveMturnByVelocityResponse_servo_id, _set_MoveMturnByVelocityResponse_result = slot_setters(MoveMturnByVelocityResponse)
+(
+    _set_MoveMturnRequest_servo_id,
+    _set_MoveMturnRequest_angle,
+    _set_MoveMturnRequest_interval,
+    _set_MoveMturnRequest_power,
+) = slot_setters(MoveMturnRequest)
+_set_MoveMturnResponse_servo_id, _set_MoveMturnResponse_result = slot_setters(MoveMturnResponse)
 (_set_PingRequest_servo_id,) = slot_setters(PingRequest)
 (_set_PingResponse_servo_id,) = slot_setters(PingResponse)
 (_set_ReadAngleRequest_servo_id,) = slot_setters(ReadAngleRequest)
@@ -139,6 +233,9 @@ _set_ReadAngleResponse_servo_id, _set_ReadAngleResponse_angle = slot_setters(Rea
 _set_ReadBatchDataResponse_servo_id, _set_ReadBatchDataResponse_user_data = slot_setters(ReadBatchDataResponse)
 _set_ReadDataRequest_servo_id, _set_ReadDataRequest_data_id = slot_setters(ReadDataRequest)
 _set_ReadDataResponse_servo_id, _set_ReadDataResponse_data_id, _set_ReadDataResponse_data = slot_setters(ReadDataResponse)
+(_set_ReadMturnAngleRequest_servo_id,) = slot_setters(ReadMturnAngleRequest)
+_set_ReadMturnAngleResponse_servo_id, _set_ReadMturnAngleResponse_angle, _set_ReadMturnAngleResponse_turns = slot_setters(ReadMturnAngleResponse)
+(_set_ResetMturnAngleRequest_servo_id,) = slot_setters(ResetMturnAngleRequest)
 (_set_ResetUserDataRequest_servo_id,) = slot_setters(ResetUserDataRequest)
 _set_ResetUserDataResponse_servo_id, _set_ResetUserDataResponse_result = slot_setters(ResetUserDataResponse)
 (
@@ -148,6 +245,7 @@ _set_ResetUserDataResponse_servo_id, _set_ResetUserDataResponse_result = slot_se
     _set_RotateRequest_power,
 ) = slot_setters(RotateRequest)
 _set_RotateResponse_servo_id, _set_RotateResponse_result = slot_setters(RotateResponse)
+(_set_SetOriginPointRequest_servo_id,) = slot_setters(SetOriginPointRequest)
 (
     _set_SpinRequest_servo_id,
     _set_SpinRequest_method,
@@ -155,6 +253,8 @@ _set_RotateResponse_servo_id, _set_RotateResponse_result = slot_setters(RotateRe
     _set_SpinRequest_value,
 ) = slot_setters(SpinRequest)
 _set_SpinResponse_servo_id, _set_SpinResponse_result = slot_setters(SpinResponse)
+_set_StopOnControlModeRequest_servo_id, _set_StopOnControlModeRequest_method, _set_StopOnControlModeRequest_power = slot_setters(StopOnControlModeRequest)
+_set_SyncCommandRequest_command, _set_SyncCommandRequest_blocks = slot_setters(SyncCommandRequest)
 (
     _set_UserData_reserved_32,
     _set_UserData_response_switch,
@@ -183,13 +283,16 @@ _set_WriteBatchDataRequest_servo_id, _set_WriteBatchDataRequest_user_data = slot
 _set_WriteBatchDataResponse_servo_id, _set_WriteBatchDataResponse_result = slot_setters(WriteBatchDataResponse)
 _set_WriteDataRequest_servo_id, _set_WriteDataRequest_data_id, _set_WriteDataRequest_data = slot_setters(WriteDataRequest)
 _set_WriteDataResponse_servo_id, _set_WriteDataResponse_data_id, _set_WriteDataResponse_result = slot_setters(WriteDataResponse)
+_MEMBERS_AsyncEnd = members(AsyncEnd)
 _MEMBERS_BaudrateOption = members(BaudrateOption)
 _MEMBERS_LockOnPowerOn = members(LockOnPowerOn)
 _MEMBERS_ResponseSwitch = members(ResponseSwitch)
 _MEMBERS_Result = members(Result)
+_MEMBERS_ServoStatus = members(ServoStatus)
 _MEMBERS_SpinDirection = members(SpinDirection)
 _MEMBERS_SpinMode = members(SpinMode)
 _MEMBERS_StallProtectMode = members(StallProtectMode)
+_MEMBERS_StopMethod = members(StopMethod)
 _MEMBERS_Switch = members(Switch)
 _MEMBERS_WheelBrake = members(WheelBrake)
 
@@ -468,6 +571,242 @@ def _decode_read_angle_response(buf: bytes, o: int, end: int) -> ReadAngleRespon
     m = _new(ReadAngleResponse)
     _set_ReadAngleResponse_servo_id(m, v_servo_id)
     _set_ReadAngleResponse_angle(m, v_angle)
+    return m
+
+
+def _decode_move_by_interval_request(buf: bytes, o: int, end: int) -> MoveByIntervalRequest:
+    if end - o != 11:
+        raise content_size_error('move_by_interval request', end - o, 11, 11)
+    v_servo_id, v_angle, v_interval, v_t_acc, v_t_dec, v_power = _S_U8_I16_U16_U16_U16_U16.unpack_from(buf, o)
+    m = _new(MoveByIntervalRequest)
+    _set_MoveByIntervalRequest_servo_id(m, v_servo_id)
+    _set_MoveByIntervalRequest_angle(m, v_angle)
+    _set_MoveByIntervalRequest_interval(m, v_interval)
+    _set_MoveByIntervalRequest_t_acc(m, v_t_acc)
+    _set_MoveByIntervalRequest_t_dec(m, v_t_dec)
+    _set_MoveByIntervalRequest_power(m, v_power)
+    return m
+
+
+def _decode_move_by_interval_response(buf: bytes, o: int, end: int) -> MoveByIntervalResponse:
+    if end - o != 2:
+        raise content_size_error('move_by_interval response', end - o, 2, 2)
+    v_servo_id, v_result = _S_U8_U8.unpack_from(buf, o)
+    m = _new(MoveByIntervalResponse)
+    _set_MoveByIntervalResponse_servo_id(m, v_servo_id)
+    _set_MoveByIntervalResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
+    return m
+
+
+def _decode_move_by_velocity_request(buf: bytes, o: int, end: int) -> MoveByVelocityRequest:
+    if end - o != 11:
+        raise content_size_error('move_by_velocity request', end - o, 11, 11)
+    v_servo_id, v_angle, v_velocity, v_t_acc, v_t_dec, v_power = _S_U8_I16_U16_U16_U16_U16.unpack_from(buf, o)
+    m = _new(MoveByVelocityRequest)
+    _set_MoveByVelocityRequest_servo_id(m, v_servo_id)
+    _set_MoveByVelocityRequest_angle(m, v_angle)
+    _set_MoveByVelocityRequest_velocity(m, v_velocity)
+    _set_MoveByVelocityRequest_t_acc(m, v_t_acc)
+    _set_MoveByVelocityRequest_t_dec(m, v_t_dec)
+    _set_MoveByVelocityRequest_power(m, v_power)
+    return m
+
+
+def _decode_move_by_velocity_response(buf: bytes, o: int, end: int) -> MoveByVelocityResponse:
+    if end - o != 2:
+        raise content_size_error('move_by_velocity response', end - o, 2, 2)
+    v_servo_id, v_result = _S_U8_U8.unpack_from(buf, o)
+    m = _new(MoveByVelocityResponse)
+    _set_MoveByVelocityResponse_servo_id(m, v_servo_id)
+    _set_MoveByVelocityResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
+    return m
+
+
+def _decode_move_mturn_request(buf: bytes, o: int, end: int) -> MoveMturnRequest:
+    if end - o != 11:
+        raise content_size_error('move_mturn request', end - o, 11, 11)
+    v_servo_id, v_angle, v_interval, v_power = _S_U8_I32_U32_U16.unpack_from(buf, o)
+    m = _new(MoveMturnRequest)
+    _set_MoveMturnRequest_servo_id(m, v_servo_id)
+    _set_MoveMturnRequest_angle(m, v_angle)
+    _set_MoveMturnRequest_interval(m, v_interval)
+    _set_MoveMturnRequest_power(m, v_power)
+    return m
+
+
+def _decode_move_mturn_response(buf: bytes, o: int, end: int) -> MoveMturnResponse:
+    if end - o != 2:
+        raise content_size_error('move_mturn response', end - o, 2, 2)
+    v_servo_id, v_result = _S_U8_U8.unpack_from(buf, o)
+    m = _new(MoveMturnResponse)
+    _set_MoveMturnResponse_servo_id(m, v_servo_id)
+    _set_MoveMturnResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
+    return m
+
+
+def _decode_move_mturn_by_interval_request(buf: bytes, o: int, end: int) -> MoveMturnByIntervalRequest:
+    if end - o != 15:
+        raise content_size_error('move_mturn_by_interval request', end - o, 15, 15)
+    v_servo_id, v_angle, v_interval, v_t_acc, v_t_dec, v_power = _S_U8_I32_U32_U16_U16_U16.unpack_from(buf, o)
+    m = _new(MoveMturnByIntervalRequest)
+    _set_MoveMturnByIntervalRequest_servo_id(m, v_servo_id)
+    _set_MoveMturnByIntervalRequest_angle(m, v_angle)
+    _set_MoveMturnByIntervalRequest_interval(m, v_interval)
+    _set_MoveMturnByIntervalRequest_t_acc(m, v_t_acc)
+    _set_MoveMturnByIntervalRequest_t_dec(m, v_t_dec)
+    _set_MoveMturnByIntervalRequest_power(m, v_power)
+    return m
+
+
+def _decode_move_mturn_by_interval_response(buf: bytes, o: int, end: int) -> MoveMturnByIntervalResponse:
+    if end - o != 2:
+        raise content_size_error('move_mturn_by_interval response', end - o, 2, 2)
+    v_servo_id, v_result = _S_U8_U8.unpack_from(buf, o)
+    m = _new(MoveMturnByIntervalResponse)
+    _set_MoveMturnByIntervalResponse_servo_id(m, v_servo_id)
+    _set_MoveMturnByIntervalResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
+    return m
+
+
+def _decode_move_mturn_by_velocity_request(buf: bytes, o: int, end: int) -> MoveMturnByVelocityRequest:
+    if end - o != 13:
+        raise content_size_error('move_mturn_by_velocity request', end - o, 13, 13)
+    v_servo_id, v_angle, v_velocity, v_t_acc, v_t_dec, v_power = _S_U8_I32_U16_U16_U16_U16.unpack_from(buf, o)
+    m = _new(MoveMturnByVelocityRequest)
+    _set_MoveMturnByVelocityRequest_servo_id(m, v_servo_id)
+    _set_MoveMturnByVelocityRequest_angle(m, v_angle)
+    _set_MoveMturnByVelocityRequest_velocity(m, v_velocity)
+    _set_MoveMturnByVelocityRequest_t_acc(m, v_t_acc)
+    _set_MoveMturnByVelocityRequest_t_dec(m, v_t_dec)
+    _set_MoveMturnByVelocityRequest_power(m, v_power)
+    return m
+
+
+def _decode_move_mturn_by_velocity_response(buf: bytes, o: int, end: int) -> MoveMturnByVelocityResponse:
+    if end - o != 2:
+        raise content_size_error('move_mturn_by_velocity response', end - o, 2, 2)
+    v_servo_id, v_result = _S_U8_U8.unpack_from(buf, o)
+    m = _new(MoveMturnByVelocityResponse)
+    _set_MoveMturnByVelocityResponse_servo_id(m, v_servo_id)
+    _set_MoveMturnByVelocityResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
+    return m
+
+
+def _decode_read_mturn_angle_request(buf: bytes, o: int, end: int) -> ReadMturnAngleRequest:
+    if end - o != 1:
+        raise content_size_error('read_mturn_angle request', end - o, 1, 1)
+    v_servo_id, = _S_U8.unpack_from(buf, o)
+    m = _new(ReadMturnAngleRequest)
+    _set_ReadMturnAngleRequest_servo_id(m, v_servo_id)
+    return m
+
+
+def _decode_read_mturn_angle_response(buf: bytes, o: int, end: int) -> ReadMturnAngleResponse:
+    if end - o != 7:
+        raise content_size_error('read_mturn_angle response', end - o, 7, 7)
+    v_servo_id, v_angle, v_turns = _S_U8_I32_I16.unpack_from(buf, o)
+    m = _new(ReadMturnAngleResponse)
+    _set_ReadMturnAngleResponse_servo_id(m, v_servo_id)
+    _set_ReadMturnAngleResponse_angle(m, v_angle)
+    _set_ReadMturnAngleResponse_turns(m, v_turns)
+    return m
+
+
+def _decode_reset_mturn_angle_request(buf: bytes, o: int, end: int) -> ResetMturnAngleRequest:
+    if end - o != 1:
+        raise content_size_error('reset_mturn_angle request', end - o, 1, 1)
+    v_servo_id, = _S_U8.unpack_from(buf, o)
+    m = _new(ResetMturnAngleRequest)
+    _set_ResetMturnAngleRequest_servo_id(m, v_servo_id)
+    return m
+
+
+def _decode_begin_async_request(buf: bytes, o: int, end: int) -> BeginAsyncRequest:
+    if end - o != 0:
+        raise content_size_error('begin_async request', end - o, 0, 0)
+    m = _new(BeginAsyncRequest)
+    return m
+
+
+def _decode_end_async_request(buf: bytes, o: int, end: int) -> EndAsyncRequest:
+    if end - o != 1:
+        raise content_size_error('end_async request', end - o, 1, 1)
+    v_mode, = _S_U8.unpack_from(buf, o)
+    m = _new(EndAsyncRequest)
+    _set_EndAsyncRequest_mode(m, _MEMBERS_AsyncEnd.get(v_mode, v_mode))
+    return m
+
+
+def _decode_monitor_request(buf: bytes, o: int, end: int) -> MonitorRequest:
+    if end - o != 1:
+        raise content_size_error('monitor request', end - o, 1, 1)
+    v_servo_id, = _S_U8.unpack_from(buf, o)
+    m = _new(MonitorRequest)
+    _set_MonitorRequest_servo_id(m, v_servo_id)
+    return m
+
+
+def _decode_monitor_response(buf: bytes, o: int, end: int) -> MonitorResponse:
+    if end - o != 16:
+        raise content_size_error('monitor response', end - o, 16, 16)
+    v_servo_id, v_voltage, v_current, v_power, v_temperature, v_status, v_angle, v_turns = _S_MONITORRESPONSE_SERVO_ID.unpack_from(buf, o)
+    v_status_flags = _MEMBERS_ServoStatus.get(v_status)
+    if v_status_flags is None:
+        v_status_flags = ServoStatus(v_status)
+    m = _new(MonitorResponse)
+    _set_MonitorResponse_servo_id(m, v_servo_id)
+    _set_MonitorResponse_voltage(m, v_voltage)
+    _set_MonitorResponse_current(m, v_current)
+    _set_MonitorResponse_power(m, v_power)
+    _set_MonitorResponse_temperature(m, v_temperature)
+    _set_MonitorResponse_status(m, v_status_flags)
+    _set_MonitorResponse_angle(m, v_angle)
+    _set_MonitorResponse_turns(m, v_turns)
+    return m
+
+
+def _decode_set_origin_point_request(buf: bytes, o: int, end: int) -> SetOriginPointRequest:
+    if end - o != 2:
+        raise content_size_error('set_origin_point request', end - o, 2, 2)
+    v_servo_id, v_reserved = _S_U8_U8.unpack_from(buf, o)
+    if v_reserved != 0:
+        raise DecodeError('set_origin_point request' + f': reserved is {v_reserved:#x}, expected 0x0')
+    m = _new(SetOriginPointRequest)
+    _set_SetOriginPointRequest_servo_id(m, v_servo_id)
+    return m
+
+
+def _decode_stop_on_control_mode_request(buf: bytes, o: int, end: int) -> StopOnControlModeRequest:
+    if end - o != 4:
+        raise content_size_error('stop_on_control_mode request', end - o, 4, 4)
+    v_servo_id, v_method, v_power = _S_U8_U8_U16.unpack_from(buf, o)
+    m = _new(StopOnControlModeRequest)
+    _set_StopOnControlModeRequest_servo_id(m, v_servo_id)
+    _set_StopOnControlModeRequest_method(m, _MEMBERS_StopMethod.get(v_method, v_method))
+    _set_StopOnControlModeRequest_power(m, v_power)
+    return m
+
+
+def _decode_sync_command_request(buf: bytes, o: int, end: int) -> SyncCommandRequest:
+    if end - o < 3:
+        raise content_size_error('sync_command request', end - o, 3, None)
+    v_command, v_block_size, v_count = _S_U8_U8_U8.unpack_from(buf, o)
+    o += 3
+    v_blocks_list = []
+    for _ in range(v_count):
+        if end - o < v_block_size:
+            raise DecodeError('sync_command request' + f': content needs {v_block_size} bytes, {end - o} left')
+        v_content = buf[o : o + v_block_size]
+        o += v_block_size
+        item = _new(BlocksItem)
+        _set_BlocksItem_content(item, v_content)
+        v_blocks_list.append(item)
+    v_blocks = tuple(v_blocks_list)
+    if o != end:
+        raise DecodeError('sync_command request' + f': {end - o} bytes left after the last field')
+    m = _new(SyncCommandRequest)
+    _set_SyncCommandRequest_command(m, v_command)
+    _set_SyncCommandRequest_blocks(m, v_blocks)
     return m
 
 
@@ -757,6 +1096,236 @@ def _encode_read_angle_response(m: ReadAngleResponse) -> bytes:
     return body + _BYTES[sum(body) & 0xff]
 
 
+def _encode_move_by_interval_request(m: MoveByIntervalRequest) -> bytes:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
+        raise out_of_range('move_by_interval request', 'servo_id', m.servo_id, 0, 254)
+    if not -1800 <= m.angle <= 1800 or m.angle.__class__ is bool:
+        raise out_of_range('move_by_interval request', 'angle', m.angle, -1800, 1800)
+    if not 0 <= m.interval <= 65535 or m.interval.__class__ is bool:
+        raise out_of_range('move_by_interval request', 'interval', m.interval, 0, 65535)
+    if not 0 <= m.t_acc <= 65535 or m.t_acc.__class__ is bool:
+        raise out_of_range('move_by_interval request', 't_acc', m.t_acc, 0, 65535)
+    if not 0 <= m.t_dec <= 65535 or m.t_dec.__class__ is bool:
+        raise out_of_range('move_by_interval request', 't_dec', m.t_dec, 0, 65535)
+    if not 0 <= m.power <= 65535 or m.power.__class__ is bool:
+        raise out_of_range('move_by_interval request', 'power', m.power, 0, 65535)
+    body = _S_FRAME_MOVEBYINTERVALREQUEST.pack(b'\x12L', 11, 11, m.servo_id, m.angle, m.interval, m.t_acc, m.t_dec, m.power)
+    return body + _BYTES[sum(body) & 0xff]
+
+
+def _encode_move_by_interval_response(m: MoveByIntervalResponse) -> bytes:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
+        raise out_of_range('move_by_interval response', 'servo_id', m.servo_id, 0, 254)
+    if not 0 <= m.result <= 1 or m.result.__class__ is bool:
+        raise out_of_range('move_by_interval response', 'result', m.result, 0, 1)
+    body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 11, 2, m.servo_id, m.result)
+    return body + _BYTES[sum(body) & 0xff]
+
+
+def _encode_move_by_velocity_request(m: MoveByVelocityRequest) -> bytes:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
+        raise out_of_range('move_by_velocity request', 'servo_id', m.servo_id, 0, 254)
+    if not -1800 <= m.angle <= 1800 or m.angle.__class__ is bool:
+        raise out_of_range('move_by_velocity request', 'angle', m.angle, -1800, 1800)
+    if not 10 <= m.velocity <= 7500 or m.velocity.__class__ is bool:
+        raise out_of_range('move_by_velocity request', 'velocity', m.velocity, 10, 7500)
+    if not 0 <= m.t_acc <= 65535 or m.t_acc.__class__ is bool:
+        raise out_of_range('move_by_velocity request', 't_acc', m.t_acc, 0, 65535)
+    if not 0 <= m.t_dec <= 65535 or m.t_dec.__class__ is bool:
+        raise out_of_range('move_by_velocity request', 't_dec', m.t_dec, 0, 65535)
+    if not 0 <= m.power <= 65535 or m.power.__class__ is bool:
+        raise out_of_range('move_by_velocity request', 'power', m.power, 0, 65535)
+    body = _S_FRAME_MOVEBYINTERVALREQUEST.pack(b'\x12L', 12, 11, m.servo_id, m.angle, m.velocity, m.t_acc, m.t_dec, m.power)
+    return body + _BYTES[sum(body) & 0xff]
+
+
+def _encode_move_by_velocity_response(m: MoveByVelocityResponse) -> bytes:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
+        raise out_of_range('move_by_velocity response', 'servo_id', m.servo_id, 0, 254)
+    if not 0 <= m.result <= 1 or m.result.__class__ is bool:
+        raise out_of_range('move_by_velocity response', 'result', m.result, 0, 1)
+    body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 12, 2, m.servo_id, m.result)
+    return body + _BYTES[sum(body) & 0xff]
+
+
+def _encode_move_mturn_request(m: MoveMturnRequest) -> bytes:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
+        raise out_of_range('move_mturn request', 'servo_id', m.servo_id, 0, 254)
+    if not -3686400 <= m.angle <= 3686400 or m.angle.__class__ is bool:
+        raise out_of_range('move_mturn request', 'angle', m.angle, -3686400, 3686400)
+    if not 0 <= m.interval <= 4096000 or m.interval.__class__ is bool:
+        raise out_of_range('move_mturn request', 'interval', m.interval, 0, 4096000)
+    if not 0 <= m.power <= 65535 or m.power.__class__ is bool:
+        raise out_of_range('move_mturn request', 'power', m.power, 0, 65535)
+    body = _S_FRAME_MOVEMTURNREQUEST.pack(b'\x12L', 13, 11, m.servo_id, m.angle, m.interval, m.power)
+    return body + _BYTES[sum(body) & 0xff]
+
+
+def _encode_move_mturn_response(m: MoveMturnResponse) -> bytes:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
+        raise out_of_range('move_mturn response', 'servo_id', m.servo_id, 0, 254)
+    if not 0 <= m.result <= 1 or m.result.__class__ is bool:
+        raise out_of_range('move_mturn response', 'result', m.result, 0, 1)
+    body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 13, 2, m.servo_id, m.result)
+    return body + _BYTES[sum(body) & 0xff]
+
+
+def _encode_move_mturn_by_interval_request(m: MoveMturnByIntervalRequest) -> bytes:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
+        raise out_of_range('move_mturn_by_interval request', 'servo_id', m.servo_id, 0, 254)
+    if not -3686400 <= m.angle <= 3686400 or m.angle.__class__ is bool:
+        raise out_of_range('move_mturn_by_interval request', 'angle', m.angle, -3686400, 3686400)
+    if not 0 <= m.interval <= 4096000 or m.interval.__class__ is bool:
+        raise out_of_range('move_mturn_by_interval request', 'interval', m.interval, 0, 4096000)
+    if not 0 <= m.t_acc <= 65535 or m.t_acc.__class__ is bool:
+        raise out_of_range('move_mturn_by_interval request', 't_acc', m.t_acc, 0, 65535)
+    if not 0 <= m.t_dec <= 65535 or m.t_dec.__class__ is bool:
+        raise out_of_range('move_mturn_by_interval request', 't_dec', m.t_dec, 0, 65535)
+    if not 0 <= m.power <= 65535 or m.power.__class__ is bool:
+        raise out_of_range('move_mturn_by_interval request', 'power', m.power, 0, 65535)
+    body = _S_FRAME_MOVEMTURNBYINTERVALREQUEST.pack(b'\x12L', 14, 15, m.servo_id, m.angle, m.interval, m.t_acc, m.t_dec, m.power)
+    return body + _BYTES[sum(body) & 0xff]
+
+
+def _encode_move_mturn_by_interval_response(m: MoveMturnByIntervalResponse) -> bytes:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
+        raise out_of_range('move_mturn_by_interval response', 'servo_id', m.servo_id, 0, 254)
+    if not 0 <= m.result <= 1 or m.result.__class__ is bool:
+        raise out_of_range('move_mturn_by_interval response', 'result', m.result, 0, 1)
+    body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 14, 2, m.servo_id, m.result)
+    return body + _BYTES[sum(body) & 0xff]
+
+
+def _encode_move_mturn_by_velocity_request(m: MoveMturnByVelocityRequest) -> bytes:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
+        raise out_of_range('move_mturn_by_velocity request', 'servo_id', m.servo_id, 0, 254)
+    if not -3686400 <= m.angle <= 3686400 or m.angle.__class__ is bool:
+        raise out_of_range('move_mturn_by_velocity request', 'angle', m.angle, -3686400, 3686400)
+    if not 10 <= m.velocity <= 7500 or m.velocity.__class__ is bool:
+        raise out_of_range('move_mturn_by_velocity request', 'velocity', m.velocity, 10, 7500)
+    if not 0 <= m.t_acc <= 65535 or m.t_acc.__class__ is bool:
+        raise out_of_range('move_mturn_by_velocity request', 't_acc', m.t_acc, 0, 65535)
+    if not 0 <= m.t_dec <= 65535 or m.t_dec.__class__ is bool:
+        raise out_of_range('move_mturn_by_velocity request', 't_dec', m.t_dec, 0, 65535)
+    if not 0 <= m.power <= 65535 or m.power.__class__ is bool:
+        raise out_of_range('move_mturn_by_velocity request', 'power', m.power, 0, 65535)
+    body = _S_FRAME_MOVEMTURNBYVELOCITYREQUEST.pack(b'\x12L', 15, 13, m.servo_id, m.angle, m.velocity, m.t_acc, m.t_dec, m.power)
+    return body + _BYTES[sum(body) & 0xff]
+
+
+def _encode_move_mturn_by_velocity_response(m: MoveMturnByVelocityResponse) -> bytes:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
+        raise out_of_range('move_mturn_by_velocity response', 'servo_id', m.servo_id, 0, 254)
+    if not 0 <= m.result <= 1 or m.result.__class__ is bool:
+        raise out_of_range('move_mturn_by_velocity response', 'result', m.result, 0, 1)
+    body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 15, 2, m.servo_id, m.result)
+    return body + _BYTES[sum(body) & 0xff]
+
+
+def _encode_read_mturn_angle_request(m: ReadMturnAngleRequest) -> bytes:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
+        raise out_of_range('read_mturn_angle request', 'servo_id', m.servo_id, 0, 254)
+    body = _S_B2_U8_U8_U8.pack(b'\x12L', 16, 1, m.servo_id)
+    return body + _BYTES[sum(body) & 0xff]
+
+
+def _encode_read_mturn_angle_response(m: ReadMturnAngleResponse) -> bytes:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
+        raise out_of_range('read_mturn_angle response', 'servo_id', m.servo_id, 0, 254)
+    if not -3686400 <= m.angle <= 3686400 or m.angle.__class__ is bool:
+        raise out_of_range('read_mturn_angle response', 'angle', m.angle, -3686400, 3686400)
+    if not -32768 <= m.turns <= 32767 or m.turns.__class__ is bool:
+        raise out_of_range('read_mturn_angle response', 'turns', m.turns, -32768, 32767)
+    body = _S_B2_U8_U8_U8_I32_I16.pack(b'\x05\x1c', 16, 7, m.servo_id, m.angle, m.turns)
+    return body + _BYTES[sum(body) & 0xff]
+
+
+def _encode_reset_mturn_angle_request(m: ResetMturnAngleRequest) -> bytes:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
+        raise out_of_range('reset_mturn_angle request', 'servo_id', m.servo_id, 0, 254)
+    body = _S_B2_U8_U8_U8.pack(b'\x12L', 17, 1, m.servo_id)
+    return body + _BYTES[sum(body) & 0xff]
+
+
+def _encode_begin_async_request(m: BeginAsyncRequest) -> bytes:
+    body = _S_B2_U8_U8.pack(b'\x12L', 18, 0)
+    return body + _BYTES[sum(body) & 0xff]
+
+
+def _encode_end_async_request(m: EndAsyncRequest) -> bytes:
+    if not 0 <= m.mode <= 1 or m.mode.__class__ is bool:
+        raise out_of_range('end_async request', 'mode', m.mode, 0, 1)
+    body = _S_B2_U8_U8_U8.pack(b'\x12L', 19, 1, m.mode)
+    return body + _BYTES[sum(body) & 0xff]
+
+
+def _encode_monitor_request(m: MonitorRequest) -> bytes:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
+        raise out_of_range('monitor request', 'servo_id', m.servo_id, 0, 254)
+    body = _S_B2_U8_U8_U8.pack(b'\x12L', 22, 1, m.servo_id)
+    return body + _BYTES[sum(body) & 0xff]
+
+
+def _encode_monitor_response(m: MonitorResponse) -> bytes:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
+        raise out_of_range('monitor response', 'servo_id', m.servo_id, 0, 254)
+    if not 0 <= m.voltage <= 65535 or m.voltage.__class__ is bool:
+        raise out_of_range('monitor response', 'voltage', m.voltage, 0, 65535)
+    if not 0 <= m.current <= 65535 or m.current.__class__ is bool:
+        raise out_of_range('monitor response', 'current', m.current, 0, 65535)
+    if not 0 <= m.power <= 65535 or m.power.__class__ is bool:
+        raise out_of_range('monitor response', 'power', m.power, 0, 65535)
+    if not 0 <= m.temperature <= 65535 or m.temperature.__class__ is bool:
+        raise out_of_range('monitor response', 'temperature', m.temperature, 0, 65535)
+    if not 0 <= m.status <= 255 or isinstance(m.status, bool):
+        raise out_of_range('monitor response', 'status', m.status, 0, 255)
+    if not -3686400 <= m.angle <= 3686400 or m.angle.__class__ is bool:
+        raise out_of_range('monitor response', 'angle', m.angle, -3686400, 3686400)
+    if not -32768 <= m.turns <= 32767 or m.turns.__class__ is bool:
+        raise out_of_range('monitor response', 'turns', m.turns, -32768, 32767)
+    body = _S_FRAME_MONITORRESPONSE.pack(b'\x05\x1c', 22, 16, m.servo_id, m.voltage, m.current, m.power, m.temperature, m.status, m.angle, m.turns)
+    return body + _BYTES[sum(body) & 0xff]
+
+
+def _encode_set_origin_point_request(m: SetOriginPointRequest) -> bytes:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
+        raise out_of_range('set_origin_point request', 'servo_id', m.servo_id, 0, 254)
+    body = _S_B2_U8_U8_U8_U8.pack(b'\x12L', 23, 2, m.servo_id, 0)
+    return body + _BYTES[sum(body) & 0xff]
+
+
+def _encode_stop_on_control_mode_request(m: StopOnControlModeRequest) -> bytes:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
+        raise out_of_range('stop_on_control_mode request', 'servo_id', m.servo_id, 0, 254)
+    if not 16 <= m.method <= 18 or m.method.__class__ is bool:
+        raise out_of_range('stop_on_control_mode request', 'method', m.method, 16, 18)
+    if not 0 <= m.power <= 65535 or m.power.__class__ is bool:
+        raise out_of_range('stop_on_control_mode request', 'power', m.power, 0, 65535)
+    body = _S_B2_U8_U8_U8_U8_U16.pack(b'\x12L', 24, 4, m.servo_id, m.method, m.power)
+    return body + _BYTES[sum(body) & 0xff]
+
+
+def _encode_sync_command_request(m: SyncCommandRequest) -> bytes:
+    if not 0 <= m.command <= 255 or m.command.__class__ is bool:
+        raise out_of_range('sync_command request', 'command', m.command, 0, 255)
+    v_block_size = len(m.blocks[0].content) if m.blocks else 0
+    if any(len(item.content) != v_block_size for item in m.blocks):
+        raise EncodeError('sync_command request' + ': every content of blocks must have the same length')
+    if v_block_size > 255:
+        raise out_of_range('sync_command request', 'block_size', v_block_size, 0, 255)
+    if len(m.blocks) > 255:
+        raise out_of_range('sync_command request', 'count', len(m.blocks), 0, 255)
+    parts_blocks = []
+    for item in m.blocks:
+        parts_blocks.append(bytes(item.content))
+    content = b''.join((_S_U8_U8_U8.pack(m.command, v_block_size, len(m.blocks)), b''.join(parts_blocks),))
+    n = len(content)
+    if n > 255:
+        raise EncodeError(f'content of {len(content)} bytes does not fit the length field')
+    body = _S_B2_U8_U8.pack(b'\x12L', 25, n) + content
+    return body + _BYTES[sum(body) & 0xff]
+
+
 _REQUEST_DECODERS: dict[int | None, Callable[..., Message]] = {
     0x01: _decode_ping_request,
     0x02: _decode_reset_user_data_request,
@@ -768,6 +1337,19 @@ _REQUEST_DECODERS: dict[int | None, Callable[..., Message]] = {
     0x08: _decode_rotate_request,
     0x09: _decode_damping_request,
     0x0a: _decode_read_angle_request,
+    0x0b: _decode_move_by_interval_request,
+    0x0c: _decode_move_by_velocity_request,
+    0x0d: _decode_move_mturn_request,
+    0x0e: _decode_move_mturn_by_interval_request,
+    0x0f: _decode_move_mturn_by_velocity_request,
+    0x10: _decode_read_mturn_angle_request,
+    0x11: _decode_reset_mturn_angle_request,
+    0x12: _decode_begin_async_request,
+    0x13: _decode_end_async_request,
+    0x16: _decode_monitor_request,
+    0x17: _decode_set_origin_point_request,
+    0x18: _decode_stop_on_control_mode_request,
+    0x19: _decode_sync_command_request,
 }
 _REQUEST_SIZES: dict[int | None, tuple[int, int | None]] = {
     0x01: (1, 1),
@@ -780,6 +1362,19 @@ _REQUEST_SIZES: dict[int | None, tuple[int, int | None]] = {
     0x08: (7, 7),
     0x09: (3, 3),
     0x0a: (1, 1),
+    0x0b: (11, 11),
+    0x0c: (11, 11),
+    0x0d: (11, 11),
+    0x0e: (15, 15),
+    0x0f: (13, 13),
+    0x10: (1, 1),
+    0x11: (1, 1),
+    0x12: (0, 0),
+    0x13: (1, 1),
+    0x16: (1, 1),
+    0x17: (2, 2),
+    0x18: (4, 4),
+    0x19: (3, None),
 }
 
 
@@ -805,6 +1400,13 @@ _RESPONSE_DECODERS: dict[int | None, Callable[..., Message]] = {
     0x08: _decode_rotate_response,
     0x09: _decode_damping_response,
     0x0a: _decode_read_angle_response,
+    0x0b: _decode_move_by_interval_response,
+    0x0c: _decode_move_by_velocity_response,
+    0x0d: _decode_move_mturn_response,
+    0x0e: _decode_move_mturn_by_interval_response,
+    0x0f: _decode_move_mturn_by_velocity_response,
+    0x10: _decode_read_mturn_angle_response,
+    0x16: _decode_monitor_response,
 }
 _RESPONSE_SIZES: dict[int | None, tuple[int, int | None]] = {
     0x01: (1, 1),
@@ -817,6 +1419,13 @@ _RESPONSE_SIZES: dict[int | None, tuple[int, int | None]] = {
     0x08: (2, 2),
     0x09: (2, 2),
     0x0a: (3, 3),
+    0x0b: (2, 2),
+    0x0c: (2, 2),
+    0x0d: (2, 2),
+    0x0e: (2, 2),
+    0x0f: (2, 2),
+    0x10: (7, 7),
+    0x16: (16, 16),
 }
 
 
@@ -852,6 +1461,26 @@ _ENCODERS: dict[type[Message], Callable[..., bytes]] = {
     DampingResponse: _encode_damping_response,
     ReadAngleRequest: _encode_read_angle_request,
     ReadAngleResponse: _encode_read_angle_response,
+    MoveByIntervalRequest: _encode_move_by_interval_request,
+    MoveByIntervalResponse: _encode_move_by_interval_response,
+    MoveByVelocityRequest: _encode_move_by_velocity_request,
+    MoveByVelocityResponse: _encode_move_by_velocity_response,
+    MoveMturnRequest: _encode_move_mturn_request,
+    MoveMturnResponse: _encode_move_mturn_response,
+    MoveMturnByIntervalRequest: _encode_move_mturn_by_interval_request,
+    MoveMturnByIntervalResponse: _encode_move_mturn_by_interval_response,
+    MoveMturnByVelocityRequest: _encode_move_mturn_by_velocity_request,
+    MoveMturnByVelocityResponse: _encode_move_mturn_by_velocity_response,
+    ReadMturnAngleRequest: _encode_read_mturn_angle_request,
+    ReadMturnAngleResponse: _encode_read_mturn_angle_response,
+    ResetMturnAngleRequest: _encode_reset_mturn_angle_request,
+    BeginAsyncRequest: _encode_begin_async_request,
+    EndAsyncRequest: _encode_end_async_request,
+    MonitorRequest: _encode_monitor_request,
+    MonitorResponse: _encode_monitor_response,
+    SetOriginPointRequest: _encode_set_origin_point_request,
+    StopOnControlModeRequest: _encode_stop_on_control_mode_request,
+    SyncCommandRequest: _encode_sync_command_request,
 }
 
 REQUEST_FORMAT = FrameFormat(

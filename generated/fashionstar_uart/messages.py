@@ -5,25 +5,44 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
-from enum import IntEnum
+from enum import IntEnum, IntFlag
 from typing import Any, ClassVar, Self
 
+from serialspec.runtime.fields import as_bytes as _bytes
 from serialspec.runtime.fields import check_keys as _check_keys
 from serialspec.runtime.fields import enum as _as_enum
+from serialspec.runtime.fields import flags as _as_flags
 from serialspec.runtime.fields import get as _get
 from serialspec.runtime.fields import integer as _integer
+from serialspec.runtime.fields import items as _items
 from serialspec.runtime.fields import mapping as _mapping
 from serialspec.runtime.message import Direction, Message
 
 __all__ = [
+    'AsyncEnd',
     'BaudrateOption',
+    'BeginAsyncRequest',
+    'BlocksItem',
     'DampingRequest',
     'DampingResponse',
     'Direction',
+    'EndAsyncRequest',
     'LockOnPowerOn',
     'MESSAGE_TYPES',
     'Message',
     'MethodBits',
+    'MonitorRequest',
+    'MonitorResponse',
+    'MoveByIntervalRequest',
+    'MoveByIntervalResponse',
+    'MoveByVelocityRequest',
+    'MoveByVelocityResponse',
+    'MoveMturnByIntervalRequest',
+    'MoveMturnByIntervalResponse',
+    'MoveMturnByVelocityRequest',
+    'MoveMturnByVelocityResponse',
+    'MoveMturnRequest',
+    'MoveMturnResponse',
     'PingRequest',
     'PingResponse',
     'ReadAngleRequest',
@@ -32,18 +51,26 @@ __all__ = [
     'ReadBatchDataResponse',
     'ReadDataRequest',
     'ReadDataResponse',
+    'ReadMturnAngleRequest',
+    'ReadMturnAngleResponse',
+    'ResetMturnAngleRequest',
     'ResetUserDataRequest',
     'ResetUserDataResponse',
     'ResponseSwitch',
     'Result',
     'RotateRequest',
     'RotateResponse',
+    'ServoStatus',
+    'SetOriginPointRequest',
     'SpinDirection',
     'SpinMode',
     'SpinRequest',
     'SpinResponse',
     'StallProtectMode',
+    'StopMethod',
+    'StopOnControlModeRequest',
     'Switch',
+    'SyncCommandRequest',
     'UserData',
     'WheelBrake',
     'WriteBatchDataRequest',
@@ -135,6 +162,26 @@ class SpinDirection(IntEnum):
     CLOCKWISE = 1
 
 
+class StopMethod(IntEnum):
+    """What the servo does after STOP_ON_CONTROL_MODE (sdk StopOptions)."""
+
+    #: stop, then release the torque (unlocked)
+    RELEASE = 16
+    #: stop, then hold the position (locked)
+    HOLD = 17
+    #: stop, then go into damping mode
+    DAMPING = 18
+
+
+class AsyncEnd(IntEnum):
+    """What END_ASYNC does with the commands held since BEGIN_ASYNC."""
+
+    #: run the held commands now
+    EXECUTE = 0
+    #: drop the held commands
+    CANCEL = 1
+
+
 class SpinMode(IntEnum):
     """spin mode"""
 
@@ -146,6 +193,28 @@ class SpinMode(IntEnum):
     TURNS = 2
     #: turn for `value` ms, then stop
     TIMED = 3
+
+
+class ServoStatus(IntFlag):
+    """The servo's working status (data_id 5, and the servo monitor's status byte); bit meanings from the fashionstar-uart-sdk (uservo.py, the comment above query_status); 000 documents none."""
+
+    NONE = 0
+    #: a command is being executed (cleared when it is done)
+    EXECUTING = 1 << 0
+    #: the last command failed (cleared by the next good one)
+    COMMAND_ERROR = 1 << 1
+    #: stall error (cleared when the stall ends)
+    STALLED = 1 << 2
+    #: voltage too high
+    OVER_VOLTAGE = 1 << 3
+    #: voltage too low
+    UNDER_VOLTAGE = 1 << 4
+    #: current error
+    CURRENT_ERROR = 1 << 5
+    #: power error
+    POWER_ERROR = 1 << 6
+    #: temperature error
+    TEMPERATURE_ERROR = 1 << 7
 
 
 @dataclass(frozen=True, slots=True)
@@ -273,6 +342,26 @@ class MethodBits:
         return cls(
             _as_enum(SpinDirection, _get(data, 'direction', where), 'direction', where),
             _as_enum(SpinMode, _get(data, 'mode', where), 'mode', where),
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class BlocksItem:
+    """One item of blocks."""
+
+    #: The carried command's request content for one servo.
+    content: bytes
+
+    def to_fields(self) -> dict[str, Any]:
+        return {
+            'content': self.content.hex(' '),
+        }
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'BlocksItem') -> Self:
+        _check_keys(data, ('content',), (), where)
+        return cls(
+            _bytes(_get(data, 'content', where), 'content', where),
         )
 
 
@@ -686,7 +775,7 @@ class RotateRequest(Message):
     angle: int
     #: Time to reach the target angle. [ms]
     interval: int
-    #: Power; 0 or more than the power limit means the power limit. [mW]
+    #: Power; 0 or more than the power limit means the power limit (000's 功率保持值, read as data_id 42: erratum power_hold_value_undefined). [mW]
     power: int = 0
 
     def to_fields(self) -> dict[str, Any]:
@@ -844,6 +933,642 @@ class ReadAngleResponse(Message):
         )
 
 
+@dataclass(frozen=True, slots=True)
+class MoveByIntervalRequest(Message):
+    """Move to an angle in a time, with acceleration and deceleration times (request)."""
+
+    PROTOCOL: ClassVar[str] = 'fashionstar_uart'
+    COMMAND: ClassVar[str] = 'move_by_interval'
+    SUBCOMMAND: ClassVar[str | None] = None
+    DIRECTION: ClassVar[Direction] = Direction.REQUEST
+    #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
+    servo_id: int
+    #: Target angle in 0.1° steps, -180.0°..180.0° (the SDK clamps to this range). [0.1°] range -1800..1800
+    angle: int
+    #: Time to reach the target angle. [ms]
+    interval: int
+    #: Acceleration time at the start of the move (the SDK sends at least 20 ms). [ms]
+    t_acc: int = 20
+    #: Deceleration time at the end of the move (the SDK sends at least 20 ms). [ms]
+    t_dec: int = 20
+    #: Power limit of the move; 0 (or more than the power limit, data_id 42) means the power limit. [mW]
+    power: int = 0
+
+    def to_fields(self) -> dict[str, Any]:
+        return {
+            'servo_id': self.servo_id,
+            'angle': self.angle,
+            'interval': self.interval,
+            't_acc': self.t_acc,
+            't_dec': self.t_dec,
+            'power': self.power,
+        }
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'move_by_interval request') -> Self:
+        _check_keys(data, ('servo_id', 'angle', 'interval', 't_acc', 't_dec', 'power'), (), where)
+        return cls(
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'angle', where), 'angle', where),
+            _integer(_get(data, 'interval', where), 'interval', where),
+            _integer(data.get('t_acc', 20), 't_acc', where),
+            _integer(data.get('t_dec', 20), 't_dec', where),
+            _integer(data.get('power', 0), 'power', where),
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class MoveByIntervalResponse(Message):
+    """Move to an angle in a time, with acceleration and deceleration times (response). Optional: Inferred from ROTATE (the SDK waits for no reply): sent only when response_switch (data_id 33) is 1, once the target is reached."""
+
+    PROTOCOL: ClassVar[str] = 'fashionstar_uart'
+    COMMAND: ClassVar[str] = 'move_by_interval'
+    SUBCOMMAND: ClassVar[str | None] = None
+    DIRECTION: ClassVar[Direction] = Direction.RESPONSE
+    #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
+    servo_id: int
+    #: Outcome of the command. range 0..1
+    result: Result | int
+
+    def to_fields(self) -> dict[str, Any]:
+        return {
+            'servo_id': self.servo_id,
+            'result': int(self.result),
+        }
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'move_by_interval response') -> Self:
+        _check_keys(data, ('servo_id', 'result'), (), where)
+        return cls(
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(Result, _get(data, 'result', where), 'result', where),
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class MoveByVelocityRequest(Message):
+    """Move to an angle at a speed, with acceleration and deceleration times (request)."""
+
+    PROTOCOL: ClassVar[str] = 'fashionstar_uart'
+    COMMAND: ClassVar[str] = 'move_by_velocity'
+    SUBCOMMAND: ClassVar[str | None] = None
+    DIRECTION: ClassVar[Direction] = Direction.REQUEST
+    #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
+    servo_id: int
+    #: Target angle in 0.1° steps, -180.0°..180.0° (the SDK clamps to this range). [0.1°] range -1800..1800
+    angle: int
+    #: Target speed in 0.1°/s (the SDK clamps to 1.0..750.0 °/s). [0.1°/s] range 10..7500
+    velocity: int
+    #: Acceleration time at the start of the move (the SDK sends at least 20 ms). [ms]
+    t_acc: int = 20
+    #: Deceleration time at the end of the move (the SDK sends at least 20 ms). [ms]
+    t_dec: int = 20
+    #: Power limit of the move; 0 (or more than the power limit, data_id 42) means the power limit. [mW]
+    power: int = 0
+
+    def to_fields(self) -> dict[str, Any]:
+        return {
+            'servo_id': self.servo_id,
+            'angle': self.angle,
+            'velocity': self.velocity,
+            't_acc': self.t_acc,
+            't_dec': self.t_dec,
+            'power': self.power,
+        }
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'move_by_velocity request') -> Self:
+        _check_keys(data, ('servo_id', 'angle', 'velocity', 't_acc', 't_dec', 'power'), (), where)
+        return cls(
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'angle', where), 'angle', where),
+            _integer(_get(data, 'velocity', where), 'velocity', where),
+            _integer(data.get('t_acc', 20), 't_acc', where),
+            _integer(data.get('t_dec', 20), 't_dec', where),
+            _integer(data.get('power', 0), 'power', where),
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class MoveByVelocityResponse(Message):
+    """Move to an angle at a speed, with acceleration and deceleration times (response). Optional: Inferred from ROTATE (the SDK waits for no reply): sent only when response_switch (data_id 33) is 1, once the target is reached."""
+
+    PROTOCOL: ClassVar[str] = 'fashionstar_uart'
+    COMMAND: ClassVar[str] = 'move_by_velocity'
+    SUBCOMMAND: ClassVar[str | None] = None
+    DIRECTION: ClassVar[Direction] = Direction.RESPONSE
+    #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
+    servo_id: int
+    #: Outcome of the command. range 0..1
+    result: Result | int
+
+    def to_fields(self) -> dict[str, Any]:
+        return {
+            'servo_id': self.servo_id,
+            'result': int(self.result),
+        }
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'move_by_velocity response') -> Self:
+        _check_keys(data, ('servo_id', 'result'), (), where)
+        return cls(
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(Result, _get(data, 'result', where), 'result', where),
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class MoveMturnRequest(Message):
+    """Multi-turn move to an angle in a time (request)."""
+
+    PROTOCOL: ClassVar[str] = 'fashionstar_uart'
+    COMMAND: ClassVar[str] = 'move_mturn'
+    SUBCOMMAND: ClassVar[str | None] = None
+    DIRECTION: ClassVar[Direction] = Direction.REQUEST
+    #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
+    servo_id: int
+    #: Multi-turn angle in 0.1° steps, up to ±1024 turns (the SDK clamps to ±368640.0°). [0.1°] range -3686400..3686400
+    angle: int
+    #: Time to reach the target angle. [ms] range 0..4096000
+    interval: int
+    #: Power limit of the move; 0 (or more than the power limit, data_id 42) means the power limit. [mW]
+    power: int = 0
+
+    def to_fields(self) -> dict[str, Any]:
+        return {
+            'servo_id': self.servo_id,
+            'angle': self.angle,
+            'interval': self.interval,
+            'power': self.power,
+        }
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'move_mturn request') -> Self:
+        _check_keys(data, ('servo_id', 'angle', 'interval', 'power'), (), where)
+        return cls(
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'angle', where), 'angle', where),
+            _integer(_get(data, 'interval', where), 'interval', where),
+            _integer(data.get('power', 0), 'power', where),
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class MoveMturnResponse(Message):
+    """Multi-turn move to an angle in a time (response). Optional: Inferred from ROTATE (the SDK waits for no reply): sent only when response_switch (data_id 33) is 1, once the target is reached."""
+
+    PROTOCOL: ClassVar[str] = 'fashionstar_uart'
+    COMMAND: ClassVar[str] = 'move_mturn'
+    SUBCOMMAND: ClassVar[str | None] = None
+    DIRECTION: ClassVar[Direction] = Direction.RESPONSE
+    #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
+    servo_id: int
+    #: Outcome of the command. range 0..1
+    result: Result | int
+
+    def to_fields(self) -> dict[str, Any]:
+        return {
+            'servo_id': self.servo_id,
+            'result': int(self.result),
+        }
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'move_mturn response') -> Self:
+        _check_keys(data, ('servo_id', 'result'), (), where)
+        return cls(
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(Result, _get(data, 'result', where), 'result', where),
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class MoveMturnByIntervalRequest(Message):
+    """Multi-turn move in a time, with acceleration and deceleration times (request)."""
+
+    PROTOCOL: ClassVar[str] = 'fashionstar_uart'
+    COMMAND: ClassVar[str] = 'move_mturn_by_interval'
+    SUBCOMMAND: ClassVar[str | None] = None
+    DIRECTION: ClassVar[Direction] = Direction.REQUEST
+    #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
+    servo_id: int
+    #: Multi-turn angle in 0.1° steps, up to ±1024 turns (the SDK clamps to ±368640.0°). [0.1°] range -3686400..3686400
+    angle: int
+    #: Time to reach the target (at least t_acc + t_dec). [ms] range 0..4096000
+    interval: int
+    #: Acceleration time at the start of the move (the SDK sends at least 20 ms). [ms]
+    t_acc: int = 20
+    #: Deceleration time at the end of the move (the SDK sends at least 20 ms). [ms]
+    t_dec: int = 20
+    #: Power limit of the move; 0 (or more than the power limit, data_id 42) means the power limit. [mW]
+    power: int = 0
+
+    def to_fields(self) -> dict[str, Any]:
+        return {
+            'servo_id': self.servo_id,
+            'angle': self.angle,
+            'interval': self.interval,
+            't_acc': self.t_acc,
+            't_dec': self.t_dec,
+            'power': self.power,
+        }
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'move_mturn_by_interval request') -> Self:
+        _check_keys(data, ('servo_id', 'angle', 'interval', 't_acc', 't_dec', 'power'), (), where)
+        return cls(
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'angle', where), 'angle', where),
+            _integer(_get(data, 'interval', where), 'interval', where),
+            _integer(data.get('t_acc', 20), 't_acc', where),
+            _integer(data.get('t_dec', 20), 't_dec', where),
+            _integer(data.get('power', 0), 'power', where),
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class MoveMturnByIntervalResponse(Message):
+    """Multi-turn move in a time, with acceleration and deceleration times (response). Optional: Inferred from ROTATE (the SDK waits for no reply): sent only when response_switch (data_id 33) is 1, once the target is reached."""
+
+    PROTOCOL: ClassVar[str] = 'fashionstar_uart'
+    COMMAND: ClassVar[str] = 'move_mturn_by_interval'
+    SUBCOMMAND: ClassVar[str | None] = None
+    DIRECTION: ClassVar[Direction] = Direction.RESPONSE
+    #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
+    servo_id: int
+    #: Outcome of the command. range 0..1
+    result: Result | int
+
+    def to_fields(self) -> dict[str, Any]:
+        return {
+            'servo_id': self.servo_id,
+            'result': int(self.result),
+        }
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'move_mturn_by_interval response') -> Self:
+        _check_keys(data, ('servo_id', 'result'), (), where)
+        return cls(
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(Result, _get(data, 'result', where), 'result', where),
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class MoveMturnByVelocityRequest(Message):
+    """Multi-turn move at a speed, with acceleration and deceleration times (request)."""
+
+    PROTOCOL: ClassVar[str] = 'fashionstar_uart'
+    COMMAND: ClassVar[str] = 'move_mturn_by_velocity'
+    SUBCOMMAND: ClassVar[str | None] = None
+    DIRECTION: ClassVar[Direction] = Direction.REQUEST
+    #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
+    servo_id: int
+    #: Multi-turn angle in 0.1° steps, up to ±1024 turns (the SDK clamps to ±368640.0°). [0.1°] range -3686400..3686400
+    angle: int
+    #: Target speed in 0.1°/s (the SDK clamps to 1.0..750.0 °/s). [0.1°/s] range 10..7500
+    velocity: int
+    #: Acceleration time at the start of the move (the SDK sends at least 20 ms). [ms]
+    t_acc: int = 20
+    #: Deceleration time at the end of the move (the SDK sends at least 20 ms). [ms]
+    t_dec: int = 20
+    #: Power limit of the move; 0 (or more than the power limit, data_id 42) means the power limit. [mW]
+    power: int = 0
+
+    def to_fields(self) -> dict[str, Any]:
+        return {
+            'servo_id': self.servo_id,
+            'angle': self.angle,
+            'velocity': self.velocity,
+            't_acc': self.t_acc,
+            't_dec': self.t_dec,
+            'power': self.power,
+        }
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'move_mturn_by_velocity request') -> Self:
+        _check_keys(data, ('servo_id', 'angle', 'velocity', 't_acc', 't_dec', 'power'), (), where)
+        return cls(
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'angle', where), 'angle', where),
+            _integer(_get(data, 'velocity', where), 'velocity', where),
+            _integer(data.get('t_acc', 20), 't_acc', where),
+            _integer(data.get('t_dec', 20), 't_dec', where),
+            _integer(data.get('power', 0), 'power', where),
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class MoveMturnByVelocityResponse(Message):
+    """Multi-turn move at a speed, with acceleration and deceleration times (response). Optional: Inferred from ROTATE (the SDK waits for no reply): sent only when response_switch (data_id 33) is 1, once the target is reached."""
+
+    PROTOCOL: ClassVar[str] = 'fashionstar_uart'
+    COMMAND: ClassVar[str] = 'move_mturn_by_velocity'
+    SUBCOMMAND: ClassVar[str | None] = None
+    DIRECTION: ClassVar[Direction] = Direction.RESPONSE
+    #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
+    servo_id: int
+    #: Outcome of the command. range 0..1
+    result: Result | int
+
+    def to_fields(self) -> dict[str, Any]:
+        return {
+            'servo_id': self.servo_id,
+            'result': int(self.result),
+        }
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'move_mturn_by_velocity response') -> Self:
+        _check_keys(data, ('servo_id', 'result'), (), where)
+        return cls(
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(Result, _get(data, 'result', where), 'result', where),
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class ReadMturnAngleRequest(Message):
+    """Read the multi-turn angle and turn count (request)."""
+
+    PROTOCOL: ClassVar[str] = 'fashionstar_uart'
+    COMMAND: ClassVar[str] = 'read_mturn_angle'
+    SUBCOMMAND: ClassVar[str | None] = None
+    DIRECTION: ClassVar[Direction] = Direction.REQUEST
+    #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
+    servo_id: int
+
+    def to_fields(self) -> dict[str, Any]:
+        return {
+            'servo_id': self.servo_id,
+        }
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'read_mturn_angle request') -> Self:
+        _check_keys(data, ('servo_id',), (), where)
+        return cls(
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class ReadMturnAngleResponse(Message):
+    """Read the multi-turn angle and turn count (response)."""
+
+    PROTOCOL: ClassVar[str] = 'fashionstar_uart'
+    COMMAND: ClassVar[str] = 'read_mturn_angle'
+    SUBCOMMAND: ClassVar[str | None] = None
+    DIRECTION: ClassVar[Direction] = Direction.RESPONSE
+    #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
+    servo_id: int
+    #: Multi-turn angle in 0.1° steps, up to ±1024 turns (the SDK clamps to ±368640.0°). [0.1°] range -3686400..3686400
+    angle: int
+    #: Whole turns in the multi-turn angle (toward zero). (layout inferred, not documented)
+    turns: int
+
+    def to_fields(self) -> dict[str, Any]:
+        return {
+            'servo_id': self.servo_id,
+            'angle': self.angle,
+            'turns': self.turns,
+        }
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'read_mturn_angle response') -> Self:
+        _check_keys(data, ('servo_id', 'angle', 'turns'), (), where)
+        return cls(
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'angle', where), 'angle', where),
+            _integer(_get(data, 'turns', where), 'turns', where),
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class ResetMturnAngleRequest(Message):
+    """Reset the multi-turn angle (request)."""
+
+    PROTOCOL: ClassVar[str] = 'fashionstar_uart'
+    COMMAND: ClassVar[str] = 'reset_mturn_angle'
+    SUBCOMMAND: ClassVar[str | None] = None
+    DIRECTION: ClassVar[Direction] = Direction.REQUEST
+    #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
+    servo_id: int
+
+    def to_fields(self) -> dict[str, Any]:
+        return {
+            'servo_id': self.servo_id,
+        }
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'reset_mturn_angle request') -> Self:
+        _check_keys(data, ('servo_id',), (), where)
+        return cls(
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class BeginAsyncRequest(Message):
+    """Begin holding move commands (request)."""
+
+    PROTOCOL: ClassVar[str] = 'fashionstar_uart'
+    COMMAND: ClassVar[str] = 'begin_async'
+    SUBCOMMAND: ClassVar[str | None] = None
+    DIRECTION: ClassVar[Direction] = Direction.REQUEST
+
+    def to_fields(self) -> dict[str, Any]:
+        return {
+        }
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'begin_async request') -> Self:
+        _check_keys(data, (), (), where)
+        return cls(
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class EndAsyncRequest(Message):
+    """Run (or drop) the held move commands (request)."""
+
+    PROTOCOL: ClassVar[str] = 'fashionstar_uart'
+    COMMAND: ClassVar[str] = 'end_async'
+    SUBCOMMAND: ClassVar[str | None] = None
+    DIRECTION: ClassVar[Direction] = Direction.REQUEST
+    #: 0 runs the held commands, 1 drops them. range 0..1
+    mode: AsyncEnd | int
+
+    def to_fields(self) -> dict[str, Any]:
+        return {
+            'mode': int(self.mode),
+        }
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'end_async request') -> Self:
+        _check_keys(data, ('mode',), (), where)
+        return cls(
+            _as_enum(AsyncEnd, _get(data, 'mode', where), 'mode', where),
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class MonitorRequest(Message):
+    """Read voltage, current, power, temperature, status and multi-turn angle at once (request)."""
+
+    PROTOCOL: ClassVar[str] = 'fashionstar_uart'
+    COMMAND: ClassVar[str] = 'monitor'
+    SUBCOMMAND: ClassVar[str | None] = None
+    DIRECTION: ClassVar[Direction] = Direction.REQUEST
+    #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
+    servo_id: int
+
+    def to_fields(self) -> dict[str, Any]:
+        return {
+            'servo_id': self.servo_id,
+        }
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'monitor request') -> Self:
+        _check_keys(data, ('servo_id',), (), where)
+        return cls(
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class MonitorResponse(Message):
+    """Read voltage, current, power, temperature, status and multi-turn angle at once (response)."""
+
+    PROTOCOL: ClassVar[str] = 'fashionstar_uart'
+    COMMAND: ClassVar[str] = 'monitor'
+    SUBCOMMAND: ClassVar[str | None] = None
+    DIRECTION: ClassVar[Direction] = Direction.RESPONSE
+    #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
+    servo_id: int
+    #: Supply voltage (as data_id 1). [mV]
+    voltage: int
+    #: Current (as data_id 2). [mA]
+    current: int
+    #: Power (as data_id 3). [mW]
+    power: int
+    #: Raw NTC reading (as data_id 4; see erratum temperature_unit). [raw ADC]
+    temperature: int
+    #: Working status (as data_id 5).
+    status: ServoStatus
+    #: Multi-turn angle in 0.1° steps, up to ±1024 turns (the SDK clamps to ±368640.0°). [0.1°] range -3686400..3686400
+    angle: int
+    #: Whole turns in the multi-turn angle (toward zero). (layout inferred, not documented)
+    turns: int
+
+    def to_fields(self) -> dict[str, Any]:
+        return {
+            'servo_id': self.servo_id,
+            'voltage': self.voltage,
+            'current': self.current,
+            'power': self.power,
+            'temperature': self.temperature,
+            'status': int(self.status),
+            'angle': self.angle,
+            'turns': self.turns,
+        }
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'monitor response') -> Self:
+        _check_keys(data, ('servo_id', 'voltage', 'current', 'power', 'temperature', 'status', 'angle', 'turns'), (), where)
+        return cls(
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'voltage', where), 'voltage', where),
+            _integer(_get(data, 'current', where), 'current', where),
+            _integer(_get(data, 'power', where), 'power', where),
+            _integer(_get(data, 'temperature', where), 'temperature', where),
+            _as_flags(ServoStatus, _get(data, 'status', where), 255, 'status', where),
+            _integer(_get(data, 'angle', where), 'angle', where),
+            _integer(_get(data, 'turns', where), 'turns', where),
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class SetOriginPointRequest(Message):
+    """Make the present position the origin (request)."""
+
+    PROTOCOL: ClassVar[str] = 'fashionstar_uart'
+    COMMAND: ClassVar[str] = 'set_origin_point'
+    SUBCOMMAND: ClassVar[str | None] = None
+    DIRECTION: ClassVar[Direction] = Direction.REQUEST
+    #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
+    servo_id: int
+
+    def to_fields(self) -> dict[str, Any]:
+        return {
+            'servo_id': self.servo_id,
+        }
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'set_origin_point request') -> Self:
+        _check_keys(data, ('servo_id',), ('reserved',), where)
+        return cls(
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class StopOnControlModeRequest(Message):
+    """Stop the move, then release, hold or damp (request)."""
+
+    PROTOCOL: ClassVar[str] = 'fashionstar_uart'
+    COMMAND: ClassVar[str] = 'stop_on_control_mode'
+    SUBCOMMAND: ClassVar[str | None] = None
+    DIRECTION: ClassVar[Direction] = Direction.REQUEST
+    #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
+    servo_id: int
+    #: What the servo does after stopping. range 16..18
+    method: StopMethod | int
+    #: Holding power (hold and damping). [mW]
+    power: int
+
+    def to_fields(self) -> dict[str, Any]:
+        return {
+            'servo_id': self.servo_id,
+            'method': int(self.method),
+            'power': self.power,
+        }
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'stop_on_control_mode request') -> Self:
+        _check_keys(data, ('servo_id', 'method', 'power'), (), where)
+        return cls(
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(StopMethod, _get(data, 'method', where), 'method', where),
+            _integer(_get(data, 'power', where), 'power', where),
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class SyncCommandRequest(Message):
+    """One command for several servos at once (request)."""
+
+    PROTOCOL: ClassVar[str] = 'fashionstar_uart'
+    COMMAND: ClassVar[str] = 'sync_command'
+    SUBCOMMAND: ClassVar[str | None] = None
+    DIRECTION: ClassVar[Direction] = Direction.REQUEST
+    #: The command carried (8, 11..15, or 22 for the monitor).
+    command: int
+    #: One block per servo.
+    blocks: tuple[BlocksItem, ...]
+
+    def to_fields(self) -> dict[str, Any]:
+        return {
+            'command': self.command,
+            'blocks': [item.to_fields() for item in self.blocks],
+        }
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'sync_command request') -> Self:
+        _check_keys(data, ('command', 'blocks'), ('block_size', 'count'), where)
+        return cls(
+            _integer(_get(data, 'command', where), 'command', where),
+            tuple(BlocksItem.from_fields(_mapping(item, 'blocks', where), where) for item in _items(_get(data, 'blocks', where), 'blocks', where)),
+        )
+
+
 MESSAGE_TYPES: tuple[type[Message], ...] = (
     PingRequest,
     PingResponse,
@@ -865,4 +1590,24 @@ MESSAGE_TYPES: tuple[type[Message], ...] = (
     DampingResponse,
     ReadAngleRequest,
     ReadAngleResponse,
+    MoveByIntervalRequest,
+    MoveByIntervalResponse,
+    MoveByVelocityRequest,
+    MoveByVelocityResponse,
+    MoveMturnRequest,
+    MoveMturnResponse,
+    MoveMturnByIntervalRequest,
+    MoveMturnByIntervalResponse,
+    MoveMturnByVelocityRequest,
+    MoveMturnByVelocityResponse,
+    ReadMturnAngleRequest,
+    ReadMturnAngleResponse,
+    ResetMturnAngleRequest,
+    BeginAsyncRequest,
+    EndAsyncRequest,
+    MonitorRequest,
+    MonitorResponse,
+    SetOriginPointRequest,
+    StopOnControlModeRequest,
+    SyncCommandRequest,
 )

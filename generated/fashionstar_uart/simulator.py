@@ -2,8 +2,12 @@
 """Fashion Star UART servo protocol: a virtual device generated from the spec's `device:` section.
 
 A servo keeps the parameter table in memory (user parameters from their defaults; read-only values from
-`initial`), answers on its servo_id, obeys broadcast (255) without answering, and moves its present angle
-linearly to the target of ROTATE over the interval.
+`initial`), answers on its servo_id, and moves its present angle linearly to the target of ROTATE over the
+interval (with the commands from the SDK, over a trapezoid of acceleration and deceleration times, or at a
+speed), with servo_status bit 0 (executing) set on the way. While BEGIN_ASYNC holds, move commands wait for
+END_ASYNC. Inferred, not documented: a servo obeys the broadcast id 255 for every command without answering
+(000 only says DAMPING takes 255), and the values the simulator starts with (7.4 V, 120 mA, 25 °C and the
+limits below) are its own choice.
 
 `FashionstarUartSimulator(ids=[1, 2]).start()` serves the devices on a new pseudo-terminal and returns its path;
 `serialspec sim specs/fashionstar_uart.yaml --id 1 --id 2` does the same from the shell. Values are wire units.
@@ -11,15 +15,29 @@ linearly to the target of ROTATE over the interval.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Mapping
 
 from serialspec.runtime.device import CommandSpec, DeviceSpec, EntrySpec, Simulator
 
-from fashionstar_uart.codec import StreamParser, encode
+from fashionstar_uart.codec import _REQUEST_DECODERS, StreamParser, encode
 from fashionstar_uart.messages import (
+    BeginAsyncRequest,
     DampingRequest,
     DampingResponse,
     Direction,
+    EndAsyncRequest,
+    MonitorRequest,
+    MonitorResponse,
+    MoveByIntervalRequest,
+    MoveByIntervalResponse,
+    MoveByVelocityRequest,
+    MoveByVelocityResponse,
+    MoveMturnByIntervalRequest,
+    MoveMturnByIntervalResponse,
+    MoveMturnByVelocityRequest,
+    MoveMturnByVelocityResponse,
+    MoveMturnRequest,
+    MoveMturnResponse,
     PingRequest,
     PingResponse,
     ReadAngleRequest,
@@ -28,12 +46,18 @@ from fashionstar_uart.messages import (
     ReadBatchDataResponse,
     ReadDataRequest,
     ReadDataResponse,
+    ReadMturnAngleRequest,
+    ReadMturnAngleResponse,
+    ResetMturnAngleRequest,
     ResetUserDataRequest,
     ResetUserDataResponse,
     RotateRequest,
     RotateResponse,
+    SetOriginPointRequest,
     SpinRequest,
     SpinResponse,
+    StopOnControlModeRequest,
+    SyncCommandRequest,
     WriteBatchDataRequest,
     WriteBatchDataResponse,
     WriteDataRequest,
@@ -79,7 +103,7 @@ DEVICE = DeviceSpec(
         EntrySpec('angle_limit_low', 52, -1800, 'rw', -32768, 32767),
         EntrySpec('angle_mid_offset', 53, 0, 'rw', -32768, 32767),
     ),
-    state={'angle': 0.0},
+    state={'angle': 0.0, 'holding': 0.0},
     reply={'result': 1.0},
     refused={'result': 0.0},
     commands=(
@@ -98,21 +122,65 @@ DEVICE = DeviceSpec(
         # spin
         CommandSpec(SpinRequest, SpinResponse, optional_when=('response_switch', 1)),
         # rotate
-        CommandSpec(RotateRequest, RotateResponse, moves=('angle', 'angle', 'interval', ''), optional_when=('response_switch', 1), after='interval'),
+        CommandSpec(RotateRequest, RotateResponse, moves=('angle', 'angle', 'interval', ''), held_while='holding', optional_when=('response_switch', 1), after='interval'),
         # damping
         CommandSpec(DampingRequest, DampingResponse, optional_when=('response_switch', 1)),
         # read_angle
         CommandSpec(ReadAngleRequest, ReadAngleResponse, reports={'angle': 'angle'}),
+        # move_by_interval
+        CommandSpec(MoveByIntervalRequest, MoveByIntervalResponse, moves=('angle', 'angle', 'interval', ''), ramp=('t_acc', 't_dec'), held_while='holding', optional_when=('response_switch', 1)),
+        # move_by_velocity
+        CommandSpec(MoveByVelocityRequest, MoveByVelocityResponse, moves=('angle', 'angle', '', 'velocity'), ramp=('t_acc', 't_dec'), held_while='holding', optional_when=('response_switch', 1)),
+        # move_mturn
+        CommandSpec(MoveMturnRequest, MoveMturnResponse, moves=('angle', 'angle', 'interval', ''), held_while='holding', optional_when=('response_switch', 1)),
+        # move_mturn_by_interval
+        CommandSpec(MoveMturnByIntervalRequest, MoveMturnByIntervalResponse, moves=('angle', 'angle', 'interval', ''), ramp=('t_acc', 't_dec'), held_while='holding', optional_when=('response_switch', 1)),
+        # move_mturn_by_velocity
+        CommandSpec(MoveMturnByVelocityRequest, MoveMturnByVelocityResponse, moves=('angle', 'angle', '', 'velocity'), ramp=('t_acc', 't_dec'), held_while='holding', optional_when=('response_switch', 1)),
+        # read_mturn_angle
+        CommandSpec(ReadMturnAngleRequest, ReadMturnAngleResponse, reports={'angle': 'angle'}, counts={'turns': ('angle', 3600.0)}),
+        # reset_mturn_angle
+        CommandSpec(ResetMturnAngleRequest, None, wraps={'angle': 3600.0}),
+        # begin_async
+        CommandSpec(BeginAsyncRequest, None, sets={'holding': 1.0}, every_device=True),
+        # end_async
+        CommandSpec(EndAsyncRequest, None, every_device=True, releases='holding', cancel_when={'mode': 1.0}),
+        # monitor
+        CommandSpec(MonitorRequest, MonitorResponse, reports={'voltage': 'voltage', 'current': 'current', 'power': 'power', 'temperature': 'temperature', 'status': 'servo_status', 'angle': 'angle'}, counts={'turns': ('angle', 3600.0)}),
+        # set_origin_point
+        CommandSpec(SetOriginPointRequest, None, sets={'angle': 0.0}),
+        # stop_on_control_mode
+        CommandSpec(StopOnControlModeRequest, None, stops=('angle',)),
+        # sync_command
+        CommandSpec(SyncCommandRequest, None, each='blocks', carries=('command', 'content')),
     ),
+    moving={'servo_status': ('angle', 0)},
+    carried={
+        8: _REQUEST_DECODERS[8],  # RotateRequest
+        11: _REQUEST_DECODERS[11],  # MoveByIntervalRequest
+        12: _REQUEST_DECODERS[12],  # MoveByVelocityRequest
+        13: _REQUEST_DECODERS[13],  # MoveMturnRequest
+        14: _REQUEST_DECODERS[14],  # MoveMturnByIntervalRequest
+        15: _REQUEST_DECODERS[15],  # MoveMturnByVelocityRequest
+        22: _REQUEST_DECODERS[22],  # MonitorRequest
+    },
 )
 
 
 class FashionstarUartSimulator(Simulator):
     """Virtual devices with the given ids on one bus; see serialspec.runtime.device for what they do."""
 
-    def __init__(self, ids: Iterable[int] = (0,), clock: Callable[[], float] | None = None) -> None:
+    def __init__(
+        self,
+        ids: Iterable[int] = (0,),
+        clock: Callable[[], float] | None = None,
+        model: str | Mapping[int, str] | None = None,
+    ) -> None:
+        """`model`: the spec lists no models, so only None."""
         kwargs = {"clock": clock} if clock is not None else {}
-        super().__init__(DEVICE, ids, encode=encode, parser=lambda: StreamParser(Direction.REQUEST), **kwargs)
+        super().__init__(
+            DEVICE, ids, encode=encode, parser=lambda: StreamParser(Direction.REQUEST), model=model, **kwargs
+        )
 
 
 #: The simulator class, under a name every generated package shares (serialspec sim uses it).

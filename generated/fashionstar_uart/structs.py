@@ -210,6 +210,128 @@ ReadAngleResponseContent = Struct(
     'angle' / Int16sl,
 )
 
+MoveByIntervalRequestContent = Struct(
+    'servo_id' / Int8ub,
+    'angle' / Int16sl,
+    'interval' / Int16ul,
+    't_acc' / Int16ul,
+    't_dec' / Int16ul,
+    'power' / Int16ul,
+)
+
+MoveByIntervalResponseContent = Struct(
+    'servo_id' / Int8ub,
+    'result' / Int8ub,
+)
+
+MoveByVelocityRequestContent = Struct(
+    'servo_id' / Int8ub,
+    'angle' / Int16sl,
+    'velocity' / Int16ul,
+    't_acc' / Int16ul,
+    't_dec' / Int16ul,
+    'power' / Int16ul,
+)
+
+MoveByVelocityResponseContent = Struct(
+    'servo_id' / Int8ub,
+    'result' / Int8ub,
+)
+
+MoveMturnRequestContent = Struct(
+    'servo_id' / Int8ub,
+    'angle' / Int32sl,
+    'interval' / Int32ul,
+    'power' / Int16ul,
+)
+
+MoveMturnResponseContent = Struct(
+    'servo_id' / Int8ub,
+    'result' / Int8ub,
+)
+
+MoveMturnByIntervalRequestContent = Struct(
+    'servo_id' / Int8ub,
+    'angle' / Int32sl,
+    'interval' / Int32ul,
+    't_acc' / Int16ul,
+    't_dec' / Int16ul,
+    'power' / Int16ul,
+)
+
+MoveMturnByIntervalResponseContent = Struct(
+    'servo_id' / Int8ub,
+    'result' / Int8ub,
+)
+
+MoveMturnByVelocityRequestContent = Struct(
+    'servo_id' / Int8ub,
+    'angle' / Int32sl,
+    'velocity' / Int16ul,
+    't_acc' / Int16ul,
+    't_dec' / Int16ul,
+    'power' / Int16ul,
+)
+
+MoveMturnByVelocityResponseContent = Struct(
+    'servo_id' / Int8ub,
+    'result' / Int8ub,
+)
+
+ReadMturnAngleRequestContent = Struct(
+    'servo_id' / Int8ub,
+)
+
+ReadMturnAngleResponseContent = Struct(
+    'servo_id' / Int8ub,
+    'angle' / Int32sl,
+    'turns' / Int16sl,
+)
+
+ResetMturnAngleRequestContent = Struct(
+    'servo_id' / Int8ub,
+)
+
+BeginAsyncRequestContent = Struct(
+)
+
+EndAsyncRequestContent = Struct(
+    'mode' / Int8ub,
+)
+
+MonitorRequestContent = Struct(
+    'servo_id' / Int8ub,
+)
+
+MonitorResponseContent = Struct(
+    'servo_id' / Int8ub,
+    'voltage' / Int16ul,
+    'current' / Int16ul,
+    'power' / Int16ul,
+    'temperature' / Int16ul,
+    'status' / Int8ub,
+    'angle' / Int32sl,
+    'turns' / Int16sl,
+)
+
+SetOriginPointRequestContent = Struct(
+    'servo_id' / Int8ub,
+    'reserved' / Const(0, Int8ub),
+)
+
+StopOnControlModeRequestContent = Struct(
+    'servo_id' / Int8ub,
+    'method' / Int8ub,
+    'power' / Int16ul,
+)
+
+SyncCommandRequestContent = Struct(
+    'command' / Int8ub,
+    'block_size' / Rebuild(Int8ub, lambda ctx: _item_size(ctx, 'content')),
+    'count' / Rebuild(Int8ub, len_(this.blocks)),
+    'blocks' / Array(this.count, Struct('content' / Bytes(this._.block_size))),
+)
+
 CONTENTS: dict[tuple[str, str], Any] = {
     ('ping', 'request'): PingRequestContent,
     ('ping', 'response'): PingResponseContent,
@@ -231,4 +353,24 @@ CONTENTS: dict[tuple[str, str], Any] = {
     ('damping', 'response'): DampingResponseContent,
     ('read_angle', 'request'): ReadAngleRequestContent,
     ('read_angle', 'response'): ReadAngleResponseContent,
+    ('move_by_interval', 'request'): MoveByIntervalRequestContent,
+    ('move_by_interval', 'response'): MoveByIntervalResponseContent,
+    ('move_by_velocity', 'request'): MoveByVelocityRequestContent,
+    ('move_by_velocity', 'response'): MoveByVelocityResponseContent,
+    ('move_mturn', 'request'): MoveMturnRequestContent,
+    ('move_mturn', 'response'): MoveMturnResponseContent,
+    ('move_mturn_by_interval', 'request'): MoveMturnByIntervalRequestContent,
+    ('move_mturn_by_interval', 'response'): MoveMturnByIntervalResponseContent,
+    ('move_mturn_by_velocity', 'request'): MoveMturnByVelocityRequestContent,
+    ('move_mturn_by_velocity', 'response'): MoveMturnByVelocityResponseContent,
+    ('read_mturn_angle', 'request'): ReadMturnAngleRequestContent,
+    ('read_mturn_angle', 'response'): ReadMturnAngleResponseContent,
+    ('reset_mturn_angle', 'request'): ResetMturnAngleRequestContent,
+    ('begin_async', 'request'): BeginAsyncRequestContent,
+    ('end_async', 'request'): EndAsyncRequestContent,
+    ('monitor', 'request'): MonitorRequestContent,
+    ('monitor', 'response'): MonitorResponseContent,
+    ('set_origin_point', 'request'): SetOriginPointRequestContent,
+    ('stop_on_control_mode', 'request'): StopOnControlModeRequestContent,
+    ('sync_command', 'request'): SyncCommandRequestContent,
 }

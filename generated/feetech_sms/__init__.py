@@ -25,6 +25,12 @@ BAUDRATE = 1000000
 SERIAL = SerialSettings(baudrate=1000000, bytesize=8, parity='none', stopbits=1.0)
 #: How a reply is matched to its request (the spec's `matching.by`).
 MATCH_BY: tuple[str, ...] = ('id',)
+#: Device models by the model number they report in `model_number` (the spec's `device.models`).
+MODELS: dict[int, str] = {
+    777: 'sts3215',
+    2825: 'sts3250',
+    11272: 'sm8512bl',
+}
 
-__all__ = ["BAUDRATE", "MATCH_BY", "MESSAGE_TYPES", "PROTOCOL", "SERIAL", "SPEC", "Direction", "Message", "StreamParser", "decode", "encode",
+__all__ = ["BAUDRATE", "MATCH_BY", "MESSAGE_TYPES", "MODELS", "PROTOCOL", "SERIAL", "SPEC", "Direction", "Message", "StreamParser", "decode", "encode",
            *_messages]

@@ -14,7 +14,7 @@ byte is written (RangeError names the field and the range).
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from typing import Any
 
 import serial
@@ -73,9 +73,15 @@ class FeetechSmsClient(ClientBase):
         timeout: float = 0.1,
         baudrate: int | None = None,
         optional_replies: bool | None = None,
+        echo: bool = False,
         **serial_options: Any,
     ) -> None:
-        bus = port if isinstance(port, Bus) else Bus(port, BINDING, timeout=timeout, baudrate=baudrate, **serial_options)
+        """`echo=True` for a one-wire half-duplex adapter that echoes every byte sent (see Bus)."""
+        bus = (
+            port
+            if isinstance(port, Bus)
+            else Bus(port, BINDING, timeout=timeout, baudrate=baudrate, echo=echo, **serial_options)
+        )
         super().__init__(bus, optional_replies)
 
     def __enter__(self) -> FeetechSmsClient:
@@ -84,7 +90,7 @@ class FeetechSmsClient(ClientBase):
     def ping(self, id: int) -> bool:
         """Query a servo's working status.
 
-        Broadcast: A servo answers a PING sent to the broadcast id too, so a broadcast PING finds the id of a single servo; with several servos on the bus their replies collide (004 §1.1).
+        Broadcast: A servo answers a PING sent to the broadcast id too (004 §1.3.1: PING 指令使用广播地址，舵机同样返回应答信息, 'when PING uses the broadcast address, the servo answers as well'), so a broadcast PING finds the id of a single servo; with several servos on the bus their replies collide (004 §1.1).
 
         Args:
             id: Servo id 0..253; 254 (0xFE) is the broadcast id: every servo takes the instruction and none answers, except to PING. (0..253)
@@ -204,7 +210,7 @@ class FeetechSmsClient(ClientBase):
             return None
         return True
 
-    def sync_read_raw(self, id: int, address: int, length: int, ids: tuple[IdsItem, ...]) -> dict[int, bytes]:
+    def sync_read_raw(self, id: int, address: int, length: int, ids: tuple[IdsItem, ...] | Sequence[int]) -> dict[int, bytes]:
         """Read the same registers of several servos.
 
         Sent to the broadcast id; every listed servo answers in turn with an ordinary reply holding `length` bytes from `address`. The length byte is the number of ids + 4, as for any request.
@@ -214,9 +220,11 @@ class FeetechSmsClient(ClientBase):
             address: First register address to read.
             length: Number of bytes each servo returns. (1..250)
             ids: The servos to read, in the order they answer.
+            (ids also takes a plain sequence of id values.)
 
         Returns: id -> data of every listed device, in the order they answer.
         """
+        ids = tuple(v if isinstance(v, IdsItem) else IdsItem(id=v) for v in ids)
         request = SyncReadRequest(id=id, address=address, length=length, ids=ids)
         replies = self.bus.request_each(request, ReplyResponse, [{'id': item.id} for item in ids])
         return {reply.id: reply.data for reply in replies}

@@ -5,7 +5,7 @@ A servo keeps the control table (registers from their defaults, read-only values
 its id, obeys broadcast (254) without answering except to PING, reports its status register (0x41) in the
 error byte of every reply, holds REG WRITE data until ACTION, answers instructions other than READ and PING
 only while response_level is 1, and moves its present position to a written goal position over goal_time (ms),
-or at goal_speed (steps/s) when goal_time is 0.
+or at goal_speed (steps/s) when goal_time is 0; moving (0x42) reads 1 on the way.
 
 `FeetechSmsSimulator(ids=[1, 2]).start()` serves the devices on a new pseudo-terminal and returns its path;
 `serialspec sim specs/feetech_sms.yaml --id 1 --id 2` does the same from the shell. Values are wire units.
@@ -13,9 +13,9 @@ or at goal_speed (steps/s) when goal_time is 0.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Mapping
 
-from serialspec.runtime.device import CommandSpec, DeviceSpec, EntrySpec, Simulator
+from serialspec.runtime.device import CommandSpec, DeviceSpec, EntrySpec, ModelSpec, Simulator
 
 from feetech_sms.codec import StreamParser, encode
 from feetech_sms.messages import (
@@ -112,15 +112,57 @@ DEVICE = DeviceSpec(
     ),
     registers=CONTROL_TABLE,
     status={'error': 'status'},
+    moving={'moving': ('present_position', None)},
+    models=(
+        ModelSpec(
+            'sts3215',
+            777,
+            {
+                'firmware_major': 3,
+                'firmware_minor': 10,
+                'cw_dead_band': 2,
+                'ccw_dead_band': 2,
+                'model_number': 777,
+            },
+        ),
+        ModelSpec(
+            'sts3250',
+            2825,
+            {
+                'firmware_major': 3,
+                'firmware_minor': 10,
+                'cw_dead_band': 2,
+                'ccw_dead_band': 2,
+                'model_number': 2825,
+            },
+        ),
+        ModelSpec(
+            'sm8512bl',
+            11272,
+            {
+                'firmware_major': 3,
+                'firmware_minor': 10,
+                'model_number': 11272,
+            },
+        ),
+    ),
 )
 
 
 class FeetechSmsSimulator(Simulator):
     """Virtual devices with the given ids on one bus; see serialspec.runtime.device for what they do."""
 
-    def __init__(self, ids: Iterable[int] = (0,), clock: Callable[[], float] | None = None) -> None:
+    def __init__(
+        self,
+        ids: Iterable[int] = (0,),
+        clock: Callable[[], float] | None = None,
+        model: str | Mapping[int, str] | None = None,
+    ) -> None:
+        """`model`: sts3215, sts3250, sm8512bl (default sts3215) for every device, or id -> model."""
         kwargs = {"clock": clock} if clock is not None else {}
-        super().__init__(DEVICE, ids, encode=encode, parser=lambda: StreamParser(Direction.REQUEST), **kwargs)
+        super().__init__(
+            DEVICE, ids, encode=encode, parser=lambda: StreamParser(Direction.REQUEST), model=model, **kwargs
+        )
 
 
 #: The simulator class, under a name every generated package shares (serialspec sim uses it).

@@ -13,7 +13,7 @@ byte is written (RangeError names the field and the range).
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from typing import Any
 
 import serial
@@ -35,6 +35,8 @@ from hiwonder_rrc.messages import (
     BusServoReadTemperatureLimitResponse,
     BusServoReadTemperatureRequest,
     BusServoReadTemperatureResponse,
+    BusServoReadTorqueRequest,
+    BusServoReadTorqueResponse,
     BusServoReadVoltageLimitRequest,
     BusServoReadVoltageLimitResponse,
     BusServoReadVoltageRequest,
@@ -47,19 +49,24 @@ from hiwonder_rrc.messages import (
     BusServoSetTemperatureLimitRequest,
     BusServoSetVoltageLimitRequest,
     BusServosItem,
+    BusServoStopRequest,
     BusServoUnloadRequest,
     BuzzerRequest,
     Direction,
+    DutiesItem,
     GamepadResponse,
     ImuResponse,
     KeyResponse,
     LedRequest,
     MotorMask,
+    MotorSetDutiesRequest,
     MotorSetSpeedRequest,
     MotorSetSpeedsRequest,
     MotorsItem,
     MotorStopMaskRequest,
     MotorStopRequest,
+    OledRequest,
+    PixelsItem,
     PwmServoReadOffsetRequest,
     PwmServoReadOffsetResponse,
     PwmServoReadPositionRequest,
@@ -68,10 +75,13 @@ from hiwonder_rrc.messages import (
     PwmServoSetPositionRequest,
     PwmServoSetPositionsRequest,
     PwmServosItem,
+    RgbSetPixelsRequest,
     SbusResponse,
+    ServosItem,
+    SystemBatteryResponse,
 )
 
-__all__ = ["BINDING", "HiwonderRrcClient", "MotorCommands", "PwmServoCommands", "BusServoCommands"]
+__all__ = ["BINDING", "HiwonderRrcClient", "MotorCommands", "PwmServoCommands", "BusServoCommands", "RgbCommands"]
 
 #: What a Bus needs of this protocol: serial defaults, codec, and the reply-matching rule.
 BINDING = Binding(
@@ -127,6 +137,22 @@ class MotorCommands:
         The device does not answer.
         """
         request = MotorStopRequest(motor_id=motor_id)
+        self._client.bus.send(request)
+
+    def set_duties(self, duties: tuple[DutiesItem, ...] | Mapping[int, float]) -> None:
+        """Drive several motors at a duty cycle (open loop).
+
+        Like set_speeds, with a PWM duty cycle instead of a closed-loop speed; the SDK takes motor numbers 1..4 and sends them less one, as for set_speeds.
+
+        Args:
+            duties: One (motor_id, duty) pair per motor.
+            (duties also takes a mapping {motor_id: duty}, one entry per item.)
+
+        The device does not answer.
+        """
+        if isinstance(duties, Mapping):
+            duties = tuple(DutiesItem(motor_id=key, duty=value) for key, value in duties.items())
+        request = MotorSetDutiesRequest(duties=duties)
         self._client.bus.send(request)
 
     def stop_mask(self, mask: MotorMask) -> None:
@@ -287,6 +313,39 @@ class BusServoCommands:
         check_status(request, reply, 'success', 0, MATCH_BY)
         return reply.temperature
 
+    def stop(self, servos: tuple[ServosItem, ...] | Sequence[int]) -> None:
+        """Stop bus servos where they are.
+
+        That each listed servo stops where it is (and keeps its torque) is inferred from the SDK's name.
+
+        Broadcast: Servo id 0xFE reaches every servo; only the ID read (0x12) uses it, with a single servo on the bus.
+
+        Args:
+            servos: The servos to stop.
+            (servos also takes a plain sequence of servo_id values.)
+
+        The device does not answer.
+        """
+        servos = tuple(v if isinstance(v, ServosItem) else ServosItem(servo_id=v) for v in servos)
+        request = BusServoStopRequest(servos=servos)
+        self._client.bus.send(request)
+
+    def read_torque(self, servo_id: int) -> int:
+        """Read whether a bus servo's torque is on.
+
+        Broadcast: Servo id 0xFE reaches every servo; only the ID read (0x12) uses it, with a single servo on the bus.
+
+        Args:
+            servo_id: Bus servo id (0xFE is the broadcast id).
+
+        Returns: torque: 1 while the torque is on (after load, 0x0C), 0 after unload (0x0B).
+        Raises DeviceError when the reply's success is not 0.
+        """
+        request = BusServoReadTorqueRequest(servo_id=servo_id)
+        reply = self._client._ask(request, BusServoReadTorqueResponse)
+        check_status(request, reply, 'success', 0, MATCH_BY)
+        return reply.torque
+
     def unload(self, servo_id: int) -> None:
         """Release a bus servo's torque.
 
@@ -352,7 +411,7 @@ class BusServoCommands:
 
         Args:
             servo_id: Bus servo id (0xFE is the broadcast id).
-            offset: Bus servo offset (偏差), an int8 from -100 to +100. (-100..100)
+            offset: Bus servo offset (偏差), an int8 from -125 to +125 (about -30°..30°); 002 and 003 give the PWM offset's -100..+100 (erratum bus_offset_range). (-125..125)
 
         The device does not answer.
         """
@@ -367,7 +426,7 @@ class BusServoCommands:
         Args:
             servo_id: Bus servo id (0xFE is the broadcast id).
 
-        Returns: offset: The servo's offset (int8; -100..100 when set through 0x20).
+        Returns: offset: The servo's offset (int8; -125..125 when set through 0x20).
         Raises DeviceError when the reply's success is not 0.
         """
         request = BusServoReadOffsetRequest(servo_id=servo_id)
@@ -481,6 +540,24 @@ class BusServoCommands:
         return reply.limit
 
 
+class RgbCommands:
+    """RGB LEDs: the sub-commands, as `client.rgb.<sub-command>(...)`."""
+
+    def __init__(self, client: HiwonderRrcClient) -> None:
+        self._client = client
+
+    def set_pixels(self, pixels: tuple[PixelsItem, ...]) -> None:
+        """Set the colour of several RGB LEDs.
+
+        Args:
+            pixels: One (index, red, green, blue) per LED.
+
+        The device does not answer.
+        """
+        request = RgbSetPixelsRequest(pixels=pixels)
+        self._client.bus.send(request)
+
+
 class HiwonderRrcClient(ClientBase):
     """Hiwonder RRC controller board protocol client over a serial port or pyserial URL; a context manager.
 
@@ -495,6 +572,7 @@ class HiwonderRrcClient(ClientBase):
     motor: MotorCommands
     pwm_servo: PwmServoCommands
     bus_servo: BusServoCommands
+    rgb: RgbCommands
 
     def __init__(
         self,
@@ -503,13 +581,20 @@ class HiwonderRrcClient(ClientBase):
         timeout: float = 0.1,
         baudrate: int | None = None,
         optional_replies: bool | None = None,
+        echo: bool = False,
         **serial_options: Any,
     ) -> None:
-        bus = port if isinstance(port, Bus) else Bus(port, BINDING, timeout=timeout, baudrate=baudrate, **serial_options)
+        """`echo=True` for a one-wire half-duplex adapter that echoes every byte sent (see Bus)."""
+        bus = (
+            port
+            if isinstance(port, Bus)
+            else Bus(port, BINDING, timeout=timeout, baudrate=baudrate, echo=echo, **serial_options)
+        )
         super().__init__(bus, optional_replies)
         self.motor = MotorCommands(self)
         self.pwm_servo = PwmServoCommands(self)
         self.bus_servo = BusServoCommands(self)
+        self.rgb = RgbCommands(self)
 
     def __enter__(self) -> HiwonderRrcClient:
         return self
@@ -542,13 +627,27 @@ class HiwonderRrcClient(ClientBase):
         request = BuzzerRequest(frequency=frequency, on_time=on_time, off_time=off_time, repeat=repeat)
         self.bus.send(request)
 
-    def reports(self, timeout: float | None = None) -> Iterator[KeyResponse | ImuResponse | GamepadResponse | SbusResponse]:
+    def oled(self, line: int, text: bytes) -> None:
+        """Show a line of text on the OLED display.
+
+        The SDK's comment says the length counts the terminating NUL, but it sends len(text) and no NUL; its example writes 'SSID:...' to line 1 and 'IP:...' to line 2.
+
+        Args:
+            line: Display line (1 or 2 in the SDK's example).
+            text: The text (UTF-8).
+
+        The device does not answer.
+        """
+        request = OledRequest(line=line, text=text)
+        self.bus.send(request)
+
+    def reports(self, timeout: float | None = None) -> Iterator[KeyResponse | ImuResponse | GamepadResponse | SbusResponse | SystemBatteryResponse]:
         """Messages the device sends on its own, as they come, typed; stops after `timeout` seconds without one.
 
         `timeout` defaults to the bus timeout. Stray replies to earlier requests are skipped.
         """
         for message in self.bus.messages(timeout):
-            if isinstance(message, (KeyResponse, ImuResponse, GamepadResponse, SbusResponse)):
+            if isinstance(message, (KeyResponse, ImuResponse, GamepadResponse, SbusResponse, SystemBatteryResponse)):
                 yield message
 
     def on_key(self, callback: Callable[[KeyResponse], None]) -> Callable[[], None]:
@@ -578,3 +677,10 @@ class HiwonderRrcClient(ClientBase):
         Callbacks run in the thread that reads the bus: during any request of this client, or while reports() runs.
         """
         return self.bus.subscribe(lambda message: callback(message) if isinstance(message, SbusResponse) else None)
+
+    def on_system_battery(self, callback: Callable[[SystemBatteryResponse], None]) -> Callable[[], None]:
+        """Call `callback` with every SystemBatteryResponse (System reports (battery voltage)); returns a function that unsubscribes.
+
+        Callbacks run in the thread that reads the bus: during any request of this client, or while reports() runs.
+        """
+        return self.bus.subscribe(lambda message: callback(message) if isinstance(message, SystemBatteryResponse) else None)

@@ -28,6 +28,8 @@ from hiwonder_rrc.messages import (
     BusServoReadTemperatureLimitResponse,
     BusServoReadTemperatureRequest,
     BusServoReadTemperatureResponse,
+    BusServoReadTorqueRequest,
+    BusServoReadTorqueResponse,
     BusServoReadVoltageLimitRequest,
     BusServoReadVoltageLimitResponse,
     BusServoReadVoltageRequest,
@@ -40,19 +42,25 @@ from hiwonder_rrc.messages import (
     BusServoSetTemperatureLimitRequest,
     BusServoSetVoltageLimitRequest,
     BusServosItem,
+    BusServoStopRequest,
     BusServoUnloadRequest,
     ButtonEvent,
     BuzzerRequest,
+    DutiesItem,
+    GamepadButtons,
     GamepadResponse,
     ImuResponse,
     KeyResponse,
     LedRequest,
     MotorMask,
+    MotorSetDutiesRequest,
     MotorSetSpeedRequest,
     MotorSetSpeedsRequest,
     MotorsItem,
     MotorStopMaskRequest,
     MotorStopRequest,
+    OledRequest,
+    PixelsItem,
     PwmServoReadOffsetRequest,
     PwmServoReadOffsetResponse,
     PwmServoReadPositionRequest,
@@ -62,22 +70,26 @@ from hiwonder_rrc.messages import (
     PwmServoSetPositionsRequest,
     PwmServosItem,
     ReadResult,
+    RgbSetPixelsRequest,
     SbusResponse,
+    ServosItem,
+    SystemBatteryResponse,
 )
 
 __all__ = ["StreamParser", "decode", "encode"]
 
 _S_B2_U8_U8 = struct.Struct('<2sBB')
+_S_B2_U8_U8_U8_U16 = struct.Struct('<2sBBBH')
 _S_B2_U8_U8_U8_U8 = struct.Struct('<2sBBBB')
 _S_B2_U8_U8_U8_U8_F32 = struct.Struct('<2sBBBBf')
 _S_B2_U8_U8_U8_U8_I8 = struct.Struct('<2sBBBBb')
 _S_B2_U8_U8_U8_U8_U16 = struct.Struct('<2sBBBBH')
 _S_B2_U8_U8_U8_U8_U8 = struct.Struct('<2sBBBBB')
 _S_F32_F32_F32_F32_F32_F32 = struct.Struct('<ffffff')
-_S_FRAME_BUSSERVOREADOFFSETRESPONSE = struct.Struct('<2sBBBBbb')
 _S_FRAME_BUSSERVOREADPOSITIONLIMITRESPONSE = struct.Struct('<2sBBBBbHH')
 _S_FRAME_BUSSERVOREADPOSITIONRESPONSE = struct.Struct('<2sBBBBbh')
 _S_FRAME_BUSSERVOREADTEMPERATURERESPONSE = struct.Struct('<2sBBBBbB')
+_S_FRAME_BUSSERVOREADTORQUERESPONSE = struct.Struct('<2sBBBBbb')
 _S_FRAME_BUSSERVOREADVOLTAGERESPONSE = struct.Struct('<2sBBBBbH')
 _S_FRAME_BUSSERVOSETPOSITIONLIMITREQUEST = struct.Struct('<2sBBBBHH')
 _S_FRAME_BUZZERREQUEST = struct.Struct('<2sBBHHHH')
@@ -89,6 +101,7 @@ _S_FRAME_SBUSRESPONSE = struct.Struct('<2sBB16hBBBB')
 _S_I16X16_U8_U8_U8_U8 = struct.Struct('<16hBBBB')
 _S_U16_U16_U16_U16 = struct.Struct('<HHHH')
 _S_U16_U8_I8_I8_I8_I8 = struct.Struct('<HBbbbb')
+_S_U8 = struct.Struct('<B')
 _S_U8_F32 = struct.Struct('<Bf')
 _S_U8_U16 = struct.Struct('<BH')
 _S_U8_U16_U16_U16 = struct.Struct('<BHHH')
@@ -105,6 +118,7 @@ _S_U8_U8_I8_U8 = struct.Struct('<BBbB')
 _S_U8_U8_U16 = struct.Struct('<BBH')
 _S_U8_U8_U16_U16 = struct.Struct('<BBHH')
 _S_U8_U8_U8 = struct.Struct('<BBB')
+_S_U8_U8_U8_U8 = struct.Struct('<BBBB')
 _CRC_TABLE = crc_table(8, 0x31, True)  # CRC-8/MAXIM
 
 # Decoders build messages with object.__new__ and store each value straight into its slot: the dataclass __init__
@@ -128,6 +142,8 @@ _set_BusServoReadPositionResponse_servo_id, _set_BusServoReadPositionResponse_su
 _set_BusServoReadTemperatureLimitResponse_servo_id, _set_BusServoReadTemperatureLimitResponse_success, _set_BusServoReadTemperatureLimitResponse_limit = slot_setters(BusServoReadTemperatureLimitResponse)
 (_set_BusServoReadTemperatureRequest_servo_id,) = slot_setters(BusServoReadTemperatureRequest)
 _set_BusServoReadTemperatureResponse_servo_id, _set_BusServoReadTemperatureResponse_success, _set_BusServoReadTemperatureResponse_temperature = slot_setters(BusServoReadTemperatureResponse)
+(_set_BusServoReadTorqueRequest_servo_id,) = slot_setters(BusServoReadTorqueRequest)
+_set_BusServoReadTorqueResponse_servo_id, _set_BusServoReadTorqueResponse_success, _set_BusServoReadTorqueResponse_torque = slot_setters(BusServoReadTorqueResponse)
 (_set_BusServoReadVoltageLimitRequest_servo_id,) = slot_setters(BusServoReadVoltageLimitRequest)
 (
     _set_BusServoReadVoltageLimitResponse_servo_id,
@@ -144,6 +160,7 @@ _set_BusServoSetPositionLimitRequest_servo_id, _set_BusServoSetPositionLimitRequ
 _set_BusServoSetPositionsRequest_duration, _set_BusServoSetPositionsRequest_bus_servos = slot_setters(BusServoSetPositionsRequest)
 _set_BusServoSetTemperatureLimitRequest_servo_id, _set_BusServoSetTemperatureLimitRequest_limit = slot_setters(BusServoSetTemperatureLimitRequest)
 _set_BusServoSetVoltageLimitRequest_servo_id, _set_BusServoSetVoltageLimitRequest_low, _set_BusServoSetVoltageLimitRequest_high = slot_setters(BusServoSetVoltageLimitRequest)
+(_set_BusServoStopRequest_servos,) = slot_setters(BusServoStopRequest)
 (_set_BusServoUnloadRequest_servo_id,) = slot_setters(BusServoUnloadRequest)
 _set_BusServosItem_servo_id, _set_BusServosItem_position = slot_setters(BusServosItem)
 (
@@ -152,6 +169,7 @@ _set_BusServosItem_servo_id, _set_BusServosItem_position = slot_setters(BusServo
     _set_BuzzerRequest_off_time,
     _set_BuzzerRequest_repeat,
 ) = slot_setters(BuzzerRequest)
+_set_DutiesItem_motor_id, _set_DutiesItem_duty = slot_setters(DutiesItem)
 (
     _set_GamepadResponse_buttons,
     _set_GamepadResponse_hat,
@@ -175,11 +193,19 @@ _set_KeyResponse_button_id, _set_KeyResponse_event = slot_setters(KeyResponse)
     _set_LedRequest_off_time,
     _set_LedRequest_repeat,
 ) = slot_setters(LedRequest)
+(_set_MotorSetDutiesRequest_duties,) = slot_setters(MotorSetDutiesRequest)
 _set_MotorSetSpeedRequest_motor_id, _set_MotorSetSpeedRequest_speed = slot_setters(MotorSetSpeedRequest)
 (_set_MotorSetSpeedsRequest_motors,) = slot_setters(MotorSetSpeedsRequest)
 (_set_MotorStopMaskRequest_mask,) = slot_setters(MotorStopMaskRequest)
 (_set_MotorStopRequest_motor_id,) = slot_setters(MotorStopRequest)
 _set_MotorsItem_motor_id, _set_MotorsItem_speed = slot_setters(MotorsItem)
+_set_OledRequest_line, _set_OledRequest_text = slot_setters(OledRequest)
+(
+    _set_PixelsItem_index,
+    _set_PixelsItem_red,
+    _set_PixelsItem_green,
+    _set_PixelsItem_blue,
+) = slot_setters(PixelsItem)
 (_set_PwmServoReadOffsetRequest_servo_id,) = slot_setters(PwmServoReadOffsetRequest)
 _set_PwmServoReadOffsetResponse_servo_id, _set_PwmServoReadOffsetResponse_offset = slot_setters(PwmServoReadOffsetResponse)
 (_set_PwmServoReadPositionRequest_servo_id,) = slot_setters(PwmServoReadPositionRequest)
@@ -188,6 +214,7 @@ _set_PwmServoSetOffsetRequest_servo_id, _set_PwmServoSetOffsetRequest_offset = s
 _set_PwmServoSetPositionRequest_duration, _set_PwmServoSetPositionRequest_servo_id, _set_PwmServoSetPositionRequest_pulse = slot_setters(PwmServoSetPositionRequest)
 _set_PwmServoSetPositionsRequest_duration, _set_PwmServoSetPositionsRequest_pwm_servos = slot_setters(PwmServoSetPositionsRequest)
 _set_PwmServosItem_servo_id, _set_PwmServosItem_pulse = slot_setters(PwmServosItem)
+(_set_RgbSetPixelsRequest_pixels,) = slot_setters(RgbSetPixelsRequest)
 (
     _set_SbusResponse_channels,
     _set_SbusResponse_ch17,
@@ -195,7 +222,10 @@ _set_PwmServosItem_servo_id, _set_PwmServosItem_pulse = slot_setters(PwmServosIt
     _set_SbusResponse_signal_loss,
     _set_SbusResponse_fail_safe,
 ) = slot_setters(SbusResponse)
+(_set_ServosItem_servo_id,) = slot_setters(ServosItem)
+(_set_SystemBatteryResponse_voltage,) = slot_setters(SystemBatteryResponse)
 _MEMBERS_ButtonEvent = members(ButtonEvent)
+_MEMBERS_GamepadButtons = members(GamepadButtons)
 _MEMBERS_MotorMask = members(MotorMask)
 _MEMBERS_ReadResult = members(ReadResult)
 
@@ -269,6 +299,31 @@ def _decode_motor_stop_request(buf: bytes, o: int, end: int) -> MotorStopRequest
         raise DecodeError('motor.stop request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x2')
     m = _new(MotorStopRequest)
     _set_MotorStopRequest_motor_id(m, v_motor_id)
+    return m
+
+
+def _decode_motor_set_duties_request(buf: bytes, o: int, end: int) -> MotorSetDutiesRequest:
+    if not 2 <= end - o <= 1277:
+        raise content_size_error('motor.set_duties request', end - o, 2, 1277)
+    v_subcommand_code, v_count = _S_U8_U8.unpack_from(buf, o)
+    if v_subcommand_code != 5:
+        raise DecodeError('motor.set_duties request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x5')
+    o += 2
+    v_duties_list = []
+    n = v_count * 5
+    if end - o < n:
+        raise DecodeError('motor.set_duties request' + f': content too short for its count ({v_count} duties)')
+    for v_motor_id, v_duty in _S_U8_F32.iter_unpack(buf[o : o + n]):
+        item = _new(DutiesItem)
+        _set_DutiesItem_motor_id(item, v_motor_id)
+        _set_DutiesItem_duty(item, v_duty)
+        v_duties_list.append(item)
+    v_duties = tuple(v_duties_list)
+    o += n
+    if o != end:
+        raise DecodeError('motor.set_duties request' + f': {end - o} bytes left after the last field')
+    m = _new(MotorSetDutiesRequest)
+    _set_MotorSetDutiesRequest_duties(m, v_duties)
     return m
 
 
@@ -478,6 +533,54 @@ def _decode_bus_servo_read_temperature_response(buf: bytes, o: int, end: int) ->
     _set_BusServoReadTemperatureResponse_servo_id(m, v_servo_id)
     _set_BusServoReadTemperatureResponse_success(m, _MEMBERS_ReadResult.get(v_success, v_success))
     _set_BusServoReadTemperatureResponse_temperature(m, v_temperature)
+    return m
+
+
+def _decode_bus_servo_stop_request(buf: bytes, o: int, end: int) -> BusServoStopRequest:
+    if not 2 <= end - o <= 257:
+        raise content_size_error('bus_servo.stop request', end - o, 2, 257)
+    v_subcommand_code, v_count = _S_U8_U8.unpack_from(buf, o)
+    if v_subcommand_code != 3:
+        raise DecodeError('bus_servo.stop request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x3')
+    o += 2
+    v_servos_list = []
+    n = v_count * 1
+    if end - o < n:
+        raise DecodeError('bus_servo.stop request' + f': content too short for its count ({v_count} servos)')
+    for v_servo_id, in _S_U8.iter_unpack(buf[o : o + n]):
+        item = _new(ServosItem)
+        _set_ServosItem_servo_id(item, v_servo_id)
+        v_servos_list.append(item)
+    v_servos = tuple(v_servos_list)
+    o += n
+    if o != end:
+        raise DecodeError('bus_servo.stop request' + f': {end - o} bytes left after the last field')
+    m = _new(BusServoStopRequest)
+    _set_BusServoStopRequest_servos(m, v_servos)
+    return m
+
+
+def _decode_bus_servo_read_torque_request(buf: bytes, o: int, end: int) -> BusServoReadTorqueRequest:
+    if end - o != 2:
+        raise content_size_error('bus_servo.read_torque request', end - o, 2, 2)
+    v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, o)
+    if v_subcommand_code != 13:
+        raise DecodeError('bus_servo.read_torque request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0xd')
+    m = _new(BusServoReadTorqueRequest)
+    _set_BusServoReadTorqueRequest_servo_id(m, v_servo_id)
+    return m
+
+
+def _decode_bus_servo_read_torque_response(buf: bytes, o: int, end: int) -> BusServoReadTorqueResponse:
+    if end - o != 4:
+        raise content_size_error('bus_servo.read_torque response', end - o, 4, 4)
+    v_servo_id, v_subcommand_code, v_success, v_torque = _S_U8_U8_I8_I8.unpack_from(buf, o)
+    if v_subcommand_code != 13:
+        raise DecodeError('bus_servo.read_torque response' + f': subcommand_code is {v_subcommand_code:#x}, expected 0xd')
+    m = _new(BusServoReadTorqueResponse)
+    _set_BusServoReadTorqueResponse_servo_id(m, v_servo_id)
+    _set_BusServoReadTorqueResponse_success(m, _MEMBERS_ReadResult.get(v_success, v_success))
+    _set_BusServoReadTorqueResponse_torque(m, v_torque)
     return m
 
 
@@ -726,8 +829,11 @@ def _decode_gamepad_response(buf: bytes, o: int, end: int) -> GamepadResponse:
     if end - o != 7:
         raise content_size_error('gamepad response', end - o, 7, 7)
     v_buttons, v_hat, v_left_x, v_left_y, v_right_x, v_right_y = _S_U16_U8_I8_I8_I8_I8.unpack_from(buf, o)
+    v_buttons_flags = _MEMBERS_GamepadButtons.get(v_buttons)
+    if v_buttons_flags is None:
+        v_buttons_flags = GamepadButtons(v_buttons)
     m = _new(GamepadResponse)
-    _set_GamepadResponse_buttons(m, v_buttons)
+    _set_GamepadResponse_buttons(m, v_buttons_flags)
     _set_GamepadResponse_hat(m, v_hat)
     _set_GamepadResponse_left_x(m, v_left_x)
     _set_GamepadResponse_left_y(m, v_left_y)
@@ -750,6 +856,61 @@ def _decode_sbus_response(buf: bytes, o: int, end: int) -> SbusResponse:
     _set_SbusResponse_ch18(m, v_ch18)
     _set_SbusResponse_signal_loss(m, v_signal_loss)
     _set_SbusResponse_fail_safe(m, v_fail_safe)
+    return m
+
+
+def _decode_system_battery_response(buf: bytes, o: int, end: int) -> SystemBatteryResponse:
+    if end - o != 3:
+        raise content_size_error('system.battery response', end - o, 3, 3)
+    v_subcommand_code, v_voltage = _S_U8_U16.unpack_from(buf, o)
+    if v_subcommand_code != 4:
+        raise DecodeError('system.battery response' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x4')
+    m = _new(SystemBatteryResponse)
+    _set_SystemBatteryResponse_voltage(m, v_voltage)
+    return m
+
+
+def _decode_oled_request(buf: bytes, o: int, end: int) -> OledRequest:
+    if not 2 <= end - o <= 257:
+        raise content_size_error('oled request', end - o, 2, 257)
+    v_line, v_length = _S_U8_U8.unpack_from(buf, o)
+    o += 2
+    if end - o < v_length:
+        raise DecodeError('oled request' + f': text needs {v_length} bytes, {end - o} left')
+    v_text = buf[o : o + v_length]
+    o += v_length
+    if o != end:
+        raise DecodeError('oled request' + f': {end - o} bytes left after the last field')
+    m = _new(OledRequest)
+    _set_OledRequest_line(m, v_line)
+    _set_OledRequest_text(m, v_text)
+    return m
+
+
+def _decode_rgb_set_pixels_request(buf: bytes, o: int, end: int) -> RgbSetPixelsRequest:
+    if not 2 <= end - o <= 1022:
+        raise content_size_error('rgb.set_pixels request', end - o, 2, 1022)
+    v_subcommand_code, v_count = _S_U8_U8.unpack_from(buf, o)
+    if v_subcommand_code != 1:
+        raise DecodeError('rgb.set_pixels request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x1')
+    o += 2
+    v_pixels_list = []
+    n = v_count * 4
+    if end - o < n:
+        raise DecodeError('rgb.set_pixels request' + f': content too short for its count ({v_count} pixels)')
+    for v_index, v_red, v_green, v_blue in _S_U8_U8_U8_U8.iter_unpack(buf[o : o + n]):
+        item = _new(PixelsItem)
+        _set_PixelsItem_index(item, v_index)
+        _set_PixelsItem_red(item, v_red)
+        _set_PixelsItem_green(item, v_green)
+        _set_PixelsItem_blue(item, v_blue)
+        v_pixels_list.append(item)
+    v_pixels = tuple(v_pixels_list)
+    o += n
+    if o != end:
+        raise DecodeError('rgb.set_pixels request' + f': {end - o} bytes left after the last field')
+    m = _new(RgbSetPixelsRequest)
+    _set_RgbSetPixelsRequest_pixels(m, v_pixels)
     return m
 
 
@@ -822,6 +983,27 @@ def _encode_motor_stop_request(m: MotorStopRequest) -> bytes:
     if not 0 <= m.motor_id <= 255 or m.motor_id.__class__ is bool:
         raise out_of_range('motor.stop request', 'motor_id', m.motor_id, 0, 255)
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 3, 2, 2, m.motor_id)
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
+
+
+def _encode_motor_set_duties_request(m: MotorSetDutiesRequest) -> bytes:
+    if len(m.duties) > 255:
+        raise out_of_range('motor.set_duties request', 'count', len(m.duties), 0, 255)
+    parts_duties = []
+    for item in m.duties:
+        if not 0 <= item.motor_id <= 255 or item.motor_id.__class__ is bool:
+            raise out_of_range('motor.set_duties request', 'motor_id', item.motor_id, 0, 255)
+        if not -340282346638528859811704183484516925440 <= item.duty <= 340282346638528859811704183484516925440:
+            raise out_of_range('motor.set_duties request', 'duty', item.duty, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
+        parts_duties.append(_S_U8_F32.pack(item.motor_id, item.duty))
+    content = b''.join((_S_U8_U8.pack(5, len(m.duties)), b''.join(parts_duties),))
+    n = len(content)
+    if n > 255:
+        raise EncodeError(f'content of {len(content)} bytes does not fit the length field')
+    body = _S_B2_U8_U8.pack(b'\xaaU', 3, n) + content
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1026,6 +1208,49 @@ def _encode_bus_servo_read_temperature_response(m: BusServoReadTemperatureRespon
     return body + _BYTES[check]
 
 
+def _encode_bus_servo_stop_request(m: BusServoStopRequest) -> bytes:
+    if len(m.servos) > 255:
+        raise out_of_range('bus_servo.stop request', 'count', len(m.servos), 0, 255)
+    parts_servos = []
+    for item in m.servos:
+        if not 0 <= item.servo_id <= 255 or item.servo_id.__class__ is bool:
+            raise out_of_range('bus_servo.stop request', 'servo_id', item.servo_id, 0, 255)
+        parts_servos.append(_S_U8.pack(item.servo_id))
+    content = b''.join((_S_U8_U8.pack(3, len(m.servos)), b''.join(parts_servos),))
+    n = len(content)
+    if n > 255:
+        raise EncodeError(f'content of {len(content)} bytes does not fit the length field')
+    body = _S_B2_U8_U8.pack(b'\xaaU', 5, n) + content
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
+
+
+def _encode_bus_servo_read_torque_request(m: BusServoReadTorqueRequest) -> bytes:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
+        raise out_of_range('bus_servo.read_torque request', 'servo_id', m.servo_id, 0, 255)
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 13, m.servo_id)
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
+
+
+def _encode_bus_servo_read_torque_response(m: BusServoReadTorqueResponse) -> bytes:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
+        raise out_of_range('bus_servo.read_torque response', 'servo_id', m.servo_id, 0, 255)
+    if not -1 <= m.success <= 0 or m.success.__class__ is bool:
+        raise out_of_range('bus_servo.read_torque response', 'success', m.success, -1, 0)
+    if not -128 <= m.torque <= 127 or m.torque.__class__ is bool:
+        raise out_of_range('bus_servo.read_torque response', 'torque', m.torque, -128, 127)
+    body = _S_FRAME_BUSSERVOREADTORQUERESPONSE.pack(b'\xaaU', 5, 4, m.servo_id, 13, m.success, m.torque)
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
+
+
 def _encode_bus_servo_unload_request(m: BusServoUnloadRequest) -> bytes:
     if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.unload request', 'servo_id', m.servo_id, 0, 255)
@@ -1085,8 +1310,8 @@ def _encode_bus_servo_read_id_response(m: BusServoReadIdResponse) -> bytes:
 def _encode_bus_servo_set_offset_request(m: BusServoSetOffsetRequest) -> bytes:
     if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.set_offset request', 'servo_id', m.servo_id, 0, 255)
-    if not -100 <= m.offset <= 100 or m.offset.__class__ is bool:
-        raise out_of_range('bus_servo.set_offset request', 'offset', m.offset, -100, 100)
+    if not -125 <= m.offset <= 125 or m.offset.__class__ is bool:
+        raise out_of_range('bus_servo.set_offset request', 'offset', m.offset, -125, 125)
     body = _S_B2_U8_U8_U8_U8_I8.pack(b'\xaaU', 5, 3, 32, m.servo_id, m.offset)
     check = 0x0
     for byte in body[2:]:
@@ -1111,7 +1336,7 @@ def _encode_bus_servo_read_offset_response(m: BusServoReadOffsetResponse) -> byt
         raise out_of_range('bus_servo.read_offset response', 'success', m.success, -1, 0)
     if not -128 <= m.offset <= 127 or m.offset.__class__ is bool:
         raise out_of_range('bus_servo.read_offset response', 'offset', m.offset, -128, 127)
-    body = _S_FRAME_BUSSERVOREADOFFSETRESPONSE.pack(b'\xaaU', 5, 4, m.servo_id, 34, m.success, m.offset)
+    body = _S_FRAME_BUSSERVOREADTORQUERESPONSE.pack(b'\xaaU', 5, 4, m.servo_id, 34, m.success, m.offset)
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1247,8 +1472,8 @@ def _encode_bus_servo_read_temperature_limit_response(m: BusServoReadTemperature
 def _encode_key_response(m: KeyResponse) -> bytes:
     if not 0 <= m.button_id <= 255 or m.button_id.__class__ is bool:
         raise out_of_range('key response', 'button_id', m.button_id, 0, 255)
-    if not 1 <= m.event <= 64 or m.event.__class__ is bool:
-        raise out_of_range('key response', 'event', m.event, 1, 64)
+    if not 1 <= m.event <= 128 or m.event.__class__ is bool:
+        raise out_of_range('key response', 'event', m.event, 1, 128)
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 6, 2, m.button_id, m.event)
     check = 0x0
     for byte in body[2:]:
@@ -1277,7 +1502,7 @@ def _encode_imu_response(m: ImuResponse) -> bytes:
 
 
 def _encode_gamepad_response(m: GamepadResponse) -> bytes:
-    if not 0 <= m.buttons <= 65535 or m.buttons.__class__ is bool:
+    if not 0 <= m.buttons <= 65535 or isinstance(m.buttons, bool):
         raise out_of_range('gamepad response', 'buttons', m.buttons, 0, 65535)
     if not 0 <= m.hat <= 255 or m.hat.__class__ is bool:
         raise out_of_range('gamepad response', 'hat', m.hat, 0, 255)
@@ -1316,6 +1541,57 @@ def _encode_sbus_response(m: SbusResponse) -> bytes:
     return body + _BYTES[check]
 
 
+def _encode_system_battery_response(m: SystemBatteryResponse) -> bytes:
+    if not 0 <= m.voltage <= 65535 or m.voltage.__class__ is bool:
+        raise out_of_range('system.battery response', 'voltage', m.voltage, 0, 65535)
+    body = _S_B2_U8_U8_U8_U16.pack(b'\xaaU', 0, 3, 4, m.voltage)
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
+
+
+def _encode_oled_request(m: OledRequest) -> bytes:
+    if not 0 <= m.line <= 255 or m.line.__class__ is bool:
+        raise out_of_range('oled request', 'line', m.line, 0, 255)
+    if len(m.text) > 255:
+        raise out_of_range('oled request', 'length', len(m.text), 0, 255)
+    content = b''.join((_S_U8_U8.pack(m.line, len(m.text)), bytes(m.text),))
+    n = len(content)
+    if n > 255:
+        raise EncodeError(f'content of {len(content)} bytes does not fit the length field')
+    body = _S_B2_U8_U8.pack(b'\xaaU', 10, n) + content
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
+
+
+def _encode_rgb_set_pixels_request(m: RgbSetPixelsRequest) -> bytes:
+    if len(m.pixels) > 255:
+        raise out_of_range('rgb.set_pixels request', 'count', len(m.pixels), 0, 255)
+    parts_pixels = []
+    for item in m.pixels:
+        if not 0 <= item.index <= 255 or item.index.__class__ is bool:
+            raise out_of_range('rgb.set_pixels request', 'index', item.index, 0, 255)
+        if not 0 <= item.red <= 255 or item.red.__class__ is bool:
+            raise out_of_range('rgb.set_pixels request', 'red', item.red, 0, 255)
+        if not 0 <= item.green <= 255 or item.green.__class__ is bool:
+            raise out_of_range('rgb.set_pixels request', 'green', item.green, 0, 255)
+        if not 0 <= item.blue <= 255 or item.blue.__class__ is bool:
+            raise out_of_range('rgb.set_pixels request', 'blue', item.blue, 0, 255)
+        parts_pixels.append(_S_U8_U8_U8_U8.pack(item.index, item.red, item.green, item.blue))
+    content = b''.join((_S_U8_U8.pack(1, len(m.pixels)), b''.join(parts_pixels),))
+    n = len(content)
+    if n > 255:
+        raise EncodeError(f'content of {len(content)} bytes does not fit the length field')
+    body = _S_B2_U8_U8.pack(b'\xaaU', 11, n) + content
+    check = 0x0
+    for byte in body[2:]:
+        check = _CRC_TABLE[check ^ byte]
+    return body + _BYTES[check]
+
+
 def _decode_motor_request(buf: bytes, o: int, end: int) -> Message:
     if end - o <= 0:
         raise DecodeError('motor request' + ": content too short for its sub-command")
@@ -1329,6 +1605,7 @@ _MOTOR_REQUEST_SUBCOMMANDS: dict[int, Callable[..., Message]] = {
     0x00: _decode_motor_set_speed_request,
     0x01: _decode_motor_set_speeds_request,
     0x02: _decode_motor_stop_request,
+    0x05: _decode_motor_set_duties_request,
     0x03: _decode_motor_stop_mask_request,
 }
 
@@ -1365,6 +1642,8 @@ _BUS_SERVO_REQUEST_SUBCOMMANDS: dict[int, Callable[..., Message]] = {
     0x05: _decode_bus_servo_read_position_request,
     0x07: _decode_bus_servo_read_voltage_request,
     0x09: _decode_bus_servo_read_temperature_request,
+    0x03: _decode_bus_servo_stop_request,
+    0x0d: _decode_bus_servo_read_torque_request,
     0x0b: _decode_bus_servo_unload_request,
     0x0c: _decode_bus_servo_load_request,
     0x10: _decode_bus_servo_set_id_request,
@@ -1378,6 +1657,20 @@ _BUS_SERVO_REQUEST_SUBCOMMANDS: dict[int, Callable[..., Message]] = {
     0x36: _decode_bus_servo_read_voltage_limit_request,
     0x38: _decode_bus_servo_set_temperature_limit_request,
     0x3a: _decode_bus_servo_read_temperature_limit_request,
+}
+
+
+def _decode_rgb_request(buf: bytes, o: int, end: int) -> Message:
+    if end - o <= 0:
+        raise DecodeError('rgb request' + ": content too short for its sub-command")
+    decoder = _RGB_REQUEST_SUBCOMMANDS.get(buf[o + 0])
+    if decoder is None:
+        raise DecodeError('rgb request' + f": unknown sub-command {buf[o + 0]:#04x}")
+    return decoder(buf, o, end)
+
+
+_RGB_REQUEST_SUBCOMMANDS: dict[int, Callable[..., Message]] = {
+    0x01: _decode_rgb_set_pixels_request,
 }
 
 
@@ -1409,11 +1702,26 @@ _BUS_SERVO_RESPONSE_SUBCOMMANDS: dict[int, Callable[..., Message]] = {
     0x05: _decode_bus_servo_read_position_response,
     0x07: _decode_bus_servo_read_voltage_response,
     0x09: _decode_bus_servo_read_temperature_response,
+    0x0d: _decode_bus_servo_read_torque_response,
     0x12: _decode_bus_servo_read_id_response,
     0x22: _decode_bus_servo_read_offset_response,
     0x32: _decode_bus_servo_read_position_limit_response,
     0x36: _decode_bus_servo_read_voltage_limit_response,
     0x3a: _decode_bus_servo_read_temperature_limit_response,
+}
+
+
+def _decode_system_response(buf: bytes, o: int, end: int) -> Message:
+    if end - o <= 0:
+        raise DecodeError('system response' + ": content too short for its sub-command")
+    decoder = _SYSTEM_RESPONSE_SUBCOMMANDS.get(buf[o + 0])
+    if decoder is None:
+        raise DecodeError('system response' + f": unknown sub-command {buf[o + 0]:#04x}")
+    return decoder(buf, o, end)
+
+
+_SYSTEM_RESPONSE_SUBCOMMANDS: dict[int, Callable[..., Message]] = {
+    0x04: _decode_system_battery_response,
 }
 
 
@@ -1423,6 +1731,8 @@ _REQUEST_DECODERS: dict[int | None, Callable[..., Message]] = {
     0x03: _decode_motor_request,
     0x04: _decode_pwm_servo_request,
     0x05: _decode_bus_servo_request,
+    0x0a: _decode_oled_request,
+    0x0b: _decode_rgb_request,
 }
 _REQUEST_SIZES: dict[int | None, tuple[int, int | None]] = {
     0x01: (7, 7),
@@ -1430,6 +1740,8 @@ _REQUEST_SIZES: dict[int | None, tuple[int, int | None]] = {
     0x03: (2, 1277),
     0x04: (2, 769),
     0x05: (2, 769),
+    0x0a: (2, 257),
+    0x0b: (2, 1022),
 }
 
 
@@ -1453,6 +1765,7 @@ _RESPONSE_DECODERS: dict[int | None, Callable[..., Message]] = {
     0x07: _decode_imu_response,
     0x08: _decode_gamepad_response,
     0x09: _decode_sbus_response,
+    0x00: _decode_system_response,
 }
 _RESPONSE_SIZES: dict[int | None, tuple[int, int | None]] = {
     0x04: (3, 4),
@@ -1461,6 +1774,7 @@ _RESPONSE_SIZES: dict[int | None, tuple[int, int | None]] = {
     0x07: (24, 24),
     0x08: (7, 7),
     0x09: (36, 36),
+    0x00: (3, 3),
 }
 
 
@@ -1483,6 +1797,7 @@ _ENCODERS: dict[type[Message], Callable[..., bytes]] = {
     MotorSetSpeedRequest: _encode_motor_set_speed_request,
     MotorSetSpeedsRequest: _encode_motor_set_speeds_request,
     MotorStopRequest: _encode_motor_stop_request,
+    MotorSetDutiesRequest: _encode_motor_set_duties_request,
     MotorStopMaskRequest: _encode_motor_stop_mask_request,
     PwmServoSetPositionsRequest: _encode_pwm_servo_set_positions_request,
     PwmServoSetPositionRequest: _encode_pwm_servo_set_position_request,
@@ -1498,6 +1813,9 @@ _ENCODERS: dict[type[Message], Callable[..., bytes]] = {
     BusServoReadVoltageResponse: _encode_bus_servo_read_voltage_response,
     BusServoReadTemperatureRequest: _encode_bus_servo_read_temperature_request,
     BusServoReadTemperatureResponse: _encode_bus_servo_read_temperature_response,
+    BusServoStopRequest: _encode_bus_servo_stop_request,
+    BusServoReadTorqueRequest: _encode_bus_servo_read_torque_request,
+    BusServoReadTorqueResponse: _encode_bus_servo_read_torque_response,
     BusServoUnloadRequest: _encode_bus_servo_unload_request,
     BusServoLoadRequest: _encode_bus_servo_load_request,
     BusServoSetIdRequest: _encode_bus_servo_set_id_request,
@@ -1520,6 +1838,9 @@ _ENCODERS: dict[type[Message], Callable[..., bytes]] = {
     ImuResponse: _encode_imu_response,
     GamepadResponse: _encode_gamepad_response,
     SbusResponse: _encode_sbus_response,
+    SystemBatteryResponse: _encode_system_battery_response,
+    OledRequest: _encode_oled_request,
+    RgbSetPixelsRequest: _encode_rgb_set_pixels_request,
 }
 
 REQUEST_FORMAT = FrameFormat(

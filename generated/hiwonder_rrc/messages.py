@@ -8,6 +8,7 @@ from dataclasses import dataclass
 from enum import IntEnum, IntFlag
 from typing import Any, ClassVar, Self
 
+from serialspec.runtime.fields import as_bytes as _bytes
 from serialspec.runtime.fields import check_keys as _check_keys
 from serialspec.runtime.fields import enum as _as_enum
 from serialspec.runtime.fields import flags as _as_flags
@@ -33,6 +34,8 @@ __all__ = [
     'BusServoReadTemperatureLimitResponse',
     'BusServoReadTemperatureRequest',
     'BusServoReadTemperatureResponse',
+    'BusServoReadTorqueRequest',
+    'BusServoReadTorqueResponse',
     'BusServoReadVoltageLimitRequest',
     'BusServoReadVoltageLimitResponse',
     'BusServoReadVoltageRequest',
@@ -44,11 +47,14 @@ __all__ = [
     'BusServoSetPositionsRequest',
     'BusServoSetTemperatureLimitRequest',
     'BusServoSetVoltageLimitRequest',
+    'BusServoStopRequest',
     'BusServoUnloadRequest',
     'BusServosItem',
     'ButtonEvent',
     'BuzzerRequest',
     'Direction',
+    'DutiesItem',
+    'GamepadButtons',
     'GamepadResponse',
     'ImuResponse',
     'KeyResponse',
@@ -56,11 +62,14 @@ __all__ = [
     'MESSAGE_TYPES',
     'Message',
     'MotorMask',
+    'MotorSetDutiesRequest',
     'MotorSetSpeedRequest',
     'MotorSetSpeedsRequest',
     'MotorStopMaskRequest',
     'MotorStopRequest',
     'MotorsItem',
+    'OledRequest',
+    'PixelsItem',
     'PwmServoReadOffsetRequest',
     'PwmServoReadOffsetResponse',
     'PwmServoReadPositionRequest',
@@ -70,7 +79,10 @@ __all__ = [
     'PwmServoSetPositionsRequest',
     'PwmServosItem',
     'ReadResult',
+    'RgbSetPixelsRequest',
     'SbusResponse',
+    'ServosItem',
+    'SystemBatteryResponse',
 ]
 
 
@@ -84,16 +96,54 @@ class ReadResult(IntEnum):
 
 
 class ButtonEvent(IntEnum):
-    """Key event values. 002 lists these as '部分按键事件回调值' (some of the event values); other values decode as plain numbers."""
+    """Key event values. 002 lists four as '部分按键事件回调值' (some of the event values); the SDK's PacketReportKeyEvents adds the other four (one bit each)."""
 
     #: button pressed (BUTTON_EVENT_PRESSED)
     PRESSED = 1
     #: button held down (BUTTON_EVENT_LONGPRESS)
     LONG_PRESS = 2
+    #: button still held, repeated (KEY_EVENT_LONGPRESS_REPEAT; sdk)
+    LONG_PRESS_REPEAT = 4
+    #: button released after a long press (KEY_EVENT_RELEASE_FROM_LP; sdk)
+    RELEASE_FROM_LONG_PRESS = 8
+    #: button released after a short press (KEY_EVENT_RELEASE_FROM_SP; sdk)
+    RELEASE_FROM_SHORT_PRESS = 16
     #: button clicked (BUTTON_EVENT_CLICK)
     CLICK = 32
     #: button double-clicked (BUTTON_EVENT_DOUBLE_CLICK)
     DOUBLE_CLICK = 64
+    #: button triple-clicked (KEY_EVENT_TRIPLE_CLICK; sdk)
+    TRIPLE_CLICK = 128
+
+
+class GamepadButtons(IntFlag):
+    """Gamepad buttons held, one bit each (sdk Board.buttons_map GAMEPAD_BUTTON_MASK_*; 002 names none)."""
+
+    NONE = 0
+    #: L2
+    L2 = 1 << 0
+    #: R2
+    R2 = 1 << 1
+    #: SELECT
+    SELECT = 1 << 2
+    #: START
+    START = 1 << 3
+    #: L3 (left stick pressed)
+    L3 = 1 << 5
+    #: R3 (right stick pressed)
+    R3 = 1 << 6
+    #: CROSS
+    CROSS = 1 << 8
+    #: CIRCLE
+    CIRCLE = 1 << 9
+    #: SQUARE
+    SQUARE = 1 << 11
+    #: TRIANGLE
+    TRIANGLE = 1 << 12
+    #: L1
+    L1 = 1 << 14
+    #: R1
+    R1 = 1 << 15
 
 
 class MotorMask(IntFlag):
@@ -143,6 +193,30 @@ class MotorsItem:
 
 
 @dataclass(frozen=True, slots=True)
+class DutiesItem:
+    """One item of duties."""
+
+    #: Encoder motor id; bit n of the stop mask is motor_id n (the board has four motor ports).
+    motor_id: int
+    #: Duty cycle; the sign gives the direction (the SDK's example uses ±50). [%]
+    duty: float
+
+    def to_fields(self) -> dict[str, Any]:
+        return {
+            'motor_id': self.motor_id,
+            'duty': self.duty,
+        }
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'DutiesItem') -> Self:
+        _check_keys(data, ('motor_id', 'duty'), (), where)
+        return cls(
+            _integer(_get(data, 'motor_id', where), 'motor_id', where),
+            _number(_get(data, 'duty', where), 'duty', where),
+        )
+
+
+@dataclass(frozen=True, slots=True)
 class PwmServosItem:
     """One item of pwm_servos."""
 
@@ -187,6 +261,58 @@ class BusServosItem:
         return cls(
             _integer(_get(data, 'servo_id', where), 'servo_id', where),
             _integer(_get(data, 'position', where), 'position', where),
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class ServosItem:
+    """One item of servos."""
+
+    #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
+
+    def to_fields(self) -> dict[str, Any]:
+        return {
+            'servo_id': self.servo_id,
+        }
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'ServosItem') -> Self:
+        _check_keys(data, ('servo_id',), (), where)
+        return cls(
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class PixelsItem:
+    """One item of pixels."""
+
+    #: LED index from 0 (the SDK takes 1.. and sends it less one).
+    index: int
+    #: Red 0..255.
+    red: int
+    #: Green 0..255.
+    green: int
+    #: Blue 0..255.
+    blue: int
+
+    def to_fields(self) -> dict[str, Any]:
+        return {
+            'index': self.index,
+            'red': self.red,
+            'green': self.green,
+            'blue': self.blue,
+        }
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'PixelsItem') -> Self:
+        _check_keys(data, ('index', 'red', 'green', 'blue'), (), where)
+        return cls(
+            _integer(_get(data, 'index', where), 'index', where),
+            _integer(_get(data, 'red', where), 'red', where),
+            _integer(_get(data, 'green', where), 'green', where),
+            _integer(_get(data, 'blue', where), 'blue', where),
         )
 
 
@@ -335,6 +461,30 @@ class MotorStopRequest(Message):
         _check_keys(data, ('motor_id',), ('subcommand_code',), where)
         return cls(
             _integer(_get(data, 'motor_id', where), 'motor_id', where),
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class MotorSetDutiesRequest(Message):
+    """Drive several motors at a duty cycle (open loop) (request)."""
+
+    PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
+    COMMAND: ClassVar[str] = 'motor'
+    SUBCOMMAND: ClassVar[str | None] = 'set_duties'
+    DIRECTION: ClassVar[Direction] = Direction.REQUEST
+    #: One (motor_id, duty) pair per motor.
+    duties: tuple[DutiesItem, ...]
+
+    def to_fields(self) -> dict[str, Any]:
+        return {
+            'duties': [item.to_fields() for item in self.duties],
+        }
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'motor.set_duties request') -> Self:
+        _check_keys(data, ('duties',), ('subcommand_code', 'count'), where)
+        return cls(
+            tuple(DutiesItem.from_fields(_mapping(item, 'duties', where), where) for item in _items(_get(data, 'duties', where), 'duties', where)),
         )
 
 
@@ -751,6 +901,86 @@ class BusServoReadTemperatureResponse(Message):
 
 
 @dataclass(frozen=True, slots=True)
+class BusServoStopRequest(Message):
+    """Stop bus servos where they are (request)."""
+
+    PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
+    COMMAND: ClassVar[str] = 'bus_servo'
+    SUBCOMMAND: ClassVar[str | None] = 'stop'
+    DIRECTION: ClassVar[Direction] = Direction.REQUEST
+    #: The servos to stop.
+    servos: tuple[ServosItem, ...]
+
+    def to_fields(self) -> dict[str, Any]:
+        return {
+            'servos': [item.to_fields() for item in self.servos],
+        }
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.stop request') -> Self:
+        _check_keys(data, ('servos',), ('subcommand_code', 'count'), where)
+        return cls(
+            tuple(ServosItem.from_fields(_mapping(item, 'servos', where), where) for item in _items(_get(data, 'servos', where), 'servos', where)),
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class BusServoReadTorqueRequest(Message):
+    """Read whether a bus servo's torque is on (request)."""
+
+    PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
+    COMMAND: ClassVar[str] = 'bus_servo'
+    SUBCOMMAND: ClassVar[str | None] = 'read_torque'
+    DIRECTION: ClassVar[Direction] = Direction.REQUEST
+    #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
+
+    def to_fields(self) -> dict[str, Any]:
+        return {
+            'servo_id': self.servo_id,
+        }
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_torque request') -> Self:
+        _check_keys(data, ('servo_id',), ('subcommand_code',), where)
+        return cls(
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class BusServoReadTorqueResponse(Message):
+    """Read whether a bus servo's torque is on (response)."""
+
+    PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
+    COMMAND: ClassVar[str] = 'bus_servo'
+    SUBCOMMAND: ClassVar[str | None] = 'read_torque'
+    DIRECTION: ClassVar[Direction] = Direction.RESPONSE
+    #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
+    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0. range -1..0
+    success: ReadResult | int
+    #: 1 while the torque is on (after load, 0x0C), 0 after unload (0x0B).
+    torque: int
+
+    def to_fields(self) -> dict[str, Any]:
+        return {
+            'servo_id': self.servo_id,
+            'success': int(self.success),
+            'torque': self.torque,
+        }
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_torque response') -> Self:
+        _check_keys(data, ('servo_id', 'success', 'torque'), ('subcommand_code',), where)
+        return cls(
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(ReadResult, _get(data, 'success', where), 'success', where),
+            _integer(_get(data, 'torque', where), 'torque', where),
+        )
+
+
+@dataclass(frozen=True, slots=True)
 class BusServoUnloadRequest(Message):
     """Release a bus servo's torque (request)."""
 
@@ -892,7 +1122,7 @@ class BusServoSetOffsetRequest(Message):
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
     #: Bus servo id (0xFE is the broadcast id).
     servo_id: int
-    #: Bus servo offset (偏差), an int8 from -100 to +100. range -100..100
+    #: Bus servo offset (偏差), an int8 from -125 to +125 (about -30°..30°); 002 and 003 give the PWM offset's -100..+100 (erratum bus_offset_range). range -125..125
     offset: int
 
     def to_fields(self) -> dict[str, Any]:
@@ -946,7 +1176,7 @@ class BusServoReadOffsetResponse(Message):
     servo_id: int
     #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0. range -1..0
     success: ReadResult | int
-    #: The servo's offset (int8; -100..100 when set through 0x20).
+    #: The servo's offset (int8; -125..125 when set through 0x20).
     offset: int
 
     def to_fields(self) -> dict[str, Any]:
@@ -1268,7 +1498,7 @@ class KeyResponse(Message):
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
     #: Button id.
     button_id: int
-    #: What happened to the button (按键事件). range 1..64
+    #: What happened to the button (按键事件). range 1..128
     event: ButtonEvent | int
 
     def to_fields(self) -> dict[str, Any]:
@@ -1338,9 +1568,9 @@ class GamepadResponse(Message):
     COMMAND: ClassVar[str] = 'gamepad'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    #: Button states (按键), one bit per button (bits not documented).
-    buttons: int
-    #: Hat (direction pad) value.
+    #: Buttons held (按键), one bit per button (bits from the SDK).
+    buttons: GamepadButtons
+    #: Direction pad (hat) value; the SDK reads 9 as right (hat x +1), 13 as left (-1), 11 as up (hat y -1) and 15 as down (+1) in its axes; other values are not documented.
     hat: int
     #: Left stick x.
     left_x: int
@@ -1353,7 +1583,7 @@ class GamepadResponse(Message):
 
     def to_fields(self) -> dict[str, Any]:
         return {
-            'buttons': self.buttons,
+            'buttons': int(self.buttons),
             'hat': self.hat,
             'left_x': self.left_x,
             'left_y': self.left_y,
@@ -1365,7 +1595,7 @@ class GamepadResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'gamepad response') -> Self:
         _check_keys(data, ('buttons', 'hat', 'left_x', 'left_y', 'right_x', 'right_y'), (), where)
         return cls(
-            _integer(_get(data, 'buttons', where), 'buttons', where),
+            _as_flags(GamepadButtons, _get(data, 'buttons', where), 65535, 'buttons', where),
             _integer(_get(data, 'hat', where), 'hat', where),
             _integer(_get(data, 'left_x', where), 'left_x', where),
             _integer(_get(data, 'left_y', where), 'left_y', where),
@@ -1414,12 +1644,89 @@ class SbusResponse(Message):
         )
 
 
+@dataclass(frozen=True, slots=True)
+class SystemBatteryResponse(Message):
+    """Battery voltage (response). Sent by the device on its own."""
+
+    PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
+    COMMAND: ClassVar[str] = 'system'
+    SUBCOMMAND: ClassVar[str | None] = 'battery'
+    DIRECTION: ClassVar[Direction] = Direction.RESPONSE
+    #: Battery voltage. [mV]
+    voltage: int
+
+    def to_fields(self) -> dict[str, Any]:
+        return {
+            'voltage': self.voltage,
+        }
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'system.battery response') -> Self:
+        _check_keys(data, ('voltage',), ('subcommand_code',), where)
+        return cls(
+            _integer(_get(data, 'voltage', where), 'voltage', where),
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class OledRequest(Message):
+    """Show a line of text on the OLED display (request)."""
+
+    PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
+    COMMAND: ClassVar[str] = 'oled'
+    SUBCOMMAND: ClassVar[str | None] = None
+    DIRECTION: ClassVar[Direction] = Direction.REQUEST
+    #: Display line (1 or 2 in the SDK's example).
+    line: int
+    #: The text (UTF-8).
+    text: bytes
+
+    def to_fields(self) -> dict[str, Any]:
+        return {
+            'line': self.line,
+            'text': self.text.hex(' '),
+        }
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'oled request') -> Self:
+        _check_keys(data, ('line', 'text'), ('length',), where)
+        return cls(
+            _integer(_get(data, 'line', where), 'line', where),
+            _bytes(_get(data, 'text', where), 'text', where),
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class RgbSetPixelsRequest(Message):
+    """Set the colour of several RGB LEDs (request)."""
+
+    PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
+    COMMAND: ClassVar[str] = 'rgb'
+    SUBCOMMAND: ClassVar[str | None] = 'set_pixels'
+    DIRECTION: ClassVar[Direction] = Direction.REQUEST
+    #: One (index, red, green, blue) per LED.
+    pixels: tuple[PixelsItem, ...]
+
+    def to_fields(self) -> dict[str, Any]:
+        return {
+            'pixels': [item.to_fields() for item in self.pixels],
+        }
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any], where: str = 'rgb.set_pixels request') -> Self:
+        _check_keys(data, ('pixels',), ('subcommand_code', 'count'), where)
+        return cls(
+            tuple(PixelsItem.from_fields(_mapping(item, 'pixels', where), where) for item in _items(_get(data, 'pixels', where), 'pixels', where)),
+        )
+
+
 MESSAGE_TYPES: tuple[type[Message], ...] = (
     LedRequest,
     BuzzerRequest,
     MotorSetSpeedRequest,
     MotorSetSpeedsRequest,
     MotorStopRequest,
+    MotorSetDutiesRequest,
     MotorStopMaskRequest,
     PwmServoSetPositionsRequest,
     PwmServoSetPositionRequest,
@@ -1435,6 +1742,9 @@ MESSAGE_TYPES: tuple[type[Message], ...] = (
     BusServoReadVoltageResponse,
     BusServoReadTemperatureRequest,
     BusServoReadTemperatureResponse,
+    BusServoStopRequest,
+    BusServoReadTorqueRequest,
+    BusServoReadTorqueResponse,
     BusServoUnloadRequest,
     BusServoLoadRequest,
     BusServoSetIdRequest,
@@ -1457,4 +1767,7 @@ MESSAGE_TYPES: tuple[type[Message], ...] = (
     ImuResponse,
     GamepadResponse,
     SbusResponse,
+    SystemBatteryResponse,
+    OledRequest,
+    RgbSetPixelsRequest,
 )

@@ -18,7 +18,7 @@ documents give none.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Mapping
 
 from serialspec.runtime.device import CommandSpec, DeviceSpec, KindSpec, Simulator
 
@@ -37,6 +37,8 @@ from hiwonder_rrc.messages import (
     BusServoReadTemperatureLimitResponse,
     BusServoReadTemperatureRequest,
     BusServoReadTemperatureResponse,
+    BusServoReadTorqueRequest,
+    BusServoReadTorqueResponse,
     BusServoReadVoltageLimitRequest,
     BusServoReadVoltageLimitResponse,
     BusServoReadVoltageRequest,
@@ -48,14 +50,17 @@ from hiwonder_rrc.messages import (
     BusServoSetPositionsRequest,
     BusServoSetTemperatureLimitRequest,
     BusServoSetVoltageLimitRequest,
+    BusServoStopRequest,
     BusServoUnloadRequest,
     BuzzerRequest,
     Direction,
     LedRequest,
+    MotorSetDutiesRequest,
     MotorSetSpeedRequest,
     MotorSetSpeedsRequest,
     MotorStopMaskRequest,
     MotorStopRequest,
+    OledRequest,
     PwmServoReadOffsetRequest,
     PwmServoReadOffsetResponse,
     PwmServoReadPositionRequest,
@@ -63,6 +68,7 @@ from hiwonder_rrc.messages import (
     PwmServoSetOffsetRequest,
     PwmServoSetPositionRequest,
     PwmServoSetPositionsRequest,
+    RgbSetPixelsRequest,
 )
 
 __all__ = ["DEVICE", "SIMULATOR", "HiwonderRrcSimulator"]
@@ -88,6 +94,8 @@ DEVICE = DeviceSpec(
         CommandSpec(MotorSetSpeedsRequest, None, writes=('speed',), kind='motor', each='motors'),
         # motor.stop
         CommandSpec(MotorStopRequest, None, kind='motor', sets={'speed': 0.0}),
+        # motor.set_duties
+        CommandSpec(MotorSetDutiesRequest, None, writes=('duty',), kind='motor', each='duties'),
         # motor.stop_mask
         CommandSpec(MotorStopMaskRequest, None),
         # pwm_servo.set_positions
@@ -108,6 +116,10 @@ DEVICE = DeviceSpec(
         CommandSpec(BusServoReadVoltageRequest, BusServoReadVoltageResponse, reports={'voltage': 'voltage'}, broadcast_reply=True, absent={'success': -1.0}),
         # bus_servo.read_temperature
         CommandSpec(BusServoReadTemperatureRequest, BusServoReadTemperatureResponse, reports={'temperature': 'temperature'}, broadcast_reply=True, absent={'success': -1.0}),
+        # bus_servo.stop
+        CommandSpec(BusServoStopRequest, None, each='servos', stops=('position',)),
+        # bus_servo.read_torque
+        CommandSpec(BusServoReadTorqueRequest, BusServoReadTorqueResponse, reports={'torque': 'torque'}, broadcast_reply=True, absent={'success': -1.0}),
         # bus_servo.unload
         CommandSpec(BusServoUnloadRequest, None, sets={'torque': 0.0}),
         # bus_servo.load
@@ -134,11 +146,15 @@ DEVICE = DeviceSpec(
         CommandSpec(BusServoSetTemperatureLimitRequest, None, stores={'limit': 'temperature_limit'}),
         # bus_servo.read_temperature_limit
         CommandSpec(BusServoReadTemperatureLimitRequest, BusServoReadTemperatureLimitResponse, reports={'limit': 'temperature_limit'}, broadcast_reply=True, absent={'success': -1.0}),
+        # oled
+        CommandSpec(OledRequest, None),
+        # rgb.set_pixels
+        CommandSpec(RgbSetPixelsRequest, None),
     ),
     echo_address=True,
     kinds=(
         KindSpec('pwm_servo', 'servo_id', (1, 2, 3, 4), None, {'pulse': 1500.0, 'offset': 0.0}),
-        KindSpec('motor', 'motor_id', (0, 1, 2, 3), None, {'speed': 0.0}),
+        KindSpec('motor', 'motor_id', (0, 1, 2, 3), None, {'speed': 0.0, 'duty': 0.0}),
     ),
 )
 
@@ -146,9 +162,17 @@ DEVICE = DeviceSpec(
 class HiwonderRrcSimulator(Simulator):
     """Virtual devices with the given ids on one bus; see serialspec.runtime.device for what they do."""
 
-    def __init__(self, ids: Iterable[int] = (0,), clock: Callable[[], float] | None = None) -> None:
+    def __init__(
+        self,
+        ids: Iterable[int] = (0,),
+        clock: Callable[[], float] | None = None,
+        model: str | Mapping[int, str] | None = None,
+    ) -> None:
+        """`model`: the spec lists no models, so only None."""
         kwargs = {"clock": clock} if clock is not None else {}
-        super().__init__(DEVICE, ids, encode=encode, parser=lambda: StreamParser(Direction.REQUEST), **kwargs)
+        super().__init__(
+            DEVICE, ids, encode=encode, parser=lambda: StreamParser(Direction.REQUEST), model=model, **kwargs
+        )
 
 
 #: The simulator class, under a name every generated package shares (serialspec sim uses it).

@@ -84,6 +84,12 @@ MotorStopRequestContent = Struct(
     'motor_id' / Int8ub,
 )
 
+MotorSetDutiesRequestContent = Struct(
+    'subcommand_code' / Const(5, Int8ub),
+    'count' / Rebuild(Int8ub, len_(this.duties)),
+    'duties' / Array(this.count, Struct('motor_id' / Int8ub, 'duty' / Float32l)),
+)
+
 MotorStopMaskRequestContent = Struct(
     'subcommand_code' / Const(3, Int8ub),
     'mask' / Int8ub,
@@ -172,6 +178,24 @@ BusServoReadTemperatureResponseContent = Struct(
     'subcommand_code' / Const(9, Int8ub),
     'success' / Int8sb,
     'temperature' / Int8ub,
+)
+
+BusServoStopRequestContent = Struct(
+    'subcommand_code' / Const(3, Int8ub),
+    'count' / Rebuild(Int8ub, len_(this.servos)),
+    'servos' / Array(this.count, Struct('servo_id' / Int8ub)),
+)
+
+BusServoReadTorqueRequestContent = Struct(
+    'subcommand_code' / Const(13, Int8ub),
+    'servo_id' / Int8ub,
+)
+
+BusServoReadTorqueResponseContent = Struct(
+    'servo_id' / Int8ub,
+    'subcommand_code' / Const(13, Int8ub),
+    'success' / Int8sb,
+    'torque' / Int8sb,
 )
 
 BusServoUnloadRequestContent = Struct(
@@ -314,12 +338,30 @@ SbusResponseContent = Struct(
     'fail_safe' / Int8ub,
 )
 
+SystemBatteryResponseContent = Struct(
+    'subcommand_code' / Const(4, Int8ub),
+    'voltage' / Int16ul,
+)
+
+OledRequestContent = Struct(
+    'line' / Int8ub,
+    'length' / Rebuild(Int8ub, lambda ctx: _item_size(ctx, 'text')),
+    'text' / Bytes(this.length),
+)
+
+RgbSetPixelsRequestContent = Struct(
+    'subcommand_code' / Const(1, Int8ub),
+    'count' / Rebuild(Int8ub, len_(this.pixels)),
+    'pixels' / Array(this.count, Struct('index' / Int8ub, 'red' / Int8ub, 'green' / Int8ub, 'blue' / Int8ub)),
+)
+
 CONTENTS: dict[tuple[str, str], Any] = {
     ('led', 'request'): LedRequestContent,
     ('buzzer', 'request'): BuzzerRequestContent,
     ('motor.set_speed', 'request'): MotorSetSpeedRequestContent,
     ('motor.set_speeds', 'request'): MotorSetSpeedsRequestContent,
     ('motor.stop', 'request'): MotorStopRequestContent,
+    ('motor.set_duties', 'request'): MotorSetDutiesRequestContent,
     ('motor.stop_mask', 'request'): MotorStopMaskRequestContent,
     ('pwm_servo.set_positions', 'request'): PwmServoSetPositionsRequestContent,
     ('pwm_servo.set_position', 'request'): PwmServoSetPositionRequestContent,
@@ -335,6 +377,9 @@ CONTENTS: dict[tuple[str, str], Any] = {
     ('bus_servo.read_voltage', 'response'): BusServoReadVoltageResponseContent,
     ('bus_servo.read_temperature', 'request'): BusServoReadTemperatureRequestContent,
     ('bus_servo.read_temperature', 'response'): BusServoReadTemperatureResponseContent,
+    ('bus_servo.stop', 'request'): BusServoStopRequestContent,
+    ('bus_servo.read_torque', 'request'): BusServoReadTorqueRequestContent,
+    ('bus_servo.read_torque', 'response'): BusServoReadTorqueResponseContent,
     ('bus_servo.unload', 'request'): BusServoUnloadRequestContent,
     ('bus_servo.load', 'request'): BusServoLoadRequestContent,
     ('bus_servo.set_id', 'request'): BusServoSetIdRequestContent,
@@ -357,4 +402,7 @@ CONTENTS: dict[tuple[str, str], Any] = {
     ('imu', 'response'): ImuResponseContent,
     ('gamepad', 'response'): GamepadResponseContent,
     ('sbus', 'response'): SbusResponseContent,
+    ('system.battery', 'response'): SystemBatteryResponseContent,
+    ('oled', 'request'): OledRequestContent,
+    ('rgb.set_pixels', 'request'): RgbSetPixelsRequestContent,
 }

@@ -27,6 +27,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="N",
         help="a device id on the bus (repeat for several; default 0); checked against the spec's id range",
     )
+    parser.add_argument(
+        "--model",
+        dest="models",
+        action="append",
+        metavar="NAME|ID=NAME",
+        help="the device model (a name from the spec's `device.models`) of every device, or of one id (repeat)",
+    )
+    parser.add_argument(
+        "--echo",
+        action="store_true",
+        help="echo every byte received before answering, like a one-wire half-duplex adapter (clients: echo=True)",
+    )
     parser.add_argument("--quiet", action="store_true", help="do not log requests and replies on stderr")
     parser.add_argument("--tap", metavar="FILE", help="record both directions of the session to a capture file")
 
@@ -46,6 +58,25 @@ def id_range(protocol: Protocol) -> tuple[int, int, int | None]:
     return low, high, device.broadcast
 
 
+def model_choice(given: list[str] | None) -> str | dict[int, str] | None:
+    """--model NAME (every device) or --model ID=NAME (one device), as the simulator's `model` argument."""
+    if not given:
+        return None
+    per_id: dict[int, str] = {}
+    every: str | None = None
+    for item in given:
+        key, sep, name = item.partition("=")
+        if not sep:
+            every = item
+        elif key.strip().isdigit():
+            per_id[int(key)] = name.strip()
+        else:
+            raise SerialspecError(f"--model {item}: expected NAME or ID=NAME (e.g. 3=sts3215)")
+    if every is not None and per_id:
+        raise SerialspecError("--model: give either one NAME for every device or ID=NAME for each, not both")
+    return per_id or every
+
+
 def run(args: argparse.Namespace) -> int:
     protocol, package = open_spec(args.spec)
     module = getattr(package, "simulator", None)
@@ -57,7 +88,11 @@ def run(args: argparse.Namespace) -> int:
         if not low <= device_id <= high or device_id == broadcast:
             also = f" ({broadcast} is the broadcast id)" if device_id == broadcast else ""
             raise SerialspecError(f"--id {device_id} is outside the spec's id range {low}..{high}{also}")
-    simulator = module.SIMULATOR(ids)
+    try:
+        simulator = module.SIMULATOR(ids, model=model_choice(args.models))
+    except ValueError as exc:
+        raise SerialspecError(f"--model: {exc}") from None
+    simulator.echo = args.echo
     tap = None
     if args.tap:
         try:
@@ -90,7 +125,7 @@ def run(args: argparse.Namespace) -> int:
     signal.signal(signal.SIGINT, stop)
     signal.signal(signal.SIGTERM, stop)
     print(path, flush=True)
-    shown = ", ".join(str(i) for i in simulator.devices)
+    shown = ", ".join(f"{i} ({d.model.name})" if d.model else str(i) for i, d in simulator.devices.items())
     print(f"serialspec sim: {protocol.name} device(s) {shown} on {path}; Ctrl-C to stop", file=sys.stderr, flush=True)
     try:
         simulator.serve(controller)

@@ -16,7 +16,7 @@ import select
 import threading
 import time
 from collections import deque
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import suppress
 from dataclasses import dataclass, field
 from enum import IntEnum, IntFlag
@@ -113,10 +113,14 @@ class Bus:
         *,
         timeout: float = 0.1,
         baudrate: int | None = None,
+        echo: bool = False,
         **serial_options: Any,
     ) -> None:
+        """`echo`: a one-wire half-duplex adapter that hears its own transmission; every frame written is read
+        back and checked before any reply is looked for (a mismatch or a missing echo is a PortError)."""
         self.binding = binding
         self.timeout = timeout
+        self.echo = echo
         self._closed = False  # by close(): no transaction reopens the port after that
         self._lock = threading.RLock()
         self._subscribers: list[Subscriber] = []
@@ -291,6 +295,33 @@ class Bus:
     def _write(self, frame: bytes) -> None:
         with self._port_failures("write"):
             self._port.write(frame)
+        if self.echo:
+            self._check_echo(frame)
+
+    def _check_echo(self, frame: bytes) -> None:
+        """Read back the echo of a frame just written; bytes after it (the reply's start) go to the parser."""
+        deadline = time.monotonic() + self.timeout
+        echoed = b""
+        while len(echoed) < len(frame):
+            remaining = deadline - time.monotonic()
+            with self._port_failures("read"):
+                chunk = self._read_some(remaining) if remaining > 0 else b""
+            if not chunk:
+                self._reset()
+                raise PortError(
+                    f"{self.port_name}: no echo of the {len(frame)} bytes written within {self.timeout:g} s "
+                    f"(got {len(echoed)}: {echoed.hex(' ') or 'nothing'}); is echo=True right for this adapter?"
+                )
+            echoed += chunk
+        if echoed[: len(frame)] != frame:
+            self._reset()
+            raise PortError(
+                f"{self.port_name}: the echo differs from the bytes written: wrote {frame.hex(' ')}, "
+                f"read back {echoed[: len(frame)].hex(' ')}"
+            )
+        rest = echoed[len(frame) :]
+        if rest:
+            self._backlog.extend(self._parser.feed(rest))
 
     def _drain(self) -> None:
         """Hand bytes that arrived between transactions (late replies, reports) to subscribers, without waiting."""
@@ -457,6 +488,33 @@ class ClientBase:
         if (address, key) not in self._parameters:
             self._parameters[(address, key)] = self._read_key(address, key)
         return self._parameters[(address, key)] == value
+
+    def _carry(
+        self,
+        requests: Sequence[Message],
+        carried: Mapping[type[Message], tuple[int, type[Message] | None]],
+        content: slice,
+        build: Callable[[int, list[bytes]], Message],
+    ) -> list[Message]:
+        """Send requests of one command inside one carrier request (a sync command); the replies, if any are due.
+
+        `carried`: request class -> (its command code, the reply class each device answers with, or None);
+        `content`: where a request's content sits in its encoded frame; `build`: the carrier from code and contents.
+        """
+        kinds = {type(r) for r in requests}
+        if len(kinds) != 1:
+            raise EncodeError("a sync command carries requests of one command: give one or more, all of one type")
+        kind = kinds.pop()
+        if kind not in carried:
+            raise EncodeError(
+                f"{kind.__name__} cannot be carried (expected one of {', '.join(c.__name__ for c in carried)})"
+            )
+        code, reply = carried[kind]
+        request = build(code, [self.bus.binding.encode(r)[content] for r in requests])
+        if reply is None:
+            self.bus.send(request)
+            return []
+        return list(self.bus.request_each(request, reply, [{self.ADDRESS: getattr(r, self.ADDRESS)} for r in requests]))
 
     def _read_key(self, address: int, key: int) -> float:
         """Read one table entry by key (generated clients whose spec can read entries override this)."""

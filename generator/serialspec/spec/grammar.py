@@ -146,6 +146,7 @@ class ListOf(Shape):
     item: Shape
     description: str = ""
     length: int | None = None
+    example: Any = None  # shown in the reference where no spec uses the key
 
     def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
         if not isinstance(value, list):
@@ -164,7 +165,7 @@ class ListOf(Shape):
         }
         if self.length is not None:
             schema["minItems"] = schema["maxItems"] = self.length
-        return schema
+        return _with_default(schema, None, self.example)
 
 
 @dataclass
@@ -584,6 +585,10 @@ EXAMPLE = Obj(
         "printed": Str("The frame exactly as the document prints it."),
         "frame": HEX_BYTES,
         "erratum": Str("Name of the erratum that explains why `frame` differs from `printed`."),
+        "completed": Str(
+            "The document prints no complete frame here (a placeholder such as `CRC` for the check byte, or the "
+            "values as a table): how `frame` completes it. A printing convention, not an erratum."
+        ),
         "command": Str("The command the frame decodes as."),
         "subcommand": Str("Its sub-command, where the command has them."),
         "request": Str("Name of the example whose request this example answers."),
@@ -636,9 +641,51 @@ DEVICE_COMMAND = Obj(
                 "target": Str("The request field (or memory entry, once written) with the target."),
                 "duration": Str("The request field (or memory entry) with the time to reach the target, in ms."),
                 "speed": Str("The request field (or memory entry) with the speed, in state units per second."),
+                "accel": Str("The request field with the acceleration time (ms) at the start of the move."),
+                "decel": Str("The request field with the deceleration time (ms) at the end of the move."),
             },
             required=("state", "target"),
             description="The device moves a state variable to a target, over a duration or at a speed.",
+        ),
+        "stops": ListOf(Str(), "State variables whose move in progress stops where it is now."),
+        "wraps": MapOf(
+            Num(),
+            "State variable -> a period: the variable keeps only its remainder, toward zero (an angle within one "
+            "turn, 3600 in 0.1°).",
+        ),
+        "counts": MapOf(
+            Obj(
+                {"state": Str("The state variable (or memory entry)."), "per": Num("The size of one whole unit.")},
+                required=("state", "per"),
+                description="The state variable counted and the size of one whole unit of it.",
+            ),
+            "Response field -> how many whole `per` the state variable holds, toward zero (turns of an angle).",
+        ),
+        "every_device": Bool(
+            "A request without an address reaches every device on the bus (default: the first one only)."
+        ),
+        "held_while": Str(
+            "A state variable: while it is not 0, the device keeps this request instead of carrying it out, until "
+            "a command that `releases` the variable."
+        ),
+        "releases": Str(
+            "A state variable: the command sets it to 0 and carries out the requests held while it was set, in "
+            "order (or drops them, see `cancel_when`)."
+        ),
+        "cancel_when": MapOf(
+            Num(), "With `releases`: request field -> the value with which the held requests are dropped."
+        ),
+        "carries": Obj(
+            {
+                "command": Str("The request field (or `each` item field) holding the code of the command carried."),
+                "content": Str("The bytes field holding that command's request content."),
+                "commands": ListOf(Str(), "The commands it can carry (default: every command with a code)."),
+            },
+            required=("command", "content"),
+            description=(
+                "The request (or each item of its `each` group) carries another command's request content; the "
+                "devices act on it as on that request, and answer as they would (a sync command)."
+            ),
         ),
         "broadcast_reply": Bool("Answers even when addressed by broadcast (default: silent).", default=False),
         "each": Str("A group field of the request whose items address one device each (by the address field)."),
@@ -656,9 +703,49 @@ DEVICE_COMMAND = Obj(
     description="What the device does with one command (command or command.subcommand).",
 )
 
+MODEL = Obj(
+    {
+        "number": Int("The model number the device reports (in `model_entry`), e.g. 777 for the FEETECH STS3215."),
+        "title": TEXT,
+        "description": TEXT,
+        "source": TEXT,
+        "initial": MapOf(
+            Num(),
+            "Memory entry or state variable -> the value this model starts with (its factory value), over the "
+            "table's default and the device's `initial`.",
+        ),
+        "entries": MapOf(
+            Obj(
+                {
+                    "range": ListOf(
+                        Num(),
+                        "This model's inclusive [min, max] in wire units, where it differs from the table's.",
+                        length=2,
+                        example=[0, 2000],
+                    ),
+                    "unit": Str("This model's unit of one wire step, where it differs from the table's.", example="mA"),
+                    "scale": Num("This model's engineering value per wire step, where it differs.", example=1),
+                    "description": Str(TEXT.description, example="XL330: 1 mA steps, up to 1750 mA."),
+                },
+                description="Where one memory entry of this model differs from the table.",
+            ),
+            "Memory entry -> where this model's range, unit or scale differs from the table's.",
+        ),
+    },
+    required=("number",),
+    description="One device model: its model number, factory values and where its table differs.",
+)
+
 DEVICE = Obj(
     {
         "description": TEXT,
+        "models": MapOf(
+            MODEL,
+            "Device models sharing the protocol and table (FEETECH STS3215, SM8512BL; DYNAMIXEL XM430, XL330): "
+            "`serialspec sim --model NAME` (or `--model ID=NAME`) picks one; the docs list them.",
+        ),
+        "default_model": Str("The model the simulator uses when none is named (default: the first of `models`)."),
+        "model_entry": Str("The memory entry holding the model number (set from the model's `number`)."),
         "memory": Str("The table the device keeps, initialised from its defaults."),
         "initial": MapOf(Num(), "Memory entry -> value the simulator starts with where the table gives no default."),
         "address": Str("The field holding the device id (default: the frame's address element)."),
@@ -668,6 +755,18 @@ DEVICE = Obj(
         "reply": MapOf(Num(), "Response field -> value when no behaviour sets it (e.g. result: 1)."),
         "refused": MapOf(Num(), "Response field -> value when a write is refused (read-only or unknown entry)."),
         "status": MapOf(Str(), "Response field -> the memory entry every response reports in it (a status byte)."),
+        "moving": MapOf(
+            Obj(
+                {
+                    "state": Str("The state variable (or memory entry) whose move it reports."),
+                    "bit": Int("Only this bit of the entry reports it (the others keep their value)."),
+                },
+                required=("state",),
+                description="The move an entry reports, as the whole entry or as one bit of it.",
+            ),
+            "Memory entry -> the move it reports: 1 while the state variable moves, 0 once it has arrived (FEETECH "
+            "`moving`); with `bit`, one bit of the entry (Fashion Star servo_status bit 0, executing).",
+        ),
         "echo_address": Bool(
             "Replies carry the id the request named (RRC: 0xFE for a broadcast read), not the answering device's own.",
             default=False,

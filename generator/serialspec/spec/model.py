@@ -387,6 +387,7 @@ class Example:
     subcommand: str | None
     request: str
     fields: dict[str, object]
+    completed: str = ""  # the document prints no complete frame: how `frame` completes it (not an erratum)
     position: tuple[int, int] = (1, 1)  # line and column in the spec, for errors found after resolution
 
 
@@ -423,6 +424,8 @@ class Motion:
     target: str
     duration: str
     speed: str
+    accel: str = ""  # request field: acceleration time (ms) at the start
+    decel: str = ""  # request field: deceleration time (ms) at the end
 
 
 @dataclass(frozen=True)
@@ -443,6 +446,15 @@ class Behaviour:
     stores: dict[str, str] = field(default_factory=dict)  # request field -> state variable
     sets: dict[str, float] = field(default_factory=dict)  # state variable -> value
     absent: dict[str, float] = field(default_factory=dict)  # response values when no device has the id
+    stops: tuple[str, ...] = ()  # state variables whose move stops where it is
+    wraps: dict[str, float] = field(default_factory=dict)  # state variable -> period it is kept within
+    counts: dict[str, tuple[str, float]] = field(default_factory=dict)  # response field -> (state, per)
+    every_device: bool = False  # a request without an address reaches every device
+    held_while: str = ""  # state variable: while set, the request is held
+    releases: str = ""  # state variable: cleared, and the held requests carried out
+    cancel_when: dict[str, float] = field(default_factory=dict)  # with releases: field -> value that drops them
+    carries: tuple[str, str] | None = None  # (command code field, content field) of a carried request
+    carried: tuple[str, ...] = ()  # the commands it can carry (empty: every command with a code)
 
 
 @dataclass(frozen=True)
@@ -455,6 +467,34 @@ class DeviceKind:
     ids: tuple[int, ...]
     broadcast: int | None
     state: dict[str, float]
+
+
+@dataclass(frozen=True)
+class ModelEntry:
+    """Where one model's memory entry differs from the table: its range, unit, scale or description."""
+
+    name: str
+    minimum: float
+    maximum: float
+    unit: str
+    scale: float | None
+    description: str
+
+
+@dataclass(frozen=True)
+class DeviceModel:
+    """One model of the device: its model number, its factory values and where its table differs."""
+
+    name: str
+    number: int
+    title: str
+    description: str
+    source: str
+    initial: dict[str, float]  # memory entry or state variable -> this model's value (over the device's initial)
+    entries: tuple[ModelEntry, ...] = ()
+
+    def entry(self, name: str) -> ModelEntry | None:
+        return next((e for e in self.entries if e.name == name), None)
 
 
 @dataclass(frozen=True)
@@ -474,6 +514,9 @@ class Device:
     status: dict[str, str] = field(default_factory=dict)  # response field -> memory entry every reply reports
     kinds: tuple[DeviceKind, ...] = ()
     echo_address: bool = False  # replies carry the id the request named, not the answering device's own
+    models: tuple[DeviceModel, ...] = ()  # the first is the default model
+    moving: dict[str, tuple[str, int | None]] = field(default_factory=dict)  # entry -> (state variable, bit)
+    model_entry: str = ""  # the memory entry holding the model number
 
     def behaviour(self, key: str) -> Behaviour | None:
         return next((b for b in self.behaviours if b.command == key), None)

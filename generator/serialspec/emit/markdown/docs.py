@@ -16,6 +16,8 @@ from serialspec.spec.model import (
     Array,
     Bytes,
     Command,
+    Device,
+    DeviceModel,
     Direction,
     Example,
     Field,
@@ -426,6 +428,7 @@ def emit_docs(protocol: Protocol) -> str:
             "printed": code_span(e.printed),
             "frame": e.frame.hex(" ").upper(),
             "erratum": e.erratum,
+            "completed": text(e.completed),
             "rows": breakdown(protocol, e),
         }
         for e in protocol.examples
@@ -488,9 +491,12 @@ def emit_docs(protocol: Protocol) -> str:
         for e in protocol.errata
     ]
     serial = protocol.serial
+    device = protocol.device
     return common.render(
         "serialspec.emit.markdown",
         "docs.md.j2",
+        models=[model_context(device, m) for m in device.models] if device else [],
+        model_entry=device.model_entry if device else "",
         protocol=protocol,
         title=text(protocol.title),
         description=text(protocol.description),
@@ -517,6 +523,35 @@ def emit_docs(protocol: Protocol) -> str:
         examples=examples,
         errata=errata,
     )
+
+
+def model_context(device: Device, model: DeviceModel) -> dict[str, Any]:
+    """One model: its values and where its entries differ from the table, one row per entry, in table order."""
+    table = {e.name: e for e in device.memory.entries} if device.memory else {}
+    names = [n for n in table if n in model.initial or model.entry(n)]
+    names += [n for n in model.initial if n not in table]  # state variables
+    rows = []
+    for name in names:
+        entry, override = table.get(name), model.entry(name)
+        bounds = override or entry
+        rows.append(
+            {
+                "name": name,
+                "value": number(model.initial[name]) if name in model.initial else "",
+                "range": f"{number(bounds.minimum)}..{number(bounds.maximum)}" if bounds else "",
+                "unit": cell(override.unit if override else entry.unit if entry else ""),
+                "note": cell(override.description if override else ""),
+            }
+        )
+    return {
+        "name": model.name,
+        "number": model.number,
+        "anchor": anchor("model", model.name),
+        "title": cell(model.title),
+        "description": text(model.description),
+        "source": text(model.source),
+        "rows": rows,
+    }
 
 
 def used_by(protocol: Protocol, values: Any) -> str:

@@ -143,6 +143,14 @@ def pair_group(f: Field) -> tuple[Field, Field] | None:
     return (members[0], members[1]) if len(members) == 2 else None
 
 
+def single_group(f: Field) -> Field | None:
+    """The one field of a group item that a plain sequence of values can give, if the item has exactly one."""
+    if not isinstance(f, Group):
+        return None
+    members = [g for g in f.fields if not (isinstance(g, Scalar) and g.hidden)]
+    return members[0] if len(members) == 1 else None
+
+
 def status_fields(message: Message) -> list[Scalar]:
     return [f for f in message.fields if isinstance(f, Scalar) and f.status_ok is not None]
 
@@ -277,6 +285,60 @@ def register_commands(protocol: Protocol, methods: list[dict[str, Any]]) -> list
     return found
 
 
+def carry_method(protocol: Protocol, request: Message, imports: set[str]) -> dict[str, Any] | None:
+    """For a request that `carries` other requests (a sync command): a method that takes those requests.
+
+    It encodes each, takes its content as one item of the carrier's group, and collects the replies the carried
+    command gets (one per request, matched by address) unless that command's reply is optional or absent.
+    """
+    behaviour = protocol.device.behaviour(request.key) if protocol.device else None
+    if behaviour is None or behaviour.carries is None:
+        return None
+    group = next((f for f in request.fields if isinstance(f, Group) and f.name == behaviour.each), None)
+    if group is None:
+        return None
+    code_field, content_field = behaviour.carries
+    layout = protocol.framing.layouts[Direction.REQUEST]
+    start, trailing = layout.offsets["content"], layout.overhead - layout.offsets["content"]
+    replies = dict(request_response_pairs(protocol))
+    carried = []
+    for command in protocol.commands:
+        inner = command.request
+        if command.code is None or inner is None or command.subcommands or inner is request:
+            continue
+        if behaviour.carried and command.name not in behaviour.carried:
+            continue
+        reply = replies.get(inner)
+        expected = reply if reply is not None and reply_condition(inner, reply) is None else None
+        imports.update(n for n in (inner.class_name, expected.class_name if expected else "") if n)
+        carried.append((inner.class_name, command.code, expected.class_name if expected else "None"))
+    imports.add(group.class_name)
+    title = protocol.command(request.command).title or request.key
+    return {
+        "name": method_name(request) + "_of",
+        "params": "requests: Sequence[Message]",
+        "returns": "list[Message]",
+        "doc": [
+            one_line(title) + ", from the requests it carries: one per device, all of one command.",
+            "",
+            f"Each request's content becomes one item of `{group.name}`; the command's replies (one per request, in"
+            " order) are returned, or [] when that command answers only when a parameter allows it or not at all.",
+        ],
+        "kind": "carry",
+        "carried": carried,
+        "carried_name": method_name(request).upper() + "_CARRIES",
+        "content": f"slice({start}, {-trailing if trailing else None})",
+        "carrier": request.class_name,
+        "code_field": code_field,
+        "group": group.name,
+        "item": group.class_name,
+        "content_field": content_field,
+        "pairs": [],
+        "singles": [],
+        "statuses": [],
+    }
+
+
 def client_module(protocol: Protocol) -> str:
     imports: set[str] = set()
     methods = []
@@ -300,11 +362,18 @@ def client_module(protocol: Protocol) -> str:
             else:
                 trailing = False
         pairs = []
+        singles = []
         for f in fields:
             imports.update(type_names(f))
             default = f" = {defaults[f.name]}" if f.name in defaults else ""
             pair = pair_group(f)
-            if pair is not None:
+            single = single_group(f)
+            if single is not None:
+                assert isinstance(f, Group)
+                imports.update(type_names(single))
+                params.append(f"{f.name}: {annotation(f)} | Sequence[{annotation(single)}]{default}")
+                singles.append({"name": f.name, "item": f.class_name, "field": single.name})
+            elif pair is not None:
                 assert isinstance(f, Group)
                 first, second = pair
                 imports.update(type_names(first) + type_names(second))
@@ -330,6 +399,7 @@ def client_module(protocol: Protocol) -> str:
             f"    ({p['name']} also takes a mapping {{{p['first']}: {p['second']}}}, one entry per item.)"
             for p in pairs
         )
+        doc.extend(f"    ({p['name']} also takes a plain sequence of {p['field']} values.)" for p in singles)
         # An address that can hold the broadcast value makes the reply optional, unless the device answers it anyway.
         may_broadcast = not (behaviour and behaviour.broadcast_reply) and any(
             f.name == address and isinstance(f, Scalar) and broadcast is not None and f.maximum >= broadcast
@@ -403,6 +473,7 @@ def client_module(protocol: Protocol) -> str:
             if table
             else "",
             "pairs": pairs,
+            "singles": singles,
             "statuses": [(f.name, f.status_ok) for f in statuses],
             "each_keys": each_keys,
         }
@@ -420,6 +491,9 @@ def client_module(protocol: Protocol) -> str:
             group["methods"].append(method)
         else:
             methods.append(method)
+        carrier = carry_method(protocol, request, imports)
+        if carrier is not None:
+            methods.append(carrier)
     reports = []
     for message in protocol.messages():
         if message.direction == Direction.RESPONSE and message.unsolicited:
@@ -443,6 +517,7 @@ def client_module(protocol: Protocol) -> str:
         broadcast=repr(broadcast),
         status=repr(tuple(e.name for e in status_elements(protocol))),
         methods=methods,
+        carriers=[m for m in methods if m["kind"] == "carry"],
         groups=list(groups.values()),
         registers=registers,
         status_flags=flags_literal,
@@ -467,12 +542,14 @@ def client_module(protocol: Protocol) -> str:
             *(["flag_names"] if status_flags(protocol) else []),
             *(["table_key"] if tables else []),
         ],
+        uses_message=any(m["kind"] == "carry" for m in everything),
         abc_imports=sorted(
             {
                 *(["Callable", "Iterator"] if reports else []),
                 *(["Mapping"] if any(m["pairs"] for m in everything) else []),
                 *(["Mapping"] if any(r["kind"] == "each_write" for r in registers) else []),
                 *(["Iterable"] if any(r["kind"] == "each_read" for r in registers) else []),
+                *(["Sequence"] if any(m["kind"] == "carry" or m["singles"] for m in everything) else []),
             }
         ),
     )

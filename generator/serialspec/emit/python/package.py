@@ -111,6 +111,8 @@ def emit_package(protocol: Protocol) -> dict[str, str]:
             baudrate=protocol.serial.baudrate,
             serial=protocol.serial,
             match_by=repr(protocol.matching),
+            models=[(m.number, m.name) for m in protocol.device.models] if protocol.device else [],
+            model_entry=protocol.device.model_entry if protocol.device else "",
         ),
         "client.py": client_module(protocol),
         "py.typed": "",

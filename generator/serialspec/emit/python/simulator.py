@@ -11,6 +11,7 @@ from serialspec.emit.python.registers import map_name, register_tables
 from serialspec.emit.python.render import render
 from serialspec.spec.model import (
     Bytes,
+    DeviceModel,
     Group,
     Message,
     Protocol,
@@ -18,6 +19,39 @@ from serialspec.spec.model import (
     TableValue,
     reply_condition,
 )
+
+#: Behaviour attributes passed to CommandSpec under the same name when they are set.
+BEHAVIOUR_ARGUMENTS = (
+    "kind",
+    "each",
+    "stores",
+    "sets",
+    "absent",
+    "buffered",
+    "commits",
+    "stops",
+    "wraps",
+    "counts",
+    "every_device",
+    "held_while",
+    "releases",
+    "cancel_when",
+    "carries",
+)
+
+
+def carried_requests(protocol: Protocol) -> list[tuple[int, str]]:
+    """(code, request class) of every request a `carries` behaviour may carry."""
+    device = protocol.device
+    carriers = [b for b in device.behaviours if b.carries] if device else []
+    if not carriers:
+        return []
+    named = {name for b in carriers for name in b.carried}
+    return [
+        (c.code, c.request.class_name)
+        for c in protocol.commands
+        if c.code is not None and c.request is not None and not c.subcommands and (not named or c.name in named)
+    ]
 
 
 def table_fields(*messages: Message | None) -> dict[str, tuple[str, ...]]:
@@ -41,6 +75,16 @@ def table_fields(*messages: Message | None) -> dict[str, tuple[str, ...]]:
 def import_order(name: str) -> tuple[int, str]:
     """The order ruff's isort gives names in one `from` import: constants, classes, others; case-insensitive."""
     return (0 if name.isupper() else 1 if name[:1].isupper() else 2, name.lower())
+
+
+def model_data(model: DeviceModel) -> dict[str, Any]:
+    """A model as the template's ModelSpec: its values, and its ranges where they differ from the table's."""
+    return {
+        "name": repr(model.name),
+        "number": model.number,
+        "values": [(repr(k), number(v)) for k, v in model.initial.items()],
+        "ranges": [(repr(e.name), number(e.minimum), number(e.maximum)) for e in model.entries],
+    }
 
 
 def simulator_module(protocol: Protocol) -> str:
@@ -74,9 +118,11 @@ def simulator_module(protocol: Protocol) -> str:
             if behaviour.moves:
                 m = behaviour.moves
                 args.append(f"moves={(m.state, m.target, m.duration, m.speed)!r}")
+                if m.accel or m.decel:
+                    args.append(f"ramp={(m.accel, m.decel)!r}")
             if behaviour.broadcast_reply:
                 args.append("broadcast_reply=True")
-            for name in ("kind", "each", "stores", "sets", "absent", "buffered", "commits"):
+            for name in BEHAVIOUR_ARGUMENTS:
                 if getattr(behaviour, name):
                     args.append(f"{name}={getattr(behaviour, name)!r}")
         condition = reply_condition(request, response)
@@ -105,8 +151,13 @@ def simulator_module(protocol: Protocol) -> str:
         commands=commands,
         registers=map_name(device.memory) if device.memory in register_tables(protocol) else "",
         status=repr(device.status) if device.status else "",
+        moving=repr(device.moving) if device.moving else "",
         echo_address=device.echo_address,
+        models=[model_data(m) for m in device.models],
+        carried=carried_requests(protocol),
         kinds=[f"KindSpec({k.name!r}, {k.address!r}, {k.ids!r}, {k.broadcast!r}, {k.state!r})," for k in device.kinds],
         imports=sorted(imports | {"Direction"}, key=import_order),
         default_id=0,
+        model_names=", ".join(m.name for m in device.models),
+        default_model=device.models[0].name if device.models else "",
     )

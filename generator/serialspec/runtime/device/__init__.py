@@ -4,7 +4,8 @@ A generated `simulator.py` holds only data (a `DeviceSpec` built from the spec's
 its commands); everything a device does is in this package (engine.py; faults.py; server.py serves it on a
 pseudo-terminal) and is the same for every protocol:
 
-- memory: the spec's table, initialised from its defaults (and the device section's `initial` values);
+- memory: the spec's table, initialised from its defaults (and the device section's `initial` values), then the
+  device's model's factory values (`models`: the first unless another is named; its ranges replace the table's);
 - a request whose address is a device's id is answered by that device, one whose address is the broadcast value is
   obeyed by every device, which stay silent unless the command says `broadcast_reply`;
 - a response is built field by field: `reads` from memory, `reports` of a state variable or memory entry,
@@ -12,7 +13,11 @@ pseudo-terminal) and is the same for every protocol:
 - a response with `optional_when` is sent only while that parameter holds the value, and one with `after`
   once the request's field of that name (ms) has elapsed;
 - `moves` makes a state variable go linearly from where it is to the request's target, over a duration or at a
-  speed; reading it meanwhile gives the value on the way;
+  speed (trapezoidal with acceleration and deceleration ramps); reading it meanwhile gives the value on the way,
+  and `moving` entries (or one bit of them) read 1 until it arrives; `stops` ends a move where it is, `wraps`
+  keeps a variable within a period and `counts` reports its whole periods (turns);
+- `held_while` keeps requests while a state variable is set, until a command `releases` them (or drops them,
+  `cancel_when`); `carries` hands the requests a sync command holds to the devices as if sent alone;
 - faults can be injected for the next replies: drop, corrupt (checksum), late, garbage, truncate, other_id;
 - `each` applies a command to every item of a request group, each item addressing its own device;
 - further `kinds` of device (a board's PWM servo ports, its motors) have their own ids, address field and state;
@@ -21,7 +26,15 @@ pseudo-terminal) and is the same for every protocol:
 - `emit()` sends a message on the device's own initiative (reports, key events) for tests.
 """
 
-from serialspec.runtime.device.engine import CommandSpec, DeviceSpec, Engine, EntrySpec, KindSpec, VirtualDevice
+from serialspec.runtime.device.engine import (
+    CommandSpec,
+    DeviceSpec,
+    Engine,
+    EntrySpec,
+    KindSpec,
+    ModelSpec,
+    VirtualDevice,
+)
 from serialspec.runtime.device.faults import FAULTS, Fault
 from serialspec.runtime.device.server import Simulator
 
@@ -33,6 +46,7 @@ __all__ = [
     "EntrySpec",
     "Fault",
     "KindSpec",
+    "ModelSpec",
     "Simulator",
     "VirtualDevice",
 ]

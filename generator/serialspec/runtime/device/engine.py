@@ -4,14 +4,16 @@ from __future__ import annotations
 
 import dataclasses
 import logging
+import math
+import struct
 import threading
 import time
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
 from serialspec.runtime.device.faults import Fault, FaultInjection
-from serialspec.runtime.errors import EncodeError
+from serialspec.runtime.errors import DecodeError, EncodeError
 from serialspec.runtime.message import Message
 from serialspec.runtime.registers import RegisterMap
 from serialspec.runtime.stream import StreamParser
@@ -54,6 +56,15 @@ class CommandSpec:
     absent: dict[str, float] = field(default_factory=dict)  # response values when no device has the id
     buffered: bool = False  # the writes wait for a command that commits (REG WRITE)
     commits: bool = False  # carries out the buffered writes (ACTION)
+    ramp: tuple[str, str] | None = None  # request fields: acceleration and deceleration time (ms) of the move
+    stops: tuple[str, ...] = ()  # state variables whose move stops where it is
+    wraps: dict[str, float] = field(default_factory=dict)  # state variable -> the period it is kept within
+    counts: dict[str, tuple[str, float]] = field(default_factory=dict)  # response field -> (state, per)
+    every_device: bool = False  # a request without an address reaches every device, not only the first
+    held_while: str = ""  # state variable: while it is set, the device holds the request
+    releases: str = ""  # state variable: cleared, and the requests held meanwhile carried out
+    cancel_when: dict[str, float] = field(default_factory=dict)  # with releases: the values that drop them
+    carries: tuple[str, str] | None = None  # (code field, content field): another command's request content
 
 
 @dataclass(frozen=True)
@@ -65,6 +76,16 @@ class KindSpec:
     ids: tuple[int, ...]
     broadcast: int | None
     state: dict[str, float]
+
+
+@dataclass(frozen=True)
+class ModelSpec:
+    """One device model: its factory values and the ranges where they differ from the table's."""
+
+    name: str
+    number: int
+    values: dict[str, float]  # memory entry or state variable -> value at power-on (and after a reset)
+    ranges: dict[str, tuple[float, float]] = field(default_factory=dict)  # memory entry -> its writable range
 
 
 @dataclass(frozen=True)
@@ -82,33 +103,83 @@ class DeviceSpec:
     echo_address: bool = False  # replies carry the id the request named, not the answering device's own
     registers: RegisterMap | None = None  # memory as registers at byte addresses, for run reads/writes
     status: dict[str, str] = field(default_factory=dict)  # response field -> memory entry every reply reports
+    models: tuple[ModelSpec, ...] = ()  # the first is the default model
+    moving: dict[str, tuple[str, int | None]] = field(default_factory=dict)  # entry -> (state variable, bit)
+    # command code -> the codec's decoder of that request's content (buf, start, end), for requests carried by another
+    carried: dict[int, Callable[[bytes, int, int], Message]] = field(default_factory=dict)
+
+    def model(self, name: str | None) -> ModelSpec | None:
+        """The model of this name (None: the default one); a ValueError names the known models."""
+        if name is None:
+            return self.models[0] if self.models else None
+        for model in self.models:
+            if model.name == name:
+                return model
+        if not self.models:
+            raise ValueError(f"unknown model {name!r}: the spec lists no device models")
+        raise ValueError(f"unknown model {name!r} (expected one of: {', '.join(m.name for m in self.models)})")
 
 
 @dataclass
 class _Motion:
+    """A move from start to target over `duration` s: linear, or trapezoidal with ramps up and down (s)."""
+
     start: float
     target: float
     began: float
     duration: float
+    accel: float = 0.0
+    decel: float = 0.0
+
+    def active(self, now: float) -> bool:
+        return now < self.began + self.duration
 
     def value(self, now: float) -> float:
-        if self.duration <= 0 or now >= self.began + self.duration:
+        t, total = now - self.began, self.duration
+        if total <= 0 or t >= total:
             return self.target
-        return self.start + (self.target - self.start) * (now - self.began) / self.duration
+        ramps = self.accel + self.decel
+        up, down = (
+            (self.accel, self.decel) if ramps <= total else (total * self.accel / ramps, total * self.decel / ramps)
+        )
+        peak = 1 / (total - up / 2 - down / 2)  # the cruise speed, as a fraction of the distance per second
+        if t < up:
+            done = peak * t * t / (2 * up)
+        elif t <= total - down:
+            done = peak * (t - up / 2)
+        else:
+            done = 1 - peak * (total - t) ** 2 / (2 * down)
+        return self.start + (self.target - self.start) * done
 
 
 class VirtualDevice:
     """One device on the virtual bus: its memory and state variables."""
 
-    def __init__(self, spec: DeviceSpec, device_id: int, clock: Callable[[], float] = time.monotonic) -> None:
+    def __init__(
+        self,
+        spec: DeviceSpec,
+        device_id: int,
+        clock: Callable[[], float] = time.monotonic,
+        model: ModelSpec | None = None,
+    ) -> None:
         self.spec = spec
         self.clock = clock
-        self.by_name = {e.name: e for e in spec.entries}
-        self.by_key = {e.key: e for e in spec.entries}
+        self.model = model
+        values = model.values if model else {}
+        ranges = model.ranges if model else {}
+        # The model's factory values and ranges replace the table's where it gives them.
+        entries = [
+            dataclasses.replace(e, default=values.get(e.name, e.default), minimum=low, maximum=high)
+            for e in spec.entries
+            for low, high in [ranges.get(e.name, (e.minimum, e.maximum))]
+        ]
+        self.by_name = {e.name: e for e in entries}
+        self.by_key = {e.key: e for e in entries}
         self.memory: dict[int, float] = {}
-        self.state: dict[str, float] = dict(spec.state)
+        self.state: dict[str, float] = {k: values.get(k, v) for k, v in spec.state.items()}
         self.motions: dict[str, _Motion] = {}
         self.buffered: list[tuple[CommandSpec, str, dict[str, Any]]] = []  # writes held until a commit
+        self.held: list[tuple[CommandSpec, Message, dict[str, Any]]] = []  # requests held until a release
         self.reset()
         self.id = device_id
         if spec.id_entry in self.by_name:
@@ -118,7 +189,7 @@ class VirtualDevice:
 
     def reset(self) -> None:
         keep = self.memory.get(self.by_name[self.spec.id_entry].key) if self.spec.id_entry in self.by_name else None
-        self.memory = {e.key: e.default for e in self.spec.entries}
+        self.memory = {e.key: e.default for e in self.by_name.values()}
         if keep is not None:
             self.memory[self.by_name[self.spec.id_entry].key] = keep
 
@@ -128,9 +199,15 @@ class VirtualDevice:
         if motion is not None:
             value = motion.value(self.clock())
             return round(value)
-        if name in self.state:
-            return self.state[name]
-        return self.memory[self.by_name[name].key]
+        value = self.state[name] if name in self.state else self.memory[self.by_name[name].key]
+        reports = self.spec.moving.get(name)
+        if reports is None:
+            return value
+        state, bit = reports
+        on_its_way = state in self.motions and self.motions[state].active(self.clock())
+        if bit is None:
+            return float(on_its_way)
+        return float(int(value) | 1 << bit if on_its_way else int(value) & ~(1 << bit))
 
     def set(self, name: str, value: float) -> None:
         self.motions.pop(name, None)
@@ -139,10 +216,10 @@ class VirtualDevice:
         else:
             self.memory[self.by_name[name].key] = value
 
-    def move(self, name: str, target: float, duration: float) -> None:
+    def move(self, name: str, target: float, duration: float, accel: float = 0.0, decel: float = 0.0) -> None:
         now = self.clock()
         start = self.get(name)
-        self.motions[name] = _Motion(start, target, now, max(0.0, duration))
+        self.motions[name] = _Motion(start, target, now, max(0.0, duration), max(0.0, accel), max(0.0, decel))
         if name in self.state:
             self.state[name] = target
         else:
@@ -168,12 +245,22 @@ class Engine(FaultInjection):
         encode: Callable[[Message], bytes],
         parser: Callable[[], StreamParser],
         clock: Callable[[], float] = time.monotonic,
+        model: str | Mapping[int, str] | None = None,
     ) -> None:
+        """`model`: the model of every device (a name of `spec.models`), or id -> name (others: the default)."""
         self.spec = spec
         self.encode = encode
         self.clock = clock
         self.parser = parser()
-        self.devices: dict[int, VirtualDevice] = {i: VirtualDevice(spec, i, clock) for i in ids}
+        ids = list(ids)
+        per_id: Mapping[int, str] = model if isinstance(model, Mapping) else {}
+        every = None if isinstance(model, Mapping) else model
+        unknown = set(per_id) - set(ids)
+        if unknown:
+            raise ValueError(f"a model is given for id {min(unknown)}, which is not on the bus")
+        self.devices: dict[int, VirtualDevice] = {
+            i: VirtualDevice(spec, i, clock, spec.model(per_id.get(i, every))) for i in ids
+        }
         # Each further kind: its devices, built from a DeviceSpec holding that kind's address and state.
         self.kinds: dict[str, dict[int, VirtualDevice]] = {}
         self._kind_specs: dict[str, DeviceSpec] = {}
@@ -220,11 +307,16 @@ class Engine(FaultInjection):
         # `each`: every item of the group addresses its own device, with the item's fields over the request's.
         items = [{**fields, **item} for item in fields[command.each]] if command.each else [fields]
         replies = []
+        if command.carries:  # each item holds another command's request: the devices act on that one
+            for given in items:
+                carried = self._carried(given, *command.carries)
+                replies.extend(self.handle(carried) if carried is not None else [])
+            return replies
         for given in items:
             address = given.get(spec.address)
             broadcast = address is not None and address == spec.broadcast
             if address is None:
-                targets = list(devices.values())[:1]
+                targets = list(devices.values()) if command.every_device else list(devices.values())[:1]
             elif broadcast:
                 targets = list(devices.values())
             else:
@@ -237,6 +329,18 @@ class Engine(FaultInjection):
                     delay = float(getattr(request, command.after, 0)) / 1000 if command.after else 0.0
                     replies.append((self.clock() + delay, frame))
         return replies
+
+    def _carried(self, given: dict[str, Any], code_field: str, content_field: str) -> Message | None:
+        """The request a sync command carries for one device: its content parsed as that command's request."""
+        decoder = self.spec.carried.get(int(given[code_field]))
+        if decoder is None:
+            return None  # a command the device does not know: ignored, as a frame of an unknown command would be
+        data = given[content_field]
+        content = bytes.fromhex(data) if isinstance(data, str) else bytes(data)
+        try:
+            return decoder(content, 0, len(content))
+        except (DecodeError, ValueError, struct.error):
+            return None  # a block that does not parse as that request is ignored, like a bad frame
 
     def _absent(self, command: CommandSpec, given: dict[str, Any]) -> bytes | None:
         """The reply a bus master gives for an id no device has: the request's fields, `absent` values, else 0."""
@@ -265,6 +369,15 @@ class Engine(FaultInjection):
     ) -> bytes | None:
         """Carry out a request on one device (`given`: its fields, an `each` item's merged in); the reply or None."""
         given = request.to_fields() if given is None else given
+        if command.held_while and device.get(command.held_while):
+            device.held.append((command, request, given))  # carried out (or dropped) by a command that releases
+            return None
+        if command.releases:
+            device.set(command.releases, 0)
+            waiting, device.held = device.held, []
+            if not any(given.get(name) == value for name, value in command.cancel_when.items()):
+                for waiting_command, waiting_request, waiting_given in waiting:
+                    self.act(device, waiting_command, waiting_request, waiting_given)
         refused = False
         # Whether an optional reply is due is decided on the switch as the request finds it (a write that turns
         # replies off is still answered), which is also what a client that remembers the switch expects.
@@ -283,11 +396,15 @@ class Engine(FaultInjection):
             for held_command, name, held in buffered:
                 self._write(device, held_command, name, held, written)
         if command.moves:
-            self._move(device, command.moves, given, written)
+            self._move(device, command.moves, given, written, command.ramp)
         for name, state in command.stores.items():
             device.set(state, given[name])
         for state, value in command.sets.items():
             device.set(state, value)
+        for state in command.stops:
+            device.set(state, device.get(state))
+        for state, period in command.wraps.items():
+            device.set(state, math.fmod(device.get(state), period))
         id_entry = device.spec.id_entry
         if id_entry in device.by_name or id_entry in device.state:
             new_id = int(device.get(id_entry))
@@ -309,6 +426,9 @@ class Engine(FaultInjection):
                 values[name] = value
             elif name in command.reports:
                 values[name] = device.get(command.reports[name])
+            elif name in command.counts:
+                state, per = command.counts[name]
+                values[name] = int(device.get(state) / per)
             elif name == device.spec.address and not device.spec.echo_address:
                 values[name] = device.id  # a device answers with its own id, also to a broadcast
             elif name in device.spec.status:
@@ -326,9 +446,18 @@ class Engine(FaultInjection):
         return self._encode_reply(command.response, values)
 
     def _move(
-        self, device: VirtualDevice, moves: tuple[str, str, str, str], given: dict[str, Any], written: set[str]
+        self,
+        device: VirtualDevice,
+        moves: tuple[str, str, str, str],
+        given: dict[str, Any],
+        written: set[str],
+        ramp: tuple[str, str] | None = None,
     ) -> None:
-        """Start a move to the target: a request field, or a memory entry this command has just written."""
+        """Start a move to the target: a request field, or a memory entry this command has just written.
+
+        With a ramp, the speed rises over the acceleration time and falls over the deceleration time; a move at a
+        speed then lasts distance / speed plus half of each ramp, so that it cruises at that speed.
+        """
         state, target, duration_name, speed_name = moves
         if target not in given and target not in written:
             return
@@ -336,14 +465,15 @@ class Engine(FaultInjection):
         def value(name: str) -> float:
             return float(given[name] if name in given else device.get(name))
 
+        accel, decel = (value(ramp[0]) / 1000, value(ramp[1]) / 1000) if ramp else (0.0, 0.0)
         goal = value(target)
         if duration_name and value(duration_name):
             duration = value(duration_name) / 1000
         elif speed_name and value(speed_name):
-            duration = abs(goal - device.get(state)) / value(speed_name)
+            duration = abs(goal - device.get(state)) / value(speed_name) + (accel + decel) / 2
         else:
             duration = 0.0
-        device.move(state, goal, duration)
+        device.move(state, goal, duration, accel, decel)
 
     def _read(self, device: VirtualDevice, command: CommandSpec, name: str, given: dict[str, Any]) -> Any:
         table = command.tables.get(name, ())

@@ -9,7 +9,7 @@ import threading
 import time
 import tty
 from collections import deque
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 
 from serialspec.runtime.device.engine import DeviceSpec, Engine
@@ -35,14 +35,17 @@ class Simulator(Engine):
         encode: Callable[[Message], bytes],
         parser: Callable[[], StreamParser],
         clock: Callable[[], float] = time.monotonic,
+        model: str | Mapping[int, str] | None = None,
     ) -> None:
-        super().__init__(spec, ids, encode=encode, parser=parser, clock=clock)
+        super().__init__(spec, ids, encode=encode, parser=parser, clock=clock, model=model)
         self._emitted: deque[bytes] = deque()  # frames emit() hands to the serving thread
         self._outbox: list[_Scheduled] = []
         self._seq = 0
         self._wake_r, self._wake_w = os.pipe()
         self._stop = threading.Event()
         self._released = False  # close() has closed the pseudo-terminal and the wake-up pipe
+        # Like a one-wire half-duplex adapter: every byte the client sends comes back to it before any reply.
+        self.echo = False
 
     def emit(self, message: Message) -> None:
         """Send a message on the device's own initiative (a report, a key event) as soon as possible."""
@@ -73,6 +76,8 @@ class Simulator(Engine):
                 if not data:
                     self._stop.wait(0.01)
                     continue
+                if self.echo:
+                    os.write(fd, data)
                 for when, frame in self.feed(data):
                     self._seq += 1
                     heapq.heappush(self._outbox, _Scheduled(when, self._seq, frame))

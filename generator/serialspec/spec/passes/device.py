@@ -12,12 +12,15 @@ from serialspec.spec.model import (
     Command,
     Device,
     DeviceKind,
+    DeviceModel,
     Direction,
     Field,
     Framing,
     Group,
+    ModelEntry,
     Motion,
     Scalar,
+    TableEntry,
     replies_by_request,
     reply_to,
 )
@@ -96,7 +99,7 @@ class DevicePass(Pass):
             if kind_name and kind_name not in kinds:
                 self.error((*item_path, "kind"), f"unknown device kind {kind_name!r} (not in `kinds:`)")
             # an unknown kind or group is reported once: the names that depend on it are not checked
-            known_state: Container[str] = (
+            known_state: dict[str, float] | _Everything = (
                 kinds[kind_name].state if kind_name in kinds else EVERYTHING if kind_name else state
             )
             response = reply_to(request, replies)
@@ -129,10 +132,12 @@ class DevicePass(Pass):
                     str(moves["target"]),
                     str(moves.get("duration", "")),
                     str(moves.get("speed", "")),
+                    str(moves.get("accel", "")),
+                    str(moves.get("decel", "")),
                 )
                 if motion.state not in known_state and motion.state not in entries:
                     self.error((*item_path, "moves", "state"), f"unknown state variable {motion.state!r}")
-                for role in ("target", "duration", "speed"):
+                for role in ("target", "duration", "speed", "accel", "decel"):
                     name = getattr(motion, role)
                     if name and name not in request_names and name not in entries:
                         self.error((*item_path, "moves", role), f"{key} has no request field or memory entry {name!r}")
@@ -166,6 +171,14 @@ class DevicePass(Pass):
                     stores,
                     sets,
                     absent,
+                    **self.behaviour_extras(
+                        item,
+                        item_path,
+                        key,
+                        request_names,
+                        response_names,
+                        known_state if isinstance(known_state, _Everything) else {**entries, **known_state},
+                    ),
                 )
             )
         status = {str(k): str(v) for k, v in (value.get("status") or {}).items()}
@@ -186,6 +199,9 @@ class DevicePass(Pass):
             status=status,
             kinds=tuple(kinds.values()),
             echo_address=bool(value.get("echo_address", False)),
+            models=self.models(value, path, entries, state),
+            moving=self.moving(value, path, entries, state),
+            model_entry=str(value.get("model_entry", "")),
         )
 
     def check_ids(self, value: dict[str, Any], path: Path, commands: list[Command], framing: Framing) -> None:
@@ -217,3 +233,147 @@ class DevicePass(Pass):
             for name in value.get(key) or {}:
                 if name not in elements and name not in carried[Direction.RESPONSE]:
                     self.error((*path, key, name), f"unknown response field {name!r}: no response carries it")
+
+    def moving(
+        self, value: dict[str, Any], path: Path, entries: dict[str, TableEntry], state: dict[str, float]
+    ) -> dict[str, tuple[str, int | None]]:
+        """Entries that report whether a state variable is on its way (a whole entry, or one bit of it)."""
+        found: dict[str, tuple[str, int | None]] = {}
+        for name, item in (value.get("moving") or {}).items():
+            where = (*path, "moving", name)
+            if name not in entries and name not in state:
+                self.error(where, f"unknown memory entry or state variable {name!r}")
+            if item["state"] not in entries and item["state"] not in state:
+                self.error((*where, "state"), f"unknown state variable {item['state']!r}")
+            bit = item.get("bit")
+            entry = entries.get(name)
+            if bit is not None and entry is not None and not 0 <= bit < entry.type.size * 8:
+                self.error((*where, "bit"), f"bit {bit} is outside {name}'s {entry.type.size * 8} bits")
+            found[str(name)] = (str(item["state"]), None if bit is None else int(bit))
+        return found
+
+    def behaviour_extras(
+        self,
+        item: dict[str, Any],
+        path: Path,
+        key: str,
+        request_names: Container[str],
+        response_names: Container[str],
+        variables: Container[str],
+    ) -> dict[str, Any]:
+        """The behaviours that stop, wrap, count, hold, release and carry, each name checked."""
+
+        def known(name: str, where: Path) -> str:
+            if name not in variables:
+                self.error(where, f"unknown state variable {name!r}")
+            return name
+
+        counts = {}
+        for field_name, count in (item.get("counts") or {}).items():
+            if field_name not in response_names:
+                self.error((*path, "counts", field_name), f"{key} has no response field {field_name!r}")
+            counts[str(field_name)] = (known(str(count["state"]), (*path, "counts", field_name)), float(count["per"]))
+        for field_name in item.get("cancel_when") or {}:
+            if field_name not in request_names:
+                self.error((*path, "cancel_when", field_name), f"{key} has no request field {field_name!r}")
+        if "cancel_when" in item and "releases" not in item:
+            self.error((*path, "cancel_when"), "`cancel_when` needs `releases`")
+        carries = item.get("carries")
+        carried: list[str] = []
+        if carries:
+            for role in ("command", "content"):
+                if carries[role] not in request_names:
+                    self.error((*path, "carries", role), f"{key} has no request field {carries[role]!r}")
+            coded = {c.name for c in self.ctx.commands if c.code is not None and c.request and not c.subcommands}
+            for name in carries.get("commands") or ():
+                if name not in coded:
+                    self.error((*path, "carries", "commands"), f"unknown command {name!r} (or it has no code)")
+                carried.append(str(name))
+        return {
+            "stops": tuple(known(str(n), (*path, "stops")) for n in item.get("stops") or ()),
+            "wraps": {known(str(n), (*path, "wraps", n)): float(p) for n, p in (item.get("wraps") or {}).items()},
+            "counts": counts,
+            "every_device": bool(item.get("every_device", False)),
+            "held_while": known(str(item["held_while"]), (*path, "held_while")) if "held_while" in item else "",
+            "releases": known(str(item["releases"]), (*path, "releases")) if "releases" in item else "",
+            "cancel_when": {str(k): float(v) for k, v in (item.get("cancel_when") or {}).items()},
+            "carries": (str(carries["command"]), str(carries["content"])) if carries else None,
+            "carried": tuple(carried),
+        }
+
+    def models(
+        self, value: dict[str, Any], path: Path, entries: dict[str, TableEntry], state: dict[str, float]
+    ) -> tuple[DeviceModel, ...]:
+        """The device's models, the default first; each value checked against the model's (or the table's) range."""
+        model_entry = str(value.get("model_entry", ""))
+        if model_entry and model_entry not in entries:
+            self.error((*path, "model_entry"), f"unknown memory entry {model_entry!r}")
+        models: list[DeviceModel] = []
+        numbers: dict[int, str] = {}
+        for name, item in (value.get("models") or {}).items():
+            model_path = (*path, "models", name)
+            self.name(name, model_path, "model name")
+            number = int(item["number"])
+            if number in numbers:
+                self.error((*model_path, "number"), f"model number {number} is already used by {numbers[number]!r}")
+            numbers[number] = name
+            overrides = []
+            for entry_name, override in (item.get("entries") or {}).items():
+                entry = entries.get(entry_name)
+                if entry is None:
+                    self.error((*model_path, "entries", entry_name), f"unknown memory entry {entry_name!r}")
+                    continue
+                range_path = (*model_path, "entries", entry_name, "range")
+                low, high = (
+                    self.bounds(entry.type, entry.sign_magnitude, override["range"], range_path, entry.sign_bit)
+                    if "range" in override
+                    else (entry.minimum, entry.maximum)
+                )
+                overrides.append(
+                    ModelEntry(
+                        entry_name,
+                        low,
+                        high,
+                        str(override.get("unit", entry.unit)),
+                        override.get("scale", entry.scale),
+                        str(override.get("description", "")),
+                    )
+                )
+            by_name = {o.name: o for o in overrides}
+            initial = {str(k): float(v) for k, v in (item.get("initial") or {}).items()}
+            if model_entry:
+                initial[model_entry] = float(number)
+            for entry_name, number_value in initial.items():
+                entry_path = (*model_path, "initial", entry_name)
+                if entry_name in state:
+                    continue
+                entry = entries.get(entry_name)
+                if entry is None:
+                    self.error(entry_path, f"unknown memory entry or state variable {entry_name!r}")
+                    continue
+                bounds = by_name.get(entry_name, entry)
+                low, high = bounds.minimum, bounds.maximum
+                if not low <= number_value <= high:
+                    where = (*model_path, "number") if entry_name == model_entry else entry_path
+                    self.error(where, f"{entry_name} = {number_value:g} is outside its range {low:g}..{high:g}")
+            models.append(
+                DeviceModel(
+                    name=name,
+                    number=number,
+                    title=str(item.get("title", "")),
+                    description=str(item.get("description", "")),
+                    source=str(item.get("source", "")),
+                    initial=initial,
+                    entries=tuple(overrides),
+                )
+            )
+        default = value.get("default_model")
+        if default is not None:
+            found = next((m for m in models if m.name == default), None)
+            if found is None:
+                known = ", ".join(m.name for m in models) or "none defined"
+                self.error((*path, "default_model"), f"unknown model {default!r} (expected one of: {known})")
+            else:
+                models.remove(found)
+                models.insert(0, found)
+        return tuple(models)

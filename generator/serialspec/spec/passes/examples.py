@@ -92,8 +92,13 @@ class Examples(Pass):
             printed_ok = parse_hex(printed) == frame
         except ValueError:
             printed_ok = False
-        if not printed_ok and not erratum:
-            self.error(path, "`frame` differs from `printed`: name the erratum that explains it")
+        completed = str(value.get("completed", ""))
+        if not printed_ok and not erratum and not completed:
+            self.error(
+                path, "`frame` differs from `printed`: name the erratum that explains it, or say it is `completed`"
+            )
+        if completed and erratum:
+            self.error((*path, "completed"), "an example is `completed` or corrected by an `erratum`, not both")
         if erratum and erratum not in {e.name for e in errata}:
             self.error((*path, "erratum"), f"unknown erratum {erratum!r}")
         return Example(
@@ -108,6 +113,7 @@ class Examples(Pass):
             value.get("subcommand"),
             str(value.get("request", "")),
             dict(value["fields"]),
+            completed,
             self.doc.where(path),
         )
 

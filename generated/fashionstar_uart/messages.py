@@ -637,7 +637,7 @@ class ReadBatchDataResponse(Message):
         _check_keys(data, ('servo_id', 'user_data'), (), where)
         return cls(
             _integer(_get(data, 'servo_id', where), 'servo_id', where),
-            UserData.from_fields(_mapping(_get(data, 'user_data', where), 'user_data', where), where),
+            UserData.from_fields(_mapping(_get(data, 'user_data', where), 'user_data', where), where + ' user_data'),
         )
 
 
@@ -665,7 +665,7 @@ class WriteBatchDataRequest(Message):
         _check_keys(data, ('servo_id', 'user_data'), (), where)
         return cls(
             _integer(_get(data, 'servo_id', where), 'servo_id', where),
-            UserData.from_fields(_mapping(_get(data, 'user_data', where), 'user_data', where), where),
+            UserData.from_fields(_mapping(_get(data, 'user_data', where), 'user_data', where), where + ' user_data'),
         )
 
 
@@ -727,7 +727,7 @@ class SpinRequest(Message):
         _check_keys(data, ('servo_id', 'method', 'speed', 'value'), (), where)
         return cls(
             _integer(_get(data, 'servo_id', where), 'servo_id', where),
-            MethodBits.from_fields(_mapping(_get(data, 'method', where), 'method', where), where),
+            MethodBits.from_fields(_mapping(_get(data, 'method', where), 'method', where), where + ' method'),
             _integer(_get(data, 'speed', where), 'speed', where),
             _integer(_get(data, 'value', where), 'value', where),
         )

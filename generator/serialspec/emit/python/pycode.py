@@ -298,7 +298,8 @@ class PackageCode:
         get = f"_get(data, {f.name!r}, where)"
         if isinstance(f, Scalar):
             if f.bits:
-                return f"{f.bits_class}.from_fields(_mapping({get}, {f.name!r}, where), where)"
+                # errors inside name the field too: "spin request method: direction must be an integer"
+                return f"{f.bits_class}.from_fields(_mapping({get}, {f.name!r}, where), where + {' ' + f.name!r})"
             if f.enum:
                 return f"_as_enum({f.enum.class_name}, {get}, {f.name!r}, where)"
             if f.flags:
@@ -318,7 +319,7 @@ class PackageCode:
                 f"for item in _items({get}, {f.name!r}, where))"
             )
         if isinstance(f, TableBlock):
-            return f"{f.class_name}.from_fields(_mapping({get}, {f.name!r}, where), where)"
+            return f"{f.class_name}.from_fields(_mapping({get}, {f.name!r}, where), where + {' ' + f.name!r})"
         return get
 
     def message(self, message: Message) -> None:

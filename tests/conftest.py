@@ -6,10 +6,11 @@ import importlib
 from dataclasses import dataclass
 from pathlib import Path
 from types import ModuleType
+from typing import Any
 
 import pytest
 from serialspec.spec import load_protocol
-from serialspec.spec.model import Protocol
+from serialspec.spec.model import Example, Protocol
 
 ROOT = Path(__file__).resolve().parent.parent
 SPECS = sorted((ROOT / "specs").glob("*.yaml"))
@@ -39,3 +40,11 @@ def by_protocol(items: list[tuple[Generated, object]]) -> list[object]:
 @pytest.fixture(params=ALL, ids=[g.protocol.name for g in ALL])
 def generated(request: pytest.FixtureRequest) -> Generated:
     return request.param  # type: ignore[no-any-return]
+
+
+def example_class(g: Generated, example: Example) -> Any:
+    """The message class an example records: the reply layout to expect where replies share a code."""
+    for cls in g.package.MESSAGE_TYPES:
+        if (example.command, example.subcommand, example.direction) == (cls.COMMAND, cls.SUBCOMMAND, cls.DIRECTION):
+            return cls
+    raise AssertionError(f"no message class for example {example.name}")

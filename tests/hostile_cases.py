@@ -656,7 +656,7 @@ CASES: list[tuple[str, str, Mutation | Text, str | None]] = [
         "covers typo",
         "tiny",
         put("framing/elements/checksum/covers", ["idd", "content"]),
-        "framing.elements.checksum.covers: unknown frame element 'idd' (expected one of header, id, code, length, content, checksum)",
+        "framing.elements.checksum.covers: unknown frame element 'idd' in the request frame (it has header, id, code, length, content, checksum)",
     ),
     (
         "device memory typo",

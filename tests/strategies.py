@@ -89,6 +89,12 @@ def fields_values(fields: tuple[Field, ...], rest_budget: int) -> st.SearchStrat
 def message_fields(protocol: Protocol, message: Message) -> st.SearchStrategy[dict[str, Any]]:
     frame = protocol.framing.layouts[message.direction].value_elements
     frame_values = st.fixed_dictionaries(
-        {e.name: st.integers(int(e.minimum), int(e.maximum)) for e in frame if e.type is not None}
+        {
+            e.name: st.fixed_dictionaries({b.name: st.integers(0, b.mask) for b in e.bits})
+            if e.bits
+            else st.integers(int(e.minimum), int(e.maximum))
+            for e in frame
+            if e.type is not None
+        }
     )
     return st.tuples(frame_values, fields_values(message.fields, 8)).map(lambda pair: {**pair[0], **pair[1]})

@@ -97,6 +97,16 @@ def test_check_fails_when_a_generated_file_is_stale(tmp_path: Path) -> None:
     assert "generated/docs/fashionstar_uart.md: stale" in result.stderr
 
 
+def test_decode_picks_the_reply_layout_by_the_request() -> None:
+    spec = "specs/dynamixel_p2.yaml"
+    status = "FF FF FD 00 01 07 00 55 00 06 04 26 65 5D"  # PING's reply, or a 3-byte READ's: the request decides
+    alone = json.loads(serialspec("decode", spec, status, "--direction", "response", "--json").stdout)
+    assert alone["command"] == "status" and alone["fields"]["data"] == "06 04 26"
+    ping = "FF FF FD 00 01 03 00 01 19 4E"
+    answered = serialspec("decode", spec, status, "--direction", "response", "--request", ping, "--json")
+    assert json.loads(answered.stdout)["fields"]["model_number"] == 1030
+
+
 def test_check_names_a_hand_written_file_inside_a_generated_package(tmp_path: Path) -> None:
     shutil.copytree(ROOT / "specs", tmp_path / "specs")
     shutil.copytree(ROOT / "generated", tmp_path / "generated", ignore=shutil.ignore_patterns("__pycache__"))

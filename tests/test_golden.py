@@ -10,7 +10,7 @@ from contextlib import suppress
 from typing import Any
 
 import pytest
-from conftest import ALL, Generated, by_protocol
+from conftest import ALL, Generated, by_protocol, example_class
 from serialspec.runtime.checksums import crc_function
 from serialspec.runtime.errors import DecodeError
 from serialspec.runtime.hexbytes import parse_hex
@@ -29,7 +29,7 @@ def message_class(g: Generated, command: str, subcommand: str | None, direction:
 
 @pytest.mark.parametrize(("g", "example"), EXAMPLES)
 def test_example_decodes_to_its_documented_values(g: Generated, example: Example) -> None:
-    message = g.package.decode(example.frame, example.direction.value)
+    message = g.package.decode(example.frame, example.direction.value, example_class(g, example))
     assert (example.command, example.subcommand) == (message.COMMAND, message.SUBCOMMAND)
     assert message.to_fields() == example.fields
 
@@ -99,7 +99,8 @@ def test_erratum_is_pinned(g: Generated, erratum: Erratum) -> None:
         for example in examples:
             covered = example.frame[layout[example.direction].covered_from : -1]
             assert claimed_crc(covered) != example.frame[-1], f"{example.name} verifies with the claimed CRC"
-            g.package.decode(example.frame, example.direction.value)  # and with the spec's CRC
+            cls = example_class(g, example)
+            g.package.decode(example.frame, example.direction.value, cls)  # and with the spec's CRC
     else:
         assert check.kind == "prose"
         assert erratum.printed and erratum.correct and erratum.source

@@ -259,7 +259,7 @@ class FashionstarUartClient(ClientBase):
         None when no reply is due (Sent only when response_switch (data_id 33) is 1, once the spin has finished.).
         """
         request = SpinRequest(servo_id=servo_id, method=method, speed=speed, value=value)
-        reply = self._maybe(request, SpinResponse, (33, 1))
+        reply = self._maybe(request, SpinResponse, (33, 1, '=='))
         if reply is None:
             return None
         return reply.result
@@ -277,7 +277,7 @@ class FashionstarUartClient(ClientBase):
         None when no reply is due (Sent only when response_switch (data_id 33) is 1, once the target angle is reached.).
         """
         request = RotateRequest(servo_id=servo_id, angle=angle, interval=interval, power=power)
-        reply = self._maybe(request, RotateResponse, (33, 1), 'interval')
+        reply = self._maybe(request, RotateResponse, (33, 1, '=='), 'interval')
         if reply is None:
             return None
         return reply.result
@@ -295,7 +295,7 @@ class FashionstarUartClient(ClientBase):
         None when no reply is due (Sent only when response_switch (data_id 33) is 1.).
         """
         request = DampingRequest(servo_id=servo_id, power=power)
-        reply = self._maybe(request, DampingResponse, (33, 1))
+        reply = self._maybe(request, DampingResponse, (33, 1, '=='))
         if reply is None:
             return None
         return reply.result
@@ -329,7 +329,7 @@ class FashionstarUartClient(ClientBase):
         None when no reply is due (Inferred from ROTATE (the SDK waits for no reply): sent only when response_switch (data_id 33) is 1, once the target is reached.).
         """
         request = MoveByIntervalRequest(servo_id=servo_id, angle=angle, interval=interval, t_acc=t_acc, t_dec=t_dec, power=power)
-        reply = self._maybe(request, MoveByIntervalResponse, (33, 1))
+        reply = self._maybe(request, MoveByIntervalResponse, (33, 1, '=='))
         if reply is None:
             return None
         return reply.result
@@ -349,7 +349,7 @@ class FashionstarUartClient(ClientBase):
         None when no reply is due (Inferred from ROTATE (the SDK waits for no reply): sent only when response_switch (data_id 33) is 1, once the target is reached.).
         """
         request = MoveByVelocityRequest(servo_id=servo_id, angle=angle, velocity=velocity, t_acc=t_acc, t_dec=t_dec, power=power)
-        reply = self._maybe(request, MoveByVelocityResponse, (33, 1))
+        reply = self._maybe(request, MoveByVelocityResponse, (33, 1, '=='))
         if reply is None:
             return None
         return reply.result
@@ -367,7 +367,7 @@ class FashionstarUartClient(ClientBase):
         None when no reply is due (Inferred from ROTATE (the SDK waits for no reply): sent only when response_switch (data_id 33) is 1, once the target is reached.).
         """
         request = MoveMturnRequest(servo_id=servo_id, angle=angle, interval=interval, power=power)
-        reply = self._maybe(request, MoveMturnResponse, (33, 1))
+        reply = self._maybe(request, MoveMturnResponse, (33, 1, '=='))
         if reply is None:
             return None
         return reply.result
@@ -387,7 +387,7 @@ class FashionstarUartClient(ClientBase):
         None when no reply is due (Inferred from ROTATE (the SDK waits for no reply): sent only when response_switch (data_id 33) is 1, once the target is reached.).
         """
         request = MoveMturnByIntervalRequest(servo_id=servo_id, angle=angle, interval=interval, t_acc=t_acc, t_dec=t_dec, power=power)
-        reply = self._maybe(request, MoveMturnByIntervalResponse, (33, 1))
+        reply = self._maybe(request, MoveMturnByIntervalResponse, (33, 1, '=='))
         if reply is None:
             return None
         return reply.result
@@ -407,7 +407,7 @@ class FashionstarUartClient(ClientBase):
         None when no reply is due (Inferred from ROTATE (the SDK waits for no reply): sent only when response_switch (data_id 33) is 1, once the target is reached.).
         """
         request = MoveMturnByVelocityRequest(servo_id=servo_id, angle=angle, velocity=velocity, t_acc=t_acc, t_dec=t_dec, power=power)
-        reply = self._maybe(request, MoveMturnByVelocityResponse, (33, 1))
+        reply = self._maybe(request, MoveMturnByVelocityResponse, (33, 1, '=='))
         if reply is None:
             return None
         return reply.result

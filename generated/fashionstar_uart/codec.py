@@ -1503,10 +1503,11 @@ RESPONSE_FORMAT = FrameFormat(
 )
 
 
-def decode(data: bytes, direction: Direction | str | None = None) -> Message:
+def decode(data: bytes, direction: Direction | str | None = None, expect: type[Message] | None = None) -> Message:
     """Decode one complete frame into its message; raises DecodeError with a one-line reason.
 
     Each direction's checks are inline here rather than in a function per direction: one call less per frame.
+    `expect` (the reply class a frame answers) matters only where replies share a code; here none do.
     """
     if direction is None:
         if data[:2] == b'\x12L':

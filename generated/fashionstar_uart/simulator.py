@@ -120,23 +120,23 @@ DEVICE = DeviceSpec(
         # write_batch_data
         CommandSpec(WriteBatchDataRequest, WriteBatchDataResponse, writes=('user_data',), tables={'user_data': ('block', 'reserved_32', 'response_switch', 'servo_id', 'reserved_35', 'baudrate', 'stall_protect_mode', 'stall_power_limit', 'over_volt_low', 'over_volt_high', 'over_temperature', 'over_power', 'over_current', 'accel_switch', 'reserved_45', 'po_lock_switch', 'wb_lock_switch', 'angle_limit_switch', 'soft_start_switch', 'soft_start_time', 'angle_limit_high', 'angle_limit_low', 'angle_mid_offset')}),
         # spin
-        CommandSpec(SpinRequest, SpinResponse, optional_when=('response_switch', 1)),
+        CommandSpec(SpinRequest, SpinResponse, optional_when=('response_switch', 1, '==')),
         # rotate
-        CommandSpec(RotateRequest, RotateResponse, moves=('angle', 'angle', 'interval', ''), held_while='holding', optional_when=('response_switch', 1), after='interval'),
+        CommandSpec(RotateRequest, RotateResponse, moves=('angle', 'angle', 'interval', ''), held_while='holding', optional_when=('response_switch', 1, '=='), after='interval'),
         # damping
-        CommandSpec(DampingRequest, DampingResponse, optional_when=('response_switch', 1)),
+        CommandSpec(DampingRequest, DampingResponse, optional_when=('response_switch', 1, '==')),
         # read_angle
         CommandSpec(ReadAngleRequest, ReadAngleResponse, reports={'angle': 'angle'}),
         # move_by_interval
-        CommandSpec(MoveByIntervalRequest, MoveByIntervalResponse, moves=('angle', 'angle', 'interval', ''), ramp=('t_acc', 't_dec'), held_while='holding', optional_when=('response_switch', 1)),
+        CommandSpec(MoveByIntervalRequest, MoveByIntervalResponse, moves=('angle', 'angle', 'interval', ''), ramp=('t_acc', 't_dec'), held_while='holding', optional_when=('response_switch', 1, '==')),
         # move_by_velocity
-        CommandSpec(MoveByVelocityRequest, MoveByVelocityResponse, moves=('angle', 'angle', '', 'velocity'), ramp=('t_acc', 't_dec'), held_while='holding', optional_when=('response_switch', 1)),
+        CommandSpec(MoveByVelocityRequest, MoveByVelocityResponse, moves=('angle', 'angle', '', 'velocity'), ramp=('t_acc', 't_dec'), held_while='holding', optional_when=('response_switch', 1, '==')),
         # move_mturn
-        CommandSpec(MoveMturnRequest, MoveMturnResponse, moves=('angle', 'angle', 'interval', ''), held_while='holding', optional_when=('response_switch', 1)),
+        CommandSpec(MoveMturnRequest, MoveMturnResponse, moves=('angle', 'angle', 'interval', ''), held_while='holding', optional_when=('response_switch', 1, '==')),
         # move_mturn_by_interval
-        CommandSpec(MoveMturnByIntervalRequest, MoveMturnByIntervalResponse, moves=('angle', 'angle', 'interval', ''), ramp=('t_acc', 't_dec'), held_while='holding', optional_when=('response_switch', 1)),
+        CommandSpec(MoveMturnByIntervalRequest, MoveMturnByIntervalResponse, moves=('angle', 'angle', 'interval', ''), ramp=('t_acc', 't_dec'), held_while='holding', optional_when=('response_switch', 1, '==')),
         # move_mturn_by_velocity
-        CommandSpec(MoveMturnByVelocityRequest, MoveMturnByVelocityResponse, moves=('angle', 'angle', '', 'velocity'), ramp=('t_acc', 't_dec'), held_while='holding', optional_when=('response_switch', 1)),
+        CommandSpec(MoveMturnByVelocityRequest, MoveMturnByVelocityResponse, moves=('angle', 'angle', '', 'velocity'), ramp=('t_acc', 't_dec'), held_while='holding', optional_when=('response_switch', 1, '==')),
         # read_mturn_angle
         CommandSpec(ReadMturnAngleRequest, ReadMturnAngleResponse, reports={'angle': 'angle'}, counts={'turns': ('angle', 3600.0)}),
         # reset_mturn_angle

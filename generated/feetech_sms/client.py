@@ -137,7 +137,7 @@ class FeetechSmsClient(ClientBase):
         """
         request = WriteRequest(id=id, address=address, data=data)
         try:
-            reply = self._maybe(request, ReplyResponse, (8, 1))
+            reply = self._maybe(request, ReplyResponse, (8, 1, '=='))
         except Timeout:
             return False
         if reply is None:
@@ -161,7 +161,7 @@ class FeetechSmsClient(ClientBase):
         """
         request = RegWriteRequest(id=id, address=address, data=data)
         try:
-            reply = self._maybe(request, ReplyResponse, (8, 1))
+            reply = self._maybe(request, ReplyResponse, (8, 1, '=='))
         except Timeout:
             return False
         if reply is None:
@@ -183,7 +183,7 @@ class FeetechSmsClient(ClientBase):
         """
         request = ActionRequest(id=id)
         try:
-            reply = self._maybe(request, ReplyResponse, (8, 1))
+            reply = self._maybe(request, ReplyResponse, (8, 1, '=='))
         except Timeout:
             return False
         if reply is None:
@@ -203,7 +203,7 @@ class FeetechSmsClient(ClientBase):
         """
         request = ResetRequest(id=id)
         try:
-            reply = self._maybe(request, ReplyResponse, (8, 1))
+            reply = self._maybe(request, ReplyResponse, (8, 1, '=='))
         except Timeout:
             return False
         if reply is None:

@@ -98,13 +98,13 @@ DEVICE = DeviceSpec(
         # read
         CommandSpec(ReadRequest, ReplyResponse, reads=('data',), tables={'data': ('run', 'address', 'length')}),
         # write
-        CommandSpec(WriteRequest, ReplyResponse, writes=('data',), moves=('present_position', 'goal_position', 'goal_time', 'goal_speed'), optional_when=('response_level', 1), tables={'data': ('run', 'address', '')}),
+        CommandSpec(WriteRequest, ReplyResponse, writes=('data',), moves=('present_position', 'goal_position', 'goal_time', 'goal_speed'), optional_when=('response_level', 1, '=='), tables={'data': ('run', 'address', '')}),
         # reg_write
-        CommandSpec(RegWriteRequest, ReplyResponse, writes=('data',), buffered=True, optional_when=('response_level', 1), tables={'data': ('run', 'address', '')}),
+        CommandSpec(RegWriteRequest, ReplyResponse, writes=('data',), buffered=True, optional_when=('response_level', 1, '=='), tables={'data': ('run', 'address', '')}),
         # action
-        CommandSpec(ActionRequest, ReplyResponse, moves=('present_position', 'goal_position', 'goal_time', 'goal_speed'), commits=True, optional_when=('response_level', 1), tables={'data': ('run', 'address', 'length')}),
+        CommandSpec(ActionRequest, ReplyResponse, moves=('present_position', 'goal_position', 'goal_time', 'goal_speed'), commits=True, optional_when=('response_level', 1, '=='), tables={'data': ('run', 'address', 'length')}),
         # reset
-        CommandSpec(ResetRequest, ReplyResponse, resets=True, optional_when=('response_level', 1), tables={'data': ('run', 'address', 'length')}),
+        CommandSpec(ResetRequest, ReplyResponse, resets=True, optional_when=('response_level', 1, '=='), tables={'data': ('run', 'address', 'length')}),
         # sync_read
         CommandSpec(SyncReadRequest, ReplyResponse, reads=('data',), each='ids', tables={'data': ('run', 'address', 'length')}),
         # sync_write

@@ -11,11 +11,11 @@ from typing import Any, TextIO
 from serialspec.cli import capture
 from serialspec.cli.frames import Frames
 from serialspec.cli.protocols import SPEC_HELP, open_spec
-from serialspec.cli.views import engineering, register_view, unit_symbols, with_unit
+from serialspec.cli.views import engineering, message_spec, register_view, unit_symbols, with_unit
 from serialspec.runtime.errors import DecodeError, SerialspecError
 from serialspec.runtime.hexbytes import parse_hex
 from serialspec.runtime.message import Message
-from serialspec.spec.model import Protocol
+from serialspec.spec.model import Protocol, replies_by_request, reply_to
 
 HELP = (
     "decode frames given as hex ('12 4c 08', '0x12 0x4c', '124c08', '12:4c:08'), one frame per argument "
@@ -44,8 +44,11 @@ def run(args: argparse.Namespace) -> int:
         raise SerialspecError("give frames as hex arguments, - to read them from stdin, or --file CAPTURE")
     protocol, package = open_spec(args.spec)
     request = None
+    expect = None  # the reply layout the request gets, where replies share a code
     if args.request:
         request = package.decode(_hex(args.request), "request")
+        reply = reply_to(message_spec(protocol, request), replies_by_request(protocol.messages()))
+        expect = next((c for c in package.MESSAGE_TYPES if reply and c.__name__ == reply.class_name), None)
     if args.file:
         return replay(args, protocol, package)
     frames = [line for line in sys.stdin if line.strip()] if args.hex == ["-"] else args.hex
@@ -53,7 +56,7 @@ def run(args: argparse.Namespace) -> int:
     for text in frames:
         try:
             frame = _hex(text)
-            message = package.decode(frame, args.direction)
+            message = package.decode(frame, args.direction, expect)
         except (DecodeError, SerialspecError) as exc:
             print(f"serialspec decode: {text.strip()}: {exc}", file=sys.stderr)
             failed += 1

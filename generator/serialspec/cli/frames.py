@@ -12,6 +12,7 @@ from types import ModuleType
 from typing import Any
 
 from serialspec.runtime.errors import DecodeError
+from serialspec.runtime.framing import EngineFormat
 from serialspec.runtime.message import Message
 from serialspec.runtime.stream import FrameFormat
 
@@ -35,6 +36,7 @@ class Frames:
         except ValueError:
             codec = package.codec
             self._paired = _Paired(codec.REQUEST_FORMAT, codec.RESPONSE_FORMAT, address)
+            self._paired.reply_layouts = getattr(codec, "REPLY_LAYOUTS", {})
             self._parser = self._paired
         self._after_error = False
 
@@ -61,13 +63,18 @@ class Frames:
 class _Direction:
     """One direction's frame format as the pairing splitter reads it: the frame size a header position implies."""
 
-    def __init__(self, frame_format: FrameFormat) -> None:
+    def __init__(self, frame_format: FrameFormat | EngineFormat) -> None:
         self.format = frame_format
+        if isinstance(frame_format, EngineFormat):  # frames of any layout: the frame engine sizes them
+            self.prefix = 1
+            self.size = frame_format.size  # type: ignore[method-assign]
+            return
         self.prefix = max(frame_format.length_offset, frame_format.command_offset or 0) + 1  # bytes to size a frame
 
     def size(self, buffer: bytes, position: int) -> int | None:
         """The frame's size if the bytes at `position` start a plausible frame (known command, fitting length)."""
         f = self.format
+        assert isinstance(f, FrameFormat)
         content = buffer[position + f.length_offset] - f.length_adds
         code = None if f.command_offset is None else buffer[position + f.command_offset]
         bounds = f.content_sizes.get(code)
@@ -79,12 +86,15 @@ class _Direction:
 class _Paired:
     """Both directions of a shared-header protocol in one stream, requests paired with their replies."""
 
-    def __init__(self, request: FrameFormat, response: FrameFormat, address: str | None) -> None:
+    def __init__(
+        self, request: FrameFormat | EngineFormat, response: FrameFormat | EngineFormat, address: str | None
+    ) -> None:
         self.request, self.response = _Direction(request), _Direction(response)
         self.header = request.header
         self.address = address
         self.buffer = b""
         self.awaiting: Message | None = None  # the last request, until a reply comes
+        self.reply_layouts: dict[type[Message], type[Message]] = {}  # request -> reply class, where codes are shared
         self.errors = 0
         self.garbage = 0
 
@@ -126,7 +136,12 @@ class _Paired:
             if position + size > len(buffer):
                 return "wait"
             try:
-                message = candidate.format.decode_at(buffer, position, position + size)
+                if isinstance(candidate.format, EngineFormat) and candidate is self.response:
+                    # where replies share a code, the layout the request waiting for its reply gets
+                    expect = self.reply_layouts.get(type(self.awaiting)) if self.awaiting else None
+                    message = candidate.format.decode_at(buffer, position, position + size, expect)
+                else:
+                    message = candidate.format.decode_at(buffer, position, position + size)
             except DecodeError:
                 failed = True
                 continue

@@ -69,5 +69,28 @@ def sum_function(width: int, invert: bool) -> Callable[[bytes], int]:
     return lambda data: sum(data) & mask
 
 
+def xor_function(width: int) -> Callable[[bytes], int]:
+    """XOR of the bytes (width 8), or of the data taken as big-endian words of width / 8 bytes."""
+    if width == 8:
+
+        def xor8(data: bytes) -> int:
+            value = 0
+            for byte in data:
+                value ^= byte
+            return value
+
+        return xor8
+    size = width // 8
+
+    def xor(data: bytes) -> int:
+        value = 0
+        padded = data + bytes(-len(data) % size)
+        for i in range(0, len(padded), size):
+            value ^= int.from_bytes(padded[i : i + size], "big")
+        return value
+
+    return xor
+
+
 # Each byte value as a one-byte bytes object: appending a 1-byte checksum is an index, not a bytes((x,)) call.
 BYTE_VALUES: tuple[bytes, ...] = tuple(bytes((value,)) for value in range(256))

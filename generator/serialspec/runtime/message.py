@@ -60,3 +60,16 @@ def slot_setters(cls: type) -> tuple[Callable[[Any, Any], None], ...]:
             raise TypeError(f"{cls.__name__}.{field.name} is not a slot")
         setters.append(slot.__set__)
     return tuple(setters)
+
+
+def compare(value: float | None, op: str, operand: float) -> bool:
+    """A device parameter's `optional_when` condition: ==, !=, >= or <= (None, an unknown value, never holds)."""
+    if value is None:
+        return False
+    if op == ">=":
+        return value >= operand
+    if op == "<=":
+        return value <= operand
+    if op == "!=":
+        return value != operand
+    return value == operand

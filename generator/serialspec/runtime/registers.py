@@ -65,11 +65,14 @@ class RegisterMap:
 
     # --- values <-> bytes -----------------------------------------------------------------------------------------
 
-    def to_wire(self, register: Register, value: int) -> bytes:
-        """One value as the register's bytes, refused (naming the register and its range) when it does not fit."""
+    def to_wire(self, register: Register, value: int, checked: bool = True) -> bytes:
+        """One value as the register's bytes, refused (naming the register and its range) when it does not fit.
+
+        `checked` False: only the type's bounds apply (a device reporting its memory, whose model's range may be
+        wider than the table's)."""
         if isinstance(value, bool) or not isinstance(value, int):
             raise EncodeError(f"{register.name} must be an integer, got {value!r}")
-        if not register.minimum <= value <= register.maximum:
+        if checked and not register.minimum <= value <= register.maximum:
             raise out_of_range(self.table, register.name, value, register.minimum, register.maximum)
         if register.sign_bit is not None and value < 0:
             value = -value | 1 << register.sign_bit

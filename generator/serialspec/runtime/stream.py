@@ -205,6 +205,9 @@ class StreamParser:
                 best, best_candidate = position, candidate
         return best, best_candidate
 
+    def expect(self, cls: type[Message] | None) -> None:
+        """The reply class the next frames answer; classic frames have one layout per code, so it changes nothing."""
+
     def pending(self) -> bytes:
         """Bytes held back, waiting to complete a frame."""
         return self._pending

@@ -11,6 +11,7 @@ unplugged and plugged back in (or a symlink such as /dev/serial/by-id/... pointe
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import select
 import threading
@@ -19,13 +20,13 @@ from collections import deque
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import suppress
 from dataclasses import dataclass, field
-from enum import IntEnum, IntFlag
+from enum import Enum, IntEnum, IntFlag
 from typing import Any, TypeVar
 
 import serial
 
 from serialspec.runtime.errors import CorruptReply, DeviceError, EncodeError, PortError, Timeout
-from serialspec.runtime.message import Message
+from serialspec.runtime.message import Message, compare
 from serialspec.runtime.stream import StreamParser
 
 M = TypeVar("M", bound=Message)
@@ -203,6 +204,7 @@ class Bus:
         with self._lock:
             self._ensure_open()
             self._drain()
+            self._parser.expect(expect)  # where replies share a code, the layout this request's reply has
             self._write(frame)
             reply = self._read_until(lambda m: isinstance(m, expect) and self.matches(request, m), wait, request)
             self._flush_backlog()
@@ -222,6 +224,7 @@ class Bus:
         with self._lock:
             self._ensure_open()
             self._drain()
+            self._parser.expect(expect)
             self._write(frame)
             for key in answers:
 
@@ -410,7 +413,12 @@ class Bus:
     def _check_status(self, reply: Message) -> None:
         for name in self.binding.status:
             value = getattr(reply, name, 0)
-            if value:
+            if dataclasses.is_dataclass(value):  # a status made of bit fields: an error when any is non-zero
+                parts = {f.name: getattr(value, f.name) for f in dataclasses.fields(value)}
+                if any(parts.values()):
+                    text = ", ".join(f"{k} = {v.name.lower() if isinstance(v, Enum) else v}" for k, v in parts.items())
+                    raise DeviceError(f"{reply.COMMAND}: the device reports {name} {text}", reply)
+            elif value:
                 text = self.binding.describe_status(name, int(value))
                 raise DeviceError(f"{reply.COMMAND}: the device reports {text}", reply)
 
@@ -450,7 +458,7 @@ class ClientBase:
     def __init__(self, bus: Bus, optional_replies: bool | None) -> None:
         self.bus = bus
         self.optional_replies = optional_replies
-        self._parameters: dict[tuple[int, int], float] = {}
+        self._parameters: dict[tuple[int, int], float | None] = {}  # None while being read
 
     def close(self) -> None:
         self.bus.close()
@@ -472,7 +480,9 @@ class ClientBase:
         extra = float(getattr(request, after)) / 1000 if after else 0.0
         return self.bus.request(request, expect, timeout=self.bus.timeout + extra)
 
-    def _maybe(self, request: Message, expect: type[M], optional: tuple[int, int] | None, after: str = "") -> M | None:
+    def _maybe(
+        self, request: Message, expect: type[M], optional: tuple[int, int, str] | None, after: str = ""
+    ) -> M | None:
         """A reply unless the device stays silent: broadcast, or an optional reply its parameter switches off."""
         self.bus.binding.encode(request)  # check every value before any byte (even a parameter read) is written
         if self._is_broadcast(request) or (optional is not None and not self._answers(request, optional)):
@@ -480,14 +490,22 @@ class ClientBase:
             return None
         return self._ask(request, expect, after)
 
-    def _answers(self, request: Message, optional: tuple[int, int]) -> bool:
+    def _answers(self, request: Message, optional: tuple[int, int, str]) -> bool:
         if self.optional_replies is not None:
             return self.optional_replies
-        key, value = optional
+        key, value, op = optional
         address = int(getattr(request, self.ADDRESS, 0))
         if (address, key) not in self._parameters:
-            self._parameters[(address, key)] = self._read_key(address, key)
-        return self._parameters[(address, key)] == value
+            # While the parameter is read, that read is asked as if it were answered (the read may itself be an
+            # optional reply: DYNAMIXEL READ at status_return_level 0); no answer means no optional replies.
+            self._parameters[(address, key)] = None
+            try:
+                self._parameters[(address, key)] = self._read_key(address, key)
+            except Timeout:
+                del self._parameters[(address, key)]
+                return False
+        current = self._parameters[(address, key)]
+        return True if current is None else compare(current, op, value)
 
     def _carry(
         self,

@@ -314,6 +314,23 @@ SCALAR_TYPE = Str("Wire type of the value.", choices=SCALAR_TYPES, default="u8")
 RANGE = ListOf(Num(), "Inclusive [min, max] of the value in wire units; checked before encoding.", length=2)
 HEX_BYTES = Str("Bytes as hex: '12 4c 08', '0x12 0x4c', '124c08' or '12:4c:08'.")
 
+
+def bit_fields(description: str) -> MapOf:
+    """Sub-fields of an integer by bit position: a field's or a frame element's `bits`."""
+    return MapOf(
+        Obj(
+            {
+                "bits": OneOf((Int(), ListOf(Int(), length=2)), "A bit number, or [high, low] for several bits."),
+                "enum": Str("Name of an entry in `enums:`."),
+                "description": TEXT,
+            },
+            required=("bits",),
+            description="One sub-field: its bit (or bits) and optionally the enum its value belongs to.",
+        ),
+        description,
+    )
+
+
 _FIELD_LONG: dict[str, Shape] = {
     "type": Str("Wire type: u8, i8, u16, i16, u32, i32, f32, bytes, array, group, table_value, table_block."),
     "use": Str("Name of an entry in `fields:` (top level) to copy; keys given here override it."),
@@ -326,18 +343,7 @@ _FIELD_LONG: dict[str, Shape] = {
     "default": Num("Value used when a message is built without this field."),
     "enum": Str("Name of an entry in `enums:`; values decode to that enum."),
     "flags": Str("Name of an entry in `flags:`; the value is a set of bit flags."),
-    "bits": MapOf(
-        Obj(
-            {
-                "bits": OneOf((Int(), ListOf(Int(), length=2)), "A bit number, or [high, low] for several bits."),
-                "enum": Str("Name of an entry in `enums:`."),
-                "description": TEXT,
-            },
-            required=("bits",),
-            description="One sub-field: its bit (or bits) and optionally the enum its value belongs to.",
-        ),
-        "Sub-fields packed into this integer, by bit position (unlisted bits must be zero).",
-    ),
+    "bits": bit_fields("Sub-fields packed into this integer, by bit position (unlisted bits must be zero)."),
     "encoding": Str(
         "How the integer is stored: plain two's complement, or sign_magnitude (top bit the sign, the rest the size).",
         choices=("plain", "sign_magnitude"),
@@ -377,10 +383,13 @@ FIELDS: Shape = MapOf(FIELD, "Fields in wire order: name -> type or mapping.")
 OPTIONAL_WHEN = Obj(
     {
         "parameter": Str("A table entry: `entry` or `table.entry` (e.g. response_switch)."),
-        "equals": Int("The value of the parameter with which the device answers."),
+        "equals": Int("The device answers while the parameter has this value."),
+        "not_equals": Int("The device answers while the parameter has any other value.", example=0),
+        "at_least": Int("The device answers while the parameter is at least this (status_return_level ≥ 1)."),
+        "at_most": Int("The device answers while the parameter is at most this.", example=1),
     },
-    required=("parameter", "equals"),
-    description="The reply is sent only while a device parameter has this value.",
+    required=("parameter",),
+    description="The reply is sent only while a device parameter compares true (give one comparison).",
 )
 
 MESSAGE = Obj(
@@ -399,6 +408,12 @@ MESSAGE = Obj(
             },
             required=("command",),
             description="For a request: answered by another command's response (FEETECH's one status packet).",
+        ),
+        "default": Bool(
+            "Among replies that share a code (or that all have none), the one a frame is decoded as when the "
+            "request it answers is unknown; the others are chosen by the request they answer.",
+            default=False,
+            example=True,
         ),
         "source": SOURCE,
     },
@@ -533,29 +548,59 @@ TABLE = Obj(
     description="Parameters or registers addressed by a key (a data_id, a register address).",
 )
 
+
+def span(description: str) -> OneOf:
+    """A span of frame elements: [first, last] (inclusive), or a mapping direction -> [first, last]."""
+    return OneOf(
+        (
+            ListOf(Str(), "[first, last] frame element names", length=2),
+            MapOf(ListOf(Str(), "[first, last] frame element names", length=2), "direction -> [first, last]"),
+        ),
+        f"{description} [first, last] frame element names, or a mapping direction -> [first, last].",
+    )
+
+
 FRAME_ELEMENT = Obj(
     {
         "role": Str(
-            "What the element is.",
-            choices=("header", "command", "length", "content", "checksum", "address", "status"),
+            "What the element is: constant bytes (header first, trailer last, constant anywhere, e.g. a reserved "
+            "byte), a frame-level value (address, command, status), the length, the content or a checksum.",
+            choices=("header", "trailer", "constant", "command", "length", "content", "checksum", "address", "status"),
         ),
-        "type": Str("Wire type of the element (command, length, address, status, checksum).", choices=SCALAR_TYPES),
+        "type": Str("Wire type of a value, length or checksum (default u8).", choices=SCALAR_TYPES),
+        "endian": Str(
+            "Byte order of a multi-byte element (default little, whatever the protocol's byte_order).",
+            choices=("little", "big"),
+            default="little",
+            example="big",
+        ),
         "value": OneOf(
             (Str(), MapOf(Str(), "direction -> hex bytes")),
-            "header: hex bytes, or a mapping direction -> hex bytes",
+            "Constant bytes as hex, or a mapping direction -> hex bytes. On a header, trailer or constant: its "
+            "bytes. On any other element: in the directions given, the element is these constant bytes instead "
+            "(DYNAMIXEL status packets carry 55 where requests carry the instruction).",
         ),
         "directions": ListOf(
-            Str(choices=("request", "response")), "The directions whose frames have the element (default: both)."
+            Str(choices=("request", "response")), "The directions whose frames have it (default both)."
         ),
-        "adds": Int("length: what the length counts beyond the content (SMS: 2 = instruction + checksum)."),
+        "counts": span(
+            "length: the span of elements it counts, on the wire (after stuffing); default the content only.",
+        ),
+        "adds": Int("length: added to the counted size (SMS: 2 = instruction + checksum); may be negative.", default=0),
         "description": TEXT,
         "range": RANGE,
         "broadcast": Int("address: the broadcast value."),
         "flags": Str("status: name of an entry in `flags:`."),
-        "covers": ListOf(Str(), "checksum: first and last element covered.", length=2),
+        "bits": bit_fields(
+            "status (or address): bit fields packed into the element (DYNAMIXEL: alert bit 7, error number 6..0)."
+        ),
+        "covers": span(
+            "checksum: the span of elements covered. Outside a transparency span it sees the wire bytes, inside "
+            "it the bytes before stuffing.",
+        ),
         "algorithm": Str(
-            "checksum: `sum` of the covered bytes (modulo 2^bits of its type), or `crc` with the parameters in `crc`.",
-            choices=("sum", "crc"),
+            "checksum: sum (of the bytes, modulo the width), xor (of the bytes) or crc.",
+            choices=("sum", "crc", "xor"),
         ),
         "invert": Bool("sum: bitwise NOT of the sum.", default=False),
         "crc": Obj(
@@ -570,11 +615,55 @@ FRAME_ELEMENT = Obj(
                 "check": Int("The catalogue check value: the CRC of b'123456789'."),
             },
             required=("width", "poly", "init", "refin", "refout", "xorout", "check"),
-            description="crc: the CRC's catalogue parameters, checked against the catalogue check value.",
+            description=(
+                "crc: the CRC by its catalogue parameters (reveng's CRC catalogue); the generator checks `check` "
+                "against the CRC of '123456789'."
+            ),
         ),
     },
     required=("role",),
-    description="One element of the frame: header, command, length, content, checksum, address or status.",
+    description="One element of the frame, in wire order.",
+)
+
+FRAME_ELEMENTS = MapOf(FRAME_ELEMENT, "The frame's elements in wire order: name -> element.")
+
+TRANSPARENCY = Obj(
+    {
+        "span": span("The elements whose bytes are stuffed or escaped."),
+        "replace": MapOf(
+            HEX_BYTES,
+            "Plain hex bytes -> the hex bytes sent instead, leftmost match first (DYNAMIXEL: 'FF FF FD' -> "
+            "'FF FF FD FD'; SLIP: 'C0' -> 'DB DC', 'DB' -> 'DB DD').",
+        ),
+        "description": TEXT,
+    },
+    required=("span", "replace"),
+    description=(
+        "Byte stuffing or escaping over a span, applied by encode and removed by decode and the stream parser. "
+        "Lengths count the bytes as sent."
+    ),
+)
+
+FRAMING = Obj(
+    {
+        "elements": FRAME_ELEMENTS,
+        "layouts": MapOf(
+            Obj(
+                {
+                    "description": Str(TEXT.description, example="Payloads of up to 255 bytes."),
+                    "elements": FRAME_ELEMENTS,
+                },
+                required=("elements",),
+                description="One alternative layout: its elements in wire order.",
+            ),
+            "Alternative layouts (instead of `elements`), told apart by their headers; encode uses the first "
+            "whose length can count the frame (VESC: 02 + u8 length, 03 + u16 length).",
+        ),
+        "transparency": TRANSPARENCY,
+        "gap": Num("Silence between frames, in character times (Modbus RTU: 3.5).", example=3.5),
+        "description": TEXT,
+    },
+    description="The frame every command travels in: `elements` (one layout) or `layouts` (alternatives).",
 )
 
 EXAMPLE = Obj(
@@ -633,7 +722,21 @@ DEVICE_COMMAND = Obj(
         "description": Str(TEXT.description, example="The servo moves to the goal position over goal_time."),
         "reads": ListOf(Str(), "Response fields filled from memory: table_value by its key, table_block entries."),
         "writes": ListOf(Str(), "Request fields stored in memory: table_value by its key, table_block entries."),
-        "resets": Bool("Memory goes back to its defaults.", default=False),
+        "resets": Bool(
+            "Memory goes back to its defaults (all but the device's id, unless `keeps` says otherwise).", default=False
+        ),
+        "keeps": Obj(
+            {
+                "field": Str("The request field that chooses (DYNAMIXEL FACTORY RESET `option`)."),
+                "entries": MapOf(
+                    ListOf(Str(), "the memory entries a reset keeps"),
+                    "Field value -> the memory entries a reset keeps.",
+                    int_keys=True,
+                ),
+            },
+            required=("field", "entries"),
+            description="resets: the entries kept, chosen by a request field (0xFF: none, 0x01: id, ...).",
+        ),
         "reports": MapOf(Str(), "Response field -> the state variable or memory entry it reports."),
         "moves": Obj(
             {
@@ -641,6 +744,13 @@ DEVICE_COMMAND = Obj(
                 "target": Str("The request field (or memory entry, once written) with the target."),
                 "duration": Str("The request field (or memory entry) with the time to reach the target, in ms."),
                 "speed": Str("The request field (or memory entry) with the speed, in state units per second."),
+                "speed_scale": Num(
+                    "State units per second for one unit of `speed` (DYNAMIXEL: 0.229 rev/min x 4096 / 60 = 15.63)."
+                ),
+                "enabled_by": Str(
+                    "A memory entry (or state variable): the move happens only while it is non-zero (torque_enable); "
+                    "otherwise the target is only stored."
+                ),
                 "accel": Str("The request field with the acceleration time (ms) at the start of the move."),
                 "decel": Str("The request field with the deceleration time (ms) at the end of the move."),
             },
@@ -691,6 +801,11 @@ DEVICE_COMMAND = Obj(
         "each": Str("A group field of the request whose items address one device each (by the address field)."),
         "buffered": Bool("The writes are held until a command that `commits` (FEETECH REG WRITE).", default=False),
         "commits": Bool("Carries out the writes held by `buffered` commands (FEETECH ACTION).", default=False),
+        "nothing_held": MapOf(
+            Num(),
+            "commits: response field (or field.bit_field) -> value when no write is held (DYNAMIXEL ACTION without "
+            "REG WRITE: error.number 2, instruction error).",
+        ),
         "kind": Str("The entry of `kinds:` whose devices the command addresses (default: the devices of --id)."),
         "stores": MapOf(Str(), "Request field -> the state variable it is stored in (where names differ)."),
         "sets": MapOf(Num(), "State variable -> the value the command sets it to."),
@@ -753,8 +868,21 @@ DEVICE = Obj(
         "broadcast": Int("The address every device obeys (default: the address element's broadcast)."),
         "state": MapOf(Num(), "State variables beyond memory -> initial value (e.g. the present angle)."),
         "reply": MapOf(Num(), "Response field -> value when no behaviour sets it (e.g. result: 1)."),
-        "refused": MapOf(Num(), "Response field -> value when a write is refused (read-only or unknown entry)."),
-        "status": MapOf(Str(), "Response field -> the memory entry every response reports in it (a status byte)."),
+        "refused": MapOf(
+            Num(),
+            "Response field (or field.bit_field) -> value when a write is refused (read-only or unknown entry; "
+            "DYNAMIXEL error.number: 7, access error).",
+        ),
+        "out_of_range": MapOf(
+            Num(),
+            "Response field (or field.bit_field) -> value when a write is refused for a value outside the entry's "
+            "range (DYNAMIXEL error.number: 4, data range error); default: `refused`.",
+        ),
+        "status": MapOf(
+            Str(),
+            "Response field -> the memory entry every response reports in it (a status byte); field.bit_field -> "
+            "an entry whose being non-zero sets that bit field (DYNAMIXEL error.alert: hardware_error_status).",
+        ),
         "moving": MapOf(
             Obj(
                 {
@@ -811,14 +939,7 @@ SPEC = Obj(
             required=("baudrate",),
             description="The serial line's settings: what clients, simulators and `monitor` open a port with.",
         ),
-        "framing": Obj(
-            {
-                "elements": MapOf(FRAME_ELEMENT, "The frame's elements in wire order: name -> element."),
-                "description": TEXT,
-            },
-            required=("elements",),
-            description="The frame every command travels in.",
-        ),
+        "framing": FRAMING,
         "matching": Obj(
             {
                 "by": ListOf(Str(), "What a reply shares with its request: `command` and field names (servo_id)."),

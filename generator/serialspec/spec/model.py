@@ -207,12 +207,18 @@ class Table:
 
 @dataclass(frozen=True)
 class OptionalWhen:
-    """A response the device sends only while one of its parameters (a table entry) holds a value."""
+    """A response the device sends only while one of its parameters (a table entry) compares true with a value."""
 
     table: str
     entry: str
     key: int
-    equals: int
+    equals: int  # the value compared with
+    op: Literal["==", "!=", ">=", "<="] = "=="
+
+    @property
+    def symbol(self) -> str:
+        """The comparison as people write it: =, ≠, ≥ or ≤."""
+        return {"==": "=", "!=": "≠", ">=": "≥", "<=": "≤"}[self.op]
 
 
 @dataclass(frozen=True)
@@ -237,6 +243,7 @@ class Message:
     answered_by: str = ""  # a request answered by another command's response (its key)
     reply_when: OptionalWhen | None = None  # a request whose reply is sent only when a device parameter has a value
     struct_name: str = ""  # the construct struct of its content
+    default_reply: bool = False  # among replies sharing a code: the one a frame is decoded as without its request
 
     @property
     def key(self) -> str:
@@ -317,18 +324,20 @@ class Crc:
 
 @dataclass(frozen=True)
 class Checksum:
-    algorithm: Literal["sum", "crc"]
+    algorithm: Literal["sum", "crc", "xor"]
     invert: bool
     crc: Crc | None
     first: str  # first frame element covered
     last: str  # last frame element covered
     type: ScalarType
+    endian: Literal["<", ">"] = "<"
+    name: str = ""  # the frame element holding it
 
 
 @dataclass(frozen=True)
 class FrameElement:
     name: str
-    role: str
+    role: str  # header, trailer, constant, address, command, status, length, content, checksum
     type: ScalarType | None
     size: int | None  # None for content
     directions: tuple[Direction, ...]
@@ -337,17 +346,44 @@ class FrameElement:
     maximum: float
     broadcast: int | None
     flags: FlagsDef | None
+    endian: Literal["<", ">"] = "<"
+    constant: bytes = b""  # header, trailer, constant: the bytes in this direction
+    bits: tuple[BitField, ...] = ()  # a status (or address, command) made of bit fields
+    bits_class: str = ""
+    counts: tuple[str, str] = ("", "")  # length: the first and last element counted
+    adds: int = 0  # length: added to the counted size
+    checksum: Checksum | None = None  # checksum: what it is and what it covers
+
+    @property
+    def fixed(self) -> bool:
+        """Constant bytes: a header, a trailer, a reserved byte, or a command's constant in this direction."""
+        return self.role in ("header", "trailer", "constant")
+
+
+@dataclass(frozen=True)
+class Transparency:
+    """Byte stuffing or escaping over a span of elements: each plain sequence is sent as its wire sequence."""
+
+    first: str
+    last: str
+    replace: tuple[tuple[bytes, bytes], ...]
+    description: str = ""
 
 
 @dataclass(frozen=True)
 class FrameLayout:
-    """The frame in one direction: elements in order with their byte offsets (content's at its start)."""
+    """The frame in one direction: elements in order with their byte offsets (content's at its start).
+
+    The offsets and the classic fields (length_offset .. covered_to_end) describe frames of the classic shape (a
+    header, a one-byte length before the content, one final checksum, no transparency); `classic` says whether this
+    layout has it. Every layout is fully described by its elements, `transparency` and `checksums`.
+    """
 
     direction: Direction
     header: bytes
     elements: tuple[FrameElement, ...]
     offsets: dict[str, int]
-    overhead: int  # frame size minus content size
+    overhead: int  # frame size minus content size (on the wire, before stuffing)
     length_offset: int
     length_adds: int
     command_offset: int | None
@@ -355,14 +391,42 @@ class FrameLayout:
     covered_from: int  # first covered byte
     covered_to_end: int  # bytes after the last covered byte
     value_elements: tuple[FrameElement, ...]  # address/status: frame-level values every message carries
+    name: str = ""  # the layout's name among alternatives ("" for the one layout)
+    transparency: Transparency | None = None
+    checksums: tuple[Checksum, ...] = ()
+    classic: bool = True
+
+    def index(self, name: str) -> int:
+        return next(i for i, e in enumerate(self.elements) if e.name == name)
+
+    @property
+    def has_command(self) -> bool:
+        """Frames of this direction carry a command code (else every message of it is codeless)."""
+        return any(e.role == "command" for e in self.elements)
+
+    @property
+    def length(self) -> FrameElement | None:
+        return next((e for e in self.elements if e.role == "length"), None)
+
+    @property
+    def trailer(self) -> bytes:
+        last = self.elements[-1]
+        return last.constant if last.role == "trailer" else b""
 
 
 @dataclass(frozen=True)
 class Framing:
     description: str
-    layouts: dict[Direction, FrameLayout]
-    checksum: Checksum
+    layouts: dict[Direction, FrameLayout]  # the (first) layout of each direction
+    checksum: Checksum | None  # the first layout's first checksum
     shared_header: bool
+    alternatives: dict[Direction, tuple[FrameLayout, ...]] = field(default_factory=dict)  # every layout, in order
+    gap: float = 0.0  # silence between frames, in character times (0: none defined)
+
+    @property
+    def classic(self) -> bool:
+        """Every layout has the classic shape (see FrameLayout): generated codecs use straight-line code."""
+        return all(layout.classic for layouts in self.alternatives.values() for layout in layouts)
 
 
 @dataclass(frozen=True)
@@ -424,6 +488,8 @@ class Motion:
     target: str
     duration: str
     speed: str
+    speed_scale: float = 1.0  # state units per second for one unit of `speed`
+    enabled_by: str = ""  # a memory entry (or state variable): the move happens only while it is non-zero
     accel: str = ""  # request field: acceleration time (ms) at the start
     decel: str = ""  # request field: deceleration time (ms) at the end
 
@@ -446,6 +512,7 @@ class Behaviour:
     stores: dict[str, str] = field(default_factory=dict)  # request field -> state variable
     sets: dict[str, float] = field(default_factory=dict)  # state variable -> value
     absent: dict[str, float] = field(default_factory=dict)  # response values when no device has the id
+    keeps: tuple[str, dict[int, tuple[str, ...]]] | None = None  # resets: request field, its value -> entries kept
     stops: tuple[str, ...] = ()  # state variables whose move stops where it is
     wraps: dict[str, float] = field(default_factory=dict)  # state variable -> period it is kept within
     counts: dict[str, tuple[str, float]] = field(default_factory=dict)  # response field -> (state, per)
@@ -455,6 +522,7 @@ class Behaviour:
     cancel_when: dict[str, float] = field(default_factory=dict)  # with releases: field -> value that drops them
     carries: tuple[str, str] | None = None  # (command code field, content field) of a carried request
     carried: tuple[str, ...] = ()  # the commands it can carry (empty: every command with a code)
+    nothing_held: dict[str, float] = field(default_factory=dict)  # commits: reply values when nothing is held
 
 
 @dataclass(frozen=True)
@@ -514,6 +582,7 @@ class Device:
     status: dict[str, str] = field(default_factory=dict)  # response field -> memory entry every reply reports
     kinds: tuple[DeviceKind, ...] = ()
     echo_address: bool = False  # replies carry the id the request named, not the answering device's own
+    out_of_range: dict[str, float] = field(default_factory=dict)  # response values when a value is out of range
     models: tuple[DeviceModel, ...] = ()  # the first is the default model
     moving: dict[str, tuple[str, int | None]] = field(default_factory=dict)  # entry -> (state variable, bit)
     model_entry: str = ""  # the memory entry holding the model number

@@ -10,11 +10,13 @@ from dataclasses import dataclass
 from typing import Any
 
 from serialspec.emit.common import render as common
+from serialspec.emit.common.frames import runtime_layouts
 from serialspec.emit.common.numbers import number
 from serialspec.emit.common.text import collapse
 from serialspec.spec.model import (
     Array,
     Bytes,
+    Checksum,
     Command,
     Device,
     DeviceModel,
@@ -177,7 +179,7 @@ def message_context(protocol: Protocol, message: Message | None) -> dict[str, An
         "optional": text(message.optional),
         "unsolicited": message.unsolicited,
         "answers": message.answers,
-        "reply": reply_text(message),
+        "reply": reply_text(message, protocol),
         "description": text(message.description),
     }
 
@@ -196,13 +198,46 @@ def size_text(low: int, high: int | None, limit: int | None) -> str:
     return f"{low}..{high} bytes" if high is not None else f"{low} bytes or more"
 
 
-def reply_text(message: Message) -> str:
-    """For a request answered by another command's response: which, and the parameter that switches it."""
+def reply_text(message: Message, protocol: Protocol | None = None) -> str:
+    """For a request answered by another command's response: which, and the parameter that switches it; for a
+    response that shares its code with other replies: how a reply is told to have this layout."""
+    if message.direction == Direction.RESPONSE and protocol is not None:
+        return shared_reply_text(protocol, message)
     if not message.answered_by:
         return ""
     switch = message.reply_when
-    when = f", sent only while `{switch.entry}` = {switch.equals}" if switch else ""
+    when = f", sent only while `{switch.entry}` {switch.symbol} {switch.equals}" if switch else ""
     return f"answered by the `{message.answered_by}` response{when}"
+
+
+def shared_reply_text(protocol: Protocol, message: Message) -> str:
+    """A reply layout that shares its code (or its having none) with others: chosen by the request it answers."""
+    layout = protocol.framing.layouts[Direction.RESPONSE]
+    code = protocol.command(message.command).code if layout.has_command else None
+    sharing = [
+        m
+        for m in protocol.messages()
+        if m.direction == Direction.RESPONSE
+        and not m.unsolicited
+        and (protocol.command(m.command).code if layout.has_command else None) == code
+        and not protocol.command(m.command).subcommands
+    ]
+    if len(sharing) < 2:
+        return ""
+    askers = sorted(
+        {
+            r.command
+            for r in protocol.messages()
+            if r.direction == Direction.REQUEST and (r.answered_by or r.key) == message.key
+        }
+    )
+    answers = ", ".join(f"`{a}`" for a in askers) or "no request"
+    default = (
+        "; a reply decoded without its request is read with this layout"
+        if message.default_reply
+        else "; chosen by the request it answers (the replies share their code)"
+    )
+    return f"the layout of the replies to {answers}{default}"
 
 
 def command_context(protocol: Protocol, command: Command) -> dict[str, Any]:
@@ -254,20 +289,21 @@ def examples_for(protocol: Protocol, command: str, subcommand: str | None) -> li
 def frame_picture(protocol: Protocol) -> list[str]:
     """The frame of each direction on one line, columns aligned: `12 4C | cmd_id | length | content (n) | checksum`."""
     lines = []
-    for layout in protocol.framing.layouts.values():
+    for layout in (lay for lays in protocol.framing.alternatives.values() for lay in lays):
         parts = []
         for e in layout.elements:
-            if e.role == "header":
-                parts.append(layout.header.hex(" ").upper())
+            if e.fixed:
+                parts.append(e.constant.hex(" ").upper())
             elif e.role == "content":
                 parts.append(f"{e.name} (n bytes)")
             else:
                 parts.append(e.name + (f" ({e.type.size} bytes)" if e.type and e.type.size > 1 else ""))
-        lines.append((layout.direction.value, parts))
+        lines.append((layout.direction.value + (f" {layout.name}" if layout.name else ""), parts))
     columns = max(len(parts) for _, parts in lines)
     widths = [max(len(p[i]) for _, p in lines if i < len(p)) for i in range(columns)]
+    label = max(9, *(len(direction) for direction, _ in lines))
     return [
-        f"{direction:<9} " + " | ".join(part.ljust(widths[i]) for i, part in enumerate(parts)).rstrip()
+        direction.ljust(label) + " " + " | ".join(part.ljust(widths[i]) for i, part in enumerate(parts)).rstrip()
         for direction, parts in lines
     ]
 
@@ -275,16 +311,32 @@ def frame_picture(protocol: Protocol) -> list[str]:
 def frame_context(protocol: Protocol, layout: FrameLayout) -> dict[str, Any]:
     rows = []
     offset = 0
+    variable = False  # past the content (or the stuffed span): offsets vary from frame to frame
+    first_variable = layout.transparency.first if layout.transparency else None
     for e in layout.elements:
         size = e.size
-        header = e.role == "header"
-        description = f"{layout.header.hex(' ').upper()} — {e.description}" if header else e.description
-        kind = e.type.name if e.type else ("bytes" if e.role == "header" else "n bytes")
-        if e.role == "length":
+        variable = variable or e.name == first_variable
+        if e.role == "header" and layout.classic:
+            description = f"{layout.header.hex(' ').upper()} — {e.description}"
+        elif e.fixed:
+            description = f"{e.constant.hex(' ').upper()} — {e.description}"
+        elif e.role == "checksum" and not layout.classic and e.checksum is not None:
+            endian = "big-endian" if e.endian == ">" else "little-endian"
+            description = f"over `{e.checksum.first}`..`{e.checksum.last}`, {endian}. {e.description}"
+        else:
+            description = e.description
+        kind = e.type.name if e.type else ("bytes" if e.fixed else "n bytes")
+        if e.role == "length" and layout.classic:
             kind += f" = n + {layout.length_adds}" if layout.length_adds else " = n"
+        elif e.role == "length":
+            adds = f" {'+' if e.adds > 0 else '-'} {abs(e.adds)}" if e.adds else ""
+            endian = ", big-endian" if e.endian == ">" and (e.size or 0) > 1 else ""
+            kind += f" = bytes `{e.counts[0]}`..`{e.counts[1]}` as sent{adds}{endian}"
         where = f"{offset}.." if size is None else (str(offset) if size == 1 else f"{offset}..{offset + size - 1}")
         if e.role in ("checksum",) or (offset is None):
             where = "last" if e.role == "checksum" else where
+        if variable and e.role not in ("content", "checksum"):
+            where = "after the content" if e.role == "trailer" or layout.offsets.get(e.name) is None else where
         rows.append(
             {
                 "offset": cell(where),
@@ -295,14 +347,44 @@ def frame_context(protocol: Protocol, layout: FrameLayout) -> dict[str, Any]:
             }
         )
         offset += size or 0
-    return {"direction": layout.direction.value, "rows": rows}
+    title = layout.direction.value.capitalize() + (f" frame, layout `{layout.name}`" if layout.name else " frame")
+    return {"direction": layout.direction.value, "title": title, "rows": rows}
 
 
-def checksum_context(protocol: Protocol) -> dict[str, Any]:
-    checksum = protocol.framing.checksum
+def transparency_text(protocol: Protocol) -> str:
+    """The byte stuffing or escaping rule, if the frames have one."""
+    rules = {layout.transparency for layouts in protocol.framing.alternatives.values() for layout in layouts}
+    found = [t for t in rules if t is not None]
+    if not found:
+        return ""
+    t = found[0]
+    pairs = ", ".join(f"{plain.hex(' ').upper()} is sent as {wire.hex(' ').upper()}" for plain, wire in t.replace)
+    return text(
+        f"From `{t.first}` to `{t.last}`, {pairs}: encode applies it, decode and the stream parser remove it. "
+        f"Lengths count the bytes as sent; checksums outside the span cover them as sent. {t.description}"
+    )
+
+
+def checksums_context(protocol: Protocol) -> list[dict[str, Any]]:
+    """Every checksum of the (first) layouts; a classic frame's one with a worked example."""
+    if protocol.framing.classic:
+        return [checksum_context(protocol)]
+    found: dict[str, Checksum] = {}
+    for layouts in protocol.framing.alternatives.values():
+        for layout in layouts:
+            for checksum in layout.checksums:
+                found.setdefault(checksum.name, checksum)
+    return [checksum_context(protocol, checksum) for checksum in found.values()]
+
+
+def checksum_context(protocol: Protocol, general: Checksum | None = None) -> dict[str, Any]:
+    checksum = general or protocol.framing.checksum
+    assert checksum is not None
     example = next(iter(protocol.examples), None)
     worked = ""
-    if example is not None:
+    if general is not None and example is not None:
+        worked = f"every example's `{checksum.name}` verifies (e.g. `{example.name}`)"
+    elif example is not None:
         layout = protocol.framing.layouts[example.direction]
         covered = example.frame[layout.covered_from : len(example.frame) - layout.covered_to_end]
         if checksum.algorithm == "sum":
@@ -332,11 +414,48 @@ def checksum_context(protocol: Protocol) -> dict[str, Any]:
             ("xorout", f"{c.xorout:#04x}"),
             ("check ('123456789')", f"{c.check:#04x}"),
         ]
-    return {"what": what, "first": checksum.first, "last": checksum.last, "worked": worked, "params": params}
+    if checksum.algorithm == "xor":
+        what = f"XOR of the covered bytes ({checksum.type.size * 8} bits)"
+    label = f" `{checksum.name}`" if general is not None else ""
+    return {
+        "label": label,
+        "what": what,
+        "first": checksum.first,
+        "last": checksum.last,
+        "worked": worked,
+        "params": params,
+    }
+
+
+def general_breakdown(protocol: Protocol, example: Example, message: Message | None) -> list[dict[str, str]]:
+    """An example frame of any layout, element by element (unstuffed) and field by field, by the frame engine."""
+    layouts = runtime_layouts(protocol, example.direction)
+    layout = next((lay for lay in layouts if example.frame.startswith(lay.header)), layouts[0])
+    unwrapped = layout.unwrap(example.frame)
+    rows: list[dict[str, str]] = []
+    for e, part in zip(layout.elements, unwrapped.parts, strict=True):
+        if e.kind == "content" and message is not None:
+            rows += content_rows(message.fields, example.fields, part, 0, len(part))
+            continue
+        value: Any = example.fields.get(e.name, "")
+        if e.kind == "command":
+            value = example.command
+        elif e.kind == "length":
+            value = f"{e.unpack(part)} (bytes `{layout.elements[e.span[0]].name}`..`{layout.elements[e.span[1]].name}`)"
+        elif e.kind == "checksum":
+            value = "verifies"
+        rows.append({"bytes": part.hex(" ").upper(), "field": e.name, "value": cell(value)})
+    return rows
 
 
 def breakdown(protocol: Protocol, example: Example) -> list[dict[str, str]]:
     """Byte spans of an example frame, element by element and field by field, with the values."""
+    if not protocol.framing.classic:
+        command = protocol.command(example.command)
+        holder = next((s for s in command.subcommands if s.name == example.subcommand), None) or command
+        return general_breakdown(
+            protocol, example, holder.request if example.direction == Direction.REQUEST else holder.response
+        )
     layout = protocol.framing.layouts[example.direction]
     command = protocol.command(example.command)
     sub = next((s for s in command.subcommands if s.name == example.subcommand), None)
@@ -510,10 +629,13 @@ def emit_docs(protocol: Protocol) -> str:
         ],
         serial_notes=text(serial.notes),
         framing=text(protocol.framing.description),
-        frames=same_once([frame_context(protocol, layout) for layout in protocol.framing.layouts.values()]),
+        frames=same_once(
+            [frame_context(protocol, lay) for lays in protocol.framing.alternatives.values() for lay in lays]
+        ),
         frame_picture=frame_picture(protocol),
+        transparency=transparency_text(protocol),
         shared_header=protocol.framing.shared_header,
-        checksum=checksum_context(protocol),
+        checksums=checksums_context(protocol),
         matching=", ".join(protocol.matching),
         matching_description=text(protocol.matching_description),
         commands=commands,

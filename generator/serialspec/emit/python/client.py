@@ -182,6 +182,7 @@ def unused_fields(protocol: Protocol, request: Message, response: Message) -> se
     of registers read from a request field this request does not have (a shared reply's `data` to a PING)."""
     unused = {e.name for e in status_elements(protocol)}
     names = {f.name for f in request.fields}
+    names |= {f.name for g in request.fields if isinstance(g, Group) for f in g.fields}  # per-item (BULK READ)
     for f in response.fields:
         if isinstance(f, Bytes) and f.table is not None:
             needed = [*([f.start] if f.start_in_request else []), *([f.size_from] if f.size_from else [])]
@@ -257,10 +258,29 @@ def register_commands(protocol: Protocol, methods: list[dict[str, Any]]) -> list
             context.update(read_key=first)
         elif group is not None and read is not None and read.table is not None and method["kind"] == "each":
             start, size = read.start, read.size_from
-            if fields != [address, start, size, group.name] or [f.name for f in group.fields] != [address]:
+            items = [f.name for f in group.fields]
+            if fields == [address, start, size, group.name] and items == [address]:
+                context.update(kind="each_read", map=map_name(read.table), alias=names_alias(read.table))
+                context.update(group=group.name, item=group.class_name, item_address=address)
+            elif fields == [address, group.name] and items == [address, start, size]:
+                # every item names its own device and run (BULK READ)
+                context.update(kind="items_read", map=map_name(read.table), alias=names_alias(read.table))
+                context.update(group=group.name, item=group.class_name, item_address=address, start=start, size=size)
+            else:
                 continue
-            context.update(kind="each_read", map=map_name(read.table), alias=names_alias(read.table), group=group.name)
-            context.update(item=group.class_name, item_address=address)
+        elif (
+            group is not None
+            and item_run is not None
+            and item_run.table is not None
+            and response is None
+            and item_run.start in {f.name for f in group.fields}
+        ):
+            if fields != [address, group.name]:
+                continue
+            # every item writes its own run to its own device (BULK WRITE)
+            context.update(kind="items_write", map=map_name(item_run.table), alias=names_alias(item_run.table))
+            context.update(group=group.name, item=group.class_name)
+            context.update(item_address=address, start=item_run.start, field=item_run.name)
         elif group is not None and item_run is not None and item_run.table is not None and response is None:
             size = item_run.size if isinstance(item_run.size, str) else ""
             if fields != [address, item_run.start, *([size] if size in fields else []), group.name]:
@@ -463,7 +483,7 @@ def client_module(protocol: Protocol) -> str:
             "build": ", ".join(f"{f.name}={f.name}" for f in fields),
             "kind": kind,
             "silent": silent,
-            "optional": f"({optional.key}, {optional.equals})" if optional else "None",
+            "optional": f"({optional.key}, {optional.equals}, {optional.op!r})" if optional else "None",
             "after": repr(response.after) if response and response.after else "",
             "result": result_expr,
             "remember": (
@@ -547,7 +567,12 @@ def client_module(protocol: Protocol) -> str:
             {
                 *(["Callable", "Iterator"] if reports else []),
                 *(["Mapping"] if any(m["pairs"] for m in everything) else []),
-                *(["Mapping"] if any(r["kind"] == "each_write" for r in registers) else []),
+                *(
+                    ["Mapping"]
+                    if any(r["kind"] in ("each_write", "items_read", "items_write") for r in registers)
+                    else []
+                ),
+                *(["Sequence"] if any(r["kind"] == "items_read" for r in registers) else []),
                 *(["Iterable"] if any(r["kind"] == "each_read" for r in registers) else []),
                 *(["Sequence"] if any(m["kind"] == "carry" or m["singles"] for m in everything) else []),
             }

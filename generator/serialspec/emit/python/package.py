@@ -8,6 +8,7 @@ from typing import Any
 
 from serialspec.emit.common.numbers import number
 from serialspec.emit.python.client import client_module
+from serialspec.emit.python.frames import checksum_definitions, code_key, codec_lines, framing_imports
 from serialspec.emit.python.pycode import (
     ClassCode,
     Lines,
@@ -23,7 +24,18 @@ from serialspec.emit.python.registers import register_tables, registers_module
 from serialspec.emit.python.render import render
 from serialspec.emit.python.simulator import simulator_module
 from serialspec.emit.python.structs import structs_module
-from serialspec.spec.model import Command, Direction, FrameLayout, Message, Protocol, Scalar, Table, TableValue
+from serialspec.spec.model import (
+    Command,
+    Direction,
+    FrameLayout,
+    Message,
+    Protocol,
+    Scalar,
+    Table,
+    TableValue,
+    replies_by_request,
+    reply_to,
+)
 
 _IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 
@@ -162,7 +174,89 @@ def message_doc(protocol: Protocol, message: Message) -> str:
 
 
 def codec_context(protocol: Protocol, code: PackageCode, exports: list[str]) -> dict[str, Any]:
-    checksum_import, checksum_definition = crc_setup(protocol.framing.checksum)
+    context = common_codec_context(protocol, code, exports)
+    if protocol.framing.classic:
+        return context | classic_codec_context(protocol)
+    return context | general_codec_context(protocol)
+
+
+def general_codec_context(protocol: Protocol) -> dict[str, Any]:
+    """Frames for the runtime's frame engine: one FrameCodec per direction, decoders by code (and by class)."""
+    imports, definitions = checksum_definitions(protocol)
+    directions: list[dict[str, Any]] = []
+    dispatchers = []
+    for direction, layout in protocol.framing.layouts.items():
+        by_code: dict[str, list[tuple[Message | None, str, int, int | None]]] = {}
+        for command in protocol.commands:
+            entry = direction_entry(command, direction)
+            if entry is None:
+                continue
+            target, low, high, sub_dispatch = entry
+            if sub_dispatch:
+                dispatchers.append(sub_dispatch | value_arguments(layout))
+            message = None if sub_dispatch else command.request if direction == Direction.REQUEST else command.response
+            by_code.setdefault(code_key(command, layout), []).append((message, target, low, high))
+        dispatch: list[tuple[str, str]] = []
+        expected: list[tuple[str, str, str]] = []  # class, code, decoder: replies chosen by the request they answer
+        sizes: list[tuple[str, int, int | None]] = []
+        single: dict[str, Message] = {}
+        for key, users in by_code.items():
+            # the resolver allows several only for plain replies, one of them marked default
+            chosen = next((u for u in users if u[0] is not None and u[0].default_reply), users[0])
+            dispatch.append((key, chosen[1]))
+            highs = [u[3] for u in users]
+            sizes.append((key, min(u[2] for u in users), None if None in highs else max(h or 0 for h in highs)))
+            if len(users) == 1 and users[0][0] is not None:
+                single[key] = users[0][0]
+            expected += [(m.class_name, key, target) for m, target, _, _ in users if m is not None and len(users) > 1]
+        directions.append(
+            {
+                "name": direction.value,
+                "upper": direction.name,
+                "dispatch": dispatch,
+                "expected": expected,
+                "frames": codec_lines(protocol, direction, sizes, single),
+                "headers": sorted({layout.header for layout in protocol.framing.alternatives[direction]}),
+            }
+        )
+    headers = [h for d in directions for h in d["headers"]]
+    shared = {cls for d in directions for cls, _, _ in d["expected"]}
+    replies = replies_by_request(protocol.messages())
+    reply_layouts = [
+        (m.class_name, reply.class_name)
+        for m in protocol.messages()
+        if m.direction == Direction.REQUEST
+        and (reply := reply_to(m, replies)) is not None
+        and reply.class_name in shared
+        and not reply.default_reply
+    ]
+    return {
+        "classic": False,
+        "reply_layouts": reply_layouts,
+        "framing_imports": sorted(
+            {"EngineFormat", *framing_imports([line for d in directions for line in d["frames"]])}, key=str.lower
+        ),
+        "checksum_imports": imports,
+        "checksum_definitions": definitions,
+        "directions": directions,
+        "dispatchers": dispatchers,
+        "by_header": all(headers) and len(set(headers)) == len(headers),
+    }
+
+
+def value_arguments(layout: FrameLayout) -> dict[str, str]:
+    return {
+        "extra": "".join(f", {e.name}: int" for e in layout.value_elements),
+        "args": "".join(f", {e.name}" for e in layout.value_elements),
+    }
+
+
+def classic_codec_context(protocol: Protocol) -> dict[str, Any]:
+    """Straight-line frame checks for frames of the classic shape (see FrameLayout.classic)."""
+    assert protocol.framing.checksum is not None
+    checksum = protocol.framing.checksum
+    assert checksum is not None  # classic frames have one
+    checksum_import, checksum_definition = crc_setup(checksum)
     directions = []
     dispatchers = []
     for direction, layout in protocol.framing.layouts.items():
@@ -177,13 +271,7 @@ def codec_context(protocol: Protocol, code: PackageCode, exports: list[str]) -> 
             dispatch.append((key, target))
             sizes.append((key, low, high))
             if sub_dispatch:
-                dispatchers.append(
-                    sub_dispatch
-                    | {
-                        "extra": "".join(f", {e.name}: int" for e in layout.value_elements),
-                        "args": "".join(f", {e.name}" for e in layout.value_elements),
-                    }
-                )
+                dispatchers.append(sub_dispatch | value_arguments(layout))
         directions.append(
             {
                 "name": direction.value,
@@ -204,11 +292,20 @@ def codec_context(protocol: Protocol, code: PackageCode, exports: list[str]) -> 
         )
     layouts = protocol.framing.layouts
     header_choices = " or ".join(layouts[d].header.hex(" ") for d in Direction)
+    return {
+        "classic": True,
+        "checksum_import": checksum_import,
+        "checksum_definition": checksum_definition,
+        "directions": directions,
+        "dispatchers": dispatchers,
+        "header_choices": header_choices,
+    }
+
+
+def common_codec_context(protocol: Protocol, code: PackageCode, exports: list[str]) -> dict[str, Any]:
     encoder_table = [(m.class_name, encoder_name(m)) for m in protocol.messages()]
     codec_names = names_used_in_codec(code)
     return {
-        "checksum_import": checksum_import,
-        "checksum_definition": checksum_definition,
         "structs": sorted(code.structs.items()),
         "tables": [
             table_context(t) for t in protocol.tables if any(uses_table(m, t.name) for m in protocol.messages())
@@ -217,15 +314,12 @@ def codec_context(protocol: Protocol, code: PackageCode, exports: list[str]) -> 
         "member_maps": sorted(code.member_maps),
         "decoders": [{"name": n, "returns": r, "extra": e, "lines": lines} for n, r, e, lines in code.decoders],
         "encoders": [{"name": n, "type": t, "lines": lines} for n, t, lines in code.encoders],
-        "directions": directions,
-        "dispatchers": dispatchers,
         "encoder_table": encoder_table,
         "imports": sorted(
             (n for n in exports if n not in ("Direction", "Message", "MESSAGE_TYPES") and n in codec_names),
             key=str.lower,  # the order isort (ruff) expects
         ),
         "shared_header": protocol.framing.shared_header,
-        "header_choices": header_choices,
     }
 
 
@@ -276,6 +370,7 @@ def frame_decode_lines(
         stored = f"{buf}[stop - 1]" if size == 1 else f"int.from_bytes({buf}[stop - {size} : stop], 'little')"
         content = f"{start} + {offset}, stop - {after}"
     args = f"{buf}, {content}" + "".join(f", {at(layout.offsets[e.name])}" for e in layout.value_elements)
+    assert protocol.framing.checksum is not None  # classic frames have one
     lines = checksum_lines(protocol.framing.checksum, covered, "expected")
     lines += [
         f"if expected != {stored}:",

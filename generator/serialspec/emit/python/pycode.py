@@ -198,7 +198,7 @@ class PackageCode:
                     "",
                     "",
                     element.type,
-                    "<",
+                    element.endian,
                     "",
                     None,
                     element.minimum,
@@ -207,8 +207,8 @@ class PackageCode:
                     None,
                     None,
                     element.flags,
-                    (),
-                    "",
+                    element.bits,
+                    element.bits_class,
                     False,
                 )
             )
@@ -323,7 +323,7 @@ class PackageCode:
         return get
 
     def message(self, message: Message) -> None:
-        for f in message.fields:
+        for f in [*self.frame_values(message.direction), *message.fields]:
             self.helper(f)
         fields = [*self.frame_values(message.direction), *self.value_fields(message)]
         doc = f"{message.command} {message.subcommand or ''} {message.direction.value}".replace("  ", " ")
@@ -369,10 +369,7 @@ class PackageCode:
         if exact and (lines[-1].startswith("o += ") or lines[-1] == "o = end"):
             lines.pop()
         frame_fields = all_fields[: len(all_fields) - len(self.value_fields(message))]
-        frame_values = [
-            self.flags_value(f.flags.class_name, f.name, lines) if isinstance(f, Scalar) and f.flags else f.name
-            for f in frame_fields
-        ]
+        frame_values = [self.after_unpack(f, f.name, lines, where) or f.name for f in frame_fields]
         self.build(message.class_name, [f.name for f in all_fields], [*frame_values, *values], "m", lines)
         lines.append("return m")
         return lines
@@ -581,13 +578,25 @@ class PackageCode:
         frame_fields = all_fields[: len(all_fields) - len(self.value_fields(message))]
         layout = self.protocol.framing.layouts[message.direction]
         elements = {e.name: e for e in layout.value_elements}
+        frame_values = []
         for f in frame_fields:
             assert isinstance(f, Scalar)
+            if f.bits:
+                frame_values.append(self.wire_value(f, "m", [], lines, where))
+                continue
             self.check_scalar(f, f"m.{f.name}", lines, where, also=elements[f.name].broadcast)
+            frame_values.append(f"m.{f.name}")
         fields = list(message.fields)
         command_code = self.protocol.command(message.command).code
+        if not self.protocol.framing.classic:
+            # the runtime's frame engine wraps the content (see emit/python/frames.py)
+            parts = self.encode_fields(fields, message.class_name, "m", lines, where)
+            content = parts[0] if len(parts) == 1 else f"b''.join(({', '.join(parts)},))" if parts else "b''"
+            code = f"{command_code:#04x}" if command_code is not None and layout.has_command else "None"
+            values = f"({frame_values[0]},)" if len(frame_values) == 1 else f"({', '.join(frame_values)})"
+            lines.append(f"return _{message.direction.name}_FRAMES.wrap({content}, {code}, {values})")
+            return lines
         code = str(command_code if command_code is not None else 0)
-        frame_values = [f"m.{f.name}" for f in frame_fields]
         if all(is_fixed_run_member(f) for f in fields):
             # one fixed size: the whole frame but its checksum is one struct, the length byte a constant
             endian, content_format, args = self.encode_run_format(fields, "m", fields, lines, where)
@@ -644,6 +653,7 @@ class PackageCode:
         """Lines that return `body` (the frame without its checksum) with its checksum appended."""
         covered = f"{body}[{layout.covered_from}:]" if layout.covered_from else body
         size = layout.checksum_offset_from_end
+        assert self.protocol.framing.checksum is not None  # classic frames have one
         lines = checksum_lines(self.protocol.framing.checksum, covered, "check")
         if len(lines) == 1:  # a single expression: append it directly
             value = lines[0].removeprefix("check = ")

@@ -37,6 +37,7 @@ BEHAVIOUR_ARGUMENTS = (
     "releases",
     "cancel_when",
     "carries",
+    "nothing_held",
 )
 
 
@@ -113,11 +114,17 @@ def simulator_module(protocol: Protocol) -> str:
                 args.append(f"writes={behaviour.writes!r}")
             if behaviour.resets:
                 args.append("resets=True")
+            if behaviour.keeps:
+                args.append(f"keeps={behaviour.keeps!r}")
             if behaviour.reports:
                 args.append(f"reports={behaviour.reports!r}")
             if behaviour.moves:
                 m = behaviour.moves
                 args.append(f"moves={(m.state, m.target, m.duration, m.speed)!r}")
+                if m.speed_scale != 1.0:
+                    args.append(f"speed_scale={m.speed_scale!r}")
+                if m.enabled_by:
+                    args.append(f"move_enabled_by={m.enabled_by!r}")
                 if m.accel or m.decel:
                     args.append(f"ramp={(m.accel, m.decel)!r}")
             if behaviour.broadcast_reply:
@@ -127,7 +134,7 @@ def simulator_module(protocol: Protocol) -> str:
                     args.append(f"{name}={getattr(behaviour, name)!r}")
         condition = reply_condition(request, response)
         if response and condition:
-            args.append(f"optional_when=({condition.entry!r}, {condition.equals})")
+            args.append(f"optional_when=({condition.entry!r}, {condition.equals}, {condition.op!r})")
         if response and response.after:
             args.append(f"after={response.after!r}")
         tables = table_fields(request, response)
@@ -147,6 +154,7 @@ def simulator_module(protocol: Protocol) -> str:
         state=repr(device.state),
         reply=repr(device.reply),
         refused=repr(device.refused),
+        out_of_range=repr(device.out_of_range) if device.out_of_range else "",
         entries=entries,
         commands=commands,
         registers=map_name(device.memory) if device.memory in register_tables(protocol) else "",

@@ -5,11 +5,13 @@ construct is the declarative reference the fast codec is tested against; it is n
 
 from __future__ import annotations
 
+from serialspec.emit.python.frames import checksum_definitions, codec_lines, framing_imports
 from serialspec.emit.python.pycode import one_line
 from serialspec.emit.python.render import render
 from serialspec.spec.model import (
     Array,
     Bytes,
+    Direction,
     Field,
     FrameLayout,
     Group,
@@ -55,10 +57,18 @@ def field_expr(f: Field, parent: str = "this") -> str:
             return "GreedyBytes"
         if isinstance(f.size, int):
             return f"Bytes({f.size})"
-        # inside a group item the size field sits in the enclosing content (this._), else beside the bytes
+        # inside a group item the size field sits beside the bytes (BULK WRITE) or in the enclosing content (this._)
         return f"Bytes({'this._' if parent == 'item' else 'this'}.{f.size})"
     if isinstance(f, Group):
-        item = "Struct(" + ", ".join(f"{i.name!r} / {field_expr(i, 'item')}" for i in f.fields) + ")"
+        names = {i.name for i in f.fields}
+        item = (
+            "Struct("
+            + ", ".join(
+                f"{i.name!r} / {field_expr(i, 'this' if isinstance(i, Bytes) and i.size in names else 'item')}"
+                for i in f.fields
+            )
+            + ")"
+        )
         if f.count == "rest":
             return f"GreedyRange({item})"
         count = f.count if isinstance(f.count, int) else f"this.{f.count}"
@@ -137,14 +147,25 @@ def structs_module(protocol: Protocol) -> str:
                 blocks[f.struct_name] = [
                     f"{e.name!r} / {field_expr_entry(e.type, e.sign_bit, f.endian)}" for e in f.entries
                 ]
-    checksum = protocol.framing.checksum
-    if checksum.algorithm == "crc":
-        assert checksum.crc is not None
-        c = checksum.crc
-        checksum_expr = f"crc_function({c.width}, {c.poly:#x}, {c.init:#x}, {c.refin}, {c.refout}, {c.xorout:#x})"
+    framing = protocol.framing
+    definitions: list[str] = []
+    if framing.classic:
+        checksum = framing.checksum
+        assert checksum is not None
+        if checksum.algorithm == "crc":
+            assert checksum.crc is not None
+            c = checksum.crc
+            checksum_expr = f"crc_function({c.width}, {c.poly:#x}, {c.init:#x}, {c.refin}, {c.refout}, {c.xorout:#x})"
+        else:
+            checksum_expr = f"sum_function({checksum.type.size * 8}, invert={checksum.invert})"
+        definitions.append(f"_checksum = {checksum_expr}")
+        checksum_imports = ["crc_function" if checksum.algorithm == "crc" else "sum_function"]
+        frames = [{"name": f"{d.name}_FRAME", "expr": frame_expr(layout)} for d, layout in framing.layouts.items()]
     else:
-        checksum_expr = f"sum_function({checksum.type.size * 8}, invert={checksum.invert})"
-    frames = [{"name": f"{d.name}_FRAME", "expr": frame_expr(layout)} for d, layout in protocol.framing.layouts.items()]
+        checksum_imports, definitions = checksum_definitions(protocol)
+        for direction in Direction:
+            definitions += ["", *codec_lines(protocol, direction, [], {})]
+        frames = [{"name": f"{d.name}_FRAME", "expr": f"Framed(_{d.name}_FRAMES)"} for d in Direction]
     return render(
         "structs.py.j2",
         spec_path=protocol.spec_path,
@@ -153,8 +174,10 @@ def structs_module(protocol: Protocol) -> str:
         tables=tables,
         blocks=blocks,
         frames=frames,
-        checksum_expr=checksum_expr,
-        checksum_import="crc_function" if checksum.algorithm == "crc" else "sum_function",
+        definitions=definitions,
+        checksum_imports=checksum_imports,
+        framing_imports=framing_imports(definitions),
+        classic=framing.classic,
     )
 
 

@@ -14,7 +14,7 @@ from typing import Any
 
 from serialspec.runtime.device.faults import Fault, FaultInjection
 from serialspec.runtime.errors import DecodeError, EncodeError
-from serialspec.runtime.message import Message
+from serialspec.runtime.message import Message, compare
 from serialspec.runtime.registers import RegisterMap
 from serialspec.runtime.stream import StreamParser
 
@@ -42,10 +42,11 @@ class CommandSpec:
     reads: tuple[str, ...] = ()
     writes: tuple[str, ...] = ()
     resets: bool = False
+    keeps: tuple[str, dict[int, tuple[str, ...]]] | None = None  # resets: request field, its value -> entries kept
     reports: dict[str, str] = field(default_factory=dict)
     moves: tuple[str, str, str, str] | None = None  # state, target field, duration field (ms), speed field (/s)
     broadcast_reply: bool = False
-    optional_when: tuple[str, int] | None = None  # (memory entry, value) with which the response is sent
+    optional_when: tuple[str, int, str] | None = None  # (memory entry, value, comparison): when it is sent
     after: str = ""  # request field: the response is sent after that many ms
     # table fields of the request and response: name -> ("value", key field) or ("block", entry names...)
     tables: dict[str, tuple[str, ...]] = field(default_factory=dict)
@@ -53,9 +54,12 @@ class CommandSpec:
     each: str = ""  # a request group whose items each address one device (item fields override the request's)
     stores: dict[str, str] = field(default_factory=dict)  # request field -> state variable
     sets: dict[str, float] = field(default_factory=dict)  # state variable -> value
+    speed_scale: float = 1.0  # moves: state units per second for one unit of the speed field
+    move_enabled_by: str = ""  # moves: only while this memory entry (or state variable) is non-zero
     absent: dict[str, float] = field(default_factory=dict)  # response values when no device has the id
     buffered: bool = False  # the writes wait for a command that commits (REG WRITE)
     commits: bool = False  # carries out the buffered writes (ACTION)
+    nothing_held: dict[str, float] = field(default_factory=dict)  # commits: reply values when nothing is held
     ramp: tuple[str, str] | None = None  # request fields: acceleration and deceleration time (ms) of the move
     stops: tuple[str, ...] = ()  # state variables whose move stops where it is
     wraps: dict[str, float] = field(default_factory=dict)  # state variable -> the period it is kept within
@@ -103,6 +107,7 @@ class DeviceSpec:
     echo_address: bool = False  # replies carry the id the request named, not the answering device's own
     registers: RegisterMap | None = None  # memory as registers at byte addresses, for run reads/writes
     status: dict[str, str] = field(default_factory=dict)  # response field -> memory entry every reply reports
+    out_of_range: dict[str, float] = field(default_factory=dict)  # reply values for an out-of-range write
     models: tuple[ModelSpec, ...] = ()  # the first is the default model
     moving: dict[str, tuple[str, int | None]] = field(default_factory=dict)  # entry -> (state variable, bit)
     # command code -> the codec's decoder of that request's content (buf, start, end), for requests carried by another
@@ -187,11 +192,14 @@ class VirtualDevice:
         elif spec.id_entry in self.state:
             self.state[spec.id_entry] = device_id
 
-    def reset(self) -> None:
-        keep = self.memory.get(self.by_name[self.spec.id_entry].key) if self.spec.id_entry in self.by_name else None
+    def reset(self, keep: tuple[str, ...] | None = None) -> None:
+        """Memory back to its defaults, but for the entries in `keep` (default: the device's id)."""
+        if keep is None:
+            keep = (self.spec.id_entry,) if self.spec.id_entry in self.by_name else ()
+        keys = [self.by_name[n].key for n in keep if n in self.by_name]
+        kept = {key: self.memory[key] for key in keys if key in self.memory}
         self.memory = {e.key: e.default for e in self.by_name.values()}
-        if keep is not None:
-            self.memory[self.by_name[self.spec.id_entry].key] = keep
+        self.memory.update(kept)
 
     def get(self, name: str) -> float:
         """A state variable or memory entry, with any motion in progress taken into account."""
@@ -226,12 +234,13 @@ class VirtualDevice:
             self.memory[self.by_name[name].key] = target
 
     def writable(self, entry: EntrySpec | None, value: Any) -> bool:
-        return (
-            entry is not None
-            and entry.access != "r"
-            and isinstance(value, int | float)
-            and entry.minimum <= value <= entry.maximum
-        )
+        return not self.refusal(entry, value)
+
+    def refusal(self, entry: EntrySpec | None, value: Any) -> str:
+        """Why a write is refused: "access" (read-only, unknown entry), "range" (out of range), or "" (it is not)."""
+        if entry is None or entry.access == "r" or not isinstance(value, int | float):
+            return "access"
+        return "" if entry.minimum <= value <= entry.maximum else "range"
 
 
 class Engine(FaultInjection):
@@ -356,7 +365,7 @@ class Engine(FaultInjection):
         if self._answering_as is not None and isinstance(values.get(self.spec.address), int | float):
             address = int(values[self.spec.address])
             values = {**values, self.spec.address: self._answering_as.other_id(address, self.spec.broadcast)}
-        values = {k: int(v) if isinstance(v, float) and v.is_integer() else v for k, v in values.items()}
+        values = _whole(values)
         try:
             return self.encode(response.from_fields(values))  # type: ignore[attr-defined]
         except (EncodeError, TypeError, ValueError, KeyError) as exc:
@@ -378,25 +387,29 @@ class Engine(FaultInjection):
             if not any(given.get(name) == value for name, value in command.cancel_when.items()):
                 for waiting_command, waiting_request, waiting_given in waiting:
                     self.act(device, waiting_command, waiting_request, waiting_given)
-        refused = False
+        refused = ""
         # Whether an optional reply is due is decided on the switch as the request finds it (a write that turns
         # replies off is still answered), which is also what a client that remembers the switch expects.
         switch = command.optional_when
-        answers = switch is None or device.get(switch[0]) == switch[1]
+        answers = switch is None or compare(device.get(switch[0]), switch[2], switch[1])
         if command.resets:
-            device.reset()
+            field_name, kept = command.keeps or ("", {})
+            device.reset(kept.get(int(given.get(field_name, -1)), None) if command.keeps else None)
         written: set[str] = set()
         if command.buffered:
             device.buffered.extend((command, name, given) for name in command.writes)
         else:
             for name in command.writes:
-                refused |= not self._write(device, command, name, given, written)
+                reason = self._write(device, command, name, given, written)
+                refused = refused or reason
         if command.commits:
+            if not device.buffered and command.nothing_held:
+                refused = refused or "held"
             buffered, device.buffered = device.buffered, []
             for held_command, name, held in buffered:
                 self._write(device, held_command, name, held, written)
-        if command.moves:
-            self._move(device, command.moves, given, written, command.ramp)
+        if command.moves and (not command.move_enabled_by or device.get(command.move_enabled_by)):
+            self._move(device, command.moves, given, written, command.ramp, command.speed_scale)
         for name, state in command.stores.items():
             device.set(state, given[name])
         for state, value in command.sets.items():
@@ -433,6 +446,8 @@ class Engine(FaultInjection):
                 values[name] = device.id  # a device answers with its own id, also to a broadcast
             elif name in device.spec.status:
                 values[name] = device.get(device.spec.status[name])
+            elif any(key.startswith(name + ".") for key in (*self.spec.reply, *device.spec.status)):
+                values[name] = {}  # bit fields, filled in below
             elif command.tables.get(name, ())[:1] == ("run",):
                 values[name] = b""  # a run of registers in a reply holds what was read: nothing here
             elif name in given:
@@ -441,8 +456,12 @@ class Engine(FaultInjection):
                 values[name] = self.spec.reply[name]
             else:
                 values[name] = 0
-        if refused:
-            values.update(self.spec.refused)
+        nest(values, {k: v for k, v in self.spec.reply.items() if "." in k})
+        nest(values, {k: int(bool(device.get(e))) for k, e in device.spec.status.items() if "." in k})
+        if refused == "held":
+            nest(values, command.nothing_held)
+        elif refused:
+            nest(values, self.spec.out_of_range if refused == "range" and self.spec.out_of_range else self.spec.refused)
         return self._encode_reply(command.response, values)
 
     def _move(
@@ -452,6 +471,7 @@ class Engine(FaultInjection):
         given: dict[str, Any],
         written: set[str],
         ramp: tuple[str, str] | None = None,
+        speed_scale: float = 1.0,
     ) -> None:
         """Start a move to the target: a request field, or a memory entry this command has just written.
 
@@ -470,7 +490,7 @@ class Engine(FaultInjection):
         if duration_name and value(duration_name):
             duration = value(duration_name) / 1000
         elif speed_name and value(speed_name):
-            duration = abs(goal - device.get(state)) / value(speed_name) + (accel + decel) / 2
+            duration = abs(goal - device.get(state)) / (value(speed_name) * speed_scale) + (accel + decel) / 2
         else:
             duration = 0.0
         device.move(state, goal, duration, accel, decel)
@@ -496,24 +516,26 @@ class Engine(FaultInjection):
                 data.append(0)
                 address += 1
                 continue
-            data += registers.to_wire(register, int(device.get(register.name)))
+            data += registers.to_wire(register, int(device.get(register.name)), checked=False)
             address += register.size
         return bytes(data[:size])
 
     def _write_run(
         self, device: VirtualDevice, registers: RegisterMap, start: int, data: bytes, written: set[str]
-    ) -> bool:
-        """Store bytes written from register `start` on; refused whole unless every register is writable, in range."""
+    ) -> str:
+        """Store bytes written from register `start` on; refused whole (the reason) unless every register is
+        writable and in range."""
         try:
             values = registers.split(start, data)
         except EncodeError:
-            return False
-        if not all(device.writable(device.by_name.get(name), value) for name, value in values.items()):
-            return False
+            return "access"
+        reasons = [device.refusal(device.by_name.get(name), value) for name, value in values.items()]
+        if any(reasons):
+            return "access" if "access" in reasons else "range"
         for name, value in values.items():
             device.set(name, value)
         written.update(values)
-        return True
+        return ""
 
     def _write(
         self,
@@ -522,7 +544,8 @@ class Engine(FaultInjection):
         name: str,
         given: dict[str, Any],
         written: set[str] | None = None,
-    ) -> bool:
+    ) -> str:
+        """Store one request field in memory; why it was refused ("access", "range"), or "" when it was not."""
         table = command.tables.get(name, ())
         if table[:1] == ("run",) and self.spec.registers is not None:
             start = int(given[table[1]])
@@ -531,11 +554,12 @@ class Engine(FaultInjection):
             return self._write_run(device, self.spec.registers, start, data, set() if written is None else written)
         if table[:1] == ("value",):
             entry = device.by_key.get(int(given[table[1]]))
-            if not device.writable(entry, given[name]):
-                return False
+            reason = device.refusal(entry, given[name])
+            if reason:
+                return reason
             assert entry is not None
             device.set(entry.name, given[name])
-            return True
+            return ""
         if table[:1] == ("block",):
             block = given[name]
             ok = all(
@@ -545,6 +569,27 @@ class Engine(FaultInjection):
                 for n in table[1:]:
                     if device.by_name[n].access != "r":
                         device.set(n, block[n])
-            return ok
+            return "" if ok else "range"
         device.set(name, given[name])
-        return True
+        return ""
+
+
+def nest(values: dict[str, Any], overlay: dict[str, Any]) -> None:
+    """Apply reply values, where `field.bit_field` names one bit field of a field made of bit fields."""
+    for key, value in overlay.items():
+        name, _, bit = key.partition(".")
+        if not bit:
+            values[name] = value
+        elif isinstance(values.get(name), dict):
+            values[name] = {**values[name], bit: value}
+
+
+def _whole(value: Any) -> Any:
+    """State and memory hold floats; a reply's integer fields (bit fields and items too) take whole numbers as ints."""
+    if isinstance(value, float) and value.is_integer():
+        return int(value)
+    if isinstance(value, dict):
+        return {k: _whole(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_whole(v) for v in value]
+    return value

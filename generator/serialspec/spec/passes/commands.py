@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, Literal
 
 from serialspec.spec.errors import SpecError
 from serialspec.spec.loader import Path
@@ -27,6 +27,13 @@ from serialspec.spec.model import (
 from serialspec.spec.passes.base import camel
 from serialspec.spec.passes.fields import FieldResolver
 
+OPTIONAL_WHEN_OPS: dict[str, Literal["==", "!=", ">=", "<="]] = {
+    "equals": "==",
+    "not_equals": "!=",
+    "at_least": ">=",
+    "at_most": "<=",
+}
+
 
 class Commands(FieldResolver):
     """Resolve `commands:` and check their codes against the framing and their `answered_by` references."""
@@ -49,8 +56,9 @@ class Commands(FieldResolver):
         for command in commands:
             for message in command.messages():
                 layout = framing.layouts[message.direction]
-                length = next(e for e in layout.elements if e.role == "length")
-                assert length.type is not None
+                length = layout.length
+                if not layout.classic or length is None or length.type is None:
+                    continue  # the frame engine's lengths count spans of their own (or the frame has none)
                 countable = int(length.type.maximum) - layout.length_adds
                 if message.min_size > countable:
                     self.error(
@@ -201,16 +209,25 @@ class Commands(FieldResolver):
 
     def check_codes(self, commands: list[Command], framing: Framing) -> None:
         for command in commands:
+            if command.code is not None and not isinstance(command.code, int):
+                continue  # not a number: the structural check has said so
+            directions = {m.direction for m in command.messages()}
+            broken = command.name in self.ctx.broken  # a message failed to resolve: its problem is reported
+            if command.code is not None and not broken and not any(framing.layouts[d].has_command for d in directions):
+                self.error(
+                    ("commands", command.name, "code"),
+                    "its frames have no command field, so no code",
+                )
             element = next(
                 (
                     e
                     for d, layout in framing.layouts.items()
                     for e in layout.elements
-                    if e.role == "command" and any(m.direction == d for m in command.messages())
+                    if e.role == "command" and d in directions
                 ),
                 None,
             )
-            if element is not None and element.type is not None and isinstance(command.code, int):
+            if element is not None and element.type is not None and command.code is not None:
                 low, high = element.type.minimum, element.type.maximum
                 if not low <= command.code <= high:
                     self.error(
@@ -218,24 +235,39 @@ class Commands(FieldResolver):
                         f"code {command.code} does not fit the {element.type.name} command element ({low:g}..{high:g})",
                     )
         for direction, layout in framing.layouts.items():
-            seen: dict[int | None, str] = {}
+            sharing: dict[int | None, list[tuple[Command, Message]]] = {}
             for command in commands:
-                has = any(m.direction == direction for m in command.messages())
-                if not has:
+                messages = [m for m in command.messages() if m.direction == direction]
+                if not messages:
                     continue
-                path: Path = ("commands", command.name)
                 if command.code is not None and not isinstance(command.code, int):
                     continue  # not a number: the structural check has said so
-                if layout.command_offset is None:
-                    if command.code is not None:
-                        self.error((*path, "code"), f"{direction.value} frames have no command field, so no code")
-                elif command.code is None:
-                    self.error(path, f"missing key 'code' ({direction.value} frames carry a command field)")
-                if command.code in seen:
-                    other = seen[command.code]
-                    what = f"code {command.code:#04x}" if command.code is not None else "a codeless reply"
-                    self.error(path, f"{what} in {direction.value} frames is already used by {other!r}")
-                seen[command.code] = command.name
+                if layout.has_command and command.code is None:
+                    self.error(
+                        ("commands", command.name),
+                        f"missing key 'code' ({direction.value} frames carry a command field)",
+                    )
+                code = command.code if layout.has_command else None
+                sharing.setdefault(code, []).append((command, messages[0]))
+            for code, users in sharing.items():
+                if len(users) < 2:
+                    continue
+                what = f"code {code:#04x}" if code is not None else "a codeless reply"
+                if direction == Direction.REQUEST or any(c.selector for c, _ in users):
+                    for command, _ in users[1:]:
+                        self.error(
+                            ("commands", command.name),
+                            f"{what} in {direction.value} frames is already used by {users[0][0].name!r}",
+                        )
+                    continue
+                defaults = [c.name for c, m in users if m.default_reply]
+                if len(defaults) != 1:
+                    names = ", ".join(c.name for c, _ in users)
+                    self.error(
+                        ("commands", users[-1][0].name, "response"),
+                        f"{what} is shared by the replies of {names}: mark one of them `default: true` (the "
+                        "layout a reply is decoded as when its request is unknown)",
+                    )
 
     def message(
         self,
@@ -248,6 +280,14 @@ class Commands(FieldResolver):
         code: int | None,
     ) -> Message:
         fields = self.fields(value.get("fields") or {}, (*path, "fields"), parent=None)
+        framing = self.ctx.framing
+        frame_values = {e.name for e in framing.layouts[direction].value_elements} if framing else set()
+        for field in fields:
+            if field.name in frame_values:
+                self.error(
+                    (*path, "fields", field.name),
+                    f"{field.name!r} is already a frame element of every {direction.value}; name the field otherwise",
+                )
         if selector is not None and code is not None:
             fields = self.insert_selector(fields, selector, direction, code, path)
         self.check_rest(fields, (*path, "fields"))
@@ -278,6 +318,7 @@ class Commands(FieldResolver):
             optional_when=self.optional_when(value.get("optional_when"), (*path, "optional_when")),
             after=self.after(value.get("after"), fields, direction, path),
             answered_by=str(answered_by.get("command", "")),
+            default_reply=bool(value.get("default", False)),
             reply_when=self.optional_when(answered_by.get("optional_when"), (*path, "answered_by", "optional_when")),
             struct_name=struct_name,
         )
@@ -296,7 +337,11 @@ class Commands(FieldResolver):
         if value is None:
             return None
         table, entry = self.table_entry(value["parameter"], (*path, "parameter"))
-        return OptionalWhen(table.name, entry.name, entry.key, int(value["equals"]))
+        given = [(key, op) for key, op in OPTIONAL_WHEN_OPS.items() if key in value]
+        if len(given) != 1:
+            raise self.fail(path, f"give one comparison: {', '.join(OPTIONAL_WHEN_OPS)}")
+        key, op = given[0]
+        return OptionalWhen(table.name, entry.name, entry.key, int(value[key]), op)
 
     def after(self, value: Any, fields: tuple[Field, ...], direction: Direction, path: Path) -> str:
         if value is None:

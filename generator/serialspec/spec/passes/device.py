@@ -132,9 +132,15 @@ class DevicePass(Pass):
                     str(moves["target"]),
                     str(moves.get("duration", "")),
                     str(moves.get("speed", "")),
+                    float(moves.get("speed_scale", 1.0)),
+                    str(moves.get("enabled_by", "")),
                     str(moves.get("accel", "")),
                     str(moves.get("decel", "")),
                 )
+                if motion.speed_scale <= 0:
+                    self.error((*item_path, "moves", "speed_scale"), "must be positive")
+                if motion.enabled_by and motion.enabled_by not in known_state and motion.enabled_by not in entries:
+                    self.error((*item_path, "moves", "enabled_by"), f"unknown memory entry {motion.enabled_by!r}")
                 if motion.state not in known_state and motion.state not in entries:
                     self.error((*item_path, "moves", "state"), f"unknown state variable {motion.state!r}")
                 for role in ("target", "duration", "speed", "accel", "decel"):
@@ -171,6 +177,7 @@ class DevicePass(Pass):
                     stores,
                     sets,
                     absent,
+                    self.keeps(item.get("keeps"), request_names, entries, (*item_path, "keeps")),
                     **self.behaviour_extras(
                         item,
                         item_path,
@@ -179,6 +186,7 @@ class DevicePass(Pass):
                         response_names,
                         known_state if isinstance(known_state, _Everything) else {**entries, **known_state},
                     ),
+                    nothing_held={str(k): float(v) for k, v in (item.get("nothing_held") or {}).items()},
                 )
             )
         status = {str(k): str(v) for k, v in (value.get("status") or {}).items()}
@@ -195,6 +203,7 @@ class DevicePass(Pass):
             state=state,
             reply={str(k): float(v) for k, v in (value.get("reply") or {}).items()},
             refused={str(k): float(v) for k, v in (value.get("refused") or {}).items()},
+            out_of_range={str(k): float(v) for k, v in (value.get("out_of_range") or {}).items()},
             behaviours=tuple(behaviours),
             status=status,
             kinds=tuple(kinds.values()),
@@ -229,10 +238,30 @@ class DevicePass(Pass):
                 self.error(where, f"unknown field {name!r}: no request carries it (nor the frame)")
             elif not isinstance(found, Scalar) or found.type.is_float:
                 self.error(where, f"{name!r} is no integer field, so it cannot hold a device id")
+        responses = carried[Direction.RESPONSE]
         for key in ("reply", "refused", "status"):
             for name in value.get(key) or {}:
-                if name not in elements and name not in carried[Direction.RESPONSE]:
+                head, _, bit = str(name).partition(".")  # `error.number`: a bit field of a value or element
+                owner = elements.get(head) or responses.get(head)
+                bits = {b.name for b in getattr(owner, "bits", ())}
+                if owner is None or (bit and bit not in bits):
                     self.error((*path, key, name), f"unknown response field {name!r}: no response carries it")
+
+    def keeps(
+        self, value: Any, request_names: Any, entries: Any, path: Path
+    ) -> tuple[str, dict[int, tuple[str, ...]]] | None:
+        """`keeps`: the request field choosing what a reset keeps, and the entries for each of its values."""
+        if value is None:
+            return None
+        field_name = str(value["field"])
+        if field_name not in request_names:
+            self.error((*path, "field"), f"no request field {field_name!r}")
+        table = {int(k): tuple(str(n) for n in names) for k, names in (value.get("entries") or {}).items()}
+        for key, names in table.items():
+            for name in names:
+                if name not in entries:
+                    self.error((*path, "entries", key), f"unknown memory entry {name!r}")
+        return field_name, table
 
     def moving(
         self, value: dict[str, Any], path: Path, entries: dict[str, TableEntry], state: dict[str, float]

@@ -1,0 +1,518 @@
+"""The general frame engine: any byte-oriented frame the spec language describes, as data.
+
+A frame is an ordered list of elements: constant parts (headers, reserved bytes, trailers), frame-level values
+(address, command, status), at most one content, lengths counting a span of elements, checksums covering a span,
+and an optional transparency rule (byte stuffing or escaping) over a span. Alternative layouts of one direction
+are told apart by their leading constant. Generated codecs describe their frames with these classes; protocols
+whose frames fit the classic shape (a header, a one-byte length, a final checksum) get straight-line code instead.
+
+Rules (the spec language's, see the generated docs): lengths and checksums outside the transparency span see the
+wire bytes, checksums inside it the bytes before the rewrite; a span either holds the whole transparency span or
+lies inside it or outside it.
+"""
+
+from __future__ import annotations
+
+import functools
+import re
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass, field
+from typing import Any, Literal
+
+from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError
+from serialspec.runtime.message import Message
+from serialspec.runtime.stream import StreamParser
+
+ElementKind = Literal["constant", "value", "command", "length", "content", "checksum"]
+
+
+@dataclass(frozen=True)
+class Element:
+    """One element of a frame layout; `span` indexes the layout's elements (inclusive)."""
+
+    name: str
+    kind: ElementKind
+    size: int = 0  # 0 for the content
+    endian: Literal["little", "big"] = "little"
+    constant: bytes = b""
+    span: tuple[int, int] = (0, 0)  # length: the elements counted; checksum: the elements covered
+    adds: int = 0  # length: added to the counted size
+    checksum: Callable[[bytes], int] | None = None
+    minimum: int = 0  # value/command: plausible values (a stray byte out of range is no frame start)
+    maximum: int = 0
+    also: int | None = None  # value: one more value allowed (an address's broadcast)
+
+    def pack(self, value: int) -> bytes:
+        return value.to_bytes(self.size, self.endian)
+
+    def unpack(self, data: bytes) -> int:
+        return int.from_bytes(data, self.endian)
+
+    def plausible(self, value: int) -> bool:
+        return self.minimum <= value <= self.maximum or value == self.also
+
+
+@dataclass(frozen=True)
+class Transparency:
+    """Byte stuffing or escaping over a span: each plain sequence becomes its wire sequence, leftmost first."""
+
+    span: tuple[int, int]
+    replace: tuple[tuple[bytes, bytes], ...]
+
+    def encode(self, data: bytes) -> bytes:
+        return _rewrite(data, self.replace)
+
+    def decode(self, data: bytes) -> bytes:
+        """The plain bytes; DecodeError unless `data` is what encode gives for them (no lone escape)."""
+        plain = _rewrite(data, tuple((wire, plain) for plain, wire in self.replace))
+        if self.encode(plain) != data:
+            raise DecodeError(f"bad stuffing: {data.hex(' ')} is not the stuffed form of any bytes")
+        return plain
+
+
+def _rewrite(data: bytes, pairs: tuple[tuple[bytes, bytes], ...]) -> bytes:
+    """Each `old` sequence of `data` replaced by its `new`, scanning left to right (the leftmost match first, the
+    pairs tried in order at each position): one bytes.replace for one pair, else one regular expression."""
+    if len(pairs) == 1:
+        old, new = pairs[0]
+        return data.replace(old, new)
+    return _rewriter(pairs)(data)
+
+
+@functools.cache
+def _rewriter(pairs: tuple[tuple[bytes, bytes], ...]) -> Callable[[bytes], bytes]:
+    table = dict(pairs)
+    pattern = re.compile(b"|".join(re.escape(old) for old, _ in pairs))
+    return lambda data: pattern.sub(lambda match: table[match.group()], data)
+
+
+@dataclass(frozen=True)
+class Layout:
+    """One frame layout of one direction."""
+
+    name: str
+    elements: tuple[Element, ...]
+    transparency: Transparency | None = None
+    # derived in __post_init__
+    content: int = field(init=False, default=-1)
+    values: tuple[int, ...] = field(init=False, default=())
+    command: int | None = field(init=False, default=None)
+    length: int | None = field(init=False, default=None)
+
+    def __post_init__(self) -> None:
+        kinds = [e.kind for e in self.elements]
+        object.__setattr__(self, "content", kinds.index("content") if "content" in kinds else -1)
+        object.__setattr__(self, "values", tuple(i for i, k in enumerate(kinds) if k == "value"))
+        object.__setattr__(self, "command", kinds.index("command") if "command" in kinds else None)
+        object.__setattr__(self, "length", kinds.index("length") if "length" in kinds else None)
+        # How unwrap cuts a frame, worked out once: fixed slices before and after the variable part, then the
+        # variable part's own elements (fixed but for the content); the checks by kind, in element order.
+        first, last = self._inner()
+        head, position = [], 0
+        for index in range(first):
+            head.append((index, position, position + self.elements[index].size))
+            position += self.elements[index].size
+        tail, position = [], 0
+        for index in range(len(self.elements) - 1, last, -1):
+            tail.append((index, position + self.elements[index].size, position))
+            position += self.elements[index].size
+        inner = self.elements[first : last + 1] if first <= last else ()
+        plan: dict[str, Any] = {
+            "before": sum(e.size for e in self.elements[:first]),
+            "after": position,
+            "head": tuple(head),
+            "tail": tuple(tail),
+            "inner_fixed": sum(e.size for e in inner),
+            "variable": self.content - first if first <= self.content <= last else -1,
+            "inner": tuple((first + i, e.size) for i, e in enumerate(inner)),
+            "constants": tuple((i, e) for i, e in enumerate(self.elements) if e.kind == "constant"),
+            "lengths": tuple((i, e) for i, e in enumerate(self.elements) if e.kind == "length"),
+            "checksums": tuple((i, e) for i, e in enumerate(self.elements) if e.kind == "checksum"),
+            "template": tuple(e.constant if e.kind == "constant" else bytes(e.size) for e in self.elements),
+        }
+        t = self.transparency
+        inside = tuple(
+            (i, e) for i, e in plan["checksums"] if t is not None and t.span[0] <= e.span[0] and e.span[1] <= t.span[1]
+        )
+        plan["inner_checksums"] = inside
+        plan["outer_checksums"] = tuple(c for c in plan["checksums"] if c not in inside)
+        object.__setattr__(self, "_plan", plan)
+
+    @property
+    def header(self) -> bytes:
+        first = self.elements[0]
+        return first.constant if first.kind == "constant" else b""
+
+    @property
+    def trailer(self) -> bytes:
+        last = self.elements[-1]
+        return last.constant if last.kind == "constant" and len(self.elements) > 1 else b""
+
+    def _inner(self) -> tuple[int, int]:
+        """The elements whose wire positions are known only relative to each other (the transparency span)."""
+        if self.transparency is None:
+            return (self.content, self.content) if self.content >= 0 else (len(self.elements), len(self.elements) - 1)
+        return self.transparency.span
+
+    @property
+    def overhead(self) -> int:
+        return sum(e.size for e in self.elements)
+
+    def prefix(self) -> int:
+        """Wire bytes before the variable part (the transparency span, else the content)."""
+        first, _ = self._inner()
+        return sum(e.size for e in self.elements[:first])
+
+    def suffix(self) -> int:
+        _, last = self._inner()
+        return sum(e.size for e in self.elements[last + 1 :])
+
+    def offset(self, index: int) -> int | None:
+        """Wire offset of an element from the frame start, when fixed (before the variable part)."""
+        first, _ = self._inner()
+        return sum(e.size for e in self.elements[:index]) if index < first else None
+
+    # --- encoding -------------------------------------------------------------------------------------------------
+
+    def wrap(self, content: bytes, code: int | None, values: tuple[int, ...]) -> bytes:
+        """The frame around `content`; EncodeError when a value does not fit its element (the length, say)."""
+        plan: dict[str, Any] = self._plan  # type: ignore[attr-defined]
+        elements = self.elements
+        plain: list[bytes] = list(plan["template"])  # constants in place, zeros for what is computed below
+        if self.content >= 0:
+            plain[self.content] = content
+        if self.command is not None:
+            plain[self.command] = _pack(elements[self.command], code or 0)
+        for index, value in zip(self.values, values, strict=True):
+            plain[index] = _pack(elements[index], value)
+        wire: dict[int, bytes] = {}
+        t = self.transparency
+        for index, element in plan["inner_checksums"]:  # inside the stuffed span: over the bytes before stuffing
+            plain[index] = self._checksum(element, b"".join(plain[element.span[0] : element.span[1] + 1]))
+        if t is not None:
+            first, last = t.span
+            wire[first] = t.encode(b"".join(plain[first : last + 1]))
+        for index, element in plan["lengths"]:
+            value = len(self._wire(plain, wire, *element.span)) + element.adds
+            if not 0 <= value < 1 << (8 * element.size):
+                raise EncodeError(f"{self.name} frame: length {value} does not fit its {element.size}-byte field")
+            plain[index] = element.pack(value)
+        for index, element in plan["outer_checksums"]:
+            plain[index] = self._checksum(element, self._wire(plain, wire, *element.span))
+        return self._wire(plain, wire, 0, len(elements) - 1)
+
+    def _wire(self, plain: list[bytes], wire: dict[int, bytes], first: int, last: int) -> bytes:
+        """Wire bytes of elements first..last (plain bytes when the transparency span is not in play)."""
+        t = self.transparency
+        if t is None or last < t.span[0] or first > t.span[1]:
+            return b"".join(plain[first : last + 1])
+        if t.span[0] <= first and last <= t.span[1]:
+            return b"".join(plain[first : last + 1])  # inside the span: the bytes before the rewrite
+        return b"".join(plain[first : t.span[0]]) + wire[t.span[0]] + b"".join(plain[t.span[1] + 1 : last + 1])
+
+    @staticmethod
+    def _checksum(element: Element, covered: bytes) -> bytes:
+        assert element.checksum is not None
+        return element.pack(element.checksum(covered))
+
+    # --- decoding -------------------------------------------------------------------------------------------------
+
+    def unwrap(self, frame: bytes) -> Unwrapped:
+        """Check a complete frame (constants, lengths, stuffing, checksums) and take it apart."""
+        plan: dict[str, Any] = self._plan  # type: ignore[attr-defined]
+        before, after = plan["before"], plan["after"]
+        n = len(frame)
+        if n < before + after:
+            raise DecodeError(f"frame of {n} bytes is shorter than the smallest {self.name} frame ({self.overhead})")
+        elements = self.elements
+        plain: list[bytes] = [b""] * len(elements)
+        for index, start, stop in plan["head"]:
+            plain[index] = frame[start:stop]
+        for index, start, stop in plan["tail"]:
+            plain[index] = frame[n - start : n - stop]
+        wire: dict[int, bytes] = {}
+        middle = frame[before : n - after]
+        if self.transparency is not None:
+            wire[self.transparency.span[0]] = middle
+            middle = self.transparency.decode(middle)
+        if plan["inner"]:
+            fixed, variable = plan["inner_fixed"], plan["variable"]
+            if variable < 0 and len(middle) != fixed or len(middle) < fixed:
+                raise DecodeError(f"{self.name} frame: {len(middle)} bytes where at least {fixed} belong")
+            position = 0
+            for offset, (index, size) in enumerate(plan["inner"]):
+                if offset == variable:
+                    size = len(middle) - fixed
+                plain[index] = middle[position : position + size]
+                position += size
+        for index, element in plan["constants"]:
+            if plain[index] != element.constant:
+                data = plain[index]
+                raise DecodeError(f"{element.name} is {data.hex(' ')}, expected {element.constant.hex(' ')}")
+        command = self.command
+        code = elements[command].unpack(plain[command]) if command is not None else None
+        values = tuple(elements[i].unpack(plain[i]) for i in self.values)
+        for index, element in plan["lengths"]:
+            counted = len(self._wire(plain, wire, *element.span)) + element.adds
+            value = element.unpack(plain[index])
+            if value != counted:
+                raise DecodeError(f"{element.name} says {value} but the frame holds {counted}")
+        for index, element in plan["checksums"]:
+            expected = element.checksum(self._wire(plain, wire, *element.span))
+            stored = element.unpack(plain[index])
+            if expected != stored:
+                raise ChecksumError(
+                    f"bad {element.name}: the frame has {stored:#0{2 + 2 * element.size}x}, "
+                    f"its bytes give {expected:#0{2 + 2 * element.size}x}"
+                )
+        content = plain[self.content] if self.content >= 0 else b""
+        return Unwrapped(self, code, values, content, tuple(plain))
+
+
+def _pack(element: Element, value: int) -> bytes:
+    try:
+        return element.pack(value)
+    except OverflowError:
+        raise EncodeError(f"{element.name} = {value} does not fit {element.size} byte(s)") from None
+
+
+@dataclass(frozen=True)
+class Unwrapped:
+    layout: Layout
+    code: int | None
+    values: tuple[int, ...]
+    content: bytes
+    parts: tuple[bytes, ...] = ()  # every element's bytes, unstuffed
+
+
+# A content size rule for frames without a length: content_size(code, buffer, start, end) -> the content's size,
+# None when more bytes are needed to tell, or -1 when no content of that command starts there.
+ContentSize = Callable[[int | None, bytes, int, int], int | None]
+
+
+@dataclass(frozen=True)
+class SizeRule:
+    """A content size that follows from the content itself: fixed bytes plus factor × a count field's value."""
+
+    fixed: int
+    terms: tuple[tuple[int, int, Literal["little", "big"], int], ...] = ()  # (offset, size, endian, factor)
+
+    def size(self, buffer: bytes, start: int, end: int) -> int | None:
+        total = self.fixed
+        for offset, size, endian, factor in self.terms:
+            if start + offset + size > end:
+                return None
+            total += factor * int.from_bytes(buffer[start + offset : start + offset + size], endian)
+        return total
+
+
+class FrameCodec:
+    """One direction's frames: its layouts (alternatives, tried in order on encode), the content decoders' codes."""
+
+    def __init__(
+        self,
+        layouts: Iterable[Layout],
+        content_sizes: dict[int | None, tuple[int, int | None]],
+        size_rules: dict[int | None, SizeRule] | None = None,
+    ) -> None:
+        self.layouts = tuple(layouts)
+        self.content_sizes = content_sizes  # content size bounds by code (plain bytes)
+        self.size_rules = size_rules or {}
+
+    def wrap(self, content: bytes, code: int | None, values: tuple[int, ...]) -> bytes:
+        problem: EncodeError | None = None
+        for layout in self.layouts:
+            try:
+                return layout.wrap(content, code, values)
+            except EncodeError as exc:
+                problem = exc
+        assert problem is not None
+        raise problem
+
+    def layout_of(self, frame: bytes) -> Layout:
+        if len(self.layouts) == 1:
+            return self.layouts[0]
+        for layout in self.layouts:
+            if frame.startswith(layout.header):
+                return layout
+        choices = " or ".join(layout.header.hex(" ") for layout in self.layouts)
+        raise DecodeError(f"frame starts {frame[:4].hex(' ')}, expected {choices}")
+
+    def unwrap(self, frame: bytes) -> Unwrapped:
+        return self.layout_of(frame).unwrap(frame)
+
+    def probe(self, layout: Layout, buffer: bytes, start: int, end: int) -> int | None:
+        """Size of a plausible frame of `layout` at buffer[start:], None when more bytes are needed, -1 if none."""
+        available = end - start
+        elements = layout.elements
+        first, _ = layout._inner()
+        position = 0
+        code: int | None = None
+        for index in range(first):  # the fixed part before anything variable
+            element = elements[index]
+            size = element.size
+            if available < position + size:
+                return None
+            data = buffer[start + position : start + position + size]
+            if element.kind == "constant" and data != element.constant:
+                return -1
+            if element.kind in ("value", "command"):
+                value = int.from_bytes(data, element.endian)
+                if element.kind == "command":
+                    code = value
+                    if code not in self.content_sizes:
+                        return -1
+                elif not element.plausible(value):
+                    return -1
+            position += size
+        if layout.command is None:
+            code = None
+            if None not in self.content_sizes:
+                return -1
+        low, high = self.content_sizes.get(code, (0, None))
+        if layout.length is not None:
+            element = elements[layout.length]
+            offset = layout.offset(layout.length)
+            assert offset is not None
+            counted = element.unpack(buffer[start + offset : start + offset + element.size]) - element.adds
+            a, b = element.span
+            outside = sum(e.size for e in elements) - sum(e.size for e in elements[a : b + 1])
+            inside_fixed = sum(e.size for e in elements[a : b + 1])
+            content = counted - inside_fixed  # wire bytes of the content (stuffed, if it is)
+            if content < low or (layout.transparency is None and high is not None and content > high):
+                return -1
+            return outside + counted
+        if layout.trailer and layout.transparency is not None:
+            stop = buffer.find(layout.trailer, start + position)
+            return None if stop < 0 else stop + len(layout.trailer) - start
+        rule = self.size_rules.get(code)
+        if rule is None:
+            return -1
+        content_start = start + layout.prefix()
+        content_size = rule.size(buffer, content_start, end)
+        if content_size is None:
+            return None
+        if content_size < low or (high is not None and content_size > high):
+            return -1
+        return layout.overhead + content_size
+
+
+Decode = Callable[[bytes, "type[Message] | None"], Message]
+
+
+class FrameStreamParser(StreamParser):
+    """Splits a byte stream into messages for frames of any layout (see `FrameCodec`).
+
+    A StreamParser to those who hold one (the bus), with its own scanning: it does not call StreamParser.__init__.
+
+    Every header occurrence (every byte, for frames without a header) is a candidate frame start. A candidate must
+    be plausible (constants, values in range, a known command, a length its command allows) before its size is
+    trusted, and must decode (stuffing, checksums, content) before it is accepted; a candidate that fails costs one
+    byte. A candidate still waiting for bytes never hides a complete valid frame that starts inside it.
+    """
+
+    def __init__(self, *formats: tuple[FrameCodec, Decode]) -> None:
+        if not formats:
+            raise ValueError("a stream parser needs at least one frame format")
+        self._formats = formats
+        self._pending = b""
+        headers = [layout.header for codec, _ in formats for layout in codec.layouts]
+        self._headers = tuple(sorted({h for h in headers}, key=len)) if all(headers) else ()
+        self._keep = max((len(h) for h in headers), default=1) - 1
+        self.errors = 0
+        self.garbage = 0
+        self.expected: type[Message] | None = None
+
+    def expect(self, cls: type[Message] | None) -> None:
+        """The reply class the next frames answer, where several reply layouts share a code (PING's vs READ's)."""
+        self.expected = cls
+
+    def _starts(self, buffer: bytes, start: int) -> int:
+        if not self._headers:
+            return start
+        best = -1
+        for header in self._headers:
+            position = buffer.find(header, start)
+            if position >= 0 and (best < 0 or position < best):
+                best = position
+        return best
+
+    def feed(self, data: bytes | bytearray | memoryview) -> list[Message]:
+        buffer = self._pending + bytes(data)
+        end = len(buffer)
+        found: list[Message] = []
+        start = done = 0  # scanning from `start`; bytes before `done` are accounted for
+        hold = -1  # the first candidate still waiting for bytes
+        while start < end:
+            position = self._starts(buffer, start)
+            if position < 0:
+                break
+            accepted = self._try(buffer, position, end, found)
+            if accepted is None or accepted < 0:
+                if accepted is None and hold < 0:
+                    hold = position
+                self.errors += accepted == -2
+                start = position + 1
+                continue
+            self.garbage += position - done
+            hold = -1
+            start = done = accepted
+        if hold >= 0:
+            cut = hold
+        elif self._headers:
+            cut = max(done, end - self._keep)
+        else:
+            cut = end
+        self.garbage += cut - done
+        self._pending = buffer[cut:]
+        return found
+
+    def _try(self, buffer: bytes, position: int, end: int, found: list[Message]) -> int | None:
+        """End of the frame accepted at position, None to wait for bytes, -1 implausible, -2 corrupt."""
+        waiting = False
+        for codec, decode in self._formats:
+            for layout in codec.layouts:
+                size = codec.probe(layout, buffer, position, end)
+                if size is None:
+                    waiting = True
+                    continue
+                if size < 0:
+                    continue
+                if position + size > end:
+                    waiting = True
+                    continue
+                try:
+                    found.append(decode(buffer[position : position + size], self.expected))
+                except DecodeError:
+                    return -2
+                return position + size
+        return None if waiting else -1
+
+    def pending(self) -> bytes:
+        return self._pending
+
+
+@dataclass(frozen=True)
+class EngineFormat:
+    """One direction's frames as code that splits a stream of both directions reads them (serialspec monitor)."""
+
+    codec: FrameCodec
+    decode: Decode
+
+    @property
+    def header(self) -> bytes:
+        return self.codec.layouts[0].header
+
+    def size(self, buffer: bytes, position: int) -> int | None:
+        """The size of a plausible frame at `position`; None if none starts there; past the buffer: wait."""
+        waiting = False
+        for layout in self.codec.layouts:
+            size = self.codec.probe(layout, buffer, position, len(buffer))
+            if size is None:
+                waiting = True
+            elif size >= 0:
+                return size
+        return len(buffer) - position + 1 if waiting else None
+
+    def decode_at(self, buffer: bytes, start: int, stop: int, expect: type[Message] | None = None) -> Message:
+        return self.decode(buffer[start:stop], expect)

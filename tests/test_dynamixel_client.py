@@ -1,0 +1,107 @@
+"""The generated DYNAMIXEL client against the generated virtual X-series servos on a real pseudo-terminal."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Iterator
+
+import pytest
+from dynamixel_p2.client import DynamixelP2Client
+from dynamixel_p2.simulator import DynamixelP2Simulator
+from serialspec.runtime.errors import DeviceError, RangeError, Timeout
+
+TIMEOUT = 1.0
+
+
+@pytest.fixture
+def sim() -> Iterator[DynamixelP2Simulator]:
+    simulator = DynamixelP2Simulator(ids=[1, 2, 3])
+    simulator.path = simulator.start()  # type: ignore[attr-defined]
+    yield simulator
+    simulator.close()
+
+
+@pytest.fixture
+def client(sim: DynamixelP2Simulator) -> Iterator[DynamixelP2Client]:
+    with DynamixelP2Client(sim.path, timeout=TIMEOUT) as c:  # type: ignore[attr-defined]
+        yield c
+
+
+def test_ping_returns_model_number_and_firmware(client: DynamixelP2Client) -> None:
+    reply = client.ping(1)
+    assert (reply.model_number, reply.firmware_version) == (1020, 52)
+    client.bus.timeout = 0.05
+    with pytest.raises(Timeout):
+        client.ping(9)
+
+
+def test_registers_by_name(client: DynamixelP2Client) -> None:
+    assert client.read(2, "velocity_limit") == 200
+    assert client.write(2, goal_pwm=-300, goal_current=-5) is True  # one run: 100..103, signed
+    assert client.read_many(2, "goal_pwm", "goal_current") == {"goal_pwm": -300, "goal_current": -5}
+
+
+def test_values_out_of_range_are_refused_before_sending(client: DynamixelP2Client) -> None:
+    with pytest.raises(RangeError, match="status_return_level"):
+        client.write(1, status_return_level=3)
+
+
+def test_device_errors_name_the_error_number(client: DynamixelP2Client) -> None:
+    with pytest.raises(DeviceError, match="access_error"):
+        client.write_raw(1, 144, b"\x05\x00")  # present_input_voltage is read-only
+
+
+def test_status_return_level_switches_replies(client: DynamixelP2Client) -> None:
+    assert client.write(3, status_return_level=1) is True  # answered: the level was 2 when the write arrived
+    assert client.write(3, led=1) is None  # level 1: a WRITE gets no status packet, the client does not wait
+    assert client.read(3, "led") == 1  # READ is still answered
+    assert client.write(3, status_return_level=0) is None
+    client.bus.timeout = 0.1
+    assert client.read_raw(3, 65, 1) is None  # level 0: READ is not answered either
+    assert client.ping(3).model_number == 1020  # PING always is
+
+
+def test_goal_position_moves_with_torque_and_profile_velocity(client: DynamixelP2Client) -> None:
+    assert client.write(1, torque_enable=1) is True
+    assert client.write(1, goal_position=1000) is True
+    assert client.read(1, "present_position") == 1000  # profile velocity 0: at once
+    assert client.write(1, profile_velocity=100) is True  # 100 x 0.229 rev/min: about 1,560 pulses/s
+    assert client.write(1, goal_position=4000) is True
+    first = client.read_many(1, "moving", "moving_status")["moving"]
+    deadline = time.monotonic() + 6
+    while client.read(1, "present_position") != 4000 and time.monotonic() < deadline:
+        time.sleep(0.02)
+    assert client.read(1, "present_position") == 4000
+    assert (first, client.read(1, "moving")) == (1, 0)  # 1 on the way (about 2 s), 0 once there
+
+
+def test_sync_read_and_write_by_name(client: DynamixelP2Client) -> None:
+    client.sync_write({1: {"profile_acceleration": 7}, 2: {"profile_acceleration": 8}})
+    assert client.sync_read([1, 2], "profile_acceleration") == {
+        1: {"profile_acceleration": 7},
+        2: {"profile_acceleration": 8},
+    }
+
+
+def test_id_change_moves_the_servo(client: DynamixelP2Client) -> None:
+    client.bus.timeout = 0.2
+    client.write_raw(2, 7, bytes([12]))  # the register named `id`; the status packet comes from id 12
+    assert client.ping(12).model_number == 1020
+    with pytest.raises(Timeout):
+        client.ping(2)
+
+
+def test_bulk_read_and_write_by_name(client: DynamixelP2Client) -> None:
+    client.bulk_write({1: {"position_p_gain": 850}, 2: {"led": 1}})
+    assert client.bulk_read({1: "position_p_gain", 2: ("led",), 3: ("model_number", "model_information")}) == {
+        1: {"position_p_gain": 850},
+        2: {"led": 1},
+        3: {"model_number": 1020, "model_information": 0},
+    }
+
+
+def test_action_without_reg_write_is_an_instruction_error(client: DynamixelP2Client) -> None:
+    with pytest.raises(DeviceError, match="instruction_error"):
+        client.action(2)
+    assert client.reg_write(2, led=1) is True
+    assert client.action(2) is True

@@ -18,6 +18,7 @@ BASES = {
     "feetech": HERE.parent / "specs" / "feetech_sms.yaml",
     "rrc": HERE.parent / "specs" / "hiwonder_rrc.yaml",
     "fashionstar": HERE.parent / "specs" / "fashionstar_uart.yaml",
+    "dynamixel": HERE.parent / "specs" / "dynamixel_p2.yaml",
 }
 
 

@@ -644,7 +644,7 @@ CASES: list[tuple[str, str, Mutation | Text, str | None]] = [
         "type typo",
         "tiny",
         put("commands/move/request/fields/extra", "uint16"),
-        "commands.move.request.fields.extra: unknown type 'uint16' (expected one of u8, i8, u16, i16, u32, i32, f32, bytes, array, group, table_value, table_block, or a field from `fields:`)",
+        "commands.move.request.fields.extra: unknown type 'uint16' (expected one of u8, i8, u16, i16, u32, i32, f32, bytes, string, cstring, array, group, table_value, table_block, or a field from `fields:`)",
     ),
     (
         "frame element flags typo",
@@ -705,7 +705,7 @@ CASES: list[tuple[str, str, Mutation | Text, str | None]] = [
         "device moves target typo",
         "tiny",
         put("device/commands/move/moves/target", "angel"),
-        "device.commands.move.moves.target: move has no request field or memory entry 'angel'",
+        "device.commands.move.moves.target: move has no request field, memory entry or state variable 'angel'",
     ),
     (
         "device reply typo",

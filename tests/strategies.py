@@ -10,15 +10,19 @@ from serialspec.spec.model import (
     Bytes,
     Field,
     Group,
+    List,
     Message,
     Protocol,
     Scalar,
     ScalarType,
     TableBlock,
     TableValue,
+    Text,
 )
 
 MAX_ITEMS = 4  # items per group: enough to cover counts, small enough to fit a length byte
+MAX_LIST = 12  # items per list of varying count
+TEXT = st.text(st.characters(min_codepoint=0x20, max_codepoint=0x7E), max_size=12)  # no NUL: it ends a cstring
 
 
 def number(scalar: ScalarType, low: float, high: float) -> st.SearchStrategy[Any]:
@@ -55,6 +59,15 @@ def fields_values(fields: tuple[Field, ...], rest_budget: int) -> st.SearchStrat
                 else:
                     size = sizes.setdefault(f.size, draw(st.integers(0, 6)))
                 values[f.name] = draw(st.binary(min_size=size, max_size=size)).hex(" ")
+            elif isinstance(f, List):
+                values[f.name] = draw(list_value(f, fields))
+            elif isinstance(f, Text):
+                if isinstance(f.size, int):
+                    values[f.name] = draw(
+                        st.text(st.characters(min_codepoint=0x20, max_codepoint=0x7E), min_size=f.size, max_size=f.size)
+                    )
+                else:
+                    values[f.name] = draw(TEXT)
             elif isinstance(f, Group):
                 count = f.count if isinstance(f.count, int) else draw(st.integers(0, MAX_ITEMS))
                 item = fields_values(f.fields, 0)
@@ -86,6 +99,21 @@ def fields_values(fields: tuple[Field, ...], rest_budget: int) -> st.SearchStrat
     return build()
 
 
+def list_value(f: List, siblings: tuple[Field, ...]) -> st.SearchStrategy[list[Any]]:
+    """Items of a list of varying count: as many as its count field's range allows (a few); a list sized in bytes
+    holds whole bytes of bits (decoding gives every bit of them back)."""
+    low, high = 0, MAX_LIST
+    counter = next((c for c in siblings if c.name == f.count), None)
+    if isinstance(f.count, int):
+        low = high = f.count
+    elif isinstance(counter, Scalar):
+        low, high = max(low, int(counter.minimum)), min(high, int(counter.maximum))
+    item = st.booleans() if f.item is None else number(f.item, f.minimum, f.maximum)
+    if f.item is None and (f.size or f.count == "rest"):
+        return st.integers(0, MAX_LIST // 8 + 1).flatmap(lambda n: st.lists(item, min_size=8 * n, max_size=8 * n))
+    return st.lists(item, min_size=low, max_size=high)
+
+
 def message_fields(protocol: Protocol, message: Message) -> st.SearchStrategy[dict[str, Any]]:
     frame = protocol.framing.layouts[message.direction].value_elements
     frame_values = st.fixed_dictionaries(
@@ -96,5 +124,14 @@ def message_fields(protocol: Protocol, message: Message) -> st.SearchStrategy[di
             for e in frame
             if e.type is not None
         }
+        | refused_code(protocol, message)
     )
     return st.tuples(frame_values, fields_values(message.fields, 8)).map(lambda pair: {**pair[0], **pair[1]})
+
+
+def refused_code(protocol: Protocol, message: Message) -> dict[str, st.SearchStrategy[int]]:
+    """An error reply also carries the code of the request it refuses (any code without the error flag)."""
+    error = protocol.error_reply
+    if not message.error_reply or error is None:
+        return {}
+    return {error.element: st.integers(0, error.flag - 1)}

@@ -54,6 +54,9 @@ def check_against_construct(g: Generated, spec: Message, frame: bytes, fields: d
     content_struct = g.structs.CONTENTS[(spec.key, spec.direction.value)]
     parsed = plain(content_struct.parse(content))
     frame_names = {e.name for e in g.protocol.framing.layouts[spec.direction].value_elements}
+    error = g.protocol.error_reply
+    if spec.error_reply and error is not None:
+        frame_names.add(error.element)  # the refused request's code, in the command element
     for name, value in fields.items():
         if name in frame_names:
             continue
@@ -119,7 +122,8 @@ def test_damaged_frames_fail_with_one_line(g: Generated) -> None:
     for example in g.protocol.examples:
         direction = example.direction.value
         frame = example.frame
-        for damaged in (frame[:-1], frame[:-1] + bytes([(frame[-1] + 1) & 0xFF]), b"\x00" + frame[1:], frame + b"\x00"):
+        first = bytes([frame[0] ^ 0x01])  # a header byte, or an address the checksum covers
+        for damaged in (frame[:-1], frame[:-1] + bytes([(frame[-1] + 1) & 0xFF]), first + frame[1:], frame + b"\x00"):
             with pytest.raises(DecodeError) as failure:
                 g.package.decode(damaged, direction)
             assert "\n" not in str(failure.value) and str(failure.value)

@@ -81,6 +81,19 @@ def test_three_mistakes_give_three_lines(tmp_path: Path) -> None:
         (("angle: i16", "angle: [i16"), "YAML syntax error"),
         (("angle: i16", "angle: {type: group, count: n, fields: {x: u8}}"), "unknown field 'n'"),
         (("angle: i16", "data: {type: bytes, size: rest}\n        after: u8"), "only the last field"),
+        (("angle: i16", 'n: {type: u8, value: "2 * m"}'), "unknown field 'm' in '2 * m'"),
+        (("angle: i16", 'n: {type: u8, value: "2 ** servo_id"}'), "'2 ** servo_id' is not allowed"),
+        (("angle: i16", 'n: {type: u8, value: "len(servo_id)"}'), "servo_id is not a list"),
+        (
+            ("angle: i16", 'a: {type: u8, value: "b + 1"}\n        b: {type: u8, value: "a - 1"}'),
+            "derived values depend on each other: a -> b -> a",
+        ),
+        (("angle: i16", 'n: {type: f32, value: "servo_id"}'), "a derived value needs an integer type"),
+        (("angle: i16", "n: {type: array, of: u16}"), "needs `count` (items) or `size`"),
+        (("angle: i16", "n: {type: array, of: bit, count: 8, range: [0, 1]}"), "bits are true or false"),
+        (("angle: i16", "name: {type: string}"), "a string needs `size`"),
+        (("angle: i16", "name: {type: cstring, size: 4}"), "a cstring ends at its NUL byte"),
+        (("type: u8}", "type: u8, error_flag: 0x80}"), "`error_flag` needs a command whose response is marked"),
     ],
 )
 def test_each_mistake_is_named_with_its_position(tmp_path: Path, change: tuple[str, str], expected: str) -> None:

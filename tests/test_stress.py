@@ -97,16 +97,30 @@ def damaged(rng: random.Random, pool: list[bytes], layout: FrameLayout) -> tuple
     """Damage to put before an intact frame, and whether it is a corrupt frame; None for none."""
     roll = rng.random()
     frame = rng.choice(pool)
-    if roll < 0.2:  # a truncated frame start: the header and a length byte
-        return frame[: layout.length_offset + 1], False
+    if roll < 0.2:  # a truncated frame start: the header and a length byte (or whatever comes before the content)
+        return frame[: start_size(layout)], False
     if roll < 0.3:
         return bytes(rng.randrange(256) for _ in range(rng.randrange(1, 12))), False
     if roll < 0.4:  # the same frame with its checksum corrupted
-        position = len(frame) - layout.checksum_offset_from_end
+        position = len(frame) - checksum_from_end(layout)
         spoiled = bytearray(frame)
         spoiled[position] ^= rng.randrange(1, 256)
         return bytes(spoiled), True
     return None
+
+
+def start_size(layout: FrameLayout) -> int:
+    """Bytes of a frame start that say what the frame is: up to its length byte, or up to its content."""
+    if layout.classic:
+        return layout.length_offset + 1
+    content = next(i for i, e in enumerate(layout.elements) if e.role == "content")
+    return sum(e.size or 0 for e in layout.elements[:content])
+
+
+def checksum_from_end(layout: FrameLayout) -> int:
+    """How far from the end of a frame its (last) checksum starts: the checksum and what follows it (a trailer)."""
+    index = max(i for i, e in enumerate(layout.elements) if e.role == "checksum")
+    return sum(e.size or 0 for e in layout.elements[index:])
 
 
 class Ambiguity:
@@ -118,6 +132,8 @@ class Ambiguity:
 
     def __call__(self, window: bytes, end: int, window_is_the_rest: bool) -> bool:
         """True if a header starting in window[:end] (the damage) begins a frame that decodes."""
+        if not self.g.protocol.framing.classic:
+            return self.general(window, end, window_is_the_rest)
         for layout in self.layouts:
             position = window.find(layout.header, 0, end + len(layout.header) - 1)
             while 0 <= position < end:
@@ -132,6 +148,27 @@ class Ambiguity:
                 except DecodeError:
                     pass
                 position = window.find(layout.header, position + 1, end + len(layout.header) - 1)
+        return False
+
+    def general(self, window: bytes, end: int, window_is_the_rest: bool) -> bool:
+        """The same for frames of any layout, sized by the codec's frame engine (every byte a candidate start
+        where frames have no header)."""
+        for layout in self.layouts:
+            codec = getattr(self.g.package.codec, f"_{layout.direction.name}_FRAMES")
+            for position in range(end):
+                for alternative in codec.layouts:
+                    size = codec.probe(alternative, window, position, len(window))
+                    if size is None or (size > 0 and position + size > len(window)):
+                        if window_is_the_rest:
+                            return True  # a frame start the stream ends in: the parser waits for it
+                        continue
+                    if size < 0:
+                        continue
+                    try:
+                        self.g.package.decode(window[position : position + size], layout.direction.value)
+                        return True
+                    except DecodeError:
+                        pass
         return False
 
 

@@ -156,3 +156,21 @@ def test_monitor_prints_frames_and_bad_frames() -> None:
     assert " request read_angle " in lines[0] and good.hex(" ") in lines[0]
     assert " BAD " in lines[1]
     assert " response read_angle " in lines[2] and '"angle": 902' in lines[2]
+
+
+def test_a_refused_setting_is_a_port_error_naming_it() -> None:
+    """A driver that refuses a setting makes pyserial raise termios.error: the bus says which setting instead."""
+    import serial
+
+    serial.protocol_handler_packages.append("refusing_ports")
+    controller, device = os.openpty()
+    try:
+        path = os.ttyname(device)
+        with pytest.raises(PortError, match=r"refusing://.*: the port refuses parity = even \(.*Invalid argument"):
+            Bus(f"refusing://{path}", BINDING, parity="E")
+        with Bus(f"refusing://{path}", BINDING, parity="O") as bus:  # every other setting is taken
+            assert bus.port_name
+    finally:
+        serial.protocol_handler_packages.remove("refusing_ports")
+        os.close(controller)
+        os.close(device)

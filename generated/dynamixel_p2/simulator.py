@@ -257,10 +257,8 @@ class DynamixelP2Simulator(Simulator):
         model: str | Mapping[int, str] | None = None,
     ) -> None:
         """`model`: xm430_w350, xl430_w250, xl330_m288 (default xm430_w350) for every device, or id -> model."""
-        kwargs = {"clock": clock} if clock is not None else {}
         super().__init__(
-            DEVICE, ids, encode=encode, parser=lambda: StreamParser(Direction.REQUEST), model=model, **kwargs
-        )
+            DEVICE, ids, encode=encode, parser=lambda: StreamParser(Direction.REQUEST), clock=clock, model=model        )
 
 
 #: The simulator class, under a name every generated package shares (serialspec sim uses it).

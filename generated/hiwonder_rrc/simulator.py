@@ -169,10 +169,8 @@ class HiwonderRrcSimulator(Simulator):
         model: str | Mapping[int, str] | None = None,
     ) -> None:
         """`model`: the spec lists no models, so only None."""
-        kwargs = {"clock": clock} if clock is not None else {}
         super().__init__(
-            DEVICE, ids, encode=encode, parser=lambda: StreamParser(Direction.REQUEST), model=model, **kwargs
-        )
+            DEVICE, ids, encode=encode, parser=lambda: StreamParser(Direction.REQUEST), clock=clock, model=model        )
 
 
 #: The simulator class, under a name every generated package shares (serialspec sim uses it).

@@ -8,6 +8,7 @@ import signal
 import sys
 import time
 from types import FrameType
+from typing import Any
 
 from serialspec.cli import capture
 from serialspec.cli.protocols import SPEC_HELP, open_spec
@@ -25,7 +26,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         type=int,
         action="append",
         metavar="N",
-        help="a device id on the bus (repeat for several; default 0); checked against the spec's id range",
+        help="a device id on the bus (repeat for several; default: the spec's `device.ids`, else 0); checked "
+        "against the spec's id range",
+    )
+    parser.add_argument(
+        "--size",
+        dest="sizes",
+        action="append",
+        metavar="SPACE=N",
+        help="number of items of a data space (repeat for several; Modbus: coils=20000)",
     )
     parser.add_argument(
         "--model",
@@ -82,16 +91,28 @@ def run(args: argparse.Namespace) -> int:
     module = getattr(package, "simulator", None)
     if module is None or protocol.device is None:
         raise SerialspecError(f"{args.spec} has no `device:` section, so no simulator is generated")
-    ids = args.ids or [0]
+    ids = args.ids or list(protocol.device.ids)
     low, high, broadcast = id_range(protocol)
     for device_id in ids:
         if not low <= device_id <= high or device_id == broadcast:
             also = f" ({broadcast} is the broadcast id)" if device_id == broadcast else ""
             raise SerialspecError(f"--id {device_id} is outside the spec's id range {low}..{high}{also}")
+    sizes: dict[str, int] = {}
+    for text in args.sizes or ():
+        name, _, count = text.partition("=")
+        if not count.isdigit() or int(count) < 1:
+            raise SerialspecError(f"--size {text}: expected SPACE=N with N a positive number")
+        sizes[name] = int(count)
+    options: dict[str, Any] = {"model": model_choice(args.models)}
+    if sizes:
+        if not protocol.device.spaces:
+            raise SerialspecError(f"--size: {protocol.name} devices keep no data spaces")
+        options["sizes"] = sizes
     try:
-        simulator = module.SIMULATOR(ids, model=model_choice(args.models))
-    except ValueError as exc:
-        raise SerialspecError(f"--model: {exc}") from None
+        simulator = module.SIMULATOR(ids, **options)
+    except ValueError as exc:  # an unknown model or data space, or a model for an id not on the bus
+        option = "--size" if "data space" in str(exc) else "--model"
+        raise SerialspecError(f"{option}: {exc}") from None
     simulator.echo = args.echo
     tap = None
     if args.tap:

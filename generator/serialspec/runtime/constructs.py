@@ -21,6 +21,38 @@ class SignMagnitude(Adapter):  # type: ignore[misc]
         return (-obj) | self.sign if obj < 0 else obj
 
 
+class PackedBits(Adapter):  # type: ignore[misc]
+    """Bits packed 8 to a byte, the first in the lowest bit (Modbus coils), as a list of bools; `count` (a number or
+    a function of the context) keeps only that many, else every bit of the bytes."""
+
+    def __init__(self, subcon: Any, count: Any = None) -> None:
+        super().__init__(subcon)
+        self.count = count
+
+    def _decode(self, obj: bytes, context: Any, path: Any) -> list[bool]:
+        bits = [bool(obj[i >> 3] >> (i & 7) & 1) for i in range(len(obj) * 8)]
+        if self.count is None:
+            return bits
+        return bits[: self.count(context) if callable(self.count) else self.count]
+
+    def _encode(self, obj: list[bool], context: Any, path: Any) -> bytes:
+        out = bytearray(-(-len(obj) // 8))
+        for i, value in enumerate(obj):
+            if value:
+                out[i >> 3] |= 1 << (i & 7)
+        return bytes(out)
+
+
+class Utf8(Adapter):  # type: ignore[misc]
+    """Bytes holding UTF-8 text."""
+
+    def _decode(self, obj: bytes, context: Any, path: Any) -> str:
+        return obj.decode("utf-8")
+
+    def _encode(self, obj: str, context: Any, path: Any) -> bytes:
+        return obj.encode("utf-8")
+
+
 class Framed(Adapter):  # type: ignore[misc]
     """A whole frame of any layout (stuffing, lengths and checksums anywhere), by the runtime's frame engine.
 

@@ -306,18 +306,26 @@ class SizeRule:
         return total
 
 
+# The key of the error reply's content sizes and size rule: a frame whose command code has the error flag set
+# (Modbus: function | 0x80) is an error reply, whatever the code of the request it refuses.
+ERROR_REPLY = -1
+
+
 class FrameCodec:
-    """One direction's frames: its layouts (alternatives, tried in order on encode), the content decoders' codes."""
+    """One direction's frames: its layouts (alternatives, tried in order on encode), the content decoders' codes;
+    `error_flag`: codes with these bits set are error replies (their sizes under ERROR_REPLY)."""
 
     def __init__(
         self,
         layouts: Iterable[Layout],
         content_sizes: dict[int | None, tuple[int, int | None]],
         size_rules: dict[int | None, SizeRule] | None = None,
+        error_flag: int = 0,
     ) -> None:
         self.layouts = tuple(layouts)
         self.content_sizes = content_sizes  # content size bounds by code (plain bytes)
         self.size_rules = size_rules or {}
+        self.error_flag = error_flag
 
     def wrap(self, content: bytes, code: int | None, values: tuple[int, ...]) -> bytes:
         problem: EncodeError | None = None
@@ -359,7 +367,7 @@ class FrameCodec:
             if element.kind in ("value", "command"):
                 value = int.from_bytes(data, element.endian)
                 if element.kind == "command":
-                    code = value
+                    code = ERROR_REPLY if value & self.error_flag else value
                     if code not in self.content_sizes:
                         return -1
                 elif not element.plausible(value):
@@ -443,6 +451,10 @@ class FrameStreamParser(StreamParser):
         found: list[Message] = []
         start = done = 0  # scanning from `start`; bytes before `done` are accounted for
         hold = -1  # the first candidate still waiting for bytes
+        # Corrupt candidates after one still waiting for its bytes count only once a frame after them is accepted
+        # (the waiting one was no frame): without a header every byte is a candidate, and those inside a frame
+        # that a read has cut are no errors. Left uncounted at the end, they are scanned again with the next bytes.
+        deferred = 0
         while start < end:
             position = self._starts(buffer, start)
             if position < 0:
@@ -451,11 +463,16 @@ class FrameStreamParser(StreamParser):
             if accepted is None or accepted < 0:
                 if accepted is None and hold < 0:
                     hold = position
-                self.errors += accepted == -2
+                if accepted == -2:
+                    if hold < 0:
+                        self.errors += 1
+                    else:
+                        deferred += 1
                 start = position + 1
                 continue
             self.garbage += position - done
-            hold = -1
+            self.errors += deferred
+            hold, deferred = -1, 0
             start = done = accepted
         if hold >= 0:
             cut = hold

@@ -57,6 +57,27 @@ class SerialSettings:
     bytesize: int = 8
     parity: str = "none"
     stopbits: float = 1
+    gap: float = 0.0  # silence the protocol needs between frames, in character times (Modbus RTU: 3.5)
+
+
+@dataclass(frozen=True)
+class ErrorReplies:
+    """A protocol's error reply (Modbus exception): its class, the member holding the code of the request it
+    refuses, the member saying why, and each command's code. The bus raises DeviceError when one answers."""
+
+    response: type[Message]
+    code_field: str
+    reason_field: str
+    codes: dict[str, int]  # command name -> code
+
+    def refuses(self, request: Message, reply: Message) -> bool:
+        code = self.codes.get(request.COMMAND)
+        return isinstance(reply, self.response) and code is not None and getattr(reply, self.code_field) == code
+
+    def describe(self, request: Message, reply: Message) -> str:
+        reason: Any = getattr(reply, self.reason_field)
+        name = f"{reason.name.lower()} ({reason.value})" if isinstance(reason, Enum) else str(reason)
+        return f"{request.COMMAND}: the device refuses it: {self.reason_field} = {name}"
 
 
 @dataclass(frozen=True)
@@ -70,6 +91,7 @@ class Binding:
     match_by: tuple[str, ...]  # `command`, `subcommand` or field names, from the spec's `matching.by`
     status: tuple[str, ...] = ()  # reply fields whose non-zero value is a device error (frame status elements)
     describe_status: Callable[[str, int], str] = field(default=lambda name, value: f"{name} = {value:#04x}")
+    errors: ErrorReplies | None = None  # the protocol's error reply, if it has one
 
 
 def check_status(request: Message, reply: Message, name: str, ok: int, match_by: tuple[str, ...]) -> None:
@@ -141,11 +163,10 @@ class Bus:
                 "timeout": timeout,
             }
             options.update(serial_options)
-            try:
-                self._port = serial.serial_for_url(port, **options)
-            except (serial.SerialException, OSError, ValueError) as exc:
-                raise PortError(f"cannot open {port}: {exc}") from None
+            self._port = _open_port(port, options)
         self.port_name = str(getattr(self._port, "name", None) or getattr(self._port, "port", "") or port)
+        self._gap = _gap_seconds(binding.serial.gap, self._port)
+        self._last_io = 0.0  # when a byte was last written or read (for the inter-frame gap)
         # spy:// logs in its read(); the fast path below reads the descriptor itself, so it tells the logger
         self._spy = getattr(self._port, "formatter", None)
 
@@ -166,7 +187,8 @@ class Bus:
         try:
             self._port.open()
         except _OPEN_FAILURES as exc:
-            raise PortError(f"cannot reopen {self.port_name}: {exc}") from None
+            reason = _refused_setting(self._port.port, _settings_of(self._port)) or _reason(exc)
+            raise PortError(f"cannot reopen {self.port_name}: {reason}") from None
         self._parser = self.binding.parser()
 
     def __enter__(self) -> Bus:
@@ -206,11 +228,27 @@ class Bus:
             self._drain()
             self._parser.expect(expect)  # where replies share a code, the layout this request's reply has
             self._write(frame)
-            reply = self._read_until(lambda m: isinstance(m, expect) and self.matches(request, m), wait, request)
+            reply = self._read_until(lambda m: self._answers(request, expect, m), wait, request)
             self._flush_backlog()
+        errors = self.binding.errors
+        if errors is not None and errors.refuses(request, reply):
+            raise DeviceError(errors.describe(request, reply), reply)
         assert isinstance(reply, expect)
         self._check_status(reply)
         return reply
+
+    def _answers(self, request: Message, expect: type[Message], reply: Message) -> bool:
+        """The reply of the expected type that matches the request, or an error reply that refuses it."""
+        if isinstance(reply, expect):
+            return self.matches(request, reply)
+        errors = self.binding.errors
+        if errors is None or not errors.refuses(request, reply):
+            return False
+        return all(
+            getattr(request, name) == getattr(reply, name)
+            for name in self.binding.match_by
+            if name not in ("command", "subcommand") and hasattr(request, name) and hasattr(reply, name)
+        )
 
     def request_each(
         self, request: Message, expect: type[M], answers: list[dict[str, Any]], *, timeout: float | None = None
@@ -296,8 +334,14 @@ class Bus:
         raise PortError(f"{self.port_name}: {doing} failed: {reason}") from None
 
     def _write(self, frame: bytes) -> None:
+        if self._gap:
+            # the one wait the bus makes: the silence a protocol needs before a frame (3.5 characters for Modbus)
+            wait = self._last_io + self._gap - time.monotonic()
+            if wait > 0:
+                time.sleep(wait)
         with self._port_failures("write"):
             self._port.write(frame)
+        self._last_io = time.monotonic()
         if self.echo:
             self._check_echo(frame)
 
@@ -376,6 +420,8 @@ class Bus:
             self._backlog.clear()
             with self._port_failures("read"):
                 chunk = b"" if held or remaining <= 0 else self._read_some(remaining)
+            if chunk:
+                self._last_io = time.monotonic()
             found = None
             for message in held + (self._parser.feed(chunk) if chunk else []):
                 if found is not None:
@@ -430,6 +476,63 @@ class Bus:
                 self._port.reset_input_buffer()
         except _RESET_FAILURES:
             pass  # a port that has failed reports it on the next read or write
+
+
+# The serial settings a port may refuse, in the order they are tried when opening fails.
+_SETTINGS = ("baudrate", "bytesize", "parity", "stopbits")
+_PARITY_NAMES = {value: name for name, value in _PARITY.items()}
+
+
+def _gap_seconds(characters: float, port: Any) -> float:
+    """A silence of `characters` character times at the port's settings (start, data, parity and stop bits)."""
+    if not characters:
+        return 0.0
+    baudrate = getattr(port, "baudrate", 0) or 0
+    if baudrate <= 0:
+        return 0.0
+    bits = 1 + int(getattr(port, "bytesize", 8)) + (getattr(port, "parity", "N") != "N") + float(port.stopbits)
+    return characters * bits / baudrate
+
+
+def _reason(exc: BaseException) -> str:
+    return str(exc) or type(exc).__name__
+
+
+def _settings_of(port: Any) -> dict[str, Any]:
+    return {name: getattr(port, name) for name in _SETTINGS if hasattr(port, name)}
+
+
+def _open_port(url: str, options: dict[str, Any]) -> Any:
+    """Open a port with its settings; a failure is a PortError naming the setting the port refused, if one was."""
+    try:
+        return serial.serial_for_url(url, **options)
+    except _OPEN_FAILURES as exc:  # termios.error among them: never a raw one
+        reason = _refused_setting(url, options) or _reason(exc)
+        raise PortError(f"cannot open {url}: {reason}") from None
+
+
+def _refused_setting(url: str, options: dict[str, Any]) -> str:
+    """Which serial setting a port refuses: open it with pyserial's defaults, then apply the settings one at a
+    time. "" when even that open fails (the port itself is the problem) or every setting is accepted alone."""
+    try:
+        port: Any = serial.serial_for_url(url, do_not_open=True)
+        port.open()
+    except _OPEN_FAILURES:
+        return ""
+    try:
+        for name in _SETTINGS:
+            if name not in options:
+                continue
+            value = options[name]
+            try:
+                setattr(port, name, value)
+            except _OPEN_FAILURES as exc:
+                shown = _PARITY_NAMES.get(value, value) if name == "parity" else value
+                return f"the port refuses {name} = {shown} ({_reason(exc)})"
+        return ""
+    finally:
+        with suppress(*_PORT_FAILURES):
+            port.close()
 
 
 class _PortFailures:

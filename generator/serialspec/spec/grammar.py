@@ -332,7 +332,10 @@ def bit_fields(description: str) -> MapOf:
 
 
 _FIELD_LONG: dict[str, Shape] = {
-    "type": Str("Wire type: u8, i8, u16, i16, u32, i32, f32, bytes, array, group, table_value, table_block."),
+    "type": Str(
+        "Wire type: u8, i8, u16, i16, u32, i32, f32, bytes, string, cstring (NUL-terminated text), array, group, "
+        "table_value, table_block."
+    ),
     "use": Str("Name of an entry in `fields:` (top level) to copy; keys given here override it."),
     "description": TEXT,
     "description_cn": Str("Description as printed in the (Chinese) document."),
@@ -351,9 +354,21 @@ _FIELD_LONG: dict[str, Shape] = {
         example="sign_magnitude",
     ),
     "endian": Str("Override of the protocol's byte order for this field.", choices=("little", "big"), example="big"),
-    "size": OneOf((Int(), Str()), "bytes: a number, `rest` (up to the end of the content) or a field name"),
+    "size": OneOf(
+        (Int(), Str()),
+        "bytes, string: a number, `rest` (up to the end of the content) or a field name; array: the earlier field "
+        "holding the array's size in bytes (Modbus byte_count)",
+    ),
     "count": OneOf((Int(), Str()), "array/group: a number, `rest`, or the name of an earlier count field"),
-    "of": Str("array: the item type."),
+    "of": Str("array: the item type (a scalar type, or `bit`: bools packed 8 to a byte, lowest bit first)."),
+    "count_from": Str(
+        "array of a response: the request field (request.<field>) saying how many items are meant, when the array "
+        "holds more (Modbus coils padded to a multiple of 8): clients keep that many."
+    ),
+    "value": Str(
+        "An integer field derived from the others by an expression, computed on encode and checked on decode: "
+        "`2 * count`, `ceil(len(coils) / 8)` (names of fields, len(), ceil(a / b), min, max, + - * / % & | << >>)."
+    ),
     "fields": Ref("fields", lambda: FIELDS, "group: the fields of each item (a mapping, like request/response)."),
     "table": Str("table_value/table_block, or bytes holding registers: name of an entry in `tables:`."),
     "key": Str("table_value: the earlier field holding the table key (e.g. data_id)."),
@@ -399,6 +414,11 @@ MESSAGE = Obj(
         "optional": TEXT,
         "unsolicited": Bool("Sent by the device on its own, not as an answer.", default=False),
         "answers": Str("For a response: the request (command or command.subcommand) it answers, if another."),
+        "error_reply": Bool(
+            "For a response: the reply a device sends instead of any request's own when it cannot carry it out, "
+            "under the request's code plus the command element's `error_flag` (Modbus exception replies). Its "
+            "message carries the code of the refused request in a value named after the command element."
+        ),
         "optional_when": OPTIONAL_WHEN,
         "after": Str("For a response: the request field (in ms) after which the device answers, e.g. a move's time."),
         "answered_by": Obj(
@@ -583,6 +603,10 @@ FRAME_ELEMENT = Obj(
         "directions": ListOf(
             Str(choices=("request", "response")), "The directions whose frames have it (default both)."
         ),
+        "error_flag": Int(
+            "command: a bit a device sets in the code of a reply that refuses the request (Modbus: 0x80); such a "
+            "reply has the layout of the command whose response is the `error_reply`."
+        ),
         "counts": span(
             "length: the span of elements it counts, on the wire (after stuffing); default the content only.",
         ),
@@ -672,6 +696,12 @@ EXAMPLE = Obj(
         "description": TEXT,
         "direction": Str("The direction the frame travels in.", choices=("request", "response")),
         "printed": Str("The frame exactly as the document prints it."),
+        "printed_span": ListOf(
+            Str(),
+            "When the document prints only part of the frame (Modbus prints the PDU: function and data), the first "
+            "and last frame element it prints; `frame` is then the whole frame.",
+            length=2,
+        ),
         "frame": HEX_BYTES,
         "erratum": Str("Name of the erratum that explains why `frame` differs from `printed`."),
         "completed": Str(
@@ -717,11 +747,42 @@ ERRATUM = Obj(
     description="A mistake in a document: what it prints, what is right, and the test that pins the right reading.",
 )
 
+REPLY_VALUES = (
+    "Response field -> value when no behaviour sets it (e.g. result: 1; text for text and bytes fields, bytes as "
+    "hex: VESC hw_name: '60')."
+)
+
+SPACE_ACCESS = Obj(
+    {
+        "space": Str("The data space (an entry of the device's `spaces:`)."),
+        "start": Str("The request field holding the first item's address."),
+        "count": Str("reads: the request field holding how many items are read."),
+        "value": Str(
+            "writes: what is stored, as an expression of the request's fields and `current` (the item's present "
+            "value), e.g. Modbus Mask Write `(current & and_mask) | (or_mask & ~and_mask)`; default: the field."
+        ),
+    },
+    required=("space", "start"),
+    description="A run of items of a data space, from the address a request field gives.",
+)
+
 DEVICE_COMMAND = Obj(
     {
         "description": Str(TEXT.description, example="The servo moves to the goal position over goal_time."),
-        "reads": ListOf(Str(), "Response fields filled from memory: table_value by its key, table_block entries."),
-        "writes": ListOf(Str(), "Request fields stored in memory: table_value by its key, table_block entries."),
+        "reads": OneOf(
+            (
+                ListOf(Str(), "Response fields filled from memory: table_value by its key, table_block entries."),
+                MapOf(SPACE_ACCESS, "Response field -> the run of a data space it holds (Modbus registers)."),
+            ),
+            "a list of response fields read from memory, or a mapping response field -> data space run",
+        ),
+        "writes": OneOf(
+            (
+                ListOf(Str(), "Request fields stored in memory: table_value by its key, table_block entries."),
+                MapOf(SPACE_ACCESS, "Request field -> the run of a data space it is stored in (a value or a list)."),
+            ),
+            "a list of request fields stored in memory, or a mapping request field -> data space run",
+        ),
         "resets": Bool(
             "Memory goes back to its defaults (all but the device's id, unless `keeps` says otherwise).", default=False
         ),
@@ -737,7 +798,11 @@ DEVICE_COMMAND = Obj(
             required=("field", "entries"),
             description="resets: the entries kept, chosen by a request field (0xFF: none, 0x01: id, ...).",
         ),
-        "reports": MapOf(Str(), "Response field -> the state variable or memory entry it reports."),
+        "reports": MapOf(
+            Str(),
+            "Response field -> the state variable or memory entry it reports, or an expression of them where the "
+            "units differ (VESC duty_now in 0.001 from a duty in 0.00001: `duty / 100`).",
+        ),
         "moves": Obj(
             {
                 "state": Str("The state variable (or memory entry) that moves."),
@@ -867,7 +932,10 @@ DEVICE = Obj(
         "id_entry": Str("The memory entry or state variable holding the device's id (writing it changes the address)."),
         "broadcast": Int("The address every device obeys (default: the address element's broadcast)."),
         "state": MapOf(Num(), "State variables beyond memory -> initial value (e.g. the present angle)."),
-        "reply": MapOf(Num(), "Response field -> value when no behaviour sets it (e.g. result: 1)."),
+        "reply": MapOf(
+            OneOf((Num(), Str()), REPLY_VALUES),
+            REPLY_VALUES,
+        ),
         "refused": MapOf(
             Num(),
             "Response field (or field.bit_field) -> value when a write is refused (read-only or unknown entry; "
@@ -900,6 +968,47 @@ DEVICE = Obj(
             default=False,
         ),
         "commands": MapOf(DEVICE_COMMAND, "Command (or command.subcommand) -> behaviour; others just answer."),
+        "ids": ListOf(Int(), "The device ids the simulator serves when none are given (default: 0)."),
+        "timeout": Obj(
+            {
+                "after": Int("Milliseconds without one of the `kept_by` commands after which the device gives up."),
+                "kept_by": ListOf(Str(), "The commands that restart the timeout (VESC: every setpoint, and ALIVE)."),
+                "sets": MapOf(Num(), "State variable -> its value once the timeout has expired (the motor released)."),
+                "description": TEXT,
+            },
+            required=("after", "kept_by", "sets"),
+            description="A command timeout: the device stops unless commands keep coming (VESC, 1 s by default).",
+        ),
+        "spaces": MapOf(
+            Obj(
+                {
+                    "type": Str(
+                        "The item type: `bit`, or an unsigned integer type.", choices=("bit", "u8", "u16", "u32")
+                    ),
+                    "size": Int("Number of items, addressed 0..size-1 (the simulator can be given other sizes)."),
+                    "access": Str("r: requests only read it; rw: they read and write it.", choices=("r", "rw")),
+                    "description": TEXT,
+                },
+                required=("type", "size"),
+                description="One data space: its item type, its size and whether requests may write it.",
+            ),
+            "Data spaces the device keeps besides its table: runs of items addressed by number, all zero at "
+            "first (Modbus coils, discrete inputs, holding and input registers).",
+        ),
+        "errors": Obj(
+            {
+                "field": Str("The error reply's field that says why (Modbus exception_code)."),
+                "out_of_space": Int("Value when a run reaches beyond its data space (Modbus 2)."),
+                "out_of_range": Int("Value when a request value is outside its range or enum (Modbus 3)."),
+                "read_only": Int("Value when a write reaches a data space that is read-only."),
+                "unsupported": Int(
+                    "Value for a request whose code no command has, recognised when it arrives whole and its "
+                    "checksum verifies (Modbus 1, illegal function); frames without a header only."
+                ),
+            },
+            required=("field",),
+            description="How the device refuses a request with the protocol's error reply (`error_reply:`).",
+        ),
         "kinds": MapOf(
             Obj(
                 {

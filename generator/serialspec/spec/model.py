@@ -12,6 +12,8 @@ from functools import cached_property
 from typing import Literal
 
 from serialspec.runtime.message import Direction as Direction  # the model and the runtime share it
+from serialspec.spec import expression
+from serialspec.spec.expression import Expr
 
 
 @dataclass(frozen=True)
@@ -111,11 +113,13 @@ class Scalar(Common):
     derived: tuple[str, ...] = ()
     # A response field reporting success: any value but this one is a device error (the client raises DeviceError).
     status_ok: int | None = None
+    # Derived by an expression over the other fields (`byte_count = 2 * count`): computed on encode, checked on decode.
+    value: Expr | None = None
 
     @property
     def hidden(self) -> bool:
         """Not a member of the message: constant or derived."""
-        return self.const is not None or bool(self.derived)
+        return self.const is not None or bool(self.derived) or self.value is not None
 
 
 @dataclass(frozen=True)
@@ -126,6 +130,43 @@ class Array(Common):
     unit: str
     minimum: float
     maximum: float
+
+
+@dataclass(frozen=True)
+class List(Common):
+    """A list of numbers or bits whose count varies: from a count field, from a byte-size field, or the rest.
+
+    `item` None means bits packed 8 to a byte, the first in the lowest bit, the last byte padded with zeros
+    (Modbus coils). The count comes from `count` (a number, `rest`, or a field) or, when that is "", from the
+    byte size in the field named by `size`.
+    """
+
+    item: ScalarType | None
+    endian: Literal["<", ">"]
+    count: int | str
+    size: str
+    unit: str
+    minimum: float
+    maximum: float
+    count_from: str = ""  # a response's: the request field saying how many items are meant (the rest is padding)
+
+    @property
+    def bits(self) -> bool:
+        return self.item is None
+
+    def byte_size(self, count: int) -> int:
+        return -(-count // 8) if self.item is None else count * self.item.size
+
+
+@dataclass(frozen=True)
+class Text(Common):
+    """Text: NUL-terminated (`size` None; the NUL is not part of the value), or sized like bytes."""
+
+    size: int | str | None  # a number, "rest", a field name, or None for NUL-terminated
+
+    @property
+    def terminated(self) -> bool:
+        return self.size is None
 
 
 @dataclass(frozen=True)
@@ -160,7 +201,7 @@ class TableBlock(Common):
     struct_name: str = ""  # the construct struct of the block
 
 
-Field = Scalar | Array | Bytes | Group | TableValue | TableBlock
+Field = Scalar | Array | List | Text | Bytes | Group | TableValue | TableBlock
 
 
 @dataclass(frozen=True)
@@ -241,6 +282,7 @@ class Message:
     optional_when: OptionalWhen | None = None  # a response sent only when a device parameter has a value
     after: str = ""  # a response sent once the request's field of this name (ms) has elapsed
     answered_by: str = ""  # a request answered by another command's response (its key)
+    error_reply: bool = False  # the reply a device sends instead of any other (Modbus exceptions: code | flag)
     reply_when: OptionalWhen | None = None  # a request whose reply is sent only when a device parameter has a value
     struct_name: str = ""  # the construct struct of its content
     default_reply: bool = False  # among replies sharing a code: the one a frame is decoded as without its request
@@ -430,6 +472,16 @@ class Framing:
 
 
 @dataclass(frozen=True)
+class ErrorReply:
+    """Replies that refuse a request: its code with `flag` set in the command element, laid out as `command`'s
+    response (Modbus exception replies: function | 0x80, then an exception code)."""
+
+    flag: int
+    element: str  # the command element; the error reply's message carries the refused code under this name
+    command: str  # the command whose response is the error reply
+
+
+@dataclass(frozen=True)
 class Serial:
     baudrate: int
     bytesize: int
@@ -452,7 +504,15 @@ class Example:
     request: str
     fields: dict[str, object]
     completed: str = ""  # the document prints no complete frame: how `frame` completes it (not an erratum)
+    # bytes of the frame before and after the part the document prints (`printed_span`; (0, 0): the whole frame)
+    printed_span: tuple[int, int] = (0, 0)
     position: tuple[int, int] = (1, 1)  # line and column in the spec, for errors found after resolution
+
+    @property
+    def printed_part(self) -> bytes:
+        """The bytes of the frame that the document prints."""
+        before, after = self.printed_span
+        return self.frame[before : len(self.frame) - after]
 
 
 @dataclass(frozen=True)
@@ -495,6 +555,38 @@ class Motion:
 
 
 @dataclass(frozen=True)
+class Space:
+    """A data space a device keeps: `size` items addressed 0..size-1, bits or unsigned integers, all 0 at first."""
+
+    name: str
+    item: ScalarType | None  # None: bits
+    size: int
+    access: str
+    description: str
+
+
+@dataclass(frozen=True)
+class SpaceAccess:
+    """A run of a data space from the address in the request field `start` (`count` items, for reads)."""
+
+    space: str
+    start: str
+    count: str = ""
+    value: Expr | None = None  # writes: what is stored, from the request's fields and `current`
+
+
+@dataclass(frozen=True)
+class DeviceErrors:
+    """How a device refuses a request with the protocol's error reply: the field saying why, and its values."""
+
+    field: str
+    out_of_space: int | None
+    out_of_range: int | None
+    read_only: int | None
+    unsupported: int | None = None
+
+
+@dataclass(frozen=True)
 class Behaviour:
     """What a device does with one command's request, besides answering it."""
 
@@ -512,6 +604,8 @@ class Behaviour:
     stores: dict[str, str] = field(default_factory=dict)  # request field -> state variable
     sets: dict[str, float] = field(default_factory=dict)  # state variable -> value
     absent: dict[str, float] = field(default_factory=dict)  # response values when no device has the id
+    space_reads: dict[str, SpaceAccess] = field(default_factory=dict)  # response field -> run read
+    space_writes: dict[str, SpaceAccess] = field(default_factory=dict)  # request field -> run written
     keeps: tuple[str, dict[int, tuple[str, ...]]] | None = None  # resets: request field, its value -> entries kept
     stops: tuple[str, ...] = ()  # state variables whose move stops where it is
     wraps: dict[str, float] = field(default_factory=dict)  # state variable -> period it is kept within
@@ -523,6 +617,16 @@ class Behaviour:
     carries: tuple[str, str] | None = None  # (command code field, content field) of a carried request
     carried: tuple[str, ...] = ()  # the commands it can carry (empty: every command with a code)
     nothing_held: dict[str, float] = field(default_factory=dict)  # commits: reply values when nothing is held
+
+
+@dataclass(frozen=True)
+class DeviceTimeout:
+    """The device gives up (sets state variables) when none of `kept_by` arrives for `after` ms."""
+
+    after: int
+    kept_by: tuple[str, ...]
+    sets: dict[str, float]
+    description: str = ""
 
 
 @dataclass(frozen=True)
@@ -576,12 +680,16 @@ class Device:
     id_entry: str  # the memory entry holding the device's own id
     broadcast: int | None
     state: dict[str, float]  # state variables beyond memory -> initial value
-    reply: dict[str, float]  # response field -> value when no behaviour sets it
+    reply: dict[str, float | str]  # response field -> value when no behaviour sets it
     refused: dict[str, float]  # response field -> value when a write is refused
     behaviours: tuple[Behaviour, ...]
     status: dict[str, str] = field(default_factory=dict)  # response field -> memory entry every reply reports
     kinds: tuple[DeviceKind, ...] = ()
     echo_address: bool = False  # replies carry the id the request named, not the answering device's own
+    ids: tuple[int, ...] = (0,)  # the ids the simulator serves by default
+    spaces: tuple[Space, ...] = ()
+    errors: DeviceErrors | None = None
+    timeout: DeviceTimeout | None = None
     out_of_range: dict[str, float] = field(default_factory=dict)  # response values when a value is out of range
     models: tuple[DeviceModel, ...] = ()  # the first is the default model
     moving: dict[str, tuple[str, int | None]] = field(default_factory=dict)  # entry -> (state variable, bit)
@@ -612,6 +720,7 @@ class Protocol:
     device: Device | None = None
     client_class: str = ""  # the generated client's and simulator's class names
     simulator_class: str = ""
+    error_reply: ErrorReply | None = None
 
     def messages(self) -> tuple[Message, ...]:
         return tuple(m for c in self.commands for m in c.messages())
@@ -632,8 +741,10 @@ def fixed_size(field: Field) -> int | None:
         return field.type.size
     if isinstance(field, Array):
         return field.item.size * field.count
-    if isinstance(field, Bytes):
+    if isinstance(field, Bytes | Text):
         return field.size if isinstance(field.size, int) else None
+    if isinstance(field, List):
+        return field.byte_size(field.count) if isinstance(field.count, int) else None
     if isinstance(field, Group):
         if isinstance(field.count, int) and field.item_size is not None:
             return field.count * field.item_size
@@ -672,10 +783,63 @@ def content_bounds(fields: tuple[Field, ...]) -> tuple[int, int | None]:
             counter = by_name.get(item.count)
             most = int(counter.maximum) if isinstance(counter, Scalar) else None
             high = None if high is None or most is None else high + most * item.item_size
-        elif isinstance(item, Bytes) and isinstance(item.size, str) and item.size != "rest":
+        elif isinstance(item, List) and (item.size or item.count not in ("", "rest")):
+            counter = by_name.get(item.size or str(item.count))
+            most = int(counter.maximum) if isinstance(counter, Scalar) else None
+            high = None if high is None or most is None else high + (most if item.size else item.byte_size(most))
+        elif isinstance(item, Text) and item.terminated:
+            low += 1
+            high = None
+        elif isinstance(item, Bytes | Text) and isinstance(item.size, str) and item.size != "rest":
             counter = by_name.get(item.size)
             most = int(counter.maximum) if isinstance(counter, Scalar) else None
             high = None if high is None or most is None else high + most
         else:
             high = None
     return low, high
+
+
+def byte_size_expression(item: List) -> Expr | None:
+    """The size in bytes of a list counted by a field, as an expression of that field (ceil(n / 8), n * 2)."""
+    if not isinstance(item.count, str) or item.count in ("", "rest"):
+        return None
+    count = expression.Name(item.count)
+    if item.item is None:
+        return expression.Ceil(count, expression.Const(8))
+    return count if item.item.size == 1 else expression.BinOp("*", expression.Const(item.item.size), count)
+
+
+def size_terms(fields: tuple[Field, ...]) -> tuple[int, tuple[tuple[int, int, str, int], ...]] | None:
+    """A content's size from its own leading fields, for frames that carry no length (Modbus RTU): fixed bytes
+    plus, for each part sized by an earlier field at a fixed offset, (offset, size, byte order, bytes per unit).
+    None when the size cannot be told that way (a part that takes the rest, a NUL-terminated text)."""
+    fixed = 0
+    terms: list[tuple[int, int, str, int]] = []
+    offsets: dict[str, tuple[int, Scalar]] = {}
+    offset: int | None = 0
+    for item in fields:
+        if isinstance(item, Scalar) and offset is not None:
+            offsets[item.name] = (offset, item)
+        size = fixed_size(item)
+        if size is not None:
+            fixed += size
+            offset = None if offset is None else offset + size
+            continue
+        offset = None
+        sizer: str = ""
+        factor = 1
+        if isinstance(item, List):
+            wanted = byte_size_expression(item)
+            same = next((name for name, (_, f) in offsets.items() if wanted is not None and f.value == wanted), "")
+            sizer = item.size or same
+            if not sizer and isinstance(item.count, str) and item.count not in ("", "rest") and item.item is not None:
+                sizer, factor = item.count, item.item.size
+        elif isinstance(item, Bytes | Text) and isinstance(item.size, str) and item.size != "rest":
+            sizer = item.size
+        elif isinstance(item, Group) and isinstance(item.count, str) and item.count != "rest" and item.item_size:
+            sizer, factor = item.count, item.item_size
+        if sizer not in offsets:
+            return None
+        where, scalar = offsets[sizer]
+        terms.append((where, scalar.type.size, "big" if scalar.endian == ">" else "little", factor))
+    return fixed, tuple(terms)

@@ -51,4 +51,5 @@ def resolve(located: Located) -> Protocol:
         device=ctx.device,
         client_class=ctx.client_class,
         simulator_class=ctx.simulator_class,
+        error_reply=ctx.error_reply,
     )

@@ -13,6 +13,7 @@ from serialspec.emit.common import render as common
 from serialspec.emit.common.frames import runtime_layouts
 from serialspec.emit.common.numbers import number
 from serialspec.emit.common.text import collapse
+from serialspec.spec import expression
 from serialspec.spec.model import (
     Array,
     Bytes,
@@ -25,12 +26,14 @@ from serialspec.spec.model import (
     Field,
     FrameLayout,
     Group,
+    List,
     Message,
     Protocol,
     Scalar,
     TableBlock,
     TableEntry,
     TableValue,
+    Text,
     fixed_size,
 )
 
@@ -69,6 +72,15 @@ def type_name(f: Field) -> str:
         return name
     if isinstance(f, Array):
         return f"{f.item.name}[{f.count}]"
+    if isinstance(f, List):
+        item = "bits (8 per byte, first in bit 0)" if f.item is None else f"{f.item.name} list"
+        if f.size:
+            return f"{item}, {f.size} bytes"
+        return f"{item}, up to the end" if f.count == "rest" else f"{item} × {f.count}"
+    if isinstance(f, Text):
+        if f.size is None:
+            return "text, NUL-terminated"
+        return "text (rest of content)" if f.size == "rest" else f"text ({f.size} bytes)"
     if isinstance(f, Bytes):
         size = "rest of content" if f.size == "rest" else f.size
         return f"bytes ({size})"
@@ -96,6 +108,8 @@ def range_text(f: Field) -> str:
     if isinstance(f, Scalar):
         if f.const is not None:
             return f"= {f.const:#04x}"
+        if f.value is not None:
+            return f"= {expression.show(f.value)}"
         if f.derived:
             return "derived: " + (
                 f"number of {f.derived[1]}" if f.derived[0] == "count" else f"size of each {f.derived[1]}"
@@ -104,6 +118,8 @@ def range_text(f: Field) -> str:
             return ""
         return scalar_range(f.type, f.minimum, f.maximum)
     if isinstance(f, Array):
+        return scalar_range(f.item, f.minimum, f.maximum)
+    if isinstance(f, List) and f.item is not None:
         return scalar_range(f.item, f.minimum, f.maximum)
     return ""
 
@@ -141,7 +157,7 @@ def field_rows(fields: tuple[Field, ...], start: int | None, prefix: str = "") -
         where = "" if offset is None else (str(offset) if size in (None, 1) else f"{offset}..{offset + size - 1}")
         if offset is not None and size is None:
             where = f"{offset}.."
-        unit = f.unit if isinstance(f, Scalar | Array) else ""
+        unit = f.unit if isinstance(f, Scalar | Array | List) else ""
         rows.append(Row(where, prefix + f.name, type_name(f), unit, range_text(f), meaning(f)))
         if isinstance(f, Group):
             rows += field_rows(f.fields, None, prefix + f.name + "[].")
@@ -179,7 +195,7 @@ def message_context(protocol: Protocol, message: Message | None) -> dict[str, An
         "optional": text(message.optional),
         "unsolicited": message.unsolicited,
         "answers": message.answers,
-        "reply": reply_text(message, protocol),
+        "reply": reply_text(message, protocol) or error_reply_text(protocol, message),
         "description": text(message.description),
     }
 
@@ -208,6 +224,17 @@ def reply_text(message: Message, protocol: Protocol | None = None) -> str:
     switch = message.reply_when
     when = f", sent only while `{switch.entry}` {switch.symbol} {switch.equals}" if switch else ""
     return f"answered by the `{message.answered_by}` response{when}"
+
+
+def error_reply_text(protocol: Protocol, message: Message) -> str:
+    """For the error reply: the code it is sent under, and what it carries besides its fields."""
+    error = protocol.error_reply
+    if not message.error_reply or error is None:
+        return ""
+    return (
+        f"sent instead of any request's reply, with `{error.element}` = the request's code | {error.flag:#04x} "
+        f"(the message holds the request's code as `{error.element}`)"
+    )
 
 
 def shared_reply_text(protocol: Protocol, message: Message) -> str:
@@ -547,6 +574,7 @@ def emit_docs(protocol: Protocol) -> str:
             "printed": code_span(e.printed),
             "frame": e.frame.hex(" ").upper(),
             "erratum": e.erratum,
+            "partial": e.printed_span != (0, 0),
             "completed": text(e.completed),
             "rows": breakdown(protocol, e),
         }
@@ -635,6 +663,8 @@ def emit_docs(protocol: Protocol) -> str:
         frame_picture=frame_picture(protocol),
         transparency=transparency_text(protocol),
         shared_header=protocol.framing.shared_header,
+        has_header=any(layout.header for layout in protocol.framing.layouts.values()),
+        gap=number(protocol.framing.gap) if protocol.framing.gap else "",
         checksums=checksums_context(protocol),
         matching=", ".join(protocol.matching),
         matching_description=text(protocol.matching_description),

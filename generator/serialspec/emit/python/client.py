@@ -30,6 +30,7 @@ from serialspec.spec.model import (
     Field,
     FrameElement,
     Group,
+    List,
     Message,
     Protocol,
     Scalar,
@@ -439,6 +440,12 @@ def client_module(protocol: Protocol) -> str:
             rest = [f for f in value_fields(protocol, response) if f.name not in echoes]
             if not rest:
                 kind, returns = ("bool", "bool")
+            elif len(rest) == 1 and isinstance(rest[0], List):
+                # a list comes back as a list; padding items (bits to a whole byte) are cut to the number asked
+                only = rest[0]
+                kind, returns = "value", annotation(only).replace("tuple[", "list[").replace(", ...]", "]")
+                wanted = only.count_from if any(f.name == only.count_from for f in request.fields) else ""
+                result_expr = f"list(reply.{only.name}[: request.{wanted}])" if wanted else f"list(reply.{only.name})"
             elif len(rest) == 1:
                 imports.update(type_names(rest[0]))
                 kind, returns, result_expr = "value", annotation(rest[0]), f"reply.{rest[0].name}"
@@ -526,8 +533,22 @@ def client_module(protocol: Protocol) -> str:
     everything = [*methods, *(m for g in groups.values() for m in g["methods"])]
     address, broadcast = address_of(protocol)
     class_name = protocol.client_class
+    errors = None
+    if protocol.error_reply is not None:
+        reply = protocol.command(protocol.error_reply.command).response
+        assert reply is not None
+        imports.add(reply.class_name)
+        reason = next((f.name for f in reply.fields if not (isinstance(f, Scalar) and f.hidden)), "")
+        codes = {c.name: c.code for c in protocol.commands if c.code is not None and c.request is not None}
+        errors = {
+            "response": reply.class_name,
+            "code_field": protocol.error_reply.element,
+            "reason_field": reason,
+            "codes": "{" + ", ".join(f"{name!r}: {code:#04x}" for name, code in codes.items()) + "}",
+        }
     return render(
         "client.py.j2",
+        errors=errors,
         spec_path=protocol.spec_path,
         title=one_line(protocol.title),
         package=protocol.name,
@@ -558,6 +579,7 @@ def client_module(protocol: Protocol) -> str:
             "Binding",
             "Bus",
             "ClientBase",
+            *(["ErrorReplies"] if errors else []),
             *(["check_status"] if any(m["statuses"] for m in everything) else []),
             *(["flag_names"] if status_flags(protocol) else []),
             *(["table_key"] if tables else []),

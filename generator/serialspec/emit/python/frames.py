@@ -10,17 +10,14 @@ from __future__ import annotations
 from serialspec.emit.common.frames import runtime_element
 from serialspec.emit.python.pycode import one_line
 from serialspec.spec.model import (
-    Bytes,
     Checksum,
     Command,
     Direction,
     FrameElement,
     FrameLayout,
-    Group,
     Message,
     Protocol,
-    Scalar,
-    fixed_size,
+    size_terms,
 )
 
 
@@ -95,34 +92,15 @@ def layout_lines(layout: FrameLayout) -> list[str]:
 
 
 def size_rule(message: Message) -> str | None:
-    """`SizeRule(...)` for a message whose content size follows from its fields, or None (`rest`, tables)."""
-    fixed = 0
-    offset: int | None = 0
-    offsets: dict[str, int] = {}
-    terms: list[str] = []
-    for field in message.fields:
-        size = fixed_size(field)
-        if offset is not None:
-            offsets[field.name] = offset
-        if size is not None:
-            fixed += size
-            offset = None if offset is None else offset + size
-            continue
-        counter = ""
-        factor: int | None = None
-        if isinstance(field, Bytes) and isinstance(field.size, str) and field.size != "rest":
-            counter, factor = field.size, 1
-        elif isinstance(field, Group) and isinstance(field.count, str) and field.count != "rest":
-            counter, factor = field.count, field.item_size
-        counted = next((f for f in message.fields if f.name == counter), None)
-        if factor is None or counter not in offsets or not isinstance(counted, Scalar):
-            return None
-        endian = "'big'" if counted.endian == ">" else "'little'"
-        terms.append(f"({offsets[counter]}, {counted.type.size}, {endian}, {factor})")
-        offset = None
+    """`SizeRule(...)` for a message whose content size follows from its fields (model.size_terms), or None."""
+    found = size_terms(message.fields)
+    if found is None:
+        return None
+    fixed, terms = found
     if not terms:
         return f"SizeRule({fixed})"
-    return f"SizeRule({fixed}, ({', '.join(terms)},))"
+    shown = ", ".join(f"({offset}, {size}, {endian!r}, {factor})" for offset, size, endian, factor in terms)
+    return f"SizeRule({fixed}, ({shown},))"
 
 
 def codec_lines(
@@ -145,15 +123,22 @@ def codec_lines(
     if any(layout.length is None for layout in layouts):
         rules = [(code, rule) for code, message in messages.items() if (rule := size_rule(message))]
         lines.append("    {" + ", ".join(f"{code}: {rule}" for code, rule in rules) + "},")
+    error = protocol.error_reply
+    if error is not None and direction == Direction.RESPONSE:
+        lines.append(f"    error_flag={error.flag:#04x},")
     lines.append(")")
     return lines
 
 
 def code_key(command: Command, layout: FrameLayout) -> str:
+    if any(m.error_reply for m in command.messages()):
+        return "ERROR_REPLY"  # any code with the error flag (runtime.framing)
     return "None" if command.code is None or not layout.has_command else f"{command.code:#04x}"
 
 
 def framing_imports(lines: list[str]) -> list[str]:
     """The runtime.framing names that definitions use."""
     text = "\n".join(lines)
-    return [name for name in ("Element", "FrameCodec", "Layout", "SizeRule", "Transparency") if f"{name}(" in text]
+    names = ("Element", "FrameCodec", "Layout", "SizeRule", "Transparency")
+    found = [name for name in names if f"{name}(" in text]
+    return ["ERROR_REPLY", *found] if "ERROR_REPLY" in text else found

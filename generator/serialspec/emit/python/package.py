@@ -22,7 +22,7 @@ from serialspec.emit.python.pycode import (
 )
 from serialspec.emit.python.registers import register_tables, registers_module
 from serialspec.emit.python.render import render
-from serialspec.emit.python.simulator import simulator_module
+from serialspec.emit.python.simulator import import_order, simulator_module
 from serialspec.emit.python.structs import structs_module
 from serialspec.spec.model import (
     Command,
@@ -122,6 +122,7 @@ def emit_package(protocol: Protocol) -> dict[str, str]:
             description=one_line(protocol.description),
             baudrate=protocol.serial.baudrate,
             serial=protocol.serial,
+            gap=repr(protocol.framing.gap) if protocol.framing.gap else "",
             match_by=repr(protocol.matching),
             models=[(m.number, m.name) for m in protocol.device.models] if protocol.device else [],
             model_entry=protocol.device.model_entry if protocol.device else "",
@@ -209,10 +210,17 @@ def general_codec_context(protocol: Protocol) -> dict[str, Any]:
             if len(users) == 1 and users[0][0] is not None:
                 single[key] = users[0][0]
             expected += [(m.class_name, key, target) for m, target, _, _ in users if m is not None and len(users) > 1]
+        error = None
+        if protocol.error_reply is not None and direction == Direction.RESPONSE:
+            element = next(e for e in layout.elements if e.name == protocol.error_reply.element)
+            assert element.type is not None
+            mask = (1 << (8 * element.type.size)) - 1
+            error = {"flag": f"{protocol.error_reply.flag:#04x}", "keep": f"{mask & ~protocol.error_reply.flag:#04x}"}
         directions.append(
             {
                 "name": direction.value,
                 "upper": direction.name,
+                "error": error,
                 "dispatch": dispatch,
                 "expected": expected,
                 "frames": codec_lines(protocol, direction, sizes, single),
@@ -234,7 +242,7 @@ def general_codec_context(protocol: Protocol) -> dict[str, Any]:
         "classic": False,
         "reply_layouts": reply_layouts,
         "framing_imports": sorted(
-            {"EngineFormat", *framing_imports([line for d in directions for line in d["frames"]])}, key=str.lower
+            {"EngineFormat", *framing_imports([line for d in directions for line in d["frames"]])}, key=import_order
         ),
         "checksum_imports": imports,
         "checksum_definitions": definitions,
@@ -305,7 +313,11 @@ def classic_codec_context(protocol: Protocol) -> dict[str, Any]:
 def common_codec_context(protocol: Protocol, code: PackageCode, exports: list[str]) -> dict[str, Any]:
     encoder_table = [(m.class_name, encoder_name(m)) for m in protocol.messages()]
     codec_names = names_used_in_codec(code)
+    used = "\n".join(line for _, _, _, lines in code.decoders for line in lines)
+    used += "\n".join(line for _, _, lines in code.encoders for line in lines)
+    packing = [n for n in ("decode_text", "encode_text", "pack_bits", "unpack_bits") if f"_{n}(" in used]
     return {
+        "packing_imports": packing,
         "structs": sorted(code.structs.items()),
         "tables": [
             table_context(t) for t in protocol.tables if any(uses_table(m, t.name) for m in protocol.messages())

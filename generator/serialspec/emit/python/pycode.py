@@ -9,10 +9,11 @@ from __future__ import annotations
 
 import re
 from collections.abc import Iterator
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from serialspec.emit.common.numbers import number
 from serialspec.emit.common.text import collapse
+from serialspec.spec import expression
 from serialspec.spec.model import (
     Array,
     Bytes,
@@ -20,11 +21,13 @@ from serialspec.spec.model import (
     Direction,
     FrameLayout,
     Group,
+    List,
     Message,
     Protocol,
     Scalar,
     TableBlock,
     TableValue,
+    Text,
     fixed_size,
 )
 from serialspec.spec.model import Field as SpecField
@@ -114,6 +117,12 @@ def annotation(f: SpecField) -> str:
         return "float" if f.type.is_float else "int"
     if isinstance(f, Array):
         return "tuple[float, ...]" if f.item.is_float else "tuple[int, ...]"
+    if isinstance(f, List):
+        if f.item is None:
+            return "tuple[bool, ...]"
+        return "tuple[float, ...]" if f.item.is_float else "tuple[int, ...]"
+    if isinstance(f, Text):
+        return "str"
     if isinstance(f, Bytes):
         return "bytes"
     if isinstance(f, Group):
@@ -125,7 +134,7 @@ def annotation(f: SpecField) -> str:
 
 def doc_line(f: SpecField) -> str:
     parts = [f.description or f.name]
-    if isinstance(f, Scalar | Array) and f.unit:
+    if isinstance(f, Scalar | Array | List) and f.unit:
         parts.append(f"[{f.unit}]")
     if isinstance(f, Scalar) and not f.bits and (f.minimum, f.maximum) != (f.type.minimum, f.type.maximum):
         parts.append(f"range {number(f.minimum)}..{number(f.maximum)}")
@@ -185,11 +194,17 @@ class PackageCode:
     def value_fields(self, message: Message) -> list[SpecField]:
         return [f for f in message.fields if not (isinstance(f, Scalar) and f.hidden)]
 
-    def frame_values(self, direction: Direction) -> list[Scalar]:
-        """Frame-level values (SMS id, error) every message of a direction carries, as scalar fields."""
+    def frame_values(self, direction: Direction, message: Message | None = None) -> list[Scalar]:
+        """Frame-level values (SMS id, error) every message of a direction carries, as scalar fields; an error reply
+        (Modbus exception) also carries the code of the request it refuses, named after the command element."""
         layout = self.protocol.framing.layouts[direction]
         values = []
-        for element in layout.value_elements:
+        elements = list(layout.value_elements)
+        error = self.protocol.error_reply
+        if message is not None and message.error_reply and error is not None:
+            element = next(e for e in layout.elements if e.name == error.element)
+            elements.append(replace(element, minimum=0, maximum=error.flag - 1, flags=None))
+        for element in elements:
             assert element.type is not None
             values.append(
                 Scalar(
@@ -284,8 +299,10 @@ class PackageCode:
             if f.bits:
                 return f"{expr}.to_fields()"
             return f"int({expr})" if (f.enum or f.flags) else expr
-        if isinstance(f, Array):
+        if isinstance(f, Array | List):
             return f"list({expr})"
+        if isinstance(f, Text):
+            return expr
         if isinstance(f, Bytes):
             return f"{expr}.hex(' ')"
         if isinstance(f, Group):
@@ -311,6 +328,10 @@ class PackageCode:
         if isinstance(f, Array):
             kind = "_numbers" if f.item.is_float else "_integers"
             return f"{kind}({get}, {f.name!r}, where)"
+        if isinstance(f, List):
+            return f"tuple(bool(x) for x in {get})" if f.bits else f"tuple({get})"
+        if isinstance(f, Text):
+            return f"str({get})"
         if isinstance(f, Bytes):
             return f"_bytes({get}, {f.name!r}, where)"
         if isinstance(f, Group):
@@ -325,7 +346,7 @@ class PackageCode:
     def message(self, message: Message) -> None:
         for f in [*self.frame_values(message.direction), *message.fields]:
             self.helper(f)
-        fields = [*self.frame_values(message.direction), *self.value_fields(message)]
+        fields = [*self.frame_values(message.direction, message), *self.value_fields(message)]
         doc = f"{message.command} {message.subcommand or ''} {message.direction.value}".replace("  ", " ")
         code = ClassCode(message.class_name, doc, "Message", self.attribute_lines(fields))
         code.class_vars = [
@@ -337,7 +358,7 @@ class PackageCode:
         code.to_fields = [f"{f.name!r}: {self.to_json(f, 'self.' + f.name)}," for f in fields]
         code.from_fields = [f"{self.from_json(f)}," for f in fields]
         self.message_classes.append(code)
-        frame_names = [f.name for f in self.frame_values(message.direction)]
+        frame_names = [f.name for f in self.frame_values(message.direction, message)]
         extra = "".join(f", {name}: int" for name in frame_names)
         self.decoders.append((decoder_name(message), message.class_name, extra, self.decoder(message, fields)))
         self.encoders.append((encoder_name(message), message.class_name, self.encoder(message, fields)))
@@ -368,6 +389,7 @@ class PackageCode:
         values = self.decode_fields(list(message.fields), message.class_name, lines, where, top=not exact)
         if exact and (lines[-1].startswith("o += ") or lines[-1] == "o = end"):
             lines.pop()
+        self.check_values(list(message.fields), lines, where)
         frame_fields = all_fields[: len(all_fields) - len(self.value_fields(message))]
         frame_values = [self.after_unpack(f, f.name, lines, where) or f.name for f in frame_fields]
         self.build(message.class_name, [f.name for f in all_fields], [*frame_values, *values], "m", lines)
@@ -411,6 +433,19 @@ class PackageCode:
             lines.append("if o != end:")
             lines.append(f"    raise DecodeError({where} + f': {{end - o}} bytes left after the last field')")
         return values
+
+    def check_values(self, fields: list[SpecField], lines: Lines, where: str) -> None:
+        """Every value derived by an expression must hold what the expression gives for the decoded fields."""
+        counted = {f.count: f.name for f in fields if isinstance(f, List) and isinstance(f.count, str)}
+        for f in fields:
+            if isinstance(f, Scalar) and f.value == expression.Length(counted.get(f.name, "")):
+                continue  # the count of the list it counts: decoding read exactly that many
+            if isinstance(f, Scalar) and f.value is not None:
+                expected = expression.render(f.value, self.local_named)
+                shown = one_line(expression.show(f.value)).replace("{", "{{").replace("}", "}}")
+                lines.append(f"if {self.local(f)} != {expected}:")
+                reason = f"{f.name} is {{{self.local(f)}}}, but {shown} = {{{expected}}}"
+                lines.append(f"    raise DecodeError({where} + f': {reason}')")
 
     def decode_run(self, run: list[SpecField], base: str, lines: Lines, where: str) -> list[str]:
         endian = next((f.endian for f in run if isinstance(f, Scalar | Array | TableBlock)), "<")
@@ -464,7 +499,7 @@ class PackageCode:
             lines.append(f"if {name} != {f.const}:")
             lines.append(f"    raise DecodeError({where} + f': {f.name} is {{{name}:#x}}, expected {f.const:#x}')")
             return None
-        if f.derived:
+        if f.derived or f.value is not None:
             return None
         if f.sign_magnitude:
             top = 1 << (f.type.size * 8 - 1)
@@ -494,6 +529,10 @@ class PackageCode:
         return name
 
     def decode_variable(self, f: SpecField, siblings: list[SpecField], base: str, lines: Lines, where: str) -> str:
+        if isinstance(f, List):
+            return self.decode_list(f, lines, where)
+        if isinstance(f, Text):
+            return self.decode_text(f, lines, where)
         if isinstance(f, Bytes):
             if f.size == "rest":
                 lines.append(f"{self.local(f)} = buf[o:end]")
@@ -563,6 +602,52 @@ class PackageCode:
         lines.append(f"{value} = tuple({value}_list)")
         return value
 
+    def decode_list(self, f: List, lines: Lines, where: str) -> str:
+        """A list of numbers or bits: its count from a number, a count field, a byte-size field, or the rest."""
+        value = self.local(f)
+        item = 1 if f.item is None else f.item.size
+        if f.size or f.count == "rest":
+            lines.append(f"nb = {self.local_named(f.size)}" if f.size else "nb = end - o")
+            if f.item is None:
+                lines.append("n = nb * 8")
+            else:
+                if item > 1:
+                    lines.append(f"if nb % {item}:")
+                    reason = f"{{nb}} bytes do not split into {f.name} items of {item}"
+                    lines.append(f"    raise DecodeError({where} + f': {reason}')")
+                lines.append(f"n = nb // {item}" if item > 1 else "n = nb")
+        else:
+            lines.append(f"n = {f.count if isinstance(f.count, int) else self.local_named(str(f.count))}")
+            lines.append("nb = (n + 7) >> 3" if f.item is None else (f"nb = n * {item}" if item > 1 else "nb = n"))
+        lines.append("if end - o < nb:")
+        lines.append(f"    raise DecodeError({where} + f': {f.name} needs {{nb}} bytes, {{end - o}} left')")
+        if f.item is None:
+            lines.append(f"{value} = _unpack_bits(buf, o, n)")
+        else:
+            lines.append(f"{value} = struct.unpack_from(f'{f.endian}{{n}}{f.item.struct_char}', buf, o)")
+        lines.append("o += nb")
+        return value
+
+    def decode_text(self, f: Text, lines: Lines, where: str) -> str:
+        value = self.local(f)
+        if f.size is None:
+            lines.append("stop = buf.find(b'\\0', o, end)")
+            lines.append("if stop < 0:")
+            lines.append(f"    raise DecodeError({where} + ': {f.name} has no NUL at its end')")
+            lines.append(f"{value} = _decode_text(buf[o:stop], {f.name!r}, {where})")
+            lines.append("o = stop + 1")
+            return value
+        if f.size == "rest":
+            lines.append(f"{value} = _decode_text(buf[o:end], {f.name!r}, {where})")
+            lines.append("o = end")
+            return value
+        size = str(f.size) if isinstance(f.size, int) else self.local_named(f.size)
+        lines.append(f"if end - o < {size}:")
+        lines.append(f"    raise DecodeError({where} + f': {f.name} needs {{{size}}} bytes, {{end - o}} left')")
+        lines.append(f"{value} = _decode_text(buf[o : o + {size}], {f.name!r}, {where})")
+        lines.append(f"o += {size}")
+        return value
+
     def local_named(self, name: str) -> str:
         return f"v_{name}"
 
@@ -579,10 +664,14 @@ class PackageCode:
         layout = self.protocol.framing.layouts[message.direction]
         elements = {e.name: e for e in layout.value_elements}
         frame_values = []
+        error = self.protocol.error_reply if message.error_reply else None
         for f in frame_fields:
             assert isinstance(f, Scalar)
             if f.bits:
                 frame_values.append(self.wire_value(f, "m", [], lines, where))
+                continue
+            if error is not None and f.name == error.element:  # the refused request's code: sent with the flag
+                self.check_scalar(f, f"m.{f.name}", lines, where)
                 continue
             self.check_scalar(f, f"m.{f.name}", lines, where, also=elements[f.name].broadcast)
             frame_values.append(f"m.{f.name}")
@@ -593,6 +682,8 @@ class PackageCode:
             parts = self.encode_fields(fields, message.class_name, "m", lines, where)
             content = parts[0] if len(parts) == 1 else f"b''.join(({', '.join(parts)},))" if parts else "b''"
             code = f"{command_code:#04x}" if command_code is not None and layout.has_command else "None"
+            if error is not None:
+                code = f"m.{error.element} | {error.flag:#04x}"
             values = f"({frame_values[0]},)" if len(frame_values) == 1 else f"({', '.join(frame_values)})"
             lines.append(f"return _{message.direction.name}_FRAMES.wrap({content}, {code}, {values})")
             return lines
@@ -702,9 +793,38 @@ class PackageCode:
                 parts.append(self.encode_variable(item, obj, lines, where))
         return parts
 
+    def derived_source(self, f: Scalar, obj: str, siblings: list[SpecField]) -> str:
+        """Python source of a derived value (by `value:` expression, or a count or size of a list or text)."""
+        by_name = {s.name: s for s in siblings}
+        if f.value is not None:
+
+            def source(name: str) -> str:
+                other = by_name[name]
+                if isinstance(other, Scalar) and (other.value is not None or other.derived):
+                    return f"({self.derived_source(other, obj, siblings)})"
+                return f"{obj}.{name}"
+
+            return expression.render(f.value, source)
+        kind, target = f.derived[0], f.derived[1]
+        other = by_name.get(target)
+        if kind == "size" and isinstance(other, List):
+            count = f"len({obj}.{target})"
+            return f"(({count} + 7) >> 3)" if other.item is None else f"{count} * {other.item.size}"
+        if kind == "size" and isinstance(other, Text):
+            return f"len({obj}.{target}.encode('utf-8'))"
+        return f"len({obj}.{target})"
+
     def wire_value(self, f: Scalar, obj: str, siblings: list[SpecField], lines: Lines, where: str) -> str:
         if f.const is not None:
             return number(f.const)
+        if f.value is not None or (f.derived and isinstance(self.sibling(siblings, f.derived[1]), List | Text)):
+            value = self.local(f) if obj == "m" else f"{obj}_{f.name}"
+            lines.append(f"{value} = {self.derived_source(f, obj, siblings)}")
+            lines.append(f"if not {number(f.minimum)} <= {value} <= {number(f.maximum)}:")
+            lines.append(
+                f"    raise out_of_range({where}, {f.name!r}, {value}, {number(f.minimum)}, {number(f.maximum)})"
+            )
+            return value
         if f.derived:
             kind, target = f.derived[0], f.derived[1]
             if kind == "count" or any(s.name == target for s in siblings):  # a count, or bytes beside their size
@@ -736,6 +856,10 @@ class PackageCode:
             top = 1 << (f.type.size * 8 - 1)
             return f"(-{expr} | {top:#x} if {expr} < 0 else {expr})"
         return expr
+
+    @staticmethod
+    def sibling(siblings: list[SpecField], name: str) -> SpecField | None:
+        return next((s for s in siblings if s.name == name), None)
 
     def encode_run(
         self, run: list[SpecField], base: str, obj: str, siblings: list[SpecField], lines: Lines, where: str
@@ -784,6 +908,28 @@ class PackageCode:
 
     def encode_variable(self, f: SpecField, obj: str, lines: Lines, where: str) -> str:
         expr = f"{obj}.{f.name}"
+        if isinstance(f, List):
+            if isinstance(f.count, int):
+                lines.append(f"if len({expr}) != {f.count}:")
+                lines.append(
+                    f"    raise EncodeError({where} + f': {f.name} needs {f.count} items, got {{len({expr})}}')"
+                )
+            if f.item is None:
+                return f"_pack_bits({expr}, {f.name!r}, {where})"
+            lines.append(f"if any(not {number(f.minimum)} <= x <= {number(f.maximum)} for x in {expr}):")
+            lines.append(
+                f"    raise out_of_range({where}, {f.name!r}, {expr}, {number(f.minimum)}, {number(f.maximum)})"
+            )
+            return f"struct.pack(f'{f.endian}{{len({expr})}}{f.item.struct_char}', *{expr})"
+        if isinstance(f, Text):
+            data = f"_encode_text({expr}, {f.name!r}, {where}, {f.size is None})"
+            if isinstance(f.size, int):
+                lines.append(f"{self.local(f)} = {data}")
+                lines.append(f"if len({self.local(f)}) != {f.size}:")
+                reason = f"{f.name} needs {f.size} bytes of UTF-8, got {{len({self.local(f)})}}"
+                lines.append(f"    raise EncodeError({where} + f': {reason}')")
+                return self.local(f)
+            return data
         if isinstance(f, Bytes):
             return f"bytes({expr})"
         if isinstance(f, TableValue):

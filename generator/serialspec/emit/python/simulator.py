@@ -9,12 +9,16 @@ from serialspec.emit.common.pairing import request_response_pairs
 from serialspec.emit.python.pycode import one_line
 from serialspec.emit.python.registers import map_name, register_tables
 from serialspec.emit.python.render import render
+from serialspec.spec import expression
 from serialspec.spec.model import (
     Bytes,
     DeviceModel,
     Group,
+    List,
     Message,
     Protocol,
+    Scalar,
+    SpaceAccess,
     TableBlock,
     TableValue,
     reply_condition,
@@ -73,6 +77,58 @@ def table_fields(*messages: Message | None) -> dict[str, tuple[str, ...]]:
     return found
 
 
+def limits(request: Message) -> dict[str, tuple[float, float, tuple[int, ...]]]:
+    """The request values a device checks before it acts (Modbus: quantities, coil values): every scalar whose
+    range is narrower than its type's or that has an enum, and the number of items of a list whose count field
+    has a range."""
+    found: dict[str, tuple[float, float, tuple[int, ...]]] = {}
+    counted = {f.count: f.name for f in request.fields if isinstance(f, List) and isinstance(f.count, str)}
+    for f in request.fields:
+        if not isinstance(f, Scalar) or f.const is not None or f.bits:
+            continue
+        narrower = (f.minimum, f.maximum) != (f.type.minimum, f.type.maximum)
+        if f.hidden and f.name in counted and narrower:
+            found[counted[f.name]] = (f.minimum, f.maximum, ())
+        elif not f.hidden and (narrower or f.enum):
+            allowed = tuple(v.value for v in f.enum.values) if f.enum else ()
+            found[f.name] = (f.minimum, f.maximum, allowed)
+    return found
+
+
+def report_source(text: str) -> str:
+    """A reported state variable by name, or a conversion of state variables as a function of `get`."""
+    parsed = expression.parse(text)
+    if isinstance(parsed, expression.Name):
+        return repr(parsed.name)
+    return f"lambda get: {expression.render(parsed, lambda n: f'get({n!r})')}"
+
+
+def derived_values(request: Message, response: Message | None) -> dict[str, str]:
+    """Request values its message does not hold (derived counts), for a reply to echo: name -> a function of the
+    request's fields (and the values derived before it)."""
+    if response is None:
+        return {}
+    found = {}
+    for f in request.fields:  # in order: a value may use one derived before it
+        if not isinstance(f, Scalar) or f.const is not None:
+            continue
+        if f.value is not None:
+            found[f.name] = f"lambda fields: {expression.render(f.value, lambda n: f'fields[{n!r}]')}"
+        elif f.derived and f.derived[0] == "count":
+            found[f.name] = f"lambda fields: len(fields[{f.derived[1]!r}])"
+    return found
+
+
+def run_spec(run: SpaceAccess) -> str:
+    args = [repr(run.space), repr(run.start)]
+    if run.count:
+        args.append(f"count={run.count!r}")
+    if run.value is not None:
+        body = expression.render(run.value, lambda n: "current" if n == "current" else f"fields[{n!r}]")
+        args.append(f"value=lambda current, fields: {body}")
+    return f"RunSpec({', '.join(args)})"
+
+
 def import_order(name: str) -> tuple[int, str]:
     """The order ruff's isort gives names in one `from` import: constants, classes, others; case-insensitive."""
     return (0 if name.isupper() else 1 if name[:1].isupper() else 2, name.lower())
@@ -117,7 +173,9 @@ def simulator_module(protocol: Protocol) -> str:
             if behaviour.keeps:
                 args.append(f"keeps={behaviour.keeps!r}")
             if behaviour.reports:
-                args.append(f"reports={behaviour.reports!r}")
+                args.append(
+                    f"reports={{{', '.join(f'{k!r}: {report_source(v)}' for k, v in behaviour.reports.items())}}}"
+                )
             if behaviour.moves:
                 m = behaviour.moves
                 args.append(f"moves={(m.state, m.target, m.duration, m.speed)!r}")
@@ -132,6 +190,20 @@ def simulator_module(protocol: Protocol) -> str:
             for name in BEHAVIOUR_ARGUMENTS:
                 if getattr(behaviour, name):
                     args.append(f"{name}={getattr(behaviour, name)!r}")
+            for name in ("space_reads", "space_writes"):
+                runs = getattr(behaviour, name)
+                if runs:
+                    args.append(f"{name}={{{', '.join(f'{k!r}: {run_spec(r)}' for k, r in runs.items())}}}")
+        derived = derived_values(request, response)
+        if derived:
+            args.append(f"derived={{{', '.join(f'{k!r}: {v}' for k, v in derived.items())}}}")
+        if device.errors is not None:
+            code = protocol.command(request.command).code
+            args.append(f"code={code!r}")
+            checked = limits(request)
+            if checked:
+                shown = ", ".join(f"{k!r}: ({number(lo)}, {number(hi)}, {v!r})" for k, (lo, hi, v) in checked.items())
+                args.append(f"limits={{{shown}}}")
         condition = reply_condition(request, response)
         if response and condition:
             args.append(f"optional_when=({condition.entry!r}, {condition.equals}, {condition.op!r})")
@@ -141,8 +213,44 @@ def simulator_module(protocol: Protocol) -> str:
         if tables:
             args.append(f"tables={tables!r}")
         commands.append({"key": request.key, "args": args})
+    spaces = [
+        f"SpaceSpec({s.name!r}, {s.size}, {s.item is None}, {1 if s.item is None else int(s.item.maximum)}, "
+        f"{s.access!r}),"
+        for s in device.spaces
+    ]
+    error = ""
+    if device.errors is not None and protocol.error_reply is not None:
+        reply = protocol.command(protocol.error_reply.command).response
+        assert reply is not None
+        imports.add(reply.class_name)
+        e = device.errors
+        unwrap = f", unsupported={e.unsupported!r}, unwrap=_unwrap_request" if e.unsupported is not None else ""
+        error = (
+            f"ErrorSpec({reply.class_name}, {protocol.error_reply.element!r}, {e.field!r}, "
+            f"out_of_space={e.out_of_space!r}, out_of_range={e.out_of_range!r}, read_only={e.read_only!r}{unwrap})"
+        )
+    runtime = ["CommandSpec", "DeviceSpec"]
+    runtime += ["EntrySpec"] if entries else []
+    runtime += ["ErrorSpec"] if error else []
+    runtime += ["KindSpec"] if device.kinds else []
+    runtime += ["ModelSpec"] if device.models else []
+    runtime += ["RunSpec"] if any(b.space_reads or b.space_writes for b in device.behaviours) else []
+    runtime += ["Simulator"]
+    runtime += ["SpaceSpec"] if spaces else []
+    runtime += ["TimeoutSpec"] if device.timeout else []
+    timeout = ""
+    if device.timeout is not None:
+        kept = [protocol.command(name).request for name in device.timeout.kept_by]
+        classes = ", ".join(m.class_name for m in kept if m is not None)
+        imports.update(m.class_name for m in kept if m is not None)
+        timeout = f"TimeoutSpec({device.timeout.after / 1000!r}, ({classes},), {device.timeout.sets!r})"
     return render(
         "simulator.py.j2",
+        runtime_imports=", ".join(runtime),
+        spaces=spaces,
+        error=error,
+        unwrap="unwrap=_unwrap_request" in error,
+        timeout=timeout,
         spec_path=protocol.spec_path,
         title=one_line(protocol.title),
         package=protocol.name,
@@ -165,7 +273,7 @@ def simulator_module(protocol: Protocol) -> str:
         carried=carried_requests(protocol),
         kinds=[f"KindSpec({k.name!r}, {k.address!r}, {k.ids!r}, {k.broadcast!r}, {k.state!r})," for k in device.kinds],
         imports=sorted(imports | {"Direction"}, key=import_order),
-        default_id=0,
+        default_ids=repr(device.ids) if len(device.ids) > 1 else f"({device.ids[0]},)",
         model_names=", ".join(m.name for m in device.models),
         default_model=device.models[0].name if device.models else "",
     )

@@ -8,6 +8,7 @@ from __future__ import annotations
 from serialspec.emit.python.frames import checksum_definitions, codec_lines, framing_imports
 from serialspec.emit.python.pycode import one_line
 from serialspec.emit.python.render import render
+from serialspec.spec import expression
 from serialspec.spec.model import (
     Array,
     Bytes,
@@ -15,11 +16,13 @@ from serialspec.spec.model import (
     Field,
     FrameLayout,
     Group,
+    List,
     Protocol,
     Scalar,
     ScalarType,
     TableBlock,
     TableValue,
+    Text,
 )
 
 _INT = {1: "Int8", 2: "Int16", 4: "Int32"}
@@ -39,6 +42,8 @@ def field_expr(f: Field, parent: str = "this") -> str:
         base = primitive(f.type, f.endian)
         if f.const is not None:
             return f"Const({f.const}, {base})"
+        if f.value is not None:
+            return f"Rebuild({base}, lambda ctx: {expression.render(f.value, lambda name: f'ctx[{name!r}]')})"
         if f.derived:
             kind, target = f.derived[0], f.derived[1]
             if kind == "count":
@@ -52,6 +57,14 @@ def field_expr(f: Field, parent: str = "this") -> str:
         return base
     if isinstance(f, Array):
         return f"Array({f.count}, {primitive(f.item, f.endian)})"
+    if isinstance(f, List):
+        return list_expr(f)
+    if isinstance(f, Text):
+        if f.size is None:
+            return "CString('utf8')"
+        if f.size == "rest":
+            return "Utf8(GreedyBytes)"
+        return f"Utf8(Bytes({f.size if isinstance(f.size, int) else 'this.' + f.size}))"
     if isinstance(f, Bytes):
         if f.size == "rest":
             return "GreedyBytes"
@@ -77,6 +90,23 @@ def field_expr(f: Field, parent: str = "this") -> str:
         return f"Switch(this.{f.key}, {f.table.value_constant})"
     assert isinstance(f, TableBlock)
     return f.struct_name
+
+
+def list_expr(f: List) -> str:
+    """An array whose count varies, or packed bits."""
+    count = f"this.{f.count}" if isinstance(f.count, str) and f.count not in ("", "rest") else f.count
+    if f.item is None:
+        if f.size:
+            return f"PackedBits(Bytes(this.{f.size}))"
+        if f.count == "rest":
+            return "PackedBits(GreedyBytes)"
+        return f"PackedBits(Bytes(({count} + 7) // 8), {count})"
+    item = primitive(f.item, f.endian)
+    if f.size:
+        return f"Array(this.{f.size} // {f.item.size}, {item})"
+    if f.count == "rest":
+        return f"GreedyRange({item})"
+    return f"Array({count}, {item})"
 
 
 def bits_expr(f: Scalar) -> str:

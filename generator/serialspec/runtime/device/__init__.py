@@ -23,6 +23,11 @@ pseudo-terminal) and is the same for every protocol:
 - further `kinds` of device (a board's PWM servo ports, its motors) have their own ids, address field and state;
   a command names its kind; a request for an id no device has is answered with `absent` values if the command
   gives them (a board answering for a servo that is not there), else not at all;
+- data `spaces` (Modbus coils and registers): runs of items read into a response field or written from a request
+  field; a request whose values the device does not accept (`limits`), whose run reaches beyond its space, or
+  that writes a read-only space gets the protocol's error reply (Modbus exceptions 3 and 2);
+- a `timeout`: a device that has had none of its keep-alive requests for a while sets state variables (VESC
+  releases its motor when setpoints stop coming);
 - `emit()` sends a message on the device's own initiative (reports, key events) for tests.
 """
 
@@ -31,8 +36,12 @@ from serialspec.runtime.device.engine import (
     DeviceSpec,
     Engine,
     EntrySpec,
+    ErrorSpec,
     KindSpec,
     ModelSpec,
+    RunSpec,
+    SpaceSpec,
+    TimeoutSpec,
     VirtualDevice,
 )
 from serialspec.runtime.device.faults import FAULTS, Fault
@@ -44,9 +53,13 @@ __all__ = [
     "DeviceSpec",
     "Engine",
     "EntrySpec",
+    "ErrorSpec",
     "Fault",
     "KindSpec",
     "ModelSpec",
+    "RunSpec",
     "Simulator",
+    "SpaceSpec",
+    "TimeoutSpec",
     "VirtualDevice",
 ]

@@ -34,6 +34,45 @@ class EntrySpec:
 
 
 @dataclass(frozen=True)
+class SpaceSpec:
+    """A data space: `size` items (bits, or unsigned integers up to `maximum`) addressed 0..size-1, all 0 at first."""
+
+    name: str
+    size: int
+    bits: bool
+    maximum: int
+    access: str = "rw"
+
+
+@dataclass(frozen=True)
+class RunSpec:
+    """A run of a data space from the address in the request field `start`; `count` items for reads; for writes,
+    `value(current, fields)` computes what is stored (default: the request field's value)."""
+
+    space: str
+    start: str
+    count: str = ""
+    value: Callable[[int, dict[str, Any]], int] | None = None
+
+
+@dataclass(frozen=True)
+class ErrorSpec:
+    """The protocol's error reply: its class, the member holding the refused request's code, the member saying why
+    and the reasons' values (Modbus: function | 0x80, exception_code 2 / 3)."""
+
+    response: type[Message]
+    code_field: str
+    field: str
+    out_of_space: int | None = None
+    out_of_range: int | None = None
+    read_only: int | None = None
+    unsupported: int | None = None  # a request whose code no command has (Modbus exception 1)
+    # unwrap(frame) -> (code, frame values) of a whole request frame whose checksum verifies (the frame engine's),
+    # for requests the codec cannot decode because their code is unknown
+    unwrap: Callable[[bytes], tuple[int | None, tuple[int, ...]]] | None = None
+
+
+@dataclass(frozen=True)
 class CommandSpec:
     """What a device does with one request type."""
 
@@ -43,7 +82,8 @@ class CommandSpec:
     writes: tuple[str, ...] = ()
     resets: bool = False
     keeps: tuple[str, dict[int, tuple[str, ...]]] | None = None  # resets: request field, its value -> entries kept
-    reports: dict[str, str] = field(default_factory=dict)
+    # response field -> the state variable or memory entry it reports, or a function of `get` (a unit conversion)
+    reports: dict[str, str | Callable[[Callable[[str], float]], float]] = field(default_factory=dict)
     moves: tuple[str, str, str, str] | None = None  # state, target field, duration field (ms), speed field (/s)
     broadcast_reply: bool = False
     optional_when: tuple[str, int, str] | None = None  # (memory entry, value, comparison): when it is sent
@@ -59,6 +99,14 @@ class CommandSpec:
     absent: dict[str, float] = field(default_factory=dict)  # response values when no device has the id
     buffered: bool = False  # the writes wait for a command that commits (REG WRITE)
     commits: bool = False  # carries out the buffered writes (ACTION)
+    code: int | None = None  # the request's code, for an error reply that refuses it
+    # request value -> (lowest, highest, allowed values or ()) the device accepts; for a list, its number of items
+    limits: dict[str, tuple[float, float, tuple[int, ...]]] = field(default_factory=dict)
+    space_reads: dict[str, RunSpec] = field(default_factory=dict)  # response field -> run of a data space
+    space_writes: dict[str, RunSpec] = field(default_factory=dict)  # request field -> run of a data space
+    # values a request carries that its message does not hold (counts, byte counts), from its fields: a reply
+    # field of the same name echoes them like any other request field
+    derived: dict[str, Callable[[dict[str, Any]], int]] = field(default_factory=dict)
     nothing_held: dict[str, float] = field(default_factory=dict)  # commits: reply values when nothing is held
     ramp: tuple[str, str] | None = None  # request fields: acceleration and deceleration time (ms) of the move
     stops: tuple[str, ...] = ()  # state variables whose move stops where it is
@@ -83,6 +131,16 @@ class KindSpec:
 
 
 @dataclass(frozen=True)
+class TimeoutSpec:
+    """The device sets `sets` once none of the `kept_by` requests has come for `after` seconds (VESC releases the
+    motor); checked whenever a request arrives, and by Engine.tick()."""
+
+    after: float
+    kept_by: tuple[type[Message], ...]
+    sets: dict[str, float]
+
+
+@dataclass(frozen=True)
 class ModelSpec:
     """One device model: its factory values and the ranges where they differ from the table's."""
 
@@ -100,13 +158,16 @@ class DeviceSpec:
     broadcast: int | None
     entries: tuple[EntrySpec, ...]
     state: dict[str, float]
-    reply: dict[str, float]
+    reply: dict[str, Any]
     refused: dict[str, float]
     commands: tuple[CommandSpec, ...]
     kinds: tuple[KindSpec, ...] = ()
     echo_address: bool = False  # replies carry the id the request named, not the answering device's own
     registers: RegisterMap | None = None  # memory as registers at byte addresses, for run reads/writes
     status: dict[str, str] = field(default_factory=dict)  # response field -> memory entry every reply reports
+    spaces: tuple[SpaceSpec, ...] = ()
+    error: ErrorSpec | None = None
+    timeout: TimeoutSpec | None = None
     out_of_range: dict[str, float] = field(default_factory=dict)  # reply values for an out-of-range write
     models: tuple[ModelSpec, ...] = ()  # the first is the default model
     moving: dict[str, tuple[str, int | None]] = field(default_factory=dict)  # entry -> (state variable, bit)
@@ -166,10 +227,12 @@ class VirtualDevice:
         device_id: int,
         clock: Callable[[], float] = time.monotonic,
         model: ModelSpec | None = None,
+        sizes: dict[str, int] | None = None,
     ) -> None:
         self.spec = spec
         self.clock = clock
         self.model = model
+        self.spaces: dict[str, list[int]] = {s.name: [0] * (sizes or {}).get(s.name, s.size) for s in spec.spaces}
         values = model.values if model else {}
         ranges = model.ranges if model else {}
         # The model's factory values and ranges replace the table's where it gives them.
@@ -184,6 +247,8 @@ class VirtualDevice:
         self.state: dict[str, float] = {k: values.get(k, v) for k, v in spec.state.items()}
         self.motions: dict[str, _Motion] = {}
         self.buffered: list[tuple[CommandSpec, str, dict[str, Any]]] = []  # writes held until a commit
+        self.kept = clock()  # when a request last restarted the timeout
+        self.timed_out = False
         self.held: list[tuple[CommandSpec, Message, dict[str, Any]]] = []  # requests held until a release
         self.reset()
         self.id = device_id
@@ -255,12 +320,18 @@ class Engine(FaultInjection):
         parser: Callable[[], StreamParser],
         clock: Callable[[], float] = time.monotonic,
         model: str | Mapping[int, str] | None = None,
+        sizes: dict[str, int] | None = None,
     ) -> None:
         """`model`: the model of every device (a name of `spec.models`), or id -> name (others: the default)."""
         self.spec = spec
         self.encode = encode
         self.clock = clock
         self.parser = parser()
+        self._new_parser = parser
+        unknown_spaces = set(sizes or {}) - {s.name for s in spec.spaces}
+        if unknown_spaces:
+            known = ", ".join(s.name for s in spec.spaces) or "none"
+            raise ValueError(f"unknown data space(s) {', '.join(sorted(unknown_spaces))} (this device has: {known})")
         ids = list(ids)
         per_id: Mapping[int, str] = model if isinstance(model, Mapping) else {}
         every = None if isinstance(model, Mapping) else model
@@ -268,7 +339,7 @@ class Engine(FaultInjection):
         if unknown:
             raise ValueError(f"a model is given for id {min(unknown)}, which is not on the bus")
         self.devices: dict[int, VirtualDevice] = {
-            i: VirtualDevice(spec, i, clock, spec.model(per_id.get(i, every))) for i in ids
+            i: VirtualDevice(spec, i, clock, spec.model(per_id.get(i, every)), sizes) for i in ids
         }
         # Each further kind: its devices, built from a DeviceSpec holding that kind's address and state.
         self.kinds: dict[str, dict[int, VirtualDevice]] = {}
@@ -291,7 +362,13 @@ class Engine(FaultInjection):
         """Handle request bytes; returns (send time, bytes) for every reply they cause, faults applied."""
         out: list[tuple[float, bytes]] = []
         with self._lock:
-            for request in self.parser.feed(data):
+            requests = self.parser.feed(data)
+            if not requests:
+                refused = self._unsupported(data)
+                if refused:
+                    self.parser = self._new_parser()  # the bytes were that frame: nothing of them is pending
+                out.extend(refused)
+            for request in requests:
                 self.log.append(request)
                 # Answering as another id changes what the reply says, so it applies while the reply is built.
                 if self.faults and self.faults[0].kind == "other_id":
@@ -306,7 +383,25 @@ class Engine(FaultInjection):
                     out.extend([(when, frame)] if answered_as is not None else self._spoil(when, frame))
         return out
 
+    def tick(self) -> None:
+        """Let the timeout of every device expire that is due (requests do this too, as they arrive)."""
+        timeout = self.spec.timeout
+        if timeout is None:
+            return
+        now = self.clock()
+        for device in self.devices.values():
+            if not device.timed_out and now - device.kept > timeout.after:
+                device.timed_out = True
+                for name, value in timeout.sets.items():
+                    device.set(name, value)
+
     def handle(self, request: Message) -> list[tuple[float, bytes]]:
+        timeout = self.spec.timeout
+        if timeout is not None:
+            self.tick()
+            if isinstance(request, timeout.kept_by):
+                for device in self.devices.values():
+                    device.kept, device.timed_out = self.clock(), False
         command = self.commands.get(type(request))
         if command is None:
             return []
@@ -387,6 +482,14 @@ class Engine(FaultInjection):
             if not any(given.get(name) == value for name, value in command.cancel_when.items()):
                 for waiting_command, waiting_request, waiting_given in waiting:
                     self.act(device, waiting_command, waiting_request, waiting_given)
+        if command.derived:
+            given = dict(given)
+            for name, derive in command.derived.items():
+                given[name] = derive(given)
+        if command.limits or command.space_reads or command.space_writes:
+            refusal = self._refusal(device, command, given)
+            if refusal is not None:
+                return self._error_reply(device, command, refusal)
         refused = ""
         # Whether an optional reply is due is decided on the switch as the request finds it (a write that turns
         # replies off is still answered), which is also what a client that remembers the switch expects.
@@ -408,6 +511,8 @@ class Engine(FaultInjection):
             buffered, device.buffered = device.buffered, []
             for held_command, name, held in buffered:
                 self._write(device, held_command, name, held, written)
+        for name, run in command.space_writes.items():
+            self._write_space(device, run, given[name], given)
         if command.moves and (not command.move_enabled_by or device.get(command.move_enabled_by)):
             self._move(device, command.moves, given, written, command.ramp, command.speed_scale)
         for name, state in command.stores.items():
@@ -432,13 +537,16 @@ class Engine(FaultInjection):
         values: dict[str, Any] = {}
         for attribute in dataclasses.fields(command.response):  # type: ignore[arg-type]
             name = attribute.name
-            if name in command.reads:
+            if name in command.space_reads:
+                values[name] = self._read_space(device, command.space_reads[name], given)
+            elif name in command.reads:
                 value = self._read(device, command, name, given)
                 if value is None:
                     return None  # an unknown key: a device stays silent
                 values[name] = value
             elif name in command.reports:
-                values[name] = device.get(command.reports[name])
+                source = command.reports[name]
+                values[name] = source(device.get) if callable(source) else device.get(source)
             elif name in command.counts:
                 state, per = command.counts[name]
                 values[name] = int(device.get(state) / per)
@@ -463,6 +571,76 @@ class Engine(FaultInjection):
         elif refused:
             nest(values, self.spec.out_of_range if refused == "range" and self.spec.out_of_range else self.spec.refused)
         return self._encode_reply(command.response, values)
+
+    # --- data spaces and error replies ------------------------------------------------------------------------------
+
+    def _refusal(self, device: VirtualDevice, command: CommandSpec, given: dict[str, Any]) -> int | None:
+        """Why the device refuses a request (the error reply's reason), or None: values outside what the device
+        accepts first, then runs beyond their data space, then writes to a read-only space."""
+        error = self.spec.error
+        if error is None:
+            return None
+        for name, (low, high, allowed) in command.limits.items():
+            value = given.get(name)
+            value = len(value) if isinstance(value, list | tuple) else value
+            if isinstance(value, int | float) and (not low <= value <= high or (allowed and value not in allowed)):
+                return error.out_of_range
+        spaces = {s.name: s for s in self.spec.spaces}
+        runs = [(run, int(given[run.count]) if run.count else 1) for run in command.space_reads.values()]
+        runs += [(run, _items(given[name])) for name, run in command.space_writes.items()]
+        for run, count in runs:
+            start = int(given[run.start])
+            if start + count > len(device.spaces[run.space]):
+                return error.out_of_space
+        for run in command.space_writes.values():
+            if spaces[run.space].access == "r":
+                return error.read_only
+        return None
+
+    def _unsupported(self, data: bytes) -> list[tuple[float, bytes]]:
+        """Bytes that arrived together and that the parser took for no frame: if they are one whole request whose
+        checksum verifies but whose code no command has, the addressed device refuses it (Modbus exception 1)."""
+        error = self.spec.error
+        if error is None or error.unsupported is None or error.unwrap is None:
+            return []
+        try:
+            code, values = error.unwrap(data)
+        except ValueError:  # DecodeError: not a whole frame
+            return []
+        known = {c.code for c in self.spec.commands}
+        if code is None or code in known:
+            return []
+        device = self.devices.get(values[0]) if self.spec.address and values else None
+        if device is None:
+            return []  # another device's, or broadcast: no reply
+        refusal = CommandSpec(error.response, None, code=code)
+        frame = self._error_reply(device, refusal, error.unsupported)
+        return [] if frame is None else self._spoil(self.clock(), frame)
+
+    def _error_reply(self, device: VirtualDevice, command: CommandSpec, reason: int | None) -> bytes | None:
+        error = self.spec.error
+        if error is None or reason is None:
+            return None
+        values = {error.code_field: command.code or 0, error.field: reason}
+        if self.spec.address:
+            values[self.spec.address] = device.id
+        return self._encode_reply(error.response, values)
+
+    def _read_space(self, device: VirtualDevice, run: RunSpec, given: dict[str, Any]) -> list[Any]:
+        start = int(given[run.start])
+        items = device.spaces[run.space][start : start + (int(given[run.count]) if run.count else 1)]
+        space = next(s for s in self.spec.spaces if s.name == run.space)
+        return [bool(v) for v in items] if space.bits else list(items)
+
+    def _write_space(self, device: VirtualDevice, run: RunSpec, value: Any, given: dict[str, Any]) -> None:
+        space = next(s for s in self.spec.spaces if s.name == run.space)
+        items = device.spaces[run.space]
+        start = int(given[run.start])
+        values = list(value) if isinstance(value, list | tuple) else [value]
+        for offset, item in enumerate(values):
+            current = items[start + offset]
+            stored = run.value(current, given) if run.value is not None else int(item)
+            items[start + offset] = (1 if stored else 0) if space.bits else stored & space.maximum
 
     def _move(
         self,
@@ -572,6 +750,11 @@ class Engine(FaultInjection):
             return "" if ok else "range"
         device.set(name, given[name])
         return ""
+
+
+def _items(value: Any) -> int:
+    """How many items of a data space a written value covers: a list's length, else one."""
+    return len(value) if isinstance(value, list | tuple) else 1
 
 
 def nest(values: dict[str, Any], overlay: dict[str, Any]) -> None:

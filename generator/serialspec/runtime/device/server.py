@@ -34,10 +34,13 @@ class Simulator(Engine):
         *,
         encode: Callable[[Message], bytes],
         parser: Callable[[], StreamParser],
-        clock: Callable[[], float] = time.monotonic,
+        clock: Callable[[], float] | None = None,
         model: str | Mapping[int, str] | None = None,
+        sizes: dict[str, int] | None = None,
     ) -> None:
-        super().__init__(spec, ids, encode=encode, parser=parser, clock=clock, model=model)
+        super().__init__(
+            spec, ids, encode=encode, parser=parser, clock=clock or time.monotonic, model=model, sizes=sizes
+        )
         self._emitted: deque[bytes] = deque()  # frames emit() hands to the serving thread
         self._outbox: list[_Scheduled] = []
         self._seq = 0

@@ -21,6 +21,7 @@ from serialspec.spec.model import (
     Device,
     EnumDef,
     Erratum,
+    ErrorReply,
     Example,
     FlagsDef,
     Framing,
@@ -174,6 +175,7 @@ class Context:
     errata: tuple[Erratum, ...] = ()
     examples: tuple[Example, ...] = ()
     device: Device | None = None
+    error_reply: ErrorReply | None = None
 
     @property
     def data(self) -> Any:

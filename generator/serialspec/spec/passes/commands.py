@@ -238,8 +238,8 @@ class Commands(FieldResolver):
             sharing: dict[int | None, list[tuple[Command, Message]]] = {}
             for command in commands:
                 messages = [m for m in command.messages() if m.direction == direction]
-                if not messages:
-                    continue
+                if not messages or any(m.error_reply for m in messages):
+                    continue  # an error reply has the code of the request it refuses (see passes/errors.py)
                 if command.code is not None and not isinstance(command.code, int):
                     continue  # not a number: the structural check has said so
                 if layout.has_command and command.code is None:
@@ -301,6 +301,8 @@ class Commands(FieldResolver):
                     self.error((*path, "fields", field.name, "status"), "a status is reported in a response")
         if answered_by and direction != Direction.REQUEST:
             self.error((*path, "answered_by"), "`answered_by` names the response that answers a request")
+        if value.get("error_reply") and direction != Direction.RESPONSE:
+            self.error((*path, "error_reply"), "an error reply is a response")
         return Message(
             command=command,
             subcommand=subcommand,
@@ -321,6 +323,7 @@ class Commands(FieldResolver):
             default_reply=bool(value.get("default", False)),
             reply_when=self.optional_when(answered_by.get("optional_when"), (*path, "answered_by", "optional_when")),
             struct_name=struct_name,
+            error_reply=bool(value.get("error_reply", False)),
         )
 
     def table_entry(self, text: str, path: Path) -> tuple[Table, TableEntry]:

@@ -5,21 +5,28 @@ from __future__ import annotations
 from collections.abc import Container
 from typing import Any
 
+from serialspec.spec import expression
 from serialspec.spec.errors import SpecError
 from serialspec.spec.loader import Path
 from serialspec.spec.model import (
+    SCALARS,
     Behaviour,
     Command,
     Device,
+    DeviceErrors,
     DeviceKind,
     DeviceModel,
+    DeviceTimeout,
     Direction,
     Field,
     Framing,
     Group,
+    Message,
     ModelEntry,
     Motion,
     Scalar,
+    Space,
+    SpaceAccess,
     TableEntry,
     replies_by_request,
     reply_to,
@@ -64,14 +71,15 @@ class DevicePass(Pass):
             (e for layout in framing.layouts.values() for e in layout.value_elements if e.role == "address"), None
         )
         address = str(value.get("address") or (address_element.name if address_element else ""))
-        if not address:
-            self.error(path, "name the field holding the device id with `address:`")
+        # a protocol without an address element (VESC) has one device per port: then no address is needed
         broadcast = value.get("broadcast", address_element.broadcast if address_element else None)
         id_entry = str(value.get("id_entry", ""))
         if id_entry and id_entry not in entries and id_entry not in (value.get("state") or {}):
             self.error((*path, "id_entry"), f"unknown memory entry or state variable {id_entry!r}")
         state = {str(k): float(v) for k, v in (value.get("state") or {}).items()}
         requests = {m.key: m for c in commands for m in c.messages() if m.direction == Direction.REQUEST}
+        spaces = self.spaces(value.get("spaces") or {}, (*path, "spaces"))
+        errors = self.errors(value.get("errors"), (*path, "errors"), commands)
         replies = replies_by_request(m for c in commands for m in c.messages())
         kinds = {
             str(name): DeviceKind(
@@ -108,22 +116,28 @@ class DevicePass(Pass):
             if each and group is None:
                 self.error((*item_path, "each"), f"{key} has no group field {each!r}")
             item_fields = group.fields if group else ()
-            request_names: Container[str] = (
-                EVERYTHING if each and group is None else {f.name for f in (*request.fields, *item_fields)} | broken
-            )
+            request_set = {f.name for f in (*request.fields, *item_fields)} | broken
+            request_names: Container[str] = EVERYTHING if each and group is None else request_set
             response_names = ({f.name for f in response.fields} if response else set()) | broken
-            for name in item.get("reads") or ():
+            space_reads = self.space_runs(item.get("reads"), response_names, request, spaces, (*item_path, "reads"))
+            space_writes = self.space_runs(item.get("writes"), request_set, request, spaces, (*item_path, "writes"))
+            for name in item.get("reads") or () if not space_reads else ():
                 if name not in response_names:
                     self.error((*item_path, "reads"), f"{key} has no response field {name!r}")
-            for name in item.get("writes") or ():
+            for name in item.get("writes") or () if not space_writes else ():
                 if name not in request_names:
                     self.error((*item_path, "writes"), f"{key} has no request field {name!r}")
             reports = {str(k): str(v) for k, v in (item.get("reports") or {}).items()}
             for field_name, source in reports.items():
                 if field_name not in response_names:
                     self.error((*item_path, "reports", field_name), f"{key} has no response field {field_name!r}")
-                if source not in known_state and source not in entries:
-                    self.error((*item_path, "reports", field_name), f"unknown state variable {source!r}")
+                try:
+                    used = set(expression.names(expression.parse(source)))
+                except expression.ExpressionError as exc:
+                    self.error((*item_path, "reports", field_name), str(exc))
+                    continue
+                for name in sorted(n for n in used if n not in known_state and n not in entries):
+                    self.error((*item_path, "reports", field_name), f"unknown state variable {name!r}")
             motion = None
             if "moves" in item:
                 moves = item["moves"]
@@ -145,8 +159,11 @@ class DevicePass(Pass):
                     self.error((*item_path, "moves", "state"), f"unknown state variable {motion.state!r}")
                 for role in ("target", "duration", "speed", "accel", "decel"):
                     name = getattr(motion, role)
-                    if name and name not in request_names and name not in entries:
-                        self.error((*item_path, "moves", role), f"{key} has no request field or memory entry {name!r}")
+                    if name and name not in request_names and name not in entries and name not in known_state:
+                        self.error(
+                            (*item_path, "moves", role),
+                            f"{key} has no request field, memory entry or state variable {name!r}",
+                        )
             stores = {str(k): str(v) for k, v in (item.get("stores") or {}).items()}
             sets = {str(k): float(v) for k, v in (item.get("sets") or {}).items()}
             absent = {str(k): float(v) for k, v in (item.get("absent") or {}).items()}
@@ -164,8 +181,8 @@ class DevicePass(Pass):
             behaviours.append(
                 Behaviour(
                     key,
-                    tuple(item.get("reads") or ()),
-                    tuple(item.get("writes") or ()),
+                    () if space_reads else tuple(item.get("reads") or ()),
+                    () if space_writes else tuple(item.get("writes") or ()),
                     bool(item.get("resets", False)),
                     reports,
                     motion,
@@ -177,6 +194,8 @@ class DevicePass(Pass):
                     stores,
                     sets,
                     absent,
+                    space_reads,
+                    space_writes,
                     self.keeps(item.get("keeps"), request_names, entries, (*item_path, "keeps")),
                     **self.behaviour_extras(
                         item,
@@ -201,13 +220,17 @@ class DevicePass(Pass):
             id_entry=id_entry,
             broadcast=broadcast,
             state=state,
-            reply={str(k): float(v) for k, v in (value.get("reply") or {}).items()},
+            reply={str(k): v if isinstance(v, str) else float(v) for k, v in (value.get("reply") or {}).items()},
             refused={str(k): float(v) for k, v in (value.get("refused") or {}).items()},
             out_of_range={str(k): float(v) for k, v in (value.get("out_of_range") or {}).items()},
             behaviours=tuple(behaviours),
             status=status,
             kinds=tuple(kinds.values()),
             echo_address=bool(value.get("echo_address", False)),
+            ids=tuple(int(i) for i in value.get("ids") or (0,)),
+            timeout=self.timeout(value.get("timeout"), (*path, "timeout"), requests, state),
+            spaces=tuple(spaces.values()),
+            errors=errors,
             models=self.models(value, path, entries, state),
             moving=self.moving(value, path, entries, state),
             model_entry=str(value.get("model_entry", "")),
@@ -246,6 +269,86 @@ class DevicePass(Pass):
                 bits = {b.name for b in getattr(owner, "bits", ())}
                 if owner is None or (bit and bit not in bits):
                     self.error((*path, key, name), f"unknown response field {name!r}: no response carries it")
+
+    def timeout(
+        self, value: Any, path: Path, requests: dict[str, Message], state: dict[str, float]
+    ) -> DeviceTimeout | None:
+        if value is None:
+            return None
+        for index, name in enumerate(value["kept_by"]):
+            if name not in requests:
+                self.error((*path, "kept_by", index), f"unknown command {name!r} (or it has no request)")
+        for name in value["sets"]:
+            if name not in state:
+                self.error((*path, "sets", name), f"unknown state variable {name!r}")
+        if value["after"] < 1:
+            self.error((*path, "after"), "the timeout must be at least 1 ms")
+        return DeviceTimeout(
+            int(value["after"]),
+            tuple(str(n) for n in value["kept_by"]),
+            {str(k): float(v) for k, v in value["sets"].items()},
+            str(value.get("description", "")),
+        )
+
+    def spaces(self, value: dict[str, Any], path: Path) -> dict[str, Space]:
+        found = {}
+        for name, item in value.items():
+            self.name(name, (*path, name), "data space name")
+            if item["size"] < 1:
+                self.error((*path, name, "size"), "a data space holds at least one item")
+            kind = item["type"]
+            found[name] = Space(
+                name,
+                None if kind == "bit" else SCALARS[kind],
+                int(item["size"]),
+                str(item.get("access", "rw")),
+                str(item.get("description", "")),
+            )
+        return found
+
+    def errors(self, value: Any, path: Path, commands: list[Command]) -> DeviceErrors | None:
+        if value is None:
+            return None
+        reply = next((m for c in commands for m in c.messages() if m.error_reply), None)
+        if reply is None:
+            raise self.fail(path, "`errors:` needs a command whose response is the `error_reply`")
+        field = str(value["field"])
+        if not any(f.name == field for f in reply.fields):
+            self.error((*path, "field"), f"the error reply {reply.command} has no field {field!r}")
+        if value.get("unsupported") is not None and self.ctx.framing is not None and self.ctx.framing.classic:
+            self.error((*path, "unsupported"), "`unsupported` needs frames the frame engine takes apart (not classic)")
+        reasons = [value.get(k) for k in ("out_of_space", "out_of_range", "read_only", "unsupported")]
+        return DeviceErrors(field, *reasons)
+
+    def space_runs(
+        self, value: Any, names: set[str], request: Message, spaces: dict[str, Space], path: Path
+    ) -> dict[str, SpaceAccess]:
+        """`reads:`/`writes:` given as field -> run of a data space (a list of names is memory, handled above)."""
+        if not isinstance(value, dict):
+            return {}
+        request_names = {f.name for f in request.fields}
+        runs = {}
+        for name, item in value.items():
+            item_path = (*path, name)
+            if name not in names:
+                self.error(item_path, f"{request.command} has no such field {name!r}")
+            if item["space"] not in spaces:
+                self.error((*item_path, "space"), f"unknown data space {item['space']!r} (not in `spaces:`)")
+            for role in ("start", "count"):
+                if item.get(role) and item[role] not in request_names:
+                    self.error((*item_path, role), f"{request.command} request has no field {item[role]!r}")
+            stored = None
+            if "value" in item:
+                try:
+                    stored = expression.parse(item["value"])
+                except expression.ExpressionError as exc:
+                    self.error((*item_path, "value"), str(exc))
+                else:
+                    for used in expression.names(stored):
+                        if used != "current" and used not in request_names:
+                            self.error((*item_path, "value"), f"unknown request field {used!r}")
+            runs[str(name)] = SpaceAccess(str(item["space"]), str(item["start"]), str(item.get("count", "")), stored)
+        return runs
 
     def keeps(
         self, value: Any, request_names: Any, entries: Any, path: Path

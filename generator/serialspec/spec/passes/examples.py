@@ -88,8 +88,10 @@ class Examples(Pass):
         frame_text = value.get("frame", printed)
         frame = self.frame_bytes(frame_text, (*path, "frame" if "frame" in value else "printed"))
         erratum = str(value.get("erratum", ""))
+        span = self.printed_span(value.get("printed_span"), direction, len(frame), (*path, "printed_span"))
+        before, after = span
         try:
-            printed_ok = parse_hex(printed) == frame
+            printed_ok = parse_hex(printed) == frame[before : len(frame) - after]
         except ValueError:
             printed_ok = False
         completed = str(value.get("completed", ""))
@@ -114,8 +116,29 @@ class Examples(Pass):
             str(value.get("request", "")),
             dict(value["fields"]),
             completed,
+            span,
             self.doc.where(path),
         )
+
+    def printed_span(self, span: Any, direction: Direction, size: int, path: Path) -> tuple[int, int]:
+        """Bytes before and after the frame elements first..last that a document prints (the content among them)."""
+        if span is None or self.ctx.framing is None:
+            return 0, 0
+        layout = self.ctx.framing.layouts[direction]
+        names = [e.name for e in layout.elements]
+        first, last = span
+        for name in span:
+            if name not in names:
+                raise self.fail(path, f"unknown frame element {name!r} (expected one of {', '.join(names)})")
+        start, stop = names.index(first), names.index(last)
+        content = next(i for i, e in enumerate(layout.elements) if e.role == "content")
+        if not start <= content <= stop:
+            raise self.fail(path, f"the span {first}..{last} must hold the content")
+        before = sum(e.size or 0 for e in layout.elements[:start])
+        after = sum(e.size or 0 for e in layout.elements[stop + 1 :])
+        if before + after > size:
+            raise self.fail(path, f"the frame is shorter than the elements around {first}..{last}")
+        return before, after
 
     def erratum(self, name: str, value: dict[str, Any], path: Path, commands: list[Command]) -> Erratum:
         self.name(name, path, "erratum name")

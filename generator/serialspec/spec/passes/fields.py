@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import replace
 from typing import Any, Literal
 
-from serialspec.spec import grammar
+from serialspec.spec import expression, grammar
 from serialspec.spec.loader import Path
 from serialspec.spec.model import (
     SCALARS,
@@ -14,15 +14,26 @@ from serialspec.spec.model import (
     Bytes,
     Field,
     Group,
+    List,
     Scalar,
     ScalarType,
     TableBlock,
     TableValue,
+    Text,
     sum_sizes,
 )
 from serialspec.spec.passes.base import RESERVED_FIELD_NAMES, Bad, Pass, camel, enum_span
 
-FIELD_KINDS = (*grammar.SCALAR_TYPES, "bytes", "array", "group", "table_value", "table_block")
+FIELD_KINDS = (
+    *grammar.SCALAR_TYPES,
+    "bytes",
+    "string",
+    "cstring",
+    "array",
+    "group",
+    "table_value",
+    "table_block",
+)
 
 
 class FieldResolver(Pass):
@@ -46,7 +57,37 @@ class FieldResolver(Pass):
             field = self.guard(field_path, self.field, name, item, field_path, resolved, parent)
             if field is not None:
                 resolved.append(field)
+        self.check_values(resolved, path)
         return tuple(resolved)
+
+    def check_values(self, fields: list[Field], path: Path) -> None:
+        """Every `value:` expression names fields of the same content, and no value depends on itself."""
+        by_name = {f.name: f for f in fields}
+        for field in fields:
+            if not isinstance(field, Scalar) or field.value is None:
+                continue
+            where = (*path, field.name, "value")
+            for name in sorted(set(expression.names(field.value))):
+                other = by_name.get(name)
+                if other is None:
+                    self.error(where, f"unknown field {name!r} in {expression.show(field.value)!r}")
+                elif name == field.name:
+                    self.error(where, f"{field.name} cannot be derived from itself")
+            for node in _nodes(field.value):
+                other = by_name.get(getattr(node, "name", ""))
+                if isinstance(node, expression.Length) and other is not None and not isinstance(other, LISTS):
+                    self.error(where, f"len({node.name}): {node.name} is not a list, bytes or text")
+                integer = isinstance(other, Scalar) and not other.type.is_float
+                if isinstance(node, expression.Name) and other is not None and not integer:
+                    self.error(where, f"{node.name} is not an integer field (use len({node.name}) for its size)")
+        seen: set[str] = set()
+        for field in fields:
+            if isinstance(field, Scalar) and field.value is not None and field.name not in seen:
+                cycle = _cycle(field.name, by_name, [])
+                if cycle:
+                    seen.update(cycle)
+                    chain = " -> ".join(cycle)
+                    self.error((*path, field.name, "value"), f"derived values depend on each other: {chain}")
 
     def expand(self, item: Any, path: Path) -> dict[str, Any]:
         """A field's mapping, with the short forms and `use:` references expanded."""
@@ -113,6 +154,19 @@ class FieldResolver(Pass):
                 start_in_request=start.startswith("request."),
                 size_from=size_from.removeprefix("request."),
             )
+        if kind in ("string", "cstring"):
+            size = spec.get("size")
+            if kind == "cstring":
+                if size is not None:
+                    self.error((*path, "size"), "a cstring ends at its NUL byte: it takes no `size`")
+                return Text(**common, size=None)
+            if size is None:
+                raise self.fail(path, "a string needs `size`: a number, `rest`, or a field name (or use cstring)")
+            if isinstance(size, str) and size != "rest":
+                self.size_field(size, name, siblings, parent, path)
+            return Text(**common, size=size)
+        if kind == "array" and (spec.get("of") == "bit" or not isinstance(spec.get("count"), int) or "size" in spec):
+            return self.list_field(common, spec, path, endian, siblings)
         if kind == "array":
             item_type = self.scalar_type(spec.get("of"), (*path, "of"))
             count = spec.get("count")
@@ -167,6 +221,59 @@ class FieldResolver(Pass):
             )
         raise self.fail((*path, "type"), f"unknown type {kind!r} (expected one of {', '.join(FIELD_KINDS)})")
 
+    def list_field(
+        self, common: dict[str, Any], spec: dict[str, Any], path: Path, endian: Literal["<", ">"], siblings: list[Field]
+    ) -> List:
+        """An array whose count varies (a count field, a byte-size field, the rest), or an array of bits."""
+        name = common["name"]
+        bits = spec.get("of") == "bit"
+        item_type = None if bits else self.scalar_type(spec.get("of"), (*path, "of"))
+        count = spec.get("count", "")
+        size = spec.get("size", "")
+        if bool(count) == bool(size):
+            raise self.fail(path, "an array of varying size needs `count` (items) or `size` (a byte-size field)")
+        if isinstance(count, int) and count < 1:
+            raise self.fail((*path, "count"), "an array's count must be at least 1")
+        if size and not isinstance(size, str) or size == "rest":
+            raise self.fail((*path, "size"), "an array's `size` names the earlier field holding its size in bytes")
+        if isinstance(count, str) and count not in ("", "rest"):
+            self.derive(count, ("count", name), siblings, path)
+        if size:
+            self.derive(size, ("size", name), siblings, path)
+        if bits:
+            if "range" in spec:
+                self.error((*path, "range"), "bits are true or false: no range")
+            low, high = 0.0, 1.0
+        else:
+            assert item_type is not None
+            low, high = self.bounds(item_type, False, spec.get("range"), (*path, "range"))
+        return List(
+            **common,
+            item=item_type,
+            endian=endian,
+            count=count,
+            size=str(size),
+            unit=str(spec.get("unit", "")),
+            minimum=low,
+            maximum=high,
+            count_from=self.count_from(spec.get("count_from"), (*path, "count_from")),
+        )
+
+    def count_from(self, value: Any, path: Path) -> str:
+        if value is None:
+            return ""
+        if not str(value).startswith("request."):
+            self.error(path, "`count_from` names a field of the request: request.<field>")
+        return str(value).removeprefix("request.")
+
+    def value_expression(self, text: Any, path: Path) -> expression.Expr | None:
+        if text is None:
+            return None
+        try:
+            return expression.parse(text)
+        except expression.ExpressionError as exc:
+            raise self.fail(path, str(exc)) from None
+
     def scalar(self, common: dict[str, Any], spec: dict[str, Any], path: Path, endian: Literal["<", ">"]) -> Scalar:
         scalar = SCALARS[spec["type"]]
         sign_magnitude = spec.get("encoding") == "sign_magnitude"
@@ -216,7 +323,18 @@ class FieldResolver(Pass):
             bits_class=self.class_name(camel(common["name"], "bits"), path) if bits else "",
             sign_magnitude=sign_magnitude,
             status_ok=self.status_ok(spec.get("status"), scalar, low, high, (*path, "status")),
+            value=self.derived_value(spec, scalar, path),
         )
+
+    def derived_value(self, spec: dict[str, Any], scalar: ScalarType, path: Path) -> expression.Expr | None:
+        value = self.value_expression(spec.get("value"), (*path, "value"))
+        if value is not None:
+            if scalar.is_float:
+                self.error((*path, "value"), "a derived value needs an integer type")
+            for other in ("const", "default", "bits", "enum", "flags"):
+                if other in spec:
+                    self.error((*path, other), f"a derived value (`value:`) takes no `{other}`")
+        return value
 
     def status_ok(self, status: Any, scalar: ScalarType, low: float, high: float, path: Path) -> int | None:
         if status is None:
@@ -231,6 +349,8 @@ class FieldResolver(Pass):
     def derive(self, name: str, derivation: tuple[str, ...], siblings: list[Field], path: Path) -> None:
         for index, field in enumerate(siblings):
             if field.name == name:
+                if isinstance(field, Scalar) and field.value is not None and not field.derived:
+                    return  # derived by its own expression, which decoding checks
                 if not isinstance(field, Scalar) or field.type.is_float or field.hidden:
                     raise self.fail(path, f"{name!r} must be an earlier integer field that nothing else derives")
                 siblings[index] = replace(field, derived=derivation)
@@ -243,3 +363,35 @@ class FieldResolver(Pass):
             self.derive(size, ("size", name), parent, path)
         else:
             self.derive(size, ("size", name), siblings, path)
+
+
+LISTS = (Array, List, Bytes, Text, Group)
+
+
+def _nodes(expr: expression.Expr) -> list[expression.Expr]:
+    """Every node of an expression tree."""
+    found: list[expression.Expr] = [expr]
+    if isinstance(expr, expression.BinOp):
+        found += _nodes(expr.left) + _nodes(expr.right)
+    elif isinstance(expr, expression.Ceil):
+        found += _nodes(expr.numerator) + _nodes(expr.denominator)
+    elif isinstance(expr, expression.MinMax):
+        for arg in expr.args:
+            found += _nodes(arg)
+    elif isinstance(expr, expression.Invert):
+        found += _nodes(expr.operand)
+    return found
+
+
+def _cycle(name: str, fields: dict[str, Field], trail: list[str]) -> list[str]:
+    """A chain of `value:` expressions from `name` back to a field already on the trail, or []."""
+    if name in trail:
+        return [*trail[trail.index(name) :], name]
+    field = fields.get(name)
+    if not isinstance(field, Scalar) or field.value is None:
+        return []
+    for other in expression.names(field.value):
+        found = _cycle(other, fields, [*trail, name])
+        if found:
+            return found
+    return []

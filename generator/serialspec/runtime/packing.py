@@ -1,0 +1,40 @@
+"""Field kinds that struct cannot pack alone: bits packed 8 to a byte, and text."""
+
+from __future__ import annotations
+
+from serialspec.runtime.errors import DecodeError, EncodeError
+
+
+def unpack_bits(buf: bytes, offset: int, count: int) -> tuple[bool, ...]:
+    """`count` bits from buf[offset:], 8 to a byte, the first in the lowest bit of the first byte."""
+    return tuple(bool(buf[offset + (i >> 3)] >> (i & 7) & 1) for i in range(count))
+
+
+def pack_bits(values: tuple[bool, ...] | list[bool], name: str, where: str) -> bytes:
+    """Bits 8 to a byte, the first in the lowest bit; the last byte padded with zeros."""
+    out = bytearray(-(-len(values) // 8))
+    for i, value in enumerate(values):
+        if value not in (0, 1):  # True, False, 1, 0
+            raise EncodeError(f"{where}: {name}[{i}] = {value!r} is not a bit (true/false)")
+        if value:
+            out[i >> 3] |= 1 << (i & 7)
+    return bytes(out)
+
+
+def decode_text(data: bytes, name: str, where: str) -> str:
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise DecodeError(f"{where}: {name} is not UTF-8 text ({exc.reason} at byte {exc.start})") from None
+
+
+def encode_text(value: str, name: str, where: str, terminated: bool) -> bytes:
+    """UTF-8 text; NUL-terminated text may hold no NUL of its own."""
+    if not isinstance(value, str):
+        raise EncodeError(f"{where}: {name} must be text, got {value!r}")
+    data = value.encode("utf-8")
+    if terminated:
+        if b"\0" in data:
+            raise EncodeError(f"{where}: {name} holds a NUL, which would end it early")
+        return data + b"\0"
+    return data

@@ -95,6 +95,35 @@ def fs_encode_read_angle_reply(message: FsReadAngleReply) -> bytes:
     return body + bytes((sum(body) & 0xFF,))
 
 
+class FsReplyStream:
+    """A straightforward hand-written stream parser for READ_ANGLE replies: find the header, check the command code,
+    length byte and checksum, unpack; after a mismatch, look again one byte after that header."""
+
+    def __init__(self) -> None:
+        self.pending = b""
+
+    def feed(self, data: bytes) -> list[FsReadAngleReply]:
+        buffer = self.pending + data if self.pending else data
+        end = len(buffer)
+        size = _FS_READ_ANGLE_FRAME.size
+        found = []
+        start = 0
+        while True:
+            position = buffer.find(FS_RESPONSE_HEADER, start)
+            if position < 0:
+                self.pending = buffer[max(start, end - 1) :]  # the last byte may begin a header
+                return found
+            if end - position < size:
+                self.pending = buffer[position:]
+                return found
+            _, code, length, servo_id, angle, checksum = _FS_READ_ANGLE_FRAME.unpack_from(buffer, position)
+            if code != FS_READ_ANGLE or length != 3 or sum(buffer[position : position + size - 1]) & 0xFF != checksum:
+                start = position + 1
+                continue
+            found.append(FsReadAngleReply(servo_id, angle))
+            start = position + size
+
+
 # --- Hiwonder RRC: AA 55, function, length, data, CRC-8/MAXIM over function..data ---------------------------------
 
 RRC_HEADER = b"\xaa\x55"

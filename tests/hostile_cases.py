@@ -113,7 +113,7 @@ CASES: list[tuple[str, str, Mutation | Text, str | None]] = [
         "nesting 5000 deep",
         "tiny",
         replace_text("title: Tiny", "title: " + "[" * 5000 + "]" * 5000),
-        "values nested too deeply (more than 64 levels)",
+        "title[0][0]: values nested too deeply (more than 64 levels)",
     ),
     (
         "nesting 70 deep",

@@ -95,15 +95,19 @@ _S_U8 = struct.Struct('<B')
 _S_U8_I16 = struct.Struct('<Bh')
 _S_U8_I16_U16_U16 = struct.Struct('<BhHH')
 _S_U8_I16_U16_U16_U16_U16 = struct.Struct('<BhHHHH')
+_S_U8_I16_U8 = struct.Struct('<BhB')
 _S_U8_I32_I16 = struct.Struct('<Bih')
 _S_U8_I32_U16_U16_U16_U16 = struct.Struct('<BiHHHH')
 _S_U8_I32_U32_U16 = struct.Struct('<BiIH')
 _S_U8_I32_U32_U16_U16_U16 = struct.Struct('<BiIHHH')
 _S_U8_U16 = struct.Struct('<BH')
+_S_U8_U16_U8 = struct.Struct('<BHB')
 _S_U8_U8 = struct.Struct('<BB')
 _S_U8_U8_U16 = struct.Struct('<BBH')
 _S_U8_U8_U16_U16 = struct.Struct('<BBHH')
+_S_U8_U8_U16_U8 = struct.Struct('<BBHB')
 _S_U8_U8_U8 = struct.Struct('<BBB')
+_S_U8_U8_U8_U8 = struct.Struct('<BBBB')
 _TABLE_PARAMETERS: dict[int, struct.Struct] = {
     1: struct.Struct('<H'),
     2: struct.Struct('<H'),
@@ -810,6 +814,470 @@ def _decode_sync_command_request(buf: bytes, o: int, end: int) -> SyncCommandReq
     return m
 
 
+def _frame_ping_request(buf: bytes, start: int) -> PingRequest | None:
+    """A whole ping request frame at buf[start:], size and header known: None if its checksum fails."""
+    v_servo_id, check = _S_U8_U8.unpack_from(buf, start + 4)
+    if (0x60 + v_servo_id) & 0xff != check:
+        return None
+    m = _new(PingRequest)
+    _set_PingRequest_servo_id(m, v_servo_id)
+    return m
+
+
+def _frame_reset_user_data_request(buf: bytes, start: int) -> ResetUserDataRequest | None:
+    """A whole reset_user_data request frame at buf[start:], size and header known: None if its checksum fails."""
+    v_servo_id, check = _S_U8_U8.unpack_from(buf, start + 4)
+    if (0x61 + v_servo_id) & 0xff != check:
+        return None
+    m = _new(ResetUserDataRequest)
+    _set_ResetUserDataRequest_servo_id(m, v_servo_id)
+    return m
+
+
+def _frame_read_data_request(buf: bytes, start: int) -> ReadDataRequest | None:
+    """A whole read_data request frame at buf[start:], size and header known: None if its checksum fails."""
+    v_servo_id, v_data_id, check = _S_U8_U8_U8.unpack_from(buf, start + 4)
+    if (0x63 + v_servo_id + v_data_id) & 0xff != check:
+        return None
+    m = _new(ReadDataRequest)
+    _set_ReadDataRequest_servo_id(m, v_servo_id)
+    _set_ReadDataRequest_data_id(m, v_data_id)
+    return m
+
+
+def _frame_read_batch_data_request(buf: bytes, start: int) -> ReadBatchDataRequest | None:
+    """A whole read_batch_data request frame at buf[start:], size and header known: None if its checksum fails."""
+    v_servo_id, check = _S_U8_U8.unpack_from(buf, start + 4)
+    if (0x64 + v_servo_id) & 0xff != check:
+        return None
+    m = _new(ReadBatchDataRequest)
+    _set_ReadBatchDataRequest_servo_id(m, v_servo_id)
+    return m
+
+
+def _frame_write_batch_data_request(buf: bytes, start: int) -> WriteBatchDataRequest | None:
+    """A whole write_batch_data request frame at buf[start:], size and header known: None if its checksum fails."""
+    expected = sum(buf[start + 0 : start + 37]) & 0xff
+    if expected != buf[start + 37]:
+        return None
+    t = _S_READBATCHDATARESPONSE_SERVO_ID.unpack_from(buf, start + 4)
+    v_servo_id = t[0]
+    v_user_data = _new(UserData)
+    _set_UserData_reserved_32(v_user_data, t[1])
+    _set_UserData_response_switch(v_user_data, _MEMBERS_ResponseSwitch.get(t[2], t[2]))
+    _set_UserData_servo_id(v_user_data, t[3])
+    _set_UserData_reserved_35(v_user_data, t[4])
+    _set_UserData_baudrate(v_user_data, _MEMBERS_BaudrateOption.get(t[5], t[5]))
+    _set_UserData_stall_protect_mode(v_user_data, _MEMBERS_StallProtectMode.get(t[6], t[6]))
+    _set_UserData_stall_power_limit(v_user_data, t[7])
+    _set_UserData_over_volt_low(v_user_data, t[8])
+    _set_UserData_over_volt_high(v_user_data, t[9])
+    _set_UserData_over_temperature(v_user_data, t[10])
+    _set_UserData_over_power(v_user_data, t[11])
+    _set_UserData_over_current(v_user_data, t[12])
+    _set_UserData_accel_switch(v_user_data, _MEMBERS_Switch.get(t[13], t[13]))
+    _set_UserData_reserved_45(v_user_data, t[14])
+    _set_UserData_po_lock_switch(v_user_data, _MEMBERS_LockOnPowerOn.get(t[15], t[15]))
+    _set_UserData_wb_lock_switch(v_user_data, _MEMBERS_WheelBrake.get(t[16], t[16]))
+    _set_UserData_angle_limit_switch(v_user_data, _MEMBERS_Switch.get(t[17], t[17]))
+    _set_UserData_soft_start_switch(v_user_data, _MEMBERS_Switch.get(t[18], t[18]))
+    _set_UserData_soft_start_time(v_user_data, t[19])
+    _set_UserData_angle_limit_high(v_user_data, t[20])
+    _set_UserData_angle_limit_low(v_user_data, t[21])
+    _set_UserData_angle_mid_offset(v_user_data, t[22])
+    m = _new(WriteBatchDataRequest)
+    _set_WriteBatchDataRequest_servo_id(m, v_servo_id)
+    _set_WriteBatchDataRequest_user_data(m, v_user_data)
+    return m
+
+
+def _frame_rotate_request(buf: bytes, start: int) -> RotateRequest | None:
+    """A whole rotate request frame at buf[start:], size and header known: None if its checksum fails."""
+    expected = sum(buf[start + 0 : start + 11]) & 0xff
+    if expected != buf[start + 11]:
+        return None
+    v_servo_id, v_angle, v_interval, v_power = _S_U8_I16_U16_U16.unpack_from(buf, start + 4)
+    m = _new(RotateRequest)
+    _set_RotateRequest_servo_id(m, v_servo_id)
+    _set_RotateRequest_angle(m, v_angle)
+    _set_RotateRequest_interval(m, v_interval)
+    _set_RotateRequest_power(m, v_power)
+    return m
+
+
+def _frame_damping_request(buf: bytes, start: int) -> DampingRequest | None:
+    """A whole damping request frame at buf[start:], size and header known: None if its checksum fails."""
+    v_servo_id, v_power, check = _S_U8_U16_U8.unpack_from(buf, start + 4)
+    if (0x6a + v_servo_id + (v_power & 0xff) + (v_power >> 8 & 0xff)) & 0xff != check:
+        return None
+    m = _new(DampingRequest)
+    _set_DampingRequest_servo_id(m, v_servo_id)
+    _set_DampingRequest_power(m, v_power)
+    return m
+
+
+def _frame_read_angle_request(buf: bytes, start: int) -> ReadAngleRequest | None:
+    """A whole read_angle request frame at buf[start:], size and header known: None if its checksum fails."""
+    v_servo_id, check = _S_U8_U8.unpack_from(buf, start + 4)
+    if (0x69 + v_servo_id) & 0xff != check:
+        return None
+    m = _new(ReadAngleRequest)
+    _set_ReadAngleRequest_servo_id(m, v_servo_id)
+    return m
+
+
+def _frame_move_by_interval_request(buf: bytes, start: int) -> MoveByIntervalRequest | None:
+    """A whole move_by_interval request frame at buf[start:], size and header known: None if its checksum fails."""
+    expected = sum(buf[start + 0 : start + 15]) & 0xff
+    if expected != buf[start + 15]:
+        return None
+    v_servo_id, v_angle, v_interval, v_t_acc, v_t_dec, v_power = _S_U8_I16_U16_U16_U16_U16.unpack_from(buf, start + 4)
+    m = _new(MoveByIntervalRequest)
+    _set_MoveByIntervalRequest_servo_id(m, v_servo_id)
+    _set_MoveByIntervalRequest_angle(m, v_angle)
+    _set_MoveByIntervalRequest_interval(m, v_interval)
+    _set_MoveByIntervalRequest_t_acc(m, v_t_acc)
+    _set_MoveByIntervalRequest_t_dec(m, v_t_dec)
+    _set_MoveByIntervalRequest_power(m, v_power)
+    return m
+
+
+def _frame_move_by_velocity_request(buf: bytes, start: int) -> MoveByVelocityRequest | None:
+    """A whole move_by_velocity request frame at buf[start:], size and header known: None if its checksum fails."""
+    expected = sum(buf[start + 0 : start + 15]) & 0xff
+    if expected != buf[start + 15]:
+        return None
+    v_servo_id, v_angle, v_velocity, v_t_acc, v_t_dec, v_power = _S_U8_I16_U16_U16_U16_U16.unpack_from(buf, start + 4)
+    m = _new(MoveByVelocityRequest)
+    _set_MoveByVelocityRequest_servo_id(m, v_servo_id)
+    _set_MoveByVelocityRequest_angle(m, v_angle)
+    _set_MoveByVelocityRequest_velocity(m, v_velocity)
+    _set_MoveByVelocityRequest_t_acc(m, v_t_acc)
+    _set_MoveByVelocityRequest_t_dec(m, v_t_dec)
+    _set_MoveByVelocityRequest_power(m, v_power)
+    return m
+
+
+def _frame_move_mturn_request(buf: bytes, start: int) -> MoveMturnRequest | None:
+    """A whole move_mturn request frame at buf[start:], size and header known: None if its checksum fails."""
+    expected = sum(buf[start + 0 : start + 15]) & 0xff
+    if expected != buf[start + 15]:
+        return None
+    v_servo_id, v_angle, v_interval, v_power = _S_U8_I32_U32_U16.unpack_from(buf, start + 4)
+    m = _new(MoveMturnRequest)
+    _set_MoveMturnRequest_servo_id(m, v_servo_id)
+    _set_MoveMturnRequest_angle(m, v_angle)
+    _set_MoveMturnRequest_interval(m, v_interval)
+    _set_MoveMturnRequest_power(m, v_power)
+    return m
+
+
+def _frame_move_mturn_by_interval_request(buf: bytes, start: int) -> MoveMturnByIntervalRequest | None:
+    """A whole move_mturn_by_interval request frame at buf[start:], size and header known: None if its checksum fails."""
+    expected = sum(buf[start + 0 : start + 19]) & 0xff
+    if expected != buf[start + 19]:
+        return None
+    v_servo_id, v_angle, v_interval, v_t_acc, v_t_dec, v_power = _S_U8_I32_U32_U16_U16_U16.unpack_from(buf, start + 4)
+    m = _new(MoveMturnByIntervalRequest)
+    _set_MoveMturnByIntervalRequest_servo_id(m, v_servo_id)
+    _set_MoveMturnByIntervalRequest_angle(m, v_angle)
+    _set_MoveMturnByIntervalRequest_interval(m, v_interval)
+    _set_MoveMturnByIntervalRequest_t_acc(m, v_t_acc)
+    _set_MoveMturnByIntervalRequest_t_dec(m, v_t_dec)
+    _set_MoveMturnByIntervalRequest_power(m, v_power)
+    return m
+
+
+def _frame_move_mturn_by_velocity_request(buf: bytes, start: int) -> MoveMturnByVelocityRequest | None:
+    """A whole move_mturn_by_velocity request frame at buf[start:], size and header known: None if its checksum fails."""
+    expected = sum(buf[start + 0 : start + 17]) & 0xff
+    if expected != buf[start + 17]:
+        return None
+    v_servo_id, v_angle, v_velocity, v_t_acc, v_t_dec, v_power = _S_U8_I32_U16_U16_U16_U16.unpack_from(buf, start + 4)
+    m = _new(MoveMturnByVelocityRequest)
+    _set_MoveMturnByVelocityRequest_servo_id(m, v_servo_id)
+    _set_MoveMturnByVelocityRequest_angle(m, v_angle)
+    _set_MoveMturnByVelocityRequest_velocity(m, v_velocity)
+    _set_MoveMturnByVelocityRequest_t_acc(m, v_t_acc)
+    _set_MoveMturnByVelocityRequest_t_dec(m, v_t_dec)
+    _set_MoveMturnByVelocityRequest_power(m, v_power)
+    return m
+
+
+def _frame_read_mturn_angle_request(buf: bytes, start: int) -> ReadMturnAngleRequest | None:
+    """A whole read_mturn_angle request frame at buf[start:], size and header known: None if its checksum fails."""
+    v_servo_id, check = _S_U8_U8.unpack_from(buf, start + 4)
+    if (0x6f + v_servo_id) & 0xff != check:
+        return None
+    m = _new(ReadMturnAngleRequest)
+    _set_ReadMturnAngleRequest_servo_id(m, v_servo_id)
+    return m
+
+
+def _frame_reset_mturn_angle_request(buf: bytes, start: int) -> ResetMturnAngleRequest | None:
+    """A whole reset_mturn_angle request frame at buf[start:], size and header known: None if its checksum fails."""
+    v_servo_id, check = _S_U8_U8.unpack_from(buf, start + 4)
+    if (0x70 + v_servo_id) & 0xff != check:
+        return None
+    m = _new(ResetMturnAngleRequest)
+    _set_ResetMturnAngleRequest_servo_id(m, v_servo_id)
+    return m
+
+
+def _frame_begin_async_request(buf: bytes, start: int) -> BeginAsyncRequest | None:
+    """A whole begin_async request frame at buf[start:], size and header known: None if its checksum fails."""
+    expected = sum(buf[start + 0 : start + 4]) & 0xff
+    if expected != buf[start + 4]:
+        return None
+    m = _new(BeginAsyncRequest)
+    return m
+
+
+def _frame_end_async_request(buf: bytes, start: int) -> EndAsyncRequest | None:
+    """A whole end_async request frame at buf[start:], size and header known: None if its checksum fails."""
+    v_mode, check = _S_U8_U8.unpack_from(buf, start + 4)
+    if (0x72 + v_mode) & 0xff != check:
+        return None
+    m = _new(EndAsyncRequest)
+    _set_EndAsyncRequest_mode(m, _MEMBERS_AsyncEnd.get(v_mode, v_mode))
+    return m
+
+
+def _frame_monitor_request(buf: bytes, start: int) -> MonitorRequest | None:
+    """A whole monitor request frame at buf[start:], size and header known: None if its checksum fails."""
+    v_servo_id, check = _S_U8_U8.unpack_from(buf, start + 4)
+    if (0x75 + v_servo_id) & 0xff != check:
+        return None
+    m = _new(MonitorRequest)
+    _set_MonitorRequest_servo_id(m, v_servo_id)
+    return m
+
+
+def _frame_stop_on_control_mode_request(buf: bytes, start: int) -> StopOnControlModeRequest | None:
+    """A whole stop_on_control_mode request frame at buf[start:], size and header known: None if its checksum fails."""
+    v_servo_id, v_method, v_power, check = _S_U8_U8_U16_U8.unpack_from(buf, start + 4)
+    if (0x7a + v_servo_id + v_method + (v_power & 0xff) + (v_power >> 8 & 0xff)) & 0xff != check:
+        return None
+    m = _new(StopOnControlModeRequest)
+    _set_StopOnControlModeRequest_servo_id(m, v_servo_id)
+    _set_StopOnControlModeRequest_method(m, _MEMBERS_StopMethod.get(v_method, v_method))
+    _set_StopOnControlModeRequest_power(m, v_power)
+    return m
+
+
+def _frame_ping_response(buf: bytes, start: int) -> PingResponse | None:
+    """A whole ping response frame at buf[start:], size and header known: None if its checksum fails."""
+    v_servo_id, check = _S_U8_U8.unpack_from(buf, start + 4)
+    if (0x23 + v_servo_id) & 0xff != check:
+        return None
+    m = _new(PingResponse)
+    _set_PingResponse_servo_id(m, v_servo_id)
+    return m
+
+
+def _frame_reset_user_data_response(buf: bytes, start: int) -> ResetUserDataResponse | None:
+    """A whole reset_user_data response frame at buf[start:], size and header known: None if its checksum fails."""
+    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, start + 4)
+    if (0x25 + v_servo_id + v_result) & 0xff != check:
+        return None
+    m = _new(ResetUserDataResponse)
+    _set_ResetUserDataResponse_servo_id(m, v_servo_id)
+    _set_ResetUserDataResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
+    return m
+
+
+def _frame_write_data_response(buf: bytes, start: int) -> WriteDataResponse | None:
+    """A whole write_data response frame at buf[start:], size and header known: None if its checksum fails."""
+    v_servo_id, v_data_id, v_result, check = _S_U8_U8_U8_U8.unpack_from(buf, start + 4)
+    if (0x28 + v_servo_id + v_data_id + v_result) & 0xff != check:
+        return None
+    m = _new(WriteDataResponse)
+    _set_WriteDataResponse_servo_id(m, v_servo_id)
+    _set_WriteDataResponse_data_id(m, v_data_id)
+    _set_WriteDataResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
+    return m
+
+
+def _frame_read_batch_data_response(buf: bytes, start: int) -> ReadBatchDataResponse | None:
+    """A whole read_batch_data response frame at buf[start:], size and header known: None if its checksum fails."""
+    expected = sum(buf[start + 0 : start + 37]) & 0xff
+    if expected != buf[start + 37]:
+        return None
+    t = _S_READBATCHDATARESPONSE_SERVO_ID.unpack_from(buf, start + 4)
+    v_servo_id = t[0]
+    v_user_data = _new(UserData)
+    _set_UserData_reserved_32(v_user_data, t[1])
+    _set_UserData_response_switch(v_user_data, _MEMBERS_ResponseSwitch.get(t[2], t[2]))
+    _set_UserData_servo_id(v_user_data, t[3])
+    _set_UserData_reserved_35(v_user_data, t[4])
+    _set_UserData_baudrate(v_user_data, _MEMBERS_BaudrateOption.get(t[5], t[5]))
+    _set_UserData_stall_protect_mode(v_user_data, _MEMBERS_StallProtectMode.get(t[6], t[6]))
+    _set_UserData_stall_power_limit(v_user_data, t[7])
+    _set_UserData_over_volt_low(v_user_data, t[8])
+    _set_UserData_over_volt_high(v_user_data, t[9])
+    _set_UserData_over_temperature(v_user_data, t[10])
+    _set_UserData_over_power(v_user_data, t[11])
+    _set_UserData_over_current(v_user_data, t[12])
+    _set_UserData_accel_switch(v_user_data, _MEMBERS_Switch.get(t[13], t[13]))
+    _set_UserData_reserved_45(v_user_data, t[14])
+    _set_UserData_po_lock_switch(v_user_data, _MEMBERS_LockOnPowerOn.get(t[15], t[15]))
+    _set_UserData_wb_lock_switch(v_user_data, _MEMBERS_WheelBrake.get(t[16], t[16]))
+    _set_UserData_angle_limit_switch(v_user_data, _MEMBERS_Switch.get(t[17], t[17]))
+    _set_UserData_soft_start_switch(v_user_data, _MEMBERS_Switch.get(t[18], t[18]))
+    _set_UserData_soft_start_time(v_user_data, t[19])
+    _set_UserData_angle_limit_high(v_user_data, t[20])
+    _set_UserData_angle_limit_low(v_user_data, t[21])
+    _set_UserData_angle_mid_offset(v_user_data, t[22])
+    m = _new(ReadBatchDataResponse)
+    _set_ReadBatchDataResponse_servo_id(m, v_servo_id)
+    _set_ReadBatchDataResponse_user_data(m, v_user_data)
+    return m
+
+
+def _frame_write_batch_data_response(buf: bytes, start: int) -> WriteBatchDataResponse | None:
+    """A whole write_batch_data response frame at buf[start:], size and header known: None if its checksum fails."""
+    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, start + 4)
+    if (0x29 + v_servo_id + v_result) & 0xff != check:
+        return None
+    m = _new(WriteBatchDataResponse)
+    _set_WriteBatchDataResponse_servo_id(m, v_servo_id)
+    _set_WriteBatchDataResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
+    return m
+
+
+def _frame_spin_response(buf: bytes, start: int) -> SpinResponse | None:
+    """A whole spin response frame at buf[start:], size and header known: None if its checksum fails."""
+    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, start + 4)
+    if (0x2a + v_servo_id + v_result) & 0xff != check:
+        return None
+    m = _new(SpinResponse)
+    _set_SpinResponse_servo_id(m, v_servo_id)
+    _set_SpinResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
+    return m
+
+
+def _frame_rotate_response(buf: bytes, start: int) -> RotateResponse | None:
+    """A whole rotate response frame at buf[start:], size and header known: None if its checksum fails."""
+    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, start + 4)
+    if (0x2b + v_servo_id + v_result) & 0xff != check:
+        return None
+    m = _new(RotateResponse)
+    _set_RotateResponse_servo_id(m, v_servo_id)
+    _set_RotateResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
+    return m
+
+
+def _frame_damping_response(buf: bytes, start: int) -> DampingResponse | None:
+    """A whole damping response frame at buf[start:], size and header known: None if its checksum fails."""
+    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, start + 4)
+    if (0x2c + v_servo_id + v_result) & 0xff != check:
+        return None
+    m = _new(DampingResponse)
+    _set_DampingResponse_servo_id(m, v_servo_id)
+    _set_DampingResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
+    return m
+
+
+def _frame_read_angle_response(buf: bytes, start: int) -> ReadAngleResponse | None:
+    """A whole read_angle response frame at buf[start:], size and header known: None if its checksum fails."""
+    v_servo_id, v_angle, check = _S_U8_I16_U8.unpack_from(buf, start + 4)
+    if (0x2e + v_servo_id + (v_angle & 0xff) + (v_angle >> 8 & 0xff)) & 0xff != check:
+        return None
+    m = _new(ReadAngleResponse)
+    _set_ReadAngleResponse_servo_id(m, v_servo_id)
+    _set_ReadAngleResponse_angle(m, v_angle)
+    return m
+
+
+def _frame_move_by_interval_response(buf: bytes, start: int) -> MoveByIntervalResponse | None:
+    """A whole move_by_interval response frame at buf[start:], size and header known: None if its checksum fails."""
+    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, start + 4)
+    if (0x2e + v_servo_id + v_result) & 0xff != check:
+        return None
+    m = _new(MoveByIntervalResponse)
+    _set_MoveByIntervalResponse_servo_id(m, v_servo_id)
+    _set_MoveByIntervalResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
+    return m
+
+
+def _frame_move_by_velocity_response(buf: bytes, start: int) -> MoveByVelocityResponse | None:
+    """A whole move_by_velocity response frame at buf[start:], size and header known: None if its checksum fails."""
+    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, start + 4)
+    if (0x2f + v_servo_id + v_result) & 0xff != check:
+        return None
+    m = _new(MoveByVelocityResponse)
+    _set_MoveByVelocityResponse_servo_id(m, v_servo_id)
+    _set_MoveByVelocityResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
+    return m
+
+
+def _frame_move_mturn_response(buf: bytes, start: int) -> MoveMturnResponse | None:
+    """A whole move_mturn response frame at buf[start:], size and header known: None if its checksum fails."""
+    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, start + 4)
+    if (0x30 + v_servo_id + v_result) & 0xff != check:
+        return None
+    m = _new(MoveMturnResponse)
+    _set_MoveMturnResponse_servo_id(m, v_servo_id)
+    _set_MoveMturnResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
+    return m
+
+
+def _frame_move_mturn_by_interval_response(buf: bytes, start: int) -> MoveMturnByIntervalResponse | None:
+    """A whole move_mturn_by_interval response frame at buf[start:], size and header known: None if its checksum fails."""
+    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, start + 4)
+    if (0x31 + v_servo_id + v_result) & 0xff != check:
+        return None
+    m = _new(MoveMturnByIntervalResponse)
+    _set_MoveMturnByIntervalResponse_servo_id(m, v_servo_id)
+    _set_MoveMturnByIntervalResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
+    return m
+
+
+def _frame_move_mturn_by_velocity_response(buf: bytes, start: int) -> MoveMturnByVelocityResponse | None:
+    """A whole move_mturn_by_velocity response frame at buf[start:], size and header known: None if its checksum fails."""
+    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, start + 4)
+    if (0x32 + v_servo_id + v_result) & 0xff != check:
+        return None
+    m = _new(MoveMturnByVelocityResponse)
+    _set_MoveMturnByVelocityResponse_servo_id(m, v_servo_id)
+    _set_MoveMturnByVelocityResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
+    return m
+
+
+def _frame_read_mturn_angle_response(buf: bytes, start: int) -> ReadMturnAngleResponse | None:
+    """A whole read_mturn_angle response frame at buf[start:], size and header known: None if its checksum fails."""
+    expected = sum(buf[start + 0 : start + 11]) & 0xff
+    if expected != buf[start + 11]:
+        return None
+    v_servo_id, v_angle, v_turns = _S_U8_I32_I16.unpack_from(buf, start + 4)
+    m = _new(ReadMturnAngleResponse)
+    _set_ReadMturnAngleResponse_servo_id(m, v_servo_id)
+    _set_ReadMturnAngleResponse_angle(m, v_angle)
+    _set_ReadMturnAngleResponse_turns(m, v_turns)
+    return m
+
+
+def _frame_monitor_response(buf: bytes, start: int) -> MonitorResponse | None:
+    """A whole monitor response frame at buf[start:], size and header known: None if its checksum fails."""
+    expected = sum(buf[start + 0 : start + 20]) & 0xff
+    if expected != buf[start + 20]:
+        return None
+    v_servo_id, v_voltage, v_current, v_power, v_temperature, v_status, v_angle, v_turns = _S_MONITORRESPONSE_SERVO_ID.unpack_from(buf, start + 4)
+    v_status_flags = _MEMBERS_ServoStatus.get(v_status)
+    if v_status_flags is None:
+        v_status_flags = ServoStatus(v_status)
+    m = _new(MonitorResponse)
+    _set_MonitorResponse_servo_id(m, v_servo_id)
+    _set_MonitorResponse_voltage(m, v_voltage)
+    _set_MonitorResponse_current(m, v_current)
+    _set_MonitorResponse_power(m, v_power)
+    _set_MonitorResponse_temperature(m, v_temperature)
+    _set_MonitorResponse_status(m, v_status_flags)
+    _set_MonitorResponse_angle(m, v_angle)
+    _set_MonitorResponse_turns(m, v_turns)
+    return m
+
+
 def _encode_ping_request(m: PingRequest) -> bytes:
     if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('ping request', 'servo_id', m.servo_id, 0, 254)
@@ -1376,6 +1844,52 @@ _REQUEST_SIZES: dict[int | None, tuple[int, int | None]] = {
     0x18: (4, 4),
     0x19: (3, None),
 }
+# Frames of one size decoded whole, by size key (command code << 8 | length byte): frame size, decoder.
+_REQUEST_FIXED: dict[int, tuple[int, Callable[[bytes, int], Message | None]]] = {
+    0x0101: (6, _frame_ping_request),
+    0x0201: (6, _frame_reset_user_data_request),
+    0x0302: (7, _frame_read_data_request),
+    0x0501: (6, _frame_read_batch_data_request),
+    0x0621: (38, _frame_write_batch_data_request),
+    0x0807: (12, _frame_rotate_request),
+    0x0903: (8, _frame_damping_request),
+    0x0a01: (6, _frame_read_angle_request),
+    0x0b0b: (16, _frame_move_by_interval_request),
+    0x0c0b: (16, _frame_move_by_velocity_request),
+    0x0d0b: (16, _frame_move_mturn_request),
+    0x0e0f: (20, _frame_move_mturn_by_interval_request),
+    0x0f0d: (18, _frame_move_mturn_by_velocity_request),
+    0x1001: (6, _frame_read_mturn_angle_request),
+    0x1101: (6, _frame_reset_mturn_angle_request),
+    0x1200: (5, _frame_begin_async_request),
+    0x1301: (6, _frame_end_async_request),
+    0x1601: (6, _frame_monitor_request),
+    0x1804: (9, _frame_stop_on_control_mode_request),
+}
+
+
+# The same frames for decode(), by their first bytes (header, command code, length byte).
+_REQUEST_WHOLE: dict[bytes, tuple[int, Callable[[bytes, int], Message | None]]] = {
+    b'\x12L\x01\x01': (6, _frame_ping_request),
+    b'\x12L\x02\x01': (6, _frame_reset_user_data_request),
+    b'\x12L\x03\x02': (7, _frame_read_data_request),
+    b'\x12L\x05\x01': (6, _frame_read_batch_data_request),
+    b'\x12L\x06!': (38, _frame_write_batch_data_request),
+    b'\x12L\x08\x07': (12, _frame_rotate_request),
+    b'\x12L\t\x03': (8, _frame_damping_request),
+    b'\x12L\n\x01': (6, _frame_read_angle_request),
+    b'\x12L\x0b\x0b': (16, _frame_move_by_interval_request),
+    b'\x12L\x0c\x0b': (16, _frame_move_by_velocity_request),
+    b'\x12L\r\x0b': (16, _frame_move_mturn_request),
+    b'\x12L\x0e\x0f': (20, _frame_move_mturn_by_interval_request),
+    b'\x12L\x0f\r': (18, _frame_move_mturn_by_velocity_request),
+    b'\x12L\x10\x01': (6, _frame_read_mturn_angle_request),
+    b'\x12L\x11\x01': (6, _frame_reset_mturn_angle_request),
+    b'\x12L\x12\x00': (5, _frame_begin_async_request),
+    b'\x12L\x13\x01': (6, _frame_end_async_request),
+    b'\x12L\x16\x01': (6, _frame_monitor_request),
+    b'\x12L\x18\x04': (9, _frame_stop_on_control_mode_request),
+}
 
 
 def _decode_request_at(buf: bytes, start: int, stop: int) -> Message:
@@ -1426,6 +1940,46 @@ _RESPONSE_SIZES: dict[int | None, tuple[int, int | None]] = {
     0x0f: (2, 2),
     0x10: (7, 7),
     0x16: (16, 16),
+}
+# Frames of one size decoded whole, by size key (command code << 8 | length byte): frame size, decoder.
+_RESPONSE_FIXED: dict[int, tuple[int, Callable[[bytes, int], Message | None]]] = {
+    0x0101: (6, _frame_ping_response),
+    0x0202: (7, _frame_reset_user_data_response),
+    0x0403: (8, _frame_write_data_response),
+    0x0521: (38, _frame_read_batch_data_response),
+    0x0602: (7, _frame_write_batch_data_response),
+    0x0702: (7, _frame_spin_response),
+    0x0802: (7, _frame_rotate_response),
+    0x0902: (7, _frame_damping_response),
+    0x0a03: (8, _frame_read_angle_response),
+    0x0b02: (7, _frame_move_by_interval_response),
+    0x0c02: (7, _frame_move_by_velocity_response),
+    0x0d02: (7, _frame_move_mturn_response),
+    0x0e02: (7, _frame_move_mturn_by_interval_response),
+    0x0f02: (7, _frame_move_mturn_by_velocity_response),
+    0x1007: (12, _frame_read_mturn_angle_response),
+    0x1610: (21, _frame_monitor_response),
+}
+
+
+# The same frames for decode(), by their first bytes (header, command code, length byte).
+_RESPONSE_WHOLE: dict[bytes, tuple[int, Callable[[bytes, int], Message | None]]] = {
+    b'\x05\x1c\x01\x01': (6, _frame_ping_response),
+    b'\x05\x1c\x02\x02': (7, _frame_reset_user_data_response),
+    b'\x05\x1c\x04\x03': (8, _frame_write_data_response),
+    b'\x05\x1c\x05!': (38, _frame_read_batch_data_response),
+    b'\x05\x1c\x06\x02': (7, _frame_write_batch_data_response),
+    b'\x05\x1c\x07\x02': (7, _frame_spin_response),
+    b'\x05\x1c\x08\x02': (7, _frame_rotate_response),
+    b'\x05\x1c\t\x02': (7, _frame_damping_response),
+    b'\x05\x1c\n\x03': (8, _frame_read_angle_response),
+    b'\x05\x1c\x0b\x02': (7, _frame_move_by_interval_response),
+    b'\x05\x1c\x0c\x02': (7, _frame_move_by_velocity_response),
+    b'\x05\x1c\r\x02': (7, _frame_move_mturn_response),
+    b'\x05\x1c\x0e\x02': (7, _frame_move_mturn_by_interval_response),
+    b'\x05\x1c\x0f\x02': (7, _frame_move_mturn_by_velocity_response),
+    b'\x05\x1c\x10\x07': (12, _frame_read_mturn_angle_response),
+    b'\x05\x1c\x16\x10': (21, _frame_monitor_response),
 }
 
 
@@ -1491,6 +2045,7 @@ REQUEST_FORMAT = FrameFormat(
     command_offset=2,
     content_sizes=_REQUEST_SIZES,
     decode_at=_decode_request_at,
+    fixed=_REQUEST_FIXED,
 )
 RESPONSE_FORMAT = FrameFormat(
     header=b'\x05\x1c',
@@ -1500,6 +2055,7 @@ RESPONSE_FORMAT = FrameFormat(
     command_offset=2,
     content_sizes=_RESPONSE_SIZES,
     decode_at=_decode_response_at,
+    fixed=_RESPONSE_FIXED,
 )
 
 
@@ -1520,6 +2076,11 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         n = len(data)
         if n < 5:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (5 bytes)")
+        fixed = _REQUEST_WHOLE.get(data[:4])
+        if fixed is not None and fixed[0] == n:
+            message = fixed[1](data, 0)
+            if message is not None:
+                return message
         if data[:2] != b'\x12L':
             raise DecodeError(f"request header is {data[:2].hex(' ')}, expected 12 4c")
         size = data[3]
@@ -1536,6 +2097,11 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         n = len(data)
         if n < 5:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (5 bytes)")
+        fixed = _RESPONSE_WHOLE.get(data[:4])
+        if fixed is not None and fixed[0] == n:
+            message = fixed[1](data, 0)
+            if message is not None:
+                return message
         if data[:2] != b'\x05\x1c':
             raise DecodeError(f"response header is {data[:2].hex(' ')}, expected 05 1c")
         size = data[3]

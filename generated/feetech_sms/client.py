@@ -251,7 +251,11 @@ class FeetechSmsClient(ClientBase):
 
     def read(self, id: int, name: ControlTableName) -> int:
         """Read from the control table: one register by name, e.g. `read(1, "firmware_major")`, in wire units."""
-        return self.read_many(id, name)[name]
+        register = CONTROL_TABLE[name]
+        if id == 254:
+            raise EncodeError("read: name one device; the broadcast id 254 gets no reply")
+        data = self.read_raw(id, register.address, CONTROL_TABLE.size(register))
+        return CONTROL_TABLE.value(register, data or b"")
 
     def read_many(self, id: int, *names: ControlTableName) -> dict[str, int]:
         """Read from the control table: several registers by name, in one transaction that spans them all."""

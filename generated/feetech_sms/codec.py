@@ -34,6 +34,7 @@ _S_B2_U8_U8_U8 = struct.Struct('<2sBBB')
 _S_B2_U8_U8_U8_U8_U8 = struct.Struct('<2sBBBBB')
 _S_U8 = struct.Struct('<B')
 _S_U8_U8 = struct.Struct('<BB')
+_S_U8_U8_U8 = struct.Struct('<BBB')
 
 # Decoders build messages with object.__new__ and store each value straight into its slot: the dataclass __init__
 # of a frozen class goes through object.__setattr__ per field, which costs more than unpacking the whole frame.
@@ -179,6 +180,52 @@ def _decode_reply_response(buf: bytes, o: int, end: int, id: int, error: int) ->
     return m
 
 
+def _frame_ping_request(buf: bytes, start: int) -> PingRequest | None:
+    """A whole ping request frame at buf[start:], size and header known: None if its checksum fails."""
+    expected = ~sum(buf[start + 2 : start + 5]) & 0xff
+    if expected != buf[start + 5]:
+        return None
+    id = buf[start + 2]
+    m = _new(PingRequest)
+    _set_PingRequest_id(m, id)
+    return m
+
+
+def _frame_read_request(buf: bytes, start: int) -> ReadRequest | None:
+    """A whole read request frame at buf[start:], size and header known: None if its checksum fails."""
+    id = buf[start + 2]
+    v_address, v_length, check = _S_U8_U8_U8.unpack_from(buf, start + 5)
+    if ~(0x6 + id + v_address + v_length) & 0xff != check:
+        return None
+    m = _new(ReadRequest)
+    _set_ReadRequest_id(m, id)
+    _set_ReadRequest_address(m, v_address)
+    _set_ReadRequest_length(m, v_length)
+    return m
+
+
+def _frame_action_request(buf: bytes, start: int) -> ActionRequest | None:
+    """A whole action request frame at buf[start:], size and header known: None if its checksum fails."""
+    expected = ~sum(buf[start + 2 : start + 5]) & 0xff
+    if expected != buf[start + 5]:
+        return None
+    id = buf[start + 2]
+    m = _new(ActionRequest)
+    _set_ActionRequest_id(m, id)
+    return m
+
+
+def _frame_reset_request(buf: bytes, start: int) -> ResetRequest | None:
+    """A whole reset request frame at buf[start:], size and header known: None if its checksum fails."""
+    expected = ~sum(buf[start + 2 : start + 5]) & 0xff
+    if expected != buf[start + 5]:
+        return None
+    id = buf[start + 2]
+    m = _new(ResetRequest)
+    _set_ResetRequest_id(m, id)
+    return m
+
+
 def _encode_ping_request(m: PingRequest) -> bytes:
     if not (0 <= m.id <= 253 or m.id == 254) or m.id.__class__ is bool:
         raise out_of_range('ping request', 'id', m.id, 0, 253)
@@ -313,6 +360,15 @@ _REQUEST_SIZES: dict[int | None, tuple[int, int | None]] = {
     0x82: (2, None),
     0x83: (2, None),
 }
+# Frames of one size decoded whole, by size key (command code << 8 | length byte): frame size, decoder.
+_REQUEST_FIXED: dict[int, tuple[int, Callable[[bytes, int], Message | None]]] = {
+    0x0102: (6, _frame_ping_request),
+    0x0204: (8, _frame_read_request),
+    0x0502: (6, _frame_action_request),
+    0x0602: (6, _frame_reset_request),
+}
+
+
 
 
 def _decode_request_at(buf: bytes, start: int, stop: int) -> Message:
@@ -332,6 +388,11 @@ _RESPONSE_DECODERS: dict[int | None, Callable[..., Message]] = {
 _RESPONSE_SIZES: dict[int | None, tuple[int, int | None]] = {
     None: (0, None),
 }
+# Frames of one size decoded whole, by size key (command code << 8 | length byte): frame size, decoder.
+_RESPONSE_FIXED: dict[int, tuple[int, Callable[[bytes, int], Message | None]]] = {
+}
+
+
 
 
 def _decode_response_at(buf: bytes, start: int, stop: int) -> Message:
@@ -363,6 +424,7 @@ REQUEST_FORMAT = FrameFormat(
     value_ranges=((2, 1, 'little', False, 0, 253, 254),),
     content_sizes=_REQUEST_SIZES,
     decode_at=_decode_request_at,
+    fixed=_REQUEST_FIXED,
 )
 RESPONSE_FORMAT = FrameFormat(
     header=b'\xff\xff',
@@ -373,6 +435,7 @@ RESPONSE_FORMAT = FrameFormat(
     value_ranges=((2, 1, 'little', False, 0, 253, 254),),
     content_sizes=_RESPONSE_SIZES,
     decode_at=_decode_response_at,
+    fixed=_RESPONSE_FIXED,
 )
 
 
@@ -388,6 +451,11 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         n = len(data)
         if n < 6:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (6 bytes)")
+        fixed = _REQUEST_FIXED.get(data[4] << 8 | data[3])
+        if fixed is not None and fixed[0] == n and data[:2] == b'\xff\xff':
+            message = fixed[1](data, 0)
+            if message is not None:
+                return message
         if data[:2] != b'\xff\xff':
             raise DecodeError(f"request header is {data[:2].hex(' ')}, expected ff ff")
         size = data[3] - 2

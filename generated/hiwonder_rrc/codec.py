@@ -914,6 +914,112 @@ def _decode_rgb_set_pixels_request(buf: bytes, o: int, end: int) -> RgbSetPixels
     return m
 
 
+def _frame_led_request(buf: bytes, start: int) -> LedRequest | None:
+    """A whole led request frame at buf[start:], size and header known: None if its checksum fails."""
+    expected = 0x0
+    for byte in buf[start + 2 : start + 11]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[start + 11]:
+        return None
+    v_led_id, v_on_time, v_off_time, v_repeat = _S_U8_U16_U16_U16.unpack_from(buf, start + 4)
+    m = _new(LedRequest)
+    _set_LedRequest_led_id(m, v_led_id)
+    _set_LedRequest_on_time(m, v_on_time)
+    _set_LedRequest_off_time(m, v_off_time)
+    _set_LedRequest_repeat(m, v_repeat)
+    return m
+
+
+def _frame_buzzer_request(buf: bytes, start: int) -> BuzzerRequest | None:
+    """A whole buzzer request frame at buf[start:], size and header known: None if its checksum fails."""
+    expected = 0x0
+    for byte in buf[start + 2 : start + 12]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[start + 12]:
+        return None
+    v_frequency, v_on_time, v_off_time, v_repeat = _S_U16_U16_U16_U16.unpack_from(buf, start + 4)
+    m = _new(BuzzerRequest)
+    _set_BuzzerRequest_frequency(m, v_frequency)
+    _set_BuzzerRequest_on_time(m, v_on_time)
+    _set_BuzzerRequest_off_time(m, v_off_time)
+    _set_BuzzerRequest_repeat(m, v_repeat)
+    return m
+
+
+def _frame_key_response(buf: bytes, start: int) -> KeyResponse | None:
+    """A whole key response frame at buf[start:], size and header known: None if its checksum fails."""
+    expected = 0x0
+    for byte in buf[start + 2 : start + 6]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[start + 6]:
+        return None
+    v_button_id, v_event = _S_U8_U8.unpack_from(buf, start + 4)
+    m = _new(KeyResponse)
+    _set_KeyResponse_button_id(m, v_button_id)
+    _set_KeyResponse_event(m, _MEMBERS_ButtonEvent.get(v_event, v_event))
+    return m
+
+
+def _frame_imu_response(buf: bytes, start: int) -> ImuResponse | None:
+    """A whole imu response frame at buf[start:], size and header known: None if its checksum fails."""
+    expected = 0x0
+    for byte in buf[start + 2 : start + 28]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[start + 28]:
+        return None
+    v_accel_x, v_accel_y, v_accel_z, v_gyro_x, v_gyro_y, v_gyro_z = _S_F32_F32_F32_F32_F32_F32.unpack_from(buf, start + 4)
+    m = _new(ImuResponse)
+    _set_ImuResponse_accel_x(m, v_accel_x)
+    _set_ImuResponse_accel_y(m, v_accel_y)
+    _set_ImuResponse_accel_z(m, v_accel_z)
+    _set_ImuResponse_gyro_x(m, v_gyro_x)
+    _set_ImuResponse_gyro_y(m, v_gyro_y)
+    _set_ImuResponse_gyro_z(m, v_gyro_z)
+    return m
+
+
+def _frame_gamepad_response(buf: bytes, start: int) -> GamepadResponse | None:
+    """A whole gamepad response frame at buf[start:], size and header known: None if its checksum fails."""
+    expected = 0x0
+    for byte in buf[start + 2 : start + 11]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[start + 11]:
+        return None
+    v_buttons, v_hat, v_left_x, v_left_y, v_right_x, v_right_y = _S_U16_U8_I8_I8_I8_I8.unpack_from(buf, start + 4)
+    v_buttons_flags = _MEMBERS_GamepadButtons.get(v_buttons)
+    if v_buttons_flags is None:
+        v_buttons_flags = GamepadButtons(v_buttons)
+    m = _new(GamepadResponse)
+    _set_GamepadResponse_buttons(m, v_buttons_flags)
+    _set_GamepadResponse_hat(m, v_hat)
+    _set_GamepadResponse_left_x(m, v_left_x)
+    _set_GamepadResponse_left_y(m, v_left_y)
+    _set_GamepadResponse_right_x(m, v_right_x)
+    _set_GamepadResponse_right_y(m, v_right_y)
+    return m
+
+
+def _frame_sbus_response(buf: bytes, start: int) -> SbusResponse | None:
+    """A whole sbus response frame at buf[start:], size and header known: None if its checksum fails."""
+    expected = 0x0
+    for byte in buf[start + 2 : start + 40]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[start + 40]:
+        return None
+    t = _S_I16X16_U8_U8_U8_U8.unpack_from(buf, start + 4)
+    v_ch17 = t[16]
+    v_ch18 = t[17]
+    v_signal_loss = t[18]
+    v_fail_safe = t[19]
+    m = _new(SbusResponse)
+    _set_SbusResponse_channels(m, t[0:16])
+    _set_SbusResponse_ch17(m, v_ch17)
+    _set_SbusResponse_ch18(m, v_ch18)
+    _set_SbusResponse_signal_loss(m, v_signal_loss)
+    _set_SbusResponse_fail_safe(m, v_fail_safe)
+    return m
+
+
 def _encode_led_request(m: LedRequest) -> bytes:
     if not 0 <= m.led_id <= 255 or m.led_id.__class__ is bool:
         raise out_of_range('led request', 'led_id', m.led_id, 0, 255)
@@ -1743,6 +1849,18 @@ _REQUEST_SIZES: dict[int | None, tuple[int, int | None]] = {
     0x0a: (2, 257),
     0x0b: (2, 1022),
 }
+# Frames of one size decoded whole, by size key (command code << 8 | length byte): frame size, decoder.
+_REQUEST_FIXED: dict[int, tuple[int, Callable[[bytes, int], Message | None]]] = {
+    0x0107: (12, _frame_led_request),
+    0x0208: (13, _frame_buzzer_request),
+}
+
+
+# The same frames for decode(), by their first bytes (header, command code, length byte).
+_REQUEST_WHOLE: dict[bytes, tuple[int, Callable[[bytes, int], Message | None]]] = {
+    b'\xaaU\x01\x07': (12, _frame_led_request),
+    b'\xaaU\x02\x08': (13, _frame_buzzer_request),
+}
 
 
 def _decode_request_at(buf: bytes, start: int, stop: int) -> Message:
@@ -1775,6 +1893,22 @@ _RESPONSE_SIZES: dict[int | None, tuple[int, int | None]] = {
     0x08: (7, 7),
     0x09: (36, 36),
     0x00: (3, 3),
+}
+# Frames of one size decoded whole, by size key (command code << 8 | length byte): frame size, decoder.
+_RESPONSE_FIXED: dict[int, tuple[int, Callable[[bytes, int], Message | None]]] = {
+    0x0602: (7, _frame_key_response),
+    0x0718: (29, _frame_imu_response),
+    0x0807: (12, _frame_gamepad_response),
+    0x0924: (41, _frame_sbus_response),
+}
+
+
+# The same frames for decode(), by their first bytes (header, command code, length byte).
+_RESPONSE_WHOLE: dict[bytes, tuple[int, Callable[[bytes, int], Message | None]]] = {
+    b'\xaaU\x06\x02': (7, _frame_key_response),
+    b'\xaaU\x07\x18': (29, _frame_imu_response),
+    b'\xaaU\x08\x07': (12, _frame_gamepad_response),
+    b'\xaaU\t$': (41, _frame_sbus_response),
 }
 
 
@@ -1851,6 +1985,7 @@ REQUEST_FORMAT = FrameFormat(
     command_offset=2,
     content_sizes=_REQUEST_SIZES,
     decode_at=_decode_request_at,
+    fixed=_REQUEST_FIXED,
 )
 RESPONSE_FORMAT = FrameFormat(
     header=b'\xaaU',
@@ -1860,6 +1995,7 @@ RESPONSE_FORMAT = FrameFormat(
     command_offset=2,
     content_sizes=_RESPONSE_SIZES,
     decode_at=_decode_response_at,
+    fixed=_RESPONSE_FIXED,
 )
 
 
@@ -1875,6 +2011,11 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         n = len(data)
         if n < 5:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (5 bytes)")
+        fixed = _REQUEST_WHOLE.get(data[:4])
+        if fixed is not None and fixed[0] == n:
+            message = fixed[1](data, 0)
+            if message is not None:
+                return message
         if data[:2] != b'\xaaU':
             raise DecodeError(f"request header is {data[:2].hex(' ')}, expected aa 55")
         size = data[3]
@@ -1893,6 +2034,11 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         n = len(data)
         if n < 5:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (5 bytes)")
+        fixed = _RESPONSE_WHOLE.get(data[:4])
+        if fixed is not None and fixed[0] == n:
+            message = fixed[1](data, 0)
+            if message is not None:
+                return message
         if data[:2] != b'\xaaU':
             raise DecodeError(f"response header is {data[:2].hex(' ')}, expected aa 55")
         size = data[3]

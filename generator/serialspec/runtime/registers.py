@@ -11,7 +11,7 @@ import struct
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 
-from serialspec.runtime.errors import EncodeError, out_of_range
+from serialspec.runtime.errors import DecodeError, EncodeError, out_of_range
 
 
 @dataclass(frozen=True, slots=True)
@@ -57,6 +57,9 @@ class RegisterMap:
 
     def span(self, names: Iterable[str]) -> tuple[int, int]:
         """The first address and the byte count of one read that covers every named register."""
+        if isinstance(names, tuple) and len(names) == 1:  # one register: the usual read
+            register = self[names[0]]
+            return register.address, self._structs[register.name].size
         chosen = [self[name] for name in names]
         if not chosen:
             raise EncodeError(f"{self.table}: name at least one register")
@@ -84,18 +87,30 @@ class RegisterMap:
             return -int(value & ((1 << register.sign_bit) - 1))
         return int(value)
 
+    def size(self, register: Register) -> int:
+        """The register's size in bytes (without working it out from its format again)."""
+        return self._structs[register.name].size
+
+    def value(self, register: Register, data: bytes) -> int:
+        """The register's value from the bytes read for it alone; fewer bytes than it holds is a DecodeError."""
+        if len(data) < self._structs[register.name].size:
+            raise DecodeError(f"{register.name}: {len(data)} bytes read, {self._structs[register.name].size} needed")
+        return self.from_wire(register, data)
+
     def unpack(self, start: int, data: bytes) -> dict[str, int]:
         """Bytes read from address `start` on, by register name; bytes that belong to no whole register by address."""
         values: dict[str, int] = {}
-        address, offset = start, 0
-        while offset < len(data):
-            register = self.by_address.get(address)
-            if register is None or offset + register.size > len(data):
+        address, offset, end = start, 0, len(data)
+        by_address, structs = self.by_address, self._structs
+        while offset < end:
+            register = by_address.get(address)
+            size = structs[register.name].size if register is not None else 0
+            if register is None or offset + size > end:
                 values[f"{address:#04x}"] = data[offset]
                 address, offset = address + 1, offset + 1
                 continue
             values[register.name] = self.from_wire(register, data, offset)
-            address, offset = address + register.size, offset + register.size
+            address, offset = address + size, offset + size
         return values
 
     def pack(self, values: Mapping[str, int], *, writable: bool = True) -> tuple[int, bytes]:

@@ -10,7 +10,8 @@ valid frame that starts inside it: that frame is delivered, and the candidate co
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from itertools import islice
 from typing import Literal
 
 from serialspec.runtime.errors import DecodeError
@@ -34,16 +35,31 @@ class FrameFormat:
     # decode_at(buffer, start, stop): the frame buffer[start:stop], whose header and length byte the parser has
     # checked: verifies the checksum and decodes; raises DecodeError (ChecksumError) for a corrupt frame.
     decode_at: Callable[[bytes, int, int], Message]
+    # Frames of one size decoded whole, by size key: (frame size, decoder(buffer, start) -> message, or None when
+    # its checksum fails). The parser uses them before decode_at; frames not here take decode_at.
+    fixed: dict[int, tuple[int, Callable[[bytes, int], Message | None]]] = field(default_factory=dict)
     value_ranges: ValueRanges = ()  # a candidate with a value outside its range is no frame
 
 
 class _Candidate:
     """A FrameFormat as the scanning loop reads it: the size of every plausible frame, by command and length byte."""
 
-    __slots__ = ("header", "prefix", "command_offset", "length_offset", "frame_sizes", "decode", "ranges", "byte")
+    __slots__ = (
+        "frame_format",
+        "header",
+        "prefix",
+        "command_offset",
+        "length_offset",
+        "frame_sizes",
+        "decode",
+        "fixed",
+        "splittable",
+        "ranges",
+    )
 
     def __init__(self, frame_format: FrameFormat) -> None:
-        self.header = frame_format.header
+        self.frame_format = frame_format  # kept alive: the cache below is keyed by its id
+        header = self.header = frame_format.header
         # bytes needed before the command code and the length byte can be read
         self.prefix = (
             max(
@@ -53,17 +69,11 @@ class _Candidate:
             )
             + 1
         )
-        # The usual case, one unsigned byte (an address 0..253 with broadcast 254), is checked inline by the scanning
-        # loop as (offset, low, high, also); any other ranges go through _in_range.
-        self.byte = (-1, 0, 0, -1)
         self.ranges = frame_format.value_ranges
-        if len(self.ranges) == 1 and self.ranges[0][1] == 1 and not self.ranges[0][3]:
-            offset, _, _, _, lowest, highest, broadcast = self.ranges[0]
-            self.byte = (offset, lowest, highest, -1 if broadcast is None else broadcast)
-            self.ranges = ()
         self.command_offset = frame_format.command_offset
         self.length_offset = frame_format.length_offset
         self.decode = frame_format.decode_at
+        self.fixed = {key: decode for key, (_, decode) in frame_format.fixed.items()}
         # One lookup per candidate instead of a range check: the length byte has only 256 values, so every
         # (command, length byte) pair whose content size the command allows maps to its frame size.
         self.frame_sizes: dict[int, int] = {}
@@ -73,6 +83,47 @@ class _Candidate:
                 if low <= content and (high is None or content <= high):
                     key = length_byte if code is None else code << 8 | length_byte
                     self.frame_sizes[key] = frame_format.overhead + content
+        # The batch scan splits the buffer at every header; that finds every header the byte-by-byte scan would
+        # only if two headers can never overlap (FEETECH's FF FF can: FF FF FF holds two) and the command code
+        # and length byte come after the header.
+        overlaps = any(header[:k] == header[-k:] for k in range(1, len(header)))
+        after = min(frame_format.length_offset, frame_format.command_offset or len(header))
+        self.splittable = bool(header) and not overlaps and after >= len(header)
+
+    def plausible(self, buffer: bytes, position: int) -> bool:
+        """Every frame-level value with a declared range holds a value in it (or the one also allowed)."""
+        for offset, size, byte_order, signed, low, high, also in self.ranges:
+            at = position + offset
+            value = (
+                buffer[at]
+                if size == 1 and not signed
+                else int.from_bytes(buffer[at : at + size], byte_order, signed=signed)
+            )
+            if not low <= value <= high and value != also:
+                return False
+        return True
+
+    def take(self, key: int, buffer: bytes, start: int, stop: int) -> Message | None:
+        """The frame buffer[start:stop] of size key `key` decoded, or None when it fails its checks."""
+        whole = self.fixed.get(key)
+        if whole is not None:
+            return whole(buffer, start)
+        try:
+            return self.decode(buffer, start, stop)
+        except DecodeError:
+            return None
+
+
+# Candidates are immutable and built once per frame format (a size table is thousands of entries): a parser is
+# created on every reset and reopen of a bus, so creating one must cost next to nothing.
+_CANDIDATES: dict[int, _Candidate] = {}
+
+
+def _candidate(frame_format: FrameFormat) -> _Candidate:
+    found = _CANDIDATES.get(id(frame_format))
+    if found is None or found.frame_format is not frame_format:
+        found = _CANDIDATES[id(frame_format)] = _Candidate(frame_format)
+    return found
 
 
 class StreamParser:
@@ -84,7 +135,8 @@ class StreamParser:
     def __init__(self, *formats: FrameFormat) -> None:
         if not formats:
             raise ValueError("a stream parser needs at least one frame format")
-        self._candidates = tuple(_Candidate(f) for f in formats)
+        self._candidates = tuple(_candidate(f) for f in formats)
+        self._single = self._candidates[0] if len(self._candidates) == 1 else None
         self._pending = b""
         self._keep = max(len(f.header) for f in formats) - 1  # a tail that could be the start of a header
         self.errors = 0
@@ -92,26 +144,125 @@ class StreamParser:
 
     def feed(self, data: bytes | bytearray | memoryview) -> list[Message]:
         # Work on immutable bytes: decoders slice their `bytes` fields straight out of the buffer.
-        buffer = self._pending + data if self._pending else bytes(data)
+        buffer = self._pending + data if self._pending else data if type(data) is bytes else bytes(data)
+        single = self._single
+        if single is None:
+            return self._scan(buffer)
         end = len(buffer)
+        if end >= single.prefix:
+            # A transaction's read is usually one whole frame, first byte on: decode it without a scan. A frame
+            # that fails goes through the scan, which counts it and resynchronises.
+            key = buffer[single.length_offset]
+            if single.command_offset is not None:
+                key |= buffer[single.command_offset] << 8
+            if single.frame_sizes.get(key) == end and buffer.startswith(single.header):
+                message = single.take(key, buffer, 0, end)
+                if message is not None:
+                    self._pending = b""
+                    return [message]
+        if single.splittable:
+            return self._split(buffer, single)
+        return self._scan(buffer)
+
+    def _split(self, buffer: bytes, current: _Candidate) -> list[Message]:
+        """The batch scan of one frame format whose header cannot overlap itself: split the buffer at every header
+        (one pass in C) and take the pieces in turn, which saves a search and most bookkeeping per frame. It
+        accepts, rejects, counts and holds back exactly what the byte-by-byte scan (`_scan`) would: a candidate
+        that fails resumes at the next header, an accepted frame skips any header inside it."""
+        header = current.header
+        width = len(header)
+        pieces = buffer.split(header)
+        end = len(buffer)
+        frame_sizes = current.frame_sizes
+        command_offset, length_offset, prefix = current.command_offset, current.length_offset, current.prefix
+        length_at = length_offset - width  # the key's bytes in the piece after the header
+        command_at = -1 if command_offset is None else command_offset - width
+        need = prefix - width
+        whole = current.frame_format.fixed
+        found: list[Message] = []
+        append = found.append
+        position = len(pieces[0])  # of the header before the piece
+        garbage = errors = start = 0  # start: where the byte-by-byte scan would look for the next header
+        for piece in islice(pieces, 1, None):
+            after = len(piece)  # bytes between this header and the next one (or the end)
+            if position >= start:  # not a header inside an accepted frame
+                garbage += position - start
+                if after >= need:
+                    key = piece[length_at] if command_at < 0 else piece[command_at] << 8 | piece[length_at]
+                    entry = whole.get(key)
+                    if current.ranges and not current.plausible(buffer, position):
+                        entry = None  # a value out of its range: no frame start (the size check below says so)
+                        key = -1
+                    if entry is not None and entry[0] - width <= after:  # the usual frame: decoded whole
+                        message = entry[1](buffer, position)
+                        if message is None:
+                            errors += 1
+                            start = position + 1
+                            garbage += 1
+                        else:
+                            append(message)
+                            start = position + entry[0]
+                        position += width + after
+                        continue
+                elif position + width + after == end or position + prefix > end:  # the key has not come yet
+                    self._pending = buffer[position:]
+                    break
+                else:  # the key runs past the next header: read it from the buffer
+                    key = buffer[position + length_offset]
+                    if command_offset is not None:
+                        key |= buffer[position + command_offset] << 8
+                size = frame_sizes.get(key)
+                if size is not None and current.ranges and not current.plausible(buffer, position):
+                    size = None
+                if size is None:  # implausible: not a frame start
+                    start = position + 1
+                    garbage += 1
+                else:
+                    stop = position + size
+                    if stop > end:  # incomplete: wait for more bytes, unless a complete frame starts inside it
+                        inner = self._complete_frame_after(buffer, position + 1)
+                        if inner >= 0:
+                            self.garbage += garbage + inner - position
+                            self.errors += errors
+                            return found + self._scan(buffer[inner:])
+                        self._pending = buffer[position:]
+                        break
+                    message = current.take(key, buffer, position, stop)
+                    if message is None:
+                        errors += 1
+                        start = position + 1
+                        garbage += 1
+                    else:
+                        append(message)
+                        start = stop
+            position += width + after
+        else:  # every header taken: keep a tail that could begin one
+            cut = max(start, end - width + 1)
+            garbage += cut - start
+            self._pending = buffer[cut:]
+        self.garbage += garbage
+        self.errors += errors
+        return found
+
+    def _scan(self, buffer: bytes) -> list[Message]:
+        """The byte-by-byte scan: the nearest header of any frame format, its key, its frame."""
+        end = len(buffer)
+        single = self._single
         found: list[Message] = []
         append = found.append
         find = buffer.find
-        candidates = self._candidates
-        single = len(candidates) == 1
         # one frame format (the usual case): its parameters stay in locals for the whole scan
-        current = candidates[0]
+        current = self._candidates[0]
         header, prefix, command_offset, length_offset = (
             current.header,
             current.prefix,
             current.command_offset,
             current.length_offset,
         )
-        frame_sizes, decode, ranges = current.frame_sizes, current.decode, current.ranges
-        byte_offset, byte_low, byte_high, byte_also = current.byte
+        frame_sizes = current.frame_sizes
         garbage = errors = start = 0
         while True:
-            if single:
+            if single is not None:
                 position = find(header, start)
             else:
                 position, current = self._next_header(buffer, start)
@@ -121,8 +272,7 @@ class StreamParser:
                     current.command_offset,
                     current.length_offset,
                 )
-                frame_sizes, decode, ranges = current.frame_sizes, current.decode, current.ranges
-                byte_offset, byte_low, byte_high, byte_also = current.byte
+                frame_sizes = current.frame_sizes
             if position < 0:
                 cut = max(start, end - self._keep)
                 garbage += cut - start
@@ -132,19 +282,11 @@ class StreamParser:
             if end - position < prefix:  # plausible so far but incomplete: wait for more bytes
                 self._pending = buffer[position:]
                 break
-            if command_offset is None:
-                size = frame_sizes.get(buffer[position + length_offset])
-            else:
-                size = frame_sizes.get(buffer[position + command_offset] << 8 | buffer[position + length_offset])
-            if (
-                size is None
-                or (
-                    byte_offset >= 0
-                    and not byte_low <= buffer[position + byte_offset] <= byte_high
-                    and buffer[position + byte_offset] != byte_also
-                )
-                or (ranges and not _in_range(buffer, position, ranges))
-            ):
+            key = buffer[position + length_offset]
+            if command_offset is not None:
+                key |= buffer[position + command_offset] << 8
+            size = frame_sizes.get(key)
+            if size is None or (current.ranges and not current.plausible(buffer, position)):
                 # implausible (unknown command, a content size it never has, a value out of range): no frame start
                 start = position + 1
                 garbage += 1
@@ -158,13 +300,13 @@ class StreamParser:
                 garbage += inner - position  # a stray header: the complete frame inside it is the real one
                 start = inner
                 continue
-            try:
-                append(decode(buffer, position, stop))
-            except DecodeError:
+            message = current.take(key, buffer, position, stop)
+            if message is None:
                 errors += 1
                 start = position + 1
                 garbage += 1
                 continue
+            append(message)
             start = stop
         self.garbage += garbage
         self.errors += errors
@@ -177,24 +319,13 @@ class StreamParser:
             position, candidate = self._next_header(buffer, start)
             if position < 0 or end - position < candidate.prefix:
                 return -1
-            if candidate.command_offset is None:
-                size = candidate.frame_sizes.get(buffer[position + candidate.length_offset])
-            else:
-                key = buffer[position + candidate.command_offset] << 8 | buffer[position + candidate.length_offset]
-                size = candidate.frame_sizes.get(key)
-            offset, low, high, also = candidate.byte
-            plausible = (
-                size is not None
-                and (offset < 0 or low <= buffer[position + offset] <= high or buffer[position + offset] == also)
-                and (not candidate.ranges or _in_range(buffer, position, candidate.ranges))
-            )
-            if plausible and size is not None and position + size <= end:
-                try:
-                    candidate.decode(buffer, position, position + size)
-                except DecodeError:
-                    pass
-                else:
-                    return position
+            key = buffer[position + candidate.length_offset]
+            if candidate.command_offset is not None:
+                key |= buffer[position + candidate.command_offset] << 8
+            size = candidate.frame_sizes.get(key)
+            complete = size is not None and position + size <= end and candidate.plausible(buffer, position)
+            if complete and size is not None and candidate.take(key, buffer, position, position + size) is not None:
+                return position
             start = position + 1
 
     def _next_header(self, buffer: bytes, start: int) -> tuple[int, _Candidate]:
@@ -211,16 +342,3 @@ class StreamParser:
     def pending(self) -> bytes:
         """Bytes held back, waiting to complete a frame."""
         return self._pending
-
-
-def _in_range(buffer: bytes, position: int, ranges: ValueRanges) -> bool:
-    for offset, size, byte_order, signed, low, high, also in ranges:
-        at = position + offset
-        value = (
-            buffer[at]
-            if size == 1 and not signed
-            else int.from_bytes(buffer[at : at + size], byte_order, signed=signed)
-        )
-        if not low <= value <= high and value != also:
-            return False
-    return True

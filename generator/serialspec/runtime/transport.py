@@ -12,8 +12,10 @@ unplugged and plugged back in (or a symlink such as /dev/serial/by-id/... pointe
 from __future__ import annotations
 
 import dataclasses
+import operator
 import os
 import select
+import sys
 import threading
 import time
 from collections import deque
@@ -42,9 +44,9 @@ try:
     _PORT_FAILURES = (serial.SerialException, OSError, termios.error)
 except ImportError:  # Windows
     _PORT_FAILURES = (serial.SerialException, OSError)
-_POSIX_SERIAL: tuple[type, ...] = tuple(
-    cls for cls in (getattr(getattr(serial, "serialposix", None), "Serial", None),) if cls is not None
-)
+# The port class whose reads and writes the bus may do itself on the descriptor (see FdLink): pyserial's own POSIX
+# port, and spy:// (which only logs around it). Other subclasses override read/write and keep going through pyserial.
+_POSIX_SERIAL: type | None = getattr(getattr(serial, "serialposix", None), "Serial", None)
 _OPEN_FAILURES: tuple[type[Exception], ...] = (*_PORT_FAILURES, ValueError)  # ValueError: a bad setting
 _RESET_FAILURES: tuple[type[Exception], ...] = (*_PORT_FAILURES, NotImplementedError)  # URLs without a buffer
 
@@ -124,6 +126,130 @@ def flag_names(flags: dict[str, type[IntFlag]]) -> Callable[[str, int], str]:
 
 
 Subscriber = Callable[[Message], None]
+_ABSENT = object()  # an attribute a message does not have
+
+
+class Link:
+    """How a bus moves bytes through a port: pyserial's own calls, for any port or URL pyserial opens.
+
+    Three operations make a transaction: `write` a frame, `read_waiting` (what arrived between transactions,
+    without waiting) and `read` (whatever arrives, blocking up to a deadline for the first byte: no sleeping, no
+    polling). Port failures propagate as pyserial raises them; the bus turns them into PortError.
+    """
+
+    __slots__ = ("port",)
+
+    def __init__(self, port: Any) -> None:
+        self.port = port
+
+    def write(self, data: bytes) -> None:
+        self.port.write(data)
+
+    def read_waiting(self) -> bytes:
+        port = self.port
+        waiting = port.in_waiting
+        if not waiting:
+            return b""
+        port.timeout = 0
+        data: bytes = port.read(waiting)
+        return data
+
+    def read(self, wait: float) -> bytes:
+        port = self.port
+        if port.timeout != wait:
+            port.timeout = wait
+        # Blocks until the first byte or the deadline; then takes whatever else has arrived.
+        chunk: bytes = port.read(1)
+        waiting = port.in_waiting if chunk else 0
+        return chunk + port.read(waiting) if waiting else chunk
+
+
+class FdLink(Link):
+    """pyserial's POSIX port (a tty, a pty), driven on its descriptor: one `os.write` per frame, one `poll` and one
+    `os.read` per chunk read. pyserial keeps no buffer of its own there and opens the descriptor non-blocking, so
+    this sees exactly the bytes it would, without a `select` after every write, an `in_waiting` ioctl per
+    transaction, or a `tcsetattr` to change the read timeout. The descriptor is taken from the port at every call:
+    a port closed under the bus fails its next call (fd None) instead of reading a stale descriptor. A spy://
+    port (pyserial's logging subclass) keeps this path: its logger is handed the bytes as its own read and write
+    would hand them.
+    """
+
+    __slots__ = ("_fd", "_poll", "_spy")
+
+    def __init__(self, port: Any, spy: Any = None) -> None:
+        super().__init__(port)
+        self._fd = -1
+        # poll() is the cheaper wait; macOS's does not work on terminal devices, so there it is select()
+        self._poll = select.poll() if sys.platform.startswith("linux") else None
+        self._spy = spy  # spy://'s formatter (its tx and rx log the bytes), or None
+
+    def write(self, data: bytes) -> None:
+        if self._spy is not None:
+            self._spy.tx(data)
+        try:
+            written = os.write(self.port.fd, data)
+        except BlockingIOError:
+            written = 0
+        if written < len(data):  # the output buffer is full: pyserial waits for room (and keeps its write_timeout)
+            _POSIX_SERIAL.write(self.port, data[written:])  # type: ignore[union-attr]  # not spy's: logged above
+
+    def read_waiting(self) -> bytes:
+        # pyserial sets VMIN = VTIME = 0: a read with nothing there returns b"" at once (one syscall, the usual
+        # case). A device that went away fails here or at the write that follows.
+        fd = self.port.fd
+        try:
+            data = os.read(fd, 4096)
+        except BlockingIOError:
+            return b""
+        while len(data) % 4096 == 0 and data:  # more may be waiting (a read that fills the buffer is rare)
+            try:
+                more = os.read(fd, 4096)
+            except BlockingIOError:
+                break
+            if not more:
+                break
+            data += more
+        if data and self._spy is not None:
+            self._spy.rx(data)
+        return data
+
+    def read(self, wait: float) -> bytes:
+        fd = self.port.fd
+        if fd is None:
+            raise serial.SerialException("the port is closed")
+        if self._poll is None:
+            ready = bool(select.select([fd], [], [], wait)[0])
+        else:
+            if fd != self._fd:  # first read, or the port was reopened
+                if self._fd >= 0:
+                    self._poll.unregister(self._fd)
+                self._poll.register(fd, select.POLLIN)
+                self._fd = fd
+            ready = bool(self._poll.poll(wait * 1000))  # milliseconds, rounded up: never before the deadline
+        if not ready:
+            if self.port.fd is None:  # closed by another thread while this one waited
+                raise serial.SerialException("the port is closed")
+            return b""
+        try:
+            data = os.read(fd, 4096)
+        except BlockingIOError:  # woken, but another reader took the bytes
+            return b""
+        if not data:  # readable but empty: the other end hung up
+            raise serial.SerialException("device disconnected")
+        if self._spy is not None:
+            self._spy.rx(data)
+        return data
+
+
+def link(port: Any) -> Link:
+    """The fastest link that sees (and, for spy://, logs) exactly what pyserial would for this port."""
+    if _POSIX_SERIAL is not None and isinstance(port, _POSIX_SERIAL):
+        if type(port) is _POSIX_SERIAL:
+            return FdLink(port)
+        spy = getattr(port, "formatter", None)
+        if type(port).__module__ == "serial.urlhandler.protocol_spy" and spy is not None:
+            return FdLink(port, spy)
+    return Link(port)
 
 
 class Bus:
@@ -165,10 +291,15 @@ class Bus:
             options.update(serial_options)
             self._port = _open_port(port, options)
         self.port_name = str(getattr(self._port, "name", None) or getattr(self._port, "port", "") or port)
+        self._link = link(self._port)
         self._gap = _gap_seconds(binding.serial.gap, self._port)
         self._last_io = 0.0  # when a byte was last written or read (for the inter-frame gap)
-        # spy:// logs in its read(); the fast path below reads the descriptor itself, so it tells the logger
-        self._spy = getattr(self._port, "formatter", None)
+        # the spec's matching rule, split once: compare the command, the sub-command, then these fields
+        match_by = binding.match_by
+        self._match_command = "command" in match_by
+        self._match_subcommand = "subcommand" in match_by
+        self._match_fields = tuple(name for name in match_by if name not in ("command", "subcommand"))
+        self._rules: dict[tuple[type, type], tuple[bool, Callable[[Any], Any] | None]] = {}
 
     # --- lifetime -------------------------------------------------------------------------------------------------
 
@@ -190,6 +321,7 @@ class Bus:
             reason = _refused_setting(self._port.port, _settings_of(self._port)) or _reason(exc)
             raise PortError(f"cannot reopen {self.port_name}: {reason}") from None
         self._parser = self.binding.parser()
+        self._link = link(self._port)
 
     def __enter__(self) -> Bus:
         return self
@@ -224,30 +356,66 @@ class Bus:
         frame = self.binding.encode(request)
         wait = self.timeout if timeout is None else timeout
         with self._lock:
-            self._ensure_open()
-            self._drain()
-            self._parser.expect(expect)  # where replies share a code, the layout this request's reply has
+            if self._closed or not self._port.is_open:
+                self._ensure_open()
+            # The usual transaction inline (nothing waiting, the reply whole in the first read): a call or two
+            # less matters at tens of microseconds per transaction. Anything else goes through _read_until.
+            link = self._link
+            try:
+                stale = link.read_waiting()
+            except Exception as exc:
+                self._port_failed("read", exc)
+                raise
+            if stale or self._backlog:
+                self._stale(stale)
+            parser = self._parser
+            parser.errors = 0
+            parser.expect(expect)  # where replies share a code, the layout this request's reply has
             self._write(frame)
-            reply = self._read_until(lambda m: self._answers(request, expect, m), wait, request)
-            self._flush_backlog()
+            started = time.monotonic()
+            rule = self._rules.get((type(request), expect)) or self._rule(type(request), expect)
+            try:
+                chunk = b"" if self._backlog else link.read(wait)  # an echo check may have read the reply
+            except Exception as exc:
+                self._port_failed("read", exc)
+                raise
+            if chunk:
+                if self._gap:
+                    self._last_io = time.monotonic()
+                messages = parser.feed(chunk)
+                if len(messages) == 1:
+                    possible, getter = rule
+                    reply = messages[0]
+                    if type(reply) is expect and possible and (getter is None or getter(reply) == getter(request)):
+                        self._refused(request, reply)
+                        if self.binding.status:
+                            self._check_status(reply)
+                        return reply  # type(reply) is expect
+                self._backlog.extend(messages)  # _read_until takes them first
+            reply = self._read_until(wait - (time.monotonic() - started), request, expect, errors=0)
+            if self._backlog:
+                self._flush_backlog()
+        self._refused(request, reply)
+        assert isinstance(reply, expect)
+        if self.binding.status:
+            self._check_status(reply)
+        return reply
+
+    def _refused(self, request: Message, reply: Message) -> None:
+        """An error reply that refuses the request (the spec's `errors:`) is a DeviceError."""
         errors = self.binding.errors
         if errors is not None and errors.refuses(request, reply):
             raise DeviceError(errors.describe(request, reply), reply)
-        assert isinstance(reply, expect)
-        self._check_status(reply)
-        return reply
 
-    def _answers(self, request: Message, expect: type[Message], reply: Message) -> bool:
-        """The reply of the expected type that matches the request, or an error reply that refuses it."""
-        if isinstance(reply, expect):
-            return self.matches(request, reply)
+    def _refusal(self, request: Message, reply: Message) -> bool:
+        """Whether `reply`, not of the expected type, is an error reply refusing `request` (from the same device)."""
         errors = self.binding.errors
         if errors is None or not errors.refuses(request, reply):
             return False
         return all(
             getattr(request, name) == getattr(reply, name)
-            for name in self.binding.match_by
-            if name not in ("command", "subcommand") and hasattr(request, name) and hasattr(reply, name)
+            for name in self._match_fields
+            if hasattr(request, name) and hasattr(reply, name)
         )
 
     def request_each(
@@ -265,15 +433,10 @@ class Bus:
             self._parser.expect(expect)
             self._write(frame)
             for key in answers:
-
-                def wanted(message: Message, key: dict[str, Any] = key) -> bool:
-                    return isinstance(message, expect) and all(getattr(message, k, None) == v for k, v in key.items())
-
                 try:
-                    reply = self._read_until(wanted, wait, request)
+                    reply = self._read_until(wait, request, expect, key)
                 except Timeout:
                     raise Timeout(request.COMMAND, " ".join(f"{k}={v}" for k, v in key.items()), wait) from None
-                assert isinstance(reply, expect)
                 replies.append(reply)
             self._flush_backlog()
         for reply in replies:
@@ -282,16 +445,30 @@ class Bus:
 
     def matches(self, request: Message, reply: Message) -> bool:
         """The spec's matching rule: the named attributes are equal where both messages have them."""
-        for name in self.binding.match_by:
-            if name == "command":
-                if reply.COMMAND != request.COMMAND:
-                    return False
-            elif name == "subcommand":
-                if reply.SUBCOMMAND != request.SUBCOMMAND:
-                    return False
-            elif hasattr(request, name) and hasattr(reply, name) and getattr(request, name) != getattr(reply, name):
+        if self._match_command and reply.COMMAND != request.COMMAND:
+            return False
+        if self._match_subcommand and reply.SUBCOMMAND != request.SUBCOMMAND:
+            return False
+        for name in self._match_fields:
+            mine = getattr(request, name, _ABSENT)
+            if mine is not _ABSENT and getattr(reply, name, mine) != mine:
                 return False
         return True
+
+    def _rule(self, request_type: type, reply_type: type) -> tuple[bool, Callable[[Any], Any] | None]:
+        """The matching rule for a reply of exactly `reply_type` to a request of `request_type`, worked out once:
+        whether it can answer at all (command, sub-command), and a getter of the fields both have (None: none)."""
+        rule = self._rules.get((request_type, reply_type))
+        if rule is None:
+            possible = not (
+                self._match_command and getattr(reply_type, "COMMAND", None) != getattr(request_type, "COMMAND", None)
+            ) and not (
+                self._match_subcommand
+                and getattr(reply_type, "SUBCOMMAND", None) != getattr(request_type, "SUBCOMMAND", None)
+            )
+            names = [n for n in self._match_fields if hasattr(request_type, n) and hasattr(reply_type, n)]
+            rule = self._rules[(request_type, reply_type)] = (possible, operator.attrgetter(*names) if names else None)
+        return rule
 
     def receive(self, timeout: float | None = None) -> Message | None:
         """The next frame that answered no request (the device's own reports), or None after the timeout."""
@@ -300,7 +477,7 @@ class Bus:
                 return self._unsolicited.popleft()
             self._ensure_open()
             try:
-                self._read_until(lambda m: True, self.timeout if timeout is None else timeout, None, keep=True)
+                self._read_until(self.timeout if timeout is None else timeout, None, Message, keep=True)
             except Timeout:
                 return None
             self._flush_backlog()
@@ -313,12 +490,8 @@ class Bus:
 
     # --- reading and writing --------------------------------------------------------------------------------------
 
-    def _port_failures(self, doing: str) -> _PortFailures:
-        """Whatever pyserial raises when the device goes away or the port is closed under the bus, as PortError."""
-        return _PortFailures(self, doing)
-
     def _port_failed(self, doing: str, exc: Exception) -> None:
-        """Raise PortError for a port failure; anything else propagates as it is.
+        """Raise PortError for a port failure; anything else is left for the caller to re-raise as it is.
 
         A port closed by another thread while a read waits makes pyserial fail with TypeError (its descriptor is
         None by then): that is a closed port too, not a bug. The failed port is closed so that the next
@@ -339,20 +512,28 @@ class Bus:
             wait = self._last_io + self._gap - time.monotonic()
             if wait > 0:
                 time.sleep(wait)
-        with self._port_failures("write"):
-            self._port.write(frame)
-        self._last_io = time.monotonic()
+        try:
+            self._link.write(frame)
+        except Exception as exc:
+            self._port_failed("write", exc)
+            raise
+        if self._gap:
+            self._last_io = time.monotonic()
         if self.echo:
             self._check_echo(frame)
 
     def _check_echo(self, frame: bytes) -> None:
-        """Read back the echo of a frame just written; bytes after it (the reply's start) go to the parser."""
+        """Read back the echo of a frame just written; frames in the bytes after it (the reply) go to the backlog,
+        which the read that follows takes first."""
         deadline = time.monotonic() + self.timeout
         echoed = b""
         while len(echoed) < len(frame):
             remaining = deadline - time.monotonic()
-            with self._port_failures("read"):
-                chunk = self._read_some(remaining) if remaining > 0 else b""
+            try:
+                chunk = self._link.read(remaining) if remaining > 0 else b""
+            except Exception as exc:
+                self._port_failed("read", exc)
+                raise
             if not chunk:
                 self._reset()
                 raise PortError(
@@ -372,77 +553,86 @@ class Bus:
 
     def _drain(self) -> None:
         """Hand bytes that arrived between transactions (late replies, reports) to subscribers, without waiting."""
-        self._flush_backlog()
-        with self._port_failures("read"):
-            waiting = self._port.in_waiting
-            if waiting:
-                self._port.timeout = 0
-                chunk = self._port.read(waiting)
-        if waiting:
-            for message in self._parser.feed(chunk):
-                self._unmatched(message)
+        try:
+            chunk = self._link.read_waiting()
+        except Exception as exc:
+            self._port_failed("read", exc)
+            raise
+        self._stale(chunk)
         self._parser.errors = 0
 
-    def _read_some(self, wait: float) -> bytes:
-        """Whatever has arrived, blocking up to `wait` seconds for the first byte (no sleeping, no polling)."""
-        fd = getattr(self._port, "fd", None) if isinstance(self._port, _POSIX_SERIAL) else None
-        if isinstance(fd, int):
-            # A device file: wait on the descriptor and read it directly. pyserial keeps no buffer of its own
-            # there, and this avoids setting its timeout (a tcsetattr per transaction) and a second read call.
-            if not select.select([fd], [], [], wait)[0]:
-                return b""
-            data = os.read(fd, 4096)
-            if not data:  # readable but empty: the other end hung up
-                raise serial.SerialException("device disconnected")
-            if self._spy is not None:
-                self._spy.rx(data)
-            return data
-        if self._port.timeout != wait:
-            self._port.timeout = wait
-        # Blocks until the first byte or the deadline; then takes whatever else has arrived.
-        chunk: bytes = self._port.read(1)
-        waiting = self._port.in_waiting if chunk else 0
-        return chunk + self._port.read(waiting) if waiting else chunk
+    def _stale(self, chunk: bytes) -> None:
+        """Frames held from the last transaction, then those in bytes that came between transactions: to
+        subscribers."""
+        if self._backlog:
+            self._flush_backlog()
+        if chunk:
+            for message in self._parser.feed(chunk):
+                self._unmatched(message)
 
     def _flush_backlog(self) -> None:
         """Frames that came with a reply but answer nothing go to subscribers now, not at the next transaction."""
         while self._backlog:
             self._unmatched(self._backlog.popleft())
 
+    def _wanted(self, message: Message, request: Message | None, expect: type[M], key: dict[str, Any] | None) -> bool:
+        """Whether `message` is what the transaction waits for: the reply to `request` (or, with `key`, the reply
+        whose attributes equal the key's values); any frame when there is no request."""
+        if not isinstance(message, expect):
+            return request is not None and key is None and self._refusal(request, message)
+        if key is not None:
+            return all(getattr(message, k, None) == v for k, v in key.items())
+        return request is None or self.matches(request, message)
+
     def _read_until(
-        self, wanted: Callable[[Message], bool], wait: float, request: Message | None, keep: bool = False
-    ) -> Message:
-        deadline = time.monotonic() + wait
-        errors = self._parser.errors
-        while True:
-            remaining = deadline - time.monotonic()
-            held = list(self._backlog)  # frames that came with the previous reply of this transaction
-            self._backlog.clear()
-            with self._port_failures("read"):
-                chunk = b"" if held or remaining <= 0 else self._read_some(remaining)
-            if chunk:
-                self._last_io = time.monotonic()
-            found = None
-            for message in held + (self._parser.feed(chunk) if chunk else []):
-                if found is not None:
-                    self._backlog.append(message)  # maybe the next reply of a request_each
-                elif wanted(message):
-                    found = message
-                    if keep:
-                        self._unmatched(message)
-                else:
+        self,
+        wait: float,
+        request: Message | None,
+        expect: type[M],
+        key: dict[str, Any] | None = None,
+        keep: bool = False,
+        errors: int | None = None,
+    ) -> M:
+        """Read until the wanted frame (see _wanted) has come, for up to `wait` seconds. Frames that came after it
+        in the same read stay in the backlog (the next reply of a request_each); every other frame goes to
+        subscribers, and to them too the wanted one when `keep`. Frames that fail their checks after the parser
+        counted `errors` (by default: from now on) make it a CorruptReply."""
+        backlog = self._backlog
+        while backlog:  # frames that came with the previous reply of this transaction
+            message = backlog.popleft()
+            if self._wanted(message, request, expect, key):
+                if keep:
                     self._unmatched(message)
-            if found is not None:
-                return found
-            if held:
-                continue
-            if self._parser.errors > errors:
-                bad = self._parser.errors - errors
+                return message  # type: ignore[return-value]  # _wanted checked its type
+            self._unmatched(message)
+        monotonic = time.monotonic
+        deadline = monotonic() + wait
+        parser = self._parser
+        if errors is None:
+            errors = parser.errors
+        chunk = b""
+        while True:
+            if chunk:
+                found = None
+                for message in parser.feed(chunk):
+                    if found is not None:
+                        backlog.append(message)  # maybe the next reply of a request_each
+                    elif self._wanted(message, request, expect, key):
+                        found = message
+                        if keep:
+                            self._unmatched(message)
+                    else:
+                        self._unmatched(message)
+                if found is not None:
+                    return found  # type: ignore[return-value]  # _wanted checked its type
+            if parser.errors > errors:
+                bad = parser.errors - errors
                 self._reset()
                 what = f" to {request.COMMAND} from {self._device(request)}" if request else ""
                 raise CorruptReply(f"corrupt reply{what}: {bad} frame(s) failed their checksum or content check")
-            if remaining <= 0 or (not chunk and time.monotonic() >= deadline):
-                pending = self._parser.pending()
+            now = monotonic()
+            if now >= deadline:
+                pending = parser.pending()
                 self._reset()
                 if request is None:
                     raise Timeout("", "", wait)
@@ -451,6 +641,13 @@ class Bus:
                         f"incomplete reply to {request.COMMAND} from {self._device(request)}: {pending.hex(' ')}"
                     )
                 raise Timeout(request.COMMAND, self._device(request), wait)
+            try:
+                chunk = self._link.read(deadline - now)
+            except Exception as exc:
+                self._port_failed("read", exc)
+                raise
+            if chunk and self._gap:
+                self._last_io = monotonic()
 
     def _device(self, request: Message) -> str:
         parts = [f"{n}={getattr(request, n)}" for n in self.binding.match_by if hasattr(request, n)]
@@ -464,7 +661,7 @@ class Bus:
                 if any(parts.values()):
                     text = ", ".join(f"{k} = {v.name.lower() if isinstance(v, Enum) else v}" for k, v in parts.items())
                     raise DeviceError(f"{reply.COMMAND}: the device reports {name} {text}", reply)
-            elif value:
+            elif value != 0:  # not `if value`: a flag's truth is a Python call, its comparison is int's
                 text = self.binding.describe_status(name, int(value))
                 raise DeviceError(f"{reply.COMMAND}: the device reports {text}", reply)
 
@@ -535,23 +732,6 @@ def _refused_setting(url: str, options: dict[str, Any]) -> str:
             port.close()
 
 
-class _PortFailures:
-    """The context manager behind Bus._port_failures: a class, as it runs three times per transaction."""
-
-    __slots__ = ("bus", "doing")
-
-    def __init__(self, bus: Bus, doing: str) -> None:
-        self.bus = bus
-        self.doing = doing
-
-    def __enter__(self) -> None:
-        return None
-
-    def __exit__(self, kind: type[BaseException] | None, exc: BaseException | None, trace: object) -> None:
-        if isinstance(exc, Exception):
-            self.bus._port_failed(self.doing, exc)
-
-
 class ClientBase:
     """What every generated client shares: the bus, the context manager, broadcast and optional replies."""
 
@@ -580,8 +760,9 @@ class ClientBase:
         return self.BROADCAST is not None and getattr(request, self.ADDRESS, None) == self.BROADCAST
 
     def _ask(self, request: Message, expect: type[M], after: str = "") -> M:
-        extra = float(getattr(request, after)) / 1000 if after else 0.0
-        return self.bus.request(request, expect, timeout=self.bus.timeout + extra)
+        if not after:
+            return self.bus.request(request, expect)
+        return self.bus.request(request, expect, timeout=self.bus.timeout + float(getattr(request, after)) / 1000)
 
     def _maybe(
         self, request: Message, expect: type[M], optional: tuple[int, int, str] | None, after: str = ""

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import os
 
+from serialspec.collection import without_cycle_collection
 from serialspec.spec.errors import SpecError, SpecErrors
 from serialspec.spec.loader import Located, load_file
 from serialspec.spec.model import Protocol
@@ -20,6 +21,7 @@ def load_protocol(path: str, display_name: str | None = None) -> Protocol:
     return resolve(located)
 
 
+@without_cycle_collection
 def resolve(located: Located) -> Protocol:
     """Run every pass over a loaded spec; raises SpecErrors listing every problem they found."""
     ctx = Context(located)

@@ -6,9 +6,11 @@ neither break a table nor inject HTML into the rendered page.
 
 from __future__ import annotations
 
+from collections import Counter
 from dataclasses import dataclass
 from typing import Any
 
+from serialspec.collection import without_cycle_collection
 from serialspec.emit.common import render as common
 from serialspec.emit.common.frames import runtime_layouts
 from serialspec.emit.common.numbers import number
@@ -241,23 +243,10 @@ def shared_reply_text(protocol: Protocol, message: Message) -> str:
     """A reply layout that shares its code (or its having none) with others: chosen by the request it answers."""
     layout = protocol.framing.layouts[Direction.RESPONSE]
     code = protocol.command(message.command).code if layout.has_command else None
-    sharing = [
-        m
-        for m in protocol.messages()
-        if m.direction == Direction.RESPONSE
-        and not m.unsolicited
-        and (protocol.command(m.command).code if layout.has_command else None) == code
-        and not protocol.command(m.command).subcommands
-    ]
-    if len(sharing) < 2:
+    sharing, asking = reply_sharing(protocol)
+    if sharing[code] < 2:
         return ""
-    askers = sorted(
-        {
-            r.command
-            for r in protocol.messages()
-            if r.direction == Direction.REQUEST and (r.answered_by or r.key) == message.key
-        }
-    )
+    askers = sorted(asking.get(message.key, ()))
     answers = ", ".join(f"`{a}`" for a in askers) or "no request"
     default = (
         "; a reply decoded without its request is read with this layout"
@@ -265,6 +254,28 @@ def shared_reply_text(protocol: Protocol, message: Message) -> str:
         else "; chosen by the request it answers (the replies share their code)"
     )
     return f"the layout of the replies to {answers}{default}"
+
+
+_SHARING: dict[int, tuple[Protocol, Counter[int | None], dict[str, set[str]]]] = {}
+
+
+def reply_sharing(protocol: Protocol) -> tuple[Counter[int | None], dict[str, set[str]]]:
+    """Worked out once per protocol (once per message was quadratic in the number of commands): how many plain
+    replies share each code (None: replies without one), and the commands whose requests each reply layout
+    answers."""
+    cached = _SHARING.get(id(protocol))
+    if cached is None or cached[0] is not protocol:
+        has_command = protocol.framing.layouts[Direction.RESPONSE].has_command
+        sharing: Counter[int | None] = Counter()
+        asking: dict[str, set[str]] = {}
+        for m in protocol.messages():
+            if m.direction == Direction.REQUEST:
+                asking.setdefault(m.answered_by or m.key, set()).add(m.command)
+            elif not m.unsolicited and not protocol.command(m.command).subcommands:
+                sharing[protocol.command(m.command).code if has_command else None] += 1
+        _SHARING.clear()  # one protocol at a time: the cache never holds on to old models
+        cached = _SHARING[id(protocol)] = (protocol, sharing, asking)
+    return cached[1], cached[2]
 
 
 def command_context(protocol: Protocol, command: Command) -> dict[str, Any]:
@@ -561,6 +572,7 @@ def _show(value: Any) -> str:
     return str(value)
 
 
+@without_cycle_collection
 def emit_docs(protocol: Protocol) -> str:
     commands = [command_context(protocol, c) for c in protocol.commands]
     examples = [

@@ -6,6 +6,7 @@ import re
 from pathlib import Path
 from typing import Any
 
+from serialspec.collection import without_cycle_collection
 from serialspec.emit.common.numbers import number
 from serialspec.emit.python.client import client_module
 from serialspec.emit.python.frames import checksum_definitions, code_key, codec_lines, framing_imports
@@ -59,6 +60,7 @@ def _keys(cls: ClassCode) -> list[str]:
     return [line.split(":")[0] for line in cls.attributes if not line.startswith("#")]
 
 
+@without_cycle_collection
 def emit_package(protocol: Protocol) -> dict[str, str]:
     """File name (relative to the package folder) -> text."""
     code = PackageCode(protocol)
@@ -175,10 +177,9 @@ def message_doc(protocol: Protocol, message: Message) -> str:
 
 
 def codec_context(protocol: Protocol, code: PackageCode, exports: list[str]) -> dict[str, Any]:
-    context = common_codec_context(protocol, code, exports)
-    if protocol.framing.classic:
-        return context | classic_codec_context(protocol)
-    return context | general_codec_context(protocol)
+    # the target's part first: the classic codec's whole-frame decoders add structs the common part lists
+    specific = classic_codec_context(protocol, code) if protocol.framing.classic else general_codec_context(protocol)
+    return common_codec_context(protocol, code, exports) | specific
 
 
 def general_codec_context(protocol: Protocol) -> dict[str, Any]:
@@ -259,7 +260,7 @@ def value_arguments(layout: FrameLayout) -> dict[str, str]:
     }
 
 
-def classic_codec_context(protocol: Protocol) -> dict[str, Any]:
+def classic_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, Any]:
     """Straight-line frame checks for frames of the classic shape (see FrameLayout.classic)."""
     assert protocol.framing.checksum is not None
     checksum = protocol.framing.checksum
@@ -267,6 +268,8 @@ def classic_codec_context(protocol: Protocol) -> dict[str, Any]:
     checksum_import, checksum_definition = crc_setup(checksum)
     directions = []
     dispatchers = []
+    frame_functions: list[dict[str, Any]] = []
+    decoder_bodies = {name: (returns, extra, lines) for name, returns, extra, lines in code.decoders}
     for direction, layout in protocol.framing.layouts.items():
         dispatch = []
         sizes = []
@@ -280,8 +283,14 @@ def classic_codec_context(protocol: Protocol) -> dict[str, Any]:
             sizes.append((key, low, high))
             if sub_dispatch:
                 dispatchers.append(sub_dispatch | value_arguments(layout))
+        fixed = fixed_frames(protocol, layout, decoder_bodies, code)
+        frame_functions += [f for _, _, f in fixed]
         directions.append(
             {
+                "fixed": [(key, size, function["name"]) for key, size, function in fixed],
+                "whole_frames": whole_frames(layout, fixed),
+                "whole_size": max(layout.length_offset, layout.command_offset or 0) + 1,
+                "key": frame_key(layout, "data"),
                 "name": direction.value,
                 "upper": direction.name,
                 "header": repr(layout.header),
@@ -305,6 +314,7 @@ def classic_codec_context(protocol: Protocol) -> dict[str, Any]:
         "checksum_import": checksum_import,
         "checksum_definition": checksum_definition,
         "directions": directions,
+        "frame_functions": frame_functions,
         "dispatchers": dispatchers,
         "header_choices": header_choices,
     }
@@ -333,6 +343,155 @@ def common_codec_context(protocol: Protocol, code: PackageCode, exports: list[st
         ),
         "shared_header": protocol.framing.shared_header,
     }
+
+
+_CURSOR = re.compile(r"\b(o|end)\b")
+
+
+def frame_key(layout: FrameLayout, buf: str, start: str = "") -> str:
+    """The expression of a frame's size key (command code and length byte) as the stream parser's tables use it."""
+    at = f"{start} + " if start else ""
+    length = f"{buf}[{at}{layout.length_offset}]"
+    if layout.command_offset is None:
+        return length
+    return f"{buf}[{at}{layout.command_offset}] << 8 | {length}"
+
+
+def whole_frames(layout: FrameLayout, fixed: list[tuple[str, int, dict[str, Any]]]) -> list[tuple[str, int, str]]:
+    """decode()'s table of the frames decoded whole, keyed by their first bytes when those are the header, command
+    code and length byte (one slice, one lookup, and the header is checked with them); [] where they are not."""
+    width = len(layout.header)
+    offsets = sorted(o for o in (layout.command_offset, layout.length_offset) if o is not None)
+    if offsets != list(range(width, width + len(offsets))):
+        return []
+    entries = []
+    for key, size, function in fixed:
+        value = int(key, 16)
+        bytes_at = {layout.length_offset: value & 0xFF}
+        if layout.command_offset is not None:
+            bytes_at[layout.command_offset] = value >> 8
+        entries.append((repr(layout.header + bytes(bytes_at[o] for o in offsets)), size, function["name"]))
+    return entries
+
+
+def fixed_frames(
+    protocol: Protocol, layout: FrameLayout, bodies: dict[str, tuple[str, str, Lines]], code: PackageCode
+) -> list[tuple[str, int, dict[str, Any]]]:
+    """Whole-frame decoders for the frames of one size whose content is one run of fixed fields: (size key, frame
+    size, function). Each checks the checksum, unpacks the content in one call and builds the message: no
+    dispatch, no size checks (the key is the command code and length byte, so the size is known), one call per
+    frame. It returns None for a frame whose checksum fails, so callers word the error (decode) or count it (the
+    stream parser); it raises nothing. Frames of any other kind keep the general path."""
+    checksum = protocol.framing.checksum
+    if checksum is None:
+        return []  # classic frames have one
+    content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
+    found = []
+    for command in protocol.commands:
+        message = command.request if layout.direction == Direction.REQUEST else command.response
+        if command.selector is not None or message is None or message.min_size != message.max_size:
+            continue
+        returns, extra, lines = bodies[decoder_name(message)]
+        if not lines[0].startswith("if end - o != "):
+            continue
+        body = lines[2:]  # the content size check: the key implies the size
+        text = "\n".join(body)
+        if text.count("(buf, o)") > 1 or _CURSOR.search(text.replace("(buf, o)", "")) or "raise " in text:
+            continue  # content read at a moving cursor, or checked beyond its size: the general path
+        size = layout.overhead + (message.min_size or 0)
+        values = [f"{e.name} = buf[start + {layout.offsets[e.name]}]" for e in layout.value_elements]
+        length_byte = (message.min_size or 0) + layout.length_adds
+        summed = summed_frame(protocol, layout, command.code, length_byte, size, body, code)
+        if summed is not None:
+            lines = [*values, *summed, *body[1:]]
+        else:
+            stored = (
+                f"buf[start + {size - 1}]"
+                if layout.checksum_offset_from_end == 1
+                else f"int.from_bytes(buf[start + {size - layout.checksum_offset_from_end} : start + {size}], 'little')"
+            )
+            covered = f"buf[start + {layout.covered_from} : start + {size - layout.covered_to_end}]"
+            lines = [
+                *checksum_lines(checksum, covered, "expected"),
+                f"if expected != {stored}:",
+                "    return None",
+                *values,
+                *(line.replace("(buf, o)", f"(buf, start + {content_offset})") for line in body),
+            ]
+        function = {
+            "name": "_frame" + decoder_name(message).removeprefix("_decode"),
+            "returns": returns,
+            "where": f"{message.key} {message.direction.value}",
+            "lines": lines,
+        }
+        key = length_byte if layout.command_offset is None else (command.code or 0) << 8 | length_byte
+        found.append((f"{key:#06x}", size, function))
+    return found
+
+
+_UNPACK = re.compile(r"^(?P<targets>.+) = (?P<struct>_S_\w+)\.unpack_from\(buf, o\)$")
+_BYTES_OF = {"B": 1, "b": 1, "H": 2, "h": 2, "I": 4, "i": 4, "Q": 8, "q": 8}
+_MOST_TERMS = 4  # byte terms of a checksum computed from the values; beyond it the frame's bytes are summed
+
+
+def summed_frame(
+    protocol: Protocol,
+    layout: FrameLayout,
+    command: int | None,
+    length_byte: int,
+    size: int,
+    body: Lines,
+    code: PackageCode,
+) -> Lines | None:
+    """For an 8-bit sum checksum right after integer-only content: lines that unpack the content and the checksum
+    in one call and check the sum from the values (a byte sum does not depend on byte order), so no slice of the
+    frame is made and summed. The frame's other covered bytes must be the header, command code and length byte
+    (constants, given the key) and one-byte frame values. None where the frame is not like that."""
+    checksum = protocol.framing.checksum
+    match = _UNPACK.match(body[0]) if body else None
+    if checksum is None or checksum.algorithm != "sum" or checksum.type.size != 1 or not match:
+        return None
+    if layout.checksum_offset_from_end != 1:
+        return None
+    fmt = code.structs[match["struct"]]
+    targets = [t.strip() for t in match["targets"].split(",") if t.strip()]
+    if len(targets) != len(fmt) - 1 or any(c not in _BYTES_OF for c in fmt[1:]):
+        return None
+    content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
+    if content_offset + sum(_BYTES_OF[c] for c in fmt[1:]) != size - 1:
+        return None  # the checksum does not follow the content
+    constant = 0
+    terms = []
+    for offset in range(layout.covered_from, size - layout.covered_to_end):
+        if offset < len(layout.header):
+            constant += layout.header[offset]
+        elif offset == layout.command_offset:
+            constant += command or 0
+        elif offset == layout.length_offset:
+            constant += length_byte
+        elif content_offset <= offset < size - 1:
+            continue  # the content's values, below
+        else:
+            element = next((e for e in layout.value_elements if layout.offsets[e.name] == offset and e.size == 1), None)
+            if element is None:
+                return None
+            terms.append(element.name)
+    for target, char in zip(targets, fmt[1:], strict=True):
+        width = _BYTES_OF[char]
+        if width == 1:
+            terms.append(target if char == "B" else f"({target} & 0xff)")
+        else:
+            terms += [f"({target} & 0xff)", *(f"({target} >> {8 * i} & 0xff)" for i in range(1, width))]
+    if len(terms) > _MOST_TERMS:
+        return None  # summing a slice of the frame in C is cheaper than this many terms in Python
+    with_check = code.struct(match["struct"].removeprefix("_S_") + "_and_check", fmt + "B")
+    total = " + ".join([f"{constant:#x}", *terms])
+    invert = "~" if checksum.invert else ""
+    return [
+        f"{', '.join(targets)}, check = {with_check}.unpack_from(buf, start + {content_offset})",
+        f"if {invert}({total}) & 0xff != check:",
+        "    return None",
+    ]
 
 
 def names_used_in_codec(code: PackageCode) -> set[str]:

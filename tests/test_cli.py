@@ -97,6 +97,32 @@ def test_check_fails_when_a_generated_file_is_stale(tmp_path: Path) -> None:
     assert "generated/docs/fashionstar_uart.md: stale" in result.stderr
 
 
+def test_a_mistake_in_one_spec_leaves_the_language_reference_alone(tmp_path: Path) -> None:
+    """The reference's examples come from every spec: a spec that fails to load must not rewrite it (or make check
+    call it stale and send the user to `generate`, which cannot help)."""
+    for folder in ("specs", "generated", "docs"):
+        shutil.copytree(ROOT / folder, tmp_path / folder, ignore=shutil.ignore_patterns("__pycache__"))
+    shutil.copy(ROOT / "pyproject.toml", tmp_path / "pyproject.toml")
+    reference = (tmp_path / "docs" / "language.md").read_text(encoding="utf-8")
+    spec = tmp_path / "specs" / "fashionstar_uart.yaml"
+    spec.write_text(spec.read_text(encoding="utf-8").replace("type: u8", "type: int17", 1), encoding="utf-8")
+    checked = serialspec("check", "--root", str(tmp_path))
+    assert checked.returncode == 1 and "'int17'" in checked.stderr
+    assert "language.md" not in checked.stderr and "run `serialspec generate`" not in checked.stderr
+    assert serialspec("generate", "--root", str(tmp_path)).returncode == 1
+    assert (tmp_path / "docs" / "language.md").read_text(encoding="utf-8") == reference
+
+
+def test_a_spec_named_on_the_command_line_leaves_the_language_reference_alone(tmp_path: Path) -> None:
+    """The reference's examples come from all the project's specs: `check SPEC` and `generate SPEC --out DIR` in a
+    project neither call it stale nor rewrite it from the one spec."""
+    assert serialspec("check", "specs/fashionstar_uart.yaml").returncode == 0
+    reference = (ROOT / "docs" / "language.md").read_text(encoding="utf-8")
+    assert serialspec("generate", "specs/fashionstar_uart.yaml", "--out", str(tmp_path)).returncode == 0
+    assert (ROOT / "docs" / "language.md").read_text(encoding="utf-8") == reference
+    assert (tmp_path / "fashionstar_uart" / "__init__.py").is_file()
+
+
 def test_decode_picks_the_reply_layout_by_the_request() -> None:
     spec = "specs/dynamixel_p2.yaml"
     status = "FF FF FD 00 01 07 00 55 00 06 04 26 65 5D"  # PING's reply, or a 3-byte READ's: the request decides
@@ -105,6 +131,18 @@ def test_decode_picks_the_reply_layout_by_the_request() -> None:
     ping = "FF FF FD 00 01 03 00 01 19 4E"
     answered = serialspec("decode", spec, status, "--direction", "response", "--request", ping, "--json")
     assert json.loads(answered.stdout)["fields"]["model_number"] == 1030
+
+
+def test_options_may_come_between_the_spec_and_the_frames() -> None:
+    """`decode SPEC --direction response --request HEX FRAME`, the order the README names them in."""
+    read = "FF FF 01 04 02 38 02 BE"
+    result = serialspec(
+        "decode", "specs/feetech_sms.yaml", "--direction", "response", "--request", read, "FF FF 01 04 00 18 05 DD"
+    )
+    assert result.returncode == 0, result.stderr
+    assert "register present_position 1304" in result.stdout
+    wrong = serialspec("decode", "specs/feetech_sms.yaml", "--direction", "response", "--bogus", "FF FF 01 02 00 FC")
+    assert wrong.returncode == 2 and "serialspec decode: error: unrecognized arguments: --bogus" in wrong.stderr
 
 
 def test_check_names_a_hand_written_file_inside_a_generated_package(tmp_path: Path) -> None:

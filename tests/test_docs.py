@@ -62,6 +62,26 @@ def test_the_readme_commands_print_what_the_readme_shows() -> None:
         assert command.startswith(".venv/bin/serialspec "), "README commands work right after `make generate`"
 
 
+def test_the_readme_command_example_and_its_mistake_give_what_the_readme_shows(tmp_path: Path) -> None:
+    """The README's new command, added at the end of `commands:`, generates; with `power: int17` it gives the
+    README's one-line error, at the line and column the README prints."""
+    command = blocks(ROOT / "README.md", "yaml")[0]
+    assert command.startswith("commands:\n")
+    shutil.copytree(ROOT / "specs", tmp_path / "specs")
+    spec = tmp_path / "specs" / "fashionstar_uart.yaml"
+    text = spec.read_text(encoding="utf-8")
+    spec.write_text(text.replace("\nexamples:\n", "\n" + command.removeprefix("commands:\n") + "examples:\n"))
+    run(f"serialspec generate {spec} --out {tmp_path / 'out'}", tmp_path)
+    assert "class ReadAnglePowerResponse(" in (tmp_path / "out" / "fashionstar_uart" / "messages.py").read_text()
+    spec.write_text(
+        spec.read_text(encoding="utf-8").replace(
+            "power: {type: u16, unit: mW, description: Power now.}", "power: int17"
+        )
+    )
+    printed = [block for block in blocks(ROOT / "README.md", "console") if "int17" in block]
+    assert run("serialspec check specs/fashionstar_uart.yaml", tmp_path) == printed[0].splitlines()
+
+
 def test_every_yaml_block_of_the_tutorial_is_part_of_its_spec() -> None:
     spec = TINYLAMP.read_text(encoding="utf-8")
     yaml_blocks = blocks(TUTORIAL, "yaml")
@@ -111,3 +131,16 @@ def test_the_documentation_site_builds_strictly(tmp_path: Path) -> None:
     assert {"index.html", "tutorial.html", "language.html", "protocols/feetech_sms.html"} <= built
     index = (tmp_path / "site" / "index.html").read_text(encoding="utf-8")
     assert 'href="protocols/feetech_sms.html"' in index and 'href="tutorial.html"' in index
+
+
+@pytest.mark.parametrize("spec", sorted((ROOT / "specs").glob("*.yaml")), ids=lambda p: p.stem)
+def test_example_breakdowns_show_values_as_people_write_them(spec: Path) -> None:
+    """A bit-field status in an example's breakdown reads `alert=0, number=0`, coils `[1; 0; 1]`: never Python's repr,
+    and a protocol without errata says so under its Errata heading."""
+    from serialspec.emit.markdown.docs import emit_docs
+    from serialspec.spec import load_protocol
+
+    docs = emit_docs(load_protocol(str(spec), spec.name))
+    assert not re.findall(r"\{'|\['|<[A-Z]\w+\.|\[(?:True|False);", docs)
+    errata = docs.split("\n## Errata\n")[1]
+    assert errata.strip() and ("### " in errata or "None recorded" in errata)

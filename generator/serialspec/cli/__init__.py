@@ -18,11 +18,17 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="serialspec", description=__doc__.split(":")[0] if __doc__ else None)
     parser.add_argument("--version", action="version", version=f"serialspec {__version__}")
     verbs = parser.add_subparsers(dest="verb", required=True, metavar="VERB")
+    subparsers = {}
     for name, module in VERBS.items():
-        sub = verbs.add_parser(name, help=module.HELP, description=module.HELP)
+        sub = subparsers[name] = verbs.add_parser(name, help=module.HELP, description=module.HELP)
         module.add_arguments(sub)
-        sub.set_defaults(run=module.run)
-    args = parser.parse_args(argv)
+        sub.set_defaults(run=module.run, verb=name)
+    args, extra = parser.parse_known_args(argv)
+    if extra:
+        # Options between a verb's positional arguments (`decode SPEC --direction response HEX`): argparse only
+        # intermixes them without subparsers, so the verb's own parser reads its arguments again.
+        given = list(sys.argv[1:] if argv is None else argv)
+        args = subparsers[args.verb].parse_intermixed_args(given[given.index(args.verb) + 1 :])
     try:
         code: int = args.run(args)
     except SpecErrors as exc:

@@ -88,7 +88,8 @@ def project(root: Path | None, specs: Sequence[str] = (), out: str | None = None
         schema: Path | None = root / "specs" / SCHEMA_NAME if (root / "specs").is_dir() else out_dir / SCHEMA_NAME
     else:
         schema = root / str(schema_setting) if schema_setting else None
-    reference = config.get("reference")
+    # The reference's examples come from the project's whole set of specs: not written from a few named ones.
+    reference = None if specs else config.get("reference")
     return Project(root, tuple(files), out_dir, schema, root / str(reference) if reference else None, bool(specs))
 
 
@@ -117,7 +118,7 @@ def expected_files(proj: Project) -> tuple[dict[Path, str], list[SpecError]]:
             if emitter.verify is not None:
                 errors.extend(emitter.verify(protocol, emitted))
         files[proj.out / protocol.name / SHIPPED_SPEC] = shipped_spec(protocol.spec_path, spec)
-    if proj.reference is not None:
+    if proj.reference is not None and not errors:  # its examples come from every spec: none while one fails
         files[proj.reference] = reference_markdown(examples)
     return files, errors
 

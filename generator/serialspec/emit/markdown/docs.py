@@ -482,7 +482,7 @@ def general_breakdown(protocol: Protocol, example: Example, message: Message | N
             value = f"{e.unpack(part)} (bytes `{layout.elements[e.span[0]].name}`..`{layout.elements[e.span[1]].name}`)"
         elif e.kind == "checksum":
             value = "verifies"
-        rows.append({"bytes": part.hex(" ").upper(), "field": e.name, "value": cell(value)})
+        rows.append({"bytes": part.hex(" ").upper(), "field": e.name, "value": cell(_show(value))})
     return rows
 
 
@@ -519,7 +519,7 @@ def breakdown(protocol: Protocol, example: Example) -> list[dict[str, str]]:
                 {
                     "bytes": frame[offset : offset + size].hex(" ").upper(),
                     "field": e.name,
-                    "value": cell(value),
+                    "value": cell(_show(value)),
                 }
             )
         offset += size
@@ -565,6 +565,8 @@ def content_rows(
 
 
 def _show(value: Any) -> str:
+    if isinstance(value, bool):  # coils and other single bits, as the documents print them
+        return str(int(value))
     if isinstance(value, dict):
         return ", ".join(f"{k}={_show(v)}" for k, v in value.items())
     if isinstance(value, list):

@@ -10,10 +10,12 @@ from typing import Any, ClassVar, Self
 
 from serialspec.runtime.fields import as_bytes as _bytes
 from serialspec.runtime.fields import check_keys as _check_keys
+from serialspec.runtime.fields import enum as _as_enum
 from serialspec.runtime.fields import get as _get
+from serialspec.runtime.fields import integer as _integer
+from serialspec.runtime.fields import items as _items
 from serialspec.runtime.fields import mapping as _mapping
 from serialspec.runtime.message import Direction, Message
-from serialspec.runtime.message import enum_or_int as _enum
 
 __all__ = [
     'ActionRequest',
@@ -55,133 +57,133 @@ __all__ = [
 class ErrorNumber(IntEnum):
     """The error number of a status packet (bits 6..0 of its error byte; protocol2 §Error)."""
 
-    NONE = 0
     #: no error
-    RESULT_FAIL = 1
+    NONE = 0
     #: failed to process the instruction packet
-    INSTRUCTION_ERROR = 2
+    RESULT_FAIL = 1
     #: undefined instruction, or ACTION without REG WRITE
-    CRC_ERROR = 3
+    INSTRUCTION_ERROR = 2
     #: the CRC of the packet does not match
-    DATA_RANGE_ERROR = 4
+    CRC_ERROR = 3
     #: the data to write is outside the item's minimum..maximum
-    DATA_LENGTH_ERROR = 5
+    DATA_RANGE_ERROR = 4
     #: the data is shorter than the item (e.g. 2 bytes of a 4-byte item)
-    DATA_LIMIT_ERROR = 6
+    DATA_LENGTH_ERROR = 5
     #: the data to write is outside the item's limit value
-    ACCESS_ERROR = 7
+    DATA_LIMIT_ERROR = 6
     #: writing a read-only or undefined item, reading a write-only one, or writing EEPROM while torque is on
+    ACCESS_ERROR = 7
 
 
 class ResetOption(IntEnum):
     """What FACTORY RESET resets (protocol2 §Factory Reset, parameter 1)."""
 
-    ALL_BUT_ID = 1
     #: reset all but the id
-    ALL_BUT_ID_AND_BAUD_RATE = 2
+    ALL_BUT_ID = 1
     #: reset all but the id and the baud rate
-    ALL = 255
+    ALL_BUT_ID_AND_BAUD_RATE = 2
     #: reset all (ignored when sent to the broadcast id, firmware 42 and later)
+    ALL = 255
 
 
 class ClearOption(IntEnum):
     """What CLEAR resets (protocol2 §Clear, parameter 1)."""
 
-    MULTI_TURN = 1
     #: reset the present position to within one turn (0..4095); only while stopped
+    MULTI_TURN = 1
 
 
 class BaudRate(IntEnum):
     """Baud rate option (register 8)."""
 
-    BAUD_9600 = 0
     #: 9600
-    BAUD_57600 = 1
+    BAUD_9600 = 0
     #: 57600
-    BAUD_115200 = 2
+    BAUD_57600 = 1
     #: 115200
-    BAUD_1000000 = 3
+    BAUD_115200 = 2
     #: 1M
-    BAUD_2000000 = 4
+    BAUD_1000000 = 3
     #: 2M
-    BAUD_3000000 = 5
+    BAUD_2000000 = 4
     #: 3M
-    BAUD_4000000 = 6
+    BAUD_3000000 = 5
     #: 4M
-    BAUD_4500000 = 7
+    BAUD_4000000 = 6
     #: 4.5M
+    BAUD_4500000 = 7
 
 
 class OperatingMode(IntEnum):
     """Operating mode (register 11)."""
 
-    CURRENT = 0
     #: current (torque) control
-    VELOCITY = 1
+    CURRENT = 0
     #: velocity control
-    POSITION = 3
+    VELOCITY = 1
     #: position control, one turn (default)
-    EXTENDED_POSITION = 4
+    POSITION = 3
     #: extended position (multi-turn) control
-    CURRENT_BASED_POSITION = 5
+    EXTENDED_POSITION = 4
     #: current-based position control
-    PWM = 16
+    CURRENT_BASED_POSITION = 5
     #: PWM (voltage) control
+    PWM = 16
 
 
 class StatusReturnLevel(IntEnum):
     """Which instructions a servo answers (register 68)."""
 
-    PING_ONLY = 0
     #: only PING is answered
-    PING_AND_READ = 1
+    PING_ONLY = 0
     #: PING and READ are answered
-    ALL = 2
+    PING_AND_READ = 1
     #: every instruction is answered (default)
+    ALL = 2
 
 
 class TorqueEnable(IntEnum):
     """Torque switch (register 64); EEPROM items are locked while it is on."""
 
-    OFF = 0
     #: torque off
-    ON = 1
+    OFF = 0
     #: torque on (EEPROM locked)
+    ON = 1
 
 
 class ProtocolType(IntEnum):
     """Protocol of the servo (register 13)."""
 
-    PROTOCOL_1 = 1
     #: DYNAMIXEL Protocol 1.0
-    PROTOCOL_2 = 2
+    PROTOCOL_1 = 1
     #: DYNAMIXEL Protocol 2.0 (default)
+    PROTOCOL_2 = 2
 
 
 class HardwareError(IntFlag):
     """Hardware error status (register 70) and shutdown conditions (register 63)."""
 
     NONE = 0
-    INPUT_VOLTAGE = 1 << 0
     #: input voltage outside the voltage limits
-    OVERHEATING = 1 << 2
+    INPUT_VOLTAGE = 1 << 0
     #: internal temperature above the temperature limit
-    MOTOR_ENCODER = 1 << 3
+    OVERHEATING = 1 << 2
     #: motor encoder fault
-    ELECTRICAL_SHOCK = 1 << 4
+    MOTOR_ENCODER = 1 << 3
     #: electrical shock on the circuit or insufficient power
-    OVERLOAD = 1 << 5
+    ELECTRICAL_SHOCK = 1 << 4
     #: persistent load above the maximum output
+    OVERLOAD = 1 << 5
 
 
 @dataclass(frozen=True, slots=True)
 class ErrorBits:
     """Bit fields of error."""
 
-    alert: int
     #: The servo has a hardware problem; see hardware_error_status (70). (bit 7)
-    number: ErrorNumber | int
+    alert: int
     #: The result of processing the instruction. (bits 6..0)
+    number: ErrorNumber | int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -193,8 +195,8 @@ class ErrorBits:
     def from_fields(cls, data: Mapping[str, Any], where: str = 'ErrorBits') -> Self:
         _check_keys(data, ('alert', 'number'), (), where)
         return cls(
-            _get(data, 'alert', where),
-            _enum(ErrorNumber, _get(data, 'number', where)),
+            _integer(_get(data, 'alert', where), 'alert', where),
+            _as_enum(ErrorNumber, _get(data, 'number', where), 'number', where),
         )
 
 
@@ -202,8 +204,8 @@ class ErrorBits:
 class IdsItem:
     """One item of ids."""
 
-    id: int
     #: A servo id. range 0..252
+    id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -214,7 +216,7 @@ class IdsItem:
     def from_fields(cls, data: Mapping[str, Any], where: str = 'IdsItem') -> Self:
         _check_keys(data, ('id',), (), where)
         return cls(
-            _get(data, 'id', where),
+            _integer(_get(data, 'id', where), 'id', where),
         )
 
 
@@ -222,8 +224,8 @@ class IdsItem:
 class ServoIdsItem:
     """One item of servo_ids."""
 
-    id: int
     #: A servo id. range 0..252
+    id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -234,7 +236,7 @@ class ServoIdsItem:
     def from_fields(cls, data: Mapping[str, Any], where: str = 'ServoIdsItem') -> Self:
         _check_keys(data, ('id',), (), where)
         return cls(
-            _get(data, 'id', where),
+            _integer(_get(data, 'id', where), 'id', where),
         )
 
 
@@ -242,10 +244,10 @@ class ServoIdsItem:
 class ServosItem:
     """One item of servos."""
 
-    id: int
     #: The servo's id. range 0..252
-    data: bytes
+    id: int
     #: The bytes written to that servo from `address` on.
+    data: bytes
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -257,7 +259,7 @@ class ServosItem:
     def from_fields(cls, data: Mapping[str, Any], where: str = 'ServosItem') -> Self:
         _check_keys(data, ('id', 'data'), (), where)
         return cls(
-            _get(data, 'id', where),
+            _integer(_get(data, 'id', where), 'id', where),
             _bytes(_get(data, 'data', where), 'data', where),
         )
 
@@ -266,12 +268,12 @@ class ServosItem:
 class ReadsItem:
     """One item of reads."""
 
-    id: int
     #: The servo's id. range 0..252
-    address: int
+    id: int
     #: First control table address to read.
-    length: int
+    address: int
     #: Number of bytes to read. range 1..1024
+    length: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -284,9 +286,9 @@ class ReadsItem:
     def from_fields(cls, data: Mapping[str, Any], where: str = 'ReadsItem') -> Self:
         _check_keys(data, ('id', 'address', 'length'), (), where)
         return cls(
-            _get(data, 'id', where),
-            _get(data, 'address', where),
-            _get(data, 'length', where),
+            _integer(_get(data, 'id', where), 'id', where),
+            _integer(_get(data, 'address', where), 'address', where),
+            _integer(_get(data, 'length', where), 'length', where),
         )
 
 
@@ -294,12 +296,12 @@ class ReadsItem:
 class WritesItem:
     """One item of writes."""
 
-    id: int
     #: The servo's id. range 0..252
-    address: int
+    id: int
     #: First control table address to write.
-    data: bytes
+    address: int
     #: The bytes written to that servo from `address` on.
+    data: bytes
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -312,8 +314,8 @@ class WritesItem:
     def from_fields(cls, data: Mapping[str, Any], where: str = 'WritesItem') -> Self:
         _check_keys(data, ('id', 'address', 'data'), (), where)
         return cls(
-            _get(data, 'id', where),
-            _get(data, 'address', where),
+            _integer(_get(data, 'id', where), 'id', where),
+            _integer(_get(data, 'address', where), 'address', where),
             _bytes(_get(data, 'data', where), 'data', where),
         )
 
@@ -326,8 +328,8 @@ class PingRequest(Message):
     COMMAND: ClassVar[str] = 'ping'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    id: int
     #: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. range 0..252
+    id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -338,7 +340,7 @@ class PingRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'ping request') -> Self:
         _check_keys(data, ('id',), (), where)
         return cls(
-            _get(data, 'id', where),
+            _integer(_get(data, 'id', where), 'id', where),
         )
 
 
@@ -350,14 +352,14 @@ class PingResponse(Message):
     COMMAND: ClassVar[str] = 'ping'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    id: int
     #: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. range 0..252
-    error: ErrorBits
+    id: int
     #: Status packets only; bit 7 is the alert bit, bits 6..0 the error number (0 = no error).
-    model_number: int
+    error: ErrorBits
     #: The servo's model number (XM430-W350: 1020, XL430-W250: 1060, XL330-M288: 1200).
-    firmware_version: int
+    model_number: int
     #: The firmware version.
+    firmware_version: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -371,10 +373,10 @@ class PingResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'ping response') -> Self:
         _check_keys(data, ('id', 'error', 'model_number', 'firmware_version'), (), where)
         return cls(
-            _get(data, 'id', where),
-            ErrorBits.from_fields(_mapping(_get(data, 'error', where), 'error', where), where),
-            _get(data, 'model_number', where),
-            _get(data, 'firmware_version', where),
+            _integer(_get(data, 'id', where), 'id', where),
+            ErrorBits.from_fields(_mapping(_get(data, 'error', where), 'error', where), where + ' error'),
+            _integer(_get(data, 'model_number', where), 'model_number', where),
+            _integer(_get(data, 'firmware_version', where), 'firmware_version', where),
         )
 
 
@@ -386,12 +388,12 @@ class ReadRequest(Message):
     COMMAND: ClassVar[str] = 'read'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    id: int
     #: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. range 0..252
-    address: int
+    id: int
     #: First control table address to read.
-    length: int
+    address: int
     #: Number of bytes to read. range 1..1024
+    length: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -404,9 +406,9 @@ class ReadRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'read request') -> Self:
         _check_keys(data, ('id', 'address', 'length'), (), where)
         return cls(
-            _get(data, 'id', where),
-            _get(data, 'address', where),
-            _get(data, 'length', where),
+            _integer(_get(data, 'id', where), 'id', where),
+            _integer(_get(data, 'address', where), 'address', where),
+            _integer(_get(data, 'length', where), 'length', where),
         )
 
 
@@ -418,12 +420,12 @@ class WriteRequest(Message):
     COMMAND: ClassVar[str] = 'write'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    id: int
     #: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. range 0..252
-    address: int
+    id: int
     #: First control table address to write.
-    data: bytes
+    address: int
     #: The bytes written, item by item from `address` on.
+    data: bytes
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -436,8 +438,8 @@ class WriteRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'write request') -> Self:
         _check_keys(data, ('id', 'address', 'data'), (), where)
         return cls(
-            _get(data, 'id', where),
-            _get(data, 'address', where),
+            _integer(_get(data, 'id', where), 'id', where),
+            _integer(_get(data, 'address', where), 'address', where),
             _bytes(_get(data, 'data', where), 'data', where),
         )
 
@@ -450,12 +452,12 @@ class RegWriteRequest(Message):
     COMMAND: ClassVar[str] = 'reg_write'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    id: int
     #: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. range 0..252
-    address: int
+    id: int
     #: First control table address to write.
-    data: bytes
+    address: int
     #: The bytes to write when ACTION arrives.
+    data: bytes
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -468,8 +470,8 @@ class RegWriteRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'reg_write request') -> Self:
         _check_keys(data, ('id', 'address', 'data'), (), where)
         return cls(
-            _get(data, 'id', where),
-            _get(data, 'address', where),
+            _integer(_get(data, 'id', where), 'id', where),
+            _integer(_get(data, 'address', where), 'address', where),
             _bytes(_get(data, 'data', where), 'data', where),
         )
 
@@ -482,8 +484,8 @@ class ActionRequest(Message):
     COMMAND: ClassVar[str] = 'action'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    id: int
     #: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. range 0..252
+    id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -494,7 +496,7 @@ class ActionRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'action request') -> Self:
         _check_keys(data, ('id',), (), where)
         return cls(
-            _get(data, 'id', where),
+            _integer(_get(data, 'id', where), 'id', where),
         )
 
 
@@ -506,10 +508,10 @@ class FactoryResetRequest(Message):
     COMMAND: ClassVar[str] = 'factory_reset'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    id: int
     #: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. range 0..252
+    id: int
+    #: What to reset. range 1..255
     option: ResetOption | int
-    #: What to reset.
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -521,8 +523,8 @@ class FactoryResetRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'factory_reset request') -> Self:
         _check_keys(data, ('id', 'option'), (), where)
         return cls(
-            _get(data, 'id', where),
-            _enum(ResetOption, _get(data, 'option', where)),
+            _integer(_get(data, 'id', where), 'id', where),
+            _as_enum(ResetOption, _get(data, 'option', where), 'option', where),
         )
 
 
@@ -534,8 +536,8 @@ class RebootRequest(Message):
     COMMAND: ClassVar[str] = 'reboot'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    id: int
     #: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. range 0..252
+    id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -546,7 +548,7 @@ class RebootRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'reboot request') -> Self:
         _check_keys(data, ('id',), (), where)
         return cls(
-            _get(data, 'id', where),
+            _integer(_get(data, 'id', where), 'id', where),
         )
 
 
@@ -558,10 +560,10 @@ class ClearRequest(Message):
     COMMAND: ClassVar[str] = 'clear'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    id: int
     #: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. range 0..252
+    id: int
+    #: What to clear. range 1..1
     option: ClearOption | int
-    #: What to clear.
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -573,8 +575,8 @@ class ClearRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'clear request') -> Self:
         _check_keys(data, ('id', 'option'), ('key',), where)
         return cls(
-            _get(data, 'id', where),
-            _enum(ClearOption, _get(data, 'option', where)),
+            _integer(_get(data, 'id', where), 'id', where),
+            _as_enum(ClearOption, _get(data, 'option', where), 'option', where),
         )
 
 
@@ -586,14 +588,14 @@ class SyncReadRequest(Message):
     COMMAND: ClassVar[str] = 'sync_read'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    id: int
     #: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. range 0..252
-    address: int
+    id: int
     #: First control table address to read.
-    length: int
+    address: int
     #: Number of bytes each servo returns. range 1..1024
-    ids: tuple[IdsItem, ...]
+    length: int
     #: The servos to read, in the order they answer.
+    ids: tuple[IdsItem, ...]
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -607,10 +609,10 @@ class SyncReadRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'sync_read request') -> Self:
         _check_keys(data, ('id', 'address', 'length', 'ids'), (), where)
         return cls(
-            _get(data, 'id', where),
-            _get(data, 'address', where),
-            _get(data, 'length', where),
-            tuple(IdsItem.from_fields(_mapping(item, 'ids', where), where) for item in _get(data, 'ids', where)),
+            _integer(_get(data, 'id', where), 'id', where),
+            _integer(_get(data, 'address', where), 'address', where),
+            _integer(_get(data, 'length', where), 'length', where),
+            tuple(IdsItem.from_fields(_mapping(item, 'ids', where), where) for item in _items(_get(data, 'ids', where), 'ids', where)),
         )
 
 
@@ -622,14 +624,14 @@ class FastSyncReadRequest(Message):
     COMMAND: ClassVar[str] = 'fast_sync_read'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    id: int
     #: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. range 0..252
-    address: int
+    id: int
     #: First control table address to read.
-    length: int
+    address: int
     #: Number of bytes each servo returns. range 1..1024
-    servo_ids: tuple[ServoIdsItem, ...]
+    length: int
     #: The servos to read, in the order their parts follow each other.
+    servo_ids: tuple[ServoIdsItem, ...]
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -643,10 +645,10 @@ class FastSyncReadRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'fast_sync_read request') -> Self:
         _check_keys(data, ('id', 'address', 'length', 'servo_ids'), (), where)
         return cls(
-            _get(data, 'id', where),
-            _get(data, 'address', where),
-            _get(data, 'length', where),
-            tuple(ServoIdsItem.from_fields(_mapping(item, 'servo_ids', where), where) for item in _get(data, 'servo_ids', where)),
+            _integer(_get(data, 'id', where), 'id', where),
+            _integer(_get(data, 'address', where), 'address', where),
+            _integer(_get(data, 'length', where), 'length', where),
+            tuple(ServoIdsItem.from_fields(_mapping(item, 'servo_ids', where), where) for item in _items(_get(data, 'servo_ids', where), 'servo_ids', where)),
         )
 
 
@@ -658,12 +660,12 @@ class SyncWriteRequest(Message):
     COMMAND: ClassVar[str] = 'sync_write'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    id: int
     #: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. range 0..252
-    address: int
+    id: int
     #: First control table address to write.
-    servos: tuple[ServosItem, ...]
+    address: int
     #: One item per servo.
+    servos: tuple[ServosItem, ...]
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -676,9 +678,9 @@ class SyncWriteRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'sync_write request') -> Self:
         _check_keys(data, ('id', 'address', 'servos'), ('length',), where)
         return cls(
-            _get(data, 'id', where),
-            _get(data, 'address', where),
-            tuple(ServosItem.from_fields(_mapping(item, 'servos', where), where) for item in _get(data, 'servos', where)),
+            _integer(_get(data, 'id', where), 'id', where),
+            _integer(_get(data, 'address', where), 'address', where),
+            tuple(ServosItem.from_fields(_mapping(item, 'servos', where), where) for item in _items(_get(data, 'servos', where), 'servos', where)),
         )
 
 
@@ -690,10 +692,10 @@ class BulkReadRequest(Message):
     COMMAND: ClassVar[str] = 'bulk_read'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    id: int
     #: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. range 0..252
-    reads: tuple[ReadsItem, ...]
+    id: int
     #: One item per servo.
+    reads: tuple[ReadsItem, ...]
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -705,8 +707,8 @@ class BulkReadRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bulk_read request') -> Self:
         _check_keys(data, ('id', 'reads'), (), where)
         return cls(
-            _get(data, 'id', where),
-            tuple(ReadsItem.from_fields(_mapping(item, 'reads', where), where) for item in _get(data, 'reads', where)),
+            _integer(_get(data, 'id', where), 'id', where),
+            tuple(ReadsItem.from_fields(_mapping(item, 'reads', where), where) for item in _items(_get(data, 'reads', where), 'reads', where)),
         )
 
 
@@ -718,10 +720,10 @@ class BulkWriteRequest(Message):
     COMMAND: ClassVar[str] = 'bulk_write'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    id: int
     #: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. range 0..252
-    writes: tuple[WritesItem, ...]
+    id: int
     #: One item per servo.
+    writes: tuple[WritesItem, ...]
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -733,8 +735,8 @@ class BulkWriteRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bulk_write request') -> Self:
         _check_keys(data, ('id', 'writes'), (), where)
         return cls(
-            _get(data, 'id', where),
-            tuple(WritesItem.from_fields(_mapping(item, 'writes', where), where) for item in _get(data, 'writes', where)),
+            _integer(_get(data, 'id', where), 'id', where),
+            tuple(WritesItem.from_fields(_mapping(item, 'writes', where), where) for item in _items(_get(data, 'writes', where), 'writes', where)),
         )
 
 
@@ -746,12 +748,12 @@ class StatusResponse(Message):
     COMMAND: ClassVar[str] = 'status'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    id: int
     #: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. range 0..252
-    error: ErrorBits
+    id: int
     #: Status packets only; bit 7 is the alert bit, bits 6..0 the error number (0 = no error).
-    data: bytes
+    error: ErrorBits
     #: The bytes read, item by item from the request's address (empty but for reads).
+    data: bytes
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -764,8 +766,8 @@ class StatusResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'status response') -> Self:
         _check_keys(data, ('id', 'error', 'data'), (), where)
         return cls(
-            _get(data, 'id', where),
-            ErrorBits.from_fields(_mapping(_get(data, 'error', where), 'error', where), where),
+            _integer(_get(data, 'id', where), 'id', where),
+            ErrorBits.from_fields(_mapping(_get(data, 'error', where), 'error', where), where + ' error'),
             _bytes(_get(data, 'data', where), 'data', where),
         )
 

@@ -10,7 +10,10 @@ from typing import Any, ClassVar, Self
 
 from serialspec.runtime.fields import as_bytes as _bytes
 from serialspec.runtime.fields import check_keys as _check_keys
+from serialspec.runtime.fields import flags as _as_flags
 from serialspec.runtime.fields import get as _get
+from serialspec.runtime.fields import integer as _integer
+from serialspec.runtime.fields import items as _items
 from serialspec.runtime.fields import mapping as _mapping
 from serialspec.runtime.message import Direction, Message
 
@@ -41,88 +44,88 @@ __all__ = [
 class BaudRate(IntEnum):
     """Baud rate option of register 0x06 (memory table; scservo_sdk SMS_STS_* rates)."""
 
-    BAUD_1000000 = 0
     #: 1000000
-    BAUD_500000 = 1
+    BAUD_1000000 = 0
     #: 500000
-    BAUD_250000 = 2
+    BAUD_500000 = 1
     #: 250000
-    BAUD_128000 = 3
+    BAUD_250000 = 2
     #: 128000
-    BAUD_115200 = 4
+    BAUD_128000 = 3
     #: 115200
-    BAUD_76800 = 5
+    BAUD_115200 = 4
     #: 76800
-    BAUD_57600 = 6
+    BAUD_76800 = 5
     #: 57600
-    BAUD_38400 = 7
+    BAUD_57600 = 6
     #: 38400
+    BAUD_38400 = 7
 
 
 class ResponseLevel(IntEnum):
     """Which instructions a servo answers (register 0x08)."""
 
-    READ_AND_PING_ONLY = 0
     #: only READ and PING are answered
-    ALL = 1
+    READ_AND_PING_ONLY = 0
     #: every instruction to the servo's own id is answered
+    ALL = 1
 
 
 class OperatingMode(IntEnum):
     """Operating mode (register 0x21)."""
 
-    POSITION = 0
     #: position servo mode
-    SPEED = 1
+    POSITION = 0
     #: constant speed (wheel) mode, closed loop
-    PWM = 2
+    SPEED = 1
     #: PWM open-loop speed mode
-    STEP = 3
+    PWM = 2
     #: step (multi-turn) mode
+    STEP = 3
 
 
 class TorqueEnable(IntEnum):
     """Torque switch (register 0x28)."""
 
-    OFF = 0
     #: torque off (free)
-    ON = 1
+    OFF = 0
     #: torque on
-    SET_MIDDLE = 128
+    ON = 1
     #: take the present position as the middle position (2048)
+    SET_MIDDLE = 128
 
 
 class Lock(IntEnum):
     """EEPROM write lock (register 0x37)."""
 
-    UNLOCKED = 0
     #: EEPROM writes are kept across power cycles
-    LOCKED = 1
+    UNLOCKED = 0
     #: EEPROM writes are not kept
+    LOCKED = 1
 
 
 class ErrorStatus(IntFlag):
     """The error status byte of a reply and the status register (0x41); a set bit reports a fault (bit numbers from scservo_sdk ERRBIT_*; 004 refers to the memory table for their meaning)."""
 
     NONE = 0
-    VOLTAGE = 1 << 0
     #: input voltage outside the voltage limits
-    ANGLE_SENSOR = 1 << 1
+    VOLTAGE = 1 << 0
     #: magnetic angle sensor fault
-    OVERHEAT = 1 << 2
+    ANGLE_SENSOR = 1 << 1
     #: temperature above the temperature limit
-    OVERCURRENT = 1 << 3
+    OVERHEAT = 1 << 2
     #: current above the protection current
-    OVERLOAD = 1 << 5
+    OVERCURRENT = 1 << 3
     #: load above the overload torque for longer than the protection time
+    OVERLOAD = 1 << 5
 
 
 @dataclass(frozen=True, slots=True)
 class IdsItem:
     """One item of ids."""
 
-    id: int
     #: A servo id. range 0..253
+    id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -133,7 +136,7 @@ class IdsItem:
     def from_fields(cls, data: Mapping[str, Any], where: str = 'IdsItem') -> Self:
         _check_keys(data, ('id',), (), where)
         return cls(
-            _get(data, 'id', where),
+            _integer(_get(data, 'id', where), 'id', where),
         )
 
 
@@ -141,10 +144,10 @@ class IdsItem:
 class ServosItem:
     """One item of servos."""
 
-    id: int
     #: The servo's id. range 0..253
-    data: bytes
+    id: int
     #: The L bytes written to that servo from `address` on.
+    data: bytes
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -156,7 +159,7 @@ class ServosItem:
     def from_fields(cls, data: Mapping[str, Any], where: str = 'ServosItem') -> Self:
         _check_keys(data, ('id', 'data'), (), where)
         return cls(
-            _get(data, 'id', where),
+            _integer(_get(data, 'id', where), 'id', where),
             _bytes(_get(data, 'data', where), 'data', where),
         )
 
@@ -169,8 +172,8 @@ class PingRequest(Message):
     COMMAND: ClassVar[str] = 'ping'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    id: int
     #: Servo id 0..253; 254 (0xFE) is the broadcast id: every servo takes the instruction and none answers, except to PING. range 0..253
+    id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -181,7 +184,7 @@ class PingRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'ping request') -> Self:
         _check_keys(data, ('id',), (), where)
         return cls(
-            _get(data, 'id', where),
+            _integer(_get(data, 'id', where), 'id', where),
         )
 
 
@@ -193,12 +196,12 @@ class ReadRequest(Message):
     COMMAND: ClassVar[str] = 'read'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    id: int
     #: Servo id 0..253; 254 (0xFE) is the broadcast id: every servo takes the instruction and none answers, except to PING. range 0..253
-    address: int
+    id: int
     #: First register address to read.
-    length: int
+    address: int
     #: Number of bytes to read. range 1..250
+    length: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -211,9 +214,9 @@ class ReadRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'read request') -> Self:
         _check_keys(data, ('id', 'address', 'length'), (), where)
         return cls(
-            _get(data, 'id', where),
-            _get(data, 'address', where),
-            _get(data, 'length', where),
+            _integer(_get(data, 'id', where), 'id', where),
+            _integer(_get(data, 'address', where), 'address', where),
+            _integer(_get(data, 'length', where), 'length', where),
         )
 
 
@@ -225,12 +228,12 @@ class WriteRequest(Message):
     COMMAND: ClassVar[str] = 'write'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    id: int
     #: Servo id 0..253; 254 (0xFE) is the broadcast id: every servo takes the instruction and none answers, except to PING. range 0..253
-    address: int
+    id: int
     #: First register address to write.
-    data: bytes
+    address: int
     #: The bytes written, register by register from `address` on.
+    data: bytes
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -243,8 +246,8 @@ class WriteRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'write request') -> Self:
         _check_keys(data, ('id', 'address', 'data'), (), where)
         return cls(
-            _get(data, 'id', where),
-            _get(data, 'address', where),
+            _integer(_get(data, 'id', where), 'id', where),
+            _integer(_get(data, 'address', where), 'address', where),
             _bytes(_get(data, 'data', where), 'data', where),
         )
 
@@ -257,12 +260,12 @@ class RegWriteRequest(Message):
     COMMAND: ClassVar[str] = 'reg_write'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    id: int
     #: Servo id 0..253; 254 (0xFE) is the broadcast id: every servo takes the instruction and none answers, except to PING. range 0..253
-    address: int
+    id: int
     #: First register address to write.
-    data: bytes
+    address: int
     #: The bytes to write when ACTION arrives.
+    data: bytes
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -275,8 +278,8 @@ class RegWriteRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'reg_write request') -> Self:
         _check_keys(data, ('id', 'address', 'data'), (), where)
         return cls(
-            _get(data, 'id', where),
-            _get(data, 'address', where),
+            _integer(_get(data, 'id', where), 'id', where),
+            _integer(_get(data, 'address', where), 'address', where),
             _bytes(_get(data, 'data', where), 'data', where),
         )
 
@@ -289,8 +292,8 @@ class ActionRequest(Message):
     COMMAND: ClassVar[str] = 'action'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    id: int
     #: Servo id 0..253; 254 (0xFE) is the broadcast id: every servo takes the instruction and none answers, except to PING. range 0..253
+    id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -301,7 +304,7 @@ class ActionRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'action request') -> Self:
         _check_keys(data, ('id',), (), where)
         return cls(
-            _get(data, 'id', where),
+            _integer(_get(data, 'id', where), 'id', where),
         )
 
 
@@ -313,8 +316,8 @@ class ResetRequest(Message):
     COMMAND: ClassVar[str] = 'reset'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    id: int
     #: Servo id 0..253; 254 (0xFE) is the broadcast id: every servo takes the instruction and none answers, except to PING. range 0..253
+    id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -325,7 +328,7 @@ class ResetRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'reset request') -> Self:
         _check_keys(data, ('id',), (), where)
         return cls(
-            _get(data, 'id', where),
+            _integer(_get(data, 'id', where), 'id', where),
         )
 
 
@@ -337,14 +340,14 @@ class SyncReadRequest(Message):
     COMMAND: ClassVar[str] = 'sync_read'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    id: int
     #: Servo id 0..253; 254 (0xFE) is the broadcast id: every servo takes the instruction and none answers, except to PING. range 0..253
-    address: int
+    id: int
     #: First register address to read.
-    length: int
+    address: int
     #: Number of bytes each servo returns. range 1..250
-    ids: tuple[IdsItem, ...]
+    length: int
     #: The servos to read, in the order they answer.
+    ids: tuple[IdsItem, ...]
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -358,10 +361,10 @@ class SyncReadRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'sync_read request') -> Self:
         _check_keys(data, ('id', 'address', 'length', 'ids'), (), where)
         return cls(
-            _get(data, 'id', where),
-            _get(data, 'address', where),
-            _get(data, 'length', where),
-            tuple(IdsItem.from_fields(_mapping(item, 'ids', where), where) for item in _get(data, 'ids', where)),
+            _integer(_get(data, 'id', where), 'id', where),
+            _integer(_get(data, 'address', where), 'address', where),
+            _integer(_get(data, 'length', where), 'length', where),
+            tuple(IdsItem.from_fields(_mapping(item, 'ids', where), where) for item in _items(_get(data, 'ids', where), 'ids', where)),
         )
 
 
@@ -373,12 +376,12 @@ class SyncWriteRequest(Message):
     COMMAND: ClassVar[str] = 'sync_write'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    id: int
     #: Servo id 0..253; 254 (0xFE) is the broadcast id: every servo takes the instruction and none answers, except to PING. range 0..253
-    address: int
+    id: int
     #: First register address to write.
-    servos: tuple[ServosItem, ...]
+    address: int
     #: One item per servo.
+    servos: tuple[ServosItem, ...]
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -391,9 +394,9 @@ class SyncWriteRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'sync_write request') -> Self:
         _check_keys(data, ('id', 'address', 'servos'), ('data_length',), where)
         return cls(
-            _get(data, 'id', where),
-            _get(data, 'address', where),
-            tuple(ServosItem.from_fields(_mapping(item, 'servos', where), where) for item in _get(data, 'servos', where)),
+            _integer(_get(data, 'id', where), 'id', where),
+            _integer(_get(data, 'address', where), 'address', where),
+            tuple(ServosItem.from_fields(_mapping(item, 'servos', where), where) for item in _items(_get(data, 'servos', where), 'servos', where)),
         )
 
 
@@ -405,12 +408,12 @@ class ReplyResponse(Message):
     COMMAND: ClassVar[str] = 'reply'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    id: int
     #: Servo id 0..253; 254 (0xFE) is the broadcast id: every servo takes the instruction and none answers, except to PING. range 0..253
-    error: ErrorStatus
+    id: int
     #: The servo's working status; 0 means no error.
-    data: bytes
+    error: ErrorStatus
     #: The bytes read, register by register from the request's address (empty except for READ).
+    data: bytes
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -423,8 +426,8 @@ class ReplyResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'reply response') -> Self:
         _check_keys(data, ('id', 'error', 'data'), (), where)
         return cls(
-            _get(data, 'id', where),
-            ErrorStatus(_get(data, 'error', where)),
+            _integer(_get(data, 'id', where), 'id', where),
+            _as_flags(ErrorStatus, _get(data, 'error', where), 255, 'error', where),
             _bytes(_get(data, 'data', where), 'data', where),
         )
 

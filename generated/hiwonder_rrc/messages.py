@@ -10,10 +10,15 @@ from typing import Any, ClassVar, Self
 
 from serialspec.runtime.fields import as_bytes as _bytes
 from serialspec.runtime.fields import check_keys as _check_keys
+from serialspec.runtime.fields import enum as _as_enum
+from serialspec.runtime.fields import flags as _as_flags
 from serialspec.runtime.fields import get as _get
+from serialspec.runtime.fields import integer as _integer
+from serialspec.runtime.fields import integers as _integers
+from serialspec.runtime.fields import items as _items
 from serialspec.runtime.fields import mapping as _mapping
+from serialspec.runtime.fields import number as _number
 from serialspec.runtime.message import Direction, Message
-from serialspec.runtime.message import enum_or_int as _enum
 
 __all__ = [
     'BusServoLoadRequest',
@@ -84,93 +89,93 @@ __all__ = [
 class ReadResult(IntEnum):
     """Outcome of a bus-servo read, as reported by the board."""
 
-    OK = 0
     #: read succeeded
-    FAILED = -1
+    OK = 0
     #: read failed (the value that follows is not valid)
+    FAILED = -1
 
 
 class ButtonEvent(IntEnum):
     """Key event values. 002 lists four as '部分按键事件回调值' (some of the event values); the SDK's PacketReportKeyEvents adds the other four (one bit each)."""
 
-    PRESSED = 1
     #: button pressed (BUTTON_EVENT_PRESSED)
-    LONG_PRESS = 2
+    PRESSED = 1
     #: button held down (BUTTON_EVENT_LONGPRESS)
-    LONG_PRESS_REPEAT = 4
+    LONG_PRESS = 2
     #: button still held, repeated (KEY_EVENT_LONGPRESS_REPEAT; sdk)
-    RELEASE_FROM_LONG_PRESS = 8
+    LONG_PRESS_REPEAT = 4
     #: button released after a long press (KEY_EVENT_RELEASE_FROM_LP; sdk)
-    RELEASE_FROM_SHORT_PRESS = 16
+    RELEASE_FROM_LONG_PRESS = 8
     #: button released after a short press (KEY_EVENT_RELEASE_FROM_SP; sdk)
-    CLICK = 32
+    RELEASE_FROM_SHORT_PRESS = 16
     #: button clicked (BUTTON_EVENT_CLICK)
-    DOUBLE_CLICK = 64
+    CLICK = 32
     #: button double-clicked (BUTTON_EVENT_DOUBLE_CLICK)
-    TRIPLE_CLICK = 128
+    DOUBLE_CLICK = 64
     #: button triple-clicked (KEY_EVENT_TRIPLE_CLICK; sdk)
+    TRIPLE_CLICK = 128
 
 
 class GamepadButtons(IntFlag):
     """Gamepad buttons held, one bit each (sdk Board.buttons_map GAMEPAD_BUTTON_MASK_*; 002 names none)."""
 
     NONE = 0
-    L2 = 1 << 0
     #: L2
-    R2 = 1 << 1
+    L2 = 1 << 0
     #: R2
-    SELECT = 1 << 2
+    R2 = 1 << 1
     #: SELECT
-    START = 1 << 3
+    SELECT = 1 << 2
     #: START
-    L3 = 1 << 5
+    START = 1 << 3
     #: L3 (left stick pressed)
-    R3 = 1 << 6
+    L3 = 1 << 5
     #: R3 (right stick pressed)
-    CROSS = 1 << 8
+    R3 = 1 << 6
     #: CROSS
-    CIRCLE = 1 << 9
+    CROSS = 1 << 8
     #: CIRCLE
-    SQUARE = 1 << 11
+    CIRCLE = 1 << 9
     #: SQUARE
-    TRIANGLE = 1 << 12
+    SQUARE = 1 << 11
     #: TRIANGLE
-    L1 = 1 << 14
+    TRIANGLE = 1 << 12
     #: L1
-    R1 = 1 << 15
+    L1 = 1 << 14
     #: R1
+    R1 = 1 << 15
 
 
 class MotorMask(IntFlag):
     """Motors to stop; bit n stops the motor with motor_id n (002/003 example 0x05 stops motors 0 and 2)."""
 
     NONE = 0
-    MOTOR_0 = 1 << 0
     #: motor 0
-    MOTOR_1 = 1 << 1
+    MOTOR_0 = 1 << 0
     #: motor 1
-    MOTOR_2 = 1 << 2
+    MOTOR_1 = 1 << 1
     #: motor 2
-    MOTOR_3 = 1 << 3
+    MOTOR_2 = 1 << 2
     #: motor 3
-    MOTOR_4 = 1 << 4
+    MOTOR_3 = 1 << 3
     #: motor 4
-    MOTOR_5 = 1 << 5
+    MOTOR_4 = 1 << 4
     #: motor 5
-    MOTOR_6 = 1 << 6
+    MOTOR_5 = 1 << 5
     #: motor 6
-    MOTOR_7 = 1 << 7
+    MOTOR_6 = 1 << 6
     #: motor 7
+    MOTOR_7 = 1 << 7
 
 
 @dataclass(frozen=True, slots=True)
 class MotorsItem:
     """One item of motors."""
 
-    motor_id: int
     #: Encoder motor id; bit n of the stop mask is motor_id n (the board has four motor ports).
-    speed: float
+    motor_id: int
     #: Motor speed in revolutions per second; the sign gives the direction. [r/s]
+    speed: float
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -182,8 +187,8 @@ class MotorsItem:
     def from_fields(cls, data: Mapping[str, Any], where: str = 'MotorsItem') -> Self:
         _check_keys(data, ('motor_id', 'speed'), (), where)
         return cls(
-            _get(data, 'motor_id', where),
-            _get(data, 'speed', where),
+            _integer(_get(data, 'motor_id', where), 'motor_id', where),
+            _number(_get(data, 'speed', where), 'speed', where),
         )
 
 
@@ -191,10 +196,10 @@ class MotorsItem:
 class DutiesItem:
     """One item of duties."""
 
-    motor_id: int
     #: Encoder motor id; bit n of the stop mask is motor_id n (the board has four motor ports).
-    duty: float
+    motor_id: int
     #: Duty cycle; the sign gives the direction (the SDK's example uses ±50). [%]
+    duty: float
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -206,8 +211,8 @@ class DutiesItem:
     def from_fields(cls, data: Mapping[str, Any], where: str = 'DutiesItem') -> Self:
         _check_keys(data, ('motor_id', 'duty'), (), where)
         return cls(
-            _get(data, 'motor_id', where),
-            _get(data, 'duty', where),
+            _integer(_get(data, 'motor_id', where), 'motor_id', where),
+            _number(_get(data, 'duty', where), 'duty', where),
         )
 
 
@@ -215,10 +220,10 @@ class DutiesItem:
 class PwmServosItem:
     """One item of pwm_servos."""
 
-    servo_id: int
     #: PWM servo id.
-    pulse: int
+    servo_id: int
     #: PWM pulse width (脉冲宽度); 500..2500 is 0°..180°. [µs] range 500..2500
+    pulse: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -230,8 +235,8 @@ class PwmServosItem:
     def from_fields(cls, data: Mapping[str, Any], where: str = 'PwmServosItem') -> Self:
         _check_keys(data, ('servo_id', 'pulse'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'pulse', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'pulse', where), 'pulse', where),
         )
 
 
@@ -239,10 +244,10 @@ class PwmServosItem:
 class BusServosItem:
     """One item of bus_servos."""
 
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
-    position: int
+    servo_id: int
     #: Bus servo position (002 calls it 脉冲宽度, pulse width); 0..1000 is 0°..240°. range 0..1000
+    position: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -254,8 +259,8 @@ class BusServosItem:
     def from_fields(cls, data: Mapping[str, Any], where: str = 'BusServosItem') -> Self:
         _check_keys(data, ('servo_id', 'position'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'position', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'position', where), 'position', where),
         )
 
 
@@ -263,8 +268,8 @@ class BusServosItem:
 class ServosItem:
     """One item of servos."""
 
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -275,7 +280,7 @@ class ServosItem:
     def from_fields(cls, data: Mapping[str, Any], where: str = 'ServosItem') -> Self:
         _check_keys(data, ('servo_id',), (), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -283,14 +288,14 @@ class ServosItem:
 class PixelsItem:
     """One item of pixels."""
 
-    index: int
     #: LED index from 0 (the SDK takes 1.. and sends it less one).
-    red: int
+    index: int
     #: Red 0..255.
-    green: int
+    red: int
     #: Green 0..255.
-    blue: int
+    green: int
     #: Blue 0..255.
+    blue: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -304,10 +309,10 @@ class PixelsItem:
     def from_fields(cls, data: Mapping[str, Any], where: str = 'PixelsItem') -> Self:
         _check_keys(data, ('index', 'red', 'green', 'blue'), (), where)
         return cls(
-            _get(data, 'index', where),
-            _get(data, 'red', where),
-            _get(data, 'green', where),
-            _get(data, 'blue', where),
+            _integer(_get(data, 'index', where), 'index', where),
+            _integer(_get(data, 'red', where), 'red', where),
+            _integer(_get(data, 'green', where), 'green', where),
+            _integer(_get(data, 'blue', where), 'blue', where),
         )
 
 
@@ -319,14 +324,14 @@ class LedRequest(Message):
     COMMAND: ClassVar[str] = 'led'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    led_id: int
     #: LED id.
-    on_time: int
+    led_id: int
     #: Time on (亮的时间). [ms]
-    off_time: int
+    on_time: int
     #: Time off (灭的时间). [ms]
-    repeat: int
+    off_time: int
     #: Number of blinks (循环次数).
+    repeat: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -340,10 +345,10 @@ class LedRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'led request') -> Self:
         _check_keys(data, ('led_id', 'on_time', 'off_time', 'repeat'), (), where)
         return cls(
-            _get(data, 'led_id', where),
-            _get(data, 'on_time', where),
-            _get(data, 'off_time', where),
-            _get(data, 'repeat', where),
+            _integer(_get(data, 'led_id', where), 'led_id', where),
+            _integer(_get(data, 'on_time', where), 'on_time', where),
+            _integer(_get(data, 'off_time', where), 'off_time', where),
+            _integer(_get(data, 'repeat', where), 'repeat', where),
         )
 
 
@@ -355,14 +360,14 @@ class BuzzerRequest(Message):
     COMMAND: ClassVar[str] = 'buzzer'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    frequency: int
     #: Tone frequency (频率). [Hz]
-    on_time: int
+    frequency: int
     #: Time sounding (响的时间). [ms]
-    off_time: int
+    on_time: int
     #: Time silent (不响的时间). [ms]
-    repeat: int
+    off_time: int
     #: Number of beeps (循环次数).
+    repeat: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -376,10 +381,10 @@ class BuzzerRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'buzzer request') -> Self:
         _check_keys(data, ('frequency', 'on_time', 'off_time', 'repeat'), (), where)
         return cls(
-            _get(data, 'frequency', where),
-            _get(data, 'on_time', where),
-            _get(data, 'off_time', where),
-            _get(data, 'repeat', where),
+            _integer(_get(data, 'frequency', where), 'frequency', where),
+            _integer(_get(data, 'on_time', where), 'on_time', where),
+            _integer(_get(data, 'off_time', where), 'off_time', where),
+            _integer(_get(data, 'repeat', where), 'repeat', where),
         )
 
 
@@ -391,10 +396,10 @@ class MotorSetSpeedRequest(Message):
     COMMAND: ClassVar[str] = 'motor'
     SUBCOMMAND: ClassVar[str | None] = 'set_speed'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    motor_id: int
     #: Encoder motor id; bit n of the stop mask is motor_id n (the board has four motor ports).
-    speed: float
+    motor_id: int
     #: Motor speed in revolutions per second; the sign gives the direction. [r/s]
+    speed: float
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -406,8 +411,8 @@ class MotorSetSpeedRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'motor.set_speed request') -> Self:
         _check_keys(data, ('motor_id', 'speed'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'motor_id', where),
-            _get(data, 'speed', where),
+            _integer(_get(data, 'motor_id', where), 'motor_id', where),
+            _number(_get(data, 'speed', where), 'speed', where),
         )
 
 
@@ -419,8 +424,8 @@ class MotorSetSpeedsRequest(Message):
     COMMAND: ClassVar[str] = 'motor'
     SUBCOMMAND: ClassVar[str | None] = 'set_speeds'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    motors: tuple[MotorsItem, ...]
     #: One (motor_id, speed) pair per motor.
+    motors: tuple[MotorsItem, ...]
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -431,7 +436,7 @@ class MotorSetSpeedsRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'motor.set_speeds request') -> Self:
         _check_keys(data, ('motors',), ('subcommand_code', 'count'), where)
         return cls(
-            tuple(MotorsItem.from_fields(_mapping(item, 'motors', where), where) for item in _get(data, 'motors', where)),
+            tuple(MotorsItem.from_fields(_mapping(item, 'motors', where), where) for item in _items(_get(data, 'motors', where), 'motors', where)),
         )
 
 
@@ -443,8 +448,8 @@ class MotorStopRequest(Message):
     COMMAND: ClassVar[str] = 'motor'
     SUBCOMMAND: ClassVar[str | None] = 'stop'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    motor_id: int
     #: Encoder motor id; bit n of the stop mask is motor_id n (the board has four motor ports).
+    motor_id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -455,7 +460,7 @@ class MotorStopRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'motor.stop request') -> Self:
         _check_keys(data, ('motor_id',), ('subcommand_code',), where)
         return cls(
-            _get(data, 'motor_id', where),
+            _integer(_get(data, 'motor_id', where), 'motor_id', where),
         )
 
 
@@ -467,8 +472,8 @@ class MotorSetDutiesRequest(Message):
     COMMAND: ClassVar[str] = 'motor'
     SUBCOMMAND: ClassVar[str | None] = 'set_duties'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    duties: tuple[DutiesItem, ...]
     #: One (motor_id, duty) pair per motor.
+    duties: tuple[DutiesItem, ...]
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -479,7 +484,7 @@ class MotorSetDutiesRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'motor.set_duties request') -> Self:
         _check_keys(data, ('duties',), ('subcommand_code', 'count'), where)
         return cls(
-            tuple(DutiesItem.from_fields(_mapping(item, 'duties', where), where) for item in _get(data, 'duties', where)),
+            tuple(DutiesItem.from_fields(_mapping(item, 'duties', where), where) for item in _items(_get(data, 'duties', where), 'duties', where)),
         )
 
 
@@ -491,8 +496,8 @@ class MotorStopMaskRequest(Message):
     COMMAND: ClassVar[str] = 'motor'
     SUBCOMMAND: ClassVar[str | None] = 'stop_mask'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    mask: MotorMask
     #: Motors to stop (电机掩码), bit n for motor n.
+    mask: MotorMask
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -503,7 +508,7 @@ class MotorStopMaskRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'motor.stop_mask request') -> Self:
         _check_keys(data, ('mask',), ('subcommand_code',), where)
         return cls(
-            MotorMask(_get(data, 'mask', where)),
+            _as_flags(MotorMask, _get(data, 'mask', where), 255, 'mask', where),
         )
 
 
@@ -515,10 +520,10 @@ class PwmServoSetPositionsRequest(Message):
     COMMAND: ClassVar[str] = 'pwm_servo'
     SUBCOMMAND: ClassVar[str | None] = 'set_positions'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    duration: int
     #: Time to complete the move (运动时间). [ms]
-    pwm_servos: tuple[PwmServosItem, ...]
+    duration: int
     #: One (servo_id, pulse) pair per servo.
+    pwm_servos: tuple[PwmServosItem, ...]
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -530,8 +535,8 @@ class PwmServoSetPositionsRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'pwm_servo.set_positions request') -> Self:
         _check_keys(data, ('duration', 'pwm_servos'), ('subcommand_code', 'count'), where)
         return cls(
-            _get(data, 'duration', where),
-            tuple(PwmServosItem.from_fields(_mapping(item, 'pwm_servos', where), where) for item in _get(data, 'pwm_servos', where)),
+            _integer(_get(data, 'duration', where), 'duration', where),
+            tuple(PwmServosItem.from_fields(_mapping(item, 'pwm_servos', where), where) for item in _items(_get(data, 'pwm_servos', where), 'pwm_servos', where)),
         )
 
 
@@ -543,12 +548,12 @@ class PwmServoSetPositionRequest(Message):
     COMMAND: ClassVar[str] = 'pwm_servo'
     SUBCOMMAND: ClassVar[str | None] = 'set_position'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    duration: int
     #: Time to complete the move (运动时间). [ms]
-    servo_id: int
+    duration: int
     #: PWM servo id.
-    pulse: int
+    servo_id: int
     #: PWM pulse width (脉冲宽度); 500..2500 is 0°..180°. [µs] range 500..2500
+    pulse: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -561,9 +566,9 @@ class PwmServoSetPositionRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'pwm_servo.set_position request') -> Self:
         _check_keys(data, ('duration', 'servo_id', 'pulse'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'duration', where),
-            _get(data, 'servo_id', where),
-            _get(data, 'pulse', where),
+            _integer(_get(data, 'duration', where), 'duration', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'pulse', where), 'pulse', where),
         )
 
 
@@ -575,8 +580,8 @@ class PwmServoReadPositionRequest(Message):
     COMMAND: ClassVar[str] = 'pwm_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_position'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: PWM servo id.
+    servo_id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -587,7 +592,7 @@ class PwmServoReadPositionRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'pwm_servo.read_position request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -599,10 +604,10 @@ class PwmServoReadPositionResponse(Message):
     COMMAND: ClassVar[str] = 'pwm_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_position'
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: PWM servo id.
-    pulse: int
+    servo_id: int
     #: The servo's current pulse width (not range-checked in a report). [µs]
+    pulse: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -614,8 +619,8 @@ class PwmServoReadPositionResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'pwm_servo.read_position response') -> Self:
         _check_keys(data, ('servo_id', 'pulse'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'pulse', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'pulse', where), 'pulse', where),
         )
 
 
@@ -627,10 +632,10 @@ class PwmServoSetOffsetRequest(Message):
     COMMAND: ClassVar[str] = 'pwm_servo'
     SUBCOMMAND: ClassVar[str | None] = 'set_offset'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: PWM servo id.
-    offset: int
+    servo_id: int
     #: PWM servo offset (偏差), an int8 from -100 to +100. [µs] range -100..100
+    offset: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -642,8 +647,8 @@ class PwmServoSetOffsetRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'pwm_servo.set_offset request') -> Self:
         _check_keys(data, ('servo_id', 'offset'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'offset', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'offset', where), 'offset', where),
         )
 
 
@@ -655,8 +660,8 @@ class PwmServoReadOffsetRequest(Message):
     COMMAND: ClassVar[str] = 'pwm_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_offset'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: PWM servo id.
+    servo_id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -667,7 +672,7 @@ class PwmServoReadOffsetRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'pwm_servo.read_offset request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -679,10 +684,10 @@ class PwmServoReadOffsetResponse(Message):
     COMMAND: ClassVar[str] = 'pwm_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_offset'
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: PWM servo id.
-    offset: int
+    servo_id: int
     #: The servo's offset (int8; -100..100 when set through 0x07). [µs]
+    offset: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -694,8 +699,8 @@ class PwmServoReadOffsetResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'pwm_servo.read_offset response') -> Self:
         _check_keys(data, ('servo_id', 'offset'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'offset', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'offset', where), 'offset', where),
         )
 
 
@@ -707,10 +712,10 @@ class BusServoSetPositionsRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'set_positions'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    duration: int
     #: Time to complete the move (运动时间). [ms]
-    bus_servos: tuple[BusServosItem, ...]
+    duration: int
     #: One (servo_id, position) pair per servo.
+    bus_servos: tuple[BusServosItem, ...]
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -722,8 +727,8 @@ class BusServoSetPositionsRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.set_positions request') -> Self:
         _check_keys(data, ('duration', 'bus_servos'), ('subcommand_code', 'count'), where)
         return cls(
-            _get(data, 'duration', where),
-            tuple(BusServosItem.from_fields(_mapping(item, 'bus_servos', where), where) for item in _get(data, 'bus_servos', where)),
+            _integer(_get(data, 'duration', where), 'duration', where),
+            tuple(BusServosItem.from_fields(_mapping(item, 'bus_servos', where), where) for item in _items(_get(data, 'bus_servos', where), 'bus_servos', where)),
         )
 
 
@@ -735,8 +740,8 @@ class BusServoReadPositionRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_position'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -747,7 +752,7 @@ class BusServoReadPositionRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_position request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -759,12 +764,12 @@ class BusServoReadPositionResponse(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_position'
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
+    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0. range -1..0
     success: ReadResult | int
-    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
-    position: int
     #: Current position (0..1000 is 0°..240°).
+    position: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -777,9 +782,9 @@ class BusServoReadPositionResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_position response') -> Self:
         _check_keys(data, ('servo_id', 'success', 'position'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _enum(ReadResult, _get(data, 'success', where)),
-            _get(data, 'position', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(ReadResult, _get(data, 'success', where), 'success', where),
+            _integer(_get(data, 'position', where), 'position', where),
         )
 
 
@@ -791,8 +796,8 @@ class BusServoReadVoltageRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_voltage'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -803,7 +808,7 @@ class BusServoReadVoltageRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_voltage request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -815,12 +820,12 @@ class BusServoReadVoltageResponse(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_voltage'
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
+    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0. range -1..0
     success: ReadResult | int
-    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
-    voltage: int
     #: Input voltage. [mV]
+    voltage: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -833,9 +838,9 @@ class BusServoReadVoltageResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_voltage response') -> Self:
         _check_keys(data, ('servo_id', 'success', 'voltage'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _enum(ReadResult, _get(data, 'success', where)),
-            _get(data, 'voltage', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(ReadResult, _get(data, 'success', where), 'success', where),
+            _integer(_get(data, 'voltage', where), 'voltage', where),
         )
 
 
@@ -847,8 +852,8 @@ class BusServoReadTemperatureRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_temperature'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -859,7 +864,7 @@ class BusServoReadTemperatureRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_temperature request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -871,12 +876,12 @@ class BusServoReadTemperatureResponse(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_temperature'
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
+    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0. range -1..0
     success: ReadResult | int
-    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
-    temperature: int
     #: Temperature. [°C]
+    temperature: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -889,9 +894,9 @@ class BusServoReadTemperatureResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_temperature response') -> Self:
         _check_keys(data, ('servo_id', 'success', 'temperature'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _enum(ReadResult, _get(data, 'success', where)),
-            _get(data, 'temperature', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(ReadResult, _get(data, 'success', where), 'success', where),
+            _integer(_get(data, 'temperature', where), 'temperature', where),
         )
 
 
@@ -903,8 +908,8 @@ class BusServoStopRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'stop'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servos: tuple[ServosItem, ...]
     #: The servos to stop.
+    servos: tuple[ServosItem, ...]
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -915,7 +920,7 @@ class BusServoStopRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.stop request') -> Self:
         _check_keys(data, ('servos',), ('subcommand_code', 'count'), where)
         return cls(
-            tuple(ServosItem.from_fields(_mapping(item, 'servos', where), where) for item in _get(data, 'servos', where)),
+            tuple(ServosItem.from_fields(_mapping(item, 'servos', where), where) for item in _items(_get(data, 'servos', where), 'servos', where)),
         )
 
 
@@ -927,8 +932,8 @@ class BusServoReadTorqueRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_torque'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -939,7 +944,7 @@ class BusServoReadTorqueRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_torque request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -951,12 +956,12 @@ class BusServoReadTorqueResponse(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_torque'
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
+    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0. range -1..0
     success: ReadResult | int
-    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
-    torque: int
     #: 1 while the torque is on (after load, 0x0C), 0 after unload (0x0B).
+    torque: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -969,9 +974,9 @@ class BusServoReadTorqueResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_torque response') -> Self:
         _check_keys(data, ('servo_id', 'success', 'torque'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _enum(ReadResult, _get(data, 'success', where)),
-            _get(data, 'torque', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(ReadResult, _get(data, 'success', where), 'success', where),
+            _integer(_get(data, 'torque', where), 'torque', where),
         )
 
 
@@ -983,8 +988,8 @@ class BusServoUnloadRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'unload'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -995,7 +1000,7 @@ class BusServoUnloadRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.unload request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -1007,8 +1012,8 @@ class BusServoLoadRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'load'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1019,7 +1024,7 @@ class BusServoLoadRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.load request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -1031,10 +1036,10 @@ class BusServoSetIdRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'set_id'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: The servo's current id.
-    new_id: int
+    servo_id: int
     #: The id to store (save_id).
+    new_id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1046,8 +1051,8 @@ class BusServoSetIdRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.set_id request') -> Self:
         _check_keys(data, ('servo_id', 'new_id'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'new_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'new_id', where), 'new_id', where),
         )
 
 
@@ -1059,8 +1064,8 @@ class BusServoReadIdRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_id'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int = 254
     #: 0xFE (broadcast query, 查询广播).
+    servo_id: int = 254
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1071,7 +1076,7 @@ class BusServoReadIdRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_id request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
         return cls(
-            data.get('servo_id', 254),
+            _integer(data.get('servo_id', 254), 'servo_id', where),
         )
 
 
@@ -1083,12 +1088,12 @@ class BusServoReadIdResponse(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_id'
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: The id the request was sent to (0xFE for the broadcast).
+    servo_id: int
+    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0. range -1..0
     success: ReadResult | int
-    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
-    id: int
     #: The id read from the servo.
+    id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1101,9 +1106,9 @@ class BusServoReadIdResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_id response') -> Self:
         _check_keys(data, ('servo_id', 'success', 'id'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _enum(ReadResult, _get(data, 'success', where)),
-            _get(data, 'id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(ReadResult, _get(data, 'success', where), 'success', where),
+            _integer(_get(data, 'id', where), 'id', where),
         )
 
 
@@ -1115,10 +1120,10 @@ class BusServoSetOffsetRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'set_offset'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
-    offset: int
+    servo_id: int
     #: Bus servo offset (偏差), an int8 from -125 to +125 (about -30°..30°); 002 and 003 give the PWM offset's -100..+100 (erratum bus_offset_range). range -125..125
+    offset: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1130,8 +1135,8 @@ class BusServoSetOffsetRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.set_offset request') -> Self:
         _check_keys(data, ('servo_id', 'offset'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'offset', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'offset', where), 'offset', where),
         )
 
 
@@ -1143,8 +1148,8 @@ class BusServoReadOffsetRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_offset'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1155,7 +1160,7 @@ class BusServoReadOffsetRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_offset request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -1167,12 +1172,12 @@ class BusServoReadOffsetResponse(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_offset'
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
+    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0. range -1..0
     success: ReadResult | int
-    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
-    offset: int
     #: The servo's offset (int8; -125..125 when set through 0x20).
+    offset: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1185,9 +1190,9 @@ class BusServoReadOffsetResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_offset response') -> Self:
         _check_keys(data, ('servo_id', 'success', 'offset'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _enum(ReadResult, _get(data, 'success', where)),
-            _get(data, 'offset', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(ReadResult, _get(data, 'success', where), 'success', where),
+            _integer(_get(data, 'offset', where), 'offset', where),
         )
 
 
@@ -1199,8 +1204,8 @@ class BusServoSaveOffsetRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'save_offset'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1211,7 +1216,7 @@ class BusServoSaveOffsetRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.save_offset request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -1223,12 +1228,12 @@ class BusServoSetPositionLimitRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'set_position_limit'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
-    low: int
+    servo_id: int
     #: Low position limit (低限位), 0..1000. range 0..1000
-    high: int
+    low: int
     #: High position limit (高限位), 0..1000. range 0..1000
+    high: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1241,9 +1246,9 @@ class BusServoSetPositionLimitRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.set_position_limit request') -> Self:
         _check_keys(data, ('servo_id', 'low', 'high'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'low', where),
-            _get(data, 'high', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'low', where), 'low', where),
+            _integer(_get(data, 'high', where), 'high', where),
         )
 
 
@@ -1255,8 +1260,8 @@ class BusServoReadPositionLimitRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_position_limit'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1267,7 +1272,7 @@ class BusServoReadPositionLimitRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_position_limit request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -1279,14 +1284,14 @@ class BusServoReadPositionLimitResponse(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_position_limit'
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
+    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0. range -1..0
     success: ReadResult | int
-    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
-    low: int
     #: Low position limit.
-    high: int
+    low: int
     #: High position limit.
+    high: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1300,10 +1305,10 @@ class BusServoReadPositionLimitResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_position_limit response') -> Self:
         _check_keys(data, ('servo_id', 'success', 'low', 'high'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _enum(ReadResult, _get(data, 'success', where)),
-            _get(data, 'low', where),
-            _get(data, 'high', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(ReadResult, _get(data, 'success', where), 'success', where),
+            _integer(_get(data, 'low', where), 'low', where),
+            _integer(_get(data, 'high', where), 'high', where),
         )
 
 
@@ -1315,12 +1320,12 @@ class BusServoSetVoltageLimitRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'set_voltage_limit'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
-    low: int
+    servo_id: int
     #: Low voltage limit (低限位), at least 4500 mV. [mV] range 4500..14000
-    high: int
+    low: int
     #: High voltage limit (高限位), at most 14000 mV. [mV] range 4500..14000
+    high: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1333,9 +1338,9 @@ class BusServoSetVoltageLimitRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.set_voltage_limit request') -> Self:
         _check_keys(data, ('servo_id', 'low', 'high'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'low', where),
-            _get(data, 'high', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'low', where), 'low', where),
+            _integer(_get(data, 'high', where), 'high', where),
         )
 
 
@@ -1347,8 +1352,8 @@ class BusServoReadVoltageLimitRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_voltage_limit'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1359,7 +1364,7 @@ class BusServoReadVoltageLimitRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_voltage_limit request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -1371,14 +1376,14 @@ class BusServoReadVoltageLimitResponse(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_voltage_limit'
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
+    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0. range -1..0
     success: ReadResult | int
-    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
-    low: int
     #: Low voltage limit. [mV]
-    high: int
+    low: int
     #: High voltage limit. [mV]
+    high: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1392,10 +1397,10 @@ class BusServoReadVoltageLimitResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_voltage_limit response') -> Self:
         _check_keys(data, ('servo_id', 'success', 'low', 'high'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _enum(ReadResult, _get(data, 'success', where)),
-            _get(data, 'low', where),
-            _get(data, 'high', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(ReadResult, _get(data, 'success', where), 'success', where),
+            _integer(_get(data, 'low', where), 'low', where),
+            _integer(_get(data, 'high', where), 'high', where),
         )
 
 
@@ -1407,10 +1412,10 @@ class BusServoSetTemperatureLimitRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'set_temperature_limit'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
-    limit: int
+    servo_id: int
     #: Over-temperature threshold (高温阈值); must be less than 100 °C. [°C] range 0..99
+    limit: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1422,8 +1427,8 @@ class BusServoSetTemperatureLimitRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.set_temperature_limit request') -> Self:
         _check_keys(data, ('servo_id', 'limit'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'limit', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'limit', where), 'limit', where),
         )
 
 
@@ -1435,8 +1440,8 @@ class BusServoReadTemperatureLimitRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_temperature_limit'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1447,7 +1452,7 @@ class BusServoReadTemperatureLimitRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_temperature_limit request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -1459,12 +1464,12 @@ class BusServoReadTemperatureLimitResponse(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_temperature_limit'
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
+    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0. range -1..0
     success: ReadResult | int
-    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
-    limit: int
     #: Over-temperature threshold. [°C]
+    limit: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1477,9 +1482,9 @@ class BusServoReadTemperatureLimitResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_temperature_limit response') -> Self:
         _check_keys(data, ('servo_id', 'success', 'limit'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _enum(ReadResult, _get(data, 'success', where)),
-            _get(data, 'limit', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(ReadResult, _get(data, 'success', where), 'success', where),
+            _integer(_get(data, 'limit', where), 'limit', where),
         )
 
 
@@ -1491,10 +1496,10 @@ class KeyResponse(Message):
     COMMAND: ClassVar[str] = 'key'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    button_id: int
     #: Button id.
+    button_id: int
+    #: What happened to the button (按键事件). range 1..128
     event: ButtonEvent | int
-    #: What happened to the button (按键事件).
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1506,8 +1511,8 @@ class KeyResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'key response') -> Self:
         _check_keys(data, ('button_id', 'event'), (), where)
         return cls(
-            _get(data, 'button_id', where),
-            _enum(ButtonEvent, _get(data, 'event', where)),
+            _integer(_get(data, 'button_id', where), 'button_id', where),
+            _as_enum(ButtonEvent, _get(data, 'event', where), 'event', where),
         )
 
 
@@ -1519,18 +1524,18 @@ class ImuResponse(Message):
     COMMAND: ClassVar[str] = 'imu'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    accel_x: float
     #: Acceleration along x.
-    accel_y: float
+    accel_x: float
     #: Acceleration along y.
-    accel_z: float
+    accel_y: float
     #: Acceleration along z.
-    gyro_x: float
+    accel_z: float
     #: Angular rate about x.
-    gyro_y: float
+    gyro_x: float
     #: Angular rate about y.
-    gyro_z: float
+    gyro_y: float
     #: Angular rate about z.
+    gyro_z: float
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1546,12 +1551,12 @@ class ImuResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'imu response') -> Self:
         _check_keys(data, ('accel_x', 'accel_y', 'accel_z', 'gyro_x', 'gyro_y', 'gyro_z'), (), where)
         return cls(
-            _get(data, 'accel_x', where),
-            _get(data, 'accel_y', where),
-            _get(data, 'accel_z', where),
-            _get(data, 'gyro_x', where),
-            _get(data, 'gyro_y', where),
-            _get(data, 'gyro_z', where),
+            _number(_get(data, 'accel_x', where), 'accel_x', where),
+            _number(_get(data, 'accel_y', where), 'accel_y', where),
+            _number(_get(data, 'accel_z', where), 'accel_z', where),
+            _number(_get(data, 'gyro_x', where), 'gyro_x', where),
+            _number(_get(data, 'gyro_y', where), 'gyro_y', where),
+            _number(_get(data, 'gyro_z', where), 'gyro_z', where),
         )
 
 
@@ -1563,18 +1568,18 @@ class GamepadResponse(Message):
     COMMAND: ClassVar[str] = 'gamepad'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    buttons: GamepadButtons
     #: Buttons held (按键), one bit per button (bits from the SDK).
-    hat: int
+    buttons: GamepadButtons
     #: Direction pad (hat) value; the SDK reads 9 as right (hat x +1), 13 as left (-1), 11 as up (hat y -1) and 15 as down (+1) in its axes; other values are not documented.
-    left_x: int
+    hat: int
     #: Left stick x.
-    left_y: int
+    left_x: int
     #: Left stick y.
-    right_x: int
+    left_y: int
     #: Right stick x.
-    right_y: int
+    right_x: int
     #: Right stick y.
+    right_y: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1590,12 +1595,12 @@ class GamepadResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'gamepad response') -> Self:
         _check_keys(data, ('buttons', 'hat', 'left_x', 'left_y', 'right_x', 'right_y'), (), where)
         return cls(
-            GamepadButtons(_get(data, 'buttons', where)),
-            _get(data, 'hat', where),
-            _get(data, 'left_x', where),
-            _get(data, 'left_y', where),
-            _get(data, 'right_x', where),
-            _get(data, 'right_y', where),
+            _as_flags(GamepadButtons, _get(data, 'buttons', where), 65535, 'buttons', where),
+            _integer(_get(data, 'hat', where), 'hat', where),
+            _integer(_get(data, 'left_x', where), 'left_x', where),
+            _integer(_get(data, 'left_y', where), 'left_y', where),
+            _integer(_get(data, 'right_x', where), 'right_x', where),
+            _integer(_get(data, 'right_y', where), 'right_y', where),
         )
 
 
@@ -1607,16 +1612,16 @@ class SbusResponse(Message):
     COMMAND: ClassVar[str] = 'sbus'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    channels: tuple[int, ...]
     #: The 16 proportional channels.
-    ch17: int
+    channels: tuple[int, ...]
     #: Digital channel 17.
-    ch18: int
+    ch17: int
     #: Digital channel 18.
-    signal_loss: int
+    ch18: int
     #: Set when the receiver has lost the signal.
-    fail_safe: int
+    signal_loss: int
     #: Set when the receiver is in fail-safe.
+    fail_safe: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1631,11 +1636,11 @@ class SbusResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'sbus response') -> Self:
         _check_keys(data, ('channels', 'ch17', 'ch18', 'signal_loss', 'fail_safe'), (), where)
         return cls(
-            tuple(_get(data, 'channels', where)),
-            _get(data, 'ch17', where),
-            _get(data, 'ch18', where),
-            _get(data, 'signal_loss', where),
-            _get(data, 'fail_safe', where),
+            _integers(_get(data, 'channels', where), 'channels', where),
+            _integer(_get(data, 'ch17', where), 'ch17', where),
+            _integer(_get(data, 'ch18', where), 'ch18', where),
+            _integer(_get(data, 'signal_loss', where), 'signal_loss', where),
+            _integer(_get(data, 'fail_safe', where), 'fail_safe', where),
         )
 
 
@@ -1647,8 +1652,8 @@ class SystemBatteryResponse(Message):
     COMMAND: ClassVar[str] = 'system'
     SUBCOMMAND: ClassVar[str | None] = 'battery'
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    voltage: int
     #: Battery voltage. [mV]
+    voltage: int
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1659,7 +1664,7 @@ class SystemBatteryResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'system.battery response') -> Self:
         _check_keys(data, ('voltage',), ('subcommand_code',), where)
         return cls(
-            _get(data, 'voltage', where),
+            _integer(_get(data, 'voltage', where), 'voltage', where),
         )
 
 
@@ -1671,10 +1676,10 @@ class OledRequest(Message):
     COMMAND: ClassVar[str] = 'oled'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    line: int
     #: Display line (1 or 2 in the SDK's example).
-    text: bytes
+    line: int
     #: The text (UTF-8).
+    text: bytes
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1686,7 +1691,7 @@ class OledRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'oled request') -> Self:
         _check_keys(data, ('line', 'text'), ('length',), where)
         return cls(
-            _get(data, 'line', where),
+            _integer(_get(data, 'line', where), 'line', where),
             _bytes(_get(data, 'text', where), 'text', where),
         )
 
@@ -1699,8 +1704,8 @@ class RgbSetPixelsRequest(Message):
     COMMAND: ClassVar[str] = 'rgb'
     SUBCOMMAND: ClassVar[str | None] = 'set_pixels'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    pixels: tuple[PixelsItem, ...]
     #: One (index, red, green, blue) per LED.
+    pixels: tuple[PixelsItem, ...]
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1711,7 +1716,7 @@ class RgbSetPixelsRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'rgb.set_pixels request') -> Self:
         _check_keys(data, ('pixels',), ('subcommand_code', 'count'), where)
         return cls(
-            tuple(PixelsItem.from_fields(_mapping(item, 'pixels', where), where) for item in _get(data, 'pixels', where)),
+            tuple(PixelsItem.from_fields(_mapping(item, 'pixels', where), where) for item in _items(_get(data, 'pixels', where), 'pixels', where)),
         )
 
 

@@ -10,13 +10,8 @@ from __future__ import annotations
 
 import hashlib
 import importlib
-import importlib.abc
-import importlib.machinery
 import importlib.resources
 import importlib.util
-import sys
-from collections.abc import Iterator
-from contextlib import contextmanager
 from pathlib import Path
 from types import ModuleType
 
@@ -92,69 +87,15 @@ def generated_from_this(protocol: Protocol, spec_text: str) -> ModuleType | None
     return package
 
 
-class _Sources(importlib.abc.MetaPathFinder, importlib.abc.Loader):
-    """Imports one generated package from its text, held in memory."""
-
-    def __init__(self, package: str, files: dict[str, str], origin: str) -> None:
-        self.package = package
-        self.files = files
-        self.origin = origin
-
-    def find_spec(
-        self, fullname: str, path: object = None, target: object = None
-    ) -> importlib.machinery.ModuleSpec | None:
-        name = self._file(fullname)
-        if name is None:
-            return None
-        origin = f"{self.origin} ({fullname} generated in memory)"
-        return importlib.util.spec_from_loader(fullname, self, origin=origin, is_package=fullname == self.package)
-
-    def _file(self, fullname: str) -> str | None:
-        if fullname == self.package:
-            return "__init__.py"
-        prefix, _, module = fullname.partition(".")
-        if prefix == self.package and f"{module}.py" in self.files:
-            return f"{module}.py"
-        return None
-
-    def create_module(self, spec: importlib.machinery.ModuleSpec) -> None:
-        return None
-
-    def exec_module(self, module: ModuleType) -> None:
-        name = self._file(module.__name__)
-        assert name is not None
-        exec(compile(self.files[name], f"<{self.package}/{name} from {self.origin}>", "exec"), module.__dict__)
-
-
-@contextmanager
-def _only(finder: _Sources) -> Iterator[None]:
-    """Import the package through `finder` without disturbing any other copy already imported in this process."""
-
-    def ours(name: str) -> bool:
-        return name == finder.package or name.startswith(finder.package + ".")
-
-    saved = {name: module for name, module in sys.modules.items() if ours(name)}
-    for name in saved:
-        del sys.modules[name]
-    sys.meta_path.insert(0, finder)
-    try:
-        yield
-    finally:
-        sys.meta_path.remove(finder)
-        for name in [name for name in sys.modules if ours(name)]:
-            del sys.modules[name]
-        sys.modules.update(saved)
-
-
 def package_in_memory(protocol: Protocol) -> ModuleType:
     """The protocol's package generated from the resolved spec and imported from memory (nothing on disk)."""
+    from serialspec.emit.python.memory import imported
     from serialspec.emit.python.package import emit_package
 
-    finder = _Sources(protocol.name, emit_package(protocol), protocol.spec_path)
-    with _only(finder):
-        package = importlib.import_module(protocol.name)
+    files = emit_package(protocol)
+    with imported(protocol.name, files, protocol.spec_path) as package:
         for module in _MODULES:
-            if f"{module}.py" in finder.files:
+            if f"{module}.py" in files:
                 importlib.import_module(f"{protocol.name}.{module}")
     return package
 

@@ -93,10 +93,10 @@ def register_view(protocol: Protocol, message: Message, request: Message | None)
             continue
         source = message
         start_name = f.start
-        if start_name.startswith("request."):
+        if f.start_in_request:
             if request is None:
                 return None
-            source, start_name = request, start_name.removeprefix("request.")
+            source = request
         start = source.to_fields().get(start_name)
         if not isinstance(start, int):
             return None

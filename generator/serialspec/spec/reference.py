@@ -10,7 +10,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from serialspec.spec import grammar
-from serialspec.spec.grammar import Any_, Bool, Int, ListOf, MapOf, Num, Obj, OneOf, Shape, Str
+from serialspec.spec.grammar import Any_, Bool, Int, ListOf, MapOf, Num, Obj, OneOf, Ref, Shape, Str
 
 NAME = "<name>"  # a key the spec author chooses (a command's name, a field's name)
 
@@ -72,6 +72,8 @@ def type_text(shape: Shape) -> str:
         return "mapping"
     if isinstance(shape, OneOf):
         return " or ".join(type_text(option) for option in shape.options)
+    if isinstance(shape, Ref):
+        return f"mapping: name → field (as in `{shape.name}:`)"
     return "any value"
 
 

@@ -15,6 +15,7 @@ from serialspec.emit.common import render as common
 from serialspec.emit.common.frames import runtime_layouts
 from serialspec.emit.common.numbers import number
 from serialspec.emit.common.text import collapse
+from serialspec.runtime.errors import SerialspecError
 from serialspec.spec import expression
 from serialspec.spec.model import (
     Array,
@@ -51,9 +52,13 @@ def cell(value: object) -> str:
 
 
 def code_span(value: str) -> str:
-    """Text shown as printed (an erratum's quote of a document): a code span, so nothing in it is markup."""
-    value = " ".join(value.split())
-    return f"`` {value} ``" if "`" in value else f"`{value}`"
+    """Text shown as printed (an erratum's quote of a document): a code span, so nothing in it is markup, whatever
+    backticks it holds (the fence is longer than any run of them inside)."""
+    value = collapse(value)
+    runs = [len(run) for run in "".join(c if c == "`" else " " for c in value).split()]
+    fence = "`" * (max(runs, default=0) + 1)
+    padded = f" {value} " if value.startswith("`") or value.endswith("`") else value
+    return f"{fence}{padded or ' '}{fence}"
 
 
 def anchor(*parts: str) -> str:
@@ -465,7 +470,10 @@ def general_breakdown(protocol: Protocol, example: Example, message: Message | N
     """An example frame of any layout, element by element (unstuffed) and field by field, by the frame engine."""
     layouts = runtime_layouts(protocol, example.direction)
     layout = next((lay for lay in layouts if example.frame.startswith(lay.header)), layouts[0])
-    unwrapped = layout.unwrap(example.frame)
+    try:
+        unwrapped = layout.unwrap(example.frame)
+    except SerialspecError as exc:  # the example verification reports it as a spec error; the page says it too
+        return [{"bytes": example.frame.hex(" ").upper(), "field": "(frame)", "value": cell(f"does not decode: {exc}")}]
     rows: list[dict[str, str]] = []
     for e, part in zip(layout.elements, unwrapped.parts, strict=True):
         if e.kind == "content" and message is not None:
@@ -541,7 +549,8 @@ def content_rows(
             )
         if size is None:
             if isinstance(f, Group):
-                count = len(values.get(f.name, []))
+                items = values.get(f.name)  # recorded values; a malformed record is a spec error of its own
+                count = len(items) if isinstance(items, list) else 0
                 item = f.item_size
                 size = count * item if item is not None else end - offset
             elif isinstance(f, TableValue):
@@ -580,7 +589,7 @@ def emit_docs(protocol: Protocol) -> str:
             "direction": e.direction.value,
             "command": e.command + (f".{e.subcommand}" if e.subcommand else ""),
             "anchor": anchor("command", e.command, e.subcommand or ""),
-            "printed": e.printed,
+            "printed": code_span(e.printed),
             "frame": e.frame.hex(" ").upper(),
             "erratum": e.erratum,
             "partial": e.printed_span != (0, 0),

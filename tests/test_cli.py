@@ -169,3 +169,18 @@ def test_a_spec_path_uses_the_generated_package_only_when_it_was_generated_from_
     assert live.encode(request)[:5] == bytes.fromhex("12 4c 08 07 ff")
     with pytest.raises(Exception, match="servo_id = 255 is outside its range 0..254"):
         package.encode(package.RotateRequest(servo_id=255, angle=0, interval=0))
+
+
+def test_a_package_generated_into_the_current_folder_is_found_by_name(tmp_path: Path) -> None:
+    """The installed `serialspec` script (not `python -m`, which puts the folder on the path itself) finds by name a
+    package that `import NAME` finds from the current folder."""
+    shutil.copy(ROOT / "examples" / "tinylamp" / "tinylamp.yaml", tmp_path)
+    script = str(Path(sys.executable).parent / "serialspec")
+    generate = subprocess.run([script, "generate", "tinylamp.yaml", "--out", "."], cwd=tmp_path, capture_output=True)
+    assert generate.returncode == 0, generate.stderr
+    (tmp_path / "tinylamp.yaml").unlink()  # by name only: no spec file to fall back on
+    run = [script, "decode", "tinylamp", "aa 01 01 01 ad"]
+    decoded = subprocess.run(run, cwd=tmp_path, capture_output=True, text=True)
+    assert decoded.returncode == 0 and decoded.stdout.startswith("tinylamp request"), decoded.stderr
+    elsewhere = subprocess.run(run, cwd=tmp_path / "docs", capture_output=True, text=True)
+    assert elsewhere.returncode == 1 and "run from the folder that holds the generated tinylamp/" in elsewhere.stderr

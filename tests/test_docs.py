@@ -112,6 +112,10 @@ def test_the_tutorial_commands_and_client_session_run_as_printed(tmp_path: Path)
     assert "RangeError: set_brightness request: brightness = 300 is outside its range 0..100" in result.stderr
     replay = run(f"serialspec decode tinylamp.yaml --file {tmp_path / 'session.capture'}", tmp_path)
     assert sum("tinylamp response" in line for line in replay) == 3
+    # the spec's editor line names the schema the tutorial's `generate --out .` wrote beside it, as step 1 says
+    schema = re.search(r"\$schema=(\S+)", (tmp_path / "tinylamp.yaml").read_text(encoding="utf-8"))
+    assert schema is not None and f"$schema={schema[1]}`" in TUTORIAL.read_text(encoding="utf-8")
+    assert (tmp_path / schema[1]).is_file()
 
 
 @pytest.mark.parametrize("page", ["README.md", "docs/tutorial.md"])

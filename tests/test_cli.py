@@ -184,3 +184,13 @@ def test_a_package_generated_into_the_current_folder_is_found_by_name(tmp_path: 
     assert decoded.returncode == 0 and decoded.stdout.startswith("tinylamp request"), decoded.stderr
     elsewhere = subprocess.run(run, cwd=tmp_path / "docs", capture_output=True, text=True)
     assert elsewhere.returncode == 1 and "run from the folder that holds the generated tinylamp/" in elsewhere.stderr
+
+
+def test_units_view_reads_flags_as_words_and_json_keeps_the_list() -> None:
+    """`--units` prints set flags as names (`overheat, overload`), none set as `none`; `--json` keeps a list."""
+    args = ("decode", str(ROOT / "specs" / "feetech_sms.yaml"), "--direction", "response", "--units")
+    faults = serialspec(*args, "ff ff 01 02 24 d8").stdout
+    assert "  error                overheat, overload\n" in faults
+    assert "  error                none\n" in serialspec(*args, "ff ff 01 02 00 fc").stdout
+    as_json = json.loads(serialspec(*args, "ff ff 01 02 24 d8", "--json").stdout)
+    assert as_json["fields"]["error"] == ["overheat", "overload"]

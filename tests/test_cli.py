@@ -194,3 +194,19 @@ def test_units_view_reads_flags_as_words_and_json_keeps_the_list() -> None:
     assert "  error                none\n" in serialspec(*args, "ff ff 01 02 00 fc").stdout
     as_json = json.loads(serialspec(*args, "ff ff 01 02 24 d8", "--json").stdout)
     assert as_json["fields"]["error"] == ["overheat", "overload"]
+
+
+def test_sim_banner_says_what_is_served_in_words() -> None:
+    """No `device(s) 0` for a protocol without an address, and a board's further kinds of device by their ids."""
+    from types import SimpleNamespace
+
+    from serialspec.cli.sim import served
+    from serialspec.spec import load_protocol
+
+    def banner(name: str, ids: list[int]) -> str:
+        protocol = load_protocol(str(ROOT / "specs" / f"{name}.yaml"))
+        return served(protocol, {i: SimpleNamespace(model=None) for i in ids})
+
+    assert banner("vesc", [0]) == "(one device: the protocol has no address)"
+    assert banner("modbus_rtu", [1, 2]) == "unit 1, 2"
+    assert banner("hiwonder_rrc", [1]) == "servo_id 1; pwm_servo servo_id 1, 2, 3, 4; motor motor_id 0, 1, 2, 3"

@@ -47,7 +47,7 @@ stress: $(STAMP)
 # Benchmarks (bench/README.md): codec, stream parsing, pseudo-terminal latency, generation; about 3 minutes on a
 # quiet machine. Prints one table per family and writes them all to bench/results.md.
 $(BENCH_STAMP): $(STAMP) pyproject.toml
-	$(BIN)/pip install --quiet -e '.[test,bench]'
+	PYTHONWARNINGS='ignore:Editable installation' $(BIN)/pip install --quiet -e '.[test,bench]'
 	touch $(BENCH_STAMP)
 
 bench: $(BENCH_STAMP)

@@ -47,8 +47,14 @@ def test_values_out_of_range_are_refused_before_sending(client: DynamixelP2Clien
 
 
 def test_device_errors_name_the_error_number(client: DynamixelP2Client) -> None:
+    # the spec's `errors:`, one reply value per reason
     with pytest.raises(DeviceError, match="access_error"):
         client.write_raw(1, 144, b"\x05\x00")  # present_input_voltage is read-only
+    with pytest.raises(DeviceError, match="access_error"):
+        client.write_raw(1, 1, b"\x05")  # the second byte of model_number: no whole register
+    with pytest.raises(DeviceError, match="data_range_error"):
+        client.write_raw(1, 68, b"\x03")  # status_return_level 3: outside 0..2
+    assert client.read(1, "status_return_level") == 2  # a refused write changes nothing
 
 
 def test_status_return_level_switches_replies(client: DynamixelP2Client) -> None:
@@ -105,3 +111,43 @@ def test_action_without_reg_write_is_an_instruction_error(client: DynamixelP2Cli
         client.action(2)
     assert client.reg_write(2, led=1) is True
     assert client.action(2) is True
+
+
+def test_clear_keeps_the_position_within_one_turn(client: DynamixelP2Client) -> None:
+    assert client.write(1, torque_enable=1) is True
+    assert client.write(1, goal_position=10000) is True  # profile velocity 0: there at once, 2 turns and 1808
+    assert client.clear(1, 1) is True
+    assert client.read(1, "present_position") == 1808
+    assert client.write(1, goal_position=-5000) is True
+    assert client.clear(1, 1) is True
+    assert client.read(1, "present_position") == 3192  # -5000 + 2 x 4096: within 0..4095, not toward zero
+    assert client.write(1, profile_velocity=1, goal_position=100000) is True  # about 16 pulses/s: hours away
+    with pytest.raises(DeviceError, match="result_fail"):
+        client.clear(1, 1)  # only while stopped
+    assert client.read(1, "moving") == 1  # the move goes on
+
+
+def test_reboot_restores_ram_and_keeps_eeprom(client: DynamixelP2Client) -> None:
+    assert client.write(2, return_delay_time=5) is True  # EEPROM
+    assert client.write(2, torque_enable=1, led=1) is True  # RAM
+    assert client.write(2, goal_position=5000) is True  # profile velocity 0: there at once
+    assert client.read(2, "present_position") == 5000
+    assert client.reg_write_raw(2, 65, b"\x01") is True  # led = 1 on ACTION; the reboot drops it
+    assert client.write(2, led=0) is True
+    assert client.reboot(2) is True
+    with pytest.raises(DeviceError, match="instruction_error"):
+        client.action(2)  # nothing held any more
+    ram = client.read_many(2, "torque_enable", "led", "goal_position", "present_position")
+    assert ram == {"torque_enable": 0, "led": 0, "goal_position": 0, "present_position": 5000 - 4096}
+    assert client.read(2, "return_delay_time") == 5
+    assert client.read(3, "led") == 0 and client.read(3, "return_delay_time") == 250  # another servo: untouched
+
+
+def test_broadcast_factory_reset_of_everything_is_ignored(client: DynamixelP2Client) -> None:
+    for servo in (1, 2):
+        assert client.write(servo, return_delay_time=7) is True
+    assert client.factory_reset(client.BROADCAST, 0xFF) is None  # ignored, and nobody answers a broadcast
+    assert client.ping(2).model_number == 1020  # every id kept
+    assert [client.read(s, "return_delay_time") for s in (1, 2)] == [7, 7]
+    assert client.factory_reset(client.BROADCAST, 0x01) is None  # all but the id: carried out
+    assert [client.read(s, "return_delay_time") for s in (1, 2)] == [250, 250]

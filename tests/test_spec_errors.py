@@ -159,3 +159,30 @@ def test_cli_reports_spec_errors_without_traceback(tmp_path: Path) -> None:
     assert result.returncode == 1
     assert "Traceback" not in result.stderr
     assert "specs/tiny.yaml:19:16: commands.move.request.fields.angle: unknown type 'int17'" in result.stderr
+
+
+def test_device_errors_name_fields_the_error_reply_has(tmp_path: Path) -> None:
+    text = (
+        MINIMAL
+        + """\
+  refusal:
+    code: 0x7F
+    response:
+      error_reply: true
+      fields: {reason: u8}
+device:
+  errors:
+    out_of_range: {reason: 3}
+    read_only: {why: 2}
+    unsupported: {reason: 1}
+  commands:
+    move: {restores: {memory: sram, except: [speed]}, broadcast_ignores: {option: 255}, modulo: {angle: 4096}}
+"""
+    )
+    lines = errors_of(tmp_path, text)
+    assert any("restores.except[0]: unknown state variable 'speed'" in x for x in lines), lines
+    assert any("broadcast_ignores.option: move has no request field 'option'" in x for x in lines), lines
+    assert any("modulo.angle: unknown state variable 'angle'" in x for x in lines), lines
+    assert any("device.errors.read_only.why: the error reply refusal has no field 'why'" in x for x in lines), lines
+    assert any("device.errors.unsupported:" in x and "not classic" in x for x in lines), lines
+    assert not any("out_of_range" in x for x in lines), lines

@@ -8,7 +8,10 @@ READ). PING is always answered; READ while status_return_level ≥ 1; every othe
 range error (4); the alert bit reports a non-zero hardware_error_status. REG WRITE holds its data (and sets
 registered_instruction) until ACTION (an ACTION with nothing held gets the instruction error, 2); writing the
 id moves the servo to its new id. With the torque on, a new goal_position moves present_position at
-profile_velocity (at once when it is 0). The firmware version 52 is an example, not a documented value.
+profile_velocity (at once when it is 0). CLEAR brings present_position within one turn (0..4095), only while
+it is not moving (result fail, 1, otherwise); REBOOT puts the RAM items back to their initial values
+(present_position within one turn) and keeps EEPROM; FACTORY RESET of everything (0xFF) sent to the broadcast
+id is ignored. The firmware version 52 is an example, not a documented value.
 
 `DynamixelP2Simulator(ids=[1, 2]).start()` serves the devices on a new pseudo-terminal and returns its path;
 `serialspec sim specs/dynamixel_p2.yaml --id 1 --id 2` does the same from the shell. Values are wire units.
@@ -161,8 +164,7 @@ DEVICE = DeviceSpec(
     ),
     state={},
     reply={'error.alert': 0.0, 'error.number': 0.0},
-    refused={'error.number': 7.0},
-    out_of_range={'error.number': 4.0},
+    errors={'out_of_space': {'error.number': 7.0}, 'out_of_range': {'error.number': 4.0}, 'read_only': {'error.number': 7.0}, 'busy': {'error.number': 1.0}},
     commands=(
         # ping
         CommandSpec(PingRequest, PingResponse, reports={'model_number': 'model_number', 'firmware_version': 'firmware_version'}, broadcast_reply=True),
@@ -175,11 +177,11 @@ DEVICE = DeviceSpec(
         # action
         CommandSpec(ActionRequest, StatusResponse, moves=('present_position', 'goal_position', '', 'profile_velocity'), speed_scale=15.6331, move_enabled_by='torque_enable', sets={'registered_instruction': 0.0}, commits=True, nothing_held={'error.number': 2.0}, optional_when=(68, 2, '>='), tables={'data': ('run', 'address', 'length')}),
         # factory_reset
-        CommandSpec(FactoryResetRequest, StatusResponse, resets=True, keeps=('option', {1: ('id',), 2: ('id', 'baud_rate'), 255: ()}), optional_when=(68, 2, '>='), tables={'data': ('run', 'address', 'length')}),
+        CommandSpec(FactoryResetRequest, StatusResponse, resets=True, keeps=('option', {1: ('id',), 2: ('id', 'baud_rate'), 255: ()}), broadcast_ignores={'option': 255.0}, optional_when=(68, 2, '>='), tables={'data': ('run', 'address', 'length')}),
         # reboot
-        CommandSpec(RebootRequest, StatusResponse, optional_when=(68, 2, '>='), tables={'data': ('run', 'address', 'length')}),
+        CommandSpec(RebootRequest, StatusResponse, modulo={'present_position': 4096.0}, restores=('torque_enable', 'led', 'status_return_level', 'registered_instruction', 'hardware_error_status', 'velocity_i_gain', 'velocity_p_gain', 'position_d_gain', 'position_i_gain', 'position_p_gain', 'feedforward_2nd_gain', 'feedforward_1st_gain', 'bus_watchdog', 'goal_pwm', 'goal_current', 'goal_velocity', 'profile_acceleration', 'profile_velocity', 'goal_position', 'realtime_tick', 'moving', 'moving_status', 'present_pwm', 'present_current', 'present_velocity', 'velocity_trajectory', 'position_trajectory', 'present_input_voltage', 'present_temperature', 'backup_ready', 'indirect_data_1', 'indirect_data_2', 'indirect_data_3', 'indirect_data_4', 'indirect_data_5', 'indirect_data_6', 'indirect_data_7', 'indirect_data_8', 'indirect_data_9', 'indirect_data_10', 'indirect_data_11', 'indirect_data_12', 'indirect_data_13', 'indirect_data_14', 'indirect_data_15', 'indirect_data_16', 'indirect_data_17', 'indirect_data_18', 'indirect_data_19', 'indirect_data_20', 'indirect_data_21', 'indirect_data_22', 'indirect_data_23', 'indirect_data_24', 'indirect_data_25', 'indirect_data_26', 'indirect_data_27', 'indirect_data_28'), optional_when=(68, 2, '>='), tables={'data': ('run', 'address', 'length')}),
         # clear
-        CommandSpec(ClearRequest, StatusResponse, optional_when=(68, 2, '>='), tables={'data': ('run', 'address', 'length')}),
+        CommandSpec(ClearRequest, StatusResponse, modulo={'present_position': 4096.0}, refused_while_moving='present_position', optional_when=(68, 2, '>='), tables={'data': ('run', 'address', 'length')}),
         # sync_read
         CommandSpec(SyncReadRequest, StatusResponse, reads=('data',), each='ids', tables={'data': ('run', 'address', 'length')}),
         # fast_sync_read

@@ -105,7 +105,7 @@ DEVICE = DeviceSpec(
     ),
     state={'angle': 0.0, 'holding': 0.0},
     reply={'result': 1.0},
-    refused={'result': 0.0},
+    errors={'out_of_space': {'result': 0.0}, 'out_of_range': {'result': 0.0}, 'read_only': {'result': 0.0}},
     commands=(
         # ping
         CommandSpec(PingRequest, PingResponse),

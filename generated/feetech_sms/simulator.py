@@ -91,7 +91,6 @@ DEVICE = DeviceSpec(
     ),
     state={},
     reply={},
-    refused={},
     commands=(
         # ping
         CommandSpec(PingRequest, ReplyResponse, broadcast_reply=True, tables={'data': ('run', 'address', 'length')}),

@@ -82,7 +82,6 @@ DEVICE = DeviceSpec(
     ),
     state={'id': 0.0, 'position': 500.0, 'voltage': 7400.0, 'temperature': 30.0, 'offset': 0.0, 'torque': 1.0, 'position_low': 0.0, 'position_high': 1000.0, 'voltage_low': 4500.0, 'voltage_high': 14000.0, 'temperature_limit': 85.0},
     reply={'success': 0.0},
-    refused={},
     commands=(
         # led
         CommandSpec(LedRequest, None),

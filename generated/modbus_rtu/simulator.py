@@ -63,7 +63,7 @@ DEVICE = DeviceSpec(
     ),
     state={},
     reply={},
-    refused={},
+    errors={'out_of_space': {'exception_code': 2.0}, 'out_of_range': {'exception_code': 3.0}, 'read_only': {'exception_code': 2.0}, 'unsupported': {'exception_code': 1.0}},
     commands=(
         # read_coils
         CommandSpec(ReadCoilsRequest, ReadCoilsResponse, space_reads={'coils': RunSpec('coils', 'address', count='count')}, code=1, limits={'count': (1, 2000, ())}),
@@ -92,7 +92,7 @@ DEVICE = DeviceSpec(
         SpaceSpec('holding_registers', 10000, False, 65535, 'rw'),
         SpaceSpec('input_registers', 10000, False, 65535, 'r'),
     ),
-    error=ErrorSpec(ExceptionResponse, 'function', 'exception_code', out_of_space=2, out_of_range=3, read_only=2, unsupported=1, unwrap=_unwrap_request),
+    error=ErrorSpec(ExceptionResponse, 'function', unwrap=_unwrap_request),
 )
 
 

@@ -45,7 +45,6 @@ DEVICE = DeviceSpec(
     ),
     state={'duty': 0.0, 'current': 0.0, 'brake_current': 0.0, 'target_rpm': 0.0, 'position': 0.0, 'handbrake_current': 0.0, 'rpm': 0.0, 'acceleration': 50000.0, 'timed_out': 0.0},
     reply={'major': 6.0, 'minor': 5.0, 'hw_name': '60', 'uuid': '30 00 43 00 0f 51 33 30 38 37 36 33', 'hw_type': 0.0, 'fw_name': '', 'v_in': 240.0, 'temp_fet': 250.0, 'temp_motor': 250.0, 'temp_mos1': 250.0, 'temp_mos2': 250.0, 'temp_mos3': 250.0},
-    refused={},
     commands=(
         # fw_version
         CommandSpec(FwVersionRequest, FwVersionResponse),

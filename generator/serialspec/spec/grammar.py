@@ -785,6 +785,32 @@ DEVICE_COMMAND = Obj(
             "State variable -> a period: the variable keeps only its remainder, toward zero (an angle within one "
             "turn, 3600 in 0.1°).",
         ),
+        "modulo": MapOf(
+            Num(),
+            "State variable -> a period: the variable keeps its remainder in 0..period-1, also below zero (an "
+            "absolute position within one turn: DYNAMIXEL CLEAR, 4096).",
+        ),
+        "restores": Obj(
+            {
+                "memory": Str("The memory whose entries go back to their initial values.", choices=("eeprom", "sram")),
+                "except": ListOf(Str(), "Entries of that memory left as they are (measured values)."),
+            },
+            required=("memory",),
+            description=(
+                "The entries kept in one memory go back to their initial values (the model's, where it gives them) "
+                "and stop moving, and writes held for a command that `commits` are dropped: a reboot clears RAM "
+                "and keeps EEPROM (DYNAMIXEL REBOOT)."
+            ),
+        ),
+        "refused_while_moving": Str(
+            "A state variable (or memory entry): while it moves, the request is refused (`errors.busy`) and "
+            "changes nothing (DYNAMIXEL CLEAR works only while the servo is stopped)."
+        ),
+        "broadcast_ignores": MapOf(
+            Num(),
+            "Request field -> a value with which a broadcast request is ignored by every device (DYNAMIXEL "
+            "FACTORY RESET of everything, option 0xFF, sent to the broadcast id).",
+        ),
         "counts": MapOf(
             Obj(
                 {"state": Str("The state variable (or memory entry)."), "per": Num("The size of one whole unit.")},
@@ -893,16 +919,6 @@ DEVICE = Obj(
             OneOf((Num(), Str()), REPLY_VALUES),
             REPLY_VALUES,
         ),
-        "refused": MapOf(
-            Num(),
-            "Response field (or field.bit_field) -> value when a write is refused (read-only or unknown entry; "
-            "DYNAMIXEL error.number: 7, access error).",
-        ),
-        "out_of_range": MapOf(
-            Num(),
-            "Response field (or field.bit_field) -> value when a write is refused for a value outside the entry's "
-            "range (DYNAMIXEL error.number: 4, data range error); default: `refused`.",
-        ),
         "status": MapOf(
             Str(),
             "Response field -> the memory entry every response reports in it (a status byte); field.bit_field -> "
@@ -954,17 +970,40 @@ DEVICE = Obj(
         ),
         "errors": Obj(
             {
-                "field": Str("The error reply's field that says why (Modbus exception_code)."),
-                "out_of_space": Int("Value when a run reaches beyond its data space (Modbus 2)."),
-                "out_of_range": Int("Value when a request value is outside its range or enum (Modbus 3)."),
-                "read_only": Int("Value when a write reaches a data space that is read-only."),
-                "unsupported": Int(
-                    "Value for a request whose code no command has, recognised when it arrives whole and its "
-                    "checksum verifies (Modbus 1, illegal function); frames without a header only."
+                "out_of_range": MapOf(
+                    Num(),
+                    "Reply values when a value is outside its entry's range, or a request value outside its "
+                    "range or enum (Modbus exception_code: 3; DYNAMIXEL error.number: 4, data range error).",
+                ),
+                "out_of_space": MapOf(
+                    Num(),
+                    "Reply values when a write reaches an address no entry has, or a run reaches beyond its data "
+                    "space (Modbus exception_code: 2; DYNAMIXEL error.number: 7, access error).",
+                ),
+                "read_only": MapOf(
+                    Num(),
+                    "Reply values when a write reaches a read-only entry or data space (DYNAMIXEL error.number: 7).",
+                ),
+                "busy": MapOf(
+                    Num(),
+                    "Reply values when a command that is `refused_while_moving` arrives during the move (DYNAMIXEL "
+                    "CLEAR: error.number: 1, result fail).",
+                ),
+                "unsupported": MapOf(
+                    Num(),
+                    "Reply values for a request whose code no command has, recognised when it arrives whole and "
+                    "its checksum verifies (Modbus exception_code: 1, illegal function); needs the protocol's "
+                    "error reply and frames without a header.",
                 ),
             },
-            required=("field",),
-            description="How the device refuses a request with the protocol's error reply (`error_reply:`).",
+            description=(
+                "How the device refuses a request, by reason: response field (or field.bit_field) -> value. The "
+                "refusal is the protocol's error reply (the response marked `error_reply`, carrying the refused "
+                "request's code) when it has one; otherwise the request's own response with these values. A "
+                "refused request changes nothing. With an error reply, request values are also checked against "
+                "their ranges and enums before the device acts. For a reason not listed the request is still not "
+                "carried out, and the reply says nothing of it (with an error reply: no reply)."
+            ),
         ),
         "kinds": MapOf(
             Obj(

@@ -568,13 +568,19 @@ class SpaceAccess:
 
 @dataclass(frozen=True)
 class DeviceErrors:
-    """How a device refuses a request with the protocol's error reply: the field saying why, and its values."""
+    """How a device refuses a request, by reason: the reply values (response field or field.bit_field -> value),
+    sent in the protocol's error reply when it has one, else in the request's own response."""
 
-    field: str
-    out_of_space: int | None
-    out_of_range: int | None
-    read_only: int | None
-    unsupported: int | None = None
+    out_of_space: dict[str, float] = field(default_factory=dict)
+    out_of_range: dict[str, float] = field(default_factory=dict)
+    read_only: dict[str, float] = field(default_factory=dict)
+    unsupported: dict[str, float] = field(default_factory=dict)
+    busy: dict[str, float] = field(default_factory=dict)
+
+    def by_reason(self) -> dict[str, dict[str, float]]:
+        """The reasons given, by name (the device runtime's reasons)."""
+        reasons = ("out_of_space", "out_of_range", "read_only", "unsupported", "busy")
+        return {reason: getattr(self, reason) for reason in reasons if getattr(self, reason)}
 
 
 @dataclass(frozen=True)
@@ -600,6 +606,10 @@ class Behaviour:
     keeps: tuple[str, dict[int, tuple[str, ...]]] | None = None  # resets: request field, its value -> entries kept
     stops: tuple[str, ...] = ()  # state variables whose move stops where it is
     wraps: dict[str, float] = field(default_factory=dict)  # state variable -> period it is kept within
+    modulo: dict[str, float] = field(default_factory=dict)  # state variable -> period: kept in 0..period-1
+    restores: tuple[str, ...] = ()  # memory entries back to their initial values (a reboot's RAM)
+    broadcast_ignores: dict[str, float] = field(default_factory=dict)  # request field -> value: broadcast ignored
+    refused_while_moving: str = ""  # state variable: while it moves, the request is refused (errors.busy)
     counts: dict[str, tuple[str, float]] = field(default_factory=dict)  # response field -> (state, per)
     every_device: bool = False  # a request without an address reaches every device
     held_while: str = ""  # state variable: while set, the request is held
@@ -672,7 +682,6 @@ class Device:
     broadcast: int | None
     state: dict[str, float]  # state variables beyond memory -> initial value
     reply: dict[str, float | str]  # response field -> value when no behaviour sets it
-    refused: dict[str, float]  # response field -> value when a write is refused
     behaviours: tuple[Behaviour, ...]
     status: dict[str, str] = field(default_factory=dict)  # response field -> memory entry every reply reports
     kinds: tuple[DeviceKind, ...] = ()
@@ -681,7 +690,6 @@ class Device:
     spaces: tuple[Space, ...] = ()
     errors: DeviceErrors | None = None
     timeout: DeviceTimeout | None = None
-    out_of_range: dict[str, float] = field(default_factory=dict)  # response values when a value is out of range
     models: tuple[DeviceModel, ...] = ()  # the first is the default model
     moving: dict[str, tuple[str, int | None]] = field(default_factory=dict)  # entry -> (state variable, bit)
     model_entry: str = ""  # the memory entry holding the model number

@@ -35,6 +35,10 @@ BEHAVIOUR_ARGUMENTS = (
     "commits",
     "stops",
     "wraps",
+    "modulo",
+    "restores",
+    "broadcast_ignores",
+    "refused_while_moving",
     "counts",
     "every_device",
     "held_while",
@@ -197,7 +201,7 @@ def simulator_module(protocol: Protocol) -> str:
         derived = derived_values(request, response)
         if derived:
             args.append(f"derived={{{', '.join(f'{k!r}: {v}' for k, v in derived.items())}}}")
-        if device.errors is not None:
+        if device.errors is not None and protocol.error_reply is not None:
             code = protocol.command(request.command).code
             args.append(f"code={code!r}")
             checked = limits(request)
@@ -223,12 +227,8 @@ def simulator_module(protocol: Protocol) -> str:
         reply = protocol.command(protocol.error_reply.command).response
         assert reply is not None
         imports.add(reply.class_name)
-        e = device.errors
-        unwrap = f", unsupported={e.unsupported!r}, unwrap=_unwrap_request" if e.unsupported is not None else ""
-        error = (
-            f"ErrorSpec({reply.class_name}, {protocol.error_reply.element!r}, {e.field!r}, "
-            f"out_of_space={e.out_of_space!r}, out_of_range={e.out_of_range!r}, read_only={e.read_only!r}{unwrap})"
-        )
+        unwrap = ", unwrap=_unwrap_request" if device.errors.unsupported else ""
+        error = f"ErrorSpec({reply.class_name}, {protocol.error_reply.element!r}{unwrap})"
     runtime = ["CommandSpec", "DeviceSpec"]
     runtime += ["EntrySpec"] if entries else []
     runtime += ["ErrorSpec"] if error else []
@@ -261,8 +261,7 @@ def simulator_module(protocol: Protocol) -> str:
         broadcast=repr(device.broadcast),
         state=repr(device.state),
         reply=repr(device.reply),
-        refused=repr(device.refused),
-        out_of_range=repr(device.out_of_range) if device.out_of_range else "",
+        errors=repr(device.errors.by_reason()) if device.errors else "",
         entries=entries,
         commands=commands,
         registers=map_name(device.memory) if device.memory in register_tables(protocol) else "",

@@ -54,16 +54,12 @@ class RunSpec:
 
 @dataclass(frozen=True)
 class ErrorSpec:
-    """The protocol's error reply: its class, the member holding the refused request's code, the member saying why
-    and the reasons' values (Modbus: function | 0x80, exception_code 2 / 3)."""
+    """The protocol's error reply, which a device sends instead of a request's own response when it refuses it: its
+    class and the member holding the refused request's code (Modbus: function | 0x80). DeviceSpec.errors says what
+    else it holds for each reason."""
 
     response: type[Message]
     code_field: str
-    field: str
-    out_of_space: int | None = None
-    out_of_range: int | None = None
-    read_only: int | None = None
-    unsupported: int | None = None  # a request whose code no command has (Modbus exception 1)
     # unwrap(frame) -> (code, frame values) of a whole request frame whose checksum verifies (the frame engine's),
     # for requests the codec cannot decode because their code is unknown
     unwrap: Callable[[bytes], tuple[int | None, tuple[int, ...]]] | None = None
@@ -108,6 +104,10 @@ class CommandSpec:
     ramp: tuple[str, str] | None = None  # request fields: acceleration and deceleration time (ms) of the move
     stops: tuple[str, ...] = ()  # state variables whose move stops where it is
     wraps: dict[str, float] = field(default_factory=dict)  # state variable -> the period it is kept within
+    modulo: dict[str, float] = field(default_factory=dict)  # state variable -> period: kept in 0..period-1
+    restores: tuple[str, ...] = ()  # memory entries back to their initial values, their moves stopped (a reboot)
+    broadcast_ignores: dict[str, float] = field(default_factory=dict)  # request field -> value: broadcast ignored
+    refused_while_moving: str = ""  # state variable: while it moves, the request is refused ("busy")
     counts: dict[str, tuple[str, float]] = field(default_factory=dict)  # response field -> (state, per)
     every_device: bool = False  # a request without an address reaches every device, not only the first
     held_while: str = ""  # state variable: while it is set, the device holds the request
@@ -156,7 +156,6 @@ class DeviceSpec:
     entries: tuple[EntrySpec, ...]
     state: dict[str, float]
     reply: dict[str, Any]
-    refused: dict[str, float]
     commands: tuple[CommandSpec, ...]
     kinds: tuple[KindSpec, ...] = ()
     echo_address: bool = False  # replies carry the id the request named, not the answering device's own
@@ -165,7 +164,10 @@ class DeviceSpec:
     spaces: tuple[SpaceSpec, ...] = ()
     error: ErrorSpec | None = None
     timeout: TimeoutSpec | None = None
-    out_of_range: dict[str, float] = field(default_factory=dict)  # reply values for an out-of-range write
+    # why a request is refused ("out_of_range", "out_of_space", "read_only", "unsupported") -> the reply values
+    # saying so, in the error reply when there is one, else in the request's own response; a reason not given
+    # is not refused
+    errors: dict[str, dict[str, float]] = field(default_factory=dict)
     models: tuple[ModelSpec, ...] = ()  # the first is the default model
     moving: dict[str, tuple[str, int | None]] = field(default_factory=dict)  # entry -> (state variable, bit)
     # command code -> the codec's decoder of that request's content (buf, start, end), for requests carried by another
@@ -299,10 +301,14 @@ class VirtualDevice:
         return not self.refusal(entry, value)
 
     def refusal(self, entry: EntrySpec | None, value: Any) -> str:
-        """Why a write is refused: "access" (read-only, unknown entry), "range" (out of range), or "" (it is not)."""
-        if entry is None or entry.access == "r" or not isinstance(value, int | float):
-            return "access"
-        return "" if entry.minimum <= value <= entry.maximum else "range"
+        """Why a write is refused: "out_of_space" (no such entry), "read_only", "out_of_range", or "" (it is not)."""
+        if entry is None:
+            return "out_of_space"
+        if entry.access == "r":
+            return "read_only"
+        if not isinstance(value, int | float):
+            return "out_of_range"
+        return "" if entry.minimum <= value <= entry.maximum else "out_of_range"
 
 
 class Engine(FaultInjection):
@@ -416,6 +422,8 @@ class Engine(FaultInjection):
         for given in items:
             address = given.get(spec.address)
             broadcast = address is not None and address == spec.broadcast
+            if broadcast and any(given.get(k) == v for k, v in command.broadcast_ignores.items()):
+                continue
             if address is None:
                 targets = list(devices.values()) if command.every_device else list(devices.values())[:1]
             elif broadcast:
@@ -481,15 +489,17 @@ class Engine(FaultInjection):
             given = dict(given)
             for name, derive in command.derived.items():
                 given[name] = derive(given)
-        if command.limits or command.space_reads or command.space_writes:
-            refusal = self._refusal(device, command, given)
-            if refusal is not None:
-                return self._error_reply(device, command, refusal)
-        refused = ""
         # Whether an optional reply is due is decided on the switch as the request finds it (a write that turns
         # replies off is still answered), which is also what a client that remembers the switch expects.
         switch = command.optional_when
         answers = switch is None or compare(device.memory.get(switch[0]), switch[2], switch[1])
+        if command.limits or command.space_reads or command.space_writes or command.refused_while_moving:
+            refusal = self._refusal(device, command, given)
+            if refusal is not None:
+                if self.spec.error is not None:
+                    return self._error_reply(device, command, refusal)
+                return self._reply(device, command, given, refusal) if answers else None
+        refused = ""
         if command.resets:
             field_name, kept = command.keeps or ("", {})
             device.reset(kept.get(int(given.get(field_name, -1)), None) if command.keeps else None)
@@ -518,6 +528,12 @@ class Engine(FaultInjection):
             device.set(state, device.get(state))
         for state, period in command.wraps.items():
             device.set(state, math.fmod(device.get(state), period))
+        for state, period in command.modulo.items():
+            device.set(state, device.get(state) % period)
+        for name in command.restores:
+            device.set(name, device.by_name[name].default)
+        if command.restores:
+            device.buffered = []  # held writes live in the memory a restore clears
         id_entry = device.spec.id_entry
         if id_entry in device.by_name or id_entry in device.state:
             new_id = int(device.get(id_entry))
@@ -525,16 +541,18 @@ class Engine(FaultInjection):
                 del self.devices[device.id]
                 device.id = new_id
                 self.devices[new_id] = device
+        return self._reply(device, command, given, refused) if answers else None
+
+    def _reply(self, device: VirtualDevice, command: CommandSpec, given: dict[str, Any], refused: str) -> bytes | None:
+        """The response to a request carried out (or refused: `refused` says why) on one device."""
         if command.response is None:
-            return None
-        if not answers:
             return None
         values: dict[str, Any] = {}
         for attribute in dataclasses.fields(command.response):  # type: ignore[arg-type]
             name = attribute.name
-            if name in command.space_reads:
+            if name in command.space_reads and not refused:
                 values[name] = self._read_space(device, command.space_reads[name], given)
-            elif name in command.reads:
+            elif name in command.reads and not refused:
                 value = self._read(device, command, name, given)
                 if value is None:
                     return None  # an unknown key: a device stays silent
@@ -561,42 +579,40 @@ class Engine(FaultInjection):
                 values[name] = 0
         nest(values, {k: v for k, v in self.spec.reply.items() if "." in k})
         nest(values, {k: int(bool(device.get(e))) for k, e in device.spec.status.items() if "." in k})
-        if refused == "held":
-            nest(values, command.nothing_held)
-        elif refused:
-            nest(values, self.spec.out_of_range if refused == "range" and self.spec.out_of_range else self.spec.refused)
+        nest(values, command.nothing_held if refused == "held" else self.spec.errors.get(refused, {}))
         return self._encode_reply(command.response, values)
 
     # --- data spaces and error replies ------------------------------------------------------------------------------
 
-    def _refusal(self, device: VirtualDevice, command: CommandSpec, given: dict[str, Any]) -> int | None:
-        """Why the device refuses a request (the error reply's reason), or None: values outside what the device
-        accepts first, then runs beyond their data space, then writes to a read-only space."""
-        error = self.spec.error
-        if error is None:
-            return None
+    def _refusal(self, device: VirtualDevice, command: CommandSpec, given: dict[str, Any]) -> str | None:
+        """Why the device refuses a request before it acts, or None: values outside what the device accepts first,
+        then runs beyond their data space, then writes to a read-only space; a move in progress that the command
+        waits for ("busy")."""
+        moving = device.motions.get(command.refused_while_moving)
+        if moving is not None and moving.active(self.clock()):
+            return "busy"
         for name, (low, high, allowed) in command.limits.items():
             value = given.get(name)
             value = len(value) if isinstance(value, list | tuple) else value
             if isinstance(value, int | float) and (not low <= value <= high or (allowed and value not in allowed)):
-                return error.out_of_range
+                return "out_of_range"
         spaces = {s.name: s for s in self.spec.spaces}
         runs = [(run, int(given[run.count]) if run.count else 1) for run in command.space_reads.values()]
         runs += [(run, _items(given[name])) for name, run in command.space_writes.items()]
         for run, count in runs:
             start = int(given[run.start])
             if start + count > len(device.spaces[run.space]):
-                return error.out_of_space
+                return "out_of_space"
         for run in command.space_writes.values():
             if spaces[run.space].access == "r":
-                return error.read_only
+                return "read_only"
         return None
 
     def _unsupported(self, data: bytes) -> list[tuple[float, bytes]]:
         """Bytes that arrived together and that the parser took for no frame: if they are one whole request whose
         checksum verifies but whose code no command has, the addressed device refuses it (Modbus exception 1)."""
         error = self.spec.error
-        if error is None or error.unsupported is None or error.unwrap is None:
+        if error is None or "unsupported" not in self.spec.errors or error.unwrap is None:
             return []
         try:
             code, values = error.unwrap(data)
@@ -609,14 +625,15 @@ class Engine(FaultInjection):
         if device is None:
             return []  # another device's, or broadcast: no reply
         refusal = CommandSpec(error.response, None, code=code)
-        frame = self._error_reply(device, refusal, error.unsupported)
+        frame = self._error_reply(device, refusal, "unsupported")
         return [] if frame is None else self._spoil(self.clock(), frame)
 
-    def _error_reply(self, device: VirtualDevice, command: CommandSpec, reason: int | None) -> bytes | None:
+    def _error_reply(self, device: VirtualDevice, command: CommandSpec, reason: str) -> bytes | None:
+        """The protocol's error reply refusing a request for `reason`; None (silence) for a reason not given."""
         error = self.spec.error
-        if error is None or reason is None:
+        if error is None or reason not in self.spec.errors:
             return None
-        values = {error.code_field: command.code or 0, error.field: reason}
+        values: dict[str, Any] = {error.code_field: command.code or 0, **self.spec.errors[reason]}
         if self.spec.address:
             values[self.spec.address] = device.id
         return self._encode_reply(error.response, values)
@@ -701,10 +718,10 @@ class Engine(FaultInjection):
         try:
             values = registers.split(start, data)
         except EncodeError:
-            return "access"
+            return "out_of_space"  # not whole registers
         reasons = [device.refusal(device.by_name.get(name), value) for name, value in values.items()]
         if any(reasons):
-            return "access" if "access" in reasons else "range"
+            return next((r for r in reasons if r and r != "out_of_range"), "out_of_range")
         for name, value in values.items():
             device.set(name, value)
         written.update(values)
@@ -718,7 +735,7 @@ class Engine(FaultInjection):
         given: dict[str, Any],
         written: set[str] | None = None,
     ) -> str:
-        """Store one request field in memory; why it was refused ("access", "range"), or "" when it was not."""
+        """Store one request field in memory; why it was refused (VirtualDevice.refusal), or "" when it was not."""
         table = command.tables.get(name, ())
         if table[:1] == ("run",) and self.spec.registers is not None:
             start = int(given[table[1]])
@@ -742,7 +759,7 @@ class Engine(FaultInjection):
                 for n in table[1:]:
                     if device.by_name[n].access != "r":
                         device.set(n, block[n])
-            return "" if ok else "range"
+            return "" if ok else "out_of_range"
         device.set(name, given[name])
         return ""
 

@@ -189,8 +189,6 @@ class DevicePass(Pass):
             broadcast=broadcast,
             state=state,
             reply={str(k): v if isinstance(v, str) else float(v) for k, v in (value.get("reply") or {}).items()},
-            refused={str(k): float(v) for k, v in (value.get("refused") or {}).items()},
-            out_of_range={str(k): float(v) for k, v in (value.get("out_of_range") or {}).items()},
             behaviours=tuple(behaviours),
             status=status,
             kinds=tuple(kinds.values()),
@@ -241,18 +239,24 @@ class DevicePass(Pass):
         return found
 
     def errors(self, value: Any, path: Path, commands: list[Command]) -> DeviceErrors | None:
+        """`errors:` reason -> reply values, each field checked against the error reply (when there is one)."""
         if value is None:
             return None
         reply = next((m for c in commands for m in c.messages() if m.error_reply), None)
-        if reply is None:
-            raise self.fail(path, "`errors:` needs a command whose response is the `error_reply`")
-        field = str(value["field"])
-        if not any(f.name == field for f in reply.fields):
-            self.error((*path, "field"), f"the error reply {reply.command} has no field {field!r}")
-        if value.get("unsupported") is not None and self.ctx.framing is not None and self.ctx.framing.classic:
-            self.error((*path, "unsupported"), "`unsupported` needs frames the frame engine takes apart (not classic)")
-        reasons = [value.get(k) for k in ("out_of_space", "out_of_range", "read_only", "unsupported")]
-        return DeviceErrors(field, *reasons)
+        reasons = {}
+        for reason, values in value.items():
+            for key in values:
+                if reply is not None and key.partition(".")[0] not in {f.name for f in reply.fields}:
+                    self.error((*path, reason, key), f"the error reply {reply.command} has no field {key!r}")
+            reasons[str(reason)] = {str(k): float(v) for k, v in values.items()}
+        if "unsupported" in reasons:
+            if reply is None:
+                self.error((*path, "unsupported"), "`unsupported` needs a command whose response is the `error_reply`")
+            elif self.ctx.framing is not None and self.ctx.framing.classic:
+                self.error(
+                    (*path, "unsupported"), "`unsupported` needs frames the frame engine takes apart (not classic)"
+                )
+        return DeviceErrors(**reasons)
 
     def space_runs(
         self, value: Any, names: set[str], request: Message, spaces: dict[str, Space], path: Path
@@ -344,6 +348,19 @@ class DevicePass(Pass):
                 self.error((*path, "cancel_when", field_name), f"{key} has no request field {field_name!r}")
         if "cancel_when" in item and "releases" not in item:
             self.error((*path, "cancel_when"), "`cancel_when` needs `releases`")
+        for field_name in item.get("broadcast_ignores") or {}:
+            if field_name not in request_names:
+                self.error((*path, "broadcast_ignores", field_name), f"{key} has no request field {field_name!r}")
+        restores: tuple[str, ...] = ()
+        if "restores" in item:
+            area, kept = item["restores"]["memory"], item["restores"].get("except") or ()
+            for index, name in enumerate(kept):
+                known(str(name), (*path, "restores", "except", index))
+            restores = tuple(
+                name
+                for name, entry in variables.items()
+                if isinstance(entry, TableEntry) and entry.memory == area and name not in kept
+            )
         carries = item.get("carries")
         carried: list[str] = []
         if carries:
@@ -358,6 +375,14 @@ class DevicePass(Pass):
         return {
             "stops": tuple(known(str(n), (*path, "stops")) for n in item.get("stops") or ()),
             "wraps": {known(str(n), (*path, "wraps", n)): float(p) for n, p in (item.get("wraps") or {}).items()},
+            "modulo": {known(str(n), (*path, "modulo", n)): float(p) for n, p in (item.get("modulo") or {}).items()},
+            "restores": restores,
+            "refused_while_moving": (
+                known(str(item["refused_while_moving"]), (*path, "refused_while_moving"))
+                if "refused_while_moving" in item
+                else ""
+            ),
+            "broadcast_ignores": {str(k): float(v) for k, v in (item.get("broadcast_ignores") or {}).items()},
             "counts": counts,
             "every_device": bool(item.get("every_device", False)),
             "held_while": known(str(item["held_while"]), (*path, "held_while")) if "held_while" in item else "",

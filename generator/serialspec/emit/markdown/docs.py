@@ -61,11 +61,13 @@ def erratum_check_words(check: ErratumCheck) -> str:
         target = f"`{check.command}`" + (f" / `{check.subcommand}`" if check.subcommand else "")
         return f"{frame}{direction} decodes as {target}"
     if check.kind == "checksum_value":
-        claimed = check.claimed if isinstance(check.claimed, str) else f"{check.claimed:#04x}"
-        return f"{frame}{direction} verifies with its checksum {check.actual:#04x}; with {claimed} it fails"
+        wrong = check.claimed if isinstance(check.claimed, str) else f"{check.claimed:#04x}"
+        return f"{frame}{direction} verifies with its checksum {check.actual:#04x}; with {wrong} it fails"
     if check.kind == "crc_parameters":
-        claimed = check.claimed.items() if isinstance(check.claimed, dict) else ()
-        named = ", ".join(f"{k} {v:#04X}".replace("0X", "0x") if isinstance(v, int) else f"{k} {v}" for k, v in claimed)
+        parameters = check.claimed.items() if isinstance(check.claimed, dict) else ()
+        named = ", ".join(
+            f"{k} {v:#04X}".replace("0X", "0x") if isinstance(v, int) else f"{k} {v}" for k, v in parameters
+        )
         examples = f"{len(check.examples)} examples'" if check.examples else "the examples'"
         return f"the CRC with the claimed parameters ({named or check.claimed}) does not give {examples} check bytes"
     return "none: the correction is explained in words"

@@ -25,6 +25,7 @@ from serialspec.spec.model import (
     Device,
     DeviceModel,
     Direction,
+    ErratumCheck,
     Example,
     Field,
     FrameLayout,
@@ -49,6 +50,28 @@ def text(value: str) -> str:
 def cell(value: object) -> str:
     """A value for a markdown table cell."""
     return text(str(value)).replace("|", "\\|") or " "
+
+
+def erratum_check_words(check: ErratumCheck) -> str:
+    """What tells the printed reading from the correct one, in words: the reader's own generated code can repeat it."""
+    frame = code_span(check.frame.hex(" ").upper() if check.frame is not None else check.frame_text)
+    direction = f" (as a {check.direction.value})" if check.direction else ""
+    if check.kind == "frame_fails":
+        return f"decoding {frame}{direction} fails with an error containing “{check.error}”"
+    if check.kind == "frame_decodes_as":
+        target = f"`{check.command}`" + (f" / `{check.subcommand}`" if check.subcommand else "")
+        return f"{frame}{direction} decodes as {target}"
+    if check.kind == "checksum_value":
+        wrong = check.claimed if isinstance(check.claimed, str) else f"{check.claimed:#04x}"
+        return f"{frame}{direction} verifies with its checksum {check.actual:#04x}; with {wrong} it fails"
+    if check.kind == "crc_parameters":
+        parameters = check.claimed.items() if isinstance(check.claimed, dict) else ()
+        named = ", ".join(
+            f"{k} {v:#04X}".replace("0X", "0x") if isinstance(v, int) else f"{k} {v}" for k, v in parameters
+        )
+        examples = f"{len(check.examples)} examples'" if check.examples else "the examples'"
+        return f"the CRC with the claimed parameters ({named or check.claimed}) does not give {examples} check bytes"
+    return "none: the correction is explained in words"
 
 
 def code_span(value: str) -> str:
@@ -651,7 +674,7 @@ def emit_docs(protocol: Protocol) -> str:
             "source": text(e.source),
             "printed": code_span(e.printed),
             "correct": text(e.correct),
-            "check": e.check.kind,
+            "check": erratum_check_words(e.check),
         }
         for e in protocol.errata
     ]

@@ -10,7 +10,9 @@ BENCH_STAMP := $(VENV)/.installed-bench
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install --quiet --upgrade pip
-	$(BIN)/pip install --quiet -e '.[test]'
+	@# setuptools' notice that an editable install is one (a warning, printed on every install) is silenced by its
+	@# message alone: other warnings and every error still show
+	PYTHONWARNINGS='ignore:Editable installation' $(BIN)/pip install --quiet -e '.[test]'
 	@# generated/ on the path: a package generated after the install imports at once, without a reinstall
 	echo "$(CURDIR)/generated" > "$$($(BIN)/python -c "import sysconfig; print(sysconfig.get_paths()['purelib'])")/serialspec-generated.pth"
 	touch $(STAMP)
@@ -45,7 +47,7 @@ stress: $(STAMP)
 # Benchmarks (bench/README.md): codec, stream parsing, pseudo-terminal latency, generation; about 3 minutes on a
 # quiet machine. Prints one table per family and writes them all to bench/results.md.
 $(BENCH_STAMP): $(STAMP) pyproject.toml
-	$(BIN)/pip install --quiet -e '.[test,bench]'
+	PYTHONWARNINGS='ignore:Editable installation' $(BIN)/pip install --quiet -e '.[test,bench]'
 	touch $(BENCH_STAMP)
 
 bench: $(BENCH_STAMP)

@@ -169,3 +169,44 @@ def test_a_spec_path_uses_the_generated_package_only_when_it_was_generated_from_
     assert live.encode(request)[:5] == bytes.fromhex("12 4c 08 07 ff")
     with pytest.raises(Exception, match="servo_id = 255 is outside its range 0..254"):
         package.encode(package.RotateRequest(servo_id=255, angle=0, interval=0))
+
+
+def test_a_package_generated_into_the_current_folder_is_found_by_name(tmp_path: Path) -> None:
+    """The installed `serialspec` script (not `python -m`, which puts the folder on the path itself) finds by name a
+    package that `import NAME` finds from the current folder."""
+    shutil.copy(ROOT / "examples" / "tinylamp" / "tinylamp.yaml", tmp_path)
+    script = str(Path(sys.executable).parent / "serialspec")
+    generate = subprocess.run([script, "generate", "tinylamp.yaml", "--out", "."], cwd=tmp_path, capture_output=True)
+    assert generate.returncode == 0, generate.stderr
+    (tmp_path / "tinylamp.yaml").unlink()  # by name only: no spec file to fall back on
+    run = [script, "decode", "tinylamp", "aa 01 01 01 ad"]
+    decoded = subprocess.run(run, cwd=tmp_path, capture_output=True, text=True)
+    assert decoded.returncode == 0 and decoded.stdout.startswith("tinylamp request"), decoded.stderr
+    elsewhere = subprocess.run(run, cwd=tmp_path / "docs", capture_output=True, text=True)
+    assert elsewhere.returncode == 1 and "run from the folder that holds the generated tinylamp/" in elsewhere.stderr
+
+
+def test_units_view_reads_flags_as_words_and_json_keeps_the_list() -> None:
+    """`--units` prints set flags as names (`overheat, overload`), none set as `none`; `--json` keeps a list."""
+    args = ("decode", str(ROOT / "specs" / "feetech_sms.yaml"), "--direction", "response", "--units")
+    faults = serialspec(*args, "ff ff 01 02 24 d8").stdout
+    assert "  error                overheat, overload\n" in faults
+    assert "  error                none\n" in serialspec(*args, "ff ff 01 02 00 fc").stdout
+    as_json = json.loads(serialspec(*args, "ff ff 01 02 24 d8", "--json").stdout)
+    assert as_json["fields"]["error"] == ["overheat", "overload"]
+
+
+def test_sim_banner_says_what_is_served_in_words() -> None:
+    """No `device(s) 0` for a protocol without an address, and a board's further kinds of device by their ids."""
+    from types import SimpleNamespace
+
+    from serialspec.cli.sim import served
+    from serialspec.spec import load_protocol
+
+    def banner(name: str, ids: list[int]) -> str:
+        protocol = load_protocol(str(ROOT / "specs" / f"{name}.yaml"))
+        return served(protocol, {i: SimpleNamespace(model=None) for i in ids})
+
+    assert banner("vesc", [0]) == "(one device: the protocol has no address)"
+    assert banner("modbus_rtu", [1, 2]) == "unit 1, 2"
+    assert banner("hiwonder_rrc", [1]) == "servo_id 1; pwm_servo servo_id 1, 2, 3, 4; motor motor_id 0, 1, 2, 3"

@@ -112,6 +112,10 @@ def test_the_tutorial_commands_and_client_session_run_as_printed(tmp_path: Path)
     assert "RangeError: set_brightness request: brightness = 300 is outside its range 0..100" in result.stderr
     replay = run(f"serialspec decode tinylamp.yaml --file {tmp_path / 'session.capture'}", tmp_path)
     assert sum("tinylamp response" in line for line in replay) == 3
+    # the spec's editor line names the schema the tutorial's `generate --out .` wrote beside it, as step 1 says
+    schema = re.search(r"\$schema=(\S+)", (tmp_path / "tinylamp.yaml").read_text(encoding="utf-8"))
+    assert schema is not None and f"$schema={schema[1]}`" in TUTORIAL.read_text(encoding="utf-8")
+    assert (tmp_path / schema[1]).is_file()
 
 
 @pytest.mark.parametrize("page", ["README.md", "docs/tutorial.md"])
@@ -144,3 +148,26 @@ def test_example_breakdowns_show_values_as_people_write_them(spec: Path) -> None
     assert not re.findall(r"\{'|\['|<[A-Z]\w+\.|\[(?:True|False);", docs)
     errata = docs.split("\n## Errata\n")[1]
     assert errata.strip() and ("### " in errata or "None recorded" in errata)
+
+
+@pytest.mark.parametrize("spec", sorted((ROOT / "specs").glob("*.yaml")), ids=lambda p: p.stem)
+def test_frame_layout_states_the_gap_once(spec: Path) -> None:
+    """A protocol with a silence between frames says so once in its frame layout section, not in the spec's
+    description and again in the template's sentence."""
+    from serialspec.emit.markdown.docs import emit_docs
+    from serialspec.spec import load_protocol
+
+    protocol = load_protocol(str(spec), spec.name)
+    section = emit_docs(protocol).split("\n## Frame layout\n")[1].split("\n## ")[0]
+    assert section.count("character times") == (1 if protocol.framing.gap else 0)
+
+
+@pytest.mark.parametrize("spec", sorted((ROOT / "specs").glob("*.yaml")), ids=lambda p: p.stem)
+def test_published_reference_cites_only_what_readers_can_find(spec: Path) -> None:
+    """No internal note, local file name, issue number or this repository's test files in a published reference:
+    sources are named as their publishers name them."""
+    from serialspec.emit.markdown.docs import emit_docs
+    from serialspec.spec import load_protocol
+
+    docs = emit_docs(load_protocol(str(spec), spec.name))
+    assert not re.findall(r"design-notes|protocol-docs/|\.txt\b|\bissue \d|tests/|test_\w+\.py", docs)

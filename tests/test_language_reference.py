@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 from typing import Any
 
 from conftest import ROOT
@@ -61,3 +62,9 @@ def test_every_plain_key_of_the_committed_reference_has_an_example() -> None:
     assert len(rows) > 150
     missing = [row[0] for row in rows if row[4].startswith("—") and "See [" not in row[3]]
     assert missing == [], "no spec uses these keys: give their shapes in spec/grammar.py an example= value"
+
+
+def test_the_reference_names_no_path_inside_this_repository() -> None:
+    """A user reads the reference beside their own specs: no source file or repo folder they do not have."""
+    text = reference_markdown([])
+    assert not re.findall(r"\w+\.py\b|specs/|generator/|serialspec/spec", text)

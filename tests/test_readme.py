@@ -31,3 +31,13 @@ def test_the_readme_session_runs_as_printed() -> None:
     assert lines[2] == "777"
     assert 0 <= int(lines[3]) < 2048
     assert lines[4] == "{1: {'goal_position': 100}, 2: {'goal_position': 300}}"
+
+
+def test_the_readme_stream_parser_snippet_runs_against_a_simulated_servo() -> None:
+    """The StreamParser snippet, as printed but for its port, reads a reply from a `serialspec sim` process."""
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    code = next(b for b in re.findall(r"```python\n(.*?)```", text, flags=re.S) if "StreamParser" in b)
+    output = io.StringIO()
+    with serve("fashionstar_uart.yaml", 0) as port, contextlib.redirect_stdout(output):
+        exec(compile(code.replace('"/dev/ttyUSB0"', repr(port)), "README.md", "exec"), {})
+    assert output.getvalue().strip().lstrip("-").isdigit()

@@ -187,7 +187,10 @@ def test_a_shipped_protocol_decodes_by_name(user: User) -> None:
     result = user.serialspec("decode", "feetech_sms", "ff ff 01 02 01 fb", "--direction", "request", "--json")
     assert json.loads(result.stdout)["command"] == "ping"
     missing = user.serialspec("decode", "no_such_protocol", "00", check=False)
-    assert missing.returncode == 1 and "no such spec file or installed protocol package" in missing.stderr
+    assert (
+        missing.returncode == 1
+        and "no such spec file, nor a protocol package no_such_protocol/ in this folder or installed" in missing.stderr
+    )
 
 
 @pytest.fixture

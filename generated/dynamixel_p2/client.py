@@ -209,7 +209,7 @@ class DynamixelP2Client(ClientBase):
 
         Args:
             id: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. (0..252)
-            option: What to reset.
+            option: What to reset. (1..255)
 
         Returns: True if the device answered, False if it stayed silent (timeout).
         None when no reply is due (broadcast gets no reply).
@@ -248,7 +248,7 @@ class DynamixelP2Client(ClientBase):
 
         Args:
             id: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. (0..252)
-            option: What to clear.
+            option: What to clear. (1..1)
 
         Returns: True if the device answered, False if it stayed silent (timeout).
         None when no reply is due (broadcast gets no reply).
@@ -351,7 +351,7 @@ class DynamixelP2Client(ClientBase):
         self.bus.send(request)
 
     def read(self, id: int, name: ControlTableName) -> int:
-        """Read from the control table: one register by name, e.g. `read(1, "present_position")`, in wire units."""
+        """Read from the control table: one register by name, e.g. `read(1, "model_number")`, in wire units."""
         register = CONTROL_TABLE[name]
         if id == 254:
             raise EncodeError("read: name one device; the broadcast id 254 gets no reply")
@@ -373,7 +373,7 @@ class DynamixelP2Client(ClientBase):
         return CONTROL_TABLE.from_wire(register, data or b"")
 
     def write(self, id: int, /, **values: int) -> bool | None:
-        """Write to the control table, by register name: `write(id, goal_position=2048, goal_time=0)`.
+        """Write to the control table, by register name: `write(1, id=1, baud_rate=1)`.
 
         The named registers must follow each other in the table (one run of bytes); each value is checked
         against its register's range and access before a byte is written. `write_raw` takes raw bytes.
@@ -385,7 +385,7 @@ class DynamixelP2Client(ClientBase):
         return result
 
     def reg_write(self, id: int, /, **values: int) -> bool | None:
-        """Buffered write, carried out on ACTION, by register name: `reg_write(id, goal_position=2048, goal_time=0)`.
+        """Buffered write, carried out on ACTION, by register name: `reg_write(1, id=1, baud_rate=1)`.
 
         The named registers must follow each other in the table (one run of bytes); each value is checked
         against its register's range and access before a byte is written. `reg_write_raw` takes raw bytes.
@@ -399,7 +399,7 @@ class DynamixelP2Client(ClientBase):
     def sync_read(
         self, ids: Iterable[int], *names: ControlTableName, id: int = 254
     ) -> dict[int, dict[str, int]]:
-        """Read the same items of several servos, by register name: `sync_read([1, 2], "present_position")` -> {1: {...}, 2: {...}}.
+        """Read the same items of several servos, by register name: `sync_read([1, 2], "model_number")` -> {1: {...}, 2: {...}}.
 
         One request; every listed device answers in turn. `sync_read_raw` takes raw addresses and returns bytes.
         """
@@ -412,7 +412,7 @@ class DynamixelP2Client(ClientBase):
         }
 
     def sync_write(self, values: Mapping[int, Mapping[str, int]], id: int = 254) -> None:
-        """Write the same items of several servos at once, by register name: `sync_write({1: {"goal_position": 100}, 2: {"goal_position": 300}})`.
+        """Write the same items of several servos at once, by register name: `sync_write({1: {"id": 1}, 2: {"id": 1}})`.
 
         Every device gets the same registers (one run, the same for all); values are checked before sending.
         `sync_write_raw` takes raw bytes.

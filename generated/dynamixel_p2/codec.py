@@ -8,6 +8,7 @@ from collections.abc import Callable
 
 from serialspec.runtime.checksums import crc_function
 from serialspec.runtime.errors import DecodeError, EncodeError, content_size_error, out_of_range
+from serialspec.runtime.fields import wrong_type
 from serialspec.runtime.framing import Element, EngineFormat, FrameCodec, Layout, Transparency
 from serialspec.runtime.framing import FrameStreamParser as _FrameStreamParser
 from serialspec.runtime.message import Direction, Message, members, slot_setters
@@ -318,113 +319,113 @@ def _decode_status_response(buf: bytes, o: int, end: int, id: int, error: int) -
 
 
 def _encode_ping_request(m: PingRequest) -> bytes:
-    if not (0 <= m.id <= 252 or m.id == 254):
+    if not (0 <= m.id <= 252 or m.id == 254) or m.id.__class__ is bool:
         raise out_of_range('ping request', 'id', m.id, 0, 252)
     return _REQUEST_FRAMES.wrap(b'', 0x01, (m.id,))
 
 
 def _encode_ping_response(m: PingResponse) -> bytes:
-    if not (0 <= m.id <= 252 or m.id == 254):
+    if not (0 <= m.id <= 252 or m.id == 254) or m.id.__class__ is bool:
         raise out_of_range('ping response', 'id', m.id, 0, 252)
-    if not 0 <= m.error.alert <= 1:
+    if not 0 <= m.error.alert <= 1 or m.error.alert.__class__ is bool:
         raise out_of_range('ping response', 'error.alert', m.error.alert, 0, 1)
-    if not 0 <= m.error.number <= 127:
+    if not 0 <= m.error.number <= 127 or m.error.number.__class__ is bool:
         raise out_of_range('ping response', 'error.number', m.error.number, 0, 127)
-    if not 0 <= m.model_number <= 65535:
+    if not 0 <= m.model_number <= 65535 or m.model_number.__class__ is bool:
         raise out_of_range('ping response', 'model_number', m.model_number, 0, 65535)
-    if not 0 <= m.firmware_version <= 255:
+    if not 0 <= m.firmware_version <= 255 or m.firmware_version.__class__ is bool:
         raise out_of_range('ping response', 'firmware_version', m.firmware_version, 0, 255)
     return _RESPONSE_FRAMES.wrap(_S_U16_U8.pack(m.model_number, m.firmware_version), None, (m.id, (m.error.alert << 7) | m.error.number))
 
 
 def _encode_read_request(m: ReadRequest) -> bytes:
-    if not (0 <= m.id <= 252 or m.id == 254):
+    if not (0 <= m.id <= 252 or m.id == 254) or m.id.__class__ is bool:
         raise out_of_range('read request', 'id', m.id, 0, 252)
-    if not 0 <= m.address <= 65535:
+    if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('read request', 'address', m.address, 0, 65535)
-    if not 1 <= m.length <= 1024:
+    if not 1 <= m.length <= 1024 or m.length.__class__ is bool:
         raise out_of_range('read request', 'length', m.length, 1, 1024)
     return _REQUEST_FRAMES.wrap(_S_U16_U16.pack(m.address, m.length), 0x02, (m.id,))
 
 
 def _encode_write_request(m: WriteRequest) -> bytes:
-    if not (0 <= m.id <= 252 or m.id == 254):
+    if not (0 <= m.id <= 252 or m.id == 254) or m.id.__class__ is bool:
         raise out_of_range('write request', 'id', m.id, 0, 252)
-    if not 0 <= m.address <= 65535:
+    if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('write request', 'address', m.address, 0, 65535)
     return _REQUEST_FRAMES.wrap(b''.join((_S_U16.pack(m.address), bytes(m.data),)), 0x03, (m.id,))
 
 
 def _encode_reg_write_request(m: RegWriteRequest) -> bytes:
-    if not (0 <= m.id <= 252 or m.id == 254):
+    if not (0 <= m.id <= 252 or m.id == 254) or m.id.__class__ is bool:
         raise out_of_range('reg_write request', 'id', m.id, 0, 252)
-    if not 0 <= m.address <= 65535:
+    if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('reg_write request', 'address', m.address, 0, 65535)
     return _REQUEST_FRAMES.wrap(b''.join((_S_U16.pack(m.address), bytes(m.data),)), 0x04, (m.id,))
 
 
 def _encode_action_request(m: ActionRequest) -> bytes:
-    if not (0 <= m.id <= 252 or m.id == 254):
+    if not (0 <= m.id <= 252 or m.id == 254) or m.id.__class__ is bool:
         raise out_of_range('action request', 'id', m.id, 0, 252)
     return _REQUEST_FRAMES.wrap(b'', 0x05, (m.id,))
 
 
 def _encode_factory_reset_request(m: FactoryResetRequest) -> bytes:
-    if not (0 <= m.id <= 252 or m.id == 254):
+    if not (0 <= m.id <= 252 or m.id == 254) or m.id.__class__ is bool:
         raise out_of_range('factory_reset request', 'id', m.id, 0, 252)
-    if not 0 <= m.option <= 255:
-        raise out_of_range('factory_reset request', 'option', m.option, 0, 255)
+    if not 1 <= m.option <= 255 or m.option.__class__ is bool:
+        raise out_of_range('factory_reset request', 'option', m.option, 1, 255)
     return _REQUEST_FRAMES.wrap(_S_U8.pack(m.option), 0x06, (m.id,))
 
 
 def _encode_reboot_request(m: RebootRequest) -> bytes:
-    if not (0 <= m.id <= 252 or m.id == 254):
+    if not (0 <= m.id <= 252 or m.id == 254) or m.id.__class__ is bool:
         raise out_of_range('reboot request', 'id', m.id, 0, 252)
     return _REQUEST_FRAMES.wrap(b'', 0x08, (m.id,))
 
 
 def _encode_clear_request(m: ClearRequest) -> bytes:
-    if not (0 <= m.id <= 252 or m.id == 254):
+    if not (0 <= m.id <= 252 or m.id == 254) or m.id.__class__ is bool:
         raise out_of_range('clear request', 'id', m.id, 0, 252)
-    if not 0 <= m.option <= 255:
-        raise out_of_range('clear request', 'option', m.option, 0, 255)
+    if not 1 <= m.option <= 1 or m.option.__class__ is bool:
+        raise out_of_range('clear request', 'option', m.option, 1, 1)
     return _REQUEST_FRAMES.wrap(_S_U8_U32.pack(m.option, 575428676), 0x10, (m.id,))
 
 
 def _encode_sync_read_request(m: SyncReadRequest) -> bytes:
-    if not (0 <= m.id <= 252 or m.id == 254):
+    if not (0 <= m.id <= 252 or m.id == 254) or m.id.__class__ is bool:
         raise out_of_range('sync_read request', 'id', m.id, 0, 252)
-    if not 0 <= m.address <= 65535:
+    if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('sync_read request', 'address', m.address, 0, 65535)
-    if not 1 <= m.length <= 1024:
+    if not 1 <= m.length <= 1024 or m.length.__class__ is bool:
         raise out_of_range('sync_read request', 'length', m.length, 1, 1024)
     parts_ids = []
     for item in m.ids:
-        if not 0 <= item.id <= 252:
+        if not 0 <= item.id <= 252 or item.id.__class__ is bool:
             raise out_of_range('sync_read request', 'id', item.id, 0, 252)
         parts_ids.append(_S_U8.pack(item.id))
     return _REQUEST_FRAMES.wrap(b''.join((_S_U16_U16.pack(m.address, m.length), b''.join(parts_ids),)), 0x82, (m.id,))
 
 
 def _encode_fast_sync_read_request(m: FastSyncReadRequest) -> bytes:
-    if not (0 <= m.id <= 252 or m.id == 254):
+    if not (0 <= m.id <= 252 or m.id == 254) or m.id.__class__ is bool:
         raise out_of_range('fast_sync_read request', 'id', m.id, 0, 252)
-    if not 0 <= m.address <= 65535:
+    if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('fast_sync_read request', 'address', m.address, 0, 65535)
-    if not 1 <= m.length <= 1024:
+    if not 1 <= m.length <= 1024 or m.length.__class__ is bool:
         raise out_of_range('fast_sync_read request', 'length', m.length, 1, 1024)
     parts_servo_ids = []
     for item in m.servo_ids:
-        if not 0 <= item.id <= 252:
+        if not 0 <= item.id <= 252 or item.id.__class__ is bool:
             raise out_of_range('fast_sync_read request', 'id', item.id, 0, 252)
         parts_servo_ids.append(_S_U8.pack(item.id))
     return _REQUEST_FRAMES.wrap(b''.join((_S_U16_U16.pack(m.address, m.length), b''.join(parts_servo_ids),)), 0x8a, (m.id,))
 
 
 def _encode_sync_write_request(m: SyncWriteRequest) -> bytes:
-    if not (0 <= m.id <= 252 or m.id == 254):
+    if not (0 <= m.id <= 252 or m.id == 254) or m.id.__class__ is bool:
         raise out_of_range('sync_write request', 'id', m.id, 0, 252)
-    if not 0 <= m.address <= 65535:
+    if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('sync_write request', 'address', m.address, 0, 65535)
     v_length = len(m.servos[0].data) if m.servos else 0
     if any(len(item.data) != v_length for item in m.servos):
@@ -433,35 +434,35 @@ def _encode_sync_write_request(m: SyncWriteRequest) -> bytes:
         raise out_of_range('sync_write request', 'length', v_length, 0, 65535)
     parts_servos = []
     for item in m.servos:
-        if not 0 <= item.id <= 252:
+        if not 0 <= item.id <= 252 or item.id.__class__ is bool:
             raise out_of_range('sync_write request', 'id', item.id, 0, 252)
         parts_servos.append(b''.join((_S_U8.pack(item.id), bytes(item.data),)))
     return _REQUEST_FRAMES.wrap(b''.join((_S_U16_U16.pack(m.address, v_length), b''.join(parts_servos),)), 0x83, (m.id,))
 
 
 def _encode_bulk_read_request(m: BulkReadRequest) -> bytes:
-    if not (0 <= m.id <= 252 or m.id == 254):
+    if not (0 <= m.id <= 252 or m.id == 254) or m.id.__class__ is bool:
         raise out_of_range('bulk_read request', 'id', m.id, 0, 252)
     parts_reads = []
     for item in m.reads:
-        if not 0 <= item.id <= 252:
+        if not 0 <= item.id <= 252 or item.id.__class__ is bool:
             raise out_of_range('bulk_read request', 'id', item.id, 0, 252)
-        if not 0 <= item.address <= 65535:
+        if not 0 <= item.address <= 65535 or item.address.__class__ is bool:
             raise out_of_range('bulk_read request', 'address', item.address, 0, 65535)
-        if not 1 <= item.length <= 1024:
+        if not 1 <= item.length <= 1024 or item.length.__class__ is bool:
             raise out_of_range('bulk_read request', 'length', item.length, 1, 1024)
         parts_reads.append(_S_U8_U16_U16.pack(item.id, item.address, item.length))
     return _REQUEST_FRAMES.wrap(b''.join(parts_reads), 0x92, (m.id,))
 
 
 def _encode_bulk_write_request(m: BulkWriteRequest) -> bytes:
-    if not (0 <= m.id <= 252 or m.id == 254):
+    if not (0 <= m.id <= 252 or m.id == 254) or m.id.__class__ is bool:
         raise out_of_range('bulk_write request', 'id', m.id, 0, 252)
     parts_writes = []
     for item in m.writes:
-        if not 0 <= item.id <= 252:
+        if not 0 <= item.id <= 252 or item.id.__class__ is bool:
             raise out_of_range('bulk_write request', 'id', item.id, 0, 252)
-        if not 0 <= item.address <= 65535:
+        if not 0 <= item.address <= 65535 or item.address.__class__ is bool:
             raise out_of_range('bulk_write request', 'address', item.address, 0, 65535)
         if len(item.data) > 65535:
             raise out_of_range('bulk_write request', 'length', len(item.data), 0, 65535)
@@ -470,11 +471,11 @@ def _encode_bulk_write_request(m: BulkWriteRequest) -> bytes:
 
 
 def _encode_status_response(m: StatusResponse) -> bytes:
-    if not (0 <= m.id <= 252 or m.id == 254):
+    if not (0 <= m.id <= 252 or m.id == 254) or m.id.__class__ is bool:
         raise out_of_range('status response', 'id', m.id, 0, 252)
-    if not 0 <= m.error.alert <= 1:
+    if not 0 <= m.error.alert <= 1 or m.error.alert.__class__ is bool:
         raise out_of_range('status response', 'error.alert', m.error.alert, 0, 1)
-    if not 0 <= m.error.number <= 127:
+    if not 0 <= m.error.number <= 127 or m.error.number.__class__ is bool:
         raise out_of_range('status response', 'error.number', m.error.number, 0, 127)
     return _RESPONSE_FRAMES.wrap(bytes(m.data), None, (m.id, (m.error.alert << 7) | m.error.number))
 
@@ -620,8 +621,10 @@ def encode(message: Message) -> bytes:
         raise EncodeError(f"{type(message).__name__} is not a dynamixel_p2 message")
     try:
         return encoder(message)
-    except (TypeError, AttributeError, struct.error) as exc:
-        raise EncodeError(f"{message.COMMAND} {message.DIRECTION.value}: {exc}") from None
+    except EncodeError:
+        raise
+    except (TypeError, AttributeError, ValueError, OverflowError, struct.error) as exc:
+        raise wrong_type(message, exc) from None  # one line naming the field, not Python's words
 
 
 # Each direction's frames for code that splits a stream of both directions (serialspec monitor).

@@ -9,10 +9,12 @@ from typing import Any, ClassVar, Self
 
 from serialspec.runtime.fields import as_bytes as _bytes
 from serialspec.runtime.fields import check_keys as _check_keys
+from serialspec.runtime.fields import enum as _as_enum
 from serialspec.runtime.fields import get as _get
+from serialspec.runtime.fields import integer as _integer
+from serialspec.runtime.fields import items as _items
 from serialspec.runtime.fields import mapping as _mapping
 from serialspec.runtime.message import Direction, Message, Record
-from serialspec.runtime.message import enum_or_int as _enum
 
 _store = object.__setattr__  # how __init__ fills the slots of a frozen class
 
@@ -56,123 +58,123 @@ __all__ = [
 class ErrorNumber(IntEnum):
     """The error number of a status packet (bits 6..0 of its error byte; protocol2 §Error)."""
 
-    NONE = 0
     #: no error
-    RESULT_FAIL = 1
+    NONE = 0
     #: failed to process the instruction packet
-    INSTRUCTION_ERROR = 2
+    RESULT_FAIL = 1
     #: undefined instruction, or ACTION without REG WRITE
-    CRC_ERROR = 3
+    INSTRUCTION_ERROR = 2
     #: the CRC of the packet does not match
-    DATA_RANGE_ERROR = 4
+    CRC_ERROR = 3
     #: the data to write is outside the item's minimum..maximum
-    DATA_LENGTH_ERROR = 5
+    DATA_RANGE_ERROR = 4
     #: the data is shorter than the item (e.g. 2 bytes of a 4-byte item)
-    DATA_LIMIT_ERROR = 6
+    DATA_LENGTH_ERROR = 5
     #: the data to write is outside the item's limit value
-    ACCESS_ERROR = 7
+    DATA_LIMIT_ERROR = 6
     #: writing a read-only or undefined item, reading a write-only one, or writing EEPROM while torque is on
+    ACCESS_ERROR = 7
 
 
 class ResetOption(IntEnum):
     """What FACTORY RESET resets (protocol2 §Factory Reset, parameter 1)."""
 
-    ALL_BUT_ID = 1
     #: reset all but the id
-    ALL_BUT_ID_AND_BAUD_RATE = 2
+    ALL_BUT_ID = 1
     #: reset all but the id and the baud rate
-    ALL = 255
+    ALL_BUT_ID_AND_BAUD_RATE = 2
     #: reset all (ignored when sent to the broadcast id, firmware 42 and later)
+    ALL = 255
 
 
 class ClearOption(IntEnum):
     """What CLEAR resets (protocol2 §Clear, parameter 1)."""
 
-    MULTI_TURN = 1
     #: reset the present position to within one turn (0..4095); only while stopped
+    MULTI_TURN = 1
 
 
 class BaudRate(IntEnum):
     """Baud rate option (register 8)."""
 
-    BAUD_9600 = 0
     #: 9600
-    BAUD_57600 = 1
+    BAUD_9600 = 0
     #: 57600
-    BAUD_115200 = 2
+    BAUD_57600 = 1
     #: 115200
-    BAUD_1000000 = 3
+    BAUD_115200 = 2
     #: 1M
-    BAUD_2000000 = 4
+    BAUD_1000000 = 3
     #: 2M
-    BAUD_3000000 = 5
+    BAUD_2000000 = 4
     #: 3M
-    BAUD_4000000 = 6
+    BAUD_3000000 = 5
     #: 4M
-    BAUD_4500000 = 7
+    BAUD_4000000 = 6
     #: 4.5M
+    BAUD_4500000 = 7
 
 
 class OperatingMode(IntEnum):
     """Operating mode (register 11)."""
 
-    CURRENT = 0
     #: current (torque) control
-    VELOCITY = 1
+    CURRENT = 0
     #: velocity control
-    POSITION = 3
+    VELOCITY = 1
     #: position control, one turn (default)
-    EXTENDED_POSITION = 4
+    POSITION = 3
     #: extended position (multi-turn) control
-    CURRENT_BASED_POSITION = 5
+    EXTENDED_POSITION = 4
     #: current-based position control
-    PWM = 16
+    CURRENT_BASED_POSITION = 5
     #: PWM (voltage) control
+    PWM = 16
 
 
 class StatusReturnLevel(IntEnum):
     """Which instructions a servo answers (register 68)."""
 
-    PING_ONLY = 0
     #: only PING is answered
-    PING_AND_READ = 1
+    PING_ONLY = 0
     #: PING and READ are answered
-    ALL = 2
+    PING_AND_READ = 1
     #: every instruction is answered (default)
+    ALL = 2
 
 
 class TorqueEnable(IntEnum):
     """Torque switch (register 64); EEPROM items are locked while it is on."""
 
-    OFF = 0
     #: torque off
-    ON = 1
+    OFF = 0
     #: torque on (EEPROM locked)
+    ON = 1
 
 
 class ProtocolType(IntEnum):
     """Protocol of the servo (register 13)."""
 
-    PROTOCOL_1 = 1
     #: DYNAMIXEL Protocol 1.0
-    PROTOCOL_2 = 2
+    PROTOCOL_1 = 1
     #: DYNAMIXEL Protocol 2.0 (default)
+    PROTOCOL_2 = 2
 
 
 class HardwareError(IntFlag):
     """Hardware error status (register 70) and shutdown conditions (register 63)."""
 
     NONE = 0
-    INPUT_VOLTAGE = 1 << 0
     #: input voltage outside the voltage limits
-    OVERHEATING = 1 << 2
+    INPUT_VOLTAGE = 1 << 0
     #: internal temperature above the temperature limit
-    MOTOR_ENCODER = 1 << 3
+    OVERHEATING = 1 << 2
     #: motor encoder fault
-    ELECTRICAL_SHOCK = 1 << 4
+    MOTOR_ENCODER = 1 << 3
     #: electrical shock on the circuit or insufficient power
-    OVERLOAD = 1 << 5
+    ELECTRICAL_SHOCK = 1 << 4
     #: persistent load above the maximum output
+    OVERLOAD = 1 << 5
 
 
 class ErrorBits(Record):
@@ -180,10 +182,10 @@ class ErrorBits(Record):
 
     __slots__ = ('alert', 'number')
     __match_args__ = ('alert', 'number')
-    alert: int
     #: The servo has a hardware problem; see hardware_error_status (70). (bit 7)
-    number: ErrorNumber | int
+    alert: int
     #: The result of processing the instruction. (bits 6..0)
+    number: ErrorNumber | int
 
     def __init__(
         self,
@@ -203,8 +205,8 @@ class ErrorBits(Record):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'ErrorBits') -> Self:
         _check_keys(data, ('alert', 'number'), (), where)
         return cls(
-            _get(data, 'alert', where),
-            _enum(ErrorNumber, _get(data, 'number', where)),
+            _integer(_get(data, 'alert', where), 'alert', where),
+            _as_enum(ErrorNumber, _get(data, 'number', where), 'number', where),
         )
 
 
@@ -213,8 +215,8 @@ class IdsItem(Record):
 
     __slots__ = ('id',)
     __match_args__ = ('id',)
-    id: int
     #: A servo id. range 0..252
+    id: int
 
     def __init__(
         self,
@@ -231,7 +233,7 @@ class IdsItem(Record):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'IdsItem') -> Self:
         _check_keys(data, ('id',), (), where)
         return cls(
-            _get(data, 'id', where),
+            _integer(_get(data, 'id', where), 'id', where),
         )
 
 
@@ -240,8 +242,8 @@ class ServoIdsItem(Record):
 
     __slots__ = ('id',)
     __match_args__ = ('id',)
-    id: int
     #: A servo id. range 0..252
+    id: int
 
     def __init__(
         self,
@@ -258,7 +260,7 @@ class ServoIdsItem(Record):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'ServoIdsItem') -> Self:
         _check_keys(data, ('id',), (), where)
         return cls(
-            _get(data, 'id', where),
+            _integer(_get(data, 'id', where), 'id', where),
         )
 
 
@@ -267,10 +269,10 @@ class ServosItem(Record):
 
     __slots__ = ('id', 'data')
     __match_args__ = ('id', 'data')
-    id: int
     #: The servo's id. range 0..252
-    data: bytes
+    id: int
     #: The bytes written to that servo from `address` on.
+    data: bytes
 
     def __init__(
         self,
@@ -290,7 +292,7 @@ class ServosItem(Record):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'ServosItem') -> Self:
         _check_keys(data, ('id', 'data'), (), where)
         return cls(
-            _get(data, 'id', where),
+            _integer(_get(data, 'id', where), 'id', where),
             _bytes(_get(data, 'data', where), 'data', where),
         )
 
@@ -300,12 +302,12 @@ class ReadsItem(Record):
 
     __slots__ = ('id', 'address', 'length')
     __match_args__ = ('id', 'address', 'length')
-    id: int
     #: The servo's id. range 0..252
-    address: int
+    id: int
     #: First control table address to read.
-    length: int
+    address: int
     #: Number of bytes to read. range 1..1024
+    length: int
 
     def __init__(
         self,
@@ -328,9 +330,9 @@ class ReadsItem(Record):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'ReadsItem') -> Self:
         _check_keys(data, ('id', 'address', 'length'), (), where)
         return cls(
-            _get(data, 'id', where),
-            _get(data, 'address', where),
-            _get(data, 'length', where),
+            _integer(_get(data, 'id', where), 'id', where),
+            _integer(_get(data, 'address', where), 'address', where),
+            _integer(_get(data, 'length', where), 'length', where),
         )
 
 
@@ -339,12 +341,12 @@ class WritesItem(Record):
 
     __slots__ = ('id', 'address', 'data')
     __match_args__ = ('id', 'address', 'data')
-    id: int
     #: The servo's id. range 0..252
-    address: int
+    id: int
     #: First control table address to write.
-    data: bytes
+    address: int
     #: The bytes written to that servo from `address` on.
+    data: bytes
 
     def __init__(
         self,
@@ -367,8 +369,8 @@ class WritesItem(Record):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'WritesItem') -> Self:
         _check_keys(data, ('id', 'address', 'data'), (), where)
         return cls(
-            _get(data, 'id', where),
-            _get(data, 'address', where),
+            _integer(_get(data, 'id', where), 'id', where),
+            _integer(_get(data, 'address', where), 'address', where),
             _bytes(_get(data, 'data', where), 'data', where),
         )
 
@@ -382,8 +384,8 @@ class PingRequest(Message):
     COMMAND: ClassVar[str] = 'ping'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    id: int
     #: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. range 0..252
+    id: int
 
     def __init__(
         self,
@@ -400,7 +402,7 @@ class PingRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'ping request') -> Self:
         _check_keys(data, ('id',), (), where)
         return cls(
-            _get(data, 'id', where),
+            _integer(_get(data, 'id', where), 'id', where),
         )
 
 
@@ -413,14 +415,14 @@ class PingResponse(Message):
     COMMAND: ClassVar[str] = 'ping'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    id: int
     #: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. range 0..252
-    error: ErrorBits
+    id: int
     #: Status packets only; bit 7 is the alert bit, bits 6..0 the error number (0 = no error).
-    model_number: int
+    error: ErrorBits
     #: The servo's model number (XM430-W350: 1020, XL430-W250: 1060, XL330-M288: 1200).
-    firmware_version: int
+    model_number: int
     #: The firmware version.
+    firmware_version: int
 
     def __init__(
         self,
@@ -446,10 +448,10 @@ class PingResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'ping response') -> Self:
         _check_keys(data, ('id', 'error', 'model_number', 'firmware_version'), (), where)
         return cls(
-            _get(data, 'id', where),
-            ErrorBits.from_fields(_mapping(_get(data, 'error', where), 'error', where), where),
-            _get(data, 'model_number', where),
-            _get(data, 'firmware_version', where),
+            _integer(_get(data, 'id', where), 'id', where),
+            ErrorBits.from_fields(_mapping(_get(data, 'error', where), 'error', where), where + ' error'),
+            _integer(_get(data, 'model_number', where), 'model_number', where),
+            _integer(_get(data, 'firmware_version', where), 'firmware_version', where),
         )
 
 
@@ -462,12 +464,12 @@ class ReadRequest(Message):
     COMMAND: ClassVar[str] = 'read'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    id: int
     #: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. range 0..252
-    address: int
+    id: int
     #: First control table address to read.
-    length: int
+    address: int
     #: Number of bytes to read. range 1..1024
+    length: int
 
     def __init__(
         self,
@@ -490,9 +492,9 @@ class ReadRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'read request') -> Self:
         _check_keys(data, ('id', 'address', 'length'), (), where)
         return cls(
-            _get(data, 'id', where),
-            _get(data, 'address', where),
-            _get(data, 'length', where),
+            _integer(_get(data, 'id', where), 'id', where),
+            _integer(_get(data, 'address', where), 'address', where),
+            _integer(_get(data, 'length', where), 'length', where),
         )
 
 
@@ -505,12 +507,12 @@ class WriteRequest(Message):
     COMMAND: ClassVar[str] = 'write'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    id: int
     #: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. range 0..252
-    address: int
+    id: int
     #: First control table address to write.
-    data: bytes
+    address: int
     #: The bytes written, item by item from `address` on.
+    data: bytes
 
     def __init__(
         self,
@@ -533,8 +535,8 @@ class WriteRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'write request') -> Self:
         _check_keys(data, ('id', 'address', 'data'), (), where)
         return cls(
-            _get(data, 'id', where),
-            _get(data, 'address', where),
+            _integer(_get(data, 'id', where), 'id', where),
+            _integer(_get(data, 'address', where), 'address', where),
             _bytes(_get(data, 'data', where), 'data', where),
         )
 
@@ -548,12 +550,12 @@ class RegWriteRequest(Message):
     COMMAND: ClassVar[str] = 'reg_write'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    id: int
     #: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. range 0..252
-    address: int
+    id: int
     #: First control table address to write.
-    data: bytes
+    address: int
     #: The bytes to write when ACTION arrives.
+    data: bytes
 
     def __init__(
         self,
@@ -576,8 +578,8 @@ class RegWriteRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'reg_write request') -> Self:
         _check_keys(data, ('id', 'address', 'data'), (), where)
         return cls(
-            _get(data, 'id', where),
-            _get(data, 'address', where),
+            _integer(_get(data, 'id', where), 'id', where),
+            _integer(_get(data, 'address', where), 'address', where),
             _bytes(_get(data, 'data', where), 'data', where),
         )
 
@@ -591,8 +593,8 @@ class ActionRequest(Message):
     COMMAND: ClassVar[str] = 'action'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    id: int
     #: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. range 0..252
+    id: int
 
     def __init__(
         self,
@@ -609,7 +611,7 @@ class ActionRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'action request') -> Self:
         _check_keys(data, ('id',), (), where)
         return cls(
-            _get(data, 'id', where),
+            _integer(_get(data, 'id', where), 'id', where),
         )
 
 
@@ -622,10 +624,10 @@ class FactoryResetRequest(Message):
     COMMAND: ClassVar[str] = 'factory_reset'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    id: int
     #: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. range 0..252
+    id: int
+    #: What to reset. range 1..255
     option: ResetOption | int
-    #: What to reset.
 
     def __init__(
         self,
@@ -645,8 +647,8 @@ class FactoryResetRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'factory_reset request') -> Self:
         _check_keys(data, ('id', 'option'), (), where)
         return cls(
-            _get(data, 'id', where),
-            _enum(ResetOption, _get(data, 'option', where)),
+            _integer(_get(data, 'id', where), 'id', where),
+            _as_enum(ResetOption, _get(data, 'option', where), 'option', where),
         )
 
 
@@ -659,8 +661,8 @@ class RebootRequest(Message):
     COMMAND: ClassVar[str] = 'reboot'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    id: int
     #: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. range 0..252
+    id: int
 
     def __init__(
         self,
@@ -677,7 +679,7 @@ class RebootRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'reboot request') -> Self:
         _check_keys(data, ('id',), (), where)
         return cls(
-            _get(data, 'id', where),
+            _integer(_get(data, 'id', where), 'id', where),
         )
 
 
@@ -690,10 +692,10 @@ class ClearRequest(Message):
     COMMAND: ClassVar[str] = 'clear'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    id: int
     #: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. range 0..252
+    id: int
+    #: What to clear. range 1..1
     option: ClearOption | int
-    #: What to clear.
 
     def __init__(
         self,
@@ -713,8 +715,8 @@ class ClearRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'clear request') -> Self:
         _check_keys(data, ('id', 'option'), ('key',), where)
         return cls(
-            _get(data, 'id', where),
-            _enum(ClearOption, _get(data, 'option', where)),
+            _integer(_get(data, 'id', where), 'id', where),
+            _as_enum(ClearOption, _get(data, 'option', where), 'option', where),
         )
 
 
@@ -727,14 +729,14 @@ class SyncReadRequest(Message):
     COMMAND: ClassVar[str] = 'sync_read'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    id: int
     #: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. range 0..252
-    address: int
+    id: int
     #: First control table address to read.
-    length: int
+    address: int
     #: Number of bytes each servo returns. range 1..1024
-    ids: tuple[IdsItem, ...]
+    length: int
     #: The servos to read, in the order they answer.
+    ids: tuple[IdsItem, ...]
 
     def __init__(
         self,
@@ -760,10 +762,10 @@ class SyncReadRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'sync_read request') -> Self:
         _check_keys(data, ('id', 'address', 'length', 'ids'), (), where)
         return cls(
-            _get(data, 'id', where),
-            _get(data, 'address', where),
-            _get(data, 'length', where),
-            tuple(IdsItem.from_fields(_mapping(item, 'ids', where), where) for item in _get(data, 'ids', where)),
+            _integer(_get(data, 'id', where), 'id', where),
+            _integer(_get(data, 'address', where), 'address', where),
+            _integer(_get(data, 'length', where), 'length', where),
+            tuple(IdsItem.from_fields(_mapping(item, 'ids', where), where) for item in _items(_get(data, 'ids', where), 'ids', where)),
         )
 
 
@@ -776,14 +778,14 @@ class FastSyncReadRequest(Message):
     COMMAND: ClassVar[str] = 'fast_sync_read'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    id: int
     #: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. range 0..252
-    address: int
+    id: int
     #: First control table address to read.
-    length: int
+    address: int
     #: Number of bytes each servo returns. range 1..1024
-    servo_ids: tuple[ServoIdsItem, ...]
+    length: int
     #: The servos to read, in the order their parts follow each other.
+    servo_ids: tuple[ServoIdsItem, ...]
 
     def __init__(
         self,
@@ -809,10 +811,10 @@ class FastSyncReadRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'fast_sync_read request') -> Self:
         _check_keys(data, ('id', 'address', 'length', 'servo_ids'), (), where)
         return cls(
-            _get(data, 'id', where),
-            _get(data, 'address', where),
-            _get(data, 'length', where),
-            tuple(ServoIdsItem.from_fields(_mapping(item, 'servo_ids', where), where) for item in _get(data, 'servo_ids', where)),
+            _integer(_get(data, 'id', where), 'id', where),
+            _integer(_get(data, 'address', where), 'address', where),
+            _integer(_get(data, 'length', where), 'length', where),
+            tuple(ServoIdsItem.from_fields(_mapping(item, 'servo_ids', where), where) for item in _items(_get(data, 'servo_ids', where), 'servo_ids', where)),
         )
 
 
@@ -825,12 +827,12 @@ class SyncWriteRequest(Message):
     COMMAND: ClassVar[str] = 'sync_write'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    id: int
     #: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. range 0..252
-    address: int
+    id: int
     #: First control table address to write.
-    servos: tuple[ServosItem, ...]
+    address: int
     #: One item per servo.
+    servos: tuple[ServosItem, ...]
 
     def __init__(
         self,
@@ -853,9 +855,9 @@ class SyncWriteRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'sync_write request') -> Self:
         _check_keys(data, ('id', 'address', 'servos'), ('length',), where)
         return cls(
-            _get(data, 'id', where),
-            _get(data, 'address', where),
-            tuple(ServosItem.from_fields(_mapping(item, 'servos', where), where) for item in _get(data, 'servos', where)),
+            _integer(_get(data, 'id', where), 'id', where),
+            _integer(_get(data, 'address', where), 'address', where),
+            tuple(ServosItem.from_fields(_mapping(item, 'servos', where), where) for item in _items(_get(data, 'servos', where), 'servos', where)),
         )
 
 
@@ -868,10 +870,10 @@ class BulkReadRequest(Message):
     COMMAND: ClassVar[str] = 'bulk_read'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    id: int
     #: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. range 0..252
-    reads: tuple[ReadsItem, ...]
+    id: int
     #: One item per servo.
+    reads: tuple[ReadsItem, ...]
 
     def __init__(
         self,
@@ -891,8 +893,8 @@ class BulkReadRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bulk_read request') -> Self:
         _check_keys(data, ('id', 'reads'), (), where)
         return cls(
-            _get(data, 'id', where),
-            tuple(ReadsItem.from_fields(_mapping(item, 'reads', where), where) for item in _get(data, 'reads', where)),
+            _integer(_get(data, 'id', where), 'id', where),
+            tuple(ReadsItem.from_fields(_mapping(item, 'reads', where), where) for item in _items(_get(data, 'reads', where), 'reads', where)),
         )
 
 
@@ -905,10 +907,10 @@ class BulkWriteRequest(Message):
     COMMAND: ClassVar[str] = 'bulk_write'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    id: int
     #: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. range 0..252
-    writes: tuple[WritesItem, ...]
+    id: int
     #: One item per servo.
+    writes: tuple[WritesItem, ...]
 
     def __init__(
         self,
@@ -928,8 +930,8 @@ class BulkWriteRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bulk_write request') -> Self:
         _check_keys(data, ('id', 'writes'), (), where)
         return cls(
-            _get(data, 'id', where),
-            tuple(WritesItem.from_fields(_mapping(item, 'writes', where), where) for item in _get(data, 'writes', where)),
+            _integer(_get(data, 'id', where), 'id', where),
+            tuple(WritesItem.from_fields(_mapping(item, 'writes', where), where) for item in _items(_get(data, 'writes', where), 'writes', where)),
         )
 
 
@@ -942,12 +944,12 @@ class StatusResponse(Message):
     COMMAND: ClassVar[str] = 'status'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    id: int
     #: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. range 0..252
-    error: ErrorBits
+    id: int
     #: Status packets only; bit 7 is the alert bit, bits 6..0 the error number (0 = no error).
-    data: bytes
+    error: ErrorBits
     #: The bytes read, item by item from the request's address (empty but for reads).
+    data: bytes
 
     def __init__(
         self,
@@ -970,8 +972,8 @@ class StatusResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'status response') -> Self:
         _check_keys(data, ('id', 'error', 'data'), (), where)
         return cls(
-            _get(data, 'id', where),
-            ErrorBits.from_fields(_mapping(_get(data, 'error', where), 'error', where), where),
+            _integer(_get(data, 'id', where), 'id', where),
+            ErrorBits.from_fields(_mapping(_get(data, 'error', where), 'error', where), where + ' error'),
             _bytes(_get(data, 'data', where), 'data', where),
         )
 

@@ -17,7 +17,7 @@ from typing import Any
 import serial
 from serialspec.runtime.errors import EncodeError, Timeout
 from serialspec.runtime.message import Message
-from serialspec.runtime.transport import Binding, Bus, ClientBase
+from serialspec.runtime.transport import Binding, Bus, ClientBase, table_key
 
 from fashionstar_uart import MATCH_BY, SERIAL
 from fashionstar_uart.codec import StreamParser, encode
@@ -183,7 +183,7 @@ class FashionstarUartClient(ClientBase):
         Args:
             servo_id: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). (0..254)
 
-        Returns: result: Outcome of the command.
+        Returns: result: Outcome of the command. (0..1)
         """
         request = ResetUserDataRequest(servo_id=servo_id)
         reply = self._ask(request, ResetUserDataResponse)
@@ -212,7 +212,7 @@ class FashionstarUartClient(ClientBase):
             data_id: User parameter to write (32..53).
             data: The value, typed by data_id.
 
-        Returns: result: Outcome of the command.
+        Returns: result: Outcome of the command. (0..1)
         """
         request = WriteDataRequest(servo_id=servo_id, data_id=data_id, data=data)
         reply = self._ask(request, WriteDataResponse)
@@ -238,7 +238,7 @@ class FashionstarUartClient(ClientBase):
             servo_id: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). (0..254)
             user_data: The user parameters 32..53 in data_id order.
 
-        Returns: result: Outcome of the command.
+        Returns: result: Outcome of the command. (0..1)
         """
         request = WriteBatchDataRequest(servo_id=servo_id, user_data=user_data)
         reply = self._ask(request, WriteBatchDataResponse)
@@ -255,7 +255,7 @@ class FashionstarUartClient(ClientBase):
             speed: Angular speed. [°/s]
             value: Turns (mode turns) or ms (mode timed); ignored by stop and continuous.
 
-        Returns: result: Outcome of the command.
+        Returns: result: Outcome of the command. (0..1)
         None when no reply is due (Sent only when response_switch (data_id 33) is 1, once the spin has finished.).
         """
         request = SpinRequest(servo_id=servo_id, method=method, speed=speed, value=value)
@@ -273,7 +273,7 @@ class FashionstarUartClient(ClientBase):
             interval: Time to reach the target angle. [ms]
             power: Power; 0 or more than the power limit means the power limit (000's 功率保持值, read as data_id 42: erratum power_hold_value_undefined). [mW]
 
-        Returns: result: Outcome of the command.
+        Returns: result: Outcome of the command. (0..1)
         None when no reply is due (Sent only when response_switch (data_id 33) is 1, once the target angle is reached.).
         """
         request = RotateRequest(servo_id=servo_id, angle=angle, interval=interval, power=power)
@@ -291,7 +291,7 @@ class FashionstarUartClient(ClientBase):
             servo_id: Servo id; 255 sets every servo (broadcast).
             power: Holding power; 0 or more than the power limit means the limit. [mW]
 
-        Returns: result: Outcome of the command.
+        Returns: result: Outcome of the command. (0..1)
         None when no reply is due (Sent only when response_switch (data_id 33) is 1.).
         """
         request = DampingRequest(servo_id=servo_id, power=power)
@@ -325,7 +325,7 @@ class FashionstarUartClient(ClientBase):
             t_dec: Deceleration time at the end of the move (the SDK sends at least 20 ms). [ms]
             power: Power limit of the move; 0 (or more than the power limit, data_id 42) means the power limit. [mW]
 
-        Returns: result: Outcome of the command.
+        Returns: result: Outcome of the command. (0..1)
         None when no reply is due (Inferred from ROTATE (the SDK waits for no reply): sent only when response_switch (data_id 33) is 1, once the target is reached.).
         """
         request = MoveByIntervalRequest(servo_id=servo_id, angle=angle, interval=interval, t_acc=t_acc, t_dec=t_dec, power=power)
@@ -345,7 +345,7 @@ class FashionstarUartClient(ClientBase):
             t_dec: Deceleration time at the end of the move (the SDK sends at least 20 ms). [ms]
             power: Power limit of the move; 0 (or more than the power limit, data_id 42) means the power limit. [mW]
 
-        Returns: result: Outcome of the command.
+        Returns: result: Outcome of the command. (0..1)
         None when no reply is due (Inferred from ROTATE (the SDK waits for no reply): sent only when response_switch (data_id 33) is 1, once the target is reached.).
         """
         request = MoveByVelocityRequest(servo_id=servo_id, angle=angle, velocity=velocity, t_acc=t_acc, t_dec=t_dec, power=power)
@@ -363,7 +363,7 @@ class FashionstarUartClient(ClientBase):
             interval: Time to reach the target angle. [ms] (0..4096000)
             power: Power limit of the move; 0 (or more than the power limit, data_id 42) means the power limit. [mW]
 
-        Returns: result: Outcome of the command.
+        Returns: result: Outcome of the command. (0..1)
         None when no reply is due (Inferred from ROTATE (the SDK waits for no reply): sent only when response_switch (data_id 33) is 1, once the target is reached.).
         """
         request = MoveMturnRequest(servo_id=servo_id, angle=angle, interval=interval, power=power)
@@ -383,7 +383,7 @@ class FashionstarUartClient(ClientBase):
             t_dec: Deceleration time at the end of the move (the SDK sends at least 20 ms). [ms]
             power: Power limit of the move; 0 (or more than the power limit, data_id 42) means the power limit. [mW]
 
-        Returns: result: Outcome of the command.
+        Returns: result: Outcome of the command. (0..1)
         None when no reply is due (Inferred from ROTATE (the SDK waits for no reply): sent only when response_switch (data_id 33) is 1, once the target is reached.).
         """
         request = MoveMturnByIntervalRequest(servo_id=servo_id, angle=angle, interval=interval, t_acc=t_acc, t_dec=t_dec, power=power)
@@ -403,7 +403,7 @@ class FashionstarUartClient(ClientBase):
             t_dec: Deceleration time at the end of the move (the SDK sends at least 20 ms). [ms]
             power: Power limit of the move; 0 (or more than the power limit, data_id 42) means the power limit. [mW]
 
-        Returns: result: Outcome of the command.
+        Returns: result: Outcome of the command. (0..1)
         None when no reply is due (Inferred from ROTATE (the SDK waits for no reply): sent only when response_switch (data_id 33) is 1, once the target is reached.).
         """
         request = MoveMturnByVelocityRequest(servo_id=servo_id, angle=angle, velocity=velocity, t_acc=t_acc, t_dec=t_dec, power=power)
@@ -453,7 +453,7 @@ class FashionstarUartClient(ClientBase):
         """Run (or drop) the held move commands.
 
         Args:
-            mode: 0 runs the held commands, 1 drops them.
+            mode: 0 runs the held commands, 1 drops them. (0..1)
 
         The device does not answer.
         """
@@ -490,7 +490,7 @@ class FashionstarUartClient(ClientBase):
 
         Args:
             servo_id: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). (0..254)
-            method: What the servo does after stopping.
+            method: What the servo does after stopping. (16..18)
             power: Holding power (hold and damping). [mW]
 
         The device does not answer.
@@ -530,20 +530,13 @@ class FashionstarUartClient(ClientBase):
 
     def read_parameter(self, servo_id: int, name: str) -> int | float:
         """Read one entry of servo parameters by data_id by name, e.g. `read_parameter(1, 'voltage')`."""
-        return self.read_data(servo_id, _key(PARAMETERS, name))
+        return self.read_data(servo_id, table_key(PARAMETERS, name))
 
     def write_parameter(self, servo_id: int, name: str, value: int | float) -> Any:
         """Write one entry of servo parameters by data_id by name; read-only entries are refused before sending."""
         if name in PARAMETERS_READ_ONLY:
             raise EncodeError(f"{name} is read-only")
-        return self.write_data(servo_id, _key(PARAMETERS, name), value)
+        return self.write_data(servo_id, table_key(PARAMETERS, name), value)
 
     def _read_key(self, address: int, key: int) -> float:
         return self.read_data(address, key)
-
-
-def _key(table: dict[str, int], name: str) -> int:
-    try:
-        return table[name]
-    except KeyError:
-        raise EncodeError(f"unknown entry {name!r} (expected one of {', '.join(table)})") from None

@@ -8,6 +8,7 @@ from collections.abc import Callable
 
 from serialspec.runtime.checksums import BYTE_VALUES as _BYTES
 from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError, content_size_error, out_of_range
+from serialspec.runtime.fields import wrong_type
 from serialspec.runtime.message import Direction, Message, members, slot_setters
 from serialspec.runtime.stream import FrameFormat
 from serialspec.runtime.stream import StreamParser as _StreamParser
@@ -145,21 +146,21 @@ _TABLE_PARAMETERS_RANGES: dict[int, tuple[float, float]] = {
     6: (0, 65535),
     7: (0, 65535),
     8: (0, 4294967295),
-    33: (0, 255),
+    33: (0, 1),
     34: (0, 254),
     36: (1, 7),
-    37: (0, 255),
+    37: (1, 2),
     38: (0, 65535),
     39: (0, 65535),
     40: (0, 65535),
     41: (0, 65535),
     42: (0, 65535),
     43: (0, 65535),
-    44: (0, 255),
-    46: (0, 255),
-    47: (0, 255),
-    48: (0, 255),
-    49: (0, 255),
+    44: (0, 1),
+    46: (0, 1),
+    47: (0, 1),
+    48: (0, 1),
+    49: (0, 1),
     50: (0, 65535),
     51: (-32768, 32767),
     52: (-32768, 32767),
@@ -1278,48 +1279,48 @@ def _frame_monitor_response(buf: bytes, start: int) -> MonitorResponse | None:
 
 
 def _encode_ping_request(m: PingRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('ping request', 'servo_id', m.servo_id, 0, 254)
     body = _S_B2_U8_U8_U8.pack(b'\x12L', 1, 1, m.servo_id)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_ping_response(m: PingResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('ping response', 'servo_id', m.servo_id, 0, 254)
     body = _S_B2_U8_U8_U8.pack(b'\x05\x1c', 1, 1, m.servo_id)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_reset_user_data_request(m: ResetUserDataRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('reset_user_data request', 'servo_id', m.servo_id, 0, 254)
     body = _S_B2_U8_U8_U8.pack(b'\x12L', 2, 1, m.servo_id)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_reset_user_data_response(m: ResetUserDataResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('reset_user_data response', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.result <= 255:
-        raise out_of_range('reset_user_data response', 'result', m.result, 0, 255)
+    if not 0 <= m.result <= 1 or m.result.__class__ is bool:
+        raise out_of_range('reset_user_data response', 'result', m.result, 0, 1)
     body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 2, 2, m.servo_id, m.result)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_read_data_request(m: ReadDataRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('read_data request', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.data_id <= 255:
+    if not 0 <= m.data_id <= 255 or m.data_id.__class__ is bool:
         raise out_of_range('read_data request', 'data_id', m.data_id, 0, 255)
     body = _S_B2_U8_U8_U8_U8.pack(b'\x12L', 3, 2, m.servo_id, m.data_id)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_read_data_response(m: ReadDataResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('read_data response', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.data_id <= 255:
+    if not 0 <= m.data_id <= 255 or m.data_id.__class__ is bool:
         raise out_of_range('read_data response', 'data_id', m.data_id, 0, 255)
     s = _TABLE_PARAMETERS.get(m.data_id)
     if s is None:
@@ -1336,9 +1337,9 @@ def _encode_read_data_response(m: ReadDataResponse) -> bytes:
 
 
 def _encode_write_data_request(m: WriteDataRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('write_data request', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.data_id <= 255:
+    if not 0 <= m.data_id <= 255 or m.data_id.__class__ is bool:
         raise out_of_range('write_data request', 'data_id', m.data_id, 0, 255)
     s = _TABLE_PARAMETERS.get(m.data_id)
     if s is None:
@@ -1355,38 +1356,38 @@ def _encode_write_data_request(m: WriteDataRequest) -> bytes:
 
 
 def _encode_write_data_response(m: WriteDataResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('write_data response', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.data_id <= 255:
+    if not 0 <= m.data_id <= 255 or m.data_id.__class__ is bool:
         raise out_of_range('write_data response', 'data_id', m.data_id, 0, 255)
-    if not 0 <= m.result <= 255:
-        raise out_of_range('write_data response', 'result', m.result, 0, 255)
+    if not 0 <= m.result <= 1 or m.result.__class__ is bool:
+        raise out_of_range('write_data response', 'result', m.result, 0, 1)
     body = _S_B2_U8_U8_U8_U8_U8.pack(b'\x05\x1c', 4, 3, m.servo_id, m.data_id, m.result)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_read_batch_data_request(m: ReadBatchDataRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('read_batch_data request', 'servo_id', m.servo_id, 0, 254)
     body = _S_B2_U8_U8_U8.pack(b'\x12L', 5, 1, m.servo_id)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_read_batch_data_response(m: ReadBatchDataResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('read_batch_data response', 'servo_id', m.servo_id, 0, 254)
     if not 0 <= m.user_data.reserved_32 <= 255:
         raise out_of_range('read_batch_data response', 'user_data.reserved_32', m.user_data.reserved_32, 0, 255)
-    if not 0 <= m.user_data.response_switch <= 255:
-        raise out_of_range('read_batch_data response', 'user_data.response_switch', m.user_data.response_switch, 0, 255)
+    if not 0 <= m.user_data.response_switch <= 1:
+        raise out_of_range('read_batch_data response', 'user_data.response_switch', m.user_data.response_switch, 0, 1)
     if not 0 <= m.user_data.servo_id <= 254:
         raise out_of_range('read_batch_data response', 'user_data.servo_id', m.user_data.servo_id, 0, 254)
     if not 0 <= m.user_data.reserved_35 <= 255:
         raise out_of_range('read_batch_data response', 'user_data.reserved_35', m.user_data.reserved_35, 0, 255)
     if not 1 <= m.user_data.baudrate <= 7:
         raise out_of_range('read_batch_data response', 'user_data.baudrate', m.user_data.baudrate, 1, 7)
-    if not 0 <= m.user_data.stall_protect_mode <= 255:
-        raise out_of_range('read_batch_data response', 'user_data.stall_protect_mode', m.user_data.stall_protect_mode, 0, 255)
+    if not 1 <= m.user_data.stall_protect_mode <= 2:
+        raise out_of_range('read_batch_data response', 'user_data.stall_protect_mode', m.user_data.stall_protect_mode, 1, 2)
     if not 0 <= m.user_data.stall_power_limit <= 65535:
         raise out_of_range('read_batch_data response', 'user_data.stall_power_limit', m.user_data.stall_power_limit, 0, 65535)
     if not 0 <= m.user_data.over_volt_low <= 65535:
@@ -1399,18 +1400,18 @@ def _encode_read_batch_data_response(m: ReadBatchDataResponse) -> bytes:
         raise out_of_range('read_batch_data response', 'user_data.over_power', m.user_data.over_power, 0, 65535)
     if not 0 <= m.user_data.over_current <= 65535:
         raise out_of_range('read_batch_data response', 'user_data.over_current', m.user_data.over_current, 0, 65535)
-    if not 0 <= m.user_data.accel_switch <= 255:
-        raise out_of_range('read_batch_data response', 'user_data.accel_switch', m.user_data.accel_switch, 0, 255)
+    if not 0 <= m.user_data.accel_switch <= 1:
+        raise out_of_range('read_batch_data response', 'user_data.accel_switch', m.user_data.accel_switch, 0, 1)
     if not 0 <= m.user_data.reserved_45 <= 255:
         raise out_of_range('read_batch_data response', 'user_data.reserved_45', m.user_data.reserved_45, 0, 255)
-    if not 0 <= m.user_data.po_lock_switch <= 255:
-        raise out_of_range('read_batch_data response', 'user_data.po_lock_switch', m.user_data.po_lock_switch, 0, 255)
-    if not 0 <= m.user_data.wb_lock_switch <= 255:
-        raise out_of_range('read_batch_data response', 'user_data.wb_lock_switch', m.user_data.wb_lock_switch, 0, 255)
-    if not 0 <= m.user_data.angle_limit_switch <= 255:
-        raise out_of_range('read_batch_data response', 'user_data.angle_limit_switch', m.user_data.angle_limit_switch, 0, 255)
-    if not 0 <= m.user_data.soft_start_switch <= 255:
-        raise out_of_range('read_batch_data response', 'user_data.soft_start_switch', m.user_data.soft_start_switch, 0, 255)
+    if not 0 <= m.user_data.po_lock_switch <= 1:
+        raise out_of_range('read_batch_data response', 'user_data.po_lock_switch', m.user_data.po_lock_switch, 0, 1)
+    if not 0 <= m.user_data.wb_lock_switch <= 1:
+        raise out_of_range('read_batch_data response', 'user_data.wb_lock_switch', m.user_data.wb_lock_switch, 0, 1)
+    if not 0 <= m.user_data.angle_limit_switch <= 1:
+        raise out_of_range('read_batch_data response', 'user_data.angle_limit_switch', m.user_data.angle_limit_switch, 0, 1)
+    if not 0 <= m.user_data.soft_start_switch <= 1:
+        raise out_of_range('read_batch_data response', 'user_data.soft_start_switch', m.user_data.soft_start_switch, 0, 1)
     if not 0 <= m.user_data.soft_start_time <= 65535:
         raise out_of_range('read_batch_data response', 'user_data.soft_start_time', m.user_data.soft_start_time, 0, 65535)
     if not -32768 <= m.user_data.angle_limit_high <= 32767:
@@ -1424,20 +1425,20 @@ def _encode_read_batch_data_response(m: ReadBatchDataResponse) -> bytes:
 
 
 def _encode_write_batch_data_request(m: WriteBatchDataRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('write_batch_data request', 'servo_id', m.servo_id, 0, 254)
     if not 0 <= m.user_data.reserved_32 <= 255:
         raise out_of_range('write_batch_data request', 'user_data.reserved_32', m.user_data.reserved_32, 0, 255)
-    if not 0 <= m.user_data.response_switch <= 255:
-        raise out_of_range('write_batch_data request', 'user_data.response_switch', m.user_data.response_switch, 0, 255)
+    if not 0 <= m.user_data.response_switch <= 1:
+        raise out_of_range('write_batch_data request', 'user_data.response_switch', m.user_data.response_switch, 0, 1)
     if not 0 <= m.user_data.servo_id <= 254:
         raise out_of_range('write_batch_data request', 'user_data.servo_id', m.user_data.servo_id, 0, 254)
     if not 0 <= m.user_data.reserved_35 <= 255:
         raise out_of_range('write_batch_data request', 'user_data.reserved_35', m.user_data.reserved_35, 0, 255)
     if not 1 <= m.user_data.baudrate <= 7:
         raise out_of_range('write_batch_data request', 'user_data.baudrate', m.user_data.baudrate, 1, 7)
-    if not 0 <= m.user_data.stall_protect_mode <= 255:
-        raise out_of_range('write_batch_data request', 'user_data.stall_protect_mode', m.user_data.stall_protect_mode, 0, 255)
+    if not 1 <= m.user_data.stall_protect_mode <= 2:
+        raise out_of_range('write_batch_data request', 'user_data.stall_protect_mode', m.user_data.stall_protect_mode, 1, 2)
     if not 0 <= m.user_data.stall_power_limit <= 65535:
         raise out_of_range('write_batch_data request', 'user_data.stall_power_limit', m.user_data.stall_power_limit, 0, 65535)
     if not 0 <= m.user_data.over_volt_low <= 65535:
@@ -1450,18 +1451,18 @@ def _encode_write_batch_data_request(m: WriteBatchDataRequest) -> bytes:
         raise out_of_range('write_batch_data request', 'user_data.over_power', m.user_data.over_power, 0, 65535)
     if not 0 <= m.user_data.over_current <= 65535:
         raise out_of_range('write_batch_data request', 'user_data.over_current', m.user_data.over_current, 0, 65535)
-    if not 0 <= m.user_data.accel_switch <= 255:
-        raise out_of_range('write_batch_data request', 'user_data.accel_switch', m.user_data.accel_switch, 0, 255)
+    if not 0 <= m.user_data.accel_switch <= 1:
+        raise out_of_range('write_batch_data request', 'user_data.accel_switch', m.user_data.accel_switch, 0, 1)
     if not 0 <= m.user_data.reserved_45 <= 255:
         raise out_of_range('write_batch_data request', 'user_data.reserved_45', m.user_data.reserved_45, 0, 255)
-    if not 0 <= m.user_data.po_lock_switch <= 255:
-        raise out_of_range('write_batch_data request', 'user_data.po_lock_switch', m.user_data.po_lock_switch, 0, 255)
-    if not 0 <= m.user_data.wb_lock_switch <= 255:
-        raise out_of_range('write_batch_data request', 'user_data.wb_lock_switch', m.user_data.wb_lock_switch, 0, 255)
-    if not 0 <= m.user_data.angle_limit_switch <= 255:
-        raise out_of_range('write_batch_data request', 'user_data.angle_limit_switch', m.user_data.angle_limit_switch, 0, 255)
-    if not 0 <= m.user_data.soft_start_switch <= 255:
-        raise out_of_range('write_batch_data request', 'user_data.soft_start_switch', m.user_data.soft_start_switch, 0, 255)
+    if not 0 <= m.user_data.po_lock_switch <= 1:
+        raise out_of_range('write_batch_data request', 'user_data.po_lock_switch', m.user_data.po_lock_switch, 0, 1)
+    if not 0 <= m.user_data.wb_lock_switch <= 1:
+        raise out_of_range('write_batch_data request', 'user_data.wb_lock_switch', m.user_data.wb_lock_switch, 0, 1)
+    if not 0 <= m.user_data.angle_limit_switch <= 1:
+        raise out_of_range('write_batch_data request', 'user_data.angle_limit_switch', m.user_data.angle_limit_switch, 0, 1)
+    if not 0 <= m.user_data.soft_start_switch <= 1:
+        raise out_of_range('write_batch_data request', 'user_data.soft_start_switch', m.user_data.soft_start_switch, 0, 1)
     if not 0 <= m.user_data.soft_start_time <= 65535:
         raise out_of_range('write_batch_data request', 'user_data.soft_start_time', m.user_data.soft_start_time, 0, 65535)
     if not -32768 <= m.user_data.angle_limit_high <= 32767:
@@ -1475,240 +1476,240 @@ def _encode_write_batch_data_request(m: WriteBatchDataRequest) -> bytes:
 
 
 def _encode_write_batch_data_response(m: WriteBatchDataResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('write_batch_data response', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.result <= 255:
-        raise out_of_range('write_batch_data response', 'result', m.result, 0, 255)
+    if not 0 <= m.result <= 1 or m.result.__class__ is bool:
+        raise out_of_range('write_batch_data response', 'result', m.result, 0, 1)
     body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 6, 2, m.servo_id, m.result)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_spin_request(m: SpinRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('spin request', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.method.direction <= 1:
+    if not 0 <= m.method.direction <= 1 or m.method.direction.__class__ is bool:
         raise out_of_range('spin request', 'method.direction', m.method.direction, 0, 1)
-    if not 0 <= m.method.mode <= 3:
+    if not 0 <= m.method.mode <= 3 or m.method.mode.__class__ is bool:
         raise out_of_range('spin request', 'method.mode', m.method.mode, 0, 3)
-    if not 0 <= m.speed <= 65535:
+    if not 0 <= m.speed <= 65535 or m.speed.__class__ is bool:
         raise out_of_range('spin request', 'speed', m.speed, 0, 65535)
-    if not 0 <= m.value <= 65535:
+    if not 0 <= m.value <= 65535 or m.value.__class__ is bool:
         raise out_of_range('spin request', 'value', m.value, 0, 65535)
     body = _S_FRAME_SPINREQUEST.pack(b'\x12L', 7, 6, m.servo_id, (m.method.direction << 7) | m.method.mode, m.speed, m.value)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_spin_response(m: SpinResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('spin response', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.result <= 255:
-        raise out_of_range('spin response', 'result', m.result, 0, 255)
+    if not 0 <= m.result <= 1 or m.result.__class__ is bool:
+        raise out_of_range('spin response', 'result', m.result, 0, 1)
     body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 7, 2, m.servo_id, m.result)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_rotate_request(m: RotateRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('rotate request', 'servo_id', m.servo_id, 0, 254)
-    if not -32768 <= m.angle <= 32767:
+    if not -32768 <= m.angle <= 32767 or m.angle.__class__ is bool:
         raise out_of_range('rotate request', 'angle', m.angle, -32768, 32767)
-    if not 0 <= m.interval <= 65535:
+    if not 0 <= m.interval <= 65535 or m.interval.__class__ is bool:
         raise out_of_range('rotate request', 'interval', m.interval, 0, 65535)
-    if not 0 <= m.power <= 65535:
+    if not 0 <= m.power <= 65535 or m.power.__class__ is bool:
         raise out_of_range('rotate request', 'power', m.power, 0, 65535)
     body = _S_FRAME_ROTATEREQUEST.pack(b'\x12L', 8, 7, m.servo_id, m.angle, m.interval, m.power)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_rotate_response(m: RotateResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('rotate response', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.result <= 255:
-        raise out_of_range('rotate response', 'result', m.result, 0, 255)
+    if not 0 <= m.result <= 1 or m.result.__class__ is bool:
+        raise out_of_range('rotate response', 'result', m.result, 0, 1)
     body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 8, 2, m.servo_id, m.result)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_damping_request(m: DampingRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('damping request', 'servo_id', m.servo_id, 0, 255)
-    if not 0 <= m.power <= 65535:
+    if not 0 <= m.power <= 65535 or m.power.__class__ is bool:
         raise out_of_range('damping request', 'power', m.power, 0, 65535)
     body = _S_B2_U8_U8_U8_U16.pack(b'\x12L', 9, 3, m.servo_id, m.power)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_damping_response(m: DampingResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('damping response', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.result <= 255:
-        raise out_of_range('damping response', 'result', m.result, 0, 255)
+    if not 0 <= m.result <= 1 or m.result.__class__ is bool:
+        raise out_of_range('damping response', 'result', m.result, 0, 1)
     body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 9, 2, m.servo_id, m.result)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_read_angle_request(m: ReadAngleRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('read_angle request', 'servo_id', m.servo_id, 0, 254)
     body = _S_B2_U8_U8_U8.pack(b'\x12L', 10, 1, m.servo_id)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_read_angle_response(m: ReadAngleResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('read_angle response', 'servo_id', m.servo_id, 0, 254)
-    if not -32768 <= m.angle <= 32767:
+    if not -32768 <= m.angle <= 32767 or m.angle.__class__ is bool:
         raise out_of_range('read_angle response', 'angle', m.angle, -32768, 32767)
     body = _S_B2_U8_U8_U8_I16.pack(b'\x05\x1c', 10, 3, m.servo_id, m.angle)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_move_by_interval_request(m: MoveByIntervalRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('move_by_interval request', 'servo_id', m.servo_id, 0, 254)
-    if not -1800 <= m.angle <= 1800:
+    if not -1800 <= m.angle <= 1800 or m.angle.__class__ is bool:
         raise out_of_range('move_by_interval request', 'angle', m.angle, -1800, 1800)
-    if not 0 <= m.interval <= 65535:
+    if not 0 <= m.interval <= 65535 or m.interval.__class__ is bool:
         raise out_of_range('move_by_interval request', 'interval', m.interval, 0, 65535)
-    if not 0 <= m.t_acc <= 65535:
+    if not 0 <= m.t_acc <= 65535 or m.t_acc.__class__ is bool:
         raise out_of_range('move_by_interval request', 't_acc', m.t_acc, 0, 65535)
-    if not 0 <= m.t_dec <= 65535:
+    if not 0 <= m.t_dec <= 65535 or m.t_dec.__class__ is bool:
         raise out_of_range('move_by_interval request', 't_dec', m.t_dec, 0, 65535)
-    if not 0 <= m.power <= 65535:
+    if not 0 <= m.power <= 65535 or m.power.__class__ is bool:
         raise out_of_range('move_by_interval request', 'power', m.power, 0, 65535)
     body = _S_FRAME_MOVEBYINTERVALREQUEST.pack(b'\x12L', 11, 11, m.servo_id, m.angle, m.interval, m.t_acc, m.t_dec, m.power)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_move_by_interval_response(m: MoveByIntervalResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('move_by_interval response', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.result <= 255:
-        raise out_of_range('move_by_interval response', 'result', m.result, 0, 255)
+    if not 0 <= m.result <= 1 or m.result.__class__ is bool:
+        raise out_of_range('move_by_interval response', 'result', m.result, 0, 1)
     body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 11, 2, m.servo_id, m.result)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_move_by_velocity_request(m: MoveByVelocityRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('move_by_velocity request', 'servo_id', m.servo_id, 0, 254)
-    if not -1800 <= m.angle <= 1800:
+    if not -1800 <= m.angle <= 1800 or m.angle.__class__ is bool:
         raise out_of_range('move_by_velocity request', 'angle', m.angle, -1800, 1800)
-    if not 10 <= m.velocity <= 7500:
+    if not 10 <= m.velocity <= 7500 or m.velocity.__class__ is bool:
         raise out_of_range('move_by_velocity request', 'velocity', m.velocity, 10, 7500)
-    if not 0 <= m.t_acc <= 65535:
+    if not 0 <= m.t_acc <= 65535 or m.t_acc.__class__ is bool:
         raise out_of_range('move_by_velocity request', 't_acc', m.t_acc, 0, 65535)
-    if not 0 <= m.t_dec <= 65535:
+    if not 0 <= m.t_dec <= 65535 or m.t_dec.__class__ is bool:
         raise out_of_range('move_by_velocity request', 't_dec', m.t_dec, 0, 65535)
-    if not 0 <= m.power <= 65535:
+    if not 0 <= m.power <= 65535 or m.power.__class__ is bool:
         raise out_of_range('move_by_velocity request', 'power', m.power, 0, 65535)
     body = _S_FRAME_MOVEBYINTERVALREQUEST.pack(b'\x12L', 12, 11, m.servo_id, m.angle, m.velocity, m.t_acc, m.t_dec, m.power)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_move_by_velocity_response(m: MoveByVelocityResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('move_by_velocity response', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.result <= 255:
-        raise out_of_range('move_by_velocity response', 'result', m.result, 0, 255)
+    if not 0 <= m.result <= 1 or m.result.__class__ is bool:
+        raise out_of_range('move_by_velocity response', 'result', m.result, 0, 1)
     body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 12, 2, m.servo_id, m.result)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_move_mturn_request(m: MoveMturnRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('move_mturn request', 'servo_id', m.servo_id, 0, 254)
-    if not -3686400 <= m.angle <= 3686400:
+    if not -3686400 <= m.angle <= 3686400 or m.angle.__class__ is bool:
         raise out_of_range('move_mturn request', 'angle', m.angle, -3686400, 3686400)
-    if not 0 <= m.interval <= 4096000:
+    if not 0 <= m.interval <= 4096000 or m.interval.__class__ is bool:
         raise out_of_range('move_mturn request', 'interval', m.interval, 0, 4096000)
-    if not 0 <= m.power <= 65535:
+    if not 0 <= m.power <= 65535 or m.power.__class__ is bool:
         raise out_of_range('move_mturn request', 'power', m.power, 0, 65535)
     body = _S_FRAME_MOVEMTURNREQUEST.pack(b'\x12L', 13, 11, m.servo_id, m.angle, m.interval, m.power)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_move_mturn_response(m: MoveMturnResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('move_mturn response', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.result <= 255:
-        raise out_of_range('move_mturn response', 'result', m.result, 0, 255)
+    if not 0 <= m.result <= 1 or m.result.__class__ is bool:
+        raise out_of_range('move_mturn response', 'result', m.result, 0, 1)
     body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 13, 2, m.servo_id, m.result)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_move_mturn_by_interval_request(m: MoveMturnByIntervalRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('move_mturn_by_interval request', 'servo_id', m.servo_id, 0, 254)
-    if not -3686400 <= m.angle <= 3686400:
+    if not -3686400 <= m.angle <= 3686400 or m.angle.__class__ is bool:
         raise out_of_range('move_mturn_by_interval request', 'angle', m.angle, -3686400, 3686400)
-    if not 0 <= m.interval <= 4096000:
+    if not 0 <= m.interval <= 4096000 or m.interval.__class__ is bool:
         raise out_of_range('move_mturn_by_interval request', 'interval', m.interval, 0, 4096000)
-    if not 0 <= m.t_acc <= 65535:
+    if not 0 <= m.t_acc <= 65535 or m.t_acc.__class__ is bool:
         raise out_of_range('move_mturn_by_interval request', 't_acc', m.t_acc, 0, 65535)
-    if not 0 <= m.t_dec <= 65535:
+    if not 0 <= m.t_dec <= 65535 or m.t_dec.__class__ is bool:
         raise out_of_range('move_mturn_by_interval request', 't_dec', m.t_dec, 0, 65535)
-    if not 0 <= m.power <= 65535:
+    if not 0 <= m.power <= 65535 or m.power.__class__ is bool:
         raise out_of_range('move_mturn_by_interval request', 'power', m.power, 0, 65535)
     body = _S_FRAME_MOVEMTURNBYINTERVALREQUEST.pack(b'\x12L', 14, 15, m.servo_id, m.angle, m.interval, m.t_acc, m.t_dec, m.power)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_move_mturn_by_interval_response(m: MoveMturnByIntervalResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('move_mturn_by_interval response', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.result <= 255:
-        raise out_of_range('move_mturn_by_interval response', 'result', m.result, 0, 255)
+    if not 0 <= m.result <= 1 or m.result.__class__ is bool:
+        raise out_of_range('move_mturn_by_interval response', 'result', m.result, 0, 1)
     body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 14, 2, m.servo_id, m.result)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_move_mturn_by_velocity_request(m: MoveMturnByVelocityRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('move_mturn_by_velocity request', 'servo_id', m.servo_id, 0, 254)
-    if not -3686400 <= m.angle <= 3686400:
+    if not -3686400 <= m.angle <= 3686400 or m.angle.__class__ is bool:
         raise out_of_range('move_mturn_by_velocity request', 'angle', m.angle, -3686400, 3686400)
-    if not 10 <= m.velocity <= 7500:
+    if not 10 <= m.velocity <= 7500 or m.velocity.__class__ is bool:
         raise out_of_range('move_mturn_by_velocity request', 'velocity', m.velocity, 10, 7500)
-    if not 0 <= m.t_acc <= 65535:
+    if not 0 <= m.t_acc <= 65535 or m.t_acc.__class__ is bool:
         raise out_of_range('move_mturn_by_velocity request', 't_acc', m.t_acc, 0, 65535)
-    if not 0 <= m.t_dec <= 65535:
+    if not 0 <= m.t_dec <= 65535 or m.t_dec.__class__ is bool:
         raise out_of_range('move_mturn_by_velocity request', 't_dec', m.t_dec, 0, 65535)
-    if not 0 <= m.power <= 65535:
+    if not 0 <= m.power <= 65535 or m.power.__class__ is bool:
         raise out_of_range('move_mturn_by_velocity request', 'power', m.power, 0, 65535)
     body = _S_FRAME_MOVEMTURNBYVELOCITYREQUEST.pack(b'\x12L', 15, 13, m.servo_id, m.angle, m.velocity, m.t_acc, m.t_dec, m.power)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_move_mturn_by_velocity_response(m: MoveMturnByVelocityResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('move_mturn_by_velocity response', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.result <= 255:
-        raise out_of_range('move_mturn_by_velocity response', 'result', m.result, 0, 255)
+    if not 0 <= m.result <= 1 or m.result.__class__ is bool:
+        raise out_of_range('move_mturn_by_velocity response', 'result', m.result, 0, 1)
     body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 15, 2, m.servo_id, m.result)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_read_mturn_angle_request(m: ReadMturnAngleRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('read_mturn_angle request', 'servo_id', m.servo_id, 0, 254)
     body = _S_B2_U8_U8_U8.pack(b'\x12L', 16, 1, m.servo_id)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_read_mturn_angle_response(m: ReadMturnAngleResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('read_mturn_angle response', 'servo_id', m.servo_id, 0, 254)
-    if not -3686400 <= m.angle <= 3686400:
+    if not -3686400 <= m.angle <= 3686400 or m.angle.__class__ is bool:
         raise out_of_range('read_mturn_angle response', 'angle', m.angle, -3686400, 3686400)
-    if not -32768 <= m.turns <= 32767:
+    if not -32768 <= m.turns <= 32767 or m.turns.__class__ is bool:
         raise out_of_range('read_mturn_angle response', 'turns', m.turns, -32768, 32767)
     body = _S_B2_U8_U8_U8_I32_I16.pack(b'\x05\x1c', 16, 7, m.servo_id, m.angle, m.turns)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_reset_mturn_angle_request(m: ResetMturnAngleRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('reset_mturn_angle request', 'servo_id', m.servo_id, 0, 254)
     body = _S_B2_U8_U8_U8.pack(b'\x12L', 17, 1, m.servo_id)
     return body + _BYTES[sum(body) & 0xff]
@@ -1720,60 +1721,60 @@ def _encode_begin_async_request(m: BeginAsyncRequest) -> bytes:
 
 
 def _encode_end_async_request(m: EndAsyncRequest) -> bytes:
-    if not 0 <= m.mode <= 255:
-        raise out_of_range('end_async request', 'mode', m.mode, 0, 255)
+    if not 0 <= m.mode <= 1 or m.mode.__class__ is bool:
+        raise out_of_range('end_async request', 'mode', m.mode, 0, 1)
     body = _S_B2_U8_U8_U8.pack(b'\x12L', 19, 1, m.mode)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_monitor_request(m: MonitorRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('monitor request', 'servo_id', m.servo_id, 0, 254)
     body = _S_B2_U8_U8_U8.pack(b'\x12L', 22, 1, m.servo_id)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_monitor_response(m: MonitorResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('monitor response', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.voltage <= 65535:
+    if not 0 <= m.voltage <= 65535 or m.voltage.__class__ is bool:
         raise out_of_range('monitor response', 'voltage', m.voltage, 0, 65535)
-    if not 0 <= m.current <= 65535:
+    if not 0 <= m.current <= 65535 or m.current.__class__ is bool:
         raise out_of_range('monitor response', 'current', m.current, 0, 65535)
-    if not 0 <= m.power <= 65535:
+    if not 0 <= m.power <= 65535 or m.power.__class__ is bool:
         raise out_of_range('monitor response', 'power', m.power, 0, 65535)
-    if not 0 <= m.temperature <= 65535:
+    if not 0 <= m.temperature <= 65535 or m.temperature.__class__ is bool:
         raise out_of_range('monitor response', 'temperature', m.temperature, 0, 65535)
-    if not 0 <= m.status <= 255:
+    if not 0 <= m.status <= 255 or isinstance(m.status, bool):
         raise out_of_range('monitor response', 'status', m.status, 0, 255)
-    if not -3686400 <= m.angle <= 3686400:
+    if not -3686400 <= m.angle <= 3686400 or m.angle.__class__ is bool:
         raise out_of_range('monitor response', 'angle', m.angle, -3686400, 3686400)
-    if not -32768 <= m.turns <= 32767:
+    if not -32768 <= m.turns <= 32767 or m.turns.__class__ is bool:
         raise out_of_range('monitor response', 'turns', m.turns, -32768, 32767)
     body = _S_FRAME_MONITORRESPONSE.pack(b'\x05\x1c', 22, 16, m.servo_id, m.voltage, m.current, m.power, m.temperature, m.status, m.angle, m.turns)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_set_origin_point_request(m: SetOriginPointRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('set_origin_point request', 'servo_id', m.servo_id, 0, 254)
     body = _S_B2_U8_U8_U8_U8.pack(b'\x12L', 23, 2, m.servo_id, 0)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_stop_on_control_mode_request(m: StopOnControlModeRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254:
+    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
         raise out_of_range('stop_on_control_mode request', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.method <= 255:
-        raise out_of_range('stop_on_control_mode request', 'method', m.method, 0, 255)
-    if not 0 <= m.power <= 65535:
+    if not 16 <= m.method <= 18 or m.method.__class__ is bool:
+        raise out_of_range('stop_on_control_mode request', 'method', m.method, 16, 18)
+    if not 0 <= m.power <= 65535 or m.power.__class__ is bool:
         raise out_of_range('stop_on_control_mode request', 'power', m.power, 0, 65535)
     body = _S_B2_U8_U8_U8_U8_U16.pack(b'\x12L', 24, 4, m.servo_id, m.method, m.power)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_sync_command_request(m: SyncCommandRequest) -> bytes:
-    if not 0 <= m.command <= 255:
+    if not 0 <= m.command <= 255 or m.command.__class__ is bool:
         raise out_of_range('sync_command request', 'command', m.command, 0, 255)
     v_block_size = len(m.blocks[0].content) if m.blocks else 0
     if any(len(item.content) != v_block_size for item in m.blocks):
@@ -2123,8 +2124,10 @@ def encode(message: Message) -> bytes:
         raise EncodeError(f"{type(message).__name__} is not a fashionstar_uart message")
     try:
         return encoder(message)
-    except (TypeError, AttributeError, struct.error) as exc:
-        raise EncodeError(f"{message.COMMAND} {message.DIRECTION.value}: {exc}") from None
+    except EncodeError:
+        raise
+    except (TypeError, AttributeError, ValueError, OverflowError, struct.error) as exc:
+        raise wrong_type(message, exc) from None  # one line naming the field, not Python's words
 
 
 class StreamParser(_StreamParser):

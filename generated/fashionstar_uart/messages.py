@@ -9,10 +9,13 @@ from typing import Any, ClassVar, Self
 
 from serialspec.runtime.fields import as_bytes as _bytes
 from serialspec.runtime.fields import check_keys as _check_keys
+from serialspec.runtime.fields import enum as _as_enum
+from serialspec.runtime.fields import flags as _as_flags
 from serialspec.runtime.fields import get as _get
+from serialspec.runtime.fields import integer as _integer
+from serialspec.runtime.fields import items as _items
 from serialspec.runtime.fields import mapping as _mapping
 from serialspec.runtime.message import Direction, Message, Record
-from serialspec.runtime.message import enum_or_int as _enum
 
 _store = object.__setattr__  # how __init__ fills the slots of a frozen class
 
@@ -81,138 +84,138 @@ __all__ = [
 class Result(IntEnum):
     """Outcome reported by the servo."""
 
-    FAILURE = 0
     #: failed
-    SUCCESS = 1
+    FAILURE = 0
     #: succeeded
+    SUCCESS = 1
 
 
 class Switch(IntEnum):
     """An on/off parameter."""
 
-    OFF = 0
     #: disabled
-    ON = 1
+    OFF = 0
     #: enabled
+    ON = 1
 
 
 class ResponseSwitch(IntEnum):
     """Whether control commands can be interrupted and whether they answer."""
 
-    INTERRUPTIBLE_SILENT = 0
     #: a new command replaces the running one; no response
-    QUEUED_WITH_RESPONSE = 1
+    INTERRUPTIBLE_SILENT = 0
     #: commands run to the end (queue of 1) and then send a response
+    QUEUED_WITH_RESPONSE = 1
 
 
 class BaudrateOption(IntEnum):
     """Serial baud rate option; takes effect at once."""
 
-    BAUD_9600 = 1
     #: 9600
-    BAUD_19200 = 2
+    BAUD_9600 = 1
     #: 19200
-    BAUD_38400 = 3
+    BAUD_19200 = 2
     #: 38400
-    BAUD_57600 = 4
+    BAUD_38400 = 3
     #: 57600
-    BAUD_115200 = 5
+    BAUD_57600 = 4
     #: 115200
-    BAUD_250000 = 6
+    BAUD_115200 = 5
     #: 250000
-    BAUD_500000 = 7
+    BAUD_250000 = 6
     #: 500000
+    BAUD_500000 = 7
 
 
 class StallProtectMode(IntEnum):
     """What the servo does when it stalls."""
 
-    LIMIT_POWER = 1
     #: lower the power to the stall power limit
-    RELEASE = 2
+    LIMIT_POWER = 1
     #: release the holding torque
+    RELEASE = 2
 
 
 class LockOnPowerOn(IntEnum):
     """lock on power on"""
 
-    RELEASE = 0
     #: torque released at power-on
-    HOLD = 1
+    RELEASE = 0
     #: holds its current angle at power-on
+    HOLD = 1
 
 
 class WheelBrake(IntEnum):
     """wheel brake"""
 
-    RELEASE = 0
     #: torque released when the wheel stops
-    HOLD = 1
+    RELEASE = 0
     #: holds when the wheel stops
+    HOLD = 1
 
 
 class SpinDirection(IntEnum):
     """spin direction"""
 
-    COUNTERCLOCKWISE = 0
     #: counter-clockwise
-    CLOCKWISE = 1
+    COUNTERCLOCKWISE = 0
     #: clockwise
+    CLOCKWISE = 1
 
 
 class StopMethod(IntEnum):
     """What the servo does after STOP_ON_CONTROL_MODE (sdk StopOptions)."""
 
-    RELEASE = 16
     #: stop, then release the torque (unlocked)
-    HOLD = 17
+    RELEASE = 16
     #: stop, then hold the position (locked)
-    DAMPING = 18
+    HOLD = 17
     #: stop, then go into damping mode
+    DAMPING = 18
 
 
 class AsyncEnd(IntEnum):
     """What END_ASYNC does with the commands held since BEGIN_ASYNC."""
 
-    EXECUTE = 0
     #: run the held commands now
-    CANCEL = 1
+    EXECUTE = 0
     #: drop the held commands
+    CANCEL = 1
 
 
 class SpinMode(IntEnum):
     """spin mode"""
 
-    STOP = 0
     #: stop
-    CONTINUOUS = 1
+    STOP = 0
     #: turn without stopping
-    TURNS = 2
+    CONTINUOUS = 1
     #: turn `value` turns, then stop
-    TIMED = 3
+    TURNS = 2
     #: turn for `value` ms, then stop
+    TIMED = 3
 
 
 class ServoStatus(IntFlag):
     """The servo's working status (data_id 5, and the servo monitor's status byte); bit meanings from the fashionstar-uart-sdk (uservo.py, the comment above query_status); 000 documents none."""
 
     NONE = 0
-    EXECUTING = 1 << 0
     #: a command is being executed (cleared when it is done)
-    COMMAND_ERROR = 1 << 1
+    EXECUTING = 1 << 0
     #: the last command failed (cleared by the next good one)
-    STALLED = 1 << 2
+    COMMAND_ERROR = 1 << 1
     #: stall error (cleared when the stall ends)
-    OVER_VOLTAGE = 1 << 3
+    STALLED = 1 << 2
     #: voltage too high
-    UNDER_VOLTAGE = 1 << 4
+    OVER_VOLTAGE = 1 << 3
     #: voltage too low
-    CURRENT_ERROR = 1 << 5
+    UNDER_VOLTAGE = 1 << 4
     #: current error
-    POWER_ERROR = 1 << 6
+    CURRENT_ERROR = 1 << 5
     #: power error
-    TEMPERATURE_ERROR = 1 << 7
+    POWER_ERROR = 1 << 6
     #: temperature error
+    TEMPERATURE_ERROR = 1 << 7
 
 
 class UserData(Record):
@@ -220,50 +223,50 @@ class UserData(Record):
 
     __slots__ = ('reserved_32', 'response_switch', 'servo_id', 'reserved_35', 'baudrate', 'stall_protect_mode', 'stall_power_limit', 'over_volt_low', 'over_volt_high', 'over_temperature', 'over_power', 'over_current', 'accel_switch', 'reserved_45', 'po_lock_switch', 'wb_lock_switch', 'angle_limit_switch', 'soft_start_switch', 'soft_start_time', 'angle_limit_high', 'angle_limit_low', 'angle_mid_offset')
     __match_args__ = ('reserved_32', 'response_switch', 'servo_id', 'reserved_35', 'baudrate', 'stall_protect_mode', 'stall_power_limit', 'over_volt_low', 'over_volt_high', 'over_temperature', 'over_power', 'over_current', 'accel_switch', 'reserved_45', 'po_lock_switch', 'wb_lock_switch', 'angle_limit_switch', 'soft_start_switch', 'soft_start_time', 'angle_limit_high', 'angle_limit_low', 'angle_mid_offset')
-    reserved_32: int
     #: data_id 32: Reserved.
-    response_switch: ResponseSwitch | int
+    reserved_32: int
     #: data_id 33: Whether ROTATE, SPIN and DAMPING can be interrupted and whether they answer.
-    servo_id: int
+    response_switch: ResponseSwitch | int
     #: data_id 34: The servo's id; 255 is the broadcast address and cannot be assigned.
-    reserved_35: int
+    servo_id: int
     #: data_id 35: Reserved.
-    baudrate: BaudrateOption | int
+    reserved_35: int
     #: data_id 36: Baud rate option (not the rate itself); takes effect at once.
-    stall_protect_mode: StallProtectMode | int
+    baudrate: BaudrateOption | int
     #: data_id 37: Strategy when the servo stalls.
-    stall_power_limit: int
+    stall_protect_mode: StallProtectMode | int
     #: data_id 38: Power limit while stalled. [mW]
-    over_volt_low: int
+    stall_power_limit: int
     #: data_id 39: Low voltage limit. [mV]
-    over_volt_high: int
+    over_volt_low: int
     #: data_id 40: High voltage limit. [mV]
-    over_temperature: int
+    over_volt_high: int
     #: data_id 41: Temperature limit (the document spells it `over_temprature`). [°C]
-    over_power: int
+    over_temperature: int
     #: data_id 42: Power limit. [mW]
-    over_current: int
+    over_power: int
     #: data_id 43: Current limit. [mA]
-    accel_switch: Switch | int
+    over_current: int
     #: data_id 44: Acceleration planning (t/4 accelerate, t/2 constant, t/4 decelerate); must be 1.
-    reserved_45: int
+    accel_switch: Switch | int
     #: data_id 45: Reserved.
-    po_lock_switch: LockOnPowerOn | int
+    reserved_45: int
     #: data_id 46: Whether the servo holds its angle at power-on.
-    wb_lock_switch: WheelBrake | int
+    po_lock_switch: LockOnPowerOn | int
     #: data_id 47: Whether the servo holds when a wheel-mode spin stops.
-    angle_limit_switch: Switch | int
+    wb_lock_switch: WheelBrake | int
     #: data_id 48: Angle limits (51, 52) apply only when this is on.
-    soft_start_switch: Switch | int
+    angle_limit_switch: Switch | int
     #: data_id 49: Run the first angle command after power-on slowly (over soft_start_time).
-    soft_start_time: int
+    soft_start_switch: Switch | int
     #: data_id 50: Duration of the first move after power-on. [ms]
-    angle_limit_high: int
+    soft_start_time: int
     #: data_id 51: Upper angle limit. [0.1°]
-    angle_limit_low: int
+    angle_limit_high: int
     #: data_id 52: Lower angle limit. [0.1°]
-    angle_mid_offset: int
+    angle_limit_low: int
     #: data_id 53: Offset of the middle position. [0.1°]
+    angle_mid_offset: int
 
     def __init__(
         self,
@@ -343,28 +346,28 @@ class UserData(Record):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'UserData') -> Self:
         _check_keys(data, ('reserved_32', 'response_switch', 'servo_id', 'reserved_35', 'baudrate', 'stall_protect_mode', 'stall_power_limit', 'over_volt_low', 'over_volt_high', 'over_temperature', 'over_power', 'over_current', 'accel_switch', 'reserved_45', 'po_lock_switch', 'wb_lock_switch', 'angle_limit_switch', 'soft_start_switch', 'soft_start_time', 'angle_limit_high', 'angle_limit_low', 'angle_mid_offset'), (), where)
         return cls(
-            _get(data, 'reserved_32', where),
-            _enum(ResponseSwitch, _get(data, 'response_switch', where)),
-            _get(data, 'servo_id', where),
-            _get(data, 'reserved_35', where),
-            _enum(BaudrateOption, _get(data, 'baudrate', where)),
-            _enum(StallProtectMode, _get(data, 'stall_protect_mode', where)),
-            _get(data, 'stall_power_limit', where),
-            _get(data, 'over_volt_low', where),
-            _get(data, 'over_volt_high', where),
-            _get(data, 'over_temperature', where),
-            _get(data, 'over_power', where),
-            _get(data, 'over_current', where),
-            _enum(Switch, _get(data, 'accel_switch', where)),
-            _get(data, 'reserved_45', where),
-            _enum(LockOnPowerOn, _get(data, 'po_lock_switch', where)),
-            _enum(WheelBrake, _get(data, 'wb_lock_switch', where)),
-            _enum(Switch, _get(data, 'angle_limit_switch', where)),
-            _enum(Switch, _get(data, 'soft_start_switch', where)),
-            _get(data, 'soft_start_time', where),
-            _get(data, 'angle_limit_high', where),
-            _get(data, 'angle_limit_low', where),
-            _get(data, 'angle_mid_offset', where),
+            _integer(_get(data, 'reserved_32', where), 'reserved_32', where),
+            _as_enum(ResponseSwitch, _get(data, 'response_switch', where), 'response_switch', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'reserved_35', where), 'reserved_35', where),
+            _as_enum(BaudrateOption, _get(data, 'baudrate', where), 'baudrate', where),
+            _as_enum(StallProtectMode, _get(data, 'stall_protect_mode', where), 'stall_protect_mode', where),
+            _integer(_get(data, 'stall_power_limit', where), 'stall_power_limit', where),
+            _integer(_get(data, 'over_volt_low', where), 'over_volt_low', where),
+            _integer(_get(data, 'over_volt_high', where), 'over_volt_high', where),
+            _integer(_get(data, 'over_temperature', where), 'over_temperature', where),
+            _integer(_get(data, 'over_power', where), 'over_power', where),
+            _integer(_get(data, 'over_current', where), 'over_current', where),
+            _as_enum(Switch, _get(data, 'accel_switch', where), 'accel_switch', where),
+            _integer(_get(data, 'reserved_45', where), 'reserved_45', where),
+            _as_enum(LockOnPowerOn, _get(data, 'po_lock_switch', where), 'po_lock_switch', where),
+            _as_enum(WheelBrake, _get(data, 'wb_lock_switch', where), 'wb_lock_switch', where),
+            _as_enum(Switch, _get(data, 'angle_limit_switch', where), 'angle_limit_switch', where),
+            _as_enum(Switch, _get(data, 'soft_start_switch', where), 'soft_start_switch', where),
+            _integer(_get(data, 'soft_start_time', where), 'soft_start_time', where),
+            _integer(_get(data, 'angle_limit_high', where), 'angle_limit_high', where),
+            _integer(_get(data, 'angle_limit_low', where), 'angle_limit_low', where),
+            _integer(_get(data, 'angle_mid_offset', where), 'angle_mid_offset', where),
         )
 
 
@@ -373,10 +376,10 @@ class MethodBits(Record):
 
     __slots__ = ('direction', 'mode')
     __match_args__ = ('direction', 'mode')
-    direction: SpinDirection | int
     #: Rotation direction. (bit 7)
-    mode: SpinMode | int
+    direction: SpinDirection | int
     #: How long to spin. (bits 1..0)
+    mode: SpinMode | int
 
     def __init__(
         self,
@@ -396,8 +399,8 @@ class MethodBits(Record):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'MethodBits') -> Self:
         _check_keys(data, ('direction', 'mode'), (), where)
         return cls(
-            _enum(SpinDirection, _get(data, 'direction', where)),
-            _enum(SpinMode, _get(data, 'mode', where)),
+            _as_enum(SpinDirection, _get(data, 'direction', where), 'direction', where),
+            _as_enum(SpinMode, _get(data, 'mode', where), 'mode', where),
         )
 
 
@@ -406,8 +409,8 @@ class BlocksItem(Record):
 
     __slots__ = ('content',)
     __match_args__ = ('content',)
-    content: bytes
     #: The carried command's request content for one servo.
+    content: bytes
 
     def __init__(
         self,
@@ -437,8 +440,8 @@ class PingRequest(Message):
     COMMAND: ClassVar[str] = 'ping'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
+    servo_id: int
 
     def __init__(
         self,
@@ -455,7 +458,7 @@ class PingRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'ping request') -> Self:
         _check_keys(data, ('servo_id',), (), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -468,8 +471,8 @@ class PingResponse(Message):
     COMMAND: ClassVar[str] = 'ping'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
+    servo_id: int
 
     def __init__(
         self,
@@ -486,7 +489,7 @@ class PingResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'ping response') -> Self:
         _check_keys(data, ('servo_id',), (), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -499,8 +502,8 @@ class ResetUserDataRequest(Message):
     COMMAND: ClassVar[str] = 'reset_user_data'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
+    servo_id: int
 
     def __init__(
         self,
@@ -517,7 +520,7 @@ class ResetUserDataRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'reset_user_data request') -> Self:
         _check_keys(data, ('servo_id',), (), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -530,10 +533,10 @@ class ResetUserDataResponse(Message):
     COMMAND: ClassVar[str] = 'reset_user_data'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
+    servo_id: int
+    #: Outcome of the command. range 0..1
     result: Result | int
-    #: Outcome of the command.
 
     def __init__(
         self,
@@ -553,8 +556,8 @@ class ResetUserDataResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'reset_user_data response') -> Self:
         _check_keys(data, ('servo_id', 'result'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _enum(Result, _get(data, 'result', where)),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(Result, _get(data, 'result', where), 'result', where),
         )
 
 
@@ -567,10 +570,10 @@ class ReadDataRequest(Message):
     COMMAND: ClassVar[str] = 'read_data'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
-    data_id: int
+    servo_id: int
     #: Parameter to read (see the parameter table).
+    data_id: int
 
     def __init__(
         self,
@@ -590,8 +593,8 @@ class ReadDataRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'read_data request') -> Self:
         _check_keys(data, ('servo_id', 'data_id'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'data_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'data_id', where), 'data_id', where),
         )
 
 
@@ -604,12 +607,12 @@ class ReadDataResponse(Message):
     COMMAND: ClassVar[str] = 'read_data'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
-    data_id: int
+    servo_id: int
     #: The parameter read.
-    data: int | float
+    data_id: int
     #: The value, typed by data_id.
+    data: int | float
 
     def __init__(
         self,
@@ -632,8 +635,8 @@ class ReadDataResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'read_data response') -> Self:
         _check_keys(data, ('servo_id', 'data_id', 'data'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'data_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'data_id', where), 'data_id', where),
             _get(data, 'data', where),
         )
 
@@ -647,12 +650,12 @@ class WriteDataRequest(Message):
     COMMAND: ClassVar[str] = 'write_data'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
-    data_id: int
+    servo_id: int
     #: User parameter to write (32..53).
-    data: int | float
+    data_id: int
     #: The value, typed by data_id.
+    data: int | float
 
     def __init__(
         self,
@@ -675,8 +678,8 @@ class WriteDataRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'write_data request') -> Self:
         _check_keys(data, ('servo_id', 'data_id', 'data'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'data_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'data_id', where), 'data_id', where),
             _get(data, 'data', where),
         )
 
@@ -690,12 +693,12 @@ class WriteDataResponse(Message):
     COMMAND: ClassVar[str] = 'write_data'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
-    data_id: int
+    servo_id: int
     #: The parameter written.
+    data_id: int
+    #: Outcome of the command. range 0..1
     result: Result | int
-    #: Outcome of the command.
 
     def __init__(
         self,
@@ -718,9 +721,9 @@ class WriteDataResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'write_data response') -> Self:
         _check_keys(data, ('servo_id', 'data_id', 'result'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'data_id', where),
-            _enum(Result, _get(data, 'result', where)),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'data_id', where), 'data_id', where),
+            _as_enum(Result, _get(data, 'result', where), 'result', where),
         )
 
 
@@ -733,8 +736,8 @@ class ReadBatchDataRequest(Message):
     COMMAND: ClassVar[str] = 'read_batch_data'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
+    servo_id: int
 
     def __init__(
         self,
@@ -751,7 +754,7 @@ class ReadBatchDataRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'read_batch_data request') -> Self:
         _check_keys(data, ('servo_id',), (), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -764,10 +767,10 @@ class ReadBatchDataResponse(Message):
     COMMAND: ClassVar[str] = 'read_batch_data'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
-    user_data: UserData
+    servo_id: int
     #: The user parameters 32..53 in data_id order. (layout inferred, not documented)
+    user_data: UserData
 
     def __init__(
         self,
@@ -787,8 +790,8 @@ class ReadBatchDataResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'read_batch_data response') -> Self:
         _check_keys(data, ('servo_id', 'user_data'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            UserData.from_fields(_mapping(_get(data, 'user_data', where), 'user_data', where), where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            UserData.from_fields(_mapping(_get(data, 'user_data', where), 'user_data', where), where + ' user_data'),
         )
 
 
@@ -801,10 +804,10 @@ class WriteBatchDataRequest(Message):
     COMMAND: ClassVar[str] = 'write_batch_data'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
-    user_data: UserData
+    servo_id: int
     #: The user parameters 32..53 in data_id order. (layout inferred, not documented)
+    user_data: UserData
 
     def __init__(
         self,
@@ -824,8 +827,8 @@ class WriteBatchDataRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'write_batch_data request') -> Self:
         _check_keys(data, ('servo_id', 'user_data'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            UserData.from_fields(_mapping(_get(data, 'user_data', where), 'user_data', where), where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            UserData.from_fields(_mapping(_get(data, 'user_data', where), 'user_data', where), where + ' user_data'),
         )
 
 
@@ -838,10 +841,10 @@ class WriteBatchDataResponse(Message):
     COMMAND: ClassVar[str] = 'write_batch_data'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
+    servo_id: int
+    #: Outcome of the command. range 0..1 (layout inferred, not documented)
     result: Result | int
-    #: Outcome of the command. (layout inferred, not documented)
 
     def __init__(
         self,
@@ -861,8 +864,8 @@ class WriteBatchDataResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'write_batch_data response') -> Self:
         _check_keys(data, ('servo_id', 'result'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _enum(Result, _get(data, 'result', where)),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(Result, _get(data, 'result', where), 'result', where),
         )
 
 
@@ -875,14 +878,14 @@ class SpinRequest(Message):
     COMMAND: ClassVar[str] = 'spin'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
-    method: MethodBits
+    servo_id: int
     #: Execution method and direction; the other bits are unused and must be zero.
-    speed: int
+    method: MethodBits
     #: Angular speed. [°/s]
-    value: int
+    speed: int
     #: Turns (mode turns) or ms (mode timed); ignored by stop and continuous.
+    value: int
 
     def __init__(
         self,
@@ -908,10 +911,10 @@ class SpinRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'spin request') -> Self:
         _check_keys(data, ('servo_id', 'method', 'speed', 'value'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            MethodBits.from_fields(_mapping(_get(data, 'method', where), 'method', where), where),
-            _get(data, 'speed', where),
-            _get(data, 'value', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            MethodBits.from_fields(_mapping(_get(data, 'method', where), 'method', where), where + ' method'),
+            _integer(_get(data, 'speed', where), 'speed', where),
+            _integer(_get(data, 'value', where), 'value', where),
         )
 
 
@@ -924,10 +927,10 @@ class SpinResponse(Message):
     COMMAND: ClassVar[str] = 'spin'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
+    servo_id: int
+    #: Outcome of the command. range 0..1
     result: Result | int
-    #: Outcome of the command.
 
     def __init__(
         self,
@@ -947,8 +950,8 @@ class SpinResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'spin response') -> Self:
         _check_keys(data, ('servo_id', 'result'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _enum(Result, _get(data, 'result', where)),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(Result, _get(data, 'result', where), 'result', where),
         )
 
 
@@ -961,14 +964,14 @@ class RotateRequest(Message):
     COMMAND: ClassVar[str] = 'rotate'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
-    angle: int
+    servo_id: int
     #: Angle in 0.1° steps; the sign gives the direction (900 is 90°). [0.1°]
-    interval: int
+    angle: int
     #: Time to reach the target angle. [ms]
-    power: int
+    interval: int
     #: Power; 0 or more than the power limit means the power limit (000's 功率保持值, read as data_id 42: erratum power_hold_value_undefined). [mW]
+    power: int
 
     def __init__(
         self,
@@ -994,10 +997,10 @@ class RotateRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'rotate request') -> Self:
         _check_keys(data, ('servo_id', 'angle', 'interval', 'power'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'angle', where),
-            _get(data, 'interval', where),
-            data.get('power', 0),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'angle', where), 'angle', where),
+            _integer(_get(data, 'interval', where), 'interval', where),
+            _integer(data.get('power', 0), 'power', where),
         )
 
 
@@ -1010,10 +1013,10 @@ class RotateResponse(Message):
     COMMAND: ClassVar[str] = 'rotate'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
+    servo_id: int
+    #: Outcome of the command. range 0..1
     result: Result | int
-    #: Outcome of the command.
 
     def __init__(
         self,
@@ -1033,8 +1036,8 @@ class RotateResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'rotate response') -> Self:
         _check_keys(data, ('servo_id', 'result'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _enum(Result, _get(data, 'result', where)),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(Result, _get(data, 'result', where), 'result', where),
         )
 
 
@@ -1047,10 +1050,10 @@ class DampingRequest(Message):
     COMMAND: ClassVar[str] = 'damping'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Servo id; 255 sets every servo (broadcast).
-    power: int
+    servo_id: int
     #: Holding power; 0 or more than the power limit means the limit. [mW]
+    power: int
 
     def __init__(
         self,
@@ -1070,8 +1073,8 @@ class DampingRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'damping request') -> Self:
         _check_keys(data, ('servo_id', 'power'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'power', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'power', where), 'power', where),
         )
 
 
@@ -1084,10 +1087,10 @@ class DampingResponse(Message):
     COMMAND: ClassVar[str] = 'damping'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
+    servo_id: int
+    #: Outcome of the command. range 0..1
     result: Result | int
-    #: Outcome of the command.
 
     def __init__(
         self,
@@ -1107,8 +1110,8 @@ class DampingResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'damping response') -> Self:
         _check_keys(data, ('servo_id', 'result'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _enum(Result, _get(data, 'result', where)),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(Result, _get(data, 'result', where), 'result', where),
         )
 
 
@@ -1121,8 +1124,8 @@ class ReadAngleRequest(Message):
     COMMAND: ClassVar[str] = 'read_angle'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
+    servo_id: int
 
     def __init__(
         self,
@@ -1139,7 +1142,7 @@ class ReadAngleRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'read_angle request') -> Self:
         _check_keys(data, ('servo_id',), (), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -1152,10 +1155,10 @@ class ReadAngleResponse(Message):
     COMMAND: ClassVar[str] = 'read_angle'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
-    angle: int
+    servo_id: int
     #: Angle in 0.1° steps; the sign gives the direction (900 is 90°). [0.1°]
+    angle: int
 
     def __init__(
         self,
@@ -1175,8 +1178,8 @@ class ReadAngleResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'read_angle response') -> Self:
         _check_keys(data, ('servo_id', 'angle'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'angle', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'angle', where), 'angle', where),
         )
 
 
@@ -1189,18 +1192,18 @@ class MoveByIntervalRequest(Message):
     COMMAND: ClassVar[str] = 'move_by_interval'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
-    angle: int
+    servo_id: int
     #: Target angle in 0.1° steps, -180.0°..180.0° (the SDK clamps to this range). [0.1°] range -1800..1800
-    interval: int
+    angle: int
     #: Time to reach the target angle. [ms]
-    t_acc: int
+    interval: int
     #: Acceleration time at the start of the move (the SDK sends at least 20 ms). [ms]
-    t_dec: int
+    t_acc: int
     #: Deceleration time at the end of the move (the SDK sends at least 20 ms). [ms]
-    power: int
+    t_dec: int
     #: Power limit of the move; 0 (or more than the power limit, data_id 42) means the power limit. [mW]
+    power: int
 
     def __init__(
         self,
@@ -1232,12 +1235,12 @@ class MoveByIntervalRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'move_by_interval request') -> Self:
         _check_keys(data, ('servo_id', 'angle', 'interval', 't_acc', 't_dec', 'power'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'angle', where),
-            _get(data, 'interval', where),
-            data.get('t_acc', 20),
-            data.get('t_dec', 20),
-            data.get('power', 0),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'angle', where), 'angle', where),
+            _integer(_get(data, 'interval', where), 'interval', where),
+            _integer(data.get('t_acc', 20), 't_acc', where),
+            _integer(data.get('t_dec', 20), 't_dec', where),
+            _integer(data.get('power', 0), 'power', where),
         )
 
 
@@ -1250,10 +1253,10 @@ class MoveByIntervalResponse(Message):
     COMMAND: ClassVar[str] = 'move_by_interval'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
+    servo_id: int
+    #: Outcome of the command. range 0..1
     result: Result | int
-    #: Outcome of the command.
 
     def __init__(
         self,
@@ -1273,8 +1276,8 @@ class MoveByIntervalResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'move_by_interval response') -> Self:
         _check_keys(data, ('servo_id', 'result'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _enum(Result, _get(data, 'result', where)),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(Result, _get(data, 'result', where), 'result', where),
         )
 
 
@@ -1287,18 +1290,18 @@ class MoveByVelocityRequest(Message):
     COMMAND: ClassVar[str] = 'move_by_velocity'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
-    angle: int
+    servo_id: int
     #: Target angle in 0.1° steps, -180.0°..180.0° (the SDK clamps to this range). [0.1°] range -1800..1800
-    velocity: int
+    angle: int
     #: Target speed in 0.1°/s (the SDK clamps to 1.0..750.0 °/s). [0.1°/s] range 10..7500
-    t_acc: int
+    velocity: int
     #: Acceleration time at the start of the move (the SDK sends at least 20 ms). [ms]
-    t_dec: int
+    t_acc: int
     #: Deceleration time at the end of the move (the SDK sends at least 20 ms). [ms]
-    power: int
+    t_dec: int
     #: Power limit of the move; 0 (or more than the power limit, data_id 42) means the power limit. [mW]
+    power: int
 
     def __init__(
         self,
@@ -1330,12 +1333,12 @@ class MoveByVelocityRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'move_by_velocity request') -> Self:
         _check_keys(data, ('servo_id', 'angle', 'velocity', 't_acc', 't_dec', 'power'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'angle', where),
-            _get(data, 'velocity', where),
-            data.get('t_acc', 20),
-            data.get('t_dec', 20),
-            data.get('power', 0),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'angle', where), 'angle', where),
+            _integer(_get(data, 'velocity', where), 'velocity', where),
+            _integer(data.get('t_acc', 20), 't_acc', where),
+            _integer(data.get('t_dec', 20), 't_dec', where),
+            _integer(data.get('power', 0), 'power', where),
         )
 
 
@@ -1348,10 +1351,10 @@ class MoveByVelocityResponse(Message):
     COMMAND: ClassVar[str] = 'move_by_velocity'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
+    servo_id: int
+    #: Outcome of the command. range 0..1
     result: Result | int
-    #: Outcome of the command.
 
     def __init__(
         self,
@@ -1371,8 +1374,8 @@ class MoveByVelocityResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'move_by_velocity response') -> Self:
         _check_keys(data, ('servo_id', 'result'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _enum(Result, _get(data, 'result', where)),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(Result, _get(data, 'result', where), 'result', where),
         )
 
 
@@ -1385,14 +1388,14 @@ class MoveMturnRequest(Message):
     COMMAND: ClassVar[str] = 'move_mturn'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
-    angle: int
+    servo_id: int
     #: Multi-turn angle in 0.1° steps, up to ±1024 turns (the SDK clamps to ±368640.0°). [0.1°] range -3686400..3686400
-    interval: int
+    angle: int
     #: Time to reach the target angle. [ms] range 0..4096000
-    power: int
+    interval: int
     #: Power limit of the move; 0 (or more than the power limit, data_id 42) means the power limit. [mW]
+    power: int
 
     def __init__(
         self,
@@ -1418,10 +1421,10 @@ class MoveMturnRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'move_mturn request') -> Self:
         _check_keys(data, ('servo_id', 'angle', 'interval', 'power'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'angle', where),
-            _get(data, 'interval', where),
-            data.get('power', 0),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'angle', where), 'angle', where),
+            _integer(_get(data, 'interval', where), 'interval', where),
+            _integer(data.get('power', 0), 'power', where),
         )
 
 
@@ -1434,10 +1437,10 @@ class MoveMturnResponse(Message):
     COMMAND: ClassVar[str] = 'move_mturn'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
+    servo_id: int
+    #: Outcome of the command. range 0..1
     result: Result | int
-    #: Outcome of the command.
 
     def __init__(
         self,
@@ -1457,8 +1460,8 @@ class MoveMturnResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'move_mturn response') -> Self:
         _check_keys(data, ('servo_id', 'result'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _enum(Result, _get(data, 'result', where)),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(Result, _get(data, 'result', where), 'result', where),
         )
 
 
@@ -1471,18 +1474,18 @@ class MoveMturnByIntervalRequest(Message):
     COMMAND: ClassVar[str] = 'move_mturn_by_interval'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
-    angle: int
+    servo_id: int
     #: Multi-turn angle in 0.1° steps, up to ±1024 turns (the SDK clamps to ±368640.0°). [0.1°] range -3686400..3686400
-    interval: int
+    angle: int
     #: Time to reach the target (at least t_acc + t_dec). [ms] range 0..4096000
-    t_acc: int
+    interval: int
     #: Acceleration time at the start of the move (the SDK sends at least 20 ms). [ms]
-    t_dec: int
+    t_acc: int
     #: Deceleration time at the end of the move (the SDK sends at least 20 ms). [ms]
-    power: int
+    t_dec: int
     #: Power limit of the move; 0 (or more than the power limit, data_id 42) means the power limit. [mW]
+    power: int
 
     def __init__(
         self,
@@ -1514,12 +1517,12 @@ class MoveMturnByIntervalRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'move_mturn_by_interval request') -> Self:
         _check_keys(data, ('servo_id', 'angle', 'interval', 't_acc', 't_dec', 'power'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'angle', where),
-            _get(data, 'interval', where),
-            data.get('t_acc', 20),
-            data.get('t_dec', 20),
-            data.get('power', 0),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'angle', where), 'angle', where),
+            _integer(_get(data, 'interval', where), 'interval', where),
+            _integer(data.get('t_acc', 20), 't_acc', where),
+            _integer(data.get('t_dec', 20), 't_dec', where),
+            _integer(data.get('power', 0), 'power', where),
         )
 
 
@@ -1532,10 +1535,10 @@ class MoveMturnByIntervalResponse(Message):
     COMMAND: ClassVar[str] = 'move_mturn_by_interval'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
+    servo_id: int
+    #: Outcome of the command. range 0..1
     result: Result | int
-    #: Outcome of the command.
 
     def __init__(
         self,
@@ -1555,8 +1558,8 @@ class MoveMturnByIntervalResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'move_mturn_by_interval response') -> Self:
         _check_keys(data, ('servo_id', 'result'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _enum(Result, _get(data, 'result', where)),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(Result, _get(data, 'result', where), 'result', where),
         )
 
 
@@ -1569,18 +1572,18 @@ class MoveMturnByVelocityRequest(Message):
     COMMAND: ClassVar[str] = 'move_mturn_by_velocity'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
-    angle: int
+    servo_id: int
     #: Multi-turn angle in 0.1° steps, up to ±1024 turns (the SDK clamps to ±368640.0°). [0.1°] range -3686400..3686400
-    velocity: int
+    angle: int
     #: Target speed in 0.1°/s (the SDK clamps to 1.0..750.0 °/s). [0.1°/s] range 10..7500
-    t_acc: int
+    velocity: int
     #: Acceleration time at the start of the move (the SDK sends at least 20 ms). [ms]
-    t_dec: int
+    t_acc: int
     #: Deceleration time at the end of the move (the SDK sends at least 20 ms). [ms]
-    power: int
+    t_dec: int
     #: Power limit of the move; 0 (or more than the power limit, data_id 42) means the power limit. [mW]
+    power: int
 
     def __init__(
         self,
@@ -1612,12 +1615,12 @@ class MoveMturnByVelocityRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'move_mturn_by_velocity request') -> Self:
         _check_keys(data, ('servo_id', 'angle', 'velocity', 't_acc', 't_dec', 'power'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'angle', where),
-            _get(data, 'velocity', where),
-            data.get('t_acc', 20),
-            data.get('t_dec', 20),
-            data.get('power', 0),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'angle', where), 'angle', where),
+            _integer(_get(data, 'velocity', where), 'velocity', where),
+            _integer(data.get('t_acc', 20), 't_acc', where),
+            _integer(data.get('t_dec', 20), 't_dec', where),
+            _integer(data.get('power', 0), 'power', where),
         )
 
 
@@ -1630,10 +1633,10 @@ class MoveMturnByVelocityResponse(Message):
     COMMAND: ClassVar[str] = 'move_mturn_by_velocity'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
+    servo_id: int
+    #: Outcome of the command. range 0..1
     result: Result | int
-    #: Outcome of the command.
 
     def __init__(
         self,
@@ -1653,8 +1656,8 @@ class MoveMturnByVelocityResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'move_mturn_by_velocity response') -> Self:
         _check_keys(data, ('servo_id', 'result'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _enum(Result, _get(data, 'result', where)),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(Result, _get(data, 'result', where), 'result', where),
         )
 
 
@@ -1667,8 +1670,8 @@ class ReadMturnAngleRequest(Message):
     COMMAND: ClassVar[str] = 'read_mturn_angle'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
+    servo_id: int
 
     def __init__(
         self,
@@ -1685,7 +1688,7 @@ class ReadMturnAngleRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'read_mturn_angle request') -> Self:
         _check_keys(data, ('servo_id',), (), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -1698,12 +1701,12 @@ class ReadMturnAngleResponse(Message):
     COMMAND: ClassVar[str] = 'read_mturn_angle'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
-    angle: int
+    servo_id: int
     #: Multi-turn angle in 0.1° steps, up to ±1024 turns (the SDK clamps to ±368640.0°). [0.1°] range -3686400..3686400
-    turns: int
+    angle: int
     #: Whole turns in the multi-turn angle (toward zero). (layout inferred, not documented)
+    turns: int
 
     def __init__(
         self,
@@ -1726,9 +1729,9 @@ class ReadMturnAngleResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'read_mturn_angle response') -> Self:
         _check_keys(data, ('servo_id', 'angle', 'turns'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'angle', where),
-            _get(data, 'turns', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'angle', where), 'angle', where),
+            _integer(_get(data, 'turns', where), 'turns', where),
         )
 
 
@@ -1741,8 +1744,8 @@ class ResetMturnAngleRequest(Message):
     COMMAND: ClassVar[str] = 'reset_mturn_angle'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
+    servo_id: int
 
     def __init__(
         self,
@@ -1759,7 +1762,7 @@ class ResetMturnAngleRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'reset_mturn_angle request') -> Self:
         _check_keys(data, ('servo_id',), (), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -1793,8 +1796,8 @@ class EndAsyncRequest(Message):
     COMMAND: ClassVar[str] = 'end_async'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
+    #: 0 runs the held commands, 1 drops them. range 0..1
     mode: AsyncEnd | int
-    #: 0 runs the held commands, 1 drops them.
 
     def __init__(
         self,
@@ -1811,7 +1814,7 @@ class EndAsyncRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'end_async request') -> Self:
         _check_keys(data, ('mode',), (), where)
         return cls(
-            _enum(AsyncEnd, _get(data, 'mode', where)),
+            _as_enum(AsyncEnd, _get(data, 'mode', where), 'mode', where),
         )
 
 
@@ -1824,8 +1827,8 @@ class MonitorRequest(Message):
     COMMAND: ClassVar[str] = 'monitor'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
+    servo_id: int
 
     def __init__(
         self,
@@ -1842,7 +1845,7 @@ class MonitorRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'monitor request') -> Self:
         _check_keys(data, ('servo_id',), (), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -1855,22 +1858,22 @@ class MonitorResponse(Message):
     COMMAND: ClassVar[str] = 'monitor'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
-    voltage: int
+    servo_id: int
     #: Supply voltage (as data_id 1). [mV]
-    current: int
+    voltage: int
     #: Current (as data_id 2). [mA]
-    power: int
+    current: int
     #: Power (as data_id 3). [mW]
-    temperature: int
+    power: int
     #: Raw NTC reading (as data_id 4; see erratum temperature_unit). [raw ADC]
-    status: ServoStatus
+    temperature: int
     #: Working status (as data_id 5).
-    angle: int
+    status: ServoStatus
     #: Multi-turn angle in 0.1° steps, up to ±1024 turns (the SDK clamps to ±368640.0°). [0.1°] range -3686400..3686400
-    turns: int
+    angle: int
     #: Whole turns in the multi-turn angle (toward zero). (layout inferred, not documented)
+    turns: int
 
     def __init__(
         self,
@@ -1908,14 +1911,14 @@ class MonitorResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'monitor response') -> Self:
         _check_keys(data, ('servo_id', 'voltage', 'current', 'power', 'temperature', 'status', 'angle', 'turns'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'voltage', where),
-            _get(data, 'current', where),
-            _get(data, 'power', where),
-            _get(data, 'temperature', where),
-            ServoStatus(_get(data, 'status', where)),
-            _get(data, 'angle', where),
-            _get(data, 'turns', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'voltage', where), 'voltage', where),
+            _integer(_get(data, 'current', where), 'current', where),
+            _integer(_get(data, 'power', where), 'power', where),
+            _integer(_get(data, 'temperature', where), 'temperature', where),
+            _as_flags(ServoStatus, _get(data, 'status', where), 255, 'status', where),
+            _integer(_get(data, 'angle', where), 'angle', where),
+            _integer(_get(data, 'turns', where), 'turns', where),
         )
 
 
@@ -1928,8 +1931,8 @@ class SetOriginPointRequest(Message):
     COMMAND: ClassVar[str] = 'set_origin_point'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
+    servo_id: int
 
     def __init__(
         self,
@@ -1946,7 +1949,7 @@ class SetOriginPointRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'set_origin_point request') -> Self:
         _check_keys(data, ('servo_id',), ('reserved',), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -1959,12 +1962,12 @@ class StopOnControlModeRequest(Message):
     COMMAND: ClassVar[str] = 'stop_on_control_mode'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
+    servo_id: int
+    #: What the servo does after stopping. range 16..18
     method: StopMethod | int
-    #: What the servo does after stopping.
-    power: int
     #: Holding power (hold and damping). [mW]
+    power: int
 
     def __init__(
         self,
@@ -1987,9 +1990,9 @@ class StopOnControlModeRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'stop_on_control_mode request') -> Self:
         _check_keys(data, ('servo_id', 'method', 'power'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _enum(StopMethod, _get(data, 'method', where)),
-            _get(data, 'power', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(StopMethod, _get(data, 'method', where), 'method', where),
+            _integer(_get(data, 'power', where), 'power', where),
         )
 
 
@@ -2002,10 +2005,10 @@ class SyncCommandRequest(Message):
     COMMAND: ClassVar[str] = 'sync_command'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    command: int
     #: The command carried (8, 11..15, or 22 for the monitor).
-    blocks: tuple[BlocksItem, ...]
+    command: int
     #: One block per servo.
+    blocks: tuple[BlocksItem, ...]
 
     def __init__(
         self,
@@ -2025,8 +2028,8 @@ class SyncCommandRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'sync_command request') -> Self:
         _check_keys(data, ('command', 'blocks'), ('block_size', 'count'), where)
         return cls(
-            _get(data, 'command', where),
-            tuple(BlocksItem.from_fields(_mapping(item, 'blocks', where), where) for item in _get(data, 'blocks', where)),
+            _integer(_get(data, 'command', where), 'command', where),
+            tuple(BlocksItem.from_fields(_mapping(item, 'blocks', where), where) for item in _items(_get(data, 'blocks', where), 'blocks', where)),
         )
 
 

@@ -81,23 +81,23 @@ DEVICE = DeviceSpec(
         EntrySpec('firmware_version', 7, 1, 'r', 0, 65535),
         EntrySpec('serial_number', 8, 1, 'r', 0, 4294967295),
         EntrySpec('reserved_32', 32, 0, 'rw', 0, 255),
-        EntrySpec('response_switch', 33, 0, 'rw', 0, 255),
+        EntrySpec('response_switch', 33, 0, 'rw', 0, 1),
         EntrySpec('servo_id', 34, 0, 'rw', 0, 254),
         EntrySpec('reserved_35', 35, 0, 'rw', 0, 255),
         EntrySpec('baudrate', 36, 5, 'rw', 1, 7),
-        EntrySpec('stall_protect_mode', 37, 1, 'rw', 0, 255),
+        EntrySpec('stall_protect_mode', 37, 1, 'rw', 1, 2),
         EntrySpec('stall_power_limit', 38, 4000, 'rw', 0, 65535),
         EntrySpec('over_volt_low', 39, 5000, 'rw', 0, 65535),
         EntrySpec('over_volt_high', 40, 8400, 'rw', 0, 65535),
         EntrySpec('over_temperature', 41, 65, 'rw', 0, 65535),
         EntrySpec('over_power', 42, 12000, 'rw', 0, 65535),
         EntrySpec('over_current', 43, 1500, 'rw', 0, 65535),
-        EntrySpec('accel_switch', 44, 1, 'rw', 0, 255),
+        EntrySpec('accel_switch', 44, 1, 'rw', 0, 1),
         EntrySpec('reserved_45', 45, 0, 'rw', 0, 255),
-        EntrySpec('po_lock_switch', 46, 0, 'rw', 0, 255),
-        EntrySpec('wb_lock_switch', 47, 0, 'rw', 0, 255),
-        EntrySpec('angle_limit_switch', 48, 0, 'rw', 0, 255),
-        EntrySpec('soft_start_switch', 49, 0, 'rw', 0, 255),
+        EntrySpec('po_lock_switch', 46, 0, 'rw', 0, 1),
+        EntrySpec('wb_lock_switch', 47, 0, 'rw', 0, 1),
+        EntrySpec('angle_limit_switch', 48, 0, 'rw', 0, 1),
+        EntrySpec('soft_start_switch', 49, 0, 'rw', 0, 1),
         EntrySpec('soft_start_time', 50, 1000, 'rw', 0, 65535),
         EntrySpec('angle_limit_high', 51, 1800, 'rw', -32768, 32767),
         EntrySpec('angle_limit_low', 52, -1800, 'rw', -32768, 32767),
@@ -120,23 +120,23 @@ DEVICE = DeviceSpec(
         # write_batch_data
         CommandSpec(WriteBatchDataRequest, WriteBatchDataResponse, writes=('user_data',), tables={'user_data': ('block', 'reserved_32', 'response_switch', 'servo_id', 'reserved_35', 'baudrate', 'stall_protect_mode', 'stall_power_limit', 'over_volt_low', 'over_volt_high', 'over_temperature', 'over_power', 'over_current', 'accel_switch', 'reserved_45', 'po_lock_switch', 'wb_lock_switch', 'angle_limit_switch', 'soft_start_switch', 'soft_start_time', 'angle_limit_high', 'angle_limit_low', 'angle_mid_offset')}),
         # spin
-        CommandSpec(SpinRequest, SpinResponse, optional_when=(33, 1, '==')),
+        CommandSpec(SpinRequest, SpinResponse, optional_when=('response_switch', 1, '==')),
         # rotate
-        CommandSpec(RotateRequest, RotateResponse, moves=('angle', 'angle', 'interval', ''), held_while='holding', optional_when=(33, 1, '=='), after='interval'),
+        CommandSpec(RotateRequest, RotateResponse, moves=('angle', 'angle', 'interval', ''), held_while='holding', optional_when=('response_switch', 1, '=='), after='interval'),
         # damping
-        CommandSpec(DampingRequest, DampingResponse, optional_when=(33, 1, '==')),
+        CommandSpec(DampingRequest, DampingResponse, optional_when=('response_switch', 1, '==')),
         # read_angle
         CommandSpec(ReadAngleRequest, ReadAngleResponse, reports={'angle': 'angle'}),
         # move_by_interval
-        CommandSpec(MoveByIntervalRequest, MoveByIntervalResponse, moves=('angle', 'angle', 'interval', ''), ramp=('t_acc', 't_dec'), held_while='holding', optional_when=(33, 1, '==')),
+        CommandSpec(MoveByIntervalRequest, MoveByIntervalResponse, moves=('angle', 'angle', 'interval', ''), ramp=('t_acc', 't_dec'), held_while='holding', optional_when=('response_switch', 1, '==')),
         # move_by_velocity
-        CommandSpec(MoveByVelocityRequest, MoveByVelocityResponse, moves=('angle', 'angle', '', 'velocity'), ramp=('t_acc', 't_dec'), held_while='holding', optional_when=(33, 1, '==')),
+        CommandSpec(MoveByVelocityRequest, MoveByVelocityResponse, moves=('angle', 'angle', '', 'velocity'), ramp=('t_acc', 't_dec'), held_while='holding', optional_when=('response_switch', 1, '==')),
         # move_mturn
-        CommandSpec(MoveMturnRequest, MoveMturnResponse, moves=('angle', 'angle', 'interval', ''), held_while='holding', optional_when=(33, 1, '==')),
+        CommandSpec(MoveMturnRequest, MoveMturnResponse, moves=('angle', 'angle', 'interval', ''), held_while='holding', optional_when=('response_switch', 1, '==')),
         # move_mturn_by_interval
-        CommandSpec(MoveMturnByIntervalRequest, MoveMturnByIntervalResponse, moves=('angle', 'angle', 'interval', ''), ramp=('t_acc', 't_dec'), held_while='holding', optional_when=(33, 1, '==')),
+        CommandSpec(MoveMturnByIntervalRequest, MoveMturnByIntervalResponse, moves=('angle', 'angle', 'interval', ''), ramp=('t_acc', 't_dec'), held_while='holding', optional_when=('response_switch', 1, '==')),
         # move_mturn_by_velocity
-        CommandSpec(MoveMturnByVelocityRequest, MoveMturnByVelocityResponse, moves=('angle', 'angle', '', 'velocity'), ramp=('t_acc', 't_dec'), held_while='holding', optional_when=(33, 1, '==')),
+        CommandSpec(MoveMturnByVelocityRequest, MoveMturnByVelocityResponse, moves=('angle', 'angle', '', 'velocity'), ramp=('t_acc', 't_dec'), held_while='holding', optional_when=('response_switch', 1, '==')),
         # read_mturn_angle
         CommandSpec(ReadMturnAngleRequest, ReadMturnAngleResponse, reports={'angle': 'angle'}, counts={'turns': ('angle', 3600.0)}),
         # reset_mturn_angle

@@ -250,7 +250,7 @@ class FeetechSmsClient(ClientBase):
         self.bus.send(request)
 
     def read(self, id: int, name: ControlTableName) -> int:
-        """Read from the control table: one register by name, e.g. `read(1, "present_position")`, in wire units."""
+        """Read from the control table: one register by name, e.g. `read(1, "firmware_major")`, in wire units."""
         register = CONTROL_TABLE[name]
         if id == 254:
             raise EncodeError("read: name one device; the broadcast id 254 gets no reply")
@@ -272,7 +272,7 @@ class FeetechSmsClient(ClientBase):
         return CONTROL_TABLE.from_wire(register, data or b"")
 
     def write(self, id: int, /, **values: int) -> bool | None:
-        """Write to the control table, by register name: `write(id, goal_position=2048, goal_time=0)`.
+        """Write to the control table, by register name: `write(1, id=1, baud_rate=0)`.
 
         The named registers must follow each other in the table (one run of bytes); each value is checked
         against its register's range and access before a byte is written. `write_raw` takes raw bytes.
@@ -284,7 +284,7 @@ class FeetechSmsClient(ClientBase):
         return result
 
     def reg_write(self, id: int, /, **values: int) -> bool | None:
-        """Buffered write, run on ACTION, by register name: `reg_write(id, goal_position=2048, goal_time=0)`.
+        """Buffered write, run on ACTION, by register name: `reg_write(1, id=1, baud_rate=0)`.
 
         The named registers must follow each other in the table (one run of bytes); each value is checked
         against its register's range and access before a byte is written. `reg_write_raw` takes raw bytes.
@@ -298,7 +298,7 @@ class FeetechSmsClient(ClientBase):
     def sync_read(
         self, ids: Iterable[int], *names: ControlTableName, id: int = 254
     ) -> dict[int, dict[str, int]]:
-        """Read the same registers of several servos, by register name: `sync_read([1, 2], "present_position")` -> {1: {...}, 2: {...}}.
+        """Read the same registers of several servos, by register name: `sync_read([1, 2], "firmware_major")` -> {1: {...}, 2: {...}}.
 
         One request; every listed device answers in turn. `sync_read_raw` takes raw addresses and returns bytes.
         """
@@ -311,7 +311,7 @@ class FeetechSmsClient(ClientBase):
         }
 
     def sync_write(self, values: Mapping[int, Mapping[str, int]], id: int = 254) -> None:
-        """Write the same registers of several servos at once, by register name: `sync_write({1: {"goal_position": 100}, 2: {"goal_position": 300}})`.
+        """Write the same registers of several servos at once, by register name: `sync_write({1: {"id": 1}, 2: {"id": 1}})`.
 
         Every device gets the same registers (one run, the same for all); values are checked before sending.
         `sync_write_raw` takes raw bytes.

@@ -8,6 +8,7 @@ from collections.abc import Callable
 
 from serialspec.runtime.checksums import BYTE_VALUES as _BYTES
 from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError, content_size_error, out_of_range
+from serialspec.runtime.fields import wrong_type
 from serialspec.runtime.message import Direction, Message, members, slot_setters
 from serialspec.runtime.stream import FrameFormat
 from serialspec.runtime.stream import StreamParser as _StreamParser
@@ -227,27 +228,27 @@ def _frame_reset_request(buf: bytes, start: int) -> ResetRequest | None:
 
 
 def _encode_ping_request(m: PingRequest) -> bytes:
-    if not 0 <= m.id <= 254:
+    if not 0 <= m.id <= 254 or m.id.__class__ is bool:
         raise out_of_range('ping request', 'id', m.id, 0, 253)
     body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m.id, 2, 1)
     return body + _BYTES[~sum(body[2:]) & 0xff]
 
 
 def _encode_read_request(m: ReadRequest) -> bytes:
-    if not 0 <= m.id <= 254:
+    if not 0 <= m.id <= 254 or m.id.__class__ is bool:
         raise out_of_range('read request', 'id', m.id, 0, 253)
-    if not 0 <= m.address <= 255:
+    if not 0 <= m.address <= 255 or m.address.__class__ is bool:
         raise out_of_range('read request', 'address', m.address, 0, 255)
-    if not 1 <= m.length <= 250:
+    if not 1 <= m.length <= 250 or m.length.__class__ is bool:
         raise out_of_range('read request', 'length', m.length, 1, 250)
     body = _S_B2_U8_U8_U8_U8_U8.pack(b'\xff\xff', m.id, 4, 2, m.address, m.length)
     return body + _BYTES[~sum(body[2:]) & 0xff]
 
 
 def _encode_write_request(m: WriteRequest) -> bytes:
-    if not 0 <= m.id <= 254:
+    if not 0 <= m.id <= 254 or m.id.__class__ is bool:
         raise out_of_range('write request', 'id', m.id, 0, 253)
-    if not 0 <= m.address <= 255:
+    if not 0 <= m.address <= 255 or m.address.__class__ is bool:
         raise out_of_range('write request', 'address', m.address, 0, 255)
     content = bytes(m.data)
     n = len(content) + 3
@@ -258,9 +259,9 @@ def _encode_write_request(m: WriteRequest) -> bytes:
 
 
 def _encode_reg_write_request(m: RegWriteRequest) -> bytes:
-    if not 0 <= m.id <= 254:
+    if not 0 <= m.id <= 254 or m.id.__class__ is bool:
         raise out_of_range('reg_write request', 'id', m.id, 0, 253)
-    if not 0 <= m.address <= 255:
+    if not 0 <= m.address <= 255 or m.address.__class__ is bool:
         raise out_of_range('reg_write request', 'address', m.address, 0, 255)
     content = bytes(m.data)
     n = len(content) + 3
@@ -271,29 +272,29 @@ def _encode_reg_write_request(m: RegWriteRequest) -> bytes:
 
 
 def _encode_action_request(m: ActionRequest) -> bytes:
-    if not 0 <= m.id <= 254:
+    if not 0 <= m.id <= 254 or m.id.__class__ is bool:
         raise out_of_range('action request', 'id', m.id, 0, 253)
     body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m.id, 2, 5)
     return body + _BYTES[~sum(body[2:]) & 0xff]
 
 
 def _encode_reset_request(m: ResetRequest) -> bytes:
-    if not 0 <= m.id <= 254:
+    if not 0 <= m.id <= 254 or m.id.__class__ is bool:
         raise out_of_range('reset request', 'id', m.id, 0, 253)
     body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m.id, 2, 6)
     return body + _BYTES[~sum(body[2:]) & 0xff]
 
 
 def _encode_sync_read_request(m: SyncReadRequest) -> bytes:
-    if not 0 <= m.id <= 254:
+    if not 0 <= m.id <= 254 or m.id.__class__ is bool:
         raise out_of_range('sync_read request', 'id', m.id, 0, 253)
-    if not 0 <= m.address <= 255:
+    if not 0 <= m.address <= 255 or m.address.__class__ is bool:
         raise out_of_range('sync_read request', 'address', m.address, 0, 255)
-    if not 1 <= m.length <= 250:
+    if not 1 <= m.length <= 250 or m.length.__class__ is bool:
         raise out_of_range('sync_read request', 'length', m.length, 1, 250)
     parts_ids = []
     for item in m.ids:
-        if not 0 <= item.id <= 253:
+        if not 0 <= item.id <= 253 or item.id.__class__ is bool:
             raise out_of_range('sync_read request', 'id', item.id, 0, 253)
         parts_ids.append(_S_U8.pack(item.id))
     content = b''.join(parts_ids)
@@ -305,9 +306,9 @@ def _encode_sync_read_request(m: SyncReadRequest) -> bytes:
 
 
 def _encode_sync_write_request(m: SyncWriteRequest) -> bytes:
-    if not 0 <= m.id <= 254:
+    if not 0 <= m.id <= 254 or m.id.__class__ is bool:
         raise out_of_range('sync_write request', 'id', m.id, 0, 253)
-    if not 0 <= m.address <= 255:
+    if not 0 <= m.address <= 255 or m.address.__class__ is bool:
         raise out_of_range('sync_write request', 'address', m.address, 0, 255)
     v_data_length = len(m.servos[0].data) if m.servos else 0
     if any(len(item.data) != v_data_length for item in m.servos):
@@ -316,7 +317,7 @@ def _encode_sync_write_request(m: SyncWriteRequest) -> bytes:
         raise out_of_range('sync_write request', 'data_length', v_data_length, 0, 255)
     parts_servos = []
     for item in m.servos:
-        if not 0 <= item.id <= 253:
+        if not 0 <= item.id <= 253 or item.id.__class__ is bool:
             raise out_of_range('sync_write request', 'id', item.id, 0, 253)
         parts_servos.append(b''.join((_S_U8.pack(item.id), bytes(item.data),)))
     content = b''.join(parts_servos)
@@ -328,9 +329,9 @@ def _encode_sync_write_request(m: SyncWriteRequest) -> bytes:
 
 
 def _encode_reply_response(m: ReplyResponse) -> bytes:
-    if not 0 <= m.id <= 254:
+    if not 0 <= m.id <= 254 or m.id.__class__ is bool:
         raise out_of_range('reply response', 'id', m.id, 0, 253)
-    if not 0 <= m.error <= 255:
+    if not 0 <= m.error <= 255 or isinstance(m.error, bool):
         raise out_of_range('reply response', 'error', m.error, 0, 255)
     content = bytes(m.data)
     n = len(content) + 2
@@ -421,6 +422,7 @@ REQUEST_FORMAT = FrameFormat(
     length_offset=3,
     length_adds=2,
     command_offset=4,
+    value_ranges=((2, 1, 'little', False, 0, 253, 254),),
     content_sizes=_REQUEST_SIZES,
     decode_at=_decode_request_at,
     fixed=_REQUEST_FIXED,
@@ -431,6 +433,7 @@ RESPONSE_FORMAT = FrameFormat(
     length_offset=3,
     length_adds=2,
     command_offset=None,
+    value_ranges=((2, 1, 'little', False, 0, 253, 254),),
     content_sizes=_RESPONSE_SIZES,
     decode_at=_decode_response_at,
     fixed=_RESPONSE_FIXED,
@@ -489,8 +492,10 @@ def encode(message: Message) -> bytes:
         raise EncodeError(f"{type(message).__name__} is not a feetech_sms message")
     try:
         return encoder(message)
-    except (TypeError, AttributeError, struct.error) as exc:
-        raise EncodeError(f"{message.COMMAND} {message.DIRECTION.value}: {exc}") from None
+    except EncodeError:
+        raise
+    except (TypeError, AttributeError, ValueError, OverflowError, struct.error) as exc:
+        raise wrong_type(message, exc) from None  # one line naming the field, not Python's words
 
 
 class StreamParser(_StreamParser):

@@ -9,7 +9,10 @@ from typing import Any, ClassVar, Self
 
 from serialspec.runtime.fields import as_bytes as _bytes
 from serialspec.runtime.fields import check_keys as _check_keys
+from serialspec.runtime.fields import flags as _as_flags
 from serialspec.runtime.fields import get as _get
+from serialspec.runtime.fields import integer as _integer
+from serialspec.runtime.fields import items as _items
 from serialspec.runtime.fields import mapping as _mapping
 from serialspec.runtime.message import Direction, Message, Record
 
@@ -42,80 +45,80 @@ __all__ = [
 class BaudRate(IntEnum):
     """Baud rate option of register 0x06 (memory table; scservo_sdk SMS_STS_* rates)."""
 
-    BAUD_1000000 = 0
     #: 1000000
-    BAUD_500000 = 1
+    BAUD_1000000 = 0
     #: 500000
-    BAUD_250000 = 2
+    BAUD_500000 = 1
     #: 250000
-    BAUD_128000 = 3
+    BAUD_250000 = 2
     #: 128000
-    BAUD_115200 = 4
+    BAUD_128000 = 3
     #: 115200
-    BAUD_76800 = 5
+    BAUD_115200 = 4
     #: 76800
-    BAUD_57600 = 6
+    BAUD_76800 = 5
     #: 57600
-    BAUD_38400 = 7
+    BAUD_57600 = 6
     #: 38400
+    BAUD_38400 = 7
 
 
 class ResponseLevel(IntEnum):
     """Which instructions a servo answers (register 0x08)."""
 
-    READ_AND_PING_ONLY = 0
     #: only READ and PING are answered
-    ALL = 1
+    READ_AND_PING_ONLY = 0
     #: every instruction to the servo's own id is answered
+    ALL = 1
 
 
 class OperatingMode(IntEnum):
     """Operating mode (register 0x21)."""
 
-    POSITION = 0
     #: position servo mode
-    SPEED = 1
+    POSITION = 0
     #: constant speed (wheel) mode, closed loop
-    PWM = 2
+    SPEED = 1
     #: PWM open-loop speed mode
-    STEP = 3
+    PWM = 2
     #: step (multi-turn) mode
+    STEP = 3
 
 
 class TorqueEnable(IntEnum):
     """Torque switch (register 0x28)."""
 
-    OFF = 0
     #: torque off (free)
-    ON = 1
+    OFF = 0
     #: torque on
-    SET_MIDDLE = 128
+    ON = 1
     #: take the present position as the middle position (2048)
+    SET_MIDDLE = 128
 
 
 class Lock(IntEnum):
     """EEPROM write lock (register 0x37)."""
 
-    UNLOCKED = 0
     #: EEPROM writes are kept across power cycles
-    LOCKED = 1
+    UNLOCKED = 0
     #: EEPROM writes are not kept
+    LOCKED = 1
 
 
 class ErrorStatus(IntFlag):
     """The error status byte of a reply and the status register (0x41); a set bit reports a fault (bit numbers from scservo_sdk ERRBIT_*; 004 refers to the memory table for their meaning)."""
 
     NONE = 0
-    VOLTAGE = 1 << 0
     #: input voltage outside the voltage limits
-    ANGLE_SENSOR = 1 << 1
+    VOLTAGE = 1 << 0
     #: magnetic angle sensor fault
-    OVERHEAT = 1 << 2
+    ANGLE_SENSOR = 1 << 1
     #: temperature above the temperature limit
-    OVERCURRENT = 1 << 3
+    OVERHEAT = 1 << 2
     #: current above the protection current
-    OVERLOAD = 1 << 5
+    OVERCURRENT = 1 << 3
     #: load above the overload torque for longer than the protection time
+    OVERLOAD = 1 << 5
 
 
 class IdsItem(Record):
@@ -123,8 +126,8 @@ class IdsItem(Record):
 
     __slots__ = ('id',)
     __match_args__ = ('id',)
-    id: int
     #: A servo id. range 0..253
+    id: int
 
     def __init__(
         self,
@@ -141,7 +144,7 @@ class IdsItem(Record):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'IdsItem') -> Self:
         _check_keys(data, ('id',), (), where)
         return cls(
-            _get(data, 'id', where),
+            _integer(_get(data, 'id', where), 'id', where),
         )
 
 
@@ -150,10 +153,10 @@ class ServosItem(Record):
 
     __slots__ = ('id', 'data')
     __match_args__ = ('id', 'data')
-    id: int
     #: The servo's id. range 0..253
-    data: bytes
+    id: int
     #: The L bytes written to that servo from `address` on.
+    data: bytes
 
     def __init__(
         self,
@@ -173,7 +176,7 @@ class ServosItem(Record):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'ServosItem') -> Self:
         _check_keys(data, ('id', 'data'), (), where)
         return cls(
-            _get(data, 'id', where),
+            _integer(_get(data, 'id', where), 'id', where),
             _bytes(_get(data, 'data', where), 'data', where),
         )
 
@@ -187,8 +190,8 @@ class PingRequest(Message):
     COMMAND: ClassVar[str] = 'ping'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    id: int
     #: Servo id 0..253; 254 (0xFE) is the broadcast id: every servo takes the instruction and none answers, except to PING. range 0..253
+    id: int
 
     def __init__(
         self,
@@ -205,7 +208,7 @@ class PingRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'ping request') -> Self:
         _check_keys(data, ('id',), (), where)
         return cls(
-            _get(data, 'id', where),
+            _integer(_get(data, 'id', where), 'id', where),
         )
 
 
@@ -218,12 +221,12 @@ class ReadRequest(Message):
     COMMAND: ClassVar[str] = 'read'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    id: int
     #: Servo id 0..253; 254 (0xFE) is the broadcast id: every servo takes the instruction and none answers, except to PING. range 0..253
-    address: int
+    id: int
     #: First register address to read.
-    length: int
+    address: int
     #: Number of bytes to read. range 1..250
+    length: int
 
     def __init__(
         self,
@@ -246,9 +249,9 @@ class ReadRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'read request') -> Self:
         _check_keys(data, ('id', 'address', 'length'), (), where)
         return cls(
-            _get(data, 'id', where),
-            _get(data, 'address', where),
-            _get(data, 'length', where),
+            _integer(_get(data, 'id', where), 'id', where),
+            _integer(_get(data, 'address', where), 'address', where),
+            _integer(_get(data, 'length', where), 'length', where),
         )
 
 
@@ -261,12 +264,12 @@ class WriteRequest(Message):
     COMMAND: ClassVar[str] = 'write'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    id: int
     #: Servo id 0..253; 254 (0xFE) is the broadcast id: every servo takes the instruction and none answers, except to PING. range 0..253
-    address: int
+    id: int
     #: First register address to write.
-    data: bytes
+    address: int
     #: The bytes written, register by register from `address` on.
+    data: bytes
 
     def __init__(
         self,
@@ -289,8 +292,8 @@ class WriteRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'write request') -> Self:
         _check_keys(data, ('id', 'address', 'data'), (), where)
         return cls(
-            _get(data, 'id', where),
-            _get(data, 'address', where),
+            _integer(_get(data, 'id', where), 'id', where),
+            _integer(_get(data, 'address', where), 'address', where),
             _bytes(_get(data, 'data', where), 'data', where),
         )
 
@@ -304,12 +307,12 @@ class RegWriteRequest(Message):
     COMMAND: ClassVar[str] = 'reg_write'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    id: int
     #: Servo id 0..253; 254 (0xFE) is the broadcast id: every servo takes the instruction and none answers, except to PING. range 0..253
-    address: int
+    id: int
     #: First register address to write.
-    data: bytes
+    address: int
     #: The bytes to write when ACTION arrives.
+    data: bytes
 
     def __init__(
         self,
@@ -332,8 +335,8 @@ class RegWriteRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'reg_write request') -> Self:
         _check_keys(data, ('id', 'address', 'data'), (), where)
         return cls(
-            _get(data, 'id', where),
-            _get(data, 'address', where),
+            _integer(_get(data, 'id', where), 'id', where),
+            _integer(_get(data, 'address', where), 'address', where),
             _bytes(_get(data, 'data', where), 'data', where),
         )
 
@@ -347,8 +350,8 @@ class ActionRequest(Message):
     COMMAND: ClassVar[str] = 'action'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    id: int
     #: Servo id 0..253; 254 (0xFE) is the broadcast id: every servo takes the instruction and none answers, except to PING. range 0..253
+    id: int
 
     def __init__(
         self,
@@ -365,7 +368,7 @@ class ActionRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'action request') -> Self:
         _check_keys(data, ('id',), (), where)
         return cls(
-            _get(data, 'id', where),
+            _integer(_get(data, 'id', where), 'id', where),
         )
 
 
@@ -378,8 +381,8 @@ class ResetRequest(Message):
     COMMAND: ClassVar[str] = 'reset'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    id: int
     #: Servo id 0..253; 254 (0xFE) is the broadcast id: every servo takes the instruction and none answers, except to PING. range 0..253
+    id: int
 
     def __init__(
         self,
@@ -396,7 +399,7 @@ class ResetRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'reset request') -> Self:
         _check_keys(data, ('id',), (), where)
         return cls(
-            _get(data, 'id', where),
+            _integer(_get(data, 'id', where), 'id', where),
         )
 
 
@@ -409,14 +412,14 @@ class SyncReadRequest(Message):
     COMMAND: ClassVar[str] = 'sync_read'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    id: int
     #: Servo id 0..253; 254 (0xFE) is the broadcast id: every servo takes the instruction and none answers, except to PING. range 0..253
-    address: int
+    id: int
     #: First register address to read.
-    length: int
+    address: int
     #: Number of bytes each servo returns. range 1..250
-    ids: tuple[IdsItem, ...]
+    length: int
     #: The servos to read, in the order they answer.
+    ids: tuple[IdsItem, ...]
 
     def __init__(
         self,
@@ -442,10 +445,10 @@ class SyncReadRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'sync_read request') -> Self:
         _check_keys(data, ('id', 'address', 'length', 'ids'), (), where)
         return cls(
-            _get(data, 'id', where),
-            _get(data, 'address', where),
-            _get(data, 'length', where),
-            tuple(IdsItem.from_fields(_mapping(item, 'ids', where), where) for item in _get(data, 'ids', where)),
+            _integer(_get(data, 'id', where), 'id', where),
+            _integer(_get(data, 'address', where), 'address', where),
+            _integer(_get(data, 'length', where), 'length', where),
+            tuple(IdsItem.from_fields(_mapping(item, 'ids', where), where) for item in _items(_get(data, 'ids', where), 'ids', where)),
         )
 
 
@@ -458,12 +461,12 @@ class SyncWriteRequest(Message):
     COMMAND: ClassVar[str] = 'sync_write'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    id: int
     #: Servo id 0..253; 254 (0xFE) is the broadcast id: every servo takes the instruction and none answers, except to PING. range 0..253
-    address: int
+    id: int
     #: First register address to write.
-    servos: tuple[ServosItem, ...]
+    address: int
     #: One item per servo.
+    servos: tuple[ServosItem, ...]
 
     def __init__(
         self,
@@ -486,9 +489,9 @@ class SyncWriteRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'sync_write request') -> Self:
         _check_keys(data, ('id', 'address', 'servos'), ('data_length',), where)
         return cls(
-            _get(data, 'id', where),
-            _get(data, 'address', where),
-            tuple(ServosItem.from_fields(_mapping(item, 'servos', where), where) for item in _get(data, 'servos', where)),
+            _integer(_get(data, 'id', where), 'id', where),
+            _integer(_get(data, 'address', where), 'address', where),
+            tuple(ServosItem.from_fields(_mapping(item, 'servos', where), where) for item in _items(_get(data, 'servos', where), 'servos', where)),
         )
 
 
@@ -501,12 +504,12 @@ class ReplyResponse(Message):
     COMMAND: ClassVar[str] = 'reply'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    id: int
     #: Servo id 0..253; 254 (0xFE) is the broadcast id: every servo takes the instruction and none answers, except to PING. range 0..253
-    error: ErrorStatus
+    id: int
     #: The servo's working status; 0 means no error.
-    data: bytes
+    error: ErrorStatus
     #: The bytes read, register by register from the request's address (empty except for READ).
+    data: bytes
 
     def __init__(
         self,
@@ -529,8 +532,8 @@ class ReplyResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'reply response') -> Self:
         _check_keys(data, ('id', 'error', 'data'), (), where)
         return cls(
-            _get(data, 'id', where),
-            ErrorStatus(_get(data, 'error', where)),
+            _integer(_get(data, 'id', where), 'id', where),
+            _as_flags(ErrorStatus, _get(data, 'error', where), 255, 'error', where),
             _bytes(_get(data, 'data', where), 'data', where),
         )
 

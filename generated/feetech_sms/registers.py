@@ -101,7 +101,7 @@ CONTROL_TABLE = RegisterMap(
         Register('speed_p_coefficient', 0x25, 'B', 0, 100, 'rw'),  # -
         Register('overcurrent_time', 0x26, 'B', 0, 254, 'rw'),  # 10 ms
         Register('velocity_i_coefficient', 0x27, 'B', 0, 254, 'rw'),  # -
-        Register('torque_enable', 0x28, 'B', 0, 255, 'rw'),  # -
+        Register('torque_enable', 0x28, 'B', 0, 128, 'rw'),  # -
         Register('acceleration', 0x29, 'B', 0, 254, 'rw'),  # 100 step/s²
         Register('goal_position', 0x2a, 'H', -32767, 32767, 'rw', sign_bit=15),  # step (0.088°)
         Register('goal_time', 0x2c, 'H', 0, 65535, 'rw'),  # ms

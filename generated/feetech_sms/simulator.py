@@ -72,7 +72,7 @@ DEVICE = DeviceSpec(
         EntrySpec('speed_p_coefficient', 37, 10, 'rw', 0, 100),
         EntrySpec('overcurrent_time', 38, 200, 'rw', 0, 254),
         EntrySpec('velocity_i_coefficient', 39, 200, 'rw', 0, 254),
-        EntrySpec('torque_enable', 40, 0, 'rw', 0, 255),
+        EntrySpec('torque_enable', 40, 0, 'rw', 0, 128),
         EntrySpec('acceleration', 41, 0, 'rw', 0, 254),
         EntrySpec('goal_position', 42, 0, 'rw', -32767, 32767),
         EntrySpec('goal_time', 44, 0, 'rw', 0, 65535),
@@ -97,13 +97,13 @@ DEVICE = DeviceSpec(
         # read
         CommandSpec(ReadRequest, ReplyResponse, reads=('data',), tables={'data': ('run', 'address', 'length')}),
         # write
-        CommandSpec(WriteRequest, ReplyResponse, writes=('data',), moves=('present_position', 'goal_position', 'goal_time', 'goal_speed'), optional_when=(8, 1, '=='), tables={'data': ('run', 'address', '')}),
+        CommandSpec(WriteRequest, ReplyResponse, writes=('data',), moves=('present_position', 'goal_position', 'goal_time', 'goal_speed'), optional_when=('response_level', 1, '=='), tables={'data': ('run', 'address', '')}),
         # reg_write
-        CommandSpec(RegWriteRequest, ReplyResponse, writes=('data',), buffered=True, optional_when=(8, 1, '=='), tables={'data': ('run', 'address', '')}),
+        CommandSpec(RegWriteRequest, ReplyResponse, writes=('data',), buffered=True, optional_when=('response_level', 1, '=='), tables={'data': ('run', 'address', '')}),
         # action
-        CommandSpec(ActionRequest, ReplyResponse, moves=('present_position', 'goal_position', 'goal_time', 'goal_speed'), commits=True, optional_when=(8, 1, '=='), tables={'data': ('run', 'address', 'length')}),
+        CommandSpec(ActionRequest, ReplyResponse, moves=('present_position', 'goal_position', 'goal_time', 'goal_speed'), commits=True, optional_when=('response_level', 1, '=='), tables={'data': ('run', 'address', 'length')}),
         # reset
-        CommandSpec(ResetRequest, ReplyResponse, resets=True, optional_when=(8, 1, '=='), tables={'data': ('run', 'address', 'length')}),
+        CommandSpec(ResetRequest, ReplyResponse, resets=True, optional_when=('response_level', 1, '=='), tables={'data': ('run', 'address', 'length')}),
         # sync_read
         CommandSpec(SyncReadRequest, ReplyResponse, reads=('data',), each='ids', tables={'data': ('run', 'address', 'length')}),
         # sync_write

@@ -14,13 +14,10 @@ byte is written (RangeError names the field and the range).
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator, Mapping, Sequence
-from enum import IntEnum
 from typing import Any
 
 import serial
-from serialspec.runtime.errors import DeviceError
-from serialspec.runtime.message import Message
-from serialspec.runtime.transport import Binding, Bus, ClientBase
+from serialspec.runtime.transport import Binding, Bus, ClientBase, check_status
 
 from hiwonder_rrc import MATCH_BY, SERIAL
 from hiwonder_rrc.codec import StreamParser, encode
@@ -281,7 +278,7 @@ class BusServoCommands:
         """
         request = BusServoReadPositionRequest(servo_id=servo_id)
         reply = self._client._ask(request, BusServoReadPositionResponse)
-        _check_status(request, reply, 'success', 0)
+        check_status(request, reply, 'success', 0, MATCH_BY)
         return reply.position
 
     def read_voltage(self, servo_id: int) -> int:
@@ -297,7 +294,7 @@ class BusServoCommands:
         """
         request = BusServoReadVoltageRequest(servo_id=servo_id)
         reply = self._client._ask(request, BusServoReadVoltageResponse)
-        _check_status(request, reply, 'success', 0)
+        check_status(request, reply, 'success', 0, MATCH_BY)
         return reply.voltage
 
     def read_temperature(self, servo_id: int) -> int:
@@ -313,7 +310,7 @@ class BusServoCommands:
         """
         request = BusServoReadTemperatureRequest(servo_id=servo_id)
         reply = self._client._ask(request, BusServoReadTemperatureResponse)
-        _check_status(request, reply, 'success', 0)
+        check_status(request, reply, 'success', 0, MATCH_BY)
         return reply.temperature
 
     def stop(self, servos: tuple[ServosItem, ...] | Sequence[int]) -> None:
@@ -346,7 +343,7 @@ class BusServoCommands:
         """
         request = BusServoReadTorqueRequest(servo_id=servo_id)
         reply = self._client._ask(request, BusServoReadTorqueResponse)
-        _check_status(request, reply, 'success', 0)
+        check_status(request, reply, 'success', 0, MATCH_BY)
         return reply.torque
 
     def unload(self, servo_id: int) -> None:
@@ -404,7 +401,7 @@ class BusServoCommands:
         """
         request = BusServoReadIdRequest(servo_id=servo_id)
         reply = self._client._ask(request, BusServoReadIdResponse)
-        _check_status(request, reply, 'success', 0)
+        check_status(request, reply, 'success', 0, MATCH_BY)
         return reply.id
 
     def set_offset(self, servo_id: int, offset: int) -> None:
@@ -434,7 +431,7 @@ class BusServoCommands:
         """
         request = BusServoReadOffsetRequest(servo_id=servo_id)
         reply = self._client._ask(request, BusServoReadOffsetResponse)
-        _check_status(request, reply, 'success', 0)
+        check_status(request, reply, 'success', 0, MATCH_BY)
         return reply.offset
 
     def save_offset(self, servo_id: int) -> None:
@@ -478,7 +475,7 @@ class BusServoCommands:
         """
         request = BusServoReadPositionLimitRequest(servo_id=servo_id)
         reply = self._client._ask(request, BusServoReadPositionLimitResponse)
-        _check_status(request, reply, 'success', 0)
+        check_status(request, reply, 'success', 0, MATCH_BY)
         return reply
 
     def set_voltage_limit(self, servo_id: int, low: int, high: int) -> None:
@@ -509,7 +506,7 @@ class BusServoCommands:
         """
         request = BusServoReadVoltageLimitRequest(servo_id=servo_id)
         reply = self._client._ask(request, BusServoReadVoltageLimitResponse)
-        _check_status(request, reply, 'success', 0)
+        check_status(request, reply, 'success', 0, MATCH_BY)
         return reply
 
     def set_temperature_limit(self, servo_id: int, limit: int) -> None:
@@ -539,7 +536,7 @@ class BusServoCommands:
         """
         request = BusServoReadTemperatureLimitRequest(servo_id=servo_id)
         reply = self._client._ask(request, BusServoReadTemperatureLimitResponse)
-        _check_status(request, reply, 'success', 0)
+        check_status(request, reply, 'success', 0, MATCH_BY)
         return reply.limit
 
 
@@ -687,13 +684,3 @@ class HiwonderRrcClient(ClientBase):
         Callbacks run in the thread that reads the bus: during any request of this client, or while reports() runs.
         """
         return self.bus.subscribe(lambda message: callback(message) if isinstance(message, SystemBatteryResponse) else None)
-
-
-def _check_status(request: Message, reply: Message, name: str, ok: int) -> None:
-    """A reply whose status field (the spec's `status: {ok: N}`) does not hold N is a device error."""
-    value = getattr(reply, name)
-    if value != ok:
-        shown = f"{value.name.lower()} ({int(value)})" if isinstance(value, IntEnum) else str(value)
-        command = ".".join(part for part in (reply.COMMAND, reply.SUBCOMMAND) if part)
-        ids = " ".join(f"{n}={getattr(request, n)}" for n in MATCH_BY if hasattr(request, n))
-        raise DeviceError(f"{command}{' to ' + ids if ids else ''}: the device reports {name} = {shown}", reply)

@@ -9,6 +9,7 @@ from collections.abc import Callable
 from serialspec.runtime.checksums import BYTE_VALUES as _BYTES
 from serialspec.runtime.checksums import crc_table
 from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError, content_size_error, out_of_range
+from serialspec.runtime.fields import wrong_type
 from serialspec.runtime.message import Direction, Message, members, slot_setters
 from serialspec.runtime.stream import FrameFormat
 from serialspec.runtime.stream import StreamParser as _StreamParser
@@ -1020,13 +1021,13 @@ def _frame_sbus_response(buf: bytes, start: int) -> SbusResponse | None:
 
 
 def _encode_led_request(m: LedRequest) -> bytes:
-    if not 0 <= m.led_id <= 255:
+    if not 0 <= m.led_id <= 255 or m.led_id.__class__ is bool:
         raise out_of_range('led request', 'led_id', m.led_id, 0, 255)
-    if not 0 <= m.on_time <= 65535:
+    if not 0 <= m.on_time <= 65535 or m.on_time.__class__ is bool:
         raise out_of_range('led request', 'on_time', m.on_time, 0, 65535)
-    if not 0 <= m.off_time <= 65535:
+    if not 0 <= m.off_time <= 65535 or m.off_time.__class__ is bool:
         raise out_of_range('led request', 'off_time', m.off_time, 0, 65535)
-    if not 0 <= m.repeat <= 65535:
+    if not 0 <= m.repeat <= 65535 or m.repeat.__class__ is bool:
         raise out_of_range('led request', 'repeat', m.repeat, 0, 65535)
     body = _S_FRAME_LEDREQUEST.pack(b'\xaaU', 1, 7, m.led_id, m.on_time, m.off_time, m.repeat)
     check = 0x0
@@ -1036,13 +1037,13 @@ def _encode_led_request(m: LedRequest) -> bytes:
 
 
 def _encode_buzzer_request(m: BuzzerRequest) -> bytes:
-    if not 0 <= m.frequency <= 65535:
+    if not 0 <= m.frequency <= 65535 or m.frequency.__class__ is bool:
         raise out_of_range('buzzer request', 'frequency', m.frequency, 0, 65535)
-    if not 0 <= m.on_time <= 65535:
+    if not 0 <= m.on_time <= 65535 or m.on_time.__class__ is bool:
         raise out_of_range('buzzer request', 'on_time', m.on_time, 0, 65535)
-    if not 0 <= m.off_time <= 65535:
+    if not 0 <= m.off_time <= 65535 or m.off_time.__class__ is bool:
         raise out_of_range('buzzer request', 'off_time', m.off_time, 0, 65535)
-    if not 0 <= m.repeat <= 65535:
+    if not 0 <= m.repeat <= 65535 or m.repeat.__class__ is bool:
         raise out_of_range('buzzer request', 'repeat', m.repeat, 0, 65535)
     body = _S_FRAME_BUZZERREQUEST.pack(b'\xaaU', 2, 8, m.frequency, m.on_time, m.off_time, m.repeat)
     check = 0x0
@@ -1052,7 +1053,7 @@ def _encode_buzzer_request(m: BuzzerRequest) -> bytes:
 
 
 def _encode_motor_set_speed_request(m: MotorSetSpeedRequest) -> bytes:
-    if not 0 <= m.motor_id <= 255:
+    if not 0 <= m.motor_id <= 255 or m.motor_id.__class__ is bool:
         raise out_of_range('motor.set_speed request', 'motor_id', m.motor_id, 0, 255)
     if not -340282346638528859811704183484516925440 <= m.speed <= 340282346638528859811704183484516925440:
         raise out_of_range('motor.set_speed request', 'speed', m.speed, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
@@ -1068,7 +1069,7 @@ def _encode_motor_set_speeds_request(m: MotorSetSpeedsRequest) -> bytes:
         raise out_of_range('motor.set_speeds request', 'count', len(m.motors), 0, 255)
     parts_motors = []
     for item in m.motors:
-        if not 0 <= item.motor_id <= 255:
+        if not 0 <= item.motor_id <= 255 or item.motor_id.__class__ is bool:
             raise out_of_range('motor.set_speeds request', 'motor_id', item.motor_id, 0, 255)
         if not -340282346638528859811704183484516925440 <= item.speed <= 340282346638528859811704183484516925440:
             raise out_of_range('motor.set_speeds request', 'speed', item.speed, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
@@ -1085,7 +1086,7 @@ def _encode_motor_set_speeds_request(m: MotorSetSpeedsRequest) -> bytes:
 
 
 def _encode_motor_stop_request(m: MotorStopRequest) -> bytes:
-    if not 0 <= m.motor_id <= 255:
+    if not 0 <= m.motor_id <= 255 or m.motor_id.__class__ is bool:
         raise out_of_range('motor.stop request', 'motor_id', m.motor_id, 0, 255)
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 3, 2, 2, m.motor_id)
     check = 0x0
@@ -1099,7 +1100,7 @@ def _encode_motor_set_duties_request(m: MotorSetDutiesRequest) -> bytes:
         raise out_of_range('motor.set_duties request', 'count', len(m.duties), 0, 255)
     parts_duties = []
     for item in m.duties:
-        if not 0 <= item.motor_id <= 255:
+        if not 0 <= item.motor_id <= 255 or item.motor_id.__class__ is bool:
             raise out_of_range('motor.set_duties request', 'motor_id', item.motor_id, 0, 255)
         if not -340282346638528859811704183484516925440 <= item.duty <= 340282346638528859811704183484516925440:
             raise out_of_range('motor.set_duties request', 'duty', item.duty, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
@@ -1116,7 +1117,7 @@ def _encode_motor_set_duties_request(m: MotorSetDutiesRequest) -> bytes:
 
 
 def _encode_motor_stop_mask_request(m: MotorStopMaskRequest) -> bytes:
-    if not 0 <= m.mask <= 255:
+    if not 0 <= m.mask <= 255 or isinstance(m.mask, bool):
         raise out_of_range('motor.stop_mask request', 'mask', m.mask, 0, 255)
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 3, 2, 3, m.mask)
     check = 0x0
@@ -1126,15 +1127,15 @@ def _encode_motor_stop_mask_request(m: MotorStopMaskRequest) -> bytes:
 
 
 def _encode_pwm_servo_set_positions_request(m: PwmServoSetPositionsRequest) -> bytes:
-    if not 0 <= m.duration <= 65535:
+    if not 0 <= m.duration <= 65535 or m.duration.__class__ is bool:
         raise out_of_range('pwm_servo.set_positions request', 'duration', m.duration, 0, 65535)
     if len(m.pwm_servos) > 255:
         raise out_of_range('pwm_servo.set_positions request', 'count', len(m.pwm_servos), 0, 255)
     parts_pwm_servos = []
     for item in m.pwm_servos:
-        if not 0 <= item.servo_id <= 255:
+        if not 0 <= item.servo_id <= 255 or item.servo_id.__class__ is bool:
             raise out_of_range('pwm_servo.set_positions request', 'servo_id', item.servo_id, 0, 255)
-        if not 500 <= item.pulse <= 2500:
+        if not 500 <= item.pulse <= 2500 or item.pulse.__class__ is bool:
             raise out_of_range('pwm_servo.set_positions request', 'pulse', item.pulse, 500, 2500)
         parts_pwm_servos.append(_S_U8_U16.pack(item.servo_id, item.pulse))
     content = b''.join(parts_pwm_servos)
@@ -1149,11 +1150,11 @@ def _encode_pwm_servo_set_positions_request(m: PwmServoSetPositionsRequest) -> b
 
 
 def _encode_pwm_servo_set_position_request(m: PwmServoSetPositionRequest) -> bytes:
-    if not 0 <= m.duration <= 65535:
+    if not 0 <= m.duration <= 65535 or m.duration.__class__ is bool:
         raise out_of_range('pwm_servo.set_position request', 'duration', m.duration, 0, 65535)
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('pwm_servo.set_position request', 'servo_id', m.servo_id, 0, 255)
-    if not 500 <= m.pulse <= 2500:
+    if not 500 <= m.pulse <= 2500 or m.pulse.__class__ is bool:
         raise out_of_range('pwm_servo.set_position request', 'pulse', m.pulse, 500, 2500)
     body = _S_FRAME_PWMSERVOSETPOSITIONREQUEST.pack(b'\xaaU', 4, 6, 3, m.duration, m.servo_id, m.pulse)
     check = 0x0
@@ -1163,7 +1164,7 @@ def _encode_pwm_servo_set_position_request(m: PwmServoSetPositionRequest) -> byt
 
 
 def _encode_pwm_servo_read_position_request(m: PwmServoReadPositionRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('pwm_servo.read_position request', 'servo_id', m.servo_id, 0, 255)
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 4, 2, 5, m.servo_id)
     check = 0x0
@@ -1173,9 +1174,9 @@ def _encode_pwm_servo_read_position_request(m: PwmServoReadPositionRequest) -> b
 
 
 def _encode_pwm_servo_read_position_response(m: PwmServoReadPositionResponse) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('pwm_servo.read_position response', 'servo_id', m.servo_id, 0, 255)
-    if not 0 <= m.pulse <= 65535:
+    if not 0 <= m.pulse <= 65535 or m.pulse.__class__ is bool:
         raise out_of_range('pwm_servo.read_position response', 'pulse', m.pulse, 0, 65535)
     body = _S_B2_U8_U8_U8_U8_U16.pack(b'\xaaU', 4, 4, m.servo_id, 5, m.pulse)
     check = 0x0
@@ -1185,9 +1186,9 @@ def _encode_pwm_servo_read_position_response(m: PwmServoReadPositionResponse) ->
 
 
 def _encode_pwm_servo_set_offset_request(m: PwmServoSetOffsetRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('pwm_servo.set_offset request', 'servo_id', m.servo_id, 0, 255)
-    if not -100 <= m.offset <= 100:
+    if not -100 <= m.offset <= 100 or m.offset.__class__ is bool:
         raise out_of_range('pwm_servo.set_offset request', 'offset', m.offset, -100, 100)
     body = _S_B2_U8_U8_U8_U8_I8.pack(b'\xaaU', 4, 3, 7, m.servo_id, m.offset)
     check = 0x0
@@ -1197,7 +1198,7 @@ def _encode_pwm_servo_set_offset_request(m: PwmServoSetOffsetRequest) -> bytes:
 
 
 def _encode_pwm_servo_read_offset_request(m: PwmServoReadOffsetRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('pwm_servo.read_offset request', 'servo_id', m.servo_id, 0, 255)
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 4, 2, 9, m.servo_id)
     check = 0x0
@@ -1207,9 +1208,9 @@ def _encode_pwm_servo_read_offset_request(m: PwmServoReadOffsetRequest) -> bytes
 
 
 def _encode_pwm_servo_read_offset_response(m: PwmServoReadOffsetResponse) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('pwm_servo.read_offset response', 'servo_id', m.servo_id, 0, 255)
-    if not -128 <= m.offset <= 127:
+    if not -128 <= m.offset <= 127 or m.offset.__class__ is bool:
         raise out_of_range('pwm_servo.read_offset response', 'offset', m.offset, -128, 127)
     body = _S_B2_U8_U8_U8_U8_I8.pack(b'\xaaU', 4, 3, m.servo_id, 9, m.offset)
     check = 0x0
@@ -1219,15 +1220,15 @@ def _encode_pwm_servo_read_offset_response(m: PwmServoReadOffsetResponse) -> byt
 
 
 def _encode_bus_servo_set_positions_request(m: BusServoSetPositionsRequest) -> bytes:
-    if not 0 <= m.duration <= 65535:
+    if not 0 <= m.duration <= 65535 or m.duration.__class__ is bool:
         raise out_of_range('bus_servo.set_positions request', 'duration', m.duration, 0, 65535)
     if len(m.bus_servos) > 255:
         raise out_of_range('bus_servo.set_positions request', 'count', len(m.bus_servos), 0, 255)
     parts_bus_servos = []
     for item in m.bus_servos:
-        if not 0 <= item.servo_id <= 255:
+        if not 0 <= item.servo_id <= 255 or item.servo_id.__class__ is bool:
             raise out_of_range('bus_servo.set_positions request', 'servo_id', item.servo_id, 0, 255)
-        if not 0 <= item.position <= 1000:
+        if not 0 <= item.position <= 1000 or item.position.__class__ is bool:
             raise out_of_range('bus_servo.set_positions request', 'position', item.position, 0, 1000)
         parts_bus_servos.append(_S_U8_U16.pack(item.servo_id, item.position))
     content = b''.join(parts_bus_servos)
@@ -1242,7 +1243,7 @@ def _encode_bus_servo_set_positions_request(m: BusServoSetPositionsRequest) -> b
 
 
 def _encode_bus_servo_read_position_request(m: BusServoReadPositionRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.read_position request', 'servo_id', m.servo_id, 0, 255)
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 5, m.servo_id)
     check = 0x0
@@ -1252,11 +1253,11 @@ def _encode_bus_servo_read_position_request(m: BusServoReadPositionRequest) -> b
 
 
 def _encode_bus_servo_read_position_response(m: BusServoReadPositionResponse) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.read_position response', 'servo_id', m.servo_id, 0, 255)
-    if not -128 <= m.success <= 127:
-        raise out_of_range('bus_servo.read_position response', 'success', m.success, -128, 127)
-    if not -32768 <= m.position <= 32767:
+    if not -1 <= m.success <= 0 or m.success.__class__ is bool:
+        raise out_of_range('bus_servo.read_position response', 'success', m.success, -1, 0)
+    if not -32768 <= m.position <= 32767 or m.position.__class__ is bool:
         raise out_of_range('bus_servo.read_position response', 'position', m.position, -32768, 32767)
     body = _S_FRAME_BUSSERVOREADPOSITIONRESPONSE.pack(b'\xaaU', 5, 5, m.servo_id, 5, m.success, m.position)
     check = 0x0
@@ -1266,7 +1267,7 @@ def _encode_bus_servo_read_position_response(m: BusServoReadPositionResponse) ->
 
 
 def _encode_bus_servo_read_voltage_request(m: BusServoReadVoltageRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.read_voltage request', 'servo_id', m.servo_id, 0, 255)
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 7, m.servo_id)
     check = 0x0
@@ -1276,11 +1277,11 @@ def _encode_bus_servo_read_voltage_request(m: BusServoReadVoltageRequest) -> byt
 
 
 def _encode_bus_servo_read_voltage_response(m: BusServoReadVoltageResponse) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.read_voltage response', 'servo_id', m.servo_id, 0, 255)
-    if not -128 <= m.success <= 127:
-        raise out_of_range('bus_servo.read_voltage response', 'success', m.success, -128, 127)
-    if not 0 <= m.voltage <= 65535:
+    if not -1 <= m.success <= 0 or m.success.__class__ is bool:
+        raise out_of_range('bus_servo.read_voltage response', 'success', m.success, -1, 0)
+    if not 0 <= m.voltage <= 65535 or m.voltage.__class__ is bool:
         raise out_of_range('bus_servo.read_voltage response', 'voltage', m.voltage, 0, 65535)
     body = _S_FRAME_BUSSERVOREADVOLTAGERESPONSE.pack(b'\xaaU', 5, 5, m.servo_id, 7, m.success, m.voltage)
     check = 0x0
@@ -1290,7 +1291,7 @@ def _encode_bus_servo_read_voltage_response(m: BusServoReadVoltageResponse) -> b
 
 
 def _encode_bus_servo_read_temperature_request(m: BusServoReadTemperatureRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.read_temperature request', 'servo_id', m.servo_id, 0, 255)
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 9, m.servo_id)
     check = 0x0
@@ -1300,11 +1301,11 @@ def _encode_bus_servo_read_temperature_request(m: BusServoReadTemperatureRequest
 
 
 def _encode_bus_servo_read_temperature_response(m: BusServoReadTemperatureResponse) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.read_temperature response', 'servo_id', m.servo_id, 0, 255)
-    if not -128 <= m.success <= 127:
-        raise out_of_range('bus_servo.read_temperature response', 'success', m.success, -128, 127)
-    if not 0 <= m.temperature <= 255:
+    if not -1 <= m.success <= 0 or m.success.__class__ is bool:
+        raise out_of_range('bus_servo.read_temperature response', 'success', m.success, -1, 0)
+    if not 0 <= m.temperature <= 255 or m.temperature.__class__ is bool:
         raise out_of_range('bus_servo.read_temperature response', 'temperature', m.temperature, 0, 255)
     body = _S_FRAME_BUSSERVOREADTEMPERATURERESPONSE.pack(b'\xaaU', 5, 4, m.servo_id, 9, m.success, m.temperature)
     check = 0x0
@@ -1318,7 +1319,7 @@ def _encode_bus_servo_stop_request(m: BusServoStopRequest) -> bytes:
         raise out_of_range('bus_servo.stop request', 'count', len(m.servos), 0, 255)
     parts_servos = []
     for item in m.servos:
-        if not 0 <= item.servo_id <= 255:
+        if not 0 <= item.servo_id <= 255 or item.servo_id.__class__ is bool:
             raise out_of_range('bus_servo.stop request', 'servo_id', item.servo_id, 0, 255)
         parts_servos.append(_S_U8.pack(item.servo_id))
     content = b''.join(parts_servos)
@@ -1333,7 +1334,7 @@ def _encode_bus_servo_stop_request(m: BusServoStopRequest) -> bytes:
 
 
 def _encode_bus_servo_read_torque_request(m: BusServoReadTorqueRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.read_torque request', 'servo_id', m.servo_id, 0, 255)
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 13, m.servo_id)
     check = 0x0
@@ -1343,11 +1344,11 @@ def _encode_bus_servo_read_torque_request(m: BusServoReadTorqueRequest) -> bytes
 
 
 def _encode_bus_servo_read_torque_response(m: BusServoReadTorqueResponse) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.read_torque response', 'servo_id', m.servo_id, 0, 255)
-    if not -128 <= m.success <= 127:
-        raise out_of_range('bus_servo.read_torque response', 'success', m.success, -128, 127)
-    if not -128 <= m.torque <= 127:
+    if not -1 <= m.success <= 0 or m.success.__class__ is bool:
+        raise out_of_range('bus_servo.read_torque response', 'success', m.success, -1, 0)
+    if not -128 <= m.torque <= 127 or m.torque.__class__ is bool:
         raise out_of_range('bus_servo.read_torque response', 'torque', m.torque, -128, 127)
     body = _S_FRAME_BUSSERVOREADTORQUERESPONSE.pack(b'\xaaU', 5, 4, m.servo_id, 13, m.success, m.torque)
     check = 0x0
@@ -1357,7 +1358,7 @@ def _encode_bus_servo_read_torque_response(m: BusServoReadTorqueResponse) -> byt
 
 
 def _encode_bus_servo_unload_request(m: BusServoUnloadRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.unload request', 'servo_id', m.servo_id, 0, 255)
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 11, m.servo_id)
     check = 0x0
@@ -1367,7 +1368,7 @@ def _encode_bus_servo_unload_request(m: BusServoUnloadRequest) -> bytes:
 
 
 def _encode_bus_servo_load_request(m: BusServoLoadRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.load request', 'servo_id', m.servo_id, 0, 255)
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 12, m.servo_id)
     check = 0x0
@@ -1377,9 +1378,9 @@ def _encode_bus_servo_load_request(m: BusServoLoadRequest) -> bytes:
 
 
 def _encode_bus_servo_set_id_request(m: BusServoSetIdRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.set_id request', 'servo_id', m.servo_id, 0, 255)
-    if not 0 <= m.new_id <= 255:
+    if not 0 <= m.new_id <= 255 or m.new_id.__class__ is bool:
         raise out_of_range('bus_servo.set_id request', 'new_id', m.new_id, 0, 255)
     body = _S_B2_U8_U8_U8_U8_U8.pack(b'\xaaU', 5, 3, 16, m.servo_id, m.new_id)
     check = 0x0
@@ -1389,7 +1390,7 @@ def _encode_bus_servo_set_id_request(m: BusServoSetIdRequest) -> bytes:
 
 
 def _encode_bus_servo_read_id_request(m: BusServoReadIdRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.read_id request', 'servo_id', m.servo_id, 0, 255)
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 18, m.servo_id)
     check = 0x0
@@ -1399,11 +1400,11 @@ def _encode_bus_servo_read_id_request(m: BusServoReadIdRequest) -> bytes:
 
 
 def _encode_bus_servo_read_id_response(m: BusServoReadIdResponse) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.read_id response', 'servo_id', m.servo_id, 0, 255)
-    if not -128 <= m.success <= 127:
-        raise out_of_range('bus_servo.read_id response', 'success', m.success, -128, 127)
-    if not 0 <= m.id <= 255:
+    if not -1 <= m.success <= 0 or m.success.__class__ is bool:
+        raise out_of_range('bus_servo.read_id response', 'success', m.success, -1, 0)
+    if not 0 <= m.id <= 255 or m.id.__class__ is bool:
         raise out_of_range('bus_servo.read_id response', 'id', m.id, 0, 255)
     body = _S_FRAME_BUSSERVOREADTEMPERATURERESPONSE.pack(b'\xaaU', 5, 4, m.servo_id, 18, m.success, m.id)
     check = 0x0
@@ -1413,9 +1414,9 @@ def _encode_bus_servo_read_id_response(m: BusServoReadIdResponse) -> bytes:
 
 
 def _encode_bus_servo_set_offset_request(m: BusServoSetOffsetRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.set_offset request', 'servo_id', m.servo_id, 0, 255)
-    if not -125 <= m.offset <= 125:
+    if not -125 <= m.offset <= 125 or m.offset.__class__ is bool:
         raise out_of_range('bus_servo.set_offset request', 'offset', m.offset, -125, 125)
     body = _S_B2_U8_U8_U8_U8_I8.pack(b'\xaaU', 5, 3, 32, m.servo_id, m.offset)
     check = 0x0
@@ -1425,7 +1426,7 @@ def _encode_bus_servo_set_offset_request(m: BusServoSetOffsetRequest) -> bytes:
 
 
 def _encode_bus_servo_read_offset_request(m: BusServoReadOffsetRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.read_offset request', 'servo_id', m.servo_id, 0, 255)
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 34, m.servo_id)
     check = 0x0
@@ -1435,11 +1436,11 @@ def _encode_bus_servo_read_offset_request(m: BusServoReadOffsetRequest) -> bytes
 
 
 def _encode_bus_servo_read_offset_response(m: BusServoReadOffsetResponse) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.read_offset response', 'servo_id', m.servo_id, 0, 255)
-    if not -128 <= m.success <= 127:
-        raise out_of_range('bus_servo.read_offset response', 'success', m.success, -128, 127)
-    if not -128 <= m.offset <= 127:
+    if not -1 <= m.success <= 0 or m.success.__class__ is bool:
+        raise out_of_range('bus_servo.read_offset response', 'success', m.success, -1, 0)
+    if not -128 <= m.offset <= 127 or m.offset.__class__ is bool:
         raise out_of_range('bus_servo.read_offset response', 'offset', m.offset, -128, 127)
     body = _S_FRAME_BUSSERVOREADTORQUERESPONSE.pack(b'\xaaU', 5, 4, m.servo_id, 34, m.success, m.offset)
     check = 0x0
@@ -1449,7 +1450,7 @@ def _encode_bus_servo_read_offset_response(m: BusServoReadOffsetResponse) -> byt
 
 
 def _encode_bus_servo_save_offset_request(m: BusServoSaveOffsetRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.save_offset request', 'servo_id', m.servo_id, 0, 255)
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 36, m.servo_id)
     check = 0x0
@@ -1459,11 +1460,11 @@ def _encode_bus_servo_save_offset_request(m: BusServoSaveOffsetRequest) -> bytes
 
 
 def _encode_bus_servo_set_position_limit_request(m: BusServoSetPositionLimitRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.set_position_limit request', 'servo_id', m.servo_id, 0, 255)
-    if not 0 <= m.low <= 1000:
+    if not 0 <= m.low <= 1000 or m.low.__class__ is bool:
         raise out_of_range('bus_servo.set_position_limit request', 'low', m.low, 0, 1000)
-    if not 0 <= m.high <= 1000:
+    if not 0 <= m.high <= 1000 or m.high.__class__ is bool:
         raise out_of_range('bus_servo.set_position_limit request', 'high', m.high, 0, 1000)
     body = _S_FRAME_BUSSERVOSETPOSITIONLIMITREQUEST.pack(b'\xaaU', 5, 6, 48, m.servo_id, m.low, m.high)
     check = 0x0
@@ -1473,7 +1474,7 @@ def _encode_bus_servo_set_position_limit_request(m: BusServoSetPositionLimitRequ
 
 
 def _encode_bus_servo_read_position_limit_request(m: BusServoReadPositionLimitRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.read_position_limit request', 'servo_id', m.servo_id, 0, 255)
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 50, m.servo_id)
     check = 0x0
@@ -1483,13 +1484,13 @@ def _encode_bus_servo_read_position_limit_request(m: BusServoReadPositionLimitRe
 
 
 def _encode_bus_servo_read_position_limit_response(m: BusServoReadPositionLimitResponse) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.read_position_limit response', 'servo_id', m.servo_id, 0, 255)
-    if not -128 <= m.success <= 127:
-        raise out_of_range('bus_servo.read_position_limit response', 'success', m.success, -128, 127)
-    if not 0 <= m.low <= 65535:
+    if not -1 <= m.success <= 0 or m.success.__class__ is bool:
+        raise out_of_range('bus_servo.read_position_limit response', 'success', m.success, -1, 0)
+    if not 0 <= m.low <= 65535 or m.low.__class__ is bool:
         raise out_of_range('bus_servo.read_position_limit response', 'low', m.low, 0, 65535)
-    if not 0 <= m.high <= 65535:
+    if not 0 <= m.high <= 65535 or m.high.__class__ is bool:
         raise out_of_range('bus_servo.read_position_limit response', 'high', m.high, 0, 65535)
     body = _S_FRAME_BUSSERVOREADPOSITIONLIMITRESPONSE.pack(b'\xaaU', 5, 7, m.servo_id, 50, m.success, m.low, m.high)
     check = 0x0
@@ -1499,11 +1500,11 @@ def _encode_bus_servo_read_position_limit_response(m: BusServoReadPositionLimitR
 
 
 def _encode_bus_servo_set_voltage_limit_request(m: BusServoSetVoltageLimitRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.set_voltage_limit request', 'servo_id', m.servo_id, 0, 255)
-    if not 4500 <= m.low <= 14000:
+    if not 4500 <= m.low <= 14000 or m.low.__class__ is bool:
         raise out_of_range('bus_servo.set_voltage_limit request', 'low', m.low, 4500, 14000)
-    if not 4500 <= m.high <= 14000:
+    if not 4500 <= m.high <= 14000 or m.high.__class__ is bool:
         raise out_of_range('bus_servo.set_voltage_limit request', 'high', m.high, 4500, 14000)
     body = _S_FRAME_BUSSERVOSETPOSITIONLIMITREQUEST.pack(b'\xaaU', 5, 6, 52, m.servo_id, m.low, m.high)
     check = 0x0
@@ -1513,7 +1514,7 @@ def _encode_bus_servo_set_voltage_limit_request(m: BusServoSetVoltageLimitReques
 
 
 def _encode_bus_servo_read_voltage_limit_request(m: BusServoReadVoltageLimitRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.read_voltage_limit request', 'servo_id', m.servo_id, 0, 255)
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 54, m.servo_id)
     check = 0x0
@@ -1523,13 +1524,13 @@ def _encode_bus_servo_read_voltage_limit_request(m: BusServoReadVoltageLimitRequ
 
 
 def _encode_bus_servo_read_voltage_limit_response(m: BusServoReadVoltageLimitResponse) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.read_voltage_limit response', 'servo_id', m.servo_id, 0, 255)
-    if not -128 <= m.success <= 127:
-        raise out_of_range('bus_servo.read_voltage_limit response', 'success', m.success, -128, 127)
-    if not 0 <= m.low <= 65535:
+    if not -1 <= m.success <= 0 or m.success.__class__ is bool:
+        raise out_of_range('bus_servo.read_voltage_limit response', 'success', m.success, -1, 0)
+    if not 0 <= m.low <= 65535 or m.low.__class__ is bool:
         raise out_of_range('bus_servo.read_voltage_limit response', 'low', m.low, 0, 65535)
-    if not 0 <= m.high <= 65535:
+    if not 0 <= m.high <= 65535 or m.high.__class__ is bool:
         raise out_of_range('bus_servo.read_voltage_limit response', 'high', m.high, 0, 65535)
     body = _S_FRAME_BUSSERVOREADPOSITIONLIMITRESPONSE.pack(b'\xaaU', 5, 7, m.servo_id, 54, m.success, m.low, m.high)
     check = 0x0
@@ -1539,9 +1540,9 @@ def _encode_bus_servo_read_voltage_limit_response(m: BusServoReadVoltageLimitRes
 
 
 def _encode_bus_servo_set_temperature_limit_request(m: BusServoSetTemperatureLimitRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.set_temperature_limit request', 'servo_id', m.servo_id, 0, 255)
-    if not 0 <= m.limit <= 99:
+    if not 0 <= m.limit <= 99 or m.limit.__class__ is bool:
         raise out_of_range('bus_servo.set_temperature_limit request', 'limit', m.limit, 0, 99)
     body = _S_B2_U8_U8_U8_U8_U8.pack(b'\xaaU', 5, 3, 56, m.servo_id, m.limit)
     check = 0x0
@@ -1551,7 +1552,7 @@ def _encode_bus_servo_set_temperature_limit_request(m: BusServoSetTemperatureLim
 
 
 def _encode_bus_servo_read_temperature_limit_request(m: BusServoReadTemperatureLimitRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.read_temperature_limit request', 'servo_id', m.servo_id, 0, 255)
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 58, m.servo_id)
     check = 0x0
@@ -1561,11 +1562,11 @@ def _encode_bus_servo_read_temperature_limit_request(m: BusServoReadTemperatureL
 
 
 def _encode_bus_servo_read_temperature_limit_response(m: BusServoReadTemperatureLimitResponse) -> bytes:
-    if not 0 <= m.servo_id <= 255:
+    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
         raise out_of_range('bus_servo.read_temperature_limit response', 'servo_id', m.servo_id, 0, 255)
-    if not -128 <= m.success <= 127:
-        raise out_of_range('bus_servo.read_temperature_limit response', 'success', m.success, -128, 127)
-    if not 0 <= m.limit <= 255:
+    if not -1 <= m.success <= 0 or m.success.__class__ is bool:
+        raise out_of_range('bus_servo.read_temperature_limit response', 'success', m.success, -1, 0)
+    if not 0 <= m.limit <= 255 or m.limit.__class__ is bool:
         raise out_of_range('bus_servo.read_temperature_limit response', 'limit', m.limit, 0, 255)
     body = _S_FRAME_BUSSERVOREADTEMPERATURERESPONSE.pack(b'\xaaU', 5, 4, m.servo_id, 58, m.success, m.limit)
     check = 0x0
@@ -1575,10 +1576,10 @@ def _encode_bus_servo_read_temperature_limit_response(m: BusServoReadTemperature
 
 
 def _encode_key_response(m: KeyResponse) -> bytes:
-    if not 0 <= m.button_id <= 255:
+    if not 0 <= m.button_id <= 255 or m.button_id.__class__ is bool:
         raise out_of_range('key response', 'button_id', m.button_id, 0, 255)
-    if not 0 <= m.event <= 255:
-        raise out_of_range('key response', 'event', m.event, 0, 255)
+    if not 1 <= m.event <= 128 or m.event.__class__ is bool:
+        raise out_of_range('key response', 'event', m.event, 1, 128)
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 6, 2, m.button_id, m.event)
     check = 0x0
     for byte in body[2:]:
@@ -1607,17 +1608,17 @@ def _encode_imu_response(m: ImuResponse) -> bytes:
 
 
 def _encode_gamepad_response(m: GamepadResponse) -> bytes:
-    if not 0 <= m.buttons <= 65535:
+    if not 0 <= m.buttons <= 65535 or isinstance(m.buttons, bool):
         raise out_of_range('gamepad response', 'buttons', m.buttons, 0, 65535)
-    if not 0 <= m.hat <= 255:
+    if not 0 <= m.hat <= 255 or m.hat.__class__ is bool:
         raise out_of_range('gamepad response', 'hat', m.hat, 0, 255)
-    if not -128 <= m.left_x <= 127:
+    if not -128 <= m.left_x <= 127 or m.left_x.__class__ is bool:
         raise out_of_range('gamepad response', 'left_x', m.left_x, -128, 127)
-    if not -128 <= m.left_y <= 127:
+    if not -128 <= m.left_y <= 127 or m.left_y.__class__ is bool:
         raise out_of_range('gamepad response', 'left_y', m.left_y, -128, 127)
-    if not -128 <= m.right_x <= 127:
+    if not -128 <= m.right_x <= 127 or m.right_x.__class__ is bool:
         raise out_of_range('gamepad response', 'right_x', m.right_x, -128, 127)
-    if not -128 <= m.right_y <= 127:
+    if not -128 <= m.right_y <= 127 or m.right_y.__class__ is bool:
         raise out_of_range('gamepad response', 'right_y', m.right_y, -128, 127)
     body = _S_FRAME_GAMEPADRESPONSE.pack(b'\xaaU', 8, 7, m.buttons, m.hat, m.left_x, m.left_y, m.right_x, m.right_y)
     check = 0x0
@@ -1631,13 +1632,13 @@ def _encode_sbus_response(m: SbusResponse) -> bytes:
         raise EncodeError('sbus response' + f': channels needs 16 items, got {len(m.channels)}')
     if any(not -32768 <= x <= 32767 for x in m.channels):
         raise out_of_range('sbus response', 'channels', m.channels, -32768, 32767)
-    if not 0 <= m.ch17 <= 255:
+    if not 0 <= m.ch17 <= 255 or m.ch17.__class__ is bool:
         raise out_of_range('sbus response', 'ch17', m.ch17, 0, 255)
-    if not 0 <= m.ch18 <= 255:
+    if not 0 <= m.ch18 <= 255 or m.ch18.__class__ is bool:
         raise out_of_range('sbus response', 'ch18', m.ch18, 0, 255)
-    if not 0 <= m.signal_loss <= 255:
+    if not 0 <= m.signal_loss <= 255 or m.signal_loss.__class__ is bool:
         raise out_of_range('sbus response', 'signal_loss', m.signal_loss, 0, 255)
-    if not 0 <= m.fail_safe <= 255:
+    if not 0 <= m.fail_safe <= 255 or m.fail_safe.__class__ is bool:
         raise out_of_range('sbus response', 'fail_safe', m.fail_safe, 0, 255)
     body = _S_FRAME_SBUSRESPONSE.pack(b'\xaaU', 9, 36, *m.channels, m.ch17, m.ch18, m.signal_loss, m.fail_safe)
     check = 0x0
@@ -1647,7 +1648,7 @@ def _encode_sbus_response(m: SbusResponse) -> bytes:
 
 
 def _encode_system_battery_response(m: SystemBatteryResponse) -> bytes:
-    if not 0 <= m.voltage <= 65535:
+    if not 0 <= m.voltage <= 65535 or m.voltage.__class__ is bool:
         raise out_of_range('system.battery response', 'voltage', m.voltage, 0, 65535)
     body = _S_B2_U8_U8_U8_U16.pack(b'\xaaU', 0, 3, 4, m.voltage)
     check = 0x0
@@ -1657,7 +1658,7 @@ def _encode_system_battery_response(m: SystemBatteryResponse) -> bytes:
 
 
 def _encode_oled_request(m: OledRequest) -> bytes:
-    if not 0 <= m.line <= 255:
+    if not 0 <= m.line <= 255 or m.line.__class__ is bool:
         raise out_of_range('oled request', 'line', m.line, 0, 255)
     if len(m.text) > 255:
         raise out_of_range('oled request', 'length', len(m.text), 0, 255)
@@ -1677,13 +1678,13 @@ def _encode_rgb_set_pixels_request(m: RgbSetPixelsRequest) -> bytes:
         raise out_of_range('rgb.set_pixels request', 'count', len(m.pixels), 0, 255)
     parts_pixels = []
     for item in m.pixels:
-        if not 0 <= item.index <= 255:
+        if not 0 <= item.index <= 255 or item.index.__class__ is bool:
             raise out_of_range('rgb.set_pixels request', 'index', item.index, 0, 255)
-        if not 0 <= item.red <= 255:
+        if not 0 <= item.red <= 255 or item.red.__class__ is bool:
             raise out_of_range('rgb.set_pixels request', 'red', item.red, 0, 255)
-        if not 0 <= item.green <= 255:
+        if not 0 <= item.green <= 255 or item.green.__class__ is bool:
             raise out_of_range('rgb.set_pixels request', 'green', item.green, 0, 255)
-        if not 0 <= item.blue <= 255:
+        if not 0 <= item.blue <= 255 or item.blue.__class__ is bool:
             raise out_of_range('rgb.set_pixels request', 'blue', item.blue, 0, 255)
         parts_pixels.append(_S_U8_U8_U8_U8.pack(item.index, item.red, item.green, item.blue))
     content = b''.join(parts_pixels)
@@ -2062,8 +2063,10 @@ def encode(message: Message) -> bytes:
         raise EncodeError(f"{type(message).__name__} is not a hiwonder_rrc message")
     try:
         return encoder(message)
-    except (TypeError, AttributeError, struct.error) as exc:
-        raise EncodeError(f"{message.COMMAND} {message.DIRECTION.value}: {exc}") from None
+    except EncodeError:
+        raise
+    except (TypeError, AttributeError, ValueError, OverflowError, struct.error) as exc:
+        raise wrong_type(message, exc) from None  # one line naming the field, not Python's words
 
 
 class StreamParser(_StreamParser):

@@ -9,10 +9,15 @@ from typing import Any, ClassVar, Self
 
 from serialspec.runtime.fields import as_bytes as _bytes
 from serialspec.runtime.fields import check_keys as _check_keys
+from serialspec.runtime.fields import enum as _as_enum
+from serialspec.runtime.fields import flags as _as_flags
 from serialspec.runtime.fields import get as _get
+from serialspec.runtime.fields import integer as _integer
+from serialspec.runtime.fields import integers as _integers
+from serialspec.runtime.fields import items as _items
 from serialspec.runtime.fields import mapping as _mapping
+from serialspec.runtime.fields import number as _number
 from serialspec.runtime.message import Direction, Message, Record
-from serialspec.runtime.message import enum_or_int as _enum
 
 _store = object.__setattr__  # how __init__ fills the slots of a frozen class
 
@@ -85,83 +90,83 @@ __all__ = [
 class ReadResult(IntEnum):
     """Outcome of a bus-servo read, as reported by the board."""
 
-    OK = 0
     #: read succeeded
-    FAILED = -1
+    OK = 0
     #: read failed (the value that follows is not valid)
+    FAILED = -1
 
 
 class ButtonEvent(IntEnum):
     """Key event values. 002 lists four as '部分按键事件回调值' (some of the event values); the SDK's PacketReportKeyEvents adds the other four (one bit each)."""
 
-    PRESSED = 1
     #: button pressed (BUTTON_EVENT_PRESSED)
-    LONG_PRESS = 2
+    PRESSED = 1
     #: button held down (BUTTON_EVENT_LONGPRESS)
-    LONG_PRESS_REPEAT = 4
+    LONG_PRESS = 2
     #: button still held, repeated (KEY_EVENT_LONGPRESS_REPEAT; sdk)
-    RELEASE_FROM_LONG_PRESS = 8
+    LONG_PRESS_REPEAT = 4
     #: button released after a long press (KEY_EVENT_RELEASE_FROM_LP; sdk)
-    RELEASE_FROM_SHORT_PRESS = 16
+    RELEASE_FROM_LONG_PRESS = 8
     #: button released after a short press (KEY_EVENT_RELEASE_FROM_SP; sdk)
-    CLICK = 32
+    RELEASE_FROM_SHORT_PRESS = 16
     #: button clicked (BUTTON_EVENT_CLICK)
-    DOUBLE_CLICK = 64
+    CLICK = 32
     #: button double-clicked (BUTTON_EVENT_DOUBLE_CLICK)
-    TRIPLE_CLICK = 128
+    DOUBLE_CLICK = 64
     #: button triple-clicked (KEY_EVENT_TRIPLE_CLICK; sdk)
+    TRIPLE_CLICK = 128
 
 
 class GamepadButtons(IntFlag):
     """Gamepad buttons held, one bit each (sdk Board.buttons_map GAMEPAD_BUTTON_MASK_*; 002 names none)."""
 
     NONE = 0
-    L2 = 1 << 0
     #: L2
-    R2 = 1 << 1
+    L2 = 1 << 0
     #: R2
-    SELECT = 1 << 2
+    R2 = 1 << 1
     #: SELECT
-    START = 1 << 3
+    SELECT = 1 << 2
     #: START
-    L3 = 1 << 5
+    START = 1 << 3
     #: L3 (left stick pressed)
-    R3 = 1 << 6
+    L3 = 1 << 5
     #: R3 (right stick pressed)
-    CROSS = 1 << 8
+    R3 = 1 << 6
     #: CROSS
-    CIRCLE = 1 << 9
+    CROSS = 1 << 8
     #: CIRCLE
-    SQUARE = 1 << 11
+    CIRCLE = 1 << 9
     #: SQUARE
-    TRIANGLE = 1 << 12
+    SQUARE = 1 << 11
     #: TRIANGLE
-    L1 = 1 << 14
+    TRIANGLE = 1 << 12
     #: L1
-    R1 = 1 << 15
+    L1 = 1 << 14
     #: R1
+    R1 = 1 << 15
 
 
 class MotorMask(IntFlag):
     """Motors to stop; bit n stops the motor with motor_id n (002/003 example 0x05 stops motors 0 and 2)."""
 
     NONE = 0
-    MOTOR_0 = 1 << 0
     #: motor 0
-    MOTOR_1 = 1 << 1
+    MOTOR_0 = 1 << 0
     #: motor 1
-    MOTOR_2 = 1 << 2
+    MOTOR_1 = 1 << 1
     #: motor 2
-    MOTOR_3 = 1 << 3
+    MOTOR_2 = 1 << 2
     #: motor 3
-    MOTOR_4 = 1 << 4
+    MOTOR_3 = 1 << 3
     #: motor 4
-    MOTOR_5 = 1 << 5
+    MOTOR_4 = 1 << 4
     #: motor 5
-    MOTOR_6 = 1 << 6
+    MOTOR_5 = 1 << 5
     #: motor 6
-    MOTOR_7 = 1 << 7
+    MOTOR_6 = 1 << 6
     #: motor 7
+    MOTOR_7 = 1 << 7
 
 
 class MotorsItem(Record):
@@ -169,10 +174,10 @@ class MotorsItem(Record):
 
     __slots__ = ('motor_id', 'speed')
     __match_args__ = ('motor_id', 'speed')
-    motor_id: int
     #: Encoder motor id; bit n of the stop mask is motor_id n (the board has four motor ports).
-    speed: float
+    motor_id: int
     #: Motor speed in revolutions per second; the sign gives the direction. [r/s]
+    speed: float
 
     def __init__(
         self,
@@ -192,8 +197,8 @@ class MotorsItem(Record):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'MotorsItem') -> Self:
         _check_keys(data, ('motor_id', 'speed'), (), where)
         return cls(
-            _get(data, 'motor_id', where),
-            _get(data, 'speed', where),
+            _integer(_get(data, 'motor_id', where), 'motor_id', where),
+            _number(_get(data, 'speed', where), 'speed', where),
         )
 
 
@@ -202,10 +207,10 @@ class DutiesItem(Record):
 
     __slots__ = ('motor_id', 'duty')
     __match_args__ = ('motor_id', 'duty')
-    motor_id: int
     #: Encoder motor id; bit n of the stop mask is motor_id n (the board has four motor ports).
-    duty: float
+    motor_id: int
     #: Duty cycle; the sign gives the direction (the SDK's example uses ±50). [%]
+    duty: float
 
     def __init__(
         self,
@@ -225,8 +230,8 @@ class DutiesItem(Record):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'DutiesItem') -> Self:
         _check_keys(data, ('motor_id', 'duty'), (), where)
         return cls(
-            _get(data, 'motor_id', where),
-            _get(data, 'duty', where),
+            _integer(_get(data, 'motor_id', where), 'motor_id', where),
+            _number(_get(data, 'duty', where), 'duty', where),
         )
 
 
@@ -235,10 +240,10 @@ class PwmServosItem(Record):
 
     __slots__ = ('servo_id', 'pulse')
     __match_args__ = ('servo_id', 'pulse')
-    servo_id: int
     #: PWM servo id.
-    pulse: int
+    servo_id: int
     #: PWM pulse width (脉冲宽度); 500..2500 is 0°..180°. [µs] range 500..2500
+    pulse: int
 
     def __init__(
         self,
@@ -258,8 +263,8 @@ class PwmServosItem(Record):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'PwmServosItem') -> Self:
         _check_keys(data, ('servo_id', 'pulse'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'pulse', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'pulse', where), 'pulse', where),
         )
 
 
@@ -268,10 +273,10 @@ class BusServosItem(Record):
 
     __slots__ = ('servo_id', 'position')
     __match_args__ = ('servo_id', 'position')
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
-    position: int
+    servo_id: int
     #: Bus servo position (002 calls it 脉冲宽度, pulse width); 0..1000 is 0°..240°. range 0..1000
+    position: int
 
     def __init__(
         self,
@@ -291,8 +296,8 @@ class BusServosItem(Record):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'BusServosItem') -> Self:
         _check_keys(data, ('servo_id', 'position'), (), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'position', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'position', where), 'position', where),
         )
 
 
@@ -301,8 +306,8 @@ class ServosItem(Record):
 
     __slots__ = ('servo_id',)
     __match_args__ = ('servo_id',)
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
 
     def __init__(
         self,
@@ -319,7 +324,7 @@ class ServosItem(Record):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'ServosItem') -> Self:
         _check_keys(data, ('servo_id',), (), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -328,14 +333,14 @@ class PixelsItem(Record):
 
     __slots__ = ('index', 'red', 'green', 'blue')
     __match_args__ = ('index', 'red', 'green', 'blue')
-    index: int
     #: LED index from 0 (the SDK takes 1.. and sends it less one).
-    red: int
+    index: int
     #: Red 0..255.
-    green: int
+    red: int
     #: Green 0..255.
-    blue: int
+    green: int
     #: Blue 0..255.
+    blue: int
 
     def __init__(
         self,
@@ -361,10 +366,10 @@ class PixelsItem(Record):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'PixelsItem') -> Self:
         _check_keys(data, ('index', 'red', 'green', 'blue'), (), where)
         return cls(
-            _get(data, 'index', where),
-            _get(data, 'red', where),
-            _get(data, 'green', where),
-            _get(data, 'blue', where),
+            _integer(_get(data, 'index', where), 'index', where),
+            _integer(_get(data, 'red', where), 'red', where),
+            _integer(_get(data, 'green', where), 'green', where),
+            _integer(_get(data, 'blue', where), 'blue', where),
         )
 
 
@@ -377,14 +382,14 @@ class LedRequest(Message):
     COMMAND: ClassVar[str] = 'led'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    led_id: int
     #: LED id.
-    on_time: int
+    led_id: int
     #: Time on (亮的时间). [ms]
-    off_time: int
+    on_time: int
     #: Time off (灭的时间). [ms]
-    repeat: int
+    off_time: int
     #: Number of blinks (循环次数).
+    repeat: int
 
     def __init__(
         self,
@@ -410,10 +415,10 @@ class LedRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'led request') -> Self:
         _check_keys(data, ('led_id', 'on_time', 'off_time', 'repeat'), (), where)
         return cls(
-            _get(data, 'led_id', where),
-            _get(data, 'on_time', where),
-            _get(data, 'off_time', where),
-            _get(data, 'repeat', where),
+            _integer(_get(data, 'led_id', where), 'led_id', where),
+            _integer(_get(data, 'on_time', where), 'on_time', where),
+            _integer(_get(data, 'off_time', where), 'off_time', where),
+            _integer(_get(data, 'repeat', where), 'repeat', where),
         )
 
 
@@ -426,14 +431,14 @@ class BuzzerRequest(Message):
     COMMAND: ClassVar[str] = 'buzzer'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    frequency: int
     #: Tone frequency (频率). [Hz]
-    on_time: int
+    frequency: int
     #: Time sounding (响的时间). [ms]
-    off_time: int
+    on_time: int
     #: Time silent (不响的时间). [ms]
-    repeat: int
+    off_time: int
     #: Number of beeps (循环次数).
+    repeat: int
 
     def __init__(
         self,
@@ -459,10 +464,10 @@ class BuzzerRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'buzzer request') -> Self:
         _check_keys(data, ('frequency', 'on_time', 'off_time', 'repeat'), (), where)
         return cls(
-            _get(data, 'frequency', where),
-            _get(data, 'on_time', where),
-            _get(data, 'off_time', where),
-            _get(data, 'repeat', where),
+            _integer(_get(data, 'frequency', where), 'frequency', where),
+            _integer(_get(data, 'on_time', where), 'on_time', where),
+            _integer(_get(data, 'off_time', where), 'off_time', where),
+            _integer(_get(data, 'repeat', where), 'repeat', where),
         )
 
 
@@ -475,10 +480,10 @@ class MotorSetSpeedRequest(Message):
     COMMAND: ClassVar[str] = 'motor'
     SUBCOMMAND: ClassVar[str | None] = 'set_speed'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    motor_id: int
     #: Encoder motor id; bit n of the stop mask is motor_id n (the board has four motor ports).
-    speed: float
+    motor_id: int
     #: Motor speed in revolutions per second; the sign gives the direction. [r/s]
+    speed: float
 
     def __init__(
         self,
@@ -498,8 +503,8 @@ class MotorSetSpeedRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'motor.set_speed request') -> Self:
         _check_keys(data, ('motor_id', 'speed'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'motor_id', where),
-            _get(data, 'speed', where),
+            _integer(_get(data, 'motor_id', where), 'motor_id', where),
+            _number(_get(data, 'speed', where), 'speed', where),
         )
 
 
@@ -512,8 +517,8 @@ class MotorSetSpeedsRequest(Message):
     COMMAND: ClassVar[str] = 'motor'
     SUBCOMMAND: ClassVar[str | None] = 'set_speeds'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    motors: tuple[MotorsItem, ...]
     #: One (motor_id, speed) pair per motor.
+    motors: tuple[MotorsItem, ...]
 
     def __init__(
         self,
@@ -530,7 +535,7 @@ class MotorSetSpeedsRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'motor.set_speeds request') -> Self:
         _check_keys(data, ('motors',), ('subcommand_code', 'count'), where)
         return cls(
-            tuple(MotorsItem.from_fields(_mapping(item, 'motors', where), where) for item in _get(data, 'motors', where)),
+            tuple(MotorsItem.from_fields(_mapping(item, 'motors', where), where) for item in _items(_get(data, 'motors', where), 'motors', where)),
         )
 
 
@@ -543,8 +548,8 @@ class MotorStopRequest(Message):
     COMMAND: ClassVar[str] = 'motor'
     SUBCOMMAND: ClassVar[str | None] = 'stop'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    motor_id: int
     #: Encoder motor id; bit n of the stop mask is motor_id n (the board has four motor ports).
+    motor_id: int
 
     def __init__(
         self,
@@ -561,7 +566,7 @@ class MotorStopRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'motor.stop request') -> Self:
         _check_keys(data, ('motor_id',), ('subcommand_code',), where)
         return cls(
-            _get(data, 'motor_id', where),
+            _integer(_get(data, 'motor_id', where), 'motor_id', where),
         )
 
 
@@ -574,8 +579,8 @@ class MotorSetDutiesRequest(Message):
     COMMAND: ClassVar[str] = 'motor'
     SUBCOMMAND: ClassVar[str | None] = 'set_duties'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    duties: tuple[DutiesItem, ...]
     #: One (motor_id, duty) pair per motor.
+    duties: tuple[DutiesItem, ...]
 
     def __init__(
         self,
@@ -592,7 +597,7 @@ class MotorSetDutiesRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'motor.set_duties request') -> Self:
         _check_keys(data, ('duties',), ('subcommand_code', 'count'), where)
         return cls(
-            tuple(DutiesItem.from_fields(_mapping(item, 'duties', where), where) for item in _get(data, 'duties', where)),
+            tuple(DutiesItem.from_fields(_mapping(item, 'duties', where), where) for item in _items(_get(data, 'duties', where), 'duties', where)),
         )
 
 
@@ -605,8 +610,8 @@ class MotorStopMaskRequest(Message):
     COMMAND: ClassVar[str] = 'motor'
     SUBCOMMAND: ClassVar[str | None] = 'stop_mask'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    mask: MotorMask
     #: Motors to stop (电机掩码), bit n for motor n.
+    mask: MotorMask
 
     def __init__(
         self,
@@ -623,7 +628,7 @@ class MotorStopMaskRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'motor.stop_mask request') -> Self:
         _check_keys(data, ('mask',), ('subcommand_code',), where)
         return cls(
-            MotorMask(_get(data, 'mask', where)),
+            _as_flags(MotorMask, _get(data, 'mask', where), 255, 'mask', where),
         )
 
 
@@ -636,10 +641,10 @@ class PwmServoSetPositionsRequest(Message):
     COMMAND: ClassVar[str] = 'pwm_servo'
     SUBCOMMAND: ClassVar[str | None] = 'set_positions'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    duration: int
     #: Time to complete the move (运动时间). [ms]
-    pwm_servos: tuple[PwmServosItem, ...]
+    duration: int
     #: One (servo_id, pulse) pair per servo.
+    pwm_servos: tuple[PwmServosItem, ...]
 
     def __init__(
         self,
@@ -659,8 +664,8 @@ class PwmServoSetPositionsRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'pwm_servo.set_positions request') -> Self:
         _check_keys(data, ('duration', 'pwm_servos'), ('subcommand_code', 'count'), where)
         return cls(
-            _get(data, 'duration', where),
-            tuple(PwmServosItem.from_fields(_mapping(item, 'pwm_servos', where), where) for item in _get(data, 'pwm_servos', where)),
+            _integer(_get(data, 'duration', where), 'duration', where),
+            tuple(PwmServosItem.from_fields(_mapping(item, 'pwm_servos', where), where) for item in _items(_get(data, 'pwm_servos', where), 'pwm_servos', where)),
         )
 
 
@@ -673,12 +678,12 @@ class PwmServoSetPositionRequest(Message):
     COMMAND: ClassVar[str] = 'pwm_servo'
     SUBCOMMAND: ClassVar[str | None] = 'set_position'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    duration: int
     #: Time to complete the move (运动时间). [ms]
-    servo_id: int
+    duration: int
     #: PWM servo id.
-    pulse: int
+    servo_id: int
     #: PWM pulse width (脉冲宽度); 500..2500 is 0°..180°. [µs] range 500..2500
+    pulse: int
 
     def __init__(
         self,
@@ -701,9 +706,9 @@ class PwmServoSetPositionRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'pwm_servo.set_position request') -> Self:
         _check_keys(data, ('duration', 'servo_id', 'pulse'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'duration', where),
-            _get(data, 'servo_id', where),
-            _get(data, 'pulse', where),
+            _integer(_get(data, 'duration', where), 'duration', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'pulse', where), 'pulse', where),
         )
 
 
@@ -716,8 +721,8 @@ class PwmServoReadPositionRequest(Message):
     COMMAND: ClassVar[str] = 'pwm_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_position'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: PWM servo id.
+    servo_id: int
 
     def __init__(
         self,
@@ -734,7 +739,7 @@ class PwmServoReadPositionRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'pwm_servo.read_position request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -747,10 +752,10 @@ class PwmServoReadPositionResponse(Message):
     COMMAND: ClassVar[str] = 'pwm_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_position'
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: PWM servo id.
-    pulse: int
+    servo_id: int
     #: The servo's current pulse width (not range-checked in a report). [µs]
+    pulse: int
 
     def __init__(
         self,
@@ -770,8 +775,8 @@ class PwmServoReadPositionResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'pwm_servo.read_position response') -> Self:
         _check_keys(data, ('servo_id', 'pulse'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'pulse', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'pulse', where), 'pulse', where),
         )
 
 
@@ -784,10 +789,10 @@ class PwmServoSetOffsetRequest(Message):
     COMMAND: ClassVar[str] = 'pwm_servo'
     SUBCOMMAND: ClassVar[str | None] = 'set_offset'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: PWM servo id.
-    offset: int
+    servo_id: int
     #: PWM servo offset (偏差), an int8 from -100 to +100. [µs] range -100..100
+    offset: int
 
     def __init__(
         self,
@@ -807,8 +812,8 @@ class PwmServoSetOffsetRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'pwm_servo.set_offset request') -> Self:
         _check_keys(data, ('servo_id', 'offset'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'offset', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'offset', where), 'offset', where),
         )
 
 
@@ -821,8 +826,8 @@ class PwmServoReadOffsetRequest(Message):
     COMMAND: ClassVar[str] = 'pwm_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_offset'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: PWM servo id.
+    servo_id: int
 
     def __init__(
         self,
@@ -839,7 +844,7 @@ class PwmServoReadOffsetRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'pwm_servo.read_offset request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -852,10 +857,10 @@ class PwmServoReadOffsetResponse(Message):
     COMMAND: ClassVar[str] = 'pwm_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_offset'
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: PWM servo id.
-    offset: int
+    servo_id: int
     #: The servo's offset (int8; -100..100 when set through 0x07). [µs]
+    offset: int
 
     def __init__(
         self,
@@ -875,8 +880,8 @@ class PwmServoReadOffsetResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'pwm_servo.read_offset response') -> Self:
         _check_keys(data, ('servo_id', 'offset'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'offset', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'offset', where), 'offset', where),
         )
 
 
@@ -889,10 +894,10 @@ class BusServoSetPositionsRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'set_positions'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    duration: int
     #: Time to complete the move (运动时间). [ms]
-    bus_servos: tuple[BusServosItem, ...]
+    duration: int
     #: One (servo_id, position) pair per servo.
+    bus_servos: tuple[BusServosItem, ...]
 
     def __init__(
         self,
@@ -912,8 +917,8 @@ class BusServoSetPositionsRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.set_positions request') -> Self:
         _check_keys(data, ('duration', 'bus_servos'), ('subcommand_code', 'count'), where)
         return cls(
-            _get(data, 'duration', where),
-            tuple(BusServosItem.from_fields(_mapping(item, 'bus_servos', where), where) for item in _get(data, 'bus_servos', where)),
+            _integer(_get(data, 'duration', where), 'duration', where),
+            tuple(BusServosItem.from_fields(_mapping(item, 'bus_servos', where), where) for item in _items(_get(data, 'bus_servos', where), 'bus_servos', where)),
         )
 
 
@@ -926,8 +931,8 @@ class BusServoReadPositionRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_position'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
 
     def __init__(
         self,
@@ -944,7 +949,7 @@ class BusServoReadPositionRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_position request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -957,12 +962,12 @@ class BusServoReadPositionResponse(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_position'
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
+    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0. range -1..0
     success: ReadResult | int
-    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
-    position: int
     #: Current position (0..1000 is 0°..240°).
+    position: int
 
     def __init__(
         self,
@@ -985,9 +990,9 @@ class BusServoReadPositionResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_position response') -> Self:
         _check_keys(data, ('servo_id', 'success', 'position'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _enum(ReadResult, _get(data, 'success', where)),
-            _get(data, 'position', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(ReadResult, _get(data, 'success', where), 'success', where),
+            _integer(_get(data, 'position', where), 'position', where),
         )
 
 
@@ -1000,8 +1005,8 @@ class BusServoReadVoltageRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_voltage'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
 
     def __init__(
         self,
@@ -1018,7 +1023,7 @@ class BusServoReadVoltageRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_voltage request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -1031,12 +1036,12 @@ class BusServoReadVoltageResponse(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_voltage'
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
+    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0. range -1..0
     success: ReadResult | int
-    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
-    voltage: int
     #: Input voltage. [mV]
+    voltage: int
 
     def __init__(
         self,
@@ -1059,9 +1064,9 @@ class BusServoReadVoltageResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_voltage response') -> Self:
         _check_keys(data, ('servo_id', 'success', 'voltage'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _enum(ReadResult, _get(data, 'success', where)),
-            _get(data, 'voltage', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(ReadResult, _get(data, 'success', where), 'success', where),
+            _integer(_get(data, 'voltage', where), 'voltage', where),
         )
 
 
@@ -1074,8 +1079,8 @@ class BusServoReadTemperatureRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_temperature'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
 
     def __init__(
         self,
@@ -1092,7 +1097,7 @@ class BusServoReadTemperatureRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_temperature request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -1105,12 +1110,12 @@ class BusServoReadTemperatureResponse(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_temperature'
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
+    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0. range -1..0
     success: ReadResult | int
-    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
-    temperature: int
     #: Temperature. [°C]
+    temperature: int
 
     def __init__(
         self,
@@ -1133,9 +1138,9 @@ class BusServoReadTemperatureResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_temperature response') -> Self:
         _check_keys(data, ('servo_id', 'success', 'temperature'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _enum(ReadResult, _get(data, 'success', where)),
-            _get(data, 'temperature', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(ReadResult, _get(data, 'success', where), 'success', where),
+            _integer(_get(data, 'temperature', where), 'temperature', where),
         )
 
 
@@ -1148,8 +1153,8 @@ class BusServoStopRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'stop'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servos: tuple[ServosItem, ...]
     #: The servos to stop.
+    servos: tuple[ServosItem, ...]
 
     def __init__(
         self,
@@ -1166,7 +1171,7 @@ class BusServoStopRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.stop request') -> Self:
         _check_keys(data, ('servos',), ('subcommand_code', 'count'), where)
         return cls(
-            tuple(ServosItem.from_fields(_mapping(item, 'servos', where), where) for item in _get(data, 'servos', where)),
+            tuple(ServosItem.from_fields(_mapping(item, 'servos', where), where) for item in _items(_get(data, 'servos', where), 'servos', where)),
         )
 
 
@@ -1179,8 +1184,8 @@ class BusServoReadTorqueRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_torque'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
 
     def __init__(
         self,
@@ -1197,7 +1202,7 @@ class BusServoReadTorqueRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_torque request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -1210,12 +1215,12 @@ class BusServoReadTorqueResponse(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_torque'
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
+    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0. range -1..0
     success: ReadResult | int
-    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
-    torque: int
     #: 1 while the torque is on (after load, 0x0C), 0 after unload (0x0B).
+    torque: int
 
     def __init__(
         self,
@@ -1238,9 +1243,9 @@ class BusServoReadTorqueResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_torque response') -> Self:
         _check_keys(data, ('servo_id', 'success', 'torque'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _enum(ReadResult, _get(data, 'success', where)),
-            _get(data, 'torque', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(ReadResult, _get(data, 'success', where), 'success', where),
+            _integer(_get(data, 'torque', where), 'torque', where),
         )
 
 
@@ -1253,8 +1258,8 @@ class BusServoUnloadRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'unload'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
 
     def __init__(
         self,
@@ -1271,7 +1276,7 @@ class BusServoUnloadRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.unload request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -1284,8 +1289,8 @@ class BusServoLoadRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'load'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
 
     def __init__(
         self,
@@ -1302,7 +1307,7 @@ class BusServoLoadRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.load request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -1315,10 +1320,10 @@ class BusServoSetIdRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'set_id'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: The servo's current id.
-    new_id: int
+    servo_id: int
     #: The id to store (save_id).
+    new_id: int
 
     def __init__(
         self,
@@ -1338,8 +1343,8 @@ class BusServoSetIdRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.set_id request') -> Self:
         _check_keys(data, ('servo_id', 'new_id'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'new_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'new_id', where), 'new_id', where),
         )
 
 
@@ -1352,8 +1357,8 @@ class BusServoReadIdRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_id'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: 0xFE (broadcast query, 查询广播).
+    servo_id: int
 
     def __init__(
         self,
@@ -1370,7 +1375,7 @@ class BusServoReadIdRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_id request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
         return cls(
-            data.get('servo_id', 254),
+            _integer(data.get('servo_id', 254), 'servo_id', where),
         )
 
 
@@ -1383,12 +1388,12 @@ class BusServoReadIdResponse(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_id'
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: The id the request was sent to (0xFE for the broadcast).
+    servo_id: int
+    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0. range -1..0
     success: ReadResult | int
-    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
-    id: int
     #: The id read from the servo.
+    id: int
 
     def __init__(
         self,
@@ -1411,9 +1416,9 @@ class BusServoReadIdResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_id response') -> Self:
         _check_keys(data, ('servo_id', 'success', 'id'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _enum(ReadResult, _get(data, 'success', where)),
-            _get(data, 'id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(ReadResult, _get(data, 'success', where), 'success', where),
+            _integer(_get(data, 'id', where), 'id', where),
         )
 
 
@@ -1426,10 +1431,10 @@ class BusServoSetOffsetRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'set_offset'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
-    offset: int
+    servo_id: int
     #: Bus servo offset (偏差), an int8 from -125 to +125 (about -30°..30°); 002 and 003 give the PWM offset's -100..+100 (erratum bus_offset_range). range -125..125
+    offset: int
 
     def __init__(
         self,
@@ -1449,8 +1454,8 @@ class BusServoSetOffsetRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.set_offset request') -> Self:
         _check_keys(data, ('servo_id', 'offset'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'offset', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'offset', where), 'offset', where),
         )
 
 
@@ -1463,8 +1468,8 @@ class BusServoReadOffsetRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_offset'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
 
     def __init__(
         self,
@@ -1481,7 +1486,7 @@ class BusServoReadOffsetRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_offset request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -1494,12 +1499,12 @@ class BusServoReadOffsetResponse(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_offset'
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
+    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0. range -1..0
     success: ReadResult | int
-    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
-    offset: int
     #: The servo's offset (int8; -125..125 when set through 0x20).
+    offset: int
 
     def __init__(
         self,
@@ -1522,9 +1527,9 @@ class BusServoReadOffsetResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_offset response') -> Self:
         _check_keys(data, ('servo_id', 'success', 'offset'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _enum(ReadResult, _get(data, 'success', where)),
-            _get(data, 'offset', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(ReadResult, _get(data, 'success', where), 'success', where),
+            _integer(_get(data, 'offset', where), 'offset', where),
         )
 
 
@@ -1537,8 +1542,8 @@ class BusServoSaveOffsetRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'save_offset'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
 
     def __init__(
         self,
@@ -1555,7 +1560,7 @@ class BusServoSaveOffsetRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.save_offset request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -1568,12 +1573,12 @@ class BusServoSetPositionLimitRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'set_position_limit'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
-    low: int
+    servo_id: int
     #: Low position limit (低限位), 0..1000. range 0..1000
-    high: int
+    low: int
     #: High position limit (高限位), 0..1000. range 0..1000
+    high: int
 
     def __init__(
         self,
@@ -1596,9 +1601,9 @@ class BusServoSetPositionLimitRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.set_position_limit request') -> Self:
         _check_keys(data, ('servo_id', 'low', 'high'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'low', where),
-            _get(data, 'high', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'low', where), 'low', where),
+            _integer(_get(data, 'high', where), 'high', where),
         )
 
 
@@ -1611,8 +1616,8 @@ class BusServoReadPositionLimitRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_position_limit'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
 
     def __init__(
         self,
@@ -1629,7 +1634,7 @@ class BusServoReadPositionLimitRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_position_limit request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -1642,14 +1647,14 @@ class BusServoReadPositionLimitResponse(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_position_limit'
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
+    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0. range -1..0
     success: ReadResult | int
-    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
-    low: int
     #: Low position limit.
-    high: int
+    low: int
     #: High position limit.
+    high: int
 
     def __init__(
         self,
@@ -1675,10 +1680,10 @@ class BusServoReadPositionLimitResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_position_limit response') -> Self:
         _check_keys(data, ('servo_id', 'success', 'low', 'high'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _enum(ReadResult, _get(data, 'success', where)),
-            _get(data, 'low', where),
-            _get(data, 'high', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(ReadResult, _get(data, 'success', where), 'success', where),
+            _integer(_get(data, 'low', where), 'low', where),
+            _integer(_get(data, 'high', where), 'high', where),
         )
 
 
@@ -1691,12 +1696,12 @@ class BusServoSetVoltageLimitRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'set_voltage_limit'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
-    low: int
+    servo_id: int
     #: Low voltage limit (低限位), at least 4500 mV. [mV] range 4500..14000
-    high: int
+    low: int
     #: High voltage limit (高限位), at most 14000 mV. [mV] range 4500..14000
+    high: int
 
     def __init__(
         self,
@@ -1719,9 +1724,9 @@ class BusServoSetVoltageLimitRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.set_voltage_limit request') -> Self:
         _check_keys(data, ('servo_id', 'low', 'high'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'low', where),
-            _get(data, 'high', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'low', where), 'low', where),
+            _integer(_get(data, 'high', where), 'high', where),
         )
 
 
@@ -1734,8 +1739,8 @@ class BusServoReadVoltageLimitRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_voltage_limit'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
 
     def __init__(
         self,
@@ -1752,7 +1757,7 @@ class BusServoReadVoltageLimitRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_voltage_limit request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -1765,14 +1770,14 @@ class BusServoReadVoltageLimitResponse(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_voltage_limit'
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
+    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0. range -1..0
     success: ReadResult | int
-    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
-    low: int
     #: Low voltage limit. [mV]
-    high: int
+    low: int
     #: High voltage limit. [mV]
+    high: int
 
     def __init__(
         self,
@@ -1798,10 +1803,10 @@ class BusServoReadVoltageLimitResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_voltage_limit response') -> Self:
         _check_keys(data, ('servo_id', 'success', 'low', 'high'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _enum(ReadResult, _get(data, 'success', where)),
-            _get(data, 'low', where),
-            _get(data, 'high', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(ReadResult, _get(data, 'success', where), 'success', where),
+            _integer(_get(data, 'low', where), 'low', where),
+            _integer(_get(data, 'high', where), 'high', where),
         )
 
 
@@ -1814,10 +1819,10 @@ class BusServoSetTemperatureLimitRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'set_temperature_limit'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
-    limit: int
+    servo_id: int
     #: Over-temperature threshold (高温阈值); must be less than 100 °C. [°C] range 0..99
+    limit: int
 
     def __init__(
         self,
@@ -1837,8 +1842,8 @@ class BusServoSetTemperatureLimitRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.set_temperature_limit request') -> Self:
         _check_keys(data, ('servo_id', 'limit'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _get(data, 'limit', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _integer(_get(data, 'limit', where), 'limit', where),
         )
 
 
@@ -1851,8 +1856,8 @@ class BusServoReadTemperatureLimitRequest(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_temperature_limit'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
 
     def __init__(
         self,
@@ -1869,7 +1874,7 @@ class BusServoReadTemperatureLimitRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_temperature_limit request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
 
 
@@ -1882,12 +1887,12 @@ class BusServoReadTemperatureLimitResponse(Message):
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_temperature_limit'
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    servo_id: int
     #: Bus servo id (0xFE is the broadcast id).
+    servo_id: int
+    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0. range -1..0
     success: ReadResult | int
-    #: Whether the board could read the servo (是否读取成功); the value that follows is valid only if 0.
-    limit: int
     #: Over-temperature threshold. [°C]
+    limit: int
 
     def __init__(
         self,
@@ -1910,9 +1915,9 @@ class BusServoReadTemperatureLimitResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_temperature_limit response') -> Self:
         _check_keys(data, ('servo_id', 'success', 'limit'), ('subcommand_code',), where)
         return cls(
-            _get(data, 'servo_id', where),
-            _enum(ReadResult, _get(data, 'success', where)),
-            _get(data, 'limit', where),
+            _integer(_get(data, 'servo_id', where), 'servo_id', where),
+            _as_enum(ReadResult, _get(data, 'success', where), 'success', where),
+            _integer(_get(data, 'limit', where), 'limit', where),
         )
 
 
@@ -1925,10 +1930,10 @@ class KeyResponse(Message):
     COMMAND: ClassVar[str] = 'key'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    button_id: int
     #: Button id.
+    button_id: int
+    #: What happened to the button (按键事件). range 1..128
     event: ButtonEvent | int
-    #: What happened to the button (按键事件).
 
     def __init__(
         self,
@@ -1948,8 +1953,8 @@ class KeyResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'key response') -> Self:
         _check_keys(data, ('button_id', 'event'), (), where)
         return cls(
-            _get(data, 'button_id', where),
-            _enum(ButtonEvent, _get(data, 'event', where)),
+            _integer(_get(data, 'button_id', where), 'button_id', where),
+            _as_enum(ButtonEvent, _get(data, 'event', where), 'event', where),
         )
 
 
@@ -1962,18 +1967,18 @@ class ImuResponse(Message):
     COMMAND: ClassVar[str] = 'imu'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    accel_x: float
     #: Acceleration along x.
-    accel_y: float
+    accel_x: float
     #: Acceleration along y.
-    accel_z: float
+    accel_y: float
     #: Acceleration along z.
-    gyro_x: float
+    accel_z: float
     #: Angular rate about x.
-    gyro_y: float
+    gyro_x: float
     #: Angular rate about y.
-    gyro_z: float
+    gyro_y: float
     #: Angular rate about z.
+    gyro_z: float
 
     def __init__(
         self,
@@ -2005,12 +2010,12 @@ class ImuResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'imu response') -> Self:
         _check_keys(data, ('accel_x', 'accel_y', 'accel_z', 'gyro_x', 'gyro_y', 'gyro_z'), (), where)
         return cls(
-            _get(data, 'accel_x', where),
-            _get(data, 'accel_y', where),
-            _get(data, 'accel_z', where),
-            _get(data, 'gyro_x', where),
-            _get(data, 'gyro_y', where),
-            _get(data, 'gyro_z', where),
+            _number(_get(data, 'accel_x', where), 'accel_x', where),
+            _number(_get(data, 'accel_y', where), 'accel_y', where),
+            _number(_get(data, 'accel_z', where), 'accel_z', where),
+            _number(_get(data, 'gyro_x', where), 'gyro_x', where),
+            _number(_get(data, 'gyro_y', where), 'gyro_y', where),
+            _number(_get(data, 'gyro_z', where), 'gyro_z', where),
         )
 
 
@@ -2023,18 +2028,18 @@ class GamepadResponse(Message):
     COMMAND: ClassVar[str] = 'gamepad'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    buttons: GamepadButtons
     #: Buttons held (按键), one bit per button (bits from the SDK).
-    hat: int
+    buttons: GamepadButtons
     #: Direction pad (hat) value; the SDK reads 9 as right (hat x +1), 13 as left (-1), 11 as up (hat y -1) and 15 as down (+1) in its axes; other values are not documented.
-    left_x: int
+    hat: int
     #: Left stick x.
-    left_y: int
+    left_x: int
     #: Left stick y.
-    right_x: int
+    left_y: int
     #: Right stick x.
-    right_y: int
+    right_x: int
     #: Right stick y.
+    right_y: int
 
     def __init__(
         self,
@@ -2066,12 +2071,12 @@ class GamepadResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'gamepad response') -> Self:
         _check_keys(data, ('buttons', 'hat', 'left_x', 'left_y', 'right_x', 'right_y'), (), where)
         return cls(
-            GamepadButtons(_get(data, 'buttons', where)),
-            _get(data, 'hat', where),
-            _get(data, 'left_x', where),
-            _get(data, 'left_y', where),
-            _get(data, 'right_x', where),
-            _get(data, 'right_y', where),
+            _as_flags(GamepadButtons, _get(data, 'buttons', where), 65535, 'buttons', where),
+            _integer(_get(data, 'hat', where), 'hat', where),
+            _integer(_get(data, 'left_x', where), 'left_x', where),
+            _integer(_get(data, 'left_y', where), 'left_y', where),
+            _integer(_get(data, 'right_x', where), 'right_x', where),
+            _integer(_get(data, 'right_y', where), 'right_y', where),
         )
 
 
@@ -2084,16 +2089,16 @@ class SbusResponse(Message):
     COMMAND: ClassVar[str] = 'sbus'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    channels: tuple[int, ...]
     #: The 16 proportional channels.
-    ch17: int
+    channels: tuple[int, ...]
     #: Digital channel 17.
-    ch18: int
+    ch17: int
     #: Digital channel 18.
-    signal_loss: int
+    ch18: int
     #: Set when the receiver has lost the signal.
-    fail_safe: int
+    signal_loss: int
     #: Set when the receiver is in fail-safe.
+    fail_safe: int
 
     def __init__(
         self,
@@ -2122,11 +2127,11 @@ class SbusResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'sbus response') -> Self:
         _check_keys(data, ('channels', 'ch17', 'ch18', 'signal_loss', 'fail_safe'), (), where)
         return cls(
-            tuple(_get(data, 'channels', where)),
-            _get(data, 'ch17', where),
-            _get(data, 'ch18', where),
-            _get(data, 'signal_loss', where),
-            _get(data, 'fail_safe', where),
+            _integers(_get(data, 'channels', where), 'channels', where),
+            _integer(_get(data, 'ch17', where), 'ch17', where),
+            _integer(_get(data, 'ch18', where), 'ch18', where),
+            _integer(_get(data, 'signal_loss', where), 'signal_loss', where),
+            _integer(_get(data, 'fail_safe', where), 'fail_safe', where),
         )
 
 
@@ -2139,8 +2144,8 @@ class SystemBatteryResponse(Message):
     COMMAND: ClassVar[str] = 'system'
     SUBCOMMAND: ClassVar[str | None] = 'battery'
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    voltage: int
     #: Battery voltage. [mV]
+    voltage: int
 
     def __init__(
         self,
@@ -2157,7 +2162,7 @@ class SystemBatteryResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'system.battery response') -> Self:
         _check_keys(data, ('voltage',), ('subcommand_code',), where)
         return cls(
-            _get(data, 'voltage', where),
+            _integer(_get(data, 'voltage', where), 'voltage', where),
         )
 
 
@@ -2170,10 +2175,10 @@ class OledRequest(Message):
     COMMAND: ClassVar[str] = 'oled'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    line: int
     #: Display line (1 or 2 in the SDK's example).
-    text: bytes
+    line: int
     #: The text (UTF-8).
+    text: bytes
 
     def __init__(
         self,
@@ -2193,7 +2198,7 @@ class OledRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'oled request') -> Self:
         _check_keys(data, ('line', 'text'), ('length',), where)
         return cls(
-            _get(data, 'line', where),
+            _integer(_get(data, 'line', where), 'line', where),
             _bytes(_get(data, 'text', where), 'text', where),
         )
 
@@ -2207,8 +2212,8 @@ class RgbSetPixelsRequest(Message):
     COMMAND: ClassVar[str] = 'rgb'
     SUBCOMMAND: ClassVar[str | None] = 'set_pixels'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    pixels: tuple[PixelsItem, ...]
     #: One (index, red, green, blue) per LED.
+    pixels: tuple[PixelsItem, ...]
 
     def __init__(
         self,
@@ -2225,7 +2230,7 @@ class RgbSetPixelsRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'rgb.set_pixels request') -> Self:
         _check_keys(data, ('pixels',), ('subcommand_code', 'count'), where)
         return cls(
-            tuple(PixelsItem.from_fields(_mapping(item, 'pixels', where), where) for item in _get(data, 'pixels', where)),
+            tuple(PixelsItem.from_fields(_mapping(item, 'pixels', where), where) for item in _items(_get(data, 'pixels', where), 'pixels', where)),
         )
 
 

@@ -182,7 +182,7 @@ class ModbusRtuClient(ClientBase):
         Args:
             unit: Server (slave) address 1..247; 0 is the broadcast address: every server carries out a write and none answers (serial §2.2). Replies carry the answering server's own address. (1..247)
             address: Address of the first item (0x0000..0xFFFF; 'item N' is address N-1 in the data model).
-            value: FF 00: ON, 00 00: OFF.
+            value: FF 00: ON, 00 00: OFF. (0..65280)
 
         Returns: True if the device answered, False if it stayed silent (timeout).
         None when no reply is due (broadcast gets no reply).

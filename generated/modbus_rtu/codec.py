@@ -8,6 +8,7 @@ from collections.abc import Callable
 
 from serialspec.runtime.checksums import crc_function
 from serialspec.runtime.errors import DecodeError, EncodeError, content_size_error, out_of_range
+from serialspec.runtime.fields import wrong_type
 from serialspec.runtime.framing import ERROR_REPLY, Element, EngineFormat, FrameCodec, Layout, SizeRule
 from serialspec.runtime.framing import FrameStreamParser as _FrameStreamParser
 from serialspec.runtime.message import Direction, Message, members, slot_setters
@@ -418,17 +419,17 @@ def _decode_exception_response(buf: bytes, o: int, end: int, unit: int, function
 
 
 def _encode_read_coils_request(m: ReadCoilsRequest) -> bytes:
-    if not 0 <= m.unit <= 247:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('read_coils request', 'unit', m.unit, 1, 247)
-    if not 0 <= m.address <= 65535:
+    if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('read_coils request', 'address', m.address, 0, 65535)
-    if not 1 <= m.count <= 2000:
+    if not 1 <= m.count <= 2000 or m.count.__class__ is bool:
         raise out_of_range('read_coils request', 'count', m.count, 1, 2000)
     return _REQUEST_FRAMES.wrap(_S_BE_U16_U16.pack(m.address, m.count), 0x01, (m.unit,))
 
 
 def _encode_read_coils_response(m: ReadCoilsResponse) -> bytes:
-    if not 0 <= m.unit <= 247:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('read_coils response', 'unit', m.unit, 1, 247)
     v_byte_count = (-(-len(m.coils) // 8))
     if not 0 <= v_byte_count <= 255:
@@ -437,17 +438,17 @@ def _encode_read_coils_response(m: ReadCoilsResponse) -> bytes:
 
 
 def _encode_read_discrete_inputs_request(m: ReadDiscreteInputsRequest) -> bytes:
-    if not 0 <= m.unit <= 247:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('read_discrete_inputs request', 'unit', m.unit, 1, 247)
-    if not 0 <= m.address <= 65535:
+    if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('read_discrete_inputs request', 'address', m.address, 0, 65535)
-    if not 1 <= m.count <= 2000:
+    if not 1 <= m.count <= 2000 or m.count.__class__ is bool:
         raise out_of_range('read_discrete_inputs request', 'count', m.count, 1, 2000)
     return _REQUEST_FRAMES.wrap(_S_BE_U16_U16.pack(m.address, m.count), 0x02, (m.unit,))
 
 
 def _encode_read_discrete_inputs_response(m: ReadDiscreteInputsResponse) -> bytes:
-    if not 0 <= m.unit <= 247:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('read_discrete_inputs response', 'unit', m.unit, 1, 247)
     v_byte_count = (-(-len(m.inputs) // 8))
     if not 0 <= v_byte_count <= 255:
@@ -456,17 +457,17 @@ def _encode_read_discrete_inputs_response(m: ReadDiscreteInputsResponse) -> byte
 
 
 def _encode_read_holding_registers_request(m: ReadHoldingRegistersRequest) -> bytes:
-    if not 0 <= m.unit <= 247:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('read_holding_registers request', 'unit', m.unit, 1, 247)
-    if not 0 <= m.address <= 65535:
+    if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('read_holding_registers request', 'address', m.address, 0, 65535)
-    if not 1 <= m.count <= 125:
+    if not 1 <= m.count <= 125 or m.count.__class__ is bool:
         raise out_of_range('read_holding_registers request', 'count', m.count, 1, 125)
     return _REQUEST_FRAMES.wrap(_S_BE_U16_U16.pack(m.address, m.count), 0x03, (m.unit,))
 
 
 def _encode_read_holding_registers_response(m: ReadHoldingRegistersResponse) -> bytes:
-    if not 0 <= m.unit <= 247:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('read_holding_registers response', 'unit', m.unit, 1, 247)
     v_byte_count = (2 * len(m.registers))
     if not 0 <= v_byte_count <= 255:
@@ -477,17 +478,17 @@ def _encode_read_holding_registers_response(m: ReadHoldingRegistersResponse) -> 
 
 
 def _encode_read_input_registers_request(m: ReadInputRegistersRequest) -> bytes:
-    if not 0 <= m.unit <= 247:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('read_input_registers request', 'unit', m.unit, 1, 247)
-    if not 0 <= m.address <= 65535:
+    if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('read_input_registers request', 'address', m.address, 0, 65535)
-    if not 1 <= m.count <= 125:
+    if not 1 <= m.count <= 125 or m.count.__class__ is bool:
         raise out_of_range('read_input_registers request', 'count', m.count, 1, 125)
     return _REQUEST_FRAMES.wrap(_S_BE_U16_U16.pack(m.address, m.count), 0x04, (m.unit,))
 
 
 def _encode_read_input_registers_response(m: ReadInputRegistersResponse) -> bytes:
-    if not 0 <= m.unit <= 247:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('read_input_registers response', 'unit', m.unit, 1, 247)
     v_byte_count = (2 * len(m.registers))
     if not 0 <= v_byte_count <= 255:
@@ -498,49 +499,49 @@ def _encode_read_input_registers_response(m: ReadInputRegistersResponse) -> byte
 
 
 def _encode_write_coil_request(m: WriteCoilRequest) -> bytes:
-    if not 0 <= m.unit <= 247:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('write_coil request', 'unit', m.unit, 1, 247)
-    if not 0 <= m.address <= 65535:
+    if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('write_coil request', 'address', m.address, 0, 65535)
-    if not 0 <= m.value <= 65535:
-        raise out_of_range('write_coil request', 'value', m.value, 0, 65535)
+    if not 0 <= m.value <= 65280 or m.value.__class__ is bool:
+        raise out_of_range('write_coil request', 'value', m.value, 0, 65280)
     return _REQUEST_FRAMES.wrap(_S_BE_U16_U16.pack(m.address, m.value), 0x05, (m.unit,))
 
 
 def _encode_write_coil_response(m: WriteCoilResponse) -> bytes:
-    if not 0 <= m.unit <= 247:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('write_coil response', 'unit', m.unit, 1, 247)
-    if not 0 <= m.address <= 65535:
+    if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('write_coil response', 'address', m.address, 0, 65535)
-    if not 0 <= m.value <= 65535:
-        raise out_of_range('write_coil response', 'value', m.value, 0, 65535)
+    if not 0 <= m.value <= 65280 or m.value.__class__ is bool:
+        raise out_of_range('write_coil response', 'value', m.value, 0, 65280)
     return _RESPONSE_FRAMES.wrap(_S_BE_U16_U16.pack(m.address, m.value), 0x05, (m.unit,))
 
 
 def _encode_write_register_request(m: WriteRegisterRequest) -> bytes:
-    if not 0 <= m.unit <= 247:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('write_register request', 'unit', m.unit, 1, 247)
-    if not 0 <= m.address <= 65535:
+    if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('write_register request', 'address', m.address, 0, 65535)
-    if not 0 <= m.value <= 65535:
+    if not 0 <= m.value <= 65535 or m.value.__class__ is bool:
         raise out_of_range('write_register request', 'value', m.value, 0, 65535)
     return _REQUEST_FRAMES.wrap(_S_BE_U16_U16.pack(m.address, m.value), 0x06, (m.unit,))
 
 
 def _encode_write_register_response(m: WriteRegisterResponse) -> bytes:
-    if not 0 <= m.unit <= 247:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('write_register response', 'unit', m.unit, 1, 247)
-    if not 0 <= m.address <= 65535:
+    if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('write_register response', 'address', m.address, 0, 65535)
-    if not 0 <= m.value <= 65535:
+    if not 0 <= m.value <= 65535 or m.value.__class__ is bool:
         raise out_of_range('write_register response', 'value', m.value, 0, 65535)
     return _RESPONSE_FRAMES.wrap(_S_BE_U16_U16.pack(m.address, m.value), 0x06, (m.unit,))
 
 
 def _encode_write_coils_request(m: WriteCoilsRequest) -> bytes:
-    if not 0 <= m.unit <= 247:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('write_coils request', 'unit', m.unit, 1, 247)
-    if not 0 <= m.address <= 65535:
+    if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('write_coils request', 'address', m.address, 0, 65535)
     v_count = len(m.values)
     if not 1 <= v_count <= 1968:
@@ -552,19 +553,19 @@ def _encode_write_coils_request(m: WriteCoilsRequest) -> bytes:
 
 
 def _encode_write_coils_response(m: WriteCoilsResponse) -> bytes:
-    if not 0 <= m.unit <= 247:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('write_coils response', 'unit', m.unit, 1, 247)
-    if not 0 <= m.address <= 65535:
+    if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('write_coils response', 'address', m.address, 0, 65535)
-    if not 0 <= m.count <= 65535:
+    if not 0 <= m.count <= 65535 or m.count.__class__ is bool:
         raise out_of_range('write_coils response', 'count', m.count, 0, 65535)
     return _RESPONSE_FRAMES.wrap(_S_BE_U16_U16.pack(m.address, m.count), 0x0f, (m.unit,))
 
 
 def _encode_write_registers_request(m: WriteRegistersRequest) -> bytes:
-    if not 0 <= m.unit <= 247:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('write_registers request', 'unit', m.unit, 1, 247)
-    if not 0 <= m.address <= 65535:
+    if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('write_registers request', 'address', m.address, 0, 65535)
     v_count = len(m.values)
     if not 1 <= v_count <= 123:
@@ -578,47 +579,47 @@ def _encode_write_registers_request(m: WriteRegistersRequest) -> bytes:
 
 
 def _encode_write_registers_response(m: WriteRegistersResponse) -> bytes:
-    if not 0 <= m.unit <= 247:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('write_registers response', 'unit', m.unit, 1, 247)
-    if not 0 <= m.address <= 65535:
+    if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('write_registers response', 'address', m.address, 0, 65535)
-    if not 0 <= m.count <= 65535:
+    if not 0 <= m.count <= 65535 or m.count.__class__ is bool:
         raise out_of_range('write_registers response', 'count', m.count, 0, 65535)
     return _RESPONSE_FRAMES.wrap(_S_BE_U16_U16.pack(m.address, m.count), 0x10, (m.unit,))
 
 
 def _encode_mask_write_register_request(m: MaskWriteRegisterRequest) -> bytes:
-    if not 0 <= m.unit <= 247:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('mask_write_register request', 'unit', m.unit, 1, 247)
-    if not 0 <= m.address <= 65535:
+    if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('mask_write_register request', 'address', m.address, 0, 65535)
-    if not 0 <= m.and_mask <= 65535:
+    if not 0 <= m.and_mask <= 65535 or m.and_mask.__class__ is bool:
         raise out_of_range('mask_write_register request', 'and_mask', m.and_mask, 0, 65535)
-    if not 0 <= m.or_mask <= 65535:
+    if not 0 <= m.or_mask <= 65535 or m.or_mask.__class__ is bool:
         raise out_of_range('mask_write_register request', 'or_mask', m.or_mask, 0, 65535)
     return _REQUEST_FRAMES.wrap(_S_BE_U16_U16_U16.pack(m.address, m.and_mask, m.or_mask), 0x16, (m.unit,))
 
 
 def _encode_mask_write_register_response(m: MaskWriteRegisterResponse) -> bytes:
-    if not 0 <= m.unit <= 247:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('mask_write_register response', 'unit', m.unit, 1, 247)
-    if not 0 <= m.address <= 65535:
+    if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('mask_write_register response', 'address', m.address, 0, 65535)
-    if not 0 <= m.and_mask <= 65535:
+    if not 0 <= m.and_mask <= 65535 or m.and_mask.__class__ is bool:
         raise out_of_range('mask_write_register response', 'and_mask', m.and_mask, 0, 65535)
-    if not 0 <= m.or_mask <= 65535:
+    if not 0 <= m.or_mask <= 65535 or m.or_mask.__class__ is bool:
         raise out_of_range('mask_write_register response', 'or_mask', m.or_mask, 0, 65535)
     return _RESPONSE_FRAMES.wrap(_S_BE_U16_U16_U16.pack(m.address, m.and_mask, m.or_mask), 0x16, (m.unit,))
 
 
 def _encode_read_write_registers_request(m: ReadWriteRegistersRequest) -> bytes:
-    if not 0 <= m.unit <= 247:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('read_write_registers request', 'unit', m.unit, 1, 247)
-    if not 0 <= m.read_address <= 65535:
+    if not 0 <= m.read_address <= 65535 or m.read_address.__class__ is bool:
         raise out_of_range('read_write_registers request', 'read_address', m.read_address, 0, 65535)
-    if not 1 <= m.read_count <= 125:
+    if not 1 <= m.read_count <= 125 or m.read_count.__class__ is bool:
         raise out_of_range('read_write_registers request', 'read_count', m.read_count, 1, 125)
-    if not 0 <= m.write_address <= 65535:
+    if not 0 <= m.write_address <= 65535 or m.write_address.__class__ is bool:
         raise out_of_range('read_write_registers request', 'write_address', m.write_address, 0, 65535)
     v_write_count = len(m.values)
     if not 1 <= v_write_count <= 121:
@@ -632,7 +633,7 @@ def _encode_read_write_registers_request(m: ReadWriteRegistersRequest) -> bytes:
 
 
 def _encode_read_write_registers_response(m: ReadWriteRegistersResponse) -> bytes:
-    if not 0 <= m.unit <= 247:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('read_write_registers response', 'unit', m.unit, 1, 247)
     v_byte_count = (2 * len(m.registers))
     if not 0 <= v_byte_count <= 255:
@@ -643,12 +644,12 @@ def _encode_read_write_registers_response(m: ReadWriteRegistersResponse) -> byte
 
 
 def _encode_exception_response(m: ExceptionResponse) -> bytes:
-    if not 0 <= m.unit <= 247:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('exception response', 'unit', m.unit, 1, 247)
-    if not 0 <= m.function <= 127:
+    if not 0 <= m.function <= 127 or m.function.__class__ is bool:
         raise out_of_range('exception response', 'function', m.function, 0, 127)
-    if not 0 <= m.exception_code <= 255:
-        raise out_of_range('exception response', 'exception_code', m.exception_code, 0, 255)
+    if not 1 <= m.exception_code <= 11 or m.exception_code.__class__ is bool:
+        raise out_of_range('exception response', 'exception_code', m.exception_code, 1, 11)
     return _RESPONSE_FRAMES.wrap(_S_BE_U8.pack(m.exception_code), m.function | 0x80, (m.unit,))
 
 
@@ -798,8 +799,10 @@ def encode(message: Message) -> bytes:
         raise EncodeError(f"{type(message).__name__} is not a modbus_rtu message")
     try:
         return encoder(message)
-    except (TypeError, AttributeError, struct.error) as exc:
-        raise EncodeError(f"{message.COMMAND} {message.DIRECTION.value}: {exc}") from None
+    except EncodeError:
+        raise
+    except (TypeError, AttributeError, ValueError, OverflowError, struct.error) as exc:
+        raise wrong_type(message, exc) from None  # one line naming the field, not Python's words
 
 
 # Each direction's frames for code that splits a stream of both directions (serialspec monitor).

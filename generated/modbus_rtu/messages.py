@@ -8,9 +8,10 @@ from enum import IntEnum
 from typing import Any, ClassVar, Self
 
 from serialspec.runtime.fields import check_keys as _check_keys
+from serialspec.runtime.fields import enum as _as_enum
 from serialspec.runtime.fields import get as _get
+from serialspec.runtime.fields import integer as _integer
 from serialspec.runtime.message import Direction, Message
-from serialspec.runtime.message import enum_or_int as _enum
 
 _store = object.__setattr__  # how __init__ fills the slots of a frozen class
 
@@ -47,33 +48,33 @@ __all__ = [
 class ExceptionCode(IntEnum):
     """Why a server could not carry out a request (app §7)."""
 
-    ILLEGAL_FUNCTION = 1
     #: the function code is not supported by the server
-    ILLEGAL_DATA_ADDRESS = 2
+    ILLEGAL_FUNCTION = 1
     #: the data address, or address plus quantity, is outside the server's data
-    ILLEGAL_DATA_VALUE = 3
+    ILLEGAL_DATA_ADDRESS = 2
     #: a value in the request is not allowed (such as a quantity out of range)
-    SERVER_DEVICE_FAILURE = 4
+    ILLEGAL_DATA_VALUE = 3
     #: an unrecoverable error occurred while the server was doing it
-    ACKNOWLEDGE = 5
+    SERVER_DEVICE_FAILURE = 4
     #: accepted; it will take a long time (poll for completion)
-    SERVER_DEVICE_BUSY = 6
+    ACKNOWLEDGE = 5
     #: the server is busy with a long-duration command; retry later
-    MEMORY_PARITY_ERROR = 8
+    SERVER_DEVICE_BUSY = 6
     #: a parity error in the extended memory of a file record read
-    GATEWAY_PATH_UNAVAILABLE = 10
+    MEMORY_PARITY_ERROR = 8
     #: the gateway could not allocate a path to the target
-    GATEWAY_TARGET_FAILED = 11
+    GATEWAY_PATH_UNAVAILABLE = 10
     #: the gateway's target device did not respond
+    GATEWAY_TARGET_FAILED = 11
 
 
 class CoilState(IntEnum):
     """The value of Write Single Coil (app §6.5); any other value is an illegal data value."""
 
-    OFF = 0
     #: coil OFF
-    ON = 65280
+    OFF = 0
     #: coil ON
+    ON = 65280
 
 
 class ReadCoilsRequest(Message):
@@ -85,12 +86,12 @@ class ReadCoilsRequest(Message):
     COMMAND: ClassVar[str] = 'read_coils'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    unit: int
     #: Server (slave) address 1..247; 0 is the broadcast address: every server carries out a write and none answers (serial §2.2). Replies carry the answering server's own address. range 1..247
-    address: int
+    unit: int
     #: Address of the first item (0x0000..0xFFFF; 'item N' is address N-1 in the data model).
-    count: int
+    address: int
     #: Quantity of coils. range 1..2000
+    count: int
 
     def __init__(
         self,
@@ -113,9 +114,9 @@ class ReadCoilsRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'read_coils request') -> Self:
         _check_keys(data, ('unit', 'address', 'count'), (), where)
         return cls(
-            _get(data, 'unit', where),
-            _get(data, 'address', where),
-            _get(data, 'count', where),
+            _integer(_get(data, 'unit', where), 'unit', where),
+            _integer(_get(data, 'address', where), 'address', where),
+            _integer(_get(data, 'count', where), 'count', where),
         )
 
 
@@ -128,10 +129,10 @@ class ReadCoilsResponse(Message):
     COMMAND: ClassVar[str] = 'read_coils'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    unit: int
     #: Server (slave) address 1..247; 0 is the broadcast address: every server carries out a write and none answers (serial §2.2). Replies carry the answering server's own address. range 1..247
-    coils: tuple[bool, ...]
+    unit: int
     #: Coil states, 8 per byte, the first coil in the lowest bit of the first byte; the last byte is padded with zeros up to a multiple of 8 (the request's count says how many are coils).
+    coils: tuple[bool, ...]
 
     def __init__(
         self,
@@ -151,7 +152,7 @@ class ReadCoilsResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'read_coils response') -> Self:
         _check_keys(data, ('unit', 'coils'), ('byte_count',), where)
         return cls(
-            _get(data, 'unit', where),
+            _integer(_get(data, 'unit', where), 'unit', where),
             tuple(bool(x) for x in _get(data, 'coils', where)),
         )
 
@@ -165,12 +166,12 @@ class ReadDiscreteInputsRequest(Message):
     COMMAND: ClassVar[str] = 'read_discrete_inputs'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    unit: int
     #: Server (slave) address 1..247; 0 is the broadcast address: every server carries out a write and none answers (serial §2.2). Replies carry the answering server's own address. range 1..247
-    address: int
+    unit: int
     #: Address of the first item (0x0000..0xFFFF; 'item N' is address N-1 in the data model).
-    count: int
+    address: int
     #: Quantity of inputs. range 1..2000
+    count: int
 
     def __init__(
         self,
@@ -193,9 +194,9 @@ class ReadDiscreteInputsRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'read_discrete_inputs request') -> Self:
         _check_keys(data, ('unit', 'address', 'count'), (), where)
         return cls(
-            _get(data, 'unit', where),
-            _get(data, 'address', where),
-            _get(data, 'count', where),
+            _integer(_get(data, 'unit', where), 'unit', where),
+            _integer(_get(data, 'address', where), 'address', where),
+            _integer(_get(data, 'count', where), 'count', where),
         )
 
 
@@ -208,10 +209,10 @@ class ReadDiscreteInputsResponse(Message):
     COMMAND: ClassVar[str] = 'read_discrete_inputs'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    unit: int
     #: Server (slave) address 1..247; 0 is the broadcast address: every server carries out a write and none answers (serial §2.2). Replies carry the answering server's own address. range 1..247
-    inputs: tuple[bool, ...]
+    unit: int
     #: Input states, 8 per byte, lowest bit first; padded with zeros to a multiple of 8.
+    inputs: tuple[bool, ...]
 
     def __init__(
         self,
@@ -231,7 +232,7 @@ class ReadDiscreteInputsResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'read_discrete_inputs response') -> Self:
         _check_keys(data, ('unit', 'inputs'), ('byte_count',), where)
         return cls(
-            _get(data, 'unit', where),
+            _integer(_get(data, 'unit', where), 'unit', where),
             tuple(bool(x) for x in _get(data, 'inputs', where)),
         )
 
@@ -245,12 +246,12 @@ class ReadHoldingRegistersRequest(Message):
     COMMAND: ClassVar[str] = 'read_holding_registers'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    unit: int
     #: Server (slave) address 1..247; 0 is the broadcast address: every server carries out a write and none answers (serial §2.2). Replies carry the answering server's own address. range 1..247
-    address: int
+    unit: int
     #: Address of the first item (0x0000..0xFFFF; 'item N' is address N-1 in the data model).
-    count: int
+    address: int
     #: Quantity of registers. range 1..125
+    count: int
 
     def __init__(
         self,
@@ -273,9 +274,9 @@ class ReadHoldingRegistersRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'read_holding_registers request') -> Self:
         _check_keys(data, ('unit', 'address', 'count'), (), where)
         return cls(
-            _get(data, 'unit', where),
-            _get(data, 'address', where),
-            _get(data, 'count', where),
+            _integer(_get(data, 'unit', where), 'unit', where),
+            _integer(_get(data, 'address', where), 'address', where),
+            _integer(_get(data, 'count', where), 'count', where),
         )
 
 
@@ -288,10 +289,10 @@ class ReadHoldingRegistersResponse(Message):
     COMMAND: ClassVar[str] = 'read_holding_registers'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    unit: int
     #: Server (slave) address 1..247; 0 is the broadcast address: every server carries out a write and none answers (serial §2.2). Replies carry the answering server's own address. range 1..247
-    registers: tuple[int, ...]
+    unit: int
     #: The register values.
+    registers: tuple[int, ...]
 
     def __init__(
         self,
@@ -311,7 +312,7 @@ class ReadHoldingRegistersResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'read_holding_registers response') -> Self:
         _check_keys(data, ('unit', 'registers'), ('byte_count',), where)
         return cls(
-            _get(data, 'unit', where),
+            _integer(_get(data, 'unit', where), 'unit', where),
             tuple(_get(data, 'registers', where)),
         )
 
@@ -325,12 +326,12 @@ class ReadInputRegistersRequest(Message):
     COMMAND: ClassVar[str] = 'read_input_registers'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    unit: int
     #: Server (slave) address 1..247; 0 is the broadcast address: every server carries out a write and none answers (serial §2.2). Replies carry the answering server's own address. range 1..247
-    address: int
+    unit: int
     #: Address of the first item (0x0000..0xFFFF; 'item N' is address N-1 in the data model).
-    count: int
+    address: int
     #: Quantity of input registers. range 1..125
+    count: int
 
     def __init__(
         self,
@@ -353,9 +354,9 @@ class ReadInputRegistersRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'read_input_registers request') -> Self:
         _check_keys(data, ('unit', 'address', 'count'), (), where)
         return cls(
-            _get(data, 'unit', where),
-            _get(data, 'address', where),
-            _get(data, 'count', where),
+            _integer(_get(data, 'unit', where), 'unit', where),
+            _integer(_get(data, 'address', where), 'address', where),
+            _integer(_get(data, 'count', where), 'count', where),
         )
 
 
@@ -368,10 +369,10 @@ class ReadInputRegistersResponse(Message):
     COMMAND: ClassVar[str] = 'read_input_registers'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    unit: int
     #: Server (slave) address 1..247; 0 is the broadcast address: every server carries out a write and none answers (serial §2.2). Replies carry the answering server's own address. range 1..247
-    registers: tuple[int, ...]
+    unit: int
     #: The input register values.
+    registers: tuple[int, ...]
 
     def __init__(
         self,
@@ -391,7 +392,7 @@ class ReadInputRegistersResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'read_input_registers response') -> Self:
         _check_keys(data, ('unit', 'registers'), ('byte_count',), where)
         return cls(
-            _get(data, 'unit', where),
+            _integer(_get(data, 'unit', where), 'unit', where),
             tuple(_get(data, 'registers', where)),
         )
 
@@ -405,12 +406,12 @@ class WriteCoilRequest(Message):
     COMMAND: ClassVar[str] = 'write_coil'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    unit: int
     #: Server (slave) address 1..247; 0 is the broadcast address: every server carries out a write and none answers (serial §2.2). Replies carry the answering server's own address. range 1..247
-    address: int
+    unit: int
     #: Address of the first item (0x0000..0xFFFF; 'item N' is address N-1 in the data model).
+    address: int
+    #: FF 00: ON, 00 00: OFF. range 0..65280
     value: CoilState | int
-    #: FF 00: ON, 00 00: OFF.
 
     def __init__(
         self,
@@ -433,9 +434,9 @@ class WriteCoilRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'write_coil request') -> Self:
         _check_keys(data, ('unit', 'address', 'value'), (), where)
         return cls(
-            _get(data, 'unit', where),
-            _get(data, 'address', where),
-            _enum(CoilState, _get(data, 'value', where)),
+            _integer(_get(data, 'unit', where), 'unit', where),
+            _integer(_get(data, 'address', where), 'address', where),
+            _as_enum(CoilState, _get(data, 'value', where), 'value', where),
         )
 
 
@@ -448,12 +449,12 @@ class WriteCoilResponse(Message):
     COMMAND: ClassVar[str] = 'write_coil'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    unit: int
     #: Server (slave) address 1..247; 0 is the broadcast address: every server carries out a write and none answers (serial §2.2). Replies carry the answering server's own address. range 1..247
-    address: int
+    unit: int
     #: Address of the first item (0x0000..0xFFFF; 'item N' is address N-1 in the data model).
+    address: int
+    #: The value written. range 0..65280
     value: CoilState | int
-    #: The value written.
 
     def __init__(
         self,
@@ -476,9 +477,9 @@ class WriteCoilResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'write_coil response') -> Self:
         _check_keys(data, ('unit', 'address', 'value'), (), where)
         return cls(
-            _get(data, 'unit', where),
-            _get(data, 'address', where),
-            _enum(CoilState, _get(data, 'value', where)),
+            _integer(_get(data, 'unit', where), 'unit', where),
+            _integer(_get(data, 'address', where), 'address', where),
+            _as_enum(CoilState, _get(data, 'value', where), 'value', where),
         )
 
 
@@ -491,12 +492,12 @@ class WriteRegisterRequest(Message):
     COMMAND: ClassVar[str] = 'write_register'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    unit: int
     #: Server (slave) address 1..247; 0 is the broadcast address: every server carries out a write and none answers (serial §2.2). Replies carry the answering server's own address. range 1..247
-    address: int
+    unit: int
     #: Address of the first item (0x0000..0xFFFF; 'item N' is address N-1 in the data model).
-    value: int
+    address: int
     #: The value to write.
+    value: int
 
     def __init__(
         self,
@@ -519,9 +520,9 @@ class WriteRegisterRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'write_register request') -> Self:
         _check_keys(data, ('unit', 'address', 'value'), (), where)
         return cls(
-            _get(data, 'unit', where),
-            _get(data, 'address', where),
-            _get(data, 'value', where),
+            _integer(_get(data, 'unit', where), 'unit', where),
+            _integer(_get(data, 'address', where), 'address', where),
+            _integer(_get(data, 'value', where), 'value', where),
         )
 
 
@@ -534,12 +535,12 @@ class WriteRegisterResponse(Message):
     COMMAND: ClassVar[str] = 'write_register'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    unit: int
     #: Server (slave) address 1..247; 0 is the broadcast address: every server carries out a write and none answers (serial §2.2). Replies carry the answering server's own address. range 1..247
-    address: int
+    unit: int
     #: Address of the first item (0x0000..0xFFFF; 'item N' is address N-1 in the data model).
-    value: int
+    address: int
     #: The value written.
+    value: int
 
     def __init__(
         self,
@@ -562,9 +563,9 @@ class WriteRegisterResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'write_register response') -> Self:
         _check_keys(data, ('unit', 'address', 'value'), (), where)
         return cls(
-            _get(data, 'unit', where),
-            _get(data, 'address', where),
-            _get(data, 'value', where),
+            _integer(_get(data, 'unit', where), 'unit', where),
+            _integer(_get(data, 'address', where), 'address', where),
+            _integer(_get(data, 'value', where), 'value', where),
         )
 
 
@@ -577,12 +578,12 @@ class WriteCoilsRequest(Message):
     COMMAND: ClassVar[str] = 'write_coils'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    unit: int
     #: Server (slave) address 1..247; 0 is the broadcast address: every server carries out a write and none answers (serial §2.2). Replies carry the answering server's own address. range 1..247
-    address: int
+    unit: int
     #: Address of the first item (0x0000..0xFFFF; 'item N' is address N-1 in the data model).
-    values: tuple[bool, ...]
+    address: int
     #: The coil values, 8 per byte, lowest bit first; the last byte padded with zeros.
+    values: tuple[bool, ...]
 
     def __init__(
         self,
@@ -605,8 +606,8 @@ class WriteCoilsRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'write_coils request') -> Self:
         _check_keys(data, ('unit', 'address', 'values'), ('count', 'byte_count'), where)
         return cls(
-            _get(data, 'unit', where),
-            _get(data, 'address', where),
+            _integer(_get(data, 'unit', where), 'unit', where),
+            _integer(_get(data, 'address', where), 'address', where),
             tuple(bool(x) for x in _get(data, 'values', where)),
         )
 
@@ -620,12 +621,12 @@ class WriteCoilsResponse(Message):
     COMMAND: ClassVar[str] = 'write_coils'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    unit: int
     #: Server (slave) address 1..247; 0 is the broadcast address: every server carries out a write and none answers (serial §2.2). Replies carry the answering server's own address. range 1..247
-    address: int
+    unit: int
     #: Address of the first item (0x0000..0xFFFF; 'item N' is address N-1 in the data model).
-    count: int
+    address: int
     #: Quantity of outputs written.
+    count: int
 
     def __init__(
         self,
@@ -648,9 +649,9 @@ class WriteCoilsResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'write_coils response') -> Self:
         _check_keys(data, ('unit', 'address', 'count'), (), where)
         return cls(
-            _get(data, 'unit', where),
-            _get(data, 'address', where),
-            _get(data, 'count', where),
+            _integer(_get(data, 'unit', where), 'unit', where),
+            _integer(_get(data, 'address', where), 'address', where),
+            _integer(_get(data, 'count', where), 'count', where),
         )
 
 
@@ -663,12 +664,12 @@ class WriteRegistersRequest(Message):
     COMMAND: ClassVar[str] = 'write_registers'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    unit: int
     #: Server (slave) address 1..247; 0 is the broadcast address: every server carries out a write and none answers (serial §2.2). Replies carry the answering server's own address. range 1..247
-    address: int
+    unit: int
     #: Address of the first item (0x0000..0xFFFF; 'item N' is address N-1 in the data model).
-    values: tuple[int, ...]
+    address: int
     #: The register values.
+    values: tuple[int, ...]
 
     def __init__(
         self,
@@ -691,8 +692,8 @@ class WriteRegistersRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'write_registers request') -> Self:
         _check_keys(data, ('unit', 'address', 'values'), ('count', 'byte_count'), where)
         return cls(
-            _get(data, 'unit', where),
-            _get(data, 'address', where),
+            _integer(_get(data, 'unit', where), 'unit', where),
+            _integer(_get(data, 'address', where), 'address', where),
             tuple(_get(data, 'values', where)),
         )
 
@@ -706,12 +707,12 @@ class WriteRegistersResponse(Message):
     COMMAND: ClassVar[str] = 'write_registers'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    unit: int
     #: Server (slave) address 1..247; 0 is the broadcast address: every server carries out a write and none answers (serial §2.2). Replies carry the answering server's own address. range 1..247
-    address: int
+    unit: int
     #: Address of the first item (0x0000..0xFFFF; 'item N' is address N-1 in the data model).
-    count: int
+    address: int
     #: Quantity of registers written.
+    count: int
 
     def __init__(
         self,
@@ -734,9 +735,9 @@ class WriteRegistersResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'write_registers response') -> Self:
         _check_keys(data, ('unit', 'address', 'count'), (), where)
         return cls(
-            _get(data, 'unit', where),
-            _get(data, 'address', where),
-            _get(data, 'count', where),
+            _integer(_get(data, 'unit', where), 'unit', where),
+            _integer(_get(data, 'address', where), 'address', where),
+            _integer(_get(data, 'count', where), 'count', where),
         )
 
 
@@ -749,14 +750,14 @@ class MaskWriteRegisterRequest(Message):
     COMMAND: ClassVar[str] = 'mask_write_register'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    unit: int
     #: Server (slave) address 1..247; 0 is the broadcast address: every server carries out a write and none answers (serial §2.2). Replies carry the answering server's own address. range 1..247
-    address: int
+    unit: int
     #: Address of the first item (0x0000..0xFFFF; 'item N' is address N-1 in the data model).
-    and_mask: int
+    address: int
     #: Bits kept from the current value.
-    or_mask: int
+    and_mask: int
     #: Bits set where and_mask is 0.
+    or_mask: int
 
     def __init__(
         self,
@@ -782,10 +783,10 @@ class MaskWriteRegisterRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'mask_write_register request') -> Self:
         _check_keys(data, ('unit', 'address', 'and_mask', 'or_mask'), (), where)
         return cls(
-            _get(data, 'unit', where),
-            _get(data, 'address', where),
-            _get(data, 'and_mask', where),
-            _get(data, 'or_mask', where),
+            _integer(_get(data, 'unit', where), 'unit', where),
+            _integer(_get(data, 'address', where), 'address', where),
+            _integer(_get(data, 'and_mask', where), 'and_mask', where),
+            _integer(_get(data, 'or_mask', where), 'or_mask', where),
         )
 
 
@@ -798,14 +799,14 @@ class MaskWriteRegisterResponse(Message):
     COMMAND: ClassVar[str] = 'mask_write_register'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    unit: int
     #: Server (slave) address 1..247; 0 is the broadcast address: every server carries out a write and none answers (serial §2.2). Replies carry the answering server's own address. range 1..247
-    address: int
+    unit: int
     #: Address of the first item (0x0000..0xFFFF; 'item N' is address N-1 in the data model).
-    and_mask: int
+    address: int
     #: The AND mask.
-    or_mask: int
+    and_mask: int
     #: The OR mask.
+    or_mask: int
 
     def __init__(
         self,
@@ -831,10 +832,10 @@ class MaskWriteRegisterResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'mask_write_register response') -> Self:
         _check_keys(data, ('unit', 'address', 'and_mask', 'or_mask'), (), where)
         return cls(
-            _get(data, 'unit', where),
-            _get(data, 'address', where),
-            _get(data, 'and_mask', where),
-            _get(data, 'or_mask', where),
+            _integer(_get(data, 'unit', where), 'unit', where),
+            _integer(_get(data, 'address', where), 'address', where),
+            _integer(_get(data, 'and_mask', where), 'and_mask', where),
+            _integer(_get(data, 'or_mask', where), 'or_mask', where),
         )
 
 
@@ -847,16 +848,16 @@ class ReadWriteRegistersRequest(Message):
     COMMAND: ClassVar[str] = 'read_write_registers'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    unit: int
     #: Server (slave) address 1..247; 0 is the broadcast address: every server carries out a write and none answers (serial §2.2). Replies carry the answering server's own address. range 1..247
-    read_address: int
+    unit: int
     #: First register to read.
-    read_count: int
+    read_address: int
     #: Quantity of registers to read. range 1..125
-    write_address: int
+    read_count: int
     #: First register to write.
-    values: tuple[int, ...]
+    write_address: int
     #: The values to write.
+    values: tuple[int, ...]
 
     def __init__(
         self,
@@ -885,10 +886,10 @@ class ReadWriteRegistersRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'read_write_registers request') -> Self:
         _check_keys(data, ('unit', 'read_address', 'read_count', 'write_address', 'values'), ('write_count', 'byte_count'), where)
         return cls(
-            _get(data, 'unit', where),
-            _get(data, 'read_address', where),
-            _get(data, 'read_count', where),
-            _get(data, 'write_address', where),
+            _integer(_get(data, 'unit', where), 'unit', where),
+            _integer(_get(data, 'read_address', where), 'read_address', where),
+            _integer(_get(data, 'read_count', where), 'read_count', where),
+            _integer(_get(data, 'write_address', where), 'write_address', where),
             tuple(_get(data, 'values', where)),
         )
 
@@ -902,10 +903,10 @@ class ReadWriteRegistersResponse(Message):
     COMMAND: ClassVar[str] = 'read_write_registers'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    unit: int
     #: Server (slave) address 1..247; 0 is the broadcast address: every server carries out a write and none answers (serial §2.2). Replies carry the answering server's own address. range 1..247
-    registers: tuple[int, ...]
+    unit: int
     #: The registers read.
+    registers: tuple[int, ...]
 
     def __init__(
         self,
@@ -925,7 +926,7 @@ class ReadWriteRegistersResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'read_write_registers response') -> Self:
         _check_keys(data, ('unit', 'registers'), ('byte_count',), where)
         return cls(
-            _get(data, 'unit', where),
+            _integer(_get(data, 'unit', where), 'unit', where),
             tuple(_get(data, 'registers', where)),
         )
 
@@ -939,12 +940,12 @@ class ExceptionResponse(Message):
     COMMAND: ClassVar[str] = 'exception'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    unit: int
     #: Server (slave) address 1..247; 0 is the broadcast address: every server carries out a write and none answers (serial §2.2). Replies carry the answering server's own address. range 1..247
-    function: int
+    unit: int
     #: The function code (app §5). A server that cannot carry a request out answers with the function code plus 0x80 and an exception code (app §7). range 0..127
+    function: int
+    #: Why the request was refused. range 1..11
     exception_code: ExceptionCode | int
-    #: Why the request was refused.
 
     def __init__(
         self,
@@ -967,9 +968,9 @@ class ExceptionResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'exception response') -> Self:
         _check_keys(data, ('unit', 'function', 'exception_code'), (), where)
         return cls(
-            _get(data, 'unit', where),
-            _get(data, 'function', where),
-            _enum(ExceptionCode, _get(data, 'exception_code', where)),
+            _integer(_get(data, 'unit', where), 'unit', where),
+            _integer(_get(data, 'function', where), 'function', where),
+            _as_enum(ExceptionCode, _get(data, 'exception_code', where), 'exception_code', where),
         )
 
 

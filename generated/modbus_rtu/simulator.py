@@ -74,7 +74,7 @@ DEVICE = DeviceSpec(
         # read_input_registers
         CommandSpec(ReadInputRegistersRequest, ReadInputRegistersResponse, space_reads={'registers': RunSpec('input_registers', 'address', count='count')}, code=4, limits={'count': (1, 125, ())}),
         # write_coil
-        CommandSpec(WriteCoilRequest, WriteCoilResponse, space_writes={'value': RunSpec('coils', 'address')}, code=5, limits={'value': (0, 65535, (0, 65280))}),
+        CommandSpec(WriteCoilRequest, WriteCoilResponse, space_writes={'value': RunSpec('coils', 'address')}, code=5, limits={'value': (0, 65280, (0, 65280))}),
         # write_register
         CommandSpec(WriteRegisterRequest, WriteRegisterResponse, space_writes={'value': RunSpec('holding_registers', 'address')}, code=6),
         # write_coils

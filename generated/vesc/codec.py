@@ -8,6 +8,7 @@ from collections.abc import Callable
 
 from serialspec.runtime.checksums import crc_function
 from serialspec.runtime.errors import DecodeError, EncodeError, content_size_error, out_of_range
+from serialspec.runtime.fields import wrong_type
 from serialspec.runtime.framing import Element, EngineFormat, FrameCodec, Layout
 from serialspec.runtime.framing import FrameStreamParser as _FrameStreamParser
 from serialspec.runtime.message import Direction, Message, members, slot_setters
@@ -288,29 +289,29 @@ def _encode_fw_version_request(m: FwVersionRequest) -> bytes:
 
 
 def _encode_fw_version_response(m: FwVersionResponse) -> bytes:
-    if not 0 <= m.major <= 255:
+    if not 0 <= m.major <= 255 or m.major.__class__ is bool:
         raise out_of_range('fw_version response', 'major', m.major, 0, 255)
-    if not 0 <= m.minor <= 255:
+    if not 0 <= m.minor <= 255 or m.minor.__class__ is bool:
         raise out_of_range('fw_version response', 'minor', m.minor, 0, 255)
     if len(m.uuid) != 12:
         raise EncodeError('fw_version response' + f': uuid needs 12 bytes, got {len(m.uuid)}')
-    if not 0 <= m.pairing_done <= 255:
+    if not 0 <= m.pairing_done <= 255 or m.pairing_done.__class__ is bool:
         raise out_of_range('fw_version response', 'pairing_done', m.pairing_done, 0, 255)
-    if not 0 <= m.test_version <= 255:
+    if not 0 <= m.test_version <= 255 or m.test_version.__class__ is bool:
         raise out_of_range('fw_version response', 'test_version', m.test_version, 0, 255)
-    if not 0 <= m.hw_type <= 255:
-        raise out_of_range('fw_version response', 'hw_type', m.hw_type, 0, 255)
-    if not 0 <= m.custom_config_count <= 255:
+    if not 0 <= m.hw_type <= 2 or m.hw_type.__class__ is bool:
+        raise out_of_range('fw_version response', 'hw_type', m.hw_type, 0, 2)
+    if not 0 <= m.custom_config_count <= 255 or m.custom_config_count.__class__ is bool:
         raise out_of_range('fw_version response', 'custom_config_count', m.custom_config_count, 0, 255)
-    if not 0 <= m.phase_filters <= 255:
+    if not 0 <= m.phase_filters <= 255 or m.phase_filters.__class__ is bool:
         raise out_of_range('fw_version response', 'phase_filters', m.phase_filters, 0, 255)
-    if not 0 <= m.qml_hw <= 255:
+    if not 0 <= m.qml_hw <= 255 or m.qml_hw.__class__ is bool:
         raise out_of_range('fw_version response', 'qml_hw', m.qml_hw, 0, 255)
-    if not 0 <= m.qml_app <= 255:
+    if not 0 <= m.qml_app <= 255 or m.qml_app.__class__ is bool:
         raise out_of_range('fw_version response', 'qml_app', m.qml_app, 0, 255)
-    if not 0 <= m.nrf_flags <= 255:
+    if not 0 <= m.nrf_flags <= 255 or m.nrf_flags.__class__ is bool:
         raise out_of_range('fw_version response', 'nrf_flags', m.nrf_flags, 0, 255)
-    if not 0 <= m.hw_crc <= 4294967295:
+    if not 0 <= m.hw_crc <= 4294967295 or m.hw_crc.__class__ is bool:
         raise out_of_range('fw_version response', 'hw_crc', m.hw_crc, 0, 4294967295)
     return _RESPONSE_FRAMES.wrap(b''.join((_S_BE_U8_U8.pack(m.major, m.minor), _encode_text(m.hw_name, 'hw_name', 'fw_version response', True), _S_BE_FWVERSIONRESPONSE_UUID.pack(m.uuid, m.pairing_done, m.test_version, m.hw_type, m.custom_config_count, m.phase_filters, m.qml_hw, m.qml_app, m.nrf_flags), _encode_text(m.fw_name, 'fw_name', 'fw_version response', True), _S_BE_U32.pack(m.hw_crc),)), 0x00, ())
 
@@ -320,89 +321,89 @@ def _encode_get_values_request(m: GetValuesRequest) -> bytes:
 
 
 def _encode_get_values_response(m: GetValuesResponse) -> bytes:
-    if not -32768 <= m.temp_fet <= 32767:
+    if not -32768 <= m.temp_fet <= 32767 or m.temp_fet.__class__ is bool:
         raise out_of_range('get_values response', 'temp_fet', m.temp_fet, -32768, 32767)
-    if not -32768 <= m.temp_motor <= 32767:
+    if not -32768 <= m.temp_motor <= 32767 or m.temp_motor.__class__ is bool:
         raise out_of_range('get_values response', 'temp_motor', m.temp_motor, -32768, 32767)
-    if not -2147483648 <= m.avg_motor_current <= 2147483647:
+    if not -2147483648 <= m.avg_motor_current <= 2147483647 or m.avg_motor_current.__class__ is bool:
         raise out_of_range('get_values response', 'avg_motor_current', m.avg_motor_current, -2147483648, 2147483647)
-    if not -2147483648 <= m.avg_input_current <= 2147483647:
+    if not -2147483648 <= m.avg_input_current <= 2147483647 or m.avg_input_current.__class__ is bool:
         raise out_of_range('get_values response', 'avg_input_current', m.avg_input_current, -2147483648, 2147483647)
-    if not -2147483648 <= m.avg_id <= 2147483647:
+    if not -2147483648 <= m.avg_id <= 2147483647 or m.avg_id.__class__ is bool:
         raise out_of_range('get_values response', 'avg_id', m.avg_id, -2147483648, 2147483647)
-    if not -2147483648 <= m.avg_iq <= 2147483647:
+    if not -2147483648 <= m.avg_iq <= 2147483647 or m.avg_iq.__class__ is bool:
         raise out_of_range('get_values response', 'avg_iq', m.avg_iq, -2147483648, 2147483647)
-    if not -32768 <= m.duty_now <= 32767:
+    if not -32768 <= m.duty_now <= 32767 or m.duty_now.__class__ is bool:
         raise out_of_range('get_values response', 'duty_now', m.duty_now, -32768, 32767)
-    if not -2147483648 <= m.rpm <= 2147483647:
+    if not -2147483648 <= m.rpm <= 2147483647 or m.rpm.__class__ is bool:
         raise out_of_range('get_values response', 'rpm', m.rpm, -2147483648, 2147483647)
-    if not -32768 <= m.v_in <= 32767:
+    if not -32768 <= m.v_in <= 32767 or m.v_in.__class__ is bool:
         raise out_of_range('get_values response', 'v_in', m.v_in, -32768, 32767)
-    if not -2147483648 <= m.amp_hours <= 2147483647:
+    if not -2147483648 <= m.amp_hours <= 2147483647 or m.amp_hours.__class__ is bool:
         raise out_of_range('get_values response', 'amp_hours', m.amp_hours, -2147483648, 2147483647)
-    if not -2147483648 <= m.amp_hours_charged <= 2147483647:
+    if not -2147483648 <= m.amp_hours_charged <= 2147483647 or m.amp_hours_charged.__class__ is bool:
         raise out_of_range('get_values response', 'amp_hours_charged', m.amp_hours_charged, -2147483648, 2147483647)
-    if not -2147483648 <= m.watt_hours <= 2147483647:
+    if not -2147483648 <= m.watt_hours <= 2147483647 or m.watt_hours.__class__ is bool:
         raise out_of_range('get_values response', 'watt_hours', m.watt_hours, -2147483648, 2147483647)
-    if not -2147483648 <= m.watt_hours_charged <= 2147483647:
+    if not -2147483648 <= m.watt_hours_charged <= 2147483647 or m.watt_hours_charged.__class__ is bool:
         raise out_of_range('get_values response', 'watt_hours_charged', m.watt_hours_charged, -2147483648, 2147483647)
-    if not -2147483648 <= m.tachometer <= 2147483647:
+    if not -2147483648 <= m.tachometer <= 2147483647 or m.tachometer.__class__ is bool:
         raise out_of_range('get_values response', 'tachometer', m.tachometer, -2147483648, 2147483647)
-    if not -2147483648 <= m.tachometer_abs <= 2147483647:
+    if not -2147483648 <= m.tachometer_abs <= 2147483647 or m.tachometer_abs.__class__ is bool:
         raise out_of_range('get_values response', 'tachometer_abs', m.tachometer_abs, -2147483648, 2147483647)
-    if not 0 <= m.fault <= 255:
-        raise out_of_range('get_values response', 'fault', m.fault, 0, 255)
-    if not -2147483648 <= m.pid_pos <= 2147483647:
+    if not 0 <= m.fault <= 33 or m.fault.__class__ is bool:
+        raise out_of_range('get_values response', 'fault', m.fault, 0, 33)
+    if not -2147483648 <= m.pid_pos <= 2147483647 or m.pid_pos.__class__ is bool:
         raise out_of_range('get_values response', 'pid_pos', m.pid_pos, -2147483648, 2147483647)
-    if not 0 <= m.controller_id <= 255:
+    if not 0 <= m.controller_id <= 255 or m.controller_id.__class__ is bool:
         raise out_of_range('get_values response', 'controller_id', m.controller_id, 0, 255)
-    if not -32768 <= m.temp_mos1 <= 32767:
+    if not -32768 <= m.temp_mos1 <= 32767 or m.temp_mos1.__class__ is bool:
         raise out_of_range('get_values response', 'temp_mos1', m.temp_mos1, -32768, 32767)
-    if not -32768 <= m.temp_mos2 <= 32767:
+    if not -32768 <= m.temp_mos2 <= 32767 or m.temp_mos2.__class__ is bool:
         raise out_of_range('get_values response', 'temp_mos2', m.temp_mos2, -32768, 32767)
-    if not -32768 <= m.temp_mos3 <= 32767:
+    if not -32768 <= m.temp_mos3 <= 32767 or m.temp_mos3.__class__ is bool:
         raise out_of_range('get_values response', 'temp_mos3', m.temp_mos3, -32768, 32767)
-    if not -2147483648 <= m.avg_vd <= 2147483647:
+    if not -2147483648 <= m.avg_vd <= 2147483647 or m.avg_vd.__class__ is bool:
         raise out_of_range('get_values response', 'avg_vd', m.avg_vd, -2147483648, 2147483647)
-    if not -2147483648 <= m.avg_vq <= 2147483647:
+    if not -2147483648 <= m.avg_vq <= 2147483647 or m.avg_vq.__class__ is bool:
         raise out_of_range('get_values response', 'avg_vq', m.avg_vq, -2147483648, 2147483647)
-    if not 0 <= m.status <= 255:
+    if not 0 <= m.status <= 255 or isinstance(m.status, bool):
         raise out_of_range('get_values response', 'status', m.status, 0, 255)
     return _RESPONSE_FRAMES.wrap(_S_BE_GETVALUESRESPONSE_TEMP_FET.pack(m.temp_fet, m.temp_motor, m.avg_motor_current, m.avg_input_current, m.avg_id, m.avg_iq, m.duty_now, m.rpm, m.v_in, m.amp_hours, m.amp_hours_charged, m.watt_hours, m.watt_hours_charged, m.tachometer, m.tachometer_abs, m.fault, m.pid_pos, m.controller_id, m.temp_mos1, m.temp_mos2, m.temp_mos3, m.avg_vd, m.avg_vq, m.status), 0x04, ())
 
 
 def _encode_set_duty_request(m: SetDutyRequest) -> bytes:
-    if not -100000 <= m.duty <= 100000:
+    if not -100000 <= m.duty <= 100000 or m.duty.__class__ is bool:
         raise out_of_range('set_duty request', 'duty', m.duty, -100000, 100000)
     return _REQUEST_FRAMES.wrap(_S_BE_I32.pack(m.duty), 0x05, ())
 
 
 def _encode_set_current_request(m: SetCurrentRequest) -> bytes:
-    if not -2147483648 <= m.current <= 2147483647:
+    if not -2147483648 <= m.current <= 2147483647 or m.current.__class__ is bool:
         raise out_of_range('set_current request', 'current', m.current, -2147483648, 2147483647)
     return _REQUEST_FRAMES.wrap(_S_BE_I32.pack(m.current), 0x06, ())
 
 
 def _encode_set_current_brake_request(m: SetCurrentBrakeRequest) -> bytes:
-    if not -2147483648 <= m.current <= 2147483647:
+    if not -2147483648 <= m.current <= 2147483647 or m.current.__class__ is bool:
         raise out_of_range('set_current_brake request', 'current', m.current, -2147483648, 2147483647)
     return _REQUEST_FRAMES.wrap(_S_BE_I32.pack(m.current), 0x07, ())
 
 
 def _encode_set_rpm_request(m: SetRpmRequest) -> bytes:
-    if not -2147483648 <= m.rpm <= 2147483647:
+    if not -2147483648 <= m.rpm <= 2147483647 or m.rpm.__class__ is bool:
         raise out_of_range('set_rpm request', 'rpm', m.rpm, -2147483648, 2147483647)
     return _REQUEST_FRAMES.wrap(_S_BE_I32.pack(m.rpm), 0x08, ())
 
 
 def _encode_set_pos_request(m: SetPosRequest) -> bytes:
-    if not -2147483648 <= m.position <= 2147483647:
+    if not -2147483648 <= m.position <= 2147483647 or m.position.__class__ is bool:
         raise out_of_range('set_pos request', 'position', m.position, -2147483648, 2147483647)
     return _REQUEST_FRAMES.wrap(_S_BE_I32.pack(m.position), 0x09, ())
 
 
 def _encode_set_handbrake_request(m: SetHandbrakeRequest) -> bytes:
-    if not -2147483648 <= m.current <= 2147483647:
+    if not -2147483648 <= m.current <= 2147483647 or m.current.__class__ is bool:
         raise out_of_range('set_handbrake request', 'current', m.current, -2147483648, 2147483647)
     return _REQUEST_FRAMES.wrap(_S_BE_I32.pack(m.current), 0x0a, ())
 
@@ -412,7 +413,7 @@ def _encode_print_response(m: PrintResponse) -> bytes:
 
 
 def _encode_rotor_position_response(m: RotorPositionResponse) -> bytes:
-    if not -2147483648 <= m.position <= 2147483647:
+    if not -2147483648 <= m.position <= 2147483647 or m.position.__class__ is bool:
         raise out_of_range('rotor_position response', 'position', m.position, -2147483648, 2147483647)
     return _RESPONSE_FRAMES.wrap(_S_BE_I32.pack(m.position), 0x16, ())
 
@@ -422,7 +423,7 @@ def _encode_alive_request(m: AliveRequest) -> bytes:
 
 
 def _encode_forward_can_request(m: ForwardCanRequest) -> bytes:
-    if not 0 <= m.can_id <= 255:
+    if not 0 <= m.can_id <= 255 or m.can_id.__class__ is bool:
         raise out_of_range('forward_can request', 'can_id', m.can_id, 0, 255)
     return _REQUEST_FRAMES.wrap(b''.join((_S_BE_U8.pack(m.can_id), bytes(m.payload),)), 0x22, ())
 
@@ -565,8 +566,10 @@ def encode(message: Message) -> bytes:
         raise EncodeError(f"{type(message).__name__} is not a vesc message")
     try:
         return encoder(message)
-    except (TypeError, AttributeError, struct.error) as exc:
-        raise EncodeError(f"{message.COMMAND} {message.DIRECTION.value}: {exc}") from None
+    except EncodeError:
+        raise
+    except (TypeError, AttributeError, ValueError, OverflowError, struct.error) as exc:
+        raise wrong_type(message, exc) from None  # one line naming the field, not Python's words
 
 
 # Each direction's frames for code that splits a stream of both directions (serialspec monitor).

@@ -9,9 +9,11 @@ from typing import Any, ClassVar, Self
 
 from serialspec.runtime.fields import as_bytes as _bytes
 from serialspec.runtime.fields import check_keys as _check_keys
+from serialspec.runtime.fields import enum as _as_enum
+from serialspec.runtime.fields import flags as _as_flags
 from serialspec.runtime.fields import get as _get
+from serialspec.runtime.fields import integer as _integer
 from serialspec.runtime.message import Direction, Message
-from serialspec.runtime.message import enum_or_int as _enum
 
 _store = object.__setattr__  # how __init__ fills the slots of a frozen class
 
@@ -90,10 +92,10 @@ class ValuesStatus(IntFlag):
     """The last byte of COMM_GET_VALUES (commands.c, mask bit 21)."""
 
     NONE = 0
-    TIMEOUT = 1 << 0
     #: the command timeout has expired: the motor was released
-    KILL_SWITCH = 1 << 1
+    TIMEOUT = 1 << 0
     #: the kill switch is active
+    KILL_SWITCH = 1 << 1
 
 
 class FwVersionRequest(Message):
@@ -126,34 +128,34 @@ class FwVersionResponse(Message):
     COMMAND: ClassVar[str] = 'fw_version'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    major: int
     #: Firmware major version.
-    minor: int
+    major: int
     #: Firmware minor version.
-    hw_name: str
+    minor: int
     #: Hardware name (HW_NAME), NUL-terminated.
-    uuid: bytes
+    hw_name: str
     #: The STM32's 96-bit unique id (plus 1 for a second motor).
-    pairing_done: int
+    uuid: bytes
     #: 1 once NRF pairing is done.
-    test_version: int
+    pairing_done: int
     #: Test build number (FW_TEST_VERSION_NUMBER); 0 for a release.
+    test_version: int
+    #: The kind of hardware. range 0..2
     hw_type: HwType | int
-    #: The kind of hardware.
-    custom_config_count: int
     #: Number of custom configurations.
-    phase_filters: int
+    custom_config_count: int
     #: 1 if the hardware has phase filters.
-    qml_hw: int
+    phase_filters: int
     #: QML UI from the hardware: 0 none, 1 yes, 2 fullscreen.
-    qml_app: int
+    qml_hw: int
     #: QML UI from the app: 0 none, else its flags.
-    nrf_flags: int
+    qml_app: int
     #: NRF radio flags.
-    fw_name: str
+    nrf_flags: int
     #: Firmware name (FW_NAME), NUL-terminated.
-    hw_crc: int
+    fw_name: str
     #: CRC of the hardware configuration (main_calc_hw_crc).
+    hw_crc: int
 
     def __init__(
         self,
@@ -209,20 +211,20 @@ class FwVersionResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'fw_version response') -> Self:
         _check_keys(data, ('major', 'minor', 'hw_name', 'uuid', 'pairing_done', 'test_version', 'hw_type', 'custom_config_count', 'phase_filters', 'qml_hw', 'qml_app', 'nrf_flags', 'fw_name', 'hw_crc'), (), where)
         return cls(
-            _get(data, 'major', where),
-            _get(data, 'minor', where),
+            _integer(_get(data, 'major', where), 'major', where),
+            _integer(_get(data, 'minor', where), 'minor', where),
             str(_get(data, 'hw_name', where)),
             _bytes(_get(data, 'uuid', where), 'uuid', where),
-            _get(data, 'pairing_done', where),
-            _get(data, 'test_version', where),
-            _enum(HwType, _get(data, 'hw_type', where)),
-            _get(data, 'custom_config_count', where),
-            _get(data, 'phase_filters', where),
-            _get(data, 'qml_hw', where),
-            _get(data, 'qml_app', where),
-            _get(data, 'nrf_flags', where),
+            _integer(_get(data, 'pairing_done', where), 'pairing_done', where),
+            _integer(_get(data, 'test_version', where), 'test_version', where),
+            _as_enum(HwType, _get(data, 'hw_type', where), 'hw_type', where),
+            _integer(_get(data, 'custom_config_count', where), 'custom_config_count', where),
+            _integer(_get(data, 'phase_filters', where), 'phase_filters', where),
+            _integer(_get(data, 'qml_hw', where), 'qml_hw', where),
+            _integer(_get(data, 'qml_app', where), 'qml_app', where),
+            _integer(_get(data, 'nrf_flags', where), 'nrf_flags', where),
             str(_get(data, 'fw_name', where)),
-            _get(data, 'hw_crc', where),
+            _integer(_get(data, 'hw_crc', where), 'hw_crc', where),
         )
 
 
@@ -256,54 +258,54 @@ class GetValuesResponse(Message):
     COMMAND: ClassVar[str] = 'get_values'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    temp_fet: int
     #: MOSFET temperature (filtered). [0.1 °C]
-    temp_motor: int
+    temp_fet: int
     #: Motor temperature (filtered). [0.1 °C]
-    avg_motor_current: int
+    temp_motor: int
     #: Average motor current since the last read. [0.01 A]
-    avg_input_current: int
+    avg_motor_current: int
     #: Average input current since the last read. [0.01 A]
-    avg_id: int
+    avg_input_current: int
     #: Average d-axis current. [0.01 A]
-    avg_iq: int
+    avg_id: int
     #: Average q-axis current. [0.01 A]
-    duty_now: int
+    avg_iq: int
     #: Duty cycle now (-1..1). [0.001]
-    rpm: int
+    duty_now: int
     #: Electrical rpm (mechanical rpm × pole pairs). [ERPM]
-    v_in: int
+    rpm: int
     #: Input voltage (filtered). [0.1 V]
-    amp_hours: int
+    v_in: int
     #: Charge drawn. [0.0001 Ah]
-    amp_hours_charged: int
+    amp_hours: int
     #: Charge regenerated. [0.0001 Ah]
-    watt_hours: int
+    amp_hours_charged: int
     #: Energy drawn. [0.0001 Wh]
-    watt_hours_charged: int
+    watt_hours: int
     #: Energy regenerated. [0.0001 Wh]
-    tachometer: int
+    watt_hours_charged: int
     #: Tachometer (6 counts per electrical revolution, signed).
-    tachometer_abs: int
+    tachometer: int
     #: Absolute tachometer.
+    tachometer_abs: int
+    #: The present fault. range 0..33
     fault: FaultCode | int
-    #: The present fault.
-    pid_pos: int
     #: Position of the position controller. [0.000001°]
-    controller_id: int
+    pid_pos: int
     #: The controller's CAN id.
-    temp_mos1: int
+    controller_id: int
     #: MOSFET 1 temperature. [0.1 °C]
-    temp_mos2: int
+    temp_mos1: int
     #: MOSFET 2 temperature. [0.1 °C]
-    temp_mos3: int
+    temp_mos2: int
     #: MOSFET 3 temperature. [0.1 °C]
-    avg_vd: int
+    temp_mos3: int
     #: Average d-axis voltage. [0.001 V]
-    avg_vq: int
+    avg_vd: int
     #: Average q-axis voltage. [0.001 V]
-    status: ValuesStatus
+    avg_vq: int
     #: Timeout and kill switch state.
+    status: ValuesStatus
 
     def __init__(
         self,
@@ -389,30 +391,30 @@ class GetValuesResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'get_values response') -> Self:
         _check_keys(data, ('temp_fet', 'temp_motor', 'avg_motor_current', 'avg_input_current', 'avg_id', 'avg_iq', 'duty_now', 'rpm', 'v_in', 'amp_hours', 'amp_hours_charged', 'watt_hours', 'watt_hours_charged', 'tachometer', 'tachometer_abs', 'fault', 'pid_pos', 'controller_id', 'temp_mos1', 'temp_mos2', 'temp_mos3', 'avg_vd', 'avg_vq', 'status'), (), where)
         return cls(
-            _get(data, 'temp_fet', where),
-            _get(data, 'temp_motor', where),
-            _get(data, 'avg_motor_current', where),
-            _get(data, 'avg_input_current', where),
-            _get(data, 'avg_id', where),
-            _get(data, 'avg_iq', where),
-            _get(data, 'duty_now', where),
-            _get(data, 'rpm', where),
-            _get(data, 'v_in', where),
-            _get(data, 'amp_hours', where),
-            _get(data, 'amp_hours_charged', where),
-            _get(data, 'watt_hours', where),
-            _get(data, 'watt_hours_charged', where),
-            _get(data, 'tachometer', where),
-            _get(data, 'tachometer_abs', where),
-            _enum(FaultCode, _get(data, 'fault', where)),
-            _get(data, 'pid_pos', where),
-            _get(data, 'controller_id', where),
-            _get(data, 'temp_mos1', where),
-            _get(data, 'temp_mos2', where),
-            _get(data, 'temp_mos3', where),
-            _get(data, 'avg_vd', where),
-            _get(data, 'avg_vq', where),
-            ValuesStatus(_get(data, 'status', where)),
+            _integer(_get(data, 'temp_fet', where), 'temp_fet', where),
+            _integer(_get(data, 'temp_motor', where), 'temp_motor', where),
+            _integer(_get(data, 'avg_motor_current', where), 'avg_motor_current', where),
+            _integer(_get(data, 'avg_input_current', where), 'avg_input_current', where),
+            _integer(_get(data, 'avg_id', where), 'avg_id', where),
+            _integer(_get(data, 'avg_iq', where), 'avg_iq', where),
+            _integer(_get(data, 'duty_now', where), 'duty_now', where),
+            _integer(_get(data, 'rpm', where), 'rpm', where),
+            _integer(_get(data, 'v_in', where), 'v_in', where),
+            _integer(_get(data, 'amp_hours', where), 'amp_hours', where),
+            _integer(_get(data, 'amp_hours_charged', where), 'amp_hours_charged', where),
+            _integer(_get(data, 'watt_hours', where), 'watt_hours', where),
+            _integer(_get(data, 'watt_hours_charged', where), 'watt_hours_charged', where),
+            _integer(_get(data, 'tachometer', where), 'tachometer', where),
+            _integer(_get(data, 'tachometer_abs', where), 'tachometer_abs', where),
+            _as_enum(FaultCode, _get(data, 'fault', where), 'fault', where),
+            _integer(_get(data, 'pid_pos', where), 'pid_pos', where),
+            _integer(_get(data, 'controller_id', where), 'controller_id', where),
+            _integer(_get(data, 'temp_mos1', where), 'temp_mos1', where),
+            _integer(_get(data, 'temp_mos2', where), 'temp_mos2', where),
+            _integer(_get(data, 'temp_mos3', where), 'temp_mos3', where),
+            _integer(_get(data, 'avg_vd', where), 'avg_vd', where),
+            _integer(_get(data, 'avg_vq', where), 'avg_vq', where),
+            _as_flags(ValuesStatus, _get(data, 'status', where), 255, 'status', where),
         )
 
 
@@ -425,8 +427,8 @@ class SetDutyRequest(Message):
     COMMAND: ClassVar[str] = 'set_duty'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    duty: int
     #: Duty cycle × 100000. [0.00001] range -100000..100000
+    duty: int
 
     def __init__(
         self,
@@ -443,7 +445,7 @@ class SetDutyRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'set_duty request') -> Self:
         _check_keys(data, ('duty',), (), where)
         return cls(
-            _get(data, 'duty', where),
+            _integer(_get(data, 'duty', where), 'duty', where),
         )
 
 
@@ -456,8 +458,8 @@ class SetCurrentRequest(Message):
     COMMAND: ClassVar[str] = 'set_current'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    current: int
     #: Motor current in mA (negative brakes or reverses). [mA]
+    current: int
 
     def __init__(
         self,
@@ -474,7 +476,7 @@ class SetCurrentRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'set_current request') -> Self:
         _check_keys(data, ('current',), (), where)
         return cls(
-            _get(data, 'current', where),
+            _integer(_get(data, 'current', where), 'current', where),
         )
 
 
@@ -487,8 +489,8 @@ class SetCurrentBrakeRequest(Message):
     COMMAND: ClassVar[str] = 'set_current_brake'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    current: int
     #: Brake current in mA. [mA]
+    current: int
 
     def __init__(
         self,
@@ -505,7 +507,7 @@ class SetCurrentBrakeRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'set_current_brake request') -> Self:
         _check_keys(data, ('current',), (), where)
         return cls(
-            _get(data, 'current', where),
+            _integer(_get(data, 'current', where), 'current', where),
         )
 
 
@@ -518,8 +520,8 @@ class SetRpmRequest(Message):
     COMMAND: ClassVar[str] = 'set_rpm'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    rpm: int
     #: Target electrical rpm. [ERPM]
+    rpm: int
 
     def __init__(
         self,
@@ -536,7 +538,7 @@ class SetRpmRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'set_rpm request') -> Self:
         _check_keys(data, ('rpm',), (), where)
         return cls(
-            _get(data, 'rpm', where),
+            _integer(_get(data, 'rpm', where), 'rpm', where),
         )
 
 
@@ -549,8 +551,8 @@ class SetPosRequest(Message):
     COMMAND: ClassVar[str] = 'set_pos'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    position: int
     #: Target position × 1000000, in degrees. [0.000001°]
+    position: int
 
     def __init__(
         self,
@@ -567,7 +569,7 @@ class SetPosRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'set_pos request') -> Self:
         _check_keys(data, ('position',), (), where)
         return cls(
-            _get(data, 'position', where),
+            _integer(_get(data, 'position', where), 'position', where),
         )
 
 
@@ -580,8 +582,8 @@ class SetHandbrakeRequest(Message):
     COMMAND: ClassVar[str] = 'set_handbrake'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    current: int
     #: Handbrake current in mA. [mA]
+    current: int
 
     def __init__(
         self,
@@ -598,7 +600,7 @@ class SetHandbrakeRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'set_handbrake request') -> Self:
         _check_keys(data, ('current',), (), where)
         return cls(
-            _get(data, 'current', where),
+            _integer(_get(data, 'current', where), 'current', where),
         )
 
 
@@ -611,8 +613,8 @@ class PrintResponse(Message):
     COMMAND: ClassVar[str] = 'print'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    text: str
     #: The text, not NUL-terminated.
+    text: str
 
     def __init__(
         self,
@@ -642,8 +644,8 @@ class RotorPositionResponse(Message):
     COMMAND: ClassVar[str] = 'rotor_position'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    position: int
     #: Rotor position × 100000, in degrees. [0.00001°]
+    position: int
 
     def __init__(
         self,
@@ -660,7 +662,7 @@ class RotorPositionResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'rotor_position response') -> Self:
         _check_keys(data, ('position',), (), where)
         return cls(
-            _get(data, 'position', where),
+            _integer(_get(data, 'position', where), 'position', where),
         )
 
 
@@ -694,10 +696,10 @@ class ForwardCanRequest(Message):
     COMMAND: ClassVar[str] = 'forward_can'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    can_id: int
     #: CAN id of the controller to reach.
-    payload: bytes
+    can_id: int
     #: The forwarded payload: a command id and its fields.
+    payload: bytes
 
     def __init__(
         self,
@@ -717,7 +719,7 @@ class ForwardCanRequest(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'forward_can request') -> Self:
         _check_keys(data, ('can_id', 'payload'), (), where)
         return cls(
-            _get(data, 'can_id', where),
+            _integer(_get(data, 'can_id', where), 'can_id', where),
             _bytes(_get(data, 'payload', where), 'payload', where),
         )
 

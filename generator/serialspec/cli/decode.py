@@ -11,7 +11,7 @@ from typing import Any, TextIO
 from serialspec.cli import capture
 from serialspec.cli.frames import Frames
 from serialspec.cli.protocols import SPEC_HELP, open_spec
-from serialspec.cli.views import engineering, message_spec, register_view, unit_symbols, with_unit
+from serialspec.cli.views import FlagNames, engineering, message_spec, register_view, unit_symbols, with_unit
 from serialspec.runtime.errors import DecodeError, SerialspecError
 from serialspec.runtime.hexbytes import parse_hex
 from serialspec.runtime.message import Message
@@ -152,6 +152,8 @@ def readable(result: dict[str, Any]) -> str:
 
 
 def _value(value: Any) -> str:
+    if isinstance(value, FlagNames):
+        return str(value)
     if isinstance(value, dict | list):
         return json.dumps(value, ensure_ascii=False)
     return str(value)

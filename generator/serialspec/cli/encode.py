@@ -29,6 +29,8 @@ def run(args: argparse.Namespace) -> int:
         data: Any = json.loads(args.json)
     except json.JSONDecodeError as exc:
         raise EncodeError(f"--json is not valid JSON: {exc.msg} at column {exc.colno}") from None
+    except (ValueError, RecursionError) as exc:  # a number of thousands of digits, lists nested thousands deep
+        raise EncodeError(f"--json cannot be read: {str(exc).split(';')[0]}") from None
     if not isinstance(data, dict) or "command" not in data:
         raise EncodeError("--json must be an object with at least `command` and `fields`")
     direction = args.direction or data.get("direction") or "request"

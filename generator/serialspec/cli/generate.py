@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 
 from serialspec.cli.project import expected_files, orphans, project
+from serialspec.runtime.errors import SerialspecError
 
 HELP = "generate DIR/<protocol>/ and DIR/docs/<protocol>.md from specs (default: the project's, see [tool.serialspec])"
 
@@ -25,10 +26,13 @@ def run(args: argparse.Namespace) -> int:
     files, errors = expected_files(proj)
     written = 0
     for path, text in files.items():
-        if not path.exists() or path.read_text(encoding="utf-8") != text:
-            path.parent.mkdir(parents=True, exist_ok=True)
-            path.write_text(text, encoding="utf-8")
-            written += 1
+        try:
+            if not path.exists() or path.read_text(encoding="utf-8") != text:
+                path.parent.mkdir(parents=True, exist_ok=True)
+                path.write_text(text, encoding="utf-8")
+                written += 1
+        except OSError as exc:
+            raise SerialspecError(f"cannot write {path}: {exc.strerror or exc}") from None
     removed = orphans(proj, files, {e.file for e in errors})
     for path in removed:
         path.unlink()

@@ -112,8 +112,11 @@ def expected_files(proj: Project) -> tuple[dict[Path, str], list[SpecError]]:
             errors.extend(exc.errors)
             continue
         for emitter in emitters():
-            for name, text in emitter.files(protocol).items():
+            emitted = emitter.files(protocol)
+            for name, text in emitted.items():
                 files[proj.out / name] = text
+            if emitter.verify is not None:
+                errors.extend(emitter.verify(protocol, emitted))
         files[proj.out / protocol.name / SHIPPED_SPEC] = shipped_spec(protocol.spec_path, spec)
     if proj.reference is not None and not errors:  # its examples come from every spec: none while one fails
         files[proj.reference] = reference_markdown(examples)

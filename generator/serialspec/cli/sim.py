@@ -67,6 +67,19 @@ def id_range(protocol: Protocol) -> tuple[int, int, int | None]:
     return low, high, device.broadcast
 
 
+def served(protocol: Protocol, devices: dict[int, Any]) -> str:
+    """What the simulator serves, in words: `id 1 (sts3215), 2 (sts3215)`; each further kind of device with its ids
+    (`pwm_servo servo_id 1, 2, 3, 4`); `(one device: the protocol has no address)` for a protocol without one."""
+    device = protocol.device
+    assert device is not None
+    if not device.address:
+        return "(one device: the protocol has no address)"
+    shown = ", ".join(f"{i} ({d.model.name})" if d.model else str(i) for i, d in devices.items())
+    groups = [f"{device.address} {shown}"]
+    groups += [f"{k.name} {k.address} {', '.join(map(str, k.ids))}" for k in device.kinds]
+    return "; ".join(groups)
+
+
 def model_choice(given: list[str] | None) -> str | dict[int, str] | None:
     """--model NAME (every device) or --model ID=NAME (one device), as the simulator's `model` argument."""
     if not given:
@@ -146,8 +159,8 @@ def run(args: argparse.Namespace) -> int:
     signal.signal(signal.SIGINT, stop)
     signal.signal(signal.SIGTERM, stop)
     print(path, flush=True)
-    shown = ", ".join(f"{i} ({d.model.name})" if d.model else str(i) for i, d in simulator.devices.items())
-    print(f"serialspec sim: {protocol.name} device(s) {shown} on {path}; Ctrl-C to stop", file=sys.stderr, flush=True)
+    shown = served(protocol, simulator.devices)
+    print(f"serialspec sim: {protocol.name} {shown} on {path}; Ctrl-C to stop", file=sys.stderr, flush=True)
     try:
         simulator.serve(controller)
     finally:

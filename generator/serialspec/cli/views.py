@@ -11,6 +11,13 @@ from serialspec.spec.model import Bytes, Field, Protocol, Scalar, Table, TableVa
 from serialspec.spec.model import Message as MessageSpec
 
 
+class FlagNames(list[str]):
+    """The names of the flags set in a value: a JSON list in `--json`, read as words (`overload, overheat`, `none`)."""
+
+    def __str__(self) -> str:
+        return ", ".join(self) or "none"
+
+
 def message_spec(protocol: Protocol, message: Message) -> MessageSpec:
     for spec in protocol.messages():
         if (spec.command, spec.subcommand, spec.direction) == (
@@ -31,7 +38,7 @@ def engineering(protocol: Protocol, message: Message, fields: dict[str, Any]) ->
             result[f.name] = _field_units(f, result[f.name], fields)
     for element in protocol.framing.layouts[message.DIRECTION].value_elements:
         if element.flags and element.name in result:
-            result[element.name] = [b.name.lower() for b in element.flags.bits if result[element.name] >> b.bit & 1]
+            result[element.name] = _flag_names(element.flags, result[element.name])
     return result
 
 
@@ -69,7 +76,7 @@ def _field_units(f: Field, value: Any, siblings: dict[str, Any]) -> Any:
         if f.enum:
             return _enum_name(f.enum, value)
         if f.flags:
-            return [b.name.lower() for b in f.flags.bits if value >> b.bit & 1]
+            return _flag_names(f.flags, value)
         if f.scale is not None:
             return round(value * f.scale, 6)
     if isinstance(f, TableValue):
@@ -79,6 +86,10 @@ def _field_units(f: Field, value: Any, siblings: dict[str, Any]) -> Any:
         if entry is not None and entry.scale is not None:
             return round(value * entry.scale, 6)
     return value
+
+
+def _flag_names(flags: Any, value: int) -> FlagNames:
+    return FlagNames(b.name.lower() for b in flags.bits if value >> b.bit & 1)
 
 
 def _enum_name(enum: Any, value: int) -> str | int:
@@ -93,10 +104,10 @@ def register_view(protocol: Protocol, message: Message, request: Message | None)
             continue
         source = message
         start_name = f.start
-        if start_name.startswith("request."):
+        if f.start_in_request:
             if request is None:
                 return None
-            source, start_name = request, start_name.removeprefix("request.")
+            source = request
         start = source.to_fields().get(start_name)
         if not isinstance(start, int):
             return None

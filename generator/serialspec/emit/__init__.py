@@ -11,6 +11,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cache
 
+from serialspec.spec.errors import SpecError
 from serialspec.spec.model import Protocol
 
 
@@ -18,6 +19,8 @@ from serialspec.spec.model import Protocol
 class Emitter:
     name: str
     files: Callable[[Protocol], dict[str, str]]  # path relative to generated/ -> text
+    # Checks of the spec that need this target's output (the Python target runs the examples through its codec).
+    verify: Callable[[Protocol, dict[str, str]], list[SpecError]] | None = None
 
 
 @cache

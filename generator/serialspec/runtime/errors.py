@@ -23,8 +23,19 @@ class RangeError(EncodeError):
     """A field value outside its allowed range, refused before any byte is written."""
 
 
-def out_of_range(where: str, field: str, value: object, low: float, high: float) -> RangeError:
-    return RangeError(f"{where}: {field} = {value!r} is outside its range {_number(low)}..{_number(high)}")
+def out_of_range(where: str, field: str, value: object, low: float, high: float) -> EncodeError:
+    """The error for a value refused before encoding: outside its range, or not a number at all (True is not 1)."""
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        return EncodeError(f"{where}: {field} must be a number in {_number(low)}..{_number(high)}, got {shown(value)}")
+    return RangeError(f"{where}: {field} = {shown(value)} is outside its range {_number(low)}..{_number(high)}")
+
+
+def shown(value: object) -> str:
+    """A value for an error line: short, one line, and never a 5,000-digit number."""
+    if isinstance(value, int) and not isinstance(value, bool) and value.bit_length() > 64:
+        return f"a number of about {value.bit_length() * 30103 // 100000 + 1} digits"
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
 
 
 def content_size_error(where: str, got: int, low: int, high: int | None) -> DecodeError:

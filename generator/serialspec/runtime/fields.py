@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable, Mapping
-from typing import Any
+from enum import IntEnum, IntFlag
+from typing import Any, TypeVar
 
-from serialspec.runtime.errors import EncodeError
+from serialspec.runtime.errors import EncodeError, shown
 from serialspec.runtime.hexbytes import parse_hex
+from serialspec.runtime.message import Record
 
 
 def check_keys(data: Mapping[str, Any], known: Iterable[str], optional: Iterable[str], where: str) -> None:
@@ -26,7 +29,7 @@ def get(data: Mapping[str, Any], name: str, where: str) -> Any:
 
 def mapping(value: Any, name: str, where: str) -> Mapping[str, Any]:
     if not isinstance(value, Mapping):
-        raise EncodeError(f"{where}: {name} must be an object, got {value!r}")
+        raise EncodeError(f"{where}: {name} must be an object, got {shown(value)}")
     return value
 
 
@@ -42,4 +45,102 @@ def as_bytes(value: Any, name: str, where: str) -> bytes:
             raise EncodeError(f"{where}: {name}: {exc}") from None
     if isinstance(value, list) and all(isinstance(v, int) and 0 <= v <= 255 for v in value):
         return bytes(value)
-    raise EncodeError(f"{where}: {name} must be hex text or a list of byte values, got {value!r}")
+    raise EncodeError(f"{where}: {name} must be hex text or a list of byte values, got {shown(value)}")
+
+
+E = TypeVar("E", bound=IntEnum)
+F = TypeVar("F", bound=IntFlag)
+
+
+def integer(value: Any, name: str, where: str) -> int:
+    """An integer given as data: true/false, text, fractions, lists are refused, naming the field."""
+    if isinstance(value, int) and not isinstance(value, bool):
+        return value
+    raise EncodeError(f"{where}: {name} must be an integer, got {shown(value)}")
+
+
+def number(value: Any, name: str, where: str) -> float:
+    """A finite number given as data (NaN and infinities are refused)."""
+    if isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value):
+        return value
+    raise EncodeError(f"{where}: {name} must be a finite number, got {shown(value)}")
+
+
+def enum(cls: type[E], value: Any, name: str, where: str) -> E | int:
+    """A member of the enum, or an integer the spec names no member for (its range is checked on encoding)."""
+    if isinstance(value, cls):
+        return value
+    number = integer(value, name, where)
+    return cls._value2member_map_.get(number, number)  # type: ignore[return-value]
+
+
+def flags(cls: type[F], value: Any, maximum: int, name: str, where: str) -> F:
+    """A set of flags: a member, or an integer 0..maximum (-1 is not "all flags")."""
+    if isinstance(value, cls):
+        return value
+    number = integer(value, name, where)
+    if not 0 <= number <= maximum:
+        raise EncodeError(f"{where}: {name} = {shown(number)} is outside its range 0..{maximum}")
+    return cls(number)
+
+
+def items(value: Any, name: str, where: str) -> list[Any]:
+    """The items of an array or group: a list."""
+    if isinstance(value, list | tuple):
+        return list(value)
+    raise EncodeError(f"{where}: {name} must be a list, got {shown(value)}")
+
+
+def integers(value: Any, name: str, where: str) -> tuple[int, ...]:
+    return tuple(integer(item, f"{name}[{index}]", where) for index, item in enumerate(items(value, name, where)))
+
+
+def numbers(value: Any, name: str, where: str) -> tuple[float, ...]:
+    return tuple(number(item, f"{name}[{index}]", where) for index, item in enumerate(items(value, name, where)))
+
+
+def wrong_type(message: Any, exc: Exception) -> EncodeError:
+    """The field of a message built in Python (not from data) whose value has the wrong type, as one line."""
+    where = " ".join(p for p in (message.COMMAND, message.SUBCOMMAND, message.DIRECTION.value) if p)
+    problem = _problem(message)
+    return EncodeError(f"{where}: {problem}" if problem else f"{where}: {exc}")
+
+
+def _problem(obj: Any, prefix: str = "") -> str:
+    annotations = type(obj).__annotations__  # strings: the generated modules postpone annotations
+    for field in obj.__match_args__:
+        value = getattr(obj, field)
+        name = prefix + field
+        annotation = str(annotations[field])
+        if annotation.startswith("tuple["):
+            if not isinstance(value, tuple | list):
+                return f"{name} must be a tuple, got {shown(value)}"
+            for index, item in enumerate(value):
+                wrong = _value_problem(item, annotation[6:-1].split(",")[0].strip(), f"{name}[{index}]")
+                if wrong:
+                    return wrong
+        elif wrong := _value_problem(value, annotation, name):
+            return wrong
+    return ""
+
+
+def _value_problem(value: Any, annotation: str, name: str) -> str:
+    kinds = {part.strip() for part in annotation.split("|")}
+    if isinstance(value, Record):
+        return _problem(value, name + ".")
+    if "bytes" in kinds:
+        return "" if isinstance(value, bytes | bytearray) else f"{name} must be bytes, got {shown(value)}"
+    if "float" in kinds:
+        ok = isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
+        return "" if ok else f"{name} must be a finite number, got {shown(value)}"
+    if "int" in kinds:
+        return (
+            ""
+            if isinstance(value, int) and not isinstance(value, bool)
+            else f"{name} must be an integer, got {shown(value)}"
+        )
+    if kinds and not any(k[:1].isupper() for k in kinds):
+        return ""
+    if not isinstance(value, Record):  # a class of the package: bit fields, a table block, a group item
+        return f"{name} must be {annotation.split(' |')[0]}, got {shown(value)}"
+    return ""

@@ -1,8 +1,10 @@
 """Splitting a byte stream into frames, for every protocol the spec language describes.
 
 A candidate frame starts at a header. Before it is accepted it must be plausible: a known command whose content
-size fits the length byte; then its checksum must verify. Whenever a candidate fails, scanning resumes one byte
-after its header, so a stray header or a truncated frame never swallows the intact frame that follows it.
+size fits the length byte, frame-level values (an address) within their declared range; then its checksum must
+verify. Whenever a candidate fails, scanning resumes one byte after its header, so a stray header or a truncated
+frame never swallows the intact frame that follows it. A candidate still waiting for bytes never hides a complete,
+valid frame that starts inside it: that frame is delivered, and the candidate counted as garbage.
 """
 
 from __future__ import annotations
@@ -10,9 +12,13 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from itertools import islice
+from typing import Literal
 
 from serialspec.runtime.errors import DecodeError
 from serialspec.runtime.message import Message
+
+# frame-level values with a declared range: (offset, size, byte order, signed, low, high, also allowed or None)
+ValueRanges = tuple[tuple[int, int, Literal["little", "big"], bool, int, int, int | None], ...]
 
 
 @dataclass(frozen=True)
@@ -32,6 +38,7 @@ class FrameFormat:
     # Frames of one size decoded whole, by size key: (frame size, decoder(buffer, start) -> message, or None when
     # its checksum fails). The parser uses them before decode_at; frames not here take decode_at.
     fixed: dict[int, tuple[int, Callable[[bytes, int], Message | None]]] = field(default_factory=dict)
+    value_ranges: ValueRanges = ()  # a candidate with a value outside its range is no frame
 
 
 class _Candidate:
@@ -47,13 +54,22 @@ class _Candidate:
         "decode",
         "fixed",
         "splittable",
+        "ranges",
     )
 
     def __init__(self, frame_format: FrameFormat) -> None:
         self.frame_format = frame_format  # kept alive: the cache below is keyed by its id
         header = self.header = frame_format.header
         # bytes needed before the command code and the length byte can be read
-        self.prefix = max(frame_format.length_offset, frame_format.command_offset or 0) + 1
+        self.prefix = (
+            max(
+                frame_format.length_offset,
+                frame_format.command_offset or 0,
+                *(offset + size - 1 for offset, size, *_ in frame_format.value_ranges),
+            )
+            + 1
+        )
+        self.ranges = frame_format.value_ranges
         self.command_offset = frame_format.command_offset
         self.length_offset = frame_format.length_offset
         self.decode = frame_format.decode_at
@@ -73,6 +89,19 @@ class _Candidate:
         overlaps = any(header[:k] == header[-k:] for k in range(1, len(header)))
         after = min(frame_format.length_offset, frame_format.command_offset or len(header))
         self.splittable = bool(header) and not overlaps and after >= len(header)
+
+    def plausible(self, buffer: bytes, position: int) -> bool:
+        """Every frame-level value with a declared range holds a value in it (or the one also allowed)."""
+        for offset, size, byte_order, signed, low, high, also in self.ranges:
+            at = position + offset
+            value = (
+                buffer[at]
+                if size == 1 and not signed
+                else int.from_bytes(buffer[at : at + size], byte_order, signed=signed)
+            )
+            if not low <= value <= high and value != also:
+                return False
+        return True
 
     def take(self, key: int, buffer: bytes, start: int, stop: int) -> Message | None:
         """The frame buffer[start:stop] of size key `key` decoded, or None when it fails its checks."""
@@ -161,6 +190,9 @@ class StreamParser:
                 if after >= need:
                     key = piece[length_at] if command_at < 0 else piece[command_at] << 8 | piece[length_at]
                     entry = whole.get(key)
+                    if current.ranges and not current.plausible(buffer, position):
+                        entry = None  # a value out of its range: no frame start (the size check below says so)
+                        key = -1
                     if entry is not None and entry[0] - width <= after:  # the usual frame: decoded whole
                         message = entry[1](buffer, position)
                         if message is None:
@@ -180,12 +212,19 @@ class StreamParser:
                     if command_offset is not None:
                         key |= buffer[position + command_offset] << 8
                 size = frame_sizes.get(key)
+                if size is not None and current.ranges and not current.plausible(buffer, position):
+                    size = None
                 if size is None:  # implausible: not a frame start
                     start = position + 1
                     garbage += 1
                 else:
                     stop = position + size
-                    if stop > end:  # incomplete: wait for more bytes
+                    if stop > end:  # incomplete: wait for more bytes, unless a complete frame starts inside it
+                        inner = self._complete_frame_after(buffer, position + 1)
+                        if inner >= 0:
+                            self.garbage += garbage + inner - position
+                            self.errors += errors
+                            return found + self._scan(buffer[inner:])
                         self._pending = buffer[position:]
                         break
                     message = current.take(key, buffer, position, stop)
@@ -247,14 +286,20 @@ class StreamParser:
             if command_offset is not None:
                 key |= buffer[position + command_offset] << 8
             size = frame_sizes.get(key)
-            if size is None:  # implausible (unknown command, or a content size it never has): not a frame start
+            if size is None or (current.ranges and not current.plausible(buffer, position)):
+                # implausible (unknown command, a content size it never has, a value out of range): no frame start
                 start = position + 1
                 garbage += 1
                 continue
             stop = position + size
             if stop > end:
-                self._pending = buffer[position:]
-                break
+                inner = self._complete_frame_after(buffer, position + 1)
+                if inner < 0:
+                    self._pending = buffer[position:]
+                    break
+                garbage += inner - position  # a stray header: the complete frame inside it is the real one
+                start = inner
+                continue
             message = current.take(key, buffer, position, stop)
             if message is None:
                 errors += 1
@@ -266,6 +311,22 @@ class StreamParser:
         self.garbage += garbage
         self.errors += errors
         return found
+
+    def _complete_frame_after(self, buffer: bytes, start: int) -> int:
+        """Where the first complete frame that decodes starts at or after `start`; -1 if there is none."""
+        end = len(buffer)
+        while True:
+            position, candidate = self._next_header(buffer, start)
+            if position < 0 or end - position < candidate.prefix:
+                return -1
+            key = buffer[position + candidate.length_offset]
+            if candidate.command_offset is not None:
+                key |= buffer[position + candidate.command_offset] << 8
+            size = candidate.frame_sizes.get(key)
+            complete = size is not None and position + size <= end and candidate.plausible(buffer, position)
+            if complete and size is not None and candidate.take(key, buffer, position, position + size) is not None:
+                return position
+            start = position + 1
 
     def _next_header(self, buffer: bytes, start: int) -> tuple[int, _Candidate]:
         best, best_candidate = -1, self._candidates[0]

@@ -21,7 +21,7 @@ from collections import deque
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import suppress
 from dataclasses import dataclass, field
-from enum import Enum, IntFlag
+from enum import Enum, IntEnum, IntFlag
 from typing import Any, TypeVar
 
 import serial
@@ -93,6 +93,24 @@ class Binding:
     status: tuple[str, ...] = ()  # reply fields whose non-zero value is a device error (frame status elements)
     describe_status: Callable[[str, int], str] = field(default=lambda name, value: f"{name} = {value:#04x}")
     errors: ErrorReplies | None = None  # the protocol's error reply, if it has one
+
+
+def check_status(request: Message, reply: Message, name: str, ok: int, match_by: tuple[str, ...]) -> None:
+    """A reply whose status field (the spec's `status: {ok: N}`) does not hold N is a device error."""
+    value = getattr(reply, name)
+    if value != ok:
+        shown = f"{value.name.lower()} ({int(value)})" if isinstance(value, IntEnum) else str(value)
+        command = ".".join(part for part in (reply.COMMAND, reply.SUBCOMMAND) if part)
+        ids = " ".join(f"{n}={getattr(request, n)}" for n in match_by if hasattr(request, n))
+        raise DeviceError(f"{command}{' to ' + ids if ids else ''}: the device reports {name} = {shown}", reply)
+
+
+def table_key(table: dict[str, int], name: str) -> int:
+    """The key of a table entry given by name (a client's parameters by name)."""
+    try:
+        return table[name]
+    except KeyError:
+        raise EncodeError(f"unknown entry {name!r} (expected one of {', '.join(table)})") from None
 
 
 def flag_names(flags: dict[str, type[IntFlag]]) -> Callable[[str, int], str]:

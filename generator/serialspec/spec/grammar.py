@@ -7,11 +7,12 @@ references that resolve, sizes that add up) is checked later, in resolve.py.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+import math
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from typing import Any
 
-from serialspec.spec.loader import Path
+from serialspec.spec.loader import CONTROL, Path
 
 SCALAR_TYPES = ("u8", "i8", "u16", "i16", "u32", "i32", "f32")
 
@@ -36,6 +37,8 @@ class Str(Shape):
     def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
         if not isinstance(value, str):
             yield path, f"expected text, got {_kind(value)}"
+        elif bad := CONTROL.search(value):
+            yield path, f"control character U+{ord(bad.group()):04X} in text (not allowed in a spec)"
         elif self.choices and value not in self.choices:
             yield path, f"unknown value {value!r} (expected one of {', '.join(self.choices)})"
 
@@ -51,27 +54,52 @@ class Int(Shape):
     description: str = ""
     default: Any = None  # the value a spec gets when it leaves the key out (for the reference and the schema)
     example: Any = None  # shown in the reference where no spec uses the key
+    minimum: int | None = None
+    maximum: int | None = None
 
     def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
         if not isinstance(value, int) or isinstance(value, bool):
             yield path, f"expected an integer, got {_kind(value)}"
+        elif (self.minimum is not None and value < self.minimum) or (self.maximum is not None and value > self.maximum):
+            yield path, f"{value} is outside {_bounds(self.minimum, self.maximum)}"
 
     def json_schema(self) -> dict[str, Any]:
-        return _with_default({"type": "integer", "description": self.description}, self.default, self.example)
+        schema: dict[str, Any] = {"type": "integer", "description": self.description}
+        if self.minimum is not None:
+            schema["minimum"] = self.minimum
+        if self.maximum is not None:
+            schema["maximum"] = self.maximum
+        return _with_default(schema, self.default, self.example)
 
 
 @dataclass
 class Num(Shape):
+    """A finite number (NaN and infinities are never a protocol fact)."""
+
     description: str = ""
     default: Any = None  # the value a spec gets when it leaves the key out (for the reference and the schema)
     example: Any = None  # shown in the reference where no spec uses the key
+    choices: tuple[float, ...] = ()
 
     def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
         if not isinstance(value, int | float) or isinstance(value, bool):
             yield path, f"expected a number, got {_kind(value)}"
+        elif not math.isfinite(value):
+            yield path, f"expected a finite number, got {value}"
+        elif self.choices and value not in self.choices:
+            yield path, f"unknown value {value} (expected one of {', '.join(f'{c:g}' for c in self.choices)})"
 
     def json_schema(self) -> dict[str, Any]:
-        return _with_default({"type": "number", "description": self.description}, self.default, self.example)
+        schema: dict[str, Any] = {"type": "number", "description": self.description}
+        if self.choices:
+            schema["enum"] = list(self.choices)
+        return _with_default(schema, self.default, self.example)
+
+
+def _bounds(minimum: int | None, maximum: int | None) -> str:
+    if minimum is not None and maximum is not None:
+        return f"{minimum}..{maximum}"
+    return f"the minimum {minimum}" if minimum is not None else f"the maximum {maximum}"
 
 
 @dataclass
@@ -194,6 +222,21 @@ class Obj(Shape):
             "required": list(self.required),
             "additionalProperties": False,
         }
+
+
+@dataclass
+class Ref(Shape):
+    """A shape defined later, or by itself (group fields are fields): checked as it, a $ref in the JSON Schema."""
+
+    name: str
+    target: Callable[[], Shape]
+    description: str = ""
+
+    def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
+        yield from self.target().check(value, path)
+
+    def json_schema(self) -> dict[str, Any]:
+        return {"$ref": f"#/$defs/{self.name}", "description": self.description}
 
 
 @dataclass
@@ -326,7 +369,7 @@ _FIELD_LONG: dict[str, Shape] = {
         "An integer field derived from the others by an expression, computed on encode and checked on decode: "
         "`2 * count`, `ceil(len(coils) / 8)` (names of fields, len(), ceil(a / b), min, max, + - * / % & | << >>)."
     ),
-    "fields": Any_("group: the fields of each item (a mapping, like request/response)."),
+    "fields": Ref("fields", lambda: FIELDS, "group: the fields of each item (a mapping, like request/response)."),
     "table": Str("table_value/table_block, or bytes holding registers: name of an entry in `tables:`."),
     "key": Str("table_value: the earlier field holding the table key (e.g. data_id)."),
     "start": Str("bytes holding registers: the field (or request.<field>) with the first register's key."),
@@ -350,7 +393,7 @@ FIELD = OneOf(
     ),
     "A field: a wire type or the name of a shared field (short form), or a mapping (long form).",
 )
-FIELDS = MapOf(FIELD, "Fields in wire order: name -> type or mapping.")
+FIELDS: Shape = MapOf(FIELD, "Fields in wire order: name -> type or mapping.")
 
 OPTIONAL_WHEN = Obj(
     {
@@ -1035,10 +1078,10 @@ SPEC = Obj(
         ),
         "serial": Obj(
             {
-                "baudrate": Int("Bits per second."),
-                "bytesize": Int("Data bits per character.", default=8),
+                "baudrate": Int("Bits per second.", minimum=1),
+                "bytesize": Int("Data bits per character.", default=8, minimum=5, maximum=8),
                 "parity": Str("Parity bit.", choices=("none", "even", "odd"), default="none"),
-                "stopbits": Num("Stop bits.", default=1),
+                "stopbits": Num("Stop bits.", default=1, choices=(1, 1.5, 2)),
                 "notes": TEXT,
             },
             required=("baudrate",),
@@ -1069,5 +1112,6 @@ SPEC = Obj(
 def json_schema() -> dict[str, Any]:
     schema = SPEC.json_schema()
     schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
+    schema["$defs"] = {"fields": FIELDS.json_schema()}
     schema["title"] = "serialspec protocol spec"
     return schema

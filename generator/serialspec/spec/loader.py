@@ -9,6 +9,7 @@ message does not depend on how PyYAML was built.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -41,7 +42,8 @@ class Located:
 
 
 def dotted(path: Path) -> str:
-    return ".".join(f"[{p}]" if isinstance(p, int) else p for p in path).replace(".[", "[")
+    text = ".".join(f"[{p}]" if isinstance(p, int) else p for p in path).replace(".[", "[")
+    return "".join(c if c.isprintable() else f"\\x{ord(c):02x}" for c in text)  # error lines stay one plain line
 
 
 # Builds scalars only (the YAML 1.1 rules of the safe loader); mappings and lists are walked by _convert.
@@ -60,10 +62,46 @@ def _position(node: yaml.Node) -> tuple[int, int]:
     return node.start_mark.line + 1, node.start_mark.column + 1
 
 
+# Limits that keep a hostile file from taking the generator down: how deep values nest, and how many values the
+# aliases of a file may expand to (beyond the values it holds: a "billion laughs" file expands to 10^9).
+MAX_DEPTH = 64
+EXPANSION_FACTOR = 4
+EXPANSION_SLACK = 10_000
+_PLAIN_TAGS = frozenset({"tag:yaml.org,2002:map", "tag:yaml.org,2002:seq"})
+# Control characters (C0 but tab, newline, carriage return; DEL; C1) have no place in a spec's text.
+CONTROL = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\x7f-\x9f]")
+
+
 def load_file(path: str, display_name: str | None = None) -> Located:
-    with open(path, encoding="utf-8") as stream:
-        text = stream.read()
-    return load_text(text, display_name or path)
+    file = display_name or path
+    try:
+        with open(path, "rb") as stream:
+            raw = stream.read()
+    except IsADirectoryError:
+        raise SpecErrors([SpecError(file, 1, 1, "", "is a folder, not a spec file")]) from None
+    except OSError as exc:
+        raise SpecErrors([SpecError(file, 1, 1, "", f"cannot read the spec: {exc.strerror or exc}")]) from None
+    return load_text(decode_text(raw, file), file)
+
+
+def decode_text(raw: bytes, file: str) -> str:
+    """A spec file's bytes as text: UTF-8 (a byte order mark is allowed), and no NUL bytes (binary files)."""
+    if b"\x00" in raw:
+        line, column = _line_column(raw, raw.index(b"\x00"))
+        raise SpecErrors([SpecError(file, line, column, "", "a binary file (NUL bytes), not YAML text")])
+    try:
+        return raw.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line, column = _line_column(raw, exc.start)
+        byte = raw[exc.start]
+        message = f"not UTF-8 text: byte {byte:#04x} cannot be decoded (save the spec as UTF-8)"
+        raise SpecErrors([SpecError(file, line, column, "", message)]) from None
+
+
+def _line_column(raw: bytes | str, offset: int) -> tuple[int, int]:
+    before = raw[:offset]
+    newline = b"\n" if isinstance(before, bytes) else "\n"
+    return before.count(newline) + 1, offset - (before.rfind(newline) + 1) + 1  # type: ignore[arg-type]
 
 
 @without_cycle_collection
@@ -79,44 +117,112 @@ def load_text(text: str, file: str) -> Located:
         line, column = (mark.line + 1, mark.column + 1) if mark else (1, 1)
         problem = exc.problem or exc.context or "invalid YAML"
         raise SpecErrors([SpecError(file, line, column, "", f"YAML syntax error: {problem}")]) from None
+    except yaml.reader.ReaderError as exc:
+        line, column = _line_column(text, exc.position)
+        problem = f"character U+{exc.character:04X} is not allowed in YAML"
+        raise SpecErrors([SpecError(file, line, column, "", problem)]) from None
+    except RecursionError:
+        message = f"values nested too deeply (more than {MAX_DEPTH} levels)"
+        raise SpecErrors([SpecError(file, 1, 1, "", message)]) from None
     if root is None:
         raise SpecErrors([SpecError(file, 1, 1, "", "empty spec (expected a mapping with protocol, framing, ...)")])
     errors: list[SpecError] = []
-    located.data = _convert(root, (), located, errors)
+    located.data = _Converter(located, errors, _count_nodes(root)).convert(root, ())
     if errors:
         raise SpecErrors(errors)
     return located
 
 
-def _convert(node: yaml.Node, path: Path, located: Located, errors: list[SpecError]) -> Any:
-    located.marks[path] = _position(node)
-    if isinstance(node, yaml.MappingNode):
-        result: dict[Any, Any] = {}
-        for key_node, value_node in node.value:
-            key = _scalar(key_node) if isinstance(key_node, yaml.ScalarNode) else None
-            if not isinstance(key, str | int) or isinstance(key, bool):
-                line, column = _position(key_node)
-                errors.append(SpecError(located.file, line, column, dotted(path), "keys must be names or numbers"))
-                continue
-            if key in result:
-                line, column = _position(key_node)
-                errors.append(SpecError(located.file, line, column, dotted((*path, key)), f"duplicate key {key!r}"))
-                continue
-            located.key_marks[(*path, key)] = _position(key_node)
-            result[key] = _convert(value_node, (*path, key), located, errors)
-        return result
-    if isinstance(node, yaml.SequenceNode):
-        return [_convert(item, (*path, index), located, errors) for index, item in enumerate(node.value)]
-    if isinstance(node, yaml.ScalarNode):
+def _count_nodes(root: yaml.Node) -> int:
+    """How many distinct nodes the file holds (aliases point at nodes already counted)."""
+    seen: set[int] = set()
+    stack = [root]
+    while stack:
+        node = stack.pop()
+        if id(node) in seen:
+            continue
+        seen.add(id(node))
+        if isinstance(node, yaml.MappingNode):
+            stack.extend(n for pair in node.value for n in pair)
+        elif isinstance(node, yaml.SequenceNode):
+            stack.extend(node.value)
+    return len(seen)
+
+
+class _Expansion(Exception):
+    """The aliases expand beyond the budget; its error is recorded."""
+
+
+class _Converter:
+    """Nodes to plain values, within the depth and expansion limits, refusing aliases that contain themselves."""
+
+    def __init__(self, located: Located, errors: list[SpecError], distinct: int) -> None:
+        self.located = located
+        self.errors = errors
+        self.budget = distinct * EXPANSION_FACTOR + EXPANSION_SLACK
+        self.open: set[int] = set()  # the nodes being converted (the current path)
+
+    def fail(self, node: yaml.Node, path: Path, message: str) -> None:
+        line, column = _position(node)
+        self.errors.append(SpecError(self.located.file, line, column, dotted(path), message))
+
+    def convert(self, node: yaml.Node, path: Path) -> Any:
         try:
-            return _scalar(node)
-        except yaml.constructor.ConstructorError as exc:
-            line, column = _position(node)
-            errors.append(SpecError(located.file, line, column, dotted(path), str(exc.problem)))
+            return self._convert(node, path)
+        except _Expansion:
             return None
-    line, column = _position(node)
-    errors.append(SpecError(located.file, line, column, dotted(path), "YAML aliases and tags are not supported"))
-    return None
+
+    def _convert(self, node: yaml.Node, path: Path) -> Any:
+        located = self.located
+        self.budget -= 1
+        if self.budget < 0:
+            self.fail(node, path, "the YAML aliases expand to too many values (a YAML bomb?)")
+            raise _Expansion
+        if len(path) > MAX_DEPTH:
+            self.fail(node, path[:3], f"values nested too deeply (more than {MAX_DEPTH} levels)")
+            return None
+        if id(node) in self.open:
+            self.fail(node, path, "a YAML alias refers to a value that contains it")
+            return None
+        located.marks[path] = _position(node)
+        if isinstance(node, yaml.CollectionNode) and node.tag not in _PLAIN_TAGS:
+            self.fail(node, path, f"YAML tag {node.tag!r} is not supported")
+            return None
+        if isinstance(node, yaml.MappingNode):
+            self.open.add(id(node))
+            result: dict[Any, Any] = {}
+            for key_node, value_node in node.value:
+                key = _scalar(key_node) if isinstance(key_node, yaml.ScalarNode) else None
+                if not isinstance(key, str | int) or isinstance(key, bool):
+                    self.fail(key_node, path, "keys must be names or numbers")
+                    continue
+                if key in result:
+                    self.fail(key_node, (*path, key), f"duplicate key {key!r}")
+                    continue
+                if isinstance(key, str) and (bad := CONTROL.search(key)):
+                    self.fail(key_node, (*path, key), f"control character U+{ord(bad.group()):04X} in a key")
+                    continue
+                located.key_marks[(*path, key)] = _position(key_node)
+                result[key] = self._convert(value_node, (*path, key))
+            self.open.discard(id(node))
+            return result
+        if isinstance(node, yaml.SequenceNode):
+            self.open.add(id(node))
+            items = [self._convert(item, (*path, index)) for index, item in enumerate(node.value)]
+            self.open.discard(id(node))
+            return items
+        if isinstance(node, yaml.ScalarNode):
+            try:
+                value = _scalar(node)
+            except yaml.constructor.ConstructorError as exc:
+                self.fail(node, path, str(exc.problem))
+                return None
+            except ValueError:  # an integer of thousands of digits
+                self.fail(node, path, f"number too long ({len(node.value)} characters)")
+                return None
+            return value  # text is checked by the grammar (serialspec.spec.grammar.Str), wherever it came from
+        self.fail(node, path, "YAML aliases and tags are not supported")
+        return None
 
 
 def _scalar(node: yaml.ScalarNode) -> Any:

@@ -173,8 +173,9 @@ class Text(Common):
 class Bytes(Common):
     size: int | str  # a number, "rest", or the name of a field holding it
     table: Table | None = None  # when the bytes are a run of registers of this table
-    start: str = ""  # the field (or request.<field>) holding the first register's key
-    size_from: str = ""  # a response's `rest` bytes: the request field giving their number (request.<field>)
+    start: str = ""  # the field holding the first register's key: a field of this content, or of the request
+    start_in_request: bool = False  # `start: request.<field>`: the field is the request's (the resolver checked it)
+    size_from: str = ""  # a response's `rest` bytes: the request field giving their number (`request.<field>`)
 
 
 @dataclass(frozen=True)
@@ -197,6 +198,7 @@ class TableBlock(Common):
     class_name: str
     entries: tuple[TableEntry, ...]
     endian: Literal["<", ">"]
+    struct_name: str = ""  # the construct struct of the block
 
 
 Field = Scalar | Array | List | Text | Bytes | Group | TableValue | TableBlock
@@ -232,6 +234,10 @@ class Table:
     description: str
     source: str
     entries: tuple[TableEntry, ...]
+    # generated names: the register map (or the table's constant), the switch of its values by key, the name alias
+    constant: str = ""
+    value_constant: str = ""
+    names_class: str = ""
 
     def entry(self, key: int) -> TableEntry | None:
         for entry in self.entries:
@@ -278,6 +284,7 @@ class Message:
     answered_by: str = ""  # a request answered by another command's response (its key)
     error_reply: bool = False  # the reply a device sends instead of any other (Modbus exceptions: code | flag)
     reply_when: OptionalWhen | None = None  # a request whose reply is sent only when a device parameter has a value
+    struct_name: str = ""  # the construct struct of its content
     default_reply: bool = False  # among replies sharing a code: the one a frame is decoded as without its request
 
     @property
@@ -499,6 +506,7 @@ class Example:
     completed: str = ""  # the document prints no complete frame: how `frame` completes it (not an erratum)
     # bytes of the frame before and after the part the document prints (`printed_span`; (0, 0): the whole frame)
     printed_span: tuple[int, int] = (0, 0)
+    position: tuple[int, int] = (1, 1)  # line and column in the spec, for errors found after resolution
 
     @property
     def printed_part(self) -> bytes:
@@ -529,6 +537,7 @@ class Erratum:
     printed: str
     correct: str
     check: ErratumCheck
+    position: tuple[int, int] = (1, 1)  # line and column of its check in the spec
 
 
 @dataclass(frozen=True)
@@ -717,6 +726,8 @@ class Protocol:
     examples: tuple[Example, ...]
     errata: tuple[Erratum, ...]
     device: Device | None = None
+    client_class: str = ""  # the generated client's and simulator's class names
+    simulator_class: str = ""
     error_reply: ErrorReply | None = None
 
     def messages(self) -> tuple[Message, ...]:

@@ -51,5 +51,7 @@ def resolve(located: Located) -> Protocol:
         examples=ctx.examples,
         errata=ctx.errata,
         device=ctx.device,
+        client_class=ctx.client_class,
+        simulator_class=ctx.simulator_class,
         error_reply=ctx.error_reply,
     )

@@ -15,6 +15,7 @@ from serialspec.emit.common import render as common
 from serialspec.emit.common.frames import runtime_layouts
 from serialspec.emit.common.numbers import number
 from serialspec.emit.common.text import collapse
+from serialspec.runtime.errors import SerialspecError
 from serialspec.spec import expression
 from serialspec.spec.model import (
     Array,
@@ -24,6 +25,7 @@ from serialspec.spec.model import (
     Device,
     DeviceModel,
     Direction,
+    ErratumCheck,
     Example,
     Field,
     FrameLayout,
@@ -50,10 +52,36 @@ def cell(value: object) -> str:
     return text(str(value)).replace("|", "\\|") or " "
 
 
+def erratum_check_words(check: ErratumCheck) -> str:
+    """What tells the printed reading from the correct one, in words: the reader's own generated code can repeat it."""
+    frame = code_span(check.frame.hex(" ").upper() if check.frame is not None else check.frame_text)
+    direction = f" (as a {check.direction.value})" if check.direction else ""
+    if check.kind == "frame_fails":
+        return f"decoding {frame}{direction} fails with an error containing “{check.error}”"
+    if check.kind == "frame_decodes_as":
+        target = f"`{check.command}`" + (f" / `{check.subcommand}`" if check.subcommand else "")
+        return f"{frame}{direction} decodes as {target}"
+    if check.kind == "checksum_value":
+        wrong = check.claimed if isinstance(check.claimed, str) else f"{check.claimed:#04x}"
+        return f"{frame}{direction} verifies with its checksum {check.actual:#04x}; with {wrong} it fails"
+    if check.kind == "crc_parameters":
+        parameters = check.claimed.items() if isinstance(check.claimed, dict) else ()
+        named = ", ".join(
+            f"{k} {v:#04X}".replace("0X", "0x") if isinstance(v, int) else f"{k} {v}" for k, v in parameters
+        )
+        examples = f"{len(check.examples)} examples'" if check.examples else "the examples'"
+        return f"the CRC with the claimed parameters ({named or check.claimed}) does not give {examples} check bytes"
+    return "none: the correction is explained in words"
+
+
 def code_span(value: str) -> str:
-    """Text shown as printed (an erratum's quote of a document): a code span, so nothing in it is markup."""
-    value = " ".join(value.split())
-    return f"`` {value} ``" if "`" in value else f"`{value}`"
+    """Text shown as printed (an erratum's quote of a document): a code span, so nothing in it is markup, whatever
+    backticks it holds (the fence is longer than any run of them inside)."""
+    value = collapse(value)
+    runs = [len(run) for run in "".join(c if c == "`" else " " for c in value).split()]
+    fence = "`" * (max(runs, default=0) + 1)
+    padded = f" {value} " if value.startswith("`") or value.endswith("`") else value
+    return f"{fence}{padded or ' '}{fence}"
 
 
 def anchor(*parts: str) -> str:
@@ -465,7 +493,10 @@ def general_breakdown(protocol: Protocol, example: Example, message: Message | N
     """An example frame of any layout, element by element (unstuffed) and field by field, by the frame engine."""
     layouts = runtime_layouts(protocol, example.direction)
     layout = next((lay for lay in layouts if example.frame.startswith(lay.header)), layouts[0])
-    unwrapped = layout.unwrap(example.frame)
+    try:
+        unwrapped = layout.unwrap(example.frame)
+    except SerialspecError as exc:  # the example verification reports it as a spec error; the page says it too
+        return [{"bytes": example.frame.hex(" ").upper(), "field": "(frame)", "value": cell(f"does not decode: {exc}")}]
     rows: list[dict[str, str]] = []
     for e, part in zip(layout.elements, unwrapped.parts, strict=True):
         if e.kind == "content" and message is not None:
@@ -541,7 +572,8 @@ def content_rows(
             )
         if size is None:
             if isinstance(f, Group):
-                count = len(values.get(f.name, []))
+                items = values.get(f.name)  # recorded values; a malformed record is a spec error of its own
+                count = len(items) if isinstance(items, list) else 0
                 item = f.item_size
                 size = count * item if item is not None else end - offset
             elif isinstance(f, TableValue):
@@ -580,7 +612,7 @@ def emit_docs(protocol: Protocol) -> str:
             "direction": e.direction.value,
             "command": e.command + (f".{e.subcommand}" if e.subcommand else ""),
             "anchor": anchor("command", e.command, e.subcommand or ""),
-            "printed": e.printed,
+            "printed": code_span(e.printed),
             "frame": e.frame.hex(" ").upper(),
             "erratum": e.erratum,
             "partial": e.printed_span != (0, 0),
@@ -642,7 +674,7 @@ def emit_docs(protocol: Protocol) -> str:
             "source": text(e.source),
             "printed": code_span(e.printed),
             "correct": text(e.correct),
-            "check": e.check.kind,
+            "check": erratum_check_words(e.check),
         }
         for e in protocol.errata
     ]

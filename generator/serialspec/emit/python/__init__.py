@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from serialspec.emit import Emitter
 from serialspec.emit.python.package import emit_package
+from serialspec.emit.python.verify import verify
+from serialspec.spec.errors import SpecError
 from serialspec.spec.model import Protocol
 
 
@@ -11,4 +13,10 @@ def files(protocol: Protocol) -> dict[str, str]:
     return {f"{protocol.name}/{name}": text for name, text in emit_package(protocol).items()}
 
 
-EMITTER = Emitter("python", files)
+def check(protocol: Protocol, emitted: dict[str, str]) -> list[SpecError]:
+    """The spec's examples and errata, run through the package just emitted."""
+    prefix = f"{protocol.name}/"
+    return verify(protocol, {path.removeprefix(prefix): text for path, text in emitted.items()})
+
+
+EMITTER = Emitter("python", files, check)

@@ -36,6 +36,7 @@ from serialspec.spec.model import (
     Scalar,
     Table,
     TableBlock,
+    TableEntry,
     TableValue,
     reply_condition,
 )
@@ -185,7 +186,7 @@ def unused_fields(protocol: Protocol, request: Message, response: Message) -> se
     names |= {f.name for g in request.fields if isinstance(g, Group) for f in g.fields}  # per-item (BULK READ)
     for f in response.fields:
         if isinstance(f, Bytes) and f.table is not None:
-            needed = [n.removeprefix("request.") for n in (f.start, f.size_from) if n.startswith("request.")]
+            needed = [*([f.start] if f.start_in_request else []), *([f.size_from] if f.size_from else [])]
             if not all(n in names for n in needed):
                 unused.add(f.name)
     return unused
@@ -197,11 +198,28 @@ def status_flags(protocol: Protocol) -> str:
     return "{" + ", ".join(pairs) + "}" if pairs else ""
 
 
+def register_examples(table: Table) -> dict[str, str]:
+    """Docstring examples from the table's own registers (never another protocol's)."""
+    entries = [e for e in table.entries if not e.reserved]
+    writable = [e for e in entries if e.access == "rw"][:2] or entries[:1]
+
+    def value(e: TableEntry) -> str:
+        return number(e.default if isinstance(e.default, int | float) else e.minimum)
+
+    return {
+        "write_example": ", ".join(f"{e.name}={value(e)}" for e in writable),
+        "read_example": entries[0].name if entries else "",
+        "each_example": ", ".join(f'{i}: {{"{writable[0].name}": {value(writable[0])}}}' for i in (1, 2))
+        if writable
+        else "",
+    }
+
+
 def register_commands(protocol: Protocol, methods: list[dict[str, Any]]) -> list[dict[str, Any]]:
     """Commands that carry a run of registers get a method by register name; the raw one keeps `<name>_raw`.
 
-    A request with `bytes` of a table from its own start field writes (`write(id, goal_position=2048)`), a request
-    whose reply holds such bytes from the request's start and size reads (`read(id, "present_position")`), and a
+    A request with `bytes` of a table from its own start field writes (`write(id, position=100)`), a request
+    whose reply holds such bytes from the request's start and size reads (`read(id, "position")`), and a
     request group whose items each hold such bytes for one device writes to several (`sync_write({1: {...}})`).
     """
     found: list[dict[str, Any]] = []
@@ -232,7 +250,7 @@ def register_commands(protocol: Protocol, methods: list[dict[str, Any]]) -> list
         if run is not None and run.table is not None and fields == [address, run.start, run.name]:
             context.update(kind="write", map=map_name(run.table), alias=names_alias(run.table))
         elif read is not None and read.table is not None and group is None and len(fields) == 3:
-            start, size = (read.start.removeprefix("request."), read.size_from.removeprefix("request."))
+            start, size = read.start, read.size_from
             if fields != [address, start, size]:
                 continue
             # the first register read also reads the parameters that switch optional replies (one _read_key)
@@ -240,7 +258,7 @@ def register_commands(protocol: Protocol, methods: list[dict[str, Any]]) -> list
             context.update(kind="read", map=map_name(read.table), alias=names_alias(read.table), returns="int")
             context.update(read_key=first)
         elif group is not None and read is not None and read.table is not None and method["kind"] == "each":
-            start, size = (read.start.removeprefix("request."), read.size_from.removeprefix("request."))
+            start, size = read.start, read.size_from
             items = [f.name for f in group.fields]
             if fields == [address, start, size, group.name] and items == [address]:
                 context.update(kind="each_read", map=map_name(read.table), alias=names_alias(read.table))
@@ -281,6 +299,8 @@ def register_commands(protocol: Protocol, methods: list[dict[str, Any]]) -> list
             )
         else:
             continue
+        table = next(t for t in protocol.tables if map_name(t) == context["map"])
+        context.update(register_examples(table))
         method["name"] = context["raw"]
         found.append(context)
     return found
@@ -512,7 +532,7 @@ def client_module(protocol: Protocol) -> str:
     imports.update(e.flags.class_name for e in status_elements(protocol) if e.flags is not None)
     everything = [*methods, *(m for g in groups.values() for m in g["methods"])]
     address, broadcast = address_of(protocol)
-    class_name = "".join(w.capitalize() for w in protocol.name.split("_")) + "Client"
+    class_name = protocol.client_class
     errors = None
     if protocol.error_reply is not None:
         reply = protocol.command(protocol.error_reply.command).response
@@ -550,14 +570,21 @@ def client_module(protocol: Protocol) -> str:
         error_imports=[
             name
             for name, used in (
-                ("DeviceError", any(m["statuses"] for m in everything)),
                 ("EncodeError", bool(tables) or any(r["kind"] != "write" for r in registers)),
                 ("Timeout", any(m["kind"] == "bool" for m in everything)),
             )
             if used
         ],
-        uses_status=any(m["statuses"] for m in everything),
-        uses_message=any(m["statuses"] or m["kind"] == "carry" for m in everything),
+        transport_imports=[
+            "Binding",
+            "Bus",
+            "ClientBase",
+            *(["ErrorReplies"] if errors else []),
+            *(["check_status"] if any(m["statuses"] for m in everything) else []),
+            *(["flag_names"] if status_flags(protocol) else []),
+            *(["table_key"] if tables else []),
+        ],
+        uses_message=any(m["kind"] == "carry" for m in everything),
         abc_imports=sorted(
             {
                 *(["Callable", "Iterator"] if reports else []),

@@ -103,10 +103,11 @@ def emit_package(protocol: Protocol) -> dict[str, str]:
     files = {
         "messages.py": render(
             "messages.py.j2",
-            used="\n".join(line for c in classes for line in [*c["to_fields"], *c["from_fields"]]),
+            field_imports=field_imports(classes),
             **base,
             enums=enums,
             flag_sets=flag_sets,
+            enum_imports=[name for name, used in (("IntEnum", enums), ("IntFlag", flag_sets)) if used],
             classes=classes,
             message_classes=[c for c in classes if c["name"] in messages],
             exports=exports,
@@ -136,6 +137,29 @@ def emit_package(protocol: Protocol) -> dict[str, str]:
     if protocol.device is not None:
         files["simulator.py"] = simulator_module(protocol)
     return files
+
+
+# The runtime's helpers that build fields from data, by the name generated code calls them (serialspec.runtime.fields).
+FIELD_HELPERS = (
+    ("as_bytes", "_bytes"),
+    ("check_keys", "_check_keys"),
+    ("enum", "_as_enum"),
+    ("flags", "_as_flags"),
+    ("get", "_get"),
+    ("integer", "_integer"),
+    ("integers", "_integers"),
+    ("items", "_items"),
+    ("mapping", "_mapping"),
+    ("number", "_number"),
+    ("numbers", "_numbers"),
+)
+
+
+def field_imports(classes: list[dict[str, Any]]) -> list[tuple[str, str]]:
+    """The helpers the classes' to_fields/from_fields call, as (name, alias), in the order isort wants."""
+    used = "\n".join(line for c in classes for line in [*c["to_fields"], *c["from_fields"]])
+    used += "\n_check_keys(" if classes else ""  # every from_fields checks its keys (the template calls it)
+    return [(name, alias) for name, alias in FIELD_HELPERS if re.search(rf"(?<![\w.]){alias}\(", used)]
 
 
 def message_doc(protocol: Protocol, message: Message) -> str:
@@ -276,6 +300,7 @@ def classic_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
                 "length_offset": layout.length_offset,
                 "length_adds": layout.length_adds,
                 "command_offset": layout.command_offset,
+                "value_ranges": value_ranges(layout, protocol.byte_order),
                 "dispatch": dispatch,
                 "sizes": sizes,
                 "whole": frame_decode_lines(protocol, layout, dispatch, "data", None),
@@ -534,6 +559,19 @@ def frame_decode_lines(
         f'    raise DecodeError(f"unknown command {{{code}:#04x}}")',
         f"return decoder({args})",
     ]
+
+
+def value_ranges(layout: FrameLayout, byte_order: str) -> str:
+    """The frame-level values whose declared range is narrower than their type (an address 0..253, broadcast 254),
+    as FrameFormat.value_ranges: (offset, size, byte order, signed, low, high, also allowed); a stream candidate
+    holding a value outside its range is no frame."""
+    ranges = [
+        f"({layout.offsets[e.name]}, {e.type.size}, {byte_order!r}, {e.type.signed}, {int(e.minimum)}, "
+        f"{int(e.maximum)}, {e.broadcast})"
+        for e in layout.value_elements
+        if e.type is not None and not e.type.is_float and (e.minimum, e.maximum) != (e.type.minimum, e.type.maximum)
+    ]
+    return "(" + ", ".join(ranges) + ("," if len(ranges) == 1 else "") + ")"
 
 
 def uses_table(message: Message, table: str) -> bool:

@@ -277,9 +277,7 @@ class PackageCode:
                 attributes.append(Attribute(bit.name, kind, f"{one_line(bit.description or bit.name)} ({where})"))
             code = ClassCode(f.bits_class, f"Bit fields of {f.name}.", "", attributes)
             code.to_fields = [f"{b.name!r}: int(self.{b.name})," for b in f.bits]
-            code.from_fields = [
-                self.from_value_expr_bits(b.name, b.enum.class_name if b.enum else None) for b in f.bits
-            ]
+            code.from_fields = [self.from_value_expr(b.name, b.enum.class_name if b.enum else None) for b in f.bits]
             self.helper_classes.append(code)
         elif isinstance(f, Group) and f.class_name not in self._seen_classes:
             self._seen_classes.add(f.class_name)
@@ -303,15 +301,16 @@ class PackageCode:
                 f"{e.name!r}: {'int(self.' + e.name + ')' if e.enum else 'self.' + e.name}," for e in f.entries
             ]
             code.from_fields = [
-                f"_enum({e.enum.class_name}, _get(data, {e.name!r}, where)),"
-                if e.enum
-                else f"_get(data, {e.name!r}, where),"
-                for e in f.entries
+                self.from_value_expr(e.name, e.enum.class_name if e.enum else None, e.type.is_float) for e in f.entries
             ]
             self.helper_classes.append(code)
 
-    def from_value_expr_bits(self, name: str, enum: str | None) -> str:
-        return f"_enum({enum}, _get(data, {name!r}, where))," if enum else f"_get(data, {name!r}, where),"
+    def from_value_expr(self, name: str, enum: str | None, is_float: bool = False) -> str:
+        """A value of a bit field or table block entry, from data: an enum member or an integer (or a number)."""
+        get = f"_get(data, {name!r}, where)"
+        if enum:
+            return f"_as_enum({enum}, {get}, {name!r}, where),"
+        return f"{'_number' if is_float else '_integer'}({get}, {name!r}, where),"
 
     def to_json(self, f: SpecField, expr: str) -> str:
         if isinstance(f, Scalar):
@@ -334,16 +333,19 @@ class PackageCode:
         get = f"_get(data, {f.name!r}, where)"
         if isinstance(f, Scalar):
             if f.bits:
-                return f"{f.bits_class}.from_fields(_mapping({get}, {f.name!r}, where), where)"
+                # errors inside name the field too: "spin request method: direction must be an integer"
+                return f"{f.bits_class}.from_fields(_mapping({get}, {f.name!r}, where), where + {' ' + f.name!r})"
             if f.enum:
-                return f"_enum({f.enum.class_name}, {get})"
+                return f"_as_enum({f.enum.class_name}, {get}, {f.name!r}, where)"
             if f.flags:
-                return f"{f.flags.class_name}({get})"
+                return f"_as_flags({f.flags.class_name}, {get}, {int(f.maximum)}, {f.name!r}, where)"
             if f.default is not None:
-                return f"data.get({f.name!r}, {number(f.default)})"
-            return get
+                get = f"data.get({f.name!r}, {number(f.default)})"
+            kind = "_number" if f.type.is_float else "_integer"
+            return f"{kind}({get}, {f.name!r}, where)"
         if isinstance(f, Array):
-            return f"tuple({get})"
+            kind = "_numbers" if f.item.is_float else "_integers"
+            return f"{kind}({get}, {f.name!r}, where)"
         if isinstance(f, List):
             return f"tuple(bool(x) for x in {get})" if f.bits else f"tuple({get})"
         if isinstance(f, Text):
@@ -351,9 +353,12 @@ class PackageCode:
         if isinstance(f, Bytes):
             return f"_bytes({get}, {f.name!r}, where)"
         if isinstance(f, Group):
-            return f"tuple({f.class_name}.from_fields(_mapping(item, {f.name!r}, where), where) for item in {get})"
+            return (
+                f"tuple({f.class_name}.from_fields(_mapping(item, {f.name!r}, where), where) "
+                f"for item in _items({get}, {f.name!r}, where))"
+            )
         if isinstance(f, TableBlock):
-            return f"{f.class_name}.from_fields(_mapping({get}, {f.name!r}, where), where)"
+            return f"{f.class_name}.from_fields(_mapping({get}, {f.name!r}, where), where + {' ' + f.name!r})"
         return get
 
     def message(self, message: Message) -> None:
@@ -811,13 +816,19 @@ class PackageCode:
 
     def check_scalar(self, f: Scalar, expr: str, lines: Lines, where: str, also: int | None = None) -> None:
         """Range check; `also` is one more value allowed outside the range (an address's broadcast value)."""
+        # an integer field refuses True and False too (bool is an int to Python, never to the wire)
+        not_bool = "" if f.type.is_float else f" or {expr}.__class__ is bool"
+        if f.flags:  # typed as the IntFlag class, which mypy knows is no bool: asked the way it accepts
+            not_bool = f" or isinstance({expr}, bool)"
         if also is not None and also in (f.minimum - 1, f.maximum + 1):  # next to the range: one comparison
             low, high = min(also, f.minimum), max(also, f.maximum)
-            lines.append(f"if not {number(low)} <= {expr} <= {number(high)}:")
+            lines.append(f"if not {number(low)} <= {expr} <= {number(high)}{not_bool}:")
         elif also is not None and not f.minimum <= also <= f.maximum:
-            lines.append(f"if not ({number(f.minimum)} <= {expr} <= {number(f.maximum)} or {expr} == {also}):")
+            lines.append(
+                f"if not ({number(f.minimum)} <= {expr} <= {number(f.maximum)} or {expr} == {also}){not_bool}:"
+            )
         else:
-            lines.append(f"if not {number(f.minimum)} <= {expr} <= {number(f.maximum)}:")
+            lines.append(f"if not {number(f.minimum)} <= {expr} <= {number(f.maximum)}{not_bool}:")
         lines.append(f"    raise out_of_range({where}, {f.name!r}, {expr}, {number(f.minimum)}, {number(f.maximum)})")
 
     def encode_fields(self, fields: list[SpecField], base: str, obj: str, lines: Lines, where: str) -> list[str]:
@@ -884,7 +895,7 @@ class PackageCode:
             packed = []
             for bit in f.bits:
                 sub = f"{expr}.{bit.name}"
-                lines.append(f"if not 0 <= {sub} <= {bit.mask}:")
+                lines.append(f"if not 0 <= {sub} <= {bit.mask} or {sub}.__class__ is bool:")
                 lines.append(f"    raise out_of_range({where}, {f.name + '.' + bit.name!r}, {sub}, 0, {bit.mask})")
                 packed.append(f"({sub} << {bit.low})" if bit.low else sub)
             return " | ".join(packed)

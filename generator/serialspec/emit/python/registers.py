@@ -23,11 +23,11 @@ def register_tables(protocol: Protocol) -> list[Table]:
 
 
 def map_name(table: Table) -> str:
-    return table.name.upper()
+    return table.constant
 
 
 def names_alias(table: Table) -> str:
-    return "".join(w.capitalize() for w in table.name.split("_")) + "Name"
+    return table.names_class
 
 
 def registers_module(protocol: Protocol) -> str:

@@ -75,7 +75,7 @@ def table_fields(*messages: Message | None) -> dict[str, tuple[str, ...]]:
             found[f.name] = ("block", *(e.name for e in f.entries))
         elif isinstance(f, Bytes) and f.table is not None and f.start:
             # the request's fields are the device's `given` values, so `request.address` is `address` there
-            found[f.name] = ("run", f.start.removeprefix("request."), f.size_from.removeprefix("request."))
+            found[f.name] = ("run", f.start, f.size_from)
         elif isinstance(f, Group):
             stack.extend(reversed(f.fields))
     return found
@@ -210,7 +210,7 @@ def simulator_module(protocol: Protocol) -> str:
                 args.append(f"limits={{{shown}}}")
         condition = reply_condition(request, response)
         if response and condition:
-            args.append(f"optional_when=({condition.key}, {condition.equals}, {condition.op!r})")
+            args.append(f"optional_when=({condition.entry!r}, {condition.equals}, {condition.op!r})")
         if response and response.after:
             args.append(f"after={response.after!r}")
         tables = table_fields(request, response)
@@ -255,7 +255,7 @@ def simulator_module(protocol: Protocol) -> str:
         title=one_line(protocol.title),
         package=protocol.name,
         description=one_line(device.description),
-        class_name="".join(w.capitalize() for w in protocol.name.split("_")) + "Simulator",
+        class_name=protocol.simulator_class,
         address=repr(device.address),
         id_entry=repr(device.id_entry),
         broadcast=repr(device.broadcast),

@@ -87,9 +87,9 @@ def field_expr(f: Field, parent: str = "this") -> str:
         count = f.count if isinstance(f.count, int) else f"this.{f.count}"
         return f"Array({count}, {item})"
     if isinstance(f, TableValue):
-        return f"Switch(this.{f.key}, {table_name(f.table.name)})"
+        return f"Switch(this.{f.key}, {f.table.value_constant})"
     assert isinstance(f, TableBlock)
-    return block_name(f.class_name)
+    return f.struct_name
 
 
 def list_expr(f: List) -> str:
@@ -125,14 +125,6 @@ def bits_expr(f: Scalar) -> str:
     return f"ByteSwapped({inner})" if f.type.size > 1 and f.endian == "<" else inner
 
 
-def table_name(name: str) -> str:
-    return f"{name.upper()}_VALUE"
-
-
-def block_name(class_name: str) -> str:
-    return f"{class_name}Block"
-
-
 def frame_expr(layout: FrameLayout) -> str:
     body = []
     adds = layout.length_adds
@@ -165,7 +157,7 @@ def structs_module(protocol: Protocol) -> str:
         fields = [f"{f.name!r} / {field_expr(f)}" for f in message.fields]
         contents.append(
             {
-                "name": f"{message.class_name}Content",
+                "name": message.struct_name,
                 "fields": fields,
                 "key": message.key,
                 "direction": message.direction.value,
@@ -173,7 +165,7 @@ def structs_module(protocol: Protocol) -> str:
         )
     tables = [
         {
-            "name": table_name(t.name),
+            "name": t.value_constant,
             "entries": [(e.key, field_expr_entry(e.type, e.sign_bit)) for e in t.entries if not e.reserved],
         }
         for t in protocol.tables
@@ -182,7 +174,7 @@ def structs_module(protocol: Protocol) -> str:
     for message in protocol.messages():
         for f in message.fields:
             if isinstance(f, TableBlock):
-                blocks[block_name(f.class_name)] = [
+                blocks[f.struct_name] = [
                     f"{e.name!r} / {field_expr_entry(e.type, e.sign_bit, f.endian)}" for e in f.entries
                 ]
     framing = protocol.framing

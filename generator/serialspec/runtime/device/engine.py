@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import logging
 import math
 import struct
 import threading
@@ -16,6 +17,8 @@ from serialspec.runtime.errors import DecodeError, EncodeError
 from serialspec.runtime.message import Message, compare, field_names
 from serialspec.runtime.registers import RegisterMap
 from serialspec.runtime.stream import StreamParser
+
+LOG = logging.getLogger("serialspec.sim")
 
 
 @dataclass(frozen=True)
@@ -79,7 +82,7 @@ class CommandSpec:
     reports: dict[str, str | Callable[[Callable[[str], float]], float]] = field(default_factory=dict)
     moves: tuple[str, str, str, str] | None = None  # state, target field, duration field (ms), speed field (/s)
     broadcast_reply: bool = False
-    optional_when: tuple[int, int, str] | None = None  # (memory key, value, comparison): when the response is sent
+    optional_when: tuple[str, int, str] | None = None  # (memory entry, value, comparison): when it is sent
     after: str = ""  # request field: the response is sent after that many ms
     # table fields of the request and response: name -> ("value", key field) or ("block", entry names...)
     tables: dict[str, tuple[str, ...]] = field(default_factory=dict)
@@ -462,10 +465,12 @@ class Engine(FaultInjection):
         if self._answering_as is not None and isinstance(values.get(self.spec.address), int | float):
             address = int(values[self.spec.address])
             values = {**values, self.spec.address: self._answering_as.other_id(address, self.spec.broadcast)}
-        values = {k: int(v) if isinstance(v, float) and v.is_integer() else v for k, v in values.items()}
+        values = _whole(values)
         try:
             return self.encode(response.from_fields(values))  # type: ignore[attr-defined]
-        except EncodeError:
+        except (EncodeError, TypeError, ValueError, KeyError) as exc:
+            # never silent: the reply is not sent, and one line says why
+            LOG.warning("simulator: no %s reply: %s", response.__name__, str(exc).splitlines()[0] if str(exc) else exc)
             return None
 
     def act(
@@ -489,7 +494,7 @@ class Engine(FaultInjection):
         # Whether an optional reply is due is decided on the switch as the request finds it (a write that turns
         # replies off is still answered), which is also what a client that remembers the switch expects.
         switch = command.optional_when
-        answers = switch is None or compare(device.memory.get(switch[0]), switch[2], switch[1])
+        answers = switch is None or compare(device.get(switch[0]), switch[2], switch[1])
         if command.limits or command.space_reads or command.space_writes or command.refused_while_moving:
             refusal = self._refusal(device, command, given)
             if refusal is not None:
@@ -773,3 +778,14 @@ def nest(values: dict[str, Any], overlay: dict[str, Any]) -> None:
             values[name] = value
         elif isinstance(values.get(name), dict):
             values[name] = {**values[name], bit: value}
+
+
+def _whole(value: Any) -> Any:
+    """State and memory hold floats; a reply's integer fields (bit fields and items too) take whole numbers as ints."""
+    if isinstance(value, float) and value.is_integer():
+        return int(value)
+    if isinstance(value, dict):
+        return {k: _whole(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_whole(v) for v in value]
+    return value

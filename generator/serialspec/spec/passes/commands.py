@@ -7,6 +7,7 @@ from typing import Any, Literal
 from serialspec.spec.errors import SpecError
 from serialspec.spec.loader import Path
 from serialspec.spec.model import (
+    Bytes,
     Command,
     Direction,
     Field,
@@ -20,6 +21,8 @@ from serialspec.spec.model import (
     TableEntry,
     content_bounds,
     fixed_size,
+    replies_by_request,
+    reply_to,
 )
 from serialspec.spec.passes.base import camel
 from serialspec.spec.passes.fields import FieldResolver
@@ -36,14 +39,82 @@ class Commands(FieldResolver):
     """Resolve `commands:` and check their codes against the framing and their `answered_by` references."""
 
     def run(self) -> list[SpecError]:
-        for key, value in (self.ctx.data.get("commands") or {}).items():
+        for key, value in self.section("commands").items():
             command = self.guard(("commands", key), self.command, key, value, ("commands", key))
             if command:
                 self.ctx.commands.append(command)
         if self.ctx.framing:
             self.check_codes(self.ctx.commands, self.ctx.framing)
+            self.check_lengths(self.ctx.commands, self.ctx.framing)
         self.check_answered_by(self.ctx.commands)
+        self.check_request_references(self.ctx.commands)
+        self.check_matching(self.ctx.commands, self.ctx.framing)
         return self.problems
+
+    def check_lengths(self, commands: list[Command], framing: Framing) -> None:
+        """Every message's smallest content must be countable by its frame's length element."""
+        for command in commands:
+            for message in command.messages():
+                layout = framing.layouts[message.direction]
+                length = layout.length
+                if not layout.classic or length is None or length.type is None:
+                    continue  # the frame engine's lengths count spans of their own (or the frame has none)
+                countable = int(length.type.maximum) - layout.length_adds
+                if message.min_size > countable:
+                    self.error(
+                        message_path(message),
+                        f"content of at least {message.min_size} bytes is more than the {length.type.name} length "
+                        f"element {length.name!r} can count ({countable})",
+                    )
+
+    def check_request_references(self, commands: list[Command]) -> None:
+        """A response's `after`, `start: request.<field>` and `size_from` name fields of the requests it answers."""
+        messages = [m for c in commands for m in c.messages()]
+        replies = replies_by_request(messages)
+        requests = {m.key: m for m in messages if m.direction == Direction.REQUEST}
+        answered: dict[str, list[Message]] = {}
+        for request in requests.values():
+            response = reply_to(request, replies)
+            if response is not None:
+                answered.setdefault(response.key, []).append(request)
+        for message in messages:
+            if message.direction != Direction.RESPONSE:
+                continue
+            path = message_path(message)
+            if message.answers and message.answers not in requests:
+                known = ", ".join(requests) or "none"
+                self.error((*path, "answers"), f"unknown request {message.answers!r} (expected one of: {known})")
+            asked = answered.get(message.key, [])
+            wanted: list[tuple[Path, str]] = []
+            if message.after:
+                wanted.append(((*path, "after"), message.after))
+            for f in message.fields:
+                if isinstance(f, Bytes) and f.start_in_request:
+                    wanted.append(((*path, "fields", f.name, "start"), f.start))
+                if isinstance(f, Bytes) and f.size_from:
+                    wanted.append(((*path, "fields", f.name, "size_from"), f.size_from))
+            for where, name in wanted:
+                if name in self.ctx.broken:
+                    continue
+                if not any(integer_field(r, name) for r in asked):
+                    names = sorted({f.name for r in asked for f in r.fields if isinstance(f, Scalar)})
+                    known = ", ".join(names) or "none"
+                    self.error(
+                        where,
+                        f"no request this response answers has an integer field {name!r} (they have: {known})",
+                    )
+
+    def check_matching(self, commands: list[Command], framing: Framing | None) -> None:
+        """`matching.by` names frame elements or fields that requests and their replies carry."""
+        names = {e.name for layout in (framing.layouts.values() if framing else ()) for e in layout.value_elements}
+        names |= {f.name for c in commands for m in c.messages() for f in m.fields}
+        names |= {"command", "subcommand"}  # the message's own command and sub-command
+        if framing is None:
+            return  # the frame's elements are unknown: its problems are reported
+        names |= self.ctx.broken
+        for index, name in enumerate(self.ctx.matching):
+            if name not in names:
+                self.error(("matching", "by", index), f"unknown field {name!r} (no frame element or field has it)")
 
     def command(self, name: str, value: dict[str, Any], path: Path) -> Command:
         self.name(name, path, "command name")
@@ -70,6 +141,12 @@ class Commands(FieldResolver):
                         f"code {sub['code']:#04x} is already used by {codes[sub['code']]!r}",
                     )
                 codes[sub["code"]] = sub_name
+                if not selector.type.minimum <= sub["code"] <= selector.type.maximum:
+                    self.error(
+                        (*sub_path, "code"),
+                        f"code {sub['code']} does not fit the {selector.type.name} selector "
+                        f"({selector.type.minimum:g}..{selector.type.maximum:g})",
+                    )
                 messages = {
                     d: self.guard(
                         (*sub_path, d.value),
@@ -132,18 +209,39 @@ class Commands(FieldResolver):
 
     def check_codes(self, commands: list[Command], framing: Framing) -> None:
         for command in commands:
+            if command.code is not None and not isinstance(command.code, int):
+                continue  # not a number: the structural check has said so
             directions = {m.direction for m in command.messages()}
-            if command.code is not None and not any(framing.layouts[d].has_command for d in directions):
+            broken = command.name in self.ctx.broken  # a message failed to resolve: its problem is reported
+            if command.code is not None and not broken and not any(framing.layouts[d].has_command for d in directions):
                 self.error(
                     ("commands", command.name, "code"),
                     "its frames have no command field, so no code",
                 )
+            element = next(
+                (
+                    e
+                    for d, layout in framing.layouts.items()
+                    for e in layout.elements
+                    if e.role == "command" and d in directions
+                ),
+                None,
+            )
+            if element is not None and element.type is not None and command.code is not None:
+                low, high = element.type.minimum, element.type.maximum
+                if not low <= command.code <= high:
+                    self.error(
+                        ("commands", command.name, "code"),
+                        f"code {command.code} does not fit the {element.type.name} command element ({low:g}..{high:g})",
+                    )
         for direction, layout in framing.layouts.items():
             sharing: dict[int | None, list[tuple[Command, Message]]] = {}
             for command in commands:
                 messages = [m for m in command.messages() if m.direction == direction]
                 if not messages or any(m.error_reply for m in messages):
                     continue  # an error reply has the code of the request it refuses (see passes/errors.py)
+                if command.code is not None and not isinstance(command.code, int):
+                    continue  # not a number: the structural check has said so
                 if layout.has_command and command.code is None:
                     self.error(
                         ("commands", command.name),
@@ -195,6 +293,7 @@ class Commands(FieldResolver):
         self.check_rest(fields, (*path, "fields"))
         low, high = content_bounds(fields)
         class_name = self.class_name(camel(command, subcommand or "", direction.value), path)
+        struct_name = self.class_name(f"{class_name}Content", path)
         answered_by = value.get("answered_by") or {}
         if direction == Direction.REQUEST:
             for field in fields:
@@ -223,6 +322,7 @@ class Commands(FieldResolver):
             answered_by=str(answered_by.get("command", "")),
             default_reply=bool(value.get("default", False)),
             reply_when=self.optional_when(answered_by.get("optional_when"), (*path, "answered_by", "optional_when")),
+            struct_name=struct_name,
             error_reply=bool(value.get("error_reply", False)),
         )
 
@@ -289,3 +389,14 @@ class Commands(FieldResolver):
         if position == offset:
             return (*fields, const)
         raise self.fail(path, f"the selector's offset {offset} does not fall between fixed-size fields")
+
+
+def message_path(message: Message) -> Path:
+    """Where a message is in the spec."""
+    if message.subcommand is not None:
+        return ("commands", message.command, "subcommands", message.subcommand, message.direction.value)
+    return ("commands", message.command, message.direction.value)
+
+
+def integer_field(message: Message, name: str) -> bool:
+    return any(isinstance(f, Scalar) and not f.type.is_float and f.name == name for f in message.fields)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Container, Mapping
 from typing import Any
 
 from serialspec.spec import expression
@@ -17,11 +18,13 @@ from serialspec.spec.model import (
     DeviceModel,
     DeviceTimeout,
     Direction,
+    Field,
     Framing,
     Group,
     Message,
     ModelEntry,
     Motion,
+    Scalar,
     Space,
     SpaceAccess,
     TableEntry,
@@ -29,6 +32,16 @@ from serialspec.spec.model import (
     reply_to,
 )
 from serialspec.spec.passes.base import Pass
+
+
+class _Everything:
+    """Contains every name: what an unknown kind or group is checked against (it is reported once itself)."""
+
+    def __contains__(self, name: object) -> bool:
+        return True
+
+
+EVERYTHING = _Everything()
 
 
 class DevicePass(Pass):
@@ -45,9 +58,15 @@ class DevicePass(Pass):
     def device(self, value: dict[str, Any], path: Path, commands: list[Command], framing: Framing) -> Device:
         memory = self.reference("table", self.tables, value.get("memory"), (*path, "memory"))
         entries = {e.name: e for e in memory.entries} if memory else {}
-        for name in value.get("initial") or {}:
+        for name, initial in (value.get("initial") or {}).items():
             if name not in entries:
                 self.error((*path, "initial", name), f"unknown memory entry {name!r}")
+            elif not entries[name].minimum <= initial <= entries[name].maximum:
+                entry = entries[name]
+                self.error(
+                    (*path, "initial", name),
+                    f"initial value {initial} is outside {name}'s range {entry.minimum:g}..{entry.maximum:g}",
+                )
         address_element = next(
             (e for layout in framing.layouts.values() for e in layout.value_elements if e.role == "address"), None
         )
@@ -73,27 +92,35 @@ class DevicePass(Pass):
             )
             for name, kind in (value.get("kinds") or {}).items()
         }
+        self.check_ids(value, path, commands, framing)
+        broken = self.ctx.broken
         behaviours = []
         for key, item in (value.get("commands") or {}).items():
             item_path = (*path, "commands", key)
             request = requests.get(key)
+            if request is None and key in self.ctx.broken:
+                continue  # the command failed to resolve: its problem is reported
             if request is None:
                 self.error(item_path, f"unknown command {key!r} (or it has no request)")
                 continue
             kind_name = str(item.get("kind", ""))
             if kind_name and kind_name not in kinds:
                 self.error((*item_path, "kind"), f"unknown device kind {kind_name!r} (not in `kinds:`)")
-            known_state = kinds[kind_name].state if kind_name in kinds else state
+            # an unknown kind or group is reported once: the names that depend on it are not checked
+            known_state: dict[str, float] | _Everything = (
+                kinds[kind_name].state if kind_name in kinds else EVERYTHING if kind_name else state
+            )
             response = reply_to(request, replies)
             each = str(item.get("each", ""))
             group = next((f for f in request.fields if isinstance(f, Group) and f.name == each), None)
             if each and group is None:
                 self.error((*item_path, "each"), f"{key} has no group field {each!r}")
             item_fields = group.fields if group else ()
-            request_names = {f.name for f in (*request.fields, *item_fields)}
-            response_names = {f.name for f in response.fields} if response else set()
+            request_set = {f.name for f in (*request.fields, *item_fields)} | broken
+            request_names: Container[str] = EVERYTHING if each and group is None else request_set
+            response_names = ({f.name for f in response.fields} if response else set()) | broken
             space_reads = self.space_runs(item.get("reads"), response_names, request, spaces, (*item_path, "reads"))
-            space_writes = self.space_runs(item.get("writes"), request_names, request, spaces, (*item_path, "writes"))
+            space_writes = self.space_runs(item.get("writes"), request_set, request, spaces, (*item_path, "writes"))
             for name in item.get("reads") or () if not space_reads else ():
                 if name not in response_names:
                     self.error((*item_path, "reads"), f"{key} has no response field {name!r}")
@@ -109,7 +136,7 @@ class DevicePass(Pass):
                 except expression.ExpressionError as exc:
                     self.error((*item_path, "reports", field_name), str(exc))
                     continue
-                for name in sorted(used - set(known_state) - set(entries)):
+                for name in sorted(n for n in used if n not in known_state and n not in entries):
                     self.error((*item_path, "reports", field_name), f"unknown state variable {name!r}")
             motion = None
             if "moves" in item:
@@ -171,7 +198,12 @@ class DevicePass(Pass):
                     space_writes,
                     self.keeps(item.get("keeps"), request_names, entries, (*item_path, "keeps")),
                     **self.behaviour_extras(
-                        item, item_path, key, request_names, response_names, {**entries, **known_state}
+                        item,
+                        item_path,
+                        key,
+                        request_names,
+                        response_names,
+                        known_state if isinstance(known_state, _Everything) else {**entries, **known_state},
                     ),
                     nothing_held={str(k): float(v) for k, v in (item.get("nothing_held") or {}).items()},
                 )
@@ -201,6 +233,44 @@ class DevicePass(Pass):
             moving=self.moving(value, path, entries, state),
             model_entry=str(value.get("model_entry", "")),
         )
+
+    def check_ids(self, value: dict[str, Any], path: Path, commands: list[Command], framing: Framing) -> None:
+        """`address` (and each kind's) names an integer the requests carry; `reply`, `refused`, `status` name what
+        the responses carry."""
+        elements = {e.name: e for layout in framing.layouts.values() for e in layout.value_elements}
+        carried: dict[Direction, dict[str, Field]] = {Direction.REQUEST: {}, Direction.RESPONSE: {}}
+        for command in commands:
+            for message in command.messages():
+                stack = list(message.fields)
+                while stack:
+                    f = stack.pop()
+                    carried[message.direction].setdefault(f.name, f)
+                    if isinstance(f, Group):
+                        stack.extend(f.fields)
+        wanted = [((*path, "address"), value.get("address"))]
+        wanted += [
+            ((*path, "kinds", k, "address"), kind.get("address")) for k, kind in (value.get("kinds") or {}).items()
+        ]
+        for where, name in wanted:
+            if name is None or name in elements:
+                continue
+            found = carried[Direction.REQUEST].get(name)
+            if found is None:
+                self.error(where, f"unknown field {name!r}: no request carries it (nor the frame)")
+            elif not isinstance(found, Scalar) or found.type.is_float:
+                self.error(where, f"{name!r} is no integer field, so it cannot hold a device id")
+        responses = carried[Direction.RESPONSE]
+        # Reply values: `reply`, `status`, and `errors` where no error reply carries them (else `errors` checks them).
+        named: list[tuple[Path, Any]] = [((key,), value.get(key)) for key in ("reply", "status")]
+        if not any(m.error_reply for c in self.ctx.commands for m in c.messages()):
+            named += [(("errors", reason), values) for reason, values in (value.get("errors") or {}).items()]
+        for where, values in named:
+            for name in values or {}:
+                head, _, bit = str(name).partition(".")  # `error.number`: a bit field of a value or element
+                owner = elements.get(head) or responses.get(head)
+                bits = {b.name for b in getattr(owner, "bits", ())}
+                if owner is None or (bit and bit not in bits):
+                    self.error((*path, *where, name), f"unknown response field {name!r}: no response carries it")
 
     def timeout(
         self, value: Any, path: Path, requests: dict[str, Message], state: dict[str, float]
@@ -327,9 +397,9 @@ class DevicePass(Pass):
         item: dict[str, Any],
         path: Path,
         key: str,
-        request_names: set[str],
-        response_names: set[str],
-        variables: dict[str, Any],
+        request_names: Container[str],
+        response_names: Container[str],
+        variables: Container[str],
     ) -> dict[str, Any]:
         """The behaviours that stop, wrap, count, hold, release and carry, each name checked."""
 
@@ -356,11 +426,12 @@ class DevicePass(Pass):
             area, kept = item["restores"]["memory"], item["restores"].get("except") or ()
             for index, name in enumerate(kept):
                 known(str(name), (*path, "restores", "except", index))
-            restores = tuple(
-                name
-                for name, entry in variables.items()
-                if isinstance(entry, TableEntry) and entry.memory == area and name not in kept
-            )
+            if isinstance(variables, Mapping):  # else the unknown kind was reported already
+                restores = tuple(
+                    name
+                    for name, entry in variables.items()
+                    if isinstance(entry, TableEntry) and entry.memory == area and name not in kept
+                )
         carries = item.get("carries")
         carried: list[str] = []
         if carries:

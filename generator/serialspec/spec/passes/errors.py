@@ -12,7 +12,8 @@ class ErrorReplies(Pass):
 
     def run(self) -> list[SpecError]:
         framing = self.ctx.framing
-        raw = (self.ctx.data.get("framing") or {}).get("elements") or {}
+        elements = self.section("framing").get("elements")
+        raw = elements if isinstance(elements, dict) else {}  # malformed: the structural check has said so
         flagged = [(name, e) for name, e in raw.items() if isinstance(e, dict) and "error_flag" in e]
         replies = [(c.name, m) for c in self.ctx.commands for m in c.messages() if m.error_reply]
         for name, _ in replies[1:]:

@@ -14,27 +14,31 @@ from serialspec.spec.model import (
     ErratumCheck,
     Example,
 )
-from serialspec.spec.passes.base import Pass
+from serialspec.spec.passes.base import Bad, Pass
 
 
 class Examples(Pass):
     """Resolve `errata:` then `examples:` (an example may name an erratum; an erratum may check examples)."""
 
     def run(self) -> list[SpecError]:
-        data, commands = self.ctx.data, self.ctx.commands
+        commands = self.ctx.commands
         errata = tuple(
             e
-            for key, value in (data.get("errata") or {}).items()
+            for key, value in self.section("errata").items()
             if (e := self.guard(("errata", key), self.erratum, key, value, ("errata", key), commands))
         )
         examples = tuple(
             e
-            for key, value in (data.get("examples") or {}).items()
+            for key, value in self.section("examples").items()
             if (e := self.guard(("examples", key), self.example, key, value, ("examples", key), commands, errata))
         )
+        names = {e.name for e in examples} | self.ctx.broken
+        for example in examples:
+            if example.request and example.request not in names:
+                self.error(("examples", example.name, "request"), f"unknown example {example.request!r}")
         for erratum in errata:
             for example_name in erratum.check.examples:
-                if example_name not in {e.name for e in examples}:
+                if isinstance(example_name, str) and example_name not in names:
                     self.error(("errata", erratum.name, "check", "examples"), f"unknown example {example_name!r}")
         self.ctx.errata, self.ctx.examples = errata, examples
         return self.problems
@@ -49,6 +53,8 @@ class Examples(Pass):
         self, commands: list[Command], command: str, subcommand: str | None, direction: Direction, path: Path
     ) -> None:
         found = next((c for c in commands if c.name == command), None)
+        if found is None and command in self.ctx.broken:
+            raise Bad  # the command failed to resolve: its problem is reported
         if found is None:
             raise self.fail((*path, "command"), f"unknown command {command!r}")
         if subcommand is not None:
@@ -60,6 +66,10 @@ class Examples(Pass):
             if found.subcommands:
                 raise self.fail(path, f"{command} has subcommands: name one with `subcommand:`")
             message = found.request if direction == Direction.REQUEST else found.response
+        raw = self.ctx.data["commands"][command]
+        raw = raw["subcommands"][subcommand] if subcommand is not None else raw
+        if message is None and direction.value in raw:
+            raise Bad  # it has one, which failed to resolve: its problem is reported
         if message is None:
             raise self.fail(path, f"{command} has no {direction.value}")
 
@@ -107,6 +117,7 @@ class Examples(Pass):
             dict(value["fields"]),
             completed,
             span,
+            self.doc.where(path),
         )
 
     def printed_span(self, span: Any, direction: Direction, size: int, path: Path) -> tuple[int, int]:
@@ -174,4 +185,5 @@ class Examples(Pass):
                 actual=check.get("actual"),
                 examples=tuple(check.get("examples") or ()),
             ),
+            self.doc.where(check_path),
         )

@@ -22,7 +22,7 @@ from serialspec.spec.model import (
     Text,
     sum_sizes,
 )
-from serialspec.spec.passes.base import Pass, camel
+from serialspec.spec.passes.base import RESERVED_FIELD_NAMES, Bad, Pass, camel, enum_span
 
 FIELD_KINDS = (
     *grammar.SCALAR_TYPES,
@@ -51,7 +51,7 @@ class FieldResolver(Pass):
         resolved: list[Field] = []
         for name, item in raw.items():
             field_path = (*path, name)
-            self.name(name, field_path, "field name")
+            self.name(name, field_path, "field name", RESERVED_FIELD_NAMES)
             if any(f.name == name for f in resolved):
                 self.error(field_path, f"duplicate field {name!r}")
             field = self.guard(field_path, self.field, name, item, field_path, resolved, parent)
@@ -100,6 +100,8 @@ class FieldResolver(Pass):
                 path,
                 f"unknown type {item!r} (expected one of {', '.join(FIELD_KINDS)}, or a field from `fields:`)",
             )
+        if not isinstance(item, dict):
+            raise Bad  # neither a type name nor a mapping: the structural check has said so
         spec = dict(item)
         if "use" in spec:
             base_name = spec.pop("use")
@@ -127,13 +129,31 @@ class FieldResolver(Pass):
             size = spec.get("size")
             if size is None:
                 raise self.fail(path, "bytes need `size`: a number, `rest`, or a field name")
+            if isinstance(size, int) and size < 1:
+                raise self.fail((*path, "size"), f"size {size}: bytes of a fixed size hold at least one byte")
             table = self.reference("table", self.tables, spec.get("table"), (*path, "table"))
             if isinstance(size, str) and size != "rest":
                 self.size_field(size, name, siblings, parent, path)
             size_from = str(spec.get("size_from", ""))
             if size_from and (size != "rest" or not size_from.startswith("request.")):
                 self.error((*path, "size_from"), "`size_from: request.<field>` goes with `size: rest`")
-            return Bytes(**common, size=size, table=table, start=str(spec.get("start", "")), size_from=size_from)
+            start = str(spec.get("start", ""))
+            if start and table is None:
+                self.error((*path, "start"), "`start` goes with `table:` (the bytes are a run of its registers)")
+            if start and not start.startswith("request."):
+                earlier = [f for f in (*siblings, *(parent or ())) if f.name == start]
+                if not earlier or not isinstance(earlier[0], Scalar) or earlier[0].type.is_float:
+                    raise self.fail(
+                        (*path, "start"), f"unknown field {start!r}: `start` names an earlier integer field"
+                    )
+            return Bytes(
+                **common,
+                size=size,
+                table=table,
+                start=start.removeprefix("request."),
+                start_in_request=start.startswith("request."),
+                size_from=size_from.removeprefix("request."),
+            )
         if kind in ("string", "cstring"):
             size = spec.get("size")
             if kind == "cstring":
@@ -168,6 +188,8 @@ class FieldResolver(Pass):
                 raise self.fail(path, "a group needs `count`: a number, `rest`, or the name of an earlier count field")
             if not isinstance(spec.get("fields"), dict):
                 raise self.fail(path, "a group needs `fields:` (a mapping of its item's fields)")
+            if not spec["fields"]:
+                raise self.fail((*path, "fields"), "a group needs at least one field in each item")
             inner = self.fields(spec["fields"], (*path, "fields"), parent=siblings)
             if isinstance(count, str) and count != "rest":
                 self.derive(count, ("count", name), siblings, path)
@@ -193,7 +215,10 @@ class FieldResolver(Pass):
             if expected is not None and size != expected:
                 self.error((*path, "expect_size"), f"the selected entries take {size} bytes, not {expected}")
             class_name = self.class_name(camel(name), path, identity=("table_block", table.name, entries))
-            return TableBlock(**common, table=table, class_name=class_name, entries=entries, endian=endian)
+            struct_name = self.class_name(f"{class_name}Block", path, identity=("table_block", table.name, entries))
+            return TableBlock(
+                **common, table=table, class_name=class_name, entries=entries, endian=endian, struct_name=struct_name
+            )
         raise self.fail((*path, "type"), f"unknown type {kind!r} (expected one of {', '.join(FIELD_KINDS)})")
 
     def list_field(
@@ -253,9 +278,14 @@ class FieldResolver(Pass):
         scalar = SCALARS[spec["type"]]
         sign_magnitude = spec.get("encoding") == "sign_magnitude"
         low, high = self.bounds(scalar, sign_magnitude, spec.get("range"), (*path, "range"))
+        value_enum = self.reference("enum", self.enums, spec.get("enum"), (*path, "enum"))
+        if value_enum is not None and spec.get("range") is None:
+            low, high = enum_span(value_enum, low, high)
         const = spec.get("const")
         if const is not None and not low <= const <= high:
             self.error((*path, "const"), f"constant {const} is outside {low:g}..{high:g}")
+        if spec.get("scale") == 0:
+            self.error((*path, "scale"), "scale 0 would make every value 0 (give the size of one wire step)")
         default = spec.get("default")
         if default is not None and not low <= default <= high:
             self.error((*path, "default"), f"default {default} is outside the range {low:g}..{high:g}")
@@ -287,7 +317,7 @@ class FieldResolver(Pass):
             maximum=high,
             const=const,
             default=default,
-            enum=self.reference("enum", self.enums, spec.get("enum"), (*path, "enum")),
+            enum=value_enum,
             flags=self.reference("flags", self.flags, spec.get("flags"), (*path, "flags")),
             bits=tuple(bits),
             bits_class=self.class_name(camel(common["name"], "bits"), path) if bits else "",

@@ -99,6 +99,9 @@ class FramingPass(FieldResolver):
         low, high = (scalar.minimum, scalar.maximum) if scalar else (0.0, 0.0)
         if "range" in item and scalar:
             low, high = self.bounds(scalar, False, item["range"], (*path, "range"))
+        broadcast = item.get("broadcast")
+        if broadcast is not None and scalar is not None and not scalar.minimum <= broadcast <= scalar.maximum:
+            self.error((*path, "broadcast"), f"broadcast {broadcast} does not fit {scalar.name}")
         bits: tuple[Any, ...] = ()
         bits_class = ""
         if "bits" in item and scalar is not None:
@@ -148,6 +151,11 @@ class FramingPass(FieldResolver):
                 params["xorout"],
                 params["check"],
             )
+            if crc.width != scalar.size * 8:
+                raise self.fail((*path, "crc", "width"), f"a {crc.width}-bit CRC does not fill a {scalar.name}")
+            for key in ("poly", "init", "xorout", "check"):
+                if not 0 <= params[key] < 1 << crc.width:
+                    raise self.fail((*path, "crc", key), f"{key} {params[key]} does not fit {crc.width} bits")
             from serialspec.runtime.checksums import crc_function
 
             computed = crc_function(crc.width, crc.poly, crc.init, crc.refin, crc.refout, crc.xorout)(b"123456789")
@@ -156,8 +164,6 @@ class FramingPass(FieldResolver):
                     (*path, "crc", "check"),
                     f"these parameters give {computed:#x} for '123456789', not the check value {crc.check:#x}",
                 )
-            if crc.width != scalar.size * 8:
-                self.error((*path, "crc", "width"), f"a {crc.width}-bit CRC does not fill a {scalar.name}")
         elif algorithm not in ("sum", "xor"):
             raise self.fail(path, "a checksum needs `algorithm: sum`, `algorithm: xor` or `algorithm: crc`")
         # the span is resolved per direction (`covers` may be given by direction); first/last filled in by layout
@@ -208,6 +214,8 @@ class FramingPass(FieldResolver):
             if text is not None:
                 try:
                     constant = parse_hex(text)
+                    if not constant:
+                        raise ValueError(f"a {element.role} needs at least one byte")
                 except ValueError as exc:
                     raise self.fail((*elements_path, name, "value"), str(exc)) from None
                 role = element.role if element.role in CONSTANT_ROLES else "constant"

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from serialspec.spec.errors import SpecError
 from serialspec.spec.model import Serial
-from serialspec.spec.passes.base import Pass
+from serialspec.spec.passes.base import RESERVED_PACKAGES, Pass, camel
 
 
 class Settings(Pass):
@@ -12,14 +12,20 @@ class Settings(Pass):
 
     def run(self) -> list[SpecError]:
         data = self.ctx.data
-        self.ctx.name = self.name(data.get("protocol", ""), ("protocol",), "protocol")
+        name = self.ctx.name = self.name(data.get("protocol", ""), ("protocol",), "protocol")
+        if name in RESERVED_PACKAGES:
+            self.error(("protocol",), f"protocol {name!r} would shadow the module {name!r} (pick another package name)")
+        # the client and simulator classes take the protocol's name: no enum, message or group may take theirs
+        self.ctx.client_class = self.class_name(camel(name, "client"), ("protocol",))
+        self.ctx.simulator_class = self.class_name(camel(name, "simulator"), ("protocol",))
         self.ctx.endian = ">" if data.get("byte_order") == "big" else "<"
-        self.ctx.shared_fields = data.get("fields") or {}
+        self.ctx.shared_fields = self.section("fields")
         serial = data.get("serial") or {}
         if isinstance(serial, dict):
             self.ctx.serial = self.guard(("serial",), self.serial, serial)
-        matching = data.get("matching") or {}
-        self.ctx.matching = tuple(matching.get("by") or ())
+        matching = self.section("matching")
+        by = matching.get("by")
+        self.ctx.matching = tuple(name for name in by if isinstance(name, str)) if isinstance(by, list) else ()
         self.ctx.matching_description = str(matching.get("description", ""))
         return self.problems
 

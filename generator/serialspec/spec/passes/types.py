@@ -16,19 +16,18 @@ from serialspec.spec.model import (
     Table,
     TableEntry,
 )
-from serialspec.spec.passes.base import LABEL, Pass, camel
+from serialspec.spec.passes.base import LABEL, Pass, camel, enum_span
 
 
 class Types(Pass):
     """Resolve `enums:`, `flags:` and `tables:` into the context, in that order (tables use both)."""
 
     def run(self) -> list[SpecError]:
-        data = self.ctx.data
-        for key, value in (data.get("enums") or {}).items():
+        for key, value in self.section("enums").items():
             self.guard(("enums", key), self.enum, key, value, ("enums", key))
-        for key, value in (data.get("flags") or {}).items():
+        for key, value in self.section("flags").items():
             self.guard(("flags", key), self.flag_set, key, value, ("flags", key))
-        for key, value in (data.get("tables") or {}).items():
+        for key, value in self.section("tables").items():
             self.guard(("tables", key), self.table, key, value, ("tables", key))
         return self.problems
 
@@ -48,6 +47,12 @@ class Types(Pass):
             if not scalar.minimum <= number <= scalar.maximum:
                 self.error(item_path, f"value {number} does not fit {scalar.name}")
             seen[number] = str(label)
+            same = next(
+                (other for other in value["values"] if other != label and str(other).upper() == str(label).upper()),
+                None,
+            )
+            if same is not None and any(v.name == str(label).upper() for v in values):
+                self.error(item_path, f"enum label {label!r} is the same as {same!r} once upper-cased")
             values.append(EnumValue(str(label).upper(), number, text))
         self.enums[key] = EnumDef(
             key, self.class_name(camel(key), path), scalar, str(value.get("description", "")), tuple(values)
@@ -64,6 +69,9 @@ class Types(Pass):
             if not 0 <= bit < scalar.size * 8:
                 self.error((*path, "bits", label), f"bit {bit} is outside a {scalar.name}")
             text = "" if isinstance(item, int) else str(item.get("text", ""))
+            if any(b.name == str(label).upper() for b in bits):
+                same = next(other for other in value["bits"] if str(other).upper() == str(label).upper())
+                self.error((*path, "bits", label), f"flag name {label!r} is the same as {same!r} once upper-cased")
             bits.append(FlagBit(str(label).upper(), bit, text))
         self.flags[key] = FlagsDef(
             key, self.class_name(camel(key), path), scalar, str(value.get("description", "")), tuple(bits)
@@ -83,6 +91,14 @@ class Types(Pass):
             sign_magnitude = item.get("encoding") == "sign_magnitude"
             sign_bit = self.sign_bit(scalar, sign_magnitude, item.get("sign_bit"), (*entry_path, "sign_bit"))
             low, high = self.bounds(scalar, sign_magnitude, item.get("range"), (*entry_path, "range"), sign_bit)
+            enum = self.reference("enum", self.enums, item.get("enum"), (*entry_path, "enum"))
+            if enum is not None and item.get("range") is None:
+                low, high = enum_span(enum, low, high)
+            if item.get("scale") == 0:
+                self.error((*entry_path, "scale"), "scale 0 would make every value 0 (give the size of one wire step)")
+            default = item.get("default")
+            if isinstance(default, int | float) and not low <= default <= high:
+                self.error((*entry_path, "default"), f"default {default} is outside the range {low:g}..{high:g}")
             entries.append(
                 TableEntry(
                     name=entry_name,
@@ -97,7 +113,7 @@ class Types(Pass):
                     default=item.get("default"),
                     access=str(item.get("access", "rw")),
                     memory=str(item.get("memory", "")),
-                    enum=self.reference("enum", self.enums, item.get("enum"), (*entry_path, "enum")),
+                    enum=enum,
                     flags=self.reference("flags", self.flags, item.get("flags"), (*entry_path, "flags")),
                     sign_magnitude=sign_magnitude,
                     reserved=bool(item.get("reserved", False)),
@@ -114,6 +130,10 @@ class Types(Pass):
             str(value.get("description", "")),
             str(value.get("source", "")),
             tuple(entries),
+            # the generated register map, table values and register-name alias are named after the table
+            constant=self.class_name(key.upper(), path),
+            value_constant=self.class_name(f"{key.upper()}_VALUE", path),
+            names_class=self.class_name(camel(key, "name"), path),
         )
 
     def check_table_layout(self, entries: list[TableEntry], path: Path) -> None:
@@ -122,7 +142,7 @@ class Types(Pass):
             return
         ordered = sorted(entries, key=lambda e: e.key)
         for before, after in zip(ordered, ordered[1:], strict=False):
-            if before.key + before.type.size > after.key:
+            if before.key < after.key < before.key + before.type.size:
                 self.error(
                     (*path, "entries", after.name, "key"),
                     f"register {after.name} at {after.key:#04x} overlaps {before.name} "

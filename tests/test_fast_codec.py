@@ -127,3 +127,15 @@ def test_two_formats_never_share_a_struct_constant() -> None:
     assert first != second
     assert code.structs[first] == long_a and code.structs[second] == long_b
     assert code.struct("other", long_b) == second  # one format, one constant
+
+
+def test_replace_copies_a_message_with_changed_fields_and_refuses_unknown_names() -> None:
+    import fashionstar_uart as fs
+    from serialspec.runtime.message import field_names, replace
+
+    message = fs.RotateRequest(servo_id=2, angle=900, interval=500)
+    moved = replace(message, angle=0)
+    assert (moved.angle, moved.servo_id, message.angle) == (0, 2, 900)
+    assert field_names(moved) == field_names(message)
+    with pytest.raises(TypeError, match="no field 'angel'"):
+        replace(message, angel=0)

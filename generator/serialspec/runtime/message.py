@@ -57,6 +57,18 @@ def field_names(record: Record | type[Record]) -> tuple[str, ...]:
     return record.__match_args__
 
 
+R = TypeVar("R", bound=Record)
+
+
+def replace(record: R, **changes: Any) -> R:
+    """A copy of `record` with some fields changed (what dataclasses.replace gave before), checked by __init__."""
+    unknown = sorted(set(changes) - set(record.__match_args__))
+    if unknown:
+        raise TypeError(f"{type(record).__qualname__} has no field {', '.join(map(repr, unknown))}")
+    values = {name: getattr(record, name) for name in record.__match_args__}
+    return type(record)(**(values | changes))
+
+
 class Message(Record):
     """A decoded frame: one command (and sub-command) in one direction, with its field values in wire units."""
 

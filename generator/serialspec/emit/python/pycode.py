@@ -14,6 +14,7 @@ from dataclasses import dataclass, field, replace
 
 from serialspec.emit.common.numbers import number
 from serialspec.emit.common.text import collapse
+from serialspec.emit.python.kinds import kind
 from serialspec.spec import expression
 from serialspec.spec.model import (
     Array,
@@ -62,20 +63,7 @@ def one_line(text: str) -> str:
 
 def struct_format(endian: str, fields: list[SpecField]) -> str:
     """The struct format of a run of fixed-size fields."""
-    chars = []
-    for f in fields:
-        if isinstance(f, Scalar):
-            chars.append(f.type.struct_char)
-        elif isinstance(f, Array):
-            chars.append(f"{f.count}{f.item.struct_char}")
-        elif isinstance(f, Bytes):
-            chars.append(f"{f.size}s")
-        elif isinstance(f, TableBlock):
-            chars.extend(e.type.struct_char for e in f.entries)
-        elif isinstance(f, Group):
-            assert isinstance(f.count, int)
-            chars.append(struct_format("", list(f.fields)) * f.count)
-    return endian + "".join(chars)
+    return endian + "".join(kind(f).struct_chars(f) for f in fields)
 
 
 def takes_the_rest(f: SpecField | None) -> bool:
@@ -89,7 +77,7 @@ def takes_the_rest(f: SpecField | None) -> bool:
 
 
 def is_fixed_run_member(f: SpecField) -> bool:
-    return isinstance(f, Scalar | Array | TableBlock) or (isinstance(f, Bytes) and isinstance(f.size, int))
+    return kind(f).fixed(f)
 
 
 _SINGLE_BYTES = re.compile(r"(\d*[bBxs?c])*")  # a struct format whose byte order changes nothing
@@ -111,29 +99,7 @@ def fixed_runs(fields: list[SpecField]) -> Iterator[list[SpecField] | SpecField]
 
 
 def annotation(f: SpecField) -> str:
-    if isinstance(f, Scalar):
-        if f.bits:
-            return f.bits_class
-        if f.enum:
-            return f"{f.enum.class_name} | int"
-        if f.flags:
-            return f.flags.class_name
-        return "float" if f.type.is_float else "int"
-    if isinstance(f, Array):
-        return "tuple[float, ...]" if f.item.is_float else "tuple[int, ...]"
-    if isinstance(f, List):
-        if f.item is None:
-            return "tuple[bool, ...]"
-        return "tuple[float, ...]" if f.item.is_float else "tuple[int, ...]"
-    if isinstance(f, Text):
-        return "str"
-    if isinstance(f, Bytes):
-        return "bytes"
-    if isinstance(f, Group):
-        return f"tuple[{f.class_name}, ...]"
-    if isinstance(f, TableValue):
-        return "int | float"
-    return f.class_name
+    return kind(f).annotation(f)
 
 
 def doc_line(f: SpecField) -> str:
@@ -313,53 +279,10 @@ class PackageCode:
         return f"{'_number' if is_float else '_integer'}({get}, {name!r}, where),"
 
     def to_json(self, f: SpecField, expr: str) -> str:
-        if isinstance(f, Scalar):
-            if f.bits:
-                return f"{expr}.to_fields()"
-            return f"int({expr})" if (f.enum or f.flags) else expr
-        if isinstance(f, Array | List):
-            return f"list({expr})"
-        if isinstance(f, Text):
-            return expr
-        if isinstance(f, Bytes):
-            return f"{expr}.hex(' ')"
-        if isinstance(f, Group):
-            return f"[item.to_fields() for item in {expr}]"
-        if isinstance(f, TableBlock):
-            return f"{expr}.to_fields()"
-        return expr
+        return kind(f).to_json(f, expr)
 
     def from_json(self, f: SpecField) -> str:
-        get = f"_get(data, {f.name!r}, where)"
-        if isinstance(f, Scalar):
-            if f.bits:
-                # errors inside name the field too: "spin request method: direction must be an integer"
-                return f"{f.bits_class}.from_fields(_mapping({get}, {f.name!r}, where), where + {' ' + f.name!r})"
-            if f.enum:
-                return f"_as_enum({f.enum.class_name}, {get}, {f.name!r}, where)"
-            if f.flags:
-                return f"_as_flags({f.flags.class_name}, {get}, {int(f.maximum)}, {f.name!r}, where)"
-            if f.default is not None:
-                get = f"data.get({f.name!r}, {number(f.default)})"
-            kind = "_number" if f.type.is_float else "_integer"
-            return f"{kind}({get}, {f.name!r}, where)"
-        if isinstance(f, Array):
-            kind = "_numbers" if f.item.is_float else "_integers"
-            return f"{kind}({get}, {f.name!r}, where)"
-        if isinstance(f, List):
-            return f"tuple(bool(x) for x in {get})" if f.bits else f"tuple({get})"
-        if isinstance(f, Text):
-            return f"str({get})"
-        if isinstance(f, Bytes):
-            return f"_bytes({get}, {f.name!r}, where)"
-        if isinstance(f, Group):
-            return (
-                f"tuple({f.class_name}.from_fields(_mapping(item, {f.name!r}, where), where) "
-                f"for item in _items({get}, {f.name!r}, where))"
-            )
-        if isinstance(f, TableBlock):
-            return f"{f.class_name}.from_fields(_mapping({get}, {f.name!r}, where), where + {' ' + f.name!r})"
-        return get
+        return kind(f).from_json(f)
 
     def message(self, message: Message) -> None:
         for f in [*self.frame_values(message.direction), *message.fields]:

@@ -2,9 +2,24 @@
 
 from typing import get_args
 
-from serialspec.emit.python.kinds import KINDS
-from serialspec.spec.model import Field
+import pytest
+from serialspec.emit.common.kinds import Registry
+from serialspec.emit.markdown import kinds as markdown_kinds
+from serialspec.emit.python import kinds as python_kinds
+from serialspec.spec.model import Field, Scalar
 
 
-def test_every_model_field_kind_is_registered_with_the_python_target() -> None:
-    assert set(KINDS) == set(get_args(Field))
+@pytest.mark.parametrize("registry", [python_kinds.kind, markdown_kinds.kind], ids=["python", "markdown"])
+def test_every_model_field_kind_is_registered(registry: Registry[object]) -> None:
+    assert set(registry.by_model) == set(get_args(Field))
+
+
+def test_a_target_missing_a_field_kind_is_refused_naming_it() -> None:
+    class Base:
+        pass
+
+    class OnlyScalars(Base):
+        model = Scalar
+
+    with pytest.raises(AssertionError, match="no behaviour for .*'Array'"):
+        Registry(Base)

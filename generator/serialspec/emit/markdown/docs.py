@@ -15,11 +15,9 @@ from serialspec.emit.common import render as common
 from serialspec.emit.common.frames import runtime_layouts
 from serialspec.emit.common.numbers import number
 from serialspec.emit.common.text import collapse
+from serialspec.emit.markdown.kinds import anchor, kind, scalar_range
 from serialspec.runtime.errors import SerialspecError
-from serialspec.spec import expression
 from serialspec.spec.model import (
-    Array,
-    Bytes,
     Checksum,
     Command,
     Device,
@@ -30,14 +28,12 @@ from serialspec.spec.model import (
     Field,
     FrameLayout,
     Group,
-    List,
     Message,
     Protocol,
     Scalar,
     TableBlock,
     TableEntry,
     TableValue,
-    Text,
     fixed_size,
 )
 
@@ -84,82 +80,16 @@ def code_span(value: str) -> str:
     return f"{fence}{padded or ' '}{fence}"
 
 
-def anchor(*parts: str) -> str:
-    return "-".join(p.replace("_", "-").replace(".", "-") for p in parts if p).lower()
-
-
 def type_name(f: Field) -> str:
-    if isinstance(f, Scalar):
-        name = f.type.name + (" (sign-magnitude)" if f.sign_magnitude else "")
-        if f.enum:
-            name += f" enum [{f.enum.class_name}](#enum-{anchor(f.enum.name)})"
-        if f.flags:
-            name += f" flags [{f.flags.class_name}](#flags-{anchor(f.flags.name)})"
-        return name
-    if isinstance(f, Array):
-        return f"{f.item.name}[{f.count}]"
-    if isinstance(f, List):
-        item = "bits (8 per byte, first in bit 0)" if f.item is None else f"{f.item.name} list"
-        if f.size:
-            return f"{item}, {f.size} bytes"
-        return f"{item}, up to the end" if f.count == "rest" else f"{item} × {f.count}"
-    if isinstance(f, Text):
-        if f.size is None:
-            return "text, NUL-terminated"
-        return "text (rest of content)" if f.size == "rest" else f"text ({f.size} bytes)"
-    if isinstance(f, Bytes):
-        size = "rest of content" if f.size == "rest" else f.size
-        return f"bytes ({size})"
-    if isinstance(f, Group):
-        count = {"rest": "up to the end"}.get(str(f.count), f"× {f.count}")
-        return f"group {count}"
-    if isinstance(f, TableValue):
-        return f"typed by {f.key} ([{f.table.title}](#table-{anchor(f.table.name)}))"
-    return f"block of [{f.table.title}](#table-{anchor(f.table.name)})"
-
-
-def value_range(minimum: float, maximum: float, is_float: bool, type_min: float, type_max: float) -> str:
-    """A range as people read it: `any` for a float's whole range, never a 39-digit number."""
-    if is_float and (minimum, maximum) == (type_min, type_max):
-        return "any"
-    show = (lambda v: f"{v:g}") if is_float else number
-    return f"{show(minimum)}..{show(maximum)}"
-
-
-def scalar_range(type_: Any, minimum: float, maximum: float) -> str:
-    return value_range(minimum, maximum, type_.is_float, type_.minimum, type_.maximum)
+    return kind(f).type_name(f)
 
 
 def range_text(f: Field) -> str:
-    if isinstance(f, Scalar):
-        if f.const is not None:
-            return f"= {f.const:#04x}"
-        if f.value is not None:
-            return f"= {expression.show(f.value)}"
-        if f.derived:
-            return "derived: " + (
-                f"number of {f.derived[1]}" if f.derived[0] == "count" else f"size of each {f.derived[1]}"
-            )
-        if f.bits:
-            return ""
-        return scalar_range(f.type, f.minimum, f.maximum)
-    if isinstance(f, Array):
-        return scalar_range(f.item, f.minimum, f.maximum)
-    if isinstance(f, List) and f.item is not None:
-        return scalar_range(f.item, f.minimum, f.maximum)
-    return ""
+    return kind(f).range_text(f)
 
 
 def meaning(f: Field) -> str:
-    parts = [f.description]
-    if isinstance(f, Scalar) and f.bits:
-        for bit in f.bits:
-            where = f"bit {bit.low}" if bit.high == bit.low else f"bits {bit.high}..{bit.low}"
-            enum = f" ({', '.join(f'{v.value}={v.name.lower()}' for v in bit.enum.values)})" if bit.enum else ""
-            parts.append(f"{where}: {bit.name}{enum}.")
-        parts.append("Other bits must be zero.")
-    if isinstance(f, Scalar) and f.status_ok is not None:
-        parts.append(f"**Status:** {f.status_ok} is success; any other value is a device error (DeviceError).")
+    parts = [f.description, *kind(f).meaning(f)]
     if f.inferred:
         parts.append(f"**Inferred layout:** {f.inferred}")
     return " ".join(p for p in parts if p)
@@ -183,8 +113,7 @@ def field_rows(fields: tuple[Field, ...], start: int | None, prefix: str = "") -
         where = "" if offset is None else (str(offset) if size in (None, 1) else f"{offset}..{offset + size - 1}")
         if offset is not None and size is None:
             where = f"{offset}.."
-        unit = f.unit if isinstance(f, Scalar | Array | List) else ""
-        rows.append(Row(where, prefix + f.name, type_name(f), unit, range_text(f), meaning(f)))
+        rows.append(Row(where, prefix + f.name, type_name(f), kind(f).unit(f), range_text(f), meaning(f)))
         if isinstance(f, Group):
             rows += field_rows(f.fields, None, prefix + f.name + "[].")
         if isinstance(f, TableBlock):

@@ -6,13 +6,12 @@ the rest of its behaviour where it has not moved yet: decoding and encoding in p
 
 from __future__ import annotations
 
-from typing import Any, Generic, TypeVar
+from typing import Any, Generic
 
+from serialspec.emit.common.kinds import F, Registry
 from serialspec.emit.common.numbers import number
 from serialspec.spec.model import Array, Bytes, Group, List, Scalar, TableBlock, TableValue, Text
 from serialspec.spec.model import Field as SpecField
-
-F = TypeVar("F", Scalar, Array, List, Text, Bytes, Group, TableValue, TableBlock)
 
 
 def _get(f: SpecField) -> str:
@@ -49,6 +48,8 @@ def _numbers(is_float: bool) -> str:
 
 
 class ScalarKind(Kind[Scalar]):
+    model = Scalar
+
     def fixed(self, f: Scalar) -> bool:
         return True
 
@@ -85,6 +86,8 @@ class ScalarKind(Kind[Scalar]):
 
 
 class ArrayKind(Kind[Array]):
+    model = Array
+
     def fixed(self, f: Array) -> bool:
         return True
 
@@ -103,6 +106,8 @@ class ArrayKind(Kind[Array]):
 
 
 class ListKind(Kind[List]):
+    model = List
+
     def annotation(self, f: List) -> str:
         return "tuple[bool, ...]" if f.item is None else _numbers(f.item.is_float)
 
@@ -114,6 +119,8 @@ class ListKind(Kind[List]):
 
 
 class TextKind(Kind[Text]):
+    model = Text
+
     def annotation(self, f: Text) -> str:
         return "str"
 
@@ -122,6 +129,8 @@ class TextKind(Kind[Text]):
 
 
 class BytesKind(Kind[Bytes]):
+    model = Bytes
+
     def fixed(self, f: Bytes) -> bool:
         return isinstance(f.size, int)
 
@@ -139,6 +148,8 @@ class BytesKind(Kind[Bytes]):
 
 
 class GroupKind(Kind[Group]):
+    model = Group
+
     def struct_chars(self, f: Group) -> str:
         assert isinstance(f.count, int)
         return "".join(kind(i).struct_chars(i) for i in f.fields) * f.count
@@ -157,11 +168,15 @@ class GroupKind(Kind[Group]):
 
 
 class TableValueKind(Kind[TableValue]):
+    model = TableValue
+
     def annotation(self, f: TableValue) -> str:
         return "int | float"
 
 
 class TableBlockKind(Kind[TableBlock]):
+    model = TableBlock
+
     def fixed(self, f: TableBlock) -> bool:
         return True
 
@@ -178,18 +193,4 @@ class TableBlockKind(Kind[TableBlock]):
         return f"{f.class_name}.from_fields(_mapping({_get(f)}, {f.name!r}, where), where + {' ' + f.name!r})"
 
 
-KINDS: dict[type, Kind[Any]] = {
-    Scalar: ScalarKind(),
-    Array: ArrayKind(),
-    List: ListKind(),
-    Text: TextKind(),
-    Bytes: BytesKind(),
-    Group: GroupKind(),
-    TableValue: TableValueKind(),
-    TableBlock: TableBlockKind(),
-}
-
-
-def kind(f: SpecField) -> Kind[Any]:
-    """The behaviour of the field's kind; every model field class is registered (a test checks it)."""
-    return KINDS[type(f)]
+kind: Registry[Kind[Any]] = Registry(Kind)

@@ -1,7 +1,8 @@
 """How each field kind looks in the generated Python: one class per model field kind, registered by model class.
 
-An emitter asks `kind(f)` instead of switching on the field's class, so a new field kind adds one class here (and
-the rest of its behaviour where it has not moved yet: decoding and encoding in pycode.py, the docs, the CLI views).
+An emitter asks `kind(f)` instead of switching on the field's class: the attribute type, the to/from JSON
+expressions, the struct format and the construct expression of each kind live here. Still switches elsewhere: the
+fast decode/encode statements (pycode.py), the simulator's and client's field look-ups, the CLI views.
 """
 
 from __future__ import annotations
@@ -10,7 +11,8 @@ from typing import Any, Generic
 
 from serialspec.emit.common.kinds import F, Registry
 from serialspec.emit.common.numbers import number
-from serialspec.spec.model import Array, Bytes, Group, List, Scalar, TableBlock, TableValue, Text
+from serialspec.spec import expression
+from serialspec.spec.model import Array, Bytes, Group, List, Scalar, ScalarType, TableBlock, TableValue, Text
 from serialspec.spec.model import Field as SpecField
 
 
@@ -34,6 +36,10 @@ class Kind(Generic[F]):
         """The type of the message attribute."""
         raise NotImplementedError
 
+    def construct(self, f: F, parent: str) -> str:
+        """The field's construct expression (the reference structs); `parent` is "item" inside a group item."""
+        raise NotImplementedError
+
     def to_json(self, f: F, expr: str) -> str:
         """The JSON value of `expr`, a value of the field (the generated `to_fields`)."""
         return expr
@@ -47,8 +53,71 @@ def _numbers(is_float: bool) -> str:
     return "tuple[float, ...]" if is_float else "tuple[int, ...]"
 
 
+_INT = {1: "Int8", 2: "Int16", 4: "Int32"}
+
+
+def primitive(scalar: ScalarType, endian: str) -> str:
+    suffix = "b" if endian == ">" else "l"
+    if scalar.is_float:
+        return f"Float32{suffix}"
+    if scalar.size == 1:
+        return "Int8sb" if scalar.signed else "Int8ub"
+    return f"{_INT[scalar.size]}{'s' if scalar.signed else 'u'}{suffix}"
+
+
+def list_expr(f: List) -> str:
+    """An array whose count varies, or packed bits."""
+    count = f"this.{f.count}" if isinstance(f.count, str) and f.count not in ("", "rest") else f.count
+    if f.item is None:
+        if f.size:
+            return f"PackedBits(Bytes(this.{f.size}))"
+        if f.count == "rest":
+            return "PackedBits(GreedyBytes)"
+        return f"PackedBits(Bytes(({count} + 7) // 8), {count})"
+    item = primitive(f.item, f.endian)
+    if f.size:
+        return f"Array(this.{f.size} // {f.item.size}, {item})"
+    if f.count == "rest":
+        return f"GreedyRange({item})"
+    return f"Array({count}, {item})"
+
+
+def bits_expr(f: Scalar) -> str:
+    """A BitStruct from the most significant bit down; unlisted bits are constant zero."""
+    width = f.type.size * 8
+    parts = []
+    bit = width - 1
+    for field in sorted(f.bits, key=lambda b: -b.high):
+        if bit > field.high:
+            parts.append(f"'_unused_{bit}' / Const(0, BitsInteger({bit - field.high}))")
+        parts.append(f"{field.name!r} / BitsInteger({field.high - field.low + 1})")
+        bit = field.low - 1
+    if bit >= 0:
+        parts.append(f"'_unused_{bit}' / Const(0, BitsInteger({bit + 1}))")
+    inner = "BitStruct(" + ", ".join(parts) + ")"
+    return f"ByteSwapped({inner})" if f.type.size > 1 and f.endian == "<" else inner
+
+
 class ScalarKind(Kind[Scalar]):
     model = Scalar
+
+    def construct(self, f: Scalar, parent: str) -> str:
+        base = primitive(f.type, f.endian)
+        if f.const is not None:
+            return f"Const({f.const}, {base})"
+        if f.value is not None:
+            return f"Rebuild({base}, lambda ctx: {expression.render(f.value, lambda name: f'ctx[{name!r}]')})"
+        if f.derived:
+            derived, target = f.derived[0], f.derived[1]
+            if derived == "count":
+                return f"Rebuild({base}, len_(this.{target}))"
+            # evaluated while building: a lambda, so the context is the one being built, not `this` itself
+            return f"Rebuild({base}, lambda ctx: _item_size(ctx, {target!r}))"
+        if f.bits:
+            return bits_expr(f)
+        if f.sign_magnitude:
+            return f"SignMagnitude({base}, {f.type.size * 8})"
+        return base
 
     def fixed(self, f: Scalar) -> bool:
         return True
@@ -88,6 +157,9 @@ class ScalarKind(Kind[Scalar]):
 class ArrayKind(Kind[Array]):
     model = Array
 
+    def construct(self, f: Array, parent: str) -> str:
+        return f"Array({f.count}, {primitive(f.item, f.endian)})"
+
     def fixed(self, f: Array) -> bool:
         return True
 
@@ -108,6 +180,9 @@ class ArrayKind(Kind[Array]):
 class ListKind(Kind[List]):
     model = List
 
+    def construct(self, f: List, parent: str) -> str:
+        return list_expr(f)
+
     def annotation(self, f: List) -> str:
         return "tuple[bool, ...]" if f.item is None else _numbers(f.item.is_float)
 
@@ -121,6 +196,13 @@ class ListKind(Kind[List]):
 class TextKind(Kind[Text]):
     model = Text
 
+    def construct(self, f: Text, parent: str) -> str:
+        if f.size is None:
+            return "CString('utf8')"
+        if f.size == "rest":
+            return "Utf8(GreedyBytes)"
+        return f"Utf8(Bytes({f.size if isinstance(f.size, int) else 'this.' + f.size}))"
+
     def annotation(self, f: Text) -> str:
         return "str"
 
@@ -130,6 +212,14 @@ class TextKind(Kind[Text]):
 
 class BytesKind(Kind[Bytes]):
     model = Bytes
+
+    def construct(self, f: Bytes, parent: str) -> str:
+        if f.size == "rest":
+            return "GreedyBytes"
+        if isinstance(f.size, int):
+            return f"Bytes({f.size})"
+        # inside a group item the size field sits beside the bytes (BULK WRITE) or in the enclosing content (this._)
+        return f"Bytes({'this._' if parent == 'item' else 'this'}.{f.size})"
 
     def fixed(self, f: Bytes) -> bool:
         return isinstance(f.size, int)
@@ -149,6 +239,21 @@ class BytesKind(Kind[Bytes]):
 
 class GroupKind(Kind[Group]):
     model = Group
+
+    def construct(self, f: Group, parent: str) -> str:
+        names = {i.name for i in f.fields}
+        item = (
+            "Struct("
+            + ", ".join(
+                f"{i.name!r} / {kind(i).construct(i, 'this' if isinstance(i, Bytes) and i.size in names else 'item')}"
+                for i in f.fields
+            )
+            + ")"
+        )
+        if f.count == "rest":
+            return f"GreedyRange({item})"
+        count = f.count if isinstance(f.count, int) else f"this.{f.count}"
+        return f"Array({count}, {item})"
 
     def struct_chars(self, f: Group) -> str:
         assert isinstance(f.count, int)
@@ -170,12 +275,18 @@ class GroupKind(Kind[Group]):
 class TableValueKind(Kind[TableValue]):
     model = TableValue
 
+    def construct(self, f: TableValue, parent: str) -> str:
+        return f"Switch(this.{f.key}, {f.table.value_constant})"
+
     def annotation(self, f: TableValue) -> str:
         return "int | float"
 
 
 class TableBlockKind(Kind[TableBlock]):
     model = TableBlock
+
+    def construct(self, f: TableBlock, parent: str) -> str:
+        return f.struct_name
 
     def fixed(self, f: TableBlock) -> bool:
         return True

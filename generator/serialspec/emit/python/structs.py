@@ -6,123 +6,22 @@ construct is the declarative reference the fast codec is tested against; it is n
 from __future__ import annotations
 
 from serialspec.emit.python.frames import checksum_definitions, codec_lines, framing_imports
+from serialspec.emit.python.kinds import kind, primitive
 from serialspec.emit.python.pycode import one_line
 from serialspec.emit.python.render import render
-from serialspec.spec import expression
 from serialspec.spec.model import (
-    Array,
-    Bytes,
     Direction,
     Field,
     FrameLayout,
-    Group,
-    List,
     Protocol,
-    Scalar,
     ScalarType,
     TableBlock,
-    TableValue,
-    Text,
 )
-
-_INT = {1: "Int8", 2: "Int16", 4: "Int32"}
-
-
-def primitive(scalar: ScalarType, endian: str) -> str:
-    suffix = "b" if endian == ">" else "l"
-    if scalar.is_float:
-        return f"Float32{suffix}"
-    if scalar.size == 1:
-        return "Int8sb" if scalar.signed else "Int8ub"
-    return f"{_INT[scalar.size]}{'s' if scalar.signed else 'u'}{suffix}"
 
 
 def field_expr(f: Field, parent: str = "this") -> str:
-    if isinstance(f, Scalar):
-        base = primitive(f.type, f.endian)
-        if f.const is not None:
-            return f"Const({f.const}, {base})"
-        if f.value is not None:
-            return f"Rebuild({base}, lambda ctx: {expression.render(f.value, lambda name: f'ctx[{name!r}]')})"
-        if f.derived:
-            kind, target = f.derived[0], f.derived[1]
-            if kind == "count":
-                return f"Rebuild({base}, len_(this.{target}))"
-            # evaluated while building: a lambda, so the context is the one being built, not `this` itself
-            return f"Rebuild({base}, lambda ctx: _item_size(ctx, {target!r}))"
-        if f.bits:
-            return bits_expr(f)
-        if f.sign_magnitude:
-            return f"SignMagnitude({base}, {f.type.size * 8})"
-        return base
-    if isinstance(f, Array):
-        return f"Array({f.count}, {primitive(f.item, f.endian)})"
-    if isinstance(f, List):
-        return list_expr(f)
-    if isinstance(f, Text):
-        if f.size is None:
-            return "CString('utf8')"
-        if f.size == "rest":
-            return "Utf8(GreedyBytes)"
-        return f"Utf8(Bytes({f.size if isinstance(f.size, int) else 'this.' + f.size}))"
-    if isinstance(f, Bytes):
-        if f.size == "rest":
-            return "GreedyBytes"
-        if isinstance(f.size, int):
-            return f"Bytes({f.size})"
-        # inside a group item the size field sits beside the bytes (BULK WRITE) or in the enclosing content (this._)
-        return f"Bytes({'this._' if parent == 'item' else 'this'}.{f.size})"
-    if isinstance(f, Group):
-        names = {i.name for i in f.fields}
-        item = (
-            "Struct("
-            + ", ".join(
-                f"{i.name!r} / {field_expr(i, 'this' if isinstance(i, Bytes) and i.size in names else 'item')}"
-                for i in f.fields
-            )
-            + ")"
-        )
-        if f.count == "rest":
-            return f"GreedyRange({item})"
-        count = f.count if isinstance(f.count, int) else f"this.{f.count}"
-        return f"Array({count}, {item})"
-    if isinstance(f, TableValue):
-        return f"Switch(this.{f.key}, {f.table.value_constant})"
-    assert isinstance(f, TableBlock)
-    return f.struct_name
-
-
-def list_expr(f: List) -> str:
-    """An array whose count varies, or packed bits."""
-    count = f"this.{f.count}" if isinstance(f.count, str) and f.count not in ("", "rest") else f.count
-    if f.item is None:
-        if f.size:
-            return f"PackedBits(Bytes(this.{f.size}))"
-        if f.count == "rest":
-            return "PackedBits(GreedyBytes)"
-        return f"PackedBits(Bytes(({count} + 7) // 8), {count})"
-    item = primitive(f.item, f.endian)
-    if f.size:
-        return f"Array(this.{f.size} // {f.item.size}, {item})"
-    if f.count == "rest":
-        return f"GreedyRange({item})"
-    return f"Array({count}, {item})"
-
-
-def bits_expr(f: Scalar) -> str:
-    """A BitStruct from the most significant bit down; unlisted bits are constant zero."""
-    width = f.type.size * 8
-    parts = []
-    bit = width - 1
-    for field in sorted(f.bits, key=lambda b: -b.high):
-        if bit > field.high:
-            parts.append(f"'_unused_{bit}' / Const(0, BitsInteger({bit - field.high}))")
-        parts.append(f"{field.name!r} / BitsInteger({field.high - field.low + 1})")
-        bit = field.low - 1
-    if bit >= 0:
-        parts.append(f"'_unused_{bit}' / Const(0, BitsInteger({bit + 1}))")
-    inner = "BitStruct(" + ", ".join(parts) + ")"
-    return f"ByteSwapped({inner})" if f.type.size > 1 and f.endian == "<" else inner
+    """The construct expression of a field; `parent` is "item" inside a group item."""
+    return kind(f).construct(f, parent)
 
 
 def frame_expr(layout: FrameLayout) -> str:

@@ -202,3 +202,12 @@ device:
     assert any("device.errors.read_only.why: the error reply refusal has no field 'why'" in x for x in lines), lines
     assert any("device.errors.unsupported:" in x and "not classic" in x for x in lines), lines
     assert not any("out_of_range" in x for x in lines), lines
+
+
+def test_a_table_with_no_entries_is_an_error_line(tmp_path: Path) -> None:
+    # a table_value over it used to take the smallest of no sizes (ValueError, a traceback); found by the spec fuzz
+    table = "tables:\n  params: {key: data_id, entries: {}}\n"
+    fields = "        data_id: u8\n        value: {type: table_value, table: params, key: data_id}\n"
+    lines = errors_of(tmp_path, MINIMAL.replace("        angle: i16\n", fields) + table)
+    assert any("tables.params.entries: a table needs at least one entry that is not reserved" in x for x in lines)
+    assert len(lines) == 1, lines

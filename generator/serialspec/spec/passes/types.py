@@ -121,6 +121,8 @@ class Types(Pass):
                     sign_bit=sign_bit,
                 )
             )
+        if all(e.reserved for e in entries):
+            raise self.fail((*path, "entries"), "a table needs at least one entry that is not reserved")
         if value.get("key_type") is None:
             self.check_table_layout(entries, path)
         self.tables[key] = Table(

@@ -1,0 +1,128 @@
+"""Strict encode of the field kinds beyond numbers: bit lists (Modbus coils), lists whose count varies, text and
+NUL-terminated text. Each wrong value is refused with one line naming the field, from data (the CLI, as a process),
+in messages built in Python, and in clients before a byte is written."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+from conftest import ALL, ROOT
+from serialspec.runtime.errors import EncodeError
+from test_captures import pty_pair
+from test_strict_encode import nothing_written
+
+MODBUS = next(g for g in ALL if g.protocol.name == "modbus_rtu")
+VESC = next(g for g in ALL if g.protocol.name == "vesc")
+CLI = [str(Path(sys.executable).parent / "serialspec")]
+
+COILS = {"unit": 1, "address": 0}
+FW = {"major": 1, "minor": 2, "uuid": "00" * 12, "pairing_done": 0, "test_version": 0, "hw_type": 0}
+FW |= {"custom_config_count": 0, "phase_filters": 0, "qml_hw": 0, "qml_app": 0, "nrf_flags": 0, "hw_crc": 0}
+FW |= {"hw_name": "hw", "fw_name": "fw"}
+
+# (generated package, command, direction, fields, words the one line holds)
+CASES: list[tuple[Any, str, str, dict[str, Any], str]] = [
+    (MODBUS, "write_coils", "request", {**COILS, "values": "abc"}, "values must be a list, got 'abc'"),
+    (
+        MODBUS,
+        "write_coils",
+        "request",
+        {**COILS, "values": [1, 2]},
+        "values[1] must be a bit (true/false or 0/1), got 2",
+    ),
+    (MODBUS, "write_coils", "request", {**COILS, "values": [True, 1.0]}, "values[1] must be a bit"),
+    (MODBUS, "write_coils", "request", {**COILS, "values": [None]}, "values[0] must be a bit"),
+    (MODBUS, "write_coils", "request", {**COILS, "values": [True] * 1969}, "count = 1969 is outside its range 1..1968"),
+    (MODBUS, "write_registers", "request", {**COILS, "values": "ab"}, "values must be a list, got 'ab'"),
+    (MODBUS, "write_registers", "request", {**COILS, "values": [1, True]}, "values[1] must be an integer, got True"),
+    (MODBUS, "write_registers", "request", {**COILS, "values": [1, 70000]}, "values[1] = 70000 is outside its range"),
+    (MODBUS, "write_registers", "request", {**COILS, "values": [0] * 124}, "count = 124 is outside its range 1..123"),
+    (MODBUS, "read_coils", "response", {"unit": 1, "coils": [True] * 2001}, "coils has 2001 items, at most 2000"),
+    (MODBUS, "read_coils", "response", {"unit": 1, "coils": "xyz"}, "coils must be a list, got 'xyz'"),
+    (VESC, "print", "response", {"text": 5}, "text must be text, got 5"),
+    (VESC, "print", "response", {"text": ["a"]}, "text must be text, got ['a']"),
+    (VESC, "print", "response", {"text": "\ud800"}, "text is not UTF-8 text"),
+    (VESC, "fw_version", "response", {**FW, "hw_name": "a\0b"}, "hw_name holds a NUL"),
+    (VESC, "fw_version", "response", {**FW, "fw_name": None}, "fw_name must be text, got None"),
+]
+IDS = [f"{c[1]}-{c[4][:24]}" for c in CASES]
+
+
+def message_class(g: Any, command: str, direction: str) -> Any:
+    return next(c for c in g.package.MESSAGE_TYPES if (c.COMMAND, c.DIRECTION.value) == (command, direction))
+
+
+@pytest.mark.parametrize(("g", "command", "direction", "fields", "words"), CASES, ids=IDS)
+def test_from_data(g: Any, command: str, direction: str, fields: dict[str, Any], words: str) -> None:
+    with pytest.raises(EncodeError) as failure:
+        g.package.encode(message_class(g, command, direction).from_fields(fields))
+    assert words in str(failure.value) and "\n" not in str(failure.value)
+
+
+@pytest.mark.parametrize(("g", "command", "direction", "fields", "words"), CASES, ids=IDS)
+def test_built_in_python(g: Any, command: str, direction: str, fields: dict[str, Any], words: str) -> None:
+    """The same values given to the message class directly (bytes for hex text, tuples for lists)."""
+    cls = message_class(g, command, direction)
+    values = {k: bytes.fromhex(v) if k == "uuid" else tuple(v) if isinstance(v, list) else v for k, v in fields.items()}
+    values = {k: v for k, v in values.items() if k in cls.__dataclass_fields__}
+    with pytest.raises(EncodeError) as failure:
+        g.package.encode(cls(**values))
+    text = str(failure.value)
+    field = words.split("[")[0].split(" ")[0]
+    assert (field in text or "count" in text) and "\n" not in text, text
+
+
+def test_the_good_values_still_encode() -> None:
+    cls = message_class(MODBUS, "write_coils", "request")
+    frame = MODBUS.package.encode(cls.from_fields({**COILS, "values": [True, 0, 1, False]}))
+    assert frame.hex()[:16] == "010f000000040105"
+    response = message_class(MODBUS, "read_coils", "response")
+    assert MODBUS.package.encode(response.from_fields({"unit": 1, "coils": [True] * 2000}))
+    fw = message_class(VESC, "fw_version", "response")
+    assert VESC.package.encode(fw.from_fields({**FW, "hw_name": "naïve"}))
+
+
+def test_the_cli_as_a_process() -> None:
+    """One case per kind through `serialspec encode` run as a process: exit 1, one line on stderr, nothing out."""
+    chosen = [CASES[1], CASES[6], CASES[9], CASES[11], CASES[14]]
+    runs = []
+    for g, command, direction, fields, words in chosen:
+        obj = json.dumps({"command": command, "direction": direction, "fields": fields})
+        spec = str(ROOT / g.protocol.spec_path)
+        argv = [*CLI, "encode", spec, "--json", obj]
+        runs.append((subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True), words))
+    for process, words in runs:
+        out, err = process.communicate(timeout=60)
+        assert (process.returncode, out) == (1, ""), err
+        assert len(err.splitlines()) == 1 and words in err and "Traceback" not in err, err
+
+
+@pytest.fixture
+def line() -> Iterator[tuple[int, str]]:
+    with pty_pair() as pair:
+        yield pair
+
+
+@pytest.mark.parametrize(
+    ("method", "values", "words"),
+    [
+        ("write_coils", "1010", "values must be a list of bits"),
+        ("write_coils", (1, 2), "values[1] must be a bit"),
+        ("write_registers", (1, True), "values[1] must be a number in 0..65535, got True"),
+        ("write_registers", (0,) * 124, "count = 124 is outside"),
+    ],
+)
+def test_client_refuses_before_writing(line: tuple[int, str], method: str, values: Any, words: str) -> None:
+    from modbus_rtu.client import ModbusRtuClient
+
+    controller, path = line
+    with ModbusRtuClient(path, timeout=0.05) as client, pytest.raises(EncodeError) as failure:
+        getattr(client, method)(1, 0, values)
+    assert words in str(failure.value) and "\n" not in str(failure.value)
+    assert nothing_written(controller)

@@ -13,7 +13,7 @@ from typing import Any
 
 import pytest
 from conftest import ALL, ROOT
-from serialspec.runtime.errors import EncodeError
+from serialspec.runtime.errors import DecodeError, EncodeError
 from test_captures import pty_pair
 from test_strict_encode import nothing_written
 
@@ -126,3 +126,60 @@ def test_client_refuses_before_writing(line: tuple[int, str], method: str, value
         getattr(client, method)(1, 0, values)
     assert words in str(failure.value) and "\n" not in str(failure.value)
     assert nothing_written(controller)
+
+
+# --- decode: frame-level values outside their declared range ----------------------------------------------------
+
+RANGED = [
+    (g, e, element)
+    for g in ALL
+    for e in g.protocol.examples
+    for element in g.protocol.framing.layouts[e.direction].value_elements
+    if element.type is not None and (element.minimum, element.maximum) != (element.type.minimum, element.type.maximum)
+]
+# one example per protocol and direction is enough: the check is per frame layout
+RANGED = list({(g.protocol.name, e.direction, el.name): (g, e, el) for g, e, el in RANGED}.values())
+
+
+def out_of_range_frame(g: Any, example: Any, element: Any) -> tuple[bytes, int]:
+    """The example's frame with `element` just past its range, every length and checksum still right."""
+    bad = int(element.maximum) + 1
+    if bad == element.broadcast:
+        bad += 1
+    if bad > element.type.maximum:
+        bad = int(element.minimum) - 1
+    layout = g.protocol.framing.layouts[example.direction]
+    if not g.protocol.framing.classic:  # the frame engine wraps the same content with the bad value
+        frames = getattr(g.package.codec, f"_{example.direction.name}_FRAMES")
+        parts = frames.unwrap(example.frame)
+        values = tuple(bad if v.name == element.name else parts.values[i] for i, v in enumerate(layout.value_elements))
+        return frames.wrap(parts.content, parts.code, values), bad
+    assert g.protocol.name == "feetech_sms", "a classic codec with ranged values: give its checksum here"
+    frame = bytearray(example.frame)
+    frame[layout.offsets[element.name]] = bad
+    frame[-1] = ~sum(frame[2:-1]) & 0xFF  # FEETECH: the complement of the sum after the header
+    return bytes(frame), bad
+
+
+@pytest.mark.parametrize(("g", "example", "element"), RANGED, ids=[f"{g.protocol.name}-{e.name}" for g, e, _ in RANGED])
+def test_decode_refuses_a_frame_value_out_of_range(g: Any, example: Any, element: Any) -> None:
+    """decode says why in one line; the stream parser, which sees no frame there, agrees."""
+    frame, bad = out_of_range_frame(g, example, element)
+    with pytest.raises(DecodeError) as failure:
+        g.package.decode(frame, example.direction.value)
+    text = str(failure.value)
+    assert f"{element.name} = {bad} is outside its range {int(element.minimum)}..{int(element.maximum)}" in text
+    assert "\n" not in text
+    assert g.package.StreamParser(example.direction.value).feed(frame) == []
+    assert g.package.decode(example.frame, example.direction.value)  # the example itself still decodes
+
+
+def test_decode_at_the_cli_as_a_process() -> None:
+    g, example, element = next(r for r in RANGED if r[0].protocol.name == "feetech_sms")
+    frame, bad = out_of_range_frame(g, example, element)
+    spec = str(ROOT / g.protocol.spec_path)
+    argv = [*CLI, "decode", spec, "--direction", example.direction.value, frame.hex(" ")]
+    result = subprocess.run(argv, capture_output=True, text=True, timeout=60)
+    assert (result.returncode, result.stdout) == (1, ""), result.stderr
+    assert f"id = {bad} is outside its range 0..253 (or 254)" in result.stderr
+    assert len(result.stderr.splitlines()) == 1

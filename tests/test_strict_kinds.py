@@ -5,6 +5,7 @@ in messages built in Python, and in clients before a byte is written."""
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 from collections.abc import Iterator
@@ -183,3 +184,52 @@ def test_decode_at_the_cli_as_a_process() -> None:
     assert (result.returncode, result.stdout) == (1, ""), result.stderr
     assert f"id = {bad} is outside its range 0..253 (or 254)" in result.stderr
     assert len(result.stderr.splitlines()) == 1
+
+
+# --- clients: a device model's ranges (spec: device.models.<model>.entries.<entry>.range) -------------------------
+
+
+def drain(controller: int) -> bytes:
+    data = b""
+    while not nothing_written(controller):
+        data += os.read(controller, 4096)
+    return data
+
+
+def test_client_checks_writes_against_the_model(line: tuple[int, str]) -> None:
+    """The XL430-W250 has no current control (goal_current 0..0): refused before a byte is written; the table's
+    range (the XM430-W350's, the default) takes 1000; a mixed bus names a model per id, a broadcast suits all."""
+    from dynamixel_p2.client import DynamixelP2Client
+
+    controller, path = line
+    with DynamixelP2Client(path, timeout=0.05, optional_replies=False, model="xl430_w250") as client:
+        with pytest.raises(EncodeError) as failure:
+            client.write(1, goal_current=1000)
+        assert str(failure.value) == "control_table (xl430_w250): goal_current = 1000 is outside its range 0..0"
+        with pytest.raises(EncodeError, match=r"max_voltage_limit = 160 is outside its range 60\.\.140"):
+            client.sync_write({1: {"max_voltage_limit": 160}, 2: {"max_voltage_limit": 100}})
+        assert nothing_written(controller)
+        client.write(1, max_voltage_limit=140)
+        assert drain(controller)
+    with DynamixelP2Client(path, timeout=0.05, optional_replies=False) as client:  # no model: the table's ranges
+        client.write(1, goal_current=1000)
+        assert drain(controller)
+    mixed = {1: "xl430_w250", 2: "xl330_m288"}
+    with DynamixelP2Client(path, timeout=0.05, optional_replies=False, model=mixed) as client:
+        with pytest.raises(EncodeError, match="xl430_w250"):
+            client.write(1, goal_current=5)
+        with pytest.raises(EncodeError, match=r"xl330_m288\): goal_current = 1751 is outside its range -1750\.\.1750"):
+            client.bulk_write({2: {"goal_current": 1751}})
+        with pytest.raises(EncodeError, match="xl430_w250"):
+            client.write(254, goal_current=5)  # the broadcast reaches the XL430 too
+        assert nothing_written(controller)
+        client.write(2, goal_current=1750)
+        client.write(3, goal_current=1000)  # a device of no named model: the table's ranges
+        assert drain(controller)
+
+
+def test_client_refuses_an_unknown_model(line: tuple[int, str]) -> None:
+    from dynamixel_p2.client import DynamixelP2Client
+
+    with pytest.raises(ValueError, match=r"model 'xl999' is not one of the spec's models \(xm430_w350, "):
+        DynamixelP2Client(line[1], model={1: "xl999"})

@@ -50,8 +50,8 @@ _S_BE_U16_U16_U8 = struct.Struct('>HHB')
 _S_BE_U8 = struct.Struct('>B')
 _CHECK_CRC: Callable[[bytes], int] = crc_function(16, 0x8005, 0xffff, True, True, 0x0)  # CRC-16/MODBUS
 
-# Decoders build messages with object.__new__ and store each value straight into its slot: the dataclass __init__
-# of a frozen class goes through object.__setattr__ per field, which costs more than unpacking the whole frame.
+# Decoders build messages with object.__new__ and store each value straight into its slot: a message's __init__
+# (frozen) goes through object.__setattr__ per field, which costs more than unpacking the whole frame.
 _new = object.__new__
 _set_ExceptionResponse_unit, _set_ExceptionResponse_function, _set_ExceptionResponse_exception_code = slot_setters(ExceptionResponse)
 (
@@ -419,7 +419,7 @@ def _decode_exception_response(buf: bytes, o: int, end: int, unit: int, function
 
 
 def _encode_read_coils_request(m: ReadCoilsRequest) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0) or m.unit.__class__ is bool:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('read_coils request', 'unit', m.unit, 1, 247)
     if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('read_coils request', 'address', m.address, 0, 65535)
@@ -429,7 +429,7 @@ def _encode_read_coils_request(m: ReadCoilsRequest) -> bytes:
 
 
 def _encode_read_coils_response(m: ReadCoilsResponse) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0) or m.unit.__class__ is bool:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('read_coils response', 'unit', m.unit, 1, 247)
     if len(m.coils) > 2000:
         raise EncodeError('read_coils response' + f': coils has {len(m.coils)} items, at most 2000 (the limit of the request field count)')
@@ -440,7 +440,7 @@ def _encode_read_coils_response(m: ReadCoilsResponse) -> bytes:
 
 
 def _encode_read_discrete_inputs_request(m: ReadDiscreteInputsRequest) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0) or m.unit.__class__ is bool:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('read_discrete_inputs request', 'unit', m.unit, 1, 247)
     if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('read_discrete_inputs request', 'address', m.address, 0, 65535)
@@ -450,7 +450,7 @@ def _encode_read_discrete_inputs_request(m: ReadDiscreteInputsRequest) -> bytes:
 
 
 def _encode_read_discrete_inputs_response(m: ReadDiscreteInputsResponse) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0) or m.unit.__class__ is bool:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('read_discrete_inputs response', 'unit', m.unit, 1, 247)
     if len(m.inputs) > 2000:
         raise EncodeError('read_discrete_inputs response' + f': inputs has {len(m.inputs)} items, at most 2000 (the limit of the request field count)')
@@ -461,7 +461,7 @@ def _encode_read_discrete_inputs_response(m: ReadDiscreteInputsResponse) -> byte
 
 
 def _encode_read_holding_registers_request(m: ReadHoldingRegistersRequest) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0) or m.unit.__class__ is bool:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('read_holding_registers request', 'unit', m.unit, 1, 247)
     if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('read_holding_registers request', 'address', m.address, 0, 65535)
@@ -471,7 +471,7 @@ def _encode_read_holding_registers_request(m: ReadHoldingRegistersRequest) -> by
 
 
 def _encode_read_holding_registers_response(m: ReadHoldingRegistersResponse) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0) or m.unit.__class__ is bool:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('read_holding_registers response', 'unit', m.unit, 1, 247)
     v_byte_count = (2 * len(m.registers))
     if not 0 <= v_byte_count <= 255:
@@ -482,7 +482,7 @@ def _encode_read_holding_registers_response(m: ReadHoldingRegistersResponse) -> 
 
 
 def _encode_read_input_registers_request(m: ReadInputRegistersRequest) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0) or m.unit.__class__ is bool:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('read_input_registers request', 'unit', m.unit, 1, 247)
     if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('read_input_registers request', 'address', m.address, 0, 65535)
@@ -492,7 +492,7 @@ def _encode_read_input_registers_request(m: ReadInputRegistersRequest) -> bytes:
 
 
 def _encode_read_input_registers_response(m: ReadInputRegistersResponse) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0) or m.unit.__class__ is bool:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('read_input_registers response', 'unit', m.unit, 1, 247)
     v_byte_count = (2 * len(m.registers))
     if not 0 <= v_byte_count <= 255:
@@ -503,7 +503,7 @@ def _encode_read_input_registers_response(m: ReadInputRegistersResponse) -> byte
 
 
 def _encode_write_coil_request(m: WriteCoilRequest) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0) or m.unit.__class__ is bool:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('write_coil request', 'unit', m.unit, 1, 247)
     if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('write_coil request', 'address', m.address, 0, 65535)
@@ -513,7 +513,7 @@ def _encode_write_coil_request(m: WriteCoilRequest) -> bytes:
 
 
 def _encode_write_coil_response(m: WriteCoilResponse) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0) or m.unit.__class__ is bool:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('write_coil response', 'unit', m.unit, 1, 247)
     if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('write_coil response', 'address', m.address, 0, 65535)
@@ -523,7 +523,7 @@ def _encode_write_coil_response(m: WriteCoilResponse) -> bytes:
 
 
 def _encode_write_register_request(m: WriteRegisterRequest) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0) or m.unit.__class__ is bool:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('write_register request', 'unit', m.unit, 1, 247)
     if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('write_register request', 'address', m.address, 0, 65535)
@@ -533,7 +533,7 @@ def _encode_write_register_request(m: WriteRegisterRequest) -> bytes:
 
 
 def _encode_write_register_response(m: WriteRegisterResponse) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0) or m.unit.__class__ is bool:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('write_register response', 'unit', m.unit, 1, 247)
     if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('write_register response', 'address', m.address, 0, 65535)
@@ -543,7 +543,7 @@ def _encode_write_register_response(m: WriteRegisterResponse) -> bytes:
 
 
 def _encode_write_coils_request(m: WriteCoilsRequest) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0) or m.unit.__class__ is bool:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('write_coils request', 'unit', m.unit, 1, 247)
     if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('write_coils request', 'address', m.address, 0, 65535)
@@ -557,7 +557,7 @@ def _encode_write_coils_request(m: WriteCoilsRequest) -> bytes:
 
 
 def _encode_write_coils_response(m: WriteCoilsResponse) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0) or m.unit.__class__ is bool:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('write_coils response', 'unit', m.unit, 1, 247)
     if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('write_coils response', 'address', m.address, 0, 65535)
@@ -567,7 +567,7 @@ def _encode_write_coils_response(m: WriteCoilsResponse) -> bytes:
 
 
 def _encode_write_registers_request(m: WriteRegistersRequest) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0) or m.unit.__class__ is bool:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('write_registers request', 'unit', m.unit, 1, 247)
     if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('write_registers request', 'address', m.address, 0, 65535)
@@ -583,7 +583,7 @@ def _encode_write_registers_request(m: WriteRegistersRequest) -> bytes:
 
 
 def _encode_write_registers_response(m: WriteRegistersResponse) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0) or m.unit.__class__ is bool:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('write_registers response', 'unit', m.unit, 1, 247)
     if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('write_registers response', 'address', m.address, 0, 65535)
@@ -593,7 +593,7 @@ def _encode_write_registers_response(m: WriteRegistersResponse) -> bytes:
 
 
 def _encode_mask_write_register_request(m: MaskWriteRegisterRequest) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0) or m.unit.__class__ is bool:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('mask_write_register request', 'unit', m.unit, 1, 247)
     if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('mask_write_register request', 'address', m.address, 0, 65535)
@@ -605,7 +605,7 @@ def _encode_mask_write_register_request(m: MaskWriteRegisterRequest) -> bytes:
 
 
 def _encode_mask_write_register_response(m: MaskWriteRegisterResponse) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0) or m.unit.__class__ is bool:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('mask_write_register response', 'unit', m.unit, 1, 247)
     if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('mask_write_register response', 'address', m.address, 0, 65535)
@@ -617,7 +617,7 @@ def _encode_mask_write_register_response(m: MaskWriteRegisterResponse) -> bytes:
 
 
 def _encode_read_write_registers_request(m: ReadWriteRegistersRequest) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0) or m.unit.__class__ is bool:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('read_write_registers request', 'unit', m.unit, 1, 247)
     if not 0 <= m.read_address <= 65535 or m.read_address.__class__ is bool:
         raise out_of_range('read_write_registers request', 'read_address', m.read_address, 0, 65535)
@@ -637,7 +637,7 @@ def _encode_read_write_registers_request(m: ReadWriteRegistersRequest) -> bytes:
 
 
 def _encode_read_write_registers_response(m: ReadWriteRegistersResponse) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0) or m.unit.__class__ is bool:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('read_write_registers response', 'unit', m.unit, 1, 247)
     v_byte_count = (2 * len(m.registers))
     if not 0 <= v_byte_count <= 255:
@@ -648,7 +648,7 @@ def _encode_read_write_registers_response(m: ReadWriteRegistersResponse) -> byte
 
 
 def _encode_exception_response(m: ExceptionResponse) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0) or m.unit.__class__ is bool:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('exception response', 'unit', m.unit, 1, 247)
     if not 0 <= m.function <= 127 or m.function.__class__ is bool:
         raise out_of_range('exception response', 'function', m.function, 0, 127)

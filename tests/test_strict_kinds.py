@@ -71,7 +71,7 @@ def test_built_in_python(g: Any, command: str, direction: str, fields: dict[str,
     """The same values given to the message class directly (bytes for hex text, tuples for lists)."""
     cls = message_class(g, command, direction)
     values = {k: bytes.fromhex(v) if k == "uuid" else tuple(v) if isinstance(v, list) else v for k, v in fields.items()}
-    values = {k: v for k, v in values.items() if k in cls.__dataclass_fields__}
+    values = {k: v for k, v in values.items() if k in cls.__match_args__}
     with pytest.raises(EncodeError) as failure:
         g.package.encode(cls(**values))
     text = str(failure.value)

@@ -7,10 +7,12 @@ from collections.abc import Mapping
 from enum import IntEnum
 from typing import Any, ClassVar, Self
 
+from serialspec.runtime.fields import bits as _bits
 from serialspec.runtime.fields import check_keys as _check_keys
 from serialspec.runtime.fields import enum as _as_enum
 from serialspec.runtime.fields import get as _get
 from serialspec.runtime.fields import integer as _integer
+from serialspec.runtime.fields import integers as _integers
 from serialspec.runtime.message import Direction, Message
 
 _store = object.__setattr__  # how __init__ fills the slots of a frozen class
@@ -153,7 +155,7 @@ class ReadCoilsResponse(Message):
         _check_keys(data, ('unit', 'coils'), ('byte_count',), where)
         return cls(
             _integer(_get(data, 'unit', where), 'unit', where),
-            tuple(bool(x) for x in _get(data, 'coils', where)),
+            _bits(_get(data, 'coils', where), 'coils', where),
         )
 
 
@@ -233,7 +235,7 @@ class ReadDiscreteInputsResponse(Message):
         _check_keys(data, ('unit', 'inputs'), ('byte_count',), where)
         return cls(
             _integer(_get(data, 'unit', where), 'unit', where),
-            tuple(bool(x) for x in _get(data, 'inputs', where)),
+            _bits(_get(data, 'inputs', where), 'inputs', where),
         )
 
 
@@ -313,7 +315,7 @@ class ReadHoldingRegistersResponse(Message):
         _check_keys(data, ('unit', 'registers'), ('byte_count',), where)
         return cls(
             _integer(_get(data, 'unit', where), 'unit', where),
-            tuple(_get(data, 'registers', where)),
+            _integers(_get(data, 'registers', where), 'registers', where),
         )
 
 
@@ -393,7 +395,7 @@ class ReadInputRegistersResponse(Message):
         _check_keys(data, ('unit', 'registers'), ('byte_count',), where)
         return cls(
             _integer(_get(data, 'unit', where), 'unit', where),
-            tuple(_get(data, 'registers', where)),
+            _integers(_get(data, 'registers', where), 'registers', where),
         )
 
 
@@ -608,7 +610,7 @@ class WriteCoilsRequest(Message):
         return cls(
             _integer(_get(data, 'unit', where), 'unit', where),
             _integer(_get(data, 'address', where), 'address', where),
-            tuple(bool(x) for x in _get(data, 'values', where)),
+            _bits(_get(data, 'values', where), 'values', where),
         )
 
 
@@ -694,7 +696,7 @@ class WriteRegistersRequest(Message):
         return cls(
             _integer(_get(data, 'unit', where), 'unit', where),
             _integer(_get(data, 'address', where), 'address', where),
-            tuple(_get(data, 'values', where)),
+            _integers(_get(data, 'values', where), 'values', where),
         )
 
 
@@ -890,7 +892,7 @@ class ReadWriteRegistersRequest(Message):
             _integer(_get(data, 'read_address', where), 'read_address', where),
             _integer(_get(data, 'read_count', where), 'read_count', where),
             _integer(_get(data, 'write_address', where), 'write_address', where),
-            tuple(_get(data, 'values', where)),
+            _integers(_get(data, 'values', where), 'values', where),
         )
 
 
@@ -927,7 +929,7 @@ class ReadWriteRegistersResponse(Message):
         _check_keys(data, ('unit', 'registers'), ('byte_count',), where)
         return cls(
             _integer(_get(data, 'unit', where), 'unit', where),
-            tuple(_get(data, 'registers', where)),
+            _integers(_get(data, 'registers', where), 'registers', where),
         )
 
 

@@ -49,6 +49,12 @@ class Kind(Generic[F]):
         return _get(f)
 
 
+def _numbers_from_json(f: Array | List) -> str:
+    """A list of numbers (or bits) from JSON, each checked to be one."""
+    kind = "_bits" if f.item is None else "_numbers" if f.item.is_float else "_integers"
+    return f"{kind}({_get(f)}, {f.name!r}, where)"
+
+
 def _numbers(is_float: bool) -> str:
     return "tuple[float, ...]" if is_float else "tuple[int, ...]"
 
@@ -173,8 +179,7 @@ class ArrayKind(Kind[Array]):
         return f"list({expr})"
 
     def from_json(self, f: Array) -> str:
-        kind = "_numbers" if f.item.is_float else "_integers"
-        return f"{kind}({_get(f)}, {f.name!r}, where)"
+        return _numbers_from_json(f)
 
 
 class ListKind(Kind[List]):
@@ -190,7 +195,7 @@ class ListKind(Kind[List]):
         return f"list({expr})"
 
     def from_json(self, f: List) -> str:
-        return f"tuple(bool(x) for x in {_get(f)})" if f.bits else f"tuple({_get(f)})"
+        return _numbers_from_json(f)
 
 
 class TextKind(Kind[Text]):
@@ -207,7 +212,7 @@ class TextKind(Kind[Text]):
         return "str"
 
     def from_json(self, f: Text) -> str:
-        return f"str({_get(f)})"
+        return f"_text({_get(f)}, {f.name!r}, where)"
 
 
 class BytesKind(Kind[Bytes]):

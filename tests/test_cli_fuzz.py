@@ -10,12 +10,14 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from conftest import ALL, ROOT, Generated
+from conftest import ALL, ROOT, Generated, examples
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from serialspec.cli import main
 
-SETTINGS = settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+SETTINGS = settings(
+    max_examples=examples(150), deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
 
 
 def run(*argv: str) -> tuple[int, str, str]:

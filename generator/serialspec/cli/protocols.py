@@ -12,6 +12,7 @@ import hashlib
 import importlib
 import importlib.resources
 import importlib.util
+import sys
 from pathlib import Path
 from types import ModuleType
 

@@ -8,10 +8,12 @@ from dataclasses import dataclass
 from enum import IntEnum
 from typing import Any, ClassVar, Self
 
+from serialspec.runtime.fields import booleans as _booleans
 from serialspec.runtime.fields import check_keys as _check_keys
 from serialspec.runtime.fields import enum as _as_enum
 from serialspec.runtime.fields import get as _get
 from serialspec.runtime.fields import integer as _integer
+from serialspec.runtime.fields import integers as _integers
 from serialspec.runtime.message import Direction, Message
 
 __all__ = [
@@ -132,7 +134,7 @@ class ReadCoilsResponse(Message):
         _check_keys(data, ('unit', 'coils'), ('byte_count',), where)
         return cls(
             _integer(_get(data, 'unit', where), 'unit', where),
-            tuple(bool(x) for x in _get(data, 'coils', where)),
+            _booleans(_get(data, 'coils', where), 'coils', where),
         )
 
 
@@ -192,7 +194,7 @@ class ReadDiscreteInputsResponse(Message):
         _check_keys(data, ('unit', 'inputs'), ('byte_count',), where)
         return cls(
             _integer(_get(data, 'unit', where), 'unit', where),
-            tuple(bool(x) for x in _get(data, 'inputs', where)),
+            _booleans(_get(data, 'inputs', where), 'inputs', where),
         )
 
 
@@ -252,7 +254,7 @@ class ReadHoldingRegistersResponse(Message):
         _check_keys(data, ('unit', 'registers'), ('byte_count',), where)
         return cls(
             _integer(_get(data, 'unit', where), 'unit', where),
-            tuple(_get(data, 'registers', where)),
+            _integers(_get(data, 'registers', where), 'registers', where),
         )
 
 
@@ -312,7 +314,7 @@ class ReadInputRegistersResponse(Message):
         _check_keys(data, ('unit', 'registers'), ('byte_count',), where)
         return cls(
             _integer(_get(data, 'unit', where), 'unit', where),
-            tuple(_get(data, 'registers', where)),
+            _integers(_get(data, 'registers', where), 'registers', where),
         )
 
 
@@ -472,7 +474,7 @@ class WriteCoilsRequest(Message):
         return cls(
             _integer(_get(data, 'unit', where), 'unit', where),
             _integer(_get(data, 'address', where), 'address', where),
-            tuple(bool(x) for x in _get(data, 'values', where)),
+            _booleans(_get(data, 'values', where), 'values', where),
         )
 
 
@@ -536,7 +538,7 @@ class WriteRegistersRequest(Message):
         return cls(
             _integer(_get(data, 'unit', where), 'unit', where),
             _integer(_get(data, 'address', where), 'address', where),
-            tuple(_get(data, 'values', where)),
+            _integers(_get(data, 'values', where), 'values', where),
         )
 
 
@@ -680,7 +682,7 @@ class ReadWriteRegistersRequest(Message):
             _integer(_get(data, 'read_address', where), 'read_address', where),
             _integer(_get(data, 'read_count', where), 'read_count', where),
             _integer(_get(data, 'write_address', where), 'write_address', where),
-            tuple(_get(data, 'values', where)),
+            _integers(_get(data, 'values', where), 'values', where),
         )
 
 
@@ -708,7 +710,7 @@ class ReadWriteRegistersResponse(Message):
         _check_keys(data, ('unit', 'registers'), ('byte_count',), where)
         return cls(
             _integer(_get(data, 'unit', where), 'unit', where),
-            tuple(_get(data, 'registers', where)),
+            _integers(_get(data, 'registers', where), 'registers', where),
         )
 
 

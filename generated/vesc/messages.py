@@ -14,6 +14,7 @@ from serialspec.runtime.fields import enum as _as_enum
 from serialspec.runtime.fields import flags as _as_flags
 from serialspec.runtime.fields import get as _get
 from serialspec.runtime.fields import integer as _integer
+from serialspec.runtime.fields import text as _text
 from serialspec.runtime.message import Direction, Message
 
 __all__ = [
@@ -178,7 +179,7 @@ class FwVersionResponse(Message):
         return cls(
             _integer(_get(data, 'major', where), 'major', where),
             _integer(_get(data, 'minor', where), 'minor', where),
-            str(_get(data, 'hw_name', where)),
+            _text(_get(data, 'hw_name', where), 'hw_name', where),
             _bytes(_get(data, 'uuid', where), 'uuid', where),
             _integer(_get(data, 'pairing_done', where), 'pairing_done', where),
             _integer(_get(data, 'test_version', where), 'test_version', where),
@@ -188,7 +189,7 @@ class FwVersionResponse(Message):
             _integer(_get(data, 'qml_hw', where), 'qml_hw', where),
             _integer(_get(data, 'qml_app', where), 'qml_app', where),
             _integer(_get(data, 'nrf_flags', where), 'nrf_flags', where),
-            str(_get(data, 'fw_name', where)),
+            _text(_get(data, 'fw_name', where), 'fw_name', where),
             _integer(_get(data, 'hw_crc', where), 'hw_crc', where),
         )
 
@@ -493,7 +494,7 @@ class PrintResponse(Message):
     def from_fields(cls, data: Mapping[str, Any], where: str = 'print response') -> Self:
         _check_keys(data, ('text',), (), where)
         return cls(
-            str(_get(data, 'text', where)),
+            _text(_get(data, 'text', where), 'text', where),
         )
 
 

@@ -99,6 +99,21 @@ def numbers(value: Any, name: str, where: str) -> tuple[float, ...]:
     return tuple(number(item, f"{name}[{index}]", where) for index, item in enumerate(items(value, name, where)))
 
 
+def booleans(value: Any, name: str, where: str) -> tuple[bool, ...]:
+    """A list of bits: each true/false or 1/0."""
+    bits = items(value, name, where)
+    for index, bit in enumerate(bits):
+        if bit not in (0, 1) or not isinstance(bit, int):
+            raise EncodeError(f"{where}: {name}[{index}] must be true/false or 1/0, got {shown(bit)}")
+    return tuple(bool(bit) for bit in bits)
+
+
+def text(value: Any, name: str, where: str) -> str:
+    if isinstance(value, str):
+        return value
+    raise EncodeError(f"{where}: {name} must be text, got {shown(value)}")
+
+
 def wrong_type(message: Any, exc: Exception) -> EncodeError:
     """The field of a message built in Python (not from data) whose value has the wrong type, as one line."""
     where = " ".join(p for p in (message.COMMAND, message.SUBCOMMAND, message.DIRECTION.value) if p)

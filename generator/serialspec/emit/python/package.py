@@ -142,6 +142,7 @@ def emit_package(protocol: Protocol) -> dict[str, str]:
 # The runtime's helpers that build fields from data, by the name generated code calls them (serialspec.runtime.fields).
 FIELD_HELPERS = (
     ("as_bytes", "_bytes"),
+    ("booleans", "_booleans"),
     ("check_keys", "_check_keys"),
     ("enum", "_as_enum"),
     ("flags", "_as_flags"),
@@ -152,6 +153,7 @@ FIELD_HELPERS = (
     ("mapping", "_mapping"),
     ("number", "_number"),
     ("numbers", "_numbers"),
+    ("text", "_text"),
 )
 
 

@@ -325,13 +325,11 @@ class PackageCode:
                 get = f"data.get({f.name!r}, {number(f.default)})"
             kind = "_number" if f.type.is_float else "_integer"
             return f"{kind}({get}, {f.name!r}, where)"
-        if isinstance(f, Array):
-            kind = "_numbers" if f.item.is_float else "_integers"
+        if isinstance(f, Array | List):
+            kind = "_booleans" if f.item is None else "_numbers" if f.item.is_float else "_integers"
             return f"{kind}({get}, {f.name!r}, where)"
-        if isinstance(f, List):
-            return f"tuple(bool(x) for x in {get})" if f.bits else f"tuple({get})"
         if isinstance(f, Text):
-            return f"str({get})"
+            return f"_text({get}, {f.name!r}, where)"
         if isinstance(f, Bytes):
             return f"_bytes({get}, {f.name!r}, where)"
         if isinstance(f, Group):

@@ -334,3 +334,142 @@ def sms_encode_write(message: SmsWrite) -> bytes:
     head = _SMS_WRITE_HEAD.pack(SMS_HEADER, message.servo_id, len(message.data) + 3, SMS_WRITE, message.address)
     body = head + message.data
     return body + bytes((~sum(body[2:]) & 0xFF,))
+
+
+# --- DYNAMIXEL 2.0: FF FF FD 00, id, length u16 (instruction .. CRC), instruction 0x55, error, params, CRC-16 ------
+# (CRC-16/UMTS: poly 0x8005, init 0, MSB first); params are byte-stuffed (FF FF FD -> FF FF FD FD) on the wire.
+
+DXL_HEADER = b"\xff\xff\xfd\x00"
+DXL_STATUS = 0x55
+
+
+def _crc16_msb_table(poly: int) -> tuple[int, ...]:
+    table = []
+    for byte in range(256):
+        crc = byte << 8
+        for _ in range(8):
+            crc = ((crc << 1) ^ poly if crc & 0x8000 else crc << 1) & 0xFFFF
+        table.append(crc)
+    return tuple(table)
+
+
+def _crc16_lsb_table(poly: int) -> tuple[int, ...]:
+    table = []
+    for byte in range(256):
+        crc = byte
+        for _ in range(8):
+            crc = (crc >> 1) ^ poly if crc & 1 else crc >> 1
+        table.append(crc)
+    return tuple(table)
+
+
+_CRC16_UMTS = _crc16_msb_table(0x8005)
+_CRC16_MODBUS = _crc16_lsb_table(0xA001)
+
+
+def crc16_umts(data: bytes) -> int:
+    crc = 0
+    for byte in data:
+        crc = ((crc << 8) & 0xFFFF) ^ _CRC16_UMTS[(crc >> 8) ^ byte]
+    return crc
+
+
+def crc16_modbus(data: bytes) -> int:
+    crc = 0xFFFF
+    for byte in data:
+        crc = (crc >> 8) ^ _CRC16_MODBUS[(crc ^ byte) & 0xFF]
+    return crc
+
+
+class DxlErrorNumber(IntEnum):
+    NONE = 0
+    RESULT_FAIL = 1
+    INSTRUCTION_ERROR = 2
+    CRC_ERROR = 3
+    DATA_RANGE_ERROR = 4
+    DATA_LENGTH_ERROR = 5
+    DATA_LIMIT_ERROR = 6
+    ACCESS_ERROR = 7
+
+
+_DXL_ERRORS = {member.value: member for member in DxlErrorNumber}
+
+
+@dataclass(slots=True)
+class DxlError:
+    alert: int
+    number: DxlErrorNumber | int
+
+
+@dataclass(slots=True)
+class DxlStatus:
+    servo_id: int
+    error: DxlError
+    data: bytes
+
+
+_DXL_HEAD = struct.Struct("<4sBHBB")  # header, id, length, instruction, error
+
+
+def dxl_decode_status(frame: bytes) -> DxlStatus:
+    n = len(frame)
+    if n < 11:
+        raise ValueError(f"status packet of {n} bytes, at least 11 expected")
+    header, servo_id, length, instruction, error = _DXL_HEAD.unpack_from(frame)
+    if header != DXL_HEADER:
+        raise ValueError(f"bad header {header.hex(' ')}")
+    if length != n - 7:
+        raise ValueError(f"length field {length}, the packet holds {n - 7}")
+    if instruction != DXL_STATUS:
+        raise ValueError(f"instruction {instruction:#04x} is not STATUS")
+    if crc16_umts(frame[:-2]) != frame[-2] | frame[-1] << 8:
+        raise ValueError("bad CRC")
+    data = frame[9:-2].replace(b"\xff\xff\xfd\xfd", b"\xff\xff\xfd")
+    number = error & 0x7F
+    return DxlStatus(servo_id, DxlError(error >> 7, _DXL_ERRORS.get(number, number)), data)
+
+
+def dxl_encode_status(message: DxlStatus) -> bytes:
+    if not 0 <= message.servo_id <= 252:
+        raise ValueError(f"id {message.servo_id} outside 0..252")
+    if not 0 <= message.error.alert <= 1 or not 0 <= message.error.number <= 127:
+        raise ValueError(f"error {message.error} out of range")
+    params = message.data.replace(b"\xff\xff\xfd", b"\xff\xff\xfd\xfd")
+    error = message.error.alert << 7 | message.error.number
+    body = _DXL_HEAD.pack(DXL_HEADER, message.servo_id, len(params) + 4, DXL_STATUS, error) + params
+    return body + crc16_umts(body).to_bytes(2, "little")
+
+
+# --- Modbus RTU: unit, function, content, CRC-16/MODBUS (little-endian); no header, no length byte -----------------
+
+MB_READ_HOLDING_REGISTERS = 3
+
+
+@dataclass(slots=True)
+class MbRegisters:
+    unit: int
+    registers: tuple[int, ...]
+
+
+def mb_decode_registers_reply(frame: bytes) -> MbRegisters:
+    n = len(frame)
+    if n < 5:
+        raise ValueError(f"reply of {n} bytes, at least 5 expected")
+    if frame[1] != MB_READ_HOLDING_REGISTERS:
+        raise ValueError(f"function {frame[1]} is not READ_HOLDING_REGISTERS")
+    count = frame[2]
+    if count != n - 5 or count & 1:
+        raise ValueError(f"byte count {count}, the reply holds {n - 5}")
+    if crc16_modbus(frame[:-2]) != frame[-2] | frame[-1] << 8:
+        raise ValueError("bad CRC")
+    return MbRegisters(frame[0], struct.unpack_from(f">{count >> 1}H", frame, 3))
+
+
+def mb_encode_registers_reply(message: MbRegisters) -> bytes:
+    if not 0 <= message.unit <= 247:
+        raise ValueError(f"unit {message.unit} outside 0..247")
+    count = len(message.registers)
+    if not 1 <= count <= 125:
+        raise ValueError(f"{count} registers, 1..125 allowed")
+    body = struct.pack(f">BBB{count}H", message.unit, MB_READ_HOLDING_REGISTERS, count * 2, *message.registers)
+    return body + crc16_modbus(body).to_bytes(2, "little")

@@ -6,13 +6,13 @@ frames have no header and no length, so every byte is a candidate frame start; V
 
 from __future__ import annotations
 
-import dataclasses
 import random
 import time
 from collections.abc import Callable
 
 import modbus_rtu as mb
 import vesc
+from serialspec.runtime.message import field_names
 
 ROUNDS = 20000
 
@@ -31,7 +31,7 @@ def per_call(function: Callable[[], object], rounds: int = ROUNDS) -> float:
 def main() -> None:
     registers = bytes.fromhex("01 03 06 02 2B 00 00 00 64 05 7A")
     request = mb.ReadHoldingRegistersRequest(unit=1, address=0, count=10)
-    values = vesc.GetValuesResponse.from_fields({f.name: 0 for f in dataclasses.fields(vesc.GetValuesResponse)})
+    values = vesc.GetValuesResponse.from_fields(dict.fromkeys(field_names(vesc.GetValuesResponse), 0))
     packet = vesc.encode(values)
     decode_modbus = per_call(lambda: mb.decode(registers, "response"))
     print(f"modbus decode, read_holding_registers reply of 3 registers: {decode_modbus:.1f} µs")

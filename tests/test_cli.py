@@ -75,6 +75,12 @@ def test_encode_refuses_out_of_range_naming_field_and_range() -> None:
     assert "servo_id = 300 is outside its range 0..254" in result.stderr
 
 
+def test_encode_refuses_a_direction_that_is_neither_request_nor_response() -> None:
+    result = serialspec("encode", FS, "--json", '{"command": "rotate", "direction": 5, "fields": {}}')
+    assert result.returncode != 0
+    assert "`direction` must be 'request' or 'response', got 5" in result.stderr
+
+
 @pytest.mark.parametrize("g", ALL, ids=[g.protocol.name for g in ALL])
 def test_every_example_round_trips_through_the_cli(g: Generated, capsys: pytest.CaptureFixture[str]) -> None:
     # In-process for speed: the subprocess tests above cover the console script itself.

@@ -8,14 +8,16 @@ calls, and fixed-size frames are packed by one struct. Each must agree with the 
 from __future__ import annotations
 
 import dataclasses
+import pickle
 from typing import Any
 
 import pytest
 from conftest import ALL, Generated, by_protocol, examples
 from hypothesis import HealthCheck, given, settings
+from serialspec.emit.python.pycode import PackageCode
 from serialspec.runtime.checksums import crc_function, sum_function
 from serialspec.runtime.errors import ChecksumError
-from serialspec.runtime.message import slot_setters
+from serialspec.runtime.message import field_names, slot_setters
 from serialspec.spec.model import Message
 from strategies import message_fields
 
@@ -55,10 +57,11 @@ def test_fast_paths_agree_with_the_plain_ones(g: Generated, spec: Message) -> No
         decoded = g.package.decode(frame, direction, cls)
         assert type(decoded) is cls
         assert decoded == built and hash(decoded) == hash(built)
-        assert all(hasattr(decoded, f.name) for f in dataclasses.fields(decoded))
-        if dataclasses.fields(decoded):  # a message with no fields (Fashion Star BEGIN_ASYNC) has none to set
+        assert all(hasattr(decoded, name) for name in field_names(decoded))
+        assert repr(decoded) == repr(built) and pickle.loads(pickle.dumps(decoded)) == decoded
+        if field_names(decoded):  # a message with no fields (Fashion Star BEGIN_ASYNC) has none to set
             with pytest.raises(dataclasses.FrozenInstanceError):
-                decoded.__setattr__(dataclasses.fields(decoded)[0].name, 0)
+                decoded.__setattr__(field_names(decoded)[0], 0)
         # the stream parser decodes in place, between other bytes, to the same message
         parser = g.package.StreamParser(direction)
         parser.expect(cls)  # the reply layout, where replies share a code
@@ -113,3 +116,26 @@ def test_slot_setters_store_into_a_frozen_slotted_dataclass() -> None:
     set_first(pair, 1)
     set_second(pair, "two")
     assert pair == Pair(1, "two") and hash(pair) == hash(Pair(1, "two"))
+
+
+def test_two_formats_never_share_a_struct_constant() -> None:
+    """Formats of more than six items are named after their message; two such formats for one name get two names
+    (the second used to replace the first silently, so a decoder would unpack with another message's layout)."""
+    code = PackageCode(ALL[0].protocol)
+    long_a, long_b = "<BBBBBBBB", "<HHHHHHHH"
+    first, second = code.struct("same", long_a), code.struct("same", long_b)
+    assert first != second
+    assert code.structs[first] == long_a and code.structs[second] == long_b
+    assert code.struct("other", long_b) == second  # one format, one constant
+
+
+def test_replace_copies_a_message_with_changed_fields_and_refuses_unknown_names() -> None:
+    import fashionstar_uart as fs
+    from serialspec.runtime.message import field_names, replace
+
+    message = fs.RotateRequest(servo_id=2, angle=900, interval=500)
+    moved = replace(message, angle=0)
+    assert (moved.angle, moved.servo_id, message.angle) == (0, 2, 900)
+    assert field_names(moved) == field_names(message)
+    with pytest.raises(TypeError, match="no field 'angel'"):
+        replace(message, angel=0)

@@ -163,13 +163,14 @@ def test_the_base_specs_are_valid() -> None:
 
 
 def test_sim_refuses_ids_no_device_can_have() -> None:
-    for argv, words in (
-        (["--id", "300"], "--id 300 is outside the spec's id range 0..253"),
-        (["--id", "254"], "(254 is the broadcast id)"),
-        (["--id", "-1"], "--id -1 is outside"),
+    for spec, argv, words in (
+        ("feetech_sms", ["--id", "300"], "--id 300 is outside the spec's id range 0..253"),
+        ("feetech_sms", ["--id", "254"], "(254 is the broadcast id)"),
+        ("feetech_sms", ["--id", "-1"], "--id -1 is outside"),
+        ("modbus_rtu", ["--id", "248"], "--id 248 is outside the spec's id range 1..247"),  # the frame element's range
     ):
         result = subprocess.run(
-            [sys.executable, "-m", "serialspec", "sim", str(ROOT / "specs" / "feetech_sms.yaml"), *argv],
+            [sys.executable, "-m", "serialspec", "sim", str(ROOT / "specs" / f"{spec}.yaml"), *argv],
             capture_output=True,
             text=True,
             timeout=60,

@@ -101,6 +101,22 @@ def test_each_mistake_is_named_with_its_position(tmp_path: Path, change: tuple[s
     assert any(expected in line for line in lines), lines
 
 
+def test_an_error_flag_with_a_command_code_that_is_not_a_number_is_an_error_line(tmp_path: Path) -> None:
+    # the error-reply pass used to apply the flag to the code regardless (TypeError on a list, a traceback)
+    text = MINIMAL.replace("type: u8}", "type: u8, error_flag: 0x80}").replace("code: 1", "code: [1]")
+    lines = errors_of(tmp_path, text)
+    assert any("commands.move.code: expected an integer" in x for x in lines), lines
+
+
+def test_the_reference_of_an_example_shorter_than_its_frame_says_it_does_not_decode(tmp_path: Path) -> None:
+    # the example verification reports such a frame; the docs emitter used to fail first (IndexError, a traceback)
+    spec = tmp_path / "tiny.yaml"
+    example = 'examples:\n  short: {source: x, direction: request, printed: "AA 55", command: move, fields: {}}\n'
+    spec.write_text(MINIMAL + example, encoding="utf-8")
+    page = emit_docs(load_protocol(str(spec), "tiny.yaml"))
+    assert "does not decode: 2 bytes, fewer than the frame's 5 without content" in page
+
+
 def test_duplicate_command_codes_and_overlapping_registers(tmp_path: Path) -> None:
     text = (
         MINIMAL

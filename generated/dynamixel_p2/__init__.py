@@ -7,7 +7,7 @@ with a status packet carrying its id, an error byte and, for PING and READ, the 
 packet start FF FF FD 00; byte stuffing keeps that pattern out of a packet's instruction and parameters.
 
 Generated from specs/dynamixel_p2.yaml: `decode`/`encode` frames with the fast codec, `StreamParser` for byte streams,
-one dataclass per command and direction in `messages`, construct structs in `structs`.
+one frozen message class per command and direction in `messages`, construct structs in `structs`.
 """
 
 from serialspec.runtime.transport import SerialSettings

@@ -50,8 +50,8 @@ _S_U8_U16_U16 = struct.Struct('<BHH')
 _S_U8_U32 = struct.Struct('<BI')
 _CHECK_CRC: Callable[[bytes], int] = crc_function(16, 0x8005, 0x0, False, False, 0x0)  # CRC-16/UMTS (CRC-16/BUYPASS)
 
-# Decoders build messages with object.__new__ and store each value straight into its slot: the dataclass __init__
-# of a frozen class goes through object.__setattr__ per field, which costs more than unpacking the whole frame.
+# Decoders build messages with object.__new__ and store each value straight into its slot: a message's __init__
+# (frozen) goes through object.__setattr__ per field, which costs more than unpacking the whole frame.
 _new = object.__new__
 (_set_ActionRequest_id,) = slot_setters(ActionRequest)
 _set_BulkReadRequest_id, _set_BulkReadRequest_reads = slot_setters(BulkReadRequest)

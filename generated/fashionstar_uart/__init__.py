@@ -5,7 +5,7 @@ Half-duplex request/response protocol of Fashion Star UART bus servos. Every com
 the first content byte (servo_id); the servo answers with the same cmd_id under a different header.
 
 Generated from specs/fashionstar_uart.yaml: `decode`/`encode` frames with the fast codec, `StreamParser` for byte streams,
-one dataclass per command and direction in `messages`, construct structs in `structs`.
+one frozen message class per command and direction in `messages`, construct structs in `structs`.
 """
 
 from serialspec.runtime.transport import SerialSettings

@@ -167,8 +167,8 @@ _TABLE_PARAMETERS_RANGES: dict[int, tuple[float, float]] = {
     53: (-32768, 32767),
 }
 
-# Decoders build messages with object.__new__ and store each value straight into its slot: the dataclass __init__
-# of a frozen class goes through object.__setattr__ per field, which costs more than unpacking the whole frame.
+# Decoders build messages with object.__new__ and store each value straight into its slot: a message's __init__
+# (frozen) goes through object.__setattr__ per field, which costs more than unpacking the whole frame.
 _new = object.__new__
 (_set_BlocksItem_content,) = slot_setters(BlocksItem)
 _set_DampingRequest_servo_id, _set_DampingRequest_power = slot_setters(DampingRequest)
@@ -1328,11 +1328,11 @@ def _encode_read_data_response(m: ReadDataResponse) -> bytes:
     low, high = _TABLE_PARAMETERS_RANGES[m.data_id]
     if not low <= m.data <= high:
         raise out_of_range('read_data response', 'data', m.data, low, high)
-    content = b''.join((_S_U8_U8.pack(m.servo_id, m.data_id), s.pack(m.data),))
-    n = len(content)
+    content = s.pack(m.data)
+    n = len(content) + 2
     if n > 255:
-        raise EncodeError(f'content of {len(content)} bytes does not fit the length field')
-    body = _S_B2_U8_U8.pack(b'\x05\x1c', 3, n) + content
+        raise EncodeError(f'content of {n} bytes does not fit the length field')
+    body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 3, n, m.servo_id, m.data_id) + content
     return body + _BYTES[sum(body) & 0xff]
 
 
@@ -1347,11 +1347,11 @@ def _encode_write_data_request(m: WriteDataRequest) -> bytes:
     low, high = _TABLE_PARAMETERS_RANGES[m.data_id]
     if not low <= m.data <= high:
         raise out_of_range('write_data request', 'data', m.data, low, high)
-    content = b''.join((_S_U8_U8.pack(m.servo_id, m.data_id), s.pack(m.data),))
-    n = len(content)
+    content = s.pack(m.data)
+    n = len(content) + 2
     if n > 255:
-        raise EncodeError(f'content of {len(content)} bytes does not fit the length field')
-    body = _S_B2_U8_U8.pack(b'\x12L', 4, n) + content
+        raise EncodeError(f'content of {n} bytes does not fit the length field')
+    body = _S_B2_U8_U8_U8_U8.pack(b'\x12L', 4, n, m.servo_id, m.data_id) + content
     return body + _BYTES[sum(body) & 0xff]
 
 
@@ -1786,11 +1786,11 @@ def _encode_sync_command_request(m: SyncCommandRequest) -> bytes:
     parts_blocks = []
     for item in m.blocks:
         parts_blocks.append(bytes(item.content))
-    content = b''.join((_S_U8_U8_U8.pack(m.command, v_block_size, len(m.blocks)), b''.join(parts_blocks),))
-    n = len(content)
+    content = b''.join(parts_blocks)
+    n = len(content) + 3
     if n > 255:
-        raise EncodeError(f'content of {len(content)} bytes does not fit the length field')
-    body = _S_B2_U8_U8.pack(b'\x12L', 25, n) + content
+        raise EncodeError(f'content of {n} bytes does not fit the length field')
+    body = _S_B2_U8_U8_U8_U8_U8.pack(b'\x12L', 25, n, m.command, v_block_size, len(m.blocks)) + content
     return body + _BYTES[sum(body) & 0xff]
 
 

@@ -8,7 +8,7 @@ control table. Requests and replies share the header FF FF, so a frame can only 
 is known.
 
 Generated from specs/feetech_sms.yaml: `decode`/`encode` frames with the fast codec, `StreamParser` for byte streams,
-one dataclass per command and direction in `messages`, construct structs in `structs`.
+one frozen message class per command and direction in `messages`, construct structs in `structs`.
 """
 
 from serialspec.runtime.transport import SerialSettings

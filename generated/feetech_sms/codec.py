@@ -31,13 +31,14 @@ from feetech_sms.messages import (
 __all__ = ["StreamParser", "decode", "encode"]
 
 _S_B2_U8_U8_U8 = struct.Struct('<2sBBB')
+_S_B2_U8_U8_U8_U8 = struct.Struct('<2sBBBB')
 _S_B2_U8_U8_U8_U8_U8 = struct.Struct('<2sBBBBB')
 _S_U8 = struct.Struct('<B')
 _S_U8_U8 = struct.Struct('<BB')
 _S_U8_U8_U8 = struct.Struct('<BBB')
 
-# Decoders build messages with object.__new__ and store each value straight into its slot: the dataclass __init__
-# of a frozen class goes through object.__setattr__ per field, which costs more than unpacking the whole frame.
+# Decoders build messages with object.__new__ and store each value straight into its slot: a message's __init__
+# (frozen) goes through object.__setattr__ per field, which costs more than unpacking the whole frame.
 _new = object.__new__
 (_set_ActionRequest_id,) = slot_setters(ActionRequest)
 (_set_IdsItem_id,) = slot_setters(IdsItem)
@@ -227,14 +228,14 @@ def _frame_reset_request(buf: bytes, start: int) -> ResetRequest | None:
 
 
 def _encode_ping_request(m: PingRequest) -> bytes:
-    if not (0 <= m.id <= 253 or m.id == 254) or m.id.__class__ is bool:
+    if not 0 <= m.id <= 254 or m.id.__class__ is bool:
         raise out_of_range('ping request', 'id', m.id, 0, 253)
     body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m.id, 2, 1)
     return body + _BYTES[~sum(body[2:]) & 0xff]
 
 
 def _encode_read_request(m: ReadRequest) -> bytes:
-    if not (0 <= m.id <= 253 or m.id == 254) or m.id.__class__ is bool:
+    if not 0 <= m.id <= 254 or m.id.__class__ is bool:
         raise out_of_range('read request', 'id', m.id, 0, 253)
     if not 0 <= m.address <= 255 or m.address.__class__ is bool:
         raise out_of_range('read request', 'address', m.address, 0, 255)
@@ -245,47 +246,47 @@ def _encode_read_request(m: ReadRequest) -> bytes:
 
 
 def _encode_write_request(m: WriteRequest) -> bytes:
-    if not (0 <= m.id <= 253 or m.id == 254) or m.id.__class__ is bool:
+    if not 0 <= m.id <= 254 or m.id.__class__ is bool:
         raise out_of_range('write request', 'id', m.id, 0, 253)
     if not 0 <= m.address <= 255 or m.address.__class__ is bool:
         raise out_of_range('write request', 'address', m.address, 0, 255)
-    content = b''.join((_S_U8.pack(m.address), bytes(m.data),))
-    n = len(content) + 2
+    content = bytes(m.data)
+    n = len(content) + 3
     if n > 255:
-        raise EncodeError(f'content of {len(content)} bytes does not fit the length field')
-    body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m.id, n, 3) + content
+        raise EncodeError(f'content of {n - 2} bytes does not fit the length field')
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xff\xff', m.id, n, 3, m.address) + content
     return body + _BYTES[~sum(body[2:]) & 0xff]
 
 
 def _encode_reg_write_request(m: RegWriteRequest) -> bytes:
-    if not (0 <= m.id <= 253 or m.id == 254) or m.id.__class__ is bool:
+    if not 0 <= m.id <= 254 or m.id.__class__ is bool:
         raise out_of_range('reg_write request', 'id', m.id, 0, 253)
     if not 0 <= m.address <= 255 or m.address.__class__ is bool:
         raise out_of_range('reg_write request', 'address', m.address, 0, 255)
-    content = b''.join((_S_U8.pack(m.address), bytes(m.data),))
-    n = len(content) + 2
+    content = bytes(m.data)
+    n = len(content) + 3
     if n > 255:
-        raise EncodeError(f'content of {len(content)} bytes does not fit the length field')
-    body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m.id, n, 4) + content
+        raise EncodeError(f'content of {n - 2} bytes does not fit the length field')
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xff\xff', m.id, n, 4, m.address) + content
     return body + _BYTES[~sum(body[2:]) & 0xff]
 
 
 def _encode_action_request(m: ActionRequest) -> bytes:
-    if not (0 <= m.id <= 253 or m.id == 254) or m.id.__class__ is bool:
+    if not 0 <= m.id <= 254 or m.id.__class__ is bool:
         raise out_of_range('action request', 'id', m.id, 0, 253)
     body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m.id, 2, 5)
     return body + _BYTES[~sum(body[2:]) & 0xff]
 
 
 def _encode_reset_request(m: ResetRequest) -> bytes:
-    if not (0 <= m.id <= 253 or m.id == 254) or m.id.__class__ is bool:
+    if not 0 <= m.id <= 254 or m.id.__class__ is bool:
         raise out_of_range('reset request', 'id', m.id, 0, 253)
     body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m.id, 2, 6)
     return body + _BYTES[~sum(body[2:]) & 0xff]
 
 
 def _encode_sync_read_request(m: SyncReadRequest) -> bytes:
-    if not (0 <= m.id <= 253 or m.id == 254) or m.id.__class__ is bool:
+    if not 0 <= m.id <= 254 or m.id.__class__ is bool:
         raise out_of_range('sync_read request', 'id', m.id, 0, 253)
     if not 0 <= m.address <= 255 or m.address.__class__ is bool:
         raise out_of_range('sync_read request', 'address', m.address, 0, 255)
@@ -296,16 +297,16 @@ def _encode_sync_read_request(m: SyncReadRequest) -> bytes:
         if not 0 <= item.id <= 253 or item.id.__class__ is bool:
             raise out_of_range('sync_read request', 'id', item.id, 0, 253)
         parts_ids.append(_S_U8.pack(item.id))
-    content = b''.join((_S_U8_U8.pack(m.address, m.length), b''.join(parts_ids),))
-    n = len(content) + 2
+    content = b''.join(parts_ids)
+    n = len(content) + 4
     if n > 255:
-        raise EncodeError(f'content of {len(content)} bytes does not fit the length field')
-    body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m.id, n, 130) + content
+        raise EncodeError(f'content of {n - 2} bytes does not fit the length field')
+    body = _S_B2_U8_U8_U8_U8_U8.pack(b'\xff\xff', m.id, n, 130, m.address, m.length) + content
     return body + _BYTES[~sum(body[2:]) & 0xff]
 
 
 def _encode_sync_write_request(m: SyncWriteRequest) -> bytes:
-    if not (0 <= m.id <= 253 or m.id == 254) or m.id.__class__ is bool:
+    if not 0 <= m.id <= 254 or m.id.__class__ is bool:
         raise out_of_range('sync_write request', 'id', m.id, 0, 253)
     if not 0 <= m.address <= 255 or m.address.__class__ is bool:
         raise out_of_range('sync_write request', 'address', m.address, 0, 255)
@@ -319,23 +320,23 @@ def _encode_sync_write_request(m: SyncWriteRequest) -> bytes:
         if not 0 <= item.id <= 253 or item.id.__class__ is bool:
             raise out_of_range('sync_write request', 'id', item.id, 0, 253)
         parts_servos.append(b''.join((_S_U8.pack(item.id), bytes(item.data),)))
-    content = b''.join((_S_U8_U8.pack(m.address, v_data_length), b''.join(parts_servos),))
-    n = len(content) + 2
+    content = b''.join(parts_servos)
+    n = len(content) + 4
     if n > 255:
-        raise EncodeError(f'content of {len(content)} bytes does not fit the length field')
-    body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m.id, n, 131) + content
+        raise EncodeError(f'content of {n - 2} bytes does not fit the length field')
+    body = _S_B2_U8_U8_U8_U8_U8.pack(b'\xff\xff', m.id, n, 131, m.address, v_data_length) + content
     return body + _BYTES[~sum(body[2:]) & 0xff]
 
 
 def _encode_reply_response(m: ReplyResponse) -> bytes:
-    if not (0 <= m.id <= 253 or m.id == 254) or m.id.__class__ is bool:
+    if not 0 <= m.id <= 254 or m.id.__class__ is bool:
         raise out_of_range('reply response', 'id', m.id, 0, 253)
     if not 0 <= m.error <= 255 or isinstance(m.error, bool):
         raise out_of_range('reply response', 'error', m.error, 0, 255)
     content = bytes(m.data)
     n = len(content) + 2
     if n > 255:
-        raise EncodeError(f'content of {len(content)} bytes does not fit the length field')
+        raise EncodeError(f'content of {n - 2} bytes does not fit the length field')
     body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m.id, n, m.error) + content
     return body + _BYTES[~sum(body[2:]) & 0xff]
 

@@ -7,7 +7,7 @@ reports and sends key events, IMU, gamepad and SBUS data on its own. Requests (h
 (board to host) share the header 0xAA 0x55, so decoding a frame needs its direction.
 
 Generated from specs/hiwonder_rrc.yaml: `decode`/`encode` frames with the fast codec, `StreamParser` for byte streams,
-one dataclass per command and direction in `messages`, construct structs in `structs`.
+one frozen message class per command and direction in `messages`, construct structs in `structs`.
 """
 
 from serialspec.runtime.transport import SerialSettings

@@ -78,8 +78,8 @@ from hiwonder_rrc.messages import (
 
 __all__ = ["StreamParser", "decode", "encode"]
 
-_S_B2_U8_U8 = struct.Struct('<2sBB')
 _S_B2_U8_U8_U8_U16 = struct.Struct('<2sBBBH')
+_S_B2_U8_U8_U8_U16_U8 = struct.Struct('<2sBBBHB')
 _S_B2_U8_U8_U8_U8 = struct.Struct('<2sBBBB')
 _S_B2_U8_U8_U8_U8_F32 = struct.Struct('<2sBBBBf')
 _S_B2_U8_U8_U8_U8_I8 = struct.Struct('<2sBBBBb')
@@ -121,8 +121,8 @@ _S_U8_U8_U8 = struct.Struct('<BBB')
 _S_U8_U8_U8_U8 = struct.Struct('<BBBB')
 _CRC_TABLE = crc_table(8, 0x31, True)  # CRC-8/MAXIM
 
-# Decoders build messages with object.__new__ and store each value straight into its slot: the dataclass __init__
-# of a frozen class goes through object.__setattr__ per field, which costs more than unpacking the whole frame.
+# Decoders build messages with object.__new__ and store each value straight into its slot: a message's __init__
+# (frozen) goes through object.__setattr__ per field, which costs more than unpacking the whole frame.
 _new = object.__new__
 (_set_BusServoLoadRequest_servo_id,) = slot_setters(BusServoLoadRequest)
 (_set_BusServoReadIdRequest_servo_id,) = slot_setters(BusServoReadIdRequest)
@@ -1074,11 +1074,11 @@ def _encode_motor_set_speeds_request(m: MotorSetSpeedsRequest) -> bytes:
         if not -340282346638528859811704183484516925440 <= item.speed <= 340282346638528859811704183484516925440:
             raise out_of_range('motor.set_speeds request', 'speed', item.speed, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
         parts_motors.append(_S_U8_F32.pack(item.motor_id, item.speed))
-    content = b''.join((_S_U8_U8.pack(1, len(m.motors)), b''.join(parts_motors),))
-    n = len(content)
+    content = b''.join(parts_motors)
+    n = len(content) + 2
     if n > 255:
-        raise EncodeError(f'content of {len(content)} bytes does not fit the length field')
-    body = _S_B2_U8_U8.pack(b'\xaaU', 3, n) + content
+        raise EncodeError(f'content of {n} bytes does not fit the length field')
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 3, n, 1, len(m.motors)) + content
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1105,11 +1105,11 @@ def _encode_motor_set_duties_request(m: MotorSetDutiesRequest) -> bytes:
         if not -340282346638528859811704183484516925440 <= item.duty <= 340282346638528859811704183484516925440:
             raise out_of_range('motor.set_duties request', 'duty', item.duty, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
         parts_duties.append(_S_U8_F32.pack(item.motor_id, item.duty))
-    content = b''.join((_S_U8_U8.pack(5, len(m.duties)), b''.join(parts_duties),))
-    n = len(content)
+    content = b''.join(parts_duties)
+    n = len(content) + 2
     if n > 255:
-        raise EncodeError(f'content of {len(content)} bytes does not fit the length field')
-    body = _S_B2_U8_U8.pack(b'\xaaU', 3, n) + content
+        raise EncodeError(f'content of {n} bytes does not fit the length field')
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 3, n, 5, len(m.duties)) + content
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1138,11 +1138,11 @@ def _encode_pwm_servo_set_positions_request(m: PwmServoSetPositionsRequest) -> b
         if not 500 <= item.pulse <= 2500 or item.pulse.__class__ is bool:
             raise out_of_range('pwm_servo.set_positions request', 'pulse', item.pulse, 500, 2500)
         parts_pwm_servos.append(_S_U8_U16.pack(item.servo_id, item.pulse))
-    content = b''.join((_S_U8_U16_U8.pack(1, m.duration, len(m.pwm_servos)), b''.join(parts_pwm_servos),))
-    n = len(content)
+    content = b''.join(parts_pwm_servos)
+    n = len(content) + 4
     if n > 255:
-        raise EncodeError(f'content of {len(content)} bytes does not fit the length field')
-    body = _S_B2_U8_U8.pack(b'\xaaU', 4, n) + content
+        raise EncodeError(f'content of {n} bytes does not fit the length field')
+    body = _S_B2_U8_U8_U8_U16_U8.pack(b'\xaaU', 4, n, 1, m.duration, len(m.pwm_servos)) + content
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1231,11 +1231,11 @@ def _encode_bus_servo_set_positions_request(m: BusServoSetPositionsRequest) -> b
         if not 0 <= item.position <= 1000 or item.position.__class__ is bool:
             raise out_of_range('bus_servo.set_positions request', 'position', item.position, 0, 1000)
         parts_bus_servos.append(_S_U8_U16.pack(item.servo_id, item.position))
-    content = b''.join((_S_U8_U16_U8.pack(1, m.duration, len(m.bus_servos)), b''.join(parts_bus_servos),))
-    n = len(content)
+    content = b''.join(parts_bus_servos)
+    n = len(content) + 4
     if n > 255:
-        raise EncodeError(f'content of {len(content)} bytes does not fit the length field')
-    body = _S_B2_U8_U8.pack(b'\xaaU', 5, n) + content
+        raise EncodeError(f'content of {n} bytes does not fit the length field')
+    body = _S_B2_U8_U8_U8_U16_U8.pack(b'\xaaU', 5, n, 1, m.duration, len(m.bus_servos)) + content
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1322,11 +1322,11 @@ def _encode_bus_servo_stop_request(m: BusServoStopRequest) -> bytes:
         if not 0 <= item.servo_id <= 255 or item.servo_id.__class__ is bool:
             raise out_of_range('bus_servo.stop request', 'servo_id', item.servo_id, 0, 255)
         parts_servos.append(_S_U8.pack(item.servo_id))
-    content = b''.join((_S_U8_U8.pack(3, len(m.servos)), b''.join(parts_servos),))
-    n = len(content)
+    content = b''.join(parts_servos)
+    n = len(content) + 2
     if n > 255:
-        raise EncodeError(f'content of {len(content)} bytes does not fit the length field')
-    body = _S_B2_U8_U8.pack(b'\xaaU', 5, n) + content
+        raise EncodeError(f'content of {n} bytes does not fit the length field')
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, n, 3, len(m.servos)) + content
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1662,11 +1662,11 @@ def _encode_oled_request(m: OledRequest) -> bytes:
         raise out_of_range('oled request', 'line', m.line, 0, 255)
     if len(m.text) > 255:
         raise out_of_range('oled request', 'length', len(m.text), 0, 255)
-    content = b''.join((_S_U8_U8.pack(m.line, len(m.text)), bytes(m.text),))
-    n = len(content)
+    content = bytes(m.text)
+    n = len(content) + 2
     if n > 255:
-        raise EncodeError(f'content of {len(content)} bytes does not fit the length field')
-    body = _S_B2_U8_U8.pack(b'\xaaU', 10, n) + content
+        raise EncodeError(f'content of {n} bytes does not fit the length field')
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 10, n, m.line, len(m.text)) + content
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1687,11 +1687,11 @@ def _encode_rgb_set_pixels_request(m: RgbSetPixelsRequest) -> bytes:
         if not 0 <= item.blue <= 255 or item.blue.__class__ is bool:
             raise out_of_range('rgb.set_pixels request', 'blue', item.blue, 0, 255)
         parts_pixels.append(_S_U8_U8_U8_U8.pack(item.index, item.red, item.green, item.blue))
-    content = b''.join((_S_U8_U8.pack(1, len(m.pixels)), b''.join(parts_pixels),))
-    n = len(content)
+    content = b''.join(parts_pixels)
+    n = len(content) + 2
     if n > 255:
-        raise EncodeError(f'content of {len(content)} bytes does not fit the length field')
-    body = _S_B2_U8_U8.pack(b'\xaaU', 11, n) + content
+        raise EncodeError(f'content of {n} bytes does not fit the length field')
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 11, n, 1, len(m.pixels)) + content
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]

@@ -9,7 +9,7 @@ CRC-16, with frames separated by at least 3.5 character times of silence. Data i
 low byte first.
 
 Generated from specs/modbus_rtu.yaml: `decode`/`encode` frames with the fast codec, `StreamParser` for byte streams,
-one dataclass per command and direction in `messages`, construct structs in `structs`.
+one frozen message class per command and direction in `messages`, construct structs in `structs`.
 """
 
 from serialspec.runtime.transport import SerialSettings

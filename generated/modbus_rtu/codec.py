@@ -50,8 +50,8 @@ _S_BE_U16_U16_U8 = struct.Struct('>HHB')
 _S_BE_U8 = struct.Struct('>B')
 _CHECK_CRC: Callable[[bytes], int] = crc_function(16, 0x8005, 0xffff, True, True, 0x0)  # CRC-16/MODBUS
 
-# Decoders build messages with object.__new__ and store each value straight into its slot: the dataclass __init__
-# of a frozen class goes through object.__setattr__ per field, which costs more than unpacking the whole frame.
+# Decoders build messages with object.__new__ and store each value straight into its slot: a message's __init__
+# (frozen) goes through object.__setattr__ per field, which costs more than unpacking the whole frame.
 _new = object.__new__
 _set_ExceptionResponse_unit, _set_ExceptionResponse_function, _set_ExceptionResponse_exception_code = slot_setters(ExceptionResponse)
 (
@@ -419,7 +419,7 @@ def _decode_exception_response(buf: bytes, o: int, end: int, unit: int, function
 
 
 def _encode_read_coils_request(m: ReadCoilsRequest) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0) or m.unit.__class__ is bool:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('read_coils request', 'unit', m.unit, 1, 247)
     if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('read_coils request', 'address', m.address, 0, 65535)
@@ -429,7 +429,7 @@ def _encode_read_coils_request(m: ReadCoilsRequest) -> bytes:
 
 
 def _encode_read_coils_response(m: ReadCoilsResponse) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0) or m.unit.__class__ is bool:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('read_coils response', 'unit', m.unit, 1, 247)
     v_byte_count = (-(-len(m.coils) // 8))
     if not 0 <= v_byte_count <= 255:
@@ -438,7 +438,7 @@ def _encode_read_coils_response(m: ReadCoilsResponse) -> bytes:
 
 
 def _encode_read_discrete_inputs_request(m: ReadDiscreteInputsRequest) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0) or m.unit.__class__ is bool:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('read_discrete_inputs request', 'unit', m.unit, 1, 247)
     if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('read_discrete_inputs request', 'address', m.address, 0, 65535)
@@ -448,7 +448,7 @@ def _encode_read_discrete_inputs_request(m: ReadDiscreteInputsRequest) -> bytes:
 
 
 def _encode_read_discrete_inputs_response(m: ReadDiscreteInputsResponse) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0) or m.unit.__class__ is bool:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('read_discrete_inputs response', 'unit', m.unit, 1, 247)
     v_byte_count = (-(-len(m.inputs) // 8))
     if not 0 <= v_byte_count <= 255:
@@ -457,7 +457,7 @@ def _encode_read_discrete_inputs_response(m: ReadDiscreteInputsResponse) -> byte
 
 
 def _encode_read_holding_registers_request(m: ReadHoldingRegistersRequest) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0) or m.unit.__class__ is bool:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('read_holding_registers request', 'unit', m.unit, 1, 247)
     if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('read_holding_registers request', 'address', m.address, 0, 65535)
@@ -467,7 +467,7 @@ def _encode_read_holding_registers_request(m: ReadHoldingRegistersRequest) -> by
 
 
 def _encode_read_holding_registers_response(m: ReadHoldingRegistersResponse) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0) or m.unit.__class__ is bool:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('read_holding_registers response', 'unit', m.unit, 1, 247)
     v_byte_count = (2 * len(m.registers))
     if not 0 <= v_byte_count <= 255:
@@ -478,7 +478,7 @@ def _encode_read_holding_registers_response(m: ReadHoldingRegistersResponse) -> 
 
 
 def _encode_read_input_registers_request(m: ReadInputRegistersRequest) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0) or m.unit.__class__ is bool:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('read_input_registers request', 'unit', m.unit, 1, 247)
     if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('read_input_registers request', 'address', m.address, 0, 65535)
@@ -488,7 +488,7 @@ def _encode_read_input_registers_request(m: ReadInputRegistersRequest) -> bytes:
 
 
 def _encode_read_input_registers_response(m: ReadInputRegistersResponse) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0) or m.unit.__class__ is bool:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('read_input_registers response', 'unit', m.unit, 1, 247)
     v_byte_count = (2 * len(m.registers))
     if not 0 <= v_byte_count <= 255:
@@ -499,7 +499,7 @@ def _encode_read_input_registers_response(m: ReadInputRegistersResponse) -> byte
 
 
 def _encode_write_coil_request(m: WriteCoilRequest) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0) or m.unit.__class__ is bool:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('write_coil request', 'unit', m.unit, 1, 247)
     if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('write_coil request', 'address', m.address, 0, 65535)
@@ -509,7 +509,7 @@ def _encode_write_coil_request(m: WriteCoilRequest) -> bytes:
 
 
 def _encode_write_coil_response(m: WriteCoilResponse) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0) or m.unit.__class__ is bool:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('write_coil response', 'unit', m.unit, 1, 247)
     if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('write_coil response', 'address', m.address, 0, 65535)
@@ -519,7 +519,7 @@ def _encode_write_coil_response(m: WriteCoilResponse) -> bytes:
 
 
 def _encode_write_register_request(m: WriteRegisterRequest) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0) or m.unit.__class__ is bool:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('write_register request', 'unit', m.unit, 1, 247)
     if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('write_register request', 'address', m.address, 0, 65535)
@@ -529,7 +529,7 @@ def _encode_write_register_request(m: WriteRegisterRequest) -> bytes:
 
 
 def _encode_write_register_response(m: WriteRegisterResponse) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0) or m.unit.__class__ is bool:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('write_register response', 'unit', m.unit, 1, 247)
     if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('write_register response', 'address', m.address, 0, 65535)
@@ -539,7 +539,7 @@ def _encode_write_register_response(m: WriteRegisterResponse) -> bytes:
 
 
 def _encode_write_coils_request(m: WriteCoilsRequest) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0) or m.unit.__class__ is bool:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('write_coils request', 'unit', m.unit, 1, 247)
     if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('write_coils request', 'address', m.address, 0, 65535)
@@ -553,7 +553,7 @@ def _encode_write_coils_request(m: WriteCoilsRequest) -> bytes:
 
 
 def _encode_write_coils_response(m: WriteCoilsResponse) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0) or m.unit.__class__ is bool:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('write_coils response', 'unit', m.unit, 1, 247)
     if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('write_coils response', 'address', m.address, 0, 65535)
@@ -563,7 +563,7 @@ def _encode_write_coils_response(m: WriteCoilsResponse) -> bytes:
 
 
 def _encode_write_registers_request(m: WriteRegistersRequest) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0) or m.unit.__class__ is bool:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('write_registers request', 'unit', m.unit, 1, 247)
     if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('write_registers request', 'address', m.address, 0, 65535)
@@ -579,7 +579,7 @@ def _encode_write_registers_request(m: WriteRegistersRequest) -> bytes:
 
 
 def _encode_write_registers_response(m: WriteRegistersResponse) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0) or m.unit.__class__ is bool:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('write_registers response', 'unit', m.unit, 1, 247)
     if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('write_registers response', 'address', m.address, 0, 65535)
@@ -589,7 +589,7 @@ def _encode_write_registers_response(m: WriteRegistersResponse) -> bytes:
 
 
 def _encode_mask_write_register_request(m: MaskWriteRegisterRequest) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0) or m.unit.__class__ is bool:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('mask_write_register request', 'unit', m.unit, 1, 247)
     if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('mask_write_register request', 'address', m.address, 0, 65535)
@@ -601,7 +601,7 @@ def _encode_mask_write_register_request(m: MaskWriteRegisterRequest) -> bytes:
 
 
 def _encode_mask_write_register_response(m: MaskWriteRegisterResponse) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0) or m.unit.__class__ is bool:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('mask_write_register response', 'unit', m.unit, 1, 247)
     if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
         raise out_of_range('mask_write_register response', 'address', m.address, 0, 65535)
@@ -613,7 +613,7 @@ def _encode_mask_write_register_response(m: MaskWriteRegisterResponse) -> bytes:
 
 
 def _encode_read_write_registers_request(m: ReadWriteRegistersRequest) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0) or m.unit.__class__ is bool:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('read_write_registers request', 'unit', m.unit, 1, 247)
     if not 0 <= m.read_address <= 65535 or m.read_address.__class__ is bool:
         raise out_of_range('read_write_registers request', 'read_address', m.read_address, 0, 65535)
@@ -633,7 +633,7 @@ def _encode_read_write_registers_request(m: ReadWriteRegistersRequest) -> bytes:
 
 
 def _encode_read_write_registers_response(m: ReadWriteRegistersResponse) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0) or m.unit.__class__ is bool:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('read_write_registers response', 'unit', m.unit, 1, 247)
     v_byte_count = (2 * len(m.registers))
     if not 0 <= v_byte_count <= 255:
@@ -644,7 +644,7 @@ def _encode_read_write_registers_response(m: ReadWriteRegistersResponse) -> byte
 
 
 def _encode_exception_response(m: ExceptionResponse) -> bytes:
-    if not (1 <= m.unit <= 247 or m.unit == 0) or m.unit.__class__ is bool:
+    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('exception response', 'unit', m.unit, 1, 247)
     if not 0 <= m.function <= 127 or m.function.__class__ is bool:
         raise out_of_range('exception response', 'function', m.function, 0, 127)

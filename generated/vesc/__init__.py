@@ -10,7 +10,7 @@ bus). Setpoints hold only while commands keep coming: without a command or COMM_
 by default) the controller releases the motor.
 
 Generated from specs/vesc.yaml: `decode`/`encode` frames with the fast codec, `StreamParser` for byte streams,
-one dataclass per command and direction in `messages`, construct structs in `structs`.
+one frozen message class per command and direction in `messages`, construct structs in `structs`.
 """
 
 from serialspec.runtime.transport import SerialSettings

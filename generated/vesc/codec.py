@@ -45,8 +45,8 @@ _S_BE_U8 = struct.Struct('>B')
 _S_BE_U8_U8 = struct.Struct('>BB')
 _CHECK_CRC: Callable[[bytes], int] = crc_function(16, 0x1021, 0x0, False, False, 0x0)  # CRC-16/XMODEM
 
-# Decoders build messages with object.__new__ and store each value straight into its slot: the dataclass __init__
-# of a frozen class goes through object.__setattr__ per field, which costs more than unpacking the whole frame.
+# Decoders build messages with object.__new__ and store each value straight into its slot: a message's __init__
+# (frozen) goes through object.__setattr__ per field, which costs more than unpacking the whole frame.
 _new = object.__new__
 _set_ForwardCanRequest_can_id, _set_ForwardCanRequest_payload = slot_setters(ForwardCanRequest)
 (

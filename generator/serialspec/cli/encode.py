@@ -34,6 +34,8 @@ def run(args: argparse.Namespace) -> int:
     if not isinstance(data, dict) or "command" not in data:
         raise EncodeError("--json must be an object with at least `command` and `fields`")
     direction = args.direction or data.get("direction") or "request"
+    if direction not in ("request", "response"):
+        raise EncodeError(f"`direction` must be 'request' or 'response', got {direction!r}")
     cls = message_type(package, data["command"], data.get("subcommand"), direction)
     fields = data.get("fields", {})
     if not isinstance(fields, dict):

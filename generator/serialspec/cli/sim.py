@@ -13,7 +13,7 @@ from typing import Any
 from serialspec.cli import capture
 from serialspec.cli.protocols import SPEC_HELP, open_spec
 from serialspec.runtime.errors import SerialspecError
-from serialspec.spec.model import Protocol, Scalar
+from serialspec.spec.model import FrameElement, Protocol, Scalar
 
 HELP = "serve virtual devices on a pseudo-terminal; prints the device path first, answers until stopped"
 
@@ -57,9 +57,10 @@ def id_range(protocol: Protocol) -> tuple[int, int, int | None]:
     assert protocol.device is not None
     device = protocol.device
     low, high = 0, 255
+    elements = (e for layout in protocol.framing.layouts.values() for e in layout.elements if e.name == device.address)
     fields = (f for m in protocol.messages() for f in m.fields if f.name == device.address)
-    address = next(fields, None)
-    if isinstance(address, Scalar):
+    address = next(elements, None) or next(fields, None)  # a frame element (Modbus, FEETECH) or a content field
+    if isinstance(address, FrameElement | Scalar):
         low, high = int(address.minimum), int(address.maximum)
     entry = next((e for e in device.memory.entries if e.name == device.id_entry), None) if device.memory else None
     if entry is not None:

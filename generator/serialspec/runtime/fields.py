@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from collections.abc import Iterable, Mapping
 from enum import IntEnum, IntFlag
@@ -10,6 +9,7 @@ from typing import Any, TypeVar
 
 from serialspec.runtime.errors import EncodeError, shown
 from serialspec.runtime.hexbytes import parse_hex
+from serialspec.runtime.message import Record
 
 
 def check_keys(data: Mapping[str, Any], known: Iterable[str], optional: Iterable[str], where: str) -> None:
@@ -122,10 +122,11 @@ def wrong_type(message: Any, exc: Exception) -> EncodeError:
 
 
 def _problem(obj: Any, prefix: str = "") -> str:
-    for field in dataclasses.fields(obj):
-        value = getattr(obj, field.name)
-        name = prefix + field.name
-        annotation = str(field.type)
+    annotations = type(obj).__annotations__  # strings: the generated modules postpone annotations
+    for field in obj.__match_args__:
+        value = getattr(obj, field)
+        name = prefix + field
+        annotation = str(annotations[field])
         if annotation.startswith("tuple["):
             if not isinstance(value, tuple | list):
                 return f"{name} must be a tuple, got {shown(value)}"
@@ -140,7 +141,7 @@ def _problem(obj: Any, prefix: str = "") -> str:
 
 def _value_problem(value: Any, annotation: str, name: str) -> str:
     kinds = {part.strip() for part in annotation.split("|")}
-    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+    if isinstance(value, Record):
         return _problem(value, name + ".")
     if "bytes" in kinds:
         return "" if isinstance(value, bytes | bytearray) else f"{name} must be bytes, got {shown(value)}"
@@ -155,6 +156,6 @@ def _value_problem(value: Any, annotation: str, name: str) -> str:
         )
     if kinds and not any(k[:1].isupper() for k in kinds):
         return ""
-    if not dataclasses.is_dataclass(value):  # a class of the package: bit fields, a table block, a group item
+    if not isinstance(value, Record):  # a class of the package: bit fields, a table block, a group item
         return f"{name} must be {annotation.split(' |')[0]}, got {shown(value)}"
     return ""

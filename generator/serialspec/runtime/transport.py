@@ -11,7 +11,6 @@ unplugged and plugged back in (or a symlink such as /dev/serial/by-id/... pointe
 
 from __future__ import annotations
 
-import dataclasses
 import operator
 import os
 import select
@@ -28,7 +27,7 @@ from typing import Any, TypeVar
 import serial
 
 from serialspec.runtime.errors import CorruptReply, DeviceError, EncodeError, PortError, Timeout
-from serialspec.runtime.message import Message, compare
+from serialspec.runtime.message import Message, Record, compare
 from serialspec.runtime.stream import StreamParser
 
 M = TypeVar("M", bound=Message)
@@ -656,8 +655,8 @@ class Bus:
     def _check_status(self, reply: Message) -> None:
         for name in self.binding.status:
             value = getattr(reply, name, 0)
-            if dataclasses.is_dataclass(value):  # a status made of bit fields: an error when any is non-zero
-                parts = {f.name: getattr(value, f.name) for f in dataclasses.fields(value)}
+            if isinstance(value, Record):  # a status made of bit fields: an error when any is non-zero
+                parts = {field: getattr(value, field) for field in value.__match_args__}
                 if any(parts.values()):
                     text = ", ".join(f"{k} = {v.name.lower() if isinstance(v, Enum) else v}" for k, v in parts.items())
                     raise DeviceError(f"{reply.COMMAND}: the device reports {name} {text}", reply)

@@ -600,7 +600,7 @@ class Behaviour:
     reads: tuple[str, ...]  # response fields filled from memory (table_value by its key, table_block)
     writes: tuple[str, ...]  # request fields stored in memory
     resets: bool  # memory back to its defaults
-    reports: dict[str, str]  # response field -> state variable or memory entry
+    reports: dict[str, Expr]  # response field -> state variable or memory entry, or a conversion of them
     moves: Motion | None
     broadcast_reply: bool  # answers even when addressed by broadcast
     each: str = ""  # a request group whose items each address one device (SYNC WRITE)

@@ -527,6 +527,9 @@ def breakdown(protocol: Protocol, example: Example) -> list[dict[str, str]]:
     holder = sub or command
     message = holder.request if example.direction == Direction.REQUEST else holder.response
     frame = example.frame
+    if len(frame) < layout.overhead:  # the example verification reports it as a spec error; the page says it too
+        short = f"does not decode: {len(frame)} bytes, fewer than the frame's {layout.overhead} without content"
+        return [{"bytes": frame.hex(" ").upper(), "field": "(frame)", "value": cell(short)}]
     rows: list[dict[str, str]] = []
     offset = 0
     content_size = len(frame) - layout.overhead

@@ -45,7 +45,7 @@ def class_context(cls: ClassCode, where: str, keys: list[str], optional: list[st
     return {
         "name": cls.name,
         "doc": cls.doc,
-        "base": cls.base,
+        "base": cls.base or "Record",
         "attributes": cls.attributes,
         "class_vars": cls.class_vars,
         "to_fields": cls.to_fields,
@@ -57,7 +57,7 @@ def class_context(cls: ClassCode, where: str, keys: list[str], optional: list[st
 
 
 def _keys(cls: ClassCode) -> list[str]:
-    return [line.split(":")[0] for line in cls.attributes if not line.startswith("#")]
+    return [a.name for a in cls.attributes]
 
 
 @without_cycle_collection

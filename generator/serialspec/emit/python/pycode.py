@@ -8,6 +8,7 @@ identifiers, and every piece of spec text reaches generated code through repr(),
 from __future__ import annotations
 
 import re
+import struct
 from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
 
@@ -91,6 +92,9 @@ def is_fixed_run_member(f: SpecField) -> bool:
     return isinstance(f, Scalar | Array | TableBlock) or (isinstance(f, Bytes) and isinstance(f.size, int))
 
 
+_SINGLE_BYTES = re.compile(r"(\d*[bBxs?c])*")  # a struct format whose byte order changes nothing
+
+
 def fixed_runs(fields: list[SpecField]) -> Iterator[list[SpecField] | SpecField]:
     """Fields in order, each run of fixed-size fields as one list (one struct call), other fields alone."""
     run: list[SpecField] = []
@@ -144,13 +148,23 @@ def doc_line(f: SpecField) -> str:
 
 
 @dataclass
+class Attribute:
+    """One field of a generated class: its name, annotation, default (Python source, or "" for none) and doc line."""
+
+    name: str
+    annotation: str
+    doc: str
+    default: str = ""
+
+
+@dataclass
 class ClassCode:
-    """A generated dataclass: its name, docstring, attribute lines, to_fields and from_fields bodies."""
+    """A generated value class: its name, docstring, fields, to_fields and from_fields bodies."""
 
     name: str
     doc: str
     base: str
-    attributes: Lines
+    attributes: list[Attribute]
     class_vars: Lines = field(default_factory=list)
     to_fields: Lines = field(default_factory=list)
     from_fields: Lines = field(default_factory=list)
@@ -186,6 +200,9 @@ class PackageCode:
             tokens.append(f"{token}X{count}" if count and char != "s" else (f"B{count}" if char == "s" else token))
         layout = "_".join(tokens) if len(tokens) <= 6 else base_name.upper()
         name = "_S_" + ("BE_" if fmt.startswith(">") else "") + layout
+        if name in self.structs:  # another format got the same name (a long layout named after its message, ...)
+            taken = name
+            name = next(f"{taken}_{n}" for n in range(2, len(self.structs) + 3) if f"{taken}_{n}" not in self.structs)
         self.structs[name] = fmt
         return name
 
@@ -229,22 +246,25 @@ class PackageCode:
             )
         return values
 
-    def attribute_lines(self, fields: list[SpecField], defaults: bool = True) -> Lines:
-        lines = []
-        # Defaults only on a trailing run of fields that all have one: dataclasses stay positional.
+    def attributes(self, fields: list[SpecField], defaults: bool = True) -> list[Attribute]:
+        # Defaults only on a trailing run of fields that all have one: classes stay positional.
         trailing_defaults: set[str] = set()
         for f in reversed(fields):
             if defaults and isinstance(f, Scalar) and f.default is not None and not f.enum and not f.bits:
                 trailing_defaults.add(f.name)
             else:
                 break
-        for f in fields:
-            default = ""
-            if isinstance(f, Scalar) and f.default is not None and f.name in trailing_defaults:
-                default = f" = {number(f.default)}"
-            lines.append(f"#: {doc_line(f)}")  # before the attribute: documentation tools attach it to the next line
-            lines.append(f"{f.name}: {annotation(f)}{default}")
-        return lines
+        return [
+            Attribute(
+                f.name,
+                annotation(f),
+                doc_line(f),
+                number(f.default)
+                if isinstance(f, Scalar) and f.name in trailing_defaults and f.default is not None
+                else "",
+            )
+            for f in fields
+        ]
 
     def helper(self, f: SpecField) -> None:
         """Dataclasses for the nested values of a field: bit fields, group items, table blocks."""
@@ -254,7 +274,7 @@ class PackageCode:
             for bit in f.bits:
                 kind = f"{bit.enum.class_name} | int" if bit.enum else "int"
                 where = f"bit {bit.low}" if bit.high == bit.low else f"bits {bit.high}..{bit.low}"
-                attributes += [f"#: {one_line(bit.description or bit.name)} ({where})", f"{bit.name}: {kind}"]
+                attributes.append(Attribute(bit.name, kind, f"{one_line(bit.description or bit.name)} ({where})"))
             code = ClassCode(f.bits_class, f"Bit fields of {f.name}.", "", attributes)
             code.to_fields = [f"{b.name!r}: int(self.{b.name})," for b in f.bits]
             code.from_fields = [self.from_value_expr(b.name, b.enum.class_name if b.enum else None) for b in f.bits]
@@ -264,7 +284,7 @@ class PackageCode:
             for inner in f.fields:
                 self.helper(inner)
             inner_fields = [i for i in f.fields if not (isinstance(i, Scalar) and i.hidden)]
-            code = ClassCode(f.class_name, f"One item of {f.name}.", "", self.attribute_lines(inner_fields, False))
+            code = ClassCode(f.class_name, f"One item of {f.name}.", "", self.attributes(inner_fields, False))
             code.to_fields = [f"{i.name!r}: {self.to_json(i, 'self.' + i.name)}," for i in inner_fields]
             code.from_fields = [f"{self.from_json(i)}," for i in inner_fields]
             self.helper_classes.append(code)
@@ -274,10 +294,8 @@ class PackageCode:
             for e in f.entries:
                 kind = f"{e.enum.class_name} | int" if e.enum else ("float" if e.type.is_float else "int")
                 unit = f" [{e.unit}]" if e.unit else ""
-                attributes += [
-                    f"#: {one_line(f'{f.table.key_name} {e.key}: {e.description or e.name}{unit}')}",
-                    f"{e.name}: {kind}",
-                ]
+                doc = one_line(f"{f.table.key_name} {e.key}: {e.description or e.name}{unit}")
+                attributes.append(Attribute(e.name, kind, doc))
             code = ClassCode(f.class_name, one_line(f"{f.description or f.name} ({f.table.title})."), "", attributes)
             code.to_fields = [
                 f"{e.name!r}: {'int(self.' + e.name + ')' if e.enum else 'self.' + e.name}," for e in f.entries
@@ -346,7 +364,7 @@ class PackageCode:
             self.helper(f)
         fields = [*self.frame_values(message.direction, message), *self.value_fields(message)]
         doc = f"{message.command} {message.subcommand or ''} {message.direction.value}".replace("  ", " ")
-        code = ClassCode(message.class_name, doc, "Message", self.attribute_lines(fields))
+        code = ClassCode(message.class_name, doc, "Message", self.attributes(fields))
         code.class_vars = [
             f"PROTOCOL: ClassVar[str] = {self.protocol.name!r}",
             f"COMMAND: ClassVar[str] = {message.command!r}",
@@ -701,6 +719,24 @@ class PackageCode:
                 name = self.struct(f"{message.class_name}_{fields[0].name}", endian + content_format)
                 parts.append(f"{name}.pack({', '.join(args)})")
         else:
+            runs = list(fixed_runs(fields))
+            run_lines: Lines = []
+            if len(runs) > 1 and isinstance(runs[0], list):
+                # a leading run of fixed fields is packed with the frame's head: one struct call and one bytes
+                # object less per frame (the head is little-endian, so the run must be too, or all single bytes)
+                endian, run_format, run_args = self.encode_run_format(runs[0], "m", fields, run_lines, where)
+                if endian == "<" or _SINGLE_BYTES.fullmatch(run_format):
+                    lines.extend(run_lines)
+                    rest = [
+                        self.encode_run(item, message.class_name, "m", fields, lines, where)
+                        if isinstance(item, list)
+                        else self.encode_variable(item, "m", lines, where)
+                        for item in runs[1:]
+                    ]
+                    content = rest[0] if len(rest) == 1 else f"b''.join(({', '.join(rest)},))"
+                    lines.append(f"content = {content}")
+                    lines.extend(self.frame_lines(layout, code, frame_values, (run_format, run_args)))
+                    return lines
             parts = self.encode_fields(fields, message.class_name, "m", lines, where)
         content = parts[0] if len(parts) == 1 else f"b''.join(({', '.join(parts)},))"
         lines.append(f"content = {content if parts else repr(b'')}")
@@ -752,18 +788,27 @@ class PackageCode:
         tail = f"_BYTES[{value}]" if size == 1 else f"({value}).to_bytes({size}, 'little')"
         return [*lines, f"return {body} + {tail}"]
 
-    def frame_lines(self, layout: FrameLayout, code: str, values: list[str]) -> Lines:
-        """Lines that return the frame around the bytes in `content`: inline in each encoder, not a call per frame."""
-        lines: Lines = [f"n = len(content) + {layout.length_adds}" if layout.length_adds else "n = len(content)"]
+    def frame_lines(
+        self, layout: FrameLayout, code: str, values: list[str], prefix: tuple[str, list[str]] | None = None
+    ) -> Lines:
+        """Lines that return the frame around the bytes in `content`: inline in each encoder, not a call per frame.
+
+        `prefix`: struct format (little-endian) and arguments of the content's first fields, packed with the head.
+        """
+        prefix_format, prefix_args = prefix or ("", [])
+        adds = layout.length_adds + struct.calcsize("<" + prefix_format)
+        lines: Lines = [f"n = len(content) + {adds}" if adds else "n = len(content)"]
         length = next(e for e in layout.elements if e.role == "length")
         assert length.type is not None
         lines.append(f"if n > {int(length.type.maximum)}:")
-        lines.append("    raise EncodeError(f'content of {len(content)} bytes does not fit the length field')")
+        size = f"n - {layout.length_adds}" if layout.length_adds else "n"
+        lines.append(f"    raise EncodeError(f'content of {{{size}}} bytes does not fit the length field')")
         head = self.head_format(layout, "<", code, "n", values)
         assert head is not None  # little-endian and a length computed at run time: always possible
         head_format, head_args = head
-        name = self.struct(f"head_{layout.direction.value}", "<" + head_format)
-        lines.append(f"body = {name}.pack({', '.join(head_args)}) + content")
+        base = f"head_{layout.direction.value}" + (f"_{prefix_format}" if prefix_format else "")
+        name = self.struct(base, "<" + head_format + prefix_format)
+        lines.append(f"body = {name}.pack({', '.join([*head_args, *prefix_args])}) + content")
         lines.extend(self.checksum_append(layout, "body"))
         return lines
 
@@ -773,7 +818,10 @@ class PackageCode:
         not_bool = "" if f.type.is_float else f" or {expr}.__class__ is bool"
         if f.flags:  # typed as the IntFlag class, which mypy knows is no bool: asked the way it accepts
             not_bool = f" or isinstance({expr}, bool)"
-        if also is not None and not f.minimum <= also <= f.maximum:
+        if also is not None and also in (f.minimum - 1, f.maximum + 1):  # next to the range: one comparison
+            low, high = min(also, f.minimum), max(also, f.maximum)
+            lines.append(f"if not {number(low)} <= {expr} <= {number(high)}{not_bool}:")
+        elif also is not None and not f.minimum <= also <= f.maximum:
             lines.append(
                 f"if not ({number(f.minimum)} <= {expr} <= {number(f.maximum)} or {expr} == {also}){not_bool}:"
             )

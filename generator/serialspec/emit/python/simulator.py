@@ -99,9 +99,8 @@ def limits(request: Message) -> dict[str, tuple[float, float, tuple[int, ...]]]:
     return found
 
 
-def report_source(text: str) -> str:
+def report_source(parsed: expression.Expr) -> str:
     """A reported state variable by name, or a conversion of state variables as a function of `get`."""
-    parsed = expression.parse(text)
     if isinstance(parsed, expression.Name):
         return repr(parsed.name)
     return f"lambda get: {expression.render(parsed, lambda n: f'get({n!r})')}"

@@ -14,7 +14,7 @@ from typing import Any
 
 from serialspec.runtime.device.faults import Fault, FaultInjection
 from serialspec.runtime.errors import DecodeError, EncodeError
-from serialspec.runtime.message import Message, compare
+from serialspec.runtime.message import Message, compare, field_names
 from serialspec.runtime.registers import RegisterMap
 from serialspec.runtime.stream import StreamParser
 
@@ -458,10 +458,7 @@ class Engine(FaultInjection):
         """The reply a bus master gives for an id no device has: the request's fields, `absent` values, else 0."""
         if command.response is None:
             return None
-        values = {
-            a.name: command.absent.get(a.name, given.get(a.name, 0))
-            for a in dataclasses.fields(command.response)  # type: ignore[arg-type]
-        }
+        values = {name: command.absent.get(name, given.get(name, 0)) for name in field_names(command.response)}
         return self._encode_reply(command.response, values)
 
     def _encode_reply(self, response: type[Message], values: dict[str, Any]) -> bytes | None:
@@ -553,8 +550,7 @@ class Engine(FaultInjection):
         if command.response is None:
             return None
         values: dict[str, Any] = {}
-        for attribute in dataclasses.fields(command.response):  # type: ignore[arg-type]
-            name = attribute.name
+        for name in field_names(command.response):
             if name in command.space_reads and not refused:
                 values[name] = self._read_space(device, command.space_reads[name], given)
             elif name in command.reads and not refused:

@@ -127,15 +127,16 @@ class DevicePass(Pass):
             for name in item.get("writes") or () if not space_writes else ():
                 if name not in request_names:
                     self.error((*item_path, "writes"), f"{key} has no request field {name!r}")
-            reports = {str(k): str(v) for k, v in (item.get("reports") or {}).items()}
-            for field_name, source in reports.items():
+            reports: dict[str, expression.Expr] = {}
+            for field_name, source in ((str(k), str(v)) for k, v in (item.get("reports") or {}).items()):
                 if field_name not in response_names:
                     self.error((*item_path, "reports", field_name), f"{key} has no response field {field_name!r}")
                 try:
-                    used = set(expression.names(expression.parse(source)))
+                    reports[field_name] = expression.parse(source)
                 except expression.ExpressionError as exc:
                     self.error((*item_path, "reports", field_name), str(exc))
                     continue
+                used = set(expression.names(reports[field_name]))
                 for name in sorted(n for n in used if n not in known_state and n not in entries):
                     self.error((*item_path, "reports", field_name), f"unknown state variable {name!r}")
             motion = None

@@ -40,7 +40,7 @@ class ErrorReplies(Pass):
             self.error(path, f"the flag must be a non-zero bit mask that fits the command's {width} bits")
             return self.problems
         for other in self.ctx.commands:
-            if other.code is not None and other.code & flag:
+            if isinstance(other.code, int) and other.code & flag:
                 self.error(("commands", other.name, "code"), f"code {other.code:#04x} has the error flag set")
         if not replies:
             self.error(path, "`error_flag` needs a command whose response is marked `error_reply: true`")

@@ -297,7 +297,7 @@ class FramingPass(FieldResolver):
         names = [e.name for e in elements]
         content_index = roles.index("content") if "content" in roles else len(elements)
         length = next((e for e in elements if e.role == "length"), None)
-        final = elements[-1]
+        final = elements[-1] if elements else None  # none: an error said so already
         classic = (
             not layout_name
             and transparency is None
@@ -310,6 +310,7 @@ class FramingPass(FieldResolver):
             and length.counts == (names[content_index], names[content_index])
             and roles.index("length") < content_index
             and len(checksums) == 1
+            and final is not None
             and final.role == "checksum"
             and (final.size == 1 or final.endian == "<")
             and names.index(checksums[0].first) <= content_index <= names.index(checksums[0].last)
@@ -336,7 +337,7 @@ class FramingPass(FieldResolver):
             length_offset=offsets.get(length.name, -1) if length else -1,
             length_adds=length.adds if length else 0,
             command_offset=offsets.get(names[roles.index("command")]) if "command" in roles else None,
-            checksum_offset_from_end=final.size or 1 if final.role == "checksum" else 0,
+            checksum_offset_from_end=final.size or 1 if final is not None and final.role == "checksum" else 0,
             covered_from=covered_from,
             covered_to_end=covered_to_end,
             value_elements=tuple(e for e in elements if e.role in ("address", "status")),

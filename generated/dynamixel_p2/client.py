@@ -18,6 +18,7 @@ from typing import Any
 
 import serial
 from serialspec.runtime.errors import EncodeError, Timeout
+from serialspec.runtime.registers import ModelRegisters
 from serialspec.runtime.transport import Binding, Bus, ClientBase
 
 from dynamixel_p2 import MATCH_BY, SERIAL
@@ -47,7 +48,7 @@ from dynamixel_p2.messages import (
     WriteRequest,
     WritesItem,
 )
-from dynamixel_p2.registers import CONTROL_TABLE, ControlTableName
+from dynamixel_p2.registers import CONTROL_TABLE, CONTROL_TABLE_MODELS, ControlTableName
 
 __all__ = ["BINDING", "DynamixelP2Client"]
 
@@ -82,9 +83,15 @@ class DynamixelP2Client(ClientBase):
         baudrate: int | None = None,
         optional_replies: bool | None = None,
         echo: bool = False,
+        model: str | Mapping[int, str] | None = None,
         **serial_options: Any,
     ) -> None:
-        """`echo=True` for a one-wire half-duplex adapter that echoes every byte sent (see Bus)."""
+        """`echo=True` for a one-wire half-duplex adapter that echoes every byte sent (see Bus).
+
+        `model`: register writes are checked against that model's ranges (xm430_w350, xl430_w250, xl330_m288), for every
+        device, or a model per device address (a bus of mixed models); None: the table's own ranges.
+        """
+        self._models = ModelRegisters(model, CONTROL_TABLE, CONTROL_TABLE_MODELS, 254)  # before the port opens
         bus = (
             port
             if isinstance(port, Bus)
@@ -378,7 +385,7 @@ class DynamixelP2Client(ClientBase):
         The named registers must follow each other in the table (one run of bytes); each value is checked
         against its register's range and access before a byte is written. `write_raw` takes raw bytes.
         """
-        start, data = CONTROL_TABLE.pack(values)
+        start, data = self._models.pack(id, values)
         result = self.write_raw(id, start, data)
         for name, value in values.items():
             self._remember(id, CONTROL_TABLE[name].address, value)
@@ -390,7 +397,7 @@ class DynamixelP2Client(ClientBase):
         The named registers must follow each other in the table (one run of bytes); each value is checked
         against its register's range and access before a byte is written. `reg_write_raw` takes raw bytes.
         """
-        start, data = CONTROL_TABLE.pack(values)
+        start, data = self._models.pack(id, values)
         result = self.reg_write_raw(id, start, data)
         for name, value in values.items():
             self._remember(id, CONTROL_TABLE[name].address, value)
@@ -417,7 +424,7 @@ class DynamixelP2Client(ClientBase):
         Every device gets the same registers (one run, the same for all); values are checked before sending.
         `sync_write_raw` takes raw bytes.
         """
-        runs = {device: CONTROL_TABLE.pack(registers) for device, registers in values.items()}
+        runs = {device: self._models.pack(device, registers) for device, registers in values.items()}
         if len({(start, len(data)) for start, data in runs.values()}) > 1:
             raise EncodeError("sync_write: every device must get the same registers")
         if not runs:
@@ -455,7 +462,7 @@ class DynamixelP2Client(ClientBase):
         """
         items = []
         for device, registers in values.items():
-            start, data = CONTROL_TABLE.pack(registers)
+            start, data = self._models.pack(device, registers)
             items.append(WritesItem(id=device, address=start, data=data))
         if not items:
             raise EncodeError("bulk_write: name at least one device")

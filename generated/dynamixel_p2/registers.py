@@ -11,7 +11,7 @@ from typing import Literal
 
 from serialspec.runtime.registers import Register, RegisterMap
 
-__all__ = ["CONTROL_TABLE", "ControlTableName"]
+__all__ = ["CONTROL_TABLE", "CONTROL_TABLE_MODELS", "ControlTableName"]
 
 #: A register name of the X-series control table (XM430-W350).
 ControlTableName = Literal[
@@ -242,3 +242,28 @@ CONTROL_TABLE = RegisterMap(
     ),
     'little',
 )
+
+#: The X-series control table (XM430-W350) as each device model has it (spec: device.models): its ranges where they differ.
+CONTROL_TABLE_MODELS: dict[str, RegisterMap] = {
+    'xm430_w350': CONTROL_TABLE,
+    'xl430_w250': CONTROL_TABLE.for_model(
+        'xl430_w250',
+        {
+            'max_voltage_limit': (60, 140),
+            'min_voltage_limit': (60, 140),
+            'current_limit': (0, 0),
+            'goal_current': (0, 0),
+        },
+    ),
+    'xl330_m288': CONTROL_TABLE.for_model(
+        'xl330_m288',
+        {
+            'max_voltage_limit': (31, 70),
+            'min_voltage_limit': (31, 70),
+            'current_limit': (0, 1750),
+            'goal_current': (-1750, 1750),
+            'velocity_limit': (0, 2047),
+            'goal_velocity': (-2047, 2047),
+        },
+    ),
+}

@@ -19,6 +19,7 @@ from typing import Any
 
 import serial
 from serialspec.runtime.errors import EncodeError, Timeout
+from serialspec.runtime.registers import ModelRegisters
 from serialspec.runtime.transport import Binding, Bus, ClientBase, flag_names
 
 from feetech_sms import MATCH_BY, SERIAL
@@ -38,7 +39,7 @@ from feetech_sms.messages import (
     SyncWriteRequest,
     WriteRequest,
 )
-from feetech_sms.registers import CONTROL_TABLE, ControlTableName
+from feetech_sms.registers import CONTROL_TABLE, CONTROL_TABLE_MODELS, ControlTableName
 
 __all__ = ["BINDING", "FeetechSmsClient"]
 
@@ -74,9 +75,15 @@ class FeetechSmsClient(ClientBase):
         baudrate: int | None = None,
         optional_replies: bool | None = None,
         echo: bool = False,
+        model: str | Mapping[int, str] | None = None,
         **serial_options: Any,
     ) -> None:
-        """`echo=True` for a one-wire half-duplex adapter that echoes every byte sent (see Bus)."""
+        """`echo=True` for a one-wire half-duplex adapter that echoes every byte sent (see Bus).
+
+        `model`: register writes are checked against that model's ranges (sts3215, sts3250, sm8512bl), for every
+        device, or a model per device address (a bus of mixed models); None: the table's own ranges.
+        """
+        self._models = ModelRegisters(model, CONTROL_TABLE, CONTROL_TABLE_MODELS, 254)  # before the port opens
         bus = (
             port
             if isinstance(port, Bus)
@@ -277,7 +284,7 @@ class FeetechSmsClient(ClientBase):
         The named registers must follow each other in the table (one run of bytes); each value is checked
         against its register's range and access before a byte is written. `write_raw` takes raw bytes.
         """
-        start, data = CONTROL_TABLE.pack(values)
+        start, data = self._models.pack(id, values)
         result = self.write_raw(id, start, data)
         for name, value in values.items():
             self._remember(id, CONTROL_TABLE[name].address, value)
@@ -289,7 +296,7 @@ class FeetechSmsClient(ClientBase):
         The named registers must follow each other in the table (one run of bytes); each value is checked
         against its register's range and access before a byte is written. `reg_write_raw` takes raw bytes.
         """
-        start, data = CONTROL_TABLE.pack(values)
+        start, data = self._models.pack(id, values)
         result = self.reg_write_raw(id, start, data)
         for name, value in values.items():
             self._remember(id, CONTROL_TABLE[name].address, value)
@@ -316,7 +323,7 @@ class FeetechSmsClient(ClientBase):
         Every device gets the same registers (one run, the same for all); values are checked before sending.
         `sync_write_raw` takes raw bytes.
         """
-        runs = {device: CONTROL_TABLE.pack(registers) for device, registers in values.items()}
+        runs = {device: self._models.pack(device, registers) for device, registers in values.items()}
         if len({(start, len(data)) for start, data in runs.values()}) > 1:
             raise EncodeError("sync_write: every device must get the same registers")
         if not runs:

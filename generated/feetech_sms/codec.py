@@ -452,6 +452,8 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         n = len(data)
         if n < 6:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (6 bytes)")
+        if not (0 <= data[2] <= 253 or data[2] == 254) and data[:2] == b'\xff\xff':
+            raise DecodeError(f"id = {data[2]} is outside its range 0..253 (or 254)")
         fixed = _REQUEST_FIXED.get(data[4] << 8 | data[3])
         if fixed is not None and fixed[0] == n and data[:2] == b'\xff\xff':
             message = fixed[1](data, 0)
@@ -473,6 +475,8 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         n = len(data)
         if n < 6:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (6 bytes)")
+        if not (0 <= data[2] <= 253 or data[2] == 254) and data[:2] == b'\xff\xff':
+            raise DecodeError(f"id = {data[2]} is outside its range 0..253 (or 254)")
         if data[:2] != b'\xff\xff':
             raise DecodeError(f"response header is {data[:2].hex(' ')}, expected ff ff")
         size = data[3] - 2

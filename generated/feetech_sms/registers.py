@@ -11,7 +11,7 @@ from typing import Literal
 
 from serialspec.runtime.registers import Register, RegisterMap
 
-__all__ = ["CONTROL_TABLE", "ControlTableName"]
+__all__ = ["CONTROL_TABLE", "CONTROL_TABLE_MODELS", "ControlTableName"]
 
 #: A register name of the SMS/STS memory control table.
 ControlTableName = Literal[
@@ -120,3 +120,10 @@ CONTROL_TABLE = RegisterMap(
     ),
     'little',
 )
+
+#: The SMS/STS memory control table as each device model has it (spec: device.models): its ranges where they differ.
+CONTROL_TABLE_MODELS: dict[str, RegisterMap] = {
+    'sts3215': CONTROL_TABLE,
+    'sts3250': CONTROL_TABLE,
+    'sm8512bl': CONTROL_TABLE,
+}

@@ -431,6 +431,8 @@ def _encode_read_coils_request(m: ReadCoilsRequest) -> bytes:
 def _encode_read_coils_response(m: ReadCoilsResponse) -> bytes:
     if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('read_coils response', 'unit', m.unit, 1, 247)
+    if len(m.coils) > 2000:
+        raise EncodeError('read_coils response' + f': coils has {len(m.coils)} items, at most 2000 (the limit of the request field count)')
     v_byte_count = (-(-len(m.coils) // 8))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('read_coils response', 'byte_count', v_byte_count, 0, 255)
@@ -450,6 +452,8 @@ def _encode_read_discrete_inputs_request(m: ReadDiscreteInputsRequest) -> bytes:
 def _encode_read_discrete_inputs_response(m: ReadDiscreteInputsResponse) -> bytes:
     if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
         raise out_of_range('read_discrete_inputs response', 'unit', m.unit, 1, 247)
+    if len(m.inputs) > 2000:
+        raise EncodeError('read_discrete_inputs response' + f': inputs has {len(m.inputs)} items, at most 2000 (the limit of the request field count)')
     v_byte_count = (-(-len(m.inputs) // 8))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('read_discrete_inputs response', 'byte_count', v_byte_count, 0, 255)
@@ -472,7 +476,7 @@ def _encode_read_holding_registers_response(m: ReadHoldingRegistersResponse) -> 
     v_byte_count = (2 * len(m.registers))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('read_holding_registers response', 'byte_count', v_byte_count, 0, 255)
-    if any(not 0 <= x <= 65535 for x in m.registers):
+    if any(not 0 <= x <= 65535 or x.__class__ is bool for x in m.registers):
         raise out_of_range('read_holding_registers response', 'registers', m.registers, 0, 65535)
     return _RESPONSE_FRAMES.wrap(b''.join((_S_BE_U8.pack(v_byte_count), struct.pack(f'>{len(m.registers)}H', *m.registers),)), 0x03, (m.unit,))
 
@@ -493,7 +497,7 @@ def _encode_read_input_registers_response(m: ReadInputRegistersResponse) -> byte
     v_byte_count = (2 * len(m.registers))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('read_input_registers response', 'byte_count', v_byte_count, 0, 255)
-    if any(not 0 <= x <= 65535 for x in m.registers):
+    if any(not 0 <= x <= 65535 or x.__class__ is bool for x in m.registers):
         raise out_of_range('read_input_registers response', 'registers', m.registers, 0, 65535)
     return _RESPONSE_FRAMES.wrap(b''.join((_S_BE_U8.pack(v_byte_count), struct.pack(f'>{len(m.registers)}H', *m.registers),)), 0x04, (m.unit,))
 
@@ -573,7 +577,7 @@ def _encode_write_registers_request(m: WriteRegistersRequest) -> bytes:
     v_byte_count = (2 * (len(m.values)))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('write_registers request', 'byte_count', v_byte_count, 0, 255)
-    if any(not 0 <= x <= 65535 for x in m.values):
+    if any(not 0 <= x <= 65535 or x.__class__ is bool for x in m.values):
         raise out_of_range('write_registers request', 'values', m.values, 0, 65535)
     return _REQUEST_FRAMES.wrap(b''.join((_S_BE_U16_U16_U8.pack(m.address, v_count, v_byte_count), struct.pack(f'>{len(m.values)}H', *m.values),)), 0x10, (m.unit,))
 
@@ -627,7 +631,7 @@ def _encode_read_write_registers_request(m: ReadWriteRegistersRequest) -> bytes:
     v_byte_count = (2 * (len(m.values)))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('read_write_registers request', 'byte_count', v_byte_count, 0, 255)
-    if any(not 0 <= x <= 65535 for x in m.values):
+    if any(not 0 <= x <= 65535 or x.__class__ is bool for x in m.values):
         raise out_of_range('read_write_registers request', 'values', m.values, 0, 65535)
     return _REQUEST_FRAMES.wrap(b''.join((_S_BE_U16_U16_U16_U16_U8.pack(m.read_address, m.read_count, m.write_address, v_write_count, v_byte_count), struct.pack(f'>{len(m.values)}H', *m.values),)), 0x17, (m.unit,))
 
@@ -638,7 +642,7 @@ def _encode_read_write_registers_response(m: ReadWriteRegistersResponse) -> byte
     v_byte_count = (2 * len(m.registers))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('read_write_registers response', 'byte_count', v_byte_count, 0, 255)
-    if any(not 0 <= x <= 65535 for x in m.registers):
+    if any(not 0 <= x <= 65535 or x.__class__ is bool for x in m.registers):
         raise out_of_range('read_write_registers response', 'registers', m.registers, 0, 65535)
     return _RESPONSE_FRAMES.wrap(b''.join((_S_BE_U8.pack(v_byte_count), struct.pack(f'>{len(m.registers)}H', *m.registers),)), 0x17, (m.unit,))
 

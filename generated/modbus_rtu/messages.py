@@ -7,7 +7,7 @@ from collections.abc import Mapping
 from enum import IntEnum
 from typing import Any, ClassVar, Self
 
-from serialspec.runtime.fields import booleans as _booleans
+from serialspec.runtime.fields import bits as _bits
 from serialspec.runtime.fields import check_keys as _check_keys
 from serialspec.runtime.fields import enum as _as_enum
 from serialspec.runtime.fields import get as _get
@@ -155,7 +155,7 @@ class ReadCoilsResponse(Message):
         _check_keys(data, ('unit', 'coils'), ('byte_count',), where)
         return cls(
             _integer(_get(data, 'unit', where), 'unit', where),
-            _booleans(_get(data, 'coils', where), 'coils', where),
+            _bits(_get(data, 'coils', where), 'coils', where),
         )
 
 
@@ -235,7 +235,7 @@ class ReadDiscreteInputsResponse(Message):
         _check_keys(data, ('unit', 'inputs'), ('byte_count',), where)
         return cls(
             _integer(_get(data, 'unit', where), 'unit', where),
-            _booleans(_get(data, 'inputs', where), 'inputs', where),
+            _bits(_get(data, 'inputs', where), 'inputs', where),
         )
 
 
@@ -610,7 +610,7 @@ class WriteCoilsRequest(Message):
         return cls(
             _integer(_get(data, 'unit', where), 'unit', where),
             _integer(_get(data, 'address', where), 'address', where),
-            _booleans(_get(data, 'values', where), 'values', where),
+            _bits(_get(data, 'values', where), 'values', where),
         )
 
 

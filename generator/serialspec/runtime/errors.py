@@ -24,7 +24,14 @@ class RangeError(EncodeError):
 
 
 def out_of_range(where: str, field: str, value: object, low: float, high: float) -> EncodeError:
-    """The error for a value refused before encoding: outside its range, or not a number at all (True is not 1)."""
+    """The error for a value refused before encoding: outside its range, or not a number at all (True is not 1).
+
+    For a list of values, the first item at fault is named: "values[3] = 70000 is outside its range 0..65535".
+    """
+    if isinstance(value, tuple | list):
+        for index, item in enumerate(value):
+            if isinstance(item, bool) or not isinstance(item, int | float) or not low <= item <= high:
+                return out_of_range(where, f"{field}[{index}]", item, low, high)
     if isinstance(value, bool) or not isinstance(value, int | float):
         return EncodeError(f"{where}: {field} must be a number in {_number(low)}..{_number(high)}, got {shown(value)}")
     return RangeError(f"{where}: {field} = {shown(value)} is outside its range {_number(low)}..{_number(high)}")

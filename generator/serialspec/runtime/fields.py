@@ -99,16 +99,19 @@ def numbers(value: Any, name: str, where: str) -> tuple[float, ...]:
     return tuple(number(item, f"{name}[{index}]", where) for index, item in enumerate(items(value, name, where)))
 
 
-def booleans(value: Any, name: str, where: str) -> tuple[bool, ...]:
-    """A list of bits: each true/false or 1/0."""
-    bits = items(value, name, where)
-    for index, bit in enumerate(bits):
-        if bit not in (0, 1) or not isinstance(bit, int):
-            raise EncodeError(f"{where}: {name}[{index}] must be true/false or 1/0, got {shown(bit)}")
-    return tuple(bool(bit) for bit in bits)
+def bits(value: Any, name: str, where: str) -> tuple[bool, ...]:
+    """A list of bits: true/false (or 0/1); text, 2, 0.5 and the like are refused, naming the item."""
+    result = []
+    for index, item in enumerate(items(value, name, where)):
+        if item is True or item is False or (item.__class__ is int and item in (0, 1)):
+            result.append(bool(item))
+        else:
+            raise EncodeError(f"{where}: {name}[{index}] must be a bit (true/false or 0/1), got {shown(item)}")
+    return tuple(result)
 
 
 def text(value: Any, name: str, where: str) -> str:
+    """Text given as data: a string (a number is not text)."""
     if isinstance(value, str):
         return value
     raise EncodeError(f"{where}: {name} must be text, got {shown(value)}")
@@ -143,6 +146,11 @@ def _value_problem(value: Any, annotation: str, name: str) -> str:
     kinds = {part.strip() for part in annotation.split("|")}
     if isinstance(value, Record):
         return _problem(value, name + ".")
+    if "bool" in kinds:
+        ok = value is True or value is False or (value.__class__ is int and value in (0, 1))
+        return "" if ok else f"{name} must be a bit (true/false or 0/1), got {shown(value)}"
+    if "str" in kinds:
+        return "" if isinstance(value, str) else f"{name} must be text, got {shown(value)}"
     if "bytes" in kinds:
         return "" if isinstance(value, bytes | bytearray) else f"{name} must be bytes, got {shown(value)}"
     if "float" in kinds:

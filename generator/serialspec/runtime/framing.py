@@ -252,6 +252,9 @@ class Layout:
         command = self.command
         code = elements[command].unpack(plain[command]) if command is not None else None
         values = tuple(elements[i].unpack(plain[i]) for i in self.values)
+        for i, value in zip(self.values, values, strict=True):
+            if not elements[i].plausible(value):  # as the stream parser, which sees no frame there
+                raise DecodeError(_outside(elements[i], value))
         for index, element in plan["lengths"]:
             counted = len(self._wire(plain, wire, *element.span)) + element.adds
             value = element.unpack(plain[index])
@@ -267,6 +270,11 @@ class Layout:
                 )
         content = plain[self.content] if self.content >= 0 else b""
         return Unwrapped(self, code, values, content, tuple(plain))
+
+
+def _outside(element: Element, value: int) -> str:
+    also = f" (or {element.also})" if element.also is not None else ""
+    return f"{element.name} = {value} is outside its range {element.minimum}..{element.maximum}{also}"
 
 
 def _pack(element: Element, value: int) -> bytes:

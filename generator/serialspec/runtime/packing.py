@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from serialspec.runtime.errors import DecodeError, EncodeError
+from serialspec.runtime.errors import DecodeError, EncodeError, shown
 
 
 def unpack_bits(buf: bytes, offset: int, count: int) -> tuple[bool, ...]:
@@ -12,10 +12,12 @@ def unpack_bits(buf: bytes, offset: int, count: int) -> tuple[bool, ...]:
 
 def pack_bits(values: tuple[bool, ...] | list[bool], name: str, where: str) -> bytes:
     """Bits 8 to a byte, the first in the lowest bit; the last byte padded with zeros."""
+    if not isinstance(values, tuple | list):
+        raise EncodeError(f"{where}: {name} must be a list of bits, got {shown(values)}")
     out = bytearray(-(-len(values) // 8))
     for i, value in enumerate(values):
-        if value not in (0, 1):  # True, False, 1, 0
-            raise EncodeError(f"{where}: {name}[{i}] = {value!r} is not a bit (true/false)")
+        if not (value is True or value is False or (value.__class__ is int and value in (0, 1))):
+            raise EncodeError(f"{where}: {name}[{i}] must be a bit (true/false or 0/1), got {shown(value)}")
         if value:
             out[i >> 3] |= 1 << (i & 7)
     return bytes(out)
@@ -31,8 +33,11 @@ def decode_text(data: bytes, name: str, where: str) -> str:
 def encode_text(value: str, name: str, where: str, terminated: bool) -> bytes:
     """UTF-8 text; NUL-terminated text may hold no NUL of its own."""
     if not isinstance(value, str):
-        raise EncodeError(f"{where}: {name} must be text, got {value!r}")
-    data = value.encode("utf-8")
+        raise EncodeError(f"{where}: {name} must be text, got {shown(value)}")
+    try:
+        data = value.encode("utf-8")
+    except UnicodeEncodeError as exc:
+        raise EncodeError(f"{where}: {name} is not UTF-8 text ({exc.reason} at character {exc.start})") from None
     if terminated:
         if b"\0" in data:
             raise EncodeError(f"{where}: {name} holds a NUL, which would end it early")

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import struct
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from serialspec.runtime.errors import DecodeError, EncodeError, out_of_range
 
@@ -130,6 +130,15 @@ class RegisterMap:
             data += self.to_wire(register, values[register.name])
         return chosen[0].address, bytes(data)
 
+    def for_model(self, model: str, ranges: Mapping[str, tuple[float, float]]) -> RegisterMap:
+        """The same registers with one device model's ranges where they differ (spec: device.models)."""
+        registers = [
+            replace(r, minimum=ranges[r.name][0], maximum=ranges[r.name][1]) if r.name in ranges else r
+            for r in self.registers
+        ]
+        endian = "big" if self._endian == ">" else "little"
+        return RegisterMap(f"{self.table} ({model})", registers, endian)
+
     def split(self, start: int, data: bytes) -> dict[str, int]:
         """Bytes written from address `start` on as register values; refused unless they cover whole registers."""
         values = self.unpack(start, data)
@@ -137,3 +146,40 @@ class RegisterMap:
         if stray:
             raise EncodeError(f"{self.table}: bytes at {', '.join(stray)} are not whole registers")
         return values
+
+
+class ModelRegisters:
+    """Which model's ranges a client checks writes against: `model` None (the table's own ranges), one model name
+    for every device, or device address -> model name (a bus of mixed models; other addresses get the table's
+    ranges, and a broadcast write must suit every model named and the table)."""
+
+    def __init__(
+        self,
+        model: str | Mapping[int, str] | None,
+        table: RegisterMap,
+        models: Mapping[str, RegisterMap],
+        broadcast: int | None,
+    ) -> None:
+        chosen = [] if model is None else [model] if isinstance(model, str) else list(model.values())
+        for name in chosen:
+            if name not in models:
+                raise ValueError(f"model {name!r} is not one of the spec's models ({', '.join(models)})")
+        self.table = table
+        self.one = models[model] if isinstance(model, str) else None
+        self.by_address = {a: models[n] for a, n in model.items()} if isinstance(model, Mapping) else {}
+        self.broadcast = broadcast
+
+    def maps(self, address: int) -> list[RegisterMap]:
+        if self.one is not None:
+            return [self.one]
+        if address == self.broadcast and self.by_address:
+            return [self.table, *{id(m): m for m in self.by_address.values()}.values()]
+        return [self.by_address.get(address, self.table)]
+
+    def pack(self, address: int, values: Mapping[str, int]) -> tuple[int, bytes]:
+        """`RegisterMap.pack` with the ranges of the model at `address` (of every model, for a broadcast)."""
+        first, *others = self.maps(address)
+        packed = first.pack(values)
+        for other in others:
+            other.pack(values)
+        return packed

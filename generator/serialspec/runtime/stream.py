@@ -155,7 +155,11 @@ class StreamParser:
             key = buffer[single.length_offset]
             if single.command_offset is not None:
                 key |= buffer[single.command_offset] << 8
-            if single.frame_sizes.get(key) == end and buffer.startswith(single.header):
+            if (
+                single.frame_sizes.get(key) == end
+                and buffer.startswith(single.header)
+                and (not single.ranges or single.plausible(buffer, 0))  # a value out of range: the scan skips it
+            ):
                 message = single.take(key, buffer, 0, end)
                 if message is not None:
                     self._pending = b""

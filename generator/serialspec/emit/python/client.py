@@ -546,9 +546,20 @@ def client_module(protocol: Protocol) -> str:
             "reason_field": reason,
             "codes": "{" + ", ".join(f"{name!r}: {code:#04x}" for name, code in codes.items()) + "}",
         }
+    device = protocol.device
+    model_map = (
+        map_name(device.memory)
+        if device is not None
+        and device.memory is not None
+        and device.models
+        and any(r["map"] == map_name(device.memory) for r in registers)
+        else ""
+    )
     return render(
         "client.py.j2",
         errors=errors,
+        model_map=model_map,
+        model_names=", ".join(m.name for m in device.models) if device is not None else "",
         spec_path=protocol.spec_path,
         title=one_line(protocol.title),
         package=protocol.name,
@@ -562,7 +573,10 @@ def client_module(protocol: Protocol) -> str:
         groups=list(groups.values()),
         registers=registers,
         status_flags=flags_literal,
-        register_imports=sorted({r["map"] for r in registers} | {r["alias"] for r in registers}, key=import_order),
+        register_imports=sorted(
+            {r["map"] for r in registers} | {r["alias"] for r in registers} | ({model_map + "_MODELS"} - {"_MODELS"}),
+            key=import_order,
+        ),
         reports=reports,
         tables=tables,
         optional_keys=sorted(optional_keys),
@@ -588,7 +602,7 @@ def client_module(protocol: Protocol) -> str:
         abc_imports=sorted(
             {
                 *(["Callable", "Iterator"] if reports else []),
-                *(["Mapping"] if any(m["pairs"] for m in everything) else []),
+                *(["Mapping"] if any(m["pairs"] for m in everything) or model_map else []),
                 *(
                     ["Mapping"]
                     if any(r["kind"] in ("each_write", "items_read", "items_write") for r in registers)

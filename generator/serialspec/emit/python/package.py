@@ -142,7 +142,7 @@ def emit_package(protocol: Protocol) -> dict[str, str]:
 # The runtime's helpers that build fields from data, by the name generated code calls them (serialspec.runtime.fields).
 FIELD_HELPERS = (
     ("as_bytes", "_bytes"),
-    ("booleans", "_booleans"),
+    ("bits", "_bits"),
     ("check_keys", "_check_keys"),
     ("enum", "_as_enum"),
     ("flags", "_as_flags"),
@@ -303,6 +303,7 @@ def classic_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
                 "length_adds": layout.length_adds,
                 "command_offset": layout.command_offset,
                 "value_ranges": value_ranges(layout, protocol.byte_order),
+                "range_checks": value_range_checks(layout, protocol.byte_order),
                 "dispatch": dispatch,
                 "sizes": sizes,
                 "whole": frame_decode_lines(protocol, layout, dispatch, "data", None),
@@ -574,6 +575,27 @@ def value_ranges(layout: FrameLayout, byte_order: str) -> str:
         if e.type is not None and not e.type.is_float and (e.minimum, e.maximum) != (e.type.minimum, e.type.maximum)
     ]
     return "(" + ", ".join(ranges) + ("," if len(ranges) == 1 else "") + ")"
+
+
+def value_range_checks(layout: FrameLayout, byte_order: str) -> list[str]:
+    """Lines of `decode` refusing a frame whose frame-level value lies outside its declared range, as the stream
+    parser (value_ranges) refuses it; a frame with another header is left to the header's own check."""
+    lines = []
+    for e in layout.value_elements:
+        if e.type is None or e.type.is_float or (e.minimum, e.maximum) == (e.type.minimum, e.type.maximum):
+            continue
+        offset, size = layout.offsets[e.name], e.type.size
+        value = (
+            f"data[{offset}]"
+            if size == 1 and not e.type.signed
+            else f"int.from_bytes(data[{offset}:{offset + size}], {byte_order!r}, signed={e.type.signed})"
+        )
+        low, high = int(e.minimum), int(e.maximum)
+        also = f" or {value} == {e.broadcast}" if e.broadcast is not None else ""
+        shown = f" (or {e.broadcast})" if e.broadcast is not None else ""
+        lines.append(f"if not ({low} <= {value} <= {high}{also}) and data[:{len(layout.header)}] == {layout.header!r}:")
+        lines.append(f'    raise DecodeError(f"{e.name} = {{{value}}} is outside its range {low}..{high}{shown}")')
+    return lines
 
 
 def uses_table(message: Message, table: str) -> bool:

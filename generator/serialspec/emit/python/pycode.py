@@ -344,7 +344,7 @@ class PackageCode:
             kind = "_number" if f.type.is_float else "_integer"
             return f"{kind}({get}, {f.name!r}, where)"
         if isinstance(f, Array | List):
-            kind = "_booleans" if f.item is None else "_numbers" if f.item.is_float else "_integers"
+            kind = "_bits" if f.item is None else "_numbers" if f.item.is_float else "_integers"
             return f"{kind}({get}, {f.name!r}, where)"
         if isinstance(f, Text):
             return f"_text({get}, {f.name!r}, where)"
@@ -692,6 +692,7 @@ class PackageCode:
             self.check_scalar(f, f"m.{f.name}", lines, where, also=elements[f.name].broadcast)
             frame_values.append(f"m.{f.name}")
         fields = list(message.fields)
+        self.check_count_from(message, lines, where)
         command_code = self.protocol.command(message.command).code
         if not self.protocol.framing.classic:
             # the runtime's frame engine wraps the content (see emit/python/frames.py)
@@ -829,6 +830,32 @@ class PackageCode:
             lines.append(f"if not {number(f.minimum)} <= {expr} <= {number(f.maximum)}{not_bool}:")
         lines.append(f"    raise out_of_range({where}, {f.name!r}, {expr}, {number(f.minimum)}, {number(f.maximum)})")
 
+    def check_count_from(self, message: Message, lines: Lines, where: str) -> None:
+        """A response list whose count the request gives (`count_from`) holds no more items than the request's
+        count field allows (Modbus: at most 2000 coils), so no frame is made that no request could have asked for."""
+        for f in message.fields:
+            if not (isinstance(f, List) and f.count_from):
+                continue
+            request = next(
+                m
+                for m in self.protocol.messages()
+                if (m.command, m.subcommand, m.direction.value) == (message.command, message.subcommand, "request")
+            )
+            count = next(c for c in request.fields if c.name == f.count_from)
+            assert isinstance(count, Scalar)
+            high = number(count.maximum)
+            lines.append(f"if len(m.{f.name}) > {high}:")
+            reason = (
+                f"{f.name} has {{len(m.{f.name})}} items, at most {high} (the limit of the request field {count.name})"
+            )
+            lines.append(f"    raise EncodeError({where} + f': {reason}')")
+
+    def check_items(self, f: Array | List, expr: str, lines: Lines, where: str) -> None:
+        """Every number of a list within the item's range, and none a bool (True is not 1); the first at fault named."""
+        low, high = number(f.minimum), number(f.maximum)
+        lines.append(f"if any(not {low} <= x <= {high} or x.__class__ is bool for x in {expr}):")
+        lines.append(f"    raise out_of_range({where}, {f.name!r}, {expr}, {low}, {high})")
+
     def encode_fields(self, fields: list[SpecField], base: str, obj: str, lines: Lines, where: str) -> list[str]:
         """Append checks and local values; return expressions of the byte parts in order."""
         parts: list[str] = []
@@ -929,10 +956,7 @@ class PackageCode:
                 lines.append(
                     f"    raise EncodeError({where} + f': {f.name} needs {f.count} items, got {{len({expr})}}')"
                 )
-                lines.append(f"if any(not {number(f.minimum)} <= x <= {number(f.maximum)} for x in {expr}):")
-                lines.append(
-                    f"    raise out_of_range({where}, {f.name!r}, {expr}, {number(f.minimum)}, {number(f.maximum)})"
-                )
+                self.check_items(f, expr, lines, where)
                 args.append(f"*{expr}")
             elif isinstance(f, Bytes):
                 expr = f"{obj}.{f.name}"
@@ -962,10 +986,7 @@ class PackageCode:
                 )
             if f.item is None:
                 return f"_pack_bits({expr}, {f.name!r}, {where})"
-            lines.append(f"if any(not {number(f.minimum)} <= x <= {number(f.maximum)} for x in {expr}):")
-            lines.append(
-                f"    raise out_of_range({where}, {f.name!r}, {expr}, {number(f.minimum)}, {number(f.maximum)})"
-            )
+            self.check_items(f, expr, lines, where)
             return f"struct.pack(f'{f.endian}{{len({expr})}}{f.item.struct_char}', *{expr})"
         if isinstance(f, Text):
             data = f"_encode_text({expr}, {f.name!r}, {where}, {f.size is None})"

@@ -30,6 +30,25 @@ def names_alias(table: Table) -> str:
     return table.names_class
 
 
+def model_maps(protocol: Protocol, table: Table) -> list[tuple[str, list[tuple[str, str, str]]]]:
+    """The device models of the table the device keeps (name, [(entry, low, high)] where the model's range differs)."""
+    device = protocol.device
+    if device is None or device.memory is None or device.memory.name != table.name:
+        return []
+    table_ranges = {e.name: (e.minimum, e.maximum) for e in table.entries}
+    return [
+        (
+            m.name,
+            [
+                (repr(e.name), number(e.minimum), number(e.maximum))
+                for e in m.entries
+                if (e.minimum, e.maximum) != table_ranges.get(e.name)
+            ],
+        )
+        for m in device.models
+    ]
+
+
 def registers_module(protocol: Protocol) -> str:
     tables = []
     for table in register_tables(protocol):
@@ -56,6 +75,7 @@ def registers_module(protocol: Protocol) -> str:
                 "title": one_line(table.title),
                 "names": [e.name for e in table.entries if not e.reserved],
                 "registers": registers,
+                "models": model_maps(protocol, table),
             }
         )
     return render(

@@ -36,13 +36,22 @@ test: $(STAMP) check lint typecheck
 # The long robustness runs: 100,000 frames per protocol and direction through the stream parsers (with garbage,
 # truncated frame starts, corrupt checksums, random read sizes), the fault matrix, and 8 threads x 5,000
 # transactions on one bus. `make test` runs the same tests in a short form (5,000 frames, 8 x 1,000 transactions).
+# Then every hypothesis fuzzer (CLI, spec front end, codec round trips, framing engine) with FUZZ_EXAMPLES examples
+# each and a random seed (tests/conftest.py: `make test` runs them derandomized, in a short form, so CI cannot flake).
+# A failure prints its seed and blob: replay with `make stress FUZZ_ARGS=--hypothesis-seed=N`.
 STRESS_FRAMES ?= 100000
 STRESS_TRANSACTIONS ?= 5000
+FUZZ_EXAMPLES ?= 2000
+FUZZ_ARGS ?=
+FUZZ_TESTS := tests/test_cli_fuzz.py tests/test_spec_fuzz.py tests/test_codec.py tests/test_fast_codec.py \
+	tests/test_framing_engine.py
 
 stress: $(STAMP)
 	@echo "stress: $(STRESS_FRAMES) frames per stream parser, 8 threads x $(STRESS_TRANSACTIONS) transactions"
 	SERIALSPEC_STRESS_FRAMES=$(STRESS_FRAMES) SERIALSPEC_STRESS_TRANSACTIONS=$(STRESS_TRANSACTIONS) \
 		$(BIN)/pytest -q -s tests/test_stress.py tests/test_faults.py
+	@echo "stress: $(FUZZ_EXAMPLES) examples per fuzzer, random seeds"
+	SERIALSPEC_FUZZ_EXAMPLES=$(FUZZ_EXAMPLES) $(BIN)/pytest -q -p no:cacheprovider $(FUZZ_TESTS) $(FUZZ_ARGS)
 
 # Benchmarks (bench/README.md): codec, stream parsing, pseudo-terminal latency, generation; about 3 minutes on a
 # quiet machine. Prints one table per family and writes them all to bench/results.md.

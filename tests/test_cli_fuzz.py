@@ -10,12 +10,14 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from conftest import ALL, ROOT, Generated
-from hypothesis import HealthCheck, given, settings
+from conftest import ALL, ROOT, Generated, examples
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 from serialspec.cli import main
 
-SETTINGS = settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+SETTINGS = settings(
+    max_examples=examples(150), deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
 
 
 def run(*argv: str) -> tuple[int, str, str]:
@@ -105,6 +107,18 @@ def test_encode_never_fails_with_a_traceback(g: Generated) -> None:
 
     @SETTINGS
     @given(obj=st.one_of(hostile_fields(g), JSON_VALUES))
+    # a bit list (Modbus coils) that is not a list: was a TypeError from the generated from_fields
+    @example(
+        obj={"command": "read_coils", "subcommand": None, "direction": "response", "fields": {"coils": None, "unit": 0}}
+    )
+    @example(
+        obj={
+            "command": "read_coils",
+            "subcommand": None,
+            "direction": "response",
+            "fields": {"coils": [1, "x"], "unit": 0},
+        }
+    )
     def check(obj: Any) -> None:
         code, out, err = run("encode", spec, "--json=" + json.dumps(obj))
         assert code in (0, 1)

@@ -5,7 +5,7 @@ from __future__ import annotations
 from typing import Any
 
 import pytest
-from conftest import ALL, Generated, by_protocol, example_class
+from conftest import ALL, Generated, by_protocol, example_class, examples
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from serialspec.runtime.errors import DecodeError, RangeError
@@ -80,7 +80,7 @@ def test_construct_struct_agrees_on_every_example(g: Generated, example: Example
 def test_random_valid_messages_round_trip_and_agree_with_construct(g: Generated, spec: Message) -> None:
     cls = message_type(g, spec)
 
-    @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+    @settings(max_examples=examples(60), deadline=None, suppress_health_check=[HealthCheck.too_slow])
     @given(message_fields(g.protocol, spec))
     def round_trip(fields: dict[str, Any]) -> None:
         frame = g.package.encode(cls.from_fields(fields))
@@ -101,7 +101,7 @@ def test_out_of_range_values_are_refused_naming_field_and_range(g: Generated, sp
     scalars = [f for f in spec.fields if isinstance(f, Scalar) and not f.hidden and not f.bits and not f.type.is_float]
     bounded = [f for f in scalars if f.maximum < 2 ** (8 * f.type.size) - 1 or f.minimum > f.type.minimum]
 
-    @settings(max_examples=20, deadline=None)
+    @settings(max_examples=examples(20), deadline=None)
     @given(message_fields(g.protocol, spec), st.data())
     def refused(fields: dict[str, Any], data: st.DataObject) -> None:
         if not bounded:

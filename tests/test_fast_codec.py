@@ -12,7 +12,7 @@ import pickle
 from typing import Any
 
 import pytest
-from conftest import ALL, Generated, by_protocol
+from conftest import ALL, Generated, by_protocol, examples
 from hypothesis import HealthCheck, given, settings
 from serialspec.emit.python.pycode import PackageCode
 from serialspec.runtime.checksums import crc_function, sum_function
@@ -43,7 +43,7 @@ def test_fast_paths_agree_with_the_plain_ones(g: Generated, spec: Message) -> No
     layout = g.protocol.framing.layouts[spec.direction]
     direction = spec.direction.value
 
-    @settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+    @settings(max_examples=examples(30), deadline=None, suppress_health_check=[HealthCheck.too_slow])
     @given(message_fields(g.protocol, spec))
     def agree(fields: dict[str, Any]) -> None:
         built = cls.from_fields(fields)  # through the dataclass __init__

@@ -8,6 +8,7 @@ SLIP-style escaping through engine objects, the way generated codecs describe th
 from __future__ import annotations
 
 import pytest
+from conftest import examples
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from serialspec.runtime.checksums import crc_function, sum_function, xor_function
@@ -91,7 +92,7 @@ def test_unstuffed_frame_is_refused() -> None:
         dynamixel_p2.decode(frame, "request")
 
 
-@settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=examples(200), deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(
     st.lists(st.sampled_from([STUFF, b"\xff", b"\xfd", b"\xff\xff", b"\x00", STUFF + b"\xfd"]), max_size=40),
     st.integers(0, 252),
@@ -231,7 +232,7 @@ SLIP = Layout(
 )
 
 
-@settings(max_examples=100, deadline=None)
+@settings(max_examples=examples(100), deadline=None)
 @given(st.binary(max_size=30), st.integers(0, 255))
 def test_escaped_frames_round_trip(data: bytes, code: int) -> None:
     frame = SLIP.wrap(data, code, ())

@@ -7,8 +7,9 @@ import copy
 from typing import Any
 
 import pytest
+from conftest import examples
 from hostile_run import BASES, base
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 from serialspec.emit import emitters
 from serialspec.spec import SpecErrors
@@ -68,8 +69,9 @@ def mutated(name: str, changes: list[tuple[Path, Any]]) -> Located:
 
 @pytest.mark.parametrize("name", sorted(BASES))
 def test_any_value_anywhere_is_a_spec_error_or_a_package(name: str) -> None:
-    @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+    @settings(max_examples=examples(60), deadline=None, suppress_health_check=[HealthCheck.too_slow])
     @given(changes=mutations(name))
+    @example(changes=[(("framing", "elements"), {})])  # no elements: was an IndexError
     def check(changes: list[tuple[Path, Any]]) -> None:
         try:
             protocol = resolve(mutated(name, changes))

@@ -224,6 +224,8 @@ class FramingPass(FieldResolver):
         names = [e.name for e in elements]
         roles = [e.role for e in elements]
         where = f"the {direction.value} frame" + (f" of layout {layout_name!r}" if layout_name else "")
+        if not elements:
+            raise self.fail(elements_path, f"{where} has no elements")
         for role in ("content", "command", "length"):
             if roles.count(role) > 1:
                 raise self.fail(elements_path, f"{where} has more than one {role} element")

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import re
-from pathlib import Path
 from typing import Any
 
 from serialspec.collection import without_cycle_collection
@@ -640,9 +639,3 @@ def direction_entry(command: Command, direction: Direction) -> tuple[str, int, i
         "where": f"{command.name} {direction.value}",
     }
     return name, low, high, sub
-
-
-def write_files(root: Path, files: dict[str, str]) -> None:
-    root.mkdir(parents=True, exist_ok=True)
-    for name, text in files.items():
-        (root / name).write_text(text, encoding="utf-8")

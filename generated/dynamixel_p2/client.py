@@ -115,7 +115,7 @@ class DynamixelP2Client(ClientBase):
         Returns: the PingResponse reply.
         """
         request = PingRequest(id=id)
-        reply = self._ask(request, PingResponse)
+        reply = self.bus.request(request, PingResponse)
         return reply
 
     def read_raw(self, id: int, address: int, length: int) -> bytes | None:
@@ -359,11 +359,10 @@ class DynamixelP2Client(ClientBase):
 
     def read(self, id: int, name: ControlTableName) -> int:
         """Read from the control table: one register by name, e.g. `read(1, "model_number")`, in wire units."""
-        register = CONTROL_TABLE[name]
+        address, size, value = CONTROL_TABLE.reader(name)
         if id == 254:
             raise EncodeError("read: name one device; the broadcast id 254 gets no reply")
-        data = self.read_raw(id, register.address, CONTROL_TABLE.size(register))
-        return CONTROL_TABLE.value(register, data or b"")
+        return value(self.read_raw(id, address, size) or b"")
 
     def read_many(self, id: int, *names: ControlTableName) -> dict[str, int]:
         """Read from the control table: several registers by name, in one transaction that spans them all."""

@@ -106,7 +106,7 @@ class FeetechSmsClient(ClientBase):
         """
         request = PingRequest(id=id)
         try:
-            self._ask(request, ReplyResponse)
+            self.bus.request(request, ReplyResponse)
         except Timeout:
             return False
         return True
@@ -124,7 +124,7 @@ class FeetechSmsClient(ClientBase):
         Returns: data: The bytes read, register by register from the request's address (empty except for READ).
         """
         request = ReadRequest(id=id, address=address, length=length)
-        reply = self._ask(request, ReplyResponse)
+        reply = self.bus.request(request, ReplyResponse)
         return reply.data
 
     def write_raw(self, id: int, address: int, data: bytes) -> bool | None:
@@ -258,11 +258,10 @@ class FeetechSmsClient(ClientBase):
 
     def read(self, id: int, name: ControlTableName) -> int:
         """Read from the control table: one register by name, e.g. `read(1, "firmware_major")`, in wire units."""
-        register = CONTROL_TABLE[name]
+        address, size, value = CONTROL_TABLE.reader(name)
         if id == 254:
             raise EncodeError("read: name one device; the broadcast id 254 gets no reply")
-        data = self.read_raw(id, register.address, CONTROL_TABLE.size(register))
-        return CONTROL_TABLE.value(register, data or b"")
+        return value(self.read_raw(id, address, size) or b"")
 
     def read_many(self, id: int, *names: ControlTableName) -> dict[str, int]:
         """Read from the control table: several registers by name, in one transaction that spans them all."""

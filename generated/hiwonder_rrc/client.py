@@ -212,7 +212,7 @@ class PwmServoCommands:
         Returns: pulse: The servo's current pulse width (not range-checked in a report). [µs]
         """
         request = PwmServoReadPositionRequest(servo_id=servo_id)
-        reply = self._client._ask(request, PwmServoReadPositionResponse)
+        reply = self._client.bus.request(request, PwmServoReadPositionResponse)
         return reply.pulse
 
     def set_offset(self, servo_id: int, offset: int) -> None:
@@ -236,7 +236,7 @@ class PwmServoCommands:
         Returns: offset: The servo's offset (int8; -100..100 when set through 0x07). [µs]
         """
         request = PwmServoReadOffsetRequest(servo_id=servo_id)
-        reply = self._client._ask(request, PwmServoReadOffsetResponse)
+        reply = self._client.bus.request(request, PwmServoReadOffsetResponse)
         return reply.offset
 
 
@@ -277,8 +277,9 @@ class BusServoCommands:
         Raises DeviceError when the reply's success is not 0.
         """
         request = BusServoReadPositionRequest(servo_id=servo_id)
-        reply = self._client._ask(request, BusServoReadPositionResponse)
-        check_status(request, reply, 'success', 0, MATCH_BY)
+        reply = self._client.bus.request(request, BusServoReadPositionResponse)
+        if reply.success != 0:
+            check_status(request, reply, 'success', 0, MATCH_BY)
         return reply.position
 
     def read_voltage(self, servo_id: int) -> int:
@@ -293,8 +294,9 @@ class BusServoCommands:
         Raises DeviceError when the reply's success is not 0.
         """
         request = BusServoReadVoltageRequest(servo_id=servo_id)
-        reply = self._client._ask(request, BusServoReadVoltageResponse)
-        check_status(request, reply, 'success', 0, MATCH_BY)
+        reply = self._client.bus.request(request, BusServoReadVoltageResponse)
+        if reply.success != 0:
+            check_status(request, reply, 'success', 0, MATCH_BY)
         return reply.voltage
 
     def read_temperature(self, servo_id: int) -> int:
@@ -309,8 +311,9 @@ class BusServoCommands:
         Raises DeviceError when the reply's success is not 0.
         """
         request = BusServoReadTemperatureRequest(servo_id=servo_id)
-        reply = self._client._ask(request, BusServoReadTemperatureResponse)
-        check_status(request, reply, 'success', 0, MATCH_BY)
+        reply = self._client.bus.request(request, BusServoReadTemperatureResponse)
+        if reply.success != 0:
+            check_status(request, reply, 'success', 0, MATCH_BY)
         return reply.temperature
 
     def stop(self, servos: tuple[ServosItem, ...] | Sequence[int]) -> None:
@@ -342,8 +345,9 @@ class BusServoCommands:
         Raises DeviceError when the reply's success is not 0.
         """
         request = BusServoReadTorqueRequest(servo_id=servo_id)
-        reply = self._client._ask(request, BusServoReadTorqueResponse)
-        check_status(request, reply, 'success', 0, MATCH_BY)
+        reply = self._client.bus.request(request, BusServoReadTorqueResponse)
+        if reply.success != 0:
+            check_status(request, reply, 'success', 0, MATCH_BY)
         return reply.torque
 
     def unload(self, servo_id: int) -> None:
@@ -400,8 +404,9 @@ class BusServoCommands:
         Raises DeviceError when the reply's success is not 0.
         """
         request = BusServoReadIdRequest(servo_id=servo_id)
-        reply = self._client._ask(request, BusServoReadIdResponse)
-        check_status(request, reply, 'success', 0, MATCH_BY)
+        reply = self._client.bus.request(request, BusServoReadIdResponse)
+        if reply.success != 0:
+            check_status(request, reply, 'success', 0, MATCH_BY)
         return reply.id
 
     def set_offset(self, servo_id: int, offset: int) -> None:
@@ -430,8 +435,9 @@ class BusServoCommands:
         Raises DeviceError when the reply's success is not 0.
         """
         request = BusServoReadOffsetRequest(servo_id=servo_id)
-        reply = self._client._ask(request, BusServoReadOffsetResponse)
-        check_status(request, reply, 'success', 0, MATCH_BY)
+        reply = self._client.bus.request(request, BusServoReadOffsetResponse)
+        if reply.success != 0:
+            check_status(request, reply, 'success', 0, MATCH_BY)
         return reply.offset
 
     def save_offset(self, servo_id: int) -> None:
@@ -474,8 +480,9 @@ class BusServoCommands:
         Raises DeviceError when the reply's success is not 0.
         """
         request = BusServoReadPositionLimitRequest(servo_id=servo_id)
-        reply = self._client._ask(request, BusServoReadPositionLimitResponse)
-        check_status(request, reply, 'success', 0, MATCH_BY)
+        reply = self._client.bus.request(request, BusServoReadPositionLimitResponse)
+        if reply.success != 0:
+            check_status(request, reply, 'success', 0, MATCH_BY)
         return reply
 
     def set_voltage_limit(self, servo_id: int, low: int, high: int) -> None:
@@ -505,8 +512,9 @@ class BusServoCommands:
         Raises DeviceError when the reply's success is not 0.
         """
         request = BusServoReadVoltageLimitRequest(servo_id=servo_id)
-        reply = self._client._ask(request, BusServoReadVoltageLimitResponse)
-        check_status(request, reply, 'success', 0, MATCH_BY)
+        reply = self._client.bus.request(request, BusServoReadVoltageLimitResponse)
+        if reply.success != 0:
+            check_status(request, reply, 'success', 0, MATCH_BY)
         return reply
 
     def set_temperature_limit(self, servo_id: int, limit: int) -> None:
@@ -535,8 +543,9 @@ class BusServoCommands:
         Raises DeviceError when the reply's success is not 0.
         """
         request = BusServoReadTemperatureLimitRequest(servo_id=servo_id)
-        reply = self._client._ask(request, BusServoReadTemperatureLimitResponse)
-        check_status(request, reply, 'success', 0, MATCH_BY)
+        reply = self._client.bus.request(request, BusServoReadTemperatureLimitResponse)
+        if reply.success != 0:
+            check_status(request, reply, 'success', 0, MATCH_BY)
         return reply.limit
 
 

@@ -98,7 +98,7 @@ class VescClient(ClientBase):
         Returns: the FwVersionResponse reply.
         """
         request = FwVersionRequest()
-        reply = self._ask(request, FwVersionResponse)
+        reply = self.bus.request(request, FwVersionResponse)
         return reply
 
     def get_values(self) -> GetValuesResponse:
@@ -111,7 +111,7 @@ class VescClient(ClientBase):
         Returns: the GetValuesResponse reply.
         """
         request = GetValuesRequest()
-        reply = self._ask(request, GetValuesResponse)
+        reply = self.bus.request(request, GetValuesResponse)
         return reply
 
     def set_duty(self, duty: int) -> None:

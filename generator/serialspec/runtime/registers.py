@@ -8,8 +8,9 @@ memory, and both refuse a bad name, a read-only register or an out-of-range valu
 from __future__ import annotations
 
 import struct
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, replace
+from functools import partial
 
 from serialspec.runtime.errors import DecodeError, EncodeError, out_of_range
 
@@ -45,6 +46,7 @@ class RegisterMap:
         self.by_address = {r.address: r for r in self.registers}
         self._endian = ">" if byte_order == "big" else "<"
         self._structs = {r.name: struct.Struct(self._endian + r.format) for r in self.registers}
+        self._readers: dict[str, tuple[int, int, Callable[[bytes], int]]] = {}
 
     def __getitem__(self, name: str) -> Register:
         register = self.by_name.get(name)
@@ -96,6 +98,17 @@ class RegisterMap:
         if len(data) < self._structs[register.name].size:
             raise DecodeError(f"{register.name}: {len(data)} bytes read, {self._structs[register.name].size} needed")
         return self.from_wire(register, data)
+
+    def reader(self, name: str) -> tuple[int, int, Callable[[bytes], int]]:
+        """Reading one register by name, worked out once: its address, its size, and `value` from the bytes read
+        for it alone (a DecodeError when fewer bytes came). An unknown name is an EncodeError."""
+        found = self._readers.get(name)
+        if found is None:
+            register = self[name]
+            layout = self._structs[name]
+            value = partial(self.value, register) if register.sign_bit is not None else _plain_value(name, layout)
+            found = self._readers[name] = (register.address, layout.size, value)
+        return found
 
     def unpack(self, start: int, data: bytes) -> dict[str, int]:
         """Bytes read from address `start` on, by register name; bytes that belong to no whole register by address."""
@@ -183,3 +196,15 @@ class ModelRegisters:
         for other in others:
             other.pack(values)
         return packed
+
+
+def _plain_value(name: str, layout: struct.Struct) -> Callable[[bytes], int]:
+    """RegisterMap.value for a register without a sign bit, as one call."""
+    unpack, size = layout.unpack_from, layout.size
+
+    def value(data: bytes) -> int:
+        if len(data) < size:
+            raise DecodeError(f"{name}: {len(data)} bytes read, {size} needed")
+        return int(unpack(data)[0])
+
+    return value

@@ -125,6 +125,9 @@ def flag_names(flags: dict[str, type[IntFlag]]) -> Callable[[str, int], str]:
 
 
 Subscriber = Callable[[Message], None]
+# How a bus checks a reply of one type to one request type (Bus._rule): request type, whether it can answer, the
+# getter of the fields to match, whether error replies exist, the reply's status fields.
+_Rule = tuple[type, bool, Callable[[Any], Any] | None, bool, tuple[str, ...]]
 _ABSENT = object()  # an attribute a message does not have
 
 
@@ -136,10 +139,11 @@ class Link:
     polling). Port failures propagate as pyserial raises them; the bus turns them into PortError.
     """
 
-    __slots__ = ("port",)
+    __slots__ = ("port", "doing")
 
     def __init__(self, port: Any) -> None:
         self.port = port
+        self.doing = "read"  # the step of `transact` under way: what failed, when it raises
 
     def write(self, data: bytes) -> None:
         self.port.write(data)
@@ -152,6 +156,22 @@ class Link:
         port.timeout = 0
         data: bytes = port.read(waiting)
         return data
+
+    def transact(self, frame: bytes, wait: float) -> tuple[bytes, bytes | None]:
+        """A transaction's I/O in one call, for a bus that neither waits out a gap nor reads back an echo.
+
+        Bytes that arrived since the last transaction come first: if there are any, they are returned with None
+        and nothing is written (the bus hands them to subscribers, then writes). Otherwise `frame` is written and
+        the first read of the reply returned (see `read`). On an exception, `doing` names the step that failed.
+        """
+        self.doing = "read"
+        stale = self.read_waiting()
+        if stale:
+            return stale, None
+        self.doing = "write"
+        self.write(frame)
+        self.doing = "read"
+        return stale, self.read(wait)
 
     def read(self, wait: float) -> bytes:
         port = self.port
@@ -195,12 +215,16 @@ class FdLink(Link):
     def read_waiting(self) -> bytes:
         # pyserial sets VMIN = VTIME = 0: a read with nothing there returns b"" at once (one syscall, the usual
         # case). A device that went away fails here or at the write that follows.
-        fd = self.port.fd
         try:
-            data = os.read(fd, 4096)
+            data = os.read(self.port.fd, 4096)
         except BlockingIOError:
             return b""
-        while len(data) % 4096 == 0 and data:  # more may be waiting (a read that fills the buffer is rare)
+        return self._rest(data) if data else data
+
+    def _rest(self, data: bytes) -> bytes:
+        """The bytes waiting, given the first read of them (more may wait: a read that fills the buffer is rare)."""
+        fd = self.port.fd
+        while len(data) % 4096 == 0:
             try:
                 more = os.read(fd, 4096)
             except BlockingIOError:
@@ -208,9 +232,25 @@ class FdLink(Link):
             if not more:
                 break
             data += more
-        if data and self._spy is not None:
+        if self._spy is not None:
             self._spy.rx(data)
         return data
+
+    def transact(self, frame: bytes, wait: float) -> tuple[bytes, bytes | None]:
+        # Link.transact's three steps inline: the usual transaction in one Python call and four system calls
+        # (read what waits, write, poll, read).
+        self.doing = "read"
+        fd = self.port.fd
+        try:
+            stale = os.read(fd, 4096)
+        except BlockingIOError:
+            stale = b""
+        if stale:
+            return self._rest(stale), None
+        self.doing = "write"
+        self.write(frame)
+        self.doing = "read"
+        return stale, self.read(wait)
 
     def read(self, wait: float) -> bytes:
         fd = self.port.fd
@@ -275,6 +315,8 @@ class Bus:
         self._unsolicited: deque[Message] = deque(maxlen=1024)
         self._backlog: deque[Message] = deque()  # frames read after a reply within the same transaction
         self._parser = binding.parser()
+        # whether the parser reads replies by the request's reply class (classic ones do not: a call saved)
+        self._expects = type(self._parser).expect is not StreamParser.expect
         self._port: Any  # a pyserial port; the stubs' SerialBase lacks in_waiting and reset_input_buffer
         if isinstance(port, serial.SerialBase):
             self._port = port
@@ -298,7 +340,8 @@ class Bus:
         self._match_command = "command" in match_by
         self._match_subcommand = "subcommand" in match_by
         self._match_fields = tuple(name for name in match_by if name not in ("command", "subcommand"))
-        self._rules: dict[tuple[type, type], tuple[bool, Callable[[Any], Any] | None]] = {}
+        self._rules: dict[type, _Rule] = {}  # the latest rule of each reply type
+        self._all_rules: dict[tuple[type, type], _Rule] = {}
 
     # --- lifetime -------------------------------------------------------------------------------------------------
 
@@ -354,50 +397,68 @@ class Bus:
         """Send a request and return its reply: the first frame of type `expect` that matches the request."""
         frame = self.binding.encode(request)
         wait = self.timeout if timeout is None else timeout
-        with self._lock:
+        lock = self._lock
+        lock.acquire()  # not `with`: half the cost, at tens of microseconds per transaction
+        try:
             if self._closed or not self._port.is_open:
                 self._ensure_open()
-            # The usual transaction inline (nothing waiting, the reply whole in the first read): a call or two
-            # less matters at tens of microseconds per transaction. Anything else goes through _read_until.
-            link = self._link
-            try:
-                stale = link.read_waiting()
-            except Exception as exc:
-                self._port_failed("read", exc)
-                raise
-            if stale or self._backlog:
-                self._stale(stale)
+            if self._backlog:
+                self._flush_backlog()
+            # The usual transaction inline (nothing waiting, the reply whole in the first read): every call less
+            # matters. Anything else goes through _read_until.
             parser = self._parser
-            parser.errors = 0
-            parser.expect(expect)  # where replies share a code, the layout this request's reply has
-            self._write(frame)
+            if self._expects:
+                parser.expect(expect)  # where replies share a code, the layout this request's reply has
             started = time.monotonic()
-            rule = self._rules.get((type(request), expect)) or self._rule(type(request), expect)
-            try:
-                chunk = b"" if self._backlog else link.read(wait)  # an echo check may have read the reply
-            except Exception as exc:
-                self._port_failed("read", exc)
-                raise
+            chunk: bytes | None = None
+            if not (self._gap or self.echo):
+                parser.errors = 0
+                link = self._link
+                try:
+                    stale, chunk = link.transact(frame, wait)
+                except Exception as exc:
+                    self._port_failed(link.doing, exc)
+                    raise
+                if chunk is None:  # bytes came between transactions: to subscribers, then the request
+                    self._stale(stale)
+            if chunk is None:  # the general path: a gap, an echo, or bytes that came before the request
+                self._drain()
+                parser = self._parser  # a subscriber's own request may have reset it
+                parser.expect(expect)
+                self._write(frame)
+                started = time.monotonic()
+                try:
+                    chunk = self._link.read(wait) if not self._backlog else b""  # an echo check may have read it
+                except Exception as exc:
+                    self._port_failed("read", exc)
+                    raise
             if chunk:
                 if self._gap:
                     self._last_io = time.monotonic()
                 messages = parser.feed(chunk)
                 if len(messages) == 1:
-                    possible, getter = rule
                     reply = messages[0]
-                    if type(reply) is expect and possible and (getter is None or getter(reply) == getter(request)):
-                        self._refused(request, reply)
-                        if self.binding.status:
-                            self._check_status(reply)
-                        return reply  # type(reply) is expect
+                    if reply.__class__ is expect:
+                        rule = self._rules.get(expect)
+                        if rule is None or rule[0] is not request.__class__:
+                            rule = self._rule(request.__class__, expect)
+                        _, possible, getter, refusals, statuses = rule
+                        if possible and (getter is None or getter(reply) == getter(request)):
+                            if refusals:
+                                self._refused(request, reply)
+                            for name in statuses:
+                                if getattr(reply, name) != 0:  # an int's comparison; a Record is never 0
+                                    self._check_status(reply)
+                            return reply  # its class is expect
                 self._backlog.extend(messages)  # _read_until takes them first
             reply = self._read_until(wait - (time.monotonic() - started), request, expect, errors=0)
             if self._backlog:
                 self._flush_backlog()
+        finally:
+            lock.release()
         self._refused(request, reply)
         assert isinstance(reply, expect)
-        if self.binding.status:
-            self._check_status(reply)
+        self._check_status(reply)
         return reply
 
     def _refused(self, request: Message, reply: Message) -> None:
@@ -454,10 +515,12 @@ class Bus:
                 return False
         return True
 
-    def _rule(self, request_type: type, reply_type: type) -> tuple[bool, Callable[[Any], Any] | None]:
-        """The matching rule for a reply of exactly `reply_type` to a request of `request_type`, worked out once:
-        whether it can answer at all (command, sub-command), and a getter of the fields both have (None: none)."""
-        rule = self._rules.get((request_type, reply_type))
+    def _rule(self, request_type: type, reply_type: type) -> _Rule:
+        """The matching rule for a reply of exactly `reply_type` to a request of `request_type`, worked out once;
+        the latest one of each reply type is at hand in `_rules` (a reply type usually answers one request type).
+        It says whether the reply can answer at all (command, sub-command); gives a getter of the fields both
+        have (None: none); whether the protocol has error replies; the reply's status fields."""
+        rule = self._all_rules.get((request_type, reply_type))
         if rule is None:
             possible = not (
                 self._match_command and getattr(reply_type, "COMMAND", None) != getattr(request_type, "COMMAND", None)
@@ -466,7 +529,11 @@ class Bus:
                 and getattr(reply_type, "SUBCOMMAND", None) != getattr(request_type, "SUBCOMMAND", None)
             )
             names = [n for n in self._match_fields if hasattr(request_type, n) and hasattr(reply_type, n)]
-            rule = self._rules[(request_type, reply_type)] = (possible, operator.attrgetter(*names) if names else None)
+            getter = operator.attrgetter(*names) if names else None
+            statuses = tuple(n for n in self.binding.status if hasattr(reply_type, n))
+            rule = (request_type, possible, getter, self.binding.errors is not None, statuses)
+            self._all_rules[(request_type, reply_type)] = rule
+        self._rules[reply_type] = rule
         return rule
 
     def receive(self, timeout: float | None = None) -> Message | None:
@@ -653,6 +720,7 @@ class Bus:
         return " ".join(parts)
 
     def _check_status(self, reply: Message) -> None:
+        """A reply whose status fields (the spec's frame status elements) are not all zero is a DeviceError."""
         for name in self.binding.status:
             value = getattr(reply, name, 0)
             if isinstance(value, Record):  # a status made of bit fields: an error when any is non-zero

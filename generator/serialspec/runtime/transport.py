@@ -127,7 +127,7 @@ def flag_names(flags: dict[str, type[IntFlag]]) -> Callable[[str, int], str]:
 Subscriber = Callable[[Message], None]
 # How a bus checks a reply of one type to one request type (Bus._rule): request type, whether it can answer, the
 # getter of the fields to match, whether error replies exist, the reply's status fields.
-_Rule = tuple[type, bool, Callable[[Any], Any] | None, bool, tuple[str, ...]]
+_Rule = tuple[type, bool, Callable[[Any], Any] | None, bool, tuple[tuple[str, tuple[str, ...]], ...]]
 _ABSENT = object()  # an attribute a message does not have
 
 
@@ -441,14 +441,15 @@ class Bus:
                     if reply.__class__ is expect:
                         rule = self._rules.get(expect)
                         if rule is None or rule[0] is not request.__class__:
-                            rule = self._rule(request.__class__, expect)
+                            rule = self._rule(request.__class__, reply)
                         _, possible, getter, refusals, statuses = rule
                         if possible and (getter is None or getter(reply) == getter(request)):
                             if refusals:
                                 self._refused(request, reply)
-                            for name in statuses:
-                                if getattr(reply, name) != 0:  # an int's comparison; a Record is never 0
-                                    self._check_status(reply)
+                            for name, parts in statuses:
+                                value = getattr(reply, name)
+                                if value != 0 if not parts else any([getattr(value, p) != 0 for p in parts]):
+                                    self._check_status(reply)  # raises DeviceError
                             return reply  # its class is expect
                 self._backlog.extend(messages)  # _read_until takes them first
             reply = self._read_until(wait - (time.monotonic() - started), request, expect, errors=0)
@@ -515,11 +516,13 @@ class Bus:
                 return False
         return True
 
-    def _rule(self, request_type: type, reply_type: type) -> _Rule:
-        """The matching rule for a reply of exactly `reply_type` to a request of `request_type`, worked out once;
-        the latest one of each reply type is at hand in `_rules` (a reply type usually answers one request type).
-        It says whether the reply can answer at all (command, sub-command); gives a getter of the fields both
-        have (None: none); whether the protocol has error replies; the reply's status fields."""
+    def _rule(self, request_type: type, reply: Message) -> _Rule:
+        """The matching rule for a reply of exactly the type of `reply` to a request of `request_type`, worked
+        out once; the latest one of each reply type is at hand in `_rules` (a reply type usually answers one
+        request type). It says whether the reply can answer at all (command, sub-command); gives a getter of the
+        fields both have (None: none); whether the protocol has error replies; the reply's status fields, each
+        with its parts when it is made of bit fields (a Record; an error when any part is not 0)."""
+        reply_type = type(reply)
         rule = self._all_rules.get((request_type, reply_type))
         if rule is None:
             possible = not (
@@ -530,7 +533,11 @@ class Bus:
             )
             names = [n for n in self._match_fields if hasattr(request_type, n) and hasattr(reply_type, n)]
             getter = operator.attrgetter(*names) if names else None
-            statuses = tuple(n for n in self.binding.status if hasattr(reply_type, n))
+            statuses = tuple(
+                (n, value.__match_args__ if isinstance(value, Record) else ())
+                for n in self.binding.status
+                if (value := getattr(reply, n, _ABSENT)) is not _ABSENT
+            )
             rule = (request_type, possible, getter, self.binding.errors is not None, statuses)
             self._all_rules[(request_type, reply_type)] = rule
         self._rules[reply_type] = rule
@@ -835,27 +842,30 @@ class ClientBase:
         self, request: Message, expect: type[M], optional: tuple[int, int, str] | None, after: str = ""
     ) -> M | None:
         """A reply unless the device stays silent: broadcast, or an optional reply its parameter switches off."""
-        self.bus.binding.encode(request)  # check every value before any byte (even a parameter read) is written
         if self._is_broadcast(request) or (optional is not None and not self._answers(request, optional)):
-            self.bus.send(request)
+            self.bus.send(request)  # which checks every value before a byte is written
             return None
-        return self._ask(request, expect, after)
+        if after:
+            return self._ask(request, expect, after)
+        return self.bus.request(request, expect)
 
     def _answers(self, request: Message, optional: tuple[int, int, str]) -> bool:
         if self.optional_replies is not None:
             return self.optional_replies
         key, value, op = optional
-        address = int(getattr(request, self.ADDRESS, 0))
-        if (address, key) not in self._parameters:
+        address = getattr(request, self.ADDRESS, 0)
+        current: Any = self._parameters.get((address, key), _ABSENT)
+        if current is _ABSENT:
+            self.bus.binding.encode(request)  # check every value before any byte (even a parameter read) is written
+            address = int(address)
             # While the parameter is read, that read is asked as if it were answered (the read may itself be an
             # optional reply: DYNAMIXEL READ at status_return_level 0); no answer means no optional replies.
             self._parameters[(address, key)] = None
             try:
-                self._parameters[(address, key)] = self._read_key(address, key)
+                current = self._parameters[(address, key)] = self._read_key(address, key)
             except Timeout:
                 del self._parameters[(address, key)]
                 return False
-        current = self._parameters[(address, key)]
         return True if current is None else compare(current, op, value)
 
     def _carry(

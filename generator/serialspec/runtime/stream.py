@@ -205,7 +205,6 @@ class StreamParser:
         decode_at = current.decode
         length_at = current.length_offset - width  # the key's bytes in the piece after the header
         command_at = -1 if current.command_offset is None else current.command_offset - width
-        need = current.prefix - width
         byte_at, allowed = current.byte_at, current.allowed
         wide = current.wide
         shifts = current.shifts
@@ -217,26 +216,28 @@ class StreamParser:
         cut = -1  # where the bytes held back begin, once a candidate must wait for more
         for piece in islice(pieces, 1, None):
             if position >= start:
-                after = len(piece)  # bytes between this header and the next one (or the end)
-                if after >= need:
+                try:  # a piece too short for the key: the general path decides
                     entry = whole.get(piece[length_at] if command_at < 0 else piece[command_at] << 8 | piece[length_at])
+                except IndexError:
+                    entry = None
+                if entry is not None:
+                    size, rest, decode = entry
+                    after = len(piece)  # bytes between this header and the next one (or the end)
+                    # the frame ends before the next header (so the bytes its values are read from are there too)
                     if (
-                        entry is not None
-                        and entry[1] <= after
+                        rest <= after
                         and (allowed is None or allowed[piece[byte_at]])
                         and (not wide or current.plausible(buffer, position))
                     ):
-                        decode = entry[2]
                         if decode is not None:
                             message = decode(buffer, position)
                         else:
                             try:
-                                message = decode_at(buffer, position, position + entry[0])
+                                message = decode_at(buffer, position, position + size)
                             except DecodeError:
                                 message = None
                         if message is not None:  # the usual frame
                             append(message)
-                            size = entry[0]
                             taken += size
                             start = position + size
                             position += width + after

@@ -113,3 +113,11 @@ def test_a_frame_right_after_one_that_ends_like_a_header(g: Generated, direction
         assert got == [m for chunk in reads for m in scan.feed(chunk)]
         assert got == [g.package.decode(first, direction), g.package.decode(second, direction)]
         assert (batch.errors, batch.garbage, batch.pending()) == (0, 0, b"")
+
+
+@pytest.mark.parametrize(("g", "direction"), PARSERS, ids=[f"{g.protocol.name}:{d.value}" for g, d in PARSERS])
+def test_parsers_of_one_frame_format_share_its_tables(g: Generated, direction: Direction) -> None:
+    """A parser is made on every reset and reopen of a bus: its size tables are built once per frame format."""
+    first, second = g.package.StreamParser(direction), g.package.StreamParser(direction)
+    assert first._single is second._single
+    assert first._single.frame_sizes and first._single.pieces

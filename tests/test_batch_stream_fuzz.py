@@ -5,6 +5,9 @@ an address out of range), frames cut short, runs of header bytes (a header that 
 FF FF, makes FF FF FF ... candidates that start inside one another), lone headers and random bytes; the same stream
 is fed in random reads to a parser as it is and to one whose batch scan is replaced by the byte-by-byte scan. After
 every read both must have returned equal messages and agree on errors, skipped bytes and the bytes held back.
+The same for made-up frame formats no shipped spec has (headers of one to three bytes that overlap themselves in
+other ways, an address range, a command code with frames decoded whole, a two-byte range), since the runtime reads
+the frame format from the model and knows no protocol.
 """
 
 from __future__ import annotations
@@ -13,9 +16,9 @@ import pytest
 from conftest import Generated, examples
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from serialspec.runtime.errors import EncodeError
-from serialspec.runtime.message import Direction, field_names, replace
-from serialspec.runtime.stream import StreamParser
+from serialspec.runtime.errors import ChecksumError, EncodeError
+from serialspec.runtime.message import Direction, Message, field_names, replace
+from serialspec.runtime.stream import FrameFormat, StreamParser, ValueRanges
 from test_batch_stream import PARSERS, byte_by_byte
 
 
@@ -121,3 +124,95 @@ def test_parsers_of_one_frame_format_share_its_tables(g: Generated, direction: D
     first, second = g.package.StreamParser(direction), g.package.StreamParser(direction)
     assert first._single is second._single
     assert first._single.frame_sizes and first._single.pieces
+
+
+# --- frame formats no shipped spec has: other headers that overlap themselves, other value ranges -----------------
+
+
+class Toy(Message):
+    """A frame of a made-up format, kept whole: two are equal when their bytes are."""
+
+    __slots__ = ("frame",)
+    __match_args__ = ("frame",)
+    PROTOCOL = "toy"
+    COMMAND = "toy"
+    SUBCOMMAND = None
+    DIRECTION = Direction.RESPONSE
+
+    def __init__(self, frame: bytes) -> None:
+        object.__setattr__(self, "frame", frame)
+
+
+def toy_decode_at(buf: bytes, start: int, stop: int, width: int) -> Toy:
+    if sum(buf[start + width : stop - 1]) & 0xFF != buf[stop - 1]:
+        raise ChecksumError("bad sum")
+    return Toy(buf[start:stop])
+
+
+def toy_format(header: bytes, kind: str) -> FrameFormat:
+    """`address`: header, address (0..253 or 254), length, content, sum; `command`: header, command, length,
+    content, sum, command 1's frames decoded whole; `wide`: header, a 16-bit big-endian address (0..1000), length,
+    content, sum. The sum covers what follows the header."""
+    width = len(header)
+
+    def decode_at(buf: bytes, start: int, stop: int) -> Toy:
+        return toy_decode_at(buf, start, stop, width)
+
+    def whole(buf: bytes, start: int) -> Toy | None:
+        try:
+            return toy_decode_at(buf, start, start + width + 5, width)
+        except ChecksumError:
+            return None
+
+    if kind == "address":
+        ranges: ValueRanges = ((width, 1, "little", False, 0, 253, 254),)
+        return FrameFormat(header, width + 3, width + 1, 0, None, {None: (0, 5)}, decode_at, value_ranges=ranges)
+    if kind == "command":
+        fixed = {1 << 8 | 2: (width + 5, whole)}
+        return FrameFormat(header, width + 3, width + 1, 0, width, {1: (2, 2), 2: (0, 4)}, decode_at, fixed)
+    ranges = ((width, 2, "big", False, 0, 1000, None),)
+    return FrameFormat(header, width + 4, width + 2, 0, None, {None: (0, 3)}, decode_at, value_ranges=ranges)
+
+
+@st.composite
+def toy_piece(draw: st.DrawFn, header: bytes, kind: str) -> bytes:
+    choice = draw(st.integers(0, 5))
+    if choice == 0:  # header bytes, repeated
+        return header[: draw(st.integers(1, len(header)))] * draw(st.integers(1, 4))
+    if choice == 1:  # noise made of header bytes and a few others
+        return bytes(draw(st.lists(st.sampled_from([*header, 0, 1, 2, 3, 254, 255]), max_size=8)))
+    if kind == "address":
+        before = bytes([draw(st.sampled_from([0, 7, 253, 254, 255]))])
+    elif kind == "command":
+        before = bytes([draw(st.sampled_from([1, 2, 3]))])
+    else:
+        before = draw(st.sampled_from([0, 999, 1000, 1001, 0xFFFF])).to_bytes(2, "big")
+    content = bytes(draw(st.lists(st.sampled_from([*header, 0, 5, 255]), max_size=2)))
+    if draw(st.booleans()):  # a last content byte that makes the sum the header's first byte
+        fix = (header[0] - sum(before) - len(content) - 1 - sum(content)) & 0xFF
+        content += bytes([fix])
+    body = before + bytes([len(content)]) + content
+    frame = header + body + bytes([sum(body) & 0xFF ^ draw(st.sampled_from([0, 0, 0, 1]))])  # some corrupt
+    return frame[: draw(st.integers(1, len(frame)))] if draw(st.integers(0, 5)) == 0 else frame
+
+
+TOY_HEADERS = [b"\xaa", b"\xaa\xaa", b"\xaa\xaa\xaa", b"\xab\xcd\xab", b"\xab\xab\xcd", b"\xab\xcd"]
+
+
+@pytest.mark.parametrize("kind", ["address", "command", "wide"])
+@pytest.mark.parametrize("header", TOY_HEADERS, ids=[h.hex() for h in TOY_HEADERS])
+def test_batch_and_byte_by_byte_scans_agree_on_other_frame_formats(header: bytes, kind: str) -> None:
+    frame_format = toy_format(header, kind)
+    assert StreamParser(frame_format)._single is not None and StreamParser(frame_format)._single.splittable
+
+    @settings(max_examples=examples(50), deadline=None, suppress_health_check=[HealthCheck.too_slow])
+    @given(st.lists(toy_piece(header, kind), min_size=1, max_size=25), st.lists(st.integers(0, 200), max_size=8))
+    def run(pieces: list[bytes], cuts: list[int]) -> None:
+        data = b"".join(pieces)
+        edges = [0, *sorted({min(c, len(data)) for c in cuts}), len(data)]
+        batch, scan = StreamParser(frame_format), byte_by_byte(StreamParser(frame_format))
+        for a, b in zip(edges, edges[1:], strict=False):
+            assert batch.feed(data[a:b]) == scan.feed(data[a:b]), data.hex(" ")
+            assert (batch.errors, batch.garbage, batch.pending()) == (scan.errors, scan.garbage, scan.pending())
+
+    run()

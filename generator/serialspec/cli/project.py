@@ -18,7 +18,6 @@ import glob
 import json
 import os
 import re
-import tomllib
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -64,6 +63,8 @@ def _config(folder: Path) -> dict[str, object]:
     pyproject = folder / "pyproject.toml"
     if not pyproject.is_file():
         return {}
+    import tomllib  # only where there is a pyproject.toml to read
+
     try:
         table = tomllib.loads(pyproject.read_text(encoding="utf-8")).get("tool", {}).get("serialspec")
     except tomllib.TOMLDecodeError:

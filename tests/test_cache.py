@@ -1,0 +1,167 @@
+"""The caches generation keeps (serialspec.cache): compiled generated modules and compiled templates.
+
+A cache may only ever save time: an entry built from other text, by other settings, or damaged in any way is
+rebuilt, never used; and an unwritable or forbidden cache folder changes nothing but the time.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import jinja2
+import pytest
+from serialspec import cache
+from serialspec.emit.common import render
+
+
+@pytest.fixture
+def folder(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[Path]:
+    """An empty cache folder of the test's own, caches written (whatever PYTHONDONTWRITEBYTECODE says)."""
+    where = tmp_path / "cache"
+    monkeypatch.setenv("SERIALSPEC_CACHE_DIR", str(where))
+    monkeypatch.setattr(sys, "dont_write_bytecode", False)
+    cache.folder.cache_clear()
+    yield where
+    cache.folder.cache_clear()
+
+
+def run(source: str, filename: str = "<test>") -> Any:
+    namespace: dict[str, Any] = {}
+    exec(cache.compiled(source, filename, "pkg.module.py"), namespace)
+    return namespace["VALUE"]
+
+
+def entries(folder: Path) -> list[Path]:
+    return sorted(p for p in folder.rglob("*") if p.is_file())
+
+
+def refuse_to_compile(monkeypatch: pytest.MonkeyPatch) -> None:
+    def refuse(*args: object, **kwargs: object) -> None:
+        raise AssertionError("compiled although the cache holds the code")
+
+    monkeypatch.setattr(cache, "compile", refuse, raising=False)  # the module's `compile`, ahead of the builtin
+
+
+def test_a_module_compiled_once_is_read_back_from_the_cache(folder: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    assert run("VALUE = 1") == 1
+    assert len(entries(folder)) == 1
+    refuse_to_compile(monkeypatch)
+    assert run("VALUE = 1") == 1
+
+
+def test_a_changed_source_is_compiled_again_and_replaces_its_entry(folder: Path) -> None:
+    assert run("VALUE = 1") == 1
+    assert run("VALUE = 2") == 2  # same module, same file name: the entry's key no longer matches
+    assert len(entries(folder)) == 1
+    assert run("VALUE = 2") == 2
+    assert run("VALUE = 1") == 1
+
+
+def test_the_file_name_the_code_reports_is_part_of_the_key(folder: Path) -> None:
+    code = cache.compiled("VALUE = 1", "<a.yaml>", "pkg.module.py")
+    assert cache.compiled("VALUE = 1", "<b.yaml>", "pkg.module.py").co_filename == "<b.yaml>"
+    assert cache.compiled("VALUE = 1", "<a.yaml>", "pkg.module.py").co_filename == code.co_filename == "<a.yaml>"
+
+
+def test_no_future_flags_leak_from_the_cache_module_into_generated_code(folder: Path) -> None:
+    # serialspec.cache has `from __future__ import annotations`; a generated module without it must see its
+    # annotations evaluated, as when Python imports its file.
+    namespace: dict[str, Any] = {}
+    exec(cache.compiled("x: int = 1\nVALUE = __annotations__", "<t>", "pkg.module.py"), namespace)
+    assert namespace["VALUE"] == {"x": int}
+
+
+@pytest.mark.parametrize(
+    "damage",
+    [
+        lambda data: data[: len(data) // 2],  # truncated
+        lambda data: b"",
+        lambda data: b"\x00" * len(data),
+        lambda data: data[:-1] + bytes([data[-1] ^ 0xFF]),  # one bit pattern changed in the marshalled code
+        lambda data: data[:30] + bytes([data[30] ^ 0xFF]) + data[31:],  # in the key
+    ],
+    ids=["truncated", "empty", "zeroed", "payload", "key"],
+)
+def test_a_damaged_entry_is_ignored_and_rewritten(folder: Path, damage: Any) -> None:
+    assert run("VALUE = 'first'") == "first"
+    [entry] = entries(folder)
+    intact = entry.read_bytes()
+    entry.write_bytes(damage(intact))
+    assert run("VALUE = 'first'") == "first"
+    assert entry.read_bytes() == intact
+
+
+def test_an_entry_that_is_a_folder_or_unreadable_changes_nothing_but_the_time(folder: Path) -> None:
+    assert run("VALUE = 1") == 1
+    [entry] = entries(folder)
+    entry.unlink()
+    entry.mkdir()  # neither readable nor replaceable as a file
+    assert run("VALUE = 1") == 1
+    assert run("VALUE = 3") == 3
+
+
+def test_nothing_is_written_when_python_may_not_write_bytecode(folder: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(sys, "dont_write_bytecode", True)
+    assert run("VALUE = 1") == 1
+    assert entries(folder) == []
+
+
+@pytest.mark.parametrize("setting", ["", "{tmp}/file/cache"], ids=["empty", "under-a-file"])
+def test_no_cache_folder_changes_nothing_but_the_time(
+    setting: str, monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    (tmp_path / "file").write_text("not a folder")
+    monkeypatch.setenv("SERIALSPEC_CACHE_DIR", setting.format(tmp=tmp_path))  # empty: the caches are off
+    monkeypatch.setattr(sys, "dont_write_bytecode", False)
+    cache.folder.cache_clear()
+    try:
+        assert cache.folder() is None
+        assert run("VALUE = 1") == 1
+    finally:
+        cache.folder.cache_clear()
+
+
+# --- compiled templates -------------------------------------------------------------------------------------------
+
+
+def environment(templates: dict[str, str], **settings: Any) -> jinja2.Environment:
+    """An environment like the targets' (serialspec.emit.common.render), over templates held in memory."""
+    env = jinja2.Environment(loader=jinja2.DictLoader(templates), **{**render._SETTINGS, **settings})
+    env.bytecode_cache = render._Cache(env)
+    return env
+
+
+def test_a_compiled_template_is_read_back_from_the_cache(folder: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    assert environment({"t": "{{ x }}!"}).get_template("t").render(x=1) == "1!"
+    assert len(entries(folder)) == 1
+
+    def refuse(*args: object, **kwargs: object) -> None:
+        raise AssertionError("compiled although the cache holds the template")
+
+    monkeypatch.setattr(jinja2.Environment, "compile", refuse)
+    assert environment({"t": "{{ x }}!"}).get_template("t").render(x=2) == "2!"
+
+
+def test_an_edited_template_is_never_rendered_from_its_old_entry(folder: Path) -> None:
+    assert environment({"t": "old {{ x }}"}).get_template("t").render(x=1) == "old 1"
+    assert environment({"t": "new {{ x }}"}).get_template("t").render(x=1) == "new 1"
+    assert environment({"t": "new {{ x }}"}).get_template("t").render(x=1) == "new 1"
+
+
+def test_other_environment_settings_do_not_use_the_entry(folder: Path) -> None:
+    source = {"t": "{% if x %}\n  yes\n{% endif %}\n"}
+    assert environment(source).get_template("t").render(x=1) == "  yes\n"
+    untrimmed = environment(source, trim_blocks=False, lstrip_blocks=False)
+    assert untrimmed.get_template("t").render(x=1) == "\n  yes\n\n"
+
+
+def test_a_damaged_template_entry_is_compiled_afresh(folder: Path) -> None:
+    assert environment({"t": "{{ x }}"}).get_template("t").render(x=1) == "1"
+    [entry] = entries(folder)
+    entry.write_bytes(entry.read_bytes()[:-10])
+    assert environment({"t": "{{ x }}"}).get_template("t").render(x=2) == "2"
+    entry.write_bytes(b"garbage")
+    assert environment({"t": "{{ x }}"}).get_template("t").render(x=3) == "3"

@@ -6,6 +6,9 @@ rebuilt, never used; and an unwritable or forbidden cache folder changes nothing
 
 from __future__ import annotations
 
+import os
+import shutil
+import subprocess
 import sys
 from collections.abc import Iterator
 from pathlib import Path
@@ -165,3 +168,101 @@ def test_a_damaged_template_entry_is_compiled_afresh(folder: Path) -> None:
     assert environment({"t": "{{ x }}"}).get_template("t").render(x=2) == "2"
     entry.write_bytes(b"garbage")
     assert environment({"t": "{{ x }}"}).get_template("t").render(x=3) == "3"
+
+
+# --- a spec's outputs ---------------------------------------------------------------------------------------------
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def generate(project: Path, cache_folder: str, verb: str = "generate") -> subprocess.CompletedProcess[str]:
+    """`serialspec generate` (or `check`) of a project in a fresh process, with a cache folder of its own."""
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+    env["SERIALSPEC_CACHE_DIR"] = cache_folder
+    command = [sys.executable, "-m", "serialspec", verb, "--root", str(project)]
+    return subprocess.run(command, capture_output=True, text=True, env=env)
+
+
+def tree(folder: Path) -> dict[str, bytes]:
+    return {
+        str(p.relative_to(folder)): p.read_bytes()
+        for p in sorted(folder.rglob("*"))
+        if p.is_file() and "__pycache__" not in p.parts
+    }
+
+
+@pytest.fixture
+def project(tmp_path: Path) -> Path:
+    shutil.copytree(ROOT / "specs", tmp_path / "project" / "specs")
+    return tmp_path / "project"
+
+
+def test_outputs_from_the_cache_are_the_files_generation_writes_without_it(project: Path, tmp_path: Path) -> None:
+    assert generate(project, "").returncode == 0  # no cache at all
+    fresh = tree(project / "generated")
+    shutil.rmtree(project / "generated")
+    folder = tmp_path / "cache"
+    assert generate(project, str(folder)).returncode == 0  # fills the cache
+    assert {p.name for p in (folder / "outputs").iterdir()} == {p.name for p in (project / "specs").glob("*.yaml")}
+    shutil.rmtree(project / "generated")
+    from_cache = generate(project, str(folder))
+    assert from_cache.returncode == 0, from_cache.stderr
+    assert tree(project / "generated") == fresh
+    assert generate(project, str(folder), "check").returncode == 0
+
+
+def test_an_edited_spec_is_generated_again(project: Path, tmp_path: Path) -> None:
+    folder = str(tmp_path / "cache")
+    assert generate(project, folder).returncode == 0
+    spec = project / "specs" / "fashionstar_uart.yaml"
+    spec.write_text(spec.read_text(encoding="utf-8").replace("Ping servo 3.", "Ping servo number 3."))
+    assert generate(project, folder, "check").returncode == 1  # stale, not answered from the cache
+    assert generate(project, folder).returncode == 0
+    assert "Ping servo number 3." in (project / "generated" / "docs" / "fashionstar_uart.md").read_text()
+    assert generate(project, folder, "check").returncode == 0
+
+
+def test_a_failing_example_is_reported_on_every_run(project: Path, tmp_path: Path) -> None:
+    folder = str(tmp_path / "cache")
+    spec = project / "specs" / "fashionstar_uart.yaml"
+    text = spec.read_text(encoding="utf-8")
+    spec.write_text(text.replace("    fields: {servo_id: 3}\n", "    fields: {servo_id: 4}\n", 1))
+    line = text[: text.index("  ping_request:\n")].count("\n") + 2  # the example's first key
+    reported = [generate(project, folder) for _ in range(2)]
+    for result in reported:
+        assert result.returncode == 1
+        assert f"specs/fashionstar_uart.yaml:{line}:5: examples.ping_request: the frame decodes to other values: " in (
+            result.stderr
+        )
+    assert reported[0].stderr == reported[1].stderr
+
+
+def test_damaged_output_entries_are_ignored(project: Path, tmp_path: Path) -> None:
+    folder = tmp_path / "cache"
+    assert generate(project, str(folder)).returncode == 0
+    written = tree(project / "generated")
+    for entry in (folder / "outputs").iterdir():
+        entry.write_bytes(entry.read_bytes()[:-7])
+    result = generate(project, str(folder))
+    assert result.returncode == 0 and " 0 changed" in result.stdout
+    assert tree(project / "generated") == written
+
+
+def test_the_generator_key_covers_every_source_and_template_of_the_package(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    package = Path(cache.__file__).parent
+    copy = tmp_path / "serialspec"
+    shutil.copytree(package, copy, ignore=shutil.ignore_patterns("__pycache__"))
+    monkeypatch.setattr(cache, "_PACKAGE", copy)
+    fingerprint = cache.generator.__wrapped__
+    before = fingerprint()
+    (copy / "__pycache__").mkdir()
+    (copy / "__pycache__" / "x.py").write_text("# not a source\n")
+    assert fingerprint() == before
+    for changed in (copy / "emit" / "markdown" / "templates" / "docs.md.j2", copy / "runtime" / "checksums.py"):
+        original = changed.read_bytes()
+        changed.write_bytes(original + b"\n")
+        assert fingerprint() != before, changed
+        changed.write_bytes(original)
+    assert fingerprint() == before

@@ -127,3 +127,23 @@ def compiled(source: str, filename: str, entry: str) -> CodeType:
     if not sys.dont_write_bytecode:
         store(name, wanted, marshal.dumps(code))
     return code
+
+
+@cache
+def generator() -> bytes:
+    """A hash of everything generation depends on besides the spec: serialspec's own code and templates (every file
+    of the package, whatever it is installed as), the jinja2 and PyYAML releases, and the Python release."""
+    digest = hashlib.sha256(_MAGIC + sys.version.encode())
+    for top, folders, names in os.walk(_PACKAGE):
+        folders[:] = sorted(f for f in folders if f != "__pycache__")
+        for name in sorted(names):
+            if name.endswith((".py", ".j2")):
+                path = os.path.join(top, name)
+                with open(path, "rb") as stream:
+                    digest.update(key(os.path.relpath(path, _PACKAGE), stream.read()))
+    for library in ("jinja2", "yaml"):  # each one's __init__ names its release
+        found = importlib.util.find_spec(library)
+        if found is not None and found.origin is not None:
+            with open(found.origin, "rb") as stream:
+                digest.update(key(library, stream.read()))
+    return digest.digest()

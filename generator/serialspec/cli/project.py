@@ -14,19 +14,18 @@ Spec paths and `--out` given on the command line replace `specs` and `out`.
 
 from __future__ import annotations
 
+import contextlib
 import glob
-import json
+import marshal
 import os
 import re
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
-from serialspec.emit import emitters
-from serialspec.spec import SpecError, SpecErrors, load_protocol
-from serialspec.spec.grammar import json_schema
-from serialspec.spec.loader import load_file
-from serialspec.spec.reference import reference_markdown
+from serialspec import cache
+from serialspec.spec.errors import SpecError, SpecErrors
 
 SCHEMA_NAME = "serialspec.schema.json"
 #: The first line of every generated text file names the spec it came from.
@@ -98,30 +97,109 @@ def expected_files(proj: Project) -> tuple[dict[Path, str], list[SpecError]]:
     """Every generated file, by path, from the project's valid specs; and every mistake in the others."""
     files: dict[Path, str] = {}
     if proj.schema is not None:
-        files[proj.schema] = json.dumps(json_schema(), indent=2, ensure_ascii=False) + "\n"
+        files[proj.schema] = _cached_text("schema", cache.generator(), _schema)
     errors = []
-    examples = []
+    made = []
     for spec in proj.specs:
         if not spec.is_file():
             errors.append(SpecError(proj.display(spec), 1, 1, "", "no such spec file"))
             continue
         try:
-            protocol = load_protocol(str(spec), proj.display(spec))
-            if proj.reference is not None:
-                examples.append(load_file(str(spec)).data)
+            outputs = spec_outputs(spec, proj.display(spec), with_data=proj.reference is not None)
         except SpecErrors as exc:
             errors.extend(exc.errors)
             continue
-        for emitter in emitters():
-            emitted = emitter.files(protocol)
-            for name, text in emitted.items():
-                files[proj.out / name] = text
-            if emitter.verify is not None:
-                errors.extend(emitter.verify(protocol, emitted))
-        files[proj.out / protocol.name / SHIPPED_SPEC] = shipped_spec(protocol.spec_path, spec)
+        files.update({proj.out / name: text for name, text in outputs.files.items()})
+        errors.extend(outputs.errors)
+        made.append(outputs)
     if proj.reference is not None and not errors:  # its examples come from every spec: none while one fails
-        files[proj.reference] = reference_markdown(examples)
+
+        def reference() -> str:
+            from serialspec.spec.reference import reference_markdown
+
+            return reference_markdown([outputs.data for outputs in made])
+
+        wanted = cache.key(cache.generator(), *(outputs.key for outputs in made))
+        files[proj.reference] = _cached_text("reference", wanted, reference)
     return files, errors
+
+
+@dataclass(frozen=True)
+class Outputs:
+    """What one valid spec generates, by file name under the output folder, and the mistakes its examples and errata
+    show when run through the package generated from it; its loaded values (for the language reference)."""
+
+    files: dict[str, str]
+    errors: list[SpecError]
+    data: Any
+    key: bytes  # of the spec's text and name, and the generator
+
+
+def spec_outputs(spec: Path, display: str, *, with_data: bool = False) -> Outputs:
+    """One spec's outputs, from the cache when the same spec text, under the same name, went through the same
+    generator (serialspec.cache.generator: its code, templates, jinja2, PyYAML and Python) before: generation is a
+    function of those alone, so the cached files, and the verdict of its examples and errata, are what generating it
+    again would give. A spec with mistakes is never cached: it is loaded again, to report them."""
+    try:
+        raw = spec.read_bytes()
+    except OSError:
+        return _generate(spec, display, b"")  # the loader says what is wrong, with its wording
+    wanted = cache.key(cache.generator(), display, raw)
+    entry = f"outputs/{spec.name}"  # one entry per spec file name: a changed spec replaces its entry
+    payload = cache.load(entry, wanted)
+    if payload is not None:
+        with contextlib.suppress(ValueError, EOFError, TypeError):
+            files, errors, data, has_data = marshal.loads(payload)
+            cached = Outputs(dict(files), [SpecError(*error) for error in errors], data, wanted)
+            if has_data or not with_data:
+                return cached
+    outputs = _generate(spec, display, wanted)
+    errors = [(e.file, e.line, e.column, e.path, e.message) for e in outputs.errors]
+    try:
+        payload = marshal.dumps((outputs.files, errors, outputs.data, True))
+    except ValueError:  # values marshal cannot hold (a YAML timestamp): cached without them
+        payload = marshal.dumps((outputs.files, errors, None, False))
+    cache.store(entry, wanted, payload)
+    return outputs
+
+
+def _generate(spec: Path, display: str, key: bytes) -> Outputs:
+    """Load and resolve one spec, run every emitter over it and check its examples and errata (raises SpecErrors)."""
+    from serialspec.emit import emitters
+    from serialspec.spec.loader import load_file
+    from serialspec.spec.resolve import resolve
+
+    located = load_file(str(spec), display)
+    data = located.data
+    protocol = resolve(located)
+    files: dict[str, str] = {}
+    errors: list[SpecError] = []
+    for emitter in emitters():
+        emitted = emitter.files(protocol)
+        files.update(emitted)
+        if emitter.verify is not None:
+            errors.extend(emitter.verify(protocol, emitted))
+    files[f"{protocol.name}/{SHIPPED_SPEC}"] = shipped_spec(protocol.spec_path, spec)
+    return Outputs(files, errors, data, key)
+
+
+def _schema() -> str:
+    import json
+
+    from serialspec.spec.grammar import json_schema
+
+    return json.dumps(json_schema(), indent=2, ensure_ascii=False) + "\n"
+
+
+def _cached_text(entry: str, wanted: bytes, make: Callable[[], str]) -> str:
+    """A generated text that depends on `wanted` alone (a key covering the generator), from the cache if there."""
+    payload = cache.load(entry, wanted)
+    if payload is not None:
+        with contextlib.suppress(UnicodeDecodeError):
+            return payload.decode("utf-8")
+    text = make()
+    cache.store(entry, wanted, text.encode("utf-8", "surrogatepass"))
+    return text
 
 
 def shipped_spec(display: str, spec: Path) -> str:

@@ -25,6 +25,8 @@ from types import CodeType
 
 _PACKAGE = Path(__file__).resolve().parent
 _MAGIC = b"serialspec cache 1\n"
+# How many entries a folder of the cache keeps (the ones written last), so that it does not grow without bound.
+KEEP_CODE = 256  # compiled generated modules: three a spec, 1..150 kB each
 
 
 @cache
@@ -74,8 +76,9 @@ def load(name: str, wanted: bytes) -> bytes | None:
     return payload
 
 
-def store(name: str, stored: bytes, payload: bytes) -> None:
-    """Store a cache entry, atomically (a reader sees the old entry or the new one), if caches may be written."""
+def store(name: str, stored: bytes, payload: bytes, *, keep: int = 0) -> None:
+    """Store a cache entry, atomically (a reader sees the old entry or the new one), if caches may be written; with
+    `keep`, the entry's folder then keeps only that many entries, the ones written last."""
     where = folder()
     if where is None or sys.dont_write_bytecode:
         return
@@ -93,6 +96,18 @@ def store(name: str, stored: bytes, payload: bytes) -> None:
             with contextlib.suppress(OSError):
                 os.unlink(temporary)
             raise
+        if keep:
+            _prune(target.parent, keep)
+
+
+def _prune(where: Path, keep: int) -> None:
+    entries = []
+    for entry in os.scandir(where):
+        with contextlib.suppress(OSError):
+            entries.append((entry.stat().st_mtime_ns, entry.path))
+    for _, path in sorted(entries, reverse=True)[keep:]:
+        with contextlib.suppress(OSError):
+            os.unlink(path)
 
 
 def key(*parts: str | bytes) -> bytes:
@@ -114,7 +129,7 @@ def compiled(source: str, filename: str, entry: str) -> CodeType:
     """
     wanted = key(importlib.util.MAGIC_NUMBER, str(sys.flags.optimize), filename, source)
     # One entry per module and file name (a spec generated under two names does not evict itself); a changed
-    # source replaces its entry.
+    # source replaces its entry; the entries written last are kept.
     where = hashlib.sha256(filename.encode("utf-8", "surrogatepass")).hexdigest()[:12]
     name = f"code/{entry}.{where}.{sys.implementation.cache_tag}"
     payload = load(name, wanted)
@@ -125,7 +140,7 @@ def compiled(source: str, filename: str, entry: str) -> CodeType:
                 return code
     code = compile(source, filename, "exec", dont_inherit=True)
     if not sys.dont_write_bytecode:
-        store(name, wanted, marshal.dumps(code))
+        store(name, wanted, marshal.dumps(code), keep=KEEP_CODE)
     return code
 
 

@@ -154,11 +154,18 @@ def generator() -> bytes:
         for name in sorted(names):
             if name.endswith((".py", ".j2")):
                 path = os.path.join(top, name)
-                with open(path, "rb") as stream:
-                    digest.update(key(os.path.relpath(path, _PACKAGE), stream.read()))
+                digest.update(key(os.path.relpath(path, _PACKAGE), _contents(path)))
     for library in ("jinja2", "yaml"):  # each one's __init__ names its release
-        found = importlib.util.find_spec(library)
-        if found is not None and found.origin is not None:
-            with open(found.origin, "rb") as stream:
-                digest.update(key(library, stream.read()))
+        with contextlib.suppress(ImportError, ValueError):
+            found = importlib.util.find_spec(library)
+            if found is not None and found.origin is not None:
+                digest.update(key(library, _contents(found.origin)))
     return digest.digest()
+
+
+def _contents(path: str) -> bytes:
+    try:
+        with open(path, "rb") as stream:
+            return stream.read()
+    except OSError as exc:  # hashed as what it is: a file that cannot be read
+        return f"unreadable: {exc.errno}".encode()

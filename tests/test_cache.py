@@ -111,6 +111,9 @@ def test_a_folder_keeps_the_entries_written_last(folder: Path, monkeypatch: pyte
         cache.store(f"some/{number}", cache.key(str(number)), b"payload", keep=3)
     assert sorted(p.name for p in (folder / "some").iterdir()) == ["2", "3", "4"]
     assert cache.load("some/4", cache.key("4")) == b"payload"
+    monkeypatch.setattr(cache, "MAX_FOLDER_BYTES", 2 * len((folder / "some" / "4").read_bytes()))
+    cache.store("some/5", cache.key("5"), b"payload", keep=3)
+    assert sorted(p.name for p in (folder / "some").iterdir()) == ["4", "5"]  # the size limit, before the count
 
 
 def test_nothing_is_written_when_python_may_not_write_bytecode(folder: Path, monkeypatch: pytest.MonkeyPatch) -> None:

@@ -27,6 +27,7 @@ _PACKAGE = Path(__file__).resolve().parent
 _MAGIC = b"serialspec cache 1\n"
 # How many entries a folder of the cache keeps (the ones written last), so that it does not grow without bound.
 KEEP_CODE = 256  # compiled generated modules: three a spec, 1..150 kB each
+MAX_FOLDER_BYTES = 256 * 1024 * 1024  # and at most this much (a 5,000-command spec's outputs take ~50 MB)
 
 
 @cache
@@ -78,7 +79,7 @@ def load(name: str, wanted: bytes) -> bytes | None:
 
 def store(name: str, stored: bytes, payload: bytes, *, keep: int = 0) -> None:
     """Store a cache entry, atomically (a reader sees the old entry or the new one), if caches may be written; with
-    `keep`, the entry's folder then keeps only that many entries, the ones written last."""
+    `keep`, the entry's folder then keeps only that many entries, the ones written last (see _prune)."""
     where = folder()
     if where is None or sys.dont_write_bytecode:
         return
@@ -101,13 +102,19 @@ def store(name: str, stored: bytes, payload: bytes, *, keep: int = 0) -> None:
 
 
 def _prune(where: Path, keep: int) -> None:
+    """Keep the `keep` entries of a folder written last, within MAX_FOLDER_BYTES (the newest one always)."""
     entries = []
     for entry in os.scandir(where):
         with contextlib.suppress(OSError):
-            entries.append((entry.stat().st_mtime_ns, entry.path))
-    for _, path in sorted(entries, reverse=True)[keep:]:
-        with contextlib.suppress(OSError):
-            os.unlink(path)
+            stat = entry.stat()
+            entries.append((stat.st_mtime_ns, stat.st_size, entry.path))
+    entries.sort(reverse=True)
+    total = 0
+    for count, (_, size, path) in enumerate(entries):
+        total += size
+        if count >= keep or (count and total > MAX_FOLDER_BYTES):
+            with contextlib.suppress(OSError):
+                os.unlink(path)
 
 
 def key(*parts: str | bytes) -> bytes:

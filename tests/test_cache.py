@@ -278,3 +278,14 @@ def test_the_generator_key_covers_every_source_and_template_of_the_package(
         assert fingerprint() != before, changed
         changed.write_bytes(original)
     assert fingerprint() == before
+
+
+def test_the_shipped_spec_is_the_text_as_a_text_file_reads_it(tmp_path: Path) -> None:
+    """Generation reads a spec's bytes once (what it generates is what its cache key names); the copy a package
+    ships is still the spec as `open(..., encoding="utf-8")` reads it, which `decode SPEC` compares it with."""
+    from serialspec.cli.project import shipped_spec
+
+    raw = "\ufeffprotocol: x\r\ntitle: é\rdescription: y\n".encode()
+    spec = tmp_path / "x.yaml"
+    spec.write_bytes(raw)
+    assert shipped_spec("x.yaml", raw).partition("\n")[2] == spec.read_text(encoding="utf-8")

@@ -15,8 +15,6 @@ from serialspec.cli.protocols import SPEC_HELP, open_spec
 from serialspec.runtime.errors import SerialspecError
 from serialspec.spec.model import FrameElement, Protocol, Scalar
 
-HELP = "serve virtual devices on a pseudo-terminal; prints the device path first, answers until stopped"
-
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("spec", help=SPEC_HELP)

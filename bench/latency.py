@@ -3,10 +3,11 @@
 `serialspec sim specs/<spec>.yaml --id 1 --quiet` runs as a separate process (it prints the pty path first). The
 benchmark process then times whole transactions, request written to reply decoded:
 
-- generated: the generated client (Fashion Star `read_angle(1)`, Hiwonder RRC `bus_servo.read_position(1)`,
-  FEETECH `read(1, "present_position")`); the rows of a protocol appear once its spec has a virtual device;
-- bare: pyserial `write(request)` then `read(len(reply))` with a 1 s timeout: no parsing at all, the floor;
-- vendor SDK: the same read through the vendor's Python SDK (Fashion Star, FEETECH; none is installed for RRC).
+- generated: the generated client (Fashion Star `read_angle(1)`, FEETECH `read(1, "present_position")`, and in
+  CASES Hiwonder RRC, DYNAMIXEL 2.0, Modbus RTU, VESC); the rows of a protocol appear once it has a virtual device;
+- bare: pyserial `write(request)` then `read(len(reply))` with a 1 s timeout, what a user writes: no parsing at
+  all, the floor (for Modbus RTU after the 3.5-character silence the protocol requires, as the generated bus);
+- vendor SDK: the same read through the vendor's Python SDK (Fashion Star, FEETECH; none is installed for the rest).
 
 Generated and bare alternate in blocks so that noise on the shared machine falls on both alike. Beside the median
 and p99 wall time per transaction, the CPU time the benchmark process spent per transaction

@@ -22,7 +22,7 @@ from serialspec.runtime.registers import ModelRegisters
 from serialspec.runtime.transport import Binding, Bus, ClientBase
 
 from dynamixel_p2 import MATCH_BY, SERIAL
-from dynamixel_p2.codec import StreamParser, encode
+from dynamixel_p2.codec import StreamParser, decode, encode
 from dynamixel_p2.messages import (
     ActionRequest,
     BulkReadRequest,
@@ -57,6 +57,7 @@ BINDING = Binding(
     protocol='dynamixel_p2',
     serial=SERIAL,
     encode=encode,
+    decode=decode,
     parser=lambda: StreamParser(Direction.RESPONSE),
     match_by=MATCH_BY,
     status=('error',),

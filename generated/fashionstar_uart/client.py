@@ -20,7 +20,7 @@ from serialspec.runtime.message import Message
 from serialspec.runtime.transport import Binding, Bus, ClientBase, table_key
 
 from fashionstar_uart import MATCH_BY, SERIAL
-from fashionstar_uart.codec import StreamParser, encode
+from fashionstar_uart.codec import StreamParser, decode, encode
 from fashionstar_uart.messages import (
     AsyncEnd,
     BeginAsyncRequest,
@@ -89,6 +89,7 @@ BINDING = Binding(
     protocol='fashionstar_uart',
     serial=SERIAL,
     encode=encode,
+    decode=decode,
     parser=lambda: StreamParser(Direction.RESPONSE),
     match_by=MATCH_BY,
     status=(),

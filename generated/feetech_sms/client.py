@@ -23,7 +23,7 @@ from serialspec.runtime.registers import ModelRegisters
 from serialspec.runtime.transport import Binding, Bus, ClientBase, flag_names
 
 from feetech_sms import MATCH_BY, SERIAL
-from feetech_sms.codec import StreamParser, encode
+from feetech_sms.codec import StreamParser, decode, encode
 from feetech_sms.messages import (
     ActionRequest,
     Direction,
@@ -48,6 +48,7 @@ BINDING = Binding(
     protocol='feetech_sms',
     serial=SERIAL,
     encode=encode,
+    decode=decode,
     parser=lambda: StreamParser(Direction.RESPONSE),
     match_by=MATCH_BY,
     status=('error',),

@@ -20,7 +20,7 @@ import serial
 from serialspec.runtime.transport import Binding, Bus, ClientBase, check_status
 
 from hiwonder_rrc import MATCH_BY, SERIAL
-from hiwonder_rrc.codec import StreamParser, encode
+from hiwonder_rrc.codec import StreamParser, decode, encode
 from hiwonder_rrc.messages import (
     BusServoLoadRequest,
     BusServoReadIdRequest,
@@ -88,6 +88,7 @@ BINDING = Binding(
     protocol='hiwonder_rrc',
     serial=SERIAL,
     encode=encode,
+    decode=decode,
     parser=lambda: StreamParser(Direction.RESPONSE),
     match_by=MATCH_BY,
     status=(),

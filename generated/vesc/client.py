@@ -23,7 +23,7 @@ import serial
 from serialspec.runtime.transport import Binding, Bus, ClientBase
 
 from vesc import MATCH_BY, SERIAL
-from vesc.codec import StreamParser, encode
+from vesc.codec import StreamParser, decode, encode
 from vesc.messages import (
     AliveRequest,
     Direction,
@@ -49,6 +49,7 @@ BINDING = Binding(
     protocol='vesc',
     serial=SERIAL,
     encode=encode,
+    decode=decode,
     parser=lambda: StreamParser(Direction.RESPONSE),
     match_by=MATCH_BY,
     status=(),

@@ -93,6 +93,9 @@ class Binding:
     status: tuple[str, ...] = ()  # reply fields whose non-zero value is a device error (frame status elements)
     describe_status: Callable[[str, int], str] = field(default=lambda name, value: f"{name} = {value:#04x}")
     errors: ErrorReplies | None = None  # the protocol's error reply, if it has one
+    # decode(frame, "response", expect): one whole reply, or DecodeError; a transaction's read of exactly the size
+    # the last reply of its type had is decoded at once, without the stream parser's scan
+    decode: Callable[[bytes, str, type[Message] | None], Message] | None = None
 
 
 def check_status(request: Message, reply: Message, name: str, ok: int, match_by: tuple[str, ...]) -> None:
@@ -340,6 +343,8 @@ class Bus:
         self._match_command = "command" in match_by
         self._match_subcommand = "subcommand" in match_by
         self._match_fields = tuple(name for name in match_by if name not in ("command", "subcommand"))
+        self._decode = binding.decode
+        self._sizes: dict[type, int] = {}  # the size of the last reply of each type read whole (see request)
         self._rules: dict[type, _Rule] = {}  # the latest rule of each reply type
         self._all_rules: dict[tuple[type, type], _Rule] = {}
 
@@ -435,22 +440,34 @@ class Bus:
             if chunk:
                 if self._gap:
                     self._last_io = time.monotonic()
-                messages = parser.feed(chunk)
-                if len(messages) == 1:
-                    reply = messages[0]
-                    if reply.__class__ is expect:
-                        rule = self._rules.get(expect)
-                        if rule is None or rule[0] is not request.__class__:
-                            rule = self._rule(request.__class__, reply)
-                        _, possible, getter, refusals, statuses = rule
-                        if possible and (getter is None or getter(reply) == getter(request)):
-                            if refusals:
-                                self._refused(request, reply)
-                            for name, parts in statuses:
-                                value = getattr(reply, name)
-                                if value != 0 if not parts else any([getattr(value, p) != 0 for p in parts]):
-                                    self._check_status(reply)  # raises DeviceError
-                            return reply  # its class is expect
+                size = len(chunk)
+                messages: list[Message] | None = None
+                if size == self._sizes.get(expect) and not parser.pending():
+                    # the size the last reply of this type had: most likely that reply, whole; decoded at once
+                    try:
+                        found: Message | None = self._decode(chunk, "response", expect)  # type: ignore[misc]
+                    except Exception:  # anything else is for the parser, which counts it and resynchronises
+                        found = None
+                else:
+                    messages = parser.feed(chunk)
+                    found = messages[0] if len(messages) == 1 else None
+                if found is not None and found.__class__ is expect:
+                    rule = self._rules.get(expect)
+                    if rule is None or rule[0] is not request.__class__:
+                        rule = self._rule(request.__class__, found)
+                    _, possible, getter, refusals, statuses = rule
+                    if possible and (getter is None or getter(found) == getter(request)):
+                        if messages is not None and self._decode is not None:
+                            self._sizes[expect] = size
+                        if refusals:
+                            self._refused(request, found)
+                        for name, parts in statuses:
+                            value = getattr(found, name)
+                            if value != 0 if not parts else any([getattr(value, p) != 0 for p in parts]):
+                                self._check_status(found)  # raises DeviceError
+                        return found  # its class is expect
+                if messages is None:  # decoded at once but no reply to this request: the parser takes it
+                    messages = parser.feed(chunk)
                 self._backlog.extend(messages)  # _read_until takes them first
             reply = self._read_until(wait - (time.monotonic() - started), request, expect, errors=0)
             if self._backlog:

@@ -58,12 +58,14 @@ class SimUnavailable(Exception):
 
 
 @contextmanager
-def simulator(spec: str, device_id: int) -> Iterator[str]:
+def simulator(spec: str, device_id: int | None) -> Iterator[str]:
     """`serialspec sim` in another process; yields the pty path it prints first; stops it with SIGTERM."""
     name = Path(spec).stem
     if importlib.util.find_spec(f"{name}.simulator") is None:
         raise SimUnavailable(f"generated/{name}/simulator.py does not exist")
-    command = [str(Path(sys.executable).parent / "serialspec"), "sim", spec, "--id", str(device_id), "--quiet"]
+    command = [str(Path(sys.executable).parent / "serialspec"), "sim", spec, "--quiet"]
+    if device_id is not None:  # None: a protocol without device addresses (VESC)
+        command[3:3] = ["--id", str(device_id)]
     process = subprocess.Popen(command, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         assert process.stdout is not None and process.stderr is not None
@@ -232,6 +234,7 @@ class Case:
     how: str  # the call, as shown in the table
     call: Callable[[Any], object]
     request: Callable[[Any], object]  # the same request as a message of the protocol's package
+    device_id: int | None = 1  # the virtual device's address; None where frames carry none
 
 
 CASES = (
@@ -262,6 +265,7 @@ CASES = (
         "client.get_values()",
         lambda client: client.get_values(),
         lambda vesc: vesc.GetValuesRequest(),
+        device_id=None,
     ),
 )
 
@@ -334,7 +338,7 @@ def run() -> Table:
         notes.append(f"FEETECH SMS rows skipped: {exc}; they appear once `serialspec sim` serves it.")
     for case in CASES:
         try:
-            with simulator(f"specs/{case.protocol}.yaml", 1) as path:
+            with simulator(f"specs/{case.protocol}.yaml", case.device_id) as path:
                 results, sent, size, gap = plain(case, path)
         except SimUnavailable as exc:
             notes.append(f"{case.protocol} rows skipped: {exc}.")

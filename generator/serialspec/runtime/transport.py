@@ -416,9 +416,11 @@ class Bus:
                 parser.expect(expect)  # where replies share a code, the layout this request's reply has
             started = time.monotonic()
             chunk: bytes | None = None
-            if not (self._gap or self.echo):
+            if not self.echo:
                 parser.errors = 0
                 link = self._link
+                if self._gap:
+                    self._wait_gap()
                 try:
                     stale, chunk = link.transact(frame, wait)
                 except Exception as exc:
@@ -426,7 +428,7 @@ class Bus:
                     raise
                 if chunk is None:  # bytes came between transactions: to subscribers, then the request
                     self._stale(stale)
-            if chunk is None:  # the general path: a gap, an echo, or bytes that came before the request
+            if chunk is None:  # the general path: an echo, or bytes that came before the request
                 self._drain()
                 parser = self._parser  # a subscriber's own request may have reset it
                 parser.expect(expect)
@@ -437,9 +439,9 @@ class Bus:
                 except Exception as exc:
                     self._port_failed("read", exc)
                     raise
+            if self._gap:
+                self._last_io = time.monotonic()  # the reply's end, or the write's (no reply)
             if chunk:
-                if self._gap:
-                    self._last_io = time.monotonic()
                 size = len(chunk)
                 messages: list[Message] | None = None
                 if size == self._sizes.get(expect) and not parser.pending():
@@ -596,12 +598,15 @@ class Bus:
             self._port.close()
         raise PortError(f"{self.port_name}: {doing} failed: {reason}") from None
 
+    def _wait_gap(self) -> None:
+        """The one wait the bus makes: the silence a protocol needs before a frame (3.5 characters for Modbus)."""
+        wait = self._last_io + self._gap - time.monotonic()
+        if wait > 0:
+            time.sleep(wait)
+
     def _write(self, frame: bytes) -> None:
         if self._gap:
-            # the one wait the bus makes: the silence a protocol needs before a frame (3.5 characters for Modbus)
-            wait = self._last_io + self._gap - time.monotonic()
-            if wait > 0:
-                time.sleep(wait)
+            self._wait_gap()
         try:
             self._link.write(frame)
         except Exception as exc:

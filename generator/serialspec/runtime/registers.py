@@ -10,7 +10,6 @@ from __future__ import annotations
 import struct
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, replace
-from functools import partial
 
 from serialspec.runtime.errors import DecodeError, EncodeError, out_of_range
 
@@ -106,8 +105,7 @@ class RegisterMap:
         if found is None:
             register = self[name]
             layout = self._structs[name]
-            value = partial(self.value, register) if register.sign_bit is not None else _plain_value(name, layout)
-            found = self._readers[name] = (register.address, layout.size, value)
+            found = self._readers[name] = (register.address, layout.size, _value(name, layout, register.sign_bit))
         return found
 
     def unpack(self, start: int, data: bytes) -> dict[str, int]:
@@ -198,13 +196,17 @@ class ModelRegisters:
         return packed
 
 
-def _plain_value(name: str, layout: struct.Struct) -> Callable[[bytes], int]:
-    """RegisterMap.value for a register without a sign bit, as one call."""
+def _value(name: str, layout: struct.Struct, sign_bit: int | None) -> Callable[[bytes], int]:
+    """RegisterMap.value of one register as one call (what `from_wire` does, worked out for that register)."""
     unpack, size = layout.unpack_from, layout.size
+    magnitude = (1 << sign_bit) - 1 if sign_bit is not None else -1
 
     def value(data: bytes) -> int:
         if len(data) < size:
             raise DecodeError(f"{name}: {len(data)} bytes read, {size} needed")
-        return int(unpack(data)[0])
+        number = int(unpack(data)[0])
+        if sign_bit is not None and number >> sign_bit & 1:  # sign-magnitude: the sign bit set is negative
+            return -(number & magnitude)
+        return number
 
     return value

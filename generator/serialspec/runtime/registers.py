@@ -200,11 +200,14 @@ def _value(name: str, layout: struct.Struct, sign_bit: int | None) -> Callable[[
     """RegisterMap.value of one register as one call (what `from_wire` does, worked out for that register)."""
     unpack, size = layout.unpack_from, layout.size
     magnitude = (1 << sign_bit) - 1 if sign_bit is not None else -1
+    integral = layout.format[-1] in "bBhHiIlLqQ"  # unpacked as an int already
 
     def value(data: bytes) -> int:
         if len(data) < size:
             raise DecodeError(f"{name}: {len(data)} bytes read, {size} needed")
-        number = int(unpack(data)[0])
+        number: int = unpack(data)[0]
+        if not integral:
+            number = int(number)  # as from_wire does
         if sign_bit is not None and number >> sign_bit & 1:  # sign-magnitude: the sign bit set is negative
             return -(number & magnitude)
         return number

@@ -463,10 +463,15 @@ class Bus:
                             self._sizes[expect] = size
                         if refusals:
                             self._refused(request, found)
-                        for name, parts in statuses:
+                        for name, parts in statuses:  # _check_status raises DeviceError
                             value = getattr(found, name)
-                            if value != 0 if not parts else any([getattr(value, p) != 0 for p in parts]):
-                                self._check_status(found)  # raises DeviceError
+                            if not parts:
+                                if value != 0:  # an int's comparison (a flag's truth is a Python call)
+                                    self._check_status(found)
+                            else:  # bit fields: no comprehension (a function call of its own before 3.12)
+                                for part in parts:
+                                    if getattr(value, part) != 0:
+                                        self._check_status(found)
                         return found  # its class is expect
                 if messages is None:  # decoded at once but no reply to this request: the parser takes it
                     messages = parser.feed(chunk)

@@ -626,8 +626,8 @@ class PackageCode:
             code = f"{command_code:#04x}" if command_code is not None and layout.has_command else "None"
             if error is not None:
                 code = f"m.{error.element} | {error.flag:#04x}"
-            values = f"({frame_values[0]},)" if len(frame_values) == 1 else f"({', '.join(frame_values)})"
-            lines.append(f"return _{message.direction.name}_FRAMES.wrap({content}, {code}, {values})")
+            arguments = ", ".join([content, code, *frame_values])
+            lines.append(f"return _wrap_{message.direction.value}({arguments})")  # emit/python/framecode.py
             return lines
         code = str(command_code if command_code is not None else 0)
         if all(is_fixed_run_member(f) for f in fields):

@@ -1,0 +1,566 @@
+"""Straight-line code for frames that are not of the classic shape (stuffing, u16 lengths over a span, CRC-16s,
+frames without a header or a length, alternative layouts told apart by their header).
+
+Each direction gets two functions: `_decode_<direction>(frame, expect)` checks a whole frame and calls the content
+decoder on the frame's own bytes, and `_wrap_<direction>(content, code, *values)` puts the frame around a
+content. They make the runtime engine's checks (runtime/framing.py, Layout.unwrap and Layout.wrap) in the engine's
+order with the engine's messages, but as code written for one layout: every offset known when the layout is fixed
+is a literal, the bytes are unstuffed only when a stuffed sequence occurs (a `find` first), and a frame's content is
+decoded in place (no copy) unless it was stuffed. Where a layout does not fit that form (a length after the
+content, a checksum over bytes inside the stuffed span, ...) the two functions call the engine instead, so every
+layout the language describes works and the straight-line form is only ever a faster way to the same result.
+
+Positions are expressions over `buf`, the frame with its stuffed span replaced by the plain bytes (the frame itself
+when nothing is stuffed): an element before the content at a literal offset, an element after it at `end + k`,
+where `end` is the content's end. Lengths and checksums that see wire bytes read `frame`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from serialspec.emit.common.frames import runtime_layouts
+from serialspec.emit.python.frames import checksum_name
+from serialspec.runtime.framing import Element, Layout
+from serialspec.spec.model import Direction, Protocol
+
+Lines = list[str]
+
+
+@dataclass(frozen=True)
+class Target:
+    """What the frame functions of one direction call and pass on: the content decoders' table names, the error
+    reply's flag (codes with it set are error replies), whether replies are chosen by the expected class."""
+
+    upper: str  # REQUEST / RESPONSE
+    value_names: tuple[str, ...]  # the frame values every message of the direction carries, in element order
+    error_flag: int = 0
+    error_keep: int = 0
+    expected: bool = False
+
+
+def straight(layout: Layout) -> bool:
+    """Whether the layout fits the straight-line form: one content inside the variable part (the stuffed span, else
+    the content), lengths at fixed offsets before it, checksums after it and after what they cover, none of them
+    over bytes inside the stuffed span only, multi-byte elements at fixed offsets in one byte order."""
+    if layout.content < 0:
+        return False
+    first, last = _variable(layout)
+    if not first <= layout.content <= last:
+        return False
+    for index, element in enumerate(layout.elements):
+        if element.kind == "length" and index >= first:
+            return False
+        if element.kind == "checksum":
+            a, b = element.span
+            if index <= last or b >= index or _inside(layout, a, b):
+                return False
+    packed = [e for e in layout.elements if e.kind in ("value", "command", "length") and e.size > 1]
+    return len({e.endian for e in packed}) <= 1
+
+
+def _variable(layout: Layout) -> tuple[int, int]:
+    """The elements whose size is known only at run time: the stuffed span, else the content alone."""
+    return layout.transparency.span if layout.transparency is not None else (layout.content, layout.content)
+
+
+def _inside(layout: Layout, a: int, b: int) -> bool:
+    """Whether elements a..b lie inside the stuffed span without holding all of it (they see the plain bytes)."""
+    t = layout.transparency
+    return t is not None and t.span[0] <= a and b <= t.span[1] and (a, b) != t.span
+
+
+def _size(elements: tuple[Element, ...]) -> int:
+    return sum(e.size for e in elements)
+
+
+class _Places:
+    """Element positions in `buf` (plain bytes): a literal offset before the content, `end + k` after it."""
+
+    def __init__(self, layout: Layout) -> None:
+        self.layout = layout
+        self.first, self.last = _variable(layout)
+        c = layout.content
+        self.before = _size(layout.elements[: self.first])  # wire bytes before the variable part
+        self.after = _size(layout.elements[self.last + 1 :])  # wire bytes after it
+        self.content = _size(layout.elements[:c])  # the content's offset
+        self.behind = _size(layout.elements[c + 1 :])  # bytes after the content (plain)
+        self.starts: list[tuple[bool, int]] = []  # (after the content, offset from 0 or from end)
+        position = 0
+        for index, element in enumerate(layout.elements):
+            if index < c:
+                self.starts.append((False, position))
+                position += element.size
+            elif index == c:
+                self.starts.append((False, position))
+                position = 0
+            else:
+                self.starts.append((True, position))
+                position += element.size
+
+    def at(self, index: int, extra: int = 0) -> str:
+        """The position of byte `extra` of element `index`."""
+        behind, offset = self.starts[index]
+        offset += extra
+        if not behind:
+            return str(offset)
+        return f"end + {offset}" if offset else "end"
+
+    def stop(self, index: int) -> str:
+        """The position just after element `index`."""
+        if index == self.layout.content:
+            return "end"
+        return self.at(index, self.layout.elements[index].size)
+
+    def read(self, index: int) -> str:
+        """The element's value, read from `buf`."""
+        element = self.layout.elements[index]
+        at = [self.at(index, i) for i in range(element.size)]
+        if element.size == 1:
+            return f"buf[{at[0]}]"
+        if element.size == 2:
+            high, low = (at[0], at[1]) if element.endian == "big" else (at[1], at[0])
+            return f"buf[{high}] << 8 | buf[{low}]"
+        return f"int.from_bytes(buf[{at[0]}:{self.stop(index)}], {element.endian!r})"
+
+    def counted(self, a: int, b: int) -> str:
+        """Bytes of elements a..b as a length counts them (wire bytes, but plain ones inside the stuffed span)."""
+        elements = self.layout.elements
+        if a <= self.first and self.last <= b:  # holds the variable part: the wire frame minus what lies outside
+            outside = (
+                self.before + self.after - _size(elements[a : self.first]) - _size(elements[self.last + 1 : b + 1])
+            )
+            return _plus("n", -outside)
+        c = self.layout.content
+        if a <= c <= b:  # inside the stuffed span: plain bytes
+            return _plus("end", _size(elements[a:c]) + _size(elements[c + 1 : b + 1]) - self.content)
+        return str(_size(elements[a : b + 1]))
+
+    def covered(self, a: int, b: int) -> str:
+        """The bytes a checksum over elements a..b sees: wire bytes of `frame` when they hold the variable part."""
+        elements = self.layout.elements
+        if a <= self.first and self.last <= b:
+            begin = _size(elements[:a])
+            tail = _size(elements[b + 1 :])
+            return f"frame[{begin or ''}:{-tail if tail else ''}]"
+        return f"buf[{_start(self.at(a))}:{self.stop(b)}]"
+
+
+def _message_constant(element: Element, data: str) -> str:
+    return f"f\"{element.name} is {{{data}.hex(' ')}}, expected {element.constant.hex(' ')}\""
+
+
+def decode_lines(layout: Layout, name: str, target: Target, checks: dict[int, str], transparency: str) -> Lines:
+    """`def <name>(frame, expect)`: one layout's frame checked in the engine's order, its content decoded.
+
+    `checks`: element index -> the checksum function's name; `transparency`: the name of the layout's
+    Transparency object (unstuffing, with its error for a frame that is not in stuffed form).
+    """
+    places = _Places(layout)
+    elements = layout.elements
+    lines: Lines = [
+        f"def {name}(frame: bytes, expect: type[Message] | None = None) -> Message:",
+        f'    """One complete {layout.name} frame, checked and taken apart; its content decoded."""',
+        "    n = len(frame)",
+    ]
+    body: Lines = []
+    smallest = places.before + places.after
+    if smallest:
+        body += [
+            f"if n < {smallest}:",
+            f'    raise DecodeError(f"frame of {{n}} bytes is shorter than the smallest {layout.name} frame '
+            f'({layout.overhead})")',
+        ]
+    t = layout.transparency
+    body.append(f"end = n - {places.behind}" if places.behind else "end = n")
+    if t is None:
+        body.append("buf = frame")
+    else:
+        stop = f"n - {places.after}" if places.after else "n"
+        found = " or ".join(f"frame.find({s!r}, {places.before}, {stop}) >= 0" for s in _signs(t.replace))
+        body += [
+            "buf = frame",
+            f"if {found}:  # stuffed: the plain bytes of the span",
+            f"    buf = frame[:{places.before}] + {transparency}.decode(frame[{places.before} : {stop}])"
+            + (f" + frame[{stop} :]" if places.after else ""),
+            f"    end = len(buf) - {places.behind}" if places.behind else "    end = len(buf)",
+        ]
+        fixed = _size(elements[places.first : places.last + 1])
+        if fixed:
+            inner = _plus("end", places.behind - places.after - places.before)
+            body += [
+                f"if end < {places.content}:",
+                f'    raise DecodeError(f"{layout.name} frame: {{{inner}}} bytes where at least {fixed} belong")',
+            ]
+    body += _constant_checks(places)
+    command = layout.command
+    values: list[str] = []
+    for index in layout.values:
+        element = elements[index]
+        value = f"v_{element.name}"
+        values.append(value)
+        body.append(f"{value} = {places.read(index)}")
+        full = element.minimum <= 0 and element.maximum >= (1 << (8 * element.size)) - 1
+        if full:
+            continue
+        also = f" or {value} == {element.also}" if element.also is not None else ""
+        shown = f" (or {element.also})" if element.also is not None else ""
+        body += [
+            f"if not ({element.minimum} <= {value} <= {element.maximum}{also}):",
+            f'    raise DecodeError(f"{element.name} = {{{value}}} is outside its range '
+            f'{element.minimum}..{element.maximum}{shown}")',
+        ]
+    for index, element in enumerate(elements):
+        if element.kind != "length":
+            continue
+        counted = places.counted(*element.span)
+        counted = _plus(counted, element.adds)
+        body += [
+            f"length = {places.read(index)}",
+            f"if length != {counted}:",
+            f'    raise DecodeError(f"{element.name} says {{length}} but the frame holds {{{counted}}}")',
+        ]
+    for index, element in enumerate(elements):
+        if element.kind != "checksum":
+            continue
+        width = 2 + 2 * element.size
+        body += [
+            f"check = {checks[index]}({places.covered(*element.span)})",
+            f"stored = {places.read(index)}",
+            "if check != stored:",
+            f'    raise ChecksumError(f"bad {element.name}: the frame has {{stored:#0{width}x}}, '
+            f'its bytes give {{check:#0{width}x}}")',
+        ]
+    arguments = ", ".join(["buf", str(places.content), "end", *values])
+    table = f"_{target.upper}_DECODERS"
+    if command is None:
+        body.append(f"decoder = {table}.get(None)")
+        code = "None"
+    else:
+        body.append(f"code = {places.read(command)}")
+        code = "code"
+        if target.error_flag:
+            body += [
+                f"if code & {target.error_flag:#04x}:  # an error reply: it refuses the request of code & ~flag",
+                f"    return {table}[ERROR_REPLY]({arguments}, code & {target.error_keep:#04x})",
+            ]
+        body.append(f"decoder = {table}.get(code)")
+    if target.expected:
+        body += [
+            "if expect is not None:",
+            f"    expected, alternative = _{target.upper}_EXPECTED.get(expect, (None, None))",
+            f"    if alternative is not None and expected {'is' if code == 'None' else '=='} {code}:",
+            "        decoder = alternative",
+        ]
+    body += [
+        "if decoder is None:",
+        f'    raise DecodeError(f"unknown command {{{code}!r}}")'
+        if code != "None"
+        else '    raise DecodeError("unknown command None")',
+        f"return decoder({arguments})",
+    ]
+    return lines + [f"    {line}" for line in body]
+
+
+def _signs(replace: tuple[tuple[bytes, bytes], ...]) -> list[bytes]:
+    """The sequences whose absence shows a span is not stuffed (its plain and wire bytes are the same): every
+    plain and wire sequence, less those that hold another one (found whenever it is)."""
+    every = sorted({s for pair in replace for s in pair}, key=len)
+    return [s for i, s in enumerate(every) if not any(o in s for o in every[:i])]
+
+
+def _constant_checks(places: _Places) -> Lines:
+    """Constant elements checked in element order; neighbours compared at once, one by one only to say which."""
+    layout = places.layout
+    runs: list[list[int]] = []
+    for index, element in enumerate(layout.elements):
+        if element.kind != "constant":
+            continue
+        if runs and runs[-1][-1] == index - 1:
+            runs[-1].append(index)
+        else:
+            runs.append([index])
+    lines: Lines = []
+    for run in runs:
+        each = [(index, layout.elements[index]) for index in run]
+        single: list[tuple[str, str, str]] = []  # condition, message per element
+        for index, element in each:
+            if element.size == 1:
+                condition = f"buf[{places.at(index)}] != {element.constant[0]:#04x}"
+                data = f"buf[{places.at(index)}:{places.stop(index)}]"
+            else:
+                data = f"buf[{_start(places.at(index))}:{places.stop(index)}]"
+                condition = f"{data} != {element.constant!r}"
+            single.append((condition, _message_constant(element, data), element.name))
+        if len(each) == 1:
+            condition, message, _ = single[0]
+            lines += [f"if {condition}:", f"    raise DecodeError({message})"]
+            continue
+        whole = b"".join(element.constant for _, element in each)
+        lines.append(f"if buf[{_start(places.at(run[0]))}:{places.stop(run[-1])}] != {whole!r}:")
+        for condition, message, _ in single[:-1]:
+            lines += [f"    if {condition}:", f"        raise DecodeError({message})"]
+        lines.append(f"    raise DecodeError({single[-1][1]})")
+    return lines
+
+
+def _start(position: str) -> str:
+    return "" if position == "0" else position
+
+
+def wrap_lines(
+    layout: Layout, name: str, target: Target, checks: dict[int, str], transparency: str, structs: dict[str, str]
+) -> Lines:
+    """`def <name>(content, code, *values) -> bytes`: the frame around `content`, as Layout.wrap makes it.
+
+    `checks` and `transparency` as for decode_lines; `structs`: the struct constants it uses (name -> format), for
+    the module to define.
+    """
+    places = _Places(layout)
+    elements = layout.elements
+    parameters = ", ".join(["content: bytes", "code: int | None", *(f"v_{v}: int" for v in target.value_names)])
+    lines: Lines = [
+        f"def {name}({parameters}) -> bytes:",
+        f'    """The {layout.name} frame around `content`; EncodeError when its length does not fit."""',
+    ]
+    body: Lines = []
+    value_of = dict(zip(layout.values, target.value_names, strict=True))
+
+    def argument(index: int) -> str:
+        element = elements[index]
+        if element.kind == "constant":
+            return repr(element.constant)
+        if element.kind == "command":
+            return "code"
+        if element.kind == "length":
+            return f"v_{element.name}"
+        return f"v_{value_of[index]}"
+
+    def packed(indices: list[int], order: str) -> str:
+        """One expression for the bytes of these elements: a literal, else one struct (neighbouring constants
+        as one `Ns` argument)."""
+        if not indices:
+            return ""
+        if all(elements[i].kind == "constant" for i in indices):
+            return repr(b"".join(elements[i].constant for i in indices))
+        fmt, arguments = order, []
+        constant = b""
+        for i in [*indices, -1]:
+            if i >= 0 and elements[i].kind == "constant":
+                constant += elements[i].constant
+                continue
+            if constant:
+                fmt += f"{len(constant)}s"
+                arguments.append(repr(constant))
+                constant = b""
+            if i >= 0:
+                fmt += _STRUCT_CHARS[elements[i].size]
+                arguments.append(argument(i))
+        name = _struct_name(fmt)
+        structs[name] = fmt
+        return f"{name}.pack({', '.join(arguments)})"
+
+    def order_of(indices: list[int]) -> str:
+        multi = {elements[i].endian for i in indices if elements[i].kind != "constant" and elements[i].size > 1}
+        return ">" if multi == {"big"} else "<"
+
+    first, last = places.first, places.last
+    c = layout.content
+    inner_before = list(range(first, c))
+    inner_after = list(range(c + 1, last + 1))
+    parts = [p for p in (packed(inner_before, order_of(inner_before)), "content") if p]
+    parts += [p for p in (packed(inner_after, order_of(inner_after)),) if p]
+    variable = " + ".join(parts)
+    t = layout.transparency
+    if t is None:
+        wire = variable
+    else:
+        body.append(f"plain = {variable}")
+        if len(t.replace) == 1:
+            plain, stuffed = t.replace[0]
+            body.append(f"wire = plain.replace({plain!r}, {stuffed!r})")
+        else:
+            body.append(f"wire = {transparency}.encode(plain)")
+        wire = "wire"
+    variable_size = _size(elements[first : last + 1])
+    for element in elements:
+        if element.kind != "length":
+            continue
+        a, b = element.span
+        if a <= first and last <= b:
+            fixed = _size(elements[a : b + 1]) - variable_size
+            value = f"len({'content' if t is None else 'wire'}) + {fixed + element.adds}"
+        elif a <= c <= b:  # inside the stuffed span: plain bytes
+            fixed = _size(elements[a : b + 1])
+            value = f"len(content) + {fixed + element.adds}"
+        else:
+            value = str(_size(elements[a : b + 1]) + element.adds)
+        value = value.replace(" + 0", "").replace("+ -", "- ")
+        limit = 1 << (8 * element.size)
+        name = f"v_{element.name}"
+        body += [
+            f"{name} = {value}",
+            f"if not 0 <= {name} < {limit}:" if element.adds < 0 else f"if {name} >= {limit}:",
+            f'    raise EncodeError(f"{layout.name} frame: length {{{name}}} does not fit its '
+            f'{element.size}-byte field")',
+        ]
+    head = list(range(first))
+    start = packed(head, order_of(head))
+    frame = " + ".join(p for p in (start, wire) if p)
+    pending: list[int] = []  # elements after the variable part not yet in `frame`
+    for index in range(last + 1, len(elements)):
+        element = elements[index]
+        if element.kind != "checksum":
+            pending.append(index)
+            continue
+        if pending:
+            frame = f"{frame} + {packed(pending, order_of(pending))}"
+            pending = []
+        a, b = element.span
+        begin = _size(elements[:a])
+        between = _size(elements[b + 1 : index])
+        # all after the variable part: counted back from the end of what is written
+        begin_expr = str(-_size(elements[a:index])) if a > last else str(begin) if begin else ""
+        covered = f"frame[{begin_expr}:{-between if between else ''}]".replace("[:]", "")
+        body.append(f"frame = {frame}")
+        frame = f"frame + {checks[index]}({covered}).to_bytes({element.size}, {element.endian!r})"
+    if pending:
+        frame = f"{frame} + {packed(pending, order_of(pending))}"
+    body.append(f"return {frame}")
+    return lines + [f"    {line}" for line in body]
+
+
+_STRUCT_CHARS = {1: "B", 2: "H", 4: "I", 8: "Q"}
+
+
+def _struct_name(fmt: str) -> str:
+    """A struct constant's name from its format, prefixed to stay clear of the content's `_S_` constants."""
+    tokens = ["BE" if fmt[0] == ">" else "LE"]
+    for count, char in _tokens(fmt[1:]):
+        tokens.append(f"{count}S" if char == "s" else {"B": "U8", "H": "U16", "I": "U32", "Q": "U64"}[char])
+    return "_F_" + "_".join(tokens)
+
+
+def _tokens(fmt: str) -> list[tuple[str, str]]:
+    found: list[tuple[str, str]] = []
+    count = ""
+    for char in fmt:
+        if char.isdigit():
+            count += char
+        else:
+            found.append((count, char))
+            count = ""
+    return found
+
+
+def engine_lines(layouts: tuple[Layout, ...], target: Target) -> tuple[Lines, Lines]:
+    """The two functions of a direction whose layouts keep the interpreted engine (FrameCodec)."""
+    direction = target.upper.lower()
+    frames = f"_{target.upper}_FRAMES"
+    values = [f"v_{v}" for v in target.value_names]
+    shown = f"({values[0]},)" if len(values) == 1 else f"({', '.join(values)})"
+    parameters = ", ".join(["content: bytes", "code: int | None", *(f"{v}: int" for v in values)])
+    wrap = [
+        f"def _wrap_{direction}({parameters}) -> bytes:",
+        f'    """The {direction} frame around `content`, made by the frame engine."""',
+        f"    return {frames}.wrap(content, code, {shown})",
+    ]
+    table = f"_{target.upper}_DECODERS"
+    decode = [
+        f"def _decode_{direction}(frame: bytes, expect: type[Message] | None = None) -> Message:",
+        f'    """One complete {direction} frame, checked and taken apart by the frame engine; its content decoded."""',
+        f"    unwrapped = {frames}.unwrap(frame)",
+    ]
+    if target.error_flag:
+        decode += [
+            "    code = unwrapped.code",
+            f"    if code is not None and code & {target.error_flag:#04x}:  # an error reply: it refuses the request "
+            "of code & ~flag",
+            "        content = unwrapped.content",
+            f"        return {table}[ERROR_REPLY](content, 0, len(content), *unwrapped.values, "
+            f"code & {target.error_keep:#04x})",
+        ]
+    decode.append(f"    decoder = {table}.get(unwrapped.code)")
+    if target.expected:
+        decode += [
+            "    if expect is not None:",
+            f"        code, alternative = _{target.upper}_EXPECTED.get(expect, (None, None))",
+            "        if alternative is not None and code == unwrapped.code:",
+            "            decoder = alternative",
+        ]
+    decode += [
+        "    if decoder is None:",
+        '        raise DecodeError(f"unknown command {unwrapped.code!r}")',
+        "    content = unwrapped.content",
+        "    return decoder(content, 0, len(content), *unwrapped.values)",
+    ]
+    return decode, wrap
+
+
+def direction_functions(
+    protocol: Protocol, direction: Direction, target: Target, structs: dict[str, str]
+) -> tuple[Lines, bool]:
+    """Module-level code of one direction's frame functions (`_decode_<d>`, `_wrap_<d>` and what they use), and
+    whether it is straight-line code (else the engine's)."""
+    layouts = runtime_layouts(protocol, direction)
+    models = protocol.framing.alternatives[direction]
+    names = {tuple(e.name for e in (layout.elements[i] for i in layout.values)) for layout in layouts}
+    if not all(straight(layout) for layout in layouts) or len(names) != 1:
+        decode, wrap = engine_lines(layouts, target)
+        return [*decode, "", "", *wrap], False
+    d = direction.value
+    several = len(layouts) > 1
+    lines: Lines = []
+    for layout, model in zip(layouts, models, strict=True):
+        suffix = f"_{layout.name}" if several else ""
+        checks = {
+            index: checksum_name(element.checksum)
+            for index, element in enumerate(model.elements)
+            if element.checksum is not None
+        }
+        stuffing = f"_{target.upper}{suffix.upper()}_TRANSPARENCY"
+        if layout.transparency is not None:
+            t = layout.transparency
+            pairs = ", ".join(f"({plain!r}, {wire!r})" for plain, wire in t.replace)
+            lines += [f"{stuffing} = Transparency({t.span}, ({pairs},))", "", ""]
+        lines += decode_lines(layout, f"_decode_{d}{suffix}", target, checks, stuffing)
+        lines += ["", ""]
+        lines += wrap_lines(layout, f"_wrap_{d}{suffix}", target, checks, stuffing, structs)
+        lines += ["", ""]
+    if several:
+        lines += _choosers(layouts, d, target)
+    while lines and not lines[-1]:
+        lines.pop()
+    return lines, True
+
+
+def _choosers(layouts: tuple[Layout, ...], d: str, target: Target) -> Lines:
+    """Functions that pick a layout: on decode by the frame's header, on encode the first whose length fits."""
+    choices = " or ".join(layout.header.hex(" ") for layout in layouts)
+    lines = [
+        f"def _decode_{d}(frame: bytes, expect: type[Message] | None = None) -> Message:",
+        f'    """One complete {d} frame, in the layout its header names."""',
+    ]
+    for layout in layouts:
+        lines += [
+            f"    if frame.startswith({layout.header!r}):",
+            f"        return _decode_{d}_{layout.name}(frame, expect)",
+        ]
+    lines += [f"    raise DecodeError(f\"frame starts {{frame[:4].hex(' ')}}, expected {choices}\")", "", ""]
+    values = "".join(f", v_{v}" for v in target.value_names)
+    parameters = ", ".join(["content: bytes", "code: int | None", *(f"v_{v}: int" for v in target.value_names)])
+    lines += [
+        f"def _wrap_{d}({parameters}) -> bytes:",
+        f'    """The {d} frame around `content` in the first layout whose length can count it."""',
+        f"    for wrap in ({', '.join(f'_wrap_{d}_{layout.name}' for layout in layouts[:-1])},):",
+        "        try:",
+        f"            return wrap(content, code{values})",
+        "        except EncodeError:",
+        "            continue",
+        f"    return _wrap_{d}_{layouts[-1].name}(content, code{values})",
+    ]
+    return lines
+
+
+def _plus(expression: str, k: int) -> str:
+    return f"{expression} + {k}" if k > 0 else f"{expression} - {-k}" if k else expression

@@ -288,6 +288,8 @@ def _decode_bulk_read_request(buf: bytes, o: int, end: int, id: int) -> BulkRead
 def _decode_bulk_write_request(buf: bytes, o: int, end: int, id: int) -> BulkWriteRequest:
     v_writes_list = []
     while o < end:
+        if end - o < 5:
+            raise DecodeError('bulk_write request' + f': id needs 5 bytes, {end - o} left')
         v_id, v_address, v_length = _S_U8_U16_U16.unpack_from(buf, o)
         o += 5
         if end - o < v_length:
@@ -568,11 +570,11 @@ def _decode_request(frame: bytes, expect: type[Message] | None = None) -> Messag
 
 
 def _wrap_request(content: bytes, code: int | None, v_id: int) -> bytes:
-    """The request frame around `content`; EncodeError when its length does not fit."""
+    """The request frame around `content`, EncodeError if it cannot be."""
     plain = _F_LE_U8.pack(code) + content
     wire = plain.replace(b'\xff\xff\xfd', b'\xff\xff\xfd\xfd')
     v_length = len(wire) + 2
-    if v_length >= 65536:
+    if not v_length < 65536:
         raise EncodeError(f"request frame: length {v_length} does not fit its 2-byte field")
     frame = _F_LE_4S_U8_U16.pack(b'\xff\xff\xfd\x00', v_id, v_length) + wire
     return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
@@ -651,11 +653,11 @@ def _decode_response(frame: bytes, expect: type[Message] | None = None) -> Messa
 
 
 def _wrap_response(content: bytes, code: int | None, v_id: int, v_error: int) -> bytes:
-    """The response frame around `content`; EncodeError when its length does not fit."""
+    """The response frame around `content`, EncodeError if it cannot be."""
     plain = _F_LE_1S_U8.pack(b'U', v_error) + content
     wire = plain.replace(b'\xff\xff\xfd', b'\xff\xff\xfd\xfd')
     v_length = len(wire) + 2
-    if v_length >= 65536:
+    if not v_length < 65536:
         raise EncodeError(f"response frame: length {v_length} does not fit its 2-byte field")
     frame = _F_LE_4S_U8_U16.pack(b'\xff\xff\xfd\x00', v_id, v_length) + wire
     return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
@@ -687,9 +689,73 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
     if direction is None:
         raise DecodeError("give the direction: requests and responses cannot be told apart by their first bytes")
     if direction == 'request':  # a Direction or its value
-        return _decode_request(bytes(data), expect)
+        frame = bytes(data)
+        n = len(frame)
+        if n < 9:
+            raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (10)")
+        end = n - 2
+        buf = frame
+        if frame.find(b'\xff\xff\xfd', 7, n - 2) >= 0:  # stuffed: the plain bytes of the span
+            buf = frame[:7] + _REQUEST_TRANSPARENCY.decode(frame[7 : n - 2]) + frame[n - 2 :]
+            end = len(buf) - 2
+        if end < 8:
+            raise DecodeError(f"request frame: {end - 7} bytes where at least 1 belong")
+        if buf[:4] != b'\xff\xff\xfd\x00':
+            if buf[:3] != b'\xff\xff\xfd':
+                raise DecodeError(f"header is {buf[:3].hex(' ')}, expected ff ff fd")
+            raise DecodeError(f"reserved is {buf[3:4].hex(' ')}, expected 00")
+        v_id = buf[4]
+        if not (0 <= v_id <= 252 or v_id == 254):
+            raise DecodeError(f"id = {v_id} is outside its range 0..252 (or 254)")
+        length = buf[6] << 8 | buf[5]
+        if length != n - 7:
+            raise DecodeError(f"length says {length} but the frame holds {n - 7}")
+        check = _CHECK_CRC(frame[:-2])
+        stored = buf[end + 1] << 8 | buf[end]
+        if check != stored:
+            raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
+        code = buf[7]
+        decoder = _REQUEST_DECODERS.get(code)
+        if decoder is None:
+            raise DecodeError(f"unknown command {code!r}")
+        return decoder(buf, 8, end, v_id)
     if direction == 'response':  # a Direction or its value
-        return _decode_response(bytes(data), expect)
+        frame = bytes(data)
+        n = len(frame)
+        if n < 9:
+            raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (11)")
+        end = n - 2
+        buf = frame
+        if frame.find(b'\xff\xff\xfd', 7, n - 2) >= 0:  # stuffed: the plain bytes of the span
+            buf = frame[:7] + _RESPONSE_TRANSPARENCY.decode(frame[7 : n - 2]) + frame[n - 2 :]
+            end = len(buf) - 2
+        if end < 9:
+            raise DecodeError(f"response frame: {end - 7} bytes where at least 2 belong")
+        if buf[:4] != b'\xff\xff\xfd\x00':
+            if buf[:3] != b'\xff\xff\xfd':
+                raise DecodeError(f"header is {buf[:3].hex(' ')}, expected ff ff fd")
+            raise DecodeError(f"reserved is {buf[3:4].hex(' ')}, expected 00")
+        if buf[7] != 0x55:
+            raise DecodeError(f"instruction is {buf[7:8].hex(' ')}, expected 55")
+        v_id = buf[4]
+        if not (0 <= v_id <= 252 or v_id == 254):
+            raise DecodeError(f"id = {v_id} is outside its range 0..252 (or 254)")
+        v_error = buf[8]
+        length = buf[6] << 8 | buf[5]
+        if length != n - 7:
+            raise DecodeError(f"length says {length} but the frame holds {n - 7}")
+        check = _CHECK_CRC(frame[:-2])
+        stored = buf[end + 1] << 8 | buf[end]
+        if check != stored:
+            raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
+        decoder = _RESPONSE_DECODERS.get(None)
+        if expect is not None:
+            expected, alternative = _RESPONSE_EXPECTED.get(expect, (None, None))
+            if alternative is not None and expected is None:
+                decoder = alternative
+        if decoder is None:
+            raise DecodeError("unknown command None")
+        return decoder(buf, 9, end, v_id, v_error)
     raise ValueError(f"direction must be request or response, not {direction!r}")
 
 

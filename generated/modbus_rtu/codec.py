@@ -477,8 +477,9 @@ def _encode_read_holding_registers_response(m: ReadHoldingRegistersResponse) -> 
     v_byte_count = (2 * len(m.registers))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('read_holding_registers response', 'byte_count', v_byte_count, 0, 255)
-    if any(not 0 <= x <= 65535 or x.__class__ is bool for x in m.registers):
-        raise out_of_range('read_holding_registers response', 'registers', m.registers, 0, 65535)
+    for x_registers in m.registers:
+        if not 0 <= x_registers <= 65535 or x_registers.__class__ is bool:
+            raise out_of_range('read_holding_registers response', 'registers', m.registers, 0, 65535)
     return _wrap_response(b''.join((_S_BE_U8.pack(v_byte_count), struct.pack(f'>{len(m.registers)}H', *m.registers),)), 0x03, m.unit)
 
 
@@ -498,8 +499,9 @@ def _encode_read_input_registers_response(m: ReadInputRegistersResponse) -> byte
     v_byte_count = (2 * len(m.registers))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('read_input_registers response', 'byte_count', v_byte_count, 0, 255)
-    if any(not 0 <= x <= 65535 or x.__class__ is bool for x in m.registers):
-        raise out_of_range('read_input_registers response', 'registers', m.registers, 0, 65535)
+    for x_registers in m.registers:
+        if not 0 <= x_registers <= 65535 or x_registers.__class__ is bool:
+            raise out_of_range('read_input_registers response', 'registers', m.registers, 0, 65535)
     return _wrap_response(b''.join((_S_BE_U8.pack(v_byte_count), struct.pack(f'>{len(m.registers)}H', *m.registers),)), 0x04, m.unit)
 
 
@@ -578,8 +580,9 @@ def _encode_write_registers_request(m: WriteRegistersRequest) -> bytes:
     v_byte_count = (2 * (len(m.values)))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('write_registers request', 'byte_count', v_byte_count, 0, 255)
-    if any(not 0 <= x <= 65535 or x.__class__ is bool for x in m.values):
-        raise out_of_range('write_registers request', 'values', m.values, 0, 65535)
+    for x_values in m.values:
+        if not 0 <= x_values <= 65535 or x_values.__class__ is bool:
+            raise out_of_range('write_registers request', 'values', m.values, 0, 65535)
     return _wrap_request(b''.join((_S_BE_U16_U16_U8.pack(m.address, v_count, v_byte_count), struct.pack(f'>{len(m.values)}H', *m.values),)), 0x10, m.unit)
 
 
@@ -632,8 +635,9 @@ def _encode_read_write_registers_request(m: ReadWriteRegistersRequest) -> bytes:
     v_byte_count = (2 * (len(m.values)))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('read_write_registers request', 'byte_count', v_byte_count, 0, 255)
-    if any(not 0 <= x <= 65535 or x.__class__ is bool for x in m.values):
-        raise out_of_range('read_write_registers request', 'values', m.values, 0, 65535)
+    for x_values in m.values:
+        if not 0 <= x_values <= 65535 or x_values.__class__ is bool:
+            raise out_of_range('read_write_registers request', 'values', m.values, 0, 65535)
     return _wrap_request(b''.join((_S_BE_U16_U16_U16_U16_U8.pack(m.read_address, m.read_count, m.write_address, v_write_count, v_byte_count), struct.pack(f'>{len(m.values)}H', *m.values),)), 0x17, m.unit)
 
 
@@ -643,8 +647,9 @@ def _encode_read_write_registers_response(m: ReadWriteRegistersResponse) -> byte
     v_byte_count = (2 * len(m.registers))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('read_write_registers response', 'byte_count', v_byte_count, 0, 255)
-    if any(not 0 <= x <= 65535 or x.__class__ is bool for x in m.registers):
-        raise out_of_range('read_write_registers response', 'registers', m.registers, 0, 65535)
+    for x_registers in m.registers:
+        if not 0 <= x_registers <= 65535 or x_registers.__class__ is bool:
+            raise out_of_range('read_write_registers response', 'registers', m.registers, 0, 65535)
     return _wrap_response(b''.join((_S_BE_U8.pack(v_byte_count), struct.pack(f'>{len(m.registers)}H', *m.registers),)), 0x17, m.unit)
 
 
@@ -717,7 +722,7 @@ def _decode_request(frame: bytes, expect: type[Message] | None = None) -> Messag
 
 
 def _wrap_request(content: bytes, code: int | None, v_unit: int) -> bytes:
-    """The request frame around `content`; EncodeError when its length does not fit."""
+    """The request frame around `content`, EncodeError if it cannot be."""
     frame = _F_LE_U8_U8.pack(v_unit, code) + content
     return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
@@ -786,7 +791,7 @@ def _decode_response(frame: bytes, expect: type[Message] | None = None) -> Messa
 
 
 def _wrap_response(content: bytes, code: int | None, v_unit: int) -> bytes:
-    """The response frame around `content`; EncodeError when its length does not fit."""
+    """The response frame around `content`, EncodeError if it cannot be."""
     frame = _F_LE_U8_U8.pack(v_unit, code) + content
     return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
@@ -823,9 +828,45 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
     if direction is None:
         raise DecodeError("give the direction: requests and responses cannot be told apart by their first bytes")
     if direction == 'request':  # a Direction or its value
-        return _decode_request(bytes(data), expect)
+        frame = bytes(data)
+        n = len(frame)
+        if n < 4:
+            raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (4)")
+        end = n - 2
+        buf = frame
+        v_unit = buf[0]
+        if not (1 <= v_unit <= 247 or v_unit == 0):
+            raise DecodeError(f"unit = {v_unit} is outside its range 1..247 (or 0)")
+        check = _CHECK_CRC(frame[:-2])
+        stored = buf[end + 1] << 8 | buf[end]
+        if check != stored:
+            raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
+        code = buf[1]
+        decoder = _REQUEST_DECODERS.get(code)
+        if decoder is None:
+            raise DecodeError(f"unknown command {code!r}")
+        return decoder(buf, 2, end, v_unit)
     if direction == 'response':  # a Direction or its value
-        return _decode_response(bytes(data), expect)
+        frame = bytes(data)
+        n = len(frame)
+        if n < 4:
+            raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (4)")
+        end = n - 2
+        buf = frame
+        v_unit = buf[0]
+        if not (1 <= v_unit <= 247 or v_unit == 0):
+            raise DecodeError(f"unit = {v_unit} is outside its range 1..247 (or 0)")
+        check = _CHECK_CRC(frame[:-2])
+        stored = buf[end + 1] << 8 | buf[end]
+        if check != stored:
+            raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
+        code = buf[1]
+        if code & 0x80:  # an error reply: it refuses the request of code & ~flag
+            return _RESPONSE_DECODERS[ERROR_REPLY](buf, 2, end, v_unit, code & 0x7f)
+        decoder = _RESPONSE_DECODERS.get(code)
+        if decoder is None:
+            raise DecodeError(f"unknown command {code!r}")
+        return decoder(buf, 2, end, v_unit)
     raise ValueError(f"direction must be request or response, not {direction!r}")
 
 

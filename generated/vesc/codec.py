@@ -123,6 +123,8 @@ def _decode_fw_version_response(buf: bytes, o: int, end: int) -> FwVersionRespon
         raise DecodeError('fw_version response' + ': hw_name has no NUL at its end')
     v_hw_name = _decode_text(buf[o:stop], 'hw_name', 'fw_version response')
     o = stop + 1
+    if end - o < 20:
+        raise DecodeError('fw_version response' + f': uuid needs 20 bytes, {end - o} left')
     v_uuid, v_pairing_done, v_test_version, v_hw_type, v_custom_config_count, v_phase_filters, v_qml_hw, v_qml_app, v_nrf_flags = _S_BE_FWVERSIONRESPONSE_UUID.unpack_from(buf, o)
     o += 20
     stop = buf.find(b'\0', o, end)
@@ -130,6 +132,8 @@ def _decode_fw_version_response(buf: bytes, o: int, end: int) -> FwVersionRespon
         raise DecodeError('fw_version response' + ': fw_name has no NUL at its end')
     v_fw_name = _decode_text(buf[o:stop], 'fw_name', 'fw_version response')
     o = stop + 1
+    if end - o < 4:
+        raise DecodeError('fw_version response' + f': hw_crc needs 4 bytes, {end - o} left')
     v_hw_crc, = _S_BE_U32.unpack_from(buf, o)
     o += 4
     if o != end:
@@ -501,15 +505,6 @@ def _decode_request_short(frame: bytes, expect: type[Message] | None = None) -> 
     return decoder(buf, 3, end)
 
 
-def _wrap_request_short(content: bytes, code: int | None) -> bytes:
-    """The short frame around `content`; EncodeError when its length does not fit."""
-    v_length = len(content) + 1
-    if v_length >= 256:
-        raise EncodeError(f"short frame: length {v_length} does not fit its 1-byte field")
-    frame = _F_LE_1S_U8_U8.pack(b'\x02', v_length, code) + content
-    return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
-
-
 def _decode_request_long(frame: bytes, expect: type[Message] | None = None) -> Message:
     """One complete long frame, checked and taken apart; its content decoded."""
     n = len(frame)
@@ -535,15 +530,6 @@ def _decode_request_long(frame: bytes, expect: type[Message] | None = None) -> M
     return decoder(buf, 4, end)
 
 
-def _wrap_request_long(content: bytes, code: int | None) -> bytes:
-    """The long frame around `content`; EncodeError when its length does not fit."""
-    v_length = len(content) + 1
-    if v_length >= 65536:
-        raise EncodeError(f"long frame: length {v_length} does not fit its 2-byte field")
-    frame = _F_BE_1S_U16_U8.pack(b'\x03', v_length, code) + content
-    return frame + _CHECK_CRC(frame[3:]).to_bytes(2, 'big') + b'\x03'
-
-
 def _decode_request(frame: bytes, expect: type[Message] | None = None) -> Message:
     """One complete request frame, in the layout its header names."""
     if frame.startswith(b'\x02'):
@@ -554,13 +540,16 @@ def _decode_request(frame: bytes, expect: type[Message] | None = None) -> Messag
 
 
 def _wrap_request(content: bytes, code: int | None) -> bytes:
-    """The request frame around `content` in the first layout whose length can count it."""
-    for wrap in (_wrap_request_short,):
-        try:
-            return wrap(content, code)
-        except EncodeError:
-            continue
-    return _wrap_request_long(content, code)
+    """The request frame around `content`, in the first layout whose length can count it."""
+    v_length = len(content) + 1
+    if v_length < 256:
+        frame = _F_LE_1S_U8_U8.pack(b'\x02', v_length, code) + content
+        return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
+    v_length = len(content) + 1
+    if not v_length < 65536:
+        raise EncodeError(f"long frame: length {v_length} does not fit its 2-byte field")
+    frame = _F_BE_1S_U16_U8.pack(b'\x03', v_length, code) + content
+    return frame + _CHECK_CRC(frame[3:]).to_bytes(2, 'big') + b'\x03'
 
 
 _RESPONSE_DECODERS: dict[int | None, Callable[..., Message]] = {
@@ -622,15 +611,6 @@ def _decode_response_short(frame: bytes, expect: type[Message] | None = None) ->
     return decoder(buf, 3, end)
 
 
-def _wrap_response_short(content: bytes, code: int | None) -> bytes:
-    """The short frame around `content`; EncodeError when its length does not fit."""
-    v_length = len(content) + 1
-    if v_length >= 256:
-        raise EncodeError(f"short frame: length {v_length} does not fit its 1-byte field")
-    frame = _F_LE_1S_U8_U8.pack(b'\x02', v_length, code) + content
-    return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
-
-
 def _decode_response_long(frame: bytes, expect: type[Message] | None = None) -> Message:
     """One complete long frame, checked and taken apart; its content decoded."""
     n = len(frame)
@@ -656,15 +636,6 @@ def _decode_response_long(frame: bytes, expect: type[Message] | None = None) -> 
     return decoder(buf, 4, end)
 
 
-def _wrap_response_long(content: bytes, code: int | None) -> bytes:
-    """The long frame around `content`; EncodeError when its length does not fit."""
-    v_length = len(content) + 1
-    if v_length >= 65536:
-        raise EncodeError(f"long frame: length {v_length} does not fit its 2-byte field")
-    frame = _F_BE_1S_U16_U8.pack(b'\x03', v_length, code) + content
-    return frame + _CHECK_CRC(frame[3:]).to_bytes(2, 'big') + b'\x03'
-
-
 def _decode_response(frame: bytes, expect: type[Message] | None = None) -> Message:
     """One complete response frame, in the layout its header names."""
     if frame.startswith(b'\x02'):
@@ -675,13 +646,16 @@ def _decode_response(frame: bytes, expect: type[Message] | None = None) -> Messa
 
 
 def _wrap_response(content: bytes, code: int | None) -> bytes:
-    """The response frame around `content` in the first layout whose length can count it."""
-    for wrap in (_wrap_response_short,):
-        try:
-            return wrap(content, code)
-        except EncodeError:
-            continue
-    return _wrap_response_long(content, code)
+    """The response frame around `content`, in the first layout whose length can count it."""
+    v_length = len(content) + 1
+    if v_length < 256:
+        frame = _F_LE_1S_U8_U8.pack(b'\x02', v_length, code) + content
+        return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
+    v_length = len(content) + 1
+    if not v_length < 65536:
+        raise EncodeError(f"long frame: length {v_length} does not fit its 2-byte field")
+    frame = _F_BE_1S_U16_U8.pack(b'\x03', v_length, code) + content
+    return frame + _CHECK_CRC(frame[3:]).to_bytes(2, 'big') + b'\x03'
 
 
 _ENCODERS: dict[type[Message], Callable[..., bytes]] = {
@@ -709,9 +683,19 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
     if direction is None:
         raise DecodeError("give the direction: requests and responses cannot be told apart by their first bytes")
     if direction == 'request':  # a Direction or its value
-        return _decode_request(bytes(data), expect)
+        frame = bytes(data)
+        if frame.startswith(b'\x02'):
+            return _decode_request_short(frame, expect)
+        if frame.startswith(b'\x03'):
+            return _decode_request_long(frame, expect)
+        raise DecodeError(f"frame starts {frame[:4].hex(' ')}, expected 02 or 03")
     if direction == 'response':  # a Direction or its value
-        return _decode_response(bytes(data), expect)
+        frame = bytes(data)
+        if frame.startswith(b'\x02'):
+            return _decode_response_short(frame, expect)
+        if frame.startswith(b'\x03'):
+            return _decode_response_long(frame, expect)
+        raise DecodeError(f"frame starts {frame[:4].hex(' ')}, expected 02 or 03")
     raise ValueError(f"direction must be request or response, not {direction!r}")
 
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import struct
 from binascii import crc_hqx
 from collections.abc import Callable
@@ -44,6 +45,8 @@ def crc_function(width: int, poly: int, init: int, refin: bool, refout: bool, xo
     """
     mask = (1 << width) - 1
     if width == 16 and poly == 0x1021 and not refin and not refout:
+        if not xorout:
+            return lambda data: crc_hqx(data, init)
         return lambda data: crc_hqx(data, init) ^ xorout
     if width == 32 and poly == 0x04C11DB7 and refin and refout:
         start = _reflect(init, width) ^ mask  # crc32 inverts the register before and after
@@ -77,44 +80,58 @@ def crc_function(width: int, poly: int, init: int, refin: bool, refout: bool, xo
     return crc
 
 
-# Precompiled structs that read a run of k 16-bit words (k < _WORD_RUNS), in either byte order.
+# Each run of k 16-bit words (k < _WORD_RUNS) read by a precompiled struct, in either byte order: its unpack_from.
 _WORD_RUNS = 128
-_WORDS = {order: tuple(struct.Struct(f"{order}{k}H") for k in range(_WORD_RUNS)) for order in "<>"}
+_UNPACK_WORDS = {order: tuple(struct.Struct(f"{order}{k}H").unpack_from for k in range(_WORD_RUNS)) for order in "<>"}
+
+
+@functools.cache
+def _word_table(poly: int, refin: bool) -> tuple[int, ...]:
+    """Entry x: the 16-bit register x after two zero bytes. Feeding bytes is linear (XOR) in the register, so entry
+    x is the entry of its high byte's part XOR the entry of its low byte's: 65,536 XORs, about 2 ms."""
+    table = crc_table(16, poly, refin)
+    if refin:  # the low byte goes in first: entry (low) = table[low] >> 8 ^ table[table[low] & 0xFF]
+        low = [(t >> 8) ^ table[t & 0xFF] for t in table]
+        return tuple([h ^ entry for h in table for entry in low])  # entry (high << 8) is table[high]
+    high = [((t << 8) & 0xFFFF) ^ table[t >> 8] for t in table]  # entry (high << 8); entry (low) is table[low]
+    return tuple([h ^ entry for h in high for entry in table])
 
 
 def _crc16_words(poly: int, init: int, refin: bool, refout: bool, xorout: int) -> Callable[[bytes], int]:
     """A 16-bit CRC two bytes per step: the register after two more bytes is table[register ^ those two bytes]
     (the bytes as one word, low byte first when reflected), from a 65,536-entry table made at the first call (a
-    few milliseconds, not paid by an import); an odd last byte goes through the 256-entry table."""
+    few milliseconds, not paid by an import, shared by every CRC of that polynomial); an odd last byte goes through
+    the 256-entry table."""
     table = crc_table(16, poly, refin)
     order = "<" if refin else ">"
-    words = _WORDS[order]
+    unpack = _UNPACK_WORDS[order]
     start = _reflect(init, 16) if refin else init
     pairs: tuple[int, ...] = ()
+    plain = refin == refout and not xorout  # the register is the CRC
 
-    def word_table() -> tuple[int, ...]:
-        # entry x: the register x after two zero bytes, one table step each
-        if refin:  # x = high << 8 | low; the low byte goes first
-            return tuple((t >> 8) ^ table[high ^ (t & 0xFF)] for high in range(256) for t in table)  # t: table[low]
-        return tuple(((t << 8) & 0xFFFF) ^ table[(t >> 8) ^ low] for t in table for low in range(256))
+    def words(data: bytes) -> tuple[int, ...]:
+        run = len(data) >> 1
+        return unpack[run](data) if run < _WORD_RUNS else struct.unpack_from(f"{order}{run}H", data)
+
+    def finish(value: int) -> int:
+        return (_reflect(value, 16) if refin != refout else value) ^ xorout
 
     def crc(data: bytes) -> int:
         nonlocal pairs
         if not pairs:
-            pairs = word_table()
+            pairs = _word_table(poly, refin)
         value = start
         n = len(data)
-        run = n >> 1
-        for word in words[run].unpack_from(data) if run < _WORD_RUNS else struct.unpack_from(f"{order}{run}H", data):
+        for word in unpack[n >> 1](data) if n < 2 * _WORD_RUNS else words(data):
             value = pairs[value ^ word]
-        if n & 1:
-            if refin:
-                value = (value >> 8) ^ table[(value ^ data[-1]) & 0xFF]
-            else:
-                value = ((value & 0xFF) << 8) ^ table[(value >> 8) ^ data[-1]]
-        if refin != refout:
-            value = _reflect(value, 16)
-        return value ^ xorout
+        if n & 1:  # the last byte alone, as in crc_function's byte loop
+            last = data[-1]
+            value = (
+                (value >> 8) ^ table[(value ^ last) & 0xFF]
+                if refin
+                else (value & 0xFF) << 8 ^ table[(value >> 8) ^ last]
+            )
+        return value if plain else finish(value)
 
     return crc
 

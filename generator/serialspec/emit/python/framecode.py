@@ -150,8 +150,11 @@ def _message_constant(element: Element, data: str) -> str:
     return f"f\"{element.name} is {{{data}.hex(' ')}}, expected {element.constant.hex(' ')}\""
 
 
-def decode_lines(layout: Layout, name: str, target: Target, checks: dict[int, str], transparency: str) -> Lines:
-    """`def <name>(frame, expect)`: one layout's frame checked in the engine's order, its content decoded.
+def decode_lines(
+    layout: Layout, name: str, target: Target, checks: dict[int, str], transparency: str
+) -> tuple[Lines, Lines]:
+    """`def <name>(frame, expect)`: one layout's frame checked in the engine's order, its content decoded; and
+    the function's body alone (for decode(), which runs it inline: one call less per frame).
 
     `checks`: element index -> the checksum function's name; `transparency`: the name of the layout's
     Transparency object (unstuffing, with its error for a frame that is not in stuffed form).
@@ -259,7 +262,7 @@ def decode_lines(layout: Layout, name: str, target: Target, checks: dict[int, st
         else '    raise DecodeError("unknown command None")',
         f"return decoder({arguments})",
     ]
-    return lines + [f"    {line}" for line in body]
+    return lines + [f"    {line}" for line in body], ["n = len(frame)", *body]
 
 
 def _signs(replace: tuple[tuple[bytes, bytes], ...]) -> list[bytes]:
@@ -308,22 +311,25 @@ def _start(position: str) -> str:
     return "" if position == "0" else position
 
 
-def wrap_lines(
-    layout: Layout, name: str, target: Target, checks: dict[int, str], transparency: str, structs: dict[str, str]
-) -> Lines:
-    """`def <name>(content, code, *values) -> bytes`: the frame around `content`, as Layout.wrap makes it.
+@dataclass
+class _Wrap:
+    """One layout's encoding, in three parts: `prelude` computes the stuffed span and the lengths, `fits` says
+    whether every length fits its element (with the EncodeError a layout raises when one does not), `rest` makes
+    and returns the frame."""
 
-    `checks` and `transparency` as for decode_lines; `structs`: the struct constants it uses (name -> format), for
-    the module to define.
-    """
+    prelude: Lines
+    fits: list[tuple[str, str]]  # condition that the length fits, the error when it does not
+    rest: Lines
+
+
+def wrap_parts(
+    layout: Layout, target: Target, checks: dict[int, str], transparency: str, structs: dict[str, str]
+) -> _Wrap:
+    """The frame around `content`, as Layout.wrap makes it. `checks` and `transparency` as for decode_lines;
+    `structs`: the struct constants it uses (name -> format), for the module to define."""
     places = _Places(layout)
     elements = layout.elements
-    parameters = ", ".join(["content: bytes", "code: int | None", *(f"v_{v}: int" for v in target.value_names)])
-    lines: Lines = [
-        f"def {name}({parameters}) -> bytes:",
-        f'    """The {layout.name} frame around `content`; EncodeError when its length does not fit."""',
-    ]
-    body: Lines = []
+    prelude: Lines = []
     value_of = dict(zip(layout.values, target.value_names, strict=True))
 
     def argument(index: int) -> str:
@@ -336,14 +342,15 @@ def wrap_lines(
             return f"v_{element.name}"
         return f"v_{value_of[index]}"
 
-    def packed(indices: list[int], order: str) -> str:
+    def packed(indices: list[int]) -> str:
         """One expression for the bytes of these elements: a literal, else one struct (neighbouring constants
         as one `Ns` argument)."""
         if not indices:
             return ""
         if all(elements[i].kind == "constant" for i in indices):
             return repr(b"".join(elements[i].constant for i in indices))
-        fmt, arguments = order, []
+        multi = {elements[i].endian for i in indices if elements[i].kind != "constant" and elements[i].size > 1}
+        fmt, arguments = ">" if multi == {"big"} else "<", []
         constant = b""
         for i in [*indices, -1]:
             if i >= 0 and elements[i].kind == "constant":
@@ -360,53 +367,45 @@ def wrap_lines(
         structs[name] = fmt
         return f"{name}.pack({', '.join(arguments)})"
 
-    def order_of(indices: list[int]) -> str:
-        multi = {elements[i].endian for i in indices if elements[i].kind != "constant" and elements[i].size > 1}
-        return ">" if multi == {"big"} else "<"
-
     first, last = places.first, places.last
     c = layout.content
-    inner_before = list(range(first, c))
-    inner_after = list(range(c + 1, last + 1))
-    parts = [p for p in (packed(inner_before, order_of(inner_before)), "content") if p]
-    parts += [p for p in (packed(inner_after, order_of(inner_after)),) if p]
-    variable = " + ".join(parts)
+    around = (packed(list(range(first, c))), "content", packed(list(range(c + 1, last + 1))))
+    variable = " + ".join(p for p in around if p)
     t = layout.transparency
     if t is None:
         wire = variable
     else:
-        body.append(f"plain = {variable}")
+        prelude.append(f"plain = {variable}")
         if len(t.replace) == 1:
             plain, stuffed = t.replace[0]
-            body.append(f"wire = plain.replace({plain!r}, {stuffed!r})")
+            prelude.append(f"wire = plain.replace({plain!r}, {stuffed!r})")
         else:
-            body.append(f"wire = {transparency}.encode(plain)")
+            prelude.append(f"wire = {transparency}.encode(plain)")
         wire = "wire"
-    variable_size = _size(elements[first : last + 1])
+    fits: list[tuple[str, str]] = []
     for element in elements:
         if element.kind != "length":
             continue
         a, b = element.span
-        if a <= first and last <= b:
-            fixed = _size(elements[a : b + 1]) - variable_size
-            value = f"len({'content' if t is None else 'wire'}) + {fixed + element.adds}"
+        if a <= first and last <= b:  # the wire bytes of the variable part and the fixed ones around it
+            fixed = _size(elements[a : b + 1]) - _size(elements[first : last + 1])
+            value = _plus(f"len({'content' if t is None else 'wire'})", fixed + element.adds)
         elif a <= c <= b:  # inside the stuffed span: plain bytes
-            fixed = _size(elements[a : b + 1])
-            value = f"len(content) + {fixed + element.adds}"
+            value = _plus("len(content)", _size(elements[a : b + 1]) + element.adds)
         else:
             value = str(_size(elements[a : b + 1]) + element.adds)
-        value = value.replace(" + 0", "").replace("+ -", "- ")
-        limit = 1 << (8 * element.size)
         name = f"v_{element.name}"
-        body += [
-            f"{name} = {value}",
-            f"if not 0 <= {name} < {limit}:" if element.adds < 0 else f"if {name} >= {limit}:",
-            f'    raise EncodeError(f"{layout.name} frame: length {{{name}}} does not fit its '
-            f'{element.size}-byte field")',
-        ]
-    head = list(range(first))
-    start = packed(head, order_of(head))
-    frame = " + ".join(p for p in (start, wire) if p)
+        limit = 1 << (8 * element.size)
+        prelude.append(f"{name} = {value}")
+        fits.append(
+            (
+                f"0 <= {name} < {limit}" if element.adds < 0 else f"{name} < {limit}",
+                f'raise EncodeError(f"{layout.name} frame: length {{{name}}} does not fit its '
+                f'{element.size}-byte field")',
+            )
+        )
+    rest: Lines = []
+    frame = " + ".join(p for p in (packed(list(range(first))), wire) if p)
     pending: list[int] = []  # elements after the variable part not yet in `frame`
     for index in range(last + 1, len(elements)):
         element = elements[index]
@@ -414,7 +413,7 @@ def wrap_lines(
             pending.append(index)
             continue
         if pending:
-            frame = f"{frame} + {packed(pending, order_of(pending))}"
+            frame = f"{frame} + {packed(pending)}"
             pending = []
         a, b = element.span
         begin = _size(elements[:a])
@@ -422,12 +421,35 @@ def wrap_lines(
         # all after the variable part: counted back from the end of what is written
         begin_expr = str(-_size(elements[a:index])) if a > last else str(begin) if begin else ""
         covered = f"frame[{begin_expr}:{-between if between else ''}]".replace("[:]", "")
-        body.append(f"frame = {frame}")
+        rest.append(f"frame = {frame}")
         frame = f"frame + {checks[index]}({covered}).to_bytes({element.size}, {element.endian!r})"
     if pending:
-        frame = f"{frame} + {packed(pending, order_of(pending))}"
-    body.append(f"return {frame}")
-    return lines + [f"    {line}" for line in body]
+        frame = f"{frame} + {packed(pending)}"
+    rest.append(f"return {frame}")
+    return _Wrap(prelude, fits, rest)
+
+
+def wrap_lines(direction: str, layouts: list[_Wrap], target: Target) -> Lines:
+    """`def _wrap_<direction>(content, code, *values) -> bytes`: the frame in the first layout whose lengths can
+    count it (as FrameCodec.wrap chooses), each layout's code inline."""
+    parameters = ", ".join(["content: bytes", "code: int | None", *(f"v_{v}: int" for v in target.value_names)])
+    doc = "in the first layout whose length can count it" if len(layouts) > 1 else "EncodeError if it cannot be"
+    body: Lines = []
+    for number, wrap in enumerate(layouts):
+        body += wrap.prelude
+        if number < len(layouts) - 1 and wrap.fits:  # an earlier layout: taken when its lengths fit
+            body.append(f"if {' and '.join(condition for condition, _ in wrap.fits)}:")
+            body += [f"    {line}" for line in wrap.rest]
+            continue
+        for condition, error in wrap.fits:
+            body += [f"if not {condition}:", f"    {error}"]
+        body += wrap.rest
+        break
+    return [
+        f"def _wrap_{direction}({parameters}) -> bytes:",
+        f'    """The {direction} frame around `content`, {doc}."""',
+        *(f"    {line}" for line in body),
+    ]
 
 
 _STRUCT_CHARS = {1: "B", 2: "H", 4: "I", 8: "Q"}
@@ -499,18 +521,20 @@ def engine_lines(layouts: tuple[Layout, ...], target: Target) -> tuple[Lines, Li
 
 def direction_functions(
     protocol: Protocol, direction: Direction, target: Target, structs: dict[str, str]
-) -> tuple[Lines, bool]:
+) -> tuple[Lines, Lines]:
     """Module-level code of one direction's frame functions (`_decode_<d>`, `_wrap_<d>` and what they use), and
-    whether it is straight-line code (else the engine's)."""
+    the lines of `decode()` that decode a frame `data` of this direction."""
     layouts = runtime_layouts(protocol, direction)
     models = protocol.framing.alternatives[direction]
     names = {tuple(e.name for e in (layout.elements[i] for i in layout.values)) for layout in layouts}
+    d = direction.value
+    call = [f"return _decode_{d}(bytes(data), expect)"]
     if not all(straight(layout) for layout in layouts) or len(names) != 1:
         decode, wrap = engine_lines(layouts, target)
-        return [*decode, "", "", *wrap], False
-    d = direction.value
+        return [*decode, "", "", *wrap], call
     several = len(layouts) > 1
     lines: Lines = []
+    wraps: list[_Wrap] = []
     for layout, model in zip(layouts, models, strict=True):
         suffix = f"_{layout.name}" if several else ""
         checks = {
@@ -523,43 +547,32 @@ def direction_functions(
             t = layout.transparency
             pairs = ", ".join(f"({plain!r}, {wire!r})" for plain, wire in t.replace)
             lines += [f"{stuffing} = Transparency({t.span}, ({pairs},))", "", ""]
-        lines += decode_lines(layout, f"_decode_{d}{suffix}", target, checks, stuffing)
-        lines += ["", ""]
-        lines += wrap_lines(layout, f"_wrap_{d}{suffix}", target, checks, stuffing, structs)
-        lines += ["", ""]
+        function, body = decode_lines(layout, f"_decode_{d}{suffix}", target, checks, stuffing)
+        lines += [*function, "", ""]
+        wraps.append(wrap_parts(layout, target, checks, stuffing, structs))
     if several:
-        lines += _choosers(layouts, d, target)
-    while lines and not lines[-1]:
-        lines.pop()
-    return lines, True
-
-
-def _choosers(layouts: tuple[Layout, ...], d: str, target: Target) -> Lines:
-    """Functions that pick a layout: on decode by the frame's header, on encode the first whose length fits."""
-    choices = " or ".join(layout.header.hex(" ") for layout in layouts)
-    lines = [
-        f"def _decode_{d}(frame: bytes, expect: type[Message] | None = None) -> Message:",
-        f'    """One complete {d} frame, in the layout its header names."""',
-    ]
-    for layout in layouts:
+        choice = _choice(layouts, d)
         lines += [
-            f"    if frame.startswith({layout.header!r}):",
-            f"        return _decode_{d}_{layout.name}(frame, expect)",
+            f"def _decode_{d}(frame: bytes, expect: type[Message] | None = None) -> Message:",
+            f'    """One complete {d} frame, in the layout its header names."""',
+            *(f"    {line}" for line in choice),
+            "",
+            "",
         ]
-    lines += [f"    raise DecodeError(f\"frame starts {{frame[:4].hex(' ')}}, expected {choices}\")", "", ""]
-    values = "".join(f", v_{v}" for v in target.value_names)
-    parameters = ", ".join(["content: bytes", "code: int | None", *(f"v_{v}: int" for v in target.value_names)])
-    lines += [
-        f"def _wrap_{d}({parameters}) -> bytes:",
-        f'    """The {d} frame around `content` in the first layout whose length can count it."""',
-        f"    for wrap in ({', '.join(f'_wrap_{d}_{layout.name}' for layout in layouts[:-1])},):",
-        "        try:",
-        f"            return wrap(content, code{values})",
-        "        except EncodeError:",
-        "            continue",
-        f"    return _wrap_{d}_{layouts[-1].name}(content, code{values})",
-    ]
-    return lines
+        call = ["frame = bytes(data)", *choice]  # decode() chooses the layout itself: one call less
+    else:
+        call = ["frame = bytes(data)", *body]  # decode() checks the frame itself: one call less
+    lines += wrap_lines(d, wraps, target)
+    return lines, call
+
+
+def _choice(layouts: tuple[Layout, ...], d: str) -> Lines:
+    """Lines that decode `frame` in the layout its header names (as FrameCodec.layout_of chooses)."""
+    lines: Lines = []
+    for layout in layouts:
+        lines += [f"if frame.startswith({layout.header!r}):", f"    return _decode_{d}_{layout.name}(frame, expect)"]
+    choices = " or ".join(layout.header.hex(" ") for layout in layouts)
+    return [*lines, f"raise DecodeError(f\"frame starts {{frame[:4].hex(' ')}}, expected {choices}\")"]
 
 
 def _plus(expression: str, k: int) -> str:

@@ -2,7 +2,9 @@
 
 Classic frames (a header, a one-byte length, one final checksum, no stuffing) get straight-line code (see
 package.py); every other framing is described here as `serialspec.runtime.framing` objects: the layouts of each
-direction, the content size bounds by command, and size rules for frames that carry no length.
+direction, the content size bounds by command, and size rules for frames that carry no length. The stream parser
+runs on them; single frames are checked and built by straight-line code written from the same layouts
+(framecode.py).
 """
 
 from __future__ import annotations

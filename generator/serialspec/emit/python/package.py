@@ -225,7 +225,7 @@ def general_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
             mask = (1 << (8 * element.type.size)) - 1
             flag = protocol.error_reply.flag
             frames = replace(frames, error_flag=flag, error_keep=mask & ~flag)
-        functions, _ = direction_functions(protocol, direction, frames, frame_structs)
+        functions, call = direction_functions(protocol, direction, frames, frame_structs)
         directions.append(
             {
                 "name": direction.value,
@@ -234,6 +234,7 @@ def general_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
                 "expected": expected,
                 "frames": codec_lines(protocol, direction, sizes, single),
                 "functions": functions,
+                "call": call,
                 "headers": sorted({layout.header for layout in protocol.framing.alternatives[direction]}),
             }
         )

@@ -4,9 +4,7 @@ from __future__ import annotations
 
 import functools
 import struct
-from binascii import crc_hqx
 from collections.abc import Callable
-from zlib import crc32
 
 
 def _reflect(value: int, width: int) -> int:
@@ -45,10 +43,14 @@ def crc_function(width: int, poly: int, init: int, refin: bool, refout: bool, xo
     """
     mask = (1 << width) - 1
     if width == 16 and poly == 0x1021 and not refin and not refout:
+        from binascii import crc_hqx  # imported here: a codec that needs neither pays for neither
+
         if not xorout:
             return lambda data: crc_hqx(data, init)
         return lambda data: crc_hqx(data, init) ^ xorout
     if width == 32 and poly == 0x04C11DB7 and refin and refout:
+        from zlib import crc32
+
         start = _reflect(init, width) ^ mask  # crc32 inverts the register before and after
 
         return lambda data: crc32(data, start) ^ mask ^ xorout
@@ -80,9 +82,14 @@ def crc_function(width: int, poly: int, init: int, refin: bool, refout: bool, xo
     return crc
 
 
-# Each run of k 16-bit words (k < _WORD_RUNS) read by a precompiled struct, in either byte order: its unpack_from.
+# Runs of k 16-bit words (k < _WORD_RUNS) are read by precompiled structs, made at the first CRC's first call.
 _WORD_RUNS = 128
-_UNPACK_WORDS = {order: tuple(struct.Struct(f"{order}{k}H").unpack_from for k in range(_WORD_RUNS)) for order in "<>"}
+
+
+@functools.cache
+def _unpack_words(order: str) -> tuple[Callable[[bytes], tuple[int, ...]], ...]:
+    """unpack_from of a struct reading k words in this byte order, for each k < _WORD_RUNS."""
+    return tuple(struct.Struct(f"{order}{k}H").unpack_from for k in range(_WORD_RUNS))
 
 
 @functools.cache
@@ -104,7 +111,7 @@ def _crc16_words(poly: int, init: int, refin: bool, refout: bool, xorout: int) -
     the 256-entry table."""
     table = crc_table(16, poly, refin)
     order = "<" if refin else ">"
-    unpack = _UNPACK_WORDS[order]
+    unpack: tuple[Callable[[bytes], tuple[int, ...]], ...] = ()
     start = _reflect(init, 16) if refin else init
     pairs: tuple[int, ...] = ()
     plain = refin == refout and not xorout  # the register is the CRC
@@ -117,9 +124,9 @@ def _crc16_words(poly: int, init: int, refin: bool, refout: bool, xorout: int) -
         return (_reflect(value, 16) if refin != refout else value) ^ xorout
 
     def crc(data: bytes) -> int:
-        nonlocal pairs
+        nonlocal pairs, unpack
         if not pairs:
-            pairs = _word_table(poly, refin)
+            pairs, unpack = _word_table(poly, refin), _unpack_words(order)
         value = start
         n = len(data)
         for word in unpack[n >> 1](data) if n < 2 * _WORD_RUNS else words(data):

@@ -234,35 +234,34 @@ def decode_lines(
             f'    raise ChecksumError(f"bad {element.name}: the frame has {{stored:#0{width}x}}, '
             f'its bytes give {{check:#0{width}x}}")',
         ]
-    arguments = ", ".join(["buf", str(places.content), "end", *values])
-    table = f"_{target.upper}_DECODERS"
-    if command is None:
-        body.append(f"decoder = {table}.get(None)")
-        code = "None"
-    else:
+    if command is not None:
         body.append(f"code = {places.read(command)}")
-        code = "code"
-        if target.error_flag:
-            body += [
-                f"if code & {target.error_flag:#04x}:  # an error reply: it refuses the request of code & ~flag",
-                f"    return {table}[ERROR_REPLY]({arguments}, code & {target.error_keep:#04x})",
-            ]
-        body.append(f"decoder = {table}.get(code)")
+    code = "None" if command is None else "code"
+    body += _dispatch(target, code, ", ".join(["buf", str(places.content), "end", *values]), nullable=False)
+    return lines + [f"    {line}" for line in body], ["n = len(frame)", *body]
+
+
+def _dispatch(target: Target, code: str, arguments: str, nullable: bool) -> Lines:
+    """Lines that decode the content with the decoder of `code` (an expression; "None" where frames carry none):
+    an error reply's where the error flag is set, the expected reply's where replies share a code."""
+    table = f"_{target.upper}_DECODERS"
+    lines: Lines = []
+    if target.error_flag and code != "None":
+        known = f"{code} is not None and " if nullable else ""
+        lines += [
+            f"if {known}{code} & {target.error_flag:#04x}:  # an error reply: it refuses the request of code & ~flag",
+            f"    return {table}[ERROR_REPLY]({arguments}, {code} & {target.error_keep:#04x})",
+        ]
+    lines.append(f"decoder = {table}.get({code})")
     if target.expected:
-        body += [
+        lines += [
             "if expect is not None:",
             f"    expected, alternative = _{target.upper}_EXPECTED.get(expect, (None, None))",
             f"    if alternative is not None and expected {'is' if code == 'None' else '=='} {code}:",
             "        decoder = alternative",
         ]
-    body += [
-        "if decoder is None:",
-        f'    raise DecodeError(f"unknown command {{{code}!r}}")'
-        if code != "None"
-        else '    raise DecodeError("unknown command None")',
-        f"return decoder({arguments})",
-    ]
-    return lines + [f"    {line}" for line in body], ["n = len(frame)", *body]
+    unknown = f'f"unknown command {{{code}!r}}"' if code != "None" else '"unknown command None"'
+    return [*lines, "if decoder is None:", f"    raise DecodeError({unknown})", f"return decoder({arguments})"]
 
 
 def _signs(replace: tuple[tuple[bytes, bytes], ...]) -> list[bytes]:
@@ -487,35 +486,14 @@ def engine_lines(layouts: tuple[Layout, ...], target: Target) -> tuple[Lines, Li
         f'    """The {direction} frame around `content`, made by the frame engine."""',
         f"    return {frames}.wrap(content, code, {shown})",
     ]
-    table = f"_{target.upper}_DECODERS"
     decode = [
         f"def _decode_{direction}(frame: bytes, expect: type[Message] | None = None) -> Message:",
         f'    """One complete {direction} frame, checked and taken apart by the frame engine; its content decoded."""',
         f"    unwrapped = {frames}.unwrap(frame)",
+        "    code, content = unwrapped.code, unwrapped.content",
     ]
-    if target.error_flag:
-        decode += [
-            "    code = unwrapped.code",
-            f"    if code is not None and code & {target.error_flag:#04x}:  # an error reply: it refuses the request "
-            "of code & ~flag",
-            "        content = unwrapped.content",
-            f"        return {table}[ERROR_REPLY](content, 0, len(content), *unwrapped.values, "
-            f"code & {target.error_keep:#04x})",
-        ]
-    decode.append(f"    decoder = {table}.get(unwrapped.code)")
-    if target.expected:
-        decode += [
-            "    if expect is not None:",
-            f"        code, alternative = _{target.upper}_EXPECTED.get(expect, (None, None))",
-            "        if alternative is not None and code == unwrapped.code:",
-            "            decoder = alternative",
-        ]
-    decode += [
-        "    if decoder is None:",
-        '        raise DecodeError(f"unknown command {unwrapped.code!r}")',
-        "    content = unwrapped.content",
-        "    return decoder(content, 0, len(content), *unwrapped.values)",
-    ]
+    arguments = "content, 0, len(content), *unwrapped.values"
+    decode += [f"    {line}" for line in _dispatch(target, "code", arguments, nullable=True)]
     return decode, wrap
 
 

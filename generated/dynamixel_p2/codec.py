@@ -689,7 +689,7 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
     if direction is None:
         raise DecodeError("give the direction: requests and responses cannot be told apart by their first bytes")
     if direction == 'request':  # a Direction or its value
-        frame = bytes(data)
+        frame = data if data.__class__ is bytes else bytes(data)
         n = len(frame)
         if n < 9:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (10)")
@@ -720,7 +720,7 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
             raise DecodeError(f"unknown command {code!r}")
         return decoder(buf, 8, end, v_id)
     if direction == 'response':  # a Direction or its value
-        frame = bytes(data)
+        frame = data if data.__class__ is bytes else bytes(data)
         n = len(frame)
         if n < 9:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (11)")

@@ -828,7 +828,7 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
     if direction is None:
         raise DecodeError("give the direction: requests and responses cannot be told apart by their first bytes")
     if direction == 'request':  # a Direction or its value
-        frame = bytes(data)
+        frame = data if data.__class__ is bytes else bytes(data)
         n = len(frame)
         if n < 4:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (4)")
@@ -847,7 +847,7 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
             raise DecodeError(f"unknown command {code!r}")
         return decoder(buf, 2, end, v_unit)
     if direction == 'response':  # a Direction or its value
-        frame = bytes(data)
+        frame = data if data.__class__ is bytes else bytes(data)
         n = len(frame)
         if n < 4:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (4)")

@@ -683,18 +683,98 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
     if direction is None:
         raise DecodeError("give the direction: requests and responses cannot be told apart by their first bytes")
     if direction == 'request':  # a Direction or its value
-        frame = bytes(data)
+        frame = data if data.__class__ is bytes else bytes(data)
         if frame.startswith(b'\x02'):
-            return _decode_request_short(frame, expect)
+            n = len(frame)
+            if n < 6:
+                raise DecodeError(f"frame of {n} bytes is shorter than the smallest short frame (6)")
+            end = n - 3
+            buf = frame
+            if buf[0] != 0x02:
+                raise DecodeError(f"start is {buf[0:1].hex(' ')}, expected 02")
+            if buf[end + 2] != 0x03:
+                raise DecodeError(f"end is {buf[end + 2:end + 3].hex(' ')}, expected 03")
+            length = buf[1]
+            if length != n - 5:
+                raise DecodeError(f"length says {length} but the frame holds {n - 5}")
+            check = _CHECK_CRC(frame[2:-3])
+            stored = buf[end] << 8 | buf[end + 1]
+            if check != stored:
+                raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
+            code = buf[2]
+            decoder = _REQUEST_DECODERS.get(code)
+            if decoder is None:
+                raise DecodeError(f"unknown command {code!r}")
+            return decoder(buf, 3, end)
         if frame.startswith(b'\x03'):
-            return _decode_request_long(frame, expect)
+            n = len(frame)
+            if n < 7:
+                raise DecodeError(f"frame of {n} bytes is shorter than the smallest long frame (7)")
+            end = n - 3
+            buf = frame
+            if buf[0] != 0x03:
+                raise DecodeError(f"start is {buf[0:1].hex(' ')}, expected 03")
+            if buf[end + 2] != 0x03:
+                raise DecodeError(f"end is {buf[end + 2:end + 3].hex(' ')}, expected 03")
+            length = buf[1] << 8 | buf[2]
+            if length != n - 6:
+                raise DecodeError(f"length says {length} but the frame holds {n - 6}")
+            check = _CHECK_CRC(frame[3:-3])
+            stored = buf[end] << 8 | buf[end + 1]
+            if check != stored:
+                raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
+            code = buf[3]
+            decoder = _REQUEST_DECODERS.get(code)
+            if decoder is None:
+                raise DecodeError(f"unknown command {code!r}")
+            return decoder(buf, 4, end)
         raise DecodeError(f"frame starts {frame[:4].hex(' ')}, expected 02 or 03")
     if direction == 'response':  # a Direction or its value
-        frame = bytes(data)
+        frame = data if data.__class__ is bytes else bytes(data)
         if frame.startswith(b'\x02'):
-            return _decode_response_short(frame, expect)
+            n = len(frame)
+            if n < 6:
+                raise DecodeError(f"frame of {n} bytes is shorter than the smallest short frame (6)")
+            end = n - 3
+            buf = frame
+            if buf[0] != 0x02:
+                raise DecodeError(f"start is {buf[0:1].hex(' ')}, expected 02")
+            if buf[end + 2] != 0x03:
+                raise DecodeError(f"end is {buf[end + 2:end + 3].hex(' ')}, expected 03")
+            length = buf[1]
+            if length != n - 5:
+                raise DecodeError(f"length says {length} but the frame holds {n - 5}")
+            check = _CHECK_CRC(frame[2:-3])
+            stored = buf[end] << 8 | buf[end + 1]
+            if check != stored:
+                raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
+            code = buf[2]
+            decoder = _RESPONSE_DECODERS.get(code)
+            if decoder is None:
+                raise DecodeError(f"unknown command {code!r}")
+            return decoder(buf, 3, end)
         if frame.startswith(b'\x03'):
-            return _decode_response_long(frame, expect)
+            n = len(frame)
+            if n < 7:
+                raise DecodeError(f"frame of {n} bytes is shorter than the smallest long frame (7)")
+            end = n - 3
+            buf = frame
+            if buf[0] != 0x03:
+                raise DecodeError(f"start is {buf[0:1].hex(' ')}, expected 03")
+            if buf[end + 2] != 0x03:
+                raise DecodeError(f"end is {buf[end + 2:end + 3].hex(' ')}, expected 03")
+            length = buf[1] << 8 | buf[2]
+            if length != n - 6:
+                raise DecodeError(f"length says {length} but the frame holds {n - 6}")
+            check = _CHECK_CRC(frame[3:-3])
+            stored = buf[end] << 8 | buf[end + 1]
+            if check != stored:
+                raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
+            code = buf[3]
+            decoder = _RESPONSE_DECODERS.get(code)
+            if decoder is None:
+                raise DecodeError(f"unknown command {code!r}")
+            return decoder(buf, 4, end)
         raise DecodeError(f"frame starts {frame[:4].hex(' ')}, expected 02 or 03")
     raise ValueError(f"direction must be request or response, not {direction!r}")
 

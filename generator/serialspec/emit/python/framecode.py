@@ -513,6 +513,7 @@ def direction_functions(
     several = len(layouts) > 1
     lines: Lines = []
     wraps: list[_Wrap] = []
+    bodies: list[Lines] = []
     for layout, model in zip(layouts, models, strict=True):
         suffix = f"_{layout.name}" if several else ""
         checks = {
@@ -527,6 +528,7 @@ def direction_functions(
             lines += [f"{stuffing} = Transparency({t.span}, ({pairs},))", "", ""]
         function, body = decode_lines(layout, f"_decode_{d}{suffix}", target, checks, stuffing)
         lines += [*function, "", ""]
+        bodies.append(body)
         wraps.append(wrap_parts(layout, target, checks, stuffing, structs))
     if several:
         choice = _choice(layouts, d)
@@ -537,18 +539,24 @@ def direction_functions(
             "",
             "",
         ]
-        call = ["frame = bytes(data)", *choice]  # decode() chooses the layout itself: one call less
-    else:
-        call = ["frame = bytes(data)", *body]  # decode() checks the frame itself: one call less
+    # decode() chooses the layout and checks the frame itself: one call less
+    call = ["frame = data if data.__class__ is bytes else bytes(data)", *_choice(layouts, d, bodies)]
     lines += wrap_lines(d, wraps, target)
     return lines, call
 
 
-def _choice(layouts: tuple[Layout, ...], d: str) -> Lines:
-    """Lines that decode `frame` in the layout its header names (as FrameCodec.layout_of chooses)."""
+def _choice(layouts: tuple[Layout, ...], d: str, bodies: list[Lines] | None = None) -> Lines:
+    """Lines that decode `frame` in the layout its header names (as FrameCodec.layout_of chooses): by a call of
+    the layout's function, or by its `bodies` inline. One layout needs no choice."""
+    if bodies is not None and len(layouts) == 1:
+        return bodies[0]
     lines: Lines = []
-    for layout in layouts:
-        lines += [f"if frame.startswith({layout.header!r}):", f"    return _decode_{d}_{layout.name}(frame, expect)"]
+    for number, layout in enumerate(layouts):
+        lines.append(f"if frame.startswith({layout.header!r}):")
+        if bodies is None:
+            lines.append(f"    return _decode_{d}_{layout.name}(frame, expect)")
+        else:
+            lines += [f"    {line}" for line in bodies[number]]
     choices = " or ".join(layout.header.hex(" ") for layout in layouts)
     return [*lines, f"raise DecodeError(f\"frame starts {{frame[:4].hex(' ')}}, expected {choices}\")"]
 

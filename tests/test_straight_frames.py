@@ -16,11 +16,13 @@ from types import ModuleType
 from typing import Any
 
 import pytest
-from conftest import examples
+from conftest import ALL, Generated, by_protocol, examples
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from serialspec.runtime.errors import DecodeError
 from serialspec.runtime.framing import ERROR_REPLY, FrameCodec
+from serialspec.spec.model import Message
+from strategies import message_fields
 from test_framing_specs import generate
 
 SHIPPED = ["dynamixel_p2", "modbus_rtu", "vesc"]
@@ -238,3 +240,23 @@ def test_an_item_cut_short_is_a_decode_error() -> None:
     frame = bytes.fromhex("ff ff fd 00 fe 07 00 93 ff ff fd fd dc 18")
     with pytest.raises(DecodeError, match="bulk_write request: id needs 5 bytes, 3 left"):
         dynamixel_p2.decode(frame, "request")
+
+
+GENERAL = by_protocol([(g, m) for g in ALL if not g.protocol.framing.classic for m in g.protocol.messages()])
+
+
+@pytest.mark.parametrize(("g", "spec"), GENERAL)
+def test_encoders_make_the_frames_the_engine_makes(g: Generated, spec: Message) -> None:
+    """Encoders whose frame is made inline (the head packed with the content) give the engine's bytes: the
+    engine takes the frame apart and wraps its content again into the same frame."""
+    cls = next(c for c in g.package.MESSAGE_TYPES if c.__name__ == spec.class_name)
+    frames: FrameCodec = getattr(g.package.codec, f"_{spec.direction.name}_FRAMES")
+
+    @settings(max_examples=examples(30), deadline=None, suppress_health_check=[HealthCheck.too_slow])
+    @given(message_fields(g.protocol, spec))
+    def same_bytes(fields: dict[str, Any]) -> None:
+        frame = g.package.encode(cls.from_fields(fields))
+        unwrapped = frames.unwrap(frame)
+        assert frames.wrap(unwrapped.content, unwrapped.code, unwrapped.values) == frame
+
+    same_bytes()

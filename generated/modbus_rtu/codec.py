@@ -44,11 +44,16 @@ from modbus_rtu.messages import (
 __all__ = ["StreamParser", "decode", "encode"]
 
 _F_LE_U8_U8 = struct.Struct('<BB')
+_S_BE_FRAME_READWRITEREGISTERSREQUEST = struct.Struct('>BBHHHHB')
 _S_BE_U16_U16 = struct.Struct('>HH')
 _S_BE_U16_U16_U16 = struct.Struct('>HHH')
 _S_BE_U16_U16_U16_U16_U8 = struct.Struct('>HHHHB')
 _S_BE_U16_U16_U8 = struct.Struct('>HHB')
 _S_BE_U8 = struct.Struct('>B')
+_S_BE_U8_U8_U16_U16 = struct.Struct('>BBHH')
+_S_BE_U8_U8_U16_U16_U16 = struct.Struct('>BBHHH')
+_S_BE_U8_U8_U16_U16_U8 = struct.Struct('>BBHHB')
+_S_BE_U8_U8_U8 = struct.Struct('>BBB')
 _CHECK_CRC: Callable[[bytes], int] = crc_function(16, 0x8005, 0xffff, True, True, 0x0)  # CRC-16/MODBUS
 
 # Decoders build messages with object.__new__ and store each value straight into its slot: a message's __init__
@@ -426,7 +431,8 @@ def _encode_read_coils_request(m: ReadCoilsRequest) -> bytes:
         raise out_of_range('read_coils request', 'address', m.address, 0, 65535)
     if not 1 <= m.count <= 2000 or m.count.__class__ is bool:
         raise out_of_range('read_coils request', 'count', m.count, 1, 2000)
-    return _wrap_request(_S_BE_U16_U16.pack(m.address, m.count), 0x01, m.unit)
+    frame = _S_BE_U8_U8_U16_U16.pack(m.unit, 0x01, m.address, m.count)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_read_coils_response(m: ReadCoilsResponse) -> bytes:
@@ -437,7 +443,8 @@ def _encode_read_coils_response(m: ReadCoilsResponse) -> bytes:
     v_byte_count = (-(-len(m.coils) // 8))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('read_coils response', 'byte_count', v_byte_count, 0, 255)
-    return _wrap_response(b''.join((_S_BE_U8.pack(v_byte_count), _pack_bits(m.coils, 'coils', 'read_coils response'),)), 0x01, m.unit)
+    frame = _S_BE_U8_U8_U8.pack(m.unit, 0x01, v_byte_count) + _pack_bits(m.coils, 'coils', 'read_coils response')
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_read_discrete_inputs_request(m: ReadDiscreteInputsRequest) -> bytes:
@@ -447,7 +454,8 @@ def _encode_read_discrete_inputs_request(m: ReadDiscreteInputsRequest) -> bytes:
         raise out_of_range('read_discrete_inputs request', 'address', m.address, 0, 65535)
     if not 1 <= m.count <= 2000 or m.count.__class__ is bool:
         raise out_of_range('read_discrete_inputs request', 'count', m.count, 1, 2000)
-    return _wrap_request(_S_BE_U16_U16.pack(m.address, m.count), 0x02, m.unit)
+    frame = _S_BE_U8_U8_U16_U16.pack(m.unit, 0x02, m.address, m.count)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_read_discrete_inputs_response(m: ReadDiscreteInputsResponse) -> bytes:
@@ -458,7 +466,8 @@ def _encode_read_discrete_inputs_response(m: ReadDiscreteInputsResponse) -> byte
     v_byte_count = (-(-len(m.inputs) // 8))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('read_discrete_inputs response', 'byte_count', v_byte_count, 0, 255)
-    return _wrap_response(b''.join((_S_BE_U8.pack(v_byte_count), _pack_bits(m.inputs, 'inputs', 'read_discrete_inputs response'),)), 0x02, m.unit)
+    frame = _S_BE_U8_U8_U8.pack(m.unit, 0x02, v_byte_count) + _pack_bits(m.inputs, 'inputs', 'read_discrete_inputs response')
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_read_holding_registers_request(m: ReadHoldingRegistersRequest) -> bytes:
@@ -468,7 +477,8 @@ def _encode_read_holding_registers_request(m: ReadHoldingRegistersRequest) -> by
         raise out_of_range('read_holding_registers request', 'address', m.address, 0, 65535)
     if not 1 <= m.count <= 125 or m.count.__class__ is bool:
         raise out_of_range('read_holding_registers request', 'count', m.count, 1, 125)
-    return _wrap_request(_S_BE_U16_U16.pack(m.address, m.count), 0x03, m.unit)
+    frame = _S_BE_U8_U8_U16_U16.pack(m.unit, 0x03, m.address, m.count)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_read_holding_registers_response(m: ReadHoldingRegistersResponse) -> bytes:
@@ -480,7 +490,8 @@ def _encode_read_holding_registers_response(m: ReadHoldingRegistersResponse) -> 
     for x_registers in m.registers:
         if not 0 <= x_registers <= 65535 or x_registers.__class__ is bool:
             raise out_of_range('read_holding_registers response', 'registers', m.registers, 0, 65535)
-    return _wrap_response(b''.join((_S_BE_U8.pack(v_byte_count), struct.pack(f'>{len(m.registers)}H', *m.registers),)), 0x03, m.unit)
+    frame = _S_BE_U8_U8_U8.pack(m.unit, 0x03, v_byte_count) + struct.pack(f'>{len(m.registers)}H', *m.registers)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_read_input_registers_request(m: ReadInputRegistersRequest) -> bytes:
@@ -490,7 +501,8 @@ def _encode_read_input_registers_request(m: ReadInputRegistersRequest) -> bytes:
         raise out_of_range('read_input_registers request', 'address', m.address, 0, 65535)
     if not 1 <= m.count <= 125 or m.count.__class__ is bool:
         raise out_of_range('read_input_registers request', 'count', m.count, 1, 125)
-    return _wrap_request(_S_BE_U16_U16.pack(m.address, m.count), 0x04, m.unit)
+    frame = _S_BE_U8_U8_U16_U16.pack(m.unit, 0x04, m.address, m.count)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_read_input_registers_response(m: ReadInputRegistersResponse) -> bytes:
@@ -502,7 +514,8 @@ def _encode_read_input_registers_response(m: ReadInputRegistersResponse) -> byte
     for x_registers in m.registers:
         if not 0 <= x_registers <= 65535 or x_registers.__class__ is bool:
             raise out_of_range('read_input_registers response', 'registers', m.registers, 0, 65535)
-    return _wrap_response(b''.join((_S_BE_U8.pack(v_byte_count), struct.pack(f'>{len(m.registers)}H', *m.registers),)), 0x04, m.unit)
+    frame = _S_BE_U8_U8_U8.pack(m.unit, 0x04, v_byte_count) + struct.pack(f'>{len(m.registers)}H', *m.registers)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_write_coil_request(m: WriteCoilRequest) -> bytes:
@@ -512,7 +525,8 @@ def _encode_write_coil_request(m: WriteCoilRequest) -> bytes:
         raise out_of_range('write_coil request', 'address', m.address, 0, 65535)
     if not 0 <= m.value <= 65280 or m.value.__class__ is bool:
         raise out_of_range('write_coil request', 'value', m.value, 0, 65280)
-    return _wrap_request(_S_BE_U16_U16.pack(m.address, m.value), 0x05, m.unit)
+    frame = _S_BE_U8_U8_U16_U16.pack(m.unit, 0x05, m.address, m.value)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_write_coil_response(m: WriteCoilResponse) -> bytes:
@@ -522,7 +536,8 @@ def _encode_write_coil_response(m: WriteCoilResponse) -> bytes:
         raise out_of_range('write_coil response', 'address', m.address, 0, 65535)
     if not 0 <= m.value <= 65280 or m.value.__class__ is bool:
         raise out_of_range('write_coil response', 'value', m.value, 0, 65280)
-    return _wrap_response(_S_BE_U16_U16.pack(m.address, m.value), 0x05, m.unit)
+    frame = _S_BE_U8_U8_U16_U16.pack(m.unit, 0x05, m.address, m.value)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_write_register_request(m: WriteRegisterRequest) -> bytes:
@@ -532,7 +547,8 @@ def _encode_write_register_request(m: WriteRegisterRequest) -> bytes:
         raise out_of_range('write_register request', 'address', m.address, 0, 65535)
     if not 0 <= m.value <= 65535 or m.value.__class__ is bool:
         raise out_of_range('write_register request', 'value', m.value, 0, 65535)
-    return _wrap_request(_S_BE_U16_U16.pack(m.address, m.value), 0x06, m.unit)
+    frame = _S_BE_U8_U8_U16_U16.pack(m.unit, 0x06, m.address, m.value)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_write_register_response(m: WriteRegisterResponse) -> bytes:
@@ -542,7 +558,8 @@ def _encode_write_register_response(m: WriteRegisterResponse) -> bytes:
         raise out_of_range('write_register response', 'address', m.address, 0, 65535)
     if not 0 <= m.value <= 65535 or m.value.__class__ is bool:
         raise out_of_range('write_register response', 'value', m.value, 0, 65535)
-    return _wrap_response(_S_BE_U16_U16.pack(m.address, m.value), 0x06, m.unit)
+    frame = _S_BE_U8_U8_U16_U16.pack(m.unit, 0x06, m.address, m.value)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_write_coils_request(m: WriteCoilsRequest) -> bytes:
@@ -556,7 +573,8 @@ def _encode_write_coils_request(m: WriteCoilsRequest) -> bytes:
     v_byte_count = (-(-(len(m.values)) // 8))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('write_coils request', 'byte_count', v_byte_count, 0, 255)
-    return _wrap_request(b''.join((_S_BE_U16_U16_U8.pack(m.address, v_count, v_byte_count), _pack_bits(m.values, 'values', 'write_coils request'),)), 0x0f, m.unit)
+    frame = _S_BE_U8_U8_U16_U16_U8.pack(m.unit, 0x0f, m.address, v_count, v_byte_count) + _pack_bits(m.values, 'values', 'write_coils request')
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_write_coils_response(m: WriteCoilsResponse) -> bytes:
@@ -566,7 +584,8 @@ def _encode_write_coils_response(m: WriteCoilsResponse) -> bytes:
         raise out_of_range('write_coils response', 'address', m.address, 0, 65535)
     if not 0 <= m.count <= 65535 or m.count.__class__ is bool:
         raise out_of_range('write_coils response', 'count', m.count, 0, 65535)
-    return _wrap_response(_S_BE_U16_U16.pack(m.address, m.count), 0x0f, m.unit)
+    frame = _S_BE_U8_U8_U16_U16.pack(m.unit, 0x0f, m.address, m.count)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_write_registers_request(m: WriteRegistersRequest) -> bytes:
@@ -583,7 +602,8 @@ def _encode_write_registers_request(m: WriteRegistersRequest) -> bytes:
     for x_values in m.values:
         if not 0 <= x_values <= 65535 or x_values.__class__ is bool:
             raise out_of_range('write_registers request', 'values', m.values, 0, 65535)
-    return _wrap_request(b''.join((_S_BE_U16_U16_U8.pack(m.address, v_count, v_byte_count), struct.pack(f'>{len(m.values)}H', *m.values),)), 0x10, m.unit)
+    frame = _S_BE_U8_U8_U16_U16_U8.pack(m.unit, 0x10, m.address, v_count, v_byte_count) + struct.pack(f'>{len(m.values)}H', *m.values)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_write_registers_response(m: WriteRegistersResponse) -> bytes:
@@ -593,7 +613,8 @@ def _encode_write_registers_response(m: WriteRegistersResponse) -> bytes:
         raise out_of_range('write_registers response', 'address', m.address, 0, 65535)
     if not 0 <= m.count <= 65535 or m.count.__class__ is bool:
         raise out_of_range('write_registers response', 'count', m.count, 0, 65535)
-    return _wrap_response(_S_BE_U16_U16.pack(m.address, m.count), 0x10, m.unit)
+    frame = _S_BE_U8_U8_U16_U16.pack(m.unit, 0x10, m.address, m.count)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_mask_write_register_request(m: MaskWriteRegisterRequest) -> bytes:
@@ -605,7 +626,8 @@ def _encode_mask_write_register_request(m: MaskWriteRegisterRequest) -> bytes:
         raise out_of_range('mask_write_register request', 'and_mask', m.and_mask, 0, 65535)
     if not 0 <= m.or_mask <= 65535 or m.or_mask.__class__ is bool:
         raise out_of_range('mask_write_register request', 'or_mask', m.or_mask, 0, 65535)
-    return _wrap_request(_S_BE_U16_U16_U16.pack(m.address, m.and_mask, m.or_mask), 0x16, m.unit)
+    frame = _S_BE_U8_U8_U16_U16_U16.pack(m.unit, 0x16, m.address, m.and_mask, m.or_mask)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_mask_write_register_response(m: MaskWriteRegisterResponse) -> bytes:
@@ -617,7 +639,8 @@ def _encode_mask_write_register_response(m: MaskWriteRegisterResponse) -> bytes:
         raise out_of_range('mask_write_register response', 'and_mask', m.and_mask, 0, 65535)
     if not 0 <= m.or_mask <= 65535 or m.or_mask.__class__ is bool:
         raise out_of_range('mask_write_register response', 'or_mask', m.or_mask, 0, 65535)
-    return _wrap_response(_S_BE_U16_U16_U16.pack(m.address, m.and_mask, m.or_mask), 0x16, m.unit)
+    frame = _S_BE_U8_U8_U16_U16_U16.pack(m.unit, 0x16, m.address, m.and_mask, m.or_mask)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_read_write_registers_request(m: ReadWriteRegistersRequest) -> bytes:
@@ -638,7 +661,8 @@ def _encode_read_write_registers_request(m: ReadWriteRegistersRequest) -> bytes:
     for x_values in m.values:
         if not 0 <= x_values <= 65535 or x_values.__class__ is bool:
             raise out_of_range('read_write_registers request', 'values', m.values, 0, 65535)
-    return _wrap_request(b''.join((_S_BE_U16_U16_U16_U16_U8.pack(m.read_address, m.read_count, m.write_address, v_write_count, v_byte_count), struct.pack(f'>{len(m.values)}H', *m.values),)), 0x17, m.unit)
+    frame = _S_BE_FRAME_READWRITEREGISTERSREQUEST.pack(m.unit, 0x17, m.read_address, m.read_count, m.write_address, v_write_count, v_byte_count) + struct.pack(f'>{len(m.values)}H', *m.values)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_read_write_registers_response(m: ReadWriteRegistersResponse) -> bytes:
@@ -650,7 +674,8 @@ def _encode_read_write_registers_response(m: ReadWriteRegistersResponse) -> byte
     for x_registers in m.registers:
         if not 0 <= x_registers <= 65535 or x_registers.__class__ is bool:
             raise out_of_range('read_write_registers response', 'registers', m.registers, 0, 65535)
-    return _wrap_response(b''.join((_S_BE_U8.pack(v_byte_count), struct.pack(f'>{len(m.registers)}H', *m.registers),)), 0x17, m.unit)
+    frame = _S_BE_U8_U8_U8.pack(m.unit, 0x17, v_byte_count) + struct.pack(f'>{len(m.registers)}H', *m.registers)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_exception_response(m: ExceptionResponse) -> bytes:
@@ -660,7 +685,8 @@ def _encode_exception_response(m: ExceptionResponse) -> bytes:
         raise out_of_range('exception response', 'function', m.function, 0, 127)
     if not 1 <= m.exception_code <= 11 or m.exception_code.__class__ is bool:
         raise out_of_range('exception response', 'exception_code', m.exception_code, 1, 11)
-    return _wrap_response(_S_BE_U8.pack(m.exception_code), m.function | 0x80, m.unit)
+    frame = _S_BE_U8_U8_U8.pack(m.unit, m.function | 0x80, m.exception_code)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 _REQUEST_DECODERS: dict[int | None, Callable[..., Message]] = {

@@ -39,6 +39,9 @@ __all__ = ["StreamParser", "decode", "encode"]
 
 _F_BE_1S_U16_U8 = struct.Struct('>1sHB')
 _F_LE_1S_U8_U8 = struct.Struct('<1sBB')
+_S_B1_U8_U8 = struct.Struct('<1sBB')
+_S_BE_B1_U8_U8_I32 = struct.Struct('>1sBBi')
+_S_BE_FRAME_GETVALUESRESPONSE = struct.Struct('>1sBBhhiiiihihiiiiiiBiBhhhiiB')
 _S_BE_FWVERSIONRESPONSE_UUID = struct.Struct('>12sBBBBBBBB')
 _S_BE_GETVALUESRESPONSE_TEMP_FET = struct.Struct('>hhiiiihihiiiiiiBiBhhhiiB')
 _S_BE_I32 = struct.Struct('>i')
@@ -291,7 +294,8 @@ def _decode_forward_can_request(buf: bytes, o: int, end: int) -> ForwardCanReque
 
 
 def _encode_fw_version_request(m: FwVersionRequest) -> bytes:
-    return _wrap_request(b'', 0x00)
+    frame = _S_B1_U8_U8.pack(b'\x02', 1, 0x00)
+    return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
 
 
 def _encode_fw_version_response(m: FwVersionResponse) -> bytes:
@@ -323,7 +327,8 @@ def _encode_fw_version_response(m: FwVersionResponse) -> bytes:
 
 
 def _encode_get_values_request(m: GetValuesRequest) -> bytes:
-    return _wrap_request(b'', 0x04)
+    frame = _S_B1_U8_U8.pack(b'\x02', 1, 0x04)
+    return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
 
 
 def _encode_get_values_response(m: GetValuesResponse) -> bytes:
@@ -375,43 +380,50 @@ def _encode_get_values_response(m: GetValuesResponse) -> bytes:
         raise out_of_range('get_values response', 'avg_vq', m.avg_vq, -2147483648, 2147483647)
     if not 0 <= m.status <= 255 or isinstance(m.status, bool):
         raise out_of_range('get_values response', 'status', m.status, 0, 255)
-    return _wrap_response(_S_BE_GETVALUESRESPONSE_TEMP_FET.pack(m.temp_fet, m.temp_motor, m.avg_motor_current, m.avg_input_current, m.avg_id, m.avg_iq, m.duty_now, m.rpm, m.v_in, m.amp_hours, m.amp_hours_charged, m.watt_hours, m.watt_hours_charged, m.tachometer, m.tachometer_abs, m.fault, m.pid_pos, m.controller_id, m.temp_mos1, m.temp_mos2, m.temp_mos3, m.avg_vd, m.avg_vq, m.status), 0x04)
+    frame = _S_BE_FRAME_GETVALUESRESPONSE.pack(b'\x02', 74, 0x04, m.temp_fet, m.temp_motor, m.avg_motor_current, m.avg_input_current, m.avg_id, m.avg_iq, m.duty_now, m.rpm, m.v_in, m.amp_hours, m.amp_hours_charged, m.watt_hours, m.watt_hours_charged, m.tachometer, m.tachometer_abs, m.fault, m.pid_pos, m.controller_id, m.temp_mos1, m.temp_mos2, m.temp_mos3, m.avg_vd, m.avg_vq, m.status)
+    return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
 
 
 def _encode_set_duty_request(m: SetDutyRequest) -> bytes:
     if not -100000 <= m.duty <= 100000 or m.duty.__class__ is bool:
         raise out_of_range('set_duty request', 'duty', m.duty, -100000, 100000)
-    return _wrap_request(_S_BE_I32.pack(m.duty), 0x05)
+    frame = _S_BE_B1_U8_U8_I32.pack(b'\x02', 5, 0x05, m.duty)
+    return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
 
 
 def _encode_set_current_request(m: SetCurrentRequest) -> bytes:
     if not -2147483648 <= m.current <= 2147483647 or m.current.__class__ is bool:
         raise out_of_range('set_current request', 'current', m.current, -2147483648, 2147483647)
-    return _wrap_request(_S_BE_I32.pack(m.current), 0x06)
+    frame = _S_BE_B1_U8_U8_I32.pack(b'\x02', 5, 0x06, m.current)
+    return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
 
 
 def _encode_set_current_brake_request(m: SetCurrentBrakeRequest) -> bytes:
     if not -2147483648 <= m.current <= 2147483647 or m.current.__class__ is bool:
         raise out_of_range('set_current_brake request', 'current', m.current, -2147483648, 2147483647)
-    return _wrap_request(_S_BE_I32.pack(m.current), 0x07)
+    frame = _S_BE_B1_U8_U8_I32.pack(b'\x02', 5, 0x07, m.current)
+    return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
 
 
 def _encode_set_rpm_request(m: SetRpmRequest) -> bytes:
     if not -2147483648 <= m.rpm <= 2147483647 or m.rpm.__class__ is bool:
         raise out_of_range('set_rpm request', 'rpm', m.rpm, -2147483648, 2147483647)
-    return _wrap_request(_S_BE_I32.pack(m.rpm), 0x08)
+    frame = _S_BE_B1_U8_U8_I32.pack(b'\x02', 5, 0x08, m.rpm)
+    return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
 
 
 def _encode_set_pos_request(m: SetPosRequest) -> bytes:
     if not -2147483648 <= m.position <= 2147483647 or m.position.__class__ is bool:
         raise out_of_range('set_pos request', 'position', m.position, -2147483648, 2147483647)
-    return _wrap_request(_S_BE_I32.pack(m.position), 0x09)
+    frame = _S_BE_B1_U8_U8_I32.pack(b'\x02', 5, 0x09, m.position)
+    return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
 
 
 def _encode_set_handbrake_request(m: SetHandbrakeRequest) -> bytes:
     if not -2147483648 <= m.current <= 2147483647 or m.current.__class__ is bool:
         raise out_of_range('set_handbrake request', 'current', m.current, -2147483648, 2147483647)
-    return _wrap_request(_S_BE_I32.pack(m.current), 0x0a)
+    frame = _S_BE_B1_U8_U8_I32.pack(b'\x02', 5, 0x0a, m.current)
+    return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
 
 
 def _encode_print_response(m: PrintResponse) -> bytes:
@@ -421,11 +433,13 @@ def _encode_print_response(m: PrintResponse) -> bytes:
 def _encode_rotor_position_response(m: RotorPositionResponse) -> bytes:
     if not -2147483648 <= m.position <= 2147483647 or m.position.__class__ is bool:
         raise out_of_range('rotor_position response', 'position', m.position, -2147483648, 2147483647)
-    return _wrap_response(_S_BE_I32.pack(m.position), 0x16)
+    frame = _S_BE_B1_U8_U8_I32.pack(b'\x02', 5, 0x16, m.position)
+    return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
 
 
 def _encode_alive_request(m: AliveRequest) -> bytes:
-    return _wrap_request(b'', 0x1e)
+    frame = _S_B1_U8_U8.pack(b'\x02', 1, 0x1e)
+    return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
 
 
 def _encode_forward_can_request(m: ForwardCanRequest) -> bytes:

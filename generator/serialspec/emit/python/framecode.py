@@ -17,14 +17,32 @@ where `end` is the content's end. Lengths and checksums that see wire bytes read
 
 from __future__ import annotations
 
+import re
+from collections.abc import Callable
 from dataclasses import dataclass
 
 from serialspec.emit.common.frames import runtime_layouts
-from serialspec.emit.python.frames import checksum_name
 from serialspec.runtime.framing import Element, Layout
-from serialspec.spec.model import Direction, Protocol
+from serialspec.spec.model import Checksum, Direction, Protocol
 
 Lines = list[str]
+Structs = Callable[[str], str]  # a struct format -> the name of the module's struct constant for it
+
+
+def checksum_name(checksum: Checksum) -> str:
+    """The codec's module-level name of a checksum's function (emit/python/frames.py defines them)."""
+    return f"_CHECK_{checksum.name.upper()}"
+
+
+def registry(structs: dict[str, str]) -> Structs:
+    """A Structs that names each format after its layout (`_F_...`) and keeps it in `structs` (name -> format)."""
+
+    def named(fmt: str) -> str:
+        name = _struct_name(fmt)
+        structs[name] = fmt
+        return name
+
+    return named
 
 
 @dataclass(frozen=True)
@@ -321,50 +339,61 @@ class _Wrap:
     rest: Lines
 
 
-def wrap_parts(
-    layout: Layout, target: Target, checks: dict[int, str], transparency: str, structs: dict[str, str]
-) -> _Wrap:
+def _packed(elements: tuple[Element, ...], indices: list[int], argument: Callable[[int], str], struct: Structs) -> str:
+    """One expression for the bytes of these elements: a literal, else one struct (neighbouring constants as one
+    `Ns` argument); `argument`: the expression of each non-constant element's value."""
+    if not indices:
+        return ""
+    if all(elements[i].kind == "constant" for i in indices):
+        return repr(b"".join(elements[i].constant for i in indices))
+    fmt, arguments = _order(elements, indices), []
+    constant = b""
+    for i in [*indices, -1]:
+        if i >= 0 and elements[i].kind == "constant":
+            constant += elements[i].constant
+            continue
+        if constant:
+            fmt += f"{len(constant)}s"
+            arguments.append(repr(constant))
+            constant = b""
+        if i >= 0:
+            fmt += _STRUCT_CHARS[elements[i].size]
+            arguments.append(argument(i))
+    return f"{struct(fmt)}.pack({', '.join(arguments)})"
+
+
+def _order(elements: tuple[Element, ...], indices: list[int]) -> str:
+    """The struct byte order of these elements' values (straight() allows one for the multi-byte ones)."""
+    multi = {elements[i].endian for i in indices if elements[i].kind != "constant" and elements[i].size > 1}
+    return ">" if multi == {"big"} else "<"
+
+
+def _arguments(layout: Layout, code: str, values: list[str]) -> Callable[[int], str]:
+    """The expression of each element's value: the command's code, the frame values in element order, lengths in
+    `v_<name>` (computed by the wrap's prelude)."""
+    value_of = dict(zip(layout.values, values, strict=True))
+
+    def argument(index: int) -> str:
+        element = layout.elements[index]
+        if element.kind == "command":
+            return code
+        if element.kind == "length":
+            return f"v_{element.name}"
+        return value_of[index]
+
+    return argument
+
+
+def wrap_parts(layout: Layout, target: Target, checks: dict[int, str], transparency: str, struct: Structs) -> _Wrap:
     """The frame around `content`, as Layout.wrap makes it. `checks` and `transparency` as for decode_lines;
-    `structs`: the struct constants it uses (name -> format), for the module to define."""
+    `struct` names the struct constants it uses."""
     places = _Places(layout)
     elements = layout.elements
     prelude: Lines = []
-    value_of = dict(zip(layout.values, target.value_names, strict=True))
-
-    def argument(index: int) -> str:
-        element = elements[index]
-        if element.kind == "constant":
-            return repr(element.constant)
-        if element.kind == "command":
-            return "code"
-        if element.kind == "length":
-            return f"v_{element.name}"
-        return f"v_{value_of[index]}"
+    argument = _arguments(layout, "code", [f"v_{v}" for v in target.value_names])
 
     def packed(indices: list[int]) -> str:
-        """One expression for the bytes of these elements: a literal, else one struct (neighbouring constants
-        as one `Ns` argument)."""
-        if not indices:
-            return ""
-        if all(elements[i].kind == "constant" for i in indices):
-            return repr(b"".join(elements[i].constant for i in indices))
-        multi = {elements[i].endian for i in indices if elements[i].kind != "constant" and elements[i].size > 1}
-        fmt, arguments = ">" if multi == {"big"} else "<", []
-        constant = b""
-        for i in [*indices, -1]:
-            if i >= 0 and elements[i].kind == "constant":
-                constant += elements[i].constant
-                continue
-            if constant:
-                fmt += f"{len(constant)}s"
-                arguments.append(repr(constant))
-                constant = b""
-            if i >= 0:
-                fmt += _STRUCT_CHARS[elements[i].size]
-                arguments.append(argument(i))
-        name = _struct_name(fmt)
-        structs[name] = fmt
-        return f"{name}.pack({', '.join(arguments)})"
+        return _packed(elements, indices, argument, struct)
 
     first, last = places.first, places.last
     c = layout.content
@@ -403,8 +432,17 @@ def wrap_parts(
                 f'{element.size}-byte field")',
             )
         )
-    rest: Lines = []
     frame = " + ".join(p for p in (packed(list(range(first))), wire) if p)
+    rest = _tail(layout, frame, checks, packed)
+    return _Wrap(prelude, fits, rest)
+
+
+def _tail(layout: Layout, frame: str, checks: dict[int, str], packed: Callable[[list[int]], str]) -> Lines:
+    """Lines that return the frame `frame` (an expression: everything up to the variable part's end) with the
+    elements after it: constants and values packed, each checksum computed over what is written before it."""
+    elements = layout.elements
+    last = _variable(layout)[1]
+    lines: Lines = []
     pending: list[int] = []  # elements after the variable part not yet in `frame`
     for index in range(last + 1, len(elements)):
         element = elements[index]
@@ -420,12 +458,11 @@ def wrap_parts(
         # all after the variable part: counted back from the end of what is written
         begin_expr = str(-_size(elements[a:index])) if a > last else str(begin) if begin else ""
         covered = f"frame[{begin_expr}:{-between if between else ''}]".replace("[:]", "")
-        rest.append(f"frame = {frame}")
+        lines.append(f"frame = {frame}")
         frame = f"frame + {checks[index]}({covered}).to_bytes({element.size}, {element.endian!r})"
     if pending:
         frame = f"{frame} + {packed(pending)}"
-    rest.append(f"return {frame}")
-    return _Wrap(prelude, fits, rest)
+    return [*lines, f"return {frame}"]
 
 
 def wrap_lines(direction: str, layouts: list[_Wrap], target: Target) -> Lines:
@@ -497,30 +534,45 @@ def engine_lines(layouts: tuple[Layout, ...], target: Target) -> tuple[Lines, Li
     return decode, wrap
 
 
+@dataclass(frozen=True)
+class Straight:
+    """A direction whose layouts all take straight-line code: the engine's layouts, each with its checksum
+    elements' function names (by element index)."""
+
+    layouts: tuple[Layout, ...]
+    checks: tuple[dict[int, str], ...]
+
+
+def straight_direction(protocol: Protocol, direction: Direction) -> Straight | None:
+    """The direction's layouts, when every one fits the straight-line form (and they carry the same values)."""
+    layouts = runtime_layouts(protocol, direction)
+    names = {tuple(e.name for e in (layout.elements[i] for i in layout.values)) for layout in layouts}
+    if not all(straight(layout) for layout in layouts) or len(names) != 1:
+        return None
+    checks = tuple(
+        {index: checksum_name(e.checksum) for index, e in enumerate(model.elements) if e.checksum is not None}
+        for model in protocol.framing.alternatives[direction]
+    )
+    return Straight(layouts, checks)
+
+
 def direction_functions(
     protocol: Protocol, direction: Direction, target: Target, structs: dict[str, str]
 ) -> tuple[Lines, Lines]:
     """Module-level code of one direction's frame functions (`_decode_<d>`, `_wrap_<d>` and what they use), and
     the lines of `decode()` that decode a frame `data` of this direction."""
-    layouts = runtime_layouts(protocol, direction)
-    models = protocol.framing.alternatives[direction]
-    names = {tuple(e.name for e in (layout.elements[i] for i in layout.values)) for layout in layouts}
+    found = straight_direction(protocol, direction)
     d = direction.value
-    call = [f"return _decode_{d}(bytes(data), expect)"]
-    if not all(straight(layout) for layout in layouts) or len(names) != 1:
-        decode, wrap = engine_lines(layouts, target)
-        return [*decode, "", "", *wrap], call
+    if found is None:
+        decode, wrap = engine_lines(runtime_layouts(protocol, direction), target)
+        return [*decode, "", "", *wrap], [f"return _decode_{d}(bytes(data), expect)"]
+    layouts = found.layouts
     several = len(layouts) > 1
     lines: Lines = []
     wraps: list[_Wrap] = []
     bodies: list[Lines] = []
-    for layout, model in zip(layouts, models, strict=True):
+    for layout, checks in zip(layouts, found.checks, strict=True):
         suffix = f"_{layout.name}" if several else ""
-        checks = {
-            index: checksum_name(element.checksum)
-            for index, element in enumerate(model.elements)
-            if element.checksum is not None
-        }
         stuffing = f"_{target.upper}{suffix.upper()}_TRANSPARENCY"
         if layout.transparency is not None:
             t = layout.transparency
@@ -529,7 +581,7 @@ def direction_functions(
         function, body = decode_lines(layout, f"_decode_{d}{suffix}", target, checks, stuffing)
         lines += [*function, "", ""]
         bodies.append(body)
-        wraps.append(wrap_parts(layout, target, checks, stuffing, structs))
+        wraps.append(wrap_parts(layout, target, checks, stuffing, registry(structs)))
     if several:
         choice = _choice(layouts, d)
         lines += [
@@ -543,6 +595,71 @@ def direction_functions(
     call = ["frame = data if data.__class__ is bytes else bytes(data)", *_choice(layouts, d, bodies)]
     lines += wrap_lines(d, wraps, target)
     return lines, call
+
+
+_PACKED = re.compile(r"^(?P<name>_S_\w+)\.pack\((?P<arguments>.*)\)$")
+
+
+def frame_encoder(
+    frames: Straight,
+    parts: list[str],
+    formats: dict[str, str],
+    code: str,
+    values: list[str],
+    size: int | None,
+    struct: Structs,
+) -> Lines | None:
+    """An encoder's last lines, which return its message's frame made inline (no call of `_wrap_<direction>`):
+    the head packed with the content's first struct in one call where their byte orders agree.
+
+    `parts`: the content's byte expressions (`formats`: struct constant -> format, for those that are one
+    `_S_....pack(...)`); `code`, `values`: the command code's and the frame values' expressions; `size`: the
+    content's size when it has one. None (the wrap function does it) for stuffed frames, and for lengths that
+    depend on a size known only at run time."""
+    chosen = None
+    for layout, checks in zip(frames.layouts, frames.checks, strict=True):
+        if layout.transparency is not None:
+            return None
+        lengths = {}
+        for index, element in enumerate(layout.elements):
+            if element.kind != "length":
+                continue
+            a, b = element.span
+            lengths[index] = _size(layout.elements[a : b + 1]) + element.adds
+            if a <= layout.content <= b:  # it counts the content: known here only for a content of one size
+                if size is None:
+                    return None
+                lengths[index] += size
+        if all(0 <= value < 1 << (8 * layout.elements[i].size) for i, value in lengths.items()):
+            chosen = (layout, checks, lengths)
+            break
+    if chosen is None:
+        return None  # no layout can count it: the wrap function says so
+    layout, checks, lengths = chosen
+    elements = layout.elements
+    argument = _arguments(layout, code, values)
+
+    def constant_or(index: int) -> str:
+        return str(lengths[index]) if index in lengths else argument(index)
+
+    head = list(range(layout.content))
+    first = _PACKED.match(parts[0]) if parts else None
+    fmt = formats.get(first["name"], "") if first else ""
+    order = _order(elements, head)
+    multi = any(elements[i].kind != "constant" and elements[i].size > 1 for i in head)
+    if first and fmt[:1] in "<>" and (fmt[0] == order or not multi):
+        # the head's elements joined to the content's first struct: one pack for both
+        fused = _packed(elements, head, constant_or, lambda f: f)
+        if fused.endswith(")"):
+            head_format, _, head_arguments = fused.partition(".pack(")
+            joined = struct(fmt[0] + head_format[1:] + fmt[1:])
+            parts = [f"{joined}.pack({head_arguments[:-1]}, {first['arguments']})", *parts[1:]]
+        else:  # constants only: a literal
+            parts = [f"{fused} + {parts[0]}", *parts[1:]]
+    else:
+        parts = [p for p in (_packed(elements, head, constant_or, struct), *parts) if p]
+    frame = " + ".join(parts) if parts else "b''"
+    return _tail(layout, frame, checks, lambda indices: _packed(elements, indices, constant_or, struct))
 
 
 def _choice(layouts: tuple[Layout, ...], d: str, bodies: list[Lines] | None = None) -> Lines:

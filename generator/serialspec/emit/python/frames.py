@@ -10,9 +10,9 @@ runs on them; single frames are checked and built by straight-line code written 
 from __future__ import annotations
 
 from serialspec.emit.common.frames import runtime_element
+from serialspec.emit.python.framecode import checksum_name
 from serialspec.emit.python.pycode import one_line
 from serialspec.spec.model import (
-    Checksum,
     Command,
     Direction,
     FrameElement,
@@ -21,10 +21,6 @@ from serialspec.spec.model import (
     Protocol,
     size_terms,
 )
-
-
-def checksum_name(checksum: Checksum) -> str:
-    return f"_CHECK_{checksum.name.upper()}"
 
 
 def checksum_definitions(protocol: Protocol) -> tuple[list[str], list[str]]:

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field, replace
 
 from serialspec.emit.common.numbers import number
 from serialspec.emit.common.text import collapse
+from serialspec.emit.python.framecode import Straight, frame_encoder, straight_direction
 from serialspec.emit.python.kinds import kind
 from serialspec.spec import expression
 from serialspec.spec.model import (
@@ -150,8 +151,17 @@ class PackageCode:
         self.built: dict[str, list[str]] = {}
         self.member_maps: set[str] = set()  # enum and flag classes whose value -> member map the decoders use
         self._seen_classes: set[str] = set()
+        self._straight: dict[Direction, Straight | None] = {}
         for message in protocol.messages():
             self.message(message)
+
+    def straight(self, direction: Direction) -> Straight | None:
+        """The direction's frames when straight-line code takes them (framecode.py), worked out once."""
+        if direction not in self._straight:
+            self._straight[direction] = (
+                None if self.protocol.framing.classic else straight_direction(self.protocol, direction)
+            )
+        return self._straight[direction]
 
     # --- structs --------------------------------------------------------------------------------------------------
 
@@ -642,6 +652,14 @@ class PackageCode:
             code = f"{command_code:#04x}" if command_code is not None and layout.has_command else "None"
             if error is not None:
                 code = f"m.{error.element} | {error.flag:#04x}"
+            frames = self.straight(message.direction)
+            size = message.min_size if message.min_size == message.max_size else None
+            name = f"frame_{message.class_name}"
+            inline = frames and frame_encoder(
+                frames, parts, self.structs, code, frame_values, size, lambda fmt: self.struct(name, fmt)
+            )
+            if inline:  # the frame made here (emit/python/framecode.py): no call of the direction's wrap
+                return [*lines, *inline]
             arguments = ", ".join([content, code, *frame_values])
             lines.append(f"return _wrap_{message.direction.value}({arguments})")  # emit/python/framecode.py
             return lines

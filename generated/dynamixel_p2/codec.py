@@ -563,9 +563,10 @@ def _decode_request(frame: bytes, expect: type[Message] | None = None) -> Messag
     if check != stored:
         raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
     code = buf[7]
-    decoder = _REQUEST_DECODERS.get(code)
-    if decoder is None:
-        raise DecodeError(f"unknown command {code!r}")
+    try:
+        decoder = _REQUEST_DECODERS[code]
+    except KeyError:
+        raise DecodeError(f"unknown command {code!r}") from None
     return decoder(buf, 8, end, v_id)
 
 
@@ -642,13 +643,14 @@ def _decode_response(frame: bytes, expect: type[Message] | None = None) -> Messa
     stored = buf[end + 1] << 8 | buf[end]
     if check != stored:
         raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
-    decoder = _RESPONSE_DECODERS.get(None)
+    try:
+        decoder = _RESPONSE_DECODERS[None]
+    except KeyError:
+        raise DecodeError("unknown command None") from None
     if expect is not None:
         expected, alternative = _RESPONSE_EXPECTED.get(expect, (None, None))
         if alternative is not None and expected is None:
             decoder = alternative
-    if decoder is None:
-        raise DecodeError("unknown command None")
     return decoder(buf, 9, end, v_id, v_error)
 
 
@@ -715,9 +717,10 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         if check != stored:
             raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
         code = buf[7]
-        decoder = _REQUEST_DECODERS.get(code)
-        if decoder is None:
-            raise DecodeError(f"unknown command {code!r}")
+        try:
+            decoder = _REQUEST_DECODERS[code]
+        except KeyError:
+            raise DecodeError(f"unknown command {code!r}") from None
         return decoder(buf, 8, end, v_id)
     if direction == 'response':  # a Direction or its value
         frame = data if data.__class__ is bytes else bytes(data)
@@ -748,13 +751,14 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         stored = buf[end + 1] << 8 | buf[end]
         if check != stored:
             raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
-        decoder = _RESPONSE_DECODERS.get(None)
+        try:
+            decoder = _RESPONSE_DECODERS[None]
+        except KeyError:
+            raise DecodeError("unknown command None") from None
         if expect is not None:
             expected, alternative = _RESPONSE_EXPECTED.get(expect, (None, None))
             if alternative is not None and expected is None:
                 decoder = alternative
-        if decoder is None:
-            raise DecodeError("unknown command None")
         return decoder(buf, 9, end, v_id, v_error)
     raise ValueError(f"direction must be request or response, not {direction!r}")
 

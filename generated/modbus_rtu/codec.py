@@ -734,16 +734,17 @@ def _decode_request(frame: bytes, expect: type[Message] | None = None) -> Messag
     end = n - 2
     buf = frame
     v_unit = buf[0]
-    if not (1 <= v_unit <= 247 or v_unit == 0):
+    if not 0 <= v_unit <= 247:
         raise DecodeError(f"unit = {v_unit} is outside its range 1..247 (or 0)")
     check = _CHECK_CRC(frame[:-2])
     stored = buf[end + 1] << 8 | buf[end]
     if check != stored:
         raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
     code = buf[1]
-    decoder = _REQUEST_DECODERS.get(code)
-    if decoder is None:
-        raise DecodeError(f"unknown command {code!r}")
+    try:
+        decoder = _REQUEST_DECODERS[code]
+    except KeyError:
+        raise DecodeError(f"unknown command {code!r}") from None
     return decoder(buf, 2, end, v_unit)
 
 
@@ -801,7 +802,7 @@ def _decode_response(frame: bytes, expect: type[Message] | None = None) -> Messa
     end = n - 2
     buf = frame
     v_unit = buf[0]
-    if not (1 <= v_unit <= 247 or v_unit == 0):
+    if not 0 <= v_unit <= 247:
         raise DecodeError(f"unit = {v_unit} is outside its range 1..247 (or 0)")
     check = _CHECK_CRC(frame[:-2])
     stored = buf[end + 1] << 8 | buf[end]
@@ -810,9 +811,10 @@ def _decode_response(frame: bytes, expect: type[Message] | None = None) -> Messa
     code = buf[1]
     if code & 0x80:  # an error reply: it refuses the request of code & ~flag
         return _RESPONSE_DECODERS[ERROR_REPLY](buf, 2, end, v_unit, code & 0x7f)
-    decoder = _RESPONSE_DECODERS.get(code)
-    if decoder is None:
-        raise DecodeError(f"unknown command {code!r}")
+    try:
+        decoder = _RESPONSE_DECODERS[code]
+    except KeyError:
+        raise DecodeError(f"unknown command {code!r}") from None
     return decoder(buf, 2, end, v_unit)
 
 
@@ -861,16 +863,17 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         end = n - 2
         buf = frame
         v_unit = buf[0]
-        if not (1 <= v_unit <= 247 or v_unit == 0):
+        if not 0 <= v_unit <= 247:
             raise DecodeError(f"unit = {v_unit} is outside its range 1..247 (or 0)")
         check = _CHECK_CRC(frame[:-2])
         stored = buf[end + 1] << 8 | buf[end]
         if check != stored:
             raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
         code = buf[1]
-        decoder = _REQUEST_DECODERS.get(code)
-        if decoder is None:
-            raise DecodeError(f"unknown command {code!r}")
+        try:
+            decoder = _REQUEST_DECODERS[code]
+        except KeyError:
+            raise DecodeError(f"unknown command {code!r}") from None
         return decoder(buf, 2, end, v_unit)
     if direction == 'response':  # a Direction or its value
         frame = data if data.__class__ is bytes else bytes(data)
@@ -880,7 +883,7 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         end = n - 2
         buf = frame
         v_unit = buf[0]
-        if not (1 <= v_unit <= 247 or v_unit == 0):
+        if not 0 <= v_unit <= 247:
             raise DecodeError(f"unit = {v_unit} is outside its range 1..247 (or 0)")
         check = _CHECK_CRC(frame[:-2])
         stored = buf[end + 1] << 8 | buf[end]
@@ -889,9 +892,10 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         code = buf[1]
         if code & 0x80:  # an error reply: it refuses the request of code & ~flag
             return _RESPONSE_DECODERS[ERROR_REPLY](buf, 2, end, v_unit, code & 0x7f)
-        decoder = _RESPONSE_DECODERS.get(code)
-        if decoder is None:
-            raise DecodeError(f"unknown command {code!r}")
+        try:
+            decoder = _RESPONSE_DECODERS[code]
+        except KeyError:
+            raise DecodeError(f"unknown command {code!r}") from None
         return decoder(buf, 2, end, v_unit)
     raise ValueError(f"direction must be request or response, not {direction!r}")
 

@@ -513,9 +513,10 @@ def _decode_request_short(frame: bytes, expect: type[Message] | None = None) -> 
     if check != stored:
         raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
     code = buf[2]
-    decoder = _REQUEST_DECODERS.get(code)
-    if decoder is None:
-        raise DecodeError(f"unknown command {code!r}")
+    try:
+        decoder = _REQUEST_DECODERS[code]
+    except KeyError:
+        raise DecodeError(f"unknown command {code!r}") from None
     return decoder(buf, 3, end)
 
 
@@ -538,9 +539,10 @@ def _decode_request_long(frame: bytes, expect: type[Message] | None = None) -> M
     if check != stored:
         raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
     code = buf[3]
-    decoder = _REQUEST_DECODERS.get(code)
-    if decoder is None:
-        raise DecodeError(f"unknown command {code!r}")
+    try:
+        decoder = _REQUEST_DECODERS[code]
+    except KeyError:
+        raise DecodeError(f"unknown command {code!r}") from None
     return decoder(buf, 4, end)
 
 
@@ -619,9 +621,10 @@ def _decode_response_short(frame: bytes, expect: type[Message] | None = None) ->
     if check != stored:
         raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
     code = buf[2]
-    decoder = _RESPONSE_DECODERS.get(code)
-    if decoder is None:
-        raise DecodeError(f"unknown command {code!r}")
+    try:
+        decoder = _RESPONSE_DECODERS[code]
+    except KeyError:
+        raise DecodeError(f"unknown command {code!r}") from None
     return decoder(buf, 3, end)
 
 
@@ -644,9 +647,10 @@ def _decode_response_long(frame: bytes, expect: type[Message] | None = None) -> 
     if check != stored:
         raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
     code = buf[3]
-    decoder = _RESPONSE_DECODERS.get(code)
-    if decoder is None:
-        raise DecodeError(f"unknown command {code!r}")
+    try:
+        decoder = _RESPONSE_DECODERS[code]
+    except KeyError:
+        raise DecodeError(f"unknown command {code!r}") from None
     return decoder(buf, 4, end)
 
 
@@ -716,9 +720,10 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
             if check != stored:
                 raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
             code = buf[2]
-            decoder = _REQUEST_DECODERS.get(code)
-            if decoder is None:
-                raise DecodeError(f"unknown command {code!r}")
+            try:
+                decoder = _REQUEST_DECODERS[code]
+            except KeyError:
+                raise DecodeError(f"unknown command {code!r}") from None
             return decoder(buf, 3, end)
         if frame.startswith(b'\x03'):
             n = len(frame)
@@ -738,9 +743,10 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
             if check != stored:
                 raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
             code = buf[3]
-            decoder = _REQUEST_DECODERS.get(code)
-            if decoder is None:
-                raise DecodeError(f"unknown command {code!r}")
+            try:
+                decoder = _REQUEST_DECODERS[code]
+            except KeyError:
+                raise DecodeError(f"unknown command {code!r}") from None
             return decoder(buf, 4, end)
         raise DecodeError(f"frame starts {frame[:4].hex(' ')}, expected 02 or 03")
     if direction == 'response':  # a Direction or its value
@@ -763,9 +769,10 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
             if check != stored:
                 raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
             code = buf[2]
-            decoder = _RESPONSE_DECODERS.get(code)
-            if decoder is None:
-                raise DecodeError(f"unknown command {code!r}")
+            try:
+                decoder = _RESPONSE_DECODERS[code]
+            except KeyError:
+                raise DecodeError(f"unknown command {code!r}") from None
             return decoder(buf, 3, end)
         if frame.startswith(b'\x03'):
             n = len(frame)
@@ -785,9 +792,10 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
             if check != stored:
                 raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
             code = buf[3]
-            decoder = _RESPONSE_DECODERS.get(code)
-            if decoder is None:
-                raise DecodeError(f"unknown command {code!r}")
+            try:
+                decoder = _RESPONSE_DECODERS[code]
+            except KeyError:
+                raise DecodeError(f"unknown command {code!r}") from None
             return decoder(buf, 4, end)
         raise DecodeError(f"frame starts {frame[:4].hex(' ')}, expected 02 or 03")
     raise ValueError(f"direction must be request or response, not {direction!r}")

@@ -224,12 +224,15 @@ def decode_lines(
         full = element.minimum <= 0 and element.maximum >= (1 << (8 * element.size)) - 1
         if full:
             continue
-        also = f" or {value} == {element.also}" if element.also is not None else ""
-        shown = f" (or {element.also})" if element.also is not None else ""
+        low, high, also = element.minimum, element.maximum, element.also
+        shown = f" (or {also})" if also is not None else ""
+        if also in (low - 1, high + 1):  # next to the range: one chained comparison
+            condition = f"{min(low, also)} <= {value} <= {max(high, also)}"
+        else:
+            condition = f"({low} <= {value} <= {high}" + (f" or {value} == {also})" if also is not None else ")")
         body += [
-            f"if not ({element.minimum} <= {value} <= {element.maximum}{also}):",
-            f'    raise DecodeError(f"{element.name} = {{{value}}} is outside its range '
-            f'{element.minimum}..{element.maximum}{shown}")',
+            f"if not {condition}:",
+            f'    raise DecodeError(f"{element.name} = {{{value}}} is outside its range {low}..{high}{shown}")',
         ]
     for index, element in enumerate(elements):
         if element.kind != "length":
@@ -270,16 +273,21 @@ def _dispatch(target: Target, code: str, arguments: str, nullable: bool) -> Line
             f"if {known}{code} & {target.error_flag:#04x}:  # an error reply: it refuses the request of code & ~flag",
             f"    return {table}[ERROR_REPLY]({arguments}, {code} & {target.error_keep:#04x})",
         ]
-    lines.append(f"decoder = {table}.get({code})")
-    if target.expected:
+    unknown = f'f"unknown command {{{code}!r}}"' if code != "None" else '"unknown command None"'
+    lines += [
+        "try:",
+        f"    decoder = {table}[{code}]",
+        "except KeyError:",
+        f"    raise DecodeError({unknown}) from None",
+    ]
+    if target.expected:  # (its codes are among the decoders')
         lines += [
             "if expect is not None:",
             f"    expected, alternative = _{target.upper}_EXPECTED.get(expect, (None, None))",
             f"    if alternative is not None and expected {'is' if code == 'None' else '=='} {code}:",
             "        decoder = alternative",
         ]
-    unknown = f'f"unknown command {{{code}!r}}"' if code != "None" else '"unknown command None"'
-    return [*lines, "if decoder is None:", f"    raise DecodeError({unknown})", f"return decoder({arguments})"]
+    return [*lines, f"return decoder({arguments})"]
 
 
 def _signs(replace: tuple[tuple[bytes, bytes], ...]) -> list[bytes]:

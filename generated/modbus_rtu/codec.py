@@ -736,10 +736,11 @@ def _decode_request(frame: bytes, expect: type[Message] | None = None) -> Messag
     v_unit = buf[0]
     if not 0 <= v_unit <= 247:
         raise DecodeError(f"unit = {v_unit} is outside its range 1..247 (or 0)")
-    check = _CHECK_CRC(frame[:-2])
-    stored = buf[end + 1] << 8 | buf[end]
-    if check != stored:
-        raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
+    if _CHECK_CRC(frame) != 0x0000:
+        check = _CHECK_CRC(frame[:-2])
+        stored = buf[end + 1] << 8 | buf[end]
+        if check != stored:
+            raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
     code = buf[1]
     try:
         decoder = _REQUEST_DECODERS[code]
@@ -804,10 +805,11 @@ def _decode_response(frame: bytes, expect: type[Message] | None = None) -> Messa
     v_unit = buf[0]
     if not 0 <= v_unit <= 247:
         raise DecodeError(f"unit = {v_unit} is outside its range 1..247 (or 0)")
-    check = _CHECK_CRC(frame[:-2])
-    stored = buf[end + 1] << 8 | buf[end]
-    if check != stored:
-        raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
+    if _CHECK_CRC(frame) != 0x0000:
+        check = _CHECK_CRC(frame[:-2])
+        stored = buf[end + 1] << 8 | buf[end]
+        if check != stored:
+            raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
     code = buf[1]
     if code & 0x80:  # an error reply: it refuses the request of code & ~flag
         return _RESPONSE_DECODERS[ERROR_REPLY](buf, 2, end, v_unit, code & 0x7f)
@@ -865,10 +867,11 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         v_unit = buf[0]
         if not 0 <= v_unit <= 247:
             raise DecodeError(f"unit = {v_unit} is outside its range 1..247 (or 0)")
-        check = _CHECK_CRC(frame[:-2])
-        stored = buf[end + 1] << 8 | buf[end]
-        if check != stored:
-            raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
+        if _CHECK_CRC(frame) != 0x0000:
+            check = _CHECK_CRC(frame[:-2])
+            stored = buf[end + 1] << 8 | buf[end]
+            if check != stored:
+                raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
         code = buf[1]
         try:
             decoder = _REQUEST_DECODERS[code]
@@ -885,10 +888,11 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         v_unit = buf[0]
         if not 0 <= v_unit <= 247:
             raise DecodeError(f"unit = {v_unit} is outside its range 1..247 (or 0)")
-        check = _CHECK_CRC(frame[:-2])
-        stored = buf[end + 1] << 8 | buf[end]
-        if check != stored:
-            raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
+        if _CHECK_CRC(frame) != 0x0000:
+            check = _CHECK_CRC(frame[:-2])
+            stored = buf[end + 1] << 8 | buf[end]
+            if check != stored:
+                raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
         code = buf[1]
         if code & 0x80:  # an error reply: it refuses the request of code & ~flag
             return _RESPONSE_DECODERS[ERROR_REPLY](buf, 2, end, v_unit, code & 0x7f)

@@ -508,10 +508,11 @@ def _decode_request_short(frame: bytes, expect: type[Message] | None = None) -> 
     length = buf[1]
     if length != n - 5:
         raise DecodeError(f"length says {length} but the frame holds {n - 5}")
-    check = _CHECK_CRC(frame[2:-3])
-    stored = buf[end] << 8 | buf[end + 1]
-    if check != stored:
-        raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
+    if _CHECK_CRC(frame[2:-1]) != 0x0000:
+        check = _CHECK_CRC(frame[2:-3])
+        stored = buf[end] << 8 | buf[end + 1]
+        if check != stored:
+            raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
     code = buf[2]
     try:
         decoder = _REQUEST_DECODERS[code]
@@ -534,10 +535,11 @@ def _decode_request_long(frame: bytes, expect: type[Message] | None = None) -> M
     length = buf[1] << 8 | buf[2]
     if length != n - 6:
         raise DecodeError(f"length says {length} but the frame holds {n - 6}")
-    check = _CHECK_CRC(frame[3:-3])
-    stored = buf[end] << 8 | buf[end + 1]
-    if check != stored:
-        raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
+    if _CHECK_CRC(frame[3:-1]) != 0x0000:
+        check = _CHECK_CRC(frame[3:-3])
+        stored = buf[end] << 8 | buf[end + 1]
+        if check != stored:
+            raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
     code = buf[3]
     try:
         decoder = _REQUEST_DECODERS[code]
@@ -616,10 +618,11 @@ def _decode_response_short(frame: bytes, expect: type[Message] | None = None) ->
     length = buf[1]
     if length != n - 5:
         raise DecodeError(f"length says {length} but the frame holds {n - 5}")
-    check = _CHECK_CRC(frame[2:-3])
-    stored = buf[end] << 8 | buf[end + 1]
-    if check != stored:
-        raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
+    if _CHECK_CRC(frame[2:-1]) != 0x0000:
+        check = _CHECK_CRC(frame[2:-3])
+        stored = buf[end] << 8 | buf[end + 1]
+        if check != stored:
+            raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
     code = buf[2]
     try:
         decoder = _RESPONSE_DECODERS[code]
@@ -642,10 +645,11 @@ def _decode_response_long(frame: bytes, expect: type[Message] | None = None) -> 
     length = buf[1] << 8 | buf[2]
     if length != n - 6:
         raise DecodeError(f"length says {length} but the frame holds {n - 6}")
-    check = _CHECK_CRC(frame[3:-3])
-    stored = buf[end] << 8 | buf[end + 1]
-    if check != stored:
-        raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
+    if _CHECK_CRC(frame[3:-1]) != 0x0000:
+        check = _CHECK_CRC(frame[3:-3])
+        stored = buf[end] << 8 | buf[end + 1]
+        if check != stored:
+            raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
     code = buf[3]
     try:
         decoder = _RESPONSE_DECODERS[code]
@@ -715,10 +719,11 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
             length = buf[1]
             if length != n - 5:
                 raise DecodeError(f"length says {length} but the frame holds {n - 5}")
-            check = _CHECK_CRC(frame[2:-3])
-            stored = buf[end] << 8 | buf[end + 1]
-            if check != stored:
-                raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
+            if _CHECK_CRC(frame[2:-1]) != 0x0000:
+                check = _CHECK_CRC(frame[2:-3])
+                stored = buf[end] << 8 | buf[end + 1]
+                if check != stored:
+                    raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
             code = buf[2]
             try:
                 decoder = _REQUEST_DECODERS[code]
@@ -738,10 +743,11 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
             length = buf[1] << 8 | buf[2]
             if length != n - 6:
                 raise DecodeError(f"length says {length} but the frame holds {n - 6}")
-            check = _CHECK_CRC(frame[3:-3])
-            stored = buf[end] << 8 | buf[end + 1]
-            if check != stored:
-                raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
+            if _CHECK_CRC(frame[3:-1]) != 0x0000:
+                check = _CHECK_CRC(frame[3:-3])
+                stored = buf[end] << 8 | buf[end + 1]
+                if check != stored:
+                    raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
             code = buf[3]
             try:
                 decoder = _REQUEST_DECODERS[code]
@@ -764,10 +770,11 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
             length = buf[1]
             if length != n - 5:
                 raise DecodeError(f"length says {length} but the frame holds {n - 5}")
-            check = _CHECK_CRC(frame[2:-3])
-            stored = buf[end] << 8 | buf[end + 1]
-            if check != stored:
-                raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
+            if _CHECK_CRC(frame[2:-1]) != 0x0000:
+                check = _CHECK_CRC(frame[2:-3])
+                stored = buf[end] << 8 | buf[end + 1]
+                if check != stored:
+                    raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
             code = buf[2]
             try:
                 decoder = _RESPONSE_DECODERS[code]
@@ -787,10 +794,11 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
             length = buf[1] << 8 | buf[2]
             if length != n - 6:
                 raise DecodeError(f"length says {length} but the frame holds {n - 6}")
-            check = _CHECK_CRC(frame[3:-3])
-            stored = buf[end] << 8 | buf[end + 1]
-            if check != stored:
-                raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
+            if _CHECK_CRC(frame[3:-1]) != 0x0000:
+                check = _CHECK_CRC(frame[3:-3])
+                stored = buf[end] << 8 | buf[end + 1]
+                if check != stored:
+                    raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
             code = buf[3]
             try:
                 decoder = _RESPONSE_DECODERS[code]

@@ -160,7 +160,7 @@ class _Places:
         if a <= self.first and self.last <= b:
             begin = _size(elements[:a])
             tail = _size(elements[b + 1 :])
-            return f"frame[{begin or ''}:{-tail if tail else ''}]"
+            return f"frame[{begin or ''}:{-tail if tail else ''}]" if begin or tail else "frame"
         return f"buf[{_start(self.at(a))}:{self.stop(b)}]"
 
 
@@ -248,18 +248,37 @@ def decode_lines(
         if element.kind != "checksum":
             continue
         width = 2 + 2 * element.size
-        body += [
+        failed = [
             f"check = {checks[index]}({places.covered(*element.span)})",
             f"stored = {places.read(index)}",
             "if check != stored:",
             f'    raise ChecksumError(f"bad {element.name}: the frame has {{stored:#0{width}x}}, '
             f'its bytes give {{check:#0{width}x}}")',
         ]
+        residue = _residue(element)
+        a, b = element.span
+        if residue is not None and b == index - 1 and a <= places.first:
+            # over the covered bytes and the checksum itself, an intact frame's CRC is one constant: no slice, no
+            # stored value to read; they are made only to say what is wrong
+            whole = places.covered(a, index)
+            body += [f"if {checks[index]}({whole}) != {residue:#0{width}x}:", *(f"    {line}" for line in failed)]
+        else:
+            body += failed
     if command is not None:
         body.append(f"code = {places.read(command)}")
     code = "None" if command is None else "code"
     body += _dispatch(target, code, ", ".join(["buf", str(places.content), "end", *values]), nullable=False)
     return lines + [f"    {line}" for line in body], ["n = len(frame)", *body]
+
+
+def _residue(element: Element) -> int | None:
+    """The checksum over any bytes followed by their own checksum (as the element stores it), where that is one
+    constant: a CRC stored in its own bit order (reflected: low byte first; else high byte first). None for the
+    others (sums, a CRC stored the other way round). Found by computing it, not by its parameters."""
+    function = element.checksum
+    assert function is not None
+    found = {function(data + element.pack(function(data))) for data in (b"", b"\x00", b"123456789", b"\xff" * 7)}
+    return found.pop() if len(found) == 1 else None
 
 
 def _dispatch(target: Target, code: str, arguments: str, nullable: bool) -> Lines:

@@ -44,7 +44,6 @@ from modbus_rtu.messages import (
 __all__ = ["StreamParser", "decode", "encode"]
 
 _F_LE_U8_U8 = struct.Struct('<BB')
-_S_BE_FRAME_READWRITEREGISTERSREQUEST = struct.Struct('>BBHHHHB')
 _S_BE_U16_U16 = struct.Struct('>HH')
 _S_BE_U16_U16_U16 = struct.Struct('>HHH')
 _S_BE_U16_U16_U16_U16_U8 = struct.Struct('>HHHHB')
@@ -490,7 +489,7 @@ def _encode_read_holding_registers_response(m: ReadHoldingRegistersResponse) -> 
     for x_registers in m.registers:
         if not 0 <= x_registers <= 65535 or x_registers.__class__ is bool:
             raise out_of_range('read_holding_registers response', 'registers', m.registers, 0, 65535)
-    frame = _S_BE_U8_U8_U8.pack(m.unit, 0x03, v_byte_count) + struct.pack(f'>{len(m.registers)}H', *m.registers)
+    frame = struct.pack(f'>BBB{len(m.registers)}H', m.unit, 0x03, v_byte_count, *m.registers)
     return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
@@ -514,7 +513,7 @@ def _encode_read_input_registers_response(m: ReadInputRegistersResponse) -> byte
     for x_registers in m.registers:
         if not 0 <= x_registers <= 65535 or x_registers.__class__ is bool:
             raise out_of_range('read_input_registers response', 'registers', m.registers, 0, 65535)
-    frame = _S_BE_U8_U8_U8.pack(m.unit, 0x04, v_byte_count) + struct.pack(f'>{len(m.registers)}H', *m.registers)
+    frame = struct.pack(f'>BBB{len(m.registers)}H', m.unit, 0x04, v_byte_count, *m.registers)
     return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
@@ -602,7 +601,7 @@ def _encode_write_registers_request(m: WriteRegistersRequest) -> bytes:
     for x_values in m.values:
         if not 0 <= x_values <= 65535 or x_values.__class__ is bool:
             raise out_of_range('write_registers request', 'values', m.values, 0, 65535)
-    frame = _S_BE_U8_U8_U16_U16_U8.pack(m.unit, 0x10, m.address, v_count, v_byte_count) + struct.pack(f'>{len(m.values)}H', *m.values)
+    frame = struct.pack(f'>BBHHB{len(m.values)}H', m.unit, 0x10, m.address, v_count, v_byte_count, *m.values)
     return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
@@ -661,7 +660,7 @@ def _encode_read_write_registers_request(m: ReadWriteRegistersRequest) -> bytes:
     for x_values in m.values:
         if not 0 <= x_values <= 65535 or x_values.__class__ is bool:
             raise out_of_range('read_write_registers request', 'values', m.values, 0, 65535)
-    frame = _S_BE_FRAME_READWRITEREGISTERSREQUEST.pack(m.unit, 0x17, m.read_address, m.read_count, m.write_address, v_write_count, v_byte_count) + struct.pack(f'>{len(m.values)}H', *m.values)
+    frame = struct.pack(f'>BBHHHHB{len(m.values)}H', m.unit, 0x17, m.read_address, m.read_count, m.write_address, v_write_count, v_byte_count, *m.values)
     return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
@@ -674,7 +673,7 @@ def _encode_read_write_registers_response(m: ReadWriteRegistersResponse) -> byte
     for x_registers in m.registers:
         if not 0 <= x_registers <= 65535 or x_registers.__class__ is bool:
             raise out_of_range('read_write_registers response', 'registers', m.registers, 0, 65535)
-    frame = _S_BE_U8_U8_U8.pack(m.unit, 0x17, v_byte_count) + struct.pack(f'>{len(m.registers)}H', *m.registers)
+    frame = struct.pack(f'>BBB{len(m.registers)}H', m.unit, 0x17, v_byte_count, *m.registers)
     return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 

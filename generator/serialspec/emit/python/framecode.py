@@ -625,6 +625,8 @@ def direction_functions(
 
 
 _PACKED = re.compile(r"^(?P<name>_S_\w+)\.pack\((?P<arguments>.*)\)$")
+# a run of numbers whose count is known at run time, as the content's encoders pack it
+_RUN = re.compile(r"^struct\.pack\(f'(?P<order>[<>])(?P<format>[^'\\]*)', (?P<arguments>\*[\w.]+)\)$")
 
 
 def frame_encoder(
@@ -679,8 +681,13 @@ def frame_encoder(
         fused = _packed(elements, head, constant_or, lambda f: f)
         if fused.endswith(")"):
             head_format, _, head_arguments = fused.partition(".pack(")
-            joined = struct(fmt[0] + head_format[1:] + fmt[1:])
-            parts = [f"{joined}.pack({head_arguments[:-1]}, {first['arguments']})", *parts[1:]]
+            static, arguments = fmt[0] + head_format[1:] + fmt[1:], f"{head_arguments[:-1]}, {first['arguments']}"
+            run = _RUN.match(parts[1]) if len(parts) > 1 else None
+            if run and run["order"] == static[0]:  # and a run of numbers after it, in the same byte order
+                fstring = repr(static + run["format"]).replace("'", "f'", 1)
+                parts = [f"struct.pack({fstring}, {arguments}, {run['arguments']})", *parts[2:]]
+            else:
+                parts = [f"{struct(static)}.pack({arguments})", *parts[1:]]
         else:  # constants only: a literal
             parts = [f"{fused} + {parts[0]}", *parts[1:]]
     else:

@@ -501,8 +501,6 @@ def _decode_request_short(frame: bytes, expect: type[Message] | None = None) -> 
         raise DecodeError(f"frame of {n} bytes is shorter than the smallest short frame (6)")
     end = n - 3
     buf = frame
-    if buf[0] != 0x02:
-        raise DecodeError(f"start is {buf[0:1].hex(' ')}, expected 02")
     if buf[end + 2] != 0x03:
         raise DecodeError(f"end is {buf[end + 2:end + 3].hex(' ')}, expected 03")
     length = buf[1]
@@ -528,8 +526,6 @@ def _decode_request_long(frame: bytes, expect: type[Message] | None = None) -> M
         raise DecodeError(f"frame of {n} bytes is shorter than the smallest long frame (7)")
     end = n - 3
     buf = frame
-    if buf[0] != 0x03:
-        raise DecodeError(f"start is {buf[0:1].hex(' ')}, expected 03")
     if buf[end + 2] != 0x03:
         raise DecodeError(f"end is {buf[end + 2:end + 3].hex(' ')}, expected 03")
     length = buf[1] << 8 | buf[2]
@@ -611,8 +607,6 @@ def _decode_response_short(frame: bytes, expect: type[Message] | None = None) ->
         raise DecodeError(f"frame of {n} bytes is shorter than the smallest short frame (6)")
     end = n - 3
     buf = frame
-    if buf[0] != 0x02:
-        raise DecodeError(f"start is {buf[0:1].hex(' ')}, expected 02")
     if buf[end + 2] != 0x03:
         raise DecodeError(f"end is {buf[end + 2:end + 3].hex(' ')}, expected 03")
     length = buf[1]
@@ -638,8 +632,6 @@ def _decode_response_long(frame: bytes, expect: type[Message] | None = None) -> 
         raise DecodeError(f"frame of {n} bytes is shorter than the smallest long frame (7)")
     end = n - 3
     buf = frame
-    if buf[0] != 0x03:
-        raise DecodeError(f"start is {buf[0:1].hex(' ')}, expected 03")
     if buf[end + 2] != 0x03:
         raise DecodeError(f"end is {buf[end + 2:end + 3].hex(' ')}, expected 03")
     length = buf[1] << 8 | buf[2]
@@ -712,8 +704,6 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
                 raise DecodeError(f"frame of {n} bytes is shorter than the smallest short frame (6)")
             end = n - 3
             buf = frame
-            if buf[0] != 0x02:
-                raise DecodeError(f"start is {buf[0:1].hex(' ')}, expected 02")
             if buf[end + 2] != 0x03:
                 raise DecodeError(f"end is {buf[end + 2:end + 3].hex(' ')}, expected 03")
             length = buf[1]
@@ -736,8 +726,6 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
                 raise DecodeError(f"frame of {n} bytes is shorter than the smallest long frame (7)")
             end = n - 3
             buf = frame
-            if buf[0] != 0x03:
-                raise DecodeError(f"start is {buf[0:1].hex(' ')}, expected 03")
             if buf[end + 2] != 0x03:
                 raise DecodeError(f"end is {buf[end + 2:end + 3].hex(' ')}, expected 03")
             length = buf[1] << 8 | buf[2]
@@ -763,8 +751,6 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
                 raise DecodeError(f"frame of {n} bytes is shorter than the smallest short frame (6)")
             end = n - 3
             buf = frame
-            if buf[0] != 0x02:
-                raise DecodeError(f"start is {buf[0:1].hex(' ')}, expected 02")
             if buf[end + 2] != 0x03:
                 raise DecodeError(f"end is {buf[end + 2:end + 3].hex(' ')}, expected 03")
             length = buf[1]
@@ -787,8 +773,6 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
                 raise DecodeError(f"frame of {n} bytes is shorter than the smallest long frame (7)")
             end = n - 3
             buf = frame
-            if buf[0] != 0x03:
-                raise DecodeError(f"start is {buf[0:1].hex(' ')}, expected 03")
             if buf[end + 2] != 0x03:
                 raise DecodeError(f"end is {buf[end + 2:end + 3].hex(' ')}, expected 03")
             length = buf[1] << 8 | buf[2]

@@ -169,13 +169,14 @@ def _message_constant(element: Element, data: str) -> str:
 
 
 def decode_lines(
-    layout: Layout, name: str, target: Target, checks: dict[int, str], transparency: str
+    layout: Layout, name: str, target: Target, checks: dict[int, str], transparency: str, header_known: bool = False
 ) -> tuple[Lines, Lines]:
     """`def <name>(frame, expect)`: one layout's frame checked in the engine's order, its content decoded; and
     the function's body alone (for decode(), which runs it inline: one call less per frame).
 
     `checks`: element index -> the checksum function's name; `transparency`: the name of the layout's
-    Transparency object (unstuffing, with its error for a frame that is not in stuffed form).
+    Transparency object (unstuffing, with its error for a frame that is not in stuffed form); `header_known`: the
+    caller has matched the header (it chose the layout by it), so it is not compared again.
     """
     places = _Places(layout)
     elements = layout.elements
@@ -213,7 +214,7 @@ def decode_lines(
                 f"if end < {places.content}:",
                 f'    raise DecodeError(f"{layout.name} frame: {{{inner}}} bytes where at least {fixed} belong")',
             ]
-    body += _constant_checks(places)
+    body += _constant_checks(places, 1 if header_known else 0)
     command = layout.command
     values: list[str] = []
     for index in layout.values:
@@ -316,12 +317,13 @@ def _signs(replace: tuple[tuple[bytes, bytes], ...]) -> list[bytes]:
     return [s for i, s in enumerate(every) if not any(o in s for o in every[:i])]
 
 
-def _constant_checks(places: _Places) -> Lines:
-    """Constant elements checked in element order; neighbours compared at once, one by one only to say which."""
+def _constant_checks(places: _Places, start: int = 0) -> Lines:
+    """Constant elements from `start` on (1: the header is known to match) checked in element order; neighbours
+    compared at once, one by one only to say which."""
     layout = places.layout
     runs: list[list[int]] = []
     for index, element in enumerate(layout.elements):
-        if element.kind != "constant":
+        if element.kind != "constant" or index < start:
             continue
         if runs and runs[-1][-1] == index - 1:
             runs[-1].append(index)
@@ -605,7 +607,8 @@ def direction_functions(
             t = layout.transparency
             pairs = ", ".join(f"({plain!r}, {wire!r})" for plain, wire in t.replace)
             lines += [f"{stuffing} = Transparency({t.span}, ({pairs},))", "", ""]
-        function, body = decode_lines(layout, f"_decode_{d}{suffix}", target, checks, stuffing)
+        # of several layouts, each is decoded once its header has chosen it (_choice)
+        function, body = decode_lines(layout, f"_decode_{d}{suffix}", target, checks, stuffing, several)
         lines += [*function, "", ""]
         bodies.append(body)
         wraps.append(wrap_parts(layout, target, checks, stuffing, registry(structs)))

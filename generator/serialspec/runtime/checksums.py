@@ -117,6 +117,7 @@ def _crc16_words(poly: int, init: int, refin: bool, refout: bool, xorout: int) -
     start = _reflect(init, 16) if refin else init
     pairs: tuple[int, ...] = ()
     plain = refin == refout and not xorout  # the register is the CRC
+    longest = 2 * _WORD_RUNS  # bytes: longer data is read by a struct made for it
 
     def words(data: bytes) -> tuple[int, ...]:
         run = len(data) >> 1
@@ -131,7 +132,7 @@ def _crc16_words(poly: int, init: int, refin: bool, refout: bool, xorout: int) -
             pairs, unpack = _word_table(poly, refin), _unpack_words(order)
         value = start
         n = len(data)
-        for word in unpack[n >> 1](data) if n < 2 * _WORD_RUNS else words(data):
+        for word in unpack[n >> 1](data) if n < longest else words(data):
             value = pairs[value ^ word]
         if n & 1:  # the last byte alone, as in crc_function's byte loop
             last = data[-1]

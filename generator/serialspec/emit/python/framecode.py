@@ -6,9 +6,12 @@ decoder on the frame's own bytes, and `_wrap_<direction>(content, code, *values)
 content. They make the runtime engine's checks (runtime/framing.py, Layout.unwrap and Layout.wrap) in the engine's
 order with the engine's messages, but as code written for one layout: every offset known when the layout is fixed
 is a literal, the bytes are unstuffed only when a stuffed sequence occurs (a `find` first), and a frame's content is
-decoded in place (no copy) unless it was stuffed. Where a layout does not fit that form (a length after the
-content, a checksum over bytes inside the stuffed span, ...) the two functions call the engine instead, so every
-layout the language describes works and the straight-line form is only ever a faster way to the same result.
+decoded in place (no copy) unless it was stuffed, and a CRC stored in its own bit order is checked by its residue
+over the frame. `decode()` runs the checks inline (one call less); encoders of unstuffed frames make their frame
+inline too (`frame_encoder`: the head packed with the content's first struct). Where a layout does not fit that
+form (a length after the content, a checksum over bytes inside the stuffed span, ...) the two functions call the
+engine instead, so every layout the language describes works and the straight-line form is only ever a faster way
+to the same result (tests/test_straight_frames.py holds them to it).
 
 Positions are expressions over `buf`, the frame with its stuffed span replaced by the plain bytes (the frame itself
 when nothing is stuffed): an element before the content at a literal offset, an element after it at `end + k`,

@@ -1630,8 +1630,9 @@ def _encode_gamepad_response(m: GamepadResponse) -> bytes:
 def _encode_sbus_response(m: SbusResponse) -> bytes:
     if len(m.channels) != 16:
         raise EncodeError('sbus response' + f': channels needs 16 items, got {len(m.channels)}')
-    if any(not -32768 <= x <= 32767 or x.__class__ is bool for x in m.channels):
-        raise out_of_range('sbus response', 'channels', m.channels, -32768, 32767)
+    for x_channels in m.channels:
+        if not -32768 <= x_channels <= 32767 or x_channels.__class__ is bool:
+            raise out_of_range('sbus response', 'channels', m.channels, -32768, 32767)
     if not 0 <= m.ch17 <= 255 or m.ch17.__class__ is bool:
         raise out_of_range('sbus response', 'ch17', m.ch17, 0, 255)
     if not 0 <= m.ch18 <= 255 or m.ch18.__class__ is bool:

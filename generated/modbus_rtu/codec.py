@@ -7,7 +7,7 @@ import struct
 from collections.abc import Callable
 
 from serialspec.runtime.checksums import crc_function
-from serialspec.runtime.errors import DecodeError, EncodeError, content_size_error, out_of_range
+from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError, content_size_error, out_of_range
 from serialspec.runtime.fields import wrong_type
 from serialspec.runtime.framing import ERROR_REPLY, Element, EngineFormat, FrameCodec, Layout, SizeRule
 from serialspec.runtime.framing import FrameStreamParser as _FrameStreamParser
@@ -43,11 +43,16 @@ from modbus_rtu.messages import (
 
 __all__ = ["StreamParser", "decode", "encode"]
 
+_F_LE_U8_U8 = struct.Struct('<BB')
 _S_BE_U16_U16 = struct.Struct('>HH')
 _S_BE_U16_U16_U16 = struct.Struct('>HHH')
 _S_BE_U16_U16_U16_U16_U8 = struct.Struct('>HHHHB')
 _S_BE_U16_U16_U8 = struct.Struct('>HHB')
 _S_BE_U8 = struct.Struct('>B')
+_S_BE_U8_U8_U16_U16 = struct.Struct('>BBHH')
+_S_BE_U8_U8_U16_U16_U16 = struct.Struct('>BBHHH')
+_S_BE_U8_U8_U16_U16_U8 = struct.Struct('>BBHHB')
+_S_BE_U8_U8_U8 = struct.Struct('>BBB')
 _CHECK_CRC: Callable[[bytes], int] = crc_function(16, 0x8005, 0xffff, True, True, 0x0)  # CRC-16/MODBUS
 
 # Decoders build messages with object.__new__ and store each value straight into its slot: a message's __init__
@@ -425,7 +430,8 @@ def _encode_read_coils_request(m: ReadCoilsRequest) -> bytes:
         raise out_of_range('read_coils request', 'address', m.address, 0, 65535)
     if not 1 <= m.count <= 2000 or m.count.__class__ is bool:
         raise out_of_range('read_coils request', 'count', m.count, 1, 2000)
-    return _REQUEST_FRAMES.wrap(_S_BE_U16_U16.pack(m.address, m.count), 0x01, (m.unit,))
+    frame = _S_BE_U8_U8_U16_U16.pack(m.unit, 0x01, m.address, m.count)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_read_coils_response(m: ReadCoilsResponse) -> bytes:
@@ -436,7 +442,8 @@ def _encode_read_coils_response(m: ReadCoilsResponse) -> bytes:
     v_byte_count = (-(-len(m.coils) // 8))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('read_coils response', 'byte_count', v_byte_count, 0, 255)
-    return _RESPONSE_FRAMES.wrap(b''.join((_S_BE_U8.pack(v_byte_count), _pack_bits(m.coils, 'coils', 'read_coils response'),)), 0x01, (m.unit,))
+    frame = _S_BE_U8_U8_U8.pack(m.unit, 0x01, v_byte_count) + _pack_bits(m.coils, 'coils', 'read_coils response')
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_read_discrete_inputs_request(m: ReadDiscreteInputsRequest) -> bytes:
@@ -446,7 +453,8 @@ def _encode_read_discrete_inputs_request(m: ReadDiscreteInputsRequest) -> bytes:
         raise out_of_range('read_discrete_inputs request', 'address', m.address, 0, 65535)
     if not 1 <= m.count <= 2000 or m.count.__class__ is bool:
         raise out_of_range('read_discrete_inputs request', 'count', m.count, 1, 2000)
-    return _REQUEST_FRAMES.wrap(_S_BE_U16_U16.pack(m.address, m.count), 0x02, (m.unit,))
+    frame = _S_BE_U8_U8_U16_U16.pack(m.unit, 0x02, m.address, m.count)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_read_discrete_inputs_response(m: ReadDiscreteInputsResponse) -> bytes:
@@ -457,7 +465,8 @@ def _encode_read_discrete_inputs_response(m: ReadDiscreteInputsResponse) -> byte
     v_byte_count = (-(-len(m.inputs) // 8))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('read_discrete_inputs response', 'byte_count', v_byte_count, 0, 255)
-    return _RESPONSE_FRAMES.wrap(b''.join((_S_BE_U8.pack(v_byte_count), _pack_bits(m.inputs, 'inputs', 'read_discrete_inputs response'),)), 0x02, (m.unit,))
+    frame = _S_BE_U8_U8_U8.pack(m.unit, 0x02, v_byte_count) + _pack_bits(m.inputs, 'inputs', 'read_discrete_inputs response')
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_read_holding_registers_request(m: ReadHoldingRegistersRequest) -> bytes:
@@ -467,7 +476,8 @@ def _encode_read_holding_registers_request(m: ReadHoldingRegistersRequest) -> by
         raise out_of_range('read_holding_registers request', 'address', m.address, 0, 65535)
     if not 1 <= m.count <= 125 or m.count.__class__ is bool:
         raise out_of_range('read_holding_registers request', 'count', m.count, 1, 125)
-    return _REQUEST_FRAMES.wrap(_S_BE_U16_U16.pack(m.address, m.count), 0x03, (m.unit,))
+    frame = _S_BE_U8_U8_U16_U16.pack(m.unit, 0x03, m.address, m.count)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_read_holding_registers_response(m: ReadHoldingRegistersResponse) -> bytes:
@@ -476,9 +486,11 @@ def _encode_read_holding_registers_response(m: ReadHoldingRegistersResponse) -> 
     v_byte_count = (2 * len(m.registers))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('read_holding_registers response', 'byte_count', v_byte_count, 0, 255)
-    if any(not 0 <= x <= 65535 or x.__class__ is bool for x in m.registers):
-        raise out_of_range('read_holding_registers response', 'registers', m.registers, 0, 65535)
-    return _RESPONSE_FRAMES.wrap(b''.join((_S_BE_U8.pack(v_byte_count), struct.pack(f'>{len(m.registers)}H', *m.registers),)), 0x03, (m.unit,))
+    for x_registers in m.registers:
+        if not 0 <= x_registers <= 65535 or x_registers.__class__ is bool:
+            raise out_of_range('read_holding_registers response', 'registers', m.registers, 0, 65535)
+    frame = struct.pack(f'>BBB{len(m.registers)}H', m.unit, 0x03, v_byte_count, *m.registers)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_read_input_registers_request(m: ReadInputRegistersRequest) -> bytes:
@@ -488,7 +500,8 @@ def _encode_read_input_registers_request(m: ReadInputRegistersRequest) -> bytes:
         raise out_of_range('read_input_registers request', 'address', m.address, 0, 65535)
     if not 1 <= m.count <= 125 or m.count.__class__ is bool:
         raise out_of_range('read_input_registers request', 'count', m.count, 1, 125)
-    return _REQUEST_FRAMES.wrap(_S_BE_U16_U16.pack(m.address, m.count), 0x04, (m.unit,))
+    frame = _S_BE_U8_U8_U16_U16.pack(m.unit, 0x04, m.address, m.count)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_read_input_registers_response(m: ReadInputRegistersResponse) -> bytes:
@@ -497,9 +510,11 @@ def _encode_read_input_registers_response(m: ReadInputRegistersResponse) -> byte
     v_byte_count = (2 * len(m.registers))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('read_input_registers response', 'byte_count', v_byte_count, 0, 255)
-    if any(not 0 <= x <= 65535 or x.__class__ is bool for x in m.registers):
-        raise out_of_range('read_input_registers response', 'registers', m.registers, 0, 65535)
-    return _RESPONSE_FRAMES.wrap(b''.join((_S_BE_U8.pack(v_byte_count), struct.pack(f'>{len(m.registers)}H', *m.registers),)), 0x04, (m.unit,))
+    for x_registers in m.registers:
+        if not 0 <= x_registers <= 65535 or x_registers.__class__ is bool:
+            raise out_of_range('read_input_registers response', 'registers', m.registers, 0, 65535)
+    frame = struct.pack(f'>BBB{len(m.registers)}H', m.unit, 0x04, v_byte_count, *m.registers)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_write_coil_request(m: WriteCoilRequest) -> bytes:
@@ -509,7 +524,8 @@ def _encode_write_coil_request(m: WriteCoilRequest) -> bytes:
         raise out_of_range('write_coil request', 'address', m.address, 0, 65535)
     if not 0 <= m.value <= 65280 or m.value.__class__ is bool:
         raise out_of_range('write_coil request', 'value', m.value, 0, 65280)
-    return _REQUEST_FRAMES.wrap(_S_BE_U16_U16.pack(m.address, m.value), 0x05, (m.unit,))
+    frame = _S_BE_U8_U8_U16_U16.pack(m.unit, 0x05, m.address, m.value)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_write_coil_response(m: WriteCoilResponse) -> bytes:
@@ -519,7 +535,8 @@ def _encode_write_coil_response(m: WriteCoilResponse) -> bytes:
         raise out_of_range('write_coil response', 'address', m.address, 0, 65535)
     if not 0 <= m.value <= 65280 or m.value.__class__ is bool:
         raise out_of_range('write_coil response', 'value', m.value, 0, 65280)
-    return _RESPONSE_FRAMES.wrap(_S_BE_U16_U16.pack(m.address, m.value), 0x05, (m.unit,))
+    frame = _S_BE_U8_U8_U16_U16.pack(m.unit, 0x05, m.address, m.value)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_write_register_request(m: WriteRegisterRequest) -> bytes:
@@ -529,7 +546,8 @@ def _encode_write_register_request(m: WriteRegisterRequest) -> bytes:
         raise out_of_range('write_register request', 'address', m.address, 0, 65535)
     if not 0 <= m.value <= 65535 or m.value.__class__ is bool:
         raise out_of_range('write_register request', 'value', m.value, 0, 65535)
-    return _REQUEST_FRAMES.wrap(_S_BE_U16_U16.pack(m.address, m.value), 0x06, (m.unit,))
+    frame = _S_BE_U8_U8_U16_U16.pack(m.unit, 0x06, m.address, m.value)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_write_register_response(m: WriteRegisterResponse) -> bytes:
@@ -539,7 +557,8 @@ def _encode_write_register_response(m: WriteRegisterResponse) -> bytes:
         raise out_of_range('write_register response', 'address', m.address, 0, 65535)
     if not 0 <= m.value <= 65535 or m.value.__class__ is bool:
         raise out_of_range('write_register response', 'value', m.value, 0, 65535)
-    return _RESPONSE_FRAMES.wrap(_S_BE_U16_U16.pack(m.address, m.value), 0x06, (m.unit,))
+    frame = _S_BE_U8_U8_U16_U16.pack(m.unit, 0x06, m.address, m.value)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_write_coils_request(m: WriteCoilsRequest) -> bytes:
@@ -553,7 +572,8 @@ def _encode_write_coils_request(m: WriteCoilsRequest) -> bytes:
     v_byte_count = (-(-(len(m.values)) // 8))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('write_coils request', 'byte_count', v_byte_count, 0, 255)
-    return _REQUEST_FRAMES.wrap(b''.join((_S_BE_U16_U16_U8.pack(m.address, v_count, v_byte_count), _pack_bits(m.values, 'values', 'write_coils request'),)), 0x0f, (m.unit,))
+    frame = _S_BE_U8_U8_U16_U16_U8.pack(m.unit, 0x0f, m.address, v_count, v_byte_count) + _pack_bits(m.values, 'values', 'write_coils request')
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_write_coils_response(m: WriteCoilsResponse) -> bytes:
@@ -563,7 +583,8 @@ def _encode_write_coils_response(m: WriteCoilsResponse) -> bytes:
         raise out_of_range('write_coils response', 'address', m.address, 0, 65535)
     if not 0 <= m.count <= 65535 or m.count.__class__ is bool:
         raise out_of_range('write_coils response', 'count', m.count, 0, 65535)
-    return _RESPONSE_FRAMES.wrap(_S_BE_U16_U16.pack(m.address, m.count), 0x0f, (m.unit,))
+    frame = _S_BE_U8_U8_U16_U16.pack(m.unit, 0x0f, m.address, m.count)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_write_registers_request(m: WriteRegistersRequest) -> bytes:
@@ -577,9 +598,11 @@ def _encode_write_registers_request(m: WriteRegistersRequest) -> bytes:
     v_byte_count = (2 * (len(m.values)))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('write_registers request', 'byte_count', v_byte_count, 0, 255)
-    if any(not 0 <= x <= 65535 or x.__class__ is bool for x in m.values):
-        raise out_of_range('write_registers request', 'values', m.values, 0, 65535)
-    return _REQUEST_FRAMES.wrap(b''.join((_S_BE_U16_U16_U8.pack(m.address, v_count, v_byte_count), struct.pack(f'>{len(m.values)}H', *m.values),)), 0x10, (m.unit,))
+    for x_values in m.values:
+        if not 0 <= x_values <= 65535 or x_values.__class__ is bool:
+            raise out_of_range('write_registers request', 'values', m.values, 0, 65535)
+    frame = struct.pack(f'>BBHHB{len(m.values)}H', m.unit, 0x10, m.address, v_count, v_byte_count, *m.values)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_write_registers_response(m: WriteRegistersResponse) -> bytes:
@@ -589,7 +612,8 @@ def _encode_write_registers_response(m: WriteRegistersResponse) -> bytes:
         raise out_of_range('write_registers response', 'address', m.address, 0, 65535)
     if not 0 <= m.count <= 65535 or m.count.__class__ is bool:
         raise out_of_range('write_registers response', 'count', m.count, 0, 65535)
-    return _RESPONSE_FRAMES.wrap(_S_BE_U16_U16.pack(m.address, m.count), 0x10, (m.unit,))
+    frame = _S_BE_U8_U8_U16_U16.pack(m.unit, 0x10, m.address, m.count)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_mask_write_register_request(m: MaskWriteRegisterRequest) -> bytes:
@@ -601,7 +625,8 @@ def _encode_mask_write_register_request(m: MaskWriteRegisterRequest) -> bytes:
         raise out_of_range('mask_write_register request', 'and_mask', m.and_mask, 0, 65535)
     if not 0 <= m.or_mask <= 65535 or m.or_mask.__class__ is bool:
         raise out_of_range('mask_write_register request', 'or_mask', m.or_mask, 0, 65535)
-    return _REQUEST_FRAMES.wrap(_S_BE_U16_U16_U16.pack(m.address, m.and_mask, m.or_mask), 0x16, (m.unit,))
+    frame = _S_BE_U8_U8_U16_U16_U16.pack(m.unit, 0x16, m.address, m.and_mask, m.or_mask)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_mask_write_register_response(m: MaskWriteRegisterResponse) -> bytes:
@@ -613,7 +638,8 @@ def _encode_mask_write_register_response(m: MaskWriteRegisterResponse) -> bytes:
         raise out_of_range('mask_write_register response', 'and_mask', m.and_mask, 0, 65535)
     if not 0 <= m.or_mask <= 65535 or m.or_mask.__class__ is bool:
         raise out_of_range('mask_write_register response', 'or_mask', m.or_mask, 0, 65535)
-    return _RESPONSE_FRAMES.wrap(_S_BE_U16_U16_U16.pack(m.address, m.and_mask, m.or_mask), 0x16, (m.unit,))
+    frame = _S_BE_U8_U8_U16_U16_U16.pack(m.unit, 0x16, m.address, m.and_mask, m.or_mask)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_read_write_registers_request(m: ReadWriteRegistersRequest) -> bytes:
@@ -631,9 +657,11 @@ def _encode_read_write_registers_request(m: ReadWriteRegistersRequest) -> bytes:
     v_byte_count = (2 * (len(m.values)))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('read_write_registers request', 'byte_count', v_byte_count, 0, 255)
-    if any(not 0 <= x <= 65535 or x.__class__ is bool for x in m.values):
-        raise out_of_range('read_write_registers request', 'values', m.values, 0, 65535)
-    return _REQUEST_FRAMES.wrap(b''.join((_S_BE_U16_U16_U16_U16_U8.pack(m.read_address, m.read_count, m.write_address, v_write_count, v_byte_count), struct.pack(f'>{len(m.values)}H', *m.values),)), 0x17, (m.unit,))
+    for x_values in m.values:
+        if not 0 <= x_values <= 65535 or x_values.__class__ is bool:
+            raise out_of_range('read_write_registers request', 'values', m.values, 0, 65535)
+    frame = struct.pack(f'>BBHHHHB{len(m.values)}H', m.unit, 0x17, m.read_address, m.read_count, m.write_address, v_write_count, v_byte_count, *m.values)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_read_write_registers_response(m: ReadWriteRegistersResponse) -> bytes:
@@ -642,9 +670,11 @@ def _encode_read_write_registers_response(m: ReadWriteRegistersResponse) -> byte
     v_byte_count = (2 * len(m.registers))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('read_write_registers response', 'byte_count', v_byte_count, 0, 255)
-    if any(not 0 <= x <= 65535 or x.__class__ is bool for x in m.registers):
-        raise out_of_range('read_write_registers response', 'registers', m.registers, 0, 65535)
-    return _RESPONSE_FRAMES.wrap(b''.join((_S_BE_U8.pack(v_byte_count), struct.pack(f'>{len(m.registers)}H', *m.registers),)), 0x17, (m.unit,))
+    for x_registers in m.registers:
+        if not 0 <= x_registers <= 65535 or x_registers.__class__ is bool:
+            raise out_of_range('read_write_registers response', 'registers', m.registers, 0, 65535)
+    frame = struct.pack(f'>BBB{len(m.registers)}H', m.unit, 0x17, v_byte_count, *m.registers)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_exception_response(m: ExceptionResponse) -> bytes:
@@ -654,7 +684,8 @@ def _encode_exception_response(m: ExceptionResponse) -> bytes:
         raise out_of_range('exception response', 'function', m.function, 0, 127)
     if not 1 <= m.exception_code <= 11 or m.exception_code.__class__ is bool:
         raise out_of_range('exception response', 'exception_code', m.exception_code, 1, 11)
-    return _RESPONSE_FRAMES.wrap(_S_BE_U8.pack(m.exception_code), m.function | 0x80, (m.unit,))
+    frame = _S_BE_U8_U8_U8.pack(m.unit, m.function | 0x80, m.exception_code)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 _REQUEST_DECODERS: dict[int | None, Callable[..., Message]] = {
@@ -695,13 +726,32 @@ _REQUEST_FRAMES = FrameCodec(
 
 
 def _decode_request(frame: bytes, expect: type[Message] | None = None) -> Message:
-    """One complete request frame, checked and taken apart by the frame engine; its content decoded."""
-    unwrapped = _REQUEST_FRAMES.unwrap(frame)
-    decoder = _REQUEST_DECODERS.get(unwrapped.code)
-    if decoder is None:
-        raise DecodeError(f"unknown command {unwrapped.code!r}")
-    content = unwrapped.content
-    return decoder(content, 0, len(content), *unwrapped.values)
+    """One complete request frame, checked and taken apart; its content decoded."""
+    n = len(frame)
+    if n < 4:
+        raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (4)")
+    end = n - 2
+    buf = frame
+    v_unit = buf[0]
+    if not 0 <= v_unit <= 247:
+        raise DecodeError(f"unit = {v_unit} is outside its range 1..247 (or 0)")
+    if _CHECK_CRC(frame) != 0x0000:
+        check = _CHECK_CRC(frame[:-2])
+        stored = buf[end + 1] << 8 | buf[end]
+        if check != stored:
+            raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
+    code = buf[1]
+    try:
+        decoder = _REQUEST_DECODERS[code]
+    except KeyError:
+        raise DecodeError(f"unknown command {code!r}") from None
+    return decoder(buf, 2, end, v_unit)
+
+
+def _wrap_request(content: bytes, code: int | None, v_unit: int) -> bytes:
+    """The request frame around `content`, EncodeError if it cannot be."""
+    frame = _F_LE_U8_U8.pack(v_unit, code) + content
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 _RESPONSE_DECODERS: dict[int | None, Callable[..., Message]] = {
@@ -745,17 +795,34 @@ _RESPONSE_FRAMES = FrameCodec(
 
 
 def _decode_response(frame: bytes, expect: type[Message] | None = None) -> Message:
-    """One complete response frame, checked and taken apart by the frame engine; its content decoded."""
-    unwrapped = _RESPONSE_FRAMES.unwrap(frame)
-    code = unwrapped.code
-    if code is not None and code & 0x80:  # an error reply: it refuses the request of code & ~flag
-        content = unwrapped.content
-        return _RESPONSE_DECODERS[ERROR_REPLY](content, 0, len(content), *unwrapped.values, code & 0x7f)
-    decoder = _RESPONSE_DECODERS.get(unwrapped.code)
-    if decoder is None:
-        raise DecodeError(f"unknown command {unwrapped.code!r}")
-    content = unwrapped.content
-    return decoder(content, 0, len(content), *unwrapped.values)
+    """One complete response frame, checked and taken apart; its content decoded."""
+    n = len(frame)
+    if n < 4:
+        raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (4)")
+    end = n - 2
+    buf = frame
+    v_unit = buf[0]
+    if not 0 <= v_unit <= 247:
+        raise DecodeError(f"unit = {v_unit} is outside its range 1..247 (or 0)")
+    if _CHECK_CRC(frame) != 0x0000:
+        check = _CHECK_CRC(frame[:-2])
+        stored = buf[end + 1] << 8 | buf[end]
+        if check != stored:
+            raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
+    code = buf[1]
+    if code & 0x80:  # an error reply: it refuses the request of code & ~flag
+        return _RESPONSE_DECODERS[ERROR_REPLY](buf, 2, end, v_unit, code & 0x7f)
+    try:
+        decoder = _RESPONSE_DECODERS[code]
+    except KeyError:
+        raise DecodeError(f"unknown command {code!r}") from None
+    return decoder(buf, 2, end, v_unit)
+
+
+def _wrap_response(content: bytes, code: int | None, v_unit: int) -> bytes:
+    """The response frame around `content`, EncodeError if it cannot be."""
+    frame = _F_LE_U8_U8.pack(v_unit, code) + content
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 _ENCODERS: dict[type[Message], Callable[..., bytes]] = {
@@ -790,9 +857,49 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
     if direction is None:
         raise DecodeError("give the direction: requests and responses cannot be told apart by their first bytes")
     if direction == 'request':  # a Direction or its value
-        return _decode_request(bytes(data), expect)
+        frame = data if data.__class__ is bytes else bytes(data)
+        n = len(frame)
+        if n < 4:
+            raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (4)")
+        end = n - 2
+        buf = frame
+        v_unit = buf[0]
+        if not 0 <= v_unit <= 247:
+            raise DecodeError(f"unit = {v_unit} is outside its range 1..247 (or 0)")
+        if _CHECK_CRC(frame) != 0x0000:
+            check = _CHECK_CRC(frame[:-2])
+            stored = buf[end + 1] << 8 | buf[end]
+            if check != stored:
+                raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
+        code = buf[1]
+        try:
+            decoder = _REQUEST_DECODERS[code]
+        except KeyError:
+            raise DecodeError(f"unknown command {code!r}") from None
+        return decoder(buf, 2, end, v_unit)
     if direction == 'response':  # a Direction or its value
-        return _decode_response(bytes(data), expect)
+        frame = data if data.__class__ is bytes else bytes(data)
+        n = len(frame)
+        if n < 4:
+            raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (4)")
+        end = n - 2
+        buf = frame
+        v_unit = buf[0]
+        if not 0 <= v_unit <= 247:
+            raise DecodeError(f"unit = {v_unit} is outside its range 1..247 (or 0)")
+        if _CHECK_CRC(frame) != 0x0000:
+            check = _CHECK_CRC(frame[:-2])
+            stored = buf[end + 1] << 8 | buf[end]
+            if check != stored:
+                raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
+        code = buf[1]
+        if code & 0x80:  # an error reply: it refuses the request of code & ~flag
+            return _RESPONSE_DECODERS[ERROR_REPLY](buf, 2, end, v_unit, code & 0x7f)
+        try:
+            decoder = _RESPONSE_DECODERS[code]
+        except KeyError:
+            raise DecodeError(f"unknown command {code!r}") from None
+        return decoder(buf, 2, end, v_unit)
     raise ValueError(f"direction must be request or response, not {direction!r}")
 
 

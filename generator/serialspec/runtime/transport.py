@@ -139,7 +139,8 @@ class Link:
 
     Three operations make a transaction: `write` a frame, `read_waiting` (what arrived between transactions,
     without waiting) and `read` (whatever arrives, blocking up to a deadline for the first byte: no sleeping, no
-    polling). Port failures propagate as pyserial raises them; the bus turns them into PortError.
+    polling); `transact` does the three in one call. Port failures propagate as pyserial raises them; the bus turns
+    them into PortError.
     """
 
     __slots__ = ("port", "doing")

@@ -162,7 +162,7 @@ class Link:
         return data
 
     def transact(self, frame: bytes, wait: float) -> tuple[bytes, bytes | None]:
-        """A transaction's I/O in one call, for a bus that neither waits out a gap nor reads back an echo.
+        """A transaction's I/O in one call, for a bus that reads back no echo (it waits out any gap before).
 
         Bytes that arrived since the last transaction come first: if there are any, they are returned with None
         and nothing is written (the bus hands them to subscribers, then writes). Otherwise `frame` is written and
@@ -441,7 +441,7 @@ class Bus:
                     self._port_failed("read", exc)
                     raise
             if self._gap:
-                self._last_io = time.monotonic()  # the reply's end, or the write's (no reply)
+                self._last_io = time.monotonic()  # the reply's end (no reply: the wait's, later than needed)
             if chunk:
                 size = len(chunk)
                 messages: list[Message] | None = None

@@ -9,7 +9,8 @@ from collections.abc import Callable
 from serialspec.runtime.checksums import BYTE_VALUES as _BYTES
 from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError, content_size_error, out_of_range
 from serialspec.runtime.fields import wrong_type
-from serialspec.runtime.message import Direction, Message, members, slot_setters
+from serialspec.runtime.message import Direction, Message, members
+from serialspec.runtime.message import build as _new  # a message from the tuple of its field values, in one call
 from serialspec.runtime.stream import FrameFormat
 from serialspec.runtime.stream import StreamParser as _StreamParser
 
@@ -37,45 +38,20 @@ _S_U8 = struct.Struct('<B')
 _S_U8_U8 = struct.Struct('<BB')
 _S_U8_U8_U8 = struct.Struct('<BBB')
 
-# Decoders build messages with object.__new__ and store each value straight into its slot: a message's __init__
-# (frozen) goes through object.__setattr__ per field, which costs more than unpacking the whole frame.
-_new = object.__new__
-(_set_ActionRequest_id,) = slot_setters(ActionRequest)
-(_set_IdsItem_id,) = slot_setters(IdsItem)
-(_set_PingRequest_id,) = slot_setters(PingRequest)
-_set_ReadRequest_id, _set_ReadRequest_address, _set_ReadRequest_length = slot_setters(ReadRequest)
-_set_RegWriteRequest_id, _set_RegWriteRequest_address, _set_RegWriteRequest_data = slot_setters(RegWriteRequest)
-_set_ReplyResponse_id, _set_ReplyResponse_error, _set_ReplyResponse_data = slot_setters(ReplyResponse)
-(_set_ResetRequest_id,) = slot_setters(ResetRequest)
-_set_ServosItem_id, _set_ServosItem_data = slot_setters(ServosItem)
-(
-    _set_SyncReadRequest_id,
-    _set_SyncReadRequest_address,
-    _set_SyncReadRequest_length,
-    _set_SyncReadRequest_ids,
-) = slot_setters(SyncReadRequest)
-_set_SyncWriteRequest_id, _set_SyncWriteRequest_address, _set_SyncWriteRequest_servos = slot_setters(SyncWriteRequest)
-_set_WriteRequest_id, _set_WriteRequest_address, _set_WriteRequest_data = slot_setters(WriteRequest)
 _MEMBERS_ErrorStatus = members(ErrorStatus)
 
 
 def _decode_ping_request(buf: bytes, o: int, end: int, id: int) -> PingRequest:
     if end - o != 0:
         raise content_size_error('ping request', end - o, 0, 0)
-    m = _new(PingRequest)
-    _set_PingRequest_id(m, id)
-    return m
+    return _new(PingRequest, (id,))
 
 
 def _decode_read_request(buf: bytes, o: int, end: int, id: int) -> ReadRequest:
     if end - o != 2:
         raise content_size_error('read request', end - o, 2, 2)
     v_address, v_length = _S_U8_U8.unpack_from(buf, o)
-    m = _new(ReadRequest)
-    _set_ReadRequest_id(m, id)
-    _set_ReadRequest_address(m, v_address)
-    _set_ReadRequest_length(m, v_length)
-    return m
+    return _new(ReadRequest, (id, v_address, v_length))
 
 
 def _decode_write_request(buf: bytes, o: int, end: int, id: int) -> WriteRequest:
@@ -84,11 +60,7 @@ def _decode_write_request(buf: bytes, o: int, end: int, id: int) -> WriteRequest
     v_address, = _S_U8.unpack_from(buf, o)
     o += 1
     v_data = buf[o:end]
-    m = _new(WriteRequest)
-    _set_WriteRequest_id(m, id)
-    _set_WriteRequest_address(m, v_address)
-    _set_WriteRequest_data(m, v_data)
-    return m
+    return _new(WriteRequest, (id, v_address, v_data))
 
 
 def _decode_reg_write_request(buf: bytes, o: int, end: int, id: int) -> RegWriteRequest:
@@ -97,27 +69,19 @@ def _decode_reg_write_request(buf: bytes, o: int, end: int, id: int) -> RegWrite
     v_address, = _S_U8.unpack_from(buf, o)
     o += 1
     v_data = buf[o:end]
-    m = _new(RegWriteRequest)
-    _set_RegWriteRequest_id(m, id)
-    _set_RegWriteRequest_address(m, v_address)
-    _set_RegWriteRequest_data(m, v_data)
-    return m
+    return _new(RegWriteRequest, (id, v_address, v_data))
 
 
 def _decode_action_request(buf: bytes, o: int, end: int, id: int) -> ActionRequest:
     if end - o != 0:
         raise content_size_error('action request', end - o, 0, 0)
-    m = _new(ActionRequest)
-    _set_ActionRequest_id(m, id)
-    return m
+    return _new(ActionRequest, (id,))
 
 
 def _decode_reset_request(buf: bytes, o: int, end: int, id: int) -> ResetRequest:
     if end - o != 0:
         raise content_size_error('reset request', end - o, 0, 0)
-    m = _new(ResetRequest)
-    _set_ResetRequest_id(m, id)
-    return m
+    return _new(ResetRequest, (id,))
 
 
 def _decode_sync_read_request(buf: bytes, o: int, end: int, id: int) -> SyncReadRequest:
@@ -130,16 +94,10 @@ def _decode_sync_read_request(buf: bytes, o: int, end: int, id: int) -> SyncRead
         raise DecodeError('sync_read request' + f': {end - o} bytes do not split into ids items of 1')
     n = end - o
     for v_id, in _S_U8.iter_unpack(buf[o : o + n]):
-        item = _new(IdsItem)
-        _set_IdsItem_id(item, v_id)
+        item = _new(IdsItem, (v_id,))
         v_ids_list.append(item)
     v_ids = tuple(v_ids_list)
-    m = _new(SyncReadRequest)
-    _set_SyncReadRequest_id(m, id)
-    _set_SyncReadRequest_address(m, v_address)
-    _set_SyncReadRequest_length(m, v_length)
-    _set_SyncReadRequest_ids(m, v_ids)
-    return m
+    return _new(SyncReadRequest, (id, v_address, v_length, v_ids))
 
 
 def _decode_sync_write_request(buf: bytes, o: int, end: int, id: int) -> SyncWriteRequest:
@@ -155,18 +113,12 @@ def _decode_sync_write_request(buf: bytes, o: int, end: int, id: int) -> SyncWri
             raise DecodeError('sync_write request' + f': data needs {v_data_length} bytes, {end - o} left')
         v_data = buf[o : o + v_data_length]
         o += v_data_length
-        item = _new(ServosItem)
-        _set_ServosItem_id(item, v_id)
-        _set_ServosItem_data(item, v_data)
+        item = _new(ServosItem, (v_id, v_data))
         v_servos_list.append(item)
     v_servos = tuple(v_servos_list)
     if o != end:
         raise DecodeError('sync_write request' + f': {end - o} bytes left after the last field')
-    m = _new(SyncWriteRequest)
-    _set_SyncWriteRequest_id(m, id)
-    _set_SyncWriteRequest_address(m, v_address)
-    _set_SyncWriteRequest_servos(m, v_servos)
-    return m
+    return _new(SyncWriteRequest, (id, v_address, v_servos))
 
 
 def _decode_reply_response(buf: bytes, o: int, end: int, id: int, error: int) -> ReplyResponse:
@@ -174,11 +126,7 @@ def _decode_reply_response(buf: bytes, o: int, end: int, id: int, error: int) ->
     error_flags = _MEMBERS_ErrorStatus.get(error)
     if error_flags is None:
         error_flags = ErrorStatus(error)
-    m = _new(ReplyResponse)
-    _set_ReplyResponse_id(m, id)
-    _set_ReplyResponse_error(m, error_flags)
-    _set_ReplyResponse_data(m, v_data)
-    return m
+    return _new(ReplyResponse, (id, error_flags, v_data))
 
 
 def _frame_ping_request(buf: bytes, start: int) -> PingRequest | None:
@@ -187,9 +135,7 @@ def _frame_ping_request(buf: bytes, start: int) -> PingRequest | None:
     if expected != buf[start + 5]:
         return None
     id = buf[start + 2]
-    m = _new(PingRequest)
-    _set_PingRequest_id(m, id)
-    return m
+    return _new(PingRequest, (id,))
 
 
 def _frame_read_request(buf: bytes, start: int) -> ReadRequest | None:
@@ -198,11 +144,7 @@ def _frame_read_request(buf: bytes, start: int) -> ReadRequest | None:
     v_address, v_length, check = _S_U8_U8_U8.unpack_from(buf, start + 5)
     if ~(0x6 + id + v_address + v_length) & 0xff != check:
         return None
-    m = _new(ReadRequest)
-    _set_ReadRequest_id(m, id)
-    _set_ReadRequest_address(m, v_address)
-    _set_ReadRequest_length(m, v_length)
-    return m
+    return _new(ReadRequest, (id, v_address, v_length))
 
 
 def _frame_action_request(buf: bytes, start: int) -> ActionRequest | None:
@@ -211,9 +153,7 @@ def _frame_action_request(buf: bytes, start: int) -> ActionRequest | None:
     if expected != buf[start + 5]:
         return None
     id = buf[start + 2]
-    m = _new(ActionRequest)
-    _set_ActionRequest_id(m, id)
-    return m
+    return _new(ActionRequest, (id,))
 
 
 def _frame_reset_request(buf: bytes, start: int) -> ResetRequest | None:
@@ -222,76 +162,87 @@ def _frame_reset_request(buf: bytes, start: int) -> ResetRequest | None:
     if expected != buf[start + 5]:
         return None
     id = buf[start + 2]
-    m = _new(ResetRequest)
-    _set_ResetRequest_id(m, id)
-    return m
+    return _new(ResetRequest, (id,))
 
 
 def _encode_ping_request(m: PingRequest) -> bytes:
-    if not 0 <= m.id <= 254 or m.id.__class__ is bool:
-        raise out_of_range('ping request', 'id', m.id, 0, 253)
-    body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m.id, 2, 1)
+    m_id = m.id
+    if not 0 <= m_id <= 254 or m_id.__class__ is bool:
+        raise out_of_range('ping request', 'id', m_id, 0, 253)
+    body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m_id, 2, 1)
     return body + _BYTES[~sum(body[2:]) & 0xff]
 
 
 def _encode_read_request(m: ReadRequest) -> bytes:
-    if not 0 <= m.id <= 254 or m.id.__class__ is bool:
-        raise out_of_range('read request', 'id', m.id, 0, 253)
-    if not 0 <= m.address <= 255 or m.address.__class__ is bool:
-        raise out_of_range('read request', 'address', m.address, 0, 255)
-    if not 1 <= m.length <= 250 or m.length.__class__ is bool:
-        raise out_of_range('read request', 'length', m.length, 1, 250)
-    body = _S_B2_U8_U8_U8_U8_U8.pack(b'\xff\xff', m.id, 4, 2, m.address, m.length)
+    m_id = m.id
+    m_address = m.address
+    m_length = m.length
+    if not 0 <= m_id <= 254 or m_id.__class__ is bool:
+        raise out_of_range('read request', 'id', m_id, 0, 253)
+    if not 0 <= m_address <= 255 or m_address.__class__ is bool:
+        raise out_of_range('read request', 'address', m_address, 0, 255)
+    if not 1 <= m_length <= 250 or m_length.__class__ is bool:
+        raise out_of_range('read request', 'length', m_length, 1, 250)
+    body = _S_B2_U8_U8_U8_U8_U8.pack(b'\xff\xff', m_id, 4, 2, m_address, m_length)
     return body + _BYTES[~sum(body[2:]) & 0xff]
 
 
 def _encode_write_request(m: WriteRequest) -> bytes:
-    if not 0 <= m.id <= 254 or m.id.__class__ is bool:
-        raise out_of_range('write request', 'id', m.id, 0, 253)
-    if not 0 <= m.address <= 255 or m.address.__class__ is bool:
-        raise out_of_range('write request', 'address', m.address, 0, 255)
+    m_id = m.id
+    m_address = m.address
+    if not 0 <= m_id <= 254 or m_id.__class__ is bool:
+        raise out_of_range('write request', 'id', m_id, 0, 253)
+    if not 0 <= m_address <= 255 or m_address.__class__ is bool:
+        raise out_of_range('write request', 'address', m_address, 0, 255)
     content = bytes(m.data)
     n = len(content) + 3
     if n > 255:
         raise EncodeError(f'content of {n - 2} bytes does not fit the length field')
-    body = _S_B2_U8_U8_U8_U8.pack(b'\xff\xff', m.id, n, 3, m.address) + content
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xff\xff', m_id, n, 3, m_address) + content
     return body + _BYTES[~sum(body[2:]) & 0xff]
 
 
 def _encode_reg_write_request(m: RegWriteRequest) -> bytes:
-    if not 0 <= m.id <= 254 or m.id.__class__ is bool:
-        raise out_of_range('reg_write request', 'id', m.id, 0, 253)
-    if not 0 <= m.address <= 255 or m.address.__class__ is bool:
-        raise out_of_range('reg_write request', 'address', m.address, 0, 255)
+    m_id = m.id
+    m_address = m.address
+    if not 0 <= m_id <= 254 or m_id.__class__ is bool:
+        raise out_of_range('reg_write request', 'id', m_id, 0, 253)
+    if not 0 <= m_address <= 255 or m_address.__class__ is bool:
+        raise out_of_range('reg_write request', 'address', m_address, 0, 255)
     content = bytes(m.data)
     n = len(content) + 3
     if n > 255:
         raise EncodeError(f'content of {n - 2} bytes does not fit the length field')
-    body = _S_B2_U8_U8_U8_U8.pack(b'\xff\xff', m.id, n, 4, m.address) + content
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xff\xff', m_id, n, 4, m_address) + content
     return body + _BYTES[~sum(body[2:]) & 0xff]
 
 
 def _encode_action_request(m: ActionRequest) -> bytes:
-    if not 0 <= m.id <= 254 or m.id.__class__ is bool:
-        raise out_of_range('action request', 'id', m.id, 0, 253)
-    body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m.id, 2, 5)
+    m_id = m.id
+    if not 0 <= m_id <= 254 or m_id.__class__ is bool:
+        raise out_of_range('action request', 'id', m_id, 0, 253)
+    body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m_id, 2, 5)
     return body + _BYTES[~sum(body[2:]) & 0xff]
 
 
 def _encode_reset_request(m: ResetRequest) -> bytes:
-    if not 0 <= m.id <= 254 or m.id.__class__ is bool:
-        raise out_of_range('reset request', 'id', m.id, 0, 253)
-    body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m.id, 2, 6)
+    m_id = m.id
+    if not 0 <= m_id <= 254 or m_id.__class__ is bool:
+        raise out_of_range('reset request', 'id', m_id, 0, 253)
+    body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m_id, 2, 6)
     return body + _BYTES[~sum(body[2:]) & 0xff]
 
 
 def _encode_sync_read_request(m: SyncReadRequest) -> bytes:
-    if not 0 <= m.id <= 254 or m.id.__class__ is bool:
-        raise out_of_range('sync_read request', 'id', m.id, 0, 253)
-    if not 0 <= m.address <= 255 or m.address.__class__ is bool:
-        raise out_of_range('sync_read request', 'address', m.address, 0, 255)
-    if not 1 <= m.length <= 250 or m.length.__class__ is bool:
-        raise out_of_range('sync_read request', 'length', m.length, 1, 250)
+    m_id = m.id
+    m_address = m.address
+    m_length = m.length
+    if not 0 <= m_id <= 254 or m_id.__class__ is bool:
+        raise out_of_range('sync_read request', 'id', m_id, 0, 253)
+    if not 0 <= m_address <= 255 or m_address.__class__ is bool:
+        raise out_of_range('sync_read request', 'address', m_address, 0, 255)
+    if not 1 <= m_length <= 250 or m_length.__class__ is bool:
+        raise out_of_range('sync_read request', 'length', m_length, 1, 250)
     parts_ids = []
     for item in m.ids:
         if not 0 <= item.id <= 253 or item.id.__class__ is bool:
@@ -301,22 +252,25 @@ def _encode_sync_read_request(m: SyncReadRequest) -> bytes:
     n = len(content) + 4
     if n > 255:
         raise EncodeError(f'content of {n - 2} bytes does not fit the length field')
-    body = _S_B2_U8_U8_U8_U8_U8.pack(b'\xff\xff', m.id, n, 130, m.address, m.length) + content
+    body = _S_B2_U8_U8_U8_U8_U8.pack(b'\xff\xff', m_id, n, 130, m_address, m_length) + content
     return body + _BYTES[~sum(body[2:]) & 0xff]
 
 
 def _encode_sync_write_request(m: SyncWriteRequest) -> bytes:
-    if not 0 <= m.id <= 254 or m.id.__class__ is bool:
-        raise out_of_range('sync_write request', 'id', m.id, 0, 253)
-    if not 0 <= m.address <= 255 or m.address.__class__ is bool:
-        raise out_of_range('sync_write request', 'address', m.address, 0, 255)
-    v_data_length = len(m.servos[0].data) if m.servos else 0
-    if any(len(item.data) != v_data_length for item in m.servos):
+    m_id = m.id
+    m_address = m.address
+    m_servos = m.servos
+    if not 0 <= m_id <= 254 or m_id.__class__ is bool:
+        raise out_of_range('sync_write request', 'id', m_id, 0, 253)
+    if not 0 <= m_address <= 255 or m_address.__class__ is bool:
+        raise out_of_range('sync_write request', 'address', m_address, 0, 255)
+    v_data_length = len(m_servos[0].data) if m_servos else 0
+    if any(len(item.data) != v_data_length for item in m_servos):
         raise EncodeError('sync_write request' + ': every data of servos must have the same length')
     if v_data_length > 255:
         raise out_of_range('sync_write request', 'data_length', v_data_length, 0, 255)
     parts_servos = []
-    for item in m.servos:
+    for item in m_servos:
         if not 0 <= item.id <= 253 or item.id.__class__ is bool:
             raise out_of_range('sync_write request', 'id', item.id, 0, 253)
         parts_servos.append(b''.join((_S_U8.pack(item.id), bytes(item.data),)))
@@ -324,20 +278,22 @@ def _encode_sync_write_request(m: SyncWriteRequest) -> bytes:
     n = len(content) + 4
     if n > 255:
         raise EncodeError(f'content of {n - 2} bytes does not fit the length field')
-    body = _S_B2_U8_U8_U8_U8_U8.pack(b'\xff\xff', m.id, n, 131, m.address, v_data_length) + content
+    body = _S_B2_U8_U8_U8_U8_U8.pack(b'\xff\xff', m_id, n, 131, m_address, v_data_length) + content
     return body + _BYTES[~sum(body[2:]) & 0xff]
 
 
 def _encode_reply_response(m: ReplyResponse) -> bytes:
-    if not 0 <= m.id <= 254 or m.id.__class__ is bool:
-        raise out_of_range('reply response', 'id', m.id, 0, 253)
-    if not 0 <= m.error <= 255 or isinstance(m.error, bool):
-        raise out_of_range('reply response', 'error', m.error, 0, 255)
+    m_id = m.id
+    m_error = m.error
+    if not 0 <= m_id <= 254 or m_id.__class__ is bool:
+        raise out_of_range('reply response', 'id', m_id, 0, 253)
+    if not 0 <= m_error <= 255 or isinstance(m_error, bool):
+        raise out_of_range('reply response', 'error', m_error, 0, 255)
     content = bytes(m.data)
     n = len(content) + 2
     if n > 255:
         raise EncodeError(f'content of {n - 2} bytes does not fit the length field')
-    body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m.id, n, m.error) + content
+    body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m_id, n, m_error) + content
     return body + _BYTES[~sum(body[2:]) & 0xff]
 
 

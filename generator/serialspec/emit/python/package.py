@@ -17,8 +17,8 @@ from serialspec.emit.python.pycode import (
     crc_setup,
     decoder_name,
     encoder_name,
+    fuse_unpack,
     one_line,
-    setter_name,
 )
 from serialspec.emit.python.registers import register_tables, registers_module
 from serialspec.emit.python.render import render
@@ -285,7 +285,7 @@ def classic_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
             if sub_dispatch:
                 dispatchers.append(sub_dispatch | value_arguments(layout))
         fixed = fixed_frames(protocol, layout, decoder_bodies, code)
-        frame_functions += [f for _, _, f in fixed]
+        frame_functions += [f | {"lines": fuse_unpack(f["lines"])} for _, _, f in fixed]
         directions.append(
             {
                 "fixed": [(key, size, function["name"]) for key, size, function in fixed],
@@ -334,9 +334,10 @@ def common_codec_context(protocol: Protocol, code: PackageCode, exports: list[st
         "tables": [
             table_context(t) for t in protocol.tables if any(uses_table(m, t.name) for m in protocol.messages())
         ],
-        "setters": [(cls, setter_targets(cls, names)) for cls, names in sorted(code.built.items()) if names],
         "member_maps": sorted(code.member_maps),
-        "decoders": [{"name": n, "returns": r, "extra": e, "lines": lines} for n, r, e, lines in code.decoders],
+        "decoders": [
+            {"name": n, "returns": r, "extra": e, "lines": fuse_unpack(lines)} for n, r, e, lines in code.decoders
+        ],
         "encoders": [{"name": n, "type": t, "lines": lines} for n, t, lines in code.encoders],
         "encoder_table": encoder_table,
         "imports": sorted(
@@ -505,18 +506,8 @@ def names_used_in_codec(code: PackageCode) -> set[str]:
     bodies = [line for _, _, _, lines in code.decoders for line in lines]
     bodies += [line for _, _, lines in code.encoders for line in lines]
     types = {r for _, r, _, _ in code.decoders} | {t for _, t, _ in code.encoders}
-    types |= set(code.built) | code.member_maps  # built through their slots; enums and flags looked up
+    types |= set(code.built) | code.member_maps  # built by decoders; enums and flags looked up
     return types | set(_IDENTIFIER.findall("\n".join(bodies)))
-
-
-def setter_targets(cls: str, names: list[str]) -> str:
-    """The assignment target for a class's slot setters: one per line when there are more than a few."""
-    setters = [setter_name(cls, n) for n in names]
-    if len(setters) == 1:
-        return f"({setters[0]},)"
-    if len(setters) <= 3:
-        return ", ".join(setters)
-    return "(\n" + "".join(f"    {s},\n" for s in setters) + ")"
 
 
 def frame_decode_lines(

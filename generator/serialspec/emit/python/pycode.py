@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import re
 import struct
+from collections import Counter
 from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
 
@@ -46,9 +47,47 @@ def encoder_name(message: Message) -> str:
     return f"_encode_{message.key.replace('.', '_')}_{message.direction.value}"
 
 
-def setter_name(class_name: str, field_name: str) -> str:
-    """The codec's module-level slot setter of one field of a message class (see PackageCode.build)."""
-    return f"_set_{class_name}_{field_name}"
+def values_tuple(values: list[str]) -> str:
+    """A tuple display of expressions: `(a, b)`, `(a,)`, `()`."""
+    return f"({values[0]},)" if len(values) == 1 else f"({', '.join(values)})"
+
+
+_FIELD_READ = re.compile(r"(?<![\w.])m\.([A-Za-z_]\w*)\b")
+
+
+def read_fields_once(lines: Lines, names: list[str]) -> Lines:
+    """An encoder's lines with each field of the message `m` that they read more than once read once, into a local
+    `m_<field>` first: a range check and the pack read a field two or three times, and a local costs less than an
+    attribute (a record's fields are read through a descriptor, ~15 ns each)."""
+    reads = Counter(name for line in lines for name in _FIELD_READ.findall(line))
+    again = [name for name in names if reads[name] > 1]
+    if not again:
+        return lines
+    local = {name: f"m_{name}" for name in again}
+
+    def replaced(match: re.Match[str]) -> str:
+        return local.get(match[1], match[0])
+
+    return [*(f"m_{name} = m.{name}" for name in again), *(_FIELD_READ.sub(replaced, line) for line in lines)]
+
+
+_UNPACKED = re.compile(r"^(?P<targets>[\w, ]+?),? = (?P<call>_S_\w+\.unpack_from\(.+\))$")
+
+
+def fuse_unpack(lines: Lines) -> Lines:
+    """A decoder's lines with an unpack into locals that are then built, in order, into the returned message made
+    one: `return _new(Cls, _S.unpack_from(buf, o))` builds it from the tuple struct gives, with no locals between."""
+    out: Lines = []
+    for line in lines:
+        unpacked = _UNPACKED.match(out[-1]) if out else None
+        if unpacked and line.startswith("return _new("):
+            names = [name.strip() for name in unpacked["targets"].split(",")]
+            cls, _, rest = line.removeprefix("return _new(").partition(", ")
+            if rest == values_tuple(names) + ")":
+                out[-1] = f"return _new({cls}, {unpacked['call']})"
+                continue
+        out.append(line)
+    return out
 
 
 def members_name(class_name: str) -> str:
@@ -302,7 +341,8 @@ class PackageCode:
         frame_names = [f.name for f in self.frame_values(message.direction, message)]
         extra = "".join(f", {name}: int" for name in frame_names)
         self.decoders.append((decoder_name(message), message.class_name, extra, self.decoder(message, fields)))
-        self.encoders.append((encoder_name(message), message.class_name, self.encoder(message, fields)))
+        encoder = read_fields_once(self.encoder(message, fields), [f.name for f in fields])
+        self.encoders.append((encoder_name(message), message.class_name, encoder))
 
     # --- decoding -------------------------------------------------------------------------------------------------
 
@@ -334,19 +374,19 @@ class PackageCode:
         frame_fields = all_fields[: len(all_fields) - len(self.value_fields(message))]
         frame_values = [self.after_unpack(f, f.name, lines, where) or f.name for f in frame_fields]
         self.build(message.class_name, [f.name for f in all_fields], [*frame_values, *values], "m", lines)
-        lines.append("return m")
+        lines[-1] = lines[-1].replace("m = ", "return ", 1)
         return lines
 
     def build(self, class_name: str, names: list[str], values: list[str], target: str, lines: Lines) -> None:
-        """Lines that make an instance of a frozen dataclass in `target`, storing each value into its slot.
+        """The line that makes an instance of a generated class in `target` from its field values, in field order.
 
-        The dataclass __init__ would store each one through object.__setattr__ (that is how frozen works), which
-        costs more than the rest of decoding; decoded values need none of __init__'s work.
+        Every decoder builds its messages here (one place, so a change of how messages are made reaches all of
+        them): `_new(Class, (values...))` is the runtime's `build`, one C call that stores the tuple of values as
+        the record (message.py); decoded values need none of the checks the class's __new__ would not make anyway.
         """
         assert len(names) == len(values), (class_name, names, values)
         self.built[class_name] = names
-        lines.append(f"{target} = _new({class_name})")
-        lines.extend(f"{setter_name(class_name, n)}({target}, {v})" for n, v in zip(names, values, strict=True))
+        lines.append(f"{target} = _new({class_name}, {values_tuple(values)})")
 
     def enum_value(self, enum: str, raw: str) -> str:
         """The member for a wire value, or the value itself when the spec names none (as enum_or_int does)."""

@@ -105,7 +105,7 @@ def _decode_action_request(buf: bytes, o: int, end: int, id: int) -> ActionReque
 def _decode_factory_reset_request(buf: bytes, o: int, end: int, id: int) -> FactoryResetRequest:
     if end - o != 1:
         raise content_size_error('factory_reset request', end - o, 1, 1)
-    v_option, = _S_U8.unpack_from(buf, o)
+    v_option = buf[o]
     return _new(FactoryResetRequest, (id, _MEMBERS_ResetOption.get(v_option, v_option)))
 
 
@@ -129,14 +129,10 @@ def _decode_sync_read_request(buf: bytes, o: int, end: int, id: int) -> SyncRead
         raise content_size_error('sync_read request', end - o, 4, None)
     v_address, v_length = _S_U16_U16.unpack_from(buf, o)
     o += 4
-    v_ids_list = []
     if (end - o) % 1:
         raise DecodeError('sync_read request' + f': {end - o} bytes do not split into ids items of 1')
     n = end - o
-    for v_id, in _S_U8.iter_unpack(buf[o : o + n]):
-        item = _new(IdsItem, (v_id,))
-        v_ids_list.append(item)
-    v_ids = tuple(v_ids_list)
+    v_ids = tuple([_new(IdsItem, values) for values in _S_U8.iter_unpack(buf[o : o + n])])
     return _new(SyncReadRequest, (id, v_address, v_length, v_ids))
 
 
@@ -145,14 +141,10 @@ def _decode_fast_sync_read_request(buf: bytes, o: int, end: int, id: int) -> Fas
         raise content_size_error('fast_sync_read request', end - o, 4, None)
     v_address, v_length = _S_U16_U16.unpack_from(buf, o)
     o += 4
-    v_servo_ids_list = []
     if (end - o) % 1:
         raise DecodeError('fast_sync_read request' + f': {end - o} bytes do not split into servo_ids items of 1')
     n = end - o
-    for v_id, in _S_U8.iter_unpack(buf[o : o + n]):
-        item = _new(ServoIdsItem, (v_id,))
-        v_servo_ids_list.append(item)
-    v_servo_ids = tuple(v_servo_ids_list)
+    v_servo_ids = tuple([_new(ServoIdsItem, values) for values in _S_U8.iter_unpack(buf[o : o + n])])
     return _new(FastSyncReadRequest, (id, v_address, v_length, v_servo_ids))
 
 
@@ -163,7 +155,7 @@ def _decode_sync_write_request(buf: bytes, o: int, end: int, id: int) -> SyncWri
     o += 4
     v_servos_list = []
     while o < end:
-        v_id, = _S_U8.unpack_from(buf, o)
+        v_id = buf[o]
         o += 1
         if end - o < v_length:
             raise DecodeError('sync_write request' + f': data needs {v_length} bytes, {end - o} left')
@@ -178,14 +170,10 @@ def _decode_sync_write_request(buf: bytes, o: int, end: int, id: int) -> SyncWri
 
 
 def _decode_bulk_read_request(buf: bytes, o: int, end: int, id: int) -> BulkReadRequest:
-    v_reads_list = []
     if (end - o) % 5:
         raise DecodeError('bulk_read request' + f': {end - o} bytes do not split into reads items of 5')
     n = end - o
-    for v_id, v_address, v_length in _S_U8_U16_U16.iter_unpack(buf[o : o + n]):
-        item = _new(ReadsItem, (v_id, v_address, v_length))
-        v_reads_list.append(item)
-    v_reads = tuple(v_reads_list)
+    v_reads = tuple([_new(ReadsItem, values) for values in _S_U8_U16_U16.iter_unpack(buf[o : o + n])])
     return _new(BulkReadRequest, (id, v_reads))
 
 
@@ -254,21 +242,25 @@ def _encode_read_request(m: ReadRequest) -> bytes:
 def _encode_write_request(m: WriteRequest) -> bytes:
     m_id = m.id
     m_address = m.address
+    m_data = m.data
     if not (0 <= m_id <= 252 or m_id == 254) or m_id.__class__ is bool:
         raise out_of_range('write request', 'id', m_id, 0, 252)
     if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
         raise out_of_range('write request', 'address', m_address, 0, 65535)
-    return _REQUEST_FRAMES.wrap(b''.join((_S_U16.pack(m_address), bytes(m.data),)), 0x03, (m_id,))
+    v_data = m_data if m_data.__class__ is bytes else bytes(m_data)
+    return _REQUEST_FRAMES.wrap(b''.join((_S_U16.pack(m_address), v_data,)), 0x03, (m_id,))
 
 
 def _encode_reg_write_request(m: RegWriteRequest) -> bytes:
     m_id = m.id
     m_address = m.address
+    m_data = m.data
     if not (0 <= m_id <= 252 or m_id == 254) or m_id.__class__ is bool:
         raise out_of_range('reg_write request', 'id', m_id, 0, 252)
     if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
         raise out_of_range('reg_write request', 'address', m_address, 0, 65535)
-    return _REQUEST_FRAMES.wrap(b''.join((_S_U16.pack(m_address), bytes(m.data),)), 0x04, (m_id,))
+    v_data = m_data if m_data.__class__ is bytes else bytes(m_data)
+    return _REQUEST_FRAMES.wrap(b''.join((_S_U16.pack(m_address), v_data,)), 0x04, (m_id,))
 
 
 def _encode_action_request(m: ActionRequest) -> bytes:
@@ -317,9 +309,10 @@ def _encode_sync_read_request(m: SyncReadRequest) -> bytes:
         raise out_of_range('sync_read request', 'length', m_length, 1, 1024)
     parts_ids = []
     for item in m.ids:
-        if not 0 <= item.id <= 252 or item.id.__class__ is bool:
-            raise out_of_range('sync_read request', 'id', item.id, 0, 252)
-        parts_ids.append(_S_U8.pack(item.id))
+        item_id = item.id
+        if not 0 <= item_id <= 252 or item_id.__class__ is bool:
+            raise out_of_range('sync_read request', 'id', item_id, 0, 252)
+        parts_ids.append(_S_U8.pack(item_id))
     return _REQUEST_FRAMES.wrap(b''.join((_S_U16_U16.pack(m_address, m_length), b''.join(parts_ids),)), 0x82, (m_id,))
 
 
@@ -335,9 +328,10 @@ def _encode_fast_sync_read_request(m: FastSyncReadRequest) -> bytes:
         raise out_of_range('fast_sync_read request', 'length', m_length, 1, 1024)
     parts_servo_ids = []
     for item in m.servo_ids:
-        if not 0 <= item.id <= 252 or item.id.__class__ is bool:
-            raise out_of_range('fast_sync_read request', 'id', item.id, 0, 252)
-        parts_servo_ids.append(_S_U8.pack(item.id))
+        item_id = item.id
+        if not 0 <= item_id <= 252 or item_id.__class__ is bool:
+            raise out_of_range('fast_sync_read request', 'id', item_id, 0, 252)
+        parts_servo_ids.append(_S_U8.pack(item_id))
     return _REQUEST_FRAMES.wrap(b''.join((_S_U16_U16.pack(m_address, m_length), b''.join(parts_servo_ids),)), 0x8a, (m_id,))
 
 
@@ -356,9 +350,12 @@ def _encode_sync_write_request(m: SyncWriteRequest) -> bytes:
         raise out_of_range('sync_write request', 'length', v_length, 0, 65535)
     parts_servos = []
     for item in m_servos:
-        if not 0 <= item.id <= 252 or item.id.__class__ is bool:
-            raise out_of_range('sync_write request', 'id', item.id, 0, 252)
-        parts_servos.append(b''.join((_S_U8.pack(item.id), bytes(item.data),)))
+        item_id = item.id
+        item_data = item.data
+        if not 0 <= item_id <= 252 or item_id.__class__ is bool:
+            raise out_of_range('sync_write request', 'id', item_id, 0, 252)
+        v_data = item_data if item_data.__class__ is bytes else bytes(item_data)
+        parts_servos.append(b''.join((_S_U8.pack(item_id), v_data,)))
     return _REQUEST_FRAMES.wrap(b''.join((_S_U16_U16.pack(m_address, v_length), b''.join(parts_servos),)), 0x83, (m_id,))
 
 
@@ -368,13 +365,16 @@ def _encode_bulk_read_request(m: BulkReadRequest) -> bytes:
         raise out_of_range('bulk_read request', 'id', m_id, 0, 252)
     parts_reads = []
     for item in m.reads:
-        if not 0 <= item.id <= 252 or item.id.__class__ is bool:
-            raise out_of_range('bulk_read request', 'id', item.id, 0, 252)
-        if not 0 <= item.address <= 65535 or item.address.__class__ is bool:
-            raise out_of_range('bulk_read request', 'address', item.address, 0, 65535)
-        if not 1 <= item.length <= 1024 or item.length.__class__ is bool:
-            raise out_of_range('bulk_read request', 'length', item.length, 1, 1024)
-        parts_reads.append(_S_U8_U16_U16.pack(item.id, item.address, item.length))
+        item_id = item.id
+        item_address = item.address
+        item_length = item.length
+        if not 0 <= item_id <= 252 or item_id.__class__ is bool:
+            raise out_of_range('bulk_read request', 'id', item_id, 0, 252)
+        if not 0 <= item_address <= 65535 or item_address.__class__ is bool:
+            raise out_of_range('bulk_read request', 'address', item_address, 0, 65535)
+        if not 1 <= item_length <= 1024 or item_length.__class__ is bool:
+            raise out_of_range('bulk_read request', 'length', item_length, 1, 1024)
+        parts_reads.append(_S_U8_U16_U16.pack(item_id, item_address, item_length))
     return _REQUEST_FRAMES.wrap(b''.join(parts_reads), 0x92, (m_id,))
 
 
@@ -384,26 +384,32 @@ def _encode_bulk_write_request(m: BulkWriteRequest) -> bytes:
         raise out_of_range('bulk_write request', 'id', m_id, 0, 252)
     parts_writes = []
     for item in m.writes:
-        if not 0 <= item.id <= 252 or item.id.__class__ is bool:
-            raise out_of_range('bulk_write request', 'id', item.id, 0, 252)
-        if not 0 <= item.address <= 65535 or item.address.__class__ is bool:
-            raise out_of_range('bulk_write request', 'address', item.address, 0, 65535)
-        if len(item.data) > 65535:
-            raise out_of_range('bulk_write request', 'length', len(item.data), 0, 65535)
-        parts_writes.append(b''.join((_S_U8_U16_U16.pack(item.id, item.address, len(item.data)), bytes(item.data),)))
+        item_id = item.id
+        item_address = item.address
+        item_data = item.data
+        if not 0 <= item_id <= 252 or item_id.__class__ is bool:
+            raise out_of_range('bulk_write request', 'id', item_id, 0, 252)
+        if not 0 <= item_address <= 65535 or item_address.__class__ is bool:
+            raise out_of_range('bulk_write request', 'address', item_address, 0, 65535)
+        if len(item_data) > 65535:
+            raise out_of_range('bulk_write request', 'length', len(item_data), 0, 65535)
+        v_data = item_data if item_data.__class__ is bytes else bytes(item_data)
+        parts_writes.append(b''.join((_S_U8_U16_U16.pack(item_id, item_address, len(item_data)), v_data,)))
     return _REQUEST_FRAMES.wrap(b''.join(parts_writes), 0x93, (m_id,))
 
 
 def _encode_status_response(m: StatusResponse) -> bytes:
     m_id = m.id
     m_error = m.error
+    m_data = m.data
     if not (0 <= m_id <= 252 or m_id == 254) or m_id.__class__ is bool:
         raise out_of_range('status response', 'id', m_id, 0, 252)
     if not 0 <= m_error.alert <= 1 or m_error.alert.__class__ is bool:
         raise out_of_range('status response', 'error.alert', m_error.alert, 0, 1)
     if not 0 <= m_error.number <= 127 or m_error.number.__class__ is bool:
         raise out_of_range('status response', 'error.number', m_error.number, 0, 127)
-    return _RESPONSE_FRAMES.wrap(bytes(m.data), None, (m_id, (m_error.alert << 7) | m_error.number))
+    v_data = m_data if m_data.__class__ is bytes else bytes(m_data)
+    return _RESPONSE_FRAMES.wrap(v_data, None, (m_id, (m_error.alert << 7) | m_error.number))
 
 
 _REQUEST_DECODERS: dict[int | None, Callable[..., Message]] = {

@@ -434,7 +434,7 @@ def _decode_begin_async_request(buf: bytes, o: int, end: int) -> BeginAsyncReque
 def _decode_end_async_request(buf: bytes, o: int, end: int) -> EndAsyncRequest:
     if end - o != 1:
         raise content_size_error('end_async request', end - o, 1, 1)
-    v_mode, = _S_U8.unpack_from(buf, o)
+    v_mode = buf[o]
     return _new(EndAsyncRequest, (_MEMBERS_AsyncEnd.get(v_mode, v_mode),))
 
 
@@ -773,6 +773,285 @@ def _frame_monitor_response(buf: bytes, start: int) -> MonitorResponse | None:
     if expected != buf[start + 20]:
         return None
     v_servo_id, v_voltage, v_current, v_power, v_temperature, v_status, v_angle, v_turns = _S_MONITORRESPONSE_SERVO_ID.unpack_from(buf, start + 4)
+    v_status_flags = _MEMBERS_ServoStatus.get(v_status)
+    if v_status_flags is None:
+        v_status_flags = ServoStatus(v_status)
+    return _new(MonitorResponse, (v_servo_id, v_voltage, v_current, v_power, v_temperature, v_status_flags, v_angle, v_turns))
+
+
+def _whole_ping_request(buf: bytes) -> PingRequest | None:
+    """A whole ping request frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, check = _S_U8_U8.unpack_from(buf, 4)
+    if (0x60 + v_servo_id) & 0xff != check:
+        return None
+    return _new(PingRequest, (v_servo_id,))
+
+
+def _whole_reset_user_data_request(buf: bytes) -> ResetUserDataRequest | None:
+    """A whole reset_user_data request frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, check = _S_U8_U8.unpack_from(buf, 4)
+    if (0x61 + v_servo_id) & 0xff != check:
+        return None
+    return _new(ResetUserDataRequest, (v_servo_id,))
+
+
+def _whole_read_data_request(buf: bytes) -> ReadDataRequest | None:
+    """A whole read_data request frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, v_data_id, check = _S_U8_U8_U8.unpack_from(buf, 4)
+    if (0x63 + v_servo_id + v_data_id) & 0xff != check:
+        return None
+    return _new(ReadDataRequest, (v_servo_id, v_data_id))
+
+
+def _whole_read_batch_data_request(buf: bytes) -> ReadBatchDataRequest | None:
+    """A whole read_batch_data request frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, check = _S_U8_U8.unpack_from(buf, 4)
+    if (0x64 + v_servo_id) & 0xff != check:
+        return None
+    return _new(ReadBatchDataRequest, (v_servo_id,))
+
+
+def _whole_write_batch_data_request(buf: bytes) -> WriteBatchDataRequest | None:
+    """A whole write_batch_data request frame, all of buf, size and header known: None if its checksum fails."""
+    if (sum(buf) - 2 * buf[37]) & 0xff:
+        return None
+    t = _S_READBATCHDATARESPONSE_SERVO_ID.unpack_from(buf, 4)
+    v_servo_id = t[0]
+    v_user_data = _new(UserData, (t[1], _MEMBERS_ResponseSwitch.get(t[2], t[2]), t[3], t[4], _MEMBERS_BaudrateOption.get(t[5], t[5]), _MEMBERS_StallProtectMode.get(t[6], t[6]), t[7], t[8], t[9], t[10], t[11], t[12], _MEMBERS_Switch.get(t[13], t[13]), t[14], _MEMBERS_LockOnPowerOn.get(t[15], t[15]), _MEMBERS_WheelBrake.get(t[16], t[16]), _MEMBERS_Switch.get(t[17], t[17]), _MEMBERS_Switch.get(t[18], t[18]), t[19], t[20], t[21], t[22]))
+    return _new(WriteBatchDataRequest, (v_servo_id, v_user_data))
+
+
+def _whole_rotate_request(buf: bytes) -> RotateRequest | None:
+    """A whole rotate request frame, all of buf, size and header known: None if its checksum fails."""
+    if (sum(buf) - 2 * buf[11]) & 0xff:
+        return None
+    return _new(RotateRequest, _S_U8_I16_U16_U16.unpack_from(buf, 4))
+
+
+def _whole_damping_request(buf: bytes) -> DampingRequest | None:
+    """A whole damping request frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, v_power, check = _S_U8_U16_U8.unpack_from(buf, 4)
+    if (0x6a + v_servo_id + (v_power & 0xff) + (v_power >> 8 & 0xff)) & 0xff != check:
+        return None
+    return _new(DampingRequest, (v_servo_id, v_power))
+
+
+def _whole_read_angle_request(buf: bytes) -> ReadAngleRequest | None:
+    """A whole read_angle request frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, check = _S_U8_U8.unpack_from(buf, 4)
+    if (0x69 + v_servo_id) & 0xff != check:
+        return None
+    return _new(ReadAngleRequest, (v_servo_id,))
+
+
+def _whole_move_by_interval_request(buf: bytes) -> MoveByIntervalRequest | None:
+    """A whole move_by_interval request frame, all of buf, size and header known: None if its checksum fails."""
+    if (sum(buf) - 2 * buf[15]) & 0xff:
+        return None
+    return _new(MoveByIntervalRequest, _S_U8_I16_U16_U16_U16_U16.unpack_from(buf, 4))
+
+
+def _whole_move_by_velocity_request(buf: bytes) -> MoveByVelocityRequest | None:
+    """A whole move_by_velocity request frame, all of buf, size and header known: None if its checksum fails."""
+    if (sum(buf) - 2 * buf[15]) & 0xff:
+        return None
+    return _new(MoveByVelocityRequest, _S_U8_I16_U16_U16_U16_U16.unpack_from(buf, 4))
+
+
+def _whole_move_mturn_request(buf: bytes) -> MoveMturnRequest | None:
+    """A whole move_mturn request frame, all of buf, size and header known: None if its checksum fails."""
+    if (sum(buf) - 2 * buf[15]) & 0xff:
+        return None
+    return _new(MoveMturnRequest, _S_U8_I32_U32_U16.unpack_from(buf, 4))
+
+
+def _whole_move_mturn_by_interval_request(buf: bytes) -> MoveMturnByIntervalRequest | None:
+    """A whole move_mturn_by_interval request frame, all of buf, size and header known: None if its checksum fails."""
+    if (sum(buf) - 2 * buf[19]) & 0xff:
+        return None
+    return _new(MoveMturnByIntervalRequest, _S_U8_I32_U32_U16_U16_U16.unpack_from(buf, 4))
+
+
+def _whole_move_mturn_by_velocity_request(buf: bytes) -> MoveMturnByVelocityRequest | None:
+    """A whole move_mturn_by_velocity request frame, all of buf, size and header known: None if its checksum fails."""
+    if (sum(buf) - 2 * buf[17]) & 0xff:
+        return None
+    return _new(MoveMturnByVelocityRequest, _S_U8_I32_U16_U16_U16_U16.unpack_from(buf, 4))
+
+
+def _whole_read_mturn_angle_request(buf: bytes) -> ReadMturnAngleRequest | None:
+    """A whole read_mturn_angle request frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, check = _S_U8_U8.unpack_from(buf, 4)
+    if (0x6f + v_servo_id) & 0xff != check:
+        return None
+    return _new(ReadMturnAngleRequest, (v_servo_id,))
+
+
+def _whole_reset_mturn_angle_request(buf: bytes) -> ResetMturnAngleRequest | None:
+    """A whole reset_mturn_angle request frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, check = _S_U8_U8.unpack_from(buf, 4)
+    if (0x70 + v_servo_id) & 0xff != check:
+        return None
+    return _new(ResetMturnAngleRequest, (v_servo_id,))
+
+
+def _whole_begin_async_request(buf: bytes) -> BeginAsyncRequest | None:
+    """A whole begin_async request frame, all of buf, size and header known: None if its checksum fails."""
+    if (sum(buf) - 2 * buf[4]) & 0xff:
+        return None
+    return _new(BeginAsyncRequest, ())
+
+
+def _whole_end_async_request(buf: bytes) -> EndAsyncRequest | None:
+    """A whole end_async request frame, all of buf, size and header known: None if its checksum fails."""
+    v_mode, check = _S_U8_U8.unpack_from(buf, 4)
+    if (0x72 + v_mode) & 0xff != check:
+        return None
+    return _new(EndAsyncRequest, (_MEMBERS_AsyncEnd.get(v_mode, v_mode),))
+
+
+def _whole_monitor_request(buf: bytes) -> MonitorRequest | None:
+    """A whole monitor request frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, check = _S_U8_U8.unpack_from(buf, 4)
+    if (0x75 + v_servo_id) & 0xff != check:
+        return None
+    return _new(MonitorRequest, (v_servo_id,))
+
+
+def _whole_stop_on_control_mode_request(buf: bytes) -> StopOnControlModeRequest | None:
+    """A whole stop_on_control_mode request frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, v_method, v_power, check = _S_U8_U8_U16_U8.unpack_from(buf, 4)
+    if (0x7a + v_servo_id + v_method + (v_power & 0xff) + (v_power >> 8 & 0xff)) & 0xff != check:
+        return None
+    return _new(StopOnControlModeRequest, (v_servo_id, _MEMBERS_StopMethod.get(v_method, v_method), v_power))
+
+
+def _whole_ping_response(buf: bytes) -> PingResponse | None:
+    """A whole ping response frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, check = _S_U8_U8.unpack_from(buf, 4)
+    if (0x23 + v_servo_id) & 0xff != check:
+        return None
+    return _new(PingResponse, (v_servo_id,))
+
+
+def _whole_reset_user_data_response(buf: bytes) -> ResetUserDataResponse | None:
+    """A whole reset_user_data response frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, 4)
+    if (0x25 + v_servo_id + v_result) & 0xff != check:
+        return None
+    return _new(ResetUserDataResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
+
+
+def _whole_write_data_response(buf: bytes) -> WriteDataResponse | None:
+    """A whole write_data response frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, v_data_id, v_result, check = _S_U8_U8_U8_U8.unpack_from(buf, 4)
+    if (0x28 + v_servo_id + v_data_id + v_result) & 0xff != check:
+        return None
+    return _new(WriteDataResponse, (v_servo_id, v_data_id, _MEMBERS_Result.get(v_result, v_result)))
+
+
+def _whole_read_batch_data_response(buf: bytes) -> ReadBatchDataResponse | None:
+    """A whole read_batch_data response frame, all of buf, size and header known: None if its checksum fails."""
+    if (sum(buf) - 2 * buf[37]) & 0xff:
+        return None
+    t = _S_READBATCHDATARESPONSE_SERVO_ID.unpack_from(buf, 4)
+    v_servo_id = t[0]
+    v_user_data = _new(UserData, (t[1], _MEMBERS_ResponseSwitch.get(t[2], t[2]), t[3], t[4], _MEMBERS_BaudrateOption.get(t[5], t[5]), _MEMBERS_StallProtectMode.get(t[6], t[6]), t[7], t[8], t[9], t[10], t[11], t[12], _MEMBERS_Switch.get(t[13], t[13]), t[14], _MEMBERS_LockOnPowerOn.get(t[15], t[15]), _MEMBERS_WheelBrake.get(t[16], t[16]), _MEMBERS_Switch.get(t[17], t[17]), _MEMBERS_Switch.get(t[18], t[18]), t[19], t[20], t[21], t[22]))
+    return _new(ReadBatchDataResponse, (v_servo_id, v_user_data))
+
+
+def _whole_write_batch_data_response(buf: bytes) -> WriteBatchDataResponse | None:
+    """A whole write_batch_data response frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, 4)
+    if (0x29 + v_servo_id + v_result) & 0xff != check:
+        return None
+    return _new(WriteBatchDataResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
+
+
+def _whole_spin_response(buf: bytes) -> SpinResponse | None:
+    """A whole spin response frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, 4)
+    if (0x2a + v_servo_id + v_result) & 0xff != check:
+        return None
+    return _new(SpinResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
+
+
+def _whole_rotate_response(buf: bytes) -> RotateResponse | None:
+    """A whole rotate response frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, 4)
+    if (0x2b + v_servo_id + v_result) & 0xff != check:
+        return None
+    return _new(RotateResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
+
+
+def _whole_damping_response(buf: bytes) -> DampingResponse | None:
+    """A whole damping response frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, 4)
+    if (0x2c + v_servo_id + v_result) & 0xff != check:
+        return None
+    return _new(DampingResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
+
+
+def _whole_read_angle_response(buf: bytes) -> ReadAngleResponse | None:
+    """A whole read_angle response frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, v_angle, check = _S_U8_I16_U8.unpack_from(buf, 4)
+    if (0x2e + v_servo_id + (v_angle & 0xff) + (v_angle >> 8 & 0xff)) & 0xff != check:
+        return None
+    return _new(ReadAngleResponse, (v_servo_id, v_angle))
+
+
+def _whole_move_by_interval_response(buf: bytes) -> MoveByIntervalResponse | None:
+    """A whole move_by_interval response frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, 4)
+    if (0x2e + v_servo_id + v_result) & 0xff != check:
+        return None
+    return _new(MoveByIntervalResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
+
+
+def _whole_move_by_velocity_response(buf: bytes) -> MoveByVelocityResponse | None:
+    """A whole move_by_velocity response frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, 4)
+    if (0x2f + v_servo_id + v_result) & 0xff != check:
+        return None
+    return _new(MoveByVelocityResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
+
+
+def _whole_move_mturn_response(buf: bytes) -> MoveMturnResponse | None:
+    """A whole move_mturn response frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, 4)
+    if (0x30 + v_servo_id + v_result) & 0xff != check:
+        return None
+    return _new(MoveMturnResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
+
+
+def _whole_move_mturn_by_interval_response(buf: bytes) -> MoveMturnByIntervalResponse | None:
+    """A whole move_mturn_by_interval response frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, 4)
+    if (0x31 + v_servo_id + v_result) & 0xff != check:
+        return None
+    return _new(MoveMturnByIntervalResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
+
+
+def _whole_move_mturn_by_velocity_response(buf: bytes) -> MoveMturnByVelocityResponse | None:
+    """A whole move_mturn_by_velocity response frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, 4)
+    if (0x32 + v_servo_id + v_result) & 0xff != check:
+        return None
+    return _new(MoveMturnByVelocityResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
+
+
+def _whole_read_mturn_angle_response(buf: bytes) -> ReadMturnAngleResponse | None:
+    """A whole read_mturn_angle response frame, all of buf, size and header known: None if its checksum fails."""
+    if (sum(buf) - 2 * buf[11]) & 0xff:
+        return None
+    return _new(ReadMturnAngleResponse, _S_U8_I32_I16.unpack_from(buf, 4))
+
+
+def _whole_monitor_response(buf: bytes) -> MonitorResponse | None:
+    """A whole monitor response frame, all of buf, size and header known: None if its checksum fails."""
+    if (sum(buf) - 2 * buf[20]) & 0xff:
+        return None
+    v_servo_id, v_voltage, v_current, v_power, v_temperature, v_status, v_angle, v_turns = _S_MONITORRESPONSE_SERVO_ID.unpack_from(buf, 4)
     v_status_flags = _MEMBERS_ServoStatus.get(v_status)
     if v_status_flags is None:
         v_status_flags = ServoStatus(v_status)
@@ -1387,7 +1666,9 @@ def _encode_sync_command_request(m: SyncCommandRequest) -> bytes:
         raise out_of_range('sync_command request', 'count', len(m_blocks), 0, 255)
     parts_blocks = []
     for item in m_blocks:
-        parts_blocks.append(bytes(item.content))
+        item_content = item.content
+        v_content = item_content if item_content.__class__ is bytes else bytes(item_content)
+        parts_blocks.append(v_content)
     content = b''.join(parts_blocks)
     n = len(content) + 3
     if n > 255:
@@ -1470,27 +1751,27 @@ _REQUEST_FIXED: dict[int, tuple[int, Callable[[bytes, int], Message | None]]] = 
 }
 
 
-# The same frames for decode(), by their first bytes (header, command code, length byte).
-_REQUEST_WHOLE: dict[bytes, tuple[int, Callable[[bytes, int], Message | None]]] = {
-    b'\x12L\x01\x01': (6, _frame_ping_request),
-    b'\x12L\x02\x01': (6, _frame_reset_user_data_request),
-    b'\x12L\x03\x02': (7, _frame_read_data_request),
-    b'\x12L\x05\x01': (6, _frame_read_batch_data_request),
-    b'\x12L\x06!': (38, _frame_write_batch_data_request),
-    b'\x12L\x08\x07': (12, _frame_rotate_request),
-    b'\x12L\t\x03': (8, _frame_damping_request),
-    b'\x12L\n\x01': (6, _frame_read_angle_request),
-    b'\x12L\x0b\x0b': (16, _frame_move_by_interval_request),
-    b'\x12L\x0c\x0b': (16, _frame_move_by_velocity_request),
-    b'\x12L\r\x0b': (16, _frame_move_mturn_request),
-    b'\x12L\x0e\x0f': (20, _frame_move_mturn_by_interval_request),
-    b'\x12L\x0f\r': (18, _frame_move_mturn_by_velocity_request),
-    b'\x12L\x10\x01': (6, _frame_read_mturn_angle_request),
-    b'\x12L\x11\x01': (6, _frame_reset_mturn_angle_request),
-    b'\x12L\x12\x00': (5, _frame_begin_async_request),
-    b'\x12L\x13\x01': (6, _frame_end_async_request),
-    b'\x12L\x16\x01': (6, _frame_monitor_request),
-    b'\x12L\x18\x04': (9, _frame_stop_on_control_mode_request),
+# The same frames for decode(), by their first bytes (header, command code, length byte): frame size, decoder.
+_REQUEST_WHOLE: dict[bytes, tuple[int, Callable[[bytes], Message | None]]] = {
+    b'\x12L\x01\x01': (6, _whole_ping_request),
+    b'\x12L\x02\x01': (6, _whole_reset_user_data_request),
+    b'\x12L\x03\x02': (7, _whole_read_data_request),
+    b'\x12L\x05\x01': (6, _whole_read_batch_data_request),
+    b'\x12L\x06!': (38, _whole_write_batch_data_request),
+    b'\x12L\x08\x07': (12, _whole_rotate_request),
+    b'\x12L\t\x03': (8, _whole_damping_request),
+    b'\x12L\n\x01': (6, _whole_read_angle_request),
+    b'\x12L\x0b\x0b': (16, _whole_move_by_interval_request),
+    b'\x12L\x0c\x0b': (16, _whole_move_by_velocity_request),
+    b'\x12L\r\x0b': (16, _whole_move_mturn_request),
+    b'\x12L\x0e\x0f': (20, _whole_move_mturn_by_interval_request),
+    b'\x12L\x0f\r': (18, _whole_move_mturn_by_velocity_request),
+    b'\x12L\x10\x01': (6, _whole_read_mturn_angle_request),
+    b'\x12L\x11\x01': (6, _whole_reset_mturn_angle_request),
+    b'\x12L\x12\x00': (5, _whole_begin_async_request),
+    b'\x12L\x13\x01': (6, _whole_end_async_request),
+    b'\x12L\x16\x01': (6, _whole_monitor_request),
+    b'\x12L\x18\x04': (9, _whole_stop_on_control_mode_request),
 }
 
 
@@ -1564,24 +1845,24 @@ _RESPONSE_FIXED: dict[int, tuple[int, Callable[[bytes, int], Message | None]]] =
 }
 
 
-# The same frames for decode(), by their first bytes (header, command code, length byte).
-_RESPONSE_WHOLE: dict[bytes, tuple[int, Callable[[bytes, int], Message | None]]] = {
-    b'\x05\x1c\x01\x01': (6, _frame_ping_response),
-    b'\x05\x1c\x02\x02': (7, _frame_reset_user_data_response),
-    b'\x05\x1c\x04\x03': (8, _frame_write_data_response),
-    b'\x05\x1c\x05!': (38, _frame_read_batch_data_response),
-    b'\x05\x1c\x06\x02': (7, _frame_write_batch_data_response),
-    b'\x05\x1c\x07\x02': (7, _frame_spin_response),
-    b'\x05\x1c\x08\x02': (7, _frame_rotate_response),
-    b'\x05\x1c\t\x02': (7, _frame_damping_response),
-    b'\x05\x1c\n\x03': (8, _frame_read_angle_response),
-    b'\x05\x1c\x0b\x02': (7, _frame_move_by_interval_response),
-    b'\x05\x1c\x0c\x02': (7, _frame_move_by_velocity_response),
-    b'\x05\x1c\r\x02': (7, _frame_move_mturn_response),
-    b'\x05\x1c\x0e\x02': (7, _frame_move_mturn_by_interval_response),
-    b'\x05\x1c\x0f\x02': (7, _frame_move_mturn_by_velocity_response),
-    b'\x05\x1c\x10\x07': (12, _frame_read_mturn_angle_response),
-    b'\x05\x1c\x16\x10': (21, _frame_monitor_response),
+# The same frames for decode(), by their first bytes (header, command code, length byte): frame size, decoder.
+_RESPONSE_WHOLE: dict[bytes, tuple[int, Callable[[bytes], Message | None]]] = {
+    b'\x05\x1c\x01\x01': (6, _whole_ping_response),
+    b'\x05\x1c\x02\x02': (7, _whole_reset_user_data_response),
+    b'\x05\x1c\x04\x03': (8, _whole_write_data_response),
+    b'\x05\x1c\x05!': (38, _whole_read_batch_data_response),
+    b'\x05\x1c\x06\x02': (7, _whole_write_batch_data_response),
+    b'\x05\x1c\x07\x02': (7, _whole_spin_response),
+    b'\x05\x1c\x08\x02': (7, _whole_rotate_response),
+    b'\x05\x1c\t\x02': (7, _whole_damping_response),
+    b'\x05\x1c\n\x03': (8, _whole_read_angle_response),
+    b'\x05\x1c\x0b\x02': (7, _whole_move_by_interval_response),
+    b'\x05\x1c\x0c\x02': (7, _whole_move_by_velocity_response),
+    b'\x05\x1c\r\x02': (7, _whole_move_mturn_response),
+    b'\x05\x1c\x0e\x02': (7, _whole_move_mturn_by_interval_response),
+    b'\x05\x1c\x0f\x02': (7, _whole_move_mturn_by_velocity_response),
+    b'\x05\x1c\x10\x07': (12, _whole_read_mturn_angle_response),
+    b'\x05\x1c\x16\x10': (21, _whole_monitor_response),
 }
 
 
@@ -1667,28 +1948,21 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
     Each direction's checks are inline here rather than in a function per direction: one call less per frame.
     `expect` (the reply class a frame answers) matters only where replies share a code; here none do.
     """
-    if direction is None:
-        if data[:2] == b'\x12L':
-            direction = 'request'
-        elif data[:2] == b'\x05\x1c':
-            direction = 'response'
-        else:
-            raise DecodeError(f"header is {data[:2].hex(' ')}, expected 12 4c or 05 1c")
     if direction == 'request':  # a Direction or its value
+        fixed = _REQUEST_WHOLE.get(data[:4])  # no key is shorter: a short frame matches none
+        if fixed is not None and fixed[0] == len(data):
+            message = fixed[1](data)
+            if message is not None:
+                return message
         n = len(data)
         if n < 5:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (5 bytes)")
-        fixed = _REQUEST_WHOLE.get(data[:4])
-        if fixed is not None and fixed[0] == n:
-            message = fixed[1](data, 0)
-            if message is not None:
-                return message
         if data[:2] != b'\x12L':
             raise DecodeError(f"request header is {data[:2].hex(' ')}, expected 12 4c")
         size = data[3]
         if n != 5 + size:
             raise DecodeError(f"length byte says {size} content bytes but the frame holds {n - 5}")
-        expected = sum(data[:-1]) & 0xff
+        expected = (sum(data) - data[-1]) & 0xff
         if expected != data[-1]:
             raise ChecksumError(f"bad checksum: the frame has {data[-1]:#04x}, its bytes give {expected:#04x}")
         decoder = _REQUEST_DECODERS.get(data[2])
@@ -1696,26 +1970,32 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
             raise DecodeError(f"unknown command {data[2]:#04x}")
         return decoder(data, 4, n - 1)
     if direction == 'response':  # a Direction or its value
+        fixed = _RESPONSE_WHOLE.get(data[:4])  # no key is shorter: a short frame matches none
+        if fixed is not None and fixed[0] == len(data):
+            message = fixed[1](data)
+            if message is not None:
+                return message
         n = len(data)
         if n < 5:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (5 bytes)")
-        fixed = _RESPONSE_WHOLE.get(data[:4])
-        if fixed is not None and fixed[0] == n:
-            message = fixed[1](data, 0)
-            if message is not None:
-                return message
         if data[:2] != b'\x05\x1c':
             raise DecodeError(f"response header is {data[:2].hex(' ')}, expected 05 1c")
         size = data[3]
         if n != 5 + size:
             raise DecodeError(f"length byte says {size} content bytes but the frame holds {n - 5}")
-        expected = sum(data[:-1]) & 0xff
+        expected = (sum(data) - data[-1]) & 0xff
         if expected != data[-1]:
             raise ChecksumError(f"bad checksum: the frame has {data[-1]:#04x}, its bytes give {expected:#04x}")
         decoder = _RESPONSE_DECODERS.get(data[2])
         if decoder is None:
             raise DecodeError(f"unknown command {data[2]:#04x}")
         return decoder(data, 4, n - 1)
+    if direction is None:  # last: a caller that knows the direction does not pay for this
+        if data[:2] == b'\x12L':
+            return decode(data, 'request', expect)
+        if data[:2] == b'\x05\x1c':
+            return decode(data, 'response', expect)
+        raise DecodeError(f"header is {data[:2].hex(' ')}, expected 12 4c or 05 1c")
     raise ValueError(f"direction must be request or response, not {direction!r}")
 
 

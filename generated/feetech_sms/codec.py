@@ -57,7 +57,7 @@ def _decode_read_request(buf: bytes, o: int, end: int, id: int) -> ReadRequest:
 def _decode_write_request(buf: bytes, o: int, end: int, id: int) -> WriteRequest:
     if end - o < 1:
         raise content_size_error('write request', end - o, 1, None)
-    v_address, = _S_U8.unpack_from(buf, o)
+    v_address = buf[o]
     o += 1
     v_data = buf[o:end]
     return _new(WriteRequest, (id, v_address, v_data))
@@ -66,7 +66,7 @@ def _decode_write_request(buf: bytes, o: int, end: int, id: int) -> WriteRequest
 def _decode_reg_write_request(buf: bytes, o: int, end: int, id: int) -> RegWriteRequest:
     if end - o < 1:
         raise content_size_error('reg_write request', end - o, 1, None)
-    v_address, = _S_U8.unpack_from(buf, o)
+    v_address = buf[o]
     o += 1
     v_data = buf[o:end]
     return _new(RegWriteRequest, (id, v_address, v_data))
@@ -89,14 +89,10 @@ def _decode_sync_read_request(buf: bytes, o: int, end: int, id: int) -> SyncRead
         raise content_size_error('sync_read request', end - o, 2, None)
     v_address, v_length = _S_U8_U8.unpack_from(buf, o)
     o += 2
-    v_ids_list = []
     if (end - o) % 1:
         raise DecodeError('sync_read request' + f': {end - o} bytes do not split into ids items of 1')
     n = end - o
-    for v_id, in _S_U8.iter_unpack(buf[o : o + n]):
-        item = _new(IdsItem, (v_id,))
-        v_ids_list.append(item)
-    v_ids = tuple(v_ids_list)
+    v_ids = tuple([_new(IdsItem, values) for values in _S_U8.iter_unpack(buf[o : o + n])])
     return _new(SyncReadRequest, (id, v_address, v_length, v_ids))
 
 
@@ -107,7 +103,7 @@ def _decode_sync_write_request(buf: bytes, o: int, end: int, id: int) -> SyncWri
     o += 2
     v_servos_list = []
     while o < end:
-        v_id, = _S_U8.unpack_from(buf, o)
+        v_id = buf[o]
         o += 1
         if end - o < v_data_length:
             raise DecodeError('sync_write request' + f': data needs {v_data_length} bytes, {end - o} left')
@@ -165,6 +161,42 @@ def _frame_reset_request(buf: bytes, start: int) -> ResetRequest | None:
     return _new(ResetRequest, (id,))
 
 
+def _whole_ping_request(buf: bytes) -> PingRequest | None:
+    """A whole ping request frame, all of buf, size and header known: None if its checksum fails."""
+    check = buf[5]
+    if ~(sum(buf) - 0x1fe - check) & 0xff != check:
+        return None
+    id = buf[2]
+    return _new(PingRequest, (id,))
+
+
+def _whole_read_request(buf: bytes) -> ReadRequest | None:
+    """A whole read request frame, all of buf, size and header known: None if its checksum fails."""
+    id = buf[2]
+    v_address, v_length, check = _S_U8_U8_U8.unpack_from(buf, 5)
+    if ~(0x6 + id + v_address + v_length) & 0xff != check:
+        return None
+    return _new(ReadRequest, (id, v_address, v_length))
+
+
+def _whole_action_request(buf: bytes) -> ActionRequest | None:
+    """A whole action request frame, all of buf, size and header known: None if its checksum fails."""
+    check = buf[5]
+    if ~(sum(buf) - 0x1fe - check) & 0xff != check:
+        return None
+    id = buf[2]
+    return _new(ActionRequest, (id,))
+
+
+def _whole_reset_request(buf: bytes) -> ResetRequest | None:
+    """A whole reset request frame, all of buf, size and header known: None if its checksum fails."""
+    check = buf[5]
+    if ~(sum(buf) - 0x1fe - check) & 0xff != check:
+        return None
+    id = buf[2]
+    return _new(ResetRequest, (id,))
+
+
 def _encode_ping_request(m: PingRequest) -> bytes:
     m_id = m.id
     if not 0 <= m_id <= 254 or m_id.__class__ is bool:
@@ -190,11 +222,13 @@ def _encode_read_request(m: ReadRequest) -> bytes:
 def _encode_write_request(m: WriteRequest) -> bytes:
     m_id = m.id
     m_address = m.address
+    m_data = m.data
     if not 0 <= m_id <= 254 or m_id.__class__ is bool:
         raise out_of_range('write request', 'id', m_id, 0, 253)
     if not 0 <= m_address <= 255 or m_address.__class__ is bool:
         raise out_of_range('write request', 'address', m_address, 0, 255)
-    content = bytes(m.data)
+    v_data = m_data if m_data.__class__ is bytes else bytes(m_data)
+    content = v_data
     n = len(content) + 3
     if n > 255:
         raise EncodeError(f'content of {n - 2} bytes does not fit the length field')
@@ -205,11 +239,13 @@ def _encode_write_request(m: WriteRequest) -> bytes:
 def _encode_reg_write_request(m: RegWriteRequest) -> bytes:
     m_id = m.id
     m_address = m.address
+    m_data = m.data
     if not 0 <= m_id <= 254 or m_id.__class__ is bool:
         raise out_of_range('reg_write request', 'id', m_id, 0, 253)
     if not 0 <= m_address <= 255 or m_address.__class__ is bool:
         raise out_of_range('reg_write request', 'address', m_address, 0, 255)
-    content = bytes(m.data)
+    v_data = m_data if m_data.__class__ is bytes else bytes(m_data)
+    content = v_data
     n = len(content) + 3
     if n > 255:
         raise EncodeError(f'content of {n - 2} bytes does not fit the length field')
@@ -245,9 +281,10 @@ def _encode_sync_read_request(m: SyncReadRequest) -> bytes:
         raise out_of_range('sync_read request', 'length', m_length, 1, 250)
     parts_ids = []
     for item in m.ids:
-        if not 0 <= item.id <= 253 or item.id.__class__ is bool:
-            raise out_of_range('sync_read request', 'id', item.id, 0, 253)
-        parts_ids.append(_S_U8.pack(item.id))
+        item_id = item.id
+        if not 0 <= item_id <= 253 or item_id.__class__ is bool:
+            raise out_of_range('sync_read request', 'id', item_id, 0, 253)
+        parts_ids.append(_S_U8.pack(item_id))
     content = b''.join(parts_ids)
     n = len(content) + 4
     if n > 255:
@@ -271,9 +308,12 @@ def _encode_sync_write_request(m: SyncWriteRequest) -> bytes:
         raise out_of_range('sync_write request', 'data_length', v_data_length, 0, 255)
     parts_servos = []
     for item in m_servos:
-        if not 0 <= item.id <= 253 or item.id.__class__ is bool:
-            raise out_of_range('sync_write request', 'id', item.id, 0, 253)
-        parts_servos.append(b''.join((_S_U8.pack(item.id), bytes(item.data),)))
+        item_id = item.id
+        item_data = item.data
+        if not 0 <= item_id <= 253 or item_id.__class__ is bool:
+            raise out_of_range('sync_write request', 'id', item_id, 0, 253)
+        v_data = item_data if item_data.__class__ is bytes else bytes(item_data)
+        parts_servos.append(b''.join((_S_U8.pack(item_id), v_data,)))
     content = b''.join(parts_servos)
     n = len(content) + 4
     if n > 255:
@@ -285,11 +325,13 @@ def _encode_sync_write_request(m: SyncWriteRequest) -> bytes:
 def _encode_reply_response(m: ReplyResponse) -> bytes:
     m_id = m.id
     m_error = m.error
+    m_data = m.data
     if not 0 <= m_id <= 254 or m_id.__class__ is bool:
         raise out_of_range('reply response', 'id', m_id, 0, 253)
     if not 0 <= m_error <= 255 or isinstance(m_error, bool):
         raise out_of_range('reply response', 'error', m_error, 0, 255)
-    content = bytes(m.data)
+    v_data = m_data if m_data.__class__ is bytes else bytes(m_data)
+    content = v_data
     n = len(content) + 2
     if n > 255:
         raise EncodeError(f'content of {n - 2} bytes does not fit the length field')
@@ -326,6 +368,13 @@ _REQUEST_FIXED: dict[int, tuple[int, Callable[[bytes, int], Message | None]]] = 
 }
 
 
+# The same frames for decode(), by size key: frame size, decoder.
+_REQUEST_WHOLE: dict[int, tuple[int, Callable[[bytes], Message | None]]] = {
+    0x0102: (6, _whole_ping_request),
+    0x0204: (8, _whole_read_request),
+    0x0502: (6, _whole_action_request),
+    0x0602: (6, _whole_reset_request),
+}
 
 
 def _decode_request_at(buf: bytes, start: int, stop: int) -> Message:
@@ -402,25 +451,23 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
     Each direction's checks are inline here rather than in a function per direction: one call less per frame.
     `expect` (the reply class a frame answers) matters only where replies share a code; here none do.
     """
-    if direction is None:
-        raise DecodeError("give the direction: requests and responses share the header ff ff")
     if direction == 'request':  # a Direction or its value
         n = len(data)
         if n < 6:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (6 bytes)")
-        if not (0 <= data[2] <= 253 or data[2] == 254) and data[:2] == b'\xff\xff':
-            raise DecodeError(f"id = {data[2]} is outside its range 0..253 (or 254)")
-        fixed = _REQUEST_FIXED.get(data[4] << 8 | data[3])
-        if fixed is not None and fixed[0] == n and data[:2] == b'\xff\xff':
-            message = fixed[1](data, 0)
-            if message is not None:
-                return message
         if data[:2] != b'\xff\xff':
             raise DecodeError(f"request header is {data[:2].hex(' ')}, expected ff ff")
+        if data[2] > 254:
+            raise DecodeError(f"id = {data[2]} is outside its range 0..253 (or 254)")
+        fixed = _REQUEST_WHOLE.get(data[4] << 8 | data[3])
+        if fixed is not None and fixed[0] == n:
+            message = fixed[1](data)
+            if message is not None:
+                return message
         size = data[3] - 2
         if size < 0 or n != 6 + size:
             raise DecodeError(f"length byte says {size} content bytes but the frame holds {n - 6}")
-        expected = ~sum(data[2:-1]) & 0xff
+        expected = ~(sum(data) - 0x1fe - data[-1]) & 0xff
         if expected != data[-1]:
             raise ChecksumError(f"bad checksum: the frame has {data[-1]:#04x}, its bytes give {expected:#04x}")
         decoder = _REQUEST_DECODERS.get(data[4])
@@ -431,17 +478,19 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         n = len(data)
         if n < 6:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (6 bytes)")
-        if not (0 <= data[2] <= 253 or data[2] == 254) and data[:2] == b'\xff\xff':
-            raise DecodeError(f"id = {data[2]} is outside its range 0..253 (or 254)")
         if data[:2] != b'\xff\xff':
             raise DecodeError(f"response header is {data[:2].hex(' ')}, expected ff ff")
+        if data[2] > 254:
+            raise DecodeError(f"id = {data[2]} is outside its range 0..253 (or 254)")
         size = data[3] - 2
         if size < 0 or n != 6 + size:
             raise DecodeError(f"length byte says {size} content bytes but the frame holds {n - 6}")
-        expected = ~sum(data[2:-1]) & 0xff
+        expected = ~(sum(data) - 0x1fe - data[-1]) & 0xff
         if expected != data[-1]:
             raise ChecksumError(f"bad checksum: the frame has {data[-1]:#04x}, its bytes give {expected:#04x}")
         return _decode_reply_response(data, 5, n - 1, data[2], data[4])
+    if direction is None:  # last: a caller that knows the direction does not pay for this
+        raise DecodeError("give the direction: requests and responses share the header ff ff")
     raise ValueError(f"direction must be request or response, not {direction!r}")
 
 

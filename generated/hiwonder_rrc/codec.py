@@ -156,14 +156,10 @@ def _decode_motor_set_speeds_request(buf: bytes, o: int, end: int) -> MotorSetSp
     if v_subcommand_code != 1:
         raise DecodeError('motor.set_speeds request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x1')
     o += 2
-    v_motors_list = []
     n = v_count * 5
     if end - o < n:
         raise DecodeError('motor.set_speeds request' + f': content too short for its count ({v_count} motors)')
-    for v_motor_id, v_speed in _S_U8_F32.iter_unpack(buf[o : o + n]):
-        item = _new(MotorsItem, (v_motor_id, v_speed))
-        v_motors_list.append(item)
-    v_motors = tuple(v_motors_list)
+    v_motors = tuple([_new(MotorsItem, values) for values in _S_U8_F32.iter_unpack(buf[o : o + n])])
     o += n
     if o != end:
         raise DecodeError('motor.set_speeds request' + f': {end - o} bytes left after the last field')
@@ -186,14 +182,10 @@ def _decode_motor_set_duties_request(buf: bytes, o: int, end: int) -> MotorSetDu
     if v_subcommand_code != 5:
         raise DecodeError('motor.set_duties request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x5')
     o += 2
-    v_duties_list = []
     n = v_count * 5
     if end - o < n:
         raise DecodeError('motor.set_duties request' + f': content too short for its count ({v_count} duties)')
-    for v_motor_id, v_duty in _S_U8_F32.iter_unpack(buf[o : o + n]):
-        item = _new(DutiesItem, (v_motor_id, v_duty))
-        v_duties_list.append(item)
-    v_duties = tuple(v_duties_list)
+    v_duties = tuple([_new(DutiesItem, values) for values in _S_U8_F32.iter_unpack(buf[o : o + n])])
     o += n
     if o != end:
         raise DecodeError('motor.set_duties request' + f': {end - o} bytes left after the last field')
@@ -219,14 +211,10 @@ def _decode_pwm_servo_set_positions_request(buf: bytes, o: int, end: int) -> Pwm
     if v_subcommand_code != 1:
         raise DecodeError('pwm_servo.set_positions request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x1')
     o += 4
-    v_pwm_servos_list = []
     n = v_count * 3
     if end - o < n:
         raise DecodeError('pwm_servo.set_positions request' + f': content too short for its count ({v_count} pwm_servos)')
-    for v_servo_id, v_pulse in _S_U8_U16.iter_unpack(buf[o : o + n]):
-        item = _new(PwmServosItem, (v_servo_id, v_pulse))
-        v_pwm_servos_list.append(item)
-    v_pwm_servos = tuple(v_pwm_servos_list)
+    v_pwm_servos = tuple([_new(PwmServosItem, values) for values in _S_U8_U16.iter_unpack(buf[o : o + n])])
     o += n
     if o != end:
         raise DecodeError('pwm_servo.set_positions request' + f': {end - o} bytes left after the last field')
@@ -294,14 +282,10 @@ def _decode_bus_servo_set_positions_request(buf: bytes, o: int, end: int) -> Bus
     if v_subcommand_code != 1:
         raise DecodeError('bus_servo.set_positions request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x1')
     o += 4
-    v_bus_servos_list = []
     n = v_count * 3
     if end - o < n:
         raise DecodeError('bus_servo.set_positions request' + f': content too short for its count ({v_count} bus_servos)')
-    for v_servo_id, v_position in _S_U8_U16.iter_unpack(buf[o : o + n]):
-        item = _new(BusServosItem, (v_servo_id, v_position))
-        v_bus_servos_list.append(item)
-    v_bus_servos = tuple(v_bus_servos_list)
+    v_bus_servos = tuple([_new(BusServosItem, values) for values in _S_U8_U16.iter_unpack(buf[o : o + n])])
     o += n
     if o != end:
         raise DecodeError('bus_servo.set_positions request' + f': {end - o} bytes left after the last field')
@@ -369,14 +353,10 @@ def _decode_bus_servo_stop_request(buf: bytes, o: int, end: int) -> BusServoStop
     if v_subcommand_code != 3:
         raise DecodeError('bus_servo.stop request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x3')
     o += 2
-    v_servos_list = []
     n = v_count * 1
     if end - o < n:
         raise DecodeError('bus_servo.stop request' + f': content too short for its count ({v_count} servos)')
-    for v_servo_id, in _S_U8.iter_unpack(buf[o : o + n]):
-        item = _new(ServosItem, (v_servo_id,))
-        v_servos_list.append(item)
-    v_servos = tuple(v_servos_list)
+    v_servos = tuple([_new(ServosItem, values) for values in _S_U8.iter_unpack(buf[o : o + n])])
     o += n
     if o != end:
         raise DecodeError('bus_servo.stop request' + f': {end - o} bytes left after the last field')
@@ -627,14 +607,10 @@ def _decode_rgb_set_pixels_request(buf: bytes, o: int, end: int) -> RgbSetPixels
     if v_subcommand_code != 1:
         raise DecodeError('rgb.set_pixels request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x1')
     o += 2
-    v_pixels_list = []
     n = v_count * 4
     if end - o < n:
         raise DecodeError('rgb.set_pixels request' + f': content too short for its count ({v_count} pixels)')
-    for v_index, v_red, v_green, v_blue in _S_U8_U8_U8_U8.iter_unpack(buf[o : o + n]):
-        item = _new(PixelsItem, (v_index, v_red, v_green, v_blue))
-        v_pixels_list.append(item)
-    v_pixels = tuple(v_pixels_list)
+    v_pixels = tuple([_new(PixelsItem, values) for values in _S_U8_U8_U8_U8.iter_unpack(buf[o : o + n])])
     o += n
     if o != end:
         raise DecodeError('rgb.set_pixels request' + f': {end - o} bytes left after the last field')
@@ -711,6 +687,665 @@ def _frame_sbus_response(buf: bytes, start: int) -> SbusResponse | None:
     return _new(SbusResponse, (t[0:16], v_ch17, v_ch18, v_signal_loss, v_fail_safe))
 
 
+def _whole_led_request(buf: bytes) -> LedRequest | None:
+    """A whole led request frame, all of buf, size and header known: None if its checksum fails."""
+    expected = 0x47
+    for byte in buf[4 : 11]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[11]:
+        return None
+    return _new(LedRequest, _S_U8_U16_U16_U16.unpack_from(buf, 4))
+
+
+def _whole_buzzer_request(buf: bytes) -> BuzzerRequest | None:
+    """A whole buzzer request frame, all of buf, size and header known: None if its checksum fails."""
+    expected = 0x53
+    for byte in buf[4 : 12]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[12]:
+        return None
+    return _new(BuzzerRequest, _S_U16_U16_U16_U16.unpack_from(buf, 4))
+
+
+def _whole_key_response(buf: bytes) -> KeyResponse | None:
+    """A whole key response frame, all of buf, size and header known: None if its checksum fails."""
+    expected = 0x16
+    for byte in buf[4 : 6]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[6]:
+        return None
+    v_button_id, v_event = _S_U8_U8.unpack_from(buf, 4)
+    return _new(KeyResponse, (v_button_id, _MEMBERS_ButtonEvent.get(v_event, v_event)))
+
+
+def _whole_imu_response(buf: bytes) -> ImuResponse | None:
+    """A whole imu response frame, all of buf, size and header known: None if its checksum fails."""
+    expected = 0x31
+    for byte in buf[4 : 28]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[28]:
+        return None
+    return _new(ImuResponse, _S_F32_F32_F32_F32_F32_F32.unpack_from(buf, 4))
+
+
+def _whole_gamepad_response(buf: bytes) -> GamepadResponse | None:
+    """A whole gamepad response frame, all of buf, size and header known: None if its checksum fails."""
+    expected = 0xf5
+    for byte in buf[4 : 11]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[11]:
+        return None
+    v_buttons, v_hat, v_left_x, v_left_y, v_right_x, v_right_y = _S_U16_U8_I8_I8_I8_I8.unpack_from(buf, 4)
+    v_buttons_flags = _MEMBERS_GamepadButtons.get(v_buttons)
+    if v_buttons_flags is None:
+        v_buttons_flags = GamepadButtons(v_buttons)
+    return _new(GamepadResponse, (v_buttons_flags, v_hat, v_left_x, v_left_y, v_right_x, v_right_y))
+
+
+def _whole_sbus_response(buf: bytes) -> SbusResponse | None:
+    """A whole sbus response frame, all of buf, size and header known: None if its checksum fails."""
+    expected = 0xf0
+    for byte in buf[4 : 40]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[40]:
+        return None
+    t = _S_I16X16_U8_U8_U8_U8.unpack_from(buf, 4)
+    v_ch17 = t[16]
+    v_ch18 = t[17]
+    v_signal_loss = t[18]
+    v_fail_safe = t[19]
+    return _new(SbusResponse, (t[0:16], v_ch17, v_ch18, v_signal_loss, v_fail_safe))
+
+
+def _whole_motor_set_speed_request(buf: bytes) -> MotorSetSpeedRequest | None:
+    """A whole motor.set_speed request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
+    expected = 0x88
+    for byte in buf[4 : 10]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[10]:
+        return None
+    v_subcommand_code, v_motor_id, v_speed = _S_U8_U8_F32.unpack_from(buf, 4)
+    return _new(MotorSetSpeedRequest, (v_motor_id, v_speed))
+
+
+def _whole_motor_stop_request(buf: bytes) -> MotorStopRequest | None:
+    """A whole motor.stop request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
+    expected = 0xe9
+    for byte in buf[4 : 6]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[6]:
+        return None
+    v_subcommand_code, v_motor_id = _S_U8_U8.unpack_from(buf, 4)
+    return _new(MotorStopRequest, (v_motor_id,))
+
+
+def _whole_motor_stop_mask_request(buf: bytes) -> MotorStopMaskRequest | None:
+    """A whole motor.stop_mask request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
+    expected = 0xe9
+    for byte in buf[4 : 6]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[6]:
+        return None
+    v_subcommand_code, v_mask = _S_U8_U8.unpack_from(buf, 4)
+    v_mask_flags = _MEMBERS_MotorMask.get(v_mask)
+    if v_mask_flags is None:
+        v_mask_flags = MotorMask(v_mask)
+    return _new(MotorStopMaskRequest, (v_mask_flags,))
+
+
+def _whole_pwm_servo_set_position_request(buf: bytes) -> PwmServoSetPositionRequest | None:
+    """A whole pwm_servo.set_position request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
+    expected = 0xe6
+    for byte in buf[4 : 10]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[10]:
+        return None
+    v_subcommand_code, v_duration, v_servo_id, v_pulse = _S_U8_U16_U8_U16.unpack_from(buf, 4)
+    return _new(PwmServoSetPositionRequest, (v_duration, v_servo_id, v_pulse))
+
+
+def _whole_pwm_servo_read_position_request(buf: bytes) -> PwmServoReadPositionRequest | None:
+    """A whole pwm_servo.read_position request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
+    expected = 0x87
+    for byte in buf[4 : 6]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[6]:
+        return None
+    v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
+    return _new(PwmServoReadPositionRequest, (v_servo_id,))
+
+
+def _whole_pwm_servo_set_offset_request(buf: bytes) -> PwmServoSetOffsetRequest | None:
+    """A whole pwm_servo.set_offset request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
+    expected = 0xd9
+    for byte in buf[4 : 7]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[7]:
+        return None
+    v_subcommand_code, v_servo_id, v_offset = _S_U8_U8_I8.unpack_from(buf, 4)
+    return _new(PwmServoSetOffsetRequest, (v_servo_id, v_offset))
+
+
+def _whole_pwm_servo_read_offset_request(buf: bytes) -> PwmServoReadOffsetRequest | None:
+    """A whole pwm_servo.read_offset request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
+    expected = 0x87
+    for byte in buf[4 : 6]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[6]:
+        return None
+    v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
+    return _new(PwmServoReadOffsetRequest, (v_servo_id,))
+
+
+def _whole_bus_servo_read_position_request(buf: bytes) -> BusServoReadPositionRequest | None:
+    """A whole bus_servo.read_position request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
+    expected = 0x43
+    for byte in buf[4 : 6]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[6]:
+        return None
+    v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
+    return _new(BusServoReadPositionRequest, (v_servo_id,))
+
+
+def _whole_bus_servo_read_voltage_request(buf: bytes) -> BusServoReadVoltageRequest | None:
+    """A whole bus_servo.read_voltage request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
+    expected = 0x43
+    for byte in buf[4 : 6]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[6]:
+        return None
+    v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
+    return _new(BusServoReadVoltageRequest, (v_servo_id,))
+
+
+def _whole_bus_servo_read_temperature_request(buf: bytes) -> BusServoReadTemperatureRequest | None:
+    """A whole bus_servo.read_temperature request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
+    expected = 0x43
+    for byte in buf[4 : 6]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[6]:
+        return None
+    v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
+    return _new(BusServoReadTemperatureRequest, (v_servo_id,))
+
+
+def _whole_bus_servo_read_torque_request(buf: bytes) -> BusServoReadTorqueRequest | None:
+    """A whole bus_servo.read_torque request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
+    expected = 0x43
+    for byte in buf[4 : 6]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[6]:
+        return None
+    v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
+    return _new(BusServoReadTorqueRequest, (v_servo_id,))
+
+
+def _whole_bus_servo_unload_request(buf: bytes) -> BusServoUnloadRequest | None:
+    """A whole bus_servo.unload request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
+    expected = 0x43
+    for byte in buf[4 : 6]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[6]:
+        return None
+    v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
+    return _new(BusServoUnloadRequest, (v_servo_id,))
+
+
+def _whole_bus_servo_load_request(buf: bytes) -> BusServoLoadRequest | None:
+    """A whole bus_servo.load request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
+    expected = 0x43
+    for byte in buf[4 : 6]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[6]:
+        return None
+    v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
+    return _new(BusServoLoadRequest, (v_servo_id,))
+
+
+def _whole_bus_servo_set_id_request(buf: bytes) -> BusServoSetIdRequest | None:
+    """A whole bus_servo.set_id request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
+    expected = 0x1d
+    for byte in buf[4 : 7]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[7]:
+        return None
+    v_subcommand_code, v_servo_id, v_new_id = _S_U8_U8_U8.unpack_from(buf, 4)
+    return _new(BusServoSetIdRequest, (v_servo_id, v_new_id))
+
+
+def _whole_bus_servo_read_id_request(buf: bytes) -> BusServoReadIdRequest | None:
+    """A whole bus_servo.read_id request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
+    expected = 0x43
+    for byte in buf[4 : 6]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[6]:
+        return None
+    v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
+    return _new(BusServoReadIdRequest, (v_servo_id,))
+
+
+def _whole_bus_servo_set_offset_request(buf: bytes) -> BusServoSetOffsetRequest | None:
+    """A whole bus_servo.set_offset request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
+    expected = 0x1d
+    for byte in buf[4 : 7]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[7]:
+        return None
+    v_subcommand_code, v_servo_id, v_offset = _S_U8_U8_I8.unpack_from(buf, 4)
+    return _new(BusServoSetOffsetRequest, (v_servo_id, v_offset))
+
+
+def _whole_bus_servo_read_offset_request(buf: bytes) -> BusServoReadOffsetRequest | None:
+    """A whole bus_servo.read_offset request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
+    expected = 0x43
+    for byte in buf[4 : 6]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[6]:
+        return None
+    v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
+    return _new(BusServoReadOffsetRequest, (v_servo_id,))
+
+
+def _whole_bus_servo_save_offset_request(buf: bytes) -> BusServoSaveOffsetRequest | None:
+    """A whole bus_servo.save_offset request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
+    expected = 0x43
+    for byte in buf[4 : 6]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[6]:
+        return None
+    v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
+    return _new(BusServoSaveOffsetRequest, (v_servo_id,))
+
+
+def _whole_bus_servo_set_position_limit_request(buf: bytes) -> BusServoSetPositionLimitRequest | None:
+    """A whole bus_servo.set_position_limit request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
+    expected = 0x22
+    for byte in buf[4 : 10]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[10]:
+        return None
+    v_subcommand_code, v_servo_id, v_low, v_high = _S_U8_U8_U16_U16.unpack_from(buf, 4)
+    return _new(BusServoSetPositionLimitRequest, (v_servo_id, v_low, v_high))
+
+
+def _whole_bus_servo_read_position_limit_request(buf: bytes) -> BusServoReadPositionLimitRequest | None:
+    """A whole bus_servo.read_position_limit request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
+    expected = 0x43
+    for byte in buf[4 : 6]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[6]:
+        return None
+    v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
+    return _new(BusServoReadPositionLimitRequest, (v_servo_id,))
+
+
+def _whole_bus_servo_set_voltage_limit_request(buf: bytes) -> BusServoSetVoltageLimitRequest | None:
+    """A whole bus_servo.set_voltage_limit request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
+    expected = 0x22
+    for byte in buf[4 : 10]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[10]:
+        return None
+    v_subcommand_code, v_servo_id, v_low, v_high = _S_U8_U8_U16_U16.unpack_from(buf, 4)
+    return _new(BusServoSetVoltageLimitRequest, (v_servo_id, v_low, v_high))
+
+
+def _whole_bus_servo_read_voltage_limit_request(buf: bytes) -> BusServoReadVoltageLimitRequest | None:
+    """A whole bus_servo.read_voltage_limit request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
+    expected = 0x43
+    for byte in buf[4 : 6]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[6]:
+        return None
+    v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
+    return _new(BusServoReadVoltageLimitRequest, (v_servo_id,))
+
+
+def _whole_bus_servo_set_temperature_limit_request(buf: bytes) -> BusServoSetTemperatureLimitRequest | None:
+    """A whole bus_servo.set_temperature_limit request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
+    expected = 0x1d
+    for byte in buf[4 : 7]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[7]:
+        return None
+    v_subcommand_code, v_servo_id, v_limit = _S_U8_U8_U8.unpack_from(buf, 4)
+    return _new(BusServoSetTemperatureLimitRequest, (v_servo_id, v_limit))
+
+
+def _whole_bus_servo_read_temperature_limit_request(buf: bytes) -> BusServoReadTemperatureLimitRequest | None:
+    """A whole bus_servo.read_temperature_limit request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
+    expected = 0x43
+    for byte in buf[4 : 6]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[6]:
+        return None
+    v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
+    return _new(BusServoReadTemperatureLimitRequest, (v_servo_id,))
+
+
+def _whole_pwm_servo_read_position_response(buf: bytes) -> PwmServoReadPositionResponse | None:
+    """A whole pwm_servo.read_position response frame, all of buf, size, header and sub-command known: None if its checksum fails."""
+    expected = 0x5a
+    for byte in buf[4 : 8]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[8]:
+        return None
+    v_servo_id, v_subcommand_code, v_pulse = _S_U8_U8_U16.unpack_from(buf, 4)
+    return _new(PwmServoReadPositionResponse, (v_servo_id, v_pulse))
+
+
+def _whole_pwm_servo_read_offset_response(buf: bytes) -> PwmServoReadOffsetResponse | None:
+    """A whole pwm_servo.read_offset response frame, all of buf, size, header and sub-command known: None if its checksum fails."""
+    expected = 0xd9
+    for byte in buf[4 : 7]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[7]:
+        return None
+    v_servo_id, v_subcommand_code, v_offset = _S_U8_U8_I8.unpack_from(buf, 4)
+    return _new(PwmServoReadOffsetResponse, (v_servo_id, v_offset))
+
+
+def _whole_bus_servo_read_position_response(buf: bytes) -> BusServoReadPositionResponse | None:
+    """A whole bus_servo.read_position response frame, all of buf, size, header and sub-command known: None if its checksum fails."""
+    expected = 0xc0
+    for byte in buf[4 : 9]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[9]:
+        return None
+    v_servo_id, v_subcommand_code, v_success, v_position = _S_U8_U8_I8_I16.unpack_from(buf, 4)
+    return _new(BusServoReadPositionResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_position))
+
+
+def _whole_bus_servo_read_voltage_response(buf: bytes) -> BusServoReadVoltageResponse | None:
+    """A whole bus_servo.read_voltage response frame, all of buf, size, header and sub-command known: None if its checksum fails."""
+    expected = 0xc0
+    for byte in buf[4 : 9]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[9]:
+        return None
+    v_servo_id, v_subcommand_code, v_success, v_voltage = _S_U8_U8_I8_U16.unpack_from(buf, 4)
+    return _new(BusServoReadVoltageResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_voltage))
+
+
+def _whole_bus_servo_read_temperature_response(buf: bytes) -> BusServoReadTemperatureResponse | None:
+    """A whole bus_servo.read_temperature response frame, all of buf, size, header and sub-command known: None if its checksum fails."""
+    expected = 0x9e
+    for byte in buf[4 : 8]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[8]:
+        return None
+    v_servo_id, v_subcommand_code, v_success, v_temperature = _S_U8_U8_I8_U8.unpack_from(buf, 4)
+    return _new(BusServoReadTemperatureResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_temperature))
+
+
+def _whole_bus_servo_read_torque_response(buf: bytes) -> BusServoReadTorqueResponse | None:
+    """A whole bus_servo.read_torque response frame, all of buf, size, header and sub-command known: None if its checksum fails."""
+    expected = 0x9e
+    for byte in buf[4 : 8]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[8]:
+        return None
+    v_servo_id, v_subcommand_code, v_success, v_torque = _S_U8_U8_I8_I8.unpack_from(buf, 4)
+    return _new(BusServoReadTorqueResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_torque))
+
+
+def _whole_bus_servo_read_id_response(buf: bytes) -> BusServoReadIdResponse | None:
+    """A whole bus_servo.read_id response frame, all of buf, size, header and sub-command known: None if its checksum fails."""
+    expected = 0x9e
+    for byte in buf[4 : 8]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[8]:
+        return None
+    v_servo_id, v_subcommand_code, v_success, v_id = _S_U8_U8_I8_U8.unpack_from(buf, 4)
+    return _new(BusServoReadIdResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_id))
+
+
+def _whole_bus_servo_read_offset_response(buf: bytes) -> BusServoReadOffsetResponse | None:
+    """A whole bus_servo.read_offset response frame, all of buf, size, header and sub-command known: None if its checksum fails."""
+    expected = 0x9e
+    for byte in buf[4 : 8]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[8]:
+        return None
+    v_servo_id, v_subcommand_code, v_success, v_offset = _S_U8_U8_I8_I8.unpack_from(buf, 4)
+    return _new(BusServoReadOffsetResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_offset))
+
+
+def _whole_bus_servo_read_position_limit_response(buf: bytes) -> BusServoReadPositionLimitResponse | None:
+    """A whole bus_servo.read_position_limit response frame, all of buf, size, header and sub-command known: None if its checksum fails."""
+    expected = 0x7c
+    for byte in buf[4 : 11]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[11]:
+        return None
+    v_servo_id, v_subcommand_code, v_success, v_low, v_high = _S_U8_U8_I8_U16_U16.unpack_from(buf, 4)
+    return _new(BusServoReadPositionLimitResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_low, v_high))
+
+
+def _whole_bus_servo_read_voltage_limit_response(buf: bytes) -> BusServoReadVoltageLimitResponse | None:
+    """A whole bus_servo.read_voltage_limit response frame, all of buf, size, header and sub-command known: None if its checksum fails."""
+    expected = 0x7c
+    for byte in buf[4 : 11]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[11]:
+        return None
+    v_servo_id, v_subcommand_code, v_success, v_low, v_high = _S_U8_U8_I8_U16_U16.unpack_from(buf, 4)
+    return _new(BusServoReadVoltageLimitResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_low, v_high))
+
+
+def _whole_bus_servo_read_temperature_limit_response(buf: bytes) -> BusServoReadTemperatureLimitResponse | None:
+    """A whole bus_servo.read_temperature_limit response frame, all of buf, size, header and sub-command known: None if its checksum fails."""
+    expected = 0x9e
+    for byte in buf[4 : 8]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[8]:
+        return None
+    v_servo_id, v_subcommand_code, v_success, v_limit = _S_U8_U8_I8_U8.unpack_from(buf, 4)
+    return _new(BusServoReadTemperatureLimitResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_limit))
+
+
+def _whole_system_battery_response(buf: bytes) -> SystemBatteryResponse | None:
+    """A whole system.battery response frame, all of buf, size, header and sub-command known: None if its checksum fails."""
+    expected = 0xe2
+    for byte in buf[4 : 7]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[7]:
+        return None
+    v_subcommand_code, v_voltage = _S_U8_U16.unpack_from(buf, 4)
+    return _new(SystemBatteryResponse, (v_voltage,))
+
+
+def _whole_motor_request_11(buf: bytes) -> Message | None:
+    """A whole motor request frame of 11 bytes, by its sub-command: None if its checksum fails or no
+    sub-command of that size has its code (decode's general path then says why)."""
+    whole = _MOTOR_REQUEST_WHOLE_11.get(buf[4])
+    return None if whole is None else whole(buf)
+
+
+_MOTOR_REQUEST_WHOLE_11: dict[int, Callable[[bytes], Message | None]] = {
+    0x00: _whole_motor_set_speed_request,
+}
+
+
+def _whole_motor_request_7(buf: bytes) -> Message | None:
+    """A whole motor request frame of 7 bytes, by its sub-command: None if its checksum fails or no
+    sub-command of that size has its code (decode's general path then says why)."""
+    whole = _MOTOR_REQUEST_WHOLE_7.get(buf[4])
+    return None if whole is None else whole(buf)
+
+
+_MOTOR_REQUEST_WHOLE_7: dict[int, Callable[[bytes], Message | None]] = {
+    0x02: _whole_motor_stop_request,
+    0x03: _whole_motor_stop_mask_request,
+}
+
+
+def _whole_pwm_servo_request_11(buf: bytes) -> Message | None:
+    """A whole pwm_servo request frame of 11 bytes, by its sub-command: None if its checksum fails or no
+    sub-command of that size has its code (decode's general path then says why)."""
+    whole = _PWM_SERVO_REQUEST_WHOLE_11.get(buf[4])
+    return None if whole is None else whole(buf)
+
+
+_PWM_SERVO_REQUEST_WHOLE_11: dict[int, Callable[[bytes], Message | None]] = {
+    0x03: _whole_pwm_servo_set_position_request,
+}
+
+
+def _whole_pwm_servo_request_7(buf: bytes) -> Message | None:
+    """A whole pwm_servo request frame of 7 bytes, by its sub-command: None if its checksum fails or no
+    sub-command of that size has its code (decode's general path then says why)."""
+    whole = _PWM_SERVO_REQUEST_WHOLE_7.get(buf[4])
+    return None if whole is None else whole(buf)
+
+
+_PWM_SERVO_REQUEST_WHOLE_7: dict[int, Callable[[bytes], Message | None]] = {
+    0x05: _whole_pwm_servo_read_position_request,
+    0x09: _whole_pwm_servo_read_offset_request,
+}
+
+
+def _whole_pwm_servo_request_8(buf: bytes) -> Message | None:
+    """A whole pwm_servo request frame of 8 bytes, by its sub-command: None if its checksum fails or no
+    sub-command of that size has its code (decode's general path then says why)."""
+    whole = _PWM_SERVO_REQUEST_WHOLE_8.get(buf[4])
+    return None if whole is None else whole(buf)
+
+
+_PWM_SERVO_REQUEST_WHOLE_8: dict[int, Callable[[bytes], Message | None]] = {
+    0x07: _whole_pwm_servo_set_offset_request,
+}
+
+
+def _whole_bus_servo_request_7(buf: bytes) -> Message | None:
+    """A whole bus_servo request frame of 7 bytes, by its sub-command: None if its checksum fails or no
+    sub-command of that size has its code (decode's general path then says why)."""
+    whole = _BUS_SERVO_REQUEST_WHOLE_7.get(buf[4])
+    return None if whole is None else whole(buf)
+
+
+_BUS_SERVO_REQUEST_WHOLE_7: dict[int, Callable[[bytes], Message | None]] = {
+    0x05: _whole_bus_servo_read_position_request,
+    0x07: _whole_bus_servo_read_voltage_request,
+    0x09: _whole_bus_servo_read_temperature_request,
+    0x0d: _whole_bus_servo_read_torque_request,
+    0x0b: _whole_bus_servo_unload_request,
+    0x0c: _whole_bus_servo_load_request,
+    0x12: _whole_bus_servo_read_id_request,
+    0x22: _whole_bus_servo_read_offset_request,
+    0x24: _whole_bus_servo_save_offset_request,
+    0x32: _whole_bus_servo_read_position_limit_request,
+    0x36: _whole_bus_servo_read_voltage_limit_request,
+    0x3a: _whole_bus_servo_read_temperature_limit_request,
+}
+
+
+def _whole_bus_servo_request_8(buf: bytes) -> Message | None:
+    """A whole bus_servo request frame of 8 bytes, by its sub-command: None if its checksum fails or no
+    sub-command of that size has its code (decode's general path then says why)."""
+    whole = _BUS_SERVO_REQUEST_WHOLE_8.get(buf[4])
+    return None if whole is None else whole(buf)
+
+
+_BUS_SERVO_REQUEST_WHOLE_8: dict[int, Callable[[bytes], Message | None]] = {
+    0x10: _whole_bus_servo_set_id_request,
+    0x20: _whole_bus_servo_set_offset_request,
+    0x38: _whole_bus_servo_set_temperature_limit_request,
+}
+
+
+def _whole_bus_servo_request_11(buf: bytes) -> Message | None:
+    """A whole bus_servo request frame of 11 bytes, by its sub-command: None if its checksum fails or no
+    sub-command of that size has its code (decode's general path then says why)."""
+    whole = _BUS_SERVO_REQUEST_WHOLE_11.get(buf[4])
+    return None if whole is None else whole(buf)
+
+
+_BUS_SERVO_REQUEST_WHOLE_11: dict[int, Callable[[bytes], Message | None]] = {
+    0x30: _whole_bus_servo_set_position_limit_request,
+    0x34: _whole_bus_servo_set_voltage_limit_request,
+}
+
+
+def _whole_pwm_servo_response_9(buf: bytes) -> Message | None:
+    """A whole pwm_servo response frame of 9 bytes, by its sub-command: None if its checksum fails or no
+    sub-command of that size has its code (decode's general path then says why)."""
+    whole = _PWM_SERVO_RESPONSE_WHOLE_9.get(buf[5])
+    return None if whole is None else whole(buf)
+
+
+_PWM_SERVO_RESPONSE_WHOLE_9: dict[int, Callable[[bytes], Message | None]] = {
+    0x05: _whole_pwm_servo_read_position_response,
+}
+
+
+def _whole_pwm_servo_response_8(buf: bytes) -> Message | None:
+    """A whole pwm_servo response frame of 8 bytes, by its sub-command: None if its checksum fails or no
+    sub-command of that size has its code (decode's general path then says why)."""
+    whole = _PWM_SERVO_RESPONSE_WHOLE_8.get(buf[5])
+    return None if whole is None else whole(buf)
+
+
+_PWM_SERVO_RESPONSE_WHOLE_8: dict[int, Callable[[bytes], Message | None]] = {
+    0x09: _whole_pwm_servo_read_offset_response,
+}
+
+
+def _whole_bus_servo_response_10(buf: bytes) -> Message | None:
+    """A whole bus_servo response frame of 10 bytes, by its sub-command: None if its checksum fails or no
+    sub-command of that size has its code (decode's general path then says why)."""
+    whole = _BUS_SERVO_RESPONSE_WHOLE_10.get(buf[5])
+    return None if whole is None else whole(buf)
+
+
+_BUS_SERVO_RESPONSE_WHOLE_10: dict[int, Callable[[bytes], Message | None]] = {
+    0x05: _whole_bus_servo_read_position_response,
+    0x07: _whole_bus_servo_read_voltage_response,
+}
+
+
+def _whole_bus_servo_response_9(buf: bytes) -> Message | None:
+    """A whole bus_servo response frame of 9 bytes, by its sub-command: None if its checksum fails or no
+    sub-command of that size has its code (decode's general path then says why)."""
+    whole = _BUS_SERVO_RESPONSE_WHOLE_9.get(buf[5])
+    return None if whole is None else whole(buf)
+
+
+_BUS_SERVO_RESPONSE_WHOLE_9: dict[int, Callable[[bytes], Message | None]] = {
+    0x09: _whole_bus_servo_read_temperature_response,
+    0x0d: _whole_bus_servo_read_torque_response,
+    0x12: _whole_bus_servo_read_id_response,
+    0x22: _whole_bus_servo_read_offset_response,
+    0x3a: _whole_bus_servo_read_temperature_limit_response,
+}
+
+
+def _whole_bus_servo_response_12(buf: bytes) -> Message | None:
+    """A whole bus_servo response frame of 12 bytes, by its sub-command: None if its checksum fails or no
+    sub-command of that size has its code (decode's general path then says why)."""
+    whole = _BUS_SERVO_RESPONSE_WHOLE_12.get(buf[5])
+    return None if whole is None else whole(buf)
+
+
+_BUS_SERVO_RESPONSE_WHOLE_12: dict[int, Callable[[bytes], Message | None]] = {
+    0x32: _whole_bus_servo_read_position_limit_response,
+    0x36: _whole_bus_servo_read_voltage_limit_response,
+}
+
+
+def _whole_system_response_8(buf: bytes) -> Message | None:
+    """A whole system response frame of 8 bytes, by its sub-command: None if its checksum fails or no
+    sub-command of that size has its code (decode's general path then says why)."""
+    whole = _SYSTEM_RESPONSE_WHOLE_8.get(buf[4])
+    return None if whole is None else whole(buf)
+
+
+_SYSTEM_RESPONSE_WHOLE_8: dict[int, Callable[[bytes], Message | None]] = {
+    0x04: _whole_system_battery_response,
+}
+
+
 def _encode_led_request(m: LedRequest) -> bytes:
     m_led_id = m.led_id
     m_on_time = m.on_time
@@ -756,7 +1391,7 @@ def _encode_motor_set_speed_request(m: MotorSetSpeedRequest) -> bytes:
     m_speed = m.speed
     if not 0 <= m_motor_id <= 255 or m_motor_id.__class__ is bool:
         raise out_of_range('motor.set_speed request', 'motor_id', m_motor_id, 0, 255)
-    if not -340282346638528859811704183484516925440 <= m_speed <= 340282346638528859811704183484516925440:
+    if not -3.4028234663852886e+38 <= m_speed <= 3.4028234663852886e+38:
         raise out_of_range('motor.set_speed request', 'speed', m_speed, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
     body = _S_B2_U8_U8_U8_U8_F32.pack(b'\xaaU', 3, 6, 0, m_motor_id, m_speed)
     check = 0x0
@@ -771,11 +1406,13 @@ def _encode_motor_set_speeds_request(m: MotorSetSpeedsRequest) -> bytes:
         raise out_of_range('motor.set_speeds request', 'count', len(m_motors), 0, 255)
     parts_motors = []
     for item in m_motors:
-        if not 0 <= item.motor_id <= 255 or item.motor_id.__class__ is bool:
-            raise out_of_range('motor.set_speeds request', 'motor_id', item.motor_id, 0, 255)
-        if not -340282346638528859811704183484516925440 <= item.speed <= 340282346638528859811704183484516925440:
-            raise out_of_range('motor.set_speeds request', 'speed', item.speed, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
-        parts_motors.append(_S_U8_F32.pack(item.motor_id, item.speed))
+        item_motor_id = item.motor_id
+        item_speed = item.speed
+        if not 0 <= item_motor_id <= 255 or item_motor_id.__class__ is bool:
+            raise out_of_range('motor.set_speeds request', 'motor_id', item_motor_id, 0, 255)
+        if not -3.4028234663852886e+38 <= item_speed <= 3.4028234663852886e+38:
+            raise out_of_range('motor.set_speeds request', 'speed', item_speed, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
+        parts_motors.append(_S_U8_F32.pack(item_motor_id, item_speed))
     content = b''.join(parts_motors)
     n = len(content) + 2
     if n > 255:
@@ -804,11 +1441,13 @@ def _encode_motor_set_duties_request(m: MotorSetDutiesRequest) -> bytes:
         raise out_of_range('motor.set_duties request', 'count', len(m_duties), 0, 255)
     parts_duties = []
     for item in m_duties:
-        if not 0 <= item.motor_id <= 255 or item.motor_id.__class__ is bool:
-            raise out_of_range('motor.set_duties request', 'motor_id', item.motor_id, 0, 255)
-        if not -340282346638528859811704183484516925440 <= item.duty <= 340282346638528859811704183484516925440:
-            raise out_of_range('motor.set_duties request', 'duty', item.duty, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
-        parts_duties.append(_S_U8_F32.pack(item.motor_id, item.duty))
+        item_motor_id = item.motor_id
+        item_duty = item.duty
+        if not 0 <= item_motor_id <= 255 or item_motor_id.__class__ is bool:
+            raise out_of_range('motor.set_duties request', 'motor_id', item_motor_id, 0, 255)
+        if not -3.4028234663852886e+38 <= item_duty <= 3.4028234663852886e+38:
+            raise out_of_range('motor.set_duties request', 'duty', item_duty, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
+        parts_duties.append(_S_U8_F32.pack(item_motor_id, item_duty))
     content = b''.join(parts_duties)
     n = len(content) + 2
     if n > 255:
@@ -840,11 +1479,13 @@ def _encode_pwm_servo_set_positions_request(m: PwmServoSetPositionsRequest) -> b
         raise out_of_range('pwm_servo.set_positions request', 'count', len(m_pwm_servos), 0, 255)
     parts_pwm_servos = []
     for item in m_pwm_servos:
-        if not 0 <= item.servo_id <= 255 or item.servo_id.__class__ is bool:
-            raise out_of_range('pwm_servo.set_positions request', 'servo_id', item.servo_id, 0, 255)
-        if not 500 <= item.pulse <= 2500 or item.pulse.__class__ is bool:
-            raise out_of_range('pwm_servo.set_positions request', 'pulse', item.pulse, 500, 2500)
-        parts_pwm_servos.append(_S_U8_U16.pack(item.servo_id, item.pulse))
+        item_servo_id = item.servo_id
+        item_pulse = item.pulse
+        if not 0 <= item_servo_id <= 255 or item_servo_id.__class__ is bool:
+            raise out_of_range('pwm_servo.set_positions request', 'servo_id', item_servo_id, 0, 255)
+        if not 500 <= item_pulse <= 2500 or item_pulse.__class__ is bool:
+            raise out_of_range('pwm_servo.set_positions request', 'pulse', item_pulse, 500, 2500)
+        parts_pwm_servos.append(_S_U8_U16.pack(item_servo_id, item_pulse))
     content = b''.join(parts_pwm_servos)
     n = len(content) + 4
     if n > 255:
@@ -946,11 +1587,13 @@ def _encode_bus_servo_set_positions_request(m: BusServoSetPositionsRequest) -> b
         raise out_of_range('bus_servo.set_positions request', 'count', len(m_bus_servos), 0, 255)
     parts_bus_servos = []
     for item in m_bus_servos:
-        if not 0 <= item.servo_id <= 255 or item.servo_id.__class__ is bool:
-            raise out_of_range('bus_servo.set_positions request', 'servo_id', item.servo_id, 0, 255)
-        if not 0 <= item.position <= 1000 or item.position.__class__ is bool:
-            raise out_of_range('bus_servo.set_positions request', 'position', item.position, 0, 1000)
-        parts_bus_servos.append(_S_U8_U16.pack(item.servo_id, item.position))
+        item_servo_id = item.servo_id
+        item_position = item.position
+        if not 0 <= item_servo_id <= 255 or item_servo_id.__class__ is bool:
+            raise out_of_range('bus_servo.set_positions request', 'servo_id', item_servo_id, 0, 255)
+        if not 0 <= item_position <= 1000 or item_position.__class__ is bool:
+            raise out_of_range('bus_servo.set_positions request', 'position', item_position, 0, 1000)
+        parts_bus_servos.append(_S_U8_U16.pack(item_servo_id, item_position))
     content = b''.join(parts_bus_servos)
     n = len(content) + 4
     if n > 255:
@@ -1052,9 +1695,10 @@ def _encode_bus_servo_stop_request(m: BusServoStopRequest) -> bytes:
         raise out_of_range('bus_servo.stop request', 'count', len(m_servos), 0, 255)
     parts_servos = []
     for item in m_servos:
-        if not 0 <= item.servo_id <= 255 or item.servo_id.__class__ is bool:
-            raise out_of_range('bus_servo.stop request', 'servo_id', item.servo_id, 0, 255)
-        parts_servos.append(_S_U8.pack(item.servo_id))
+        item_servo_id = item.servo_id
+        if not 0 <= item_servo_id <= 255 or item_servo_id.__class__ is bool:
+            raise out_of_range('bus_servo.stop request', 'servo_id', item_servo_id, 0, 255)
+        parts_servos.append(_S_U8.pack(item_servo_id))
     content = b''.join(parts_servos)
     n = len(content) + 2
     if n > 255:
@@ -1370,17 +2014,17 @@ def _encode_imu_response(m: ImuResponse) -> bytes:
     m_gyro_x = m.gyro_x
     m_gyro_y = m.gyro_y
     m_gyro_z = m.gyro_z
-    if not -340282346638528859811704183484516925440 <= m_accel_x <= 340282346638528859811704183484516925440:
+    if not -3.4028234663852886e+38 <= m_accel_x <= 3.4028234663852886e+38:
         raise out_of_range('imu response', 'accel_x', m_accel_x, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
-    if not -340282346638528859811704183484516925440 <= m_accel_y <= 340282346638528859811704183484516925440:
+    if not -3.4028234663852886e+38 <= m_accel_y <= 3.4028234663852886e+38:
         raise out_of_range('imu response', 'accel_y', m_accel_y, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
-    if not -340282346638528859811704183484516925440 <= m_accel_z <= 340282346638528859811704183484516925440:
+    if not -3.4028234663852886e+38 <= m_accel_z <= 3.4028234663852886e+38:
         raise out_of_range('imu response', 'accel_z', m_accel_z, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
-    if not -340282346638528859811704183484516925440 <= m_gyro_x <= 340282346638528859811704183484516925440:
+    if not -3.4028234663852886e+38 <= m_gyro_x <= 3.4028234663852886e+38:
         raise out_of_range('imu response', 'gyro_x', m_gyro_x, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
-    if not -340282346638528859811704183484516925440 <= m_gyro_y <= 340282346638528859811704183484516925440:
+    if not -3.4028234663852886e+38 <= m_gyro_y <= 3.4028234663852886e+38:
         raise out_of_range('imu response', 'gyro_y', m_gyro_y, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
-    if not -340282346638528859811704183484516925440 <= m_gyro_z <= 340282346638528859811704183484516925440:
+    if not -3.4028234663852886e+38 <= m_gyro_z <= 3.4028234663852886e+38:
         raise out_of_range('imu response', 'gyro_z', m_gyro_z, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
     body = _S_FRAME_IMURESPONSE.pack(b'\xaaU', 7, 24, m_accel_x, m_accel_y, m_accel_z, m_gyro_x, m_gyro_y, m_gyro_z)
     check = 0x0
@@ -1458,7 +2102,8 @@ def _encode_oled_request(m: OledRequest) -> bytes:
         raise out_of_range('oled request', 'line', m_line, 0, 255)
     if len(m_text) > 255:
         raise out_of_range('oled request', 'length', len(m_text), 0, 255)
-    content = bytes(m_text)
+    v_text = m_text if m_text.__class__ is bytes else bytes(m_text)
+    content = v_text
     n = len(content) + 2
     if n > 255:
         raise EncodeError(f'content of {n} bytes does not fit the length field')
@@ -1475,15 +2120,19 @@ def _encode_rgb_set_pixels_request(m: RgbSetPixelsRequest) -> bytes:
         raise out_of_range('rgb.set_pixels request', 'count', len(m_pixels), 0, 255)
     parts_pixels = []
     for item in m_pixels:
-        if not 0 <= item.index <= 255 or item.index.__class__ is bool:
-            raise out_of_range('rgb.set_pixels request', 'index', item.index, 0, 255)
-        if not 0 <= item.red <= 255 or item.red.__class__ is bool:
-            raise out_of_range('rgb.set_pixels request', 'red', item.red, 0, 255)
-        if not 0 <= item.green <= 255 or item.green.__class__ is bool:
-            raise out_of_range('rgb.set_pixels request', 'green', item.green, 0, 255)
-        if not 0 <= item.blue <= 255 or item.blue.__class__ is bool:
-            raise out_of_range('rgb.set_pixels request', 'blue', item.blue, 0, 255)
-        parts_pixels.append(_S_U8_U8_U8_U8.pack(item.index, item.red, item.green, item.blue))
+        item_index = item.index
+        item_red = item.red
+        item_green = item.green
+        item_blue = item.blue
+        if not 0 <= item_index <= 255 or item_index.__class__ is bool:
+            raise out_of_range('rgb.set_pixels request', 'index', item_index, 0, 255)
+        if not 0 <= item_red <= 255 or item_red.__class__ is bool:
+            raise out_of_range('rgb.set_pixels request', 'red', item_red, 0, 255)
+        if not 0 <= item_green <= 255 or item_green.__class__ is bool:
+            raise out_of_range('rgb.set_pixels request', 'green', item_green, 0, 255)
+        if not 0 <= item_blue <= 255 or item_blue.__class__ is bool:
+            raise out_of_range('rgb.set_pixels request', 'blue', item_blue, 0, 255)
+        parts_pixels.append(_S_U8_U8_U8_U8.pack(item_index, item_red, item_green, item_blue))
     content = b''.join(parts_pixels)
     n = len(content) + 2
     if n > 255:
@@ -1653,10 +2302,18 @@ _REQUEST_FIXED: dict[int, tuple[int, Callable[[bytes, int], Message | None]]] = 
 }
 
 
-# The same frames for decode(), by their first bytes (header, command code, length byte).
-_REQUEST_WHOLE: dict[bytes, tuple[int, Callable[[bytes, int], Message | None]]] = {
-    b'\xaaU\x01\x07': (12, _frame_led_request),
-    b'\xaaU\x02\x08': (13, _frame_buzzer_request),
+# The same frames for decode(), by their first bytes (header, command code, length byte): frame size, decoder.
+_REQUEST_WHOLE: dict[bytes, tuple[int, Callable[[bytes], Message | None]]] = {
+    b'\xaaU\x01\x07': (12, _whole_led_request),
+    b'\xaaU\x02\x08': (13, _whole_buzzer_request),
+    b'\xaaU\x03\x06': (11, _whole_motor_request_11),
+    b'\xaaU\x03\x02': (7, _whole_motor_request_7),
+    b'\xaaU\x04\x06': (11, _whole_pwm_servo_request_11),
+    b'\xaaU\x04\x02': (7, _whole_pwm_servo_request_7),
+    b'\xaaU\x04\x03': (8, _whole_pwm_servo_request_8),
+    b'\xaaU\x05\x02': (7, _whole_bus_servo_request_7),
+    b'\xaaU\x05\x03': (8, _whole_bus_servo_request_8),
+    b'\xaaU\x05\x06': (11, _whole_bus_servo_request_11),
 }
 
 
@@ -1700,12 +2357,18 @@ _RESPONSE_FIXED: dict[int, tuple[int, Callable[[bytes, int], Message | None]]] =
 }
 
 
-# The same frames for decode(), by their first bytes (header, command code, length byte).
-_RESPONSE_WHOLE: dict[bytes, tuple[int, Callable[[bytes, int], Message | None]]] = {
-    b'\xaaU\x06\x02': (7, _frame_key_response),
-    b'\xaaU\x07\x18': (29, _frame_imu_response),
-    b'\xaaU\x08\x07': (12, _frame_gamepad_response),
-    b'\xaaU\t$': (41, _frame_sbus_response),
+# The same frames for decode(), by their first bytes (header, command code, length byte): frame size, decoder.
+_RESPONSE_WHOLE: dict[bytes, tuple[int, Callable[[bytes], Message | None]]] = {
+    b'\xaaU\x06\x02': (7, _whole_key_response),
+    b'\xaaU\x07\x18': (29, _whole_imu_response),
+    b'\xaaU\x08\x07': (12, _whole_gamepad_response),
+    b'\xaaU\t$': (41, _whole_sbus_response),
+    b'\xaaU\x04\x04': (9, _whole_pwm_servo_response_9),
+    b'\xaaU\x04\x03': (8, _whole_pwm_servo_response_8),
+    b'\xaaU\x05\x05': (10, _whole_bus_servo_response_10),
+    b'\xaaU\x05\x04': (9, _whole_bus_servo_response_9),
+    b'\xaaU\x05\x07': (12, _whole_bus_servo_response_12),
+    b'\xaaU\x00\x03': (8, _whole_system_response_8),
 }
 
 
@@ -1802,17 +2465,15 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
     Each direction's checks are inline here rather than in a function per direction: one call less per frame.
     `expect` (the reply class a frame answers) matters only where replies share a code; here none do.
     """
-    if direction is None:
-        raise DecodeError("give the direction: requests and responses share the header aa 55")
     if direction == 'request':  # a Direction or its value
+        fixed = _REQUEST_WHOLE.get(data[:4])  # no key is shorter: a short frame matches none
+        if fixed is not None and fixed[0] == len(data):
+            message = fixed[1](data)
+            if message is not None:
+                return message
         n = len(data)
         if n < 5:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (5 bytes)")
-        fixed = _REQUEST_WHOLE.get(data[:4])
-        if fixed is not None and fixed[0] == n:
-            message = fixed[1](data, 0)
-            if message is not None:
-                return message
         if data[:2] != b'\xaaU':
             raise DecodeError(f"request header is {data[:2].hex(' ')}, expected aa 55")
         size = data[3]
@@ -1828,14 +2489,14 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
             raise DecodeError(f"unknown command {data[2]:#04x}")
         return decoder(data, 4, n - 1)
     if direction == 'response':  # a Direction or its value
+        fixed = _RESPONSE_WHOLE.get(data[:4])  # no key is shorter: a short frame matches none
+        if fixed is not None and fixed[0] == len(data):
+            message = fixed[1](data)
+            if message is not None:
+                return message
         n = len(data)
         if n < 5:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (5 bytes)")
-        fixed = _RESPONSE_WHOLE.get(data[:4])
-        if fixed is not None and fixed[0] == n:
-            message = fixed[1](data, 0)
-            if message is not None:
-                return message
         if data[:2] != b'\xaaU':
             raise DecodeError(f"response header is {data[:2].hex(' ')}, expected aa 55")
         size = data[3]
@@ -1850,6 +2511,8 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         if decoder is None:
             raise DecodeError(f"unknown command {data[2]:#04x}")
         return decoder(data, 4, n - 1)
+    if direction is None:  # last: a caller that knows the direction does not pay for this
+        raise DecodeError("give the direction: requests and responses share the header aa 55")
     raise ValueError(f"direction must be request or response, not {direction!r}")
 
 

@@ -65,7 +65,7 @@ def _decode_read_coils_request(buf: bytes, o: int, end: int, unit: int) -> ReadC
 def _decode_read_coils_response(buf: bytes, o: int, end: int, unit: int) -> ReadCoilsResponse:
     if not 1 <= end - o <= 256:
         raise content_size_error('read_coils response', end - o, 1, 256)
-    v_byte_count, = _S_BE_U8.unpack_from(buf, o)
+    v_byte_count = buf[o]
     o += 1
     nb = v_byte_count
     n = nb * 8
@@ -90,7 +90,7 @@ def _decode_read_discrete_inputs_request(buf: bytes, o: int, end: int, unit: int
 def _decode_read_discrete_inputs_response(buf: bytes, o: int, end: int, unit: int) -> ReadDiscreteInputsResponse:
     if not 1 <= end - o <= 256:
         raise content_size_error('read_discrete_inputs response', end - o, 1, 256)
-    v_byte_count, = _S_BE_U8.unpack_from(buf, o)
+    v_byte_count = buf[o]
     o += 1
     nb = v_byte_count
     n = nb * 8
@@ -115,7 +115,7 @@ def _decode_read_holding_registers_request(buf: bytes, o: int, end: int, unit: i
 def _decode_read_holding_registers_response(buf: bytes, o: int, end: int, unit: int) -> ReadHoldingRegistersResponse:
     if not 1 <= end - o <= 256:
         raise content_size_error('read_holding_registers response', end - o, 1, 256)
-    v_byte_count, = _S_BE_U8.unpack_from(buf, o)
+    v_byte_count = buf[o]
     o += 1
     nb = v_byte_count
     if nb % 2:
@@ -142,7 +142,7 @@ def _decode_read_input_registers_request(buf: bytes, o: int, end: int, unit: int
 def _decode_read_input_registers_response(buf: bytes, o: int, end: int, unit: int) -> ReadInputRegistersResponse:
     if not 1 <= end - o <= 256:
         raise content_size_error('read_input_registers response', end - o, 1, 256)
-    v_byte_count, = _S_BE_U8.unpack_from(buf, o)
+    v_byte_count = buf[o]
     o += 1
     nb = v_byte_count
     if nb % 2:
@@ -272,7 +272,7 @@ def _decode_read_write_registers_request(buf: bytes, o: int, end: int, unit: int
 def _decode_read_write_registers_response(buf: bytes, o: int, end: int, unit: int) -> ReadWriteRegistersResponse:
     if not 1 <= end - o <= 256:
         raise content_size_error('read_write_registers response', end - o, 1, 256)
-    v_byte_count, = _S_BE_U8.unpack_from(buf, o)
+    v_byte_count = buf[o]
     o += 1
     nb = v_byte_count
     if nb % 2:
@@ -292,7 +292,7 @@ def _decode_read_write_registers_response(buf: bytes, o: int, end: int, unit: in
 def _decode_exception_response(buf: bytes, o: int, end: int, unit: int, function: int) -> ExceptionResponse:
     if end - o != 1:
         raise content_size_error('exception response', end - o, 1, 1)
-    v_exception_code, = _S_BE_U8.unpack_from(buf, o)
+    v_exception_code = buf[o]
     return _new(ExceptionResponse, (unit, function, _MEMBERS_ExceptionCode.get(v_exception_code, v_exception_code)))
 
 

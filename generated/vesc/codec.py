@@ -156,7 +156,7 @@ def _decode_alive_request(buf: bytes, o: int, end: int) -> AliveRequest:
 def _decode_forward_can_request(buf: bytes, o: int, end: int) -> ForwardCanRequest:
     if end - o < 1:
         raise content_size_error('forward_can request', end - o, 1, None)
-    v_can_id, = _S_BE_U8.unpack_from(buf, o)
+    v_can_id = buf[o]
     o += 1
     v_payload = buf[o:end]
     return _new(ForwardCanRequest, (v_can_id, v_payload))
@@ -345,9 +345,11 @@ def _encode_alive_request(m: AliveRequest) -> bytes:
 
 def _encode_forward_can_request(m: ForwardCanRequest) -> bytes:
     m_can_id = m.can_id
+    m_payload = m.payload
     if not 0 <= m_can_id <= 255 or m_can_id.__class__ is bool:
         raise out_of_range('forward_can request', 'can_id', m_can_id, 0, 255)
-    return _REQUEST_FRAMES.wrap(b''.join((_S_BE_U8.pack(m_can_id), bytes(m.payload),)), 0x22, ())
+    v_payload = m_payload if m_payload.__class__ is bytes else bytes(m_payload)
+    return _REQUEST_FRAMES.wrap(b''.join((_S_BE_U8.pack(m_can_id), v_payload,)), 0x22, ())
 
 
 _REQUEST_DECODERS: dict[int | None, Callable[..., Message]] = {

@@ -24,6 +24,7 @@ from serialspec.emit.python.registers import register_tables, registers_module
 from serialspec.emit.python.render import render
 from serialspec.emit.python.simulator import import_order, simulator_module
 from serialspec.emit.python.structs import structs_module
+from serialspec.runtime.checksums import crc_table
 from serialspec.spec.model import (
     Command,
     Direction,
@@ -270,6 +271,8 @@ def classic_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
     directions = []
     dispatchers = []
     frame_functions: list[dict[str, Any]] = []
+    whole_functions: list[dict[str, Any]] = []
+    whole_pickers: list[dict[str, Any]] = []
     decoder_bodies = {name: (returns, extra, lines) for name, returns, extra, lines in code.decoders}
     for direction, layout in protocol.framing.layouts.items():
         dispatch = []
@@ -285,11 +288,24 @@ def classic_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
             if sub_dispatch:
                 dispatchers.append(sub_dispatch | value_arguments(layout))
         fixed = fixed_frames(protocol, layout, decoder_bodies, code)
-        frame_functions += [f | {"lines": fuse_unpack(f["lines"])} for _, _, f in fixed]
+        sub_functions, pickers, sub_entries = subcommand_frames(protocol, layout, decoder_bodies, code)
+        whole = whole_frames(layout, [*fixed, *sub_entries])
+        if whole:  # decode() looks frames up by their first bytes
+            whole_functions += [f | {"whole_lines": fuse_unpack(f["whole_lines"], code.structs)} for f in sub_functions]
+            whole_pickers += pickers
+        frame_functions += [
+            f
+            | {
+                "lines": fuse_unpack(f["lines"], code.structs),
+                "whole_lines": fuse_unpack(f["whole_lines"], code.structs),
+            }
+            for _, _, f in fixed
+        ]
         directions.append(
             {
                 "fixed": [(key, size, function["name"]) for key, size, function in fixed],
-                "whole_frames": whole_frames(layout, fixed),
+                "fixed_whole": [(key, size, function["whole_name"]) for key, size, function in fixed],
+                "whole_frames": whole,
                 "whole_size": max(layout.length_offset, layout.command_offset or 0) + 1,
                 "key": frame_key(layout, "data"),
                 "name": direction.value,
@@ -317,6 +333,8 @@ def classic_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
         "checksum_definition": checksum_definition,
         "directions": directions,
         "frame_functions": frame_functions,
+        "whole_functions": whole_functions,
+        "whole_pickers": whole_pickers,
         "dispatchers": dispatchers,
         "header_choices": header_choices,
     }
@@ -336,7 +354,8 @@ def common_codec_context(protocol: Protocol, code: PackageCode, exports: list[st
         ],
         "member_maps": sorted(code.member_maps),
         "decoders": [
-            {"name": n, "returns": r, "extra": e, "lines": fuse_unpack(lines)} for n, r, e, lines in code.decoders
+            {"name": n, "returns": r, "extra": e, "lines": fuse_unpack(lines, code.structs)}
+            for n, r, e, lines in code.decoders
         ],
         "encoders": [{"name": n, "type": t, "lines": lines} for n, t, lines in code.encoders],
         "encoder_table": encoder_table,
@@ -373,7 +392,7 @@ def whole_frames(layout: FrameLayout, fixed: list[tuple[str, int, dict[str, Any]
         bytes_at = {layout.length_offset: value & 0xFF}
         if layout.command_offset is not None:
             bytes_at[layout.command_offset] = value >> 8
-        entries.append((repr(layout.header + bytes(bytes_at[o] for o in offsets)), size, function["name"]))
+        entries.append((repr(layout.header + bytes(bytes_at[o] for o in offsets)), size, function["whole_name"]))
     return entries
 
 
@@ -385,51 +404,158 @@ def fixed_frames(
     dispatch, no size checks (the key is the command code and length byte, so the size is known), one call per
     frame. It returns None for a frame whose checksum fails, so callers word the error (decode) or count it (the
     stream parser); it raises nothing. Frames of any other kind keep the general path."""
-    checksum = protocol.framing.checksum
-    if checksum is None:
-        return []  # classic frames have one
-    content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
     found = []
     for command in protocol.commands:
         message = command.request if layout.direction == Direction.REQUEST else command.response
-        if command.selector is not None or message is None or message.min_size != message.max_size:
+        if command.selector is not None or message is None:
             continue
-        returns, extra, lines = bodies[decoder_name(message)]
-        if not lines[0].startswith("if end - o != "):
-            continue
-        body = lines[2:]  # the content size check: the key implies the size
-        text = "\n".join(body)
-        if text.count("(buf, o)") > 1 or _CURSOR.search(text.replace("(buf, o)", "")) or "raise " in text:
-            continue  # content read at a moving cursor, or checked beyond its size: the general path
-        size = layout.overhead + (message.min_size or 0)
-        values = [f"{e.name} = buf[start + {layout.offsets[e.name]}]" for e in layout.value_elements]
-        length_byte = (message.min_size or 0) + layout.length_adds
-        summed = summed_frame(protocol, layout, command.code, length_byte, size, body, code)
-        if summed is not None:
-            lines = [*values, *summed, *body[1:]]
-        else:
-            stored = (
-                f"buf[start + {size - 1}]"
-                if layout.checksum_offset_from_end == 1
-                else f"int.from_bytes(buf[start + {size - layout.checksum_offset_from_end} : start + {size}], 'little')"
-            )
-            covered = f"buf[start + {layout.covered_from} : start + {size - layout.covered_to_end}]"
-            lines = [
-                *checksum_lines(checksum, covered, "expected"),
-                f"if expected != {stored}:",
-                "    return None",
-                *values,
-                *(line.replace("(buf, o)", f"(buf, start + {content_offset})") for line in body),
-            ]
-        function = {
-            "name": "_frame" + decoder_name(message).removeprefix("_decode"),
-            "returns": returns,
-            "where": f"{message.key} {message.direction.value}",
-            "lines": lines,
-        }
-        key = length_byte if layout.command_offset is None else (command.code or 0) << 8 | length_byte
-        found.append((f"{key:#06x}", size, function))
+        made = frame_function(protocol, layout, command, message, bodies, code)
+        if made is not None:
+            key, size, function = made
+            found.append((f"{key:#06x}", size, function))
     return found
+
+
+def subcommand_frames(
+    protocol: Protocol, layout: FrameLayout, bodies: dict[str, tuple[str, str, Lines]], code: PackageCode
+) -> tuple[list[dict[str, Any]], list[dict[str, Any]], list[tuple[str, int, dict[str, Any]]]]:
+    """decode()'s whole-frame decoders of sub-command frames of one size (as fixed_frames, the sub-command's check
+    dropped: its code picks the decoder) and, per command and frame size, the function that picks one by the
+    sub-command byte: (decoders, pickers, decode's table entries of the pickers, as fixed_frames gives them)."""
+    content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
+    functions: list[dict[str, Any]] = []
+    pickers: list[dict[str, Any]] = []
+    entries = []
+    for command in protocol.commands:
+        if command.selector is None or layout.direction not in command.selector.offsets:
+            continue
+        by_size: dict[tuple[int, int], list[tuple[int, dict[str, Any]]]] = {}
+        for sub in command.subcommands:
+            message = sub.request if layout.direction == Direction.REQUEST else sub.response
+            if message is None:
+                continue
+            made = frame_function(protocol, layout, command, message, bodies, code, command.selector.name)
+            if made is not None:
+                key, size, function = made
+                functions.append(function)
+                by_size.setdefault((key, size), []).append((sub.code, function))
+        for (key, size), subs in by_size.items():
+            where = f"{command.name} {layout.direction.value}"
+            picker = {
+                "whole_name": f"_whole_{command.name}_{layout.direction.value}_{size}",
+                "table": f"_{command.name.upper()}_{layout.direction.name}_WHOLE_{size}",
+                "at": content_offset + command.selector.offsets[layout.direction],
+                "size": size,
+                "where": where,
+                "entries": [(f"{c:#04x}", f["whole_name"]) for c, f in subs],
+            }
+            pickers.append(picker)
+            entries.append((f"{key:#06x}", size, picker))
+    return functions, pickers, entries
+
+
+def frame_function(
+    protocol: Protocol,
+    layout: FrameLayout,
+    command: Command,
+    message: Message,
+    bodies: dict[str, tuple[str, str, Lines]],
+    code: PackageCode,
+    selector: str | None = None,
+) -> tuple[int, int, dict[str, Any]] | None:
+    """The whole-frame decoders of one message (see fixed_frames): size key, frame size, function; None where the
+    message's frames need the general path. `selector`: the sub-command field, whose check the key makes."""
+    checksum = protocol.framing.checksum
+    if checksum is None or message.min_size != message.max_size:
+        return None  # classic frames have a checksum
+    content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
+    returns, extra, lines = bodies[decoder_name(message)]
+    if not lines[0].startswith("if end - o != "):
+        return None
+    body = lines[2:]  # the content size check: the key implies the size
+    if selector is not None:  # the sub-command's check: the picker chose this decoder by it
+        at = next((i for i, line in enumerate(body) if line.startswith(f"if v_{selector} != ")), None)
+        if at is None:
+            return None
+        body = body[:at] + body[at + 2 :]
+    text = "\n".join(body)
+    if text.count("(buf, o)") > 1 or _CURSOR.search(text.replace("(buf, o)", "")) or "raise " in text:
+        return None  # content read at a moving cursor, or checked beyond its size: the general path
+    size = layout.overhead + (message.min_size or 0)
+    values = [f"{e.name} = buf[start + {layout.offsets[e.name]}]" for e in layout.value_elements]
+    length_byte = (message.min_size or 0) + layout.length_adds
+    summed = summed_frame(protocol, layout, command.code, length_byte, size, body, code)
+    if summed is not None:
+        lines = [*values, *summed, *body[1:]]
+    else:
+        stored = (
+            f"buf[start + {size - 1}]"
+            if layout.checksum_offset_from_end == 1
+            else f"int.from_bytes(buf[start + {size - layout.checksum_offset_from_end} : start + {size}], 'little')"
+        )
+        covered = f"buf[start + {layout.covered_from} : start + {size - layout.covered_to_end}]"
+        lines = [
+            *checksum_lines(checksum, covered, "expected"),
+            f"if expected != {stored}:",
+            "    return None",
+            *values,
+            *(line.replace("(buf, o)", f"(buf, start + {content_offset})") for line in body),
+        ]
+    known = dict(enumerate(layout.header)) | {layout.length_offset: length_byte}
+    if layout.command_offset is not None:
+        known[layout.command_offset] = command.code or 0
+    function = {
+        "name": "_frame" + decoder_name(message).removeprefix("_decode"),
+        "whole_name": "_whole" + decoder_name(message).removeprefix("_decode"),
+        "returns": returns,
+        "where": f"{message.key} {message.direction.value}",
+        "lines": lines,
+        "whole_lines": whole_frame_lines(protocol, layout, size, lines, summed is not None, known),
+    }
+    key = length_byte if layout.command_offset is None else (command.code or 0) << 8 | length_byte
+    return key, size, function
+
+
+_CRC_LOOP = re.compile(r"^for byte in buf\[(?P<first>\d+) : (?P<stop>\d+)\]:$")
+_AT_START = re.compile(r"\bstart \+ (\d+)\b")
+
+
+def whole_frame_lines(
+    protocol: Protocol, layout: FrameLayout, size: int, lines: Lines, summed: bool, known: dict[int, int]
+) -> Lines:
+    """decode()'s version of a whole-frame decoder: `buf` is exactly the frame (decode checked its size), so
+    offsets are constants; an 8-bit sum over all but a constant header is the sum of the whole frame less the
+    header and the checksum byte (no slice is made); an 8-bit CRC starts from its value after the covered bytes
+    that the frame's key fixes (`known`: offset -> byte; header, command code, length byte)."""
+    lines = [_AT_START.sub(r"\1", line) for line in lines]
+    checksum = protocol.framing.checksum
+    assert checksum is not None  # classic frames have one
+    crc = checksum.crc
+    loop = _CRC_LOOP.match(lines[1]) if len(lines) > 1 else None
+    if crc is not None and crc.width == 8 and crc.refin == crc.refout and loop and not summed:
+        table = crc_table(8, crc.poly, crc.refin)
+        state = int(lines[0].removeprefix("expected = "), 16)
+        first = int(loop["first"])
+        while first in known and first < int(loop["stop"]) - 1:
+            state = table[state ^ known[first]]
+            first += 1
+        return [f"expected = {state:#x}", f"for byte in buf[{first} : {loop['stop']}]:", *lines[2:]]
+    header = layout.header[: layout.covered_from]
+    whole_sum = (
+        not summed
+        and checksum.algorithm == "sum"
+        and checksum.type.size == 1
+        and layout.checksum_offset_from_end == 1
+        and layout.covered_to_end == 1
+        and len(header) == layout.covered_from
+    )
+    if not whole_sum:
+        return lines
+    assert lines[0].startswith("expected = ") and lines[1].startswith("if expected != "), lines[:2]
+    less = f" - {sum(header):#x}" if header else ""
+    if not checksum.invert:  # sum(covered) = check (mod 256): the whole frame sums to twice the check, plus the rest
+        return [f"if (sum(buf){less} - 2 * buf[{size - 1}]) & 0xff:", *lines[2:]]
+    return [f"check = buf[{size - 1}]", f"if ~(sum(buf){less} - check) & 0xff != check:", *lines[2:]]
 
 
 _UNPACK = re.compile(r"^(?P<targets>.+) = (?P<struct>_S_\w+)\.unpack_from\(buf, o\)$")
@@ -524,6 +650,8 @@ def frame_decode_lines(
     def at(position: int) -> str:
         return f"{buf}[{position}]" if start is None else f"{buf}[{start} + {position}]"
 
+    checksum = protocol.framing.checksum
+    assert checksum is not None  # classic frames have one
     if start is None:
         covered = f"{buf}[{layout.covered_from or ''}:-{layout.covered_to_end}]"
         stored = f"{buf}[-1]" if size == 1 else f"int.from_bytes({buf}[-{size}:], 'little')"
@@ -534,8 +662,13 @@ def frame_decode_lines(
         stored = f"{buf}[stop - 1]" if size == 1 else f"int.from_bytes({buf}[stop - {size} : stop], 'little')"
         content = f"{start} + {offset}, stop - {after}"
     args = f"{buf}, {content}" + "".join(f", {at(layout.offsets[e.name])}" for e in layout.value_elements)
-    assert protocol.framing.checksum is not None  # classic frames have one
-    lines = checksum_lines(protocol.framing.checksum, covered, "expected")
+    lines = checksum_lines(checksum, covered, "expected")
+    header = layout.header[: layout.covered_from]
+    whole_sum = checksum.algorithm == "sum" and size == 1 == layout.covered_to_end == checksum.type.size
+    if start is None and whole_sum and len(header) == layout.covered_from:
+        # all but a checked header and the check: the sum of the whole frame less those, no slice made
+        less = f" - {sum(header):#x}" if header else ""
+        lines = [f"expected = {'~' if checksum.invert else ''}(sum({buf}){less} - {stored}) & 0xff"]
     lines += [
         f"if expected != {stored}:",
         f'    raise ChecksumError(f"bad checksum: the frame has {{{stored}:#04x}}, its bytes give {{expected:#04x}}")',
@@ -569,7 +702,7 @@ def value_ranges(layout: FrameLayout, byte_order: str) -> str:
 
 def value_range_checks(layout: FrameLayout, byte_order: str) -> list[str]:
     """Lines of `decode` refusing a frame whose frame-level value lies outside its declared range, as the stream
-    parser (value_ranges) refuses it; a frame with another header is left to the header's own check."""
+    parser (value_ranges) refuses it; decode checks the header before them."""
     lines = []
     for e in layout.value_elements:
         if e.type is None or e.type.is_float or (e.minimum, e.maximum) == (e.type.minimum, e.type.maximum):
@@ -581,9 +714,18 @@ def value_range_checks(layout: FrameLayout, byte_order: str) -> list[str]:
             else f"int.from_bytes(data[{offset}:{offset + size}], {byte_order!r}, signed={e.type.signed})"
         )
         low, high = int(e.minimum), int(e.maximum)
-        also = f" or {value} == {e.broadcast}" if e.broadcast is not None else ""
         shown = f" (or {e.broadcast})" if e.broadcast is not None else ""
-        lines.append(f"if not ({low} <= {value} <= {high}{also}) and data[:{len(layout.header)}] == {layout.header!r}:")
+        lowest, highest = low, high
+        if e.broadcast in (low - 1, high + 1):  # next to the range: one comparison
+            lowest, highest = min(low, e.broadcast), max(high, e.broadcast)
+        also = f" or {value} == {e.broadcast}" if e.broadcast is not None and lowest == low and highest == high else ""
+        if lowest <= e.type.minimum and not also:  # no value of the type is below it
+            refused = f"{value} > {highest}"
+        elif highest >= e.type.maximum and not also:
+            refused = f"{value} < {lowest}"
+        else:
+            refused = f"not ({lowest} <= {value} <= {highest}{also})"
+        lines.append(f"if {refused}:")
         lines.append(f'    raise DecodeError(f"{e.name} = {{{value}}} is outside its range {low}..{high}{shown}")')
     return lines
 

@@ -52,31 +52,71 @@ def values_tuple(values: list[str]) -> str:
     return f"({values[0]},)" if len(values) == 1 else f"({', '.join(values)})"
 
 
-_FIELD_READ = re.compile(r"(?<![\w.])m\.([A-Za-z_]\w*)\b")
+def bound(f: Scalar, value: float) -> str:
+    """A range bound as the literal a comparison with the field's values is quickest with: a float field's bounds
+    as floats where they are exactly that (a float compared with float32's maximum written as a 39-digit integer
+    takes a slow path in CPython), others as numbers."""
+    if f.type.is_float and float(value) == value:
+        return repr(float(value))
+    return number(value)
+
+
+_LOOP = re.compile(r"^(?P<indent> *)for (?P<var>[A-Za-z_]\w*) in .+:$")
 
 
 def read_fields_once(lines: Lines, names: list[str]) -> Lines:
     """An encoder's lines with each field of the message `m` that they read more than once read once, into a local
-    `m_<field>` first: a range check and the pack read a field two or three times, and a local costs less than an
-    attribute (a record's fields are read through a descriptor, ~15 ns each)."""
-    reads = Counter(name for line in lines for name in _FIELD_READ.findall(line))
-    again = [name for name in names if reads[name] > 1]
+    `m_<field>` first, and likewise each field of a loop's item (`item_<field>`): a range check and the pack read a
+    field two or three times, and a local costs less than an attribute (a record's fields are read through a
+    descriptor, ~15 ns each)."""
+    return _loops_read_once(_read_once(lines, "m", names, ""))
+
+
+def _read_once(lines: Lines, var: str, names: list[str] | None, indent: str) -> Lines:
+    """`lines` with the fields of `var` read more than once (of `names`, or any not called) read once up front."""
+    reads_of = re.compile(rf"(?<![\w.]){var}\.([A-Za-z_]\w*)\b(?!\()")
+    reads = Counter(name for line in lines for name in reads_of.findall(line))
+    again = [name for name in (names if names is not None else reads) if reads[name] > 1]
     if not again:
         return lines
-    local = {name: f"m_{name}" for name in again}
+    local = {name: f"{var}_{name}" for name in again}
 
     def replaced(match: re.Match[str]) -> str:
         return local.get(match[1], match[0])
 
-    return [*(f"m_{name} = m.{name}" for name in again), *(_FIELD_READ.sub(replaced, line) for line in lines)]
+    first = [f"{indent}{var}_{name} = {var}.{name}" for name in again]
+    return [*first, *(reads_of.sub(replaced, line) for line in lines)]
+
+
+def _loops_read_once(lines: Lines) -> Lines:
+    out: Lines = []
+    i = 0
+    while i < len(lines):
+        out.append(lines[i])
+        loop = _LOOP.match(lines[i])
+        i += 1
+        if loop is None:
+            continue
+        inner = loop["indent"] + "    "
+        end = i
+        while end < len(lines) and lines[end].startswith(inner):
+            end += 1
+        out += _loops_read_once(_read_once(lines[i:end], loop["var"], None, inner))
+        i = end
+    return out
 
 
 _UNPACKED = re.compile(r"^(?P<targets>[\w, ]+?),? = (?P<call>_S_\w+\.unpack_from\(.+\))$")
 
 
-def fuse_unpack(lines: Lines) -> Lines:
-    """A decoder's lines with an unpack into locals that are then built, in order, into the returned message made
-    one: `return _new(Cls, _S.unpack_from(buf, o))` builds it from the tuple struct gives, with no locals between."""
+_ONE_BYTE = re.compile(r"^(?P<indent> *)(?P<target>\w+), = (?P<struct>_S_\w+)\.unpack_from\(buf, (?P<at>.+)\)$")
+
+
+def fuse_unpack(lines: Lines, structs: dict[str, str]) -> Lines:
+    """A decoder's final lines, made cheaper where the analysis of whole frames (package.fixed_frames) is done
+    with them: an unpack into locals that are then built, in order, into the returned message becomes one line,
+    `return _new(Cls, _S.unpack_from(buf, o))` (the tuple struct gives is the message's); a lone unsigned byte is
+    read by indexing, not unpacked."""
     out: Lines = []
     for line in lines:
         unpacked = _UNPACKED.match(out[-1]) if out else None
@@ -87,6 +127,10 @@ def fuse_unpack(lines: Lines) -> Lines:
                 out[-1] = f"return _new({cls}, {unpacked['call']})"
                 continue
         out.append(line)
+    for index, line in enumerate(out):
+        one = _ONE_BYTE.match(line)
+        if one and structs.get(one["struct"]) in ("<B", ">B"):
+            out[index] = f"{one['indent']}{one['target']} = buf[{one['at']}]"
     return out
 
 
@@ -388,6 +432,12 @@ class PackageCode:
         self.built[class_name] = names
         lines.append(f"{target} = _new({class_name}, {values_tuple(values)})")
 
+    def build_each(self, class_name: str, names: list[str], tuples: str) -> str:
+        """The expression of a tuple of instances of a generated class, one built (as `build` does) from each tuple
+        of field values, in field order, that the expression `tuples` yields (a struct's iter_unpack)."""
+        self.built[class_name] = names
+        return f"tuple([_new({class_name}, values) for values in {tuples}])"
+
     def enum_value(self, enum: str, raw: str) -> str:
         """The member for a wire value, or the value itself when the spec names none (as enum_or_int does)."""
         self.member_maps.add(enum)
@@ -561,9 +611,15 @@ class PackageCode:
             item_lines: Lines = []
             item_values = [self.after_unpack(i, n, item_lines, where) for i, n in zip(item_fields, names, strict=True)]
             values = [v for v in item_values if v is not None]
+            items = f"{item_struct}.iter_unpack(buf[o : o + n])"
+            if not item_lines and values == names:  # the unpacked tuples are the items' values
+                lines.pop(lines.index(f"{value}_list = []"))
+                lines.append(f"{value} = {self.build_each(f.class_name, item_names, items)}")
+                lines.append("o += n")
+                return value
             self.build(f.class_name, item_names, values, "item", item_lines)
             target = ", ".join(names) + ("," if len(names) == 1 else "")
-            lines.append(f"for {target} in {item_struct}.iter_unpack(buf[o : o + n]):")
+            lines.append(f"for {target} in {items}:")
             lines.extend("    " + line for line in item_lines)
             lines.append(f"    {value}_list.append(item)")
             lines.append(f"{value} = tuple({value}_list)")
@@ -784,15 +840,14 @@ class PackageCode:
         not_bool = "" if f.type.is_float else f" or {expr}.__class__ is bool"
         if f.flags:  # typed as the IntFlag class, which mypy knows is no bool: asked the way it accepts
             not_bool = f" or isinstance({expr}, bool)"
+        low, high = bound(f, f.minimum), bound(f, f.maximum)
         if also is not None and also in (f.minimum - 1, f.maximum + 1):  # next to the range: one comparison
-            low, high = min(also, f.minimum), max(also, f.maximum)
-            lines.append(f"if not {number(low)} <= {expr} <= {number(high)}{not_bool}:")
+            low, high = bound(f, min(also, f.minimum)), bound(f, max(also, f.maximum))
+            lines.append(f"if not {low} <= {expr} <= {high}{not_bool}:")
         elif also is not None and not f.minimum <= also <= f.maximum:
-            lines.append(
-                f"if not ({number(f.minimum)} <= {expr} <= {number(f.maximum)} or {expr} == {also}){not_bool}:"
-            )
+            lines.append(f"if not ({low} <= {expr} <= {high} or {expr} == {also}){not_bool}:")
         else:
-            lines.append(f"if not {number(f.minimum)} <= {expr} <= {number(f.maximum)}{not_bool}:")
+            lines.append(f"if not {low} <= {expr} <= {high}{not_bool}:")
         lines.append(f"    raise out_of_range({where}, {f.name!r}, {expr}, {number(f.minimum)}, {number(f.maximum)})")
 
     def check_count_from(self, message: Message, lines: Lines, where: str) -> None:
@@ -962,8 +1017,9 @@ class PackageCode:
                 lines.append(f"    raise EncodeError({where} + f': {reason}')")
                 return self.local(f)
             return data
-        if isinstance(f, Bytes):
-            return f"bytes({expr})"
+        if isinstance(f, Bytes):  # bytes as they are (bytes(b) looks up b.__bytes__ first), anything else made bytes
+            lines.append(f"{self.local(f)} = {expr} if {expr}.__class__ is bytes else bytes({expr})")
+            return self.local(f)
         if isinstance(f, TableValue):
             table = f"_TABLE_{f.table.name.upper()}"
             key = f"{obj}.{f.key}"

@@ -168,6 +168,7 @@ def test_sim_refuses_ids_no_device_can_have() -> None:
         ("feetech_sms", ["--id", "254"], "(254 is the broadcast id)"),
         ("feetech_sms", ["--id", "-1"], "--id -1 is outside"),
         ("modbus_rtu", ["--id", "248"], "--id 248 is outside the spec's id range 1..247"),  # the frame element's range
+        ("vesc", ["--id", "3"], "--id: vesc frames carry no device address"),
     ):
         result = subprocess.run(
             [sys.executable, "-m", "serialspec", "sim", str(ROOT / "specs" / f"{spec}.yaml"), *argv],

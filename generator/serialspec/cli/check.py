@@ -8,8 +8,6 @@ from pathlib import Path
 
 from serialspec.cli.project import expected_files, orphans, project, strangers
 
-HELP = "check the specs and that the generated files match them (exit 1 naming each stale or orphaned file)"
-
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("specs", nargs="*", metavar="SPEC", help="spec files (default: the project's specs)")

@@ -17,11 +17,6 @@ from serialspec.runtime.hexbytes import parse_hex
 from serialspec.runtime.message import Message
 from serialspec.spec.model import Protocol, replies_by_request, reply_to
 
-HELP = (
-    "decode frames given as hex ('12 4c 08', '0x12 0x4c', '124c08', '12:4c:08'), one frame per argument "
-    "('-': one per line from stdin), or a capture with --file"
-)
-
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("spec", help=SPEC_HELP)

@@ -9,8 +9,6 @@ from typing import Any
 from serialspec.cli.protocols import message_type, open_spec
 from serialspec.runtime.errors import EncodeError
 
-HELP = "encode a JSON object ({command, subcommand, direction, fields}) as a frame; prints hex"
-
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("spec", help="the protocol's spec file")

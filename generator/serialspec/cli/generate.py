@@ -10,8 +10,6 @@ from pathlib import Path
 from serialspec.cli.project import expected_files, orphans, project
 from serialspec.runtime.errors import SerialspecError
 
-HELP = "generate DIR/<protocol>/ and DIR/docs/<protocol>.md from specs (default: the project's, see [tool.serialspec])"
-
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("specs", nargs="*", metavar="SPEC", help="spec files (default: the project's specs)")

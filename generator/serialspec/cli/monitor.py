@@ -19,7 +19,6 @@ from serialspec.cli.views import engineering, unit_symbols, with_unit
 from serialspec.runtime.errors import PortError, SerialspecError
 from serialspec.spec.model import Protocol
 
-HELP = "print every frame seen on a port (device path or pyserial URL), one line each with a timestamp"
 COLOURS = {"request": "\033[36m", "response": "\033[32m", "BAD": "\033[31m"}
 
 

@@ -15,8 +15,6 @@ from serialspec.cli.protocols import SPEC_HELP, open_spec
 from serialspec.runtime.errors import SerialspecError
 from serialspec.spec.model import FrameElement, Protocol, Scalar
 
-HELP = "serve virtual devices on a pseudo-terminal; prints the device path first, answers until stopped"
-
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("spec", help=SPEC_HELP)
@@ -105,6 +103,8 @@ def run(args: argparse.Namespace) -> int:
     module = getattr(package, "simulator", None)
     if module is None or protocol.device is None:
         raise SerialspecError(f"{args.spec} has no `device:` section, so no simulator is generated")
+    if args.ids and not protocol.device.address:
+        raise SerialspecError(f"--id: {protocol.name} frames carry no device address, so the bus has one device")
     ids = args.ids or list(protocol.device.ids)
     low, high, broadcast = id_range(protocol)
     for device_id in ids:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Callable
+from functools import cache
 
 
 def _reflect(value: int, width: int) -> int:
@@ -13,6 +14,7 @@ def _reflect(value: int, width: int) -> int:
     return result
 
 
+@cache  # a table is computed once per CRC (generating a spec asks for its table many times)
 def crc_table(width: int, poly: int, refin: bool) -> tuple[int, ...]:
     """The 256-entry table of a CRC in the Rocksoft/catalogue model (reflected table when refin)."""
     mask = (1 << width) - 1

@@ -3,64 +3,82 @@
 from __future__ import annotations
 
 import contextlib
-import os
-import sys
+import importlib.util
+import pickle
 from functools import cache
-from pathlib import Path
 from typing import Any
 
 import jinja2
 
-# Compiling the templates costs more than everything else `serialspec generate` does for the shipped specs, so the
-# compiled templates are cached the way Python caches modules: in the package's own __pycache__, keyed by each
-# template's source (jinja2 checks its checksum and the Python version), written unless Python itself is told not
-# to write bytecode (PYTHONDONTWRITEBYTECODE, -B) and read whenever it is there. Where that directory cannot be
-# written (a read-only install), the templates are compiled on every run, as before.
-_CACHE = Path(__file__).resolve().parent / "__pycache__" / "jinja2"
+from serialspec import cache as caches
+
+_SETTINGS: dict[str, Any] = {
+    "trim_blocks": True,
+    "lstrip_blocks": True,
+    "keep_trailing_newline": True,
+    "undefined": jinja2.StrictUndefined,
+    "autoescape": False,  # targets escape spec text themselves, for where it lands
+}
 
 
-def _bytecode_cache() -> jinja2.BytecodeCache | None:
-    write = not sys.dont_write_bytecode
-    if write:
-        with contextlib.suppress(OSError):
-            _CACHE.mkdir(parents=True, exist_ok=True)
-    if not _CACHE.is_dir():
-        return None
-    return _QuietCache(str(_CACHE), write=write and os.access(_CACHE, os.W_OK))
+_SYNTAX = (
+    "block_start_string",
+    "block_end_string",
+    "variable_start_string",
+    "variable_end_string",
+    "comment_start_string",
+    "comment_end_string",
+    "line_statement_prefix",
+    "line_comment_prefix",
+    "trim_blocks",
+    "lstrip_blocks",
+    "newline_sequence",
+    "keep_trailing_newline",
+    "autoescape",
+    "optimized",
+)
 
 
-class _QuietCache(jinja2.FileSystemBytecodeCache):
-    """A cache that never fails generation: a file it cannot read or write is a template compiled afresh."""
+class _Cache(jinja2.BytecodeCache):
+    """Compiled templates, kept in serialspec's cache folder (serialspec.cache) the way Python keeps `.pyc` files.
 
-    def __init__(self, directory: str, *, write: bool) -> None:
-        super().__init__(directory)
-        self.write = write
+    Compiling the templates costs more than everything else `serialspec generate` does for a small spec. An entry is
+    used only when it was compiled from the same template text, by the same jinja2 with the same settings, for the
+    same Python; any other entry, or a damaged one, is a template compiled afresh (and the entry rewritten).
+    """
+
+    def __init__(self, environment: jinja2.Environment) -> None:
+        # What the compiled code depends on besides the template's text: jinja2 itself and the environment's syntax
+        # and settings (the Python version is in jinja2's own header of each entry, and in the key too).
+        settings = {name: getattr(environment, name) for name in _SYNTAX}
+        settings["undefined"] = environment.undefined.__qualname__
+        settings["extensions"] = sorted(environment.extensions)
+        settings["filters"] = sorted(environment.filters)
+        settings["tests"] = sorted(environment.tests)
+        self.fingerprint = repr((jinja2.__version__, sorted(settings.items()))).encode()
+
+    def _key(self, bucket: jinja2.bccache.Bucket) -> bytes:
+        return caches.key(importlib.util.MAGIC_NUMBER, self.fingerprint, bucket.key, bucket.checksum)
 
     def load_bytecode(self, bucket: jinja2.bccache.Bucket) -> None:
-        try:
-            super().load_bytecode(bucket)
-        except (OSError, EOFError, ValueError):
-            bucket.reset()
+        payload = caches.load(f"jinja2/{bucket.key}", self._key(bucket))
+        if payload is not None:
+            try:
+                bucket.bytecode_from_string(payload)
+            except (ValueError, EOFError, TypeError, pickle.UnpicklingError):
+                bucket.reset()
 
     def dump_bytecode(self, bucket: jinja2.bccache.Bucket) -> None:
-        if self.write:
-            with contextlib.suppress(OSError):
-                super().dump_bytecode(bucket)
+        with contextlib.suppress(TypeError):
+            caches.store(f"jinja2/{bucket.key}", self._key(bucket), bucket.bytecode_to_string())
 
 
 @cache
 def environment(package: str) -> jinja2.Environment:
     """The environment of one target package (its templates live in its `templates/` folder)."""
-    env = jinja2.Environment(
-        loader=jinja2.PackageLoader(package, "templates"),
-        trim_blocks=True,
-        lstrip_blocks=True,
-        keep_trailing_newline=True,
-        undefined=jinja2.StrictUndefined,
-        autoescape=False,  # targets escape spec text themselves, for where it lands
-        bytecode_cache=_bytecode_cache(),
-    )
+    env = jinja2.Environment(loader=jinja2.PackageLoader(package, "templates"), **_SETTINGS)
     env.filters["pyrepr"] = repr  # a Python literal, safe whatever the text holds
+    env.bytecode_cache = _Cache(env)
     return env
 
 

@@ -1,4 +1,8 @@
-"""Importing a generated package from its text, in memory, without disturbing another copy already imported."""
+"""Importing a generated package from its text, in memory, without disturbing another copy already imported.
+
+Each module is compiled as Python would compile its file; the code objects are cached by their exact source text
+(serialspec.cache), so generating an unchanged spec again does not compile its package again.
+"""
 
 from __future__ import annotations
 
@@ -10,6 +14,8 @@ import sys
 from collections.abc import Iterator
 from contextlib import contextmanager
 from types import ModuleType
+
+from serialspec import cache
 
 
 class _Sources(importlib.abc.MetaPathFinder, importlib.abc.Loader):
@@ -43,7 +49,8 @@ class _Sources(importlib.abc.MetaPathFinder, importlib.abc.Loader):
     def exec_module(self, module: ModuleType) -> None:
         name = self._file(module.__name__)
         assert name is not None
-        exec(compile(self.files[name], f"<{self.package}/{name} from {self.origin}>", "exec"), module.__dict__)
+        filename = f"<{self.package}/{name} from {self.origin}>"
+        exec(cache.compiled(self.files[name], filename, f"{self.package}.{name}"), module.__dict__)
 
 
 @contextmanager

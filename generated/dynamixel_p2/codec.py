@@ -548,9 +548,10 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
 
 def encode(message: Message) -> bytes:
     """Encode a message as a complete frame; raises EncodeError (RangeError for values out of range)."""
-    encoder = _ENCODERS.get(type(message))
-    if encoder is None:
-        raise EncodeError(f"{type(message).__name__} is not a dynamixel_p2 message")
+    try:
+        encoder = _ENCODERS[type(message)]  # a subscript costs less than .get(); the miss is the rare case
+    except KeyError:
+        raise EncodeError(f"{type(message).__name__} is not a dynamixel_p2 message") from None
     try:
         return encoder(message)
     except EncodeError:

@@ -409,6 +409,8 @@ def _decode_response_at(buf: bytes, start: int, stop: int) -> Message:
     return _decode_reply_response(buf, start + 5, stop - 1, buf[start + 2], buf[start + 4])
 
 
+_REQUEST = Direction.REQUEST
+_RESPONSE = Direction.RESPONSE
 _ENCODERS: dict[type[Message], Callable[..., bytes]] = {
     PingRequest: _encode_ping_request,
     ReadRequest: _encode_read_request,
@@ -448,10 +450,11 @@ RESPONSE_FORMAT = FrameFormat(
 def decode(data: bytes, direction: Direction | str | None = None, expect: type[Message] | None = None) -> Message:
     """Decode one complete frame into its message; raises DecodeError with a one-line reason.
 
-    Each direction's checks are inline here rather than in a function per direction: one call less per frame.
+    Each direction's checks are inline here rather than in a function per direction: one call less per frame. A
+    Direction is told by identity, first; its value as text ("request") costs one call more.
     `expect` (the reply class a frame answers) matters only where replies share a code; here none do.
     """
-    if direction == 'request':  # a Direction or its value
+    if direction is _REQUEST:
         n = len(data)
         if n < 6:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (6 bytes)")
@@ -474,7 +477,7 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         if decoder is None:
             raise DecodeError(f"unknown command {data[4]:#04x}")
         return decoder(data, 5, n - 1, data[2])
-    if direction == 'response':  # a Direction or its value
+    if direction is _RESPONSE:
         n = len(data)
         if n < 6:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (6 bytes)")
@@ -489,6 +492,10 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         if expected != data[-1]:
             raise ChecksumError(f"bad checksum: the frame has {data[-1]:#04x}, its bytes give {expected:#04x}")
         return _decode_reply_response(data, 5, n - 1, data[2], data[4])
+    if direction == 'request':  # its value as text
+        return decode(data, _REQUEST, expect)
+    if direction == 'response':  # its value as text
+        return decode(data, _RESPONSE, expect)
     if direction is None:  # last: a caller that knows the direction does not pay for this
         raise DecodeError("give the direction: requests and responses share the header ff ff")
     raise ValueError(f"direction must be request or response, not {direction!r}")
@@ -496,9 +503,10 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
 
 def encode(message: Message) -> bytes:
     """Encode a message as a complete frame; raises EncodeError (RangeError for values out of range)."""
-    encoder = _ENCODERS.get(type(message))
-    if encoder is None:
-        raise EncodeError(f"{type(message).__name__} is not a feetech_sms message")
+    try:
+        encoder = _ENCODERS[type(message)]  # a subscript costs less than .get(); the miss is the rare case
+    except KeyError:
+        raise EncodeError(f"{type(message).__name__} is not a feetech_sms message") from None
     try:
         return encoder(message)
     except EncodeError:

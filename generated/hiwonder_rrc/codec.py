@@ -2385,6 +2385,8 @@ def _decode_response_at(buf: bytes, start: int, stop: int) -> Message:
     return decoder(buf, start + 4, stop - 1)
 
 
+_REQUEST = Direction.REQUEST
+_RESPONSE = Direction.RESPONSE
 _ENCODERS: dict[type[Message], Callable[..., bytes]] = {
     LedRequest: _encode_led_request,
     BuzzerRequest: _encode_buzzer_request,
@@ -2462,10 +2464,11 @@ RESPONSE_FORMAT = FrameFormat(
 def decode(data: bytes, direction: Direction | str | None = None, expect: type[Message] | None = None) -> Message:
     """Decode one complete frame into its message; raises DecodeError with a one-line reason.
 
-    Each direction's checks are inline here rather than in a function per direction: one call less per frame.
+    Each direction's checks are inline here rather than in a function per direction: one call less per frame. A
+    Direction is told by identity, first; its value as text ("request") costs one call more.
     `expect` (the reply class a frame answers) matters only where replies share a code; here none do.
     """
-    if direction == 'request':  # a Direction or its value
+    if direction is _REQUEST:
         fixed = _REQUEST_WHOLE.get(data[:4])  # no key is shorter: a short frame matches none
         if fixed is not None and fixed[0] == len(data):
             message = fixed[1](data)
@@ -2488,7 +2491,7 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         if decoder is None:
             raise DecodeError(f"unknown command {data[2]:#04x}")
         return decoder(data, 4, n - 1)
-    if direction == 'response':  # a Direction or its value
+    if direction is _RESPONSE:
         fixed = _RESPONSE_WHOLE.get(data[:4])  # no key is shorter: a short frame matches none
         if fixed is not None and fixed[0] == len(data):
             message = fixed[1](data)
@@ -2511,6 +2514,10 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         if decoder is None:
             raise DecodeError(f"unknown command {data[2]:#04x}")
         return decoder(data, 4, n - 1)
+    if direction == 'request':  # its value as text
+        return decode(data, _REQUEST, expect)
+    if direction == 'response':  # its value as text
+        return decode(data, _RESPONSE, expect)
     if direction is None:  # last: a caller that knows the direction does not pay for this
         raise DecodeError("give the direction: requests and responses share the header aa 55")
     raise ValueError(f"direction must be request or response, not {direction!r}")
@@ -2518,9 +2525,10 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
 
 def encode(message: Message) -> bytes:
     """Encode a message as a complete frame; raises EncodeError (RangeError for values out of range)."""
-    encoder = _ENCODERS.get(type(message))
-    if encoder is None:
-        raise EncodeError(f"{type(message).__name__} is not a hiwonder_rrc message")
+    try:
+        encoder = _ENCODERS[type(message)]  # a subscript costs less than .get(); the miss is the rare case
+    except KeyError:
+        raise EncodeError(f"{type(message).__name__} is not a hiwonder_rrc message") from None
     try:
         return encoder(message)
     except EncodeError:

@@ -1777,9 +1777,10 @@ _REQUEST_WHOLE: dict[bytes, tuple[int, Callable[[bytes], Message | None]]] = {
 
 def _decode_request_at(buf: bytes, start: int, stop: int) -> Message:
     """The frame buf[start:stop], whose header and length byte the stream parser has checked."""
+    check = buf[stop - 1]
     expected = sum(buf[start : stop - 1]) & 0xff
-    if expected != buf[stop - 1]:
-        raise ChecksumError(f"bad checksum: the frame has {buf[stop - 1]:#04x}, its bytes give {expected:#04x}")
+    if expected != check:
+        raise ChecksumError(f"bad checksum: the frame has {check:#04x}, its bytes give {expected:#04x}")
     decoder = _REQUEST_DECODERS.get(buf[start + 2])
     if decoder is None:
         raise DecodeError(f"unknown command {buf[start + 2]:#04x}")
@@ -1868,9 +1869,10 @@ _RESPONSE_WHOLE: dict[bytes, tuple[int, Callable[[bytes], Message | None]]] = {
 
 def _decode_response_at(buf: bytes, start: int, stop: int) -> Message:
     """The frame buf[start:stop], whose header and length byte the stream parser has checked."""
+    check = buf[stop - 1]
     expected = sum(buf[start : stop - 1]) & 0xff
-    if expected != buf[stop - 1]:
-        raise ChecksumError(f"bad checksum: the frame has {buf[stop - 1]:#04x}, its bytes give {expected:#04x}")
+    if expected != check:
+        raise ChecksumError(f"bad checksum: the frame has {check:#04x}, its bytes give {expected:#04x}")
     decoder = _RESPONSE_DECODERS.get(buf[start + 2])
     if decoder is None:
         raise DecodeError(f"unknown command {buf[start + 2]:#04x}")
@@ -1965,9 +1967,10 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         size = data[3]
         if n != 5 + size:
             raise DecodeError(f"length byte says {size} content bytes but the frame holds {n - 5}")
-        expected = (sum(data) - data[-1]) & 0xff
-        if expected != data[-1]:
-            raise ChecksumError(f"bad checksum: the frame has {data[-1]:#04x}, its bytes give {expected:#04x}")
+        check = data[-1]
+        expected = (sum(data) - check) & 0xff
+        if expected != check:
+            raise ChecksumError(f"bad checksum: the frame has {check:#04x}, its bytes give {expected:#04x}")
         decoder = _REQUEST_DECODERS.get(data[2])
         if decoder is None:
             raise DecodeError(f"unknown command {data[2]:#04x}")
@@ -1986,9 +1989,10 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         size = data[3]
         if n != 5 + size:
             raise DecodeError(f"length byte says {size} content bytes but the frame holds {n - 5}")
-        expected = (sum(data) - data[-1]) & 0xff
-        if expected != data[-1]:
-            raise ChecksumError(f"bad checksum: the frame has {data[-1]:#04x}, its bytes give {expected:#04x}")
+        check = data[-1]
+        expected = (sum(data) - check) & 0xff
+        if expected != check:
+            raise ChecksumError(f"bad checksum: the frame has {check:#04x}, its bytes give {expected:#04x}")
         decoder = _RESPONSE_DECODERS.get(data[2])
         if decoder is None:
             raise DecodeError(f"unknown command {data[2]:#04x}")

@@ -379,9 +379,10 @@ _REQUEST_WHOLE: dict[int, tuple[int, Callable[[bytes], Message | None]]] = {
 
 def _decode_request_at(buf: bytes, start: int, stop: int) -> Message:
     """The frame buf[start:stop], whose header and length byte the stream parser has checked."""
+    check = buf[stop - 1]
     expected = ~sum(buf[start + 2 : stop - 1]) & 0xff
-    if expected != buf[stop - 1]:
-        raise ChecksumError(f"bad checksum: the frame has {buf[stop - 1]:#04x}, its bytes give {expected:#04x}")
+    if expected != check:
+        raise ChecksumError(f"bad checksum: the frame has {check:#04x}, its bytes give {expected:#04x}")
     decoder = _REQUEST_DECODERS.get(buf[start + 4])
     if decoder is None:
         raise DecodeError(f"unknown command {buf[start + 4]:#04x}")
@@ -403,9 +404,10 @@ _RESPONSE_FIXED: dict[int, tuple[int, Callable[[bytes, int], Message | None]]] =
 
 def _decode_response_at(buf: bytes, start: int, stop: int) -> Message:
     """The frame buf[start:stop], whose header and length byte the stream parser has checked."""
+    check = buf[stop - 1]
     expected = ~sum(buf[start + 2 : stop - 1]) & 0xff
-    if expected != buf[stop - 1]:
-        raise ChecksumError(f"bad checksum: the frame has {buf[stop - 1]:#04x}, its bytes give {expected:#04x}")
+    if expected != check:
+        raise ChecksumError(f"bad checksum: the frame has {check:#04x}, its bytes give {expected:#04x}")
     return _decode_reply_response(buf, start + 5, stop - 1, buf[start + 2], buf[start + 4])
 
 
@@ -470,9 +472,10 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         size = data[3] - 2
         if size < 0 or n != 6 + size:
             raise DecodeError(f"length byte says {size} content bytes but the frame holds {n - 6}")
-        expected = ~(sum(data) - 0x1fe - data[-1]) & 0xff
-        if expected != data[-1]:
-            raise ChecksumError(f"bad checksum: the frame has {data[-1]:#04x}, its bytes give {expected:#04x}")
+        check = data[-1]
+        expected = ~(sum(data) - 0x1fe - check) & 0xff
+        if expected != check:
+            raise ChecksumError(f"bad checksum: the frame has {check:#04x}, its bytes give {expected:#04x}")
         decoder = _REQUEST_DECODERS.get(data[4])
         if decoder is None:
             raise DecodeError(f"unknown command {data[4]:#04x}")
@@ -488,9 +491,10 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         size = data[3] - 2
         if size < 0 or n != 6 + size:
             raise DecodeError(f"length byte says {size} content bytes but the frame holds {n - 6}")
-        expected = ~(sum(data) - 0x1fe - data[-1]) & 0xff
-        if expected != data[-1]:
-            raise ChecksumError(f"bad checksum: the frame has {data[-1]:#04x}, its bytes give {expected:#04x}")
+        check = data[-1]
+        expected = ~(sum(data) - 0x1fe - check) & 0xff
+        if expected != check:
+            raise ChecksumError(f"bad checksum: the frame has {check:#04x}, its bytes give {expected:#04x}")
         return _decode_reply_response(data, 5, n - 1, data[2], data[4])
     if direction == 'request':  # its value as text
         return decode(data, _REQUEST, expect)

@@ -689,9 +689,13 @@ def _frame_sbus_response(buf: bytes, start: int) -> SbusResponse | None:
 
 def _whole_led_request(buf: bytes) -> LedRequest | None:
     """A whole led request frame, all of buf, size and header known: None if its checksum fails."""
-    expected = 0x47
-    for byte in buf[4 : 11]:
-        expected = _CRC_TABLE[expected ^ byte]
+    expected = _CRC_TABLE[0x47 ^ buf[4]]
+    expected = _CRC_TABLE[expected ^ buf[5]]
+    expected = _CRC_TABLE[expected ^ buf[6]]
+    expected = _CRC_TABLE[expected ^ buf[7]]
+    expected = _CRC_TABLE[expected ^ buf[8]]
+    expected = _CRC_TABLE[expected ^ buf[9]]
+    expected = _CRC_TABLE[expected ^ buf[10]]
     if expected != buf[11]:
         return None
     return _new(LedRequest, _S_U8_U16_U16_U16.unpack_from(buf, 4))
@@ -699,9 +703,14 @@ def _whole_led_request(buf: bytes) -> LedRequest | None:
 
 def _whole_buzzer_request(buf: bytes) -> BuzzerRequest | None:
     """A whole buzzer request frame, all of buf, size and header known: None if its checksum fails."""
-    expected = 0x53
-    for byte in buf[4 : 12]:
-        expected = _CRC_TABLE[expected ^ byte]
+    expected = _CRC_TABLE[0x53 ^ buf[4]]
+    expected = _CRC_TABLE[expected ^ buf[5]]
+    expected = _CRC_TABLE[expected ^ buf[6]]
+    expected = _CRC_TABLE[expected ^ buf[7]]
+    expected = _CRC_TABLE[expected ^ buf[8]]
+    expected = _CRC_TABLE[expected ^ buf[9]]
+    expected = _CRC_TABLE[expected ^ buf[10]]
+    expected = _CRC_TABLE[expected ^ buf[11]]
     if expected != buf[12]:
         return None
     return _new(BuzzerRequest, _S_U16_U16_U16_U16.unpack_from(buf, 4))
@@ -709,9 +718,8 @@ def _whole_buzzer_request(buf: bytes) -> BuzzerRequest | None:
 
 def _whole_key_response(buf: bytes) -> KeyResponse | None:
     """A whole key response frame, all of buf, size and header known: None if its checksum fails."""
-    expected = 0x16
-    for byte in buf[4 : 6]:
-        expected = _CRC_TABLE[expected ^ byte]
+    expected = _CRC_TABLE[0x16 ^ buf[4]]
+    expected = _CRC_TABLE[expected ^ buf[5]]
     if expected != buf[6]:
         return None
     v_button_id, v_event = _S_U8_U8.unpack_from(buf, 4)
@@ -730,9 +738,13 @@ def _whole_imu_response(buf: bytes) -> ImuResponse | None:
 
 def _whole_gamepad_response(buf: bytes) -> GamepadResponse | None:
     """A whole gamepad response frame, all of buf, size and header known: None if its checksum fails."""
-    expected = 0xf5
-    for byte in buf[4 : 11]:
-        expected = _CRC_TABLE[expected ^ byte]
+    expected = _CRC_TABLE[0xf5 ^ buf[4]]
+    expected = _CRC_TABLE[expected ^ buf[5]]
+    expected = _CRC_TABLE[expected ^ buf[6]]
+    expected = _CRC_TABLE[expected ^ buf[7]]
+    expected = _CRC_TABLE[expected ^ buf[8]]
+    expected = _CRC_TABLE[expected ^ buf[9]]
+    expected = _CRC_TABLE[expected ^ buf[10]]
     if expected != buf[11]:
         return None
     v_buttons, v_hat, v_left_x, v_left_y, v_right_x, v_right_y = _S_U16_U8_I8_I8_I8_I8.unpack_from(buf, 4)
@@ -757,593 +769,297 @@ def _whole_sbus_response(buf: bytes) -> SbusResponse | None:
     return _new(SbusResponse, (t[0:16], v_ch17, v_ch18, v_signal_loss, v_fail_safe))
 
 
-def _whole_motor_set_speed_request(buf: bytes) -> MotorSetSpeedRequest | None:
-    """A whole motor.set_speed request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
-    expected = 0x88
-    for byte in buf[4 : 10]:
-        expected = _CRC_TABLE[expected ^ byte]
-    if expected != buf[10]:
-        return None
-    v_subcommand_code, v_motor_id, v_speed = _S_U8_U8_F32.unpack_from(buf, 4)
-    return _new(MotorSetSpeedRequest, (v_motor_id, v_speed))
-
-
-def _whole_motor_stop_request(buf: bytes) -> MotorStopRequest | None:
-    """A whole motor.stop request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
-    expected = 0xe9
-    for byte in buf[4 : 6]:
-        expected = _CRC_TABLE[expected ^ byte]
-    if expected != buf[6]:
-        return None
-    v_subcommand_code, v_motor_id = _S_U8_U8.unpack_from(buf, 4)
-    return _new(MotorStopRequest, (v_motor_id,))
-
-
-def _whole_motor_stop_mask_request(buf: bytes) -> MotorStopMaskRequest | None:
-    """A whole motor.stop_mask request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
-    expected = 0xe9
-    for byte in buf[4 : 6]:
-        expected = _CRC_TABLE[expected ^ byte]
-    if expected != buf[6]:
-        return None
-    v_subcommand_code, v_mask = _S_U8_U8.unpack_from(buf, 4)
-    v_mask_flags = _MEMBERS_MotorMask.get(v_mask)
-    if v_mask_flags is None:
-        v_mask_flags = MotorMask(v_mask)
-    return _new(MotorStopMaskRequest, (v_mask_flags,))
-
-
-def _whole_pwm_servo_set_position_request(buf: bytes) -> PwmServoSetPositionRequest | None:
-    """A whole pwm_servo.set_position request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
-    expected = 0xe6
-    for byte in buf[4 : 10]:
-        expected = _CRC_TABLE[expected ^ byte]
-    if expected != buf[10]:
-        return None
-    v_subcommand_code, v_duration, v_servo_id, v_pulse = _S_U8_U16_U8_U16.unpack_from(buf, 4)
-    return _new(PwmServoSetPositionRequest, (v_duration, v_servo_id, v_pulse))
-
-
-def _whole_pwm_servo_read_position_request(buf: bytes) -> PwmServoReadPositionRequest | None:
-    """A whole pwm_servo.read_position request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
-    expected = 0x87
-    for byte in buf[4 : 6]:
-        expected = _CRC_TABLE[expected ^ byte]
-    if expected != buf[6]:
-        return None
-    v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
-    return _new(PwmServoReadPositionRequest, (v_servo_id,))
-
-
-def _whole_pwm_servo_set_offset_request(buf: bytes) -> PwmServoSetOffsetRequest | None:
-    """A whole pwm_servo.set_offset request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
-    expected = 0xd9
-    for byte in buf[4 : 7]:
-        expected = _CRC_TABLE[expected ^ byte]
-    if expected != buf[7]:
-        return None
-    v_subcommand_code, v_servo_id, v_offset = _S_U8_U8_I8.unpack_from(buf, 4)
-    return _new(PwmServoSetOffsetRequest, (v_servo_id, v_offset))
-
-
-def _whole_pwm_servo_read_offset_request(buf: bytes) -> PwmServoReadOffsetRequest | None:
-    """A whole pwm_servo.read_offset request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
-    expected = 0x87
-    for byte in buf[4 : 6]:
-        expected = _CRC_TABLE[expected ^ byte]
-    if expected != buf[6]:
-        return None
-    v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
-    return _new(PwmServoReadOffsetRequest, (v_servo_id,))
-
-
-def _whole_bus_servo_read_position_request(buf: bytes) -> BusServoReadPositionRequest | None:
-    """A whole bus_servo.read_position request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
-    expected = 0x43
-    for byte in buf[4 : 6]:
-        expected = _CRC_TABLE[expected ^ byte]
-    if expected != buf[6]:
-        return None
-    v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
-    return _new(BusServoReadPositionRequest, (v_servo_id,))
-
-
-def _whole_bus_servo_read_voltage_request(buf: bytes) -> BusServoReadVoltageRequest | None:
-    """A whole bus_servo.read_voltage request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
-    expected = 0x43
-    for byte in buf[4 : 6]:
-        expected = _CRC_TABLE[expected ^ byte]
-    if expected != buf[6]:
-        return None
-    v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
-    return _new(BusServoReadVoltageRequest, (v_servo_id,))
-
-
-def _whole_bus_servo_read_temperature_request(buf: bytes) -> BusServoReadTemperatureRequest | None:
-    """A whole bus_servo.read_temperature request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
-    expected = 0x43
-    for byte in buf[4 : 6]:
-        expected = _CRC_TABLE[expected ^ byte]
-    if expected != buf[6]:
-        return None
-    v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
-    return _new(BusServoReadTemperatureRequest, (v_servo_id,))
-
-
-def _whole_bus_servo_read_torque_request(buf: bytes) -> BusServoReadTorqueRequest | None:
-    """A whole bus_servo.read_torque request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
-    expected = 0x43
-    for byte in buf[4 : 6]:
-        expected = _CRC_TABLE[expected ^ byte]
-    if expected != buf[6]:
-        return None
-    v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
-    return _new(BusServoReadTorqueRequest, (v_servo_id,))
-
-
-def _whole_bus_servo_unload_request(buf: bytes) -> BusServoUnloadRequest | None:
-    """A whole bus_servo.unload request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
-    expected = 0x43
-    for byte in buf[4 : 6]:
-        expected = _CRC_TABLE[expected ^ byte]
-    if expected != buf[6]:
-        return None
-    v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
-    return _new(BusServoUnloadRequest, (v_servo_id,))
-
-
-def _whole_bus_servo_load_request(buf: bytes) -> BusServoLoadRequest | None:
-    """A whole bus_servo.load request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
-    expected = 0x43
-    for byte in buf[4 : 6]:
-        expected = _CRC_TABLE[expected ^ byte]
-    if expected != buf[6]:
-        return None
-    v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
-    return _new(BusServoLoadRequest, (v_servo_id,))
-
-
-def _whole_bus_servo_set_id_request(buf: bytes) -> BusServoSetIdRequest | None:
-    """A whole bus_servo.set_id request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
-    expected = 0x1d
-    for byte in buf[4 : 7]:
-        expected = _CRC_TABLE[expected ^ byte]
-    if expected != buf[7]:
-        return None
-    v_subcommand_code, v_servo_id, v_new_id = _S_U8_U8_U8.unpack_from(buf, 4)
-    return _new(BusServoSetIdRequest, (v_servo_id, v_new_id))
-
-
-def _whole_bus_servo_read_id_request(buf: bytes) -> BusServoReadIdRequest | None:
-    """A whole bus_servo.read_id request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
-    expected = 0x43
-    for byte in buf[4 : 6]:
-        expected = _CRC_TABLE[expected ^ byte]
-    if expected != buf[6]:
-        return None
-    v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
-    return _new(BusServoReadIdRequest, (v_servo_id,))
-
-
-def _whole_bus_servo_set_offset_request(buf: bytes) -> BusServoSetOffsetRequest | None:
-    """A whole bus_servo.set_offset request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
-    expected = 0x1d
-    for byte in buf[4 : 7]:
-        expected = _CRC_TABLE[expected ^ byte]
-    if expected != buf[7]:
-        return None
-    v_subcommand_code, v_servo_id, v_offset = _S_U8_U8_I8.unpack_from(buf, 4)
-    return _new(BusServoSetOffsetRequest, (v_servo_id, v_offset))
-
-
-def _whole_bus_servo_read_offset_request(buf: bytes) -> BusServoReadOffsetRequest | None:
-    """A whole bus_servo.read_offset request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
-    expected = 0x43
-    for byte in buf[4 : 6]:
-        expected = _CRC_TABLE[expected ^ byte]
-    if expected != buf[6]:
-        return None
-    v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
-    return _new(BusServoReadOffsetRequest, (v_servo_id,))
-
-
-def _whole_bus_servo_save_offset_request(buf: bytes) -> BusServoSaveOffsetRequest | None:
-    """A whole bus_servo.save_offset request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
-    expected = 0x43
-    for byte in buf[4 : 6]:
-        expected = _CRC_TABLE[expected ^ byte]
-    if expected != buf[6]:
-        return None
-    v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
-    return _new(BusServoSaveOffsetRequest, (v_servo_id,))
-
-
-def _whole_bus_servo_set_position_limit_request(buf: bytes) -> BusServoSetPositionLimitRequest | None:
-    """A whole bus_servo.set_position_limit request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
-    expected = 0x22
-    for byte in buf[4 : 10]:
-        expected = _CRC_TABLE[expected ^ byte]
-    if expected != buf[10]:
-        return None
-    v_subcommand_code, v_servo_id, v_low, v_high = _S_U8_U8_U16_U16.unpack_from(buf, 4)
-    return _new(BusServoSetPositionLimitRequest, (v_servo_id, v_low, v_high))
-
-
-def _whole_bus_servo_read_position_limit_request(buf: bytes) -> BusServoReadPositionLimitRequest | None:
-    """A whole bus_servo.read_position_limit request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
-    expected = 0x43
-    for byte in buf[4 : 6]:
-        expected = _CRC_TABLE[expected ^ byte]
-    if expected != buf[6]:
-        return None
-    v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
-    return _new(BusServoReadPositionLimitRequest, (v_servo_id,))
-
-
-def _whole_bus_servo_set_voltage_limit_request(buf: bytes) -> BusServoSetVoltageLimitRequest | None:
-    """A whole bus_servo.set_voltage_limit request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
-    expected = 0x22
-    for byte in buf[4 : 10]:
-        expected = _CRC_TABLE[expected ^ byte]
-    if expected != buf[10]:
-        return None
-    v_subcommand_code, v_servo_id, v_low, v_high = _S_U8_U8_U16_U16.unpack_from(buf, 4)
-    return _new(BusServoSetVoltageLimitRequest, (v_servo_id, v_low, v_high))
-
-
-def _whole_bus_servo_read_voltage_limit_request(buf: bytes) -> BusServoReadVoltageLimitRequest | None:
-    """A whole bus_servo.read_voltage_limit request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
-    expected = 0x43
-    for byte in buf[4 : 6]:
-        expected = _CRC_TABLE[expected ^ byte]
-    if expected != buf[6]:
-        return None
-    v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
-    return _new(BusServoReadVoltageLimitRequest, (v_servo_id,))
-
-
-def _whole_bus_servo_set_temperature_limit_request(buf: bytes) -> BusServoSetTemperatureLimitRequest | None:
-    """A whole bus_servo.set_temperature_limit request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
-    expected = 0x1d
-    for byte in buf[4 : 7]:
-        expected = _CRC_TABLE[expected ^ byte]
-    if expected != buf[7]:
-        return None
-    v_subcommand_code, v_servo_id, v_limit = _S_U8_U8_U8.unpack_from(buf, 4)
-    return _new(BusServoSetTemperatureLimitRequest, (v_servo_id, v_limit))
-
-
-def _whole_bus_servo_read_temperature_limit_request(buf: bytes) -> BusServoReadTemperatureLimitRequest | None:
-    """A whole bus_servo.read_temperature_limit request frame, all of buf, size, header and sub-command known: None if its checksum fails."""
-    expected = 0x43
-    for byte in buf[4 : 6]:
-        expected = _CRC_TABLE[expected ^ byte]
-    if expected != buf[6]:
-        return None
-    v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
-    return _new(BusServoReadTemperatureLimitRequest, (v_servo_id,))
-
-
-def _whole_pwm_servo_read_position_response(buf: bytes) -> PwmServoReadPositionResponse | None:
-    """A whole pwm_servo.read_position response frame, all of buf, size, header and sub-command known: None if its checksum fails."""
-    expected = 0x5a
-    for byte in buf[4 : 8]:
-        expected = _CRC_TABLE[expected ^ byte]
-    if expected != buf[8]:
-        return None
-    v_servo_id, v_subcommand_code, v_pulse = _S_U8_U8_U16.unpack_from(buf, 4)
-    return _new(PwmServoReadPositionResponse, (v_servo_id, v_pulse))
-
-
-def _whole_pwm_servo_read_offset_response(buf: bytes) -> PwmServoReadOffsetResponse | None:
-    """A whole pwm_servo.read_offset response frame, all of buf, size, header and sub-command known: None if its checksum fails."""
-    expected = 0xd9
-    for byte in buf[4 : 7]:
-        expected = _CRC_TABLE[expected ^ byte]
-    if expected != buf[7]:
-        return None
-    v_servo_id, v_subcommand_code, v_offset = _S_U8_U8_I8.unpack_from(buf, 4)
-    return _new(PwmServoReadOffsetResponse, (v_servo_id, v_offset))
-
-
-def _whole_bus_servo_read_position_response(buf: bytes) -> BusServoReadPositionResponse | None:
-    """A whole bus_servo.read_position response frame, all of buf, size, header and sub-command known: None if its checksum fails."""
-    expected = 0xc0
-    for byte in buf[4 : 9]:
-        expected = _CRC_TABLE[expected ^ byte]
-    if expected != buf[9]:
-        return None
-    v_servo_id, v_subcommand_code, v_success, v_position = _S_U8_U8_I8_I16.unpack_from(buf, 4)
-    return _new(BusServoReadPositionResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_position))
-
-
-def _whole_bus_servo_read_voltage_response(buf: bytes) -> BusServoReadVoltageResponse | None:
-    """A whole bus_servo.read_voltage response frame, all of buf, size, header and sub-command known: None if its checksum fails."""
-    expected = 0xc0
-    for byte in buf[4 : 9]:
-        expected = _CRC_TABLE[expected ^ byte]
-    if expected != buf[9]:
-        return None
-    v_servo_id, v_subcommand_code, v_success, v_voltage = _S_U8_U8_I8_U16.unpack_from(buf, 4)
-    return _new(BusServoReadVoltageResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_voltage))
-
-
-def _whole_bus_servo_read_temperature_response(buf: bytes) -> BusServoReadTemperatureResponse | None:
-    """A whole bus_servo.read_temperature response frame, all of buf, size, header and sub-command known: None if its checksum fails."""
-    expected = 0x9e
-    for byte in buf[4 : 8]:
-        expected = _CRC_TABLE[expected ^ byte]
-    if expected != buf[8]:
-        return None
-    v_servo_id, v_subcommand_code, v_success, v_temperature = _S_U8_U8_I8_U8.unpack_from(buf, 4)
-    return _new(BusServoReadTemperatureResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_temperature))
-
-
-def _whole_bus_servo_read_torque_response(buf: bytes) -> BusServoReadTorqueResponse | None:
-    """A whole bus_servo.read_torque response frame, all of buf, size, header and sub-command known: None if its checksum fails."""
-    expected = 0x9e
-    for byte in buf[4 : 8]:
-        expected = _CRC_TABLE[expected ^ byte]
-    if expected != buf[8]:
-        return None
-    v_servo_id, v_subcommand_code, v_success, v_torque = _S_U8_U8_I8_I8.unpack_from(buf, 4)
-    return _new(BusServoReadTorqueResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_torque))
-
-
-def _whole_bus_servo_read_id_response(buf: bytes) -> BusServoReadIdResponse | None:
-    """A whole bus_servo.read_id response frame, all of buf, size, header and sub-command known: None if its checksum fails."""
-    expected = 0x9e
-    for byte in buf[4 : 8]:
-        expected = _CRC_TABLE[expected ^ byte]
-    if expected != buf[8]:
-        return None
-    v_servo_id, v_subcommand_code, v_success, v_id = _S_U8_U8_I8_U8.unpack_from(buf, 4)
-    return _new(BusServoReadIdResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_id))
-
-
-def _whole_bus_servo_read_offset_response(buf: bytes) -> BusServoReadOffsetResponse | None:
-    """A whole bus_servo.read_offset response frame, all of buf, size, header and sub-command known: None if its checksum fails."""
-    expected = 0x9e
-    for byte in buf[4 : 8]:
-        expected = _CRC_TABLE[expected ^ byte]
-    if expected != buf[8]:
-        return None
-    v_servo_id, v_subcommand_code, v_success, v_offset = _S_U8_U8_I8_I8.unpack_from(buf, 4)
-    return _new(BusServoReadOffsetResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_offset))
-
-
-def _whole_bus_servo_read_position_limit_response(buf: bytes) -> BusServoReadPositionLimitResponse | None:
-    """A whole bus_servo.read_position_limit response frame, all of buf, size, header and sub-command known: None if its checksum fails."""
-    expected = 0x7c
-    for byte in buf[4 : 11]:
-        expected = _CRC_TABLE[expected ^ byte]
-    if expected != buf[11]:
-        return None
-    v_servo_id, v_subcommand_code, v_success, v_low, v_high = _S_U8_U8_I8_U16_U16.unpack_from(buf, 4)
-    return _new(BusServoReadPositionLimitResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_low, v_high))
-
-
-def _whole_bus_servo_read_voltage_limit_response(buf: bytes) -> BusServoReadVoltageLimitResponse | None:
-    """A whole bus_servo.read_voltage_limit response frame, all of buf, size, header and sub-command known: None if its checksum fails."""
-    expected = 0x7c
-    for byte in buf[4 : 11]:
-        expected = _CRC_TABLE[expected ^ byte]
-    if expected != buf[11]:
-        return None
-    v_servo_id, v_subcommand_code, v_success, v_low, v_high = _S_U8_U8_I8_U16_U16.unpack_from(buf, 4)
-    return _new(BusServoReadVoltageLimitResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_low, v_high))
-
-
-def _whole_bus_servo_read_temperature_limit_response(buf: bytes) -> BusServoReadTemperatureLimitResponse | None:
-    """A whole bus_servo.read_temperature_limit response frame, all of buf, size, header and sub-command known: None if its checksum fails."""
-    expected = 0x9e
-    for byte in buf[4 : 8]:
-        expected = _CRC_TABLE[expected ^ byte]
-    if expected != buf[8]:
-        return None
-    v_servo_id, v_subcommand_code, v_success, v_limit = _S_U8_U8_I8_U8.unpack_from(buf, 4)
-    return _new(BusServoReadTemperatureLimitResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_limit))
-
-
-def _whole_system_battery_response(buf: bytes) -> SystemBatteryResponse | None:
-    """A whole system.battery response frame, all of buf, size, header and sub-command known: None if its checksum fails."""
-    expected = 0xe2
-    for byte in buf[4 : 7]:
-        expected = _CRC_TABLE[expected ^ byte]
-    if expected != buf[7]:
-        return None
-    v_subcommand_code, v_voltage = _S_U8_U16.unpack_from(buf, 4)
-    return _new(SystemBatteryResponse, (v_voltage,))
-
-
 def _whole_motor_request_11(buf: bytes) -> Message | None:
     """A whole motor request frame of 11 bytes, by its sub-command: None if its checksum fails or no
     sub-command of that size has its code (decode's general path then says why)."""
-    whole = _MOTOR_REQUEST_WHOLE_11.get(buf[4])
-    return None if whole is None else whole(buf)
-
-
-_MOTOR_REQUEST_WHOLE_11: dict[int, Callable[[bytes], Message | None]] = {
-    0x00: _whole_motor_set_speed_request,
-}
+    expected = _CRC_TABLE[0x88 ^ buf[4]]
+    expected = _CRC_TABLE[expected ^ buf[5]]
+    expected = _CRC_TABLE[expected ^ buf[6]]
+    expected = _CRC_TABLE[expected ^ buf[7]]
+    expected = _CRC_TABLE[expected ^ buf[8]]
+    expected = _CRC_TABLE[expected ^ buf[9]]
+    if expected != buf[10]:
+        return None
+    sub = buf[4]
+    if sub == 0x00:
+        v_subcommand_code, v_motor_id, v_speed = _S_U8_U8_F32.unpack_from(buf, 4)
+        return _new(MotorSetSpeedRequest, (v_motor_id, v_speed))
+    return None
 
 
 def _whole_motor_request_7(buf: bytes) -> Message | None:
     """A whole motor request frame of 7 bytes, by its sub-command: None if its checksum fails or no
     sub-command of that size has its code (decode's general path then says why)."""
-    whole = _MOTOR_REQUEST_WHOLE_7.get(buf[4])
-    return None if whole is None else whole(buf)
-
-
-_MOTOR_REQUEST_WHOLE_7: dict[int, Callable[[bytes], Message | None]] = {
-    0x02: _whole_motor_stop_request,
-    0x03: _whole_motor_stop_mask_request,
-}
+    expected = _CRC_TABLE[0xe9 ^ buf[4]]
+    expected = _CRC_TABLE[expected ^ buf[5]]
+    if expected != buf[6]:
+        return None
+    sub = buf[4]
+    if sub == 0x02:
+        v_subcommand_code, v_motor_id = _S_U8_U8.unpack_from(buf, 4)
+        return _new(MotorStopRequest, (v_motor_id,))
+    if sub == 0x03:
+        v_subcommand_code, v_mask = _S_U8_U8.unpack_from(buf, 4)
+        v_mask_flags = _MEMBERS_MotorMask.get(v_mask)
+        if v_mask_flags is None:
+            v_mask_flags = MotorMask(v_mask)
+        return _new(MotorStopMaskRequest, (v_mask_flags,))
+    return None
 
 
 def _whole_pwm_servo_request_11(buf: bytes) -> Message | None:
     """A whole pwm_servo request frame of 11 bytes, by its sub-command: None if its checksum fails or no
     sub-command of that size has its code (decode's general path then says why)."""
-    whole = _PWM_SERVO_REQUEST_WHOLE_11.get(buf[4])
-    return None if whole is None else whole(buf)
-
-
-_PWM_SERVO_REQUEST_WHOLE_11: dict[int, Callable[[bytes], Message | None]] = {
-    0x03: _whole_pwm_servo_set_position_request,
-}
+    expected = _CRC_TABLE[0xe6 ^ buf[4]]
+    expected = _CRC_TABLE[expected ^ buf[5]]
+    expected = _CRC_TABLE[expected ^ buf[6]]
+    expected = _CRC_TABLE[expected ^ buf[7]]
+    expected = _CRC_TABLE[expected ^ buf[8]]
+    expected = _CRC_TABLE[expected ^ buf[9]]
+    if expected != buf[10]:
+        return None
+    sub = buf[4]
+    if sub == 0x03:
+        v_subcommand_code, v_duration, v_servo_id, v_pulse = _S_U8_U16_U8_U16.unpack_from(buf, 4)
+        return _new(PwmServoSetPositionRequest, (v_duration, v_servo_id, v_pulse))
+    return None
 
 
 def _whole_pwm_servo_request_7(buf: bytes) -> Message | None:
     """A whole pwm_servo request frame of 7 bytes, by its sub-command: None if its checksum fails or no
     sub-command of that size has its code (decode's general path then says why)."""
-    whole = _PWM_SERVO_REQUEST_WHOLE_7.get(buf[4])
-    return None if whole is None else whole(buf)
-
-
-_PWM_SERVO_REQUEST_WHOLE_7: dict[int, Callable[[bytes], Message | None]] = {
-    0x05: _whole_pwm_servo_read_position_request,
-    0x09: _whole_pwm_servo_read_offset_request,
-}
+    expected = _CRC_TABLE[0x87 ^ buf[4]]
+    expected = _CRC_TABLE[expected ^ buf[5]]
+    if expected != buf[6]:
+        return None
+    sub = buf[4]
+    if sub == 0x05:
+        v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
+        return _new(PwmServoReadPositionRequest, (v_servo_id,))
+    if sub == 0x09:
+        v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
+        return _new(PwmServoReadOffsetRequest, (v_servo_id,))
+    return None
 
 
 def _whole_pwm_servo_request_8(buf: bytes) -> Message | None:
     """A whole pwm_servo request frame of 8 bytes, by its sub-command: None if its checksum fails or no
     sub-command of that size has its code (decode's general path then says why)."""
-    whole = _PWM_SERVO_REQUEST_WHOLE_8.get(buf[4])
-    return None if whole is None else whole(buf)
-
-
-_PWM_SERVO_REQUEST_WHOLE_8: dict[int, Callable[[bytes], Message | None]] = {
-    0x07: _whole_pwm_servo_set_offset_request,
-}
+    expected = _CRC_TABLE[0xd9 ^ buf[4]]
+    expected = _CRC_TABLE[expected ^ buf[5]]
+    expected = _CRC_TABLE[expected ^ buf[6]]
+    if expected != buf[7]:
+        return None
+    sub = buf[4]
+    if sub == 0x07:
+        v_subcommand_code, v_servo_id, v_offset = _S_U8_U8_I8.unpack_from(buf, 4)
+        return _new(PwmServoSetOffsetRequest, (v_servo_id, v_offset))
+    return None
 
 
 def _whole_bus_servo_request_7(buf: bytes) -> Message | None:
     """A whole bus_servo request frame of 7 bytes, by its sub-command: None if its checksum fails or no
     sub-command of that size has its code (decode's general path then says why)."""
-    whole = _BUS_SERVO_REQUEST_WHOLE_7.get(buf[4])
-    return None if whole is None else whole(buf)
-
-
-_BUS_SERVO_REQUEST_WHOLE_7: dict[int, Callable[[bytes], Message | None]] = {
-    0x05: _whole_bus_servo_read_position_request,
-    0x07: _whole_bus_servo_read_voltage_request,
-    0x09: _whole_bus_servo_read_temperature_request,
-    0x0d: _whole_bus_servo_read_torque_request,
-    0x0b: _whole_bus_servo_unload_request,
-    0x0c: _whole_bus_servo_load_request,
-    0x12: _whole_bus_servo_read_id_request,
-    0x22: _whole_bus_servo_read_offset_request,
-    0x24: _whole_bus_servo_save_offset_request,
-    0x32: _whole_bus_servo_read_position_limit_request,
-    0x36: _whole_bus_servo_read_voltage_limit_request,
-    0x3a: _whole_bus_servo_read_temperature_limit_request,
-}
+    expected = _CRC_TABLE[0x43 ^ buf[4]]
+    expected = _CRC_TABLE[expected ^ buf[5]]
+    if expected != buf[6]:
+        return None
+    sub = buf[4]
+    if sub == 0x05:
+        v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
+        return _new(BusServoReadPositionRequest, (v_servo_id,))
+    if sub == 0x07:
+        v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
+        return _new(BusServoReadVoltageRequest, (v_servo_id,))
+    if sub == 0x09:
+        v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
+        return _new(BusServoReadTemperatureRequest, (v_servo_id,))
+    if sub == 0x0d:
+        v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
+        return _new(BusServoReadTorqueRequest, (v_servo_id,))
+    if sub == 0x0b:
+        v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
+        return _new(BusServoUnloadRequest, (v_servo_id,))
+    if sub == 0x0c:
+        v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
+        return _new(BusServoLoadRequest, (v_servo_id,))
+    if sub == 0x12:
+        v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
+        return _new(BusServoReadIdRequest, (v_servo_id,))
+    if sub == 0x22:
+        v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
+        return _new(BusServoReadOffsetRequest, (v_servo_id,))
+    if sub == 0x24:
+        v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
+        return _new(BusServoSaveOffsetRequest, (v_servo_id,))
+    if sub == 0x32:
+        v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
+        return _new(BusServoReadPositionLimitRequest, (v_servo_id,))
+    if sub == 0x36:
+        v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
+        return _new(BusServoReadVoltageLimitRequest, (v_servo_id,))
+    if sub == 0x3a:
+        v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
+        return _new(BusServoReadTemperatureLimitRequest, (v_servo_id,))
+    return None
 
 
 def _whole_bus_servo_request_8(buf: bytes) -> Message | None:
     """A whole bus_servo request frame of 8 bytes, by its sub-command: None if its checksum fails or no
     sub-command of that size has its code (decode's general path then says why)."""
-    whole = _BUS_SERVO_REQUEST_WHOLE_8.get(buf[4])
-    return None if whole is None else whole(buf)
-
-
-_BUS_SERVO_REQUEST_WHOLE_8: dict[int, Callable[[bytes], Message | None]] = {
-    0x10: _whole_bus_servo_set_id_request,
-    0x20: _whole_bus_servo_set_offset_request,
-    0x38: _whole_bus_servo_set_temperature_limit_request,
-}
+    expected = _CRC_TABLE[0x1d ^ buf[4]]
+    expected = _CRC_TABLE[expected ^ buf[5]]
+    expected = _CRC_TABLE[expected ^ buf[6]]
+    if expected != buf[7]:
+        return None
+    sub = buf[4]
+    if sub == 0x10:
+        v_subcommand_code, v_servo_id, v_new_id = _S_U8_U8_U8.unpack_from(buf, 4)
+        return _new(BusServoSetIdRequest, (v_servo_id, v_new_id))
+    if sub == 0x20:
+        v_subcommand_code, v_servo_id, v_offset = _S_U8_U8_I8.unpack_from(buf, 4)
+        return _new(BusServoSetOffsetRequest, (v_servo_id, v_offset))
+    if sub == 0x38:
+        v_subcommand_code, v_servo_id, v_limit = _S_U8_U8_U8.unpack_from(buf, 4)
+        return _new(BusServoSetTemperatureLimitRequest, (v_servo_id, v_limit))
+    return None
 
 
 def _whole_bus_servo_request_11(buf: bytes) -> Message | None:
     """A whole bus_servo request frame of 11 bytes, by its sub-command: None if its checksum fails or no
     sub-command of that size has its code (decode's general path then says why)."""
-    whole = _BUS_SERVO_REQUEST_WHOLE_11.get(buf[4])
-    return None if whole is None else whole(buf)
-
-
-_BUS_SERVO_REQUEST_WHOLE_11: dict[int, Callable[[bytes], Message | None]] = {
-    0x30: _whole_bus_servo_set_position_limit_request,
-    0x34: _whole_bus_servo_set_voltage_limit_request,
-}
+    expected = _CRC_TABLE[0x22 ^ buf[4]]
+    expected = _CRC_TABLE[expected ^ buf[5]]
+    expected = _CRC_TABLE[expected ^ buf[6]]
+    expected = _CRC_TABLE[expected ^ buf[7]]
+    expected = _CRC_TABLE[expected ^ buf[8]]
+    expected = _CRC_TABLE[expected ^ buf[9]]
+    if expected != buf[10]:
+        return None
+    sub = buf[4]
+    if sub == 0x30:
+        v_subcommand_code, v_servo_id, v_low, v_high = _S_U8_U8_U16_U16.unpack_from(buf, 4)
+        return _new(BusServoSetPositionLimitRequest, (v_servo_id, v_low, v_high))
+    if sub == 0x34:
+        v_subcommand_code, v_servo_id, v_low, v_high = _S_U8_U8_U16_U16.unpack_from(buf, 4)
+        return _new(BusServoSetVoltageLimitRequest, (v_servo_id, v_low, v_high))
+    return None
 
 
 def _whole_pwm_servo_response_9(buf: bytes) -> Message | None:
     """A whole pwm_servo response frame of 9 bytes, by its sub-command: None if its checksum fails or no
     sub-command of that size has its code (decode's general path then says why)."""
-    whole = _PWM_SERVO_RESPONSE_WHOLE_9.get(buf[5])
-    return None if whole is None else whole(buf)
-
-
-_PWM_SERVO_RESPONSE_WHOLE_9: dict[int, Callable[[bytes], Message | None]] = {
-    0x05: _whole_pwm_servo_read_position_response,
-}
+    expected = _CRC_TABLE[0x5a ^ buf[4]]
+    expected = _CRC_TABLE[expected ^ buf[5]]
+    expected = _CRC_TABLE[expected ^ buf[6]]
+    expected = _CRC_TABLE[expected ^ buf[7]]
+    if expected != buf[8]:
+        return None
+    sub = buf[5]
+    if sub == 0x05:
+        v_servo_id, v_subcommand_code, v_pulse = _S_U8_U8_U16.unpack_from(buf, 4)
+        return _new(PwmServoReadPositionResponse, (v_servo_id, v_pulse))
+    return None
 
 
 def _whole_pwm_servo_response_8(buf: bytes) -> Message | None:
     """A whole pwm_servo response frame of 8 bytes, by its sub-command: None if its checksum fails or no
     sub-command of that size has its code (decode's general path then says why)."""
-    whole = _PWM_SERVO_RESPONSE_WHOLE_8.get(buf[5])
-    return None if whole is None else whole(buf)
-
-
-_PWM_SERVO_RESPONSE_WHOLE_8: dict[int, Callable[[bytes], Message | None]] = {
-    0x09: _whole_pwm_servo_read_offset_response,
-}
+    expected = _CRC_TABLE[0xd9 ^ buf[4]]
+    expected = _CRC_TABLE[expected ^ buf[5]]
+    expected = _CRC_TABLE[expected ^ buf[6]]
+    if expected != buf[7]:
+        return None
+    sub = buf[5]
+    if sub == 0x09:
+        v_servo_id, v_subcommand_code, v_offset = _S_U8_U8_I8.unpack_from(buf, 4)
+        return _new(PwmServoReadOffsetResponse, (v_servo_id, v_offset))
+    return None
 
 
 def _whole_bus_servo_response_10(buf: bytes) -> Message | None:
     """A whole bus_servo response frame of 10 bytes, by its sub-command: None if its checksum fails or no
     sub-command of that size has its code (decode's general path then says why)."""
-    whole = _BUS_SERVO_RESPONSE_WHOLE_10.get(buf[5])
-    return None if whole is None else whole(buf)
-
-
-_BUS_SERVO_RESPONSE_WHOLE_10: dict[int, Callable[[bytes], Message | None]] = {
-    0x05: _whole_bus_servo_read_position_response,
-    0x07: _whole_bus_servo_read_voltage_response,
-}
+    expected = _CRC_TABLE[0xc0 ^ buf[4]]
+    expected = _CRC_TABLE[expected ^ buf[5]]
+    expected = _CRC_TABLE[expected ^ buf[6]]
+    expected = _CRC_TABLE[expected ^ buf[7]]
+    expected = _CRC_TABLE[expected ^ buf[8]]
+    if expected != buf[9]:
+        return None
+    sub = buf[5]
+    if sub == 0x05:
+        v_servo_id, v_subcommand_code, v_success, v_position = _S_U8_U8_I8_I16.unpack_from(buf, 4)
+        return _new(BusServoReadPositionResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_position))
+    if sub == 0x07:
+        v_servo_id, v_subcommand_code, v_success, v_voltage = _S_U8_U8_I8_U16.unpack_from(buf, 4)
+        return _new(BusServoReadVoltageResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_voltage))
+    return None
 
 
 def _whole_bus_servo_response_9(buf: bytes) -> Message | None:
     """A whole bus_servo response frame of 9 bytes, by its sub-command: None if its checksum fails or no
     sub-command of that size has its code (decode's general path then says why)."""
-    whole = _BUS_SERVO_RESPONSE_WHOLE_9.get(buf[5])
-    return None if whole is None else whole(buf)
-
-
-_BUS_SERVO_RESPONSE_WHOLE_9: dict[int, Callable[[bytes], Message | None]] = {
-    0x09: _whole_bus_servo_read_temperature_response,
-    0x0d: _whole_bus_servo_read_torque_response,
-    0x12: _whole_bus_servo_read_id_response,
-    0x22: _whole_bus_servo_read_offset_response,
-    0x3a: _whole_bus_servo_read_temperature_limit_response,
-}
+    expected = _CRC_TABLE[0x9e ^ buf[4]]
+    expected = _CRC_TABLE[expected ^ buf[5]]
+    expected = _CRC_TABLE[expected ^ buf[6]]
+    expected = _CRC_TABLE[expected ^ buf[7]]
+    if expected != buf[8]:
+        return None
+    sub = buf[5]
+    if sub == 0x09:
+        v_servo_id, v_subcommand_code, v_success, v_temperature = _S_U8_U8_I8_U8.unpack_from(buf, 4)
+        return _new(BusServoReadTemperatureResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_temperature))
+    if sub == 0x0d:
+        v_servo_id, v_subcommand_code, v_success, v_torque = _S_U8_U8_I8_I8.unpack_from(buf, 4)
+        return _new(BusServoReadTorqueResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_torque))
+    if sub == 0x12:
+        v_servo_id, v_subcommand_code, v_success, v_id = _S_U8_U8_I8_U8.unpack_from(buf, 4)
+        return _new(BusServoReadIdResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_id))
+    if sub == 0x22:
+        v_servo_id, v_subcommand_code, v_success, v_offset = _S_U8_U8_I8_I8.unpack_from(buf, 4)
+        return _new(BusServoReadOffsetResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_offset))
+    if sub == 0x3a:
+        v_servo_id, v_subcommand_code, v_success, v_limit = _S_U8_U8_I8_U8.unpack_from(buf, 4)
+        return _new(BusServoReadTemperatureLimitResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_limit))
+    return None
 
 
 def _whole_bus_servo_response_12(buf: bytes) -> Message | None:
     """A whole bus_servo response frame of 12 bytes, by its sub-command: None if its checksum fails or no
     sub-command of that size has its code (decode's general path then says why)."""
-    whole = _BUS_SERVO_RESPONSE_WHOLE_12.get(buf[5])
-    return None if whole is None else whole(buf)
-
-
-_BUS_SERVO_RESPONSE_WHOLE_12: dict[int, Callable[[bytes], Message | None]] = {
-    0x32: _whole_bus_servo_read_position_limit_response,
-    0x36: _whole_bus_servo_read_voltage_limit_response,
-}
+    expected = _CRC_TABLE[0x7c ^ buf[4]]
+    expected = _CRC_TABLE[expected ^ buf[5]]
+    expected = _CRC_TABLE[expected ^ buf[6]]
+    expected = _CRC_TABLE[expected ^ buf[7]]
+    expected = _CRC_TABLE[expected ^ buf[8]]
+    expected = _CRC_TABLE[expected ^ buf[9]]
+    expected = _CRC_TABLE[expected ^ buf[10]]
+    if expected != buf[11]:
+        return None
+    sub = buf[5]
+    if sub == 0x32:
+        v_servo_id, v_subcommand_code, v_success, v_low, v_high = _S_U8_U8_I8_U16_U16.unpack_from(buf, 4)
+        return _new(BusServoReadPositionLimitResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_low, v_high))
+    if sub == 0x36:
+        v_servo_id, v_subcommand_code, v_success, v_low, v_high = _S_U8_U8_I8_U16_U16.unpack_from(buf, 4)
+        return _new(BusServoReadVoltageLimitResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_low, v_high))
+    return None
 
 
 def _whole_system_response_8(buf: bytes) -> Message | None:
     """A whole system response frame of 8 bytes, by its sub-command: None if its checksum fails or no
     sub-command of that size has its code (decode's general path then says why)."""
-    whole = _SYSTEM_RESPONSE_WHOLE_8.get(buf[4])
-    return None if whole is None else whole(buf)
-
-
-_SYSTEM_RESPONSE_WHOLE_8: dict[int, Callable[[bytes], Message | None]] = {
-    0x04: _whole_system_battery_response,
-}
+    expected = _CRC_TABLE[0xe2 ^ buf[4]]
+    expected = _CRC_TABLE[expected ^ buf[5]]
+    expected = _CRC_TABLE[expected ^ buf[6]]
+    if expected != buf[7]:
+        return None
+    sub = buf[4]
+    if sub == 0x04:
+        v_subcommand_code, v_voltage = _S_U8_U16.unpack_from(buf, 4)
+        return _new(SystemBatteryResponse, (v_voltage,))
+    return None
 
 
 def _encode_led_request(m: LedRequest) -> bytes:
@@ -2319,11 +2035,12 @@ _REQUEST_WHOLE: dict[bytes, tuple[int, Callable[[bytes], Message | None]]] = {
 
 def _decode_request_at(buf: bytes, start: int, stop: int) -> Message:
     """The frame buf[start:stop], whose header and length byte the stream parser has checked."""
+    check = buf[stop - 1]
     expected = 0x0
     for byte in buf[start + 2 : stop - 1]:
         expected = _CRC_TABLE[expected ^ byte]
-    if expected != buf[stop - 1]:
-        raise ChecksumError(f"bad checksum: the frame has {buf[stop - 1]:#04x}, its bytes give {expected:#04x}")
+    if expected != check:
+        raise ChecksumError(f"bad checksum: the frame has {check:#04x}, its bytes give {expected:#04x}")
     decoder = _REQUEST_DECODERS.get(buf[start + 2])
     if decoder is None:
         raise DecodeError(f"unknown command {buf[start + 2]:#04x}")
@@ -2374,11 +2091,12 @@ _RESPONSE_WHOLE: dict[bytes, tuple[int, Callable[[bytes], Message | None]]] = {
 
 def _decode_response_at(buf: bytes, start: int, stop: int) -> Message:
     """The frame buf[start:stop], whose header and length byte the stream parser has checked."""
+    check = buf[stop - 1]
     expected = 0x0
     for byte in buf[start + 2 : stop - 1]:
         expected = _CRC_TABLE[expected ^ byte]
-    if expected != buf[stop - 1]:
-        raise ChecksumError(f"bad checksum: the frame has {buf[stop - 1]:#04x}, its bytes give {expected:#04x}")
+    if expected != check:
+        raise ChecksumError(f"bad checksum: the frame has {check:#04x}, its bytes give {expected:#04x}")
     decoder = _RESPONSE_DECODERS.get(buf[start + 2])
     if decoder is None:
         raise DecodeError(f"unknown command {buf[start + 2]:#04x}")
@@ -2482,11 +2200,12 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         size = data[3]
         if n != 5 + size:
             raise DecodeError(f"length byte says {size} content bytes but the frame holds {n - 5}")
+        check = data[-1]
         expected = 0x0
         for byte in data[2:-1]:
             expected = _CRC_TABLE[expected ^ byte]
-        if expected != data[-1]:
-            raise ChecksumError(f"bad checksum: the frame has {data[-1]:#04x}, its bytes give {expected:#04x}")
+        if expected != check:
+            raise ChecksumError(f"bad checksum: the frame has {check:#04x}, its bytes give {expected:#04x}")
         decoder = _REQUEST_DECODERS.get(data[2])
         if decoder is None:
             raise DecodeError(f"unknown command {data[2]:#04x}")
@@ -2505,11 +2224,12 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         size = data[3]
         if n != 5 + size:
             raise DecodeError(f"length byte says {size} content bytes but the frame holds {n - 5}")
+        check = data[-1]
         expected = 0x0
         for byte in data[2:-1]:
             expected = _CRC_TABLE[expected ^ byte]
-        if expected != data[-1]:
-            raise ChecksumError(f"bad checksum: the frame has {data[-1]:#04x}, its bytes give {expected:#04x}")
+        if expected != check:
+            raise ChecksumError(f"bad checksum: the frame has {check:#04x}, its bytes give {expected:#04x}")
         decoder = _RESPONSE_DECODERS.get(data[2])
         if decoder is None:
             raise DecodeError(f"unknown command {data[2]:#04x}")

@@ -165,12 +165,12 @@ def members(enum: type[M]) -> dict[Any, M]:
 
 
 def slot_setters(cls: type) -> tuple[Callable[[Any, Any], None], ...]:
-    """One setter per field of a generated (frozen, slotted) class, in field order, that stores into the field's slot.
+    """One setter per field of a frozen, slotted class, in field order, that stores into the field's slot.
 
-    __init__ of a frozen class stores every field through object.__setattr__, which costs more than unpacking a
-    whole frame; the codec builds decoded messages with `object.__new__` and these setters instead (the values come
-    from a checked frame, so __init__ has nothing else to do). Raises TypeError for a class without slots, so a
-    change of the message classes cannot silently fall back to something slower or wrong.
+    Generated classes no longer need it: they are tuples underneath and decoders make them with `build`, in one
+    call. For a frozen slotted class of your own, `object.__new__` and these setters fill an instance without its
+    __init__ (which stores each field through object.__setattr__). Raises TypeError for a class without slots, so
+    a change of the class cannot silently fall back to something slower or wrong.
     """
     setters = []
     for name in getattr(cls, "__match_args__", ()):

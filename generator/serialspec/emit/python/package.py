@@ -437,21 +437,44 @@ def subcommand_frames(
             made = frame_function(protocol, layout, command, message, bodies, code, command.selector.name)
             if made is not None:
                 key, size, function = made
-                functions.append(function)
                 by_size.setdefault((key, size), []).append((sub.code, function))
+        at = content_offset + command.selector.offsets[layout.direction]
         for (key, size), subs in by_size.items():
-            where = f"{command.name} {layout.direction.value}"
             picker = {
                 "whole_name": f"_whole_{command.name}_{layout.direction.value}_{size}",
                 "table": f"_{command.name.upper()}_{layout.direction.name}_WHOLE_{size}",
-                "at": content_offset + command.selector.offsets[layout.direction],
                 "size": size,
-                "where": where,
+                "where": f"{command.name} {layout.direction.value}",
                 "entries": [(f"{c:#04x}", f["whole_name"]) for c, f in subs],
             }
-            pickers.append(picker)
+            lines = picked_inline(subs, at, code)
+            if lines is None:  # each sub-command's own decoder, from a table
+                functions += [f for _, f in subs]
+                lines = [f"whole = {picker['table']}.get(buf[{at}])", "return None if whole is None else whole(buf)"]
+            else:
+                picker["entries"] = []
+            pickers.append(picker | {"lines": lines})
             entries.append((f"{key:#06x}", size, picker))
     return functions, pickers, entries
+
+
+def picked_inline(subs: list[tuple[int, dict[str, Any]]], at: int, code: PackageCode) -> Lines | None:
+    """One function's lines for the sub-command frames of one size, where their checksum does not depend on their
+    fields (a sum or CRC over the bytes, the same lines for all, given the key): the check once, then each
+    sub-command's unpacking under an `if` on its code. None where the check is made from the unpacked values."""
+    first = subs[0][1]["whole_lines"]
+    if "    return None" not in first:
+        return None
+    checks = first[: first.index("    return None") + 1]
+    if any("unpack_from" in line for line in checks):
+        return None
+    if any(f["whole_lines"][: len(checks)] != checks for _, f in subs):
+        return None
+    lines = [*checks, f"sub = buf[{at}]"]
+    for sub_code, f in subs:
+        body = fuse_unpack(f["whole_lines"][len(checks) :], code.structs)
+        lines += [f"if sub == {sub_code:#04x}:", *(f"    {line}" for line in body)]
+    return [*lines, "return None"]
 
 
 def frame_function(
@@ -516,6 +539,7 @@ def frame_function(
     return key, size, function
 
 
+_MOST_UNROLLED = 12  # CRC-8 steps written out one by one in a whole-frame decoder; more take a loop
 _CRC_LOOP = re.compile(r"^for byte in buf\[(?P<first>\d+) : (?P<stop>\d+)\]:$")
 _AT_START = re.compile(r"\bstart \+ (\d+)\b")
 
@@ -539,7 +563,13 @@ def whole_frame_lines(
         while first in known and first < int(loop["stop"]) - 1:
             state = table[state ^ known[first]]
             first += 1
-        return [f"expected = {state:#x}", f"for byte in buf[{first} : {loop['stop']}]:", *lines[2:]]
+        stop = int(loop["stop"])
+        if stop - first > _MOST_UNROLLED:
+            return [f"expected = {state:#x}", f"for byte in buf[{first} : {stop}]:", *lines[2:]]
+        # a few bytes: one table step each, no slice and no loop
+        steps = [f"expected = _CRC_TABLE[{state:#x} ^ buf[{first}]]"]
+        steps += [f"expected = _CRC_TABLE[expected ^ buf[{offset}]]" for offset in range(first + 1, stop)]
+        return [*steps, *lines[3:]]  # in place of the loop and its one-line body
     header = layout.header[: layout.covered_from]
     whole_sum = (
         not summed
@@ -662,13 +692,15 @@ def frame_decode_lines(
         stored = f"{buf}[stop - 1]" if size == 1 else f"int.from_bytes({buf}[stop - {size} : stop], 'little')"
         content = f"{start} + {offset}, stop - {after}"
     args = f"{buf}, {content}" + "".join(f", {at(layout.offsets[e.name])}" for e in layout.value_elements)
-    lines = checksum_lines(checksum, covered, "expected")
+    lines = [f"check = {stored}"]  # read once: the sum and the comparison both use it
+    stored = "check"
+    lines += checksum_lines(checksum, covered, "expected")
     header = layout.header[: layout.covered_from]
     whole_sum = checksum.algorithm == "sum" and size == 1 == layout.covered_to_end == checksum.type.size
     if start is None and whole_sum and len(header) == layout.covered_from:
         # all but a checked header and the check: the sum of the whole frame less those, no slice made
         less = f" - {sum(header):#x}" if header else ""
-        lines = [f"expected = {'~' if checksum.invert else ''}(sum({buf}){less} - {stored}) & 0xff"]
+        lines = [lines[0], f"expected = {'~' if checksum.invert else ''}(sum({buf}){less} - {stored}) & 0xff"]
     lines += [
         f"if expected != {stored}:",
         f'    raise ChecksumError(f"bad checksum: the frame has {{{stored}:#04x}}, its bytes give {{expected:#04x}}")',

@@ -197,6 +197,28 @@ def _whole_reset_request(buf: bytes) -> ResetRequest | None:
     return _new(ResetRequest, (id,))
 
 
+def _whole_write_request(buf: bytes) -> WriteRequest | None:
+    """A whole write request frame, all of buf, its size and first bytes known: None if its checksum fails."""
+    check = buf[-1]
+    if ~(sum(buf) - 0x1fe - check) & 0xff != check:
+        return None
+    id = buf[2]
+    v_address = buf[5]
+    v_data = buf[6:-1]
+    return _new(WriteRequest, (id, v_address, v_data))
+
+
+def _whole_reg_write_request(buf: bytes) -> RegWriteRequest | None:
+    """A whole reg_write request frame, all of buf, its size and first bytes known: None if its checksum fails."""
+    check = buf[-1]
+    if ~(sum(buf) - 0x1fe - check) & 0xff != check:
+        return None
+    id = buf[2]
+    v_address = buf[5]
+    v_data = buf[6:-1]
+    return _new(RegWriteRequest, (id, v_address, v_data))
+
+
 def _encode_ping_request(m: PingRequest) -> bytes:
     m_id = m.id
     if not 0 <= m_id <= 254 or m_id.__class__ is bool:
@@ -374,6 +396,8 @@ _REQUEST_WHOLE: dict[int, tuple[int, Callable[[bytes], Message | None]]] = {
     0x0204: (8, _whole_read_request),
     0x0502: (6, _whole_action_request),
     0x0602: (6, _whole_reset_request),
+    **{0x03 << 8 | n: (n + 4, _whole_write_request) for n in range(3, 256)},
+    **{0x04 << 8 | n: (n + 4, _whole_reg_write_request) for n in range(3, 256)},
 }
 
 

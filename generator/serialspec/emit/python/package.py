@@ -19,6 +19,7 @@ from serialspec.emit.python.pycode import (
     encoder_name,
     fuse_unpack,
     one_line,
+    takes_the_rest,
 )
 from serialspec.emit.python.registers import register_tables, registers_module
 from serialspec.emit.python.render import render
@@ -26,6 +27,7 @@ from serialspec.emit.python.simulator import import_order, simulator_module
 from serialspec.emit.python.structs import structs_module
 from serialspec.runtime.checksums import crc_table
 from serialspec.spec.model import (
+    Bytes,
     Command,
     Direction,
     FrameLayout,
@@ -290,6 +292,8 @@ def classic_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
         fixed = fixed_frames(protocol, layout, decoder_bodies, code)
         sub_functions, pickers, sub_entries = subcommand_frames(protocol, layout, decoder_bodies, code)
         whole = whole_frames(layout, [*fixed, *sub_entries])
+        rests = rest_frames(protocol, layout, decoder_bodies, code) if whole or fixed else []
+        whole_functions += rests
         if whole:  # decode() looks frames up by their first bytes
             whole_functions += [f | {"whole_lines": fuse_unpack(f["whole_lines"], code.structs)} for f in sub_functions]
             whole_pickers += pickers
@@ -305,6 +309,7 @@ def classic_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
             {
                 "fixed": [(key, size, function["name"]) for key, size, function in fixed],
                 "fixed_whole": [(key, size, function["whole_name"]) for key, size, function in fixed],
+                "rest_keys": [rest_key(layout, r, bool(whole)) for r in rests],
                 "whole_frames": whole,
                 "whole_size": max(layout.length_offset, layout.command_offset or 0) + 1,
                 "key": frame_key(layout, "data"),
@@ -377,6 +382,27 @@ def frame_key(layout: FrameLayout, buf: str, start: str = "") -> str:
     if layout.command_offset is None:
         return length
     return f"{buf}[{at}{layout.command_offset}] << 8 | {length}"
+
+
+def rest_key(layout: FrameLayout, rest: dict[str, Any], by_bytes: bool) -> dict[str, Any]:
+    """decode()'s table entries of a frame that takes the rest (rest_frames), one per length byte `n`: the key's
+    expression in `n` (first bytes as whole_frames makes them, or the size key as frame_key), the range of `n`,
+    and the frame size less `n`."""
+    code = rest["code"] or 0
+    if by_bytes:  # header, then command code and length byte in offset order
+        key = " + ".join(
+            [
+                repr(layout.header),
+                *(
+                    "bytes((n,))" if o == layout.length_offset else repr(bytes([code]))
+                    for o in sorted(o for o in (layout.command_offset, layout.length_offset) if o is not None)
+                ),
+            ]
+        )
+    else:
+        key = f"{code:#04x} << 8 | n" if layout.command_offset is not None else "n"
+    low, high = rest["lengths"]
+    return {"key": key, "low": low, "high": high, "adds": rest["adds"], "name": rest["whole_name"]}
 
 
 def whole_frames(layout: FrameLayout, fixed: list[tuple[str, int, dict[str, Any]]]) -> list[tuple[str, int, str]]:
@@ -456,6 +482,74 @@ def subcommand_frames(
             pickers.append(picker | {"lines": lines})
             entries.append((f"{key:#06x}", size, picker))
     return functions, pickers, entries
+
+
+def rest_frames(
+    protocol: Protocol, layout: FrameLayout, bodies: dict[str, tuple[str, str, Lines]], code: PackageCode
+) -> list[dict[str, Any]]:
+    """decode()'s whole-frame decoders of the frames whose content is fixed fields then bytes to its end (FEETECH
+    WRITE: an address, then the data): any length byte from the smallest such content up names one, so decode()'s
+    table holds a key per length byte. Each checks the checksum, reads the fields at constant offsets and the bytes
+    up to the frame's tail: no dispatch, no content decoder's call. Others keep the general path."""
+    checksum = protocol.framing.checksum
+    length = layout.length
+    if checksum is None or length is None or length.type is None:
+        return []
+    content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
+    tail = layout.overhead - content_offset  # bytes after the content
+    found = []
+    for command in protocol.commands:
+        message = command.request if layout.direction == Direction.REQUEST else command.response
+        if command.selector is not None or message is None or message.max_size is not None or not message.fields:
+            continue
+        if not (isinstance(message.fields[-1], Bytes) and takes_the_rest(message.fields[-1])):
+            continue
+        returns, extra, lines = bodies[decoder_name(message)]
+        if not lines[0].startswith("if end - o < "):
+            continue
+        offset, body = content_offset, []
+        for line in lines[2:]:  # the size check: the key implies it
+            moved = re.fullmatch(r"o \+= (\d+)", line)
+            if moved:
+                offset += int(moved[1])
+                continue
+            line = line.replace("buf[o:end]", f"buf[{offset}:-{tail}]").replace("(buf, o)", f"(buf, {offset})")
+            if "raise " in line or _CURSOR.search(line):
+                break  # checked beyond its size, or read at a cursor: the general path
+            body.append(line)
+        else:
+            check_lines = rest_check_lines(protocol, layout)
+            values = [f"{e.name} = buf[{layout.offsets[e.name]}]" for e in layout.value_elements]
+            lowest = (message.min_size or 0) + layout.length_adds
+            found.append(
+                {
+                    "whole_name": "_whole" + decoder_name(message).removeprefix("_decode"),
+                    "returns": returns,
+                    "where": f"{message.key} {message.direction.value}",
+                    "whole_lines": fuse_unpack([*check_lines, "    return None", *values, *body], code.structs),
+                    "code": command.code,
+                    "lengths": (lowest, length.type.maximum),
+                    "adds": layout.overhead - layout.length_adds,  # frame size = length byte + this
+                }
+            )
+    return found
+
+
+def rest_check_lines(protocol: Protocol, layout: FrameLayout) -> Lines:
+    """The checksum test of a whole frame of any size (`buf` is the frame): true when it fails."""
+    checksum = protocol.framing.checksum
+    assert checksum is not None  # classic frames have one
+    size = layout.checksum_offset_from_end
+    stored = "buf[-1]" if size == 1 else f"int.from_bytes(buf[-{size}:], 'little')"
+    header = layout.header[: layout.covered_from]
+    whole_sum = checksum.algorithm == "sum" and size == 1 == layout.covered_to_end == checksum.type.size
+    if whole_sum and len(header) == layout.covered_from:
+        less = f" - {sum(header):#x}" if header else ""
+        if not checksum.invert:
+            return [f"if (sum(buf){less} - 2 * buf[-1]) & 0xff:"]
+        return ["check = buf[-1]", f"if ~(sum(buf){less} - check) & 0xff != check:"]
+    covered = f"buf[{layout.covered_from}:-{layout.covered_to_end}]"
+    return [*checksum_lines(checksum, covered, "expected"), f"if expected != {stored}:"]
 
 
 def picked_inline(subs: list[tuple[int, dict[str, Any]]], at: int, code: PackageCode) -> Lines | None:

@@ -1751,27 +1751,28 @@ _REQUEST_FIXED: dict[int, tuple[int, Callable[[bytes, int], Message | None]]] = 
 }
 
 
-# The same frames for decode(), by their first bytes (header, command code, length byte): frame size, decoder.
-_REQUEST_WHOLE: dict[bytes, tuple[int, Callable[[bytes], Message | None]]] = {
-    b'\x12L\x01\x01': (6, _whole_ping_request),
-    b'\x12L\x02\x01': (6, _whole_reset_user_data_request),
-    b'\x12L\x03\x02': (7, _whole_read_data_request),
-    b'\x12L\x05\x01': (6, _whole_read_batch_data_request),
-    b'\x12L\x06!': (38, _whole_write_batch_data_request),
-    b'\x12L\x08\x07': (12, _whole_rotate_request),
-    b'\x12L\t\x03': (8, _whole_damping_request),
-    b'\x12L\n\x01': (6, _whole_read_angle_request),
-    b'\x12L\x0b\x0b': (16, _whole_move_by_interval_request),
-    b'\x12L\x0c\x0b': (16, _whole_move_by_velocity_request),
-    b'\x12L\r\x0b': (16, _whole_move_mturn_request),
-    b'\x12L\x0e\x0f': (20, _whole_move_mturn_by_interval_request),
-    b'\x12L\x0f\r': (18, _whole_move_mturn_by_velocity_request),
-    b'\x12L\x10\x01': (6, _whole_read_mturn_angle_request),
-    b'\x12L\x11\x01': (6, _whole_reset_mturn_angle_request),
-    b'\x12L\x12\x00': (5, _whole_begin_async_request),
-    b'\x12L\x13\x01': (6, _whole_end_async_request),
-    b'\x12L\x16\x01': (6, _whole_monitor_request),
-    b'\x12L\x18\x04': (9, _whole_stop_on_control_mode_request),
+# The same frames for decode(), by their first bytes (header, command code, length byte): frame size, decoder, and
+# for a frame whose message is its content as one struct unpacks it, that unpack and the class (decode() builds it).
+_REQUEST_WHOLE: dict[bytes, tuple[int, Callable[[bytes], Message | None], Callable[[bytes, int], tuple[int, ...]] | None, type[Message]]] = {
+    b'\x12L\x01\x01': (6, _whole_ping_request, None, Message),
+    b'\x12L\x02\x01': (6, _whole_reset_user_data_request, None, Message),
+    b'\x12L\x03\x02': (7, _whole_read_data_request, None, Message),
+    b'\x12L\x05\x01': (6, _whole_read_batch_data_request, None, Message),
+    b'\x12L\x06!': (38, _whole_write_batch_data_request, None, Message),
+    b'\x12L\x08\x07': (12, _whole_rotate_request, _S_U8_I16_U16_U16.unpack_from, RotateRequest),
+    b'\x12L\t\x03': (8, _whole_damping_request, None, Message),
+    b'\x12L\n\x01': (6, _whole_read_angle_request, None, Message),
+    b'\x12L\x0b\x0b': (16, _whole_move_by_interval_request, _S_U8_I16_U16_U16_U16_U16.unpack_from, MoveByIntervalRequest),
+    b'\x12L\x0c\x0b': (16, _whole_move_by_velocity_request, _S_U8_I16_U16_U16_U16_U16.unpack_from, MoveByVelocityRequest),
+    b'\x12L\r\x0b': (16, _whole_move_mturn_request, _S_U8_I32_U32_U16.unpack_from, MoveMturnRequest),
+    b'\x12L\x0e\x0f': (20, _whole_move_mturn_by_interval_request, _S_U8_I32_U32_U16_U16_U16.unpack_from, MoveMturnByIntervalRequest),
+    b'\x12L\x0f\r': (18, _whole_move_mturn_by_velocity_request, _S_U8_I32_U16_U16_U16_U16.unpack_from, MoveMturnByVelocityRequest),
+    b'\x12L\x10\x01': (6, _whole_read_mturn_angle_request, None, Message),
+    b'\x12L\x11\x01': (6, _whole_reset_mturn_angle_request, None, Message),
+    b'\x12L\x12\x00': (5, _whole_begin_async_request, None, Message),
+    b'\x12L\x13\x01': (6, _whole_end_async_request, None, Message),
+    b'\x12L\x16\x01': (6, _whole_monitor_request, None, Message),
+    b'\x12L\x18\x04': (9, _whole_stop_on_control_mode_request, None, Message),
 }
 
 
@@ -1846,24 +1847,25 @@ _RESPONSE_FIXED: dict[int, tuple[int, Callable[[bytes, int], Message | None]]] =
 }
 
 
-# The same frames for decode(), by their first bytes (header, command code, length byte): frame size, decoder.
-_RESPONSE_WHOLE: dict[bytes, tuple[int, Callable[[bytes], Message | None]]] = {
-    b'\x05\x1c\x01\x01': (6, _whole_ping_response),
-    b'\x05\x1c\x02\x02': (7, _whole_reset_user_data_response),
-    b'\x05\x1c\x04\x03': (8, _whole_write_data_response),
-    b'\x05\x1c\x05!': (38, _whole_read_batch_data_response),
-    b'\x05\x1c\x06\x02': (7, _whole_write_batch_data_response),
-    b'\x05\x1c\x07\x02': (7, _whole_spin_response),
-    b'\x05\x1c\x08\x02': (7, _whole_rotate_response),
-    b'\x05\x1c\t\x02': (7, _whole_damping_response),
-    b'\x05\x1c\n\x03': (8, _whole_read_angle_response),
-    b'\x05\x1c\x0b\x02': (7, _whole_move_by_interval_response),
-    b'\x05\x1c\x0c\x02': (7, _whole_move_by_velocity_response),
-    b'\x05\x1c\r\x02': (7, _whole_move_mturn_response),
-    b'\x05\x1c\x0e\x02': (7, _whole_move_mturn_by_interval_response),
-    b'\x05\x1c\x0f\x02': (7, _whole_move_mturn_by_velocity_response),
-    b'\x05\x1c\x10\x07': (12, _whole_read_mturn_angle_response),
-    b'\x05\x1c\x16\x10': (21, _whole_monitor_response),
+# The same frames for decode(), by their first bytes (header, command code, length byte): frame size, decoder, and
+# for a frame whose message is its content as one struct unpacks it, that unpack and the class (decode() builds it).
+_RESPONSE_WHOLE: dict[bytes, tuple[int, Callable[[bytes], Message | None], Callable[[bytes, int], tuple[int, ...]] | None, type[Message]]] = {
+    b'\x05\x1c\x01\x01': (6, _whole_ping_response, None, Message),
+    b'\x05\x1c\x02\x02': (7, _whole_reset_user_data_response, None, Message),
+    b'\x05\x1c\x04\x03': (8, _whole_write_data_response, None, Message),
+    b'\x05\x1c\x05!': (38, _whole_read_batch_data_response, None, Message),
+    b'\x05\x1c\x06\x02': (7, _whole_write_batch_data_response, None, Message),
+    b'\x05\x1c\x07\x02': (7, _whole_spin_response, None, Message),
+    b'\x05\x1c\x08\x02': (7, _whole_rotate_response, None, Message),
+    b'\x05\x1c\t\x02': (7, _whole_damping_response, None, Message),
+    b'\x05\x1c\n\x03': (8, _whole_read_angle_response, None, Message),
+    b'\x05\x1c\x0b\x02': (7, _whole_move_by_interval_response, None, Message),
+    b'\x05\x1c\x0c\x02': (7, _whole_move_by_velocity_response, None, Message),
+    b'\x05\x1c\r\x02': (7, _whole_move_mturn_response, None, Message),
+    b'\x05\x1c\x0e\x02': (7, _whole_move_mturn_by_interval_response, None, Message),
+    b'\x05\x1c\x0f\x02': (7, _whole_move_mturn_by_velocity_response, None, Message),
+    b'\x05\x1c\x10\x07': (12, _whole_read_mturn_angle_response, _S_U8_I32_I16.unpack_from, ReadMturnAngleResponse),
+    b'\x05\x1c\x16\x10': (21, _whole_monitor_response, None, Message),
 }
 
 
@@ -1956,9 +1958,13 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
     if direction is _REQUEST:
         fixed = _REQUEST_WHOLE.get(data[:4])  # no key is shorter: a short frame matches none
         if fixed is not None and fixed[0] == len(data):
-            message = fixed[1](data)
-            if message is not None:
-                return message
+            _, whole, unpack, cls = fixed
+            if unpack is None:
+                message = whole(data)
+                if message is not None:
+                    return message
+            elif not (sum(data) - 2 * data[-1]) & 0xff:  # its message is its content as unpacked: built here, no call
+                return _new(cls, unpack(data, 4))
         n = len(data)
         if n < 5:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (5 bytes)")
@@ -1978,9 +1984,13 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
     if direction is _RESPONSE:
         fixed = _RESPONSE_WHOLE.get(data[:4])  # no key is shorter: a short frame matches none
         if fixed is not None and fixed[0] == len(data):
-            message = fixed[1](data)
-            if message is not None:
-                return message
+            _, whole, unpack, cls = fixed
+            if unpack is None:
+                message = whole(data)
+                if message is not None:
+                    return message
+            elif not (sum(data) - 2 * data[-1]) & 0xff:  # its message is its content as unpacked: built here, no call
+                return _new(cls, unpack(data, 4))
         n = len(data)
         if n < 5:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (5 bytes)")

@@ -311,6 +311,9 @@ def classic_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
                 "fixed_whole": [(key, size, function["whole_name"]) for key, size, function in fixed],
                 "rest_keys": [rest_key(layout, r, bool(whole)) for r in rests],
                 "whole_frames": whole,
+                "plain": any(plain for *_, plain in whole),
+                "plain_check": plain_check(protocol, layout),
+                "content_offset": layout.offsets[next(e.name for e in layout.elements if e.role == "content")],
                 "whole_size": max(layout.length_offset, layout.command_offset or 0) + 1,
                 "key": frame_key(layout, "data"),
                 "name": direction.value,
@@ -405,7 +408,9 @@ def rest_key(layout: FrameLayout, rest: dict[str, Any], by_bytes: bool) -> dict[
     return {"key": key, "low": low, "high": high, "adds": rest["adds"], "name": rest["whole_name"]}
 
 
-def whole_frames(layout: FrameLayout, fixed: list[tuple[str, int, dict[str, Any]]]) -> list[tuple[str, int, str]]:
+def whole_frames(
+    layout: FrameLayout, fixed: list[tuple[str, int, dict[str, Any]]]
+) -> list[tuple[str, int, str, tuple[str, str] | None]]:
     """decode()'s table of the frames decoded whole, keyed by their first bytes when those are the header, command
     code and length byte (one slice, one lookup, and the header is checked with them); [] where they are not."""
     width = len(layout.header)
@@ -418,7 +423,8 @@ def whole_frames(layout: FrameLayout, fixed: list[tuple[str, int, dict[str, Any]
         bytes_at = {layout.length_offset: value & 0xFF}
         if layout.command_offset is not None:
             bytes_at[layout.command_offset] = value >> 8
-        entries.append((repr(layout.header + bytes(bytes_at[o] for o in offsets)), size, function["whole_name"]))
+        key_bytes = repr(layout.header + bytes(bytes_at[o] for o in offsets))
+        entries.append((key_bytes, size, function["whole_name"], function.get("plain")))
     return entries
 
 
@@ -621,7 +627,7 @@ def frame_function(
     known = dict(enumerate(layout.header)) | {layout.length_offset: length_byte}
     if layout.command_offset is not None:
         known[layout.command_offset] = command.code or 0
-    function = {
+    function: dict[str, Any] = {
         "name": "_frame" + decoder_name(message).removeprefix("_decode"),
         "whole_name": "_whole" + decoder_name(message).removeprefix("_decode"),
         "returns": returns,
@@ -629,8 +635,39 @@ def frame_function(
         "lines": lines,
         "whole_lines": whole_frame_lines(protocol, layout, size, lines, summed is not None, known),
     }
+    # built in decode() where its whole-frame decoder sums the frame's bytes (one from the values is quicker yet)
+    function["plain"] = plain_frame(protocol, layout, body, code) if summed is None else None
     key = length_byte if layout.command_offset is None else (command.code or 0) << 8 | length_byte
     return key, size, function
+
+
+_PLAIN = re.compile(r"^return _new\((?P<cls>\w+), (?P<struct>_S_\w+)\.unpack_from\(buf, o\)\)$")
+
+
+def plain_check(protocol: Protocol, layout: FrameLayout) -> str | None:
+    """decode()'s test that a whole frame `data` (its size known) holds its checksum, where it is one expression
+    over the frame's bytes: an 8-bit sum over all but a constant header and the check. None for others."""
+    checksum = protocol.framing.checksum
+    header = layout.header[: layout.covered_from]
+    if checksum is None or checksum.algorithm != "sum" or len(header) != layout.covered_from:
+        return None
+    if not layout.checksum_offset_from_end == 1 == layout.covered_to_end == checksum.type.size:
+        return None
+    less = f" - {sum(header):#x}" if header else ""
+    if checksum.invert:
+        return f"~(sum(data){less} - data[-1]) & 0xff == data[-1]"
+    return f"not (sum(data){less} - 2 * data[-1]) & 0xff"
+
+
+def plain_frame(protocol: Protocol, layout: FrameLayout, body: Lines, code: PackageCode) -> tuple[str, str] | None:
+    """(class, struct) of a frame whose message is the tuple one struct unpacks from its content, as it is, and
+    whose checksum decode() tests in one expression (plain_check): decode() builds it itself, with no call.
+    None for others (frame values, conversions, checks)."""
+    fused = fuse_unpack(body, code.structs)
+    plain = _PLAIN.match(fused[0]) if len(fused) == 1 else None
+    if plain is None or layout.value_elements or plain_check(protocol, layout) is None:
+        return None
+    return plain["cls"], plain["struct"]
 
 
 _MOST_UNROLLED = 12  # CRC-8 steps written out one by one in a whole-frame decoder; more take a loop

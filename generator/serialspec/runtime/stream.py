@@ -55,6 +55,11 @@ class _Candidate:
         "fixed",
         "splittable",
         "ranges",
+        "pieces",
+        "shifts",
+        "byte_at",
+        "allowed",
+        "wide",
     )
 
     def __init__(self, frame_format: FrameFormat) -> None:
@@ -83,12 +88,26 @@ class _Candidate:
                 if low <= content and (high is None or content <= high):
                     key = length_byte if code is None else code << 8 | length_byte
                     self.frame_sizes[key] = frame_format.overhead + content
-        # The batch scan splits the buffer at every header; that finds every header the byte-by-byte scan would
-        # only if two headers can never overlap (FEETECH's FF FF can: FF FF FF holds two) and the command code
-        # and length byte come after the header.
-        overlaps = any(header[:k] == header[-k:] for k in range(1, len(header)))
-        after = min(frame_format.length_offset, frame_format.command_offset or len(header))
-        self.splittable = bool(header) and not overlaps and after >= len(header)
+        # The batch scan splits the buffer at every header and reads the command code and length byte in the piece
+        # after it, so they must come after the header. A header that can overlap itself (FEETECH's FF FF: FF FF FF
+        # holds two) hides the occurrences that start inside one split at: `shifts` are where those can start, after
+        # an occurrence's first byte; the batch scan looks there whenever the candidate at the split is not a frame.
+        width = len(header)
+        after = min(frame_format.length_offset, frame_format.command_offset or width)
+        self.splittable = bool(header) and after >= width
+        self.shifts = tuple(k for k in range(1, width) if header[k:] == header[: width - k])
+        # Every plausible frame as the batch scan reads it: size key -> (frame size, its bytes after the header, the
+        # decoder of the frames decoded whole, or None for decode_at).
+        self.pieces = {key: (size, size - width, self.fixed.get(key)) for key, size in self.frame_sizes.items()}
+        # The usual value range (one unsigned byte after the header: an address) as a table of 256 yes/no bytes
+        # read in the piece; other ranges (`wide`) go through plausible().
+        single = [r for r in self.ranges if r[1] == 1 and not r[3] and r[0] >= width]
+        self.wide = len(single) != len(self.ranges) or len(single) > 1
+        self.byte_at, self.allowed = -1, None
+        if len(single) == 1:
+            offset, _, _, _, low, high, also = single[0]
+            self.byte_at = offset - width
+            self.allowed = bytes(low <= value <= high or value == also for value in range(256))
 
     def plausible(self, buffer: bytes, position: int) -> bool:
         """Every frame-level value with a declared range holds a value in it (or the one also allowed)."""
@@ -169,84 +188,114 @@ class StreamParser:
         return self._scan(buffer)
 
     def _split(self, buffer: bytes, current: _Candidate) -> list[Message]:
-        """The batch scan of one frame format whose header cannot overlap itself: split the buffer at every header
-        (one pass in C) and take the pieces in turn, which saves a search and most bookkeeping per frame. It
-        accepts, rejects, counts and holds back exactly what the byte-by-byte scan (`_scan`) would: a candidate
-        that fails resumes at the next header, an accepted frame skips any header inside it."""
+        """The batch scan of one frame format: split the buffer at every header (one pass in C) and take the pieces
+        in turn, which saves a search and most bookkeeping per frame. It accepts, rejects, counts and holds back
+        exactly what the byte-by-byte scan (`_scan`) would: a candidate that fails resumes at the next header (one
+        that overlaps its own header included), an accepted frame skips any header inside it.
+
+        The usual piece holds one plausible frame, then perhaps garbage: that takes one lookup and one call.
+        Anything else (a frame cut by the next header, a value out of range, a corrupt frame, headers overlapping
+        one another, the end of the buffer) takes the general path below it.
+        """
         header = current.header
         width = len(header)
         pieces = buffer.split(header)
         end = len(buffer)
-        frame_sizes = current.frame_sizes
-        command_offset, length_offset, prefix = current.command_offset, current.length_offset, current.prefix
-        length_at = length_offset - width  # the key's bytes in the piece after the header
-        command_at = -1 if command_offset is None else command_offset - width
-        need = prefix - width
-        whole = current.frame_format.fixed
+        whole = current.pieces
+        decode_at = current.decode
+        length_at = current.length_offset - width  # the key's bytes in the piece after the header
+        command_at = -1 if current.command_offset is None else current.command_offset - width
+        byte_at, allowed = current.byte_at, current.allowed
+        wide = current.wide
+        shifts = current.shifts
         found: list[Message] = []
         append = found.append
         position = len(pieces[0])  # of the header before the piece
-        garbage = errors = start = 0  # start: where the byte-by-byte scan would look for the next header
+        start = 0  # where the byte-by-byte scan would look for the next header
+        taken = errors = 0  # bytes in accepted frames; corrupt candidates
+        cut = -1  # where the bytes held back begin, once a candidate must wait for more
         for piece in islice(pieces, 1, None):
-            after = len(piece)  # bytes between this header and the next one (or the end)
-            if position >= start:  # not a header inside an accepted frame
-                garbage += position - start
-                if after >= need:
-                    key = piece[length_at] if command_at < 0 else piece[command_at] << 8 | piece[length_at]
-                    entry = whole.get(key)
-                    if current.ranges and not current.plausible(buffer, position):
-                        entry = None  # a value out of its range: no frame start (the size check below says so)
-                        key = -1
-                    if entry is not None and entry[0] - width <= after:  # the usual frame: decoded whole
-                        message = entry[1](buffer, position)
-                        if message is None:
-                            errors += 1
-                            start = position + 1
-                            garbage += 1
+            if position >= start:
+                try:  # a piece too short for the key: the general path decides
+                    entry = whole.get(piece[length_at] if command_at < 0 else piece[command_at] << 8 | piece[length_at])
+                except IndexError:
+                    entry = None
+                if entry is not None:
+                    size, rest, decode = entry
+                    after = len(piece)  # bytes between this header and the next one (or the end)
+                    # the frame ends before the next header (so the bytes its values are read from are there too)
+                    if (
+                        rest <= after
+                        and (allowed is None or allowed[piece[byte_at]])
+                        and (not wide or current.plausible(buffer, position))
+                    ):
+                        if decode is not None:
+                            message = decode(buffer, position)
                         else:
+                            try:
+                                message = decode_at(buffer, position, position + size)
+                            except DecodeError:
+                                message = None
+                        if message is not None:  # the usual frame
                             append(message)
-                            start = position + entry[0]
-                        position += width + after
-                        continue
-                elif position + width + after == end or position + prefix > end:  # the key has not come yet
-                    self._pending = buffer[position:]
+                            taken += size
+                            start = position + size
+                            position += width + after
+                            continue
+                # the general path: this candidate, then the headers overlapping its header
+                ats = (position, *(position + k for k in shifts)) if shifts else (position,)
+            elif shifts and position + width > start:  # a header overlapping this one may start after the frame
+                ats = tuple(position + k for k in shifts)
+            else:  # a header inside an accepted frame
+                position += width + len(piece)
+                continue
+            for at in ats:
+                if at < start or (at != position and not buffer.startswith(header, at)):
+                    continue
+                taking = self._take_at(buffer, at, current)
+                if taking is None:  # incomplete: wait for more bytes, unless a complete frame starts inside it
+                    inner = self._complete_frame_after(buffer, at + 1)
+                    if inner >= 0:
+                        self.garbage += inner - taken
+                        self.errors += errors
+                        return found + self._scan(buffer[inner:])
+                    cut = at
                     break
-                else:  # the key runs past the next header: read it from the buffer
-                    key = buffer[position + length_offset]
-                    if command_offset is not None:
-                        key |= buffer[position + command_offset] << 8
-                size = frame_sizes.get(key)
-                if size is not None and current.ranges and not current.plausible(buffer, position):
-                    size = None
-                if size is None:  # implausible: not a frame start
-                    start = position + 1
-                    garbage += 1
+                message, stop = taking
+                if message is not None:
+                    append(message)
+                    taken += stop - at
+                    start = stop
                 else:
-                    stop = position + size
-                    if stop > end:  # incomplete: wait for more bytes, unless a complete frame starts inside it
-                        inner = self._complete_frame_after(buffer, position + 1)
-                        if inner >= 0:
-                            self.garbage += garbage + inner - position
-                            self.errors += errors
-                            return found + self._scan(buffer[inner:])
-                        self._pending = buffer[position:]
-                        break
-                    message = current.take(key, buffer, position, stop)
-                    if message is None:
-                        errors += 1
-                        start = position + 1
-                        garbage += 1
-                    else:
-                        append(message)
-                        start = stop
-            position += width + after
+                    errors += stop  # 1: a corrupt frame; 0: no frame
+                    start = at + 1
+            if cut >= 0:
+                break
+            position += width + len(piece)
         else:  # every header taken: keep a tail that could begin one
             cut = max(start, end - width + 1)
-            garbage += cut - start
-            self._pending = buffer[cut:]
-        self.garbage += garbage
+        self._pending = buffer[cut:]
+        self.garbage += cut - taken
         self.errors += errors
         return found
+
+    def _take_at(self, buffer: bytes, at: int, current: _Candidate) -> tuple[Message | None, int] | None:
+        """The candidate whose header is at `at`: (message, where it ends) when it is a frame; (None, 1) when it is
+        corrupt, (None, 0) when it is no frame (implausible); None when it is plausible but its bytes have not all
+        come."""
+        end = len(buffer)
+        if end - at < current.prefix:
+            return None
+        key = buffer[at + current.length_offset]
+        if current.command_offset is not None:
+            key |= buffer[at + current.command_offset] << 8
+        size = current.frame_sizes.get(key)
+        if size is None or (current.ranges and not current.plausible(buffer, at)):
+            return None, 0
+        if at + size > end:
+            return None
+        message = current.take(key, buffer, at, at + size)
+        return (None, 1) if message is None else (message, at + size)
 
     def _scan(self, buffer: bytes) -> list[Message]:
         """The byte-by-byte scan: the nearest header of any frame format, its key, its frame."""

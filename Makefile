@@ -44,7 +44,7 @@ STRESS_TRANSACTIONS ?= 5000
 FUZZ_EXAMPLES ?= 2000
 FUZZ_ARGS ?=
 FUZZ_TESTS := tests/test_cli_fuzz.py tests/test_spec_fuzz.py tests/test_codec.py tests/test_fast_codec.py \
-	tests/test_framing_engine.py tests/test_batch_stream_fuzz.py
+	tests/test_framing_engine.py tests/test_batch_stream_fuzz.py tests/test_straight_frames.py
 
 stress: $(STAMP)
 	@echo "stress: $(STRESS_FRAMES) frames per stream parser, 8 threads x $(STRESS_TRANSACTIONS) transactions"

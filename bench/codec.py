@@ -85,6 +85,14 @@ CASES = [
         hw.mb_encode_registers_reply,
         construct=False,
     ),
+    Case(
+        "vesc",
+        "set_duty_half",
+        "VESC COMM_SET_DUTY request",
+        hw.vesc_decode_set_duty,
+        hw.vesc_encode_set_duty,
+        construct=False,
+    ),
 ]
 
 
@@ -245,9 +253,13 @@ def run() -> Table:
             "whole frame where its size is fixed, the same checks, a slotted dataclass, enum/flag members.",
             "construct: the generated `structs.py` (frame struct with RawCopy + Checksum, then the command's content "
             "struct); decode yields construct Containers (no typed message), encode builds content then frame. "
-            "DYNAMIXEL and Modbus: — (their structs.py describes the content, not the stuffed or header-less frame).",
-            "DYNAMIXEL 2.0 and Modbus RTU run on the runtime's general frame engine (runtime/framing.py: stuffing, "
-            "u16 length, CRC-16, header-less framing); hand-written: one function each, table-driven CRC-16 loop.",
+            "DYNAMIXEL, Modbus and VESC: — (their structs.py describes the content, not the stuffed, header-less or "
+            "two-layout frame).",
+            "DYNAMIXEL 2.0, Modbus RTU and VESC frames are not of the classic shape (stuffing, u16 length over a span, "
+            "CRC-16, no header, two layouts): the generator writes straight-line frame code for them from the "
+            "framing description (emit/python/framecode.py); the CRC-16s are the runtime's crc_function (two bytes "
+            "per step from a 65,536-entry table; CRC-16/XMODEM is binascii.crc_hqx). Hand-written: one function "
+            "each, a table-driven CRC-16 loop a byte at a time (VESC: binascii.crc_hqx).",
             f"pymavlink {mavlink_version()} `common` (MAVLink 2): `MAVLink.decode(frame)` and `message.pack(mav)`; its "
             "CRC runs in the compiled `fastcrc` extension when installed (it is here). ATTITUDE "
             f"({attitude_size} B): decode {us(attitude['decode'].best_ns)} µs, encode "

@@ -10,6 +10,7 @@ generated packages: these are the frames as a person would code them from the do
 
 from __future__ import annotations
 
+import binascii
 import struct
 from dataclasses import dataclass
 from enum import IntEnum, IntFlag
@@ -478,3 +479,45 @@ def mb_encode_registers_reply(message: MbRegisters) -> bytes:
         raise ValueError(f"{count} registers, 1..125 allowed")
     body = struct.pack(f">BBB{count}H", message.unit, MB_READ_HOLDING_REGISTERS, count * 2, *message.registers)
     return body + crc16_modbus(body).to_bytes(2, "little")
+
+
+# --- VESC: 02, length u8, payload (command id + fields, big-endian), CRC-16/XMODEM big-endian, 03 ------------------
+# (payloads of 256 bytes and more start with 03 and a u16 length; COMM_SET_DUTY never needs them). The CRC is the
+# standard library's binascii.crc_hqx, which computes CRC-16/XMODEM in C: what a person writing this would use.
+
+VESC_START = 2
+VESC_END = 3
+VESC_SET_DUTY = 5
+
+
+@dataclass(slots=True)
+class VescSetDuty:
+    duty: int  # 0.00001
+
+
+_VESC_SET_DUTY_FRAME = struct.Struct(">BBBiHB")  # start, length, command, duty, crc, end
+_VESC_SET_DUTY_PAYLOAD = struct.Struct(">Bi")
+
+
+def vesc_decode_set_duty(frame: bytes) -> VescSetDuty:
+    if len(frame) != _VESC_SET_DUTY_FRAME.size:
+        raise ValueError(f"set-duty frame is {len(frame)} bytes, expected {_VESC_SET_DUTY_FRAME.size}")
+    start, length, command, duty, crc, end = _VESC_SET_DUTY_FRAME.unpack(frame)
+    if start != VESC_START:
+        raise ValueError(f"start byte {start:#04x}, expected 02")
+    if end != VESC_END:
+        raise ValueError(f"end byte {end:#04x}, expected 03")
+    if length != 5:
+        raise ValueError(f"length byte {length}, expected 5")
+    if binascii.crc_hqx(frame[2:7], 0) != crc:
+        raise ValueError("bad CRC")
+    if command != VESC_SET_DUTY:
+        raise ValueError(f"command {command} is not COMM_SET_DUTY")
+    return VescSetDuty(duty)
+
+
+def vesc_encode_set_duty(message: VescSetDuty) -> bytes:
+    if not -100000 <= message.duty <= 100000:
+        raise ValueError(f"duty {message.duty} outside -100000..100000")
+    payload = _VESC_SET_DUTY_PAYLOAD.pack(VESC_SET_DUTY, message.duty)
+    return b"\x02\x05" + payload + binascii.crc_hqx(payload, 0).to_bytes(2, "big") + b"\x03"

@@ -7,7 +7,7 @@ import struct
 from collections.abc import Callable
 
 from serialspec.runtime.checksums import crc_function
-from serialspec.runtime.errors import DecodeError, EncodeError, content_size_error, out_of_range
+from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError, content_size_error, out_of_range
 from serialspec.runtime.fields import wrong_type
 from serialspec.runtime.framing import Element, EngineFormat, FrameCodec, Layout, Transparency
 from serialspec.runtime.framing import FrameStreamParser as _FrameStreamParser
@@ -43,6 +43,9 @@ from dynamixel_p2.messages import (
 
 __all__ = ["StreamParser", "decode", "encode"]
 
+_F_LE_1S_U8 = struct.Struct('<1sB')
+_F_LE_4S_U8_U16 = struct.Struct('<4sBH')
+_F_LE_U8 = struct.Struct('<B')
 _S_U16 = struct.Struct('<H')
 _S_U16_U16 = struct.Struct('<HH')
 _S_U16_U8 = struct.Struct('<HB')
@@ -180,6 +183,8 @@ def _decode_bulk_read_request(buf: bytes, o: int, end: int, id: int) -> BulkRead
 def _decode_bulk_write_request(buf: bytes, o: int, end: int, id: int) -> BulkWriteRequest:
     v_writes_list = []
     while o < end:
+        if end - o < 5:
+            raise DecodeError('bulk_write request' + f': id needs 5 bytes, {end - o} left')
         v_id, v_address, v_length = _S_U8_U16_U16.unpack_from(buf, o)
         o += 5
         if end - o < v_length:
@@ -205,7 +210,7 @@ def _encode_ping_request(m: PingRequest) -> bytes:
     m_id = m.id
     if not (0 <= m_id <= 252 or m_id == 254) or m_id.__class__ is bool:
         raise out_of_range('ping request', 'id', m_id, 0, 252)
-    return _REQUEST_FRAMES.wrap(b'', 0x01, (m_id,))
+    return _wrap_request(b'', 0x01, m_id)
 
 
 def _encode_ping_response(m: PingResponse) -> bytes:
@@ -223,7 +228,7 @@ def _encode_ping_response(m: PingResponse) -> bytes:
         raise out_of_range('ping response', 'model_number', m_model_number, 0, 65535)
     if not 0 <= m_firmware_version <= 255 or m_firmware_version.__class__ is bool:
         raise out_of_range('ping response', 'firmware_version', m_firmware_version, 0, 255)
-    return _RESPONSE_FRAMES.wrap(_S_U16_U8.pack(m_model_number, m_firmware_version), None, (m_id, (m_error.alert << 7) | m_error.number))
+    return _wrap_response(_S_U16_U8.pack(m_model_number, m_firmware_version), None, m_id, (m_error.alert << 7) | m_error.number)
 
 
 def _encode_read_request(m: ReadRequest) -> bytes:
@@ -236,7 +241,7 @@ def _encode_read_request(m: ReadRequest) -> bytes:
         raise out_of_range('read request', 'address', m_address, 0, 65535)
     if not 1 <= m_length <= 1024 or m_length.__class__ is bool:
         raise out_of_range('read request', 'length', m_length, 1, 1024)
-    return _REQUEST_FRAMES.wrap(_S_U16_U16.pack(m_address, m_length), 0x02, (m_id,))
+    return _wrap_request(_S_U16_U16.pack(m_address, m_length), 0x02, m_id)
 
 
 def _encode_write_request(m: WriteRequest) -> bytes:
@@ -248,7 +253,7 @@ def _encode_write_request(m: WriteRequest) -> bytes:
     if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
         raise out_of_range('write request', 'address', m_address, 0, 65535)
     v_data = m_data if m_data.__class__ is bytes else bytes(m_data)
-    return _REQUEST_FRAMES.wrap(b''.join((_S_U16.pack(m_address), v_data,)), 0x03, (m_id,))
+    return _wrap_request(b''.join((_S_U16.pack(m_address), v_data,)), 0x03, m_id)
 
 
 def _encode_reg_write_request(m: RegWriteRequest) -> bytes:
@@ -260,14 +265,14 @@ def _encode_reg_write_request(m: RegWriteRequest) -> bytes:
     if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
         raise out_of_range('reg_write request', 'address', m_address, 0, 65535)
     v_data = m_data if m_data.__class__ is bytes else bytes(m_data)
-    return _REQUEST_FRAMES.wrap(b''.join((_S_U16.pack(m_address), v_data,)), 0x04, (m_id,))
+    return _wrap_request(b''.join((_S_U16.pack(m_address), v_data,)), 0x04, m_id)
 
 
 def _encode_action_request(m: ActionRequest) -> bytes:
     m_id = m.id
     if not (0 <= m_id <= 252 or m_id == 254) or m_id.__class__ is bool:
         raise out_of_range('action request', 'id', m_id, 0, 252)
-    return _REQUEST_FRAMES.wrap(b'', 0x05, (m_id,))
+    return _wrap_request(b'', 0x05, m_id)
 
 
 def _encode_factory_reset_request(m: FactoryResetRequest) -> bytes:
@@ -277,14 +282,14 @@ def _encode_factory_reset_request(m: FactoryResetRequest) -> bytes:
         raise out_of_range('factory_reset request', 'id', m_id, 0, 252)
     if not 1 <= m_option <= 255 or m_option.__class__ is bool:
         raise out_of_range('factory_reset request', 'option', m_option, 1, 255)
-    return _REQUEST_FRAMES.wrap(_S_U8.pack(m_option), 0x06, (m_id,))
+    return _wrap_request(_S_U8.pack(m_option), 0x06, m_id)
 
 
 def _encode_reboot_request(m: RebootRequest) -> bytes:
     m_id = m.id
     if not (0 <= m_id <= 252 or m_id == 254) or m_id.__class__ is bool:
         raise out_of_range('reboot request', 'id', m_id, 0, 252)
-    return _REQUEST_FRAMES.wrap(b'', 0x08, (m_id,))
+    return _wrap_request(b'', 0x08, m_id)
 
 
 def _encode_clear_request(m: ClearRequest) -> bytes:
@@ -294,7 +299,7 @@ def _encode_clear_request(m: ClearRequest) -> bytes:
         raise out_of_range('clear request', 'id', m_id, 0, 252)
     if not 1 <= m_option <= 1 or m_option.__class__ is bool:
         raise out_of_range('clear request', 'option', m_option, 1, 1)
-    return _REQUEST_FRAMES.wrap(_S_U8_U32.pack(m_option, 575428676), 0x10, (m_id,))
+    return _wrap_request(_S_U8_U32.pack(m_option, 575428676), 0x10, m_id)
 
 
 def _encode_sync_read_request(m: SyncReadRequest) -> bytes:
@@ -313,7 +318,7 @@ def _encode_sync_read_request(m: SyncReadRequest) -> bytes:
         if not 0 <= item_id <= 252 or item_id.__class__ is bool:
             raise out_of_range('sync_read request', 'id', item_id, 0, 252)
         parts_ids.append(_S_U8.pack(item_id))
-    return _REQUEST_FRAMES.wrap(b''.join((_S_U16_U16.pack(m_address, m_length), b''.join(parts_ids),)), 0x82, (m_id,))
+    return _wrap_request(b''.join((_S_U16_U16.pack(m_address, m_length), b''.join(parts_ids),)), 0x82, m_id)
 
 
 def _encode_fast_sync_read_request(m: FastSyncReadRequest) -> bytes:
@@ -332,7 +337,7 @@ def _encode_fast_sync_read_request(m: FastSyncReadRequest) -> bytes:
         if not 0 <= item_id <= 252 or item_id.__class__ is bool:
             raise out_of_range('fast_sync_read request', 'id', item_id, 0, 252)
         parts_servo_ids.append(_S_U8.pack(item_id))
-    return _REQUEST_FRAMES.wrap(b''.join((_S_U16_U16.pack(m_address, m_length), b''.join(parts_servo_ids),)), 0x8a, (m_id,))
+    return _wrap_request(b''.join((_S_U16_U16.pack(m_address, m_length), b''.join(parts_servo_ids),)), 0x8a, m_id)
 
 
 def _encode_sync_write_request(m: SyncWriteRequest) -> bytes:
@@ -356,7 +361,7 @@ def _encode_sync_write_request(m: SyncWriteRequest) -> bytes:
             raise out_of_range('sync_write request', 'id', item_id, 0, 252)
         v_data = item_data if item_data.__class__ is bytes else bytes(item_data)
         parts_servos.append(b''.join((_S_U8.pack(item_id), v_data,)))
-    return _REQUEST_FRAMES.wrap(b''.join((_S_U16_U16.pack(m_address, v_length), b''.join(parts_servos),)), 0x83, (m_id,))
+    return _wrap_request(b''.join((_S_U16_U16.pack(m_address, v_length), b''.join(parts_servos),)), 0x83, m_id)
 
 
 def _encode_bulk_read_request(m: BulkReadRequest) -> bytes:
@@ -375,7 +380,7 @@ def _encode_bulk_read_request(m: BulkReadRequest) -> bytes:
         if not 1 <= item_length <= 1024 or item_length.__class__ is bool:
             raise out_of_range('bulk_read request', 'length', item_length, 1, 1024)
         parts_reads.append(_S_U8_U16_U16.pack(item_id, item_address, item_length))
-    return _REQUEST_FRAMES.wrap(b''.join(parts_reads), 0x92, (m_id,))
+    return _wrap_request(b''.join(parts_reads), 0x92, m_id)
 
 
 def _encode_bulk_write_request(m: BulkWriteRequest) -> bytes:
@@ -395,7 +400,7 @@ def _encode_bulk_write_request(m: BulkWriteRequest) -> bytes:
             raise out_of_range('bulk_write request', 'length', len(item_data), 0, 65535)
         v_data = item_data if item_data.__class__ is bytes else bytes(item_data)
         parts_writes.append(b''.join((_S_U8_U16_U16.pack(item_id, item_address, len(item_data)), v_data,)))
-    return _REQUEST_FRAMES.wrap(b''.join(parts_writes), 0x93, (m_id,))
+    return _wrap_request(b''.join(parts_writes), 0x93, m_id)
 
 
 def _encode_status_response(m: StatusResponse) -> bytes:
@@ -409,7 +414,7 @@ def _encode_status_response(m: StatusResponse) -> bytes:
     if not 0 <= m_error.number <= 127 or m_error.number.__class__ is bool:
         raise out_of_range('status response', 'error.number', m_error.number, 0, 127)
     v_data = m_data if m_data.__class__ is bytes else bytes(m_data)
-    return _RESPONSE_FRAMES.wrap(v_data, None, (m_id, (m_error.alert << 7) | m_error.number))
+    return _wrap_response(v_data, None, m_id, (m_error.alert << 7) | m_error.number)
 
 
 _REQUEST_DECODERS: dict[int | None, Callable[..., Message]] = {
@@ -460,14 +465,52 @@ _REQUEST_FRAMES = FrameCodec(
 )
 
 
+_REQUEST_TRANSPARENCY = Transparency((4, 5), ((b'\xff\xff\xfd', b'\xff\xff\xfd\xfd'),))
+
+
 def _decode_request(frame: bytes, expect: type[Message] | None = None) -> Message:
-    """One complete request frame, checked and taken apart by the frame engine; its content decoded."""
-    unwrapped = _REQUEST_FRAMES.unwrap(frame)
-    decoder = _REQUEST_DECODERS.get(unwrapped.code)
-    if decoder is None:
-        raise DecodeError(f"unknown command {unwrapped.code!r}")
-    content = unwrapped.content
-    return decoder(content, 0, len(content), *unwrapped.values)
+    """One complete request frame, checked and taken apart; its content decoded."""
+    n = len(frame)
+    if n < 9:
+        raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (10)")
+    end = n - 2
+    buf = frame
+    if frame.find(b'\xff\xff\xfd', 7, n - 2) >= 0:  # stuffed: the plain bytes of the span
+        buf = frame[:7] + _REQUEST_TRANSPARENCY.decode(frame[7 : n - 2]) + frame[n - 2 :]
+        end = len(buf) - 2
+    if end < 8:
+        raise DecodeError(f"request frame: {end - 7} bytes where at least 1 belong")
+    if buf[:4] != b'\xff\xff\xfd\x00':
+        if buf[:3] != b'\xff\xff\xfd':
+            raise DecodeError(f"header is {buf[:3].hex(' ')}, expected ff ff fd")
+        raise DecodeError(f"reserved is {buf[3:4].hex(' ')}, expected 00")
+    v_id = buf[4]
+    if not (0 <= v_id <= 252 or v_id == 254):
+        raise DecodeError(f"id = {v_id} is outside its range 0..252 (or 254)")
+    length = buf[6] << 8 | buf[5]
+    if length != n - 7:
+        raise DecodeError(f"length says {length} but the frame holds {n - 7}")
+    check = _CHECK_CRC(frame[:-2])
+    stored = buf[end + 1] << 8 | buf[end]
+    if check != stored:
+        raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
+    code = buf[7]
+    try:
+        decoder = _REQUEST_DECODERS[code]
+    except KeyError:
+        raise DecodeError(f"unknown command {code!r}") from None
+    return decoder(buf, 8, end, v_id)
+
+
+def _wrap_request(content: bytes, code: int | None, v_id: int) -> bytes:
+    """The request frame around `content`, EncodeError if it cannot be."""
+    plain = _F_LE_U8.pack(code) + content
+    wire = plain.replace(b'\xff\xff\xfd', b'\xff\xff\xfd\xfd')
+    v_length = len(wire) + 2
+    if not v_length < 65536:
+        raise EncodeError(f"request frame: length {v_length} does not fit its 2-byte field")
+    frame = _F_LE_4S_U8_U16.pack(b'\xff\xff\xfd\x00', v_id, v_length) + wire
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 _RESPONSE_DECODERS: dict[int | None, Callable[..., Message]] = {
@@ -500,18 +543,58 @@ _RESPONSE_FRAMES = FrameCodec(
 )
 
 
+_RESPONSE_TRANSPARENCY = Transparency((4, 6), ((b'\xff\xff\xfd', b'\xff\xff\xfd\xfd'),))
+
+
 def _decode_response(frame: bytes, expect: type[Message] | None = None) -> Message:
-    """One complete response frame, checked and taken apart by the frame engine; its content decoded."""
-    unwrapped = _RESPONSE_FRAMES.unwrap(frame)
-    decoder = _RESPONSE_DECODERS.get(unwrapped.code)
+    """One complete response frame, checked and taken apart; its content decoded."""
+    n = len(frame)
+    if n < 9:
+        raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (11)")
+    end = n - 2
+    buf = frame
+    if frame.find(b'\xff\xff\xfd', 7, n - 2) >= 0:  # stuffed: the plain bytes of the span
+        buf = frame[:7] + _RESPONSE_TRANSPARENCY.decode(frame[7 : n - 2]) + frame[n - 2 :]
+        end = len(buf) - 2
+    if end < 9:
+        raise DecodeError(f"response frame: {end - 7} bytes where at least 2 belong")
+    if buf[:4] != b'\xff\xff\xfd\x00':
+        if buf[:3] != b'\xff\xff\xfd':
+            raise DecodeError(f"header is {buf[:3].hex(' ')}, expected ff ff fd")
+        raise DecodeError(f"reserved is {buf[3:4].hex(' ')}, expected 00")
+    if buf[7] != 0x55:
+        raise DecodeError(f"instruction is {buf[7:8].hex(' ')}, expected 55")
+    v_id = buf[4]
+    if not (0 <= v_id <= 252 or v_id == 254):
+        raise DecodeError(f"id = {v_id} is outside its range 0..252 (or 254)")
+    v_error = buf[8]
+    length = buf[6] << 8 | buf[5]
+    if length != n - 7:
+        raise DecodeError(f"length says {length} but the frame holds {n - 7}")
+    check = _CHECK_CRC(frame[:-2])
+    stored = buf[end + 1] << 8 | buf[end]
+    if check != stored:
+        raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
+    try:
+        decoder = _RESPONSE_DECODERS[None]
+    except KeyError:
+        raise DecodeError("unknown command None") from None
     if expect is not None:
-        code, alternative = _RESPONSE_EXPECTED.get(expect, (None, None))
-        if alternative is not None and code == unwrapped.code:
+        expected, alternative = _RESPONSE_EXPECTED.get(expect, (None, None))
+        if alternative is not None and expected is None:
             decoder = alternative
-    if decoder is None:
-        raise DecodeError(f"unknown command {unwrapped.code!r}")
-    content = unwrapped.content
-    return decoder(content, 0, len(content), *unwrapped.values)
+    return decoder(buf, 9, end, v_id, v_error)
+
+
+def _wrap_response(content: bytes, code: int | None, v_id: int, v_error: int) -> bytes:
+    """The response frame around `content`, EncodeError if it cannot be."""
+    plain = _F_LE_1S_U8.pack(b'U', v_error) + content
+    wire = plain.replace(b'\xff\xff\xfd', b'\xff\xff\xfd\xfd')
+    v_length = len(wire) + 2
+    if not v_length < 65536:
+        raise EncodeError(f"response frame: length {v_length} does not fit its 2-byte field")
+    frame = _F_LE_4S_U8_U16.pack(b'\xff\xff\xfd\x00', v_id, v_length) + wire
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 _ENCODERS: dict[type[Message], Callable[..., bytes]] = {
@@ -540,9 +623,75 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
     if direction is None:
         raise DecodeError("give the direction: requests and responses cannot be told apart by their first bytes")
     if direction == 'request':  # a Direction or its value
-        return _decode_request(bytes(data), expect)
+        frame = data if data.__class__ is bytes else bytes(data)
+        n = len(frame)
+        if n < 9:
+            raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (10)")
+        end = n - 2
+        buf = frame
+        if frame.find(b'\xff\xff\xfd', 7, n - 2) >= 0:  # stuffed: the plain bytes of the span
+            buf = frame[:7] + _REQUEST_TRANSPARENCY.decode(frame[7 : n - 2]) + frame[n - 2 :]
+            end = len(buf) - 2
+        if end < 8:
+            raise DecodeError(f"request frame: {end - 7} bytes where at least 1 belong")
+        if buf[:4] != b'\xff\xff\xfd\x00':
+            if buf[:3] != b'\xff\xff\xfd':
+                raise DecodeError(f"header is {buf[:3].hex(' ')}, expected ff ff fd")
+            raise DecodeError(f"reserved is {buf[3:4].hex(' ')}, expected 00")
+        v_id = buf[4]
+        if not (0 <= v_id <= 252 or v_id == 254):
+            raise DecodeError(f"id = {v_id} is outside its range 0..252 (or 254)")
+        length = buf[6] << 8 | buf[5]
+        if length != n - 7:
+            raise DecodeError(f"length says {length} but the frame holds {n - 7}")
+        check = _CHECK_CRC(frame[:-2])
+        stored = buf[end + 1] << 8 | buf[end]
+        if check != stored:
+            raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
+        code = buf[7]
+        try:
+            decoder = _REQUEST_DECODERS[code]
+        except KeyError:
+            raise DecodeError(f"unknown command {code!r}") from None
+        return decoder(buf, 8, end, v_id)
     if direction == 'response':  # a Direction or its value
-        return _decode_response(bytes(data), expect)
+        frame = data if data.__class__ is bytes else bytes(data)
+        n = len(frame)
+        if n < 9:
+            raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (11)")
+        end = n - 2
+        buf = frame
+        if frame.find(b'\xff\xff\xfd', 7, n - 2) >= 0:  # stuffed: the plain bytes of the span
+            buf = frame[:7] + _RESPONSE_TRANSPARENCY.decode(frame[7 : n - 2]) + frame[n - 2 :]
+            end = len(buf) - 2
+        if end < 9:
+            raise DecodeError(f"response frame: {end - 7} bytes where at least 2 belong")
+        if buf[:4] != b'\xff\xff\xfd\x00':
+            if buf[:3] != b'\xff\xff\xfd':
+                raise DecodeError(f"header is {buf[:3].hex(' ')}, expected ff ff fd")
+            raise DecodeError(f"reserved is {buf[3:4].hex(' ')}, expected 00")
+        if buf[7] != 0x55:
+            raise DecodeError(f"instruction is {buf[7:8].hex(' ')}, expected 55")
+        v_id = buf[4]
+        if not (0 <= v_id <= 252 or v_id == 254):
+            raise DecodeError(f"id = {v_id} is outside its range 0..252 (or 254)")
+        v_error = buf[8]
+        length = buf[6] << 8 | buf[5]
+        if length != n - 7:
+            raise DecodeError(f"length says {length} but the frame holds {n - 7}")
+        check = _CHECK_CRC(frame[:-2])
+        stored = buf[end + 1] << 8 | buf[end]
+        if check != stored:
+            raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
+        try:
+            decoder = _RESPONSE_DECODERS[None]
+        except KeyError:
+            raise DecodeError("unknown command None") from None
+        if expect is not None:
+            expected, alternative = _RESPONSE_EXPECTED.get(expect, (None, None))
+            if alternative is not None and expected is None:
+                decoder = alternative
+        return decoder(buf, 9, end, v_id, v_error)
     raise ValueError(f"direction must be request or response, not {direction!r}")
 
 

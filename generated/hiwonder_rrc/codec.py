@@ -1783,8 +1783,9 @@ def _encode_sbus_response(m: SbusResponse) -> bytes:
     m_fail_safe = m.fail_safe
     if len(m_channels) != 16:
         raise EncodeError('sbus response' + f': channels needs 16 items, got {len(m_channels)}')
-    if any(not -32768 <= x <= 32767 or x.__class__ is bool for x in m_channels):
-        raise out_of_range('sbus response', 'channels', m_channels, -32768, 32767)
+    for x_channels in m_channels:
+        if not -32768 <= x_channels <= 32767 or x_channels.__class__ is bool:
+            raise out_of_range('sbus response', 'channels', m_channels, -32768, 32767)
     if not 0 <= m_ch17 <= 255 or m_ch17.__class__ is bool:
         raise out_of_range('sbus response', 'ch17', m_ch17, 0, 255)
     if not 0 <= m_ch18 <= 255 or m_ch18.__class__ is bool:

@@ -7,7 +7,7 @@ import struct
 from collections.abc import Callable
 
 from serialspec.runtime.checksums import crc_function
-from serialspec.runtime.errors import DecodeError, EncodeError, content_size_error, out_of_range
+from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError, content_size_error, out_of_range
 from serialspec.runtime.fields import wrong_type
 from serialspec.runtime.framing import ERROR_REPLY, Element, EngineFormat, FrameCodec, Layout, SizeRule
 from serialspec.runtime.framing import FrameStreamParser as _FrameStreamParser
@@ -44,11 +44,16 @@ from modbus_rtu.messages import (
 
 __all__ = ["StreamParser", "decode", "encode"]
 
+_F_LE_U8_U8 = struct.Struct('<BB')
 _S_BE_U16_U16 = struct.Struct('>HH')
 _S_BE_U16_U16_U16 = struct.Struct('>HHH')
 _S_BE_U16_U16_U16_U16_U8 = struct.Struct('>HHHHB')
 _S_BE_U16_U16_U8 = struct.Struct('>HHB')
 _S_BE_U8 = struct.Struct('>B')
+_S_BE_U8_U8_U16_U16 = struct.Struct('>BBHH')
+_S_BE_U8_U8_U16_U16_U16 = struct.Struct('>BBHHH')
+_S_BE_U8_U8_U16_U16_U8 = struct.Struct('>BBHHB')
+_S_BE_U8_U8_U8 = struct.Struct('>BBB')
 _CHECK_CRC: Callable[[bytes], int] = crc_function(16, 0x8005, 0xffff, True, True, 0x0)  # CRC-16/MODBUS
 
 _MEMBERS_CoilState = members(CoilState)
@@ -306,7 +311,8 @@ def _encode_read_coils_request(m: ReadCoilsRequest) -> bytes:
         raise out_of_range('read_coils request', 'address', m_address, 0, 65535)
     if not 1 <= m_count <= 2000 or m_count.__class__ is bool:
         raise out_of_range('read_coils request', 'count', m_count, 1, 2000)
-    return _REQUEST_FRAMES.wrap(_S_BE_U16_U16.pack(m_address, m_count), 0x01, (m_unit,))
+    frame = _S_BE_U8_U8_U16_U16.pack(m_unit, 0x01, m_address, m_count)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_read_coils_response(m: ReadCoilsResponse) -> bytes:
@@ -319,7 +325,8 @@ def _encode_read_coils_response(m: ReadCoilsResponse) -> bytes:
     v_byte_count = (-(-len(m_coils) // 8))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('read_coils response', 'byte_count', v_byte_count, 0, 255)
-    return _RESPONSE_FRAMES.wrap(b''.join((_S_BE_U8.pack(v_byte_count), _pack_bits(m_coils, 'coils', 'read_coils response'),)), 0x01, (m_unit,))
+    frame = _S_BE_U8_U8_U8.pack(m_unit, 0x01, v_byte_count) + _pack_bits(m_coils, 'coils', 'read_coils response')
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_read_discrete_inputs_request(m: ReadDiscreteInputsRequest) -> bytes:
@@ -332,7 +339,8 @@ def _encode_read_discrete_inputs_request(m: ReadDiscreteInputsRequest) -> bytes:
         raise out_of_range('read_discrete_inputs request', 'address', m_address, 0, 65535)
     if not 1 <= m_count <= 2000 or m_count.__class__ is bool:
         raise out_of_range('read_discrete_inputs request', 'count', m_count, 1, 2000)
-    return _REQUEST_FRAMES.wrap(_S_BE_U16_U16.pack(m_address, m_count), 0x02, (m_unit,))
+    frame = _S_BE_U8_U8_U16_U16.pack(m_unit, 0x02, m_address, m_count)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_read_discrete_inputs_response(m: ReadDiscreteInputsResponse) -> bytes:
@@ -345,7 +353,8 @@ def _encode_read_discrete_inputs_response(m: ReadDiscreteInputsResponse) -> byte
     v_byte_count = (-(-len(m_inputs) // 8))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('read_discrete_inputs response', 'byte_count', v_byte_count, 0, 255)
-    return _RESPONSE_FRAMES.wrap(b''.join((_S_BE_U8.pack(v_byte_count), _pack_bits(m_inputs, 'inputs', 'read_discrete_inputs response'),)), 0x02, (m_unit,))
+    frame = _S_BE_U8_U8_U8.pack(m_unit, 0x02, v_byte_count) + _pack_bits(m_inputs, 'inputs', 'read_discrete_inputs response')
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_read_holding_registers_request(m: ReadHoldingRegistersRequest) -> bytes:
@@ -358,7 +367,8 @@ def _encode_read_holding_registers_request(m: ReadHoldingRegistersRequest) -> by
         raise out_of_range('read_holding_registers request', 'address', m_address, 0, 65535)
     if not 1 <= m_count <= 125 or m_count.__class__ is bool:
         raise out_of_range('read_holding_registers request', 'count', m_count, 1, 125)
-    return _REQUEST_FRAMES.wrap(_S_BE_U16_U16.pack(m_address, m_count), 0x03, (m_unit,))
+    frame = _S_BE_U8_U8_U16_U16.pack(m_unit, 0x03, m_address, m_count)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_read_holding_registers_response(m: ReadHoldingRegistersResponse) -> bytes:
@@ -369,9 +379,11 @@ def _encode_read_holding_registers_response(m: ReadHoldingRegistersResponse) -> 
     v_byte_count = (2 * len(m_registers))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('read_holding_registers response', 'byte_count', v_byte_count, 0, 255)
-    if any(not 0 <= x <= 65535 or x.__class__ is bool for x in m_registers):
-        raise out_of_range('read_holding_registers response', 'registers', m_registers, 0, 65535)
-    return _RESPONSE_FRAMES.wrap(b''.join((_S_BE_U8.pack(v_byte_count), struct.pack(f'>{len(m_registers)}H', *m_registers),)), 0x03, (m_unit,))
+    for x_registers in m_registers:
+        if not 0 <= x_registers <= 65535 or x_registers.__class__ is bool:
+            raise out_of_range('read_holding_registers response', 'registers', m_registers, 0, 65535)
+    frame = struct.pack(f'>BBB{len(m_registers)}H', m_unit, 0x03, v_byte_count, *m_registers)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_read_input_registers_request(m: ReadInputRegistersRequest) -> bytes:
@@ -384,7 +396,8 @@ def _encode_read_input_registers_request(m: ReadInputRegistersRequest) -> bytes:
         raise out_of_range('read_input_registers request', 'address', m_address, 0, 65535)
     if not 1 <= m_count <= 125 or m_count.__class__ is bool:
         raise out_of_range('read_input_registers request', 'count', m_count, 1, 125)
-    return _REQUEST_FRAMES.wrap(_S_BE_U16_U16.pack(m_address, m_count), 0x04, (m_unit,))
+    frame = _S_BE_U8_U8_U16_U16.pack(m_unit, 0x04, m_address, m_count)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_read_input_registers_response(m: ReadInputRegistersResponse) -> bytes:
@@ -395,9 +408,11 @@ def _encode_read_input_registers_response(m: ReadInputRegistersResponse) -> byte
     v_byte_count = (2 * len(m_registers))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('read_input_registers response', 'byte_count', v_byte_count, 0, 255)
-    if any(not 0 <= x <= 65535 or x.__class__ is bool for x in m_registers):
-        raise out_of_range('read_input_registers response', 'registers', m_registers, 0, 65535)
-    return _RESPONSE_FRAMES.wrap(b''.join((_S_BE_U8.pack(v_byte_count), struct.pack(f'>{len(m_registers)}H', *m_registers),)), 0x04, (m_unit,))
+    for x_registers in m_registers:
+        if not 0 <= x_registers <= 65535 or x_registers.__class__ is bool:
+            raise out_of_range('read_input_registers response', 'registers', m_registers, 0, 65535)
+    frame = struct.pack(f'>BBB{len(m_registers)}H', m_unit, 0x04, v_byte_count, *m_registers)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_write_coil_request(m: WriteCoilRequest) -> bytes:
@@ -410,7 +425,8 @@ def _encode_write_coil_request(m: WriteCoilRequest) -> bytes:
         raise out_of_range('write_coil request', 'address', m_address, 0, 65535)
     if not 0 <= m_value <= 65280 or m_value.__class__ is bool:
         raise out_of_range('write_coil request', 'value', m_value, 0, 65280)
-    return _REQUEST_FRAMES.wrap(_S_BE_U16_U16.pack(m_address, m_value), 0x05, (m_unit,))
+    frame = _S_BE_U8_U8_U16_U16.pack(m_unit, 0x05, m_address, m_value)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_write_coil_response(m: WriteCoilResponse) -> bytes:
@@ -423,7 +439,8 @@ def _encode_write_coil_response(m: WriteCoilResponse) -> bytes:
         raise out_of_range('write_coil response', 'address', m_address, 0, 65535)
     if not 0 <= m_value <= 65280 or m_value.__class__ is bool:
         raise out_of_range('write_coil response', 'value', m_value, 0, 65280)
-    return _RESPONSE_FRAMES.wrap(_S_BE_U16_U16.pack(m_address, m_value), 0x05, (m_unit,))
+    frame = _S_BE_U8_U8_U16_U16.pack(m_unit, 0x05, m_address, m_value)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_write_register_request(m: WriteRegisterRequest) -> bytes:
@@ -436,7 +453,8 @@ def _encode_write_register_request(m: WriteRegisterRequest) -> bytes:
         raise out_of_range('write_register request', 'address', m_address, 0, 65535)
     if not 0 <= m_value <= 65535 or m_value.__class__ is bool:
         raise out_of_range('write_register request', 'value', m_value, 0, 65535)
-    return _REQUEST_FRAMES.wrap(_S_BE_U16_U16.pack(m_address, m_value), 0x06, (m_unit,))
+    frame = _S_BE_U8_U8_U16_U16.pack(m_unit, 0x06, m_address, m_value)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_write_register_response(m: WriteRegisterResponse) -> bytes:
@@ -449,7 +467,8 @@ def _encode_write_register_response(m: WriteRegisterResponse) -> bytes:
         raise out_of_range('write_register response', 'address', m_address, 0, 65535)
     if not 0 <= m_value <= 65535 or m_value.__class__ is bool:
         raise out_of_range('write_register response', 'value', m_value, 0, 65535)
-    return _RESPONSE_FRAMES.wrap(_S_BE_U16_U16.pack(m_address, m_value), 0x06, (m_unit,))
+    frame = _S_BE_U8_U8_U16_U16.pack(m_unit, 0x06, m_address, m_value)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_write_coils_request(m: WriteCoilsRequest) -> bytes:
@@ -466,7 +485,8 @@ def _encode_write_coils_request(m: WriteCoilsRequest) -> bytes:
     v_byte_count = (-(-(len(m_values)) // 8))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('write_coils request', 'byte_count', v_byte_count, 0, 255)
-    return _REQUEST_FRAMES.wrap(b''.join((_S_BE_U16_U16_U8.pack(m_address, v_count, v_byte_count), _pack_bits(m_values, 'values', 'write_coils request'),)), 0x0f, (m_unit,))
+    frame = _S_BE_U8_U8_U16_U16_U8.pack(m_unit, 0x0f, m_address, v_count, v_byte_count) + _pack_bits(m_values, 'values', 'write_coils request')
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_write_coils_response(m: WriteCoilsResponse) -> bytes:
@@ -479,7 +499,8 @@ def _encode_write_coils_response(m: WriteCoilsResponse) -> bytes:
         raise out_of_range('write_coils response', 'address', m_address, 0, 65535)
     if not 0 <= m_count <= 65535 or m_count.__class__ is bool:
         raise out_of_range('write_coils response', 'count', m_count, 0, 65535)
-    return _RESPONSE_FRAMES.wrap(_S_BE_U16_U16.pack(m_address, m_count), 0x0f, (m_unit,))
+    frame = _S_BE_U8_U8_U16_U16.pack(m_unit, 0x0f, m_address, m_count)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_write_registers_request(m: WriteRegistersRequest) -> bytes:
@@ -496,9 +517,11 @@ def _encode_write_registers_request(m: WriteRegistersRequest) -> bytes:
     v_byte_count = (2 * (len(m_values)))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('write_registers request', 'byte_count', v_byte_count, 0, 255)
-    if any(not 0 <= x <= 65535 or x.__class__ is bool for x in m_values):
-        raise out_of_range('write_registers request', 'values', m_values, 0, 65535)
-    return _REQUEST_FRAMES.wrap(b''.join((_S_BE_U16_U16_U8.pack(m_address, v_count, v_byte_count), struct.pack(f'>{len(m_values)}H', *m_values),)), 0x10, (m_unit,))
+    for x_values in m_values:
+        if not 0 <= x_values <= 65535 or x_values.__class__ is bool:
+            raise out_of_range('write_registers request', 'values', m_values, 0, 65535)
+    frame = struct.pack(f'>BBHHB{len(m_values)}H', m_unit, 0x10, m_address, v_count, v_byte_count, *m_values)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_write_registers_response(m: WriteRegistersResponse) -> bytes:
@@ -511,7 +534,8 @@ def _encode_write_registers_response(m: WriteRegistersResponse) -> bytes:
         raise out_of_range('write_registers response', 'address', m_address, 0, 65535)
     if not 0 <= m_count <= 65535 or m_count.__class__ is bool:
         raise out_of_range('write_registers response', 'count', m_count, 0, 65535)
-    return _RESPONSE_FRAMES.wrap(_S_BE_U16_U16.pack(m_address, m_count), 0x10, (m_unit,))
+    frame = _S_BE_U8_U8_U16_U16.pack(m_unit, 0x10, m_address, m_count)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_mask_write_register_request(m: MaskWriteRegisterRequest) -> bytes:
@@ -527,7 +551,8 @@ def _encode_mask_write_register_request(m: MaskWriteRegisterRequest) -> bytes:
         raise out_of_range('mask_write_register request', 'and_mask', m_and_mask, 0, 65535)
     if not 0 <= m_or_mask <= 65535 or m_or_mask.__class__ is bool:
         raise out_of_range('mask_write_register request', 'or_mask', m_or_mask, 0, 65535)
-    return _REQUEST_FRAMES.wrap(_S_BE_U16_U16_U16.pack(m_address, m_and_mask, m_or_mask), 0x16, (m_unit,))
+    frame = _S_BE_U8_U8_U16_U16_U16.pack(m_unit, 0x16, m_address, m_and_mask, m_or_mask)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_mask_write_register_response(m: MaskWriteRegisterResponse) -> bytes:
@@ -543,7 +568,8 @@ def _encode_mask_write_register_response(m: MaskWriteRegisterResponse) -> bytes:
         raise out_of_range('mask_write_register response', 'and_mask', m_and_mask, 0, 65535)
     if not 0 <= m_or_mask <= 65535 or m_or_mask.__class__ is bool:
         raise out_of_range('mask_write_register response', 'or_mask', m_or_mask, 0, 65535)
-    return _RESPONSE_FRAMES.wrap(_S_BE_U16_U16_U16.pack(m_address, m_and_mask, m_or_mask), 0x16, (m_unit,))
+    frame = _S_BE_U8_U8_U16_U16_U16.pack(m_unit, 0x16, m_address, m_and_mask, m_or_mask)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_read_write_registers_request(m: ReadWriteRegistersRequest) -> bytes:
@@ -566,9 +592,11 @@ def _encode_read_write_registers_request(m: ReadWriteRegistersRequest) -> bytes:
     v_byte_count = (2 * (len(m_values)))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('read_write_registers request', 'byte_count', v_byte_count, 0, 255)
-    if any(not 0 <= x <= 65535 or x.__class__ is bool for x in m_values):
-        raise out_of_range('read_write_registers request', 'values', m_values, 0, 65535)
-    return _REQUEST_FRAMES.wrap(b''.join((_S_BE_U16_U16_U16_U16_U8.pack(m_read_address, m_read_count, m_write_address, v_write_count, v_byte_count), struct.pack(f'>{len(m_values)}H', *m_values),)), 0x17, (m_unit,))
+    for x_values in m_values:
+        if not 0 <= x_values <= 65535 or x_values.__class__ is bool:
+            raise out_of_range('read_write_registers request', 'values', m_values, 0, 65535)
+    frame = struct.pack(f'>BBHHHHB{len(m_values)}H', m_unit, 0x17, m_read_address, m_read_count, m_write_address, v_write_count, v_byte_count, *m_values)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_read_write_registers_response(m: ReadWriteRegistersResponse) -> bytes:
@@ -579,9 +607,11 @@ def _encode_read_write_registers_response(m: ReadWriteRegistersResponse) -> byte
     v_byte_count = (2 * len(m_registers))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('read_write_registers response', 'byte_count', v_byte_count, 0, 255)
-    if any(not 0 <= x <= 65535 or x.__class__ is bool for x in m_registers):
-        raise out_of_range('read_write_registers response', 'registers', m_registers, 0, 65535)
-    return _RESPONSE_FRAMES.wrap(b''.join((_S_BE_U8.pack(v_byte_count), struct.pack(f'>{len(m_registers)}H', *m_registers),)), 0x17, (m_unit,))
+    for x_registers in m_registers:
+        if not 0 <= x_registers <= 65535 or x_registers.__class__ is bool:
+            raise out_of_range('read_write_registers response', 'registers', m_registers, 0, 65535)
+    frame = struct.pack(f'>BBB{len(m_registers)}H', m_unit, 0x17, v_byte_count, *m_registers)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_exception_response(m: ExceptionResponse) -> bytes:
@@ -594,7 +624,8 @@ def _encode_exception_response(m: ExceptionResponse) -> bytes:
         raise out_of_range('exception response', 'function', m_function, 0, 127)
     if not 1 <= m_exception_code <= 11 or m_exception_code.__class__ is bool:
         raise out_of_range('exception response', 'exception_code', m_exception_code, 1, 11)
-    return _RESPONSE_FRAMES.wrap(_S_BE_U8.pack(m_exception_code), m_function | 0x80, (m_unit,))
+    frame = _S_BE_U8_U8_U8.pack(m_unit, m_function | 0x80, m_exception_code)
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 _REQUEST_DECODERS: dict[int | None, Callable[..., Message]] = {
@@ -635,13 +666,32 @@ _REQUEST_FRAMES = FrameCodec(
 
 
 def _decode_request(frame: bytes, expect: type[Message] | None = None) -> Message:
-    """One complete request frame, checked and taken apart by the frame engine; its content decoded."""
-    unwrapped = _REQUEST_FRAMES.unwrap(frame)
-    decoder = _REQUEST_DECODERS.get(unwrapped.code)
-    if decoder is None:
-        raise DecodeError(f"unknown command {unwrapped.code!r}")
-    content = unwrapped.content
-    return decoder(content, 0, len(content), *unwrapped.values)
+    """One complete request frame, checked and taken apart; its content decoded."""
+    n = len(frame)
+    if n < 4:
+        raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (4)")
+    end = n - 2
+    buf = frame
+    v_unit = buf[0]
+    if not 0 <= v_unit <= 247:
+        raise DecodeError(f"unit = {v_unit} is outside its range 1..247 (or 0)")
+    if _CHECK_CRC(frame) != 0x0000:
+        check = _CHECK_CRC(frame[:-2])
+        stored = buf[end + 1] << 8 | buf[end]
+        if check != stored:
+            raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
+    code = buf[1]
+    try:
+        decoder = _REQUEST_DECODERS[code]
+    except KeyError:
+        raise DecodeError(f"unknown command {code!r}") from None
+    return decoder(buf, 2, end, v_unit)
+
+
+def _wrap_request(content: bytes, code: int | None, v_unit: int) -> bytes:
+    """The request frame around `content`, EncodeError if it cannot be."""
+    frame = _F_LE_U8_U8.pack(v_unit, code) + content
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 _RESPONSE_DECODERS: dict[int | None, Callable[..., Message]] = {
@@ -685,17 +735,34 @@ _RESPONSE_FRAMES = FrameCodec(
 
 
 def _decode_response(frame: bytes, expect: type[Message] | None = None) -> Message:
-    """One complete response frame, checked and taken apart by the frame engine; its content decoded."""
-    unwrapped = _RESPONSE_FRAMES.unwrap(frame)
-    code = unwrapped.code
-    if code is not None and code & 0x80:  # an error reply: it refuses the request of code & ~flag
-        content = unwrapped.content
-        return _RESPONSE_DECODERS[ERROR_REPLY](content, 0, len(content), *unwrapped.values, code & 0x7f)
-    decoder = _RESPONSE_DECODERS.get(unwrapped.code)
-    if decoder is None:
-        raise DecodeError(f"unknown command {unwrapped.code!r}")
-    content = unwrapped.content
-    return decoder(content, 0, len(content), *unwrapped.values)
+    """One complete response frame, checked and taken apart; its content decoded."""
+    n = len(frame)
+    if n < 4:
+        raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (4)")
+    end = n - 2
+    buf = frame
+    v_unit = buf[0]
+    if not 0 <= v_unit <= 247:
+        raise DecodeError(f"unit = {v_unit} is outside its range 1..247 (or 0)")
+    if _CHECK_CRC(frame) != 0x0000:
+        check = _CHECK_CRC(frame[:-2])
+        stored = buf[end + 1] << 8 | buf[end]
+        if check != stored:
+            raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
+    code = buf[1]
+    if code & 0x80:  # an error reply: it refuses the request of code & ~flag
+        return _RESPONSE_DECODERS[ERROR_REPLY](buf, 2, end, v_unit, code & 0x7f)
+    try:
+        decoder = _RESPONSE_DECODERS[code]
+    except KeyError:
+        raise DecodeError(f"unknown command {code!r}") from None
+    return decoder(buf, 2, end, v_unit)
+
+
+def _wrap_response(content: bytes, code: int | None, v_unit: int) -> bytes:
+    """The response frame around `content`, EncodeError if it cannot be."""
+    frame = _F_LE_U8_U8.pack(v_unit, code) + content
+    return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 _ENCODERS: dict[type[Message], Callable[..., bytes]] = {
@@ -730,9 +797,49 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
     if direction is None:
         raise DecodeError("give the direction: requests and responses cannot be told apart by their first bytes")
     if direction == 'request':  # a Direction or its value
-        return _decode_request(bytes(data), expect)
+        frame = data if data.__class__ is bytes else bytes(data)
+        n = len(frame)
+        if n < 4:
+            raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (4)")
+        end = n - 2
+        buf = frame
+        v_unit = buf[0]
+        if not 0 <= v_unit <= 247:
+            raise DecodeError(f"unit = {v_unit} is outside its range 1..247 (or 0)")
+        if _CHECK_CRC(frame) != 0x0000:
+            check = _CHECK_CRC(frame[:-2])
+            stored = buf[end + 1] << 8 | buf[end]
+            if check != stored:
+                raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
+        code = buf[1]
+        try:
+            decoder = _REQUEST_DECODERS[code]
+        except KeyError:
+            raise DecodeError(f"unknown command {code!r}") from None
+        return decoder(buf, 2, end, v_unit)
     if direction == 'response':  # a Direction or its value
-        return _decode_response(bytes(data), expect)
+        frame = data if data.__class__ is bytes else bytes(data)
+        n = len(frame)
+        if n < 4:
+            raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (4)")
+        end = n - 2
+        buf = frame
+        v_unit = buf[0]
+        if not 0 <= v_unit <= 247:
+            raise DecodeError(f"unit = {v_unit} is outside its range 1..247 (or 0)")
+        if _CHECK_CRC(frame) != 0x0000:
+            check = _CHECK_CRC(frame[:-2])
+            stored = buf[end + 1] << 8 | buf[end]
+            if check != stored:
+                raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
+        code = buf[1]
+        if code & 0x80:  # an error reply: it refuses the request of code & ~flag
+            return _RESPONSE_DECODERS[ERROR_REPLY](buf, 2, end, v_unit, code & 0x7f)
+        try:
+            decoder = _RESPONSE_DECODERS[code]
+        except KeyError:
+            raise DecodeError(f"unknown command {code!r}") from None
+        return decoder(buf, 2, end, v_unit)
     raise ValueError(f"direction must be request or response, not {direction!r}")
 
 

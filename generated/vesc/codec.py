@@ -7,7 +7,7 @@ import struct
 from collections.abc import Callable
 
 from serialspec.runtime.checksums import crc_function
-from serialspec.runtime.errors import DecodeError, EncodeError, content_size_error, out_of_range
+from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError, content_size_error, out_of_range
 from serialspec.runtime.fields import wrong_type
 from serialspec.runtime.framing import Element, EngineFormat, FrameCodec, Layout
 from serialspec.runtime.framing import FrameStreamParser as _FrameStreamParser
@@ -38,6 +38,11 @@ from vesc.messages import (
 
 __all__ = ["StreamParser", "decode", "encode"]
 
+_F_BE_1S_U16_U8 = struct.Struct('>1sHB')
+_F_LE_1S_U8_U8 = struct.Struct('<1sBB')
+_S_B1_U8_U8 = struct.Struct('<1sBB')
+_S_BE_B1_U8_U8_I32 = struct.Struct('>1sBBi')
+_S_BE_FRAME_GETVALUESRESPONSE = struct.Struct('>1sBBhhiiiihihiiiiiiBiBhhhiiB')
 _S_BE_FWVERSIONRESPONSE_UUID = struct.Struct('>12sBBBBBBBB')
 _S_BE_GETVALUESRESPONSE_TEMP_FET = struct.Struct('>hhiiiihihiiiiiiBiBhhhiiB')
 _S_BE_I32 = struct.Struct('>i')
@@ -67,6 +72,8 @@ def _decode_fw_version_response(buf: bytes, o: int, end: int) -> FwVersionRespon
         raise DecodeError('fw_version response' + ': hw_name has no NUL at its end')
     v_hw_name = _decode_text(buf[o:stop], 'hw_name', 'fw_version response')
     o = stop + 1
+    if end - o < 20:
+        raise DecodeError('fw_version response' + f': uuid needs 20 bytes, {end - o} left')
     v_uuid, v_pairing_done, v_test_version, v_hw_type, v_custom_config_count, v_phase_filters, v_qml_hw, v_qml_app, v_nrf_flags = _S_BE_FWVERSIONRESPONSE_UUID.unpack_from(buf, o)
     o += 20
     stop = buf.find(b'\0', o, end)
@@ -74,6 +81,8 @@ def _decode_fw_version_response(buf: bytes, o: int, end: int) -> FwVersionRespon
         raise DecodeError('fw_version response' + ': fw_name has no NUL at its end')
     v_fw_name = _decode_text(buf[o:stop], 'fw_name', 'fw_version response')
     o = stop + 1
+    if end - o < 4:
+        raise DecodeError('fw_version response' + f': hw_crc needs 4 bytes, {end - o} left')
     v_hw_crc, = _S_BE_U32.unpack_from(buf, o)
     o += 4
     if o != end:
@@ -163,7 +172,8 @@ def _decode_forward_can_request(buf: bytes, o: int, end: int) -> ForwardCanReque
 
 
 def _encode_fw_version_request(m: FwVersionRequest) -> bytes:
-    return _REQUEST_FRAMES.wrap(b'', 0x00, ())
+    frame = _S_B1_U8_U8.pack(b'\x02', 1, 0x00)
+    return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
 
 
 def _encode_fw_version_response(m: FwVersionResponse) -> bytes:
@@ -203,11 +213,12 @@ def _encode_fw_version_response(m: FwVersionResponse) -> bytes:
         raise out_of_range('fw_version response', 'nrf_flags', m_nrf_flags, 0, 255)
     if not 0 <= m_hw_crc <= 4294967295 or m_hw_crc.__class__ is bool:
         raise out_of_range('fw_version response', 'hw_crc', m_hw_crc, 0, 4294967295)
-    return _RESPONSE_FRAMES.wrap(b''.join((_S_BE_U8_U8.pack(m_major, m_minor), _encode_text(m.hw_name, 'hw_name', 'fw_version response', True), _S_BE_FWVERSIONRESPONSE_UUID.pack(m_uuid, m_pairing_done, m_test_version, m_hw_type, m_custom_config_count, m_phase_filters, m_qml_hw, m_qml_app, m_nrf_flags), _encode_text(m.fw_name, 'fw_name', 'fw_version response', True), _S_BE_U32.pack(m_hw_crc),)), 0x00, ())
+    return _wrap_response(b''.join((_S_BE_U8_U8.pack(m_major, m_minor), _encode_text(m.hw_name, 'hw_name', 'fw_version response', True), _S_BE_FWVERSIONRESPONSE_UUID.pack(m_uuid, m_pairing_done, m_test_version, m_hw_type, m_custom_config_count, m_phase_filters, m_qml_hw, m_qml_app, m_nrf_flags), _encode_text(m.fw_name, 'fw_name', 'fw_version response', True), _S_BE_U32.pack(m_hw_crc),)), 0x00)
 
 
 def _encode_get_values_request(m: GetValuesRequest) -> bytes:
-    return _REQUEST_FRAMES.wrap(b'', 0x04, ())
+    frame = _S_B1_U8_U8.pack(b'\x02', 1, 0x04)
+    return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
 
 
 def _encode_get_values_response(m: GetValuesResponse) -> bytes:
@@ -283,64 +294,73 @@ def _encode_get_values_response(m: GetValuesResponse) -> bytes:
         raise out_of_range('get_values response', 'avg_vq', m_avg_vq, -2147483648, 2147483647)
     if not 0 <= m_status <= 255 or isinstance(m_status, bool):
         raise out_of_range('get_values response', 'status', m_status, 0, 255)
-    return _RESPONSE_FRAMES.wrap(_S_BE_GETVALUESRESPONSE_TEMP_FET.pack(m_temp_fet, m_temp_motor, m_avg_motor_current, m_avg_input_current, m_avg_id, m_avg_iq, m_duty_now, m_rpm, m_v_in, m_amp_hours, m_amp_hours_charged, m_watt_hours, m_watt_hours_charged, m_tachometer, m_tachometer_abs, m_fault, m_pid_pos, m_controller_id, m_temp_mos1, m_temp_mos2, m_temp_mos3, m_avg_vd, m_avg_vq, m_status), 0x04, ())
+    frame = _S_BE_FRAME_GETVALUESRESPONSE.pack(b'\x02', 74, 0x04, m_temp_fet, m_temp_motor, m_avg_motor_current, m_avg_input_current, m_avg_id, m_avg_iq, m_duty_now, m_rpm, m_v_in, m_amp_hours, m_amp_hours_charged, m_watt_hours, m_watt_hours_charged, m_tachometer, m_tachometer_abs, m_fault, m_pid_pos, m_controller_id, m_temp_mos1, m_temp_mos2, m_temp_mos3, m_avg_vd, m_avg_vq, m_status)
+    return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
 
 
 def _encode_set_duty_request(m: SetDutyRequest) -> bytes:
     m_duty = m.duty
     if not -100000 <= m_duty <= 100000 or m_duty.__class__ is bool:
         raise out_of_range('set_duty request', 'duty', m_duty, -100000, 100000)
-    return _REQUEST_FRAMES.wrap(_S_BE_I32.pack(m_duty), 0x05, ())
+    frame = _S_BE_B1_U8_U8_I32.pack(b'\x02', 5, 0x05, m_duty)
+    return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
 
 
 def _encode_set_current_request(m: SetCurrentRequest) -> bytes:
     m_current = m.current
     if not -2147483648 <= m_current <= 2147483647 or m_current.__class__ is bool:
         raise out_of_range('set_current request', 'current', m_current, -2147483648, 2147483647)
-    return _REQUEST_FRAMES.wrap(_S_BE_I32.pack(m_current), 0x06, ())
+    frame = _S_BE_B1_U8_U8_I32.pack(b'\x02', 5, 0x06, m_current)
+    return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
 
 
 def _encode_set_current_brake_request(m: SetCurrentBrakeRequest) -> bytes:
     m_current = m.current
     if not -2147483648 <= m_current <= 2147483647 or m_current.__class__ is bool:
         raise out_of_range('set_current_brake request', 'current', m_current, -2147483648, 2147483647)
-    return _REQUEST_FRAMES.wrap(_S_BE_I32.pack(m_current), 0x07, ())
+    frame = _S_BE_B1_U8_U8_I32.pack(b'\x02', 5, 0x07, m_current)
+    return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
 
 
 def _encode_set_rpm_request(m: SetRpmRequest) -> bytes:
     m_rpm = m.rpm
     if not -2147483648 <= m_rpm <= 2147483647 or m_rpm.__class__ is bool:
         raise out_of_range('set_rpm request', 'rpm', m_rpm, -2147483648, 2147483647)
-    return _REQUEST_FRAMES.wrap(_S_BE_I32.pack(m_rpm), 0x08, ())
+    frame = _S_BE_B1_U8_U8_I32.pack(b'\x02', 5, 0x08, m_rpm)
+    return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
 
 
 def _encode_set_pos_request(m: SetPosRequest) -> bytes:
     m_position = m.position
     if not -2147483648 <= m_position <= 2147483647 or m_position.__class__ is bool:
         raise out_of_range('set_pos request', 'position', m_position, -2147483648, 2147483647)
-    return _REQUEST_FRAMES.wrap(_S_BE_I32.pack(m_position), 0x09, ())
+    frame = _S_BE_B1_U8_U8_I32.pack(b'\x02', 5, 0x09, m_position)
+    return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
 
 
 def _encode_set_handbrake_request(m: SetHandbrakeRequest) -> bytes:
     m_current = m.current
     if not -2147483648 <= m_current <= 2147483647 or m_current.__class__ is bool:
         raise out_of_range('set_handbrake request', 'current', m_current, -2147483648, 2147483647)
-    return _REQUEST_FRAMES.wrap(_S_BE_I32.pack(m_current), 0x0a, ())
+    frame = _S_BE_B1_U8_U8_I32.pack(b'\x02', 5, 0x0a, m_current)
+    return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
 
 
 def _encode_print_response(m: PrintResponse) -> bytes:
-    return _RESPONSE_FRAMES.wrap(_encode_text(m.text, 'text', 'print response', False), 0x15, ())
+    return _wrap_response(_encode_text(m.text, 'text', 'print response', False), 0x15)
 
 
 def _encode_rotor_position_response(m: RotorPositionResponse) -> bytes:
     m_position = m.position
     if not -2147483648 <= m_position <= 2147483647 or m_position.__class__ is bool:
         raise out_of_range('rotor_position response', 'position', m_position, -2147483648, 2147483647)
-    return _RESPONSE_FRAMES.wrap(_S_BE_I32.pack(m_position), 0x16, ())
+    frame = _S_BE_B1_U8_U8_I32.pack(b'\x02', 5, 0x16, m_position)
+    return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
 
 
 def _encode_alive_request(m: AliveRequest) -> bytes:
-    return _REQUEST_FRAMES.wrap(b'', 0x1e, ())
+    frame = _S_B1_U8_U8.pack(b'\x02', 1, 0x1e)
+    return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
 
 
 def _encode_forward_can_request(m: ForwardCanRequest) -> bytes:
@@ -349,7 +369,7 @@ def _encode_forward_can_request(m: ForwardCanRequest) -> bytes:
     if not 0 <= m_can_id <= 255 or m_can_id.__class__ is bool:
         raise out_of_range('forward_can request', 'can_id', m_can_id, 0, 255)
     v_payload = m_payload if m_payload.__class__ is bytes else bytes(m_payload)
-    return _REQUEST_FRAMES.wrap(b''.join((_S_BE_U8.pack(m_can_id), v_payload,)), 0x22, ())
+    return _wrap_request(b''.join((_S_BE_U8.pack(m_can_id), v_payload,)), 0x22)
 
 
 _REQUEST_DECODERS: dict[int | None, Callable[..., Message]] = {
@@ -398,14 +418,76 @@ _REQUEST_FRAMES = FrameCodec(
 )
 
 
+def _decode_request_short(frame: bytes, expect: type[Message] | None = None) -> Message:
+    """One complete short frame, checked and taken apart; its content decoded."""
+    n = len(frame)
+    if n < 6:
+        raise DecodeError(f"frame of {n} bytes is shorter than the smallest short frame (6)")
+    end = n - 3
+    buf = frame
+    if buf[end + 2] != 0x03:
+        raise DecodeError(f"end is {buf[end + 2:end + 3].hex(' ')}, expected 03")
+    length = buf[1]
+    if length != n - 5:
+        raise DecodeError(f"length says {length} but the frame holds {n - 5}")
+    if _CHECK_CRC(frame[2:-1]) != 0x0000:
+        check = _CHECK_CRC(frame[2:-3])
+        stored = buf[end] << 8 | buf[end + 1]
+        if check != stored:
+            raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
+    code = buf[2]
+    try:
+        decoder = _REQUEST_DECODERS[code]
+    except KeyError:
+        raise DecodeError(f"unknown command {code!r}") from None
+    return decoder(buf, 3, end)
+
+
+def _decode_request_long(frame: bytes, expect: type[Message] | None = None) -> Message:
+    """One complete long frame, checked and taken apart; its content decoded."""
+    n = len(frame)
+    if n < 7:
+        raise DecodeError(f"frame of {n} bytes is shorter than the smallest long frame (7)")
+    end = n - 3
+    buf = frame
+    if buf[end + 2] != 0x03:
+        raise DecodeError(f"end is {buf[end + 2:end + 3].hex(' ')}, expected 03")
+    length = buf[1] << 8 | buf[2]
+    if length != n - 6:
+        raise DecodeError(f"length says {length} but the frame holds {n - 6}")
+    if _CHECK_CRC(frame[3:-1]) != 0x0000:
+        check = _CHECK_CRC(frame[3:-3])
+        stored = buf[end] << 8 | buf[end + 1]
+        if check != stored:
+            raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
+    code = buf[3]
+    try:
+        decoder = _REQUEST_DECODERS[code]
+    except KeyError:
+        raise DecodeError(f"unknown command {code!r}") from None
+    return decoder(buf, 4, end)
+
+
 def _decode_request(frame: bytes, expect: type[Message] | None = None) -> Message:
-    """One complete request frame, checked and taken apart by the frame engine; its content decoded."""
-    unwrapped = _REQUEST_FRAMES.unwrap(frame)
-    decoder = _REQUEST_DECODERS.get(unwrapped.code)
-    if decoder is None:
-        raise DecodeError(f"unknown command {unwrapped.code!r}")
-    content = unwrapped.content
-    return decoder(content, 0, len(content), *unwrapped.values)
+    """One complete request frame, in the layout its header names."""
+    if frame.startswith(b'\x02'):
+        return _decode_request_short(frame, expect)
+    if frame.startswith(b'\x03'):
+        return _decode_request_long(frame, expect)
+    raise DecodeError(f"frame starts {frame[:4].hex(' ')}, expected 02 or 03")
+
+
+def _wrap_request(content: bytes, code: int | None) -> bytes:
+    """The request frame around `content`, in the first layout whose length can count it."""
+    v_length = len(content) + 1
+    if v_length < 256:
+        frame = _F_LE_1S_U8_U8.pack(b'\x02', v_length, code) + content
+        return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
+    v_length = len(content) + 1
+    if not v_length < 65536:
+        raise EncodeError(f"long frame: length {v_length} does not fit its 2-byte field")
+    frame = _F_BE_1S_U16_U8.pack(b'\x03', v_length, code) + content
+    return frame + _CHECK_CRC(frame[3:]).to_bytes(2, 'big') + b'\x03'
 
 
 _RESPONSE_DECODERS: dict[int | None, Callable[..., Message]] = {
@@ -442,14 +524,76 @@ _RESPONSE_FRAMES = FrameCodec(
 )
 
 
+def _decode_response_short(frame: bytes, expect: type[Message] | None = None) -> Message:
+    """One complete short frame, checked and taken apart; its content decoded."""
+    n = len(frame)
+    if n < 6:
+        raise DecodeError(f"frame of {n} bytes is shorter than the smallest short frame (6)")
+    end = n - 3
+    buf = frame
+    if buf[end + 2] != 0x03:
+        raise DecodeError(f"end is {buf[end + 2:end + 3].hex(' ')}, expected 03")
+    length = buf[1]
+    if length != n - 5:
+        raise DecodeError(f"length says {length} but the frame holds {n - 5}")
+    if _CHECK_CRC(frame[2:-1]) != 0x0000:
+        check = _CHECK_CRC(frame[2:-3])
+        stored = buf[end] << 8 | buf[end + 1]
+        if check != stored:
+            raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
+    code = buf[2]
+    try:
+        decoder = _RESPONSE_DECODERS[code]
+    except KeyError:
+        raise DecodeError(f"unknown command {code!r}") from None
+    return decoder(buf, 3, end)
+
+
+def _decode_response_long(frame: bytes, expect: type[Message] | None = None) -> Message:
+    """One complete long frame, checked and taken apart; its content decoded."""
+    n = len(frame)
+    if n < 7:
+        raise DecodeError(f"frame of {n} bytes is shorter than the smallest long frame (7)")
+    end = n - 3
+    buf = frame
+    if buf[end + 2] != 0x03:
+        raise DecodeError(f"end is {buf[end + 2:end + 3].hex(' ')}, expected 03")
+    length = buf[1] << 8 | buf[2]
+    if length != n - 6:
+        raise DecodeError(f"length says {length} but the frame holds {n - 6}")
+    if _CHECK_CRC(frame[3:-1]) != 0x0000:
+        check = _CHECK_CRC(frame[3:-3])
+        stored = buf[end] << 8 | buf[end + 1]
+        if check != stored:
+            raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
+    code = buf[3]
+    try:
+        decoder = _RESPONSE_DECODERS[code]
+    except KeyError:
+        raise DecodeError(f"unknown command {code!r}") from None
+    return decoder(buf, 4, end)
+
+
 def _decode_response(frame: bytes, expect: type[Message] | None = None) -> Message:
-    """One complete response frame, checked and taken apart by the frame engine; its content decoded."""
-    unwrapped = _RESPONSE_FRAMES.unwrap(frame)
-    decoder = _RESPONSE_DECODERS.get(unwrapped.code)
-    if decoder is None:
-        raise DecodeError(f"unknown command {unwrapped.code!r}")
-    content = unwrapped.content
-    return decoder(content, 0, len(content), *unwrapped.values)
+    """One complete response frame, in the layout its header names."""
+    if frame.startswith(b'\x02'):
+        return _decode_response_short(frame, expect)
+    if frame.startswith(b'\x03'):
+        return _decode_response_long(frame, expect)
+    raise DecodeError(f"frame starts {frame[:4].hex(' ')}, expected 02 or 03")
+
+
+def _wrap_response(content: bytes, code: int | None) -> bytes:
+    """The response frame around `content`, in the first layout whose length can count it."""
+    v_length = len(content) + 1
+    if v_length < 256:
+        frame = _F_LE_1S_U8_U8.pack(b'\x02', v_length, code) + content
+        return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
+    v_length = len(content) + 1
+    if not v_length < 65536:
+        raise EncodeError(f"long frame: length {v_length} does not fit its 2-byte field")
+    frame = _F_BE_1S_U16_U8.pack(b'\x03', v_length, code) + content
+    return frame + _CHECK_CRC(frame[3:]).to_bytes(2, 'big') + b'\x03'
 
 
 _ENCODERS: dict[type[Message], Callable[..., bytes]] = {
@@ -477,9 +621,99 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
     if direction is None:
         raise DecodeError("give the direction: requests and responses cannot be told apart by their first bytes")
     if direction == 'request':  # a Direction or its value
-        return _decode_request(bytes(data), expect)
+        frame = data if data.__class__ is bytes else bytes(data)
+        if frame.startswith(b'\x02'):
+            n = len(frame)
+            if n < 6:
+                raise DecodeError(f"frame of {n} bytes is shorter than the smallest short frame (6)")
+            end = n - 3
+            buf = frame
+            if buf[end + 2] != 0x03:
+                raise DecodeError(f"end is {buf[end + 2:end + 3].hex(' ')}, expected 03")
+            length = buf[1]
+            if length != n - 5:
+                raise DecodeError(f"length says {length} but the frame holds {n - 5}")
+            if _CHECK_CRC(frame[2:-1]) != 0x0000:
+                check = _CHECK_CRC(frame[2:-3])
+                stored = buf[end] << 8 | buf[end + 1]
+                if check != stored:
+                    raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
+            code = buf[2]
+            try:
+                decoder = _REQUEST_DECODERS[code]
+            except KeyError:
+                raise DecodeError(f"unknown command {code!r}") from None
+            return decoder(buf, 3, end)
+        if frame.startswith(b'\x03'):
+            n = len(frame)
+            if n < 7:
+                raise DecodeError(f"frame of {n} bytes is shorter than the smallest long frame (7)")
+            end = n - 3
+            buf = frame
+            if buf[end + 2] != 0x03:
+                raise DecodeError(f"end is {buf[end + 2:end + 3].hex(' ')}, expected 03")
+            length = buf[1] << 8 | buf[2]
+            if length != n - 6:
+                raise DecodeError(f"length says {length} but the frame holds {n - 6}")
+            if _CHECK_CRC(frame[3:-1]) != 0x0000:
+                check = _CHECK_CRC(frame[3:-3])
+                stored = buf[end] << 8 | buf[end + 1]
+                if check != stored:
+                    raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
+            code = buf[3]
+            try:
+                decoder = _REQUEST_DECODERS[code]
+            except KeyError:
+                raise DecodeError(f"unknown command {code!r}") from None
+            return decoder(buf, 4, end)
+        raise DecodeError(f"frame starts {frame[:4].hex(' ')}, expected 02 or 03")
     if direction == 'response':  # a Direction or its value
-        return _decode_response(bytes(data), expect)
+        frame = data if data.__class__ is bytes else bytes(data)
+        if frame.startswith(b'\x02'):
+            n = len(frame)
+            if n < 6:
+                raise DecodeError(f"frame of {n} bytes is shorter than the smallest short frame (6)")
+            end = n - 3
+            buf = frame
+            if buf[end + 2] != 0x03:
+                raise DecodeError(f"end is {buf[end + 2:end + 3].hex(' ')}, expected 03")
+            length = buf[1]
+            if length != n - 5:
+                raise DecodeError(f"length says {length} but the frame holds {n - 5}")
+            if _CHECK_CRC(frame[2:-1]) != 0x0000:
+                check = _CHECK_CRC(frame[2:-3])
+                stored = buf[end] << 8 | buf[end + 1]
+                if check != stored:
+                    raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
+            code = buf[2]
+            try:
+                decoder = _RESPONSE_DECODERS[code]
+            except KeyError:
+                raise DecodeError(f"unknown command {code!r}") from None
+            return decoder(buf, 3, end)
+        if frame.startswith(b'\x03'):
+            n = len(frame)
+            if n < 7:
+                raise DecodeError(f"frame of {n} bytes is shorter than the smallest long frame (7)")
+            end = n - 3
+            buf = frame
+            if buf[end + 2] != 0x03:
+                raise DecodeError(f"end is {buf[end + 2:end + 3].hex(' ')}, expected 03")
+            length = buf[1] << 8 | buf[2]
+            if length != n - 6:
+                raise DecodeError(f"length says {length} but the frame holds {n - 6}")
+            if _CHECK_CRC(frame[3:-1]) != 0x0000:
+                check = _CHECK_CRC(frame[3:-3])
+                stored = buf[end] << 8 | buf[end + 1]
+                if check != stored:
+                    raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
+            code = buf[3]
+            try:
+                decoder = _RESPONSE_DECODERS[code]
+            except KeyError:
+                raise DecodeError(f"unknown command {code!r}") from None
+            return decoder(buf, 4, end)
+        raise DecodeError(f"frame starts {frame[:4].hex(' ')}, expected 02 or 03")
     raise ValueError(f"direction must be request or response, not {direction!r}")
 
 

@@ -3,8 +3,10 @@
 A frame is an ordered list of elements: constant parts (headers, reserved bytes, trailers), frame-level values
 (address, command, status), at most one content, lengths counting a span of elements, checksums covering a span,
 and an optional transparency rule (byte stuffing or escaping) over a span. Alternative layouts of one direction
-are told apart by their leading constant. Generated codecs describe their frames with these classes; protocols
-whose frames fit the classic shape (a header, a one-byte length, a final checksum) get straight-line code instead.
+are told apart by their leading constant. Generated codecs describe their frames with these classes: the stream
+parser sizes frames with them, and they are the reference the codecs' straight-line frame code (written from the
+same layouts by emit/python/framecode.py) agrees with, check for check and message for message; a layout that code
+cannot take (a checksum inside the stuffed span) is coded by Layout.wrap and Layout.unwrap themselves.
 
 Rules (the spec language's, see the generated docs): lengths and checksums outside the transparency span see the
 wire bytes, checksums inside it the bytes before the rewrite; a span either holds the whole transparency span or
@@ -136,6 +138,21 @@ class Layout:
         )
         plan["inner_checksums"] = inside
         plan["outer_checksums"] = tuple(c for c in plan["checksums"] if c not in inside)
+        # What FrameCodec.probe reads, worked out once: the fixed elements before the variable part with their
+        # offsets, and the length element's offset, size, byte order, adds and the sizes around what it counts.
+        probe_head, position = [], 0
+        for element in self.elements[:first]:
+            probe_head.append((element, position, position + element.size))
+            position += element.size
+        plan["probe_head"] = tuple(probe_head)
+        plan["probe_length"] = None
+        if self.length is not None:
+            length = self.elements[self.length]
+            offset = self.offset(self.length)
+            a, b = length.span
+            counted = sum(e.size for e in self.elements[a : b + 1])
+            plan["probe_length"] = (offset, length, self.overhead - counted, counted)
+        plan["prefix"] = self.prefix()
         object.__setattr__(self, "_plan", plan)
 
     @property
@@ -359,53 +376,44 @@ class FrameCodec:
 
     def probe(self, layout: Layout, buffer: bytes, start: int, end: int) -> int | None:
         """Size of a plausible frame of `layout` at buffer[start:], None when more bytes are needed, -1 if none."""
+        plan: dict[str, Any] = layout._plan  # type: ignore[attr-defined]
         available = end - start
-        elements = layout.elements
-        first, _ = layout._inner()
-        position = 0
         code: int | None = None
-        for index in range(first):  # the fixed part before anything variable
-            element = elements[index]
-            size = element.size
-            if available < position + size:
+        for element, first, stop in plan["probe_head"]:  # the fixed part before anything variable
+            if available < stop:
                 return None
-            data = buffer[start + position : start + position + size]
-            if element.kind == "constant" and data != element.constant:
-                return -1
-            if element.kind in ("value", "command"):
-                value = int.from_bytes(data, element.endian)
-                if element.kind == "command":
-                    code = ERROR_REPLY if value & self.error_flag else value
-                    if code not in self.content_sizes:
-                        return -1
-                elif not element.plausible(value):
+            data = buffer[start + first : start + stop]
+            kind = element.kind
+            if kind == "constant":
+                if data != element.constant:
                     return -1
-            position += size
+            elif kind == "command":
+                value = int.from_bytes(data, element.endian)
+                code = ERROR_REPLY if value & self.error_flag else value
+                if code not in self.content_sizes:
+                    return -1
+            elif kind == "value" and not element.plausible(int.from_bytes(data, element.endian)):
+                return -1
         if layout.command is None:
             code = None
             if None not in self.content_sizes:
                 return -1
         low, high = self.content_sizes.get(code, (0, None))
-        if layout.length is not None:
-            element = elements[layout.length]
-            offset = layout.offset(layout.length)
-            assert offset is not None
+        length: tuple[int, Element, int, int] | None = plan["probe_length"]
+        if length is not None:
+            offset, element, outside, inside_fixed = length
             counted = element.unpack(buffer[start + offset : start + offset + element.size]) - element.adds
-            a, b = element.span
-            outside = sum(e.size for e in elements) - sum(e.size for e in elements[a : b + 1])
-            inside_fixed = sum(e.size for e in elements[a : b + 1])
             content = counted - inside_fixed  # wire bytes of the content (stuffed, if it is)
             if content < low or (layout.transparency is None and high is not None and content > high):
                 return -1
             return outside + counted
         if layout.trailer and layout.transparency is not None:
-            stop = buffer.find(layout.trailer, start + position)
+            stop = buffer.find(layout.trailer, start + plan["before"])
             return None if stop < 0 else stop + len(layout.trailer) - start
         rule = self.size_rules.get(code)
         if rule is None:
             return -1
-        content_start = start + layout.prefix()
-        content_size = rule.size(buffer, content_start, end)
+        content_size = rule.size(buffer, start + plan["prefix"], end)
         if content_size is None:
             return None
         if content_size < low or (high is not None and content_size > high):

@@ -2,15 +2,17 @@
 
 Classic frames (a header, a one-byte length, one final checksum, no stuffing) get straight-line code (see
 package.py); every other framing is described here as `serialspec.runtime.framing` objects: the layouts of each
-direction, the content size bounds by command, and size rules for frames that carry no length.
+direction, the content size bounds by command, and size rules for frames that carry no length. The stream parser
+runs on them; single frames are checked and built by straight-line code written from the same layouts
+(framecode.py).
 """
 
 from __future__ import annotations
 
 from serialspec.emit.common.frames import runtime_element
+from serialspec.emit.python.framecode import checksum_name
 from serialspec.emit.python.pycode import one_line
 from serialspec.spec.model import (
-    Checksum,
     Command,
     Direction,
     FrameElement,
@@ -19,10 +21,6 @@ from serialspec.spec.model import (
     Protocol,
     size_terms,
 )
-
-
-def checksum_name(checksum: Checksum) -> str:
-    return f"_CHECK_{checksum.name.upper()}"
 
 
 def checksum_definitions(protocol: Protocol) -> tuple[list[str], list[str]]:

@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import re
+from dataclasses import replace
 from typing import Any
 
 from serialspec.collection import without_cycle_collection
 from serialspec.emit.common.numbers import number
 from serialspec.emit.python.client import client_module
+from serialspec.emit.python.framecode import Target, direction_functions
 from serialspec.emit.python.frames import checksum_definitions, code_key, codec_lines, framing_imports
 from serialspec.emit.python.pycode import (
     ClassCode,
@@ -182,15 +184,19 @@ def message_doc(protocol: Protocol, message: Message) -> str:
 
 def codec_context(protocol: Protocol, code: PackageCode, exports: list[str]) -> dict[str, Any]:
     # the target's part first: the classic codec's whole-frame decoders add structs the common part lists
-    specific = classic_codec_context(protocol, code) if protocol.framing.classic else general_codec_context(protocol)
+    classic = protocol.framing.classic
+    specific = classic_codec_context(protocol, code) if classic else general_codec_context(protocol, code)
     return common_codec_context(protocol, code, exports) | specific
 
 
-def general_codec_context(protocol: Protocol) -> dict[str, Any]:
-    """Frames for the runtime's frame engine: one FrameCodec per direction, decoders by code (and by class)."""
+def general_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, Any]:
+    """Frames of any other shape: straight-line frame functions per direction where the layouts allow them (see
+    framecode.py), else the runtime's frame engine; one FrameCodec per direction either way (the stream parser's),
+    decoders by code (and by class)."""
     imports, definitions = checksum_definitions(protocol)
     directions: list[dict[str, Any]] = []
     dispatchers = []
+    frame_structs: dict[str, str] = {}
     for direction, layout in protocol.framing.layouts.items():
         by_code: dict[str, list[tuple[Message | None, str, int, int | None]]] = {}
         for command in protocol.commands:
@@ -215,20 +221,23 @@ def general_codec_context(protocol: Protocol) -> dict[str, Any]:
             if len(users) == 1 and users[0][0] is not None:
                 single[key] = users[0][0]
             expected += [(m.class_name, key, target) for m, target, _, _ in users if m is not None and len(users) > 1]
-        error = None
+        frames = Target(direction.name, tuple(e.name for e in layout.value_elements), expected=bool(expected))
         if protocol.error_reply is not None and direction == Direction.RESPONSE:
             element = next(e for e in layout.elements if e.name == protocol.error_reply.element)
             assert element.type is not None
             mask = (1 << (8 * element.type.size)) - 1
-            error = {"flag": f"{protocol.error_reply.flag:#04x}", "keep": f"{mask & ~protocol.error_reply.flag:#04x}"}
+            flag = protocol.error_reply.flag
+            frames = replace(frames, error_flag=flag, error_keep=mask & ~flag)
+        functions, call = direction_functions(protocol, direction, frames, frame_structs)
         directions.append(
             {
                 "name": direction.value,
                 "upper": direction.name,
-                "error": error,
                 "dispatch": dispatch,
                 "expected": expected,
                 "frames": codec_lines(protocol, direction, sizes, single),
+                "functions": functions,
+                "call": call,
                 "headers": sorted({layout.header for layout in protocol.framing.alternatives[direction]}),
             }
         )
@@ -243,12 +252,13 @@ def general_codec_context(protocol: Protocol) -> dict[str, Any]:
         and reply.class_name in shared
         and not reply.default_reply
     ]
+    code.structs.update(frame_structs)  # listed with the content's structs (common_codec_context)
+    every = [line for d in directions for line in [*d["frames"], *d["functions"]]]
     return {
         "classic": False,
         "reply_layouts": reply_layouts,
-        "framing_imports": sorted(
-            {"EngineFormat", *framing_imports([line for d in directions for line in d["frames"]])}, key=import_order
-        ),
+        "framing_imports": sorted({"EngineFormat", *framing_imports(every)}, key=import_order),
+        "checksum_error": any("ChecksumError(" in line for line in every),
         "checksum_imports": imports,
         "checksum_definitions": definitions,
         "directions": directions,

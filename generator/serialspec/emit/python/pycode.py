@@ -15,6 +15,7 @@ from dataclasses import dataclass, field, replace
 
 from serialspec.emit.common.numbers import number
 from serialspec.emit.common.text import collapse
+from serialspec.emit.python.framecode import Straight, frame_encoder, straight_direction
 from serialspec.emit.python.kinds import kind
 from serialspec.spec import expression
 from serialspec.spec.model import (
@@ -233,8 +234,17 @@ class PackageCode:
         self.built: dict[str, list[str]] = {}
         self.member_maps: set[str] = set()  # enum and flag classes whose value -> member map the decoders use
         self._seen_classes: set[str] = set()
+        self._straight: dict[Direction, Straight | None] = {}
         for message in protocol.messages():
             self.message(message)
+
+    def straight(self, direction: Direction) -> Straight | None:
+        """The direction's frames when straight-line code takes them (framecode.py), worked out once."""
+        if direction not in self._straight:
+            self._straight[direction] = (
+                None if self.protocol.framing.classic else straight_direction(self.protocol, direction)
+            )
+        return self._straight[direction]
 
     # --- structs --------------------------------------------------------------------------------------------------
 
@@ -452,14 +462,29 @@ class PackageCode:
         lines.append(f"    {name} = {flags}({raw})")
         return name
 
-    def decode_fields(self, fields: list[SpecField], base: str, lines: Lines, where: str, top: bool) -> list[str]:
-        """Append lines reading fields at cursor `o`; return the expressions of the non-hidden values."""
+    def decode_fields(
+        self, fields: list[SpecField], base: str, lines: Lines, where: str, top: bool, known: int | None = None
+    ) -> list[str]:
+        """Append lines reading fields at cursor `o`; return the expressions of the non-hidden values.
+
+        `known`: bytes known to be left at `o` (None: as many as the leading fixed fields take, which the content's
+        size check covers). A run of fixed fields beyond them (after a variable field, in an item of varying size)
+        checks the bytes left first: content is decoded in place, and reading past `end` would read the frame's
+        next bytes rather than fail."""
         values: list[str] = []
         for item in fixed_runs(fields):
             if isinstance(item, list):
+                size = sum(fixed_size(f) or 0 for f in item)
+                if known is not None and size > known:
+                    lines.append(f"if end - o < {size}:")
+                    reason = f"{item[0].name} needs {size} bytes, {{end - o}} left"
+                    lines.append(f"    raise DecodeError({where} + f': {reason}')")
+                    known = size
+                known = None if known is None else known - size
                 values += self.decode_run(item, base, lines, where)
             else:
                 values.append(self.decode_variable(item, fields, base, lines, where))
+                known = 0
         if top:
             lines.append("if o != end:")
             lines.append(f"    raise DecodeError({where} + f': {{end - o}} bytes left after the last field')")
@@ -632,7 +657,8 @@ class PackageCode:
             count = str(f.count) if isinstance(f.count, int) else self.local_named(f.count)
             lines.append(f"for _ in range({count}):")
         inner: Lines = []
-        item_args = self.decode_fields(item_fields, f.class_name, inner, where, top=False)
+        # in `while o < end` one byte is known to be left, in `for _ in range(count)` none
+        item_args = self.decode_fields(item_fields, f.class_name, inner, where, False, 1 if f.count == "rest" else 0)
         self.build(f.class_name, item_names, item_args, "item", inner)
         lines.extend("    " + line for line in inner)
         lines.append(f"    {value}_list.append(item)")
@@ -722,8 +748,16 @@ class PackageCode:
             code = f"{command_code:#04x}" if command_code is not None and layout.has_command else "None"
             if error is not None:
                 code = f"m.{error.element} | {error.flag:#04x}"
-            values = f"({frame_values[0]},)" if len(frame_values) == 1 else f"({', '.join(frame_values)})"
-            lines.append(f"return _{message.direction.name}_FRAMES.wrap({content}, {code}, {values})")
+            frames = self.straight(message.direction)
+            size = message.min_size if message.min_size == message.max_size else None
+            name = f"frame_{message.class_name}"
+            inline = frames and frame_encoder(
+                frames, parts, self.structs, code, frame_values, size, lambda fmt: self.struct(name, fmt)
+            )
+            if inline:  # the frame made here (emit/python/framecode.py): no call of the direction's wrap
+                return [*lines, *inline]
+            arguments = ", ".join([content, code, *frame_values])
+            lines.append(f"return _wrap_{message.direction.value}({arguments})")  # emit/python/framecode.py
             return lines
         code = str(command_code if command_code is not None else 0)
         if all(is_fixed_run_member(f) for f in fields):
@@ -871,10 +905,14 @@ class PackageCode:
             lines.append(f"    raise EncodeError({where} + f': {reason}')")
 
     def check_items(self, f: Array | List, expr: str, lines: Lines, where: str) -> None:
-        """Every number of a list within the item's range, and none a bool (True is not 1); the first at fault named."""
+        """Every number of a list within the item's range, and none a bool (True is not 1); the first at fault named.
+
+        A plain loop: any() over a generator costs a frame per call, twice the time for a few items."""
         low, high = number(f.minimum), number(f.maximum)
-        lines.append(f"if any(not {low} <= x <= {high} or x.__class__ is bool for x in {expr}):")
-        lines.append(f"    raise out_of_range({where}, {f.name!r}, {expr}, {low}, {high})")
+        item = f"x_{f.name}"
+        lines.append(f"for {item} in {expr}:")
+        lines.append(f"    if not {low} <= {item} <= {high} or {item}.__class__ is bool:")
+        lines.append(f"        raise out_of_range({where}, {f.name!r}, {expr}, {low}, {high})")
 
     def encode_fields(self, fields: list[SpecField], base: str, obj: str, lines: Lines, where: str) -> list[str]:
         """Append checks and local values; return expressions of the byte parts in order."""

@@ -247,7 +247,8 @@ def run() -> Table:
         rows=rows,
         notes=[
             "generated: `package.decode(frame, direction)` / `package.encode(message)`: header, length, checksum, "
-            "command dispatch, field unpack, range checks on encode, a frozen slotted message filled slot by slot.",
+            "command dispatch, field unpack, range checks on encode, a frozen message built from the tuple of its "
+            "values.",
             "hand-written: bench/handwritten.py, one function per frame with a precompiled struct.Struct for the "
             "whole frame where its size is fixed, the same checks, a slotted dataclass, enum/flag members.",
             "construct: the generated `structs.py` (frame struct with RawCopy + Checksum, then the command's content "

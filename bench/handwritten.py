@@ -2,8 +2,9 @@
 
 Written the way a competent engineer writes them for one device: precompiled struct.Struct for the whole frame
 where it has a fixed size, every check the generated codec makes (header, length byte, checksum, command code,
-sub-command, counts, the ranges it checks before encoding), and a small slotted dataclass as the result. Enum and
-flag bytes become enum members as in the generated messages. Nothing here is generated or imported from the
+sub-command, counts, the range of a frame's id, the ranges it checks before encoding, True and False refused as
+numbers), and a small slotted dataclass as the result. Enum and flag bytes become enum members as in the generated
+messages. Nothing here is generated or imported from the
 generated packages: these are the frames as a person would code them from the documents.
 """
 
@@ -58,13 +59,13 @@ def fs_decode_rotate(frame: bytes) -> FsRotate:
 
 
 def fs_encode_rotate(message: FsRotate) -> bytes:
-    if not 0 <= message.servo_id <= 254:
+    if not 0 <= message.servo_id <= 254 or message.servo_id.__class__ is bool:
         raise ValueError(f"servo_id {message.servo_id} outside 0..254")
-    if not -32768 <= message.angle <= 32767:
+    if not -32768 <= message.angle <= 32767 or message.angle.__class__ is bool:
         raise ValueError(f"angle {message.angle} outside -32768..32767")
-    if not 0 <= message.interval <= 65535:
+    if not 0 <= message.interval <= 65535 or message.interval.__class__ is bool:
         raise ValueError(f"interval {message.interval} outside 0..65535")
-    if not 0 <= message.power <= 65535:
+    if not 0 <= message.power <= 65535 or message.power.__class__ is bool:
         raise ValueError(f"power {message.power} outside 0..65535")
     body = _FS_ROTATE_BODY.pack(
         FS_REQUEST_HEADER, FS_ROTATE, 7, message.servo_id, message.angle, message.interval, message.power
@@ -88,9 +89,9 @@ def fs_decode_read_angle_reply(frame: bytes) -> FsReadAngleReply:
 
 
 def fs_encode_read_angle_reply(message: FsReadAngleReply) -> bytes:
-    if not 0 <= message.servo_id <= 254:
+    if not 0 <= message.servo_id <= 254 or message.servo_id.__class__ is bool:
         raise ValueError(f"servo_id {message.servo_id} outside 0..254")
-    if not -32768 <= message.angle <= 32767:
+    if not -32768 <= message.angle <= 32767 or message.angle.__class__ is bool:
         raise ValueError(f"angle {message.angle} outside -32768..32767")
     body = _FS_READ_ANGLE_BODY.pack(FS_RESPONSE_HEADER, FS_READ_ANGLE, 3, message.servo_id, message.angle)
     return body + bytes((sum(body) & 0xFF,))
@@ -203,11 +204,11 @@ def rrc_decode_position_report(frame: bytes) -> RrcPositionReport:
 
 
 def rrc_encode_position_report(message: RrcPositionReport) -> bytes:
-    if not 0 <= message.servo_id <= 255:
+    if not 0 <= message.servo_id <= 255 or message.servo_id.__class__ is bool:
         raise ValueError(f"servo_id {message.servo_id} outside 0..255")
-    if not -128 <= message.success <= 127:
-        raise ValueError(f"success {message.success} outside -128..127")
-    if not -32768 <= message.position <= 32767:
+    if not -1 <= message.success <= 0 or message.success.__class__ is bool:
+        raise ValueError(f"success {message.success} outside -1..0")
+    if not -32768 <= message.position <= 32767 or message.position.__class__ is bool:
         raise ValueError(f"position {message.position} outside -32768..32767")
     body = _RRC_REPORT_BODY.pack(
         RRC_HEADER, RRC_BUS_SERVO, 5, message.servo_id, RRC_READ_POSITION, message.success, message.position
@@ -242,7 +243,7 @@ def rrc_encode_set_speeds(message: RrcSetSpeeds) -> bytes:
         raise ValueError(f"{count} motors do not fit one frame")
     parts = []
     for motor in message.motors:
-        if not 0 <= motor.motor_id <= 255:
+        if not 0 <= motor.motor_id <= 255 or motor.motor_id.__class__ is bool:
             raise ValueError(f"motor_id {motor.motor_id} outside 0..255")
         if not -FLOAT32_MAX <= motor.speed <= FLOAT32_MAX:
             raise ValueError(f"speed {motor.speed} is not a finite float32")
@@ -291,6 +292,8 @@ def sms_decode_reply(frame: bytes) -> SmsReply:
     header, servo_id, length, error = _SMS_HEAD.unpack_from(frame)
     if header != SMS_HEADER:
         raise ValueError(f"bad header {header.hex(' ')}")
+    if servo_id > 254:
+        raise ValueError(f"id {servo_id} outside 0..254")
     if length != size - 4:
         raise ValueError(f"length byte {length}, but the frame holds {size - 4}")
     if ~sum(frame[2:-1]) & 0xFF != frame[-1]:
@@ -299,9 +302,9 @@ def sms_decode_reply(frame: bytes) -> SmsReply:
 
 
 def sms_encode_reply(message: SmsReply) -> bytes:
-    if not 0 <= message.servo_id <= 254:
+    if not 0 <= message.servo_id <= 254 or message.servo_id.__class__ is bool:
         raise ValueError(f"id {message.servo_id} outside 0..254")
-    if not 0 <= message.error <= 255:
+    if not 0 <= message.error <= 255 or message.error.__class__ is bool:
         raise ValueError(f"error {message.error} outside 0..255")
     if len(message.data) > 253:
         raise ValueError(f"{len(message.data)} data bytes do not fit one frame")
@@ -316,6 +319,8 @@ def sms_decode_write(frame: bytes) -> SmsWrite:
     header, servo_id, length, instruction, address = _SMS_WRITE_HEAD.unpack_from(frame)
     if header != SMS_HEADER:
         raise ValueError(f"bad header {header.hex(' ')}")
+    if servo_id > 254:
+        raise ValueError(f"id {servo_id} outside 0..254")
     if length != size - 4:
         raise ValueError(f"length byte {length}, but the frame holds {size - 4}")
     if ~sum(frame[2:-1]) & 0xFF != frame[-1]:
@@ -326,9 +331,9 @@ def sms_decode_write(frame: bytes) -> SmsWrite:
 
 
 def sms_encode_write(message: SmsWrite) -> bytes:
-    if not 0 <= message.servo_id <= 254:
+    if not 0 <= message.servo_id <= 254 or message.servo_id.__class__ is bool:
         raise ValueError(f"id {message.servo_id} outside 0..254")
-    if not 0 <= message.address <= 255:
+    if not 0 <= message.address <= 255 or message.address.__class__ is bool:
         raise ValueError(f"address {message.address} outside 0..255")
     if len(message.data) > 252:
         raise ValueError(f"{len(message.data)} data bytes do not fit one frame")

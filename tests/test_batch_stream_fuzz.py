@@ -17,7 +17,7 @@ from conftest import Generated, examples
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from serialspec.runtime.errors import ChecksumError, EncodeError
-from serialspec.runtime.message import Direction, Message, field_names, replace
+from serialspec.runtime.message import Direction, Message, build, field_names, replace
 from serialspec.runtime.stream import FrameFormat, StreamParser, ValueRanges
 from test_batch_stream import PARSERS, byte_by_byte
 
@@ -132,15 +132,16 @@ def test_parsers_of_one_frame_format_share_its_tables(g: Generated, direction: D
 class Toy(Message):
     """A frame of a made-up format, kept whole: two are equal when their bytes are."""
 
-    __slots__ = ("frame",)
+    __slots__ = ()  # a message is a tuple of its fields underneath (runtime/message.py)
     __match_args__ = ("frame",)
     PROTOCOL = "toy"
     COMMAND = "toy"
     SUBCOMMAND = None
     DIRECTION = Direction.RESPONSE
+    frame: bytes
 
-    def __init__(self, frame: bytes) -> None:
-        object.__setattr__(self, "frame", frame)
+    def __new__(cls, frame: bytes) -> Toy:
+        return build(cls, (frame,))
 
 
 def toy_decode_at(buf: bytes, start: int, stop: int, width: int) -> Toy:

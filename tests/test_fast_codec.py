@@ -1,8 +1,8 @@
 """The codec's fast paths against the plain ones they replace.
 
-Decoders build messages through their slots instead of the dataclass __init__, the stream parser decodes frames in
-place (`decode_at`) instead of through `decode`, checksums are inlined expressions and loops instead of runtime
-calls, and fixed-size frames are packed by one struct. Each must agree with the plain way of doing the same.
+Decoders build messages from the tuple of their values instead of through __new__, the stream parser decodes
+frames in place (`decode_at`) instead of through `decode`, checksums are inlined expressions and loops instead of
+runtime calls, and fixed-size frames are packed by one struct. Each must agree with the plain way of doing the same.
 """
 
 from __future__ import annotations

@@ -11,7 +11,8 @@ from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError, c
 from serialspec.runtime.fields import wrong_type
 from serialspec.runtime.framing import Element, EngineFormat, FrameCodec, Layout, Transparency
 from serialspec.runtime.framing import FrameStreamParser as _FrameStreamParser
-from serialspec.runtime.message import Direction, Message, members, slot_setters
+from serialspec.runtime.message import Direction, Message, members
+from serialspec.runtime.message import build as _new  # a message from the tuple of its field values, in one call
 
 from dynamixel_p2.messages import (
     ActionRequest,
@@ -53,45 +54,6 @@ _S_U8_U16_U16 = struct.Struct('<BHH')
 _S_U8_U32 = struct.Struct('<BI')
 _CHECK_CRC: Callable[[bytes], int] = crc_function(16, 0x8005, 0x0, False, False, 0x0)  # CRC-16/UMTS (CRC-16/BUYPASS)
 
-# Decoders build messages with object.__new__ and store each value straight into its slot: a message's __init__
-# (frozen) goes through object.__setattr__ per field, which costs more than unpacking the whole frame.
-_new = object.__new__
-(_set_ActionRequest_id,) = slot_setters(ActionRequest)
-_set_BulkReadRequest_id, _set_BulkReadRequest_reads = slot_setters(BulkReadRequest)
-_set_BulkWriteRequest_id, _set_BulkWriteRequest_writes = slot_setters(BulkWriteRequest)
-_set_ClearRequest_id, _set_ClearRequest_option = slot_setters(ClearRequest)
-_set_ErrorBits_alert, _set_ErrorBits_number = slot_setters(ErrorBits)
-_set_FactoryResetRequest_id, _set_FactoryResetRequest_option = slot_setters(FactoryResetRequest)
-(
-    _set_FastSyncReadRequest_id,
-    _set_FastSyncReadRequest_address,
-    _set_FastSyncReadRequest_length,
-    _set_FastSyncReadRequest_servo_ids,
-) = slot_setters(FastSyncReadRequest)
-(_set_IdsItem_id,) = slot_setters(IdsItem)
-(_set_PingRequest_id,) = slot_setters(PingRequest)
-(
-    _set_PingResponse_id,
-    _set_PingResponse_error,
-    _set_PingResponse_model_number,
-    _set_PingResponse_firmware_version,
-) = slot_setters(PingResponse)
-_set_ReadRequest_id, _set_ReadRequest_address, _set_ReadRequest_length = slot_setters(ReadRequest)
-_set_ReadsItem_id, _set_ReadsItem_address, _set_ReadsItem_length = slot_setters(ReadsItem)
-(_set_RebootRequest_id,) = slot_setters(RebootRequest)
-_set_RegWriteRequest_id, _set_RegWriteRequest_address, _set_RegWriteRequest_data = slot_setters(RegWriteRequest)
-(_set_ServoIdsItem_id,) = slot_setters(ServoIdsItem)
-_set_ServosItem_id, _set_ServosItem_data = slot_setters(ServosItem)
-_set_StatusResponse_id, _set_StatusResponse_error, _set_StatusResponse_data = slot_setters(StatusResponse)
-(
-    _set_SyncReadRequest_id,
-    _set_SyncReadRequest_address,
-    _set_SyncReadRequest_length,
-    _set_SyncReadRequest_ids,
-) = slot_setters(SyncReadRequest)
-_set_SyncWriteRequest_id, _set_SyncWriteRequest_address, _set_SyncWriteRequest_servos = slot_setters(SyncWriteRequest)
-_set_WriteRequest_id, _set_WriteRequest_address, _set_WriteRequest_data = slot_setters(WriteRequest)
-_set_WritesItem_id, _set_WritesItem_address, _set_WritesItem_data = slot_setters(WritesItem)
 _MEMBERS_ClearOption = members(ClearOption)
 _MEMBERS_ErrorNumber = members(ErrorNumber)
 _MEMBERS_ResetOption = members(ResetOption)
@@ -100,9 +62,7 @@ _MEMBERS_ResetOption = members(ResetOption)
 def _decode_ping_request(buf: bytes, o: int, end: int, id: int) -> PingRequest:
     if end - o != 0:
         raise content_size_error('ping request', end - o, 0, 0)
-    m = _new(PingRequest)
-    _set_PingRequest_id(m, id)
-    return m
+    return _new(PingRequest, (id,))
 
 
 def _decode_ping_response(buf: bytes, o: int, end: int, id: int, error: int) -> PingResponse:
@@ -110,26 +70,15 @@ def _decode_ping_response(buf: bytes, o: int, end: int, id: int, error: int) -> 
         raise content_size_error('ping response', end - o, 3, 3)
     v_model_number, v_firmware_version = _S_U16_U8.unpack_from(buf, o)
     error_number = error & 0x7f
-    error_bits = _new(ErrorBits)
-    _set_ErrorBits_alert(error_bits, (error >> 7) & 0x1)
-    _set_ErrorBits_number(error_bits, _MEMBERS_ErrorNumber.get(error_number, error_number))
-    m = _new(PingResponse)
-    _set_PingResponse_id(m, id)
-    _set_PingResponse_error(m, error_bits)
-    _set_PingResponse_model_number(m, v_model_number)
-    _set_PingResponse_firmware_version(m, v_firmware_version)
-    return m
+    error_bits = _new(ErrorBits, ((error >> 7) & 0x1, _MEMBERS_ErrorNumber.get(error_number, error_number)))
+    return _new(PingResponse, (id, error_bits, v_model_number, v_firmware_version))
 
 
 def _decode_read_request(buf: bytes, o: int, end: int, id: int) -> ReadRequest:
     if end - o != 4:
         raise content_size_error('read request', end - o, 4, 4)
     v_address, v_length = _S_U16_U16.unpack_from(buf, o)
-    m = _new(ReadRequest)
-    _set_ReadRequest_id(m, id)
-    _set_ReadRequest_address(m, v_address)
-    _set_ReadRequest_length(m, v_length)
-    return m
+    return _new(ReadRequest, (id, v_address, v_length))
 
 
 def _decode_write_request(buf: bytes, o: int, end: int, id: int) -> WriteRequest:
@@ -138,11 +87,7 @@ def _decode_write_request(buf: bytes, o: int, end: int, id: int) -> WriteRequest
     v_address, = _S_U16.unpack_from(buf, o)
     o += 2
     v_data = buf[o:end]
-    m = _new(WriteRequest)
-    _set_WriteRequest_id(m, id)
-    _set_WriteRequest_address(m, v_address)
-    _set_WriteRequest_data(m, v_data)
-    return m
+    return _new(WriteRequest, (id, v_address, v_data))
 
 
 def _decode_reg_write_request(buf: bytes, o: int, end: int, id: int) -> RegWriteRequest:
@@ -151,37 +96,26 @@ def _decode_reg_write_request(buf: bytes, o: int, end: int, id: int) -> RegWrite
     v_address, = _S_U16.unpack_from(buf, o)
     o += 2
     v_data = buf[o:end]
-    m = _new(RegWriteRequest)
-    _set_RegWriteRequest_id(m, id)
-    _set_RegWriteRequest_address(m, v_address)
-    _set_RegWriteRequest_data(m, v_data)
-    return m
+    return _new(RegWriteRequest, (id, v_address, v_data))
 
 
 def _decode_action_request(buf: bytes, o: int, end: int, id: int) -> ActionRequest:
     if end - o != 0:
         raise content_size_error('action request', end - o, 0, 0)
-    m = _new(ActionRequest)
-    _set_ActionRequest_id(m, id)
-    return m
+    return _new(ActionRequest, (id,))
 
 
 def _decode_factory_reset_request(buf: bytes, o: int, end: int, id: int) -> FactoryResetRequest:
     if end - o != 1:
         raise content_size_error('factory_reset request', end - o, 1, 1)
-    v_option, = _S_U8.unpack_from(buf, o)
-    m = _new(FactoryResetRequest)
-    _set_FactoryResetRequest_id(m, id)
-    _set_FactoryResetRequest_option(m, _MEMBERS_ResetOption.get(v_option, v_option))
-    return m
+    v_option = buf[o]
+    return _new(FactoryResetRequest, (id, _MEMBERS_ResetOption.get(v_option, v_option)))
 
 
 def _decode_reboot_request(buf: bytes, o: int, end: int, id: int) -> RebootRequest:
     if end - o != 0:
         raise content_size_error('reboot request', end - o, 0, 0)
-    m = _new(RebootRequest)
-    _set_RebootRequest_id(m, id)
-    return m
+    return _new(RebootRequest, (id,))
 
 
 def _decode_clear_request(buf: bytes, o: int, end: int, id: int) -> ClearRequest:
@@ -190,10 +124,7 @@ def _decode_clear_request(buf: bytes, o: int, end: int, id: int) -> ClearRequest
     v_option, v_key = _S_U8_U32.unpack_from(buf, o)
     if v_key != 575428676:
         raise DecodeError('clear request' + f': key is {v_key:#x}, expected 0x224c5844')
-    m = _new(ClearRequest)
-    _set_ClearRequest_id(m, id)
-    _set_ClearRequest_option(m, _MEMBERS_ClearOption.get(v_option, v_option))
-    return m
+    return _new(ClearRequest, (id, _MEMBERS_ClearOption.get(v_option, v_option)))
 
 
 def _decode_sync_read_request(buf: bytes, o: int, end: int, id: int) -> SyncReadRequest:
@@ -201,21 +132,11 @@ def _decode_sync_read_request(buf: bytes, o: int, end: int, id: int) -> SyncRead
         raise content_size_error('sync_read request', end - o, 4, None)
     v_address, v_length = _S_U16_U16.unpack_from(buf, o)
     o += 4
-    v_ids_list = []
     if (end - o) % 1:
         raise DecodeError('sync_read request' + f': {end - o} bytes do not split into ids items of 1')
     n = end - o
-    for v_id, in _S_U8.iter_unpack(buf[o : o + n]):
-        item = _new(IdsItem)
-        _set_IdsItem_id(item, v_id)
-        v_ids_list.append(item)
-    v_ids = tuple(v_ids_list)
-    m = _new(SyncReadRequest)
-    _set_SyncReadRequest_id(m, id)
-    _set_SyncReadRequest_address(m, v_address)
-    _set_SyncReadRequest_length(m, v_length)
-    _set_SyncReadRequest_ids(m, v_ids)
-    return m
+    v_ids = tuple([_new(IdsItem, values) for values in _S_U8.iter_unpack(buf[o : o + n])])
+    return _new(SyncReadRequest, (id, v_address, v_length, v_ids))
 
 
 def _decode_fast_sync_read_request(buf: bytes, o: int, end: int, id: int) -> FastSyncReadRequest:
@@ -223,21 +144,11 @@ def _decode_fast_sync_read_request(buf: bytes, o: int, end: int, id: int) -> Fas
         raise content_size_error('fast_sync_read request', end - o, 4, None)
     v_address, v_length = _S_U16_U16.unpack_from(buf, o)
     o += 4
-    v_servo_ids_list = []
     if (end - o) % 1:
         raise DecodeError('fast_sync_read request' + f': {end - o} bytes do not split into servo_ids items of 1')
     n = end - o
-    for v_id, in _S_U8.iter_unpack(buf[o : o + n]):
-        item = _new(ServoIdsItem)
-        _set_ServoIdsItem_id(item, v_id)
-        v_servo_ids_list.append(item)
-    v_servo_ids = tuple(v_servo_ids_list)
-    m = _new(FastSyncReadRequest)
-    _set_FastSyncReadRequest_id(m, id)
-    _set_FastSyncReadRequest_address(m, v_address)
-    _set_FastSyncReadRequest_length(m, v_length)
-    _set_FastSyncReadRequest_servo_ids(m, v_servo_ids)
-    return m
+    v_servo_ids = tuple([_new(ServoIdsItem, values) for values in _S_U8.iter_unpack(buf[o : o + n])])
+    return _new(FastSyncReadRequest, (id, v_address, v_length, v_servo_ids))
 
 
 def _decode_sync_write_request(buf: bytes, o: int, end: int, id: int) -> SyncWriteRequest:
@@ -247,42 +158,26 @@ def _decode_sync_write_request(buf: bytes, o: int, end: int, id: int) -> SyncWri
     o += 4
     v_servos_list = []
     while o < end:
-        v_id, = _S_U8.unpack_from(buf, o)
+        v_id = buf[o]
         o += 1
         if end - o < v_length:
             raise DecodeError('sync_write request' + f': data needs {v_length} bytes, {end - o} left')
         v_data = buf[o : o + v_length]
         o += v_length
-        item = _new(ServosItem)
-        _set_ServosItem_id(item, v_id)
-        _set_ServosItem_data(item, v_data)
+        item = _new(ServosItem, (v_id, v_data))
         v_servos_list.append(item)
     v_servos = tuple(v_servos_list)
     if o != end:
         raise DecodeError('sync_write request' + f': {end - o} bytes left after the last field')
-    m = _new(SyncWriteRequest)
-    _set_SyncWriteRequest_id(m, id)
-    _set_SyncWriteRequest_address(m, v_address)
-    _set_SyncWriteRequest_servos(m, v_servos)
-    return m
+    return _new(SyncWriteRequest, (id, v_address, v_servos))
 
 
 def _decode_bulk_read_request(buf: bytes, o: int, end: int, id: int) -> BulkReadRequest:
-    v_reads_list = []
     if (end - o) % 5:
         raise DecodeError('bulk_read request' + f': {end - o} bytes do not split into reads items of 5')
     n = end - o
-    for v_id, v_address, v_length in _S_U8_U16_U16.iter_unpack(buf[o : o + n]):
-        item = _new(ReadsItem)
-        _set_ReadsItem_id(item, v_id)
-        _set_ReadsItem_address(item, v_address)
-        _set_ReadsItem_length(item, v_length)
-        v_reads_list.append(item)
-    v_reads = tuple(v_reads_list)
-    m = _new(BulkReadRequest)
-    _set_BulkReadRequest_id(m, id)
-    _set_BulkReadRequest_reads(m, v_reads)
-    return m
+    v_reads = tuple([_new(ReadsItem, values) for values in _S_U8_U16_U16.iter_unpack(buf[o : o + n])])
+    return _new(BulkReadRequest, (id, v_reads))
 
 
 def _decode_bulk_write_request(buf: bytes, o: int, end: int, id: int) -> BulkWriteRequest:
@@ -296,193 +191,230 @@ def _decode_bulk_write_request(buf: bytes, o: int, end: int, id: int) -> BulkWri
             raise DecodeError('bulk_write request' + f': data needs {v_length} bytes, {end - o} left')
         v_data = buf[o : o + v_length]
         o += v_length
-        item = _new(WritesItem)
-        _set_WritesItem_id(item, v_id)
-        _set_WritesItem_address(item, v_address)
-        _set_WritesItem_data(item, v_data)
+        item = _new(WritesItem, (v_id, v_address, v_data))
         v_writes_list.append(item)
     v_writes = tuple(v_writes_list)
     if o != end:
         raise DecodeError('bulk_write request' + f': {end - o} bytes left after the last field')
-    m = _new(BulkWriteRequest)
-    _set_BulkWriteRequest_id(m, id)
-    _set_BulkWriteRequest_writes(m, v_writes)
-    return m
+    return _new(BulkWriteRequest, (id, v_writes))
 
 
 def _decode_status_response(buf: bytes, o: int, end: int, id: int, error: int) -> StatusResponse:
     v_data = buf[o:end]
     error_number = error & 0x7f
-    error_bits = _new(ErrorBits)
-    _set_ErrorBits_alert(error_bits, (error >> 7) & 0x1)
-    _set_ErrorBits_number(error_bits, _MEMBERS_ErrorNumber.get(error_number, error_number))
-    m = _new(StatusResponse)
-    _set_StatusResponse_id(m, id)
-    _set_StatusResponse_error(m, error_bits)
-    _set_StatusResponse_data(m, v_data)
-    return m
+    error_bits = _new(ErrorBits, ((error >> 7) & 0x1, _MEMBERS_ErrorNumber.get(error_number, error_number)))
+    return _new(StatusResponse, (id, error_bits, v_data))
 
 
 def _encode_ping_request(m: PingRequest) -> bytes:
-    if not (0 <= m.id <= 252 or m.id == 254) or m.id.__class__ is bool:
-        raise out_of_range('ping request', 'id', m.id, 0, 252)
-    return _wrap_request(b'', 0x01, m.id)
+    m_id = m.id
+    if not (0 <= m_id <= 252 or m_id == 254) or m_id.__class__ is bool:
+        raise out_of_range('ping request', 'id', m_id, 0, 252)
+    return _wrap_request(b'', 0x01, m_id)
 
 
 def _encode_ping_response(m: PingResponse) -> bytes:
-    if not (0 <= m.id <= 252 or m.id == 254) or m.id.__class__ is bool:
-        raise out_of_range('ping response', 'id', m.id, 0, 252)
-    if not 0 <= m.error.alert <= 1 or m.error.alert.__class__ is bool:
-        raise out_of_range('ping response', 'error.alert', m.error.alert, 0, 1)
-    if not 0 <= m.error.number <= 127 or m.error.number.__class__ is bool:
-        raise out_of_range('ping response', 'error.number', m.error.number, 0, 127)
-    if not 0 <= m.model_number <= 65535 or m.model_number.__class__ is bool:
-        raise out_of_range('ping response', 'model_number', m.model_number, 0, 65535)
-    if not 0 <= m.firmware_version <= 255 or m.firmware_version.__class__ is bool:
-        raise out_of_range('ping response', 'firmware_version', m.firmware_version, 0, 255)
-    return _wrap_response(_S_U16_U8.pack(m.model_number, m.firmware_version), None, m.id, (m.error.alert << 7) | m.error.number)
+    m_id = m.id
+    m_error = m.error
+    m_model_number = m.model_number
+    m_firmware_version = m.firmware_version
+    if not (0 <= m_id <= 252 or m_id == 254) or m_id.__class__ is bool:
+        raise out_of_range('ping response', 'id', m_id, 0, 252)
+    if not 0 <= m_error.alert <= 1 or m_error.alert.__class__ is bool:
+        raise out_of_range('ping response', 'error.alert', m_error.alert, 0, 1)
+    if not 0 <= m_error.number <= 127 or m_error.number.__class__ is bool:
+        raise out_of_range('ping response', 'error.number', m_error.number, 0, 127)
+    if not 0 <= m_model_number <= 65535 or m_model_number.__class__ is bool:
+        raise out_of_range('ping response', 'model_number', m_model_number, 0, 65535)
+    if not 0 <= m_firmware_version <= 255 or m_firmware_version.__class__ is bool:
+        raise out_of_range('ping response', 'firmware_version', m_firmware_version, 0, 255)
+    return _wrap_response(_S_U16_U8.pack(m_model_number, m_firmware_version), None, m_id, (m_error.alert << 7) | m_error.number)
 
 
 def _encode_read_request(m: ReadRequest) -> bytes:
-    if not (0 <= m.id <= 252 or m.id == 254) or m.id.__class__ is bool:
-        raise out_of_range('read request', 'id', m.id, 0, 252)
-    if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
-        raise out_of_range('read request', 'address', m.address, 0, 65535)
-    if not 1 <= m.length <= 1024 or m.length.__class__ is bool:
-        raise out_of_range('read request', 'length', m.length, 1, 1024)
-    return _wrap_request(_S_U16_U16.pack(m.address, m.length), 0x02, m.id)
+    m_id = m.id
+    m_address = m.address
+    m_length = m.length
+    if not (0 <= m_id <= 252 or m_id == 254) or m_id.__class__ is bool:
+        raise out_of_range('read request', 'id', m_id, 0, 252)
+    if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
+        raise out_of_range('read request', 'address', m_address, 0, 65535)
+    if not 1 <= m_length <= 1024 or m_length.__class__ is bool:
+        raise out_of_range('read request', 'length', m_length, 1, 1024)
+    return _wrap_request(_S_U16_U16.pack(m_address, m_length), 0x02, m_id)
 
 
 def _encode_write_request(m: WriteRequest) -> bytes:
-    if not (0 <= m.id <= 252 or m.id == 254) or m.id.__class__ is bool:
-        raise out_of_range('write request', 'id', m.id, 0, 252)
-    if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
-        raise out_of_range('write request', 'address', m.address, 0, 65535)
-    return _wrap_request(b''.join((_S_U16.pack(m.address), bytes(m.data),)), 0x03, m.id)
+    m_id = m.id
+    m_address = m.address
+    m_data = m.data
+    if not (0 <= m_id <= 252 or m_id == 254) or m_id.__class__ is bool:
+        raise out_of_range('write request', 'id', m_id, 0, 252)
+    if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
+        raise out_of_range('write request', 'address', m_address, 0, 65535)
+    v_data = m_data if m_data.__class__ is bytes else bytes(m_data)
+    return _wrap_request(b''.join((_S_U16.pack(m_address), v_data,)), 0x03, m_id)
 
 
 def _encode_reg_write_request(m: RegWriteRequest) -> bytes:
-    if not (0 <= m.id <= 252 or m.id == 254) or m.id.__class__ is bool:
-        raise out_of_range('reg_write request', 'id', m.id, 0, 252)
-    if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
-        raise out_of_range('reg_write request', 'address', m.address, 0, 65535)
-    return _wrap_request(b''.join((_S_U16.pack(m.address), bytes(m.data),)), 0x04, m.id)
+    m_id = m.id
+    m_address = m.address
+    m_data = m.data
+    if not (0 <= m_id <= 252 or m_id == 254) or m_id.__class__ is bool:
+        raise out_of_range('reg_write request', 'id', m_id, 0, 252)
+    if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
+        raise out_of_range('reg_write request', 'address', m_address, 0, 65535)
+    v_data = m_data if m_data.__class__ is bytes else bytes(m_data)
+    return _wrap_request(b''.join((_S_U16.pack(m_address), v_data,)), 0x04, m_id)
 
 
 def _encode_action_request(m: ActionRequest) -> bytes:
-    if not (0 <= m.id <= 252 or m.id == 254) or m.id.__class__ is bool:
-        raise out_of_range('action request', 'id', m.id, 0, 252)
-    return _wrap_request(b'', 0x05, m.id)
+    m_id = m.id
+    if not (0 <= m_id <= 252 or m_id == 254) or m_id.__class__ is bool:
+        raise out_of_range('action request', 'id', m_id, 0, 252)
+    return _wrap_request(b'', 0x05, m_id)
 
 
 def _encode_factory_reset_request(m: FactoryResetRequest) -> bytes:
-    if not (0 <= m.id <= 252 or m.id == 254) or m.id.__class__ is bool:
-        raise out_of_range('factory_reset request', 'id', m.id, 0, 252)
-    if not 1 <= m.option <= 255 or m.option.__class__ is bool:
-        raise out_of_range('factory_reset request', 'option', m.option, 1, 255)
-    return _wrap_request(_S_U8.pack(m.option), 0x06, m.id)
+    m_id = m.id
+    m_option = m.option
+    if not (0 <= m_id <= 252 or m_id == 254) or m_id.__class__ is bool:
+        raise out_of_range('factory_reset request', 'id', m_id, 0, 252)
+    if not 1 <= m_option <= 255 or m_option.__class__ is bool:
+        raise out_of_range('factory_reset request', 'option', m_option, 1, 255)
+    return _wrap_request(_S_U8.pack(m_option), 0x06, m_id)
 
 
 def _encode_reboot_request(m: RebootRequest) -> bytes:
-    if not (0 <= m.id <= 252 or m.id == 254) or m.id.__class__ is bool:
-        raise out_of_range('reboot request', 'id', m.id, 0, 252)
-    return _wrap_request(b'', 0x08, m.id)
+    m_id = m.id
+    if not (0 <= m_id <= 252 or m_id == 254) or m_id.__class__ is bool:
+        raise out_of_range('reboot request', 'id', m_id, 0, 252)
+    return _wrap_request(b'', 0x08, m_id)
 
 
 def _encode_clear_request(m: ClearRequest) -> bytes:
-    if not (0 <= m.id <= 252 or m.id == 254) or m.id.__class__ is bool:
-        raise out_of_range('clear request', 'id', m.id, 0, 252)
-    if not 1 <= m.option <= 1 or m.option.__class__ is bool:
-        raise out_of_range('clear request', 'option', m.option, 1, 1)
-    return _wrap_request(_S_U8_U32.pack(m.option, 575428676), 0x10, m.id)
+    m_id = m.id
+    m_option = m.option
+    if not (0 <= m_id <= 252 or m_id == 254) or m_id.__class__ is bool:
+        raise out_of_range('clear request', 'id', m_id, 0, 252)
+    if not 1 <= m_option <= 1 or m_option.__class__ is bool:
+        raise out_of_range('clear request', 'option', m_option, 1, 1)
+    return _wrap_request(_S_U8_U32.pack(m_option, 575428676), 0x10, m_id)
 
 
 def _encode_sync_read_request(m: SyncReadRequest) -> bytes:
-    if not (0 <= m.id <= 252 or m.id == 254) or m.id.__class__ is bool:
-        raise out_of_range('sync_read request', 'id', m.id, 0, 252)
-    if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
-        raise out_of_range('sync_read request', 'address', m.address, 0, 65535)
-    if not 1 <= m.length <= 1024 or m.length.__class__ is bool:
-        raise out_of_range('sync_read request', 'length', m.length, 1, 1024)
+    m_id = m.id
+    m_address = m.address
+    m_length = m.length
+    if not (0 <= m_id <= 252 or m_id == 254) or m_id.__class__ is bool:
+        raise out_of_range('sync_read request', 'id', m_id, 0, 252)
+    if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
+        raise out_of_range('sync_read request', 'address', m_address, 0, 65535)
+    if not 1 <= m_length <= 1024 or m_length.__class__ is bool:
+        raise out_of_range('sync_read request', 'length', m_length, 1, 1024)
     parts_ids = []
     for item in m.ids:
-        if not 0 <= item.id <= 252 or item.id.__class__ is bool:
-            raise out_of_range('sync_read request', 'id', item.id, 0, 252)
-        parts_ids.append(_S_U8.pack(item.id))
-    return _wrap_request(b''.join((_S_U16_U16.pack(m.address, m.length), b''.join(parts_ids),)), 0x82, m.id)
+        item_id = item.id
+        if not 0 <= item_id <= 252 or item_id.__class__ is bool:
+            raise out_of_range('sync_read request', 'id', item_id, 0, 252)
+        parts_ids.append(_S_U8.pack(item_id))
+    return _wrap_request(b''.join((_S_U16_U16.pack(m_address, m_length), b''.join(parts_ids),)), 0x82, m_id)
 
 
 def _encode_fast_sync_read_request(m: FastSyncReadRequest) -> bytes:
-    if not (0 <= m.id <= 252 or m.id == 254) or m.id.__class__ is bool:
-        raise out_of_range('fast_sync_read request', 'id', m.id, 0, 252)
-    if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
-        raise out_of_range('fast_sync_read request', 'address', m.address, 0, 65535)
-    if not 1 <= m.length <= 1024 or m.length.__class__ is bool:
-        raise out_of_range('fast_sync_read request', 'length', m.length, 1, 1024)
+    m_id = m.id
+    m_address = m.address
+    m_length = m.length
+    if not (0 <= m_id <= 252 or m_id == 254) or m_id.__class__ is bool:
+        raise out_of_range('fast_sync_read request', 'id', m_id, 0, 252)
+    if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
+        raise out_of_range('fast_sync_read request', 'address', m_address, 0, 65535)
+    if not 1 <= m_length <= 1024 or m_length.__class__ is bool:
+        raise out_of_range('fast_sync_read request', 'length', m_length, 1, 1024)
     parts_servo_ids = []
     for item in m.servo_ids:
-        if not 0 <= item.id <= 252 or item.id.__class__ is bool:
-            raise out_of_range('fast_sync_read request', 'id', item.id, 0, 252)
-        parts_servo_ids.append(_S_U8.pack(item.id))
-    return _wrap_request(b''.join((_S_U16_U16.pack(m.address, m.length), b''.join(parts_servo_ids),)), 0x8a, m.id)
+        item_id = item.id
+        if not 0 <= item_id <= 252 or item_id.__class__ is bool:
+            raise out_of_range('fast_sync_read request', 'id', item_id, 0, 252)
+        parts_servo_ids.append(_S_U8.pack(item_id))
+    return _wrap_request(b''.join((_S_U16_U16.pack(m_address, m_length), b''.join(parts_servo_ids),)), 0x8a, m_id)
 
 
 def _encode_sync_write_request(m: SyncWriteRequest) -> bytes:
-    if not (0 <= m.id <= 252 or m.id == 254) or m.id.__class__ is bool:
-        raise out_of_range('sync_write request', 'id', m.id, 0, 252)
-    if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
-        raise out_of_range('sync_write request', 'address', m.address, 0, 65535)
-    v_length = len(m.servos[0].data) if m.servos else 0
-    if any(len(item.data) != v_length for item in m.servos):
+    m_id = m.id
+    m_address = m.address
+    m_servos = m.servos
+    if not (0 <= m_id <= 252 or m_id == 254) or m_id.__class__ is bool:
+        raise out_of_range('sync_write request', 'id', m_id, 0, 252)
+    if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
+        raise out_of_range('sync_write request', 'address', m_address, 0, 65535)
+    v_length = len(m_servos[0].data) if m_servos else 0
+    if any(len(item.data) != v_length for item in m_servos):
         raise EncodeError('sync_write request' + ': every data of servos must have the same length')
     if v_length > 65535:
         raise out_of_range('sync_write request', 'length', v_length, 0, 65535)
     parts_servos = []
-    for item in m.servos:
-        if not 0 <= item.id <= 252 or item.id.__class__ is bool:
-            raise out_of_range('sync_write request', 'id', item.id, 0, 252)
-        parts_servos.append(b''.join((_S_U8.pack(item.id), bytes(item.data),)))
-    return _wrap_request(b''.join((_S_U16_U16.pack(m.address, v_length), b''.join(parts_servos),)), 0x83, m.id)
+    for item in m_servos:
+        item_id = item.id
+        item_data = item.data
+        if not 0 <= item_id <= 252 or item_id.__class__ is bool:
+            raise out_of_range('sync_write request', 'id', item_id, 0, 252)
+        v_data = item_data if item_data.__class__ is bytes else bytes(item_data)
+        parts_servos.append(b''.join((_S_U8.pack(item_id), v_data,)))
+    return _wrap_request(b''.join((_S_U16_U16.pack(m_address, v_length), b''.join(parts_servos),)), 0x83, m_id)
 
 
 def _encode_bulk_read_request(m: BulkReadRequest) -> bytes:
-    if not (0 <= m.id <= 252 or m.id == 254) or m.id.__class__ is bool:
-        raise out_of_range('bulk_read request', 'id', m.id, 0, 252)
+    m_id = m.id
+    if not (0 <= m_id <= 252 or m_id == 254) or m_id.__class__ is bool:
+        raise out_of_range('bulk_read request', 'id', m_id, 0, 252)
     parts_reads = []
     for item in m.reads:
-        if not 0 <= item.id <= 252 or item.id.__class__ is bool:
-            raise out_of_range('bulk_read request', 'id', item.id, 0, 252)
-        if not 0 <= item.address <= 65535 or item.address.__class__ is bool:
-            raise out_of_range('bulk_read request', 'address', item.address, 0, 65535)
-        if not 1 <= item.length <= 1024 or item.length.__class__ is bool:
-            raise out_of_range('bulk_read request', 'length', item.length, 1, 1024)
-        parts_reads.append(_S_U8_U16_U16.pack(item.id, item.address, item.length))
-    return _wrap_request(b''.join(parts_reads), 0x92, m.id)
+        item_id = item.id
+        item_address = item.address
+        item_length = item.length
+        if not 0 <= item_id <= 252 or item_id.__class__ is bool:
+            raise out_of_range('bulk_read request', 'id', item_id, 0, 252)
+        if not 0 <= item_address <= 65535 or item_address.__class__ is bool:
+            raise out_of_range('bulk_read request', 'address', item_address, 0, 65535)
+        if not 1 <= item_length <= 1024 or item_length.__class__ is bool:
+            raise out_of_range('bulk_read request', 'length', item_length, 1, 1024)
+        parts_reads.append(_S_U8_U16_U16.pack(item_id, item_address, item_length))
+    return _wrap_request(b''.join(parts_reads), 0x92, m_id)
 
 
 def _encode_bulk_write_request(m: BulkWriteRequest) -> bytes:
-    if not (0 <= m.id <= 252 or m.id == 254) or m.id.__class__ is bool:
-        raise out_of_range('bulk_write request', 'id', m.id, 0, 252)
+    m_id = m.id
+    if not (0 <= m_id <= 252 or m_id == 254) or m_id.__class__ is bool:
+        raise out_of_range('bulk_write request', 'id', m_id, 0, 252)
     parts_writes = []
     for item in m.writes:
-        if not 0 <= item.id <= 252 or item.id.__class__ is bool:
-            raise out_of_range('bulk_write request', 'id', item.id, 0, 252)
-        if not 0 <= item.address <= 65535 or item.address.__class__ is bool:
-            raise out_of_range('bulk_write request', 'address', item.address, 0, 65535)
-        if len(item.data) > 65535:
-            raise out_of_range('bulk_write request', 'length', len(item.data), 0, 65535)
-        parts_writes.append(b''.join((_S_U8_U16_U16.pack(item.id, item.address, len(item.data)), bytes(item.data),)))
-    return _wrap_request(b''.join(parts_writes), 0x93, m.id)
+        item_id = item.id
+        item_address = item.address
+        item_data = item.data
+        if not 0 <= item_id <= 252 or item_id.__class__ is bool:
+            raise out_of_range('bulk_write request', 'id', item_id, 0, 252)
+        if not 0 <= item_address <= 65535 or item_address.__class__ is bool:
+            raise out_of_range('bulk_write request', 'address', item_address, 0, 65535)
+        if len(item_data) > 65535:
+            raise out_of_range('bulk_write request', 'length', len(item_data), 0, 65535)
+        v_data = item_data if item_data.__class__ is bytes else bytes(item_data)
+        parts_writes.append(b''.join((_S_U8_U16_U16.pack(item_id, item_address, len(item_data)), v_data,)))
+    return _wrap_request(b''.join(parts_writes), 0x93, m_id)
 
 
 def _encode_status_response(m: StatusResponse) -> bytes:
-    if not (0 <= m.id <= 252 or m.id == 254) or m.id.__class__ is bool:
-        raise out_of_range('status response', 'id', m.id, 0, 252)
-    if not 0 <= m.error.alert <= 1 or m.error.alert.__class__ is bool:
-        raise out_of_range('status response', 'error.alert', m.error.alert, 0, 1)
-    if not 0 <= m.error.number <= 127 or m.error.number.__class__ is bool:
-        raise out_of_range('status response', 'error.number', m.error.number, 0, 127)
-    return _wrap_response(bytes(m.data), None, m.id, (m.error.alert << 7) | m.error.number)
+    m_id = m.id
+    m_error = m.error
+    m_data = m.data
+    if not (0 <= m_id <= 252 or m_id == 254) or m_id.__class__ is bool:
+        raise out_of_range('status response', 'id', m_id, 0, 252)
+    if not 0 <= m_error.alert <= 1 or m_error.alert.__class__ is bool:
+        raise out_of_range('status response', 'error.alert', m_error.alert, 0, 1)
+    if not 0 <= m_error.number <= 127 or m_error.number.__class__ is bool:
+        raise out_of_range('status response', 'error.number', m_error.number, 0, 127)
+    v_data = m_data if m_data.__class__ is bytes else bytes(m_data)
+    return _wrap_response(v_data, None, m_id, (m_error.alert << 7) | m_error.number)
 
 
 _REQUEST_DECODERS: dict[int | None, Callable[..., Message]] = {
@@ -765,9 +697,10 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
 
 def encode(message: Message) -> bytes:
     """Encode a message as a complete frame; raises EncodeError (RangeError for values out of range)."""
-    encoder = _ENCODERS.get(type(message))
-    if encoder is None:
-        raise EncodeError(f"{type(message).__name__} is not a dynamixel_p2 message")
+    try:
+        encoder = _ENCODERS[type(message)]  # a subscript costs less than .get(); the miss is the rare case
+    except KeyError:
+        raise EncodeError(f"{type(message).__name__} is not a dynamixel_p2 message") from None
     try:
         return encoder(message)
     except EncodeError:

@@ -15,8 +15,7 @@ from serialspec.runtime.fields import integer as _integer
 from serialspec.runtime.fields import items as _items
 from serialspec.runtime.fields import mapping as _mapping
 from serialspec.runtime.message import Direction, Message, Record
-
-_store = object.__setattr__  # how __init__ fills the slots of a frozen class
+from serialspec.runtime.message import build as _build
 
 __all__ = [
     'ActionRequest',
@@ -180,20 +179,19 @@ class HardwareError(IntFlag):
 class ErrorBits(Record):
     """Bit fields of error."""
 
-    __slots__ = ('alert', 'number')
+    __slots__ = ()
     __match_args__ = ('alert', 'number')
     #: The servo has a hardware problem; see hardware_error_status (70). (bit 7)
     alert: int
     #: The result of processing the instruction. (bits 6..0)
     number: ErrorNumber | int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         alert: int,
         number: ErrorNumber | int,
-    ) -> None:
-        _store(self, 'alert', alert)
-        _store(self, 'number', number)
+    ) -> Self:
+        return _build(cls, (alert, number))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -213,16 +211,16 @@ class ErrorBits(Record):
 class IdsItem(Record):
     """One item of ids."""
 
-    __slots__ = ('id',)
+    __slots__ = ()
     __match_args__ = ('id',)
     #: A servo id. range 0..252
     id: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         id: int,
-    ) -> None:
-        _store(self, 'id', id)
+    ) -> Self:
+        return _build(cls, (id,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -240,16 +238,16 @@ class IdsItem(Record):
 class ServoIdsItem(Record):
     """One item of servo_ids."""
 
-    __slots__ = ('id',)
+    __slots__ = ()
     __match_args__ = ('id',)
     #: A servo id. range 0..252
     id: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         id: int,
-    ) -> None:
-        _store(self, 'id', id)
+    ) -> Self:
+        return _build(cls, (id,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -267,20 +265,19 @@ class ServoIdsItem(Record):
 class ServosItem(Record):
     """One item of servos."""
 
-    __slots__ = ('id', 'data')
+    __slots__ = ()
     __match_args__ = ('id', 'data')
     #: The servo's id. range 0..252
     id: int
     #: The bytes written to that servo from `address` on.
     data: bytes
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         id: int,
         data: bytes,
-    ) -> None:
-        _store(self, 'id', id)
-        _store(self, 'data', data)
+    ) -> Self:
+        return _build(cls, (id, data))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -300,7 +297,7 @@ class ServosItem(Record):
 class ReadsItem(Record):
     """One item of reads."""
 
-    __slots__ = ('id', 'address', 'length')
+    __slots__ = ()
     __match_args__ = ('id', 'address', 'length')
     #: The servo's id. range 0..252
     id: int
@@ -309,15 +306,13 @@ class ReadsItem(Record):
     #: Number of bytes to read. range 1..1024
     length: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         id: int,
         address: int,
         length: int,
-    ) -> None:
-        _store(self, 'id', id)
-        _store(self, 'address', address)
-        _store(self, 'length', length)
+    ) -> Self:
+        return _build(cls, (id, address, length))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -339,7 +334,7 @@ class ReadsItem(Record):
 class WritesItem(Record):
     """One item of writes."""
 
-    __slots__ = ('id', 'address', 'data')
+    __slots__ = ()
     __match_args__ = ('id', 'address', 'data')
     #: The servo's id. range 0..252
     id: int
@@ -348,15 +343,13 @@ class WritesItem(Record):
     #: The bytes written to that servo from `address` on.
     data: bytes
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         id: int,
         address: int,
         data: bytes,
-    ) -> None:
-        _store(self, 'id', id)
-        _store(self, 'address', address)
-        _store(self, 'data', data)
+    ) -> Self:
+        return _build(cls, (id, address, data))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -378,7 +371,7 @@ class WritesItem(Record):
 class PingRequest(Message):
     """Check that a servo is there, and read its model number and firmware version (request)."""
 
-    __slots__ = ('id',)
+    __slots__ = ()
     __match_args__ = ('id',)
     PROTOCOL: ClassVar[str] = 'dynamixel_p2'
     COMMAND: ClassVar[str] = 'ping'
@@ -387,11 +380,11 @@ class PingRequest(Message):
     #: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. range 0..252
     id: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         id: int,
-    ) -> None:
-        _store(self, 'id', id)
+    ) -> Self:
+        return _build(cls, (id,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -409,7 +402,7 @@ class PingRequest(Message):
 class PingResponse(Message):
     """Check that a servo is there, and read its model number and firmware version (response). PING's own status packet layout (the other instructions' replies are `status`)."""
 
-    __slots__ = ('id', 'error', 'model_number', 'firmware_version')
+    __slots__ = ()
     __match_args__ = ('id', 'error', 'model_number', 'firmware_version')
     PROTOCOL: ClassVar[str] = 'dynamixel_p2'
     COMMAND: ClassVar[str] = 'ping'
@@ -424,17 +417,14 @@ class PingResponse(Message):
     #: The firmware version.
     firmware_version: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         id: int,
         error: ErrorBits,
         model_number: int,
         firmware_version: int,
-    ) -> None:
-        _store(self, 'id', id)
-        _store(self, 'error', error)
-        _store(self, 'model_number', model_number)
-        _store(self, 'firmware_version', firmware_version)
+    ) -> Self:
+        return _build(cls, (id, error, model_number, firmware_version))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -458,7 +448,7 @@ class PingResponse(Message):
 class ReadRequest(Message):
     """Read from the control table (request)."""
 
-    __slots__ = ('id', 'address', 'length')
+    __slots__ = ()
     __match_args__ = ('id', 'address', 'length')
     PROTOCOL: ClassVar[str] = 'dynamixel_p2'
     COMMAND: ClassVar[str] = 'read'
@@ -471,15 +461,13 @@ class ReadRequest(Message):
     #: Number of bytes to read. range 1..1024
     length: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         id: int,
         address: int,
         length: int,
-    ) -> None:
-        _store(self, 'id', id)
-        _store(self, 'address', address)
-        _store(self, 'length', length)
+    ) -> Self:
+        return _build(cls, (id, address, length))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -501,7 +489,7 @@ class ReadRequest(Message):
 class WriteRequest(Message):
     """Write to the control table (request)."""
 
-    __slots__ = ('id', 'address', 'data')
+    __slots__ = ()
     __match_args__ = ('id', 'address', 'data')
     PROTOCOL: ClassVar[str] = 'dynamixel_p2'
     COMMAND: ClassVar[str] = 'write'
@@ -514,15 +502,13 @@ class WriteRequest(Message):
     #: The bytes written, item by item from `address` on.
     data: bytes
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         id: int,
         address: int,
         data: bytes,
-    ) -> None:
-        _store(self, 'id', id)
-        _store(self, 'address', address)
-        _store(self, 'data', data)
+    ) -> Self:
+        return _build(cls, (id, address, data))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -544,7 +530,7 @@ class WriteRequest(Message):
 class RegWriteRequest(Message):
     """Buffered write, carried out on ACTION (request)."""
 
-    __slots__ = ('id', 'address', 'data')
+    __slots__ = ()
     __match_args__ = ('id', 'address', 'data')
     PROTOCOL: ClassVar[str] = 'dynamixel_p2'
     COMMAND: ClassVar[str] = 'reg_write'
@@ -557,15 +543,13 @@ class RegWriteRequest(Message):
     #: The bytes to write when ACTION arrives.
     data: bytes
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         id: int,
         address: int,
         data: bytes,
-    ) -> None:
-        _store(self, 'id', id)
-        _store(self, 'address', address)
-        _store(self, 'data', data)
+    ) -> Self:
+        return _build(cls, (id, address, data))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -587,7 +571,7 @@ class RegWriteRequest(Message):
 class ActionRequest(Message):
     """Carry out the held REG WRITE (request)."""
 
-    __slots__ = ('id',)
+    __slots__ = ()
     __match_args__ = ('id',)
     PROTOCOL: ClassVar[str] = 'dynamixel_p2'
     COMMAND: ClassVar[str] = 'action'
@@ -596,11 +580,11 @@ class ActionRequest(Message):
     #: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. range 0..252
     id: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         id: int,
-    ) -> None:
-        _store(self, 'id', id)
+    ) -> Self:
+        return _build(cls, (id,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -618,7 +602,7 @@ class ActionRequest(Message):
 class FactoryResetRequest(Message):
     """Reset the control table to its factory values (request)."""
 
-    __slots__ = ('id', 'option')
+    __slots__ = ()
     __match_args__ = ('id', 'option')
     PROTOCOL: ClassVar[str] = 'dynamixel_p2'
     COMMAND: ClassVar[str] = 'factory_reset'
@@ -629,13 +613,12 @@ class FactoryResetRequest(Message):
     #: What to reset. range 1..255
     option: ResetOption | int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         id: int,
         option: ResetOption | int,
-    ) -> None:
-        _store(self, 'id', id)
-        _store(self, 'option', option)
+    ) -> Self:
+        return _build(cls, (id, option))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -655,7 +638,7 @@ class FactoryResetRequest(Message):
 class RebootRequest(Message):
     """Reboot the servo (request)."""
 
-    __slots__ = ('id',)
+    __slots__ = ()
     __match_args__ = ('id',)
     PROTOCOL: ClassVar[str] = 'dynamixel_p2'
     COMMAND: ClassVar[str] = 'reboot'
@@ -664,11 +647,11 @@ class RebootRequest(Message):
     #: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. range 0..252
     id: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         id: int,
-    ) -> None:
-        _store(self, 'id', id)
+    ) -> Self:
+        return _build(cls, (id,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -686,7 +669,7 @@ class RebootRequest(Message):
 class ClearRequest(Message):
     """Reset the multi-turn information (request)."""
 
-    __slots__ = ('id', 'option')
+    __slots__ = ()
     __match_args__ = ('id', 'option')
     PROTOCOL: ClassVar[str] = 'dynamixel_p2'
     COMMAND: ClassVar[str] = 'clear'
@@ -697,13 +680,12 @@ class ClearRequest(Message):
     #: What to clear. range 1..1
     option: ClearOption | int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         id: int,
         option: ClearOption | int,
-    ) -> None:
-        _store(self, 'id', id)
-        _store(self, 'option', option)
+    ) -> Self:
+        return _build(cls, (id, option))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -723,7 +705,7 @@ class ClearRequest(Message):
 class SyncReadRequest(Message):
     """Read the same items of several servos (request)."""
 
-    __slots__ = ('id', 'address', 'length', 'ids')
+    __slots__ = ()
     __match_args__ = ('id', 'address', 'length', 'ids')
     PROTOCOL: ClassVar[str] = 'dynamixel_p2'
     COMMAND: ClassVar[str] = 'sync_read'
@@ -738,17 +720,14 @@ class SyncReadRequest(Message):
     #: The servos to read, in the order they answer.
     ids: tuple[IdsItem, ...]
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         id: int,
         address: int,
         length: int,
         ids: tuple[IdsItem, ...],
-    ) -> None:
-        _store(self, 'id', id)
-        _store(self, 'address', address)
-        _store(self, 'length', length)
-        _store(self, 'ids', ids)
+    ) -> Self:
+        return _build(cls, (id, address, length, ids))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -772,7 +751,7 @@ class SyncReadRequest(Message):
 class FastSyncReadRequest(Message):
     """Read the same items of several servos, answered in one packet (request)."""
 
-    __slots__ = ('id', 'address', 'length', 'servo_ids')
+    __slots__ = ()
     __match_args__ = ('id', 'address', 'length', 'servo_ids')
     PROTOCOL: ClassVar[str] = 'dynamixel_p2'
     COMMAND: ClassVar[str] = 'fast_sync_read'
@@ -787,17 +766,14 @@ class FastSyncReadRequest(Message):
     #: The servos to read, in the order their parts follow each other.
     servo_ids: tuple[ServoIdsItem, ...]
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         id: int,
         address: int,
         length: int,
         servo_ids: tuple[ServoIdsItem, ...],
-    ) -> None:
-        _store(self, 'id', id)
-        _store(self, 'address', address)
-        _store(self, 'length', length)
-        _store(self, 'servo_ids', servo_ids)
+    ) -> Self:
+        return _build(cls, (id, address, length, servo_ids))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -821,7 +797,7 @@ class FastSyncReadRequest(Message):
 class SyncWriteRequest(Message):
     """Write the same items of several servos at once (request)."""
 
-    __slots__ = ('id', 'address', 'servos')
+    __slots__ = ()
     __match_args__ = ('id', 'address', 'servos')
     PROTOCOL: ClassVar[str] = 'dynamixel_p2'
     COMMAND: ClassVar[str] = 'sync_write'
@@ -834,15 +810,13 @@ class SyncWriteRequest(Message):
     #: One item per servo.
     servos: tuple[ServosItem, ...]
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         id: int,
         address: int,
         servos: tuple[ServosItem, ...],
-    ) -> None:
-        _store(self, 'id', id)
-        _store(self, 'address', address)
-        _store(self, 'servos', servos)
+    ) -> Self:
+        return _build(cls, (id, address, servos))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -864,7 +838,7 @@ class SyncWriteRequest(Message):
 class BulkReadRequest(Message):
     """Read different items of several servos (request)."""
 
-    __slots__ = ('id', 'reads')
+    __slots__ = ()
     __match_args__ = ('id', 'reads')
     PROTOCOL: ClassVar[str] = 'dynamixel_p2'
     COMMAND: ClassVar[str] = 'bulk_read'
@@ -875,13 +849,12 @@ class BulkReadRequest(Message):
     #: One item per servo.
     reads: tuple[ReadsItem, ...]
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         id: int,
         reads: tuple[ReadsItem, ...],
-    ) -> None:
-        _store(self, 'id', id)
-        _store(self, 'reads', reads)
+    ) -> Self:
+        return _build(cls, (id, reads))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -901,7 +874,7 @@ class BulkReadRequest(Message):
 class BulkWriteRequest(Message):
     """Write different items of several servos at once (request)."""
 
-    __slots__ = ('id', 'writes')
+    __slots__ = ()
     __match_args__ = ('id', 'writes')
     PROTOCOL: ClassVar[str] = 'dynamixel_p2'
     COMMAND: ClassVar[str] = 'bulk_write'
@@ -912,13 +885,12 @@ class BulkWriteRequest(Message):
     #: One item per servo.
     writes: tuple[WritesItem, ...]
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         id: int,
         writes: tuple[WritesItem, ...],
-    ) -> None:
-        _store(self, 'id', id)
-        _store(self, 'writes', writes)
+    ) -> Self:
+        return _build(cls, (id, writes))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -938,7 +910,7 @@ class BulkWriteRequest(Message):
 class StatusResponse(Message):
     """Status packet (a servo's answer to every instruction but PING) (response)."""
 
-    __slots__ = ('id', 'error', 'data')
+    __slots__ = ()
     __match_args__ = ('id', 'error', 'data')
     PROTOCOL: ClassVar[str] = 'dynamixel_p2'
     COMMAND: ClassVar[str] = 'status'
@@ -951,15 +923,13 @@ class StatusResponse(Message):
     #: The bytes read, item by item from the request's address (empty but for reads).
     data: bytes
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         id: int,
         error: ErrorBits,
         data: bytes,
-    ) -> None:
-        _store(self, 'id', id)
-        _store(self, 'error', error)
-        _store(self, 'data', data)
+    ) -> Self:
+        return _build(cls, (id, error, data))
 
     def to_fields(self) -> dict[str, Any]:
         return {

@@ -9,7 +9,8 @@ from collections.abc import Callable
 from serialspec.runtime.checksums import BYTE_VALUES as _BYTES
 from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError, content_size_error, out_of_range
 from serialspec.runtime.fields import wrong_type
-from serialspec.runtime.message import Direction, Message, members, slot_setters
+from serialspec.runtime.message import Direction, Message, members
+from serialspec.runtime.message import build as _new  # a message from the tuple of its field values, in one call
 from serialspec.runtime.stream import FrameFormat
 from serialspec.runtime.stream import StreamParser as _StreamParser
 
@@ -167,126 +168,6 @@ _TABLE_PARAMETERS_RANGES: dict[int, tuple[float, float]] = {
     53: (-32768, 32767),
 }
 
-# Decoders build messages with object.__new__ and store each value straight into its slot: a message's __init__
-# (frozen) goes through object.__setattr__ per field, which costs more than unpacking the whole frame.
-_new = object.__new__
-(_set_BlocksItem_content,) = slot_setters(BlocksItem)
-_set_DampingRequest_servo_id, _set_DampingRequest_power = slot_setters(DampingRequest)
-_set_DampingResponse_servo_id, _set_DampingResponse_result = slot_setters(DampingResponse)
-(_set_EndAsyncRequest_mode,) = slot_setters(EndAsyncRequest)
-_set_MethodBits_direction, _set_MethodBits_mode = slot_setters(MethodBits)
-(_set_MonitorRequest_servo_id,) = slot_setters(MonitorRequest)
-(
-    _set_MonitorResponse_servo_id,
-    _set_MonitorResponse_voltage,
-    _set_MonitorResponse_current,
-    _set_MonitorResponse_power,
-    _set_MonitorResponse_temperature,
-    _set_MonitorResponse_status,
-    _set_MonitorResponse_angle,
-    _set_MonitorResponse_turns,
-) = slot_setters(MonitorResponse)
-(
-    _set_MoveByIntervalRequest_servo_id,
-    _set_MoveByIntervalRequest_angle,
-    _set_MoveByIntervalRequest_interval,
-    _set_MoveByIntervalRequest_t_acc,
-    _set_MoveByIntervalRequest_t_dec,
-    _set_MoveByIntervalRequest_power,
-) = slot_setters(MoveByIntervalRequest)
-_set_MoveByIntervalResponse_servo_id, _set_MoveByIntervalResponse_result = slot_setters(MoveByIntervalResponse)
-(
-    _set_MoveByVelocityRequest_servo_id,
-    _set_MoveByVelocityRequest_angle,
-    _set_MoveByVelocityRequest_velocity,
-    _set_MoveByVelocityRequest_t_acc,
-    _set_MoveByVelocityRequest_t_dec,
-    _set_MoveByVelocityRequest_power,
-) = slot_setters(MoveByVelocityRequest)
-_set_MoveByVelocityResponse_servo_id, _set_MoveByVelocityResponse_result = slot_setters(MoveByVelocityResponse)
-(
-    _set_MoveMturnByIntervalRequest_servo_id,
-    _set_MoveMturnByIntervalRequest_angle,
-    _set_MoveMturnByIntervalRequest_interval,
-    _set_MoveMturnByIntervalRequest_t_acc,
-    _set_MoveMturnByIntervalRequest_t_dec,
-    _set_MoveMturnByIntervalRequest_power,
-) = slot_setters(MoveMturnByIntervalRequest)
-_set_MoveMturnByIntervalResponse_servo_id, _set_MoveMturnByIntervalResponse_result = slot_setters(MoveMturnByIntervalResponse)
-(
-    _set_MoveMturnByVelocityRequest_servo_id,
-    _set_MoveMturnByVelocityRequest_angle,
-    _set_MoveMturnByVelocityRequest_velocity,
-    _set_MoveMturnByVelocityRequest_t_acc,
-    _set_MoveMturnByVelocityRequest_t_dec,
-    _set_MoveMturnByVelocityRequest_power,
-) = slot_setters(MoveMturnByVelocityRequest)
-_set_MoveMturnByVelocityResponse_servo_id, _set_MoveMturnByVelocityResponse_result = slot_setters(MoveMturnByVelocityResponse)
-(
-    _set_MoveMturnRequest_servo_id,
-    _set_MoveMturnRequest_angle,
-    _set_MoveMturnRequest_interval,
-    _set_MoveMturnRequest_power,
-) = slot_setters(MoveMturnRequest)
-_set_MoveMturnResponse_servo_id, _set_MoveMturnResponse_result = slot_setters(MoveMturnResponse)
-(_set_PingRequest_servo_id,) = slot_setters(PingRequest)
-(_set_PingResponse_servo_id,) = slot_setters(PingResponse)
-(_set_ReadAngleRequest_servo_id,) = slot_setters(ReadAngleRequest)
-_set_ReadAngleResponse_servo_id, _set_ReadAngleResponse_angle = slot_setters(ReadAngleResponse)
-(_set_ReadBatchDataRequest_servo_id,) = slot_setters(ReadBatchDataRequest)
-_set_ReadBatchDataResponse_servo_id, _set_ReadBatchDataResponse_user_data = slot_setters(ReadBatchDataResponse)
-_set_ReadDataRequest_servo_id, _set_ReadDataRequest_data_id = slot_setters(ReadDataRequest)
-_set_ReadDataResponse_servo_id, _set_ReadDataResponse_data_id, _set_ReadDataResponse_data = slot_setters(ReadDataResponse)
-(_set_ReadMturnAngleRequest_servo_id,) = slot_setters(ReadMturnAngleRequest)
-_set_ReadMturnAngleResponse_servo_id, _set_ReadMturnAngleResponse_angle, _set_ReadMturnAngleResponse_turns = slot_setters(ReadMturnAngleResponse)
-(_set_ResetMturnAngleRequest_servo_id,) = slot_setters(ResetMturnAngleRequest)
-(_set_ResetUserDataRequest_servo_id,) = slot_setters(ResetUserDataRequest)
-_set_ResetUserDataResponse_servo_id, _set_ResetUserDataResponse_result = slot_setters(ResetUserDataResponse)
-(
-    _set_RotateRequest_servo_id,
-    _set_RotateRequest_angle,
-    _set_RotateRequest_interval,
-    _set_RotateRequest_power,
-) = slot_setters(RotateRequest)
-_set_RotateResponse_servo_id, _set_RotateResponse_result = slot_setters(RotateResponse)
-(_set_SetOriginPointRequest_servo_id,) = slot_setters(SetOriginPointRequest)
-(
-    _set_SpinRequest_servo_id,
-    _set_SpinRequest_method,
-    _set_SpinRequest_speed,
-    _set_SpinRequest_value,
-) = slot_setters(SpinRequest)
-_set_SpinResponse_servo_id, _set_SpinResponse_result = slot_setters(SpinResponse)
-_set_StopOnControlModeRequest_servo_id, _set_StopOnControlModeRequest_method, _set_StopOnControlModeRequest_power = slot_setters(StopOnControlModeRequest)
-_set_SyncCommandRequest_command, _set_SyncCommandRequest_blocks = slot_setters(SyncCommandRequest)
-(
-    _set_UserData_reserved_32,
-    _set_UserData_response_switch,
-    _set_UserData_servo_id,
-    _set_UserData_reserved_35,
-    _set_UserData_baudrate,
-    _set_UserData_stall_protect_mode,
-    _set_UserData_stall_power_limit,
-    _set_UserData_over_volt_low,
-    _set_UserData_over_volt_high,
-    _set_UserData_over_temperature,
-    _set_UserData_over_power,
-    _set_UserData_over_current,
-    _set_UserData_accel_switch,
-    _set_UserData_reserved_45,
-    _set_UserData_po_lock_switch,
-    _set_UserData_wb_lock_switch,
-    _set_UserData_angle_limit_switch,
-    _set_UserData_soft_start_switch,
-    _set_UserData_soft_start_time,
-    _set_UserData_angle_limit_high,
-    _set_UserData_angle_limit_low,
-    _set_UserData_angle_mid_offset,
-) = slot_setters(UserData)
-_set_WriteBatchDataRequest_servo_id, _set_WriteBatchDataRequest_user_data = slot_setters(WriteBatchDataRequest)
-_set_WriteBatchDataResponse_servo_id, _set_WriteBatchDataResponse_result = slot_setters(WriteBatchDataResponse)
-_set_WriteDataRequest_servo_id, _set_WriteDataRequest_data_id, _set_WriteDataRequest_data = slot_setters(WriteDataRequest)
-_set_WriteDataResponse_servo_id, _set_WriteDataResponse_data_id, _set_WriteDataResponse_result = slot_setters(WriteDataResponse)
 _MEMBERS_AsyncEnd = members(AsyncEnd)
 _MEMBERS_BaudrateOption = members(BaudrateOption)
 _MEMBERS_LockOnPowerOn = members(LockOnPowerOn)
@@ -304,48 +185,32 @@ _MEMBERS_WheelBrake = members(WheelBrake)
 def _decode_ping_request(buf: bytes, o: int, end: int) -> PingRequest:
     if end - o != 1:
         raise content_size_error('ping request', end - o, 1, 1)
-    v_servo_id, = _S_U8.unpack_from(buf, o)
-    m = _new(PingRequest)
-    _set_PingRequest_servo_id(m, v_servo_id)
-    return m
+    return _new(PingRequest, _S_U8.unpack_from(buf, o))
 
 
 def _decode_ping_response(buf: bytes, o: int, end: int) -> PingResponse:
     if end - o != 1:
         raise content_size_error('ping response', end - o, 1, 1)
-    v_servo_id, = _S_U8.unpack_from(buf, o)
-    m = _new(PingResponse)
-    _set_PingResponse_servo_id(m, v_servo_id)
-    return m
+    return _new(PingResponse, _S_U8.unpack_from(buf, o))
 
 
 def _decode_reset_user_data_request(buf: bytes, o: int, end: int) -> ResetUserDataRequest:
     if end - o != 1:
         raise content_size_error('reset_user_data request', end - o, 1, 1)
-    v_servo_id, = _S_U8.unpack_from(buf, o)
-    m = _new(ResetUserDataRequest)
-    _set_ResetUserDataRequest_servo_id(m, v_servo_id)
-    return m
+    return _new(ResetUserDataRequest, _S_U8.unpack_from(buf, o))
 
 
 def _decode_reset_user_data_response(buf: bytes, o: int, end: int) -> ResetUserDataResponse:
     if end - o != 2:
         raise content_size_error('reset_user_data response', end - o, 2, 2)
     v_servo_id, v_result = _S_U8_U8.unpack_from(buf, o)
-    m = _new(ResetUserDataResponse)
-    _set_ResetUserDataResponse_servo_id(m, v_servo_id)
-    _set_ResetUserDataResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
-    return m
+    return _new(ResetUserDataResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
 
 
 def _decode_read_data_request(buf: bytes, o: int, end: int) -> ReadDataRequest:
     if end - o != 2:
         raise content_size_error('read_data request', end - o, 2, 2)
-    v_servo_id, v_data_id = _S_U8_U8.unpack_from(buf, o)
-    m = _new(ReadDataRequest)
-    _set_ReadDataRequest_servo_id(m, v_servo_id)
-    _set_ReadDataRequest_data_id(m, v_data_id)
-    return m
+    return _new(ReadDataRequest, _S_U8_U8.unpack_from(buf, o))
 
 
 def _decode_read_data_response(buf: bytes, o: int, end: int) -> ReadDataResponse:
@@ -362,11 +227,7 @@ def _decode_read_data_response(buf: bytes, o: int, end: int) -> ReadDataResponse
     o += s.size
     if o != end:
         raise DecodeError('read_data response' + f': {end - o} bytes left after the last field')
-    m = _new(ReadDataResponse)
-    _set_ReadDataResponse_servo_id(m, v_servo_id)
-    _set_ReadDataResponse_data_id(m, v_data_id)
-    _set_ReadDataResponse_data(m, v_data)
-    return m
+    return _new(ReadDataResponse, (v_servo_id, v_data_id, v_data))
 
 
 def _decode_write_data_request(buf: bytes, o: int, end: int) -> WriteDataRequest:
@@ -383,31 +244,20 @@ def _decode_write_data_request(buf: bytes, o: int, end: int) -> WriteDataRequest
     o += s.size
     if o != end:
         raise DecodeError('write_data request' + f': {end - o} bytes left after the last field')
-    m = _new(WriteDataRequest)
-    _set_WriteDataRequest_servo_id(m, v_servo_id)
-    _set_WriteDataRequest_data_id(m, v_data_id)
-    _set_WriteDataRequest_data(m, v_data)
-    return m
+    return _new(WriteDataRequest, (v_servo_id, v_data_id, v_data))
 
 
 def _decode_write_data_response(buf: bytes, o: int, end: int) -> WriteDataResponse:
     if end - o != 3:
         raise content_size_error('write_data response', end - o, 3, 3)
     v_servo_id, v_data_id, v_result = _S_U8_U8_U8.unpack_from(buf, o)
-    m = _new(WriteDataResponse)
-    _set_WriteDataResponse_servo_id(m, v_servo_id)
-    _set_WriteDataResponse_data_id(m, v_data_id)
-    _set_WriteDataResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
-    return m
+    return _new(WriteDataResponse, (v_servo_id, v_data_id, _MEMBERS_Result.get(v_result, v_result)))
 
 
 def _decode_read_batch_data_request(buf: bytes, o: int, end: int) -> ReadBatchDataRequest:
     if end - o != 1:
         raise content_size_error('read_batch_data request', end - o, 1, 1)
-    v_servo_id, = _S_U8.unpack_from(buf, o)
-    m = _new(ReadBatchDataRequest)
-    _set_ReadBatchDataRequest_servo_id(m, v_servo_id)
-    return m
+    return _new(ReadBatchDataRequest, _S_U8.unpack_from(buf, o))
 
 
 def _decode_read_batch_data_response(buf: bytes, o: int, end: int) -> ReadBatchDataResponse:
@@ -415,33 +265,8 @@ def _decode_read_batch_data_response(buf: bytes, o: int, end: int) -> ReadBatchD
         raise content_size_error('read_batch_data response', end - o, 33, 33)
     t = _S_READBATCHDATARESPONSE_SERVO_ID.unpack_from(buf, o)
     v_servo_id = t[0]
-    v_user_data = _new(UserData)
-    _set_UserData_reserved_32(v_user_data, t[1])
-    _set_UserData_response_switch(v_user_data, _MEMBERS_ResponseSwitch.get(t[2], t[2]))
-    _set_UserData_servo_id(v_user_data, t[3])
-    _set_UserData_reserved_35(v_user_data, t[4])
-    _set_UserData_baudrate(v_user_data, _MEMBERS_BaudrateOption.get(t[5], t[5]))
-    _set_UserData_stall_protect_mode(v_user_data, _MEMBERS_StallProtectMode.get(t[6], t[6]))
-    _set_UserData_stall_power_limit(v_user_data, t[7])
-    _set_UserData_over_volt_low(v_user_data, t[8])
-    _set_UserData_over_volt_high(v_user_data, t[9])
-    _set_UserData_over_temperature(v_user_data, t[10])
-    _set_UserData_over_power(v_user_data, t[11])
-    _set_UserData_over_current(v_user_data, t[12])
-    _set_UserData_accel_switch(v_user_data, _MEMBERS_Switch.get(t[13], t[13]))
-    _set_UserData_reserved_45(v_user_data, t[14])
-    _set_UserData_po_lock_switch(v_user_data, _MEMBERS_LockOnPowerOn.get(t[15], t[15]))
-    _set_UserData_wb_lock_switch(v_user_data, _MEMBERS_WheelBrake.get(t[16], t[16]))
-    _set_UserData_angle_limit_switch(v_user_data, _MEMBERS_Switch.get(t[17], t[17]))
-    _set_UserData_soft_start_switch(v_user_data, _MEMBERS_Switch.get(t[18], t[18]))
-    _set_UserData_soft_start_time(v_user_data, t[19])
-    _set_UserData_angle_limit_high(v_user_data, t[20])
-    _set_UserData_angle_limit_low(v_user_data, t[21])
-    _set_UserData_angle_mid_offset(v_user_data, t[22])
-    m = _new(ReadBatchDataResponse)
-    _set_ReadBatchDataResponse_servo_id(m, v_servo_id)
-    _set_ReadBatchDataResponse_user_data(m, v_user_data)
-    return m
+    v_user_data = _new(UserData, (t[1], _MEMBERS_ResponseSwitch.get(t[2], t[2]), t[3], t[4], _MEMBERS_BaudrateOption.get(t[5], t[5]), _MEMBERS_StallProtectMode.get(t[6], t[6]), t[7], t[8], t[9], t[10], t[11], t[12], _MEMBERS_Switch.get(t[13], t[13]), t[14], _MEMBERS_LockOnPowerOn.get(t[15], t[15]), _MEMBERS_WheelBrake.get(t[16], t[16]), _MEMBERS_Switch.get(t[17], t[17]), _MEMBERS_Switch.get(t[18], t[18]), t[19], t[20], t[21], t[22]))
+    return _new(ReadBatchDataResponse, (v_servo_id, v_user_data))
 
 
 def _decode_write_batch_data_request(buf: bytes, o: int, end: int) -> WriteBatchDataRequest:
@@ -449,43 +274,15 @@ def _decode_write_batch_data_request(buf: bytes, o: int, end: int) -> WriteBatch
         raise content_size_error('write_batch_data request', end - o, 33, 33)
     t = _S_READBATCHDATARESPONSE_SERVO_ID.unpack_from(buf, o)
     v_servo_id = t[0]
-    v_user_data = _new(UserData)
-    _set_UserData_reserved_32(v_user_data, t[1])
-    _set_UserData_response_switch(v_user_data, _MEMBERS_ResponseSwitch.get(t[2], t[2]))
-    _set_UserData_servo_id(v_user_data, t[3])
-    _set_UserData_reserved_35(v_user_data, t[4])
-    _set_UserData_baudrate(v_user_data, _MEMBERS_BaudrateOption.get(t[5], t[5]))
-    _set_UserData_stall_protect_mode(v_user_data, _MEMBERS_StallProtectMode.get(t[6], t[6]))
-    _set_UserData_stall_power_limit(v_user_data, t[7])
-    _set_UserData_over_volt_low(v_user_data, t[8])
-    _set_UserData_over_volt_high(v_user_data, t[9])
-    _set_UserData_over_temperature(v_user_data, t[10])
-    _set_UserData_over_power(v_user_data, t[11])
-    _set_UserData_over_current(v_user_data, t[12])
-    _set_UserData_accel_switch(v_user_data, _MEMBERS_Switch.get(t[13], t[13]))
-    _set_UserData_reserved_45(v_user_data, t[14])
-    _set_UserData_po_lock_switch(v_user_data, _MEMBERS_LockOnPowerOn.get(t[15], t[15]))
-    _set_UserData_wb_lock_switch(v_user_data, _MEMBERS_WheelBrake.get(t[16], t[16]))
-    _set_UserData_angle_limit_switch(v_user_data, _MEMBERS_Switch.get(t[17], t[17]))
-    _set_UserData_soft_start_switch(v_user_data, _MEMBERS_Switch.get(t[18], t[18]))
-    _set_UserData_soft_start_time(v_user_data, t[19])
-    _set_UserData_angle_limit_high(v_user_data, t[20])
-    _set_UserData_angle_limit_low(v_user_data, t[21])
-    _set_UserData_angle_mid_offset(v_user_data, t[22])
-    m = _new(WriteBatchDataRequest)
-    _set_WriteBatchDataRequest_servo_id(m, v_servo_id)
-    _set_WriteBatchDataRequest_user_data(m, v_user_data)
-    return m
+    v_user_data = _new(UserData, (t[1], _MEMBERS_ResponseSwitch.get(t[2], t[2]), t[3], t[4], _MEMBERS_BaudrateOption.get(t[5], t[5]), _MEMBERS_StallProtectMode.get(t[6], t[6]), t[7], t[8], t[9], t[10], t[11], t[12], _MEMBERS_Switch.get(t[13], t[13]), t[14], _MEMBERS_LockOnPowerOn.get(t[15], t[15]), _MEMBERS_WheelBrake.get(t[16], t[16]), _MEMBERS_Switch.get(t[17], t[17]), _MEMBERS_Switch.get(t[18], t[18]), t[19], t[20], t[21], t[22]))
+    return _new(WriteBatchDataRequest, (v_servo_id, v_user_data))
 
 
 def _decode_write_batch_data_response(buf: bytes, o: int, end: int) -> WriteBatchDataResponse:
     if end - o != 2:
         raise content_size_error('write_batch_data response', end - o, 2, 2)
     v_servo_id, v_result = _S_U8_U8.unpack_from(buf, o)
-    m = _new(WriteBatchDataResponse)
-    _set_WriteBatchDataResponse_servo_id(m, v_servo_id)
-    _set_WriteBatchDataResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
-    return m
+    return _new(WriteBatchDataResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
 
 
 def _decode_spin_request(buf: bytes, o: int, end: int) -> SpinRequest:
@@ -496,258 +293,155 @@ def _decode_spin_request(buf: bytes, o: int, end: int) -> SpinRequest:
     v_method_mode = v_method & 0x3
     if v_method & 0x7c:
         raise DecodeError('spin request' + f': unused bits of method are set ({v_method:#04x})')
-    v_method_bits = _new(MethodBits)
-    _set_MethodBits_direction(v_method_bits, _MEMBERS_SpinDirection.get(v_method_direction, v_method_direction))
-    _set_MethodBits_mode(v_method_bits, _MEMBERS_SpinMode.get(v_method_mode, v_method_mode))
-    m = _new(SpinRequest)
-    _set_SpinRequest_servo_id(m, v_servo_id)
-    _set_SpinRequest_method(m, v_method_bits)
-    _set_SpinRequest_speed(m, v_speed)
-    _set_SpinRequest_value(m, v_value)
-    return m
+    v_method_bits = _new(MethodBits, (_MEMBERS_SpinDirection.get(v_method_direction, v_method_direction), _MEMBERS_SpinMode.get(v_method_mode, v_method_mode)))
+    return _new(SpinRequest, (v_servo_id, v_method_bits, v_speed, v_value))
 
 
 def _decode_spin_response(buf: bytes, o: int, end: int) -> SpinResponse:
     if end - o != 2:
         raise content_size_error('spin response', end - o, 2, 2)
     v_servo_id, v_result = _S_U8_U8.unpack_from(buf, o)
-    m = _new(SpinResponse)
-    _set_SpinResponse_servo_id(m, v_servo_id)
-    _set_SpinResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
-    return m
+    return _new(SpinResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
 
 
 def _decode_rotate_request(buf: bytes, o: int, end: int) -> RotateRequest:
     if end - o != 7:
         raise content_size_error('rotate request', end - o, 7, 7)
-    v_servo_id, v_angle, v_interval, v_power = _S_U8_I16_U16_U16.unpack_from(buf, o)
-    m = _new(RotateRequest)
-    _set_RotateRequest_servo_id(m, v_servo_id)
-    _set_RotateRequest_angle(m, v_angle)
-    _set_RotateRequest_interval(m, v_interval)
-    _set_RotateRequest_power(m, v_power)
-    return m
+    return _new(RotateRequest, _S_U8_I16_U16_U16.unpack_from(buf, o))
 
 
 def _decode_rotate_response(buf: bytes, o: int, end: int) -> RotateResponse:
     if end - o != 2:
         raise content_size_error('rotate response', end - o, 2, 2)
     v_servo_id, v_result = _S_U8_U8.unpack_from(buf, o)
-    m = _new(RotateResponse)
-    _set_RotateResponse_servo_id(m, v_servo_id)
-    _set_RotateResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
-    return m
+    return _new(RotateResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
 
 
 def _decode_damping_request(buf: bytes, o: int, end: int) -> DampingRequest:
     if end - o != 3:
         raise content_size_error('damping request', end - o, 3, 3)
-    v_servo_id, v_power = _S_U8_U16.unpack_from(buf, o)
-    m = _new(DampingRequest)
-    _set_DampingRequest_servo_id(m, v_servo_id)
-    _set_DampingRequest_power(m, v_power)
-    return m
+    return _new(DampingRequest, _S_U8_U16.unpack_from(buf, o))
 
 
 def _decode_damping_response(buf: bytes, o: int, end: int) -> DampingResponse:
     if end - o != 2:
         raise content_size_error('damping response', end - o, 2, 2)
     v_servo_id, v_result = _S_U8_U8.unpack_from(buf, o)
-    m = _new(DampingResponse)
-    _set_DampingResponse_servo_id(m, v_servo_id)
-    _set_DampingResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
-    return m
+    return _new(DampingResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
 
 
 def _decode_read_angle_request(buf: bytes, o: int, end: int) -> ReadAngleRequest:
     if end - o != 1:
         raise content_size_error('read_angle request', end - o, 1, 1)
-    v_servo_id, = _S_U8.unpack_from(buf, o)
-    m = _new(ReadAngleRequest)
-    _set_ReadAngleRequest_servo_id(m, v_servo_id)
-    return m
+    return _new(ReadAngleRequest, _S_U8.unpack_from(buf, o))
 
 
 def _decode_read_angle_response(buf: bytes, o: int, end: int) -> ReadAngleResponse:
     if end - o != 3:
         raise content_size_error('read_angle response', end - o, 3, 3)
-    v_servo_id, v_angle = _S_U8_I16.unpack_from(buf, o)
-    m = _new(ReadAngleResponse)
-    _set_ReadAngleResponse_servo_id(m, v_servo_id)
-    _set_ReadAngleResponse_angle(m, v_angle)
-    return m
+    return _new(ReadAngleResponse, _S_U8_I16.unpack_from(buf, o))
 
 
 def _decode_move_by_interval_request(buf: bytes, o: int, end: int) -> MoveByIntervalRequest:
     if end - o != 11:
         raise content_size_error('move_by_interval request', end - o, 11, 11)
-    v_servo_id, v_angle, v_interval, v_t_acc, v_t_dec, v_power = _S_U8_I16_U16_U16_U16_U16.unpack_from(buf, o)
-    m = _new(MoveByIntervalRequest)
-    _set_MoveByIntervalRequest_servo_id(m, v_servo_id)
-    _set_MoveByIntervalRequest_angle(m, v_angle)
-    _set_MoveByIntervalRequest_interval(m, v_interval)
-    _set_MoveByIntervalRequest_t_acc(m, v_t_acc)
-    _set_MoveByIntervalRequest_t_dec(m, v_t_dec)
-    _set_MoveByIntervalRequest_power(m, v_power)
-    return m
+    return _new(MoveByIntervalRequest, _S_U8_I16_U16_U16_U16_U16.unpack_from(buf, o))
 
 
 def _decode_move_by_interval_response(buf: bytes, o: int, end: int) -> MoveByIntervalResponse:
     if end - o != 2:
         raise content_size_error('move_by_interval response', end - o, 2, 2)
     v_servo_id, v_result = _S_U8_U8.unpack_from(buf, o)
-    m = _new(MoveByIntervalResponse)
-    _set_MoveByIntervalResponse_servo_id(m, v_servo_id)
-    _set_MoveByIntervalResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
-    return m
+    return _new(MoveByIntervalResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
 
 
 def _decode_move_by_velocity_request(buf: bytes, o: int, end: int) -> MoveByVelocityRequest:
     if end - o != 11:
         raise content_size_error('move_by_velocity request', end - o, 11, 11)
-    v_servo_id, v_angle, v_velocity, v_t_acc, v_t_dec, v_power = _S_U8_I16_U16_U16_U16_U16.unpack_from(buf, o)
-    m = _new(MoveByVelocityRequest)
-    _set_MoveByVelocityRequest_servo_id(m, v_servo_id)
-    _set_MoveByVelocityRequest_angle(m, v_angle)
-    _set_MoveByVelocityRequest_velocity(m, v_velocity)
-    _set_MoveByVelocityRequest_t_acc(m, v_t_acc)
-    _set_MoveByVelocityRequest_t_dec(m, v_t_dec)
-    _set_MoveByVelocityRequest_power(m, v_power)
-    return m
+    return _new(MoveByVelocityRequest, _S_U8_I16_U16_U16_U16_U16.unpack_from(buf, o))
 
 
 def _decode_move_by_velocity_response(buf: bytes, o: int, end: int) -> MoveByVelocityResponse:
     if end - o != 2:
         raise content_size_error('move_by_velocity response', end - o, 2, 2)
     v_servo_id, v_result = _S_U8_U8.unpack_from(buf, o)
-    m = _new(MoveByVelocityResponse)
-    _set_MoveByVelocityResponse_servo_id(m, v_servo_id)
-    _set_MoveByVelocityResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
-    return m
+    return _new(MoveByVelocityResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
 
 
 def _decode_move_mturn_request(buf: bytes, o: int, end: int) -> MoveMturnRequest:
     if end - o != 11:
         raise content_size_error('move_mturn request', end - o, 11, 11)
-    v_servo_id, v_angle, v_interval, v_power = _S_U8_I32_U32_U16.unpack_from(buf, o)
-    m = _new(MoveMturnRequest)
-    _set_MoveMturnRequest_servo_id(m, v_servo_id)
-    _set_MoveMturnRequest_angle(m, v_angle)
-    _set_MoveMturnRequest_interval(m, v_interval)
-    _set_MoveMturnRequest_power(m, v_power)
-    return m
+    return _new(MoveMturnRequest, _S_U8_I32_U32_U16.unpack_from(buf, o))
 
 
 def _decode_move_mturn_response(buf: bytes, o: int, end: int) -> MoveMturnResponse:
     if end - o != 2:
         raise content_size_error('move_mturn response', end - o, 2, 2)
     v_servo_id, v_result = _S_U8_U8.unpack_from(buf, o)
-    m = _new(MoveMturnResponse)
-    _set_MoveMturnResponse_servo_id(m, v_servo_id)
-    _set_MoveMturnResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
-    return m
+    return _new(MoveMturnResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
 
 
 def _decode_move_mturn_by_interval_request(buf: bytes, o: int, end: int) -> MoveMturnByIntervalRequest:
     if end - o != 15:
         raise content_size_error('move_mturn_by_interval request', end - o, 15, 15)
-    v_servo_id, v_angle, v_interval, v_t_acc, v_t_dec, v_power = _S_U8_I32_U32_U16_U16_U16.unpack_from(buf, o)
-    m = _new(MoveMturnByIntervalRequest)
-    _set_MoveMturnByIntervalRequest_servo_id(m, v_servo_id)
-    _set_MoveMturnByIntervalRequest_angle(m, v_angle)
-    _set_MoveMturnByIntervalRequest_interval(m, v_interval)
-    _set_MoveMturnByIntervalRequest_t_acc(m, v_t_acc)
-    _set_MoveMturnByIntervalRequest_t_dec(m, v_t_dec)
-    _set_MoveMturnByIntervalRequest_power(m, v_power)
-    return m
+    return _new(MoveMturnByIntervalRequest, _S_U8_I32_U32_U16_U16_U16.unpack_from(buf, o))
 
 
 def _decode_move_mturn_by_interval_response(buf: bytes, o: int, end: int) -> MoveMturnByIntervalResponse:
     if end - o != 2:
         raise content_size_error('move_mturn_by_interval response', end - o, 2, 2)
     v_servo_id, v_result = _S_U8_U8.unpack_from(buf, o)
-    m = _new(MoveMturnByIntervalResponse)
-    _set_MoveMturnByIntervalResponse_servo_id(m, v_servo_id)
-    _set_MoveMturnByIntervalResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
-    return m
+    return _new(MoveMturnByIntervalResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
 
 
 def _decode_move_mturn_by_velocity_request(buf: bytes, o: int, end: int) -> MoveMturnByVelocityRequest:
     if end - o != 13:
         raise content_size_error('move_mturn_by_velocity request', end - o, 13, 13)
-    v_servo_id, v_angle, v_velocity, v_t_acc, v_t_dec, v_power = _S_U8_I32_U16_U16_U16_U16.unpack_from(buf, o)
-    m = _new(MoveMturnByVelocityRequest)
-    _set_MoveMturnByVelocityRequest_servo_id(m, v_servo_id)
-    _set_MoveMturnByVelocityRequest_angle(m, v_angle)
-    _set_MoveMturnByVelocityRequest_velocity(m, v_velocity)
-    _set_MoveMturnByVelocityRequest_t_acc(m, v_t_acc)
-    _set_MoveMturnByVelocityRequest_t_dec(m, v_t_dec)
-    _set_MoveMturnByVelocityRequest_power(m, v_power)
-    return m
+    return _new(MoveMturnByVelocityRequest, _S_U8_I32_U16_U16_U16_U16.unpack_from(buf, o))
 
 
 def _decode_move_mturn_by_velocity_response(buf: bytes, o: int, end: int) -> MoveMturnByVelocityResponse:
     if end - o != 2:
         raise content_size_error('move_mturn_by_velocity response', end - o, 2, 2)
     v_servo_id, v_result = _S_U8_U8.unpack_from(buf, o)
-    m = _new(MoveMturnByVelocityResponse)
-    _set_MoveMturnByVelocityResponse_servo_id(m, v_servo_id)
-    _set_MoveMturnByVelocityResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
-    return m
+    return _new(MoveMturnByVelocityResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
 
 
 def _decode_read_mturn_angle_request(buf: bytes, o: int, end: int) -> ReadMturnAngleRequest:
     if end - o != 1:
         raise content_size_error('read_mturn_angle request', end - o, 1, 1)
-    v_servo_id, = _S_U8.unpack_from(buf, o)
-    m = _new(ReadMturnAngleRequest)
-    _set_ReadMturnAngleRequest_servo_id(m, v_servo_id)
-    return m
+    return _new(ReadMturnAngleRequest, _S_U8.unpack_from(buf, o))
 
 
 def _decode_read_mturn_angle_response(buf: bytes, o: int, end: int) -> ReadMturnAngleResponse:
     if end - o != 7:
         raise content_size_error('read_mturn_angle response', end - o, 7, 7)
-    v_servo_id, v_angle, v_turns = _S_U8_I32_I16.unpack_from(buf, o)
-    m = _new(ReadMturnAngleResponse)
-    _set_ReadMturnAngleResponse_servo_id(m, v_servo_id)
-    _set_ReadMturnAngleResponse_angle(m, v_angle)
-    _set_ReadMturnAngleResponse_turns(m, v_turns)
-    return m
+    return _new(ReadMturnAngleResponse, _S_U8_I32_I16.unpack_from(buf, o))
 
 
 def _decode_reset_mturn_angle_request(buf: bytes, o: int, end: int) -> ResetMturnAngleRequest:
     if end - o != 1:
         raise content_size_error('reset_mturn_angle request', end - o, 1, 1)
-    v_servo_id, = _S_U8.unpack_from(buf, o)
-    m = _new(ResetMturnAngleRequest)
-    _set_ResetMturnAngleRequest_servo_id(m, v_servo_id)
-    return m
+    return _new(ResetMturnAngleRequest, _S_U8.unpack_from(buf, o))
 
 
 def _decode_begin_async_request(buf: bytes, o: int, end: int) -> BeginAsyncRequest:
     if end - o != 0:
         raise content_size_error('begin_async request', end - o, 0, 0)
-    m = _new(BeginAsyncRequest)
-    return m
+    return _new(BeginAsyncRequest, ())
 
 
 def _decode_end_async_request(buf: bytes, o: int, end: int) -> EndAsyncRequest:
     if end - o != 1:
         raise content_size_error('end_async request', end - o, 1, 1)
-    v_mode, = _S_U8.unpack_from(buf, o)
-    m = _new(EndAsyncRequest)
-    _set_EndAsyncRequest_mode(m, _MEMBERS_AsyncEnd.get(v_mode, v_mode))
-    return m
+    v_mode = buf[o]
+    return _new(EndAsyncRequest, (_MEMBERS_AsyncEnd.get(v_mode, v_mode),))
 
 
 def _decode_monitor_request(buf: bytes, o: int, end: int) -> MonitorRequest:
     if end - o != 1:
         raise content_size_error('monitor request', end - o, 1, 1)
-    v_servo_id, = _S_U8.unpack_from(buf, o)
-    m = _new(MonitorRequest)
-    _set_MonitorRequest_servo_id(m, v_servo_id)
-    return m
+    return _new(MonitorRequest, _S_U8.unpack_from(buf, o))
 
 
 def _decode_monitor_response(buf: bytes, o: int, end: int) -> MonitorResponse:
@@ -757,16 +451,7 @@ def _decode_monitor_response(buf: bytes, o: int, end: int) -> MonitorResponse:
     v_status_flags = _MEMBERS_ServoStatus.get(v_status)
     if v_status_flags is None:
         v_status_flags = ServoStatus(v_status)
-    m = _new(MonitorResponse)
-    _set_MonitorResponse_servo_id(m, v_servo_id)
-    _set_MonitorResponse_voltage(m, v_voltage)
-    _set_MonitorResponse_current(m, v_current)
-    _set_MonitorResponse_power(m, v_power)
-    _set_MonitorResponse_temperature(m, v_temperature)
-    _set_MonitorResponse_status(m, v_status_flags)
-    _set_MonitorResponse_angle(m, v_angle)
-    _set_MonitorResponse_turns(m, v_turns)
-    return m
+    return _new(MonitorResponse, (v_servo_id, v_voltage, v_current, v_power, v_temperature, v_status_flags, v_angle, v_turns))
 
 
 def _decode_set_origin_point_request(buf: bytes, o: int, end: int) -> SetOriginPointRequest:
@@ -775,20 +460,14 @@ def _decode_set_origin_point_request(buf: bytes, o: int, end: int) -> SetOriginP
     v_servo_id, v_reserved = _S_U8_U8.unpack_from(buf, o)
     if v_reserved != 0:
         raise DecodeError('set_origin_point request' + f': reserved is {v_reserved:#x}, expected 0x0')
-    m = _new(SetOriginPointRequest)
-    _set_SetOriginPointRequest_servo_id(m, v_servo_id)
-    return m
+    return _new(SetOriginPointRequest, (v_servo_id,))
 
 
 def _decode_stop_on_control_mode_request(buf: bytes, o: int, end: int) -> StopOnControlModeRequest:
     if end - o != 4:
         raise content_size_error('stop_on_control_mode request', end - o, 4, 4)
     v_servo_id, v_method, v_power = _S_U8_U8_U16.unpack_from(buf, o)
-    m = _new(StopOnControlModeRequest)
-    _set_StopOnControlModeRequest_servo_id(m, v_servo_id)
-    _set_StopOnControlModeRequest_method(m, _MEMBERS_StopMethod.get(v_method, v_method))
-    _set_StopOnControlModeRequest_power(m, v_power)
-    return m
+    return _new(StopOnControlModeRequest, (v_servo_id, _MEMBERS_StopMethod.get(v_method, v_method), v_power))
 
 
 def _decode_sync_command_request(buf: bytes, o: int, end: int) -> SyncCommandRequest:
@@ -802,16 +481,12 @@ def _decode_sync_command_request(buf: bytes, o: int, end: int) -> SyncCommandReq
             raise DecodeError('sync_command request' + f': content needs {v_block_size} bytes, {end - o} left')
         v_content = buf[o : o + v_block_size]
         o += v_block_size
-        item = _new(BlocksItem)
-        _set_BlocksItem_content(item, v_content)
+        item = _new(BlocksItem, (v_content,))
         v_blocks_list.append(item)
     v_blocks = tuple(v_blocks_list)
     if o != end:
         raise DecodeError('sync_command request' + f': {end - o} bytes left after the last field')
-    m = _new(SyncCommandRequest)
-    _set_SyncCommandRequest_command(m, v_command)
-    _set_SyncCommandRequest_blocks(m, v_blocks)
-    return m
+    return _new(SyncCommandRequest, (v_command, v_blocks))
 
 
 def _frame_ping_request(buf: bytes, start: int) -> PingRequest | None:
@@ -819,9 +494,7 @@ def _frame_ping_request(buf: bytes, start: int) -> PingRequest | None:
     v_servo_id, check = _S_U8_U8.unpack_from(buf, start + 4)
     if (0x60 + v_servo_id) & 0xff != check:
         return None
-    m = _new(PingRequest)
-    _set_PingRequest_servo_id(m, v_servo_id)
-    return m
+    return _new(PingRequest, (v_servo_id,))
 
 
 def _frame_reset_user_data_request(buf: bytes, start: int) -> ResetUserDataRequest | None:
@@ -829,9 +502,7 @@ def _frame_reset_user_data_request(buf: bytes, start: int) -> ResetUserDataReque
     v_servo_id, check = _S_U8_U8.unpack_from(buf, start + 4)
     if (0x61 + v_servo_id) & 0xff != check:
         return None
-    m = _new(ResetUserDataRequest)
-    _set_ResetUserDataRequest_servo_id(m, v_servo_id)
-    return m
+    return _new(ResetUserDataRequest, (v_servo_id,))
 
 
 def _frame_read_data_request(buf: bytes, start: int) -> ReadDataRequest | None:
@@ -839,10 +510,7 @@ def _frame_read_data_request(buf: bytes, start: int) -> ReadDataRequest | None:
     v_servo_id, v_data_id, check = _S_U8_U8_U8.unpack_from(buf, start + 4)
     if (0x63 + v_servo_id + v_data_id) & 0xff != check:
         return None
-    m = _new(ReadDataRequest)
-    _set_ReadDataRequest_servo_id(m, v_servo_id)
-    _set_ReadDataRequest_data_id(m, v_data_id)
-    return m
+    return _new(ReadDataRequest, (v_servo_id, v_data_id))
 
 
 def _frame_read_batch_data_request(buf: bytes, start: int) -> ReadBatchDataRequest | None:
@@ -850,9 +518,7 @@ def _frame_read_batch_data_request(buf: bytes, start: int) -> ReadBatchDataReque
     v_servo_id, check = _S_U8_U8.unpack_from(buf, start + 4)
     if (0x64 + v_servo_id) & 0xff != check:
         return None
-    m = _new(ReadBatchDataRequest)
-    _set_ReadBatchDataRequest_servo_id(m, v_servo_id)
-    return m
+    return _new(ReadBatchDataRequest, (v_servo_id,))
 
 
 def _frame_write_batch_data_request(buf: bytes, start: int) -> WriteBatchDataRequest | None:
@@ -862,33 +528,8 @@ def _frame_write_batch_data_request(buf: bytes, start: int) -> WriteBatchDataReq
         return None
     t = _S_READBATCHDATARESPONSE_SERVO_ID.unpack_from(buf, start + 4)
     v_servo_id = t[0]
-    v_user_data = _new(UserData)
-    _set_UserData_reserved_32(v_user_data, t[1])
-    _set_UserData_response_switch(v_user_data, _MEMBERS_ResponseSwitch.get(t[2], t[2]))
-    _set_UserData_servo_id(v_user_data, t[3])
-    _set_UserData_reserved_35(v_user_data, t[4])
-    _set_UserData_baudrate(v_user_data, _MEMBERS_BaudrateOption.get(t[5], t[5]))
-    _set_UserData_stall_protect_mode(v_user_data, _MEMBERS_StallProtectMode.get(t[6], t[6]))
-    _set_UserData_stall_power_limit(v_user_data, t[7])
-    _set_UserData_over_volt_low(v_user_data, t[8])
-    _set_UserData_over_volt_high(v_user_data, t[9])
-    _set_UserData_over_temperature(v_user_data, t[10])
-    _set_UserData_over_power(v_user_data, t[11])
-    _set_UserData_over_current(v_user_data, t[12])
-    _set_UserData_accel_switch(v_user_data, _MEMBERS_Switch.get(t[13], t[13]))
-    _set_UserData_reserved_45(v_user_data, t[14])
-    _set_UserData_po_lock_switch(v_user_data, _MEMBERS_LockOnPowerOn.get(t[15], t[15]))
-    _set_UserData_wb_lock_switch(v_user_data, _MEMBERS_WheelBrake.get(t[16], t[16]))
-    _set_UserData_angle_limit_switch(v_user_data, _MEMBERS_Switch.get(t[17], t[17]))
-    _set_UserData_soft_start_switch(v_user_data, _MEMBERS_Switch.get(t[18], t[18]))
-    _set_UserData_soft_start_time(v_user_data, t[19])
-    _set_UserData_angle_limit_high(v_user_data, t[20])
-    _set_UserData_angle_limit_low(v_user_data, t[21])
-    _set_UserData_angle_mid_offset(v_user_data, t[22])
-    m = _new(WriteBatchDataRequest)
-    _set_WriteBatchDataRequest_servo_id(m, v_servo_id)
-    _set_WriteBatchDataRequest_user_data(m, v_user_data)
-    return m
+    v_user_data = _new(UserData, (t[1], _MEMBERS_ResponseSwitch.get(t[2], t[2]), t[3], t[4], _MEMBERS_BaudrateOption.get(t[5], t[5]), _MEMBERS_StallProtectMode.get(t[6], t[6]), t[7], t[8], t[9], t[10], t[11], t[12], _MEMBERS_Switch.get(t[13], t[13]), t[14], _MEMBERS_LockOnPowerOn.get(t[15], t[15]), _MEMBERS_WheelBrake.get(t[16], t[16]), _MEMBERS_Switch.get(t[17], t[17]), _MEMBERS_Switch.get(t[18], t[18]), t[19], t[20], t[21], t[22]))
+    return _new(WriteBatchDataRequest, (v_servo_id, v_user_data))
 
 
 def _frame_rotate_request(buf: bytes, start: int) -> RotateRequest | None:
@@ -896,13 +537,7 @@ def _frame_rotate_request(buf: bytes, start: int) -> RotateRequest | None:
     expected = sum(buf[start + 0 : start + 11]) & 0xff
     if expected != buf[start + 11]:
         return None
-    v_servo_id, v_angle, v_interval, v_power = _S_U8_I16_U16_U16.unpack_from(buf, start + 4)
-    m = _new(RotateRequest)
-    _set_RotateRequest_servo_id(m, v_servo_id)
-    _set_RotateRequest_angle(m, v_angle)
-    _set_RotateRequest_interval(m, v_interval)
-    _set_RotateRequest_power(m, v_power)
-    return m
+    return _new(RotateRequest, _S_U8_I16_U16_U16.unpack_from(buf, start + 4))
 
 
 def _frame_damping_request(buf: bytes, start: int) -> DampingRequest | None:
@@ -910,10 +545,7 @@ def _frame_damping_request(buf: bytes, start: int) -> DampingRequest | None:
     v_servo_id, v_power, check = _S_U8_U16_U8.unpack_from(buf, start + 4)
     if (0x6a + v_servo_id + (v_power & 0xff) + (v_power >> 8 & 0xff)) & 0xff != check:
         return None
-    m = _new(DampingRequest)
-    _set_DampingRequest_servo_id(m, v_servo_id)
-    _set_DampingRequest_power(m, v_power)
-    return m
+    return _new(DampingRequest, (v_servo_id, v_power))
 
 
 def _frame_read_angle_request(buf: bytes, start: int) -> ReadAngleRequest | None:
@@ -921,9 +553,7 @@ def _frame_read_angle_request(buf: bytes, start: int) -> ReadAngleRequest | None
     v_servo_id, check = _S_U8_U8.unpack_from(buf, start + 4)
     if (0x69 + v_servo_id) & 0xff != check:
         return None
-    m = _new(ReadAngleRequest)
-    _set_ReadAngleRequest_servo_id(m, v_servo_id)
-    return m
+    return _new(ReadAngleRequest, (v_servo_id,))
 
 
 def _frame_move_by_interval_request(buf: bytes, start: int) -> MoveByIntervalRequest | None:
@@ -931,15 +561,7 @@ def _frame_move_by_interval_request(buf: bytes, start: int) -> MoveByIntervalReq
     expected = sum(buf[start + 0 : start + 15]) & 0xff
     if expected != buf[start + 15]:
         return None
-    v_servo_id, v_angle, v_interval, v_t_acc, v_t_dec, v_power = _S_U8_I16_U16_U16_U16_U16.unpack_from(buf, start + 4)
-    m = _new(MoveByIntervalRequest)
-    _set_MoveByIntervalRequest_servo_id(m, v_servo_id)
-    _set_MoveByIntervalRequest_angle(m, v_angle)
-    _set_MoveByIntervalRequest_interval(m, v_interval)
-    _set_MoveByIntervalRequest_t_acc(m, v_t_acc)
-    _set_MoveByIntervalRequest_t_dec(m, v_t_dec)
-    _set_MoveByIntervalRequest_power(m, v_power)
-    return m
+    return _new(MoveByIntervalRequest, _S_U8_I16_U16_U16_U16_U16.unpack_from(buf, start + 4))
 
 
 def _frame_move_by_velocity_request(buf: bytes, start: int) -> MoveByVelocityRequest | None:
@@ -947,15 +569,7 @@ def _frame_move_by_velocity_request(buf: bytes, start: int) -> MoveByVelocityReq
     expected = sum(buf[start + 0 : start + 15]) & 0xff
     if expected != buf[start + 15]:
         return None
-    v_servo_id, v_angle, v_velocity, v_t_acc, v_t_dec, v_power = _S_U8_I16_U16_U16_U16_U16.unpack_from(buf, start + 4)
-    m = _new(MoveByVelocityRequest)
-    _set_MoveByVelocityRequest_servo_id(m, v_servo_id)
-    _set_MoveByVelocityRequest_angle(m, v_angle)
-    _set_MoveByVelocityRequest_velocity(m, v_velocity)
-    _set_MoveByVelocityRequest_t_acc(m, v_t_acc)
-    _set_MoveByVelocityRequest_t_dec(m, v_t_dec)
-    _set_MoveByVelocityRequest_power(m, v_power)
-    return m
+    return _new(MoveByVelocityRequest, _S_U8_I16_U16_U16_U16_U16.unpack_from(buf, start + 4))
 
 
 def _frame_move_mturn_request(buf: bytes, start: int) -> MoveMturnRequest | None:
@@ -963,13 +577,7 @@ def _frame_move_mturn_request(buf: bytes, start: int) -> MoveMturnRequest | None
     expected = sum(buf[start + 0 : start + 15]) & 0xff
     if expected != buf[start + 15]:
         return None
-    v_servo_id, v_angle, v_interval, v_power = _S_U8_I32_U32_U16.unpack_from(buf, start + 4)
-    m = _new(MoveMturnRequest)
-    _set_MoveMturnRequest_servo_id(m, v_servo_id)
-    _set_MoveMturnRequest_angle(m, v_angle)
-    _set_MoveMturnRequest_interval(m, v_interval)
-    _set_MoveMturnRequest_power(m, v_power)
-    return m
+    return _new(MoveMturnRequest, _S_U8_I32_U32_U16.unpack_from(buf, start + 4))
 
 
 def _frame_move_mturn_by_interval_request(buf: bytes, start: int) -> MoveMturnByIntervalRequest | None:
@@ -977,15 +585,7 @@ def _frame_move_mturn_by_interval_request(buf: bytes, start: int) -> MoveMturnBy
     expected = sum(buf[start + 0 : start + 19]) & 0xff
     if expected != buf[start + 19]:
         return None
-    v_servo_id, v_angle, v_interval, v_t_acc, v_t_dec, v_power = _S_U8_I32_U32_U16_U16_U16.unpack_from(buf, start + 4)
-    m = _new(MoveMturnByIntervalRequest)
-    _set_MoveMturnByIntervalRequest_servo_id(m, v_servo_id)
-    _set_MoveMturnByIntervalRequest_angle(m, v_angle)
-    _set_MoveMturnByIntervalRequest_interval(m, v_interval)
-    _set_MoveMturnByIntervalRequest_t_acc(m, v_t_acc)
-    _set_MoveMturnByIntervalRequest_t_dec(m, v_t_dec)
-    _set_MoveMturnByIntervalRequest_power(m, v_power)
-    return m
+    return _new(MoveMturnByIntervalRequest, _S_U8_I32_U32_U16_U16_U16.unpack_from(buf, start + 4))
 
 
 def _frame_move_mturn_by_velocity_request(buf: bytes, start: int) -> MoveMturnByVelocityRequest | None:
@@ -993,15 +593,7 @@ def _frame_move_mturn_by_velocity_request(buf: bytes, start: int) -> MoveMturnBy
     expected = sum(buf[start + 0 : start + 17]) & 0xff
     if expected != buf[start + 17]:
         return None
-    v_servo_id, v_angle, v_velocity, v_t_acc, v_t_dec, v_power = _S_U8_I32_U16_U16_U16_U16.unpack_from(buf, start + 4)
-    m = _new(MoveMturnByVelocityRequest)
-    _set_MoveMturnByVelocityRequest_servo_id(m, v_servo_id)
-    _set_MoveMturnByVelocityRequest_angle(m, v_angle)
-    _set_MoveMturnByVelocityRequest_velocity(m, v_velocity)
-    _set_MoveMturnByVelocityRequest_t_acc(m, v_t_acc)
-    _set_MoveMturnByVelocityRequest_t_dec(m, v_t_dec)
-    _set_MoveMturnByVelocityRequest_power(m, v_power)
-    return m
+    return _new(MoveMturnByVelocityRequest, _S_U8_I32_U16_U16_U16_U16.unpack_from(buf, start + 4))
 
 
 def _frame_read_mturn_angle_request(buf: bytes, start: int) -> ReadMturnAngleRequest | None:
@@ -1009,9 +601,7 @@ def _frame_read_mturn_angle_request(buf: bytes, start: int) -> ReadMturnAngleReq
     v_servo_id, check = _S_U8_U8.unpack_from(buf, start + 4)
     if (0x6f + v_servo_id) & 0xff != check:
         return None
-    m = _new(ReadMturnAngleRequest)
-    _set_ReadMturnAngleRequest_servo_id(m, v_servo_id)
-    return m
+    return _new(ReadMturnAngleRequest, (v_servo_id,))
 
 
 def _frame_reset_mturn_angle_request(buf: bytes, start: int) -> ResetMturnAngleRequest | None:
@@ -1019,9 +609,7 @@ def _frame_reset_mturn_angle_request(buf: bytes, start: int) -> ResetMturnAngleR
     v_servo_id, check = _S_U8_U8.unpack_from(buf, start + 4)
     if (0x70 + v_servo_id) & 0xff != check:
         return None
-    m = _new(ResetMturnAngleRequest)
-    _set_ResetMturnAngleRequest_servo_id(m, v_servo_id)
-    return m
+    return _new(ResetMturnAngleRequest, (v_servo_id,))
 
 
 def _frame_begin_async_request(buf: bytes, start: int) -> BeginAsyncRequest | None:
@@ -1029,8 +617,7 @@ def _frame_begin_async_request(buf: bytes, start: int) -> BeginAsyncRequest | No
     expected = sum(buf[start + 0 : start + 4]) & 0xff
     if expected != buf[start + 4]:
         return None
-    m = _new(BeginAsyncRequest)
-    return m
+    return _new(BeginAsyncRequest, ())
 
 
 def _frame_end_async_request(buf: bytes, start: int) -> EndAsyncRequest | None:
@@ -1038,9 +625,7 @@ def _frame_end_async_request(buf: bytes, start: int) -> EndAsyncRequest | None:
     v_mode, check = _S_U8_U8.unpack_from(buf, start + 4)
     if (0x72 + v_mode) & 0xff != check:
         return None
-    m = _new(EndAsyncRequest)
-    _set_EndAsyncRequest_mode(m, _MEMBERS_AsyncEnd.get(v_mode, v_mode))
-    return m
+    return _new(EndAsyncRequest, (_MEMBERS_AsyncEnd.get(v_mode, v_mode),))
 
 
 def _frame_monitor_request(buf: bytes, start: int) -> MonitorRequest | None:
@@ -1048,9 +633,7 @@ def _frame_monitor_request(buf: bytes, start: int) -> MonitorRequest | None:
     v_servo_id, check = _S_U8_U8.unpack_from(buf, start + 4)
     if (0x75 + v_servo_id) & 0xff != check:
         return None
-    m = _new(MonitorRequest)
-    _set_MonitorRequest_servo_id(m, v_servo_id)
-    return m
+    return _new(MonitorRequest, (v_servo_id,))
 
 
 def _frame_stop_on_control_mode_request(buf: bytes, start: int) -> StopOnControlModeRequest | None:
@@ -1058,11 +641,7 @@ def _frame_stop_on_control_mode_request(buf: bytes, start: int) -> StopOnControl
     v_servo_id, v_method, v_power, check = _S_U8_U8_U16_U8.unpack_from(buf, start + 4)
     if (0x7a + v_servo_id + v_method + (v_power & 0xff) + (v_power >> 8 & 0xff)) & 0xff != check:
         return None
-    m = _new(StopOnControlModeRequest)
-    _set_StopOnControlModeRequest_servo_id(m, v_servo_id)
-    _set_StopOnControlModeRequest_method(m, _MEMBERS_StopMethod.get(v_method, v_method))
-    _set_StopOnControlModeRequest_power(m, v_power)
-    return m
+    return _new(StopOnControlModeRequest, (v_servo_id, _MEMBERS_StopMethod.get(v_method, v_method), v_power))
 
 
 def _frame_ping_response(buf: bytes, start: int) -> PingResponse | None:
@@ -1070,9 +649,7 @@ def _frame_ping_response(buf: bytes, start: int) -> PingResponse | None:
     v_servo_id, check = _S_U8_U8.unpack_from(buf, start + 4)
     if (0x23 + v_servo_id) & 0xff != check:
         return None
-    m = _new(PingResponse)
-    _set_PingResponse_servo_id(m, v_servo_id)
-    return m
+    return _new(PingResponse, (v_servo_id,))
 
 
 def _frame_reset_user_data_response(buf: bytes, start: int) -> ResetUserDataResponse | None:
@@ -1080,10 +657,7 @@ def _frame_reset_user_data_response(buf: bytes, start: int) -> ResetUserDataResp
     v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, start + 4)
     if (0x25 + v_servo_id + v_result) & 0xff != check:
         return None
-    m = _new(ResetUserDataResponse)
-    _set_ResetUserDataResponse_servo_id(m, v_servo_id)
-    _set_ResetUserDataResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
-    return m
+    return _new(ResetUserDataResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
 
 
 def _frame_write_data_response(buf: bytes, start: int) -> WriteDataResponse | None:
@@ -1091,11 +665,7 @@ def _frame_write_data_response(buf: bytes, start: int) -> WriteDataResponse | No
     v_servo_id, v_data_id, v_result, check = _S_U8_U8_U8_U8.unpack_from(buf, start + 4)
     if (0x28 + v_servo_id + v_data_id + v_result) & 0xff != check:
         return None
-    m = _new(WriteDataResponse)
-    _set_WriteDataResponse_servo_id(m, v_servo_id)
-    _set_WriteDataResponse_data_id(m, v_data_id)
-    _set_WriteDataResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
-    return m
+    return _new(WriteDataResponse, (v_servo_id, v_data_id, _MEMBERS_Result.get(v_result, v_result)))
 
 
 def _frame_read_batch_data_response(buf: bytes, start: int) -> ReadBatchDataResponse | None:
@@ -1105,33 +675,8 @@ def _frame_read_batch_data_response(buf: bytes, start: int) -> ReadBatchDataResp
         return None
     t = _S_READBATCHDATARESPONSE_SERVO_ID.unpack_from(buf, start + 4)
     v_servo_id = t[0]
-    v_user_data = _new(UserData)
-    _set_UserData_reserved_32(v_user_data, t[1])
-    _set_UserData_response_switch(v_user_data, _MEMBERS_ResponseSwitch.get(t[2], t[2]))
-    _set_UserData_servo_id(v_user_data, t[3])
-    _set_UserData_reserved_35(v_user_data, t[4])
-    _set_UserData_baudrate(v_user_data, _MEMBERS_BaudrateOption.get(t[5], t[5]))
-    _set_UserData_stall_protect_mode(v_user_data, _MEMBERS_StallProtectMode.get(t[6], t[6]))
-    _set_UserData_stall_power_limit(v_user_data, t[7])
-    _set_UserData_over_volt_low(v_user_data, t[8])
-    _set_UserData_over_volt_high(v_user_data, t[9])
-    _set_UserData_over_temperature(v_user_data, t[10])
-    _set_UserData_over_power(v_user_data, t[11])
-    _set_UserData_over_current(v_user_data, t[12])
-    _set_UserData_accel_switch(v_user_data, _MEMBERS_Switch.get(t[13], t[13]))
-    _set_UserData_reserved_45(v_user_data, t[14])
-    _set_UserData_po_lock_switch(v_user_data, _MEMBERS_LockOnPowerOn.get(t[15], t[15]))
-    _set_UserData_wb_lock_switch(v_user_data, _MEMBERS_WheelBrake.get(t[16], t[16]))
-    _set_UserData_angle_limit_switch(v_user_data, _MEMBERS_Switch.get(t[17], t[17]))
-    _set_UserData_soft_start_switch(v_user_data, _MEMBERS_Switch.get(t[18], t[18]))
-    _set_UserData_soft_start_time(v_user_data, t[19])
-    _set_UserData_angle_limit_high(v_user_data, t[20])
-    _set_UserData_angle_limit_low(v_user_data, t[21])
-    _set_UserData_angle_mid_offset(v_user_data, t[22])
-    m = _new(ReadBatchDataResponse)
-    _set_ReadBatchDataResponse_servo_id(m, v_servo_id)
-    _set_ReadBatchDataResponse_user_data(m, v_user_data)
-    return m
+    v_user_data = _new(UserData, (t[1], _MEMBERS_ResponseSwitch.get(t[2], t[2]), t[3], t[4], _MEMBERS_BaudrateOption.get(t[5], t[5]), _MEMBERS_StallProtectMode.get(t[6], t[6]), t[7], t[8], t[9], t[10], t[11], t[12], _MEMBERS_Switch.get(t[13], t[13]), t[14], _MEMBERS_LockOnPowerOn.get(t[15], t[15]), _MEMBERS_WheelBrake.get(t[16], t[16]), _MEMBERS_Switch.get(t[17], t[17]), _MEMBERS_Switch.get(t[18], t[18]), t[19], t[20], t[21], t[22]))
+    return _new(ReadBatchDataResponse, (v_servo_id, v_user_data))
 
 
 def _frame_write_batch_data_response(buf: bytes, start: int) -> WriteBatchDataResponse | None:
@@ -1139,10 +684,7 @@ def _frame_write_batch_data_response(buf: bytes, start: int) -> WriteBatchDataRe
     v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, start + 4)
     if (0x29 + v_servo_id + v_result) & 0xff != check:
         return None
-    m = _new(WriteBatchDataResponse)
-    _set_WriteBatchDataResponse_servo_id(m, v_servo_id)
-    _set_WriteBatchDataResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
-    return m
+    return _new(WriteBatchDataResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
 
 
 def _frame_spin_response(buf: bytes, start: int) -> SpinResponse | None:
@@ -1150,10 +692,7 @@ def _frame_spin_response(buf: bytes, start: int) -> SpinResponse | None:
     v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, start + 4)
     if (0x2a + v_servo_id + v_result) & 0xff != check:
         return None
-    m = _new(SpinResponse)
-    _set_SpinResponse_servo_id(m, v_servo_id)
-    _set_SpinResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
-    return m
+    return _new(SpinResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
 
 
 def _frame_rotate_response(buf: bytes, start: int) -> RotateResponse | None:
@@ -1161,10 +700,7 @@ def _frame_rotate_response(buf: bytes, start: int) -> RotateResponse | None:
     v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, start + 4)
     if (0x2b + v_servo_id + v_result) & 0xff != check:
         return None
-    m = _new(RotateResponse)
-    _set_RotateResponse_servo_id(m, v_servo_id)
-    _set_RotateResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
-    return m
+    return _new(RotateResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
 
 
 def _frame_damping_response(buf: bytes, start: int) -> DampingResponse | None:
@@ -1172,10 +708,7 @@ def _frame_damping_response(buf: bytes, start: int) -> DampingResponse | None:
     v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, start + 4)
     if (0x2c + v_servo_id + v_result) & 0xff != check:
         return None
-    m = _new(DampingResponse)
-    _set_DampingResponse_servo_id(m, v_servo_id)
-    _set_DampingResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
-    return m
+    return _new(DampingResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
 
 
 def _frame_read_angle_response(buf: bytes, start: int) -> ReadAngleResponse | None:
@@ -1183,10 +716,7 @@ def _frame_read_angle_response(buf: bytes, start: int) -> ReadAngleResponse | No
     v_servo_id, v_angle, check = _S_U8_I16_U8.unpack_from(buf, start + 4)
     if (0x2e + v_servo_id + (v_angle & 0xff) + (v_angle >> 8 & 0xff)) & 0xff != check:
         return None
-    m = _new(ReadAngleResponse)
-    _set_ReadAngleResponse_servo_id(m, v_servo_id)
-    _set_ReadAngleResponse_angle(m, v_angle)
-    return m
+    return _new(ReadAngleResponse, (v_servo_id, v_angle))
 
 
 def _frame_move_by_interval_response(buf: bytes, start: int) -> MoveByIntervalResponse | None:
@@ -1194,10 +724,7 @@ def _frame_move_by_interval_response(buf: bytes, start: int) -> MoveByIntervalRe
     v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, start + 4)
     if (0x2e + v_servo_id + v_result) & 0xff != check:
         return None
-    m = _new(MoveByIntervalResponse)
-    _set_MoveByIntervalResponse_servo_id(m, v_servo_id)
-    _set_MoveByIntervalResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
-    return m
+    return _new(MoveByIntervalResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
 
 
 def _frame_move_by_velocity_response(buf: bytes, start: int) -> MoveByVelocityResponse | None:
@@ -1205,10 +732,7 @@ def _frame_move_by_velocity_response(buf: bytes, start: int) -> MoveByVelocityRe
     v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, start + 4)
     if (0x2f + v_servo_id + v_result) & 0xff != check:
         return None
-    m = _new(MoveByVelocityResponse)
-    _set_MoveByVelocityResponse_servo_id(m, v_servo_id)
-    _set_MoveByVelocityResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
-    return m
+    return _new(MoveByVelocityResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
 
 
 def _frame_move_mturn_response(buf: bytes, start: int) -> MoveMturnResponse | None:
@@ -1216,10 +740,7 @@ def _frame_move_mturn_response(buf: bytes, start: int) -> MoveMturnResponse | No
     v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, start + 4)
     if (0x30 + v_servo_id + v_result) & 0xff != check:
         return None
-    m = _new(MoveMturnResponse)
-    _set_MoveMturnResponse_servo_id(m, v_servo_id)
-    _set_MoveMturnResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
-    return m
+    return _new(MoveMturnResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
 
 
 def _frame_move_mturn_by_interval_response(buf: bytes, start: int) -> MoveMturnByIntervalResponse | None:
@@ -1227,10 +748,7 @@ def _frame_move_mturn_by_interval_response(buf: bytes, start: int) -> MoveMturnB
     v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, start + 4)
     if (0x31 + v_servo_id + v_result) & 0xff != check:
         return None
-    m = _new(MoveMturnByIntervalResponse)
-    _set_MoveMturnByIntervalResponse_servo_id(m, v_servo_id)
-    _set_MoveMturnByIntervalResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
-    return m
+    return _new(MoveMturnByIntervalResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
 
 
 def _frame_move_mturn_by_velocity_response(buf: bytes, start: int) -> MoveMturnByVelocityResponse | None:
@@ -1238,10 +756,7 @@ def _frame_move_mturn_by_velocity_response(buf: bytes, start: int) -> MoveMturnB
     v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, start + 4)
     if (0x32 + v_servo_id + v_result) & 0xff != check:
         return None
-    m = _new(MoveMturnByVelocityResponse)
-    _set_MoveMturnByVelocityResponse_servo_id(m, v_servo_id)
-    _set_MoveMturnByVelocityResponse_result(m, _MEMBERS_Result.get(v_result, v_result))
-    return m
+    return _new(MoveMturnByVelocityResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
 
 
 def _frame_read_mturn_angle_response(buf: bytes, start: int) -> ReadMturnAngleResponse | None:
@@ -1249,12 +764,7 @@ def _frame_read_mturn_angle_response(buf: bytes, start: int) -> ReadMturnAngleRe
     expected = sum(buf[start + 0 : start + 11]) & 0xff
     if expected != buf[start + 11]:
         return None
-    v_servo_id, v_angle, v_turns = _S_U8_I32_I16.unpack_from(buf, start + 4)
-    m = _new(ReadMturnAngleResponse)
-    _set_ReadMturnAngleResponse_servo_id(m, v_servo_id)
-    _set_ReadMturnAngleResponse_angle(m, v_angle)
-    _set_ReadMturnAngleResponse_turns(m, v_turns)
-    return m
+    return _new(ReadMturnAngleResponse, _S_U8_I32_I16.unpack_from(buf, start + 4))
 
 
 def _frame_monitor_response(buf: bytes, start: int) -> MonitorResponse | None:
@@ -1266,452 +776,807 @@ def _frame_monitor_response(buf: bytes, start: int) -> MonitorResponse | None:
     v_status_flags = _MEMBERS_ServoStatus.get(v_status)
     if v_status_flags is None:
         v_status_flags = ServoStatus(v_status)
-    m = _new(MonitorResponse)
-    _set_MonitorResponse_servo_id(m, v_servo_id)
-    _set_MonitorResponse_voltage(m, v_voltage)
-    _set_MonitorResponse_current(m, v_current)
-    _set_MonitorResponse_power(m, v_power)
-    _set_MonitorResponse_temperature(m, v_temperature)
-    _set_MonitorResponse_status(m, v_status_flags)
-    _set_MonitorResponse_angle(m, v_angle)
-    _set_MonitorResponse_turns(m, v_turns)
-    return m
+    return _new(MonitorResponse, (v_servo_id, v_voltage, v_current, v_power, v_temperature, v_status_flags, v_angle, v_turns))
+
+
+def _whole_ping_request(buf: bytes) -> PingRequest | None:
+    """A whole ping request frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, check = _S_U8_U8.unpack_from(buf, 4)
+    if (0x60 + v_servo_id) & 0xff != check:
+        return None
+    return _new(PingRequest, (v_servo_id,))
+
+
+def _whole_reset_user_data_request(buf: bytes) -> ResetUserDataRequest | None:
+    """A whole reset_user_data request frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, check = _S_U8_U8.unpack_from(buf, 4)
+    if (0x61 + v_servo_id) & 0xff != check:
+        return None
+    return _new(ResetUserDataRequest, (v_servo_id,))
+
+
+def _whole_read_data_request(buf: bytes) -> ReadDataRequest | None:
+    """A whole read_data request frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, v_data_id, check = _S_U8_U8_U8.unpack_from(buf, 4)
+    if (0x63 + v_servo_id + v_data_id) & 0xff != check:
+        return None
+    return _new(ReadDataRequest, (v_servo_id, v_data_id))
+
+
+def _whole_read_batch_data_request(buf: bytes) -> ReadBatchDataRequest | None:
+    """A whole read_batch_data request frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, check = _S_U8_U8.unpack_from(buf, 4)
+    if (0x64 + v_servo_id) & 0xff != check:
+        return None
+    return _new(ReadBatchDataRequest, (v_servo_id,))
+
+
+def _whole_write_batch_data_request(buf: bytes) -> WriteBatchDataRequest | None:
+    """A whole write_batch_data request frame, all of buf, size and header known: None if its checksum fails."""
+    if (sum(buf) - 2 * buf[37]) & 0xff:
+        return None
+    t = _S_READBATCHDATARESPONSE_SERVO_ID.unpack_from(buf, 4)
+    v_servo_id = t[0]
+    v_user_data = _new(UserData, (t[1], _MEMBERS_ResponseSwitch.get(t[2], t[2]), t[3], t[4], _MEMBERS_BaudrateOption.get(t[5], t[5]), _MEMBERS_StallProtectMode.get(t[6], t[6]), t[7], t[8], t[9], t[10], t[11], t[12], _MEMBERS_Switch.get(t[13], t[13]), t[14], _MEMBERS_LockOnPowerOn.get(t[15], t[15]), _MEMBERS_WheelBrake.get(t[16], t[16]), _MEMBERS_Switch.get(t[17], t[17]), _MEMBERS_Switch.get(t[18], t[18]), t[19], t[20], t[21], t[22]))
+    return _new(WriteBatchDataRequest, (v_servo_id, v_user_data))
+
+
+def _whole_rotate_request(buf: bytes) -> RotateRequest | None:
+    """A whole rotate request frame, all of buf, size and header known: None if its checksum fails."""
+    if (sum(buf) - 2 * buf[11]) & 0xff:
+        return None
+    return _new(RotateRequest, _S_U8_I16_U16_U16.unpack_from(buf, 4))
+
+
+def _whole_damping_request(buf: bytes) -> DampingRequest | None:
+    """A whole damping request frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, v_power, check = _S_U8_U16_U8.unpack_from(buf, 4)
+    if (0x6a + v_servo_id + (v_power & 0xff) + (v_power >> 8 & 0xff)) & 0xff != check:
+        return None
+    return _new(DampingRequest, (v_servo_id, v_power))
+
+
+def _whole_read_angle_request(buf: bytes) -> ReadAngleRequest | None:
+    """A whole read_angle request frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, check = _S_U8_U8.unpack_from(buf, 4)
+    if (0x69 + v_servo_id) & 0xff != check:
+        return None
+    return _new(ReadAngleRequest, (v_servo_id,))
+
+
+def _whole_move_by_interval_request(buf: bytes) -> MoveByIntervalRequest | None:
+    """A whole move_by_interval request frame, all of buf, size and header known: None if its checksum fails."""
+    if (sum(buf) - 2 * buf[15]) & 0xff:
+        return None
+    return _new(MoveByIntervalRequest, _S_U8_I16_U16_U16_U16_U16.unpack_from(buf, 4))
+
+
+def _whole_move_by_velocity_request(buf: bytes) -> MoveByVelocityRequest | None:
+    """A whole move_by_velocity request frame, all of buf, size and header known: None if its checksum fails."""
+    if (sum(buf) - 2 * buf[15]) & 0xff:
+        return None
+    return _new(MoveByVelocityRequest, _S_U8_I16_U16_U16_U16_U16.unpack_from(buf, 4))
+
+
+def _whole_move_mturn_request(buf: bytes) -> MoveMturnRequest | None:
+    """A whole move_mturn request frame, all of buf, size and header known: None if its checksum fails."""
+    if (sum(buf) - 2 * buf[15]) & 0xff:
+        return None
+    return _new(MoveMturnRequest, _S_U8_I32_U32_U16.unpack_from(buf, 4))
+
+
+def _whole_move_mturn_by_interval_request(buf: bytes) -> MoveMturnByIntervalRequest | None:
+    """A whole move_mturn_by_interval request frame, all of buf, size and header known: None if its checksum fails."""
+    if (sum(buf) - 2 * buf[19]) & 0xff:
+        return None
+    return _new(MoveMturnByIntervalRequest, _S_U8_I32_U32_U16_U16_U16.unpack_from(buf, 4))
+
+
+def _whole_move_mturn_by_velocity_request(buf: bytes) -> MoveMturnByVelocityRequest | None:
+    """A whole move_mturn_by_velocity request frame, all of buf, size and header known: None if its checksum fails."""
+    if (sum(buf) - 2 * buf[17]) & 0xff:
+        return None
+    return _new(MoveMturnByVelocityRequest, _S_U8_I32_U16_U16_U16_U16.unpack_from(buf, 4))
+
+
+def _whole_read_mturn_angle_request(buf: bytes) -> ReadMturnAngleRequest | None:
+    """A whole read_mturn_angle request frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, check = _S_U8_U8.unpack_from(buf, 4)
+    if (0x6f + v_servo_id) & 0xff != check:
+        return None
+    return _new(ReadMturnAngleRequest, (v_servo_id,))
+
+
+def _whole_reset_mturn_angle_request(buf: bytes) -> ResetMturnAngleRequest | None:
+    """A whole reset_mturn_angle request frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, check = _S_U8_U8.unpack_from(buf, 4)
+    if (0x70 + v_servo_id) & 0xff != check:
+        return None
+    return _new(ResetMturnAngleRequest, (v_servo_id,))
+
+
+def _whole_begin_async_request(buf: bytes) -> BeginAsyncRequest | None:
+    """A whole begin_async request frame, all of buf, size and header known: None if its checksum fails."""
+    if (sum(buf) - 2 * buf[4]) & 0xff:
+        return None
+    return _new(BeginAsyncRequest, ())
+
+
+def _whole_end_async_request(buf: bytes) -> EndAsyncRequest | None:
+    """A whole end_async request frame, all of buf, size and header known: None if its checksum fails."""
+    v_mode, check = _S_U8_U8.unpack_from(buf, 4)
+    if (0x72 + v_mode) & 0xff != check:
+        return None
+    return _new(EndAsyncRequest, (_MEMBERS_AsyncEnd.get(v_mode, v_mode),))
+
+
+def _whole_monitor_request(buf: bytes) -> MonitorRequest | None:
+    """A whole monitor request frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, check = _S_U8_U8.unpack_from(buf, 4)
+    if (0x75 + v_servo_id) & 0xff != check:
+        return None
+    return _new(MonitorRequest, (v_servo_id,))
+
+
+def _whole_stop_on_control_mode_request(buf: bytes) -> StopOnControlModeRequest | None:
+    """A whole stop_on_control_mode request frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, v_method, v_power, check = _S_U8_U8_U16_U8.unpack_from(buf, 4)
+    if (0x7a + v_servo_id + v_method + (v_power & 0xff) + (v_power >> 8 & 0xff)) & 0xff != check:
+        return None
+    return _new(StopOnControlModeRequest, (v_servo_id, _MEMBERS_StopMethod.get(v_method, v_method), v_power))
+
+
+def _whole_ping_response(buf: bytes) -> PingResponse | None:
+    """A whole ping response frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, check = _S_U8_U8.unpack_from(buf, 4)
+    if (0x23 + v_servo_id) & 0xff != check:
+        return None
+    return _new(PingResponse, (v_servo_id,))
+
+
+def _whole_reset_user_data_response(buf: bytes) -> ResetUserDataResponse | None:
+    """A whole reset_user_data response frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, 4)
+    if (0x25 + v_servo_id + v_result) & 0xff != check:
+        return None
+    return _new(ResetUserDataResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
+
+
+def _whole_write_data_response(buf: bytes) -> WriteDataResponse | None:
+    """A whole write_data response frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, v_data_id, v_result, check = _S_U8_U8_U8_U8.unpack_from(buf, 4)
+    if (0x28 + v_servo_id + v_data_id + v_result) & 0xff != check:
+        return None
+    return _new(WriteDataResponse, (v_servo_id, v_data_id, _MEMBERS_Result.get(v_result, v_result)))
+
+
+def _whole_read_batch_data_response(buf: bytes) -> ReadBatchDataResponse | None:
+    """A whole read_batch_data response frame, all of buf, size and header known: None if its checksum fails."""
+    if (sum(buf) - 2 * buf[37]) & 0xff:
+        return None
+    t = _S_READBATCHDATARESPONSE_SERVO_ID.unpack_from(buf, 4)
+    v_servo_id = t[0]
+    v_user_data = _new(UserData, (t[1], _MEMBERS_ResponseSwitch.get(t[2], t[2]), t[3], t[4], _MEMBERS_BaudrateOption.get(t[5], t[5]), _MEMBERS_StallProtectMode.get(t[6], t[6]), t[7], t[8], t[9], t[10], t[11], t[12], _MEMBERS_Switch.get(t[13], t[13]), t[14], _MEMBERS_LockOnPowerOn.get(t[15], t[15]), _MEMBERS_WheelBrake.get(t[16], t[16]), _MEMBERS_Switch.get(t[17], t[17]), _MEMBERS_Switch.get(t[18], t[18]), t[19], t[20], t[21], t[22]))
+    return _new(ReadBatchDataResponse, (v_servo_id, v_user_data))
+
+
+def _whole_write_batch_data_response(buf: bytes) -> WriteBatchDataResponse | None:
+    """A whole write_batch_data response frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, 4)
+    if (0x29 + v_servo_id + v_result) & 0xff != check:
+        return None
+    return _new(WriteBatchDataResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
+
+
+def _whole_spin_response(buf: bytes) -> SpinResponse | None:
+    """A whole spin response frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, 4)
+    if (0x2a + v_servo_id + v_result) & 0xff != check:
+        return None
+    return _new(SpinResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
+
+
+def _whole_rotate_response(buf: bytes) -> RotateResponse | None:
+    """A whole rotate response frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, 4)
+    if (0x2b + v_servo_id + v_result) & 0xff != check:
+        return None
+    return _new(RotateResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
+
+
+def _whole_damping_response(buf: bytes) -> DampingResponse | None:
+    """A whole damping response frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, 4)
+    if (0x2c + v_servo_id + v_result) & 0xff != check:
+        return None
+    return _new(DampingResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
+
+
+def _whole_read_angle_response(buf: bytes) -> ReadAngleResponse | None:
+    """A whole read_angle response frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, v_angle, check = _S_U8_I16_U8.unpack_from(buf, 4)
+    if (0x2e + v_servo_id + (v_angle & 0xff) + (v_angle >> 8 & 0xff)) & 0xff != check:
+        return None
+    return _new(ReadAngleResponse, (v_servo_id, v_angle))
+
+
+def _whole_move_by_interval_response(buf: bytes) -> MoveByIntervalResponse | None:
+    """A whole move_by_interval response frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, 4)
+    if (0x2e + v_servo_id + v_result) & 0xff != check:
+        return None
+    return _new(MoveByIntervalResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
+
+
+def _whole_move_by_velocity_response(buf: bytes) -> MoveByVelocityResponse | None:
+    """A whole move_by_velocity response frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, 4)
+    if (0x2f + v_servo_id + v_result) & 0xff != check:
+        return None
+    return _new(MoveByVelocityResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
+
+
+def _whole_move_mturn_response(buf: bytes) -> MoveMturnResponse | None:
+    """A whole move_mturn response frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, 4)
+    if (0x30 + v_servo_id + v_result) & 0xff != check:
+        return None
+    return _new(MoveMturnResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
+
+
+def _whole_move_mturn_by_interval_response(buf: bytes) -> MoveMturnByIntervalResponse | None:
+    """A whole move_mturn_by_interval response frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, 4)
+    if (0x31 + v_servo_id + v_result) & 0xff != check:
+        return None
+    return _new(MoveMturnByIntervalResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
+
+
+def _whole_move_mturn_by_velocity_response(buf: bytes) -> MoveMturnByVelocityResponse | None:
+    """A whole move_mturn_by_velocity response frame, all of buf, size and header known: None if its checksum fails."""
+    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, 4)
+    if (0x32 + v_servo_id + v_result) & 0xff != check:
+        return None
+    return _new(MoveMturnByVelocityResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
+
+
+def _whole_read_mturn_angle_response(buf: bytes) -> ReadMturnAngleResponse | None:
+    """A whole read_mturn_angle response frame, all of buf, size and header known: None if its checksum fails."""
+    if (sum(buf) - 2 * buf[11]) & 0xff:
+        return None
+    return _new(ReadMturnAngleResponse, _S_U8_I32_I16.unpack_from(buf, 4))
+
+
+def _whole_monitor_response(buf: bytes) -> MonitorResponse | None:
+    """A whole monitor response frame, all of buf, size and header known: None if its checksum fails."""
+    if (sum(buf) - 2 * buf[20]) & 0xff:
+        return None
+    v_servo_id, v_voltage, v_current, v_power, v_temperature, v_status, v_angle, v_turns = _S_MONITORRESPONSE_SERVO_ID.unpack_from(buf, 4)
+    v_status_flags = _MEMBERS_ServoStatus.get(v_status)
+    if v_status_flags is None:
+        v_status_flags = ServoStatus(v_status)
+    return _new(MonitorResponse, (v_servo_id, v_voltage, v_current, v_power, v_temperature, v_status_flags, v_angle, v_turns))
 
 
 def _encode_ping_request(m: PingRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
-        raise out_of_range('ping request', 'servo_id', m.servo_id, 0, 254)
-    body = _S_B2_U8_U8_U8.pack(b'\x12L', 1, 1, m.servo_id)
+    m_servo_id = m.servo_id
+    if not 0 <= m_servo_id <= 254 or m_servo_id.__class__ is bool:
+        raise out_of_range('ping request', 'servo_id', m_servo_id, 0, 254)
+    body = _S_B2_U8_U8_U8.pack(b'\x12L', 1, 1, m_servo_id)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_ping_response(m: PingResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
-        raise out_of_range('ping response', 'servo_id', m.servo_id, 0, 254)
-    body = _S_B2_U8_U8_U8.pack(b'\x05\x1c', 1, 1, m.servo_id)
+    m_servo_id = m.servo_id
+    if not 0 <= m_servo_id <= 254 or m_servo_id.__class__ is bool:
+        raise out_of_range('ping response', 'servo_id', m_servo_id, 0, 254)
+    body = _S_B2_U8_U8_U8.pack(b'\x05\x1c', 1, 1, m_servo_id)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_reset_user_data_request(m: ResetUserDataRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
-        raise out_of_range('reset_user_data request', 'servo_id', m.servo_id, 0, 254)
-    body = _S_B2_U8_U8_U8.pack(b'\x12L', 2, 1, m.servo_id)
+    m_servo_id = m.servo_id
+    if not 0 <= m_servo_id <= 254 or m_servo_id.__class__ is bool:
+        raise out_of_range('reset_user_data request', 'servo_id', m_servo_id, 0, 254)
+    body = _S_B2_U8_U8_U8.pack(b'\x12L', 2, 1, m_servo_id)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_reset_user_data_response(m: ResetUserDataResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
-        raise out_of_range('reset_user_data response', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.result <= 1 or m.result.__class__ is bool:
-        raise out_of_range('reset_user_data response', 'result', m.result, 0, 1)
-    body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 2, 2, m.servo_id, m.result)
+    m_servo_id = m.servo_id
+    m_result = m.result
+    if not 0 <= m_servo_id <= 254 or m_servo_id.__class__ is bool:
+        raise out_of_range('reset_user_data response', 'servo_id', m_servo_id, 0, 254)
+    if not 0 <= m_result <= 1 or m_result.__class__ is bool:
+        raise out_of_range('reset_user_data response', 'result', m_result, 0, 1)
+    body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 2, 2, m_servo_id, m_result)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_read_data_request(m: ReadDataRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
-        raise out_of_range('read_data request', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.data_id <= 255 or m.data_id.__class__ is bool:
-        raise out_of_range('read_data request', 'data_id', m.data_id, 0, 255)
-    body = _S_B2_U8_U8_U8_U8.pack(b'\x12L', 3, 2, m.servo_id, m.data_id)
+    m_servo_id = m.servo_id
+    m_data_id = m.data_id
+    if not 0 <= m_servo_id <= 254 or m_servo_id.__class__ is bool:
+        raise out_of_range('read_data request', 'servo_id', m_servo_id, 0, 254)
+    if not 0 <= m_data_id <= 255 or m_data_id.__class__ is bool:
+        raise out_of_range('read_data request', 'data_id', m_data_id, 0, 255)
+    body = _S_B2_U8_U8_U8_U8.pack(b'\x12L', 3, 2, m_servo_id, m_data_id)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_read_data_response(m: ReadDataResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
-        raise out_of_range('read_data response', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.data_id <= 255 or m.data_id.__class__ is bool:
-        raise out_of_range('read_data response', 'data_id', m.data_id, 0, 255)
-    s = _TABLE_PARAMETERS.get(m.data_id)
+    m_servo_id = m.servo_id
+    m_data_id = m.data_id
+    m_data = m.data
+    if not 0 <= m_servo_id <= 254 or m_servo_id.__class__ is bool:
+        raise out_of_range('read_data response', 'servo_id', m_servo_id, 0, 254)
+    if not 0 <= m_data_id <= 255 or m_data_id.__class__ is bool:
+        raise out_of_range('read_data response', 'data_id', m_data_id, 0, 255)
+    s = _TABLE_PARAMETERS.get(m_data_id)
     if s is None:
-        raise EncodeError('read_data response' + f': unknown data_id {m.data_id}')
-    low, high = _TABLE_PARAMETERS_RANGES[m.data_id]
-    if not low <= m.data <= high:
-        raise out_of_range('read_data response', 'data', m.data, low, high)
-    content = s.pack(m.data)
+        raise EncodeError('read_data response' + f': unknown data_id {m_data_id}')
+    low, high = _TABLE_PARAMETERS_RANGES[m_data_id]
+    if not low <= m_data <= high:
+        raise out_of_range('read_data response', 'data', m_data, low, high)
+    content = s.pack(m_data)
     n = len(content) + 2
     if n > 255:
         raise EncodeError(f'content of {n} bytes does not fit the length field')
-    body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 3, n, m.servo_id, m.data_id) + content
+    body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 3, n, m_servo_id, m_data_id) + content
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_write_data_request(m: WriteDataRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
-        raise out_of_range('write_data request', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.data_id <= 255 or m.data_id.__class__ is bool:
-        raise out_of_range('write_data request', 'data_id', m.data_id, 0, 255)
-    s = _TABLE_PARAMETERS.get(m.data_id)
+    m_servo_id = m.servo_id
+    m_data_id = m.data_id
+    m_data = m.data
+    if not 0 <= m_servo_id <= 254 or m_servo_id.__class__ is bool:
+        raise out_of_range('write_data request', 'servo_id', m_servo_id, 0, 254)
+    if not 0 <= m_data_id <= 255 or m_data_id.__class__ is bool:
+        raise out_of_range('write_data request', 'data_id', m_data_id, 0, 255)
+    s = _TABLE_PARAMETERS.get(m_data_id)
     if s is None:
-        raise EncodeError('write_data request' + f': unknown data_id {m.data_id}')
-    low, high = _TABLE_PARAMETERS_RANGES[m.data_id]
-    if not low <= m.data <= high:
-        raise out_of_range('write_data request', 'data', m.data, low, high)
-    content = s.pack(m.data)
+        raise EncodeError('write_data request' + f': unknown data_id {m_data_id}')
+    low, high = _TABLE_PARAMETERS_RANGES[m_data_id]
+    if not low <= m_data <= high:
+        raise out_of_range('write_data request', 'data', m_data, low, high)
+    content = s.pack(m_data)
     n = len(content) + 2
     if n > 255:
         raise EncodeError(f'content of {n} bytes does not fit the length field')
-    body = _S_B2_U8_U8_U8_U8.pack(b'\x12L', 4, n, m.servo_id, m.data_id) + content
+    body = _S_B2_U8_U8_U8_U8.pack(b'\x12L', 4, n, m_servo_id, m_data_id) + content
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_write_data_response(m: WriteDataResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
-        raise out_of_range('write_data response', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.data_id <= 255 or m.data_id.__class__ is bool:
-        raise out_of_range('write_data response', 'data_id', m.data_id, 0, 255)
-    if not 0 <= m.result <= 1 or m.result.__class__ is bool:
-        raise out_of_range('write_data response', 'result', m.result, 0, 1)
-    body = _S_B2_U8_U8_U8_U8_U8.pack(b'\x05\x1c', 4, 3, m.servo_id, m.data_id, m.result)
+    m_servo_id = m.servo_id
+    m_data_id = m.data_id
+    m_result = m.result
+    if not 0 <= m_servo_id <= 254 or m_servo_id.__class__ is bool:
+        raise out_of_range('write_data response', 'servo_id', m_servo_id, 0, 254)
+    if not 0 <= m_data_id <= 255 or m_data_id.__class__ is bool:
+        raise out_of_range('write_data response', 'data_id', m_data_id, 0, 255)
+    if not 0 <= m_result <= 1 or m_result.__class__ is bool:
+        raise out_of_range('write_data response', 'result', m_result, 0, 1)
+    body = _S_B2_U8_U8_U8_U8_U8.pack(b'\x05\x1c', 4, 3, m_servo_id, m_data_id, m_result)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_read_batch_data_request(m: ReadBatchDataRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
-        raise out_of_range('read_batch_data request', 'servo_id', m.servo_id, 0, 254)
-    body = _S_B2_U8_U8_U8.pack(b'\x12L', 5, 1, m.servo_id)
+    m_servo_id = m.servo_id
+    if not 0 <= m_servo_id <= 254 or m_servo_id.__class__ is bool:
+        raise out_of_range('read_batch_data request', 'servo_id', m_servo_id, 0, 254)
+    body = _S_B2_U8_U8_U8.pack(b'\x12L', 5, 1, m_servo_id)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_read_batch_data_response(m: ReadBatchDataResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
-        raise out_of_range('read_batch_data response', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.user_data.reserved_32 <= 255:
-        raise out_of_range('read_batch_data response', 'user_data.reserved_32', m.user_data.reserved_32, 0, 255)
-    if not 0 <= m.user_data.response_switch <= 1:
-        raise out_of_range('read_batch_data response', 'user_data.response_switch', m.user_data.response_switch, 0, 1)
-    if not 0 <= m.user_data.servo_id <= 254:
-        raise out_of_range('read_batch_data response', 'user_data.servo_id', m.user_data.servo_id, 0, 254)
-    if not 0 <= m.user_data.reserved_35 <= 255:
-        raise out_of_range('read_batch_data response', 'user_data.reserved_35', m.user_data.reserved_35, 0, 255)
-    if not 1 <= m.user_data.baudrate <= 7:
-        raise out_of_range('read_batch_data response', 'user_data.baudrate', m.user_data.baudrate, 1, 7)
-    if not 1 <= m.user_data.stall_protect_mode <= 2:
-        raise out_of_range('read_batch_data response', 'user_data.stall_protect_mode', m.user_data.stall_protect_mode, 1, 2)
-    if not 0 <= m.user_data.stall_power_limit <= 65535:
-        raise out_of_range('read_batch_data response', 'user_data.stall_power_limit', m.user_data.stall_power_limit, 0, 65535)
-    if not 0 <= m.user_data.over_volt_low <= 65535:
-        raise out_of_range('read_batch_data response', 'user_data.over_volt_low', m.user_data.over_volt_low, 0, 65535)
-    if not 0 <= m.user_data.over_volt_high <= 65535:
-        raise out_of_range('read_batch_data response', 'user_data.over_volt_high', m.user_data.over_volt_high, 0, 65535)
-    if not 0 <= m.user_data.over_temperature <= 65535:
-        raise out_of_range('read_batch_data response', 'user_data.over_temperature', m.user_data.over_temperature, 0, 65535)
-    if not 0 <= m.user_data.over_power <= 65535:
-        raise out_of_range('read_batch_data response', 'user_data.over_power', m.user_data.over_power, 0, 65535)
-    if not 0 <= m.user_data.over_current <= 65535:
-        raise out_of_range('read_batch_data response', 'user_data.over_current', m.user_data.over_current, 0, 65535)
-    if not 0 <= m.user_data.accel_switch <= 1:
-        raise out_of_range('read_batch_data response', 'user_data.accel_switch', m.user_data.accel_switch, 0, 1)
-    if not 0 <= m.user_data.reserved_45 <= 255:
-        raise out_of_range('read_batch_data response', 'user_data.reserved_45', m.user_data.reserved_45, 0, 255)
-    if not 0 <= m.user_data.po_lock_switch <= 1:
-        raise out_of_range('read_batch_data response', 'user_data.po_lock_switch', m.user_data.po_lock_switch, 0, 1)
-    if not 0 <= m.user_data.wb_lock_switch <= 1:
-        raise out_of_range('read_batch_data response', 'user_data.wb_lock_switch', m.user_data.wb_lock_switch, 0, 1)
-    if not 0 <= m.user_data.angle_limit_switch <= 1:
-        raise out_of_range('read_batch_data response', 'user_data.angle_limit_switch', m.user_data.angle_limit_switch, 0, 1)
-    if not 0 <= m.user_data.soft_start_switch <= 1:
-        raise out_of_range('read_batch_data response', 'user_data.soft_start_switch', m.user_data.soft_start_switch, 0, 1)
-    if not 0 <= m.user_data.soft_start_time <= 65535:
-        raise out_of_range('read_batch_data response', 'user_data.soft_start_time', m.user_data.soft_start_time, 0, 65535)
-    if not -32768 <= m.user_data.angle_limit_high <= 32767:
-        raise out_of_range('read_batch_data response', 'user_data.angle_limit_high', m.user_data.angle_limit_high, -32768, 32767)
-    if not -32768 <= m.user_data.angle_limit_low <= 32767:
-        raise out_of_range('read_batch_data response', 'user_data.angle_limit_low', m.user_data.angle_limit_low, -32768, 32767)
-    if not -32768 <= m.user_data.angle_mid_offset <= 32767:
-        raise out_of_range('read_batch_data response', 'user_data.angle_mid_offset', m.user_data.angle_mid_offset, -32768, 32767)
-    body = _S_FRAME_READBATCHDATARESPONSE.pack(b'\x05\x1c', 5, 33, m.servo_id, m.user_data.reserved_32, m.user_data.response_switch, m.user_data.servo_id, m.user_data.reserved_35, m.user_data.baudrate, m.user_data.stall_protect_mode, m.user_data.stall_power_limit, m.user_data.over_volt_low, m.user_data.over_volt_high, m.user_data.over_temperature, m.user_data.over_power, m.user_data.over_current, m.user_data.accel_switch, m.user_data.reserved_45, m.user_data.po_lock_switch, m.user_data.wb_lock_switch, m.user_data.angle_limit_switch, m.user_data.soft_start_switch, m.user_data.soft_start_time, m.user_data.angle_limit_high, m.user_data.angle_limit_low, m.user_data.angle_mid_offset)
+    m_servo_id = m.servo_id
+    m_user_data = m.user_data
+    if not 0 <= m_servo_id <= 254 or m_servo_id.__class__ is bool:
+        raise out_of_range('read_batch_data response', 'servo_id', m_servo_id, 0, 254)
+    if not 0 <= m_user_data.reserved_32 <= 255:
+        raise out_of_range('read_batch_data response', 'user_data.reserved_32', m_user_data.reserved_32, 0, 255)
+    if not 0 <= m_user_data.response_switch <= 1:
+        raise out_of_range('read_batch_data response', 'user_data.response_switch', m_user_data.response_switch, 0, 1)
+    if not 0 <= m_user_data.servo_id <= 254:
+        raise out_of_range('read_batch_data response', 'user_data.servo_id', m_user_data.servo_id, 0, 254)
+    if not 0 <= m_user_data.reserved_35 <= 255:
+        raise out_of_range('read_batch_data response', 'user_data.reserved_35', m_user_data.reserved_35, 0, 255)
+    if not 1 <= m_user_data.baudrate <= 7:
+        raise out_of_range('read_batch_data response', 'user_data.baudrate', m_user_data.baudrate, 1, 7)
+    if not 1 <= m_user_data.stall_protect_mode <= 2:
+        raise out_of_range('read_batch_data response', 'user_data.stall_protect_mode', m_user_data.stall_protect_mode, 1, 2)
+    if not 0 <= m_user_data.stall_power_limit <= 65535:
+        raise out_of_range('read_batch_data response', 'user_data.stall_power_limit', m_user_data.stall_power_limit, 0, 65535)
+    if not 0 <= m_user_data.over_volt_low <= 65535:
+        raise out_of_range('read_batch_data response', 'user_data.over_volt_low', m_user_data.over_volt_low, 0, 65535)
+    if not 0 <= m_user_data.over_volt_high <= 65535:
+        raise out_of_range('read_batch_data response', 'user_data.over_volt_high', m_user_data.over_volt_high, 0, 65535)
+    if not 0 <= m_user_data.over_temperature <= 65535:
+        raise out_of_range('read_batch_data response', 'user_data.over_temperature', m_user_data.over_temperature, 0, 65535)
+    if not 0 <= m_user_data.over_power <= 65535:
+        raise out_of_range('read_batch_data response', 'user_data.over_power', m_user_data.over_power, 0, 65535)
+    if not 0 <= m_user_data.over_current <= 65535:
+        raise out_of_range('read_batch_data response', 'user_data.over_current', m_user_data.over_current, 0, 65535)
+    if not 0 <= m_user_data.accel_switch <= 1:
+        raise out_of_range('read_batch_data response', 'user_data.accel_switch', m_user_data.accel_switch, 0, 1)
+    if not 0 <= m_user_data.reserved_45 <= 255:
+        raise out_of_range('read_batch_data response', 'user_data.reserved_45', m_user_data.reserved_45, 0, 255)
+    if not 0 <= m_user_data.po_lock_switch <= 1:
+        raise out_of_range('read_batch_data response', 'user_data.po_lock_switch', m_user_data.po_lock_switch, 0, 1)
+    if not 0 <= m_user_data.wb_lock_switch <= 1:
+        raise out_of_range('read_batch_data response', 'user_data.wb_lock_switch', m_user_data.wb_lock_switch, 0, 1)
+    if not 0 <= m_user_data.angle_limit_switch <= 1:
+        raise out_of_range('read_batch_data response', 'user_data.angle_limit_switch', m_user_data.angle_limit_switch, 0, 1)
+    if not 0 <= m_user_data.soft_start_switch <= 1:
+        raise out_of_range('read_batch_data response', 'user_data.soft_start_switch', m_user_data.soft_start_switch, 0, 1)
+    if not 0 <= m_user_data.soft_start_time <= 65535:
+        raise out_of_range('read_batch_data response', 'user_data.soft_start_time', m_user_data.soft_start_time, 0, 65535)
+    if not -32768 <= m_user_data.angle_limit_high <= 32767:
+        raise out_of_range('read_batch_data response', 'user_data.angle_limit_high', m_user_data.angle_limit_high, -32768, 32767)
+    if not -32768 <= m_user_data.angle_limit_low <= 32767:
+        raise out_of_range('read_batch_data response', 'user_data.angle_limit_low', m_user_data.angle_limit_low, -32768, 32767)
+    if not -32768 <= m_user_data.angle_mid_offset <= 32767:
+        raise out_of_range('read_batch_data response', 'user_data.angle_mid_offset', m_user_data.angle_mid_offset, -32768, 32767)
+    body = _S_FRAME_READBATCHDATARESPONSE.pack(b'\x05\x1c', 5, 33, m_servo_id, m_user_data.reserved_32, m_user_data.response_switch, m_user_data.servo_id, m_user_data.reserved_35, m_user_data.baudrate, m_user_data.stall_protect_mode, m_user_data.stall_power_limit, m_user_data.over_volt_low, m_user_data.over_volt_high, m_user_data.over_temperature, m_user_data.over_power, m_user_data.over_current, m_user_data.accel_switch, m_user_data.reserved_45, m_user_data.po_lock_switch, m_user_data.wb_lock_switch, m_user_data.angle_limit_switch, m_user_data.soft_start_switch, m_user_data.soft_start_time, m_user_data.angle_limit_high, m_user_data.angle_limit_low, m_user_data.angle_mid_offset)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_write_batch_data_request(m: WriteBatchDataRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
-        raise out_of_range('write_batch_data request', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.user_data.reserved_32 <= 255:
-        raise out_of_range('write_batch_data request', 'user_data.reserved_32', m.user_data.reserved_32, 0, 255)
-    if not 0 <= m.user_data.response_switch <= 1:
-        raise out_of_range('write_batch_data request', 'user_data.response_switch', m.user_data.response_switch, 0, 1)
-    if not 0 <= m.user_data.servo_id <= 254:
-        raise out_of_range('write_batch_data request', 'user_data.servo_id', m.user_data.servo_id, 0, 254)
-    if not 0 <= m.user_data.reserved_35 <= 255:
-        raise out_of_range('write_batch_data request', 'user_data.reserved_35', m.user_data.reserved_35, 0, 255)
-    if not 1 <= m.user_data.baudrate <= 7:
-        raise out_of_range('write_batch_data request', 'user_data.baudrate', m.user_data.baudrate, 1, 7)
-    if not 1 <= m.user_data.stall_protect_mode <= 2:
-        raise out_of_range('write_batch_data request', 'user_data.stall_protect_mode', m.user_data.stall_protect_mode, 1, 2)
-    if not 0 <= m.user_data.stall_power_limit <= 65535:
-        raise out_of_range('write_batch_data request', 'user_data.stall_power_limit', m.user_data.stall_power_limit, 0, 65535)
-    if not 0 <= m.user_data.over_volt_low <= 65535:
-        raise out_of_range('write_batch_data request', 'user_data.over_volt_low', m.user_data.over_volt_low, 0, 65535)
-    if not 0 <= m.user_data.over_volt_high <= 65535:
-        raise out_of_range('write_batch_data request', 'user_data.over_volt_high', m.user_data.over_volt_high, 0, 65535)
-    if not 0 <= m.user_data.over_temperature <= 65535:
-        raise out_of_range('write_batch_data request', 'user_data.over_temperature', m.user_data.over_temperature, 0, 65535)
-    if not 0 <= m.user_data.over_power <= 65535:
-        raise out_of_range('write_batch_data request', 'user_data.over_power', m.user_data.over_power, 0, 65535)
-    if not 0 <= m.user_data.over_current <= 65535:
-        raise out_of_range('write_batch_data request', 'user_data.over_current', m.user_data.over_current, 0, 65535)
-    if not 0 <= m.user_data.accel_switch <= 1:
-        raise out_of_range('write_batch_data request', 'user_data.accel_switch', m.user_data.accel_switch, 0, 1)
-    if not 0 <= m.user_data.reserved_45 <= 255:
-        raise out_of_range('write_batch_data request', 'user_data.reserved_45', m.user_data.reserved_45, 0, 255)
-    if not 0 <= m.user_data.po_lock_switch <= 1:
-        raise out_of_range('write_batch_data request', 'user_data.po_lock_switch', m.user_data.po_lock_switch, 0, 1)
-    if not 0 <= m.user_data.wb_lock_switch <= 1:
-        raise out_of_range('write_batch_data request', 'user_data.wb_lock_switch', m.user_data.wb_lock_switch, 0, 1)
-    if not 0 <= m.user_data.angle_limit_switch <= 1:
-        raise out_of_range('write_batch_data request', 'user_data.angle_limit_switch', m.user_data.angle_limit_switch, 0, 1)
-    if not 0 <= m.user_data.soft_start_switch <= 1:
-        raise out_of_range('write_batch_data request', 'user_data.soft_start_switch', m.user_data.soft_start_switch, 0, 1)
-    if not 0 <= m.user_data.soft_start_time <= 65535:
-        raise out_of_range('write_batch_data request', 'user_data.soft_start_time', m.user_data.soft_start_time, 0, 65535)
-    if not -32768 <= m.user_data.angle_limit_high <= 32767:
-        raise out_of_range('write_batch_data request', 'user_data.angle_limit_high', m.user_data.angle_limit_high, -32768, 32767)
-    if not -32768 <= m.user_data.angle_limit_low <= 32767:
-        raise out_of_range('write_batch_data request', 'user_data.angle_limit_low', m.user_data.angle_limit_low, -32768, 32767)
-    if not -32768 <= m.user_data.angle_mid_offset <= 32767:
-        raise out_of_range('write_batch_data request', 'user_data.angle_mid_offset', m.user_data.angle_mid_offset, -32768, 32767)
-    body = _S_FRAME_READBATCHDATARESPONSE.pack(b'\x12L', 6, 33, m.servo_id, m.user_data.reserved_32, m.user_data.response_switch, m.user_data.servo_id, m.user_data.reserved_35, m.user_data.baudrate, m.user_data.stall_protect_mode, m.user_data.stall_power_limit, m.user_data.over_volt_low, m.user_data.over_volt_high, m.user_data.over_temperature, m.user_data.over_power, m.user_data.over_current, m.user_data.accel_switch, m.user_data.reserved_45, m.user_data.po_lock_switch, m.user_data.wb_lock_switch, m.user_data.angle_limit_switch, m.user_data.soft_start_switch, m.user_data.soft_start_time, m.user_data.angle_limit_high, m.user_data.angle_limit_low, m.user_data.angle_mid_offset)
+    m_servo_id = m.servo_id
+    m_user_data = m.user_data
+    if not 0 <= m_servo_id <= 254 or m_servo_id.__class__ is bool:
+        raise out_of_range('write_batch_data request', 'servo_id', m_servo_id, 0, 254)
+    if not 0 <= m_user_data.reserved_32 <= 255:
+        raise out_of_range('write_batch_data request', 'user_data.reserved_32', m_user_data.reserved_32, 0, 255)
+    if not 0 <= m_user_data.response_switch <= 1:
+        raise out_of_range('write_batch_data request', 'user_data.response_switch', m_user_data.response_switch, 0, 1)
+    if not 0 <= m_user_data.servo_id <= 254:
+        raise out_of_range('write_batch_data request', 'user_data.servo_id', m_user_data.servo_id, 0, 254)
+    if not 0 <= m_user_data.reserved_35 <= 255:
+        raise out_of_range('write_batch_data request', 'user_data.reserved_35', m_user_data.reserved_35, 0, 255)
+    if not 1 <= m_user_data.baudrate <= 7:
+        raise out_of_range('write_batch_data request', 'user_data.baudrate', m_user_data.baudrate, 1, 7)
+    if not 1 <= m_user_data.stall_protect_mode <= 2:
+        raise out_of_range('write_batch_data request', 'user_data.stall_protect_mode', m_user_data.stall_protect_mode, 1, 2)
+    if not 0 <= m_user_data.stall_power_limit <= 65535:
+        raise out_of_range('write_batch_data request', 'user_data.stall_power_limit', m_user_data.stall_power_limit, 0, 65535)
+    if not 0 <= m_user_data.over_volt_low <= 65535:
+        raise out_of_range('write_batch_data request', 'user_data.over_volt_low', m_user_data.over_volt_low, 0, 65535)
+    if not 0 <= m_user_data.over_volt_high <= 65535:
+        raise out_of_range('write_batch_data request', 'user_data.over_volt_high', m_user_data.over_volt_high, 0, 65535)
+    if not 0 <= m_user_data.over_temperature <= 65535:
+        raise out_of_range('write_batch_data request', 'user_data.over_temperature', m_user_data.over_temperature, 0, 65535)
+    if not 0 <= m_user_data.over_power <= 65535:
+        raise out_of_range('write_batch_data request', 'user_data.over_power', m_user_data.over_power, 0, 65535)
+    if not 0 <= m_user_data.over_current <= 65535:
+        raise out_of_range('write_batch_data request', 'user_data.over_current', m_user_data.over_current, 0, 65535)
+    if not 0 <= m_user_data.accel_switch <= 1:
+        raise out_of_range('write_batch_data request', 'user_data.accel_switch', m_user_data.accel_switch, 0, 1)
+    if not 0 <= m_user_data.reserved_45 <= 255:
+        raise out_of_range('write_batch_data request', 'user_data.reserved_45', m_user_data.reserved_45, 0, 255)
+    if not 0 <= m_user_data.po_lock_switch <= 1:
+        raise out_of_range('write_batch_data request', 'user_data.po_lock_switch', m_user_data.po_lock_switch, 0, 1)
+    if not 0 <= m_user_data.wb_lock_switch <= 1:
+        raise out_of_range('write_batch_data request', 'user_data.wb_lock_switch', m_user_data.wb_lock_switch, 0, 1)
+    if not 0 <= m_user_data.angle_limit_switch <= 1:
+        raise out_of_range('write_batch_data request', 'user_data.angle_limit_switch', m_user_data.angle_limit_switch, 0, 1)
+    if not 0 <= m_user_data.soft_start_switch <= 1:
+        raise out_of_range('write_batch_data request', 'user_data.soft_start_switch', m_user_data.soft_start_switch, 0, 1)
+    if not 0 <= m_user_data.soft_start_time <= 65535:
+        raise out_of_range('write_batch_data request', 'user_data.soft_start_time', m_user_data.soft_start_time, 0, 65535)
+    if not -32768 <= m_user_data.angle_limit_high <= 32767:
+        raise out_of_range('write_batch_data request', 'user_data.angle_limit_high', m_user_data.angle_limit_high, -32768, 32767)
+    if not -32768 <= m_user_data.angle_limit_low <= 32767:
+        raise out_of_range('write_batch_data request', 'user_data.angle_limit_low', m_user_data.angle_limit_low, -32768, 32767)
+    if not -32768 <= m_user_data.angle_mid_offset <= 32767:
+        raise out_of_range('write_batch_data request', 'user_data.angle_mid_offset', m_user_data.angle_mid_offset, -32768, 32767)
+    body = _S_FRAME_READBATCHDATARESPONSE.pack(b'\x12L', 6, 33, m_servo_id, m_user_data.reserved_32, m_user_data.response_switch, m_user_data.servo_id, m_user_data.reserved_35, m_user_data.baudrate, m_user_data.stall_protect_mode, m_user_data.stall_power_limit, m_user_data.over_volt_low, m_user_data.over_volt_high, m_user_data.over_temperature, m_user_data.over_power, m_user_data.over_current, m_user_data.accel_switch, m_user_data.reserved_45, m_user_data.po_lock_switch, m_user_data.wb_lock_switch, m_user_data.angle_limit_switch, m_user_data.soft_start_switch, m_user_data.soft_start_time, m_user_data.angle_limit_high, m_user_data.angle_limit_low, m_user_data.angle_mid_offset)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_write_batch_data_response(m: WriteBatchDataResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
-        raise out_of_range('write_batch_data response', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.result <= 1 or m.result.__class__ is bool:
-        raise out_of_range('write_batch_data response', 'result', m.result, 0, 1)
-    body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 6, 2, m.servo_id, m.result)
+    m_servo_id = m.servo_id
+    m_result = m.result
+    if not 0 <= m_servo_id <= 254 or m_servo_id.__class__ is bool:
+        raise out_of_range('write_batch_data response', 'servo_id', m_servo_id, 0, 254)
+    if not 0 <= m_result <= 1 or m_result.__class__ is bool:
+        raise out_of_range('write_batch_data response', 'result', m_result, 0, 1)
+    body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 6, 2, m_servo_id, m_result)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_spin_request(m: SpinRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
-        raise out_of_range('spin request', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.method.direction <= 1 or m.method.direction.__class__ is bool:
-        raise out_of_range('spin request', 'method.direction', m.method.direction, 0, 1)
-    if not 0 <= m.method.mode <= 3 or m.method.mode.__class__ is bool:
-        raise out_of_range('spin request', 'method.mode', m.method.mode, 0, 3)
-    if not 0 <= m.speed <= 65535 or m.speed.__class__ is bool:
-        raise out_of_range('spin request', 'speed', m.speed, 0, 65535)
-    if not 0 <= m.value <= 65535 or m.value.__class__ is bool:
-        raise out_of_range('spin request', 'value', m.value, 0, 65535)
-    body = _S_FRAME_SPINREQUEST.pack(b'\x12L', 7, 6, m.servo_id, (m.method.direction << 7) | m.method.mode, m.speed, m.value)
+    m_servo_id = m.servo_id
+    m_method = m.method
+    m_speed = m.speed
+    m_value = m.value
+    if not 0 <= m_servo_id <= 254 or m_servo_id.__class__ is bool:
+        raise out_of_range('spin request', 'servo_id', m_servo_id, 0, 254)
+    if not 0 <= m_method.direction <= 1 or m_method.direction.__class__ is bool:
+        raise out_of_range('spin request', 'method.direction', m_method.direction, 0, 1)
+    if not 0 <= m_method.mode <= 3 or m_method.mode.__class__ is bool:
+        raise out_of_range('spin request', 'method.mode', m_method.mode, 0, 3)
+    if not 0 <= m_speed <= 65535 or m_speed.__class__ is bool:
+        raise out_of_range('spin request', 'speed', m_speed, 0, 65535)
+    if not 0 <= m_value <= 65535 or m_value.__class__ is bool:
+        raise out_of_range('spin request', 'value', m_value, 0, 65535)
+    body = _S_FRAME_SPINREQUEST.pack(b'\x12L', 7, 6, m_servo_id, (m_method.direction << 7) | m_method.mode, m_speed, m_value)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_spin_response(m: SpinResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
-        raise out_of_range('spin response', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.result <= 1 or m.result.__class__ is bool:
-        raise out_of_range('spin response', 'result', m.result, 0, 1)
-    body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 7, 2, m.servo_id, m.result)
+    m_servo_id = m.servo_id
+    m_result = m.result
+    if not 0 <= m_servo_id <= 254 or m_servo_id.__class__ is bool:
+        raise out_of_range('spin response', 'servo_id', m_servo_id, 0, 254)
+    if not 0 <= m_result <= 1 or m_result.__class__ is bool:
+        raise out_of_range('spin response', 'result', m_result, 0, 1)
+    body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 7, 2, m_servo_id, m_result)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_rotate_request(m: RotateRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
-        raise out_of_range('rotate request', 'servo_id', m.servo_id, 0, 254)
-    if not -32768 <= m.angle <= 32767 or m.angle.__class__ is bool:
-        raise out_of_range('rotate request', 'angle', m.angle, -32768, 32767)
-    if not 0 <= m.interval <= 65535 or m.interval.__class__ is bool:
-        raise out_of_range('rotate request', 'interval', m.interval, 0, 65535)
-    if not 0 <= m.power <= 65535 or m.power.__class__ is bool:
-        raise out_of_range('rotate request', 'power', m.power, 0, 65535)
-    body = _S_FRAME_ROTATEREQUEST.pack(b'\x12L', 8, 7, m.servo_id, m.angle, m.interval, m.power)
+    m_servo_id = m.servo_id
+    m_angle = m.angle
+    m_interval = m.interval
+    m_power = m.power
+    if not 0 <= m_servo_id <= 254 or m_servo_id.__class__ is bool:
+        raise out_of_range('rotate request', 'servo_id', m_servo_id, 0, 254)
+    if not -32768 <= m_angle <= 32767 or m_angle.__class__ is bool:
+        raise out_of_range('rotate request', 'angle', m_angle, -32768, 32767)
+    if not 0 <= m_interval <= 65535 or m_interval.__class__ is bool:
+        raise out_of_range('rotate request', 'interval', m_interval, 0, 65535)
+    if not 0 <= m_power <= 65535 or m_power.__class__ is bool:
+        raise out_of_range('rotate request', 'power', m_power, 0, 65535)
+    body = _S_FRAME_ROTATEREQUEST.pack(b'\x12L', 8, 7, m_servo_id, m_angle, m_interval, m_power)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_rotate_response(m: RotateResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
-        raise out_of_range('rotate response', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.result <= 1 or m.result.__class__ is bool:
-        raise out_of_range('rotate response', 'result', m.result, 0, 1)
-    body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 8, 2, m.servo_id, m.result)
+    m_servo_id = m.servo_id
+    m_result = m.result
+    if not 0 <= m_servo_id <= 254 or m_servo_id.__class__ is bool:
+        raise out_of_range('rotate response', 'servo_id', m_servo_id, 0, 254)
+    if not 0 <= m_result <= 1 or m_result.__class__ is bool:
+        raise out_of_range('rotate response', 'result', m_result, 0, 1)
+    body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 8, 2, m_servo_id, m_result)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_damping_request(m: DampingRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
-        raise out_of_range('damping request', 'servo_id', m.servo_id, 0, 255)
-    if not 0 <= m.power <= 65535 or m.power.__class__ is bool:
-        raise out_of_range('damping request', 'power', m.power, 0, 65535)
-    body = _S_B2_U8_U8_U8_U16.pack(b'\x12L', 9, 3, m.servo_id, m.power)
+    m_servo_id = m.servo_id
+    m_power = m.power
+    if not 0 <= m_servo_id <= 255 or m_servo_id.__class__ is bool:
+        raise out_of_range('damping request', 'servo_id', m_servo_id, 0, 255)
+    if not 0 <= m_power <= 65535 or m_power.__class__ is bool:
+        raise out_of_range('damping request', 'power', m_power, 0, 65535)
+    body = _S_B2_U8_U8_U8_U16.pack(b'\x12L', 9, 3, m_servo_id, m_power)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_damping_response(m: DampingResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
-        raise out_of_range('damping response', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.result <= 1 or m.result.__class__ is bool:
-        raise out_of_range('damping response', 'result', m.result, 0, 1)
-    body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 9, 2, m.servo_id, m.result)
+    m_servo_id = m.servo_id
+    m_result = m.result
+    if not 0 <= m_servo_id <= 254 or m_servo_id.__class__ is bool:
+        raise out_of_range('damping response', 'servo_id', m_servo_id, 0, 254)
+    if not 0 <= m_result <= 1 or m_result.__class__ is bool:
+        raise out_of_range('damping response', 'result', m_result, 0, 1)
+    body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 9, 2, m_servo_id, m_result)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_read_angle_request(m: ReadAngleRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
-        raise out_of_range('read_angle request', 'servo_id', m.servo_id, 0, 254)
-    body = _S_B2_U8_U8_U8.pack(b'\x12L', 10, 1, m.servo_id)
+    m_servo_id = m.servo_id
+    if not 0 <= m_servo_id <= 254 or m_servo_id.__class__ is bool:
+        raise out_of_range('read_angle request', 'servo_id', m_servo_id, 0, 254)
+    body = _S_B2_U8_U8_U8.pack(b'\x12L', 10, 1, m_servo_id)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_read_angle_response(m: ReadAngleResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
-        raise out_of_range('read_angle response', 'servo_id', m.servo_id, 0, 254)
-    if not -32768 <= m.angle <= 32767 or m.angle.__class__ is bool:
-        raise out_of_range('read_angle response', 'angle', m.angle, -32768, 32767)
-    body = _S_B2_U8_U8_U8_I16.pack(b'\x05\x1c', 10, 3, m.servo_id, m.angle)
+    m_servo_id = m.servo_id
+    m_angle = m.angle
+    if not 0 <= m_servo_id <= 254 or m_servo_id.__class__ is bool:
+        raise out_of_range('read_angle response', 'servo_id', m_servo_id, 0, 254)
+    if not -32768 <= m_angle <= 32767 or m_angle.__class__ is bool:
+        raise out_of_range('read_angle response', 'angle', m_angle, -32768, 32767)
+    body = _S_B2_U8_U8_U8_I16.pack(b'\x05\x1c', 10, 3, m_servo_id, m_angle)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_move_by_interval_request(m: MoveByIntervalRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
-        raise out_of_range('move_by_interval request', 'servo_id', m.servo_id, 0, 254)
-    if not -1800 <= m.angle <= 1800 or m.angle.__class__ is bool:
-        raise out_of_range('move_by_interval request', 'angle', m.angle, -1800, 1800)
-    if not 0 <= m.interval <= 65535 or m.interval.__class__ is bool:
-        raise out_of_range('move_by_interval request', 'interval', m.interval, 0, 65535)
-    if not 0 <= m.t_acc <= 65535 or m.t_acc.__class__ is bool:
-        raise out_of_range('move_by_interval request', 't_acc', m.t_acc, 0, 65535)
-    if not 0 <= m.t_dec <= 65535 or m.t_dec.__class__ is bool:
-        raise out_of_range('move_by_interval request', 't_dec', m.t_dec, 0, 65535)
-    if not 0 <= m.power <= 65535 or m.power.__class__ is bool:
-        raise out_of_range('move_by_interval request', 'power', m.power, 0, 65535)
-    body = _S_FRAME_MOVEBYINTERVALREQUEST.pack(b'\x12L', 11, 11, m.servo_id, m.angle, m.interval, m.t_acc, m.t_dec, m.power)
+    m_servo_id = m.servo_id
+    m_angle = m.angle
+    m_interval = m.interval
+    m_t_acc = m.t_acc
+    m_t_dec = m.t_dec
+    m_power = m.power
+    if not 0 <= m_servo_id <= 254 or m_servo_id.__class__ is bool:
+        raise out_of_range('move_by_interval request', 'servo_id', m_servo_id, 0, 254)
+    if not -1800 <= m_angle <= 1800 or m_angle.__class__ is bool:
+        raise out_of_range('move_by_interval request', 'angle', m_angle, -1800, 1800)
+    if not 0 <= m_interval <= 65535 or m_interval.__class__ is bool:
+        raise out_of_range('move_by_interval request', 'interval', m_interval, 0, 65535)
+    if not 0 <= m_t_acc <= 65535 or m_t_acc.__class__ is bool:
+        raise out_of_range('move_by_interval request', 't_acc', m_t_acc, 0, 65535)
+    if not 0 <= m_t_dec <= 65535 or m_t_dec.__class__ is bool:
+        raise out_of_range('move_by_interval request', 't_dec', m_t_dec, 0, 65535)
+    if not 0 <= m_power <= 65535 or m_power.__class__ is bool:
+        raise out_of_range('move_by_interval request', 'power', m_power, 0, 65535)
+    body = _S_FRAME_MOVEBYINTERVALREQUEST.pack(b'\x12L', 11, 11, m_servo_id, m_angle, m_interval, m_t_acc, m_t_dec, m_power)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_move_by_interval_response(m: MoveByIntervalResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
-        raise out_of_range('move_by_interval response', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.result <= 1 or m.result.__class__ is bool:
-        raise out_of_range('move_by_interval response', 'result', m.result, 0, 1)
-    body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 11, 2, m.servo_id, m.result)
+    m_servo_id = m.servo_id
+    m_result = m.result
+    if not 0 <= m_servo_id <= 254 or m_servo_id.__class__ is bool:
+        raise out_of_range('move_by_interval response', 'servo_id', m_servo_id, 0, 254)
+    if not 0 <= m_result <= 1 or m_result.__class__ is bool:
+        raise out_of_range('move_by_interval response', 'result', m_result, 0, 1)
+    body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 11, 2, m_servo_id, m_result)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_move_by_velocity_request(m: MoveByVelocityRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
-        raise out_of_range('move_by_velocity request', 'servo_id', m.servo_id, 0, 254)
-    if not -1800 <= m.angle <= 1800 or m.angle.__class__ is bool:
-        raise out_of_range('move_by_velocity request', 'angle', m.angle, -1800, 1800)
-    if not 10 <= m.velocity <= 7500 or m.velocity.__class__ is bool:
-        raise out_of_range('move_by_velocity request', 'velocity', m.velocity, 10, 7500)
-    if not 0 <= m.t_acc <= 65535 or m.t_acc.__class__ is bool:
-        raise out_of_range('move_by_velocity request', 't_acc', m.t_acc, 0, 65535)
-    if not 0 <= m.t_dec <= 65535 or m.t_dec.__class__ is bool:
-        raise out_of_range('move_by_velocity request', 't_dec', m.t_dec, 0, 65535)
-    if not 0 <= m.power <= 65535 or m.power.__class__ is bool:
-        raise out_of_range('move_by_velocity request', 'power', m.power, 0, 65535)
-    body = _S_FRAME_MOVEBYINTERVALREQUEST.pack(b'\x12L', 12, 11, m.servo_id, m.angle, m.velocity, m.t_acc, m.t_dec, m.power)
+    m_servo_id = m.servo_id
+    m_angle = m.angle
+    m_velocity = m.velocity
+    m_t_acc = m.t_acc
+    m_t_dec = m.t_dec
+    m_power = m.power
+    if not 0 <= m_servo_id <= 254 or m_servo_id.__class__ is bool:
+        raise out_of_range('move_by_velocity request', 'servo_id', m_servo_id, 0, 254)
+    if not -1800 <= m_angle <= 1800 or m_angle.__class__ is bool:
+        raise out_of_range('move_by_velocity request', 'angle', m_angle, -1800, 1800)
+    if not 10 <= m_velocity <= 7500 or m_velocity.__class__ is bool:
+        raise out_of_range('move_by_velocity request', 'velocity', m_velocity, 10, 7500)
+    if not 0 <= m_t_acc <= 65535 or m_t_acc.__class__ is bool:
+        raise out_of_range('move_by_velocity request', 't_acc', m_t_acc, 0, 65535)
+    if not 0 <= m_t_dec <= 65535 or m_t_dec.__class__ is bool:
+        raise out_of_range('move_by_velocity request', 't_dec', m_t_dec, 0, 65535)
+    if not 0 <= m_power <= 65535 or m_power.__class__ is bool:
+        raise out_of_range('move_by_velocity request', 'power', m_power, 0, 65535)
+    body = _S_FRAME_MOVEBYINTERVALREQUEST.pack(b'\x12L', 12, 11, m_servo_id, m_angle, m_velocity, m_t_acc, m_t_dec, m_power)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_move_by_velocity_response(m: MoveByVelocityResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
-        raise out_of_range('move_by_velocity response', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.result <= 1 or m.result.__class__ is bool:
-        raise out_of_range('move_by_velocity response', 'result', m.result, 0, 1)
-    body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 12, 2, m.servo_id, m.result)
+    m_servo_id = m.servo_id
+    m_result = m.result
+    if not 0 <= m_servo_id <= 254 or m_servo_id.__class__ is bool:
+        raise out_of_range('move_by_velocity response', 'servo_id', m_servo_id, 0, 254)
+    if not 0 <= m_result <= 1 or m_result.__class__ is bool:
+        raise out_of_range('move_by_velocity response', 'result', m_result, 0, 1)
+    body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 12, 2, m_servo_id, m_result)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_move_mturn_request(m: MoveMturnRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
-        raise out_of_range('move_mturn request', 'servo_id', m.servo_id, 0, 254)
-    if not -3686400 <= m.angle <= 3686400 or m.angle.__class__ is bool:
-        raise out_of_range('move_mturn request', 'angle', m.angle, -3686400, 3686400)
-    if not 0 <= m.interval <= 4096000 or m.interval.__class__ is bool:
-        raise out_of_range('move_mturn request', 'interval', m.interval, 0, 4096000)
-    if not 0 <= m.power <= 65535 or m.power.__class__ is bool:
-        raise out_of_range('move_mturn request', 'power', m.power, 0, 65535)
-    body = _S_FRAME_MOVEMTURNREQUEST.pack(b'\x12L', 13, 11, m.servo_id, m.angle, m.interval, m.power)
+    m_servo_id = m.servo_id
+    m_angle = m.angle
+    m_interval = m.interval
+    m_power = m.power
+    if not 0 <= m_servo_id <= 254 or m_servo_id.__class__ is bool:
+        raise out_of_range('move_mturn request', 'servo_id', m_servo_id, 0, 254)
+    if not -3686400 <= m_angle <= 3686400 or m_angle.__class__ is bool:
+        raise out_of_range('move_mturn request', 'angle', m_angle, -3686400, 3686400)
+    if not 0 <= m_interval <= 4096000 or m_interval.__class__ is bool:
+        raise out_of_range('move_mturn request', 'interval', m_interval, 0, 4096000)
+    if not 0 <= m_power <= 65535 or m_power.__class__ is bool:
+        raise out_of_range('move_mturn request', 'power', m_power, 0, 65535)
+    body = _S_FRAME_MOVEMTURNREQUEST.pack(b'\x12L', 13, 11, m_servo_id, m_angle, m_interval, m_power)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_move_mturn_response(m: MoveMturnResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
-        raise out_of_range('move_mturn response', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.result <= 1 or m.result.__class__ is bool:
-        raise out_of_range('move_mturn response', 'result', m.result, 0, 1)
-    body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 13, 2, m.servo_id, m.result)
+    m_servo_id = m.servo_id
+    m_result = m.result
+    if not 0 <= m_servo_id <= 254 or m_servo_id.__class__ is bool:
+        raise out_of_range('move_mturn response', 'servo_id', m_servo_id, 0, 254)
+    if not 0 <= m_result <= 1 or m_result.__class__ is bool:
+        raise out_of_range('move_mturn response', 'result', m_result, 0, 1)
+    body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 13, 2, m_servo_id, m_result)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_move_mturn_by_interval_request(m: MoveMturnByIntervalRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
-        raise out_of_range('move_mturn_by_interval request', 'servo_id', m.servo_id, 0, 254)
-    if not -3686400 <= m.angle <= 3686400 or m.angle.__class__ is bool:
-        raise out_of_range('move_mturn_by_interval request', 'angle', m.angle, -3686400, 3686400)
-    if not 0 <= m.interval <= 4096000 or m.interval.__class__ is bool:
-        raise out_of_range('move_mturn_by_interval request', 'interval', m.interval, 0, 4096000)
-    if not 0 <= m.t_acc <= 65535 or m.t_acc.__class__ is bool:
-        raise out_of_range('move_mturn_by_interval request', 't_acc', m.t_acc, 0, 65535)
-    if not 0 <= m.t_dec <= 65535 or m.t_dec.__class__ is bool:
-        raise out_of_range('move_mturn_by_interval request', 't_dec', m.t_dec, 0, 65535)
-    if not 0 <= m.power <= 65535 or m.power.__class__ is bool:
-        raise out_of_range('move_mturn_by_interval request', 'power', m.power, 0, 65535)
-    body = _S_FRAME_MOVEMTURNBYINTERVALREQUEST.pack(b'\x12L', 14, 15, m.servo_id, m.angle, m.interval, m.t_acc, m.t_dec, m.power)
+    m_servo_id = m.servo_id
+    m_angle = m.angle
+    m_interval = m.interval
+    m_t_acc = m.t_acc
+    m_t_dec = m.t_dec
+    m_power = m.power
+    if not 0 <= m_servo_id <= 254 or m_servo_id.__class__ is bool:
+        raise out_of_range('move_mturn_by_interval request', 'servo_id', m_servo_id, 0, 254)
+    if not -3686400 <= m_angle <= 3686400 or m_angle.__class__ is bool:
+        raise out_of_range('move_mturn_by_interval request', 'angle', m_angle, -3686400, 3686400)
+    if not 0 <= m_interval <= 4096000 or m_interval.__class__ is bool:
+        raise out_of_range('move_mturn_by_interval request', 'interval', m_interval, 0, 4096000)
+    if not 0 <= m_t_acc <= 65535 or m_t_acc.__class__ is bool:
+        raise out_of_range('move_mturn_by_interval request', 't_acc', m_t_acc, 0, 65535)
+    if not 0 <= m_t_dec <= 65535 or m_t_dec.__class__ is bool:
+        raise out_of_range('move_mturn_by_interval request', 't_dec', m_t_dec, 0, 65535)
+    if not 0 <= m_power <= 65535 or m_power.__class__ is bool:
+        raise out_of_range('move_mturn_by_interval request', 'power', m_power, 0, 65535)
+    body = _S_FRAME_MOVEMTURNBYINTERVALREQUEST.pack(b'\x12L', 14, 15, m_servo_id, m_angle, m_interval, m_t_acc, m_t_dec, m_power)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_move_mturn_by_interval_response(m: MoveMturnByIntervalResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
-        raise out_of_range('move_mturn_by_interval response', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.result <= 1 or m.result.__class__ is bool:
-        raise out_of_range('move_mturn_by_interval response', 'result', m.result, 0, 1)
-    body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 14, 2, m.servo_id, m.result)
+    m_servo_id = m.servo_id
+    m_result = m.result
+    if not 0 <= m_servo_id <= 254 or m_servo_id.__class__ is bool:
+        raise out_of_range('move_mturn_by_interval response', 'servo_id', m_servo_id, 0, 254)
+    if not 0 <= m_result <= 1 or m_result.__class__ is bool:
+        raise out_of_range('move_mturn_by_interval response', 'result', m_result, 0, 1)
+    body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 14, 2, m_servo_id, m_result)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_move_mturn_by_velocity_request(m: MoveMturnByVelocityRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
-        raise out_of_range('move_mturn_by_velocity request', 'servo_id', m.servo_id, 0, 254)
-    if not -3686400 <= m.angle <= 3686400 or m.angle.__class__ is bool:
-        raise out_of_range('move_mturn_by_velocity request', 'angle', m.angle, -3686400, 3686400)
-    if not 10 <= m.velocity <= 7500 or m.velocity.__class__ is bool:
-        raise out_of_range('move_mturn_by_velocity request', 'velocity', m.velocity, 10, 7500)
-    if not 0 <= m.t_acc <= 65535 or m.t_acc.__class__ is bool:
-        raise out_of_range('move_mturn_by_velocity request', 't_acc', m.t_acc, 0, 65535)
-    if not 0 <= m.t_dec <= 65535 or m.t_dec.__class__ is bool:
-        raise out_of_range('move_mturn_by_velocity request', 't_dec', m.t_dec, 0, 65535)
-    if not 0 <= m.power <= 65535 or m.power.__class__ is bool:
-        raise out_of_range('move_mturn_by_velocity request', 'power', m.power, 0, 65535)
-    body = _S_FRAME_MOVEMTURNBYVELOCITYREQUEST.pack(b'\x12L', 15, 13, m.servo_id, m.angle, m.velocity, m.t_acc, m.t_dec, m.power)
+    m_servo_id = m.servo_id
+    m_angle = m.angle
+    m_velocity = m.velocity
+    m_t_acc = m.t_acc
+    m_t_dec = m.t_dec
+    m_power = m.power
+    if not 0 <= m_servo_id <= 254 or m_servo_id.__class__ is bool:
+        raise out_of_range('move_mturn_by_velocity request', 'servo_id', m_servo_id, 0, 254)
+    if not -3686400 <= m_angle <= 3686400 or m_angle.__class__ is bool:
+        raise out_of_range('move_mturn_by_velocity request', 'angle', m_angle, -3686400, 3686400)
+    if not 10 <= m_velocity <= 7500 or m_velocity.__class__ is bool:
+        raise out_of_range('move_mturn_by_velocity request', 'velocity', m_velocity, 10, 7500)
+    if not 0 <= m_t_acc <= 65535 or m_t_acc.__class__ is bool:
+        raise out_of_range('move_mturn_by_velocity request', 't_acc', m_t_acc, 0, 65535)
+    if not 0 <= m_t_dec <= 65535 or m_t_dec.__class__ is bool:
+        raise out_of_range('move_mturn_by_velocity request', 't_dec', m_t_dec, 0, 65535)
+    if not 0 <= m_power <= 65535 or m_power.__class__ is bool:
+        raise out_of_range('move_mturn_by_velocity request', 'power', m_power, 0, 65535)
+    body = _S_FRAME_MOVEMTURNBYVELOCITYREQUEST.pack(b'\x12L', 15, 13, m_servo_id, m_angle, m_velocity, m_t_acc, m_t_dec, m_power)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_move_mturn_by_velocity_response(m: MoveMturnByVelocityResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
-        raise out_of_range('move_mturn_by_velocity response', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.result <= 1 or m.result.__class__ is bool:
-        raise out_of_range('move_mturn_by_velocity response', 'result', m.result, 0, 1)
-    body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 15, 2, m.servo_id, m.result)
+    m_servo_id = m.servo_id
+    m_result = m.result
+    if not 0 <= m_servo_id <= 254 or m_servo_id.__class__ is bool:
+        raise out_of_range('move_mturn_by_velocity response', 'servo_id', m_servo_id, 0, 254)
+    if not 0 <= m_result <= 1 or m_result.__class__ is bool:
+        raise out_of_range('move_mturn_by_velocity response', 'result', m_result, 0, 1)
+    body = _S_B2_U8_U8_U8_U8.pack(b'\x05\x1c', 15, 2, m_servo_id, m_result)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_read_mturn_angle_request(m: ReadMturnAngleRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
-        raise out_of_range('read_mturn_angle request', 'servo_id', m.servo_id, 0, 254)
-    body = _S_B2_U8_U8_U8.pack(b'\x12L', 16, 1, m.servo_id)
+    m_servo_id = m.servo_id
+    if not 0 <= m_servo_id <= 254 or m_servo_id.__class__ is bool:
+        raise out_of_range('read_mturn_angle request', 'servo_id', m_servo_id, 0, 254)
+    body = _S_B2_U8_U8_U8.pack(b'\x12L', 16, 1, m_servo_id)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_read_mturn_angle_response(m: ReadMturnAngleResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
-        raise out_of_range('read_mturn_angle response', 'servo_id', m.servo_id, 0, 254)
-    if not -3686400 <= m.angle <= 3686400 or m.angle.__class__ is bool:
-        raise out_of_range('read_mturn_angle response', 'angle', m.angle, -3686400, 3686400)
-    if not -32768 <= m.turns <= 32767 or m.turns.__class__ is bool:
-        raise out_of_range('read_mturn_angle response', 'turns', m.turns, -32768, 32767)
-    body = _S_B2_U8_U8_U8_I32_I16.pack(b'\x05\x1c', 16, 7, m.servo_id, m.angle, m.turns)
+    m_servo_id = m.servo_id
+    m_angle = m.angle
+    m_turns = m.turns
+    if not 0 <= m_servo_id <= 254 or m_servo_id.__class__ is bool:
+        raise out_of_range('read_mturn_angle response', 'servo_id', m_servo_id, 0, 254)
+    if not -3686400 <= m_angle <= 3686400 or m_angle.__class__ is bool:
+        raise out_of_range('read_mturn_angle response', 'angle', m_angle, -3686400, 3686400)
+    if not -32768 <= m_turns <= 32767 or m_turns.__class__ is bool:
+        raise out_of_range('read_mturn_angle response', 'turns', m_turns, -32768, 32767)
+    body = _S_B2_U8_U8_U8_I32_I16.pack(b'\x05\x1c', 16, 7, m_servo_id, m_angle, m_turns)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_reset_mturn_angle_request(m: ResetMturnAngleRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
-        raise out_of_range('reset_mturn_angle request', 'servo_id', m.servo_id, 0, 254)
-    body = _S_B2_U8_U8_U8.pack(b'\x12L', 17, 1, m.servo_id)
+    m_servo_id = m.servo_id
+    if not 0 <= m_servo_id <= 254 or m_servo_id.__class__ is bool:
+        raise out_of_range('reset_mturn_angle request', 'servo_id', m_servo_id, 0, 254)
+    body = _S_B2_U8_U8_U8.pack(b'\x12L', 17, 1, m_servo_id)
     return body + _BYTES[sum(body) & 0xff]
 
 
@@ -1721,76 +1586,94 @@ def _encode_begin_async_request(m: BeginAsyncRequest) -> bytes:
 
 
 def _encode_end_async_request(m: EndAsyncRequest) -> bytes:
-    if not 0 <= m.mode <= 1 or m.mode.__class__ is bool:
-        raise out_of_range('end_async request', 'mode', m.mode, 0, 1)
-    body = _S_B2_U8_U8_U8.pack(b'\x12L', 19, 1, m.mode)
+    m_mode = m.mode
+    if not 0 <= m_mode <= 1 or m_mode.__class__ is bool:
+        raise out_of_range('end_async request', 'mode', m_mode, 0, 1)
+    body = _S_B2_U8_U8_U8.pack(b'\x12L', 19, 1, m_mode)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_monitor_request(m: MonitorRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
-        raise out_of_range('monitor request', 'servo_id', m.servo_id, 0, 254)
-    body = _S_B2_U8_U8_U8.pack(b'\x12L', 22, 1, m.servo_id)
+    m_servo_id = m.servo_id
+    if not 0 <= m_servo_id <= 254 or m_servo_id.__class__ is bool:
+        raise out_of_range('monitor request', 'servo_id', m_servo_id, 0, 254)
+    body = _S_B2_U8_U8_U8.pack(b'\x12L', 22, 1, m_servo_id)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_monitor_response(m: MonitorResponse) -> bytes:
-    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
-        raise out_of_range('monitor response', 'servo_id', m.servo_id, 0, 254)
-    if not 0 <= m.voltage <= 65535 or m.voltage.__class__ is bool:
-        raise out_of_range('monitor response', 'voltage', m.voltage, 0, 65535)
-    if not 0 <= m.current <= 65535 or m.current.__class__ is bool:
-        raise out_of_range('monitor response', 'current', m.current, 0, 65535)
-    if not 0 <= m.power <= 65535 or m.power.__class__ is bool:
-        raise out_of_range('monitor response', 'power', m.power, 0, 65535)
-    if not 0 <= m.temperature <= 65535 or m.temperature.__class__ is bool:
-        raise out_of_range('monitor response', 'temperature', m.temperature, 0, 65535)
-    if not 0 <= m.status <= 255 or isinstance(m.status, bool):
-        raise out_of_range('monitor response', 'status', m.status, 0, 255)
-    if not -3686400 <= m.angle <= 3686400 or m.angle.__class__ is bool:
-        raise out_of_range('monitor response', 'angle', m.angle, -3686400, 3686400)
-    if not -32768 <= m.turns <= 32767 or m.turns.__class__ is bool:
-        raise out_of_range('monitor response', 'turns', m.turns, -32768, 32767)
-    body = _S_FRAME_MONITORRESPONSE.pack(b'\x05\x1c', 22, 16, m.servo_id, m.voltage, m.current, m.power, m.temperature, m.status, m.angle, m.turns)
+    m_servo_id = m.servo_id
+    m_voltage = m.voltage
+    m_current = m.current
+    m_power = m.power
+    m_temperature = m.temperature
+    m_status = m.status
+    m_angle = m.angle
+    m_turns = m.turns
+    if not 0 <= m_servo_id <= 254 or m_servo_id.__class__ is bool:
+        raise out_of_range('monitor response', 'servo_id', m_servo_id, 0, 254)
+    if not 0 <= m_voltage <= 65535 or m_voltage.__class__ is bool:
+        raise out_of_range('monitor response', 'voltage', m_voltage, 0, 65535)
+    if not 0 <= m_current <= 65535 or m_current.__class__ is bool:
+        raise out_of_range('monitor response', 'current', m_current, 0, 65535)
+    if not 0 <= m_power <= 65535 or m_power.__class__ is bool:
+        raise out_of_range('monitor response', 'power', m_power, 0, 65535)
+    if not 0 <= m_temperature <= 65535 or m_temperature.__class__ is bool:
+        raise out_of_range('monitor response', 'temperature', m_temperature, 0, 65535)
+    if not 0 <= m_status <= 255 or isinstance(m_status, bool):
+        raise out_of_range('monitor response', 'status', m_status, 0, 255)
+    if not -3686400 <= m_angle <= 3686400 or m_angle.__class__ is bool:
+        raise out_of_range('monitor response', 'angle', m_angle, -3686400, 3686400)
+    if not -32768 <= m_turns <= 32767 or m_turns.__class__ is bool:
+        raise out_of_range('monitor response', 'turns', m_turns, -32768, 32767)
+    body = _S_FRAME_MONITORRESPONSE.pack(b'\x05\x1c', 22, 16, m_servo_id, m_voltage, m_current, m_power, m_temperature, m_status, m_angle, m_turns)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_set_origin_point_request(m: SetOriginPointRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
-        raise out_of_range('set_origin_point request', 'servo_id', m.servo_id, 0, 254)
-    body = _S_B2_U8_U8_U8_U8.pack(b'\x12L', 23, 2, m.servo_id, 0)
+    m_servo_id = m.servo_id
+    if not 0 <= m_servo_id <= 254 or m_servo_id.__class__ is bool:
+        raise out_of_range('set_origin_point request', 'servo_id', m_servo_id, 0, 254)
+    body = _S_B2_U8_U8_U8_U8.pack(b'\x12L', 23, 2, m_servo_id, 0)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_stop_on_control_mode_request(m: StopOnControlModeRequest) -> bytes:
-    if not 0 <= m.servo_id <= 254 or m.servo_id.__class__ is bool:
-        raise out_of_range('stop_on_control_mode request', 'servo_id', m.servo_id, 0, 254)
-    if not 16 <= m.method <= 18 or m.method.__class__ is bool:
-        raise out_of_range('stop_on_control_mode request', 'method', m.method, 16, 18)
-    if not 0 <= m.power <= 65535 or m.power.__class__ is bool:
-        raise out_of_range('stop_on_control_mode request', 'power', m.power, 0, 65535)
-    body = _S_B2_U8_U8_U8_U8_U16.pack(b'\x12L', 24, 4, m.servo_id, m.method, m.power)
+    m_servo_id = m.servo_id
+    m_method = m.method
+    m_power = m.power
+    if not 0 <= m_servo_id <= 254 or m_servo_id.__class__ is bool:
+        raise out_of_range('stop_on_control_mode request', 'servo_id', m_servo_id, 0, 254)
+    if not 16 <= m_method <= 18 or m_method.__class__ is bool:
+        raise out_of_range('stop_on_control_mode request', 'method', m_method, 16, 18)
+    if not 0 <= m_power <= 65535 or m_power.__class__ is bool:
+        raise out_of_range('stop_on_control_mode request', 'power', m_power, 0, 65535)
+    body = _S_B2_U8_U8_U8_U8_U16.pack(b'\x12L', 24, 4, m_servo_id, m_method, m_power)
     return body + _BYTES[sum(body) & 0xff]
 
 
 def _encode_sync_command_request(m: SyncCommandRequest) -> bytes:
-    if not 0 <= m.command <= 255 or m.command.__class__ is bool:
-        raise out_of_range('sync_command request', 'command', m.command, 0, 255)
-    v_block_size = len(m.blocks[0].content) if m.blocks else 0
-    if any(len(item.content) != v_block_size for item in m.blocks):
+    m_command = m.command
+    m_blocks = m.blocks
+    if not 0 <= m_command <= 255 or m_command.__class__ is bool:
+        raise out_of_range('sync_command request', 'command', m_command, 0, 255)
+    v_block_size = len(m_blocks[0].content) if m_blocks else 0
+    if any(len(item.content) != v_block_size for item in m_blocks):
         raise EncodeError('sync_command request' + ': every content of blocks must have the same length')
     if v_block_size > 255:
         raise out_of_range('sync_command request', 'block_size', v_block_size, 0, 255)
-    if len(m.blocks) > 255:
-        raise out_of_range('sync_command request', 'count', len(m.blocks), 0, 255)
+    if len(m_blocks) > 255:
+        raise out_of_range('sync_command request', 'count', len(m_blocks), 0, 255)
     parts_blocks = []
-    for item in m.blocks:
-        parts_blocks.append(bytes(item.content))
+    for item in m_blocks:
+        item_content = item.content
+        v_content = item_content if item_content.__class__ is bytes else bytes(item_content)
+        parts_blocks.append(v_content)
     content = b''.join(parts_blocks)
     n = len(content) + 3
     if n > 255:
         raise EncodeError(f'content of {n} bytes does not fit the length field')
-    body = _S_B2_U8_U8_U8_U8_U8.pack(b'\x12L', 25, n, m.command, v_block_size, len(m.blocks)) + content
+    body = _S_B2_U8_U8_U8_U8_U8.pack(b'\x12L', 25, n, m_command, v_block_size, len(m_blocks)) + content
     return body + _BYTES[sum(body) & 0xff]
 
 
@@ -1868,35 +1751,37 @@ _REQUEST_FIXED: dict[int, tuple[int, Callable[[bytes, int], Message | None]]] = 
 }
 
 
-# The same frames for decode(), by their first bytes (header, command code, length byte).
-_REQUEST_WHOLE: dict[bytes, tuple[int, Callable[[bytes, int], Message | None]]] = {
-    b'\x12L\x01\x01': (6, _frame_ping_request),
-    b'\x12L\x02\x01': (6, _frame_reset_user_data_request),
-    b'\x12L\x03\x02': (7, _frame_read_data_request),
-    b'\x12L\x05\x01': (6, _frame_read_batch_data_request),
-    b'\x12L\x06!': (38, _frame_write_batch_data_request),
-    b'\x12L\x08\x07': (12, _frame_rotate_request),
-    b'\x12L\t\x03': (8, _frame_damping_request),
-    b'\x12L\n\x01': (6, _frame_read_angle_request),
-    b'\x12L\x0b\x0b': (16, _frame_move_by_interval_request),
-    b'\x12L\x0c\x0b': (16, _frame_move_by_velocity_request),
-    b'\x12L\r\x0b': (16, _frame_move_mturn_request),
-    b'\x12L\x0e\x0f': (20, _frame_move_mturn_by_interval_request),
-    b'\x12L\x0f\r': (18, _frame_move_mturn_by_velocity_request),
-    b'\x12L\x10\x01': (6, _frame_read_mturn_angle_request),
-    b'\x12L\x11\x01': (6, _frame_reset_mturn_angle_request),
-    b'\x12L\x12\x00': (5, _frame_begin_async_request),
-    b'\x12L\x13\x01': (6, _frame_end_async_request),
-    b'\x12L\x16\x01': (6, _frame_monitor_request),
-    b'\x12L\x18\x04': (9, _frame_stop_on_control_mode_request),
+# The same frames for decode(), by their first bytes (header, command code, length byte): frame size, decoder, and
+# for a frame whose message is its content as one struct unpacks it, that unpack and the class (decode() builds it).
+_REQUEST_WHOLE: dict[bytes, tuple[int, Callable[[bytes], Message | None], Callable[[bytes, int], tuple[int, ...]] | None, type[Message]]] = {
+    b'\x12L\x01\x01': (6, _whole_ping_request, None, Message),
+    b'\x12L\x02\x01': (6, _whole_reset_user_data_request, None, Message),
+    b'\x12L\x03\x02': (7, _whole_read_data_request, None, Message),
+    b'\x12L\x05\x01': (6, _whole_read_batch_data_request, None, Message),
+    b'\x12L\x06!': (38, _whole_write_batch_data_request, None, Message),
+    b'\x12L\x08\x07': (12, _whole_rotate_request, _S_U8_I16_U16_U16.unpack_from, RotateRequest),
+    b'\x12L\t\x03': (8, _whole_damping_request, None, Message),
+    b'\x12L\n\x01': (6, _whole_read_angle_request, None, Message),
+    b'\x12L\x0b\x0b': (16, _whole_move_by_interval_request, _S_U8_I16_U16_U16_U16_U16.unpack_from, MoveByIntervalRequest),
+    b'\x12L\x0c\x0b': (16, _whole_move_by_velocity_request, _S_U8_I16_U16_U16_U16_U16.unpack_from, MoveByVelocityRequest),
+    b'\x12L\r\x0b': (16, _whole_move_mturn_request, _S_U8_I32_U32_U16.unpack_from, MoveMturnRequest),
+    b'\x12L\x0e\x0f': (20, _whole_move_mturn_by_interval_request, _S_U8_I32_U32_U16_U16_U16.unpack_from, MoveMturnByIntervalRequest),
+    b'\x12L\x0f\r': (18, _whole_move_mturn_by_velocity_request, _S_U8_I32_U16_U16_U16_U16.unpack_from, MoveMturnByVelocityRequest),
+    b'\x12L\x10\x01': (6, _whole_read_mturn_angle_request, None, Message),
+    b'\x12L\x11\x01': (6, _whole_reset_mturn_angle_request, None, Message),
+    b'\x12L\x12\x00': (5, _whole_begin_async_request, None, Message),
+    b'\x12L\x13\x01': (6, _whole_end_async_request, None, Message),
+    b'\x12L\x16\x01': (6, _whole_monitor_request, None, Message),
+    b'\x12L\x18\x04': (9, _whole_stop_on_control_mode_request, None, Message),
 }
 
 
 def _decode_request_at(buf: bytes, start: int, stop: int) -> Message:
     """The frame buf[start:stop], whose header and length byte the stream parser has checked."""
+    check = buf[stop - 1]
     expected = sum(buf[start : stop - 1]) & 0xff
-    if expected != buf[stop - 1]:
-        raise ChecksumError(f"bad checksum: the frame has {buf[stop - 1]:#04x}, its bytes give {expected:#04x}")
+    if expected != check:
+        raise ChecksumError(f"bad checksum: the frame has {check:#04x}, its bytes give {expected:#04x}")
     decoder = _REQUEST_DECODERS.get(buf[start + 2])
     if decoder is None:
         raise DecodeError(f"unknown command {buf[start + 2]:#04x}")
@@ -1962,38 +1847,42 @@ _RESPONSE_FIXED: dict[int, tuple[int, Callable[[bytes, int], Message | None]]] =
 }
 
 
-# The same frames for decode(), by their first bytes (header, command code, length byte).
-_RESPONSE_WHOLE: dict[bytes, tuple[int, Callable[[bytes, int], Message | None]]] = {
-    b'\x05\x1c\x01\x01': (6, _frame_ping_response),
-    b'\x05\x1c\x02\x02': (7, _frame_reset_user_data_response),
-    b'\x05\x1c\x04\x03': (8, _frame_write_data_response),
-    b'\x05\x1c\x05!': (38, _frame_read_batch_data_response),
-    b'\x05\x1c\x06\x02': (7, _frame_write_batch_data_response),
-    b'\x05\x1c\x07\x02': (7, _frame_spin_response),
-    b'\x05\x1c\x08\x02': (7, _frame_rotate_response),
-    b'\x05\x1c\t\x02': (7, _frame_damping_response),
-    b'\x05\x1c\n\x03': (8, _frame_read_angle_response),
-    b'\x05\x1c\x0b\x02': (7, _frame_move_by_interval_response),
-    b'\x05\x1c\x0c\x02': (7, _frame_move_by_velocity_response),
-    b'\x05\x1c\r\x02': (7, _frame_move_mturn_response),
-    b'\x05\x1c\x0e\x02': (7, _frame_move_mturn_by_interval_response),
-    b'\x05\x1c\x0f\x02': (7, _frame_move_mturn_by_velocity_response),
-    b'\x05\x1c\x10\x07': (12, _frame_read_mturn_angle_response),
-    b'\x05\x1c\x16\x10': (21, _frame_monitor_response),
+# The same frames for decode(), by their first bytes (header, command code, length byte): frame size, decoder, and
+# for a frame whose message is its content as one struct unpacks it, that unpack and the class (decode() builds it).
+_RESPONSE_WHOLE: dict[bytes, tuple[int, Callable[[bytes], Message | None], Callable[[bytes, int], tuple[int, ...]] | None, type[Message]]] = {
+    b'\x05\x1c\x01\x01': (6, _whole_ping_response, None, Message),
+    b'\x05\x1c\x02\x02': (7, _whole_reset_user_data_response, None, Message),
+    b'\x05\x1c\x04\x03': (8, _whole_write_data_response, None, Message),
+    b'\x05\x1c\x05!': (38, _whole_read_batch_data_response, None, Message),
+    b'\x05\x1c\x06\x02': (7, _whole_write_batch_data_response, None, Message),
+    b'\x05\x1c\x07\x02': (7, _whole_spin_response, None, Message),
+    b'\x05\x1c\x08\x02': (7, _whole_rotate_response, None, Message),
+    b'\x05\x1c\t\x02': (7, _whole_damping_response, None, Message),
+    b'\x05\x1c\n\x03': (8, _whole_read_angle_response, None, Message),
+    b'\x05\x1c\x0b\x02': (7, _whole_move_by_interval_response, None, Message),
+    b'\x05\x1c\x0c\x02': (7, _whole_move_by_velocity_response, None, Message),
+    b'\x05\x1c\r\x02': (7, _whole_move_mturn_response, None, Message),
+    b'\x05\x1c\x0e\x02': (7, _whole_move_mturn_by_interval_response, None, Message),
+    b'\x05\x1c\x0f\x02': (7, _whole_move_mturn_by_velocity_response, None, Message),
+    b'\x05\x1c\x10\x07': (12, _whole_read_mturn_angle_response, _S_U8_I32_I16.unpack_from, ReadMturnAngleResponse),
+    b'\x05\x1c\x16\x10': (21, _whole_monitor_response, None, Message),
 }
 
 
 def _decode_response_at(buf: bytes, start: int, stop: int) -> Message:
     """The frame buf[start:stop], whose header and length byte the stream parser has checked."""
+    check = buf[stop - 1]
     expected = sum(buf[start : stop - 1]) & 0xff
-    if expected != buf[stop - 1]:
-        raise ChecksumError(f"bad checksum: the frame has {buf[stop - 1]:#04x}, its bytes give {expected:#04x}")
+    if expected != check:
+        raise ChecksumError(f"bad checksum: the frame has {check:#04x}, its bytes give {expected:#04x}")
     decoder = _RESPONSE_DECODERS.get(buf[start + 2])
     if decoder is None:
         raise DecodeError(f"unknown command {buf[start + 2]:#04x}")
     return decoder(buf, start + 4, stop - 1)
 
 
+_REQUEST = Direction.REQUEST
+_RESPONSE = Direction.RESPONSE
 _ENCODERS: dict[type[Message], Callable[..., bytes]] = {
     PingRequest: _encode_ping_request,
     PingResponse: _encode_ping_response,
@@ -2062,66 +1951,81 @@ RESPONSE_FORMAT = FrameFormat(
 def decode(data: bytes, direction: Direction | str | None = None, expect: type[Message] | None = None) -> Message:
     """Decode one complete frame into its message; raises DecodeError with a one-line reason.
 
-    Each direction's checks are inline here rather than in a function per direction: one call less per frame.
+    Each direction's checks are inline here rather than in a function per direction: one call less per frame. A
+    Direction is told by identity, first; its value as text ("request") costs one call more.
     `expect` (the reply class a frame answers) matters only where replies share a code; here none do.
     """
-    if direction is None:
-        if data[:2] == b'\x12L':
-            direction = 'request'
-        elif data[:2] == b'\x05\x1c':
-            direction = 'response'
-        else:
-            raise DecodeError(f"header is {data[:2].hex(' ')}, expected 12 4c or 05 1c")
-    if direction == 'request':  # a Direction or its value
+    if direction is _REQUEST:
+        fixed = _REQUEST_WHOLE.get(data[:4])  # no key is shorter: a short frame matches none
+        if fixed is not None and fixed[0] == len(data):
+            _, whole, unpack, cls = fixed
+            if unpack is None:
+                message = whole(data)
+                if message is not None:
+                    return message
+            elif not (sum(data) - 2 * data[-1]) & 0xff:  # its message is its content as unpacked: built here, no call
+                return _new(cls, unpack(data, 4))
         n = len(data)
         if n < 5:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (5 bytes)")
-        fixed = _REQUEST_WHOLE.get(data[:4])
-        if fixed is not None and fixed[0] == n:
-            message = fixed[1](data, 0)
-            if message is not None:
-                return message
         if data[:2] != b'\x12L':
             raise DecodeError(f"request header is {data[:2].hex(' ')}, expected 12 4c")
         size = data[3]
         if n != 5 + size:
             raise DecodeError(f"length byte says {size} content bytes but the frame holds {n - 5}")
-        expected = sum(data[:-1]) & 0xff
-        if expected != data[-1]:
-            raise ChecksumError(f"bad checksum: the frame has {data[-1]:#04x}, its bytes give {expected:#04x}")
+        check = data[-1]
+        expected = (sum(data) - check) & 0xff
+        if expected != check:
+            raise ChecksumError(f"bad checksum: the frame has {check:#04x}, its bytes give {expected:#04x}")
         decoder = _REQUEST_DECODERS.get(data[2])
         if decoder is None:
             raise DecodeError(f"unknown command {data[2]:#04x}")
         return decoder(data, 4, n - 1)
-    if direction == 'response':  # a Direction or its value
+    if direction is _RESPONSE:
+        fixed = _RESPONSE_WHOLE.get(data[:4])  # no key is shorter: a short frame matches none
+        if fixed is not None and fixed[0] == len(data):
+            _, whole, unpack, cls = fixed
+            if unpack is None:
+                message = whole(data)
+                if message is not None:
+                    return message
+            elif not (sum(data) - 2 * data[-1]) & 0xff:  # its message is its content as unpacked: built here, no call
+                return _new(cls, unpack(data, 4))
         n = len(data)
         if n < 5:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (5 bytes)")
-        fixed = _RESPONSE_WHOLE.get(data[:4])
-        if fixed is not None and fixed[0] == n:
-            message = fixed[1](data, 0)
-            if message is not None:
-                return message
         if data[:2] != b'\x05\x1c':
             raise DecodeError(f"response header is {data[:2].hex(' ')}, expected 05 1c")
         size = data[3]
         if n != 5 + size:
             raise DecodeError(f"length byte says {size} content bytes but the frame holds {n - 5}")
-        expected = sum(data[:-1]) & 0xff
-        if expected != data[-1]:
-            raise ChecksumError(f"bad checksum: the frame has {data[-1]:#04x}, its bytes give {expected:#04x}")
+        check = data[-1]
+        expected = (sum(data) - check) & 0xff
+        if expected != check:
+            raise ChecksumError(f"bad checksum: the frame has {check:#04x}, its bytes give {expected:#04x}")
         decoder = _RESPONSE_DECODERS.get(data[2])
         if decoder is None:
             raise DecodeError(f"unknown command {data[2]:#04x}")
         return decoder(data, 4, n - 1)
+    if direction == 'request':  # its value as text
+        return decode(data, _REQUEST, expect)
+    if direction == 'response':  # its value as text
+        return decode(data, _RESPONSE, expect)
+    if direction is None:  # last: a caller that knows the direction does not pay for this
+        if data[:2] == b'\x12L':
+            return decode(data, _REQUEST, expect)
+        if data[:2] == b'\x05\x1c':
+            return decode(data, _RESPONSE, expect)
+        raise DecodeError(f"header is {data[:2].hex(' ')}, expected 12 4c or 05 1c")
     raise ValueError(f"direction must be request or response, not {direction!r}")
 
 
 def encode(message: Message) -> bytes:
     """Encode a message as a complete frame; raises EncodeError (RangeError for values out of range)."""
-    encoder = _ENCODERS.get(type(message))
-    if encoder is None:
-        raise EncodeError(f"{type(message).__name__} is not a fashionstar_uart message")
+    try:
+        encoder = _ENCODERS[type(message)]  # a subscript costs less than .get(); the miss is the rare case
+    except KeyError:
+        raise EncodeError(f"{type(message).__name__} is not a fashionstar_uart message") from None
     try:
         return encoder(message)
     except EncodeError:

@@ -16,8 +16,7 @@ from serialspec.runtime.fields import integer as _integer
 from serialspec.runtime.fields import items as _items
 from serialspec.runtime.fields import mapping as _mapping
 from serialspec.runtime.message import Direction, Message, Record
-
-_store = object.__setattr__  # how __init__ fills the slots of a frozen class
+from serialspec.runtime.message import build as _build
 
 __all__ = [
     'AsyncEnd',
@@ -221,7 +220,7 @@ class ServoStatus(IntFlag):
 class UserData(Record):
     """The user parameters 32..53 in data_id order. (Servo parameters by data_id)."""
 
-    __slots__ = ('reserved_32', 'response_switch', 'servo_id', 'reserved_35', 'baudrate', 'stall_protect_mode', 'stall_power_limit', 'over_volt_low', 'over_volt_high', 'over_temperature', 'over_power', 'over_current', 'accel_switch', 'reserved_45', 'po_lock_switch', 'wb_lock_switch', 'angle_limit_switch', 'soft_start_switch', 'soft_start_time', 'angle_limit_high', 'angle_limit_low', 'angle_mid_offset')
+    __slots__ = ()
     __match_args__ = ('reserved_32', 'response_switch', 'servo_id', 'reserved_35', 'baudrate', 'stall_protect_mode', 'stall_power_limit', 'over_volt_low', 'over_volt_high', 'over_temperature', 'over_power', 'over_current', 'accel_switch', 'reserved_45', 'po_lock_switch', 'wb_lock_switch', 'angle_limit_switch', 'soft_start_switch', 'soft_start_time', 'angle_limit_high', 'angle_limit_low', 'angle_mid_offset')
     #: data_id 32: Reserved.
     reserved_32: int
@@ -268,8 +267,8 @@ class UserData(Record):
     #: data_id 53: Offset of the middle position. [0.1°]
     angle_mid_offset: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         reserved_32: int,
         response_switch: ResponseSwitch | int,
         servo_id: int,
@@ -292,29 +291,8 @@ class UserData(Record):
         angle_limit_high: int,
         angle_limit_low: int,
         angle_mid_offset: int,
-    ) -> None:
-        _store(self, 'reserved_32', reserved_32)
-        _store(self, 'response_switch', response_switch)
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'reserved_35', reserved_35)
-        _store(self, 'baudrate', baudrate)
-        _store(self, 'stall_protect_mode', stall_protect_mode)
-        _store(self, 'stall_power_limit', stall_power_limit)
-        _store(self, 'over_volt_low', over_volt_low)
-        _store(self, 'over_volt_high', over_volt_high)
-        _store(self, 'over_temperature', over_temperature)
-        _store(self, 'over_power', over_power)
-        _store(self, 'over_current', over_current)
-        _store(self, 'accel_switch', accel_switch)
-        _store(self, 'reserved_45', reserved_45)
-        _store(self, 'po_lock_switch', po_lock_switch)
-        _store(self, 'wb_lock_switch', wb_lock_switch)
-        _store(self, 'angle_limit_switch', angle_limit_switch)
-        _store(self, 'soft_start_switch', soft_start_switch)
-        _store(self, 'soft_start_time', soft_start_time)
-        _store(self, 'angle_limit_high', angle_limit_high)
-        _store(self, 'angle_limit_low', angle_limit_low)
-        _store(self, 'angle_mid_offset', angle_mid_offset)
+    ) -> Self:
+        return _build(cls, (reserved_32, response_switch, servo_id, reserved_35, baudrate, stall_protect_mode, stall_power_limit, over_volt_low, over_volt_high, over_temperature, over_power, over_current, accel_switch, reserved_45, po_lock_switch, wb_lock_switch, angle_limit_switch, soft_start_switch, soft_start_time, angle_limit_high, angle_limit_low, angle_mid_offset))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -374,20 +352,19 @@ class UserData(Record):
 class MethodBits(Record):
     """Bit fields of method."""
 
-    __slots__ = ('direction', 'mode')
+    __slots__ = ()
     __match_args__ = ('direction', 'mode')
     #: Rotation direction. (bit 7)
     direction: SpinDirection | int
     #: How long to spin. (bits 1..0)
     mode: SpinMode | int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         direction: SpinDirection | int,
         mode: SpinMode | int,
-    ) -> None:
-        _store(self, 'direction', direction)
-        _store(self, 'mode', mode)
+    ) -> Self:
+        return _build(cls, (direction, mode))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -407,16 +384,16 @@ class MethodBits(Record):
 class BlocksItem(Record):
     """One item of blocks."""
 
-    __slots__ = ('content',)
+    __slots__ = ()
     __match_args__ = ('content',)
     #: The carried command's request content for one servo.
     content: bytes
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         content: bytes,
-    ) -> None:
-        _store(self, 'content', content)
+    ) -> Self:
+        return _build(cls, (content,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -434,7 +411,7 @@ class BlocksItem(Record):
 class PingRequest(Message):
     """Check that a servo is online (request)."""
 
-    __slots__ = ('servo_id',)
+    __slots__ = ()
     __match_args__ = ('servo_id',)
     PROTOCOL: ClassVar[str] = 'fashionstar_uart'
     COMMAND: ClassVar[str] = 'ping'
@@ -443,11 +420,11 @@ class PingRequest(Message):
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
     servo_id: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
+    ) -> Self:
+        return _build(cls, (servo_id,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -465,7 +442,7 @@ class PingRequest(Message):
 class PingResponse(Message):
     """Check that a servo is online (response)."""
 
-    __slots__ = ('servo_id',)
+    __slots__ = ()
     __match_args__ = ('servo_id',)
     PROTOCOL: ClassVar[str] = 'fashionstar_uart'
     COMMAND: ClassVar[str] = 'ping'
@@ -474,11 +451,11 @@ class PingResponse(Message):
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
     servo_id: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
+    ) -> Self:
+        return _build(cls, (servo_id,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -496,7 +473,7 @@ class PingResponse(Message):
 class ResetUserDataRequest(Message):
     """Reset the user parameters to their defaults (request)."""
 
-    __slots__ = ('servo_id',)
+    __slots__ = ()
     __match_args__ = ('servo_id',)
     PROTOCOL: ClassVar[str] = 'fashionstar_uart'
     COMMAND: ClassVar[str] = 'reset_user_data'
@@ -505,11 +482,11 @@ class ResetUserDataRequest(Message):
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
     servo_id: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
+    ) -> Self:
+        return _build(cls, (servo_id,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -527,7 +504,7 @@ class ResetUserDataRequest(Message):
 class ResetUserDataResponse(Message):
     """Reset the user parameters to their defaults (response)."""
 
-    __slots__ = ('servo_id', 'result')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'result')
     PROTOCOL: ClassVar[str] = 'fashionstar_uart'
     COMMAND: ClassVar[str] = 'reset_user_data'
@@ -538,13 +515,12 @@ class ResetUserDataResponse(Message):
     #: Outcome of the command. range 0..1
     result: Result | int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         result: Result | int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'result', result)
+    ) -> Self:
+        return _build(cls, (servo_id, result))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -564,7 +540,7 @@ class ResetUserDataResponse(Message):
 class ReadDataRequest(Message):
     """Read one parameter (request)."""
 
-    __slots__ = ('servo_id', 'data_id')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'data_id')
     PROTOCOL: ClassVar[str] = 'fashionstar_uart'
     COMMAND: ClassVar[str] = 'read_data'
@@ -575,13 +551,12 @@ class ReadDataRequest(Message):
     #: Parameter to read (see the parameter table).
     data_id: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         data_id: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'data_id', data_id)
+    ) -> Self:
+        return _build(cls, (servo_id, data_id))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -601,7 +576,7 @@ class ReadDataRequest(Message):
 class ReadDataResponse(Message):
     """Read one parameter (response)."""
 
-    __slots__ = ('servo_id', 'data_id', 'data')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'data_id', 'data')
     PROTOCOL: ClassVar[str] = 'fashionstar_uart'
     COMMAND: ClassVar[str] = 'read_data'
@@ -614,15 +589,13 @@ class ReadDataResponse(Message):
     #: The value, typed by data_id.
     data: int | float
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         data_id: int,
         data: int | float,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'data_id', data_id)
-        _store(self, 'data', data)
+    ) -> Self:
+        return _build(cls, (servo_id, data_id, data))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -644,7 +617,7 @@ class ReadDataResponse(Message):
 class WriteDataRequest(Message):
     """Write one user parameter (request)."""
 
-    __slots__ = ('servo_id', 'data_id', 'data')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'data_id', 'data')
     PROTOCOL: ClassVar[str] = 'fashionstar_uart'
     COMMAND: ClassVar[str] = 'write_data'
@@ -657,15 +630,13 @@ class WriteDataRequest(Message):
     #: The value, typed by data_id.
     data: int | float
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         data_id: int,
         data: int | float,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'data_id', data_id)
-        _store(self, 'data', data)
+    ) -> Self:
+        return _build(cls, (servo_id, data_id, data))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -687,7 +658,7 @@ class WriteDataRequest(Message):
 class WriteDataResponse(Message):
     """Write one user parameter (response)."""
 
-    __slots__ = ('servo_id', 'data_id', 'result')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'data_id', 'result')
     PROTOCOL: ClassVar[str] = 'fashionstar_uart'
     COMMAND: ClassVar[str] = 'write_data'
@@ -700,15 +671,13 @@ class WriteDataResponse(Message):
     #: Outcome of the command. range 0..1
     result: Result | int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         data_id: int,
         result: Result | int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'data_id', data_id)
-        _store(self, 'result', result)
+    ) -> Self:
+        return _build(cls, (servo_id, data_id, result))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -730,7 +699,7 @@ class WriteDataResponse(Message):
 class ReadBatchDataRequest(Message):
     """Read the whole 32-byte user parameter block (request)."""
 
-    __slots__ = ('servo_id',)
+    __slots__ = ()
     __match_args__ = ('servo_id',)
     PROTOCOL: ClassVar[str] = 'fashionstar_uart'
     COMMAND: ClassVar[str] = 'read_batch_data'
@@ -739,11 +708,11 @@ class ReadBatchDataRequest(Message):
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
     servo_id: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
+    ) -> Self:
+        return _build(cls, (servo_id,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -761,7 +730,7 @@ class ReadBatchDataRequest(Message):
 class ReadBatchDataResponse(Message):
     """Read the whole 32-byte user parameter block (response)."""
 
-    __slots__ = ('servo_id', 'user_data')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'user_data')
     PROTOCOL: ClassVar[str] = 'fashionstar_uart'
     COMMAND: ClassVar[str] = 'read_batch_data'
@@ -772,13 +741,12 @@ class ReadBatchDataResponse(Message):
     #: The user parameters 32..53 in data_id order. (layout inferred, not documented)
     user_data: UserData
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         user_data: UserData,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'user_data', user_data)
+    ) -> Self:
+        return _build(cls, (servo_id, user_data))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -798,7 +766,7 @@ class ReadBatchDataResponse(Message):
 class WriteBatchDataRequest(Message):
     """Write the whole 32-byte user parameter block (request)."""
 
-    __slots__ = ('servo_id', 'user_data')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'user_data')
     PROTOCOL: ClassVar[str] = 'fashionstar_uart'
     COMMAND: ClassVar[str] = 'write_batch_data'
@@ -809,13 +777,12 @@ class WriteBatchDataRequest(Message):
     #: The user parameters 32..53 in data_id order. (layout inferred, not documented)
     user_data: UserData
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         user_data: UserData,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'user_data', user_data)
+    ) -> Self:
+        return _build(cls, (servo_id, user_data))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -835,7 +802,7 @@ class WriteBatchDataRequest(Message):
 class WriteBatchDataResponse(Message):
     """Write the whole 32-byte user parameter block (response)."""
 
-    __slots__ = ('servo_id', 'result')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'result')
     PROTOCOL: ClassVar[str] = 'fashionstar_uart'
     COMMAND: ClassVar[str] = 'write_batch_data'
@@ -846,13 +813,12 @@ class WriteBatchDataResponse(Message):
     #: Outcome of the command. range 0..1 (layout inferred, not documented)
     result: Result | int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         result: Result | int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'result', result)
+    ) -> Self:
+        return _build(cls, (servo_id, result))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -872,7 +838,7 @@ class WriteBatchDataResponse(Message):
 class SpinRequest(Message):
     """Wheel mode (request)."""
 
-    __slots__ = ('servo_id', 'method', 'speed', 'value')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'method', 'speed', 'value')
     PROTOCOL: ClassVar[str] = 'fashionstar_uart'
     COMMAND: ClassVar[str] = 'spin'
@@ -887,17 +853,14 @@ class SpinRequest(Message):
     #: Turns (mode turns) or ms (mode timed); ignored by stop and continuous.
     value: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         method: MethodBits,
         speed: int,
         value: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'method', method)
-        _store(self, 'speed', speed)
-        _store(self, 'value', value)
+    ) -> Self:
+        return _build(cls, (servo_id, method, speed, value))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -921,7 +884,7 @@ class SpinRequest(Message):
 class SpinResponse(Message):
     """Wheel mode (response). Optional: Sent only when response_switch (data_id 33) is 1, once the spin has finished."""
 
-    __slots__ = ('servo_id', 'result')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'result')
     PROTOCOL: ClassVar[str] = 'fashionstar_uart'
     COMMAND: ClassVar[str] = 'spin'
@@ -932,13 +895,12 @@ class SpinResponse(Message):
     #: Outcome of the command. range 0..1
     result: Result | int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         result: Result | int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'result', result)
+    ) -> Self:
+        return _build(cls, (servo_id, result))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -958,7 +920,7 @@ class SpinResponse(Message):
 class RotateRequest(Message):
     """Angle mode - move to an angle (request)."""
 
-    __slots__ = ('servo_id', 'angle', 'interval', 'power')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'angle', 'interval', 'power')
     PROTOCOL: ClassVar[str] = 'fashionstar_uart'
     COMMAND: ClassVar[str] = 'rotate'
@@ -971,19 +933,16 @@ class RotateRequest(Message):
     #: Time to reach the target angle. [ms]
     interval: int
     #: Power; 0 or more than the power limit means the power limit (000's 功率保持值, read as data_id 42: erratum power_hold_value_undefined). [mW]
-    power: int
+    power: int = 0
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         angle: int,
         interval: int,
         power: int = 0,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'angle', angle)
-        _store(self, 'interval', interval)
-        _store(self, 'power', power)
+    ) -> Self:
+        return _build(cls, (servo_id, angle, interval, power))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1007,7 +966,7 @@ class RotateRequest(Message):
 class RotateResponse(Message):
     """Angle mode - move to an angle (response). Optional: Sent only when response_switch (data_id 33) is 1, once the target angle is reached."""
 
-    __slots__ = ('servo_id', 'result')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'result')
     PROTOCOL: ClassVar[str] = 'fashionstar_uart'
     COMMAND: ClassVar[str] = 'rotate'
@@ -1018,13 +977,12 @@ class RotateResponse(Message):
     #: Outcome of the command. range 0..1
     result: Result | int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         result: Result | int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'result', result)
+    ) -> Self:
+        return _build(cls, (servo_id, result))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1044,7 +1002,7 @@ class RotateResponse(Message):
 class DampingRequest(Message):
     """Damping mode (request)."""
 
-    __slots__ = ('servo_id', 'power')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'power')
     PROTOCOL: ClassVar[str] = 'fashionstar_uart'
     COMMAND: ClassVar[str] = 'damping'
@@ -1055,13 +1013,12 @@ class DampingRequest(Message):
     #: Holding power; 0 or more than the power limit means the limit. [mW]
     power: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         power: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'power', power)
+    ) -> Self:
+        return _build(cls, (servo_id, power))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1081,7 +1038,7 @@ class DampingRequest(Message):
 class DampingResponse(Message):
     """Damping mode (response). Optional: Sent only when response_switch (data_id 33) is 1."""
 
-    __slots__ = ('servo_id', 'result')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'result')
     PROTOCOL: ClassVar[str] = 'fashionstar_uart'
     COMMAND: ClassVar[str] = 'damping'
@@ -1092,13 +1049,12 @@ class DampingResponse(Message):
     #: Outcome of the command. range 0..1
     result: Result | int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         result: Result | int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'result', result)
+    ) -> Self:
+        return _build(cls, (servo_id, result))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1118,7 +1074,7 @@ class DampingResponse(Message):
 class ReadAngleRequest(Message):
     """Read the current angle (request)."""
 
-    __slots__ = ('servo_id',)
+    __slots__ = ()
     __match_args__ = ('servo_id',)
     PROTOCOL: ClassVar[str] = 'fashionstar_uart'
     COMMAND: ClassVar[str] = 'read_angle'
@@ -1127,11 +1083,11 @@ class ReadAngleRequest(Message):
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
     servo_id: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
+    ) -> Self:
+        return _build(cls, (servo_id,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1149,7 +1105,7 @@ class ReadAngleRequest(Message):
 class ReadAngleResponse(Message):
     """Read the current angle (response)."""
 
-    __slots__ = ('servo_id', 'angle')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'angle')
     PROTOCOL: ClassVar[str] = 'fashionstar_uart'
     COMMAND: ClassVar[str] = 'read_angle'
@@ -1160,13 +1116,12 @@ class ReadAngleResponse(Message):
     #: Angle in 0.1° steps; the sign gives the direction (900 is 90°). [0.1°]
     angle: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         angle: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'angle', angle)
+    ) -> Self:
+        return _build(cls, (servo_id, angle))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1186,7 +1141,7 @@ class ReadAngleResponse(Message):
 class MoveByIntervalRequest(Message):
     """Move to an angle in a time, with acceleration and deceleration times (request)."""
 
-    __slots__ = ('servo_id', 'angle', 'interval', 't_acc', 't_dec', 'power')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'angle', 'interval', 't_acc', 't_dec', 'power')
     PROTOCOL: ClassVar[str] = 'fashionstar_uart'
     COMMAND: ClassVar[str] = 'move_by_interval'
@@ -1199,27 +1154,22 @@ class MoveByIntervalRequest(Message):
     #: Time to reach the target angle. [ms]
     interval: int
     #: Acceleration time at the start of the move (the SDK sends at least 20 ms). [ms]
-    t_acc: int
+    t_acc: int = 20
     #: Deceleration time at the end of the move (the SDK sends at least 20 ms). [ms]
-    t_dec: int
+    t_dec: int = 20
     #: Power limit of the move; 0 (or more than the power limit, data_id 42) means the power limit. [mW]
-    power: int
+    power: int = 0
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         angle: int,
         interval: int,
         t_acc: int = 20,
         t_dec: int = 20,
         power: int = 0,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'angle', angle)
-        _store(self, 'interval', interval)
-        _store(self, 't_acc', t_acc)
-        _store(self, 't_dec', t_dec)
-        _store(self, 'power', power)
+    ) -> Self:
+        return _build(cls, (servo_id, angle, interval, t_acc, t_dec, power))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1247,7 +1197,7 @@ class MoveByIntervalRequest(Message):
 class MoveByIntervalResponse(Message):
     """Move to an angle in a time, with acceleration and deceleration times (response). Optional: Inferred from ROTATE (the SDK waits for no reply): sent only when response_switch (data_id 33) is 1, once the target is reached."""
 
-    __slots__ = ('servo_id', 'result')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'result')
     PROTOCOL: ClassVar[str] = 'fashionstar_uart'
     COMMAND: ClassVar[str] = 'move_by_interval'
@@ -1258,13 +1208,12 @@ class MoveByIntervalResponse(Message):
     #: Outcome of the command. range 0..1
     result: Result | int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         result: Result | int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'result', result)
+    ) -> Self:
+        return _build(cls, (servo_id, result))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1284,7 +1233,7 @@ class MoveByIntervalResponse(Message):
 class MoveByVelocityRequest(Message):
     """Move to an angle at a speed, with acceleration and deceleration times (request)."""
 
-    __slots__ = ('servo_id', 'angle', 'velocity', 't_acc', 't_dec', 'power')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'angle', 'velocity', 't_acc', 't_dec', 'power')
     PROTOCOL: ClassVar[str] = 'fashionstar_uart'
     COMMAND: ClassVar[str] = 'move_by_velocity'
@@ -1297,27 +1246,22 @@ class MoveByVelocityRequest(Message):
     #: Target speed in 0.1°/s (the SDK clamps to 1.0..750.0 °/s). [0.1°/s] range 10..7500
     velocity: int
     #: Acceleration time at the start of the move (the SDK sends at least 20 ms). [ms]
-    t_acc: int
+    t_acc: int = 20
     #: Deceleration time at the end of the move (the SDK sends at least 20 ms). [ms]
-    t_dec: int
+    t_dec: int = 20
     #: Power limit of the move; 0 (or more than the power limit, data_id 42) means the power limit. [mW]
-    power: int
+    power: int = 0
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         angle: int,
         velocity: int,
         t_acc: int = 20,
         t_dec: int = 20,
         power: int = 0,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'angle', angle)
-        _store(self, 'velocity', velocity)
-        _store(self, 't_acc', t_acc)
-        _store(self, 't_dec', t_dec)
-        _store(self, 'power', power)
+    ) -> Self:
+        return _build(cls, (servo_id, angle, velocity, t_acc, t_dec, power))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1345,7 +1289,7 @@ class MoveByVelocityRequest(Message):
 class MoveByVelocityResponse(Message):
     """Move to an angle at a speed, with acceleration and deceleration times (response). Optional: Inferred from ROTATE (the SDK waits for no reply): sent only when response_switch (data_id 33) is 1, once the target is reached."""
 
-    __slots__ = ('servo_id', 'result')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'result')
     PROTOCOL: ClassVar[str] = 'fashionstar_uart'
     COMMAND: ClassVar[str] = 'move_by_velocity'
@@ -1356,13 +1300,12 @@ class MoveByVelocityResponse(Message):
     #: Outcome of the command. range 0..1
     result: Result | int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         result: Result | int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'result', result)
+    ) -> Self:
+        return _build(cls, (servo_id, result))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1382,7 +1325,7 @@ class MoveByVelocityResponse(Message):
 class MoveMturnRequest(Message):
     """Multi-turn move to an angle in a time (request)."""
 
-    __slots__ = ('servo_id', 'angle', 'interval', 'power')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'angle', 'interval', 'power')
     PROTOCOL: ClassVar[str] = 'fashionstar_uart'
     COMMAND: ClassVar[str] = 'move_mturn'
@@ -1395,19 +1338,16 @@ class MoveMturnRequest(Message):
     #: Time to reach the target angle. [ms] range 0..4096000
     interval: int
     #: Power limit of the move; 0 (or more than the power limit, data_id 42) means the power limit. [mW]
-    power: int
+    power: int = 0
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         angle: int,
         interval: int,
         power: int = 0,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'angle', angle)
-        _store(self, 'interval', interval)
-        _store(self, 'power', power)
+    ) -> Self:
+        return _build(cls, (servo_id, angle, interval, power))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1431,7 +1371,7 @@ class MoveMturnRequest(Message):
 class MoveMturnResponse(Message):
     """Multi-turn move to an angle in a time (response). Optional: Inferred from ROTATE (the SDK waits for no reply): sent only when response_switch (data_id 33) is 1, once the target is reached."""
 
-    __slots__ = ('servo_id', 'result')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'result')
     PROTOCOL: ClassVar[str] = 'fashionstar_uart'
     COMMAND: ClassVar[str] = 'move_mturn'
@@ -1442,13 +1382,12 @@ class MoveMturnResponse(Message):
     #: Outcome of the command. range 0..1
     result: Result | int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         result: Result | int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'result', result)
+    ) -> Self:
+        return _build(cls, (servo_id, result))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1468,7 +1407,7 @@ class MoveMturnResponse(Message):
 class MoveMturnByIntervalRequest(Message):
     """Multi-turn move in a time, with acceleration and deceleration times (request)."""
 
-    __slots__ = ('servo_id', 'angle', 'interval', 't_acc', 't_dec', 'power')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'angle', 'interval', 't_acc', 't_dec', 'power')
     PROTOCOL: ClassVar[str] = 'fashionstar_uart'
     COMMAND: ClassVar[str] = 'move_mturn_by_interval'
@@ -1481,27 +1420,22 @@ class MoveMturnByIntervalRequest(Message):
     #: Time to reach the target (at least t_acc + t_dec). [ms] range 0..4096000
     interval: int
     #: Acceleration time at the start of the move (the SDK sends at least 20 ms). [ms]
-    t_acc: int
+    t_acc: int = 20
     #: Deceleration time at the end of the move (the SDK sends at least 20 ms). [ms]
-    t_dec: int
+    t_dec: int = 20
     #: Power limit of the move; 0 (or more than the power limit, data_id 42) means the power limit. [mW]
-    power: int
+    power: int = 0
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         angle: int,
         interval: int,
         t_acc: int = 20,
         t_dec: int = 20,
         power: int = 0,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'angle', angle)
-        _store(self, 'interval', interval)
-        _store(self, 't_acc', t_acc)
-        _store(self, 't_dec', t_dec)
-        _store(self, 'power', power)
+    ) -> Self:
+        return _build(cls, (servo_id, angle, interval, t_acc, t_dec, power))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1529,7 +1463,7 @@ class MoveMturnByIntervalRequest(Message):
 class MoveMturnByIntervalResponse(Message):
     """Multi-turn move in a time, with acceleration and deceleration times (response). Optional: Inferred from ROTATE (the SDK waits for no reply): sent only when response_switch (data_id 33) is 1, once the target is reached."""
 
-    __slots__ = ('servo_id', 'result')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'result')
     PROTOCOL: ClassVar[str] = 'fashionstar_uart'
     COMMAND: ClassVar[str] = 'move_mturn_by_interval'
@@ -1540,13 +1474,12 @@ class MoveMturnByIntervalResponse(Message):
     #: Outcome of the command. range 0..1
     result: Result | int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         result: Result | int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'result', result)
+    ) -> Self:
+        return _build(cls, (servo_id, result))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1566,7 +1499,7 @@ class MoveMturnByIntervalResponse(Message):
 class MoveMturnByVelocityRequest(Message):
     """Multi-turn move at a speed, with acceleration and deceleration times (request)."""
 
-    __slots__ = ('servo_id', 'angle', 'velocity', 't_acc', 't_dec', 'power')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'angle', 'velocity', 't_acc', 't_dec', 'power')
     PROTOCOL: ClassVar[str] = 'fashionstar_uart'
     COMMAND: ClassVar[str] = 'move_mturn_by_velocity'
@@ -1579,27 +1512,22 @@ class MoveMturnByVelocityRequest(Message):
     #: Target speed in 0.1°/s (the SDK clamps to 1.0..750.0 °/s). [0.1°/s] range 10..7500
     velocity: int
     #: Acceleration time at the start of the move (the SDK sends at least 20 ms). [ms]
-    t_acc: int
+    t_acc: int = 20
     #: Deceleration time at the end of the move (the SDK sends at least 20 ms). [ms]
-    t_dec: int
+    t_dec: int = 20
     #: Power limit of the move; 0 (or more than the power limit, data_id 42) means the power limit. [mW]
-    power: int
+    power: int = 0
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         angle: int,
         velocity: int,
         t_acc: int = 20,
         t_dec: int = 20,
         power: int = 0,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'angle', angle)
-        _store(self, 'velocity', velocity)
-        _store(self, 't_acc', t_acc)
-        _store(self, 't_dec', t_dec)
-        _store(self, 'power', power)
+    ) -> Self:
+        return _build(cls, (servo_id, angle, velocity, t_acc, t_dec, power))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1627,7 +1555,7 @@ class MoveMturnByVelocityRequest(Message):
 class MoveMturnByVelocityResponse(Message):
     """Multi-turn move at a speed, with acceleration and deceleration times (response). Optional: Inferred from ROTATE (the SDK waits for no reply): sent only when response_switch (data_id 33) is 1, once the target is reached."""
 
-    __slots__ = ('servo_id', 'result')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'result')
     PROTOCOL: ClassVar[str] = 'fashionstar_uart'
     COMMAND: ClassVar[str] = 'move_mturn_by_velocity'
@@ -1638,13 +1566,12 @@ class MoveMturnByVelocityResponse(Message):
     #: Outcome of the command. range 0..1
     result: Result | int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         result: Result | int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'result', result)
+    ) -> Self:
+        return _build(cls, (servo_id, result))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1664,7 +1591,7 @@ class MoveMturnByVelocityResponse(Message):
 class ReadMturnAngleRequest(Message):
     """Read the multi-turn angle and turn count (request)."""
 
-    __slots__ = ('servo_id',)
+    __slots__ = ()
     __match_args__ = ('servo_id',)
     PROTOCOL: ClassVar[str] = 'fashionstar_uart'
     COMMAND: ClassVar[str] = 'read_mturn_angle'
@@ -1673,11 +1600,11 @@ class ReadMturnAngleRequest(Message):
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
     servo_id: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
+    ) -> Self:
+        return _build(cls, (servo_id,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1695,7 +1622,7 @@ class ReadMturnAngleRequest(Message):
 class ReadMturnAngleResponse(Message):
     """Read the multi-turn angle and turn count (response)."""
 
-    __slots__ = ('servo_id', 'angle', 'turns')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'angle', 'turns')
     PROTOCOL: ClassVar[str] = 'fashionstar_uart'
     COMMAND: ClassVar[str] = 'read_mturn_angle'
@@ -1708,15 +1635,13 @@ class ReadMturnAngleResponse(Message):
     #: Whole turns in the multi-turn angle (toward zero). (layout inferred, not documented)
     turns: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         angle: int,
         turns: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'angle', angle)
-        _store(self, 'turns', turns)
+    ) -> Self:
+        return _build(cls, (servo_id, angle, turns))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1738,7 +1663,7 @@ class ReadMturnAngleResponse(Message):
 class ResetMturnAngleRequest(Message):
     """Reset the multi-turn angle (request)."""
 
-    __slots__ = ('servo_id',)
+    __slots__ = ()
     __match_args__ = ('servo_id',)
     PROTOCOL: ClassVar[str] = 'fashionstar_uart'
     COMMAND: ClassVar[str] = 'reset_mturn_angle'
@@ -1747,11 +1672,11 @@ class ResetMturnAngleRequest(Message):
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
     servo_id: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
+    ) -> Self:
+        return _build(cls, (servo_id,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1776,6 +1701,9 @@ class BeginAsyncRequest(Message):
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
 
+    def __new__(cls) -> Self:
+        return _build(cls, ())
+
     def to_fields(self) -> dict[str, Any]:
         return {
         }
@@ -1790,7 +1718,7 @@ class BeginAsyncRequest(Message):
 class EndAsyncRequest(Message):
     """Run (or drop) the held move commands (request)."""
 
-    __slots__ = ('mode',)
+    __slots__ = ()
     __match_args__ = ('mode',)
     PROTOCOL: ClassVar[str] = 'fashionstar_uart'
     COMMAND: ClassVar[str] = 'end_async'
@@ -1799,11 +1727,11 @@ class EndAsyncRequest(Message):
     #: 0 runs the held commands, 1 drops them. range 0..1
     mode: AsyncEnd | int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         mode: AsyncEnd | int,
-    ) -> None:
-        _store(self, 'mode', mode)
+    ) -> Self:
+        return _build(cls, (mode,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1821,7 +1749,7 @@ class EndAsyncRequest(Message):
 class MonitorRequest(Message):
     """Read voltage, current, power, temperature, status and multi-turn angle at once (request)."""
 
-    __slots__ = ('servo_id',)
+    __slots__ = ()
     __match_args__ = ('servo_id',)
     PROTOCOL: ClassVar[str] = 'fashionstar_uart'
     COMMAND: ClassVar[str] = 'monitor'
@@ -1830,11 +1758,11 @@ class MonitorRequest(Message):
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
     servo_id: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
+    ) -> Self:
+        return _build(cls, (servo_id,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1852,7 +1780,7 @@ class MonitorRequest(Message):
 class MonitorResponse(Message):
     """Read voltage, current, power, temperature, status and multi-turn angle at once (response)."""
 
-    __slots__ = ('servo_id', 'voltage', 'current', 'power', 'temperature', 'status', 'angle', 'turns')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'voltage', 'current', 'power', 'temperature', 'status', 'angle', 'turns')
     PROTOCOL: ClassVar[str] = 'fashionstar_uart'
     COMMAND: ClassVar[str] = 'monitor'
@@ -1875,8 +1803,8 @@ class MonitorResponse(Message):
     #: Whole turns in the multi-turn angle (toward zero). (layout inferred, not documented)
     turns: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         voltage: int,
         current: int,
@@ -1885,15 +1813,8 @@ class MonitorResponse(Message):
         status: ServoStatus,
         angle: int,
         turns: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'voltage', voltage)
-        _store(self, 'current', current)
-        _store(self, 'power', power)
-        _store(self, 'temperature', temperature)
-        _store(self, 'status', status)
-        _store(self, 'angle', angle)
-        _store(self, 'turns', turns)
+    ) -> Self:
+        return _build(cls, (servo_id, voltage, current, power, temperature, status, angle, turns))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1925,7 +1846,7 @@ class MonitorResponse(Message):
 class SetOriginPointRequest(Message):
     """Make the present position the origin (request)."""
 
-    __slots__ = ('servo_id',)
+    __slots__ = ()
     __match_args__ = ('servo_id',)
     PROTOCOL: ClassVar[str] = 'fashionstar_uart'
     COMMAND: ClassVar[str] = 'set_origin_point'
@@ -1934,11 +1855,11 @@ class SetOriginPointRequest(Message):
     #: Servo id (0..254; 255 is the broadcast address and cannot be assigned to a servo). range 0..254
     servo_id: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
+    ) -> Self:
+        return _build(cls, (servo_id,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1956,7 +1877,7 @@ class SetOriginPointRequest(Message):
 class StopOnControlModeRequest(Message):
     """Stop the move, then release, hold or damp (request)."""
 
-    __slots__ = ('servo_id', 'method', 'power')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'method', 'power')
     PROTOCOL: ClassVar[str] = 'fashionstar_uart'
     COMMAND: ClassVar[str] = 'stop_on_control_mode'
@@ -1969,15 +1890,13 @@ class StopOnControlModeRequest(Message):
     #: Holding power (hold and damping). [mW]
     power: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         method: StopMethod | int,
         power: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'method', method)
-        _store(self, 'power', power)
+    ) -> Self:
+        return _build(cls, (servo_id, method, power))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1999,7 +1918,7 @@ class StopOnControlModeRequest(Message):
 class SyncCommandRequest(Message):
     """One command for several servos at once (request)."""
 
-    __slots__ = ('command', 'blocks')
+    __slots__ = ()
     __match_args__ = ('command', 'blocks')
     PROTOCOL: ClassVar[str] = 'fashionstar_uart'
     COMMAND: ClassVar[str] = 'sync_command'
@@ -2010,13 +1929,12 @@ class SyncCommandRequest(Message):
     #: One block per servo.
     blocks: tuple[BlocksItem, ...]
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         command: int,
         blocks: tuple[BlocksItem, ...],
-    ) -> None:
-        _store(self, 'command', command)
-        _store(self, 'blocks', blocks)
+    ) -> Self:
+        return _build(cls, (command, blocks))
 
     def to_fields(self) -> dict[str, Any]:
         return {

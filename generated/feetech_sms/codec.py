@@ -9,7 +9,8 @@ from collections.abc import Callable
 from serialspec.runtime.checksums import BYTE_VALUES as _BYTES
 from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError, content_size_error, out_of_range
 from serialspec.runtime.fields import wrong_type
-from serialspec.runtime.message import Direction, Message, members, slot_setters
+from serialspec.runtime.message import Direction, Message, members
+from serialspec.runtime.message import build as _new  # a message from the tuple of its field values, in one call
 from serialspec.runtime.stream import FrameFormat
 from serialspec.runtime.stream import StreamParser as _StreamParser
 
@@ -37,87 +38,50 @@ _S_U8 = struct.Struct('<B')
 _S_U8_U8 = struct.Struct('<BB')
 _S_U8_U8_U8 = struct.Struct('<BBB')
 
-# Decoders build messages with object.__new__ and store each value straight into its slot: a message's __init__
-# (frozen) goes through object.__setattr__ per field, which costs more than unpacking the whole frame.
-_new = object.__new__
-(_set_ActionRequest_id,) = slot_setters(ActionRequest)
-(_set_IdsItem_id,) = slot_setters(IdsItem)
-(_set_PingRequest_id,) = slot_setters(PingRequest)
-_set_ReadRequest_id, _set_ReadRequest_address, _set_ReadRequest_length = slot_setters(ReadRequest)
-_set_RegWriteRequest_id, _set_RegWriteRequest_address, _set_RegWriteRequest_data = slot_setters(RegWriteRequest)
-_set_ReplyResponse_id, _set_ReplyResponse_error, _set_ReplyResponse_data = slot_setters(ReplyResponse)
-(_set_ResetRequest_id,) = slot_setters(ResetRequest)
-_set_ServosItem_id, _set_ServosItem_data = slot_setters(ServosItem)
-(
-    _set_SyncReadRequest_id,
-    _set_SyncReadRequest_address,
-    _set_SyncReadRequest_length,
-    _set_SyncReadRequest_ids,
-) = slot_setters(SyncReadRequest)
-_set_SyncWriteRequest_id, _set_SyncWriteRequest_address, _set_SyncWriteRequest_servos = slot_setters(SyncWriteRequest)
-_set_WriteRequest_id, _set_WriteRequest_address, _set_WriteRequest_data = slot_setters(WriteRequest)
 _MEMBERS_ErrorStatus = members(ErrorStatus)
 
 
 def _decode_ping_request(buf: bytes, o: int, end: int, id: int) -> PingRequest:
     if end - o != 0:
         raise content_size_error('ping request', end - o, 0, 0)
-    m = _new(PingRequest)
-    _set_PingRequest_id(m, id)
-    return m
+    return _new(PingRequest, (id,))
 
 
 def _decode_read_request(buf: bytes, o: int, end: int, id: int) -> ReadRequest:
     if end - o != 2:
         raise content_size_error('read request', end - o, 2, 2)
     v_address, v_length = _S_U8_U8.unpack_from(buf, o)
-    m = _new(ReadRequest)
-    _set_ReadRequest_id(m, id)
-    _set_ReadRequest_address(m, v_address)
-    _set_ReadRequest_length(m, v_length)
-    return m
+    return _new(ReadRequest, (id, v_address, v_length))
 
 
 def _decode_write_request(buf: bytes, o: int, end: int, id: int) -> WriteRequest:
     if end - o < 1:
         raise content_size_error('write request', end - o, 1, None)
-    v_address, = _S_U8.unpack_from(buf, o)
+    v_address = buf[o]
     o += 1
     v_data = buf[o:end]
-    m = _new(WriteRequest)
-    _set_WriteRequest_id(m, id)
-    _set_WriteRequest_address(m, v_address)
-    _set_WriteRequest_data(m, v_data)
-    return m
+    return _new(WriteRequest, (id, v_address, v_data))
 
 
 def _decode_reg_write_request(buf: bytes, o: int, end: int, id: int) -> RegWriteRequest:
     if end - o < 1:
         raise content_size_error('reg_write request', end - o, 1, None)
-    v_address, = _S_U8.unpack_from(buf, o)
+    v_address = buf[o]
     o += 1
     v_data = buf[o:end]
-    m = _new(RegWriteRequest)
-    _set_RegWriteRequest_id(m, id)
-    _set_RegWriteRequest_address(m, v_address)
-    _set_RegWriteRequest_data(m, v_data)
-    return m
+    return _new(RegWriteRequest, (id, v_address, v_data))
 
 
 def _decode_action_request(buf: bytes, o: int, end: int, id: int) -> ActionRequest:
     if end - o != 0:
         raise content_size_error('action request', end - o, 0, 0)
-    m = _new(ActionRequest)
-    _set_ActionRequest_id(m, id)
-    return m
+    return _new(ActionRequest, (id,))
 
 
 def _decode_reset_request(buf: bytes, o: int, end: int, id: int) -> ResetRequest:
     if end - o != 0:
         raise content_size_error('reset request', end - o, 0, 0)
-    m = _new(ResetRequest)
-    _set_ResetRequest_id(m, id)
-    return m
+    return _new(ResetRequest, (id,))
 
 
 def _decode_sync_read_request(buf: bytes, o: int, end: int, id: int) -> SyncReadRequest:
@@ -125,21 +89,11 @@ def _decode_sync_read_request(buf: bytes, o: int, end: int, id: int) -> SyncRead
         raise content_size_error('sync_read request', end - o, 2, None)
     v_address, v_length = _S_U8_U8.unpack_from(buf, o)
     o += 2
-    v_ids_list = []
     if (end - o) % 1:
         raise DecodeError('sync_read request' + f': {end - o} bytes do not split into ids items of 1')
     n = end - o
-    for v_id, in _S_U8.iter_unpack(buf[o : o + n]):
-        item = _new(IdsItem)
-        _set_IdsItem_id(item, v_id)
-        v_ids_list.append(item)
-    v_ids = tuple(v_ids_list)
-    m = _new(SyncReadRequest)
-    _set_SyncReadRequest_id(m, id)
-    _set_SyncReadRequest_address(m, v_address)
-    _set_SyncReadRequest_length(m, v_length)
-    _set_SyncReadRequest_ids(m, v_ids)
-    return m
+    v_ids = tuple([_new(IdsItem, values) for values in _S_U8.iter_unpack(buf[o : o + n])])
+    return _new(SyncReadRequest, (id, v_address, v_length, v_ids))
 
 
 def _decode_sync_write_request(buf: bytes, o: int, end: int, id: int) -> SyncWriteRequest:
@@ -149,24 +103,18 @@ def _decode_sync_write_request(buf: bytes, o: int, end: int, id: int) -> SyncWri
     o += 2
     v_servos_list = []
     while o < end:
-        v_id, = _S_U8.unpack_from(buf, o)
+        v_id = buf[o]
         o += 1
         if end - o < v_data_length:
             raise DecodeError('sync_write request' + f': data needs {v_data_length} bytes, {end - o} left')
         v_data = buf[o : o + v_data_length]
         o += v_data_length
-        item = _new(ServosItem)
-        _set_ServosItem_id(item, v_id)
-        _set_ServosItem_data(item, v_data)
+        item = _new(ServosItem, (v_id, v_data))
         v_servos_list.append(item)
     v_servos = tuple(v_servos_list)
     if o != end:
         raise DecodeError('sync_write request' + f': {end - o} bytes left after the last field')
-    m = _new(SyncWriteRequest)
-    _set_SyncWriteRequest_id(m, id)
-    _set_SyncWriteRequest_address(m, v_address)
-    _set_SyncWriteRequest_servos(m, v_servos)
-    return m
+    return _new(SyncWriteRequest, (id, v_address, v_servos))
 
 
 def _decode_reply_response(buf: bytes, o: int, end: int, id: int, error: int) -> ReplyResponse:
@@ -174,11 +122,7 @@ def _decode_reply_response(buf: bytes, o: int, end: int, id: int, error: int) ->
     error_flags = _MEMBERS_ErrorStatus.get(error)
     if error_flags is None:
         error_flags = ErrorStatus(error)
-    m = _new(ReplyResponse)
-    _set_ReplyResponse_id(m, id)
-    _set_ReplyResponse_error(m, error_flags)
-    _set_ReplyResponse_data(m, v_data)
-    return m
+    return _new(ReplyResponse, (id, error_flags, v_data))
 
 
 def _frame_ping_request(buf: bytes, start: int) -> PingRequest | None:
@@ -187,9 +131,7 @@ def _frame_ping_request(buf: bytes, start: int) -> PingRequest | None:
     if expected != buf[start + 5]:
         return None
     id = buf[start + 2]
-    m = _new(PingRequest)
-    _set_PingRequest_id(m, id)
-    return m
+    return _new(PingRequest, (id,))
 
 
 def _frame_read_request(buf: bytes, start: int) -> ReadRequest | None:
@@ -198,11 +140,7 @@ def _frame_read_request(buf: bytes, start: int) -> ReadRequest | None:
     v_address, v_length, check = _S_U8_U8_U8.unpack_from(buf, start + 5)
     if ~(0x6 + id + v_address + v_length) & 0xff != check:
         return None
-    m = _new(ReadRequest)
-    _set_ReadRequest_id(m, id)
-    _set_ReadRequest_address(m, v_address)
-    _set_ReadRequest_length(m, v_length)
-    return m
+    return _new(ReadRequest, (id, v_address, v_length))
 
 
 def _frame_action_request(buf: bytes, start: int) -> ActionRequest | None:
@@ -211,9 +149,7 @@ def _frame_action_request(buf: bytes, start: int) -> ActionRequest | None:
     if expected != buf[start + 5]:
         return None
     id = buf[start + 2]
-    m = _new(ActionRequest)
-    _set_ActionRequest_id(m, id)
-    return m
+    return _new(ActionRequest, (id,))
 
 
 def _frame_reset_request(buf: bytes, start: int) -> ResetRequest | None:
@@ -222,122 +158,206 @@ def _frame_reset_request(buf: bytes, start: int) -> ResetRequest | None:
     if expected != buf[start + 5]:
         return None
     id = buf[start + 2]
-    m = _new(ResetRequest)
-    _set_ResetRequest_id(m, id)
-    return m
+    return _new(ResetRequest, (id,))
+
+
+def _whole_ping_request(buf: bytes) -> PingRequest | None:
+    """A whole ping request frame, all of buf, size and header known: None if its checksum fails."""
+    check = buf[5]
+    if ~(sum(buf) - 0x1fe - check) & 0xff != check:
+        return None
+    id = buf[2]
+    return _new(PingRequest, (id,))
+
+
+def _whole_read_request(buf: bytes) -> ReadRequest | None:
+    """A whole read request frame, all of buf, size and header known: None if its checksum fails."""
+    id = buf[2]
+    v_address, v_length, check = _S_U8_U8_U8.unpack_from(buf, 5)
+    if ~(0x6 + id + v_address + v_length) & 0xff != check:
+        return None
+    return _new(ReadRequest, (id, v_address, v_length))
+
+
+def _whole_action_request(buf: bytes) -> ActionRequest | None:
+    """A whole action request frame, all of buf, size and header known: None if its checksum fails."""
+    check = buf[5]
+    if ~(sum(buf) - 0x1fe - check) & 0xff != check:
+        return None
+    id = buf[2]
+    return _new(ActionRequest, (id,))
+
+
+def _whole_reset_request(buf: bytes) -> ResetRequest | None:
+    """A whole reset request frame, all of buf, size and header known: None if its checksum fails."""
+    check = buf[5]
+    if ~(sum(buf) - 0x1fe - check) & 0xff != check:
+        return None
+    id = buf[2]
+    return _new(ResetRequest, (id,))
+
+
+def _whole_write_request(buf: bytes) -> WriteRequest | None:
+    """A whole write request frame, all of buf, its size and first bytes known: None if its checksum fails."""
+    check = buf[-1]
+    if ~(sum(buf) - 0x1fe - check) & 0xff != check:
+        return None
+    id = buf[2]
+    v_address = buf[5]
+    v_data = buf[6:-1]
+    return _new(WriteRequest, (id, v_address, v_data))
+
+
+def _whole_reg_write_request(buf: bytes) -> RegWriteRequest | None:
+    """A whole reg_write request frame, all of buf, its size and first bytes known: None if its checksum fails."""
+    check = buf[-1]
+    if ~(sum(buf) - 0x1fe - check) & 0xff != check:
+        return None
+    id = buf[2]
+    v_address = buf[5]
+    v_data = buf[6:-1]
+    return _new(RegWriteRequest, (id, v_address, v_data))
 
 
 def _encode_ping_request(m: PingRequest) -> bytes:
-    if not 0 <= m.id <= 254 or m.id.__class__ is bool:
-        raise out_of_range('ping request', 'id', m.id, 0, 253)
-    body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m.id, 2, 1)
+    m_id = m.id
+    if not 0 <= m_id <= 254 or m_id.__class__ is bool:
+        raise out_of_range('ping request', 'id', m_id, 0, 253)
+    body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m_id, 2, 1)
     return body + _BYTES[~sum(body[2:]) & 0xff]
 
 
 def _encode_read_request(m: ReadRequest) -> bytes:
-    if not 0 <= m.id <= 254 or m.id.__class__ is bool:
-        raise out_of_range('read request', 'id', m.id, 0, 253)
-    if not 0 <= m.address <= 255 or m.address.__class__ is bool:
-        raise out_of_range('read request', 'address', m.address, 0, 255)
-    if not 1 <= m.length <= 250 or m.length.__class__ is bool:
-        raise out_of_range('read request', 'length', m.length, 1, 250)
-    body = _S_B2_U8_U8_U8_U8_U8.pack(b'\xff\xff', m.id, 4, 2, m.address, m.length)
+    m_id = m.id
+    m_address = m.address
+    m_length = m.length
+    if not 0 <= m_id <= 254 or m_id.__class__ is bool:
+        raise out_of_range('read request', 'id', m_id, 0, 253)
+    if not 0 <= m_address <= 255 or m_address.__class__ is bool:
+        raise out_of_range('read request', 'address', m_address, 0, 255)
+    if not 1 <= m_length <= 250 or m_length.__class__ is bool:
+        raise out_of_range('read request', 'length', m_length, 1, 250)
+    body = _S_B2_U8_U8_U8_U8_U8.pack(b'\xff\xff', m_id, 4, 2, m_address, m_length)
     return body + _BYTES[~sum(body[2:]) & 0xff]
 
 
 def _encode_write_request(m: WriteRequest) -> bytes:
-    if not 0 <= m.id <= 254 or m.id.__class__ is bool:
-        raise out_of_range('write request', 'id', m.id, 0, 253)
-    if not 0 <= m.address <= 255 or m.address.__class__ is bool:
-        raise out_of_range('write request', 'address', m.address, 0, 255)
-    content = bytes(m.data)
+    m_id = m.id
+    m_address = m.address
+    m_data = m.data
+    if not 0 <= m_id <= 254 or m_id.__class__ is bool:
+        raise out_of_range('write request', 'id', m_id, 0, 253)
+    if not 0 <= m_address <= 255 or m_address.__class__ is bool:
+        raise out_of_range('write request', 'address', m_address, 0, 255)
+    v_data = m_data if m_data.__class__ is bytes else bytes(m_data)
+    content = v_data
     n = len(content) + 3
     if n > 255:
         raise EncodeError(f'content of {n - 2} bytes does not fit the length field')
-    body = _S_B2_U8_U8_U8_U8.pack(b'\xff\xff', m.id, n, 3, m.address) + content
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xff\xff', m_id, n, 3, m_address) + content
     return body + _BYTES[~sum(body[2:]) & 0xff]
 
 
 def _encode_reg_write_request(m: RegWriteRequest) -> bytes:
-    if not 0 <= m.id <= 254 or m.id.__class__ is bool:
-        raise out_of_range('reg_write request', 'id', m.id, 0, 253)
-    if not 0 <= m.address <= 255 or m.address.__class__ is bool:
-        raise out_of_range('reg_write request', 'address', m.address, 0, 255)
-    content = bytes(m.data)
+    m_id = m.id
+    m_address = m.address
+    m_data = m.data
+    if not 0 <= m_id <= 254 or m_id.__class__ is bool:
+        raise out_of_range('reg_write request', 'id', m_id, 0, 253)
+    if not 0 <= m_address <= 255 or m_address.__class__ is bool:
+        raise out_of_range('reg_write request', 'address', m_address, 0, 255)
+    v_data = m_data if m_data.__class__ is bytes else bytes(m_data)
+    content = v_data
     n = len(content) + 3
     if n > 255:
         raise EncodeError(f'content of {n - 2} bytes does not fit the length field')
-    body = _S_B2_U8_U8_U8_U8.pack(b'\xff\xff', m.id, n, 4, m.address) + content
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xff\xff', m_id, n, 4, m_address) + content
     return body + _BYTES[~sum(body[2:]) & 0xff]
 
 
 def _encode_action_request(m: ActionRequest) -> bytes:
-    if not 0 <= m.id <= 254 or m.id.__class__ is bool:
-        raise out_of_range('action request', 'id', m.id, 0, 253)
-    body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m.id, 2, 5)
+    m_id = m.id
+    if not 0 <= m_id <= 254 or m_id.__class__ is bool:
+        raise out_of_range('action request', 'id', m_id, 0, 253)
+    body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m_id, 2, 5)
     return body + _BYTES[~sum(body[2:]) & 0xff]
 
 
 def _encode_reset_request(m: ResetRequest) -> bytes:
-    if not 0 <= m.id <= 254 or m.id.__class__ is bool:
-        raise out_of_range('reset request', 'id', m.id, 0, 253)
-    body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m.id, 2, 6)
+    m_id = m.id
+    if not 0 <= m_id <= 254 or m_id.__class__ is bool:
+        raise out_of_range('reset request', 'id', m_id, 0, 253)
+    body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m_id, 2, 6)
     return body + _BYTES[~sum(body[2:]) & 0xff]
 
 
 def _encode_sync_read_request(m: SyncReadRequest) -> bytes:
-    if not 0 <= m.id <= 254 or m.id.__class__ is bool:
-        raise out_of_range('sync_read request', 'id', m.id, 0, 253)
-    if not 0 <= m.address <= 255 or m.address.__class__ is bool:
-        raise out_of_range('sync_read request', 'address', m.address, 0, 255)
-    if not 1 <= m.length <= 250 or m.length.__class__ is bool:
-        raise out_of_range('sync_read request', 'length', m.length, 1, 250)
+    m_id = m.id
+    m_address = m.address
+    m_length = m.length
+    if not 0 <= m_id <= 254 or m_id.__class__ is bool:
+        raise out_of_range('sync_read request', 'id', m_id, 0, 253)
+    if not 0 <= m_address <= 255 or m_address.__class__ is bool:
+        raise out_of_range('sync_read request', 'address', m_address, 0, 255)
+    if not 1 <= m_length <= 250 or m_length.__class__ is bool:
+        raise out_of_range('sync_read request', 'length', m_length, 1, 250)
     parts_ids = []
     for item in m.ids:
-        if not 0 <= item.id <= 253 or item.id.__class__ is bool:
-            raise out_of_range('sync_read request', 'id', item.id, 0, 253)
-        parts_ids.append(_S_U8.pack(item.id))
+        item_id = item.id
+        if not 0 <= item_id <= 253 or item_id.__class__ is bool:
+            raise out_of_range('sync_read request', 'id', item_id, 0, 253)
+        parts_ids.append(_S_U8.pack(item_id))
     content = b''.join(parts_ids)
     n = len(content) + 4
     if n > 255:
         raise EncodeError(f'content of {n - 2} bytes does not fit the length field')
-    body = _S_B2_U8_U8_U8_U8_U8.pack(b'\xff\xff', m.id, n, 130, m.address, m.length) + content
+    body = _S_B2_U8_U8_U8_U8_U8.pack(b'\xff\xff', m_id, n, 130, m_address, m_length) + content
     return body + _BYTES[~sum(body[2:]) & 0xff]
 
 
 def _encode_sync_write_request(m: SyncWriteRequest) -> bytes:
-    if not 0 <= m.id <= 254 or m.id.__class__ is bool:
-        raise out_of_range('sync_write request', 'id', m.id, 0, 253)
-    if not 0 <= m.address <= 255 or m.address.__class__ is bool:
-        raise out_of_range('sync_write request', 'address', m.address, 0, 255)
-    v_data_length = len(m.servos[0].data) if m.servos else 0
-    if any(len(item.data) != v_data_length for item in m.servos):
+    m_id = m.id
+    m_address = m.address
+    m_servos = m.servos
+    if not 0 <= m_id <= 254 or m_id.__class__ is bool:
+        raise out_of_range('sync_write request', 'id', m_id, 0, 253)
+    if not 0 <= m_address <= 255 or m_address.__class__ is bool:
+        raise out_of_range('sync_write request', 'address', m_address, 0, 255)
+    v_data_length = len(m_servos[0].data) if m_servos else 0
+    if any(len(item.data) != v_data_length for item in m_servos):
         raise EncodeError('sync_write request' + ': every data of servos must have the same length')
     if v_data_length > 255:
         raise out_of_range('sync_write request', 'data_length', v_data_length, 0, 255)
     parts_servos = []
-    for item in m.servos:
-        if not 0 <= item.id <= 253 or item.id.__class__ is bool:
-            raise out_of_range('sync_write request', 'id', item.id, 0, 253)
-        parts_servos.append(b''.join((_S_U8.pack(item.id), bytes(item.data),)))
+    for item in m_servos:
+        item_id = item.id
+        item_data = item.data
+        if not 0 <= item_id <= 253 or item_id.__class__ is bool:
+            raise out_of_range('sync_write request', 'id', item_id, 0, 253)
+        v_data = item_data if item_data.__class__ is bytes else bytes(item_data)
+        parts_servos.append(b''.join((_S_U8.pack(item_id), v_data,)))
     content = b''.join(parts_servos)
     n = len(content) + 4
     if n > 255:
         raise EncodeError(f'content of {n - 2} bytes does not fit the length field')
-    body = _S_B2_U8_U8_U8_U8_U8.pack(b'\xff\xff', m.id, n, 131, m.address, v_data_length) + content
+    body = _S_B2_U8_U8_U8_U8_U8.pack(b'\xff\xff', m_id, n, 131, m_address, v_data_length) + content
     return body + _BYTES[~sum(body[2:]) & 0xff]
 
 
 def _encode_reply_response(m: ReplyResponse) -> bytes:
-    if not 0 <= m.id <= 254 or m.id.__class__ is bool:
-        raise out_of_range('reply response', 'id', m.id, 0, 253)
-    if not 0 <= m.error <= 255 or isinstance(m.error, bool):
-        raise out_of_range('reply response', 'error', m.error, 0, 255)
-    content = bytes(m.data)
+    m_id = m.id
+    m_error = m.error
+    m_data = m.data
+    if not 0 <= m_id <= 254 or m_id.__class__ is bool:
+        raise out_of_range('reply response', 'id', m_id, 0, 253)
+    if not 0 <= m_error <= 255 or isinstance(m_error, bool):
+        raise out_of_range('reply response', 'error', m_error, 0, 255)
+    v_data = m_data if m_data.__class__ is bytes else bytes(m_data)
+    content = v_data
     n = len(content) + 2
     if n > 255:
         raise EncodeError(f'content of {n - 2} bytes does not fit the length field')
-    body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m.id, n, m.error) + content
+    body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m_id, n, m_error) + content
     return body + _BYTES[~sum(body[2:]) & 0xff]
 
 
@@ -370,13 +390,23 @@ _REQUEST_FIXED: dict[int, tuple[int, Callable[[bytes, int], Message | None]]] = 
 }
 
 
+# The same frames for decode(), by size key: frame size, decoder.
+_REQUEST_WHOLE: dict[int, tuple[int, Callable[[bytes], Message | None]]] = {
+    0x0102: (6, _whole_ping_request),
+    0x0204: (8, _whole_read_request),
+    0x0502: (6, _whole_action_request),
+    0x0602: (6, _whole_reset_request),
+    **{0x03 << 8 | n: (n + 4, _whole_write_request) for n in range(3, 256)},
+    **{0x04 << 8 | n: (n + 4, _whole_reg_write_request) for n in range(3, 256)},
+}
 
 
 def _decode_request_at(buf: bytes, start: int, stop: int) -> Message:
     """The frame buf[start:stop], whose header and length byte the stream parser has checked."""
+    check = buf[stop - 1]
     expected = ~sum(buf[start + 2 : stop - 1]) & 0xff
-    if expected != buf[stop - 1]:
-        raise ChecksumError(f"bad checksum: the frame has {buf[stop - 1]:#04x}, its bytes give {expected:#04x}")
+    if expected != check:
+        raise ChecksumError(f"bad checksum: the frame has {check:#04x}, its bytes give {expected:#04x}")
     decoder = _REQUEST_DECODERS.get(buf[start + 4])
     if decoder is None:
         raise DecodeError(f"unknown command {buf[start + 4]:#04x}")
@@ -398,12 +428,15 @@ _RESPONSE_FIXED: dict[int, tuple[int, Callable[[bytes, int], Message | None]]] =
 
 def _decode_response_at(buf: bytes, start: int, stop: int) -> Message:
     """The frame buf[start:stop], whose header and length byte the stream parser has checked."""
+    check = buf[stop - 1]
     expected = ~sum(buf[start + 2 : stop - 1]) & 0xff
-    if expected != buf[stop - 1]:
-        raise ChecksumError(f"bad checksum: the frame has {buf[stop - 1]:#04x}, its bytes give {expected:#04x}")
+    if expected != check:
+        raise ChecksumError(f"bad checksum: the frame has {check:#04x}, its bytes give {expected:#04x}")
     return _decode_reply_response(buf, start + 5, stop - 1, buf[start + 2], buf[start + 4])
 
 
+_REQUEST = Direction.REQUEST
+_RESPONSE = Direction.RESPONSE
 _ENCODERS: dict[type[Message], Callable[..., bytes]] = {
     PingRequest: _encode_ping_request,
     ReadRequest: _encode_read_request,
@@ -443,57 +476,65 @@ RESPONSE_FORMAT = FrameFormat(
 def decode(data: bytes, direction: Direction | str | None = None, expect: type[Message] | None = None) -> Message:
     """Decode one complete frame into its message; raises DecodeError with a one-line reason.
 
-    Each direction's checks are inline here rather than in a function per direction: one call less per frame.
+    Each direction's checks are inline here rather than in a function per direction: one call less per frame. A
+    Direction is told by identity, first; its value as text ("request") costs one call more.
     `expect` (the reply class a frame answers) matters only where replies share a code; here none do.
     """
-    if direction is None:
-        raise DecodeError("give the direction: requests and responses share the header ff ff")
-    if direction == 'request':  # a Direction or its value
+    if direction is _REQUEST:
         n = len(data)
         if n < 6:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (6 bytes)")
-        if not (0 <= data[2] <= 253 or data[2] == 254) and data[:2] == b'\xff\xff':
-            raise DecodeError(f"id = {data[2]} is outside its range 0..253 (or 254)")
-        fixed = _REQUEST_FIXED.get(data[4] << 8 | data[3])
-        if fixed is not None and fixed[0] == n and data[:2] == b'\xff\xff':
-            message = fixed[1](data, 0)
-            if message is not None:
-                return message
         if data[:2] != b'\xff\xff':
             raise DecodeError(f"request header is {data[:2].hex(' ')}, expected ff ff")
+        if data[2] > 254:
+            raise DecodeError(f"id = {data[2]} is outside its range 0..253 (or 254)")
+        fixed = _REQUEST_WHOLE.get(data[4] << 8 | data[3])
+        if fixed is not None and fixed[0] == n:
+            message = fixed[1](data)
+            if message is not None:
+                return message
         size = data[3] - 2
         if size < 0 or n != 6 + size:
             raise DecodeError(f"length byte says {size} content bytes but the frame holds {n - 6}")
-        expected = ~sum(data[2:-1]) & 0xff
-        if expected != data[-1]:
-            raise ChecksumError(f"bad checksum: the frame has {data[-1]:#04x}, its bytes give {expected:#04x}")
+        check = data[-1]
+        expected = ~(sum(data) - 0x1fe - check) & 0xff
+        if expected != check:
+            raise ChecksumError(f"bad checksum: the frame has {check:#04x}, its bytes give {expected:#04x}")
         decoder = _REQUEST_DECODERS.get(data[4])
         if decoder is None:
             raise DecodeError(f"unknown command {data[4]:#04x}")
         return decoder(data, 5, n - 1, data[2])
-    if direction == 'response':  # a Direction or its value
+    if direction is _RESPONSE:
         n = len(data)
         if n < 6:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (6 bytes)")
-        if not (0 <= data[2] <= 253 or data[2] == 254) and data[:2] == b'\xff\xff':
-            raise DecodeError(f"id = {data[2]} is outside its range 0..253 (or 254)")
         if data[:2] != b'\xff\xff':
             raise DecodeError(f"response header is {data[:2].hex(' ')}, expected ff ff")
+        if data[2] > 254:
+            raise DecodeError(f"id = {data[2]} is outside its range 0..253 (or 254)")
         size = data[3] - 2
         if size < 0 or n != 6 + size:
             raise DecodeError(f"length byte says {size} content bytes but the frame holds {n - 6}")
-        expected = ~sum(data[2:-1]) & 0xff
-        if expected != data[-1]:
-            raise ChecksumError(f"bad checksum: the frame has {data[-1]:#04x}, its bytes give {expected:#04x}")
+        check = data[-1]
+        expected = ~(sum(data) - 0x1fe - check) & 0xff
+        if expected != check:
+            raise ChecksumError(f"bad checksum: the frame has {check:#04x}, its bytes give {expected:#04x}")
         return _decode_reply_response(data, 5, n - 1, data[2], data[4])
+    if direction == 'request':  # its value as text
+        return decode(data, _REQUEST, expect)
+    if direction == 'response':  # its value as text
+        return decode(data, _RESPONSE, expect)
+    if direction is None:  # last: a caller that knows the direction does not pay for this
+        raise DecodeError("give the direction: requests and responses share the header ff ff")
     raise ValueError(f"direction must be request or response, not {direction!r}")
 
 
 def encode(message: Message) -> bytes:
     """Encode a message as a complete frame; raises EncodeError (RangeError for values out of range)."""
-    encoder = _ENCODERS.get(type(message))
-    if encoder is None:
-        raise EncodeError(f"{type(message).__name__} is not a feetech_sms message")
+    try:
+        encoder = _ENCODERS[type(message)]  # a subscript costs less than .get(); the miss is the rare case
+    except KeyError:
+        raise EncodeError(f"{type(message).__name__} is not a feetech_sms message") from None
     try:
         return encoder(message)
     except EncodeError:

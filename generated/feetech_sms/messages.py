@@ -15,8 +15,7 @@ from serialspec.runtime.fields import integer as _integer
 from serialspec.runtime.fields import items as _items
 from serialspec.runtime.fields import mapping as _mapping
 from serialspec.runtime.message import Direction, Message, Record
-
-_store = object.__setattr__  # how __init__ fills the slots of a frozen class
+from serialspec.runtime.message import build as _build
 
 __all__ = [
     'ActionRequest',
@@ -124,16 +123,16 @@ class ErrorStatus(IntFlag):
 class IdsItem(Record):
     """One item of ids."""
 
-    __slots__ = ('id',)
+    __slots__ = ()
     __match_args__ = ('id',)
     #: A servo id. range 0..253
     id: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         id: int,
-    ) -> None:
-        _store(self, 'id', id)
+    ) -> Self:
+        return _build(cls, (id,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -151,20 +150,19 @@ class IdsItem(Record):
 class ServosItem(Record):
     """One item of servos."""
 
-    __slots__ = ('id', 'data')
+    __slots__ = ()
     __match_args__ = ('id', 'data')
     #: The servo's id. range 0..253
     id: int
     #: The L bytes written to that servo from `address` on.
     data: bytes
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         id: int,
         data: bytes,
-    ) -> None:
-        _store(self, 'id', id)
-        _store(self, 'data', data)
+    ) -> Self:
+        return _build(cls, (id, data))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -184,7 +182,7 @@ class ServosItem(Record):
 class PingRequest(Message):
     """Query a servo's working status (request)."""
 
-    __slots__ = ('id',)
+    __slots__ = ()
     __match_args__ = ('id',)
     PROTOCOL: ClassVar[str] = 'feetech_sms'
     COMMAND: ClassVar[str] = 'ping'
@@ -193,11 +191,11 @@ class PingRequest(Message):
     #: Servo id 0..253; 254 (0xFE) is the broadcast id: every servo takes the instruction and none answers, except to PING. range 0..253
     id: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         id: int,
-    ) -> None:
-        _store(self, 'id', id)
+    ) -> Self:
+        return _build(cls, (id,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -215,7 +213,7 @@ class PingRequest(Message):
 class ReadRequest(Message):
     """Read from the control table (request)."""
 
-    __slots__ = ('id', 'address', 'length')
+    __slots__ = ()
     __match_args__ = ('id', 'address', 'length')
     PROTOCOL: ClassVar[str] = 'feetech_sms'
     COMMAND: ClassVar[str] = 'read'
@@ -228,15 +226,13 @@ class ReadRequest(Message):
     #: Number of bytes to read. range 1..250
     length: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         id: int,
         address: int,
         length: int,
-    ) -> None:
-        _store(self, 'id', id)
-        _store(self, 'address', address)
-        _store(self, 'length', length)
+    ) -> Self:
+        return _build(cls, (id, address, length))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -258,7 +254,7 @@ class ReadRequest(Message):
 class WriteRequest(Message):
     """Write to the control table (request)."""
 
-    __slots__ = ('id', 'address', 'data')
+    __slots__ = ()
     __match_args__ = ('id', 'address', 'data')
     PROTOCOL: ClassVar[str] = 'feetech_sms'
     COMMAND: ClassVar[str] = 'write'
@@ -271,15 +267,13 @@ class WriteRequest(Message):
     #: The bytes written, register by register from `address` on.
     data: bytes
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         id: int,
         address: int,
         data: bytes,
-    ) -> None:
-        _store(self, 'id', id)
-        _store(self, 'address', address)
-        _store(self, 'data', data)
+    ) -> Self:
+        return _build(cls, (id, address, data))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -301,7 +295,7 @@ class WriteRequest(Message):
 class RegWriteRequest(Message):
     """Buffered write, run on ACTION (request)."""
 
-    __slots__ = ('id', 'address', 'data')
+    __slots__ = ()
     __match_args__ = ('id', 'address', 'data')
     PROTOCOL: ClassVar[str] = 'feetech_sms'
     COMMAND: ClassVar[str] = 'reg_write'
@@ -314,15 +308,13 @@ class RegWriteRequest(Message):
     #: The bytes to write when ACTION arrives.
     data: bytes
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         id: int,
         address: int,
         data: bytes,
-    ) -> None:
-        _store(self, 'id', id)
-        _store(self, 'address', address)
-        _store(self, 'data', data)
+    ) -> Self:
+        return _build(cls, (id, address, data))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -344,7 +336,7 @@ class RegWriteRequest(Message):
 class ActionRequest(Message):
     """Run the buffered REG WRITEs (request)."""
 
-    __slots__ = ('id',)
+    __slots__ = ()
     __match_args__ = ('id',)
     PROTOCOL: ClassVar[str] = 'feetech_sms'
     COMMAND: ClassVar[str] = 'action'
@@ -353,11 +345,11 @@ class ActionRequest(Message):
     #: Servo id 0..253; 254 (0xFE) is the broadcast id: every servo takes the instruction and none answers, except to PING. range 0..253
     id: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         id: int,
-    ) -> None:
-        _store(self, 'id', id)
+    ) -> Self:
+        return _build(cls, (id,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -375,7 +367,7 @@ class ActionRequest(Message):
 class ResetRequest(Message):
     """Reset the control table to its factory values (request)."""
 
-    __slots__ = ('id',)
+    __slots__ = ()
     __match_args__ = ('id',)
     PROTOCOL: ClassVar[str] = 'feetech_sms'
     COMMAND: ClassVar[str] = 'reset'
@@ -384,11 +376,11 @@ class ResetRequest(Message):
     #: Servo id 0..253; 254 (0xFE) is the broadcast id: every servo takes the instruction and none answers, except to PING. range 0..253
     id: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         id: int,
-    ) -> None:
-        _store(self, 'id', id)
+    ) -> Self:
+        return _build(cls, (id,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -406,7 +398,7 @@ class ResetRequest(Message):
 class SyncReadRequest(Message):
     """Read the same registers of several servos (request)."""
 
-    __slots__ = ('id', 'address', 'length', 'ids')
+    __slots__ = ()
     __match_args__ = ('id', 'address', 'length', 'ids')
     PROTOCOL: ClassVar[str] = 'feetech_sms'
     COMMAND: ClassVar[str] = 'sync_read'
@@ -421,17 +413,14 @@ class SyncReadRequest(Message):
     #: The servos to read, in the order they answer.
     ids: tuple[IdsItem, ...]
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         id: int,
         address: int,
         length: int,
         ids: tuple[IdsItem, ...],
-    ) -> None:
-        _store(self, 'id', id)
-        _store(self, 'address', address)
-        _store(self, 'length', length)
-        _store(self, 'ids', ids)
+    ) -> Self:
+        return _build(cls, (id, address, length, ids))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -455,7 +444,7 @@ class SyncReadRequest(Message):
 class SyncWriteRequest(Message):
     """Write the same registers of several servos at once (request)."""
 
-    __slots__ = ('id', 'address', 'servos')
+    __slots__ = ()
     __match_args__ = ('id', 'address', 'servos')
     PROTOCOL: ClassVar[str] = 'feetech_sms'
     COMMAND: ClassVar[str] = 'sync_write'
@@ -468,15 +457,13 @@ class SyncWriteRequest(Message):
     #: One item per servo.
     servos: tuple[ServosItem, ...]
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         id: int,
         address: int,
         servos: tuple[ServosItem, ...],
-    ) -> None:
-        _store(self, 'id', id)
-        _store(self, 'address', address)
-        _store(self, 'servos', servos)
+    ) -> Self:
+        return _build(cls, (id, address, servos))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -498,7 +485,7 @@ class SyncWriteRequest(Message):
 class ReplyResponse(Message):
     """Status packet (a servo's answer to any instruction) (response)."""
 
-    __slots__ = ('id', 'error', 'data')
+    __slots__ = ()
     __match_args__ = ('id', 'error', 'data')
     PROTOCOL: ClassVar[str] = 'feetech_sms'
     COMMAND: ClassVar[str] = 'reply'
@@ -511,15 +498,13 @@ class ReplyResponse(Message):
     #: The bytes read, register by register from the request's address (empty except for READ).
     data: bytes
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         id: int,
         error: ErrorStatus,
         data: bytes,
-    ) -> None:
-        _store(self, 'id', id)
-        _store(self, 'error', error)
-        _store(self, 'data', data)
+    ) -> Self:
+        return _build(cls, (id, error, data))
 
     def to_fields(self) -> dict[str, Any]:
         return {

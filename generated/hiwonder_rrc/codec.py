@@ -10,7 +10,8 @@ from serialspec.runtime.checksums import BYTE_VALUES as _BYTES
 from serialspec.runtime.checksums import crc_table
 from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError, content_size_error, out_of_range
 from serialspec.runtime.fields import wrong_type
-from serialspec.runtime.message import Direction, Message, members, slot_setters
+from serialspec.runtime.message import Direction, Message, members
+from serialspec.runtime.message import build as _new  # a message from the tuple of its field values, in one call
 from serialspec.runtime.stream import FrameFormat
 from serialspec.runtime.stream import StreamParser as _StreamParser
 
@@ -121,109 +122,6 @@ _S_U8_U8_U8 = struct.Struct('<BBB')
 _S_U8_U8_U8_U8 = struct.Struct('<BBBB')
 _CRC_TABLE = crc_table(8, 0x31, True)  # CRC-8/MAXIM
 
-# Decoders build messages with object.__new__ and store each value straight into its slot: a message's __init__
-# (frozen) goes through object.__setattr__ per field, which costs more than unpacking the whole frame.
-_new = object.__new__
-(_set_BusServoLoadRequest_servo_id,) = slot_setters(BusServoLoadRequest)
-(_set_BusServoReadIdRequest_servo_id,) = slot_setters(BusServoReadIdRequest)
-_set_BusServoReadIdResponse_servo_id, _set_BusServoReadIdResponse_success, _set_BusServoReadIdResponse_id = slot_setters(BusServoReadIdResponse)
-(_set_BusServoReadOffsetRequest_servo_id,) = slot_setters(BusServoReadOffsetRequest)
-_set_BusServoReadOffsetResponse_servo_id, _set_BusServoReadOffsetResponse_success, _set_BusServoReadOffsetResponse_offset = slot_setters(BusServoReadOffsetResponse)
-(_set_BusServoReadPositionLimitRequest_servo_id,) = slot_setters(BusServoReadPositionLimitRequest)
-(
-    _set_BusServoReadPositionLimitResponse_servo_id,
-    _set_BusServoReadPositionLimitResponse_success,
-    _set_BusServoReadPositionLimitResponse_low,
-    _set_BusServoReadPositionLimitResponse_high,
-) = slot_setters(BusServoReadPositionLimitResponse)
-(_set_BusServoReadPositionRequest_servo_id,) = slot_setters(BusServoReadPositionRequest)
-_set_BusServoReadPositionResponse_servo_id, _set_BusServoReadPositionResponse_success, _set_BusServoReadPositionResponse_position = slot_setters(BusServoReadPositionResponse)
-(_set_BusServoReadTemperatureLimitRequest_servo_id,) = slot_setters(BusServoReadTemperatureLimitRequest)
-_set_BusServoReadTemperatureLimitResponse_servo_id, _set_BusServoReadTemperatureLimitResponse_success, _set_BusServoReadTemperatureLimitResponse_limit = slot_setters(BusServoReadTemperatureLimitResponse)
-(_set_BusServoReadTemperatureRequest_servo_id,) = slot_setters(BusServoReadTemperatureRequest)
-_set_BusServoReadTemperatureResponse_servo_id, _set_BusServoReadTemperatureResponse_success, _set_BusServoReadTemperatureResponse_temperature = slot_setters(BusServoReadTemperatureResponse)
-(_set_BusServoReadTorqueRequest_servo_id,) = slot_setters(BusServoReadTorqueRequest)
-_set_BusServoReadTorqueResponse_servo_id, _set_BusServoReadTorqueResponse_success, _set_BusServoReadTorqueResponse_torque = slot_setters(BusServoReadTorqueResponse)
-(_set_BusServoReadVoltageLimitRequest_servo_id,) = slot_setters(BusServoReadVoltageLimitRequest)
-(
-    _set_BusServoReadVoltageLimitResponse_servo_id,
-    _set_BusServoReadVoltageLimitResponse_success,
-    _set_BusServoReadVoltageLimitResponse_low,
-    _set_BusServoReadVoltageLimitResponse_high,
-) = slot_setters(BusServoReadVoltageLimitResponse)
-(_set_BusServoReadVoltageRequest_servo_id,) = slot_setters(BusServoReadVoltageRequest)
-_set_BusServoReadVoltageResponse_servo_id, _set_BusServoReadVoltageResponse_success, _set_BusServoReadVoltageResponse_voltage = slot_setters(BusServoReadVoltageResponse)
-(_set_BusServoSaveOffsetRequest_servo_id,) = slot_setters(BusServoSaveOffsetRequest)
-_set_BusServoSetIdRequest_servo_id, _set_BusServoSetIdRequest_new_id = slot_setters(BusServoSetIdRequest)
-_set_BusServoSetOffsetRequest_servo_id, _set_BusServoSetOffsetRequest_offset = slot_setters(BusServoSetOffsetRequest)
-_set_BusServoSetPositionLimitRequest_servo_id, _set_BusServoSetPositionLimitRequest_low, _set_BusServoSetPositionLimitRequest_high = slot_setters(BusServoSetPositionLimitRequest)
-_set_BusServoSetPositionsRequest_duration, _set_BusServoSetPositionsRequest_bus_servos = slot_setters(BusServoSetPositionsRequest)
-_set_BusServoSetTemperatureLimitRequest_servo_id, _set_BusServoSetTemperatureLimitRequest_limit = slot_setters(BusServoSetTemperatureLimitRequest)
-_set_BusServoSetVoltageLimitRequest_servo_id, _set_BusServoSetVoltageLimitRequest_low, _set_BusServoSetVoltageLimitRequest_high = slot_setters(BusServoSetVoltageLimitRequest)
-(_set_BusServoStopRequest_servos,) = slot_setters(BusServoStopRequest)
-(_set_BusServoUnloadRequest_servo_id,) = slot_setters(BusServoUnloadRequest)
-_set_BusServosItem_servo_id, _set_BusServosItem_position = slot_setters(BusServosItem)
-(
-    _set_BuzzerRequest_frequency,
-    _set_BuzzerRequest_on_time,
-    _set_BuzzerRequest_off_time,
-    _set_BuzzerRequest_repeat,
-) = slot_setters(BuzzerRequest)
-_set_DutiesItem_motor_id, _set_DutiesItem_duty = slot_setters(DutiesItem)
-(
-    _set_GamepadResponse_buttons,
-    _set_GamepadResponse_hat,
-    _set_GamepadResponse_left_x,
-    _set_GamepadResponse_left_y,
-    _set_GamepadResponse_right_x,
-    _set_GamepadResponse_right_y,
-) = slot_setters(GamepadResponse)
-(
-    _set_ImuResponse_accel_x,
-    _set_ImuResponse_accel_y,
-    _set_ImuResponse_accel_z,
-    _set_ImuResponse_gyro_x,
-    _set_ImuResponse_gyro_y,
-    _set_ImuResponse_gyro_z,
-) = slot_setters(ImuResponse)
-_set_KeyResponse_button_id, _set_KeyResponse_event = slot_setters(KeyResponse)
-(
-    _set_LedRequest_led_id,
-    _set_LedRequest_on_time,
-    _set_LedRequest_off_time,
-    _set_LedRequest_repeat,
-) = slot_setters(LedRequest)
-(_set_MotorSetDutiesRequest_duties,) = slot_setters(MotorSetDutiesRequest)
-_set_MotorSetSpeedRequest_motor_id, _set_MotorSetSpeedRequest_speed = slot_setters(MotorSetSpeedRequest)
-(_set_MotorSetSpeedsRequest_motors,) = slot_setters(MotorSetSpeedsRequest)
-(_set_MotorStopMaskRequest_mask,) = slot_setters(MotorStopMaskRequest)
-(_set_MotorStopRequest_motor_id,) = slot_setters(MotorStopRequest)
-_set_MotorsItem_motor_id, _set_MotorsItem_speed = slot_setters(MotorsItem)
-_set_OledRequest_line, _set_OledRequest_text = slot_setters(OledRequest)
-(
-    _set_PixelsItem_index,
-    _set_PixelsItem_red,
-    _set_PixelsItem_green,
-    _set_PixelsItem_blue,
-) = slot_setters(PixelsItem)
-(_set_PwmServoReadOffsetRequest_servo_id,) = slot_setters(PwmServoReadOffsetRequest)
-_set_PwmServoReadOffsetResponse_servo_id, _set_PwmServoReadOffsetResponse_offset = slot_setters(PwmServoReadOffsetResponse)
-(_set_PwmServoReadPositionRequest_servo_id,) = slot_setters(PwmServoReadPositionRequest)
-_set_PwmServoReadPositionResponse_servo_id, _set_PwmServoReadPositionResponse_pulse = slot_setters(PwmServoReadPositionResponse)
-_set_PwmServoSetOffsetRequest_servo_id, _set_PwmServoSetOffsetRequest_offset = slot_setters(PwmServoSetOffsetRequest)
-_set_PwmServoSetPositionRequest_duration, _set_PwmServoSetPositionRequest_servo_id, _set_PwmServoSetPositionRequest_pulse = slot_setters(PwmServoSetPositionRequest)
-_set_PwmServoSetPositionsRequest_duration, _set_PwmServoSetPositionsRequest_pwm_servos = slot_setters(PwmServoSetPositionsRequest)
-_set_PwmServosItem_servo_id, _set_PwmServosItem_pulse = slot_setters(PwmServosItem)
-(_set_RgbSetPixelsRequest_pixels,) = slot_setters(RgbSetPixelsRequest)
-(
-    _set_SbusResponse_channels,
-    _set_SbusResponse_ch17,
-    _set_SbusResponse_ch18,
-    _set_SbusResponse_signal_loss,
-    _set_SbusResponse_fail_safe,
-) = slot_setters(SbusResponse)
-(_set_ServosItem_servo_id,) = slot_setters(ServosItem)
-(_set_SystemBatteryResponse_voltage,) = slot_setters(SystemBatteryResponse)
 _MEMBERS_ButtonEvent = members(ButtonEvent)
 _MEMBERS_GamepadButtons = members(GamepadButtons)
 _MEMBERS_MotorMask = members(MotorMask)
@@ -233,25 +131,13 @@ _MEMBERS_ReadResult = members(ReadResult)
 def _decode_led_request(buf: bytes, o: int, end: int) -> LedRequest:
     if end - o != 7:
         raise content_size_error('led request', end - o, 7, 7)
-    v_led_id, v_on_time, v_off_time, v_repeat = _S_U8_U16_U16_U16.unpack_from(buf, o)
-    m = _new(LedRequest)
-    _set_LedRequest_led_id(m, v_led_id)
-    _set_LedRequest_on_time(m, v_on_time)
-    _set_LedRequest_off_time(m, v_off_time)
-    _set_LedRequest_repeat(m, v_repeat)
-    return m
+    return _new(LedRequest, _S_U8_U16_U16_U16.unpack_from(buf, o))
 
 
 def _decode_buzzer_request(buf: bytes, o: int, end: int) -> BuzzerRequest:
     if end - o != 8:
         raise content_size_error('buzzer request', end - o, 8, 8)
-    v_frequency, v_on_time, v_off_time, v_repeat = _S_U16_U16_U16_U16.unpack_from(buf, o)
-    m = _new(BuzzerRequest)
-    _set_BuzzerRequest_frequency(m, v_frequency)
-    _set_BuzzerRequest_on_time(m, v_on_time)
-    _set_BuzzerRequest_off_time(m, v_off_time)
-    _set_BuzzerRequest_repeat(m, v_repeat)
-    return m
+    return _new(BuzzerRequest, _S_U16_U16_U16_U16.unpack_from(buf, o))
 
 
 def _decode_motor_set_speed_request(buf: bytes, o: int, end: int) -> MotorSetSpeedRequest:
@@ -260,10 +146,7 @@ def _decode_motor_set_speed_request(buf: bytes, o: int, end: int) -> MotorSetSpe
     v_subcommand_code, v_motor_id, v_speed = _S_U8_U8_F32.unpack_from(buf, o)
     if v_subcommand_code != 0:
         raise DecodeError('motor.set_speed request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x0')
-    m = _new(MotorSetSpeedRequest)
-    _set_MotorSetSpeedRequest_motor_id(m, v_motor_id)
-    _set_MotorSetSpeedRequest_speed(m, v_speed)
-    return m
+    return _new(MotorSetSpeedRequest, (v_motor_id, v_speed))
 
 
 def _decode_motor_set_speeds_request(buf: bytes, o: int, end: int) -> MotorSetSpeedsRequest:
@@ -273,22 +156,14 @@ def _decode_motor_set_speeds_request(buf: bytes, o: int, end: int) -> MotorSetSp
     if v_subcommand_code != 1:
         raise DecodeError('motor.set_speeds request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x1')
     o += 2
-    v_motors_list = []
     n = v_count * 5
     if end - o < n:
         raise DecodeError('motor.set_speeds request' + f': content too short for its count ({v_count} motors)')
-    for v_motor_id, v_speed in _S_U8_F32.iter_unpack(buf[o : o + n]):
-        item = _new(MotorsItem)
-        _set_MotorsItem_motor_id(item, v_motor_id)
-        _set_MotorsItem_speed(item, v_speed)
-        v_motors_list.append(item)
-    v_motors = tuple(v_motors_list)
+    v_motors = tuple([_new(MotorsItem, values) for values in _S_U8_F32.iter_unpack(buf[o : o + n])])
     o += n
     if o != end:
         raise DecodeError('motor.set_speeds request' + f': {end - o} bytes left after the last field')
-    m = _new(MotorSetSpeedsRequest)
-    _set_MotorSetSpeedsRequest_motors(m, v_motors)
-    return m
+    return _new(MotorSetSpeedsRequest, (v_motors,))
 
 
 def _decode_motor_stop_request(buf: bytes, o: int, end: int) -> MotorStopRequest:
@@ -297,9 +172,7 @@ def _decode_motor_stop_request(buf: bytes, o: int, end: int) -> MotorStopRequest
     v_subcommand_code, v_motor_id = _S_U8_U8.unpack_from(buf, o)
     if v_subcommand_code != 2:
         raise DecodeError('motor.stop request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x2')
-    m = _new(MotorStopRequest)
-    _set_MotorStopRequest_motor_id(m, v_motor_id)
-    return m
+    return _new(MotorStopRequest, (v_motor_id,))
 
 
 def _decode_motor_set_duties_request(buf: bytes, o: int, end: int) -> MotorSetDutiesRequest:
@@ -309,22 +182,14 @@ def _decode_motor_set_duties_request(buf: bytes, o: int, end: int) -> MotorSetDu
     if v_subcommand_code != 5:
         raise DecodeError('motor.set_duties request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x5')
     o += 2
-    v_duties_list = []
     n = v_count * 5
     if end - o < n:
         raise DecodeError('motor.set_duties request' + f': content too short for its count ({v_count} duties)')
-    for v_motor_id, v_duty in _S_U8_F32.iter_unpack(buf[o : o + n]):
-        item = _new(DutiesItem)
-        _set_DutiesItem_motor_id(item, v_motor_id)
-        _set_DutiesItem_duty(item, v_duty)
-        v_duties_list.append(item)
-    v_duties = tuple(v_duties_list)
+    v_duties = tuple([_new(DutiesItem, values) for values in _S_U8_F32.iter_unpack(buf[o : o + n])])
     o += n
     if o != end:
         raise DecodeError('motor.set_duties request' + f': {end - o} bytes left after the last field')
-    m = _new(MotorSetDutiesRequest)
-    _set_MotorSetDutiesRequest_duties(m, v_duties)
-    return m
+    return _new(MotorSetDutiesRequest, (v_duties,))
 
 
 def _decode_motor_stop_mask_request(buf: bytes, o: int, end: int) -> MotorStopMaskRequest:
@@ -336,9 +201,7 @@ def _decode_motor_stop_mask_request(buf: bytes, o: int, end: int) -> MotorStopMa
     v_mask_flags = _MEMBERS_MotorMask.get(v_mask)
     if v_mask_flags is None:
         v_mask_flags = MotorMask(v_mask)
-    m = _new(MotorStopMaskRequest)
-    _set_MotorStopMaskRequest_mask(m, v_mask_flags)
-    return m
+    return _new(MotorStopMaskRequest, (v_mask_flags,))
 
 
 def _decode_pwm_servo_set_positions_request(buf: bytes, o: int, end: int) -> PwmServoSetPositionsRequest:
@@ -348,23 +211,14 @@ def _decode_pwm_servo_set_positions_request(buf: bytes, o: int, end: int) -> Pwm
     if v_subcommand_code != 1:
         raise DecodeError('pwm_servo.set_positions request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x1')
     o += 4
-    v_pwm_servos_list = []
     n = v_count * 3
     if end - o < n:
         raise DecodeError('pwm_servo.set_positions request' + f': content too short for its count ({v_count} pwm_servos)')
-    for v_servo_id, v_pulse in _S_U8_U16.iter_unpack(buf[o : o + n]):
-        item = _new(PwmServosItem)
-        _set_PwmServosItem_servo_id(item, v_servo_id)
-        _set_PwmServosItem_pulse(item, v_pulse)
-        v_pwm_servos_list.append(item)
-    v_pwm_servos = tuple(v_pwm_servos_list)
+    v_pwm_servos = tuple([_new(PwmServosItem, values) for values in _S_U8_U16.iter_unpack(buf[o : o + n])])
     o += n
     if o != end:
         raise DecodeError('pwm_servo.set_positions request' + f': {end - o} bytes left after the last field')
-    m = _new(PwmServoSetPositionsRequest)
-    _set_PwmServoSetPositionsRequest_duration(m, v_duration)
-    _set_PwmServoSetPositionsRequest_pwm_servos(m, v_pwm_servos)
-    return m
+    return _new(PwmServoSetPositionsRequest, (v_duration, v_pwm_servos))
 
 
 def _decode_pwm_servo_set_position_request(buf: bytes, o: int, end: int) -> PwmServoSetPositionRequest:
@@ -373,11 +227,7 @@ def _decode_pwm_servo_set_position_request(buf: bytes, o: int, end: int) -> PwmS
     v_subcommand_code, v_duration, v_servo_id, v_pulse = _S_U8_U16_U8_U16.unpack_from(buf, o)
     if v_subcommand_code != 3:
         raise DecodeError('pwm_servo.set_position request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x3')
-    m = _new(PwmServoSetPositionRequest)
-    _set_PwmServoSetPositionRequest_duration(m, v_duration)
-    _set_PwmServoSetPositionRequest_servo_id(m, v_servo_id)
-    _set_PwmServoSetPositionRequest_pulse(m, v_pulse)
-    return m
+    return _new(PwmServoSetPositionRequest, (v_duration, v_servo_id, v_pulse))
 
 
 def _decode_pwm_servo_read_position_request(buf: bytes, o: int, end: int) -> PwmServoReadPositionRequest:
@@ -386,9 +236,7 @@ def _decode_pwm_servo_read_position_request(buf: bytes, o: int, end: int) -> Pwm
     v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, o)
     if v_subcommand_code != 5:
         raise DecodeError('pwm_servo.read_position request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x5')
-    m = _new(PwmServoReadPositionRequest)
-    _set_PwmServoReadPositionRequest_servo_id(m, v_servo_id)
-    return m
+    return _new(PwmServoReadPositionRequest, (v_servo_id,))
 
 
 def _decode_pwm_servo_read_position_response(buf: bytes, o: int, end: int) -> PwmServoReadPositionResponse:
@@ -397,10 +245,7 @@ def _decode_pwm_servo_read_position_response(buf: bytes, o: int, end: int) -> Pw
     v_servo_id, v_subcommand_code, v_pulse = _S_U8_U8_U16.unpack_from(buf, o)
     if v_subcommand_code != 5:
         raise DecodeError('pwm_servo.read_position response' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x5')
-    m = _new(PwmServoReadPositionResponse)
-    _set_PwmServoReadPositionResponse_servo_id(m, v_servo_id)
-    _set_PwmServoReadPositionResponse_pulse(m, v_pulse)
-    return m
+    return _new(PwmServoReadPositionResponse, (v_servo_id, v_pulse))
 
 
 def _decode_pwm_servo_set_offset_request(buf: bytes, o: int, end: int) -> PwmServoSetOffsetRequest:
@@ -409,10 +254,7 @@ def _decode_pwm_servo_set_offset_request(buf: bytes, o: int, end: int) -> PwmSer
     v_subcommand_code, v_servo_id, v_offset = _S_U8_U8_I8.unpack_from(buf, o)
     if v_subcommand_code != 7:
         raise DecodeError('pwm_servo.set_offset request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x7')
-    m = _new(PwmServoSetOffsetRequest)
-    _set_PwmServoSetOffsetRequest_servo_id(m, v_servo_id)
-    _set_PwmServoSetOffsetRequest_offset(m, v_offset)
-    return m
+    return _new(PwmServoSetOffsetRequest, (v_servo_id, v_offset))
 
 
 def _decode_pwm_servo_read_offset_request(buf: bytes, o: int, end: int) -> PwmServoReadOffsetRequest:
@@ -421,9 +263,7 @@ def _decode_pwm_servo_read_offset_request(buf: bytes, o: int, end: int) -> PwmSe
     v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, o)
     if v_subcommand_code != 9:
         raise DecodeError('pwm_servo.read_offset request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x9')
-    m = _new(PwmServoReadOffsetRequest)
-    _set_PwmServoReadOffsetRequest_servo_id(m, v_servo_id)
-    return m
+    return _new(PwmServoReadOffsetRequest, (v_servo_id,))
 
 
 def _decode_pwm_servo_read_offset_response(buf: bytes, o: int, end: int) -> PwmServoReadOffsetResponse:
@@ -432,10 +272,7 @@ def _decode_pwm_servo_read_offset_response(buf: bytes, o: int, end: int) -> PwmS
     v_servo_id, v_subcommand_code, v_offset = _S_U8_U8_I8.unpack_from(buf, o)
     if v_subcommand_code != 9:
         raise DecodeError('pwm_servo.read_offset response' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x9')
-    m = _new(PwmServoReadOffsetResponse)
-    _set_PwmServoReadOffsetResponse_servo_id(m, v_servo_id)
-    _set_PwmServoReadOffsetResponse_offset(m, v_offset)
-    return m
+    return _new(PwmServoReadOffsetResponse, (v_servo_id, v_offset))
 
 
 def _decode_bus_servo_set_positions_request(buf: bytes, o: int, end: int) -> BusServoSetPositionsRequest:
@@ -445,23 +282,14 @@ def _decode_bus_servo_set_positions_request(buf: bytes, o: int, end: int) -> Bus
     if v_subcommand_code != 1:
         raise DecodeError('bus_servo.set_positions request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x1')
     o += 4
-    v_bus_servos_list = []
     n = v_count * 3
     if end - o < n:
         raise DecodeError('bus_servo.set_positions request' + f': content too short for its count ({v_count} bus_servos)')
-    for v_servo_id, v_position in _S_U8_U16.iter_unpack(buf[o : o + n]):
-        item = _new(BusServosItem)
-        _set_BusServosItem_servo_id(item, v_servo_id)
-        _set_BusServosItem_position(item, v_position)
-        v_bus_servos_list.append(item)
-    v_bus_servos = tuple(v_bus_servos_list)
+    v_bus_servos = tuple([_new(BusServosItem, values) for values in _S_U8_U16.iter_unpack(buf[o : o + n])])
     o += n
     if o != end:
         raise DecodeError('bus_servo.set_positions request' + f': {end - o} bytes left after the last field')
-    m = _new(BusServoSetPositionsRequest)
-    _set_BusServoSetPositionsRequest_duration(m, v_duration)
-    _set_BusServoSetPositionsRequest_bus_servos(m, v_bus_servos)
-    return m
+    return _new(BusServoSetPositionsRequest, (v_duration, v_bus_servos))
 
 
 def _decode_bus_servo_read_position_request(buf: bytes, o: int, end: int) -> BusServoReadPositionRequest:
@@ -470,9 +298,7 @@ def _decode_bus_servo_read_position_request(buf: bytes, o: int, end: int) -> Bus
     v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, o)
     if v_subcommand_code != 5:
         raise DecodeError('bus_servo.read_position request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x5')
-    m = _new(BusServoReadPositionRequest)
-    _set_BusServoReadPositionRequest_servo_id(m, v_servo_id)
-    return m
+    return _new(BusServoReadPositionRequest, (v_servo_id,))
 
 
 def _decode_bus_servo_read_position_response(buf: bytes, o: int, end: int) -> BusServoReadPositionResponse:
@@ -481,11 +307,7 @@ def _decode_bus_servo_read_position_response(buf: bytes, o: int, end: int) -> Bu
     v_servo_id, v_subcommand_code, v_success, v_position = _S_U8_U8_I8_I16.unpack_from(buf, o)
     if v_subcommand_code != 5:
         raise DecodeError('bus_servo.read_position response' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x5')
-    m = _new(BusServoReadPositionResponse)
-    _set_BusServoReadPositionResponse_servo_id(m, v_servo_id)
-    _set_BusServoReadPositionResponse_success(m, _MEMBERS_ReadResult.get(v_success, v_success))
-    _set_BusServoReadPositionResponse_position(m, v_position)
-    return m
+    return _new(BusServoReadPositionResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_position))
 
 
 def _decode_bus_servo_read_voltage_request(buf: bytes, o: int, end: int) -> BusServoReadVoltageRequest:
@@ -494,9 +316,7 @@ def _decode_bus_servo_read_voltage_request(buf: bytes, o: int, end: int) -> BusS
     v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, o)
     if v_subcommand_code != 7:
         raise DecodeError('bus_servo.read_voltage request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x7')
-    m = _new(BusServoReadVoltageRequest)
-    _set_BusServoReadVoltageRequest_servo_id(m, v_servo_id)
-    return m
+    return _new(BusServoReadVoltageRequest, (v_servo_id,))
 
 
 def _decode_bus_servo_read_voltage_response(buf: bytes, o: int, end: int) -> BusServoReadVoltageResponse:
@@ -505,11 +325,7 @@ def _decode_bus_servo_read_voltage_response(buf: bytes, o: int, end: int) -> Bus
     v_servo_id, v_subcommand_code, v_success, v_voltage = _S_U8_U8_I8_U16.unpack_from(buf, o)
     if v_subcommand_code != 7:
         raise DecodeError('bus_servo.read_voltage response' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x7')
-    m = _new(BusServoReadVoltageResponse)
-    _set_BusServoReadVoltageResponse_servo_id(m, v_servo_id)
-    _set_BusServoReadVoltageResponse_success(m, _MEMBERS_ReadResult.get(v_success, v_success))
-    _set_BusServoReadVoltageResponse_voltage(m, v_voltage)
-    return m
+    return _new(BusServoReadVoltageResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_voltage))
 
 
 def _decode_bus_servo_read_temperature_request(buf: bytes, o: int, end: int) -> BusServoReadTemperatureRequest:
@@ -518,9 +334,7 @@ def _decode_bus_servo_read_temperature_request(buf: bytes, o: int, end: int) -> 
     v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, o)
     if v_subcommand_code != 9:
         raise DecodeError('bus_servo.read_temperature request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x9')
-    m = _new(BusServoReadTemperatureRequest)
-    _set_BusServoReadTemperatureRequest_servo_id(m, v_servo_id)
-    return m
+    return _new(BusServoReadTemperatureRequest, (v_servo_id,))
 
 
 def _decode_bus_servo_read_temperature_response(buf: bytes, o: int, end: int) -> BusServoReadTemperatureResponse:
@@ -529,11 +343,7 @@ def _decode_bus_servo_read_temperature_response(buf: bytes, o: int, end: int) ->
     v_servo_id, v_subcommand_code, v_success, v_temperature = _S_U8_U8_I8_U8.unpack_from(buf, o)
     if v_subcommand_code != 9:
         raise DecodeError('bus_servo.read_temperature response' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x9')
-    m = _new(BusServoReadTemperatureResponse)
-    _set_BusServoReadTemperatureResponse_servo_id(m, v_servo_id)
-    _set_BusServoReadTemperatureResponse_success(m, _MEMBERS_ReadResult.get(v_success, v_success))
-    _set_BusServoReadTemperatureResponse_temperature(m, v_temperature)
-    return m
+    return _new(BusServoReadTemperatureResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_temperature))
 
 
 def _decode_bus_servo_stop_request(buf: bytes, o: int, end: int) -> BusServoStopRequest:
@@ -543,21 +353,14 @@ def _decode_bus_servo_stop_request(buf: bytes, o: int, end: int) -> BusServoStop
     if v_subcommand_code != 3:
         raise DecodeError('bus_servo.stop request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x3')
     o += 2
-    v_servos_list = []
     n = v_count * 1
     if end - o < n:
         raise DecodeError('bus_servo.stop request' + f': content too short for its count ({v_count} servos)')
-    for v_servo_id, in _S_U8.iter_unpack(buf[o : o + n]):
-        item = _new(ServosItem)
-        _set_ServosItem_servo_id(item, v_servo_id)
-        v_servos_list.append(item)
-    v_servos = tuple(v_servos_list)
+    v_servos = tuple([_new(ServosItem, values) for values in _S_U8.iter_unpack(buf[o : o + n])])
     o += n
     if o != end:
         raise DecodeError('bus_servo.stop request' + f': {end - o} bytes left after the last field')
-    m = _new(BusServoStopRequest)
-    _set_BusServoStopRequest_servos(m, v_servos)
-    return m
+    return _new(BusServoStopRequest, (v_servos,))
 
 
 def _decode_bus_servo_read_torque_request(buf: bytes, o: int, end: int) -> BusServoReadTorqueRequest:
@@ -566,9 +369,7 @@ def _decode_bus_servo_read_torque_request(buf: bytes, o: int, end: int) -> BusSe
     v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, o)
     if v_subcommand_code != 13:
         raise DecodeError('bus_servo.read_torque request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0xd')
-    m = _new(BusServoReadTorqueRequest)
-    _set_BusServoReadTorqueRequest_servo_id(m, v_servo_id)
-    return m
+    return _new(BusServoReadTorqueRequest, (v_servo_id,))
 
 
 def _decode_bus_servo_read_torque_response(buf: bytes, o: int, end: int) -> BusServoReadTorqueResponse:
@@ -577,11 +378,7 @@ def _decode_bus_servo_read_torque_response(buf: bytes, o: int, end: int) -> BusS
     v_servo_id, v_subcommand_code, v_success, v_torque = _S_U8_U8_I8_I8.unpack_from(buf, o)
     if v_subcommand_code != 13:
         raise DecodeError('bus_servo.read_torque response' + f': subcommand_code is {v_subcommand_code:#x}, expected 0xd')
-    m = _new(BusServoReadTorqueResponse)
-    _set_BusServoReadTorqueResponse_servo_id(m, v_servo_id)
-    _set_BusServoReadTorqueResponse_success(m, _MEMBERS_ReadResult.get(v_success, v_success))
-    _set_BusServoReadTorqueResponse_torque(m, v_torque)
-    return m
+    return _new(BusServoReadTorqueResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_torque))
 
 
 def _decode_bus_servo_unload_request(buf: bytes, o: int, end: int) -> BusServoUnloadRequest:
@@ -590,9 +387,7 @@ def _decode_bus_servo_unload_request(buf: bytes, o: int, end: int) -> BusServoUn
     v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, o)
     if v_subcommand_code != 11:
         raise DecodeError('bus_servo.unload request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0xb')
-    m = _new(BusServoUnloadRequest)
-    _set_BusServoUnloadRequest_servo_id(m, v_servo_id)
-    return m
+    return _new(BusServoUnloadRequest, (v_servo_id,))
 
 
 def _decode_bus_servo_load_request(buf: bytes, o: int, end: int) -> BusServoLoadRequest:
@@ -601,9 +396,7 @@ def _decode_bus_servo_load_request(buf: bytes, o: int, end: int) -> BusServoLoad
     v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, o)
     if v_subcommand_code != 12:
         raise DecodeError('bus_servo.load request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0xc')
-    m = _new(BusServoLoadRequest)
-    _set_BusServoLoadRequest_servo_id(m, v_servo_id)
-    return m
+    return _new(BusServoLoadRequest, (v_servo_id,))
 
 
 def _decode_bus_servo_set_id_request(buf: bytes, o: int, end: int) -> BusServoSetIdRequest:
@@ -612,10 +405,7 @@ def _decode_bus_servo_set_id_request(buf: bytes, o: int, end: int) -> BusServoSe
     v_subcommand_code, v_servo_id, v_new_id = _S_U8_U8_U8.unpack_from(buf, o)
     if v_subcommand_code != 16:
         raise DecodeError('bus_servo.set_id request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x10')
-    m = _new(BusServoSetIdRequest)
-    _set_BusServoSetIdRequest_servo_id(m, v_servo_id)
-    _set_BusServoSetIdRequest_new_id(m, v_new_id)
-    return m
+    return _new(BusServoSetIdRequest, (v_servo_id, v_new_id))
 
 
 def _decode_bus_servo_read_id_request(buf: bytes, o: int, end: int) -> BusServoReadIdRequest:
@@ -624,9 +414,7 @@ def _decode_bus_servo_read_id_request(buf: bytes, o: int, end: int) -> BusServoR
     v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, o)
     if v_subcommand_code != 18:
         raise DecodeError('bus_servo.read_id request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x12')
-    m = _new(BusServoReadIdRequest)
-    _set_BusServoReadIdRequest_servo_id(m, v_servo_id)
-    return m
+    return _new(BusServoReadIdRequest, (v_servo_id,))
 
 
 def _decode_bus_servo_read_id_response(buf: bytes, o: int, end: int) -> BusServoReadIdResponse:
@@ -635,11 +423,7 @@ def _decode_bus_servo_read_id_response(buf: bytes, o: int, end: int) -> BusServo
     v_servo_id, v_subcommand_code, v_success, v_id = _S_U8_U8_I8_U8.unpack_from(buf, o)
     if v_subcommand_code != 18:
         raise DecodeError('bus_servo.read_id response' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x12')
-    m = _new(BusServoReadIdResponse)
-    _set_BusServoReadIdResponse_servo_id(m, v_servo_id)
-    _set_BusServoReadIdResponse_success(m, _MEMBERS_ReadResult.get(v_success, v_success))
-    _set_BusServoReadIdResponse_id(m, v_id)
-    return m
+    return _new(BusServoReadIdResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_id))
 
 
 def _decode_bus_servo_set_offset_request(buf: bytes, o: int, end: int) -> BusServoSetOffsetRequest:
@@ -648,10 +432,7 @@ def _decode_bus_servo_set_offset_request(buf: bytes, o: int, end: int) -> BusSer
     v_subcommand_code, v_servo_id, v_offset = _S_U8_U8_I8.unpack_from(buf, o)
     if v_subcommand_code != 32:
         raise DecodeError('bus_servo.set_offset request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x20')
-    m = _new(BusServoSetOffsetRequest)
-    _set_BusServoSetOffsetRequest_servo_id(m, v_servo_id)
-    _set_BusServoSetOffsetRequest_offset(m, v_offset)
-    return m
+    return _new(BusServoSetOffsetRequest, (v_servo_id, v_offset))
 
 
 def _decode_bus_servo_read_offset_request(buf: bytes, o: int, end: int) -> BusServoReadOffsetRequest:
@@ -660,9 +441,7 @@ def _decode_bus_servo_read_offset_request(buf: bytes, o: int, end: int) -> BusSe
     v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, o)
     if v_subcommand_code != 34:
         raise DecodeError('bus_servo.read_offset request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x22')
-    m = _new(BusServoReadOffsetRequest)
-    _set_BusServoReadOffsetRequest_servo_id(m, v_servo_id)
-    return m
+    return _new(BusServoReadOffsetRequest, (v_servo_id,))
 
 
 def _decode_bus_servo_read_offset_response(buf: bytes, o: int, end: int) -> BusServoReadOffsetResponse:
@@ -671,11 +450,7 @@ def _decode_bus_servo_read_offset_response(buf: bytes, o: int, end: int) -> BusS
     v_servo_id, v_subcommand_code, v_success, v_offset = _S_U8_U8_I8_I8.unpack_from(buf, o)
     if v_subcommand_code != 34:
         raise DecodeError('bus_servo.read_offset response' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x22')
-    m = _new(BusServoReadOffsetResponse)
-    _set_BusServoReadOffsetResponse_servo_id(m, v_servo_id)
-    _set_BusServoReadOffsetResponse_success(m, _MEMBERS_ReadResult.get(v_success, v_success))
-    _set_BusServoReadOffsetResponse_offset(m, v_offset)
-    return m
+    return _new(BusServoReadOffsetResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_offset))
 
 
 def _decode_bus_servo_save_offset_request(buf: bytes, o: int, end: int) -> BusServoSaveOffsetRequest:
@@ -684,9 +459,7 @@ def _decode_bus_servo_save_offset_request(buf: bytes, o: int, end: int) -> BusSe
     v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, o)
     if v_subcommand_code != 36:
         raise DecodeError('bus_servo.save_offset request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x24')
-    m = _new(BusServoSaveOffsetRequest)
-    _set_BusServoSaveOffsetRequest_servo_id(m, v_servo_id)
-    return m
+    return _new(BusServoSaveOffsetRequest, (v_servo_id,))
 
 
 def _decode_bus_servo_set_position_limit_request(buf: bytes, o: int, end: int) -> BusServoSetPositionLimitRequest:
@@ -695,11 +468,7 @@ def _decode_bus_servo_set_position_limit_request(buf: bytes, o: int, end: int) -
     v_subcommand_code, v_servo_id, v_low, v_high = _S_U8_U8_U16_U16.unpack_from(buf, o)
     if v_subcommand_code != 48:
         raise DecodeError('bus_servo.set_position_limit request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x30')
-    m = _new(BusServoSetPositionLimitRequest)
-    _set_BusServoSetPositionLimitRequest_servo_id(m, v_servo_id)
-    _set_BusServoSetPositionLimitRequest_low(m, v_low)
-    _set_BusServoSetPositionLimitRequest_high(m, v_high)
-    return m
+    return _new(BusServoSetPositionLimitRequest, (v_servo_id, v_low, v_high))
 
 
 def _decode_bus_servo_read_position_limit_request(buf: bytes, o: int, end: int) -> BusServoReadPositionLimitRequest:
@@ -708,9 +477,7 @@ def _decode_bus_servo_read_position_limit_request(buf: bytes, o: int, end: int) 
     v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, o)
     if v_subcommand_code != 50:
         raise DecodeError('bus_servo.read_position_limit request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x32')
-    m = _new(BusServoReadPositionLimitRequest)
-    _set_BusServoReadPositionLimitRequest_servo_id(m, v_servo_id)
-    return m
+    return _new(BusServoReadPositionLimitRequest, (v_servo_id,))
 
 
 def _decode_bus_servo_read_position_limit_response(buf: bytes, o: int, end: int) -> BusServoReadPositionLimitResponse:
@@ -719,12 +486,7 @@ def _decode_bus_servo_read_position_limit_response(buf: bytes, o: int, end: int)
     v_servo_id, v_subcommand_code, v_success, v_low, v_high = _S_U8_U8_I8_U16_U16.unpack_from(buf, o)
     if v_subcommand_code != 50:
         raise DecodeError('bus_servo.read_position_limit response' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x32')
-    m = _new(BusServoReadPositionLimitResponse)
-    _set_BusServoReadPositionLimitResponse_servo_id(m, v_servo_id)
-    _set_BusServoReadPositionLimitResponse_success(m, _MEMBERS_ReadResult.get(v_success, v_success))
-    _set_BusServoReadPositionLimitResponse_low(m, v_low)
-    _set_BusServoReadPositionLimitResponse_high(m, v_high)
-    return m
+    return _new(BusServoReadPositionLimitResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_low, v_high))
 
 
 def _decode_bus_servo_set_voltage_limit_request(buf: bytes, o: int, end: int) -> BusServoSetVoltageLimitRequest:
@@ -733,11 +495,7 @@ def _decode_bus_servo_set_voltage_limit_request(buf: bytes, o: int, end: int) ->
     v_subcommand_code, v_servo_id, v_low, v_high = _S_U8_U8_U16_U16.unpack_from(buf, o)
     if v_subcommand_code != 52:
         raise DecodeError('bus_servo.set_voltage_limit request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x34')
-    m = _new(BusServoSetVoltageLimitRequest)
-    _set_BusServoSetVoltageLimitRequest_servo_id(m, v_servo_id)
-    _set_BusServoSetVoltageLimitRequest_low(m, v_low)
-    _set_BusServoSetVoltageLimitRequest_high(m, v_high)
-    return m
+    return _new(BusServoSetVoltageLimitRequest, (v_servo_id, v_low, v_high))
 
 
 def _decode_bus_servo_read_voltage_limit_request(buf: bytes, o: int, end: int) -> BusServoReadVoltageLimitRequest:
@@ -746,9 +504,7 @@ def _decode_bus_servo_read_voltage_limit_request(buf: bytes, o: int, end: int) -
     v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, o)
     if v_subcommand_code != 54:
         raise DecodeError('bus_servo.read_voltage_limit request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x36')
-    m = _new(BusServoReadVoltageLimitRequest)
-    _set_BusServoReadVoltageLimitRequest_servo_id(m, v_servo_id)
-    return m
+    return _new(BusServoReadVoltageLimitRequest, (v_servo_id,))
 
 
 def _decode_bus_servo_read_voltage_limit_response(buf: bytes, o: int, end: int) -> BusServoReadVoltageLimitResponse:
@@ -757,12 +513,7 @@ def _decode_bus_servo_read_voltage_limit_response(buf: bytes, o: int, end: int) 
     v_servo_id, v_subcommand_code, v_success, v_low, v_high = _S_U8_U8_I8_U16_U16.unpack_from(buf, o)
     if v_subcommand_code != 54:
         raise DecodeError('bus_servo.read_voltage_limit response' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x36')
-    m = _new(BusServoReadVoltageLimitResponse)
-    _set_BusServoReadVoltageLimitResponse_servo_id(m, v_servo_id)
-    _set_BusServoReadVoltageLimitResponse_success(m, _MEMBERS_ReadResult.get(v_success, v_success))
-    _set_BusServoReadVoltageLimitResponse_low(m, v_low)
-    _set_BusServoReadVoltageLimitResponse_high(m, v_high)
-    return m
+    return _new(BusServoReadVoltageLimitResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_low, v_high))
 
 
 def _decode_bus_servo_set_temperature_limit_request(buf: bytes, o: int, end: int) -> BusServoSetTemperatureLimitRequest:
@@ -771,10 +522,7 @@ def _decode_bus_servo_set_temperature_limit_request(buf: bytes, o: int, end: int
     v_subcommand_code, v_servo_id, v_limit = _S_U8_U8_U8.unpack_from(buf, o)
     if v_subcommand_code != 56:
         raise DecodeError('bus_servo.set_temperature_limit request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x38')
-    m = _new(BusServoSetTemperatureLimitRequest)
-    _set_BusServoSetTemperatureLimitRequest_servo_id(m, v_servo_id)
-    _set_BusServoSetTemperatureLimitRequest_limit(m, v_limit)
-    return m
+    return _new(BusServoSetTemperatureLimitRequest, (v_servo_id, v_limit))
 
 
 def _decode_bus_servo_read_temperature_limit_request(buf: bytes, o: int, end: int) -> BusServoReadTemperatureLimitRequest:
@@ -783,9 +531,7 @@ def _decode_bus_servo_read_temperature_limit_request(buf: bytes, o: int, end: in
     v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, o)
     if v_subcommand_code != 58:
         raise DecodeError('bus_servo.read_temperature_limit request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x3a')
-    m = _new(BusServoReadTemperatureLimitRequest)
-    _set_BusServoReadTemperatureLimitRequest_servo_id(m, v_servo_id)
-    return m
+    return _new(BusServoReadTemperatureLimitRequest, (v_servo_id,))
 
 
 def _decode_bus_servo_read_temperature_limit_response(buf: bytes, o: int, end: int) -> BusServoReadTemperatureLimitResponse:
@@ -794,35 +540,20 @@ def _decode_bus_servo_read_temperature_limit_response(buf: bytes, o: int, end: i
     v_servo_id, v_subcommand_code, v_success, v_limit = _S_U8_U8_I8_U8.unpack_from(buf, o)
     if v_subcommand_code != 58:
         raise DecodeError('bus_servo.read_temperature_limit response' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x3a')
-    m = _new(BusServoReadTemperatureLimitResponse)
-    _set_BusServoReadTemperatureLimitResponse_servo_id(m, v_servo_id)
-    _set_BusServoReadTemperatureLimitResponse_success(m, _MEMBERS_ReadResult.get(v_success, v_success))
-    _set_BusServoReadTemperatureLimitResponse_limit(m, v_limit)
-    return m
+    return _new(BusServoReadTemperatureLimitResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_limit))
 
 
 def _decode_key_response(buf: bytes, o: int, end: int) -> KeyResponse:
     if end - o != 2:
         raise content_size_error('key response', end - o, 2, 2)
     v_button_id, v_event = _S_U8_U8.unpack_from(buf, o)
-    m = _new(KeyResponse)
-    _set_KeyResponse_button_id(m, v_button_id)
-    _set_KeyResponse_event(m, _MEMBERS_ButtonEvent.get(v_event, v_event))
-    return m
+    return _new(KeyResponse, (v_button_id, _MEMBERS_ButtonEvent.get(v_event, v_event)))
 
 
 def _decode_imu_response(buf: bytes, o: int, end: int) -> ImuResponse:
     if end - o != 24:
         raise content_size_error('imu response', end - o, 24, 24)
-    v_accel_x, v_accel_y, v_accel_z, v_gyro_x, v_gyro_y, v_gyro_z = _S_F32_F32_F32_F32_F32_F32.unpack_from(buf, o)
-    m = _new(ImuResponse)
-    _set_ImuResponse_accel_x(m, v_accel_x)
-    _set_ImuResponse_accel_y(m, v_accel_y)
-    _set_ImuResponse_accel_z(m, v_accel_z)
-    _set_ImuResponse_gyro_x(m, v_gyro_x)
-    _set_ImuResponse_gyro_y(m, v_gyro_y)
-    _set_ImuResponse_gyro_z(m, v_gyro_z)
-    return m
+    return _new(ImuResponse, _S_F32_F32_F32_F32_F32_F32.unpack_from(buf, o))
 
 
 def _decode_gamepad_response(buf: bytes, o: int, end: int) -> GamepadResponse:
@@ -832,14 +563,7 @@ def _decode_gamepad_response(buf: bytes, o: int, end: int) -> GamepadResponse:
     v_buttons_flags = _MEMBERS_GamepadButtons.get(v_buttons)
     if v_buttons_flags is None:
         v_buttons_flags = GamepadButtons(v_buttons)
-    m = _new(GamepadResponse)
-    _set_GamepadResponse_buttons(m, v_buttons_flags)
-    _set_GamepadResponse_hat(m, v_hat)
-    _set_GamepadResponse_left_x(m, v_left_x)
-    _set_GamepadResponse_left_y(m, v_left_y)
-    _set_GamepadResponse_right_x(m, v_right_x)
-    _set_GamepadResponse_right_y(m, v_right_y)
-    return m
+    return _new(GamepadResponse, (v_buttons_flags, v_hat, v_left_x, v_left_y, v_right_x, v_right_y))
 
 
 def _decode_sbus_response(buf: bytes, o: int, end: int) -> SbusResponse:
@@ -850,13 +574,7 @@ def _decode_sbus_response(buf: bytes, o: int, end: int) -> SbusResponse:
     v_ch18 = t[17]
     v_signal_loss = t[18]
     v_fail_safe = t[19]
-    m = _new(SbusResponse)
-    _set_SbusResponse_channels(m, t[0:16])
-    _set_SbusResponse_ch17(m, v_ch17)
-    _set_SbusResponse_ch18(m, v_ch18)
-    _set_SbusResponse_signal_loss(m, v_signal_loss)
-    _set_SbusResponse_fail_safe(m, v_fail_safe)
-    return m
+    return _new(SbusResponse, (t[0:16], v_ch17, v_ch18, v_signal_loss, v_fail_safe))
 
 
 def _decode_system_battery_response(buf: bytes, o: int, end: int) -> SystemBatteryResponse:
@@ -865,9 +583,7 @@ def _decode_system_battery_response(buf: bytes, o: int, end: int) -> SystemBatte
     v_subcommand_code, v_voltage = _S_U8_U16.unpack_from(buf, o)
     if v_subcommand_code != 4:
         raise DecodeError('system.battery response' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x4')
-    m = _new(SystemBatteryResponse)
-    _set_SystemBatteryResponse_voltage(m, v_voltage)
-    return m
+    return _new(SystemBatteryResponse, (v_voltage,))
 
 
 def _decode_oled_request(buf: bytes, o: int, end: int) -> OledRequest:
@@ -881,10 +597,7 @@ def _decode_oled_request(buf: bytes, o: int, end: int) -> OledRequest:
     o += v_length
     if o != end:
         raise DecodeError('oled request' + f': {end - o} bytes left after the last field')
-    m = _new(OledRequest)
-    _set_OledRequest_line(m, v_line)
-    _set_OledRequest_text(m, v_text)
-    return m
+    return _new(OledRequest, (v_line, v_text))
 
 
 def _decode_rgb_set_pixels_request(buf: bytes, o: int, end: int) -> RgbSetPixelsRequest:
@@ -894,24 +607,14 @@ def _decode_rgb_set_pixels_request(buf: bytes, o: int, end: int) -> RgbSetPixels
     if v_subcommand_code != 1:
         raise DecodeError('rgb.set_pixels request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x1')
     o += 2
-    v_pixels_list = []
     n = v_count * 4
     if end - o < n:
         raise DecodeError('rgb.set_pixels request' + f': content too short for its count ({v_count} pixels)')
-    for v_index, v_red, v_green, v_blue in _S_U8_U8_U8_U8.iter_unpack(buf[o : o + n]):
-        item = _new(PixelsItem)
-        _set_PixelsItem_index(item, v_index)
-        _set_PixelsItem_red(item, v_red)
-        _set_PixelsItem_green(item, v_green)
-        _set_PixelsItem_blue(item, v_blue)
-        v_pixels_list.append(item)
-    v_pixels = tuple(v_pixels_list)
+    v_pixels = tuple([_new(PixelsItem, values) for values in _S_U8_U8_U8_U8.iter_unpack(buf[o : o + n])])
     o += n
     if o != end:
         raise DecodeError('rgb.set_pixels request' + f': {end - o} bytes left after the last field')
-    m = _new(RgbSetPixelsRequest)
-    _set_RgbSetPixelsRequest_pixels(m, v_pixels)
-    return m
+    return _new(RgbSetPixelsRequest, (v_pixels,))
 
 
 def _frame_led_request(buf: bytes, start: int) -> LedRequest | None:
@@ -921,13 +624,7 @@ def _frame_led_request(buf: bytes, start: int) -> LedRequest | None:
         expected = _CRC_TABLE[expected ^ byte]
     if expected != buf[start + 11]:
         return None
-    v_led_id, v_on_time, v_off_time, v_repeat = _S_U8_U16_U16_U16.unpack_from(buf, start + 4)
-    m = _new(LedRequest)
-    _set_LedRequest_led_id(m, v_led_id)
-    _set_LedRequest_on_time(m, v_on_time)
-    _set_LedRequest_off_time(m, v_off_time)
-    _set_LedRequest_repeat(m, v_repeat)
-    return m
+    return _new(LedRequest, _S_U8_U16_U16_U16.unpack_from(buf, start + 4))
 
 
 def _frame_buzzer_request(buf: bytes, start: int) -> BuzzerRequest | None:
@@ -937,13 +634,7 @@ def _frame_buzzer_request(buf: bytes, start: int) -> BuzzerRequest | None:
         expected = _CRC_TABLE[expected ^ byte]
     if expected != buf[start + 12]:
         return None
-    v_frequency, v_on_time, v_off_time, v_repeat = _S_U16_U16_U16_U16.unpack_from(buf, start + 4)
-    m = _new(BuzzerRequest)
-    _set_BuzzerRequest_frequency(m, v_frequency)
-    _set_BuzzerRequest_on_time(m, v_on_time)
-    _set_BuzzerRequest_off_time(m, v_off_time)
-    _set_BuzzerRequest_repeat(m, v_repeat)
-    return m
+    return _new(BuzzerRequest, _S_U16_U16_U16_U16.unpack_from(buf, start + 4))
 
 
 def _frame_key_response(buf: bytes, start: int) -> KeyResponse | None:
@@ -954,10 +645,7 @@ def _frame_key_response(buf: bytes, start: int) -> KeyResponse | None:
     if expected != buf[start + 6]:
         return None
     v_button_id, v_event = _S_U8_U8.unpack_from(buf, start + 4)
-    m = _new(KeyResponse)
-    _set_KeyResponse_button_id(m, v_button_id)
-    _set_KeyResponse_event(m, _MEMBERS_ButtonEvent.get(v_event, v_event))
-    return m
+    return _new(KeyResponse, (v_button_id, _MEMBERS_ButtonEvent.get(v_event, v_event)))
 
 
 def _frame_imu_response(buf: bytes, start: int) -> ImuResponse | None:
@@ -967,15 +655,7 @@ def _frame_imu_response(buf: bytes, start: int) -> ImuResponse | None:
         expected = _CRC_TABLE[expected ^ byte]
     if expected != buf[start + 28]:
         return None
-    v_accel_x, v_accel_y, v_accel_z, v_gyro_x, v_gyro_y, v_gyro_z = _S_F32_F32_F32_F32_F32_F32.unpack_from(buf, start + 4)
-    m = _new(ImuResponse)
-    _set_ImuResponse_accel_x(m, v_accel_x)
-    _set_ImuResponse_accel_y(m, v_accel_y)
-    _set_ImuResponse_accel_z(m, v_accel_z)
-    _set_ImuResponse_gyro_x(m, v_gyro_x)
-    _set_ImuResponse_gyro_y(m, v_gyro_y)
-    _set_ImuResponse_gyro_z(m, v_gyro_z)
-    return m
+    return _new(ImuResponse, _S_F32_F32_F32_F32_F32_F32.unpack_from(buf, start + 4))
 
 
 def _frame_gamepad_response(buf: bytes, start: int) -> GamepadResponse | None:
@@ -989,14 +669,7 @@ def _frame_gamepad_response(buf: bytes, start: int) -> GamepadResponse | None:
     v_buttons_flags = _MEMBERS_GamepadButtons.get(v_buttons)
     if v_buttons_flags is None:
         v_buttons_flags = GamepadButtons(v_buttons)
-    m = _new(GamepadResponse)
-    _set_GamepadResponse_buttons(m, v_buttons_flags)
-    _set_GamepadResponse_hat(m, v_hat)
-    _set_GamepadResponse_left_x(m, v_left_x)
-    _set_GamepadResponse_left_y(m, v_left_y)
-    _set_GamepadResponse_right_x(m, v_right_x)
-    _set_GamepadResponse_right_y(m, v_right_y)
-    return m
+    return _new(GamepadResponse, (v_buttons_flags, v_hat, v_left_x, v_left_y, v_right_x, v_right_y))
 
 
 def _frame_sbus_response(buf: bytes, start: int) -> SbusResponse | None:
@@ -1011,25 +684,398 @@ def _frame_sbus_response(buf: bytes, start: int) -> SbusResponse | None:
     v_ch18 = t[17]
     v_signal_loss = t[18]
     v_fail_safe = t[19]
-    m = _new(SbusResponse)
-    _set_SbusResponse_channels(m, t[0:16])
-    _set_SbusResponse_ch17(m, v_ch17)
-    _set_SbusResponse_ch18(m, v_ch18)
-    _set_SbusResponse_signal_loss(m, v_signal_loss)
-    _set_SbusResponse_fail_safe(m, v_fail_safe)
-    return m
+    return _new(SbusResponse, (t[0:16], v_ch17, v_ch18, v_signal_loss, v_fail_safe))
+
+
+def _whole_led_request(buf: bytes) -> LedRequest | None:
+    """A whole led request frame, all of buf, size and header known: None if its checksum fails."""
+    expected = _CRC_TABLE[0x47 ^ buf[4]]
+    expected = _CRC_TABLE[expected ^ buf[5]]
+    expected = _CRC_TABLE[expected ^ buf[6]]
+    expected = _CRC_TABLE[expected ^ buf[7]]
+    expected = _CRC_TABLE[expected ^ buf[8]]
+    expected = _CRC_TABLE[expected ^ buf[9]]
+    expected = _CRC_TABLE[expected ^ buf[10]]
+    if expected != buf[11]:
+        return None
+    return _new(LedRequest, _S_U8_U16_U16_U16.unpack_from(buf, 4))
+
+
+def _whole_buzzer_request(buf: bytes) -> BuzzerRequest | None:
+    """A whole buzzer request frame, all of buf, size and header known: None if its checksum fails."""
+    expected = _CRC_TABLE[0x53 ^ buf[4]]
+    expected = _CRC_TABLE[expected ^ buf[5]]
+    expected = _CRC_TABLE[expected ^ buf[6]]
+    expected = _CRC_TABLE[expected ^ buf[7]]
+    expected = _CRC_TABLE[expected ^ buf[8]]
+    expected = _CRC_TABLE[expected ^ buf[9]]
+    expected = _CRC_TABLE[expected ^ buf[10]]
+    expected = _CRC_TABLE[expected ^ buf[11]]
+    if expected != buf[12]:
+        return None
+    return _new(BuzzerRequest, _S_U16_U16_U16_U16.unpack_from(buf, 4))
+
+
+def _whole_key_response(buf: bytes) -> KeyResponse | None:
+    """A whole key response frame, all of buf, size and header known: None if its checksum fails."""
+    expected = _CRC_TABLE[0x16 ^ buf[4]]
+    expected = _CRC_TABLE[expected ^ buf[5]]
+    if expected != buf[6]:
+        return None
+    v_button_id, v_event = _S_U8_U8.unpack_from(buf, 4)
+    return _new(KeyResponse, (v_button_id, _MEMBERS_ButtonEvent.get(v_event, v_event)))
+
+
+def _whole_imu_response(buf: bytes) -> ImuResponse | None:
+    """A whole imu response frame, all of buf, size and header known: None if its checksum fails."""
+    expected = 0x31
+    for byte in buf[4 : 28]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[28]:
+        return None
+    return _new(ImuResponse, _S_F32_F32_F32_F32_F32_F32.unpack_from(buf, 4))
+
+
+def _whole_gamepad_response(buf: bytes) -> GamepadResponse | None:
+    """A whole gamepad response frame, all of buf, size and header known: None if its checksum fails."""
+    expected = _CRC_TABLE[0xf5 ^ buf[4]]
+    expected = _CRC_TABLE[expected ^ buf[5]]
+    expected = _CRC_TABLE[expected ^ buf[6]]
+    expected = _CRC_TABLE[expected ^ buf[7]]
+    expected = _CRC_TABLE[expected ^ buf[8]]
+    expected = _CRC_TABLE[expected ^ buf[9]]
+    expected = _CRC_TABLE[expected ^ buf[10]]
+    if expected != buf[11]:
+        return None
+    v_buttons, v_hat, v_left_x, v_left_y, v_right_x, v_right_y = _S_U16_U8_I8_I8_I8_I8.unpack_from(buf, 4)
+    v_buttons_flags = _MEMBERS_GamepadButtons.get(v_buttons)
+    if v_buttons_flags is None:
+        v_buttons_flags = GamepadButtons(v_buttons)
+    return _new(GamepadResponse, (v_buttons_flags, v_hat, v_left_x, v_left_y, v_right_x, v_right_y))
+
+
+def _whole_sbus_response(buf: bytes) -> SbusResponse | None:
+    """A whole sbus response frame, all of buf, size and header known: None if its checksum fails."""
+    expected = 0xf0
+    for byte in buf[4 : 40]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[40]:
+        return None
+    t = _S_I16X16_U8_U8_U8_U8.unpack_from(buf, 4)
+    v_ch17 = t[16]
+    v_ch18 = t[17]
+    v_signal_loss = t[18]
+    v_fail_safe = t[19]
+    return _new(SbusResponse, (t[0:16], v_ch17, v_ch18, v_signal_loss, v_fail_safe))
+
+
+def _whole_motor_request_11(buf: bytes) -> Message | None:
+    """A whole motor request frame of 11 bytes, by its sub-command: None if its checksum fails or no
+    sub-command of that size has its code (decode's general path then says why)."""
+    expected = _CRC_TABLE[0x88 ^ buf[4]]
+    expected = _CRC_TABLE[expected ^ buf[5]]
+    expected = _CRC_TABLE[expected ^ buf[6]]
+    expected = _CRC_TABLE[expected ^ buf[7]]
+    expected = _CRC_TABLE[expected ^ buf[8]]
+    expected = _CRC_TABLE[expected ^ buf[9]]
+    if expected != buf[10]:
+        return None
+    sub = buf[4]
+    if sub == 0x00:
+        v_subcommand_code, v_motor_id, v_speed = _S_U8_U8_F32.unpack_from(buf, 4)
+        return _new(MotorSetSpeedRequest, (v_motor_id, v_speed))
+    return None
+
+
+def _whole_motor_request_7(buf: bytes) -> Message | None:
+    """A whole motor request frame of 7 bytes, by its sub-command: None if its checksum fails or no
+    sub-command of that size has its code (decode's general path then says why)."""
+    expected = _CRC_TABLE[0xe9 ^ buf[4]]
+    expected = _CRC_TABLE[expected ^ buf[5]]
+    if expected != buf[6]:
+        return None
+    sub = buf[4]
+    if sub == 0x02:
+        v_subcommand_code, v_motor_id = _S_U8_U8.unpack_from(buf, 4)
+        return _new(MotorStopRequest, (v_motor_id,))
+    if sub == 0x03:
+        v_subcommand_code, v_mask = _S_U8_U8.unpack_from(buf, 4)
+        v_mask_flags = _MEMBERS_MotorMask.get(v_mask)
+        if v_mask_flags is None:
+            v_mask_flags = MotorMask(v_mask)
+        return _new(MotorStopMaskRequest, (v_mask_flags,))
+    return None
+
+
+def _whole_pwm_servo_request_11(buf: bytes) -> Message | None:
+    """A whole pwm_servo request frame of 11 bytes, by its sub-command: None if its checksum fails or no
+    sub-command of that size has its code (decode's general path then says why)."""
+    expected = _CRC_TABLE[0xe6 ^ buf[4]]
+    expected = _CRC_TABLE[expected ^ buf[5]]
+    expected = _CRC_TABLE[expected ^ buf[6]]
+    expected = _CRC_TABLE[expected ^ buf[7]]
+    expected = _CRC_TABLE[expected ^ buf[8]]
+    expected = _CRC_TABLE[expected ^ buf[9]]
+    if expected != buf[10]:
+        return None
+    sub = buf[4]
+    if sub == 0x03:
+        v_subcommand_code, v_duration, v_servo_id, v_pulse = _S_U8_U16_U8_U16.unpack_from(buf, 4)
+        return _new(PwmServoSetPositionRequest, (v_duration, v_servo_id, v_pulse))
+    return None
+
+
+def _whole_pwm_servo_request_7(buf: bytes) -> Message | None:
+    """A whole pwm_servo request frame of 7 bytes, by its sub-command: None if its checksum fails or no
+    sub-command of that size has its code (decode's general path then says why)."""
+    expected = _CRC_TABLE[0x87 ^ buf[4]]
+    expected = _CRC_TABLE[expected ^ buf[5]]
+    if expected != buf[6]:
+        return None
+    sub = buf[4]
+    if sub == 0x05:
+        v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
+        return _new(PwmServoReadPositionRequest, (v_servo_id,))
+    if sub == 0x09:
+        v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
+        return _new(PwmServoReadOffsetRequest, (v_servo_id,))
+    return None
+
+
+def _whole_pwm_servo_request_8(buf: bytes) -> Message | None:
+    """A whole pwm_servo request frame of 8 bytes, by its sub-command: None if its checksum fails or no
+    sub-command of that size has its code (decode's general path then says why)."""
+    expected = _CRC_TABLE[0xd9 ^ buf[4]]
+    expected = _CRC_TABLE[expected ^ buf[5]]
+    expected = _CRC_TABLE[expected ^ buf[6]]
+    if expected != buf[7]:
+        return None
+    sub = buf[4]
+    if sub == 0x07:
+        v_subcommand_code, v_servo_id, v_offset = _S_U8_U8_I8.unpack_from(buf, 4)
+        return _new(PwmServoSetOffsetRequest, (v_servo_id, v_offset))
+    return None
+
+
+def _whole_bus_servo_request_7(buf: bytes) -> Message | None:
+    """A whole bus_servo request frame of 7 bytes, by its sub-command: None if its checksum fails or no
+    sub-command of that size has its code (decode's general path then says why)."""
+    expected = _CRC_TABLE[0x43 ^ buf[4]]
+    expected = _CRC_TABLE[expected ^ buf[5]]
+    if expected != buf[6]:
+        return None
+    sub = buf[4]
+    if sub == 0x05:
+        v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
+        return _new(BusServoReadPositionRequest, (v_servo_id,))
+    if sub == 0x07:
+        v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
+        return _new(BusServoReadVoltageRequest, (v_servo_id,))
+    if sub == 0x09:
+        v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
+        return _new(BusServoReadTemperatureRequest, (v_servo_id,))
+    if sub == 0x0d:
+        v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
+        return _new(BusServoReadTorqueRequest, (v_servo_id,))
+    if sub == 0x0b:
+        v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
+        return _new(BusServoUnloadRequest, (v_servo_id,))
+    if sub == 0x0c:
+        v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
+        return _new(BusServoLoadRequest, (v_servo_id,))
+    if sub == 0x12:
+        v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
+        return _new(BusServoReadIdRequest, (v_servo_id,))
+    if sub == 0x22:
+        v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
+        return _new(BusServoReadOffsetRequest, (v_servo_id,))
+    if sub == 0x24:
+        v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
+        return _new(BusServoSaveOffsetRequest, (v_servo_id,))
+    if sub == 0x32:
+        v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
+        return _new(BusServoReadPositionLimitRequest, (v_servo_id,))
+    if sub == 0x36:
+        v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
+        return _new(BusServoReadVoltageLimitRequest, (v_servo_id,))
+    if sub == 0x3a:
+        v_subcommand_code, v_servo_id = _S_U8_U8.unpack_from(buf, 4)
+        return _new(BusServoReadTemperatureLimitRequest, (v_servo_id,))
+    return None
+
+
+def _whole_bus_servo_request_8(buf: bytes) -> Message | None:
+    """A whole bus_servo request frame of 8 bytes, by its sub-command: None if its checksum fails or no
+    sub-command of that size has its code (decode's general path then says why)."""
+    expected = _CRC_TABLE[0x1d ^ buf[4]]
+    expected = _CRC_TABLE[expected ^ buf[5]]
+    expected = _CRC_TABLE[expected ^ buf[6]]
+    if expected != buf[7]:
+        return None
+    sub = buf[4]
+    if sub == 0x10:
+        v_subcommand_code, v_servo_id, v_new_id = _S_U8_U8_U8.unpack_from(buf, 4)
+        return _new(BusServoSetIdRequest, (v_servo_id, v_new_id))
+    if sub == 0x20:
+        v_subcommand_code, v_servo_id, v_offset = _S_U8_U8_I8.unpack_from(buf, 4)
+        return _new(BusServoSetOffsetRequest, (v_servo_id, v_offset))
+    if sub == 0x38:
+        v_subcommand_code, v_servo_id, v_limit = _S_U8_U8_U8.unpack_from(buf, 4)
+        return _new(BusServoSetTemperatureLimitRequest, (v_servo_id, v_limit))
+    return None
+
+
+def _whole_bus_servo_request_11(buf: bytes) -> Message | None:
+    """A whole bus_servo request frame of 11 bytes, by its sub-command: None if its checksum fails or no
+    sub-command of that size has its code (decode's general path then says why)."""
+    expected = _CRC_TABLE[0x22 ^ buf[4]]
+    expected = _CRC_TABLE[expected ^ buf[5]]
+    expected = _CRC_TABLE[expected ^ buf[6]]
+    expected = _CRC_TABLE[expected ^ buf[7]]
+    expected = _CRC_TABLE[expected ^ buf[8]]
+    expected = _CRC_TABLE[expected ^ buf[9]]
+    if expected != buf[10]:
+        return None
+    sub = buf[4]
+    if sub == 0x30:
+        v_subcommand_code, v_servo_id, v_low, v_high = _S_U8_U8_U16_U16.unpack_from(buf, 4)
+        return _new(BusServoSetPositionLimitRequest, (v_servo_id, v_low, v_high))
+    if sub == 0x34:
+        v_subcommand_code, v_servo_id, v_low, v_high = _S_U8_U8_U16_U16.unpack_from(buf, 4)
+        return _new(BusServoSetVoltageLimitRequest, (v_servo_id, v_low, v_high))
+    return None
+
+
+def _whole_pwm_servo_response_9(buf: bytes) -> Message | None:
+    """A whole pwm_servo response frame of 9 bytes, by its sub-command: None if its checksum fails or no
+    sub-command of that size has its code (decode's general path then says why)."""
+    expected = _CRC_TABLE[0x5a ^ buf[4]]
+    expected = _CRC_TABLE[expected ^ buf[5]]
+    expected = _CRC_TABLE[expected ^ buf[6]]
+    expected = _CRC_TABLE[expected ^ buf[7]]
+    if expected != buf[8]:
+        return None
+    sub = buf[5]
+    if sub == 0x05:
+        v_servo_id, v_subcommand_code, v_pulse = _S_U8_U8_U16.unpack_from(buf, 4)
+        return _new(PwmServoReadPositionResponse, (v_servo_id, v_pulse))
+    return None
+
+
+def _whole_pwm_servo_response_8(buf: bytes) -> Message | None:
+    """A whole pwm_servo response frame of 8 bytes, by its sub-command: None if its checksum fails or no
+    sub-command of that size has its code (decode's general path then says why)."""
+    expected = _CRC_TABLE[0xd9 ^ buf[4]]
+    expected = _CRC_TABLE[expected ^ buf[5]]
+    expected = _CRC_TABLE[expected ^ buf[6]]
+    if expected != buf[7]:
+        return None
+    sub = buf[5]
+    if sub == 0x09:
+        v_servo_id, v_subcommand_code, v_offset = _S_U8_U8_I8.unpack_from(buf, 4)
+        return _new(PwmServoReadOffsetResponse, (v_servo_id, v_offset))
+    return None
+
+
+def _whole_bus_servo_response_10(buf: bytes) -> Message | None:
+    """A whole bus_servo response frame of 10 bytes, by its sub-command: None if its checksum fails or no
+    sub-command of that size has its code (decode's general path then says why)."""
+    expected = _CRC_TABLE[0xc0 ^ buf[4]]
+    expected = _CRC_TABLE[expected ^ buf[5]]
+    expected = _CRC_TABLE[expected ^ buf[6]]
+    expected = _CRC_TABLE[expected ^ buf[7]]
+    expected = _CRC_TABLE[expected ^ buf[8]]
+    if expected != buf[9]:
+        return None
+    sub = buf[5]
+    if sub == 0x05:
+        v_servo_id, v_subcommand_code, v_success, v_position = _S_U8_U8_I8_I16.unpack_from(buf, 4)
+        return _new(BusServoReadPositionResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_position))
+    if sub == 0x07:
+        v_servo_id, v_subcommand_code, v_success, v_voltage = _S_U8_U8_I8_U16.unpack_from(buf, 4)
+        return _new(BusServoReadVoltageResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_voltage))
+    return None
+
+
+def _whole_bus_servo_response_9(buf: bytes) -> Message | None:
+    """A whole bus_servo response frame of 9 bytes, by its sub-command: None if its checksum fails or no
+    sub-command of that size has its code (decode's general path then says why)."""
+    expected = _CRC_TABLE[0x9e ^ buf[4]]
+    expected = _CRC_TABLE[expected ^ buf[5]]
+    expected = _CRC_TABLE[expected ^ buf[6]]
+    expected = _CRC_TABLE[expected ^ buf[7]]
+    if expected != buf[8]:
+        return None
+    sub = buf[5]
+    if sub == 0x09:
+        v_servo_id, v_subcommand_code, v_success, v_temperature = _S_U8_U8_I8_U8.unpack_from(buf, 4)
+        return _new(BusServoReadTemperatureResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_temperature))
+    if sub == 0x0d:
+        v_servo_id, v_subcommand_code, v_success, v_torque = _S_U8_U8_I8_I8.unpack_from(buf, 4)
+        return _new(BusServoReadTorqueResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_torque))
+    if sub == 0x12:
+        v_servo_id, v_subcommand_code, v_success, v_id = _S_U8_U8_I8_U8.unpack_from(buf, 4)
+        return _new(BusServoReadIdResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_id))
+    if sub == 0x22:
+        v_servo_id, v_subcommand_code, v_success, v_offset = _S_U8_U8_I8_I8.unpack_from(buf, 4)
+        return _new(BusServoReadOffsetResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_offset))
+    if sub == 0x3a:
+        v_servo_id, v_subcommand_code, v_success, v_limit = _S_U8_U8_I8_U8.unpack_from(buf, 4)
+        return _new(BusServoReadTemperatureLimitResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_limit))
+    return None
+
+
+def _whole_bus_servo_response_12(buf: bytes) -> Message | None:
+    """A whole bus_servo response frame of 12 bytes, by its sub-command: None if its checksum fails or no
+    sub-command of that size has its code (decode's general path then says why)."""
+    expected = _CRC_TABLE[0x7c ^ buf[4]]
+    expected = _CRC_TABLE[expected ^ buf[5]]
+    expected = _CRC_TABLE[expected ^ buf[6]]
+    expected = _CRC_TABLE[expected ^ buf[7]]
+    expected = _CRC_TABLE[expected ^ buf[8]]
+    expected = _CRC_TABLE[expected ^ buf[9]]
+    expected = _CRC_TABLE[expected ^ buf[10]]
+    if expected != buf[11]:
+        return None
+    sub = buf[5]
+    if sub == 0x32:
+        v_servo_id, v_subcommand_code, v_success, v_low, v_high = _S_U8_U8_I8_U16_U16.unpack_from(buf, 4)
+        return _new(BusServoReadPositionLimitResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_low, v_high))
+    if sub == 0x36:
+        v_servo_id, v_subcommand_code, v_success, v_low, v_high = _S_U8_U8_I8_U16_U16.unpack_from(buf, 4)
+        return _new(BusServoReadVoltageLimitResponse, (v_servo_id, _MEMBERS_ReadResult.get(v_success, v_success), v_low, v_high))
+    return None
+
+
+def _whole_system_response_8(buf: bytes) -> Message | None:
+    """A whole system response frame of 8 bytes, by its sub-command: None if its checksum fails or no
+    sub-command of that size has its code (decode's general path then says why)."""
+    expected = _CRC_TABLE[0xe2 ^ buf[4]]
+    expected = _CRC_TABLE[expected ^ buf[5]]
+    expected = _CRC_TABLE[expected ^ buf[6]]
+    if expected != buf[7]:
+        return None
+    sub = buf[4]
+    if sub == 0x04:
+        v_subcommand_code, v_voltage = _S_U8_U16.unpack_from(buf, 4)
+        return _new(SystemBatteryResponse, (v_voltage,))
+    return None
 
 
 def _encode_led_request(m: LedRequest) -> bytes:
-    if not 0 <= m.led_id <= 255 or m.led_id.__class__ is bool:
-        raise out_of_range('led request', 'led_id', m.led_id, 0, 255)
-    if not 0 <= m.on_time <= 65535 or m.on_time.__class__ is bool:
-        raise out_of_range('led request', 'on_time', m.on_time, 0, 65535)
-    if not 0 <= m.off_time <= 65535 or m.off_time.__class__ is bool:
-        raise out_of_range('led request', 'off_time', m.off_time, 0, 65535)
-    if not 0 <= m.repeat <= 65535 or m.repeat.__class__ is bool:
-        raise out_of_range('led request', 'repeat', m.repeat, 0, 65535)
-    body = _S_FRAME_LEDREQUEST.pack(b'\xaaU', 1, 7, m.led_id, m.on_time, m.off_time, m.repeat)
+    m_led_id = m.led_id
+    m_on_time = m.on_time
+    m_off_time = m.off_time
+    m_repeat = m.repeat
+    if not 0 <= m_led_id <= 255 or m_led_id.__class__ is bool:
+        raise out_of_range('led request', 'led_id', m_led_id, 0, 255)
+    if not 0 <= m_on_time <= 65535 or m_on_time.__class__ is bool:
+        raise out_of_range('led request', 'on_time', m_on_time, 0, 65535)
+    if not 0 <= m_off_time <= 65535 or m_off_time.__class__ is bool:
+        raise out_of_range('led request', 'off_time', m_off_time, 0, 65535)
+    if not 0 <= m_repeat <= 65535 or m_repeat.__class__ is bool:
+        raise out_of_range('led request', 'repeat', m_repeat, 0, 65535)
+    body = _S_FRAME_LEDREQUEST.pack(b'\xaaU', 1, 7, m_led_id, m_on_time, m_off_time, m_repeat)
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1037,15 +1083,19 @@ def _encode_led_request(m: LedRequest) -> bytes:
 
 
 def _encode_buzzer_request(m: BuzzerRequest) -> bytes:
-    if not 0 <= m.frequency <= 65535 or m.frequency.__class__ is bool:
-        raise out_of_range('buzzer request', 'frequency', m.frequency, 0, 65535)
-    if not 0 <= m.on_time <= 65535 or m.on_time.__class__ is bool:
-        raise out_of_range('buzzer request', 'on_time', m.on_time, 0, 65535)
-    if not 0 <= m.off_time <= 65535 or m.off_time.__class__ is bool:
-        raise out_of_range('buzzer request', 'off_time', m.off_time, 0, 65535)
-    if not 0 <= m.repeat <= 65535 or m.repeat.__class__ is bool:
-        raise out_of_range('buzzer request', 'repeat', m.repeat, 0, 65535)
-    body = _S_FRAME_BUZZERREQUEST.pack(b'\xaaU', 2, 8, m.frequency, m.on_time, m.off_time, m.repeat)
+    m_frequency = m.frequency
+    m_on_time = m.on_time
+    m_off_time = m.off_time
+    m_repeat = m.repeat
+    if not 0 <= m_frequency <= 65535 or m_frequency.__class__ is bool:
+        raise out_of_range('buzzer request', 'frequency', m_frequency, 0, 65535)
+    if not 0 <= m_on_time <= 65535 or m_on_time.__class__ is bool:
+        raise out_of_range('buzzer request', 'on_time', m_on_time, 0, 65535)
+    if not 0 <= m_off_time <= 65535 or m_off_time.__class__ is bool:
+        raise out_of_range('buzzer request', 'off_time', m_off_time, 0, 65535)
+    if not 0 <= m_repeat <= 65535 or m_repeat.__class__ is bool:
+        raise out_of_range('buzzer request', 'repeat', m_repeat, 0, 65535)
+    body = _S_FRAME_BUZZERREQUEST.pack(b'\xaaU', 2, 8, m_frequency, m_on_time, m_off_time, m_repeat)
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1053,11 +1103,13 @@ def _encode_buzzer_request(m: BuzzerRequest) -> bytes:
 
 
 def _encode_motor_set_speed_request(m: MotorSetSpeedRequest) -> bytes:
-    if not 0 <= m.motor_id <= 255 or m.motor_id.__class__ is bool:
-        raise out_of_range('motor.set_speed request', 'motor_id', m.motor_id, 0, 255)
-    if not -340282346638528859811704183484516925440 <= m.speed <= 340282346638528859811704183484516925440:
-        raise out_of_range('motor.set_speed request', 'speed', m.speed, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
-    body = _S_B2_U8_U8_U8_U8_F32.pack(b'\xaaU', 3, 6, 0, m.motor_id, m.speed)
+    m_motor_id = m.motor_id
+    m_speed = m.speed
+    if not 0 <= m_motor_id <= 255 or m_motor_id.__class__ is bool:
+        raise out_of_range('motor.set_speed request', 'motor_id', m_motor_id, 0, 255)
+    if not -3.4028234663852886e+38 <= m_speed <= 3.4028234663852886e+38:
+        raise out_of_range('motor.set_speed request', 'speed', m_speed, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
+    body = _S_B2_U8_U8_U8_U8_F32.pack(b'\xaaU', 3, 6, 0, m_motor_id, m_speed)
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1065,20 +1117,23 @@ def _encode_motor_set_speed_request(m: MotorSetSpeedRequest) -> bytes:
 
 
 def _encode_motor_set_speeds_request(m: MotorSetSpeedsRequest) -> bytes:
-    if len(m.motors) > 255:
-        raise out_of_range('motor.set_speeds request', 'count', len(m.motors), 0, 255)
+    m_motors = m.motors
+    if len(m_motors) > 255:
+        raise out_of_range('motor.set_speeds request', 'count', len(m_motors), 0, 255)
     parts_motors = []
-    for item in m.motors:
-        if not 0 <= item.motor_id <= 255 or item.motor_id.__class__ is bool:
-            raise out_of_range('motor.set_speeds request', 'motor_id', item.motor_id, 0, 255)
-        if not -340282346638528859811704183484516925440 <= item.speed <= 340282346638528859811704183484516925440:
-            raise out_of_range('motor.set_speeds request', 'speed', item.speed, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
-        parts_motors.append(_S_U8_F32.pack(item.motor_id, item.speed))
+    for item in m_motors:
+        item_motor_id = item.motor_id
+        item_speed = item.speed
+        if not 0 <= item_motor_id <= 255 or item_motor_id.__class__ is bool:
+            raise out_of_range('motor.set_speeds request', 'motor_id', item_motor_id, 0, 255)
+        if not -3.4028234663852886e+38 <= item_speed <= 3.4028234663852886e+38:
+            raise out_of_range('motor.set_speeds request', 'speed', item_speed, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
+        parts_motors.append(_S_U8_F32.pack(item_motor_id, item_speed))
     content = b''.join(parts_motors)
     n = len(content) + 2
     if n > 255:
         raise EncodeError(f'content of {n} bytes does not fit the length field')
-    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 3, n, 1, len(m.motors)) + content
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 3, n, 1, len(m_motors)) + content
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1086,9 +1141,10 @@ def _encode_motor_set_speeds_request(m: MotorSetSpeedsRequest) -> bytes:
 
 
 def _encode_motor_stop_request(m: MotorStopRequest) -> bytes:
-    if not 0 <= m.motor_id <= 255 or m.motor_id.__class__ is bool:
-        raise out_of_range('motor.stop request', 'motor_id', m.motor_id, 0, 255)
-    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 3, 2, 2, m.motor_id)
+    m_motor_id = m.motor_id
+    if not 0 <= m_motor_id <= 255 or m_motor_id.__class__ is bool:
+        raise out_of_range('motor.stop request', 'motor_id', m_motor_id, 0, 255)
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 3, 2, 2, m_motor_id)
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1096,20 +1152,23 @@ def _encode_motor_stop_request(m: MotorStopRequest) -> bytes:
 
 
 def _encode_motor_set_duties_request(m: MotorSetDutiesRequest) -> bytes:
-    if len(m.duties) > 255:
-        raise out_of_range('motor.set_duties request', 'count', len(m.duties), 0, 255)
+    m_duties = m.duties
+    if len(m_duties) > 255:
+        raise out_of_range('motor.set_duties request', 'count', len(m_duties), 0, 255)
     parts_duties = []
-    for item in m.duties:
-        if not 0 <= item.motor_id <= 255 or item.motor_id.__class__ is bool:
-            raise out_of_range('motor.set_duties request', 'motor_id', item.motor_id, 0, 255)
-        if not -340282346638528859811704183484516925440 <= item.duty <= 340282346638528859811704183484516925440:
-            raise out_of_range('motor.set_duties request', 'duty', item.duty, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
-        parts_duties.append(_S_U8_F32.pack(item.motor_id, item.duty))
+    for item in m_duties:
+        item_motor_id = item.motor_id
+        item_duty = item.duty
+        if not 0 <= item_motor_id <= 255 or item_motor_id.__class__ is bool:
+            raise out_of_range('motor.set_duties request', 'motor_id', item_motor_id, 0, 255)
+        if not -3.4028234663852886e+38 <= item_duty <= 3.4028234663852886e+38:
+            raise out_of_range('motor.set_duties request', 'duty', item_duty, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
+        parts_duties.append(_S_U8_F32.pack(item_motor_id, item_duty))
     content = b''.join(parts_duties)
     n = len(content) + 2
     if n > 255:
         raise EncodeError(f'content of {n} bytes does not fit the length field')
-    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 3, n, 5, len(m.duties)) + content
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 3, n, 5, len(m_duties)) + content
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1117,9 +1176,10 @@ def _encode_motor_set_duties_request(m: MotorSetDutiesRequest) -> bytes:
 
 
 def _encode_motor_stop_mask_request(m: MotorStopMaskRequest) -> bytes:
-    if not 0 <= m.mask <= 255 or isinstance(m.mask, bool):
-        raise out_of_range('motor.stop_mask request', 'mask', m.mask, 0, 255)
-    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 3, 2, 3, m.mask)
+    m_mask = m.mask
+    if not 0 <= m_mask <= 255 or isinstance(m_mask, bool):
+        raise out_of_range('motor.stop_mask request', 'mask', m_mask, 0, 255)
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 3, 2, 3, m_mask)
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1127,22 +1187,26 @@ def _encode_motor_stop_mask_request(m: MotorStopMaskRequest) -> bytes:
 
 
 def _encode_pwm_servo_set_positions_request(m: PwmServoSetPositionsRequest) -> bytes:
-    if not 0 <= m.duration <= 65535 or m.duration.__class__ is bool:
-        raise out_of_range('pwm_servo.set_positions request', 'duration', m.duration, 0, 65535)
-    if len(m.pwm_servos) > 255:
-        raise out_of_range('pwm_servo.set_positions request', 'count', len(m.pwm_servos), 0, 255)
+    m_duration = m.duration
+    m_pwm_servos = m.pwm_servos
+    if not 0 <= m_duration <= 65535 or m_duration.__class__ is bool:
+        raise out_of_range('pwm_servo.set_positions request', 'duration', m_duration, 0, 65535)
+    if len(m_pwm_servos) > 255:
+        raise out_of_range('pwm_servo.set_positions request', 'count', len(m_pwm_servos), 0, 255)
     parts_pwm_servos = []
-    for item in m.pwm_servos:
-        if not 0 <= item.servo_id <= 255 or item.servo_id.__class__ is bool:
-            raise out_of_range('pwm_servo.set_positions request', 'servo_id', item.servo_id, 0, 255)
-        if not 500 <= item.pulse <= 2500 or item.pulse.__class__ is bool:
-            raise out_of_range('pwm_servo.set_positions request', 'pulse', item.pulse, 500, 2500)
-        parts_pwm_servos.append(_S_U8_U16.pack(item.servo_id, item.pulse))
+    for item in m_pwm_servos:
+        item_servo_id = item.servo_id
+        item_pulse = item.pulse
+        if not 0 <= item_servo_id <= 255 or item_servo_id.__class__ is bool:
+            raise out_of_range('pwm_servo.set_positions request', 'servo_id', item_servo_id, 0, 255)
+        if not 500 <= item_pulse <= 2500 or item_pulse.__class__ is bool:
+            raise out_of_range('pwm_servo.set_positions request', 'pulse', item_pulse, 500, 2500)
+        parts_pwm_servos.append(_S_U8_U16.pack(item_servo_id, item_pulse))
     content = b''.join(parts_pwm_servos)
     n = len(content) + 4
     if n > 255:
         raise EncodeError(f'content of {n} bytes does not fit the length field')
-    body = _S_B2_U8_U8_U8_U16_U8.pack(b'\xaaU', 4, n, 1, m.duration, len(m.pwm_servos)) + content
+    body = _S_B2_U8_U8_U8_U16_U8.pack(b'\xaaU', 4, n, 1, m_duration, len(m_pwm_servos)) + content
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1150,13 +1214,16 @@ def _encode_pwm_servo_set_positions_request(m: PwmServoSetPositionsRequest) -> b
 
 
 def _encode_pwm_servo_set_position_request(m: PwmServoSetPositionRequest) -> bytes:
-    if not 0 <= m.duration <= 65535 or m.duration.__class__ is bool:
-        raise out_of_range('pwm_servo.set_position request', 'duration', m.duration, 0, 65535)
-    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
-        raise out_of_range('pwm_servo.set_position request', 'servo_id', m.servo_id, 0, 255)
-    if not 500 <= m.pulse <= 2500 or m.pulse.__class__ is bool:
-        raise out_of_range('pwm_servo.set_position request', 'pulse', m.pulse, 500, 2500)
-    body = _S_FRAME_PWMSERVOSETPOSITIONREQUEST.pack(b'\xaaU', 4, 6, 3, m.duration, m.servo_id, m.pulse)
+    m_duration = m.duration
+    m_servo_id = m.servo_id
+    m_pulse = m.pulse
+    if not 0 <= m_duration <= 65535 or m_duration.__class__ is bool:
+        raise out_of_range('pwm_servo.set_position request', 'duration', m_duration, 0, 65535)
+    if not 0 <= m_servo_id <= 255 or m_servo_id.__class__ is bool:
+        raise out_of_range('pwm_servo.set_position request', 'servo_id', m_servo_id, 0, 255)
+    if not 500 <= m_pulse <= 2500 or m_pulse.__class__ is bool:
+        raise out_of_range('pwm_servo.set_position request', 'pulse', m_pulse, 500, 2500)
+    body = _S_FRAME_PWMSERVOSETPOSITIONREQUEST.pack(b'\xaaU', 4, 6, 3, m_duration, m_servo_id, m_pulse)
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1164,9 +1231,10 @@ def _encode_pwm_servo_set_position_request(m: PwmServoSetPositionRequest) -> byt
 
 
 def _encode_pwm_servo_read_position_request(m: PwmServoReadPositionRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
-        raise out_of_range('pwm_servo.read_position request', 'servo_id', m.servo_id, 0, 255)
-    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 4, 2, 5, m.servo_id)
+    m_servo_id = m.servo_id
+    if not 0 <= m_servo_id <= 255 or m_servo_id.__class__ is bool:
+        raise out_of_range('pwm_servo.read_position request', 'servo_id', m_servo_id, 0, 255)
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 4, 2, 5, m_servo_id)
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1174,11 +1242,13 @@ def _encode_pwm_servo_read_position_request(m: PwmServoReadPositionRequest) -> b
 
 
 def _encode_pwm_servo_read_position_response(m: PwmServoReadPositionResponse) -> bytes:
-    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
-        raise out_of_range('pwm_servo.read_position response', 'servo_id', m.servo_id, 0, 255)
-    if not 0 <= m.pulse <= 65535 or m.pulse.__class__ is bool:
-        raise out_of_range('pwm_servo.read_position response', 'pulse', m.pulse, 0, 65535)
-    body = _S_B2_U8_U8_U8_U8_U16.pack(b'\xaaU', 4, 4, m.servo_id, 5, m.pulse)
+    m_servo_id = m.servo_id
+    m_pulse = m.pulse
+    if not 0 <= m_servo_id <= 255 or m_servo_id.__class__ is bool:
+        raise out_of_range('pwm_servo.read_position response', 'servo_id', m_servo_id, 0, 255)
+    if not 0 <= m_pulse <= 65535 or m_pulse.__class__ is bool:
+        raise out_of_range('pwm_servo.read_position response', 'pulse', m_pulse, 0, 65535)
+    body = _S_B2_U8_U8_U8_U8_U16.pack(b'\xaaU', 4, 4, m_servo_id, 5, m_pulse)
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1186,11 +1256,13 @@ def _encode_pwm_servo_read_position_response(m: PwmServoReadPositionResponse) ->
 
 
 def _encode_pwm_servo_set_offset_request(m: PwmServoSetOffsetRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
-        raise out_of_range('pwm_servo.set_offset request', 'servo_id', m.servo_id, 0, 255)
-    if not -100 <= m.offset <= 100 or m.offset.__class__ is bool:
-        raise out_of_range('pwm_servo.set_offset request', 'offset', m.offset, -100, 100)
-    body = _S_B2_U8_U8_U8_U8_I8.pack(b'\xaaU', 4, 3, 7, m.servo_id, m.offset)
+    m_servo_id = m.servo_id
+    m_offset = m.offset
+    if not 0 <= m_servo_id <= 255 or m_servo_id.__class__ is bool:
+        raise out_of_range('pwm_servo.set_offset request', 'servo_id', m_servo_id, 0, 255)
+    if not -100 <= m_offset <= 100 or m_offset.__class__ is bool:
+        raise out_of_range('pwm_servo.set_offset request', 'offset', m_offset, -100, 100)
+    body = _S_B2_U8_U8_U8_U8_I8.pack(b'\xaaU', 4, 3, 7, m_servo_id, m_offset)
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1198,9 +1270,10 @@ def _encode_pwm_servo_set_offset_request(m: PwmServoSetOffsetRequest) -> bytes:
 
 
 def _encode_pwm_servo_read_offset_request(m: PwmServoReadOffsetRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
-        raise out_of_range('pwm_servo.read_offset request', 'servo_id', m.servo_id, 0, 255)
-    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 4, 2, 9, m.servo_id)
+    m_servo_id = m.servo_id
+    if not 0 <= m_servo_id <= 255 or m_servo_id.__class__ is bool:
+        raise out_of_range('pwm_servo.read_offset request', 'servo_id', m_servo_id, 0, 255)
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 4, 2, 9, m_servo_id)
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1208,11 +1281,13 @@ def _encode_pwm_servo_read_offset_request(m: PwmServoReadOffsetRequest) -> bytes
 
 
 def _encode_pwm_servo_read_offset_response(m: PwmServoReadOffsetResponse) -> bytes:
-    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
-        raise out_of_range('pwm_servo.read_offset response', 'servo_id', m.servo_id, 0, 255)
-    if not -128 <= m.offset <= 127 or m.offset.__class__ is bool:
-        raise out_of_range('pwm_servo.read_offset response', 'offset', m.offset, -128, 127)
-    body = _S_B2_U8_U8_U8_U8_I8.pack(b'\xaaU', 4, 3, m.servo_id, 9, m.offset)
+    m_servo_id = m.servo_id
+    m_offset = m.offset
+    if not 0 <= m_servo_id <= 255 or m_servo_id.__class__ is bool:
+        raise out_of_range('pwm_servo.read_offset response', 'servo_id', m_servo_id, 0, 255)
+    if not -128 <= m_offset <= 127 or m_offset.__class__ is bool:
+        raise out_of_range('pwm_servo.read_offset response', 'offset', m_offset, -128, 127)
+    body = _S_B2_U8_U8_U8_U8_I8.pack(b'\xaaU', 4, 3, m_servo_id, 9, m_offset)
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1220,22 +1295,26 @@ def _encode_pwm_servo_read_offset_response(m: PwmServoReadOffsetResponse) -> byt
 
 
 def _encode_bus_servo_set_positions_request(m: BusServoSetPositionsRequest) -> bytes:
-    if not 0 <= m.duration <= 65535 or m.duration.__class__ is bool:
-        raise out_of_range('bus_servo.set_positions request', 'duration', m.duration, 0, 65535)
-    if len(m.bus_servos) > 255:
-        raise out_of_range('bus_servo.set_positions request', 'count', len(m.bus_servos), 0, 255)
+    m_duration = m.duration
+    m_bus_servos = m.bus_servos
+    if not 0 <= m_duration <= 65535 or m_duration.__class__ is bool:
+        raise out_of_range('bus_servo.set_positions request', 'duration', m_duration, 0, 65535)
+    if len(m_bus_servos) > 255:
+        raise out_of_range('bus_servo.set_positions request', 'count', len(m_bus_servos), 0, 255)
     parts_bus_servos = []
-    for item in m.bus_servos:
-        if not 0 <= item.servo_id <= 255 or item.servo_id.__class__ is bool:
-            raise out_of_range('bus_servo.set_positions request', 'servo_id', item.servo_id, 0, 255)
-        if not 0 <= item.position <= 1000 or item.position.__class__ is bool:
-            raise out_of_range('bus_servo.set_positions request', 'position', item.position, 0, 1000)
-        parts_bus_servos.append(_S_U8_U16.pack(item.servo_id, item.position))
+    for item in m_bus_servos:
+        item_servo_id = item.servo_id
+        item_position = item.position
+        if not 0 <= item_servo_id <= 255 or item_servo_id.__class__ is bool:
+            raise out_of_range('bus_servo.set_positions request', 'servo_id', item_servo_id, 0, 255)
+        if not 0 <= item_position <= 1000 or item_position.__class__ is bool:
+            raise out_of_range('bus_servo.set_positions request', 'position', item_position, 0, 1000)
+        parts_bus_servos.append(_S_U8_U16.pack(item_servo_id, item_position))
     content = b''.join(parts_bus_servos)
     n = len(content) + 4
     if n > 255:
         raise EncodeError(f'content of {n} bytes does not fit the length field')
-    body = _S_B2_U8_U8_U8_U16_U8.pack(b'\xaaU', 5, n, 1, m.duration, len(m.bus_servos)) + content
+    body = _S_B2_U8_U8_U8_U16_U8.pack(b'\xaaU', 5, n, 1, m_duration, len(m_bus_servos)) + content
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1243,9 +1322,10 @@ def _encode_bus_servo_set_positions_request(m: BusServoSetPositionsRequest) -> b
 
 
 def _encode_bus_servo_read_position_request(m: BusServoReadPositionRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
-        raise out_of_range('bus_servo.read_position request', 'servo_id', m.servo_id, 0, 255)
-    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 5, m.servo_id)
+    m_servo_id = m.servo_id
+    if not 0 <= m_servo_id <= 255 or m_servo_id.__class__ is bool:
+        raise out_of_range('bus_servo.read_position request', 'servo_id', m_servo_id, 0, 255)
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 5, m_servo_id)
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1253,13 +1333,16 @@ def _encode_bus_servo_read_position_request(m: BusServoReadPositionRequest) -> b
 
 
 def _encode_bus_servo_read_position_response(m: BusServoReadPositionResponse) -> bytes:
-    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
-        raise out_of_range('bus_servo.read_position response', 'servo_id', m.servo_id, 0, 255)
-    if not -1 <= m.success <= 0 or m.success.__class__ is bool:
-        raise out_of_range('bus_servo.read_position response', 'success', m.success, -1, 0)
-    if not -32768 <= m.position <= 32767 or m.position.__class__ is bool:
-        raise out_of_range('bus_servo.read_position response', 'position', m.position, -32768, 32767)
-    body = _S_FRAME_BUSSERVOREADPOSITIONRESPONSE.pack(b'\xaaU', 5, 5, m.servo_id, 5, m.success, m.position)
+    m_servo_id = m.servo_id
+    m_success = m.success
+    m_position = m.position
+    if not 0 <= m_servo_id <= 255 or m_servo_id.__class__ is bool:
+        raise out_of_range('bus_servo.read_position response', 'servo_id', m_servo_id, 0, 255)
+    if not -1 <= m_success <= 0 or m_success.__class__ is bool:
+        raise out_of_range('bus_servo.read_position response', 'success', m_success, -1, 0)
+    if not -32768 <= m_position <= 32767 or m_position.__class__ is bool:
+        raise out_of_range('bus_servo.read_position response', 'position', m_position, -32768, 32767)
+    body = _S_FRAME_BUSSERVOREADPOSITIONRESPONSE.pack(b'\xaaU', 5, 5, m_servo_id, 5, m_success, m_position)
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1267,9 +1350,10 @@ def _encode_bus_servo_read_position_response(m: BusServoReadPositionResponse) ->
 
 
 def _encode_bus_servo_read_voltage_request(m: BusServoReadVoltageRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
-        raise out_of_range('bus_servo.read_voltage request', 'servo_id', m.servo_id, 0, 255)
-    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 7, m.servo_id)
+    m_servo_id = m.servo_id
+    if not 0 <= m_servo_id <= 255 or m_servo_id.__class__ is bool:
+        raise out_of_range('bus_servo.read_voltage request', 'servo_id', m_servo_id, 0, 255)
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 7, m_servo_id)
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1277,13 +1361,16 @@ def _encode_bus_servo_read_voltage_request(m: BusServoReadVoltageRequest) -> byt
 
 
 def _encode_bus_servo_read_voltage_response(m: BusServoReadVoltageResponse) -> bytes:
-    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
-        raise out_of_range('bus_servo.read_voltage response', 'servo_id', m.servo_id, 0, 255)
-    if not -1 <= m.success <= 0 or m.success.__class__ is bool:
-        raise out_of_range('bus_servo.read_voltage response', 'success', m.success, -1, 0)
-    if not 0 <= m.voltage <= 65535 or m.voltage.__class__ is bool:
-        raise out_of_range('bus_servo.read_voltage response', 'voltage', m.voltage, 0, 65535)
-    body = _S_FRAME_BUSSERVOREADVOLTAGERESPONSE.pack(b'\xaaU', 5, 5, m.servo_id, 7, m.success, m.voltage)
+    m_servo_id = m.servo_id
+    m_success = m.success
+    m_voltage = m.voltage
+    if not 0 <= m_servo_id <= 255 or m_servo_id.__class__ is bool:
+        raise out_of_range('bus_servo.read_voltage response', 'servo_id', m_servo_id, 0, 255)
+    if not -1 <= m_success <= 0 or m_success.__class__ is bool:
+        raise out_of_range('bus_servo.read_voltage response', 'success', m_success, -1, 0)
+    if not 0 <= m_voltage <= 65535 or m_voltage.__class__ is bool:
+        raise out_of_range('bus_servo.read_voltage response', 'voltage', m_voltage, 0, 65535)
+    body = _S_FRAME_BUSSERVOREADVOLTAGERESPONSE.pack(b'\xaaU', 5, 5, m_servo_id, 7, m_success, m_voltage)
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1291,9 +1378,10 @@ def _encode_bus_servo_read_voltage_response(m: BusServoReadVoltageResponse) -> b
 
 
 def _encode_bus_servo_read_temperature_request(m: BusServoReadTemperatureRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
-        raise out_of_range('bus_servo.read_temperature request', 'servo_id', m.servo_id, 0, 255)
-    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 9, m.servo_id)
+    m_servo_id = m.servo_id
+    if not 0 <= m_servo_id <= 255 or m_servo_id.__class__ is bool:
+        raise out_of_range('bus_servo.read_temperature request', 'servo_id', m_servo_id, 0, 255)
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 9, m_servo_id)
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1301,13 +1389,16 @@ def _encode_bus_servo_read_temperature_request(m: BusServoReadTemperatureRequest
 
 
 def _encode_bus_servo_read_temperature_response(m: BusServoReadTemperatureResponse) -> bytes:
-    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
-        raise out_of_range('bus_servo.read_temperature response', 'servo_id', m.servo_id, 0, 255)
-    if not -1 <= m.success <= 0 or m.success.__class__ is bool:
-        raise out_of_range('bus_servo.read_temperature response', 'success', m.success, -1, 0)
-    if not 0 <= m.temperature <= 255 or m.temperature.__class__ is bool:
-        raise out_of_range('bus_servo.read_temperature response', 'temperature', m.temperature, 0, 255)
-    body = _S_FRAME_BUSSERVOREADTEMPERATURERESPONSE.pack(b'\xaaU', 5, 4, m.servo_id, 9, m.success, m.temperature)
+    m_servo_id = m.servo_id
+    m_success = m.success
+    m_temperature = m.temperature
+    if not 0 <= m_servo_id <= 255 or m_servo_id.__class__ is bool:
+        raise out_of_range('bus_servo.read_temperature response', 'servo_id', m_servo_id, 0, 255)
+    if not -1 <= m_success <= 0 or m_success.__class__ is bool:
+        raise out_of_range('bus_servo.read_temperature response', 'success', m_success, -1, 0)
+    if not 0 <= m_temperature <= 255 or m_temperature.__class__ is bool:
+        raise out_of_range('bus_servo.read_temperature response', 'temperature', m_temperature, 0, 255)
+    body = _S_FRAME_BUSSERVOREADTEMPERATURERESPONSE.pack(b'\xaaU', 5, 4, m_servo_id, 9, m_success, m_temperature)
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1315,18 +1406,20 @@ def _encode_bus_servo_read_temperature_response(m: BusServoReadTemperatureRespon
 
 
 def _encode_bus_servo_stop_request(m: BusServoStopRequest) -> bytes:
-    if len(m.servos) > 255:
-        raise out_of_range('bus_servo.stop request', 'count', len(m.servos), 0, 255)
+    m_servos = m.servos
+    if len(m_servos) > 255:
+        raise out_of_range('bus_servo.stop request', 'count', len(m_servos), 0, 255)
     parts_servos = []
-    for item in m.servos:
-        if not 0 <= item.servo_id <= 255 or item.servo_id.__class__ is bool:
-            raise out_of_range('bus_servo.stop request', 'servo_id', item.servo_id, 0, 255)
-        parts_servos.append(_S_U8.pack(item.servo_id))
+    for item in m_servos:
+        item_servo_id = item.servo_id
+        if not 0 <= item_servo_id <= 255 or item_servo_id.__class__ is bool:
+            raise out_of_range('bus_servo.stop request', 'servo_id', item_servo_id, 0, 255)
+        parts_servos.append(_S_U8.pack(item_servo_id))
     content = b''.join(parts_servos)
     n = len(content) + 2
     if n > 255:
         raise EncodeError(f'content of {n} bytes does not fit the length field')
-    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, n, 3, len(m.servos)) + content
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, n, 3, len(m_servos)) + content
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1334,9 +1427,10 @@ def _encode_bus_servo_stop_request(m: BusServoStopRequest) -> bytes:
 
 
 def _encode_bus_servo_read_torque_request(m: BusServoReadTorqueRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
-        raise out_of_range('bus_servo.read_torque request', 'servo_id', m.servo_id, 0, 255)
-    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 13, m.servo_id)
+    m_servo_id = m.servo_id
+    if not 0 <= m_servo_id <= 255 or m_servo_id.__class__ is bool:
+        raise out_of_range('bus_servo.read_torque request', 'servo_id', m_servo_id, 0, 255)
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 13, m_servo_id)
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1344,13 +1438,16 @@ def _encode_bus_servo_read_torque_request(m: BusServoReadTorqueRequest) -> bytes
 
 
 def _encode_bus_servo_read_torque_response(m: BusServoReadTorqueResponse) -> bytes:
-    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
-        raise out_of_range('bus_servo.read_torque response', 'servo_id', m.servo_id, 0, 255)
-    if not -1 <= m.success <= 0 or m.success.__class__ is bool:
-        raise out_of_range('bus_servo.read_torque response', 'success', m.success, -1, 0)
-    if not -128 <= m.torque <= 127 or m.torque.__class__ is bool:
-        raise out_of_range('bus_servo.read_torque response', 'torque', m.torque, -128, 127)
-    body = _S_FRAME_BUSSERVOREADTORQUERESPONSE.pack(b'\xaaU', 5, 4, m.servo_id, 13, m.success, m.torque)
+    m_servo_id = m.servo_id
+    m_success = m.success
+    m_torque = m.torque
+    if not 0 <= m_servo_id <= 255 or m_servo_id.__class__ is bool:
+        raise out_of_range('bus_servo.read_torque response', 'servo_id', m_servo_id, 0, 255)
+    if not -1 <= m_success <= 0 or m_success.__class__ is bool:
+        raise out_of_range('bus_servo.read_torque response', 'success', m_success, -1, 0)
+    if not -128 <= m_torque <= 127 or m_torque.__class__ is bool:
+        raise out_of_range('bus_servo.read_torque response', 'torque', m_torque, -128, 127)
+    body = _S_FRAME_BUSSERVOREADTORQUERESPONSE.pack(b'\xaaU', 5, 4, m_servo_id, 13, m_success, m_torque)
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1358,9 +1455,10 @@ def _encode_bus_servo_read_torque_response(m: BusServoReadTorqueResponse) -> byt
 
 
 def _encode_bus_servo_unload_request(m: BusServoUnloadRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
-        raise out_of_range('bus_servo.unload request', 'servo_id', m.servo_id, 0, 255)
-    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 11, m.servo_id)
+    m_servo_id = m.servo_id
+    if not 0 <= m_servo_id <= 255 or m_servo_id.__class__ is bool:
+        raise out_of_range('bus_servo.unload request', 'servo_id', m_servo_id, 0, 255)
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 11, m_servo_id)
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1368,9 +1466,10 @@ def _encode_bus_servo_unload_request(m: BusServoUnloadRequest) -> bytes:
 
 
 def _encode_bus_servo_load_request(m: BusServoLoadRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
-        raise out_of_range('bus_servo.load request', 'servo_id', m.servo_id, 0, 255)
-    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 12, m.servo_id)
+    m_servo_id = m.servo_id
+    if not 0 <= m_servo_id <= 255 or m_servo_id.__class__ is bool:
+        raise out_of_range('bus_servo.load request', 'servo_id', m_servo_id, 0, 255)
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 12, m_servo_id)
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1378,11 +1477,13 @@ def _encode_bus_servo_load_request(m: BusServoLoadRequest) -> bytes:
 
 
 def _encode_bus_servo_set_id_request(m: BusServoSetIdRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
-        raise out_of_range('bus_servo.set_id request', 'servo_id', m.servo_id, 0, 255)
-    if not 0 <= m.new_id <= 255 or m.new_id.__class__ is bool:
-        raise out_of_range('bus_servo.set_id request', 'new_id', m.new_id, 0, 255)
-    body = _S_B2_U8_U8_U8_U8_U8.pack(b'\xaaU', 5, 3, 16, m.servo_id, m.new_id)
+    m_servo_id = m.servo_id
+    m_new_id = m.new_id
+    if not 0 <= m_servo_id <= 255 or m_servo_id.__class__ is bool:
+        raise out_of_range('bus_servo.set_id request', 'servo_id', m_servo_id, 0, 255)
+    if not 0 <= m_new_id <= 255 or m_new_id.__class__ is bool:
+        raise out_of_range('bus_servo.set_id request', 'new_id', m_new_id, 0, 255)
+    body = _S_B2_U8_U8_U8_U8_U8.pack(b'\xaaU', 5, 3, 16, m_servo_id, m_new_id)
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1390,9 +1491,10 @@ def _encode_bus_servo_set_id_request(m: BusServoSetIdRequest) -> bytes:
 
 
 def _encode_bus_servo_read_id_request(m: BusServoReadIdRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
-        raise out_of_range('bus_servo.read_id request', 'servo_id', m.servo_id, 0, 255)
-    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 18, m.servo_id)
+    m_servo_id = m.servo_id
+    if not 0 <= m_servo_id <= 255 or m_servo_id.__class__ is bool:
+        raise out_of_range('bus_servo.read_id request', 'servo_id', m_servo_id, 0, 255)
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 18, m_servo_id)
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1400,13 +1502,16 @@ def _encode_bus_servo_read_id_request(m: BusServoReadIdRequest) -> bytes:
 
 
 def _encode_bus_servo_read_id_response(m: BusServoReadIdResponse) -> bytes:
-    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
-        raise out_of_range('bus_servo.read_id response', 'servo_id', m.servo_id, 0, 255)
-    if not -1 <= m.success <= 0 or m.success.__class__ is bool:
-        raise out_of_range('bus_servo.read_id response', 'success', m.success, -1, 0)
-    if not 0 <= m.id <= 255 or m.id.__class__ is bool:
-        raise out_of_range('bus_servo.read_id response', 'id', m.id, 0, 255)
-    body = _S_FRAME_BUSSERVOREADTEMPERATURERESPONSE.pack(b'\xaaU', 5, 4, m.servo_id, 18, m.success, m.id)
+    m_servo_id = m.servo_id
+    m_success = m.success
+    m_id = m.id
+    if not 0 <= m_servo_id <= 255 or m_servo_id.__class__ is bool:
+        raise out_of_range('bus_servo.read_id response', 'servo_id', m_servo_id, 0, 255)
+    if not -1 <= m_success <= 0 or m_success.__class__ is bool:
+        raise out_of_range('bus_servo.read_id response', 'success', m_success, -1, 0)
+    if not 0 <= m_id <= 255 or m_id.__class__ is bool:
+        raise out_of_range('bus_servo.read_id response', 'id', m_id, 0, 255)
+    body = _S_FRAME_BUSSERVOREADTEMPERATURERESPONSE.pack(b'\xaaU', 5, 4, m_servo_id, 18, m_success, m_id)
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1414,11 +1519,13 @@ def _encode_bus_servo_read_id_response(m: BusServoReadIdResponse) -> bytes:
 
 
 def _encode_bus_servo_set_offset_request(m: BusServoSetOffsetRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
-        raise out_of_range('bus_servo.set_offset request', 'servo_id', m.servo_id, 0, 255)
-    if not -125 <= m.offset <= 125 or m.offset.__class__ is bool:
-        raise out_of_range('bus_servo.set_offset request', 'offset', m.offset, -125, 125)
-    body = _S_B2_U8_U8_U8_U8_I8.pack(b'\xaaU', 5, 3, 32, m.servo_id, m.offset)
+    m_servo_id = m.servo_id
+    m_offset = m.offset
+    if not 0 <= m_servo_id <= 255 or m_servo_id.__class__ is bool:
+        raise out_of_range('bus_servo.set_offset request', 'servo_id', m_servo_id, 0, 255)
+    if not -125 <= m_offset <= 125 or m_offset.__class__ is bool:
+        raise out_of_range('bus_servo.set_offset request', 'offset', m_offset, -125, 125)
+    body = _S_B2_U8_U8_U8_U8_I8.pack(b'\xaaU', 5, 3, 32, m_servo_id, m_offset)
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1426,9 +1533,10 @@ def _encode_bus_servo_set_offset_request(m: BusServoSetOffsetRequest) -> bytes:
 
 
 def _encode_bus_servo_read_offset_request(m: BusServoReadOffsetRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
-        raise out_of_range('bus_servo.read_offset request', 'servo_id', m.servo_id, 0, 255)
-    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 34, m.servo_id)
+    m_servo_id = m.servo_id
+    if not 0 <= m_servo_id <= 255 or m_servo_id.__class__ is bool:
+        raise out_of_range('bus_servo.read_offset request', 'servo_id', m_servo_id, 0, 255)
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 34, m_servo_id)
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1436,13 +1544,16 @@ def _encode_bus_servo_read_offset_request(m: BusServoReadOffsetRequest) -> bytes
 
 
 def _encode_bus_servo_read_offset_response(m: BusServoReadOffsetResponse) -> bytes:
-    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
-        raise out_of_range('bus_servo.read_offset response', 'servo_id', m.servo_id, 0, 255)
-    if not -1 <= m.success <= 0 or m.success.__class__ is bool:
-        raise out_of_range('bus_servo.read_offset response', 'success', m.success, -1, 0)
-    if not -128 <= m.offset <= 127 or m.offset.__class__ is bool:
-        raise out_of_range('bus_servo.read_offset response', 'offset', m.offset, -128, 127)
-    body = _S_FRAME_BUSSERVOREADTORQUERESPONSE.pack(b'\xaaU', 5, 4, m.servo_id, 34, m.success, m.offset)
+    m_servo_id = m.servo_id
+    m_success = m.success
+    m_offset = m.offset
+    if not 0 <= m_servo_id <= 255 or m_servo_id.__class__ is bool:
+        raise out_of_range('bus_servo.read_offset response', 'servo_id', m_servo_id, 0, 255)
+    if not -1 <= m_success <= 0 or m_success.__class__ is bool:
+        raise out_of_range('bus_servo.read_offset response', 'success', m_success, -1, 0)
+    if not -128 <= m_offset <= 127 or m_offset.__class__ is bool:
+        raise out_of_range('bus_servo.read_offset response', 'offset', m_offset, -128, 127)
+    body = _S_FRAME_BUSSERVOREADTORQUERESPONSE.pack(b'\xaaU', 5, 4, m_servo_id, 34, m_success, m_offset)
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1450,9 +1561,10 @@ def _encode_bus_servo_read_offset_response(m: BusServoReadOffsetResponse) -> byt
 
 
 def _encode_bus_servo_save_offset_request(m: BusServoSaveOffsetRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
-        raise out_of_range('bus_servo.save_offset request', 'servo_id', m.servo_id, 0, 255)
-    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 36, m.servo_id)
+    m_servo_id = m.servo_id
+    if not 0 <= m_servo_id <= 255 or m_servo_id.__class__ is bool:
+        raise out_of_range('bus_servo.save_offset request', 'servo_id', m_servo_id, 0, 255)
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 36, m_servo_id)
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1460,13 +1572,16 @@ def _encode_bus_servo_save_offset_request(m: BusServoSaveOffsetRequest) -> bytes
 
 
 def _encode_bus_servo_set_position_limit_request(m: BusServoSetPositionLimitRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
-        raise out_of_range('bus_servo.set_position_limit request', 'servo_id', m.servo_id, 0, 255)
-    if not 0 <= m.low <= 1000 or m.low.__class__ is bool:
-        raise out_of_range('bus_servo.set_position_limit request', 'low', m.low, 0, 1000)
-    if not 0 <= m.high <= 1000 or m.high.__class__ is bool:
-        raise out_of_range('bus_servo.set_position_limit request', 'high', m.high, 0, 1000)
-    body = _S_FRAME_BUSSERVOSETPOSITIONLIMITREQUEST.pack(b'\xaaU', 5, 6, 48, m.servo_id, m.low, m.high)
+    m_servo_id = m.servo_id
+    m_low = m.low
+    m_high = m.high
+    if not 0 <= m_servo_id <= 255 or m_servo_id.__class__ is bool:
+        raise out_of_range('bus_servo.set_position_limit request', 'servo_id', m_servo_id, 0, 255)
+    if not 0 <= m_low <= 1000 or m_low.__class__ is bool:
+        raise out_of_range('bus_servo.set_position_limit request', 'low', m_low, 0, 1000)
+    if not 0 <= m_high <= 1000 or m_high.__class__ is bool:
+        raise out_of_range('bus_servo.set_position_limit request', 'high', m_high, 0, 1000)
+    body = _S_FRAME_BUSSERVOSETPOSITIONLIMITREQUEST.pack(b'\xaaU', 5, 6, 48, m_servo_id, m_low, m_high)
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1474,9 +1589,10 @@ def _encode_bus_servo_set_position_limit_request(m: BusServoSetPositionLimitRequ
 
 
 def _encode_bus_servo_read_position_limit_request(m: BusServoReadPositionLimitRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
-        raise out_of_range('bus_servo.read_position_limit request', 'servo_id', m.servo_id, 0, 255)
-    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 50, m.servo_id)
+    m_servo_id = m.servo_id
+    if not 0 <= m_servo_id <= 255 or m_servo_id.__class__ is bool:
+        raise out_of_range('bus_servo.read_position_limit request', 'servo_id', m_servo_id, 0, 255)
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 50, m_servo_id)
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1484,15 +1600,19 @@ def _encode_bus_servo_read_position_limit_request(m: BusServoReadPositionLimitRe
 
 
 def _encode_bus_servo_read_position_limit_response(m: BusServoReadPositionLimitResponse) -> bytes:
-    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
-        raise out_of_range('bus_servo.read_position_limit response', 'servo_id', m.servo_id, 0, 255)
-    if not -1 <= m.success <= 0 or m.success.__class__ is bool:
-        raise out_of_range('bus_servo.read_position_limit response', 'success', m.success, -1, 0)
-    if not 0 <= m.low <= 65535 or m.low.__class__ is bool:
-        raise out_of_range('bus_servo.read_position_limit response', 'low', m.low, 0, 65535)
-    if not 0 <= m.high <= 65535 or m.high.__class__ is bool:
-        raise out_of_range('bus_servo.read_position_limit response', 'high', m.high, 0, 65535)
-    body = _S_FRAME_BUSSERVOREADPOSITIONLIMITRESPONSE.pack(b'\xaaU', 5, 7, m.servo_id, 50, m.success, m.low, m.high)
+    m_servo_id = m.servo_id
+    m_success = m.success
+    m_low = m.low
+    m_high = m.high
+    if not 0 <= m_servo_id <= 255 or m_servo_id.__class__ is bool:
+        raise out_of_range('bus_servo.read_position_limit response', 'servo_id', m_servo_id, 0, 255)
+    if not -1 <= m_success <= 0 or m_success.__class__ is bool:
+        raise out_of_range('bus_servo.read_position_limit response', 'success', m_success, -1, 0)
+    if not 0 <= m_low <= 65535 or m_low.__class__ is bool:
+        raise out_of_range('bus_servo.read_position_limit response', 'low', m_low, 0, 65535)
+    if not 0 <= m_high <= 65535 or m_high.__class__ is bool:
+        raise out_of_range('bus_servo.read_position_limit response', 'high', m_high, 0, 65535)
+    body = _S_FRAME_BUSSERVOREADPOSITIONLIMITRESPONSE.pack(b'\xaaU', 5, 7, m_servo_id, 50, m_success, m_low, m_high)
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1500,13 +1620,16 @@ def _encode_bus_servo_read_position_limit_response(m: BusServoReadPositionLimitR
 
 
 def _encode_bus_servo_set_voltage_limit_request(m: BusServoSetVoltageLimitRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
-        raise out_of_range('bus_servo.set_voltage_limit request', 'servo_id', m.servo_id, 0, 255)
-    if not 4500 <= m.low <= 14000 or m.low.__class__ is bool:
-        raise out_of_range('bus_servo.set_voltage_limit request', 'low', m.low, 4500, 14000)
-    if not 4500 <= m.high <= 14000 or m.high.__class__ is bool:
-        raise out_of_range('bus_servo.set_voltage_limit request', 'high', m.high, 4500, 14000)
-    body = _S_FRAME_BUSSERVOSETPOSITIONLIMITREQUEST.pack(b'\xaaU', 5, 6, 52, m.servo_id, m.low, m.high)
+    m_servo_id = m.servo_id
+    m_low = m.low
+    m_high = m.high
+    if not 0 <= m_servo_id <= 255 or m_servo_id.__class__ is bool:
+        raise out_of_range('bus_servo.set_voltage_limit request', 'servo_id', m_servo_id, 0, 255)
+    if not 4500 <= m_low <= 14000 or m_low.__class__ is bool:
+        raise out_of_range('bus_servo.set_voltage_limit request', 'low', m_low, 4500, 14000)
+    if not 4500 <= m_high <= 14000 or m_high.__class__ is bool:
+        raise out_of_range('bus_servo.set_voltage_limit request', 'high', m_high, 4500, 14000)
+    body = _S_FRAME_BUSSERVOSETPOSITIONLIMITREQUEST.pack(b'\xaaU', 5, 6, 52, m_servo_id, m_low, m_high)
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1514,9 +1637,10 @@ def _encode_bus_servo_set_voltage_limit_request(m: BusServoSetVoltageLimitReques
 
 
 def _encode_bus_servo_read_voltage_limit_request(m: BusServoReadVoltageLimitRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
-        raise out_of_range('bus_servo.read_voltage_limit request', 'servo_id', m.servo_id, 0, 255)
-    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 54, m.servo_id)
+    m_servo_id = m.servo_id
+    if not 0 <= m_servo_id <= 255 or m_servo_id.__class__ is bool:
+        raise out_of_range('bus_servo.read_voltage_limit request', 'servo_id', m_servo_id, 0, 255)
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 54, m_servo_id)
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1524,15 +1648,19 @@ def _encode_bus_servo_read_voltage_limit_request(m: BusServoReadVoltageLimitRequ
 
 
 def _encode_bus_servo_read_voltage_limit_response(m: BusServoReadVoltageLimitResponse) -> bytes:
-    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
-        raise out_of_range('bus_servo.read_voltage_limit response', 'servo_id', m.servo_id, 0, 255)
-    if not -1 <= m.success <= 0 or m.success.__class__ is bool:
-        raise out_of_range('bus_servo.read_voltage_limit response', 'success', m.success, -1, 0)
-    if not 0 <= m.low <= 65535 or m.low.__class__ is bool:
-        raise out_of_range('bus_servo.read_voltage_limit response', 'low', m.low, 0, 65535)
-    if not 0 <= m.high <= 65535 or m.high.__class__ is bool:
-        raise out_of_range('bus_servo.read_voltage_limit response', 'high', m.high, 0, 65535)
-    body = _S_FRAME_BUSSERVOREADPOSITIONLIMITRESPONSE.pack(b'\xaaU', 5, 7, m.servo_id, 54, m.success, m.low, m.high)
+    m_servo_id = m.servo_id
+    m_success = m.success
+    m_low = m.low
+    m_high = m.high
+    if not 0 <= m_servo_id <= 255 or m_servo_id.__class__ is bool:
+        raise out_of_range('bus_servo.read_voltage_limit response', 'servo_id', m_servo_id, 0, 255)
+    if not -1 <= m_success <= 0 or m_success.__class__ is bool:
+        raise out_of_range('bus_servo.read_voltage_limit response', 'success', m_success, -1, 0)
+    if not 0 <= m_low <= 65535 or m_low.__class__ is bool:
+        raise out_of_range('bus_servo.read_voltage_limit response', 'low', m_low, 0, 65535)
+    if not 0 <= m_high <= 65535 or m_high.__class__ is bool:
+        raise out_of_range('bus_servo.read_voltage_limit response', 'high', m_high, 0, 65535)
+    body = _S_FRAME_BUSSERVOREADPOSITIONLIMITRESPONSE.pack(b'\xaaU', 5, 7, m_servo_id, 54, m_success, m_low, m_high)
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1540,11 +1668,13 @@ def _encode_bus_servo_read_voltage_limit_response(m: BusServoReadVoltageLimitRes
 
 
 def _encode_bus_servo_set_temperature_limit_request(m: BusServoSetTemperatureLimitRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
-        raise out_of_range('bus_servo.set_temperature_limit request', 'servo_id', m.servo_id, 0, 255)
-    if not 0 <= m.limit <= 99 or m.limit.__class__ is bool:
-        raise out_of_range('bus_servo.set_temperature_limit request', 'limit', m.limit, 0, 99)
-    body = _S_B2_U8_U8_U8_U8_U8.pack(b'\xaaU', 5, 3, 56, m.servo_id, m.limit)
+    m_servo_id = m.servo_id
+    m_limit = m.limit
+    if not 0 <= m_servo_id <= 255 or m_servo_id.__class__ is bool:
+        raise out_of_range('bus_servo.set_temperature_limit request', 'servo_id', m_servo_id, 0, 255)
+    if not 0 <= m_limit <= 99 or m_limit.__class__ is bool:
+        raise out_of_range('bus_servo.set_temperature_limit request', 'limit', m_limit, 0, 99)
+    body = _S_B2_U8_U8_U8_U8_U8.pack(b'\xaaU', 5, 3, 56, m_servo_id, m_limit)
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1552,9 +1682,10 @@ def _encode_bus_servo_set_temperature_limit_request(m: BusServoSetTemperatureLim
 
 
 def _encode_bus_servo_read_temperature_limit_request(m: BusServoReadTemperatureLimitRequest) -> bytes:
-    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
-        raise out_of_range('bus_servo.read_temperature_limit request', 'servo_id', m.servo_id, 0, 255)
-    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 58, m.servo_id)
+    m_servo_id = m.servo_id
+    if not 0 <= m_servo_id <= 255 or m_servo_id.__class__ is bool:
+        raise out_of_range('bus_servo.read_temperature_limit request', 'servo_id', m_servo_id, 0, 255)
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 58, m_servo_id)
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1562,13 +1693,16 @@ def _encode_bus_servo_read_temperature_limit_request(m: BusServoReadTemperatureL
 
 
 def _encode_bus_servo_read_temperature_limit_response(m: BusServoReadTemperatureLimitResponse) -> bytes:
-    if not 0 <= m.servo_id <= 255 or m.servo_id.__class__ is bool:
-        raise out_of_range('bus_servo.read_temperature_limit response', 'servo_id', m.servo_id, 0, 255)
-    if not -1 <= m.success <= 0 or m.success.__class__ is bool:
-        raise out_of_range('bus_servo.read_temperature_limit response', 'success', m.success, -1, 0)
-    if not 0 <= m.limit <= 255 or m.limit.__class__ is bool:
-        raise out_of_range('bus_servo.read_temperature_limit response', 'limit', m.limit, 0, 255)
-    body = _S_FRAME_BUSSERVOREADTEMPERATURERESPONSE.pack(b'\xaaU', 5, 4, m.servo_id, 58, m.success, m.limit)
+    m_servo_id = m.servo_id
+    m_success = m.success
+    m_limit = m.limit
+    if not 0 <= m_servo_id <= 255 or m_servo_id.__class__ is bool:
+        raise out_of_range('bus_servo.read_temperature_limit response', 'servo_id', m_servo_id, 0, 255)
+    if not -1 <= m_success <= 0 or m_success.__class__ is bool:
+        raise out_of_range('bus_servo.read_temperature_limit response', 'success', m_success, -1, 0)
+    if not 0 <= m_limit <= 255 or m_limit.__class__ is bool:
+        raise out_of_range('bus_servo.read_temperature_limit response', 'limit', m_limit, 0, 255)
+    body = _S_FRAME_BUSSERVOREADTEMPERATURERESPONSE.pack(b'\xaaU', 5, 4, m_servo_id, 58, m_success, m_limit)
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1576,11 +1710,13 @@ def _encode_bus_servo_read_temperature_limit_response(m: BusServoReadTemperature
 
 
 def _encode_key_response(m: KeyResponse) -> bytes:
-    if not 0 <= m.button_id <= 255 or m.button_id.__class__ is bool:
-        raise out_of_range('key response', 'button_id', m.button_id, 0, 255)
-    if not 1 <= m.event <= 128 or m.event.__class__ is bool:
-        raise out_of_range('key response', 'event', m.event, 1, 128)
-    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 6, 2, m.button_id, m.event)
+    m_button_id = m.button_id
+    m_event = m.event
+    if not 0 <= m_button_id <= 255 or m_button_id.__class__ is bool:
+        raise out_of_range('key response', 'button_id', m_button_id, 0, 255)
+    if not 1 <= m_event <= 128 or m_event.__class__ is bool:
+        raise out_of_range('key response', 'event', m_event, 1, 128)
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 6, 2, m_button_id, m_event)
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1588,19 +1724,25 @@ def _encode_key_response(m: KeyResponse) -> bytes:
 
 
 def _encode_imu_response(m: ImuResponse) -> bytes:
-    if not -340282346638528859811704183484516925440 <= m.accel_x <= 340282346638528859811704183484516925440:
-        raise out_of_range('imu response', 'accel_x', m.accel_x, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
-    if not -340282346638528859811704183484516925440 <= m.accel_y <= 340282346638528859811704183484516925440:
-        raise out_of_range('imu response', 'accel_y', m.accel_y, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
-    if not -340282346638528859811704183484516925440 <= m.accel_z <= 340282346638528859811704183484516925440:
-        raise out_of_range('imu response', 'accel_z', m.accel_z, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
-    if not -340282346638528859811704183484516925440 <= m.gyro_x <= 340282346638528859811704183484516925440:
-        raise out_of_range('imu response', 'gyro_x', m.gyro_x, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
-    if not -340282346638528859811704183484516925440 <= m.gyro_y <= 340282346638528859811704183484516925440:
-        raise out_of_range('imu response', 'gyro_y', m.gyro_y, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
-    if not -340282346638528859811704183484516925440 <= m.gyro_z <= 340282346638528859811704183484516925440:
-        raise out_of_range('imu response', 'gyro_z', m.gyro_z, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
-    body = _S_FRAME_IMURESPONSE.pack(b'\xaaU', 7, 24, m.accel_x, m.accel_y, m.accel_z, m.gyro_x, m.gyro_y, m.gyro_z)
+    m_accel_x = m.accel_x
+    m_accel_y = m.accel_y
+    m_accel_z = m.accel_z
+    m_gyro_x = m.gyro_x
+    m_gyro_y = m.gyro_y
+    m_gyro_z = m.gyro_z
+    if not -3.4028234663852886e+38 <= m_accel_x <= 3.4028234663852886e+38:
+        raise out_of_range('imu response', 'accel_x', m_accel_x, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
+    if not -3.4028234663852886e+38 <= m_accel_y <= 3.4028234663852886e+38:
+        raise out_of_range('imu response', 'accel_y', m_accel_y, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
+    if not -3.4028234663852886e+38 <= m_accel_z <= 3.4028234663852886e+38:
+        raise out_of_range('imu response', 'accel_z', m_accel_z, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
+    if not -3.4028234663852886e+38 <= m_gyro_x <= 3.4028234663852886e+38:
+        raise out_of_range('imu response', 'gyro_x', m_gyro_x, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
+    if not -3.4028234663852886e+38 <= m_gyro_y <= 3.4028234663852886e+38:
+        raise out_of_range('imu response', 'gyro_y', m_gyro_y, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
+    if not -3.4028234663852886e+38 <= m_gyro_z <= 3.4028234663852886e+38:
+        raise out_of_range('imu response', 'gyro_z', m_gyro_z, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
+    body = _S_FRAME_IMURESPONSE.pack(b'\xaaU', 7, 24, m_accel_x, m_accel_y, m_accel_z, m_gyro_x, m_gyro_y, m_gyro_z)
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1608,19 +1750,25 @@ def _encode_imu_response(m: ImuResponse) -> bytes:
 
 
 def _encode_gamepad_response(m: GamepadResponse) -> bytes:
-    if not 0 <= m.buttons <= 65535 or isinstance(m.buttons, bool):
-        raise out_of_range('gamepad response', 'buttons', m.buttons, 0, 65535)
-    if not 0 <= m.hat <= 255 or m.hat.__class__ is bool:
-        raise out_of_range('gamepad response', 'hat', m.hat, 0, 255)
-    if not -128 <= m.left_x <= 127 or m.left_x.__class__ is bool:
-        raise out_of_range('gamepad response', 'left_x', m.left_x, -128, 127)
-    if not -128 <= m.left_y <= 127 or m.left_y.__class__ is bool:
-        raise out_of_range('gamepad response', 'left_y', m.left_y, -128, 127)
-    if not -128 <= m.right_x <= 127 or m.right_x.__class__ is bool:
-        raise out_of_range('gamepad response', 'right_x', m.right_x, -128, 127)
-    if not -128 <= m.right_y <= 127 or m.right_y.__class__ is bool:
-        raise out_of_range('gamepad response', 'right_y', m.right_y, -128, 127)
-    body = _S_FRAME_GAMEPADRESPONSE.pack(b'\xaaU', 8, 7, m.buttons, m.hat, m.left_x, m.left_y, m.right_x, m.right_y)
+    m_buttons = m.buttons
+    m_hat = m.hat
+    m_left_x = m.left_x
+    m_left_y = m.left_y
+    m_right_x = m.right_x
+    m_right_y = m.right_y
+    if not 0 <= m_buttons <= 65535 or isinstance(m_buttons, bool):
+        raise out_of_range('gamepad response', 'buttons', m_buttons, 0, 65535)
+    if not 0 <= m_hat <= 255 or m_hat.__class__ is bool:
+        raise out_of_range('gamepad response', 'hat', m_hat, 0, 255)
+    if not -128 <= m_left_x <= 127 or m_left_x.__class__ is bool:
+        raise out_of_range('gamepad response', 'left_x', m_left_x, -128, 127)
+    if not -128 <= m_left_y <= 127 or m_left_y.__class__ is bool:
+        raise out_of_range('gamepad response', 'left_y', m_left_y, -128, 127)
+    if not -128 <= m_right_x <= 127 or m_right_x.__class__ is bool:
+        raise out_of_range('gamepad response', 'right_x', m_right_x, -128, 127)
+    if not -128 <= m_right_y <= 127 or m_right_y.__class__ is bool:
+        raise out_of_range('gamepad response', 'right_y', m_right_y, -128, 127)
+    body = _S_FRAME_GAMEPADRESPONSE.pack(b'\xaaU', 8, 7, m_buttons, m_hat, m_left_x, m_left_y, m_right_x, m_right_y)
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1628,20 +1776,25 @@ def _encode_gamepad_response(m: GamepadResponse) -> bytes:
 
 
 def _encode_sbus_response(m: SbusResponse) -> bytes:
-    if len(m.channels) != 16:
-        raise EncodeError('sbus response' + f': channels needs 16 items, got {len(m.channels)}')
-    for x_channels in m.channels:
+    m_channels = m.channels
+    m_ch17 = m.ch17
+    m_ch18 = m.ch18
+    m_signal_loss = m.signal_loss
+    m_fail_safe = m.fail_safe
+    if len(m_channels) != 16:
+        raise EncodeError('sbus response' + f': channels needs 16 items, got {len(m_channels)}')
+    for x_channels in m_channels:
         if not -32768 <= x_channels <= 32767 or x_channels.__class__ is bool:
-            raise out_of_range('sbus response', 'channels', m.channels, -32768, 32767)
-    if not 0 <= m.ch17 <= 255 or m.ch17.__class__ is bool:
-        raise out_of_range('sbus response', 'ch17', m.ch17, 0, 255)
-    if not 0 <= m.ch18 <= 255 or m.ch18.__class__ is bool:
-        raise out_of_range('sbus response', 'ch18', m.ch18, 0, 255)
-    if not 0 <= m.signal_loss <= 255 or m.signal_loss.__class__ is bool:
-        raise out_of_range('sbus response', 'signal_loss', m.signal_loss, 0, 255)
-    if not 0 <= m.fail_safe <= 255 or m.fail_safe.__class__ is bool:
-        raise out_of_range('sbus response', 'fail_safe', m.fail_safe, 0, 255)
-    body = _S_FRAME_SBUSRESPONSE.pack(b'\xaaU', 9, 36, *m.channels, m.ch17, m.ch18, m.signal_loss, m.fail_safe)
+            raise out_of_range('sbus response', 'channels', m_channels, -32768, 32767)
+    if not 0 <= m_ch17 <= 255 or m_ch17.__class__ is bool:
+        raise out_of_range('sbus response', 'ch17', m_ch17, 0, 255)
+    if not 0 <= m_ch18 <= 255 or m_ch18.__class__ is bool:
+        raise out_of_range('sbus response', 'ch18', m_ch18, 0, 255)
+    if not 0 <= m_signal_loss <= 255 or m_signal_loss.__class__ is bool:
+        raise out_of_range('sbus response', 'signal_loss', m_signal_loss, 0, 255)
+    if not 0 <= m_fail_safe <= 255 or m_fail_safe.__class__ is bool:
+        raise out_of_range('sbus response', 'fail_safe', m_fail_safe, 0, 255)
+    body = _S_FRAME_SBUSRESPONSE.pack(b'\xaaU', 9, 36, *m_channels, m_ch17, m_ch18, m_signal_loss, m_fail_safe)
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1649,9 +1802,10 @@ def _encode_sbus_response(m: SbusResponse) -> bytes:
 
 
 def _encode_system_battery_response(m: SystemBatteryResponse) -> bytes:
-    if not 0 <= m.voltage <= 65535 or m.voltage.__class__ is bool:
-        raise out_of_range('system.battery response', 'voltage', m.voltage, 0, 65535)
-    body = _S_B2_U8_U8_U8_U16.pack(b'\xaaU', 0, 3, 4, m.voltage)
+    m_voltage = m.voltage
+    if not 0 <= m_voltage <= 65535 or m_voltage.__class__ is bool:
+        raise out_of_range('system.battery response', 'voltage', m_voltage, 0, 65535)
+    body = _S_B2_U8_U8_U8_U16.pack(b'\xaaU', 0, 3, 4, m_voltage)
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1659,15 +1813,18 @@ def _encode_system_battery_response(m: SystemBatteryResponse) -> bytes:
 
 
 def _encode_oled_request(m: OledRequest) -> bytes:
-    if not 0 <= m.line <= 255 or m.line.__class__ is bool:
-        raise out_of_range('oled request', 'line', m.line, 0, 255)
-    if len(m.text) > 255:
-        raise out_of_range('oled request', 'length', len(m.text), 0, 255)
-    content = bytes(m.text)
+    m_line = m.line
+    m_text = m.text
+    if not 0 <= m_line <= 255 or m_line.__class__ is bool:
+        raise out_of_range('oled request', 'line', m_line, 0, 255)
+    if len(m_text) > 255:
+        raise out_of_range('oled request', 'length', len(m_text), 0, 255)
+    v_text = m_text if m_text.__class__ is bytes else bytes(m_text)
+    content = v_text
     n = len(content) + 2
     if n > 255:
         raise EncodeError(f'content of {n} bytes does not fit the length field')
-    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 10, n, m.line, len(m.text)) + content
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 10, n, m_line, len(m_text)) + content
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1675,24 +1832,29 @@ def _encode_oled_request(m: OledRequest) -> bytes:
 
 
 def _encode_rgb_set_pixels_request(m: RgbSetPixelsRequest) -> bytes:
-    if len(m.pixels) > 255:
-        raise out_of_range('rgb.set_pixels request', 'count', len(m.pixels), 0, 255)
+    m_pixels = m.pixels
+    if len(m_pixels) > 255:
+        raise out_of_range('rgb.set_pixels request', 'count', len(m_pixels), 0, 255)
     parts_pixels = []
-    for item in m.pixels:
-        if not 0 <= item.index <= 255 or item.index.__class__ is bool:
-            raise out_of_range('rgb.set_pixels request', 'index', item.index, 0, 255)
-        if not 0 <= item.red <= 255 or item.red.__class__ is bool:
-            raise out_of_range('rgb.set_pixels request', 'red', item.red, 0, 255)
-        if not 0 <= item.green <= 255 or item.green.__class__ is bool:
-            raise out_of_range('rgb.set_pixels request', 'green', item.green, 0, 255)
-        if not 0 <= item.blue <= 255 or item.blue.__class__ is bool:
-            raise out_of_range('rgb.set_pixels request', 'blue', item.blue, 0, 255)
-        parts_pixels.append(_S_U8_U8_U8_U8.pack(item.index, item.red, item.green, item.blue))
+    for item in m_pixels:
+        item_index = item.index
+        item_red = item.red
+        item_green = item.green
+        item_blue = item.blue
+        if not 0 <= item_index <= 255 or item_index.__class__ is bool:
+            raise out_of_range('rgb.set_pixels request', 'index', item_index, 0, 255)
+        if not 0 <= item_red <= 255 or item_red.__class__ is bool:
+            raise out_of_range('rgb.set_pixels request', 'red', item_red, 0, 255)
+        if not 0 <= item_green <= 255 or item_green.__class__ is bool:
+            raise out_of_range('rgb.set_pixels request', 'green', item_green, 0, 255)
+        if not 0 <= item_blue <= 255 or item_blue.__class__ is bool:
+            raise out_of_range('rgb.set_pixels request', 'blue', item_blue, 0, 255)
+        parts_pixels.append(_S_U8_U8_U8_U8.pack(item_index, item_red, item_green, item_blue))
     content = b''.join(parts_pixels)
     n = len(content) + 2
     if n > 255:
         raise EncodeError(f'content of {n} bytes does not fit the length field')
-    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 11, n, 1, len(m.pixels)) + content
+    body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 11, n, 1, len(m_pixels)) + content
     check = 0x0
     for byte in body[2:]:
         check = _CRC_TABLE[check ^ byte]
@@ -1857,20 +2019,29 @@ _REQUEST_FIXED: dict[int, tuple[int, Callable[[bytes, int], Message | None]]] = 
 }
 
 
-# The same frames for decode(), by their first bytes (header, command code, length byte).
-_REQUEST_WHOLE: dict[bytes, tuple[int, Callable[[bytes, int], Message | None]]] = {
-    b'\xaaU\x01\x07': (12, _frame_led_request),
-    b'\xaaU\x02\x08': (13, _frame_buzzer_request),
+# The same frames for decode(), by their first bytes (header, command code, length byte): frame size, decoder.
+_REQUEST_WHOLE: dict[bytes, tuple[int, Callable[[bytes], Message | None]]] = {
+    b'\xaaU\x01\x07': (12, _whole_led_request),
+    b'\xaaU\x02\x08': (13, _whole_buzzer_request),
+    b'\xaaU\x03\x06': (11, _whole_motor_request_11),
+    b'\xaaU\x03\x02': (7, _whole_motor_request_7),
+    b'\xaaU\x04\x06': (11, _whole_pwm_servo_request_11),
+    b'\xaaU\x04\x02': (7, _whole_pwm_servo_request_7),
+    b'\xaaU\x04\x03': (8, _whole_pwm_servo_request_8),
+    b'\xaaU\x05\x02': (7, _whole_bus_servo_request_7),
+    b'\xaaU\x05\x03': (8, _whole_bus_servo_request_8),
+    b'\xaaU\x05\x06': (11, _whole_bus_servo_request_11),
 }
 
 
 def _decode_request_at(buf: bytes, start: int, stop: int) -> Message:
     """The frame buf[start:stop], whose header and length byte the stream parser has checked."""
+    check = buf[stop - 1]
     expected = 0x0
     for byte in buf[start + 2 : stop - 1]:
         expected = _CRC_TABLE[expected ^ byte]
-    if expected != buf[stop - 1]:
-        raise ChecksumError(f"bad checksum: the frame has {buf[stop - 1]:#04x}, its bytes give {expected:#04x}")
+    if expected != check:
+        raise ChecksumError(f"bad checksum: the frame has {check:#04x}, its bytes give {expected:#04x}")
     decoder = _REQUEST_DECODERS.get(buf[start + 2])
     if decoder is None:
         raise DecodeError(f"unknown command {buf[start + 2]:#04x}")
@@ -1904,28 +2075,37 @@ _RESPONSE_FIXED: dict[int, tuple[int, Callable[[bytes, int], Message | None]]] =
 }
 
 
-# The same frames for decode(), by their first bytes (header, command code, length byte).
-_RESPONSE_WHOLE: dict[bytes, tuple[int, Callable[[bytes, int], Message | None]]] = {
-    b'\xaaU\x06\x02': (7, _frame_key_response),
-    b'\xaaU\x07\x18': (29, _frame_imu_response),
-    b'\xaaU\x08\x07': (12, _frame_gamepad_response),
-    b'\xaaU\t$': (41, _frame_sbus_response),
+# The same frames for decode(), by their first bytes (header, command code, length byte): frame size, decoder.
+_RESPONSE_WHOLE: dict[bytes, tuple[int, Callable[[bytes], Message | None]]] = {
+    b'\xaaU\x06\x02': (7, _whole_key_response),
+    b'\xaaU\x07\x18': (29, _whole_imu_response),
+    b'\xaaU\x08\x07': (12, _whole_gamepad_response),
+    b'\xaaU\t$': (41, _whole_sbus_response),
+    b'\xaaU\x04\x04': (9, _whole_pwm_servo_response_9),
+    b'\xaaU\x04\x03': (8, _whole_pwm_servo_response_8),
+    b'\xaaU\x05\x05': (10, _whole_bus_servo_response_10),
+    b'\xaaU\x05\x04': (9, _whole_bus_servo_response_9),
+    b'\xaaU\x05\x07': (12, _whole_bus_servo_response_12),
+    b'\xaaU\x00\x03': (8, _whole_system_response_8),
 }
 
 
 def _decode_response_at(buf: bytes, start: int, stop: int) -> Message:
     """The frame buf[start:stop], whose header and length byte the stream parser has checked."""
+    check = buf[stop - 1]
     expected = 0x0
     for byte in buf[start + 2 : stop - 1]:
         expected = _CRC_TABLE[expected ^ byte]
-    if expected != buf[stop - 1]:
-        raise ChecksumError(f"bad checksum: the frame has {buf[stop - 1]:#04x}, its bytes give {expected:#04x}")
+    if expected != check:
+        raise ChecksumError(f"bad checksum: the frame has {check:#04x}, its bytes give {expected:#04x}")
     decoder = _RESPONSE_DECODERS.get(buf[start + 2])
     if decoder is None:
         raise DecodeError(f"unknown command {buf[start + 2]:#04x}")
     return decoder(buf, start + 4, stop - 1)
 
 
+_REQUEST = Direction.REQUEST
+_RESPONSE = Direction.RESPONSE
 _ENCODERS: dict[type[Message], Callable[..., bytes]] = {
     LedRequest: _encode_led_request,
     BuzzerRequest: _encode_buzzer_request,
@@ -2003,65 +2183,73 @@ RESPONSE_FORMAT = FrameFormat(
 def decode(data: bytes, direction: Direction | str | None = None, expect: type[Message] | None = None) -> Message:
     """Decode one complete frame into its message; raises DecodeError with a one-line reason.
 
-    Each direction's checks are inline here rather than in a function per direction: one call less per frame.
+    Each direction's checks are inline here rather than in a function per direction: one call less per frame. A
+    Direction is told by identity, first; its value as text ("request") costs one call more.
     `expect` (the reply class a frame answers) matters only where replies share a code; here none do.
     """
-    if direction is None:
-        raise DecodeError("give the direction: requests and responses share the header aa 55")
-    if direction == 'request':  # a Direction or its value
+    if direction is _REQUEST:
+        fixed = _REQUEST_WHOLE.get(data[:4])  # no key is shorter: a short frame matches none
+        if fixed is not None and fixed[0] == len(data):
+            message = fixed[1](data)
+            if message is not None:
+                return message
         n = len(data)
         if n < 5:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (5 bytes)")
-        fixed = _REQUEST_WHOLE.get(data[:4])
-        if fixed is not None and fixed[0] == n:
-            message = fixed[1](data, 0)
-            if message is not None:
-                return message
         if data[:2] != b'\xaaU':
             raise DecodeError(f"request header is {data[:2].hex(' ')}, expected aa 55")
         size = data[3]
         if n != 5 + size:
             raise DecodeError(f"length byte says {size} content bytes but the frame holds {n - 5}")
+        check = data[-1]
         expected = 0x0
         for byte in data[2:-1]:
             expected = _CRC_TABLE[expected ^ byte]
-        if expected != data[-1]:
-            raise ChecksumError(f"bad checksum: the frame has {data[-1]:#04x}, its bytes give {expected:#04x}")
+        if expected != check:
+            raise ChecksumError(f"bad checksum: the frame has {check:#04x}, its bytes give {expected:#04x}")
         decoder = _REQUEST_DECODERS.get(data[2])
         if decoder is None:
             raise DecodeError(f"unknown command {data[2]:#04x}")
         return decoder(data, 4, n - 1)
-    if direction == 'response':  # a Direction or its value
+    if direction is _RESPONSE:
+        fixed = _RESPONSE_WHOLE.get(data[:4])  # no key is shorter: a short frame matches none
+        if fixed is not None and fixed[0] == len(data):
+            message = fixed[1](data)
+            if message is not None:
+                return message
         n = len(data)
         if n < 5:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (5 bytes)")
-        fixed = _RESPONSE_WHOLE.get(data[:4])
-        if fixed is not None and fixed[0] == n:
-            message = fixed[1](data, 0)
-            if message is not None:
-                return message
         if data[:2] != b'\xaaU':
             raise DecodeError(f"response header is {data[:2].hex(' ')}, expected aa 55")
         size = data[3]
         if n != 5 + size:
             raise DecodeError(f"length byte says {size} content bytes but the frame holds {n - 5}")
+        check = data[-1]
         expected = 0x0
         for byte in data[2:-1]:
             expected = _CRC_TABLE[expected ^ byte]
-        if expected != data[-1]:
-            raise ChecksumError(f"bad checksum: the frame has {data[-1]:#04x}, its bytes give {expected:#04x}")
+        if expected != check:
+            raise ChecksumError(f"bad checksum: the frame has {check:#04x}, its bytes give {expected:#04x}")
         decoder = _RESPONSE_DECODERS.get(data[2])
         if decoder is None:
             raise DecodeError(f"unknown command {data[2]:#04x}")
         return decoder(data, 4, n - 1)
+    if direction == 'request':  # its value as text
+        return decode(data, _REQUEST, expect)
+    if direction == 'response':  # its value as text
+        return decode(data, _RESPONSE, expect)
+    if direction is None:  # last: a caller that knows the direction does not pay for this
+        raise DecodeError("give the direction: requests and responses share the header aa 55")
     raise ValueError(f"direction must be request or response, not {direction!r}")
 
 
 def encode(message: Message) -> bytes:
     """Encode a message as a complete frame; raises EncodeError (RangeError for values out of range)."""
-    encoder = _ENCODERS.get(type(message))
-    if encoder is None:
-        raise EncodeError(f"{type(message).__name__} is not a hiwonder_rrc message")
+    try:
+        encoder = _ENCODERS[type(message)]  # a subscript costs less than .get(); the miss is the rare case
+    except KeyError:
+        raise EncodeError(f"{type(message).__name__} is not a hiwonder_rrc message") from None
     try:
         return encoder(message)
     except EncodeError:

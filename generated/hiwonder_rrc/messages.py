@@ -18,8 +18,7 @@ from serialspec.runtime.fields import items as _items
 from serialspec.runtime.fields import mapping as _mapping
 from serialspec.runtime.fields import number as _number
 from serialspec.runtime.message import Direction, Message, Record
-
-_store = object.__setattr__  # how __init__ fills the slots of a frozen class
+from serialspec.runtime.message import build as _build
 
 __all__ = [
     'BusServoLoadRequest',
@@ -172,20 +171,19 @@ class MotorMask(IntFlag):
 class MotorsItem(Record):
     """One item of motors."""
 
-    __slots__ = ('motor_id', 'speed')
+    __slots__ = ()
     __match_args__ = ('motor_id', 'speed')
     #: Encoder motor id; bit n of the stop mask is motor_id n (the board has four motor ports).
     motor_id: int
     #: Motor speed in revolutions per second; the sign gives the direction. [r/s]
     speed: float
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         motor_id: int,
         speed: float,
-    ) -> None:
-        _store(self, 'motor_id', motor_id)
-        _store(self, 'speed', speed)
+    ) -> Self:
+        return _build(cls, (motor_id, speed))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -205,20 +203,19 @@ class MotorsItem(Record):
 class DutiesItem(Record):
     """One item of duties."""
 
-    __slots__ = ('motor_id', 'duty')
+    __slots__ = ()
     __match_args__ = ('motor_id', 'duty')
     #: Encoder motor id; bit n of the stop mask is motor_id n (the board has four motor ports).
     motor_id: int
     #: Duty cycle; the sign gives the direction (the SDK's example uses ±50). [%]
     duty: float
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         motor_id: int,
         duty: float,
-    ) -> None:
-        _store(self, 'motor_id', motor_id)
-        _store(self, 'duty', duty)
+    ) -> Self:
+        return _build(cls, (motor_id, duty))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -238,20 +235,19 @@ class DutiesItem(Record):
 class PwmServosItem(Record):
     """One item of pwm_servos."""
 
-    __slots__ = ('servo_id', 'pulse')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'pulse')
     #: PWM servo id.
     servo_id: int
     #: PWM pulse width (脉冲宽度); 500..2500 is 0°..180°. [µs] range 500..2500
     pulse: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         pulse: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'pulse', pulse)
+    ) -> Self:
+        return _build(cls, (servo_id, pulse))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -271,20 +267,19 @@ class PwmServosItem(Record):
 class BusServosItem(Record):
     """One item of bus_servos."""
 
-    __slots__ = ('servo_id', 'position')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'position')
     #: Bus servo id (0xFE is the broadcast id).
     servo_id: int
     #: Bus servo position (002 calls it 脉冲宽度, pulse width); 0..1000 is 0°..240°. range 0..1000
     position: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         position: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'position', position)
+    ) -> Self:
+        return _build(cls, (servo_id, position))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -304,16 +299,16 @@ class BusServosItem(Record):
 class ServosItem(Record):
     """One item of servos."""
 
-    __slots__ = ('servo_id',)
+    __slots__ = ()
     __match_args__ = ('servo_id',)
     #: Bus servo id (0xFE is the broadcast id).
     servo_id: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
+    ) -> Self:
+        return _build(cls, (servo_id,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -331,7 +326,7 @@ class ServosItem(Record):
 class PixelsItem(Record):
     """One item of pixels."""
 
-    __slots__ = ('index', 'red', 'green', 'blue')
+    __slots__ = ()
     __match_args__ = ('index', 'red', 'green', 'blue')
     #: LED index from 0 (the SDK takes 1.. and sends it less one).
     index: int
@@ -342,17 +337,14 @@ class PixelsItem(Record):
     #: Blue 0..255.
     blue: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         index: int,
         red: int,
         green: int,
         blue: int,
-    ) -> None:
-        _store(self, 'index', index)
-        _store(self, 'red', red)
-        _store(self, 'green', green)
-        _store(self, 'blue', blue)
+    ) -> Self:
+        return _build(cls, (index, red, green, blue))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -376,7 +368,7 @@ class PixelsItem(Record):
 class LedRequest(Message):
     """Blink the LED (request)."""
 
-    __slots__ = ('led_id', 'on_time', 'off_time', 'repeat')
+    __slots__ = ()
     __match_args__ = ('led_id', 'on_time', 'off_time', 'repeat')
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'led'
@@ -391,17 +383,14 @@ class LedRequest(Message):
     #: Number of blinks (循环次数).
     repeat: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         led_id: int,
         on_time: int,
         off_time: int,
         repeat: int,
-    ) -> None:
-        _store(self, 'led_id', led_id)
-        _store(self, 'on_time', on_time)
-        _store(self, 'off_time', off_time)
-        _store(self, 'repeat', repeat)
+    ) -> Self:
+        return _build(cls, (led_id, on_time, off_time, repeat))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -425,7 +414,7 @@ class LedRequest(Message):
 class BuzzerRequest(Message):
     """Sound the buzzer (request)."""
 
-    __slots__ = ('frequency', 'on_time', 'off_time', 'repeat')
+    __slots__ = ()
     __match_args__ = ('frequency', 'on_time', 'off_time', 'repeat')
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'buzzer'
@@ -440,17 +429,14 @@ class BuzzerRequest(Message):
     #: Number of beeps (循环次数).
     repeat: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         frequency: int,
         on_time: int,
         off_time: int,
         repeat: int,
-    ) -> None:
-        _store(self, 'frequency', frequency)
-        _store(self, 'on_time', on_time)
-        _store(self, 'off_time', off_time)
-        _store(self, 'repeat', repeat)
+    ) -> Self:
+        return _build(cls, (frequency, on_time, off_time, repeat))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -474,7 +460,7 @@ class BuzzerRequest(Message):
 class MotorSetSpeedRequest(Message):
     """Run one motor at a speed (request)."""
 
-    __slots__ = ('motor_id', 'speed')
+    __slots__ = ()
     __match_args__ = ('motor_id', 'speed')
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'motor'
@@ -485,13 +471,12 @@ class MotorSetSpeedRequest(Message):
     #: Motor speed in revolutions per second; the sign gives the direction. [r/s]
     speed: float
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         motor_id: int,
         speed: float,
-    ) -> None:
-        _store(self, 'motor_id', motor_id)
-        _store(self, 'speed', speed)
+    ) -> Self:
+        return _build(cls, (motor_id, speed))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -511,7 +496,7 @@ class MotorSetSpeedRequest(Message):
 class MotorSetSpeedsRequest(Message):
     """Run several motors, each at its speed (request)."""
 
-    __slots__ = ('motors',)
+    __slots__ = ()
     __match_args__ = ('motors',)
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'motor'
@@ -520,11 +505,11 @@ class MotorSetSpeedsRequest(Message):
     #: One (motor_id, speed) pair per motor.
     motors: tuple[MotorsItem, ...]
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         motors: tuple[MotorsItem, ...],
-    ) -> None:
-        _store(self, 'motors', motors)
+    ) -> Self:
+        return _build(cls, (motors,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -542,7 +527,7 @@ class MotorSetSpeedsRequest(Message):
 class MotorStopRequest(Message):
     """Stop one motor (request)."""
 
-    __slots__ = ('motor_id',)
+    __slots__ = ()
     __match_args__ = ('motor_id',)
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'motor'
@@ -551,11 +536,11 @@ class MotorStopRequest(Message):
     #: Encoder motor id; bit n of the stop mask is motor_id n (the board has four motor ports).
     motor_id: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         motor_id: int,
-    ) -> None:
-        _store(self, 'motor_id', motor_id)
+    ) -> Self:
+        return _build(cls, (motor_id,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -573,7 +558,7 @@ class MotorStopRequest(Message):
 class MotorSetDutiesRequest(Message):
     """Drive several motors at a duty cycle (open loop) (request)."""
 
-    __slots__ = ('duties',)
+    __slots__ = ()
     __match_args__ = ('duties',)
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'motor'
@@ -582,11 +567,11 @@ class MotorSetDutiesRequest(Message):
     #: One (motor_id, duty) pair per motor.
     duties: tuple[DutiesItem, ...]
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         duties: tuple[DutiesItem, ...],
-    ) -> None:
-        _store(self, 'duties', duties)
+    ) -> Self:
+        return _build(cls, (duties,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -604,7 +589,7 @@ class MotorSetDutiesRequest(Message):
 class MotorStopMaskRequest(Message):
     """Stop the motors of a bit mask (request)."""
 
-    __slots__ = ('mask',)
+    __slots__ = ()
     __match_args__ = ('mask',)
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'motor'
@@ -613,11 +598,11 @@ class MotorStopMaskRequest(Message):
     #: Motors to stop (电机掩码), bit n for motor n.
     mask: MotorMask
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         mask: MotorMask,
-    ) -> None:
-        _store(self, 'mask', mask)
+    ) -> Self:
+        return _build(cls, (mask,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -635,7 +620,7 @@ class MotorStopMaskRequest(Message):
 class PwmServoSetPositionsRequest(Message):
     """Move several PWM servos in one duration (request)."""
 
-    __slots__ = ('duration', 'pwm_servos')
+    __slots__ = ()
     __match_args__ = ('duration', 'pwm_servos')
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'pwm_servo'
@@ -646,13 +631,12 @@ class PwmServoSetPositionsRequest(Message):
     #: One (servo_id, pulse) pair per servo.
     pwm_servos: tuple[PwmServosItem, ...]
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         duration: int,
         pwm_servos: tuple[PwmServosItem, ...],
-    ) -> None:
-        _store(self, 'duration', duration)
-        _store(self, 'pwm_servos', pwm_servos)
+    ) -> Self:
+        return _build(cls, (duration, pwm_servos))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -672,7 +656,7 @@ class PwmServoSetPositionsRequest(Message):
 class PwmServoSetPositionRequest(Message):
     """Move one PWM servo (request)."""
 
-    __slots__ = ('duration', 'servo_id', 'pulse')
+    __slots__ = ()
     __match_args__ = ('duration', 'servo_id', 'pulse')
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'pwm_servo'
@@ -685,15 +669,13 @@ class PwmServoSetPositionRequest(Message):
     #: PWM pulse width (脉冲宽度); 500..2500 is 0°..180°. [µs] range 500..2500
     pulse: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         duration: int,
         servo_id: int,
         pulse: int,
-    ) -> None:
-        _store(self, 'duration', duration)
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'pulse', pulse)
+    ) -> Self:
+        return _build(cls, (duration, servo_id, pulse))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -715,7 +697,7 @@ class PwmServoSetPositionRequest(Message):
 class PwmServoReadPositionRequest(Message):
     """Read a PWM servo's pulse width (request)."""
 
-    __slots__ = ('servo_id',)
+    __slots__ = ()
     __match_args__ = ('servo_id',)
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'pwm_servo'
@@ -724,11 +706,11 @@ class PwmServoReadPositionRequest(Message):
     #: PWM servo id.
     servo_id: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
+    ) -> Self:
+        return _build(cls, (servo_id,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -746,7 +728,7 @@ class PwmServoReadPositionRequest(Message):
 class PwmServoReadPositionResponse(Message):
     """Read a PWM servo's pulse width (response)."""
 
-    __slots__ = ('servo_id', 'pulse')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'pulse')
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'pwm_servo'
@@ -757,13 +739,12 @@ class PwmServoReadPositionResponse(Message):
     #: The servo's current pulse width (not range-checked in a report). [µs]
     pulse: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         pulse: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'pulse', pulse)
+    ) -> Self:
+        return _build(cls, (servo_id, pulse))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -783,7 +764,7 @@ class PwmServoReadPositionResponse(Message):
 class PwmServoSetOffsetRequest(Message):
     """Set a PWM servo's offset (request)."""
 
-    __slots__ = ('servo_id', 'offset')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'offset')
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'pwm_servo'
@@ -794,13 +775,12 @@ class PwmServoSetOffsetRequest(Message):
     #: PWM servo offset (偏差), an int8 from -100 to +100. [µs] range -100..100
     offset: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         offset: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'offset', offset)
+    ) -> Self:
+        return _build(cls, (servo_id, offset))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -820,7 +800,7 @@ class PwmServoSetOffsetRequest(Message):
 class PwmServoReadOffsetRequest(Message):
     """Read a PWM servo's offset (request)."""
 
-    __slots__ = ('servo_id',)
+    __slots__ = ()
     __match_args__ = ('servo_id',)
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'pwm_servo'
@@ -829,11 +809,11 @@ class PwmServoReadOffsetRequest(Message):
     #: PWM servo id.
     servo_id: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
+    ) -> Self:
+        return _build(cls, (servo_id,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -851,7 +831,7 @@ class PwmServoReadOffsetRequest(Message):
 class PwmServoReadOffsetResponse(Message):
     """Read a PWM servo's offset (response)."""
 
-    __slots__ = ('servo_id', 'offset')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'offset')
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'pwm_servo'
@@ -862,13 +842,12 @@ class PwmServoReadOffsetResponse(Message):
     #: The servo's offset (int8; -100..100 when set through 0x07). [µs]
     offset: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         offset: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'offset', offset)
+    ) -> Self:
+        return _build(cls, (servo_id, offset))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -888,7 +867,7 @@ class PwmServoReadOffsetResponse(Message):
 class BusServoSetPositionsRequest(Message):
     """Move several bus servos in one duration (request)."""
 
-    __slots__ = ('duration', 'bus_servos')
+    __slots__ = ()
     __match_args__ = ('duration', 'bus_servos')
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'bus_servo'
@@ -899,13 +878,12 @@ class BusServoSetPositionsRequest(Message):
     #: One (servo_id, position) pair per servo.
     bus_servos: tuple[BusServosItem, ...]
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         duration: int,
         bus_servos: tuple[BusServosItem, ...],
-    ) -> None:
-        _store(self, 'duration', duration)
-        _store(self, 'bus_servos', bus_servos)
+    ) -> Self:
+        return _build(cls, (duration, bus_servos))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -925,7 +903,7 @@ class BusServoSetPositionsRequest(Message):
 class BusServoReadPositionRequest(Message):
     """Read a bus servo's position (request)."""
 
-    __slots__ = ('servo_id',)
+    __slots__ = ()
     __match_args__ = ('servo_id',)
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'bus_servo'
@@ -934,11 +912,11 @@ class BusServoReadPositionRequest(Message):
     #: Bus servo id (0xFE is the broadcast id).
     servo_id: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
+    ) -> Self:
+        return _build(cls, (servo_id,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -956,7 +934,7 @@ class BusServoReadPositionRequest(Message):
 class BusServoReadPositionResponse(Message):
     """Read a bus servo's position (response)."""
 
-    __slots__ = ('servo_id', 'success', 'position')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'success', 'position')
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'bus_servo'
@@ -969,15 +947,13 @@ class BusServoReadPositionResponse(Message):
     #: Current position (0..1000 is 0°..240°).
     position: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         success: ReadResult | int,
         position: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'success', success)
-        _store(self, 'position', position)
+    ) -> Self:
+        return _build(cls, (servo_id, success, position))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -999,7 +975,7 @@ class BusServoReadPositionResponse(Message):
 class BusServoReadVoltageRequest(Message):
     """Read a bus servo's input voltage (request)."""
 
-    __slots__ = ('servo_id',)
+    __slots__ = ()
     __match_args__ = ('servo_id',)
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'bus_servo'
@@ -1008,11 +984,11 @@ class BusServoReadVoltageRequest(Message):
     #: Bus servo id (0xFE is the broadcast id).
     servo_id: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
+    ) -> Self:
+        return _build(cls, (servo_id,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1030,7 +1006,7 @@ class BusServoReadVoltageRequest(Message):
 class BusServoReadVoltageResponse(Message):
     """Read a bus servo's input voltage (response)."""
 
-    __slots__ = ('servo_id', 'success', 'voltage')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'success', 'voltage')
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'bus_servo'
@@ -1043,15 +1019,13 @@ class BusServoReadVoltageResponse(Message):
     #: Input voltage. [mV]
     voltage: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         success: ReadResult | int,
         voltage: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'success', success)
-        _store(self, 'voltage', voltage)
+    ) -> Self:
+        return _build(cls, (servo_id, success, voltage))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1073,7 +1047,7 @@ class BusServoReadVoltageResponse(Message):
 class BusServoReadTemperatureRequest(Message):
     """Read a bus servo's temperature (request)."""
 
-    __slots__ = ('servo_id',)
+    __slots__ = ()
     __match_args__ = ('servo_id',)
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'bus_servo'
@@ -1082,11 +1056,11 @@ class BusServoReadTemperatureRequest(Message):
     #: Bus servo id (0xFE is the broadcast id).
     servo_id: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
+    ) -> Self:
+        return _build(cls, (servo_id,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1104,7 +1078,7 @@ class BusServoReadTemperatureRequest(Message):
 class BusServoReadTemperatureResponse(Message):
     """Read a bus servo's temperature (response)."""
 
-    __slots__ = ('servo_id', 'success', 'temperature')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'success', 'temperature')
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'bus_servo'
@@ -1117,15 +1091,13 @@ class BusServoReadTemperatureResponse(Message):
     #: Temperature. [°C]
     temperature: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         success: ReadResult | int,
         temperature: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'success', success)
-        _store(self, 'temperature', temperature)
+    ) -> Self:
+        return _build(cls, (servo_id, success, temperature))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1147,7 +1119,7 @@ class BusServoReadTemperatureResponse(Message):
 class BusServoStopRequest(Message):
     """Stop bus servos where they are (request)."""
 
-    __slots__ = ('servos',)
+    __slots__ = ()
     __match_args__ = ('servos',)
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'bus_servo'
@@ -1156,11 +1128,11 @@ class BusServoStopRequest(Message):
     #: The servos to stop.
     servos: tuple[ServosItem, ...]
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servos: tuple[ServosItem, ...],
-    ) -> None:
-        _store(self, 'servos', servos)
+    ) -> Self:
+        return _build(cls, (servos,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1178,7 +1150,7 @@ class BusServoStopRequest(Message):
 class BusServoReadTorqueRequest(Message):
     """Read whether a bus servo's torque is on (request)."""
 
-    __slots__ = ('servo_id',)
+    __slots__ = ()
     __match_args__ = ('servo_id',)
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'bus_servo'
@@ -1187,11 +1159,11 @@ class BusServoReadTorqueRequest(Message):
     #: Bus servo id (0xFE is the broadcast id).
     servo_id: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
+    ) -> Self:
+        return _build(cls, (servo_id,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1209,7 +1181,7 @@ class BusServoReadTorqueRequest(Message):
 class BusServoReadTorqueResponse(Message):
     """Read whether a bus servo's torque is on (response)."""
 
-    __slots__ = ('servo_id', 'success', 'torque')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'success', 'torque')
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'bus_servo'
@@ -1222,15 +1194,13 @@ class BusServoReadTorqueResponse(Message):
     #: 1 while the torque is on (after load, 0x0C), 0 after unload (0x0B).
     torque: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         success: ReadResult | int,
         torque: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'success', success)
-        _store(self, 'torque', torque)
+    ) -> Self:
+        return _build(cls, (servo_id, success, torque))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1252,7 +1222,7 @@ class BusServoReadTorqueResponse(Message):
 class BusServoUnloadRequest(Message):
     """Release a bus servo's torque (request)."""
 
-    __slots__ = ('servo_id',)
+    __slots__ = ()
     __match_args__ = ('servo_id',)
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'bus_servo'
@@ -1261,11 +1231,11 @@ class BusServoUnloadRequest(Message):
     #: Bus servo id (0xFE is the broadcast id).
     servo_id: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
+    ) -> Self:
+        return _build(cls, (servo_id,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1283,7 +1253,7 @@ class BusServoUnloadRequest(Message):
 class BusServoLoadRequest(Message):
     """Apply a bus servo's torque (request)."""
 
-    __slots__ = ('servo_id',)
+    __slots__ = ()
     __match_args__ = ('servo_id',)
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'bus_servo'
@@ -1292,11 +1262,11 @@ class BusServoLoadRequest(Message):
     #: Bus servo id (0xFE is the broadcast id).
     servo_id: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
+    ) -> Self:
+        return _build(cls, (servo_id,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1314,7 +1284,7 @@ class BusServoLoadRequest(Message):
 class BusServoSetIdRequest(Message):
     """Change a bus servo's id (request)."""
 
-    __slots__ = ('servo_id', 'new_id')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'new_id')
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'bus_servo'
@@ -1325,13 +1295,12 @@ class BusServoSetIdRequest(Message):
     #: The id to store (save_id).
     new_id: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         new_id: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'new_id', new_id)
+    ) -> Self:
+        return _build(cls, (servo_id, new_id))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1351,20 +1320,20 @@ class BusServoSetIdRequest(Message):
 class BusServoReadIdRequest(Message):
     """Read the id of the only servo on the bus (request)."""
 
-    __slots__ = ('servo_id',)
+    __slots__ = ()
     __match_args__ = ('servo_id',)
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'bus_servo'
     SUBCOMMAND: ClassVar[str | None] = 'read_id'
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
     #: 0xFE (broadcast query, 查询广播).
-    servo_id: int
+    servo_id: int = 254
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int = 254,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
+    ) -> Self:
+        return _build(cls, (servo_id,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1382,7 +1351,7 @@ class BusServoReadIdRequest(Message):
 class BusServoReadIdResponse(Message):
     """Read the id of the only servo on the bus (response)."""
 
-    __slots__ = ('servo_id', 'success', 'id')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'success', 'id')
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'bus_servo'
@@ -1395,15 +1364,13 @@ class BusServoReadIdResponse(Message):
     #: The id read from the servo.
     id: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         success: ReadResult | int,
         id: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'success', success)
-        _store(self, 'id', id)
+    ) -> Self:
+        return _build(cls, (servo_id, success, id))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1425,7 +1392,7 @@ class BusServoReadIdResponse(Message):
 class BusServoSetOffsetRequest(Message):
     """Set a bus servo's offset (request)."""
 
-    __slots__ = ('servo_id', 'offset')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'offset')
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'bus_servo'
@@ -1436,13 +1403,12 @@ class BusServoSetOffsetRequest(Message):
     #: Bus servo offset (偏差), an int8 from -125 to +125 (about -30°..30°); 002 and 003 give the PWM offset's -100..+100 (erratum bus_offset_range). range -125..125
     offset: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         offset: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'offset', offset)
+    ) -> Self:
+        return _build(cls, (servo_id, offset))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1462,7 +1428,7 @@ class BusServoSetOffsetRequest(Message):
 class BusServoReadOffsetRequest(Message):
     """Read a bus servo's offset (request)."""
 
-    __slots__ = ('servo_id',)
+    __slots__ = ()
     __match_args__ = ('servo_id',)
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'bus_servo'
@@ -1471,11 +1437,11 @@ class BusServoReadOffsetRequest(Message):
     #: Bus servo id (0xFE is the broadcast id).
     servo_id: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
+    ) -> Self:
+        return _build(cls, (servo_id,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1493,7 +1459,7 @@ class BusServoReadOffsetRequest(Message):
 class BusServoReadOffsetResponse(Message):
     """Read a bus servo's offset (response)."""
 
-    __slots__ = ('servo_id', 'success', 'offset')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'success', 'offset')
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'bus_servo'
@@ -1506,15 +1472,13 @@ class BusServoReadOffsetResponse(Message):
     #: The servo's offset (int8; -125..125 when set through 0x20).
     offset: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         success: ReadResult | int,
         offset: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'success', success)
-        _store(self, 'offset', offset)
+    ) -> Self:
+        return _build(cls, (servo_id, success, offset))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1536,7 +1500,7 @@ class BusServoReadOffsetResponse(Message):
 class BusServoSaveOffsetRequest(Message):
     """Store a bus servo's current offset (request)."""
 
-    __slots__ = ('servo_id',)
+    __slots__ = ()
     __match_args__ = ('servo_id',)
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'bus_servo'
@@ -1545,11 +1509,11 @@ class BusServoSaveOffsetRequest(Message):
     #: Bus servo id (0xFE is the broadcast id).
     servo_id: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
+    ) -> Self:
+        return _build(cls, (servo_id,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1567,7 +1531,7 @@ class BusServoSaveOffsetRequest(Message):
 class BusServoSetPositionLimitRequest(Message):
     """Set a bus servo's position limits (request)."""
 
-    __slots__ = ('servo_id', 'low', 'high')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'low', 'high')
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'bus_servo'
@@ -1580,15 +1544,13 @@ class BusServoSetPositionLimitRequest(Message):
     #: High position limit (高限位), 0..1000. range 0..1000
     high: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         low: int,
         high: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'low', low)
-        _store(self, 'high', high)
+    ) -> Self:
+        return _build(cls, (servo_id, low, high))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1610,7 +1572,7 @@ class BusServoSetPositionLimitRequest(Message):
 class BusServoReadPositionLimitRequest(Message):
     """Read a bus servo's position limits (request)."""
 
-    __slots__ = ('servo_id',)
+    __slots__ = ()
     __match_args__ = ('servo_id',)
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'bus_servo'
@@ -1619,11 +1581,11 @@ class BusServoReadPositionLimitRequest(Message):
     #: Bus servo id (0xFE is the broadcast id).
     servo_id: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
+    ) -> Self:
+        return _build(cls, (servo_id,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1641,7 +1603,7 @@ class BusServoReadPositionLimitRequest(Message):
 class BusServoReadPositionLimitResponse(Message):
     """Read a bus servo's position limits (response)."""
 
-    __slots__ = ('servo_id', 'success', 'low', 'high')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'success', 'low', 'high')
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'bus_servo'
@@ -1656,17 +1618,14 @@ class BusServoReadPositionLimitResponse(Message):
     #: High position limit.
     high: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         success: ReadResult | int,
         low: int,
         high: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'success', success)
-        _store(self, 'low', low)
-        _store(self, 'high', high)
+    ) -> Self:
+        return _build(cls, (servo_id, success, low, high))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1690,7 +1649,7 @@ class BusServoReadPositionLimitResponse(Message):
 class BusServoSetVoltageLimitRequest(Message):
     """Set a bus servo's voltage limits (request)."""
 
-    __slots__ = ('servo_id', 'low', 'high')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'low', 'high')
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'bus_servo'
@@ -1703,15 +1662,13 @@ class BusServoSetVoltageLimitRequest(Message):
     #: High voltage limit (高限位), at most 14000 mV. [mV] range 4500..14000
     high: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         low: int,
         high: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'low', low)
-        _store(self, 'high', high)
+    ) -> Self:
+        return _build(cls, (servo_id, low, high))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1733,7 +1690,7 @@ class BusServoSetVoltageLimitRequest(Message):
 class BusServoReadVoltageLimitRequest(Message):
     """Read a bus servo's voltage limits (request)."""
 
-    __slots__ = ('servo_id',)
+    __slots__ = ()
     __match_args__ = ('servo_id',)
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'bus_servo'
@@ -1742,11 +1699,11 @@ class BusServoReadVoltageLimitRequest(Message):
     #: Bus servo id (0xFE is the broadcast id).
     servo_id: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
+    ) -> Self:
+        return _build(cls, (servo_id,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1764,7 +1721,7 @@ class BusServoReadVoltageLimitRequest(Message):
 class BusServoReadVoltageLimitResponse(Message):
     """Read a bus servo's voltage limits (response)."""
 
-    __slots__ = ('servo_id', 'success', 'low', 'high')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'success', 'low', 'high')
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'bus_servo'
@@ -1779,17 +1736,14 @@ class BusServoReadVoltageLimitResponse(Message):
     #: High voltage limit. [mV]
     high: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         success: ReadResult | int,
         low: int,
         high: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'success', success)
-        _store(self, 'low', low)
-        _store(self, 'high', high)
+    ) -> Self:
+        return _build(cls, (servo_id, success, low, high))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1813,7 +1767,7 @@ class BusServoReadVoltageLimitResponse(Message):
 class BusServoSetTemperatureLimitRequest(Message):
     """Set a bus servo's temperature limit (request)."""
 
-    __slots__ = ('servo_id', 'limit')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'limit')
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'bus_servo'
@@ -1824,13 +1778,12 @@ class BusServoSetTemperatureLimitRequest(Message):
     #: Over-temperature threshold (高温阈值); must be less than 100 °C. [°C] range 0..99
     limit: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         limit: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'limit', limit)
+    ) -> Self:
+        return _build(cls, (servo_id, limit))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1850,7 +1803,7 @@ class BusServoSetTemperatureLimitRequest(Message):
 class BusServoReadTemperatureLimitRequest(Message):
     """Read a bus servo's temperature limit (request)."""
 
-    __slots__ = ('servo_id',)
+    __slots__ = ()
     __match_args__ = ('servo_id',)
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'bus_servo'
@@ -1859,11 +1812,11 @@ class BusServoReadTemperatureLimitRequest(Message):
     #: Bus servo id (0xFE is the broadcast id).
     servo_id: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
+    ) -> Self:
+        return _build(cls, (servo_id,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1881,7 +1834,7 @@ class BusServoReadTemperatureLimitRequest(Message):
 class BusServoReadTemperatureLimitResponse(Message):
     """Read a bus servo's temperature limit (response)."""
 
-    __slots__ = ('servo_id', 'success', 'limit')
+    __slots__ = ()
     __match_args__ = ('servo_id', 'success', 'limit')
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'bus_servo'
@@ -1894,15 +1847,13 @@ class BusServoReadTemperatureLimitResponse(Message):
     #: Over-temperature threshold. [°C]
     limit: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         servo_id: int,
         success: ReadResult | int,
         limit: int,
-    ) -> None:
-        _store(self, 'servo_id', servo_id)
-        _store(self, 'success', success)
-        _store(self, 'limit', limit)
+    ) -> Self:
+        return _build(cls, (servo_id, success, limit))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1924,7 +1875,7 @@ class BusServoReadTemperatureLimitResponse(Message):
 class KeyResponse(Message):
     """Key event (response). Sent by the device on its own."""
 
-    __slots__ = ('button_id', 'event')
+    __slots__ = ()
     __match_args__ = ('button_id', 'event')
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'key'
@@ -1935,13 +1886,12 @@ class KeyResponse(Message):
     #: What happened to the button (按键事件). range 1..128
     event: ButtonEvent | int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         button_id: int,
         event: ButtonEvent | int,
-    ) -> None:
-        _store(self, 'button_id', button_id)
-        _store(self, 'event', event)
+    ) -> Self:
+        return _build(cls, (button_id, event))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1961,7 +1911,7 @@ class KeyResponse(Message):
 class ImuResponse(Message):
     """IMU data (response). Sent by the device on its own."""
 
-    __slots__ = ('accel_x', 'accel_y', 'accel_z', 'gyro_x', 'gyro_y', 'gyro_z')
+    __slots__ = ()
     __match_args__ = ('accel_x', 'accel_y', 'accel_z', 'gyro_x', 'gyro_y', 'gyro_z')
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'imu'
@@ -1980,21 +1930,16 @@ class ImuResponse(Message):
     #: Angular rate about z.
     gyro_z: float
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         accel_x: float,
         accel_y: float,
         accel_z: float,
         gyro_x: float,
         gyro_y: float,
         gyro_z: float,
-    ) -> None:
-        _store(self, 'accel_x', accel_x)
-        _store(self, 'accel_y', accel_y)
-        _store(self, 'accel_z', accel_z)
-        _store(self, 'gyro_x', gyro_x)
-        _store(self, 'gyro_y', gyro_y)
-        _store(self, 'gyro_z', gyro_z)
+    ) -> Self:
+        return _build(cls, (accel_x, accel_y, accel_z, gyro_x, gyro_y, gyro_z))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -2022,7 +1967,7 @@ class ImuResponse(Message):
 class GamepadResponse(Message):
     """Gamepad data (response). Sent by the device on its own."""
 
-    __slots__ = ('buttons', 'hat', 'left_x', 'left_y', 'right_x', 'right_y')
+    __slots__ = ()
     __match_args__ = ('buttons', 'hat', 'left_x', 'left_y', 'right_x', 'right_y')
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'gamepad'
@@ -2041,21 +1986,16 @@ class GamepadResponse(Message):
     #: Right stick y.
     right_y: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         buttons: GamepadButtons,
         hat: int,
         left_x: int,
         left_y: int,
         right_x: int,
         right_y: int,
-    ) -> None:
-        _store(self, 'buttons', buttons)
-        _store(self, 'hat', hat)
-        _store(self, 'left_x', left_x)
-        _store(self, 'left_y', left_y)
-        _store(self, 'right_x', right_x)
-        _store(self, 'right_y', right_y)
+    ) -> Self:
+        return _build(cls, (buttons, hat, left_x, left_y, right_x, right_y))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -2083,7 +2023,7 @@ class GamepadResponse(Message):
 class SbusResponse(Message):
     """SBUS radio-control receiver data (response). Sent by the device on its own."""
 
-    __slots__ = ('channels', 'ch17', 'ch18', 'signal_loss', 'fail_safe')
+    __slots__ = ()
     __match_args__ = ('channels', 'ch17', 'ch18', 'signal_loss', 'fail_safe')
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'sbus'
@@ -2100,19 +2040,15 @@ class SbusResponse(Message):
     #: Set when the receiver is in fail-safe.
     fail_safe: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         channels: tuple[int, ...],
         ch17: int,
         ch18: int,
         signal_loss: int,
         fail_safe: int,
-    ) -> None:
-        _store(self, 'channels', channels)
-        _store(self, 'ch17', ch17)
-        _store(self, 'ch18', ch18)
-        _store(self, 'signal_loss', signal_loss)
-        _store(self, 'fail_safe', fail_safe)
+    ) -> Self:
+        return _build(cls, (channels, ch17, ch18, signal_loss, fail_safe))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -2138,7 +2074,7 @@ class SbusResponse(Message):
 class SystemBatteryResponse(Message):
     """Battery voltage (response). Sent by the device on its own."""
 
-    __slots__ = ('voltage',)
+    __slots__ = ()
     __match_args__ = ('voltage',)
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'system'
@@ -2147,11 +2083,11 @@ class SystemBatteryResponse(Message):
     #: Battery voltage. [mV]
     voltage: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         voltage: int,
-    ) -> None:
-        _store(self, 'voltage', voltage)
+    ) -> Self:
+        return _build(cls, (voltage,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -2169,7 +2105,7 @@ class SystemBatteryResponse(Message):
 class OledRequest(Message):
     """Show a line of text on the OLED display (request)."""
 
-    __slots__ = ('line', 'text')
+    __slots__ = ()
     __match_args__ = ('line', 'text')
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'oled'
@@ -2180,13 +2116,12 @@ class OledRequest(Message):
     #: The text (UTF-8).
     text: bytes
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         line: int,
         text: bytes,
-    ) -> None:
-        _store(self, 'line', line)
-        _store(self, 'text', text)
+    ) -> Self:
+        return _build(cls, (line, text))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -2206,7 +2141,7 @@ class OledRequest(Message):
 class RgbSetPixelsRequest(Message):
     """Set the colour of several RGB LEDs (request)."""
 
-    __slots__ = ('pixels',)
+    __slots__ = ()
     __match_args__ = ('pixels',)
     PROTOCOL: ClassVar[str] = 'hiwonder_rrc'
     COMMAND: ClassVar[str] = 'rgb'
@@ -2215,11 +2150,11 @@ class RgbSetPixelsRequest(Message):
     #: One (index, red, green, blue) per LED.
     pixels: tuple[PixelsItem, ...]
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         pixels: tuple[PixelsItem, ...],
-    ) -> None:
-        _store(self, 'pixels', pixels)
+    ) -> Self:
+        return _build(cls, (pixels,))
 
     def to_fields(self) -> dict[str, Any]:
         return {

@@ -11,7 +11,8 @@ from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError, c
 from serialspec.runtime.fields import wrong_type
 from serialspec.runtime.framing import ERROR_REPLY, Element, EngineFormat, FrameCodec, Layout, SizeRule
 from serialspec.runtime.framing import FrameStreamParser as _FrameStreamParser
-from serialspec.runtime.message import Direction, Message, members, slot_setters
+from serialspec.runtime.message import Direction, Message, members
+from serialspec.runtime.message import build as _new  # a message from the tuple of its field values, in one call
 from serialspec.runtime.packing import pack_bits as _pack_bits
 from serialspec.runtime.packing import unpack_bits as _unpack_bits
 
@@ -55,46 +56,6 @@ _S_BE_U8_U8_U16_U16_U8 = struct.Struct('>BBHHB')
 _S_BE_U8_U8_U8 = struct.Struct('>BBB')
 _CHECK_CRC: Callable[[bytes], int] = crc_function(16, 0x8005, 0xffff, True, True, 0x0)  # CRC-16/MODBUS
 
-# Decoders build messages with object.__new__ and store each value straight into its slot: a message's __init__
-# (frozen) goes through object.__setattr__ per field, which costs more than unpacking the whole frame.
-_new = object.__new__
-_set_ExceptionResponse_unit, _set_ExceptionResponse_function, _set_ExceptionResponse_exception_code = slot_setters(ExceptionResponse)
-(
-    _set_MaskWriteRegisterRequest_unit,
-    _set_MaskWriteRegisterRequest_address,
-    _set_MaskWriteRegisterRequest_and_mask,
-    _set_MaskWriteRegisterRequest_or_mask,
-) = slot_setters(MaskWriteRegisterRequest)
-(
-    _set_MaskWriteRegisterResponse_unit,
-    _set_MaskWriteRegisterResponse_address,
-    _set_MaskWriteRegisterResponse_and_mask,
-    _set_MaskWriteRegisterResponse_or_mask,
-) = slot_setters(MaskWriteRegisterResponse)
-_set_ReadCoilsRequest_unit, _set_ReadCoilsRequest_address, _set_ReadCoilsRequest_count = slot_setters(ReadCoilsRequest)
-_set_ReadCoilsResponse_unit, _set_ReadCoilsResponse_coils = slot_setters(ReadCoilsResponse)
-_set_ReadDiscreteInputsRequest_unit, _set_ReadDiscreteInputsRequest_address, _set_ReadDiscreteInputsRequest_count = slot_setters(ReadDiscreteInputsRequest)
-_set_ReadDiscreteInputsResponse_unit, _set_ReadDiscreteInputsResponse_inputs = slot_setters(ReadDiscreteInputsResponse)
-_set_ReadHoldingRegistersRequest_unit, _set_ReadHoldingRegistersRequest_address, _set_ReadHoldingRegistersRequest_count = slot_setters(ReadHoldingRegistersRequest)
-_set_ReadHoldingRegistersResponse_unit, _set_ReadHoldingRegistersResponse_registers = slot_setters(ReadHoldingRegistersResponse)
-_set_ReadInputRegistersRequest_unit, _set_ReadInputRegistersRequest_address, _set_ReadInputRegistersRequest_count = slot_setters(ReadInputRegistersRequest)
-_set_ReadInputRegistersResponse_unit, _set_ReadInputRegistersResponse_registers = slot_setters(ReadInputRegistersResponse)
-(
-    _set_ReadWriteRegistersRequest_unit,
-    _set_ReadWriteRegistersRequest_read_address,
-    _set_ReadWriteRegistersRequest_read_count,
-    _set_ReadWriteRegistersRequest_write_address,
-    _set_ReadWriteRegistersRequest_values,
-) = slot_setters(ReadWriteRegistersRequest)
-_set_ReadWriteRegistersResponse_unit, _set_ReadWriteRegistersResponse_registers = slot_setters(ReadWriteRegistersResponse)
-_set_WriteCoilRequest_unit, _set_WriteCoilRequest_address, _set_WriteCoilRequest_value = slot_setters(WriteCoilRequest)
-_set_WriteCoilResponse_unit, _set_WriteCoilResponse_address, _set_WriteCoilResponse_value = slot_setters(WriteCoilResponse)
-_set_WriteCoilsRequest_unit, _set_WriteCoilsRequest_address, _set_WriteCoilsRequest_values = slot_setters(WriteCoilsRequest)
-_set_WriteCoilsResponse_unit, _set_WriteCoilsResponse_address, _set_WriteCoilsResponse_count = slot_setters(WriteCoilsResponse)
-_set_WriteRegisterRequest_unit, _set_WriteRegisterRequest_address, _set_WriteRegisterRequest_value = slot_setters(WriteRegisterRequest)
-_set_WriteRegisterResponse_unit, _set_WriteRegisterResponse_address, _set_WriteRegisterResponse_value = slot_setters(WriteRegisterResponse)
-_set_WriteRegistersRequest_unit, _set_WriteRegistersRequest_address, _set_WriteRegistersRequest_values = slot_setters(WriteRegistersRequest)
-_set_WriteRegistersResponse_unit, _set_WriteRegistersResponse_address, _set_WriteRegistersResponse_count = slot_setters(WriteRegistersResponse)
 _MEMBERS_CoilState = members(CoilState)
 _MEMBERS_ExceptionCode = members(ExceptionCode)
 
@@ -103,17 +64,13 @@ def _decode_read_coils_request(buf: bytes, o: int, end: int, unit: int) -> ReadC
     if end - o != 4:
         raise content_size_error('read_coils request', end - o, 4, 4)
     v_address, v_count = _S_BE_U16_U16.unpack_from(buf, o)
-    m = _new(ReadCoilsRequest)
-    _set_ReadCoilsRequest_unit(m, unit)
-    _set_ReadCoilsRequest_address(m, v_address)
-    _set_ReadCoilsRequest_count(m, v_count)
-    return m
+    return _new(ReadCoilsRequest, (unit, v_address, v_count))
 
 
 def _decode_read_coils_response(buf: bytes, o: int, end: int, unit: int) -> ReadCoilsResponse:
     if not 1 <= end - o <= 256:
         raise content_size_error('read_coils response', end - o, 1, 256)
-    v_byte_count, = _S_BE_U8.unpack_from(buf, o)
+    v_byte_count = buf[o]
     o += 1
     nb = v_byte_count
     n = nb * 8
@@ -125,27 +82,20 @@ def _decode_read_coils_response(buf: bytes, o: int, end: int, unit: int) -> Read
         raise DecodeError('read_coils response' + f': {end - o} bytes left after the last field')
     if v_byte_count != (-(-len(v_coils) // 8)):
         raise DecodeError('read_coils response' + f': byte_count is {v_byte_count}, but ceil(len(coils) / 8) = {(-(-len(v_coils) // 8))}')
-    m = _new(ReadCoilsResponse)
-    _set_ReadCoilsResponse_unit(m, unit)
-    _set_ReadCoilsResponse_coils(m, v_coils)
-    return m
+    return _new(ReadCoilsResponse, (unit, v_coils))
 
 
 def _decode_read_discrete_inputs_request(buf: bytes, o: int, end: int, unit: int) -> ReadDiscreteInputsRequest:
     if end - o != 4:
         raise content_size_error('read_discrete_inputs request', end - o, 4, 4)
     v_address, v_count = _S_BE_U16_U16.unpack_from(buf, o)
-    m = _new(ReadDiscreteInputsRequest)
-    _set_ReadDiscreteInputsRequest_unit(m, unit)
-    _set_ReadDiscreteInputsRequest_address(m, v_address)
-    _set_ReadDiscreteInputsRequest_count(m, v_count)
-    return m
+    return _new(ReadDiscreteInputsRequest, (unit, v_address, v_count))
 
 
 def _decode_read_discrete_inputs_response(buf: bytes, o: int, end: int, unit: int) -> ReadDiscreteInputsResponse:
     if not 1 <= end - o <= 256:
         raise content_size_error('read_discrete_inputs response', end - o, 1, 256)
-    v_byte_count, = _S_BE_U8.unpack_from(buf, o)
+    v_byte_count = buf[o]
     o += 1
     nb = v_byte_count
     n = nb * 8
@@ -157,27 +107,20 @@ def _decode_read_discrete_inputs_response(buf: bytes, o: int, end: int, unit: in
         raise DecodeError('read_discrete_inputs response' + f': {end - o} bytes left after the last field')
     if v_byte_count != (-(-len(v_inputs) // 8)):
         raise DecodeError('read_discrete_inputs response' + f': byte_count is {v_byte_count}, but ceil(len(inputs) / 8) = {(-(-len(v_inputs) // 8))}')
-    m = _new(ReadDiscreteInputsResponse)
-    _set_ReadDiscreteInputsResponse_unit(m, unit)
-    _set_ReadDiscreteInputsResponse_inputs(m, v_inputs)
-    return m
+    return _new(ReadDiscreteInputsResponse, (unit, v_inputs))
 
 
 def _decode_read_holding_registers_request(buf: bytes, o: int, end: int, unit: int) -> ReadHoldingRegistersRequest:
     if end - o != 4:
         raise content_size_error('read_holding_registers request', end - o, 4, 4)
     v_address, v_count = _S_BE_U16_U16.unpack_from(buf, o)
-    m = _new(ReadHoldingRegistersRequest)
-    _set_ReadHoldingRegistersRequest_unit(m, unit)
-    _set_ReadHoldingRegistersRequest_address(m, v_address)
-    _set_ReadHoldingRegistersRequest_count(m, v_count)
-    return m
+    return _new(ReadHoldingRegistersRequest, (unit, v_address, v_count))
 
 
 def _decode_read_holding_registers_response(buf: bytes, o: int, end: int, unit: int) -> ReadHoldingRegistersResponse:
     if not 1 <= end - o <= 256:
         raise content_size_error('read_holding_registers response', end - o, 1, 256)
-    v_byte_count, = _S_BE_U8.unpack_from(buf, o)
+    v_byte_count = buf[o]
     o += 1
     nb = v_byte_count
     if nb % 2:
@@ -191,27 +134,20 @@ def _decode_read_holding_registers_response(buf: bytes, o: int, end: int, unit: 
         raise DecodeError('read_holding_registers response' + f': {end - o} bytes left after the last field')
     if v_byte_count != (2 * len(v_registers)):
         raise DecodeError('read_holding_registers response' + f': byte_count is {v_byte_count}, but 2 * len(registers) = {(2 * len(v_registers))}')
-    m = _new(ReadHoldingRegistersResponse)
-    _set_ReadHoldingRegistersResponse_unit(m, unit)
-    _set_ReadHoldingRegistersResponse_registers(m, v_registers)
-    return m
+    return _new(ReadHoldingRegistersResponse, (unit, v_registers))
 
 
 def _decode_read_input_registers_request(buf: bytes, o: int, end: int, unit: int) -> ReadInputRegistersRequest:
     if end - o != 4:
         raise content_size_error('read_input_registers request', end - o, 4, 4)
     v_address, v_count = _S_BE_U16_U16.unpack_from(buf, o)
-    m = _new(ReadInputRegistersRequest)
-    _set_ReadInputRegistersRequest_unit(m, unit)
-    _set_ReadInputRegistersRequest_address(m, v_address)
-    _set_ReadInputRegistersRequest_count(m, v_count)
-    return m
+    return _new(ReadInputRegistersRequest, (unit, v_address, v_count))
 
 
 def _decode_read_input_registers_response(buf: bytes, o: int, end: int, unit: int) -> ReadInputRegistersResponse:
     if not 1 <= end - o <= 256:
         raise content_size_error('read_input_registers response', end - o, 1, 256)
-    v_byte_count, = _S_BE_U8.unpack_from(buf, o)
+    v_byte_count = buf[o]
     o += 1
     nb = v_byte_count
     if nb % 2:
@@ -225,54 +161,35 @@ def _decode_read_input_registers_response(buf: bytes, o: int, end: int, unit: in
         raise DecodeError('read_input_registers response' + f': {end - o} bytes left after the last field')
     if v_byte_count != (2 * len(v_registers)):
         raise DecodeError('read_input_registers response' + f': byte_count is {v_byte_count}, but 2 * len(registers) = {(2 * len(v_registers))}')
-    m = _new(ReadInputRegistersResponse)
-    _set_ReadInputRegistersResponse_unit(m, unit)
-    _set_ReadInputRegistersResponse_registers(m, v_registers)
-    return m
+    return _new(ReadInputRegistersResponse, (unit, v_registers))
 
 
 def _decode_write_coil_request(buf: bytes, o: int, end: int, unit: int) -> WriteCoilRequest:
     if end - o != 4:
         raise content_size_error('write_coil request', end - o, 4, 4)
     v_address, v_value = _S_BE_U16_U16.unpack_from(buf, o)
-    m = _new(WriteCoilRequest)
-    _set_WriteCoilRequest_unit(m, unit)
-    _set_WriteCoilRequest_address(m, v_address)
-    _set_WriteCoilRequest_value(m, _MEMBERS_CoilState.get(v_value, v_value))
-    return m
+    return _new(WriteCoilRequest, (unit, v_address, _MEMBERS_CoilState.get(v_value, v_value)))
 
 
 def _decode_write_coil_response(buf: bytes, o: int, end: int, unit: int) -> WriteCoilResponse:
     if end - o != 4:
         raise content_size_error('write_coil response', end - o, 4, 4)
     v_address, v_value = _S_BE_U16_U16.unpack_from(buf, o)
-    m = _new(WriteCoilResponse)
-    _set_WriteCoilResponse_unit(m, unit)
-    _set_WriteCoilResponse_address(m, v_address)
-    _set_WriteCoilResponse_value(m, _MEMBERS_CoilState.get(v_value, v_value))
-    return m
+    return _new(WriteCoilResponse, (unit, v_address, _MEMBERS_CoilState.get(v_value, v_value)))
 
 
 def _decode_write_register_request(buf: bytes, o: int, end: int, unit: int) -> WriteRegisterRequest:
     if end - o != 4:
         raise content_size_error('write_register request', end - o, 4, 4)
     v_address, v_value = _S_BE_U16_U16.unpack_from(buf, o)
-    m = _new(WriteRegisterRequest)
-    _set_WriteRegisterRequest_unit(m, unit)
-    _set_WriteRegisterRequest_address(m, v_address)
-    _set_WriteRegisterRequest_value(m, v_value)
-    return m
+    return _new(WriteRegisterRequest, (unit, v_address, v_value))
 
 
 def _decode_write_register_response(buf: bytes, o: int, end: int, unit: int) -> WriteRegisterResponse:
     if end - o != 4:
         raise content_size_error('write_register response', end - o, 4, 4)
     v_address, v_value = _S_BE_U16_U16.unpack_from(buf, o)
-    m = _new(WriteRegisterResponse)
-    _set_WriteRegisterResponse_unit(m, unit)
-    _set_WriteRegisterResponse_address(m, v_address)
-    _set_WriteRegisterResponse_value(m, v_value)
-    return m
+    return _new(WriteRegisterResponse, (unit, v_address, v_value))
 
 
 def _decode_write_coils_request(buf: bytes, o: int, end: int, unit: int) -> WriteCoilsRequest:
@@ -290,22 +207,14 @@ def _decode_write_coils_request(buf: bytes, o: int, end: int, unit: int) -> Writ
         raise DecodeError('write_coils request' + f': {end - o} bytes left after the last field')
     if v_byte_count != (-(-v_count // 8)):
         raise DecodeError('write_coils request' + f': byte_count is {v_byte_count}, but ceil(count / 8) = {(-(-v_count // 8))}')
-    m = _new(WriteCoilsRequest)
-    _set_WriteCoilsRequest_unit(m, unit)
-    _set_WriteCoilsRequest_address(m, v_address)
-    _set_WriteCoilsRequest_values(m, v_values)
-    return m
+    return _new(WriteCoilsRequest, (unit, v_address, v_values))
 
 
 def _decode_write_coils_response(buf: bytes, o: int, end: int, unit: int) -> WriteCoilsResponse:
     if end - o != 4:
         raise content_size_error('write_coils response', end - o, 4, 4)
     v_address, v_count = _S_BE_U16_U16.unpack_from(buf, o)
-    m = _new(WriteCoilsResponse)
-    _set_WriteCoilsResponse_unit(m, unit)
-    _set_WriteCoilsResponse_address(m, v_address)
-    _set_WriteCoilsResponse_count(m, v_count)
-    return m
+    return _new(WriteCoilsResponse, (unit, v_address, v_count))
 
 
 def _decode_write_registers_request(buf: bytes, o: int, end: int, unit: int) -> WriteRegistersRequest:
@@ -323,46 +232,28 @@ def _decode_write_registers_request(buf: bytes, o: int, end: int, unit: int) -> 
         raise DecodeError('write_registers request' + f': {end - o} bytes left after the last field')
     if v_byte_count != (2 * v_count):
         raise DecodeError('write_registers request' + f': byte_count is {v_byte_count}, but 2 * count = {(2 * v_count)}')
-    m = _new(WriteRegistersRequest)
-    _set_WriteRegistersRequest_unit(m, unit)
-    _set_WriteRegistersRequest_address(m, v_address)
-    _set_WriteRegistersRequest_values(m, v_values)
-    return m
+    return _new(WriteRegistersRequest, (unit, v_address, v_values))
 
 
 def _decode_write_registers_response(buf: bytes, o: int, end: int, unit: int) -> WriteRegistersResponse:
     if end - o != 4:
         raise content_size_error('write_registers response', end - o, 4, 4)
     v_address, v_count = _S_BE_U16_U16.unpack_from(buf, o)
-    m = _new(WriteRegistersResponse)
-    _set_WriteRegistersResponse_unit(m, unit)
-    _set_WriteRegistersResponse_address(m, v_address)
-    _set_WriteRegistersResponse_count(m, v_count)
-    return m
+    return _new(WriteRegistersResponse, (unit, v_address, v_count))
 
 
 def _decode_mask_write_register_request(buf: bytes, o: int, end: int, unit: int) -> MaskWriteRegisterRequest:
     if end - o != 6:
         raise content_size_error('mask_write_register request', end - o, 6, 6)
     v_address, v_and_mask, v_or_mask = _S_BE_U16_U16_U16.unpack_from(buf, o)
-    m = _new(MaskWriteRegisterRequest)
-    _set_MaskWriteRegisterRequest_unit(m, unit)
-    _set_MaskWriteRegisterRequest_address(m, v_address)
-    _set_MaskWriteRegisterRequest_and_mask(m, v_and_mask)
-    _set_MaskWriteRegisterRequest_or_mask(m, v_or_mask)
-    return m
+    return _new(MaskWriteRegisterRequest, (unit, v_address, v_and_mask, v_or_mask))
 
 
 def _decode_mask_write_register_response(buf: bytes, o: int, end: int, unit: int) -> MaskWriteRegisterResponse:
     if end - o != 6:
         raise content_size_error('mask_write_register response', end - o, 6, 6)
     v_address, v_and_mask, v_or_mask = _S_BE_U16_U16_U16.unpack_from(buf, o)
-    m = _new(MaskWriteRegisterResponse)
-    _set_MaskWriteRegisterResponse_unit(m, unit)
-    _set_MaskWriteRegisterResponse_address(m, v_address)
-    _set_MaskWriteRegisterResponse_and_mask(m, v_and_mask)
-    _set_MaskWriteRegisterResponse_or_mask(m, v_or_mask)
-    return m
+    return _new(MaskWriteRegisterResponse, (unit, v_address, v_and_mask, v_or_mask))
 
 
 def _decode_read_write_registers_request(buf: bytes, o: int, end: int, unit: int) -> ReadWriteRegistersRequest:
@@ -380,19 +271,13 @@ def _decode_read_write_registers_request(buf: bytes, o: int, end: int, unit: int
         raise DecodeError('read_write_registers request' + f': {end - o} bytes left after the last field')
     if v_byte_count != (2 * v_write_count):
         raise DecodeError('read_write_registers request' + f': byte_count is {v_byte_count}, but 2 * write_count = {(2 * v_write_count)}')
-    m = _new(ReadWriteRegistersRequest)
-    _set_ReadWriteRegistersRequest_unit(m, unit)
-    _set_ReadWriteRegistersRequest_read_address(m, v_read_address)
-    _set_ReadWriteRegistersRequest_read_count(m, v_read_count)
-    _set_ReadWriteRegistersRequest_write_address(m, v_write_address)
-    _set_ReadWriteRegistersRequest_values(m, v_values)
-    return m
+    return _new(ReadWriteRegistersRequest, (unit, v_read_address, v_read_count, v_write_address, v_values))
 
 
 def _decode_read_write_registers_response(buf: bytes, o: int, end: int, unit: int) -> ReadWriteRegistersResponse:
     if not 1 <= end - o <= 256:
         raise content_size_error('read_write_registers response', end - o, 1, 256)
-    v_byte_count, = _S_BE_U8.unpack_from(buf, o)
+    v_byte_count = buf[o]
     o += 1
     nb = v_byte_count
     if nb % 2:
@@ -406,285 +291,340 @@ def _decode_read_write_registers_response(buf: bytes, o: int, end: int, unit: in
         raise DecodeError('read_write_registers response' + f': {end - o} bytes left after the last field')
     if v_byte_count != (2 * len(v_registers)):
         raise DecodeError('read_write_registers response' + f': byte_count is {v_byte_count}, but 2 * len(registers) = {(2 * len(v_registers))}')
-    m = _new(ReadWriteRegistersResponse)
-    _set_ReadWriteRegistersResponse_unit(m, unit)
-    _set_ReadWriteRegistersResponse_registers(m, v_registers)
-    return m
+    return _new(ReadWriteRegistersResponse, (unit, v_registers))
 
 
 def _decode_exception_response(buf: bytes, o: int, end: int, unit: int, function: int) -> ExceptionResponse:
     if end - o != 1:
         raise content_size_error('exception response', end - o, 1, 1)
-    v_exception_code, = _S_BE_U8.unpack_from(buf, o)
-    m = _new(ExceptionResponse)
-    _set_ExceptionResponse_unit(m, unit)
-    _set_ExceptionResponse_function(m, function)
-    _set_ExceptionResponse_exception_code(m, _MEMBERS_ExceptionCode.get(v_exception_code, v_exception_code))
-    return m
+    v_exception_code = buf[o]
+    return _new(ExceptionResponse, (unit, function, _MEMBERS_ExceptionCode.get(v_exception_code, v_exception_code)))
 
 
 def _encode_read_coils_request(m: ReadCoilsRequest) -> bytes:
-    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
-        raise out_of_range('read_coils request', 'unit', m.unit, 1, 247)
-    if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
-        raise out_of_range('read_coils request', 'address', m.address, 0, 65535)
-    if not 1 <= m.count <= 2000 or m.count.__class__ is bool:
-        raise out_of_range('read_coils request', 'count', m.count, 1, 2000)
-    frame = _S_BE_U8_U8_U16_U16.pack(m.unit, 0x01, m.address, m.count)
+    m_unit = m.unit
+    m_address = m.address
+    m_count = m.count
+    if not 0 <= m_unit <= 247 or m_unit.__class__ is bool:
+        raise out_of_range('read_coils request', 'unit', m_unit, 1, 247)
+    if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
+        raise out_of_range('read_coils request', 'address', m_address, 0, 65535)
+    if not 1 <= m_count <= 2000 or m_count.__class__ is bool:
+        raise out_of_range('read_coils request', 'count', m_count, 1, 2000)
+    frame = _S_BE_U8_U8_U16_U16.pack(m_unit, 0x01, m_address, m_count)
     return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_read_coils_response(m: ReadCoilsResponse) -> bytes:
-    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
-        raise out_of_range('read_coils response', 'unit', m.unit, 1, 247)
-    if len(m.coils) > 2000:
-        raise EncodeError('read_coils response' + f': coils has {len(m.coils)} items, at most 2000 (the limit of the request field count)')
-    v_byte_count = (-(-len(m.coils) // 8))
+    m_unit = m.unit
+    m_coils = m.coils
+    if not 0 <= m_unit <= 247 or m_unit.__class__ is bool:
+        raise out_of_range('read_coils response', 'unit', m_unit, 1, 247)
+    if len(m_coils) > 2000:
+        raise EncodeError('read_coils response' + f': coils has {len(m_coils)} items, at most 2000 (the limit of the request field count)')
+    v_byte_count = (-(-len(m_coils) // 8))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('read_coils response', 'byte_count', v_byte_count, 0, 255)
-    frame = _S_BE_U8_U8_U8.pack(m.unit, 0x01, v_byte_count) + _pack_bits(m.coils, 'coils', 'read_coils response')
+    frame = _S_BE_U8_U8_U8.pack(m_unit, 0x01, v_byte_count) + _pack_bits(m_coils, 'coils', 'read_coils response')
     return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_read_discrete_inputs_request(m: ReadDiscreteInputsRequest) -> bytes:
-    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
-        raise out_of_range('read_discrete_inputs request', 'unit', m.unit, 1, 247)
-    if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
-        raise out_of_range('read_discrete_inputs request', 'address', m.address, 0, 65535)
-    if not 1 <= m.count <= 2000 or m.count.__class__ is bool:
-        raise out_of_range('read_discrete_inputs request', 'count', m.count, 1, 2000)
-    frame = _S_BE_U8_U8_U16_U16.pack(m.unit, 0x02, m.address, m.count)
+    m_unit = m.unit
+    m_address = m.address
+    m_count = m.count
+    if not 0 <= m_unit <= 247 or m_unit.__class__ is bool:
+        raise out_of_range('read_discrete_inputs request', 'unit', m_unit, 1, 247)
+    if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
+        raise out_of_range('read_discrete_inputs request', 'address', m_address, 0, 65535)
+    if not 1 <= m_count <= 2000 or m_count.__class__ is bool:
+        raise out_of_range('read_discrete_inputs request', 'count', m_count, 1, 2000)
+    frame = _S_BE_U8_U8_U16_U16.pack(m_unit, 0x02, m_address, m_count)
     return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_read_discrete_inputs_response(m: ReadDiscreteInputsResponse) -> bytes:
-    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
-        raise out_of_range('read_discrete_inputs response', 'unit', m.unit, 1, 247)
-    if len(m.inputs) > 2000:
-        raise EncodeError('read_discrete_inputs response' + f': inputs has {len(m.inputs)} items, at most 2000 (the limit of the request field count)')
-    v_byte_count = (-(-len(m.inputs) // 8))
+    m_unit = m.unit
+    m_inputs = m.inputs
+    if not 0 <= m_unit <= 247 or m_unit.__class__ is bool:
+        raise out_of_range('read_discrete_inputs response', 'unit', m_unit, 1, 247)
+    if len(m_inputs) > 2000:
+        raise EncodeError('read_discrete_inputs response' + f': inputs has {len(m_inputs)} items, at most 2000 (the limit of the request field count)')
+    v_byte_count = (-(-len(m_inputs) // 8))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('read_discrete_inputs response', 'byte_count', v_byte_count, 0, 255)
-    frame = _S_BE_U8_U8_U8.pack(m.unit, 0x02, v_byte_count) + _pack_bits(m.inputs, 'inputs', 'read_discrete_inputs response')
+    frame = _S_BE_U8_U8_U8.pack(m_unit, 0x02, v_byte_count) + _pack_bits(m_inputs, 'inputs', 'read_discrete_inputs response')
     return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_read_holding_registers_request(m: ReadHoldingRegistersRequest) -> bytes:
-    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
-        raise out_of_range('read_holding_registers request', 'unit', m.unit, 1, 247)
-    if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
-        raise out_of_range('read_holding_registers request', 'address', m.address, 0, 65535)
-    if not 1 <= m.count <= 125 or m.count.__class__ is bool:
-        raise out_of_range('read_holding_registers request', 'count', m.count, 1, 125)
-    frame = _S_BE_U8_U8_U16_U16.pack(m.unit, 0x03, m.address, m.count)
+    m_unit = m.unit
+    m_address = m.address
+    m_count = m.count
+    if not 0 <= m_unit <= 247 or m_unit.__class__ is bool:
+        raise out_of_range('read_holding_registers request', 'unit', m_unit, 1, 247)
+    if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
+        raise out_of_range('read_holding_registers request', 'address', m_address, 0, 65535)
+    if not 1 <= m_count <= 125 or m_count.__class__ is bool:
+        raise out_of_range('read_holding_registers request', 'count', m_count, 1, 125)
+    frame = _S_BE_U8_U8_U16_U16.pack(m_unit, 0x03, m_address, m_count)
     return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_read_holding_registers_response(m: ReadHoldingRegistersResponse) -> bytes:
-    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
-        raise out_of_range('read_holding_registers response', 'unit', m.unit, 1, 247)
-    v_byte_count = (2 * len(m.registers))
+    m_unit = m.unit
+    m_registers = m.registers
+    if not 0 <= m_unit <= 247 or m_unit.__class__ is bool:
+        raise out_of_range('read_holding_registers response', 'unit', m_unit, 1, 247)
+    v_byte_count = (2 * len(m_registers))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('read_holding_registers response', 'byte_count', v_byte_count, 0, 255)
-    for x_registers in m.registers:
+    for x_registers in m_registers:
         if not 0 <= x_registers <= 65535 or x_registers.__class__ is bool:
-            raise out_of_range('read_holding_registers response', 'registers', m.registers, 0, 65535)
-    frame = struct.pack(f'>BBB{len(m.registers)}H', m.unit, 0x03, v_byte_count, *m.registers)
+            raise out_of_range('read_holding_registers response', 'registers', m_registers, 0, 65535)
+    frame = struct.pack(f'>BBB{len(m_registers)}H', m_unit, 0x03, v_byte_count, *m_registers)
     return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_read_input_registers_request(m: ReadInputRegistersRequest) -> bytes:
-    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
-        raise out_of_range('read_input_registers request', 'unit', m.unit, 1, 247)
-    if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
-        raise out_of_range('read_input_registers request', 'address', m.address, 0, 65535)
-    if not 1 <= m.count <= 125 or m.count.__class__ is bool:
-        raise out_of_range('read_input_registers request', 'count', m.count, 1, 125)
-    frame = _S_BE_U8_U8_U16_U16.pack(m.unit, 0x04, m.address, m.count)
+    m_unit = m.unit
+    m_address = m.address
+    m_count = m.count
+    if not 0 <= m_unit <= 247 or m_unit.__class__ is bool:
+        raise out_of_range('read_input_registers request', 'unit', m_unit, 1, 247)
+    if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
+        raise out_of_range('read_input_registers request', 'address', m_address, 0, 65535)
+    if not 1 <= m_count <= 125 or m_count.__class__ is bool:
+        raise out_of_range('read_input_registers request', 'count', m_count, 1, 125)
+    frame = _S_BE_U8_U8_U16_U16.pack(m_unit, 0x04, m_address, m_count)
     return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_read_input_registers_response(m: ReadInputRegistersResponse) -> bytes:
-    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
-        raise out_of_range('read_input_registers response', 'unit', m.unit, 1, 247)
-    v_byte_count = (2 * len(m.registers))
+    m_unit = m.unit
+    m_registers = m.registers
+    if not 0 <= m_unit <= 247 or m_unit.__class__ is bool:
+        raise out_of_range('read_input_registers response', 'unit', m_unit, 1, 247)
+    v_byte_count = (2 * len(m_registers))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('read_input_registers response', 'byte_count', v_byte_count, 0, 255)
-    for x_registers in m.registers:
+    for x_registers in m_registers:
         if not 0 <= x_registers <= 65535 or x_registers.__class__ is bool:
-            raise out_of_range('read_input_registers response', 'registers', m.registers, 0, 65535)
-    frame = struct.pack(f'>BBB{len(m.registers)}H', m.unit, 0x04, v_byte_count, *m.registers)
+            raise out_of_range('read_input_registers response', 'registers', m_registers, 0, 65535)
+    frame = struct.pack(f'>BBB{len(m_registers)}H', m_unit, 0x04, v_byte_count, *m_registers)
     return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_write_coil_request(m: WriteCoilRequest) -> bytes:
-    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
-        raise out_of_range('write_coil request', 'unit', m.unit, 1, 247)
-    if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
-        raise out_of_range('write_coil request', 'address', m.address, 0, 65535)
-    if not 0 <= m.value <= 65280 or m.value.__class__ is bool:
-        raise out_of_range('write_coil request', 'value', m.value, 0, 65280)
-    frame = _S_BE_U8_U8_U16_U16.pack(m.unit, 0x05, m.address, m.value)
+    m_unit = m.unit
+    m_address = m.address
+    m_value = m.value
+    if not 0 <= m_unit <= 247 or m_unit.__class__ is bool:
+        raise out_of_range('write_coil request', 'unit', m_unit, 1, 247)
+    if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
+        raise out_of_range('write_coil request', 'address', m_address, 0, 65535)
+    if not 0 <= m_value <= 65280 or m_value.__class__ is bool:
+        raise out_of_range('write_coil request', 'value', m_value, 0, 65280)
+    frame = _S_BE_U8_U8_U16_U16.pack(m_unit, 0x05, m_address, m_value)
     return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_write_coil_response(m: WriteCoilResponse) -> bytes:
-    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
-        raise out_of_range('write_coil response', 'unit', m.unit, 1, 247)
-    if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
-        raise out_of_range('write_coil response', 'address', m.address, 0, 65535)
-    if not 0 <= m.value <= 65280 or m.value.__class__ is bool:
-        raise out_of_range('write_coil response', 'value', m.value, 0, 65280)
-    frame = _S_BE_U8_U8_U16_U16.pack(m.unit, 0x05, m.address, m.value)
+    m_unit = m.unit
+    m_address = m.address
+    m_value = m.value
+    if not 0 <= m_unit <= 247 or m_unit.__class__ is bool:
+        raise out_of_range('write_coil response', 'unit', m_unit, 1, 247)
+    if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
+        raise out_of_range('write_coil response', 'address', m_address, 0, 65535)
+    if not 0 <= m_value <= 65280 or m_value.__class__ is bool:
+        raise out_of_range('write_coil response', 'value', m_value, 0, 65280)
+    frame = _S_BE_U8_U8_U16_U16.pack(m_unit, 0x05, m_address, m_value)
     return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_write_register_request(m: WriteRegisterRequest) -> bytes:
-    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
-        raise out_of_range('write_register request', 'unit', m.unit, 1, 247)
-    if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
-        raise out_of_range('write_register request', 'address', m.address, 0, 65535)
-    if not 0 <= m.value <= 65535 or m.value.__class__ is bool:
-        raise out_of_range('write_register request', 'value', m.value, 0, 65535)
-    frame = _S_BE_U8_U8_U16_U16.pack(m.unit, 0x06, m.address, m.value)
+    m_unit = m.unit
+    m_address = m.address
+    m_value = m.value
+    if not 0 <= m_unit <= 247 or m_unit.__class__ is bool:
+        raise out_of_range('write_register request', 'unit', m_unit, 1, 247)
+    if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
+        raise out_of_range('write_register request', 'address', m_address, 0, 65535)
+    if not 0 <= m_value <= 65535 or m_value.__class__ is bool:
+        raise out_of_range('write_register request', 'value', m_value, 0, 65535)
+    frame = _S_BE_U8_U8_U16_U16.pack(m_unit, 0x06, m_address, m_value)
     return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_write_register_response(m: WriteRegisterResponse) -> bytes:
-    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
-        raise out_of_range('write_register response', 'unit', m.unit, 1, 247)
-    if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
-        raise out_of_range('write_register response', 'address', m.address, 0, 65535)
-    if not 0 <= m.value <= 65535 or m.value.__class__ is bool:
-        raise out_of_range('write_register response', 'value', m.value, 0, 65535)
-    frame = _S_BE_U8_U8_U16_U16.pack(m.unit, 0x06, m.address, m.value)
+    m_unit = m.unit
+    m_address = m.address
+    m_value = m.value
+    if not 0 <= m_unit <= 247 or m_unit.__class__ is bool:
+        raise out_of_range('write_register response', 'unit', m_unit, 1, 247)
+    if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
+        raise out_of_range('write_register response', 'address', m_address, 0, 65535)
+    if not 0 <= m_value <= 65535 or m_value.__class__ is bool:
+        raise out_of_range('write_register response', 'value', m_value, 0, 65535)
+    frame = _S_BE_U8_U8_U16_U16.pack(m_unit, 0x06, m_address, m_value)
     return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_write_coils_request(m: WriteCoilsRequest) -> bytes:
-    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
-        raise out_of_range('write_coils request', 'unit', m.unit, 1, 247)
-    if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
-        raise out_of_range('write_coils request', 'address', m.address, 0, 65535)
-    v_count = len(m.values)
+    m_unit = m.unit
+    m_address = m.address
+    m_values = m.values
+    if not 0 <= m_unit <= 247 or m_unit.__class__ is bool:
+        raise out_of_range('write_coils request', 'unit', m_unit, 1, 247)
+    if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
+        raise out_of_range('write_coils request', 'address', m_address, 0, 65535)
+    v_count = len(m_values)
     if not 1 <= v_count <= 1968:
         raise out_of_range('write_coils request', 'count', v_count, 1, 1968)
-    v_byte_count = (-(-(len(m.values)) // 8))
+    v_byte_count = (-(-(len(m_values)) // 8))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('write_coils request', 'byte_count', v_byte_count, 0, 255)
-    frame = _S_BE_U8_U8_U16_U16_U8.pack(m.unit, 0x0f, m.address, v_count, v_byte_count) + _pack_bits(m.values, 'values', 'write_coils request')
+    frame = _S_BE_U8_U8_U16_U16_U8.pack(m_unit, 0x0f, m_address, v_count, v_byte_count) + _pack_bits(m_values, 'values', 'write_coils request')
     return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_write_coils_response(m: WriteCoilsResponse) -> bytes:
-    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
-        raise out_of_range('write_coils response', 'unit', m.unit, 1, 247)
-    if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
-        raise out_of_range('write_coils response', 'address', m.address, 0, 65535)
-    if not 0 <= m.count <= 65535 or m.count.__class__ is bool:
-        raise out_of_range('write_coils response', 'count', m.count, 0, 65535)
-    frame = _S_BE_U8_U8_U16_U16.pack(m.unit, 0x0f, m.address, m.count)
+    m_unit = m.unit
+    m_address = m.address
+    m_count = m.count
+    if not 0 <= m_unit <= 247 or m_unit.__class__ is bool:
+        raise out_of_range('write_coils response', 'unit', m_unit, 1, 247)
+    if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
+        raise out_of_range('write_coils response', 'address', m_address, 0, 65535)
+    if not 0 <= m_count <= 65535 or m_count.__class__ is bool:
+        raise out_of_range('write_coils response', 'count', m_count, 0, 65535)
+    frame = _S_BE_U8_U8_U16_U16.pack(m_unit, 0x0f, m_address, m_count)
     return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_write_registers_request(m: WriteRegistersRequest) -> bytes:
-    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
-        raise out_of_range('write_registers request', 'unit', m.unit, 1, 247)
-    if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
-        raise out_of_range('write_registers request', 'address', m.address, 0, 65535)
-    v_count = len(m.values)
+    m_unit = m.unit
+    m_address = m.address
+    m_values = m.values
+    if not 0 <= m_unit <= 247 or m_unit.__class__ is bool:
+        raise out_of_range('write_registers request', 'unit', m_unit, 1, 247)
+    if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
+        raise out_of_range('write_registers request', 'address', m_address, 0, 65535)
+    v_count = len(m_values)
     if not 1 <= v_count <= 123:
         raise out_of_range('write_registers request', 'count', v_count, 1, 123)
-    v_byte_count = (2 * (len(m.values)))
+    v_byte_count = (2 * (len(m_values)))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('write_registers request', 'byte_count', v_byte_count, 0, 255)
-    for x_values in m.values:
+    for x_values in m_values:
         if not 0 <= x_values <= 65535 or x_values.__class__ is bool:
-            raise out_of_range('write_registers request', 'values', m.values, 0, 65535)
-    frame = struct.pack(f'>BBHHB{len(m.values)}H', m.unit, 0x10, m.address, v_count, v_byte_count, *m.values)
+            raise out_of_range('write_registers request', 'values', m_values, 0, 65535)
+    frame = struct.pack(f'>BBHHB{len(m_values)}H', m_unit, 0x10, m_address, v_count, v_byte_count, *m_values)
     return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_write_registers_response(m: WriteRegistersResponse) -> bytes:
-    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
-        raise out_of_range('write_registers response', 'unit', m.unit, 1, 247)
-    if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
-        raise out_of_range('write_registers response', 'address', m.address, 0, 65535)
-    if not 0 <= m.count <= 65535 or m.count.__class__ is bool:
-        raise out_of_range('write_registers response', 'count', m.count, 0, 65535)
-    frame = _S_BE_U8_U8_U16_U16.pack(m.unit, 0x10, m.address, m.count)
+    m_unit = m.unit
+    m_address = m.address
+    m_count = m.count
+    if not 0 <= m_unit <= 247 or m_unit.__class__ is bool:
+        raise out_of_range('write_registers response', 'unit', m_unit, 1, 247)
+    if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
+        raise out_of_range('write_registers response', 'address', m_address, 0, 65535)
+    if not 0 <= m_count <= 65535 or m_count.__class__ is bool:
+        raise out_of_range('write_registers response', 'count', m_count, 0, 65535)
+    frame = _S_BE_U8_U8_U16_U16.pack(m_unit, 0x10, m_address, m_count)
     return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_mask_write_register_request(m: MaskWriteRegisterRequest) -> bytes:
-    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
-        raise out_of_range('mask_write_register request', 'unit', m.unit, 1, 247)
-    if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
-        raise out_of_range('mask_write_register request', 'address', m.address, 0, 65535)
-    if not 0 <= m.and_mask <= 65535 or m.and_mask.__class__ is bool:
-        raise out_of_range('mask_write_register request', 'and_mask', m.and_mask, 0, 65535)
-    if not 0 <= m.or_mask <= 65535 or m.or_mask.__class__ is bool:
-        raise out_of_range('mask_write_register request', 'or_mask', m.or_mask, 0, 65535)
-    frame = _S_BE_U8_U8_U16_U16_U16.pack(m.unit, 0x16, m.address, m.and_mask, m.or_mask)
+    m_unit = m.unit
+    m_address = m.address
+    m_and_mask = m.and_mask
+    m_or_mask = m.or_mask
+    if not 0 <= m_unit <= 247 or m_unit.__class__ is bool:
+        raise out_of_range('mask_write_register request', 'unit', m_unit, 1, 247)
+    if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
+        raise out_of_range('mask_write_register request', 'address', m_address, 0, 65535)
+    if not 0 <= m_and_mask <= 65535 or m_and_mask.__class__ is bool:
+        raise out_of_range('mask_write_register request', 'and_mask', m_and_mask, 0, 65535)
+    if not 0 <= m_or_mask <= 65535 or m_or_mask.__class__ is bool:
+        raise out_of_range('mask_write_register request', 'or_mask', m_or_mask, 0, 65535)
+    frame = _S_BE_U8_U8_U16_U16_U16.pack(m_unit, 0x16, m_address, m_and_mask, m_or_mask)
     return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_mask_write_register_response(m: MaskWriteRegisterResponse) -> bytes:
-    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
-        raise out_of_range('mask_write_register response', 'unit', m.unit, 1, 247)
-    if not 0 <= m.address <= 65535 or m.address.__class__ is bool:
-        raise out_of_range('mask_write_register response', 'address', m.address, 0, 65535)
-    if not 0 <= m.and_mask <= 65535 or m.and_mask.__class__ is bool:
-        raise out_of_range('mask_write_register response', 'and_mask', m.and_mask, 0, 65535)
-    if not 0 <= m.or_mask <= 65535 or m.or_mask.__class__ is bool:
-        raise out_of_range('mask_write_register response', 'or_mask', m.or_mask, 0, 65535)
-    frame = _S_BE_U8_U8_U16_U16_U16.pack(m.unit, 0x16, m.address, m.and_mask, m.or_mask)
+    m_unit = m.unit
+    m_address = m.address
+    m_and_mask = m.and_mask
+    m_or_mask = m.or_mask
+    if not 0 <= m_unit <= 247 or m_unit.__class__ is bool:
+        raise out_of_range('mask_write_register response', 'unit', m_unit, 1, 247)
+    if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
+        raise out_of_range('mask_write_register response', 'address', m_address, 0, 65535)
+    if not 0 <= m_and_mask <= 65535 or m_and_mask.__class__ is bool:
+        raise out_of_range('mask_write_register response', 'and_mask', m_and_mask, 0, 65535)
+    if not 0 <= m_or_mask <= 65535 or m_or_mask.__class__ is bool:
+        raise out_of_range('mask_write_register response', 'or_mask', m_or_mask, 0, 65535)
+    frame = _S_BE_U8_U8_U16_U16_U16.pack(m_unit, 0x16, m_address, m_and_mask, m_or_mask)
     return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_read_write_registers_request(m: ReadWriteRegistersRequest) -> bytes:
-    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
-        raise out_of_range('read_write_registers request', 'unit', m.unit, 1, 247)
-    if not 0 <= m.read_address <= 65535 or m.read_address.__class__ is bool:
-        raise out_of_range('read_write_registers request', 'read_address', m.read_address, 0, 65535)
-    if not 1 <= m.read_count <= 125 or m.read_count.__class__ is bool:
-        raise out_of_range('read_write_registers request', 'read_count', m.read_count, 1, 125)
-    if not 0 <= m.write_address <= 65535 or m.write_address.__class__ is bool:
-        raise out_of_range('read_write_registers request', 'write_address', m.write_address, 0, 65535)
-    v_write_count = len(m.values)
+    m_unit = m.unit
+    m_read_address = m.read_address
+    m_read_count = m.read_count
+    m_write_address = m.write_address
+    m_values = m.values
+    if not 0 <= m_unit <= 247 or m_unit.__class__ is bool:
+        raise out_of_range('read_write_registers request', 'unit', m_unit, 1, 247)
+    if not 0 <= m_read_address <= 65535 or m_read_address.__class__ is bool:
+        raise out_of_range('read_write_registers request', 'read_address', m_read_address, 0, 65535)
+    if not 1 <= m_read_count <= 125 or m_read_count.__class__ is bool:
+        raise out_of_range('read_write_registers request', 'read_count', m_read_count, 1, 125)
+    if not 0 <= m_write_address <= 65535 or m_write_address.__class__ is bool:
+        raise out_of_range('read_write_registers request', 'write_address', m_write_address, 0, 65535)
+    v_write_count = len(m_values)
     if not 1 <= v_write_count <= 121:
         raise out_of_range('read_write_registers request', 'write_count', v_write_count, 1, 121)
-    v_byte_count = (2 * (len(m.values)))
+    v_byte_count = (2 * (len(m_values)))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('read_write_registers request', 'byte_count', v_byte_count, 0, 255)
-    for x_values in m.values:
+    for x_values in m_values:
         if not 0 <= x_values <= 65535 or x_values.__class__ is bool:
-            raise out_of_range('read_write_registers request', 'values', m.values, 0, 65535)
-    frame = struct.pack(f'>BBHHHHB{len(m.values)}H', m.unit, 0x17, m.read_address, m.read_count, m.write_address, v_write_count, v_byte_count, *m.values)
+            raise out_of_range('read_write_registers request', 'values', m_values, 0, 65535)
+    frame = struct.pack(f'>BBHHHHB{len(m_values)}H', m_unit, 0x17, m_read_address, m_read_count, m_write_address, v_write_count, v_byte_count, *m_values)
     return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_read_write_registers_response(m: ReadWriteRegistersResponse) -> bytes:
-    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
-        raise out_of_range('read_write_registers response', 'unit', m.unit, 1, 247)
-    v_byte_count = (2 * len(m.registers))
+    m_unit = m.unit
+    m_registers = m.registers
+    if not 0 <= m_unit <= 247 or m_unit.__class__ is bool:
+        raise out_of_range('read_write_registers response', 'unit', m_unit, 1, 247)
+    v_byte_count = (2 * len(m_registers))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('read_write_registers response', 'byte_count', v_byte_count, 0, 255)
-    for x_registers in m.registers:
+    for x_registers in m_registers:
         if not 0 <= x_registers <= 65535 or x_registers.__class__ is bool:
-            raise out_of_range('read_write_registers response', 'registers', m.registers, 0, 65535)
-    frame = struct.pack(f'>BBB{len(m.registers)}H', m.unit, 0x17, v_byte_count, *m.registers)
+            raise out_of_range('read_write_registers response', 'registers', m_registers, 0, 65535)
+    frame = struct.pack(f'>BBB{len(m_registers)}H', m_unit, 0x17, v_byte_count, *m_registers)
     return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
 def _encode_exception_response(m: ExceptionResponse) -> bytes:
-    if not 0 <= m.unit <= 247 or m.unit.__class__ is bool:
-        raise out_of_range('exception response', 'unit', m.unit, 1, 247)
-    if not 0 <= m.function <= 127 or m.function.__class__ is bool:
-        raise out_of_range('exception response', 'function', m.function, 0, 127)
-    if not 1 <= m.exception_code <= 11 or m.exception_code.__class__ is bool:
-        raise out_of_range('exception response', 'exception_code', m.exception_code, 1, 11)
-    frame = _S_BE_U8_U8_U8.pack(m.unit, m.function | 0x80, m.exception_code)
+    m_unit = m.unit
+    m_function = m.function
+    m_exception_code = m.exception_code
+    if not 0 <= m_unit <= 247 or m_unit.__class__ is bool:
+        raise out_of_range('exception response', 'unit', m_unit, 1, 247)
+    if not 0 <= m_function <= 127 or m_function.__class__ is bool:
+        raise out_of_range('exception response', 'function', m_function, 0, 127)
+    if not 1 <= m_exception_code <= 11 or m_exception_code.__class__ is bool:
+        raise out_of_range('exception response', 'exception_code', m_exception_code, 1, 11)
+    frame = _S_BE_U8_U8_U8.pack(m_unit, m_function | 0x80, m_exception_code)
     return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
@@ -905,9 +845,10 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
 
 def encode(message: Message) -> bytes:
     """Encode a message as a complete frame; raises EncodeError (RangeError for values out of range)."""
-    encoder = _ENCODERS.get(type(message))
-    if encoder is None:
-        raise EncodeError(f"{type(message).__name__} is not a modbus_rtu message")
+    try:
+        encoder = _ENCODERS[type(message)]  # a subscript costs less than .get(); the miss is the rare case
+    except KeyError:
+        raise EncodeError(f"{type(message).__name__} is not a modbus_rtu message") from None
     try:
         return encoder(message)
     except EncodeError:

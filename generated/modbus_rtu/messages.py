@@ -14,8 +14,7 @@ from serialspec.runtime.fields import get as _get
 from serialspec.runtime.fields import integer as _integer
 from serialspec.runtime.fields import integers as _integers
 from serialspec.runtime.message import Direction, Message
-
-_store = object.__setattr__  # how __init__ fills the slots of a frozen class
+from serialspec.runtime.message import build as _build
 
 __all__ = [
     'CoilState',
@@ -82,7 +81,7 @@ class CoilState(IntEnum):
 class ReadCoilsRequest(Message):
     """Read Coils (request)."""
 
-    __slots__ = ('unit', 'address', 'count')
+    __slots__ = ()
     __match_args__ = ('unit', 'address', 'count')
     PROTOCOL: ClassVar[str] = 'modbus_rtu'
     COMMAND: ClassVar[str] = 'read_coils'
@@ -95,15 +94,13 @@ class ReadCoilsRequest(Message):
     #: Quantity of coils. range 1..2000
     count: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         unit: int,
         address: int,
         count: int,
-    ) -> None:
-        _store(self, 'unit', unit)
-        _store(self, 'address', address)
-        _store(self, 'count', count)
+    ) -> Self:
+        return _build(cls, (unit, address, count))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -125,7 +122,7 @@ class ReadCoilsRequest(Message):
 class ReadCoilsResponse(Message):
     """Read Coils (response)."""
 
-    __slots__ = ('unit', 'coils')
+    __slots__ = ()
     __match_args__ = ('unit', 'coils')
     PROTOCOL: ClassVar[str] = 'modbus_rtu'
     COMMAND: ClassVar[str] = 'read_coils'
@@ -136,13 +133,12 @@ class ReadCoilsResponse(Message):
     #: Coil states, 8 per byte, the first coil in the lowest bit of the first byte; the last byte is padded with zeros up to a multiple of 8 (the request's count says how many are coils).
     coils: tuple[bool, ...]
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         unit: int,
         coils: tuple[bool, ...],
-    ) -> None:
-        _store(self, 'unit', unit)
-        _store(self, 'coils', coils)
+    ) -> Self:
+        return _build(cls, (unit, coils))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -162,7 +158,7 @@ class ReadCoilsResponse(Message):
 class ReadDiscreteInputsRequest(Message):
     """Read Discrete Inputs (request)."""
 
-    __slots__ = ('unit', 'address', 'count')
+    __slots__ = ()
     __match_args__ = ('unit', 'address', 'count')
     PROTOCOL: ClassVar[str] = 'modbus_rtu'
     COMMAND: ClassVar[str] = 'read_discrete_inputs'
@@ -175,15 +171,13 @@ class ReadDiscreteInputsRequest(Message):
     #: Quantity of inputs. range 1..2000
     count: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         unit: int,
         address: int,
         count: int,
-    ) -> None:
-        _store(self, 'unit', unit)
-        _store(self, 'address', address)
-        _store(self, 'count', count)
+    ) -> Self:
+        return _build(cls, (unit, address, count))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -205,7 +199,7 @@ class ReadDiscreteInputsRequest(Message):
 class ReadDiscreteInputsResponse(Message):
     """Read Discrete Inputs (response)."""
 
-    __slots__ = ('unit', 'inputs')
+    __slots__ = ()
     __match_args__ = ('unit', 'inputs')
     PROTOCOL: ClassVar[str] = 'modbus_rtu'
     COMMAND: ClassVar[str] = 'read_discrete_inputs'
@@ -216,13 +210,12 @@ class ReadDiscreteInputsResponse(Message):
     #: Input states, 8 per byte, lowest bit first; padded with zeros to a multiple of 8.
     inputs: tuple[bool, ...]
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         unit: int,
         inputs: tuple[bool, ...],
-    ) -> None:
-        _store(self, 'unit', unit)
-        _store(self, 'inputs', inputs)
+    ) -> Self:
+        return _build(cls, (unit, inputs))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -242,7 +235,7 @@ class ReadDiscreteInputsResponse(Message):
 class ReadHoldingRegistersRequest(Message):
     """Read Holding Registers (request)."""
 
-    __slots__ = ('unit', 'address', 'count')
+    __slots__ = ()
     __match_args__ = ('unit', 'address', 'count')
     PROTOCOL: ClassVar[str] = 'modbus_rtu'
     COMMAND: ClassVar[str] = 'read_holding_registers'
@@ -255,15 +248,13 @@ class ReadHoldingRegistersRequest(Message):
     #: Quantity of registers. range 1..125
     count: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         unit: int,
         address: int,
         count: int,
-    ) -> None:
-        _store(self, 'unit', unit)
-        _store(self, 'address', address)
-        _store(self, 'count', count)
+    ) -> Self:
+        return _build(cls, (unit, address, count))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -285,7 +276,7 @@ class ReadHoldingRegistersRequest(Message):
 class ReadHoldingRegistersResponse(Message):
     """Read Holding Registers (response)."""
 
-    __slots__ = ('unit', 'registers')
+    __slots__ = ()
     __match_args__ = ('unit', 'registers')
     PROTOCOL: ClassVar[str] = 'modbus_rtu'
     COMMAND: ClassVar[str] = 'read_holding_registers'
@@ -296,13 +287,12 @@ class ReadHoldingRegistersResponse(Message):
     #: The register values.
     registers: tuple[int, ...]
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         unit: int,
         registers: tuple[int, ...],
-    ) -> None:
-        _store(self, 'unit', unit)
-        _store(self, 'registers', registers)
+    ) -> Self:
+        return _build(cls, (unit, registers))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -322,7 +312,7 @@ class ReadHoldingRegistersResponse(Message):
 class ReadInputRegistersRequest(Message):
     """Read Input Registers (request)."""
 
-    __slots__ = ('unit', 'address', 'count')
+    __slots__ = ()
     __match_args__ = ('unit', 'address', 'count')
     PROTOCOL: ClassVar[str] = 'modbus_rtu'
     COMMAND: ClassVar[str] = 'read_input_registers'
@@ -335,15 +325,13 @@ class ReadInputRegistersRequest(Message):
     #: Quantity of input registers. range 1..125
     count: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         unit: int,
         address: int,
         count: int,
-    ) -> None:
-        _store(self, 'unit', unit)
-        _store(self, 'address', address)
-        _store(self, 'count', count)
+    ) -> Self:
+        return _build(cls, (unit, address, count))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -365,7 +353,7 @@ class ReadInputRegistersRequest(Message):
 class ReadInputRegistersResponse(Message):
     """Read Input Registers (response)."""
 
-    __slots__ = ('unit', 'registers')
+    __slots__ = ()
     __match_args__ = ('unit', 'registers')
     PROTOCOL: ClassVar[str] = 'modbus_rtu'
     COMMAND: ClassVar[str] = 'read_input_registers'
@@ -376,13 +364,12 @@ class ReadInputRegistersResponse(Message):
     #: The input register values.
     registers: tuple[int, ...]
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         unit: int,
         registers: tuple[int, ...],
-    ) -> None:
-        _store(self, 'unit', unit)
-        _store(self, 'registers', registers)
+    ) -> Self:
+        return _build(cls, (unit, registers))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -402,7 +389,7 @@ class ReadInputRegistersResponse(Message):
 class WriteCoilRequest(Message):
     """Write Single Coil (request)."""
 
-    __slots__ = ('unit', 'address', 'value')
+    __slots__ = ()
     __match_args__ = ('unit', 'address', 'value')
     PROTOCOL: ClassVar[str] = 'modbus_rtu'
     COMMAND: ClassVar[str] = 'write_coil'
@@ -415,15 +402,13 @@ class WriteCoilRequest(Message):
     #: FF 00: ON, 00 00: OFF. range 0..65280
     value: CoilState | int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         unit: int,
         address: int,
         value: CoilState | int,
-    ) -> None:
-        _store(self, 'unit', unit)
-        _store(self, 'address', address)
-        _store(self, 'value', value)
+    ) -> Self:
+        return _build(cls, (unit, address, value))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -445,7 +430,7 @@ class WriteCoilRequest(Message):
 class WriteCoilResponse(Message):
     """Write Single Coil (response)."""
 
-    __slots__ = ('unit', 'address', 'value')
+    __slots__ = ()
     __match_args__ = ('unit', 'address', 'value')
     PROTOCOL: ClassVar[str] = 'modbus_rtu'
     COMMAND: ClassVar[str] = 'write_coil'
@@ -458,15 +443,13 @@ class WriteCoilResponse(Message):
     #: The value written. range 0..65280
     value: CoilState | int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         unit: int,
         address: int,
         value: CoilState | int,
-    ) -> None:
-        _store(self, 'unit', unit)
-        _store(self, 'address', address)
-        _store(self, 'value', value)
+    ) -> Self:
+        return _build(cls, (unit, address, value))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -488,7 +471,7 @@ class WriteCoilResponse(Message):
 class WriteRegisterRequest(Message):
     """Write Single Register (request)."""
 
-    __slots__ = ('unit', 'address', 'value')
+    __slots__ = ()
     __match_args__ = ('unit', 'address', 'value')
     PROTOCOL: ClassVar[str] = 'modbus_rtu'
     COMMAND: ClassVar[str] = 'write_register'
@@ -501,15 +484,13 @@ class WriteRegisterRequest(Message):
     #: The value to write.
     value: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         unit: int,
         address: int,
         value: int,
-    ) -> None:
-        _store(self, 'unit', unit)
-        _store(self, 'address', address)
-        _store(self, 'value', value)
+    ) -> Self:
+        return _build(cls, (unit, address, value))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -531,7 +512,7 @@ class WriteRegisterRequest(Message):
 class WriteRegisterResponse(Message):
     """Write Single Register (response)."""
 
-    __slots__ = ('unit', 'address', 'value')
+    __slots__ = ()
     __match_args__ = ('unit', 'address', 'value')
     PROTOCOL: ClassVar[str] = 'modbus_rtu'
     COMMAND: ClassVar[str] = 'write_register'
@@ -544,15 +525,13 @@ class WriteRegisterResponse(Message):
     #: The value written.
     value: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         unit: int,
         address: int,
         value: int,
-    ) -> None:
-        _store(self, 'unit', unit)
-        _store(self, 'address', address)
-        _store(self, 'value', value)
+    ) -> Self:
+        return _build(cls, (unit, address, value))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -574,7 +553,7 @@ class WriteRegisterResponse(Message):
 class WriteCoilsRequest(Message):
     """Write Multiple Coils (request)."""
 
-    __slots__ = ('unit', 'address', 'values')
+    __slots__ = ()
     __match_args__ = ('unit', 'address', 'values')
     PROTOCOL: ClassVar[str] = 'modbus_rtu'
     COMMAND: ClassVar[str] = 'write_coils'
@@ -587,15 +566,13 @@ class WriteCoilsRequest(Message):
     #: The coil values, 8 per byte, lowest bit first; the last byte padded with zeros.
     values: tuple[bool, ...]
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         unit: int,
         address: int,
         values: tuple[bool, ...],
-    ) -> None:
-        _store(self, 'unit', unit)
-        _store(self, 'address', address)
-        _store(self, 'values', values)
+    ) -> Self:
+        return _build(cls, (unit, address, values))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -617,7 +594,7 @@ class WriteCoilsRequest(Message):
 class WriteCoilsResponse(Message):
     """Write Multiple Coils (response)."""
 
-    __slots__ = ('unit', 'address', 'count')
+    __slots__ = ()
     __match_args__ = ('unit', 'address', 'count')
     PROTOCOL: ClassVar[str] = 'modbus_rtu'
     COMMAND: ClassVar[str] = 'write_coils'
@@ -630,15 +607,13 @@ class WriteCoilsResponse(Message):
     #: Quantity of outputs written.
     count: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         unit: int,
         address: int,
         count: int,
-    ) -> None:
-        _store(self, 'unit', unit)
-        _store(self, 'address', address)
-        _store(self, 'count', count)
+    ) -> Self:
+        return _build(cls, (unit, address, count))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -660,7 +635,7 @@ class WriteCoilsResponse(Message):
 class WriteRegistersRequest(Message):
     """Write Multiple Registers (request)."""
 
-    __slots__ = ('unit', 'address', 'values')
+    __slots__ = ()
     __match_args__ = ('unit', 'address', 'values')
     PROTOCOL: ClassVar[str] = 'modbus_rtu'
     COMMAND: ClassVar[str] = 'write_registers'
@@ -673,15 +648,13 @@ class WriteRegistersRequest(Message):
     #: The register values.
     values: tuple[int, ...]
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         unit: int,
         address: int,
         values: tuple[int, ...],
-    ) -> None:
-        _store(self, 'unit', unit)
-        _store(self, 'address', address)
-        _store(self, 'values', values)
+    ) -> Self:
+        return _build(cls, (unit, address, values))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -703,7 +676,7 @@ class WriteRegistersRequest(Message):
 class WriteRegistersResponse(Message):
     """Write Multiple Registers (response)."""
 
-    __slots__ = ('unit', 'address', 'count')
+    __slots__ = ()
     __match_args__ = ('unit', 'address', 'count')
     PROTOCOL: ClassVar[str] = 'modbus_rtu'
     COMMAND: ClassVar[str] = 'write_registers'
@@ -716,15 +689,13 @@ class WriteRegistersResponse(Message):
     #: Quantity of registers written.
     count: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         unit: int,
         address: int,
         count: int,
-    ) -> None:
-        _store(self, 'unit', unit)
-        _store(self, 'address', address)
-        _store(self, 'count', count)
+    ) -> Self:
+        return _build(cls, (unit, address, count))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -746,7 +717,7 @@ class WriteRegistersResponse(Message):
 class MaskWriteRegisterRequest(Message):
     """Mask Write Register (request)."""
 
-    __slots__ = ('unit', 'address', 'and_mask', 'or_mask')
+    __slots__ = ()
     __match_args__ = ('unit', 'address', 'and_mask', 'or_mask')
     PROTOCOL: ClassVar[str] = 'modbus_rtu'
     COMMAND: ClassVar[str] = 'mask_write_register'
@@ -761,17 +732,14 @@ class MaskWriteRegisterRequest(Message):
     #: Bits set where and_mask is 0.
     or_mask: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         unit: int,
         address: int,
         and_mask: int,
         or_mask: int,
-    ) -> None:
-        _store(self, 'unit', unit)
-        _store(self, 'address', address)
-        _store(self, 'and_mask', and_mask)
-        _store(self, 'or_mask', or_mask)
+    ) -> Self:
+        return _build(cls, (unit, address, and_mask, or_mask))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -795,7 +763,7 @@ class MaskWriteRegisterRequest(Message):
 class MaskWriteRegisterResponse(Message):
     """Mask Write Register (response)."""
 
-    __slots__ = ('unit', 'address', 'and_mask', 'or_mask')
+    __slots__ = ()
     __match_args__ = ('unit', 'address', 'and_mask', 'or_mask')
     PROTOCOL: ClassVar[str] = 'modbus_rtu'
     COMMAND: ClassVar[str] = 'mask_write_register'
@@ -810,17 +778,14 @@ class MaskWriteRegisterResponse(Message):
     #: The OR mask.
     or_mask: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         unit: int,
         address: int,
         and_mask: int,
         or_mask: int,
-    ) -> None:
-        _store(self, 'unit', unit)
-        _store(self, 'address', address)
-        _store(self, 'and_mask', and_mask)
-        _store(self, 'or_mask', or_mask)
+    ) -> Self:
+        return _build(cls, (unit, address, and_mask, or_mask))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -844,7 +809,7 @@ class MaskWriteRegisterResponse(Message):
 class ReadWriteRegistersRequest(Message):
     """Read/Write Multiple Registers (request)."""
 
-    __slots__ = ('unit', 'read_address', 'read_count', 'write_address', 'values')
+    __slots__ = ()
     __match_args__ = ('unit', 'read_address', 'read_count', 'write_address', 'values')
     PROTOCOL: ClassVar[str] = 'modbus_rtu'
     COMMAND: ClassVar[str] = 'read_write_registers'
@@ -861,19 +826,15 @@ class ReadWriteRegistersRequest(Message):
     #: The values to write.
     values: tuple[int, ...]
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         unit: int,
         read_address: int,
         read_count: int,
         write_address: int,
         values: tuple[int, ...],
-    ) -> None:
-        _store(self, 'unit', unit)
-        _store(self, 'read_address', read_address)
-        _store(self, 'read_count', read_count)
-        _store(self, 'write_address', write_address)
-        _store(self, 'values', values)
+    ) -> Self:
+        return _build(cls, (unit, read_address, read_count, write_address, values))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -899,7 +860,7 @@ class ReadWriteRegistersRequest(Message):
 class ReadWriteRegistersResponse(Message):
     """Read/Write Multiple Registers (response)."""
 
-    __slots__ = ('unit', 'registers')
+    __slots__ = ()
     __match_args__ = ('unit', 'registers')
     PROTOCOL: ClassVar[str] = 'modbus_rtu'
     COMMAND: ClassVar[str] = 'read_write_registers'
@@ -910,13 +871,12 @@ class ReadWriteRegistersResponse(Message):
     #: The registers read.
     registers: tuple[int, ...]
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         unit: int,
         registers: tuple[int, ...],
-    ) -> None:
-        _store(self, 'unit', unit)
-        _store(self, 'registers', registers)
+    ) -> Self:
+        return _build(cls, (unit, registers))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -936,7 +896,7 @@ class ReadWriteRegistersResponse(Message):
 class ExceptionResponse(Message):
     """Exception reply (response)."""
 
-    __slots__ = ('unit', 'function', 'exception_code')
+    __slots__ = ()
     __match_args__ = ('unit', 'function', 'exception_code')
     PROTOCOL: ClassVar[str] = 'modbus_rtu'
     COMMAND: ClassVar[str] = 'exception'
@@ -949,15 +909,13 @@ class ExceptionResponse(Message):
     #: Why the request was refused. range 1..11
     exception_code: ExceptionCode | int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         unit: int,
         function: int,
         exception_code: ExceptionCode | int,
-    ) -> None:
-        _store(self, 'unit', unit)
-        _store(self, 'function', function)
-        _store(self, 'exception_code', exception_code)
+    ) -> Self:
+        return _build(cls, (unit, function, exception_code))
 
     def to_fields(self) -> dict[str, Any]:
         return {

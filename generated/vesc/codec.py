@@ -11,7 +11,8 @@ from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError, c
 from serialspec.runtime.fields import wrong_type
 from serialspec.runtime.framing import Element, EngineFormat, FrameCodec, Layout
 from serialspec.runtime.framing import FrameStreamParser as _FrameStreamParser
-from serialspec.runtime.message import Direction, Message, members, slot_setters
+from serialspec.runtime.message import Direction, Message, members
+from serialspec.runtime.message import build as _new  # a message from the tuple of its field values, in one call
 from serialspec.runtime.packing import decode_text as _decode_text
 from serialspec.runtime.packing import encode_text as _encode_text
 
@@ -50,60 +51,6 @@ _S_BE_U8 = struct.Struct('>B')
 _S_BE_U8_U8 = struct.Struct('>BB')
 _CHECK_CRC: Callable[[bytes], int] = crc_function(16, 0x1021, 0x0, False, False, 0x0)  # CRC-16/XMODEM
 
-# Decoders build messages with object.__new__ and store each value straight into its slot: a message's __init__
-# (frozen) goes through object.__setattr__ per field, which costs more than unpacking the whole frame.
-_new = object.__new__
-_set_ForwardCanRequest_can_id, _set_ForwardCanRequest_payload = slot_setters(ForwardCanRequest)
-(
-    _set_FwVersionResponse_major,
-    _set_FwVersionResponse_minor,
-    _set_FwVersionResponse_hw_name,
-    _set_FwVersionResponse_uuid,
-    _set_FwVersionResponse_pairing_done,
-    _set_FwVersionResponse_test_version,
-    _set_FwVersionResponse_hw_type,
-    _set_FwVersionResponse_custom_config_count,
-    _set_FwVersionResponse_phase_filters,
-    _set_FwVersionResponse_qml_hw,
-    _set_FwVersionResponse_qml_app,
-    _set_FwVersionResponse_nrf_flags,
-    _set_FwVersionResponse_fw_name,
-    _set_FwVersionResponse_hw_crc,
-) = slot_setters(FwVersionResponse)
-(
-    _set_GetValuesResponse_temp_fet,
-    _set_GetValuesResponse_temp_motor,
-    _set_GetValuesResponse_avg_motor_current,
-    _set_GetValuesResponse_avg_input_current,
-    _set_GetValuesResponse_avg_id,
-    _set_GetValuesResponse_avg_iq,
-    _set_GetValuesResponse_duty_now,
-    _set_GetValuesResponse_rpm,
-    _set_GetValuesResponse_v_in,
-    _set_GetValuesResponse_amp_hours,
-    _set_GetValuesResponse_amp_hours_charged,
-    _set_GetValuesResponse_watt_hours,
-    _set_GetValuesResponse_watt_hours_charged,
-    _set_GetValuesResponse_tachometer,
-    _set_GetValuesResponse_tachometer_abs,
-    _set_GetValuesResponse_fault,
-    _set_GetValuesResponse_pid_pos,
-    _set_GetValuesResponse_controller_id,
-    _set_GetValuesResponse_temp_mos1,
-    _set_GetValuesResponse_temp_mos2,
-    _set_GetValuesResponse_temp_mos3,
-    _set_GetValuesResponse_avg_vd,
-    _set_GetValuesResponse_avg_vq,
-    _set_GetValuesResponse_status,
-) = slot_setters(GetValuesResponse)
-(_set_PrintResponse_text,) = slot_setters(PrintResponse)
-(_set_RotorPositionResponse_position,) = slot_setters(RotorPositionResponse)
-(_set_SetCurrentBrakeRequest_current,) = slot_setters(SetCurrentBrakeRequest)
-(_set_SetCurrentRequest_current,) = slot_setters(SetCurrentRequest)
-(_set_SetDutyRequest_duty,) = slot_setters(SetDutyRequest)
-(_set_SetHandbrakeRequest_current,) = slot_setters(SetHandbrakeRequest)
-(_set_SetPosRequest_position,) = slot_setters(SetPosRequest)
-(_set_SetRpmRequest_rpm,) = slot_setters(SetRpmRequest)
 _MEMBERS_FaultCode = members(FaultCode)
 _MEMBERS_HwType = members(HwType)
 _MEMBERS_ValuesStatus = members(ValuesStatus)
@@ -112,8 +59,7 @@ _MEMBERS_ValuesStatus = members(ValuesStatus)
 def _decode_fw_version_request(buf: bytes, o: int, end: int) -> FwVersionRequest:
     if end - o != 0:
         raise content_size_error('fw_version request', end - o, 0, 0)
-    m = _new(FwVersionRequest)
-    return m
+    return _new(FwVersionRequest, ())
 
 
 def _decode_fw_version_response(buf: bytes, o: int, end: int) -> FwVersionResponse:
@@ -141,29 +87,13 @@ def _decode_fw_version_response(buf: bytes, o: int, end: int) -> FwVersionRespon
     o += 4
     if o != end:
         raise DecodeError('fw_version response' + f': {end - o} bytes left after the last field')
-    m = _new(FwVersionResponse)
-    _set_FwVersionResponse_major(m, v_major)
-    _set_FwVersionResponse_minor(m, v_minor)
-    _set_FwVersionResponse_hw_name(m, v_hw_name)
-    _set_FwVersionResponse_uuid(m, v_uuid)
-    _set_FwVersionResponse_pairing_done(m, v_pairing_done)
-    _set_FwVersionResponse_test_version(m, v_test_version)
-    _set_FwVersionResponse_hw_type(m, _MEMBERS_HwType.get(v_hw_type, v_hw_type))
-    _set_FwVersionResponse_custom_config_count(m, v_custom_config_count)
-    _set_FwVersionResponse_phase_filters(m, v_phase_filters)
-    _set_FwVersionResponse_qml_hw(m, v_qml_hw)
-    _set_FwVersionResponse_qml_app(m, v_qml_app)
-    _set_FwVersionResponse_nrf_flags(m, v_nrf_flags)
-    _set_FwVersionResponse_fw_name(m, v_fw_name)
-    _set_FwVersionResponse_hw_crc(m, v_hw_crc)
-    return m
+    return _new(FwVersionResponse, (v_major, v_minor, v_hw_name, v_uuid, v_pairing_done, v_test_version, _MEMBERS_HwType.get(v_hw_type, v_hw_type), v_custom_config_count, v_phase_filters, v_qml_hw, v_qml_app, v_nrf_flags, v_fw_name, v_hw_crc))
 
 
 def _decode_get_values_request(buf: bytes, o: int, end: int) -> GetValuesRequest:
     if end - o != 0:
         raise content_size_error('get_values request', end - o, 0, 0)
-    m = _new(GetValuesRequest)
-    return m
+    return _new(GetValuesRequest, ())
 
 
 def _decode_get_values_response(buf: bytes, o: int, end: int) -> GetValuesResponse:
@@ -173,86 +103,43 @@ def _decode_get_values_response(buf: bytes, o: int, end: int) -> GetValuesRespon
     v_status_flags = _MEMBERS_ValuesStatus.get(v_status)
     if v_status_flags is None:
         v_status_flags = ValuesStatus(v_status)
-    m = _new(GetValuesResponse)
-    _set_GetValuesResponse_temp_fet(m, v_temp_fet)
-    _set_GetValuesResponse_temp_motor(m, v_temp_motor)
-    _set_GetValuesResponse_avg_motor_current(m, v_avg_motor_current)
-    _set_GetValuesResponse_avg_input_current(m, v_avg_input_current)
-    _set_GetValuesResponse_avg_id(m, v_avg_id)
-    _set_GetValuesResponse_avg_iq(m, v_avg_iq)
-    _set_GetValuesResponse_duty_now(m, v_duty_now)
-    _set_GetValuesResponse_rpm(m, v_rpm)
-    _set_GetValuesResponse_v_in(m, v_v_in)
-    _set_GetValuesResponse_amp_hours(m, v_amp_hours)
-    _set_GetValuesResponse_amp_hours_charged(m, v_amp_hours_charged)
-    _set_GetValuesResponse_watt_hours(m, v_watt_hours)
-    _set_GetValuesResponse_watt_hours_charged(m, v_watt_hours_charged)
-    _set_GetValuesResponse_tachometer(m, v_tachometer)
-    _set_GetValuesResponse_tachometer_abs(m, v_tachometer_abs)
-    _set_GetValuesResponse_fault(m, _MEMBERS_FaultCode.get(v_fault, v_fault))
-    _set_GetValuesResponse_pid_pos(m, v_pid_pos)
-    _set_GetValuesResponse_controller_id(m, v_controller_id)
-    _set_GetValuesResponse_temp_mos1(m, v_temp_mos1)
-    _set_GetValuesResponse_temp_mos2(m, v_temp_mos2)
-    _set_GetValuesResponse_temp_mos3(m, v_temp_mos3)
-    _set_GetValuesResponse_avg_vd(m, v_avg_vd)
-    _set_GetValuesResponse_avg_vq(m, v_avg_vq)
-    _set_GetValuesResponse_status(m, v_status_flags)
-    return m
+    return _new(GetValuesResponse, (v_temp_fet, v_temp_motor, v_avg_motor_current, v_avg_input_current, v_avg_id, v_avg_iq, v_duty_now, v_rpm, v_v_in, v_amp_hours, v_amp_hours_charged, v_watt_hours, v_watt_hours_charged, v_tachometer, v_tachometer_abs, _MEMBERS_FaultCode.get(v_fault, v_fault), v_pid_pos, v_controller_id, v_temp_mos1, v_temp_mos2, v_temp_mos3, v_avg_vd, v_avg_vq, v_status_flags))
 
 
 def _decode_set_duty_request(buf: bytes, o: int, end: int) -> SetDutyRequest:
     if end - o != 4:
         raise content_size_error('set_duty request', end - o, 4, 4)
-    v_duty, = _S_BE_I32.unpack_from(buf, o)
-    m = _new(SetDutyRequest)
-    _set_SetDutyRequest_duty(m, v_duty)
-    return m
+    return _new(SetDutyRequest, _S_BE_I32.unpack_from(buf, o))
 
 
 def _decode_set_current_request(buf: bytes, o: int, end: int) -> SetCurrentRequest:
     if end - o != 4:
         raise content_size_error('set_current request', end - o, 4, 4)
-    v_current, = _S_BE_I32.unpack_from(buf, o)
-    m = _new(SetCurrentRequest)
-    _set_SetCurrentRequest_current(m, v_current)
-    return m
+    return _new(SetCurrentRequest, _S_BE_I32.unpack_from(buf, o))
 
 
 def _decode_set_current_brake_request(buf: bytes, o: int, end: int) -> SetCurrentBrakeRequest:
     if end - o != 4:
         raise content_size_error('set_current_brake request', end - o, 4, 4)
-    v_current, = _S_BE_I32.unpack_from(buf, o)
-    m = _new(SetCurrentBrakeRequest)
-    _set_SetCurrentBrakeRequest_current(m, v_current)
-    return m
+    return _new(SetCurrentBrakeRequest, _S_BE_I32.unpack_from(buf, o))
 
 
 def _decode_set_rpm_request(buf: bytes, o: int, end: int) -> SetRpmRequest:
     if end - o != 4:
         raise content_size_error('set_rpm request', end - o, 4, 4)
-    v_rpm, = _S_BE_I32.unpack_from(buf, o)
-    m = _new(SetRpmRequest)
-    _set_SetRpmRequest_rpm(m, v_rpm)
-    return m
+    return _new(SetRpmRequest, _S_BE_I32.unpack_from(buf, o))
 
 
 def _decode_set_pos_request(buf: bytes, o: int, end: int) -> SetPosRequest:
     if end - o != 4:
         raise content_size_error('set_pos request', end - o, 4, 4)
-    v_position, = _S_BE_I32.unpack_from(buf, o)
-    m = _new(SetPosRequest)
-    _set_SetPosRequest_position(m, v_position)
-    return m
+    return _new(SetPosRequest, _S_BE_I32.unpack_from(buf, o))
 
 
 def _decode_set_handbrake_request(buf: bytes, o: int, end: int) -> SetHandbrakeRequest:
     if end - o != 4:
         raise content_size_error('set_handbrake request', end - o, 4, 4)
-    v_current, = _S_BE_I32.unpack_from(buf, o)
-    m = _new(SetHandbrakeRequest)
-    _set_SetHandbrakeRequest_current(m, v_current)
-    return m
+    return _new(SetHandbrakeRequest, _S_BE_I32.unpack_from(buf, o))
 
 
 def _decode_print_response(buf: bytes, o: int, end: int) -> PrintResponse:
@@ -260,37 +147,28 @@ def _decode_print_response(buf: bytes, o: int, end: int) -> PrintResponse:
     o = end
     if o != end:
         raise DecodeError('print response' + f': {end - o} bytes left after the last field')
-    m = _new(PrintResponse)
-    _set_PrintResponse_text(m, v_text)
-    return m
+    return _new(PrintResponse, (v_text,))
 
 
 def _decode_rotor_position_response(buf: bytes, o: int, end: int) -> RotorPositionResponse:
     if end - o != 4:
         raise content_size_error('rotor_position response', end - o, 4, 4)
-    v_position, = _S_BE_I32.unpack_from(buf, o)
-    m = _new(RotorPositionResponse)
-    _set_RotorPositionResponse_position(m, v_position)
-    return m
+    return _new(RotorPositionResponse, _S_BE_I32.unpack_from(buf, o))
 
 
 def _decode_alive_request(buf: bytes, o: int, end: int) -> AliveRequest:
     if end - o != 0:
         raise content_size_error('alive request', end - o, 0, 0)
-    m = _new(AliveRequest)
-    return m
+    return _new(AliveRequest, ())
 
 
 def _decode_forward_can_request(buf: bytes, o: int, end: int) -> ForwardCanRequest:
     if end - o < 1:
         raise content_size_error('forward_can request', end - o, 1, None)
-    v_can_id, = _S_BE_U8.unpack_from(buf, o)
+    v_can_id = buf[o]
     o += 1
     v_payload = buf[o:end]
-    m = _new(ForwardCanRequest)
-    _set_ForwardCanRequest_can_id(m, v_can_id)
-    _set_ForwardCanRequest_payload(m, v_payload)
-    return m
+    return _new(ForwardCanRequest, (v_can_id, v_payload))
 
 
 def _encode_fw_version_request(m: FwVersionRequest) -> bytes:
@@ -299,31 +177,43 @@ def _encode_fw_version_request(m: FwVersionRequest) -> bytes:
 
 
 def _encode_fw_version_response(m: FwVersionResponse) -> bytes:
-    if not 0 <= m.major <= 255 or m.major.__class__ is bool:
-        raise out_of_range('fw_version response', 'major', m.major, 0, 255)
-    if not 0 <= m.minor <= 255 or m.minor.__class__ is bool:
-        raise out_of_range('fw_version response', 'minor', m.minor, 0, 255)
-    if len(m.uuid) != 12:
-        raise EncodeError('fw_version response' + f': uuid needs 12 bytes, got {len(m.uuid)}')
-    if not 0 <= m.pairing_done <= 255 or m.pairing_done.__class__ is bool:
-        raise out_of_range('fw_version response', 'pairing_done', m.pairing_done, 0, 255)
-    if not 0 <= m.test_version <= 255 or m.test_version.__class__ is bool:
-        raise out_of_range('fw_version response', 'test_version', m.test_version, 0, 255)
-    if not 0 <= m.hw_type <= 2 or m.hw_type.__class__ is bool:
-        raise out_of_range('fw_version response', 'hw_type', m.hw_type, 0, 2)
-    if not 0 <= m.custom_config_count <= 255 or m.custom_config_count.__class__ is bool:
-        raise out_of_range('fw_version response', 'custom_config_count', m.custom_config_count, 0, 255)
-    if not 0 <= m.phase_filters <= 255 or m.phase_filters.__class__ is bool:
-        raise out_of_range('fw_version response', 'phase_filters', m.phase_filters, 0, 255)
-    if not 0 <= m.qml_hw <= 255 or m.qml_hw.__class__ is bool:
-        raise out_of_range('fw_version response', 'qml_hw', m.qml_hw, 0, 255)
-    if not 0 <= m.qml_app <= 255 or m.qml_app.__class__ is bool:
-        raise out_of_range('fw_version response', 'qml_app', m.qml_app, 0, 255)
-    if not 0 <= m.nrf_flags <= 255 or m.nrf_flags.__class__ is bool:
-        raise out_of_range('fw_version response', 'nrf_flags', m.nrf_flags, 0, 255)
-    if not 0 <= m.hw_crc <= 4294967295 or m.hw_crc.__class__ is bool:
-        raise out_of_range('fw_version response', 'hw_crc', m.hw_crc, 0, 4294967295)
-    return _wrap_response(b''.join((_S_BE_U8_U8.pack(m.major, m.minor), _encode_text(m.hw_name, 'hw_name', 'fw_version response', True), _S_BE_FWVERSIONRESPONSE_UUID.pack(m.uuid, m.pairing_done, m.test_version, m.hw_type, m.custom_config_count, m.phase_filters, m.qml_hw, m.qml_app, m.nrf_flags), _encode_text(m.fw_name, 'fw_name', 'fw_version response', True), _S_BE_U32.pack(m.hw_crc),)), 0x00)
+    m_major = m.major
+    m_minor = m.minor
+    m_uuid = m.uuid
+    m_pairing_done = m.pairing_done
+    m_test_version = m.test_version
+    m_hw_type = m.hw_type
+    m_custom_config_count = m.custom_config_count
+    m_phase_filters = m.phase_filters
+    m_qml_hw = m.qml_hw
+    m_qml_app = m.qml_app
+    m_nrf_flags = m.nrf_flags
+    m_hw_crc = m.hw_crc
+    if not 0 <= m_major <= 255 or m_major.__class__ is bool:
+        raise out_of_range('fw_version response', 'major', m_major, 0, 255)
+    if not 0 <= m_minor <= 255 or m_minor.__class__ is bool:
+        raise out_of_range('fw_version response', 'minor', m_minor, 0, 255)
+    if len(m_uuid) != 12:
+        raise EncodeError('fw_version response' + f': uuid needs 12 bytes, got {len(m_uuid)}')
+    if not 0 <= m_pairing_done <= 255 or m_pairing_done.__class__ is bool:
+        raise out_of_range('fw_version response', 'pairing_done', m_pairing_done, 0, 255)
+    if not 0 <= m_test_version <= 255 or m_test_version.__class__ is bool:
+        raise out_of_range('fw_version response', 'test_version', m_test_version, 0, 255)
+    if not 0 <= m_hw_type <= 2 or m_hw_type.__class__ is bool:
+        raise out_of_range('fw_version response', 'hw_type', m_hw_type, 0, 2)
+    if not 0 <= m_custom_config_count <= 255 or m_custom_config_count.__class__ is bool:
+        raise out_of_range('fw_version response', 'custom_config_count', m_custom_config_count, 0, 255)
+    if not 0 <= m_phase_filters <= 255 or m_phase_filters.__class__ is bool:
+        raise out_of_range('fw_version response', 'phase_filters', m_phase_filters, 0, 255)
+    if not 0 <= m_qml_hw <= 255 or m_qml_hw.__class__ is bool:
+        raise out_of_range('fw_version response', 'qml_hw', m_qml_hw, 0, 255)
+    if not 0 <= m_qml_app <= 255 or m_qml_app.__class__ is bool:
+        raise out_of_range('fw_version response', 'qml_app', m_qml_app, 0, 255)
+    if not 0 <= m_nrf_flags <= 255 or m_nrf_flags.__class__ is bool:
+        raise out_of_range('fw_version response', 'nrf_flags', m_nrf_flags, 0, 255)
+    if not 0 <= m_hw_crc <= 4294967295 or m_hw_crc.__class__ is bool:
+        raise out_of_range('fw_version response', 'hw_crc', m_hw_crc, 0, 4294967295)
+    return _wrap_response(b''.join((_S_BE_U8_U8.pack(m_major, m_minor), _encode_text(m.hw_name, 'hw_name', 'fw_version response', True), _S_BE_FWVERSIONRESPONSE_UUID.pack(m_uuid, m_pairing_done, m_test_version, m_hw_type, m_custom_config_count, m_phase_filters, m_qml_hw, m_qml_app, m_nrf_flags), _encode_text(m.fw_name, 'fw_name', 'fw_version response', True), _S_BE_U32.pack(m_hw_crc),)), 0x00)
 
 
 def _encode_get_values_request(m: GetValuesRequest) -> bytes:
@@ -332,97 +222,127 @@ def _encode_get_values_request(m: GetValuesRequest) -> bytes:
 
 
 def _encode_get_values_response(m: GetValuesResponse) -> bytes:
-    if not -32768 <= m.temp_fet <= 32767 or m.temp_fet.__class__ is bool:
-        raise out_of_range('get_values response', 'temp_fet', m.temp_fet, -32768, 32767)
-    if not -32768 <= m.temp_motor <= 32767 or m.temp_motor.__class__ is bool:
-        raise out_of_range('get_values response', 'temp_motor', m.temp_motor, -32768, 32767)
-    if not -2147483648 <= m.avg_motor_current <= 2147483647 or m.avg_motor_current.__class__ is bool:
-        raise out_of_range('get_values response', 'avg_motor_current', m.avg_motor_current, -2147483648, 2147483647)
-    if not -2147483648 <= m.avg_input_current <= 2147483647 or m.avg_input_current.__class__ is bool:
-        raise out_of_range('get_values response', 'avg_input_current', m.avg_input_current, -2147483648, 2147483647)
-    if not -2147483648 <= m.avg_id <= 2147483647 or m.avg_id.__class__ is bool:
-        raise out_of_range('get_values response', 'avg_id', m.avg_id, -2147483648, 2147483647)
-    if not -2147483648 <= m.avg_iq <= 2147483647 or m.avg_iq.__class__ is bool:
-        raise out_of_range('get_values response', 'avg_iq', m.avg_iq, -2147483648, 2147483647)
-    if not -32768 <= m.duty_now <= 32767 or m.duty_now.__class__ is bool:
-        raise out_of_range('get_values response', 'duty_now', m.duty_now, -32768, 32767)
-    if not -2147483648 <= m.rpm <= 2147483647 or m.rpm.__class__ is bool:
-        raise out_of_range('get_values response', 'rpm', m.rpm, -2147483648, 2147483647)
-    if not -32768 <= m.v_in <= 32767 or m.v_in.__class__ is bool:
-        raise out_of_range('get_values response', 'v_in', m.v_in, -32768, 32767)
-    if not -2147483648 <= m.amp_hours <= 2147483647 or m.amp_hours.__class__ is bool:
-        raise out_of_range('get_values response', 'amp_hours', m.amp_hours, -2147483648, 2147483647)
-    if not -2147483648 <= m.amp_hours_charged <= 2147483647 or m.amp_hours_charged.__class__ is bool:
-        raise out_of_range('get_values response', 'amp_hours_charged', m.amp_hours_charged, -2147483648, 2147483647)
-    if not -2147483648 <= m.watt_hours <= 2147483647 or m.watt_hours.__class__ is bool:
-        raise out_of_range('get_values response', 'watt_hours', m.watt_hours, -2147483648, 2147483647)
-    if not -2147483648 <= m.watt_hours_charged <= 2147483647 or m.watt_hours_charged.__class__ is bool:
-        raise out_of_range('get_values response', 'watt_hours_charged', m.watt_hours_charged, -2147483648, 2147483647)
-    if not -2147483648 <= m.tachometer <= 2147483647 or m.tachometer.__class__ is bool:
-        raise out_of_range('get_values response', 'tachometer', m.tachometer, -2147483648, 2147483647)
-    if not -2147483648 <= m.tachometer_abs <= 2147483647 or m.tachometer_abs.__class__ is bool:
-        raise out_of_range('get_values response', 'tachometer_abs', m.tachometer_abs, -2147483648, 2147483647)
-    if not 0 <= m.fault <= 33 or m.fault.__class__ is bool:
-        raise out_of_range('get_values response', 'fault', m.fault, 0, 33)
-    if not -2147483648 <= m.pid_pos <= 2147483647 or m.pid_pos.__class__ is bool:
-        raise out_of_range('get_values response', 'pid_pos', m.pid_pos, -2147483648, 2147483647)
-    if not 0 <= m.controller_id <= 255 or m.controller_id.__class__ is bool:
-        raise out_of_range('get_values response', 'controller_id', m.controller_id, 0, 255)
-    if not -32768 <= m.temp_mos1 <= 32767 or m.temp_mos1.__class__ is bool:
-        raise out_of_range('get_values response', 'temp_mos1', m.temp_mos1, -32768, 32767)
-    if not -32768 <= m.temp_mos2 <= 32767 or m.temp_mos2.__class__ is bool:
-        raise out_of_range('get_values response', 'temp_mos2', m.temp_mos2, -32768, 32767)
-    if not -32768 <= m.temp_mos3 <= 32767 or m.temp_mos3.__class__ is bool:
-        raise out_of_range('get_values response', 'temp_mos3', m.temp_mos3, -32768, 32767)
-    if not -2147483648 <= m.avg_vd <= 2147483647 or m.avg_vd.__class__ is bool:
-        raise out_of_range('get_values response', 'avg_vd', m.avg_vd, -2147483648, 2147483647)
-    if not -2147483648 <= m.avg_vq <= 2147483647 or m.avg_vq.__class__ is bool:
-        raise out_of_range('get_values response', 'avg_vq', m.avg_vq, -2147483648, 2147483647)
-    if not 0 <= m.status <= 255 or isinstance(m.status, bool):
-        raise out_of_range('get_values response', 'status', m.status, 0, 255)
-    frame = _S_BE_FRAME_GETVALUESRESPONSE.pack(b'\x02', 74, 0x04, m.temp_fet, m.temp_motor, m.avg_motor_current, m.avg_input_current, m.avg_id, m.avg_iq, m.duty_now, m.rpm, m.v_in, m.amp_hours, m.amp_hours_charged, m.watt_hours, m.watt_hours_charged, m.tachometer, m.tachometer_abs, m.fault, m.pid_pos, m.controller_id, m.temp_mos1, m.temp_mos2, m.temp_mos3, m.avg_vd, m.avg_vq, m.status)
+    m_temp_fet = m.temp_fet
+    m_temp_motor = m.temp_motor
+    m_avg_motor_current = m.avg_motor_current
+    m_avg_input_current = m.avg_input_current
+    m_avg_id = m.avg_id
+    m_avg_iq = m.avg_iq
+    m_duty_now = m.duty_now
+    m_rpm = m.rpm
+    m_v_in = m.v_in
+    m_amp_hours = m.amp_hours
+    m_amp_hours_charged = m.amp_hours_charged
+    m_watt_hours = m.watt_hours
+    m_watt_hours_charged = m.watt_hours_charged
+    m_tachometer = m.tachometer
+    m_tachometer_abs = m.tachometer_abs
+    m_fault = m.fault
+    m_pid_pos = m.pid_pos
+    m_controller_id = m.controller_id
+    m_temp_mos1 = m.temp_mos1
+    m_temp_mos2 = m.temp_mos2
+    m_temp_mos3 = m.temp_mos3
+    m_avg_vd = m.avg_vd
+    m_avg_vq = m.avg_vq
+    m_status = m.status
+    if not -32768 <= m_temp_fet <= 32767 or m_temp_fet.__class__ is bool:
+        raise out_of_range('get_values response', 'temp_fet', m_temp_fet, -32768, 32767)
+    if not -32768 <= m_temp_motor <= 32767 or m_temp_motor.__class__ is bool:
+        raise out_of_range('get_values response', 'temp_motor', m_temp_motor, -32768, 32767)
+    if not -2147483648 <= m_avg_motor_current <= 2147483647 or m_avg_motor_current.__class__ is bool:
+        raise out_of_range('get_values response', 'avg_motor_current', m_avg_motor_current, -2147483648, 2147483647)
+    if not -2147483648 <= m_avg_input_current <= 2147483647 or m_avg_input_current.__class__ is bool:
+        raise out_of_range('get_values response', 'avg_input_current', m_avg_input_current, -2147483648, 2147483647)
+    if not -2147483648 <= m_avg_id <= 2147483647 or m_avg_id.__class__ is bool:
+        raise out_of_range('get_values response', 'avg_id', m_avg_id, -2147483648, 2147483647)
+    if not -2147483648 <= m_avg_iq <= 2147483647 or m_avg_iq.__class__ is bool:
+        raise out_of_range('get_values response', 'avg_iq', m_avg_iq, -2147483648, 2147483647)
+    if not -32768 <= m_duty_now <= 32767 or m_duty_now.__class__ is bool:
+        raise out_of_range('get_values response', 'duty_now', m_duty_now, -32768, 32767)
+    if not -2147483648 <= m_rpm <= 2147483647 or m_rpm.__class__ is bool:
+        raise out_of_range('get_values response', 'rpm', m_rpm, -2147483648, 2147483647)
+    if not -32768 <= m_v_in <= 32767 or m_v_in.__class__ is bool:
+        raise out_of_range('get_values response', 'v_in', m_v_in, -32768, 32767)
+    if not -2147483648 <= m_amp_hours <= 2147483647 or m_amp_hours.__class__ is bool:
+        raise out_of_range('get_values response', 'amp_hours', m_amp_hours, -2147483648, 2147483647)
+    if not -2147483648 <= m_amp_hours_charged <= 2147483647 or m_amp_hours_charged.__class__ is bool:
+        raise out_of_range('get_values response', 'amp_hours_charged', m_amp_hours_charged, -2147483648, 2147483647)
+    if not -2147483648 <= m_watt_hours <= 2147483647 or m_watt_hours.__class__ is bool:
+        raise out_of_range('get_values response', 'watt_hours', m_watt_hours, -2147483648, 2147483647)
+    if not -2147483648 <= m_watt_hours_charged <= 2147483647 or m_watt_hours_charged.__class__ is bool:
+        raise out_of_range('get_values response', 'watt_hours_charged', m_watt_hours_charged, -2147483648, 2147483647)
+    if not -2147483648 <= m_tachometer <= 2147483647 or m_tachometer.__class__ is bool:
+        raise out_of_range('get_values response', 'tachometer', m_tachometer, -2147483648, 2147483647)
+    if not -2147483648 <= m_tachometer_abs <= 2147483647 or m_tachometer_abs.__class__ is bool:
+        raise out_of_range('get_values response', 'tachometer_abs', m_tachometer_abs, -2147483648, 2147483647)
+    if not 0 <= m_fault <= 33 or m_fault.__class__ is bool:
+        raise out_of_range('get_values response', 'fault', m_fault, 0, 33)
+    if not -2147483648 <= m_pid_pos <= 2147483647 or m_pid_pos.__class__ is bool:
+        raise out_of_range('get_values response', 'pid_pos', m_pid_pos, -2147483648, 2147483647)
+    if not 0 <= m_controller_id <= 255 or m_controller_id.__class__ is bool:
+        raise out_of_range('get_values response', 'controller_id', m_controller_id, 0, 255)
+    if not -32768 <= m_temp_mos1 <= 32767 or m_temp_mos1.__class__ is bool:
+        raise out_of_range('get_values response', 'temp_mos1', m_temp_mos1, -32768, 32767)
+    if not -32768 <= m_temp_mos2 <= 32767 or m_temp_mos2.__class__ is bool:
+        raise out_of_range('get_values response', 'temp_mos2', m_temp_mos2, -32768, 32767)
+    if not -32768 <= m_temp_mos3 <= 32767 or m_temp_mos3.__class__ is bool:
+        raise out_of_range('get_values response', 'temp_mos3', m_temp_mos3, -32768, 32767)
+    if not -2147483648 <= m_avg_vd <= 2147483647 or m_avg_vd.__class__ is bool:
+        raise out_of_range('get_values response', 'avg_vd', m_avg_vd, -2147483648, 2147483647)
+    if not -2147483648 <= m_avg_vq <= 2147483647 or m_avg_vq.__class__ is bool:
+        raise out_of_range('get_values response', 'avg_vq', m_avg_vq, -2147483648, 2147483647)
+    if not 0 <= m_status <= 255 or isinstance(m_status, bool):
+        raise out_of_range('get_values response', 'status', m_status, 0, 255)
+    frame = _S_BE_FRAME_GETVALUESRESPONSE.pack(b'\x02', 74, 0x04, m_temp_fet, m_temp_motor, m_avg_motor_current, m_avg_input_current, m_avg_id, m_avg_iq, m_duty_now, m_rpm, m_v_in, m_amp_hours, m_amp_hours_charged, m_watt_hours, m_watt_hours_charged, m_tachometer, m_tachometer_abs, m_fault, m_pid_pos, m_controller_id, m_temp_mos1, m_temp_mos2, m_temp_mos3, m_avg_vd, m_avg_vq, m_status)
     return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
 
 
 def _encode_set_duty_request(m: SetDutyRequest) -> bytes:
-    if not -100000 <= m.duty <= 100000 or m.duty.__class__ is bool:
-        raise out_of_range('set_duty request', 'duty', m.duty, -100000, 100000)
-    frame = _S_BE_B1_U8_U8_I32.pack(b'\x02', 5, 0x05, m.duty)
+    m_duty = m.duty
+    if not -100000 <= m_duty <= 100000 or m_duty.__class__ is bool:
+        raise out_of_range('set_duty request', 'duty', m_duty, -100000, 100000)
+    frame = _S_BE_B1_U8_U8_I32.pack(b'\x02', 5, 0x05, m_duty)
     return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
 
 
 def _encode_set_current_request(m: SetCurrentRequest) -> bytes:
-    if not -2147483648 <= m.current <= 2147483647 or m.current.__class__ is bool:
-        raise out_of_range('set_current request', 'current', m.current, -2147483648, 2147483647)
-    frame = _S_BE_B1_U8_U8_I32.pack(b'\x02', 5, 0x06, m.current)
+    m_current = m.current
+    if not -2147483648 <= m_current <= 2147483647 or m_current.__class__ is bool:
+        raise out_of_range('set_current request', 'current', m_current, -2147483648, 2147483647)
+    frame = _S_BE_B1_U8_U8_I32.pack(b'\x02', 5, 0x06, m_current)
     return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
 
 
 def _encode_set_current_brake_request(m: SetCurrentBrakeRequest) -> bytes:
-    if not -2147483648 <= m.current <= 2147483647 or m.current.__class__ is bool:
-        raise out_of_range('set_current_brake request', 'current', m.current, -2147483648, 2147483647)
-    frame = _S_BE_B1_U8_U8_I32.pack(b'\x02', 5, 0x07, m.current)
+    m_current = m.current
+    if not -2147483648 <= m_current <= 2147483647 or m_current.__class__ is bool:
+        raise out_of_range('set_current_brake request', 'current', m_current, -2147483648, 2147483647)
+    frame = _S_BE_B1_U8_U8_I32.pack(b'\x02', 5, 0x07, m_current)
     return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
 
 
 def _encode_set_rpm_request(m: SetRpmRequest) -> bytes:
-    if not -2147483648 <= m.rpm <= 2147483647 or m.rpm.__class__ is bool:
-        raise out_of_range('set_rpm request', 'rpm', m.rpm, -2147483648, 2147483647)
-    frame = _S_BE_B1_U8_U8_I32.pack(b'\x02', 5, 0x08, m.rpm)
+    m_rpm = m.rpm
+    if not -2147483648 <= m_rpm <= 2147483647 or m_rpm.__class__ is bool:
+        raise out_of_range('set_rpm request', 'rpm', m_rpm, -2147483648, 2147483647)
+    frame = _S_BE_B1_U8_U8_I32.pack(b'\x02', 5, 0x08, m_rpm)
     return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
 
 
 def _encode_set_pos_request(m: SetPosRequest) -> bytes:
-    if not -2147483648 <= m.position <= 2147483647 or m.position.__class__ is bool:
-        raise out_of_range('set_pos request', 'position', m.position, -2147483648, 2147483647)
-    frame = _S_BE_B1_U8_U8_I32.pack(b'\x02', 5, 0x09, m.position)
+    m_position = m.position
+    if not -2147483648 <= m_position <= 2147483647 or m_position.__class__ is bool:
+        raise out_of_range('set_pos request', 'position', m_position, -2147483648, 2147483647)
+    frame = _S_BE_B1_U8_U8_I32.pack(b'\x02', 5, 0x09, m_position)
     return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
 
 
 def _encode_set_handbrake_request(m: SetHandbrakeRequest) -> bytes:
-    if not -2147483648 <= m.current <= 2147483647 or m.current.__class__ is bool:
-        raise out_of_range('set_handbrake request', 'current', m.current, -2147483648, 2147483647)
-    frame = _S_BE_B1_U8_U8_I32.pack(b'\x02', 5, 0x0a, m.current)
+    m_current = m.current
+    if not -2147483648 <= m_current <= 2147483647 or m_current.__class__ is bool:
+        raise out_of_range('set_handbrake request', 'current', m_current, -2147483648, 2147483647)
+    frame = _S_BE_B1_U8_U8_I32.pack(b'\x02', 5, 0x0a, m_current)
     return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
 
 
@@ -431,9 +351,10 @@ def _encode_print_response(m: PrintResponse) -> bytes:
 
 
 def _encode_rotor_position_response(m: RotorPositionResponse) -> bytes:
-    if not -2147483648 <= m.position <= 2147483647 or m.position.__class__ is bool:
-        raise out_of_range('rotor_position response', 'position', m.position, -2147483648, 2147483647)
-    frame = _S_BE_B1_U8_U8_I32.pack(b'\x02', 5, 0x16, m.position)
+    m_position = m.position
+    if not -2147483648 <= m_position <= 2147483647 or m_position.__class__ is bool:
+        raise out_of_range('rotor_position response', 'position', m_position, -2147483648, 2147483647)
+    frame = _S_BE_B1_U8_U8_I32.pack(b'\x02', 5, 0x16, m_position)
     return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
 
 
@@ -443,9 +364,12 @@ def _encode_alive_request(m: AliveRequest) -> bytes:
 
 
 def _encode_forward_can_request(m: ForwardCanRequest) -> bytes:
-    if not 0 <= m.can_id <= 255 or m.can_id.__class__ is bool:
-        raise out_of_range('forward_can request', 'can_id', m.can_id, 0, 255)
-    return _wrap_request(b''.join((_S_BE_U8.pack(m.can_id), bytes(m.payload),)), 0x22)
+    m_can_id = m.can_id
+    m_payload = m.payload
+    if not 0 <= m_can_id <= 255 or m_can_id.__class__ is bool:
+        raise out_of_range('forward_can request', 'can_id', m_can_id, 0, 255)
+    v_payload = m_payload if m_payload.__class__ is bytes else bytes(m_payload)
+    return _wrap_request(b''.join((_S_BE_U8.pack(m_can_id), v_payload,)), 0x22)
 
 
 _REQUEST_DECODERS: dict[int | None, Callable[..., Message]] = {
@@ -795,9 +719,10 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
 
 def encode(message: Message) -> bytes:
     """Encode a message as a complete frame; raises EncodeError (RangeError for values out of range)."""
-    encoder = _ENCODERS.get(type(message))
-    if encoder is None:
-        raise EncodeError(f"{type(message).__name__} is not a vesc message")
+    try:
+        encoder = _ENCODERS[type(message)]  # a subscript costs less than .get(); the miss is the rare case
+    except KeyError:
+        raise EncodeError(f"{type(message).__name__} is not a vesc message") from None
     try:
         return encoder(message)
     except EncodeError:

@@ -15,8 +15,7 @@ from serialspec.runtime.fields import get as _get
 from serialspec.runtime.fields import integer as _integer
 from serialspec.runtime.fields import text as _text
 from serialspec.runtime.message import Direction, Message
-
-_store = object.__setattr__  # how __init__ fills the slots of a frozen class
+from serialspec.runtime.message import build as _build
 
 __all__ = [
     'AliveRequest',
@@ -109,6 +108,9 @@ class FwVersionRequest(Message):
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
 
+    def __new__(cls) -> Self:
+        return _build(cls, ())
+
     def to_fields(self) -> dict[str, Any]:
         return {
         }
@@ -123,7 +125,7 @@ class FwVersionRequest(Message):
 class FwVersionResponse(Message):
     """COMM_FW_VERSION (response)."""
 
-    __slots__ = ('major', 'minor', 'hw_name', 'uuid', 'pairing_done', 'test_version', 'hw_type', 'custom_config_count', 'phase_filters', 'qml_hw', 'qml_app', 'nrf_flags', 'fw_name', 'hw_crc')
+    __slots__ = ()
     __match_args__ = ('major', 'minor', 'hw_name', 'uuid', 'pairing_done', 'test_version', 'hw_type', 'custom_config_count', 'phase_filters', 'qml_hw', 'qml_app', 'nrf_flags', 'fw_name', 'hw_crc')
     PROTOCOL: ClassVar[str] = 'vesc'
     COMMAND: ClassVar[str] = 'fw_version'
@@ -158,8 +160,8 @@ class FwVersionResponse(Message):
     #: CRC of the hardware configuration (main_calc_hw_crc).
     hw_crc: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         major: int,
         minor: int,
         hw_name: str,
@@ -174,21 +176,8 @@ class FwVersionResponse(Message):
         nrf_flags: int,
         fw_name: str,
         hw_crc: int,
-    ) -> None:
-        _store(self, 'major', major)
-        _store(self, 'minor', minor)
-        _store(self, 'hw_name', hw_name)
-        _store(self, 'uuid', uuid)
-        _store(self, 'pairing_done', pairing_done)
-        _store(self, 'test_version', test_version)
-        _store(self, 'hw_type', hw_type)
-        _store(self, 'custom_config_count', custom_config_count)
-        _store(self, 'phase_filters', phase_filters)
-        _store(self, 'qml_hw', qml_hw)
-        _store(self, 'qml_app', qml_app)
-        _store(self, 'nrf_flags', nrf_flags)
-        _store(self, 'fw_name', fw_name)
-        _store(self, 'hw_crc', hw_crc)
+    ) -> Self:
+        return _build(cls, (major, minor, hw_name, uuid, pairing_done, test_version, hw_type, custom_config_count, phase_filters, qml_hw, qml_app, nrf_flags, fw_name, hw_crc))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -239,6 +228,9 @@ class GetValuesRequest(Message):
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
 
+    def __new__(cls) -> Self:
+        return _build(cls, ())
+
     def to_fields(self) -> dict[str, Any]:
         return {
         }
@@ -253,7 +245,7 @@ class GetValuesRequest(Message):
 class GetValuesResponse(Message):
     """COMM_GET_VALUES (response)."""
 
-    __slots__ = ('temp_fet', 'temp_motor', 'avg_motor_current', 'avg_input_current', 'avg_id', 'avg_iq', 'duty_now', 'rpm', 'v_in', 'amp_hours', 'amp_hours_charged', 'watt_hours', 'watt_hours_charged', 'tachometer', 'tachometer_abs', 'fault', 'pid_pos', 'controller_id', 'temp_mos1', 'temp_mos2', 'temp_mos3', 'avg_vd', 'avg_vq', 'status')
+    __slots__ = ()
     __match_args__ = ('temp_fet', 'temp_motor', 'avg_motor_current', 'avg_input_current', 'avg_id', 'avg_iq', 'duty_now', 'rpm', 'v_in', 'amp_hours', 'amp_hours_charged', 'watt_hours', 'watt_hours_charged', 'tachometer', 'tachometer_abs', 'fault', 'pid_pos', 'controller_id', 'temp_mos1', 'temp_mos2', 'temp_mos3', 'avg_vd', 'avg_vq', 'status')
     PROTOCOL: ClassVar[str] = 'vesc'
     COMMAND: ClassVar[str] = 'get_values'
@@ -308,8 +300,8 @@ class GetValuesResponse(Message):
     #: Timeout and kill switch state.
     status: ValuesStatus
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         temp_fet: int,
         temp_motor: int,
         avg_motor_current: int,
@@ -334,31 +326,8 @@ class GetValuesResponse(Message):
         avg_vd: int,
         avg_vq: int,
         status: ValuesStatus,
-    ) -> None:
-        _store(self, 'temp_fet', temp_fet)
-        _store(self, 'temp_motor', temp_motor)
-        _store(self, 'avg_motor_current', avg_motor_current)
-        _store(self, 'avg_input_current', avg_input_current)
-        _store(self, 'avg_id', avg_id)
-        _store(self, 'avg_iq', avg_iq)
-        _store(self, 'duty_now', duty_now)
-        _store(self, 'rpm', rpm)
-        _store(self, 'v_in', v_in)
-        _store(self, 'amp_hours', amp_hours)
-        _store(self, 'amp_hours_charged', amp_hours_charged)
-        _store(self, 'watt_hours', watt_hours)
-        _store(self, 'watt_hours_charged', watt_hours_charged)
-        _store(self, 'tachometer', tachometer)
-        _store(self, 'tachometer_abs', tachometer_abs)
-        _store(self, 'fault', fault)
-        _store(self, 'pid_pos', pid_pos)
-        _store(self, 'controller_id', controller_id)
-        _store(self, 'temp_mos1', temp_mos1)
-        _store(self, 'temp_mos2', temp_mos2)
-        _store(self, 'temp_mos3', temp_mos3)
-        _store(self, 'avg_vd', avg_vd)
-        _store(self, 'avg_vq', avg_vq)
-        _store(self, 'status', status)
+    ) -> Self:
+        return _build(cls, (temp_fet, temp_motor, avg_motor_current, avg_input_current, avg_id, avg_iq, duty_now, rpm, v_in, amp_hours, amp_hours_charged, watt_hours, watt_hours_charged, tachometer, tachometer_abs, fault, pid_pos, controller_id, temp_mos1, temp_mos2, temp_mos3, avg_vd, avg_vq, status))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -422,7 +391,7 @@ class GetValuesResponse(Message):
 class SetDutyRequest(Message):
     """COMM_SET_DUTY (request)."""
 
-    __slots__ = ('duty',)
+    __slots__ = ()
     __match_args__ = ('duty',)
     PROTOCOL: ClassVar[str] = 'vesc'
     COMMAND: ClassVar[str] = 'set_duty'
@@ -431,11 +400,11 @@ class SetDutyRequest(Message):
     #: Duty cycle × 100000. [0.00001] range -100000..100000
     duty: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         duty: int,
-    ) -> None:
-        _store(self, 'duty', duty)
+    ) -> Self:
+        return _build(cls, (duty,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -453,7 +422,7 @@ class SetDutyRequest(Message):
 class SetCurrentRequest(Message):
     """COMM_SET_CURRENT (request)."""
 
-    __slots__ = ('current',)
+    __slots__ = ()
     __match_args__ = ('current',)
     PROTOCOL: ClassVar[str] = 'vesc'
     COMMAND: ClassVar[str] = 'set_current'
@@ -462,11 +431,11 @@ class SetCurrentRequest(Message):
     #: Motor current in mA (negative brakes or reverses). [mA]
     current: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         current: int,
-    ) -> None:
-        _store(self, 'current', current)
+    ) -> Self:
+        return _build(cls, (current,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -484,7 +453,7 @@ class SetCurrentRequest(Message):
 class SetCurrentBrakeRequest(Message):
     """COMM_SET_CURRENT_BRAKE (request)."""
 
-    __slots__ = ('current',)
+    __slots__ = ()
     __match_args__ = ('current',)
     PROTOCOL: ClassVar[str] = 'vesc'
     COMMAND: ClassVar[str] = 'set_current_brake'
@@ -493,11 +462,11 @@ class SetCurrentBrakeRequest(Message):
     #: Brake current in mA. [mA]
     current: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         current: int,
-    ) -> None:
-        _store(self, 'current', current)
+    ) -> Self:
+        return _build(cls, (current,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -515,7 +484,7 @@ class SetCurrentBrakeRequest(Message):
 class SetRpmRequest(Message):
     """COMM_SET_RPM (request)."""
 
-    __slots__ = ('rpm',)
+    __slots__ = ()
     __match_args__ = ('rpm',)
     PROTOCOL: ClassVar[str] = 'vesc'
     COMMAND: ClassVar[str] = 'set_rpm'
@@ -524,11 +493,11 @@ class SetRpmRequest(Message):
     #: Target electrical rpm. [ERPM]
     rpm: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         rpm: int,
-    ) -> None:
-        _store(self, 'rpm', rpm)
+    ) -> Self:
+        return _build(cls, (rpm,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -546,7 +515,7 @@ class SetRpmRequest(Message):
 class SetPosRequest(Message):
     """COMM_SET_POS (request)."""
 
-    __slots__ = ('position',)
+    __slots__ = ()
     __match_args__ = ('position',)
     PROTOCOL: ClassVar[str] = 'vesc'
     COMMAND: ClassVar[str] = 'set_pos'
@@ -555,11 +524,11 @@ class SetPosRequest(Message):
     #: Target position × 1000000, in degrees. [0.000001°]
     position: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         position: int,
-    ) -> None:
-        _store(self, 'position', position)
+    ) -> Self:
+        return _build(cls, (position,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -577,7 +546,7 @@ class SetPosRequest(Message):
 class SetHandbrakeRequest(Message):
     """COMM_SET_HANDBRAKE (request)."""
 
-    __slots__ = ('current',)
+    __slots__ = ()
     __match_args__ = ('current',)
     PROTOCOL: ClassVar[str] = 'vesc'
     COMMAND: ClassVar[str] = 'set_handbrake'
@@ -586,11 +555,11 @@ class SetHandbrakeRequest(Message):
     #: Handbrake current in mA. [mA]
     current: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         current: int,
-    ) -> None:
-        _store(self, 'current', current)
+    ) -> Self:
+        return _build(cls, (current,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -608,7 +577,7 @@ class SetHandbrakeRequest(Message):
 class PrintResponse(Message):
     """COMM_PRINT (response). Sent by the device on its own."""
 
-    __slots__ = ('text',)
+    __slots__ = ()
     __match_args__ = ('text',)
     PROTOCOL: ClassVar[str] = 'vesc'
     COMMAND: ClassVar[str] = 'print'
@@ -617,11 +586,11 @@ class PrintResponse(Message):
     #: The text, not NUL-terminated.
     text: str
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         text: str,
-    ) -> None:
-        _store(self, 'text', text)
+    ) -> Self:
+        return _build(cls, (text,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -639,7 +608,7 @@ class PrintResponse(Message):
 class RotorPositionResponse(Message):
     """COMM_ROTOR_POSITION (response). Sent by the device on its own."""
 
-    __slots__ = ('position',)
+    __slots__ = ()
     __match_args__ = ('position',)
     PROTOCOL: ClassVar[str] = 'vesc'
     COMMAND: ClassVar[str] = 'rotor_position'
@@ -648,11 +617,11 @@ class RotorPositionResponse(Message):
     #: Rotor position × 100000, in degrees. [0.00001°]
     position: int
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         position: int,
-    ) -> None:
-        _store(self, 'position', position)
+    ) -> Self:
+        return _build(cls, (position,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -677,6 +646,9 @@ class AliveRequest(Message):
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
 
+    def __new__(cls) -> Self:
+        return _build(cls, ())
+
     def to_fields(self) -> dict[str, Any]:
         return {
         }
@@ -691,7 +663,7 @@ class AliveRequest(Message):
 class ForwardCanRequest(Message):
     """COMM_FORWARD_CAN (request)."""
 
-    __slots__ = ('can_id', 'payload')
+    __slots__ = ()
     __match_args__ = ('can_id', 'payload')
     PROTOCOL: ClassVar[str] = 'vesc'
     COMMAND: ClassVar[str] = 'forward_can'
@@ -702,13 +674,12 @@ class ForwardCanRequest(Message):
     #: The forwarded payload: a command id and its fields.
     payload: bytes
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         can_id: int,
         payload: bytes,
-    ) -> None:
-        _store(self, 'can_id', can_id)
-        _store(self, 'payload', payload)
+    ) -> Self:
+        return _build(cls, (can_id, payload))
 
     def to_fields(self) -> dict[str, Any]:
         return {

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from serialspec.runtime.message import is_sequence
+
 
 class SerialspecError(Exception):
     """Base of every error the runtime and generated code raise on purpose."""
@@ -28,7 +30,7 @@ def out_of_range(where: str, field: str, value: object, low: float, high: float)
 
     For a list of values, the first item at fault is named: "values[3] = 70000 is outside its range 0..65535".
     """
-    if isinstance(value, tuple | list):
+    if is_sequence(value):
         for index, item in enumerate(value):
             if isinstance(item, bool) or not isinstance(item, int | float) or not low <= item <= high:
                 return out_of_range(where, f"{field}[{index}]", item, low, high)

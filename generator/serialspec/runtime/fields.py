@@ -9,7 +9,7 @@ from typing import Any, TypeVar
 
 from serialspec.runtime.errors import EncodeError, shown
 from serialspec.runtime.hexbytes import parse_hex
-from serialspec.runtime.message import Record
+from serialspec.runtime.message import Record, is_sequence
 
 
 def check_keys(data: Mapping[str, Any], known: Iterable[str], optional: Iterable[str], where: str) -> None:
@@ -86,7 +86,7 @@ def flags(cls: type[F], value: Any, maximum: int, name: str, where: str) -> F:
 
 def items(value: Any, name: str, where: str) -> list[Any]:
     """The items of an array or group: a list."""
-    if isinstance(value, list | tuple):
+    if is_sequence(value):
         return list(value)
     raise EncodeError(f"{where}: {name} must be a list, got {shown(value)}")
 
@@ -131,7 +131,7 @@ def _problem(obj: Any, prefix: str = "") -> str:
         name = prefix + field
         annotation = str(annotations[field])
         if annotation.startswith("tuple["):
-            if not isinstance(value, tuple | list):
+            if not is_sequence(value):
                 return f"{name} must be a tuple, got {shown(value)}"
             for index, item in enumerate(value):
                 wrong = _value_problem(item, annotation[6:-1].split(",")[0].strip(), f"{name}[{index}]")

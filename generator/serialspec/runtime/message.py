@@ -2,10 +2,11 @@
 
 from __future__ import annotations
 
+from collections import _tuplegetter  # type: ignore[attr-defined]
 from collections.abc import Callable
 from dataclasses import FrozenInstanceError
 from enum import Enum, IntEnum, StrEnum
-from typing import Any, ClassVar, TypeVar, dataclass_transform
+from typing import TYPE_CHECKING, Any, ClassVar, TypeGuard, TypeVar, dataclass_transform
 
 
 class Direction(StrEnum):
@@ -13,19 +14,53 @@ class Direction(StrEnum):
     RESPONSE = "response"
 
 
-@dataclass_transform(eq_default=True, frozen_default=True)
-class Record:
-    """The base of the generated value classes: slotted, immutable, compared and hashed by field values.
+R = TypeVar("R", bound="Record")
 
-    The generated classes used to be frozen slotted dataclasses; the decorator's work (compiling __init__, __eq__,
-    __repr__, __hash__ and rebuilding the class for its slots) cost ~0.35 ms per class at import, most of a client's
-    import time. Now each class lists its fields in `__match_args__` and `__slots__` and has a generated __init__;
-    equality, hashing, repr, pickling and immutability (FrozenInstanceError, as before) come from here.
-    `dataclass_transform` tells type checkers what it is: keyword construction, frozen fields.
+if TYPE_CHECKING:  # to a type checker a record is a plain object with frozen attributes, not a sequence
+    _Base = object
+
+    def build(cls: type[R], values: tuple[Any, ...], /) -> R:
+        """A record of class `cls` holding `values`, its fields in order, unchecked (what decoders call)."""
+        raise NotImplementedError
+
+else:
+    _Base = tuple
+    build = tuple.__new__
+
+
+_ALL = slice(None)
+# tuple's own methods, called on records (typed loosely: to a type checker a record is not a tuple)
+_items: Callable[[object, slice], tuple[Any, ...]] = tuple.__getitem__  # type: ignore[assignment]
+_tuple_eq: Callable[[object, object], bool] = tuple.__eq__  # type: ignore[assignment]
+_tuple_ne: Callable[[object, object], bool] = tuple.__ne__
+_tuple_hash: Callable[[object], int] = tuple.__hash__  # type: ignore[assignment]
+
+
+@dataclass_transform(eq_default=True, frozen_default=True)
+class Record(_Base):
+    """The base of the generated value classes: immutable, compared and hashed by field values.
+
+    A record is stored as a tuple of its field values (a tuple subclass, hidden from type checkers): `build(cls,
+    values)` makes one in a single C call (~0.1 µs whatever the number of fields), where filling slots costs ~45 ns
+    a field, and a decoder passes the tuple `struct.unpack_from` gives straight to it. Each field is read through a
+    C descriptor (`collections._tuplegetter`, what namedtuple uses) that __init_subclass__ installs from
+    `__match_args__`; a generated class declares its fields as annotations and has a generated `__new__`.
+
+    Nothing of the tuple shows: a record equals only a record of its own class with equal fields (never a plain
+    tuple), does not order, is always true (even with no fields), has no length, cannot be indexed, iterated,
+    added or multiplied, and assignment raises FrozenInstanceError as a frozen dataclass did. Its hash is the hash
+    of its field values, its repr names them, and it pickles and copies by class and values. `dataclass_transform`
+    tells type checkers what it is: keyword construction, frozen fields.
     """
 
     __slots__ = ()
     __match_args__: ClassVar[tuple[str, ...]] = ()
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        names = cls.__dict__.get("__match_args__", ())
+        for index, name in enumerate(names):
+            setattr(cls, name, _tuplegetter(index, f"Field {index} of {cls.__name__}: {name}."))
 
     def __setattr__(self, name: str, value: Any) -> None:
         raise FrozenInstanceError(f"cannot assign to field {name!r}")
@@ -34,22 +69,53 @@ class Record:
         raise FrozenInstanceError(f"cannot delete field {name!r}")
 
     def _values(self) -> tuple[Any, ...]:
-        return tuple([getattr(self, name) for name in self.__match_args__])
+        return _items(self, _ALL)  # a plain tuple of the field values
 
     def __eq__(self, other: object) -> bool:
         if other.__class__ is not self.__class__:
-            return NotImplemented
-        return self._values() == other._values()
+            # a plain tuple would otherwise compare by its items, through tuple's own comparison
+            return False if isinstance(other, tuple) else NotImplemented
+        return _tuple_eq(self, other)
 
-    def __hash__(self) -> int:
-        return hash(self._values())
+    def __ne__(self, other: object) -> bool:
+        if other.__class__ is not self.__class__:
+            return True if isinstance(other, tuple) else NotImplemented
+        return _tuple_ne(self, other)
+
+    __hash__ = _tuple_hash  # the hash of the field values, as before
 
     def __repr__(self) -> str:
         values = ", ".join(f"{name}={getattr(self, name)!r}" for name in self.__match_args__)
         return f"{type(self).__qualname__}({values})"
 
     def __reduce__(self) -> tuple[Any, ...]:
-        return (type(self), self._values())  # __init__ takes the fields positionally, in this order
+        return (type(self), self._values())  # __new__ takes the fields positionally, in this order
+
+    def __bool__(self) -> bool:
+        return True  # a tuple of no fields would be false
+
+
+def _not_a_sequence(self: Record, *args: Any) -> Any:
+    raise TypeError(f"{type(self).__qualname__} is a record, not a sequence: use its fields by name")
+
+
+for _name in ("__len__", "__iter__", "__getitem__", "__contains__", "__add__", "__mul__", "__rmul__", "count", "index"):
+    setattr(Record, _name, _not_a_sequence)
+
+
+def _unordered(self: Record, other: object) -> Any:
+    if isinstance(other, tuple):  # tuple's own ordering would otherwise answer for `(1,) < record`
+        raise TypeError(f"{type(self).__qualname__} records are not ordered")
+    return NotImplemented
+
+
+for _name in ("__lt__", "__le__", "__gt__", "__ge__"):
+    setattr(Record, _name, _unordered)
+
+
+def is_sequence(value: object) -> TypeGuard[tuple[Any, ...] | list[Any]]:
+    """A list or tuple of values, not a record (which is a tuple underneath): how the runtime tells lists apart."""
+    return isinstance(value, tuple | list) and not isinstance(value, Record)
 
 
 def field_names(record: Record | type[Record]) -> tuple[str, ...]:
@@ -57,11 +123,8 @@ def field_names(record: Record | type[Record]) -> tuple[str, ...]:
     return record.__match_args__
 
 
-R = TypeVar("R", bound=Record)
-
-
 def replace(record: R, **changes: Any) -> R:
-    """A copy of `record` with some fields changed (what dataclasses.replace gave before), checked by __init__."""
+    """A copy of `record` with some fields changed (what dataclasses.replace gave before), checked by __new__."""
     unknown = sorted(set(changes) - set(record.__match_args__))
     if unknown:
         raise TypeError(f"{type(record).__qualname__} has no field {', '.join(map(repr, unknown))}")
@@ -102,12 +165,12 @@ def members(enum: type[M]) -> dict[Any, M]:
 
 
 def slot_setters(cls: type) -> tuple[Callable[[Any, Any], None], ...]:
-    """One setter per field of a generated (frozen, slotted) class, in field order, that stores into the field's slot.
+    """One setter per field of a frozen, slotted class, in field order, that stores into the field's slot.
 
-    __init__ of a frozen class stores every field through object.__setattr__, which costs more than unpacking a
-    whole frame; the codec builds decoded messages with `object.__new__` and these setters instead (the values come
-    from a checked frame, so __init__ has nothing else to do). Raises TypeError for a class without slots, so a
-    change of the message classes cannot silently fall back to something slower or wrong.
+    Generated classes no longer need it: they are tuples underneath and decoders make them with `build`, in one
+    call. For a frozen slotted class of your own, `object.__new__` and these setters fill an instance without its
+    __init__ (which stores each field through object.__setattr__). Raises TypeError for a class without slots, so
+    a change of the class cannot silently fall back to something slower or wrong.
     """
     setters = []
     for name in getattr(cls, "__match_args__", ()):

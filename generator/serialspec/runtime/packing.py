@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from serialspec.runtime.errors import DecodeError, EncodeError, shown
+from serialspec.runtime.message import is_sequence
 
 
 def unpack_bits(buf: bytes, offset: int, count: int) -> tuple[bool, ...]:
@@ -12,7 +13,7 @@ def unpack_bits(buf: bytes, offset: int, count: int) -> tuple[bool, ...]:
 
 def pack_bits(values: tuple[bool, ...] | list[bool], name: str, where: str) -> bytes:
     """Bits 8 to a byte, the first in the lowest bit; the last byte padded with zeros."""
-    if not isinstance(values, tuple | list):
+    if not is_sequence(values):
         raise EncodeError(f"{where}: {name} must be a list of bits, got {shown(values)}")
     out = bytearray(-(-len(values) // 8))
     for i, value in enumerate(values):

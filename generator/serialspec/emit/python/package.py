@@ -19,14 +19,17 @@ from serialspec.emit.python.pycode import (
     crc_setup,
     decoder_name,
     encoder_name,
+    fuse_unpack,
     one_line,
-    setter_name,
+    takes_the_rest,
 )
 from serialspec.emit.python.registers import register_tables, registers_module
 from serialspec.emit.python.render import render
 from serialspec.emit.python.simulator import import_order, simulator_module
 from serialspec.emit.python.structs import structs_module
+from serialspec.runtime.checksums import crc_table
 from serialspec.spec.model import (
+    Bytes,
     Command,
     Direction,
     FrameLayout,
@@ -280,6 +283,8 @@ def classic_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
     directions = []
     dispatchers = []
     frame_functions: list[dict[str, Any]] = []
+    whole_functions: list[dict[str, Any]] = []
+    whole_pickers: list[dict[str, Any]] = []
     decoder_bodies = {name: (returns, extra, lines) for name, returns, extra, lines in code.decoders}
     for direction, layout in protocol.framing.layouts.items():
         dispatch = []
@@ -295,11 +300,30 @@ def classic_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
             if sub_dispatch:
                 dispatchers.append(sub_dispatch | value_arguments(layout))
         fixed = fixed_frames(protocol, layout, decoder_bodies, code)
-        frame_functions += [f for _, _, f in fixed]
+        sub_functions, pickers, sub_entries = subcommand_frames(protocol, layout, decoder_bodies, code)
+        whole = whole_frames(layout, [*fixed, *sub_entries])
+        rests = rest_frames(protocol, layout, decoder_bodies, code) if whole or fixed else []
+        whole_functions += rests
+        if whole:  # decode() looks frames up by their first bytes
+            whole_functions += [f | {"whole_lines": fuse_unpack(f["whole_lines"], code.structs)} for f in sub_functions]
+            whole_pickers += pickers
+        frame_functions += [
+            f
+            | {
+                "lines": fuse_unpack(f["lines"], code.structs),
+                "whole_lines": fuse_unpack(f["whole_lines"], code.structs),
+            }
+            for _, _, f in fixed
+        ]
         directions.append(
             {
                 "fixed": [(key, size, function["name"]) for key, size, function in fixed],
-                "whole_frames": whole_frames(layout, fixed),
+                "fixed_whole": [(key, size, function["whole_name"]) for key, size, function in fixed],
+                "rest_keys": [rest_key(layout, r, bool(whole)) for r in rests],
+                "whole_frames": whole,
+                "plain": any(plain for *_, plain in whole),
+                "plain_check": plain_check(protocol, layout),
+                "content_offset": layout.offsets[next(e.name for e in layout.elements if e.role == "content")],
                 "whole_size": max(layout.length_offset, layout.command_offset or 0) + 1,
                 "key": frame_key(layout, "data"),
                 "name": direction.value,
@@ -327,6 +351,8 @@ def classic_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
         "checksum_definition": checksum_definition,
         "directions": directions,
         "frame_functions": frame_functions,
+        "whole_functions": whole_functions,
+        "whole_pickers": whole_pickers,
         "dispatchers": dispatchers,
         "header_choices": header_choices,
     }
@@ -344,9 +370,11 @@ def common_codec_context(protocol: Protocol, code: PackageCode, exports: list[st
         "tables": [
             table_context(t) for t in protocol.tables if any(uses_table(m, t.name) for m in protocol.messages())
         ],
-        "setters": [(cls, setter_targets(cls, names)) for cls, names in sorted(code.built.items()) if names],
         "member_maps": sorted(code.member_maps),
-        "decoders": [{"name": n, "returns": r, "extra": e, "lines": lines} for n, r, e, lines in code.decoders],
+        "decoders": [
+            {"name": n, "returns": r, "extra": e, "lines": fuse_unpack(lines, code.structs)}
+            for n, r, e, lines in code.decoders
+        ],
         "encoders": [{"name": n, "type": t, "lines": lines} for n, t, lines in code.encoders],
         "encoder_table": encoder_table,
         "imports": sorted(
@@ -369,7 +397,30 @@ def frame_key(layout: FrameLayout, buf: str, start: str = "") -> str:
     return f"{buf}[{at}{layout.command_offset}] << 8 | {length}"
 
 
-def whole_frames(layout: FrameLayout, fixed: list[tuple[str, int, dict[str, Any]]]) -> list[tuple[str, int, str]]:
+def rest_key(layout: FrameLayout, rest: dict[str, Any], by_bytes: bool) -> dict[str, Any]:
+    """decode()'s table entries of a frame that takes the rest (rest_frames), one per length byte `n`: the key's
+    expression in `n` (first bytes as whole_frames makes them, or the size key as frame_key), the range of `n`,
+    and the frame size less `n`."""
+    code = rest["code"] or 0
+    if by_bytes:  # header, then command code and length byte in offset order
+        key = " + ".join(
+            [
+                repr(layout.header),
+                *(
+                    "bytes((n,))" if o == layout.length_offset else repr(bytes([code]))
+                    for o in sorted(o for o in (layout.command_offset, layout.length_offset) if o is not None)
+                ),
+            ]
+        )
+    else:
+        key = f"{code:#04x} << 8 | n" if layout.command_offset is not None else "n"
+    low, high = rest["lengths"]
+    return {"key": key, "low": low, "high": high, "adds": rest["adds"], "name": rest["whole_name"]}
+
+
+def whole_frames(
+    layout: FrameLayout, fixed: list[tuple[str, int, dict[str, Any]]]
+) -> list[tuple[str, int, str, tuple[str, str] | None]]:
     """decode()'s table of the frames decoded whole, keyed by their first bytes when those are the header, command
     code and length byte (one slice, one lookup, and the header is checked with them); [] where they are not."""
     width = len(layout.header)
@@ -382,7 +433,8 @@ def whole_frames(layout: FrameLayout, fixed: list[tuple[str, int, dict[str, Any]
         bytes_at = {layout.length_offset: value & 0xFF}
         if layout.command_offset is not None:
             bytes_at[layout.command_offset] = value >> 8
-        entries.append((repr(layout.header + bytes(bytes_at[o] for o in offsets)), size, function["name"]))
+        key_bytes = repr(layout.header + bytes(bytes_at[o] for o in offsets))
+        entries.append((key_bytes, size, function["whole_name"], function.get("plain")))
     return entries
 
 
@@ -394,51 +446,287 @@ def fixed_frames(
     dispatch, no size checks (the key is the command code and length byte, so the size is known), one call per
     frame. It returns None for a frame whose checksum fails, so callers word the error (decode) or count it (the
     stream parser); it raises nothing. Frames of any other kind keep the general path."""
-    checksum = protocol.framing.checksum
-    if checksum is None:
-        return []  # classic frames have one
-    content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
     found = []
     for command in protocol.commands:
         message = command.request if layout.direction == Direction.REQUEST else command.response
-        if command.selector is not None or message is None or message.min_size != message.max_size:
+        if command.selector is not None or message is None:
+            continue
+        made = frame_function(protocol, layout, command, message, bodies, code)
+        if made is not None:
+            key, size, function = made
+            found.append((f"{key:#06x}", size, function))
+    return found
+
+
+def subcommand_frames(
+    protocol: Protocol, layout: FrameLayout, bodies: dict[str, tuple[str, str, Lines]], code: PackageCode
+) -> tuple[list[dict[str, Any]], list[dict[str, Any]], list[tuple[str, int, dict[str, Any]]]]:
+    """decode()'s whole-frame decoders of sub-command frames of one size (as fixed_frames, the sub-command's check
+    dropped: its code picks the decoder) and, per command and frame size, the function that picks one by the
+    sub-command byte: (decoders, pickers, decode's table entries of the pickers, as fixed_frames gives them)."""
+    content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
+    functions: list[dict[str, Any]] = []
+    pickers: list[dict[str, Any]] = []
+    entries = []
+    for command in protocol.commands:
+        if command.selector is None or layout.direction not in command.selector.offsets:
+            continue
+        by_size: dict[tuple[int, int], list[tuple[int, dict[str, Any]]]] = {}
+        for sub in command.subcommands:
+            message = sub.request if layout.direction == Direction.REQUEST else sub.response
+            if message is None:
+                continue
+            made = frame_function(protocol, layout, command, message, bodies, code, command.selector.name)
+            if made is not None:
+                key, size, function = made
+                by_size.setdefault((key, size), []).append((sub.code, function))
+        at = content_offset + command.selector.offsets[layout.direction]
+        for (key, size), subs in by_size.items():
+            picker = {
+                "whole_name": f"_whole_{command.name}_{layout.direction.value}_{size}",
+                "table": f"_{command.name.upper()}_{layout.direction.name}_WHOLE_{size}",
+                "size": size,
+                "where": f"{command.name} {layout.direction.value}",
+                "entries": [(f"{c:#04x}", f["whole_name"]) for c, f in subs],
+            }
+            lines = picked_inline(subs, at, code)
+            if lines is None:  # each sub-command's own decoder, from a table
+                functions += [f for _, f in subs]
+                lines = [f"whole = {picker['table']}.get(buf[{at}])", "return None if whole is None else whole(buf)"]
+            else:
+                picker["entries"] = []
+            pickers.append(picker | {"lines": lines})
+            entries.append((f"{key:#06x}", size, picker))
+    return functions, pickers, entries
+
+
+def rest_frames(
+    protocol: Protocol, layout: FrameLayout, bodies: dict[str, tuple[str, str, Lines]], code: PackageCode
+) -> list[dict[str, Any]]:
+    """decode()'s whole-frame decoders of the frames whose content is fixed fields then bytes to its end (FEETECH
+    WRITE: an address, then the data): any length byte from the smallest such content up names one, so decode()'s
+    table holds a key per length byte. Each checks the checksum, reads the fields at constant offsets and the bytes
+    up to the frame's tail: no dispatch, no content decoder's call. Others keep the general path."""
+    checksum = protocol.framing.checksum
+    length = layout.length
+    if checksum is None or length is None or length.type is None:
+        return []
+    content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
+    tail = layout.overhead - content_offset  # bytes after the content
+    found = []
+    for command in protocol.commands:
+        message = command.request if layout.direction == Direction.REQUEST else command.response
+        if command.selector is not None or message is None or message.max_size is not None or not message.fields:
+            continue
+        if not (isinstance(message.fields[-1], Bytes) and takes_the_rest(message.fields[-1])):
             continue
         returns, extra, lines = bodies[decoder_name(message)]
-        if not lines[0].startswith("if end - o != "):
+        if not lines[0].startswith("if end - o < "):
             continue
-        body = lines[2:]  # the content size check: the key implies the size
-        text = "\n".join(body)
-        if text.count("(buf, o)") > 1 or _CURSOR.search(text.replace("(buf, o)", "")) or "raise " in text:
-            continue  # content read at a moving cursor, or checked beyond its size: the general path
-        size = layout.overhead + (message.min_size or 0)
-        values = [f"{e.name} = buf[start + {layout.offsets[e.name]}]" for e in layout.value_elements]
-        length_byte = (message.min_size or 0) + layout.length_adds
-        summed = summed_frame(protocol, layout, command.code, length_byte, size, body, code)
-        if summed is not None:
-            lines = [*values, *summed, *body[1:]]
+        offset, body = content_offset, []
+        for line in lines[2:]:  # the size check: the key implies it
+            moved = re.fullmatch(r"o \+= (\d+)", line)
+            if moved:
+                offset += int(moved[1])
+                continue
+            line = line.replace("buf[o:end]", f"buf[{offset}:-{tail}]").replace("(buf, o)", f"(buf, {offset})")
+            if "raise " in line or _CURSOR.search(line):
+                break  # checked beyond its size, or read at a cursor: the general path
+            body.append(line)
         else:
-            stored = (
-                f"buf[start + {size - 1}]"
-                if layout.checksum_offset_from_end == 1
-                else f"int.from_bytes(buf[start + {size - layout.checksum_offset_from_end} : start + {size}], 'little')"
+            check_lines = rest_check_lines(protocol, layout)
+            values = [f"{e.name} = buf[{layout.offsets[e.name]}]" for e in layout.value_elements]
+            lowest = (message.min_size or 0) + layout.length_adds
+            found.append(
+                {
+                    "whole_name": "_whole" + decoder_name(message).removeprefix("_decode"),
+                    "returns": returns,
+                    "where": f"{message.key} {message.direction.value}",
+                    "whole_lines": fuse_unpack([*check_lines, "    return None", *values, *body], code.structs),
+                    "code": command.code,
+                    "lengths": (lowest, length.type.maximum),
+                    "adds": layout.overhead - layout.length_adds,  # frame size = length byte + this
+                }
             )
-            covered = f"buf[start + {layout.covered_from} : start + {size - layout.covered_to_end}]"
-            lines = [
-                *checksum_lines(checksum, covered, "expected"),
-                f"if expected != {stored}:",
-                "    return None",
-                *values,
-                *(line.replace("(buf, o)", f"(buf, start + {content_offset})") for line in body),
-            ]
-        function = {
-            "name": "_frame" + decoder_name(message).removeprefix("_decode"),
-            "returns": returns,
-            "where": f"{message.key} {message.direction.value}",
-            "lines": lines,
-        }
-        key = length_byte if layout.command_offset is None else (command.code or 0) << 8 | length_byte
-        found.append((f"{key:#06x}", size, function))
     return found
+
+
+def rest_check_lines(protocol: Protocol, layout: FrameLayout) -> Lines:
+    """The checksum test of a whole frame of any size (`buf` is the frame): true when it fails."""
+    checksum = protocol.framing.checksum
+    assert checksum is not None  # classic frames have one
+    size = layout.checksum_offset_from_end
+    stored = "buf[-1]" if size == 1 else f"int.from_bytes(buf[-{size}:], 'little')"
+    header = layout.header[: layout.covered_from]
+    whole_sum = checksum.algorithm == "sum" and size == 1 == layout.covered_to_end == checksum.type.size
+    if whole_sum and len(header) == layout.covered_from:
+        less = f" - {sum(header):#x}" if header else ""
+        if not checksum.invert:
+            return [f"if (sum(buf){less} - 2 * buf[-1]) & 0xff:"]
+        return ["check = buf[-1]", f"if ~(sum(buf){less} - check) & 0xff != check:"]
+    covered = f"buf[{layout.covered_from}:-{layout.covered_to_end}]"
+    return [*checksum_lines(checksum, covered, "expected"), f"if expected != {stored}:"]
+
+
+def picked_inline(subs: list[tuple[int, dict[str, Any]]], at: int, code: PackageCode) -> Lines | None:
+    """One function's lines for the sub-command frames of one size, where their checksum does not depend on their
+    fields (a sum or CRC over the bytes, the same lines for all, given the key): the check once, then each
+    sub-command's unpacking under an `if` on its code. None where the check is made from the unpacked values."""
+    first = subs[0][1]["whole_lines"]
+    if "    return None" not in first:
+        return None
+    checks = first[: first.index("    return None") + 1]
+    if any("unpack_from" in line for line in checks):
+        return None
+    if any(f["whole_lines"][: len(checks)] != checks for _, f in subs):
+        return None
+    lines = [*checks, f"sub = buf[{at}]"]
+    for sub_code, f in subs:
+        body = fuse_unpack(f["whole_lines"][len(checks) :], code.structs)
+        lines += [f"if sub == {sub_code:#04x}:", *(f"    {line}" for line in body)]
+    return [*lines, "return None"]
+
+
+def frame_function(
+    protocol: Protocol,
+    layout: FrameLayout,
+    command: Command,
+    message: Message,
+    bodies: dict[str, tuple[str, str, Lines]],
+    code: PackageCode,
+    selector: str | None = None,
+) -> tuple[int, int, dict[str, Any]] | None:
+    """The whole-frame decoders of one message (see fixed_frames): size key, frame size, function; None where the
+    message's frames need the general path. `selector`: the sub-command field, whose check the key makes."""
+    checksum = protocol.framing.checksum
+    if checksum is None or message.min_size != message.max_size:
+        return None  # classic frames have a checksum
+    content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
+    returns, extra, lines = bodies[decoder_name(message)]
+    if not lines[0].startswith("if end - o != "):
+        return None
+    body = lines[2:]  # the content size check: the key implies the size
+    if selector is not None:  # the sub-command's check: the picker chose this decoder by it
+        at = next((i for i, line in enumerate(body) if line.startswith(f"if v_{selector} != ")), None)
+        if at is None:
+            return None
+        body = body[:at] + body[at + 2 :]
+    text = "\n".join(body)
+    if text.count("(buf, o)") > 1 or _CURSOR.search(text.replace("(buf, o)", "")) or "raise " in text:
+        return None  # content read at a moving cursor, or checked beyond its size: the general path
+    size = layout.overhead + (message.min_size or 0)
+    values = [f"{e.name} = buf[start + {layout.offsets[e.name]}]" for e in layout.value_elements]
+    length_byte = (message.min_size or 0) + layout.length_adds
+    summed = summed_frame(protocol, layout, command.code, length_byte, size, body, code)
+    if summed is not None:
+        lines = [*values, *summed, *body[1:]]
+    else:
+        stored = (
+            f"buf[start + {size - 1}]"
+            if layout.checksum_offset_from_end == 1
+            else f"int.from_bytes(buf[start + {size - layout.checksum_offset_from_end} : start + {size}], 'little')"
+        )
+        covered = f"buf[start + {layout.covered_from} : start + {size - layout.covered_to_end}]"
+        lines = [
+            *checksum_lines(checksum, covered, "expected"),
+            f"if expected != {stored}:",
+            "    return None",
+            *values,
+            *(line.replace("(buf, o)", f"(buf, start + {content_offset})") for line in body),
+        ]
+    known = dict(enumerate(layout.header)) | {layout.length_offset: length_byte}
+    if layout.command_offset is not None:
+        known[layout.command_offset] = command.code or 0
+    function: dict[str, Any] = {
+        "name": "_frame" + decoder_name(message).removeprefix("_decode"),
+        "whole_name": "_whole" + decoder_name(message).removeprefix("_decode"),
+        "returns": returns,
+        "where": f"{message.key} {message.direction.value}",
+        "lines": lines,
+        "whole_lines": whole_frame_lines(protocol, layout, size, lines, summed is not None, known),
+    }
+    # built in decode() where its whole-frame decoder sums the frame's bytes (one from the values is quicker yet)
+    function["plain"] = plain_frame(protocol, layout, body, code) if summed is None else None
+    key = length_byte if layout.command_offset is None else (command.code or 0) << 8 | length_byte
+    return key, size, function
+
+
+_PLAIN = re.compile(r"^return _new\((?P<cls>\w+), (?P<struct>_S_\w+)\.unpack_from\(buf, o\)\)$")
+
+
+def plain_check(protocol: Protocol, layout: FrameLayout) -> str | None:
+    """decode()'s test that a whole frame `data` (its size known) holds its checksum, where it is one expression
+    over the frame's bytes: an 8-bit sum over all but a constant header and the check. None for others."""
+    checksum = protocol.framing.checksum
+    header = layout.header[: layout.covered_from]
+    if checksum is None or checksum.algorithm != "sum" or len(header) != layout.covered_from:
+        return None
+    if not layout.checksum_offset_from_end == 1 == layout.covered_to_end == checksum.type.size:
+        return None
+    less = f" - {sum(header):#x}" if header else ""
+    if checksum.invert:
+        return f"~(sum(data){less} - data[-1]) & 0xff == data[-1]"
+    return f"not (sum(data){less} - 2 * data[-1]) & 0xff"
+
+
+def plain_frame(protocol: Protocol, layout: FrameLayout, body: Lines, code: PackageCode) -> tuple[str, str] | None:
+    """(class, struct) of a frame whose message is the tuple one struct unpacks from its content, as it is, and
+    whose checksum decode() tests in one expression (plain_check): decode() builds it itself, with no call.
+    None for others (frame values, conversions, checks)."""
+    fused = fuse_unpack(body, code.structs)
+    plain = _PLAIN.match(fused[0]) if len(fused) == 1 else None
+    if plain is None or layout.value_elements or plain_check(protocol, layout) is None:
+        return None
+    return plain["cls"], plain["struct"]
+
+
+_MOST_UNROLLED = 12  # CRC-8 steps written out one by one in a whole-frame decoder; more take a loop
+_CRC_LOOP = re.compile(r"^for byte in buf\[(?P<first>\d+) : (?P<stop>\d+)\]:$")
+_AT_START = re.compile(r"\bstart \+ (\d+)\b")
+
+
+def whole_frame_lines(
+    protocol: Protocol, layout: FrameLayout, size: int, lines: Lines, summed: bool, known: dict[int, int]
+) -> Lines:
+    """decode()'s version of a whole-frame decoder: `buf` is exactly the frame (decode checked its size), so
+    offsets are constants; an 8-bit sum over all but a constant header is the sum of the whole frame less the
+    header and the checksum byte (no slice is made); an 8-bit CRC starts from its value after the covered bytes
+    that the frame's key fixes (`known`: offset -> byte; header, command code, length byte)."""
+    lines = [_AT_START.sub(r"\1", line) for line in lines]
+    checksum = protocol.framing.checksum
+    assert checksum is not None  # classic frames have one
+    crc = checksum.crc
+    loop = _CRC_LOOP.match(lines[1]) if len(lines) > 1 else None
+    if crc is not None and crc.width == 8 and crc.refin == crc.refout and loop and not summed:
+        table = crc_table(8, crc.poly, crc.refin)
+        state = int(lines[0].removeprefix("expected = "), 16)
+        first = int(loop["first"])
+        while first in known and first < int(loop["stop"]) - 1:
+            state = table[state ^ known[first]]
+            first += 1
+        stop = int(loop["stop"])
+        if stop - first > _MOST_UNROLLED:
+            return [f"expected = {state:#x}", f"for byte in buf[{first} : {stop}]:", *lines[2:]]
+        # a few bytes: one table step each, no slice and no loop
+        steps = [f"expected = _CRC_TABLE[{state:#x} ^ buf[{first}]]"]
+        steps += [f"expected = _CRC_TABLE[expected ^ buf[{offset}]]" for offset in range(first + 1, stop)]
+        return [*steps, *lines[3:]]  # in place of the loop and its one-line body
+    header = layout.header[: layout.covered_from]
+    whole_sum = (
+        not summed
+        and checksum.algorithm == "sum"
+        and checksum.type.size == 1
+        and layout.checksum_offset_from_end == 1
+        and layout.covered_to_end == 1
+        and len(header) == layout.covered_from
+    )
+    if not whole_sum:
+        return lines
+    assert lines[0].startswith("expected = ") and lines[1].startswith("if expected != "), lines[:2]
+    less = f" - {sum(header):#x}" if header else ""
+    if not checksum.invert:  # sum(covered) = check (mod 256): the whole frame sums to twice the check, plus the rest
+        return [f"if (sum(buf){less} - 2 * buf[{size - 1}]) & 0xff:", *lines[2:]]
+    return [f"check = buf[{size - 1}]", f"if ~(sum(buf){less} - check) & 0xff != check:", *lines[2:]]
 
 
 _UNPACK = re.compile(r"^(?P<targets>.+) = (?P<struct>_S_\w+)\.unpack_from\(buf, o\)$")
@@ -515,18 +803,8 @@ def names_used_in_codec(code: PackageCode) -> set[str]:
     bodies = [line for _, _, _, lines in code.decoders for line in lines]
     bodies += [line for _, _, lines in code.encoders for line in lines]
     types = {r for _, r, _, _ in code.decoders} | {t for _, t, _ in code.encoders}
-    types |= set(code.built) | code.member_maps  # built through their slots; enums and flags looked up
+    types |= set(code.built) | code.member_maps  # built by decoders; enums and flags looked up
     return types | set(_IDENTIFIER.findall("\n".join(bodies)))
-
-
-def setter_targets(cls: str, names: list[str]) -> str:
-    """The assignment target for a class's slot setters: one per line when there are more than a few."""
-    setters = [setter_name(cls, n) for n in names]
-    if len(setters) == 1:
-        return f"({setters[0]},)"
-    if len(setters) <= 3:
-        return ", ".join(setters)
-    return "(\n" + "".join(f"    {s},\n" for s in setters) + ")"
 
 
 def frame_decode_lines(
@@ -543,6 +821,8 @@ def frame_decode_lines(
     def at(position: int) -> str:
         return f"{buf}[{position}]" if start is None else f"{buf}[{start} + {position}]"
 
+    checksum = protocol.framing.checksum
+    assert checksum is not None  # classic frames have one
     if start is None:
         covered = f"{buf}[{layout.covered_from or ''}:-{layout.covered_to_end}]"
         stored = f"{buf}[-1]" if size == 1 else f"int.from_bytes({buf}[-{size}:], 'little')"
@@ -553,8 +833,15 @@ def frame_decode_lines(
         stored = f"{buf}[stop - 1]" if size == 1 else f"int.from_bytes({buf}[stop - {size} : stop], 'little')"
         content = f"{start} + {offset}, stop - {after}"
     args = f"{buf}, {content}" + "".join(f", {at(layout.offsets[e.name])}" for e in layout.value_elements)
-    assert protocol.framing.checksum is not None  # classic frames have one
-    lines = checksum_lines(protocol.framing.checksum, covered, "expected")
+    lines = [f"check = {stored}"]  # read once: the sum and the comparison both use it
+    stored = "check"
+    lines += checksum_lines(checksum, covered, "expected")
+    header = layout.header[: layout.covered_from]
+    whole_sum = checksum.algorithm == "sum" and size == 1 == layout.covered_to_end == checksum.type.size
+    if start is None and whole_sum and len(header) == layout.covered_from:
+        # all but a checked header and the check: the sum of the whole frame less those, no slice made
+        less = f" - {sum(header):#x}" if header else ""
+        lines = [lines[0], f"expected = {'~' if checksum.invert else ''}(sum({buf}){less} - {stored}) & 0xff"]
     lines += [
         f"if expected != {stored}:",
         f'    raise ChecksumError(f"bad checksum: the frame has {{{stored}:#04x}}, its bytes give {{expected:#04x}}")',
@@ -588,7 +875,7 @@ def value_ranges(layout: FrameLayout, byte_order: str) -> str:
 
 def value_range_checks(layout: FrameLayout, byte_order: str) -> list[str]:
     """Lines of `decode` refusing a frame whose frame-level value lies outside its declared range, as the stream
-    parser (value_ranges) refuses it; a frame with another header is left to the header's own check."""
+    parser (value_ranges) refuses it; decode checks the header before them."""
     lines = []
     for e in layout.value_elements:
         if e.type is None or e.type.is_float or (e.minimum, e.maximum) == (e.type.minimum, e.type.maximum):
@@ -600,9 +887,18 @@ def value_range_checks(layout: FrameLayout, byte_order: str) -> list[str]:
             else f"int.from_bytes(data[{offset}:{offset + size}], {byte_order!r}, signed={e.type.signed})"
         )
         low, high = int(e.minimum), int(e.maximum)
-        also = f" or {value} == {e.broadcast}" if e.broadcast is not None else ""
         shown = f" (or {e.broadcast})" if e.broadcast is not None else ""
-        lines.append(f"if not ({low} <= {value} <= {high}{also}) and data[:{len(layout.header)}] == {layout.header!r}:")
+        lowest, highest = low, high
+        if e.broadcast in (low - 1, high + 1):  # next to the range: one comparison
+            lowest, highest = min(low, e.broadcast), max(high, e.broadcast)
+        also = f" or {value} == {e.broadcast}" if e.broadcast is not None and lowest == low and highest == high else ""
+        if lowest <= e.type.minimum and not also:  # no value of the type is below it
+            refused = f"{value} > {highest}"
+        elif highest >= e.type.maximum and not also:
+            refused = f"{value} < {lowest}"
+        else:
+            refused = f"not ({lowest} <= {value} <= {highest}{also})"
+        lines.append(f"if {refused}:")
         lines.append(f'    raise DecodeError(f"{e.name} = {{{value}}} is outside its range {low}..{high}{shown}")')
     return lines
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import re
 import struct
+from collections import Counter
 from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
 
@@ -47,9 +48,91 @@ def encoder_name(message: Message) -> str:
     return f"_encode_{message.key.replace('.', '_')}_{message.direction.value}"
 
 
-def setter_name(class_name: str, field_name: str) -> str:
-    """The codec's module-level slot setter of one field of a message class (see PackageCode.build)."""
-    return f"_set_{class_name}_{field_name}"
+def values_tuple(values: list[str]) -> str:
+    """A tuple display of expressions: `(a, b)`, `(a,)`, `()`."""
+    return f"({values[0]},)" if len(values) == 1 else f"({', '.join(values)})"
+
+
+def bound(f: Scalar, value: float) -> str:
+    """A range bound as the literal a comparison with the field's values is quickest with: a float field's bounds
+    as floats where they are exactly that (a float compared with float32's maximum written as a 39-digit integer
+    takes a slow path in CPython), others as numbers."""
+    if f.type.is_float and float(value) == value:
+        return repr(float(value))
+    return number(value)
+
+
+_LOOP = re.compile(r"^(?P<indent> *)for (?P<var>[A-Za-z_]\w*) in .+:$")
+
+
+def read_fields_once(lines: Lines, names: list[str]) -> Lines:
+    """An encoder's lines with each field of the message `m` that they read more than once read once, into a local
+    `m_<field>` first, and likewise each field of a loop's item (`item_<field>`): a range check and the pack read a
+    field two or three times, and a local costs less than an attribute (a record's fields are read through a
+    descriptor, ~15 ns each)."""
+    return _loops_read_once(_read_once(lines, "m", names, ""))
+
+
+def _read_once(lines: Lines, var: str, names: list[str] | None, indent: str) -> Lines:
+    """`lines` with the fields of `var` read more than once (of `names`, or any not called) read once up front."""
+    reads_of = re.compile(rf"(?<![\w.]){var}\.([A-Za-z_]\w*)\b(?!\()")
+    reads = Counter(name for line in lines for name in reads_of.findall(line))
+    again = [name for name in (names if names is not None else reads) if reads[name] > 1]
+    if not again:
+        return lines
+    local = {name: f"{var}_{name}" for name in again}
+
+    def replaced(match: re.Match[str]) -> str:
+        return local.get(match[1], match[0])
+
+    first = [f"{indent}{var}_{name} = {var}.{name}" for name in again]
+    return [*first, *(reads_of.sub(replaced, line) for line in lines)]
+
+
+def _loops_read_once(lines: Lines) -> Lines:
+    out: Lines = []
+    i = 0
+    while i < len(lines):
+        out.append(lines[i])
+        loop = _LOOP.match(lines[i])
+        i += 1
+        if loop is None:
+            continue
+        inner = loop["indent"] + "    "
+        end = i
+        while end < len(lines) and lines[end].startswith(inner):
+            end += 1
+        out += _loops_read_once(_read_once(lines[i:end], loop["var"], None, inner))
+        i = end
+    return out
+
+
+_UNPACKED = re.compile(r"^(?P<targets>[\w, ]+?),? = (?P<call>_S_\w+\.unpack_from\(.+\))$")
+
+
+_ONE_BYTE = re.compile(r"^(?P<indent> *)(?P<target>\w+), = (?P<struct>_S_\w+)\.unpack_from\(buf, (?P<at>.+)\)$")
+
+
+def fuse_unpack(lines: Lines, structs: dict[str, str]) -> Lines:
+    """A decoder's final lines, made cheaper where the analysis of whole frames (package.fixed_frames) is done
+    with them: an unpack into locals that are then built, in order, into the returned message becomes one line,
+    `return _new(Cls, _S.unpack_from(buf, o))` (the tuple struct gives is the message's); a lone unsigned byte is
+    read by indexing, not unpacked."""
+    out: Lines = []
+    for line in lines:
+        unpacked = _UNPACKED.match(out[-1]) if out else None
+        if unpacked and line.startswith("return _new("):
+            names = [name.strip() for name in unpacked["targets"].split(",")]
+            cls, _, rest = line.removeprefix("return _new(").partition(", ")
+            if rest == values_tuple(names) + ")":
+                out[-1] = f"return _new({cls}, {unpacked['call']})"
+                continue
+        out.append(line)
+    for index, line in enumerate(out):
+        one = _ONE_BYTE.match(line)
+        if one and structs.get(one["struct"]) in ("<B", ">B"):
+            out[index] = f"{one['indent']}{one['target']} = buf[{one['at']}]"
+    return out
 
 
 def members_name(class_name: str) -> str:
@@ -312,7 +395,8 @@ class PackageCode:
         frame_names = [f.name for f in self.frame_values(message.direction, message)]
         extra = "".join(f", {name}: int" for name in frame_names)
         self.decoders.append((decoder_name(message), message.class_name, extra, self.decoder(message, fields)))
-        self.encoders.append((encoder_name(message), message.class_name, self.encoder(message, fields)))
+        encoder = read_fields_once(self.encoder(message, fields), [f.name for f in fields])
+        self.encoders.append((encoder_name(message), message.class_name, encoder))
 
     # --- decoding -------------------------------------------------------------------------------------------------
 
@@ -344,19 +428,25 @@ class PackageCode:
         frame_fields = all_fields[: len(all_fields) - len(self.value_fields(message))]
         frame_values = [self.after_unpack(f, f.name, lines, where) or f.name for f in frame_fields]
         self.build(message.class_name, [f.name for f in all_fields], [*frame_values, *values], "m", lines)
-        lines.append("return m")
+        lines[-1] = lines[-1].replace("m = ", "return ", 1)
         return lines
 
     def build(self, class_name: str, names: list[str], values: list[str], target: str, lines: Lines) -> None:
-        """Lines that make an instance of a frozen dataclass in `target`, storing each value into its slot.
+        """The line that makes an instance of a generated class in `target` from its field values, in field order.
 
-        The dataclass __init__ would store each one through object.__setattr__ (that is how frozen works), which
-        costs more than the rest of decoding; decoded values need none of __init__'s work.
+        Every decoder builds its messages here (one place, so a change of how messages are made reaches all of
+        them): `_new(Class, (values...))` is the runtime's `build`, one C call that stores the tuple of values as
+        the record (message.py); decoded values need none of the checks the class's __new__ would not make anyway.
         """
         assert len(names) == len(values), (class_name, names, values)
         self.built[class_name] = names
-        lines.append(f"{target} = _new({class_name})")
-        lines.extend(f"{setter_name(class_name, n)}({target}, {v})" for n, v in zip(names, values, strict=True))
+        lines.append(f"{target} = _new({class_name}, {values_tuple(values)})")
+
+    def build_each(self, class_name: str, names: list[str], tuples: str) -> str:
+        """The expression of a tuple of instances of a generated class, one built (as `build` does) from each tuple
+        of field values, in field order, that the expression `tuples` yields (a struct's iter_unpack)."""
+        self.built[class_name] = names
+        return f"tuple([_new({class_name}, values) for values in {tuples}])"
 
     def enum_value(self, enum: str, raw: str) -> str:
         """The member for a wire value, or the value itself when the spec names none (as enum_or_int does)."""
@@ -546,9 +636,15 @@ class PackageCode:
             item_lines: Lines = []
             item_values = [self.after_unpack(i, n, item_lines, where) for i, n in zip(item_fields, names, strict=True)]
             values = [v for v in item_values if v is not None]
+            items = f"{item_struct}.iter_unpack(buf[o : o + n])"
+            if not item_lines and values == names:  # the unpacked tuples are the items' values
+                lines.pop(lines.index(f"{value}_list = []"))
+                lines.append(f"{value} = {self.build_each(f.class_name, item_names, items)}")
+                lines.append("o += n")
+                return value
             self.build(f.class_name, item_names, values, "item", item_lines)
             target = ", ".join(names) + ("," if len(names) == 1 else "")
-            lines.append(f"for {target} in {item_struct}.iter_unpack(buf[o : o + n]):")
+            lines.append(f"for {target} in {items}:")
             lines.extend("    " + line for line in item_lines)
             lines.append(f"    {value}_list.append(item)")
             lines.append(f"{value} = tuple({value}_list)")
@@ -778,15 +874,14 @@ class PackageCode:
         not_bool = "" if f.type.is_float else f" or {expr}.__class__ is bool"
         if f.flags:  # typed as the IntFlag class, which mypy knows is no bool: asked the way it accepts
             not_bool = f" or isinstance({expr}, bool)"
+        low, high = bound(f, f.minimum), bound(f, f.maximum)
         if also is not None and also in (f.minimum - 1, f.maximum + 1):  # next to the range: one comparison
-            low, high = min(also, f.minimum), max(also, f.maximum)
-            lines.append(f"if not {number(low)} <= {expr} <= {number(high)}{not_bool}:")
+            low, high = bound(f, min(also, f.minimum)), bound(f, max(also, f.maximum))
+            lines.append(f"if not {low} <= {expr} <= {high}{not_bool}:")
         elif also is not None and not f.minimum <= also <= f.maximum:
-            lines.append(
-                f"if not ({number(f.minimum)} <= {expr} <= {number(f.maximum)} or {expr} == {also}){not_bool}:"
-            )
+            lines.append(f"if not ({low} <= {expr} <= {high} or {expr} == {also}){not_bool}:")
         else:
-            lines.append(f"if not {number(f.minimum)} <= {expr} <= {number(f.maximum)}{not_bool}:")
+            lines.append(f"if not {low} <= {expr} <= {high}{not_bool}:")
         lines.append(f"    raise out_of_range({where}, {f.name!r}, {expr}, {number(f.minimum)}, {number(f.maximum)})")
 
     def check_count_from(self, message: Message, lines: Lines, where: str) -> None:
@@ -960,8 +1055,9 @@ class PackageCode:
                 lines.append(f"    raise EncodeError({where} + f': {reason}')")
                 return self.local(f)
             return data
-        if isinstance(f, Bytes):
-            return f"bytes({expr})"
+        if isinstance(f, Bytes):  # bytes as they are (bytes(b) looks up b.__bytes__ first), anything else made bytes
+            lines.append(f"{self.local(f)} = {expr} if {expr}.__class__ is bytes else bytes({expr})")
+            return self.local(f)
         if isinstance(f, TableValue):
             table = f"_TABLE_{f.table.name.upper()}"
             key = f"{obj}.{f.key}"

@@ -14,7 +14,7 @@ from typing import Any
 
 from serialspec.runtime.device.faults import Fault, FaultInjection
 from serialspec.runtime.errors import DecodeError, EncodeError
-from serialspec.runtime.message import Message, compare, field_names
+from serialspec.runtime.message import Message, compare, field_names, is_sequence
 from serialspec.runtime.registers import RegisterMap
 from serialspec.runtime.stream import StreamParser
 
@@ -594,7 +594,7 @@ class Engine(FaultInjection):
             return "busy"
         for name, (low, high, allowed) in command.limits.items():
             value = given.get(name)
-            value = len(value) if isinstance(value, list | tuple) else value
+            value = len(value) if is_sequence(value) else value
             if isinstance(value, int | float) and (not low <= value <= high or (allowed and value not in allowed)):
                 return "out_of_range"
         spaces = {s.name: s for s in self.spec.spaces}
@@ -649,7 +649,7 @@ class Engine(FaultInjection):
         space = next(s for s in self.spec.spaces if s.name == run.space)
         items = device.spaces[run.space]
         start = int(given[run.start])
-        values = list(value) if isinstance(value, list | tuple) else [value]
+        values = list(value) if is_sequence(value) else [value]
         for offset, item in enumerate(values):
             current = items[start + offset]
             stored = run.value(current, given) if run.value is not None else int(item)
@@ -767,7 +767,7 @@ class Engine(FaultInjection):
 
 def _items(value: Any) -> int:
     """How many items of a data space a written value covers: a list's length, else one."""
-    return len(value) if isinstance(value, list | tuple) else 1
+    return len(value) if is_sequence(value) else 1
 
 
 def nest(values: dict[str, Any], overlay: dict[str, Any]) -> None:
@@ -786,6 +786,6 @@ def _whole(value: Any) -> Any:
         return int(value)
     if isinstance(value, dict):
         return {k: _whole(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
+    if is_sequence(value):
         return [_whole(v) for v in value]
     return value

@@ -186,6 +186,15 @@ def test_decode_at_the_cli_as_a_process() -> None:
     assert len(result.stderr.splitlines()) == 1
 
 
+def test_encode_names_the_broadcast_value_beside_the_range() -> None:
+    g = next(r[0] for r in RANGED if r[0].protocol.name == "feetech_sms")
+    request = g.package.messages.PingRequest(id=255)
+    with pytest.raises(EncodeError) as failure:
+        g.package.encode(request)
+    assert str(failure.value) == "ping request: id = 255 is outside its range 0..253 (or 254)"
+    assert g.package.encode(g.package.messages.PingRequest(id=254))  # the broadcast id itself is allowed
+
+
 # --- clients: a device model's ranges (spec: device.models.<model>.entries.<entry>.range) -------------------------
 
 

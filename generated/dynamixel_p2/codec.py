@@ -209,7 +209,7 @@ def _decode_status_response(buf: bytes, o: int, end: int, id: int, error: int) -
 def _encode_ping_request(m: PingRequest) -> bytes:
     m_id = m.id
     if not (0 <= m_id <= 252 or m_id == 254) or m_id.__class__ is bool:
-        raise out_of_range('ping request', 'id', m_id, 0, 252)
+        raise out_of_range('ping request', 'id', m_id, 0, 252, 254)
     return _wrap_request(b'', 0x01, m_id)
 
 
@@ -219,7 +219,7 @@ def _encode_ping_response(m: PingResponse) -> bytes:
     m_model_number = m.model_number
     m_firmware_version = m.firmware_version
     if not (0 <= m_id <= 252 or m_id == 254) or m_id.__class__ is bool:
-        raise out_of_range('ping response', 'id', m_id, 0, 252)
+        raise out_of_range('ping response', 'id', m_id, 0, 252, 254)
     if not 0 <= m_error.alert <= 1 or m_error.alert.__class__ is bool:
         raise out_of_range('ping response', 'error.alert', m_error.alert, 0, 1)
     if not 0 <= m_error.number <= 127 or m_error.number.__class__ is bool:
@@ -236,7 +236,7 @@ def _encode_read_request(m: ReadRequest) -> bytes:
     m_address = m.address
     m_length = m.length
     if not (0 <= m_id <= 252 or m_id == 254) or m_id.__class__ is bool:
-        raise out_of_range('read request', 'id', m_id, 0, 252)
+        raise out_of_range('read request', 'id', m_id, 0, 252, 254)
     if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
         raise out_of_range('read request', 'address', m_address, 0, 65535)
     if not 1 <= m_length <= 1024 or m_length.__class__ is bool:
@@ -249,7 +249,7 @@ def _encode_write_request(m: WriteRequest) -> bytes:
     m_address = m.address
     m_data = m.data
     if not (0 <= m_id <= 252 or m_id == 254) or m_id.__class__ is bool:
-        raise out_of_range('write request', 'id', m_id, 0, 252)
+        raise out_of_range('write request', 'id', m_id, 0, 252, 254)
     if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
         raise out_of_range('write request', 'address', m_address, 0, 65535)
     v_data = m_data if m_data.__class__ is bytes else bytes(m_data)
@@ -261,7 +261,7 @@ def _encode_reg_write_request(m: RegWriteRequest) -> bytes:
     m_address = m.address
     m_data = m.data
     if not (0 <= m_id <= 252 or m_id == 254) or m_id.__class__ is bool:
-        raise out_of_range('reg_write request', 'id', m_id, 0, 252)
+        raise out_of_range('reg_write request', 'id', m_id, 0, 252, 254)
     if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
         raise out_of_range('reg_write request', 'address', m_address, 0, 65535)
     v_data = m_data if m_data.__class__ is bytes else bytes(m_data)
@@ -271,7 +271,7 @@ def _encode_reg_write_request(m: RegWriteRequest) -> bytes:
 def _encode_action_request(m: ActionRequest) -> bytes:
     m_id = m.id
     if not (0 <= m_id <= 252 or m_id == 254) or m_id.__class__ is bool:
-        raise out_of_range('action request', 'id', m_id, 0, 252)
+        raise out_of_range('action request', 'id', m_id, 0, 252, 254)
     return _wrap_request(b'', 0x05, m_id)
 
 
@@ -279,7 +279,7 @@ def _encode_factory_reset_request(m: FactoryResetRequest) -> bytes:
     m_id = m.id
     m_option = m.option
     if not (0 <= m_id <= 252 or m_id == 254) or m_id.__class__ is bool:
-        raise out_of_range('factory_reset request', 'id', m_id, 0, 252)
+        raise out_of_range('factory_reset request', 'id', m_id, 0, 252, 254)
     if not 1 <= m_option <= 255 or m_option.__class__ is bool:
         raise out_of_range('factory_reset request', 'option', m_option, 1, 255)
     return _wrap_request(_S_U8.pack(m_option), 0x06, m_id)
@@ -288,7 +288,7 @@ def _encode_factory_reset_request(m: FactoryResetRequest) -> bytes:
 def _encode_reboot_request(m: RebootRequest) -> bytes:
     m_id = m.id
     if not (0 <= m_id <= 252 or m_id == 254) or m_id.__class__ is bool:
-        raise out_of_range('reboot request', 'id', m_id, 0, 252)
+        raise out_of_range('reboot request', 'id', m_id, 0, 252, 254)
     return _wrap_request(b'', 0x08, m_id)
 
 
@@ -296,7 +296,7 @@ def _encode_clear_request(m: ClearRequest) -> bytes:
     m_id = m.id
     m_option = m.option
     if not (0 <= m_id <= 252 or m_id == 254) or m_id.__class__ is bool:
-        raise out_of_range('clear request', 'id', m_id, 0, 252)
+        raise out_of_range('clear request', 'id', m_id, 0, 252, 254)
     if not 1 <= m_option <= 1 or m_option.__class__ is bool:
         raise out_of_range('clear request', 'option', m_option, 1, 1)
     return _wrap_request(_S_U8_U32.pack(m_option, 575428676), 0x10, m_id)
@@ -307,7 +307,7 @@ def _encode_sync_read_request(m: SyncReadRequest) -> bytes:
     m_address = m.address
     m_length = m.length
     if not (0 <= m_id <= 252 or m_id == 254) or m_id.__class__ is bool:
-        raise out_of_range('sync_read request', 'id', m_id, 0, 252)
+        raise out_of_range('sync_read request', 'id', m_id, 0, 252, 254)
     if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
         raise out_of_range('sync_read request', 'address', m_address, 0, 65535)
     if not 1 <= m_length <= 1024 or m_length.__class__ is bool:
@@ -326,7 +326,7 @@ def _encode_fast_sync_read_request(m: FastSyncReadRequest) -> bytes:
     m_address = m.address
     m_length = m.length
     if not (0 <= m_id <= 252 or m_id == 254) or m_id.__class__ is bool:
-        raise out_of_range('fast_sync_read request', 'id', m_id, 0, 252)
+        raise out_of_range('fast_sync_read request', 'id', m_id, 0, 252, 254)
     if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
         raise out_of_range('fast_sync_read request', 'address', m_address, 0, 65535)
     if not 1 <= m_length <= 1024 or m_length.__class__ is bool:
@@ -345,7 +345,7 @@ def _encode_sync_write_request(m: SyncWriteRequest) -> bytes:
     m_address = m.address
     m_servos = m.servos
     if not (0 <= m_id <= 252 or m_id == 254) or m_id.__class__ is bool:
-        raise out_of_range('sync_write request', 'id', m_id, 0, 252)
+        raise out_of_range('sync_write request', 'id', m_id, 0, 252, 254)
     if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
         raise out_of_range('sync_write request', 'address', m_address, 0, 65535)
     v_length = len(m_servos[0].data) if m_servos else 0
@@ -367,7 +367,7 @@ def _encode_sync_write_request(m: SyncWriteRequest) -> bytes:
 def _encode_bulk_read_request(m: BulkReadRequest) -> bytes:
     m_id = m.id
     if not (0 <= m_id <= 252 or m_id == 254) or m_id.__class__ is bool:
-        raise out_of_range('bulk_read request', 'id', m_id, 0, 252)
+        raise out_of_range('bulk_read request', 'id', m_id, 0, 252, 254)
     parts_reads = []
     for item in m.reads:
         item_id = item.id
@@ -386,7 +386,7 @@ def _encode_bulk_read_request(m: BulkReadRequest) -> bytes:
 def _encode_bulk_write_request(m: BulkWriteRequest) -> bytes:
     m_id = m.id
     if not (0 <= m_id <= 252 or m_id == 254) or m_id.__class__ is bool:
-        raise out_of_range('bulk_write request', 'id', m_id, 0, 252)
+        raise out_of_range('bulk_write request', 'id', m_id, 0, 252, 254)
     parts_writes = []
     for item in m.writes:
         item_id = item.id
@@ -408,7 +408,7 @@ def _encode_status_response(m: StatusResponse) -> bytes:
     m_error = m.error
     m_data = m.data
     if not (0 <= m_id <= 252 or m_id == 254) or m_id.__class__ is bool:
-        raise out_of_range('status response', 'id', m_id, 0, 252)
+        raise out_of_range('status response', 'id', m_id, 0, 252, 254)
     if not 0 <= m_error.alert <= 1 or m_error.alert.__class__ is bool:
         raise out_of_range('status response', 'error.alert', m_error.alert, 0, 1)
     if not 0 <= m_error.number <= 127 or m_error.number.__class__ is bool:

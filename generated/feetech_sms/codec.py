@@ -222,7 +222,7 @@ def _whole_reg_write_request(buf: bytes) -> RegWriteRequest | None:
 def _encode_ping_request(m: PingRequest) -> bytes:
     m_id = m.id
     if not 0 <= m_id <= 254 or m_id.__class__ is bool:
-        raise out_of_range('ping request', 'id', m_id, 0, 253)
+        raise out_of_range('ping request', 'id', m_id, 0, 253, 254)
     body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m_id, 2, 1)
     return body + _BYTES[~sum(body[2:]) & 0xff]
 
@@ -232,7 +232,7 @@ def _encode_read_request(m: ReadRequest) -> bytes:
     m_address = m.address
     m_length = m.length
     if not 0 <= m_id <= 254 or m_id.__class__ is bool:
-        raise out_of_range('read request', 'id', m_id, 0, 253)
+        raise out_of_range('read request', 'id', m_id, 0, 253, 254)
     if not 0 <= m_address <= 255 or m_address.__class__ is bool:
         raise out_of_range('read request', 'address', m_address, 0, 255)
     if not 1 <= m_length <= 250 or m_length.__class__ is bool:
@@ -246,7 +246,7 @@ def _encode_write_request(m: WriteRequest) -> bytes:
     m_address = m.address
     m_data = m.data
     if not 0 <= m_id <= 254 or m_id.__class__ is bool:
-        raise out_of_range('write request', 'id', m_id, 0, 253)
+        raise out_of_range('write request', 'id', m_id, 0, 253, 254)
     if not 0 <= m_address <= 255 or m_address.__class__ is bool:
         raise out_of_range('write request', 'address', m_address, 0, 255)
     v_data = m_data if m_data.__class__ is bytes else bytes(m_data)
@@ -263,7 +263,7 @@ def _encode_reg_write_request(m: RegWriteRequest) -> bytes:
     m_address = m.address
     m_data = m.data
     if not 0 <= m_id <= 254 or m_id.__class__ is bool:
-        raise out_of_range('reg_write request', 'id', m_id, 0, 253)
+        raise out_of_range('reg_write request', 'id', m_id, 0, 253, 254)
     if not 0 <= m_address <= 255 or m_address.__class__ is bool:
         raise out_of_range('reg_write request', 'address', m_address, 0, 255)
     v_data = m_data if m_data.__class__ is bytes else bytes(m_data)
@@ -278,7 +278,7 @@ def _encode_reg_write_request(m: RegWriteRequest) -> bytes:
 def _encode_action_request(m: ActionRequest) -> bytes:
     m_id = m.id
     if not 0 <= m_id <= 254 or m_id.__class__ is bool:
-        raise out_of_range('action request', 'id', m_id, 0, 253)
+        raise out_of_range('action request', 'id', m_id, 0, 253, 254)
     body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m_id, 2, 5)
     return body + _BYTES[~sum(body[2:]) & 0xff]
 
@@ -286,7 +286,7 @@ def _encode_action_request(m: ActionRequest) -> bytes:
 def _encode_reset_request(m: ResetRequest) -> bytes:
     m_id = m.id
     if not 0 <= m_id <= 254 or m_id.__class__ is bool:
-        raise out_of_range('reset request', 'id', m_id, 0, 253)
+        raise out_of_range('reset request', 'id', m_id, 0, 253, 254)
     body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m_id, 2, 6)
     return body + _BYTES[~sum(body[2:]) & 0xff]
 
@@ -296,7 +296,7 @@ def _encode_sync_read_request(m: SyncReadRequest) -> bytes:
     m_address = m.address
     m_length = m.length
     if not 0 <= m_id <= 254 or m_id.__class__ is bool:
-        raise out_of_range('sync_read request', 'id', m_id, 0, 253)
+        raise out_of_range('sync_read request', 'id', m_id, 0, 253, 254)
     if not 0 <= m_address <= 255 or m_address.__class__ is bool:
         raise out_of_range('sync_read request', 'address', m_address, 0, 255)
     if not 1 <= m_length <= 250 or m_length.__class__ is bool:
@@ -320,7 +320,7 @@ def _encode_sync_write_request(m: SyncWriteRequest) -> bytes:
     m_address = m.address
     m_servos = m.servos
     if not 0 <= m_id <= 254 or m_id.__class__ is bool:
-        raise out_of_range('sync_write request', 'id', m_id, 0, 253)
+        raise out_of_range('sync_write request', 'id', m_id, 0, 253, 254)
     if not 0 <= m_address <= 255 or m_address.__class__ is bool:
         raise out_of_range('sync_write request', 'address', m_address, 0, 255)
     v_data_length = len(m_servos[0].data) if m_servos else 0
@@ -349,7 +349,7 @@ def _encode_reply_response(m: ReplyResponse) -> bytes:
     m_error = m.error
     m_data = m.data
     if not 0 <= m_id <= 254 or m_id.__class__ is bool:
-        raise out_of_range('reply response', 'id', m_id, 0, 253)
+        raise out_of_range('reply response', 'id', m_id, 0, 253, 254)
     if not 0 <= m_error <= 255 or isinstance(m_error, bool):
         raise out_of_range('reply response', 'error', m_error, 0, 255)
     v_data = m_data if m_data.__class__ is bytes else bytes(m_data)

@@ -306,7 +306,7 @@ def _encode_read_coils_request(m: ReadCoilsRequest) -> bytes:
     m_address = m.address
     m_count = m.count
     if not 0 <= m_unit <= 247 or m_unit.__class__ is bool:
-        raise out_of_range('read_coils request', 'unit', m_unit, 1, 247)
+        raise out_of_range('read_coils request', 'unit', m_unit, 1, 247, 0)
     if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
         raise out_of_range('read_coils request', 'address', m_address, 0, 65535)
     if not 1 <= m_count <= 2000 or m_count.__class__ is bool:
@@ -319,7 +319,7 @@ def _encode_read_coils_response(m: ReadCoilsResponse) -> bytes:
     m_unit = m.unit
     m_coils = m.coils
     if not 0 <= m_unit <= 247 or m_unit.__class__ is bool:
-        raise out_of_range('read_coils response', 'unit', m_unit, 1, 247)
+        raise out_of_range('read_coils response', 'unit', m_unit, 1, 247, 0)
     if len(m_coils) > 2000:
         raise EncodeError('read_coils response' + f': coils has {len(m_coils)} items, at most 2000 (the limit of the request field count)')
     v_byte_count = (-(-len(m_coils) // 8))
@@ -334,7 +334,7 @@ def _encode_read_discrete_inputs_request(m: ReadDiscreteInputsRequest) -> bytes:
     m_address = m.address
     m_count = m.count
     if not 0 <= m_unit <= 247 or m_unit.__class__ is bool:
-        raise out_of_range('read_discrete_inputs request', 'unit', m_unit, 1, 247)
+        raise out_of_range('read_discrete_inputs request', 'unit', m_unit, 1, 247, 0)
     if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
         raise out_of_range('read_discrete_inputs request', 'address', m_address, 0, 65535)
     if not 1 <= m_count <= 2000 or m_count.__class__ is bool:
@@ -347,7 +347,7 @@ def _encode_read_discrete_inputs_response(m: ReadDiscreteInputsResponse) -> byte
     m_unit = m.unit
     m_inputs = m.inputs
     if not 0 <= m_unit <= 247 or m_unit.__class__ is bool:
-        raise out_of_range('read_discrete_inputs response', 'unit', m_unit, 1, 247)
+        raise out_of_range('read_discrete_inputs response', 'unit', m_unit, 1, 247, 0)
     if len(m_inputs) > 2000:
         raise EncodeError('read_discrete_inputs response' + f': inputs has {len(m_inputs)} items, at most 2000 (the limit of the request field count)')
     v_byte_count = (-(-len(m_inputs) // 8))
@@ -362,7 +362,7 @@ def _encode_read_holding_registers_request(m: ReadHoldingRegistersRequest) -> by
     m_address = m.address
     m_count = m.count
     if not 0 <= m_unit <= 247 or m_unit.__class__ is bool:
-        raise out_of_range('read_holding_registers request', 'unit', m_unit, 1, 247)
+        raise out_of_range('read_holding_registers request', 'unit', m_unit, 1, 247, 0)
     if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
         raise out_of_range('read_holding_registers request', 'address', m_address, 0, 65535)
     if not 1 <= m_count <= 125 or m_count.__class__ is bool:
@@ -375,7 +375,7 @@ def _encode_read_holding_registers_response(m: ReadHoldingRegistersResponse) -> 
     m_unit = m.unit
     m_registers = m.registers
     if not 0 <= m_unit <= 247 or m_unit.__class__ is bool:
-        raise out_of_range('read_holding_registers response', 'unit', m_unit, 1, 247)
+        raise out_of_range('read_holding_registers response', 'unit', m_unit, 1, 247, 0)
     v_byte_count = (2 * len(m_registers))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('read_holding_registers response', 'byte_count', v_byte_count, 0, 255)
@@ -391,7 +391,7 @@ def _encode_read_input_registers_request(m: ReadInputRegistersRequest) -> bytes:
     m_address = m.address
     m_count = m.count
     if not 0 <= m_unit <= 247 or m_unit.__class__ is bool:
-        raise out_of_range('read_input_registers request', 'unit', m_unit, 1, 247)
+        raise out_of_range('read_input_registers request', 'unit', m_unit, 1, 247, 0)
     if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
         raise out_of_range('read_input_registers request', 'address', m_address, 0, 65535)
     if not 1 <= m_count <= 125 or m_count.__class__ is bool:
@@ -404,7 +404,7 @@ def _encode_read_input_registers_response(m: ReadInputRegistersResponse) -> byte
     m_unit = m.unit
     m_registers = m.registers
     if not 0 <= m_unit <= 247 or m_unit.__class__ is bool:
-        raise out_of_range('read_input_registers response', 'unit', m_unit, 1, 247)
+        raise out_of_range('read_input_registers response', 'unit', m_unit, 1, 247, 0)
     v_byte_count = (2 * len(m_registers))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('read_input_registers response', 'byte_count', v_byte_count, 0, 255)
@@ -420,7 +420,7 @@ def _encode_write_coil_request(m: WriteCoilRequest) -> bytes:
     m_address = m.address
     m_value = m.value
     if not 0 <= m_unit <= 247 or m_unit.__class__ is bool:
-        raise out_of_range('write_coil request', 'unit', m_unit, 1, 247)
+        raise out_of_range('write_coil request', 'unit', m_unit, 1, 247, 0)
     if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
         raise out_of_range('write_coil request', 'address', m_address, 0, 65535)
     if not 0 <= m_value <= 65280 or m_value.__class__ is bool:
@@ -434,7 +434,7 @@ def _encode_write_coil_response(m: WriteCoilResponse) -> bytes:
     m_address = m.address
     m_value = m.value
     if not 0 <= m_unit <= 247 or m_unit.__class__ is bool:
-        raise out_of_range('write_coil response', 'unit', m_unit, 1, 247)
+        raise out_of_range('write_coil response', 'unit', m_unit, 1, 247, 0)
     if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
         raise out_of_range('write_coil response', 'address', m_address, 0, 65535)
     if not 0 <= m_value <= 65280 or m_value.__class__ is bool:
@@ -448,7 +448,7 @@ def _encode_write_register_request(m: WriteRegisterRequest) -> bytes:
     m_address = m.address
     m_value = m.value
     if not 0 <= m_unit <= 247 or m_unit.__class__ is bool:
-        raise out_of_range('write_register request', 'unit', m_unit, 1, 247)
+        raise out_of_range('write_register request', 'unit', m_unit, 1, 247, 0)
     if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
         raise out_of_range('write_register request', 'address', m_address, 0, 65535)
     if not 0 <= m_value <= 65535 or m_value.__class__ is bool:
@@ -462,7 +462,7 @@ def _encode_write_register_response(m: WriteRegisterResponse) -> bytes:
     m_address = m.address
     m_value = m.value
     if not 0 <= m_unit <= 247 or m_unit.__class__ is bool:
-        raise out_of_range('write_register response', 'unit', m_unit, 1, 247)
+        raise out_of_range('write_register response', 'unit', m_unit, 1, 247, 0)
     if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
         raise out_of_range('write_register response', 'address', m_address, 0, 65535)
     if not 0 <= m_value <= 65535 or m_value.__class__ is bool:
@@ -476,7 +476,7 @@ def _encode_write_coils_request(m: WriteCoilsRequest) -> bytes:
     m_address = m.address
     m_values = m.values
     if not 0 <= m_unit <= 247 or m_unit.__class__ is bool:
-        raise out_of_range('write_coils request', 'unit', m_unit, 1, 247)
+        raise out_of_range('write_coils request', 'unit', m_unit, 1, 247, 0)
     if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
         raise out_of_range('write_coils request', 'address', m_address, 0, 65535)
     v_count = len(m_values)
@@ -494,7 +494,7 @@ def _encode_write_coils_response(m: WriteCoilsResponse) -> bytes:
     m_address = m.address
     m_count = m.count
     if not 0 <= m_unit <= 247 or m_unit.__class__ is bool:
-        raise out_of_range('write_coils response', 'unit', m_unit, 1, 247)
+        raise out_of_range('write_coils response', 'unit', m_unit, 1, 247, 0)
     if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
         raise out_of_range('write_coils response', 'address', m_address, 0, 65535)
     if not 0 <= m_count <= 65535 or m_count.__class__ is bool:
@@ -508,7 +508,7 @@ def _encode_write_registers_request(m: WriteRegistersRequest) -> bytes:
     m_address = m.address
     m_values = m.values
     if not 0 <= m_unit <= 247 or m_unit.__class__ is bool:
-        raise out_of_range('write_registers request', 'unit', m_unit, 1, 247)
+        raise out_of_range('write_registers request', 'unit', m_unit, 1, 247, 0)
     if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
         raise out_of_range('write_registers request', 'address', m_address, 0, 65535)
     v_count = len(m_values)
@@ -529,7 +529,7 @@ def _encode_write_registers_response(m: WriteRegistersResponse) -> bytes:
     m_address = m.address
     m_count = m.count
     if not 0 <= m_unit <= 247 or m_unit.__class__ is bool:
-        raise out_of_range('write_registers response', 'unit', m_unit, 1, 247)
+        raise out_of_range('write_registers response', 'unit', m_unit, 1, 247, 0)
     if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
         raise out_of_range('write_registers response', 'address', m_address, 0, 65535)
     if not 0 <= m_count <= 65535 or m_count.__class__ is bool:
@@ -544,7 +544,7 @@ def _encode_mask_write_register_request(m: MaskWriteRegisterRequest) -> bytes:
     m_and_mask = m.and_mask
     m_or_mask = m.or_mask
     if not 0 <= m_unit <= 247 or m_unit.__class__ is bool:
-        raise out_of_range('mask_write_register request', 'unit', m_unit, 1, 247)
+        raise out_of_range('mask_write_register request', 'unit', m_unit, 1, 247, 0)
     if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
         raise out_of_range('mask_write_register request', 'address', m_address, 0, 65535)
     if not 0 <= m_and_mask <= 65535 or m_and_mask.__class__ is bool:
@@ -561,7 +561,7 @@ def _encode_mask_write_register_response(m: MaskWriteRegisterResponse) -> bytes:
     m_and_mask = m.and_mask
     m_or_mask = m.or_mask
     if not 0 <= m_unit <= 247 or m_unit.__class__ is bool:
-        raise out_of_range('mask_write_register response', 'unit', m_unit, 1, 247)
+        raise out_of_range('mask_write_register response', 'unit', m_unit, 1, 247, 0)
     if not 0 <= m_address <= 65535 or m_address.__class__ is bool:
         raise out_of_range('mask_write_register response', 'address', m_address, 0, 65535)
     if not 0 <= m_and_mask <= 65535 or m_and_mask.__class__ is bool:
@@ -579,7 +579,7 @@ def _encode_read_write_registers_request(m: ReadWriteRegistersRequest) -> bytes:
     m_write_address = m.write_address
     m_values = m.values
     if not 0 <= m_unit <= 247 or m_unit.__class__ is bool:
-        raise out_of_range('read_write_registers request', 'unit', m_unit, 1, 247)
+        raise out_of_range('read_write_registers request', 'unit', m_unit, 1, 247, 0)
     if not 0 <= m_read_address <= 65535 or m_read_address.__class__ is bool:
         raise out_of_range('read_write_registers request', 'read_address', m_read_address, 0, 65535)
     if not 1 <= m_read_count <= 125 or m_read_count.__class__ is bool:
@@ -603,7 +603,7 @@ def _encode_read_write_registers_response(m: ReadWriteRegistersResponse) -> byte
     m_unit = m.unit
     m_registers = m.registers
     if not 0 <= m_unit <= 247 or m_unit.__class__ is bool:
-        raise out_of_range('read_write_registers response', 'unit', m_unit, 1, 247)
+        raise out_of_range('read_write_registers response', 'unit', m_unit, 1, 247, 0)
     v_byte_count = (2 * len(m_registers))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('read_write_registers response', 'byte_count', v_byte_count, 0, 255)
@@ -619,7 +619,7 @@ def _encode_exception_response(m: ExceptionResponse) -> bytes:
     m_function = m.function
     m_exception_code = m.exception_code
     if not 0 <= m_unit <= 247 or m_unit.__class__ is bool:
-        raise out_of_range('exception response', 'unit', m_unit, 1, 247)
+        raise out_of_range('exception response', 'unit', m_unit, 1, 247, 0)
     if not 0 <= m_function <= 127 or m_function.__class__ is bool:
         raise out_of_range('exception response', 'function', m_function, 0, 127)
     if not 1 <= m_exception_code <= 11 or m_exception_code.__class__ is bool:

@@ -25,18 +25,24 @@ class RangeError(EncodeError):
     """A field value outside its allowed range, refused before any byte is written."""
 
 
-def out_of_range(where: str, field: str, value: object, low: float, high: float) -> EncodeError:
+def out_of_range(
+    where: str, field: str, value: object, low: float, high: float, broadcast: int | None = None
+) -> EncodeError:
     """The error for a value refused before encoding: outside its range, or not a number at all (True is not 1).
 
     For a list of values, the first item at fault is named: "values[3] = 70000 is outside its range 0..65535".
+    `broadcast` is an address's broadcast value, allowed beside the range, which the line names too.
     """
     if is_sequence(value):
         for index, item in enumerate(value):
             if isinstance(item, bool) or not isinstance(item, int | float) or not low <= item <= high:
-                return out_of_range(where, f"{field}[{index}]", item, low, high)
+                return out_of_range(where, f"{field}[{index}]", item, low, high, broadcast)
+    allowed = f"{_number(low)}..{_number(high)}"
+    if broadcast is not None:
+        allowed += f" (or {broadcast})"  # as decode words it
     if isinstance(value, bool) or not isinstance(value, int | float):
-        return EncodeError(f"{where}: {field} must be a number in {_number(low)}..{_number(high)}, got {shown(value)}")
-    return RangeError(f"{where}: {field} = {shown(value)} is outside its range {_number(low)}..{_number(high)}")
+        return EncodeError(f"{where}: {field} must be a number in {allowed}, got {shown(value)}")
+    return RangeError(f"{where}: {field} = {shown(value)} is outside its range {allowed}")
 
 
 def shown(value: object) -> str:

@@ -882,7 +882,10 @@ class PackageCode:
             lines.append(f"if not ({low} <= {expr} <= {high} or {expr} == {also}){not_bool}:")
         else:
             lines.append(f"if not {low} <= {expr} <= {high}{not_bool}:")
-        lines.append(f"    raise out_of_range({where}, {f.name!r}, {expr}, {number(f.minimum)}, {number(f.maximum)})")
+        broadcast = "" if also is None or f.minimum <= also <= f.maximum else f", {also}"
+        lines.append(
+            f"    raise out_of_range({where}, {f.name!r}, {expr}, {number(f.minimum)}, {number(f.maximum)}{broadcast})"
+        )
 
     def check_count_from(self, message: Message, lines: Lines, where: str) -> None:
         """A response list whose count the request gives (`count_from`) holds no more items than the request's

@@ -45,6 +45,24 @@ def test_registers_by_name(client: FeetechSmsClient) -> None:
     }
 
 
+def test_a_read_by_name_sent_again_is_still_checked_before_a_byte(
+    client: FeetechSmsClient, sim: FeetechSmsSimulator
+) -> None:
+    # the first read of (device, register) is checked and encoded; the next ones send that frame as it was
+    assert client.read(1, "present_position") == client.read(1, "present_position")
+    sent = len(sim.log)
+    for bad in (True, 1.0):  # equal to 1 and hashed alike, yet not a device id
+        with pytest.raises(EncodeError, match="id"):
+            client.read(bad, "present_position")  # type: ignore[arg-type]
+    with pytest.raises(RangeError, match="id = 255"):
+        client.read(255, "present_position")
+    with pytest.raises(EncodeError, match="unknown register 'speed'"):
+        client.read(1, "speed")  # type: ignore[arg-type]
+    time.sleep(0.05)
+    assert len(sim.log) == sent
+    assert client.read(2, "torque_limit") == 1000  # another device's read: checked and encoded afresh
+
+
 def test_sign_magnitude_registers_keep_their_sign_bit(client: FeetechSmsClient) -> None:
     assert client.write(1, position_offset=-100) is True  # sign in bit 11, not 15
     assert client.read_raw(1, CONTROL_TABLE["position_offset"].address, 2) == (100 | 1 << 11).to_bytes(2, "little")

@@ -259,9 +259,15 @@ class FeetechSmsClient(ClientBase):
 
     def read(self, id: int, name: ControlTableName) -> int:
         """Read from the control table: one register by name, e.g. `read(1, "firmware_major")`, in wire units."""
+        # A read of this register from this device checked and encoded before: its request and frame as they were.
+        known = self._reads.get((id, name)) if id.__class__ is int else None
+        if known is not None:
+            return known[2](self.bus.request(known[0], ReplyResponse, frame=known[1]).data)
         address, size, value = CONTROL_TABLE.reader(name)
         if id == 254:
             raise EncodeError("read: name one device; the broadcast id 254 gets no reply")
+        request = ReadRequest(id=id, address=address, length=size)
+        self._reads[(id, name)] = (request, encode(request), value)  # encode refuses a bad value first
         return value(self.read_raw(id, address, size) or b"")
 
     def read_many(self, id: int, *names: ControlTableName) -> dict[str, int]:

@@ -27,7 +27,7 @@ from typing import Any, TypeVar
 import serial
 
 from serialspec.runtime.errors import CorruptReply, DeviceError, EncodeError, PortError, Timeout
-from serialspec.runtime.message import Message, Record, compare
+from serialspec.runtime.message import Direction, Message, Record
 from serialspec.runtime.stream import StreamParser
 
 M = TypeVar("M", bound=Message)
@@ -132,6 +132,14 @@ Subscriber = Callable[[Message], None]
 # getter of the fields to match, whether error replies exist, the reply's status fields.
 _Rule = tuple[type, bool, Callable[[Any], Any] | None, bool, tuple[tuple[str, tuple[str, ...]], ...]]
 _ABSENT = object()  # an attribute a message does not have
+_RESPONSE = Direction.RESPONSE  # what decode is told: its member, which generated codecs tell by identity first
+# A parameter's `optional_when` condition (runtime.message.compare) as one C call; None never gets here.
+_COMPARE: dict[str, Callable[[Any, Any], bool]] = {
+    "==": operator.eq,
+    "!=": operator.ne,
+    ">=": operator.ge,
+    "<=": operator.le,
+}
 
 
 class Link:
@@ -399,9 +407,14 @@ class Bus:
             self._drain()
             self._write(frame)
 
-    def request(self, request: Message, expect: type[M], *, timeout: float | None = None) -> M:
-        """Send a request and return its reply: the first frame of type `expect` that matches the request."""
-        frame = self.binding.encode(request)
+    def request(
+        self, request: Message, expect: type[M], *, timeout: float | None = None, frame: bytes | None = None
+    ) -> M:
+        """Send a request and return its reply: the first frame of type `expect` that matches the request.
+
+        `frame`: the request as the codec encoded it before (a client sending one read again): not encoded again."""
+        if frame is None:
+            frame = self.binding.encode(request)
         wait = self.timeout if timeout is None else timeout
         lock = self._lock
         lock.acquire()  # not `with`: half the cost, at tens of microseconds per transaction
@@ -448,7 +461,7 @@ class Bus:
                 if size == self._sizes.get(expect) and not parser.pending():
                     # the size the last reply of this type had: most likely that reply, whole; decoded at once
                     try:
-                        found: Message | None = self._decode(chunk, "response", expect)  # type: ignore[misc]
+                        found: Message | None = self._decode(chunk, _RESPONSE, expect)  # type: ignore[misc]
                     except Exception:  # anything else is for the parser, which counts it and resynchronises
                         found = None
                 else:
@@ -844,6 +857,9 @@ class ClientBase:
         self.bus = bus
         self.optional_replies = optional_replies
         self._parameters: dict[tuple[int, int], float | None] = {}  # None while being read
+        # (address, register name) -> request, its frame, the value from the reply's bytes: reads by name checked
+        # and encoded once (only a request the codec accepted is here), then sent as they are
+        self._reads: dict[tuple[int, str], tuple[Message, bytes, Callable[[bytes], int]]] = {}
 
     def close(self) -> None:
         self.bus.close()
@@ -894,7 +910,7 @@ class ClientBase:
             except Timeout:
                 del self._parameters[(address, key)]
                 return False
-        return True if current is None else compare(current, op, value)
+        return True if current is None else _COMPARE[op](current, value)
 
     def _carry(
         self,

@@ -257,6 +257,12 @@ def register_commands(protocol: Protocol, methods: list[dict[str, Any]]) -> list
             first = not any(c["kind"] == "read" for c in found)
             context.update(kind="read", map=map_name(read.table), alias=names_alias(read.table), returns="int")
             context.update(read_key=first)
+            # a read of one register by name, checked and encoded once per device and register, then sent as it is
+            # (not where the timeout grows with a field or the method checks a status itself)
+            quick = not method["after"] and not method["statuses"]
+            optional = method["optional"] if method["silent"] else ""
+            context.update(quick=quick, request=method["request"], response=method["response"], optional=optional)
+            context.update(start=start, size=size, data=read.name)
         elif group is not None and read is not None and read.table is not None and method["kind"] == "each":
             start, size = read.start, read.size_from
             items = [f.name for f in group.fields]

@@ -202,9 +202,12 @@ def _value(name: str, layout: struct.Struct, sign_bit: int | None) -> Callable[[
     magnitude = (1 << sign_bit) - 1 if sign_bit is not None else -1
     integral = layout.format[-1] in "bBhHiIlLqQ"  # unpacked as an int already
 
+    def short(data: bytes) -> DecodeError:
+        return DecodeError(f"{name}: {len(data)} bytes read, {size} needed")
+
     def value(data: bytes) -> int:
         if len(data) < size:
-            raise DecodeError(f"{name}: {len(data)} bytes read, {size} needed")
+            raise short(data)
         number: int = unpack(data)[0]
         if not integral:
             number = int(number)  # as from_wire does
@@ -212,4 +215,11 @@ def _value(name: str, layout: struct.Struct, sign_bit: int | None) -> Callable[[
             return -(number & magnitude)
         return number
 
-    return value
+    def plain(data: bytes) -> int:  # the usual register: an integer format, no sign bit; one C call
+        try:
+            number: int = unpack(data)[0]
+        except struct.error:  # fewer bytes than it holds
+            raise short(data) from None
+        return number
+
+    return plain if integral and sign_bit is None else value

@@ -129,8 +129,11 @@ def flag_names(flags: dict[str, type[IntFlag]]) -> Callable[[str, int], str]:
 
 Subscriber = Callable[[Message], None]
 # How a bus checks a reply of one type to one request type (Bus._rule): request type, whether it can answer, the
-# getter of the fields to match, whether error replies exist, the reply's status fields.
-_Rule = tuple[type, bool, Callable[[Any], Any] | None, bool, tuple[tuple[str, tuple[str, ...]], ...]]
+# getter of the fields to match, whether error replies exist, the reply's status fields (each with the zeros of its
+# bit fields, or None for a plain number).
+_Rule = tuple[type, bool, Callable[[Any], Any] | None, bool, tuple[tuple[str, tuple[int, ...] | None], ...]]
+# A record's field values against a plain tuple, as tuples (a record's own != says a record never equals a tuple).
+_differ: Callable[[Any, tuple[int, ...]], bool] = tuple.__ne__
 _ABSENT = object()  # an attribute a message does not have
 _RESPONSE = Direction.RESPONSE  # what decode is told: its member, which generated codecs tell by identity first
 # A parameter's `optional_when` condition (runtime.message.compare) as one C call; None never gets here.
@@ -250,19 +253,41 @@ class FdLink(Link):
 
     def transact(self, frame: bytes, wait: float) -> tuple[bytes, bytes | None]:
         # Link.transact's three steps inline: the usual transaction in one Python call and four system calls
-        # (read what waits, write, poll, read).
+        # (poll for what waits, write, poll, read). What waits is asked with a poll that does not wait: a read of
+        # nothing raises BlockingIOError, whose making and catching costs five times the poll.
         self.doing = "read"
         fd = self.port.fd
-        try:
-            stale = os.read(fd, 4096)
-        except BlockingIOError:
-            stale = b""
-        if stale:
-            return self._rest(stale), None
+        poll = self._poll
+        if poll is None or fd != self._fd or poll.poll(0):  # bytes wait, the other end hung up, or first use
+            try:
+                stale = os.read(fd, 4096)
+            except BlockingIOError:
+                stale = b""
+            if stale:
+                return self._rest(stale), None
         self.doing = "write"
-        self.write(frame)
+        if self._spy is not None:
+            self.write(frame)
+        else:  # write() inline
+            try:
+                written = os.write(fd, frame)
+            except BlockingIOError:
+                written = 0
+            if written < len(frame):
+                _POSIX_SERIAL.write(self.port, frame[written:])  # type: ignore[union-attr]
         self.doing = "read"
-        return stale, self.read(wait)
+        if poll is None or fd != self._fd or self._spy is not None:
+            return b"", self.read(wait)
+        # read() inline: the descriptor is registered and open (it was read or polled above)
+        if not poll.poll(wait * 1000):  # milliseconds, rounded up: never before the deadline
+            return b"", self.read(0.0)  # the deadline passed: read() tells a port closed meanwhile from silence
+        try:
+            data = os.read(fd, 4096)
+        except BlockingIOError:  # woken, but another reader took the bytes
+            return b"", b""
+        if not data:  # readable but empty: the other end hung up
+            raise serial.SerialException("device disconnected")
+        return b"", data
 
     def read(self, wait: float) -> bytes:
         fd = self.port.fd
@@ -426,8 +451,9 @@ class Bus:
             # The usual transaction inline (nothing waiting, the reply whole in the first read): every call less
             # matters. Anything else goes through _read_until.
             parser = self._parser
-            if self._expects:
-                parser.expect(expect)  # where replies share a code, the layout this request's reply has
+            # where replies share a code, the parser is told the layout this request's reply has before it is fed
+            # (a reply decoded at once is told by its argument)
+            expects = self._expects
             started = time.monotonic()
             chunk: bytes | None = None
             if not self.echo:
@@ -441,6 +467,8 @@ class Bus:
                     self._port_failed(link.doing, exc)
                     raise
                 if chunk is None:  # bytes came between transactions: to subscribers, then the request
+                    if expects:
+                        parser.expect(expect)
                     self._stale(stale)
             if chunk is None:  # the general path: an echo, or bytes that came before the request
                 self._drain()
@@ -465,6 +493,8 @@ class Bus:
                     except Exception:  # anything else is for the parser, which counts it and resynchronises
                         found = None
                 else:
+                    if expects:
+                        parser.expect(expect)
                     messages = parser.feed(chunk)
                     found = messages[0] if len(messages) == 1 else None
                 if found is not None and found.__class__ is expect:
@@ -477,19 +507,19 @@ class Bus:
                             self._sizes[expect] = size
                         if refusals:
                             self._refused(request, found)
-                        for name, parts in statuses:  # _check_status raises DeviceError
-                            value = getattr(found, name)
-                            if not parts:
-                                if value != 0:  # an int's comparison (a flag's truth is a Python call)
-                                    self._check_status(found)
-                            else:  # bit fields: no comprehension (a function call of its own before 3.12)
-                                for part in parts:
-                                    if getattr(value, part) != 0:
-                                        self._check_status(found)
+                        for name, zero in statuses:  # _check_status raises DeviceError
+                            # an int's comparison (a flag's truth is a Python call); bit fields (a record) compared
+                            # with their zeros as tuples, in one C call
+                            if (getattr(found, name) != 0) if zero is None else _differ(getattr(found, name), zero):
+                                self._check_status(found)
                         return found  # its class is expect
                 if messages is None:  # decoded at once but no reply to this request: the parser takes it
+                    if expects:
+                        parser.expect(expect)
                     messages = parser.feed(chunk)
                 self._backlog.extend(messages)  # _read_until takes them first
+            if expects:
+                self._parser.expect(expect)
             reply = self._read_until(wait - (time.monotonic() - started), request, expect, errors=0)
             if self._backlog:
                 self._flush_backlog()
@@ -559,7 +589,7 @@ class Bus:
         out once; the latest one of each reply type is at hand in `_rules` (a reply type usually answers one
         request type). It says whether the reply can answer at all (command, sub-command); gives a getter of the
         fields both have (None: none); whether the protocol has error replies; the reply's status fields, each
-        with its parts when it is made of bit fields (a Record; an error when any part is not 0)."""
+        with the zeros of its parts when it is made of bit fields (a Record; an error when any part is not 0)."""
         reply_type = type(reply)
         rule = self._all_rules.get((request_type, reply_type))
         if rule is None:
@@ -572,7 +602,7 @@ class Bus:
             names = [n for n in self._match_fields if hasattr(request_type, n) and hasattr(reply_type, n)]
             getter = operator.attrgetter(*names) if names else None
             statuses = tuple(
-                (n, value.__match_args__ if isinstance(value, Record) else ())
+                (n, (0,) * len(value.__match_args__) if isinstance(value, Record) else None)
                 for n in self.binding.status
                 if (value := getattr(reply, n, _ABSENT)) is not _ABSENT
             )

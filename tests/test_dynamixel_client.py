@@ -8,7 +8,7 @@ from collections.abc import Iterator
 import pytest
 from dynamixel_p2.client import DynamixelP2Client
 from dynamixel_p2.simulator import DynamixelP2Simulator
-from serialspec.runtime.errors import DeviceError, RangeError, Timeout
+from serialspec.runtime.errors import DecodeError, DeviceError, RangeError, Timeout
 
 TIMEOUT = 1.0
 
@@ -63,7 +63,9 @@ def test_status_return_level_switches_replies(client: DynamixelP2Client) -> None
     assert client.read(3, "led") == 1  # READ is still answered
     assert client.write(3, status_return_level=0) is None
     client.bus.timeout = 0.1
-    assert client.read_raw(3, 65, 1) is None  # level 0: READ is not answered either
+    with pytest.raises(DecodeError, match="led: 0 bytes read"):  # not Timeout: sent, not waited for
+        client.read(3, "led")  # level 0: READ is not answered either (this read's frame was kept: still sent)
+    assert client.read_raw(3, 65, 1) is None
     assert client.ping(3).model_number == 1020  # PING always is
 
 

@@ -362,13 +362,17 @@ class DynamixelP2Client(ClientBase):
         """Read from the control table: one register by name, e.g. `read(1, "model_number")`, in wire units."""
         # A read of this register from this device checked and encoded before: its request and frame as they were.
         known = self._reads.get((id, name)) if id.__class__ is int else None
-        if known is not None and self._answers(known[0], (68, 1, '>=')):
+        # and its reply due, as the parameter that switches it says (or optional_replies)
+        if known is not None and (
+            self._due.get(known[3], False) if self.optional_replies is None else self.optional_replies
+        ):
             return known[2](self.bus.request(known[0], StatusResponse, frame=known[1]).data)
         address, size, value = CONTROL_TABLE.reader(name)
         if id == 254:
             raise EncodeError("read: name one device; the broadcast id 254 gets no reply")
         request = ReadRequest(id=id, address=address, length=size)
-        self._reads[(id, name)] = (request, encode(request), value)  # encode refuses a bad value first
+        frame = encode(request)  # which refuses a bad value
+        self._reads[(id, name)] = (request, frame, value, (id, (68, 1, '>=')))
         return value(self.read_raw(id, address, size) or b"")
 
     def read_many(self, id: int, *names: ControlTableName) -> dict[str, int]:

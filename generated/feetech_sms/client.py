@@ -267,7 +267,8 @@ class FeetechSmsClient(ClientBase):
         if id == 254:
             raise EncodeError("read: name one device; the broadcast id 254 gets no reply")
         request = ReadRequest(id=id, address=address, length=size)
-        self._reads[(id, name)] = (request, encode(request), value)  # encode refuses a bad value first
+        frame = encode(request)  # which refuses a bad value
+        self._reads[(id, name)] = (request, frame, value)
         return value(self.read_raw(id, address, size) or b"")
 
     def read_many(self, id: int, *names: ControlTableName) -> dict[str, int]:

@@ -129,7 +129,7 @@ def flag_names(flags: dict[str, type[IntFlag]]) -> Callable[[str, int], str]:
 
 Subscriber = Callable[[Message], None]
 # How a bus checks a reply of one type to one request type (Bus._rule): request type, whether it can answer, the
-# getter of the fields to match, whether error replies exist, the reply's status fields (each with the zeros of its
+# getter of the fields to match, whether the reply is an error reply, the reply's status fields (each with the zeros of its
 # bit fields, or None for a plain number).
 _Rule = tuple[type, bool, Callable[[Any], Any] | None, bool, tuple[tuple[str, tuple[int, ...] | None], ...]]
 # A record's field values against a plain tuple, as tuples (a record's own != says a record never equals a tuple).
@@ -588,7 +588,7 @@ class Bus:
         """The matching rule for a reply of exactly the type of `reply` to a request of `request_type`, worked
         out once; the latest one of each reply type is at hand in `_rules` (a reply type usually answers one
         request type). It says whether the reply can answer at all (command, sub-command); gives a getter of the
-        fields both have (None: none); whether the protocol has error replies; the reply's status fields, each
+        fields both have (None: none); whether it is the protocol's error reply; the reply's status fields, each
         with the zeros of its parts when it is made of bit fields (a Record; an error when any part is not 0)."""
         reply_type = type(reply)
         rule = self._all_rules.get((request_type, reply_type))
@@ -606,7 +606,9 @@ class Bus:
                 for n in self.binding.status
                 if (value := getattr(reply, n, _ABSENT)) is not _ABSENT
             )
-            rule = (request_type, possible, getter, self.binding.errors is not None, statuses)
+            errors = self.binding.errors  # a reply that is no error reply refuses nothing
+            refusals = errors is not None and isinstance(reply, errors.response)
+            rule = (request_type, possible, getter, refusals, statuses)
             self._all_rules[(request_type, reply_type)] = rule
         self._rules[reply_type] = rule
         return rule
@@ -887,9 +889,13 @@ class ClientBase:
         self.bus = bus
         self.optional_replies = optional_replies
         self._parameters: dict[tuple[int, int], float | None] = {}  # None while being read
-        # (address, register name) -> request, its frame, the value from the reply's bytes: reads by name checked
-        # and encoded once (only a request the codec accepted is here), then sent as they are
-        self._reads: dict[tuple[int, str], tuple[Message, bytes, Callable[[bytes], int]]] = {}
+        # (address, register name) -> request, its frame, the value from the reply's bytes (and the key of `_due`
+        # for a reply its parameter may switch off): reads by name checked and encoded once (only a request the
+        # codec accepted is here), then sent as they are
+        self._reads: dict[tuple[int, str], tuple[Any, ...]] = {}
+        # (address, optional condition) -> whether those replies are due, from the parameters as last read or
+        # written (emptied whenever they change): what a read sent again asks, without a call
+        self._due: dict[tuple[int, tuple[int, int, str]], bool] = {}
 
     def close(self) -> None:
         self.bus.close()
@@ -934,13 +940,19 @@ class ClientBase:
             address = int(address)
             # While the parameter is read, that read is asked as if it were answered (the read may itself be an
             # optional reply: DYNAMIXEL READ at status_return_level 0); no answer means no optional replies.
+            self._due.clear()
             self._parameters[(address, key)] = None
             try:
                 current = self._parameters[(address, key)] = self._read_key(address, key)
             except Timeout:
                 del self._parameters[(address, key)]
                 return False
-        return True if current is None else _COMPARE[op](current, value)
+            finally:
+                self._due.clear()
+        if current is None:
+            return True
+        due = self._due[(address, optional)] = _COMPARE[op](current, value)
+        return due
 
     def _carry(
         self,
@@ -974,6 +986,7 @@ class ClientBase:
         raise NotImplementedError("this protocol cannot read the parameter that switches its optional replies")
 
     def _remember(self, address: int, key: int, value: float) -> None:
+        self._due.clear()
         if self.BROADCAST is not None and address == self.BROADCAST:
             self._parameters = {k: v for k, v in self._parameters.items() if k[1] != key}
         else:

@@ -268,7 +268,7 @@ class FeetechSmsClient(ClientBase):
             raise EncodeError("read: name one device; the broadcast id 254 gets no reply")
         request = ReadRequest(id=id, address=address, length=size)
         frame = encode(request)  # which refuses a bad value
-        self._reads[(id, name)] = (request, frame, value)
+        self._reads[(id, name)] = (request, frame, value, ())
         return value(self.read_raw(id, address, size) or b"")
 
     def read_many(self, id: int, *names: ControlTableName) -> dict[str, int]:

@@ -129,8 +129,8 @@ def flag_names(flags: dict[str, type[IntFlag]]) -> Callable[[str, int], str]:
 
 Subscriber = Callable[[Message], None]
 # How a bus checks a reply of one type to one request type (Bus._rule): request type, whether it can answer, the
-# getter of the fields to match, whether the reply is an error reply, the reply's status fields (each with the zeros of its
-# bit fields, or None for a plain number).
+# getter of the fields to match, whether the reply is an error reply, the reply's status fields (each with the
+# zeros of its bit fields, or None for a plain number).
 _Rule = tuple[type, bool, Callable[[Any], Any] | None, bool, tuple[tuple[str, tuple[int, ...] | None], ...]]
 # A record's field values against a plain tuple, as tuples (a record's own != says a record never equals a tuple).
 _differ: Callable[[Any, tuple[int, ...]], bool] = tuple.__ne__
@@ -889,13 +889,13 @@ class ClientBase:
         self.bus = bus
         self.optional_replies = optional_replies
         self._parameters: dict[tuple[int, int], float | None] = {}  # None while being read
-        # (address, register name) -> request, its frame, the value from the reply's bytes (and the key of `_due`
-        # for a reply its parameter may switch off): reads by name checked and encoded once (only a request the
+        # (address, register name) -> request, its frame, the value from the reply's bytes, the key of `_due` for a
+        # reply a parameter may switch off (else ()): reads by name checked and encoded once (only a request the
         # codec accepted is here), then sent as they are
-        self._reads: dict[tuple[int, str], tuple[Any, ...]] = {}
+        self._reads: dict[tuple[int, str], tuple[Message, bytes, Callable[[bytes], int], tuple[Any, ...]]] = {}
         # (address, optional condition) -> whether those replies are due, from the parameters as last read or
         # written (emptied whenever they change): what a read sent again asks, without a call
-        self._due: dict[tuple[int, tuple[int, int, str]], bool] = {}
+        self._due: dict[tuple[Any, ...], bool] = {}
 
     def close(self) -> None:
         self.bus.close()

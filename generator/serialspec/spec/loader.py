@@ -10,6 +10,7 @@ message does not depend on how PyYAML was built.
 from __future__ import annotations
 
 import re
+import sys
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -50,6 +51,7 @@ def dotted(path: Path) -> str:
 _CONSTRUCTOR = yaml.SafeLoader("")
 _COMPOSER: type[yaml.SafeLoader] = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 _STR = "tag:yaml.org,2002:str"
+_ScalarNode = yaml.ScalarNode
 # The safe loader's constructor of each scalar tag, called directly: construct_object's bookkeeping (recursion
 # guard, a cache of every node built) is for mappings and lists, which _convert walks itself.
 _SCALARS: dict[str, Any] = {
@@ -127,7 +129,9 @@ def load_text(text: str, file: str) -> Located:
     if root is None:
         raise SpecErrors([SpecError(file, 1, 1, "", "empty spec (expected a mapping with protocol, framing, ...)")])
     errors: list[SpecError] = []
-    located.data = _Converter(located, errors, _count_nodes(root)).convert(root, ())
+    # Without an anchor (`&`) there is no alias: every node is converted once, within any budget; not counted.
+    distinct = _count_nodes(root) if "&" in text else None
+    located.data = _Converter(located, errors, distinct).convert(root, ())
     if errors:
         raise SpecErrors(errors)
     return located
@@ -156,10 +160,11 @@ class _Expansion(Exception):
 class _Converter:
     """Nodes to plain values, within the depth and expansion limits, refusing aliases that contain themselves."""
 
-    def __init__(self, located: Located, errors: list[SpecError], distinct: int) -> None:
+    def __init__(self, located: Located, errors: list[SpecError], distinct: int | None) -> None:
+        """`distinct`: how many distinct nodes the file holds; None when it has no aliases (nothing to budget)."""
         self.located = located
         self.errors = errors
-        self.budget = distinct * EXPANSION_FACTOR + EXPANSION_SLACK
+        self.budget = distinct * EXPANSION_FACTOR + EXPANSION_SLACK if distinct is not None else sys.maxsize
         self.open: set[int] = set()  # the nodes being converted (the current path)
 
     def fail(self, node: yaml.Node, path: Path, message: str) -> None:
@@ -181,6 +186,10 @@ class _Converter:
         if len(path) > MAX_DEPTH:
             self.fail(node, path[:3], f"values nested too deeply (more than {MAX_DEPTH} levels)")
             return None
+        if node.__class__ is _ScalarNode and node.tag == _STR:  # most values: text (a scalar contains no alias)
+            mark = node.start_mark
+            located.marks[path] = (mark.line + 1, mark.column + 1)
+            return node.value
         if id(node) in self.open:
             self.fail(node, path, "a YAML alias refers to a value that contains it")
             return None
@@ -196,14 +205,15 @@ class _Converter:
                 if not isinstance(key, str | int) or isinstance(key, bool):
                     self.fail(key_node, path, "keys must be names or numbers")
                     continue
+                inner = (*path, key)
                 if key in result:
-                    self.fail(key_node, (*path, key), f"duplicate key {key!r}")
+                    self.fail(key_node, inner, f"duplicate key {key!r}")
                     continue
                 if isinstance(key, str) and (bad := CONTROL.search(key)):
-                    self.fail(key_node, (*path, key), f"control character U+{ord(bad.group()):04X} in a key")
+                    self.fail(key_node, inner, f"control character U+{ord(bad.group()):04X} in a key")
                     continue
-                located.key_marks[(*path, key)] = _position(key_node)
-                result[key] = self._convert(value_node, (*path, key))
+                located.key_marks[inner] = _position(key_node)
+                result[key] = self._convert(value_node, inner)
             self.open.discard(id(node))
             return result
         if isinstance(node, yaml.SequenceNode):

@@ -20,7 +20,7 @@ T = TypeVar("T")
 
 
 class _Layout:
-    """A frozen class's fields: names in order, defaults, default factories."""
+    """A value class's fields: names in order, defaults, default factories."""
 
     __slots__ = ("names", "known", "defaults", "factories")
 
@@ -37,7 +37,17 @@ _FIELD = getattr(dataclasses, "_FIELD", None)  # what marks a dataclass field (n
 
 @dataclass_transform(eq_default=True, frozen_default=True, field_specifiers=(dataclasses.field,))
 def frozen(cls: type[T]) -> type[T]:
-    """Make `cls` an immutable value class of the fields it annotates (after those of its frozen bases)."""
+    """Make `cls` an immutable value class of the fields it annotates (after those of its value-class bases)."""
+    return _make(cls, _METHODS)
+
+
+@dataclass_transform(eq_default=True, field_specifiers=(dataclasses.field,))
+def mutable(cls: type[T]) -> type[T]:
+    """Make `cls` a value class whose fields may be assigned (`@dataclass`): not hashable, as dataclasses makes it."""
+    return _make(cls, _MUTABLE_METHODS)
+
+
+def _make(cls: type[T], methods: dict[str, Any]) -> type[T]:
     names: list[str] = []
     defaults: dict[str, Any] = {}
     factories: dict[str, Callable[[], Any]] = {}
@@ -75,7 +85,7 @@ def frozen(cls: type[T]) -> type[T]:
     _LAYOUTS[cls] = _Layout(tuple(names), defaults, factories)
     setattr(cls, "__dataclass_fields__", _fields(cls, names, defaults, factories))  # noqa: B010 (not in the type)
     own = cls.__dict__
-    for method, function in _METHODS.items():
+    for method, function in methods.items():
         if method not in own or (method == "__hash__" and own[method] is None):  # eq defined here: hash set to None
             setattr(cls, method, function)
     setattr(cls, "__match_args__", tuple(names))  # noqa: B010 (not in the type)
@@ -84,7 +94,7 @@ def frozen(cls: type[T]) -> type[T]:
 
 def _layout(cls: type) -> _Layout:
     layout = _LAYOUTS.get(cls)
-    if layout is None:  # a subclass that is not frozen itself: its nearest frozen base's fields
+    if layout is None:  # a subclass that is not made a value class itself: its nearest base's fields
         layout = next(_LAYOUTS[base] for base in cls.__mro__ if base in _LAYOUTS)
     return layout
 
@@ -118,6 +128,9 @@ def _init(self: Any, *args: Any, **kwargs: Any) -> None:
     cls = type(self)
     layout = _layout(cls)
     names = layout.names
+    if not kwargs and len(args) == len(names):  # every field given in order: the common case
+        self.__dict__.update(zip(names, args, strict=True))
+        return
     if len(args) > len(names):
         raise TypeError(f"{cls.__qualname__}() takes {len(names)} arguments but {len(args)} were given")
     values = dict(zip(names, args, strict=False))  # fewer arguments than fields: the rest by keyword or default
@@ -127,16 +140,16 @@ def _init(self: Any, *args: Any, **kwargs: Any) -> None:
         if name not in layout.known:
             raise TypeError(f"{cls.__qualname__}() got an unexpected keyword argument {name!r}")
         values[name] = value
-    if len(values) < len(names):
-        for name in names:
-            if name not in values:
-                if name in layout.defaults:
-                    values[name] = layout.defaults[name]
-                elif name in layout.factories:
-                    values[name] = layout.factories[name]()
-                else:
-                    raise TypeError(f"{cls.__qualname__}() missing required argument: {name!r}")
-    self.__dict__.update(values)
+    fields = self.__dict__
+    for name in names:  # stored in field order, whatever order they were given in (vars() lists them so)
+        if name in values:
+            fields[name] = values[name]
+        elif name in layout.defaults:
+            fields[name] = layout.defaults[name]
+        elif name in layout.factories:
+            fields[name] = layout.factories[name]()
+        else:
+            raise TypeError(f"{cls.__qualname__}() missing required argument: {name!r}")
 
 
 def _values(self: Any) -> tuple[Any, ...]:
@@ -176,3 +189,4 @@ _METHODS: dict[str, Callable[..., Any]] = {
     "__setattr__": _setattr,
     "__delattr__": _delattr,
 }
+_MUTABLE_METHODS: dict[str, Any] = {"__init__": _init, "__repr__": _repr, "__eq__": _eq, "__hash__": None}

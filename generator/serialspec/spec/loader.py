@@ -10,19 +10,19 @@ message does not depend on how PyYAML was built.
 from __future__ import annotations
 
 import re
-import sys
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import Any
 
 import yaml
 
 from serialspec.collection import without_cycle_collection
 from serialspec.spec.errors import SpecError, SpecErrors
+from serialspec.spec.frozen import mutable
 
 Path = tuple[str | int, ...]
 
 
-@dataclass
+@mutable
 class Located:
     """A loaded document plus the (line, column) of every value, by path from the root."""
 
@@ -129,9 +129,7 @@ def load_text(text: str, file: str) -> Located:
     if root is None:
         raise SpecErrors([SpecError(file, 1, 1, "", "empty spec (expected a mapping with protocol, framing, ...)")])
     errors: list[SpecError] = []
-    # Without an anchor (`&`) there is no alias: every node is converted once, within any budget; not counted.
-    distinct = _count_nodes(root) if "&" in text else None
-    located.data = _Converter(located, errors, distinct).convert(root, ())
+    located.data = _Converter(located, errors, root).convert(root, ())
     if errors:
         raise SpecErrors(errors)
     return located
@@ -160,11 +158,13 @@ class _Expansion(Exception):
 class _Converter:
     """Nodes to plain values, within the depth and expansion limits, refusing aliases that contain themselves."""
 
-    def __init__(self, located: Located, errors: list[SpecError], distinct: int | None) -> None:
-        """`distinct`: how many distinct nodes the file holds; None when it has no aliases (nothing to budget)."""
+    def __init__(self, located: Located, errors: list[SpecError], root: yaml.Node) -> None:
         self.located = located
         self.errors = errors
-        self.budget = distinct * EXPANSION_FACTOR + EXPANSION_SLACK if distinct is not None else sys.maxsize
+        # Values converted may number EXPANSION_SLACK + EXPANSION_FACTOR * the distinct nodes: the nodes are counted
+        # only once the slack is spent (a large file, or aliases), which most files never reach.
+        self.budget = EXPANSION_SLACK
+        self.root: yaml.Node | None = root
         self.open: set[int] = set()  # the nodes being converted (the current path)
 
     def fail(self, node: yaml.Node, path: Path, message: str) -> None:
@@ -180,6 +180,9 @@ class _Converter:
     def _convert(self, node: yaml.Node, path: Path) -> Any:
         located = self.located
         self.budget -= 1
+        if self.budget < 0 and self.root is not None:
+            self.budget += _count_nodes(self.root) * EXPANSION_FACTOR
+            self.root = None
         if self.budget < 0:
             self.fail(node, path, "the YAML aliases expand to too many values (a YAML bomb?)")
             raise _Expansion

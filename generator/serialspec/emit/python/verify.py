@@ -34,12 +34,12 @@ class _Checker:
     def __init__(self, protocol: Protocol, package: ModuleType) -> None:
         self.protocol = protocol
         self.package = package
+        self.classes: dict[tuple[str, str | None, str], Any] = {}
+        for cls in reversed(package.MESSAGE_TYPES):  # the first of any two alike wins, as a search in order finds
+            self.classes[cls.COMMAND, cls.SUBCOMMAND, cls.DIRECTION.value] = cls
 
     def message_class(self, command: str, subcommand: str | None, direction: str) -> Any:
-        for cls in self.package.MESSAGE_TYPES:
-            if (cls.COMMAND, cls.SUBCOMMAND, cls.DIRECTION.value) == (command, subcommand, direction):
-                return cls
-        return None
+        return self.classes.get((command, subcommand, direction))
 
     def decodes_as(self, frame: bytes, direction: str, command: str, subcommand: str | None, fields: Any) -> str:
         """What is wrong with reading `frame` as the given message with the given values ("" if nothing)."""

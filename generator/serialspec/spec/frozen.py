@@ -6,7 +6,9 @@ installs shared methods instead, which read the class's field names: the same co
 arguments, defaults and `field(default_factory=...)`, the fields of a frozen base first), equality and hash by
 field values within one class, the repr, `__match_args__`, assignment refused with FrozenInstanceError, and
 `__dataclass_fields__` (dataclasses.fields, replace and asdict work on them). Methods a class defines itself are
-kept, as dataclasses keeps them. `dataclass_transform` tells type checkers what they are.
+kept, as dataclasses keeps them. `dataclass_transform` tells type checkers what they are. `mutable` does the same
+for a plain `@dataclass` (fields may be assigned; not hashable). Not supported, as nothing here uses them:
+`field(init=False)`, `__post_init__`, and `@dataclass` subclasses of these classes (use `frozen` or `mutable`).
 """
 
 from __future__ import annotations

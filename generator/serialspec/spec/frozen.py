@@ -68,6 +68,8 @@ def _make(cls: type[T], methods: dict[str, Any]) -> type[T]:
         factories.pop(name, None)
         value = cls.__dict__.get(name, MISSING)
         if isinstance(value, dataclasses.Field):
+            if not value.init:
+                raise TypeError(f"{cls.__qualname__}.{name}: field(init=False) is not supported here")
             if value.default is not MISSING:
                 defaults[name] = value.default
                 setattr(cls, name, value.default)
@@ -78,6 +80,8 @@ def _make(cls: type[T], methods: dict[str, Any]) -> type[T]:
                 delattr(cls, name)
         elif value is not MISSING:
             defaults[name] = value
+    if hasattr(cls, "__post_init__"):
+        raise TypeError(f"{cls.__qualname__}: __post_init__ is not supported here")
     seen_default = ""
     for name in names:
         if name in defaults or name in factories:

@@ -200,28 +200,50 @@ class _Converter:
         if isinstance(node, yaml.CollectionNode) and node.tag not in _PLAIN_TAGS:
             self.fail(node, path, f"YAML tag {node.tag!r} is not supported")
             return None
+        # Text values inside a mapping or list are taken in the loop (most values are): what _convert does for them,
+        # without a call each. `shallow`: their paths, one longer than this one, are within the depth limit.
+        shallow = len(path) < MAX_DEPTH
+        marks = located.marks
         if isinstance(node, yaml.MappingNode):
             self.open.add(id(node))
             result: dict[Any, Any] = {}
             for key_node, value_node in node.value:
-                key = _scalar(key_node) if isinstance(key_node, yaml.ScalarNode) else None
-                if not isinstance(key, str | int) or isinstance(key, bool):
-                    self.fail(key_node, path, "keys must be names or numbers")
-                    continue
+                if key_node.__class__ is _ScalarNode and key_node.tag == _STR:
+                    key = key_node.value  # a name: most keys
+                else:
+                    key = _scalar(key_node) if isinstance(key_node, yaml.ScalarNode) else None
+                    if not isinstance(key, str | int) or isinstance(key, bool):
+                        self.fail(key_node, path, "keys must be names or numbers")
+                        continue
                 inner = (*path, key)
                 if key in result:
                     self.fail(key_node, inner, f"duplicate key {key!r}")
                     continue
-                if isinstance(key, str) and (bad := CONTROL.search(key)):
+                if isinstance(key, str) and not key.isprintable() and (bad := CONTROL.search(key)):
                     self.fail(key_node, inner, f"control character U+{ord(bad.group()):04X} in a key")
                     continue
-                located.key_marks[inner] = _position(key_node)
-                result[key] = self._convert(value_node, inner)
+                mark = key_node.start_mark
+                located.key_marks[inner] = (mark.line + 1, mark.column + 1)
+                if value_node.__class__ is _ScalarNode and value_node.tag == _STR and shallow and self.budget > 0:
+                    self.budget -= 1
+                    mark = value_node.start_mark
+                    marks[inner] = (mark.line + 1, mark.column + 1)
+                    result[key] = value_node.value
+                else:
+                    result[key] = self._convert(value_node, inner)
             self.open.discard(id(node))
             return result
         if isinstance(node, yaml.SequenceNode):
             self.open.add(id(node))
-            items = [self._convert(item, (*path, index)) for index, item in enumerate(node.value)]
+            items = []
+            for index, item in enumerate(node.value):
+                if item.__class__ is _ScalarNode and item.tag == _STR and shallow and self.budget > 0:
+                    self.budget -= 1
+                    mark = item.start_mark
+                    marks[(*path, index)] = (mark.line + 1, mark.column + 1)
+                    items.append(item.value)
+                else:
+                    items.append(self._convert(item, (*path, index)))
             self.open.discard(id(node))
             return items
         if isinstance(node, yaml.ScalarNode):

@@ -22,6 +22,7 @@ from serialspec.runtime.registers import ModelRegisters
 from serialspec.runtime.transport import Binding, Bus, ClientBase
 
 from dynamixel_p2 import MATCH_BY, SERIAL
+from dynamixel_p2.codec import _ENCODERS as ENCODERS  # each request class's encoder, for the bus to call at once
 from dynamixel_p2.codec import StreamParser, decode, encode
 from dynamixel_p2.messages import (
     ActionRequest,
@@ -57,6 +58,7 @@ BINDING = Binding(
     protocol='dynamixel_p2',
     serial=SERIAL,
     encode=encode,
+    encoders=ENCODERS,
     decode=decode,
     parser=lambda: StreamParser(Direction.RESPONSE),
     match_by=MATCH_BY,

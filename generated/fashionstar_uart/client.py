@@ -20,6 +20,7 @@ from serialspec.runtime.message import Message
 from serialspec.runtime.transport import Binding, Bus, ClientBase, table_key
 
 from fashionstar_uart import MATCH_BY, SERIAL
+from fashionstar_uart.codec import _ENCODERS as ENCODERS  # each request class's encoder, for the bus to call at once
 from fashionstar_uart.codec import StreamParser, decode, encode
 from fashionstar_uart.messages import (
     AsyncEnd,
@@ -89,6 +90,7 @@ BINDING = Binding(
     protocol='fashionstar_uart',
     serial=SERIAL,
     encode=encode,
+    encoders=ENCODERS,
     decode=decode,
     parser=lambda: StreamParser(Direction.RESPONSE),
     match_by=MATCH_BY,

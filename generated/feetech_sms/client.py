@@ -23,6 +23,7 @@ from serialspec.runtime.registers import ModelRegisters
 from serialspec.runtime.transport import Binding, Bus, ClientBase, flag_names
 
 from feetech_sms import MATCH_BY, SERIAL
+from feetech_sms.codec import _ENCODERS as ENCODERS  # each request class's encoder, for the bus to call at once
 from feetech_sms.codec import StreamParser, decode, encode
 from feetech_sms.messages import (
     ActionRequest,
@@ -48,6 +49,7 @@ BINDING = Binding(
     protocol='feetech_sms',
     serial=SERIAL,
     encode=encode,
+    encoders=ENCODERS,
     decode=decode,
     parser=lambda: StreamParser(Direction.RESPONSE),
     match_by=MATCH_BY,

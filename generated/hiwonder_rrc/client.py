@@ -20,6 +20,7 @@ import serial
 from serialspec.runtime.transport import Binding, Bus, ClientBase, check_status
 
 from hiwonder_rrc import MATCH_BY, SERIAL
+from hiwonder_rrc.codec import _ENCODERS as ENCODERS  # each request class's encoder, for the bus to call at once
 from hiwonder_rrc.codec import StreamParser, decode, encode
 from hiwonder_rrc.messages import (
     BusServoLoadRequest,
@@ -88,6 +89,7 @@ BINDING = Binding(
     protocol='hiwonder_rrc',
     serial=SERIAL,
     encode=encode,
+    encoders=ENCODERS,
     decode=decode,
     parser=lambda: StreamParser(Direction.RESPONSE),
     match_by=MATCH_BY,

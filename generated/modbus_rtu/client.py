@@ -22,6 +22,7 @@ from serialspec.runtime.errors import Timeout
 from serialspec.runtime.transport import Binding, Bus, ClientBase, ErrorReplies
 
 from modbus_rtu import MATCH_BY, SERIAL
+from modbus_rtu.codec import _ENCODERS as ENCODERS  # each request class's encoder, for the bus to call at once
 from modbus_rtu.codec import StreamParser, decode, encode
 from modbus_rtu.messages import (
     CoilState,
@@ -56,6 +57,7 @@ BINDING = Binding(
     protocol='modbus_rtu',
     serial=SERIAL,
     encode=encode,
+    encoders=ENCODERS,
     decode=decode,
     parser=lambda: StreamParser(Direction.RESPONSE),
     match_by=MATCH_BY,

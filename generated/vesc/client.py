@@ -23,6 +23,7 @@ import serial
 from serialspec.runtime.transport import Binding, Bus, ClientBase
 
 from vesc import MATCH_BY, SERIAL
+from vesc.codec import _ENCODERS as ENCODERS  # each request class's encoder, for the bus to call at once
 from vesc.codec import StreamParser, decode, encode
 from vesc.messages import (
     AliveRequest,
@@ -49,6 +50,7 @@ BINDING = Binding(
     protocol='vesc',
     serial=SERIAL,
     encode=encode,
+    encoders=ENCODERS,
     decode=decode,
     parser=lambda: StreamParser(Direction.RESPONSE),
     match_by=MATCH_BY,

@@ -445,6 +445,10 @@ class FrameCodec:
             return lambda buffer, start, end: self.probe(layout, buffer, start, end)
         command = commands[0] if commands else None  # none: after the head (stuffed), so no code is read here
         length: tuple[int, Element, int, int] | None = plan["probe_length"]
+        measured = None  # the length element read in place: offset, stop, byte order, adds, sizes around it
+        if length is not None:
+            offset, element, outside, inside_fixed = length
+            measured = (offset, offset + element.size, element.endian, element.adds, outside, inside_fixed)
         trailer = layout.trailer if layout.trailer and layout.transparency is not None else b""
         before, prefix, overhead, bounded = plan["before"], plan["prefix"], layout.overhead, layout.transparency is None
 
@@ -474,9 +478,9 @@ class FrameCodec:
                 if not minimum <= value <= maximum and value != also:
                     return -1
             low, high = content_sizes.get(code, (0, None))
-            if length is not None:
-                offset, element, outside, inside_fixed = length
-                counted = element.unpack(buffer[start + offset : start + offset + element.size]) - element.adds
+            if measured is not None:
+                offset, stop, endian, adds, outside, inside_fixed = measured
+                counted = int.from_bytes(buffer[start + offset : start + stop], endian) - adds
                 content = counted - inside_fixed
                 if content < low or (bounded and high is not None and content > high):
                     return -1
@@ -515,6 +519,8 @@ class FrameStreamParser(StreamParser):
         if not formats:
             raise ValueError("a stream parser needs at least one frame format")
         self._formats = formats
+        # every layout's sizer with its format's decoder, in the order candidates try them
+        self._sizers = tuple((sizer, decode) for codec, decode in formats for sizer in codec.sizers)
         self._pending = b""
         headers = [layout.header for codec, _ in formats for layout in codec.layouts]
         self._headers = tuple(sorted({h for h in headers}, key=len)) if all(headers) else ()
@@ -579,22 +585,21 @@ class FrameStreamParser(StreamParser):
     def _try(self, buffer: bytes, position: int, end: int, found: list[Message]) -> int | None:
         """End of the frame accepted at position, None to wait for bytes, -1 implausible, -2 corrupt."""
         waiting = False
-        for codec, decode in self._formats:
-            for sizer in codec.sizers:
-                size = sizer(buffer, position, end)
-                if size is None:
-                    waiting = True
-                    continue
-                if size < 0:
-                    continue
-                if position + size > end:
-                    waiting = True
-                    continue
-                try:
-                    found.append(decode(buffer[position : position + size], self.expected))
-                except DecodeError:
-                    return -2
-                return position + size
+        for sizer, decode in self._sizers:
+            size = sizer(buffer, position, end)
+            if size is None:
+                waiting = True
+                continue
+            if size < 0:
+                continue
+            if position + size > end:
+                waiting = True
+                continue
+            try:
+                found.append(decode(buffer[position : position + size], self.expected))
+            except DecodeError:
+                return -2
+            return position + size
         return None if waiting else -1
 
     def pending(self) -> bytes:

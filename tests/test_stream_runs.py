@@ -14,7 +14,7 @@ from __future__ import annotations
 from collections.abc import Iterator
 
 import pytest
-from conftest import Generated
+from conftest import Generated, examples
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from serialspec.runtime.message import Direction, Message, build
@@ -94,7 +94,7 @@ def test_runs_take_what_the_byte_by_byte_scan_takes(g: Generated, direction: Dir
     frames = [e.frame for e in g.protocol.examples if e.direction == direction]
     taken: list[list[int]] = []
 
-    @settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+    @settings(max_examples=examples(100), deadline=None, suppress_health_check=[HealthCheck.too_slow])
     @given(run_stream(frames, header, g.protocol.framing.layouts[direction].length_offset))
     def run(drawn: tuple[bytes, list[bytes]]) -> None:
         batch = g.package.StreamParser(direction)
@@ -188,7 +188,7 @@ def pair_stream(draw: st.DrawFn) -> tuple[bytes, list[bytes]]:
 def test_runs_of_a_made_up_format_with_an_inverted_sum_after_the_header() -> None:
     taken: list[list[int]] = []
 
-    @settings(max_examples=300, deadline=None)
+    @settings(max_examples=examples(300), deadline=None)
     @given(pair_stream())
     def run(drawn: tuple[bytes, list[bytes]]) -> None:
         batch = StreamParser(PAIR_FORMAT)

@@ -48,29 +48,33 @@ def counting(parser: StreamParser) -> list[int]:
 
 @st.composite
 def run_stream(draw: st.DrawFn, frames: list[bytes], header: bytes, length_at: int) -> tuple[bytes, list[bytes]]:
+    """Runs of one frame long enough to be taken as runs, a few frames in them damaged, noise after some."""
     parts: list[bytes] = []
-    for _ in range(draw(st.integers(1, 6))):
+    for _ in range(draw(st.integers(1, 4))):
         frame = draw(st.sampled_from(frames))
-        for _ in range(draw(st.integers(1, 40))):
-            kind = draw(st.integers(0, 19))
+        copies = [frame] * draw(st.integers(1, 120))
+        noise = st.binary(min_size=1, max_size=3) | st.lists(
+            st.sampled_from([*header, 0, 1, 0xFF, *frame[len(header) :]]), min_size=1, max_size=3
+        ).map(bytes)
+        for at, extra in draw(st.lists(st.tuples(st.integers(0, len(copies) - 1), noise), max_size=40)):
+            copies[at] += extra  # the frame, then noise
+        for _ in range(draw(st.integers(0, 3))):
+            at = draw(st.integers(0, len(copies) - 1))
+            kind = draw(st.integers(0, 3))
             if kind == 0:  # a byte changed after the header: key, content or checksum
-                at = draw(st.integers(len(header), len(frame) - 1))
-                parts.append(frame[:at] + bytes([frame[at] ^ draw(st.integers(1, 255))]) + frame[at + 1 :])
+                where = draw(st.integers(len(header), len(frame) - 1))
+                copies[at] = frame[:where] + bytes([frame[where] ^ draw(st.integers(1, 255))]) + frame[where + 1 :]
             elif kind == 1:  # cut short
-                parts.append(frame[: draw(st.integers(1, len(frame) - 1))])
+                copies[at] = frame[: draw(st.integers(1, len(frame) - 1))]
             elif kind == 2 and length_at < len(frame) - 2:  # another length byte, its sum kept: another key
                 changed = bytearray(frame)
                 step = draw(st.integers(1, 255))
                 changed[length_at] = (changed[length_at] + step) & 0xFF
                 changed[-2] = (changed[-2] - step) & 0xFF
-                parts.append(bytes(changed))
-            elif kind == 3:  # a stray header
-                parts.append(header[: draw(st.integers(1, len(header)))])
-            elif kind < 7:  # the frame, then noise
-                noise = st.sampled_from([*header, 0, 1, 0xFF, *frame[len(header) :]])
-                parts.append(frame + bytes(draw(st.lists(noise, min_size=1, max_size=3))))
-            else:
-                parts.append(frame)
+                copies[at] = bytes(changed)
+            else:  # a stray header before it
+                copies[at] = header[: draw(st.integers(1, len(header)))] + copies[at]
+        parts += copies
     return in_reads(draw, b"".join(parts))
 
 
@@ -171,9 +175,9 @@ PAIR_FORMAT = FrameFormat(
 def pair_stream(draw: st.DrawFn) -> tuple[bytes, list[bytes]]:
     values = st.sampled_from([0, 1, 0xAA, 0x55, 0xFE, 0xFF])
     parts = []
-    for _ in range(draw(st.integers(1, 60))):
+    for _ in range(draw(st.integers(1, 150))):
         frame = pair_frame(draw(values), draw(values))
-        kind = draw(st.integers(0, 9))
+        kind = draw(st.integers(0, 39))
         if kind == 0:
             at = draw(st.integers(2, 5))
             frame = frame[:at] + bytes([frame[at] ^ draw(st.integers(1, 255))]) + frame[at + 1 :]

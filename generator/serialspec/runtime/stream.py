@@ -161,9 +161,13 @@ class _Candidate:
 # created on every reset and reopen of a bus, so creating one must cost next to nothing.
 _CANDIDATES: dict[int, _Candidate] = {}
 
-# Pieces a run takes at most: the first run, and the first after a run that failed, is short (little is lost where
-# frames of different keys alternate); each run taken at least half doubles the next, for this read and later ones.
-_FIRST_RUN = 8
+# Runs (see StreamParser._run). A run costs a few microseconds whatever its length, so one shorter than
+# _SHORTEST_RUN frames does not pay: after one, or a run refused, no run is tried for the next `backoff` pieces,
+# which doubles each time (up to _LONGEST_RUN) and is back to _SHORTEST_RUN after a run that paid. Where frames of
+# different keys alternate, the stream takes the usual path, at most one try in _LONGEST_RUN pieces lost. A run takes
+# _FIRST_RUN pieces at most at first, and twice as many after each run that took at least half of them.
+_SHORTEST_RUN = 24
+_FIRST_RUN = 32
 _LONGEST_RUN = 1024
 
 
@@ -187,7 +191,8 @@ class StreamParser:
         self._single = self._candidates[0] if len(self._candidates) == 1 else None
         self._pending = b""
         self._keep = max(len(f.header) for f in formats) - 1  # a tail that could be the start of a header
-        self._block = _FIRST_RUN  # pieces the batch scan's next run takes at most (see _split)
+        # runs: pieces the next one takes at most, pieces to wait before it is tried, the wait after the next failure
+        self._block, self._wait, self._backoff = _FIRST_RUN, 0, _SHORTEST_RUN
         self.errors = 0
         self.garbage = 0  # bytes skipped that belonged to no accepted frame
 
@@ -246,7 +251,7 @@ class StreamParser:
         cut = -1  # where the bytes held back begin, once a candidate must wait for more
         runs = current.runs
         last = len(pieces) - 1  # the piece the buffer ends with: never in a run (its frame may be cut)
-        block, retry = self._block, 0  # pieces the next run takes at most; no run tried before piece `retry`
+        block, retry = self._block, 1 + self._wait  # pieces the next run takes at most; none tried before `retry`
         walk = enumerate(islice(pieces, 1, None), 1)
         for index, piece in walk:
             if position >= start:
@@ -257,22 +262,26 @@ class StreamParser:
                 entry = whole.get(key)
                 if entry is not None:
                     size, rest, decode = entry
-                    run = runs.get(key) if runs and index >= retry and last - index > 1 else None
+                    run = runs.get(key) if runs and index >= retry and last - index >= _SHORTEST_RUN else None
                     if run is not None:  # this frame and the ones after it with the same key, checked together
                         count, frames = self._run(current, pieces, index, min(last, index + block), key, rest)
+                        if count >= _SHORTEST_RUN:
+                            self._backoff = _SHORTEST_RUN
+                            if count > block // 2:
+                                block = self._block = min(2 * block, _LONGEST_RUN)
+                        else:  # too short to pay, or refused: the usual path for a while
+                            retry = index + max(count, 1) + self._backoff
+                            self._backoff = min(2 * self._backoff, _LONGEST_RUN)
+                            block = self._block = _FIRST_RUN
                         if count > 1:
                             found.extend(run(frames))
                             taken += count * size
-                            if count > block // 2:
-                                block = self._block = min(2 * block, _LONGEST_RUN)
                             # the header of the run's last frame, its end, and the header after it
                             position += count * width + sum(map(len, pieces[index : index + count - 1])) - width
                             start = position + size
                             position += width + len(pieces[index + count - 1])
                             next(islice(walk, count - 1, count - 1), None)  # the pieces taken
                             continue
-                        block, retry = _FIRST_RUN, index + _FIRST_RUN
-                        self._block = block
                     after = len(piece)  # bytes between this header and the next one (or the end)
                     # the frame ends before the next header (so the bytes its values are read from are there too)
                     if (
@@ -309,6 +318,7 @@ class StreamParser:
                     if inner >= 0:
                         self.garbage += inner - taken
                         self.errors += errors
+                        self._wait = max(0, retry - len(pieces))
                         return found + self._scan(buffer[inner:])
                     cut = at
                     break
@@ -328,6 +338,7 @@ class StreamParser:
         self._pending = buffer[cut:]
         self.garbage += cut - taken
         self.errors += errors
+        self._wait = max(0, retry - len(pieces))  # carried to the next read's pieces
         return found
 
     @staticmethod

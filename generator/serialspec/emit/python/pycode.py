@@ -448,6 +448,12 @@ class PackageCode:
         self.built[class_name] = names
         return f"tuple([_new({class_name}, values) for values in {tuples}])"
 
+    def build_all(self, class_name: str, names: list[str], tuples: str) -> str:
+        """The expression of an iterator of instances of a generated class, one built (as `build` does) from each
+        tuple of field values, in field order, that the expression `tuples` yields, with no Python call per item."""
+        self.built[class_name] = names
+        return f"map(_new, repeat({class_name}), {tuples})"
+
     def enum_value(self, enum: str, raw: str) -> str:
         """The member for a wire value, or the value itself when the spec names none (as enum_or_int does)."""
         self.member_maps.add(enum)

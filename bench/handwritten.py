@@ -517,7 +517,7 @@ def vesc_decode_set_duty(frame: bytes) -> VescSetDuty:
 
 
 def vesc_encode_set_duty(message: VescSetDuty) -> bytes:
-    if not -100000 <= message.duty <= 100000:
+    if not -100000 <= message.duty <= 100000 or message.duty.__class__ is bool:
         raise ValueError(f"duty {message.duty} outside -100000..100000")
     payload = _VESC_SET_DUTY_PAYLOAD.pack(VESC_SET_DUTY, message.duty)
     return b"\x02\x05" + payload + binascii.crc_hqx(payload, 0).to_bytes(2, "big") + b"\x03"

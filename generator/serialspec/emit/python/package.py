@@ -228,7 +228,8 @@ def general_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
             mask = (1 << (8 * element.type.size)) - 1
             flag = protocol.error_reply.flag
             frames = replace(frames, error_flag=flag, error_keep=mask & ~flag)
-        functions, call = direction_functions(protocol, direction, frames, frame_structs)
+        plain = plain_messages(single, code) if not expected and not frames.error_flag else []
+        functions, call = direction_functions(protocol, direction, frames, frame_structs, plain)
         directions.append(
             {
                 "name": direction.value,
@@ -253,18 +254,36 @@ def general_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
         and not reply.default_reply
     ]
     code.structs.update(frame_structs)  # listed with the content's structs (common_codec_context)
-    every = [line for d in directions for line in [*d["frames"], *d["functions"]]]
+    every = [line for d in directions for line in [*d["frames"], *d["functions"], *d["call"]]]
+    every += [line for _, _, lines in code.encoders for line in lines]
     return {
         "classic": False,
         "reply_layouts": reply_layouts,
         "framing_imports": sorted({"EngineFormat", *framing_imports(every)}, key=import_order),
         "checksum_error": any("ChecksumError(" in line for line in every),
         "checksum_imports": imports,
+        "crc_hqx": any("_crc_hqx(" in line for line in every),  # a CRC the standard library computes, called directly
         "checksum_definitions": definitions,
         "directions": directions,
         "dispatchers": dispatchers,
         "by_header": all(headers) and len(set(headers)) == len(headers),
     }
+
+
+def plain_messages(single: dict[str, Message], code: PackageCode) -> list[tuple[int, int, str, str]]:
+    """(code, content size, class, struct) of the messages of one size whose decoder, past its size check, is one
+    struct's unpack of the content as their message (framecode.whole_frames decodes their frames whole)."""
+    bodies = {name: lines for name, _, _, lines in code.decoders}
+    found = []
+    for key, message in single.items():
+        lines = bodies[decoder_name(message)]
+        if key in ("None", "ERROR_REPLY") or message.min_size != message.max_size or len(lines) < 3:
+            continue
+        fused = fuse_unpack(lines[2:], code.structs)
+        plain = _PLAIN.match(fused[0]) if len(fused) == 1 and lines[0].startswith("if end - o != ") else None
+        if plain is not None:
+            found.append((int(key, 16), message.min_size or 0, plain["cls"], plain["struct"]))
+    return found
 
 
 def value_arguments(layout: FrameLayout) -> dict[str, str]:

@@ -132,8 +132,6 @@ def _decode_read_holding_registers_response(buf: bytes, o: int, end: int, unit: 
     o += nb
     if o != end:
         raise DecodeError('read_holding_registers response' + f': {end - o} bytes left after the last field')
-    if v_byte_count != (2 * len(v_registers)):
-        raise DecodeError('read_holding_registers response' + f': byte_count is {v_byte_count}, but 2 * len(registers) = {(2 * len(v_registers))}')
     return _new(ReadHoldingRegistersResponse, (unit, v_registers))
 
 
@@ -159,8 +157,6 @@ def _decode_read_input_registers_response(buf: bytes, o: int, end: int, unit: in
     o += nb
     if o != end:
         raise DecodeError('read_input_registers response' + f': {end - o} bytes left after the last field')
-    if v_byte_count != (2 * len(v_registers)):
-        raise DecodeError('read_input_registers response' + f': byte_count is {v_byte_count}, but 2 * len(registers) = {(2 * len(v_registers))}')
     return _new(ReadInputRegistersResponse, (unit, v_registers))
 
 
@@ -289,8 +285,6 @@ def _decode_read_write_registers_response(buf: bytes, o: int, end: int, unit: in
     o += nb
     if o != end:
         raise DecodeError('read_write_registers response' + f': {end - o} bytes left after the last field')
-    if v_byte_count != (2 * len(v_registers)):
-        raise DecodeError('read_write_registers response' + f': byte_count is {v_byte_count}, but 2 * len(registers) = {(2 * len(v_registers))}')
     return _new(ReadWriteRegistersResponse, (unit, v_registers))
 
 
@@ -765,6 +759,8 @@ def _wrap_response(content: bytes, code: int | None, v_unit: int) -> bytes:
     return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
+_REQUEST = Direction.REQUEST
+_RESPONSE = Direction.RESPONSE
 _ENCODERS: dict[type[Message], Callable[..., bytes]] = {
     ReadCoilsRequest: _encode_read_coils_request,
     ReadCoilsResponse: _encode_read_coils_response,
@@ -796,7 +792,7 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
     """
     if direction is None:
         raise DecodeError("give the direction: requests and responses cannot be told apart by their first bytes")
-    if direction == 'request':  # a Direction or its value
+    if direction is _REQUEST or direction == 'request':  # a Direction (told by identity, first) or its value
         frame = data if data.__class__ is bytes else bytes(data)
         n = len(frame)
         if n < 4:
@@ -817,7 +813,7 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         except KeyError:
             raise DecodeError(f"unknown command {code!r}") from None
         return decoder(buf, 2, end, v_unit)
-    if direction == 'response':  # a Direction or its value
+    if direction is _RESPONSE or direction == 'response':  # a Direction (told by identity, first) or its value
         frame = data if data.__class__ is bytes else bytes(data)
         n = len(frame)
         if n < 4:

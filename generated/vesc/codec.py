@@ -616,6 +616,8 @@ def _wrap_response(content: bytes, code: int | None) -> bytes:
     return frame + _crc_hqx(frame[3:], 0x0).to_bytes(2, 'big') + b'\x03'
 
 
+_REQUEST = Direction.REQUEST
+_RESPONSE = Direction.RESPONSE
 _ENCODERS: dict[type[Message], Callable[..., bytes]] = {
     FwVersionRequest: _encode_fw_version_request,
     FwVersionResponse: _encode_fw_version_response,
@@ -640,7 +642,7 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
     """
     if direction is None:
         raise DecodeError("give the direction: requests and responses cannot be told apart by their first bytes")
-    if direction == 'request':  # a Direction or its value
+    if direction is _REQUEST or direction == 'request':  # a Direction (told by identity, first) or its value
         frame = data if data.__class__ is bytes else bytes(data)
         whole = _REQUEST_WHOLE.get(frame[:3])
         if whole is not None and whole[0] == len(frame) and frame[-1] == 0x03 and _crc_hqx(frame[2:-1], 0x0) == 0x0000:
@@ -690,7 +692,7 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
                 raise DecodeError(f"unknown command {code!r}") from None
             return decoder(buf, 4, end)
         raise DecodeError(f"frame starts {frame[:4].hex(' ')}, expected 02 or 03")
-    if direction == 'response':  # a Direction or its value
+    if direction is _RESPONSE or direction == 'response':  # a Direction (told by identity, first) or its value
         frame = data if data.__class__ is bytes else bytes(data)
         whole = _RESPONSE_WHOLE.get(frame[:3])
         if whole is not None and whole[0] == len(frame) and frame[-1] == 0x03 and _crc_hqx(frame[2:-1], 0x0) == 0x0000:

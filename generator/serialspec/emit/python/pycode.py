@@ -493,9 +493,17 @@ class PackageCode:
     def check_values(self, fields: list[SpecField], lines: Lines, where: str) -> None:
         """Every value derived by an expression must hold what the expression gives for the decoded fields."""
         counted = {f.count: f.name for f in fields if isinstance(f, List) and isinstance(f.count, str)}
+        # a byte size of a list of numbers: decoding read size // item items and refused a remainder
+        sized = {f.size: f for f in fields if isinstance(f, List) and f.size and f.item is not None}
         for f in fields:
             if isinstance(f, Scalar) and f.value == expression.Length(counted.get(f.name, "")):
                 continue  # the count of the list it counts: decoding read exactly that many
+            listed = sized.get(f.name)
+            if isinstance(f, Scalar) and listed is not None and listed.item is not None:
+                items = expression.Length(listed.name)
+                scaled = expression.BinOp("*", expression.Const(listed.item.size), items)
+                if f.value in (scaled, items if listed.item.size == 1 else None):
+                    continue  # the byte size of the list it sizes: decoding read exactly that many bytes
             if isinstance(f, Scalar) and f.value is not None:
                 expected = expression.render(f.value, self.local_named)
                 shown = one_line(expression.show(f.value)).replace("{", "{{").replace("}", "}}")

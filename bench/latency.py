@@ -3,10 +3,11 @@
 `serialspec sim specs/<spec>.yaml --id 1 --quiet` runs as a separate process (it prints the pty path first). The
 benchmark process then times whole transactions, request written to reply decoded:
 
-- generated: the generated client (Fashion Star `read_angle(1)`, Hiwonder RRC `bus_servo.read_position(1)`,
-  FEETECH `read(1, "present_position")`); the rows of a protocol appear once its spec has a virtual device;
-- bare: pyserial `write(request)` then `read(len(reply))` with a 1 s timeout: no parsing at all, the floor;
-- vendor SDK: the same read through the vendor's Python SDK (Fashion Star, FEETECH; none is installed for RRC).
+- generated: the generated client (Fashion Star `read_angle(1)`, FEETECH `read(1, "present_position")`, and in
+  CASES Hiwonder RRC, DYNAMIXEL 2.0, Modbus RTU, VESC); the rows of a protocol appear once it has a virtual device;
+- bare: pyserial `write(request)` then `read(len(reply))` with a 1 s timeout, what a user writes: no parsing at
+  all, the floor (for Modbus RTU after the 3.5-character silence the protocol requires, as the generated bus);
+- vendor SDK: the same read through the vendor's Python SDK (Fashion Star, FEETECH; none is installed for the rest).
 
 Generated and bare alternate in blocks so that noise on the shared machine falls on both alike. Beside the median
 and p99 wall time per transaction, the CPU time the benchmark process spent per transaction
@@ -57,12 +58,14 @@ class SimUnavailable(Exception):
 
 
 @contextmanager
-def simulator(spec: str, device_id: int) -> Iterator[str]:
+def simulator(spec: str, device_id: int | None) -> Iterator[str]:
     """`serialspec sim` in another process; yields the pty path it prints first; stops it with SIGTERM."""
     name = Path(spec).stem
     if importlib.util.find_spec(f"{name}.simulator") is None:
         raise SimUnavailable(f"generated/{name}/simulator.py does not exist")
-    command = [str(Path(sys.executable).parent / "serialspec"), "sim", spec, "--id", str(device_id), "--quiet"]
+    command = [str(Path(sys.executable).parent / "serialspec"), "sim", spec, "--quiet"]
+    if device_id is not None:  # None: a protocol without device addresses (VESC)
+        command[3:3] = ["--id", str(device_id)]
     process = subprocess.Popen(command, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         assert process.stdout is not None and process.stderr is not None
@@ -110,7 +113,12 @@ def alone(call: Callable[[], object], count: int) -> Result:
     return result
 
 
-def bare_read(port: serial.Serial, request: bytes, reply_size: int) -> Callable[[], bytes]:
+def bare_read(port: serial.Serial, request: bytes, reply_size: int, gap: float = 0.0) -> Callable[[], bytes]:
+    """What a user writes with pyserial alone: write the request, read(n) the reply whose size n is known. With
+    `gap` (Modbus RTU's 3.5 characters of silence before a frame, in seconds) it first waits that long after the
+    last byte read, as the protocol requires and the generated bus does."""
+    last = 0.0
+
     def transact() -> bytes:
         port.write(request)
         reply = port.read(reply_size)
@@ -118,7 +126,26 @@ def bare_read(port: serial.Serial, request: bytes, reply_size: int) -> Callable[
             raise RuntimeError(f"bare read got {len(reply)} of {reply_size} bytes")
         return reply
 
-    return transact
+    def transact_after_gap() -> bytes:
+        nonlocal last
+        wait = last + gap - time.monotonic()
+        if wait > 0:
+            time.sleep(wait)
+        reply = transact()
+        last = time.monotonic()
+        return reply
+
+    return transact_after_gap if gap else transact
+
+
+def reply_size(port: serial.Serial, request: bytes) -> int:
+    """The size of the device's reply to `request`, by asking once (the bare read needs it to read(n))."""
+    port.write(request)
+    time.sleep(0.2)
+    size = len(port.read(port.in_waiting))
+    if not size:
+        raise RuntimeError(f"no reply to {request.hex(' ')}")
+    return size
 
 
 def fashionstar(path: str) -> dict[str, Result]:
@@ -198,19 +225,65 @@ def feetech(path: str) -> tuple[dict[str, Result], str]:
     return results, how
 
 
-def hiwonder(path: str) -> dict[str, Result]:
-    rrc = importlib.import_module("hiwonder_rrc")
-    client_module = importlib.import_module("hiwonder_rrc.client")
-    request = rrc.encode(rrc.BusServoReadPositionRequest(servo_id=1))
-    reply_size = len(rrc.encode(rrc.BusServoReadPositionResponse(servo_id=1, success=0, position=0)))
+@dataclass(frozen=True)
+class Case:
+    """A protocol timed against bare pyserial only (no vendor SDK in the bench): its generated client's read."""
+
+    protocol: str
+    client_class: str
+    how: str  # the call, as shown in the table
+    call: Callable[[Any], object]
+    request: Callable[[Any], object]  # the same request as a message of the protocol's package
+    device_id: int | None = 1  # the virtual device's address; None where frames carry none
+
+
+CASES = (
+    Case(
+        "hiwonder_rrc",
+        "HiwonderRrcClient",
+        "client.bus_servo.read_position(1)",
+        lambda client: client.bus_servo.read_position(1),
+        lambda rrc: rrc.BusServoReadPositionRequest(servo_id=1),
+    ),
+    Case(
+        "dynamixel_p2",
+        "DynamixelP2Client",
+        'client.read(1, "present_position")',
+        lambda client: client.read(1, "present_position"),
+        lambda dxl: dxl.ReadRequest(id=1, address=132, length=4),
+    ),
+    Case(
+        "modbus_rtu",
+        "ModbusRtuClient",
+        "client.read_holding_registers(1, 0, 2)",
+        lambda client: client.read_holding_registers(1, 0, 2),
+        lambda mb: mb.ReadHoldingRegistersRequest(unit=1, address=0, count=2),
+    ),
+    Case(
+        "vesc",
+        "VescClient",
+        "client.get_values()",
+        lambda client: client.get_values(),
+        lambda vesc: vesc.GetValuesRequest(),
+        device_id=None,
+    ),
+)
+
+
+def plain(case: Case, path: str) -> tuple[dict[str, Result], int, int, float]:
+    """The generated client and bare pyserial side by side; also the request and reply sizes, and the gap."""
+    package = importlib.import_module(case.protocol)
+    client_class = getattr(importlib.import_module(f"{case.protocol}.client"), case.client_class)
+    request = package.encode(case.request(package))
     with (
-        client_module.HiwonderRrcClient(path, timeout=1.0) as client,
-        serial.Serial(path, rrc.BAUDRATE, timeout=1.0) as bare,
+        client_class(path, timeout=1.0) as client,
+        serial.Serial(path, package.BAUDRATE, timeout=1.0) as bare,
     ):
-        assert isinstance(client.bus_servo.read_position(1), int)
-        return side_by_side(
-            {"generated": lambda: client.bus_servo.read_position(1), "bare": bare_read(bare, request, reply_size)}
-        )
+        case.call(client)
+        size = reply_size(bare, request)
+        gap = client.bus._gap  # the silence the protocol needs before a frame (Modbus RTU), on both sides
+        results = side_by_side({"generated": lambda: case.call(client), "bare": bare_read(bare, request, size, gap)})
+    return results, len(request), size, gap
 
 
 def _row(protocol: str, what: str, result: Result, bare: Result | None, target: bool) -> list[str]:
@@ -251,15 +324,6 @@ def run() -> Table:
         "(used by its ping/monitor) polls the same way but stops at the first valid packet."
     )
     try:
-        with simulator("specs/hiwonder_rrc.yaml", 1) as path:
-            rrc = hiwonder(path)
-        rows += [
-            _row("hiwonder_rrc", "generated `client.bus_servo.read_position(1)`", rrc["generated"], rrc["bare"], True),
-            _row("hiwonder_rrc", "bare pyserial write 7 B + read(10)", rrc["bare"], rrc["bare"], False),
-        ]
-    except SimUnavailable as exc:
-        notes.append(f"Hiwonder RRC rows skipped: {exc}.")
-    try:
         with simulator("specs/feetech_sms.yaml", 1) as path:
             sms, how = feetech(path)
         rows += [
@@ -272,6 +336,29 @@ def run() -> Table:
         )
     except SimUnavailable as exc:
         notes.append(f"FEETECH SMS rows skipped: {exc}; they appear once `serialspec sim` serves it.")
+    for case in CASES:
+        try:
+            with simulator(f"specs/{case.protocol}.yaml", case.device_id) as path:
+                results, sent, size, gap = plain(case, path)
+        except SimUnavailable as exc:
+            notes.append(f"{case.protocol} rows skipped: {exc}.")
+            continue
+        silence = f"{gap * 1e6:.0f} µs of silence (3.5 characters) + " if gap else ""
+        rows += [
+            _row(case.protocol, f"generated `{case.how}`", results["generated"], results["bare"], True),
+            _row(
+                case.protocol,
+                f"bare pyserial {silence}write {sent} B + read({size})",
+                results["bare"],
+                results["bare"],
+                False,
+            ),
+        ]
+        if gap:
+            notes.append(
+                f"{case.protocol}: both sides wait out the {gap * 1e6:.0f} µs of silence the protocol needs before a "
+                f"frame at {importlib.import_module(case.protocol).BAUDRATE} baud (time.sleep), so the wait dominates."
+            )
     notes.append(
         f"Generated and bare run side by side: {BLOCKS} alternating blocks of {PER_BLOCK} transactions after "
         f"{WARMUP} warm-up ones. CPU µs/tx: process time of the benchmark process per transaction; CPU share: that "

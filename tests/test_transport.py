@@ -71,6 +71,33 @@ def test_faults(sim: tuple[FashionstarUartSimulator, str], fault: str) -> None:
         assert [m.COMMAND for m in seen] == ["read_angle"]  # the late reply went to subscribers
 
 
+@pytest.mark.parametrize("fault", ["corrupt", "other_id", "late", "truncate"])
+def test_faults_in_a_reply_of_the_size_the_last_one_had(sim: tuple[FashionstarUartSimulator, str], fault: str) -> None:
+    """After a reply of a type, a read of its size is decoded at once, without the stream parser: every fault in
+    such a read is still caught as the parser would catch it, and the bus goes on."""
+    simulator, path = sim
+    seen: list[Message] = []
+    with Bus(path, BINDING, timeout=0.2) as bus:
+        bus.subscribe(seen.append)
+        assert bus.request(ReadAngleRequest(servo_id=1), ReadAngleResponse).servo_id == 1  # its size is known now
+        simulator.inject(fault, delay=0.3)
+        if fault == "corrupt":
+            with pytest.raises(CorruptReply, match="corrupt reply to read_angle from servo_id=1"):
+                bus.request(ReadAngleRequest(servo_id=1), ReadAngleResponse)
+        elif fault == "truncate":
+            with pytest.raises(CorruptReply, match="incomplete reply to read_angle"):
+                bus.request(ReadAngleRequest(servo_id=1), ReadAngleResponse)
+        else:  # another servo's answer of the same size is no reply; a late one comes after the timeout
+            with pytest.raises(Timeout, match="servo_id=1"):
+                bus.request(ReadAngleRequest(servo_id=1), ReadAngleResponse)
+        if fault == "late":
+            time.sleep(0.2)  # let the late reply arrive between transactions
+        for _ in range(3):
+            assert bus.request(ReadAngleRequest(servo_id=1), ReadAngleResponse).servo_id == 1
+    expected = {"other_id": [("read_angle", 2)], "late": [("read_angle", 1)]}.get(fault, [])
+    assert [(m.COMMAND, getattr(m, "servo_id", None)) for m in seen] == expected
+
+
 def test_threads_never_interleave(sim: tuple[FashionstarUartSimulator, str]) -> None:
     _, path = sim
     errors: list[BaseException] = []

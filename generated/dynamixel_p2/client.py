@@ -22,7 +22,7 @@ from serialspec.runtime.registers import ModelRegisters
 from serialspec.runtime.transport import Binding, Bus, ClientBase
 
 from dynamixel_p2 import MATCH_BY, SERIAL
-from dynamixel_p2.codec import StreamParser, encode
+from dynamixel_p2.codec import StreamParser, decode, encode
 from dynamixel_p2.messages import (
     ActionRequest,
     BulkReadRequest,
@@ -57,6 +57,7 @@ BINDING = Binding(
     protocol='dynamixel_p2',
     serial=SERIAL,
     encode=encode,
+    decode=decode,
     parser=lambda: StreamParser(Direction.RESPONSE),
     match_by=MATCH_BY,
     status=('error',),
@@ -115,7 +116,7 @@ class DynamixelP2Client(ClientBase):
         Returns: the PingResponse reply.
         """
         request = PingRequest(id=id)
-        reply = self._ask(request, PingResponse)
+        reply = self.bus.request(request, PingResponse)
         return reply
 
     def read_raw(self, id: int, address: int, length: int) -> bytes | None:
@@ -359,11 +360,10 @@ class DynamixelP2Client(ClientBase):
 
     def read(self, id: int, name: ControlTableName) -> int:
         """Read from the control table: one register by name, e.g. `read(1, "model_number")`, in wire units."""
-        register = CONTROL_TABLE[name]
+        address, size, value = CONTROL_TABLE.reader(name)
         if id == 254:
             raise EncodeError("read: name one device; the broadcast id 254 gets no reply")
-        data = self.read_raw(id, register.address, CONTROL_TABLE.size(register))
-        return CONTROL_TABLE.value(register, data or b"")
+        return value(self.read_raw(id, address, size) or b"")
 
     def read_many(self, id: int, *names: ControlTableName) -> dict[str, int]:
         """Read from the control table: several registers by name, in one transaction that spans them all."""

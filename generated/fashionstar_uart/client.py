@@ -20,7 +20,7 @@ from serialspec.runtime.message import Message
 from serialspec.runtime.transport import Binding, Bus, ClientBase, table_key
 
 from fashionstar_uart import MATCH_BY, SERIAL
-from fashionstar_uart.codec import StreamParser, encode
+from fashionstar_uart.codec import StreamParser, decode, encode
 from fashionstar_uart.messages import (
     AsyncEnd,
     BeginAsyncRequest,
@@ -89,6 +89,7 @@ BINDING = Binding(
     protocol='fashionstar_uart',
     serial=SERIAL,
     encode=encode,
+    decode=decode,
     parser=lambda: StreamParser(Direction.RESPONSE),
     match_by=MATCH_BY,
     status=(),
@@ -172,7 +173,7 @@ class FashionstarUartClient(ClientBase):
         """
         request = PingRequest(servo_id=servo_id)
         try:
-            self._ask(request, PingResponse)
+            self.bus.request(request, PingResponse)
         except Timeout:
             return False
         return True
@@ -186,7 +187,7 @@ class FashionstarUartClient(ClientBase):
         Returns: result: Outcome of the command. (0..1)
         """
         request = ResetUserDataRequest(servo_id=servo_id)
-        reply = self._ask(request, ResetUserDataResponse)
+        reply = self.bus.request(request, ResetUserDataResponse)
         return reply.result
 
     def read_data(self, servo_id: int, data_id: int) -> int | float:
@@ -201,7 +202,7 @@ class FashionstarUartClient(ClientBase):
         Returns: data: The value, typed by data_id.
         """
         request = ReadDataRequest(servo_id=servo_id, data_id=data_id)
-        reply = self._ask(request, ReadDataResponse)
+        reply = self.bus.request(request, ReadDataResponse)
         return reply.data
 
     def write_data(self, servo_id: int, data_id: int, data: int | float) -> Result | int:
@@ -215,7 +216,7 @@ class FashionstarUartClient(ClientBase):
         Returns: result: Outcome of the command. (0..1)
         """
         request = WriteDataRequest(servo_id=servo_id, data_id=data_id, data=data)
-        reply = self._ask(request, WriteDataResponse)
+        reply = self.bus.request(request, WriteDataResponse)
         self._remember(servo_id, data_id, data)
         return reply.result
 
@@ -228,7 +229,7 @@ class FashionstarUartClient(ClientBase):
         Returns: user_data: The user parameters 32..53 in data_id order.
         """
         request = ReadBatchDataRequest(servo_id=servo_id)
-        reply = self._ask(request, ReadBatchDataResponse)
+        reply = self.bus.request(request, ReadBatchDataResponse)
         return reply.user_data
 
     def write_batch_data(self, servo_id: int, user_data: UserData) -> Result | int:
@@ -241,7 +242,7 @@ class FashionstarUartClient(ClientBase):
         Returns: result: Outcome of the command. (0..1)
         """
         request = WriteBatchDataRequest(servo_id=servo_id, user_data=user_data)
-        reply = self._ask(request, WriteBatchDataResponse)
+        reply = self.bus.request(request, WriteBatchDataResponse)
         return reply.result
 
     def spin(self, servo_id: int, method: MethodBits, speed: int, value: int) -> Result | int | None:
@@ -309,7 +310,7 @@ class FashionstarUartClient(ClientBase):
         Returns: angle: Angle in 0.1° steps; the sign gives the direction (900 is 90°). [0.1°]
         """
         request = ReadAngleRequest(servo_id=servo_id)
-        reply = self._ask(request, ReadAngleResponse)
+        reply = self.bus.request(request, ReadAngleResponse)
         return reply.angle
 
     def move_by_interval(self, servo_id: int, angle: int, interval: int, t_acc: int = 20, t_dec: int = 20, power: int = 0) -> Result | int | None:
@@ -421,7 +422,7 @@ class FashionstarUartClient(ClientBase):
         Returns: the ReadMturnAngleResponse reply.
         """
         request = ReadMturnAngleRequest(servo_id=servo_id)
-        reply = self._ask(request, ReadMturnAngleResponse)
+        reply = self.bus.request(request, ReadMturnAngleResponse)
         return reply
 
     def reset_mturn_angle(self, servo_id: int) -> None:
@@ -471,7 +472,7 @@ class FashionstarUartClient(ClientBase):
         Returns: the MonitorResponse reply.
         """
         request = MonitorRequest(servo_id=servo_id)
-        reply = self._ask(request, MonitorResponse)
+        reply = self.bus.request(request, MonitorResponse)
         return reply
 
     def set_origin_point(self, servo_id: int) -> None:

@@ -23,7 +23,7 @@ from serialspec.runtime.registers import ModelRegisters
 from serialspec.runtime.transport import Binding, Bus, ClientBase, flag_names
 
 from feetech_sms import MATCH_BY, SERIAL
-from feetech_sms.codec import StreamParser, encode
+from feetech_sms.codec import StreamParser, decode, encode
 from feetech_sms.messages import (
     ActionRequest,
     Direction,
@@ -48,6 +48,7 @@ BINDING = Binding(
     protocol='feetech_sms',
     serial=SERIAL,
     encode=encode,
+    decode=decode,
     parser=lambda: StreamParser(Direction.RESPONSE),
     match_by=MATCH_BY,
     status=('error',),
@@ -106,7 +107,7 @@ class FeetechSmsClient(ClientBase):
         """
         request = PingRequest(id=id)
         try:
-            self._ask(request, ReplyResponse)
+            self.bus.request(request, ReplyResponse)
         except Timeout:
             return False
         return True
@@ -124,7 +125,7 @@ class FeetechSmsClient(ClientBase):
         Returns: data: The bytes read, register by register from the request's address (empty except for READ).
         """
         request = ReadRequest(id=id, address=address, length=length)
-        reply = self._ask(request, ReplyResponse)
+        reply = self.bus.request(request, ReplyResponse)
         return reply.data
 
     def write_raw(self, id: int, address: int, data: bytes) -> bool | None:
@@ -258,11 +259,10 @@ class FeetechSmsClient(ClientBase):
 
     def read(self, id: int, name: ControlTableName) -> int:
         """Read from the control table: one register by name, e.g. `read(1, "firmware_major")`, in wire units."""
-        register = CONTROL_TABLE[name]
+        address, size, value = CONTROL_TABLE.reader(name)
         if id == 254:
             raise EncodeError("read: name one device; the broadcast id 254 gets no reply")
-        data = self.read_raw(id, register.address, CONTROL_TABLE.size(register))
-        return CONTROL_TABLE.value(register, data or b"")
+        return value(self.read_raw(id, address, size) or b"")
 
     def read_many(self, id: int, *names: ControlTableName) -> dict[str, int]:
         """Read from the control table: several registers by name, in one transaction that spans them all."""

@@ -20,7 +20,7 @@ import serial
 from serialspec.runtime.transport import Binding, Bus, ClientBase, check_status
 
 from hiwonder_rrc import MATCH_BY, SERIAL
-from hiwonder_rrc.codec import StreamParser, encode
+from hiwonder_rrc.codec import StreamParser, decode, encode
 from hiwonder_rrc.messages import (
     BusServoLoadRequest,
     BusServoReadIdRequest,
@@ -88,6 +88,7 @@ BINDING = Binding(
     protocol='hiwonder_rrc',
     serial=SERIAL,
     encode=encode,
+    decode=decode,
     parser=lambda: StreamParser(Direction.RESPONSE),
     match_by=MATCH_BY,
     status=(),
@@ -212,7 +213,7 @@ class PwmServoCommands:
         Returns: pulse: The servo's current pulse width (not range-checked in a report). [µs]
         """
         request = PwmServoReadPositionRequest(servo_id=servo_id)
-        reply = self._client._ask(request, PwmServoReadPositionResponse)
+        reply = self._client.bus.request(request, PwmServoReadPositionResponse)
         return reply.pulse
 
     def set_offset(self, servo_id: int, offset: int) -> None:
@@ -236,7 +237,7 @@ class PwmServoCommands:
         Returns: offset: The servo's offset (int8; -100..100 when set through 0x07). [µs]
         """
         request = PwmServoReadOffsetRequest(servo_id=servo_id)
-        reply = self._client._ask(request, PwmServoReadOffsetResponse)
+        reply = self._client.bus.request(request, PwmServoReadOffsetResponse)
         return reply.offset
 
 
@@ -277,8 +278,9 @@ class BusServoCommands:
         Raises DeviceError when the reply's success is not 0.
         """
         request = BusServoReadPositionRequest(servo_id=servo_id)
-        reply = self._client._ask(request, BusServoReadPositionResponse)
-        check_status(request, reply, 'success', 0, MATCH_BY)
+        reply = self._client.bus.request(request, BusServoReadPositionResponse)
+        if reply.success != 0:
+            check_status(request, reply, 'success', 0, MATCH_BY)
         return reply.position
 
     def read_voltage(self, servo_id: int) -> int:
@@ -293,8 +295,9 @@ class BusServoCommands:
         Raises DeviceError when the reply's success is not 0.
         """
         request = BusServoReadVoltageRequest(servo_id=servo_id)
-        reply = self._client._ask(request, BusServoReadVoltageResponse)
-        check_status(request, reply, 'success', 0, MATCH_BY)
+        reply = self._client.bus.request(request, BusServoReadVoltageResponse)
+        if reply.success != 0:
+            check_status(request, reply, 'success', 0, MATCH_BY)
         return reply.voltage
 
     def read_temperature(self, servo_id: int) -> int:
@@ -309,8 +312,9 @@ class BusServoCommands:
         Raises DeviceError when the reply's success is not 0.
         """
         request = BusServoReadTemperatureRequest(servo_id=servo_id)
-        reply = self._client._ask(request, BusServoReadTemperatureResponse)
-        check_status(request, reply, 'success', 0, MATCH_BY)
+        reply = self._client.bus.request(request, BusServoReadTemperatureResponse)
+        if reply.success != 0:
+            check_status(request, reply, 'success', 0, MATCH_BY)
         return reply.temperature
 
     def stop(self, servos: tuple[ServosItem, ...] | Sequence[int]) -> None:
@@ -342,8 +346,9 @@ class BusServoCommands:
         Raises DeviceError when the reply's success is not 0.
         """
         request = BusServoReadTorqueRequest(servo_id=servo_id)
-        reply = self._client._ask(request, BusServoReadTorqueResponse)
-        check_status(request, reply, 'success', 0, MATCH_BY)
+        reply = self._client.bus.request(request, BusServoReadTorqueResponse)
+        if reply.success != 0:
+            check_status(request, reply, 'success', 0, MATCH_BY)
         return reply.torque
 
     def unload(self, servo_id: int) -> None:
@@ -400,8 +405,9 @@ class BusServoCommands:
         Raises DeviceError when the reply's success is not 0.
         """
         request = BusServoReadIdRequest(servo_id=servo_id)
-        reply = self._client._ask(request, BusServoReadIdResponse)
-        check_status(request, reply, 'success', 0, MATCH_BY)
+        reply = self._client.bus.request(request, BusServoReadIdResponse)
+        if reply.success != 0:
+            check_status(request, reply, 'success', 0, MATCH_BY)
         return reply.id
 
     def set_offset(self, servo_id: int, offset: int) -> None:
@@ -430,8 +436,9 @@ class BusServoCommands:
         Raises DeviceError when the reply's success is not 0.
         """
         request = BusServoReadOffsetRequest(servo_id=servo_id)
-        reply = self._client._ask(request, BusServoReadOffsetResponse)
-        check_status(request, reply, 'success', 0, MATCH_BY)
+        reply = self._client.bus.request(request, BusServoReadOffsetResponse)
+        if reply.success != 0:
+            check_status(request, reply, 'success', 0, MATCH_BY)
         return reply.offset
 
     def save_offset(self, servo_id: int) -> None:
@@ -474,8 +481,9 @@ class BusServoCommands:
         Raises DeviceError when the reply's success is not 0.
         """
         request = BusServoReadPositionLimitRequest(servo_id=servo_id)
-        reply = self._client._ask(request, BusServoReadPositionLimitResponse)
-        check_status(request, reply, 'success', 0, MATCH_BY)
+        reply = self._client.bus.request(request, BusServoReadPositionLimitResponse)
+        if reply.success != 0:
+            check_status(request, reply, 'success', 0, MATCH_BY)
         return reply
 
     def set_voltage_limit(self, servo_id: int, low: int, high: int) -> None:
@@ -505,8 +513,9 @@ class BusServoCommands:
         Raises DeviceError when the reply's success is not 0.
         """
         request = BusServoReadVoltageLimitRequest(servo_id=servo_id)
-        reply = self._client._ask(request, BusServoReadVoltageLimitResponse)
-        check_status(request, reply, 'success', 0, MATCH_BY)
+        reply = self._client.bus.request(request, BusServoReadVoltageLimitResponse)
+        if reply.success != 0:
+            check_status(request, reply, 'success', 0, MATCH_BY)
         return reply
 
     def set_temperature_limit(self, servo_id: int, limit: int) -> None:
@@ -535,8 +544,9 @@ class BusServoCommands:
         Raises DeviceError when the reply's success is not 0.
         """
         request = BusServoReadTemperatureLimitRequest(servo_id=servo_id)
-        reply = self._client._ask(request, BusServoReadTemperatureLimitResponse)
-        check_status(request, reply, 'success', 0, MATCH_BY)
+        reply = self._client.bus.request(request, BusServoReadTemperatureLimitResponse)
+        if reply.success != 0:
+            check_status(request, reply, 'success', 0, MATCH_BY)
         return reply.limit
 
 

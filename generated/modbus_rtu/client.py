@@ -22,7 +22,7 @@ from serialspec.runtime.errors import Timeout
 from serialspec.runtime.transport import Binding, Bus, ClientBase, ErrorReplies
 
 from modbus_rtu import MATCH_BY, SERIAL
-from modbus_rtu.codec import StreamParser, encode
+from modbus_rtu.codec import StreamParser, decode, encode
 from modbus_rtu.messages import (
     CoilState,
     Direction,
@@ -56,6 +56,7 @@ BINDING = Binding(
     protocol='modbus_rtu',
     serial=SERIAL,
     encode=encode,
+    decode=decode,
     parser=lambda: StreamParser(Direction.RESPONSE),
     match_by=MATCH_BY,
     status=(),

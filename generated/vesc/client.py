@@ -23,7 +23,7 @@ import serial
 from serialspec.runtime.transport import Binding, Bus, ClientBase
 
 from vesc import MATCH_BY, SERIAL
-from vesc.codec import StreamParser, encode
+from vesc.codec import StreamParser, decode, encode
 from vesc.messages import (
     AliveRequest,
     Direction,
@@ -49,6 +49,7 @@ BINDING = Binding(
     protocol='vesc',
     serial=SERIAL,
     encode=encode,
+    decode=decode,
     parser=lambda: StreamParser(Direction.RESPONSE),
     match_by=MATCH_BY,
     status=(),
@@ -98,7 +99,7 @@ class VescClient(ClientBase):
         Returns: the FwVersionResponse reply.
         """
         request = FwVersionRequest()
-        reply = self._ask(request, FwVersionResponse)
+        reply = self.bus.request(request, FwVersionResponse)
         return reply
 
     def get_values(self) -> GetValuesResponse:
@@ -111,7 +112,7 @@ class VescClient(ClientBase):
         Returns: the GetValuesResponse reply.
         """
         request = GetValuesRequest()
-        reply = self._ask(request, GetValuesResponse)
+        reply = self.bus.request(request, GetValuesResponse)
         return reply
 
     def set_duty(self, duty: int) -> None:

@@ -8,7 +8,7 @@ memory, and both refuse a bad name, a read-only register or an out-of-range valu
 from __future__ import annotations
 
 import struct
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, replace
 
 from serialspec.runtime.errors import DecodeError, EncodeError, out_of_range
@@ -45,6 +45,7 @@ class RegisterMap:
         self.by_address = {r.address: r for r in self.registers}
         self._endian = ">" if byte_order == "big" else "<"
         self._structs = {r.name: struct.Struct(self._endian + r.format) for r in self.registers}
+        self._readers: dict[str, tuple[int, int, Callable[[bytes], int]]] = {}
 
     def __getitem__(self, name: str) -> Register:
         register = self.by_name.get(name)
@@ -96,6 +97,16 @@ class RegisterMap:
         if len(data) < self._structs[register.name].size:
             raise DecodeError(f"{register.name}: {len(data)} bytes read, {self._structs[register.name].size} needed")
         return self.from_wire(register, data)
+
+    def reader(self, name: str) -> tuple[int, int, Callable[[bytes], int]]:
+        """Reading one register by name, worked out once: its address, its size, and `value` from the bytes read
+        for it alone (a DecodeError when fewer bytes came). An unknown name is an EncodeError."""
+        found = self._readers.get(name)
+        if found is None:
+            register = self[name]
+            layout = self._structs[name]
+            found = self._readers[name] = (register.address, layout.size, _value(name, layout, register.sign_bit))
+        return found
 
     def unpack(self, start: int, data: bytes) -> dict[str, int]:
         """Bytes read from address `start` on, by register name; bytes that belong to no whole register by address."""
@@ -183,3 +194,22 @@ class ModelRegisters:
         for other in others:
             other.pack(values)
         return packed
+
+
+def _value(name: str, layout: struct.Struct, sign_bit: int | None) -> Callable[[bytes], int]:
+    """RegisterMap.value of one register as one call (what `from_wire` does, worked out for that register)."""
+    unpack, size = layout.unpack_from, layout.size
+    magnitude = (1 << sign_bit) - 1 if sign_bit is not None else -1
+    integral = layout.format[-1] in "bBhHiIlLqQ"  # unpacked as an int already
+
+    def value(data: bytes) -> int:
+        if len(data) < size:
+            raise DecodeError(f"{name}: {len(data)} bytes read, {size} needed")
+        number: int = unpack(data)[0]
+        if not integral:
+            number = int(number)  # as from_wire does
+        if sign_bit is not None and number >> sign_bit & 1:  # sign-magnitude: the sign bit set is negative
+            return -(number & magnitude)
+        return number
+
+    return value

@@ -93,6 +93,9 @@ class Binding:
     status: tuple[str, ...] = ()  # reply fields whose non-zero value is a device error (frame status elements)
     describe_status: Callable[[str, int], str] = field(default=lambda name, value: f"{name} = {value:#04x}")
     errors: ErrorReplies | None = None  # the protocol's error reply, if it has one
+    # decode(frame, "response", expect): one whole reply, or DecodeError; a transaction's read of exactly the size
+    # the last reply of its type had is decoded at once, without the stream parser's scan
+    decode: Callable[[bytes, str, type[Message] | None], Message] | None = None
 
 
 def check_status(request: Message, reply: Message, name: str, ok: int, match_by: tuple[str, ...]) -> None:
@@ -125,6 +128,9 @@ def flag_names(flags: dict[str, type[IntFlag]]) -> Callable[[str, int], str]:
 
 
 Subscriber = Callable[[Message], None]
+# How a bus checks a reply of one type to one request type (Bus._rule): request type, whether it can answer, the
+# getter of the fields to match, whether error replies exist, the reply's status fields.
+_Rule = tuple[type, bool, Callable[[Any], Any] | None, bool, tuple[tuple[str, tuple[str, ...]], ...]]
 _ABSENT = object()  # an attribute a message does not have
 
 
@@ -133,13 +139,15 @@ class Link:
 
     Three operations make a transaction: `write` a frame, `read_waiting` (what arrived between transactions,
     without waiting) and `read` (whatever arrives, blocking up to a deadline for the first byte: no sleeping, no
-    polling). Port failures propagate as pyserial raises them; the bus turns them into PortError.
+    polling); `transact` does the three in one call. Port failures propagate as pyserial raises them; the bus turns
+    them into PortError.
     """
 
-    __slots__ = ("port",)
+    __slots__ = ("port", "doing")
 
     def __init__(self, port: Any) -> None:
         self.port = port
+        self.doing = "read"  # the step of `transact` under way: what failed, when it raises
 
     def write(self, data: bytes) -> None:
         self.port.write(data)
@@ -152,6 +160,22 @@ class Link:
         port.timeout = 0
         data: bytes = port.read(waiting)
         return data
+
+    def transact(self, frame: bytes, wait: float) -> tuple[bytes, bytes | None]:
+        """A transaction's I/O in one call, for a bus that reads back no echo (it waits out any gap before).
+
+        Bytes that arrived since the last transaction come first: if there are any, they are returned with None
+        and nothing is written (the bus hands them to subscribers, then writes). Otherwise `frame` is written and
+        the first read of the reply returned (see `read`). On an exception, `doing` names the step that failed.
+        """
+        self.doing = "read"
+        stale = self.read_waiting()
+        if stale:
+            return stale, None
+        self.doing = "write"
+        self.write(frame)
+        self.doing = "read"
+        return stale, self.read(wait)
 
     def read(self, wait: float) -> bytes:
         port = self.port
@@ -195,12 +219,16 @@ class FdLink(Link):
     def read_waiting(self) -> bytes:
         # pyserial sets VMIN = VTIME = 0: a read with nothing there returns b"" at once (one syscall, the usual
         # case). A device that went away fails here or at the write that follows.
-        fd = self.port.fd
         try:
-            data = os.read(fd, 4096)
+            data = os.read(self.port.fd, 4096)
         except BlockingIOError:
             return b""
-        while len(data) % 4096 == 0 and data:  # more may be waiting (a read that fills the buffer is rare)
+        return self._rest(data) if data else data
+
+    def _rest(self, data: bytes) -> bytes:
+        """The bytes waiting, given the first read of them (more may wait: a read that fills the buffer is rare)."""
+        fd = self.port.fd
+        while len(data) % 4096 == 0:
             try:
                 more = os.read(fd, 4096)
             except BlockingIOError:
@@ -208,9 +236,25 @@ class FdLink(Link):
             if not more:
                 break
             data += more
-        if data and self._spy is not None:
+        if self._spy is not None:
             self._spy.rx(data)
         return data
+
+    def transact(self, frame: bytes, wait: float) -> tuple[bytes, bytes | None]:
+        # Link.transact's three steps inline: the usual transaction in one Python call and four system calls
+        # (read what waits, write, poll, read).
+        self.doing = "read"
+        fd = self.port.fd
+        try:
+            stale = os.read(fd, 4096)
+        except BlockingIOError:
+            stale = b""
+        if stale:
+            return self._rest(stale), None
+        self.doing = "write"
+        self.write(frame)
+        self.doing = "read"
+        return stale, self.read(wait)
 
     def read(self, wait: float) -> bytes:
         fd = self.port.fd
@@ -275,6 +319,8 @@ class Bus:
         self._unsolicited: deque[Message] = deque(maxlen=1024)
         self._backlog: deque[Message] = deque()  # frames read after a reply within the same transaction
         self._parser = binding.parser()
+        # whether the parser reads replies by the request's reply class (classic ones do not: a call saved)
+        self._expects = type(self._parser).expect is not StreamParser.expect
         self._port: Any  # a pyserial port; the stubs' SerialBase lacks in_waiting and reset_input_buffer
         if isinstance(port, serial.SerialBase):
             self._port = port
@@ -298,7 +344,10 @@ class Bus:
         self._match_command = "command" in match_by
         self._match_subcommand = "subcommand" in match_by
         self._match_fields = tuple(name for name in match_by if name not in ("command", "subcommand"))
-        self._rules: dict[tuple[type, type], tuple[bool, Callable[[Any], Any] | None]] = {}
+        self._decode = binding.decode
+        self._sizes: dict[type, int] = {}  # the size of the last reply of each type read whole (see request)
+        self._rules: dict[type, _Rule] = {}  # the latest rule of each reply type
+        self._all_rules: dict[tuple[type, type], _Rule] = {}
 
     # --- lifetime -------------------------------------------------------------------------------------------------
 
@@ -354,50 +403,88 @@ class Bus:
         """Send a request and return its reply: the first frame of type `expect` that matches the request."""
         frame = self.binding.encode(request)
         wait = self.timeout if timeout is None else timeout
-        with self._lock:
+        lock = self._lock
+        lock.acquire()  # not `with`: half the cost, at tens of microseconds per transaction
+        try:
             if self._closed or not self._port.is_open:
                 self._ensure_open()
-            # The usual transaction inline (nothing waiting, the reply whole in the first read): a call or two
-            # less matters at tens of microseconds per transaction. Anything else goes through _read_until.
-            link = self._link
-            try:
-                stale = link.read_waiting()
-            except Exception as exc:
-                self._port_failed("read", exc)
-                raise
-            if stale or self._backlog:
-                self._stale(stale)
+            if self._backlog:
+                self._flush_backlog()
+            # The usual transaction inline (nothing waiting, the reply whole in the first read): every call less
+            # matters. Anything else goes through _read_until.
             parser = self._parser
-            parser.errors = 0
-            parser.expect(expect)  # where replies share a code, the layout this request's reply has
-            self._write(frame)
+            if self._expects:
+                parser.expect(expect)  # where replies share a code, the layout this request's reply has
             started = time.monotonic()
-            rule = self._rules.get((type(request), expect)) or self._rule(type(request), expect)
-            try:
-                chunk = b"" if self._backlog else link.read(wait)  # an echo check may have read the reply
-            except Exception as exc:
-                self._port_failed("read", exc)
-                raise
-            if chunk:
+            chunk: bytes | None = None
+            if not self.echo:
+                parser.errors = 0
+                link = self._link
                 if self._gap:
-                    self._last_io = time.monotonic()
-                messages = parser.feed(chunk)
-                if len(messages) == 1:
-                    possible, getter = rule
-                    reply = messages[0]
-                    if type(reply) is expect and possible and (getter is None or getter(reply) == getter(request)):
-                        self._refused(request, reply)
-                        if self.binding.status:
-                            self._check_status(reply)
-                        return reply  # type(reply) is expect
+                    self._wait_gap()
+                try:
+                    stale, chunk = link.transact(frame, wait)
+                except Exception as exc:
+                    self._port_failed(link.doing, exc)
+                    raise
+                if chunk is None:  # bytes came between transactions: to subscribers, then the request
+                    self._stale(stale)
+            if chunk is None:  # the general path: an echo, or bytes that came before the request
+                self._drain()
+                parser = self._parser  # a subscriber's own request may have reset it
+                parser.expect(expect)
+                self._write(frame)
+                started = time.monotonic()
+                try:
+                    chunk = self._link.read(wait) if not self._backlog else b""  # an echo check may have read it
+                except Exception as exc:
+                    self._port_failed("read", exc)
+                    raise
+            if self._gap:
+                self._last_io = time.monotonic()  # the reply's end (no reply: the wait's, later than needed)
+            if chunk:
+                size = len(chunk)
+                messages: list[Message] | None = None
+                if size == self._sizes.get(expect) and not parser.pending():
+                    # the size the last reply of this type had: most likely that reply, whole; decoded at once
+                    try:
+                        found: Message | None = self._decode(chunk, "response", expect)  # type: ignore[misc]
+                    except Exception:  # anything else is for the parser, which counts it and resynchronises
+                        found = None
+                else:
+                    messages = parser.feed(chunk)
+                    found = messages[0] if len(messages) == 1 else None
+                if found is not None and found.__class__ is expect:
+                    rule = self._rules.get(expect)
+                    if rule is None or rule[0] is not request.__class__:
+                        rule = self._rule(request.__class__, found)
+                    _, possible, getter, refusals, statuses = rule
+                    if possible and (getter is None or getter(found) == getter(request)):
+                        if messages is not None and self._decode is not None:
+                            self._sizes[expect] = size
+                        if refusals:
+                            self._refused(request, found)
+                        for name, parts in statuses:  # _check_status raises DeviceError
+                            value = getattr(found, name)
+                            if not parts:
+                                if value != 0:  # an int's comparison (a flag's truth is a Python call)
+                                    self._check_status(found)
+                            else:  # bit fields: no comprehension (a function call of its own before 3.12)
+                                for part in parts:
+                                    if getattr(value, part) != 0:
+                                        self._check_status(found)
+                        return found  # its class is expect
+                if messages is None:  # decoded at once but no reply to this request: the parser takes it
+                    messages = parser.feed(chunk)
                 self._backlog.extend(messages)  # _read_until takes them first
             reply = self._read_until(wait - (time.monotonic() - started), request, expect, errors=0)
             if self._backlog:
                 self._flush_backlog()
+        finally:
+            lock.release()
         self._refused(request, reply)
         assert isinstance(reply, expect)
-        if self.binding.status:
-            self._check_status(reply)
+        self._check_status(reply)
         return reply
 
     def _refused(self, request: Message, reply: Message) -> None:
@@ -454,10 +541,14 @@ class Bus:
                 return False
         return True
 
-    def _rule(self, request_type: type, reply_type: type) -> tuple[bool, Callable[[Any], Any] | None]:
-        """The matching rule for a reply of exactly `reply_type` to a request of `request_type`, worked out once:
-        whether it can answer at all (command, sub-command), and a getter of the fields both have (None: none)."""
-        rule = self._rules.get((request_type, reply_type))
+    def _rule(self, request_type: type, reply: Message) -> _Rule:
+        """The matching rule for a reply of exactly the type of `reply` to a request of `request_type`, worked
+        out once; the latest one of each reply type is at hand in `_rules` (a reply type usually answers one
+        request type). It says whether the reply can answer at all (command, sub-command); gives a getter of the
+        fields both have (None: none); whether the protocol has error replies; the reply's status fields, each
+        with its parts when it is made of bit fields (a Record; an error when any part is not 0)."""
+        reply_type = type(reply)
+        rule = self._all_rules.get((request_type, reply_type))
         if rule is None:
             possible = not (
                 self._match_command and getattr(reply_type, "COMMAND", None) != getattr(request_type, "COMMAND", None)
@@ -466,7 +557,15 @@ class Bus:
                 and getattr(reply_type, "SUBCOMMAND", None) != getattr(request_type, "SUBCOMMAND", None)
             )
             names = [n for n in self._match_fields if hasattr(request_type, n) and hasattr(reply_type, n)]
-            rule = self._rules[(request_type, reply_type)] = (possible, operator.attrgetter(*names) if names else None)
+            getter = operator.attrgetter(*names) if names else None
+            statuses = tuple(
+                (n, value.__match_args__ if isinstance(value, Record) else ())
+                for n in self.binding.status
+                if (value := getattr(reply, n, _ABSENT)) is not _ABSENT
+            )
+            rule = (request_type, possible, getter, self.binding.errors is not None, statuses)
+            self._all_rules[(request_type, reply_type)] = rule
+        self._rules[reply_type] = rule
         return rule
 
     def receive(self, timeout: float | None = None) -> Message | None:
@@ -505,12 +604,15 @@ class Bus:
             self._port.close()
         raise PortError(f"{self.port_name}: {doing} failed: {reason}") from None
 
+    def _wait_gap(self) -> None:
+        """The one wait the bus makes: the silence a protocol needs before a frame (3.5 characters for Modbus)."""
+        wait = self._last_io + self._gap - time.monotonic()
+        if wait > 0:
+            time.sleep(wait)
+
     def _write(self, frame: bytes) -> None:
         if self._gap:
-            # the one wait the bus makes: the silence a protocol needs before a frame (3.5 characters for Modbus)
-            wait = self._last_io + self._gap - time.monotonic()
-            if wait > 0:
-                time.sleep(wait)
+            self._wait_gap()
         try:
             self._link.write(frame)
         except Exception as exc:
@@ -653,6 +755,7 @@ class Bus:
         return " ".join(parts)
 
     def _check_status(self, reply: Message) -> None:
+        """A reply whose status fields (the spec's frame status elements) are not all zero is a DeviceError."""
         for name in self.binding.status:
             value = getattr(reply, name, 0)
             if isinstance(value, Record):  # a status made of bit fields: an error when any is non-zero
@@ -767,27 +870,30 @@ class ClientBase:
         self, request: Message, expect: type[M], optional: tuple[int, int, str] | None, after: str = ""
     ) -> M | None:
         """A reply unless the device stays silent: broadcast, or an optional reply its parameter switches off."""
-        self.bus.binding.encode(request)  # check every value before any byte (even a parameter read) is written
         if self._is_broadcast(request) or (optional is not None and not self._answers(request, optional)):
-            self.bus.send(request)
+            self.bus.send(request)  # which checks every value before a byte is written
             return None
-        return self._ask(request, expect, after)
+        if after:
+            return self._ask(request, expect, after)
+        return self.bus.request(request, expect)
 
     def _answers(self, request: Message, optional: tuple[int, int, str]) -> bool:
         if self.optional_replies is not None:
             return self.optional_replies
         key, value, op = optional
-        address = int(getattr(request, self.ADDRESS, 0))
-        if (address, key) not in self._parameters:
+        address = getattr(request, self.ADDRESS, 0)
+        current: Any = self._parameters.get((address, key), _ABSENT)
+        if current is _ABSENT:
+            self.bus.binding.encode(request)  # check every value before any byte (even a parameter read) is written
+            address = int(address)
             # While the parameter is read, that read is asked as if it were answered (the read may itself be an
             # optional reply: DYNAMIXEL READ at status_return_level 0); no answer means no optional replies.
             self._parameters[(address, key)] = None
             try:
-                self._parameters[(address, key)] = self._read_key(address, key)
+                current = self._parameters[(address, key)] = self._read_key(address, key)
             except Timeout:
                 del self._parameters[(address, key)]
                 return False
-        current = self._parameters[(address, key)]
         return True if current is None else compare(current, op, value)
 
     def _carry(

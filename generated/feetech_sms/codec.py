@@ -163,8 +163,7 @@ def _frame_reset_request(buf: bytes, start: int) -> ResetRequest | None:
 
 def _whole_ping_request(buf: bytes) -> PingRequest | None:
     """A whole ping request frame, all of buf, size and header known: None if its checksum fails."""
-    check = buf[5]
-    if ~(sum(buf) - 0x1fe - check) & 0xff != check:
+    if (sum(buf) - 0x2fd) & 0xff:
         return None
     id = buf[2]
     return _new(PingRequest, (id,))
@@ -181,8 +180,7 @@ def _whole_read_request(buf: bytes) -> ReadRequest | None:
 
 def _whole_action_request(buf: bytes) -> ActionRequest | None:
     """A whole action request frame, all of buf, size and header known: None if its checksum fails."""
-    check = buf[5]
-    if ~(sum(buf) - 0x1fe - check) & 0xff != check:
+    if (sum(buf) - 0x2fd) & 0xff:
         return None
     id = buf[2]
     return _new(ActionRequest, (id,))
@@ -190,8 +188,7 @@ def _whole_action_request(buf: bytes) -> ActionRequest | None:
 
 def _whole_reset_request(buf: bytes) -> ResetRequest | None:
     """A whole reset request frame, all of buf, size and header known: None if its checksum fails."""
-    check = buf[5]
-    if ~(sum(buf) - 0x1fe - check) & 0xff != check:
+    if (sum(buf) - 0x2fd) & 0xff:
         return None
     id = buf[2]
     return _new(ResetRequest, (id,))
@@ -199,8 +196,7 @@ def _whole_reset_request(buf: bytes) -> ResetRequest | None:
 
 def _whole_write_request(buf: bytes) -> WriteRequest | None:
     """A whole write request frame, all of buf, its size and first bytes known: None if its checksum fails."""
-    check = buf[-1]
-    if ~(sum(buf) - 0x1fe - check) & 0xff != check:
+    if (sum(buf) - 0x2fd) & 0xff:  # inverted: the bytes and the check sum to 0xff
         return None
     id = buf[2]
     v_address = buf[5]
@@ -210,8 +206,7 @@ def _whole_write_request(buf: bytes) -> WriteRequest | None:
 
 def _whole_reg_write_request(buf: bytes) -> RegWriteRequest | None:
     """A whole reg_write request frame, all of buf, its size and first bytes known: None if its checksum fails."""
-    check = buf[-1]
-    if ~(sum(buf) - 0x1fe - check) & 0xff != check:
+    if (sum(buf) - 0x2fd) & 0xff:  # inverted: the bytes and the check sum to 0xff
         return None
     id = buf[2]
     v_address = buf[5]

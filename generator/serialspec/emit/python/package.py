@@ -582,7 +582,7 @@ def rest_check_lines(protocol: Protocol, layout: FrameLayout) -> Lines:
         less = f" - {sum(header):#x}" if header else ""
         if not checksum.invert:
             return [f"if (sum(buf){less} - 2 * buf[-1]) & 0xff:"]
-        return ["check = buf[-1]", f"if ~(sum(buf){less} - check) & 0xff != check:"]
+        return [f"if (sum(buf) - {sum(header) + 0xFF:#x}) & 0xff:  # inverted: the bytes and the check sum to 0xff"]
     covered = f"buf[{layout.covered_from}:-{layout.covered_to_end}]"
     return [*checksum_lines(checksum, covered, "expected"), f"if expected != {stored}:"]
 
@@ -683,8 +683,8 @@ def plain_check(protocol: Protocol, layout: FrameLayout) -> str | None:
     if not layout.checksum_offset_from_end == 1 == layout.covered_to_end == checksum.type.size:
         return None
     less = f" - {sum(header):#x}" if header else ""
-    if checksum.invert:
-        return f"~(sum(data){less} - data[-1]) & 0xff == data[-1]"
+    if checksum.invert:  # the covered bytes and their inverted sum add up to 0xff
+        return f"not (sum(data) - {sum(header) + 0xFF:#x}) & 0xff"
     return f"not (sum(data){less} - 2 * data[-1]) & 0xff"
 
 
@@ -745,7 +745,8 @@ def whole_frame_lines(
     less = f" - {sum(header):#x}" if header else ""
     if not checksum.invert:  # sum(covered) = check (mod 256): the whole frame sums to twice the check, plus the rest
         return [f"if (sum(buf){less} - 2 * buf[{size - 1}]) & 0xff:", *lines[2:]]
-    return [f"check = buf[{size - 1}]", f"if ~(sum(buf){less} - check) & 0xff != check:", *lines[2:]]
+    # inverted: the covered bytes and the check sum to 0xff, so the whole frame to that plus the header
+    return [f"if (sum(buf) - {sum(header) + 0xFF:#x}) & 0xff:", *lines[2:]]
 
 
 _UNPACK = re.compile(r"^(?P<targets>.+) = (?P<struct>_S_\w+)\.unpack_from\(buf, o\)$")

@@ -41,6 +41,8 @@ __all__ = ["StreamParser", "decode", "encode"]
 
 _F_BE_1S_U16_U8 = struct.Struct('>1sHB')
 _F_LE_1S_U8_U8 = struct.Struct('<1sBB')
+_F_REQUEST_WHOLE_BE_I32 = struct.Struct('>3xi3x')
+_F_RESPONSE_WHOLE_BE_I32 = struct.Struct('>3xi3x')
 _S_BE_FRAME_GETVALUESRESPONSE = struct.Struct('>BhhiiiihihiiiiiiBiBhhhiiB')
 _S_BE_FWVERSIONRESPONSE_UUID = struct.Struct('>12sBBBBBBBB')
 _S_BE_GETVALUESRESPONSE_TEMP_FET = struct.Struct('>hhiiiihihiiiiiiBiBhhhiiB')
@@ -174,7 +176,7 @@ def _decode_forward_can_request(buf: bytes, o: int, end: int) -> ForwardCanReque
 
 def _encode_fw_version_request(m: FwVersionRequest) -> bytes:
     body = _S_U8.pack(0x00)
-    return b'\x02\x01' + body + _crc_hqx(body, 0x0).to_bytes(2, 'big') + b'\x03'
+    return b''.join((b'\x02\x01', body, _crc_hqx(body, 0x0).to_bytes(2, 'big'), b'\x03'))
 
 
 def _encode_fw_version_response(m: FwVersionResponse) -> bytes:
@@ -219,7 +221,7 @@ def _encode_fw_version_response(m: FwVersionResponse) -> bytes:
 
 def _encode_get_values_request(m: GetValuesRequest) -> bytes:
     body = _S_U8.pack(0x04)
-    return b'\x02\x01' + body + _crc_hqx(body, 0x0).to_bytes(2, 'big') + b'\x03'
+    return b''.join((b'\x02\x01', body, _crc_hqx(body, 0x0).to_bytes(2, 'big'), b'\x03'))
 
 
 def _encode_get_values_response(m: GetValuesResponse) -> bytes:
@@ -296,7 +298,7 @@ def _encode_get_values_response(m: GetValuesResponse) -> bytes:
     if not 0 <= m_status <= 255 or isinstance(m_status, bool):
         raise out_of_range('get_values response', 'status', m_status, 0, 255)
     body = _S_BE_FRAME_GETVALUESRESPONSE.pack(0x04, m_temp_fet, m_temp_motor, m_avg_motor_current, m_avg_input_current, m_avg_id, m_avg_iq, m_duty_now, m_rpm, m_v_in, m_amp_hours, m_amp_hours_charged, m_watt_hours, m_watt_hours_charged, m_tachometer, m_tachometer_abs, m_fault, m_pid_pos, m_controller_id, m_temp_mos1, m_temp_mos2, m_temp_mos3, m_avg_vd, m_avg_vq, m_status)
-    return b'\x02J' + body + _crc_hqx(body, 0x0).to_bytes(2, 'big') + b'\x03'
+    return b''.join((b'\x02J', body, _crc_hqx(body, 0x0).to_bytes(2, 'big'), b'\x03'))
 
 
 def _encode_set_duty_request(m: SetDutyRequest) -> bytes:
@@ -304,7 +306,7 @@ def _encode_set_duty_request(m: SetDutyRequest) -> bytes:
     if not -100000 <= m_duty <= 100000 or m_duty.__class__ is bool:
         raise out_of_range('set_duty request', 'duty', m_duty, -100000, 100000)
     body = _S_BE_U8_I32.pack(0x05, m_duty)
-    return b'\x02\x05' + body + _crc_hqx(body, 0x0).to_bytes(2, 'big') + b'\x03'
+    return b''.join((b'\x02\x05', body, _crc_hqx(body, 0x0).to_bytes(2, 'big'), b'\x03'))
 
 
 def _encode_set_current_request(m: SetCurrentRequest) -> bytes:
@@ -312,7 +314,7 @@ def _encode_set_current_request(m: SetCurrentRequest) -> bytes:
     if not -2147483648 <= m_current <= 2147483647 or m_current.__class__ is bool:
         raise out_of_range('set_current request', 'current', m_current, -2147483648, 2147483647)
     body = _S_BE_U8_I32.pack(0x06, m_current)
-    return b'\x02\x05' + body + _crc_hqx(body, 0x0).to_bytes(2, 'big') + b'\x03'
+    return b''.join((b'\x02\x05', body, _crc_hqx(body, 0x0).to_bytes(2, 'big'), b'\x03'))
 
 
 def _encode_set_current_brake_request(m: SetCurrentBrakeRequest) -> bytes:
@@ -320,7 +322,7 @@ def _encode_set_current_brake_request(m: SetCurrentBrakeRequest) -> bytes:
     if not -2147483648 <= m_current <= 2147483647 or m_current.__class__ is bool:
         raise out_of_range('set_current_brake request', 'current', m_current, -2147483648, 2147483647)
     body = _S_BE_U8_I32.pack(0x07, m_current)
-    return b'\x02\x05' + body + _crc_hqx(body, 0x0).to_bytes(2, 'big') + b'\x03'
+    return b''.join((b'\x02\x05', body, _crc_hqx(body, 0x0).to_bytes(2, 'big'), b'\x03'))
 
 
 def _encode_set_rpm_request(m: SetRpmRequest) -> bytes:
@@ -328,7 +330,7 @@ def _encode_set_rpm_request(m: SetRpmRequest) -> bytes:
     if not -2147483648 <= m_rpm <= 2147483647 or m_rpm.__class__ is bool:
         raise out_of_range('set_rpm request', 'rpm', m_rpm, -2147483648, 2147483647)
     body = _S_BE_U8_I32.pack(0x08, m_rpm)
-    return b'\x02\x05' + body + _crc_hqx(body, 0x0).to_bytes(2, 'big') + b'\x03'
+    return b''.join((b'\x02\x05', body, _crc_hqx(body, 0x0).to_bytes(2, 'big'), b'\x03'))
 
 
 def _encode_set_pos_request(m: SetPosRequest) -> bytes:
@@ -336,7 +338,7 @@ def _encode_set_pos_request(m: SetPosRequest) -> bytes:
     if not -2147483648 <= m_position <= 2147483647 or m_position.__class__ is bool:
         raise out_of_range('set_pos request', 'position', m_position, -2147483648, 2147483647)
     body = _S_BE_U8_I32.pack(0x09, m_position)
-    return b'\x02\x05' + body + _crc_hqx(body, 0x0).to_bytes(2, 'big') + b'\x03'
+    return b''.join((b'\x02\x05', body, _crc_hqx(body, 0x0).to_bytes(2, 'big'), b'\x03'))
 
 
 def _encode_set_handbrake_request(m: SetHandbrakeRequest) -> bytes:
@@ -344,7 +346,7 @@ def _encode_set_handbrake_request(m: SetHandbrakeRequest) -> bytes:
     if not -2147483648 <= m_current <= 2147483647 or m_current.__class__ is bool:
         raise out_of_range('set_handbrake request', 'current', m_current, -2147483648, 2147483647)
     body = _S_BE_U8_I32.pack(0x0a, m_current)
-    return b'\x02\x05' + body + _crc_hqx(body, 0x0).to_bytes(2, 'big') + b'\x03'
+    return b''.join((b'\x02\x05', body, _crc_hqx(body, 0x0).to_bytes(2, 'big'), b'\x03'))
 
 
 def _encode_print_response(m: PrintResponse) -> bytes:
@@ -356,12 +358,12 @@ def _encode_rotor_position_response(m: RotorPositionResponse) -> bytes:
     if not -2147483648 <= m_position <= 2147483647 or m_position.__class__ is bool:
         raise out_of_range('rotor_position response', 'position', m_position, -2147483648, 2147483647)
     body = _S_BE_U8_I32.pack(0x16, m_position)
-    return b'\x02\x05' + body + _crc_hqx(body, 0x0).to_bytes(2, 'big') + b'\x03'
+    return b''.join((b'\x02\x05', body, _crc_hqx(body, 0x0).to_bytes(2, 'big'), b'\x03'))
 
 
 def _encode_alive_request(m: AliveRequest) -> bytes:
     body = _S_U8.pack(0x1e)
-    return b'\x02\x01' + body + _crc_hqx(body, 0x0).to_bytes(2, 'big') + b'\x03'
+    return b''.join((b'\x02\x01', body, _crc_hqx(body, 0x0).to_bytes(2, 'big'), b'\x03'))
 
 
 def _encode_forward_can_request(m: ForwardCanRequest) -> bytes:
@@ -479,14 +481,14 @@ def _decode_request(frame: bytes, expect: type[Message] | None = None) -> Messag
 
 
 # Request frames of one size whose message is their content as one struct unpacks it, by their
-# first bytes (up to the content): frame size, class, unpack.
-_REQUEST_WHOLE: dict[bytes, tuple[int, type[Message], Callable[[bytes, int], tuple[object, ...]]]] = {
-    b'\x02\x05\x05': (10, SetDutyRequest, _S_BE_I32.unpack_from),
-    b'\x02\x05\x06': (10, SetCurrentRequest, _S_BE_I32.unpack_from),
-    b'\x02\x05\x07': (10, SetCurrentBrakeRequest, _S_BE_I32.unpack_from),
-    b'\x02\x05\x08': (10, SetRpmRequest, _S_BE_I32.unpack_from),
-    b'\x02\x05\t': (10, SetPosRequest, _S_BE_I32.unpack_from),
-    b'\x02\x05\n': (10, SetHandbrakeRequest, _S_BE_I32.unpack_from),
+# first bytes (up to the content): class, unpack of the whole frame.
+_REQUEST_WHOLE: dict[bytes, tuple[type[Message], Callable[[bytes], tuple[object, ...]]]] = {
+    b'\x02\x05\x05': (SetDutyRequest, _F_REQUEST_WHOLE_BE_I32.unpack),
+    b'\x02\x05\x06': (SetCurrentRequest, _F_REQUEST_WHOLE_BE_I32.unpack),
+    b'\x02\x05\x07': (SetCurrentBrakeRequest, _F_REQUEST_WHOLE_BE_I32.unpack),
+    b'\x02\x05\x08': (SetRpmRequest, _F_REQUEST_WHOLE_BE_I32.unpack),
+    b'\x02\x05\t': (SetPosRequest, _F_REQUEST_WHOLE_BE_I32.unpack),
+    b'\x02\x05\n': (SetHandbrakeRequest, _F_REQUEST_WHOLE_BE_I32.unpack),
 }
 
 
@@ -597,9 +599,9 @@ def _decode_response(frame: bytes, expect: type[Message] | None = None) -> Messa
 
 
 # Response frames of one size whose message is their content as one struct unpacks it, by their
-# first bytes (up to the content): frame size, class, unpack.
-_RESPONSE_WHOLE: dict[bytes, tuple[int, type[Message], Callable[[bytes, int], tuple[object, ...]]]] = {
-    b'\x02\x05\x16': (10, RotorPositionResponse, _S_BE_I32.unpack_from),
+# first bytes (up to the content): class, unpack of the whole frame.
+_RESPONSE_WHOLE: dict[bytes, tuple[type[Message], Callable[[bytes], tuple[object, ...]]]] = {
+    b'\x02\x05\x16': (RotorPositionResponse, _F_RESPONSE_WHOLE_BE_I32.unpack),
 }
 
 
@@ -645,8 +647,11 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
     if direction is _REQUEST or direction == 'request':  # a Direction (told by identity, first) or its value
         frame = data if data.__class__ is bytes else bytes(data)
         whole = _REQUEST_WHOLE.get(frame[:3])
-        if whole is not None and whole[0] == len(frame) and frame[-1] == 0x03 and _crc_hqx(frame[2:-1], 0x0) == 0x0000:
-            return _new(whole[1], whole[2](frame, 3))
+        if whole is not None and frame[-1] == 0x03 and _crc_hqx(frame[2:-1], 0x0) == 0x0000:
+            try:
+                return _new(whole[0], whole[1](frame))
+            except struct.error:
+                pass  # a frame of another size: the general path says what is wrong
         if frame.startswith(b'\x02'):
             n = len(frame)
             if n < 6:
@@ -695,8 +700,11 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
     if direction is _RESPONSE or direction == 'response':  # a Direction (told by identity, first) or its value
         frame = data if data.__class__ is bytes else bytes(data)
         whole = _RESPONSE_WHOLE.get(frame[:3])
-        if whole is not None and whole[0] == len(frame) and frame[-1] == 0x03 and _crc_hqx(frame[2:-1], 0x0) == 0x0000:
-            return _new(whole[1], whole[2](frame, 3))
+        if whole is not None and frame[-1] == 0x03 and _crc_hqx(frame[2:-1], 0x0) == 0x0000:
+            try:
+                return _new(whole[0], whole[1](frame))
+            except struct.error:
+                pass  # a frame of another size: the general path says what is wrong
         if frame.startswith(b'\x02'):
             n = len(frame)
             if n < 6:

@@ -605,7 +605,7 @@ def direction_functions(
     direction: Direction,
     target: Target,
     structs: dict[str, str],
-    plain: list[tuple[int, int, str, str]],
+    plain: list[tuple[int, int, str, str, str]],
 ) -> tuple[Lines, Lines]:
     """Module-level code of one direction's frame functions (`_decode_<d>`, `_wrap_<d>` and what they use), and
     the lines of `decode()` that decode a frame `data` of this direction (`plain`: see whole_frames)."""
@@ -641,7 +641,7 @@ def direction_functions(
             "",
         ]
     # decode() chooses the layout and checks the frame itself: one call less
-    table, fast = whole_frames(found, d, plain)
+    table, fast = whole_frames(found, d, plain, structs)
     call = ["frame = data if data.__class__ is bytes else bytes(data)", *fast, *_choice(layouts, d, bodies)]
     lines += [*table, "", ""] if table else []
     lines += wrap_lines(d, wraps, target)
@@ -726,11 +726,10 @@ def frame_encoder(
         element = elements[index]
         check = checks[index].format("body")
         after = _packed(elements, list(range(index + 1, len(elements))), constant_or, struct)
-        tail = f" + {after}" if after else ""
-        return [
-            f"body = {frame}",
-            f"return {literal!r} + body + {check}.to_bytes({element.size}, {element.endian!r}){tail}",
-        ]
+        # one join: cheaper than three or four concatenations, each of which makes a bytes object
+        pieces = [repr(literal), "body", f"{check}.to_bytes({element.size}, {element.endian!r})"]
+        pieces += [after] if after else []
+        return [f"body = {frame}", f"return b''.join(({', '.join(pieces)}))"]
     return _tail(layout, frame, checks, lambda indices: _packed(elements, indices, constant_or, struct))
 
 
@@ -777,20 +776,23 @@ def _choice(layouts: tuple[Layout, ...], d: str, bodies: list[Lines] | None = No
 _END = re.compile(r"\bend(?: \+ (\d+))?")
 
 
-def whole_frames(found: Straight, d: str, plain: list[tuple[int, int, str, str]]) -> tuple[Lines, Lines]:
+def whole_frames(
+    found: Straight, d: str, plain: list[tuple[int, int, str, str, str]], structs: dict[str, str]
+) -> tuple[Lines, Lines]:
     """decode()'s fast path for frames of one size whose message is their content as one struct unpacks it: a table
-    keyed by the bytes before the content (header, length, command code: the key fixes the frame's size), and lines
-    that check the rest of a frame `frame` (constants and checksums after the content, counted from its end) and
-    build the message with no call but the unpack. A frame that fails any check goes on to the general path, which
-    says why. `plain`: (code, content size, class, struct) of each such message. ([], []) where the direction's
-    first layout has values before the content or is stuffed, or no message fits."""
+    keyed by the bytes before the content (header, length, command code), and lines that check the rest of a frame
+    `frame` (constants and checksums after the content, counted from its end) and build the message with no call
+    but the unpack: a struct of the whole frame (the bytes around the content skipped as padding), whose unpack
+    refuses a frame of another size. A frame that fails any check goes on to the general path, which says why.
+    `plain`: (code, content size, class, content struct and its format) of each such message; `structs` gets the whole
+    frames' structs. ([], []) where the direction's first layout has values or is stuffed, or no message fits."""
     layout, checks = found.layouts[0], found.checks[0]
     elements = layout.elements
     if layout.transparency is not None or any(e.kind == "value" for e in elements):
         return [], []
     places = _Places(layout)
-    entries: list[tuple[bytes, int, str, str]] = []
-    for code, size, cls, struct_name in plain:
+    entries: list[tuple[bytes, str, str]] = []
+    for code, size, cls, content, fmt in plain:
         head = b""
         for element in elements[: layout.content]:
             if element.kind == "constant":
@@ -804,7 +806,9 @@ def whole_frames(found: Straight, d: str, plain: list[tuple[int, int, str, str]]
                     break
                 head += element.pack(counted)
         else:
-            entries.append((head, places.content + size + places.behind, cls, struct_name))
+            name = f"_F_{d.upper()}_WHOLE{content.removeprefix('_S')}"  # the content's struct in the frame
+            structs[name] = f"{fmt[0]}{places.content}x{fmt[1:]}{places.behind}x"
+            entries.append((head, cls, name))
     if not entries:
         return [], []
 
@@ -830,15 +834,18 @@ def whole_frames(found: Straight, d: str, plain: list[tuple[int, int, str, str]]
     table = f"_{d.upper()}_WHOLE"
     definition = [
         f"# {d.capitalize()} frames of one size whose message is their content as one struct unpacks it, by their",
-        "# first bytes (up to the content): frame size, class, unpack.",
-        f"{table}: dict[bytes, tuple[int, type[Message], Callable[[bytes, int], tuple[object, ...]]]] = {{",
-        *(f"    {key!r}: ({size}, {cls}, {name}.unpack_from)," for key, size, cls, name in entries),
+        "# first bytes (up to the content): class, unpack of the whole frame.",
+        f"{table}: dict[bytes, tuple[type[Message], Callable[[bytes], tuple[object, ...]]]] = {{",
+        *(f"    {key!r}: ({cls}, {name}.unpack)," for key, cls, name in entries),
         "}",
     ]
     lines = [
         f"whole = {table}.get(frame[:{places.content}])",
-        f"if whole is not None and whole[0] == len(frame) and {' and '.join(conditions)}:",
-        f"    return _new(whole[1], whole[2](frame, {places.content}))",
+        f"if whole is not None and {' and '.join(conditions)}:",
+        "    try:",
+        "        return _new(whole[0], whole[1](frame))",
+        "    except struct.error:",
+        "        pass  # a frame of another size: the general path says what is wrong",
     ]
     return definition, lines
 

@@ -270,9 +270,9 @@ def general_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
     }
 
 
-def plain_messages(single: dict[str, Message], code: PackageCode) -> list[tuple[int, int, str, str]]:
-    """(code, content size, class, struct) of the messages of one size whose decoder, past its size check, is one
-    struct's unpack of the content as their message (framecode.whole_frames decodes their frames whole)."""
+def plain_messages(single: dict[str, Message], code: PackageCode) -> list[tuple[int, int, str, str, str]]:
+    """(code, content size, class, struct, its format) of the messages of one size whose decoder, past its size
+    check, is one struct's unpack of the content as their message (framecode.whole_frames decodes them whole)."""
     bodies = {name: lines for name, _, _, lines in code.decoders}
     found = []
     for key, message in single.items():
@@ -282,7 +282,8 @@ def plain_messages(single: dict[str, Message], code: PackageCode) -> list[tuple[
         fused = fuse_unpack(lines[2:], code.structs)
         plain = _PLAIN.match(fused[0]) if len(fused) == 1 and lines[0].startswith("if end - o != ") else None
         if plain is not None:
-            found.append((int(key, 16), message.min_size or 0, plain["cls"], plain["struct"]))
+            struct = plain["struct"]
+            found.append((int(key, 16), message.min_size or 0, plain["cls"], struct, code.structs[struct]))
     return found
 
 

@@ -373,10 +373,16 @@ def _encode_read_holding_registers_response(m: ReadHoldingRegistersResponse) -> 
     v_byte_count = (2 * len(m_registers))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('read_holding_registers response', 'byte_count', v_byte_count, 0, 255)
-    for x_registers in m_registers:
-        if not 0 <= x_registers <= 65535 or x_registers.__class__ is bool:
-            raise out_of_range('read_holding_registers response', 'registers', m_registers, 0, 65535)
-    frame = struct.pack(f'>BBB{len(m_registers)}H', m_unit, 0x03, v_byte_count, *m_registers)
+    try:
+        for x_registers in m_registers:
+            if x_registers.__class__ is bool:  # struct.pack takes True and False as numbers: refused below
+                raise TypeError
+        frame = struct.pack(f'>BBB{len(m_registers)}H', m_unit, 0x03, v_byte_count, *m_registers)
+    except (TypeError, struct.error):  # the item at fault, looked for only when the pack fails
+        for x_registers in m_registers:
+            if not 0 <= x_registers <= 65535 or x_registers.__class__ is bool:
+                raise out_of_range('read_holding_registers response', 'registers', m_registers, 0, 65535) from None
+        raise
     return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
@@ -402,10 +408,16 @@ def _encode_read_input_registers_response(m: ReadInputRegistersResponse) -> byte
     v_byte_count = (2 * len(m_registers))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('read_input_registers response', 'byte_count', v_byte_count, 0, 255)
-    for x_registers in m_registers:
-        if not 0 <= x_registers <= 65535 or x_registers.__class__ is bool:
-            raise out_of_range('read_input_registers response', 'registers', m_registers, 0, 65535)
-    frame = struct.pack(f'>BBB{len(m_registers)}H', m_unit, 0x04, v_byte_count, *m_registers)
+    try:
+        for x_registers in m_registers:
+            if x_registers.__class__ is bool:  # struct.pack takes True and False as numbers: refused below
+                raise TypeError
+        frame = struct.pack(f'>BBB{len(m_registers)}H', m_unit, 0x04, v_byte_count, *m_registers)
+    except (TypeError, struct.error):  # the item at fault, looked for only when the pack fails
+        for x_registers in m_registers:
+            if not 0 <= x_registers <= 65535 or x_registers.__class__ is bool:
+                raise out_of_range('read_input_registers response', 'registers', m_registers, 0, 65535) from None
+        raise
     return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
@@ -511,10 +523,16 @@ def _encode_write_registers_request(m: WriteRegistersRequest) -> bytes:
     v_byte_count = (2 * (len(m_values)))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('write_registers request', 'byte_count', v_byte_count, 0, 255)
-    for x_values in m_values:
-        if not 0 <= x_values <= 65535 or x_values.__class__ is bool:
-            raise out_of_range('write_registers request', 'values', m_values, 0, 65535)
-    frame = struct.pack(f'>BBHHB{len(m_values)}H', m_unit, 0x10, m_address, v_count, v_byte_count, *m_values)
+    try:
+        for x_values in m_values:
+            if x_values.__class__ is bool:  # struct.pack takes True and False as numbers: refused below
+                raise TypeError
+        frame = struct.pack(f'>BBHHB{len(m_values)}H', m_unit, 0x10, m_address, v_count, v_byte_count, *m_values)
+    except (TypeError, struct.error):  # the item at fault, looked for only when the pack fails
+        for x_values in m_values:
+            if not 0 <= x_values <= 65535 or x_values.__class__ is bool:
+                raise out_of_range('write_registers request', 'values', m_values, 0, 65535) from None
+        raise
     return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
@@ -586,10 +604,16 @@ def _encode_read_write_registers_request(m: ReadWriteRegistersRequest) -> bytes:
     v_byte_count = (2 * (len(m_values)))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('read_write_registers request', 'byte_count', v_byte_count, 0, 255)
-    for x_values in m_values:
-        if not 0 <= x_values <= 65535 or x_values.__class__ is bool:
-            raise out_of_range('read_write_registers request', 'values', m_values, 0, 65535)
-    frame = struct.pack(f'>BBHHHHB{len(m_values)}H', m_unit, 0x17, m_read_address, m_read_count, m_write_address, v_write_count, v_byte_count, *m_values)
+    try:
+        for x_values in m_values:
+            if x_values.__class__ is bool:  # struct.pack takes True and False as numbers: refused below
+                raise TypeError
+        frame = struct.pack(f'>BBHHHHB{len(m_values)}H', m_unit, 0x17, m_read_address, m_read_count, m_write_address, v_write_count, v_byte_count, *m_values)
+    except (TypeError, struct.error):  # the item at fault, looked for only when the pack fails
+        for x_values in m_values:
+            if not 0 <= x_values <= 65535 or x_values.__class__ is bool:
+                raise out_of_range('read_write_registers request', 'values', m_values, 0, 65535) from None
+        raise
     return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
@@ -601,10 +625,16 @@ def _encode_read_write_registers_response(m: ReadWriteRegistersResponse) -> byte
     v_byte_count = (2 * len(m_registers))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('read_write_registers response', 'byte_count', v_byte_count, 0, 255)
-    for x_registers in m_registers:
-        if not 0 <= x_registers <= 65535 or x_registers.__class__ is bool:
-            raise out_of_range('read_write_registers response', 'registers', m_registers, 0, 65535)
-    frame = struct.pack(f'>BBB{len(m_registers)}H', m_unit, 0x17, v_byte_count, *m_registers)
+    try:
+        for x_registers in m_registers:
+            if x_registers.__class__ is bool:  # struct.pack takes True and False as numbers: refused below
+                raise TypeError
+        frame = struct.pack(f'>BBB{len(m_registers)}H', m_unit, 0x17, v_byte_count, *m_registers)
+    except (TypeError, struct.error):  # the item at fault, looked for only when the pack fails
+        for x_registers in m_registers:
+            if not 0 <= x_registers <= 65535 or x_registers.__class__ is bool:
+                raise out_of_range('read_write_registers response', 'registers', m_registers, 0, 65535) from None
+        raise
     return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 

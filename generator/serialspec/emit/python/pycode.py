@@ -65,6 +65,39 @@ def bound(f: Scalar, value: float) -> str:
 _LOOP = re.compile(r"^(?P<indent> *)for (?P<var>[A-Za-z_]\w*) in .+:$")
 
 
+_DEFERRED = "#deferred "  # check_items' mark before the loop over a list whose item range is its type's
+
+
+def deferred_item_checks(lines: Lines) -> Lines:
+    """An encoder's lines with each loop that check_items marked run only when the pack of its list fails: the
+    list's numbers span their type's whole range, so struct.pack refuses exactly what the loop would, but True and
+    False (which it takes as numbers: looked for first, the cheaper loop). The full loop then finds the item at fault
+    and raises what it raised before; a failure it does not explain (a float) goes on as struct's error. A mark
+    whose list is packed inside a block keeps its loop where it was."""
+    for index, mark in enumerate(lines):
+        if not mark.startswith(_DEFERRED):
+            continue
+        expr = mark.removeprefix(_DEFERRED)
+        loop = lines[index + 1 : index + 4]
+        rest = lines[:index] + lines[index + 4 :]
+        at = next((i for i, line in enumerate(rest) if i >= index and f"*{expr})" in line), None)
+        if at is None or rest[at].startswith(" ") or any(line.startswith(" ") for line in rest[index:at]):
+            return deferred_item_checks(lines[:index] + lines[index + 1 :])
+        failed = [*loop[:-1], loop[-1] + " from None", "raise"]
+        item = loop[0].removeprefix("for ").partition(" in ")[0]
+        block = [
+            "try:",
+            f"    for {item} in {expr}:",
+            f"        if {item}.__class__ is bool:  # struct.pack takes True and False as numbers: refused below",
+            "            raise TypeError",
+            f"    {rest[at]}",
+            "except (TypeError, struct.error):  # the item at fault, looked for only when the pack fails",
+            *(f"    {line}" for line in failed),
+        ]
+        return deferred_item_checks(rest[:at] + block + rest[at + 1 :])
+    return lines
+
+
 def read_fields_once(lines: Lines, names: list[str]) -> Lines:
     """An encoder's lines with each field of the message `m` that they read more than once read once, into a local
     `m_<field>` first, and likewise each field of a loop's item (`item_<field>`): a range check and the pack read a
@@ -395,7 +428,7 @@ class PackageCode:
         frame_names = [f.name for f in self.frame_values(message.direction, message)]
         extra = "".join(f", {name}: int" for name in frame_names)
         self.decoders.append((decoder_name(message), message.class_name, extra, self.decoder(message, fields)))
-        encoder = read_fields_once(self.encoder(message, fields), [f.name for f in fields])
+        encoder = read_fields_once(deferred_item_checks(self.encoder(message, fields)), [f.name for f in fields])
         self.encoders.append((encoder_name(message), message.class_name, encoder))
 
     # --- decoding -------------------------------------------------------------------------------------------------
@@ -921,6 +954,9 @@ class PackageCode:
         A plain loop: any() over a generator costs a frame per call, twice the time for a few items."""
         low, high = number(f.minimum), number(f.maximum)
         item = f"x_{f.name}"
+        kind = f.item if isinstance(f, List) else None
+        if kind is not None and not kind.is_float and (f.minimum, f.maximum) == (kind.minimum, kind.maximum):
+            lines.append(f"{_DEFERRED}{expr}")  # struct.pack checks the range: the loop only if it fails (deferred)
         lines.append(f"for {item} in {expr}:")
         lines.append(f"    if not {low} <= {item} <= {high} or {item}.__class__ is bool:")
         lines.append(f"        raise out_of_range({where}, {f.name!r}, {expr}, {low}, {high})")

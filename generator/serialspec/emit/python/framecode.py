@@ -1,18 +1,19 @@
 """Straight-line code for frames that are not of the classic shape (stuffing, u16 lengths over a span, CRC-16s, frames
-without a header or a length, alternative layouts told apart by their header). Each direction gets two functions:
-`_decode_<direction>(frame, expect)` checks a whole frame and calls the content decoder on the frame's own bytes,
-and `_wrap_<direction>(content, code, *values)` puts the frame around a content. They make the runtime engine's
-checks (runtime/framing.py, Layout.unwrap and Layout.wrap) in the engine's order with the engine's messages, but as
-code written for one layout: every offset known when the layout is fixed is a literal, the bytes are unstuffed only
-when a stuffed sequence occurs (a `find` first), and a frame's content is decoded in place (no copy) unless it was
-stuffed, and a CRC stored in its own bit order is checked by its residue over the frame. `decode()` runs the checks
-inline (one call less), and first looks a frame of one size whose message is its content as one struct unpacks it up
-by its first bytes (`whole_frames`: checked from its end, unpacked whole, no call); encoders of unstuffed frames
-make their frame inline too (`frame_encoder`: the head packed with the content's first struct, constant leading
-bytes as a literal beside the checksummed body). Where a layout does not fit that form (a length after the content,
-a checksum over bytes inside the stuffed span, ...) the two functions call the engine instead, so every layout the
-language describes works and the straight-line form is only ever a faster way to the same result
-(tests/test_straight_frames.py holds them to it).
+without a header or a length, alternative layouts told apart by their header).
+
+Each direction gets two functions: `_decode_<direction>(frame, expect)` checks a whole frame and calls the content
+decoder on the frame's own bytes, and `_wrap_<direction>(content, code, *values)` puts the frame around a content.
+They make the runtime engine's checks (runtime/framing.py, Layout.unwrap and Layout.wrap) in the engine's order with
+the engine's messages, but as code written for one layout: every offset known when the layout is fixed is a literal,
+the bytes are unstuffed only when a stuffed sequence occurs (a `find` first), and a frame's content is decoded in
+place (no copy) unless it was stuffed, and a CRC stored in its own bit order is checked by its residue over the
+frame. `decode()` runs the checks inline (one call less), and first looks a frame of one size whose message is its
+content as one struct unpacks it up by its first bytes (`whole_frames`: checked from its end, unpacked whole, no
+call); encoders of unstuffed frames make their frame inline too (`frame_encoder`: the head packed with the content's
+first struct, constant leading bytes as a literal beside the checksummed body). Where a layout does not fit that
+form (a length after the content, a checksum over bytes inside the stuffed span, ...) the two functions call the
+engine instead, so every layout the language describes works and the straight-line form is only ever a faster way to
+the same result (tests/test_straight_frames.py holds them to it).
 
 Positions are expressions over `buf`, the frame with its stuffed span replaced by the plain bytes (the frame itself
 when nothing is stuffed): an element before the content at a literal offset, an element after it at `end + k`,

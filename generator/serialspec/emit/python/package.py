@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import re
+import struct
 from dataclasses import replace
 from typing import Any
 
@@ -327,24 +328,42 @@ def classic_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
         if whole:  # decode() looks frames up by their first bytes
             whole_functions += [f | {"whole_lines": fuse_unpack(f["whole_lines"], code.structs)} for f in sub_functions]
             whole_pickers += pickers
-        frame_functions += [
-            f
-            | {
-                "lines": fuse_unpack(f["lines"], code.structs),
-                "whole_lines": fuse_unpack(f["whole_lines"], code.structs),
+        range_checks = value_range_checks(layout, protocol.byte_order)
+        # decode() looks these frames up before any other check: where each decoder refuses a frame of another size
+        # itself (struct.error from an unpack of the whole frame), decode() need not compare sizes first
+        whole_size = max(layout.length_offset, layout.command_offset or 0) + 1
+        content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
+        exact = bool(whole) and not sub_entries and not rests and not range_checks
+        bodies = {f["whole_name"]: fuse_unpack(f["whole_lines"], code.structs) for _, _, f in fixed}
+        if exact:
+            bodies = {
+                name: exact_whole(lines, size, whole_size, code)
+                for (_, size, f), (name, lines) in zip(fixed, bodies.items(), strict=True)
             }
+            whole = [
+                (
+                    key,
+                    size,
+                    name,
+                    None if plain is None else (plain[0], exact_struct(plain[1], size, content_offset, code)),
+                )
+                for key, size, name, plain in whole
+            ]
+        frame_functions += [
+            f | {"lines": fuse_unpack(f["lines"], code.structs), "whole_lines": bodies[f["whole_name"]], "exact": exact}
             for _, _, f in fixed
         ]
         directions.append(
             {
+                "exact": exact,
                 "fixed": [(key, size, function["name"]) for key, size, function in fixed],
                 "fixed_whole": [(key, size, function["whole_name"]) for key, size, function in fixed],
                 "rest_keys": [rest_key(layout, r, bool(whole)) for r in rests],
                 "whole_frames": whole,
                 "plain": any(plain for *_, plain in whole),
                 "plain_check": plain_check(protocol, layout),
-                "content_offset": layout.offsets[next(e.name for e in layout.elements if e.role == "content")],
-                "whole_size": max(layout.length_offset, layout.command_offset or 0) + 1,
+                "content_offset": content_offset,
+                "whole_size": whole_size,
                 "key": frame_key(layout, "data"),
                 "name": direction.value,
                 "upper": direction.name,
@@ -356,7 +375,7 @@ def classic_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
                 "length_adds": layout.length_adds,
                 "command_offset": layout.command_offset,
                 "value_ranges": value_ranges(layout, protocol.byte_order),
-                "range_checks": value_range_checks(layout, protocol.byte_order),
+                "range_checks": range_checks,
                 "dispatch": dispatch,
                 "sizes": sizes,
                 "whole": frame_decode_lines(protocol, layout, dispatch, "data", None),
@@ -669,6 +688,37 @@ def frame_function(
     function["plain"] = plain_frame(protocol, layout, body, code) if summed is None else None
     key = length_byte if layout.command_offset is None else (command.code or 0) << 8 | length_byte
     return key, size, function
+
+
+_UNPACK_AT = re.compile(r"\b(?P<name>_S_\w+)\.unpack_from\(buf, (?P<at>\d+)\)")
+_SUM_LAST = re.compile(r"^if \(sum\(buf\)(?P<less>.*) - 2 \* buf\[\d+\]\) & 0xff:$")
+_AT_CONSTANT = re.compile(r"\bbuf\[(\d+)\]")
+
+
+def exact_struct(name: str, size: int, content_offset: int, code: PackageCode) -> str:
+    """A struct of a whole frame of `size` bytes that unpacks what struct `name` unpacks at the content's offset,
+    the bytes around it skipped: its unpack refuses (struct.error) a frame of any other size."""
+    fmt = code.structs[name]
+    after = size - content_offset - struct.calcsize(fmt)
+    whole = f"{fmt[0]}{content_offset}x{fmt[1:]}" + (f"{after}x" if after else "")
+    exact = f"{name}_IN_{size}"
+    code.structs[exact] = whole
+    return exact
+
+
+def exact_whole(lines: Lines, size: int, known: int, code: PackageCode) -> Lines:
+    """A whole-frame decoder that refuses a frame of another size than `size` by itself: its one unpack made of the
+    whole frame (struct.error), a sum's check byte read from the end; else a size check first, returning None.
+    `known`: the bytes decode() has matched (its key), which any frame it is given holds."""
+    lines = [_SUM_LAST.sub(lambda m: f"if (sum(buf){m['less']} - 2 * buf[-1]) & 0xff:", line) for line in lines]
+    unpacks = [m for line in lines for m in _UNPACK_AT.finditer(line)]
+    before = lines[: next((i for i, line in enumerate(lines) if _UNPACK_AT.search(line)), len(lines))]
+    reads = [int(i) for line in before for i in _AT_CONSTANT.findall(line)]
+    if len(unpacks) != 1 or any(i >= known for i in reads):
+        return [f"if len(buf) != {size}:", "    return None", *lines]
+    found = unpacks[0]
+    exact = exact_struct(found["name"], size, int(found["at"]), code)
+    return [_UNPACK_AT.sub(f"{exact}.unpack(buf)", line) for line in lines]
 
 
 _PLAIN = re.compile(r"^return _new\((?P<cls>\w+), (?P<struct>_S_\w+)\.unpack_from\(buf, o\)\)$")

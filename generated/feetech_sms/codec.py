@@ -219,7 +219,7 @@ def _encode_ping_request(m: PingRequest) -> bytes:
     if not 0 <= m_id <= 254 or m_id.__class__ is bool:
         raise out_of_range('ping request', 'id', m_id, 0, 253, 254)
     body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m_id, 2, 1)
-    return body + _BYTES[~sum(body[2:]) & 0xff]
+    return body + _BYTES[~(sum(body) - 0x1fe) & 0xff]
 
 
 def _encode_read_request(m: ReadRequest) -> bytes:
@@ -233,7 +233,7 @@ def _encode_read_request(m: ReadRequest) -> bytes:
     if not 1 <= m_length <= 250 or m_length.__class__ is bool:
         raise out_of_range('read request', 'length', m_length, 1, 250)
     body = _S_B2_U8_U8_U8_U8_U8.pack(b'\xff\xff', m_id, 4, 2, m_address, m_length)
-    return body + _BYTES[~sum(body[2:]) & 0xff]
+    return body + _BYTES[~(sum(body) - 0x1fe) & 0xff]
 
 
 def _encode_write_request(m: WriteRequest) -> bytes:
@@ -250,7 +250,7 @@ def _encode_write_request(m: WriteRequest) -> bytes:
     if n > 255:
         raise EncodeError(f'content of {n - 2} bytes does not fit the length field')
     body = _S_B2_U8_U8_U8_U8.pack(b'\xff\xff', m_id, n, 3, m_address) + content
-    return body + _BYTES[~sum(body[2:]) & 0xff]
+    return body + _BYTES[~(sum(body) - 0x1fe) & 0xff]
 
 
 def _encode_reg_write_request(m: RegWriteRequest) -> bytes:
@@ -267,7 +267,7 @@ def _encode_reg_write_request(m: RegWriteRequest) -> bytes:
     if n > 255:
         raise EncodeError(f'content of {n - 2} bytes does not fit the length field')
     body = _S_B2_U8_U8_U8_U8.pack(b'\xff\xff', m_id, n, 4, m_address) + content
-    return body + _BYTES[~sum(body[2:]) & 0xff]
+    return body + _BYTES[~(sum(body) - 0x1fe) & 0xff]
 
 
 def _encode_action_request(m: ActionRequest) -> bytes:
@@ -275,7 +275,7 @@ def _encode_action_request(m: ActionRequest) -> bytes:
     if not 0 <= m_id <= 254 or m_id.__class__ is bool:
         raise out_of_range('action request', 'id', m_id, 0, 253, 254)
     body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m_id, 2, 5)
-    return body + _BYTES[~sum(body[2:]) & 0xff]
+    return body + _BYTES[~(sum(body) - 0x1fe) & 0xff]
 
 
 def _encode_reset_request(m: ResetRequest) -> bytes:
@@ -283,7 +283,7 @@ def _encode_reset_request(m: ResetRequest) -> bytes:
     if not 0 <= m_id <= 254 or m_id.__class__ is bool:
         raise out_of_range('reset request', 'id', m_id, 0, 253, 254)
     body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m_id, 2, 6)
-    return body + _BYTES[~sum(body[2:]) & 0xff]
+    return body + _BYTES[~(sum(body) - 0x1fe) & 0xff]
 
 
 def _encode_sync_read_request(m: SyncReadRequest) -> bytes:
@@ -307,7 +307,7 @@ def _encode_sync_read_request(m: SyncReadRequest) -> bytes:
     if n > 255:
         raise EncodeError(f'content of {n - 2} bytes does not fit the length field')
     body = _S_B2_U8_U8_U8_U8_U8.pack(b'\xff\xff', m_id, n, 130, m_address, m_length) + content
-    return body + _BYTES[~sum(body[2:]) & 0xff]
+    return body + _BYTES[~(sum(body) - 0x1fe) & 0xff]
 
 
 def _encode_sync_write_request(m: SyncWriteRequest) -> bytes:
@@ -336,7 +336,7 @@ def _encode_sync_write_request(m: SyncWriteRequest) -> bytes:
     if n > 255:
         raise EncodeError(f'content of {n - 2} bytes does not fit the length field')
     body = _S_B2_U8_U8_U8_U8_U8.pack(b'\xff\xff', m_id, n, 131, m_address, v_data_length) + content
-    return body + _BYTES[~sum(body[2:]) & 0xff]
+    return body + _BYTES[~(sum(body) - 0x1fe) & 0xff]
 
 
 def _encode_reply_response(m: ReplyResponse) -> bytes:
@@ -353,7 +353,7 @@ def _encode_reply_response(m: ReplyResponse) -> bytes:
     if n > 255:
         raise EncodeError(f'content of {n - 2} bytes does not fit the length field')
     body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m_id, n, m_error) + content
-    return body + _BYTES[~sum(body[2:]) & 0xff]
+    return body + _BYTES[~(sum(body) - 0x1fe) & 0xff]
 
 
 _REQUEST_DECODERS: dict[int | None, Callable[..., Message]] = {

@@ -875,8 +875,14 @@ class PackageCode:
         """Lines that return `body` (the frame without its checksum) with its checksum appended."""
         covered = f"{body}[{layout.covered_from}:]" if layout.covered_from else body
         size = layout.checksum_offset_from_end
-        assert self.protocol.framing.checksum is not None  # classic frames have one
-        lines = checksum_lines(self.protocol.framing.checksum, covered, "check")
+        checksum = self.protocol.framing.checksum
+        assert checksum is not None  # classic frames have one
+        lines = checksum_lines(checksum, covered, "check")
+        skipped = layout.header[: layout.covered_from]
+        if checksum.algorithm == "sum" and layout.covered_from and len(skipped) == layout.covered_from:
+            # the bytes before the covered ones are the header, a constant: the sum less it, no slice made
+            mask = (1 << (checksum.type.size * 8)) - 1
+            lines = [f"check = {'~' if checksum.invert else ''}(sum({body}) - {sum(skipped):#x}) & {mask:#x}"]
         if len(lines) == 1:  # a single expression: append it directly
             value = lines[0].removeprefix("check = ")
             lines = []

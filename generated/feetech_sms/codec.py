@@ -385,14 +385,14 @@ _REQUEST_FIXED: dict[int, tuple[int, Callable[[bytes, int], Message | None]]] = 
 }
 
 
-# The same frames for decode(), by size key: frame size, decoder.
-_REQUEST_WHOLE: dict[int, tuple[int, Callable[[bytes], Message | None]]] = {
-    0x0102: (6, _whole_ping_request),
-    0x0204: (8, _whole_read_request),
-    0x0502: (6, _whole_action_request),
-    0x0602: (6, _whole_reset_request),
-    **{0x03 << 8 | n: (n + 4, _whole_write_request) for n in range(3, 256)},
-    **{0x04 << 8 | n: (n + 4, _whole_reg_write_request) for n in range(3, 256)},
+# The same frames for decode(), by their command code and length byte as they lie in the frame: frame size, decoder.
+_REQUEST_WHOLE: dict[bytes, tuple[int, Callable[[bytes], Message | None]]] = {
+    b'\x02\x01': (6, _whole_ping_request),
+    b'\x04\x02': (8, _whole_read_request),
+    b'\x02\x05': (6, _whole_action_request),
+    b'\x02\x06': (6, _whole_reset_request),
+    **{bytes((n, 0x03)): (n + 4, _whole_write_request) for n in range(3, 256)},
+    **{bytes((n, 0x04)): (n + 4, _whole_reg_write_request) for n in range(3, 256)},
 }
 
 
@@ -476,6 +476,11 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
     `expect` (the reply class a frame answers) matters only where replies share a code; here none do.
     """
     if direction is _REQUEST:
+        fixed = _REQUEST_WHOLE.get(data[3:5])  # a short frame's slice is shorter: it matches none
+        if fixed is not None and fixed[0] == len(data) and data[:2] == b'\xff\xff' and data[2] <= 254:
+            message = fixed[1](data)
+            if message is not None:
+                return message
         n = len(data)
         if n < 6:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (6 bytes)")
@@ -483,11 +488,6 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
             raise DecodeError(f"request header is {data[:2].hex(' ')}, expected ff ff")
         if data[2] > 254:
             raise DecodeError(f"id = {data[2]} is outside its range 0..253 (or 254)")
-        fixed = _REQUEST_WHOLE.get(data[4] << 8 | data[3])
-        if fixed is not None and fixed[0] == n:
-            message = fixed[1](data)
-            if message is not None:
-                return message
         size = data[3] - 2
         if size < 0 or n != 6 + size:
             raise DecodeError(f"length byte says {size} content bytes but the frame holds {n - 6}")

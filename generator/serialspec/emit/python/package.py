@@ -353,8 +353,13 @@ def classic_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
             f | {"lines": fuse_unpack(f["lines"], code.structs), "whole_lines": bodies[f["whole_name"]], "exact": exact}
             for _, _, f in fixed
         ]
+        slice_key = None if whole else key_slice(layout)
         directions.append(
             {
+                "slice_key": slice_key,
+                "slice_fixed": [(slice_bytes(layout, key), size, f["whole_name"]) for key, size, f in fixed],
+                "slice_rests": [slice_rest(layout, r) for r in rests],
+                "accepted": [accepted(line.removeprefix("if ").removesuffix(":")) for line in range_checks[::2]],
                 "exact": exact,
                 "fixed": [(key, size, function["name"]) for key, size, function in fixed],
                 "fixed_whole": [(key, size, function["whole_name"]) for key, size, function in fixed],
@@ -434,6 +439,44 @@ def frame_key(layout: FrameLayout, buf: str, start: str = "") -> str:
     if layout.command_offset is None:
         return length
     return f"{buf}[{at}{layout.command_offset}] << 8 | {length}"
+
+
+def accepted(refused: str) -> str:
+    """The condition that a frame value is in range, from value_range_checks' condition that it is not."""
+    for op, opposite in ((" > ", " <= "), (" < ", " >= ")):
+        left, found, right = refused.partition(op)
+        if found and "(" not in refused:
+            return f"{left}{opposite}{right}"
+    return refused.removeprefix("not ") if refused.startswith("not (") else f"not {refused}"
+
+
+def key_slice(layout: FrameLayout) -> str | None:
+    """Where a frame's command code and length byte are neighbours after its header (FEETECH: an id between): the
+    slice of `data` holding them, decode()'s key for its whole frames (a short frame's is shorter: it matches
+    none, so the lookup comes before any check). None where they are not neighbours."""
+    if layout.command_offset is None:
+        return None
+    low = min(layout.command_offset, layout.length_offset)
+    if max(layout.command_offset, layout.length_offset) != low + 1 or low < len(layout.header):
+        return None
+    return f"data[{low}:{low + 2}]"
+
+
+def slice_bytes(layout: FrameLayout, key: str) -> str:
+    """A size key (command code << 8 | length byte, as fixed_frames makes it) as the bytes key_slice reads."""
+    value = int(key, 16)
+    assert layout.command_offset is not None  # key_slice holds it
+    by_offset = {layout.command_offset: value >> 8, layout.length_offset: value & 0xFF}
+    return repr(bytes(by_offset[o] for o in sorted(by_offset)))
+
+
+def slice_rest(layout: FrameLayout, rest: dict[str, Any]) -> dict[str, Any]:
+    """rest_key's entries as the bytes key_slice reads: the key's expression in the length byte `n`."""
+    assert layout.command_offset is not None  # key_slice holds it
+    by_offset = {layout.command_offset: f"{rest['code'] or 0:#04x}", layout.length_offset: "n"}
+    key = f"bytes(({', '.join(by_offset[o] for o in sorted(by_offset))}))"
+    low, high = rest["lengths"]
+    return {"key": key, "low": low, "high": high, "adds": rest["adds"], "name": rest["whole_name"]}
 
 
 def rest_key(layout: FrameLayout, rest: dict[str, Any], by_bytes: bool) -> dict[str, Any]:

@@ -15,6 +15,7 @@ from serialspec.runtime.message import Direction, Message, members
 from serialspec.runtime.message import build as _new  # a message from the tuple of its field values, in one call
 from serialspec.runtime.packing import pack_bits as _pack_bits
 from serialspec.runtime.packing import unpack_bits as _unpack_bits
+from serialspec.runtime.packing import unpack_runs as _unpack_runs
 
 from modbus_rtu.messages import (
     CoilState,
@@ -54,6 +55,7 @@ _S_BE_U8_U8_U16_U16 = struct.Struct('>BBHH')
 _S_BE_U8_U8_U16_U16_U16 = struct.Struct('>BBHHH')
 _S_BE_U8_U8_U16_U16_U8 = struct.Struct('>BBHHB')
 _S_BE_U8_U8_U8 = struct.Struct('>BBB')
+_RUNS_BE_U16 = _unpack_runs('>H', 127)  # unpack_from of 0..127 items
 _CHECK_CRC: Callable[[bytes], int] = crc_function(16, 0x8005, 0xffff, True, True, 0x0)  # CRC-16/MODBUS
 
 _MEMBERS_CoilState = members(CoilState)
@@ -128,7 +130,7 @@ def _decode_read_holding_registers_response(buf: bytes, o: int, end: int, unit: 
     n = nb // 2
     if end - o < nb:
         raise DecodeError('read_holding_registers response' + f': registers needs {nb} bytes, {end - o} left')
-    v_registers = struct.unpack_from(f'>{n}H', buf, o)
+    v_registers = _RUNS_BE_U16[n](buf, o)
     o += nb
     if o != end:
         raise DecodeError('read_holding_registers response' + f': {end - o} bytes left after the last field')
@@ -153,7 +155,7 @@ def _decode_read_input_registers_response(buf: bytes, o: int, end: int, unit: in
     n = nb // 2
     if end - o < nb:
         raise DecodeError('read_input_registers response' + f': registers needs {nb} bytes, {end - o} left')
-    v_registers = struct.unpack_from(f'>{n}H', buf, o)
+    v_registers = _RUNS_BE_U16[n](buf, o)
     o += nb
     if o != end:
         raise DecodeError('read_input_registers response' + f': {end - o} bytes left after the last field')
@@ -281,7 +283,7 @@ def _decode_read_write_registers_response(buf: bytes, o: int, end: int, unit: in
     n = nb // 2
     if end - o < nb:
         raise DecodeError('read_write_registers response' + f': registers needs {nb} bytes, {end - o} left')
-    v_registers = struct.unpack_from(f'>{n}H', buf, o)
+    v_registers = _RUNS_BE_U16[n](buf, o)
     o += nb
     if o != end:
         raise DecodeError('read_write_registers response' + f': {end - o} bytes left after the last field')

@@ -409,7 +409,8 @@ def common_codec_context(protocol: Protocol, code: PackageCode, exports: list[st
     used += "\n".join(line for _, _, lines in code.encoders for line in lines)
     packing = [n for n in ("decode_text", "encode_text", "pack_bits", "unpack_bits") if f"_{n}(" in used]
     return {
-        "packing_imports": packing,
+        "packing_imports": sorted([*packing, *(["unpack_runs"] if code.runs else [])]),
+        "runs": sorted(code.runs.items()),
         "structs": sorted(code.structs.items()),
         "tables": [
             table_context(t) for t in protocol.tables if any(uses_table(m, t.name) for m in protocol.messages())

@@ -37,6 +37,7 @@ from serialspec.spec.model import (
 from serialspec.spec.model import Field as SpecField
 
 Lines = list[str]
+_MOST_RUNS = 256  # the most items of a list read by a struct made for each count (see unpack_runs)
 _STRUCT_NAMES = {"B": "U8", "b": "I8", "H": "U16", "h": "I16", "I": "U32", "i": "I32", "f": "F32"}
 
 
@@ -266,6 +267,7 @@ class PackageCode:
         # classes the decoders build through their slots (see `build`): class name -> field names in order
         self.built: dict[str, list[str]] = {}
         self.member_maps: set[str] = set()  # enum and flag classes whose value -> member map the decoders use
+        self.runs: dict[str, tuple[str, int]] = {}  # unpack_runs tables the decoders use: name -> (format, most)
         self._seen_classes: set[str] = set()
         self._straight: dict[Direction, Straight | None] = {}
         for message in protocol.messages():
@@ -627,7 +629,7 @@ class PackageCode:
 
     def decode_variable(self, f: SpecField, siblings: list[SpecField], base: str, lines: Lines, where: str) -> str:
         if isinstance(f, List):
-            return self.decode_list(f, lines, where)
+            return self.decode_list(f, lines, where, siblings)
         if isinstance(f, Text):
             return self.decode_text(f, lines, where)
         if isinstance(f, Bytes):
@@ -706,7 +708,7 @@ class PackageCode:
         lines.append(f"{value} = tuple({value}_list)")
         return value
 
-    def decode_list(self, f: List, lines: Lines, where: str) -> str:
+    def decode_list(self, f: List, lines: Lines, where: str, siblings: list[SpecField]) -> str:
         """A list of numbers or bits: its count from a number, a count field, a byte-size field, or the rest."""
         value = self.local(f)
         item = 1 if f.item is None else f.item.size
@@ -725,12 +727,28 @@ class PackageCode:
             lines.append("nb = (n + 7) >> 3" if f.item is None else (f"nb = n * {item}" if item > 1 else "nb = n"))
         lines.append("if end - o < nb:")
         lines.append(f"    raise DecodeError({where} + f': {f.name} needs {{nb}} bytes, {{end - o}} left')")
+        most = self.most_items(f, siblings)
         if f.item is None:
             lines.append(f"{value} = _unpack_bits(buf, o, n)")
+        elif most is not None and most <= _MOST_RUNS:  # a struct per count, made once
+            name = f"_RUNS_{'BE' if f.endian == '>' else 'LE'}_{_STRUCT_NAMES[f.item.struct_char]}"
+            self.runs[name] = (f"{f.endian}{f.item.struct_char}", max(most, self.runs.get(name, ("", 0))[1]))
+            lines.append(f"{value} = {name}[n](buf, o)")
         else:
             lines.append(f"{value} = struct.unpack_from(f'{f.endian}{{n}}{f.item.struct_char}', buf, o)")
         lines.append("o += nb")
         return value
+
+    def most_items(self, f: List, siblings: list[SpecField]) -> int | None:
+        """The most items a list of numbers can hold, where a count or byte-size field of the message bounds it: by
+        the field's type, not its declared range (a frame may carry any value the type holds)."""
+        scalars = {s.name: s for s in siblings if isinstance(s, Scalar) and not s.type.is_float}
+        item = 1 if f.item is None else f.item.size
+        if f.size and str(f.size) in scalars:
+            return int(scalars[str(f.size)].type.maximum) // item
+        if isinstance(f.count, str) and f.count in scalars:
+            return int(scalars[f.count].type.maximum)
+        return None
 
     def decode_text(self, f: Text, lines: Lines, where: str) -> str:
         value = self.local(f)

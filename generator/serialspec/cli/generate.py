@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import shutil
 import sys
 from pathlib import Path
 
@@ -36,6 +35,8 @@ def run(args: argparse.Namespace) -> int:
         path.unlink()
         print(f"removed {proj.display(path)} (no spec generates it any more)", file=sys.stderr)
     for folder in {p.parent for p in removed}:
+        import shutil  # only where an orphaned package leaves its bytecode behind
+
         shutil.rmtree(folder / "__pycache__", ignore_errors=True)
         if folder.is_dir() and not any(folder.iterdir()):
             folder.rmdir()

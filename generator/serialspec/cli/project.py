@@ -21,12 +21,13 @@ import marshal
 import os
 import re
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from serialspec import cache
+from serialspec.collection import without_cycle_collection
 from serialspec.spec.errors import SpecError, SpecErrors
+from serialspec.spec.frozen import frozen
 
 SCHEMA_NAME = "serialspec.schema.json"
 #: The first line of every generated text file names the spec it came from.
@@ -35,7 +36,7 @@ KEEP_OUTPUTS = 64  # specs whose outputs the cache keeps (the ones generated las
 SHIPPED_SPEC = "spec.yaml"  # the spec, shipped inside its package (package data) for `serialspec decode NAME`
 
 
-@dataclass(frozen=True)
+@frozen
 class Project:
     root: Path
     specs: tuple[Path, ...]
@@ -126,7 +127,7 @@ def expected_files(proj: Project) -> tuple[dict[Path, str], list[SpecError]]:
     return files, errors
 
 
-@dataclass(frozen=True)
+@frozen
 class Outputs:
     """What one valid spec generates, by file name under the output folder, and the mistakes its examples and errata
     show when run through the package generated from it; its loaded values (for the language reference)."""
@@ -169,6 +170,7 @@ def spec_outputs(spec: Path, display: str, *, with_data: bool = False) -> Output
     return outputs
 
 
+@without_cycle_collection  # the emitters' imports (first spec), rendering and the examples' checks too
 def _generate(raw: bytes, display: str, key: bytes) -> Outputs:
     """Load and resolve one spec, run every emitter over it and check its examples and errata (raises SpecErrors)."""
     from serialspec.emit import emitters

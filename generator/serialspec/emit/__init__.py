@@ -8,14 +8,14 @@ from __future__ import annotations
 import importlib
 import pkgutil
 from collections.abc import Callable
-from dataclasses import dataclass
 from functools import cache
 
 from serialspec.spec.errors import SpecError
+from serialspec.spec.frozen import frozen
 from serialspec.spec.model import Protocol
 
 
-@dataclass(frozen=True)
+@frozen
 class Emitter:
     name: str
     files: Callable[[Protocol], dict[str, str]]  # path relative to generated/ -> text

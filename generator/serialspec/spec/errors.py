@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from serialspec.spec.frozen import frozen
 
 
-@dataclass(frozen=True)
+@frozen
 class SpecError:
     file: str
     line: int

@@ -12,7 +12,8 @@ from __future__ import annotations
 
 import ast
 from collections.abc import Callable, Iterator, Mapping
-from dataclasses import dataclass
+
+from serialspec.spec.frozen import frozen
 
 _OPERATORS: dict[type[ast.operator], str] = {
     ast.Add: "+",
@@ -33,40 +34,40 @@ class ExpressionError(ValueError):
     """The text is not an expression of the spec language; the message says why, for one spec error line."""
 
 
-@dataclass(frozen=True)
+@frozen
 class Const:
     value: int
 
 
-@dataclass(frozen=True)
+@frozen
 class Name:
     """The value of an earlier field of the same message."""
 
     name: str
 
 
-@dataclass(frozen=True)
+@frozen
 class Length:
     """The number of items of a list field (`len(values)`)."""
 
     name: str
 
 
-@dataclass(frozen=True)
+@frozen
 class BinOp:
     op: str
     left: Expr
     right: Expr
 
 
-@dataclass(frozen=True)
+@frozen
 class Invert:
     """`~a`: every bit flipped (a Python int's ~, so -a - 1; whoever stores it masks it to its width)."""
 
     operand: Expr
 
 
-@dataclass(frozen=True)
+@frozen
 class Ceil:
     """`ceil(numerator / denominator)`: integer division rounding up."""
 
@@ -74,7 +75,7 @@ class Ceil:
     denominator: Expr
 
 
-@dataclass(frozen=True)
+@frozen
 class MinMax:
     function: str  # "min" or "max"
     args: tuple[Expr, ...]

@@ -9,9 +9,10 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import Any
 
+from serialspec.spec.frozen import mutable
 from serialspec.spec.loader import CONTROL, Path
 
 SCALAR_TYPES = ("u8", "i8", "u16", "i16", "u32", "i32", "f32")
@@ -27,7 +28,7 @@ class Shape:
         raise NotImplementedError
 
 
-@dataclass
+@mutable
 class Str(Shape):
     description: str = ""
     choices: tuple[str, ...] = ()
@@ -49,7 +50,7 @@ class Str(Shape):
         return _with_default(schema, self.default, self.example)
 
 
-@dataclass
+@mutable
 class Int(Shape):
     description: str = ""
     default: Any = None  # the value a spec gets when it leaves the key out (for the reference and the schema)
@@ -72,7 +73,7 @@ class Int(Shape):
         return _with_default(schema, self.default, self.example)
 
 
-@dataclass
+@mutable
 class Num(Shape):
     """A finite number (NaN and infinities are never a protocol fact)."""
 
@@ -102,7 +103,7 @@ def _bounds(minimum: int | None, maximum: int | None) -> str:
     return f"the minimum {minimum}" if minimum is not None else f"the maximum {maximum}"
 
 
-@dataclass
+@mutable
 class Bool(Shape):
     description: str = ""
     default: Any = None  # the value a spec gets when it leaves the key out (for the reference and the schema)
@@ -130,7 +131,7 @@ def value_description(shape: Shape, parent: str) -> str:
     return shape.description or parent
 
 
-@dataclass
+@mutable
 class Any_(Shape):
     description: str = ""
 
@@ -141,7 +142,7 @@ class Any_(Shape):
         return {"description": self.description}
 
 
-@dataclass
+@mutable
 class ListOf(Shape):
     item: Shape
     description: str = ""
@@ -168,7 +169,7 @@ class ListOf(Shape):
         return _with_default(schema, None, self.example)
 
 
-@dataclass
+@mutable
 class MapOf(Shape):
     """A mapping from names (or numbers) chosen by the spec author to values of one shape."""
 
@@ -194,7 +195,7 @@ class MapOf(Shape):
         }
 
 
-@dataclass
+@mutable
 class Obj(Shape):
     keys: dict[str, Shape]
     required: tuple[str, ...] = ()
@@ -224,7 +225,7 @@ class Obj(Shape):
         }
 
 
-@dataclass
+@mutable
 class Ref(Shape):
     """A shape defined later, or by itself (group fields are fields): checked as it, a $ref in the JSON Schema."""
 
@@ -239,7 +240,7 @@ class Ref(Shape):
         return {"$ref": f"#/$defs/{self.name}", "description": self.description}
 
 
-@dataclass
+@mutable
 class OneOf(Shape):
     """Either a short form (e.g. a bare type name) or a long form; picked by the kind of value given."""
 

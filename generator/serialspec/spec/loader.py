@@ -10,18 +10,19 @@ message does not depend on how PyYAML was built.
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import Any
 
 import yaml
 
 from serialspec.collection import without_cycle_collection
 from serialspec.spec.errors import SpecError, SpecErrors
+from serialspec.spec.frozen import mutable
 
 Path = tuple[str | int, ...]
 
 
-@dataclass
+@mutable
 class Located:
     """A loaded document plus the (line, column) of every value, by path from the root."""
 
@@ -50,6 +51,7 @@ def dotted(path: Path) -> str:
 _CONSTRUCTOR = yaml.SafeLoader("")
 _COMPOSER: type[yaml.SafeLoader] = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 _STR = "tag:yaml.org,2002:str"
+_ScalarNode = yaml.ScalarNode
 # The safe loader's constructor of each scalar tag, called directly: construct_object's bookkeeping (recursion
 # guard, a cache of every node built) is for mappings and lists, which _convert walks itself.
 _SCALARS: dict[str, Any] = {
@@ -127,7 +129,7 @@ def load_text(text: str, file: str) -> Located:
     if root is None:
         raise SpecErrors([SpecError(file, 1, 1, "", "empty spec (expected a mapping with protocol, framing, ...)")])
     errors: list[SpecError] = []
-    located.data = _Converter(located, errors, _count_nodes(root)).convert(root, ())
+    located.data = _Converter(located, errors, root).convert(root, ())
     if errors:
         raise SpecErrors(errors)
     return located
@@ -156,10 +158,13 @@ class _Expansion(Exception):
 class _Converter:
     """Nodes to plain values, within the depth and expansion limits, refusing aliases that contain themselves."""
 
-    def __init__(self, located: Located, errors: list[SpecError], distinct: int) -> None:
+    def __init__(self, located: Located, errors: list[SpecError], root: yaml.Node) -> None:
         self.located = located
         self.errors = errors
-        self.budget = distinct * EXPANSION_FACTOR + EXPANSION_SLACK
+        # Values converted may number EXPANSION_SLACK + EXPANSION_FACTOR * the distinct nodes: the nodes are counted
+        # only once the slack is spent (a large file, or aliases), which most files never reach.
+        self.budget = EXPANSION_SLACK
+        self.root: yaml.Node | None = root
         self.open: set[int] = set()  # the nodes being converted (the current path)
 
     def fail(self, node: yaml.Node, path: Path, message: str) -> None:
@@ -175,12 +180,19 @@ class _Converter:
     def _convert(self, node: yaml.Node, path: Path) -> Any:
         located = self.located
         self.budget -= 1
+        if self.budget < 0 and self.root is not None:
+            self.budget += _count_nodes(self.root) * EXPANSION_FACTOR
+            self.root = None
         if self.budget < 0:
             self.fail(node, path, "the YAML aliases expand to too many values (a YAML bomb?)")
             raise _Expansion
         if len(path) > MAX_DEPTH:
             self.fail(node, path[:3], f"values nested too deeply (more than {MAX_DEPTH} levels)")
             return None
+        if node.__class__ is _ScalarNode and node.tag == _STR:  # most values: text (a scalar contains no alias)
+            mark = node.start_mark
+            located.marks[path] = (mark.line + 1, mark.column + 1)
+            return node.value
         if id(node) in self.open:
             self.fail(node, path, "a YAML alias refers to a value that contains it")
             return None
@@ -188,27 +200,50 @@ class _Converter:
         if isinstance(node, yaml.CollectionNode) and node.tag not in _PLAIN_TAGS:
             self.fail(node, path, f"YAML tag {node.tag!r} is not supported")
             return None
+        # Text values inside a mapping or list are taken in the loop (most values are): what _convert does for them,
+        # without a call each. `shallow`: their paths, one longer than this one, are within the depth limit.
+        shallow = len(path) < MAX_DEPTH
+        marks = located.marks
         if isinstance(node, yaml.MappingNode):
             self.open.add(id(node))
             result: dict[Any, Any] = {}
             for key_node, value_node in node.value:
-                key = _scalar(key_node) if isinstance(key_node, yaml.ScalarNode) else None
-                if not isinstance(key, str | int) or isinstance(key, bool):
-                    self.fail(key_node, path, "keys must be names or numbers")
-                    continue
+                if key_node.__class__ is _ScalarNode and key_node.tag == _STR:
+                    key = key_node.value  # a name: most keys
+                else:
+                    key = _scalar(key_node) if isinstance(key_node, yaml.ScalarNode) else None
+                    if not isinstance(key, str | int) or isinstance(key, bool):
+                        self.fail(key_node, path, "keys must be names or numbers")
+                        continue
+                inner = (*path, key)
                 if key in result:
-                    self.fail(key_node, (*path, key), f"duplicate key {key!r}")
+                    self.fail(key_node, inner, f"duplicate key {key!r}")
                     continue
-                if isinstance(key, str) and (bad := CONTROL.search(key)):
-                    self.fail(key_node, (*path, key), f"control character U+{ord(bad.group()):04X} in a key")
+                if isinstance(key, str) and not key.isprintable() and (bad := CONTROL.search(key)):
+                    self.fail(key_node, inner, f"control character U+{ord(bad.group()):04X} in a key")
                     continue
-                located.key_marks[(*path, key)] = _position(key_node)
-                result[key] = self._convert(value_node, (*path, key))
+                mark = key_node.start_mark
+                located.key_marks[inner] = (mark.line + 1, mark.column + 1)
+                if value_node.__class__ is _ScalarNode and value_node.tag == _STR and shallow and self.budget > 0:
+                    self.budget -= 1
+                    mark = value_node.start_mark
+                    marks[inner] = (mark.line + 1, mark.column + 1)
+                    result[key] = value_node.value
+                else:
+                    result[key] = self._convert(value_node, inner)
             self.open.discard(id(node))
             return result
         if isinstance(node, yaml.SequenceNode):
             self.open.add(id(node))
-            items = [self._convert(item, (*path, index)) for index, item in enumerate(node.value)]
+            items = []
+            for index, item in enumerate(node.value):
+                if item.__class__ is _ScalarNode and item.tag == _STR and shallow and self.budget > 0:
+                    self.budget -= 1
+                    mark = item.start_mark
+                    marks[(*path, index)] = (mark.line + 1, mark.column + 1)
+                    items.append(item.value)
+                else:
+                    items.append(self._convert(item, (*path, index)))
             self.open.discard(id(node))
             return items
         if isinstance(node, yaml.ScalarNode):

@@ -7,16 +7,17 @@ uses to reject stray headers, class names, and which fields are derived (counts,
 from __future__ import annotations
 
 from collections.abc import Iterable
-from dataclasses import dataclass, field
+from dataclasses import field
 from functools import cached_property
 from typing import Literal
 
 from serialspec.runtime.message import Direction as Direction  # the model and the runtime share it
 from serialspec.spec import expression
 from serialspec.spec.expression import Expr
+from serialspec.spec.frozen import frozen
 
 
-@dataclass(frozen=True)
+@frozen
 class ScalarType:
     name: str
     size: int
@@ -38,14 +39,14 @@ SCALARS: dict[str, ScalarType] = {
 }
 
 
-@dataclass(frozen=True)
+@frozen
 class EnumValue:
     name: str
     value: int
     text: str
 
 
-@dataclass(frozen=True)
+@frozen
 class EnumDef:
     name: str
     class_name: str
@@ -54,14 +55,14 @@ class EnumDef:
     values: tuple[EnumValue, ...]
 
 
-@dataclass(frozen=True)
+@frozen
 class FlagBit:
     name: str
     bit: int
     text: str
 
 
-@dataclass(frozen=True)
+@frozen
 class FlagsDef:
     name: str
     class_name: str
@@ -70,7 +71,7 @@ class FlagsDef:
     bits: tuple[FlagBit, ...]
 
 
-@dataclass(frozen=True)
+@frozen
 class BitField:
     name: str
     high: int
@@ -83,7 +84,7 @@ class BitField:
         return (1 << (self.high - self.low + 1)) - 1
 
 
-@dataclass(frozen=True)
+@frozen
 class Common:
     """What every field kind carries."""
 
@@ -93,7 +94,7 @@ class Common:
     inferred: str
 
 
-@dataclass(frozen=True)
+@frozen
 class Scalar(Common):
     type: ScalarType
     endian: Literal["<", ">"]
@@ -122,7 +123,7 @@ class Scalar(Common):
         return self.const is not None or bool(self.derived) or self.value is not None
 
 
-@dataclass(frozen=True)
+@frozen
 class Array(Common):
     item: ScalarType
     endian: Literal["<", ">"]
@@ -132,7 +133,7 @@ class Array(Common):
     maximum: float
 
 
-@dataclass(frozen=True)
+@frozen
 class List(Common):
     """A list of numbers or bits whose count varies: from a count field, from a byte-size field, or the rest.
 
@@ -158,7 +159,7 @@ class List(Common):
         return -(-count // 8) if self.item is None else count * self.item.size
 
 
-@dataclass(frozen=True)
+@frozen
 class Text(Common):
     """Text: NUL-terminated (`size` None; the NUL is not part of the value), or sized like bytes."""
 
@@ -169,7 +170,7 @@ class Text(Common):
         return self.size is None
 
 
-@dataclass(frozen=True)
+@frozen
 class Bytes(Common):
     size: int | str  # a number, "rest", or the name of a field holding it
     table: Table | None = None  # when the bytes are a run of registers of this table
@@ -178,7 +179,7 @@ class Bytes(Common):
     size_from: str = ""  # a response's `rest` bytes: the request field giving their number (`request.<field>`)
 
 
-@dataclass(frozen=True)
+@frozen
 class Group(Common):
     class_name: str
     count: int | str  # a number, "rest", or the name of a count field
@@ -186,13 +187,13 @@ class Group(Common):
     item_size: int | None  # None when an item holds bytes sized by another field
 
 
-@dataclass(frozen=True)
+@frozen
 class TableValue(Common):
     table: Table
     key: str
 
 
-@dataclass(frozen=True)
+@frozen
 class TableBlock(Common):
     table: Table
     class_name: str
@@ -204,7 +205,7 @@ class TableBlock(Common):
 Field = Scalar | Array | List | Text | Bytes | Group | TableValue | TableBlock
 
 
-@dataclass(frozen=True)
+@frozen
 class TableEntry:
     name: str
     key: int
@@ -226,7 +227,7 @@ class TableEntry:
     sign_bit: int | None = None  # sign_magnitude: the sign's bit (the top bit unless the spec says otherwise)
 
 
-@dataclass(frozen=True)
+@frozen
 class Table:
     name: str
     title: str
@@ -246,7 +247,7 @@ class Table:
         return None
 
 
-@dataclass(frozen=True)
+@frozen
 class OptionalWhen:
     """A response the device sends only while one of its parameters (a table entry) compares true with a value."""
 
@@ -262,7 +263,7 @@ class OptionalWhen:
         return {"==": "=", "!=": "≠", ">=": "≥", "<=": "≤"}[self.op]
 
 
-@dataclass(frozen=True)
+@frozen
 class Message:
     """One direction of a command or sub-command."""
 
@@ -311,14 +312,14 @@ def reply_condition(request: Message, response: Message | None) -> OptionalWhen 
     return request.reply_when or (response.optional_when if response else None)
 
 
-@dataclass(frozen=True)
+@frozen
 class Selector:
     name: str
     type: ScalarType
     offsets: dict[Direction, int]
 
 
-@dataclass(frozen=True)
+@frozen
 class Subcommand:
     name: str
     code: int
@@ -330,7 +331,7 @@ class Subcommand:
     source: str
 
 
-@dataclass(frozen=True)
+@frozen
 class Command:
     name: str
     code: int | None
@@ -352,7 +353,7 @@ class Command:
         return tuple(found)
 
 
-@dataclass(frozen=True)
+@frozen
 class Crc:
     name: str
     width: int
@@ -364,7 +365,7 @@ class Crc:
     check: int
 
 
-@dataclass(frozen=True)
+@frozen
 class Checksum:
     algorithm: Literal["sum", "crc", "xor"]
     invert: bool
@@ -376,7 +377,7 @@ class Checksum:
     name: str = ""  # the frame element holding it
 
 
-@dataclass(frozen=True)
+@frozen
 class FrameElement:
     name: str
     role: str  # header, trailer, constant, address, command, status, length, content, checksum
@@ -402,7 +403,7 @@ class FrameElement:
         return self.role in ("header", "trailer", "constant")
 
 
-@dataclass(frozen=True)
+@frozen
 class Transparency:
     """Byte stuffing or escaping over a span of elements: each plain sequence is sent as its wire sequence."""
 
@@ -412,7 +413,7 @@ class Transparency:
     description: str = ""
 
 
-@dataclass(frozen=True)
+@frozen
 class FrameLayout:
     """The frame in one direction: elements in order with their byte offsets (content's at its start).
 
@@ -456,7 +457,7 @@ class FrameLayout:
         return last.constant if last.role == "trailer" else b""
 
 
-@dataclass(frozen=True)
+@frozen
 class Framing:
     description: str
     layouts: dict[Direction, FrameLayout]  # the (first) layout of each direction
@@ -471,7 +472,7 @@ class Framing:
         return all(layout.classic for layouts in self.alternatives.values() for layout in layouts)
 
 
-@dataclass(frozen=True)
+@frozen
 class ErrorReply:
     """Replies that refuse a request: its code with `flag` set in the command element, laid out as `command`'s
     response (Modbus exception replies: function | 0x80, then an exception code)."""
@@ -481,7 +482,7 @@ class ErrorReply:
     command: str  # the command whose response is the error reply
 
 
-@dataclass(frozen=True)
+@frozen
 class Serial:
     baudrate: int
     bytesize: int
@@ -490,7 +491,7 @@ class Serial:
     notes: str
 
 
-@dataclass(frozen=True)
+@frozen
 class Example:
     name: str
     source: str
@@ -515,7 +516,7 @@ class Example:
         return self.frame[before : len(self.frame) - after]
 
 
-@dataclass(frozen=True)
+@frozen
 class ErratumCheck:
     kind: str
     frame: bytes | None
@@ -530,7 +531,7 @@ class ErratumCheck:
     examples: tuple[str, ...]
 
 
-@dataclass(frozen=True)
+@frozen
 class Erratum:
     name: str
     source: str
@@ -540,7 +541,7 @@ class Erratum:
     position: tuple[int, int] = (1, 1)  # line and column of its check in the spec
 
 
-@dataclass(frozen=True)
+@frozen
 class Motion:
     """A move: the state value goes to the request's target over a duration (ms) or at a speed (units/s)."""
 
@@ -554,7 +555,7 @@ class Motion:
     decel: str = ""  # request field: deceleration time (ms) at the end
 
 
-@dataclass(frozen=True)
+@frozen
 class Space:
     """A data space a device keeps: `size` items addressed 0..size-1, bits or unsigned integers, all 0 at first."""
 
@@ -565,7 +566,7 @@ class Space:
     description: str
 
 
-@dataclass(frozen=True)
+@frozen
 class SpaceAccess:
     """A run of a data space from the address in the request field `start` (`count` items, for reads)."""
 
@@ -575,7 +576,7 @@ class SpaceAccess:
     value: Expr | None = None  # writes: what is stored, from the request's fields and `current`
 
 
-@dataclass(frozen=True)
+@frozen
 class DeviceErrors:
     """How a device refuses a request, by reason: the reply values (response field or field.bit_field -> value),
     sent in the protocol's error reply when it has one, else in the request's own response."""
@@ -592,7 +593,7 @@ class DeviceErrors:
         return {reason: getattr(self, reason) for reason in reasons if getattr(self, reason)}
 
 
-@dataclass(frozen=True)
+@frozen
 class Behaviour:
     """What a device does with one command's request, besides answering it."""
 
@@ -629,7 +630,7 @@ class Behaviour:
     nothing_held: dict[str, float] = field(default_factory=dict)  # commits: reply values when nothing is held
 
 
-@dataclass(frozen=True)
+@frozen
 class DeviceTimeout:
     """The device gives up (sets state variables) when none of `kept_by` arrives for `after` ms."""
 
@@ -639,7 +640,7 @@ class DeviceTimeout:
     description: str = ""
 
 
-@dataclass(frozen=True)
+@frozen
 class DeviceKind:
     """Devices of another kind behind the same port, with their own ids and state (a board's PWM servo ports)."""
 
@@ -651,7 +652,7 @@ class DeviceKind:
     state: dict[str, float]
 
 
-@dataclass(frozen=True)
+@frozen
 class ModelEntry:
     """Where one model's memory entry differs from the table: its range, unit, scale or description."""
 
@@ -663,7 +664,7 @@ class ModelEntry:
     description: str
 
 
-@dataclass(frozen=True)
+@frozen
 class DeviceModel:
     """One model of the device: its model number, its factory values and where its table differs."""
 
@@ -679,7 +680,7 @@ class DeviceModel:
         return next((e for e in self.entries if e.name == name), None)
 
 
-@dataclass(frozen=True)
+@frozen
 class Device:
     """How a device behaves, for the simulator (and the address/broadcast rule, for the client)."""
 
@@ -707,7 +708,7 @@ class Device:
         return next((b for b in self.behaviours if b.command == key), None)
 
 
-@dataclass(frozen=True)
+@frozen
 class Protocol:
     name: str
     title: str

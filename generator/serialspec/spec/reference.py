@@ -6,16 +6,16 @@ from __future__ import annotations
 
 import json
 from collections.abc import Iterator, Sequence
-from dataclasses import dataclass
 from typing import Any
 
 from serialspec.spec import grammar
+from serialspec.spec.frozen import frozen
 from serialspec.spec.grammar import Any_, Bool, Int, ListOf, MapOf, Num, Obj, OneOf, Ref, Shape, Str
 
 NAME = "<name>"  # a key the spec author chooses (a command's name, a field's name)
 
 
-@dataclass(frozen=True)
+@frozen
 class Key:
     path: tuple[str, ...]  # from the spec's top level; NAME where the author chooses the key
     shape: Shape

@@ -7,7 +7,6 @@ neither break a table nor inject HTML into the rendered page.
 from __future__ import annotations
 
 from collections import Counter
-from dataclasses import dataclass
 from typing import Any
 
 from serialspec.collection import without_cycle_collection
@@ -17,6 +16,7 @@ from serialspec.emit.common.numbers import number
 from serialspec.emit.common.text import collapse
 from serialspec.emit.markdown.kinds import anchor, kind, scalar_range
 from serialspec.runtime.errors import SerialspecError
+from serialspec.spec.frozen import mutable
 from serialspec.spec.model import (
     Checksum,
     Command,
@@ -95,7 +95,7 @@ def meaning(f: Field) -> str:
     return " ".join(p for p in parts if p)
 
 
-@dataclass
+@mutable
 class Row:
     offset: str
     name: str

@@ -49,15 +49,18 @@ class _Sources(importlib.abc.MetaPathFinder, importlib.abc.Loader):
     def exec_module(self, module: ModuleType) -> None:
         name = self._file(module.__name__)
         assert name is not None
+        if name not in self.files:  # a package without its __init__.py: an empty package around its modules
+            return
         filename = f"<{self.package}/{name} from {self.origin}>"
         exec(cache.compiled(self.files[name], filename, f"{self.package}.{name}"), module.__dict__)
 
 
 @contextmanager
-def imported(package: str, files: dict[str, str], origin: str = "memory") -> Iterator[ModuleType]:
-    """The package made of `files` (module file name -> text), imported for the block. Any package of that name
-    already imported (the committed one, in tests) is set aside meanwhile and put back; the modules imported in the
-    block stay usable after it."""
+def imported(package: str, files: dict[str, str], origin: str = "memory", module: str = "") -> Iterator[ModuleType]:
+    """The package made of `files` (module file name -> text), imported for the block; or with `module`, that module
+    of it (files without "__init__.py": the package is an empty one, its own imports are not run). Any package of
+    that name already imported (the committed one, in tests) is set aside meanwhile and put back; the modules
+    imported in the block stay usable after it."""
 
     def ours(name: str) -> bool:
         return name == package or name.startswith(package + ".")
@@ -68,7 +71,7 @@ def imported(package: str, files: dict[str, str], origin: str = "memory") -> Ite
         del sys.modules[name]
     sys.meta_path.insert(0, finder)
     try:
-        yield importlib.import_module(package)
+        yield importlib.import_module(f"{package}.{module}" if module else package)
     finally:
         sys.meta_path.remove(finder)
         for name in [name for name in sys.modules if ours(name)]:

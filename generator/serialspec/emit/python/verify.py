@@ -7,6 +7,7 @@ The package is imported from the generated text in memory (serialspec.emit.pytho
 
 from __future__ import annotations
 
+import importlib
 from types import ModuleType
 from typing import Any
 
@@ -31,15 +32,15 @@ def _difference(found: dict[str, Any], recorded: dict[str, object]) -> str:
 
 
 class _Checker:
-    def __init__(self, protocol: Protocol, package: ModuleType) -> None:
+    def __init__(self, protocol: Protocol, package: ModuleType, message_types: tuple[Any, ...]) -> None:
         self.protocol = protocol
-        self.package = package
+        self.package = package  # the codec: decode, encode
+        self.classes: dict[tuple[str, str | None, str], Any] = {}
+        for cls in reversed(message_types):  # the first of any two alike wins, as a search in order finds
+            self.classes[cls.COMMAND, cls.SUBCOMMAND, cls.DIRECTION.value] = cls
 
     def message_class(self, command: str, subcommand: str | None, direction: str) -> Any:
-        for cls in self.package.MESSAGE_TYPES:
-            if (cls.COMMAND, cls.SUBCOMMAND, cls.DIRECTION.value) == (command, subcommand, direction):
-                return cls
-        return None
+        return self.classes.get((command, subcommand, direction))
 
     def decodes_as(self, frame: bytes, direction: str, command: str, subcommand: str | None, fields: Any) -> str:
         """What is wrong with reading `frame` as the given message with the given values ("" if nothing)."""
@@ -129,8 +130,12 @@ def verify(protocol: Protocol, files: dict[str, str]) -> list[SpecError]:
     if not protocol.examples and not protocol.errata:
         return []
     problems: list[SpecError] = []
-    with imported(protocol.name, files, protocol.spec_path) as package:  # one that does not import: a bug, raised
-        checker = _Checker(protocol, package)
+    # The codec (and the messages it imports) is what the checks run: the package's __init__ (which brings in the
+    # serial transport for the client) is not needed for them.
+    codec_files = {name: text for name, text in files.items() if name != "__init__.py"}
+    with imported(protocol.name, codec_files, protocol.spec_path, "codec") as codec:  # not importing: a bug, raised
+        messages = importlib.import_module(f"{protocol.name}.messages")  # the codec's own import of it
+        checker = _Checker(protocol, codec, messages.MESSAGE_TYPES)
         for example in protocol.examples:
             if wrong := checker.example(example):
                 line, column = example.position

@@ -10,10 +10,11 @@ import builtins
 import keyword
 import re
 import sys
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import Any, Literal
 
 from serialspec.spec.errors import SpecError
+from serialspec.spec.frozen import mutable
 from serialspec.spec.loader import Located, Path, dotted
 from serialspec.spec.model import (
     SCALARS,
@@ -149,7 +150,7 @@ def camel(*parts: str) -> str:
     return "".join(word.capitalize() for part in parts for word in part.split("_") if word)
 
 
-@dataclass
+@mutable
 class Context:
     """The document being resolved and everything resolved from it so far."""
 

@@ -128,12 +128,11 @@ def _decode_read_holding_registers_response(buf: bytes, o: int, end: int, unit: 
     if nb % 2:
         raise DecodeError('read_holding_registers response' + f': {nb} bytes do not split into registers items of 2')
     n = nb // 2
-    if end - o < nb:
-        raise DecodeError('read_holding_registers response' + f': registers needs {nb} bytes, {end - o} left')
+    if end - o != nb:
+        if end - o < nb:
+            raise DecodeError('read_holding_registers response' + f': registers needs {nb} bytes, {end - o} left')
+        raise DecodeError('read_holding_registers response' + f': {end - o - nb} bytes left after the last field')
     v_registers = _RUNS_BE_U16[n](buf, o)
-    o += nb
-    if o != end:
-        raise DecodeError('read_holding_registers response' + f': {end - o} bytes left after the last field')
     return _new(ReadHoldingRegistersResponse, (unit, v_registers))
 
 
@@ -153,12 +152,11 @@ def _decode_read_input_registers_response(buf: bytes, o: int, end: int, unit: in
     if nb % 2:
         raise DecodeError('read_input_registers response' + f': {nb} bytes do not split into registers items of 2')
     n = nb // 2
-    if end - o < nb:
-        raise DecodeError('read_input_registers response' + f': registers needs {nb} bytes, {end - o} left')
+    if end - o != nb:
+        if end - o < nb:
+            raise DecodeError('read_input_registers response' + f': registers needs {nb} bytes, {end - o} left')
+        raise DecodeError('read_input_registers response' + f': {end - o - nb} bytes left after the last field')
     v_registers = _RUNS_BE_U16[n](buf, o)
-    o += nb
-    if o != end:
-        raise DecodeError('read_input_registers response' + f': {end - o} bytes left after the last field')
     return _new(ReadInputRegistersResponse, (unit, v_registers))
 
 
@@ -281,12 +279,11 @@ def _decode_read_write_registers_response(buf: bytes, o: int, end: int, unit: in
     if nb % 2:
         raise DecodeError('read_write_registers response' + f': {nb} bytes do not split into registers items of 2')
     n = nb // 2
-    if end - o < nb:
-        raise DecodeError('read_write_registers response' + f': registers needs {nb} bytes, {end - o} left')
+    if end - o != nb:
+        if end - o < nb:
+            raise DecodeError('read_write_registers response' + f': registers needs {nb} bytes, {end - o} left')
+        raise DecodeError('read_write_registers response' + f': {end - o - nb} bytes left after the last field')
     v_registers = _RUNS_BE_U16[n](buf, o)
-    o += nb
-    if o != end:
-        raise DecodeError('read_write_registers response' + f': {end - o} bytes left after the last field')
     return _new(ReadWriteRegistersResponse, (unit, v_registers))
 
 

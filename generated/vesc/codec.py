@@ -84,12 +84,11 @@ def _decode_fw_version_response(buf: bytes, o: int, end: int) -> FwVersionRespon
         raise DecodeError('fw_version response' + ': fw_name has no NUL at its end')
     v_fw_name = _decode_text(buf[o:stop], 'fw_name', 'fw_version response')
     o = stop + 1
-    if end - o < 4:
-        raise DecodeError('fw_version response' + f': hw_crc needs 4 bytes, {end - o} left')
+    if end - o != 4:
+        if end - o < 4:
+            raise DecodeError('fw_version response' + f': hw_crc needs 4 bytes, {end - o} left')
+        raise DecodeError('fw_version response' + f': {end - o - 4} bytes left after the last field')
     v_hw_crc, = _S_BE_U32.unpack_from(buf, o)
-    o += 4
-    if o != end:
-        raise DecodeError('fw_version response' + f': {end - o} bytes left after the last field')
     return _new(FwVersionResponse, (v_major, v_minor, v_hw_name, v_uuid, v_pairing_done, v_test_version, _MEMBERS_HwType.get(v_hw_type, v_hw_type), v_custom_config_count, v_phase_filters, v_qml_hw, v_qml_app, v_nrf_flags, v_fw_name, v_hw_crc))
 
 

@@ -66,6 +66,34 @@ def bound(f: Scalar, value: float) -> str:
 _LOOP = re.compile(r"^(?P<indent> *)for (?P<var>[A-Za-z_]\w*) in .+:$")
 
 
+_NEEDS = re.compile(r"^if end - o < (?P<size>\w+):$")
+
+
+def fold_last_size_check(lines: Lines) -> Lines:
+    """A decoder's lines with the size check of its last field, read up to the content's end, and the check that
+    nothing is left after it made one comparison on the way of an intact frame (`end - o != size`), each error
+    still raised as before; the cursor is not moved past the last field, as nothing reads it."""
+    if len(lines) < 7 or not lines[-1].startswith("return ") or _CURSOR_WORD.search(lines[-1]):
+        return lines
+    needs, raised, read, moved, left, raised_left = lines[-7:-1]
+    found = _NEEDS.match(needs)
+    if found is None or moved != f"o += {found['size']}" or left != "if o != end:" or read.startswith(" "):
+        return lines
+    if not raised.startswith("    raise ") or not raised_left.endswith("bytes left after the last field')"):
+        return lines
+    size = found["size"]
+    return [
+        *lines[:-7],
+        f"if end - o != {size}:",
+        f"    {needs}",
+        f"    {raised}",
+        raised_left.replace("{end - o}", f"{{end - o - {size}}}"),
+        read,
+        lines[-1],
+    ]
+
+
+_CURSOR_WORD = re.compile(r"\bo\b")
 _DEFERRED = "#deferred "  # check_items' mark before the loop over a list whose item range is its type's
 
 
@@ -429,7 +457,8 @@ class PackageCode:
         self.message_classes.append(code)
         frame_names = [f.name for f in self.frame_values(message.direction, message)]
         extra = "".join(f", {name}: int" for name in frame_names)
-        self.decoders.append((decoder_name(message), message.class_name, extra, self.decoder(message, fields)))
+        decoder = fold_last_size_check(self.decoder(message, fields))
+        self.decoders.append((decoder_name(message), message.class_name, extra, decoder))
         encoder = read_fields_once(deferred_item_checks(self.encoder(message, fields)), [f.name for f in fields])
         self.encoders.append((encoder_name(message), message.class_name, encoder))
 

@@ -4,7 +4,8 @@
 from __future__ import annotations
 
 import struct
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from itertools import repeat
 
 from serialspec.runtime.checksums import BYTE_VALUES as _BYTES
 from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError, content_size_error, out_of_range
@@ -99,16 +100,19 @@ _S_U8_I16 = struct.Struct('<Bh')
 _S_U8_I16_U16_U16 = struct.Struct('<BhHH')
 _S_U8_I16_U16_U16_IN_12 = struct.Struct('<4xBhHH1x')
 _S_U8_I16_U16_U16_U16_U16 = struct.Struct('<BhHHHH')
+_S_U8_I16_U16_U16_U16_U16_AFTER_HEADER = struct.Struct('<2xBhHHHHx')
 _S_U8_I16_U16_U16_U16_U16_IN_16 = struct.Struct('<4xBhHHHH1x')
 _S_U8_I16_U8 = struct.Struct('<BhB')
 _S_U8_I16_U8_IN_8 = struct.Struct('<4xBhB')
 _S_U8_I32_I16 = struct.Struct('<Bih')
 _S_U8_I32_I16_IN_12 = struct.Struct('<4xBih1x')
 _S_U8_I32_U16_U16_U16_U16 = struct.Struct('<BiHHHH')
+_S_U8_I32_U16_U16_U16_U16_AFTER_HEADER = struct.Struct('<2xBiHHHHx')
 _S_U8_I32_U16_U16_U16_U16_IN_18 = struct.Struct('<4xBiHHHH1x')
 _S_U8_I32_U32_U16 = struct.Struct('<BiIH')
 _S_U8_I32_U32_U16_IN_16 = struct.Struct('<4xBiIH1x')
 _S_U8_I32_U32_U16_U16_U16 = struct.Struct('<BiIHHH')
+_S_U8_I32_U32_U16_U16_U16_AFTER_HEADER = struct.Struct('<2xBiIHHHx')
 _S_U8_I32_U32_U16_U16_U16_IN_20 = struct.Struct('<4xBiIHHH1x')
 _S_U8_U16 = struct.Struct('<BH')
 _S_U8_U16_U8 = struct.Struct('<BHB')
@@ -123,6 +127,13 @@ _S_U8_U8_U8 = struct.Struct('<BBB')
 _S_U8_U8_U8_IN_7 = struct.Struct('<4xBBB')
 _S_U8_U8_U8_U8 = struct.Struct('<BBBB')
 _S_U8_U8_U8_U8_IN_8 = struct.Struct('<4xBBBB')
+_S_XX2_U8_I16_U16_U16_X = struct.Struct('<2xBhHHx')
+_S_XX2_U8_I16_X = struct.Struct('<2xBhx')
+_S_XX2_U8_I32_I16_X = struct.Struct('<2xBihx')
+_S_XX2_U8_I32_U32_U16_X = struct.Struct('<2xBiIHx')
+_S_XX2_U8_U16_X = struct.Struct('<2xBHx')
+_S_XX2_U8_U8_X = struct.Struct('<2xBBx')
+_S_XX2_U8_X = struct.Struct('<2xBx')
 _TABLE_PARAMETERS: dict[int, struct.Struct] = {
     1: struct.Struct('<H'),
     2: struct.Struct('<H'),
@@ -791,6 +802,96 @@ def _frame_monitor_response(buf: bytes, start: int) -> MonitorResponse | None:
     if v_status_flags is None:
         v_status_flags = ServoStatus(v_status)
     return _new(MonitorResponse, (v_servo_id, v_voltage, v_current, v_power, v_temperature, v_status_flags, v_angle, v_turns))
+
+
+def _run_ping_request(frames: bytes) -> Iterator[PingRequest]:
+    """Ping request frames end to end, their headers left out, every check made: their messages."""
+    return map(_new, repeat(PingRequest), _S_XX2_U8_X.iter_unpack(frames))
+
+
+def _run_reset_user_data_request(frames: bytes) -> Iterator[ResetUserDataRequest]:
+    """Reset_user_data request frames end to end, their headers left out, every check made: their messages."""
+    return map(_new, repeat(ResetUserDataRequest), _S_XX2_U8_X.iter_unpack(frames))
+
+
+def _run_read_data_request(frames: bytes) -> Iterator[ReadDataRequest]:
+    """Read_data request frames end to end, their headers left out, every check made: their messages."""
+    return map(_new, repeat(ReadDataRequest), _S_XX2_U8_U8_X.iter_unpack(frames))
+
+
+def _run_read_batch_data_request(frames: bytes) -> Iterator[ReadBatchDataRequest]:
+    """Read_batch_data request frames end to end, their headers left out, every check made: their messages."""
+    return map(_new, repeat(ReadBatchDataRequest), _S_XX2_U8_X.iter_unpack(frames))
+
+
+def _run_rotate_request(frames: bytes) -> Iterator[RotateRequest]:
+    """Rotate request frames end to end, their headers left out, every check made: their messages."""
+    return map(_new, repeat(RotateRequest), _S_XX2_U8_I16_U16_U16_X.iter_unpack(frames))
+
+
+def _run_damping_request(frames: bytes) -> Iterator[DampingRequest]:
+    """Damping request frames end to end, their headers left out, every check made: their messages."""
+    return map(_new, repeat(DampingRequest), _S_XX2_U8_U16_X.iter_unpack(frames))
+
+
+def _run_read_angle_request(frames: bytes) -> Iterator[ReadAngleRequest]:
+    """Read_angle request frames end to end, their headers left out, every check made: their messages."""
+    return map(_new, repeat(ReadAngleRequest), _S_XX2_U8_X.iter_unpack(frames))
+
+
+def _run_move_by_interval_request(frames: bytes) -> Iterator[MoveByIntervalRequest]:
+    """Move_by_interval request frames end to end, their headers left out, every check made: their messages."""
+    return map(_new, repeat(MoveByIntervalRequest), _S_U8_I16_U16_U16_U16_U16_AFTER_HEADER.iter_unpack(frames))
+
+
+def _run_move_by_velocity_request(frames: bytes) -> Iterator[MoveByVelocityRequest]:
+    """Move_by_velocity request frames end to end, their headers left out, every check made: their messages."""
+    return map(_new, repeat(MoveByVelocityRequest), _S_U8_I16_U16_U16_U16_U16_AFTER_HEADER.iter_unpack(frames))
+
+
+def _run_move_mturn_request(frames: bytes) -> Iterator[MoveMturnRequest]:
+    """Move_mturn request frames end to end, their headers left out, every check made: their messages."""
+    return map(_new, repeat(MoveMturnRequest), _S_XX2_U8_I32_U32_U16_X.iter_unpack(frames))
+
+
+def _run_move_mturn_by_interval_request(frames: bytes) -> Iterator[MoveMturnByIntervalRequest]:
+    """Move_mturn_by_interval request frames end to end, their headers left out, every check made: their messages."""
+    return map(_new, repeat(MoveMturnByIntervalRequest), _S_U8_I32_U32_U16_U16_U16_AFTER_HEADER.iter_unpack(frames))
+
+
+def _run_move_mturn_by_velocity_request(frames: bytes) -> Iterator[MoveMturnByVelocityRequest]:
+    """Move_mturn_by_velocity request frames end to end, their headers left out, every check made: their messages."""
+    return map(_new, repeat(MoveMturnByVelocityRequest), _S_U8_I32_U16_U16_U16_U16_AFTER_HEADER.iter_unpack(frames))
+
+
+def _run_read_mturn_angle_request(frames: bytes) -> Iterator[ReadMturnAngleRequest]:
+    """Read_mturn_angle request frames end to end, their headers left out, every check made: their messages."""
+    return map(_new, repeat(ReadMturnAngleRequest), _S_XX2_U8_X.iter_unpack(frames))
+
+
+def _run_reset_mturn_angle_request(frames: bytes) -> Iterator[ResetMturnAngleRequest]:
+    """Reset_mturn_angle request frames end to end, their headers left out, every check made: their messages."""
+    return map(_new, repeat(ResetMturnAngleRequest), _S_XX2_U8_X.iter_unpack(frames))
+
+
+def _run_monitor_request(frames: bytes) -> Iterator[MonitorRequest]:
+    """Monitor request frames end to end, their headers left out, every check made: their messages."""
+    return map(_new, repeat(MonitorRequest), _S_XX2_U8_X.iter_unpack(frames))
+
+
+def _run_ping_response(frames: bytes) -> Iterator[PingResponse]:
+    """Ping response frames end to end, their headers left out, every check made: their messages."""
+    return map(_new, repeat(PingResponse), _S_XX2_U8_X.iter_unpack(frames))
+
+
+def _run_read_angle_response(frames: bytes) -> Iterator[ReadAngleResponse]:
+    """Read_angle response frames end to end, their headers left out, every check made: their messages."""
+    return map(_new, repeat(ReadAngleResponse), _S_XX2_U8_I16_X.iter_unpack(frames))
+
+
+def _run_read_mturn_angle_response(frames: bytes) -> Iterator[ReadMturnAngleResponse]:
+    """Read_mturn_angle response frames end to end, their headers left out, every check made: their messages."""
+    return map(_new, repeat(ReadMturnAngleResponse), _S_XX2_U8_I32_I16_X.iter_unpack(frames))
 
 
 def _whole_ping_request(buf: bytes) -> PingRequest | None:
@@ -1986,6 +2087,24 @@ REQUEST_FORMAT = FrameFormat(
     content_sizes=_REQUEST_SIZES,
     decode_at=_decode_request_at,
     fixed=_REQUEST_FIXED,
+    summed=(0, False),
+    runs={
+        0x0101: _run_ping_request,
+        0x0201: _run_reset_user_data_request,
+        0x0302: _run_read_data_request,
+        0x0501: _run_read_batch_data_request,
+        0x0807: _run_rotate_request,
+        0x0903: _run_damping_request,
+        0x0a01: _run_read_angle_request,
+        0x0b0b: _run_move_by_interval_request,
+        0x0c0b: _run_move_by_velocity_request,
+        0x0d0b: _run_move_mturn_request,
+        0x0e0f: _run_move_mturn_by_interval_request,
+        0x0f0d: _run_move_mturn_by_velocity_request,
+        0x1001: _run_read_mturn_angle_request,
+        0x1101: _run_reset_mturn_angle_request,
+        0x1601: _run_monitor_request,
+    },
 )
 RESPONSE_FORMAT = FrameFormat(
     header=b'\x05\x1c',
@@ -1996,6 +2115,12 @@ RESPONSE_FORMAT = FrameFormat(
     content_sizes=_RESPONSE_SIZES,
     decode_at=_decode_response_at,
     fixed=_RESPONSE_FIXED,
+    summed=(0, False),
+    runs={
+        0x0101: _run_ping_response,
+        0x0a03: _run_read_angle_response,
+        0x1007: _run_read_mturn_angle_response,
+    },
 )
 
 

@@ -351,6 +351,8 @@ class FrameCodec:
         self.content_sizes = content_sizes  # content size bounds by code (plain bytes)
         self.size_rules = size_rules or {}
         self.error_flag = error_flag
+        # probe() for each layout, its plan read once into a closure (what the stream parser calls per candidate)
+        self.sizers = tuple(self._sizer(layout) for layout in self.layouts)
 
     def wrap(self, content: bytes, code: int | None, values: tuple[int, ...]) -> bytes:
         problem: EncodeError | None = None
@@ -420,6 +422,84 @@ class FrameCodec:
             return -1
         return layout.overhead + content_size
 
+    def _sizer(self, layout: Layout) -> Callable[[bytes, int, int], int | None]:
+        """probe(layout, ...) as a closure over what it reads of the layout's plan, worked out once.
+
+        Where the candidate's fixed head has all come (the usual case), its checks are made with no test of the bytes
+        available: which one fails first then makes no difference (each says no frame). Otherwise probe() decides, so
+        the answer is always probe()'s: tests/test_frame_stream.py draws candidates and holds the two to it.
+        """
+        plan: dict[str, Any] = layout._plan  # type: ignore[attr-defined]
+        head: tuple[tuple[Element, int, int], ...] = plan["probe_head"]
+        need = max((stop for _, _, stop in head), default=0)
+        constants = tuple((first, e.constant) for e, first, _ in head if e.kind == "constant")
+        commands = tuple((first, stop, e.endian) for e, first, stop in head if e.kind == "command")
+        values = tuple(
+            (first, stop, e.endian, e.minimum, e.maximum, e.also) for e, first, stop in head if e.kind == "value"
+        )
+        content_sizes, size_rules, error_flag = self.content_sizes, self.size_rules, self.error_flag
+        codeless = layout.command is None
+        if codeless and None not in content_sizes:
+            return lambda buffer, start, end: self.probe(layout, buffer, start, end)
+        if len(commands) > 1 or (codeless and commands):  # probe() decides
+            return lambda buffer, start, end: self.probe(layout, buffer, start, end)
+        command = commands[0] if commands else None  # none: after the head (stuffed), so no code is read here
+        length: tuple[int, Element, int, int] | None = plan["probe_length"]
+        measured = None  # the length element read in place: offset, stop, byte order, adds, sizes around it
+        if length is not None:
+            offset, element, outside, inside_fixed = length
+            measured = (offset, offset + element.size, element.endian, element.adds, outside, inside_fixed)
+        trailer = layout.trailer if layout.trailer and layout.transparency is not None else b""
+        before, prefix, overhead, bounded = plan["before"], plan["prefix"], layout.overhead, layout.transparency is None
+
+        def sizer(buffer: bytes, start: int, end: int) -> int | None:
+            if end - start < need:
+                return self.probe(layout, buffer, start, end)
+            for first, constant in constants:
+                if not buffer.startswith(constant, start + first):
+                    return -1
+            code: int | None = None
+            if command is not None:
+                first, stop, endian = command
+                value = (
+                    buffer[start + first]
+                    if stop - first == 1
+                    else int.from_bytes(buffer[start + first : start + stop], endian)
+                )
+                code = ERROR_REPLY if value & error_flag else value
+                if code not in content_sizes:
+                    return -1
+            for first, stop, endian, minimum, maximum, also in values:
+                value = (
+                    buffer[start + first]
+                    if stop - first == 1
+                    else int.from_bytes(buffer[start + first : start + stop], endian)
+                )
+                if not minimum <= value <= maximum and value != also:
+                    return -1
+            low, high = content_sizes.get(code, (0, None))
+            if measured is not None:
+                offset, stop, endian, adds, outside, inside_fixed = measured
+                counted = int.from_bytes(buffer[start + offset : start + stop], endian) - adds
+                content = counted - inside_fixed
+                if content < low or (bounded and high is not None and content > high):
+                    return -1
+                return outside + counted
+            if trailer:
+                stop = buffer.find(trailer, start + before)
+                return None if stop < 0 else stop + len(trailer) - start
+            rule = size_rules.get(code)
+            if rule is None:
+                return -1
+            content_size = rule.size(buffer, start + prefix, end)
+            if content_size is None:
+                return None
+            if content_size < low or (high is not None and content_size > high):
+                return -1
+            return overhead + content_size
+
+        return sizer
+
 
 Decode = Callable[[bytes, "type[Message] | None"], Message]
 
@@ -439,6 +519,8 @@ class FrameStreamParser(StreamParser):
         if not formats:
             raise ValueError("a stream parser needs at least one frame format")
         self._formats = formats
+        # every layout's sizer with its format's decoder, in the order candidates try them
+        self._sizers = tuple((sizer, decode) for codec, decode in formats for sizer in codec.sizers)
         self._pending = b""
         headers = [layout.header for codec, _ in formats for layout in codec.layouts]
         self._headers = tuple(sorted({h for h in headers}, key=len)) if all(headers) else ()
@@ -503,22 +585,21 @@ class FrameStreamParser(StreamParser):
     def _try(self, buffer: bytes, position: int, end: int, found: list[Message]) -> int | None:
         """End of the frame accepted at position, None to wait for bytes, -1 implausible, -2 corrupt."""
         waiting = False
-        for codec, decode in self._formats:
-            for layout in codec.layouts:
-                size = codec.probe(layout, buffer, position, end)
-                if size is None:
-                    waiting = True
-                    continue
-                if size < 0:
-                    continue
-                if position + size > end:
-                    waiting = True
-                    continue
-                try:
-                    found.append(decode(buffer[position : position + size], self.expected))
-                except DecodeError:
-                    return -2
-                return position + size
+        for sizer, decode in self._sizers:
+            size = sizer(buffer, position, end)
+            if size is None:
+                waiting = True
+                continue
+            if size < 0:
+                continue
+            if position + size > end:
+                waiting = True
+                continue
+            try:
+                found.append(decode(buffer[position : position + size], self.expected))
+            except DecodeError:
+                return -2
+            return position + size
         return None if waiting else -1
 
     def pending(self) -> bytes:

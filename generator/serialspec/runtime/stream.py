@@ -9,7 +9,7 @@ valid frame that starts inside it: that frame is delivered, and the candidate co
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from itertools import islice
 from typing import Literal
@@ -39,6 +39,11 @@ class FrameFormat:
     # its checksum fails). The parser uses them before decode_at; frames not here take decode_at.
     fixed: dict[int, tuple[int, Callable[[bytes, int], Message | None]]] = field(default_factory=dict)
     value_ranges: ValueRanges = ()  # a candidate with a value outside its range is no frame
+    # Where the checksum is the frame's last byte, the 8-bit sum of its bytes from `summed[0]` on (inverted when
+    # summed[1]): the frames decoded in runs, by size key: runs[key](frames) gives the messages of frames of that key
+    # laid end to end without their headers, each checked already (their message is their content as unpacked).
+    summed: tuple[int, bool] | None = None
+    runs: dict[int, Callable[[bytes], Iterable[Message]]] = field(default_factory=dict)
 
 
 class _Candidate:
@@ -60,6 +65,10 @@ class _Candidate:
         "byte_at",
         "allowed",
         "wide",
+        "runs",
+        "key_bytes",
+        "sum_from",
+        "sum_table",
     )
 
     def __init__(self, frame_format: FrameFormat) -> None:
@@ -108,6 +117,21 @@ class _Candidate:
             offset, _, _, _, low, high, also = single[0]
             self.byte_at = offset - width
             self.allowed = bytes(low <= value <= high or value == also for value in range(256))
+        # Runs of frames of one size key, checked together (see _run): where each key byte is in the piece, the
+        # first byte the checksum sums there, and a table taking a sum of the piece's bytes to the check byte.
+        summed = frame_format.summed
+        self.runs = frame_format.runs if summed is not None and self.splittable and not self.ranges else {}
+        self.key_bytes = tuple(
+            (offset - width, shift)
+            for offset, shift in ((frame_format.command_offset, 8), (frame_format.length_offset, 0))
+            if offset is not None
+        )
+        self.sum_from, self.sum_table = 0, b""
+        if summed is not None:
+            covered_from, invert = summed
+            constant = sum(header[covered_from:])
+            self.sum_from = max(0, covered_from - width)
+            self.sum_table = bytes((constant + value) & 0xFF ^ (0xFF if invert else 0) for value in range(256))
 
     def plausible(self, buffer: bytes, position: int) -> bool:
         """Every frame-level value with a declared range holds a value in it (or the one also allowed)."""
@@ -137,6 +161,15 @@ class _Candidate:
 # created on every reset and reopen of a bus, so creating one must cost next to nothing.
 _CANDIDATES: dict[int, _Candidate] = {}
 
+# Runs (see StreamParser._run). A run costs a few microseconds whatever its length, so one shorter than
+# _SHORTEST_RUN frames does not pay: after one, or a run refused, no run is tried for the next `backoff` pieces,
+# which doubles each time (up to _LONGEST_RUN) and is back to _SHORTEST_RUN after a run that paid. Where frames of
+# different keys alternate, the stream takes the usual path, at most one try in _LONGEST_RUN pieces lost. A run takes
+# _FIRST_RUN pieces at most at first, and twice as many after each run that took at least half of them.
+_SHORTEST_RUN = 24
+_FIRST_RUN = 32
+_LONGEST_RUN = 1024
+
 
 def _candidate(frame_format: FrameFormat) -> _Candidate:
     found = _CANDIDATES.get(id(frame_format))
@@ -158,6 +191,8 @@ class StreamParser:
         self._single = self._candidates[0] if len(self._candidates) == 1 else None
         self._pending = b""
         self._keep = max(len(f.header) for f in formats) - 1  # a tail that could be the start of a header
+        # runs: pieces the next one takes at most, pieces to wait before it is tried, the wait after the next failure
+        self._block, self._wait, self._backoff = _FIRST_RUN, 0, _SHORTEST_RUN
         self.errors = 0
         self.garbage = 0  # bytes skipped that belonged to no accepted frame
 
@@ -214,14 +249,39 @@ class StreamParser:
         start = 0  # where the byte-by-byte scan would look for the next header
         taken = errors = 0  # bytes in accepted frames; corrupt candidates
         cut = -1  # where the bytes held back begin, once a candidate must wait for more
-        for piece in islice(pieces, 1, None):
+        runs = current.runs
+        last = len(pieces) - 1  # the piece the buffer ends with: never in a run (its frame may be cut)
+        block, retry = self._block, 1 + self._wait  # pieces the next run takes at most; none tried before `retry`
+        walk = enumerate(islice(pieces, 1, None), 1)
+        for index, piece in walk:
             if position >= start:
                 try:  # a piece too short for the key: the general path decides
-                    entry = whole.get(piece[length_at] if command_at < 0 else piece[command_at] << 8 | piece[length_at])
+                    key = piece[length_at] if command_at < 0 else piece[command_at] << 8 | piece[length_at]
                 except IndexError:
-                    entry = None
+                    key = -1
+                entry = whole.get(key)
                 if entry is not None:
                     size, rest, decode = entry
+                    run = runs.get(key) if runs and index >= retry and last - index >= _SHORTEST_RUN else None
+                    if run is not None:  # this frame and the ones after it with the same key, checked together
+                        count, frames = self._run(current, pieces, index, min(last, index + block), key, rest)
+                        if count >= _SHORTEST_RUN:
+                            self._backoff = _SHORTEST_RUN
+                            if count > block // 2:
+                                block = self._block = min(2 * block, _LONGEST_RUN)
+                        else:  # too short to pay, or refused: the usual path for a while
+                            retry = index + max(count, 1) + self._backoff
+                            self._backoff = min(2 * self._backoff, _LONGEST_RUN)
+                            block = self._block = _FIRST_RUN
+                        if count > 1:
+                            found.extend(run(frames))
+                            taken += count * size
+                            # the header of the run's last frame, its end, and the header after it
+                            position += count * width + sum(map(len, pieces[index : index + count - 1])) - width
+                            start = position + size
+                            position += width + len(pieces[index + count - 1])
+                            next(islice(walk, count - 1, count - 1), None)  # the pieces taken
+                            continue
                     after = len(piece)  # bytes between this header and the next one (or the end)
                     # the frame ends before the next header (so the bytes its values are read from are there too)
                     if (
@@ -258,6 +318,7 @@ class StreamParser:
                     if inner >= 0:
                         self.garbage += inner - taken
                         self.errors += errors
+                        self._wait = max(0, retry - len(pieces))
                         return found + self._scan(buffer[inner:])
                     cut = at
                     break
@@ -277,7 +338,44 @@ class StreamParser:
         self._pending = buffer[cut:]
         self.garbage += cut - taken
         self.errors += errors
+        self._wait = max(0, retry - len(pieces))  # carried to the next read's pieces
         return found
+
+    @staticmethod
+    def _run(current: _Candidate, pieces: list[bytes], first: int, stop: int, key: int, rest: int) -> tuple[int, bytes]:
+        """How many of pieces[first:stop] (each after a header), from the first on, begin with a frame of size key
+        `key` whose checksum holds; and those frames end to end, headers left out, for the run decoder.
+
+        The checks are made on all the frames at once, in C: each key byte is a column of the joined frames (a
+        strided slice) matched against its value; each frame's checksum, an 8-bit sum of its bytes, is read from
+        16-bit lanes of one big integer, one per frame, that add up the frame's bytes (no lane can overflow into the
+        next): a column of the frames' bytes in every other byte of a big integer, one column after
+        another added up.
+        """
+        block = pieces[first:stop]
+        count = len(block)
+        frames = b"".join([piece[:rest] for piece in block])
+        if len(frames) != count * rest:  # a piece too short for its frame: the run ends before it
+            count = next(i for i, piece in enumerate(block) if len(piece) < rest)
+            frames = frames[: count * rest]
+        for at, shift in current.key_bytes:
+            column = frames[at::rest]
+            count = min(count, len(column) - len(column.lstrip(bytes((key >> shift & 0xFF,)))))
+        if count < 2:
+            return 0, b""
+        frames = frames[: count * rest]
+        lanes = bytearray(2 * count)
+        total = 0
+        for at in range(current.sum_from, rest - 1):
+            lanes[::2] = frames[at::rest]
+            total += int.from_bytes(lanes, "little")
+        sums = total.to_bytes(2 * count, "little")[::2].translate(current.sum_table)
+        checks = frames[rest - 1 :: rest]
+        if sums != checks:  # the run ends at the first frame whose checksum fails
+            differ = int.from_bytes(sums, "little") ^ int.from_bytes(checks, "little")
+            count = ((differ & -differ).bit_length() - 1) // 8
+            frames = frames[: count * rest]
+        return count, frames
 
     def _take_at(self, buffer: bytes, at: int, current: _Candidate) -> tuple[Message | None, int] | None:
         """The candidate whose header is at `at`: (message, where it ends) when it is a frame; (None, 1) when it is

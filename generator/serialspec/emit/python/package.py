@@ -321,6 +321,7 @@ def classic_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
             if sub_dispatch:
                 dispatchers.append(sub_dispatch | value_arguments(layout))
         fixed = fixed_frames(protocol, layout, decoder_bodies, code)
+        runs = [(key, function["run"]["name"]) for key, _, function in fixed if function.get("run")]
         sub_functions, pickers, sub_entries = subcommand_frames(protocol, layout, decoder_bodies, code)
         whole = whole_frames(layout, [*fixed, *sub_entries])
         rests = rest_frames(protocol, layout, decoder_bodies, code) if whole or fixed else []
@@ -362,6 +363,8 @@ def classic_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
                 "accepted": [accepted(line.removeprefix("if ").removesuffix(":")) for line in range_checks[::2]],
                 "exact": exact,
                 "fixed": [(key, size, function["name"]) for key, size, function in fixed],
+                "runs": runs,
+                "summed": summed_checksum(protocol, layout) if runs else None,
                 "fixed_whole": [(key, size, function["whole_name"]) for key, size, function in fixed],
                 "rest_keys": [rest_key(layout, r, bool(whole)) for r in rests],
                 "whole_frames": whole,
@@ -395,6 +398,7 @@ def classic_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
         "checksum_definition": checksum_definition,
         "directions": directions,
         "frame_functions": frame_functions,
+        "runs": any(d["runs"] for d in directions),
         "whole_functions": whole_functions,
         "whole_pickers": whole_pickers,
         "dispatchers": dispatchers,
@@ -409,8 +413,8 @@ def common_codec_context(protocol: Protocol, code: PackageCode, exports: list[st
     used += "\n".join(line for _, _, lines in code.encoders for line in lines)
     packing = [n for n in ("decode_text", "encode_text", "pack_bits", "unpack_bits") if f"_{n}(" in used]
     return {
-        "packing_imports": sorted([*packing, *(["unpack_runs"] if code.runs else [])]),
-        "runs": sorted(code.runs.items()),
+        "packing_imports": sorted([*packing, *(["unpack_runs"] if code.unpack_runs else [])]),
+        "unpack_runs": sorted(code.unpack_runs.items()),
         "structs": sorted(code.structs.items()),
         "tables": [
             table_context(t) for t in protocol.tables if any(uses_table(m, t.name) for m in protocol.messages())
@@ -729,7 +733,9 @@ def frame_function(
         "whole_lines": whole_frame_lines(protocol, layout, size, lines, summed is not None, known),
     }
     # built in decode() where its whole-frame decoder sums the frame's bytes (one from the values is quicker yet)
-    function["plain"] = plain_frame(protocol, layout, body, code) if summed is None else None
+    plain = plain_frame(protocol, layout, body, code)
+    function["plain"] = plain if summed is None else None
+    function["run"] = run_frames(layout, message, size, plain, code)
     key = length_byte if layout.command_offset is None else (command.code or 0) << 8 | length_byte
     return key, size, function
 
@@ -768,6 +774,15 @@ def exact_whole(lines: Lines, size: int, known: int, code: PackageCode) -> Lines
 _PLAIN = re.compile(r"^return _new\((?P<cls>\w+), (?P<struct>_S_\w+)\.unpack_from\(buf, o\)\)$")
 
 
+def summed_checksum(protocol: Protocol, layout: FrameLayout) -> str | None:
+    """The stream parser's `summed`: (first byte covered, inverted) where the checksum is an 8-bit sum of every byte
+    from there to the last, which it is; None for other checksums."""
+    checksum = protocol.framing.checksum
+    if checksum is None or plain_check(protocol, layout) is None:
+        return None
+    return f"({layout.covered_from}, {checksum.invert})"
+
+
 def plain_check(protocol: Protocol, layout: FrameLayout) -> str | None:
     """decode()'s test that a whole frame `data` (its size known) holds its checksum, where it is one expression
     over the frame's bytes: an 8-bit sum over all but a constant header and the check. None for others."""
@@ -781,6 +796,33 @@ def plain_check(protocol: Protocol, layout: FrameLayout) -> str | None:
     if checksum.invert:  # the covered bytes and their inverted sum add up to 0xff
         return f"not (sum(data) - {sum(header) + 0xFF:#x}) & 0xff"
     return f"not (sum(data){less} - 2 * data[-1]) & 0xff"
+
+
+def run_frames(
+    layout: FrameLayout, message: Message, size: int, plain: tuple[str, str] | None, code: PackageCode
+) -> dict[str, str] | None:
+    """The stream parser's decoder of a run of a plain frame (plain_frame), checked already, laid end to end with
+    their headers left out: one struct over the bytes after the header (the command code, length byte and checksum
+    skipped as padding) and a message built from each tuple it unpacks. None where the content is not the whole of
+    the frame between those."""
+    if plain is None:
+        return None
+    cls, content = plain
+    fmt = code.structs[content]
+    width = len(layout.header)
+    content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
+    if content_offset < width or content_offset + struct.calcsize(fmt) != size - 1:
+        return None
+    lead = content_offset - width
+    after = fmt[0] + (f"{lead}x" if lead else "") + fmt[1:] + "x"
+    frames = code.struct(content.removeprefix("_S_") + "_after_header", after)
+    names = [f.name for f in message.fields]
+    return {
+        "name": "_run" + decoder_name(message).removeprefix("_decode"),
+        "build": code.build_all(cls, names, f"{frames}.iter_unpack(frames)"),
+        "returns": cls,
+        "where": f"{message.key} {message.direction.value}",
+    }
 
 
 def plain_frame(protocol: Protocol, layout: FrameLayout, body: Lines, code: PackageCode) -> tuple[str, str] | None:

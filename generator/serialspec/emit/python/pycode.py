@@ -295,7 +295,7 @@ class PackageCode:
         # classes the decoders build through their slots (see `build`): class name -> field names in order
         self.built: dict[str, list[str]] = {}
         self.member_maps: set[str] = set()  # enum and flag classes whose value -> member map the decoders use
-        self.runs: dict[str, tuple[str, int]] = {}  # unpack_runs tables the decoders use: name -> (format, most)
+        self.unpack_runs: dict[str, tuple[str, int]] = {}  # unpack_runs tables the decoders use: name -> (format, most)
         self._seen_classes: set[str] = set()
         self._straight: dict[Direction, Straight | None] = {}
         for message in protocol.messages():
@@ -511,6 +511,12 @@ class PackageCode:
         of field values, in field order, that the expression `tuples` yields (a struct's iter_unpack)."""
         self.built[class_name] = names
         return f"tuple([_new({class_name}, values) for values in {tuples}])"
+
+    def build_all(self, class_name: str, names: list[str], tuples: str) -> str:
+        """The expression of an iterator of instances of a generated class, one built (as `build` does) from each
+        tuple of field values, in field order, that the expression `tuples` yields, with no Python call per item."""
+        self.built[class_name] = names
+        return f"map(_new, repeat({class_name}), {tuples})"
 
     def enum_value(self, enum: str, raw: str) -> str:
         """The member for a wire value, or the value itself when the spec names none (as enum_or_int does)."""
@@ -761,7 +767,8 @@ class PackageCode:
             lines.append(f"{value} = _unpack_bits(buf, o, n)")
         elif most is not None and most <= _MOST_RUNS:  # a struct per count, made once
             name = f"_RUNS_{'BE' if f.endian == '>' else 'LE'}_{_STRUCT_NAMES[f.item.struct_char]}"
-            self.runs[name] = (f"{f.endian}{f.item.struct_char}", max(most, self.runs.get(name, ("", 0))[1]))
+            known = self.unpack_runs.get(name, ("", 0))[1]
+            self.unpack_runs[name] = (f"{f.endian}{f.item.struct_char}", max(most, known))
             lines.append(f"{value} = {name}[n](buf, o)")
         else:
             lines.append(f"{value} = struct.unpack_from(f'{f.endian}{{n}}{f.item.struct_char}', buf, o)")

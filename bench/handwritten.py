@@ -472,11 +472,14 @@ def mb_decode_registers_reply(frame: bytes) -> MbRegisters:
 
 
 def mb_encode_registers_reply(message: MbRegisters) -> bytes:
-    if not 0 <= message.unit <= 247:
+    if not 0 <= message.unit <= 247 or message.unit.__class__ is bool:
         raise ValueError(f"unit {message.unit} outside 0..247")
     count = len(message.registers)
     if not 1 <= count <= 125:
         raise ValueError(f"{count} registers, 1..125 allowed")
+    for register in message.registers:  # struct.pack checks 0..65535, but takes True and False as numbers
+        if register.__class__ is bool:
+            raise ValueError(f"register {register} is not a number")
     body = struct.pack(f">BBB{count}H", message.unit, MB_READ_HOLDING_REGISTERS, count * 2, *message.registers)
     return body + crc16_modbus(body).to_bytes(2, "little")
 
@@ -517,7 +520,7 @@ def vesc_decode_set_duty(frame: bytes) -> VescSetDuty:
 
 
 def vesc_encode_set_duty(message: VescSetDuty) -> bytes:
-    if not -100000 <= message.duty <= 100000:
+    if not -100000 <= message.duty <= 100000 or message.duty.__class__ is bool:
         raise ValueError(f"duty {message.duty} outside -100000..100000")
     payload = _VESC_SET_DUTY_PAYLOAD.pack(VESC_SET_DUTY, message.duty)
     return b"\x02\x05" + payload + binascii.crc_hqx(payload, 0).to_bytes(2, "big") + b"\x03"

@@ -597,6 +597,8 @@ def _wrap_response(content: bytes, code: int | None, v_id: int, v_error: int) ->
     return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
+_REQUEST = Direction.REQUEST
+_RESPONSE = Direction.RESPONSE
 _ENCODERS: dict[type[Message], Callable[..., bytes]] = {
     PingRequest: _encode_ping_request,
     PingResponse: _encode_ping_response,
@@ -622,7 +624,7 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
     """
     if direction is None:
         raise DecodeError("give the direction: requests and responses cannot be told apart by their first bytes")
-    if direction == 'request':  # a Direction or its value
+    if direction is _REQUEST or direction == 'request':  # a Direction (told by identity, first) or its value
         frame = data if data.__class__ is bytes else bytes(data)
         n = len(frame)
         if n < 9:
@@ -654,7 +656,7 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         except KeyError:
             raise DecodeError(f"unknown command {code!r}") from None
         return decoder(buf, 8, end, v_id)
-    if direction == 'response':  # a Direction or its value
+    if direction is _RESPONSE or direction == 'response':  # a Direction (told by identity, first) or its value
         frame = data if data.__class__ is bytes else bytes(data)
         n = len(frame)
         if n < 9:

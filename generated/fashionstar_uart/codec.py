@@ -92,27 +92,41 @@ _S_FRAME_READBATCHDATARESPONSE = struct.Struct('<2sBBBBBBBBBHHHHHHBBBBBBHhhh')
 _S_FRAME_ROTATEREQUEST = struct.Struct('<2sBBBhHH')
 _S_FRAME_SPINREQUEST = struct.Struct('<2sBBBBHH')
 _S_MONITORRESPONSE_SERVO_ID = struct.Struct('<BHHHHBih')
+_S_MONITORRESPONSE_SERVO_ID_IN_21 = struct.Struct('<4xBHHHHBih1x')
 _S_READBATCHDATARESPONSE_SERVO_ID = struct.Struct('<BBBBBBBHHHHHHBBBBBBHhhh')
+_S_READBATCHDATARESPONSE_SERVO_ID_IN_38 = struct.Struct('<4xBBBBBBBHHHHHHBBBBBBHhhh1x')
 _S_U8 = struct.Struct('<B')
 _S_U8_I16 = struct.Struct('<Bh')
 _S_U8_I16_U16_U16 = struct.Struct('<BhHH')
+_S_U8_I16_U16_U16_IN_12 = struct.Struct('<4xBhHH1x')
 _S_U8_I16_U16_U16_U16_U16 = struct.Struct('<BhHHHH')
 _S_U8_I16_U16_U16_U16_U16_AFTER_HEADER = struct.Struct('<2xBhHHHHx')
+_S_U8_I16_U16_U16_U16_U16_IN_16 = struct.Struct('<4xBhHHHH1x')
 _S_U8_I16_U8 = struct.Struct('<BhB')
+_S_U8_I16_U8_IN_8 = struct.Struct('<4xBhB')
 _S_U8_I32_I16 = struct.Struct('<Bih')
+_S_U8_I32_I16_IN_12 = struct.Struct('<4xBih1x')
 _S_U8_I32_U16_U16_U16_U16 = struct.Struct('<BiHHHH')
 _S_U8_I32_U16_U16_U16_U16_AFTER_HEADER = struct.Struct('<2xBiHHHHx')
+_S_U8_I32_U16_U16_U16_U16_IN_18 = struct.Struct('<4xBiHHHH1x')
 _S_U8_I32_U32_U16 = struct.Struct('<BiIH')
+_S_U8_I32_U32_U16_IN_16 = struct.Struct('<4xBiIH1x')
 _S_U8_I32_U32_U16_U16_U16 = struct.Struct('<BiIHHH')
 _S_U8_I32_U32_U16_U16_U16_AFTER_HEADER = struct.Struct('<2xBiIHHHx')
+_S_U8_I32_U32_U16_U16_U16_IN_20 = struct.Struct('<4xBiIHHH1x')
 _S_U8_U16 = struct.Struct('<BH')
 _S_U8_U16_U8 = struct.Struct('<BHB')
+_S_U8_U16_U8_IN_8 = struct.Struct('<4xBHB')
 _S_U8_U8 = struct.Struct('<BB')
+_S_U8_U8_IN_6 = struct.Struct('<4xBB')
 _S_U8_U8_U16 = struct.Struct('<BBH')
 _S_U8_U8_U16_U16 = struct.Struct('<BBHH')
 _S_U8_U8_U16_U8 = struct.Struct('<BBHB')
+_S_U8_U8_U16_U8_IN_9 = struct.Struct('<4xBBHB')
 _S_U8_U8_U8 = struct.Struct('<BBB')
+_S_U8_U8_U8_IN_7 = struct.Struct('<4xBBB')
 _S_U8_U8_U8_U8 = struct.Struct('<BBBB')
+_S_U8_U8_U8_U8_IN_8 = struct.Struct('<4xBBBB')
 _S_XX2_U8_I16_U16_U16_X = struct.Struct('<2xBhHHx')
 _S_XX2_U8_I16_X = struct.Struct('<2xBhx')
 _S_XX2_U8_I32_I16_X = struct.Struct('<2xBihx')
@@ -881,278 +895,315 @@ def _run_read_mturn_angle_response(frames: bytes) -> Iterator[ReadMturnAngleResp
 
 
 def _whole_ping_request(buf: bytes) -> PingRequest | None:
-    """A whole ping request frame, all of buf, size and header known: None if its checksum fails."""
-    v_servo_id, check = _S_U8_U8.unpack_from(buf, 4)
+    """A whole ping request frame, all of buf, header known: None if its checksum fails (struct.error or None if
+    its size is not the command's)."""
+    v_servo_id, check = _S_U8_U8_IN_6.unpack(buf)
     if (0x60 + v_servo_id) & 0xff != check:
         return None
     return _new(PingRequest, (v_servo_id,))
 
 
 def _whole_reset_user_data_request(buf: bytes) -> ResetUserDataRequest | None:
-    """A whole reset_user_data request frame, all of buf, size and header known: None if its checksum fails."""
-    v_servo_id, check = _S_U8_U8.unpack_from(buf, 4)
+    """A whole reset_user_data request frame, all of buf, header known: None if its checksum fails (struct.error or None if
+    its size is not the command's)."""
+    v_servo_id, check = _S_U8_U8_IN_6.unpack(buf)
     if (0x61 + v_servo_id) & 0xff != check:
         return None
     return _new(ResetUserDataRequest, (v_servo_id,))
 
 
 def _whole_read_data_request(buf: bytes) -> ReadDataRequest | None:
-    """A whole read_data request frame, all of buf, size and header known: None if its checksum fails."""
-    v_servo_id, v_data_id, check = _S_U8_U8_U8.unpack_from(buf, 4)
+    """A whole read_data request frame, all of buf, header known: None if its checksum fails (struct.error or None if
+    its size is not the command's)."""
+    v_servo_id, v_data_id, check = _S_U8_U8_U8_IN_7.unpack(buf)
     if (0x63 + v_servo_id + v_data_id) & 0xff != check:
         return None
     return _new(ReadDataRequest, (v_servo_id, v_data_id))
 
 
 def _whole_read_batch_data_request(buf: bytes) -> ReadBatchDataRequest | None:
-    """A whole read_batch_data request frame, all of buf, size and header known: None if its checksum fails."""
-    v_servo_id, check = _S_U8_U8.unpack_from(buf, 4)
+    """A whole read_batch_data request frame, all of buf, header known: None if its checksum fails (struct.error or None if
+    its size is not the command's)."""
+    v_servo_id, check = _S_U8_U8_IN_6.unpack(buf)
     if (0x64 + v_servo_id) & 0xff != check:
         return None
     return _new(ReadBatchDataRequest, (v_servo_id,))
 
 
 def _whole_write_batch_data_request(buf: bytes) -> WriteBatchDataRequest | None:
-    """A whole write_batch_data request frame, all of buf, size and header known: None if its checksum fails."""
-    if (sum(buf) - 2 * buf[37]) & 0xff:
+    """A whole write_batch_data request frame, all of buf, header known: None if its checksum fails (struct.error or None if
+    its size is not the command's)."""
+    if (sum(buf) - 2 * buf[-1]) & 0xff:
         return None
-    t = _S_READBATCHDATARESPONSE_SERVO_ID.unpack_from(buf, 4)
+    t = _S_READBATCHDATARESPONSE_SERVO_ID_IN_38.unpack(buf)
     v_servo_id = t[0]
     v_user_data = _new(UserData, (t[1], _MEMBERS_ResponseSwitch.get(t[2], t[2]), t[3], t[4], _MEMBERS_BaudrateOption.get(t[5], t[5]), _MEMBERS_StallProtectMode.get(t[6], t[6]), t[7], t[8], t[9], t[10], t[11], t[12], _MEMBERS_Switch.get(t[13], t[13]), t[14], _MEMBERS_LockOnPowerOn.get(t[15], t[15]), _MEMBERS_WheelBrake.get(t[16], t[16]), _MEMBERS_Switch.get(t[17], t[17]), _MEMBERS_Switch.get(t[18], t[18]), t[19], t[20], t[21], t[22]))
     return _new(WriteBatchDataRequest, (v_servo_id, v_user_data))
 
 
 def _whole_rotate_request(buf: bytes) -> RotateRequest | None:
-    """A whole rotate request frame, all of buf, size and header known: None if its checksum fails."""
-    if (sum(buf) - 2 * buf[11]) & 0xff:
+    """A whole rotate request frame, all of buf, header known: None if its checksum fails (struct.error or None if
+    its size is not the command's)."""
+    if (sum(buf) - 2 * buf[-1]) & 0xff:
         return None
-    return _new(RotateRequest, _S_U8_I16_U16_U16.unpack_from(buf, 4))
+    return _new(RotateRequest, _S_U8_I16_U16_U16_IN_12.unpack(buf))
 
 
 def _whole_damping_request(buf: bytes) -> DampingRequest | None:
-    """A whole damping request frame, all of buf, size and header known: None if its checksum fails."""
-    v_servo_id, v_power, check = _S_U8_U16_U8.unpack_from(buf, 4)
+    """A whole damping request frame, all of buf, header known: None if its checksum fails (struct.error or None if
+    its size is not the command's)."""
+    v_servo_id, v_power, check = _S_U8_U16_U8_IN_8.unpack(buf)
     if (0x6a + v_servo_id + (v_power & 0xff) + (v_power >> 8 & 0xff)) & 0xff != check:
         return None
     return _new(DampingRequest, (v_servo_id, v_power))
 
 
 def _whole_read_angle_request(buf: bytes) -> ReadAngleRequest | None:
-    """A whole read_angle request frame, all of buf, size and header known: None if its checksum fails."""
-    v_servo_id, check = _S_U8_U8.unpack_from(buf, 4)
+    """A whole read_angle request frame, all of buf, header known: None if its checksum fails (struct.error or None if
+    its size is not the command's)."""
+    v_servo_id, check = _S_U8_U8_IN_6.unpack(buf)
     if (0x69 + v_servo_id) & 0xff != check:
         return None
     return _new(ReadAngleRequest, (v_servo_id,))
 
 
 def _whole_move_by_interval_request(buf: bytes) -> MoveByIntervalRequest | None:
-    """A whole move_by_interval request frame, all of buf, size and header known: None if its checksum fails."""
-    if (sum(buf) - 2 * buf[15]) & 0xff:
+    """A whole move_by_interval request frame, all of buf, header known: None if its checksum fails (struct.error or None if
+    its size is not the command's)."""
+    if (sum(buf) - 2 * buf[-1]) & 0xff:
         return None
-    return _new(MoveByIntervalRequest, _S_U8_I16_U16_U16_U16_U16.unpack_from(buf, 4))
+    return _new(MoveByIntervalRequest, _S_U8_I16_U16_U16_U16_U16_IN_16.unpack(buf))
 
 
 def _whole_move_by_velocity_request(buf: bytes) -> MoveByVelocityRequest | None:
-    """A whole move_by_velocity request frame, all of buf, size and header known: None if its checksum fails."""
-    if (sum(buf) - 2 * buf[15]) & 0xff:
+    """A whole move_by_velocity request frame, all of buf, header known: None if its checksum fails (struct.error or None if
+    its size is not the command's)."""
+    if (sum(buf) - 2 * buf[-1]) & 0xff:
         return None
-    return _new(MoveByVelocityRequest, _S_U8_I16_U16_U16_U16_U16.unpack_from(buf, 4))
+    return _new(MoveByVelocityRequest, _S_U8_I16_U16_U16_U16_U16_IN_16.unpack(buf))
 
 
 def _whole_move_mturn_request(buf: bytes) -> MoveMturnRequest | None:
-    """A whole move_mturn request frame, all of buf, size and header known: None if its checksum fails."""
-    if (sum(buf) - 2 * buf[15]) & 0xff:
+    """A whole move_mturn request frame, all of buf, header known: None if its checksum fails (struct.error or None if
+    its size is not the command's)."""
+    if (sum(buf) - 2 * buf[-1]) & 0xff:
         return None
-    return _new(MoveMturnRequest, _S_U8_I32_U32_U16.unpack_from(buf, 4))
+    return _new(MoveMturnRequest, _S_U8_I32_U32_U16_IN_16.unpack(buf))
 
 
 def _whole_move_mturn_by_interval_request(buf: bytes) -> MoveMturnByIntervalRequest | None:
-    """A whole move_mturn_by_interval request frame, all of buf, size and header known: None if its checksum fails."""
-    if (sum(buf) - 2 * buf[19]) & 0xff:
+    """A whole move_mturn_by_interval request frame, all of buf, header known: None if its checksum fails (struct.error or None if
+    its size is not the command's)."""
+    if (sum(buf) - 2 * buf[-1]) & 0xff:
         return None
-    return _new(MoveMturnByIntervalRequest, _S_U8_I32_U32_U16_U16_U16.unpack_from(buf, 4))
+    return _new(MoveMturnByIntervalRequest, _S_U8_I32_U32_U16_U16_U16_IN_20.unpack(buf))
 
 
 def _whole_move_mturn_by_velocity_request(buf: bytes) -> MoveMturnByVelocityRequest | None:
-    """A whole move_mturn_by_velocity request frame, all of buf, size and header known: None if its checksum fails."""
-    if (sum(buf) - 2 * buf[17]) & 0xff:
+    """A whole move_mturn_by_velocity request frame, all of buf, header known: None if its checksum fails (struct.error or None if
+    its size is not the command's)."""
+    if (sum(buf) - 2 * buf[-1]) & 0xff:
         return None
-    return _new(MoveMturnByVelocityRequest, _S_U8_I32_U16_U16_U16_U16.unpack_from(buf, 4))
+    return _new(MoveMturnByVelocityRequest, _S_U8_I32_U16_U16_U16_U16_IN_18.unpack(buf))
 
 
 def _whole_read_mturn_angle_request(buf: bytes) -> ReadMturnAngleRequest | None:
-    """A whole read_mturn_angle request frame, all of buf, size and header known: None if its checksum fails."""
-    v_servo_id, check = _S_U8_U8.unpack_from(buf, 4)
+    """A whole read_mturn_angle request frame, all of buf, header known: None if its checksum fails (struct.error or None if
+    its size is not the command's)."""
+    v_servo_id, check = _S_U8_U8_IN_6.unpack(buf)
     if (0x6f + v_servo_id) & 0xff != check:
         return None
     return _new(ReadMturnAngleRequest, (v_servo_id,))
 
 
 def _whole_reset_mturn_angle_request(buf: bytes) -> ResetMturnAngleRequest | None:
-    """A whole reset_mturn_angle request frame, all of buf, size and header known: None if its checksum fails."""
-    v_servo_id, check = _S_U8_U8.unpack_from(buf, 4)
+    """A whole reset_mturn_angle request frame, all of buf, header known: None if its checksum fails (struct.error or None if
+    its size is not the command's)."""
+    v_servo_id, check = _S_U8_U8_IN_6.unpack(buf)
     if (0x70 + v_servo_id) & 0xff != check:
         return None
     return _new(ResetMturnAngleRequest, (v_servo_id,))
 
 
 def _whole_begin_async_request(buf: bytes) -> BeginAsyncRequest | None:
-    """A whole begin_async request frame, all of buf, size and header known: None if its checksum fails."""
-    if (sum(buf) - 2 * buf[4]) & 0xff:
+    """A whole begin_async request frame, all of buf, header known: None if its checksum fails (struct.error or None if
+    its size is not the command's)."""
+    if len(buf) != 5:
+        return None
+    if (sum(buf) - 2 * buf[-1]) & 0xff:
         return None
     return _new(BeginAsyncRequest, ())
 
 
 def _whole_end_async_request(buf: bytes) -> EndAsyncRequest | None:
-    """A whole end_async request frame, all of buf, size and header known: None if its checksum fails."""
-    v_mode, check = _S_U8_U8.unpack_from(buf, 4)
+    """A whole end_async request frame, all of buf, header known: None if its checksum fails (struct.error or None if
+    its size is not the command's)."""
+    v_mode, check = _S_U8_U8_IN_6.unpack(buf)
     if (0x72 + v_mode) & 0xff != check:
         return None
     return _new(EndAsyncRequest, (_MEMBERS_AsyncEnd.get(v_mode, v_mode),))
 
 
 def _whole_monitor_request(buf: bytes) -> MonitorRequest | None:
-    """A whole monitor request frame, all of buf, size and header known: None if its checksum fails."""
-    v_servo_id, check = _S_U8_U8.unpack_from(buf, 4)
+    """A whole monitor request frame, all of buf, header known: None if its checksum fails (struct.error or None if
+    its size is not the command's)."""
+    v_servo_id, check = _S_U8_U8_IN_6.unpack(buf)
     if (0x75 + v_servo_id) & 0xff != check:
         return None
     return _new(MonitorRequest, (v_servo_id,))
 
 
 def _whole_stop_on_control_mode_request(buf: bytes) -> StopOnControlModeRequest | None:
-    """A whole stop_on_control_mode request frame, all of buf, size and header known: None if its checksum fails."""
-    v_servo_id, v_method, v_power, check = _S_U8_U8_U16_U8.unpack_from(buf, 4)
+    """A whole stop_on_control_mode request frame, all of buf, header known: None if its checksum fails (struct.error or None if
+    its size is not the command's)."""
+    v_servo_id, v_method, v_power, check = _S_U8_U8_U16_U8_IN_9.unpack(buf)
     if (0x7a + v_servo_id + v_method + (v_power & 0xff) + (v_power >> 8 & 0xff)) & 0xff != check:
         return None
     return _new(StopOnControlModeRequest, (v_servo_id, _MEMBERS_StopMethod.get(v_method, v_method), v_power))
 
 
 def _whole_ping_response(buf: bytes) -> PingResponse | None:
-    """A whole ping response frame, all of buf, size and header known: None if its checksum fails."""
-    v_servo_id, check = _S_U8_U8.unpack_from(buf, 4)
+    """A whole ping response frame, all of buf, header known: None if its checksum fails (struct.error or None if
+    its size is not the command's)."""
+    v_servo_id, check = _S_U8_U8_IN_6.unpack(buf)
     if (0x23 + v_servo_id) & 0xff != check:
         return None
     return _new(PingResponse, (v_servo_id,))
 
 
 def _whole_reset_user_data_response(buf: bytes) -> ResetUserDataResponse | None:
-    """A whole reset_user_data response frame, all of buf, size and header known: None if its checksum fails."""
-    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, 4)
+    """A whole reset_user_data response frame, all of buf, header known: None if its checksum fails (struct.error or None if
+    its size is not the command's)."""
+    v_servo_id, v_result, check = _S_U8_U8_U8_IN_7.unpack(buf)
     if (0x25 + v_servo_id + v_result) & 0xff != check:
         return None
     return _new(ResetUserDataResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
 
 
 def _whole_write_data_response(buf: bytes) -> WriteDataResponse | None:
-    """A whole write_data response frame, all of buf, size and header known: None if its checksum fails."""
-    v_servo_id, v_data_id, v_result, check = _S_U8_U8_U8_U8.unpack_from(buf, 4)
+    """A whole write_data response frame, all of buf, header known: None if its checksum fails (struct.error or None if
+    its size is not the command's)."""
+    v_servo_id, v_data_id, v_result, check = _S_U8_U8_U8_U8_IN_8.unpack(buf)
     if (0x28 + v_servo_id + v_data_id + v_result) & 0xff != check:
         return None
     return _new(WriteDataResponse, (v_servo_id, v_data_id, _MEMBERS_Result.get(v_result, v_result)))
 
 
 def _whole_read_batch_data_response(buf: bytes) -> ReadBatchDataResponse | None:
-    """A whole read_batch_data response frame, all of buf, size and header known: None if its checksum fails."""
-    if (sum(buf) - 2 * buf[37]) & 0xff:
+    """A whole read_batch_data response frame, all of buf, header known: None if its checksum fails (struct.error or None if
+    its size is not the command's)."""
+    if (sum(buf) - 2 * buf[-1]) & 0xff:
         return None
-    t = _S_READBATCHDATARESPONSE_SERVO_ID.unpack_from(buf, 4)
+    t = _S_READBATCHDATARESPONSE_SERVO_ID_IN_38.unpack(buf)
     v_servo_id = t[0]
     v_user_data = _new(UserData, (t[1], _MEMBERS_ResponseSwitch.get(t[2], t[2]), t[3], t[4], _MEMBERS_BaudrateOption.get(t[5], t[5]), _MEMBERS_StallProtectMode.get(t[6], t[6]), t[7], t[8], t[9], t[10], t[11], t[12], _MEMBERS_Switch.get(t[13], t[13]), t[14], _MEMBERS_LockOnPowerOn.get(t[15], t[15]), _MEMBERS_WheelBrake.get(t[16], t[16]), _MEMBERS_Switch.get(t[17], t[17]), _MEMBERS_Switch.get(t[18], t[18]), t[19], t[20], t[21], t[22]))
     return _new(ReadBatchDataResponse, (v_servo_id, v_user_data))
 
 
 def _whole_write_batch_data_response(buf: bytes) -> WriteBatchDataResponse | None:
-    """A whole write_batch_data response frame, all of buf, size and header known: None if its checksum fails."""
-    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, 4)
+    """A whole write_batch_data response frame, all of buf, header known: None if its checksum fails (struct.error or None if
+    its size is not the command's)."""
+    v_servo_id, v_result, check = _S_U8_U8_U8_IN_7.unpack(buf)
     if (0x29 + v_servo_id + v_result) & 0xff != check:
         return None
     return _new(WriteBatchDataResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
 
 
 def _whole_spin_response(buf: bytes) -> SpinResponse | None:
-    """A whole spin response frame, all of buf, size and header known: None if its checksum fails."""
-    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, 4)
+    """A whole spin response frame, all of buf, header known: None if its checksum fails (struct.error or None if
+    its size is not the command's)."""
+    v_servo_id, v_result, check = _S_U8_U8_U8_IN_7.unpack(buf)
     if (0x2a + v_servo_id + v_result) & 0xff != check:
         return None
     return _new(SpinResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
 
 
 def _whole_rotate_response(buf: bytes) -> RotateResponse | None:
-    """A whole rotate response frame, all of buf, size and header known: None if its checksum fails."""
-    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, 4)
+    """A whole rotate response frame, all of buf, header known: None if its checksum fails (struct.error or None if
+    its size is not the command's)."""
+    v_servo_id, v_result, check = _S_U8_U8_U8_IN_7.unpack(buf)
     if (0x2b + v_servo_id + v_result) & 0xff != check:
         return None
     return _new(RotateResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
 
 
 def _whole_damping_response(buf: bytes) -> DampingResponse | None:
-    """A whole damping response frame, all of buf, size and header known: None if its checksum fails."""
-    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, 4)
+    """A whole damping response frame, all of buf, header known: None if its checksum fails (struct.error or None if
+    its size is not the command's)."""
+    v_servo_id, v_result, check = _S_U8_U8_U8_IN_7.unpack(buf)
     if (0x2c + v_servo_id + v_result) & 0xff != check:
         return None
     return _new(DampingResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
 
 
 def _whole_read_angle_response(buf: bytes) -> ReadAngleResponse | None:
-    """A whole read_angle response frame, all of buf, size and header known: None if its checksum fails."""
-    v_servo_id, v_angle, check = _S_U8_I16_U8.unpack_from(buf, 4)
+    """A whole read_angle response frame, all of buf, header known: None if its checksum fails (struct.error or None if
+    its size is not the command's)."""
+    v_servo_id, v_angle, check = _S_U8_I16_U8_IN_8.unpack(buf)
     if (0x2e + v_servo_id + (v_angle & 0xff) + (v_angle >> 8 & 0xff)) & 0xff != check:
         return None
     return _new(ReadAngleResponse, (v_servo_id, v_angle))
 
 
 def _whole_move_by_interval_response(buf: bytes) -> MoveByIntervalResponse | None:
-    """A whole move_by_interval response frame, all of buf, size and header known: None if its checksum fails."""
-    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, 4)
+    """A whole move_by_interval response frame, all of buf, header known: None if its checksum fails (struct.error or None if
+    its size is not the command's)."""
+    v_servo_id, v_result, check = _S_U8_U8_U8_IN_7.unpack(buf)
     if (0x2e + v_servo_id + v_result) & 0xff != check:
         return None
     return _new(MoveByIntervalResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
 
 
 def _whole_move_by_velocity_response(buf: bytes) -> MoveByVelocityResponse | None:
-    """A whole move_by_velocity response frame, all of buf, size and header known: None if its checksum fails."""
-    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, 4)
+    """A whole move_by_velocity response frame, all of buf, header known: None if its checksum fails (struct.error or None if
+    its size is not the command's)."""
+    v_servo_id, v_result, check = _S_U8_U8_U8_IN_7.unpack(buf)
     if (0x2f + v_servo_id + v_result) & 0xff != check:
         return None
     return _new(MoveByVelocityResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
 
 
 def _whole_move_mturn_response(buf: bytes) -> MoveMturnResponse | None:
-    """A whole move_mturn response frame, all of buf, size and header known: None if its checksum fails."""
-    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, 4)
+    """A whole move_mturn response frame, all of buf, header known: None if its checksum fails (struct.error or None if
+    its size is not the command's)."""
+    v_servo_id, v_result, check = _S_U8_U8_U8_IN_7.unpack(buf)
     if (0x30 + v_servo_id + v_result) & 0xff != check:
         return None
     return _new(MoveMturnResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
 
 
 def _whole_move_mturn_by_interval_response(buf: bytes) -> MoveMturnByIntervalResponse | None:
-    """A whole move_mturn_by_interval response frame, all of buf, size and header known: None if its checksum fails."""
-    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, 4)
+    """A whole move_mturn_by_interval response frame, all of buf, header known: None if its checksum fails (struct.error or None if
+    its size is not the command's)."""
+    v_servo_id, v_result, check = _S_U8_U8_U8_IN_7.unpack(buf)
     if (0x31 + v_servo_id + v_result) & 0xff != check:
         return None
     return _new(MoveMturnByIntervalResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
 
 
 def _whole_move_mturn_by_velocity_response(buf: bytes) -> MoveMturnByVelocityResponse | None:
-    """A whole move_mturn_by_velocity response frame, all of buf, size and header known: None if its checksum fails."""
-    v_servo_id, v_result, check = _S_U8_U8_U8.unpack_from(buf, 4)
+    """A whole move_mturn_by_velocity response frame, all of buf, header known: None if its checksum fails (struct.error or None if
+    its size is not the command's)."""
+    v_servo_id, v_result, check = _S_U8_U8_U8_IN_7.unpack(buf)
     if (0x32 + v_servo_id + v_result) & 0xff != check:
         return None
     return _new(MoveMturnByVelocityResponse, (v_servo_id, _MEMBERS_Result.get(v_result, v_result)))
 
 
 def _whole_read_mturn_angle_response(buf: bytes) -> ReadMturnAngleResponse | None:
-    """A whole read_mturn_angle response frame, all of buf, size and header known: None if its checksum fails."""
-    if (sum(buf) - 2 * buf[11]) & 0xff:
+    """A whole read_mturn_angle response frame, all of buf, header known: None if its checksum fails (struct.error or None if
+    its size is not the command's)."""
+    if (sum(buf) - 2 * buf[-1]) & 0xff:
         return None
-    return _new(ReadMturnAngleResponse, _S_U8_I32_I16.unpack_from(buf, 4))
+    return _new(ReadMturnAngleResponse, _S_U8_I32_I16_IN_12.unpack(buf))
 
 
 def _whole_monitor_response(buf: bytes) -> MonitorResponse | None:
-    """A whole monitor response frame, all of buf, size and header known: None if its checksum fails."""
-    if (sum(buf) - 2 * buf[20]) & 0xff:
+    """A whole monitor response frame, all of buf, header known: None if its checksum fails (struct.error or None if
+    its size is not the command's)."""
+    if (sum(buf) - 2 * buf[-1]) & 0xff:
         return None
-    v_servo_id, v_voltage, v_current, v_power, v_temperature, v_status, v_angle, v_turns = _S_MONITORRESPONSE_SERVO_ID.unpack_from(buf, 4)
+    v_servo_id, v_voltage, v_current, v_power, v_temperature, v_status, v_angle, v_turns = _S_MONITORRESPONSE_SERVO_ID_IN_21.unpack(buf)
     v_status_flags = _MEMBERS_ServoStatus.get(v_status)
     if v_status_flags is None:
         v_status_flags = ServoStatus(v_status)
@@ -1854,20 +1905,20 @@ _REQUEST_FIXED: dict[int, tuple[int, Callable[[bytes, int], Message | None]]] = 
 
 # The same frames for decode(), by their first bytes (header, command code, length byte): frame size, decoder, and
 # for a frame whose message is its content as one struct unpacks it, that unpack and the class (decode() builds it).
-_REQUEST_WHOLE: dict[bytes, tuple[int, Callable[[bytes], Message | None], Callable[[bytes, int], tuple[int, ...]] | None, type[Message]]] = {
+_REQUEST_WHOLE: dict[bytes, tuple[int, Callable[[bytes], Message | None], Callable[[bytes], tuple[int, ...]] | None, type[Message]]] = {
     b'\x12L\x01\x01': (6, _whole_ping_request, None, Message),
     b'\x12L\x02\x01': (6, _whole_reset_user_data_request, None, Message),
     b'\x12L\x03\x02': (7, _whole_read_data_request, None, Message),
     b'\x12L\x05\x01': (6, _whole_read_batch_data_request, None, Message),
     b'\x12L\x06!': (38, _whole_write_batch_data_request, None, Message),
-    b'\x12L\x08\x07': (12, _whole_rotate_request, _S_U8_I16_U16_U16.unpack_from, RotateRequest),
+    b'\x12L\x08\x07': (12, _whole_rotate_request, _S_U8_I16_U16_U16_IN_12.unpack, RotateRequest),
     b'\x12L\t\x03': (8, _whole_damping_request, None, Message),
     b'\x12L\n\x01': (6, _whole_read_angle_request, None, Message),
-    b'\x12L\x0b\x0b': (16, _whole_move_by_interval_request, _S_U8_I16_U16_U16_U16_U16.unpack_from, MoveByIntervalRequest),
-    b'\x12L\x0c\x0b': (16, _whole_move_by_velocity_request, _S_U8_I16_U16_U16_U16_U16.unpack_from, MoveByVelocityRequest),
-    b'\x12L\r\x0b': (16, _whole_move_mturn_request, _S_U8_I32_U32_U16.unpack_from, MoveMturnRequest),
-    b'\x12L\x0e\x0f': (20, _whole_move_mturn_by_interval_request, _S_U8_I32_U32_U16_U16_U16.unpack_from, MoveMturnByIntervalRequest),
-    b'\x12L\x0f\r': (18, _whole_move_mturn_by_velocity_request, _S_U8_I32_U16_U16_U16_U16.unpack_from, MoveMturnByVelocityRequest),
+    b'\x12L\x0b\x0b': (16, _whole_move_by_interval_request, _S_U8_I16_U16_U16_U16_U16_IN_16.unpack, MoveByIntervalRequest),
+    b'\x12L\x0c\x0b': (16, _whole_move_by_velocity_request, _S_U8_I16_U16_U16_U16_U16_IN_16.unpack, MoveByVelocityRequest),
+    b'\x12L\r\x0b': (16, _whole_move_mturn_request, _S_U8_I32_U32_U16_IN_16.unpack, MoveMturnRequest),
+    b'\x12L\x0e\x0f': (20, _whole_move_mturn_by_interval_request, _S_U8_I32_U32_U16_U16_U16_IN_20.unpack, MoveMturnByIntervalRequest),
+    b'\x12L\x0f\r': (18, _whole_move_mturn_by_velocity_request, _S_U8_I32_U16_U16_U16_U16_IN_18.unpack, MoveMturnByVelocityRequest),
     b'\x12L\x10\x01': (6, _whole_read_mturn_angle_request, None, Message),
     b'\x12L\x11\x01': (6, _whole_reset_mturn_angle_request, None, Message),
     b'\x12L\x12\x00': (5, _whole_begin_async_request, None, Message),
@@ -1950,7 +2001,7 @@ _RESPONSE_FIXED: dict[int, tuple[int, Callable[[bytes, int], Message | None]]] =
 
 # The same frames for decode(), by their first bytes (header, command code, length byte): frame size, decoder, and
 # for a frame whose message is its content as one struct unpacks it, that unpack and the class (decode() builds it).
-_RESPONSE_WHOLE: dict[bytes, tuple[int, Callable[[bytes], Message | None], Callable[[bytes, int], tuple[int, ...]] | None, type[Message]]] = {
+_RESPONSE_WHOLE: dict[bytes, tuple[int, Callable[[bytes], Message | None], Callable[[bytes], tuple[int, ...]] | None, type[Message]]] = {
     b'\x05\x1c\x01\x01': (6, _whole_ping_response, None, Message),
     b'\x05\x1c\x02\x02': (7, _whole_reset_user_data_response, None, Message),
     b'\x05\x1c\x04\x03': (8, _whole_write_data_response, None, Message),
@@ -1965,7 +2016,7 @@ _RESPONSE_WHOLE: dict[bytes, tuple[int, Callable[[bytes], Message | None], Calla
     b'\x05\x1c\r\x02': (7, _whole_move_mturn_response, None, Message),
     b'\x05\x1c\x0e\x02': (7, _whole_move_mturn_by_interval_response, None, Message),
     b'\x05\x1c\x0f\x02': (7, _whole_move_mturn_by_velocity_response, None, Message),
-    b'\x05\x1c\x10\x07': (12, _whole_read_mturn_angle_response, _S_U8_I32_I16.unpack_from, ReadMturnAngleResponse),
+    b'\x05\x1c\x10\x07': (12, _whole_read_mturn_angle_response, _S_U8_I32_I16_IN_12.unpack, ReadMturnAngleResponse),
     b'\x05\x1c\x16\x10': (21, _whole_monitor_response, None, Message),
 }
 
@@ -2082,14 +2133,17 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
     """
     if direction is _REQUEST:
         fixed = _REQUEST_WHOLE.get(data[:4])  # no key is shorter: a short frame matches none
-        if fixed is not None and fixed[0] == len(data):
+        if fixed is not None:
             _, whole, unpack, cls = fixed
-            if unpack is None:
-                message = whole(data)
-                if message is not None:
-                    return message
-            elif not (sum(data) - 2 * data[-1]) & 0xff:  # its message is its content as unpacked: built here, no call
-                return _new(cls, unpack(data, 4))
+            try:  # each unpacks the whole frame, so one of another size raises struct.error: no size compared here
+                if unpack is None:
+                    message = whole(data)
+                    if message is not None:
+                        return message
+                elif not (sum(data) - 2 * data[-1]) & 0xff:  # its message is its content as unpacked: built here, no call
+                    return _new(cls, unpack(data))
+            except struct.error:
+                pass  # not the size its first bytes say: the checks below say what is wrong
         n = len(data)
         if n < 5:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (5 bytes)")
@@ -2108,14 +2162,17 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         return decoder(data, 4, n - 1)
     if direction is _RESPONSE:
         fixed = _RESPONSE_WHOLE.get(data[:4])  # no key is shorter: a short frame matches none
-        if fixed is not None and fixed[0] == len(data):
+        if fixed is not None:
             _, whole, unpack, cls = fixed
-            if unpack is None:
-                message = whole(data)
-                if message is not None:
-                    return message
-            elif not (sum(data) - 2 * data[-1]) & 0xff:  # its message is its content as unpacked: built here, no call
-                return _new(cls, unpack(data, 4))
+            try:  # each unpacks the whole frame, so one of another size raises struct.error: no size compared here
+                if unpack is None:
+                    message = whole(data)
+                    if message is not None:
+                        return message
+                elif not (sum(data) - 2 * data[-1]) & 0xff:  # its message is its content as unpacked: built here, no call
+                    return _new(cls, unpack(data))
+            except struct.error:
+                pass  # not the size its first bytes say: the checks below say what is wrong
         n = len(data)
         if n < 5:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (5 bytes)")

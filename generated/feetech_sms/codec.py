@@ -163,8 +163,7 @@ def _frame_reset_request(buf: bytes, start: int) -> ResetRequest | None:
 
 def _whole_ping_request(buf: bytes) -> PingRequest | None:
     """A whole ping request frame, all of buf, size and header known: None if its checksum fails."""
-    check = buf[5]
-    if ~(sum(buf) - 0x1fe - check) & 0xff != check:
+    if (sum(buf) - 0x2fd) & 0xff:
         return None
     id = buf[2]
     return _new(PingRequest, (id,))
@@ -181,8 +180,7 @@ def _whole_read_request(buf: bytes) -> ReadRequest | None:
 
 def _whole_action_request(buf: bytes) -> ActionRequest | None:
     """A whole action request frame, all of buf, size and header known: None if its checksum fails."""
-    check = buf[5]
-    if ~(sum(buf) - 0x1fe - check) & 0xff != check:
+    if (sum(buf) - 0x2fd) & 0xff:
         return None
     id = buf[2]
     return _new(ActionRequest, (id,))
@@ -190,8 +188,7 @@ def _whole_action_request(buf: bytes) -> ActionRequest | None:
 
 def _whole_reset_request(buf: bytes) -> ResetRequest | None:
     """A whole reset request frame, all of buf, size and header known: None if its checksum fails."""
-    check = buf[5]
-    if ~(sum(buf) - 0x1fe - check) & 0xff != check:
+    if (sum(buf) - 0x2fd) & 0xff:
         return None
     id = buf[2]
     return _new(ResetRequest, (id,))
@@ -199,8 +196,7 @@ def _whole_reset_request(buf: bytes) -> ResetRequest | None:
 
 def _whole_write_request(buf: bytes) -> WriteRequest | None:
     """A whole write request frame, all of buf, its size and first bytes known: None if its checksum fails."""
-    check = buf[-1]
-    if ~(sum(buf) - 0x1fe - check) & 0xff != check:
+    if (sum(buf) - 0x2fd) & 0xff:  # inverted: the bytes and the check sum to 0xff
         return None
     id = buf[2]
     v_address = buf[5]
@@ -210,8 +206,7 @@ def _whole_write_request(buf: bytes) -> WriteRequest | None:
 
 def _whole_reg_write_request(buf: bytes) -> RegWriteRequest | None:
     """A whole reg_write request frame, all of buf, its size and first bytes known: None if its checksum fails."""
-    check = buf[-1]
-    if ~(sum(buf) - 0x1fe - check) & 0xff != check:
+    if (sum(buf) - 0x2fd) & 0xff:  # inverted: the bytes and the check sum to 0xff
         return None
     id = buf[2]
     v_address = buf[5]
@@ -224,7 +219,7 @@ def _encode_ping_request(m: PingRequest) -> bytes:
     if not 0 <= m_id <= 254 or m_id.__class__ is bool:
         raise out_of_range('ping request', 'id', m_id, 0, 253, 254)
     body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m_id, 2, 1)
-    return body + _BYTES[~sum(body[2:]) & 0xff]
+    return body + _BYTES[~(sum(body) - 0x1fe) & 0xff]
 
 
 def _encode_read_request(m: ReadRequest) -> bytes:
@@ -238,7 +233,7 @@ def _encode_read_request(m: ReadRequest) -> bytes:
     if not 1 <= m_length <= 250 or m_length.__class__ is bool:
         raise out_of_range('read request', 'length', m_length, 1, 250)
     body = _S_B2_U8_U8_U8_U8_U8.pack(b'\xff\xff', m_id, 4, 2, m_address, m_length)
-    return body + _BYTES[~sum(body[2:]) & 0xff]
+    return body + _BYTES[~(sum(body) - 0x1fe) & 0xff]
 
 
 def _encode_write_request(m: WriteRequest) -> bytes:
@@ -255,7 +250,7 @@ def _encode_write_request(m: WriteRequest) -> bytes:
     if n > 255:
         raise EncodeError(f'content of {n - 2} bytes does not fit the length field')
     body = _S_B2_U8_U8_U8_U8.pack(b'\xff\xff', m_id, n, 3, m_address) + content
-    return body + _BYTES[~sum(body[2:]) & 0xff]
+    return body + _BYTES[~(sum(body) - 0x1fe) & 0xff]
 
 
 def _encode_reg_write_request(m: RegWriteRequest) -> bytes:
@@ -272,7 +267,7 @@ def _encode_reg_write_request(m: RegWriteRequest) -> bytes:
     if n > 255:
         raise EncodeError(f'content of {n - 2} bytes does not fit the length field')
     body = _S_B2_U8_U8_U8_U8.pack(b'\xff\xff', m_id, n, 4, m_address) + content
-    return body + _BYTES[~sum(body[2:]) & 0xff]
+    return body + _BYTES[~(sum(body) - 0x1fe) & 0xff]
 
 
 def _encode_action_request(m: ActionRequest) -> bytes:
@@ -280,7 +275,7 @@ def _encode_action_request(m: ActionRequest) -> bytes:
     if not 0 <= m_id <= 254 or m_id.__class__ is bool:
         raise out_of_range('action request', 'id', m_id, 0, 253, 254)
     body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m_id, 2, 5)
-    return body + _BYTES[~sum(body[2:]) & 0xff]
+    return body + _BYTES[~(sum(body) - 0x1fe) & 0xff]
 
 
 def _encode_reset_request(m: ResetRequest) -> bytes:
@@ -288,7 +283,7 @@ def _encode_reset_request(m: ResetRequest) -> bytes:
     if not 0 <= m_id <= 254 or m_id.__class__ is bool:
         raise out_of_range('reset request', 'id', m_id, 0, 253, 254)
     body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m_id, 2, 6)
-    return body + _BYTES[~sum(body[2:]) & 0xff]
+    return body + _BYTES[~(sum(body) - 0x1fe) & 0xff]
 
 
 def _encode_sync_read_request(m: SyncReadRequest) -> bytes:
@@ -312,7 +307,7 @@ def _encode_sync_read_request(m: SyncReadRequest) -> bytes:
     if n > 255:
         raise EncodeError(f'content of {n - 2} bytes does not fit the length field')
     body = _S_B2_U8_U8_U8_U8_U8.pack(b'\xff\xff', m_id, n, 130, m_address, m_length) + content
-    return body + _BYTES[~sum(body[2:]) & 0xff]
+    return body + _BYTES[~(sum(body) - 0x1fe) & 0xff]
 
 
 def _encode_sync_write_request(m: SyncWriteRequest) -> bytes:
@@ -341,7 +336,7 @@ def _encode_sync_write_request(m: SyncWriteRequest) -> bytes:
     if n > 255:
         raise EncodeError(f'content of {n - 2} bytes does not fit the length field')
     body = _S_B2_U8_U8_U8_U8_U8.pack(b'\xff\xff', m_id, n, 131, m_address, v_data_length) + content
-    return body + _BYTES[~sum(body[2:]) & 0xff]
+    return body + _BYTES[~(sum(body) - 0x1fe) & 0xff]
 
 
 def _encode_reply_response(m: ReplyResponse) -> bytes:
@@ -358,7 +353,7 @@ def _encode_reply_response(m: ReplyResponse) -> bytes:
     if n > 255:
         raise EncodeError(f'content of {n - 2} bytes does not fit the length field')
     body = _S_B2_U8_U8_U8.pack(b'\xff\xff', m_id, n, m_error) + content
-    return body + _BYTES[~sum(body[2:]) & 0xff]
+    return body + _BYTES[~(sum(body) - 0x1fe) & 0xff]
 
 
 _REQUEST_DECODERS: dict[int | None, Callable[..., Message]] = {
@@ -390,14 +385,14 @@ _REQUEST_FIXED: dict[int, tuple[int, Callable[[bytes, int], Message | None]]] = 
 }
 
 
-# The same frames for decode(), by size key: frame size, decoder.
-_REQUEST_WHOLE: dict[int, tuple[int, Callable[[bytes], Message | None]]] = {
-    0x0102: (6, _whole_ping_request),
-    0x0204: (8, _whole_read_request),
-    0x0502: (6, _whole_action_request),
-    0x0602: (6, _whole_reset_request),
-    **{0x03 << 8 | n: (n + 4, _whole_write_request) for n in range(3, 256)},
-    **{0x04 << 8 | n: (n + 4, _whole_reg_write_request) for n in range(3, 256)},
+# The same frames for decode(), by their command code and length byte as they lie in the frame: frame size, decoder.
+_REQUEST_WHOLE: dict[bytes, tuple[int, Callable[[bytes], Message | None]]] = {
+    b'\x02\x01': (6, _whole_ping_request),
+    b'\x04\x02': (8, _whole_read_request),
+    b'\x02\x05': (6, _whole_action_request),
+    b'\x02\x06': (6, _whole_reset_request),
+    **{bytes((n, 0x03)): (n + 4, _whole_write_request) for n in range(3, 256)},
+    **{bytes((n, 0x04)): (n + 4, _whole_reg_write_request) for n in range(3, 256)},
 }
 
 
@@ -481,6 +476,11 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
     `expect` (the reply class a frame answers) matters only where replies share a code; here none do.
     """
     if direction is _REQUEST:
+        fixed = _REQUEST_WHOLE.get(data[3:5])  # a short frame's slice is shorter: it matches none
+        if fixed is not None and fixed[0] == len(data) and data[:2] == b'\xff\xff' and data[2] <= 254:
+            message = fixed[1](data)
+            if message is not None:
+                return message
         n = len(data)
         if n < 6:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (6 bytes)")
@@ -488,11 +488,6 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
             raise DecodeError(f"request header is {data[:2].hex(' ')}, expected ff ff")
         if data[2] > 254:
             raise DecodeError(f"id = {data[2]} is outside its range 0..253 (or 254)")
-        fixed = _REQUEST_WHOLE.get(data[4] << 8 | data[3])
-        if fixed is not None and fixed[0] == n:
-            message = fixed[1](data)
-            if message is not None:
-                return message
         size = data[3] - 2
         if size < 0 or n != 6 + size:
             raise DecodeError(f"length byte says {size} content bytes but the frame holds {n - 6}")

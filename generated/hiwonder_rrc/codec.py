@@ -157,12 +157,11 @@ def _decode_motor_set_speeds_request(buf: bytes, o: int, end: int) -> MotorSetSp
         raise DecodeError('motor.set_speeds request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x1')
     o += 2
     n = v_count * 5
-    if end - o < n:
-        raise DecodeError('motor.set_speeds request' + f': content too short for its count ({v_count} motors)')
+    if end - o != n:
+        if end - o < n:
+            raise DecodeError('motor.set_speeds request' + f': content too short for its count ({v_count} motors)')
+        raise DecodeError('motor.set_speeds request' + f': {end - o - n} bytes left after the last field')
     v_motors = tuple([_new(MotorsItem, values) for values in _S_U8_F32.iter_unpack(buf[o : o + n])])
-    o += n
-    if o != end:
-        raise DecodeError('motor.set_speeds request' + f': {end - o} bytes left after the last field')
     return _new(MotorSetSpeedsRequest, (v_motors,))
 
 
@@ -183,12 +182,11 @@ def _decode_motor_set_duties_request(buf: bytes, o: int, end: int) -> MotorSetDu
         raise DecodeError('motor.set_duties request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x5')
     o += 2
     n = v_count * 5
-    if end - o < n:
-        raise DecodeError('motor.set_duties request' + f': content too short for its count ({v_count} duties)')
+    if end - o != n:
+        if end - o < n:
+            raise DecodeError('motor.set_duties request' + f': content too short for its count ({v_count} duties)')
+        raise DecodeError('motor.set_duties request' + f': {end - o - n} bytes left after the last field')
     v_duties = tuple([_new(DutiesItem, values) for values in _S_U8_F32.iter_unpack(buf[o : o + n])])
-    o += n
-    if o != end:
-        raise DecodeError('motor.set_duties request' + f': {end - o} bytes left after the last field')
     return _new(MotorSetDutiesRequest, (v_duties,))
 
 
@@ -212,12 +210,11 @@ def _decode_pwm_servo_set_positions_request(buf: bytes, o: int, end: int) -> Pwm
         raise DecodeError('pwm_servo.set_positions request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x1')
     o += 4
     n = v_count * 3
-    if end - o < n:
-        raise DecodeError('pwm_servo.set_positions request' + f': content too short for its count ({v_count} pwm_servos)')
+    if end - o != n:
+        if end - o < n:
+            raise DecodeError('pwm_servo.set_positions request' + f': content too short for its count ({v_count} pwm_servos)')
+        raise DecodeError('pwm_servo.set_positions request' + f': {end - o - n} bytes left after the last field')
     v_pwm_servos = tuple([_new(PwmServosItem, values) for values in _S_U8_U16.iter_unpack(buf[o : o + n])])
-    o += n
-    if o != end:
-        raise DecodeError('pwm_servo.set_positions request' + f': {end - o} bytes left after the last field')
     return _new(PwmServoSetPositionsRequest, (v_duration, v_pwm_servos))
 
 
@@ -283,12 +280,11 @@ def _decode_bus_servo_set_positions_request(buf: bytes, o: int, end: int) -> Bus
         raise DecodeError('bus_servo.set_positions request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x1')
     o += 4
     n = v_count * 3
-    if end - o < n:
-        raise DecodeError('bus_servo.set_positions request' + f': content too short for its count ({v_count} bus_servos)')
+    if end - o != n:
+        if end - o < n:
+            raise DecodeError('bus_servo.set_positions request' + f': content too short for its count ({v_count} bus_servos)')
+        raise DecodeError('bus_servo.set_positions request' + f': {end - o - n} bytes left after the last field')
     v_bus_servos = tuple([_new(BusServosItem, values) for values in _S_U8_U16.iter_unpack(buf[o : o + n])])
-    o += n
-    if o != end:
-        raise DecodeError('bus_servo.set_positions request' + f': {end - o} bytes left after the last field')
     return _new(BusServoSetPositionsRequest, (v_duration, v_bus_servos))
 
 
@@ -354,12 +350,11 @@ def _decode_bus_servo_stop_request(buf: bytes, o: int, end: int) -> BusServoStop
         raise DecodeError('bus_servo.stop request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x3')
     o += 2
     n = v_count * 1
-    if end - o < n:
-        raise DecodeError('bus_servo.stop request' + f': content too short for its count ({v_count} servos)')
+    if end - o != n:
+        if end - o < n:
+            raise DecodeError('bus_servo.stop request' + f': content too short for its count ({v_count} servos)')
+        raise DecodeError('bus_servo.stop request' + f': {end - o - n} bytes left after the last field')
     v_servos = tuple([_new(ServosItem, values) for values in _S_U8.iter_unpack(buf[o : o + n])])
-    o += n
-    if o != end:
-        raise DecodeError('bus_servo.stop request' + f': {end - o} bytes left after the last field')
     return _new(BusServoStopRequest, (v_servos,))
 
 
@@ -591,12 +586,11 @@ def _decode_oled_request(buf: bytes, o: int, end: int) -> OledRequest:
         raise content_size_error('oled request', end - o, 2, 257)
     v_line, v_length = _S_U8_U8.unpack_from(buf, o)
     o += 2
-    if end - o < v_length:
-        raise DecodeError('oled request' + f': text needs {v_length} bytes, {end - o} left')
+    if end - o != v_length:
+        if end - o < v_length:
+            raise DecodeError('oled request' + f': text needs {v_length} bytes, {end - o} left')
+        raise DecodeError('oled request' + f': {end - o - v_length} bytes left after the last field')
     v_text = buf[o : o + v_length]
-    o += v_length
-    if o != end:
-        raise DecodeError('oled request' + f': {end - o} bytes left after the last field')
     return _new(OledRequest, (v_line, v_text))
 
 
@@ -608,12 +602,11 @@ def _decode_rgb_set_pixels_request(buf: bytes, o: int, end: int) -> RgbSetPixels
         raise DecodeError('rgb.set_pixels request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x1')
     o += 2
     n = v_count * 4
-    if end - o < n:
-        raise DecodeError('rgb.set_pixels request' + f': content too short for its count ({v_count} pixels)')
+    if end - o != n:
+        if end - o < n:
+            raise DecodeError('rgb.set_pixels request' + f': content too short for its count ({v_count} pixels)')
+        raise DecodeError('rgb.set_pixels request' + f': {end - o - n} bytes left after the last field')
     v_pixels = tuple([_new(PixelsItem, values) for values in _S_U8_U8_U8_U8.iter_unpack(buf[o : o + n])])
-    o += n
-    if o != end:
-        raise DecodeError('rgb.set_pixels request' + f': {end - o} bytes left after the last field')
     return _new(RgbSetPixelsRequest, (v_pixels,))
 
 

@@ -15,6 +15,7 @@ from serialspec.runtime.message import Direction, Message, members
 from serialspec.runtime.message import build as _new  # a message from the tuple of its field values, in one call
 from serialspec.runtime.packing import pack_bits as _pack_bits
 from serialspec.runtime.packing import unpack_bits as _unpack_bits
+from serialspec.runtime.packing import unpack_runs as _unpack_runs
 
 from modbus_rtu.messages import (
     CoilState,
@@ -54,6 +55,7 @@ _S_BE_U8_U8_U16_U16 = struct.Struct('>BBHH')
 _S_BE_U8_U8_U16_U16_U16 = struct.Struct('>BBHHH')
 _S_BE_U8_U8_U16_U16_U8 = struct.Struct('>BBHHB')
 _S_BE_U8_U8_U8 = struct.Struct('>BBB')
+_RUNS_BE_U16 = _unpack_runs('>H', 127)  # unpack_from of 0..127 items
 _CHECK_CRC: Callable[[bytes], int] = crc_function(16, 0x8005, 0xffff, True, True, 0x0)  # CRC-16/MODBUS
 
 _MEMBERS_CoilState = members(CoilState)
@@ -126,14 +128,11 @@ def _decode_read_holding_registers_response(buf: bytes, o: int, end: int, unit: 
     if nb % 2:
         raise DecodeError('read_holding_registers response' + f': {nb} bytes do not split into registers items of 2')
     n = nb // 2
-    if end - o < nb:
-        raise DecodeError('read_holding_registers response' + f': registers needs {nb} bytes, {end - o} left')
-    v_registers = struct.unpack_from(f'>{n}H', buf, o)
-    o += nb
-    if o != end:
-        raise DecodeError('read_holding_registers response' + f': {end - o} bytes left after the last field')
-    if v_byte_count != (2 * len(v_registers)):
-        raise DecodeError('read_holding_registers response' + f': byte_count is {v_byte_count}, but 2 * len(registers) = {(2 * len(v_registers))}')
+    if end - o != nb:
+        if end - o < nb:
+            raise DecodeError('read_holding_registers response' + f': registers needs {nb} bytes, {end - o} left')
+        raise DecodeError('read_holding_registers response' + f': {end - o - nb} bytes left after the last field')
+    v_registers = _RUNS_BE_U16[n](buf, o)
     return _new(ReadHoldingRegistersResponse, (unit, v_registers))
 
 
@@ -153,14 +152,11 @@ def _decode_read_input_registers_response(buf: bytes, o: int, end: int, unit: in
     if nb % 2:
         raise DecodeError('read_input_registers response' + f': {nb} bytes do not split into registers items of 2')
     n = nb // 2
-    if end - o < nb:
-        raise DecodeError('read_input_registers response' + f': registers needs {nb} bytes, {end - o} left')
-    v_registers = struct.unpack_from(f'>{n}H', buf, o)
-    o += nb
-    if o != end:
-        raise DecodeError('read_input_registers response' + f': {end - o} bytes left after the last field')
-    if v_byte_count != (2 * len(v_registers)):
-        raise DecodeError('read_input_registers response' + f': byte_count is {v_byte_count}, but 2 * len(registers) = {(2 * len(v_registers))}')
+    if end - o != nb:
+        if end - o < nb:
+            raise DecodeError('read_input_registers response' + f': registers needs {nb} bytes, {end - o} left')
+        raise DecodeError('read_input_registers response' + f': {end - o - nb} bytes left after the last field')
+    v_registers = _RUNS_BE_U16[n](buf, o)
     return _new(ReadInputRegistersResponse, (unit, v_registers))
 
 
@@ -283,14 +279,11 @@ def _decode_read_write_registers_response(buf: bytes, o: int, end: int, unit: in
     if nb % 2:
         raise DecodeError('read_write_registers response' + f': {nb} bytes do not split into registers items of 2')
     n = nb // 2
-    if end - o < nb:
-        raise DecodeError('read_write_registers response' + f': registers needs {nb} bytes, {end - o} left')
-    v_registers = struct.unpack_from(f'>{n}H', buf, o)
-    o += nb
-    if o != end:
-        raise DecodeError('read_write_registers response' + f': {end - o} bytes left after the last field')
-    if v_byte_count != (2 * len(v_registers)):
-        raise DecodeError('read_write_registers response' + f': byte_count is {v_byte_count}, but 2 * len(registers) = {(2 * len(v_registers))}')
+    if end - o != nb:
+        if end - o < nb:
+            raise DecodeError('read_write_registers response' + f': registers needs {nb} bytes, {end - o} left')
+        raise DecodeError('read_write_registers response' + f': {end - o - nb} bytes left after the last field')
+    v_registers = _RUNS_BE_U16[n](buf, o)
     return _new(ReadWriteRegistersResponse, (unit, v_registers))
 
 
@@ -379,10 +372,16 @@ def _encode_read_holding_registers_response(m: ReadHoldingRegistersResponse) -> 
     v_byte_count = (2 * len(m_registers))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('read_holding_registers response', 'byte_count', v_byte_count, 0, 255)
-    for x_registers in m_registers:
-        if not 0 <= x_registers <= 65535 or x_registers.__class__ is bool:
-            raise out_of_range('read_holding_registers response', 'registers', m_registers, 0, 65535)
-    frame = struct.pack(f'>BBB{len(m_registers)}H', m_unit, 0x03, v_byte_count, *m_registers)
+    try:
+        for x_registers in m_registers:
+            if x_registers.__class__ is bool:  # struct.pack takes True and False as numbers: refused below
+                raise TypeError
+        frame = struct.pack(f'>BBB{len(m_registers)}H', m_unit, 0x03, v_byte_count, *m_registers)
+    except (TypeError, struct.error):  # the item at fault, looked for only when the pack fails
+        for x_registers in m_registers:
+            if not 0 <= x_registers <= 65535 or x_registers.__class__ is bool:
+                raise out_of_range('read_holding_registers response', 'registers', m_registers, 0, 65535) from None
+        raise
     return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
@@ -408,10 +407,16 @@ def _encode_read_input_registers_response(m: ReadInputRegistersResponse) -> byte
     v_byte_count = (2 * len(m_registers))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('read_input_registers response', 'byte_count', v_byte_count, 0, 255)
-    for x_registers in m_registers:
-        if not 0 <= x_registers <= 65535 or x_registers.__class__ is bool:
-            raise out_of_range('read_input_registers response', 'registers', m_registers, 0, 65535)
-    frame = struct.pack(f'>BBB{len(m_registers)}H', m_unit, 0x04, v_byte_count, *m_registers)
+    try:
+        for x_registers in m_registers:
+            if x_registers.__class__ is bool:  # struct.pack takes True and False as numbers: refused below
+                raise TypeError
+        frame = struct.pack(f'>BBB{len(m_registers)}H', m_unit, 0x04, v_byte_count, *m_registers)
+    except (TypeError, struct.error):  # the item at fault, looked for only when the pack fails
+        for x_registers in m_registers:
+            if not 0 <= x_registers <= 65535 or x_registers.__class__ is bool:
+                raise out_of_range('read_input_registers response', 'registers', m_registers, 0, 65535) from None
+        raise
     return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
@@ -517,10 +522,16 @@ def _encode_write_registers_request(m: WriteRegistersRequest) -> bytes:
     v_byte_count = (2 * (len(m_values)))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('write_registers request', 'byte_count', v_byte_count, 0, 255)
-    for x_values in m_values:
-        if not 0 <= x_values <= 65535 or x_values.__class__ is bool:
-            raise out_of_range('write_registers request', 'values', m_values, 0, 65535)
-    frame = struct.pack(f'>BBHHB{len(m_values)}H', m_unit, 0x10, m_address, v_count, v_byte_count, *m_values)
+    try:
+        for x_values in m_values:
+            if x_values.__class__ is bool:  # struct.pack takes True and False as numbers: refused below
+                raise TypeError
+        frame = struct.pack(f'>BBHHB{len(m_values)}H', m_unit, 0x10, m_address, v_count, v_byte_count, *m_values)
+    except (TypeError, struct.error):  # the item at fault, looked for only when the pack fails
+        for x_values in m_values:
+            if not 0 <= x_values <= 65535 or x_values.__class__ is bool:
+                raise out_of_range('write_registers request', 'values', m_values, 0, 65535) from None
+        raise
     return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
@@ -592,10 +603,16 @@ def _encode_read_write_registers_request(m: ReadWriteRegistersRequest) -> bytes:
     v_byte_count = (2 * (len(m_values)))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('read_write_registers request', 'byte_count', v_byte_count, 0, 255)
-    for x_values in m_values:
-        if not 0 <= x_values <= 65535 or x_values.__class__ is bool:
-            raise out_of_range('read_write_registers request', 'values', m_values, 0, 65535)
-    frame = struct.pack(f'>BBHHHHB{len(m_values)}H', m_unit, 0x17, m_read_address, m_read_count, m_write_address, v_write_count, v_byte_count, *m_values)
+    try:
+        for x_values in m_values:
+            if x_values.__class__ is bool:  # struct.pack takes True and False as numbers: refused below
+                raise TypeError
+        frame = struct.pack(f'>BBHHHHB{len(m_values)}H', m_unit, 0x17, m_read_address, m_read_count, m_write_address, v_write_count, v_byte_count, *m_values)
+    except (TypeError, struct.error):  # the item at fault, looked for only when the pack fails
+        for x_values in m_values:
+            if not 0 <= x_values <= 65535 or x_values.__class__ is bool:
+                raise out_of_range('read_write_registers request', 'values', m_values, 0, 65535) from None
+        raise
     return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
@@ -607,10 +624,16 @@ def _encode_read_write_registers_response(m: ReadWriteRegistersResponse) -> byte
     v_byte_count = (2 * len(m_registers))
     if not 0 <= v_byte_count <= 255:
         raise out_of_range('read_write_registers response', 'byte_count', v_byte_count, 0, 255)
-    for x_registers in m_registers:
-        if not 0 <= x_registers <= 65535 or x_registers.__class__ is bool:
-            raise out_of_range('read_write_registers response', 'registers', m_registers, 0, 65535)
-    frame = struct.pack(f'>BBB{len(m_registers)}H', m_unit, 0x17, v_byte_count, *m_registers)
+    try:
+        for x_registers in m_registers:
+            if x_registers.__class__ is bool:  # struct.pack takes True and False as numbers: refused below
+                raise TypeError
+        frame = struct.pack(f'>BBB{len(m_registers)}H', m_unit, 0x17, v_byte_count, *m_registers)
+    except (TypeError, struct.error):  # the item at fault, looked for only when the pack fails
+        for x_registers in m_registers:
+            if not 0 <= x_registers <= 65535 or x_registers.__class__ is bool:
+                raise out_of_range('read_write_registers response', 'registers', m_registers, 0, 65535) from None
+        raise
     return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
@@ -765,6 +788,8 @@ def _wrap_response(content: bytes, code: int | None, v_unit: int) -> bytes:
     return frame + _CHECK_CRC(frame).to_bytes(2, 'little')
 
 
+_REQUEST = Direction.REQUEST
+_RESPONSE = Direction.RESPONSE
 _ENCODERS: dict[type[Message], Callable[..., bytes]] = {
     ReadCoilsRequest: _encode_read_coils_request,
     ReadCoilsResponse: _encode_read_coils_response,
@@ -796,7 +821,7 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
     """
     if direction is None:
         raise DecodeError("give the direction: requests and responses cannot be told apart by their first bytes")
-    if direction == 'request':  # a Direction or its value
+    if direction is _REQUEST or direction == 'request':  # a Direction (told by identity, first) or its value
         frame = data if data.__class__ is bytes else bytes(data)
         n = len(frame)
         if n < 4:
@@ -817,7 +842,7 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         except KeyError:
             raise DecodeError(f"unknown command {code!r}") from None
         return decoder(buf, 2, end, v_unit)
-    if direction == 'response':  # a Direction or its value
+    if direction is _RESPONSE or direction == 'response':  # a Direction (told by identity, first) or its value
         frame = data if data.__class__ is bytes else bytes(data)
         n = len(frame)
         if n < 4:

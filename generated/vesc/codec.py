@@ -7,6 +7,7 @@ import struct
 from collections.abc import Callable
 
 from serialspec.runtime.checksums import crc_function
+from serialspec.runtime.checksums import crc_hqx as _crc_hqx
 from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError, content_size_error, out_of_range
 from serialspec.runtime.fields import wrong_type
 from serialspec.runtime.framing import Element, EngineFormat, FrameCodec, Layout
@@ -40,15 +41,17 @@ __all__ = ["StreamParser", "decode", "encode"]
 
 _F_BE_1S_U16_U8 = struct.Struct('>1sHB')
 _F_LE_1S_U8_U8 = struct.Struct('<1sBB')
-_S_B1_U8_U8 = struct.Struct('<1sBB')
-_S_BE_B1_U8_U8_I32 = struct.Struct('>1sBBi')
-_S_BE_FRAME_GETVALUESRESPONSE = struct.Struct('>1sBBhhiiiihihiiiiiiBiBhhhiiB')
+_F_REQUEST_WHOLE_BE_I32 = struct.Struct('>3xi3x')
+_F_RESPONSE_WHOLE_BE_I32 = struct.Struct('>3xi3x')
+_S_BE_FRAME_GETVALUESRESPONSE = struct.Struct('>BhhiiiihihiiiiiiBiBhhhiiB')
 _S_BE_FWVERSIONRESPONSE_UUID = struct.Struct('>12sBBBBBBBB')
 _S_BE_GETVALUESRESPONSE_TEMP_FET = struct.Struct('>hhiiiihihiiiiiiBiBhhhiiB')
 _S_BE_I32 = struct.Struct('>i')
 _S_BE_U32 = struct.Struct('>I')
 _S_BE_U8 = struct.Struct('>B')
+_S_BE_U8_I32 = struct.Struct('>Bi')
 _S_BE_U8_U8 = struct.Struct('>BB')
+_S_U8 = struct.Struct('<B')
 _CHECK_CRC: Callable[[bytes], int] = crc_function(16, 0x1021, 0x0, False, False, 0x0)  # CRC-16/XMODEM
 
 _MEMBERS_FaultCode = members(FaultCode)
@@ -81,12 +84,11 @@ def _decode_fw_version_response(buf: bytes, o: int, end: int) -> FwVersionRespon
         raise DecodeError('fw_version response' + ': fw_name has no NUL at its end')
     v_fw_name = _decode_text(buf[o:stop], 'fw_name', 'fw_version response')
     o = stop + 1
-    if end - o < 4:
-        raise DecodeError('fw_version response' + f': hw_crc needs 4 bytes, {end - o} left')
+    if end - o != 4:
+        if end - o < 4:
+            raise DecodeError('fw_version response' + f': hw_crc needs 4 bytes, {end - o} left')
+        raise DecodeError('fw_version response' + f': {end - o - 4} bytes left after the last field')
     v_hw_crc, = _S_BE_U32.unpack_from(buf, o)
-    o += 4
-    if o != end:
-        raise DecodeError('fw_version response' + f': {end - o} bytes left after the last field')
     return _new(FwVersionResponse, (v_major, v_minor, v_hw_name, v_uuid, v_pairing_done, v_test_version, _MEMBERS_HwType.get(v_hw_type, v_hw_type), v_custom_config_count, v_phase_filters, v_qml_hw, v_qml_app, v_nrf_flags, v_fw_name, v_hw_crc))
 
 
@@ -172,8 +174,8 @@ def _decode_forward_can_request(buf: bytes, o: int, end: int) -> ForwardCanReque
 
 
 def _encode_fw_version_request(m: FwVersionRequest) -> bytes:
-    frame = _S_B1_U8_U8.pack(b'\x02', 1, 0x00)
-    return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
+    body = _S_U8.pack(0x00)
+    return b''.join((b'\x02\x01', body, _crc_hqx(body, 0x0).to_bytes(2, 'big'), b'\x03'))
 
 
 def _encode_fw_version_response(m: FwVersionResponse) -> bytes:
@@ -217,8 +219,8 @@ def _encode_fw_version_response(m: FwVersionResponse) -> bytes:
 
 
 def _encode_get_values_request(m: GetValuesRequest) -> bytes:
-    frame = _S_B1_U8_U8.pack(b'\x02', 1, 0x04)
-    return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
+    body = _S_U8.pack(0x04)
+    return b''.join((b'\x02\x01', body, _crc_hqx(body, 0x0).to_bytes(2, 'big'), b'\x03'))
 
 
 def _encode_get_values_response(m: GetValuesResponse) -> bytes:
@@ -294,56 +296,56 @@ def _encode_get_values_response(m: GetValuesResponse) -> bytes:
         raise out_of_range('get_values response', 'avg_vq', m_avg_vq, -2147483648, 2147483647)
     if not 0 <= m_status <= 255 or isinstance(m_status, bool):
         raise out_of_range('get_values response', 'status', m_status, 0, 255)
-    frame = _S_BE_FRAME_GETVALUESRESPONSE.pack(b'\x02', 74, 0x04, m_temp_fet, m_temp_motor, m_avg_motor_current, m_avg_input_current, m_avg_id, m_avg_iq, m_duty_now, m_rpm, m_v_in, m_amp_hours, m_amp_hours_charged, m_watt_hours, m_watt_hours_charged, m_tachometer, m_tachometer_abs, m_fault, m_pid_pos, m_controller_id, m_temp_mos1, m_temp_mos2, m_temp_mos3, m_avg_vd, m_avg_vq, m_status)
-    return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
+    body = _S_BE_FRAME_GETVALUESRESPONSE.pack(0x04, m_temp_fet, m_temp_motor, m_avg_motor_current, m_avg_input_current, m_avg_id, m_avg_iq, m_duty_now, m_rpm, m_v_in, m_amp_hours, m_amp_hours_charged, m_watt_hours, m_watt_hours_charged, m_tachometer, m_tachometer_abs, m_fault, m_pid_pos, m_controller_id, m_temp_mos1, m_temp_mos2, m_temp_mos3, m_avg_vd, m_avg_vq, m_status)
+    return b''.join((b'\x02J', body, _crc_hqx(body, 0x0).to_bytes(2, 'big'), b'\x03'))
 
 
 def _encode_set_duty_request(m: SetDutyRequest) -> bytes:
     m_duty = m.duty
     if not -100000 <= m_duty <= 100000 or m_duty.__class__ is bool:
         raise out_of_range('set_duty request', 'duty', m_duty, -100000, 100000)
-    frame = _S_BE_B1_U8_U8_I32.pack(b'\x02', 5, 0x05, m_duty)
-    return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
+    body = _S_BE_U8_I32.pack(0x05, m_duty)
+    return b''.join((b'\x02\x05', body, _crc_hqx(body, 0x0).to_bytes(2, 'big'), b'\x03'))
 
 
 def _encode_set_current_request(m: SetCurrentRequest) -> bytes:
     m_current = m.current
     if not -2147483648 <= m_current <= 2147483647 or m_current.__class__ is bool:
         raise out_of_range('set_current request', 'current', m_current, -2147483648, 2147483647)
-    frame = _S_BE_B1_U8_U8_I32.pack(b'\x02', 5, 0x06, m_current)
-    return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
+    body = _S_BE_U8_I32.pack(0x06, m_current)
+    return b''.join((b'\x02\x05', body, _crc_hqx(body, 0x0).to_bytes(2, 'big'), b'\x03'))
 
 
 def _encode_set_current_brake_request(m: SetCurrentBrakeRequest) -> bytes:
     m_current = m.current
     if not -2147483648 <= m_current <= 2147483647 or m_current.__class__ is bool:
         raise out_of_range('set_current_brake request', 'current', m_current, -2147483648, 2147483647)
-    frame = _S_BE_B1_U8_U8_I32.pack(b'\x02', 5, 0x07, m_current)
-    return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
+    body = _S_BE_U8_I32.pack(0x07, m_current)
+    return b''.join((b'\x02\x05', body, _crc_hqx(body, 0x0).to_bytes(2, 'big'), b'\x03'))
 
 
 def _encode_set_rpm_request(m: SetRpmRequest) -> bytes:
     m_rpm = m.rpm
     if not -2147483648 <= m_rpm <= 2147483647 or m_rpm.__class__ is bool:
         raise out_of_range('set_rpm request', 'rpm', m_rpm, -2147483648, 2147483647)
-    frame = _S_BE_B1_U8_U8_I32.pack(b'\x02', 5, 0x08, m_rpm)
-    return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
+    body = _S_BE_U8_I32.pack(0x08, m_rpm)
+    return b''.join((b'\x02\x05', body, _crc_hqx(body, 0x0).to_bytes(2, 'big'), b'\x03'))
 
 
 def _encode_set_pos_request(m: SetPosRequest) -> bytes:
     m_position = m.position
     if not -2147483648 <= m_position <= 2147483647 or m_position.__class__ is bool:
         raise out_of_range('set_pos request', 'position', m_position, -2147483648, 2147483647)
-    frame = _S_BE_B1_U8_U8_I32.pack(b'\x02', 5, 0x09, m_position)
-    return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
+    body = _S_BE_U8_I32.pack(0x09, m_position)
+    return b''.join((b'\x02\x05', body, _crc_hqx(body, 0x0).to_bytes(2, 'big'), b'\x03'))
 
 
 def _encode_set_handbrake_request(m: SetHandbrakeRequest) -> bytes:
     m_current = m.current
     if not -2147483648 <= m_current <= 2147483647 or m_current.__class__ is bool:
         raise out_of_range('set_handbrake request', 'current', m_current, -2147483648, 2147483647)
-    frame = _S_BE_B1_U8_U8_I32.pack(b'\x02', 5, 0x0a, m_current)
-    return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
+    body = _S_BE_U8_I32.pack(0x0a, m_current)
+    return b''.join((b'\x02\x05', body, _crc_hqx(body, 0x0).to_bytes(2, 'big'), b'\x03'))
 
 
 def _encode_print_response(m: PrintResponse) -> bytes:
@@ -354,13 +356,13 @@ def _encode_rotor_position_response(m: RotorPositionResponse) -> bytes:
     m_position = m.position
     if not -2147483648 <= m_position <= 2147483647 or m_position.__class__ is bool:
         raise out_of_range('rotor_position response', 'position', m_position, -2147483648, 2147483647)
-    frame = _S_BE_B1_U8_U8_I32.pack(b'\x02', 5, 0x16, m_position)
-    return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
+    body = _S_BE_U8_I32.pack(0x16, m_position)
+    return b''.join((b'\x02\x05', body, _crc_hqx(body, 0x0).to_bytes(2, 'big'), b'\x03'))
 
 
 def _encode_alive_request(m: AliveRequest) -> bytes:
-    frame = _S_B1_U8_U8.pack(b'\x02', 1, 0x1e)
-    return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
+    body = _S_U8.pack(0x1e)
+    return b''.join((b'\x02\x01', body, _crc_hqx(body, 0x0).to_bytes(2, 'big'), b'\x03'))
 
 
 def _encode_forward_can_request(m: ForwardCanRequest) -> bytes:
@@ -430,8 +432,8 @@ def _decode_request_short(frame: bytes, expect: type[Message] | None = None) -> 
     length = buf[1]
     if length != n - 5:
         raise DecodeError(f"length says {length} but the frame holds {n - 5}")
-    if _CHECK_CRC(frame[2:-1]) != 0x0000:
-        check = _CHECK_CRC(frame[2:-3])
+    if _crc_hqx(frame[2:-1], 0x0) != 0x0000:
+        check = _crc_hqx(frame[2:-3], 0x0)
         stored = buf[end] << 8 | buf[end + 1]
         if check != stored:
             raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
@@ -455,8 +457,8 @@ def _decode_request_long(frame: bytes, expect: type[Message] | None = None) -> M
     length = buf[1] << 8 | buf[2]
     if length != n - 6:
         raise DecodeError(f"length says {length} but the frame holds {n - 6}")
-    if _CHECK_CRC(frame[3:-1]) != 0x0000:
-        check = _CHECK_CRC(frame[3:-3])
+    if _crc_hqx(frame[3:-1], 0x0) != 0x0000:
+        check = _crc_hqx(frame[3:-3], 0x0)
         stored = buf[end] << 8 | buf[end + 1]
         if check != stored:
             raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
@@ -477,17 +479,29 @@ def _decode_request(frame: bytes, expect: type[Message] | None = None) -> Messag
     raise DecodeError(f"frame starts {frame[:4].hex(' ')}, expected 02 or 03")
 
 
+# Request frames of one size whose message is their content as one struct unpacks it, by their
+# first bytes (up to the content): class, unpack of the whole frame.
+_REQUEST_WHOLE: dict[bytes, tuple[type[Message], Callable[[bytes], tuple[object, ...]]]] = {
+    b'\x02\x05\x05': (SetDutyRequest, _F_REQUEST_WHOLE_BE_I32.unpack),
+    b'\x02\x05\x06': (SetCurrentRequest, _F_REQUEST_WHOLE_BE_I32.unpack),
+    b'\x02\x05\x07': (SetCurrentBrakeRequest, _F_REQUEST_WHOLE_BE_I32.unpack),
+    b'\x02\x05\x08': (SetRpmRequest, _F_REQUEST_WHOLE_BE_I32.unpack),
+    b'\x02\x05\t': (SetPosRequest, _F_REQUEST_WHOLE_BE_I32.unpack),
+    b'\x02\x05\n': (SetHandbrakeRequest, _F_REQUEST_WHOLE_BE_I32.unpack),
+}
+
+
 def _wrap_request(content: bytes, code: int | None) -> bytes:
     """The request frame around `content`, in the first layout whose length can count it."""
     v_length = len(content) + 1
     if v_length < 256:
         frame = _F_LE_1S_U8_U8.pack(b'\x02', v_length, code) + content
-        return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
+        return frame + _crc_hqx(frame[2:], 0x0).to_bytes(2, 'big') + b'\x03'
     v_length = len(content) + 1
     if not v_length < 65536:
         raise EncodeError(f"long frame: length {v_length} does not fit its 2-byte field")
     frame = _F_BE_1S_U16_U8.pack(b'\x03', v_length, code) + content
-    return frame + _CHECK_CRC(frame[3:]).to_bytes(2, 'big') + b'\x03'
+    return frame + _crc_hqx(frame[3:], 0x0).to_bytes(2, 'big') + b'\x03'
 
 
 _RESPONSE_DECODERS: dict[int | None, Callable[..., Message]] = {
@@ -536,8 +550,8 @@ def _decode_response_short(frame: bytes, expect: type[Message] | None = None) ->
     length = buf[1]
     if length != n - 5:
         raise DecodeError(f"length says {length} but the frame holds {n - 5}")
-    if _CHECK_CRC(frame[2:-1]) != 0x0000:
-        check = _CHECK_CRC(frame[2:-3])
+    if _crc_hqx(frame[2:-1], 0x0) != 0x0000:
+        check = _crc_hqx(frame[2:-3], 0x0)
         stored = buf[end] << 8 | buf[end + 1]
         if check != stored:
             raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
@@ -561,8 +575,8 @@ def _decode_response_long(frame: bytes, expect: type[Message] | None = None) -> 
     length = buf[1] << 8 | buf[2]
     if length != n - 6:
         raise DecodeError(f"length says {length} but the frame holds {n - 6}")
-    if _CHECK_CRC(frame[3:-1]) != 0x0000:
-        check = _CHECK_CRC(frame[3:-3])
+    if _crc_hqx(frame[3:-1], 0x0) != 0x0000:
+        check = _crc_hqx(frame[3:-3], 0x0)
         stored = buf[end] << 8 | buf[end + 1]
         if check != stored:
             raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
@@ -583,19 +597,28 @@ def _decode_response(frame: bytes, expect: type[Message] | None = None) -> Messa
     raise DecodeError(f"frame starts {frame[:4].hex(' ')}, expected 02 or 03")
 
 
+# Response frames of one size whose message is their content as one struct unpacks it, by their
+# first bytes (up to the content): class, unpack of the whole frame.
+_RESPONSE_WHOLE: dict[bytes, tuple[type[Message], Callable[[bytes], tuple[object, ...]]]] = {
+    b'\x02\x05\x16': (RotorPositionResponse, _F_RESPONSE_WHOLE_BE_I32.unpack),
+}
+
+
 def _wrap_response(content: bytes, code: int | None) -> bytes:
     """The response frame around `content`, in the first layout whose length can count it."""
     v_length = len(content) + 1
     if v_length < 256:
         frame = _F_LE_1S_U8_U8.pack(b'\x02', v_length, code) + content
-        return frame + _CHECK_CRC(frame[2:]).to_bytes(2, 'big') + b'\x03'
+        return frame + _crc_hqx(frame[2:], 0x0).to_bytes(2, 'big') + b'\x03'
     v_length = len(content) + 1
     if not v_length < 65536:
         raise EncodeError(f"long frame: length {v_length} does not fit its 2-byte field")
     frame = _F_BE_1S_U16_U8.pack(b'\x03', v_length, code) + content
-    return frame + _CHECK_CRC(frame[3:]).to_bytes(2, 'big') + b'\x03'
+    return frame + _crc_hqx(frame[3:], 0x0).to_bytes(2, 'big') + b'\x03'
 
 
+_REQUEST = Direction.REQUEST
+_RESPONSE = Direction.RESPONSE
 _ENCODERS: dict[type[Message], Callable[..., bytes]] = {
     FwVersionRequest: _encode_fw_version_request,
     FwVersionResponse: _encode_fw_version_response,
@@ -620,8 +643,14 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
     """
     if direction is None:
         raise DecodeError("give the direction: requests and responses cannot be told apart by their first bytes")
-    if direction == 'request':  # a Direction or its value
+    if direction is _REQUEST or direction == 'request':  # a Direction (told by identity, first) or its value
         frame = data if data.__class__ is bytes else bytes(data)
+        whole = _REQUEST_WHOLE.get(frame[:3])
+        if whole is not None and frame[-1] == 0x03 and _crc_hqx(frame[2:-1], 0x0) == 0x0000:
+            try:
+                return _new(whole[0], whole[1](frame))
+            except struct.error:
+                pass  # a frame of another size: the general path says what is wrong
         if frame.startswith(b'\x02'):
             n = len(frame)
             if n < 6:
@@ -633,8 +662,8 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
             length = buf[1]
             if length != n - 5:
                 raise DecodeError(f"length says {length} but the frame holds {n - 5}")
-            if _CHECK_CRC(frame[2:-1]) != 0x0000:
-                check = _CHECK_CRC(frame[2:-3])
+            if _crc_hqx(frame[2:-1], 0x0) != 0x0000:
+                check = _crc_hqx(frame[2:-3], 0x0)
                 stored = buf[end] << 8 | buf[end + 1]
                 if check != stored:
                     raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
@@ -655,8 +684,8 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
             length = buf[1] << 8 | buf[2]
             if length != n - 6:
                 raise DecodeError(f"length says {length} but the frame holds {n - 6}")
-            if _CHECK_CRC(frame[3:-1]) != 0x0000:
-                check = _CHECK_CRC(frame[3:-3])
+            if _crc_hqx(frame[3:-1], 0x0) != 0x0000:
+                check = _crc_hqx(frame[3:-3], 0x0)
                 stored = buf[end] << 8 | buf[end + 1]
                 if check != stored:
                     raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
@@ -667,8 +696,14 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
                 raise DecodeError(f"unknown command {code!r}") from None
             return decoder(buf, 4, end)
         raise DecodeError(f"frame starts {frame[:4].hex(' ')}, expected 02 or 03")
-    if direction == 'response':  # a Direction or its value
+    if direction is _RESPONSE or direction == 'response':  # a Direction (told by identity, first) or its value
         frame = data if data.__class__ is bytes else bytes(data)
+        whole = _RESPONSE_WHOLE.get(frame[:3])
+        if whole is not None and frame[-1] == 0x03 and _crc_hqx(frame[2:-1], 0x0) == 0x0000:
+            try:
+                return _new(whole[0], whole[1](frame))
+            except struct.error:
+                pass  # a frame of another size: the general path says what is wrong
         if frame.startswith(b'\x02'):
             n = len(frame)
             if n < 6:
@@ -680,8 +715,8 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
             length = buf[1]
             if length != n - 5:
                 raise DecodeError(f"length says {length} but the frame holds {n - 5}")
-            if _CHECK_CRC(frame[2:-1]) != 0x0000:
-                check = _CHECK_CRC(frame[2:-3])
+            if _crc_hqx(frame[2:-1], 0x0) != 0x0000:
+                check = _crc_hqx(frame[2:-3], 0x0)
                 stored = buf[end] << 8 | buf[end + 1]
                 if check != stored:
                     raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
@@ -702,8 +737,8 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
             length = buf[1] << 8 | buf[2]
             if length != n - 6:
                 raise DecodeError(f"length says {length} but the frame holds {n - 6}")
-            if _CHECK_CRC(frame[3:-1]) != 0x0000:
-                check = _CHECK_CRC(frame[3:-3])
+            if _crc_hqx(frame[3:-1], 0x0) != 0x0000:
+                check = _crc_hqx(frame[3:-3], 0x0)
                 stored = buf[end] << 8 | buf[end + 1]
                 if check != stored:
                     raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import functools
 import struct
+from binascii import crc_hqx as crc_hqx  # re-exported: generated code calls it directly (crc_in_one_call)
 from collections.abc import Callable
 from functools import cache
 
@@ -44,14 +45,12 @@ def crc_function(width: int, poly: int, init: int, refin: bool, refout: bool, xo
     bytes per step for every other 16-bit CRC (`_crc16_words`), else a table-driven loop over the bytes.
     """
     mask = (1 << width) - 1
-    if width == 16 and poly == 0x1021 and not refin and not refout:
-        from binascii import crc_hqx  # imported here: a codec that needs neither pays for neither
-
+    if crc_in_one_call(width, poly, init, refin, refout, xorout) is not None:
         if not xorout:
             return lambda data: crc_hqx(data, init)
         return lambda data: crc_hqx(data, init) ^ xorout
     if width == 32 and poly == 0x04C11DB7 and refin and refout:
-        from zlib import crc32
+        from zlib import crc32  # imported here: a codec that does not need it does not pay for it
 
         start = _reflect(init, width) ^ mask  # crc32 inverts the register before and after
 
@@ -82,6 +81,16 @@ def crc_function(width: int, poly: int, init: int, refin: bool, refout: bool, xo
             return (value ^ xorout) & mask
 
     return crc
+
+
+def crc_in_one_call(width: int, poly: int, init: int, refin: bool, refout: bool, xorout: int) -> str | None:
+    """Generated code's expression of the CRC of `{}` where the standard library computes it in one C call
+    (binascii.crc_hqx, exported here: poly 0x1021, unreflected, 16 bits), so a codec calls it with no Python
+    function between; None for the others, which generated code calls through crc_function's result."""
+    if width == 16 and poly == 0x1021 and not refin and not refout:
+        call = f"_crc_hqx({{}}, {init:#x})"
+        return f"({call} ^ {xorout:#x})" if xorout else call
+    return None
 
 
 # Runs of k 16-bit words (k < _WORD_RUNS) are read by precompiled structs, made at the first CRC's first call.

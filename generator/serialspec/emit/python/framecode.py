@@ -1,17 +1,19 @@
-"""Straight-line code for frames that are not of the classic shape (stuffing, u16 lengths over a span, CRC-16s,
-frames without a header or a length, alternative layouts told apart by their header).
+"""Straight-line code for frames that are not of the classic shape (stuffing, u16 lengths over a span, CRC-16s, frames
+without a header or a length, alternative layouts told apart by their header).
 
 Each direction gets two functions: `_decode_<direction>(frame, expect)` checks a whole frame and calls the content
-decoder on the frame's own bytes, and `_wrap_<direction>(content, code, *values)` puts the frame around a
-content. They make the runtime engine's checks (runtime/framing.py, Layout.unwrap and Layout.wrap) in the engine's
-order with the engine's messages, but as code written for one layout: every offset known when the layout is fixed
-is a literal, the bytes are unstuffed only when a stuffed sequence occurs (a `find` first), and a frame's content is
-decoded in place (no copy) unless it was stuffed, and a CRC stored in its own bit order is checked by its residue
-over the frame. `decode()` runs the checks inline (one call less); encoders of unstuffed frames make their frame
-inline too (`frame_encoder`: the head packed with the content's first struct). Where a layout does not fit that
+decoder on the frame's own bytes, and `_wrap_<direction>(content, code, *values)` puts the frame around a content.
+They make the runtime engine's checks (runtime/framing.py, Layout.unwrap and Layout.wrap) in the engine's order with
+the engine's messages, but as code written for one layout: every offset known when the layout is fixed is a literal,
+the bytes are unstuffed only when a stuffed sequence occurs (a `find` first), and a frame's content is decoded in
+place (no copy) unless it was stuffed, and a CRC stored in its own bit order is checked by its residue over the
+frame. `decode()` runs the checks inline (one call less), and first looks a frame of one size whose message is its
+content as one struct unpacks it up by its first bytes (`whole_frames`: checked from its end, unpacked whole, no
+call); encoders of unstuffed frames make their frame inline too (`frame_encoder`: the head packed with the content's
+first struct, constant leading bytes as a literal beside the checksummed body). Where a layout does not fit that
 form (a length after the content, a checksum over bytes inside the stuffed span, ...) the two functions call the
-engine instead, so every layout the language describes works and the straight-line form is only ever a faster way
-to the same result (tests/test_straight_frames.py holds them to it).
+engine instead, so every layout the language describes works and the straight-line form is only ever a faster way to
+the same result (tests/test_straight_frames.py holds them to it).
 
 Positions are expressions over `buf`, the frame with its stuffed span replaced by the plain bytes (the frame itself
 when nothing is stuffed): an element before the content at a literal offset, an element after it at `end + k`,
@@ -25,6 +27,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from serialspec.emit.common.frames import runtime_layouts
+from serialspec.runtime.checksums import crc_in_one_call
 from serialspec.runtime.framing import Element, Layout
 from serialspec.spec.model import Checksum, Direction, Protocol
 
@@ -35,6 +38,17 @@ Structs = Callable[[str], str]  # a struct format -> the name of the module's st
 def checksum_name(checksum: Checksum) -> str:
     """The codec's module-level name of a checksum's function (emit/python/frames.py defines them)."""
     return f"_CHECK_{checksum.name.upper()}"
+
+
+def checksum_call(checksum: Checksum) -> str:
+    """The expression of a checksum over `{}` (a str.format template): the standard library's C function called
+    directly where it computes this CRC (no Python function between), else the module's checksum function."""
+    crc = checksum.crc
+    if checksum.algorithm == "crc" and crc is not None:
+        direct = crc_in_one_call(crc.width, crc.poly, crc.init, crc.refin, crc.refout, crc.xorout)
+        if direct is not None:
+            return direct
+    return checksum_name(checksum) + "({})"
 
 
 def registry(structs: dict[str, str]) -> Structs:
@@ -253,7 +267,7 @@ def decode_lines(
             continue
         width = 2 + 2 * element.size
         failed = [
-            f"check = {checks[index]}({places.covered(*element.span)})",
+            f"check = {checks[index].format(places.covered(*element.span))}",
             f"stored = {places.read(index)}",
             "if check != stored:",
             f'    raise ChecksumError(f"bad {element.name}: the frame has {{stored:#0{width}x}}, '
@@ -265,7 +279,7 @@ def decode_lines(
             # over the covered bytes and the checksum itself, an intact frame's CRC is one constant: no slice, no
             # stored value to read; they are made only to say what is wrong
             whole = places.covered(a, index)
-            body += [f"if {checks[index]}({whole}) != {residue:#0{width}x}:", *(f"    {line}" for line in failed)]
+            body += [f"if {checks[index].format(whole)} != {residue:#0{width}x}:", *(f"    {line}" for line in failed)]
         else:
             body += failed
     if command is not None:
@@ -491,7 +505,7 @@ def _tail(layout: Layout, frame: str, checks: dict[int, str], packed: Callable[[
         begin_expr = str(-_size(elements[a:index])) if a > last else str(begin) if begin else ""
         covered = f"frame[{begin_expr}:{-between if between else ''}]".replace("[:]", "")
         lines.append(f"frame = {frame}")
-        frame = f"frame + {checks[index]}({covered}).to_bytes({element.size}, {element.endian!r})"
+        frame = f"frame + {checks[index].format(covered)}.to_bytes({element.size}, {element.endian!r})"
     if pending:
         frame = f"{frame} + {packed(pending)}"
     return [*lines, f"return {frame}"]
@@ -582,17 +596,21 @@ def straight_direction(protocol: Protocol, direction: Direction) -> Straight | N
     if not all(straight(layout) for layout in layouts) or len(names) != 1:
         return None
     checks = tuple(
-        {index: checksum_name(e.checksum) for index, e in enumerate(model.elements) if e.checksum is not None}
+        {index: checksum_call(e.checksum) for index, e in enumerate(model.elements) if e.checksum is not None}
         for model in protocol.framing.alternatives[direction]
     )
     return Straight(layouts, checks)
 
 
 def direction_functions(
-    protocol: Protocol, direction: Direction, target: Target, structs: dict[str, str]
+    protocol: Protocol,
+    direction: Direction,
+    target: Target,
+    structs: dict[str, str],
+    plain: list[tuple[int, int, str, str, str]],
 ) -> tuple[Lines, Lines]:
     """Module-level code of one direction's frame functions (`_decode_<d>`, `_wrap_<d>` and what they use), and
-    the lines of `decode()` that decode a frame `data` of this direction."""
+    the lines of `decode()` that decode a frame `data` of this direction (`plain`: see whole_frames)."""
     found = straight_direction(protocol, direction)
     d = direction.value
     if found is None:
@@ -625,7 +643,9 @@ def direction_functions(
             "",
         ]
     # decode() chooses the layout and checks the frame itself: one call less
-    call = ["frame = data if data.__class__ is bytes else bytes(data)", *_choice(layouts, d, bodies)]
+    table, fast = whole_frames(found, d, plain, structs)
+    call = ["frame = data if data.__class__ is bytes else bytes(data)", *fast, *_choice(layouts, d, bodies)]
+    lines += [*table, "", ""] if table else []
     lines += wrap_lines(d, wraps, target)
     return lines, call
 
@@ -678,6 +698,9 @@ def frame_encoder(
         return str(lengths[index]) if index in lengths else argument(index)
 
     head = list(range(layout.content))
+    prefix = _fixed_prefix(layout, lengths)
+    if prefix is not None:  # the checksum covers all after constant bytes: they are a literal, not packed
+        head = head[len(prefix[1]) :]
     first = _PACKED.match(parts[0]) if parts else None
     fmt = formats.get(first["name"], "") if first else ""
     order = _order(elements, head)
@@ -699,7 +722,41 @@ def frame_encoder(
     else:
         parts = [p for p in (_packed(elements, head, constant_or, struct), *parts) if p]
     frame = " + ".join(parts) if parts else "b''"
+    if prefix is not None:
+        # the checksum over what was packed, the constants before it added as they are (no slice to make)
+        literal, _, index = prefix
+        element = elements[index]
+        check = checks[index].format("body")
+        after = _packed(elements, list(range(index + 1, len(elements))), constant_or, struct)
+        # one join: cheaper than three or four concatenations, each of which makes a bytes object
+        pieces = [repr(literal), "body", f"{check}.to_bytes({element.size}, {element.endian!r})"]
+        pieces += [after] if after else []
+        return [f"body = {frame}", f"return b''.join(({', '.join(pieces)}))"]
     return _tail(layout, frame, checks, lambda indices: _packed(elements, indices, constant_or, struct))
+
+
+def _fixed_prefix(layout: Layout, lengths: dict[int, int]) -> tuple[bytes, list[int], int] | None:
+    """Where a layout's one checksum covers all from some element to the content's end and only constants and
+    lengths known before encoding (`lengths`: index -> value) come before it: their bytes, their indices and the
+    checksum's index. None for other layouts."""
+    elements = layout.elements
+    found = [i for i, e in enumerate(elements) if e.kind == "checksum"]
+    if len(found) != 1 or layout.transparency is not None:
+        return None
+    index = found[0]
+    a, b = elements[index].span
+    if not (0 < a <= layout.content == b == index - 1):
+        return None
+    literal = b""
+    for i in range(a):
+        element = elements[i]
+        if element.kind == "constant":
+            literal += element.constant
+        elif i in lengths:
+            literal += element.pack(lengths[i])
+        else:
+            return None
+    return literal, list(range(a)), index
 
 
 def _choice(layouts: tuple[Layout, ...], d: str, bodies: list[Lines] | None = None) -> Lines:
@@ -716,6 +773,83 @@ def _choice(layouts: tuple[Layout, ...], d: str, bodies: list[Lines] | None = No
             lines += [f"    {line}" for line in bodies[number]]
     choices = " or ".join(layout.header.hex(" ") for layout in layouts)
     return [*lines, f"raise DecodeError(f\"frame starts {{frame[:4].hex(' ')}}, expected {choices}\")"]
+
+
+_END = re.compile(r"\bend(?: \+ (\d+))?")
+
+
+def whole_frames(
+    found: Straight, d: str, plain: list[tuple[int, int, str, str, str]], structs: dict[str, str]
+) -> tuple[Lines, Lines]:
+    """decode()'s fast path for frames of one size whose message is their content as one struct unpacks it: a table
+    keyed by the bytes before the content (header, length, command code), and lines that check the rest of a frame
+    `frame` (constants and checksums after the content, counted from its end) and build the message with no call
+    but the unpack: a struct of the whole frame (the bytes around the content skipped as padding), whose unpack
+    refuses a frame of another size. A frame that fails any check goes on to the general path, which says why.
+    `plain`: (code, content size, class, content struct and its format) of each such message; `structs` gets the whole
+    frames' structs. ([], []) where the direction's first layout has values or is stuffed, or no message fits."""
+    layout, checks = found.layouts[0], found.checks[0]
+    elements = layout.elements
+    if layout.transparency is not None or any(e.kind == "value" for e in elements):
+        return [], []
+    places = _Places(layout)
+    entries: list[tuple[bytes, str, str]] = []
+    for code, size, cls, content, fmt in plain:
+        head = b""
+        for element in elements[: layout.content]:
+            if element.kind == "constant":
+                head += element.constant
+            elif element.kind == "command":
+                head += element.pack(code)
+            else:  # a length: the bytes it counts, given the content's size
+                a, b = element.span
+                counted = _size(elements[a : b + 1]) + element.adds + (size if a <= layout.content <= b else 0)
+                if not 0 <= counted < 1 << (8 * element.size):
+                    break
+                head += element.pack(counted)
+        else:
+            name = f"_F_{d.upper()}_WHOLE{content.removeprefix('_S')}"  # the content's struct in the frame
+            structs[name] = f"{fmt[0]}{places.content}x{fmt[1:]}{places.behind}x"
+            entries.append((head, cls, name))
+    if not entries:
+        return [], []
+
+    def from_end(text: str) -> str:  # `end + k` (the content's end) counted back from the frame's end
+        return _END.sub(lambda m: str(int(m[1] or 0) - places.behind), text).replace("buf[", "frame[")
+
+    conditions: Lines = []
+    for index, element in enumerate(elements[layout.content + 1 :], layout.content + 1):
+        if element.kind == "constant" and element.size == 1:  # constants first: cheaper than a checksum
+            conditions.insert(0, f"{from_end(f'buf[{places.at(index)}]')} == {element.constant[0]:#04x}")
+        elif element.kind == "constant":
+            data = from_end(f"buf[{places.at(index)}:{places.stop(index)}]").replace(":0]", ":]")
+            conditions.insert(0, f"{data} == {element.constant!r}")
+        elif element.kind == "checksum":
+            residue = _residue(element)
+            a, b = element.span
+            if residue is not None and b == index - 1:
+                call = checks[index].format(from_end(places.covered(a, index)))
+                conditions.append(f"{call} == {residue:#0{2 + 2 * element.size}x}")
+            else:
+                call = checks[index].format(from_end(places.covered(a, b)))
+                conditions.append(f"{call} == {from_end(places.read(index))}")
+    table = f"_{d.upper()}_WHOLE"
+    definition = [
+        f"# {d.capitalize()} frames of one size whose message is their content as one struct unpacks it, by their",
+        "# first bytes (up to the content): class, unpack of the whole frame.",
+        f"{table}: dict[bytes, tuple[type[Message], Callable[[bytes], tuple[object, ...]]]] = {{",
+        *(f"    {key!r}: ({cls}, {name}.unpack)," for key, cls, name in entries),
+        "}",
+    ]
+    lines = [
+        f"whole = {table}.get(frame[:{places.content}])",
+        f"if whole is not None and {' and '.join(conditions)}:",
+        "    try:",
+        "        return _new(whole[0], whole[1](frame))",
+        "    except struct.error:",
+        "        pass  # a frame of another size: the general path says what is wrong",
+    ]
+    return definition, lines
 
 
 def _plus(expression: str, k: int) -> str:

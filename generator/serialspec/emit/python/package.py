@@ -229,7 +229,8 @@ def general_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
             mask = (1 << (8 * element.type.size)) - 1
             flag = protocol.error_reply.flag
             frames = replace(frames, error_flag=flag, error_keep=mask & ~flag)
-        functions, call = direction_functions(protocol, direction, frames, frame_structs)
+        plain = plain_messages(single, code) if not expected and not frames.error_flag else []
+        functions, call = direction_functions(protocol, direction, frames, frame_structs, plain)
         directions.append(
             {
                 "name": direction.value,
@@ -254,18 +255,37 @@ def general_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
         and not reply.default_reply
     ]
     code.structs.update(frame_structs)  # listed with the content's structs (common_codec_context)
-    every = [line for d in directions for line in [*d["frames"], *d["functions"]]]
+    every = [line for d in directions for line in [*d["frames"], *d["functions"], *d["call"]]]
+    every += [line for _, _, lines in code.encoders for line in lines]
     return {
         "classic": False,
         "reply_layouts": reply_layouts,
         "framing_imports": sorted({"EngineFormat", *framing_imports(every)}, key=import_order),
         "checksum_error": any("ChecksumError(" in line for line in every),
         "checksum_imports": imports,
+        "crc_hqx": any("_crc_hqx(" in line for line in every),  # a CRC the standard library computes, called directly
         "checksum_definitions": definitions,
         "directions": directions,
         "dispatchers": dispatchers,
         "by_header": all(headers) and len(set(headers)) == len(headers),
     }
+
+
+def plain_messages(single: dict[str, Message], code: PackageCode) -> list[tuple[int, int, str, str, str]]:
+    """(code, content size, class, struct, its format) of the messages of one size whose decoder, past its size
+    check, is one struct's unpack of the content as their message (framecode.whole_frames decodes them whole)."""
+    bodies = {name: lines for name, _, _, lines in code.decoders}
+    found = []
+    for key, message in single.items():
+        lines = bodies[decoder_name(message)]
+        if key in ("None", "ERROR_REPLY") or message.min_size != message.max_size or len(lines) < 3:
+            continue
+        fused = fuse_unpack(lines[2:], code.structs)
+        plain = _PLAIN.match(fused[0]) if len(fused) == 1 and lines[0].startswith("if end - o != ") else None
+        if plain is not None:
+            struct = plain["struct"]
+            found.append((int(key, 16), message.min_size or 0, plain["cls"], struct, code.structs[struct]))
+    return found
 
 
 def value_arguments(layout: FrameLayout) -> dict[str, str]:
@@ -309,16 +329,39 @@ def classic_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
         if whole:  # decode() looks frames up by their first bytes
             whole_functions += [f | {"whole_lines": fuse_unpack(f["whole_lines"], code.structs)} for f in sub_functions]
             whole_pickers += pickers
-        frame_functions += [
-            f
-            | {
-                "lines": fuse_unpack(f["lines"], code.structs),
-                "whole_lines": fuse_unpack(f["whole_lines"], code.structs),
+        range_checks = value_range_checks(layout, protocol.byte_order)
+        # decode() looks these frames up before any other check: where each decoder refuses a frame of another size
+        # itself (struct.error from an unpack of the whole frame), decode() need not compare sizes first
+        whole_size = max(layout.length_offset, layout.command_offset or 0) + 1
+        content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
+        exact = bool(whole) and not sub_entries and not rests and not range_checks
+        bodies = {f["whole_name"]: fuse_unpack(f["whole_lines"], code.structs) for _, _, f in fixed}
+        if exact:
+            bodies = {
+                name: exact_whole(lines, size, whole_size, code)
+                for (_, size, f), (name, lines) in zip(fixed, bodies.items(), strict=True)
             }
+            whole = [
+                (
+                    key,
+                    size,
+                    name,
+                    None if plain is None else (plain[0], exact_struct(plain[1], size, content_offset, code)),
+                )
+                for key, size, name, plain in whole
+            ]
+        frame_functions += [
+            f | {"lines": fuse_unpack(f["lines"], code.structs), "whole_lines": bodies[f["whole_name"]], "exact": exact}
             for _, _, f in fixed
         ]
+        slice_key = None if whole else key_slice(layout)
         directions.append(
             {
+                "slice_key": slice_key,
+                "slice_fixed": [(slice_bytes(layout, key), size, f["whole_name"]) for key, size, f in fixed],
+                "slice_rests": [slice_rest(layout, r) for r in rests],
+                "accepted": [accepted(line.removeprefix("if ").removesuffix(":")) for line in range_checks[::2]],
+                "exact": exact,
                 "fixed": [(key, size, function["name"]) for key, size, function in fixed],
                 "runs": runs,
                 "summed": summed_checksum(protocol, layout) if runs else None,
@@ -327,8 +370,8 @@ def classic_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
                 "whole_frames": whole,
                 "plain": any(plain for *_, plain in whole),
                 "plain_check": plain_check(protocol, layout),
-                "content_offset": layout.offsets[next(e.name for e in layout.elements if e.role == "content")],
-                "whole_size": max(layout.length_offset, layout.command_offset or 0) + 1,
+                "content_offset": content_offset,
+                "whole_size": whole_size,
                 "key": frame_key(layout, "data"),
                 "name": direction.value,
                 "upper": direction.name,
@@ -340,7 +383,7 @@ def classic_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
                 "length_adds": layout.length_adds,
                 "command_offset": layout.command_offset,
                 "value_ranges": value_ranges(layout, protocol.byte_order),
-                "range_checks": value_range_checks(layout, protocol.byte_order),
+                "range_checks": range_checks,
                 "dispatch": dispatch,
                 "sizes": sizes,
                 "whole": frame_decode_lines(protocol, layout, dispatch, "data", None),
@@ -370,7 +413,8 @@ def common_codec_context(protocol: Protocol, code: PackageCode, exports: list[st
     used += "\n".join(line for _, _, lines in code.encoders for line in lines)
     packing = [n for n in ("decode_text", "encode_text", "pack_bits", "unpack_bits") if f"_{n}(" in used]
     return {
-        "packing_imports": packing,
+        "packing_imports": sorted([*packing, *(["unpack_runs"] if code.unpack_runs else [])]),
+        "unpack_runs": sorted(code.unpack_runs.items()),
         "structs": sorted(code.structs.items()),
         "tables": [
             table_context(t) for t in protocol.tables if any(uses_table(m, t.name) for m in protocol.messages())
@@ -400,6 +444,44 @@ def frame_key(layout: FrameLayout, buf: str, start: str = "") -> str:
     if layout.command_offset is None:
         return length
     return f"{buf}[{at}{layout.command_offset}] << 8 | {length}"
+
+
+def accepted(refused: str) -> str:
+    """The condition that a frame value is in range, from value_range_checks' condition that it is not."""
+    for op, opposite in ((" > ", " <= "), (" < ", " >= ")):
+        left, found, right = refused.partition(op)
+        if found and "(" not in refused:
+            return f"{left}{opposite}{right}"
+    return refused.removeprefix("not ") if refused.startswith("not (") else f"not {refused}"
+
+
+def key_slice(layout: FrameLayout) -> str | None:
+    """Where a frame's command code and length byte are neighbours after its header (FEETECH: an id between): the
+    slice of `data` holding them, decode()'s key for its whole frames (a short frame's is shorter: it matches
+    none, so the lookup comes before any check). None where they are not neighbours."""
+    if layout.command_offset is None:
+        return None
+    low = min(layout.command_offset, layout.length_offset)
+    if max(layout.command_offset, layout.length_offset) != low + 1 or low < len(layout.header):
+        return None
+    return f"data[{low}:{low + 2}]"
+
+
+def slice_bytes(layout: FrameLayout, key: str) -> str:
+    """A size key (command code << 8 | length byte, as fixed_frames makes it) as the bytes key_slice reads."""
+    value = int(key, 16)
+    assert layout.command_offset is not None  # key_slice holds it
+    by_offset = {layout.command_offset: value >> 8, layout.length_offset: value & 0xFF}
+    return repr(bytes(by_offset[o] for o in sorted(by_offset)))
+
+
+def slice_rest(layout: FrameLayout, rest: dict[str, Any]) -> dict[str, Any]:
+    """rest_key's entries as the bytes key_slice reads: the key's expression in the length byte `n`."""
+    assert layout.command_offset is not None  # key_slice holds it
+    by_offset = {layout.command_offset: f"{rest['code'] or 0:#04x}", layout.length_offset: "n"}
+    key = f"bytes(({', '.join(by_offset[o] for o in sorted(by_offset))}))"
+    low, high = rest["lengths"]
+    return {"key": key, "low": low, "high": high, "adds": rest["adds"], "name": rest["whole_name"]}
 
 
 def rest_key(layout: FrameLayout, rest: dict[str, Any], by_bytes: bool) -> dict[str, Any]:
@@ -568,7 +650,7 @@ def rest_check_lines(protocol: Protocol, layout: FrameLayout) -> Lines:
         less = f" - {sum(header):#x}" if header else ""
         if not checksum.invert:
             return [f"if (sum(buf){less} - 2 * buf[-1]) & 0xff:"]
-        return ["check = buf[-1]", f"if ~(sum(buf){less} - check) & 0xff != check:"]
+        return [f"if (sum(buf) - {sum(header) + 0xFF:#x}) & 0xff:  # inverted: the bytes and the check sum to 0xff"]
     covered = f"buf[{layout.covered_from}:-{layout.covered_to_end}]"
     return [*checksum_lines(checksum, covered, "expected"), f"if expected != {stored}:"]
 
@@ -658,6 +740,37 @@ def frame_function(
     return key, size, function
 
 
+_UNPACK_AT = re.compile(r"\b(?P<name>_S_\w+)\.unpack_from\(buf, (?P<at>\d+)\)")
+_SUM_LAST = re.compile(r"^if \(sum\(buf\)(?P<less>.*) - 2 \* buf\[\d+\]\) & 0xff:$")
+_AT_CONSTANT = re.compile(r"\bbuf\[(\d+)\]")
+
+
+def exact_struct(name: str, size: int, content_offset: int, code: PackageCode) -> str:
+    """A struct of a whole frame of `size` bytes that unpacks what struct `name` unpacks at the content's offset,
+    the bytes around it skipped: its unpack refuses (struct.error) a frame of any other size."""
+    fmt = code.structs[name]
+    after = size - content_offset - struct.calcsize(fmt)
+    whole = f"{fmt[0]}{content_offset}x{fmt[1:]}" + (f"{after}x" if after else "")
+    exact = f"{name}_IN_{size}"
+    code.structs[exact] = whole
+    return exact
+
+
+def exact_whole(lines: Lines, size: int, known: int, code: PackageCode) -> Lines:
+    """A whole-frame decoder that refuses a frame of another size than `size` by itself: its one unpack made of the
+    whole frame (struct.error), a sum's check byte read from the end; else a size check first, returning None.
+    `known`: the bytes decode() has matched (its key), which any frame it is given holds."""
+    lines = [_SUM_LAST.sub(lambda m: f"if (sum(buf){m['less']} - 2 * buf[-1]) & 0xff:", line) for line in lines]
+    unpacks = [m for line in lines for m in _UNPACK_AT.finditer(line)]
+    before = lines[: next((i for i, line in enumerate(lines) if _UNPACK_AT.search(line)), len(lines))]
+    reads = [int(i) for line in before for i in _AT_CONSTANT.findall(line)]
+    if len(unpacks) != 1 or any(i >= known for i in reads):
+        return [f"if len(buf) != {size}:", "    return None", *lines]
+    found = unpacks[0]
+    exact = exact_struct(found["name"], size, int(found["at"]), code)
+    return [_UNPACK_AT.sub(f"{exact}.unpack(buf)", line) for line in lines]
+
+
 _PLAIN = re.compile(r"^return _new\((?P<cls>\w+), (?P<struct>_S_\w+)\.unpack_from\(buf, o\)\)$")
 
 
@@ -680,8 +793,8 @@ def plain_check(protocol: Protocol, layout: FrameLayout) -> str | None:
     if not layout.checksum_offset_from_end == 1 == layout.covered_to_end == checksum.type.size:
         return None
     less = f" - {sum(header):#x}" if header else ""
-    if checksum.invert:
-        return f"~(sum(data){less} - data[-1]) & 0xff == data[-1]"
+    if checksum.invert:  # the covered bytes and their inverted sum add up to 0xff
+        return f"not (sum(data) - {sum(header) + 0xFF:#x}) & 0xff"
     return f"not (sum(data){less} - 2 * data[-1]) & 0xff"
 
 
@@ -769,7 +882,8 @@ def whole_frame_lines(
     less = f" - {sum(header):#x}" if header else ""
     if not checksum.invert:  # sum(covered) = check (mod 256): the whole frame sums to twice the check, plus the rest
         return [f"if (sum(buf){less} - 2 * buf[{size - 1}]) & 0xff:", *lines[2:]]
-    return [f"check = buf[{size - 1}]", f"if ~(sum(buf){less} - check) & 0xff != check:", *lines[2:]]
+    # inverted: the covered bytes and the check sum to 0xff, so the whole frame to that plus the header
+    return [f"if (sum(buf) - {sum(header) + 0xFF:#x}) & 0xff:", *lines[2:]]
 
 
 _UNPACK = re.compile(r"^(?P<targets>.+) = (?P<struct>_S_\w+)\.unpack_from\(buf, o\)$")

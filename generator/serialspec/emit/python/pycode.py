@@ -37,6 +37,7 @@ from serialspec.spec.model import (
 from serialspec.spec.model import Field as SpecField
 
 Lines = list[str]
+_MOST_RUNS = 256  # the most items of a list read by a struct made for each count (see unpack_runs)
 _STRUCT_NAMES = {"B": "U8", "b": "I8", "H": "U16", "h": "I16", "I": "U32", "i": "I32", "f": "F32"}
 
 
@@ -63,6 +64,67 @@ def bound(f: Scalar, value: float) -> str:
 
 
 _LOOP = re.compile(r"^(?P<indent> *)for (?P<var>[A-Za-z_]\w*) in .+:$")
+
+
+_NEEDS = re.compile(r"^if end - o < (?P<size>\w+):$")
+
+
+def fold_last_size_check(lines: Lines) -> Lines:
+    """A decoder's lines with the size check of its last field, read up to the content's end, and the check that
+    nothing is left after it made one comparison on the way of an intact frame (`end - o != size`), each error
+    still raised as before; the cursor is not moved past the last field, as nothing reads it."""
+    if len(lines) < 7 or not lines[-1].startswith("return ") or _CURSOR_WORD.search(lines[-1]):
+        return lines
+    needs, raised, read, moved, left, raised_left = lines[-7:-1]
+    found = _NEEDS.match(needs)
+    if found is None or moved != f"o += {found['size']}" or left != "if o != end:" or read.startswith(" "):
+        return lines
+    if not raised.startswith("    raise ") or not raised_left.endswith("bytes left after the last field')"):
+        return lines
+    size = found["size"]
+    return [
+        *lines[:-7],
+        f"if end - o != {size}:",
+        f"    {needs}",
+        f"    {raised}",
+        raised_left.replace("{end - o}", f"{{end - o - {size}}}"),
+        read,
+        lines[-1],
+    ]
+
+
+_CURSOR_WORD = re.compile(r"\bo\b")
+_DEFERRED = "#deferred "  # check_items' mark before the loop over a list whose item range is its type's
+
+
+def deferred_item_checks(lines: Lines) -> Lines:
+    """An encoder's lines with each loop that check_items marked run only when the pack of its list fails: the
+    list's numbers span their type's whole range, so struct.pack refuses exactly what the loop would, but True and
+    False (which it takes as numbers: looked for first, the cheaper loop). The full loop then finds the item at fault
+    and raises what it raised before; a failure it does not explain (a float) goes on as struct's error. A mark
+    whose list is packed inside a block keeps its loop where it was."""
+    for index, mark in enumerate(lines):
+        if not mark.startswith(_DEFERRED):
+            continue
+        expr = mark.removeprefix(_DEFERRED)
+        loop = lines[index + 1 : index + 4]
+        rest = lines[:index] + lines[index + 4 :]
+        at = next((i for i, line in enumerate(rest) if i >= index and f"*{expr})" in line), None)
+        if at is None or rest[at].startswith(" ") or any(line.startswith(" ") for line in rest[index:at]):
+            return deferred_item_checks(lines[:index] + lines[index + 1 :])
+        failed = [*loop[:-1], loop[-1] + " from None", "raise"]
+        item = loop[0].removeprefix("for ").partition(" in ")[0]
+        block = [
+            "try:",
+            f"    for {item} in {expr}:",
+            f"        if {item}.__class__ is bool:  # struct.pack takes True and False as numbers: refused below",
+            "            raise TypeError",
+            f"    {rest[at]}",
+            "except (TypeError, struct.error):  # the item at fault, looked for only when the pack fails",
+            *(f"    {line}" for line in failed),
+        ]
+        return deferred_item_checks(rest[:at] + block + rest[at + 1 :])
+    return lines
 
 
 def read_fields_once(lines: Lines, names: list[str]) -> Lines:
@@ -233,6 +295,7 @@ class PackageCode:
         # classes the decoders build through their slots (see `build`): class name -> field names in order
         self.built: dict[str, list[str]] = {}
         self.member_maps: set[str] = set()  # enum and flag classes whose value -> member map the decoders use
+        self.unpack_runs: dict[str, tuple[str, int]] = {}  # unpack_runs tables the decoders use: name -> (format, most)
         self._seen_classes: set[str] = set()
         self._straight: dict[Direction, Straight | None] = {}
         for message in protocol.messages():
@@ -394,8 +457,9 @@ class PackageCode:
         self.message_classes.append(code)
         frame_names = [f.name for f in self.frame_values(message.direction, message)]
         extra = "".join(f", {name}: int" for name in frame_names)
-        self.decoders.append((decoder_name(message), message.class_name, extra, self.decoder(message, fields)))
-        encoder = read_fields_once(self.encoder(message, fields), [f.name for f in fields])
+        decoder = fold_last_size_check(self.decoder(message, fields))
+        self.decoders.append((decoder_name(message), message.class_name, extra, decoder))
+        encoder = read_fields_once(deferred_item_checks(self.encoder(message, fields)), [f.name for f in fields])
         self.encoders.append((encoder_name(message), message.class_name, encoder))
 
     # --- decoding -------------------------------------------------------------------------------------------------
@@ -499,9 +563,17 @@ class PackageCode:
     def check_values(self, fields: list[SpecField], lines: Lines, where: str) -> None:
         """Every value derived by an expression must hold what the expression gives for the decoded fields."""
         counted = {f.count: f.name for f in fields if isinstance(f, List) and isinstance(f.count, str)}
+        # a byte size of a list of numbers: decoding read size // item items and refused a remainder
+        sized = {f.size: f for f in fields if isinstance(f, List) and f.size and f.item is not None}
         for f in fields:
             if isinstance(f, Scalar) and f.value == expression.Length(counted.get(f.name, "")):
                 continue  # the count of the list it counts: decoding read exactly that many
+            listed = sized.get(f.name)
+            if isinstance(f, Scalar) and listed is not None and listed.item is not None:
+                items = expression.Length(listed.name)
+                scaled = expression.BinOp("*", expression.Const(listed.item.size), items)
+                if f.value in (scaled, items if listed.item.size == 1 else None):
+                    continue  # the byte size of the list it sizes: decoding read exactly that many bytes
             if isinstance(f, Scalar) and f.value is not None:
                 expected = expression.render(f.value, self.local_named)
                 shown = one_line(expression.show(f.value)).replace("{", "{{").replace("}", "}}")
@@ -592,7 +664,7 @@ class PackageCode:
 
     def decode_variable(self, f: SpecField, siblings: list[SpecField], base: str, lines: Lines, where: str) -> str:
         if isinstance(f, List):
-            return self.decode_list(f, lines, where)
+            return self.decode_list(f, lines, where, siblings)
         if isinstance(f, Text):
             return self.decode_text(f, lines, where)
         if isinstance(f, Bytes):
@@ -671,7 +743,7 @@ class PackageCode:
         lines.append(f"{value} = tuple({value}_list)")
         return value
 
-    def decode_list(self, f: List, lines: Lines, where: str) -> str:
+    def decode_list(self, f: List, lines: Lines, where: str, siblings: list[SpecField]) -> str:
         """A list of numbers or bits: its count from a number, a count field, a byte-size field, or the rest."""
         value = self.local(f)
         item = 1 if f.item is None else f.item.size
@@ -690,12 +762,29 @@ class PackageCode:
             lines.append("nb = (n + 7) >> 3" if f.item is None else (f"nb = n * {item}" if item > 1 else "nb = n"))
         lines.append("if end - o < nb:")
         lines.append(f"    raise DecodeError({where} + f': {f.name} needs {{nb}} bytes, {{end - o}} left')")
+        most = self.most_items(f, siblings)
         if f.item is None:
             lines.append(f"{value} = _unpack_bits(buf, o, n)")
+        elif most is not None and most <= _MOST_RUNS:  # a struct per count, made once
+            name = f"_RUNS_{'BE' if f.endian == '>' else 'LE'}_{_STRUCT_NAMES[f.item.struct_char]}"
+            known = self.unpack_runs.get(name, ("", 0))[1]
+            self.unpack_runs[name] = (f"{f.endian}{f.item.struct_char}", max(most, known))
+            lines.append(f"{value} = {name}[n](buf, o)")
         else:
             lines.append(f"{value} = struct.unpack_from(f'{f.endian}{{n}}{f.item.struct_char}', buf, o)")
         lines.append("o += nb")
         return value
+
+    def most_items(self, f: List, siblings: list[SpecField]) -> int | None:
+        """The most items a list of numbers can hold, where a count or byte-size field of the message bounds it: by
+        the field's type, not its declared range (a frame may carry any value the type holds)."""
+        scalars = {s.name: s for s in siblings if isinstance(s, Scalar) and not s.type.is_float}
+        item = 1 if f.item is None else f.item.size
+        if f.size and str(f.size) in scalars:
+            return int(scalars[str(f.size)].type.maximum) // item
+        if isinstance(f.count, str) and f.count in scalars:
+            return int(scalars[f.count].type.maximum)
+        return None
 
     def decode_text(self, f: Text, lines: Lines, where: str) -> str:
         value = self.local(f)
@@ -840,8 +929,14 @@ class PackageCode:
         """Lines that return `body` (the frame without its checksum) with its checksum appended."""
         covered = f"{body}[{layout.covered_from}:]" if layout.covered_from else body
         size = layout.checksum_offset_from_end
-        assert self.protocol.framing.checksum is not None  # classic frames have one
-        lines = checksum_lines(self.protocol.framing.checksum, covered, "check")
+        checksum = self.protocol.framing.checksum
+        assert checksum is not None  # classic frames have one
+        lines = checksum_lines(checksum, covered, "check")
+        skipped = layout.header[: layout.covered_from]
+        if checksum.algorithm == "sum" and layout.covered_from and len(skipped) == layout.covered_from:
+            # the bytes before the covered ones are the header, a constant: the sum less it, no slice made
+            mask = (1 << (checksum.type.size * 8)) - 1
+            lines = [f"check = {'~' if checksum.invert else ''}(sum({body}) - {sum(skipped):#x}) & {mask:#x}"]
         if len(lines) == 1:  # a single expression: append it directly
             value = lines[0].removeprefix("check = ")
             lines = []
@@ -919,6 +1014,9 @@ class PackageCode:
         A plain loop: any() over a generator costs a frame per call, twice the time for a few items."""
         low, high = number(f.minimum), number(f.maximum)
         item = f"x_{f.name}"
+        kind = f.item if isinstance(f, List) else None
+        if kind is not None and not kind.is_float and (f.minimum, f.maximum) == (kind.minimum, kind.maximum):
+            lines.append(f"{_DEFERRED}{expr}")  # struct.pack checks the range: the loop only if it fails (deferred)
         lines.append(f"for {item} in {expr}:")
         lines.append(f"    if not {low} <= {item} <= {high} or {item}.__class__ is bool:")
         lines.append(f"        raise out_of_range({where}, {f.name!r}, {expr}, {low}, {high})")

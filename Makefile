@@ -53,7 +53,7 @@ stress: $(STAMP)
 	@echo "stress: $(FUZZ_EXAMPLES) examples per fuzzer, random seeds"
 	SERIALSPEC_FUZZ_EXAMPLES=$(FUZZ_EXAMPLES) $(BIN)/pytest -q -p no:cacheprovider $(FUZZ_TESTS) $(FUZZ_ARGS)
 
-# Benchmarks (bench/README.md): codec, stream parsing, pseudo-terminal latency, generation; about 3 minutes on a
+# Benchmarks (bench/README.md): codec, stream parsing, pseudo-terminal latency, generation; about a minute on a
 # quiet machine. Prints one table per family and writes them all to bench/results.md.
 $(BENCH_STAMP): $(STAMP) pyproject.toml
 	PYTHONWARNINGS='ignore:Editable installation' $(BIN)/pip install --quiet -e '.[test,bench]'

@@ -762,6 +762,140 @@ def _whole_sbus_response(buf: bytes) -> SbusResponse | None:
     return _new(SbusResponse, (t[0:16], v_ch17, v_ch18, v_signal_loss, v_fail_safe))
 
 
+def _whole_motor_request(buf: bytes) -> Message | None:
+    """A whole motor request frame, all of buf, its size and first bytes known: None if its checksum fails."""
+    expected = 0x0
+    for byte in buf[2:-1]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[-1]:
+        return None
+    sub = buf[4]
+    if sub == 0x01:
+        o, end = 4, len(buf) - 1
+        if not 2 <= end - o <= 1277:
+            raise content_size_error('motor.set_speeds request', end - o, 2, 1277)
+        v_subcommand_code, v_count = _S_U8_U8.unpack_from(buf, o)
+        if v_subcommand_code != 1:
+            raise DecodeError('motor.set_speeds request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x1')
+        o += 2
+        n = v_count * 5
+        if end - o != n:
+            if end - o < n:
+                raise DecodeError('motor.set_speeds request' + f': content too short for its count ({v_count} motors)')
+            raise DecodeError('motor.set_speeds request' + f': {end - o - n} bytes left after the last field')
+        v_motors = tuple([_new(MotorsItem, values) for values in _S_U8_F32.iter_unpack(buf[o : o + n])])
+        return _new(MotorSetSpeedsRequest, (v_motors,))
+    if sub == 0x05:
+        o, end = 4, len(buf) - 1
+        if not 2 <= end - o <= 1277:
+            raise content_size_error('motor.set_duties request', end - o, 2, 1277)
+        v_subcommand_code, v_count = _S_U8_U8.unpack_from(buf, o)
+        if v_subcommand_code != 5:
+            raise DecodeError('motor.set_duties request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x5')
+        o += 2
+        n = v_count * 5
+        if end - o != n:
+            if end - o < n:
+                raise DecodeError('motor.set_duties request' + f': content too short for its count ({v_count} duties)')
+            raise DecodeError('motor.set_duties request' + f': {end - o - n} bytes left after the last field')
+        v_duties = tuple([_new(DutiesItem, values) for values in _S_U8_F32.iter_unpack(buf[o : o + n])])
+        return _new(MotorSetDutiesRequest, (v_duties,))
+    return None
+
+
+def _whole_pwm_servo_request(buf: bytes) -> Message | None:
+    """A whole pwm_servo request frame, all of buf, its size and first bytes known: None if its checksum fails."""
+    expected = 0x0
+    for byte in buf[2:-1]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[-1]:
+        return None
+    sub = buf[4]
+    if sub == 0x01:
+        o, end = 4, len(buf) - 1
+        if not 4 <= end - o <= 769:
+            raise content_size_error('pwm_servo.set_positions request', end - o, 4, 769)
+        v_subcommand_code, v_duration, v_count = _S_U8_U16_U8.unpack_from(buf, o)
+        if v_subcommand_code != 1:
+            raise DecodeError('pwm_servo.set_positions request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x1')
+        o += 4
+        n = v_count * 3
+        if end - o != n:
+            if end - o < n:
+                raise DecodeError('pwm_servo.set_positions request' + f': content too short for its count ({v_count} pwm_servos)')
+            raise DecodeError('pwm_servo.set_positions request' + f': {end - o - n} bytes left after the last field')
+        v_pwm_servos = tuple([_new(PwmServosItem, values) for values in _S_U8_U16.iter_unpack(buf[o : o + n])])
+        return _new(PwmServoSetPositionsRequest, (v_duration, v_pwm_servos))
+    return None
+
+
+def _whole_bus_servo_request(buf: bytes) -> Message | None:
+    """A whole bus_servo request frame, all of buf, its size and first bytes known: None if its checksum fails."""
+    expected = 0x0
+    for byte in buf[2:-1]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[-1]:
+        return None
+    sub = buf[4]
+    if sub == 0x01:
+        o, end = 4, len(buf) - 1
+        if not 4 <= end - o <= 769:
+            raise content_size_error('bus_servo.set_positions request', end - o, 4, 769)
+        v_subcommand_code, v_duration, v_count = _S_U8_U16_U8.unpack_from(buf, o)
+        if v_subcommand_code != 1:
+            raise DecodeError('bus_servo.set_positions request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x1')
+        o += 4
+        n = v_count * 3
+        if end - o != n:
+            if end - o < n:
+                raise DecodeError('bus_servo.set_positions request' + f': content too short for its count ({v_count} bus_servos)')
+            raise DecodeError('bus_servo.set_positions request' + f': {end - o - n} bytes left after the last field')
+        v_bus_servos = tuple([_new(BusServosItem, values) for values in _S_U8_U16.iter_unpack(buf[o : o + n])])
+        return _new(BusServoSetPositionsRequest, (v_duration, v_bus_servos))
+    if sub == 0x03:
+        o, end = 4, len(buf) - 1
+        if not 2 <= end - o <= 257:
+            raise content_size_error('bus_servo.stop request', end - o, 2, 257)
+        v_subcommand_code, v_count = _S_U8_U8.unpack_from(buf, o)
+        if v_subcommand_code != 3:
+            raise DecodeError('bus_servo.stop request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x3')
+        o += 2
+        n = v_count * 1
+        if end - o != n:
+            if end - o < n:
+                raise DecodeError('bus_servo.stop request' + f': content too short for its count ({v_count} servos)')
+            raise DecodeError('bus_servo.stop request' + f': {end - o - n} bytes left after the last field')
+        v_servos = tuple([_new(ServosItem, values) for values in _S_U8.iter_unpack(buf[o : o + n])])
+        return _new(BusServoStopRequest, (v_servos,))
+    return None
+
+
+def _whole_rgb_request(buf: bytes) -> Message | None:
+    """A whole rgb request frame, all of buf, its size and first bytes known: None if its checksum fails."""
+    expected = 0x0
+    for byte in buf[2:-1]:
+        expected = _CRC_TABLE[expected ^ byte]
+    if expected != buf[-1]:
+        return None
+    sub = buf[4]
+    if sub == 0x01:
+        o, end = 4, len(buf) - 1
+        if not 2 <= end - o <= 1022:
+            raise content_size_error('rgb.set_pixels request', end - o, 2, 1022)
+        v_subcommand_code, v_count = _S_U8_U8.unpack_from(buf, o)
+        if v_subcommand_code != 1:
+            raise DecodeError('rgb.set_pixels request' + f': subcommand_code is {v_subcommand_code:#x}, expected 0x1')
+        o += 2
+        n = v_count * 4
+        if end - o != n:
+            if end - o < n:
+                raise DecodeError('rgb.set_pixels request' + f': content too short for its count ({v_count} pixels)')
+            raise DecodeError('rgb.set_pixels request' + f': {end - o - n} bytes left after the last field')
+        v_pixels = tuple([_new(PixelsItem, values) for values in _S_U8_U8_U8_U8.iter_unpack(buf[o : o + n])])
+        return _new(RgbSetPixelsRequest, (v_pixels,))
+    return None
+
+
 def _whole_motor_request_11(buf: bytes) -> Message | None:
     """A whole motor request frame of 11 bytes, by its sub-command: None if its checksum fails or no
     sub-command of that size has its code (decode's general path then says why)."""
@@ -2014,6 +2148,10 @@ _REQUEST_FIXED: dict[int, tuple[int, Callable[[bytes, int], Message | None]]] = 
 
 # The same frames for decode(), by their first bytes (header, command code, length byte): frame size, decoder.
 _REQUEST_WHOLE: dict[bytes, tuple[int, Callable[[bytes], Message | None]]] = {
+    **{b'\xaaU' + b'\x03' + bytes((n,)): (n + 5, _whole_motor_request) for n in range(2, 256)},
+    **{b'\xaaU' + b'\x04' + bytes((n,)): (n + 5, _whole_pwm_servo_request) for n in range(4, 256)},
+    **{b'\xaaU' + b'\x05' + bytes((n,)): (n + 5, _whole_bus_servo_request) for n in range(2, 256)},
+    **{b'\xaaU' + b'\x0b' + bytes((n,)): (n + 5, _whole_rgb_request) for n in range(2, 256)},
     b'\xaaU\x01\x07': (12, _whole_led_request),
     b'\xaaU\x02\x08': (13, _whole_buzzer_request),
     b'\xaaU\x03\x06': (11, _whole_motor_request_11),

@@ -326,6 +326,8 @@ def classic_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
         whole = whole_frames(layout, [*fixed, *sub_entries])
         rests = rest_frames(protocol, layout, decoder_bodies, code) if whole or fixed else []
         whole_functions += rests
+        sub_rests = subcommand_rest_frames(protocol, layout, decoder_bodies) if whole else []
+        whole_functions += sub_rests
         if whole:  # decode() looks frames up by their first bytes
             whole_functions += [f | {"whole_lines": fuse_unpack(f["whole_lines"], code.structs)} for f in sub_functions]
             whole_pickers += pickers
@@ -334,7 +336,7 @@ def classic_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
         # itself (struct.error from an unpack of the whole frame), decode() need not compare sizes first
         whole_size = max(layout.length_offset, layout.command_offset or 0) + 1
         content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
-        exact = bool(whole) and not sub_entries and not rests and not range_checks
+        exact = bool(whole) and not sub_entries and not rests and not sub_rests and not range_checks
         bodies = {f["whole_name"]: fuse_unpack(f["whole_lines"], code.structs) for _, _, f in fixed}
         if exact:
             bodies = {
@@ -367,6 +369,8 @@ def classic_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
                 "summed": summed_checksum(protocol, layout) if runs else None,
                 "fixed_whole": [(key, size, function["whole_name"]) for key, size, function in fixed],
                 "rest_keys": [rest_key(layout, r, bool(whole)) for r in rests],
+                # before the frames of one size: where a length byte names both, those keep their decoder
+                "sub_rest_keys": [rest_key(layout, r, True) for r in sub_rests],
                 "whole_frames": whole,
                 "plain": any(plain for *_, plain in whole),
                 "plain_check": plain_check(protocol, layout),
@@ -635,6 +639,58 @@ def rest_frames(
                     "adds": layout.overhead - layout.length_adds,  # frame size = length byte + this
                 }
             )
+    return found
+
+
+def subcommand_rest_frames(
+    protocol: Protocol, layout: FrameLayout, bodies: dict[str, tuple[str, str, Lines]]
+) -> list[dict[str, Any]]:
+    """decode()'s whole-frame decoders of the sub-command frames of more than one size (a list its count sizes), one
+    per command: any length byte from the smallest such content up names it (a key per length byte, as rest_frames).
+    Each checks the checksum, then picks the sub-command by its byte and runs that sub-command's content decoder's
+    lines in place: no dispatch and no call. It returns None where the checksum fails or no such sub-command has the
+    code (decode()'s general path then says why); a frame its lines refuse raises what the general path raises, as
+    that path, with the same checks passed, runs the same lines."""
+    checksum = protocol.framing.checksum
+    length = layout.length
+    if checksum is None or length is None or length.type is None or layout.value_elements:
+        return []
+    content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
+    tail = layout.overhead - content_offset  # bytes after the content
+    found = []
+    for command in protocol.commands:
+        if command.selector is None or layout.direction not in command.selector.offsets:
+            continue
+        at = command.selector.offsets[layout.direction]
+        subs = []
+        for sub in command.subcommands:
+            message = sub.request if layout.direction == Direction.REQUEST else sub.response
+            if message is None or message.min_size == message.max_size:
+                continue  # none, or of one size (subcommand_frames)
+            returns, extra, lines = bodies[decoder_name(message)]
+            if not extra:
+                subs.append((sub.code, message, lines))
+        if not subs:
+            continue
+        lines = [*rest_check_lines(protocol, layout), "    return None", f"sub = buf[{content_offset + at}]"]
+        for sub_code, _, body in subs:
+            lines += [f"if sub == {sub_code:#04x}:", f"    o, end = {content_offset}, len(buf) - {tail}"]
+            lines += [f"    {line}" for line in body]
+        smallest = min(message.min_size or 0 for _, message, _ in subs)
+        sizes = [message.max_size for _, message, _ in subs]
+        largest = length.type.maximum if None in sizes else max(s for s in sizes if s is not None) + layout.length_adds
+        found.append(
+            {
+                "whole_name": f"_whole_{command.name}_{layout.direction.value}",
+                "returns": "Message",
+                "where": f"{command.name} {layout.direction.value}",
+                "whole_lines": [*lines, "return None"],
+                "code": command.code,
+                # the sub-command's byte lies within the content: no smaller content reaches the picker
+                "lengths": (max(smallest, at + 1) + layout.length_adds, min(largest, length.type.maximum)),
+                "adds": layout.overhead - layout.length_adds,  # frame size = length byte + this
+            }
+        )
     return found
 
 

@@ -43,6 +43,7 @@ _F_BE_1S_U16_U8 = struct.Struct('>1sHB')
 _F_LE_1S_U8_U8 = struct.Struct('<1sBB')
 _F_REQUEST_WHOLE_BE_I32 = struct.Struct('>3xi3x')
 _F_RESPONSE_WHOLE_BE_I32 = struct.Struct('>3xi3x')
+_S_BE_B2_U8_I32_U16_B1 = struct.Struct('>2sBiH1s')
 _S_BE_FRAME_GETVALUESRESPONSE = struct.Struct('>BhhiiiihihiiiiiiBiBhhhiiB')
 _S_BE_FWVERSIONRESPONSE_UUID = struct.Struct('>12sBBBBBBBB')
 _S_BE_GETVALUESRESPONSE_TEMP_FET = struct.Struct('>hhiiiihihiiiiiiBiBhhhiiB')
@@ -305,7 +306,7 @@ def _encode_set_duty_request(m: SetDutyRequest) -> bytes:
     if not -100000 <= m_duty <= 100000 or m_duty.__class__ is bool:
         raise out_of_range('set_duty request', 'duty', m_duty, -100000, 100000)
     body = _S_BE_U8_I32.pack(0x05, m_duty)
-    return b''.join((b'\x02\x05', body, _crc_hqx(body, 0x0).to_bytes(2, 'big'), b'\x03'))
+    return _S_BE_B2_U8_I32_U16_B1.pack(b'\x02\x05', 0x05, m_duty, _crc_hqx(body, 0x0), b'\x03')
 
 
 def _encode_set_current_request(m: SetCurrentRequest) -> bytes:
@@ -313,7 +314,7 @@ def _encode_set_current_request(m: SetCurrentRequest) -> bytes:
     if not -2147483648 <= m_current <= 2147483647 or m_current.__class__ is bool:
         raise out_of_range('set_current request', 'current', m_current, -2147483648, 2147483647)
     body = _S_BE_U8_I32.pack(0x06, m_current)
-    return b''.join((b'\x02\x05', body, _crc_hqx(body, 0x0).to_bytes(2, 'big'), b'\x03'))
+    return _S_BE_B2_U8_I32_U16_B1.pack(b'\x02\x05', 0x06, m_current, _crc_hqx(body, 0x0), b'\x03')
 
 
 def _encode_set_current_brake_request(m: SetCurrentBrakeRequest) -> bytes:
@@ -321,7 +322,7 @@ def _encode_set_current_brake_request(m: SetCurrentBrakeRequest) -> bytes:
     if not -2147483648 <= m_current <= 2147483647 or m_current.__class__ is bool:
         raise out_of_range('set_current_brake request', 'current', m_current, -2147483648, 2147483647)
     body = _S_BE_U8_I32.pack(0x07, m_current)
-    return b''.join((b'\x02\x05', body, _crc_hqx(body, 0x0).to_bytes(2, 'big'), b'\x03'))
+    return _S_BE_B2_U8_I32_U16_B1.pack(b'\x02\x05', 0x07, m_current, _crc_hqx(body, 0x0), b'\x03')
 
 
 def _encode_set_rpm_request(m: SetRpmRequest) -> bytes:
@@ -329,7 +330,7 @@ def _encode_set_rpm_request(m: SetRpmRequest) -> bytes:
     if not -2147483648 <= m_rpm <= 2147483647 or m_rpm.__class__ is bool:
         raise out_of_range('set_rpm request', 'rpm', m_rpm, -2147483648, 2147483647)
     body = _S_BE_U8_I32.pack(0x08, m_rpm)
-    return b''.join((b'\x02\x05', body, _crc_hqx(body, 0x0).to_bytes(2, 'big'), b'\x03'))
+    return _S_BE_B2_U8_I32_U16_B1.pack(b'\x02\x05', 0x08, m_rpm, _crc_hqx(body, 0x0), b'\x03')
 
 
 def _encode_set_pos_request(m: SetPosRequest) -> bytes:
@@ -337,7 +338,7 @@ def _encode_set_pos_request(m: SetPosRequest) -> bytes:
     if not -2147483648 <= m_position <= 2147483647 or m_position.__class__ is bool:
         raise out_of_range('set_pos request', 'position', m_position, -2147483648, 2147483647)
     body = _S_BE_U8_I32.pack(0x09, m_position)
-    return b''.join((b'\x02\x05', body, _crc_hqx(body, 0x0).to_bytes(2, 'big'), b'\x03'))
+    return _S_BE_B2_U8_I32_U16_B1.pack(b'\x02\x05', 0x09, m_position, _crc_hqx(body, 0x0), b'\x03')
 
 
 def _encode_set_handbrake_request(m: SetHandbrakeRequest) -> bytes:
@@ -345,7 +346,7 @@ def _encode_set_handbrake_request(m: SetHandbrakeRequest) -> bytes:
     if not -2147483648 <= m_current <= 2147483647 or m_current.__class__ is bool:
         raise out_of_range('set_handbrake request', 'current', m_current, -2147483648, 2147483647)
     body = _S_BE_U8_I32.pack(0x0a, m_current)
-    return b''.join((b'\x02\x05', body, _crc_hqx(body, 0x0).to_bytes(2, 'big'), b'\x03'))
+    return _S_BE_B2_U8_I32_U16_B1.pack(b'\x02\x05', 0x0a, m_current, _crc_hqx(body, 0x0), b'\x03')
 
 
 def _encode_print_response(m: PrintResponse) -> bytes:
@@ -357,7 +358,7 @@ def _encode_rotor_position_response(m: RotorPositionResponse) -> bytes:
     if not -2147483648 <= m_position <= 2147483647 or m_position.__class__ is bool:
         raise out_of_range('rotor_position response', 'position', m_position, -2147483648, 2147483647)
     body = _S_BE_U8_I32.pack(0x16, m_position)
-    return b''.join((b'\x02\x05', body, _crc_hqx(body, 0x0).to_bytes(2, 'big'), b'\x03'))
+    return _S_BE_B2_U8_I32_U16_B1.pack(b'\x02\x05', 0x16, m_position, _crc_hqx(body, 0x0), b'\x03')
 
 
 def _encode_alive_request(m: AliveRequest) -> bytes:

@@ -22,6 +22,7 @@ where `end` is the content's end. Lengths and checksums that see wire bytes read
 
 from __future__ import annotations
 
+import ast
 import re
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -704,6 +705,7 @@ def frame_encoder(
     first = _PACKED.match(parts[0]) if parts else None
     fmt = formats.get(first["name"], "") if first else ""
     order = _order(elements, head)
+    packed = None  # (format, arguments) where the frame up to the checksum is one pack of them
     multi = any(elements[i].kind != "constant" and elements[i].size > 1 for i in head)
     if first and fmt[:1] in "<>" and (fmt[0] == order or not multi):
         # the head's elements joined to the content's first struct: one pack for both
@@ -717,6 +719,7 @@ def frame_encoder(
                 parts = [f"struct.pack({fstring}, {arguments}, {run['arguments']})", *parts[2:]]
             else:
                 parts = [f"{struct(static)}.pack({arguments})", *parts[1:]]
+                packed = (static, arguments) if len(parts) == 1 else None
         else:  # constants only: a literal
             parts = [f"{fused} + {parts[0]}", *parts[1:]]
     else:
@@ -731,8 +734,44 @@ def frame_encoder(
         # one join: cheaper than three or four concatenations, each of which makes a bytes object
         pieces = [repr(literal), "body", f"{check}.to_bytes({element.size}, {element.endian!r})"]
         pieces += [after] if after else []
+        whole = _repacked(packed, literal, element, check, after)
+        if whole is not None:
+            # the checksum needs the packed bytes; the frame is then one more pack of the same values, cheaper
+            # than joining the pieces
+            return [f"body = {frame}", f"return {struct(whole[0])}.pack({whole[1]})"]
         return [f"body = {frame}", f"return b''.join(({', '.join(pieces)}))"]
     return _tail(layout, frame, checks, lambda indices: _packed(elements, indices, constant_or, struct))
+
+
+_SIMPLE_ARGUMENTS = re.compile(r"^[\w. ]+(, [\w. ]+)*$")  # names, attributes, numbers: cheap to give twice
+_CHECK_CODES = {1: "B", 2: "H", 4: "I"}
+_MOST_REPACKED = 4  # values packed a second time into the whole frame; more are joined
+
+
+def _repacked(
+    packed: tuple[str, str] | None, literal: bytes, element: Element, check: str, after: str | None
+) -> tuple[str, str] | None:
+    """A struct format and its arguments for a whole frame that is `literal`, then one pack of simple values (the
+    bytes the checksum covers), then the checksum and constant bytes (`after`, a literal); None for others."""
+    if packed is None or not _SIMPLE_ARGUMENTS.match(packed[1]) or element.size not in _CHECK_CODES:
+        return None
+    if packed[1].count(",") >= _MOST_REPACKED:
+        return None  # each value packed twice: for many, the join is cheaper
+    fmt, arguments = packed
+    if element.size > 1 and {"big": ">", "little": "<"}.get(element.endian or "") != fmt[0]:
+        return None
+    tail: bytes = b""
+    if after:
+        if not after.startswith(("b'", 'b"')):
+            return None
+        tail = ast.literal_eval(after)
+    whole = fmt[0] + (f"{len(literal)}s" if literal else "") + fmt[1:] + _CHECK_CODES[element.size]
+    values = [repr(literal)] if literal else []
+    values += [arguments, check]
+    if after and tail:
+        whole += f"{len(tail)}s"
+        values.append(after)
+    return whole, ", ".join(values)
 
 
 def _fixed_prefix(layout: Layout, lengths: dict[int, int]) -> tuple[bytes, list[int], int] | None:

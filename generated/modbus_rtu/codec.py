@@ -819,8 +819,6 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
 
     `expect`: the reply class the frame answers, where several reply layouts share a code (PING's and READ's).
     """
-    if direction is None:
-        raise DecodeError("give the direction: requests and responses cannot be told apart by their first bytes")
     if direction is _REQUEST or direction == 'request':  # a Direction (told by identity, first) or its value
         frame = data if data.__class__ is bytes else bytes(data)
         n = len(frame)
@@ -865,6 +863,8 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         except KeyError:
             raise DecodeError(f"unknown command {code!r}") from None
         return decoder(buf, 2, end, v_unit)
+    if direction is None:  # last: a caller that knows the direction does not pay for this
+        raise DecodeError("give the direction: requests and responses cannot be told apart by their first bytes")
     raise ValueError(f"direction must be request or response, not {direction!r}")
 
 

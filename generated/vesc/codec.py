@@ -642,8 +642,6 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
 
     `expect`: the reply class the frame answers, where several reply layouts share a code (PING's and READ's).
     """
-    if direction is None:
-        raise DecodeError("give the direction: requests and responses cannot be told apart by their first bytes")
     if direction is _REQUEST or direction == 'request':  # a Direction (told by identity, first) or its value
         frame = data if data.__class__ is bytes else bytes(data)
         whole = _REQUEST_WHOLE.get(frame[:3])
@@ -750,6 +748,8 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
                 raise DecodeError(f"unknown command {code!r}") from None
             return decoder(buf, 4, end)
         raise DecodeError(f"frame starts {frame[:4].hex(' ')}, expected 02 or 03")
+    if direction is None:  # last: a caller that knows the direction does not pay for this
+        raise DecodeError("give the direction: requests and responses cannot be told apart by their first bytes")
     raise ValueError(f"direction must be request or response, not {direction!r}")
 
 

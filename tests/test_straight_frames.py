@@ -11,6 +11,7 @@ with `adds` inside a stuffed span, a big-endian u16 length, a trailer) and one t
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 from types import ModuleType
 from typing import Any
@@ -260,3 +261,44 @@ def test_encoders_make_the_frames_the_engine_makes(g: Generated, spec: Message) 
         assert frames.wrap(unwrapped.content, unwrapped.code, unwrapped.values) == frame
 
     same_bytes()
+
+
+# Requests and responses told apart by their header, in a framing that is not of the classic shape (a two-byte
+# length, a CRC-16): decode() without a direction picks the direction by the header.
+TOLD_BY_HEADER = """
+protocol: {name}
+title: Told by header
+byte_order: little
+serial: {{baudrate: 115200}}
+framing:
+  elements:
+    start: {{role: header, value: {{request: "A5 01", response: "5A 02"}}}}
+    length: {{role: length, type: u16, counts: [command, body]}}
+    command: {{role: command, type: u8}}
+    body: {{role: content}}
+    check:
+      role: checksum
+      type: u16
+      algorithm: crc
+      crc: {{name: CRC-16/MODBUS, width: 16, poly: 0x8005, init: 0xffff, refin: true, refout: true, xorout: 0,
+             check: 0x4b37}}
+      covers: [length, body]
+commands:
+  get:
+    code: 3
+    request: {{fields: {{channel: u8}}}}
+    response: {{fields: {{channel: u8, value: i16}}}}
+"""
+
+
+def test_a_general_framing_tells_directions_by_header(tmp_path: Path) -> None:
+    codec = generate(tmp_path, TOLD_BY_HEADER, "told_by_header")
+    messages = sys.modules["told_by_header.messages"]
+    request, response = messages.GetRequest(channel=2), messages.GetResponse(channel=2, value=-300)
+    for message in (request, response):
+        frame = codec.encode(message)
+        assert codec.decode(frame) == message == codec.decode(frame, message.DIRECTION)
+    with pytest.raises(DecodeError, match="neither a request nor a response header"):
+        codec.decode(b"\x00" + codec.encode(request)[1:])
+    with pytest.raises(ValueError, match="direction must be request or response"):
+        codec.decode(codec.encode(request), "sideways")

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import functools
 import struct
 from binascii import crc_hqx as crc_hqx  # re-exported: generated code calls it directly (crc_in_one_call)
 from collections.abc import Callable
@@ -97,13 +96,13 @@ def crc_in_one_call(width: int, poly: int, init: int, refin: bool, refout: bool,
 _WORD_RUNS = 128
 
 
-@functools.cache
+@cache
 def _unpack_words(order: str) -> tuple[Callable[[bytes], tuple[int, ...]], ...]:
     """unpack_from of a struct reading k words in this byte order, for each k < _WORD_RUNS."""
     return tuple(struct.Struct(f"{order}{k}H").unpack_from for k in range(_WORD_RUNS))
 
 
-@functools.cache
+@cache
 def _word_table(poly: int, refin: bool) -> tuple[int, ...]:
     """Entry x: the 16-bit register x after two zero bytes. Feeding bytes is linear (XOR) in the register, so entry
     x is the entry of its high byte's part XOR the entry of its low byte's: 65,536 XORs, about 2 ms."""
@@ -128,10 +127,6 @@ def _crc16_words(poly: int, init: int, refin: bool, refout: bool, xorout: int) -
     plain = refin == refout and not xorout  # the register is the CRC
     longest = 2 * _WORD_RUNS  # bytes: longer data is read by a struct made for it
 
-    def words(data: bytes) -> tuple[int, ...]:
-        run = len(data) >> 1
-        return unpack[run](data) if run < _WORD_RUNS else struct.unpack_from(f"{order}{run}H", data)
-
     def finish(value: int) -> int:
         return (_reflect(value, 16) if refin != refout else value) ^ xorout
 
@@ -141,7 +136,7 @@ def _crc16_words(poly: int, init: int, refin: bool, refout: bool, xorout: int) -
             pairs, unpack = _word_table(poly, refin), _unpack_words(order)
         value = start
         n = len(data)
-        for word in unpack[n >> 1](data) if n < longest else words(data):
+        for word in unpack[n >> 1](data) if n < longest else struct.unpack_from(f"{order}{n >> 1}H", data):
             value = pairs[value ^ word]
         if n & 1:  # the last byte alone, as in crc_function's byte loop
             last = data[-1]

@@ -427,7 +427,7 @@ class FrameCodec:
 
         Where the candidate's fixed head has all come (the usual case), its checks are made with no test of the bytes
         available: which one fails first then makes no difference (each says no frame). Otherwise probe() decides, so
-        the answer is always probe()'s: tests/test_frame_stream.py draws candidates and holds the two to it.
+        the answer is always probe()'s: tests/test_frame_sizers.py draws candidates and holds the two to it.
         """
         plan: dict[str, Any] = layout._plan  # type: ignore[attr-defined]
         head: tuple[tuple[Element, int, int], ...] = plan["probe_head"]

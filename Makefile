@@ -5,14 +5,16 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 BENCH_STAMP := $(VENV)/.installed-bench
 
-.PHONY: generate test check lint typecheck clean demo stress bench wheel runtime-wheel docs
+.PHONY: generate test test-fast constraints check lint typecheck clean demo stress bench wheel runtime-wheel docs
 
-$(STAMP): pyproject.toml
+CONSTRAINTS := requirements/constraints.txt
+
+$(STAMP): pyproject.toml $(CONSTRAINTS)
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install --quiet --upgrade pip
 	@# setuptools' notice that an editable install is one (a warning, printed on every install) is silenced by its
 	@# message alone: other warnings and every error still show
-	PYTHONWARNINGS='ignore:Editable installation' $(BIN)/pip install --quiet -e '.[test]'
+	PYTHONWARNINGS='ignore:Editable installation' $(BIN)/pip install --quiet -c $(CONSTRAINTS) -e '.[test]'
 	@# generated/ on the path: a package generated after the install imports at once, without a reinstall
 	echo "$(CURDIR)/generated" > "$$($(BIN)/python -c "import sysconfig; print(sysconfig.get_paths()['purelib'])")/serialspec-generated.pth"
 	touch $(STAMP)
@@ -30,8 +32,18 @@ lint: $(STAMP)
 typecheck: $(STAMP)
 	$(BIN)/mypy generator/serialspec generated
 
+# The whole suite on every core (pytest-xdist); `make test-fast` leaves out the tests marked slow (wheels, docs site,
+# vendors' SDKs over pseudo-terminals) for the inner loop of an edit.
 test: $(STAMP) check lint typecheck
-	$(BIN)/pytest -q
+	$(BIN)/pytest -q -n auto
+
+test-fast: $(STAMP) check
+	$(BIN)/pytest -q -n auto -m "not slow"
+
+# Pin what the development install resolved to (after changing pyproject.toml's extras), for CI and fresh clones.
+constraints: $(STAMP)
+	{ sed -n '1,2p' $(CONSTRAINTS); $(BIN)/pip freeze --exclude-editable | grep -v '^serialspec'; } > $(CONSTRAINTS).new
+	mv $(CONSTRAINTS).new $(CONSTRAINTS)
 
 # The long robustness runs: 100,000 frames per protocol and direction through the stream parsers (with garbage,
 # truncated frame starts, corrupt checksums, random read sizes), the fault matrix, and 8 threads x 5,000
@@ -56,7 +68,7 @@ stress: $(STAMP)
 # Benchmarks (bench/README.md): codec, stream parsing, pseudo-terminal latency, generation; about a minute on a
 # quiet machine. Prints one table per family and writes them all to bench/results.md.
 $(BENCH_STAMP): $(STAMP) pyproject.toml
-	PYTHONWARNINGS='ignore:Editable installation' $(BIN)/pip install --quiet -e '.[test,bench]'
+	PYTHONWARNINGS='ignore:Editable installation' $(BIN)/pip install --quiet -c $(CONSTRAINTS) -e '.[test,bench]'
 	touch $(BENCH_STAMP)
 
 bench: $(BENCH_STAMP)

@@ -27,11 +27,11 @@ from pathlib import Path
 from typing import Any
 
 import yaml
-from serialspec.emit.markdown.docs import emit_docs
-from serialspec.emit.python.package import emit_package
-from serialspec.spec.loader import load_file
-from serialspec.spec.model import Protocol
-from serialspec.spec.resolve import resolve
+from serialspec.backends.markdown.docs import emit_docs
+from serialspec.backends.python.package import emit_package
+from serialspec.lang.loader import load_file
+from serialspec.lang.model import Protocol
+from serialspec.lang.resolve import resolve
 
 from bench.synthetic import synthetic_yaml
 from bench.timing import Table, verdict

@@ -11,8 +11,8 @@ from typing import Any
 
 import pytest
 from hypothesis import settings
-from serialspec.spec import load_protocol
-from serialspec.spec.model import Example, Protocol
+from serialspec.lang import load_protocol
+from serialspec.lang.model import Example, Protocol
 
 # Hypothesis policy. `make test` (and CI, which runs it once on a clean clone) must give the same answer every time:
 # a fuzzer that fails one run in five blocks everyone and teaches people to rerun until green. So by default every
@@ -67,3 +67,15 @@ def example_class(g: Generated, example: Example) -> Any:
         if (example.command, example.subcommand, example.direction) == (cls.COMMAND, cls.SUBCOMMAND, cls.DIRECTION):
             return cls
     raise AssertionError(f"no message class for example {example.name}")
+
+
+# What `make test-fast` leaves out: whole-program runs that take seconds each (wheels built and installed, the docs
+# site, the vendors' SDKs and peers over pseudo-terminals, the long concurrency runs). `make test` runs them all.
+SLOW_FILES = frozenset({"test_wheel.py", "test_docs.py", "test_stress.py", "test_faults.py", "test_spec_fuzz.py"})
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    for item in items:
+        name = item.path.name
+        if name in SLOW_FILES or name.startswith("test_interop_"):
+            item.add_marker(pytest.mark.slow)

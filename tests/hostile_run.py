@@ -7,10 +7,10 @@ from functools import cache
 from pathlib import Path
 
 from hostile_cases import CASES, Mutation, Text
-from serialspec.emit import emitters
-from serialspec.spec import SpecErrors
-from serialspec.spec.loader import Located, decode_text, load_file, load_text
-from serialspec.spec.resolve import resolve
+from serialspec.backends import emitters
+from serialspec.lang import SpecErrors
+from serialspec.lang.loader import Located, decode_text, load_file, load_text
+from serialspec.lang.resolve import resolve
 
 HERE = Path(__file__).resolve().parent
 BASES = {

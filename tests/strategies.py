@@ -5,7 +5,7 @@ from __future__ import annotations
 from typing import Any
 
 from hypothesis import strategies as st
-from serialspec.spec.model import (
+from serialspec.lang.model import (
     Array,
     Bytes,
     Field,

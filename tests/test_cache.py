@@ -17,7 +17,7 @@ from typing import Any
 import jinja2
 import pytest
 from serialspec import cache
-from serialspec.emit.common import render
+from serialspec.backends.common import render
 
 
 @pytest.fixture
@@ -141,7 +141,7 @@ def test_no_cache_folder_changes_nothing_but_the_time(
 
 
 def environment(templates: dict[str, str], **settings: Any) -> jinja2.Environment:
-    """An environment like the targets' (serialspec.emit.common.render), over templates held in memory."""
+    """An environment like the targets' (serialspec.backends.common.render), over templates held in memory."""
     env = jinja2.Environment(loader=jinja2.DictLoader(templates), **{**render._SETTINGS, **settings})
     env.bytecode_cache = render._Cache(env)
     return env
@@ -272,7 +272,7 @@ def test_the_generator_key_covers_every_source_and_template_of_the_package(
     (copy / "__pycache__").mkdir()
     (copy / "__pycache__" / "x.py").write_text("# not a source\n")
     assert fingerprint() == before
-    for changed in (copy / "emit" / "markdown" / "templates" / "docs.md.j2", copy / "runtime" / "checksums.py"):
+    for changed in (copy / "backends" / "markdown" / "templates" / "docs.md.j2", copy / "runtime" / "checksums.py"):
         original = changed.read_bytes()
         changed.write_bytes(original + b"\n")
         assert fingerprint() != before, changed

@@ -207,7 +207,7 @@ def test_sim_banner_says_what_is_served_in_words() -> None:
     from types import SimpleNamespace
 
     from serialspec.cli.sim import served
-    from serialspec.spec import load_protocol
+    from serialspec.lang import load_protocol
 
     def banner(name: str, ids: list[int]) -> str:
         protocol = load_protocol(str(ROOT / "specs" / f"{name}.yaml"))

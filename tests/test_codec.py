@@ -8,8 +8,8 @@ import pytest
 from conftest import ALL, Generated, by_protocol, example_class, examples
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from serialspec.lang.model import Example, Message, Scalar
 from serialspec.runtime.errors import DecodeError, RangeError
-from serialspec.spec.model import Example, Message, Scalar
 from strategies import message_fields
 
 MESSAGES = by_protocol([(g, m) for g in ALL for m in g.protocol.messages()])

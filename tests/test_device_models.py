@@ -21,8 +21,8 @@ from feetech_sms.codec import StreamParser, encode
 from feetech_sms.messages import Direction, ResetRequest, WriteRequest
 from feetech_sms.registers import CONTROL_TABLE
 from feetech_sms.simulator import DEVICE, FeetechSmsSimulator
+from serialspec.lang import SpecErrors, load_protocol
 from serialspec.runtime.device import ModelSpec, Simulator
-from serialspec.spec import SpecErrors, load_protocol
 from sim_process import ROOT, serve
 
 scservo_sdk = pytest.importorskip("scservo_sdk")
@@ -204,8 +204,8 @@ def test_moving_reads_1_on_the_way_and_0_on_arrival() -> None:
 
 def test_a_models_entries_reach_the_docs_and_the_simulator(tmp_path: Path) -> None:
     """Per-model ranges and units (DYNAMIXEL's XL330 counts current in 1 mA, the XM430 in 2.69 mA) end to end."""
-    from serialspec.emit.markdown.docs import emit_docs
-    from serialspec.emit.python.simulator import simulator_module
+    from serialspec.backends.markdown.docs import emit_docs
+    from serialspec.backends.python.simulator import simulator_module
 
     text = (ROOT / "specs" / "feetech_sms.yaml").read_text(encoding="utf-8")
     text = text.replace(

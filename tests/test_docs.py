@@ -141,8 +141,8 @@ def test_the_documentation_site_builds_strictly(tmp_path: Path) -> None:
 def test_example_breakdowns_show_values_as_people_write_them(spec: Path) -> None:
     """A bit-field status in an example's breakdown reads `alert=0, number=0`, coils `[1; 0; 1]`: never Python's repr,
     and a protocol without errata says so under its Errata heading."""
-    from serialspec.emit.markdown.docs import emit_docs
-    from serialspec.spec import load_protocol
+    from serialspec.backends.markdown.docs import emit_docs
+    from serialspec.lang import load_protocol
 
     docs = emit_docs(load_protocol(str(spec), spec.name))
     assert not re.findall(r"\{'|\['|<[A-Z]\w+\.|\[(?:True|False);", docs)
@@ -154,8 +154,8 @@ def test_example_breakdowns_show_values_as_people_write_them(spec: Path) -> None
 def test_frame_layout_states_the_gap_once(spec: Path) -> None:
     """A protocol with a silence between frames says so once in its frame layout section, not in the spec's
     description and again in the template's sentence."""
-    from serialspec.emit.markdown.docs import emit_docs
-    from serialspec.spec import load_protocol
+    from serialspec.backends.markdown.docs import emit_docs
+    from serialspec.lang import load_protocol
 
     protocol = load_protocol(str(spec), spec.name)
     section = emit_docs(protocol).split("\n## Frame layout\n")[1].split("\n## ")[0]
@@ -166,8 +166,8 @@ def test_frame_layout_states_the_gap_once(spec: Path) -> None:
 def test_published_reference_cites_only_what_readers_can_find(spec: Path) -> None:
     """No internal note, local file name, issue number or this repository's test files in a published reference:
     sources are named as their publishers name them."""
-    from serialspec.emit.markdown.docs import emit_docs
-    from serialspec.spec import load_protocol
+    from serialspec.backends.markdown.docs import emit_docs
+    from serialspec.lang import load_protocol
 
     docs = emit_docs(load_protocol(str(spec), spec.name))
     assert not re.findall(r"design-notes|protocol-docs/|\.txt\b|\bissue \d|tests/|test_\w+\.py", docs)

@@ -14,11 +14,11 @@ from typing import Any
 import pytest
 from conftest import ALL, Generated, by_protocol, examples
 from hypothesis import HealthCheck, given, settings
-from serialspec.emit.python.pycode import PackageCode
+from serialspec.backends.python.pycode import PackageCode
+from serialspec.lang.model import Message
 from serialspec.runtime.checksums import crc_function, sum_function
 from serialspec.runtime.errors import ChecksumError
 from serialspec.runtime.message import field_names, slot_setters
-from serialspec.spec.model import Message
 from strategies import message_fields
 
 MESSAGES = by_protocol([(g, m) for g in ALL for m in g.protocol.messages()])

@@ -9,9 +9,9 @@ from pathlib import Path
 from types import ModuleType
 
 import pytest
-from serialspec.emit.python import files
+from serialspec.backends.python import files
+from serialspec.lang import SpecErrors, load_protocol
 from serialspec.runtime.errors import DecodeError
-from serialspec.spec import SpecErrors, load_protocol
 
 MODBUS_LIKE = """
 protocol: {name}

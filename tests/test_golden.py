@@ -11,10 +11,10 @@ from typing import Any
 
 import pytest
 from conftest import ALL, Generated, by_protocol, example_class
+from serialspec.lang.model import Erratum, Example
 from serialspec.runtime.checksums import crc_function
 from serialspec.runtime.errors import DecodeError
 from serialspec.runtime.hexbytes import parse_hex
-from serialspec.spec.model import Erratum, Example
 
 EXAMPLES = by_protocol([(g, e) for g in ALL for e in g.protocol.examples])
 ERRATA = by_protocol([(g, e) for g in ALL for e in g.protocol.errata])

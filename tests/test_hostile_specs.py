@@ -16,8 +16,8 @@ from pathlib import Path
 import pytest
 from hostile_cases import CASES, HOSTILE, Mutation, Text, both, put
 from hostile_run import BASES, base, outcome
-from serialspec.emit.python.memory import imported
-from serialspec.spec import SpecErrors, load_protocol
+from serialspec.backends.python.memory import imported
+from serialspec.lang import SpecErrors, load_protocol
 
 LINE = re.compile(r"^(?P<file>[\w.]+\.yaml):(?P<line>[1-9]\d*):(?P<column>[1-9]\d*): (?P<rest>.+)$")
 ROOT = Path(__file__).resolve().parent.parent
@@ -40,6 +40,25 @@ def test_hostile_spec(base_name: str, mutation: Mutation | Text, expected: str |
         return
     assert lines == []
     inert(files)
+
+
+NESTING = [pytest.param(*c[1:], id=c[0]) for c in CASES if c[3] and ("nested" in c[3] or "YAML syntax" in c[3])]
+
+
+@pytest.mark.parametrize("composer", ["libyaml", "pure-Python"])
+@pytest.mark.parametrize(("base_name", "mutation", "expected"), NESTING)
+def test_yaml_errors_do_not_depend_on_the_pyyaml_build(
+    base_name: str, mutation: Mutation | Text, expected: str | None, composer: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The same line, path included, whether PyYAML has libyaml or not (the pure composer recurses per level)."""
+    import yaml
+    from serialspec.lang import loader
+
+    if composer == "libyaml" and not hasattr(yaml, "CSafeLoader"):
+        pytest.skip("this PyYAML has no libyaml")
+    monkeypatch.setattr(loader, "_COMPOSER", yaml.CSafeLoader if composer == "libyaml" else yaml.SafeLoader)
+    lines, _ = outcome(base_name, mutation)
+    assert [LINE.match(line)["rest"] for line in lines if LINE.match(line)] == [expected]  # type: ignore[index]
 
 
 def inert(files: dict[str, str]) -> None:

@@ -3,10 +3,10 @@
 from typing import get_args
 
 import pytest
-from serialspec.emit.common.kinds import Registry
-from serialspec.emit.markdown import kinds as markdown_kinds
-from serialspec.emit.python import kinds as python_kinds
-from serialspec.spec.model import Field, Scalar
+from serialspec.backends.common.kinds import Registry
+from serialspec.backends.markdown import kinds as markdown_kinds
+from serialspec.backends.python import kinds as python_kinds
+from serialspec.lang.model import Field, Scalar
 
 
 @pytest.mark.parametrize("registry", [python_kinds.kind, markdown_kinds.kind], ids=["python", "markdown"])

@@ -7,12 +7,12 @@ import re
 from typing import Any
 
 from conftest import ROOT
-from serialspec.spec.grammar import json_schema
-from serialspec.spec.reference import NAME, dotted, keys, reference_markdown, undocumented
+from serialspec.lang.grammar import json_schema
+from serialspec.lang.reference import NAME, dotted, keys, reference_markdown, undocumented
 
 
 def test_every_key_of_the_grammar_has_a_description() -> None:
-    assert undocumented() == [], "describe these keys where spec/grammar.py declares them"
+    assert undocumented() == [], "describe these keys where lang/grammar.py declares them"
 
 
 def _schema_nodes(node: Any, path: str = "") -> list[tuple[str, dict[str, Any]]]:
@@ -61,7 +61,7 @@ def test_every_plain_key_of_the_committed_reference_has_an_example() -> None:
     rows = [row.split(" | ") for row in text.splitlines() if row.startswith("| `")]
     assert len(rows) > 150
     missing = [row[0] for row in rows if row[4].startswith("—") and "See [" not in row[3]]
-    assert missing == [], "no spec uses these keys: give their shapes in spec/grammar.py an example= value"
+    assert missing == [], "no spec uses these keys: give their shapes in lang/grammar.py an example= value"
 
 
 def test_the_reference_names_no_path_inside_this_repository() -> None:

@@ -16,9 +16,9 @@ from typing import Any
 import pytest
 from conftest import ALL, Generated, by_protocol, examples
 from hypothesis import HealthCheck, given, settings
+from serialspec.lang.model import Message
 from serialspec.runtime.errors import EncodeError
 from serialspec.runtime.message import Record, build, field_names, is_sequence, replace
-from serialspec.spec.model import Message
 from strategies import message_fields
 
 MESSAGES = by_protocol([(g, m) for g in ALL for m in g.protocol.messages()])

@@ -25,8 +25,8 @@ from hiwonder_rrc import (
 )
 from hiwonder_rrc.client import HiwonderRrcClient
 from hiwonder_rrc.simulator import HiwonderRrcSimulator
+from serialspec.lang import SpecErrors, load_protocol
 from serialspec.runtime.errors import DeviceError, RangeError, Timeout
-from serialspec.spec import SpecErrors, load_protocol
 from sim_process import serve
 
 TIMEOUT = 1.0  # generous: tests wait for replies, they never time them

@@ -10,9 +10,9 @@ from pathlib import Path
 
 import pytest
 import yaml
-from serialspec.emit.markdown.docs import emit_docs
-from serialspec.emit.python.package import emit_package
-from serialspec.spec import SpecErrors, load_protocol
+from serialspec.backends.markdown.docs import emit_docs
+from serialspec.backends.python.package import emit_package
+from serialspec.lang import SpecErrors, load_protocol
 
 MINIMAL = """\
 protocol: tiny

@@ -11,10 +11,10 @@ from conftest import examples
 from hostile_run import BASES, base
 from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
-from serialspec.emit import emitters
-from serialspec.spec import SpecErrors
-from serialspec.spec.loader import Located, Path
-from serialspec.spec.resolve import resolve
+from serialspec.backends import emitters
+from serialspec.lang import SpecErrors
+from serialspec.lang.loader import Located, Path
+from serialspec.lang.resolve import resolve
 
 VALUES = st.one_of(
     st.none(),

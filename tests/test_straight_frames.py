@@ -1,4 +1,4 @@
-"""Straight-line frame code (emit/python/framecode.py) against the interpreted frame engine (runtime/framing.py).
+"""Straight-line frame code (backends/python/framecode.py) against the interpreted frame engine (runtime/framing.py).
 
 Codecs of frames that are not of the classic shape check and build their frames in generated straight-line code;
 the engine's FrameCodec (which the stream parser still uses to size frames) stays the reference. On random frames,
@@ -20,9 +20,9 @@ import pytest
 from conftest import ALL, Generated, by_protocol, examples
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from serialspec.lang.model import Message
 from serialspec.runtime.errors import DecodeError
 from serialspec.runtime.framing import ERROR_REPLY, FrameCodec
-from serialspec.spec.model import Message
 from strategies import message_fields
 from test_framing_specs import generate
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 from conftest import ALL, Generated, by_protocol
-from serialspec.spec.model import Example
+from serialspec.lang.model import Example
 
 
 def test_fashion_star_parser_takes_both_directions_at_once() -> None:

@@ -27,8 +27,8 @@ from typing import Any
 import pytest
 from conftest import ALL, Generated
 from hypothesis import HealthCheck, Phase, given, settings
+from serialspec.lang.model import Direction, FrameLayout, Message
 from serialspec.runtime.errors import DecodeError
-from serialspec.spec.model import Direction, FrameLayout, Message
 from strategies import message_fields
 
 FRAMES = int(os.environ.get("SERIALSPEC_STRESS_FRAMES", "5000"))

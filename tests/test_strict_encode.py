@@ -9,9 +9,9 @@ from typing import Any
 
 import pytest
 from conftest import ALL, Generated, by_protocol
+from serialspec.lang.model import Example, Scalar
 from serialspec.runtime.errors import EncodeError
 from serialspec.runtime.message import field_names
-from serialspec.spec.model import Example, Scalar
 from test_captures import pty_pair
 
 BAD = [True, False, 1.5, float("nan"), float("inf"), "1", None, [1], {"a": 1}, 10**40, -(10**40)]

@@ -279,7 +279,7 @@ def test_generated_code_runs_on_the_runtime_alone(
         "import sys; sys.path.insert(0, 'lamps')\n"
         "import tinylamp, tinylamp.client, tinylamp.simulator\n"
         "frame = tinylamp.encode(tinylamp.SetBrightnessRequest(lamp_id=1, brightness=50, fade=200))\n"
-        "print(frame.hex(' '), 'serialspec.spec' in sys.modules)\n"
+        "print(frame.hex(' '), 'serialspec.lang' in sys.modules)\n"
         "try:\n    import yaml\nexcept ImportError:\n    print('no yaml')\n"
     )
     assert printed.splitlines() == [f"{DIM} False", "no yaml"]

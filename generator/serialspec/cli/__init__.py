@@ -8,8 +8,8 @@ import sys
 from collections.abc import Sequence
 
 from serialspec import __version__
+from serialspec.lang.errors import SpecErrors
 from serialspec.runtime.errors import SerialspecError
-from serialspec.spec.errors import SpecErrors
 
 # Each verb (its module, serialspec.cli.<verb>, is imported only to run it: `generate` loads no serial-port code)
 # and its one-line help.

@@ -12,10 +12,10 @@ from serialspec.cli import capture
 from serialspec.cli.frames import Frames
 from serialspec.cli.protocols import SPEC_HELP, open_spec
 from serialspec.cli.views import FlagNames, engineering, message_spec, register_view, unit_symbols, with_unit
+from serialspec.lang.model import Protocol, replies_by_request, reply_to
 from serialspec.runtime.errors import DecodeError, SerialspecError
 from serialspec.runtime.hexbytes import parse_hex
 from serialspec.runtime.message import Message
-from serialspec.spec.model import Protocol, replies_by_request, reply_to
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

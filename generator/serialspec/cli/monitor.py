@@ -16,8 +16,8 @@ from serialspec.cli import capture
 from serialspec.cli.frames import Frames, Seen
 from serialspec.cli.protocols import SPEC_HELP, open_spec
 from serialspec.cli.views import engineering, unit_symbols, with_unit
+from serialspec.lang.model import Protocol
 from serialspec.runtime.errors import PortError, SerialspecError
-from serialspec.spec.model import Protocol
 
 COLOURS = {"request": "\033[36m", "response": "\033[32m", "BAD": "\033[31m"}
 

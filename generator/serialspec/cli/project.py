@@ -26,8 +26,8 @@ from typing import Any
 
 from serialspec import cache
 from serialspec.collection import without_cycle_collection
-from serialspec.spec.errors import SpecError, SpecErrors
-from serialspec.spec.frozen import frozen
+from serialspec.lang.errors import SpecError, SpecErrors
+from serialspec.lang.frozen import frozen
 
 SCHEMA_NAME = "serialspec.schema.json"
 #: The first line of every generated text file names the spec it came from.
@@ -118,7 +118,7 @@ def expected_files(proj: Project) -> tuple[dict[Path, str], list[SpecError]]:
     if proj.reference is not None and not errors:  # its examples come from every spec: none while one fails
 
         def reference() -> str:
-            from serialspec.spec.reference import reference_markdown
+            from serialspec.lang.reference import reference_markdown
 
             return reference_markdown([outputs.data for outputs in made])
 
@@ -146,7 +146,7 @@ def spec_outputs(spec: Path, display: str, *, with_data: bool = False) -> Output
     try:
         raw = spec.read_bytes()  # read once: what is generated is what the key names, whatever happens to the file
     except OSError:
-        from serialspec.spec.loader import load_file
+        from serialspec.lang.loader import load_file
 
         load_file(str(spec), display)  # raises SpecErrors: what is wrong, in the loader's words
         return spec_outputs(spec, display, with_data=with_data)  # readable after all
@@ -173,9 +173,9 @@ def spec_outputs(spec: Path, display: str, *, with_data: bool = False) -> Output
 @without_cycle_collection  # the emitters' imports (first spec), rendering and the examples' checks too
 def _generate(raw: bytes, display: str, key: bytes) -> Outputs:
     """Load and resolve one spec, run every emitter over it and check its examples and errata (raises SpecErrors)."""
-    from serialspec.emit import emitters
-    from serialspec.spec.loader import decode_text, load_text
-    from serialspec.spec.resolve import resolve
+    from serialspec.backends import emitters
+    from serialspec.lang.loader import decode_text, load_text
+    from serialspec.lang.resolve import resolve
 
     located = load_text(decode_text(raw, display), display)
     protocol = resolve(located)
@@ -193,7 +193,7 @@ def _generate(raw: bytes, display: str, key: bytes) -> Outputs:
 def _schema() -> str:
     import json
 
-    from serialspec.spec.grammar import json_schema
+    from serialspec.lang.grammar import json_schema
 
     return json.dumps(json_schema(), indent=2, ensure_ascii=False) + "\n"
 

@@ -16,9 +16,9 @@ import sys
 from pathlib import Path
 from types import ModuleType
 
+from serialspec.lang import load_protocol
+from serialspec.lang.model import Protocol
 from serialspec.runtime.errors import SerialspecError
-from serialspec.spec import load_protocol
-from serialspec.spec.model import Protocol
 
 SHIPPED_SPEC = "spec.yaml"
 SPEC_HELP = (
@@ -101,8 +101,8 @@ def generated_from_this(protocol: Protocol, spec_text: str) -> ModuleType | None
 
 def package_in_memory(protocol: Protocol) -> ModuleType:
     """The protocol's package generated from the resolved spec and imported from memory (nothing on disk)."""
-    from serialspec.emit.python.memory import imported
-    from serialspec.emit.python.package import emit_package
+    from serialspec.backends.python.memory import imported
+    from serialspec.backends.python.package import emit_package
 
     files = emit_package(protocol)
     with imported(protocol.name, files, protocol.spec_path) as package:

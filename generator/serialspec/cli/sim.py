@@ -12,8 +12,8 @@ from typing import Any
 
 from serialspec.cli import capture
 from serialspec.cli.protocols import SPEC_HELP, open_spec
+from serialspec.lang.model import FrameElement, Protocol, Scalar
 from serialspec.runtime.errors import SerialspecError
-from serialspec.spec.model import FrameElement, Protocol, Scalar
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

@@ -5,10 +5,10 @@ from __future__ import annotations
 import re
 from typing import Any
 
+from serialspec.lang.model import Bytes, Field, Protocol, Scalar, Table, TableValue
+from serialspec.lang.model import Message as MessageSpec
 from serialspec.runtime.message import Message
 from serialspec.runtime.registers import Register, RegisterMap
-from serialspec.spec.model import Bytes, Field, Protocol, Scalar, Table, TableValue
-from serialspec.spec.model import Message as MessageSpec
 
 
 class FlagNames(list[str]):

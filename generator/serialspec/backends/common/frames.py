@@ -1,0 +1,72 @@
+"""The model's frame layouts as the runtime's frame engine objects, for every emitter.
+
+The Python codec prints them as code; the markdown emitter runs them over example frames (to show stuffed frames
+byte by byte). One mapping from model to engine, so the two cannot disagree.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from serialspec.lang.model import Checksum, Direction, FrameElement, FrameLayout, Protocol
+from serialspec.runtime.checksums import crc_function, sum_function, xor_function
+from serialspec.runtime.framing import Element, ElementKind, Layout, Transparency
+
+KINDS: dict[str, ElementKind] = {
+    "header": "constant",
+    "trailer": "constant",
+    "constant": "constant",
+    "address": "value",
+    "status": "value",
+    "command": "command",
+    "length": "length",
+    "content": "content",
+    "checksum": "checksum",
+}
+
+
+def checksum_function(checksum: Checksum) -> Callable[[bytes], int]:
+    width = checksum.type.size * 8
+    if checksum.algorithm == "crc":
+        c = checksum.crc
+        assert c is not None
+        return crc_function(c.width, c.poly, c.init, c.refin, c.refout, c.xorout)
+    if checksum.algorithm == "xor":
+        return xor_function(width)
+    return sum_function(width, checksum.invert)
+
+
+def runtime_element(layout: FrameLayout, element: FrameElement) -> Element:
+    kind = KINDS[element.role]
+    span = (0, 0)
+    function = None
+    if kind == "length":
+        span = (layout.index(element.counts[0]), layout.index(element.counts[1]))
+    elif kind == "checksum":
+        assert element.checksum is not None
+        span = (layout.index(element.checksum.first), layout.index(element.checksum.last))
+        function = checksum_function(element.checksum)
+    return Element(
+        name=element.name,
+        kind=kind,
+        size=element.size or 0,
+        endian="big" if element.endian == ">" else "little",
+        constant=element.constant,
+        span=span,
+        adds=element.adds,
+        checksum=function,
+        minimum=int(element.minimum) if kind in ("value", "command") else 0,
+        maximum=int(element.maximum) if kind in ("value", "command") else 0,
+        also=element.broadcast if kind in ("value", "command") else None,
+    )
+
+
+def runtime_layout(layout: FrameLayout) -> Layout:
+    t = layout.transparency
+    transparency = Transparency((layout.index(t.first), layout.index(t.last)), t.replace) if t else None
+    elements = tuple(runtime_element(layout, e) for e in layout.elements)
+    return Layout(layout.name or layout.direction.value, elements, transparency)
+
+
+def runtime_layouts(protocol: Protocol, direction: Direction) -> tuple[Layout, ...]:
+    return tuple(runtime_layout(layout) for layout in protocol.framing.alternatives[direction])

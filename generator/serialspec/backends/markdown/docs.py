@@ -1,0 +1,700 @@
+"""Emit the markdown reference of one protocol: frames, checksum, commands, tables, examples, errata.
+
+Every piece of spec text goes through `cell()` or `text()`, so a `|`, `<` or newline in a description can
+neither break a table nor inject HTML into the rendered page.
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+from typing import Any
+
+from serialspec.backends.common import render as common
+from serialspec.backends.common.frames import runtime_layouts
+from serialspec.backends.common.numbers import number
+from serialspec.backends.common.text import collapse
+from serialspec.backends.markdown.kinds import anchor, kind, scalar_range
+from serialspec.collection import without_cycle_collection
+from serialspec.lang.frozen import mutable
+from serialspec.lang.model import (
+    Checksum,
+    Command,
+    Device,
+    DeviceModel,
+    Direction,
+    ErratumCheck,
+    Example,
+    Field,
+    FrameLayout,
+    Group,
+    Message,
+    Protocol,
+    Scalar,
+    TableBlock,
+    TableEntry,
+    TableValue,
+    fixed_size,
+)
+from serialspec.runtime.errors import SerialspecError
+
+
+def text(value: str) -> str:
+    """Spec text for a markdown paragraph: one line, HTML-significant characters escaped."""
+    return collapse(value).replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
+
+
+def cell(value: object) -> str:
+    """A value for a markdown table cell."""
+    return text(str(value)).replace("|", "\\|") or " "
+
+
+def erratum_check_words(check: ErratumCheck) -> str:
+    """What tells the printed reading from the correct one, in words: the reader's own generated code can repeat it."""
+    frame = code_span(check.frame.hex(" ").upper() if check.frame is not None else check.frame_text)
+    direction = f" (as a {check.direction.value})" if check.direction else ""
+    if check.kind == "frame_fails":
+        return f"decoding {frame}{direction} fails with an error containing “{check.error}”"
+    if check.kind == "frame_decodes_as":
+        target = f"`{check.command}`" + (f" / `{check.subcommand}`" if check.subcommand else "")
+        return f"{frame}{direction} decodes as {target}"
+    if check.kind == "checksum_value":
+        wrong = check.claimed if isinstance(check.claimed, str) else f"{check.claimed:#04x}"
+        return f"{frame}{direction} verifies with its checksum {check.actual:#04x}; with {wrong} it fails"
+    if check.kind == "crc_parameters":
+        parameters = check.claimed.items() if isinstance(check.claimed, dict) else ()
+        named = ", ".join(
+            f"{k} {v:#04X}".replace("0X", "0x") if isinstance(v, int) else f"{k} {v}" for k, v in parameters
+        )
+        examples = f"{len(check.examples)} examples'" if check.examples else "the examples'"
+        return f"the CRC with the claimed parameters ({named or check.claimed}) does not give {examples} check bytes"
+    return "none: the correction is explained in words"
+
+
+def code_span(value: str) -> str:
+    """Text shown as printed (an erratum's quote of a document): a code span, so nothing in it is markup, whatever
+    backticks it holds (the fence is longer than any run of them inside)."""
+    value = collapse(value)
+    runs = [len(run) for run in "".join(c if c == "`" else " " for c in value).split()]
+    fence = "`" * (max(runs, default=0) + 1)
+    padded = f" {value} " if value.startswith("`") or value.endswith("`") else value
+    return f"{fence}{padded or ' '}{fence}"
+
+
+def type_name(f: Field) -> str:
+    return kind(f).type_name(f)
+
+
+def range_text(f: Field) -> str:
+    return kind(f).range_text(f)
+
+
+def meaning(f: Field) -> str:
+    parts = [f.description, *kind(f).meaning(f)]
+    if f.inferred:
+        parts.append(f"**Inferred layout:** {f.inferred}")
+    return " ".join(p for p in parts if p)
+
+
+@mutable
+class Row:
+    offset: str
+    name: str
+    type: str
+    unit: str
+    range: str
+    meaning: str
+
+
+def field_rows(fields: tuple[Field, ...], start: int | None, prefix: str = "") -> list[Row]:
+    rows = []
+    offset = start
+    for f in fields:
+        size = fixed_size(f)
+        where = "" if offset is None else (str(offset) if size in (None, 1) else f"{offset}..{offset + size - 1}")
+        if offset is not None and size is None:
+            where = f"{offset}.."
+        rows.append(Row(where, prefix + f.name, type_name(f), kind(f).unit(f), range_text(f), meaning(f)))
+        if isinstance(f, Group):
+            rows += field_rows(f.fields, None, prefix + f.name + "[].")
+        if isinstance(f, TableBlock):
+            rows += [
+                Row(
+                    "",
+                    f"{prefix}{f.name}.{e.name}",
+                    e.type.name,
+                    e.unit,
+                    scalar_range(e.type, e.minimum, e.maximum),
+                    f"{f.table.key_name} {e.key}: {e.description}",
+                )
+                for e in f.entries
+            ]
+        offset = None if offset is None or size is None else offset + size
+    return rows
+
+
+def message_context(protocol: Protocol, message: Message | None) -> dict[str, Any] | None:
+    if message is None:
+        return None
+    layout = protocol.framing.layouts[message.direction]
+    content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
+    size = size_text(message.min_size, message.max_size, content_limit(layout))
+    rows = [
+        Row(str(layout.offsets[e.name]), e.name, e.type.name if e.type else "", "", "", text(e.description))
+        for e in layout.value_elements
+    ]
+    rows += field_rows(message.fields, content_offset)
+    return {
+        "direction": message.direction.value,
+        "rows": [{k: cell(v) for k, v in vars(r).items()} for r in rows],
+        "size": size,
+        "optional": text(message.optional),
+        "unsolicited": message.unsolicited,
+        "answers": message.answers,
+        "reply": reply_text(message, protocol) or error_reply_text(protocol, message),
+        "description": text(message.description),
+    }
+
+
+def content_limit(layout: FrameLayout) -> int | None:
+    """The most content bytes the frame's length element can count (None: no length element)."""
+    length = next((e for e in layout.elements if e.role == "length" and e.type is not None), None)
+    return None if length is None or length.type is None else (1 << 8 * length.type.size) - 1 - layout.length_adds
+
+
+def size_text(low: int, high: int | None, limit: int | None) -> str:
+    if limit is not None and (high is None or high > limit):
+        high = limit
+    if high == low:
+        return f"{low} byte" + ("" if low == 1 else "s")
+    return f"{low}..{high} bytes" if high is not None else f"{low} bytes or more"
+
+
+def reply_text(message: Message, protocol: Protocol | None = None) -> str:
+    """For a request answered by another command's response: which, and the parameter that switches it; for a
+    response that shares its code with other replies: how a reply is told to have this layout."""
+    if message.direction == Direction.RESPONSE and protocol is not None:
+        return shared_reply_text(protocol, message)
+    if not message.answered_by:
+        return ""
+    switch = message.reply_when
+    when = f", sent only while `{switch.entry}` {switch.symbol} {switch.equals}" if switch else ""
+    return f"answered by the `{message.answered_by}` response{when}"
+
+
+def error_reply_text(protocol: Protocol, message: Message) -> str:
+    """For the error reply: the code it is sent under, and what it carries besides its fields."""
+    error = protocol.error_reply
+    if not message.error_reply or error is None:
+        return ""
+    return (
+        f"sent instead of any request's reply, with `{error.element}` = the request's code | {error.flag:#04x} "
+        f"(the message holds the request's code as `{error.element}`)"
+    )
+
+
+def shared_reply_text(protocol: Protocol, message: Message) -> str:
+    """A reply layout that shares its code (or its having none) with others: chosen by the request it answers."""
+    layout = protocol.framing.layouts[Direction.RESPONSE]
+    code = protocol.command(message.command).code if layout.has_command else None
+    sharing, asking = reply_sharing(protocol)
+    if sharing[code] < 2:
+        return ""
+    askers = sorted(asking.get(message.key, ()))
+    answers = ", ".join(f"`{a}`" for a in askers) or "no request"
+    default = (
+        "; a reply decoded without its request is read with this layout"
+        if message.default_reply
+        else "; chosen by the request it answers (the replies share their code)"
+    )
+    return f"the layout of the replies to {answers}{default}"
+
+
+_SHARING: dict[int, tuple[Protocol, Counter[int | None], dict[str, set[str]]]] = {}
+
+
+def reply_sharing(protocol: Protocol) -> tuple[Counter[int | None], dict[str, set[str]]]:
+    """Worked out once per protocol (once per message was quadratic in the number of commands): how many plain
+    replies share each code (None: replies without one), and the commands whose requests each reply layout
+    answers."""
+    cached = _SHARING.get(id(protocol))
+    if cached is None or cached[0] is not protocol:
+        has_command = protocol.framing.layouts[Direction.RESPONSE].has_command
+        sharing: Counter[int | None] = Counter()
+        asking: dict[str, set[str]] = {}
+        for m in protocol.messages():
+            if m.direction == Direction.REQUEST:
+                asking.setdefault(m.answered_by or m.key, set()).add(m.command)
+            elif not m.unsolicited and not protocol.command(m.command).subcommands:
+                sharing[protocol.command(m.command).code if has_command else None] += 1
+        _SHARING.clear()  # one protocol at a time: the cache never holds on to old models
+        cached = _SHARING[id(protocol)] = (protocol, sharing, asking)
+    return cached[1], cached[2]
+
+
+def command_context(protocol: Protocol, command: Command) -> dict[str, Any]:
+    subs = []
+    for sub in command.subcommands:
+        subs.append(
+            {
+                "name": sub.name,
+                "code": f"{sub.code:#04x}",
+                "title": text(sub.title),
+                "title_cn": text(sub.title_cn),
+                "description": text(sub.description),
+                "source": text(sub.source),
+                "anchor": anchor("command", command.name, sub.name),
+                "messages": same_once(
+                    [m for m in (message_context(protocol, sub.request), message_context(protocol, sub.response)) if m]
+                ),
+                "examples": examples_for(protocol, command.name, sub.name),
+            }
+        )
+    return {
+        "name": command.name,
+        "code": f"{command.code:#04x}" if command.code is not None else "—",
+        "title": text(command.title),
+        "title_cn": text(command.title_cn),
+        "description": text(command.description),
+        "broadcast": text(command.broadcast),
+        "source": text(command.source),
+        "anchor": anchor("command", command.name),
+        "messages": same_once(
+            [m for m in (message_context(protocol, command.request), message_context(protocol, command.response)) if m]
+        ),
+        "subcommands": subs,
+        "examples": examples_for(protocol, command.name, None),
+    }
+
+
+def same_once(parts: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """A request and a response (or two frames) that read exactly alike are shown once, for both directions."""
+    if len(parts) == 2 and {**parts[0], "direction": ""} == {**parts[1], "direction": ""}:
+        return [{**parts[0], "direction": f"{parts[0]['direction']} and {parts[1]['direction']}"}]
+    return parts
+
+
+def examples_for(protocol: Protocol, command: str, subcommand: str | None) -> list[str]:
+    return [e.name for e in protocol.examples if (e.command, e.subcommand) == (command, subcommand)]
+
+
+def frame_picture(protocol: Protocol) -> list[str]:
+    """The frame of each direction on one line, columns aligned: `12 4C | cmd_id | length | content (n) | checksum`."""
+    lines = []
+    for layout in (lay for lays in protocol.framing.alternatives.values() for lay in lays):
+        parts = []
+        for e in layout.elements:
+            if e.fixed:
+                parts.append(e.constant.hex(" ").upper())
+            elif e.role == "content":
+                parts.append(f"{e.name} (n bytes)")
+            else:
+                parts.append(e.name + (f" ({e.type.size} bytes)" if e.type and e.type.size > 1 else ""))
+        lines.append((layout.direction.value + (f" {layout.name}" if layout.name else ""), parts))
+    columns = max(len(parts) for _, parts in lines)
+    widths = [max(len(p[i]) for _, p in lines if i < len(p)) for i in range(columns)]
+    label = max(9, *(len(direction) for direction, _ in lines))
+    return [
+        direction.ljust(label) + " " + " | ".join(part.ljust(widths[i]) for i, part in enumerate(parts)).rstrip()
+        for direction, parts in lines
+    ]
+
+
+def frame_context(protocol: Protocol, layout: FrameLayout) -> dict[str, Any]:
+    rows = []
+    offset = 0
+    variable = False  # past the content (or the stuffed span): offsets vary from frame to frame
+    first_variable = layout.transparency.first if layout.transparency else None
+    for e in layout.elements:
+        size = e.size
+        variable = variable or e.name == first_variable
+        if e.role == "header" and layout.classic:
+            description = f"{layout.header.hex(' ').upper()} — {e.description}"
+        elif e.fixed:
+            description = f"{e.constant.hex(' ').upper()} — {e.description}"
+        elif e.role == "checksum" and not layout.classic and e.checksum is not None:
+            endian = "big-endian" if e.endian == ">" else "little-endian"
+            description = f"over `{e.checksum.first}`..`{e.checksum.last}`, {endian}. {e.description}"
+        else:
+            description = e.description
+        kind = e.type.name if e.type else ("bytes" if e.fixed else "n bytes")
+        if e.role == "length" and layout.classic:
+            kind += f" = n + {layout.length_adds}" if layout.length_adds else " = n"
+        elif e.role == "length":
+            adds = f" {'+' if e.adds > 0 else '-'} {abs(e.adds)}" if e.adds else ""
+            endian = ", big-endian" if e.endian == ">" and (e.size or 0) > 1 else ""
+            kind += f" = bytes `{e.counts[0]}`..`{e.counts[1]}` as sent{adds}{endian}"
+        where = f"{offset}.." if size is None else (str(offset) if size == 1 else f"{offset}..{offset + size - 1}")
+        if e.role in ("checksum",) or (offset is None):
+            where = "last" if e.role == "checksum" else where
+        if variable and e.role not in ("content", "checksum"):
+            where = "after the content" if e.role == "trailer" or layout.offsets.get(e.name) is None else where
+        rows.append(
+            {
+                "offset": cell(where),
+                "name": cell(e.name),
+                "role": e.role,
+                "type": cell(kind),
+                "meaning": cell(description),
+            }
+        )
+        offset += size or 0
+    title = layout.direction.value.capitalize() + (f" frame, layout `{layout.name}`" if layout.name else " frame")
+    return {"direction": layout.direction.value, "title": title, "rows": rows}
+
+
+def transparency_text(protocol: Protocol) -> str:
+    """The byte stuffing or escaping rule, if the frames have one."""
+    rules = {layout.transparency for layouts in protocol.framing.alternatives.values() for layout in layouts}
+    found = [t for t in rules if t is not None]
+    if not found:
+        return ""
+    t = found[0]
+    pairs = ", ".join(f"{plain.hex(' ').upper()} is sent as {wire.hex(' ').upper()}" for plain, wire in t.replace)
+    return text(
+        f"From `{t.first}` to `{t.last}`, {pairs}: encode applies it, decode and the stream parser remove it. "
+        f"Lengths count the bytes as sent; checksums outside the span cover them as sent. {t.description}"
+    )
+
+
+def checksums_context(protocol: Protocol) -> list[dict[str, Any]]:
+    """Every checksum of the (first) layouts; a classic frame's one with a worked example."""
+    if protocol.framing.classic:
+        return [checksum_context(protocol)]
+    found: dict[str, Checksum] = {}
+    for layouts in protocol.framing.alternatives.values():
+        for layout in layouts:
+            for checksum in layout.checksums:
+                found.setdefault(checksum.name, checksum)
+    return [checksum_context(protocol, checksum) for checksum in found.values()]
+
+
+def checksum_context(protocol: Protocol, general: Checksum | None = None) -> dict[str, Any]:
+    checksum = general or protocol.framing.checksum
+    assert checksum is not None
+    example = next(iter(protocol.examples), None)
+    worked = ""
+    if general is not None and example is not None:
+        worked = f"every example's `{checksum.name}` verifies (e.g. `{example.name}`)"
+    elif example is not None:
+        layout = protocol.framing.layouts[example.direction]
+        covered = example.frame[layout.covered_from : len(example.frame) - layout.covered_to_end]
+        if checksum.algorithm == "sum":
+            total = sum(covered)
+            invert = "~" if checksum.invert else ""
+            worked = (
+                f"{invert}({' + '.join(f'0x{b:02X}' for b in covered)}) = {invert}{total:#x} "
+                f"→ 0x{example.frame[-1]:02X} (example `{example.name}`)"
+            )
+        else:
+            worked = f"CRC of {covered.hex(' ').upper()} = 0x{example.frame[-1]:02X} (example `{example.name}`)"
+    if checksum.algorithm == "sum":
+        what = (
+            "bitwise NOT of the sum" if checksum.invert else "sum"
+        ) + f" of the covered bytes, modulo {1 << (checksum.type.size * 8)}"
+        params = []
+    else:
+        assert checksum.crc is not None
+        c = checksum.crc
+        what = f"{c.name or 'CRC'} over the covered bytes"
+        params = [
+            ("width", c.width),
+            ("poly", f"{c.poly:#04x}"),
+            ("init", f"{c.init:#04x}"),
+            ("refin", c.refin),
+            ("refout", c.refout),
+            ("xorout", f"{c.xorout:#04x}"),
+            ("check ('123456789')", f"{c.check:#04x}"),
+        ]
+    if checksum.algorithm == "xor":
+        what = f"XOR of the covered bytes ({checksum.type.size * 8} bits)"
+    label = f" `{checksum.name}`" if general is not None else ""
+    return {
+        "label": label,
+        "what": what,
+        "first": checksum.first,
+        "last": checksum.last,
+        "worked": worked,
+        "params": params,
+    }
+
+
+def general_breakdown(protocol: Protocol, example: Example, message: Message | None) -> list[dict[str, str]]:
+    """An example frame of any layout, element by element (unstuffed) and field by field, by the frame engine."""
+    layouts = runtime_layouts(protocol, example.direction)
+    layout = next((lay for lay in layouts if example.frame.startswith(lay.header)), layouts[0])
+    try:
+        unwrapped = layout.unwrap(example.frame)
+    except SerialspecError as exc:  # the example verification reports it as a spec error; the page says it too
+        return [{"bytes": example.frame.hex(" ").upper(), "field": "(frame)", "value": cell(f"does not decode: {exc}")}]
+    rows: list[dict[str, str]] = []
+    for e, part in zip(layout.elements, unwrapped.parts, strict=True):
+        if e.kind == "content" and message is not None:
+            rows += content_rows(message.fields, example.fields, part, 0, len(part))
+            continue
+        value: Any = example.fields.get(e.name, "")
+        if e.kind == "command":
+            value = example.command
+        elif e.kind == "length":
+            value = f"{e.unpack(part)} (bytes `{layout.elements[e.span[0]].name}`..`{layout.elements[e.span[1]].name}`)"
+        elif e.kind == "checksum":
+            value = "verifies"
+        rows.append({"bytes": part.hex(" ").upper(), "field": e.name, "value": cell(_show(value))})
+    return rows
+
+
+def breakdown(protocol: Protocol, example: Example) -> list[dict[str, str]]:
+    """Byte spans of an example frame, element by element and field by field, with the values."""
+    if not protocol.framing.classic:
+        command = protocol.command(example.command)
+        holder = next((s for s in command.subcommands if s.name == example.subcommand), None) or command
+        return general_breakdown(
+            protocol, example, holder.request if example.direction == Direction.REQUEST else holder.response
+        )
+    layout = protocol.framing.layouts[example.direction]
+    command = protocol.command(example.command)
+    sub = next((s for s in command.subcommands if s.name == example.subcommand), None)
+    holder = sub or command
+    message = holder.request if example.direction == Direction.REQUEST else holder.response
+    frame = example.frame
+    if len(frame) < layout.overhead:  # the example verification reports it as a spec error; the page says it too
+        short = f"does not decode: {len(frame)} bytes, fewer than the frame's {layout.overhead} without content"
+        return [{"bytes": frame.hex(" ").upper(), "field": "(frame)", "value": cell(short)}]
+    rows: list[dict[str, str]] = []
+    offset = 0
+    content_size = len(frame) - layout.overhead
+    for e in layout.elements:
+        size = content_size if e.role == "content" else (e.size or 0)
+        if e.role == "content" and message is not None:
+            rows += content_rows(message.fields, example.fields, frame, offset, offset + size)
+        else:
+            value = example.fields.get(e.name, "")
+            if e.role == "command":
+                value = f"{command.name}"
+            elif e.role == "length":
+                value = f"{frame[offset]} ({content_size} content bytes)"
+            elif e.role == "checksum":
+                value = "verifies"
+            rows.append(
+                {
+                    "bytes": frame[offset : offset + size].hex(" ").upper(),
+                    "field": e.name,
+                    "value": cell(_show(value)),
+                }
+            )
+        offset += size
+    return rows
+
+
+def content_rows(
+    fields: tuple[Field, ...], values: dict[str, Any], frame: bytes, start: int, end: int
+) -> list[dict[str, str]]:
+    rows = []
+    offset = start
+    for f in fields:
+        size = fixed_size(f)
+        value: Any = values.get(f.name, "")
+        if isinstance(f, Scalar) and f.const is not None:
+            value = f"{f.const:#04x} (selector)"
+        elif isinstance(f, Scalar) and f.derived:
+            target = values.get(f.derived[1], [])
+            value = (
+                f"{frame[offset] if offset < end else ''} (derived)"
+                if f.derived[0] == "count" or not target
+                else "derived"
+            )
+        if size is None:
+            if isinstance(f, Group):
+                items = values.get(f.name)  # recorded values; a malformed record is a spec error of its own
+                count = len(items) if isinstance(items, list) else 0
+                item = f.item_size
+                size = count * item if item is not None else end - offset
+            elif isinstance(f, TableValue):
+                size = end - offset
+            else:
+                size = end - offset
+        rows.append(
+            {
+                "bytes": frame[offset : offset + size].hex(" ").upper(),
+                "field": f.name,
+                "value": cell(_show(value)),
+            }
+        )
+        offset += size
+    return rows
+
+
+def _show(value: Any) -> str:
+    if isinstance(value, bool):  # coils and other single bits, as the documents print them
+        return str(int(value))
+    if isinstance(value, dict):
+        return ", ".join(f"{k}={_show(v)}" for k, v in value.items())
+    if isinstance(value, list):
+        return "[" + "; ".join(_show(v) for v in value) + "]"
+    return str(value)
+
+
+@without_cycle_collection
+def emit_docs(protocol: Protocol) -> str:
+    commands = [command_context(protocol, c) for c in protocol.commands]
+    examples = [
+        {
+            "name": e.name,
+            "source": text(e.source),
+            "description": text(e.description),
+            "direction": e.direction.value,
+            "command": e.command + (f".{e.subcommand}" if e.subcommand else ""),
+            "anchor": anchor("command", e.command, e.subcommand or ""),
+            "printed": code_span(e.printed),
+            "frame": e.frame.hex(" ").upper(),
+            "erratum": e.erratum,
+            "partial": e.printed_span != (0, 0),
+            "completed": text(e.completed),
+            "rows": breakdown(protocol, e),
+        }
+        for e in protocol.examples
+    ]
+    tables = [
+        {
+            "name": t.name,
+            "anchor": anchor("table", t.name),
+            "title": text(t.title),
+            "key": t.key_name,
+            "description": text(t.description),
+            "source": text(t.source),
+            "rows": [
+                {
+                    "key": f"{e.key}" if t.key_name != "address" else f"{e.key:#04x}",
+                    "name": cell("(reserved)" if e.reserved else e.name)
+                    + (f"<br>{cell(e.name_cn)}" if e.name_cn else ""),
+                    "type": e.type.name + sign_note(e) + (f", {cell(e.unit)}" if e.unit else ""),
+                    "range": scalar_range(e.type, e.minimum, e.maximum),
+                    "default": cell("" if e.default is None else e.default),
+                    "access": e.access + (f", {e.memory}" if e.memory else ""),
+                    "meaning": cell(
+                        e.description
+                        + (f" Values: [{e.enum.class_name}](#enum-{anchor(e.enum.name)})." if e.enum else "")
+                    ),
+                }
+                for e in t.entries
+            ],
+        }
+        for t in protocol.tables
+    ]
+    enums = [
+        {
+            "name": e.name,
+            "class_name": e.class_name,
+            "anchor": anchor("enum", e.name),
+            "description": text(e.description) or used_by(protocol, e),
+            "values": [{"value": v.value, "name": v.name.lower(), "text": cell(v.text) or "—"} for v in e.values],
+        }
+        for e in protocol.enums
+    ]
+    flags = [
+        {
+            "name": f.name,
+            "class_name": f.class_name,
+            "anchor": anchor("flags", f.name),
+            "description": text(f.description) or used_by(protocol, f),
+            "bits": [{"bit": b.bit, "name": b.name.lower(), "text": cell(b.text) or "—"} for b in f.bits],
+        }
+        for f in protocol.flags
+    ]
+    errata = [
+        {
+            "name": e.name,
+            "source": text(e.source),
+            "printed": code_span(e.printed),
+            "correct": text(e.correct),
+            "check": erratum_check_words(e.check),
+        }
+        for e in protocol.errata
+    ]
+    serial = protocol.serial
+    device = protocol.device
+    return common.render(
+        "serialspec.backends.markdown",
+        "docs.md.j2",
+        models=[model_context(device, m) for m in device.models] if device else [],
+        model_entry=device.model_entry if device else "",
+        protocol=protocol,
+        title=text(protocol.title),
+        description=text(protocol.description),
+        sources=[(k, text(v)) for k, v in protocol.sources.items()],
+        serial=[
+            ("baud rate", serial.baudrate),
+            ("data bits", serial.bytesize),
+            ("parity", serial.parity),
+            ("stop bits", number(serial.stopbits)),
+            ("byte order", protocol.byte_order + "-endian"),
+        ],
+        serial_notes=text(serial.notes),
+        framing=text(protocol.framing.description),
+        frames=same_once(
+            [frame_context(protocol, lay) for lays in protocol.framing.alternatives.values() for lay in lays]
+        ),
+        frame_picture=frame_picture(protocol),
+        transparency=transparency_text(protocol),
+        shared_header=protocol.framing.shared_header,
+        has_header=any(layout.header for layout in protocol.framing.layouts.values()),
+        gap=number(protocol.framing.gap) if protocol.framing.gap else "",
+        checksums=checksums_context(protocol),
+        matching=", ".join(protocol.matching),
+        matching_description=text(protocol.matching_description),
+        commands=commands,
+        tables=tables,
+        enums=enums,
+        flags=flags,
+        examples=examples,
+        errata=errata,
+    )
+
+
+def model_context(device: Device, model: DeviceModel) -> dict[str, Any]:
+    """One model: its values and where its entries differ from the table, one row per entry, in table order."""
+    table = {e.name: e for e in device.memory.entries} if device.memory else {}
+    names = [n for n in table if n in model.initial or model.entry(n)]
+    names += [n for n in model.initial if n not in table]  # state variables
+    rows = []
+    for name in names:
+        entry, override = table.get(name), model.entry(name)
+        bounds = override or entry
+        rows.append(
+            {
+                "name": name,
+                "value": number(model.initial[name]) if name in model.initial else "",
+                "range": f"{number(bounds.minimum)}..{number(bounds.maximum)}" if bounds else "",
+                "unit": cell(override.unit if override else entry.unit if entry else ""),
+                "note": cell(override.description if override else ""),
+            }
+        )
+    return {
+        "name": model.name,
+        "number": model.number,
+        "anchor": anchor("model", model.name),
+        "title": cell(model.title),
+        "description": text(model.description),
+        "source": text(model.source),
+        "rows": rows,
+    }
+
+
+def used_by(protocol: Protocol, values: Any) -> str:
+    """Where an enum or flag set is used, for one that has no description of its own."""
+    users = dict.fromkeys(
+        [
+            f"`{m.key}` {m.direction.value} `{f.name}`"
+            for m in protocol.messages()
+            for f in m.fields
+            if isinstance(f, Scalar) and values in (f.enum, f.flags)
+        ]
+        + [f"`{t.name}` entry `{e.name}`" for t in protocol.tables for e in t.entries if values in (e.enum, e.flags)]
+    )
+    return ("Values of " + ", ".join(users) + ".") if users else ""
+
+
+def sign_note(entry: TableEntry) -> str:
+    if not entry.sign_magnitude:
+        return ""
+    top = entry.type.size * 8 - 1
+    return " sign-magnitude" + ("" if entry.sign_bit in (None, top) else f" (sign in bit {entry.sign_bit})")

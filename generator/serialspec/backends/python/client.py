@@ -1,0 +1,622 @@
+"""Emit a protocol's typed client: one method per command and sub-command, built on runtime.transport.
+
+Decisions made here, the same for every protocol:
+- arguments and results are wire units, like the messages (the spec's `unit`/`scale` are in the docstrings);
+- a method returns the reply's one field that is not an echo of the request, the whole reply when there are
+  several, and True/False (answered or not) when there are none;
+- a reply that can be absent (broadcast address, `optional_when`) makes the method return None then;
+- a table that one command reads by key and another writes by key gets read_<entry>/write_<entry> by name:
+  `read_parameter(id, "voltage")`;
+- a command with sub-commands becomes an attribute holding a generated group class, one method per sub-command:
+  `client.bus_servo.read_position(5)`;
+- a response field with `status: {ok: N}` is checked (DeviceError unless it holds N) and left out of the result;
+- a group whose items have exactly two fields also takes a mapping {first: second}: `set_speeds({1: -1.0})`;
+- messages the device sends on its own come from `reports(timeout)` (an iterator) or `on_<report>(callback)`.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from serialspec.backends.common.numbers import number
+from serialspec.backends.common.pairing import request_response_pairs
+from serialspec.backends.python.pycode import annotation, one_line
+from serialspec.backends.python.registers import map_name, names_alias
+from serialspec.backends.python.render import render
+from serialspec.backends.python.simulator import import_order
+from serialspec.lang.model import (
+    Bytes,
+    Direction,
+    Field,
+    FrameElement,
+    Group,
+    List,
+    Message,
+    Protocol,
+    Scalar,
+    Table,
+    TableBlock,
+    TableEntry,
+    TableValue,
+    reply_condition,
+)
+
+RESERVED = {"bus", "close", "subscribe", "optional_replies", "reports"}
+
+
+def address_of(protocol: Protocol, request: Message | None = None) -> tuple[str, int | None]:
+    """The field holding the device id and its broadcast value (for `request`: those of the kind it addresses)."""
+    if protocol.device is not None:
+        behaviour = protocol.device.behaviour(request.key) if request else None
+        kind = next((k for k in protocol.device.kinds if behaviour and k.name == behaviour.kind), None)
+        if kind is not None:
+            return kind.address, kind.broadcast
+        return protocol.device.address, protocol.device.broadcast
+    for layout in protocol.framing.layouts.values():
+        for element in layout.value_elements:
+            if element.role == "address":
+                return element.name, element.broadcast
+    return "", None
+
+
+def value_fields(protocol: Protocol, message: Message) -> list[Field]:
+    """The members of a message class, frame-level values (SMS id) first, as the codec generator orders them."""
+    layout = protocol.framing.layouts[message.direction]
+    frame = [
+        Scalar(
+            e.name,
+            e.description,
+            "",
+            "",
+            e.type,
+            "<",
+            "",
+            None,
+            e.minimum,
+            e.maximum,
+            None,
+            None,
+            None,
+            e.flags,
+            (),
+            "",
+            False,
+        )
+        for e in layout.value_elements
+        if e.type is not None
+    ]
+    return [*frame, *(f for f in message.fields if not (isinstance(f, Scalar) and f.hidden))]
+
+
+def type_names(f: Field) -> list[str]:
+    if isinstance(f, Scalar):
+        names = (f.bits_class, f.enum.class_name if f.enum else "", f.flags.class_name if f.flags else "")
+        return [n for n in names if n]
+    if isinstance(f, Group | TableBlock):
+        return [f.class_name]
+    return []
+
+
+def describe(f: Field) -> str:
+    parts = [f.description or f.name.replace("_", " ")]
+    unit = getattr(f, "unit", "")
+    if unit:
+        parts.append(f"[{unit}]")
+    if isinstance(f, Scalar) and not f.bits and (f.minimum, f.maximum) != (f.type.minimum, f.type.maximum):
+        parts.append(f"({number(f.minimum)}..{number(f.maximum)})")
+    return one_line(" ".join(parts))
+
+
+def table_commands(protocol: Protocol) -> list[dict[str, Any]]:
+    """Tables some command reads by key and another writes by key: read_/write_<entry> by name."""
+    address, _ = address_of(protocol)
+    found = []
+    for table in protocol.tables:
+        reader = writer = None
+        for request, response in request_response_pairs(protocol):
+            names = [f.name for f in value_fields(protocol, request)]
+            if response is not None:
+                value = next((f for f in response.fields if isinstance(f, TableValue) and f.table is table), None)
+                if value is not None and names == [address, value.key] and reader is None:
+                    reader = (request, value)
+            value = next((f for f in request.fields if isinstance(f, TableValue) and f.table is table), None)
+            if value is not None and names == [address, value.key, value.name] and writer is None:
+                writer = (request, value)
+        if reader and writer:
+            found.append(table_context(protocol, table, reader, writer))
+    return found
+
+
+def method_name(message: Message) -> str:
+    name = message.key.replace(".", "_")
+    return f"{name}_command" if name in RESERVED else name
+
+
+def attribute_name(name: str) -> str:
+    return f"{name}_command" if name in RESERVED else name
+
+
+def pair_group(f: Field) -> tuple[Field, Field] | None:
+    """The two fields of a group item that a mapping {first: second} can give, if the item has exactly two."""
+    if not isinstance(f, Group):
+        return None
+    members = [g for g in f.fields if not (isinstance(g, Scalar) and g.hidden)]
+    return (members[0], members[1]) if len(members) == 2 else None
+
+
+def single_group(f: Field) -> Field | None:
+    """The one field of a group item that a plain sequence of values can give, if the item has exactly one."""
+    if not isinstance(f, Group):
+        return None
+    members = [g for g in f.fields if not (isinstance(g, Scalar) and g.hidden)]
+    return members[0] if len(members) == 1 else None
+
+
+def status_fields(message: Message) -> list[Scalar]:
+    return [f for f in message.fields if isinstance(f, Scalar) and f.status_ok is not None]
+
+
+def table_context(
+    protocol: Protocol, table: Table, reader: tuple[Message, TableValue], writer: tuple[Message, TableValue]
+) -> dict[str, Any]:
+    entries = [e for e in table.entries if not e.reserved]
+    return {
+        "name": table.name,
+        "singular": table.name[:-1] if table.name.endswith("s") else table.name,
+        "upper": table.name.upper(),
+        "title": one_line(table.title or table.name),
+        "entries": [(e.name, e.key) for e in entries],
+        "read_only": [e.name for e in entries if e.access == "r"],
+        "reader": method_name(reader[0]),
+        "writer": method_name(writer[0]),
+        "key": reader[1].key,
+    }
+
+
+def status_elements(protocol: Protocol) -> list[FrameElement]:
+    """The reply's frame-level status values (FEETECH `error`): the bus raises DeviceError when one is non-zero."""
+    return [e for e in protocol.framing.layouts[Direction.RESPONSE].value_elements if e.role == "status"]
+
+
+def unused_fields(protocol: Protocol, request: Message, response: Message) -> set[str]:
+    """Reply fields that carry nothing for this request: frame status (checked by the bus, DeviceError) and a run
+    of registers read from a request field this request does not have (a shared reply's `data` to a PING)."""
+    unused = {e.name for e in status_elements(protocol)}
+    names = {f.name for f in request.fields}
+    names |= {f.name for g in request.fields if isinstance(g, Group) for f in g.fields}  # per-item (BULK READ)
+    for f in response.fields:
+        if isinstance(f, Bytes) and f.table is not None:
+            needed = [*([f.start] if f.start_in_request else []), *([f.size_from] if f.size_from else [])]
+            if not all(n in names for n in needed):
+                unused.add(f.name)
+    return unused
+
+
+def status_flags(protocol: Protocol) -> str:
+    """The reply's frame status elements that have flags, as a literal {name: flags class} (empty if none)."""
+    pairs = [f"{e.name!r}: {e.flags.class_name}" for e in status_elements(protocol) if e.flags is not None]
+    return "{" + ", ".join(pairs) + "}" if pairs else ""
+
+
+def register_examples(table: Table) -> dict[str, str]:
+    """Docstring examples from the table's own registers (never another protocol's)."""
+    entries = [e for e in table.entries if not e.reserved]
+    writable = [e for e in entries if e.access == "rw"][:2] or entries[:1]
+
+    def value(e: TableEntry) -> str:
+        return number(e.default if isinstance(e.default, int | float) else e.minimum)
+
+    return {
+        "write_example": ", ".join(f"{e.name}={value(e)}" for e in writable),
+        "read_example": entries[0].name if entries else "",
+        "each_example": ", ".join(f'{i}: {{"{writable[0].name}": {value(writable[0])}}}' for i in (1, 2))
+        if writable
+        else "",
+    }
+
+
+def register_commands(protocol: Protocol, methods: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Commands that carry a run of registers get a method by register name; the raw one keeps `<name>_raw`.
+
+    A request with `bytes` of a table from its own start field writes (`write(id, position=100)`), a request
+    whose reply holds such bytes from the request's start and size reads (`read(id, "position")`), and a
+    request group whose items each hold such bytes for one device writes to several (`sync_write({1: {...}})`).
+    """
+    found: list[dict[str, Any]] = []
+    by_name = {m["name"]: m for m in methods}
+    for request, response in request_response_pairs(protocol):
+        method = by_name.get(method_name(request))
+        if method is None:
+            continue
+        address, broadcast = address_of(protocol, request)
+        context = {
+            "name": method["name"],
+            "raw": method["name"] + "_raw",
+            "returns": method["returns"],
+            "address": address,
+            "broadcast": broadcast,
+            "title": method["doc"][0].rstrip("."),
+        }
+        run = next(
+            (f for f in request.fields if isinstance(f, Bytes) and f.table and f.start and f.size == "rest"), None
+        )
+        group = next((f for f in request.fields if isinstance(f, Group)), None)
+        item_run = (
+            next((f for f in group.fields if isinstance(f, Bytes) and f.table and f.start), None) if group else None
+        )
+        replied = response.fields if response else ()
+        read = next((f for f in replied if isinstance(f, Bytes) and f.table and f.size_from), None)
+        fields = [f.name for f in value_fields(protocol, request)]
+        if run is not None and run.table is not None and fields == [address, run.start, run.name]:
+            context.update(kind="write", map=map_name(run.table), alias=names_alias(run.table))
+        elif read is not None and read.table is not None and group is None and len(fields) == 3:
+            start, size = read.start, read.size_from
+            if fields != [address, start, size]:
+                continue
+            # the first register read also reads the parameters that switch optional replies (one _read_key)
+            first = not any(c["kind"] == "read" for c in found)
+            context.update(kind="read", map=map_name(read.table), alias=names_alias(read.table), returns="int")
+            context.update(read_key=first)
+            # a read of one register by name, checked and encoded once per device and register, then sent as it is
+            # (not where the timeout grows with a field or the method checks a status itself)
+            quick = not method["after"] and not method["statuses"]
+            optional = method["optional"] if method["silent"] else ""
+            context.update(quick=quick, request=method["request"], response=method["response"], optional=optional)
+            context.update(start=start, size=size, data=read.name)
+        elif group is not None and read is not None and read.table is not None and method["kind"] == "each":
+            start, size = read.start, read.size_from
+            items = [f.name for f in group.fields]
+            if fields == [address, start, size, group.name] and items == [address]:
+                context.update(kind="each_read", map=map_name(read.table), alias=names_alias(read.table))
+                context.update(group=group.name, item=group.class_name, item_address=address)
+            elif fields == [address, group.name] and items == [address, start, size]:
+                # every item names its own device and run (BULK READ)
+                context.update(kind="items_read", map=map_name(read.table), alias=names_alias(read.table))
+                context.update(group=group.name, item=group.class_name, item_address=address, start=start, size=size)
+            else:
+                continue
+        elif (
+            group is not None
+            and item_run is not None
+            and item_run.table is not None
+            and response is None
+            and item_run.start in {f.name for f in group.fields}
+        ):
+            if fields != [address, group.name]:
+                continue
+            # every item writes its own run to its own device (BULK WRITE)
+            context.update(kind="items_write", map=map_name(item_run.table), alias=names_alias(item_run.table))
+            context.update(group=group.name, item=group.class_name)
+            context.update(item_address=address, start=item_run.start, field=item_run.name)
+        elif group is not None and item_run is not None and item_run.table is not None and response is None:
+            size = item_run.size if isinstance(item_run.size, str) else ""
+            if fields != [address, item_run.start, *([size] if size in fields else []), group.name]:
+                continue
+            item_address = next(f.name for f in group.fields if f.name == address)
+            context.update(
+                kind="each_write",
+                map=map_name(item_run.table),
+                alias=names_alias(item_run.table),
+                group=group.name,
+                item=group.class_name,
+                item_address=item_address,
+                field=item_run.name,
+                size=size if size in fields else "",
+            )
+        else:
+            continue
+        table = next(t for t in protocol.tables if map_name(t) == context["map"])
+        context.update(register_examples(table))
+        method["name"] = context["raw"]
+        found.append(context)
+    return found
+
+
+def carry_method(protocol: Protocol, request: Message, imports: set[str]) -> dict[str, Any] | None:
+    """For a request that `carries` other requests (a sync command): a method that takes those requests.
+
+    It encodes each, takes its content as one item of the carrier's group, and collects the replies the carried
+    command gets (one per request, matched by address) unless that command's reply is optional or absent.
+    """
+    behaviour = protocol.device.behaviour(request.key) if protocol.device else None
+    if behaviour is None or behaviour.carries is None:
+        return None
+    group = next((f for f in request.fields if isinstance(f, Group) and f.name == behaviour.each), None)
+    if group is None:
+        return None
+    code_field, content_field = behaviour.carries
+    layout = protocol.framing.layouts[Direction.REQUEST]
+    start, trailing = layout.offsets["content"], layout.overhead - layout.offsets["content"]
+    replies = dict(request_response_pairs(protocol))
+    carried = []
+    for command in protocol.commands:
+        inner = command.request
+        if command.code is None or inner is None or command.subcommands or inner is request:
+            continue
+        if behaviour.carried and command.name not in behaviour.carried:
+            continue
+        reply = replies.get(inner)
+        expected = reply if reply is not None and reply_condition(inner, reply) is None else None
+        imports.update(n for n in (inner.class_name, expected.class_name if expected else "") if n)
+        carried.append((inner.class_name, command.code, expected.class_name if expected else "None"))
+    imports.add(group.class_name)
+    title = protocol.command(request.command).title or request.key
+    return {
+        "name": method_name(request) + "_of",
+        "params": "requests: Sequence[Message]",
+        "returns": "list[Message]",
+        "doc": [
+            one_line(title) + ", from the requests it carries: one per device, all of one command.",
+            "",
+            f"Each request's content becomes one item of `{group.name}`; the command's replies (one per request, in"
+            " order) are returned, or [] when that command answers only when a parameter allows it or not at all.",
+        ],
+        "kind": "carry",
+        "carried": carried,
+        "carried_name": method_name(request).upper() + "_CARRIES",
+        "content": f"slice({start}, {-trailing if trailing else None})",
+        "carrier": request.class_name,
+        "code_field": code_field,
+        "group": group.name,
+        "item": group.class_name,
+        "content_field": content_field,
+        "pairs": [],
+        "singles": [],
+        "statuses": [],
+    }
+
+
+def client_module(protocol: Protocol) -> str:
+    imports: set[str] = set()
+    methods = []
+    optional_keys: set[int] = set()
+    tables = table_commands(protocol)
+    writers = {t["writer"]: t for t in tables}
+    groups: dict[str, dict[str, Any]] = {}
+    for request, response in request_response_pairs(protocol):
+        command = protocol.command(request.command)
+        sub = next((s for s in command.subcommands if s.name == request.subcommand), None)
+        fields = value_fields(protocol, request)
+        imports.add(request.class_name)
+        address, broadcast = address_of(protocol, request)
+        behaviour = protocol.device.behaviour(request.key) if protocol.device else None
+        params = []
+        trailing = True
+        defaults: dict[str, str] = {}
+        for f in reversed(fields):
+            if trailing and isinstance(f, Scalar) and f.default is not None and not f.enum and not f.bits:
+                defaults[f.name] = number(f.default)
+            else:
+                trailing = False
+        pairs = []
+        singles = []
+        for f in fields:
+            imports.update(type_names(f))
+            default = f" = {defaults[f.name]}" if f.name in defaults else ""
+            pair = pair_group(f)
+            single = single_group(f)
+            if single is not None:
+                assert isinstance(f, Group)
+                imports.update(type_names(single))
+                params.append(f"{f.name}: {annotation(f)} | Sequence[{annotation(single)}]{default}")
+                singles.append({"name": f.name, "item": f.class_name, "field": single.name})
+            elif pair is not None:
+                assert isinstance(f, Group)
+                first, second = pair
+                imports.update(type_names(first) + type_names(second))
+                params.append(
+                    f"{f.name}: {annotation(f)} | Mapping[{annotation(first)}, {annotation(second)}]{default}"
+                )
+                pairs.append({"name": f.name, "item": f.class_name, "first": first.name, "second": second.name})
+            else:
+                params.append(f"{f.name}: {annotation(f)}{default}")
+        title = (sub.title if sub else command.title) or request.key.replace("_", " ")
+        doc = [one_line(title) + ("" if title.endswith(".") else ".")]
+        description = (sub.description if sub else command.description) or request.description
+        if description:
+            doc.append("")
+            doc.append(one_line(description))
+        if command.broadcast:
+            doc.append("")
+            doc.append("Broadcast: " + one_line(command.broadcast))
+        doc.append("")
+        doc.append("Args:")
+        doc.extend(f"    {f.name}: {describe(f)}" for f in fields)
+        doc.extend(
+            f"    ({p['name']} also takes a mapping {{{p['first']}: {p['second']}}}, one entry per item.)"
+            for p in pairs
+        )
+        doc.extend(f"    ({p['name']} also takes a plain sequence of {p['field']} values.)" for p in singles)
+        # An address that can hold the broadcast value makes the reply optional, unless the device answers it anyway.
+        may_broadcast = not (behaviour and behaviour.broadcast_reply) and any(
+            f.name == address and isinstance(f, Scalar) and broadcast is not None and f.maximum >= broadcast
+            for f in fields
+        )
+        optional = reply_condition(request, response)
+        if optional:
+            optional_keys.add(optional.key)
+        silent = response is None or optional is not None or may_broadcast
+        kind = "send"
+        returns = "None"
+        result_expr = ""
+        statuses = status_fields(response) if response else []
+        if response is not None:
+            imports.add(response.class_name)
+            echoes = {f.name for f in fields} | {f.name for f in statuses} | unused_fields(protocol, request, response)
+            rest = [f for f in value_fields(protocol, response) if f.name not in echoes]
+            if not rest:
+                kind, returns = ("bool", "bool")
+            elif len(rest) == 1 and isinstance(rest[0], List):
+                # a list comes back as a list; padding items (bits to a whole byte) are cut to the number asked
+                only = rest[0]
+                kind, returns = "value", annotation(only).replace("tuple[", "list[").replace(", ...]", "]")
+                wanted = only.count_from if any(f.name == only.count_from for f in request.fields) else ""
+                result_expr = f"list(reply.{only.name}[: request.{wanted}])" if wanted else f"list(reply.{only.name})"
+            elif len(rest) == 1:
+                imports.update(type_names(rest[0]))
+                kind, returns, result_expr = "value", annotation(rest[0]), f"reply.{rest[0].name}"
+            else:
+                kind, returns, result_expr = "message", response.class_name, "reply"
+            if silent:
+                returns = f"{returns} | None"
+            doc.append("")
+            if kind == "bool":
+                doc.append("Returns: True if the device answered, False if it stayed silent (timeout).")
+            elif kind == "value":
+                doc.append(f"Returns: {rest[0].name}: {describe(rest[0])}")
+            else:
+                doc.append(f"Returns: the {response.class_name} reply.")
+            if silent:
+                why = one_line(response.optional) if response.optional else "broadcast gets no reply"
+                doc.append(f"None when no reply is due ({why}).")
+            for f in statuses:
+                doc.append(f"Raises DeviceError when the reply's {f.name} is not {f.status_ok}.")
+        else:
+            doc.append("")
+            doc.append("The device does not answer.")
+        each_keys = ""
+        each_name = behaviour.each if behaviour else ""
+        each = next((f for f in request.fields if isinstance(f, Group) and f.name == each_name), None)
+        if each is not None and response is not None and kind == "value":
+            # Every listed device answers in turn (SYNC READ): one reply per item, matched by its address.
+            kind, silent = "each", False
+            value = result_expr.removeprefix("reply.")
+            returns = f"dict[int, {annotation(rest[0])}]"
+            result_expr = f"{{reply.{address}: reply.{value} for reply in replies}}"
+            each_keys = f"[{{{address!r}: item.{address}}} for item in {each.name}]"
+            doc[-1] = f"Returns: {address} -> {value} of every listed device, in the order they answer."
+        table = writers.get(method_name(request))
+        method = {
+            "name": method_name(request),
+            "params": ", ".join(params),
+            "returns": returns,
+            "doc": doc,
+            "request": request.class_name,
+            "response": response.class_name if response else "",
+            "build": ", ".join(f"{f.name}={f.name}" for f in fields),
+            "kind": kind,
+            "silent": silent,
+            "optional": f"({optional.key}, {optional.equals}, {optional.op!r})" if optional else "None",
+            "after": repr(response.after) if response and response.after else "",
+            "result": result_expr,
+            "remember": (
+                f"_remember({address}, {table['key']}, "
+                f"{next(f.name for f in request.fields if isinstance(f, TableValue))})"
+            )
+            if table
+            else "",
+            "pairs": pairs,
+            "singles": singles,
+            "statuses": [(f.name, f.status_ok) for f in statuses],
+            "each_keys": each_keys,
+        }
+        if sub is not None:
+            group = groups.setdefault(
+                command.name,
+                {
+                    "attribute": attribute_name(command.name),
+                    "class_name": command.group_class,
+                    "title": one_line(command.title or command.name.replace("_", " ")),
+                    "methods": [],
+                },
+            )
+            method["name"] = sub.name
+            group["methods"].append(method)
+        else:
+            methods.append(method)
+        carrier = carry_method(protocol, request, imports)
+        if carrier is not None:
+            methods.append(carrier)
+    reports = []
+    for message in protocol.messages():
+        if message.direction == Direction.RESPONSE and message.unsolicited:
+            imports.add(message.class_name)
+            title = message.title or protocol.command(message.command).title or message.key
+            reports.append({"name": method_name(message), "class_name": message.class_name, "title": one_line(title)})
+    registers = register_commands(protocol, methods)
+    flags_literal = status_flags(protocol)
+    imports.update(e.flags.class_name for e in status_elements(protocol) if e.flags is not None)
+    everything = [*methods, *(m for g in groups.values() for m in g["methods"])]
+    address, broadcast = address_of(protocol)
+    class_name = protocol.client_class
+    errors = None
+    if protocol.error_reply is not None:
+        reply = protocol.command(protocol.error_reply.command).response
+        assert reply is not None
+        imports.add(reply.class_name)
+        reason = next((f.name for f in reply.fields if not (isinstance(f, Scalar) and f.hidden)), "")
+        codes = {c.name: c.code for c in protocol.commands if c.code is not None and c.request is not None}
+        errors = {
+            "response": reply.class_name,
+            "code_field": protocol.error_reply.element,
+            "reason_field": reason,
+            "codes": "{" + ", ".join(f"{name!r}: {code:#04x}" for name, code in codes.items()) + "}",
+        }
+    device = protocol.device
+    model_map = (
+        map_name(device.memory)
+        if device is not None
+        and device.memory is not None
+        and device.models
+        and any(r["map"] == map_name(device.memory) for r in registers)
+        else ""
+    )
+    return render(
+        "client.py.j2",
+        errors=errors,
+        model_map=model_map,
+        model_names=", ".join(m.name for m in device.models) if device is not None else "",
+        spec_path=protocol.spec_path,
+        title=one_line(protocol.title),
+        package=protocol.name,
+        class_name=class_name,
+        description=one_line(protocol.description),
+        address=repr(address),
+        broadcast=repr(broadcast),
+        status=repr(tuple(e.name for e in status_elements(protocol))),
+        methods=methods,
+        carriers=[m for m in methods if m["kind"] == "carry"],
+        groups=list(groups.values()),
+        registers=registers,
+        status_flags=flags_literal,
+        register_imports=sorted(
+            {r["map"] for r in registers} | {r["alias"] for r in registers} | ({model_map + "_MODELS"} - {"_MODELS"}),
+            key=import_order,
+        ),
+        reports=reports,
+        tables=tables,
+        optional_keys=sorted(optional_keys),
+        imports=sorted(imports | {"Direction"}, key=import_order),
+        error_imports=[
+            name
+            for name, used in (
+                ("EncodeError", bool(tables) or any(r["kind"] != "write" for r in registers)),
+                ("Timeout", any(m["kind"] == "bool" for m in everything)),
+            )
+            if used
+        ],
+        transport_imports=[
+            "Binding",
+            "Bus",
+            "ClientBase",
+            *(["ErrorReplies"] if errors else []),
+            *(["check_status"] if any(m["statuses"] for m in everything) else []),
+            *(["flag_names"] if status_flags(protocol) else []),
+            *(["table_key"] if tables else []),
+        ],
+        uses_message=any(m["kind"] == "carry" for m in everything),
+        abc_imports=sorted(
+            {
+                *(["Callable", "Iterator"] if reports else []),
+                *(["Mapping"] if any(m["pairs"] for m in everything) or model_map else []),
+                *(
+                    ["Mapping"]
+                    if any(r["kind"] in ("each_write", "items_read", "items_write") for r in registers)
+                    else []
+                ),
+                *(["Sequence"] if any(r["kind"] == "items_read" for r in registers) else []),
+                *(["Iterable"] if any(r["kind"] == "each_read" for r in registers) else []),
+                *(["Sequence"] if any(m["kind"] == "carry" or m["singles"] for m in everything) else []),
+            }
+        ),
+    )

@@ -1,0 +1,142 @@
+"""The codec's frames when they are not of the classic shape: data for the runtime's general frame engine.
+
+Classic frames (a header, a one-byte length, one final checksum, no stuffing) get straight-line code (see
+package.py); every other framing is described here as `serialspec.runtime.framing` objects: the layouts of each
+direction, the content size bounds by command, and size rules for frames that carry no length. The stream parser
+runs on them; single frames are checked and built by straight-line code written from the same layouts
+(framecode.py).
+"""
+
+from __future__ import annotations
+
+from serialspec.backends.common.frames import runtime_element
+from serialspec.backends.python.framecode import checksum_name
+from serialspec.backends.python.pycode import one_line
+from serialspec.lang.model import (
+    Command,
+    Direction,
+    FrameElement,
+    FrameLayout,
+    Message,
+    Protocol,
+    size_terms,
+)
+
+
+def checksum_definitions(protocol: Protocol) -> tuple[list[str], list[str]]:
+    """The runtime imports and module-level definitions of every checksum function the layouts use."""
+    imports: set[str] = set()
+    definitions: dict[str, str] = {}
+    for layouts in protocol.framing.alternatives.values():
+        for layout in layouts:
+            for checksum in layout.checksums:
+                width = checksum.type.size * 8
+                if checksum.algorithm == "crc":
+                    crc = checksum.crc
+                    assert crc is not None
+                    imports.add("crc_function")
+                    value = (
+                        f"crc_function({crc.width}, {crc.poly:#x}, {crc.init:#x}, {crc.refin}, {crc.refout}, "
+                        f"{crc.xorout:#x})  # {one_line(crc.name)}"
+                    )
+                elif checksum.algorithm == "xor":
+                    imports.add("xor_function")
+                    value = f"xor_function({width})"
+                else:
+                    imports.add("sum_function")
+                    value = f"sum_function({width}, {checksum.invert})"
+                definitions[checksum_name(checksum)] = f"{checksum_name(checksum)}: Callable[[bytes], int] = {value}"
+    return sorted(imports), [definitions[name] for name in sorted(definitions)]
+
+
+def element_expr(layout: FrameLayout, element: FrameElement) -> str:
+    """`Element(...)`: the engine's element (backends/common/frames.py) printed, its checksum by name."""
+    e = runtime_element(layout, element)
+    args = [repr(e.name), repr(e.kind)]
+    if e.kind != "content":
+        args.append(str(e.size))
+    if e.endian == "big" and e.size > 1:
+        args.append("endian='big'")
+    if e.kind == "constant":
+        args.append(f"constant={e.constant!r}")
+    if e.kind in ("value", "command"):
+        args += [f"minimum={e.minimum}", f"maximum={e.maximum}"]
+        if e.also is not None:
+            args.append(f"also={e.also}")
+    if e.kind in ("length", "checksum"):
+        args.append(f"span={e.span}")
+    if e.adds:
+        args.append(f"adds={e.adds}")
+    if e.kind == "checksum":
+        assert element.checksum is not None
+        args.append(f"checksum={checksum_name(element.checksum)}")
+    return f"Element({', '.join(args)})"
+
+
+def layout_lines(layout: FrameLayout) -> list[str]:
+    """`Layout(...)` of one layout, as lines (indented by the caller)."""
+    lines = [f"Layout({(layout.name or layout.direction.value)!r}, ("]
+    lines += [f"    {element_expr(layout, e)}," for e in layout.elements]
+    if layout.transparency is None:
+        lines.append(")),")
+        return lines
+    t = layout.transparency
+    pairs = ", ".join(f"({plain!r}, {wire!r})" for plain, wire in t.replace)
+    lines.append("), Transparency(")
+    lines.append(f"    ({layout.index(t.first)}, {layout.index(t.last)}),")
+    lines.append(f"    ({pairs},),")
+    lines.append(")),")
+    return lines
+
+
+def size_rule(message: Message) -> str | None:
+    """`SizeRule(...)` for a message whose content size follows from its fields (model.size_terms), or None."""
+    found = size_terms(message.fields)
+    if found is None:
+        return None
+    fixed, terms = found
+    if not terms:
+        return f"SizeRule({fixed})"
+    shown = ", ".join(f"({offset}, {size}, {endian!r}, {factor})" for offset, size, endian, factor in terms)
+    return f"SizeRule({fixed}, ({shown},))"
+
+
+def codec_lines(
+    protocol: Protocol,
+    direction: Direction,
+    sizes: list[tuple[str, int, int | None]],
+    messages: dict[str, Message],
+) -> list[str]:
+    """`_<DIRECTION>_FRAMES = FrameCodec(...)`: the layouts, content sizes by code and, without a length, size
+    rules by code (`messages`: the one message of each code, where there is one)."""
+    layouts = protocol.framing.alternatives[direction]
+    lines = [f"_{direction.name}_FRAMES = FrameCodec(", "    ("]
+    for layout in layouts:
+        lines += [f"        {line}" for line in layout_lines(layout)]
+    lines.append("    ),")
+    # content size bounds by command code (None: unbounded)
+    lines.append("    {")
+    lines += [f"        {code}: ({low}, {high})," for code, low, high in sizes]
+    lines.append("    },")
+    if any(layout.length is None for layout in layouts):
+        rules = [(code, rule) for code, message in messages.items() if (rule := size_rule(message))]
+        lines.append("    {" + ", ".join(f"{code}: {rule}" for code, rule in rules) + "},")
+    error = protocol.error_reply
+    if error is not None and direction == Direction.RESPONSE:
+        lines.append(f"    error_flag={error.flag:#04x},")
+    lines.append(")")
+    return lines
+
+
+def code_key(command: Command, layout: FrameLayout) -> str:
+    if any(m.error_reply for m in command.messages()):
+        return "ERROR_REPLY"  # any code with the error flag (runtime.framing)
+    return "None" if command.code is None or not layout.has_command else f"{command.code:#04x}"
+
+
+def framing_imports(lines: list[str]) -> list[str]:
+    """The runtime.framing names that definitions use."""
+    text = "\n".join(lines)
+    names = ("Element", "FrameCodec", "Layout", "SizeRule", "Transparency")
+    found = [name for name in names if f"{name}(" in text]
+    return ["ERROR_REPLY", *found] if "ERROR_REPLY" in text else found

@@ -1,0 +1,312 @@
+"""How each field kind looks in the generated Python: one class per model field kind, registered by model class.
+
+An emitter asks `kind(f)` instead of switching on the field's class: the attribute type, the to/from JSON
+expressions, the struct format and the construct expression of each kind live here. Still switches elsewhere: the
+fast decode/encode statements (pycode.py), the simulator's and client's field look-ups, the CLI views.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Generic
+
+from serialspec.backends.common.kinds import F, Registry
+from serialspec.backends.common.numbers import number
+from serialspec.lang import expression
+from serialspec.lang.model import Array, Bytes, Group, List, Scalar, ScalarType, TableBlock, TableValue, Text
+from serialspec.lang.model import Field as SpecField
+
+
+def _get(f: SpecField) -> str:
+    """The expression reading a field's JSON value from `data` (the generated `from_fields`)."""
+    return f"_get(data, {f.name!r}, where)"
+
+
+class Kind(Generic[F]):
+    """What a field kind is in generated Python. The defaults fit a kind of varying size with a plain value."""
+
+    def fixed(self, f: F) -> bool:
+        """A member of a run of fixed-size fields read and written by one struct call."""
+        return False
+
+    def struct_chars(self, f: F) -> str:
+        """The field's part of a struct format; nothing for a kind of varying size."""
+        return ""
+
+    def annotation(self, f: F) -> str:
+        """The type of the message attribute."""
+        raise NotImplementedError
+
+    def construct(self, f: F, parent: str) -> str:
+        """The field's construct expression (the reference structs); `parent` is "item" inside a group item."""
+        raise NotImplementedError
+
+    def to_json(self, f: F, expr: str) -> str:
+        """The JSON value of `expr`, a value of the field (the generated `to_fields`)."""
+        return expr
+
+    def from_json(self, f: F) -> str:
+        """The field's value from `data` (the generated `from_fields`), refusing a wrong kind of value."""
+        return _get(f)
+
+
+def _numbers_from_json(f: Array | List) -> str:
+    """A list of numbers (or bits) from JSON, each checked to be one."""
+    kind = "_bits" if f.item is None else "_numbers" if f.item.is_float else "_integers"
+    return f"{kind}({_get(f)}, {f.name!r}, where)"
+
+
+def _numbers(is_float: bool) -> str:
+    return "tuple[float, ...]" if is_float else "tuple[int, ...]"
+
+
+_INT = {1: "Int8", 2: "Int16", 4: "Int32"}
+
+
+def primitive(scalar: ScalarType, endian: str) -> str:
+    suffix = "b" if endian == ">" else "l"
+    if scalar.is_float:
+        return f"Float32{suffix}"
+    if scalar.size == 1:
+        return "Int8sb" if scalar.signed else "Int8ub"
+    return f"{_INT[scalar.size]}{'s' if scalar.signed else 'u'}{suffix}"
+
+
+def list_expr(f: List) -> str:
+    """An array whose count varies, or packed bits."""
+    count = f"this.{f.count}" if isinstance(f.count, str) and f.count not in ("", "rest") else f.count
+    if f.item is None:
+        if f.size:
+            return f"PackedBits(Bytes(this.{f.size}))"
+        if f.count == "rest":
+            return "PackedBits(GreedyBytes)"
+        return f"PackedBits(Bytes(({count} + 7) // 8), {count})"
+    item = primitive(f.item, f.endian)
+    if f.size:
+        return f"Array(this.{f.size} // {f.item.size}, {item})"
+    if f.count == "rest":
+        return f"GreedyRange({item})"
+    return f"Array({count}, {item})"
+
+
+def bits_expr(f: Scalar) -> str:
+    """A BitStruct from the most significant bit down; unlisted bits are constant zero."""
+    width = f.type.size * 8
+    parts = []
+    bit = width - 1
+    for field in sorted(f.bits, key=lambda b: -b.high):
+        if bit > field.high:
+            parts.append(f"'_unused_{bit}' / Const(0, BitsInteger({bit - field.high}))")
+        parts.append(f"{field.name!r} / BitsInteger({field.high - field.low + 1})")
+        bit = field.low - 1
+    if bit >= 0:
+        parts.append(f"'_unused_{bit}' / Const(0, BitsInteger({bit + 1}))")
+    inner = "BitStruct(" + ", ".join(parts) + ")"
+    return f"ByteSwapped({inner})" if f.type.size > 1 and f.endian == "<" else inner
+
+
+class ScalarKind(Kind[Scalar]):
+    model = Scalar
+
+    def construct(self, f: Scalar, parent: str) -> str:
+        base = primitive(f.type, f.endian)
+        if f.const is not None:
+            return f"Const({f.const}, {base})"
+        if f.value is not None:
+            return f"Rebuild({base}, lambda ctx: {expression.render(f.value, lambda name: f'ctx[{name!r}]')})"
+        if f.derived:
+            derived, target = f.derived[0], f.derived[1]
+            if derived == "count":
+                return f"Rebuild({base}, len_(this.{target}))"
+            # evaluated while building: a lambda, so the context is the one being built, not `this` itself
+            return f"Rebuild({base}, lambda ctx: _item_size(ctx, {target!r}))"
+        if f.bits:
+            return bits_expr(f)
+        if f.sign_magnitude:
+            return f"SignMagnitude({base}, {f.type.size * 8})"
+        return base
+
+    def fixed(self, f: Scalar) -> bool:
+        return True
+
+    def struct_chars(self, f: Scalar) -> str:
+        return f.type.struct_char
+
+    def annotation(self, f: Scalar) -> str:
+        if f.bits:
+            return f.bits_class
+        if f.enum:
+            return f"{f.enum.class_name} | int"
+        if f.flags:
+            return f.flags.class_name
+        return "float" if f.type.is_float else "int"
+
+    def to_json(self, f: Scalar, expr: str) -> str:
+        if f.bits:
+            return f"{expr}.to_fields()"
+        return f"int({expr})" if (f.enum or f.flags) else expr
+
+    def from_json(self, f: Scalar) -> str:
+        get = _get(f)
+        if f.bits:
+            # errors inside name the field too: "spin request method: direction must be an integer"
+            return f"{f.bits_class}.from_fields(_mapping({get}, {f.name!r}, where), where + {' ' + f.name!r})"
+        if f.enum:
+            return f"_as_enum({f.enum.class_name}, {get}, {f.name!r}, where)"
+        if f.flags:
+            return f"_as_flags({f.flags.class_name}, {get}, {int(f.maximum)}, {f.name!r}, where)"
+        if f.default is not None:
+            get = f"data.get({f.name!r}, {number(f.default)})"
+        kind = "_number" if f.type.is_float else "_integer"
+        return f"{kind}({get}, {f.name!r}, where)"
+
+
+class ArrayKind(Kind[Array]):
+    model = Array
+
+    def construct(self, f: Array, parent: str) -> str:
+        return f"Array({f.count}, {primitive(f.item, f.endian)})"
+
+    def fixed(self, f: Array) -> bool:
+        return True
+
+    def struct_chars(self, f: Array) -> str:
+        return f"{f.count}{f.item.struct_char}"
+
+    def annotation(self, f: Array) -> str:
+        return _numbers(f.item.is_float)
+
+    def to_json(self, f: Array, expr: str) -> str:
+        return f"list({expr})"
+
+    def from_json(self, f: Array) -> str:
+        return _numbers_from_json(f)
+
+
+class ListKind(Kind[List]):
+    model = List
+
+    def construct(self, f: List, parent: str) -> str:
+        return list_expr(f)
+
+    def annotation(self, f: List) -> str:
+        return "tuple[bool, ...]" if f.item is None else _numbers(f.item.is_float)
+
+    def to_json(self, f: List, expr: str) -> str:
+        return f"list({expr})"
+
+    def from_json(self, f: List) -> str:
+        return _numbers_from_json(f)
+
+
+class TextKind(Kind[Text]):
+    model = Text
+
+    def construct(self, f: Text, parent: str) -> str:
+        if f.size is None:
+            return "CString('utf8')"
+        if f.size == "rest":
+            return "Utf8(GreedyBytes)"
+        return f"Utf8(Bytes({f.size if isinstance(f.size, int) else 'this.' + f.size}))"
+
+    def annotation(self, f: Text) -> str:
+        return "str"
+
+    def from_json(self, f: Text) -> str:
+        return f"_text({_get(f)}, {f.name!r}, where)"
+
+
+class BytesKind(Kind[Bytes]):
+    model = Bytes
+
+    def construct(self, f: Bytes, parent: str) -> str:
+        if f.size == "rest":
+            return "GreedyBytes"
+        if isinstance(f.size, int):
+            return f"Bytes({f.size})"
+        # inside a group item the size field sits beside the bytes (BULK WRITE) or in the enclosing content (this._)
+        return f"Bytes({'this._' if parent == 'item' else 'this'}.{f.size})"
+
+    def fixed(self, f: Bytes) -> bool:
+        return isinstance(f.size, int)
+
+    def struct_chars(self, f: Bytes) -> str:
+        return f"{f.size}s"
+
+    def annotation(self, f: Bytes) -> str:
+        return "bytes"
+
+    def to_json(self, f: Bytes, expr: str) -> str:
+        return f"{expr}.hex(' ')"
+
+    def from_json(self, f: Bytes) -> str:
+        return f"_bytes({_get(f)}, {f.name!r}, where)"
+
+
+class GroupKind(Kind[Group]):
+    model = Group
+
+    def construct(self, f: Group, parent: str) -> str:
+        names = {i.name for i in f.fields}
+        item = (
+            "Struct("
+            + ", ".join(
+                f"{i.name!r} / {kind(i).construct(i, 'this' if isinstance(i, Bytes) and i.size in names else 'item')}"
+                for i in f.fields
+            )
+            + ")"
+        )
+        if f.count == "rest":
+            return f"GreedyRange({item})"
+        count = f.count if isinstance(f.count, int) else f"this.{f.count}"
+        return f"Array({count}, {item})"
+
+    def struct_chars(self, f: Group) -> str:
+        assert isinstance(f.count, int)
+        return "".join(kind(i).struct_chars(i) for i in f.fields) * f.count
+
+    def annotation(self, f: Group) -> str:
+        return f"tuple[{f.class_name}, ...]"
+
+    def to_json(self, f: Group, expr: str) -> str:
+        return f"[item.to_fields() for item in {expr}]"
+
+    def from_json(self, f: Group) -> str:
+        return (
+            f"tuple({f.class_name}.from_fields(_mapping(item, {f.name!r}, where), where) "
+            f"for item in _items({_get(f)}, {f.name!r}, where))"
+        )
+
+
+class TableValueKind(Kind[TableValue]):
+    model = TableValue
+
+    def construct(self, f: TableValue, parent: str) -> str:
+        return f"Switch(this.{f.key}, {f.table.value_constant})"
+
+    def annotation(self, f: TableValue) -> str:
+        return "int | float"
+
+
+class TableBlockKind(Kind[TableBlock]):
+    model = TableBlock
+
+    def construct(self, f: TableBlock, parent: str) -> str:
+        return f.struct_name
+
+    def fixed(self, f: TableBlock) -> bool:
+        return True
+
+    def struct_chars(self, f: TableBlock) -> str:
+        return "".join(e.type.struct_char for e in f.entries)
+
+    def annotation(self, f: TableBlock) -> str:
+        return f.class_name
+
+    def to_json(self, f: TableBlock, expr: str) -> str:
+        return f"{expr}.to_fields()"
+
+    def from_json(self, f: TableBlock) -> str:
+        return f"{f.class_name}.from_fields(_mapping({_get(f)}, {f.name!r}, where), where + {' ' + f.name!r})"
+
+
+kind: Registry[Kind[Any]] = Registry(Kind)

@@ -1,0 +1,1232 @@
+"""Python source fragments computed from the model, which the package templates lay out.
+
+The decisions live here (how each field kind is read, written, range-checked and turned into JSON); the templates
+only place the fragments into modules. Every fragment is built from names the resolver has checked to be
+identifiers, and every piece of spec text reaches generated code through repr(), so no spec text can inject code.
+"""
+
+from __future__ import annotations
+
+import re
+import struct
+from collections import Counter
+from collections.abc import Iterator
+from dataclasses import dataclass, field, replace
+
+from serialspec.backends.common.numbers import number
+from serialspec.backends.common.text import collapse
+from serialspec.backends.python.framecode import Straight, frame_encoder, straight_direction
+from serialspec.backends.python.kinds import kind
+from serialspec.lang import expression
+from serialspec.lang.model import (
+    Array,
+    Bytes,
+    Checksum,
+    Direction,
+    FrameLayout,
+    Group,
+    List,
+    Message,
+    Protocol,
+    Scalar,
+    TableBlock,
+    TableValue,
+    Text,
+    fixed_size,
+)
+from serialspec.lang.model import Field as SpecField
+
+Lines = list[str]
+_MOST_RUNS = 256  # the most items of a list read by a struct made for each count (see unpack_runs)
+_STRUCT_NAMES = {"B": "U8", "b": "I8", "H": "U16", "h": "I16", "I": "U32", "i": "I32", "f": "F32"}
+
+
+def decoder_name(message: Message) -> str:
+    return f"_decode_{message.key.replace('.', '_')}_{message.direction.value}"
+
+
+def encoder_name(message: Message) -> str:
+    return f"_encode_{message.key.replace('.', '_')}_{message.direction.value}"
+
+
+def values_tuple(values: list[str]) -> str:
+    """A tuple display of expressions: `(a, b)`, `(a,)`, `()`."""
+    return f"({values[0]},)" if len(values) == 1 else f"({', '.join(values)})"
+
+
+def bound(f: Scalar, value: float) -> str:
+    """A range bound as the literal a comparison with the field's values is quickest with: a float field's bounds
+    as floats where they are exactly that (a float compared with float32's maximum written as a 39-digit integer
+    takes a slow path in CPython), others as numbers."""
+    if f.type.is_float and float(value) == value:
+        return repr(float(value))
+    return number(value)
+
+
+_LOOP = re.compile(r"^(?P<indent> *)for (?P<var>[A-Za-z_]\w*) in .+:$")
+
+
+_NEEDS = re.compile(r"^if end - o < (?P<size>\w+):$")
+
+
+def fold_last_size_check(lines: Lines) -> Lines:
+    """A decoder's lines with the size check of its last field, read up to the content's end, and the check that
+    nothing is left after it made one comparison on the way of an intact frame (`end - o != size`), each error
+    still raised as before; the cursor is not moved past the last field, as nothing reads it."""
+    if len(lines) < 7 or not lines[-1].startswith("return ") or _CURSOR_WORD.search(lines[-1]):
+        return lines
+    needs, raised, read, moved, left, raised_left = lines[-7:-1]
+    found = _NEEDS.match(needs)
+    if found is None or moved != f"o += {found['size']}" or left != "if o != end:" or read.startswith(" "):
+        return lines
+    if not raised.startswith("    raise ") or not raised_left.endswith("bytes left after the last field')"):
+        return lines
+    size = found["size"]
+    return [
+        *lines[:-7],
+        f"if end - o != {size}:",
+        f"    {needs}",
+        f"    {raised}",
+        raised_left.replace("{end - o}", f"{{end - o - {size}}}"),
+        read,
+        lines[-1],
+    ]
+
+
+_CURSOR_WORD = re.compile(r"\bo\b")
+_DEFERRED = "#deferred "  # check_items' mark before the loop over a list whose item range is its type's
+
+
+def deferred_item_checks(lines: Lines) -> Lines:
+    """An encoder's lines with each loop that check_items marked run only when the pack of its list fails: the
+    list's numbers span their type's whole range, so struct.pack refuses exactly what the loop would, but True and
+    False (which it takes as numbers: looked for first, the cheaper loop). The full loop then finds the item at fault
+    and raises what it raised before; a failure it does not explain (a float) goes on as struct's error. A mark
+    whose list is packed inside a block keeps its loop where it was."""
+    for index, mark in enumerate(lines):
+        if not mark.startswith(_DEFERRED):
+            continue
+        expr = mark.removeprefix(_DEFERRED)
+        loop = lines[index + 1 : index + 4]
+        rest = lines[:index] + lines[index + 4 :]
+        at = next((i for i, line in enumerate(rest) if i >= index and f"*{expr})" in line), None)
+        if at is None or rest[at].startswith(" ") or any(line.startswith(" ") for line in rest[index:at]):
+            return deferred_item_checks(lines[:index] + lines[index + 1 :])
+        failed = [*loop[:-1], loop[-1] + " from None", "raise"]
+        item = loop[0].removeprefix("for ").partition(" in ")[0]
+        block = [
+            "try:",
+            f"    for {item} in {expr}:",
+            f"        if {item}.__class__ is bool:  # struct.pack takes True and False as numbers: refused below",
+            "            raise TypeError",
+            f"    {rest[at]}",
+            "except (TypeError, struct.error):  # the item at fault, looked for only when the pack fails",
+            *(f"    {line}" for line in failed),
+        ]
+        return deferred_item_checks(rest[:at] + block + rest[at + 1 :])
+    return lines
+
+
+def read_fields_once(lines: Lines, names: list[str]) -> Lines:
+    """An encoder's lines with each field of the message `m` that they read more than once read once, into a local
+    `m_<field>` first, and likewise each field of a loop's item (`item_<field>`): a range check and the pack read a
+    field two or three times, and a local costs less than an attribute (a record's fields are read through a
+    descriptor, ~15 ns each)."""
+    return _loops_read_once(_read_once(lines, "m", names, ""))
+
+
+def _read_once(lines: Lines, var: str, names: list[str] | None, indent: str) -> Lines:
+    """`lines` with the fields of `var` read more than once (of `names`, or any not called) read once up front."""
+    reads_of = re.compile(rf"(?<![\w.]){var}\.([A-Za-z_]\w*)\b(?!\()")
+    reads = Counter(name for line in lines for name in reads_of.findall(line))
+    again = [name for name in (names if names is not None else reads) if reads[name] > 1]
+    if not again:
+        return lines
+    local = {name: f"{var}_{name}" for name in again}
+
+    def replaced(match: re.Match[str]) -> str:
+        return local.get(match[1], match[0])
+
+    first = [f"{indent}{var}_{name} = {var}.{name}" for name in again]
+    return [*first, *(reads_of.sub(replaced, line) for line in lines)]
+
+
+def _loops_read_once(lines: Lines) -> Lines:
+    out: Lines = []
+    i = 0
+    while i < len(lines):
+        out.append(lines[i])
+        loop = _LOOP.match(lines[i])
+        i += 1
+        if loop is None:
+            continue
+        inner = loop["indent"] + "    "
+        end = i
+        while end < len(lines) and lines[end].startswith(inner):
+            end += 1
+        out += _loops_read_once(_read_once(lines[i:end], loop["var"], None, inner))
+        i = end
+    return out
+
+
+_UNPACKED = re.compile(r"^(?P<targets>[\w, ]+?),? = (?P<call>_S_\w+\.unpack_from\(.+\))$")
+
+
+_ONE_BYTE = re.compile(r"^(?P<indent> *)(?P<target>\w+), = (?P<struct>_S_\w+)\.unpack_from\(buf, (?P<at>.+)\)$")
+
+
+def fuse_unpack(lines: Lines, structs: dict[str, str]) -> Lines:
+    """A decoder's final lines, made cheaper where the analysis of whole frames (package.fixed_frames) is done
+    with them: an unpack into locals that are then built, in order, into the returned message becomes one line,
+    `return _new(Cls, _S.unpack_from(buf, o))` (the tuple struct gives is the message's); a lone unsigned byte is
+    read by indexing, not unpacked."""
+    out: Lines = []
+    for line in lines:
+        unpacked = _UNPACKED.match(out[-1]) if out else None
+        if unpacked and line.startswith("return _new("):
+            names = [name.strip() for name in unpacked["targets"].split(",")]
+            cls, _, rest = line.removeprefix("return _new(").partition(", ")
+            if rest == values_tuple(names) + ")":
+                out[-1] = f"return _new({cls}, {unpacked['call']})"
+                continue
+        out.append(line)
+    for index, line in enumerate(out):
+        one = _ONE_BYTE.match(line)
+        if one and structs.get(one["struct"]) in ("<B", ">B"):
+            out[index] = f"{one['indent']}{one['target']} = buf[{one['at']}]"
+    return out
+
+
+def members_name(class_name: str) -> str:
+    """The codec's module-level value -> member map of an enum or flag class."""
+    return f"_MEMBERS_{class_name}"
+
+
+def one_line(text: str) -> str:
+    """Spec text made safe for a comment or docstring: one line, no backslashes or quotes that could close it."""
+    return collapse(text).replace("\\", "\\\\").replace('"', "'")
+
+
+def struct_format(endian: str, fields: list[SpecField]) -> str:
+    """The struct format of a run of fixed-size fields."""
+    return endian + "".join(kind(f).struct_chars(f) for f in fields)
+
+
+def takes_the_rest(f: SpecField | None) -> bool:
+    """A field that reads exactly up to the end of the content, whatever its size.
+
+    Not a group of varying-size items: its last item may overrun `end`, which the check after it must catch.
+    """
+    if isinstance(f, Group):
+        return f.count == "rest" and f.item_size is not None
+    return isinstance(f, Bytes) and f.size == "rest"
+
+
+def is_fixed_run_member(f: SpecField) -> bool:
+    return kind(f).fixed(f)
+
+
+_SINGLE_BYTES = re.compile(r"(\d*[bBxs?c])*")  # a struct format whose byte order changes nothing
+
+
+def fixed_runs(fields: list[SpecField]) -> Iterator[list[SpecField] | SpecField]:
+    """Fields in order, each run of fixed-size fields as one list (one struct call), other fields alone."""
+    run: list[SpecField] = []
+    for f in fields:
+        if is_fixed_run_member(f):
+            run.append(f)
+            continue
+        if run:
+            yield run
+            run = []
+        yield f
+    if run:
+        yield run
+
+
+def annotation(f: SpecField) -> str:
+    return kind(f).annotation(f)
+
+
+def doc_line(f: SpecField) -> str:
+    parts = [f.description or f.name]
+    if isinstance(f, Scalar | Array | List) and f.unit:
+        parts.append(f"[{f.unit}]")
+    if isinstance(f, Scalar) and not f.bits and (f.minimum, f.maximum) != (f.type.minimum, f.type.maximum):
+        parts.append(f"range {number(f.minimum)}..{number(f.maximum)}")
+    if f.inferred:
+        parts.append("(layout inferred, not documented)")
+    return one_line(" ".join(parts))
+
+
+@dataclass
+class Attribute:
+    """One field of a generated class: its name, annotation, default (Python source, or "" for none) and doc line."""
+
+    name: str
+    annotation: str
+    doc: str
+    default: str = ""
+
+
+@dataclass
+class ClassCode:
+    """A generated value class: its name, docstring, fields, to_fields and from_fields bodies."""
+
+    name: str
+    doc: str
+    base: str
+    attributes: list[Attribute]
+    class_vars: Lines = field(default_factory=list)
+    to_fields: Lines = field(default_factory=list)
+    from_fields: Lines = field(default_factory=list)
+
+
+class PackageCode:
+    """Every fragment of one protocol's generated package."""
+
+    def __init__(self, protocol: Protocol) -> None:
+        self.protocol = protocol
+        self.structs: dict[str, str] = {}  # constant name -> format
+        self.helper_classes: list[ClassCode] = []
+        self.message_classes: list[ClassCode] = []
+        self.decoders: list[tuple[str, str, str, Lines]] = []  # name, return type, extra parameters, body
+        self.encoders: list[tuple[str, str, Lines]] = []  # name, parameter type, body
+        # classes the decoders build through their slots (see `build`): class name -> field names in order
+        self.built: dict[str, list[str]] = {}
+        self.member_maps: set[str] = set()  # enum and flag classes whose value -> member map the decoders use
+        self.unpack_runs: dict[str, tuple[str, int]] = {}  # unpack_runs tables the decoders use: name -> (format, most)
+        self._seen_classes: set[str] = set()
+        self._straight: dict[Direction, Straight | None] = {}
+        for message in protocol.messages():
+            self.message(message)
+
+    def straight(self, direction: Direction) -> Straight | None:
+        """The direction's frames when straight-line code takes them (framecode.py), worked out once."""
+        if direction not in self._straight:
+            self._straight[direction] = (
+                None if self.protocol.framing.classic else straight_direction(self.protocol, direction)
+            )
+        return self._straight[direction]
+
+    # --- structs --------------------------------------------------------------------------------------------------
+
+    def struct(self, base_name: str, fmt: str) -> str:
+        """A shared struct.Struct constant for a format, named after its layout (e.g. _S_U8_I16_U16_U16)."""
+        for name, existing in self.structs.items():
+            if existing == fmt:
+                return name
+        tokens = []
+        for count, char in re.findall(r"(\d*)([a-zA-Z?])", fmt):
+            token = _STRUCT_NAMES.get(char, char.upper())
+            tokens.append(f"{token}X{count}" if count and char != "s" else (f"B{count}" if char == "s" else token))
+        layout = "_".join(tokens) if len(tokens) <= 6 else base_name.upper()
+        name = "_S_" + ("BE_" if fmt.startswith(">") else "") + layout
+        if name in self.structs:  # another format got the same name (a long layout named after its message, ...)
+            taken = name
+            name = next(f"{taken}_{n}" for n in range(2, len(self.structs) + 3) if f"{taken}_{n}" not in self.structs)
+        self.structs[name] = fmt
+        return name
+
+    # --- classes --------------------------------------------------------------------------------------------------
+
+    def value_fields(self, message: Message) -> list[SpecField]:
+        return [f for f in message.fields if not (isinstance(f, Scalar) and f.hidden)]
+
+    def frame_values(self, direction: Direction, message: Message | None = None) -> list[Scalar]:
+        """Frame-level values (SMS id, error) every message of a direction carries, as scalar fields; an error reply
+        (Modbus exception) also carries the code of the request it refuses, named after the command element."""
+        layout = self.protocol.framing.layouts[direction]
+        values = []
+        elements = list(layout.value_elements)
+        error = self.protocol.error_reply
+        if message is not None and message.error_reply and error is not None:
+            element = next(e for e in layout.elements if e.name == error.element)
+            elements.append(replace(element, minimum=0, maximum=error.flag - 1, flags=None))
+        for element in elements:
+            assert element.type is not None
+            values.append(
+                Scalar(
+                    element.name,
+                    element.description,
+                    "",
+                    "",
+                    element.type,
+                    element.endian,
+                    "",
+                    None,
+                    element.minimum,
+                    element.maximum,
+                    None,
+                    None,
+                    None,
+                    element.flags,
+                    element.bits,
+                    element.bits_class,
+                    False,
+                )
+            )
+        return values
+
+    def attributes(self, fields: list[SpecField], defaults: bool = True) -> list[Attribute]:
+        # Defaults only on a trailing run of fields that all have one: classes stay positional.
+        trailing_defaults: set[str] = set()
+        for f in reversed(fields):
+            if defaults and isinstance(f, Scalar) and f.default is not None and not f.enum and not f.bits:
+                trailing_defaults.add(f.name)
+            else:
+                break
+        return [
+            Attribute(
+                f.name,
+                annotation(f),
+                doc_line(f),
+                number(f.default)
+                if isinstance(f, Scalar) and f.name in trailing_defaults and f.default is not None
+                else "",
+            )
+            for f in fields
+        ]
+
+    def helper(self, f: SpecField) -> None:
+        """Dataclasses for the nested values of a field: bit fields, group items, table blocks."""
+        if isinstance(f, Scalar) and f.bits and f.bits_class not in self._seen_classes:
+            self._seen_classes.add(f.bits_class)
+            attributes = []
+            for bit in f.bits:
+                kind = f"{bit.enum.class_name} | int" if bit.enum else "int"
+                where = f"bit {bit.low}" if bit.high == bit.low else f"bits {bit.high}..{bit.low}"
+                attributes.append(Attribute(bit.name, kind, f"{one_line(bit.description or bit.name)} ({where})"))
+            code = ClassCode(f.bits_class, f"Bit fields of {f.name}.", "", attributes)
+            code.to_fields = [f"{b.name!r}: int(self.{b.name})," for b in f.bits]
+            code.from_fields = [self.from_value_expr(b.name, b.enum.class_name if b.enum else None) for b in f.bits]
+            self.helper_classes.append(code)
+        elif isinstance(f, Group) and f.class_name not in self._seen_classes:
+            self._seen_classes.add(f.class_name)
+            for inner in f.fields:
+                self.helper(inner)
+            inner_fields = [i for i in f.fields if not (isinstance(i, Scalar) and i.hidden)]
+            code = ClassCode(f.class_name, f"One item of {f.name}.", "", self.attributes(inner_fields, False))
+            code.to_fields = [f"{i.name!r}: {self.to_json(i, 'self.' + i.name)}," for i in inner_fields]
+            code.from_fields = [f"{self.from_json(i)}," for i in inner_fields]
+            self.helper_classes.append(code)
+        elif isinstance(f, TableBlock) and f.class_name not in self._seen_classes:
+            self._seen_classes.add(f.class_name)
+            attributes = []
+            for e in f.entries:
+                kind = f"{e.enum.class_name} | int" if e.enum else ("float" if e.type.is_float else "int")
+                unit = f" [{e.unit}]" if e.unit else ""
+                doc = one_line(f"{f.table.key_name} {e.key}: {e.description or e.name}{unit}")
+                attributes.append(Attribute(e.name, kind, doc))
+            code = ClassCode(f.class_name, one_line(f"{f.description or f.name} ({f.table.title})."), "", attributes)
+            code.to_fields = [
+                f"{e.name!r}: {'int(self.' + e.name + ')' if e.enum else 'self.' + e.name}," for e in f.entries
+            ]
+            code.from_fields = [
+                self.from_value_expr(e.name, e.enum.class_name if e.enum else None, e.type.is_float) for e in f.entries
+            ]
+            self.helper_classes.append(code)
+
+    def from_value_expr(self, name: str, enum: str | None, is_float: bool = False) -> str:
+        """A value of a bit field or table block entry, from data: an enum member or an integer (or a number)."""
+        get = f"_get(data, {name!r}, where)"
+        if enum:
+            return f"_as_enum({enum}, {get}, {name!r}, where),"
+        return f"{'_number' if is_float else '_integer'}({get}, {name!r}, where),"
+
+    def to_json(self, f: SpecField, expr: str) -> str:
+        return kind(f).to_json(f, expr)
+
+    def from_json(self, f: SpecField) -> str:
+        return kind(f).from_json(f)
+
+    def message(self, message: Message) -> None:
+        for f in [*self.frame_values(message.direction), *message.fields]:
+            self.helper(f)
+        fields = [*self.frame_values(message.direction, message), *self.value_fields(message)]
+        doc = f"{message.command} {message.subcommand or ''} {message.direction.value}".replace("  ", " ")
+        code = ClassCode(message.class_name, doc, "Message", self.attributes(fields))
+        code.class_vars = [
+            f"PROTOCOL: ClassVar[str] = {self.protocol.name!r}",
+            f"COMMAND: ClassVar[str] = {message.command!r}",
+            f"SUBCOMMAND: ClassVar[str | None] = {message.subcommand!r}",
+            f"DIRECTION: ClassVar[Direction] = Direction.{message.direction.name}",
+        ]
+        code.to_fields = [f"{f.name!r}: {self.to_json(f, 'self.' + f.name)}," for f in fields]
+        code.from_fields = [f"{self.from_json(f)}," for f in fields]
+        self.message_classes.append(code)
+        frame_names = [f.name for f in self.frame_values(message.direction, message)]
+        extra = "".join(f", {name}: int" for name in frame_names)
+        decoder = fold_last_size_check(self.decoder(message, fields))
+        self.decoders.append((decoder_name(message), message.class_name, extra, decoder))
+        encoder = read_fields_once(deferred_item_checks(self.encoder(message, fields)), [f.name for f in fields])
+        self.encoders.append((encoder_name(message), message.class_name, encoder))
+
+    # --- decoding -------------------------------------------------------------------------------------------------
+
+    def where(self, message: Message) -> str:
+        return repr(f"{message.key} {message.direction.value}")
+
+    def decoder(self, message: Message, all_fields: list[SpecField]) -> Lines:
+        """Body of `_decode_X(buf, o, end, *frame_values)`: content bytes buf[o:end] -> message."""
+        lines: Lines = []
+        where = self.where(message)
+        low, high = message.min_size, message.max_size
+        if low == high:
+            lines.append(f"if end - o != {low}:")
+        elif high is None:
+            lines.append(f"if end - o < {low}:")
+        else:
+            lines.append(f"if not {low} <= end - o <= {high}:")
+        lines.append(f"    raise content_size_error({where}, end - o, {low}, {high})")
+        if low == 0 and high is None:
+            del lines[-2:]  # any size will do
+        # Where the layout alone says the fields end at `end` (one fixed size, checked above, or a last field that
+        # takes the rest), no check that they do is emitted, and nothing reads the cursor after the last field.
+        exact = low == high and all(fixed_size(f) is not None for f in message.fields)
+        exact = exact or takes_the_rest(message.fields[-1] if message.fields else None)
+        values = self.decode_fields(list(message.fields), message.class_name, lines, where, top=not exact)
+        if exact and (lines[-1].startswith("o += ") or lines[-1] == "o = end"):
+            lines.pop()
+        self.check_values(list(message.fields), lines, where)
+        frame_fields = all_fields[: len(all_fields) - len(self.value_fields(message))]
+        frame_values = [self.after_unpack(f, f.name, lines, where) or f.name for f in frame_fields]
+        self.build(message.class_name, [f.name for f in all_fields], [*frame_values, *values], "m", lines)
+        lines[-1] = lines[-1].replace("m = ", "return ", 1)
+        return lines
+
+    def build(self, class_name: str, names: list[str], values: list[str], target: str, lines: Lines) -> None:
+        """The line that makes an instance of a generated class in `target` from its field values, in field order.
+
+        Every decoder builds its messages here (one place, so a change of how messages are made reaches all of
+        them): `_new(Class, (values...))` is the runtime's `build`, one C call that stores the tuple of values as
+        the record (message.py); decoded values need none of the checks the class's __new__ would not make anyway.
+        """
+        assert len(names) == len(values), (class_name, names, values)
+        self.built[class_name] = names
+        lines.append(f"{target} = _new({class_name}, {values_tuple(values)})")
+
+    def build_each(self, class_name: str, names: list[str], tuples: str) -> str:
+        """The expression of a tuple of instances of a generated class, one built (as `build` does) from each tuple
+        of field values, in field order, that the expression `tuples` yields (a struct's iter_unpack)."""
+        self.built[class_name] = names
+        return f"tuple([_new({class_name}, values) for values in {tuples}])"
+
+    def build_all(self, class_name: str, names: list[str], tuples: str) -> str:
+        """The expression of an iterator of instances of a generated class, one built (as `build` does) from each
+        tuple of field values, in field order, that the expression `tuples` yields, with no Python call per item."""
+        self.built[class_name] = names
+        return f"map(_new, repeat({class_name}), {tuples})"
+
+    def enum_value(self, enum: str, raw: str) -> str:
+        """The member for a wire value, or the value itself when the spec names none (as enum_or_int does)."""
+        self.member_maps.add(enum)
+        return f"{members_name(enum)}.get({raw}, {raw})"
+
+    def flags_value(self, flags: str, raw: str, lines: Lines) -> str:
+        """A flags member for a wire value: looked up, made by the flag class only the first time it is seen."""
+        self.member_maps.add(flags)
+        name = f"{raw}_flags"
+        lines.append(f"{name} = {members_name(flags)}.get({raw})")
+        lines.append(f"if {name} is None:")
+        lines.append(f"    {name} = {flags}({raw})")
+        return name
+
+    def decode_fields(
+        self, fields: list[SpecField], base: str, lines: Lines, where: str, top: bool, known: int | None = None
+    ) -> list[str]:
+        """Append lines reading fields at cursor `o`; return the expressions of the non-hidden values.
+
+        `known`: bytes known to be left at `o` (None: as many as the leading fixed fields take, which the content's
+        size check covers). A run of fixed fields beyond them (after a variable field, in an item of varying size)
+        checks the bytes left first: content is decoded in place, and reading past `end` would read the frame's
+        next bytes rather than fail."""
+        values: list[str] = []
+        for item in fixed_runs(fields):
+            if isinstance(item, list):
+                size = sum(fixed_size(f) or 0 for f in item)
+                if known is not None and size > known:
+                    lines.append(f"if end - o < {size}:")
+                    reason = f"{item[0].name} needs {size} bytes, {{end - o}} left"
+                    lines.append(f"    raise DecodeError({where} + f': {reason}')")
+                    known = size
+                known = None if known is None else known - size
+                values += self.decode_run(item, base, lines, where)
+            else:
+                values.append(self.decode_variable(item, fields, base, lines, where))
+                known = 0
+        if top:
+            lines.append("if o != end:")
+            lines.append(f"    raise DecodeError({where} + f': {{end - o}} bytes left after the last field')")
+        return values
+
+    def check_values(self, fields: list[SpecField], lines: Lines, where: str) -> None:
+        """Every value derived by an expression must hold what the expression gives for the decoded fields."""
+        counted = {f.count: f.name for f in fields if isinstance(f, List) and isinstance(f.count, str)}
+        # a byte size of a list of numbers: decoding read size // item items and refused a remainder
+        sized = {f.size: f for f in fields if isinstance(f, List) and f.size and f.item is not None}
+        for f in fields:
+            if isinstance(f, Scalar) and f.value == expression.Length(counted.get(f.name, "")):
+                continue  # the count of the list it counts: decoding read exactly that many
+            listed = sized.get(f.name)
+            if isinstance(f, Scalar) and listed is not None and listed.item is not None:
+                items = expression.Length(listed.name)
+                scaled = expression.BinOp("*", expression.Const(listed.item.size), items)
+                if f.value in (scaled, items if listed.item.size == 1 else None):
+                    continue  # the byte size of the list it sizes: decoding read exactly that many bytes
+            if isinstance(f, Scalar) and f.value is not None:
+                expected = expression.render(f.value, self.local_named)
+                shown = one_line(expression.show(f.value)).replace("{", "{{").replace("}", "}}")
+                lines.append(f"if {self.local(f)} != {expected}:")
+                reason = f"{f.name} is {{{self.local(f)}}}, but {shown} = {{{expected}}}"
+                lines.append(f"    raise DecodeError({where} + f': {reason}')")
+
+    def decode_run(self, run: list[SpecField], base: str, lines: Lines, where: str) -> list[str]:
+        endian = next((f.endian for f in run if isinstance(f, Scalar | Array | TableBlock)), "<")
+        fmt = struct_format(endian, run)
+        const_name = self.struct(f"{base}_{run[0].name}", fmt)
+        size = sum(fixed_size(f) or 0 for f in run)
+        simple = all(isinstance(f, Scalar | Bytes) for f in run)
+        values: list[str] = []
+        if simple:
+            names = [self.local(f) for f in run]
+            target = ", ".join(names) + ("," if len(names) == 1 else "")
+            lines.append(f"{target} = {const_name}.unpack_from(buf, o)")
+            for f, name in zip(run, names, strict=True):
+                expr = self.after_unpack(f, name, lines, where)
+                if expr is not None:
+                    values.append(expr)
+        else:
+            lines.append(f"t = {const_name}.unpack_from(buf, o)")
+            position = 0
+            for f in run:
+                if isinstance(f, Array):
+                    values.append(f"t[{position}:{position + f.count}]")
+                    position += f.count
+                elif isinstance(f, TableBlock):
+                    items = []
+                    for e in f.entries:
+                        item = f"t[{position}]"
+                        items.append(self.enum_value(e.enum.class_name, item) if e.enum else item)
+                        position += 1
+                    self.build(f.class_name, [e.name for e in f.entries], items, self.local(f), lines)
+                    values.append(self.local(f))
+                else:
+                    name = self.local(f)
+                    lines.append(f"{name} = t[{position}]")
+                    position += 1
+                    expr = self.after_unpack(f, name, lines, where)
+                    if expr is not None:
+                        values.append(expr)
+        lines.append(f"o += {size}")
+        return values
+
+    @staticmethod
+    def local(f: SpecField) -> str:
+        return f"v_{f.name}"
+
+    def after_unpack(self, f: SpecField, name: str, lines: Lines, where: str) -> str | None:
+        """Checks and conversions after a scalar is unpacked; the value expression, or None if hidden."""
+        if not isinstance(f, Scalar):
+            return name
+        if f.const is not None:
+            lines.append(f"if {name} != {f.const}:")
+            lines.append(f"    raise DecodeError({where} + f': {f.name} is {{{name}:#x}}, expected {f.const:#x}')")
+            return None
+        if f.derived or f.value is not None:
+            return None
+        if f.sign_magnitude:
+            top = 1 << (f.type.size * 8 - 1)
+            lines.append(f"if {name} & {top:#x}:")
+            lines.append(f"    {name} = -({name} & {top - 1:#x})")
+        if f.bits:
+            used = 0
+            parts = []
+            for bit in f.bits:
+                used |= bit.mask << bit.low
+                raw = f"({name} >> {bit.low}) & {bit.mask:#x}" if bit.low else f"{name} & {bit.mask:#x}"
+                if bit.enum:
+                    lines.append(f"{name}_{bit.name} = {raw}")
+                    parts.append(self.enum_value(bit.enum.class_name, f"{name}_{bit.name}"))
+                else:
+                    parts.append(raw)
+            unused = ((1 << (f.type.size * 8)) - 1) & ~used
+            if unused:
+                lines.append(f"if {name} & {unused:#x}:")
+                lines.append(f"    raise DecodeError({where} + f': unused bits of {f.name} are set ({{{name}:#04x}})')")
+            self.build(f.bits_class, [b.name for b in f.bits], parts, f"{name}_bits", lines)
+            return f"{name}_bits"
+        if f.enum:
+            return self.enum_value(f.enum.class_name, name)
+        if f.flags:
+            return self.flags_value(f.flags.class_name, name, lines)
+        return name
+
+    def decode_variable(self, f: SpecField, siblings: list[SpecField], base: str, lines: Lines, where: str) -> str:
+        if isinstance(f, List):
+            return self.decode_list(f, lines, where, siblings)
+        if isinstance(f, Text):
+            return self.decode_text(f, lines, where)
+        if isinstance(f, Bytes):
+            if f.size == "rest":
+                lines.append(f"{self.local(f)} = buf[o:end]")
+                lines.append("o = end")
+            else:
+                size = self.local_named(str(f.size))
+                lines.append(f"if end - o < {size}:")
+                lines.append(f"    raise DecodeError({where} + f': {f.name} needs {{{size}}} bytes, {{end - o}} left')")
+                lines.append(f"{self.local(f)} = buf[o : o + {size}]")
+                lines.append(f"o += {size}")
+            return self.local(f)
+        if isinstance(f, TableValue):
+            table = f"_TABLE_{f.table.name.upper()}"
+            key = self.local_named(f.key)
+            lines.append(f"s = {table}.get({key})")
+            lines.append("if s is None:")
+            lines.append(f"    raise DecodeError({where} + f': unknown {f.table.key_name} {{{key}}}')")
+            lines.append("if end - o < s.size:")
+            reason = f"{f.name} needs {{s.size}} bytes for {f.table.key_name} {{{key}}}"
+            lines.append(f"    raise DecodeError({where} + f': {reason}')")
+            lines.append(f"({self.local(f)},) = s.unpack_from(buf, o)")
+            lines.append("o += s.size")
+            return self.local(f)
+        assert isinstance(f, Group)
+        item_fields = list(f.fields)
+        value = self.local(f)
+        item_names = [i.name for i in item_fields if not (isinstance(i, Scalar) and i.hidden)]
+        lines.append(f"{value}_list = []")
+        if f.item_size is not None:
+            item_fmt = struct_format(self.protocol_endian(), item_fields)
+            item_struct = self.struct(f"{f.class_name}", item_fmt)
+            if f.count == "rest":
+                lines.append(f"if (end - o) % {f.item_size}:")
+                reason = f"{{end - o}} bytes do not split into {f.name} items of {f.item_size}"
+                lines.append(f"    raise DecodeError({where} + f': {reason}')")
+                lines.append("n = end - o")
+            else:
+                count = str(f.count) if isinstance(f.count, int) else self.local_named(f.count)
+                lines.append(f"n = {count} * {f.item_size}")
+                lines.append("if end - o < n:")
+                lines.append(
+                    f"    raise DecodeError({where} + f': content too short for its count ({{{count}}} {f.name})')"
+                )
+            names = [self.local(i) for i in item_fields]
+            item_lines: Lines = []
+            item_values = [self.after_unpack(i, n, item_lines, where) for i, n in zip(item_fields, names, strict=True)]
+            values = [v for v in item_values if v is not None]
+            items = f"{item_struct}.iter_unpack(buf[o : o + n])"
+            if not item_lines and values == names:  # the unpacked tuples are the items' values
+                lines.pop(lines.index(f"{value}_list = []"))
+                lines.append(f"{value} = {self.build_each(f.class_name, item_names, items)}")
+                lines.append("o += n")
+                return value
+            self.build(f.class_name, item_names, values, "item", item_lines)
+            target = ", ".join(names) + ("," if len(names) == 1 else "")
+            lines.append(f"for {target} in {items}:")
+            lines.extend("    " + line for line in item_lines)
+            lines.append(f"    {value}_list.append(item)")
+            lines.append(f"{value} = tuple({value}_list)")
+            lines.append("o += n")
+            return value
+        # items of varying size: read them one by one
+        if f.count == "rest":
+            lines.append("while o < end:")
+        else:
+            count = str(f.count) if isinstance(f.count, int) else self.local_named(f.count)
+            lines.append(f"for _ in range({count}):")
+        inner: Lines = []
+        # in `while o < end` one byte is known to be left, in `for _ in range(count)` none
+        item_args = self.decode_fields(item_fields, f.class_name, inner, where, False, 1 if f.count == "rest" else 0)
+        self.build(f.class_name, item_names, item_args, "item", inner)
+        lines.extend("    " + line for line in inner)
+        lines.append(f"    {value}_list.append(item)")
+        lines.append(f"{value} = tuple({value}_list)")
+        return value
+
+    def decode_list(self, f: List, lines: Lines, where: str, siblings: list[SpecField]) -> str:
+        """A list of numbers or bits: its count from a number, a count field, a byte-size field, or the rest."""
+        value = self.local(f)
+        item = 1 if f.item is None else f.item.size
+        if f.size or f.count == "rest":
+            lines.append(f"nb = {self.local_named(f.size)}" if f.size else "nb = end - o")
+            if f.item is None:
+                lines.append("n = nb * 8")
+            else:
+                if item > 1:
+                    lines.append(f"if nb % {item}:")
+                    reason = f"{{nb}} bytes do not split into {f.name} items of {item}"
+                    lines.append(f"    raise DecodeError({where} + f': {reason}')")
+                lines.append(f"n = nb // {item}" if item > 1 else "n = nb")
+        else:
+            lines.append(f"n = {f.count if isinstance(f.count, int) else self.local_named(str(f.count))}")
+            lines.append("nb = (n + 7) >> 3" if f.item is None else (f"nb = n * {item}" if item > 1 else "nb = n"))
+        lines.append("if end - o < nb:")
+        lines.append(f"    raise DecodeError({where} + f': {f.name} needs {{nb}} bytes, {{end - o}} left')")
+        most = self.most_items(f, siblings)
+        if f.item is None:
+            lines.append(f"{value} = _unpack_bits(buf, o, n)")
+        elif most is not None and most <= _MOST_RUNS:  # a struct per count, made once
+            name = f"_RUNS_{'BE' if f.endian == '>' else 'LE'}_{_STRUCT_NAMES[f.item.struct_char]}"
+            known = self.unpack_runs.get(name, ("", 0))[1]
+            self.unpack_runs[name] = (f"{f.endian}{f.item.struct_char}", max(most, known))
+            lines.append(f"{value} = {name}[n](buf, o)")
+        else:
+            lines.append(f"{value} = struct.unpack_from(f'{f.endian}{{n}}{f.item.struct_char}', buf, o)")
+        lines.append("o += nb")
+        return value
+
+    def most_items(self, f: List, siblings: list[SpecField]) -> int | None:
+        """The most items a list of numbers can hold, where a count or byte-size field of the message bounds it: by
+        the field's type, not its declared range (a frame may carry any value the type holds)."""
+        scalars = {s.name: s for s in siblings if isinstance(s, Scalar) and not s.type.is_float}
+        item = 1 if f.item is None else f.item.size
+        if f.size and str(f.size) in scalars:
+            return int(scalars[str(f.size)].type.maximum) // item
+        if isinstance(f.count, str) and f.count in scalars:
+            return int(scalars[f.count].type.maximum)
+        return None
+
+    def decode_text(self, f: Text, lines: Lines, where: str) -> str:
+        value = self.local(f)
+        if f.size is None:
+            lines.append("stop = buf.find(b'\\0', o, end)")
+            lines.append("if stop < 0:")
+            lines.append(f"    raise DecodeError({where} + ': {f.name} has no NUL at its end')")
+            lines.append(f"{value} = _decode_text(buf[o:stop], {f.name!r}, {where})")
+            lines.append("o = stop + 1")
+            return value
+        if f.size == "rest":
+            lines.append(f"{value} = _decode_text(buf[o:end], {f.name!r}, {where})")
+            lines.append("o = end")
+            return value
+        size = str(f.size) if isinstance(f.size, int) else self.local_named(f.size)
+        lines.append(f"if end - o < {size}:")
+        lines.append(f"    raise DecodeError({where} + f': {f.name} needs {{{size}}} bytes, {{end - o}} left')")
+        lines.append(f"{value} = _decode_text(buf[o : o + {size}], {f.name!r}, {where})")
+        lines.append(f"o += {size}")
+        return value
+
+    def local_named(self, name: str) -> str:
+        return f"v_{name}"
+
+    def protocol_endian(self) -> str:
+        return ">" if self.protocol.byte_order == "big" else "<"
+
+    # --- encoding -------------------------------------------------------------------------------------------------
+
+    def encoder(self, message: Message, all_fields: list[SpecField]) -> Lines:
+        """Body of `_encode_X(m) -> bytes`: range checks, then the frame's bytes."""
+        lines: Lines = []
+        where = self.where(message)
+        frame_fields = all_fields[: len(all_fields) - len(self.value_fields(message))]
+        layout = self.protocol.framing.layouts[message.direction]
+        elements = {e.name: e for e in layout.value_elements}
+        frame_values = []
+        error = self.protocol.error_reply if message.error_reply else None
+        for f in frame_fields:
+            assert isinstance(f, Scalar)
+            if f.bits:
+                frame_values.append(self.wire_value(f, "m", [], lines, where))
+                continue
+            if error is not None and f.name == error.element:  # the refused request's code: sent with the flag
+                self.check_scalar(f, f"m.{f.name}", lines, where)
+                continue
+            self.check_scalar(f, f"m.{f.name}", lines, where, also=elements[f.name].broadcast)
+            frame_values.append(f"m.{f.name}")
+        fields = list(message.fields)
+        self.check_count_from(message, lines, where)
+        command_code = self.protocol.command(message.command).code
+        if not self.protocol.framing.classic:
+            # the runtime's frame engine wraps the content (see backends/python/frames.py)
+            parts = self.encode_fields(fields, message.class_name, "m", lines, where)
+            content = parts[0] if len(parts) == 1 else f"b''.join(({', '.join(parts)},))" if parts else "b''"
+            code = f"{command_code:#04x}" if command_code is not None and layout.has_command else "None"
+            if error is not None:
+                code = f"m.{error.element} | {error.flag:#04x}"
+            frames = self.straight(message.direction)
+            size = message.min_size if message.min_size == message.max_size else None
+            name = f"frame_{message.class_name}"
+            inline = frames and frame_encoder(
+                frames, parts, self.structs, code, frame_values, size, lambda fmt: self.struct(name, fmt)
+            )
+            if inline:  # the frame made here (backends/python/framecode.py): no call of the direction's wrap
+                return [*lines, *inline]
+            arguments = ", ".join([content, code, *frame_values])
+            lines.append(f"return _wrap_{message.direction.value}({arguments})")  # backends/python/framecode.py
+            return lines
+        code = str(command_code if command_code is not None else 0)
+        if all(is_fixed_run_member(f) for f in fields):
+            # one fixed size: the whole frame but its checksum is one struct, the length byte a constant
+            endian, content_format, args = self.encode_run_format(fields, "m", fields, lines, where)
+            head = self.head_format(layout, endian, code, f"{message.min_size + layout.length_adds}", frame_values)
+            if head is not None:
+                head_format, head_args = head
+                name = self.struct(f"frame_{message.class_name}", endian + head_format + content_format)
+                lines.append(f"body = {name}.pack({', '.join([*head_args, *args])})")
+                lines.extend(self.checksum_append(layout, "body"))
+                return lines
+            parts = []
+            if fields:
+                name = self.struct(f"{message.class_name}_{fields[0].name}", endian + content_format)
+                parts.append(f"{name}.pack({', '.join(args)})")
+        else:
+            runs = list(fixed_runs(fields))
+            run_lines: Lines = []
+            if len(runs) > 1 and isinstance(runs[0], list):
+                # a leading run of fixed fields is packed with the frame's head: one struct call and one bytes
+                # object less per frame (the head is little-endian, so the run must be too, or all single bytes)
+                endian, run_format, run_args = self.encode_run_format(runs[0], "m", fields, run_lines, where)
+                if endian == "<" or _SINGLE_BYTES.fullmatch(run_format):
+                    lines.extend(run_lines)
+                    rest = [
+                        self.encode_run(item, message.class_name, "m", fields, lines, where)
+                        if isinstance(item, list)
+                        else self.encode_variable(item, "m", lines, where)
+                        for item in runs[1:]
+                    ]
+                    content = rest[0] if len(rest) == 1 else f"b''.join(({', '.join(rest)},))"
+                    lines.append(f"content = {content}")
+                    lines.extend(self.frame_lines(layout, code, frame_values, (run_format, run_args)))
+                    return lines
+            parts = self.encode_fields(fields, message.class_name, "m", lines, where)
+        content = parts[0] if len(parts) == 1 else f"b''.join(({', '.join(parts)},))"
+        lines.append(f"content = {content if parts else repr(b'')}")
+        lines.extend(self.frame_lines(layout, code, frame_values))
+        return lines
+
+    def head_format(
+        self, layout: FrameLayout, endian: str, code: str, length: str, values: list[str]
+    ) -> tuple[str, list[str]] | None:
+        """Struct format (no byte order) and arguments of the frame elements before the content.
+
+        None when the head cannot share the content's struct: a multi-byte frame element in a big-endian content
+        (frame elements are little-endian), or a constant length that does not fit its element.
+        """
+        assert [e.role for e in layout.elements[-2:]] == ["content", "checksum"]  # the resolver checks both
+        chars: list[str] = []
+        args: list[str] = []
+        remaining = iter(values)
+        for element in layout.elements[:-2]:
+            if element.role == "header":
+                chars.append(f"{len(layout.header)}s")
+                args.append(repr(layout.header))
+                continue
+            assert element.type is not None
+            if element.type.size > 1 and endian != "<":
+                return None
+            chars.append(element.type.struct_char)
+            if element.role == "command":
+                args.append(code)
+            elif element.role == "length":
+                if length.isdigit() and int(length) > element.type.maximum:
+                    return None
+                args.append(length)
+            else:  # address, status: the message's frame values, in element order
+                args.append(next(remaining))
+        return "".join(chars), args
+
+    def checksum_append(self, layout: FrameLayout, body: str) -> Lines:
+        """Lines that return `body` (the frame without its checksum) with its checksum appended."""
+        covered = f"{body}[{layout.covered_from}:]" if layout.covered_from else body
+        size = layout.checksum_offset_from_end
+        checksum = self.protocol.framing.checksum
+        assert checksum is not None  # classic frames have one
+        lines = checksum_lines(checksum, covered, "check")
+        skipped = layout.header[: layout.covered_from]
+        if checksum.algorithm == "sum" and layout.covered_from and len(skipped) == layout.covered_from:
+            # the bytes before the covered ones are the header, a constant: the sum less it, no slice made
+            mask = (1 << (checksum.type.size * 8)) - 1
+            lines = [f"check = {'~' if checksum.invert else ''}(sum({body}) - {sum(skipped):#x}) & {mask:#x}"]
+        if len(lines) == 1:  # a single expression: append it directly
+            value = lines[0].removeprefix("check = ")
+            lines = []
+        else:
+            value = "check"
+        tail = f"_BYTES[{value}]" if size == 1 else f"({value}).to_bytes({size}, 'little')"
+        return [*lines, f"return {body} + {tail}"]
+
+    def frame_lines(
+        self, layout: FrameLayout, code: str, values: list[str], prefix: tuple[str, list[str]] | None = None
+    ) -> Lines:
+        """Lines that return the frame around the bytes in `content`: inline in each encoder, not a call per frame.
+
+        `prefix`: struct format (little-endian) and arguments of the content's first fields, packed with the head.
+        """
+        prefix_format, prefix_args = prefix or ("", [])
+        adds = layout.length_adds + struct.calcsize("<" + prefix_format)
+        lines: Lines = [f"n = len(content) + {adds}" if adds else "n = len(content)"]
+        length = next(e for e in layout.elements if e.role == "length")
+        assert length.type is not None
+        lines.append(f"if n > {int(length.type.maximum)}:")
+        size = f"n - {layout.length_adds}" if layout.length_adds else "n"
+        lines.append(f"    raise EncodeError(f'content of {{{size}}} bytes does not fit the length field')")
+        head = self.head_format(layout, "<", code, "n", values)
+        assert head is not None  # little-endian and a length computed at run time: always possible
+        head_format, head_args = head
+        base = f"head_{layout.direction.value}" + (f"_{prefix_format}" if prefix_format else "")
+        name = self.struct(base, "<" + head_format + prefix_format)
+        lines.append(f"body = {name}.pack({', '.join([*head_args, *prefix_args])}) + content")
+        lines.extend(self.checksum_append(layout, "body"))
+        return lines
+
+    def check_scalar(self, f: Scalar, expr: str, lines: Lines, where: str, also: int | None = None) -> None:
+        """Range check; `also` is one more value allowed outside the range (an address's broadcast value)."""
+        # an integer field refuses True and False too (bool is an int to Python, never to the wire)
+        not_bool = "" if f.type.is_float else f" or {expr}.__class__ is bool"
+        if f.flags:  # typed as the IntFlag class, which mypy knows is no bool: asked the way it accepts
+            not_bool = f" or isinstance({expr}, bool)"
+        low, high = bound(f, f.minimum), bound(f, f.maximum)
+        if also is not None and also in (f.minimum - 1, f.maximum + 1):  # next to the range: one comparison
+            low, high = bound(f, min(also, f.minimum)), bound(f, max(also, f.maximum))
+            lines.append(f"if not {low} <= {expr} <= {high}{not_bool}:")
+        elif also is not None and not f.minimum <= also <= f.maximum:
+            lines.append(f"if not ({low} <= {expr} <= {high} or {expr} == {also}){not_bool}:")
+        else:
+            lines.append(f"if not {low} <= {expr} <= {high}{not_bool}:")
+        broadcast = "" if also is None or f.minimum <= also <= f.maximum else f", {also}"
+        lines.append(
+            f"    raise out_of_range({where}, {f.name!r}, {expr}, {number(f.minimum)}, {number(f.maximum)}{broadcast})"
+        )
+
+    def check_count_from(self, message: Message, lines: Lines, where: str) -> None:
+        """A response list whose count the request gives (`count_from`) holds no more items than the request's
+        count field allows (Modbus: at most 2000 coils), so no frame is made that no request could have asked for."""
+        for f in message.fields:
+            if not (isinstance(f, List) and f.count_from):
+                continue
+            request = next(
+                m
+                for m in self.protocol.messages()
+                if (m.command, m.subcommand, m.direction.value) == (message.command, message.subcommand, "request")
+            )
+            count = next(c for c in request.fields if c.name == f.count_from)
+            assert isinstance(count, Scalar)
+            high = number(count.maximum)
+            lines.append(f"if len(m.{f.name}) > {high}:")
+            reason = (
+                f"{f.name} has {{len(m.{f.name})}} items, at most {high} (the limit of the request field {count.name})"
+            )
+            lines.append(f"    raise EncodeError({where} + f': {reason}')")
+
+    def check_items(self, f: Array | List, expr: str, lines: Lines, where: str) -> None:
+        """Every number of a list within the item's range, and none a bool (True is not 1); the first at fault named.
+
+        A plain loop: any() over a generator costs a frame per call, twice the time for a few items."""
+        low, high = number(f.minimum), number(f.maximum)
+        item = f"x_{f.name}"
+        kind = f.item if isinstance(f, List) else None
+        if kind is not None and not kind.is_float and (f.minimum, f.maximum) == (kind.minimum, kind.maximum):
+            lines.append(f"{_DEFERRED}{expr}")  # struct.pack checks the range: the loop only if it fails (deferred)
+        lines.append(f"for {item} in {expr}:")
+        lines.append(f"    if not {low} <= {item} <= {high} or {item}.__class__ is bool:")
+        lines.append(f"        raise out_of_range({where}, {f.name!r}, {expr}, {low}, {high})")
+
+    def encode_fields(self, fields: list[SpecField], base: str, obj: str, lines: Lines, where: str) -> list[str]:
+        """Append checks and local values; return expressions of the byte parts in order."""
+        parts: list[str] = []
+        for item in fixed_runs(fields):
+            if isinstance(item, list):
+                parts.append(self.encode_run(item, base, obj, fields, lines, where))
+            else:
+                parts.append(self.encode_variable(item, obj, lines, where))
+        return parts
+
+    def derived_source(self, f: Scalar, obj: str, siblings: list[SpecField]) -> str:
+        """Python source of a derived value (by `value:` expression, or a count or size of a list or text)."""
+        by_name = {s.name: s for s in siblings}
+        if f.value is not None:
+
+            def source(name: str) -> str:
+                other = by_name[name]
+                if isinstance(other, Scalar) and (other.value is not None or other.derived):
+                    return f"({self.derived_source(other, obj, siblings)})"
+                return f"{obj}.{name}"
+
+            return expression.render(f.value, source)
+        kind, target = f.derived[0], f.derived[1]
+        other = by_name.get(target)
+        if kind == "size" and isinstance(other, List):
+            count = f"len({obj}.{target})"
+            return f"(({count} + 7) >> 3)" if other.item is None else f"{count} * {other.item.size}"
+        if kind == "size" and isinstance(other, Text):
+            return f"len({obj}.{target}.encode('utf-8'))"
+        return f"len({obj}.{target})"
+
+    def wire_value(self, f: Scalar, obj: str, siblings: list[SpecField], lines: Lines, where: str) -> str:
+        if f.const is not None:
+            return number(f.const)
+        if f.value is not None or (f.derived and isinstance(self.sibling(siblings, f.derived[1]), List | Text)):
+            value = self.local(f) if obj == "m" else f"{obj}_{f.name}"
+            lines.append(f"{value} = {self.derived_source(f, obj, siblings)}")
+            lines.append(f"if not {number(f.minimum)} <= {value} <= {number(f.maximum)}:")
+            lines.append(
+                f"    raise out_of_range({where}, {f.name!r}, {value}, {number(f.minimum)}, {number(f.maximum)})"
+            )
+            return value
+        if f.derived:
+            kind, target = f.derived[0], f.derived[1]
+            if kind == "count" or any(s.name == target for s in siblings):  # a count, or bytes beside their size
+                value = f"len({obj}.{target})"
+            else:
+                group = next(s for s in siblings if isinstance(s, Group) and any(i.name == target for i in s.fields))
+                value = self.local_named(f.name)
+                lines.append(f"{value} = len({obj}.{group.name}[0].{target}) if {obj}.{group.name} else 0")
+                lines.append(f"if any(len(item.{target}) != {value} for item in {obj}.{group.name}):")
+                lines.append(
+                    f"    raise EncodeError({where} + ': every {target} of {group.name} must have the same length')"
+                )
+            lines.append(f"if {value} > {number(f.maximum)}:")
+            lines.append(
+                f"    raise out_of_range({where}, {f.name!r}, {value}, {number(f.minimum)}, {number(f.maximum)})"
+            )
+            return value
+        expr = f"{obj}.{f.name}"
+        if f.bits:
+            packed = []
+            for bit in f.bits:
+                sub = f"{expr}.{bit.name}"
+                lines.append(f"if not 0 <= {sub} <= {bit.mask} or {sub}.__class__ is bool:")
+                lines.append(f"    raise out_of_range({where}, {f.name + '.' + bit.name!r}, {sub}, 0, {bit.mask})")
+                packed.append(f"({sub} << {bit.low})" if bit.low else sub)
+            return " | ".join(packed)
+        self.check_scalar(f, expr, lines, where)
+        if f.sign_magnitude:
+            top = 1 << (f.type.size * 8 - 1)
+            return f"(-{expr} | {top:#x} if {expr} < 0 else {expr})"
+        return expr
+
+    @staticmethod
+    def sibling(siblings: list[SpecField], name: str) -> SpecField | None:
+        return next((s for s in siblings if s.name == name), None)
+
+    def encode_run(
+        self, run: list[SpecField], base: str, obj: str, siblings: list[SpecField], lines: Lines, where: str
+    ) -> str:
+        endian, fmt, args = self.encode_run_format(run, obj, siblings, lines, where)
+        const_name = self.struct(f"{base}_{run[0].name}", endian + fmt)
+        return f"{const_name}.pack({', '.join(args)})"
+
+    def encode_run_format(
+        self, run: list[SpecField], obj: str, siblings: list[SpecField], lines: Lines, where: str
+    ) -> tuple[str, str, list[str]]:
+        """Byte order, struct format (without it) and pack arguments of a run of fixed-size fields; checks to lines."""
+        endian = next((f.endian for f in run if isinstance(f, Scalar | Array | TableBlock)), "<")
+        args: list[str] = []
+        for f in run:
+            if isinstance(f, Scalar):
+                args.append(self.wire_value(f, obj, siblings, lines, where))
+            elif isinstance(f, Array):
+                expr = f"{obj}.{f.name}"
+                lines.append(f"if len({expr}) != {f.count}:")
+                lines.append(
+                    f"    raise EncodeError({where} + f': {f.name} needs {f.count} items, got {{len({expr})}}')"
+                )
+                self.check_items(f, expr, lines, where)
+                args.append(f"*{expr}")
+            elif isinstance(f, Bytes):
+                expr = f"{obj}.{f.name}"
+                lines.append(f"if len({expr}) != {f.size}:")
+                lines.append(
+                    f"    raise EncodeError({where} + f': {f.name} needs {f.size} bytes, got {{len({expr})}}')"
+                )
+                args.append(expr)
+            elif isinstance(f, TableBlock):
+                for e in f.entries:
+                    expr = f"{obj}.{f.name}.{e.name}"
+                    lines.append(f"if not {number(e.minimum)} <= {expr} <= {number(e.maximum)}:")
+                    lines.append(
+                        f"    raise out_of_range({where}, {f.name + '.' + e.name!r}, {expr}, "
+                        f"{number(e.minimum)}, {number(e.maximum)})"
+                    )
+                    args.append(expr)
+        return endian, struct_format("", run), args
+
+    def encode_variable(self, f: SpecField, obj: str, lines: Lines, where: str) -> str:
+        expr = f"{obj}.{f.name}"
+        if isinstance(f, List):
+            if isinstance(f.count, int):
+                lines.append(f"if len({expr}) != {f.count}:")
+                lines.append(
+                    f"    raise EncodeError({where} + f': {f.name} needs {f.count} items, got {{len({expr})}}')"
+                )
+            if f.item is None:
+                return f"_pack_bits({expr}, {f.name!r}, {where})"
+            self.check_items(f, expr, lines, where)
+            return f"struct.pack(f'{f.endian}{{len({expr})}}{f.item.struct_char}', *{expr})"
+        if isinstance(f, Text):
+            data = f"_encode_text({expr}, {f.name!r}, {where}, {f.size is None})"
+            if isinstance(f.size, int):
+                lines.append(f"{self.local(f)} = {data}")
+                lines.append(f"if len({self.local(f)}) != {f.size}:")
+                reason = f"{f.name} needs {f.size} bytes of UTF-8, got {{len({self.local(f)})}}"
+                lines.append(f"    raise EncodeError({where} + f': {reason}')")
+                return self.local(f)
+            return data
+        if isinstance(f, Bytes):  # bytes as they are (bytes(b) looks up b.__bytes__ first), anything else made bytes
+            lines.append(f"{self.local(f)} = {expr} if {expr}.__class__ is bytes else bytes({expr})")
+            return self.local(f)
+        if isinstance(f, TableValue):
+            table = f"_TABLE_{f.table.name.upper()}"
+            key = f"{obj}.{f.key}"
+            lines.append(f"s = {table}.get({key})")
+            lines.append("if s is None:")
+            lines.append(f"    raise EncodeError({where} + f': unknown {f.table.key_name} {{{key}}}')")
+            lines.append(f"low, high = _TABLE_{f.table.name.upper()}_RANGES[{key}]")
+            lines.append(f"if not low <= {expr} <= high:")
+            lines.append(f"    raise out_of_range({where}, {f.name!r}, {expr}, low, high)")
+            return f"s.pack({expr})"
+        assert isinstance(f, Group)
+        if isinstance(f.count, int):
+            lines.append(f"if len({expr}) != {f.count}:")
+            lines.append(f"    raise EncodeError({where} + f': {f.name} needs {f.count} items, got {{len({expr})}}')")
+        # the items are checked and packed in a loop here, not by a function called per item
+        item = "item" if obj == "m" else f"{obj}_item"
+        item_lines: Lines = []
+        parts = self.encode_fields(list(f.fields), f.class_name, item, item_lines, where)
+        packed = f"b''.join(({', '.join(parts)},))" if len(parts) > 1 else parts[0]
+        lines.append(f"parts_{f.name} = []")
+        lines.append(f"for {item} in {expr}:")
+        lines.extend("    " + line for line in item_lines)
+        lines.append(f"    parts_{f.name}.append({packed})")
+        return f"b''.join(parts_{f.name})"
+
+
+def reflect(value: int, width: int) -> int:
+    return int(f"{value:0{width}b}"[::-1], 2)
+
+
+def checksum_lines(checksum: Checksum, covered: str, target: str) -> Lines:
+    """Lines that compute a frame's checksum over the bytes `covered` (an expression) into `target`.
+
+    A sum is one expression; an 8-bit CRC a loop over a 256-entry table (`_CRC_TABLE`, which the codec defines) with
+    no call per frame; any other CRC the runtime's table-driven function (`_crc`).
+    """
+    mask = (1 << (checksum.type.size * 8)) - 1
+    if checksum.algorithm == "sum":
+        return [f"{target} = {'~' if checksum.invert else ''}sum({covered}) & {mask:#x}"]
+    crc = checksum.crc
+    assert crc is not None
+    if crc.width != 8 or crc.refin != crc.refout:
+        return [f"{target} = _crc({covered})"]
+    # With 8 bits the table-driven step is table[crc ^ byte] whether the CRC is reflected or not.
+    lines = [
+        f"{target} = {reflect(crc.init, 8) if crc.refin else crc.init:#x}",
+        f"for byte in {covered}:",
+        f"    {target} = _CRC_TABLE[{target} ^ byte]",
+    ]
+    if crc.xorout:
+        lines.append(f"{target} ^= {crc.xorout:#x}")
+    return lines
+
+
+def crc_setup(checksum: Checksum) -> tuple[str, str]:
+    """The runtime import and the module-level definition that `checksum_lines` relies on ('' for sums)."""
+    crc = checksum.crc
+    if checksum.algorithm == "sum" or crc is None:
+        return "", ""
+    if crc.width != 8 or crc.refin != crc.refout:
+        definition = (
+            f"crc_function({crc.width}, {crc.poly:#x}, {crc.init:#x}, {crc.refin}, {crc.refout}, {crc.xorout:#x})"
+        )
+        return "crc_function", f"_crc: Callable[[bytes], int] = {definition}  # {one_line(crc.name)}"
+    return "crc_table", f"_CRC_TABLE = crc_table(8, {crc.poly:#x}, {crc.refin})  # {one_line(crc.name)}"

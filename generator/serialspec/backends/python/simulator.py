@@ -1,0 +1,277 @@
+"""Emit a protocol's virtual device: the spec's `device:` section, tables and commands as data for runtime.device."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from serialspec.backends.common.numbers import number
+from serialspec.backends.common.pairing import request_response_pairs
+from serialspec.backends.python.pycode import one_line
+from serialspec.backends.python.registers import map_name, register_tables
+from serialspec.backends.python.render import render
+from serialspec.lang import expression
+from serialspec.lang.model import (
+    Bytes,
+    DeviceModel,
+    Group,
+    List,
+    Message,
+    Protocol,
+    Scalar,
+    SpaceAccess,
+    TableBlock,
+    TableValue,
+    reply_condition,
+)
+
+#: Behaviour attributes passed to CommandSpec under the same name when they are set.
+BEHAVIOUR_ARGUMENTS = (
+    "kind",
+    "each",
+    "stores",
+    "sets",
+    "absent",
+    "buffered",
+    "commits",
+    "stops",
+    "wraps",
+    "modulo",
+    "restores",
+    "broadcast_ignores",
+    "refused_while_moving",
+    "counts",
+    "every_device",
+    "held_while",
+    "releases",
+    "cancel_when",
+    "carries",
+    "nothing_held",
+)
+
+
+def carried_requests(protocol: Protocol) -> list[tuple[int, str]]:
+    """(code, request class) of every request a `carries` behaviour may carry."""
+    device = protocol.device
+    carriers = [b for b in device.behaviours if b.carries] if device else []
+    if not carriers:
+        return []
+    named = {name for b in carriers for name in b.carried}
+    return [
+        (c.code, c.request.class_name)
+        for c in protocol.commands
+        if c.code is not None and c.request is not None and not c.subcommands and (not named or c.name in named)
+    ]
+
+
+def table_fields(*messages: Message | None) -> dict[str, tuple[str, ...]]:
+    """Fields (group items' too) that hold table entries: by key, as a block, or as a run of registers."""
+    found: dict[str, tuple[str, ...]] = {}
+    stack = [f for message in messages if message for f in reversed(message.fields)]
+    while stack:
+        f = stack.pop()
+        if isinstance(f, TableValue):
+            found[f.name] = ("value", f.key)
+        elif isinstance(f, TableBlock):
+            found[f.name] = ("block", *(e.name for e in f.entries))
+        elif isinstance(f, Bytes) and f.table is not None and f.start:
+            # the request's fields are the device's `given` values, so `request.address` is `address` there
+            found[f.name] = ("run", f.start, f.size_from)
+        elif isinstance(f, Group):
+            stack.extend(reversed(f.fields))
+    return found
+
+
+def limits(request: Message) -> dict[str, tuple[float, float, tuple[int, ...]]]:
+    """The request values a device checks before it acts (Modbus: quantities, coil values): every scalar whose
+    range is narrower than its type's or that has an enum, and the number of items of a list whose count field
+    has a range."""
+    found: dict[str, tuple[float, float, tuple[int, ...]]] = {}
+    counted = {f.count: f.name for f in request.fields if isinstance(f, List) and isinstance(f.count, str)}
+    for f in request.fields:
+        if not isinstance(f, Scalar) or f.const is not None or f.bits:
+            continue
+        narrower = (f.minimum, f.maximum) != (f.type.minimum, f.type.maximum)
+        if f.hidden and f.name in counted and narrower:
+            found[counted[f.name]] = (f.minimum, f.maximum, ())
+        elif not f.hidden and (narrower or f.enum):
+            allowed = tuple(v.value for v in f.enum.values) if f.enum else ()
+            found[f.name] = (f.minimum, f.maximum, allowed)
+    return found
+
+
+def report_source(parsed: expression.Expr) -> str:
+    """A reported state variable by name, or a conversion of state variables as a function of `get`."""
+    if isinstance(parsed, expression.Name):
+        return repr(parsed.name)
+    return f"lambda get: {expression.render(parsed, lambda n: f'get({n!r})')}"
+
+
+def derived_values(request: Message, response: Message | None) -> dict[str, str]:
+    """Request values its message does not hold (derived counts), for a reply to echo: name -> a function of the
+    request's fields (and the values derived before it)."""
+    if response is None:
+        return {}
+    found = {}
+    for f in request.fields:  # in order: a value may use one derived before it
+        if not isinstance(f, Scalar) or f.const is not None:
+            continue
+        if f.value is not None:
+            found[f.name] = f"lambda fields: {expression.render(f.value, lambda n: f'fields[{n!r}]')}"
+        elif f.derived and f.derived[0] == "count":
+            found[f.name] = f"lambda fields: len(fields[{f.derived[1]!r}])"
+    return found
+
+
+def run_spec(run: SpaceAccess) -> str:
+    args = [repr(run.space), repr(run.start)]
+    if run.count:
+        args.append(f"count={run.count!r}")
+    if run.value is not None:
+        body = expression.render(run.value, lambda n: "current" if n == "current" else f"fields[{n!r}]")
+        args.append(f"value=lambda current, fields: {body}")
+    return f"RunSpec({', '.join(args)})"
+
+
+def import_order(name: str) -> tuple[int, str]:
+    """The order ruff's isort gives names in one `from` import: constants, classes, others; case-insensitive."""
+    return (0 if name.isupper() else 1 if name[:1].isupper() else 2, name.lower())
+
+
+def model_data(model: DeviceModel) -> dict[str, Any]:
+    """A model as the template's ModelSpec: its values, and its ranges where they differ from the table's."""
+    return {
+        "name": repr(model.name),
+        "number": model.number,
+        "values": [(repr(k), number(v)) for k, v in model.initial.items()],
+        "ranges": [(repr(e.name), number(e.minimum), number(e.maximum)) for e in model.entries],
+    }
+
+
+def simulator_module(protocol: Protocol) -> str:
+    device = protocol.device
+    assert device is not None
+    entries = []
+    for entry in device.memory.entries if device.memory else ():
+        default = entry.default if isinstance(entry.default, int | float) else 0
+        value = device.initial.get(entry.name, default)
+        entries.append(
+            f"EntrySpec({entry.name!r}, {entry.key}, {number(value)}, {entry.access!r}, "
+            f"{number(entry.minimum)}, {number(entry.maximum)}),"
+        )
+    commands: list[dict[str, Any]] = []
+    imports: set[str] = set()
+    for request, response in request_response_pairs(protocol):
+        behaviour = device.behaviour(request.key)
+        args = [request.class_name, response.class_name if response else "None"]
+        imports.add(request.class_name)
+        if response:
+            imports.add(response.class_name)
+        if behaviour:
+            if behaviour.reads:
+                args.append(f"reads={behaviour.reads!r}")
+            if behaviour.writes:
+                args.append(f"writes={behaviour.writes!r}")
+            if behaviour.resets:
+                args.append("resets=True")
+            if behaviour.keeps:
+                args.append(f"keeps={behaviour.keeps!r}")
+            if behaviour.reports:
+                args.append(
+                    f"reports={{{', '.join(f'{k!r}: {report_source(v)}' for k, v in behaviour.reports.items())}}}"
+                )
+            if behaviour.moves:
+                m = behaviour.moves
+                args.append(f"moves={(m.state, m.target, m.duration, m.speed)!r}")
+                if m.speed_scale != 1.0:
+                    args.append(f"speed_scale={m.speed_scale!r}")
+                if m.enabled_by:
+                    args.append(f"move_enabled_by={m.enabled_by!r}")
+                if m.accel or m.decel:
+                    args.append(f"ramp={(m.accel, m.decel)!r}")
+            if behaviour.broadcast_reply:
+                args.append("broadcast_reply=True")
+            for name in BEHAVIOUR_ARGUMENTS:
+                if getattr(behaviour, name):
+                    args.append(f"{name}={getattr(behaviour, name)!r}")
+            for name in ("space_reads", "space_writes"):
+                runs = getattr(behaviour, name)
+                if runs:
+                    args.append(f"{name}={{{', '.join(f'{k!r}: {run_spec(r)}' for k, r in runs.items())}}}")
+        derived = derived_values(request, response)
+        if derived:
+            args.append(f"derived={{{', '.join(f'{k!r}: {v}' for k, v in derived.items())}}}")
+        if device.errors is not None and protocol.error_reply is not None:
+            code = protocol.command(request.command).code
+            args.append(f"code={code!r}")
+            checked = limits(request)
+            if checked:
+                shown = ", ".join(f"{k!r}: ({number(lo)}, {number(hi)}, {v!r})" for k, (lo, hi, v) in checked.items())
+                args.append(f"limits={{{shown}}}")
+        condition = reply_condition(request, response)
+        if response and condition:
+            args.append(f"optional_when=({condition.entry!r}, {condition.equals}, {condition.op!r})")
+        if response and response.after:
+            args.append(f"after={response.after!r}")
+        tables = table_fields(request, response)
+        if tables:
+            args.append(f"tables={tables!r}")
+        commands.append({"key": request.key, "args": args})
+    spaces = [
+        f"SpaceSpec({s.name!r}, {s.size}, {s.item is None}, {1 if s.item is None else int(s.item.maximum)}, "
+        f"{s.access!r}),"
+        for s in device.spaces
+    ]
+    error = ""
+    if device.errors is not None and protocol.error_reply is not None:
+        reply = protocol.command(protocol.error_reply.command).response
+        assert reply is not None
+        imports.add(reply.class_name)
+        unwrap = ", unwrap=_unwrap_request" if device.errors.unsupported else ""
+        error = f"ErrorSpec({reply.class_name}, {protocol.error_reply.element!r}{unwrap})"
+    runtime = ["CommandSpec", "DeviceSpec"]
+    runtime += ["EntrySpec"] if entries else []
+    runtime += ["ErrorSpec"] if error else []
+    runtime += ["KindSpec"] if device.kinds else []
+    runtime += ["ModelSpec"] if device.models else []
+    runtime += ["RunSpec"] if any(b.space_reads or b.space_writes for b in device.behaviours) else []
+    runtime += ["Simulator"]
+    runtime += ["SpaceSpec"] if spaces else []
+    runtime += ["TimeoutSpec"] if device.timeout else []
+    timeout = ""
+    if device.timeout is not None:
+        kept = [protocol.command(name).request for name in device.timeout.kept_by]
+        classes = ", ".join(m.class_name for m in kept if m is not None)
+        imports.update(m.class_name for m in kept if m is not None)
+        timeout = f"TimeoutSpec({device.timeout.after / 1000!r}, ({classes},), {device.timeout.sets!r})"
+    return render(
+        "simulator.py.j2",
+        runtime_imports=", ".join(runtime),
+        spaces=spaces,
+        error=error,
+        unwrap="unwrap=_unwrap_request" in error,
+        timeout=timeout,
+        spec_path=protocol.spec_path,
+        title=one_line(protocol.title),
+        package=protocol.name,
+        description=one_line(device.description),
+        class_name=protocol.simulator_class,
+        address=repr(device.address),
+        id_entry=repr(device.id_entry),
+        broadcast=repr(device.broadcast),
+        state=repr(device.state),
+        reply=repr(device.reply),
+        errors=repr(device.errors.by_reason()) if device.errors else "",
+        entries=entries,
+        commands=commands,
+        registers=map_name(device.memory) if device.memory in register_tables(protocol) else "",
+        status=repr(device.status) if device.status else "",
+        moving=repr(device.moving) if device.moving else "",
+        echo_address=device.echo_address,
+        models=[model_data(m) for m in device.models],
+        carried=carried_requests(protocol),
+        kinds=[f"KindSpec({k.name!r}, {k.address!r}, {k.ids!r}, {k.broadcast!r}, {k.state!r})," for k in device.kinds],
+        imports=sorted(imports | {"Direction"}, key=import_order),
+        default_ids=repr(device.ids) if len(device.ids) > 1 else f"({device.ids[0]},)",
+        model_names=", ".join(m.name for m in device.models),
+        default_model=device.models[0].name if device.models else "",
+    )

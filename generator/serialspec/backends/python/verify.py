@@ -1,0 +1,147 @@
+"""Run a spec's examples and errata through the package just generated from it, before anything is written.
+
+`generate` and `check` report an example that does not decode to its recorded values (or whose values do not encode
+back to its bytes), and an erratum whose check does not hold, as spec errors at the example's or check's line.
+The package is imported from the generated text in memory (serialspec.backends.python.memory).
+"""
+
+from __future__ import annotations
+
+import importlib
+from types import ModuleType
+from typing import Any
+
+from serialspec.backends.python.memory import imported
+from serialspec.lang.errors import SpecError
+from serialspec.lang.model import Erratum, Example, Protocol
+from serialspec.runtime.checksums import crc_function
+from serialspec.runtime.errors import SerialspecError
+from serialspec.runtime.hexbytes import parse_hex
+
+
+def _difference(found: dict[str, Any], recorded: dict[str, object]) -> str:
+    names = [*recorded, *(k for k in found if k not in recorded)]
+    wrong = [
+        f"{name} is {found[name]!r}, not {recorded[name]!r}"
+        if name in found and name in recorded
+        else (f"{name} is not in the frame" if name in recorded else f"{name}={found[name]!r} is not recorded")
+        for name in names
+        if found.get(name, ...) != recorded.get(name, ...)
+    ]
+    return "; ".join(wrong)
+
+
+class _Checker:
+    def __init__(self, protocol: Protocol, package: ModuleType, message_types: tuple[Any, ...]) -> None:
+        self.protocol = protocol
+        self.package = package  # the codec: decode, encode
+        self.classes: dict[tuple[str, str | None, str], Any] = {}
+        for cls in reversed(message_types):  # the first of any two alike wins, as a search in order finds
+            self.classes[cls.COMMAND, cls.SUBCOMMAND, cls.DIRECTION.value] = cls
+
+    def message_class(self, command: str, subcommand: str | None, direction: str) -> Any:
+        return self.classes.get((command, subcommand, direction))
+
+    def decodes_as(self, frame: bytes, direction: str, command: str, subcommand: str | None, fields: Any) -> str:
+        """What is wrong with reading `frame` as the given message with the given values ("" if nothing)."""
+        expect = self.message_class(command, subcommand, direction)  # the reply layout, where replies share a code
+        try:
+            message = self.package.decode(frame, direction, expect)
+        except SerialspecError as exc:
+            return f"the frame does not decode: {exc}"
+        if (command, subcommand) != (message.COMMAND, message.SUBCOMMAND):
+            found = ".".join(p for p in (message.COMMAND, message.SUBCOMMAND) if p)
+            return f"the frame decodes as {found}, not {'.'.join(p for p in (command, subcommand) if p)}"
+        found_fields = message.to_fields()
+        if found_fields != fields:
+            return f"the frame decodes to other values: {_difference(found_fields, fields)}"
+        return ""
+
+    def example(self, example: Example) -> str:
+        direction = example.direction.value
+        wrong = self.decodes_as(example.frame, direction, example.command, example.subcommand, example.fields)
+        if wrong:
+            return wrong
+        cls = self.message_class(example.command, example.subcommand, direction)
+        try:
+            encoded = self.package.encode(cls.from_fields(example.fields))
+        except SerialspecError as exc:
+            return f"its values do not encode: {exc}"
+        if encoded != example.frame:
+            return f"its values encode to {encoded.hex(' ')}, not the frame"
+        return ""
+
+    def erratum(self, erratum: Erratum) -> str:
+        check = erratum.check
+        direction = check.direction.value if check.direction else None
+        if check.kind == "frame_fails":
+            try:
+                self.package.decode(parse_hex(check.frame_text), direction)
+            except (SerialspecError, ValueError) as exc:
+                return "" if check.error in str(exc) else f"the frame fails with {str(exc)!r}, not {check.error!r}"
+            return "the frame decodes: it does not fail"
+        if check.kind == "frame_decodes_as" and check.frame is not None and direction is not None:
+            return self.decodes_as(check.frame, direction, check.command, check.subcommand, check.fields)
+        if check.kind == "checksum_value" and check.frame is not None:
+            if check.frame[-1] != check.actual or check.actual == check.claimed:
+                return f"the frame ends in {check.frame[-1]:#04x}: `actual` must be it, and differ from `claimed`"
+            return self.decodes_as_anything(check.frame, direction)
+        if check.kind == "crc_parameters":
+            return self.claimed_crc(erratum)
+        return ""
+
+    def decodes_as_anything(self, frame: bytes, direction: str | None) -> str:
+        try:
+            self.package.decode(frame, direction)
+        except SerialspecError as exc:
+            return f"the frame does not decode: {exc}"
+        return ""
+
+    def claimed_crc(self, erratum: Erratum) -> str:
+        checksum = self.protocol.framing.checksum
+        crc = checksum.crc if checksum is not None else None
+        claimed = erratum.check.claimed
+        if crc is None or not isinstance(claimed, dict):
+            return ""
+        parameters = {
+            "width": crc.width,
+            "poly": crc.poly,
+            "init": crc.init,
+            "refin": crc.refin,
+            "refout": crc.refout,
+            "xorout": crc.xorout,
+        }
+        try:
+            claimed_crc = crc_function(**{**parameters, **claimed})
+        except (TypeError, ValueError) as exc:
+            return f"the claimed parameters are no CRC: {exc}"
+        names = erratum.check.examples
+        examples = [e for e in self.protocol.examples if e.name in names] if names else list(self.protocol.examples)
+        layouts = self.protocol.framing.layouts
+        for example in examples:
+            covered = example.frame[layouts[example.direction].covered_from : -1]
+            if claimed_crc(covered) == example.frame[-1]:
+                return f"example {example.name} verifies with the claimed CRC too"
+        return ""
+
+
+def verify(protocol: Protocol, files: dict[str, str]) -> list[SpecError]:
+    """Every example and erratum of the protocol checked against its generated package (`files` by file name)."""
+    if not protocol.examples and not protocol.errata:
+        return []
+    problems: list[SpecError] = []
+    # The codec (and the messages it imports) is what the checks run: the package's __init__ (which brings in the
+    # serial transport for the client) is not needed for them.
+    codec_files = {name: text for name, text in files.items() if name != "__init__.py"}
+    with imported(protocol.name, codec_files, protocol.spec_path, "codec") as codec:  # not importing: a bug, raised
+        messages = importlib.import_module(f"{protocol.name}.messages")  # the codec's own import of it
+        checker = _Checker(protocol, codec, messages.MESSAGE_TYPES)
+        for example in protocol.examples:
+            if wrong := checker.example(example):
+                line, column = example.position
+                problems.append(SpecError(protocol.spec_path, line, column, f"examples.{example.name}", wrong))
+        for erratum in protocol.errata:
+            if wrong := checker.erratum(erratum):
+                line, column = erratum.position
+                problems.append(SpecError(protocol.spec_path, line, column, f"errata.{erratum.name}.check", wrong))
+    return problems

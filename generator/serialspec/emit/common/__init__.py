@@ -1,5 +1,0 @@
-"""What every target shares: template rendering, text handling, number formatting, request/response pairing.
-
-A target is a sub-package of `serialspec.emit` (python/, markdown/, ...) exporting `EMITTER`; it reads only the
-resolved model (`serialspec.spec.model`) and this layer, never the resolver.
-"""

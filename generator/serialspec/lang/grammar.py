@@ -1,0 +1,1118 @@
+"""The spec language's shape, declared once as data.
+
+The same declaration checks a loaded spec's structure (unknown keys, wrong kinds of value, missing keys) and is
+exported as the JSON Schema that editors use to complete and check spec files. Meaning (types that exist,
+references that resolve, sizes that add up) is checked later, in resolve.py.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Iterator
+from dataclasses import field
+from typing import Any
+
+from serialspec.lang.frozen import mutable
+from serialspec.lang.loader import CONTROL, Path
+
+SCALAR_TYPES = ("u8", "i8", "u16", "i16", "u32", "i32", "f32")
+
+
+class Shape:
+    description = ""
+
+    def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
+        raise NotImplementedError
+
+    def json_schema(self) -> dict[str, Any]:
+        raise NotImplementedError
+
+
+@mutable
+class Str(Shape):
+    description: str = ""
+    choices: tuple[str, ...] = ()
+    default: Any = None  # the value a spec gets when it leaves the key out (for the reference and the schema)
+    example: Any = None  # shown in the reference where no spec uses the key
+
+    def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
+        if not isinstance(value, str):
+            yield path, f"expected text, got {_kind(value)}"
+        elif bad := CONTROL.search(value):
+            yield path, f"control character U+{ord(bad.group()):04X} in text (not allowed in a spec)"
+        elif self.choices and value not in self.choices:
+            yield path, f"unknown value {value!r} (expected one of {', '.join(self.choices)})"
+
+    def json_schema(self) -> dict[str, Any]:
+        schema: dict[str, Any] = {"type": "string", "description": self.description}
+        if self.choices:
+            schema["enum"] = list(self.choices)
+        return _with_default(schema, self.default, self.example)
+
+
+@mutable
+class Int(Shape):
+    description: str = ""
+    default: Any = None  # the value a spec gets when it leaves the key out (for the reference and the schema)
+    example: Any = None  # shown in the reference where no spec uses the key
+    minimum: int | None = None
+    maximum: int | None = None
+
+    def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
+        if not isinstance(value, int) or isinstance(value, bool):
+            yield path, f"expected an integer, got {_kind(value)}"
+        elif (self.minimum is not None and value < self.minimum) or (self.maximum is not None and value > self.maximum):
+            yield path, f"{value} is outside {_bounds(self.minimum, self.maximum)}"
+
+    def json_schema(self) -> dict[str, Any]:
+        schema: dict[str, Any] = {"type": "integer", "description": self.description}
+        if self.minimum is not None:
+            schema["minimum"] = self.minimum
+        if self.maximum is not None:
+            schema["maximum"] = self.maximum
+        return _with_default(schema, self.default, self.example)
+
+
+@mutable
+class Num(Shape):
+    """A finite number (NaN and infinities are never a protocol fact)."""
+
+    description: str = ""
+    default: Any = None  # the value a spec gets when it leaves the key out (for the reference and the schema)
+    example: Any = None  # shown in the reference where no spec uses the key
+    choices: tuple[float, ...] = ()
+
+    def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
+        if not isinstance(value, int | float) or isinstance(value, bool):
+            yield path, f"expected a number, got {_kind(value)}"
+        elif not math.isfinite(value):
+            yield path, f"expected a finite number, got {value}"
+        elif self.choices and value not in self.choices:
+            yield path, f"unknown value {value} (expected one of {', '.join(f'{c:g}' for c in self.choices)})"
+
+    def json_schema(self) -> dict[str, Any]:
+        schema: dict[str, Any] = {"type": "number", "description": self.description}
+        if self.choices:
+            schema["enum"] = list(self.choices)
+        return _with_default(schema, self.default, self.example)
+
+
+def _bounds(minimum: int | None, maximum: int | None) -> str:
+    if minimum is not None and maximum is not None:
+        return f"{minimum}..{maximum}"
+    return f"the minimum {minimum}" if minimum is not None else f"the maximum {maximum}"
+
+
+@mutable
+class Bool(Shape):
+    description: str = ""
+    default: Any = None  # the value a spec gets when it leaves the key out (for the reference and the schema)
+    example: Any = None  # shown in the reference where no spec uses the key
+
+    def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
+        if not isinstance(value, bool):
+            yield path, f"expected true or false, got {_kind(value)}"
+
+    def json_schema(self) -> dict[str, Any]:
+        return _with_default({"type": "boolean", "description": self.description}, self.default, self.example)
+
+
+def _with_default(schema: dict[str, Any], default: Any, example: Any = None) -> dict[str, Any]:
+    if default is not None:
+        schema["default"] = default
+    if example is not None:
+        schema["examples"] = [example]
+    return schema
+
+
+def value_description(shape: Shape, parent: str) -> str:
+    """A shape's own description, or its parent's for a part that needs none of its own (a map's value, a list's
+    item, an option of a OneOf: `Document id -> what it is.` describes the values of `sources:`)."""
+    return shape.description or parent
+
+
+@mutable
+class Any_(Shape):
+    description: str = ""
+
+    def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
+        return iter(())
+
+    def json_schema(self) -> dict[str, Any]:
+        return {"description": self.description}
+
+
+@mutable
+class ListOf(Shape):
+    item: Shape
+    description: str = ""
+    length: int | None = None
+    example: Any = None  # shown in the reference where no spec uses the key
+
+    def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
+        if not isinstance(value, list):
+            yield path, f"expected a list, got {_kind(value)}"
+            return
+        if self.length is not None and len(value) != self.length:
+            yield path, f"expected a list of {self.length} items, got {len(value)}"
+        for index, item in enumerate(value):
+            yield from self.item.check(item, (*path, index))
+
+    def json_schema(self) -> dict[str, Any]:
+        schema: dict[str, Any] = {
+            "type": "array",
+            "items": _described(self.item, self.description),
+            "description": self.description,
+        }
+        if self.length is not None:
+            schema["minItems"] = schema["maxItems"] = self.length
+        return _with_default(schema, None, self.example)
+
+
+@mutable
+class MapOf(Shape):
+    """A mapping from names (or numbers) chosen by the spec author to values of one shape."""
+
+    value: Shape
+    description: str = ""
+    int_keys: bool = False
+
+    def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
+        if not isinstance(value, dict):
+            yield path, f"expected a mapping, got {_kind(value)}"
+            return
+        for key, item in value.items():
+            if self.int_keys != isinstance(key, int):
+                yield (*path, key), "expected a number as key" if self.int_keys else "expected a name as key"
+                continue
+            yield from self.value.check(item, (*path, key))
+
+    def json_schema(self) -> dict[str, Any]:
+        return {
+            "type": "object",
+            "additionalProperties": _described(self.value, self.description),
+            "description": self.description,
+        }
+
+
+@mutable
+class Obj(Shape):
+    keys: dict[str, Shape]
+    required: tuple[str, ...] = ()
+    description: str = ""
+
+    def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
+        if not isinstance(value, dict):
+            yield path, f"expected a mapping with keys {', '.join(self.keys)}, got {_kind(value)}"
+            return
+        for key in self.required:
+            if key not in value:
+                yield path, f"missing key {key!r}"
+        for key, item in value.items():
+            shape = self.keys.get(key) if isinstance(key, str) else None
+            if shape is None:
+                yield (*path, key), f"unknown key {key!r} (expected one of {', '.join(self.keys)})"
+            else:
+                yield from shape.check(item, (*path, key))
+
+    def json_schema(self) -> dict[str, Any]:
+        return {
+            "type": "object",
+            "description": self.description,
+            "properties": {key: shape.json_schema() for key, shape in self.keys.items()},
+            "required": list(self.required),
+            "additionalProperties": False,
+        }
+
+
+@mutable
+class Ref(Shape):
+    """A shape defined later, or by itself (group fields are fields): checked as it, a $ref in the JSON Schema."""
+
+    name: str
+    target: Callable[[], Shape]
+    description: str = ""
+
+    def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
+        yield from self.target().check(value, path)
+
+    def json_schema(self) -> dict[str, Any]:
+        return {"$ref": f"#/$defs/{self.name}", "description": self.description}
+
+
+@mutable
+class OneOf(Shape):
+    """Either a short form (e.g. a bare type name) or a long form; picked by the kind of value given."""
+
+    options: tuple[Shape, ...] = field(default_factory=tuple)
+    description: str = ""
+
+    def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
+        for option in self.options:
+            problems = list(option.check(value, path))
+            if not problems:
+                return
+            if _accepts_kind(option, value):
+                yield from problems
+                return
+        yield path, f"unexpected {_kind(value)}: {self.description}"
+
+    def json_schema(self) -> dict[str, Any]:
+        options = [_described(option, self.description) for option in self.options]
+        return {"anyOf": options, "description": self.description}
+
+
+def _described(shape: Shape, parent: str) -> dict[str, Any]:
+    return _fill(shape.json_schema(), parent)
+
+
+def _fill(schema: dict[str, Any], parent: str) -> dict[str, Any]:
+    """Give every part without a description of its own (an option, a list's items) its parent's."""
+    if not schema.get("description"):
+        schema["description"] = parent
+    for part in ("items", "additionalProperties"):
+        if isinstance(schema.get(part), dict):
+            _fill(schema[part], schema["description"])
+    for option in schema.get("anyOf", []):
+        _fill(option, schema["description"])
+    return schema
+
+
+def _accepts_kind(shape: Shape, value: Any) -> bool:
+    kinds: dict[type[Shape], type | tuple[type, ...]] = {
+        Str: str,
+        Int: int,
+        Num: (int, float),
+        Bool: bool,
+        ListOf: list,
+        MapOf: dict,
+        Obj: dict,
+    }
+    expected = kinds.get(type(shape))
+    return expected is not None and isinstance(value, expected)
+
+
+def _kind(value: Any) -> str:
+    if value is None:
+        return "nothing"
+    return {
+        bool: "true/false",
+        int: "a number",
+        float: "a number",
+        str: "text",
+        list: "a list",
+        dict: "a mapping",
+    }.get(type(value), type(value).__name__)
+
+
+# --- the language -------------------------------------------------------------------------------------------------
+
+TEXT = Str("Free text (English); shown in docs and docstrings, never executed.")
+TITLE = Str("A one-line title (free text), shown in the reference and as the docstring's first line.")
+TITLE_CN = Str("The title as printed in the (Chinese) document.")
+SOURCE = Str("Where the fact comes from: a document id from `sources:` and its section (free text).")
+SCALAR_TYPE = Str("Wire type of the value.", choices=SCALAR_TYPES, default="u8")
+RANGE = ListOf(Num(), "Inclusive [min, max] of the value in wire units; checked before encoding.", length=2)
+HEX_BYTES = Str("Bytes as hex: '12 4c 08', '0x12 0x4c', '124c08' or '12:4c:08'.")
+
+
+def bit_fields(description: str) -> MapOf:
+    """Sub-fields of an integer by bit position: a field's or a frame element's `bits`."""
+    return MapOf(
+        Obj(
+            {
+                "bits": OneOf((Int(), ListOf(Int(), length=2)), "A bit number, or [high, low] for several bits."),
+                "enum": Str("Name of an entry in `enums:`."),
+                "description": TEXT,
+            },
+            required=("bits",),
+            description="One sub-field: its bit (or bits) and optionally the enum its value belongs to.",
+        ),
+        description,
+    )
+
+
+_FIELD_LONG: dict[str, Shape] = {
+    "type": Str(
+        "Wire type: u8, i8, u16, i16, u32, i32, f32, bytes, string, cstring (NUL-terminated text), array, group, "
+        "table_value, table_block."
+    ),
+    "use": Str("Name of an entry in `fields:` (top level) to copy; keys given here override it."),
+    "description": TEXT,
+    "description_cn": Str("Description as printed in the (Chinese) document."),
+    "unit": Str("Unit of one wire step, e.g. mV, ms, 0.1°."),
+    "scale": Num("Engineering value = wire value × scale (e.g. 0.1 for 0.1° steps)."),
+    "range": RANGE,
+    "const": Int("The field always has this value (sub-command selectors, fixed addresses).", example=1),
+    "default": Num("Value used when a message is built without this field."),
+    "enum": Str("Name of an entry in `enums:`; values decode to that enum."),
+    "flags": Str("Name of an entry in `flags:`; the value is a set of bit flags."),
+    "bits": bit_fields("Sub-fields packed into this integer, by bit position (unlisted bits must be zero)."),
+    "encoding": Str(
+        "How the integer is stored: plain two's complement, or sign_magnitude (top bit the sign, the rest the size).",
+        choices=("plain", "sign_magnitude"),
+        default="plain",
+        example="sign_magnitude",
+    ),
+    "endian": Str("Override of the protocol's byte order for this field.", choices=("little", "big"), example="big"),
+    "size": OneOf(
+        (Int(), Str()),
+        "bytes, string: a number, `rest` (up to the end of the content) or a field name; array: the earlier field "
+        "holding the array's size in bytes (Modbus byte_count)",
+    ),
+    "count": OneOf((Int(), Str()), "array/group: a number, `rest`, or the name of an earlier count field"),
+    "of": Str("array: the item type (a scalar type, or `bit`: bools packed 8 to a byte, lowest bit first)."),
+    "count_from": Str(
+        "array of a response: the request field (request.<field>) saying how many items are meant, when the array "
+        "holds more (Modbus coils padded to a multiple of 8): clients keep that many."
+    ),
+    "value": Str(
+        "An integer field derived from the others by an expression, computed on encode and checked on decode: "
+        "`2 * count`, `ceil(len(coils) / 8)` (names of fields, len(), ceil(a / b), min, max, + - * / % & | << >>)."
+    ),
+    "fields": Ref("fields", lambda: FIELDS, "group: the fields of each item (a mapping, like request/response)."),
+    "table": Str("table_value/table_block, or bytes holding registers: name of an entry in `tables:`."),
+    "key": Str("table_value: the earlier field holding the table key (e.g. data_id)."),
+    "start": Str("bytes holding registers: the field (or request.<field>) with the first register's key."),
+    "size_from": Str("bytes of a response, size `rest`: the request field giving its size (request.<field>)."),
+    "select": MapOf(Any_(), "table_block: entry attributes an entry must have to be in the block, e.g. {access: rw}."),
+    "expect_size": Int("table_block: the block's size in bytes, asserted by the generator."),
+    "inferred": TEXT,
+    "status": Obj(
+        {"ok": Int("The value that means success; any other value is a device error.")},
+        required=("ok",),
+        description=(
+            "A response field that says whether the device could do it (RRC `success`): the client raises "
+            "DeviceError unless it holds `ok`, and returns the other fields."
+        ),
+    ),
+}
+FIELD = OneOf(
+    (
+        Str("A wire type or the name of an entry in `fields:`"),
+        Obj(_FIELD_LONG, description="A field in full: its type, and its unit, range, enum... where it has them."),
+    ),
+    "A field: a wire type or the name of a shared field (short form), or a mapping (long form).",
+)
+FIELDS: Shape = MapOf(FIELD, "Fields in wire order: name -> type or mapping.")
+
+OPTIONAL_WHEN = Obj(
+    {
+        "parameter": Str("A table entry: `entry` or `table.entry` (e.g. response_switch)."),
+        "equals": Int("The device answers while the parameter has this value."),
+        "not_equals": Int("The device answers while the parameter has any other value.", example=0),
+        "at_least": Int("The device answers while the parameter is at least this (status_return_level ≥ 1)."),
+        "at_most": Int("The device answers while the parameter is at most this.", example=1),
+    },
+    required=("parameter",),
+    description="The reply is sent only while a device parameter compares true (give one comparison).",
+)
+
+MESSAGE = Obj(
+    {
+        "description": Str(TEXT.description, example="Sent once the move has finished."),
+        "fields": FIELDS,
+        "optional": TEXT,
+        "unsolicited": Bool("Sent by the device on its own, not as an answer.", default=False),
+        "answers": Str("For a response: the request (command or command.subcommand) it answers, if another."),
+        "error_reply": Bool(
+            "For a response: the reply a device sends instead of any request's own when it cannot carry it out, "
+            "under the request's code plus the command element's `error_flag` (Modbus exception replies). Its "
+            "message carries the code of the refused request in a value named after the command element."
+        ),
+        "optional_when": OPTIONAL_WHEN,
+        "after": Str("For a response: the request field (in ms) after which the device answers, e.g. a move's time."),
+        "answered_by": Obj(
+            {
+                "command": Str("The command whose response answers this request (one reply layout for many)."),
+                "optional_when": OPTIONAL_WHEN,
+            },
+            required=("command",),
+            description="For a request: answered by another command's response (FEETECH's one status packet).",
+        ),
+        "default": Bool(
+            "Among replies that share a code (or that all have none), the one a frame is decoded as when the "
+            "request it answers is unknown; the others are chosen by the request they answer.",
+            default=False,
+            example=True,
+        ),
+        "source": SOURCE,
+    },
+    description="One direction of a command: its content fields and how it is sent.",
+)
+
+SUBCOMMAND = Obj(
+    {
+        "code": Int("Selector value."),
+        "title": TITLE,
+        "title_cn": TITLE_CN,
+        "description": TEXT,
+        "request": MESSAGE,
+        "response": MESSAGE,
+        "source": SOURCE,
+    },
+    required=("code",),
+    description="A sub-command: its selector value and the fields of its request and response.",
+)
+
+COMMAND = Obj(
+    {
+        "code": Int(
+            "Value of the frame's command field; omit for the one response of a protocol whose replies "
+            "carry no command field."
+        ),
+        "title": TITLE,
+        "title_cn": TITLE_CN,
+        "description": TEXT,
+        "request": MESSAGE,
+        "response": MESSAGE,
+        "broadcast": TEXT,
+        "source": SOURCE,
+        "selector": Obj(
+            {
+                "type": Str("Wire type of the selector.", choices=SCALAR_TYPES, default="u8"),
+                "name": Str("The selector's field name, as messages show it."),
+                "offset": MapOf(Int(), "Byte offset of the selector in the content, by direction."),
+            },
+            required=("offset",),
+            description="Where the sub-command selector sits in the content, by direction.",
+        ),
+        "subcommands": MapOf(SUBCOMMAND, "Sub-commands the selector picks: name -> sub-command."),
+    },
+    description="A command: its code, and the fields of its request and response.",
+)
+
+ENUM = Obj(
+    {
+        "type": Str("Wire type of fields holding the enum.", choices=SCALAR_TYPES, default="u8"),
+        "description": TEXT,
+        "values": MapOf(
+            OneOf(
+                (
+                    Int(),
+                    Obj(
+                        {
+                            "value": Int("The wire value."),
+                            "text": Str("What the value means (free text)."),
+                            "text_cn": Str("The meaning as printed in the (Chinese) document.", example="释放"),
+                        },
+                        required=("value",),
+                    ),
+                ),
+                "The wire value, or {value, text}.",
+            ),
+            "Label -> wire value.",
+        ),
+    },
+    required=("values",),
+    description="Names for the values of a field; decoded values become members of a generated IntEnum.",
+)
+
+FLAGS = Obj(
+    {
+        "type": Str("Wire type of fields holding the flags.", choices=SCALAR_TYPES, default="u8", example="u16"),
+        "description": TEXT,
+        "bits": MapOf(
+            OneOf(
+                (
+                    Int(),
+                    Obj(
+                        {"bit": Int("Bit number (0 is the least significant)."), "text": TEXT},
+                        required=("bit",),
+                    ),
+                ),
+                "A bit number, or {bit, text}.",
+            ),
+            "Flag name -> bit number.",
+        ),
+    },
+    required=("bits",),
+    description="Names for the bits of a field; decoded values become a generated IntFlag.",
+)
+
+TABLE_ENTRY = Obj(
+    {
+        "key": Int("data_id or register address."),
+        "type": Str("Wire type of the value.", choices=SCALAR_TYPES),
+        "name_cn": Str("The name as printed in the (Chinese) document."),
+        "description": TEXT,
+        "unit": Str("Unit of one wire step, e.g. mV, 0.1°."),
+        "scale": Num("Engineering value = wire value × scale."),
+        "range": RANGE,
+        "default": OneOf((Num(), Str()), "The value after a reset: a number, or text when the document gives none."),
+        "access": Str("r (read-only) or rw (readable and writable).", choices=("r", "rw"), default="rw"),
+        "memory": Str("Where the device keeps it: eeprom (kept over power-off) or sram.", choices=("eeprom", "sram")),
+        "enum": Str("Name of an entry in `enums:`."),
+        "flags": Str("Name of an entry in `flags:`."),
+        "encoding": Str(
+            "How the integer is stored (see a field's `encoding`).",
+            choices=("plain", "sign_magnitude"),
+            default="plain",
+        ),
+        "sign_bit": Int("sign_magnitude: the bit holding the sign when it is not the top bit (FEETECH load: 10)."),
+        "reserved": Bool("A slot the document reserves: no name of its own.", default=False),
+        "source": SOURCE,
+    },
+    required=("key", "type"),
+    description="One parameter or register of the table.",
+)
+
+TABLE = Obj(
+    {
+        "title": TITLE,
+        "key": Str("What the key is called on the wire (data_id, address)."),
+        "description": TEXT,
+        "source": SOURCE,
+        "entries": MapOf(TABLE_ENTRY, "The table's entries: name -> entry."),
+    },
+    required=("key", "entries"),
+    description="Parameters or registers addressed by a key (a data_id, a register address).",
+)
+
+
+def span(description: str) -> OneOf:
+    """A span of frame elements: [first, last] (inclusive), or a mapping direction -> [first, last]."""
+    return OneOf(
+        (
+            ListOf(Str(), "[first, last] frame element names", length=2),
+            MapOf(ListOf(Str(), "[first, last] frame element names", length=2), "direction -> [first, last]"),
+        ),
+        f"{description} [first, last] frame element names, or a mapping direction -> [first, last].",
+    )
+
+
+FRAME_ELEMENT = Obj(
+    {
+        "role": Str(
+            "What the element is: constant bytes (header first, trailer last, constant anywhere, e.g. a reserved "
+            "byte), a frame-level value (address, command, status), the length, the content or a checksum.",
+            choices=("header", "trailer", "constant", "command", "length", "content", "checksum", "address", "status"),
+        ),
+        "type": Str("Wire type of a value, length or checksum (default u8).", choices=SCALAR_TYPES),
+        "endian": Str(
+            "Byte order of a multi-byte element (default little, whatever the protocol's byte_order).",
+            choices=("little", "big"),
+            default="little",
+            example="big",
+        ),
+        "value": OneOf(
+            (Str(), MapOf(Str(), "direction -> hex bytes")),
+            "Constant bytes as hex, or a mapping direction -> hex bytes. On a header, trailer or constant: its "
+            "bytes. On any other element: in the directions given, the element is these constant bytes instead "
+            "(DYNAMIXEL status packets carry 55 where requests carry the instruction).",
+        ),
+        "directions": ListOf(
+            Str(choices=("request", "response")), "The directions whose frames have it (default both)."
+        ),
+        "error_flag": Int(
+            "command: a bit a device sets in the code of a reply that refuses the request (Modbus: 0x80); such a "
+            "reply has the layout of the command whose response is the `error_reply`."
+        ),
+        "counts": span(
+            "length: the span of elements it counts, on the wire (after stuffing); default the content only.",
+        ),
+        "adds": Int("length: added to the counted size (SMS: 2 = instruction + checksum); may be negative.", default=0),
+        "description": TEXT,
+        "range": RANGE,
+        "broadcast": Int("address: the broadcast value."),
+        "flags": Str("status: name of an entry in `flags:`."),
+        "bits": bit_fields(
+            "status (or address): bit fields packed into the element (DYNAMIXEL: alert bit 7, error number 6..0)."
+        ),
+        "covers": span(
+            "checksum: the span of elements covered. Outside a transparency span it sees the wire bytes, inside "
+            "it the bytes before stuffing.",
+        ),
+        "algorithm": Str(
+            "checksum: sum (of the bytes, modulo the width), xor (of the bytes) or crc.",
+            choices=("sum", "crc", "xor"),
+        ),
+        "invert": Bool("sum: bitwise NOT of the sum.", default=False),
+        "crc": Obj(
+            {
+                "name": Str("Catalogue name, e.g. CRC-16/MODBUS."),
+                "width": Int("Bits of the CRC."),
+                "poly": Int("Generator polynomial, normal form without the top bit (0x8005)."),
+                "init": Int("Register value before the first byte."),
+                "refin": Bool("Each input byte is reflected (least significant bit first)."),
+                "refout": Bool("The result is reflected before `xorout`."),
+                "xorout": Int("Value XORed into the result."),
+                "check": Int("The catalogue check value: the CRC of b'123456789'."),
+            },
+            required=("width", "poly", "init", "refin", "refout", "xorout", "check"),
+            description=(
+                "crc: the CRC by its catalogue parameters (reveng's CRC catalogue); the generator checks `check` "
+                "against the CRC of '123456789'."
+            ),
+        ),
+    },
+    required=("role",),
+    description="One element of the frame, in wire order.",
+)
+
+FRAME_ELEMENTS = MapOf(FRAME_ELEMENT, "The frame's elements in wire order: name -> element.")
+
+TRANSPARENCY = Obj(
+    {
+        "span": span("The elements whose bytes are stuffed or escaped."),
+        "replace": MapOf(
+            HEX_BYTES,
+            "Plain hex bytes -> the hex bytes sent instead, leftmost match first (DYNAMIXEL: 'FF FF FD' -> "
+            "'FF FF FD FD'; SLIP: 'C0' -> 'DB DC', 'DB' -> 'DB DD').",
+        ),
+        "description": TEXT,
+    },
+    required=("span", "replace"),
+    description=(
+        "Byte stuffing or escaping over a span, applied by encode and removed by decode and the stream parser. "
+        "Lengths count the bytes as sent."
+    ),
+)
+
+FRAMING = Obj(
+    {
+        "elements": FRAME_ELEMENTS,
+        "layouts": MapOf(
+            Obj(
+                {
+                    "description": Str(TEXT.description, example="Payloads of up to 255 bytes."),
+                    "elements": FRAME_ELEMENTS,
+                },
+                required=("elements",),
+                description="One alternative layout: its elements in wire order.",
+            ),
+            "Alternative layouts (instead of `elements`), told apart by their headers; encode uses the first "
+            "whose length can count the frame (VESC: 02 + u8 length, 03 + u16 length).",
+        ),
+        "transparency": TRANSPARENCY,
+        "gap": Num("Silence between frames, in character times (Modbus RTU: 3.5).", example=3.5),
+        "description": TEXT,
+    },
+    description="The frame every command travels in: `elements` (one layout) or `layouts` (alternatives).",
+)
+
+EXAMPLE = Obj(
+    {
+        "source": Str("Document and section the frame is printed in."),
+        "description": TEXT,
+        "direction": Str("The direction the frame travels in.", choices=("request", "response")),
+        "printed": Str("The frame exactly as the document prints it."),
+        "printed_span": ListOf(
+            Str(),
+            "When the document prints only part of the frame (Modbus prints the PDU: function and data), the first "
+            "and last frame element it prints; `frame` is then the whole frame.",
+            length=2,
+        ),
+        "frame": HEX_BYTES,
+        "erratum": Str("Name of the erratum that explains why `frame` differs from `printed`."),
+        "completed": Str(
+            "The document prints no complete frame here (a placeholder such as `CRC` for the check byte, or the "
+            "values as a table): how `frame` completes it. A printing convention, not an erratum."
+        ),
+        "command": Str("The command the frame decodes as."),
+        "subcommand": Str("Its sub-command, where the command has them."),
+        "request": Str("Name of the example whose request this example answers."),
+        "fields": MapOf(Any_(), "The field values the frame carries (raw wire values)."),
+    },
+    required=("source", "direction", "printed", "command", "fields"),
+    description="A frame as a document prints it, with the fields it carries; the tests decode and encode it.",
+)
+
+ERRATUM = Obj(
+    {
+        "source": Str("Document and section."),
+        "printed": Str("What the document says."),
+        "correct": Str("What is right, and why."),
+        "check": Obj(
+            {
+                "kind": Str(
+                    "The test: the printed frame fails to decode, decodes as given, a checksum's real value, "
+                    "CRC parameters that contradict their check value, or prose (no test).",
+                    choices=("frame_fails", "frame_decodes_as", "checksum_value", "crc_parameters", "prose"),
+                ),
+                "frame": HEX_BYTES,
+                "direction": Str("The direction of `frame`.", choices=("request", "response")),
+                "error": Str("frame_fails: words the one-line decode error contains."),
+                "command": Str("frame_decodes_as: the command the frame decodes as."),
+                "subcommand": Str("frame_decodes_as: its sub-command."),
+                "fields": MapOf(Any_(), "frame_decodes_as: the field values it decodes to."),
+                "claimed": Any_("checksum_value: the claimed value; crc_parameters: the claimed parameters."),
+                "actual": Int("checksum_value: the value the bytes really give."),
+                "examples": ListOf(Str(), "Examples whose frames the check runs over."),
+            },
+            required=("kind",),
+            description="How a test pins the right reading.",
+        ),
+    },
+    required=("source", "printed", "correct", "check"),
+    description="A mistake in a document: what it prints, what is right, and the test that pins the right reading.",
+)
+
+REPLY_VALUES = (
+    "Response field -> value when no behaviour sets it (e.g. result: 1; text for text and bytes fields, bytes as "
+    "hex: VESC hw_name: '60')."
+)
+
+SPACE_ACCESS = Obj(
+    {
+        "space": Str("The data space (an entry of the device's `spaces:`)."),
+        "start": Str("The request field holding the first item's address."),
+        "count": Str("reads: the request field holding how many items are read."),
+        "value": Str(
+            "writes: what is stored, as an expression of the request's fields and `current` (the item's present "
+            "value), e.g. Modbus Mask Write `(current & and_mask) | (or_mask & ~and_mask)`; default: the field."
+        ),
+    },
+    required=("space", "start"),
+    description="A run of items of a data space, from the address a request field gives.",
+)
+
+DEVICE_COMMAND = Obj(
+    {
+        "description": Str(TEXT.description, example="The servo moves to the goal position over goal_time."),
+        "reads": OneOf(
+            (
+                ListOf(Str(), "Response fields filled from memory: table_value by its key, table_block entries."),
+                MapOf(SPACE_ACCESS, "Response field -> the run of a data space it holds (Modbus registers)."),
+            ),
+            "a list of response fields read from memory, or a mapping response field -> data space run",
+        ),
+        "writes": OneOf(
+            (
+                ListOf(Str(), "Request fields stored in memory: table_value by its key, table_block entries."),
+                MapOf(SPACE_ACCESS, "Request field -> the run of a data space it is stored in (a value or a list)."),
+            ),
+            "a list of request fields stored in memory, or a mapping request field -> data space run",
+        ),
+        "resets": Bool(
+            "Memory goes back to its defaults (all but the device's id, unless `keeps` says otherwise).", default=False
+        ),
+        "keeps": Obj(
+            {
+                "field": Str("The request field that chooses (DYNAMIXEL FACTORY RESET `option`)."),
+                "entries": MapOf(
+                    ListOf(Str(), "the memory entries a reset keeps"),
+                    "Field value -> the memory entries a reset keeps.",
+                    int_keys=True,
+                ),
+            },
+            required=("field", "entries"),
+            description="resets: the entries kept, chosen by a request field (0xFF: none, 0x01: id, ...).",
+        ),
+        "reports": MapOf(
+            Str(),
+            "Response field -> the state variable or memory entry it reports, or an expression of them where the "
+            "units differ (VESC duty_now in 0.001 from a duty in 0.00001: `duty / 100`).",
+        ),
+        "moves": Obj(
+            {
+                "state": Str("The state variable (or memory entry) that moves."),
+                "target": Str("The request field (or memory entry, once written) with the target."),
+                "duration": Str("The request field (or memory entry) with the time to reach the target, in ms."),
+                "speed": Str("The request field (or memory entry) with the speed, in state units per second."),
+                "speed_scale": Num(
+                    "State units per second for one unit of `speed` (DYNAMIXEL: 0.229 rev/min x 4096 / 60 = 15.63)."
+                ),
+                "enabled_by": Str(
+                    "A memory entry (or state variable): the move happens only while it is non-zero (torque_enable); "
+                    "otherwise the target is only stored."
+                ),
+                "accel": Str("The request field with the acceleration time (ms) at the start of the move."),
+                "decel": Str("The request field with the deceleration time (ms) at the end of the move."),
+            },
+            required=("state", "target"),
+            description="The device moves a state variable to a target, over a duration or at a speed.",
+        ),
+        "stops": ListOf(Str(), "State variables whose move in progress stops where it is now."),
+        "wraps": MapOf(
+            Num(),
+            "State variable -> a period: the variable keeps only its remainder, toward zero (an angle within one "
+            "turn, 3600 in 0.1°).",
+        ),
+        "modulo": MapOf(
+            Num(),
+            "State variable -> a period: the variable keeps its remainder in 0..period-1, also below zero (an "
+            "absolute position within one turn: DYNAMIXEL CLEAR, 4096).",
+        ),
+        "restores": Obj(
+            {
+                "memory": Str("The memory whose entries go back to their initial values.", choices=("eeprom", "sram")),
+                "except": ListOf(Str(), "Entries of that memory left as they are (measured values)."),
+            },
+            required=("memory",),
+            description=(
+                "The entries kept in one memory go back to their initial values (the model's, where it gives them) "
+                "and stop moving, and writes held for a command that `commits` are dropped: a reboot clears RAM "
+                "and keeps EEPROM (DYNAMIXEL REBOOT)."
+            ),
+        ),
+        "refused_while_moving": Str(
+            "A state variable (or memory entry): while it moves, the request is refused (`errors.busy`) and "
+            "changes nothing (DYNAMIXEL CLEAR works only while the servo is stopped)."
+        ),
+        "broadcast_ignores": MapOf(
+            Num(),
+            "Request field -> a value with which a broadcast request is ignored by every device (DYNAMIXEL "
+            "FACTORY RESET of everything, option 0xFF, sent to the broadcast id).",
+        ),
+        "counts": MapOf(
+            Obj(
+                {"state": Str("The state variable (or memory entry)."), "per": Num("The size of one whole unit.")},
+                required=("state", "per"),
+                description="The state variable counted and the size of one whole unit of it.",
+            ),
+            "Response field -> how many whole `per` the state variable holds, toward zero (turns of an angle).",
+        ),
+        "every_device": Bool(
+            "A request without an address reaches every device on the bus (default: the first one only)."
+        ),
+        "held_while": Str(
+            "A state variable: while it is not 0, the device keeps this request instead of carrying it out, until "
+            "a command that `releases` the variable."
+        ),
+        "releases": Str(
+            "A state variable: the command sets it to 0 and carries out the requests held while it was set, in "
+            "order (or drops them, see `cancel_when`)."
+        ),
+        "cancel_when": MapOf(
+            Num(), "With `releases`: request field -> the value with which the held requests are dropped."
+        ),
+        "carries": Obj(
+            {
+                "command": Str("The request field (or `each` item field) holding the code of the command carried."),
+                "content": Str("The bytes field holding that command's request content."),
+                "commands": ListOf(Str(), "The commands it can carry (default: every command with a code)."),
+            },
+            required=("command", "content"),
+            description=(
+                "The request (or each item of its `each` group) carries another command's request content; the "
+                "devices act on it as on that request, and answer as they would (a sync command)."
+            ),
+        ),
+        "broadcast_reply": Bool("Answers even when addressed by broadcast (default: silent).", default=False),
+        "each": Str("A group field of the request whose items address one device each (by the address field)."),
+        "buffered": Bool("The writes are held until a command that `commits` (FEETECH REG WRITE).", default=False),
+        "commits": Bool("Carries out the writes held by `buffered` commands (FEETECH ACTION).", default=False),
+        "nothing_held": MapOf(
+            Num(),
+            "commits: response field (or field.bit_field) -> value when no write is held (DYNAMIXEL ACTION without "
+            "REG WRITE: error.number 2, instruction error).",
+        ),
+        "kind": Str("The entry of `kinds:` whose devices the command addresses (default: the devices of --id)."),
+        "stores": MapOf(Str(), "Request field -> the state variable it is stored in (where names differ)."),
+        "sets": MapOf(Num(), "State variable -> the value the command sets it to."),
+        "absent": MapOf(
+            Num(),
+            "Response field -> value when no device has the addressed id and the bus master answers for it "
+            "(RRC: the board reports success -1); without it, silence.",
+        ),
+    },
+    description="What the device does with one command (command or command.subcommand).",
+)
+
+MODEL = Obj(
+    {
+        "number": Int("The model number the device reports (in `model_entry`), e.g. 777 for the FEETECH STS3215."),
+        "title": TEXT,
+        "description": TEXT,
+        "source": TEXT,
+        "initial": MapOf(
+            Num(),
+            "Memory entry or state variable -> the value this model starts with (its factory value), over the "
+            "table's default and the device's `initial`.",
+        ),
+        "entries": MapOf(
+            Obj(
+                {
+                    "range": ListOf(
+                        Num(),
+                        "This model's inclusive [min, max] in wire units, where it differs from the table's.",
+                        length=2,
+                        example=[0, 2000],
+                    ),
+                    "unit": Str("This model's unit of one wire step, where it differs from the table's.", example="mA"),
+                    "scale": Num("This model's engineering value per wire step, where it differs.", example=1),
+                    "description": Str(TEXT.description, example="XL330: 1 mA steps, up to 1750 mA."),
+                },
+                description="Where one memory entry of this model differs from the table.",
+            ),
+            "Memory entry -> where this model's range, unit or scale differs from the table's.",
+        ),
+    },
+    required=("number",),
+    description="One device model: its model number, factory values and where its table differs.",
+)
+
+DEVICE = Obj(
+    {
+        "description": TEXT,
+        "models": MapOf(
+            MODEL,
+            "Device models sharing the protocol and table (FEETECH STS3215, SM8512BL; DYNAMIXEL XM430, XL330): "
+            "`serialspec sim --model NAME` (or `--model ID=NAME`) picks one; the docs list them.",
+        ),
+        "default_model": Str("The model the simulator uses when none is named (default: the first of `models`)."),
+        "model_entry": Str("The memory entry holding the model number (set from the model's `number`)."),
+        "memory": Str("The table the device keeps, initialised from its defaults."),
+        "initial": MapOf(Num(), "Memory entry -> value the simulator starts with where the table gives no default."),
+        "address": Str("The field holding the device id (default: the frame's address element)."),
+        "id_entry": Str("The memory entry or state variable holding the device's id (writing it changes the address)."),
+        "broadcast": Int("The address every device obeys (default: the address element's broadcast)."),
+        "state": MapOf(Num(), "State variables beyond memory -> initial value (e.g. the present angle)."),
+        "reply": MapOf(
+            OneOf((Num(), Str()), REPLY_VALUES),
+            REPLY_VALUES,
+        ),
+        "status": MapOf(
+            Str(),
+            "Response field -> the memory entry every response reports in it (a status byte); field.bit_field -> "
+            "an entry whose being non-zero sets that bit field (DYNAMIXEL error.alert: hardware_error_status).",
+        ),
+        "moving": MapOf(
+            Obj(
+                {
+                    "state": Str("The state variable (or memory entry) whose move it reports."),
+                    "bit": Int("Only this bit of the entry reports it (the others keep their value)."),
+                },
+                required=("state",),
+                description="The move an entry reports, as the whole entry or as one bit of it.",
+            ),
+            "Memory entry -> the move it reports: 1 while the state variable moves, 0 once it has arrived (FEETECH "
+            "`moving`); with `bit`, one bit of the entry (Fashion Star servo_status bit 0, executing).",
+        ),
+        "echo_address": Bool(
+            "Replies carry the id the request named (RRC: 0xFE for a broadcast read), not the answering device's own.",
+            default=False,
+        ),
+        "commands": MapOf(DEVICE_COMMAND, "Command (or command.subcommand) -> behaviour; others just answer."),
+        "ids": ListOf(Int(), "The device ids the simulator serves when none are given (default: 0)."),
+        "timeout": Obj(
+            {
+                "after": Int("Milliseconds without one of the `kept_by` commands after which the device gives up."),
+                "kept_by": ListOf(Str(), "The commands that restart the timeout (VESC: every setpoint, and ALIVE)."),
+                "sets": MapOf(Num(), "State variable -> its value once the timeout has expired (the motor released)."),
+                "description": TEXT,
+            },
+            required=("after", "kept_by", "sets"),
+            description="A command timeout: the device stops unless commands keep coming (VESC, 1 s by default).",
+        ),
+        "spaces": MapOf(
+            Obj(
+                {
+                    "type": Str(
+                        "The item type: `bit`, or an unsigned integer type.", choices=("bit", "u8", "u16", "u32")
+                    ),
+                    "size": Int("Number of items, addressed 0..size-1 (the simulator can be given other sizes)."),
+                    "access": Str("r: requests only read it; rw: they read and write it.", choices=("r", "rw")),
+                    "description": TEXT,
+                },
+                required=("type", "size"),
+                description="One data space: its item type, its size and whether requests may write it.",
+            ),
+            "Data spaces the device keeps besides its table: runs of items addressed by number, all zero at "
+            "first (Modbus coils, discrete inputs, holding and input registers).",
+        ),
+        "errors": Obj(
+            {
+                "out_of_range": MapOf(
+                    Num(),
+                    "Reply values when a value is outside its entry's range, or a request value outside its "
+                    "range or enum (Modbus exception_code: 3; DYNAMIXEL error.number: 4, data range error).",
+                ),
+                "out_of_space": MapOf(
+                    Num(),
+                    "Reply values when a write reaches an address no entry has, or a run reaches beyond its data "
+                    "space (Modbus exception_code: 2; DYNAMIXEL error.number: 7, access error).",
+                ),
+                "read_only": MapOf(
+                    Num(),
+                    "Reply values when a write reaches a read-only entry or data space (DYNAMIXEL error.number: 7).",
+                ),
+                "busy": MapOf(
+                    Num(),
+                    "Reply values when a command that is `refused_while_moving` arrives during the move (DYNAMIXEL "
+                    "CLEAR: error.number: 1, result fail).",
+                ),
+                "unsupported": MapOf(
+                    Num(),
+                    "Reply values for a request whose code no command has, recognised when it arrives whole and "
+                    "its checksum verifies (Modbus exception_code: 1, illegal function); needs the protocol's "
+                    "error reply and frames without a header.",
+                ),
+            },
+            description=(
+                "How the device refuses a request, by reason: response field (or field.bit_field) -> value. The "
+                "refusal is the protocol's error reply (the response marked `error_reply`, carrying the refused "
+                "request's code) when it has one; otherwise the request's own response with these values. A "
+                "refused request changes nothing. With an error reply, request values are also checked against "
+                "their ranges and enums before the device acts. For a reason not listed the request is still not "
+                "carried out, and the reply says nothing of it (with an error reply: no reply)."
+            ),
+        ),
+        "kinds": MapOf(
+            Obj(
+                {
+                    "description": TEXT,
+                    "address": Str("The request field holding this kind's id."),
+                    "ids": ListOf(Int(), "The ids the simulator creates (fixed by the hardware, not by --id)."),
+                    "broadcast": Int("The id every device of this kind obeys.", example=255),
+                    "state": MapOf(Num(), "State variables of each device of this kind -> initial value."),
+                },
+                required=("address", "ids"),
+                description="One further kind of device: the field with its id, its ids and its state.",
+            ),
+            "Further kinds of device behind the same port, each with its own ids (a board's PWM servo ports, its "
+            "motors); a command names its kind with `kind:`. The devices --id creates are the default kind.",
+        ),
+    },
+    description="How the device behaves: what the generated simulator does, and the address rule the client uses.",
+)
+
+SPEC = Obj(
+    {
+        "protocol": Str("Python package name of the generated code."),
+        "title": TITLE,
+        "description": TEXT,
+        "sources": MapOf(Str(), "Document id -> what it is."),
+        "byte_order": Str(
+            "Byte order of every multi-byte value, unless a field's `endian` says otherwise.", choices=("little", "big")
+        ),
+        "serial": Obj(
+            {
+                "baudrate": Int("Bits per second.", minimum=1),
+                "bytesize": Int("Data bits per character.", default=8, minimum=5, maximum=8),
+                "parity": Str("Parity bit.", choices=("none", "even", "odd"), default="none"),
+                "stopbits": Num("Stop bits.", default=1, choices=(1, 1.5, 2)),
+                "notes": TEXT,
+            },
+            required=("baudrate",),
+            description="The serial line's settings: what clients, simulators and `monitor` open a port with.",
+        ),
+        "framing": FRAMING,
+        "matching": Obj(
+            {
+                "by": ListOf(Str(), "What a reply shares with its request: `command` and field names (servo_id)."),
+                "description": TEXT,
+            },
+            description="How a reply is matched to its request.",
+        ),
+        "fields": FIELDS,
+        "enums": MapOf(ENUM, "Value sets: name -> enum; fields refer to them with `enum:`."),
+        "flags": MapOf(FLAGS, "Bit sets: name -> flags; fields refer to them with `flags:`."),
+        "tables": MapOf(TABLE, "Parameter or register tables: name -> table."),
+        "commands": MapOf(COMMAND, "The protocol's commands: name -> command."),
+        "examples": MapOf(EXAMPLE, "Frames printed in the documents, each decoded and encoded by the tests."),
+        "errata": MapOf(ERRATUM, "Mistakes in the documents, each pinned by a test."),
+        "device": DEVICE,
+    },
+    required=("protocol", "title", "byte_order", "serial", "framing", "commands"),
+    description="A serialspec protocol spec.",
+)
+
+
+def json_schema() -> dict[str, Any]:
+    schema = SPEC.json_schema()
+    schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
+    schema["$defs"] = {"fields": FIELDS.json_schema()}
+    schema["title"] = "serialspec protocol spec"
+    return schema

@@ -1,0 +1,331 @@
+"""What every pass shares: the context earlier passes fill in, and the helpers that report problems.
+
+A pass has one job. It reads the loaded document and what earlier passes resolved (the `Context`), records what it
+resolves there, and returns its problems; `serialspec.lang.resolve` runs the passes in order.
+"""
+
+from __future__ import annotations
+
+import builtins
+import keyword
+import re
+import sys
+from dataclasses import field
+from typing import Any, Literal
+
+from serialspec.lang.errors import SpecError
+from serialspec.lang.frozen import mutable
+from serialspec.lang.loader import Located, Path, dotted
+from serialspec.lang.model import (
+    SCALARS,
+    Command,
+    Device,
+    EnumDef,
+    Erratum,
+    ErrorReply,
+    Example,
+    FlagsDef,
+    Framing,
+    ScalarType,
+    Serial,
+    Table,
+)
+
+NAME = re.compile(r"^[a-z][a-z0-9_]*$")
+LABEL = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
+
+# --- reserved names: every name generated code uses itself, so that no spec name can shadow one -----------------
+
+# Attribute and parameter names the generated classes and methods use themselves.
+RESERVED_NAMES = frozenset({"to_fields", "from_fields", "self"})
+# A field is also a parameter of a client method, whose body has these locals and calls these builtins (a parameter
+# of the same name would shadow them); `id`, a usual address field, is a builtin generated code never calls.
+RESERVED_FIELD_NAMES = (
+    RESERVED_NAMES
+    | {"request", "reply", "replies"}
+    | {
+        "any",
+        "bool",
+        "bytearray",
+        "bytes",
+        "classmethod",
+        "dict",
+        "float",
+        "frozenset",
+        "getattr",
+        "hasattr",
+        "int",
+        "isinstance",
+        "iter",
+        "len",
+        "list",
+        "next",
+        "object",
+        "str",
+        "sum",
+        "super",
+        "tuple",
+        "type",
+    }
+)
+# Names the generated modules (messages, codec, client, simulator, registers, __init__) import or define next to
+# the classes a spec names, and Python's capitalised builtins: a generated class of the same name would shadow one.
+GENERATED_CLASS_NAMES = frozenset(
+    {
+        "Any",
+        "Binding",
+        "Bus",
+        "Callable",
+        "ChecksumError",
+        "ClassVar",
+        "ClientBase",
+        "CommandSpec",
+        "CorruptReply",
+        "DecodeError",
+        "DeviceError",
+        "DeviceSpec",
+        "Direction",
+        "EncodeError",
+        "EntrySpec",
+        "FrameFormat",
+        "IntEnum",
+        "IntFlag",
+        "Iterable",
+        "Iterator",
+        "KindSpec",
+        "Literal",
+        "Mapping",
+        "Message",
+        "PortError",
+        "RangeError",
+        "Register",
+        "RegisterMap",
+        "Self",
+        "SerialSettings",
+        "SerialspecError",
+        "Simulator",
+        "StreamParser",
+        "Timeout",
+        "TransportError",
+    }
+    | {name for name in dir(builtins) if name[:1].isupper()}
+)
+# Module-level constants of the generated package.
+GENERATED_CONSTANTS = frozenset(
+    {
+        "BAUDRATE",
+        "BINDING",
+        "CONTENTS",
+        "DEVICE",
+        "MATCH_BY",
+        "MESSAGE_TYPES",
+        "PROTOCOL",
+        "REQUEST_FORMAT",
+        "REQUEST_FRAME",
+        "RESPONSE_FORMAT",
+        "RESPONSE_FRAME",
+        "SERIAL",
+        "SIMULATOR",
+        "SPEC",
+    }
+)
+# A protocol's name is its package's: it must not shadow a module the generated code (or anything) imports.
+RESERVED_PACKAGES = frozenset(sys.stdlib_module_names) | {
+    "construct",
+    "docs",  # generated/docs holds the markdown references
+    "jinja2",
+    "serial",
+    "serialspec",
+    "yaml",
+}
+
+
+def enum_span(enum: EnumDef, low: float, high: float) -> tuple[float, float]:
+    """The range of a value an enum names when the spec gives none: its declared values' span (within the type)."""
+    values = [v.value for v in enum.values]
+    return (max(low, min(values)), min(high, max(values))) if values else (low, high)
+
+
+def camel(*parts: str) -> str:
+    return "".join(word.capitalize() for part in parts for word in part.split("_") if word)
+
+
+@mutable
+class Context:
+    """The document being resolved and everything resolved from it so far."""
+
+    doc: Located
+    structural: set[Path] = field(default_factory=set)  # paths the structural check found malformed
+    # Names of definitions (fields, enums, tables, commands, ...) that failed to resolve, their problem reported:
+    # a reference to one is not reported again.
+    broken: set[str] = field(default_factory=set)
+    class_names: dict[str, tuple[Path, object]] = field(default_factory=dict)
+    endian: Literal["<", ">"] = "<"
+    shared_fields: dict[str, Any] = field(default_factory=dict)
+    name: str = ""
+    client_class: str = ""
+    simulator_class: str = ""
+    serial: Serial | None = None
+    matching: tuple[str, ...] = ()
+    matching_description: str = ""
+    enums: dict[str, EnumDef] = field(default_factory=dict)
+    flags: dict[str, FlagsDef] = field(default_factory=dict)
+    tables: dict[str, Table] = field(default_factory=dict)
+    framing: Framing | None = None
+    commands: list[Command] = field(default_factory=list)
+    errata: tuple[Erratum, ...] = ()
+    examples: tuple[Example, ...] = ()
+    device: Device | None = None
+    error_reply: ErrorReply | None = None
+
+    @property
+    def data(self) -> Any:
+        return self.doc.data
+
+    def malformed_near(self, path: Path) -> bool:
+        """The structural check reported a value at, inside or around path, or in a shared field (used anywhere)."""
+        return any(
+            bad[: len(path)] == path or path[: len(bad)] == bad or bad[:1] == ("fields",) for bad in self.structural
+        )
+
+
+# The mappings whose keys name definitions other parts of a spec refer to.
+DEFINITIONS = frozenset({"fields", "enums", "flags", "tables", "commands", "subcommands", "examples", "errata"})
+
+
+class Bad(Exception):
+    """A value could not be resolved; its problem is already recorded."""
+
+
+class Pass:
+    """One resolution step: `run()` does its job and returns the problems it found."""
+
+    def __init__(self, ctx: Context) -> None:
+        self.ctx = ctx
+        self.problems: list[SpecError] = []
+
+    def run(self) -> list[SpecError]:
+        raise NotImplementedError
+
+    # --- what earlier passes resolved -----------------------------------------------------------------------------
+
+    @property
+    def doc(self) -> Located:
+        return self.ctx.doc
+
+    @property
+    def endian(self) -> Literal["<", ">"]:
+        return self.ctx.endian
+
+    @property
+    def enums(self) -> dict[str, EnumDef]:
+        return self.ctx.enums
+
+    @property
+    def flags(self) -> dict[str, FlagsDef]:
+        return self.ctx.flags
+
+    @property
+    def tables(self) -> dict[str, Table]:
+        return self.ctx.tables
+
+    @property
+    def shared_fields(self) -> dict[str, Any]:
+        return self.ctx.shared_fields
+
+    def section(self, key: str) -> dict[Any, Any]:
+        """A top-level mapping of the spec; empty when missing or malformed (the structural check reports that)."""
+        value = self.ctx.data.get(key)
+        return value if isinstance(value, dict) else {}
+
+    # --- reporting ------------------------------------------------------------------------------------------------
+
+    def error(self, path: Path, message: str) -> None:
+        if any(path[: len(bad)] == bad for bad in self.ctx.structural):
+            return  # already reported by the structural check
+        self.problems.append(self.doc.error(path, message))
+
+    def fail(self, path: Path, message: str) -> Bad:
+        self.error(path, message)
+        return Bad()
+
+    def guard(self, path: Path, function: Any, *args: Any) -> Any:
+        """Resolve the value at path with function(*args); None if it cannot be (its problem is recorded).
+
+        Only a value the structural check has already reported may fail unexpectedly; anything else is a bug in
+        serialspec and is raised, never swallowed.
+        """
+        try:
+            return function(*args)
+        except Bad:
+            pass
+        except (TypeError, AttributeError, ValueError, LookupError, OverflowError):
+            if not self.ctx.malformed_near(path):
+                raise
+        if len(path) >= 2 and path[-2] in DEFINITIONS and isinstance(path[-1], str):
+            self.ctx.broken.add(path[-1])
+        if path[-1:] in (("request",), ("response",)) and len(path) >= 3:  # a message: its command is broken
+            self.ctx.broken.add(str(path[-2]) if path[0] != "commands" or len(path) == 3 else f"{path[1]}.{path[3]}")
+        return None
+
+    # --- names and references -------------------------------------------------------------------------------------
+
+    def name(self, value: str, path: Path, what: str = "name", reserved: frozenset[str] = RESERVED_NAMES) -> str:
+        if not isinstance(value, str) or not NAME.match(value):
+            self.error(
+                path,
+                f"{what} {value!r} must be a lower-case identifier (a-z, 0-9, _; starting with a letter)",
+            )
+        elif keyword.iskeyword(value) or value in reserved:
+            self.error(path, f"{what} {value!r} is reserved (a Python keyword or a name generated code uses)")
+        return str(value)
+
+    def class_name(self, name: str, path: Path, identity: object = None) -> str:
+        """Register a generated class (or constant) name; the same name may be reused only for the same definition."""
+        class_names = self.ctx.class_names
+        if name in GENERATED_CLASS_NAMES or name in GENERATED_CONSTANTS:
+            self.error(path, f"generated name {name} would shadow the {name} that generated code uses; rename it")
+            return name
+        if name in class_names:
+            other_path, other_identity = class_names[name]
+            if other_path != path and (identity is None or identity != other_identity):
+                self.error(path, f"generated class name {name} is already used by {dotted(other_path)}")
+            return name
+        class_names[name] = (path, identity)
+        return name
+
+    def reference(self, kind: str, registry: dict[str, Any], value: Any, path: Path) -> Any:
+        if value is None:
+            return None
+        if value not in registry:
+            if value in self.ctx.broken:
+                raise Bad  # defined, but it failed to resolve: its own problem is reported
+            known = ", ".join(registry) or "none defined"
+            raise self.fail(path, f"unknown {kind} {value!r} (expected one of: {known})")
+        return registry[value]
+
+    # --- types and ranges -----------------------------------------------------------------------------------------
+
+    def scalar_type(self, value: Any, path: Path, allow_float: bool = True) -> ScalarType:
+        found = SCALARS.get(value) if isinstance(value, str) else None
+        if found is None or (found.is_float and not allow_float):
+            choices = [n for n, t in SCALARS.items() if allow_float or not t.is_float]
+            raise self.fail(path, f"unknown type {value!r} (expected one of {', '.join(choices)})")
+        return found
+
+    def bounds(
+        self, scalar: ScalarType, sign_magnitude: bool, given: Any, path: Path, sign_bit: int | None = None
+    ) -> tuple[float, float]:
+        if sign_magnitude:
+            limit = (1 << (sign_bit if sign_bit is not None else scalar.size * 8 - 1)) - 1
+            low, high = float(-limit), float(limit)
+        else:
+            low, high = scalar.minimum, scalar.maximum
+        if given is None:
+            return low, high
+        given_low, given_high = given
+        if given_low > given_high:
+            self.error(path, f"range [{given_low}, {given_high}] is empty")
+        if given_low < low or given_high > high:
+            self.error(path, f"range [{given_low}, {given_high}] does not fit {scalar.name} ({low:g}..{high:g})")
+        return given_low, given_high

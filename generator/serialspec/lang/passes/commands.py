@@ -1,0 +1,402 @@
+"""Commands, their sub-commands and messages; command codes; which response answers which request."""
+
+from __future__ import annotations
+
+from typing import Any, Literal
+
+from serialspec.lang.errors import SpecError
+from serialspec.lang.loader import Path
+from serialspec.lang.model import (
+    Bytes,
+    Command,
+    Direction,
+    Field,
+    Framing,
+    Message,
+    OptionalWhen,
+    Scalar,
+    Selector,
+    Subcommand,
+    Table,
+    TableEntry,
+    content_bounds,
+    fixed_size,
+    replies_by_request,
+    reply_to,
+)
+from serialspec.lang.passes.base import camel
+from serialspec.lang.passes.fields import FieldResolver
+
+OPTIONAL_WHEN_OPS: dict[str, Literal["==", "!=", ">=", "<="]] = {
+    "equals": "==",
+    "not_equals": "!=",
+    "at_least": ">=",
+    "at_most": "<=",
+}
+
+
+class Commands(FieldResolver):
+    """Resolve `commands:` and check their codes against the framing and their `answered_by` references."""
+
+    def run(self) -> list[SpecError]:
+        for key, value in self.section("commands").items():
+            command = self.guard(("commands", key), self.command, key, value, ("commands", key))
+            if command:
+                self.ctx.commands.append(command)
+        if self.ctx.framing:
+            self.check_codes(self.ctx.commands, self.ctx.framing)
+            self.check_lengths(self.ctx.commands, self.ctx.framing)
+        self.check_answered_by(self.ctx.commands)
+        self.check_request_references(self.ctx.commands)
+        self.check_matching(self.ctx.commands, self.ctx.framing)
+        return self.problems
+
+    def check_lengths(self, commands: list[Command], framing: Framing) -> None:
+        """Every message's smallest content must be countable by its frame's length element."""
+        for command in commands:
+            for message in command.messages():
+                layout = framing.layouts[message.direction]
+                length = layout.length
+                if not layout.classic or length is None or length.type is None:
+                    continue  # the frame engine's lengths count spans of their own (or the frame has none)
+                countable = int(length.type.maximum) - layout.length_adds
+                if message.min_size > countable:
+                    self.error(
+                        message_path(message),
+                        f"content of at least {message.min_size} bytes is more than the {length.type.name} length "
+                        f"element {length.name!r} can count ({countable})",
+                    )
+
+    def check_request_references(self, commands: list[Command]) -> None:
+        """A response's `after`, `start: request.<field>` and `size_from` name fields of the requests it answers."""
+        messages = [m for c in commands for m in c.messages()]
+        replies = replies_by_request(messages)
+        requests = {m.key: m for m in messages if m.direction == Direction.REQUEST}
+        answered: dict[str, list[Message]] = {}
+        for request in requests.values():
+            response = reply_to(request, replies)
+            if response is not None:
+                answered.setdefault(response.key, []).append(request)
+        for message in messages:
+            if message.direction != Direction.RESPONSE:
+                continue
+            path = message_path(message)
+            if message.answers and message.answers not in requests:
+                known = ", ".join(requests) or "none"
+                self.error((*path, "answers"), f"unknown request {message.answers!r} (expected one of: {known})")
+            asked = answered.get(message.key, [])
+            wanted: list[tuple[Path, str]] = []
+            if message.after:
+                wanted.append(((*path, "after"), message.after))
+            for f in message.fields:
+                if isinstance(f, Bytes) and f.start_in_request:
+                    wanted.append(((*path, "fields", f.name, "start"), f.start))
+                if isinstance(f, Bytes) and f.size_from:
+                    wanted.append(((*path, "fields", f.name, "size_from"), f.size_from))
+            for where, name in wanted:
+                if name in self.ctx.broken:
+                    continue
+                if not any(integer_field(r, name) for r in asked):
+                    names = sorted({f.name for r in asked for f in r.fields if isinstance(f, Scalar)})
+                    known = ", ".join(names) or "none"
+                    self.error(
+                        where,
+                        f"no request this response answers has an integer field {name!r} (they have: {known})",
+                    )
+
+    def check_matching(self, commands: list[Command], framing: Framing | None) -> None:
+        """`matching.by` names frame elements or fields that requests and their replies carry."""
+        names = {e.name for layout in (framing.layouts.values() if framing else ()) for e in layout.value_elements}
+        names |= {f.name for c in commands for m in c.messages() for f in m.fields}
+        names |= {"command", "subcommand"}  # the message's own command and sub-command
+        if framing is None:
+            return  # the frame's elements are unknown: its problems are reported
+        names |= self.ctx.broken
+        for index, name in enumerate(self.ctx.matching):
+            if name not in names:
+                self.error(("matching", "by", index), f"unknown field {name!r} (no frame element or field has it)")
+
+    def command(self, name: str, value: dict[str, Any], path: Path) -> Command:
+        self.name(name, path, "command name")
+        selector = None
+        subcommands: list[Subcommand] = []
+        if "subcommands" in value:
+            raw_selector = value.get("selector")
+            if raw_selector is None:
+                raise self.fail(
+                    path, "a command with subcommands needs `selector: {type, offset: {request, response}}`"
+                )
+            selector = Selector(
+                name=self.name(raw_selector.get("name", "subcommand_code"), (*path, "selector", "name")),
+                type=self.scalar_type(raw_selector.get("type", "u8"), (*path, "selector", "type"), False),
+                offsets={Direction(k): v for k, v in raw_selector["offset"].items() if k in ("request", "response")},
+            )
+            codes: dict[int, str] = {}
+            for sub_name, sub in value["subcommands"].items():
+                sub_path = (*path, "subcommands", sub_name)
+                self.name(sub_name, sub_path, "subcommand name")
+                if sub["code"] in codes:
+                    self.error(
+                        (*sub_path, "code"),
+                        f"code {sub['code']:#04x} is already used by {codes[sub['code']]!r}",
+                    )
+                codes[sub["code"]] = sub_name
+                if not selector.type.minimum <= sub["code"] <= selector.type.maximum:
+                    self.error(
+                        (*sub_path, "code"),
+                        f"code {sub['code']} does not fit the {selector.type.name} selector "
+                        f"({selector.type.minimum:g}..{selector.type.maximum:g})",
+                    )
+                messages = {
+                    d: self.guard(
+                        (*sub_path, d.value),
+                        self.message,
+                        name,
+                        sub_name,
+                        d,
+                        sub[d.value],
+                        (*sub_path, d.value),
+                        selector,
+                        sub["code"],
+                    )
+                    for d in Direction
+                    if d.value in sub
+                }
+                subcommands.append(
+                    Subcommand(
+                        sub_name,
+                        sub["code"],
+                        str(sub.get("title", "")),
+                        str(sub.get("title_cn", "")),
+                        str(sub.get("description", "")),
+                        messages.get(Direction.REQUEST),
+                        messages.get(Direction.RESPONSE),
+                        str(sub.get("source", "")),
+                    )
+                )
+            for direction in ("request", "response"):
+                if direction in value:
+                    self.error((*path, direction), "a command with subcommands describes content in each subcommand")
+        messages = {
+            d: self.guard((*path, d.value), self.message, name, None, d, value[d.value], (*path, d.value), None, None)
+            for d in Direction
+            if d.value in value and "subcommands" not in value
+        }
+        return Command(
+            name=name,
+            code=value.get("code"),
+            title=str(value.get("title", "")),
+            title_cn=str(value.get("title_cn", "")),
+            description=str(value.get("description", "")),
+            broadcast=str(value.get("broadcast", "")),
+            source=str(value.get("source", "")),
+            request=messages.get(Direction.REQUEST),
+            response=messages.get(Direction.RESPONSE),
+            selector=selector,
+            subcommands=tuple(subcommands),
+            group_class=self.class_name(camel(name, "commands"), path) if subcommands else "",
+        )
+
+    def check_answered_by(self, commands: list[Command]) -> None:
+        responses = {m.key: m for c in commands for m in c.messages() if m.direction == Direction.RESPONSE}
+        for command in commands:
+            for message in command.messages():
+                if message.answered_by and message.answered_by not in responses:
+                    self.error(
+                        ("commands", command.name, "request", "answered_by", "command"),
+                        f"{message.answered_by!r} is not a command with a response",
+                    )
+
+    def check_codes(self, commands: list[Command], framing: Framing) -> None:
+        for command in commands:
+            if command.code is not None and not isinstance(command.code, int):
+                continue  # not a number: the structural check has said so
+            directions = {m.direction for m in command.messages()}
+            broken = command.name in self.ctx.broken  # a message failed to resolve: its problem is reported
+            if command.code is not None and not broken and not any(framing.layouts[d].has_command for d in directions):
+                self.error(
+                    ("commands", command.name, "code"),
+                    "its frames have no command field, so no code",
+                )
+            element = next(
+                (
+                    e
+                    for d, layout in framing.layouts.items()
+                    for e in layout.elements
+                    if e.role == "command" and d in directions
+                ),
+                None,
+            )
+            if element is not None and element.type is not None and command.code is not None:
+                low, high = element.type.minimum, element.type.maximum
+                if not low <= command.code <= high:
+                    self.error(
+                        ("commands", command.name, "code"),
+                        f"code {command.code} does not fit the {element.type.name} command element ({low:g}..{high:g})",
+                    )
+        for direction, layout in framing.layouts.items():
+            sharing: dict[int | None, list[tuple[Command, Message]]] = {}
+            for command in commands:
+                messages = [m for m in command.messages() if m.direction == direction]
+                if not messages or any(m.error_reply for m in messages):
+                    continue  # an error reply has the code of the request it refuses (see passes/errors.py)
+                if command.code is not None and not isinstance(command.code, int):
+                    continue  # not a number: the structural check has said so
+                if layout.has_command and command.code is None:
+                    self.error(
+                        ("commands", command.name),
+                        f"missing key 'code' ({direction.value} frames carry a command field)",
+                    )
+                code = command.code if layout.has_command else None
+                sharing.setdefault(code, []).append((command, messages[0]))
+            for code, users in sharing.items():
+                if len(users) < 2:
+                    continue
+                what = f"code {code:#04x}" if code is not None else "a codeless reply"
+                if direction == Direction.REQUEST or any(c.selector for c, _ in users):
+                    for command, _ in users[1:]:
+                        self.error(
+                            ("commands", command.name),
+                            f"{what} in {direction.value} frames is already used by {users[0][0].name!r}",
+                        )
+                    continue
+                defaults = [c.name for c, m in users if m.default_reply]
+                if len(defaults) != 1:
+                    names = ", ".join(c.name for c, _ in users)
+                    self.error(
+                        ("commands", users[-1][0].name, "response"),
+                        f"{what} is shared by the replies of {names}: mark one of them `default: true` (the "
+                        "layout a reply is decoded as when its request is unknown)",
+                    )
+
+    def message(
+        self,
+        command: str,
+        subcommand: str | None,
+        direction: Direction,
+        value: dict[str, Any],
+        path: Path,
+        selector: Selector | None,
+        code: int | None,
+    ) -> Message:
+        fields = self.fields(value.get("fields") or {}, (*path, "fields"), parent=None)
+        framing = self.ctx.framing
+        frame_values = {e.name for e in framing.layouts[direction].value_elements} if framing else set()
+        for field in fields:
+            if field.name in frame_values:
+                self.error(
+                    (*path, "fields", field.name),
+                    f"{field.name!r} is already a frame element of every {direction.value}; name the field otherwise",
+                )
+        if selector is not None and code is not None:
+            fields = self.insert_selector(fields, selector, direction, code, path)
+        self.check_rest(fields, (*path, "fields"))
+        low, high = content_bounds(fields)
+        class_name = self.class_name(camel(command, subcommand or "", direction.value), path)
+        struct_name = self.class_name(f"{class_name}Content", path)
+        answered_by = value.get("answered_by") or {}
+        if direction == Direction.REQUEST:
+            for field in fields:
+                if isinstance(field, Scalar) and field.status_ok is not None:
+                    self.error((*path, "fields", field.name, "status"), "a status is reported in a response")
+        if answered_by and direction != Direction.REQUEST:
+            self.error((*path, "answered_by"), "`answered_by` names the response that answers a request")
+        if value.get("error_reply") and direction != Direction.RESPONSE:
+            self.error((*path, "error_reply"), "an error reply is a response")
+        return Message(
+            command=command,
+            subcommand=subcommand,
+            direction=direction,
+            class_name=class_name,
+            title=str(value.get("title", "")),
+            description=str(value.get("description", "")),
+            fields=fields,
+            optional=str(value.get("optional", "")),
+            unsolicited=bool(value.get("unsolicited", False)),
+            answers=str(value.get("answers", "")),
+            min_size=low,
+            max_size=high,
+            source=str(value.get("source", "")),
+            optional_when=self.optional_when(value.get("optional_when"), (*path, "optional_when")),
+            after=self.after(value.get("after"), fields, direction, path),
+            answered_by=str(answered_by.get("command", "")),
+            default_reply=bool(value.get("default", False)),
+            reply_when=self.optional_when(answered_by.get("optional_when"), (*path, "answered_by", "optional_when")),
+            struct_name=struct_name,
+            error_reply=bool(value.get("error_reply", False)),
+        )
+
+    def table_entry(self, text: str, path: Path) -> tuple[Table, TableEntry]:
+        """A table entry named `entry` (searched in every table) or `table.entry`."""
+        table_name, _, entry_name = text.rpartition(".")
+        tables = [self.tables[table_name]] if table_name in self.tables else list(self.tables.values())
+        for table in tables:
+            for entry in table.entries:
+                if entry.name == entry_name:
+                    return table, entry
+        raise self.fail(path, f"unknown table entry {text!r}")
+
+    def optional_when(self, value: Any, path: Path) -> OptionalWhen | None:
+        if value is None:
+            return None
+        table, entry = self.table_entry(value["parameter"], (*path, "parameter"))
+        given = [(key, op) for key, op in OPTIONAL_WHEN_OPS.items() if key in value]
+        if len(given) != 1:
+            raise self.fail(path, f"give one comparison: {', '.join(OPTIONAL_WHEN_OPS)}")
+        key, op = given[0]
+        return OptionalWhen(table.name, entry.name, entry.key, int(value[key]), op)
+
+    def after(self, value: Any, fields: tuple[Field, ...], direction: Direction, path: Path) -> str:
+        if value is None:
+            return ""
+        if direction != Direction.RESPONSE:
+            self.error((*path, "after"), "`after` describes when a response is sent")
+        return str(value)
+
+    def insert_selector(
+        self, fields: tuple[Field, ...], selector: Selector, direction: Direction, code: int, path: Path
+    ) -> tuple[Field, ...]:
+        offset = selector.offsets.get(direction)
+        if offset is None:
+            raise self.fail(path, f"the selector has no offset for {direction.value}")
+        const = Scalar(
+            selector.name,
+            "sub-command selector",
+            "",
+            "",
+            selector.type,
+            self.endian,
+            "",
+            None,
+            selector.type.minimum,
+            selector.type.maximum,
+            code,
+            None,
+            None,
+            None,
+            (),
+            "",
+            False,
+        )
+        position = 0
+        for index, field in enumerate(fields):
+            if position == offset:
+                return (*fields[:index], const, *fields[index:])
+            size = fixed_size(field)
+            if size is None:
+                break
+            position += size
+        if position == offset:
+            return (*fields, const)
+        raise self.fail(path, f"the selector's offset {offset} does not fall between fixed-size fields")
+
+
+def message_path(message: Message) -> Path:
+    """Where a message is in the spec."""
+    if message.subcommand is not None:
+        return ("commands", message.command, "subcommands", message.subcommand, message.direction.value)
+    return ("commands", message.command, message.direction.value)
+
+
+def integer_field(message: Message, name: str) -> bool:
+    return any(isinstance(f, Scalar) and not f.type.is_float and f.name == name for f in message.fields)

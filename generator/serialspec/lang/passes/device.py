@@ -1,0 +1,542 @@
+"""The `device:` section: how a virtual device behaves, checked against the commands it answers."""
+
+from __future__ import annotations
+
+from collections.abc import Container, Mapping
+from typing import Any
+
+from serialspec.lang import expression
+from serialspec.lang.errors import SpecError
+from serialspec.lang.loader import Path
+from serialspec.lang.model import (
+    SCALARS,
+    Behaviour,
+    Command,
+    Device,
+    DeviceErrors,
+    DeviceKind,
+    DeviceModel,
+    DeviceTimeout,
+    Direction,
+    Field,
+    Framing,
+    Group,
+    Message,
+    ModelEntry,
+    Motion,
+    Scalar,
+    Space,
+    SpaceAccess,
+    TableEntry,
+    replies_by_request,
+    reply_to,
+)
+from serialspec.lang.passes.base import Pass
+
+
+class _Everything:
+    """Contains every name: what an unknown kind or group is checked against (it is reported once itself)."""
+
+    def __contains__(self, name: object) -> bool:
+        return True
+
+
+EVERYTHING = _Everything()
+
+
+class DevicePass(Pass):
+    """Resolve `device:` (when the framing resolved: the device's address defaults to a frame element)."""
+
+    def run(self) -> list[SpecError]:
+        data, framing = self.ctx.data, self.ctx.framing
+        if "device" in data and framing is not None and isinstance(data.get("serial") or {}, dict):
+            self.ctx.device = self.guard(
+                ("device",), self.device, data["device"], ("device",), self.ctx.commands, framing
+            )
+        return self.problems
+
+    def device(self, value: dict[str, Any], path: Path, commands: list[Command], framing: Framing) -> Device:
+        memory = self.reference("table", self.tables, value.get("memory"), (*path, "memory"))
+        entries = {e.name: e for e in memory.entries} if memory else {}
+        for name, initial in (value.get("initial") or {}).items():
+            if name not in entries:
+                self.error((*path, "initial", name), f"unknown memory entry {name!r}")
+            elif not entries[name].minimum <= initial <= entries[name].maximum:
+                entry = entries[name]
+                self.error(
+                    (*path, "initial", name),
+                    f"initial value {initial} is outside {name}'s range {entry.minimum:g}..{entry.maximum:g}",
+                )
+        address_element = next(
+            (e for layout in framing.layouts.values() for e in layout.value_elements if e.role == "address"), None
+        )
+        address = str(value.get("address") or (address_element.name if address_element else ""))
+        # a protocol without an address element (VESC) has one device per port: then no address is needed
+        broadcast = value.get("broadcast", address_element.broadcast if address_element else None)
+        id_entry = str(value.get("id_entry", ""))
+        if id_entry and id_entry not in entries and id_entry not in (value.get("state") or {}):
+            self.error((*path, "id_entry"), f"unknown memory entry or state variable {id_entry!r}")
+        state = {str(k): float(v) for k, v in (value.get("state") or {}).items()}
+        requests = {m.key: m for c in commands for m in c.messages() if m.direction == Direction.REQUEST}
+        spaces = self.spaces(value.get("spaces") or {}, (*path, "spaces"))
+        errors = self.errors(value.get("errors"), (*path, "errors"), commands)
+        replies = replies_by_request(m for c in commands for m in c.messages())
+        kinds = {
+            str(name): DeviceKind(
+                str(name),
+                str(kind.get("description", "")),
+                str(kind["address"]),
+                tuple(int(i) for i in kind["ids"]),
+                kind.get("broadcast"),
+                {str(k): float(v) for k, v in (kind.get("state") or {}).items()},
+            )
+            for name, kind in (value.get("kinds") or {}).items()
+        }
+        self.check_ids(value, path, commands, framing)
+        broken = self.ctx.broken
+        behaviours = []
+        for key, item in (value.get("commands") or {}).items():
+            item_path = (*path, "commands", key)
+            request = requests.get(key)
+            if request is None and key in self.ctx.broken:
+                continue  # the command failed to resolve: its problem is reported
+            if request is None:
+                self.error(item_path, f"unknown command {key!r} (or it has no request)")
+                continue
+            kind_name = str(item.get("kind", ""))
+            if kind_name and kind_name not in kinds:
+                self.error((*item_path, "kind"), f"unknown device kind {kind_name!r} (not in `kinds:`)")
+            # an unknown kind or group is reported once: the names that depend on it are not checked
+            known_state: dict[str, float] | _Everything = (
+                kinds[kind_name].state if kind_name in kinds else EVERYTHING if kind_name else state
+            )
+            response = reply_to(request, replies)
+            each = str(item.get("each", ""))
+            group = next((f for f in request.fields if isinstance(f, Group) and f.name == each), None)
+            if each and group is None:
+                self.error((*item_path, "each"), f"{key} has no group field {each!r}")
+            item_fields = group.fields if group else ()
+            request_set = {f.name for f in (*request.fields, *item_fields)} | broken
+            request_names: Container[str] = EVERYTHING if each and group is None else request_set
+            response_names = ({f.name for f in response.fields} if response else set()) | broken
+            space_reads = self.space_runs(item.get("reads"), response_names, request, spaces, (*item_path, "reads"))
+            space_writes = self.space_runs(item.get("writes"), request_set, request, spaces, (*item_path, "writes"))
+            for name in item.get("reads") or () if not space_reads else ():
+                if name not in response_names:
+                    self.error((*item_path, "reads"), f"{key} has no response field {name!r}")
+            for name in item.get("writes") or () if not space_writes else ():
+                if name not in request_names:
+                    self.error((*item_path, "writes"), f"{key} has no request field {name!r}")
+            reports: dict[str, expression.Expr] = {}
+            for field_name, source in ((str(k), str(v)) for k, v in (item.get("reports") or {}).items()):
+                if field_name not in response_names:
+                    self.error((*item_path, "reports", field_name), f"{key} has no response field {field_name!r}")
+                try:
+                    reports[field_name] = expression.parse(source)
+                except expression.ExpressionError as exc:
+                    self.error((*item_path, "reports", field_name), str(exc))
+                    continue
+                used = set(expression.names(reports[field_name]))
+                for name in sorted(n for n in used if n not in known_state and n not in entries):
+                    self.error((*item_path, "reports", field_name), f"unknown state variable {name!r}")
+            motion = None
+            if "moves" in item:
+                moves = item["moves"]
+                motion = Motion(
+                    str(moves["state"]),
+                    str(moves["target"]),
+                    str(moves.get("duration", "")),
+                    str(moves.get("speed", "")),
+                    float(moves.get("speed_scale", 1.0)),
+                    str(moves.get("enabled_by", "")),
+                    str(moves.get("accel", "")),
+                    str(moves.get("decel", "")),
+                )
+                if motion.speed_scale <= 0:
+                    self.error((*item_path, "moves", "speed_scale"), "must be positive")
+                if motion.enabled_by and motion.enabled_by not in known_state and motion.enabled_by not in entries:
+                    self.error((*item_path, "moves", "enabled_by"), f"unknown memory entry {motion.enabled_by!r}")
+                if motion.state not in known_state and motion.state not in entries:
+                    self.error((*item_path, "moves", "state"), f"unknown state variable {motion.state!r}")
+                for role in ("target", "duration", "speed", "accel", "decel"):
+                    name = getattr(motion, role)
+                    if name and name not in request_names and name not in entries and name not in known_state:
+                        self.error(
+                            (*item_path, "moves", role),
+                            f"{key} has no request field, memory entry or state variable {name!r}",
+                        )
+            stores = {str(k): str(v) for k, v in (item.get("stores") or {}).items()}
+            sets = {str(k): float(v) for k, v in (item.get("sets") or {}).items()}
+            absent = {str(k): float(v) for k, v in (item.get("absent") or {}).items()}
+            for field_name, target in stores.items():
+                if field_name not in request_names:
+                    self.error((*item_path, "stores", field_name), f"{key} has no request field {field_name!r}")
+                if target not in known_state and target not in entries:
+                    self.error((*item_path, "stores", field_name), f"unknown state variable {target!r}")
+            for target in sets:
+                if target not in known_state and target not in entries:
+                    self.error((*item_path, "sets", target), f"unknown state variable {target!r}")
+            for field_name in absent:
+                if field_name not in response_names:
+                    self.error((*item_path, "absent", field_name), f"{key} has no response field {field_name!r}")
+            behaviours.append(
+                Behaviour(
+                    key,
+                    () if space_reads else tuple(item.get("reads") or ()),
+                    () if space_writes else tuple(item.get("writes") or ()),
+                    bool(item.get("resets", False)),
+                    reports,
+                    motion,
+                    bool(item.get("broadcast_reply", False)),
+                    each,
+                    bool(item.get("buffered", False)),
+                    bool(item.get("commits", False)),
+                    kind_name,
+                    stores,
+                    sets,
+                    absent,
+                    space_reads,
+                    space_writes,
+                    self.keeps(item.get("keeps"), request_names, entries, (*item_path, "keeps")),
+                    **self.behaviour_extras(
+                        item,
+                        item_path,
+                        key,
+                        request_names,
+                        response_names,
+                        known_state if isinstance(known_state, _Everything) else {**entries, **known_state},
+                    ),
+                    nothing_held={str(k): float(v) for k, v in (item.get("nothing_held") or {}).items()},
+                )
+            )
+        status = {str(k): str(v) for k, v in (value.get("status") or {}).items()}
+        for field_name, entry_name in status.items():
+            if entry_name not in entries:
+                self.error((*path, "status", field_name), f"unknown memory entry {entry_name!r}")
+        return Device(
+            description=str(value.get("description", "")),
+            memory=memory,
+            initial={str(k): float(v) for k, v in (value.get("initial") or {}).items()},
+            address=address,
+            id_entry=id_entry,
+            broadcast=broadcast,
+            state=state,
+            reply={str(k): v if isinstance(v, str) else float(v) for k, v in (value.get("reply") or {}).items()},
+            behaviours=tuple(behaviours),
+            status=status,
+            kinds=tuple(kinds.values()),
+            echo_address=bool(value.get("echo_address", False)),
+            ids=tuple(int(i) for i in value.get("ids") or (0,)),
+            timeout=self.timeout(value.get("timeout"), (*path, "timeout"), requests, state),
+            spaces=tuple(spaces.values()),
+            errors=errors,
+            models=self.models(value, path, entries, state),
+            moving=self.moving(value, path, entries, state),
+            model_entry=str(value.get("model_entry", "")),
+        )
+
+    def check_ids(self, value: dict[str, Any], path: Path, commands: list[Command], framing: Framing) -> None:
+        """`address` (and each kind's) names an integer the requests carry; `reply`, `refused`, `status` name what
+        the responses carry."""
+        elements = {e.name: e for layout in framing.layouts.values() for e in layout.value_elements}
+        carried: dict[Direction, dict[str, Field]] = {Direction.REQUEST: {}, Direction.RESPONSE: {}}
+        for command in commands:
+            for message in command.messages():
+                stack = list(message.fields)
+                while stack:
+                    f = stack.pop()
+                    carried[message.direction].setdefault(f.name, f)
+                    if isinstance(f, Group):
+                        stack.extend(f.fields)
+        wanted = [((*path, "address"), value.get("address"))]
+        wanted += [
+            ((*path, "kinds", k, "address"), kind.get("address")) for k, kind in (value.get("kinds") or {}).items()
+        ]
+        for where, name in wanted:
+            if name is None or name in elements:
+                continue
+            found = carried[Direction.REQUEST].get(name)
+            if found is None:
+                self.error(where, f"unknown field {name!r}: no request carries it (nor the frame)")
+            elif not isinstance(found, Scalar) or found.type.is_float:
+                self.error(where, f"{name!r} is no integer field, so it cannot hold a device id")
+        responses = carried[Direction.RESPONSE]
+        # Reply values: `reply`, `status`, and `errors` where no error reply carries them (else `errors` checks them).
+        named: list[tuple[Path, Any]] = [((key,), value.get(key)) for key in ("reply", "status")]
+        if not any(m.error_reply for c in self.ctx.commands for m in c.messages()):
+            named += [(("errors", reason), values) for reason, values in (value.get("errors") or {}).items()]
+        for where, values in named:
+            for name in values or {}:
+                head, _, bit = str(name).partition(".")  # `error.number`: a bit field of a value or element
+                owner = elements.get(head) or responses.get(head)
+                bits = {b.name for b in getattr(owner, "bits", ())}
+                if owner is None or (bit and bit not in bits):
+                    self.error((*path, *where, name), f"unknown response field {name!r}: no response carries it")
+
+    def timeout(
+        self, value: Any, path: Path, requests: dict[str, Message], state: dict[str, float]
+    ) -> DeviceTimeout | None:
+        if value is None:
+            return None
+        for index, name in enumerate(value["kept_by"]):
+            if name not in requests:
+                self.error((*path, "kept_by", index), f"unknown command {name!r} (or it has no request)")
+        for name in value["sets"]:
+            if name not in state:
+                self.error((*path, "sets", name), f"unknown state variable {name!r}")
+        if value["after"] < 1:
+            self.error((*path, "after"), "the timeout must be at least 1 ms")
+        return DeviceTimeout(
+            int(value["after"]),
+            tuple(str(n) for n in value["kept_by"]),
+            {str(k): float(v) for k, v in value["sets"].items()},
+            str(value.get("description", "")),
+        )
+
+    def spaces(self, value: dict[str, Any], path: Path) -> dict[str, Space]:
+        found = {}
+        for name, item in value.items():
+            self.name(name, (*path, name), "data space name")
+            if item["size"] < 1:
+                self.error((*path, name, "size"), "a data space holds at least one item")
+            kind = item["type"]
+            found[name] = Space(
+                name,
+                None if kind == "bit" else SCALARS[kind],
+                int(item["size"]),
+                str(item.get("access", "rw")),
+                str(item.get("description", "")),
+            )
+        return found
+
+    def errors(self, value: Any, path: Path, commands: list[Command]) -> DeviceErrors | None:
+        """`errors:` reason -> reply values, each field checked against the error reply (when there is one)."""
+        if value is None:
+            return None
+        reply = next((m for c in commands for m in c.messages() if m.error_reply), None)
+        reasons = {}
+        for reason, values in value.items():
+            for key in values:
+                if reply is not None and key.partition(".")[0] not in {f.name for f in reply.fields}:
+                    self.error((*path, reason, key), f"the error reply {reply.command} has no field {key!r}")
+            reasons[str(reason)] = {str(k): float(v) for k, v in values.items()}
+        if "unsupported" in reasons:
+            if reply is None:
+                self.error((*path, "unsupported"), "`unsupported` needs a command whose response is the `error_reply`")
+            elif self.ctx.framing is not None and self.ctx.framing.classic:
+                self.error(
+                    (*path, "unsupported"), "`unsupported` needs frames the frame engine takes apart (not classic)"
+                )
+        return DeviceErrors(**reasons)
+
+    def space_runs(
+        self, value: Any, names: set[str], request: Message, spaces: dict[str, Space], path: Path
+    ) -> dict[str, SpaceAccess]:
+        """`reads:`/`writes:` given as field -> run of a data space (a list of names is memory, handled above)."""
+        if not isinstance(value, dict):
+            return {}
+        request_names = {f.name for f in request.fields}
+        runs = {}
+        for name, item in value.items():
+            item_path = (*path, name)
+            if name not in names:
+                self.error(item_path, f"{request.command} has no such field {name!r}")
+            if item["space"] not in spaces:
+                self.error((*item_path, "space"), f"unknown data space {item['space']!r} (not in `spaces:`)")
+            for role in ("start", "count"):
+                if item.get(role) and item[role] not in request_names:
+                    self.error((*item_path, role), f"{request.command} request has no field {item[role]!r}")
+            stored = None
+            if "value" in item:
+                try:
+                    stored = expression.parse(item["value"])
+                except expression.ExpressionError as exc:
+                    self.error((*item_path, "value"), str(exc))
+                else:
+                    for used in expression.names(stored):
+                        if used != "current" and used not in request_names:
+                            self.error((*item_path, "value"), f"unknown request field {used!r}")
+            runs[str(name)] = SpaceAccess(str(item["space"]), str(item["start"]), str(item.get("count", "")), stored)
+        return runs
+
+    def keeps(
+        self, value: Any, request_names: Any, entries: Any, path: Path
+    ) -> tuple[str, dict[int, tuple[str, ...]]] | None:
+        """`keeps`: the request field choosing what a reset keeps, and the entries for each of its values."""
+        if value is None:
+            return None
+        field_name = str(value["field"])
+        if field_name not in request_names:
+            self.error((*path, "field"), f"no request field {field_name!r}")
+        table = {int(k): tuple(str(n) for n in names) for k, names in (value.get("entries") or {}).items()}
+        for key, names in table.items():
+            for name in names:
+                if name not in entries:
+                    self.error((*path, "entries", key), f"unknown memory entry {name!r}")
+        return field_name, table
+
+    def moving(
+        self, value: dict[str, Any], path: Path, entries: dict[str, TableEntry], state: dict[str, float]
+    ) -> dict[str, tuple[str, int | None]]:
+        """Entries that report whether a state variable is on its way (a whole entry, or one bit of it)."""
+        found: dict[str, tuple[str, int | None]] = {}
+        for name, item in (value.get("moving") or {}).items():
+            where = (*path, "moving", name)
+            if name not in entries and name not in state:
+                self.error(where, f"unknown memory entry or state variable {name!r}")
+            if item["state"] not in entries and item["state"] not in state:
+                self.error((*where, "state"), f"unknown state variable {item['state']!r}")
+            bit = item.get("bit")
+            entry = entries.get(name)
+            if bit is not None and entry is not None and not 0 <= bit < entry.type.size * 8:
+                self.error((*where, "bit"), f"bit {bit} is outside {name}'s {entry.type.size * 8} bits")
+            found[str(name)] = (str(item["state"]), None if bit is None else int(bit))
+        return found
+
+    def behaviour_extras(
+        self,
+        item: dict[str, Any],
+        path: Path,
+        key: str,
+        request_names: Container[str],
+        response_names: Container[str],
+        variables: Container[str],
+    ) -> dict[str, Any]:
+        """The behaviours that stop, wrap, count, hold, release and carry, each name checked."""
+
+        def known(name: str, where: Path) -> str:
+            if name not in variables:
+                self.error(where, f"unknown state variable {name!r}")
+            return name
+
+        counts = {}
+        for field_name, count in (item.get("counts") or {}).items():
+            if field_name not in response_names:
+                self.error((*path, "counts", field_name), f"{key} has no response field {field_name!r}")
+            counts[str(field_name)] = (known(str(count["state"]), (*path, "counts", field_name)), float(count["per"]))
+        for field_name in item.get("cancel_when") or {}:
+            if field_name not in request_names:
+                self.error((*path, "cancel_when", field_name), f"{key} has no request field {field_name!r}")
+        if "cancel_when" in item and "releases" not in item:
+            self.error((*path, "cancel_when"), "`cancel_when` needs `releases`")
+        for field_name in item.get("broadcast_ignores") or {}:
+            if field_name not in request_names:
+                self.error((*path, "broadcast_ignores", field_name), f"{key} has no request field {field_name!r}")
+        restores: tuple[str, ...] = ()
+        if "restores" in item:
+            area, kept = item["restores"]["memory"], item["restores"].get("except") or ()
+            for index, name in enumerate(kept):
+                known(str(name), (*path, "restores", "except", index))
+            if isinstance(variables, Mapping):  # else the unknown kind was reported already
+                restores = tuple(
+                    name
+                    for name, entry in variables.items()
+                    if isinstance(entry, TableEntry) and entry.memory == area and name not in kept
+                )
+        carries = item.get("carries")
+        carried: list[str] = []
+        if carries:
+            for role in ("command", "content"):
+                if carries[role] not in request_names:
+                    self.error((*path, "carries", role), f"{key} has no request field {carries[role]!r}")
+            coded = {c.name for c in self.ctx.commands if c.code is not None and c.request and not c.subcommands}
+            for name in carries.get("commands") or ():
+                if name not in coded:
+                    self.error((*path, "carries", "commands"), f"unknown command {name!r} (or it has no code)")
+                carried.append(str(name))
+        return {
+            "stops": tuple(known(str(n), (*path, "stops")) for n in item.get("stops") or ()),
+            "wraps": {known(str(n), (*path, "wraps", n)): float(p) for n, p in (item.get("wraps") or {}).items()},
+            "modulo": {known(str(n), (*path, "modulo", n)): float(p) for n, p in (item.get("modulo") or {}).items()},
+            "restores": restores,
+            "refused_while_moving": (
+                known(str(item["refused_while_moving"]), (*path, "refused_while_moving"))
+                if "refused_while_moving" in item
+                else ""
+            ),
+            "broadcast_ignores": {str(k): float(v) for k, v in (item.get("broadcast_ignores") or {}).items()},
+            "counts": counts,
+            "every_device": bool(item.get("every_device", False)),
+            "held_while": known(str(item["held_while"]), (*path, "held_while")) if "held_while" in item else "",
+            "releases": known(str(item["releases"]), (*path, "releases")) if "releases" in item else "",
+            "cancel_when": {str(k): float(v) for k, v in (item.get("cancel_when") or {}).items()},
+            "carries": (str(carries["command"]), str(carries["content"])) if carries else None,
+            "carried": tuple(carried),
+        }
+
+    def models(
+        self, value: dict[str, Any], path: Path, entries: dict[str, TableEntry], state: dict[str, float]
+    ) -> tuple[DeviceModel, ...]:
+        """The device's models, the default first; each value checked against the model's (or the table's) range."""
+        model_entry = str(value.get("model_entry", ""))
+        if model_entry and model_entry not in entries:
+            self.error((*path, "model_entry"), f"unknown memory entry {model_entry!r}")
+        models: list[DeviceModel] = []
+        numbers: dict[int, str] = {}
+        for name, item in (value.get("models") or {}).items():
+            model_path = (*path, "models", name)
+            self.name(name, model_path, "model name")
+            number = int(item["number"])
+            if number in numbers:
+                self.error((*model_path, "number"), f"model number {number} is already used by {numbers[number]!r}")
+            numbers[number] = name
+            overrides = []
+            for entry_name, override in (item.get("entries") or {}).items():
+                entry = entries.get(entry_name)
+                if entry is None:
+                    self.error((*model_path, "entries", entry_name), f"unknown memory entry {entry_name!r}")
+                    continue
+                range_path = (*model_path, "entries", entry_name, "range")
+                low, high = (
+                    self.bounds(entry.type, entry.sign_magnitude, override["range"], range_path, entry.sign_bit)
+                    if "range" in override
+                    else (entry.minimum, entry.maximum)
+                )
+                overrides.append(
+                    ModelEntry(
+                        entry_name,
+                        low,
+                        high,
+                        str(override.get("unit", entry.unit)),
+                        override.get("scale", entry.scale),
+                        str(override.get("description", "")),
+                    )
+                )
+            by_name = {o.name: o for o in overrides}
+            initial = {str(k): float(v) for k, v in (item.get("initial") or {}).items()}
+            if model_entry:
+                initial[model_entry] = float(number)
+            for entry_name, number_value in initial.items():
+                entry_path = (*model_path, "initial", entry_name)
+                if entry_name in state:
+                    continue
+                entry = entries.get(entry_name)
+                if entry is None:
+                    self.error(entry_path, f"unknown memory entry or state variable {entry_name!r}")
+                    continue
+                bounds = by_name.get(entry_name, entry)
+                low, high = bounds.minimum, bounds.maximum
+                if not low <= number_value <= high:
+                    where = (*model_path, "number") if entry_name == model_entry else entry_path
+                    self.error(where, f"{entry_name} = {number_value:g} is outside its range {low:g}..{high:g}")
+            models.append(
+                DeviceModel(
+                    name=name,
+                    number=number,
+                    title=str(item.get("title", "")),
+                    description=str(item.get("description", "")),
+                    source=str(item.get("source", "")),
+                    initial=initial,
+                    entries=tuple(overrides),
+                )
+            )
+        default = value.get("default_model")
+        if default is not None:
+            found = next((m for m in models if m.name == default), None)
+            if found is None:
+                known = ", ".join(m.name for m in models) or "none defined"
+                self.error((*path, "default_model"), f"unknown model {default!r} (expected one of: {known})")
+            else:
+                models.remove(found)
+                models.insert(0, found)
+        return tuple(models)

@@ -1,0 +1,397 @@
+"""The content of messages: fields of every kind, shared fields, counts and sizes derived from fields."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from typing import Any, Literal
+
+from serialspec.lang import expression, grammar
+from serialspec.lang.loader import Path
+from serialspec.lang.model import (
+    SCALARS,
+    Array,
+    BitField,
+    Bytes,
+    Field,
+    Group,
+    List,
+    Scalar,
+    ScalarType,
+    TableBlock,
+    TableValue,
+    Text,
+    sum_sizes,
+)
+from serialspec.lang.passes.base import RESERVED_FIELD_NAMES, Bad, Pass, camel, enum_span
+
+FIELD_KINDS = (
+    *grammar.SCALAR_TYPES,
+    "bytes",
+    "string",
+    "cstring",
+    "array",
+    "group",
+    "table_value",
+    "table_block",
+)
+
+
+class FieldResolver(Pass):
+    """Resolves a message's fields; the commands pass uses it for every message."""
+
+    def check_rest(self, fields: tuple[Field, ...], path: Path) -> None:
+        for field in fields[:-1]:
+            takes_rest = (isinstance(field, Bytes) and field.size == "rest") or (
+                isinstance(field, Group) and field.count == "rest"
+            )
+            if takes_rest:
+                self.error((*path, field.name), "only the last field can take the rest of the content")
+
+    def fields(self, raw: dict[str, Any], path: Path, parent: list[Field] | None) -> tuple[Field, ...]:
+        resolved: list[Field] = []
+        for name, item in raw.items():
+            field_path = (*path, name)
+            self.name(name, field_path, "field name", RESERVED_FIELD_NAMES)
+            if any(f.name == name for f in resolved):
+                self.error(field_path, f"duplicate field {name!r}")
+            field = self.guard(field_path, self.field, name, item, field_path, resolved, parent)
+            if field is not None:
+                resolved.append(field)
+        self.check_values(resolved, path)
+        return tuple(resolved)
+
+    def check_values(self, fields: list[Field], path: Path) -> None:
+        """Every `value:` expression names fields of the same content, and no value depends on itself."""
+        by_name = {f.name: f for f in fields}
+        for field in fields:
+            if not isinstance(field, Scalar) or field.value is None:
+                continue
+            where = (*path, field.name, "value")
+            for name in sorted(set(expression.names(field.value))):
+                other = by_name.get(name)
+                if other is None:
+                    self.error(where, f"unknown field {name!r} in {expression.show(field.value)!r}")
+                elif name == field.name:
+                    self.error(where, f"{field.name} cannot be derived from itself")
+            for node in _nodes(field.value):
+                other = by_name.get(getattr(node, "name", ""))
+                if isinstance(node, expression.Length) and other is not None and not isinstance(other, LISTS):
+                    self.error(where, f"len({node.name}): {node.name} is not a list, bytes or text")
+                integer = isinstance(other, Scalar) and not other.type.is_float
+                if isinstance(node, expression.Name) and other is not None and not integer:
+                    self.error(where, f"{node.name} is not an integer field (use len({node.name}) for its size)")
+        seen: set[str] = set()
+        for field in fields:
+            if isinstance(field, Scalar) and field.value is not None and field.name not in seen:
+                cycle = _cycle(field.name, by_name, [])
+                if cycle:
+                    seen.update(cycle)
+                    chain = " -> ".join(cycle)
+                    self.error((*path, field.name, "value"), f"derived values depend on each other: {chain}")
+
+    def expand(self, item: Any, path: Path) -> dict[str, Any]:
+        """A field's mapping, with the short forms and `use:` references expanded."""
+        if isinstance(item, str):
+            if item in FIELD_KINDS:
+                return {"type": item}
+            if item in self.shared_fields:
+                return self.expand(self.shared_fields[item], ("fields", item))
+            raise self.fail(
+                path,
+                f"unknown type {item!r} (expected one of {', '.join(FIELD_KINDS)}, or a field from `fields:`)",
+            )
+        if not isinstance(item, dict):
+            raise Bad  # neither a type name nor a mapping: the structural check has said so
+        spec = dict(item)
+        if "use" in spec:
+            base_name = spec.pop("use")
+            if base_name not in self.shared_fields:
+                known = ", ".join(self.shared_fields) or "none defined"
+                raise self.fail((*path, "use"), f"unknown shared field {base_name!r} (expected one of: {known})")
+            spec = {**self.expand(self.shared_fields[base_name], ("fields", base_name)), **spec}
+        if "type" not in spec:
+            raise self.fail(path, "missing key 'type'")
+        return spec
+
+    def field(self, name: str, item: Any, path: Path, siblings: list[Field], parent: list[Field] | None) -> Field:
+        spec = self.expand(item, path)
+        kind = spec["type"]
+        common = dict(
+            name=name,
+            description=str(spec.get("description", "")),
+            description_cn=str(spec.get("description_cn", "")),
+            inferred=str(spec.get("inferred", "")),
+        )
+        endian: Literal["<", ">"] = {"little": "<", "big": ">"}.get(spec.get("endian", ""), self.endian)  # type: ignore[assignment]
+        if kind in SCALARS:
+            return self.scalar(common, spec, path, endian)
+        if kind == "bytes":
+            size = spec.get("size")
+            if size is None:
+                raise self.fail(path, "bytes need `size`: a number, `rest`, or a field name")
+            if isinstance(size, int) and size < 1:
+                raise self.fail((*path, "size"), f"size {size}: bytes of a fixed size hold at least one byte")
+            table = self.reference("table", self.tables, spec.get("table"), (*path, "table"))
+            if isinstance(size, str) and size != "rest":
+                self.size_field(size, name, siblings, parent, path)
+            size_from = str(spec.get("size_from", ""))
+            if size_from and (size != "rest" or not size_from.startswith("request.")):
+                self.error((*path, "size_from"), "`size_from: request.<field>` goes with `size: rest`")
+            start = str(spec.get("start", ""))
+            if start and table is None:
+                self.error((*path, "start"), "`start` goes with `table:` (the bytes are a run of its registers)")
+            if start and not start.startswith("request."):
+                earlier = [f for f in (*siblings, *(parent or ())) if f.name == start]
+                if not earlier or not isinstance(earlier[0], Scalar) or earlier[0].type.is_float:
+                    raise self.fail(
+                        (*path, "start"), f"unknown field {start!r}: `start` names an earlier integer field"
+                    )
+            return Bytes(
+                **common,
+                size=size,
+                table=table,
+                start=start.removeprefix("request."),
+                start_in_request=start.startswith("request."),
+                size_from=size_from.removeprefix("request."),
+            )
+        if kind in ("string", "cstring"):
+            size = spec.get("size")
+            if kind == "cstring":
+                if size is not None:
+                    self.error((*path, "size"), "a cstring ends at its NUL byte: it takes no `size`")
+                return Text(**common, size=None)
+            if size is None:
+                raise self.fail(path, "a string needs `size`: a number, `rest`, or a field name (or use cstring)")
+            if isinstance(size, str) and size != "rest":
+                self.size_field(size, name, siblings, parent, path)
+            return Text(**common, size=size)
+        if kind == "array" and (spec.get("of") == "bit" or not isinstance(spec.get("count"), int) or "size" in spec):
+            return self.list_field(common, spec, path, endian, siblings)
+        if kind == "array":
+            item_type = self.scalar_type(spec.get("of"), (*path, "of"))
+            count = spec.get("count")
+            if not isinstance(count, int) or count < 1:
+                raise self.fail((*path, "count"), "an array needs a fixed `count` (use a group for counted items)")
+            low, high = self.bounds(item_type, False, spec.get("range"), (*path, "range"))
+            return Array(
+                **common,
+                item=item_type,
+                endian=endian,
+                count=count,
+                unit=str(spec.get("unit", "")),
+                minimum=low,
+                maximum=high,
+            )
+        if kind == "group":
+            count = spec.get("count")
+            if count is None:
+                raise self.fail(path, "a group needs `count`: a number, `rest`, or the name of an earlier count field")
+            if not isinstance(spec.get("fields"), dict):
+                raise self.fail(path, "a group needs `fields:` (a mapping of its item's fields)")
+            if not spec["fields"]:
+                raise self.fail((*path, "fields"), "a group needs at least one field in each item")
+            inner = self.fields(spec["fields"], (*path, "fields"), parent=siblings)
+            if isinstance(count, str) and count != "rest":
+                self.derive(count, ("count", name), siblings, path)
+            item_size = sum_sizes(inner)
+            class_name = self.class_name(camel(name, "item"), path)
+            return Group(**common, class_name=class_name, count=count, fields=inner, item_size=item_size)
+        if kind == "table_value":
+            table = self.reference("table", self.tables, spec.get("table"), (*path, "table"))
+            key = spec.get("key")
+            if table is None or not any(f.name == key for f in siblings):
+                raise self.fail(path, "a table_value needs `table:` and `key:` naming an earlier field")
+            return TableValue(**common, table=table, key=str(key))
+        if kind == "table_block":
+            table = self.reference("table", self.tables, spec.get("table"), (*path, "table"))
+            if table is None:
+                raise self.fail(path, "a table_block needs `table:`")
+            select = spec.get("select") or {}
+            entries = tuple(
+                e for e in table.entries if all(str(getattr(e, k, None)) == str(v) for k, v in select.items())
+            )
+            size = sum(e.type.size for e in entries)
+            expected = spec.get("expect_size")
+            if expected is not None and size != expected:
+                self.error((*path, "expect_size"), f"the selected entries take {size} bytes, not {expected}")
+            class_name = self.class_name(camel(name), path, identity=("table_block", table.name, entries))
+            struct_name = self.class_name(f"{class_name}Block", path, identity=("table_block", table.name, entries))
+            return TableBlock(
+                **common, table=table, class_name=class_name, entries=entries, endian=endian, struct_name=struct_name
+            )
+        raise self.fail((*path, "type"), f"unknown type {kind!r} (expected one of {', '.join(FIELD_KINDS)})")
+
+    def list_field(
+        self, common: dict[str, Any], spec: dict[str, Any], path: Path, endian: Literal["<", ">"], siblings: list[Field]
+    ) -> List:
+        """An array whose count varies (a count field, a byte-size field, the rest), or an array of bits."""
+        name = common["name"]
+        bits = spec.get("of") == "bit"
+        item_type = None if bits else self.scalar_type(spec.get("of"), (*path, "of"))
+        count = spec.get("count", "")
+        size = spec.get("size", "")
+        if bool(count) == bool(size):
+            raise self.fail(path, "an array of varying size needs `count` (items) or `size` (a byte-size field)")
+        if isinstance(count, int) and count < 1:
+            raise self.fail((*path, "count"), "an array's count must be at least 1")
+        if size and not isinstance(size, str) or size == "rest":
+            raise self.fail((*path, "size"), "an array's `size` names the earlier field holding its size in bytes")
+        if isinstance(count, str) and count not in ("", "rest"):
+            self.derive(count, ("count", name), siblings, path)
+        if size:
+            self.derive(size, ("size", name), siblings, path)
+        if bits:
+            if "range" in spec:
+                self.error((*path, "range"), "bits are true or false: no range")
+            low, high = 0.0, 1.0
+        else:
+            assert item_type is not None
+            low, high = self.bounds(item_type, False, spec.get("range"), (*path, "range"))
+        return List(
+            **common,
+            item=item_type,
+            endian=endian,
+            count=count,
+            size=str(size),
+            unit=str(spec.get("unit", "")),
+            minimum=low,
+            maximum=high,
+            count_from=self.count_from(spec.get("count_from"), (*path, "count_from")),
+        )
+
+    def count_from(self, value: Any, path: Path) -> str:
+        if value is None:
+            return ""
+        if not str(value).startswith("request."):
+            self.error(path, "`count_from` names a field of the request: request.<field>")
+        return str(value).removeprefix("request.")
+
+    def value_expression(self, text: Any, path: Path) -> expression.Expr | None:
+        if text is None:
+            return None
+        try:
+            return expression.parse(text)
+        except expression.ExpressionError as exc:
+            raise self.fail(path, str(exc)) from None
+
+    def scalar(self, common: dict[str, Any], spec: dict[str, Any], path: Path, endian: Literal["<", ">"]) -> Scalar:
+        scalar = SCALARS[spec["type"]]
+        sign_magnitude = spec.get("encoding") == "sign_magnitude"
+        low, high = self.bounds(scalar, sign_magnitude, spec.get("range"), (*path, "range"))
+        value_enum = self.reference("enum", self.enums, spec.get("enum"), (*path, "enum"))
+        if value_enum is not None and spec.get("range") is None:
+            low, high = enum_span(value_enum, low, high)
+        const = spec.get("const")
+        if const is not None and not low <= const <= high:
+            self.error((*path, "const"), f"constant {const} is outside {low:g}..{high:g}")
+        if spec.get("scale") == 0:
+            self.error((*path, "scale"), "scale 0 would make every value 0 (give the size of one wire step)")
+        default = spec.get("default")
+        if default is not None and not low <= default <= high:
+            self.error((*path, "default"), f"default {default} is outside the range {low:g}..{high:g}")
+        bits: list[BitField] = []
+        used = 0
+        for bit_name, bit_spec in (spec.get("bits") or {}).items():
+            bit_path = (*path, "bits", bit_name)
+            self.name(bit_name, bit_path, "bit field name")
+            where = bit_spec["bits"]
+            high_bit, low_bit = (where, where) if isinstance(where, int) else (where[0], where[1])
+            if not 0 <= low_bit <= high_bit < scalar.size * 8:
+                self.error(bit_path, f"bits {high_bit}..{low_bit} do not fit a {scalar.name}")
+                continue
+            mask = ((1 << (high_bit - low_bit + 1)) - 1) << low_bit
+            if used & mask:
+                self.error(bit_path, "overlaps another bit field")
+            used |= mask
+            enum = self.reference("enum", self.enums, bit_spec.get("enum"), (*bit_path, "enum"))
+            bits.append(BitField(bit_name, high_bit, low_bit, enum, str(bit_spec.get("description", ""))))
+        if bits and (scalar.is_float or scalar.signed):
+            self.error((*path, "bits"), "bit fields need an unsigned integer type")
+        return Scalar(
+            **common,
+            type=scalar,
+            endian=endian,
+            unit=str(spec.get("unit", "")),
+            scale=spec.get("scale"),
+            minimum=low,
+            maximum=high,
+            const=const,
+            default=default,
+            enum=value_enum,
+            flags=self.reference("flags", self.flags, spec.get("flags"), (*path, "flags")),
+            bits=tuple(bits),
+            bits_class=self.class_name(camel(common["name"], "bits"), path) if bits else "",
+            sign_magnitude=sign_magnitude,
+            status_ok=self.status_ok(spec.get("status"), scalar, low, high, (*path, "status")),
+            value=self.derived_value(spec, scalar, path),
+        )
+
+    def derived_value(self, spec: dict[str, Any], scalar: ScalarType, path: Path) -> expression.Expr | None:
+        value = self.value_expression(spec.get("value"), (*path, "value"))
+        if value is not None:
+            if scalar.is_float:
+                self.error((*path, "value"), "a derived value needs an integer type")
+            for other in ("const", "default", "bits", "enum", "flags"):
+                if other in spec:
+                    self.error((*path, other), f"a derived value (`value:`) takes no `{other}`")
+        return value
+
+    def status_ok(self, status: Any, scalar: ScalarType, low: float, high: float, path: Path) -> int | None:
+        if status is None:
+            return None
+        ok = int(status["ok"])
+        if scalar.is_float:
+            self.error(path, "a status needs an integer type")
+        elif not low <= ok <= high:
+            self.error((*path, "ok"), f"{ok} is outside the field's range {low:g}..{high:g}")
+        return ok
+
+    def derive(self, name: str, derivation: tuple[str, ...], siblings: list[Field], path: Path) -> None:
+        for index, field in enumerate(siblings):
+            if field.name == name:
+                if isinstance(field, Scalar) and field.value is not None and not field.derived:
+                    return  # derived by its own expression, which decoding checks
+                if not isinstance(field, Scalar) or field.type.is_float or field.hidden:
+                    raise self.fail(path, f"{name!r} must be an earlier integer field that nothing else derives")
+                siblings[index] = replace(field, derived=derivation)
+                return
+        raise self.fail(path, f"unknown field {name!r}: a count or size must be an earlier field of the same content")
+
+    def size_field(self, size: str, name: str, siblings: list[Field], parent: list[Field] | None, path: Path) -> None:
+        """Bytes sized by a field: inside a group, a field before the group sets the size of every item."""
+        if parent is not None and any(f.name == size for f in parent):
+            self.derive(size, ("size", name), parent, path)
+        else:
+            self.derive(size, ("size", name), siblings, path)
+
+
+LISTS = (Array, List, Bytes, Text, Group)
+
+
+def _nodes(expr: expression.Expr) -> list[expression.Expr]:
+    """Every node of an expression tree."""
+    found: list[expression.Expr] = [expr]
+    if isinstance(expr, expression.BinOp):
+        found += _nodes(expr.left) + _nodes(expr.right)
+    elif isinstance(expr, expression.Ceil):
+        found += _nodes(expr.numerator) + _nodes(expr.denominator)
+    elif isinstance(expr, expression.MinMax):
+        for arg in expr.args:
+            found += _nodes(arg)
+    elif isinstance(expr, expression.Invert):
+        found += _nodes(expr.operand)
+    return found
+
+
+def _cycle(name: str, fields: dict[str, Field], trail: list[str]) -> list[str]:
+    """A chain of `value:` expressions from `name` back to a field already on the trail, or []."""
+    if name in trail:
+        return [*trail[trail.index(name) :], name]
+    field = fields.get(name)
+    if not isinstance(field, Scalar) or field.value is None:
+        return []
+    for other in expression.names(field.value):
+        found = _cycle(other, fields, [*trail, name])
+        if found:
+            return found
+    return []

@@ -1,0 +1,348 @@
+"""The frame around every message: elements, alternative layouts, lengths over spans, checksums, transparency.
+
+Every layout is described completely by its elements; the classic fields of FrameLayout (offsets from the header,
+a one-byte length, one final checksum) are filled in too, and `classic` says whether they describe the whole frame.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from typing import Any, Literal
+
+from serialspec.lang.errors import SpecError
+from serialspec.lang.loader import Path
+from serialspec.lang.model import (
+    Checksum,
+    Crc,
+    Direction,
+    FrameElement,
+    FrameLayout,
+    Framing,
+    ScalarType,
+    Transparency,
+)
+from serialspec.lang.passes.fields import FieldResolver
+from serialspec.runtime.hexbytes import parse_hex
+
+CONSTANT_ROLES = ("header", "trailer", "constant")
+_CLASSIC_ROLES = {"header", "address", "command", "status", "length", "content", "checksum"}
+
+
+class FramingPass(FieldResolver):
+    """Resolve `framing:` into the layouts of each direction (a field resolver for the elements' bit fields)."""
+
+    def run(self) -> list[SpecError]:
+        self.ctx.framing = self.guard(("framing",), self.framing, self.ctx.data.get("framing") or {}, ("framing",))
+        return self.problems
+
+    def framing(self, value: dict[str, Any], path: Path) -> Framing:
+        if "layouts" in value and "elements" in value:
+            raise self.fail(path, "give either `elements` (one layout) or `layouts` (alternatives), not both")
+        if "layouts" in value:
+            raw_layouts = {
+                name: (item.get("elements") or {}, (*path, "layouts", name, "elements"))
+                for name, item in value["layouts"].items()
+            }
+            if not raw_layouts:
+                raise self.fail((*path, "layouts"), "give at least one layout")
+        elif "elements" in value:
+            raw_layouts = {"": (value["elements"], (*path, "elements"))}
+        else:
+            raise self.fail(path, "missing key 'elements' (or 'layouts')")
+        transparency = value.get("transparency")
+        alternatives: dict[Direction, list[FrameLayout]] = {d: [] for d in Direction}
+        for layout_name, (raw, elements_path) in raw_layouts.items():
+            elements = [
+                (name, item, self.frame_element(name, item, (*elements_path, name))) for name, item in raw.items()
+            ]
+            for direction in Direction:
+                alternatives[direction].append(
+                    self.layout(direction, layout_name, elements, transparency, elements_path, path)
+                )
+        for direction, layouts in alternatives.items():
+            if len(layouts) > 1:
+                headers = [layout.header for layout in layouts]
+                if not all(headers) or len(set(headers)) != len(headers):
+                    raise self.fail(
+                        (*path, "layouts"),
+                        f"alternative {direction.value} layouts must start with different headers",
+                    )
+                values = {tuple(e.name for e in layout.value_elements) for layout in layouts}
+                if len(values) != 1:
+                    raise self.fail((*path, "layouts"), "alternative layouts must carry the same address/status")
+        first = {d: layouts[0] for d, layouts in alternatives.items()}
+        checksums = first[Direction.REQUEST].checksums or first[Direction.RESPONSE].checksums
+        return Framing(
+            description=str(value.get("description", "")),
+            layouts=first,
+            checksum=checksums[0] if checksums else None,
+            shared_header=first[Direction.REQUEST].header == first[Direction.RESPONSE].header,
+            alternatives={d: tuple(layouts) for d, layouts in alternatives.items()},
+            gap=float(value.get("gap", 0.0)),
+        )
+
+    def frame_element(self, name: str, item: dict[str, Any], path: Path) -> FrameElement:
+        """The element as declared (both directions); `layout` makes each direction's copy."""
+        self.name(name, path, "frame element")
+        role = item["role"]
+        directions = tuple(Direction(d) for d in item.get("directions", ("request", "response")))
+        endian: Literal["<", ">"] = ">" if item.get("endian") == "big" else "<"
+        scalar: ScalarType | None = None
+        size: int | None = None
+        if role not in CONSTANT_ROLES and role != "content":
+            scalar = self.scalar_type(item.get("type", "u8"), (*path, "type"), allow_float=False)
+            size = scalar.size
+        elif "type" in item:
+            self.error((*path, "type"), f"a {role} has no type")
+        if role in CONSTANT_ROLES and "value" not in item:
+            raise self.fail(path, f"a {role} needs `value`: hex bytes, or a mapping by direction")
+        low, high = (scalar.minimum, scalar.maximum) if scalar else (0.0, 0.0)
+        if "range" in item and scalar:
+            low, high = self.bounds(scalar, False, item["range"], (*path, "range"))
+        broadcast = item.get("broadcast")
+        if broadcast is not None and scalar is not None and not scalar.minimum <= broadcast <= scalar.maximum:
+            self.error((*path, "broadcast"), f"broadcast {broadcast} does not fit {scalar.name}")
+        bits: tuple[Any, ...] = ()
+        bits_class = ""
+        if "bits" in item and scalar is not None:
+            common = {"name": name, "description": "", "description_cn": "", "inferred": ""}
+            resolved = self.scalar(common, {"type": scalar.name, "bits": item["bits"]}, path, endian)
+            bits, bits_class = resolved.bits, resolved.bits_class
+        checksum = self.checksum(item, name, scalar, endian, path) if role == "checksum" and scalar else None
+        for key, allowed in (("adds", "length"), ("counts", "length"), ("covers", "checksum")):
+            if key in item and role != allowed:
+                self.error((*path, key), f"`{key}` belongs to a {allowed} element")
+        return FrameElement(
+            name=name,
+            role=role,
+            type=scalar,
+            size=size,
+            directions=directions,
+            description=str(item.get("description", "")),
+            minimum=low,
+            maximum=high,
+            broadcast=item.get("broadcast"),
+            flags=self.reference("flags", self.flags, item.get("flags"), (*path, "flags")),
+            endian=endian,
+            bits=bits,
+            bits_class=bits_class,
+            adds=int(item.get("adds", 0)),
+            checksum=checksum,
+        )
+
+    def checksum(
+        self, item: dict[str, Any], name: str, scalar: ScalarType, endian: Literal["<", ">"], path: Path
+    ) -> Checksum:
+        if not item.get("covers"):
+            raise self.fail(path, "a checksum needs `covers: [first, last]` (frame element names)")
+        algorithm = item.get("algorithm")
+        crc = None
+        if algorithm == "crc":
+            params = item.get("crc")
+            if not params:
+                raise self.fail(path, "algorithm crc needs `crc:` with width, poly, init, refin, refout, xorout, check")
+            crc = Crc(
+                str(params.get("name", "")),
+                params["width"],
+                params["poly"],
+                params["init"],
+                params["refin"],
+                params["refout"],
+                params["xorout"],
+                params["check"],
+            )
+            if crc.width != scalar.size * 8:
+                raise self.fail((*path, "crc", "width"), f"a {crc.width}-bit CRC does not fill a {scalar.name}")
+            for key in ("poly", "init", "xorout", "check"):
+                if not 0 <= params[key] < 1 << crc.width:
+                    raise self.fail((*path, "crc", key), f"{key} {params[key]} does not fit {crc.width} bits")
+            from serialspec.runtime.checksums import crc_function
+
+            computed = crc_function(crc.width, crc.poly, crc.init, crc.refin, crc.refout, crc.xorout)(b"123456789")
+            if computed != crc.check:
+                self.error(
+                    (*path, "crc", "check"),
+                    f"these parameters give {computed:#x} for '123456789', not the check value {crc.check:#x}",
+                )
+        elif algorithm not in ("sum", "xor"):
+            raise self.fail(path, "a checksum needs `algorithm: sum`, `algorithm: xor` or `algorithm: crc`")
+        # the span is resolved per direction (`covers` may be given by direction); first/last filled in by layout
+        return Checksum(algorithm, bool(item.get("invert", False)), crc, "", "", scalar, endian, name)
+
+    def span(
+        self, raw: Any, direction: Direction, names: list[str], path: Path, default: tuple[str, str] | None = None
+    ) -> tuple[str, str]:
+        """A `[first, last]` span, or a mapping direction -> span, checked against this direction's elements."""
+        if raw is None:
+            if default is None:
+                raise self.fail(path, "missing span: give [first, last] frame element names")
+            return default
+        if isinstance(raw, dict):
+            if direction.value not in raw:
+                raise self.fail(path, f"no span given for {direction.value}")
+            raw, path = raw[direction.value], (*path, direction.value)
+        if not isinstance(raw, list) or len(raw) != 2 or not all(isinstance(n, str) for n in raw):
+            raise self.fail(path, "expected [first, last]: two frame element names")
+        for name in raw:
+            if name not in names:
+                raise self.fail(
+                    path, f"unknown frame element {name!r} in the {direction.value} frame (it has {', '.join(names)})"
+                )
+        if names.index(raw[0]) > names.index(raw[1]):
+            raise self.fail(path, f"{raw[0]!r} comes after {raw[1]!r}")
+        return raw[0], raw[1]
+
+    def layout(
+        self,
+        direction: Direction,
+        layout_name: str,
+        declared: list[tuple[str, dict[str, Any], FrameElement]],
+        transparency_raw: Any,
+        elements_path: Path,
+        framing_path: Path,
+    ) -> FrameLayout:
+        elements: list[FrameElement] = []
+        raws: dict[str, dict[str, Any]] = {}
+        for name, item, element in declared:
+            if direction not in element.directions:
+                continue
+            raws[name] = item
+            value = item.get("value")
+            text = value if isinstance(value, str) else value.get(direction.value) if isinstance(value, dict) else None
+            if text is None and element.role in CONSTANT_ROLES:
+                raise self.fail((*elements_path, name, "value"), f"no {element.role} given for {direction.value}")
+            if text is not None:
+                try:
+                    constant = parse_hex(text)
+                    if not constant:
+                        raise ValueError(f"a {element.role} needs at least one byte")
+                except ValueError as exc:
+                    raise self.fail((*elements_path, name, "value"), str(exc)) from None
+                role = element.role if element.role in CONSTANT_ROLES else "constant"
+                element = replace(element, role=role, constant=constant, size=len(constant), type=None)
+            elements.append(element)
+        names = [e.name for e in elements]
+        roles = [e.role for e in elements]
+        where = f"the {direction.value} frame" + (f" of layout {layout_name!r}" if layout_name else "")
+        if not elements:
+            raise self.fail(elements_path, f"{where} has no elements")
+        for role in ("content", "command", "length"):
+            if roles.count(role) > 1:
+                raise self.fail(elements_path, f"{where} has more than one {role} element")
+        if "header" in roles[1:]:
+            raise self.fail(elements_path, f"a header must be the first element of {where}")
+        if "trailer" in roles[:-1]:
+            raise self.fail(elements_path, f"a trailer must be the last element of {where}")
+        content_index = roles.index("content") if "content" in roles else -1
+        # transparency
+        transparency = None
+        if transparency_raw is not None:
+            t_path: Path = (*framing_path, "transparency")
+            first, last = self.span(transparency_raw.get("span"), direction, names, (*t_path, "span"))
+            pairs = []
+            for plain, wire in (transparency_raw.get("replace") or {}).items():
+                try:
+                    pairs.append((parse_hex(str(plain)), parse_hex(str(wire))))
+                except ValueError as exc:
+                    raise self.fail((*t_path, "replace", plain), str(exc)) from None
+            if not pairs or any(not p or not w for p, w in pairs):
+                raise self.fail((*t_path, "replace"), "give plain -> wire byte sequences, none empty")
+            if not names.index(first) <= content_index <= names.index(last):
+                raise self.fail((*t_path, "span"), "the transparency span must hold the content")
+            transparency = Transparency(first, last, tuple(pairs), str(transparency_raw.get("description", "")))
+        t_first, t_last = (
+            (names.index(transparency.first), names.index(transparency.last)) if transparency else (-1, -1)
+        )
+
+        def overlaps_badly(a: int, b: int) -> bool:
+            inside = t_first <= a and b <= t_last
+            holds = a <= t_first and t_last <= b
+            apart = b < t_first or a > t_last
+            return transparency is not None and not (inside or holds or apart)
+
+        # lengths and checksums: their spans
+        for index, element in enumerate(elements):
+            item = raws[element.name]
+            e_path: Path = (*elements_path, element.name)
+            if element.role == "length":
+                default = (names[content_index], names[content_index]) if content_index >= 0 else None
+                counts = self.span(item.get("counts"), direction, names, (*e_path, "counts"), default)
+                a, b = names.index(counts[0]), names.index(counts[1])
+                if index >= a or (transparency and index >= t_first):
+                    raise self.fail(e_path, "the length must come before what it counts (and before any stuffing)")
+                if overlaps_badly(a, b):
+                    raise self.fail((*e_path, "counts"), "the counted span must hold the transparency span or miss it")
+                elements[index] = replace(element, counts=counts)
+            elif element.role == "checksum" and element.checksum is not None:
+                covers = self.span(item.get("covers"), direction, names, (*e_path, "covers"))
+                a, b = names.index(covers[0]), names.index(covers[1])
+                if a <= index <= b:
+                    raise self.fail((*e_path, "covers"), "a checksum cannot cover itself")
+                if overlaps_badly(a, b):
+                    raise self.fail((*e_path, "covers"), "the covered span must hold the transparency span or miss it")
+                checksum = replace(element.checksum, first=covers[0], last=covers[1])
+                elements[index] = replace(element, checksum=checksum)
+        checksums = tuple(e.checksum for e in elements if e.checksum is not None)
+        return self.classic_fields(direction, layout_name, tuple(elements), transparency, checksums)
+
+    def classic_fields(
+        self,
+        direction: Direction,
+        layout_name: str,
+        elements: tuple[FrameElement, ...],
+        transparency: Transparency | None,
+        checksums: tuple[Checksum, ...],
+    ) -> FrameLayout:
+        roles = [e.role for e in elements]
+        names = [e.name for e in elements]
+        content_index = roles.index("content") if "content" in roles else len(elements)
+        length = next((e for e in elements if e.role == "length"), None)
+        final = elements[-1] if elements else None  # none: an error said so already
+        classic = (
+            not layout_name
+            and transparency is None
+            and set(roles) <= _CLASSIC_ROLES
+            and roles.count("header") == 1
+            and roles[0] == "header"
+            and "content" in roles
+            and length is not None
+            and length.size == 1
+            and length.counts == (names[content_index], names[content_index])
+            and roles.index("length") < content_index
+            and len(checksums) == 1
+            and final is not None
+            and final.role == "checksum"
+            and (final.size == 1 or final.endian == "<")
+            and names.index(checksums[0].first) <= content_index <= names.index(checksums[0].last)
+            and all((e.size or 0) <= 1 or e.endian == "<" for e in elements)
+        )
+        offsets: dict[str, int] = {}
+        position = 0
+        for element in elements[:content_index]:
+            offsets[element.name] = position
+            position += element.size or 0
+        if content_index < len(elements):
+            offsets[elements[content_index].name] = position
+        overhead = sum(e.size or 0 for e in elements)
+        covered_from = covered_to_end = 0
+        if checksums and checksums[0].first in offsets:
+            covered_from = offsets[checksums[0].first]
+            covered_to_end = sum(e.size or 0 for e in elements[names.index(checksums[0].last) + 1 :])
+        return FrameLayout(
+            direction=direction,
+            header=elements[0].constant if roles and roles[0] == "header" else b"",
+            elements=elements,
+            offsets=offsets,
+            overhead=overhead,
+            length_offset=offsets.get(length.name, -1) if length else -1,
+            length_adds=length.adds if length else 0,
+            command_offset=offsets.get(names[roles.index("command")]) if "command" in roles else None,
+            checksum_offset_from_end=final.size or 1 if final is not None and final.role == "checksum" else 0,
+            covered_from=covered_from,
+            covered_to_end=covered_to_end,
+            value_elements=tuple(e for e in elements if e.role in ("address", "status")),
+            name=layout_name,
+            transparency=transparency,
+            checksums=checksums,
+            classic=classic,
+        )

@@ -15,12 +15,22 @@ from serialspec.lang.frozen import frozen
 from serialspec.lang.model import Protocol
 
 
+class Unsupported(Exception):
+    """A spec feature a target cannot generate yet; its message names the feature in one line.
+
+    `serialspec generate --target NAME` refuses the spec with it; a run of every target leaves that target's files
+    out for the spec (the other targets are still written)."""
+
+
 @frozen
 class Emitter:
     name: str
     files: Callable[[Protocol], dict[str, str]]  # path relative to generated/ -> text
     # Checks of the spec that need this target's output (the Python target runs the examples through its codec).
     verify: Callable[[Protocol, dict[str, str]], list[SpecError]] | None = None
+    # The folder under the project's generated/ that holds this target's files (`--target NAME --out DIR` writes
+    # them to DIR without it): "" when the paths need none.
+    folder: str = ""
 
 
 @cache

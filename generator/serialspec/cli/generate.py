@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import argparse
 import sys
+from dataclasses import replace
 from pathlib import Path
 
-from serialspec.cli.project import expected_files, orphans, project
+from serialspec.cli.project import Project, expected_files, orphans, project, target_files
 from serialspec.runtime.errors import SerialspecError
 
 
@@ -16,11 +17,33 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--root", type=Path, help="project root (default: the nearest folder with a [tool.serialspec] table or specs/)"
     )
+    parser.add_argument(
+        "--target",
+        metavar="NAME",
+        help="only this target's files (c, python, markdown, ...), written to DIR/<protocol>/ (--out DIR; default: "
+        "the target's folder of the project's output); default: every target",
+    )
 
 
-def run(args: argparse.Namespace) -> int:
-    proj = project(args.root, args.specs, args.out)
-    files, errors = expected_files(proj)
+def run_target(proj: Project, target: str, out_given: bool) -> int:
+    """One target's files, into the output folder as given (no orphans removed: the folder may hold other files)."""
+    from serialspec.backends import emitters
+
+    chosen = next((e for e in emitters() if e.name == target), None)
+    if chosen is None:
+        names = ", ".join(e.name for e in emitters())
+        raise SerialspecError(f"no target {target!r}: the targets are {names}")
+    if not out_given and chosen.folder:
+        proj = replace(proj, out=proj.out / chosen.folder)
+    files, errors = target_files(proj, target)
+    written = _write(files)
+    print(f"{len(files)} {target} files generated in {proj.display(proj.out)}, {written} changed")
+    for error in errors:
+        print(error, file=sys.stderr)
+    return 1 if errors else 0
+
+
+def _write(files: dict[Path, str]) -> int:
     written = 0
     for path, text in files.items():
         try:
@@ -30,6 +53,15 @@ def run(args: argparse.Namespace) -> int:
                 written += 1
         except OSError as exc:
             raise SerialspecError(f"cannot write {path}: {exc.strerror or exc}") from None
+    return written
+
+
+def run(args: argparse.Namespace) -> int:
+    proj = project(args.root, args.specs, args.out)
+    if args.target:
+        return run_target(proj, args.target, bool(args.out))
+    files, errors = expected_files(proj)
+    written = _write(files)
     removed = orphans(proj, files, {e.file for e in errors})
     for path in removed:
         path.unlink()

@@ -173,7 +173,7 @@ def spec_outputs(spec: Path, display: str, *, with_data: bool = False) -> Output
 @without_cycle_collection  # the emitters' imports (first spec), rendering and the examples' checks too
 def _generate(raw: bytes, display: str, key: bytes) -> Outputs:
     """Load and resolve one spec, run every emitter over it and check its examples and errata (raises SpecErrors)."""
-    from serialspec.backends import emitters
+    from serialspec.backends import Unsupported, emitters
     from serialspec.lang.loader import decode_text, load_text
     from serialspec.lang.resolve import resolve
 
@@ -182,12 +182,48 @@ def _generate(raw: bytes, display: str, key: bytes) -> Outputs:
     files: dict[str, str] = {}
     errors: list[SpecError] = []
     for emitter in emitters():
-        emitted = emitter.files(protocol)
+        try:
+            emitted = emitter.files(protocol)
+        except Unsupported:  # a target that cannot generate this spec yet: its files left out (--target says why)
+            continue
+        emitted = {f"{emitter.folder}/{path}" if emitter.folder else path: text for path, text in emitted.items()}
         files.update(emitted)
         if emitter.verify is not None:
             errors.extend(emitter.verify(protocol, emitted))
     files[f"{protocol.name}/{SHIPPED_SPEC}"] = shipped_spec(protocol.spec_path, raw)
     return Outputs(files, errors, located.data, key)
+
+
+def target_files(proj: Project, target: str) -> tuple[dict[Path, str], list[SpecError]]:
+    """One target's files for the project's specs, by path under the output folder without the target's own folder
+    (`serialspec generate --target c --out DIR` writes DIR/<protocol>/...); SerialspecError when the target cannot
+    generate a spec yet, naming the feature."""
+    from serialspec.backends import Unsupported, emitters
+    from serialspec.lang.loader import decode_text, load_text
+    from serialspec.lang.resolve import resolve
+    from serialspec.runtime.errors import SerialspecError
+
+    emitter = next(e for e in emitters() if e.name == target)
+    files: dict[Path, str] = {}
+    errors: list[SpecError] = []
+    for spec in proj.specs:
+        display = proj.display(spec)
+        try:
+            raw = spec.read_bytes()
+        except OSError as exc:
+            errors.append(SpecError(display, 1, 1, "", f"cannot read the spec: {exc.strerror or exc}"))
+            continue
+        try:
+            protocol = resolve(load_text(decode_text(raw, display), display))
+        except SpecErrors as exc:
+            errors.extend(exc.errors)
+            continue
+        try:
+            emitted = emitter.files(protocol)
+        except Unsupported as exc:
+            raise SerialspecError(f"{display}: the {target} target does not support {exc} yet") from None
+        files.update({proj.out / path: text for path, text in emitted.items()})
+    return files, errors
 
 
 def _schema() -> str:
@@ -229,12 +265,13 @@ def generated_from(path: Path) -> str | None:
 def orphans(proj: Project, files: dict[Path, str], failed: set[str]) -> list[Path]:
     """Generated files in the output folder that no spec produces any more (a renamed or deleted protocol).
 
-    Only files that carry the generated header count, one folder deep (DIR/<package>/, DIR/docs/); with specs named
+    Only files that carry the generated header count, one or two folders deep (DIR/<package>/, DIR/docs/,
+    DIR/c/<protocol>/); with specs named
     on the command line, only files generated from those specs (or from spec files that no longer exist).
     """
     chosen = {proj.display(s) for s in proj.specs}
     found = []
-    for path in sorted(proj.out.glob("*/*")):
+    for path in sorted([*proj.out.glob("*/*"), *proj.out.glob("*/*/*")]):  # packages, docs/; a target's folder
         if not path.is_file() or path in files:
             continue
         spec = generated_from(path)

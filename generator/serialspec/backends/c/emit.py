@@ -1,0 +1,879 @@
+"""The C99 target: one folder per protocol with `<p>.h`, `<p>.c` (types, encoders, decoders, checksums, the
+incremental parser) and `<p>_json.h`, `<p>_json.c` (a formatter for hosts, logs and tests).
+
+Everything comes from the resolved model. The frame layouts become static const tables that a small frame engine
+(engine.py, the runtime's framing.py as C) walks; each message's content becomes straight-line code. Features the
+C target cannot generate yet raise Unsupported naming the feature (`serialspec generate --target c` refuses the spec).
+"""
+
+from __future__ import annotations
+
+import hashlib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import assert_never
+
+from serialspec.backends import Unsupported
+from serialspec.backends.c.checksums import CChecksum, c_checksum
+from serialspec.backends.common.text import collapse
+from serialspec.lang.model import (
+    Array,
+    BitField,
+    Bytes,
+    Checksum,
+    Direction,
+    Field,
+    FrameLayout,
+    Group,
+    List,
+    Message,
+    Protocol,
+    Scalar,
+    ScalarType,
+    TableBlock,
+    TableValue,
+    Text,
+)
+
+#: Default capacities where the spec sets no smaller bound (each overridable with #define before the header).
+DEFAULT_MAX_BYTES = 256  # bytes, text, per field
+DEFAULT_MAX_ITEMS = 32  # items of a group, per field
+DEFAULT_MAX_FRAME = 1024  # the parser's buffer and the encoder's scratch, when the spec allows bigger frames
+
+C_KEYWORDS = frozenset(
+    [
+        "auto",
+        "break",
+        "case",
+        "char",
+        "const",
+        "continue",
+        "default",
+        "do",
+        "double",
+        "else",
+        "enum",
+        "extern",
+        "float",
+        "for",
+        "goto",
+        "if",
+        "inline",
+        "int",
+        "long",
+        "register",
+        "restrict",
+        "return",
+        "short",
+        "signed",
+        "sizeof",
+        "static",
+        "struct",
+        "switch",
+        "typedef",
+        "union",
+        "unsigned",
+        "void",
+        "volatile",
+        "while",
+        "bool",
+        "true",
+        "false",
+        "class",
+        "new",
+        "delete",
+        "this",
+        "template",
+        "typename",
+        "private",
+        "public",
+        "protected",
+        "operator",
+        "friend",
+        "virtual",
+    ]
+)
+
+
+def ident(name: str) -> str:
+    """A spec name as a C identifier (a keyword of C or C++ gets a trailing underscore)."""
+    text = "".join(ch if ch.isalnum() or ch == "_" else "_" for ch in name)
+    if text[:1].isdigit():
+        text = "_" + text
+    return text + "_" if text in C_KEYWORDS else text
+
+
+def comment(text: str) -> str:
+    """Spec text inside a C comment: one line, no comment end, ASCII-safe."""
+    return collapse(text).replace("*/", "* /").replace("/*", "/ *")
+
+
+def ctype(t: ScalarType) -> str:
+    if t.is_float:
+        return "float"
+    return f"{'int' if t.signed else 'uint'}{t.size * 8}_t"
+
+
+def cint(value: float, t: ScalarType) -> str:
+    """A literal of a scalar's type (float bounds as float literals, integers with their suffix)."""
+    if t.is_float:
+        return f"{float(value)!r}f" if abs(value) < 3.4e38 else ("3.40282347e+38f" if value > 0 else "-3.40282347e+38f")
+    v = int(value)
+    if t.signed:
+        return f"({v + 1}L - 1L)" if v == -0x80000000 else f"{v}L"
+    return f"{v}UL" if v > 0xFFFF else f"{v}u"
+
+
+@dataclass
+class Ctx:
+    """What one protocol's generation collects: its names and the C text of each part."""
+
+    protocol: Protocol
+    p: str
+    P: str
+    checks: list[tuple[Checksum, CChecksum]] = field(default_factory=list)
+    caps: list[str] = field(default_factory=list)  # #ifndef capacity defaults for the header
+    structs: list[str] = field(default_factory=list)
+    helpers: set[str] = field(default_factory=set)
+
+    def check_index(self, checksum: Checksum) -> int:
+        for i, (known, _) in enumerate(self.checks):
+            if (known.algorithm, known.invert, known.crc, known.type) == (
+                checksum.algorithm,
+                checksum.invert,
+                checksum.crc,
+                checksum.type,
+            ):
+                return i
+        made = c_checksum(self.p, checksum)
+        if any(made.name == c.name for _, c in self.checks):
+            raise Unsupported(f"checksum: two {checksum.algorithm} checksums of one width that differ")
+        self.checks.append((checksum, made))
+        return len(self.checks) - 1
+
+
+# --- what the C target can do --------------------------------------------------------------------------------------
+
+
+def refuse_unsupported(protocol: Protocol) -> None:
+    """Raise Unsupported naming the first feature of the spec the C target cannot generate yet."""
+    if protocol.error_reply is not None:
+        raise Unsupported("error replies (a flag in the command code: `error_reply`)")
+    for command in protocol.commands:
+        if command.subcommands:
+            raise Unsupported(f"sub-commands (command {command.name})")
+    for layouts in protocol.framing.alternatives.values():
+        for layout in layouts:
+            refuse_layout(layout)
+    for message in protocol.messages():
+        refuse_fields(message.fields, message.key)
+
+
+def refuse_layout(layout: FrameLayout) -> None:
+    where = f"the {layout.direction.value} frame{' ' + layout.name if layout.name else ''}"
+    elements = layout.elements
+    for e in elements:
+        if e.type is not None and (e.type.size > 4 or e.type.signed or e.type.is_float):
+            raise Unsupported(f"{where}: element {e.name} of type {e.type.name}")
+    t = layout.transparency
+    names = [e.name for e in elements]
+    content = next((i for i, e in enumerate(elements) if e.role == "content"), -1)
+    first = names.index(t.first) if t else content if content >= 0 else len(elements)
+    last = names.index(t.last) if t else content if content >= 0 else len(elements) - 1
+    length = next((i for i, e in enumerate(elements) if e.role == "length"), -1)
+    if length >= 0 and length >= first:
+        raise Unsupported(f"{where}: a length after the variable part of the frame")
+    for i, e in enumerate(elements):
+        if e.role == "checksum" and t is not None and e.checksum is not None:
+            a, b = names.index(e.checksum.first), names.index(e.checksum.last)
+            inside = first <= i <= last
+            if inside and not (first <= a and b <= last):
+                raise Unsupported(f"{where}: checksum {e.name} inside the stuffed span over bytes outside it")
+        if e.role == "checksum" and e.checksum is not None and e.checksum.algorithm == "crc":
+            crc = e.checksum.crc
+            if crc is None or not 8 <= crc.width <= 32:
+                raise Unsupported(f"{where}: a CRC of width {crc.width if crc else '?'}")
+    trailer = elements[-1].role == "trailer" and len(elements) > 1
+    if length < 0 and not (trailer and t is not None):
+        raise Unsupported(f"{where}: frames without a length element (content sized by its own fields)")
+
+
+def refuse_fields(fields: tuple[Field, ...], where: str) -> None:
+    for f in fields:
+        match f:
+            case Scalar():
+                if f.value is not None:
+                    raise Unsupported(f"{where}: {f.name}: a value computed by an expression")
+                if f.sign_magnitude:
+                    raise Unsupported(f"{where}: {f.name}: sign-magnitude numbers")
+            case Array():
+                pass
+            case List():
+                raise Unsupported(f"{where}: {f.name}: lists (field kind `list`)")
+            case Text():
+                pass
+            case Bytes():
+                pass
+            case Group():
+                refuse_fields(f.fields, where)
+            case TableValue():
+                raise Unsupported(f"{where}: {f.name}: table values (field kind `table_value`)")
+            case TableBlock():
+                raise Unsupported(f"{where}: {f.name}: table blocks (field kind `table_block`)")
+            case _:
+                assert_never(f)
+
+
+# --- names -------------------------------------------------------------------------------------------------------
+
+
+def msg_id(message: Message) -> str:
+    return ident(f"{message.key.replace('.', '_')}_{message.direction.value}")
+
+
+def messages(protocol: Protocol) -> list[Message]:
+    return list(protocol.messages())
+
+
+def value_elements(protocol: Protocol, direction: Direction) -> tuple[tuple[str, ScalarType], ...]:
+    layout = protocol.framing.layouts[direction]
+    return tuple((e.name, e.type) for e in layout.value_elements if e.type is not None)
+
+
+def code_of(protocol: Protocol, message: Message) -> int | None:
+    layout = protocol.framing.layouts[message.direction]
+    return protocol.command(message.command).code if layout.has_command else None
+
+
+# --- sizes and capacities ------------------------------------------------------------------------------------------
+
+
+def frame_max(protocol: Protocol, direction: Direction) -> int | None:
+    """The largest wire frame of a direction (None: unbounded), from the length element's range."""
+    most = 0
+    for layout in protocol.framing.alternatives[direction]:
+        length = layout.length
+        if length is None or length.type is None:
+            return None
+        a, b = layout.index(length.counts[0]), layout.index(length.counts[1])
+        counted_fixed = sum(e.size or 0 for e in layout.elements[a : b + 1])
+        top = (1 << (8 * length.type.size)) - 1
+        most = max(most, layout.overhead - counted_fixed + top - length.adds)
+    return most
+
+
+def content_max(protocol: Protocol, direction: Direction) -> int:
+    """The largest content a frame of this direction can hold (for capacities), capped for the default build."""
+    most = frame_max(protocol, direction)
+    overhead = min(layout.overhead for layout in protocol.framing.alternatives[direction])
+    return min(DEFAULT_MAX_FRAME, most - overhead if most is not None else DEFAULT_MAX_FRAME)
+
+
+# --- the header's types ------------------------------------------------------------------------------------------
+
+
+@dataclass
+class Member:
+    """One member of a C struct for a visible field."""
+
+    name: str
+    decl: str
+    doc: str
+
+
+def cap_macro(ctx: Ctx, path: str, default: int) -> str:
+    macro = f"{ctx.P}_{path.upper()}_MAX"
+    ctx.caps.append(f"#ifndef {macro}\n#define {macro} {default}u\n#endif")
+    return macro
+
+
+def field_doc(f: Field) -> str:
+    parts = [comment(f.description)] if f.description else []
+    if isinstance(f, Scalar | Array | List) and f.unit:
+        parts.append(f"unit: {f.unit}")
+    if isinstance(f, Scalar) and f.scale:
+        parts.append(f"scale: {f.scale:g} per unit")
+    if isinstance(f, Scalar | Array) and not (isinstance(f, Scalar) and f.type.is_float):
+        parts.append(f"range {f.minimum:g}..{f.maximum:g}")
+    if isinstance(f, Scalar) and f.enum:
+        parts.append(f"enum {f.enum.name}")
+    if isinstance(f, Scalar) and f.bits:
+        parts.append("bits " + ", ".join(f"{b.name} [{b.high}:{b.low}]" for b in f.bits))
+    return "; ".join(parts)
+
+
+def members(ctx: Ctx, fields: tuple[Field, ...], path: str, room: int) -> list[Member]:
+    """The struct members of the visible fields (path: the capacity macros' stem; room: the content's max bytes)."""
+    found: list[Member] = []
+    for f in fields:
+        name = ident(f.name)
+        doc = field_doc(f)
+        match f:
+            case Scalar():
+                if not f.hidden:
+                    found.append(Member(name, f"{ctype(f.type)} {name};", doc))
+            case Array():
+                found.append(Member(name, f"{ctype(f.item)} {name}[{f.count}];", doc))
+            case Bytes():
+                if isinstance(f.size, int):
+                    found.append(Member(name, f"uint8_t {name}[{f.size}];", doc))
+                else:
+                    macro = cap_macro(ctx, f"{path}_{f.name}", min(room, DEFAULT_MAX_BYTES))
+                    found.append(Member(name, f"uint8_t {name}[{macro}];", doc))
+                    found.append(Member(f"{name}_len", f"size_t {name}_len;", f"bytes in {f.name}"))
+            case Text():
+                size = f.size if isinstance(f.size, int) else min(room, DEFAULT_MAX_BYTES)
+                macro = cap_macro(ctx, f"{path}_{f.name}", size)
+                found.append(Member(name, f"char {name}[{macro} + 1u];", doc + "; UTF-8, NUL-terminated here"))
+                found.append(Member(f"{name}_len", f"size_t {name}_len;", f"bytes of text in {f.name}"))
+            case Group():
+                item = f"{ctx.p}_{path}_{f.name}_item_t"
+                inner = members(ctx, f.fields, f"{path}_{f.name}", room)
+                body = "\n".join(f"    {m.decl}{'  /* ' + m.doc + ' */' if m.doc else ''}" for m in inner)
+                ctx.structs.append(
+                    f"/* One item of {f.name}. */\ntypedef struct {{\n{body or '    uint8_t unused_;'}\n}} {item};\n"
+                )
+                if isinstance(f.count, int):
+                    found.append(Member(name, f"{item} {name}[{f.count}];", doc))
+                else:
+                    size = f.item_size or 1
+                    macro = cap_macro(ctx, f"{path}_{f.name}", max(1, min(room // size, DEFAULT_MAX_ITEMS)))
+                    found.append(Member(name, f"{item} {name}[{macro}];", doc))
+                    found.append(Member(f"{name}_count", f"size_t {name}_count;", f"items in {f.name}"))
+            case List() | TableValue() | TableBlock():
+                raise Unsupported(f"{path}: {f.name}")
+            case _:
+                assert_never(f)
+    return found
+
+
+# --- content decoders ----------------------------------------------------------------------------------------------
+
+
+@dataclass
+class Scope:
+    """Names readable while decoding or encoding fields: hidden values in locals, visible ones in the struct."""
+
+    target: str  # C expression of the struct being filled or read, with its member operator ("m->", "it->")
+    names: dict[str, str]  # field name -> C expression of its value
+    parent: Scope | None = None
+
+    def lookup(self, name: str) -> str:
+        scope: Scope | None = self
+        while scope is not None:
+            if name in scope.names:
+                return scope.names[name]
+            scope = scope.parent
+        raise Unsupported(f"a size or count from field {name}, which the C target cannot reach")
+
+
+def read_scalar(ctx: Ctx, t: ScalarType, endian: str, at: str) -> str:
+    raw = f"{ctx.p}__get({at}, {t.size}u, {1 if endian == '>' else 0}u)"
+    if t.is_float:
+        ctx.helpers.add("f32")
+        return f"{ctx.p}__f32({raw})"
+    if t.signed:
+        ctx.helpers.add(f"s{t.size * 8}")
+        return f"{ctx.p}__s{t.size * 8}({raw})"
+    return raw if t.size == 4 else f"({ctype(t)}){raw}"
+
+
+def decode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[str], depth: int) -> None:
+    pad = "    " * depth
+    for f in fields:
+        name = ident(f.name)
+        tgt = f"{scope.target}{name}"
+        out.append(f"{pad}/* {f.name}{': ' + comment(f.description)[:90] if f.description else ''} */")
+        match f:
+            case Scalar():
+                size = f.type.size
+                out.append(f"{pad}if (n - o < {size}u) {{ return {ctx.P}_E_LENGTH; }}")
+                value = read_scalar(ctx, f.type, f.endian, "c + o")
+                if f.const is not None:
+                    out.append(
+                        f"{pad}if ({ctx.p}__get(c + o, {size}u, {1 if f.endian == '>' else 0}u) != "
+                        f"{f.const}UL) {{ return {ctx.P}_E_CONTENT; }}"
+                    )
+                elif f.hidden:
+                    local = f"d{depth}_{name}"
+                    out.append(f"{pad}{local} = {ctx.p}__get(c + o, {size}u, {1 if f.endian == '>' else 0}u);")
+                    scope.names[f.name] = local
+                else:
+                    out.append(f"{pad}{tgt} = {value};")
+                    scope.names[f.name] = f"(uint32_t){tgt}" if not f.type.is_float else tgt
+                out.append(f"{pad}o += {size}u;")
+            case Array():
+                total = f.count * f.item.size
+                out.append(f"{pad}if (n - o < {total}u) {{ return {ctx.P}_E_LENGTH; }}")
+                out.append(f"{pad}for (i{depth} = 0u; i{depth} < {f.count}u; i{depth}++) {{")
+                value = read_scalar(ctx, f.item, f.endian, f"c + o + i{depth} * {f.item.size}u")
+                out.append(f"{pad}    {tgt}[i{depth}] = {value};")
+                out.append(f"{pad}}}")
+                out.append(f"{pad}o += {total}u;")
+            case Bytes() | Text():
+                terminated = isinstance(f, Text) and f.terminated
+                if terminated:
+                    out.append(f"{pad}for (k = o; k < n && c[k] != 0u; k++) {{ }}")
+                    out.append(f"{pad}if (k >= n) {{ return {ctx.P}_E_CONTENT; }}")
+                    out.append(f"{pad}len = k - o;")
+                elif isinstance(f.size, int):
+                    out.append(f"{pad}len = {f.size}u;")
+                elif f.size == "rest":
+                    out.append(f"{pad}len = n - o;")
+                elif f.size is not None:
+                    out.append(f"{pad}len = (size_t){scope.lookup(f.size)};")
+                if not terminated:
+                    out.append(f"{pad}if (n - o < len) {{ return {ctx.P}_E_LENGTH; }}")
+                if isinstance(f, Text):
+                    out.append(f"{pad}if (len > sizeof({tgt}) - 1u) {{ return {ctx.P}_E_CAPACITY; }}")
+                    out.append(f"{pad}if (!{ctx.p}__utf8(c + o, len)) {{ return {ctx.P}_E_CONTENT; }}")
+                    ctx.helpers.add("utf8")
+                    out.append(f"{pad}memcpy({tgt}, c + o, len);")
+                    out.append(f"{pad}{tgt}[len] = '\\0';")
+                    out.append(f"{pad}{tgt}_len = len;")
+                    out.append(f"{pad}o += len{' + 1u' if terminated else ''};")
+                else:
+                    if not isinstance(f.size, int):
+                        out.append(f"{pad}if (len > sizeof({tgt})) {{ return {ctx.P}_E_CAPACITY; }}")
+                    out.append(f"{pad}memcpy({tgt}, c + o, len);")
+                    if not isinstance(f.size, int):
+                        out.append(f"{pad}{tgt}_len = len;")
+                    out.append(f"{pad}o += len;")
+            case Group():
+                i = f"i{depth}"
+                item_scope = Scope(f"{tgt}[{i}].", {}, scope)
+                body: list[str] = []
+                hidden = [x for x in f.fields if isinstance(x, Scalar) and x.hidden and x.const is None]
+                for h in hidden:
+                    body.append(f"{pad}    uint32_t d{depth + 1}_{ident(h.name)};")
+                decode_fields(ctx, f.fields, item_scope, body, depth + 1)
+                capacity = f"(sizeof({tgt}) / sizeof({tgt}[0]))"
+                if isinstance(f.count, int) or f.count != "rest":
+                    count = f"{f.count}u" if isinstance(f.count, int) else f"(size_t){scope.lookup(f.count)}"
+                    if not isinstance(f.count, int):
+                        out.append(f"{pad}if ({count} > {capacity}) {{ return {ctx.P}_E_CAPACITY; }}")
+                        out.append(f"{pad}{tgt}_count = {count};")
+                    out.append(f"{pad}for ({i} = 0u; {i} < {count}; {i}++) {{")
+                    out.extend(body)
+                    out.append(f"{pad}}}")
+                elif f.item_size is not None:
+                    out.append(f"{pad}if ((n - o) % {f.item_size}u != 0u) {{ return {ctx.P}_E_LENGTH; }}")
+                    out.append(f"{pad}if ((n - o) / {f.item_size}u > {capacity}) {{ return {ctx.P}_E_CAPACITY; }}")
+                    out.append(f"{pad}{tgt}_count = (n - o) / {f.item_size}u;")
+                    out.append(f"{pad}for ({i} = 0u; {i} < {tgt}_count; {i}++) {{")
+                    out.extend(body)
+                    out.append(f"{pad}}}")
+                else:
+                    out.append(f"{pad}{tgt}_count = 0u;")
+                    out.append(f"{pad}for ({i} = 0u; o < n; {i}++) {{")
+                    out.append(f"{pad}    if ({i} >= {capacity}) {{ return {ctx.P}_E_CAPACITY; }}")
+                    out.extend(body)
+                    out.append(f"{pad}    {tgt}_count = {i} + 1u;")
+                    out.append(f"{pad}}}")
+            case List() | TableValue() | TableBlock():
+                raise Unsupported(f.name)
+            case _:
+                assert_never(f)
+
+
+def uses(fields: tuple[Field, ...], kinds: tuple[type, ...]) -> bool:
+    for f in fields:
+        if isinstance(f, kinds):
+            return True
+        if isinstance(f, Group) and uses(f.fields, kinds):
+            return True
+    return False
+
+
+def depth_of(fields: tuple[Field, ...]) -> int:
+    return max((1 + depth_of(f.fields) for f in fields if isinstance(f, Group)), default=0)
+
+
+def decoder(ctx: Ctx, message: Message) -> str:
+    mid = msg_id(message)
+    scope = Scope("m->", {})
+    body: list[str] = []
+    decode_fields(ctx, message.fields, scope, body, 1)
+    locals_ = ["    size_t o = 0u;"]
+    if uses(message.fields, (Bytes, Text)):
+        locals_.append("    size_t len;")
+    if any(isinstance(f, Text) and f.terminated for f in message.fields):
+        locals_.append("    size_t k;")
+    for d in range(1, depth_of(message.fields) + 2):
+        if any(f"i{d}" in line for line in body):
+            locals_.append(f"    size_t i{d};")
+    for f in message.fields:
+        if isinstance(f, Scalar) and f.hidden and f.const is None:
+            locals_.append(f"    uint32_t d1_{ident(f.name)};")
+    low, high = message.min_size, message.max_size
+    size_check = (
+        f"    if (n != {low}u) {{ return {ctx.P}_E_LENGTH; }}"
+        if low == high
+        else f"    if (n < {low}u) {{ return {ctx.P}_E_LENGTH; }}"
+        if low
+        else "    (void)n;"
+    )
+    return "\n".join(
+        [
+            f"/* The content of {message.key} ({message.direction.value}): fields in wire order. */",
+            f"static int {ctx.p}__dec_{mid}(const uint8_t *c, size_t n, {ctx.p}_{mid}_t *m)",
+            "{",
+            *locals_,
+            "    (void)c;",
+            "    (void)m;",
+            size_check,
+            *body,
+            f"    if (o != n) {{ return {ctx.P}_E_LENGTH; }}",
+            f"    return {ctx.P}_OK;",
+            "}",
+            "",
+        ]
+    )
+
+
+# --- content encoders ----------------------------------------------------------------------------------------------
+
+
+def scalar_bits(ctx: Ctx, t: ScalarType, expr: str) -> str:
+    """The wire value of a scalar as uint32_t (two's complement for signed, IEEE bits for f32)."""
+    if t.is_float:
+        ctx.helpers.add("f32bits")
+        return f"{ctx.p}__f32bits({expr})"
+    if t.signed:
+        mask = (1 << (8 * t.size)) - 1
+        return f"((uint32_t)(int32_t)({expr}) & 0x{mask:x}UL)"
+    return f"(uint32_t)({expr})"
+
+
+def range_test(f_min: float, f_max: float, t: ScalarType, expr: str) -> str | None:
+    """A C test true when expr is outside [f_min, f_max]; None when the type cannot hold such a value."""
+    if t.is_float:
+        return f"!({expr} >= {cint(f_min, t)} && {expr} <= {cint(f_max, t)})"
+    parts = []
+    if f_min > t.minimum:
+        parts.append(f"{expr} < {cint(f_min, t)}")
+    if f_max < t.maximum:
+        parts.append(f"{expr} > {cint(f_max, t)}")
+    return " || ".join(parts) or None
+
+
+def check_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[str], depth: int) -> None:
+    """Range checks of every value before a byte is written (encode refuses with P_E_RANGE)."""
+    pad = "    " * depth
+    for f in fields:
+        name = ident(f.name)
+        tgt = f"{scope.target}{name}"
+        match f:
+            case Scalar():
+                if f.hidden:
+                    continue
+                test = range_test(f.minimum, f.maximum, f.type, tgt)
+                if test:
+                    out.append(f"{pad}if ({test}) {{ return {ctx.P}_E_RANGE; }} /* {f.name} */")
+            case Array():
+                test = range_test(f.minimum, f.maximum, f.item, f"{tgt}[i{depth}]")
+                if test:
+                    out.append(f"{pad}for (i{depth} = 0u; i{depth} < {f.count}u; i{depth}++) {{")
+                    out.append(f"{pad}    if ({test}) {{ return {ctx.P}_E_RANGE; }} /* {f.name} */")
+                    out.append(f"{pad}}}")
+            case Bytes():
+                if not isinstance(f.size, int):
+                    out.append(f"{pad}if ({tgt}_len > sizeof({tgt})) {{ return {ctx.P}_E_RANGE; }} /* {f.name} */")
+            case Text():
+                out.append(f"{pad}if ({tgt}_len > sizeof({tgt}) - 1u) {{ return {ctx.P}_E_RANGE; }} /* {f.name} */")
+                if isinstance(f.size, int):
+                    out.append(f"{pad}if ({tgt}_len != {f.size}u) {{ return {ctx.P}_E_RANGE; }} /* {f.name} */")
+                ctx.helpers.add("utf8")
+                nul = f" || memchr({tgt}, 0, {tgt}_len) != NULL" if f.terminated else ""
+                out.append(
+                    f"{pad}if (!{ctx.p}__utf8((const uint8_t *){tgt}, {tgt}_len){nul}) {{ return {ctx.P}_E_RANGE; }}"
+                )
+            case Group():
+                i = f"i{depth}"
+                count = f"{f.count}u" if isinstance(f.count, int) else f"{tgt}_count"
+                inner: list[str] = []
+                check_fields(ctx, f.fields, Scope(f"{tgt}[{i}].", {}, scope), inner, depth + 1)
+                if not isinstance(f.count, int):
+                    out.append(f"{pad}if ({count} > sizeof({tgt}) / sizeof({tgt}[0])) {{ return {ctx.P}_E_RANGE; }}")
+                if inner:
+                    out.append(f"{pad}for ({i} = 0u; {i} < {count}; {i}++) {{")
+                    out.extend(inner)
+                    out.append(f"{pad}}}")
+            case List() | TableValue() | TableBlock():
+                raise Unsupported(f.name)
+            case _:
+                assert_never(f)
+
+
+def derived_value(
+    ctx: Ctx, f: Scalar, fields: tuple[Field, ...], scope: Scope, out: list[str], pad: str, depth: int
+) -> str:
+    """C statements computing a derived count or size into a local; returns the local's name."""
+    local = f"v{depth}_{ident(f.name)}"
+    kind, target = f.derived[0], f.derived[1]
+    by_name = {x.name: x for x in fields}
+    if kind == "count":
+        group = by_name.get(target)
+        if isinstance(group, Group) and not isinstance(group.count, int):
+            out.append(f"{pad}{local} = (uint32_t){scope.target}{ident(target)}_count;")
+        else:
+            raise Unsupported(f"{f.name}: a count of {target}")
+    elif kind == "size":
+        sized = by_name.get(target)
+        if isinstance(sized, Bytes | Text):
+            out.append(f"{pad}{local} = (uint32_t){scope.target}{ident(target)}_len;")
+        else:
+            group = next((g for g in fields if isinstance(g, Group) and any(x.name == target for x in g.fields)), None)
+            if group is None or isinstance(group.count, int):
+                raise Unsupported(f"{f.name}: the size of {target}")
+            g = f"{scope.target}{ident(group.name)}"
+            member = ident(target)
+            out.append(f"{pad}{local} = {g}_count ? (uint32_t){g}[0].{member}_len : 0u;")
+            out.append(f"{pad}for (j = 0u; j < {g}_count; j++) {{")
+            out.append(f"{pad}    if ((uint32_t){g}[j].{member}_len != {local}) {{ return {ctx.P}_E_RANGE; }}")
+            out.append(f"{pad}}}")
+            ctx.helpers.add("j")
+    else:
+        raise Unsupported(f"{f.name}: derived {kind}")
+    test = range_test(f.minimum, f.maximum, ScalarType("u32", 4, "I", False, False, 0, 0xFFFFFFFF), local)
+    if test:
+        out.append(f"{pad}if ({test}) {{ return {ctx.P}_E_RANGE; }} /* {f.name} */")
+    scope.names[f.name] = local
+    return local
+
+
+def encode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[str], depth: int) -> None:
+    pad = "    " * depth
+    for f in fields:
+        name = ident(f.name)
+        tgt = f"{scope.target}{name}"
+        match f:
+            case Scalar():
+                size = f.type.size
+                if f.const is not None:
+                    value = f"{f.const}UL"
+                elif f.derived:
+                    value = scope.lookup(f.name)
+                else:
+                    value = scalar_bits(ctx, f.type, tgt)
+                out.append(f"{pad}if (cap - o < {size}u) {{ return {ctx.P}_E_BUFFER; }}")
+                out.append(
+                    f"{pad}{ctx.p}__put(c + o, {size}u, {1 if f.endian == '>' else 0}u, {value}); /* {f.name} */"
+                )
+                out.append(f"{pad}o += {size}u;")
+            case Array():
+                total = f.count * f.item.size
+                out.append(f"{pad}if (cap - o < {total}u) {{ return {ctx.P}_E_BUFFER; }}")
+                out.append(f"{pad}for (i{depth} = 0u; i{depth} < {f.count}u; i{depth}++) {{")
+                value = scalar_bits(ctx, f.item, f"{tgt}[i{depth}]")
+                big = 1 if f.endian == ">" else 0
+                out.append(
+                    f"{pad}    {ctx.p}__put(c + o + i{depth} * {f.item.size}u, {f.item.size}u, {big}u, {value});"
+                )
+                out.append(f"{pad}}}")
+                out.append(f"{pad}o += {total}u;")
+            case Bytes() | Text():
+                length = f"{f.size}u" if isinstance(f, Bytes) and isinstance(f.size, int) else f"{tgt}_len"
+                extra = " + 1u" if isinstance(f, Text) and f.terminated else ""
+                if isinstance(f.size, str) and f.size != "rest" and f.size not in scope.names:
+                    pass  # sized by a field of an outer scope: the derived check made every item agree
+                out.append(f"{pad}if (cap - o < {length}{extra}) {{ return {ctx.P}_E_BUFFER; }}")
+                out.append(f"{pad}memcpy(c + o, {tgt}, {length}); /* {f.name} */")
+                out.append(f"{pad}o += {length};")
+                if extra:
+                    out.append(f"{pad}c[o++] = 0u;")
+            case Group():
+                i = f"i{depth}"
+                count = f"{f.count}u" if isinstance(f.count, int) else f"{tgt}_count"
+                item_scope = Scope(f"{tgt}[{i}].", {}, scope)
+                inner: list[str] = []
+                for h in f.fields:
+                    if isinstance(h, Scalar) and h.derived:
+                        inner.append(f"{pad}    uint32_t v{depth + 1}_{ident(h.name)};")
+                for h in f.fields:
+                    if isinstance(h, Scalar) and h.derived:
+                        derived_value(ctx, h, f.fields, item_scope, inner, pad + "    ", depth + 1)
+                encode_fields(ctx, f.fields, item_scope, inner, depth + 1)
+                out.append(f"{pad}for ({i} = 0u; {i} < {count}; {i}++) {{")
+                out.extend(inner)
+                out.append(f"{pad}}}")
+            case List() | TableValue() | TableBlock():
+                raise Unsupported(f.name)
+            case _:
+                assert_never(f)
+
+
+def encoder(ctx: Ctx, message: Message) -> str:
+    mid = msg_id(message)
+    scope = Scope("m->", {})
+    checks: list[str] = []
+    check_fields(ctx, message.fields, scope, checks, 1)
+    derived: list[str] = []
+    ctx.helpers.discard("j")
+    for f in message.fields:
+        if isinstance(f, Scalar) and f.derived:
+            derived_value(ctx, f, message.fields, scope, derived, "    ", 1)
+    uses_j = "j" in ctx.helpers
+    ctx.helpers.discard("j")
+    body: list[str] = []
+    encode_fields(ctx, message.fields, scope, body, 1)
+    text = "\n".join([*checks, *derived, *body])
+    locals_ = ["    size_t o = 0u;"]
+    for d in range(1, depth_of(message.fields) + 2):
+        if f"i{d}" in text:
+            locals_.append(f"    size_t i{d};")
+    if uses_j:
+        locals_.append("    size_t j;")
+    for f in message.fields:
+        if isinstance(f, Scalar) and f.derived:
+            locals_.append(f"    uint32_t v1_{ident(f.name)};")
+    return "\n".join(
+        [
+            f"/* The content of {message.key} ({message.direction.value}): every value checked against the spec's",
+            " * range before a byte is written, then the fields in wire order. */",
+            f"static int {ctx.p}__enc_{mid}(const void *mv, uint8_t *c, size_t cap, size_t *n)",
+            "{",
+            f"    const {ctx.p}_{mid}_t *m = (const {ctx.p}_{mid}_t *)mv;",
+            *locals_,
+            "    (void)m;",
+            "    (void)c;",
+            "    (void)cap;",
+            *checks,
+            *derived,
+            *body,
+            "    *n = o;",
+            f"    return {ctx.P}_OK;",
+            "}",
+            "",
+        ]
+    )
+
+
+# --- JSON ----------------------------------------------------------------------------------------------------------
+
+
+def json_fields(ctx: Ctx, fields: tuple[Field, ...], target: str, out: list[str], depth: int, first: bool) -> bool:
+    """C statements writing `"name": value` pairs of the visible fields (as `serialspec decode --json` does)."""
+    pad = "    " * depth
+    for f in fields:
+        if isinstance(f, Scalar) and f.hidden:
+            continue
+        name = ident(f.name)
+        tgt = f"{target}{name}"
+        sep = "" if first else ", "
+        first = False
+        out.append(f'{pad}{ctx.p}__ws(w, "{sep}\\"{f.name}\\": ");')
+        match f:
+            case Scalar():
+                if f.bits:
+                    json_bits(ctx, f.bits, tgt, out, pad)
+                else:
+                    out.append(pad + json_number(ctx, f.type, tgt))
+            case Array():
+                out.append(f'{pad}{ctx.p}__ws(w, "[");')
+                out.append(f"{pad}for (i{depth} = 0u; i{depth} < {f.count}u; i{depth}++) {{")
+                out.append(f'{pad}    if (i{depth}) {{ {ctx.p}__ws(w, ", "); }}')
+                out.append(f"{pad}    " + json_number(ctx, f.item, f"{tgt}[i{depth}]"))
+                out.append(f"{pad}}}")
+                out.append(f'{pad}{ctx.p}__ws(w, "]");')
+            case Bytes():
+                length = f"{f.size}u" if isinstance(f.size, int) else f"{tgt}_len"
+                out.append(f"{pad}{ctx.p}__wbytes(w, {tgt}, {length});")
+            case Text():
+                out.append(f"{pad}{ctx.p}__wtext(w, {tgt}, {tgt}_len);")
+            case Group():
+                i = f"i{depth}"
+                count = f"{f.count}u" if isinstance(f.count, int) else f"{tgt}_count"
+                out.append(f'{pad}{ctx.p}__ws(w, "[");')
+                out.append(f"{pad}for ({i} = 0u; {i} < {count}; {i}++) {{")
+                out.append(f'{pad}    {ctx.p}__ws(w, {i} ? ", {{" : "{{");')
+                json_fields(ctx, f.fields, f"{tgt}[{i}].", out, depth + 1, True)
+                out.append(f'{pad}    {ctx.p}__ws(w, "}}");')
+                out.append(f"{pad}}}")
+                out.append(f'{pad}{ctx.p}__ws(w, "]");')
+            case List() | TableValue() | TableBlock():
+                raise Unsupported(f.name)
+            case _:
+                assert_never(f)
+    return first
+
+
+def json_bits(ctx: Ctx, bits: tuple[BitField, ...], value: str, out: list[str], pad: str) -> None:
+    """A value made of bit fields as an object of them (the bits class's to_fields)."""
+    out.append(f'{pad}{ctx.p}__ws(w, "{{");')
+    for k, b in enumerate(bits):
+        s = "" if k == 0 else ", "
+        out.append(
+            f'{pad}{ctx.p}__ws(w, "{s}\\"{b.name}\\": "); '
+            f"{ctx.p}__wu(w, ((uint32_t){value} >> {b.low}) & 0x{b.mask:x}u);"
+        )
+    out.append(f'{pad}{ctx.p}__ws(w, "}}");')
+
+
+def json_number(ctx: Ctx, t: ScalarType, expr: str) -> str:
+    if t.is_float:
+        return f"{ctx.p}__wf(w, (double){expr});"
+    if t.signed:
+        return f"{ctx.p}__wi(w, (int32_t){expr});"
+    return f"{ctx.p}__wu(w, (uint32_t){expr});"
+
+
+def json_function(ctx: Ctx, message: Message) -> str:
+    mid = msg_id(message)
+    body: list[str] = []
+    first = True
+    layout = ctx.protocol.framing.layouts[message.direction]
+    for e in layout.value_elements:
+        sep = "" if first else ", "
+        first = False
+        body.append(f'    {ctx.p}__ws(w, "{sep}\\"{e.name}\\": ");')
+        if e.bits:
+            json_bits(ctx, e.bits, f"m->{ident(e.name)}", body, "    ")
+        else:
+            body.append(f"    {ctx.p}__wu(w, (uint32_t)m->{ident(e.name)});")
+    json_fields(ctx, message.fields, "m->", body, 1, first)
+    text = "\n".join(body)
+    locals_ = [f"    size_t i{d};" for d in range(1, depth_of(message.fields) + 2) if f"i{d}" in text]
+    return "\n".join(
+        [
+            f"static void {ctx.p}__json_{mid}({ctx.p}__w_t *w, const {ctx.p}_{mid}_t *m)",
+            "{",
+            *locals_,
+            "    (void)w;",
+            "    (void)m;",
+            *body,
+            "}",
+            "",
+        ]
+    )
+
+
+# --- the whole files -------------------------------------------------------------------------------------------------
+
+
+def spec_hash(protocol: Protocol) -> str:
+    try:
+        return hashlib.sha256(Path(protocol.spec_path).read_bytes()).hexdigest()
+    except OSError:
+        return ""
+
+
+def files(protocol: Protocol) -> dict[str, str]:
+    refuse_unsupported(protocol)
+    ctx = Ctx(protocol, protocol.name, protocol.name.upper())
+    for layouts in protocol.framing.alternatives.values():  # the checksums first: the header declares them
+        for layout in layouts:
+            for e in layout.elements:
+                if e.checksum is not None:
+                    ctx.check_index(e.checksum)
+    from serialspec.backends.c.files import header, json_header, json_source, source
+
+    p = protocol.name
+    h = header(ctx)
+    c = source(ctx)
+    return {
+        f"{p}/{p}.h": h,
+        f"{p}/{p}.c": c,
+        f"{p}/{p}_json.h": json_header(ctx),
+        f"{p}/{p}_json.c": json_source(ctx),
+    }

@@ -1,0 +1,474 @@
+"""The frame engine every generated .c carries: the spec's layouts as tables, walked by code that follows
+serialspec.runtime.framing (Layout.wrap, Layout.unwrap, FrameCodec.probe). PFX_/pfx_ stand for the protocol's prefix."""
+
+ENGINE = r"""/* ---- the frame engine: the spec's layouts as tables (runtime/framing.py's Layout, as C) ---------------------- */
+
+#define PFX__ROLE_CONSTANT 0u
+#define PFX__ROLE_VALUE 1u
+#define PFX__ROLE_COMMAND 2u
+#define PFX__ROLE_LENGTH 3u
+#define PFX__ROLE_CONTENT 4u
+#define PFX__ROLE_CHECKSUM 5u
+
+#define PFX__WAIT (-2L)
+#define PFX__NONE (-1L)
+
+typedef struct {
+    uint8_t role;     /* PFX__ROLE_... */
+    uint8_t size;     /* bytes (0 for the content) */
+    uint8_t big;      /* big-endian */
+    uint8_t first;    /* length: elements counted; checksum: elements covered (indexes, inclusive) */
+    uint8_t last;
+    uint8_t check;    /* checksum: which algorithm (pfx__check) */
+    uint8_t has_also; /* value: one more value allowed (a broadcast address) */
+    int32_t adds;     /* length: added to the counted size */
+    uint32_t minimum; /* value, command: the plausible values */
+    uint32_t maximum;
+    uint32_t also;
+    const uint8_t *constant; /* constant: its bytes (size of them) */
+} pfx__element_t;
+
+typedef struct {
+    const uint8_t *plain;
+    const uint8_t *wire;
+    uint8_t plain_len;
+    uint8_t wire_len;
+} pfx__pair_t;
+
+typedef struct {
+    const pfx__element_t *e;
+    uint8_t count;
+    int8_t content;    /* index of the content, -1 without */
+    int8_t command;    /* index of the command code, -1 without */
+    uint8_t has_t;     /* transparency (byte stuffing) over elements t_first..t_last */
+    uint8_t t_first;
+    uint8_t t_last;
+    const pfx__pair_t *pairs;
+    uint8_t npairs;
+    uint8_t header_len; /* the leading constant's size (0: no header) */
+    uint8_t prefix;     /* the classic parser waits for this many bytes before it judges a candidate (else 0) */
+} pfx__layout_t;
+
+/* Where each element of a frame lies: wire bytes (start, end) and, inside the stuffed span, plain bytes. */
+typedef struct {
+    size_t ws[PFX__MAX_ELEMENTS];
+    size_t we[PFX__MAX_ELEMENTS];
+    size_t ps[PFX__MAX_ELEMENTS];
+    size_t pe[PFX__MAX_ELEMENTS];
+} pfx__where_t;
+
+#if PFX_ENABLE_DECODE
+static uint32_t pfx__get(const uint8_t *b, uint8_t size, uint8_t big)
+{
+    uint32_t v = 0u;
+    uint8_t i;
+    for (i = 0u; i < size; i++) {
+        v = (v << 8) | b[big ? i : (uint8_t)(size - 1u - i)];
+    }
+    return v;
+}
+
+#endif
+
+#if PFX_ENABLE_ENCODE
+static void pfx__put(uint8_t *b, uint8_t size, uint8_t big, uint32_t v)
+{
+    uint8_t i;
+    for (i = 0u; i < size; i++) {
+        b[big ? (uint8_t)(size - 1u - i) : i] = (uint8_t)((v >> (8u * i)) & 0xFFu);
+    }
+}
+#endif
+
+/* The elements before the variable part (the stuffed span, else the content) and after it. */
+static uint8_t pfx__inner_first(const pfx__layout_t *L)
+{
+    if (L->has_t) {
+        return L->t_first;
+    }
+    return L->content >= 0 ? (uint8_t)L->content : L->count;
+}
+
+static int pfx__inner_last(const pfx__layout_t *L)
+{
+    if (L->has_t) {
+        return (int)L->t_last;
+    }
+    return L->content >= 0 ? (int)L->content : (int)L->count - 1;
+}
+
+/* Each plain sequence rewritten as its wire sequence (to_wire) or back, leftmost first, the pairs tried in order at
+ * each position. With cmp: compare the result with cmp[0..cap) instead of writing it (1: equal). */
+static int pfx__rewrite(const pfx__layout_t *L, int to_wire, const uint8_t *src, size_t n, uint8_t *dst,
+                        const uint8_t *cmp, size_t cap, size_t *out)
+{
+    size_t i = 0u, o = 0u;
+    uint8_t k;
+    while (i < n) {
+        int matched = 0;
+        for (k = 0u; k < L->npairs; k++) {
+            const uint8_t *from = to_wire ? L->pairs[k].plain : L->pairs[k].wire;
+            size_t flen = to_wire ? L->pairs[k].plain_len : L->pairs[k].wire_len;
+            const uint8_t *to = to_wire ? L->pairs[k].wire : L->pairs[k].plain;
+            size_t tlen = to_wire ? L->pairs[k].wire_len : L->pairs[k].plain_len;
+            if (flen <= n - i && memcmp(src + i, from, flen) == 0) {
+                if (tlen > cap - o) {
+                    return 0;
+                }
+                if (cmp != NULL) {
+                    if (memcmp(cmp + o, to, tlen) != 0) {
+                        return 0;
+                    }
+                } else {
+                    memcpy(dst + o, to, tlen);
+                }
+                o += tlen;
+                i += flen;
+                matched = 1;
+                break;
+            }
+        }
+        if (!matched) {
+            if (o >= cap) {
+                return 0;
+            }
+            if (cmp != NULL) {
+                if (cmp[o] != src[i]) {
+                    return 0;
+                }
+            } else {
+                dst[o] = src[i];
+            }
+            o++;
+            i++;
+        }
+    }
+    *out = o;
+    return cmp == NULL || o == cap;
+}
+
+/* The bytes of elements a..b: the plain bytes when they lie inside the stuffed span, else the wire bytes. */
+static const uint8_t *pfx__range(const pfx__layout_t *L, const pfx__where_t *w, const uint8_t *wire,
+                                 const uint8_t *plain, uint8_t a, uint8_t b, size_t *n)
+{
+    if (L->has_t && a >= L->t_first && b <= L->t_last) {
+        *n = w->pe[b] - w->ps[a];
+        return plain + w->ps[a];
+    }
+    *n = w->we[b] - w->ws[a];
+    return wire + w->ws[a];
+}
+
+#if PFX_ENABLE_ENCODE
+/* The frame around a content already in place (at out + prefix, or in span + its offset when stuffed): the frame
+ * engine's wrap (runtime/framing.py Layout.wrap), its checks in its order. */
+static int pfx__wrap(const pfx__layout_t *L, uint8_t *out, size_t cap, uint8_t *span, size_t clen, uint32_t code,
+                     const uint32_t *values, size_t *len)
+{
+    pfx__where_t w;
+    size_t pos = 0u, i, sz;
+    uint8_t k, v = 0u;
+    uint8_t first = pfx__inner_first(L);
+    int last = pfx__inner_last(L);
+    const uint8_t *bytes;
+    /* plain bytes of the stuffed span: its elements laid out around the content, inner checksums over them */
+    if (L->has_t) {
+        size_t p = 0u;
+        for (k = L->t_first; k <= L->t_last; k++) {
+            const pfx__element_t *e = &L->e[k];
+            w.ps[k] = p;
+            sz = e->role == PFX__ROLE_CONTENT ? clen : e->size;
+            if (sz > PFX_MAX_FRAME - p) {
+                return PFX_E_BUFFER;
+            }
+            if (e->role == PFX__ROLE_CONSTANT) {
+                memcpy(span + p, e->constant, e->size);
+            } else if (e->role == PFX__ROLE_COMMAND) {
+                pfx__put(span + p, e->size, e->big, code);
+            } else if (e->role != PFX__ROLE_CONTENT) {
+                memset(span + p, 0, e->size);
+            }
+            p += sz;
+            w.pe[k] = p;
+        }
+        for (k = 0u; k < L->count; k++) {
+            if (L->e[k].role == PFX__ROLE_VALUE) {
+                if (k >= L->t_first && k <= L->t_last) {
+                    pfx__put(span + w.ps[k], L->e[k].size, L->e[k].big, values[v]);
+                }
+                v++;
+            }
+        }
+        for (k = L->t_first; k <= L->t_last; k++) {
+            const pfx__element_t *e = &L->e[k];
+            if (e->role == PFX__ROLE_CHECKSUM) {
+                bytes = span + w.ps[e->first];
+                pfx__put(span + w.ps[k], e->size, e->big, pfx__check(e->check, bytes, w.pe[e->last] - w.ps[e->first]));
+            }
+        }
+    }
+    /* the wire bytes, element by element (the stuffed span rewritten as a whole) */
+    v = 0u;
+    for (k = 0u; k < L->count; k++) {
+        const pfx__element_t *e = &L->e[k];
+        if (L->has_t && k == L->t_first) {
+            size_t made;
+            if (!pfx__rewrite(L, 1, span, w.pe[L->t_last], out + pos, NULL, cap - pos, &made)) {
+                return PFX_E_BUFFER;
+            }
+            for (i = L->t_first; i <= L->t_last; i++) {
+                w.ws[i] = pos;
+                w.we[i] = pos + made;
+            }
+            for (i = L->t_first; i <= L->t_last; i++) {
+                if (L->e[i].role == PFX__ROLE_VALUE) {
+                    v++;
+                }
+            }
+            pos += made;
+            k = L->t_last;
+            continue;
+        }
+        sz = e->role == PFX__ROLE_CONTENT ? clen : e->size;
+        if (sz > cap - pos) {
+            return PFX_E_BUFFER;
+        }
+        w.ws[k] = pos;
+        if (e->role == PFX__ROLE_CONSTANT) {
+            memcpy(out + pos, e->constant, e->size);
+        } else if (e->role == PFX__ROLE_COMMAND) {
+            pfx__put(out + pos, e->size, e->big, code);
+        } else if (e->role == PFX__ROLE_VALUE) {
+            pfx__put(out + pos, e->size, e->big, values[v++]);
+        } else if (e->role != PFX__ROLE_CONTENT) {
+            memset(out + pos, 0, e->size);
+        }
+        pos += sz;
+        w.we[k] = pos;
+    }
+    (void)first;
+    (void)last;
+    /* lengths, then the checksums outside the stuffed span, over the wire bytes */
+    for (k = 0u; k < L->count; k++) {
+        const pfx__element_t *e = &L->e[k];
+        if (e->role == PFX__ROLE_LENGTH) {
+            int32_t value;
+            uint32_t top = e->size >= 4u ? 0xFFFFFFFFu : ((uint32_t)1u << (8u * e->size)) - 1u;
+            (void)pfx__range(L, &w, out, span, e->first, e->last, &sz);
+            value = (int32_t)sz + e->adds;
+            if (value < 0 || (uint32_t)value > top) {
+                return PFX_E_LENGTH;
+            }
+            pfx__put(out + w.ws[k], e->size, e->big, (uint32_t)value);
+        }
+    }
+    for (k = 0u; k < L->count; k++) {
+        const pfx__element_t *e = &L->e[k];
+        if (e->role == PFX__ROLE_CHECKSUM && !(L->has_t && k >= L->t_first && k <= L->t_last)) {
+            bytes = pfx__range(L, &w, out, span, e->first, e->last, &sz);
+            pfx__put(out + w.ws[k], e->size, e->big, pfx__check(e->check, bytes, sz));
+        }
+    }
+    *len = pos;
+    return PFX_OK;
+}
+#endif
+
+#if PFX_ENABLE_DECODE
+/* Check a complete frame (constants, values, lengths, stuffing, checksums) and take it apart: the frame engine's
+ * unwrap (runtime/framing.py Layout.unwrap). plain: room for the unstuffed span. */
+static int pfx__unwrap(const pfx__layout_t *L, const uint8_t *frame, size_t n, uint8_t *plain, uint32_t *code,
+                       uint32_t *values, const uint8_t **content, size_t *clen)
+{
+    pfx__where_t w;
+    size_t before = 0u, after = 0u, pos, sz;
+    uint8_t k, v = 0u;
+    uint8_t first = pfx__inner_first(L);
+    int last = pfx__inner_last(L);
+    const uint8_t *bytes;
+    const uint8_t *body = frame;
+    for (k = 0u; k < first; k++) {
+        before += L->e[k].size;
+    }
+    for (k = L->count; (int)k - 1 > last; k--) {
+        after += L->e[k - 1u].size;
+    }
+    if (n < before + after) {
+        return PFX_E_LENGTH;
+    }
+    pos = 0u;
+    for (k = 0u; k < first; k++) {
+        w.ws[k] = pos;
+        pos += L->e[k].size;
+        w.we[k] = pos;
+    }
+    pos = n;
+    for (k = L->count; (int)k - 1 > last; k--) {
+        w.we[k - 1u] = pos;
+        pos -= L->e[k - 1u].size;
+        w.ws[k - 1u] = pos;
+    }
+    if (L->has_t) {
+        size_t pn, fixed = 0u, p = 0u;
+        if (!pfx__rewrite(L, 0, frame + before, n - before - after, plain, NULL, PFX_MAX_FRAME, &pn)) {
+            return PFX_E_CAPACITY;
+        }
+        if (!pfx__rewrite(L, 1, plain, pn, NULL, frame + before, n - before - after, &sz)) {
+            return PFX_E_FRAME; /* bad stuffing: not the stuffed form of any bytes */
+        }
+        for (k = L->t_first; k <= L->t_last; k++) {
+            fixed += L->e[k].size;
+        }
+        if ((L->content < (int)L->t_first || L->content > (int)L->t_last) ? pn != fixed : pn < fixed) {
+            return PFX_E_LENGTH;
+        }
+        for (k = L->t_first; k <= L->t_last; k++) {
+            w.ws[k] = before;
+            w.we[k] = n - after;
+            w.ps[k] = p;
+            p += L->e[k].role == PFX__ROLE_CONTENT ? pn - fixed : L->e[k].size;
+            w.pe[k] = p;
+        }
+        body = plain;
+    } else if (L->content >= 0) {
+        w.ws[L->content] = before;
+        w.we[L->content] = n - after;
+    }
+    for (k = 0u; k < L->count; k++) {
+        const pfx__element_t *e = &L->e[k];
+        bytes = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+        if (e->role == PFX__ROLE_CONSTANT && memcmp(bytes, e->constant, e->size) != 0) {
+            return PFX_E_FRAME;
+        }
+    }
+    *code = 0u;
+    for (k = 0u; k < L->count; k++) {
+        const pfx__element_t *e = &L->e[k];
+        bytes = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+        if (e->role == PFX__ROLE_COMMAND) {
+            *code = pfx__get(bytes, e->size, e->big);
+        } else if (e->role == PFX__ROLE_VALUE) {
+            uint32_t value = pfx__get(bytes, e->size, e->big);
+            if ((value < e->minimum || value > e->maximum) && !(e->has_also && value == e->also)) {
+                return PFX_E_RANGE;
+            }
+            values[v++] = value;
+        }
+    }
+    for (k = 0u; k < L->count; k++) {
+        const pfx__element_t *e = &L->e[k];
+        if (e->role == PFX__ROLE_LENGTH) {
+            bytes = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+            (void)pfx__range(L, &w, frame, body, e->first, e->last, &sz);
+            if ((int32_t)pfx__get(bytes, e->size, e->big) != (int32_t)sz + e->adds) {
+                return PFX_E_LENGTH;
+            }
+        }
+    }
+    for (k = 0u; k < L->count; k++) {
+        const pfx__element_t *e = &L->e[k];
+        if (e->role == PFX__ROLE_CHECKSUM) {
+            const uint8_t *stored = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+            bytes = pfx__range(L, &w, frame, body, e->first, e->last, &sz);
+            if (pfx__check(e->check, bytes, sz) != pfx__get(stored, e->size, e->big)) {
+                return PFX_E_CHECKSUM;
+            }
+        }
+    }
+    if (L->content >= 0) {
+        int inside = L->has_t && L->content >= (int)L->t_first && L->content <= (int)L->t_last;
+        *content = inside ? body + w.ps[L->content] : frame + w.ws[L->content];
+        *clen = inside ? w.pe[L->content] - w.ps[L->content] : w.we[L->content] - w.ws[L->content];
+    } else {
+        *content = frame;
+        *clen = 0u;
+    }
+    return PFX_OK;
+}
+#endif
+
+#if PFX_ENABLE_PARSER
+static int pfx__bounds(pfx_direction_t dir, long code, size_t *low, size_t *high, int *bounded);
+
+/* The size of a plausible frame of layout L at b[0..avail): PFX__WAIT for more bytes, PFX__NONE when none starts
+ * there (runtime/framing.py FrameCodec.probe). */
+static long pfx__probe(const pfx__layout_t *L, pfx_direction_t dir, const uint8_t *b, size_t avail)
+{
+    size_t pos = 0u, low = 0u, high = 0u, before = 0u;
+    int bounded = 0, known;
+    uint8_t k, first = pfx__inner_first(L);
+    long code = PFX__NO_CODE;
+    if (avail < L->prefix) {
+        return PFX__WAIT;
+    }
+    for (k = 0u; k < first; k++) {
+        const pfx__element_t *e = &L->e[k];
+        size_t stop = pos + e->size;
+        if (avail < stop) {
+            return PFX__WAIT;
+        }
+        if (e->role == PFX__ROLE_CONSTANT) {
+            if (memcmp(b + pos, e->constant, e->size) != 0) {
+                return PFX__NONE;
+            }
+        } else if (e->role == PFX__ROLE_COMMAND) {
+            code = (long)pfx__get(b + pos, e->size, e->big);
+            if (!pfx__bounds(dir, code, &low, &high, &bounded)) {
+                return PFX__NONE;
+            }
+        } else if (e->role == PFX__ROLE_VALUE) {
+            uint32_t value = pfx__get(b + pos, e->size, e->big);
+            if ((value < e->minimum || value > e->maximum) && !(e->has_also && value == e->also)) {
+                return PFX__NONE;
+            }
+        }
+        pos = stop;
+    }
+    before = pos;
+    if (L->command < 0) {
+        if (!pfx__bounds(dir, PFX__NO_CODE, &low, &high, &bounded)) {
+            return PFX__NONE;
+        }
+    } else if (code == PFX__NO_CODE) {
+        low = 0u; /* the code lies in the stuffed span: no bounds before the frame is unstuffed */
+        bounded = 0;
+    }
+    known = 0;
+    for (k = 0u; k < first; k++) {
+        const pfx__element_t *e = &L->e[k];
+        if (e->role == PFX__ROLE_LENGTH) {
+            size_t off = 0u, counted_fixed = 0u, overhead = 0u;
+            uint8_t i;
+            long counted, content;
+            for (i = 0u; i < k; i++) {
+                off += L->e[i].size;
+            }
+            for (i = 0u; i < L->count; i++) {
+                overhead += L->e[i].size;
+            }
+            for (i = e->first; i <= e->last; i++) {
+                counted_fixed += L->e[i].size;
+            }
+            counted = (long)pfx__get(b + off, e->size, e->big) - (long)e->adds;
+            content = counted - (long)counted_fixed;
+            if (content < (long)low || (!L->has_t && bounded && content > (long)high)) {
+                return PFX__NONE;
+            }
+            return (long)(overhead - counted_fixed) + counted;
+        }
+    }
+    (void)known;
+    if (L->has_t && L->e[L->count - 1u].role == PFX__ROLE_CONSTANT && L->count > 1u) {
+        const pfx__element_t *t = &L->e[L->count - 1u];
+        size_t i;
+        for (i = before; i + t->size <= avail; i++) {
+            if (memcmp(b + i, t->constant, t->size) == 0) {
+                return (long)(i + t->size);
+            }
+        }
+        return PFX__WAIT;
+    }
+    return PFX__NONE;
+}
+#endif
+"""

@@ -1,0 +1,157 @@
+/* A test driver for one protocol's generated C: hex in, JSON out, one command a line (tests/test_c_backend.py).
+ *
+ * Built with -DPROTO=<protocol> -include <protocol>_json.h. Commands, each answered by one line (stream: several):
+ *   dec DIR HEX [KIND]       decode a frame: "ok <json>" or "err <result>"
+ *   rt DIR HEX [KIND]        decode, then encode the message again: "ok <hex>" or "err <result>"
+ *   stream DIR SIZES HEX     feed the bytes in pieces of SIZES (comma-separated, repeated): "msg <json>" per message,
+ *                            then "end <frames> <garbage> <errors> <held>"
+ *   enc1 DIR HEX CAP         decode, then encode into CAP bytes with canary bytes after them: "ok <hex>" / "err <r>"
+ */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define CAT2(a, b) a##b
+#define CAT(a, b) CAT2(a, b)
+#define P(name) CAT(PROTO, CAT(_, name))
+
+static P(msg_t) msg;
+static P(parser_t) parser;
+static uint8_t frame[1 << 17];
+static uint8_t out[1 << 17];
+static char json[1 << 20];
+static char line[1 << 19];
+
+static size_t unhex(const char *s, uint8_t *b, size_t cap)
+{
+    size_t n = 0u;
+    while (s[0] != '\0' && s[1] != '\0' && n < cap) {
+        unsigned v;
+        if (sscanf(s, "%2x", &v) != 1) {
+            break;
+        }
+        b[n++] = (uint8_t)v;
+        s += 2;
+    }
+    return n;
+}
+
+static void puthex(const uint8_t *b, size_t n)
+{
+    size_t i;
+    for (i = 0u; i < n; i++) {
+        printf("%02x", b[i]);
+    }
+}
+
+static P(kind_t) kind_of(const char *name)
+{
+    int k;
+    if (name == NULL) {
+        return CAT(PROTO_UPPER, _KIND_NONE);
+    }
+    for (k = 1; k < (int)CAT(PROTO_UPPER, _KIND_COUNT); k++) {
+        if (strcmp(P(kind_name)((P(kind_t))k), name) == 0) {
+            return (P(kind_t))k;
+        }
+    }
+    return CAT(PROTO_UPPER, _KIND_NONE);
+}
+
+int main(void)
+{
+    while (fgets(line, sizeof(line), stdin) != NULL) {
+        char *cmd = strtok(line, " \n");
+        char *dir_text = strtok(NULL, " \n");
+        P(direction_t) dir;
+        if (cmd == NULL || dir_text == NULL) {
+            printf("bad\n");
+            fflush(stdout);
+            continue;
+        }
+        dir = strcmp(dir_text, "request") == 0 ? CAT(PROTO_UPPER, _REQUEST) : CAT(PROTO_UPPER, _RESPONSE);
+        if (strcmp(cmd, "dec") == 0 || strcmp(cmd, "rt") == 0 || strcmp(cmd, "enc1") == 0) {
+            char *hex = strtok(NULL, " \n");
+            char *extra = strtok(NULL, " \n");
+            size_t n = unhex(hex ? hex : "", frame, sizeof(frame));
+            int r;
+            if (strcmp(cmd, "enc1") == 0) {
+                r = P(decode)(frame, n, dir, &msg);
+            } else {
+                r = P(decode_expect)(frame, n, dir, kind_of(extra), &msg);
+            }
+            if (r != 0) {
+                printf("err %s\n", P(result_name)(r));
+            } else if (strcmp(cmd, "dec") == 0) {
+                size_t need = P(to_json)(&msg, json, sizeof(json));
+                printf("ok %s\n", need < sizeof(json) ? json : "{}");
+            } else {
+                size_t len = 12345u, cap = sizeof(out) - 64u, i;
+                if (strcmp(cmd, "enc1") == 0) {
+                    cap = (size_t)strtoul(extra ? extra : "0", NULL, 10);
+                }
+                memset(out, 0xA5, cap + 64u);
+                r = P(encode)(&msg, out, cap, &len);
+                for (i = cap; i < cap + 64u; i++) {
+                    if (out[i] != 0xA5) {
+                        printf("overrun\n");
+                        return 1;
+                    }
+                }
+                if (r != 0) {
+                    printf("err %s %lu\n", P(result_name)(r), (unsigned long)len);
+                } else {
+                    printf("ok ");
+                    puthex(out, len);
+                    printf("\n");
+                }
+            }
+        } else if (strcmp(cmd, "stream") == 0) {
+            char *sizes = strtok(NULL, " \n");
+            char *hex = strtok(NULL, " \n");
+            size_t n = unhex(hex ? hex : "", frame, sizeof(frame)), at = 0u;
+            size_t piece[64], npieces = 0u, which = 0u;
+            char *s = sizes;
+            while (s != NULL && *s != '\0' && npieces < 64u) {
+                piece[npieces++] = (size_t)strtoul(s, &s, 10);
+                if (*s == ',') {
+                    s++;
+                }
+            }
+            if (npieces == 0u) {
+                piece[npieces++] = 1u;
+            }
+            P(parser_init)(&parser, dir);
+            while (at <= n) {
+                size_t take = piece[which++ % npieces];
+                size_t used;
+                bool got;
+                if (take > n - at) {
+                    take = n - at;
+                }
+                /* a piece may hold several messages: feed it until it is used up, then once more with nothing */
+                for (;;) {
+                    used = P(parser_feed)(&parser, frame + at, take, &msg, &got);
+                    at += used;
+                    take -= used;
+                    if (got) {
+                        P(to_json)(&msg, json, sizeof(json));
+                        printf("msg %s\n", json);
+                    }
+                    if (!got && take == 0u) {
+                        break;
+                    }
+                }
+                if (at >= n) {
+                    break;
+                }
+            }
+            printf("end %lu %lu %lu %lu\n", (unsigned long)parser.frames, (unsigned long)parser.garbage,
+                   (unsigned long)parser.errors, (unsigned long)parser.n);
+        } else {
+            printf("bad\n");
+        }
+        fflush(stdout);
+    }
+    return 0;
+}

@@ -189,7 +189,7 @@ def test_random_messages_encode_and_decode_as_python_does(g: Generated, spec: Me
     cls = message_class(g, spec)
     kind = kind_of(g, cls)
 
-    @settings(max_examples=examples(25), deadline=None, suppress_health_check=[HealthCheck.too_slow])
+    @settings(max_examples=examples(8), deadline=None, suppress_health_check=[HealthCheck.too_slow])
     @given(message_fields(g.protocol, spec), st.data())
     def agree(fields: dict[str, Any], data: st.DataObject) -> None:
         frame = g.package.encode(cls.from_fields(fields))
@@ -284,7 +284,7 @@ def python_stream(g: Generated, direction: Direction, data: bytes) -> tuple[list
 def test_noisy_streams_in_random_pieces_give_what_python_gives(g: Generated) -> None:
     directions = list(g.protocol.framing.layouts)
 
-    @settings(max_examples=examples(60), deadline=None, suppress_health_check=[HealthCheck.too_slow])
+    @settings(max_examples=examples(40), deadline=None, suppress_health_check=[HealthCheck.too_slow])
     @given(st.sampled_from(directions).flatmap(lambda d: st.tuples(st.just(d), noisy_stream(g, d))), st.data())
     def agree(case: tuple[Direction, bytes], data: st.DataObject) -> None:
         direction, stream = case

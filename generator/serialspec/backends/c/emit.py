@@ -160,8 +160,8 @@ def refuse_unsupported(protocol: Protocol) -> None:
     if protocol.error_reply is not None:
         raise Unsupported("error replies (a flag in the command code: `error_reply`)")
     for command in protocol.commands:
-        if command.subcommands:
-            raise Unsupported(f"sub-commands (command {command.name})")
+        if command.selector is not None and command.selector.type.size != 1:
+            raise Unsupported(f"sub-command selectors of more than one byte (command {command.name})")
     for layouts in protocol.framing.alternatives.values():
         for layout in layouts:
             refuse_layout(layout)

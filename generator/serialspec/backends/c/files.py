@@ -319,12 +319,7 @@ def source(ctx: Ctx) -> str:
     # content bounds by code, for the parser's plausibility checks
     bounds_cases: list[str] = []
     for d in directions(protocol):
-        by_code: dict[int | None, list[Message]] = {}
-        layout = protocol.framing.layouts[d]
-        for m in msgs:
-            if m.direction == d:
-                code = protocol.command(m.command).code if layout.has_command else None
-                by_code.setdefault(code, []).append(m)
+        by_code = messages_by_code(protocol, d)
         rows = []
         for code, users in by_code.items():
             low = min(u.min_size for u in users)
@@ -343,25 +338,30 @@ def source(ctx: Ctx) -> str:
     # decode dispatch
     dec_cases: list[str] = []
     for d in directions(protocol):
-        by_code2: dict[int | None, list[Message]] = {}
-        layout = protocol.framing.layouts[d]
-        for m in msgs:
-            if m.direction == d:
-                code = protocol.command(m.command).code if layout.has_command else None
-                by_code2.setdefault(code, []).append(m)
         rows = []
         values = value_elements(protocol, d)
-        for code, users in by_code2.items():
+        for code, users in messages_by_code(protocol, d).items():
             key = f"{code}L" if code is not None else f"{P}__NO_CODE"
-            default = next((u for u in users if u.default_reply), users[0])
+            command = protocol.command(users[0].command)
             body = []
-            if len(users) > 1:
+            if command.selector is not None:  # sub-commands: told apart by the selector byte in the content
+                offset = command.selector.offsets[d]
+                body.append(f"            if (n <= {offset}u) {{ return {P}_E_LENGTH; }}")
+                body.append(f"            switch (c[{offset}]) {{")
+                for sub in command.subcommands:
+                    m = sub.request if d == Direction.REQUEST else sub.response
+                    if m is not None:
+                        body.append(f"            case {sub.code}u: {dec_call(ctx, m, values)}")
+                body.append(f"            default: return {P}_E_UNKNOWN;")
+                body.append("            }")
+            else:
+                default = next((u for u in users if u.default_reply), users[0])
                 for u in users:
                     if u is not default:
                         body.append(f"            if (expect == {kind_name(ctx, u)}) {{")
                         body.append(f"                {dec_call(ctx, u, values)}")
                         body.append("            }")
-            body.append(f"            {dec_call(ctx, default, values)}")
+                body.append(f"            {dec_call(ctx, default, values)}")
             rows.append(f"        case {key}: {{\n" + "\n".join(body) + "\n        }")
         dec_cases.append(
             f"    case {P}_{d.name}:\n        switch (code) {{\n"
@@ -796,6 +796,16 @@ const char *{p}_result_name(int result)
     return names[result];
 }}
 """
+
+
+def messages_by_code(protocol: Protocol, direction: Direction) -> dict[int | None, list[Message]]:
+    """A direction's messages by the command code their frames carry (None: the layout carries none)."""
+    layout = protocol.framing.layouts[direction]
+    found: dict[int | None, list[Message]] = {}
+    for m in messages(protocol):
+        if m.direction == direction:
+            found.setdefault(protocol.command(m.command).code if layout.has_command else None, []).append(m)
+    return found
 
 
 def span_decl_all(decls: dict[Direction, str], P: str) -> str:

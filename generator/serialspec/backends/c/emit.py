@@ -216,10 +216,11 @@ def refuse_fields(fields: tuple[Field, ...], where: str) -> None:
                 pass
             case Group():
                 refuse_fields(f.fields, where)
-            case TableValue():
-                raise Unsupported(f"{where}: {f.name}: table values (field kind `table_value`)")
-            case TableBlock():
-                raise Unsupported(f"{where}: {f.name}: table blocks (field kind `table_block`)")
+            case TableValue() | TableBlock():
+                entries = f.entries if isinstance(f, TableBlock) else f.table.entries
+                for e in entries:
+                    if e.type.is_float or e.sign_magnitude:
+                        raise Unsupported(f"{where}: {f.name}: table entry {e.name} ({e.type.name}, sign-magnitude)")
             case _:
                 assert_never(f)
 
@@ -340,7 +341,19 @@ def members(ctx: Ctx, fields: tuple[Field, ...], path: str, room: int) -> list[M
                     macro = cap_macro(ctx, f"{path}_{f.name}", max(1, min(room // size, DEFAULT_MAX_ITEMS)))
                     found.append(Member(name, f"{item} {name}[{macro}];", doc))
                     found.append(Member(f"{name}_count", f"size_t {name}_count;", f"items in {f.name}"))
-            case List() | TableValue() | TableBlock():
+            case TableValue():
+                found.append(
+                    Member(name, f"int64_t {name};", doc + f"; its type is the {f.table.name} entry {f.key} names")
+                )
+            case TableBlock():
+                block = f"{ctx.p}_{path}_{f.name}_t"
+                body = "\n".join(
+                    f"    {ctype(e.type)} {ident(e.name)};  /* {e.key}: {comment(e.description)[:80]} */"
+                    for e in f.entries
+                )
+                ctx.structs.append(f"/* {comment(f.description)} */\ntypedef struct {{\n{body}\n}} {block};\n")
+                found.append(Member(name, f"{block} {name};", doc))
+            case List():
                 raise Unsupported(f"{path}: {f.name}")
             case _:
                 assert_never(f)
@@ -470,7 +483,30 @@ def decode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                     out.extend(body)
                     out.append(f"{pad}    {tgt}_count = {i} + 1u;")
                     out.append(f"{pad}}}")
-            case List() | TableValue() | TableBlock():
+            case TableValue():
+                key = scope.lookup(f.key)
+                out.append(f"{pad}switch ({key}) {{")
+                for e in f.table.entries:
+                    if e.reserved:
+                        continue
+                    size = e.type.size
+                    value = read_scalar(ctx, e.type, f"{'>' if ctx.protocol.byte_order == 'big' else '<'}", "c + o")
+                    out.append(f"{pad}case {e.key}u: /* {e.name} */")
+                    out.append(f"{pad}    if (n - o < {size}u) {{ return {ctx.P}_E_LENGTH; }}")
+                    out.append(f"{pad}    {tgt} = (int64_t){value};")
+                    out.append(f"{pad}    o += {size}u;")
+                    out.append(f"{pad}    break;")
+                out.append(f"{pad}default:")
+                out.append(f"{pad}    return {ctx.P}_E_CONTENT; /* a key the table does not define */")
+                out.append(f"{pad}}}")
+            case TableBlock():
+                total = sum(e.type.size for e in f.entries)
+                out.append(f"{pad}if (n - o < {total}u) {{ return {ctx.P}_E_LENGTH; }}")
+                for e in f.entries:
+                    value = read_scalar(ctx, e.type, f.endian, "c + o")
+                    out.append(f"{pad}{tgt}.{ident(e.name)} = {value}; /* {e.key} */")
+                    out.append(f"{pad}o += {e.type.size}u;")
+            case List():
                 raise Unsupported(f.name)
             case _:
                 assert_never(f)
@@ -599,7 +635,24 @@ def check_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[st
                     out.append(f"{pad}for ({i} = 0u; {i} < {count}; {i}++) {{")
                     out.extend(inner)
                     out.append(f"{pad}}}")
-            case List() | TableValue() | TableBlock():
+            case TableValue():
+                out.append(f"{pad}switch ({scope.target}{ident(f.key)}) {{ /* {f.name}: the range of its entry */")
+                for e in f.table.entries:
+                    if e.reserved:
+                        continue
+                    low, high = int(e.minimum), int(e.maximum)
+                    out.append(
+                        f"{pad}case {e.key}u: if ({tgt} < ({low + 1}LL - 1LL) || {tgt} > {high}LL) "
+                        f"{{ return {ctx.P}_E_RANGE; }} break;"
+                    )
+                out.append(f"{pad}default: return {ctx.P}_E_RANGE; /* a key the table does not define */")
+                out.append(f"{pad}}}")
+            case TableBlock():
+                for e in f.entries:
+                    test = range_test(e.minimum, e.maximum, e.type, f"{tgt}.{ident(e.name)}")
+                    if test:
+                        out.append(f"{pad}if ({test}) {{ return {ctx.P}_E_RANGE; }} /* {f.name}.{e.name} */")
+            case List():
                 raise Unsupported(f.name)
             case _:
                 assert_never(f)
@@ -697,7 +750,33 @@ def encode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                 out.append(f"{pad}for ({i} = 0u; {i} < {count}; {i}++) {{")
                 out.extend(inner)
                 out.append(f"{pad}}}")
-            case List() | TableValue() | TableBlock():
+            case TableValue():
+                big = 1 if ctx.protocol.byte_order == "big" else 0
+                out.append(f"{pad}switch ({scope.target}{ident(f.key)}) {{ /* {f.name} */")
+                for e in f.table.entries:
+                    if e.reserved:
+                        continue
+                    size = e.type.size
+                    mask = (1 << (8 * size)) - 1
+                    out.append(f"{pad}case {e.key}u:")
+                    out.append(f"{pad}    if (cap - o < {size}u) {{ return {ctx.P}_E_BUFFER; }}")
+                    out.append(
+                        f"{pad}    {ctx.p}__put(c + o, {size}u, {big}u, (uint32_t)((uint64_t){tgt} & 0x{mask:x}u));"
+                    )
+                    out.append(f"{pad}    o += {size}u;")
+                    out.append(f"{pad}    break;")
+                out.append(f"{pad}default:")
+                out.append(f"{pad}    return {ctx.P}_E_RANGE;")
+                out.append(f"{pad}}}")
+            case TableBlock():
+                total = sum(e.type.size for e in f.entries)
+                big = 1 if f.endian == ">" else 0
+                out.append(f"{pad}if (cap - o < {total}u) {{ return {ctx.P}_E_BUFFER; }}")
+                for e in f.entries:
+                    value = scalar_bits(ctx, e.type, f"{tgt}.{ident(e.name)}")
+                    out.append(f"{pad}{ctx.p}__put(c + o, {e.type.size}u, {big}u, {value}); /* {e.key} */")
+                    out.append(f"{pad}o += {e.type.size}u;")
+            case List():
                 raise Unsupported(f.name)
             case _:
                 assert_never(f)
@@ -791,7 +870,19 @@ def json_fields(ctx: Ctx, fields: tuple[Field, ...], target: str, out: list[str]
                 out.append(f'{pad}    {ctx.p}__ws(w, "}}");')
                 out.append(f"{pad}}}")
                 out.append(f'{pad}{ctx.p}__ws(w, "]");')
-            case List() | TableValue() | TableBlock():
+            case TableValue():
+                out.append(
+                    f"{pad}if ({tgt} < 0) {{ {ctx.p}__wi(w, (int32_t){tgt}); }} "
+                    f"else {{ {ctx.p}__wu(w, (uint32_t){tgt}); }}"
+                )
+            case TableBlock():
+                out.append(f'{pad}{ctx.p}__ws(w, "{{");')
+                for k, e in enumerate(f.entries):
+                    sep2 = "" if k == 0 else ", "
+                    out.append(f'{pad}{ctx.p}__ws(w, "{sep2}\\"{e.name}\\": ");')
+                    out.append(pad + json_number(ctx, e.type, f"{tgt}.{ident(e.name)}"))
+                out.append(f'{pad}{ctx.p}__ws(w, "}}");')
+            case List():
                 raise Unsupported(f.name)
             case _:
                 assert_never(f)

@@ -48,7 +48,7 @@ static uint32_t dynamixel_p2__check(uint8_t which, const uint8_t *d, size_t n)
         return 0u;
     }
 }
-/* ---- the frame engine: the spec's layouts as tables (runtime/framing.py's Layout, as C) ---------------------- */
+/* ---- the frame engine: the spec's layouts as tables (runtime/framing.py's Layout, as C) ---- */
 
 #define DYNAMIXEL_P2__ROLE_CONSTANT 0u
 #define DYNAMIXEL_P2__ROLE_VALUE 1u

@@ -44,7 +44,7 @@ static uint32_t fashionstar_uart__check(uint8_t which, const uint8_t *d, size_t 
         return 0u;
     }
 }
-/* ---- the frame engine: the spec's layouts as tables (runtime/framing.py's Layout, as C) ---------------------- */
+/* ---- the frame engine: the spec's layouts as tables (runtime/framing.py's Layout, as C) ---- */
 
 #define FASHIONSTAR_UART__ROLE_CONSTANT 0u
 #define FASHIONSTAR_UART__ROLE_VALUE 1u

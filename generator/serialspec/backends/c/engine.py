@@ -1,7 +1,7 @@
 """The frame engine every generated .c carries: the spec's layouts as tables, walked by code that follows
 serialspec.runtime.framing (Layout.wrap, Layout.unwrap, FrameCodec.probe). PFX_/pfx_ stand for the protocol's prefix."""
 
-ENGINE = r"""/* ---- the frame engine: the spec's layouts as tables (runtime/framing.py's Layout, as C) ---------------------- */
+ENGINE = r"""/* ---- the frame engine: the spec's layouts as tables (runtime/framing.py's Layout, as C) ---- */
 
 #define PFX__ROLE_CONSTANT 0u
 #define PFX__ROLE_VALUE 1u

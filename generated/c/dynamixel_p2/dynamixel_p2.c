@@ -16,6 +16,7 @@ typedef char dynamixel_p2__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 
 #define DYNAMIXEL_P2__MAX_ELEMENTS 8u
 #define DYNAMIXEL_P2__NO_CODE (-1L)
+#define DYNAMIXEL_P2__ERROR_CODE (-2L) /* any code with the error flag: an error reply */
 /* counting as serialspec.runtime.stream.StreamParser (1), else as framing.FrameStreamParser */
 #define DYNAMIXEL_P2__CLASSIC 0
 #define DYNAMIXEL_P2__HEADERS 1 /* every layout starts with a header: candidates start at headers only */
@@ -94,6 +95,7 @@ typedef struct {
     uint8_t npairs;
     uint8_t header_len; /* the leading constant's size (0: no header) */
     uint8_t prefix;     /* the classic parser waits for this many bytes before it judges a candidate (else 0) */
+    uint32_t error_flag; /* a command code with these bits set is an error reply (0: none) */
 } dynamixel_p2__layout_t;
 
 /* Where each element of a frame lies: wire bytes (start, end) and, inside the stuffed span, plain bytes. */
@@ -436,6 +438,7 @@ static int dynamixel_p2__unwrap(const dynamixel_p2__layout_t *L, const uint8_t *
 
 #if DYNAMIXEL_P2_ENABLE_PARSER
 static int dynamixel_p2__bounds(dynamixel_p2_direction_t dir, long code, size_t *low, size_t *high, int *bounded);
+static long dynamixel_p2__content_size(dynamixel_p2_direction_t dir, long code, const uint8_t *c, size_t avail);
 
 /* The size of a plausible frame of layout L at b[0..avail): DYNAMIXEL_P2__WAIT for more bytes, DYNAMIXEL_P2__NONE when none starts
  * there (runtime/framing.py FrameCodec.probe). */
@@ -459,7 +462,8 @@ static long dynamixel_p2__probe(const dynamixel_p2__layout_t *L, dynamixel_p2_di
                 return DYNAMIXEL_P2__NONE;
             }
         } else if (e->role == DYNAMIXEL_P2__ROLE_COMMAND) {
-            code = (long)dynamixel_p2__get(b + pos, e->size, e->big);
+            uint32_t value = dynamixel_p2__get(b + pos, e->size, e->big);
+            code = (value & L->error_flag) != 0u ? DYNAMIXEL_P2__ERROR_CODE : (long)value;
             if (!dynamixel_p2__bounds(dir, code, &low, &high, &bounded)) {
                 return DYNAMIXEL_P2__NONE;
             }
@@ -515,7 +519,21 @@ static long dynamixel_p2__probe(const dynamixel_p2__layout_t *L, dynamixel_p2_di
         }
         return DYNAMIXEL_P2__WAIT;
     }
-    return DYNAMIXEL_P2__NONE;
+    {
+        /* no length: the content's size follows from its own leading fields (a size rule), by code */
+        size_t overhead = 0u;
+        long size = dynamixel_p2__content_size(dir, code, b + before, avail - before);
+        if (size < 0) {
+            return size;
+        }
+        if ((size_t)size < low || (bounded && (size_t)size > high)) {
+            return DYNAMIXEL_P2__NONE;
+        }
+        for (k = 0u; k < L->count; k++) {
+            overhead += L->e[k].size;
+        }
+        return (long)overhead + size;
+    }
 }
 #endif
 
@@ -539,7 +557,7 @@ static const uint8_t dynamixel_p2__l_request_0_w0[] = {0xffu, 0xffu, 0xfdu, 0xfd
 static const dynamixel_p2__pair_t dynamixel_p2__l_request_0_pairs[] = {
     {dynamixel_p2__l_request_0_p0, dynamixel_p2__l_request_0_w0, 3u, 4u},
 };
-static const dynamixel_p2__layout_t dynamixel_p2__l_request_0 = {dynamixel_p2__l_request_0_e, 7u, 5, 4, 1u, 4u, 5u, dynamixel_p2__l_request_0_pairs, 1u, 3u, 0u};
+static const dynamixel_p2__layout_t dynamixel_p2__l_request_0 = {dynamixel_p2__l_request_0_e, 7u, 5, 4, 1u, 4u, 5u, dynamixel_p2__l_request_0_pairs, 1u, 3u, 0u, 0UL};
 
 /* The response frame. */
 /* Byte stuffing (protocol2 §Packet Process): from the instruction to the last parameter, every FF FF FD is sent as FF FF FD FD, so the header appears nowhere else in a packet. */
@@ -561,7 +579,7 @@ static const uint8_t dynamixel_p2__l_response_0_w0[] = {0xffu, 0xffu, 0xfdu, 0xf
 static const dynamixel_p2__pair_t dynamixel_p2__l_response_0_pairs[] = {
     {dynamixel_p2__l_response_0_p0, dynamixel_p2__l_response_0_w0, 3u, 4u},
 };
-static const dynamixel_p2__layout_t dynamixel_p2__l_response_0 = {dynamixel_p2__l_response_0_e, 8u, 6, -1, 1u, 4u, 6u, dynamixel_p2__l_response_0_pairs, 1u, 3u, 0u};
+static const dynamixel_p2__layout_t dynamixel_p2__l_response_0 = {dynamixel_p2__l_response_0_e, 8u, 6, -1, 1u, 4u, 6u, dynamixel_p2__l_response_0_pairs, 1u, 3u, 0u, 0UL};
 
 static const dynamixel_p2__layout_t *const dynamixel_p2__layouts_request[] = {&dynamixel_p2__l_request_0};
 static const dynamixel_p2__layout_t *const dynamixel_p2__layouts_response[] = {&dynamixel_p2__l_response_0};
@@ -584,6 +602,48 @@ static const dynamixel_p2__layout_t *const *dynamixel_p2__layouts(dynamixel_p2_d
 
 
 #if DYNAMIXEL_P2_ENABLE_PARSER
+/* Frames without a length: the content size from its own leading fields, by code (WAIT: those have not come). */
+static long dynamixel_p2__content_size(dynamixel_p2_direction_t dir, long code, const uint8_t *c, size_t avail)
+{
+    long size;
+    (void)c;
+    (void)avail;
+    (void)size;
+    switch (dir) {
+    case DYNAMIXEL_P2_REQUEST:
+        switch (code) {
+        case 1L:
+            size = 0L;
+            return size;
+        case 2L:
+            size = 4L;
+            return size;
+        case 5L:
+            size = 0L;
+            return size;
+        case 6L:
+            size = 1L;
+            return size;
+        case 8L:
+            size = 0L;
+            return size;
+        case 16L:
+            size = 5L;
+            return size;
+        default:
+            return DYNAMIXEL_P2__NONE;
+        }
+    case DYNAMIXEL_P2_RESPONSE:
+        switch (code) {
+
+        default:
+            return DYNAMIXEL_P2__NONE;
+        }
+    default:
+        return DYNAMIXEL_P2__NONE;
+    }
+}
+
 /* Content size bounds by command code: a candidate whose code or size is outside them is no frame. */
 static int dynamixel_p2__bounds(dynamixel_p2_direction_t dir, long code, size_t *low, size_t *high, int *bounded)
 {
@@ -1740,6 +1800,7 @@ static size_t dynamixel_p2__next(dynamixel_p2_parser_t *p, size_t start)
     }
     return p->n;
 #else
+    (void)p;
     return start;
 #endif
 }

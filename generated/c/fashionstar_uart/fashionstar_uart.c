@@ -16,6 +16,7 @@ typedef char fashionstar_uart__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 
 #define FASHIONSTAR_UART__MAX_ELEMENTS 5u
 #define FASHIONSTAR_UART__NO_CODE (-1L)
+#define FASHIONSTAR_UART__ERROR_CODE (-2L) /* any code with the error flag: an error reply */
 /* counting as serialspec.runtime.stream.StreamParser (1), else as framing.FrameStreamParser */
 #define FASHIONSTAR_UART__CLASSIC 1
 #define FASHIONSTAR_UART__HEADERS 1 /* every layout starts with a header: candidates start at headers only */
@@ -90,6 +91,7 @@ typedef struct {
     uint8_t npairs;
     uint8_t header_len; /* the leading constant's size (0: no header) */
     uint8_t prefix;     /* the classic parser waits for this many bytes before it judges a candidate (else 0) */
+    uint32_t error_flag; /* a command code with these bits set is an error reply (0: none) */
 } fashionstar_uart__layout_t;
 
 /* Where each element of a frame lies: wire bytes (start, end) and, inside the stuffed span, plain bytes. */
@@ -432,6 +434,7 @@ static int fashionstar_uart__unwrap(const fashionstar_uart__layout_t *L, const u
 
 #if FASHIONSTAR_UART_ENABLE_PARSER
 static int fashionstar_uart__bounds(fashionstar_uart_direction_t dir, long code, size_t *low, size_t *high, int *bounded);
+static long fashionstar_uart__content_size(fashionstar_uart_direction_t dir, long code, const uint8_t *c, size_t avail);
 
 /* The size of a plausible frame of layout L at b[0..avail): FASHIONSTAR_UART__WAIT for more bytes, FASHIONSTAR_UART__NONE when none starts
  * there (runtime/framing.py FrameCodec.probe). */
@@ -455,7 +458,8 @@ static long fashionstar_uart__probe(const fashionstar_uart__layout_t *L, fashion
                 return FASHIONSTAR_UART__NONE;
             }
         } else if (e->role == FASHIONSTAR_UART__ROLE_COMMAND) {
-            code = (long)fashionstar_uart__get(b + pos, e->size, e->big);
+            uint32_t value = fashionstar_uart__get(b + pos, e->size, e->big);
+            code = (value & L->error_flag) != 0u ? FASHIONSTAR_UART__ERROR_CODE : (long)value;
             if (!fashionstar_uart__bounds(dir, code, &low, &high, &bounded)) {
                 return FASHIONSTAR_UART__NONE;
             }
@@ -511,7 +515,21 @@ static long fashionstar_uart__probe(const fashionstar_uart__layout_t *L, fashion
         }
         return FASHIONSTAR_UART__WAIT;
     }
-    return FASHIONSTAR_UART__NONE;
+    {
+        /* no length: the content's size follows from its own leading fields (a size rule), by code */
+        size_t overhead = 0u;
+        long size = fashionstar_uart__content_size(dir, code, b + before, avail - before);
+        if (size < 0) {
+            return size;
+        }
+        if ((size_t)size < low || (bounded && (size_t)size > high)) {
+            return FASHIONSTAR_UART__NONE;
+        }
+        for (k = 0u; k < L->count; k++) {
+            overhead += L->e[k].size;
+        }
+        return (long)overhead + size;
+    }
 }
 #endif
 
@@ -526,7 +544,7 @@ static const fashionstar_uart__element_t fashionstar_uart__l_request_0_e[] = {
     {FASHIONSTAR_UART__ROLE_CONTENT, 0u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* content */
     {FASHIONSTAR_UART__ROLE_CHECKSUM, 1u, 0u, 0u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* checksum */
 };
-static const fashionstar_uart__layout_t fashionstar_uart__l_request_0 = {fashionstar_uart__l_request_0_e, 5u, 3, 1, 0u, 0u, 0u, NULL, 0u, 2u, 4u};
+static const fashionstar_uart__layout_t fashionstar_uart__l_request_0 = {fashionstar_uart__l_request_0_e, 5u, 3, 1, 0u, 0u, 0u, NULL, 0u, 2u, 4u, 0UL};
 
 /* The response frame. */
 static const uint8_t fashionstar_uart__l_response_0_c0[] = {0x05u, 0x1cu};
@@ -537,7 +555,7 @@ static const fashionstar_uart__element_t fashionstar_uart__l_response_0_e[] = {
     {FASHIONSTAR_UART__ROLE_CONTENT, 0u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* content */
     {FASHIONSTAR_UART__ROLE_CHECKSUM, 1u, 0u, 0u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* checksum */
 };
-static const fashionstar_uart__layout_t fashionstar_uart__l_response_0 = {fashionstar_uart__l_response_0_e, 5u, 3, 1, 0u, 0u, 0u, NULL, 0u, 2u, 4u};
+static const fashionstar_uart__layout_t fashionstar_uart__l_response_0 = {fashionstar_uart__l_response_0_e, 5u, 3, 1, 0u, 0u, 0u, NULL, 0u, 2u, 4u, 0UL};
 
 static const fashionstar_uart__layout_t *const fashionstar_uart__layouts_request[] = {&fashionstar_uart__l_request_0};
 static const fashionstar_uart__layout_t *const fashionstar_uart__layouts_response[] = {&fashionstar_uart__l_response_0};
@@ -581,6 +599,140 @@ static int32_t fashionstar_uart__s32(uint32_t v)
 #endif
 
 #if FASHIONSTAR_UART_ENABLE_PARSER
+/* Frames without a length: the content size from its own leading fields, by code (WAIT: those have not come). */
+static long fashionstar_uart__content_size(fashionstar_uart_direction_t dir, long code, const uint8_t *c, size_t avail)
+{
+    long size;
+    (void)c;
+    (void)avail;
+    (void)size;
+    switch (dir) {
+    case FASHIONSTAR_UART_REQUEST:
+        switch (code) {
+        case 1L:
+            size = 1L;
+            return size;
+        case 2L:
+            size = 1L;
+            return size;
+        case 3L:
+            size = 2L;
+            return size;
+        case 5L:
+            size = 1L;
+            return size;
+        case 6L:
+            size = 33L;
+            return size;
+        case 7L:
+            size = 6L;
+            return size;
+        case 8L:
+            size = 7L;
+            return size;
+        case 9L:
+            size = 3L;
+            return size;
+        case 10L:
+            size = 1L;
+            return size;
+        case 11L:
+            size = 11L;
+            return size;
+        case 12L:
+            size = 11L;
+            return size;
+        case 13L:
+            size = 11L;
+            return size;
+        case 14L:
+            size = 15L;
+            return size;
+        case 15L:
+            size = 13L;
+            return size;
+        case 16L:
+            size = 1L;
+            return size;
+        case 17L:
+            size = 1L;
+            return size;
+        case 18L:
+            size = 0L;
+            return size;
+        case 19L:
+            size = 1L;
+            return size;
+        case 22L:
+            size = 1L;
+            return size;
+        case 23L:
+            size = 2L;
+            return size;
+        case 24L:
+            size = 4L;
+            return size;
+        default:
+            return FASHIONSTAR_UART__NONE;
+        }
+    case FASHIONSTAR_UART_RESPONSE:
+        switch (code) {
+        case 1L:
+            size = 1L;
+            return size;
+        case 2L:
+            size = 2L;
+            return size;
+        case 4L:
+            size = 3L;
+            return size;
+        case 5L:
+            size = 33L;
+            return size;
+        case 6L:
+            size = 2L;
+            return size;
+        case 7L:
+            size = 2L;
+            return size;
+        case 8L:
+            size = 2L;
+            return size;
+        case 9L:
+            size = 2L;
+            return size;
+        case 10L:
+            size = 3L;
+            return size;
+        case 11L:
+            size = 2L;
+            return size;
+        case 12L:
+            size = 2L;
+            return size;
+        case 13L:
+            size = 2L;
+            return size;
+        case 14L:
+            size = 2L;
+            return size;
+        case 15L:
+            size = 2L;
+            return size;
+        case 16L:
+            size = 7L;
+            return size;
+        case 22L:
+            size = 16L;
+            return size;
+        default:
+            return FASHIONSTAR_UART__NONE;
+        }
+    default:
+        return FASHIONSTAR_UART__NONE;
+    }
+}
+
 /* Content size bounds by command code: a candidate whose code or size is outside them is no frame. */
 static int fashionstar_uart__bounds(fashionstar_uart_direction_t dir, long code, size_t *low, size_t *high, int *bounded)
 {
@@ -4012,6 +4164,7 @@ static size_t fashionstar_uart__next(fashionstar_uart_parser_t *p, size_t start)
     }
     return p->n;
 #else
+    (void)p;
     return start;
 #endif
 }

@@ -16,6 +16,7 @@ typedef char feetech_sms__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 
 #define FEETECH_SMS__MAX_ELEMENTS 6u
 #define FEETECH_SMS__NO_CODE (-1L)
+#define FEETECH_SMS__ERROR_CODE (-2L) /* any code with the error flag: an error reply */
 /* counting as serialspec.runtime.stream.StreamParser (1), else as framing.FrameStreamParser */
 #define FEETECH_SMS__CLASSIC 1
 #define FEETECH_SMS__HEADERS 1 /* every layout starts with a header: candidates start at headers only */
@@ -90,6 +91,7 @@ typedef struct {
     uint8_t npairs;
     uint8_t header_len; /* the leading constant's size (0: no header) */
     uint8_t prefix;     /* the classic parser waits for this many bytes before it judges a candidate (else 0) */
+    uint32_t error_flag; /* a command code with these bits set is an error reply (0: none) */
 } feetech_sms__layout_t;
 
 /* Where each element of a frame lies: wire bytes (start, end) and, inside the stuffed span, plain bytes. */
@@ -432,6 +434,7 @@ static int feetech_sms__unwrap(const feetech_sms__layout_t *L, const uint8_t *fr
 
 #if FEETECH_SMS_ENABLE_PARSER
 static int feetech_sms__bounds(feetech_sms_direction_t dir, long code, size_t *low, size_t *high, int *bounded);
+static long feetech_sms__content_size(feetech_sms_direction_t dir, long code, const uint8_t *c, size_t avail);
 
 /* The size of a plausible frame of layout L at b[0..avail): FEETECH_SMS__WAIT for more bytes, FEETECH_SMS__NONE when none starts
  * there (runtime/framing.py FrameCodec.probe). */
@@ -455,7 +458,8 @@ static long feetech_sms__probe(const feetech_sms__layout_t *L, feetech_sms_direc
                 return FEETECH_SMS__NONE;
             }
         } else if (e->role == FEETECH_SMS__ROLE_COMMAND) {
-            code = (long)feetech_sms__get(b + pos, e->size, e->big);
+            uint32_t value = feetech_sms__get(b + pos, e->size, e->big);
+            code = (value & L->error_flag) != 0u ? FEETECH_SMS__ERROR_CODE : (long)value;
             if (!feetech_sms__bounds(dir, code, &low, &high, &bounded)) {
                 return FEETECH_SMS__NONE;
             }
@@ -511,7 +515,21 @@ static long feetech_sms__probe(const feetech_sms__layout_t *L, feetech_sms_direc
         }
         return FEETECH_SMS__WAIT;
     }
-    return FEETECH_SMS__NONE;
+    {
+        /* no length: the content's size follows from its own leading fields (a size rule), by code */
+        size_t overhead = 0u;
+        long size = feetech_sms__content_size(dir, code, b + before, avail - before);
+        if (size < 0) {
+            return size;
+        }
+        if ((size_t)size < low || (bounded && (size_t)size > high)) {
+            return FEETECH_SMS__NONE;
+        }
+        for (k = 0u; k < L->count; k++) {
+            overhead += L->e[k].size;
+        }
+        return (long)overhead + size;
+    }
 }
 #endif
 
@@ -527,7 +545,7 @@ static const feetech_sms__element_t feetech_sms__l_request_0_e[] = {
     {FEETECH_SMS__ROLE_CONTENT, 0u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* params */
     {FEETECH_SMS__ROLE_CHECKSUM, 1u, 0u, 1u, 4u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* checksum */
 };
-static const feetech_sms__layout_t feetech_sms__l_request_0 = {feetech_sms__l_request_0_e, 6u, 4, 3, 0u, 0u, 0u, NULL, 0u, 2u, 5u};
+static const feetech_sms__layout_t feetech_sms__l_request_0 = {feetech_sms__l_request_0_e, 6u, 4, 3, 0u, 0u, 0u, NULL, 0u, 2u, 5u, 0UL};
 
 /* The response frame. */
 static const uint8_t feetech_sms__l_response_0_c0[] = {0xffu, 0xffu};
@@ -539,7 +557,7 @@ static const feetech_sms__element_t feetech_sms__l_response_0_e[] = {
     {FEETECH_SMS__ROLE_CONTENT, 0u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* params */
     {FEETECH_SMS__ROLE_CHECKSUM, 1u, 0u, 1u, 4u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* checksum */
 };
-static const feetech_sms__layout_t feetech_sms__l_response_0 = {feetech_sms__l_response_0_e, 6u, 4, -1, 0u, 0u, 0u, NULL, 0u, 2u, 4u};
+static const feetech_sms__layout_t feetech_sms__l_response_0 = {feetech_sms__l_response_0_e, 6u, 4, -1, 0u, 0u, 0u, NULL, 0u, 2u, 4u, 0UL};
 
 static const feetech_sms__layout_t *const feetech_sms__layouts_request[] = {&feetech_sms__l_request_0};
 static const feetech_sms__layout_t *const feetech_sms__layouts_response[] = {&feetech_sms__l_response_0};
@@ -562,6 +580,42 @@ static const feetech_sms__layout_t *const *feetech_sms__layouts(feetech_sms_dire
 
 
 #if FEETECH_SMS_ENABLE_PARSER
+/* Frames without a length: the content size from its own leading fields, by code (WAIT: those have not come). */
+static long feetech_sms__content_size(feetech_sms_direction_t dir, long code, const uint8_t *c, size_t avail)
+{
+    long size;
+    (void)c;
+    (void)avail;
+    (void)size;
+    switch (dir) {
+    case FEETECH_SMS_REQUEST:
+        switch (code) {
+        case 1L:
+            size = 0L;
+            return size;
+        case 2L:
+            size = 2L;
+            return size;
+        case 5L:
+            size = 0L;
+            return size;
+        case 6L:
+            size = 0L;
+            return size;
+        default:
+            return FEETECH_SMS__NONE;
+        }
+    case FEETECH_SMS_RESPONSE:
+        switch (code) {
+
+        default:
+            return FEETECH_SMS__NONE;
+        }
+    default:
+        return FEETECH_SMS__NONE;
+    }
+}
+
 /* Content size bounds by command code: a candidate whose code or size is outside them is no frame. */
 static int feetech_sms__bounds(feetech_sms_direction_t dir, long code, size_t *low, size_t *high, int *bounded)
 {
@@ -1312,6 +1366,7 @@ static size_t feetech_sms__next(feetech_sms_parser_t *p, size_t start)
     }
     return p->n;
 #else
+    (void)p;
     return start;
 #endif
 }

@@ -16,6 +16,7 @@ typedef char hiwonder_rrc__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 
 #define HIWONDER_RRC__MAX_ELEMENTS 5u
 #define HIWONDER_RRC__NO_CODE (-1L)
+#define HIWONDER_RRC__ERROR_CODE (-2L) /* any code with the error flag: an error reply */
 /* counting as serialspec.runtime.stream.StreamParser (1), else as framing.FrameStreamParser */
 #define HIWONDER_RRC__CLASSIC 1
 #define HIWONDER_RRC__HEADERS 1 /* every layout starts with a header: candidates start at headers only */
@@ -94,6 +95,7 @@ typedef struct {
     uint8_t npairs;
     uint8_t header_len; /* the leading constant's size (0: no header) */
     uint8_t prefix;     /* the classic parser waits for this many bytes before it judges a candidate (else 0) */
+    uint32_t error_flag; /* a command code with these bits set is an error reply (0: none) */
 } hiwonder_rrc__layout_t;
 
 /* Where each element of a frame lies: wire bytes (start, end) and, inside the stuffed span, plain bytes. */
@@ -436,6 +438,7 @@ static int hiwonder_rrc__unwrap(const hiwonder_rrc__layout_t *L, const uint8_t *
 
 #if HIWONDER_RRC_ENABLE_PARSER
 static int hiwonder_rrc__bounds(hiwonder_rrc_direction_t dir, long code, size_t *low, size_t *high, int *bounded);
+static long hiwonder_rrc__content_size(hiwonder_rrc_direction_t dir, long code, const uint8_t *c, size_t avail);
 
 /* The size of a plausible frame of layout L at b[0..avail): HIWONDER_RRC__WAIT for more bytes, HIWONDER_RRC__NONE when none starts
  * there (runtime/framing.py FrameCodec.probe). */
@@ -459,7 +462,8 @@ static long hiwonder_rrc__probe(const hiwonder_rrc__layout_t *L, hiwonder_rrc_di
                 return HIWONDER_RRC__NONE;
             }
         } else if (e->role == HIWONDER_RRC__ROLE_COMMAND) {
-            code = (long)hiwonder_rrc__get(b + pos, e->size, e->big);
+            uint32_t value = hiwonder_rrc__get(b + pos, e->size, e->big);
+            code = (value & L->error_flag) != 0u ? HIWONDER_RRC__ERROR_CODE : (long)value;
             if (!hiwonder_rrc__bounds(dir, code, &low, &high, &bounded)) {
                 return HIWONDER_RRC__NONE;
             }
@@ -515,7 +519,21 @@ static long hiwonder_rrc__probe(const hiwonder_rrc__layout_t *L, hiwonder_rrc_di
         }
         return HIWONDER_RRC__WAIT;
     }
-    return HIWONDER_RRC__NONE;
+    {
+        /* no length: the content's size follows from its own leading fields (a size rule), by code */
+        size_t overhead = 0u;
+        long size = hiwonder_rrc__content_size(dir, code, b + before, avail - before);
+        if (size < 0) {
+            return size;
+        }
+        if ((size_t)size < low || (bounded && (size_t)size > high)) {
+            return HIWONDER_RRC__NONE;
+        }
+        for (k = 0u; k < L->count; k++) {
+            overhead += L->e[k].size;
+        }
+        return (long)overhead + size;
+    }
 }
 #endif
 
@@ -530,7 +548,7 @@ static const hiwonder_rrc__element_t hiwonder_rrc__l_request_0_e[] = {
     {HIWONDER_RRC__ROLE_CONTENT, 0u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* data */
     {HIWONDER_RRC__ROLE_CHECKSUM, 1u, 0u, 1u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* crc */
 };
-static const hiwonder_rrc__layout_t hiwonder_rrc__l_request_0 = {hiwonder_rrc__l_request_0_e, 5u, 3, 1, 0u, 0u, 0u, NULL, 0u, 2u, 4u};
+static const hiwonder_rrc__layout_t hiwonder_rrc__l_request_0 = {hiwonder_rrc__l_request_0_e, 5u, 3, 1, 0u, 0u, 0u, NULL, 0u, 2u, 4u, 0UL};
 
 /* The response frame. */
 static const uint8_t hiwonder_rrc__l_response_0_c0[] = {0xaau, 0x55u};
@@ -541,7 +559,7 @@ static const hiwonder_rrc__element_t hiwonder_rrc__l_response_0_e[] = {
     {HIWONDER_RRC__ROLE_CONTENT, 0u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* data */
     {HIWONDER_RRC__ROLE_CHECKSUM, 1u, 0u, 1u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* crc */
 };
-static const hiwonder_rrc__layout_t hiwonder_rrc__l_response_0 = {hiwonder_rrc__l_response_0_e, 5u, 3, 1, 0u, 0u, 0u, NULL, 0u, 2u, 4u};
+static const hiwonder_rrc__layout_t hiwonder_rrc__l_response_0 = {hiwonder_rrc__l_response_0_e, 5u, 3, 1, 0u, 0u, 0u, NULL, 0u, 2u, 4u, 0UL};
 
 static const hiwonder_rrc__layout_t *const hiwonder_rrc__layouts_request[] = {&hiwonder_rrc__l_request_0};
 static const hiwonder_rrc__layout_t *const hiwonder_rrc__layouts_response[] = {&hiwonder_rrc__l_response_0};
@@ -603,6 +621,60 @@ static uint32_t hiwonder_rrc__f32bits(float f)
 #endif
 
 #if HIWONDER_RRC_ENABLE_PARSER
+/* Frames without a length: the content size from its own leading fields, by code (WAIT: those have not come). */
+static long hiwonder_rrc__content_size(hiwonder_rrc_direction_t dir, long code, const uint8_t *c, size_t avail)
+{
+    long size;
+    (void)c;
+    (void)avail;
+    (void)size;
+    switch (dir) {
+    case HIWONDER_RRC_REQUEST:
+        switch (code) {
+        case 1L:
+            size = 7L;
+            return size;
+        case 2L:
+            size = 8L;
+            return size;
+        case 10L:
+            size = 2L;
+            if (avail < 2u) { return HIWONDER_RRC__WAIT; }
+            size += 1L * (long)hiwonder_rrc__get(c + 1, 1u, 0u);
+            return size;
+        case 11L:
+            size = 2L;
+            if (avail < 2u) { return HIWONDER_RRC__WAIT; }
+            size += 4L * (long)hiwonder_rrc__get(c + 1, 1u, 0u);
+            return size;
+        default:
+            return HIWONDER_RRC__NONE;
+        }
+    case HIWONDER_RRC_RESPONSE:
+        switch (code) {
+        case 6L:
+            size = 2L;
+            return size;
+        case 7L:
+            size = 24L;
+            return size;
+        case 8L:
+            size = 7L;
+            return size;
+        case 9L:
+            size = 36L;
+            return size;
+        case 0L:
+            size = 3L;
+            return size;
+        default:
+            return HIWONDER_RRC__NONE;
+        }
+    default:
+        return HIWONDER_RRC__NONE;
+    }
+}
+
 /* Content size bounds by command code: a candidate whose code or size is outside them is no frame. */
 static int hiwonder_rrc__bounds(hiwonder_rrc_direction_t dir, long code, size_t *low, size_t *high, int *bounded)
 {
@@ -3980,6 +4052,7 @@ static size_t hiwonder_rrc__next(hiwonder_rrc_parser_t *p, size_t start)
     }
     return p->n;
 #else
+    (void)p;
     return start;
 #endif
 }

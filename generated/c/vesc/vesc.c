@@ -16,6 +16,7 @@ typedef char vesc__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 
 #define VESC__MAX_ELEMENTS 6u
 #define VESC__NO_CODE (-1L)
+#define VESC__ERROR_CODE (-2L) /* any code with the error flag: an error reply */
 /* counting as serialspec.runtime.stream.StreamParser (1), else as framing.FrameStreamParser */
 #define VESC__CLASSIC 0
 #define VESC__HEADERS 1 /* every layout starts with a header: candidates start at headers only */
@@ -94,6 +95,7 @@ typedef struct {
     uint8_t npairs;
     uint8_t header_len; /* the leading constant's size (0: no header) */
     uint8_t prefix;     /* the classic parser waits for this many bytes before it judges a candidate (else 0) */
+    uint32_t error_flag; /* a command code with these bits set is an error reply (0: none) */
 } vesc__layout_t;
 
 /* Where each element of a frame lies: wire bytes (start, end) and, inside the stuffed span, plain bytes. */
@@ -436,6 +438,7 @@ static int vesc__unwrap(const vesc__layout_t *L, const uint8_t *frame, size_t n,
 
 #if VESC_ENABLE_PARSER
 static int vesc__bounds(vesc_direction_t dir, long code, size_t *low, size_t *high, int *bounded);
+static long vesc__content_size(vesc_direction_t dir, long code, const uint8_t *c, size_t avail);
 
 /* The size of a plausible frame of layout L at b[0..avail): VESC__WAIT for more bytes, VESC__NONE when none starts
  * there (runtime/framing.py FrameCodec.probe). */
@@ -459,7 +462,8 @@ static long vesc__probe(const vesc__layout_t *L, vesc_direction_t dir, const uin
                 return VESC__NONE;
             }
         } else if (e->role == VESC__ROLE_COMMAND) {
-            code = (long)vesc__get(b + pos, e->size, e->big);
+            uint32_t value = vesc__get(b + pos, e->size, e->big);
+            code = (value & L->error_flag) != 0u ? VESC__ERROR_CODE : (long)value;
             if (!vesc__bounds(dir, code, &low, &high, &bounded)) {
                 return VESC__NONE;
             }
@@ -515,7 +519,21 @@ static long vesc__probe(const vesc__layout_t *L, vesc_direction_t dir, const uin
         }
         return VESC__WAIT;
     }
-    return VESC__NONE;
+    {
+        /* no length: the content's size follows from its own leading fields (a size rule), by code */
+        size_t overhead = 0u;
+        long size = vesc__content_size(dir, code, b + before, avail - before);
+        if (size < 0) {
+            return size;
+        }
+        if ((size_t)size < low || (bounded && (size_t)size > high)) {
+            return VESC__NONE;
+        }
+        for (k = 0u; k < L->count; k++) {
+            overhead += L->e[k].size;
+        }
+        return (long)overhead + size;
+    }
 }
 #endif
 
@@ -532,7 +550,7 @@ static const vesc__element_t vesc__l_request_0_e[] = {
     {VESC__ROLE_CHECKSUM, 2u, 1u, 2u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* crc */
     {VESC__ROLE_CONSTANT, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, vesc__l_request_0_c5},  /* end */
 };
-static const vesc__layout_t vesc__l_request_0 = {vesc__l_request_0_e, 6u, 3, 2, 0u, 0u, 0u, NULL, 0u, 1u, 0u};
+static const vesc__layout_t vesc__l_request_0 = {vesc__l_request_0_e, 6u, 3, 2, 0u, 0u, 0u, NULL, 0u, 1u, 0u, 0UL};
 
 /* The request frame long. */
 static const uint8_t vesc__l_request_1_c0[] = {0x03u};
@@ -545,7 +563,7 @@ static const vesc__element_t vesc__l_request_1_e[] = {
     {VESC__ROLE_CHECKSUM, 2u, 1u, 2u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* crc */
     {VESC__ROLE_CONSTANT, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, vesc__l_request_1_c5},  /* end */
 };
-static const vesc__layout_t vesc__l_request_1 = {vesc__l_request_1_e, 6u, 3, 2, 0u, 0u, 0u, NULL, 0u, 1u, 0u};
+static const vesc__layout_t vesc__l_request_1 = {vesc__l_request_1_e, 6u, 3, 2, 0u, 0u, 0u, NULL, 0u, 1u, 0u, 0UL};
 
 /* The response frame short. */
 static const uint8_t vesc__l_response_0_c0[] = {0x02u};
@@ -558,7 +576,7 @@ static const vesc__element_t vesc__l_response_0_e[] = {
     {VESC__ROLE_CHECKSUM, 2u, 1u, 2u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* crc */
     {VESC__ROLE_CONSTANT, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, vesc__l_response_0_c5},  /* end */
 };
-static const vesc__layout_t vesc__l_response_0 = {vesc__l_response_0_e, 6u, 3, 2, 0u, 0u, 0u, NULL, 0u, 1u, 0u};
+static const vesc__layout_t vesc__l_response_0 = {vesc__l_response_0_e, 6u, 3, 2, 0u, 0u, 0u, NULL, 0u, 1u, 0u, 0UL};
 
 /* The response frame long. */
 static const uint8_t vesc__l_response_1_c0[] = {0x03u};
@@ -571,7 +589,7 @@ static const vesc__element_t vesc__l_response_1_e[] = {
     {VESC__ROLE_CHECKSUM, 2u, 1u, 2u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* crc */
     {VESC__ROLE_CONSTANT, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, vesc__l_response_1_c5},  /* end */
 };
-static const vesc__layout_t vesc__l_response_1 = {vesc__l_response_1_e, 6u, 3, 2, 0u, 0u, 0u, NULL, 0u, 1u, 0u};
+static const vesc__layout_t vesc__l_response_1 = {vesc__l_response_1_e, 6u, 3, 2, 0u, 0u, 0u, NULL, 0u, 1u, 0u, 0UL};
 
 static const vesc__layout_t *const vesc__layouts_request[] = {&vesc__l_request_0, &vesc__l_request_1};
 static const vesc__layout_t *const vesc__layouts_response[] = {&vesc__l_response_0, &vesc__l_response_1};
@@ -659,6 +677,62 @@ static int vesc__utf8(const uint8_t *s, size_t n)
 #endif
 
 #if VESC_ENABLE_PARSER
+/* Frames without a length: the content size from its own leading fields, by code (WAIT: those have not come). */
+static long vesc__content_size(vesc_direction_t dir, long code, const uint8_t *c, size_t avail)
+{
+    long size;
+    (void)c;
+    (void)avail;
+    (void)size;
+    switch (dir) {
+    case VESC_REQUEST:
+        switch (code) {
+        case 0L:
+            size = 0L;
+            return size;
+        case 4L:
+            size = 0L;
+            return size;
+        case 5L:
+            size = 4L;
+            return size;
+        case 6L:
+            size = 4L;
+            return size;
+        case 7L:
+            size = 4L;
+            return size;
+        case 8L:
+            size = 4L;
+            return size;
+        case 9L:
+            size = 4L;
+            return size;
+        case 10L:
+            size = 4L;
+            return size;
+        case 30L:
+            size = 0L;
+            return size;
+        default:
+            return VESC__NONE;
+        }
+    case VESC_RESPONSE:
+        switch (code) {
+        case 4L:
+            size = 73L;
+            return size;
+        case 22L:
+            size = 4L;
+            return size;
+        default:
+            return VESC__NONE;
+        }
+    default:
+        return VESC__NONE;
+    }
+}
+
 /* Content size bounds by command code: a candidate whose code or size is outside them is no frame. */
 static int vesc__bounds(vesc_direction_t dir, long code, size_t *low, size_t *high, int *bounded)
 {
@@ -1816,6 +1890,7 @@ static size_t vesc__next(vesc_parser_t *p, size_t start)
     }
     return p->n;
 #else
+    (void)p;
     return start;
 #endif
 }

@@ -9,6 +9,7 @@ C target cannot generate yet raise Unsupported naming the feature (`serialspec g
 from __future__ import annotations
 
 import hashlib
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import assert_never
@@ -16,6 +17,8 @@ from typing import assert_never
 from serialspec.backends import Unsupported
 from serialspec.backends.c.checksums import CChecksum, c_checksum
 from serialspec.backends.common.text import collapse
+from serialspec.lang import expression
+from serialspec.lang.expression import Expr
 from serialspec.lang.model import (
     Array,
     BitField,
@@ -157,8 +160,6 @@ class Ctx:
 
 def refuse_unsupported(protocol: Protocol) -> None:
     """Raise Unsupported naming the first feature of the spec the C target cannot generate yet."""
-    if protocol.error_reply is not None:
-        raise Unsupported("error replies (a flag in the command code: `error_reply`)")
     for command in protocol.commands:
         if command.selector is not None and command.selector.type.size != 1:
             raise Unsupported(f"sub-command selectors of more than one byte (command {command.name})")
@@ -193,29 +194,27 @@ def refuse_layout(layout: FrameLayout) -> None:
             crc = e.checksum.crc
             if crc is None or not 8 <= crc.width <= 32:
                 raise Unsupported(f"{where}: a CRC of width {crc.width if crc else '?'}")
-    trailer = elements[-1].role == "trailer" and len(elements) > 1
-    if length < 0 and not (trailer and t is not None):
-        raise Unsupported(f"{where}: frames without a length element (content sized by its own fields)")
 
 
-def refuse_fields(fields: tuple[Field, ...], where: str) -> None:
+def refuse_fields(fields: tuple[Field, ...], where: str, nested: bool = False) -> None:
     for f in fields:
         match f:
             case Scalar():
-                if f.value is not None:
-                    raise Unsupported(f"{where}: {f.name}: a value computed by an expression")
+                if f.value is not None and nested:
+                    raise Unsupported(f"{where}: {f.name}: a value computed by an expression inside a group")
                 if f.sign_magnitude:
                     raise Unsupported(f"{where}: {f.name}: sign-magnitude numbers")
             case Array():
                 pass
             case List():
-                raise Unsupported(f"{where}: {f.name}: lists (field kind `list`)")
+                if f.item is not None and f.item.is_float:
+                    raise Unsupported(f"{where}: {f.name}: lists of floats")
             case Text():
                 pass
             case Bytes():
                 pass
             case Group():
-                refuse_fields(f.fields, where)
+                refuse_fields(f.fields, where, True)
             case TableValue() | TableBlock():
                 entries = f.entries if isinstance(f, TableBlock) else f.table.entries
                 for e in entries:
@@ -241,9 +240,14 @@ def value_elements(protocol: Protocol, direction: Direction) -> tuple[tuple[str,
     return tuple((e.name, e.type) for e in layout.value_elements if e.type is not None)
 
 
-def code_of(protocol: Protocol, message: Message) -> int | None:
-    layout = protocol.framing.layouts[message.direction]
-    return protocol.command(message.command).code if layout.has_command else None
+def error_element(protocol: Protocol, message: Message) -> tuple[str, ScalarType] | None:
+    """An error reply's extra member: the refused request's code, from the command element."""
+    error = protocol.error_reply
+    if not message.error_reply or error is None:
+        return None
+    element = next(e for e in protocol.framing.layouts[message.direction].elements if e.name == error.element)
+    assert element.type is not None
+    return error.element, element.type
 
 
 # --- sizes and capacities ------------------------------------------------------------------------------------------
@@ -354,7 +358,15 @@ def members(ctx: Ctx, fields: tuple[Field, ...], path: str, room: int) -> list[M
                 ctx.structs.append(f"/* {comment(f.description)} */\ntypedef struct {{\n{body}\n}} {block};\n")
                 found.append(Member(name, f"{block} {name};", doc))
             case List():
-                raise Unsupported(f"{path}: {f.name}")
+                if f.item is None:  # bits, 8 to a byte, the first in the lowest bit (as on the wire)
+                    macro = cap_macro(ctx, f"{path}_{f.name}", max(1, min(room, DEFAULT_MAX_BYTES)))
+                    found.append(Member(name, f"uint8_t {name}[{macro}];", doc + "; bits, 8 to a byte"))
+                    found.append(Member(f"{name}_count", f"size_t {name}_count;", f"bits in {f.name}"))
+                else:
+                    most = max(1, min(room // f.item.size, DEFAULT_MAX_BYTES))
+                    macro = cap_macro(ctx, f"{path}_{f.name}", most)
+                    found.append(Member(name, f"{ctype(f.item)} {name}[{macro}];", doc))
+                    found.append(Member(f"{name}_count", f"size_t {name}_count;", f"items in {f.name}"))
             case _:
                 assert_never(f)
     return found
@@ -507,9 +519,80 @@ def decode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                     out.append(f"{pad}{tgt}.{ident(e.name)} = {value}; /* {e.key} */")
                     out.append(f"{pad}o += {e.type.size}u;")
             case List():
-                raise Unsupported(f.name)
+                item = f.item.size if f.item is not None else 0
+                if f.size:  # sized in bytes by a field
+                    out.append(f"{pad}len = (size_t){scope.lookup(f.size)};")
+                    if item > 1:
+                        out.append(f"{pad}if (len % {item}u != 0u) {{ return {ctx.P}_E_LENGTH; }}")
+                    count = "len * 8u" if not item else "len" if item == 1 else f"len / {item}u"
+                elif f.count == "rest":
+                    out.append(f"{pad}len = n - o;")
+                    if item > 1:
+                        out.append(f"{pad}if (len % {item}u != 0u) {{ return {ctx.P}_E_LENGTH; }}")
+                    count = "len * 8u" if not item else "len" if item == 1 else f"len / {item}u"
+                else:
+                    number = f"{f.count}u" if isinstance(f.count, int) else f"(size_t){scope.lookup(f.count)}"
+                    out.append(f"{pad}{tgt}_count = {number};")
+                    out.append(
+                        f"{pad}len = ({tgt}_count + 7u) / 8u;" if not item else f"{pad}len = {tgt}_count * {item}u;"
+                    )
+                    count = ""
+                out.append(f"{pad}if (n - o < len) {{ return {ctx.P}_E_LENGTH; }}")
+                if count:
+                    out.append(f"{pad}{tgt}_count = {count};")
+                capacity = f"sizeof({tgt})" if not item else f"(sizeof({tgt}) / sizeof({tgt}[0]))"
+                out.append(
+                    f"{pad}if ({'len' if not item else tgt + '_count'} > {capacity}) {{ return {ctx.P}_E_CAPACITY; }}"
+                )
+                if f.item is None:
+                    out.append(f"{pad}memcpy({tgt}, c + o, len);")
+                else:
+                    out.append(f"{pad}for (i{depth} = 0u; i{depth} < {tgt}_count; i{depth}++) {{")
+                    value = read_scalar(ctx, f.item, f.endian, f"c + o + i{depth} * {item}u")
+                    out.append(f"{pad}    {tgt}[i{depth}] = {value};")
+                    out.append(f"{pad}}}")
+                out.append(f"{pad}o += len;")
             case _:
                 assert_never(f)
+
+
+def render_c(expr: Expr, name: Callable[[str], str], length: Callable[[str], str]) -> str:
+    """An expression of the spec in C, over int64_t: `name(field)` and `length(list)` give the operands."""
+    match expr:
+        case expression.Const():
+            return f"(int64_t){expr.value}"
+        case expression.Name():
+            return f"(int64_t){name(expr.name)}"
+        case expression.Length():
+            return f"(int64_t){length(expr.name)}"
+        case expression.BinOp():
+            return f"({render_c(expr.left, name, length)} {expr.op} {render_c(expr.right, name, length)})"
+        case expression.Invert():
+            return f"(~{render_c(expr.operand, name, length)})"
+        case expression.Ceil():
+            a, b = render_c(expr.numerator, name, length), render_c(expr.denominator, name, length)
+            return f"(({a} + {b} - 1) / {b})"
+        case expression.MinMax():
+            args = [render_c(a, name, length) for a in expr.args]
+            result = args[0]
+            for arg in args[1:]:
+                pick = "<" if expr.function == "min" else ">"
+                result = f"({result} {pick} {arg} ? {result} : {arg})"
+            return result
+        case _:
+            assert_never(expr)
+
+
+def value_checks(ctx: Ctx, fields: tuple[Field, ...], scope: Scope) -> list[str]:
+    """Decode: every value the spec computes by an expression recomputed from the frame's fields, and compared."""
+    lines = []
+    for f in fields:
+        if isinstance(f, Scalar) and f.value is not None:
+            computed = render_c(f.value, scope.lookup, lambda list_name: f"{scope.target}{ident(list_name)}_count")
+            lines.append(
+                f"    if ((int64_t){scope.lookup(f.name)} != {computed}) {{ return {ctx.P}_E_CONTENT; }} /* {f.name} */"
+            )
+    return lines
 
 
 def uses(fields: tuple[Field, ...], kinds: tuple[type, ...]) -> bool:
@@ -531,7 +614,7 @@ def decoder(ctx: Ctx, message: Message) -> str:
     body: list[str] = []
     decode_fields(ctx, message.fields, scope, body, 1)
     locals_ = ["    size_t o = 0u;"]
-    if uses(message.fields, (Bytes, Text)):
+    if uses(message.fields, (Bytes, Text, List)):
         locals_.append("    size_t len;")
     if any(isinstance(f, Text) and f.terminated for f in message.fields):
         locals_.append("    size_t k;")
@@ -560,6 +643,7 @@ def decoder(ctx: Ctx, message: Message) -> str:
             size_check,
             *body,
             f"    if (o != n) {{ return {ctx.P}_E_LENGTH; }}",
+            *value_checks(ctx, message.fields, scope),
             f"    return {ctx.P}_OK;",
             "}",
             "",
@@ -653,7 +737,16 @@ def check_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[st
                     if test:
                         out.append(f"{pad}if ({test}) {{ return {ctx.P}_E_RANGE; }} /* {f.name}.{e.name} */")
             case List():
-                raise Unsupported(f.name)
+                capacity = f"sizeof({tgt}) * 8u" if f.item is None else f"sizeof({tgt}) / sizeof({tgt}[0])"
+                out.append(f"{pad}if ({tgt}_count > {capacity}) {{ return {ctx.P}_E_RANGE; }} /* {f.name} */")
+                if isinstance(f.count, int):
+                    out.append(f"{pad}if ({tgt}_count != {f.count}u) {{ return {ctx.P}_E_RANGE; }} /* {f.name} */")
+                if f.item is not None:
+                    test = range_test(f.minimum, f.maximum, f.item, f"{tgt}[i{depth}]")
+                    if test:
+                        out.append(f"{pad}for (i{depth} = 0u; i{depth} < {tgt}_count; i{depth}++) {{")
+                        out.append(f"{pad}    if ({test}) {{ return {ctx.P}_E_RANGE; }} /* {f.name} */")
+                        out.append(f"{pad}}}")
             case _:
                 assert_never(f)
 
@@ -707,6 +800,8 @@ def encode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                     value = f"{f.const}UL"
                 elif f.derived:
                     value = scope.lookup(f.name)
+                elif f.value is not None:
+                    value = f"(uint32_t){scope.lookup(f.name)}"
                 else:
                     value = scalar_bits(ctx, f.type, tgt)
                 out.append(f"{pad}if (cap - o < {size}u) {{ return {ctx.P}_E_BUFFER; }}")
@@ -777,9 +872,41 @@ def encode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                     out.append(f"{pad}{ctx.p}__put(c + o, {e.type.size}u, {big}u, {value}); /* {e.key} */")
                     out.append(f"{pad}o += {e.type.size}u;")
             case List():
-                raise Unsupported(f.name)
+                if f.item is None:
+                    out.append(f"{pad}len = ({tgt}_count + 7u) / 8u;")
+                    out.append(f"{pad}if (cap - o < len) {{ return {ctx.P}_E_BUFFER; }}")
+                    out.append(f"{pad}memcpy(c + o, {tgt}, len); /* {f.name} */")
+                    out.append(f"{pad}if ({tgt}_count % 8u != 0u) {{ /* the last byte's unused bits are 0 */")
+                    out.append(
+                        f"{pad}    c[o + len - 1u] = (uint8_t)(c[o + len - 1u] & ((1u << ({tgt}_count % 8u)) - 1u));"
+                    )
+                    out.append(f"{pad}}}")
+                    out.append(f"{pad}o += len;")
+                else:
+                    size = f.item.size
+                    big = 1 if f.endian == ">" else 0
+                    out.append(f"{pad}if ((cap - o) / {size}u < {tgt}_count) {{ return {ctx.P}_E_BUFFER; }}")
+                    out.append(f"{pad}for (i{depth} = 0u; i{depth} < {tgt}_count; i{depth}++) {{")
+                    value = scalar_bits(ctx, f.item, f"{tgt}[i{depth}]")
+                    out.append(f"{pad}    {ctx.p}__put(c + o, {size}u, {big}u, {value}); /* {f.name} */")
+                    out.append(f"{pad}    o += {size}u;")
+                    out.append(f"{pad}}}")
             case _:
                 assert_never(f)
+
+
+def computed_values(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[str]) -> None:
+    """Encode: the values the spec computes by an expression, in field order, each range-checked."""
+    for f in fields:
+        if isinstance(f, Scalar) and f.value is not None:
+            local = f"v1_{ident(f.name)}"
+            computed = render_c(f.value, scope.lookup, lambda list_name: f"{scope.target}{ident(list_name)}_count")
+            out.append(f"    {local} = {computed};")
+            out.append(
+                f"    if ({local} < {int(f.minimum)}LL || {local} > {int(f.maximum)}LL) "
+                f"{{ return {ctx.P}_E_RANGE; }} /* {f.name} */"
+            )
+            scope.names[f.name] = local
 
 
 def encoder(ctx: Ctx, message: Message) -> str:
@@ -792,6 +919,9 @@ def encoder(ctx: Ctx, message: Message) -> str:
     for f in message.fields:
         if isinstance(f, Scalar) and f.derived:
             derived_value(ctx, f, message.fields, scope, derived, "    ", 1)
+    for name in [x.name for x in message.fields if not (isinstance(x, Scalar) and x.hidden)]:
+        scope.names.setdefault(name, f"m->{ident(name)}")
+    computed_values(ctx, message.fields, scope, derived)
     uses_j = "j" in ctx.helpers
     ctx.helpers.discard("j")
     body: list[str] = []
@@ -806,6 +936,10 @@ def encoder(ctx: Ctx, message: Message) -> str:
     for f in message.fields:
         if isinstance(f, Scalar) and f.derived:
             locals_.append(f"    uint32_t v1_{ident(f.name)};")
+        elif isinstance(f, Scalar) and f.value is not None:
+            locals_.append(f"    int64_t v1_{ident(f.name)};")
+    if any(isinstance(f, List) and f.item is None for f in message.fields):
+        locals_.append("    size_t len;")
     return "\n".join(
         [
             f"/* The content of {message.key} ({message.direction.value}): every value checked against the spec's",
@@ -883,7 +1017,16 @@ def json_fields(ctx: Ctx, fields: tuple[Field, ...], target: str, out: list[str]
                     out.append(pad + json_number(ctx, e.type, f"{tgt}.{ident(e.name)}"))
                 out.append(f'{pad}{ctx.p}__ws(w, "}}");')
             case List():
-                raise Unsupported(f.name)
+                out.append(f'{pad}{ctx.p}__ws(w, "[");')
+                out.append(f"{pad}for (i{depth} = 0u; i{depth} < {tgt}_count; i{depth}++) {{")
+                out.append(f'{pad}    if (i{depth}) {{ {ctx.p}__ws(w, ", "); }}')
+                if f.item is None:
+                    bit = f"({tgt}[i{depth} / 8u] >> (i{depth} % 8u)) & 1u"
+                    out.append(f'{pad}    {ctx.p}__ws(w, ({bit}) ? "true" : "false");')
+                else:
+                    out.append(f"{pad}    " + json_number(ctx, f.item, f"{tgt}[i{depth}]"))
+                out.append(f"{pad}}}")
+                out.append(f'{pad}{ctx.p}__ws(w, "]");')
             case _:
                 assert_never(f)
     return first
@@ -922,6 +1065,11 @@ def json_function(ctx: Ctx, message: Message) -> str:
             json_bits(ctx, e.bits, f"m->{ident(e.name)}", body, "    ")
         else:
             body.append(f"    {ctx.p}__wu(w, (uint32_t)m->{ident(e.name)});")
+    error = ctx.protocol.error_reply
+    if message.error_reply and error is not None:
+        body.append(f'    {ctx.p}__ws(w, "{"" if first else ", "}\\"{error.element}\\": ");')
+        body.append(f"    {ctx.p}__wu(w, (uint32_t)m->{ident(error.element)});")
+        first = False
     json_fields(ctx, message.fields, "m->", body, 1, first)
     text = "\n".join(body)
     locals_ = [f"    size_t i{d};" for d in range(1, depth_of(message.fields) + 2) if f"i{d}" in text]

@@ -47,6 +47,7 @@ typedef struct {
     uint8_t npairs;
     uint8_t header_len; /* the leading constant's size (0: no header) */
     uint8_t prefix;     /* the classic parser waits for this many bytes before it judges a candidate (else 0) */
+    uint32_t error_flag; /* a command code with these bits set is an error reply (0: none) */
 } pfx__layout_t;
 
 /* Where each element of a frame lies: wire bytes (start, end) and, inside the stuffed span, plain bytes. */
@@ -389,6 +390,7 @@ static int pfx__unwrap(const pfx__layout_t *L, const uint8_t *frame, size_t n, u
 
 #if PFX_ENABLE_PARSER
 static int pfx__bounds(pfx_direction_t dir, long code, size_t *low, size_t *high, int *bounded);
+static long pfx__content_size(pfx_direction_t dir, long code, const uint8_t *c, size_t avail);
 
 /* The size of a plausible frame of layout L at b[0..avail): PFX__WAIT for more bytes, PFX__NONE when none starts
  * there (runtime/framing.py FrameCodec.probe). */
@@ -412,7 +414,8 @@ static long pfx__probe(const pfx__layout_t *L, pfx_direction_t dir, const uint8_
                 return PFX__NONE;
             }
         } else if (e->role == PFX__ROLE_COMMAND) {
-            code = (long)pfx__get(b + pos, e->size, e->big);
+            uint32_t value = pfx__get(b + pos, e->size, e->big);
+            code = (value & L->error_flag) != 0u ? PFX__ERROR_CODE : (long)value;
             if (!pfx__bounds(dir, code, &low, &high, &bounded)) {
                 return PFX__NONE;
             }
@@ -468,7 +471,21 @@ static long pfx__probe(const pfx__layout_t *L, pfx_direction_t dir, const uint8_
         }
         return PFX__WAIT;
     }
-    return PFX__NONE;
+    {
+        /* no length: the content's size follows from its own leading fields (a size rule), by code */
+        size_t overhead = 0u;
+        long size = pfx__content_size(dir, code, b + before, avail - before);
+        if (size < 0) {
+            return size;
+        }
+        if ((size_t)size < low || (bounded && (size_t)size > high)) {
+            return PFX__NONE;
+        }
+        for (k = 0u; k < L->count; k++) {
+            overhead += L->e[k].size;
+        }
+        return (long)overhead + size;
+    }
 }
 #endif
 """

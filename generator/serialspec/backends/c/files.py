@@ -10,6 +10,7 @@ from serialspec.backends.c.emit import (
     content_max,
     decoder,
     encoder,
+    error_element,
     frame_max,
     ident,
     json_function,
@@ -20,7 +21,7 @@ from serialspec.backends.c.emit import (
     value_elements,
 )
 from serialspec.backends.c.engine import ENGINE
-from serialspec.lang.model import Direction, FrameLayout, Message, Protocol
+from serialspec.lang.model import Direction, FrameLayout, Message, Protocol, size_terms
 
 DIRECTIONS = (Direction.REQUEST, Direction.RESPONSE)
 
@@ -56,9 +57,12 @@ def header(ctx: Ctx) -> str:
         if m.max_size is not None:
             room = min(room, m.max_size)
         mems = [
-            f"    {t.name.replace('u', 'uint', 1) if False else _ctype_of(t)} {ident(name)};  /* frame {name} */"
+            f"    {_ctype_of(t)} {ident(name)};  /* frame {name} */"
             for name, t in value_elements(protocol, m.direction)
         ]
+        element = error_element(protocol, m)
+        if element is not None:
+            mems.append(f"    {_ctype_of(element[1])} {ident(element[0])};  /* the code of the request refused */")
         for member in members(ctx, m.fields, mid, room):
             mems.append(f"    {member.decl}{'  /* ' + member.doc + ' */' if member.doc else ''}")
         title = protocol.command(m.command).title or m.key
@@ -258,6 +262,8 @@ def layout_tables(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) -
     header_len = len(layout.header)
     tf = names.index(t.first) if t else 0
     tl = names.index(t.last) if t else 0
+    error = ctx.protocol.error_reply
+    error_flag = error.flag if error is not None and direction == Direction.RESPONSE else 0
     prefix = 0
     if ctx.protocol.framing.classic:  # stream.StreamParser: a candidate waits until its key and values have come
         offset = 0
@@ -270,7 +276,8 @@ def layout_tables(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) -
                 break
     lines.append(
         f"static const {p}__layout_t {name} = {{{name}_e, {len(layout.elements)}u, {content}, {command}, "
-        f"{1 if t else 0}u, {tf}u, {tl}u, {pairs}, {len(t.replace) if t else 0}u, {header_len}u, {prefix}u}};"
+        f"{1 if t else 0}u, {tf}u, {tl}u, {pairs}, {len(t.replace) if t else 0}u, {header_len}u, {prefix}u, "
+        f"{error_flag}UL}};"
     )
     if t:
         lines.insert(0, f"/* {comment(t.description)} */")
@@ -325,7 +332,7 @@ def source(ctx: Ctx) -> str:
             low = min(u.min_size for u in users)
             highs = [u.max_size for u in users]
             high = None if None in highs else max(h or 0 for h in highs)
-            key = f"{code}L" if code is not None else f"{P}__NO_CODE"
+            key = code_key(P, code)
             rows.append(
                 f"        case {key}: *low = {low}u; *high = {high or 0}u; *bounded = {0 if high is None else 1}; "
                 "return 1;"
@@ -340,10 +347,24 @@ def source(ctx: Ctx) -> str:
     for d in directions(protocol):
         rows = []
         values = value_elements(protocol, d)
+        error_first = []
         for code, users in messages_by_code(protocol, d).items():
-            key = f"{code}L" if code is not None else f"{P}__NO_CODE"
+            key = code_key(P, code)
             command = protocol.command(users[0].command)
             body = []
+            if code == ERROR_CODE and protocol.error_reply is not None:
+                error = protocol.error_reply
+                element = error_element(protocol, users[0])
+                assert element is not None
+                keep = ((1 << (8 * element[1].size)) - 1) & ~error.flag
+                error_first = [
+                    f"        if (code >= 0 && ((unsigned long)code & {error.flag}UL) != 0u) {{",
+                    f"            out->u.{msg_id(users[0])}.{ident(error.element)} = "
+                    f"({_ctype_of(element[1])})((unsigned long)code & {keep}UL);",
+                    f"            {dec_call(ctx, users[0], values)}",
+                    "        }",
+                ]
+                continue
             if command.selector is not None:  # sub-commands: told apart by the selector byte in the content
                 offset = command.selector.offsets[d]
                 body.append(f"            if (n <= {offset}u) {{ return {P}_E_LENGTH; }}")
@@ -364,7 +385,9 @@ def source(ctx: Ctx) -> str:
                 body.append(f"            {dec_call(ctx, default, values)}")
             rows.append(f"        case {key}: {{\n" + "\n".join(body) + "\n        }")
         dec_cases.append(
-            f"    case {P}_{d.name}:\n        switch (code) {{\n"
+            f"    case {P}_{d.name}:\n"
+            + "".join(line + "\n" for line in error_first)
+            + "        switch (code) {\n"
             + "\n".join(rows)
             + f"\n        default: return {P}_E_UNKNOWN;\n        }}"
         )
@@ -374,9 +397,15 @@ def source(ctx: Ctx) -> str:
         mid = msg_id(m)
         layout = protocol.framing.layouts[m.direction]
         values = value_elements(protocol, m.direction)
-        code = protocol.command(m.command).code if layout.has_command else None
+        number = protocol.command(m.command).code if layout.has_command else None
+        wire_code = f"{number if number is not None else 0}UL"
         vchecks = []
         vsets = []
+        element = error_element(protocol, m)
+        if element is not None and protocol.error_reply is not None:
+            flag = protocol.error_reply.flag
+            vchecks.append(f"    if ((m->{ident(element[0])} & {flag}u) != 0u) {{ return {P}_E_RANGE; }}")
+            wire_code = f"((uint32_t)m->{ident(element[0])} | {flag}UL)"
         for i, (name, t) in enumerate(values):
             e = next(e for e in layout.value_elements if e.name == name)
             test = []
@@ -402,7 +431,7 @@ def source(ctx: Ctx) -> str:
                     *vchecks,
                     *vsets,
                     *([] if values else ["    values[0] = 0u;"]),
-                    f"    return {p}__frame({P}_{m.direction.name}, {code if code is not None else 0}UL, values, m, "
+                    f"    return {p}__frame({P}_{m.direction.name}, {wire_code}, values, m, "
                     f"{p}__enc_{mid}, buf, cap, len);",
                     "}",
                     "",
@@ -442,6 +471,7 @@ typedef char {p}__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 
 #define {P}__MAX_ELEMENTS {max_elements}u
 #define {P}__NO_CODE (-1L)
+#define {P}__ERROR_CODE (-2L) /* any code with the error flag: an error reply */
 /* counting as serialspec.runtime.stream.StreamParser (1), else as framing.FrameStreamParser */
 #define {P}__CLASSIC {classic}
 #define {P}__HEADERS {has_headers} /* every layout starts with a header: candidates start at headers only */
@@ -478,6 +508,20 @@ static const {p}__layout_t *const *{p}__layouts({p}_direction_t dir, uint8_t *co
 
 {helpers}
 #if {P}_ENABLE_PARSER
+/* Frames without a length: the content size from its own leading fields, by code (WAIT: those have not come). */
+static long {p}__content_size({p}_direction_t dir, long code, const uint8_t *c, size_t avail)
+{{
+    long size;
+    (void)c;
+    (void)avail;
+    (void)size;
+    switch (dir) {{
+{chr(10).join(size_rule_cases(ctx, d) for d in directions(protocol))}
+    default:
+        return {P}__NONE;
+    }}
+}}
+
 /* Content size bounds by command code: a candidate whose code or size is outside them is no frame. */
 static int {p}__bounds({p}_direction_t dir, long code, size_t *low, size_t *high, int *bounded)
 {{
@@ -692,6 +736,7 @@ static size_t {p}__next({p}_parser_t *p, size_t start)
     }}
     return p->n;
 #else
+    (void)p;
     return start;
 #endif
 }}
@@ -798,14 +843,45 @@ const char *{p}_result_name(int result)
 """
 
 
+ERROR_CODE = -2  # the key of the error reply (any code with the error flag), as runtime.framing.ERROR_REPLY
+
+
 def messages_by_code(protocol: Protocol, direction: Direction) -> dict[int | None, list[Message]]:
-    """A direction's messages by the command code their frames carry (None: the layout carries none)."""
+    """A direction's messages by the command code their frames carry (None: the layout carries none; ERROR_CODE:
+    the error reply)."""
     layout = protocol.framing.layouts[direction]
     found: dict[int | None, list[Message]] = {}
     for m in messages(protocol):
         if m.direction == direction:
-            found.setdefault(protocol.command(m.command).code if layout.has_command else None, []).append(m)
+            code = ERROR_CODE if m.error_reply else protocol.command(m.command).code if layout.has_command else None
+            found.setdefault(code, []).append(m)
     return found
+
+
+def code_key(P: str, code: int | None) -> str:
+    return f"{P}__NO_CODE" if code is None else f"{P}__ERROR_CODE" if code == ERROR_CODE else f"{code}L"
+
+
+def size_rule_cases(ctx: Ctx, direction: Direction) -> str:
+    """The content size of each code whose one message is sized by its own leading fields (model.size_terms)."""
+    rows = []
+    for code, users in messages_by_code(ctx.protocol, direction).items():
+        found = size_terms(users[0].fields) if len(users) == 1 else None
+        if found is None:
+            continue
+        fixed, terms = found
+        body = [f"        case {code_key(ctx.P, code)}:", f"            size = {fixed}L;"]
+        for offset, size, endian, factor in terms:
+            big = 1 if endian == "big" else 0
+            body.append(f"            if (avail < {offset + size}u) {{ return {ctx.P}__WAIT; }}")
+            body.append(f"            size += {factor}L * (long){ctx.p}__get(c + {offset}, {size}u, {big}u);")
+        body.append("            return size;")
+        rows.append("\n".join(body))
+    return (
+        f"    case {ctx.P}_{direction.name}:\n        switch (code) {{\n"
+        + "\n".join(rows)
+        + f"\n        default:\n            return {ctx.P}__NONE;\n        }}"
+    )
 
 
 def span_decl_all(decls: dict[Direction, str], P: str) -> str:

@@ -189,7 +189,7 @@ def test_random_messages_encode_and_decode_as_python_does(g: Generated, spec: Me
     cls = message_class(g, spec)
     kind = kind_of(g, cls)
 
-    @settings(max_examples=examples(8), deadline=None, suppress_health_check=[HealthCheck.too_slow])
+    @settings(max_examples=examples(5), deadline=None, suppress_health_check=[HealthCheck.too_slow])
     @given(message_fields(g.protocol, spec), st.data())
     def agree(fields: dict[str, Any], data: st.DataObject) -> None:
         frame = g.package.encode(cls.from_fields(fields))
@@ -236,7 +236,7 @@ def check_decode_agrees(g: Generated, frame: bytes, direction: Direction) -> Non
 
 @pytest.mark.parametrize("g", C_SPECS, ids=IDS)
 def test_random_bytes_are_refused_or_decoded_as_python_does(g: Generated) -> None:
-    @settings(max_examples=examples(100), deadline=None)
+    @settings(max_examples=examples(60), deadline=None)
     @given(st.binary(max_size=24), st.sampled_from(list(g.protocol.framing.layouts)))
     def agree(frame: bytes, direction: Direction) -> None:
         header = g.protocol.framing.layouts[direction].header
@@ -284,7 +284,7 @@ def python_stream(g: Generated, direction: Direction, data: bytes) -> tuple[list
 def test_noisy_streams_in_random_pieces_give_what_python_gives(g: Generated) -> None:
     directions = list(g.protocol.framing.layouts)
 
-    @settings(max_examples=examples(40), deadline=None, suppress_health_check=[HealthCheck.too_slow])
+    @settings(max_examples=examples(20), deadline=None, suppress_health_check=[HealthCheck.too_slow])
     @given(st.sampled_from(directions).flatmap(lambda d: st.tuples(st.just(d), noisy_stream(g, d))), st.data())
     def agree(case: tuple[Direction, bytes], data: st.DataObject) -> None:
         direction, stream = case
@@ -301,3 +301,34 @@ def test_noisy_streams_in_random_pieces_give_what_python_gives(g: Generated) -> 
         assert counters == python_counters
 
     agree()
+
+
+@pytest.mark.parametrize("g", C_SPECS, ids=IDS)
+def test_feature_switches_leave_out_encode_decode_or_parser_without_a_warning(g: Generated, tmp_path: Path) -> None:
+    assert GCC is not None
+    upper = g.protocol.name.upper()
+    builds = (
+        [f"-D{upper}_ENABLE_ENCODE=0"],  # decode and parser
+        [f"-D{upper}_ENABLE_DECODE=0", f"-D{upper}_ENABLE_PARSER=0"],  # encode only
+    )
+    for switches in builds:
+        command = [GCC, *FLAGS, "-Os", *switches, "-c", str(sources(g)[0]), "-o", str(tmp_path / "x.o")]
+        run = subprocess.run(command, capture_output=True)
+        assert run.returncode == 0 and not run.stderr, run.stderr.decode()
+
+
+@pytest.mark.parametrize("g", C_SPECS, ids=IDS)
+def test_fuzz_harness_finds_nothing_in_seeded_random_runs(g: Generated, tmp_path: Path) -> None:
+    """tests/c/fuzz.c as gcc-only CI runs it: seeded random inputs under the sanitizers (with clang, the same file
+    is a libFuzzer target: -fsanitize=fuzzer -DFUZZ_LIBFUZZER)."""
+    assert GCC is not None
+    name = g.protocol.name
+    c, j = sources(g)
+    exe = tmp_path / "fuzz"
+    include = ["-I", str(c.parent), f"-DPROTO={name}", f"-DPROTO_UPPER={name.upper()}", "-include", f"{name}_json.h"]
+    build = [GCC, "-std=c99", "-O1", *SANITIZE, *include, str(ROOT / "tests/c/fuzz.c"), str(c), str(j), "-o", str(exe)]
+    run = subprocess.run(build, capture_output=True)
+    assert run.returncode == 0, run.stderr.decode()
+    run = subprocess.run([str(exe), str(examples(300)), "12345"], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    assert "no failure" in run.stdout

@@ -1788,14 +1788,20 @@ static size_t dynamixel_p2__next(dynamixel_p2_parser_t *p, size_t start)
     const dynamixel_p2__layout_t *const *layouts = dynamixel_p2__layouts(p->dir, &count);
     size_t pos;
     for (pos = start; pos < p->n; pos++) {
+        int whole = 1; /* every header could be read here: a position none matches is never a candidate */
         if (p->verdict[pos] == DYNAMIXEL_P2__V_NONE) {
             continue;
         }
         for (k = 0u; k < count; k++) {
             const dynamixel_p2__layout_t *L = layouts[k];
-            if (L->header_len <= p->n - pos && memcmp(p->buf + pos, L->e[0].constant, L->header_len) == 0) {
+            if (L->header_len > p->n - pos) {
+                whole = 0;
+            } else if (memcmp(p->buf + pos, L->e[0].constant, L->header_len) == 0) {
                 return pos;
             }
+        }
+        if (whole) {
+            p->verdict[pos] = DYNAMIXEL_P2__V_NONE;
         }
     }
     return p->n;

@@ -1354,14 +1354,20 @@ static size_t feetech_sms__next(feetech_sms_parser_t *p, size_t start)
     const feetech_sms__layout_t *const *layouts = feetech_sms__layouts(p->dir, &count);
     size_t pos;
     for (pos = start; pos < p->n; pos++) {
+        int whole = 1; /* every header could be read here: a position none matches is never a candidate */
         if (p->verdict[pos] == FEETECH_SMS__V_NONE) {
             continue;
         }
         for (k = 0u; k < count; k++) {
             const feetech_sms__layout_t *L = layouts[k];
-            if (L->header_len <= p->n - pos && memcmp(p->buf + pos, L->e[0].constant, L->header_len) == 0) {
+            if (L->header_len > p->n - pos) {
+                whole = 0;
+            } else if (memcmp(p->buf + pos, L->e[0].constant, L->header_len) == 0) {
                 return pos;
             }
+        }
+        if (whole) {
+            p->verdict[pos] = FEETECH_SMS__V_NONE;
         }
     }
     return p->n;

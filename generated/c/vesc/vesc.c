@@ -1878,14 +1878,20 @@ static size_t vesc__next(vesc_parser_t *p, size_t start)
     const vesc__layout_t *const *layouts = vesc__layouts(p->dir, &count);
     size_t pos;
     for (pos = start; pos < p->n; pos++) {
+        int whole = 1; /* every header could be read here: a position none matches is never a candidate */
         if (p->verdict[pos] == VESC__V_NONE) {
             continue;
         }
         for (k = 0u; k < count; k++) {
             const vesc__layout_t *L = layouts[k];
-            if (L->header_len <= p->n - pos && memcmp(p->buf + pos, L->e[0].constant, L->header_len) == 0) {
+            if (L->header_len > p->n - pos) {
+                whole = 0;
+            } else if (memcmp(p->buf + pos, L->e[0].constant, L->header_len) == 0) {
                 return pos;
             }
+        }
+        if (whole) {
+            p->verdict[pos] = VESC__V_NONE;
         }
     }
     return p->n;

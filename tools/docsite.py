@@ -35,7 +35,12 @@ td code { white-space: nowrap; }
 
 def pages() -> dict[str, str]:
     """Repository path -> site path of every page."""
-    found = {"README.md": "index.md", "docs/tutorial.md": "tutorial.md", "docs/language.md": "language.md"}
+    found = {
+        "README.md": "index.md",
+        "docs/tutorial.md": "tutorial.md",
+        "docs/language.md": "language.md",
+        "docs/c.md": "c.md",
+    }
     for doc in sorted((ROOT / "generated" / "docs").glob("*.md")):
         found[f"generated/docs/{doc.name}"] = f"protocols/{doc.name}"
     return found
@@ -81,6 +86,7 @@ def config(mapping: dict[str, str], site: Path) -> dict[str, object]:
             {"Home": "index.md"},
             {"Tutorial": "tutorial.md"},
             {"Language reference": "language.md"},
+            {"C target": "c.md"},
             {"Protocols": protocols},
         ],
     }

@@ -332,3 +332,25 @@ def test_fuzz_harness_finds_nothing_in_seeded_random_runs(g: Generated, tmp_path
     run = subprocess.run([str(exe), str(examples(300)), "12345"], capture_output=True, text=True)
     assert run.returncode == 0, run.stderr
     assert "no failure" in run.stdout
+
+
+def test_example_host_program_talks_to_a_virtual_servo(tmp_path: Path) -> None:
+    """examples/c/feetech_ping.c, built against the generated C, pings and reads a servo `serialspec sim` serves."""
+    from sim_process import serve
+
+    assert GCC is not None
+    folder = GENERATED_C / "feetech_sms"
+    exe = tmp_path / "feetech_ping"
+    sources = [
+        str(ROOT / "examples/c/feetech_ping.c"),
+        str(folder / "feetech_sms.c"),
+        str(folder / "feetech_sms_json.c"),
+    ]
+    run = subprocess.run([GCC, "-std=c99", "-Wall", "-Wextra", "-Werror", "-I", str(folder), *sources, "-o", str(exe)])
+    assert run.returncode == 0
+    with serve("feetech_sms.yaml", 1) as path:
+        run = subprocess.run([str(exe), path, "1"], capture_output=True, text=True, timeout=30)
+    assert run.returncode == 0, run.stderr
+    ping, read = (json.loads(line) for line in run.stdout.splitlines())
+    assert ping["fields"] == {"id": 1, "error": 0, "data": ""}
+    assert read["command"] == "reply" and len(bytes.fromhex(read["fields"]["data"])) == 6

@@ -96,6 +96,12 @@ typedef struct {
     uint8_t header_len; /* the leading constant's size (0: no header) */
     uint8_t prefix;     /* the classic parser waits for this many bytes before it judges a candidate (else 0) */
     uint32_t error_flag; /* a command code with these bits set is an error reply (0: none) */
+    uint16_t overhead;   /* every element's size but the content's */
+    uint16_t before;     /* bytes before the variable part (the stuffed span, else the content) */
+    uint16_t after;      /* bytes after it */
+    int8_t length;       /* index of the length element (before the variable part), -1 without */
+    uint16_t length_off; /* its offset */
+    uint16_t counted;    /* the fixed sizes of the elements it counts */
 } dynamixel_p2__layout_t;
 
 /* Where each element of a frame lies: wire bytes (start, end) and, inside the stuffed span, plain bytes. */
@@ -336,12 +342,8 @@ static int dynamixel_p2__unwrap(const dynamixel_p2__layout_t *L, const uint8_t *
     int last = dynamixel_p2__inner_last(L);
     const uint8_t *bytes;
     const uint8_t *body = frame;
-    for (k = 0u; k < first; k++) {
-        before += L->e[k].size;
-    }
-    for (k = L->count; (int)k - 1 > last; k--) {
-        after += L->e[k - 1u].size;
-    }
+    before = L->before;
+    after = L->after;
     if (n < before + after) {
         return DYNAMIXEL_P2_E_LENGTH;
     }
@@ -445,7 +447,7 @@ static long dynamixel_p2__content_size(dynamixel_p2_direction_t dir, long code, 
 static long dynamixel_p2__probe(const dynamixel_p2__layout_t *L, dynamixel_p2_direction_t dir, const uint8_t *b, size_t avail)
 {
     size_t pos = 0u, low = 0u, high = 0u, before = 0u;
-    int bounded = 0, known;
+    int bounded = 0;
     uint8_t k, first = dynamixel_p2__inner_first(L);
     long code = DYNAMIXEL_P2__NO_CODE;
     if (avail < L->prefix) {
@@ -484,31 +486,15 @@ static long dynamixel_p2__probe(const dynamixel_p2__layout_t *L, dynamixel_p2_di
         low = 0u; /* the code lies in the stuffed span: no bounds before the frame is unstuffed */
         bounded = 0;
     }
-    known = 0;
-    for (k = 0u; k < first; k++) {
-        const dynamixel_p2__element_t *e = &L->e[k];
-        if (e->role == DYNAMIXEL_P2__ROLE_LENGTH) {
-            size_t off = 0u, counted_fixed = 0u, overhead = 0u;
-            uint8_t i;
-            long counted, content;
-            for (i = 0u; i < k; i++) {
-                off += L->e[i].size;
-            }
-            for (i = 0u; i < L->count; i++) {
-                overhead += L->e[i].size;
-            }
-            for (i = e->first; i <= e->last; i++) {
-                counted_fixed += L->e[i].size;
-            }
-            counted = (long)dynamixel_p2__get(b + off, e->size, e->big) - (long)e->adds;
-            content = counted - (long)counted_fixed;
-            if (content < (long)low || (!L->has_t && bounded && content > (long)high)) {
-                return DYNAMIXEL_P2__NONE;
-            }
-            return (long)(overhead - counted_fixed) + counted;
+    if (L->length >= 0) {
+        const dynamixel_p2__element_t *e = &L->e[L->length];
+        long counted = (long)dynamixel_p2__get(b + L->length_off, e->size, e->big) - (long)e->adds;
+        long content = counted - (long)L->counted;
+        if (content < (long)low || (!L->has_t && bounded && content > (long)high)) {
+            return DYNAMIXEL_P2__NONE;
         }
+        return (long)(L->overhead - L->counted) + counted;
     }
-    (void)known;
     if (L->has_t && L->e[L->count - 1u].role == DYNAMIXEL_P2__ROLE_CONSTANT && L->count > 1u) {
         const dynamixel_p2__element_t *t = &L->e[L->count - 1u];
         size_t i;
@@ -521,7 +507,6 @@ static long dynamixel_p2__probe(const dynamixel_p2__layout_t *L, dynamixel_p2_di
     }
     {
         /* no length: the content's size follows from its own leading fields (a size rule), by code */
-        size_t overhead = 0u;
         long size = dynamixel_p2__content_size(dir, code, b + before, avail - before);
         if (size < 0) {
             return size;
@@ -529,10 +514,7 @@ static long dynamixel_p2__probe(const dynamixel_p2__layout_t *L, dynamixel_p2_di
         if ((size_t)size < low || (bounded && (size_t)size > high)) {
             return DYNAMIXEL_P2__NONE;
         }
-        for (k = 0u; k < L->count; k++) {
-            overhead += L->e[k].size;
-        }
-        return (long)overhead + size;
+        return (long)L->overhead + size;
     }
 }
 #endif
@@ -557,7 +539,7 @@ static const uint8_t dynamixel_p2__l_request_0_w0[] = {0xffu, 0xffu, 0xfdu, 0xfd
 static const dynamixel_p2__pair_t dynamixel_p2__l_request_0_pairs[] = {
     {dynamixel_p2__l_request_0_p0, dynamixel_p2__l_request_0_w0, 3u, 4u},
 };
-static const dynamixel_p2__layout_t dynamixel_p2__l_request_0 = {dynamixel_p2__l_request_0_e, 7u, 5, 4, 1u, 4u, 5u, dynamixel_p2__l_request_0_pairs, 1u, 3u, 0u, 0UL};
+static const dynamixel_p2__layout_t dynamixel_p2__l_request_0 = {dynamixel_p2__l_request_0_e, 7u, 5, 4, 1u, 4u, 5u, dynamixel_p2__l_request_0_pairs, 1u, 3u, 0u, 0UL, 10u, 7u, 2u, 3, 5u, 3u};
 
 /* The response frame. */
 /* Byte stuffing (protocol2 §Packet Process): from the instruction to the last parameter, every FF FF FD is sent as FF FF FD FD, so the header appears nowhere else in a packet. */
@@ -579,7 +561,7 @@ static const uint8_t dynamixel_p2__l_response_0_w0[] = {0xffu, 0xffu, 0xfdu, 0xf
 static const dynamixel_p2__pair_t dynamixel_p2__l_response_0_pairs[] = {
     {dynamixel_p2__l_response_0_p0, dynamixel_p2__l_response_0_w0, 3u, 4u},
 };
-static const dynamixel_p2__layout_t dynamixel_p2__l_response_0 = {dynamixel_p2__l_response_0_e, 8u, 6, -1, 1u, 4u, 6u, dynamixel_p2__l_response_0_pairs, 1u, 3u, 0u, 0UL};
+static const dynamixel_p2__layout_t dynamixel_p2__l_response_0 = {dynamixel_p2__l_response_0_e, 8u, 6, -1, 1u, 4u, 6u, dynamixel_p2__l_response_0_pairs, 1u, 3u, 0u, 0UL, 11u, 7u, 2u, 3, 5u, 4u};
 
 static const dynamixel_p2__layout_t *const dynamixel_p2__layouts_request[] = {&dynamixel_p2__l_request_0};
 static const dynamixel_p2__layout_t *const dynamixel_p2__layouts_response[] = {&dynamixel_p2__l_response_0};
@@ -1751,8 +1733,14 @@ static int dynamixel_p2__try(dynamixel_p2_parser_t *p, size_t pos, dynamixel_p2_
     if (p->verdict[pos] != 0u) {
         return p->verdict[pos];
     }
+    if (pos == 0u && p->first > p->n) { /* its size is known and its bytes have not all come */
+        return DYNAMIXEL_P2__V_WAIT;
+    }
     for (k = 0u; k < count; k++) {
         long s = dynamixel_p2__probe(layouts[k], p->dir, p->buf + pos, p->n - pos);
+        if (pos == 0u && count == 1u && s > 0) {
+            p->first = (size_t)s;
+        }
         if (s == DYNAMIXEL_P2__WAIT) {
             waiting = 1;
             continue;
@@ -1822,6 +1810,7 @@ static int dynamixel_p2__push(dynamixel_p2_parser_t *p, uint8_t byte, dynamixel_
         memmove(p->verdict, p->verdict + 1, p->n - 1u);
         p->n--;
         p->garbage++;
+        p->first = 0u;
     }
     p->buf[p->n] = byte;
     p->verdict[p->n] = 0u;
@@ -1872,6 +1861,7 @@ static int dynamixel_p2__push(dynamixel_p2_parser_t *p, uint8_t byte, dynamixel_
         memmove(p->buf, p->buf + cut, p->n - cut);
         memmove(p->verdict, p->verdict + cut, p->n - cut);
         p->n -= cut;
+        p->first = 0u;
     }
     return got;
 }

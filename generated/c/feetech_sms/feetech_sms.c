@@ -92,6 +92,12 @@ typedef struct {
     uint8_t header_len; /* the leading constant's size (0: no header) */
     uint8_t prefix;     /* the classic parser waits for this many bytes before it judges a candidate (else 0) */
     uint32_t error_flag; /* a command code with these bits set is an error reply (0: none) */
+    uint16_t overhead;   /* every element's size but the content's */
+    uint16_t before;     /* bytes before the variable part (the stuffed span, else the content) */
+    uint16_t after;      /* bytes after it */
+    int8_t length;       /* index of the length element (before the variable part), -1 without */
+    uint16_t length_off; /* its offset */
+    uint16_t counted;    /* the fixed sizes of the elements it counts */
 } feetech_sms__layout_t;
 
 /* Where each element of a frame lies: wire bytes (start, end) and, inside the stuffed span, plain bytes. */
@@ -332,12 +338,8 @@ static int feetech_sms__unwrap(const feetech_sms__layout_t *L, const uint8_t *fr
     int last = feetech_sms__inner_last(L);
     const uint8_t *bytes;
     const uint8_t *body = frame;
-    for (k = 0u; k < first; k++) {
-        before += L->e[k].size;
-    }
-    for (k = L->count; (int)k - 1 > last; k--) {
-        after += L->e[k - 1u].size;
-    }
+    before = L->before;
+    after = L->after;
     if (n < before + after) {
         return FEETECH_SMS_E_LENGTH;
     }
@@ -441,7 +443,7 @@ static long feetech_sms__content_size(feetech_sms_direction_t dir, long code, co
 static long feetech_sms__probe(const feetech_sms__layout_t *L, feetech_sms_direction_t dir, const uint8_t *b, size_t avail)
 {
     size_t pos = 0u, low = 0u, high = 0u, before = 0u;
-    int bounded = 0, known;
+    int bounded = 0;
     uint8_t k, first = feetech_sms__inner_first(L);
     long code = FEETECH_SMS__NO_CODE;
     if (avail < L->prefix) {
@@ -480,31 +482,15 @@ static long feetech_sms__probe(const feetech_sms__layout_t *L, feetech_sms_direc
         low = 0u; /* the code lies in the stuffed span: no bounds before the frame is unstuffed */
         bounded = 0;
     }
-    known = 0;
-    for (k = 0u; k < first; k++) {
-        const feetech_sms__element_t *e = &L->e[k];
-        if (e->role == FEETECH_SMS__ROLE_LENGTH) {
-            size_t off = 0u, counted_fixed = 0u, overhead = 0u;
-            uint8_t i;
-            long counted, content;
-            for (i = 0u; i < k; i++) {
-                off += L->e[i].size;
-            }
-            for (i = 0u; i < L->count; i++) {
-                overhead += L->e[i].size;
-            }
-            for (i = e->first; i <= e->last; i++) {
-                counted_fixed += L->e[i].size;
-            }
-            counted = (long)feetech_sms__get(b + off, e->size, e->big) - (long)e->adds;
-            content = counted - (long)counted_fixed;
-            if (content < (long)low || (!L->has_t && bounded && content > (long)high)) {
-                return FEETECH_SMS__NONE;
-            }
-            return (long)(overhead - counted_fixed) + counted;
+    if (L->length >= 0) {
+        const feetech_sms__element_t *e = &L->e[L->length];
+        long counted = (long)feetech_sms__get(b + L->length_off, e->size, e->big) - (long)e->adds;
+        long content = counted - (long)L->counted;
+        if (content < (long)low || (!L->has_t && bounded && content > (long)high)) {
+            return FEETECH_SMS__NONE;
         }
+        return (long)(L->overhead - L->counted) + counted;
     }
-    (void)known;
     if (L->has_t && L->e[L->count - 1u].role == FEETECH_SMS__ROLE_CONSTANT && L->count > 1u) {
         const feetech_sms__element_t *t = &L->e[L->count - 1u];
         size_t i;
@@ -517,7 +503,6 @@ static long feetech_sms__probe(const feetech_sms__layout_t *L, feetech_sms_direc
     }
     {
         /* no length: the content's size follows from its own leading fields (a size rule), by code */
-        size_t overhead = 0u;
         long size = feetech_sms__content_size(dir, code, b + before, avail - before);
         if (size < 0) {
             return size;
@@ -525,10 +510,7 @@ static long feetech_sms__probe(const feetech_sms__layout_t *L, feetech_sms_direc
         if ((size_t)size < low || (bounded && (size_t)size > high)) {
             return FEETECH_SMS__NONE;
         }
-        for (k = 0u; k < L->count; k++) {
-            overhead += L->e[k].size;
-        }
-        return (long)overhead + size;
+        return (long)L->overhead + size;
     }
 }
 #endif
@@ -545,7 +527,7 @@ static const feetech_sms__element_t feetech_sms__l_request_0_e[] = {
     {FEETECH_SMS__ROLE_CONTENT, 0u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* params */
     {FEETECH_SMS__ROLE_CHECKSUM, 1u, 0u, 1u, 4u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* checksum */
 };
-static const feetech_sms__layout_t feetech_sms__l_request_0 = {feetech_sms__l_request_0_e, 6u, 4, 3, 0u, 0u, 0u, NULL, 0u, 2u, 5u, 0UL};
+static const feetech_sms__layout_t feetech_sms__l_request_0 = {feetech_sms__l_request_0_e, 6u, 4, 3, 0u, 0u, 0u, NULL, 0u, 2u, 5u, 0UL, 6u, 5u, 1u, 2, 3u, 0u};
 
 /* The response frame. */
 static const uint8_t feetech_sms__l_response_0_c0[] = {0xffu, 0xffu};
@@ -557,7 +539,7 @@ static const feetech_sms__element_t feetech_sms__l_response_0_e[] = {
     {FEETECH_SMS__ROLE_CONTENT, 0u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* params */
     {FEETECH_SMS__ROLE_CHECKSUM, 1u, 0u, 1u, 4u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* checksum */
 };
-static const feetech_sms__layout_t feetech_sms__l_response_0 = {feetech_sms__l_response_0_e, 6u, 4, -1, 0u, 0u, 0u, NULL, 0u, 2u, 4u, 0UL};
+static const feetech_sms__layout_t feetech_sms__l_response_0 = {feetech_sms__l_response_0_e, 6u, 4, -1, 0u, 0u, 0u, NULL, 0u, 2u, 4u, 0UL, 6u, 5u, 1u, 2, 3u, 0u};
 
 static const feetech_sms__layout_t *const feetech_sms__layouts_request[] = {&feetech_sms__l_request_0};
 static const feetech_sms__layout_t *const feetech_sms__layouts_response[] = {&feetech_sms__l_response_0};
@@ -1317,8 +1299,14 @@ static int feetech_sms__try(feetech_sms_parser_t *p, size_t pos, feetech_sms_msg
     if (p->verdict[pos] != 0u) {
         return p->verdict[pos];
     }
+    if (pos == 0u && p->first > p->n) { /* its size is known and its bytes have not all come */
+        return FEETECH_SMS__V_WAIT;
+    }
     for (k = 0u; k < count; k++) {
         long s = feetech_sms__probe(layouts[k], p->dir, p->buf + pos, p->n - pos);
+        if (pos == 0u && count == 1u && s > 0) {
+            p->first = (size_t)s;
+        }
         if (s == FEETECH_SMS__WAIT) {
             waiting = 1;
             continue;
@@ -1388,6 +1376,7 @@ static int feetech_sms__push(feetech_sms_parser_t *p, uint8_t byte, feetech_sms_
         memmove(p->verdict, p->verdict + 1, p->n - 1u);
         p->n--;
         p->garbage++;
+        p->first = 0u;
     }
     p->buf[p->n] = byte;
     p->verdict[p->n] = 0u;
@@ -1438,6 +1427,7 @@ static int feetech_sms__push(feetech_sms_parser_t *p, uint8_t byte, feetech_sms_
         memmove(p->buf, p->buf + cut, p->n - cut);
         memmove(p->verdict, p->verdict + cut, p->n - cut);
         p->n -= cut;
+        p->first = 0u;
     }
     return got;
 }

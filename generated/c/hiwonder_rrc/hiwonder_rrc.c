@@ -96,6 +96,12 @@ typedef struct {
     uint8_t header_len; /* the leading constant's size (0: no header) */
     uint8_t prefix;     /* the classic parser waits for this many bytes before it judges a candidate (else 0) */
     uint32_t error_flag; /* a command code with these bits set is an error reply (0: none) */
+    uint16_t overhead;   /* every element's size but the content's */
+    uint16_t before;     /* bytes before the variable part (the stuffed span, else the content) */
+    uint16_t after;      /* bytes after it */
+    int8_t length;       /* index of the length element (before the variable part), -1 without */
+    uint16_t length_off; /* its offset */
+    uint16_t counted;    /* the fixed sizes of the elements it counts */
 } hiwonder_rrc__layout_t;
 
 /* Where each element of a frame lies: wire bytes (start, end) and, inside the stuffed span, plain bytes. */
@@ -336,12 +342,8 @@ static int hiwonder_rrc__unwrap(const hiwonder_rrc__layout_t *L, const uint8_t *
     int last = hiwonder_rrc__inner_last(L);
     const uint8_t *bytes;
     const uint8_t *body = frame;
-    for (k = 0u; k < first; k++) {
-        before += L->e[k].size;
-    }
-    for (k = L->count; (int)k - 1 > last; k--) {
-        after += L->e[k - 1u].size;
-    }
+    before = L->before;
+    after = L->after;
     if (n < before + after) {
         return HIWONDER_RRC_E_LENGTH;
     }
@@ -445,7 +447,7 @@ static long hiwonder_rrc__content_size(hiwonder_rrc_direction_t dir, long code, 
 static long hiwonder_rrc__probe(const hiwonder_rrc__layout_t *L, hiwonder_rrc_direction_t dir, const uint8_t *b, size_t avail)
 {
     size_t pos = 0u, low = 0u, high = 0u, before = 0u;
-    int bounded = 0, known;
+    int bounded = 0;
     uint8_t k, first = hiwonder_rrc__inner_first(L);
     long code = HIWONDER_RRC__NO_CODE;
     if (avail < L->prefix) {
@@ -484,31 +486,15 @@ static long hiwonder_rrc__probe(const hiwonder_rrc__layout_t *L, hiwonder_rrc_di
         low = 0u; /* the code lies in the stuffed span: no bounds before the frame is unstuffed */
         bounded = 0;
     }
-    known = 0;
-    for (k = 0u; k < first; k++) {
-        const hiwonder_rrc__element_t *e = &L->e[k];
-        if (e->role == HIWONDER_RRC__ROLE_LENGTH) {
-            size_t off = 0u, counted_fixed = 0u, overhead = 0u;
-            uint8_t i;
-            long counted, content;
-            for (i = 0u; i < k; i++) {
-                off += L->e[i].size;
-            }
-            for (i = 0u; i < L->count; i++) {
-                overhead += L->e[i].size;
-            }
-            for (i = e->first; i <= e->last; i++) {
-                counted_fixed += L->e[i].size;
-            }
-            counted = (long)hiwonder_rrc__get(b + off, e->size, e->big) - (long)e->adds;
-            content = counted - (long)counted_fixed;
-            if (content < (long)low || (!L->has_t && bounded && content > (long)high)) {
-                return HIWONDER_RRC__NONE;
-            }
-            return (long)(overhead - counted_fixed) + counted;
+    if (L->length >= 0) {
+        const hiwonder_rrc__element_t *e = &L->e[L->length];
+        long counted = (long)hiwonder_rrc__get(b + L->length_off, e->size, e->big) - (long)e->adds;
+        long content = counted - (long)L->counted;
+        if (content < (long)low || (!L->has_t && bounded && content > (long)high)) {
+            return HIWONDER_RRC__NONE;
         }
+        return (long)(L->overhead - L->counted) + counted;
     }
-    (void)known;
     if (L->has_t && L->e[L->count - 1u].role == HIWONDER_RRC__ROLE_CONSTANT && L->count > 1u) {
         const hiwonder_rrc__element_t *t = &L->e[L->count - 1u];
         size_t i;
@@ -521,7 +507,6 @@ static long hiwonder_rrc__probe(const hiwonder_rrc__layout_t *L, hiwonder_rrc_di
     }
     {
         /* no length: the content's size follows from its own leading fields (a size rule), by code */
-        size_t overhead = 0u;
         long size = hiwonder_rrc__content_size(dir, code, b + before, avail - before);
         if (size < 0) {
             return size;
@@ -529,10 +514,7 @@ static long hiwonder_rrc__probe(const hiwonder_rrc__layout_t *L, hiwonder_rrc_di
         if ((size_t)size < low || (bounded && (size_t)size > high)) {
             return HIWONDER_RRC__NONE;
         }
-        for (k = 0u; k < L->count; k++) {
-            overhead += L->e[k].size;
-        }
-        return (long)overhead + size;
+        return (long)L->overhead + size;
     }
 }
 #endif
@@ -548,7 +530,7 @@ static const hiwonder_rrc__element_t hiwonder_rrc__l_request_0_e[] = {
     {HIWONDER_RRC__ROLE_CONTENT, 0u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* data */
     {HIWONDER_RRC__ROLE_CHECKSUM, 1u, 0u, 1u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* crc */
 };
-static const hiwonder_rrc__layout_t hiwonder_rrc__l_request_0 = {hiwonder_rrc__l_request_0_e, 5u, 3, 1, 0u, 0u, 0u, NULL, 0u, 2u, 4u, 0UL};
+static const hiwonder_rrc__layout_t hiwonder_rrc__l_request_0 = {hiwonder_rrc__l_request_0_e, 5u, 3, 1, 0u, 0u, 0u, NULL, 0u, 2u, 4u, 0UL, 5u, 4u, 1u, 2, 3u, 0u};
 
 /* The response frame. */
 static const uint8_t hiwonder_rrc__l_response_0_c0[] = {0xaau, 0x55u};
@@ -559,7 +541,7 @@ static const hiwonder_rrc__element_t hiwonder_rrc__l_response_0_e[] = {
     {HIWONDER_RRC__ROLE_CONTENT, 0u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* data */
     {HIWONDER_RRC__ROLE_CHECKSUM, 1u, 0u, 1u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* crc */
 };
-static const hiwonder_rrc__layout_t hiwonder_rrc__l_response_0 = {hiwonder_rrc__l_response_0_e, 5u, 3, 1, 0u, 0u, 0u, NULL, 0u, 2u, 4u, 0UL};
+static const hiwonder_rrc__layout_t hiwonder_rrc__l_response_0 = {hiwonder_rrc__l_response_0_e, 5u, 3, 1, 0u, 0u, 0u, NULL, 0u, 2u, 4u, 0UL, 5u, 4u, 1u, 2, 3u, 0u};
 
 static const hiwonder_rrc__layout_t *const hiwonder_rrc__layouts_request[] = {&hiwonder_rrc__l_request_0};
 static const hiwonder_rrc__layout_t *const hiwonder_rrc__layouts_response[] = {&hiwonder_rrc__l_response_0};
@@ -4003,8 +3985,14 @@ static int hiwonder_rrc__try(hiwonder_rrc_parser_t *p, size_t pos, hiwonder_rrc_
     if (p->verdict[pos] != 0u) {
         return p->verdict[pos];
     }
+    if (pos == 0u && p->first > p->n) { /* its size is known and its bytes have not all come */
+        return HIWONDER_RRC__V_WAIT;
+    }
     for (k = 0u; k < count; k++) {
         long s = hiwonder_rrc__probe(layouts[k], p->dir, p->buf + pos, p->n - pos);
+        if (pos == 0u && count == 1u && s > 0) {
+            p->first = (size_t)s;
+        }
         if (s == HIWONDER_RRC__WAIT) {
             waiting = 1;
             continue;
@@ -4074,6 +4062,7 @@ static int hiwonder_rrc__push(hiwonder_rrc_parser_t *p, uint8_t byte, hiwonder_r
         memmove(p->verdict, p->verdict + 1, p->n - 1u);
         p->n--;
         p->garbage++;
+        p->first = 0u;
     }
     p->buf[p->n] = byte;
     p->verdict[p->n] = 0u;
@@ -4124,6 +4113,7 @@ static int hiwonder_rrc__push(hiwonder_rrc_parser_t *p, uint8_t byte, hiwonder_r
         memmove(p->buf, p->buf + cut, p->n - cut);
         memmove(p->verdict, p->verdict + cut, p->n - cut);
         p->n -= cut;
+        p->first = 0u;
     }
     return got;
 }

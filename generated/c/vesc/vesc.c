@@ -96,6 +96,12 @@ typedef struct {
     uint8_t header_len; /* the leading constant's size (0: no header) */
     uint8_t prefix;     /* the classic parser waits for this many bytes before it judges a candidate (else 0) */
     uint32_t error_flag; /* a command code with these bits set is an error reply (0: none) */
+    uint16_t overhead;   /* every element's size but the content's */
+    uint16_t before;     /* bytes before the variable part (the stuffed span, else the content) */
+    uint16_t after;      /* bytes after it */
+    int8_t length;       /* index of the length element (before the variable part), -1 without */
+    uint16_t length_off; /* its offset */
+    uint16_t counted;    /* the fixed sizes of the elements it counts */
 } vesc__layout_t;
 
 /* Where each element of a frame lies: wire bytes (start, end) and, inside the stuffed span, plain bytes. */
@@ -336,12 +342,8 @@ static int vesc__unwrap(const vesc__layout_t *L, const uint8_t *frame, size_t n,
     int last = vesc__inner_last(L);
     const uint8_t *bytes;
     const uint8_t *body = frame;
-    for (k = 0u; k < first; k++) {
-        before += L->e[k].size;
-    }
-    for (k = L->count; (int)k - 1 > last; k--) {
-        after += L->e[k - 1u].size;
-    }
+    before = L->before;
+    after = L->after;
     if (n < before + after) {
         return VESC_E_LENGTH;
     }
@@ -445,7 +447,7 @@ static long vesc__content_size(vesc_direction_t dir, long code, const uint8_t *c
 static long vesc__probe(const vesc__layout_t *L, vesc_direction_t dir, const uint8_t *b, size_t avail)
 {
     size_t pos = 0u, low = 0u, high = 0u, before = 0u;
-    int bounded = 0, known;
+    int bounded = 0;
     uint8_t k, first = vesc__inner_first(L);
     long code = VESC__NO_CODE;
     if (avail < L->prefix) {
@@ -484,31 +486,15 @@ static long vesc__probe(const vesc__layout_t *L, vesc_direction_t dir, const uin
         low = 0u; /* the code lies in the stuffed span: no bounds before the frame is unstuffed */
         bounded = 0;
     }
-    known = 0;
-    for (k = 0u; k < first; k++) {
-        const vesc__element_t *e = &L->e[k];
-        if (e->role == VESC__ROLE_LENGTH) {
-            size_t off = 0u, counted_fixed = 0u, overhead = 0u;
-            uint8_t i;
-            long counted, content;
-            for (i = 0u; i < k; i++) {
-                off += L->e[i].size;
-            }
-            for (i = 0u; i < L->count; i++) {
-                overhead += L->e[i].size;
-            }
-            for (i = e->first; i <= e->last; i++) {
-                counted_fixed += L->e[i].size;
-            }
-            counted = (long)vesc__get(b + off, e->size, e->big) - (long)e->adds;
-            content = counted - (long)counted_fixed;
-            if (content < (long)low || (!L->has_t && bounded && content > (long)high)) {
-                return VESC__NONE;
-            }
-            return (long)(overhead - counted_fixed) + counted;
+    if (L->length >= 0) {
+        const vesc__element_t *e = &L->e[L->length];
+        long counted = (long)vesc__get(b + L->length_off, e->size, e->big) - (long)e->adds;
+        long content = counted - (long)L->counted;
+        if (content < (long)low || (!L->has_t && bounded && content > (long)high)) {
+            return VESC__NONE;
         }
+        return (long)(L->overhead - L->counted) + counted;
     }
-    (void)known;
     if (L->has_t && L->e[L->count - 1u].role == VESC__ROLE_CONSTANT && L->count > 1u) {
         const vesc__element_t *t = &L->e[L->count - 1u];
         size_t i;
@@ -521,7 +507,6 @@ static long vesc__probe(const vesc__layout_t *L, vesc_direction_t dir, const uin
     }
     {
         /* no length: the content's size follows from its own leading fields (a size rule), by code */
-        size_t overhead = 0u;
         long size = vesc__content_size(dir, code, b + before, avail - before);
         if (size < 0) {
             return size;
@@ -529,10 +514,7 @@ static long vesc__probe(const vesc__layout_t *L, vesc_direction_t dir, const uin
         if ((size_t)size < low || (bounded && (size_t)size > high)) {
             return VESC__NONE;
         }
-        for (k = 0u; k < L->count; k++) {
-            overhead += L->e[k].size;
-        }
-        return (long)overhead + size;
+        return (long)L->overhead + size;
     }
 }
 #endif
@@ -550,7 +532,7 @@ static const vesc__element_t vesc__l_request_0_e[] = {
     {VESC__ROLE_CHECKSUM, 2u, 1u, 2u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* crc */
     {VESC__ROLE_CONSTANT, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, vesc__l_request_0_c5},  /* end */
 };
-static const vesc__layout_t vesc__l_request_0 = {vesc__l_request_0_e, 6u, 3, 2, 0u, 0u, 0u, NULL, 0u, 1u, 0u, 0UL};
+static const vesc__layout_t vesc__l_request_0 = {vesc__l_request_0_e, 6u, 3, 2, 0u, 0u, 0u, NULL, 0u, 1u, 0u, 0UL, 6u, 3u, 3u, 1, 1u, 1u};
 
 /* The request frame long. */
 static const uint8_t vesc__l_request_1_c0[] = {0x03u};
@@ -563,7 +545,7 @@ static const vesc__element_t vesc__l_request_1_e[] = {
     {VESC__ROLE_CHECKSUM, 2u, 1u, 2u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* crc */
     {VESC__ROLE_CONSTANT, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, vesc__l_request_1_c5},  /* end */
 };
-static const vesc__layout_t vesc__l_request_1 = {vesc__l_request_1_e, 6u, 3, 2, 0u, 0u, 0u, NULL, 0u, 1u, 0u, 0UL};
+static const vesc__layout_t vesc__l_request_1 = {vesc__l_request_1_e, 6u, 3, 2, 0u, 0u, 0u, NULL, 0u, 1u, 0u, 0UL, 7u, 4u, 3u, 1, 1u, 1u};
 
 /* The response frame short. */
 static const uint8_t vesc__l_response_0_c0[] = {0x02u};
@@ -576,7 +558,7 @@ static const vesc__element_t vesc__l_response_0_e[] = {
     {VESC__ROLE_CHECKSUM, 2u, 1u, 2u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* crc */
     {VESC__ROLE_CONSTANT, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, vesc__l_response_0_c5},  /* end */
 };
-static const vesc__layout_t vesc__l_response_0 = {vesc__l_response_0_e, 6u, 3, 2, 0u, 0u, 0u, NULL, 0u, 1u, 0u, 0UL};
+static const vesc__layout_t vesc__l_response_0 = {vesc__l_response_0_e, 6u, 3, 2, 0u, 0u, 0u, NULL, 0u, 1u, 0u, 0UL, 6u, 3u, 3u, 1, 1u, 1u};
 
 /* The response frame long. */
 static const uint8_t vesc__l_response_1_c0[] = {0x03u};
@@ -589,7 +571,7 @@ static const vesc__element_t vesc__l_response_1_e[] = {
     {VESC__ROLE_CHECKSUM, 2u, 1u, 2u, 3u, 0u, 0u, 0L, 0UL, 0UL, 0UL, NULL},  /* crc */
     {VESC__ROLE_CONSTANT, 1u, 0u, 0u, 0u, 0u, 0u, 0L, 0UL, 0UL, 0UL, vesc__l_response_1_c5},  /* end */
 };
-static const vesc__layout_t vesc__l_response_1 = {vesc__l_response_1_e, 6u, 3, 2, 0u, 0u, 0u, NULL, 0u, 1u, 0u, 0UL};
+static const vesc__layout_t vesc__l_response_1 = {vesc__l_response_1_e, 6u, 3, 2, 0u, 0u, 0u, NULL, 0u, 1u, 0u, 0UL, 7u, 4u, 3u, 1, 1u, 1u};
 
 static const vesc__layout_t *const vesc__layouts_request[] = {&vesc__l_request_0, &vesc__l_request_1};
 static const vesc__layout_t *const vesc__layouts_response[] = {&vesc__l_response_0, &vesc__l_response_1};
@@ -1841,8 +1823,14 @@ static int vesc__try(vesc_parser_t *p, size_t pos, vesc_msg_t *out, size_t *size
     if (p->verdict[pos] != 0u) {
         return p->verdict[pos];
     }
+    if (pos == 0u && p->first > p->n) { /* its size is known and its bytes have not all come */
+        return VESC__V_WAIT;
+    }
     for (k = 0u; k < count; k++) {
         long s = vesc__probe(layouts[k], p->dir, p->buf + pos, p->n - pos);
+        if (pos == 0u && count == 1u && s > 0) {
+            p->first = (size_t)s;
+        }
         if (s == VESC__WAIT) {
             waiting = 1;
             continue;
@@ -1912,6 +1900,7 @@ static int vesc__push(vesc_parser_t *p, uint8_t byte, vesc_msg_t *out)
         memmove(p->verdict, p->verdict + 1, p->n - 1u);
         p->n--;
         p->garbage++;
+        p->first = 0u;
     }
     p->buf[p->n] = byte;
     p->verdict[p->n] = 0u;
@@ -1962,6 +1951,7 @@ static int vesc__push(vesc_parser_t *p, uint8_t byte, vesc_msg_t *out)
         memmove(p->buf, p->buf + cut, p->n - cut);
         memmove(p->verdict, p->verdict + cut, p->n - cut);
         p->n -= cut;
+        p->first = 0u;
     }
     return got;
 }

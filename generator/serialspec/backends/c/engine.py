@@ -48,6 +48,12 @@ typedef struct {
     uint8_t header_len; /* the leading constant's size (0: no header) */
     uint8_t prefix;     /* the classic parser waits for this many bytes before it judges a candidate (else 0) */
     uint32_t error_flag; /* a command code with these bits set is an error reply (0: none) */
+    uint16_t overhead;   /* every element's size but the content's */
+    uint16_t before;     /* bytes before the variable part (the stuffed span, else the content) */
+    uint16_t after;      /* bytes after it */
+    int8_t length;       /* index of the length element (before the variable part), -1 without */
+    uint16_t length_off; /* its offset */
+    uint16_t counted;    /* the fixed sizes of the elements it counts */
 } pfx__layout_t;
 
 /* Where each element of a frame lies: wire bytes (start, end) and, inside the stuffed span, plain bytes. */
@@ -288,12 +294,8 @@ static int pfx__unwrap(const pfx__layout_t *L, const uint8_t *frame, size_t n, u
     int last = pfx__inner_last(L);
     const uint8_t *bytes;
     const uint8_t *body = frame;
-    for (k = 0u; k < first; k++) {
-        before += L->e[k].size;
-    }
-    for (k = L->count; (int)k - 1 > last; k--) {
-        after += L->e[k - 1u].size;
-    }
+    before = L->before;
+    after = L->after;
     if (n < before + after) {
         return PFX_E_LENGTH;
     }
@@ -397,7 +399,7 @@ static long pfx__content_size(pfx_direction_t dir, long code, const uint8_t *c, 
 static long pfx__probe(const pfx__layout_t *L, pfx_direction_t dir, const uint8_t *b, size_t avail)
 {
     size_t pos = 0u, low = 0u, high = 0u, before = 0u;
-    int bounded = 0, known;
+    int bounded = 0;
     uint8_t k, first = pfx__inner_first(L);
     long code = PFX__NO_CODE;
     if (avail < L->prefix) {
@@ -436,31 +438,15 @@ static long pfx__probe(const pfx__layout_t *L, pfx_direction_t dir, const uint8_
         low = 0u; /* the code lies in the stuffed span: no bounds before the frame is unstuffed */
         bounded = 0;
     }
-    known = 0;
-    for (k = 0u; k < first; k++) {
-        const pfx__element_t *e = &L->e[k];
-        if (e->role == PFX__ROLE_LENGTH) {
-            size_t off = 0u, counted_fixed = 0u, overhead = 0u;
-            uint8_t i;
-            long counted, content;
-            for (i = 0u; i < k; i++) {
-                off += L->e[i].size;
-            }
-            for (i = 0u; i < L->count; i++) {
-                overhead += L->e[i].size;
-            }
-            for (i = e->first; i <= e->last; i++) {
-                counted_fixed += L->e[i].size;
-            }
-            counted = (long)pfx__get(b + off, e->size, e->big) - (long)e->adds;
-            content = counted - (long)counted_fixed;
-            if (content < (long)low || (!L->has_t && bounded && content > (long)high)) {
-                return PFX__NONE;
-            }
-            return (long)(overhead - counted_fixed) + counted;
+    if (L->length >= 0) {
+        const pfx__element_t *e = &L->e[L->length];
+        long counted = (long)pfx__get(b + L->length_off, e->size, e->big) - (long)e->adds;
+        long content = counted - (long)L->counted;
+        if (content < (long)low || (!L->has_t && bounded && content > (long)high)) {
+            return PFX__NONE;
         }
+        return (long)(L->overhead - L->counted) + counted;
     }
-    (void)known;
     if (L->has_t && L->e[L->count - 1u].role == PFX__ROLE_CONSTANT && L->count > 1u) {
         const pfx__element_t *t = &L->e[L->count - 1u];
         size_t i;
@@ -473,7 +459,6 @@ static long pfx__probe(const pfx__layout_t *L, pfx_direction_t dir, const uint8_
     }
     {
         /* no length: the content's size follows from its own leading fields (a size rule), by code */
-        size_t overhead = 0u;
         long size = pfx__content_size(dir, code, b + before, avail - before);
         if (size < 0) {
             return size;
@@ -481,10 +466,7 @@ static long pfx__probe(const pfx__layout_t *L, pfx_direction_t dir, const uint8_
         if ((size_t)size < low || (bounded && (size_t)size > high)) {
             return PFX__NONE;
         }
-        for (k = 0u; k < L->count; k++) {
-            overhead += L->e[k].size;
-        }
-        return (long)overhead + size;
+        return (long)L->overhead + size;
     }
 }
 #endif

@@ -164,6 +164,7 @@ typedef struct {{
     uint32_t frames;                  /* messages delivered */
     uint32_t garbage;                 /* bytes skipped that belonged to no message */
     uint32_t errors;                  /* corrupt candidates (a bad checksum, content that does not decode) */
+    size_t first;                     /* the size of the candidate at buf[0] once known (one layout), else 0 */
     uint8_t buf[{P}_MAX_FRAME];        /* bytes held: the candidate frames still waiting for bytes */
     uint8_t verdict[{P}_MAX_FRAME];    /* per byte held: 0 undecided, 1 no frame starts here, 2 a corrupt one */
 }} {p}_parser_t;
@@ -264,6 +265,16 @@ def layout_tables(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) -
     tl = names.index(t.last) if t else 0
     error = ctx.protocol.error_reply
     error_flag = error.flag if error is not None and direction == Direction.RESPONSE else 0
+    sizes = [len(e.constant) if e.role in ("header", "trailer", "constant") else e.size or 0 for e in layout.elements]
+    first = tf if t else content if content >= 0 else len(sizes)
+    last = tl if t else content if content >= 0 else len(sizes) - 1
+    overhead, before, after = sum(sizes), sum(sizes[:first]), sum(sizes[last + 1 :])
+    length = next((i for i, e in enumerate(layout.elements) if e.role == "length"), -1)
+    length_off = sum(sizes[:length]) if length >= 0 else 0
+    counted = 0
+    if length >= 0:
+        a, b = names.index(layout.elements[length].counts[0]), names.index(layout.elements[length].counts[1])
+        counted = sum(sizes[a : b + 1])
     prefix = 0
     if ctx.protocol.framing.classic:  # stream.StreamParser: a candidate waits until its key and values have come
         offset = 0
@@ -277,7 +288,7 @@ def layout_tables(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) -
     lines.append(
         f"static const {p}__layout_t {name} = {{{name}_e, {len(layout.elements)}u, {content}, {command}, "
         f"{1 if t else 0}u, {tf}u, {tl}u, {pairs}, {len(t.replace) if t else 0}u, {header_len}u, {prefix}u, "
-        f"{error_flag}UL}};"
+        f"{error_flag}UL, {overhead}u, {before}u, {after}u, {length}, {length_off}u, {counted}u}};"
     )
     if t:
         lines.insert(0, f"/* {comment(t.description)} */")
@@ -687,8 +698,14 @@ static int {p}__try({p}_parser_t *p, size_t pos, {p}_msg_t *out, size_t *size)
     if (p->verdict[pos] != 0u) {{
         return p->verdict[pos];
     }}
+    if (pos == 0u && p->first > p->n) {{ /* its size is known and its bytes have not all come */
+        return {P}__V_WAIT;
+    }}
     for (k = 0u; k < count; k++) {{
         long s = {p}__probe(layouts[k], p->dir, p->buf + pos, p->n - pos);
+        if (pos == 0u && count == 1u && s > 0) {{
+            p->first = (size_t)s;
+        }}
         if (s == {P}__WAIT) {{
             waiting = 1;
             continue;
@@ -758,6 +775,7 @@ static int {p}__push({p}_parser_t *p, uint8_t byte, {p}_msg_t *out)
         memmove(p->verdict, p->verdict + 1, p->n - 1u);
         p->n--;
         p->garbage++;
+        p->first = 0u;
     }}
     p->buf[p->n] = byte;
     p->verdict[p->n] = 0u;
@@ -808,6 +826,7 @@ static int {p}__push({p}_parser_t *p, uint8_t byte, {p}_msg_t *out)
         memmove(p->buf, p->buf + cut, p->n - cut);
         memmove(p->verdict, p->verdict + cut, p->n - cut);
         p->n -= cut;
+        p->first = 0u;
     }}
     return got;
 }}

@@ -186,3 +186,16 @@ def test_board_groups_and_reports_as_an_async_iterator() -> None:
     finally:
         simulator.close()
     assert [type(m).__name__ for m in simulator.log] == ["BusServoReadPositionRequest"]
+
+
+def test_the_readme_asyncio_session_runs_as_printed() -> None:
+    import contextlib
+    import io
+    import re
+
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    code = next(b for b in re.findall(r"```python\n(.*?)```", text, flags=re.S) if "AsyncFeetechSmsClient" in b)
+    output = io.StringIO()
+    with serve("feetech_sms.yaml", 1, 2) as port, contextlib.redirect_stdout(output):
+        exec(compile(code.replace("/dev/pts/5", port), "README.md", "exec"), {})
+    assert output.getvalue().splitlines() == ["True False", "[777, 1000]"]

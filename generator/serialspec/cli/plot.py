@@ -251,6 +251,7 @@ def draw(pyplot: Any, panels: list[Panel], title: str, out: Path) -> None:
     axes[-1, 0].set_xlabel("time (s)")
     figure.suptitle(title)
     try:
+        out.parent.mkdir(parents=True, exist_ok=True)
         figure.savefig(out, dpi=100)
     except OSError as exc:
         raise SerialspecError(f"cannot write {out}: {exc.strerror}") from None

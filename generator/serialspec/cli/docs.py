@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import importlib.resources
 from pathlib import Path
+from typing import Any
 
 from serialspec.cli.protocols import SHIPPED_SPEC, SPEC_HELP, open_spec
 from serialspec.lang.model import Protocol
@@ -37,7 +38,10 @@ def run(args: argparse.Namespace) -> int:
         # the reference links its spec as generated/docs/ sees it; on the site the spec sits in specs/
         text = emit_docs(protocol).replace(f"](../../{protocol.spec_path})", f"](../specs/{name}.yaml)")
         pages[f"protocols/{name}.md"] = text
-    nav = [{"Home": "index.md"}, {"Protocols": [{name: f"protocols/{name}.md"} for name in protocols]}]
+    nav: list[dict[str, Any]] = [
+        {"Home": "index.md"},
+        {"Protocols": [{name: f"protocols/{name}.md"} for name in protocols]},
+    ]
     out = Path(args.out).resolve()
     docsite.build(pages, nav, out, name=args.title, files=files)
     print(f"serialspec docs: {len(protocols)} protocol(s) in {args.out}: open {Path(args.out) / 'index.html'}")

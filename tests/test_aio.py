@@ -199,3 +199,51 @@ def test_the_readme_asyncio_session_runs_as_printed() -> None:
     with serve("feetech_sms.yaml", 1, 2) as port, contextlib.redirect_stdout(output):
         exec(compile(code.replace("/dev/pts/5", port), "README.md", "exec"), {})
     assert output.getvalue().splitlines() == ["True False", "[777, 1000]"]
+
+
+def test_a_port_without_a_descriptor_for_the_loop_reads_in_a_worker_thread() -> None:
+    """socket:// (no POSIX serial port to watch): the same client over a TCP bridge to the sim's pseudo-terminal."""
+    import os
+    import select
+    import socket
+    import threading
+
+    from modbus_rtu.aio import AsyncModbusRtuClient
+
+    with serve("modbus_rtu.yaml", 1) as path, socket.create_server(("127.0.0.1", 0)) as server:
+        device = os.open(path, os.O_RDWR | os.O_NOCTTY)
+        stop = threading.Event()
+
+        def bridge() -> None:
+            connection, _ = server.accept()
+            with connection:
+                while not stop.is_set():
+                    ready, _, _ = select.select([connection, device], [], [], 0.05)
+                    if connection in ready:
+                        data = connection.recv(4096)
+                        if not data:
+                            return
+                        os.write(device, data)
+                    if device in ready:
+                        connection.sendall(os.read(device, 4096))
+
+        thread = threading.Thread(target=bridge, daemon=True)
+        thread.start()
+
+        async def session() -> None:
+            url = f"socket://127.0.0.1:{server.getsockname()[1]}"
+            async with AsyncModbusRtuClient(url, timeout=TIMEOUT) as client:
+                assert await client.write_registers(1, 10, [7, 8]) == 2
+                assert await asyncio.gather(
+                    client.read_holding_registers(1, 10, 2), client.read_holding_registers(1, 11, 1)
+                ) == [[7, 8], [8]]
+                client.bus.timeout = 0.05
+                with pytest.raises(Timeout):
+                    await client.read_holding_registers(2, 0, 1)
+
+        try:
+            asyncio.run(session())
+        finally:
+            stop.set()
+            thread.join(5)
+            os.close(device)

@@ -200,12 +200,11 @@ class AsyncBus:
         loop = asyncio.get_running_loop()
         ready: asyncio.Future[None] = loop.create_future()
         loop.add_reader(fd, _wake, ready)
+        deadline = loop.call_later(wait, _wake, ready)  # woken by the first byte or the deadline, whichever comes
         try:
-            async with asyncio.timeout(wait):
-                await ready
-        except TimeoutError:
-            pass
+            await ready
         finally:
+            deadline.cancel()
             loop.remove_reader(fd)
         return link.read(0.0)  # what is there (b"" at the deadline); a port that hung up fails here
 

@@ -73,6 +73,9 @@ RESERVED_FIELD_NAMES = (
 GENERATED_CLASS_NAMES = frozenset(
     {
         "Any",
+        "AsyncBus",
+        "AsyncClientBase",
+        "AsyncIterator",
         "Binding",
         "Bus",
         "Callable",

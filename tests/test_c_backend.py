@@ -95,11 +95,11 @@ def test_several_protocols_link_into_one_program(tmp_path: Path) -> None:
 class Driver:
     """The driver program for one protocol, built with the sanitizers, kept running: one command a line."""
 
-    def __init__(self, g: Generated, folder: Path) -> None:
+    def __init__(self, name: str, source: Path, folder: Path) -> None:
+        """Build tests/c/driver.c with the C of protocol `name` found in `source`, into `folder`, and start it."""
         assert GCC is not None
-        name = g.protocol.name
         exe = folder / f"driver_{name}"
-        c, j = sources(g)
+        c, j = source / f"{name}.c", source / f"{name}_json.c"
         big = [f"-D{name.upper()}_MAX_FRAME=70000u"]  # no frame the tests make exceeds the parser's buffer
         command = [
             GCC,
@@ -122,6 +122,11 @@ class Driver:
         assert run.returncode == 0, run.stderr.decode()
         self.process = subprocess.Popen([str(exe)], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True, bufsize=1)
 
+    def close(self) -> None:
+        assert self.process.stdin is not None
+        self.process.stdin.close()
+        self.process.wait(10)
+
     def ask(self, line: str) -> list[str]:
         assert self.process.stdin is not None and self.process.stdout is not None
         self.process.stdin.write(line + "\n")
@@ -140,7 +145,28 @@ def driver(name: str) -> Driver:
     import tempfile
 
     folder = Path(tempfile.mkdtemp(prefix="serialspec-c-"))
-    return Driver(next(g for g in C_SPECS if g.protocol.name == name), folder)
+    return Driver(name, GENERATED_C / name, folder)
+
+
+def agrees_with_python(run: Driver, g: Generated, spec: Message, fields: dict[str, Any]) -> bytes:
+    """One message through the Python codec and the C: the same values, the same bytes again; its frame."""
+    cls = message_class(g, spec)
+    kind = kind_of(g, cls)
+    frame: bytes = g.package.encode(cls.from_fields(fields))
+    expected = python_json(g.package.decode(frame, spec.direction.value, cls))
+    (answer,) = run.ask(f"dec {spec.direction.value} {frame.hex()} {kind}")
+    assert answer.startswith("ok ") and json.loads(answer[3:]) == expected, (answer, expected)
+    (answer,) = run.ask(f"rt {spec.direction.value} {frame.hex()} {kind}")
+    assert answer == f"ok {frame.hex()}"
+    return frame
+
+
+def stream_agrees_with_python(run: Driver, g: Generated, direction: Direction, stream: bytes, sizes: str) -> None:
+    """A stream fed to the C parser in pieces of `sizes` gives what the Python parser fed byte by byte gives."""
+    answers = run.ask(f"stream {direction.value} {sizes} {stream.hex() or '-'}")
+    messages = [json.loads(a[4:]) for a in answers if a.startswith("msg ")]
+    counters = tuple(int(x) for x in answers[-1].split()[1:])
+    assert (messages, counters) == python_stream(g, direction, stream)
 
 
 def c_decode(g: Generated, frame: bytes, direction: Direction, kind: str = "") -> dict[str, Any] | str:
@@ -186,17 +212,11 @@ def message_class(g: Generated, spec: Message) -> Any:
 
 @pytest.mark.parametrize(("g", "spec"), MESSAGES)
 def test_random_messages_encode_and_decode_as_python_does(g: Generated, spec: Message) -> None:
-    cls = message_class(g, spec)
-    kind = kind_of(g, cls)
 
     @settings(max_examples=examples(5), deadline=None, suppress_health_check=[HealthCheck.too_slow])
     @given(message_fields(g.protocol, spec), st.data())
     def agree(fields: dict[str, Any], data: st.DataObject) -> None:
-        frame = g.package.encode(cls.from_fields(fields))
-        expected = g.package.decode(frame, spec.direction.value, cls)
-        assert c_decode(g, frame, spec.direction, kind) == python_json(expected)
-        (answer,) = driver(g.protocol.name).ask(f"rt {spec.direction.value} {frame.hex()} {kind}")
-        assert answer == f"ok {frame.hex()}"
+        frame = agrees_with_python(driver(g.protocol.name), g, spec, fields)
         # never past cap: every capacity short of the frame is refused, canaries intact (the driver checks them)
         cap = data.draw(st.integers(0, len(frame) - 1))
         (answer,) = driver(g.protocol.name).ask(f"enc1 {spec.direction.value} {frame.hex()} {cap}")
@@ -291,14 +311,7 @@ def test_noisy_streams_in_random_pieces_give_what_python_gives(g: Generated) -> 
         sizes = data.draw(st.lists(st.integers(0, 9), min_size=1, max_size=6))
         if not any(sizes):
             sizes.append(1)
-        answers = driver(g.protocol.name).ask(
-            f"stream {direction.value} {','.join(map(str, sizes))} {stream.hex() or '-'}"
-        )
-        messages = [json.loads(a[4:]) for a in answers if a.startswith("msg ")]
-        counters = tuple(int(x) for x in answers[-1].split()[1:])
-        expected, python_counters = python_stream(g, direction, stream)
-        assert messages == expected
-        assert counters == python_counters
+        stream_agrees_with_python(driver(g.protocol.name), g, direction, stream, ",".join(map(str, sizes)))
 
     agree()
 

@@ -328,7 +328,7 @@ def build(name: str) -> Built:
         problems = []
         for emitter in emitters():
             emitted = emitter.files(protocol)
-            files.update(emitted)
+            files.update({f"{emitter.folder}/{path}" if emitter.folder else path: t for path, t in emitted.items()})
             if emitter.verify is not None:
                 problems.extend(emitter.verify(protocol, emitted))
         if problems:
@@ -437,6 +437,32 @@ def test_every_output(name: str, tmp_path: Path) -> None:
         spec = tmp_path / "matrix_case.yaml"
         spec.write_text(built.text, encoding="utf-8")
         cli_decode(g, spec)
+        c_target(g, built, tmp_path)
+
+
+def c_target(g: Generated, built: Built, tmp_path: Path) -> None:
+    """The case's C (tests/test_c_backend.py's driver, with the sanitizers) against the Python codec: random messages
+    give the same values and bytes, and a stream of them among garbage in pieces gives the same messages."""
+    from test_c_backend import GCC, Driver, agrees_with_python, stream_agrees_with_python
+
+    if GCC is None:
+        return
+    source = tmp_path / "c"
+    source.mkdir()
+    for path, text in built.files.items():
+        if path.startswith("c/matrix_case/"):
+            (source / path.rsplit("/", 1)[1]).write_text(text, encoding="utf-8")
+    run = Driver("matrix_case", source, tmp_path)
+    try:
+        for direction in g.protocol.framing.layouts:
+            frames = []
+            for message in g.protocol.messages():
+                if message.direction == direction:
+                    for fields in st_examples(message_fields(g.protocol, message), 3):
+                        frames.append(agrees_with_python(run, g, message, fields))
+            stream_agrees_with_python(run, g, direction, b"\x00\x01".join(frames) + b"\x02", "1,3,0,7")
+    finally:
+        run.close()
 
 
 SETTINGS = settings(max_examples=examples(15), deadline=None, suppress_health_check=list(HealthCheck))

@@ -111,6 +111,14 @@ def comment(text: str) -> str:
     return collapse(text).replace("*/", "* /").replace("/*", "/ *")
 
 
+I32 = ScalarType("i32", 4, "i", True, False, -0x80000000, 0x7FFFFFFF)
+
+
+def value_type(f: Scalar) -> ScalarType:
+    """The C type a scalar's value takes: its own, or a signed 32-bit one for sign-magnitude numbers."""
+    return I32 if f.sign_magnitude else f.type
+
+
 def ctype(t: ScalarType) -> str:
     if t.is_float:
         return "float"
@@ -202,8 +210,6 @@ def refuse_fields(fields: tuple[Field, ...], where: str, nested: bool = False) -
             case Scalar():
                 if f.value is not None and nested:
                     raise Unsupported(f"{where}: {f.name}: a value computed by an expression inside a group")
-                if f.sign_magnitude:
-                    raise Unsupported(f"{where}: {f.name}: sign-magnitude numbers")
             case Array():
                 pass
             case List():
@@ -316,7 +322,7 @@ def members(ctx: Ctx, fields: tuple[Field, ...], path: str, room: int) -> list[M
         match f:
             case Scalar():
                 if not f.hidden:
-                    found.append(Member(name, f"{ctype(f.type)} {name};", doc))
+                    found.append(Member(name, f"{ctype(value_type(f))} {name};", doc))
             case Array():
                 found.append(Member(name, f"{ctype(f.item)} {name}[{f.count}];", doc))
             case Bytes():
@@ -414,6 +420,11 @@ def decode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                 size = f.type.size
                 out.append(f"{pad}if (n - o < {size}u) {{ return {ctx.P}_E_LENGTH; }}")
                 value = read_scalar(ctx, f.type, f.endian, "c + o")
+                if f.sign_magnitude:  # the top bit is the sign, the rest the magnitude
+                    top = 1 << (8 * size - 1)
+                    raw = f"{ctx.p}__get(c + o, {size}u, {1 if f.endian == '>' else 0}u)"
+                    value = f"{ctx.p}__sm({raw}, 0x{top:x}UL)"
+                    ctx.helpers.add("sm")
                 if f.const is not None:
                     out.append(
                         f"{pad}if ({ctx.p}__get(c + o, {size}u, {1 if f.endian == '>' else 0}u) != "
@@ -687,7 +698,7 @@ def check_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[st
             case Scalar():
                 if f.hidden:
                     continue
-                test = range_test(f.minimum, f.maximum, f.type, tgt)
+                test = range_test(f.minimum, f.maximum, value_type(f), tgt)
                 if test:
                     out.append(f"{pad}if ({test}) {{ return {ctx.P}_E_RANGE; }} /* {f.name} */")
             case Array():
@@ -760,7 +771,7 @@ def derived_value(
     by_name = {x.name: x for x in fields}
     if kind == "count":
         group = by_name.get(target)
-        if isinstance(group, Group) and not isinstance(group.count, int):
+        if isinstance(group, Group | List) and not isinstance(group.count, int):
             out.append(f"{pad}{local} = (uint32_t){scope.target}{ident(target)}_count;")
         else:
             raise Unsupported(f"{f.name}: a count of {target}")
@@ -804,6 +815,9 @@ def encode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                     value = f"(uint32_t){scope.lookup(f.name)}"
                 else:
                     value = scalar_bits(ctx, f.type, tgt)
+                    if f.sign_magnitude:
+                        top = 1 << (8 * size - 1)
+                        value = f"({tgt} < 0 ? ((uint32_t)(-(int32_t){tgt}) | 0x{top:x}UL) : (uint32_t){tgt})"
                 out.append(f"{pad}if (cap - o < {size}u) {{ return {ctx.P}_E_BUFFER; }}")
                 out.append(
                     f"{pad}{ctx.p}__put(c + o, {size}u, {1 if f.endian == '>' else 0}u, {value}); /* {f.name} */"
@@ -981,7 +995,7 @@ def json_fields(ctx: Ctx, fields: tuple[Field, ...], target: str, out: list[str]
                 if f.bits:
                     json_bits(ctx, f.bits, tgt, out, pad)
                 else:
-                    out.append(pad + json_number(ctx, f.type, tgt))
+                    out.append(pad + json_number(ctx, value_type(f), tgt))
             case Array():
                 out.append(f'{pad}{ctx.p}__ws(w, "[");')
                 out.append(f"{pad}for (i{depth} = 0u; i{depth} < {f.count}u; i{depth}++) {{")

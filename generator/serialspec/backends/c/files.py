@@ -941,6 +941,20 @@ static int{bits}_t {p}__s{bits}(uint32_t v)
 #endif
 """
             )
+    if "sm" in ctx.helpers:
+        parts.append(
+            f"""#if {P}_ENABLE_DECODE
+/* A sign-magnitude number: the top bit (top) is the sign, the bits below it the magnitude. */
+static int32_t {p}__sm(uint32_t raw, uint32_t top)
+{{
+    if ((raw & top) != 0u) {{
+        return -(int32_t)(raw & (top - 1u));
+    }}
+    return (int32_t)raw;
+}}
+#endif
+"""
+        )
     if "f32" in ctx.helpers:
         parts.append(
             f"""#if {P}_ENABLE_DECODE

@@ -11,7 +11,7 @@ from conftest import examples
 from hostile_run import BASES, base
 from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
-from serialspec.backends import emitters
+from serialspec.backends import emit, emitters
 from serialspec.lang import SpecErrors
 from serialspec.lang.loader import Located, Path
 from serialspec.lang.resolve import resolve
@@ -76,8 +76,8 @@ def test_any_value_anywhere_is_a_spec_error_or_a_package(name: str) -> None:
         try:
             protocol = resolve(mutated(name, changes))
             for emitter in emitters():
-                files = emitter.files(protocol)
-                if emitter.verify is not None:
+                files = emit(emitter, protocol)  # none from a target that cannot generate the spec yet
+                if emitter.verify is not None and files:
                     emitter.verify(protocol, files)
         except SpecErrors as exc:
             assert all(str(e).count("\n") == 0 for e in exc.errors)

@@ -33,6 +33,16 @@ class Emitter:
     folder: str = ""
 
 
+def emit(emitter: Emitter, protocol: Protocol) -> dict[str, str]:
+    """A target's files for a protocol by path under generated/ (its folder first); none where the target cannot
+    generate the spec yet (Unsupported: `generate --target NAME` says why)."""
+    try:
+        emitted = emitter.files(protocol)
+    except Unsupported:
+        return {}
+    return {f"{emitter.folder}/{path}" if emitter.folder else path: text for path, text in emitted.items()}
+
+
 @cache
 def emitters() -> tuple[Emitter, ...]:
     """Every target under serialspec.backends, in name order (common/ is the shared layer, not a target)."""

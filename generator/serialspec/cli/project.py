@@ -173,7 +173,7 @@ def spec_outputs(spec: Path, display: str, *, with_data: bool = False) -> Output
 @without_cycle_collection  # the emitters' imports (first spec), rendering and the examples' checks too
 def _generate(raw: bytes, display: str, key: bytes) -> Outputs:
     """Load and resolve one spec, run every emitter over it and check its examples and errata (raises SpecErrors)."""
-    from serialspec.backends import Unsupported, emitters
+    from serialspec.backends import emit, emitters
     from serialspec.lang.loader import decode_text, load_text
     from serialspec.lang.resolve import resolve
 
@@ -182,13 +182,9 @@ def _generate(raw: bytes, display: str, key: bytes) -> Outputs:
     files: dict[str, str] = {}
     errors: list[SpecError] = []
     for emitter in emitters():
-        try:
-            emitted = emitter.files(protocol)
-        except Unsupported:  # a target that cannot generate this spec yet: its files left out (--target says why)
-            continue
-        emitted = {f"{emitter.folder}/{path}" if emitter.folder else path: text for path, text in emitted.items()}
+        emitted = emit(emitter, protocol)  # none from a target that cannot generate this spec yet
         files.update(emitted)
-        if emitter.verify is not None:
+        if emitter.verify is not None and emitted:
             errors.extend(emitter.verify(protocol, emitted))
     files[f"{protocol.name}/{SHIPPED_SPEC}"] = shipped_spec(protocol.spec_path, raw)
     return Outputs(files, errors, located.data, key)

@@ -109,7 +109,8 @@ class Algorithm:
         return [module_import], [f"{name}: Callable[[bytes], int] = {call}{comment}"]
 
     def python_call(self, name: str) -> str:
-        """The checksum of the bytes `{}` as one expression (a str.format template)."""
+        """The checksum of the bytes `{}` as one expression (a str.format template), an operand of any operator
+        (parenthesised where it is not an atom or a call)."""
         return name + "({})"
 
     def python_lines(self, name: str, covered: str, target: str) -> list[str]:

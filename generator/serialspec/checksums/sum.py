@@ -49,7 +49,13 @@ class Sum(Algorithm):
         return [], []  # the built-in sum(), in line
 
     def python_call(self, name: str) -> str:
-        return f"{'~' if self.invert else ''}sum({{}}) & {self.mask:#x}"
+        return f"({self.python_sum('{}')})"
+
+    def python_lines(self, name: str, covered: str, target: str) -> list[str]:
+        return [f"{target} = {self.python_sum(covered)}"]
+
+    def python_sum(self, covered: str) -> str:
+        return f"{'~' if self.invert else ''}sum({covered}) & {self.mask:#x}"
 
     def byte_total(self, total: str) -> str:
         return f"{'~' if self.invert else ''}({total}) & {self.mask:#x}"

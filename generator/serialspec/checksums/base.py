@@ -44,6 +44,7 @@ class Key:
     kind: Literal["bool", "int", "str", "object"]
     description: str
     default: Any = None
+    example: Any = None  # shown in the language reference where no spec uses the key
     minimum: int | None = None
     maximum: int | None = None
     keys: tuple[Key, ...] = ()  # an object's keys

@@ -598,11 +598,13 @@ def _shape(key: Key) -> Shape:
     """The shape of an algorithm's key, as the checksum registry gives it (plain data)."""
     match key.kind:
         case "bool":
-            return Bool(key.description, default=key.default)
+            return Bool(key.description, default=key.default, example=key.example)
         case "int":
-            return Int(key.description, default=key.default, minimum=key.minimum, maximum=key.maximum)
+            return Int(
+                key.description, default=key.default, example=key.example, minimum=key.minimum, maximum=key.maximum
+            )
         case "str":
-            return Str(key.description, default=key.default)
+            return Str(key.description, default=key.default, example=key.example)
         case "object":
             keys = {k.name: _shape(k) for k in key.keys}
             return Obj(keys, required=key.required, description=key.description)

@@ -14,10 +14,7 @@ from __future__ import annotations
 
 import importlib
 import json
-import subprocess
 import sys
-from collections.abc import Iterator
-from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from types import ModuleType
@@ -27,12 +24,13 @@ import pytest
 from conftest import examples
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from serialspec.checksums import algorithms
+from serialspec.checksums import algorithms, owned_keys
 from serialspec.checksums.base import Algorithm, Sample
 from serialspec.cli import main as serialspec_main
-from serialspec.lang import load_protocol
+from serialspec.lang import SpecErrors, load_protocol
 from serialspec.lang.grammar import json_schema
 from serialspec.runtime.errors import ChecksumError
+from sim_process import serve
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -110,6 +108,22 @@ def test_every_algorithm_documents_its_options() -> None:
     for name, algorithm in algorithms().items():
         assert algorithm.samples, f"{name}: no samples, so no option of it is tested here"
         assert algorithm.__doc__ or sys.modules[algorithm.__module__].__doc__, name
+
+
+@pytest.mark.parametrize(("key", "owner"), sorted(owned_keys().items()))
+def test_an_algorithms_keys_belong_to_it(tmp_path: Path, key: str, owner: str) -> None:
+    """Each key an algorithm owns is shown by one of its samples, and refused beside another algorithm."""
+    value = next((s.keys[key] for s in algorithms()[owner].samples if key in s.keys), None)
+    assert value is not None, f"no sample of {owner} gives `{key}`: the matrix does not test it"
+    other, algorithm = next((n, a) for n, a in algorithms().items() if n != owner)
+    sample = algorithm.samples[0]
+    spec = tmp_path / "foreign.yaml"
+    foreign = Sample(sample.label, sample.type, {**sample.keys, key: value})
+    spec.write_text(spec_text("foreign", other, foreign, "general"), encoding="utf-8")
+    with pytest.raises(SpecErrors) as raised:
+        load_protocol(str(spec))
+    (line,) = str(raised.value).splitlines()
+    assert line.endswith(f"framing.elements.checksum.{key}: `{key}` belongs to `algorithm: {owner}`, not {other}")
 
 
 @dataclass
@@ -269,20 +283,6 @@ def test_docs_describe_the_checksum(
         assert f"| {name} | {value} |" in section
 
 
-@contextmanager
-def simulator(spec: Path) -> Iterator[str]:
-    args = [sys.executable, "-m", "serialspec", "sim", str(spec), "--quiet", "--id", "1", "--id", "7"]
-    process = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    try:
-        assert process.stdout is not None
-        path = process.stdout.readline().strip()
-        assert path.startswith("/dev/"), process.stderr.read() if process.stderr else path
-        yield path
-    finally:
-        process.terminate()
-        assert process.wait(10) == 0
-
-
 @pytest.mark.slow
 @pytest.mark.parametrize(("algorithm", "sample", "shape"), CASES)
 def test_client_against_the_simulator(
@@ -295,7 +295,7 @@ def test_client_against_the_simulator(
     finally:
         sys.path.remove(str(case.out))
     client_class = next(v for k, v in vars(client_module).items() if k.endswith("Client") and k != "ClientBase")
-    with simulator(case.spec) as path, client_class(path, timeout=1.0) as client:
+    with serve(str(case.spec), 1, 7) as path, client_class(path, timeout=1.0) as client:  # an absolute spec path
         assert client.ping(1) and client.ping(7)
         client.set_level(7, 321, 0)
         assert client.read_level(7) == 321

@@ -6,7 +6,7 @@ from __future__ import annotations
 import struct
 from collections.abc import Callable
 
-from serialspec.checksums.crc import crc_function, crc_table
+from serialspec.checksums.crc import crc_table
 from serialspec.runtime.checksums import BYTE_VALUES as _BYTES
 from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError, content_size_error, out_of_range
 from serialspec.runtime.fields import wrong_type
@@ -120,8 +120,7 @@ _S_U8_U8_U16 = struct.Struct('<BBH')
 _S_U8_U8_U16_U16 = struct.Struct('<BBHH')
 _S_U8_U8_U8 = struct.Struct('<BBB')
 _S_U8_U8_U8_U8 = struct.Struct('<BBBB')
-_CHECK_CRC: Callable[[bytes], int] = crc_function(8, 0x31, 0x0, True, True, 0x0)  # CRC-8/MAXIM
-_CHECK_CRC_TABLE = crc_table(8, 0x31, True)
+_CHECK_CRC_TABLE = crc_table(8, 0x31, True)  # CRC-8/MAXIM
 
 _MEMBERS_ButtonEvent = members(ButtonEvent)
 _MEMBERS_GamepadButtons = members(GamepadButtons)

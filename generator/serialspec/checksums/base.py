@@ -103,8 +103,10 @@ class Algorithm:
     # -- the Python backend: straight-line codecs --------------------------------------------------------------
 
     def python_setup(self, name: str) -> tuple[list[Import], list[str]]:
-        """Imports and module-level definitions that python_call and python_lines rely on, for the checksum named
-        `name` in the generated module (they define `name`, or names made from it, where they need one)."""
+        """Imports and module-level definitions that python_lines relies on, for the checksum named `name` in the
+        generated module (they define `name`, its runtime function, or names made from it, where they need one).
+        python_call relies on at most these and `name`: codecs that use it define the runtime function as `name`
+        (the frame engine's elements call it too)."""
         module_import, call = self.function_code()
         comment = f"  # {self.title()}" if self.title() else ""
         return [module_import], [f"{name}: Callable[[bytes], int] = {call}{comment}"]

@@ -316,10 +316,11 @@ class Crc(Algorithm):
         return self.width == 8 and self.refin == self.refout
 
     def python_setup(self, name: str) -> tuple[list[Import], list[str]]:
-        if self.stepped:  # python_lines' table; python_call's function
-            imports, definitions = super().python_setup(name)
+        if self.stepped:  # python_lines' table (python_call calls the function)
             table = f"{name.upper()}_TABLE = crc_table(8, {self.poly:#x}, {self.refin})"
-            return [*imports, ("serialspec.checksums.crc", "crc_table")], [*definitions, table]
+            return [("serialspec.checksums.crc", "crc_table")], [
+                f"{table}  # {self.title()}" if self.title() else table
+            ]
         if crc_in_one_call(*self.parameters_tuple) is not None:
             return [("serialspec.checksums.crc", "crc_hqx as _crc_hqx")], []
         return super().python_setup(name)

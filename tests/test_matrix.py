@@ -40,8 +40,8 @@ SHAPES = {
     "classic": (
         '{role: header, value: {request: "AA", response: "BB"}}',
         {"command": "{role: command, type: u8}", "length": "{role: length, type: u8}"},
-        ["header", "content"],
-        lambda frame, size: frame[:-size],
+        ["command", "content"],  # the header left out: the classic codec's fast paths for a skipped header
+        lambda frame, size: frame[1:-size],
     ),
     "general": (
         '{role: header, value: "B5 62"}',

@@ -23,7 +23,7 @@ typedef char dynamixel_p2__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define DYNAMIXEL_P2__KEEP 2u      /* bytes kept at the end that could begin a header */
 
 /* ---- checksums ---- */
-/* CRC-16/UMTS (CRC-16/BUYPASS): width 16, poly 0x8005, init 0x0, refin false, refout false, xorout 0x0 (check 0xfee8). Incremental: start with 0x0u, feed pieces, then use it as is. Bitwise: no table, no static data. */
+/* CRC-16/UMTS (CRC-16/BUYPASS): width 16, poly 0x8005, init 0x0, refin false, refout false, xorout 0x0 (check 0xfee8). Incremental: start with 0x0, feed pieces, then use it as is. Bitwise: no table, no static data. */
 uint16_t dynamixel_p2_crc_16_umts(uint16_t acc, const uint8_t *data, size_t n)
 {
     uint32_t r = acc;

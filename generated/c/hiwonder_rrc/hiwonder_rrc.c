@@ -23,7 +23,7 @@ typedef char hiwonder_rrc__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define HIWONDER_RRC__KEEP 1u      /* bytes kept at the end that could begin a header */
 
 /* ---- checksums ---- */
-/* CRC-8/MAXIM: width 8, poly 0x31, init 0x0, refin true, refout true, xorout 0x0 (check 0xa1). Incremental: start with 0x0u, feed pieces, then use it as is. Bitwise: no table, no static data. */
+/* CRC-8/MAXIM: width 8, poly 0x31, init 0x0, refin true, refout true, xorout 0x0 (check 0xa1). Incremental: start with 0x0, feed pieces, then use it as is. Bitwise: no table, no static data. */
 uint8_t hiwonder_rrc_crc_8_maxim(uint8_t acc, const uint8_t *data, size_t n)
 {
     uint32_t r = acc;

@@ -23,7 +23,7 @@ typedef char modbus_rtu__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define MODBUS_RTU__KEEP -1u      /* bytes kept at the end that could begin a header */
 
 /* ---- checksums ---- */
-/* CRC-16/MODBUS: width 16, poly 0x8005, init 0xffff, refin true, refout true, xorout 0x0 (check 0x4b37). Incremental: start with 0xffffu, feed pieces, then use it as is. Bitwise: no table, no static data. */
+/* CRC-16/MODBUS: width 16, poly 0x8005, init 0xffff, refin true, refout true, xorout 0x0 (check 0x4b37). Incremental: start with 0xffff, feed pieces, then use it as is. Bitwise: no table, no static data. */
 uint16_t modbus_rtu_crc_16_modbus(uint16_t acc, const uint8_t *data, size_t n)
 {
     uint32_t r = acc;

@@ -23,7 +23,7 @@ typedef char vesc__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define VESC__KEEP 0u      /* bytes kept at the end that could begin a header */
 
 /* ---- checksums ---- */
-/* CRC-16/XMODEM: width 16, poly 0x1021, init 0x0, refin false, refout false, xorout 0x0 (check 0x31c3). Incremental: start with 0x0u, feed pieces, then use it as is. Bitwise: no table, no static data. */
+/* CRC-16/XMODEM: width 16, poly 0x1021, init 0x0, refin false, refout false, xorout 0x0 (check 0x31c3). Incremental: start with 0x0, feed pieces, then use it as is. Bitwise: no table, no static data. */
 uint16_t vesc_crc_16_xmodem(uint16_t acc, const uint8_t *data, size_t n)
 {
     uint32_t r = acc;

@@ -1,7 +1,8 @@
-"""Checksum algorithms as C: one function per algorithm, in one place (the registry can take them over per backend).
+"""Checksum algorithms as C: one function per algorithm of the registry (serialspec/checksums/), in one place, so
+each can move into its algorithm's class (its C, beside its Python and docs) as the registry grows backends.
 
-Each function returns the C text of an incremental, public function `<name>(acc, data, n)` and the expressions that
-start and finish it, so a firmware author can checksum a frame in pieces and the frame engine calls the same code.
+Each returns the C text of an incremental, public function `<name>(acc, data, n)` and the expressions that start
+and finish it, so a firmware author can checksum a frame in pieces and the frame engine calls the same code.
 """
 
 from __future__ import annotations
@@ -9,8 +10,12 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from serialspec.backends import Unsupported
+from serialspec.checksums.crc import Crc
+from serialspec.checksums.fletcher import Fletcher
+from serialspec.checksums.sum import Sum
+from serialspec.checksums.xor import Xor
 from serialspec.lang.frozen import frozen
-from serialspec.lang.model import Checksum, Crc
+from serialspec.lang.model import Checksum
 
 
 @frozen
@@ -22,7 +27,7 @@ class CChecksum:
     definition: str  # the function's C text
     prototype: str
     start: str  # C expression of the accumulator's start value
-    finish: str  # C expression of the checksum from the accumulator `a` (a str.format template with {a})
+    finish: str  # C expression of the checksum from the accumulator (a str.format template with {a})
 
 
 def _ctype(width: int) -> str:
@@ -33,41 +38,24 @@ def _reflect(value: int, width: int) -> int:
     return int(f"{value:0{width}b}"[::-1], 2)
 
 
+_PREFIX_HOLE = "@P@_"  # replaced by the protocol's internal prefix (its reflect helper)
+
+
 def _crc(prefix: str, checksum: Checksum) -> CChecksum:
-    crc = checksum.crc
-    assert crc is not None
-    c = _crc_parts(crc)
-    slug = "".join(ch if ch.isalnum() else "_" for ch in crc.name.split(" ")[0].lower()).strip("_")
+    crc = checksum.algorithm
+    assert isinstance(crc, Crc)
+    if not 8 <= crc.width <= 32:
+        raise Unsupported(f"checksum {checksum.name}: a CRC of {crc.width} bits")
+    title = crc.title()
+    slug = "".join(ch if ch.isalnum() else "_" for ch in title.split(" ")[0].lower()).strip("_") if title else ""
+    if not slug:
+        slug = f"crc{crc.width}_{crc.poly:x}_{crc.init:x}_{int(crc.refin)}{int(crc.refout)}_{crc.xorout:x}"
     name = f"{prefix}_{slug}"
     mask = (1 << crc.width) - 1
     t = _ctype(crc.width)
-    doc = (
-        f"/* {crc.name}: width {crc.width}, poly 0x{crc.poly:x}, init 0x{crc.init:x}, refin {str(crc.refin).lower()}, "
-        f"refout {str(crc.refout).lower()}, xorout 0x{crc.xorout:x} (check 0x{crc.check:x}). Incremental: start with "
-        f"{c['start']}, feed pieces, then {c['finish_doc']}. Bitwise: no table, no static data. */"
-    )
-    prototype = f"{t} {name}({t} acc, const uint8_t *data, size_t n);"
-    body = f"""{doc}
-{t} {name}({t} acc, const uint8_t *data, size_t n)
-{{
-    uint32_t r = acc;
-    size_t i;
-    int bit;
-    for (i = 0; i < n; i++) {{
-{c["loop"]}
-    }}
-    return ({t})(r & 0x{mask:x}u);
-}}
-"""
-    return CChecksum(name, t, body, prototype, c["start"], c["finish"])
-
-
-def _crc_parts(crc: Crc) -> dict[str, str]:
-    """The register kept in the input's bit order (reflected when refin); finish reflects it when refout differs."""
-    width, mask = crc.width, (1 << crc.width) - 1
-    if crc.refin:
-        poly = _reflect(crc.poly, width)
-        start = _reflect(crc.init, width)
+    if crc.refin:  # the register kept in the input's bit order (reflected); finish reflects it where refout differs
+        start = _reflect(crc.init, crc.width)
+        poly = _reflect(crc.poly, crc.width)
         loop = (
             "        r ^= data[i];\n"
             "        for (bit = 0; bit < 8; bit++) {\n"
@@ -76,36 +64,50 @@ def _crc_parts(crc: Crc) -> dict[str, str]:
         )
     else:
         start = crc.init
-        top = 1 << (width - 1)
+        top = 1 << (crc.width - 1)
         loop = (
-            f"        r ^= (uint32_t)data[i] << {width - 8};\n"
+            f"        r ^= (uint32_t)data[i] << {crc.width - 8};\n"
             "        for (bit = 0; bit < 8; bit++) {\n"
             f"            r = (r & 0x{top:x}u) ? (((r << 1) ^ 0x{crc.poly:x}u) & 0x{mask:x}u)"
             f" : ((r << 1) & 0x{mask:x}u);\n"
             "        }"
         )
     reflect = crc.refin != crc.refout
-    finish = "(uint32_t)({a})"
-    if reflect:
-        finish = f"{_PREFIX_HOLE}reflect((uint32_t)({{a}}), {width})"
+    finish = f"{_PREFIX_HOLE}reflect((uint32_t)({{a}}), {crc.width})" if reflect else "(uint32_t)({a})"
     if crc.xorout:
         finish = f"(({finish}) ^ 0x{crc.xorout:x}u)"
-    doc = ("reflect the result over its width, " if reflect else "") + (
+    steps = ("reflect the result over its width, " if reflect else "") + (
         f"xor it with 0x{crc.xorout:x}" if crc.xorout else "use it as is"
     )
-    return {"start": f"0x{start:x}u", "loop": loop, "finish": finish, "finish_doc": doc}
-
-
-_PREFIX_HOLE = "@P@_"  # replaced by the protocol's internal prefix (the engine's reflect helper)
+    doc = (
+        f"/* {title or 'CRC'}: width {crc.width}, poly 0x{crc.poly:x}, init 0x{crc.init:x}, refin "
+        f"{str(crc.refin).lower()}, refout {str(crc.refout).lower()}, xorout 0x{crc.xorout:x} (check 0x{crc.check:x}). "
+        f"Incremental: start with 0x{start:x}, feed pieces, then {steps}. Bitwise: no table, no static data. */"
+    )
+    body = f"""{doc}
+{t} {name}({t} acc, const uint8_t *data, size_t n)
+{{
+    uint32_t r = acc;
+    size_t i;
+    int bit;
+    for (i = 0; i < n; i++) {{
+{loop}
+    }}
+    return ({t})(r & 0x{mask:x}u);
+}}
+"""
+    prototype = f"{t} {name}({t} acc, const uint8_t *data, size_t n);"
+    return CChecksum(name, t, body, prototype, f"0x{start:x}u", finish)
 
 
 def _sum(prefix: str, checksum: Checksum) -> CChecksum:
-    width = checksum.type.size * 8
+    algorithm = checksum.algorithm
+    assert isinstance(algorithm, Sum)
+    width = algorithm.width
     t = _ctype(width)
     name = f"{prefix}_sum{width}"
     mask = (1 << width) - 1
-    prototype = f"{t} {name}({t} acc, const uint8_t *data, size_t n);"
-    final = "the sum inverted" if checksum.invert else "the sum"
+    final = "the sum inverted" if algorithm.invert else "the sum"
     body = f"""/* Sum of the bytes modulo 2^{width}. Incremental: start with 0; the frame's checksum is {final}. */
 {t} {name}({t} acc, const uint8_t *data, size_t n)
 {{
@@ -117,19 +119,17 @@ def _sum(prefix: str, checksum: Checksum) -> CChecksum:
     return ({t})(s & 0x{mask:x}u);
 }}
 """
-    finish = f"(~(uint32_t)({{a}}) & 0x{mask:x}u)" if checksum.invert else "(uint32_t)({a})"
-    if checksum.invert:
-        name_inv = name  # the same function: the inversion is the frame's final step
-        return CChecksum(name_inv, t, body, prototype, "0u", finish)
+    finish = f"(~(uint32_t)({{a}}) & 0x{mask:x}u)" if algorithm.invert else "(uint32_t)({a})"
+    prototype = f"{t} {name}({t} acc, const uint8_t *data, size_t n);"
     return CChecksum(name, t, body, prototype, "0u", finish)
 
 
 def _xor(prefix: str, checksum: Checksum) -> CChecksum:
-    width = checksum.type.size * 8
-    if width != 8:
-        raise Unsupported(f"checksum: xor over {width}-bit words")
+    algorithm = checksum.algorithm
+    assert isinstance(algorithm, Xor)
+    if algorithm.width != 8:
+        raise Unsupported(f"checksum {checksum.name}: xor over {algorithm.width}-bit words")
     name = f"{prefix}_xor8"
-    prototype = f"uint8_t {name}(uint8_t acc, const uint8_t *data, size_t n);"
     body = f"""/* XOR of the bytes. Incremental: start with 0. */
 uint8_t {name}(uint8_t acc, const uint8_t *data, size_t n)
 {{
@@ -141,15 +141,46 @@ uint8_t {name}(uint8_t acc, const uint8_t *data, size_t n)
     return x;
 }}
 """
+    prototype = f"uint8_t {name}(uint8_t acc, const uint8_t *data, size_t n);"
     return CChecksum(name, "uint8_t", body, prototype, "0u", "(uint32_t)({a})")
 
 
-ALGORITHMS: dict[str, Callable[[str, Checksum], CChecksum]] = {"crc": _crc, "sum": _sum, "xor": _xor}
+def _fletcher(prefix: str, checksum: Checksum) -> CChecksum:
+    algorithm = checksum.algorithm
+    assert isinstance(algorithm, Fletcher)
+    m = algorithm.modulus
+    name = f"{prefix}_fletcher{m}"
+    body = f"""/* Fletcher modulo {m}: CK_A the sum of the bytes, CK_B the sum of CK_A after each byte; the value is
+ * CK_B << 8 | CK_A. Incremental: acc holds CK_B << 8 | CK_A, start with 0. */
+uint16_t {name}(uint16_t acc, const uint8_t *data, size_t n)
+{{
+    uint32_t a = acc & 0xFFu, b = (uint32_t)acc >> 8;
+    size_t i;
+    for (i = 0; i < n; i++) {{
+        a = (a + data[i]) % {m}u;
+        b = (b + a) % {m}u;
+    }}
+    return (uint16_t)((b << 8) | a);
+}}
+"""
+    prototype = f"uint16_t {name}(uint16_t acc, const uint8_t *data, size_t n);"
+    return CChecksum(name, "uint16_t", body, prototype, "0u", "(uint32_t)({a})")
+
+
+ALGORITHMS: dict[str, Callable[[str, Checksum], CChecksum]] = {
+    "crc": _crc,
+    "sum": _sum,
+    "xor": _xor,
+    "fletcher": _fletcher,
+}
 
 
 def c_checksum(prefix: str, checksum: Checksum) -> CChecksum:
-    """The C of one checksum: the algorithm's own function (ALGORITHMS), with the protocol's prefix."""
-    made = ALGORITHMS[checksum.algorithm](prefix, checksum)
+    """The C of one checksum: its algorithm's function (ALGORITHMS), with the protocol's prefix."""
+    make = ALGORITHMS.get(checksum.algorithm.name)
+    if make is None:
+        raise Unsupported(f"checksum {checksum.name}: algorithm {checksum.algorithm.name}")
+    made = make(prefix, checksum)
     return CChecksum(
         made.name,
         made.ctype,

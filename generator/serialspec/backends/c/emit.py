@@ -149,16 +149,11 @@ class Ctx:
 
     def check_index(self, checksum: Checksum) -> int:
         for i, (known, _) in enumerate(self.checks):
-            if (known.algorithm, known.invert, known.crc, known.type) == (
-                checksum.algorithm,
-                checksum.invert,
-                checksum.crc,
-                checksum.type,
-            ):
+            if (known.algorithm, known.type) == (checksum.algorithm, checksum.type):
                 return i
         made = c_checksum(self.p, checksum)
-        if any(made.name == c.name for _, c in self.checks):
-            raise Unsupported(f"checksum: two {checksum.algorithm} checksums of one width that differ")
+        if any(made.name == c.name and made.definition != c.definition for _, c in self.checks):
+            raise Unsupported(f"checksum {checksum.name}: two {checksum.algorithm.name} checksums that differ")
         self.checks.append((checksum, made))
         return len(self.checks) - 1
 
@@ -198,10 +193,6 @@ def refuse_layout(layout: FrameLayout) -> None:
             inside = first <= i <= last
             if inside and not (first <= a and b <= last):
                 raise Unsupported(f"{where}: checksum {e.name} inside the stuffed span over bytes outside it")
-        if e.role == "checksum" and e.checksum is not None and e.checksum.algorithm == "crc":
-            crc = e.checksum.crc
-            if crc is None or not 8 <= crc.width <= 32:
-                raise Unsupported(f"{where}: a CRC of width {crc.width if crc else '?'}")
 
 
 def refuse_fields(fields: tuple[Field, ...], where: str, nested: bool = False) -> None:

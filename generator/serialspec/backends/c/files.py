@@ -83,7 +83,7 @@ def header(ctx: Ctx) -> str:
     encoders = "\n".join(
         f"int {p}_encode_{msg_id(m)}(const {p}_{msg_id(m)}_t *m, uint8_t *buf, size_t cap, size_t *len);" for m in msgs
     )
-    checks = "\n".join(c.prototype for _, c in ctx.checks)
+    checks = "\n".join(dict.fromkeys(c.prototype for _, c in ctx.checks))
     guard = f"{P}_H"
     return f"""{banner(protocol)}
 #ifndef {guard}
@@ -316,7 +316,7 @@ def source(ctx: Ctx) -> str:
     decoders = "\n".join(decoder(ctx, m) for m in msgs)
     encoders = "\n".join(encoder(ctx, m) for m in msgs)
     # checksums
-    check_defs = "\n".join(c.definition for _, c in ctx.checks)
+    check_defs = "\n".join(dict.fromkeys(c.definition for _, c in ctx.checks))
     cases = "\n".join(
         f"    case {i}u:\n        return {c.finish.format(a=f'{c.name}({c.start}, d, n)')};"
         for i, (_, c) in enumerate(ctx.checks)

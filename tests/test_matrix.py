@@ -313,3 +313,39 @@ def test_client_against_the_simulator(
         client.set_level(7, 321, 0)
         assert client.read_level(7) == 321
         assert client.read_level(1) == 0
+
+
+@pytest.mark.parametrize(("algorithm", "sample", "shape"), CASES)
+def test_c_target(tmp_path_factory: pytest.TempPathFactory, algorithm: str, sample: Sample, shape: str) -> None:
+    """The C `generate` wrote beside the package (docs/c.md), through tests/test_c_backend.py's sanitized driver:
+    messages encode to the Python codec's bytes (its checksum) and decode to its values, a corrupt checksum is
+    refused, and a stream in pieces gives the messages the Python parser gives."""
+    from conftest import Generated
+    from test_c_backend import GCC, Driver, agrees_with_python, stream_agrees_with_python
+
+    if GCC is None:
+        pytest.skip("gcc is not installed")
+    case = made(tmp_path_factory, algorithm, sample, shape)
+    p = case.package
+    protocol = load_protocol(str(case.spec))
+    g = Generated(protocol, p, case.structs)
+    run = Driver(case.name, case.out / "c" / case.name, tmp_path_factory.mktemp("c"))
+    try:
+        frames = []
+        for message in (
+            p.PingRequest(lamp_id=1),
+            p.SetLevelRequest(lamp_id=254, level=1000, fade=0x1234),
+            p.EchoRequest(lamp_id=3, data=bytes(range(0x70, 0x70 + 37))),
+            p.EchoResponse(lamp_id=0, data=b""),
+            p.ReadLevelResponse(lamp_id=9, level=0xFFFF),
+        ):
+            spec = next(m for m in protocol.messages() if m.class_name == type(message).__name__)
+            frame = agrees_with_python(run, g, spec, message.to_fields())
+            bad = frame[:-1] + bytes([frame[-1] ^ 0x01])
+            assert run.ask(f"dec {spec.direction.value} {bad.hex()}") == ["err E_CHECKSUM"]
+            if spec.direction.value == "response":
+                frames.append(frame)
+        direction = next(m.direction for m in protocol.messages() if m.direction.value == "response")
+        stream_agrees_with_python(run, g, direction, b"\x00".join(frames) + b"\x01", "1,2,5")
+    finally:
+        run.close()

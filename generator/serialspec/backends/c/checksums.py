@@ -127,10 +127,10 @@ def _sum(prefix: str, checksum: Checksum) -> CChecksum:
 def _xor(prefix: str, checksum: Checksum) -> CChecksum:
     algorithm = checksum.algorithm
     assert isinstance(algorithm, Xor)
-    if algorithm.width != 8:
-        raise Unsupported(f"checksum {checksum.name}: xor over {algorithm.width}-bit words")
-    name = f"{prefix}_xor8"
-    body = f"""/* XOR of the bytes. Incremental: start with 0. */
+    width = algorithm.width
+    if width == 8:
+        name = f"{prefix}_xor8"
+        body = f"""/* XOR of the bytes. Incremental: start with 0. */
 uint8_t {name}(uint8_t acc, const uint8_t *data, size_t n)
 {{
     uint8_t x = acc;
@@ -141,8 +141,29 @@ uint8_t {name}(uint8_t acc, const uint8_t *data, size_t n)
     return x;
 }}
 """
-    prototype = f"uint8_t {name}(uint8_t acc, const uint8_t *data, size_t n);"
-    return CChecksum(name, "uint8_t", body, prototype, "0u", "(uint32_t)({a})")
+        prototype = f"uint8_t {name}(uint8_t acc, const uint8_t *data, size_t n);"
+        return CChecksum(name, "uint8_t", body, prototype, "0u", "(uint32_t)({a})")
+    size = width // 8
+    t = _ctype(width)
+    name = f"{prefix}_xor{width}"
+    body = f"""/* XOR of the bytes taken as big-endian {width}-bit words, the last padded with zeros.
+ * Incremental in pieces of whole words: start with 0. */
+{t} {name}({t} acc, const uint8_t *data, size_t n)
+{{
+    uint32_t x = acc;
+    size_t i, k;
+    for (i = 0; i < n; i += {size}u) {{
+        uint32_t word = 0u;
+        for (k = 0; k < {size}u; k++) {{
+            word = (word << 8) | (i + k < n ? data[i + k] : 0u);
+        }}
+        x ^= word;
+    }}
+    return ({t})x;
+}}
+"""
+    prototype = f"{t} {name}({t} acc, const uint8_t *data, size_t n);"
+    return CChecksum(name, t, body, prototype, "0u", "(uint32_t)({a})")
 
 
 def _fletcher(prefix: str, checksum: Checksum) -> CChecksum:

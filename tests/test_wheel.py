@@ -177,7 +177,8 @@ def test_a_project_table_in_pyproject_sets_specs_and_output(user: User) -> None:
     assert (project / "src" / "tinylamp" / "codec.py").is_file() and (
         project / "src" / "docs" / "tinylamp.md"
     ).is_file()
-    assert robot.serialspec("check").stdout.startswith("11 generated files match")
+    assert (project / "src" / "c" / "tinylamp" / "tinylamp.h").is_file()  # the C target, beside the package
+    assert robot.serialspec("check").stdout.startswith("15 generated files match")
     (project / "src" / "tinylamp" / "codec.py").write_text("edited\n", encoding="utf-8")
     stale = robot.serialspec("check", check=False)
     assert stale.returncode == 1 and "src/tinylamp/codec.py: stale" in stale.stderr

@@ -1,11 +1,14 @@
 """Emit the markdown reference of one protocol: frames, checksum, commands, tables, examples, errata.
 
 Every piece of spec text goes through `cell()` or `text()`, so a `|`, `<` or newline in a description can
-neither break a table nor inject HTML into the rendered page.
+neither break a table nor inject HTML into the rendered page, a `{` cannot add attributes (`{: onclick=...}` under
+the site's attr_list extension), and a link may only lead to http, https or mailto (`[x](javascript:...)` shows as
+text).
 """
 
 from __future__ import annotations
 
+import re
 from collections import Counter
 from typing import Any
 
@@ -37,10 +40,26 @@ from serialspec.lang.model import (
 )
 from serialspec.runtime.errors import SerialspecError
 
+# A `]` that closes a link's text, with the destination after it: `[x](dest` (and `[x]: dest`, see DEFINITION)
+LINK_END = re.compile(r"\](?=\s*[(:]\s*(?:&lt;)?\s*([^\s)]*))")
+# A reference definition, `[x]: dest` at the start of a line (the text's): it would vanish from the page and turn
+# `[y][x]` anywhere on it into a link, so it shows as text
+DEFINITION = re.compile(r"\[[^\]]*\]:")
+SCHEME = re.compile(r"([A-Za-z][A-Za-z0-9+.-]*):")
+SAFE_SCHEMES = frozenset({"http", "https", "mailto"})
+
+
+def _link_end(match: re.Match[str]) -> str:
+    scheme = SCHEME.match(match[1].replace("\\", ""))
+    return "\\]" if scheme and scheme[1].lower() not in SAFE_SCHEMES else "]"
+
 
 def text(value: str) -> str:
-    """Spec text for a markdown paragraph: one line, HTML-significant characters escaped."""
-    return collapse(value).replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
+    """Spec text for a markdown paragraph: one line, HTML-significant characters escaped, attribute lists and links
+    to other schemes than http, https and mailto (javascript:, data:, vbscript:, ...) shown as text."""
+    escaped = collapse(value).replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;").replace("{", "\\{")
+    escaped = LINK_END.sub(_link_end, escaped)
+    return "\\" + escaped if DEFINITION.match(escaped) else escaped
 
 
 def cell(value: object) -> str:
@@ -139,7 +158,7 @@ def message_context(protocol: Protocol, message: Message | None) -> dict[str, An
     content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
     size = size_text(message.min_size, message.max_size, content_limit(layout))
     rows = [
-        Row(str(layout.offsets[e.name]), e.name, e.type.name if e.type else "", "", "", text(e.description))
+        Row(str(layout.offsets[e.name]), e.name, e.type.name if e.type else "", "", "", e.description)
         for e in layout.value_elements
     ]
     rows += field_rows(message.fields, content_offset)

@@ -1018,7 +1018,19 @@ CASES: list[tuple[str, str, Mutation | Text, str | None]] = [
     ("hostile serial notes", "tiny", put("serial/notes", HOSTILE), None),
     ("trailing backslash", "tiny", put("commands/move/title", "Move \\"), None),
     ("triple quotes", "tiny", put("commands/move/description", "ends with '''\"\"\""), None),
-    ("long description", "tiny", put("description", "word " * 20000), None),
+    ("long description", "tiny", put("description", "word " * 2000), None),
+    (
+        "description over the text limit",
+        "tiny",
+        put("commands/move/description", "word " * 2000 + "w"),
+        "commands.move.description: text of 10,001 characters (at most 10,000)",
+    ),
+    (
+        "file over the size limit",
+        "tiny",
+        Text(lambda t: (t + "# " + "x" * 1_000_000 + "\n").encode()),
+        "the file is larger than 1,000,000 bytes, the most a spec may have",
+    ),
     (
         "nul in a description",
         "tiny",

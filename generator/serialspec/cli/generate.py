@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 from serialspec.cli.project import expected_files, orphans, project
+from serialspec.lang.errors import shown
 from serialspec.runtime.errors import SerialspecError
 
 
@@ -41,6 +42,6 @@ def run(args: argparse.Namespace) -> int:
         if folder.is_dir() and not any(folder.iterdir()):
             folder.rmdir()
     print(f"{len(files)} files generated in {proj.display(proj.out)}, {written} changed, {len(removed)} removed")
-    for error in errors:
-        print(error, file=sys.stderr)
+    for line in shown(errors):
+        print(line, file=sys.stderr)
     return 1 if errors else 0

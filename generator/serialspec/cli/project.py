@@ -28,6 +28,7 @@ from serialspec import cache
 from serialspec.collection import without_cycle_collection
 from serialspec.lang.errors import SpecError, SpecErrors
 from serialspec.lang.frozen import frozen
+from serialspec.lang.limits import read_spec
 
 SCHEMA_NAME = "serialspec.schema.json"
 #: The first line of every generated text file names the spec it came from.
@@ -144,7 +145,7 @@ def spec_outputs(spec: Path, display: str, *, with_data: bool = False) -> Output
     function of those alone, so the cached files, and the verdict of its examples and errata, are what generating it
     again would give. A spec with mistakes is never cached: it is loaded again, to report them."""
     try:
-        raw = spec.read_bytes()  # read once: what is generated is what the key names, whatever happens to the file
+        raw = read_spec(str(spec))  # read once: what is generated is what the key names, whatever happens to it
     except OSError:
         from serialspec.lang.loader import load_file
 

@@ -13,6 +13,7 @@ from dataclasses import field
 from typing import Any
 
 from serialspec.lang.frozen import mutable
+from serialspec.lang.limits import MAX_TEXT
 from serialspec.lang.loader import CONTROL, Path
 
 SCALAR_TYPES = ("u8", "i8", "u16", "i16", "u32", "i32", "f32")
@@ -38,6 +39,8 @@ class Str(Shape):
     def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
         if not isinstance(value, str):
             yield path, f"expected text, got {_kind(value)}"
+        elif len(value) > MAX_TEXT:
+            yield path, f"text of {len(value):,} characters (at most {MAX_TEXT:,})"
         elif bad := CONTROL.search(value):
             yield path, f"control character U+{ord(bad.group()):04X} in text (not allowed in a spec)"
         elif self.choices and value not in self.choices:

@@ -44,8 +44,13 @@ def test_read_returns_as_soon_as_the_reply_is_complete(sim: tuple[FashionstarUar
 def test_timeout_names_command_and_id_and_bus_stays_usable(sim: tuple[FashionstarUartSimulator, str]) -> None:
     _, path = sim
     with Bus(path, BINDING, timeout=0.05) as bus:
-        with pytest.raises(Timeout, match=r"read_angle from servo_id=7"):
-            bus.request(ReadAngleRequest(servo_id=7), ReadAngleResponse)
+        for timeout in (None, 0.03):  # the bus's, then the call's own
+            with pytest.raises(Timeout) as failure:
+                bus.request(ReadAngleRequest(servo_id=7), ReadAngleResponse, timeout=timeout)
+            # the timeout, not what was left of it after the first read (`within -5 ms`, `-0 ms`)
+            wanted = 0.05 if timeout is None else timeout
+            assert str(failure.value) == f"no reply to read_angle from servo_id=7 within {wanted * 1000:.0f} ms"
+            assert failure.value.timeout == wanted
         assert bus.request(ReadAngleRequest(servo_id=2), ReadAngleResponse).servo_id == 2
 
 

@@ -528,7 +528,7 @@ class Bus:
                 self._backlog.extend(messages)  # _read_until takes them first
             if expects:
                 self._parser.expect(expect)
-            reply = self._read_until(wait - (time.monotonic() - started), request, expect, errors=0)
+            reply = self._read_until(wait - (time.monotonic() - started), request, expect, errors=0, timeout=wait)
             if self._backlog:
                 self._flush_backlog()
         finally:
@@ -746,11 +746,13 @@ class Bus:
         key: dict[str, Any] | None = None,
         keep: bool = False,
         errors: int | None = None,
+        timeout: float | None = None,
     ) -> M:
         """Read until the wanted frame (see _wanted) has come, for up to `wait` seconds. Frames that came after it
         in the same read stay in the backlog (the next reply of a request_each); every other frame goes to
         subscribers, and to them too the wanted one when `keep`. Frames that fail their checks after the parser
-        counted `errors` (by default: from now on) make it a CorruptReply."""
+        counted `errors` (by default: from now on) make it a CorruptReply. A Timeout names `timeout`, the whole
+        transaction's (by default `wait`: what is left of it when part was spent before, maybe less than nothing)."""
         backlog = self._backlog
         while backlog:  # frames that came with the previous reply of this transaction
             message = backlog.popleft()
@@ -788,13 +790,15 @@ class Bus:
             if now >= deadline:
                 pending = parser.pending()
                 self._reset()
+                if timeout is None:
+                    timeout = wait
                 if request is None:
-                    raise Timeout("", "", wait)
+                    raise Timeout("", "", timeout)
                 if pending:
                     raise CorruptReply(
                         f"incomplete reply to {request.COMMAND} from {self._device(request)}: {pending.hex(' ')}"
                     )
-                raise Timeout(request.COMMAND, self._device(request), wait)
+                raise Timeout(request.COMMAND, self._device(request), timeout)
             try:
                 chunk = self._link.read(deadline - now)
             except Exception as exc:

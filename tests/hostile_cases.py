@@ -1018,6 +1018,12 @@ CASES: list[tuple[str, str, Mutation | Text, str | None]] = [
     ("hostile serial notes", "tiny", put("serial/notes", HOSTILE), None),
     ("trailing backslash", "tiny", put("commands/move/title", "Move \\"), None),
     ("triple quotes", "tiny", put("commands/move/description", "ends with '''\"\"\""), None),
+    (
+        "probe without a reply",
+        "tiny",
+        put("commands/write/probe", True),
+        "commands.write.probe: a probe needs a reply: a `response`, or `answered_by` on its request",
+    ),
     ("long description", "tiny", put("description", "word " * 2000), None),
     (
         "description over the text limit",

@@ -470,6 +470,13 @@ COMMAND = Obj(
         "request": MESSAGE,
         "response": MESSAGE,
         "broadcast": TEXT,
+        "probe": Bool(
+            "The command asks whether a device is there (PING): its client method returns True when the device "
+            "answers and False when none does, whatever the reply holds. Every other command with a reply raises "
+            "Timeout when none comes.",
+            default=False,
+            example=True,
+        ),
         "source": SOURCE,
         "selector": Obj(
             {

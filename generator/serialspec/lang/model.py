@@ -345,6 +345,7 @@ class Command:
     selector: Selector | None
     subcommands: tuple[Subcommand, ...]
     group_class: str = ""  # the client's class grouping the sub-commands' methods ("" without sub-commands)
+    probe: bool = False  # asks whether a device is there: clients return True/False, never raise Timeout
 
     def messages(self) -> tuple[Message, ...]:
         found = [m for m in (self.request, self.response) if m]

@@ -908,6 +908,7 @@ class ClientBase:
         # (address, optional condition) -> whether those replies are due, from the parameters as last read or
         # written (emptied whenever they change): what a read sent again asks, without a call
         self._due: dict[tuple[Any, ...], bool] = {}
+        self._read_was_optional = False  # the parameter read under way asked whether its own reply is due
 
     def close(self) -> None:
         self.bus.close()
@@ -941,6 +942,20 @@ class ClientBase:
             return self._ask(request, expect, after)
         return self.bus.request(request, expect)
 
+    def _from_new_address(
+        self, request: Message, expect: type[Message], address: int, optional: tuple[int, int, str] | None
+    ) -> bool | None:
+        """A write of the device's own id, whose reply comes (if it is due) from the new id: True once it has."""
+        if self._is_broadcast(request) or (optional is not None and not self._answers(request, optional)):
+            self.bus.send(request)
+            return None
+        try:
+            self.bus.request_each(request, expect, [{self.ADDRESS: address}])
+        except Timeout as exc:
+            device = f"{self.bus._device(request)} (as {self.ADDRESS}={address})"
+            raise Timeout(request.COMMAND, device, exc.timeout) from None
+        return True
+
     def _answers(self, request: Message, optional: tuple[int, int, str]) -> bool:
         if self.optional_replies is not None:
             return self.optional_replies
@@ -954,14 +969,18 @@ class ClientBase:
             # optional reply: DYNAMIXEL READ at status_return_level 0); no answer means no optional replies.
             self._due.clear()
             self._parameters[(address, key)] = None
+            self._read_was_optional = False
             try:
                 current = self._parameters[(address, key)] = self._read_key(address, key)
-            except Timeout:
+            except Timeout as exc:
                 del self._parameters[(address, key)]
-                return False
+                if not self._read_was_optional:  # a read that is always answered was not: no device is there
+                    raise Timeout(request.COMMAND, self.bus._device(request), exc.timeout) from None
+                return False  # silence may be the parameter's doing (DYNAMIXEL status_return_level 0)
             finally:
                 self._due.clear()
         if current is None:
+            self._read_was_optional = True
             return True
         due = self._due[(address, optional)] = _COMPARE[op](current, value)
         return due

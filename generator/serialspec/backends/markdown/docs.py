@@ -275,6 +275,7 @@ def command_context(protocol: Protocol, command: Command) -> dict[str, Any]:
         "title_cn": text(command.title_cn),
         "description": text(command.description),
         "broadcast": text(command.broadcast),
+        "probe": command.probe,
         "source": text(command.source),
         "anchor": anchor("command", command.name),
         "messages": same_once(

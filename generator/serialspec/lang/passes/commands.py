@@ -182,6 +182,11 @@ class Commands(FieldResolver):
             for d in Direction
             if d.value in value and "subcommands" not in value
         }
+        probe = bool(value.get("probe", False))
+        if probe and ("subcommands" in value or "request" not in value):
+            self.error((*path, "probe"), "a probe is a command with a request (and a reply), not sub-commands")
+        elif probe and "response" not in value and "answered_by" not in (value["request"] or {}):
+            self.error((*path, "probe"), "a probe needs a reply: a `response`, or `answered_by` on its request")
         return Command(
             name=name,
             code=value.get("code"),
@@ -195,6 +200,7 @@ class Commands(FieldResolver):
             selector=selector,
             subcommands=tuple(subcommands),
             group_class=self.class_name(camel(name, "commands"), path) if subcommands else "",
+            probe=probe,
         )
 
     def check_answered_by(self, commands: list[Command]) -> None:

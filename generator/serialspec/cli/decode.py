@@ -9,7 +9,7 @@ from types import ModuleType
 from typing import Any, TextIO
 
 from serialspec.cli import capture
-from serialspec.cli.frames import Frames
+from serialspec.cli.frames import Frames, Seen
 from serialspec.cli.protocols import SPEC_HELP, open_spec
 from serialspec.cli.views import FlagNames, engineering, message_spec, register_view, unit_symbols, with_unit
 from serialspec.lang.model import Protocol, replies_by_request, reply_to
@@ -75,23 +75,28 @@ def replay(args: argparse.Namespace, protocol: Protocol, package: ModuleType) ->
             for number, chunk in capture.read(stream):
                 direction = chunk.direction or args.direction
                 frames = streams.get(direction) or streams.setdefault(direction, Frames(package, direction, address))
-                for seen in frames.feed(chunk.data):
+                for seen in frames.feed(chunk.data, number):
                     if seen.message is None:
                         failed += 1
-                        print(
-                            f"serialspec decode: line {number}: {seen.reason} in [{seen.data.hex(' ')}]",
-                            file=sys.stderr,
-                        )
+                        bad(seen)
                         continue
                     result = describe(protocol, seen.message, seen.data, args.units, None)
                     show({"time": chunk.when, **result} if chunk.when else result, args.json)
         except ValueError as exc:
             raise SerialspecError(f"{args.file}: {exc}") from None
     for frames in streams.values():
+        for seen in frames.finish():
+            failed += 1
+            bad(seen)
         if frames.pending():
             failed += 1
             print(f"serialspec decode: {args.file} ends inside a frame: [{frames.pending().hex(' ')}]", file=sys.stderr)
     return 1 if failed else 0
+
+
+def bad(seen: Seen) -> None:
+    """Bad bytes of a capture, under the line their first byte is on."""
+    print(f"serialspec decode: line {seen.origin}: {seen.reason} in [{seen.data.hex(' ')}]", file=sys.stderr)
 
 
 def _open(path: str) -> TextIO:

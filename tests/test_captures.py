@@ -216,3 +216,39 @@ def test_every_byte_of_a_noisy_stream_is_a_frame_or_reported_bad_once_whatever_t
         start, stop = chunks[s.origin]  # type: ignore[index]
         assert start <= offset < stop
         offset += len(s.data)
+
+
+def test_a_spy_log_replays_with_register_names_from_the_request_before(tmp_path: Path) -> None:
+    """pyserial's spy:// log, which the README names beside captures, could not be decoded (`'000000.000' is not a
+    hex byte`), and a replayed READ reply showed `data 09 03`, not `model_number 777`, though its request is the
+    frame before: a reply is shown with the request it answers, in a capture and in a spy log alike."""
+    from feetech_sms.client import FeetechSmsClient
+    from feetech_sms.simulator import FeetechSmsSimulator
+
+    simulator = FeetechSmsSimulator(ids=[1])
+    path = simulator.start()
+    log = tmp_path / "spy.log"
+    try:
+        with FeetechSmsClient(f"spy://{path}?file={log}", optional_replies=True) as client:
+            assert client.read(1, "model_number") == 777
+            client.ping(1)  # a reply that answers no READ: shown without registers
+    finally:
+        simulator.close()
+    assert log.read_text(encoding="utf-8").startswith("000000.")
+    capture = tmp_path / "read.capture"
+    capture.write_text(
+        "2026-11-22T09:40:00.000000+00:00 request ff ff 01 04 02 03 02 f3\n"
+        "2026-11-22T09:40:00.001000+00:00 response ff ff 01 04 00 09 03 ee\n",
+        encoding="utf-8",
+    )
+    for replayed in (log, capture):
+        result = subprocess.run(
+            [sys.executable, "-m", "serialspec", "decode", SMS, "--file", str(replayed), "--json"],
+            capture_output=True,
+            text=True,
+        )
+        assert result.returncode == 0 and result.stderr == "", result.stderr
+        decoded = [json.loads(line) for line in result.stdout.splitlines()]
+        assert [(d["direction"], d["command"]) for d in decoded][:2] == [("request", "read"), ("response", "reply")]
+        assert decoded[1]["registers"] == {"model_number": 777}
+        assert all("registers" not in d for d in decoded[2:] if d["direction"] == "response")

@@ -65,10 +65,13 @@ def show(result: dict[str, Any], as_json: bool) -> None:
 
 
 def replay(args: argparse.Namespace, protocol: Protocol, package: ModuleType) -> int:
-    """Decode a capture: each direction's bytes joined again and split into frames; bad bytes reported."""
+    """Decode a capture: each direction's bytes joined again and split into frames; bad bytes reported. A reply is
+    shown with the last request before it when it answers that request (registers by name, as `--request` does)."""
     address = protocol.device.address if protocol.device else None
     streams: dict[str | None, Frames] = {}
     failed = 0
+    replies = replies_by_request(protocol.messages())
+    asked: Message | None = None  # the last request seen
     stream = sys.stdin if args.file == "-" else _open(args.file)
     with stream:
         try:
@@ -80,7 +83,14 @@ def replay(args: argparse.Namespace, protocol: Protocol, package: ModuleType) ->
                         failed += 1
                         bad(seen)
                         continue
-                    result = describe(protocol, seen.message, seen.data, args.units, None)
+                    message, request = seen.message, None
+                    if message.DIRECTION.value == "request":
+                        asked = message
+                    elif asked is not None and reply_to(message_spec(protocol, asked), replies) is message_spec(
+                        protocol, message
+                    ):
+                        request = asked
+                    result = describe(protocol, message, seen.data, args.units, request)
                     show({"time": chunk.when, **result} if chunk.when else result, args.json)
         except ValueError as exc:
             raise SerialspecError(f"{args.file}: {exc}") from None

@@ -446,7 +446,9 @@ class Bus:
             encoder = self._encoders.get(request.__class__)
             try:
                 frame = encoder(request)  # type: ignore[misc]  # None: encode says why
-            except Exception:  # encode raises it again, as one line naming the field (EncodeError, RangeError)
+            except Exception:  # encode raises it again, as one line naming the field (EncodeError, RangeError),
+                frame = None  # outside this handler: one error, not two chained
+            if frame is None:
                 frame = self.binding.encode(request)
         wait = self.timeout if timeout is None else timeout
         lock = self._lock

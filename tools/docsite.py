@@ -33,6 +33,22 @@ td code { white-space: nowrap; }
 """
 
 
+# Search reads its index with a web worker, which a browser refuses to a page opened from disk: there its results
+# page would say "Searching..." forever, so it says how to serve the site instead.
+SEARCH_FROM_DISK = """\
+if (location.protocol === "file:") {
+  document.addEventListener("DOMContentLoaded", function () {
+    var results = document.getElementById("mkdocs-search-results");
+    if (results) {
+      results.innerHTML = "<p>Search needs the site served over HTTP: a browser does not let a page opened from "
+        + "disk read the search index. Serve it with <code>python3 -m http.server -d site</code> and open "
+        + "<a href='http://localhost:8000/'>http://localhost:8000/</a>; every other page works from disk.</p>";
+    }
+  });
+}
+"""
+
+
 def pages() -> dict[str, str]:
     """Repository path -> site path of every page."""
     found = {"README.md": "index.md", "docs/tutorial.md": "tutorial.md", "docs/language.md": "language.md"}
@@ -62,6 +78,7 @@ def stage() -> dict[str, str]:
         (STAGE / target).parent.mkdir(parents=True, exist_ok=True)
         (STAGE / target).write_text(LINK.sub(relink, text), encoding="utf-8")
     (STAGE / "extra.css").write_text(CSS, encoding="utf-8")
+    (STAGE / "search-from-disk.js").write_text(SEARCH_FROM_DISK, encoding="utf-8")
     return mapping
 
 
@@ -75,6 +92,7 @@ def config(mapping: dict[str, str], site: Path) -> dict[str, object]:
         "use_directory_urls": False,  # the site works from the file system too
         "theme": {"name": "readthedocs", "highlightjs": False, "navigation_depth": 2},
         "extra_css": ["extra.css"],
+        "extra_javascript": ["search-from-disk.js"],
         "markdown_extensions": ["tables", "attr_list", {"toc": {"permalink": True}}],
         "validation": {"links": {"not_found": "warn", "anchors": "warn", "unrecognized_links": "warn"}},
         "nav": [
@@ -92,7 +110,11 @@ def build(site: Path) -> int:
     # JSON is YAML: no YAML writer needed
     config_file.write_text(json.dumps(config(mapping, site), indent=2), encoding="utf-8")
     # not --quiet: mkdocs counts the warnings strict mode fails on only where it prints them
-    return subprocess.run([sys.executable, "-m", "mkdocs", "build", "-f", str(config_file)]).returncode
+    code = subprocess.run([sys.executable, "-m", "mkdocs", "build", "-f", str(config_file)]).returncode
+    if code == 0:
+        shown = os.path.relpath(site) if site.is_relative_to(Path.cwd()) else str(site)
+        print(f"open {shown}/index.html; for search, serve it: python3 -m http.server -d {shown}", file=sys.stderr)
+    return code
 
 
 if __name__ == "__main__":

@@ -37,5 +37,5 @@ def run(args: argparse.Namespace) -> int:
         print("run `serialspec generate` to bring the generated files up to date", file=sys.stderr)
     if problems or errors:
         return 1
-    print(f"{len(files)} generated files match the specs")
+    print(f"{len(files)} generated {'file matches' if len(files) == 1 else 'files match'} the specs")
     return 0

@@ -22,7 +22,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("spec", help=SPEC_HELP)
     parser.add_argument("hex", nargs="*", help="one frame per argument; - reads frames from stdin, one per line")
     parser.add_argument(
-        "--file", metavar="FILE", help="a capture (monitor --save, sim --tap) or hex lines to replay; - for stdin"
+        "--file",
+        metavar="FILE",
+        help="a capture (monitor --save, sim --tap), a spy:// log or hex lines to replay; - for stdin",
     )
     parser.add_argument("--json", action="store_true", help="one JSON object per frame")
     parser.add_argument(

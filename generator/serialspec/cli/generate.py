@@ -41,7 +41,8 @@ def run(args: argparse.Namespace) -> int:
         shutil.rmtree(folder / "__pycache__", ignore_errors=True)
         if folder.is_dir() and not any(folder.iterdir()):
             folder.rmdir()
-    print(f"{len(files)} files generated in {proj.display(proj.out)}, {written} changed, {len(removed)} removed")
+    files_generated = f"{len(files)} file{'' if len(files) == 1 else 's'} generated"
+    print(f"{files_generated} in {proj.display(proj.out)}, {written} changed, {len(removed)} removed")
     for line in shown(errors):
         print(line, file=sys.stderr)
     return 1 if errors else 0

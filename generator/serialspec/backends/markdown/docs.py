@@ -328,9 +328,9 @@ def frame_context(protocol: Protocol, layout: FrameLayout) -> dict[str, Any]:
         size = e.size
         variable = variable or e.name == first_variable
         if e.role == "header" and layout.classic:
-            description = f"{layout.header.hex(' ').upper()} — {e.description}"
+            description = " — ".join(p for p in (layout.header.hex(" ").upper(), e.description) if p)
         elif e.fixed:
-            description = f"{e.constant.hex(' ').upper()} — {e.description}"
+            description = " — ".join(p for p in (e.constant.hex(" ").upper(), e.description) if p)
         elif e.role == "checksum" and not layout.classic and e.checksum is not None:
             endian = "big-endian" if e.endian == ">" else "little-endian"
             description = f"over `{e.checksum.first}`..`{e.checksum.last}`, {endian}. {e.description}"
@@ -662,6 +662,8 @@ def emit_docs(protocol: Protocol) -> str:
         matching=", ".join(protocol.matching),
         matching_description=text(protocol.matching_description),
         commands=commands,
+        # the index's column of the titles as the (Chinese) documents print them, where a command has one
+        titles_cn=any(c["title_cn"] or any(s["title_cn"] for s in c["subcommands"]) for c in commands),
         tables=tables,
         enums=enums,
         flags=flags,

@@ -210,7 +210,24 @@ CASES: list[tuple[str, str, Mutation | Text, str | None]] = [
         replace_text("title: Tiny\n", "title: Tiny\n? [a, b]\n: c\n"),
         "keys must be names or numbers",
     ),
-    ("boolean key", "tiny", replace_text("title: Tiny\n", "title: Tiny\nyes: 1\n"), "keys must be names or numbers"),
+    (
+        "boolean key",
+        "tiny",
+        replace_text("title: Tiny\n", "title: Tiny\nyes: 1\n"),
+        "the key yes reads as true in YAML: quote it ('yes')",
+    ),
+    (
+        "enum value named off",  # a newcomer's first enum: off/on are false/true in YAML 1.1
+        "tiny",
+        replace_text("mode: {values: {slow: 0, fast: 1}}", "mode: {values: {off: 0, fast: 1}}"),
+        "enums.mode.values: the key off reads as false in YAML: quote it ('off')",
+    ),
+    (
+        "null key",
+        "tiny",
+        replace_text("title: Tiny\n", "title: Tiny\n~: 1\n"),
+        "the key ~ reads as nothing in YAML: quote it ('~')",
+    ),
     # --- numbers: codes, sizes, scales, ranges, defaults, serial settings ----------------------------------------------
     (
         "code 256",

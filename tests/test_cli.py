@@ -216,3 +216,17 @@ def test_sim_banner_says_what_is_served_in_words() -> None:
     assert banner("vesc", [0]) == "(one device: the protocol has no address)"
     assert banner("modbus_rtu", [1, 2]) == "unit 1, 2"
     assert banner("hiwonder_rrc", [1]) == "servo_id 1; pwm_servo servo_id 1, 2, 3, 4; motor motor_id 0, 1, 2, 3"
+
+
+def test_a_mistyped_command_or_a_missing_direction_says_what_to_type(capsys: pytest.CaptureFixture[str]) -> None:
+    """`encode --json '{"command": "rotat"}'` said only "has no request 'rotat'", and a shared-header frame "give the
+    direction" without naming the option (found following the README from the wheel)."""
+    assert main(["encode", "fashionstar_uart", "--json", '{"command": "rotat", "fields": {}}']) == 1
+    assert capsys.readouterr().err.strip() == (
+        "serialspec encode: fashionstar_uart has no request 'rotat' (did you mean rotate?)"
+    )
+    assert main(["decode", "feetech_sms", "ff ff 01 04 00 09 03 ee"]) == 1
+    assert capsys.readouterr().err.strip() == (
+        "serialspec decode: ff ff 01 04 00 09 03 ee: give the direction: requests and responses share the header "
+        "ff ff (--direction request|response)"
+    )

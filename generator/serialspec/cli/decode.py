@@ -55,7 +55,8 @@ def run(args: argparse.Namespace) -> int:
             frame = _hex(text)
             message = package.decode(frame, args.direction, expect)
         except (DecodeError, SerialspecError) as exc:
-            print(f"serialspec decode: {text.strip()}: {exc}", file=sys.stderr)
+            hint = " (--direction request|response)" if str(exc).startswith("give the direction") else ""
+            print(f"serialspec decode: {text.strip()}: {exc}{hint}", file=sys.stderr)
             failed += 1
             continue
         show(describe(protocol, message, frame, args.units, request), args.json)

@@ -119,4 +119,21 @@ def message_type(package: ModuleType, command: str, subcommand: str | None, dire
         if (cls.COMMAND, cls.SUBCOMMAND, cls.DIRECTION.value) == (command, subcommand, direction):
             return cls  # type: ignore[no-any-return]
     what = f"{command}.{subcommand}" if subcommand else command
-    raise SerialspecError(f"{package.__name__} has no {direction} {what!r}")
+    import difflib  # only for a name that is not there
+
+    names = sorted(
+        {
+            f"{c.COMMAND}.{c.SUBCOMMAND}" if c.SUBCOMMAND else c.COMMAND
+            for c in package.MESSAGE_TYPES
+            if c.DIRECTION.value == direction
+        }
+    )
+    close = difflib.get_close_matches(what, names, n=3)
+    hint = (
+        f" (did you mean {' or '.join(close)}?)"
+        if close
+        else f" (it has {', '.join(names)})"
+        if len(names) <= 12
+        else ""
+    )
+    raise SerialspecError(f"{package.__name__} has no {direction} {what!r}{hint}")

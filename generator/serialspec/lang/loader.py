@@ -272,7 +272,16 @@ class _Converter:
                 else:
                     key = _scalar(key_node) if isinstance(key_node, yaml.ScalarNode) else None
                     if not isinstance(key, str | int) or isinstance(key, bool):
-                        self.fail(key_node, path, "keys must be names or numbers")
+                        if isinstance(key_node, yaml.ScalarNode) and isinstance(
+                            key, bool | None
+                        ):  # YAML 1.1 reads on/off/yes/no/null as true/false/nothing
+                            shown = "nothing" if key is None else str(key).lower()
+                            message = (
+                                f"the key {key_node.value} reads as {shown} in YAML: quote it ('{key_node.value}')"
+                            )
+                        else:
+                            message = "keys must be names or numbers"
+                        self.fail(key_node, path, message)
                         continue
                 inner = (*path, key)
                 if key in result:

@@ -1036,6 +1036,27 @@ CASES: list[tuple[str, str, Mutation | Text, str | None]] = [
     ("trailing backslash", "tiny", put("commands/move/title", "Move \\"), None),
     ("triple quotes", "tiny", put("commands/move/description", "ends with '''\"\"\""), None),
     (
+        "matching by the command element's name",  # the tutorial matches by `command`; a spec of one's own names it
+        "tiny",
+        put("matching", {"by": ["id", "code"]}),
+        "matching.by[1]: 'code' is the command element: a reply's command is matched as `command`",
+    ),
+    (
+        "matching by the checksum",
+        "tiny",
+        put("matching", {"by": ["id", "checksum"]}),
+        "matching.by[1]: 'checksum' is the frame's checksum, not a value a reply repeats from its request",
+    ),
+    (
+        "example with a wrong 16-bit checksum",  # shown as wide as it is: 0x0000, not 0x00
+        "tiny",
+        both(
+            put("framing/elements/checksum/type", "u16"),
+            put("examples/move_request/printed", "AA 55 01 01 05 64 00 01 0A 00 00 00"),
+        ),
+        "examples.move_request: the frame does not decode: bad checksum: the frame has 0x0000, its bytes give 0x0076",
+    ),
+    (
         "probe without a reply",
         "tiny",
         put("commands/write/probe", True),

@@ -112,9 +112,17 @@ class Commands(FieldResolver):
         if framing is None:
             return  # the frame's elements are unknown: its problems are reported
         names |= self.ctx.broken
+        roles = {e.name: e.role for layout in framing.layouts.values() for e in layout.elements}
         for index, name in enumerate(self.ctx.matching):
-            if name not in names:
-                self.error(("matching", "by", index), f"unknown field {name!r} (no frame element or field has it)")
+            if name in names:
+                continue
+            if roles.get(name) == "command":
+                message = f"{name!r} is the command element: a reply's command is matched as `command`"
+            elif name in roles:
+                message = f"{name!r} is the frame's {roles[name]}, not a value a reply repeats from its request"
+            else:
+                message = f"unknown field {name!r} (no frame element or field has it)"
+            self.error(("matching", "by", index), message)
 
     def command(self, name: str, value: dict[str, Any], path: Path) -> Command:
         self.name(name, path, "command name")

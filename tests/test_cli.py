@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 import shutil
 import subprocess
 import sys
@@ -230,3 +231,15 @@ def test_a_mistyped_command_or_a_missing_direction_says_what_to_type(capsys: pyt
         "serialspec decode: ff ff 01 04 00 09 03 ee: give the direction: requests and responses share the header "
         "ff ff (--direction request|response)"
     )
+
+
+@pytest.mark.parametrize("out", [".", "src", "build/out"])
+def test_a_reference_links_its_spec_from_wherever_it_is_generated(tmp_path: Path, out: str) -> None:
+    """The reference linked its spec as `../../SPEC` wherever it was written: from `generate tinylamp.yaml --out .`
+    (the tutorial's), `docs/tinylamp.md` pointed one folder above the project."""
+    shutil.copy(ROOT / "examples" / "tinylamp" / "tinylamp.yaml", tmp_path / "tinylamp.yaml")
+    assert serialspec("generate", "tinylamp.yaml", "--out", out, cwd=tmp_path).returncode == 0
+    page = tmp_path / out / "docs" / "tinylamp.md"
+    link = re.search(r"spec: \[`tinylamp\.yaml`\]\(([^)]+)\)", page.read_text(encoding="utf-8"))
+    assert link is not None
+    assert (page.parent / link[1]).resolve() == (tmp_path / "tinylamp.yaml").resolve()

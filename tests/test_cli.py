@@ -243,3 +243,18 @@ def test_a_reference_links_its_spec_from_wherever_it_is_generated(tmp_path: Path
     link = re.search(r"spec: \[`tinylamp\.yaml`\]\(([^)]+)\)", page.read_text(encoding="utf-8"))
     assert link is not None
     assert (page.parent / link[1]).resolve() == (tmp_path / "tinylamp.yaml").resolve()
+
+
+def test_check_without_specs_and_generate_of_a_missing_spec_say_so_and_write_nothing(tmp_path: Path) -> None:
+    """In a folder without specs, `check` said `generated/serialspec.schema.json: missing` and sent the user to
+    generate; `generate nope.yaml` reported the missing file but still made generated/ with the schema in it."""
+    result = serialspec("check", cwd=tmp_path)
+    assert result.returncode == 1
+    assert result.stderr.splitlines() == [
+        "serialspec check: no specs to check in .: name spec files, or list them in pyproject.toml's "
+        "[tool.serialspec] specs (default: specs/*.yaml)"
+    ]
+    result = serialspec("generate", "nope.yaml", cwd=tmp_path)
+    assert result.returncode == 1
+    assert result.stderr.splitlines() == ["nope.yaml:1:1: no such spec file"]
+    assert list(tmp_path.iterdir()) == []

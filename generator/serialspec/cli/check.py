@@ -8,6 +8,7 @@ from pathlib import Path
 
 from serialspec.cli.project import expected_files, orphans, project, strangers
 from serialspec.lang.errors import shown
+from serialspec.runtime.errors import SerialspecError
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -20,6 +21,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     proj = project(args.root, args.specs, args.out)
+    if not proj.specs:
+        raise SerialspecError(
+            f"no specs to check in {proj.display(proj.root) or '.'}: name spec files, or list them in pyproject.toml's "
+            "[tool.serialspec] specs (default: specs/*.yaml)"
+        )
     files, errors = expected_files(proj)
     problems: list[str] = []
     for path, text in files.items():

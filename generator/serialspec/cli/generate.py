@@ -22,6 +22,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     proj = project(args.root, args.specs, args.out)
     files, errors = expected_files(proj)
+    if proj.chosen and errors and all(path == proj.schema for path in files):
+        # every spec named has mistakes: nothing is written (not even the schema, into a generated/ of its own)
+        for line in shown(errors):
+            print(line, file=sys.stderr)
+        return 1
     written = 0
     for path, text in files.items():
         try:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import sys
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 
 from serialspec import __version__
 from serialspec.lang.errors import SpecErrors
@@ -22,22 +22,34 @@ VERBS = {
     "encode": "encode a JSON object ({command, subcommand, direction, fields}) as a frame; prints hex",
     "sim": "serve virtual devices on a pseudo-terminal; prints the device path first, answers until stopped",
     "monitor": "print every frame seen on a port (device path or pyserial URL), one line each with a timestamp",
+    # tools (issue 24)
+    "ports": "list the serial ports: device path, description, VID:PID and serial number",
+    "scan": "find the devices on a bus: each id (and baud rate) answering the spec's presence request, with its model",
+    "replay": "send the frames of one direction of a capture to a port, with their timing",
+    "completion": "print the shell completion script for bash, zsh or fish",
 }
 
 
-def main(argv: Sequence[str] | None = None) -> int:
+def build_parser(chosen: Iterable[str]) -> tuple[argparse.ArgumentParser, dict[str, argparse.ArgumentParser]]:
+    """The command's parser, with the arguments of the `chosen` verbs only (each verb's module is imported for its
+    arguments), and each verb's own parser."""
     parser = argparse.ArgumentParser(prog="serialspec", description=__doc__.split(":")[0] if __doc__ else None)
     parser.add_argument("--version", action="version", version=f"serialspec {__version__}")
     verbs = parser.add_subparsers(dest="verb", required=True, metavar="VERB")
-    given = list(sys.argv[1:] if argv is None else argv)
-    chosen = next((word for word in given if not word.startswith("-")), None)  # options before it: --help, --version
     subparsers = {}
     for name, text in VERBS.items():
         sub = subparsers[name] = verbs.add_parser(name, help=text, description=text)
-        if name == chosen:
+        if name in chosen:
             module = importlib.import_module(f"{__name__}.{name}")
             module.add_arguments(sub)
             sub.set_defaults(run=module.run, verb=name)
+    return parser, subparsers
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    given = list(sys.argv[1:] if argv is None else argv)
+    chosen = next((word for word in given if not word.startswith("-")), None)  # options before it: --help, --version
+    parser, subparsers = build_parser(() if chosen is None else (chosen,))
     args, extra = parser.parse_known_args(argv)
     if extra:
         # Options between a verb's positional arguments (`decode SPEC --direction response HEX`): argparse only

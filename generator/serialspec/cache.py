@@ -170,6 +170,29 @@ def generator() -> bytes:
     return digest.digest()
 
 
+@cache
+def language() -> bytes:
+    """A stamp of what a resolved spec model depends on besides the spec: the spec language's modules (lang/, and the
+    runtime's message module, whose Direction the model holds), PyYAML's release and Python's; like a .pyc file's,
+    by each file's size and time of change, so that a command that reads a cached model stays cheap."""
+    digest = hashlib.sha256(_MAGIC + sys.version.encode())
+    paths = [str(_PACKAGE / "runtime" / "message.py")]
+    for top, folders, names in os.walk(_PACKAGE / "lang"):
+        folders[:] = sorted(f for f in folders if f != "__pycache__")
+        paths += [os.path.join(top, name) for name in sorted(names) if name.endswith(".py")]
+    with contextlib.suppress(ImportError, ValueError):
+        found = importlib.util.find_spec("yaml")
+        if found is not None and found.origin is not None:
+            paths.append(found.origin)
+    for path in paths:
+        try:
+            stat = os.stat(path)
+            digest.update(key(os.path.relpath(path, _PACKAGE), str(stat.st_size), str(stat.st_mtime_ns)))
+        except OSError as exc:
+            digest.update(key(path, f"unreadable: {exc.errno}"))
+    return digest.digest()
+
+
 def _contents(path: str) -> bytes:
     try:
         with open(path, "rb") as stream:

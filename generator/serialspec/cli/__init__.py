@@ -4,12 +4,11 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import sys
 from collections.abc import Iterable, Sequence
 
 from serialspec import __version__
-from serialspec.lang.errors import SpecErrors
-from serialspec.runtime.errors import SerialspecError
 
 # Each verb (its module, serialspec.cli.<verb>, is imported only to run it: `generate` loads no serial-port code)
 # and its one-line help.
@@ -30,15 +29,29 @@ VERBS = {
 }
 
 
+class _Formatter(argparse.HelpFormatter):
+    """argparse's help layout, sized without importing shutil (and with it lzma and bz2) on every start: the width
+    as shutil.get_terminal_size() gives it (COLUMNS, else the terminal's, else 80), less 2 as argparse does."""
+
+    def __init__(self, prog: str) -> None:
+        try:
+            columns = int(os.environ.get("COLUMNS", "")) or os.get_terminal_size().columns
+        except (ValueError, OSError):
+            columns = 80
+        super().__init__(prog, width=max(columns, 10) - 2)
+
+
 def build_parser(chosen: Iterable[str]) -> tuple[argparse.ArgumentParser, dict[str, argparse.ArgumentParser]]:
     """The command's parser, with the arguments of the `chosen` verbs only (each verb's module is imported for its
     arguments), and each verb's own parser."""
-    parser = argparse.ArgumentParser(prog="serialspec", description=__doc__.split(":")[0] if __doc__ else None)
+    parser = argparse.ArgumentParser(
+        prog="serialspec", description=__doc__.split(":")[0] if __doc__ else None, formatter_class=_Formatter
+    )
     parser.add_argument("--version", action="version", version=f"serialspec {__version__}")
     verbs = parser.add_subparsers(dest="verb", required=True, metavar="VERB")
     subparsers = {}
     for name, text in VERBS.items():
-        sub = subparsers[name] = verbs.add_parser(name, help=text, description=text)
+        sub = subparsers[name] = verbs.add_parser(name, help=text, description=text, formatter_class=_Formatter)
         if name in chosen:
             module = importlib.import_module(f"{__name__}.{name}")
             module.add_arguments(sub)
@@ -57,14 +70,20 @@ def main(argv: Sequence[str] | None = None) -> int:
         args = subparsers[args.verb].parse_intermixed_args(given[given.index(args.verb) + 1 :])
     try:
         code: int = args.run(args)
-    except SpecErrors as exc:
-        print(exc, file=sys.stderr)
-        return 1
-    except SerialspecError as exc:
-        print(f"serialspec {args.verb}: {exc}", file=sys.stderr)
-        return 1
     except BrokenPipeError:
         return 0
+    except Exception as exc:  # the two kinds meant for the user are told in one line each; anything else is a bug
+        # (imported here: a command that fails in neither way does not pay for importing them)
+        from serialspec.lang.errors import SpecErrors
+        from serialspec.runtime.errors import SerialspecError
+
+        if isinstance(exc, SpecErrors):
+            print(exc, file=sys.stderr)
+            return 1
+        if isinstance(exc, SerialspecError):
+            print(f"serialspec {args.verb}: {exc}", file=sys.stderr)
+            return 1
+        raise
     return code
 
 

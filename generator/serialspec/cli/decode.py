@@ -8,8 +8,6 @@ import sys
 from types import ModuleType
 from typing import Any, TextIO
 
-from serialspec.cli import capture
-from serialspec.cli.frames import Frames
 from serialspec.cli.protocols import SPEC_HELP, open_spec
 from serialspec.cli.views import FlagNames, engineering, message_spec, register_view, unit_symbols, with_unit
 from serialspec.lang.model import Protocol, replies_by_request, reply_to
@@ -66,6 +64,9 @@ def show(result: dict[str, Any], as_json: bool) -> None:
 
 def replay(args: argparse.Namespace, protocol: Protocol, package: ModuleType) -> int:
     """Decode a capture: each direction's bytes joined again and split into frames; bad bytes reported."""
+    from serialspec.cli import capture
+    from serialspec.cli.frames import Frames
+
     address = protocol.device.address if protocol.device else None
     streams: dict[str | None, Frames] = {}
     failed = 0

@@ -6,7 +6,9 @@ from __future__ import annotations
 import datetime
 import json
 import os
+import re
 import select
+import shlex
 import shutil
 import subprocess
 import sys
@@ -27,6 +29,11 @@ def serialspec(*args: str, stdin: str | None = None) -> subprocess.CompletedProc
     return result
 
 
+def scan(*arguments: str) -> subprocess.CompletedProcess[str]:
+    """`serialspec scan`, each id waited for 0.3 s: a simulator on a loaded machine may answer later than a servo."""
+    return serialspec("scan", *arguments, "--timeout", "0.3")
+
+
 def spec(name: str) -> str:
     return str(ROOT / "specs" / f"{name}.yaml")
 
@@ -41,35 +48,34 @@ def requests_in(tap: Path) -> list[bytes]:
 def test_scan_finds_each_servo_and_reads_its_model_register(tmp_path: Path) -> None:
     tap = tmp_path / "bus.tap"
     with serve("feetech_sms.yaml", 1, 5, options=["--model", "5=sm8512bl", "--tap", str(tap)]) as port:
-        result = serialspec("scan", spec("feetech_sms"), "--port", port, "--ids", "0-8")
+        result = scan(spec("feetech_sms"), "--port", port, "--ids", "0-8")
     assert result.returncode == 0, result.stderr
     assert result.stdout.splitlines() == [
         "id   1  1000000 baud  model sts3215",
         "id   5  1000000 baud  model sm8512bl",
     ]
     # one PING per id, then a READ of the model register (0x03, two bytes) of each servo found
-    sent = requests_in(tap)
-    assert sent[:9] == [bytes([0xFF, 0xFF, i, 2, 1, ~(i + 3) & 0xFF]) for i in range(9)]
-    assert sent[9:] == [bytes([0xFF, 0xFF, i, 4, 2, 3, 2, ~(i + 4 + 2 + 3 + 2) & 0xFF]) for i in (1, 5)]
+    pings = b"".join(bytes([0xFF, 0xFF, i, 2, 1, ~(i + 3) & 0xFF]) for i in range(9))
+    reads = b"".join(bytes([0xFF, 0xFF, i, 4, 2, 3, 2, ~(i + 4 + 2 + 3 + 2) & 0xFF]) for i in (1, 5))
+    assert b"".join(requests_in(tap)) == pings + reads
 
 
 def test_scan_finds_a_dynamixel_bus_with_one_broadcast_ping(tmp_path: Path) -> None:
     tap = tmp_path / "bus.tap"
     with serve("dynamixel_p2.yaml", 1, 3, options=["--model", "3=xl330_m288", "--tap", str(tap)]) as port:
-        result = serialspec("scan", spec("dynamixel_p2"), "--port", port, "--json")
+        result = scan(spec("dynamixel_p2"), "--port", port, "--json")
     assert result.returncode == 0, result.stderr
     assert [json.loads(line) for line in result.stdout.splitlines()] == [
         {"id": 1, "baudrate": 57600, "model": "xm430_w350"},
         {"id": 3, "baudrate": 57600, "model": "xl330_m288"},
     ]
-    sent = requests_in(tap)
-    assert len(sent) == 1 and sent[0][4] == 0xFE, sent  # one PING to the broadcast id, the model in its replies
+    # one PING to the broadcast id (the e-manual's example frame), the models in its replies
+    assert b"".join(requests_in(tap)) == bytes.fromhex("ff ff fd 00 fe 03 00 01 31 42")
 
 
 def test_scan_at_several_baud_rates_and_every_rate_of_the_spec() -> None:
     with serve("fashionstar_uart.yaml", 2) as port:
-        given = serialspec(
-            "scan",
+        given = scan(
             spec("fashionstar_uart"),
             "--port",
             port,
@@ -80,7 +86,7 @@ def test_scan_at_several_baud_rates_and_every_rate_of_the_spec() -> None:
             "--baudrate",
             "500000",
         )
-        every = serialspec("scan", spec("fashionstar_uart"), "--port", port, "--ids", "2", "--all-baudrates", "--json")
+        every = scan(spec("fashionstar_uart"), "--port", port, "--ids", "2", "--all-baudrates", "--json")
     assert given.stdout.splitlines() == ["id   2  9600 baud  model 1", "id   2  500000 baud  model 1"]
     # a pseudo-terminal takes every rate: the servo answers at each of the seven the spec lists, default first
     rates = [json.loads(line)["baudrate"] for line in every.stdout.splitlines()]
@@ -89,7 +95,7 @@ def test_scan_at_several_baud_rates_and_every_rate_of_the_spec() -> None:
 
 def test_scan_counts_a_modbus_server_by_its_reply_to_a_register_read() -> None:
     with serve("modbus_rtu.yaml", 1, 17) as port:
-        result = serialspec("scan", spec("modbus_rtu"), "--port", port, "--ids", "1-20,30", "--json")
+        result = scan(spec("modbus_rtu"), "--port", port, "--ids", "1-3,17,30", "--json")
     assert [json.loads(line) for line in result.stdout.splitlines()] == [
         {"id": 1, "baudrate": 19200, "model": None},
         {"id": 17, "baudrate": 19200, "model": None},
@@ -98,7 +104,7 @@ def test_scan_counts_a_modbus_server_by_its_reply_to_a_register_read() -> None:
 
 def test_scan_of_a_protocol_without_ids_asks_the_port_once() -> None:
     with serve("vesc.yaml") as port:
-        result = serialspec("scan", spec("vesc"), "--port", port)
+        result = scan(spec("vesc"), "--port", port)
     assert result.stdout.splitlines() == ["id   -  115200 baud  model 60"]
 
 
@@ -127,7 +133,7 @@ def test_scan_refuses_bad_ids_and_rates_before_writing_a_byte(tmp_path: Path) ->
 
 def test_scan_with_no_device_says_so_and_exits_1() -> None:
     with serve("feetech_sms.yaml", 9) as port:
-        result = serialspec("scan", spec("feetech_sms"), "--port", port, "--ids", "1-3")
+        result = scan(spec("feetech_sms"), "--port", port, "--ids", "1-3")
     assert (result.returncode, result.stdout, result.stderr.strip()) == (
         1,
         "",
@@ -140,7 +146,8 @@ def test_scan_shows_a_progress_bar_on_a_terminal_only() -> None:
     controller, terminal = os.openpty()
     with serve("feetech_sms.yaml", 2) as port:
         process = subprocess.Popen(
-            [sys.executable, "-m", "serialspec", "scan", spec("feetech_sms"), "--port", port, "--ids", "0-4"],
+            [sys.executable, "-m", "serialspec", "scan", spec("feetech_sms"), "--port", port, "--ids", "0-4"]
+            + ["--timeout", "0.3"],
             stdout=subprocess.PIPE,
             stderr=terminal,
             text=True,
@@ -166,7 +173,7 @@ def test_scan_shows_a_progress_bar_on_a_terminal_only() -> None:
     assert "] 5/5 at 1000000 baud" in text
     assert text.endswith("\r")  # the bar is cleared at the end
     with serve("feetech_sms.yaml", 2) as port:
-        piped = serialspec("scan", spec("feetech_sms"), "--port", port, "--ids", "0-4")
+        piped = scan(spec("feetech_sms"), "--port", port, "--ids", "0-4")
     assert piped.stderr == ""  # not a terminal: no bar
 
 
@@ -204,7 +211,7 @@ def test_replay_sends_a_captures_requests_with_their_timing(tmp_path: Path) -> N
     with serve("feetech_sms.yaml", 1, options=["--tap", str(again)]) as port:
         result = serialspec("replay", str(recorded), "--port", port, "--speed", "2")
     assert result.returncode == 0, result.stderr
-    assert requests_in(again) == requests_in(recorded)
+    assert b"".join(requests_in(again)) == b"".join(requests_in(recorded))
     assert result.stderr.startswith("serialspec replay: 3 request chunk(s), 22 byte(s) sent to ")
     # the requests spread over the capture's 0.4 s / 2 (sent all at once, they would come within milliseconds); the
     # bound is loose: the simulator's reads, which stamp them, may come late under load
@@ -313,3 +320,44 @@ def test_completion_completes_verbs_and_options_in_a_real_shell(shell: str, tmp_
     )
     shown = subprocess.run(["bash", "-c", probe], capture_output=True, text=True, timeout=30)
     assert shown.stdout.splitlines() == ["scan", "--all-baudrates", "bash zsh fish"], shown.stderr
+
+
+# --- the README's examples, as printed ----------------------------------------------------------------------------
+
+
+def readme_command(verb: str) -> tuple[list[str], list[str]]:
+    """The README's console example of `serialspec VERB`: its arguments and the lines it prints."""
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    for block in re.findall(r"```console\n(.*?)```", text, flags=re.S):
+        lines = block.splitlines()
+        if lines[0].startswith(f"$ .venv/bin/serialspec {verb} "):
+            return shlex.split(lines[0][2:])[2:], lines[1:]
+    raise AssertionError(f"no console example of {verb} in README.md")
+
+
+README_PORT = "/dev/pts/5"
+
+
+def test_the_readme_scan_prints_what_the_readme_shows() -> None:
+    arguments, printed = readme_command("scan")
+    with serve("feetech_sms.yaml", 1, 2) as port:  # the README's session: `sim specs/feetech_sms.yaml --id 1 --id 2`
+        result = subprocess.run(
+            [sys.executable, "-m", "serialspec", "scan", *(port if a == README_PORT else a for a in arguments)],
+            capture_output=True,
+            text=True,
+            cwd=ROOT,
+        )
+    assert result.stdout.splitlines() == printed
+
+
+def test_the_readme_replay_prints_what_the_readme_shows(tmp_path: Path) -> None:
+    arguments, printed = readme_command("replay")
+    shutil.copy(session_capture(tmp_path), tmp_path / "session.capture")  # ping, and two register reads
+    with serve("feetech_sms.yaml", 1, 2) as port:
+        result = subprocess.run(
+            [sys.executable, "-m", "serialspec", "replay", *(port if a == README_PORT else a for a in arguments)],
+            capture_output=True,
+            text=True,
+            cwd=tmp_path,
+        )
+    assert result.stderr.replace(port, README_PORT).splitlines() == printed

@@ -7,6 +7,7 @@ repository's sources, tests and generated/ are not on their path.
 
 from __future__ import annotations
 
+import contextlib
 import importlib.util
 import json
 import os
@@ -193,11 +194,11 @@ def test_a_shipped_protocol_decodes_by_name(user: User) -> None:
     )
 
 
-@pytest.fixture
-def sim(user: User) -> Iterator[tuple[str, Path]]:
-    tap = user.home / "session.capture"
+@contextlib.contextmanager
+def serving(user: User, *arguments: str) -> Iterator[str]:
+    """`serialspec sim ARGUMENTS` of the installed wheel, yielding the port it prints, stopped after the block."""
     process = subprocess.Popen(
-        [str(user.bin / "serialspec"), "sim", "tinylamp.yaml", "--id", "1", "--tap", str(tap)],
+        [str(user.bin / "serialspec"), "sim", *arguments],
         cwd=user.home,
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
@@ -205,10 +206,17 @@ def sim(user: User) -> Iterator[tuple[str, Path]]:
     )
     try:
         assert process.stdout is not None
-        yield process.stdout.readline().strip(), tap
+        yield process.stdout.readline().strip()
     finally:
         process.send_signal(signal.SIGTERM)
         assert process.wait(5) == 0
+
+
+@pytest.fixture
+def sim(user: User) -> Iterator[tuple[str, Path]]:
+    tap = user.home / "session.capture"
+    with serving(user, "tinylamp.yaml", "--id", "1", "--tap", str(tap)) as port:
+        yield port, tap
 
 
 def test_sim_with_a_client_and_its_tap_replays(user: User, sim: tuple[str, Path]) -> None:
@@ -270,21 +278,9 @@ def test_a_capture_saved_by_monitor_replays_through_decode(user: User) -> None:
 def test_the_tools_work_from_the_wheel(user: User) -> None:
     """scan and replay against a shipped protocol's sim, completion, and the license in the wheel's metadata."""
     tap = user.home / "scan.capture"
-    process = subprocess.Popen(
-        [str(user.bin / "serialspec"), "sim", "feetech_sms", "--id", "3", "--quiet", "--tap", str(tap)],
-        cwd=user.home,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
-    try:
-        assert process.stdout is not None
-        port = process.stdout.readline().strip()
+    with serving(user, "feetech_sms", "--id", "3", "--quiet", "--tap", str(tap)) as port:
         found = user.serialspec("scan", "feetech_sms", "--port", port, "--ids", "1-4", "--json")
         replayed = user.serialspec("replay", str(tap), "--port", port, "--speed", "0")
-    finally:
-        process.send_signal(signal.SIGTERM)
-        assert process.wait(5) == 0
     assert [json.loads(line) for line in found.stdout.splitlines()] == [
         {"id": 3, "baudrate": 1000000, "model": "sts3215"}
     ]

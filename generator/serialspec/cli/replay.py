@@ -77,11 +77,8 @@ def run(args: argparse.Namespace) -> int:
             except (serial.SerialException, OSError) as exc:
                 raise PortError(f"{args.port}: {exc}") from None
             sent += len(data)
-    elapsed = time.monotonic() - started
     print(
-        f"serialspec replay: {len(plan)} {args.direction} chunk(s), {sent} byte(s) sent to {args.port} "
-        f"in {elapsed:.3f} s",
-        file=sys.stderr,
+        f"serialspec replay: {len(plan)} {args.direction} chunk(s), {sent} byte(s) sent to {args.port}", file=sys.stderr
     )
     return 0
 

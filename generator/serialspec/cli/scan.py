@@ -24,8 +24,9 @@ from serialspec.lang.model import Bytes, Direction, Presence, Protocol, replies_
 from serialspec.runtime.errors import PortError, SerialspecError
 from serialspec.runtime.message import Message
 
-#: The wait for a reply, beyond the time its bytes take on the line (a device's turnaround; USB adapters' latency).
-SLACK = 0.02
+#: The wait for a reply, beyond the time its bytes take on the line: a device's turnaround and a USB adapter's
+#: latency (an FTDI chip's timer holds received bytes up to 16 ms by default).
+SLACK = 0.04
 #: The port's read timeout: how late a wait ends after its deadline, at most.
 POLL = 0.005
 

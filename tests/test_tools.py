@@ -54,10 +54,13 @@ def test_scan_finds_each_servo_and_reads_its_model_register(tmp_path: Path) -> N
         "id   1  1000000 baud  model sts3215",
         "id   5  1000000 baud  model sm8512bl",
     ]
-    # one PING per id, then a READ of the model register (0x03, two bytes) of each servo found
-    pings = b"".join(bytes([0xFF, 0xFF, i, 2, 1, ~(i + 3) & 0xFF]) for i in range(9))
-    reads = b"".join(bytes([0xFF, 0xFF, i, 4, 2, 3, 2, ~(i + 4 + 2 + 3 + 2) & 0xFF]) for i in (1, 5))
-    assert b"".join(requests_in(tap)) == pings + reads
+    # one PING per id; after each servo's reply, a READ of its model register (0x03, two bytes)
+    expected = b""
+    for i in range(9):
+        expected += bytes([0xFF, 0xFF, i, 2, 1, ~(i + 3) & 0xFF])
+        if i in (1, 5):
+            expected += bytes([0xFF, 0xFF, i, 4, 2, 3, 2, ~(i + 4 + 2 + 3 + 2) & 0xFF])
+    assert b"".join(requests_in(tap)) == expected
 
 
 def test_scan_finds_a_dynamixel_bus_with_one_broadcast_ping(tmp_path: Path) -> None:

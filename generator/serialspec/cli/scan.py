@@ -14,6 +14,7 @@ import argparse
 import json
 import sys
 import time
+from collections.abc import Iterator
 from dataclasses import dataclass
 from types import ModuleType
 from typing import Any
@@ -125,6 +126,7 @@ class Scanner:
         self.model_reply: type[Message] | None
         self.model_request, self.model_reply = pair(presence.model_request) if presence.model_field else (None, None)
         self.models = {m.number: m.name for m in protocol.device.models} if protocol.device else {}
+        self.gap = 0.0  # seconds of silence before each request, set per baud rate
         # the presence request is checked (types, ranges) before a byte is written
         self.frame(self.request, presence.fields, None if not presence.ids else presence.ids[0])
 
@@ -140,31 +142,39 @@ class Scanner:
         encoded: bytes = self.package.encode(message)  # EncodeError/RangeError: one line naming the field
         return encoded
 
-    def scan(self, port: Any, ids: list[int], rate: int, wait: float, progress: Progress | None) -> list[Found]:
+    def scan(self, port: Any, ids: list[int], rate: int, wait: float, progress: Progress | None) -> Iterator[Found]:
+        """Each device that answers at this rate, as soon as it has (and its model has been read)."""
         presence = self.presence
+        # the silence the protocol needs between frames (Modbus RTU: 3.5 characters), kept before each request
+        self.gap = self.package.SERIAL.gap * 11 / rate
         if not presence.id_field:
             if progress is not None:
                 progress.step(rate, 0)
             reply = self.ask(port, self.frame(self.request, presence.fields, None), None, None, wait)
-            return [Found(None, rate, self.model(port, None, reply, wait))] if reply is not None else []
+            if reply is not None:
+                yield Found(None, rate, self.model(port, None, reply, wait))
+            return
         found: dict[int, Message] = {}
         broadcast = self.protocol.device.broadcast if self.protocol.device else None
         if presence.broadcast and broadcast is not None:
             found = self.everyone(port, self.frame(self.request, presence.fields, broadcast), set(ids), wait, len(ids))
-        if not found:
+        for device in sorted(found):
+            yield Found(device, rate, self.model(port, device, found[device], wait))
+        if not found:  # no answer to the broadcast (or none to send): each id in turn
             for number, device in enumerate(ids):
                 if progress is not None:
                     progress.step(rate, number)
                 reply = self.ask(port, self.frame(self.request, presence.fields, device), device, None, wait)
                 if reply is not None:
-                    found[device] = reply
+                    yield Found(device, rate, self.model(port, device, reply, wait))
         if progress is not None:
             progress.step(rate, len(ids))
-        return [Found(device, rate, self.model(port, device, found[device], wait)) for device in sorted(found)]
 
     def ask(self, port: Any, frame: bytes, device: int | None, expect: type[Message] | None, wait: float) -> Any:
         """The first reply from `device` (of class `expect`, when given) within `wait` seconds, or None."""
         parser = self.parser(expect or self.reply)
+        if self.gap:
+            time.sleep(self.gap)
         port.reset_input_buffer()
         port.write(frame)
         deadline = time.monotonic() + wait
@@ -179,6 +189,8 @@ class Scanner:
     def everyone(self, port: Any, frame: bytes, ids: set[int], wait: float, most: int) -> dict[int, Message]:
         """The replies to a broadcast request, each device in turn: read until `wait` passes without one."""
         parser = self.parser(self.reply)
+        if self.gap:
+            time.sleep(self.gap)
         port.reset_input_buffer()
         port.write(frame)
         found: dict[int, Message] = {}

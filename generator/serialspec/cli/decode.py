@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from types import ModuleType
 from typing import Any, TextIO
@@ -59,7 +58,12 @@ def run(args: argparse.Namespace) -> int:
 
 
 def show(result: dict[str, Any], as_json: bool) -> None:
-    print(json.dumps(result, ensure_ascii=False) if as_json else readable(result), flush=True)
+    if as_json:
+        import json
+
+        print(json.dumps(result, ensure_ascii=False), flush=True)
+    else:
+        print(readable(result), flush=True)
 
 
 def replay(args: argparse.Namespace, protocol: Protocol, package: ModuleType) -> int:
@@ -151,5 +155,7 @@ def _value(value: Any) -> str:
     if isinstance(value, FlagNames):
         return str(value)
     if isinstance(value, dict | list):
+        import json
+
         return json.dumps(value, ensure_ascii=False)
     return str(value)

@@ -21,7 +21,8 @@ VERBS = {
     "encode": "encode a JSON object ({command, subcommand, direction, fields}) as a frame; prints hex",
     "sim": "serve virtual devices on a pseudo-terminal; prints the device path first, answers until stopped",
     "monitor": "print every frame seen on a port (device path or pyserial URL), one line each with a timestamp",
-    # tools (issue 24)
+    "docs": "build a documentation site (mkdocs) of specs: each protocol's reference and its spec, searchable",
+    "plot": "plot fields over time in their units, one panel each, from a capture or live from a port (PNG, SVG)",
     "ports": "list the serial ports: device path, description, VID:PID and serial number",
     "scan": "find the devices on a bus: each id (and baud rate) answering the spec's presence request, with its model",
     "replay": "send the frames of one direction of a capture to a port, with their timing",

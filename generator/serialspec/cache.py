@@ -181,14 +181,19 @@ def generator() -> bytes:
     return digest.digest()
 
 
+#: The folders of the package a resolved model depends on (backends/ and cli/ only read models).
+MODEL_PARTS = ("lang", "checksums", "runtime")
+
+
 @cache
 def language() -> bytes:
-    """A stamp of what a resolved spec model depends on besides the spec: the spec language's modules (lang/, and the
-    runtime's message module, whose Direction the model holds), PyYAML's release and Python's; like a .pyc file's,
-    by each file's size and time of change, so that a command that reads a cached model stays cheap."""
+    """A stamp of what a resolved spec model depends on besides the spec: the language's modules and those whose
+    objects a model holds (the checksum algorithms, the runtime's Direction), PyYAML's release and Python's. Like a
+    .pyc file's, by each file's size and time of change rather than its contents, so that a command that reads a
+    cached model (`decode`) stays cheap."""
     digest = _sha256(_MAGIC + sys.version.encode())
-    paths = [str(_PACKAGE / "runtime" / "message.py")]
-    for top, folders, names in os.walk(_PACKAGE / "lang"):
+    paths = []
+    for top, folders, names in (step for part in MODEL_PARTS for step in os.walk(_PACKAGE / part)):
         folders[:] = sorted(f for f in folders if f != "__pycache__")
         paths += [os.path.join(top, name) for name in sorted(names) if name.endswith(".py")]
     with contextlib.suppress(ImportError, ValueError):

@@ -3,19 +3,19 @@
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from types import ModuleType
-from typing import Any, TextIO
+from typing import TYPE_CHECKING, Any, TextIO
 
-from serialspec.cli import capture
-from serialspec.cli.frames import Frames, Seen
 from serialspec.cli.protocols import SPEC_HELP, open_spec
 from serialspec.cli.views import FlagNames, engineering, message_spec, register_view, unit_symbols, with_unit
 from serialspec.lang.model import Protocol, replies_by_request, reply_to
 from serialspec.runtime.errors import DecodeError, SerialspecError
 from serialspec.runtime.hexbytes import parse_hex
 from serialspec.runtime.message import Message
+
+if TYPE_CHECKING:
+    from serialspec.cli.frames import Seen
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -64,12 +64,20 @@ def run(args: argparse.Namespace) -> int:
 
 
 def show(result: dict[str, Any], as_json: bool) -> None:
-    print(json.dumps(result, ensure_ascii=False) if as_json else readable(result), flush=True)
+    if as_json:
+        import json
+
+        print(json.dumps(result, ensure_ascii=False), flush=True)
+    else:
+        print(readable(result), flush=True)
 
 
 def replay(args: argparse.Namespace, protocol: Protocol, package: ModuleType) -> int:
     """Decode a capture: each direction's bytes joined again and split into frames; bad bytes reported. A reply is
     shown with the last request before it when it answers that request (registers by name, as `--request` does)."""
+    from serialspec.cli import capture
+    from serialspec.cli.frames import Frames
+
     address = protocol.device.address if protocol.device else None
     streams: dict[str | None, Frames] = {}
     failed = 0
@@ -168,5 +176,7 @@ def _value(value: Any) -> str:
     if isinstance(value, FlagNames):
         return str(value)
     if isinstance(value, dict | list):
+        import json
+
         return json.dumps(value, ensure_ascii=False)
     return str(value)

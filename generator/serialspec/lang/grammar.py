@@ -963,9 +963,50 @@ MODEL = Obj(
     description="One device model: its model number, factory values and where its table differs.",
 )
 
+PRESENCE = Obj(
+    {
+        "request": Str(
+            "The command (or command.subcommand) a device answers whenever it is there: any reply, an error reply "
+            "too, means a device has that id (FEETECH and DYNAMIXEL PING, a Modbus register read)."
+        ),
+        "fields": MapOf(Num(), "Request field -> its value, besides the id (a read's address and count)."),
+        "ids": ListOf(
+            Int(),
+            "The first and last id `serialspec scan` asks by default (default: the device's id range, without the "
+            "broadcast id).",
+            length=2,
+            example=[1, 247],
+        ),
+        "broadcast": Bool(
+            "Every device answers the request sent to the broadcast id, one after another (DYNAMIXEL broadcast "
+            "PING): one request finds them all; `scan` asks the ids one by one only when none answers it.",
+            default=False,
+        ),
+        "model": Obj(
+            {
+                "request": Str("The command whose reply holds the model (default: the presence request's own)."),
+                "fields": MapOf(Num(), "Request field -> its value, besides the id (the model register's address)."),
+                "field": Str(
+                    "The reply field holding the model: a number (a name from `models` by its `number`), text, or a "
+                    "run of registers holding the device's `model_entry`."
+                ),
+            },
+            required=("field",),
+            description="Where a device's model is read: a reply field, of the presence reply or of another request.",
+        ),
+        "description": TEXT,
+    },
+    required=("request",),
+    description=(
+        "How to find the devices on a bus (`serialspec scan`): the request each one answers, the ids to ask, and "
+        "where its model is."
+    ),
+)
+
 DEVICE = Obj(
     {
         "description": TEXT,
+        "presence": PRESENCE,
         "models": MapOf(
             MODEL,
             "Device models sharing the protocol and table (FEETECH STS3215, SM8512BL; DYNAMIXEL XM430, XL330): "
@@ -1100,6 +1141,12 @@ SPEC = Obj(
         "serial": Obj(
             {
                 "baudrate": Int("Bits per second.", minimum=1),
+                "baudrates": ListOf(
+                    Int(minimum=1),
+                    "Every rate a device can be set to, the default first (`serialspec scan --all-baudrates` tries "
+                    "each).",
+                    example=[1000000, 500000, 115200],
+                ),
                 "bytesize": Int("Data bits per character.", default=8, minimum=5, maximum=8),
                 "parity": Str("Parity bit.", choices=("none", "even", "odd"), default="none"),
                 "stopbits": Num("Stop bits.", default=1, choices=(1, 1.5, 2)),

@@ -28,6 +28,7 @@ import serial
 
 from serialspec.runtime.errors import CorruptReply, DeviceError, EncodeError, PortError, Timeout
 from serialspec.runtime.message import Direction, Message, Record
+from serialspec.runtime.settings import SerialSettings as SerialSettings  # packages generated before import it here
 from serialspec.runtime.stream import StreamParser
 
 M = TypeVar("M", bound=Message)
@@ -70,17 +71,6 @@ except ImportError:  # Windows
 _POSIX_SERIAL: type | None = getattr(getattr(serial, "serialposix", None), "Serial", None)
 _OPEN_FAILURES: tuple[type[Exception], ...] = (*_PORT_FAILURES, ValueError)  # ValueError: a bad setting
 _RESET_FAILURES: tuple[type[Exception], ...] = (*_PORT_FAILURES, NotImplementedError)  # URLs without a buffer
-
-
-@dataclass(frozen=True)
-class SerialSettings:
-    """The spec's `serial:` section: defaults for opening a port."""
-
-    baudrate: int
-    bytesize: int = 8
-    parity: str = "none"
-    stopbits: float = 1
-    gap: float = 0.0  # silence the protocol needs between frames, in character times (Modbus RTU: 3.5)
 
 
 @dataclass(frozen=True)

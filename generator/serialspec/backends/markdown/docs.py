@@ -633,12 +633,14 @@ def emit_docs(protocol: Protocol) -> str:
         sources=[(k, text(v)) for k, v in protocol.sources.items()],
         serial=[
             ("baud rate", serial.baudrate),
+            *([("baud rates a device can be set to", ", ".join(map(str, serial.baudrates)))] * bool(serial.baudrates)),
             ("data bits", serial.bytesize),
             ("parity", serial.parity),
             ("stop bits", number(serial.stopbits)),
             ("byte order", protocol.byte_order + "-endian"),
         ],
         serial_notes=text(serial.notes),
+        presence=presence_text(protocol),
         framing=text(protocol.framing.description),
         frames=same_once(
             [frame_context(protocol, lay) for lays in protocol.framing.alternatives.values() for lay in lays]
@@ -660,6 +662,44 @@ def emit_docs(protocol: Protocol) -> str:
         examples=examples,
         errata=errata,
     )
+
+
+def presence_text(protocol: Protocol) -> str:
+    """The device's `presence:` in words: what `serialspec scan` asks, which ids, and where the model is."""
+    presence = protocol.device.presence if protocol.device else None
+    if presence is None:
+        return ""
+
+    def request(key: str, values: dict[str, float]) -> str:
+        given = ", ".join(f"{name} = {number(value)}" for name, value in values.items())
+        return f"`{key}`" + (f" ({given})" if given else "")
+
+    if presence.ids is not None:
+        first, last = presence.ids
+        asked = f"sends {request(presence.request, presence.fields)} to each id {first}..{last}"
+        if presence.broadcast:
+            asked = (
+                f"sends {request(presence.request, presence.fields)} to the broadcast id once, which every device "
+                f"answers in turn (and {asked.removeprefix('sends ')} when none does)"
+            )
+    else:
+        asked = f"sends {request(presence.request, presence.fields)} (one device per port: no id)"
+    words = [f"`serialspec scan {protocol.spec_path} --port PORT` {asked}; any reply, an error reply too, is a device."]
+    if presence.model_field:
+        where = f"`{presence.model_field}`"
+        if presence.model_register is not None:
+            where = f"register `{presence.model_register.name}` in {where}"
+        source = (
+            "its reply"
+            if presence.model_request == presence.request and not presence.model_fields
+            else (f"the reply to {request(presence.model_request, presence.model_fields)}")
+        )
+        words.append(f"The model is {where} of {source}.")
+    if protocol.serial.baudrates:
+        words.append("`--all-baudrates` tries every rate above.")
+    if presence.description:
+        words.append(text(presence.description))
+    return " ".join(words)
 
 
 def model_context(device: Device, model: DeviceModel) -> dict[str, Any]:

@@ -14,8 +14,8 @@
 extern "C" {
 #endif
 
-/* SHA-256 of the spec this was generated from. */
-#define DYNAMIXEL_P2_SPEC_SHA256 "67d3aa76955eb87ebab6d0d16110069c18066c0e7e185be69da599cd50674336"
+/* SHA-256 of the resolved spec this was generated from (its model's values). */
+#define DYNAMIXEL_P2_SPEC_SHA256 "4099b84682feeba1fde71e6425518b5666d0da3e4ace344d693bf0cf3d60929d"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef DYNAMIXEL_P2_ENABLE_ENCODE

@@ -14,8 +14,8 @@
 extern "C" {
 #endif
 
-/* SHA-256 of the spec this was generated from. */
-#define FEETECH_SMS_SPEC_SHA256 "d3c3f29f097591ef10cd44e13a35c3ebe41e3299b20af75784a9ed05afba8d0e"
+/* SHA-256 of the resolved spec this was generated from (its model's values). */
+#define FEETECH_SMS_SPEC_SHA256 "1c0c350e3d004b0bba59b1a7be0e8a6a998dc5214de9925408e5b41838cba278"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef FEETECH_SMS_ENABLE_ENCODE

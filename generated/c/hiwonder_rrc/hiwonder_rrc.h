@@ -14,8 +14,8 @@
 extern "C" {
 #endif
 
-/* SHA-256 of the spec this was generated from. */
-#define HIWONDER_RRC_SPEC_SHA256 "34c7dc9fe2cc7c8c79ec50d0bcdedff33af357c7cb795df74290834ea94edfca"
+/* SHA-256 of the resolved spec this was generated from (its model's values). */
+#define HIWONDER_RRC_SPEC_SHA256 "3eec351430e25eb83a9fbf50a1e2472607d616a771e0dc7ee45fa77d30c44df8"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef HIWONDER_RRC_ENABLE_ENCODE

@@ -14,8 +14,8 @@
 extern "C" {
 #endif
 
-/* SHA-256 of the spec this was generated from. */
-#define MODBUS_RTU_SPEC_SHA256 "a997d9546dbade2c32c3c55e3910108a105291535d99ff00f8b7ebbe8a4e2154"
+/* SHA-256 of the resolved spec this was generated from (its model's values). */
+#define MODBUS_RTU_SPEC_SHA256 "115cd97d946711030eab46a666ecf5ddad9f24ab9e0b6f85e8058321c33130c8"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef MODBUS_RTU_ENABLE_ENCODE

@@ -14,8 +14,8 @@
 extern "C" {
 #endif
 
-/* SHA-256 of the spec this was generated from. */
-#define VESC_SPEC_SHA256 "b5dd832e3bd471742762dbf38419520d38d2f9e53a6bddda129c3247c40da94a"
+/* SHA-256 of the resolved spec this was generated from (its model's values). */
+#define VESC_SPEC_SHA256 "a8c1810c0b4a221ea2ce3fd861441698501ec60e3e580f3afc31f780541148ce"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef VESC_ENABLE_ENCODE

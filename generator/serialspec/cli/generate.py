@@ -8,6 +8,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from serialspec.cli.project import Project, expected_files, orphans, project, target_files
+from serialspec.lang.errors import shown
 from serialspec.runtime.errors import SerialspecError
 
 
@@ -38,8 +39,8 @@ def run_target(proj: Project, target: str, out_given: bool) -> int:
     files, errors = target_files(proj, target)
     written = _write(files)
     print(f"{len(files)} {target} files generated in {proj.display(proj.out)}, {written} changed")
-    for error in errors:
-        print(error, file=sys.stderr)
+    for line in shown(errors):
+        print(line, file=sys.stderr)
     return 1 if errors else 0
 
 
@@ -61,6 +62,11 @@ def run(args: argparse.Namespace) -> int:
     if args.target:
         return run_target(proj, args.target, bool(args.out))
     files, errors = expected_files(proj)
+    if proj.chosen and errors and all(path == proj.schema for path in files):
+        # every spec named has mistakes: nothing is written (not even the schema, into a generated/ of its own)
+        for line in shown(errors):
+            print(line, file=sys.stderr)
+        return 1
     written = _write(files)
     removed = orphans(proj, files, {e.file for e in errors})
     for path in removed:
@@ -72,7 +78,8 @@ def run(args: argparse.Namespace) -> int:
         shutil.rmtree(folder / "__pycache__", ignore_errors=True)
         if folder.is_dir() and not any(folder.iterdir()):
             folder.rmdir()
-    print(f"{len(files)} files generated in {proj.display(proj.out)}, {written} changed, {len(removed)} removed")
-    for error in errors:
-        print(error, file=sys.stderr)
+    files_generated = f"{len(files)} file{'' if len(files) == 1 else 's'} generated"
+    print(f"{files_generated} in {proj.display(proj.out)}, {written} changed, {len(removed)} removed")
+    for line in shown(errors):
+        print(line, file=sys.stderr)
     return 1 if errors else 0

@@ -11,7 +11,6 @@ from __future__ import annotations
 import hashlib
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import assert_never
 
 from serialspec.backends import Unsupported
@@ -1096,10 +1095,11 @@ def json_function(ctx: Ctx, message: Message) -> str:
 
 
 def spec_hash(protocol: Protocol) -> str:
-    try:
-        return hashlib.sha256(Path(protocol.spec_path).read_bytes()).hexdigest()
-    except OSError:
-        return ""
+    """SHA-256 of the resolved spec (the model's values, whatever the spec's layout or comments): the same wherever
+    and however it is generated."""
+    from dataclasses import replace
+
+    return hashlib.sha256(repr(replace(protocol, spec_path="")).encode("utf-8")).hexdigest()
 
 
 def files(protocol: Protocol) -> dict[str, str]:

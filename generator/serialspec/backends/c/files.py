@@ -97,7 +97,7 @@ def header(ctx: Ctx) -> str:
 extern "C" {{
 #endif
 
-/* SHA-256 of the spec this was generated from. */
+/* SHA-256 of the resolved spec this was generated from (its model's values). */
 #define {P}_SPEC_SHA256 "{spec_hash(protocol)}"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */

@@ -194,7 +194,7 @@ class Commands(FieldResolver):
             response=messages.get(Direction.RESPONSE),
             selector=selector,
             subcommands=tuple(subcommands),
-            group_class=self.class_name(camel(name, "commands"), path) if subcommands else "",
+            group_class=self.client_class_name(camel(name, "commands"), path) if subcommands else "",
         )
 
     def check_answered_by(self, commands: list[Command]) -> None:

@@ -22,6 +22,8 @@ VERBS = {
     "encode": "encode a JSON object ({command, subcommand, direction, fields}) as a frame; prints hex",
     "sim": "serve virtual devices on a pseudo-terminal; prints the device path first, answers until stopped",
     "monitor": "print every frame seen on a port (device path or pyserial URL), one line each with a timestamp",
+    "watch": "a live full-screen view of a port: one row per device and command, last values in units, rates, errors",
+    "export": "write a capture (monitor --save, sim --tap) as pcap for Wireshark (see generate --target wireshark)",
 }
 
 

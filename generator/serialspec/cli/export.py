@@ -34,9 +34,7 @@ def run(args: argparse.Namespace) -> int:
     stream = sys.stdin if args.capture == "-" else _open(args.capture)
     with stream:
         lines = stream.readlines()
-    name = args.protocol or next(
-        (line[len(HEADER) :].strip() for line in lines if line.startswith(HEADER)), None
-    )
+    name = args.protocol or next((line[len(HEADER) :].strip() for line in lines if line.startswith(HEADER)), None)
     if not name:
         raise SerialspecError(f"{args.capture} names no protocol (no '{HEADER} NAME' line): give --protocol NAME")
     encoded = name.encode("utf-8")

@@ -117,7 +117,9 @@ def expected_files(proj: Project, targets: Sequence[str] = ()) -> tuple[dict[Pat
         files.update({proj.out / name: text for name, text in chosen.items()})
         errors.extend(outputs.errors)
         made.append(outputs)
-    if proj.reference is not None and not errors and not targets:  # its examples come from every spec: none while one fails
+    if (
+        proj.reference is not None and not errors and not targets
+    ):  # its examples come from every spec: none while one fails
 
         def reference() -> str:
             from serialspec.lang.reference import reference_markdown

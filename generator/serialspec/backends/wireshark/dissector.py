@@ -125,9 +125,7 @@ def _checksum(checksum: Checksum) -> dict[str, Any]:
     result: dict[str, Any] = {"algorithm": checksum.algorithm, "invert": checksum.invert}
     if checksum.crc is not None:
         crc = checksum.crc
-        result.update(
-            name=crc.name, width=crc.width, poly=crc.poly, init=crc.init, refin=crc.refin, refout=crc.refout
-        )
+        result.update(name=crc.name, width=crc.width, poly=crc.poly, init=crc.init, refin=crc.refin, refout=crc.refout)
         result["xorout"] = crc.xorout
     return result
 
@@ -257,7 +255,9 @@ def lua(value: object, depth: int) -> str:
             for key, item in value.items():
                 if item is None:
                     continue
-                name = key if isinstance(key, str) and key.isidentifier() and key not in _KEYWORDS else f"[{lua(key, 0)}]"
+                name = (
+                    key if isinstance(key, str) and key.isidentifier() and key not in _KEYWORDS else f"[{lua(key, 0)}]"
+                )
                 entries.append(f"{name} = {lua(item, depth + 1)}")
             if not entries:
                 return "{}"

@@ -1,0 +1,216 @@
+"""The Wireshark dissectors, run by tshark as a user would: `serialspec generate --target wireshark`, a capture
+exported with `serialspec export --pcap`, every shipped spec's example frames shown with the command and field values
+`serialspec decode --json` gives, several frames a packet, bad checksums flagged."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+import sys
+import xml.etree.ElementTree as ET
+from pathlib import Path
+from typing import Any
+
+import pytest
+from conftest import ALL, ROOT
+from serialspec.lang.model import (
+    Array,
+    Bytes,
+    Field,
+    Group,
+    List,
+    Message,
+    Protocol,
+    Scalar,
+    TableBlock,
+    TableValue,
+    Text,
+)
+
+pytestmark = pytest.mark.slow
+TSHARK = shutil.which("tshark")
+SERIALSPEC = [sys.executable, "-m", "serialspec"]
+
+
+def run(*args: str) -> str:
+    done = subprocess.run(args, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    return done.stdout
+
+
+def decoded(protocol: Protocol, direction: str, frames: list[bytes]) -> list[dict[str, Any]]:
+    spec = str(ROOT / protocol.spec_path)
+    out = run(*SERIALSPEC, "decode", spec, "--json", "--direction", direction, *(f.hex(" ") for f in frames))
+    return [json.loads(line) for line in out.splitlines()]
+
+
+def example_frames(protocol: Protocol) -> dict[str, list[bytes]]:
+    """Every example frame of the spec by direction, those the codec decodes (erratum examples as printed do not)."""
+    frames: dict[str, list[bytes]] = {"request": [], "response": []}
+    for example in protocol.examples:
+        if not example.erratum and example.frame not in frames[example.direction.value]:
+            frames[example.direction.value].append(example.frame)
+    return frames
+
+
+def pdml_frames(xml: str) -> list[ET.Element]:
+    """Every frame the dissectors found, in order: the protocol trees after each packet's serialspec header."""
+    names = {g.protocol.name for g in ALL}
+    return [proto for packet in ET.fromstring(xml).iter("packet") for proto in packet if proto.get("name") in names]
+
+
+def children(element: ET.Element, name: str) -> list[ET.Element]:
+    return [child for child in element if child.get("name") == name]
+
+
+def child(element: ET.Element, name: str) -> ET.Element:
+    found = children(element, name)
+    assert len(found) == 1, f"{name}: {len(found)} in {ET.tostring(element, encoding='unicode')[:2000]}"
+    return found[0]
+
+
+def number(text: str) -> int | float:
+    value = float(text)
+    return int(value) if "." not in text and "e" not in text else value
+
+
+def value(field: Field, shown: ET.Element, abbr: str) -> Any:
+    """A field's value as the dissector shows it, in `decode --json`'s form."""
+    match field:
+        case Scalar():
+            if field.bits:
+                return {b.name: int(child(shown, f"{abbr}.{b.name}").get("show") or 0) for b in field.bits}
+            return number(shown.get("show") or "")
+        case Array() | List():
+            items = children(shown, f"{abbr}.value")
+            if isinstance(field, List) and field.bits:
+                return [item.get("show") == "1" for item in items]
+            return [number(item.get("show") or "") for item in items]
+        case Text():
+            return shown.get("show")
+        case Bytes():
+            data = bytes.fromhex(shown.get("value") or "")
+            return data.hex(" ")
+        case Group():
+            return [fields_of(field.fields, item, abbr) for item in children(shown, f"{abbr}.item")]
+        case TableValue():
+            return number(shown.get("show") or "")
+        case TableBlock():
+            return {e.name: number(child(shown, f"{abbr}.{e.name}").get("show") or "") for e in field.entries}
+    raise AssertionError(field)
+
+
+def fields_of(fields: tuple[Field, ...], tree: ET.Element, prefix: str) -> dict[str, Any]:
+    return {
+        f.name: value(f, child(tree, f"{prefix}.{f.name}"), f"{prefix}.{f.name}")
+        for f in fields
+        if not (isinstance(f, Scalar) and f.hidden)
+    }
+
+
+def message_of(protocol: Protocol, direction: str, command: str, subcommand: str | None) -> Message:
+    return next(
+        m
+        for m in protocol.messages()
+        if (m.command, m.subcommand, m.direction.value) == (command, subcommand, direction)
+    )
+
+
+def shown(protocol: Protocol, tree: ET.Element) -> dict[str, Any]:
+    """What the dissector shows of one frame, as `decode --json` puts it."""
+    name = protocol.name
+    direction = child(tree, f"{name}.direction").get("show") or ""
+    command = child(tree, f"{name}.command").get("show") or ""
+    subs = children(tree, f"{name}.subcommand")
+    subcommand = subs[0].get("show") if subs else None
+    message = message_of(protocol, direction, command, subcommand)
+    prefix = ".".join(p for p in (name, command, subcommand, direction) if p)
+    fields: dict[str, Any] = {}
+    for element in protocol.framing.layouts[message.direction].value_elements:
+        if element.bits:
+            item = child(tree, f"{name}.frame.{element.name}")
+            fields[element.name] = {
+                b.name: int(child(item, f"{name}.frame.{element.name}.{b.name}").get("show") or 0) for b in element.bits
+            }
+        else:
+            fields[element.name] = int(child(tree, f"{name}.frame.{element.name}").get("show") or "")
+    if message.error_reply and protocol.error_reply:
+        refused = protocol.error_reply.element
+        fields[refused] = int(child(tree, f"{prefix}.{refused}").get("show") or "")
+    fields.update(fields_of(message.fields, tree, prefix))
+    checksum_ok = child(tree, f"{name}.checksum_ok").get("show") == "1"
+    return {
+        "direction": direction,
+        "command": command,
+        "subcommand": subcommand,
+        "fields": fields,
+        "checksum_ok": checksum_ok,
+    }
+
+
+@pytest.mark.skipif(
+    TSHARK is None, reason="tshark is not installed (make generate installs it where it can: root and apt-get)"
+)
+def test_tshark_shows_every_example_frame_as_decode_json_does(tmp_path: Path) -> None:
+    assert TSHARK is not None
+    specs = [str(ROOT / g.protocol.spec_path) for g in ALL]
+    run(*SERIALSPEC, "generate", *specs, "--target", "wireshark", "--out", str(tmp_path / "out"))
+    lines = []
+    wanted: list[dict[str, Any]] = []
+    second = 0
+    for g in ALL:
+        protocol = g.protocol
+        capture = [f"# serialspec capture: {protocol.name}"]
+        for direction, frames in example_frames(protocol).items():
+            if not frames:
+                continue
+            results = decoded(protocol, direction, frames)
+            assert len(results) == len(frames)
+            for frame in frames:  # one frame a packet
+                second += 1
+                capture.append(f"2026-11-25T10:00:{second % 60:02d}.{second:06d}+00:00 {direction} {frame.hex(' ')}")
+            # then all of them in one packet
+            capture.append(f"2026-11-25T10:01:00.000000+00:00 {direction} {b''.join(frames).hex(' ')}")
+            wanted += [{"protocol": protocol.name, **r} for r in results] * 2
+        path = tmp_path / f"{protocol.name}.capture"
+        path.write_text("\n".join(capture) + "\n", encoding="utf-8")
+        run(*SERIALSPEC, "export", str(path), "--pcap", str(tmp_path / f"{protocol.name}.pcap"))
+        lines.append(protocol.name)
+    # one tshark, every dissector loaded at once (they share the capture's link type)
+    scripts = [f"lua_script:{tmp_path / 'out' / name / f'{name}.lua'}" for name in lines]
+    options = [word for script in scripts for word in ("-X", script)]
+    trees = []
+    for name in lines:
+        trees += pdml_frames(run(TSHARK, *options, "-r", str(tmp_path / f"{name}.pcap"), "-T", "pdml"))
+    assert len(trees) == len(wanted)
+    protocols = {g.protocol.name: g.protocol for g in ALL}
+    for tree, expected in zip(trees, wanted, strict=True):
+        seen = shown(protocols[expected["protocol"]], tree)
+        assert seen == {key: expected[key] for key in seen}, expected["hex"]
+    assert sum(len(example_frames(g.protocol)["request"]) for g in ALL) > 50
+
+
+@pytest.mark.skipif(
+    TSHARK is None, reason="tshark is not installed (make generate installs it where it can: root and apt-get)"
+)
+def test_tshark_flags_a_bad_checksum_and_bytes_outside_frames(tmp_path: Path) -> None:
+    assert TSHARK is not None
+    spec = str(ROOT / "specs" / "fashionstar_uart.yaml")
+    run(*SERIALSPEC, "generate", spec, "--target", "wireshark", "--out", str(tmp_path))
+    capture = tmp_path / "bad.capture"
+    capture.write_text(
+        "# serialspec capture: fashionstar_uart\n"
+        "2026-11-25T10:00:00.000000+00:00 request 12 4c 01 01 03 64 99 12 4c 01 01 03 63\n",
+        encoding="utf-8",
+    )
+    run(*SERIALSPEC, "export", str(capture), "--pcap", str(tmp_path / "bad.pcap"))
+    script = f"lua_script:{tmp_path / 'fashionstar_uart' / 'fashionstar_uart.lua'}"
+    out = run(TSHARK, "-X", script, "-r", str(tmp_path / "bad.pcap"), "-V")
+    assert "checksum: 0x64 [incorrect, should be 0x63]" in out
+    assert "Bytes outside any frame: 99" in out
+    assert out.count("request ping") == 2
+    fields = run(
+        TSHARK, "-X", script, "-r", str(tmp_path / "bad.pcap"), "-T", "fields", "-e", "fashionstar_uart.checksum_ok"
+    )
+    assert fields.strip() == "0,1"

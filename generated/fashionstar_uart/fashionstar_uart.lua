@@ -5,8 +5,8 @@
 -- Lua plugins folder (Help > About Wireshark > Folders). It reads the captures `serialspec export CAPTURE --pcap FILE`
 -- writes: link type DLT_USER0 (147), each packet a pseudo-header (one byte of direction: 0 request, 1 response,
 -- 2 unknown; one byte of length and the protocol's name) and then the bytes as they were seen on the port, which may
--- hold several frames. Each frame is a "fashionstar_uart" tree with its command, its frame elements
--- (fashionstar_uart.<element>) and its fields (fashionstar_uart.<command>[.<subcommand>].<direction>.<field>),
+-- hold several frames. Each frame is a "fashionstar_uart" tree with its command (fashionstar_uart.command), its
+-- frame elements (fashionstar_uart.frame.<element>) and its fields (fashionstar_uart.<command>[.<subcommand>].<direction>.<field>),
 -- values as sent on the wire with their units, scaled values and enum names beside them; the checksums are verified
 -- (fashionstar_uart.checksum_ok == 0 finds the bad frames).
 
@@ -2491,7 +2491,7 @@ else -- Lua 5.3 and later: the operators
 end
 
 local P = SPEC.name
-local proto = Proto(P, SPEC.title)
+local proto = Proto(P, SPEC.title .. " (serialspec)")
 local SIZES = {u8 = 1, i8 = 1, u16 = 2, i16 = 2, u32 = 4, i32 = 4, f32 = 4}
 local MAKERS = {
   u8 = ProtoField.uint8, i8 = ProtoField.int8, u16 = ProtoField.uint16, i16 = ProtoField.int16,
@@ -2616,7 +2616,7 @@ for _, direction in pairs(SPEC.directions) do
     layout.overhead = 0
     for index, element in ipairs(layout.elements) do
       layout.overhead = layout.overhead + element.size
-      local abbr = P .. "." .. element.name
+      local abbr = P .. ".frame." .. element.name
       if element.role == "header" or element.role == "trailer" or element.role == "constant" then
         element.pf = new(abbr, function() return ProtoField.bytes(abbr, element.name, base.SPACE, element.description) end)
       elseif element.role ~= "content" then

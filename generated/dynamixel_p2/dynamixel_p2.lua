@@ -10,6 +10,45 @@
 -- values as sent on the wire with their units, scaled values and enum names beside them; the checksums are verified
 -- (dynamixel_p2.checksum_ok == 0 finds the bad frames).
 
+-- enums by name, the tables whose entries fields hold (by key), the frame layouts where both directions share them
+local ENUMS = {
+  error_number = {
+    [0] = "none",
+    [1] = "result_fail",
+    [2] = "instruction_error",
+    [3] = "crc_error",
+    [4] = "data_range_error",
+    [5] = "data_length_error",
+    [6] = "data_limit_error",
+    [7] = "access_error",
+  },
+  reset_option = {[1] = "all_but_id", [2] = "all_but_id_and_baud_rate", [255] = "all"},
+  clear_option = {[1] = "multi_turn"},
+  baud_rate = {
+    [0] = "baud_9600",
+    [1] = "baud_57600",
+    [2] = "baud_115200",
+    [3] = "baud_1000000",
+    [4] = "baud_2000000",
+    [5] = "baud_3000000",
+    [6] = "baud_4000000",
+    [7] = "baud_4500000",
+  },
+  operating_mode = {
+    [0] = "current",
+    [1] = "velocity",
+    [3] = "position",
+    [4] = "extended_position",
+    [5] = "current_based_position",
+    [16] = "pwm",
+  },
+  status_return_level = {[0] = "ping_only", [1] = "ping_and_read", [2] = "all"},
+  torque_enable = {[0] = "off", [1] = "on"},
+  protocol_type = {[1] = "protocol_1", [2] = "protocol_2"},
+}
+local TABLES = {}
+local LAYOUTS = nil
+
 local SPEC = {
   name = "dynamixel_p2",
   title = "ROBOTIS DYNAMIXEL Protocol 2.0",
@@ -18,7 +57,6 @@ local SPEC = {
     request = {
       layouts = {
         {
-          name = "request",
           elements = {
             {
               name = "header",
@@ -229,7 +267,7 @@ local SPEC = {
                 type = "u8",
                 big = false,
                 unit = "",
-                enum = {[1] = "all_but_id", [2] = "all_but_id_and_baud_rate", [255] = "all"},
+                enum = ENUMS["reset_option"],
                 hidden = false,
                 sign_magnitude = false,
               },
@@ -268,7 +306,7 @@ local SPEC = {
                 type = "u8",
                 big = false,
                 unit = "",
-                enum = {[1] = "multi_turn"},
+                enum = ENUMS["clear_option"],
                 hidden = false,
                 sign_magnitude = false,
               },
@@ -575,7 +613,6 @@ local SPEC = {
     response = {
       layouts = {
         {
-          name = "response",
           elements = {
             {
               name = "header",
@@ -638,16 +675,7 @@ local SPEC = {
                   name = "number",
                   high = 6,
                   low = 0,
-                  enum = {
-                    [0] = "none",
-                    [1] = "result_fail",
-                    [2] = "instruction_error",
-                    [3] = "crc_error",
-                    [4] = "data_range_error",
-                    [5] = "data_length_error",
-                    [6] = "data_limit_error",
-                    [7] = "access_error",
-                  },
+                  enum = ENUMS["error_number"],
                   description = "The result of processing the instruction.",
                 },
               },
@@ -822,6 +850,14 @@ local function declare_field(f, abbr)
     f.pf = new(abbr, function() return ProtoField.none(abbr, f.name, f.description) end)
     f.item = new(abbr .. ".item", function() return ProtoField.none(abbr .. ".item", f.name .. " item") end)
     declare(f.fields, abbr)
+  elseif kind == "table_block" then -- a run of a table's entries: a group of one item, its fields the entries
+    f.kind, f.count, f.single, f.tail, f.fields = "group", 1, true, 0, {}
+    for _, key in ipairs(f.keys) do
+      local field = {kind = "scalar", big = f.big, tail = 0}
+      for name, value in pairs(f.table[key]) do field[name] = value end
+      f.fields[#f.fields + 1] = field
+    end
+    declare_field(f, abbr)
   elseif kind == "table_value" then
     local float, signed = false, false
     for _, entry in pairs(f.entries) do
@@ -1159,6 +1195,14 @@ local function decode_field(f, tvb, pos, stop, tree, scope)
     group:set_len(pos - start)
     if not f.single then group:append_text(string.format(": %d item(s)", i)) end
     return pos
+  elseif kind == "table_block" then -- a run of a table's entries: a group of one item, its fields the entries
+    f.kind, f.count, f.single, f.tail, f.fields = "group", 1, true, 0, {}
+    for _, key in ipairs(f.keys) do
+      local field = {kind = "scalar", big = f.big, tail = 0}
+      for name, value in pairs(f.table[key]) do field[name] = value end
+      f.fields[#f.fields + 1] = field
+    end
+    declare_field(f, abbr)
   elseif kind == "table_value" then
     local key = scope[f.key]
     local entry = key and f.entries[key]

@@ -10,6 +10,26 @@
 -- values as sent on the wire with their units, scaled values and enum names beside them; the checksums are verified
 -- (feetech_sms.checksum_ok == 0 finds the bad frames).
 
+-- enums by name, the tables whose entries fields hold (by key), the frame layouts where both directions share them
+local ENUMS = {
+  baud_rate = {
+    [0] = "baud_1000000",
+    [1] = "baud_500000",
+    [2] = "baud_250000",
+    [3] = "baud_128000",
+    [4] = "baud_115200",
+    [5] = "baud_76800",
+    [6] = "baud_57600",
+    [7] = "baud_38400",
+  },
+  response_level = {[0] = "read_and_ping_only", [1] = "all"},
+  operating_mode = {[0] = "position", [1] = "speed", [2] = "pwm", [3] = "step"},
+  torque_enable = {[0] = "off", [1] = "on", [128] = "set_middle"},
+  lock = {[0] = "unlocked", [1] = "locked"},
+}
+local TABLES = {}
+local LAYOUTS = nil
+
 local SPEC = {
   name = "feetech_sms",
   title = "FEETECH SMS1.0 bus servo protocol",
@@ -18,7 +38,6 @@ local SPEC = {
     request = {
       layouts = {
         {
-          name = "request",
           elements = {
             {
               name = "header",
@@ -327,7 +346,6 @@ local SPEC = {
     response = {
       layouts = {
         {
-          name = "response",
           elements = {
             {
               name = "header",
@@ -498,6 +516,14 @@ local function declare_field(f, abbr)
     f.pf = new(abbr, function() return ProtoField.none(abbr, f.name, f.description) end)
     f.item = new(abbr .. ".item", function() return ProtoField.none(abbr .. ".item", f.name .. " item") end)
     declare(f.fields, abbr)
+  elseif kind == "table_block" then -- a run of a table's entries: a group of one item, its fields the entries
+    f.kind, f.count, f.single, f.tail, f.fields = "group", 1, true, 0, {}
+    for _, key in ipairs(f.keys) do
+      local field = {kind = "scalar", big = f.big, tail = 0}
+      for name, value in pairs(f.table[key]) do field[name] = value end
+      f.fields[#f.fields + 1] = field
+    end
+    declare_field(f, abbr)
   elseif kind == "table_value" then
     local float, signed = false, false
     for _, entry in pairs(f.entries) do
@@ -835,6 +861,14 @@ local function decode_field(f, tvb, pos, stop, tree, scope)
     group:set_len(pos - start)
     if not f.single then group:append_text(string.format(": %d item(s)", i)) end
     return pos
+  elseif kind == "table_block" then -- a run of a table's entries: a group of one item, its fields the entries
+    f.kind, f.count, f.single, f.tail, f.fields = "group", 1, true, 0, {}
+    for _, key in ipairs(f.keys) do
+      local field = {kind = "scalar", big = f.big, tail = 0}
+      for name, value in pairs(f.table[key]) do field[name] = value end
+      f.fields[#f.fields + 1] = field
+    end
+    declare_field(f, abbr)
   elseif kind == "table_value" then
     local key = scope[f.key]
     local entry = key and f.entries[key]

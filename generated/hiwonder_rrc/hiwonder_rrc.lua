@@ -10,71 +10,87 @@
 -- values as sent on the wire with their units, scaled values and enum names beside them; the checksums are verified
 -- (hiwonder_rrc.checksum_ok == 0 finds the bad frames).
 
+-- enums by name, the tables whose entries fields hold (by key), the frame layouts where both directions share them
+local ENUMS = {
+  read_result = {[0] = "ok", [-1] = "failed"},
+  button_event = {
+    [1] = "pressed",
+    [2] = "long_press",
+    [4] = "long_press_repeat",
+    [8] = "release_from_long_press",
+    [16] = "release_from_short_press",
+    [32] = "click",
+    [64] = "double_click",
+    [128] = "triple_click",
+  },
+}
+local TABLES = {}
+local LAYOUTS = {
+  {
+    elements = {
+      {
+        name = "header",
+        role = "header",
+        size = 2,
+        big = false,
+        constant = "\xaaU",
+        description = "Frame start (\xe5\xb8\xa7\xe5\xa4\xb4), the same in both directions.",
+      },
+      {
+        name = "function",
+        role = "command",
+        size = 1,
+        big = false,
+        min = 0,
+        max = 255,
+        description = "Function code (\xe5\x8a\x9f\xe8\x83\xbd\xe7\xa0\x81) naming the frame's purpose (1 LED .. 9 SBUS).",
+      },
+      {
+        name = "length",
+        role = "length",
+        size = 1,
+        big = false,
+        span = {4, 4},
+        adds = 0,
+        description = "Number of data bytes (\xe6\x95\xb0\xe6\x8d\xae\xe9\x95\xbf\xe5\xba\xa6), not the number of parameters.",
+      },
+      {
+        name = "data",
+        role = "content",
+        size = 0,
+        big = false,
+        description = "The parameters (\xe5\x8f\x82\xe6\x95\xb0); for functions with sub-commands, a host request starts with the sub-command.",
+      },
+      {
+        name = "crc",
+        role = "checksum",
+        size = 1,
+        big = false,
+        span = {2, 4},
+        checksum = {
+          algorithm = "crc",
+          invert = false,
+          name = "CRC-8/MAXIM",
+          width = 8,
+          poly = 49,
+          init = 0,
+          refin = true,
+          refout = true,
+          xorout = 0,
+        },
+        description = "CRC-8/MAXIM of function, length and data.",
+      },
+    },
+  },
+}
+
 local SPEC = {
   name = "hiwonder_rrc",
   title = "Hiwonder RRC controller board protocol",
   big = false,
   directions = {
     request = {
-      layouts = {
-        {
-          name = "request",
-          elements = {
-            {
-              name = "header",
-              role = "header",
-              size = 2,
-              big = false,
-              constant = "\xaaU",
-              description = "Frame start (\xe5\xb8\xa7\xe5\xa4\xb4), the same in both directions.",
-            },
-            {
-              name = "function",
-              role = "command",
-              size = 1,
-              big = false,
-              min = 0,
-              max = 255,
-              description = "Function code (\xe5\x8a\x9f\xe8\x83\xbd\xe7\xa0\x81) naming the frame's purpose (1 LED .. 9 SBUS).",
-            },
-            {
-              name = "length",
-              role = "length",
-              size = 1,
-              big = false,
-              span = {4, 4},
-              adds = 0,
-              description = "Number of data bytes (\xe6\x95\xb0\xe6\x8d\xae\xe9\x95\xbf\xe5\xba\xa6), not the number of parameters.",
-            },
-            {
-              name = "data",
-              role = "content",
-              size = 0,
-              big = false,
-              description = "The parameters (\xe5\x8f\x82\xe6\x95\xb0); for functions with sub-commands, a host request starts with the sub-command.",
-            },
-            {
-              name = "crc",
-              role = "checksum",
-              size = 1,
-              big = false,
-              span = {2, 4},
-              checksum = {
-                algorithm = "crc",
-                invert = false,
-                name = "CRC-8/MAXIM",
-                width = 8,
-                poly = 49,
-                init = 0,
-                refin = true,
-                refout = true,
-                xorout = 0,
-              },
-              description = "CRC-8/MAXIM of function, length and data.",
-            },
-          },
-        },
-      },
+      layouts = LAYOUTS,
       codes = {
         [1] = {
           message = {
@@ -1606,65 +1622,7 @@ local SPEC = {
       },
     },
     response = {
-      layouts = {
-        {
-          name = "response",
-          elements = {
-            {
-              name = "header",
-              role = "header",
-              size = 2,
-              big = false,
-              constant = "\xaaU",
-              description = "Frame start (\xe5\xb8\xa7\xe5\xa4\xb4), the same in both directions.",
-            },
-            {
-              name = "function",
-              role = "command",
-              size = 1,
-              big = false,
-              min = 0,
-              max = 255,
-              description = "Function code (\xe5\x8a\x9f\xe8\x83\xbd\xe7\xa0\x81) naming the frame's purpose (1 LED .. 9 SBUS).",
-            },
-            {
-              name = "length",
-              role = "length",
-              size = 1,
-              big = false,
-              span = {4, 4},
-              adds = 0,
-              description = "Number of data bytes (\xe6\x95\xb0\xe6\x8d\xae\xe9\x95\xbf\xe5\xba\xa6), not the number of parameters.",
-            },
-            {
-              name = "data",
-              role = "content",
-              size = 0,
-              big = false,
-              description = "The parameters (\xe5\x8f\x82\xe6\x95\xb0); for functions with sub-commands, a host request starts with the sub-command.",
-            },
-            {
-              name = "crc",
-              role = "checksum",
-              size = 1,
-              big = false,
-              span = {2, 4},
-              checksum = {
-                algorithm = "crc",
-                invert = false,
-                name = "CRC-8/MAXIM",
-                width = 8,
-                poly = 49,
-                init = 0,
-                refin = true,
-                refout = true,
-                xorout = 0,
-              },
-              description = "CRC-8/MAXIM of function, length and data.",
-            },
-          },
-        },
-      },
+      layouts = LAYOUTS,
       codes = {
         [4] = {
           selector = {offset = 1, size = 1},
@@ -1800,7 +1758,7 @@ local SPEC = {
                   type = "i8",
                   big = false,
                   unit = "",
-                  enum = {[0] = "ok", [-1] = "failed"},
+                  enum = ENUMS["read_result"],
                   hidden = false,
                   sign_magnitude = false,
                 },
@@ -1856,7 +1814,7 @@ local SPEC = {
                   type = "i8",
                   big = false,
                   unit = "",
-                  enum = {[0] = "ok", [-1] = "failed"},
+                  enum = ENUMS["read_result"],
                   hidden = false,
                   sign_magnitude = false,
                 },
@@ -1912,7 +1870,7 @@ local SPEC = {
                   type = "i8",
                   big = false,
                   unit = "",
-                  enum = {[0] = "ok", [-1] = "failed"},
+                  enum = ENUMS["read_result"],
                   hidden = false,
                   sign_magnitude = false,
                 },
@@ -1968,7 +1926,7 @@ local SPEC = {
                   type = "i8",
                   big = false,
                   unit = "",
-                  enum = {[0] = "ok", [-1] = "failed"},
+                  enum = ENUMS["read_result"],
                   hidden = false,
                   sign_magnitude = false,
                 },
@@ -2024,7 +1982,7 @@ local SPEC = {
                   type = "i8",
                   big = false,
                   unit = "",
-                  enum = {[0] = "ok", [-1] = "failed"},
+                  enum = ENUMS["read_result"],
                   hidden = false,
                   sign_magnitude = false,
                 },
@@ -2080,7 +2038,7 @@ local SPEC = {
                   type = "i8",
                   big = false,
                   unit = "",
-                  enum = {[0] = "ok", [-1] = "failed"},
+                  enum = ENUMS["read_result"],
                   hidden = false,
                   sign_magnitude = false,
                 },
@@ -2136,7 +2094,7 @@ local SPEC = {
                   type = "i8",
                   big = false,
                   unit = "",
-                  enum = {[0] = "ok", [-1] = "failed"},
+                  enum = ENUMS["read_result"],
                   hidden = false,
                   sign_magnitude = false,
                 },
@@ -2203,7 +2161,7 @@ local SPEC = {
                   type = "i8",
                   big = false,
                   unit = "",
-                  enum = {[0] = "ok", [-1] = "failed"},
+                  enum = ENUMS["read_result"],
                   hidden = false,
                   sign_magnitude = false,
                 },
@@ -2270,7 +2228,7 @@ local SPEC = {
                   type = "i8",
                   big = false,
                   unit = "",
-                  enum = {[0] = "ok", [-1] = "failed"},
+                  enum = ENUMS["read_result"],
                   hidden = false,
                   sign_magnitude = false,
                 },
@@ -2319,16 +2277,7 @@ local SPEC = {
                 type = "u8",
                 big = false,
                 unit = "",
-                enum = {
-                  [1] = "pressed",
-                  [2] = "long_press",
-                  [4] = "long_press_repeat",
-                  [8] = "release_from_long_press",
-                  [16] = "release_from_short_press",
-                  [32] = "click",
-                  [64] = "double_click",
-                  [128] = "triple_click",
-                },
+                enum = ENUMS["button_event"],
                 hidden = false,
                 sign_magnitude = false,
               },
@@ -2706,6 +2655,14 @@ local function declare_field(f, abbr)
     f.pf = new(abbr, function() return ProtoField.none(abbr, f.name, f.description) end)
     f.item = new(abbr .. ".item", function() return ProtoField.none(abbr .. ".item", f.name .. " item") end)
     declare(f.fields, abbr)
+  elseif kind == "table_block" then -- a run of a table's entries: a group of one item, its fields the entries
+    f.kind, f.count, f.single, f.tail, f.fields = "group", 1, true, 0, {}
+    for _, key in ipairs(f.keys) do
+      local field = {kind = "scalar", big = f.big, tail = 0}
+      for name, value in pairs(f.table[key]) do field[name] = value end
+      f.fields[#f.fields + 1] = field
+    end
+    declare_field(f, abbr)
   elseif kind == "table_value" then
     local float, signed = false, false
     for _, entry in pairs(f.entries) do
@@ -3043,6 +3000,14 @@ local function decode_field(f, tvb, pos, stop, tree, scope)
     group:set_len(pos - start)
     if not f.single then group:append_text(string.format(": %d item(s)", i)) end
     return pos
+  elseif kind == "table_block" then -- a run of a table's entries: a group of one item, its fields the entries
+    f.kind, f.count, f.single, f.tail, f.fields = "group", 1, true, 0, {}
+    for _, key in ipairs(f.keys) do
+      local field = {kind = "scalar", big = f.big, tail = 0}
+      for name, value in pairs(f.table[key]) do field[name] = value end
+      f.fields[#f.fields + 1] = field
+    end
+    declare_field(f, abbr)
   elseif kind == "table_value" then
     local key = scope[f.key]
     local entry = key and f.entries[key]

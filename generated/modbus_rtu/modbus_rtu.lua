@@ -10,64 +10,81 @@
 -- values as sent on the wire with their units, scaled values and enum names beside them; the checksums are verified
 -- (modbus_rtu.checksum_ok == 0 finds the bad frames).
 
+-- enums by name, the tables whose entries fields hold (by key), the frame layouts where both directions share them
+local ENUMS = {
+  exception_code = {
+    [1] = "illegal_function",
+    [2] = "illegal_data_address",
+    [3] = "illegal_data_value",
+    [4] = "server_device_failure",
+    [5] = "acknowledge",
+    [6] = "server_device_busy",
+    [8] = "memory_parity_error",
+    [10] = "gateway_path_unavailable",
+    [11] = "gateway_target_failed",
+  },
+  coil_state = {[0] = "off", [65280] = "on"},
+}
+local TABLES = {}
+local LAYOUTS = {
+  {
+    elements = {
+      {
+        name = "unit",
+        role = "address",
+        size = 1,
+        big = false,
+        min = 1,
+        max = 247,
+        broadcast = 0,
+        description = "Server (slave) address 1..247; 0 is the broadcast address: every server carries out a write and none answers (serial \xc2\xa72.2). Replies carry the answering server's own address.",
+      },
+      {
+        name = "function",
+        role = "command",
+        size = 1,
+        big = false,
+        min = 0,
+        max = 255,
+        description = "The function code (app \xc2\xa75). A server that cannot carry a request out answers with the function code plus 0x80 and an exception code (app \xc2\xa77).",
+      },
+      {
+        name = "data",
+        role = "content",
+        size = 0,
+        big = false,
+        description = "The function's data, big-endian.",
+      },
+      {
+        name = "crc",
+        role = "checksum",
+        size = 2,
+        big = false,
+        span = {1, 3},
+        checksum = {
+          algorithm = "crc",
+          invert = false,
+          name = "CRC-16/MODBUS",
+          width = 16,
+          poly = 32773,
+          init = 65535,
+          refin = true,
+          refout = true,
+          xorout = 0,
+        },
+        description = "CRC-16 over the address, function code and data; low byte first (serial \xc2\xa72.5.1.2, \xc2\xa76.2.2).",
+      },
+    },
+  },
+}
+
 local SPEC = {
   name = "modbus_rtu",
   title = "Modbus RTU",
   big = true,
   directions = {
     request = {
-      layouts = {
-        {
-          name = "request",
-          elements = {
-            {
-              name = "unit",
-              role = "address",
-              size = 1,
-              big = false,
-              min = 1,
-              max = 247,
-              broadcast = 0,
-              description = "Server (slave) address 1..247; 0 is the broadcast address: every server carries out a write and none answers (serial \xc2\xa72.2). Replies carry the answering server's own address.",
-            },
-            {
-              name = "function",
-              role = "command",
-              size = 1,
-              big = false,
-              min = 0,
-              max = 255,
-              description = "The function code (app \xc2\xa75). A server that cannot carry a request out answers with the function code plus 0x80 and an exception code (app \xc2\xa77).",
-            },
-            {
-              name = "data",
-              role = "content",
-              size = 0,
-              big = false,
-              description = "The function's data, big-endian.",
-            },
-            {
-              name = "crc",
-              role = "checksum",
-              size = 2,
-              big = false,
-              span = {1, 3},
-              checksum = {
-                algorithm = "crc",
-                invert = false,
-                name = "CRC-16/MODBUS",
-                width = 16,
-                poly = 32773,
-                init = 65535,
-                refin = true,
-                refout = true,
-                xorout = 0,
-              },
-              description = "CRC-16 over the address, function code and data; low byte first (serial \xc2\xa72.5.1.2, \xc2\xa76.2.2).",
-            },
-          },
-        },
-      },
+      layouts = LAYOUTS,
       codes = {
         [1] = {
           message = {
@@ -238,7 +255,7 @@ local SPEC = {
                 type = "u16",
                 big = true,
                 unit = "",
-                enum = {[0] = "off", [65280] = "on"},
+                enum = ENUMS["coil_state"],
                 hidden = false,
                 sign_magnitude = false,
               },
@@ -531,58 +548,7 @@ local SPEC = {
       error_element = "function",
     },
     response = {
-      layouts = {
-        {
-          name = "response",
-          elements = {
-            {
-              name = "unit",
-              role = "address",
-              size = 1,
-              big = false,
-              min = 1,
-              max = 247,
-              broadcast = 0,
-              description = "Server (slave) address 1..247; 0 is the broadcast address: every server carries out a write and none answers (serial \xc2\xa72.2). Replies carry the answering server's own address.",
-            },
-            {
-              name = "function",
-              role = "command",
-              size = 1,
-              big = false,
-              min = 0,
-              max = 255,
-              description = "The function code (app \xc2\xa75). A server that cannot carry a request out answers with the function code plus 0x80 and an exception code (app \xc2\xa77).",
-            },
-            {
-              name = "data",
-              role = "content",
-              size = 0,
-              big = false,
-              description = "The function's data, big-endian.",
-            },
-            {
-              name = "crc",
-              role = "checksum",
-              size = 2,
-              big = false,
-              span = {1, 3},
-              checksum = {
-                algorithm = "crc",
-                invert = false,
-                name = "CRC-16/MODBUS",
-                width = 16,
-                poly = 32773,
-                init = 65535,
-                refin = true,
-                refout = true,
-                xorout = 0,
-              },
-              description = "CRC-16 over the address, function code and data; low byte first (serial \xc2\xa72.5.1.2, \xc2\xa76.2.2).",
-            },
-          },
-        },
-      },
+      layouts = LAYOUTS,
       codes = {
         [1] = {
           message = {
@@ -749,7 +715,7 @@ local SPEC = {
                 type = "u16",
                 big = true,
                 unit = "",
-                enum = {[0] = "off", [65280] = "on"},
+                enum = ENUMS["coil_state"],
                 hidden = false,
                 sign_magnitude = false,
               },
@@ -965,17 +931,7 @@ local SPEC = {
                 type = "u8",
                 big = true,
                 unit = "",
-                enum = {
-                  [1] = "illegal_function",
-                  [2] = "illegal_data_address",
-                  [3] = "illegal_data_value",
-                  [4] = "server_device_failure",
-                  [5] = "acknowledge",
-                  [6] = "server_device_busy",
-                  [8] = "memory_parity_error",
-                  [10] = "gateway_path_unavailable",
-                  [11] = "gateway_target_failed",
-                },
+                enum = ENUMS["exception_code"],
                 hidden = false,
                 sign_magnitude = false,
               },
@@ -1074,6 +1030,14 @@ local function declare_field(f, abbr)
     f.pf = new(abbr, function() return ProtoField.none(abbr, f.name, f.description) end)
     f.item = new(abbr .. ".item", function() return ProtoField.none(abbr .. ".item", f.name .. " item") end)
     declare(f.fields, abbr)
+  elseif kind == "table_block" then -- a run of a table's entries: a group of one item, its fields the entries
+    f.kind, f.count, f.single, f.tail, f.fields = "group", 1, true, 0, {}
+    for _, key in ipairs(f.keys) do
+      local field = {kind = "scalar", big = f.big, tail = 0}
+      for name, value in pairs(f.table[key]) do field[name] = value end
+      f.fields[#f.fields + 1] = field
+    end
+    declare_field(f, abbr)
   elseif kind == "table_value" then
     local float, signed = false, false
     for _, entry in pairs(f.entries) do
@@ -1411,6 +1375,14 @@ local function decode_field(f, tvb, pos, stop, tree, scope)
     group:set_len(pos - start)
     if not f.single then group:append_text(string.format(": %d item(s)", i)) end
     return pos
+  elseif kind == "table_block" then -- a run of a table's entries: a group of one item, its fields the entries
+    f.kind, f.count, f.single, f.tail, f.fields = "group", 1, true, 0, {}
+    for _, key in ipairs(f.keys) do
+      local field = {kind = "scalar", big = f.big, tail = 0}
+      for name, value in pairs(f.table[key]) do field[name] = value end
+      f.fields[#f.fields + 1] = field
+    end
+    declare_field(f, abbr)
   elseif kind == "table_value" then
     local key = scope[f.key]
     local entry = key and f.entries[key]

@@ -10,144 +10,185 @@
 -- values as sent on the wire with their units, scaled values and enum names beside them; the checksums are verified
 -- (vesc.checksum_ok == 0 finds the bad frames).
 
+-- enums by name, the tables whose entries fields hold (by key), the frame layouts where both directions share them
+local ENUMS = {
+  fault_code = {
+    [0] = "none",
+    [1] = "over_voltage",
+    [2] = "under_voltage",
+    [3] = "drv",
+    [4] = "abs_over_current",
+    [5] = "over_temp_fet",
+    [6] = "over_temp_motor",
+    [7] = "gate_driver_over_voltage",
+    [8] = "gate_driver_under_voltage",
+    [9] = "mcu_under_voltage",
+    [10] = "booting_from_watchdog_reset",
+    [11] = "encoder_spi",
+    [12] = "encoder_sincos_below_min_amplitude",
+    [13] = "encoder_sincos_above_max_amplitude",
+    [14] = "flash_corruption",
+    [15] = "high_offset_current_sensor_1",
+    [16] = "high_offset_current_sensor_2",
+    [17] = "high_offset_current_sensor_3",
+    [18] = "unbalanced_currents",
+    [19] = "brk",
+    [20] = "resolver_lot",
+    [21] = "resolver_dos",
+    [22] = "resolver_los",
+    [23] = "flash_corruption_app_cfg",
+    [24] = "flash_corruption_mc_cfg",
+    [25] = "encoder_no_magnet",
+    [26] = "encoder_magnet_too_strong",
+    [27] = "phase_filter",
+    [28] = "encoder_fault",
+    [29] = "lv_output_fault",
+    [30] = "encoder_slip",
+    [31] = "overspeed",
+    [32] = "underspeed",
+    [33] = "abs_overspeed",
+  },
+  hw_type = {[0] = "vesc", [1] = "vesc_bms", [2] = "custom_module"},
+}
+local TABLES = {}
+local LAYOUTS = {
+  {
+    elements = {
+      {
+        name = "start",
+        role = "header",
+        size = 1,
+        big = false,
+        constant = "\x02",
+        description = "Start of a packet whose length takes one byte.",
+      },
+      {
+        name = "length",
+        role = "length",
+        size = 1,
+        big = false,
+        span = {3, 4},
+        adds = 0,
+        description = "Payload length in bytes.",
+      },
+      {
+        name = "command",
+        role = "command",
+        size = 1,
+        big = false,
+        min = 0,
+        max = 255,
+        description = "The command id (COMM_PACKET_ID).",
+      },
+      {
+        name = "payload",
+        role = "content",
+        size = 0,
+        big = false,
+        description = "The command's fields, big-endian.",
+      },
+      {
+        name = "crc",
+        role = "checksum",
+        size = 2,
+        big = true,
+        span = {3, 4},
+        checksum = {
+          algorithm = "crc",
+          invert = false,
+          name = "CRC-16/XMODEM",
+          width = 16,
+          poly = 4129,
+          init = 0,
+          refin = false,
+          refout = false,
+          xorout = 0,
+        },
+        description = "CRC-16/XMODEM of the payload (the command id included), high byte first.",
+      },
+      {
+        name = "end",
+        role = "trailer",
+        size = 1,
+        big = false,
+        constant = "\x03",
+        description = "End of packet.",
+      },
+    },
+  },
+  {
+    elements = {
+      {
+        name = "start",
+        role = "header",
+        size = 1,
+        big = false,
+        constant = "\x03",
+        description = "Start of a packet whose length takes two bytes.",
+      },
+      {
+        name = "length",
+        role = "length",
+        size = 2,
+        big = true,
+        span = {3, 4},
+        adds = 0,
+        description = "Payload length.",
+      },
+      {
+        name = "command",
+        role = "command",
+        size = 1,
+        big = false,
+        min = 0,
+        max = 255,
+        description = "The command id (COMM_PACKET_ID).",
+      },
+      {
+        name = "payload",
+        role = "content",
+        size = 0,
+        big = false,
+        description = "The command's fields, big-endian.",
+      },
+      {
+        name = "crc",
+        role = "checksum",
+        size = 2,
+        big = true,
+        span = {3, 4},
+        checksum = {
+          algorithm = "crc",
+          invert = false,
+          name = "CRC-16/XMODEM",
+          width = 16,
+          poly = 4129,
+          init = 0,
+          refin = false,
+          refout = false,
+          xorout = 0,
+        },
+        description = "CRC-16/XMODEM of the payload (the command id included), high byte first.",
+      },
+      {
+        name = "end",
+        role = "trailer",
+        size = 1,
+        big = false,
+        constant = "\x03",
+        description = "End of packet.",
+      },
+    },
+  },
+}
+
 local SPEC = {
   name = "vesc",
   title = "VESC motor controller communication",
   big = true,
   directions = {
     request = {
-      layouts = {
-        {
-          name = "short",
-          elements = {
-            {
-              name = "start",
-              role = "header",
-              size = 1,
-              big = false,
-              constant = "\x02",
-              description = "Start of a packet whose length takes one byte.",
-            },
-            {
-              name = "length",
-              role = "length",
-              size = 1,
-              big = false,
-              span = {3, 4},
-              adds = 0,
-              description = "Payload length in bytes.",
-            },
-            {
-              name = "command",
-              role = "command",
-              size = 1,
-              big = false,
-              min = 0,
-              max = 255,
-              description = "The command id (COMM_PACKET_ID).",
-            },
-            {
-              name = "payload",
-              role = "content",
-              size = 0,
-              big = false,
-              description = "The command's fields, big-endian.",
-            },
-            {
-              name = "crc",
-              role = "checksum",
-              size = 2,
-              big = true,
-              span = {3, 4},
-              checksum = {
-                algorithm = "crc",
-                invert = false,
-                name = "CRC-16/XMODEM",
-                width = 16,
-                poly = 4129,
-                init = 0,
-                refin = false,
-                refout = false,
-                xorout = 0,
-              },
-              description = "CRC-16/XMODEM of the payload (the command id included), high byte first.",
-            },
-            {
-              name = "end",
-              role = "trailer",
-              size = 1,
-              big = false,
-              constant = "\x03",
-              description = "End of packet.",
-            },
-          },
-        },
-        {
-          name = "long",
-          elements = {
-            {
-              name = "start",
-              role = "header",
-              size = 1,
-              big = false,
-              constant = "\x03",
-              description = "Start of a packet whose length takes two bytes.",
-            },
-            {
-              name = "length",
-              role = "length",
-              size = 2,
-              big = true,
-              span = {3, 4},
-              adds = 0,
-              description = "Payload length.",
-            },
-            {
-              name = "command",
-              role = "command",
-              size = 1,
-              big = false,
-              min = 0,
-              max = 255,
-              description = "The command id (COMM_PACKET_ID).",
-            },
-            {
-              name = "payload",
-              role = "content",
-              size = 0,
-              big = false,
-              description = "The command's fields, big-endian.",
-            },
-            {
-              name = "crc",
-              role = "checksum",
-              size = 2,
-              big = true,
-              span = {3, 4},
-              checksum = {
-                algorithm = "crc",
-                invert = false,
-                name = "CRC-16/XMODEM",
-                width = 16,
-                poly = 4129,
-                init = 0,
-                refin = false,
-                refout = false,
-                xorout = 0,
-              },
-              description = "CRC-16/XMODEM of the payload (the command id included), high byte first.",
-            },
-            {
-              name = "end",
-              role = "trailer",
-              size = 1,
-              big = false,
-              constant = "\x03",
-              description = "End of packet.",
-            },
-          },
-        },
-      },
+      layouts = LAYOUTS,
       codes = {
         [0] = {
           message = {
@@ -375,138 +416,7 @@ local SPEC = {
       },
     },
     response = {
-      layouts = {
-        {
-          name = "short",
-          elements = {
-            {
-              name = "start",
-              role = "header",
-              size = 1,
-              big = false,
-              constant = "\x02",
-              description = "Start of a packet whose length takes one byte.",
-            },
-            {
-              name = "length",
-              role = "length",
-              size = 1,
-              big = false,
-              span = {3, 4},
-              adds = 0,
-              description = "Payload length in bytes.",
-            },
-            {
-              name = "command",
-              role = "command",
-              size = 1,
-              big = false,
-              min = 0,
-              max = 255,
-              description = "The command id (COMM_PACKET_ID).",
-            },
-            {
-              name = "payload",
-              role = "content",
-              size = 0,
-              big = false,
-              description = "The command's fields, big-endian.",
-            },
-            {
-              name = "crc",
-              role = "checksum",
-              size = 2,
-              big = true,
-              span = {3, 4},
-              checksum = {
-                algorithm = "crc",
-                invert = false,
-                name = "CRC-16/XMODEM",
-                width = 16,
-                poly = 4129,
-                init = 0,
-                refin = false,
-                refout = false,
-                xorout = 0,
-              },
-              description = "CRC-16/XMODEM of the payload (the command id included), high byte first.",
-            },
-            {
-              name = "end",
-              role = "trailer",
-              size = 1,
-              big = false,
-              constant = "\x03",
-              description = "End of packet.",
-            },
-          },
-        },
-        {
-          name = "long",
-          elements = {
-            {
-              name = "start",
-              role = "header",
-              size = 1,
-              big = false,
-              constant = "\x03",
-              description = "Start of a packet whose length takes two bytes.",
-            },
-            {
-              name = "length",
-              role = "length",
-              size = 2,
-              big = true,
-              span = {3, 4},
-              adds = 0,
-              description = "Payload length.",
-            },
-            {
-              name = "command",
-              role = "command",
-              size = 1,
-              big = false,
-              min = 0,
-              max = 255,
-              description = "The command id (COMM_PACKET_ID).",
-            },
-            {
-              name = "payload",
-              role = "content",
-              size = 0,
-              big = false,
-              description = "The command's fields, big-endian.",
-            },
-            {
-              name = "crc",
-              role = "checksum",
-              size = 2,
-              big = true,
-              span = {3, 4},
-              checksum = {
-                algorithm = "crc",
-                invert = false,
-                name = "CRC-16/XMODEM",
-                width = 16,
-                poly = 4129,
-                init = 0,
-                refin = false,
-                refout = false,
-                xorout = 0,
-              },
-              description = "CRC-16/XMODEM of the payload (the command id included), high byte first.",
-            },
-            {
-              name = "end",
-              role = "trailer",
-              size = 1,
-              big = false,
-              constant = "\x03",
-              description = "End of packet.",
-            },
-          },
-        },
-      },
+      layouts = LAYOUTS,
       codes = {
         [0] = {
           message = {
@@ -579,7 +489,7 @@ local SPEC = {
                 type = "u8",
                 big = true,
                 unit = "",
-                enum = {[0] = "vesc", [1] = "vesc_bms", [2] = "custom_module"},
+                enum = ENUMS["hw_type"],
                 hidden = false,
                 sign_magnitude = false,
               },
@@ -851,42 +761,7 @@ local SPEC = {
                 type = "u8",
                 big = true,
                 unit = "",
-                enum = {
-                  [0] = "none",
-                  [1] = "over_voltage",
-                  [2] = "under_voltage",
-                  [3] = "drv",
-                  [4] = "abs_over_current",
-                  [5] = "over_temp_fet",
-                  [6] = "over_temp_motor",
-                  [7] = "gate_driver_over_voltage",
-                  [8] = "gate_driver_under_voltage",
-                  [9] = "mcu_under_voltage",
-                  [10] = "booting_from_watchdog_reset",
-                  [11] = "encoder_spi",
-                  [12] = "encoder_sincos_below_min_amplitude",
-                  [13] = "encoder_sincos_above_max_amplitude",
-                  [14] = "flash_corruption",
-                  [15] = "high_offset_current_sensor_1",
-                  [16] = "high_offset_current_sensor_2",
-                  [17] = "high_offset_current_sensor_3",
-                  [18] = "unbalanced_currents",
-                  [19] = "brk",
-                  [20] = "resolver_lot",
-                  [21] = "resolver_dos",
-                  [22] = "resolver_los",
-                  [23] = "flash_corruption_app_cfg",
-                  [24] = "flash_corruption_mc_cfg",
-                  [25] = "encoder_no_magnet",
-                  [26] = "encoder_magnet_too_strong",
-                  [27] = "phase_filter",
-                  [28] = "encoder_fault",
-                  [29] = "lv_output_fault",
-                  [30] = "encoder_slip",
-                  [31] = "overspeed",
-                  [32] = "underspeed",
-                  [33] = "abs_overspeed",
-                },
+                enum = ENUMS["fault_code"],
                 hidden = false,
                 sign_magnitude = false,
               },
@@ -1128,6 +1003,14 @@ local function declare_field(f, abbr)
     f.pf = new(abbr, function() return ProtoField.none(abbr, f.name, f.description) end)
     f.item = new(abbr .. ".item", function() return ProtoField.none(abbr .. ".item", f.name .. " item") end)
     declare(f.fields, abbr)
+  elseif kind == "table_block" then -- a run of a table's entries: a group of one item, its fields the entries
+    f.kind, f.count, f.single, f.tail, f.fields = "group", 1, true, 0, {}
+    for _, key in ipairs(f.keys) do
+      local field = {kind = "scalar", big = f.big, tail = 0}
+      for name, value in pairs(f.table[key]) do field[name] = value end
+      f.fields[#f.fields + 1] = field
+    end
+    declare_field(f, abbr)
   elseif kind == "table_value" then
     local float, signed = false, false
     for _, entry in pairs(f.entries) do
@@ -1465,6 +1348,14 @@ local function decode_field(f, tvb, pos, stop, tree, scope)
     group:set_len(pos - start)
     if not f.single then group:append_text(string.format(": %d item(s)", i)) end
     return pos
+  elseif kind == "table_block" then -- a run of a table's entries: a group of one item, its fields the entries
+    f.kind, f.count, f.single, f.tail, f.fields = "group", 1, true, 0, {}
+    for _, key in ipairs(f.keys) do
+      local field = {kind = "scalar", big = f.big, tail = 0}
+      for name, value in pairs(f.table[key]) do field[name] = value end
+      f.fields[#f.fields + 1] = field
+    end
+    declare_field(f, abbr)
   elseif kind == "table_value" then
     local key = scope[f.key]
     local entry = key and f.entries[key]

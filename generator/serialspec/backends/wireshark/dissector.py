@@ -14,6 +14,7 @@ from typing import Any, assert_never
 from serialspec.backends.common.frames import runtime_layout
 from serialspec.backends.common.render import render
 from serialspec.cli.views import engineering_unit
+from serialspec.lang.frozen import frozen
 from serialspec.lang.model import (
     Array,
     BitField,
@@ -30,6 +31,7 @@ from serialspec.lang.model import (
     Protocol,
     Scalar,
     TableBlock,
+    TableEntry,
     TableValue,
     Text,
     content_bounds,
@@ -38,13 +40,51 @@ from serialspec.lang.model import (
 
 
 def emit_dissector(protocol: Protocol) -> str:
+    directions = {d.value: _direction(protocol, d) for d in protocol.framing.alternatives}
+    used = {
+        f.table.name
+        for m in protocol.messages()
+        for f in _all_fields(m.fields)
+        if isinstance(f, TableValue | TableBlock)
+    }
+    tables = {t.name: {e.key: _entry(e) for e in t.entries} for t in protocol.tables if t.name in used}
+    layouts = [d["layouts"] for d in directions.values()]
+    shared = None
+    if len(layouts) == 2 and layouts[0] == layouts[1]:  # the same frames both ways: written once
+        shared = layouts[0]
+        for direction in directions.values():
+            direction["layouts"] = Ref("LAYOUTS")
     data = {
         "name": protocol.name,
         "title": protocol.title,
         "big": protocol.byte_order == "big",
-        "directions": {d.value: _direction(protocol, d) for d in protocol.framing.alternatives},
+        "directions": directions,
     }
-    return render("serialspec.backends.wireshark", "dissector.lua.j2", protocol=protocol, data=lua(data, 0))
+    return render(
+        "serialspec.backends.wireshark",
+        "dissector.lua.j2",
+        protocol=protocol,
+        enums=lua({e.name: _enum_values(e) for e in protocol.enums}, 0),
+        tables=lua(tables, 0),
+        layouts=lua(shared, 0),
+        data=lua(data, 0),
+    )
+
+
+def _all_fields(fields: tuple[Field, ...]) -> list[Field]:
+    found: list[Field] = []
+    for item in fields:
+        found.append(item)
+        if isinstance(item, Group):
+            found += _all_fields(item.fields)
+    return found
+
+
+@frozen
+class Ref:
+    """A Lua expression in place of a literal: a table written once and shared (ENUMS, TABLES, LAYOUTS)."""
+
+    expression: str
 
 
 def _direction(protocol: Protocol, direction: Direction) -> dict[str, Any]:
@@ -110,7 +150,7 @@ def _layout(layout: FrameLayout) -> dict[str, Any]:
             item["checksum"] = _checksum(element.checksum)
         item["description"] = element.description
         elements.append(item)
-    result: dict[str, Any] = {"name": layout.name or layout.direction.value, "elements": elements}
+    result: dict[str, Any] = {"elements": elements}
     if engine.transparency is not None:
         first, last = engine.transparency.span
         result["transparency"] = {
@@ -176,34 +216,10 @@ def _field(item: Field, tail: int) -> dict[str, Any]:
         case Group():
             common.update(kind="group", count=item.count, fields=_fields(item.fields))
         case TableValue():
-            entries = {}
-            for entry in item.table.entries:
-                if not entry.reserved:
-                    entries[entry.key] = {
-                        "name": entry.name,
-                        "type": entry.type.name,
-                        "unit": engineering_unit(entry.unit, entry.scale),
-                        "scale": entry.scale,
-                        "enum": _enum(entry.enum),
-                    }
-            common.update(kind="table_value", key=item.key, entries=entries)
+            common.update(kind="table_value", key=item.key, entries=Ref(f"TABLES[{_lua_name(item.table.name)}]"))
         case TableBlock():
-            block = [
-                {
-                    "kind": "scalar",
-                    "name": entry.name,
-                    "type": entry.type.name,
-                    "big": item.endian == ">",
-                    "unit": engineering_unit(entry.unit, entry.scale),
-                    "scale": entry.scale,
-                    "description": entry.description,
-                    "sign_magnitude": entry.sign_magnitude,
-                    "tail": 0,
-                    **_scalar_extras(entry.flags, (), entry.enum),
-                }
-                for entry in item.entries
-            ]
-            common.update(kind="group", count=1, fields=block, single=True)
+            table = Ref(f"TABLES[{_lua_name(item.table.name)}]")
+            common.update(kind="table_block", table=table, keys=[e.key for e in item.entries], big=item.endian == ">")
         case _:
             assert_never(item)
     return common
@@ -223,8 +239,28 @@ def _scalar_extras(flags: FlagsDef | None, bits: tuple[BitField, ...], enum: Enu
     return extras
 
 
-def _enum(enum: EnumDef | None) -> dict[int, str] | None:
-    return None if enum is None else {v.value: v.name.lower() for v in enum.values}
+def _entry(entry: TableEntry) -> dict[str, Any]:
+    return {
+        "name": entry.name,
+        "type": entry.type.name,
+        "unit": engineering_unit(entry.unit, entry.scale),
+        "scale": entry.scale,
+        "description": entry.description,
+        "sign_magnitude": entry.sign_magnitude,
+        **_scalar_extras(entry.flags, (), entry.enum),
+    }
+
+
+def _enum(enum: EnumDef | None) -> Ref | dict[int, str] | None:
+    return None if enum is None else Ref(f"ENUMS[{_lua_name(enum.name)}]")
+
+
+def _enum_values(enum: EnumDef) -> dict[int, str]:
+    return {v.value: v.name.lower() for v in enum.values}
+
+
+def _lua_name(name: str) -> str:
+    return _lua_string(name.encode("utf-8"))
 
 
 def lua(value: object, depth: int) -> str:
@@ -233,6 +269,8 @@ def lua(value: object, depth: int) -> str:
     match value:
         case None:
             return "nil"
+        case Ref():
+            return value.expression
         case bool():
             return "true" if value else "false"
         case int():

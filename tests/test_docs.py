@@ -17,7 +17,8 @@ ROOT = Path(__file__).resolve().parent.parent
 TUTORIAL = ROOT / "docs" / "tutorial.md"
 TINYLAMP = ROOT / "examples" / "tinylamp" / "tinylamp.yaml"
 PRINTED_PORT = "/dev/pts/5"
-SERVERS = ("sim", "monitor")  # run until stopped: their sessions are checked below and in test_readme.py
+# run until stopped: their sessions are checked below, in test_readme.py and test_watch.py (watch, in tmux)
+SERVERS = ("sim", "monitor", "watch")
 
 
 def blocks(page: Path, language: str) -> list[str]:

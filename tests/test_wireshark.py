@@ -5,6 +5,8 @@ exported with `serialspec export --pcap`, every shipped spec's example frames sh
 from __future__ import annotations
 
 import json
+import re
+import shlex
 import shutil
 import subprocess
 import sys
@@ -214,3 +216,29 @@ def test_tshark_flags_a_bad_checksum_and_bytes_outside_frames(tmp_path: Path) ->
         TSHARK, "-X", script, "-r", str(tmp_path / "bad.pcap"), "-T", "fields", "-e", "fashionstar_uart.checksum_ok"
     )
     assert fields.strip() == "0,1"
+
+
+@pytest.mark.skipif(
+    TSHARK is None, reason="tshark is not installed (make generate installs it where it can: root and apt-get)"
+)
+def test_the_readme_wireshark_commands_show_what_the_readme_shows(tmp_path: Path) -> None:
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    section = readme[readme.index("### Captures in Wireshark") :]
+    section = section[: section.index("\n## ")]
+    console = re.findall(r"```console\n(.*?)```", section, flags=re.S)[0].splitlines()
+    script = re.findall(r"```sh\n(.*?)```", section, flags=re.S)[0].splitlines()
+    shown = re.findall(r"```text\n(.*?)```", section, flags=re.S)[0].splitlines()
+    shutil.copytree(ROOT / "specs", tmp_path / "specs")
+    shutil.copytree(ROOT / "examples" / "captures", tmp_path / "examples" / "captures")
+    commands = [line.removeprefix("$ ") for line in console if line.startswith("$ ")] + script
+    out = ""
+    for command in commands:
+        words = shlex.split(command)
+        words = [*SERIALSPEC, *words[1:]] if words[0] == ".venv/bin/serialspec" else words
+        done = subprocess.run(words, cwd=tmp_path, capture_output=True, text=True, timeout=300)
+        assert done.returncode == 0, (command, done.stderr)
+        out = done.stdout
+    assert console[1] == "9 packet(s) written to build/fashionstar_session.pcap"
+    lines = out.splitlines()
+    start = lines.index(shown[0])
+    assert lines[start : start + len(shown)] == shown, out

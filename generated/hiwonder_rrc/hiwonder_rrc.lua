@@ -3231,6 +3231,10 @@ end
 
 local function dissect(tvb, pinfo, tree, direction_code)
   pinfo.cols.protocol = P
+  if DIRECTIONS[direction_code] then -- who sent the bytes: the host (requests) or the devices (responses)
+    pinfo.cols.src = direction_code == 0 and "host" or "device"
+    pinfo.cols.dst = direction_code == 0 and "device" or "host"
+  end
   local data = tvb:raw()
   local names = DIRECTIONS[direction_code] and {DIRECTIONS[direction_code]} or {"request", "response"}
   local pos, info, garbage = 1, {}, nil

@@ -11,6 +11,7 @@ import argparse
 import datetime
 import struct
 import sys
+from pathlib import Path
 from typing import BinaryIO, TextIO
 
 from serialspec.cli import capture
@@ -82,6 +83,7 @@ def _open(path: str) -> TextIO:
 
 def _create(path: str) -> BinaryIO:
     try:
+        Path(path).parent.mkdir(parents=True, exist_ok=True)
         return open(path, "wb")
     except OSError as exc:
         raise SerialspecError(f"cannot write {path}: {exc.strerror}") from None

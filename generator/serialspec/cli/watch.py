@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import argparse
 import collections
+import os
 import signal
 import sys
 import time
@@ -36,6 +37,7 @@ from serialspec.runtime.message import Message
 
 RATE_WINDOW = 5.0  # seconds over which a row's rate is counted
 REFRESH = 0.25  # seconds between redraws
+PIPE_WIDTH = 160  # columns of the table printed where the output is not a terminal
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -161,7 +163,7 @@ class Board:
         table.add_column("device", justify="right")
         table.add_column("command / register")
         table.add_column("dir")
-        table.add_column("last values", ratio=1, overflow="fold")
+        table.add_column("last values", ratio=1, min_width=24, overflow="fold")
         table.add_column("frames", justify="right")
         table.add_column("per s", justify="right")
         table.add_column("errors", justify="right")
@@ -306,7 +308,9 @@ def run(args: argparse.Namespace) -> int:
         else:  # not a terminal (a pipe, a file): the table once, at the end
             while not stopping and (end is None or time.monotonic() < end):
                 listen(source, board)
-        Console(file=sys.stdout, width=console.width).print(board.table(time.monotonic()))
+        # on a terminal its width; elsewhere (a pipe, a file) COLUMNS if set, else a width that keeps rows on one line
+        width = console.width if console.is_terminal or "COLUMNS" in os.environ else PIPE_WIDTH
+        Console(file=sys.stdout, width=width).print(board.table(time.monotonic()))
     finally:
         source.close()
     return 0

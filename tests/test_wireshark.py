@@ -242,3 +242,26 @@ def test_the_readme_wireshark_commands_show_what_the_readme_shows(tmp_path: Path
     lines = out.splitlines()
     start = lines.index(shown[0])
     assert lines[start : start + len(shown)] == shown, out
+
+
+@pytest.mark.skipif(
+    TSHARK is None, reason="tshark is not installed (make generate installs it where it can: root and apt-get)"
+)
+def test_a_frame_cut_between_packets_is_shown_whole_where_it_ends(tmp_path: Path) -> None:
+    assert TSHARK is not None
+    spec = str(ROOT / "specs" / "fashionstar_uart.yaml")
+    run(*SERIALSPEC, "generate", spec, "--target", "wireshark", "--out", str(tmp_path))
+    capture = tmp_path / "cut.capture"
+    capture.write_text(  # a ROTATE in two chunks, a reply between them (the other direction), then a PING
+        "# serialspec capture: fashionstar_uart\n"
+        "2026-11-25T10:00:00.000000+00:00 request 12 4c 08 07 02\n"
+        "2026-11-25T10:00:00.000100+00:00 response 05 1c 0a 03 00 86 03 b7\n"
+        "2026-11-25T10:00:00.000200+00:00 request 84 03 f4 01 00 00 eb 12 4c 01\n"
+        "2026-11-25T10:00:00.000300+00:00 request 01 03 63\n",
+        encoding="utf-8",
+    )
+    run(*SERIALSPEC, "export", str(capture), "--pcap", str(tmp_path / "cut.pcap"))
+    script = f"lua_script:{tmp_path / 'fashionstar_uart' / 'fashionstar_uart.lua'}"
+    fields = ["-e", "fashionstar_uart.command", "-e", "fashionstar_uart.rotate.request.angle"]
+    out = run(TSHARK, "-X", script, "-r", str(tmp_path / "cut.pcap"), "-T", "fields", *fields)
+    assert out.splitlines() == ["\t", "read_angle\t", "rotate\t900", "ping\t"]

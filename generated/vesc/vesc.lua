@@ -1048,7 +1048,7 @@ local f_garbage = new(P .. ".garbage", function()
   return ProtoField.bytes(P .. ".garbage", "Bytes outside any frame", base.SPACE)
 end)
 local f_incomplete = new(P .. ".incomplete", function()
-  return ProtoField.bytes(P .. ".incomplete", "Incomplete frame (continues after this packet)", base.SPACE)
+  return ProtoField.bytes(P .. ".incomplete", "Frame continued in the next packet of this direction", base.SPACE)
 end)
 
 for _, direction in pairs(SPEC.directions) do
@@ -1577,13 +1577,30 @@ local function dissect_frame(direction_name, direction, layout, entry, tvb, data
   end
 end
 
+-- A frame cut between packets (a port gives bytes in chunks) is shown whole in the packet that completes it: the
+-- bytes of the incomplete frame at the end of a packet go before the next packet of the same direction.
+local carried = {} -- packet number -> the bytes of an incomplete frame the packets before it left
+local pending = {} -- direction -> the incomplete frame at the end of the last packet of that direction
+function proto.init()
+  carried, pending = {}, {}
+end
+local MOST_CARRIED = 65536
+
 local function dissect(tvb, pinfo, tree, direction_code)
   pinfo.cols.protocol = P
+  if not pinfo.visited then
+    carried[pinfo.number] = pending[direction_code]
+    pending[direction_code] = nil
+  end
+  local data = tvb:raw()
+  if carried[pinfo.number] then
+    data = carried[pinfo.number] .. data
+    tvb = ByteArray.new(data, true):tvb("Frames completed by this packet")
+  end
   if DIRECTIONS[direction_code] then -- who sent the bytes: the host (requests) or the devices (responses)
     pinfo.cols.src = direction_code == 0 and "host" or "device"
     pinfo.cols.dst = direction_code == 0 and "device" or "host"
   end
-  local data = tvb:raw()
   local names = DIRECTIONS[direction_code] and {DIRECTIONS[direction_code]} or {"request", "response"}
   local pos, info, garbage = 1, {}, nil
   while pos <= #data do
@@ -1611,7 +1628,10 @@ local function dissect(tvb, pinfo, tree, direction_code)
     if not found then
       if incomplete then
         tree:add(f_incomplete, tvb(pos - 1))
-        info[#info + 1] = "incomplete frame"
+        info[#info + 1] = "frame continues"
+        if not pinfo.visited and #data - pos < MOST_CARRIED then
+          pending[direction_code] = data:sub(pos)
+        end
         break
       end
       garbage = garbage or pos

@@ -5,6 +5,7 @@ exported with `serialspec export --pcap`, every shipped spec's example frames sh
 from __future__ import annotations
 
 import json
+import math
 import re
 import shlex
 import shutil
@@ -15,7 +16,10 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from conftest import ALL, ROOT
+from conftest import ALL, ROOT, Generated, examples
+from hypothesis import HealthCheck, Phase, given, settings
+from hypothesis import strategies as st
+from serialspec.cli.decode import describe
 from serialspec.lang.model import (
     Array,
     Bytes,
@@ -29,6 +33,7 @@ from serialspec.lang.model import (
     TableValue,
     Text,
 )
+from strategies import message_fields
 
 pytestmark = pytest.mark.slow
 TSHARK = shutil.which("tshark")
@@ -265,3 +270,55 @@ def test_a_frame_cut_between_packets_is_shown_whole_where_it_ends(tmp_path: Path
     fields = ["-e", "fashionstar_uart.command", "-e", "fashionstar_uart.rotate.request.angle"]
     out = run(TSHARK, "-X", script, "-r", str(tmp_path / "cut.pcap"), "-T", "fields", *fields)
     assert out.splitlines() == ["\t", "read_angle\t", "rotate\t900", "ping\t"]
+
+
+def same(seen: Any, wanted: Any) -> bool:
+    """Equal, floats to the 6 significant digits Wireshark shows of a float32."""
+    if isinstance(wanted, float):
+        return isinstance(seen, int | float) and math.isclose(seen, wanted, rel_tol=5e-6, abs_tol=1e-37)
+    if isinstance(wanted, dict):
+        return isinstance(seen, dict) and seen.keys() == wanted.keys() and all(same(seen[k], wanted[k]) for k in wanted)
+    if isinstance(wanted, list):
+        return isinstance(seen, list) and len(seen) == len(wanted) and all(map(same, seen, wanted))
+    return bool(seen == wanted)
+
+
+@pytest.mark.skipif(
+    TSHARK is None, reason="tshark is not installed (make generate installs it where it can: root and apt-get)"
+)
+@pytest.mark.parametrize("g", ALL, ids=[g.protocol.name for g in ALL])
+def test_tshark_shows_random_messages_of_every_command_as_decode_does(g: Generated, tmp_path: Path) -> None:
+    """Every message of the spec with random valid fields (stuffed bytes, groups, lists, texts, table values), all
+    in one capture: tshark shows what the codec decodes."""
+    assert TSHARK is not None
+    protocol = g.protocol
+    run(*SERIALSPEC, "generate", str(ROOT / protocol.spec_path), "--target", "wireshark", "--out", str(tmp_path))
+    script = f"lua_script:{tmp_path / protocol.name / f'{protocol.name}.lua'}"
+    specs = [m for m in protocol.messages() if not m.unsolicited or m.direction.value == "response"]
+
+    # no shrinking: each example runs tshark (a failure shows its frame and both views)
+    @settings(
+        max_examples=examples(2),
+        deadline=None,
+        suppress_health_check=list(HealthCheck),
+        phases=(Phase.explicit, Phase.reuse, Phase.generate),
+    )
+    @given(st.data())
+    def shown_as_decoded(data: st.DataObject) -> None:
+        lines = [f"# serialspec capture: {protocol.name}"]
+        wanted = []
+        for spec in specs:
+            cls = next(c for c in g.package.MESSAGE_TYPES if c.__name__ == spec.class_name)
+            frame = g.package.encode(cls.from_fields(data.draw(message_fields(protocol, spec), label=spec.key)))
+            message = g.package.decode(frame, spec.direction.value)  # as a frame without its request decodes
+            wanted.append(describe(protocol, message, frame, False, None))
+            lines.append(f"2026-11-25T10:00:00.000000+00:00 {spec.direction.value} {frame.hex(' ')}")
+        (tmp_path / "random.capture").write_text("\n".join(lines) + "\n", encoding="utf-8")
+        run(*SERIALSPEC, "export", str(tmp_path / "random.capture"), "--pcap", str(tmp_path / "random.pcap"))
+        trees = pdml_frames(run(TSHARK, "-X", script, "-r", str(tmp_path / "random.pcap"), "-T", "pdml"))
+        assert len(trees) == len(wanted)
+        for tree, expected in zip(trees, wanted, strict=True):
+            seen = shown(protocol, tree)
+            assert same(seen, {key: expected[key] for key in seen}), (expected["hex"], seen, expected)
+
+    shown_as_decoded()

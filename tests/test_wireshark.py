@@ -4,6 +4,9 @@ exported with `serialspec export --pcap`, every shipped spec's example frames sh
 
 from __future__ import annotations
 
+import contextlib
+import datetime
+import io
 import json
 import math
 import re
@@ -19,6 +22,7 @@ import pytest
 from conftest import ALL, ROOT, Generated, examples
 from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
+from serialspec import cli
 from serialspec.cli.decode import describe
 from serialspec.lang.model import (
     Array,
@@ -47,9 +51,12 @@ def run(*args: str) -> str:
 
 
 def decoded(protocol: Protocol, direction: str, frames: list[bytes]) -> list[dict[str, Any]]:
+    """`serialspec decode SPEC --json --direction D HEX...`, run in this process (the CLI's own code)."""
     spec = str(ROOT / protocol.spec_path)
-    out = run(*SERIALSPEC, "decode", spec, "--json", "--direction", direction, *(f.hex(" ") for f in frames))
-    return [json.loads(line) for line in out.splitlines()]
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        assert cli.main(["decode", spec, "--json", "--direction", direction, *(f.hex(" ") for f in frames)]) == 0
+    return [json.loads(line) for line in out.getvalue().splitlines()]
 
 
 def example_frames(protocol: Protocol) -> dict[str, list[bytes]]:
@@ -163,9 +170,9 @@ def test_tshark_shows_every_example_frame_as_decode_json_does(tmp_path: Path) ->
     assert TSHARK is not None
     specs = [str(ROOT / g.protocol.spec_path) for g in ALL]
     run(*SERIALSPEC, "generate", *specs, "--target", "wireshark", "--out", str(tmp_path / "out"))
-    lines = []
+    captures = []
     wanted: list[dict[str, Any]] = []
-    second = 0
+    moment = datetime.datetime(2026, 11, 25, 10, tzinfo=datetime.UTC)
     for g in ALL:
         protocol = g.protocol
         capture = [f"# serialspec capture: {protocol.name}"]
@@ -174,22 +181,19 @@ def test_tshark_shows_every_example_frame_as_decode_json_does(tmp_path: Path) ->
                 continue
             results = decoded(protocol, direction, frames)
             assert len(results) == len(frames)
-            for frame in frames:  # one frame a packet
-                second += 1
-                capture.append(f"2026-11-25T10:00:{second % 60:02d}.{second:06d}+00:00 {direction} {frame.hex(' ')}")
-            # then all of them in one packet
-            capture.append(f"2026-11-25T10:01:00.000000+00:00 {direction} {b''.join(frames).hex(' ')}")
+            # one frame a packet, then all of them in one packet
+            for data in [*frames, b"".join(frames)]:
+                moment += datetime.timedelta(milliseconds=1)
+                capture.append(f"{moment.isoformat(timespec='microseconds')} {direction} {data.hex(' ')}")
             wanted += [{"protocol": protocol.name, **r} for r in results] * 2
         path = tmp_path / f"{protocol.name}.capture"
         path.write_text("\n".join(capture) + "\n", encoding="utf-8")
-        run(*SERIALSPEC, "export", str(path), "--pcap", str(tmp_path / f"{protocol.name}.pcap"))
-        lines.append(protocol.name)
-    # one tshark, every dissector loaded at once (they share the capture's link type)
-    scripts = [f"lua_script:{tmp_path / 'out' / name / f'{name}.lua'}" for name in lines]
+        captures.append(str(path))
+    # every spec's capture in one pcap, read by one tshark with every dissector loaded (they share the link type)
+    run(*SERIALSPEC, "export", *captures, "--pcap", str(tmp_path / "examples.pcap"))
+    scripts = [f"lua_script:{tmp_path / 'out' / g.protocol.name / f'{g.protocol.name}.lua'}" for g in ALL]
     options = [word for script in scripts for word in ("-X", script)]
-    trees = []
-    for name in lines:
-        trees += pdml_frames(run(TSHARK, *options, "-r", str(tmp_path / f"{name}.pcap"), "-T", "pdml"))
+    trees = pdml_frames(run(TSHARK, *options, "-r", str(tmp_path / "examples.pcap"), "-T", "pdml"))
     assert len(trees) == len(wanted)
     protocols = {g.protocol.name: g.protocol for g in ALL}
     for tree, expected in zip(trees, wanted, strict=True):

@@ -7,7 +7,6 @@ import shutil
 import subprocess
 import sys
 import time
-import tty
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -15,6 +14,7 @@ from pathlib import Path
 import pytest
 from conftest import ROOT
 from sim_process import serve
+from test_captures import pty_pair
 
 pytestmark = [
     pytest.mark.slow,
@@ -23,7 +23,7 @@ pytestmark = [
     ),
 ]
 SMS = str(ROOT / "specs" / "feetech_sms.yaml")
-WAIT = 30.0  # seconds a screen may take to show what is expected before the test gives up (no timing is tested)
+WAIT = 120.0  # seconds a screen may take to show what is expected before the test gives up (no timing is tested)
 
 
 class Pane:
@@ -106,18 +106,6 @@ def test_watch_follows_a_running_sim_and_shows_each_command_and_register_in_unit
         assert row(final, " 2 ", "torque_limit", "100.0 %"), final  # the last table stays on the terminal
 
 
-@contextmanager
-def pty_pair() -> Iterator[tuple[int, str]]:
-    controller, device = os.openpty()
-    tty.setraw(device)
-    tty.setraw(controller)
-    try:
-        yield controller, os.ttyname(device)
-    finally:
-        os.close(controller)
-        os.close(device)
-
-
 def test_watch_listens_on_a_port_counting_rates_errors_and_bad_frames() -> None:
     # An SMS session as a sniffer hears it: PING 1 and its reply, READ 1 two bytes from 56 and its reply, a reply
     # with the overload error bit, and a frame with a bad checksum.
@@ -127,7 +115,8 @@ def test_watch_listens_on_a_port_counting_rates_errors_and_bad_frames() -> None:
     )
     with pty_pair() as (controller, path), pane("port") as screen:
         screen.start([sys.executable, "-m", "serialspec", "watch", SMS, "--port", path])
-        screen.wait_for(lambda s: "0 frames" in s)
+        # the view is drawn once the port is open: bytes written before would be flushed by the open
+        assert "0 frames" in screen.wait_for(lambda s: "0 frames" in s)
         os.write(controller, session)
         text = screen.wait_for(lambda s: "1 bad" in s)
         assert "5 frames, 1 bad" in text, text

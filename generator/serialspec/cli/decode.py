@@ -6,7 +6,7 @@ import argparse
 import json
 import sys
 from types import ModuleType
-from typing import Any, TextIO
+from typing import Any
 
 from serialspec.cli import capture
 from serialspec.cli.frames import Frames
@@ -69,7 +69,7 @@ def replay(args: argparse.Namespace, protocol: Protocol, package: ModuleType) ->
     address = protocol.device.address if protocol.device else None
     streams: dict[str | None, Frames] = {}
     failed = 0
-    stream = sys.stdin if args.file == "-" else _open(args.file)
+    stream = sys.stdin if args.file == "-" else capture.open_text(args.file)
     with stream:
         try:
             for number, chunk in capture.read(stream):
@@ -92,13 +92,6 @@ def replay(args: argparse.Namespace, protocol: Protocol, package: ModuleType) ->
             failed += 1
             print(f"serialspec decode: {args.file} ends inside a frame: [{frames.pending().hex(' ')}]", file=sys.stderr)
     return 1 if failed else 0
-
-
-def _open(path: str) -> TextIO:
-    try:
-        return open(path, encoding="utf-8")
-    except OSError as exc:
-        raise SerialspecError(f"cannot read {path}: {exc.strerror}") from None
 
 
 def _hex(text: str) -> bytes:

@@ -13,7 +13,7 @@ import datetime
 import struct
 import sys
 from pathlib import Path
-from typing import BinaryIO, TextIO
+from typing import BinaryIO
 
 from serialspec.cli import capture
 from serialspec.runtime.errors import SerialspecError
@@ -56,7 +56,7 @@ def run(args: argparse.Namespace) -> int:
 
 def _read(path: str, protocol: str | None) -> tuple[bytes, list[capture.Chunk]]:
     """A capture's protocol name (from its first line, else `protocol`) and chunks."""
-    stream = sys.stdin if path == "-" else _open(path)
+    stream = sys.stdin if path == "-" else capture.open_text(path)
     with stream:
         lines = stream.readlines()
     name = next((line[len(HEADER) :].strip() for line in lines if line.startswith(HEADER)), None) or protocol
@@ -91,13 +91,6 @@ def _timestamp(when: str) -> tuple[int, int]:
         moment = moment.replace(tzinfo=datetime.UTC)
     micros = (moment - EPOCH) // datetime.timedelta(microseconds=1)
     return micros // 1_000_000, micros % 1_000_000
-
-
-def _open(path: str) -> TextIO:
-    try:
-        return open(path, encoding="utf-8")
-    except OSError as exc:
-        raise SerialspecError(f"cannot read {path}: {exc.strerror}") from None
 
 
 def _create(path: str) -> BinaryIO:

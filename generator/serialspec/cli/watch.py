@@ -12,15 +12,15 @@ from __future__ import annotations
 import argparse
 import collections
 import os
-import signal
 import sys
 import time
 from dataclasses import dataclass, field
-from types import FrameType, ModuleType
+from types import ModuleType
 from typing import Any, TextIO
 
 from serialspec.cli import capture
 from serialspec.cli.frames import Frames, Seen
+from serialspec.cli.listening import Stopping, open_port
 from serialspec.cli.protocols import SPEC_HELP, open_spec
 from serialspec.cli.views import (
     FlagNames,
@@ -210,20 +210,9 @@ class PortSource:
     def __init__(self, args: argparse.Namespace, package: ModuleType, address: str | None) -> None:
         import serial
 
-        settings = package.SERIAL
         self.name = args.port
         self.frames = Frames(package, None, address)
-        try:
-            self.port = serial.serial_for_url(
-                args.port,
-                baudrate=args.baudrate or settings.baudrate,
-                bytesize=settings.bytesize,
-                parity={"none": "N", "even": "E", "odd": "O"}.get(settings.parity, "N"),
-                stopbits=settings.stopbits,
-                timeout=REFRESH,
-            )
-        except (serial.SerialException, OSError, ValueError) as exc:
-            raise PortError(f"cannot open {args.port}: {exc}") from None
+        self.port = open_port(args.port, args.baudrate, package.SERIAL, REFRESH)
         self.errors: tuple[type[BaseException], ...] = (serial.SerialException, OSError)
 
     def read(self) -> list[Seen]:
@@ -245,10 +234,7 @@ class TapSource:
     def __init__(self, path: str, package: ModuleType, address: str | None) -> None:
         self.name = path
         self.package, self.address = package, address
-        try:
-            self.stream: TextIO = open(path, encoding="utf-8")  # noqa: SIM115 (closed by close())
-        except OSError as exc:
-            raise SerialspecError(f"cannot read {path}: {exc.strerror}") from None
+        self.stream: TextIO = capture.open_text(path)
         self.partial = ""
         self.streams: dict[str | None, Frames] = {}
 
@@ -285,14 +271,7 @@ def run(args: argparse.Namespace) -> int:
         PortSource(args, package, address) if args.port else TapSource(args.tap, package, address)
     )
     board = Board(protocol, source.name, args.raw)
-    stopping = False
-
-    def stop(signum: int, frame: FrameType | None) -> None:
-        nonlocal stopping
-        stopping = True
-
-    signal.signal(signal.SIGINT, stop)
-    signal.signal(signal.SIGTERM, stop)
+    stopping = Stopping()
     console = Console()
     end = time.monotonic() + args.duration if args.duration else None
     try:

@@ -1030,7 +1030,7 @@ declare = function(fields, prefix)
   end
 end
 
-local function declare_message(message, layouts)
+local function declare_message(message)
   declare(message.fields, message.prefix)
   if message.refused then
     local abbr = message.prefix .. "." .. message.refused

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import argparse
 import collections
-import os
 import sys
 import time
 from dataclasses import dataclass, field
@@ -287,8 +286,8 @@ def run(args: argparse.Namespace) -> int:
         else:  # not a terminal (a pipe, a file): the table once, at the end
             while not stopping and (end is None or time.monotonic() < end):
                 listen(source, board)
-        # on a terminal its width; elsewhere (a pipe, a file) COLUMNS if set, else a width that keeps rows on one line
-        width = console.width if console.is_terminal or "COLUMNS" in os.environ else PIPE_WIDTH
+        # on a terminal its width; elsewhere (a pipe, a file) a width that keeps rows on one line
+        width = console.width if console.is_terminal else PIPE_WIDTH
         Console(file=sys.stdout, width=width).print(board.table(time.monotonic()))
     finally:
         source.close()

@@ -192,6 +192,9 @@ def _text(value: Any) -> str:
         return str(value)
     if isinstance(value, dict):
         return "{" + ", ".join(f"{k}={_text(v)}" for k, v in value.items()) + "}"
+    if isinstance(value, list) and value and all(isinstance(v, bool) for v in value):  # bits: 8 to a group
+        bits = "".join("1" if v else "0" for v in value)
+        return " ".join(bits[i : i + 8] for i in range(0, len(bits), 8))
     if isinstance(value, list):
         return "[" + ", ".join(_text(v) for v in value) + "]"
     return str(value)

@@ -205,14 +205,15 @@ def test_tshark_shows_every_example_frame_as_decode_json_does(tmp_path: Path) ->
 @pytest.mark.skipif(
     TSHARK is None, reason="tshark is not installed (make generate installs it where it can: root and apt-get)"
 )
-def test_tshark_flags_a_bad_checksum_and_bytes_outside_frames(tmp_path: Path) -> None:
+def test_tshark_flags_a_bad_checksum_bytes_outside_frames_and_a_short_content(tmp_path: Path) -> None:
     assert TSHARK is not None
     spec = str(ROOT / "specs" / "fashionstar_uart.yaml")
     run(*SERIALSPEC, "generate", spec, "--target", "wireshark", "--out", str(tmp_path))
     capture = tmp_path / "bad.capture"
     capture.write_text(
         "# serialspec capture: fashionstar_uart\n"
-        "2026-11-25T10:00:00.000000+00:00 request 12 4c 01 01 03 64 99 12 4c 01 01 03 63\n",
+        "2026-11-25T10:00:00.000000+00:00 request 12 4c 01 01 03 64 99 12 4c 01 01 03 63\n"
+        "2026-11-25T10:00:01.000000+00:00 request 12 4c 08 01 02 69\n",  # a ROTATE of one byte: its sum is right
         encoding="utf-8",
     )
     run(*SERIALSPEC, "export", str(capture), "--pcap", str(tmp_path / "bad.pcap"))
@@ -221,10 +222,11 @@ def test_tshark_flags_a_bad_checksum_and_bytes_outside_frames(tmp_path: Path) ->
     assert "checksum: 0x64 [incorrect, should be 0x63]" in out
     assert "Bytes outside any frame: 99" in out
     assert out.count("request ping") == 2
+    assert "[angle: 2 byte(s) needed at offset 1, the content has 1]" in out
     fields = run(
         TSHARK, "-X", script, "-r", str(tmp_path / "bad.pcap"), "-T", "fields", "-e", "fashionstar_uart.checksum_ok"
     )
-    assert fields.strip() == "0,1"
+    assert fields.split() == ["0,1", "1"]
 
 
 @pytest.mark.skipif(

@@ -1301,6 +1301,18 @@ local function wire_of(layout, plain, stuffed, first, last)
   return table.concat(plain, "", first, t.first - 1) .. stuffed .. table.concat(plain, "", t.last + 1, last)
 end
 
+local function decode_content(message, range, length, tree)
+  local content = length > 0 and range:tvb() or nil
+  if content == nil and #message.fields > 0 then
+    -- an empty content: the fields (all of size 0 if the frame is right) read from an empty buffer
+    content = ByteArray.new("00"):tvb("Empty content")
+  end
+  local stop = decode_fields(message.fields, content, 0, length, tree, {})
+  if stop ~= length then
+    error(string.format("%d byte(s) of content left over", length - stop), 0)
+  end
+end
+
 local function dissect_frame(direction_name, direction, layout, entry, tvb, data, pos, size, tree, info)
   local frame = data:sub(pos, pos + size - 1)
   local elements = layout.elements
@@ -1347,8 +1359,31 @@ local function dissect_frame(direction_name, direction, layout, entry, tvb, data
     ranges[index] = inner(inner_start + offset, length)
     offset = offset + length
   end
-  -- constants, values, lengths and checksums
-  local code, ok, content_index = nil, true, nil
+  -- the command and the message (the command may lie in the stuffed part: read here, after unstuffing)
+  local code, content_index = nil, nil
+  for index, element in ipairs(elements) do
+    if element.role == "command" then code = unsigned(plain[index], element.big) end
+    if element.role == "content" then content_index = index end
+  end
+  entry = entry or entry_of(direction, code)
+  if entry == nil then error(string.format("no command %s in this direction", tostring(code)), 0) end
+  local message = entry.message
+  if entry.subs then
+    local at = entry.selector.offset
+    local selector = unsigned(plain[content_index]:sub(at + 1, at + entry.selector.size), SPEC.big)
+    message = entry.subs[selector]
+    if message == nil then error(string.format("no sub-command %d of this command", selector), 0) end
+  end
+  local title = message.command .. (message.subcommand and "." .. message.subcommand or "")
+  root:set_text(string.format("%s %s %s", SPEC.title, direction_name, title))
+  root:add(f_command, tvb(pos - 1, size), message.command)
+  if message.subcommand then root:add(f_subcommand, tvb(pos - 1, size), message.subcommand) end
+  if message.refused and code then
+    root:add(message.refused_pf, tvb(pos - 1, size), band(code, 0xFFFFFFFF - direction.error_flag))
+  end
+  -- the frame's elements in wire order, the message's fields where the content lies; constants, lengths and
+  -- checksums checked
+  local ok, malformed = true, false
   for index, element in ipairs(elements) do
     local role = element.role
     if element.constant then
@@ -1358,15 +1393,17 @@ local function dissect_frame(direction_name, direction, layout, entry, tvb, data
         ok = false
       end
     elseif role == "content" then
-      content_index = index
+      local done, problem = pcall(decode_content, message, ranges[index], #plain[index], root)
+      if not done then
+        root:add_proto_expert_info(e_malformed, tostring(problem))
+        malformed = true
+      end
     else
       local value = unsigned(plain[index], element.big)
       local item = add(root, element.pf, ranges[index], element.big)
       for _, b in ipairs(element.bits or {}) do add(item, b.pf, ranges[index], element.big) end
       for _, flag in ipairs(element.flags or {}) do add(item, flag.pf, ranges[index], element.big) end
-      if role == "command" then
-        code = value
-      elseif role == "length" then
+      if role == "length" then
         local counted = #wire_of(layout, plain, stuffed, element.span[1], element.span[2]) + element.adds
         if counted ~= value then
           item:add_proto_expert_info(e_malformed, string.format("%s says %d but the frame holds %d",
@@ -1386,42 +1423,7 @@ local function dissect_frame(direction_name, direction, layout, entry, tvb, data
     end
   end
   root:add(f_checksum_ok, tvb(pos - 1, size), ok)
-  -- the message (its command read here where the command lies in the stuffed part)
-  entry = entry or entry_of(direction, code)
-  if entry == nil then error(string.format("no command %s in this direction", tostring(code)), 0) end
-  local message = entry.message
-  local title
-  if entry.subs then
-    local content = plain[content_index]
-    local at = entry.selector.offset
-    local selector = unsigned(content:sub(at + 1, at + entry.selector.size), SPEC.big)
-    message = entry.subs[selector]
-    if message == nil then
-      error(string.format("no sub-command %d of this command", selector), 0)
-    end
-  end
-  title = message.command .. (message.subcommand and "." .. message.subcommand or "")
-  root:add(f_command, tvb(pos - 1, size), message.command)
-  if message.subcommand then root:add(f_subcommand, tvb(pos - 1, size), message.subcommand) end
-  root:set_text(string.format("%s %s %s", SPEC.title, direction_name, title))
-  info[#info + 1] = title .. (ok and "" or " [bad checksum]")
-  if message.refused and code then
-    root:add(message.refused_pf, tvb(pos - 1, size), band(code, 0xFFFFFFFF - direction.error_flag))
-  end
-  if content_index then
-    local range = ranges[content_index]
-    local length = #plain[content_index]
-    local content = length > 0 and range:tvb() or nil
-    if content == nil and #message.fields > 0 then
-      -- an empty content: the fields (all of size 0 if the frame is right) read from an empty buffer
-      content = ByteArray.new("00"):tvb("Empty content")
-    end
-    local scope = {}
-    local stop = decode_fields(message.fields, content, 0, length, root, scope)
-    if stop ~= length then
-      root:add_proto_expert_info(e_malformed, string.format("%d byte(s) of content left over", length - stop))
-    end
-  end
+  info[#info + 1] = title .. (ok and "" or " [bad checksum]") .. (malformed and " [malformed]" or "")
 end
 
 -- A frame cut between packets (a port gives bytes in chunks) is shown whole in the packet that completes it: the

@@ -234,7 +234,7 @@ def test_tshark_flags_a_bad_checksum_bytes_outside_frames_and_a_short_content(tm
 )
 def test_the_readme_wireshark_commands_show_what_the_readme_shows(tmp_path: Path) -> None:
     readme = (ROOT / "README.md").read_text(encoding="utf-8")
-    section = readme[readme.index("### Captures in Wireshark") :]
+    section = readme[readme.index("**Captures in Wireshark.**") :]
     section = section[: section.index("\n## ")]
     console = re.findall(r"```console\n(.*?)```", section, flags=re.S)[0].splitlines()
     script = re.findall(r"```sh\n(.*?)```", section, flags=re.S)[0].splitlines()

@@ -328,3 +328,62 @@ def test_tshark_shows_random_messages_of_every_command_as_decode_does(g: Generat
             assert same(seen, {key: expected[key] for key in seen}), (expected["hex"], seen, expected)
 
     shown_as_decoded()
+
+
+@pytest.mark.skipif(
+    TSHARK is None, reason="tshark is not installed (make generate installs it where it can: root and apt-get)"
+)
+def test_tshark_shows_every_language_matrix_case_as_decode_does(tmp_path: Path) -> None:
+    """Every alternative the language documents (tests/test_language_matrix.py's cases, each its own protocol and
+    dissector, all loaded in one tshark): a random message of every command and direction, shown as decoded."""
+    assert TSHARK is not None
+    from serialspec.backends.python import files as python_files
+    from serialspec.backends.python.memory import imported
+    from serialspec.backends.wireshark.dissector import emit_dissector
+    from serialspec.lang.loader import load_text
+    from serialspec.lang.resolve import resolve
+    from test_language_matrix import CASES, KNOWN, spec_text
+
+    names = [name for name in sorted(CASES) if name not in KNOWN]
+    with contextlib.ExitStack() as stack:
+        built: list[tuple[Protocol, Any]] = []
+        for number, name in enumerate(names):
+            text = spec_text(name, CASES[name]).replace("protocol: matrix_case", f"protocol: matrix_{number}")
+            protocol = resolve(load_text(text, f"matrix_{number}.yaml"))
+            modules = {path.split("/", 1)[1]: code for path, code in python_files(protocol).items()}
+            built.append((protocol, stack.enter_context(imported(protocol.name, modules, "the language matrix"))))
+            (tmp_path / f"{protocol.name}.lua").write_text(emit_dissector(protocol), encoding="utf-8")
+        options = [word for protocol, _ in built for word in ("-X", f"lua_script:{tmp_path / protocol.name}.lua")]
+
+        @settings(
+            max_examples=examples(1),
+            deadline=None,
+            suppress_health_check=list(HealthCheck),
+            phases=(Phase.explicit, Phase.reuse, Phase.generate),
+        )
+        @given(st.data())
+        def shown_as_decoded(data: st.DataObject) -> None:
+            captures, wanted = [], []
+            for protocol, package in built:
+                lines = [f"# serialspec capture: {protocol.name}"]
+                for spec in protocol.messages():
+                    cls = next(c for c in package.MESSAGE_TYPES if c.__name__ == spec.class_name)
+                    fields = data.draw(message_fields(protocol, spec), label=f"{protocol.title} {spec.key}")
+                    frame = package.encode(cls.from_fields(fields))
+                    message = package.decode(frame, spec.direction.value)
+                    wanted.append((protocol, describe(protocol, message, frame, False, None)))
+                    lines.append(f"2026-11-25T10:00:00.000000+00:00 {spec.direction.value} {frame.hex(' ')}")
+                (tmp_path / f"{protocol.name}.capture").write_text("\n".join(lines) + "\n", encoding="utf-8")
+                captures.append(str(tmp_path / f"{protocol.name}.capture"))
+            run(*SERIALSPEC, "export", *captures, "--pcap", str(tmp_path / "matrix.pcap"))
+            xml = run(TSHARK, *options, "-r", str(tmp_path / "matrix.pcap"), "-T", "pdml")
+            names = {protocol.name for protocol, _ in built}
+            trees = [
+                proto for packet in ET.fromstring(xml).iter("packet") for proto in packet if proto.get("name") in names
+            ]
+            assert [t.get("name") for t in trees] == [protocol.name for protocol, _ in wanted]
+            for tree, (protocol, expected) in zip(trees, wanted, strict=True):
+                seen = shown(protocol, tree)
+                assert same(seen, {key: expected[key] for key in seen}), (protocol.title, expected["hex"], seen)
+
+        shown_as_decoded()

@@ -712,42 +712,6 @@ local SPEC = {
         },
       },
       codes = {
-        [1] = {
-          message = {
-            command = "ping",
-            title = "",
-            prefix = "dynamixel_p2.ping.response",
-            fields = {
-              {
-                name = "model_number",
-                description = "The servo's model number (XM430-W350: 1020, XL430-W250: 1060, XL330-M288: 1200).",
-                tail = 1,
-                kind = "scalar",
-                type = "u16",
-                big = false,
-                unit = "",
-                hidden = false,
-                sign_magnitude = false,
-              },
-              {
-                name = "firmware_version",
-                description = "The firmware version.",
-                tail = 0,
-                kind = "scalar",
-                type = "u8",
-                big = false,
-                unit = "",
-                hidden = false,
-                sign_magnitude = false,
-              },
-            },
-            min = 3,
-            max = 3,
-            size = {fixed = 3, terms = {}},
-          },
-          min = 3,
-          max = 3,
-        },
         none = {
           message = {
             command = "status",

@@ -89,6 +89,7 @@ class Ref:
 
 def _direction(protocol: Protocol, direction: Direction) -> dict[str, Any]:
     layouts = protocol.framing.alternatives[direction]
+    coded = any(layout.has_command for layout in layouts)  # else every message of this direction is codeless
     codes: dict[int | str, Any] = {}
     for command in protocol.commands:
         selector = command.selector
@@ -106,12 +107,12 @@ def _direction(protocol: Protocol, direction: Direction) -> dict[str, Any]:
                 sizes = {(m["min"], m["max"]) for m in subs.values()}
                 entry["min"] = min(low for low, _ in sizes)
                 entry["max"] = None if any(high is None for _, high in sizes) else max(h for _, h in sizes if h)
-                codes.setdefault(_code(command.code), entry)
+                codes.setdefault(_code(command.code if coded else None), entry)
                 continue
         message = command.request if direction == Direction.REQUEST else command.response
         if message is None:
             continue
-        key = _code(command.code)
+        key = _code(command.code if coded else None)
         if protocol.error_reply is not None and command.name == protocol.error_reply.command:
             key = "error"
         if key in codes and not message.default_reply:

@@ -330,28 +330,22 @@ def test_tshark_shows_random_messages_of_every_command_as_decode_does(g: Generat
     shown_as_decoded()
 
 
-@pytest.mark.skipif(
-    TSHARK is None, reason="tshark is not installed (make generate installs it where it can: root and apt-get)"
-)
-def test_tshark_shows_every_language_matrix_case_as_decode_does(tmp_path: Path) -> None:
-    """Every alternative the language documents (tests/test_language_matrix.py's cases, each its own protocol and
-    dissector, all loaded in one tshark): a random message of every command and direction, shown as decoded."""
+def through_tshark(tmp_path: Path, specs: list[str], corrupt: bool = False) -> None:
+    """Specs (YAML texts, each its own protocol and dissector, all loaded in one tshark): a random message of every
+    command and direction, shown as decoded; with `corrupt`, each also with its last byte changed, flagged bad."""
     assert TSHARK is not None
     from serialspec.backends.python import files as python_files
     from serialspec.backends.python.memory import imported
     from serialspec.backends.wireshark.dissector import emit_dissector
     from serialspec.lang.loader import load_text
     from serialspec.lang.resolve import resolve
-    from test_language_matrix import CASES, KNOWN, spec_text
 
-    names = [name for name in sorted(CASES) if name not in KNOWN]
     with contextlib.ExitStack() as stack:
         built: list[tuple[Protocol, Any]] = []
-        for number, name in enumerate(names):
-            text = spec_text(name, CASES[name]).replace("protocol: matrix_case", f"protocol: matrix_{number}")
-            protocol = resolve(load_text(text, f"matrix_{number}.yaml"))
+        for text in specs:
+            protocol = resolve(load_text(text, "case.yaml"))
             modules = {path.split("/", 1)[1]: code for path, code in python_files(protocol).items()}
-            built.append((protocol, stack.enter_context(imported(protocol.name, modules, "the language matrix"))))
+            built.append((protocol, stack.enter_context(imported(protocol.name, modules, "a tshark case"))))
             (tmp_path / f"{protocol.name}.lua").write_text(emit_dissector(protocol), encoding="utf-8")
         options = [word for protocol, _ in built for word in ("-X", f"lua_script:{tmp_path / protocol.name}.lua")]
 
@@ -373,10 +367,14 @@ def test_tshark_shows_every_language_matrix_case_as_decode_does(tmp_path: Path) 
                     message = package.decode(frame, spec.direction.value)
                     wanted.append((protocol, describe(protocol, message, frame, False, None)))
                     lines.append(f"2026-11-25T10:00:00.000000+00:00 {spec.direction.value} {frame.hex(' ')}")
+                    if corrupt:
+                        bad = frame[:-1] + bytes([frame[-1] ^ 0x5A])
+                        wanted.append((protocol, {**wanted[-1][1], "checksum_ok": False, "hex": bad.hex(" ")}))
+                        lines.append(f"2026-11-25T10:00:00.000000+00:00 {spec.direction.value} {bad.hex(' ')}")
                 (tmp_path / f"{protocol.name}.capture").write_text("\n".join(lines) + "\n", encoding="utf-8")
                 captures.append(str(tmp_path / f"{protocol.name}.capture"))
-            run(*SERIALSPEC, "export", *captures, "--pcap", str(tmp_path / "matrix.pcap"))
-            xml = run(TSHARK, *options, "-r", str(tmp_path / "matrix.pcap"), "-T", "pdml")
+            run(*SERIALSPEC, "export", *captures, "--pcap", str(tmp_path / "cases.pcap"))
+            xml = run(TSHARK, *options, "-r", str(tmp_path / "cases.pcap"), "-T", "pdml")
             names = {protocol.name for protocol, _ in built}
             trees = [
                 proto for packet in ET.fromstring(xml).iter("packet") for proto in packet if proto.get("name") in names
@@ -387,3 +385,36 @@ def test_tshark_shows_every_language_matrix_case_as_decode_does(tmp_path: Path) 
                 assert same(seen, {key: expected[key] for key in seen}), (protocol.title, expected["hex"], seen)
 
         shown_as_decoded()
+
+
+@pytest.mark.skipif(
+    TSHARK is None, reason="tshark is not installed (make generate installs it where it can: root and apt-get)"
+)
+def test_tshark_shows_every_language_matrix_case_as_decode_does(tmp_path: Path) -> None:
+    """Every alternative the language documents (tests/test_language_matrix.py's cases)."""
+    from test_language_matrix import CASES, KNOWN, spec_text
+
+    names = [name for name in sorted(CASES) if name not in KNOWN]
+    specs = [
+        spec_text(name, CASES[name]).replace("protocol: matrix_case", f"protocol: matrix_{number}")
+        for number, name in enumerate(names)
+    ]
+    through_tshark(tmp_path, specs)
+
+
+@pytest.mark.skipif(
+    TSHARK is None, reason="tshark is not installed (make generate installs it where it can: root and apt-get)"
+)
+def test_tshark_verifies_every_checksum_algorithm(tmp_path: Path) -> None:
+    """Every registered checksum algorithm with each documented option (tests/test_matrix.py's cases): right frames
+    pass, a frame with its last byte changed is flagged."""
+    from serialspec.checksums import algorithms
+    from test_matrix import SHAPES, spec_text
+
+    specs = [
+        spec_text(f"checksum_{name}_{index}_{shape}", name, sample, shape)
+        for name, algorithm in algorithms().items()
+        for index, sample in enumerate(algorithm.samples)
+        for shape in SHAPES
+    ]
+    through_tshark(tmp_path, specs, corrupt=True)

@@ -69,7 +69,6 @@ local LAYOUTS = {
         span = {2, 4},
         checksum = {
           algorithm = "crc",
-          invert = false,
           name = "CRC-8/MAXIM",
           width = 8,
           poly = 49,
@@ -2782,6 +2781,13 @@ local function checksum(spec, size, data)
       total = (total + data:byte(i)) % (mask + 1)
     end
     return spec.invert and mask - total or total
+  elseif spec.algorithm == "fletcher" then -- CK_B << 8 | CK_A
+    local a, b = 0, 0
+    for i = 1, #data do
+      a = (a + data:byte(i)) % spec.modulus
+      b = (b + a) % spec.modulus
+    end
+    return b * 256 + a
   elseif spec.algorithm == "xor" then
     local total = 0
     for i = 1, #data, size do
@@ -3215,9 +3221,12 @@ local function dissect_frame(direction_name, direction, layout, entry, tvb, data
             element.name, value, counted))
         end
       elseif role == "checksum" then
-        local expected = checksum(element.checksum, element.size,
+        local expected = not element.checksum.unverified and checksum(element.checksum, element.size,
           wire_of(layout, plain, stuffed, element.span[1], element.span[2]))
-        if expected == value then
+        if not expected then
+          item:append_text(" [not verified: this dissector has no code for algorithm " .. element.checksum.algorithm
+            .. "]")
+        elseif expected == value then
           item:append_text(" [correct]")
         else
           ok = false

@@ -13,6 +13,10 @@ from typing import Any, assert_never
 
 from serialspec.backends.common.frames import runtime_layout
 from serialspec.backends.common.render import render
+from serialspec.checksums.crc import Crc
+from serialspec.checksums.fletcher import Fletcher
+from serialspec.checksums.sum import Sum
+from serialspec.checksums.xor import Xor
 from serialspec.cli.views import engineering_unit
 from serialspec.lang.frozen import frozen
 from serialspec.lang.model import (
@@ -163,12 +167,20 @@ def _layout(layout: FrameLayout) -> dict[str, Any]:
 
 
 def _checksum(checksum: Checksum) -> dict[str, Any]:
-    result: dict[str, Any] = {"algorithm": checksum.algorithm, "invert": checksum.invert}
-    if checksum.crc is not None:
-        crc = checksum.crc
-        result.update(name=crc.name, width=crc.width, poly=crc.poly, init=crc.init, refin=crc.refin, refout=crc.refout)
-        result["xorout"] = crc.xorout
-    return result
+    """The algorithm and its parameters, for the engine's own Lua code of each (checksum() in the template)."""
+    algorithm = checksum.algorithm
+    match algorithm:
+        case Sum():
+            return {"algorithm": "sum", "invert": algorithm.invert}
+        case Xor():
+            return {"algorithm": "xor"}
+        case Fletcher():
+            return {"algorithm": "fletcher", "modulus": algorithm.modulus}
+        case Crc():
+            parameters = ("width", "poly", "init", "refin", "refout", "xorout")
+            return {"algorithm": "crc", "name": algorithm.catalogue} | {p: getattr(algorithm, p) for p in parameters}
+    # an algorithm this backend has no Lua for yet: the dissector shows the value, unverified, and says why
+    return {"algorithm": algorithm.name, "unverified": True}
 
 
 def _message(protocol: Protocol, message: Message) -> dict[str, Any]:

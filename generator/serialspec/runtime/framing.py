@@ -512,7 +512,10 @@ class FrameStreamParser(StreamParser):
     Every header occurrence (every byte, for frames without a header) is a candidate frame start. A candidate must
     be plausible (constants, values in range, a known command, a length its command allows) before its size is
     trusted, and must decode (stuffing, checksums, content) before it is accepted; a candidate that fails costs one
-    byte. A candidate still waiting for bytes never hides a complete valid frame that starts inside it.
+    byte. The rule of runtime/stream.py decides between overlapping candidates, whatever the reads: the frame that
+    completes first wins (of two ending on the same byte, the first), so a candidate, complete or still waiting for
+    bytes, never hides a valid frame that starts inside it and ends before it. Where several layouts fit at one
+    position, the one that completes first decides it.
     """
 
     def __init__(self, *formats: tuple[FrameCodec, Decode]) -> None:
@@ -525,6 +528,8 @@ class FrameStreamParser(StreamParser):
         headers = [layout.header for codec, _ in formats for layout in codec.layouts]
         self._headers = tuple(sorted({h for h in headers}, key=len)) if all(headers) else ()
         self._keep = max((len(h) for h in headers), default=1) - 1
+        # no frame is shorter than its layout's fixed elements
+        self._smallest = max(1, min(layout.overhead for codec, _ in formats for layout in codec.layouts))
         self.errors = 0
         self.garbage = 0
         self.expected: type[Message] | None = None
@@ -548,30 +553,37 @@ class FrameStreamParser(StreamParser):
         end = len(buffer)
         found: list[Message] = []
         start = done = 0  # scanning from `start`; bytes before `done` are accounted for
-        hold = -1  # the first candidate still waiting for bytes
-        # Corrupt candidates after one still waiting for its bytes count only once a frame after them is accepted
-        # (the waiting one was no frame): without a header every byte is a candidate, and those inside a frame
-        # that a read has cut are no errors. Left uncounted at the end, they are scanned again with the next bytes.
-        deferred = 0
+        hold = -1  # the candidate waiting for bytes, if any
         while start < end:
             position = self._starts(buffer, start)
             if position < 0:
                 break
-            accepted = self._try(buffer, position, end, found)
-            if accepted is None or accepted < 0:
-                if accepted is None and hold < 0:
-                    hold = position
-                if accepted == -2:
-                    if hold < 0:
-                        self.errors += 1
-                    else:
-                        deferred += 1
+            sized = self._size(buffer, position, end)
+            if sized is None:  # no frame starts here
+                start = position + 1
+                continue
+            stop, decode = sized
+            complete = decode is not None and stop <= end
+            # a frame inside this candidate that ends before it (or before the bytes run out) completes first
+            inner = self._earliest(buffer, position + 1, stop if complete else end + 1)
+            if inner is not None:
+                message, where, start = inner
+                found.append(message)
+                self.garbage += where - done
+                done = start
+                continue
+            if not complete:
+                hold = position
+                break
+            assert decode is not None
+            try:
+                found.append(decode(buffer[position:stop], self.expected))
+            except DecodeError:
+                self.errors += 1
                 start = position + 1
                 continue
             self.garbage += position - done
-            self.errors += deferred
-            hold, deferred = -1, 0
-            start = done = accepted
+            start = done = stop
         if hold >= 0:
             cut = hold
         elif self._headers:
@@ -582,25 +594,40 @@ class FrameStreamParser(StreamParser):
         self._pending = buffer[cut:]
         return found
 
-    def _try(self, buffer: bytes, position: int, end: int, found: list[Message]) -> int | None:
-        """End of the frame accepted at position, None to wait for bytes, -1 implausible, -2 corrupt."""
-        waiting = False
+    def _size(self, buffer: bytes, position: int, end: int) -> tuple[int, Decode | None] | None:
+        """The candidate at `position`: (where its layout that completes first ends, that layout's decoder), the
+        decoder None while a layout's size is not known yet (it ends past `end`); None when no layout fits."""
+        best: tuple[int, Decode | None] | None = None
         for sizer, decode in self._sizers:
             size = sizer(buffer, position, end)
             if size is None:
-                waiting = True
-                continue
-            if size < 0:
-                continue
-            if position + size > end:
-                waiting = True
-                continue
-            try:
-                found.append(decode(buffer[position : position + size], self.expected))
-            except DecodeError:
-                return -2
-            return position + size
-        return None if waiting else -1
+                if best is None:
+                    best = (end + 1, None)
+            elif size >= 0 and (best is None or position + size < best[0]):
+                best = (position + size, decode)
+        return best
+
+    def _earliest(self, buffer: bytes, first: int, bound: int) -> tuple[Message, int, int] | None:
+        """The frame that completes first (of two ending together, the first) among the valid frames that start at
+        or after `first` and end before `bound` (at most len(buffer) + 1): (message, start, end), or None."""
+        best = None
+        end = len(buffer)
+        smallest = self._smallest
+        while True:
+            position = self._starts(buffer, first)
+            if position < 0 or position + smallest >= bound:
+                return best
+            sized = self._size(buffer, position, end)
+            if sized is not None:
+                stop, decode = sized
+                if decode is not None and stop < bound:
+                    try:
+                        message = decode(buffer[position:stop], self.expected)
+                    except DecodeError:
+                        message = None
+                    if message is not None:
+                        best, bound = (message, position, stop), stop
+            first = position + 1
 
     def pending(self) -> bytes:
         return self._pending

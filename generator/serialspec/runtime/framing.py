@@ -422,6 +422,58 @@ class FrameCodec:
             return -1
         return layout.overhead + content_size
 
+    def verifier(self, layout: Layout) -> Callable[[bytes, int, int], bool] | None:
+        """Whether the checksum of the frame buffer[start:stop] of `layout` holds, without decoding it (no exception
+        to raise and catch for the many candidates that fail): for a layout with one checksum after its content,
+        covering elements from its fixed head on, no stuffing. None for other layouts (decoding decides)."""
+        plan: dict[str, Any] = layout._plan  # type: ignore[attr-defined]
+        if layout.transparency is not None or len(plan["checksums"]) != 1:
+            return None
+        index, element = plan["checksums"][0]
+        head = {i: begin for i, begin, _ in plan["head"]}
+        tail = {i: (begin, finish) for i, begin, finish in plan["tail"]}
+        first, last = element.span
+        if index not in tail or first not in head or last + 1 not in tail or element.checksum is None:
+            return None
+        begin, covered_end, (stored, stored_end) = head[first], tail[last + 1][0], tail[index]
+        checksum, endian = element.checksum, element.endian
+
+        def verify(buffer: bytes, start: int, stop: int) -> bool:
+            value = int.from_bytes(buffer[stop - stored : stop - stored_end], endian)
+            return bool(checksum(buffer[start + begin : stop - covered_end]) == value)
+
+        return verify
+
+    def head_pattern(self, layout: Layout) -> bytes | None:
+        """A regular expression for where a plausible frame of `layout` can start: each byte of its fixed head that
+        the sizer checks (constants, one-byte commands and values) as the class of the bytes it allows, a head the
+        buffer ends in matching as far as it goes (the sizer then waits for more). b"" when any byte can start one;
+        None when no frame of the layout is plausible. The stream parser finds its candidates with it, in C."""
+        if layout.command is None and None not in self.content_sizes:
+            return None
+        plan: dict[str, Any] = layout._plan  # type: ignore[attr-defined]
+        classes: list[bytes] = []
+        for element, first, stop in plan["probe_head"]:
+            allowed: list[list[int]] = [list(range(256))] * (stop - first)
+            if element.kind == "constant":
+                allowed = [[byte] for byte in element.constant]
+            elif element.kind == "command" and stop == first + 1:
+                codes = self.content_sizes
+                allowed = [[v for v in range(256) if (ERROR_REPLY if v & self.error_flag else v) in codes]]
+            elif element.kind == "value" and stop == first + 1:
+                allowed = [[v for v in range(256) if element.plausible(v)]]
+            for values in allowed:
+                if not values:
+                    return None
+                whole = len(values) == 256
+                classes.append(b"." if whole else b"[" + b"".join(re.escape(bytes([v])) for v in values) + b"]")
+        while classes and classes[-1] == b".":
+            classes.pop()
+        pattern = b""
+        for each in reversed(classes):  # each byte, or the end of the buffer before it
+            pattern = each + (b"(?:" + pattern + b"|\\Z)" if pattern else b"")
+        return pattern
+
     def _sizer(self, layout: Layout) -> Callable[[bytes, int, int], int | None]:
         """probe(layout, ...) as a closure over what it reads of the layout's plan, worked out once.
 
@@ -502,6 +554,16 @@ class FrameCodec:
 
 
 Decode = Callable[[bytes, "type[Message] | None"], Message]
+Verify = Callable[[bytes, int, int], bool]
+
+
+def _finder(formats: Iterable[tuple[FrameCodec, Decode]]) -> re.Pattern[bytes] | None:
+    """Where a candidate of any layout can start (FrameCodec.head_pattern), as one pattern; None: at every byte."""
+    patterns = [codec.head_pattern(layout) for codec, _ in formats for layout in codec.layouts]
+    found = [pattern for pattern in patterns if pattern is not None]
+    if not found or not all(found):  # a layout any byte can start (or none at all): every byte is a candidate
+        return None
+    return re.compile(b"(?=" + b"|".join(b"(?:" + pattern + b")" for pattern in found) + b")", re.DOTALL)
 
 
 class FrameStreamParser(StreamParser):
@@ -523,13 +585,19 @@ class FrameStreamParser(StreamParser):
             raise ValueError("a stream parser needs at least one frame format")
         self._formats = formats
         # every layout's sizer with its format's decoder, in the order candidates try them
-        self._sizers = tuple((sizer, decode) for codec, decode in formats for sizer in codec.sizers)
+        # and a checksum test before a candidate is decoded, where the layout allows one (FrameCodec.verifier)
+        self._sizers = tuple(
+            (sizer, decode, codec.verifier(layout))
+            for codec, decode in formats
+            for sizer, layout in zip(codec.sizers, codec.layouts, strict=True)
+        )
         self._pending = b""
         headers = [layout.header for codec, _ in formats for layout in codec.layouts]
-        self._headers = tuple(sorted({h for h in headers}, key=len)) if all(headers) else ()
+        self._headers = bool(all(headers))
         self._keep = max((len(h) for h in headers), default=1) - 1
         # no frame is shorter than its layout's fixed elements
         self._smallest = max(1, min(layout.overhead for codec, _ in formats for layout in codec.layouts))
+        self._finder = _finder(formats)
         self.errors = 0
         self.garbage = 0
         self.expected: type[Message] | None = None
@@ -538,96 +606,91 @@ class FrameStreamParser(StreamParser):
         """The reply class the next frames answer, where several reply layouts share a code (PING's vs READ's)."""
         self.expected = cls
 
-    def _starts(self, buffer: bytes, start: int) -> int:
-        if not self._headers:
-            return start
-        best = -1
-        for header in self._headers:
-            position = buffer.find(header, start)
-            if position >= 0 and (best < 0 or position < best):
-                best = position
-        return best
-
     def feed(self, data: bytes | bytearray | memoryview) -> list[Message]:
+        """One pass over the candidates from the last frame taken on: the valid frame that ends first (then starts
+        first) among them is the next one taken, and no candidate after it needs a look once none can end before it.
+        A corrupt candidate counts as an error when the byte-by-byte scan would have decided it before taking that
+        frame: when it and every candidate before it had all their bytes by the time that frame ended."""
         buffer = self._pending + bytes(data)
         end = len(buffer)
         found: list[Message] = []
-        start = done = 0  # scanning from `start`; bytes before `done` are accounted for
-        hold = -1  # the candidate waiting for bytes, if any
-        while start < end:
-            position = self._starts(buffer, start)
-            if position < 0:
+        search = self._finder.search if self._finder is not None else None
+        smallest, expected = self._smallest, self.expected
+        start = 0
+        while True:
+            best: tuple[Message, int, int] | None = None
+            bound = end + 1  # where the best frame so far ends: a frame must end before it to win
+            seen: list[tuple[int, int, bool]] = []  # candidates before it: (start, end or end + 1, corrupt)
+            waiting = False
+            position = start
+            while True:
+                if search is not None:
+                    match = search(buffer, position)
+                    if match is None:
+                        break
+                    position = match.start()
+                # no frame from here can end before the best one (or, none found, in the bytes there are, once one
+                # candidate is known to be waiting for more)
+                if position >= end or (position + smallest >= bound and (best is not None or waiting)):
+                    break
+                sized = self._size(buffer, position, end)
+                if sized is not None:
+                    stop, decode, verify = sized
+                    if decode is None:  # still waiting for bytes
+                        seen.append((position, end + 1, False))
+                        waiting = True
+                    elif stop < bound:
+                        message = None
+                        if verify is None or verify(buffer, position, stop):  # no message built when it fails
+                            try:
+                                message = decode(buffer[position:stop], expected)
+                            except DecodeError:
+                                message = None
+                        if message is None:
+                            seen.append((position, stop, True))
+                        else:
+                            best, bound = (message, position, stop), stop
+                    else:
+                        seen.append((position, stop, False))
+                position += 1
+            first, last = (best[1], best[2]) if best is not None else (end + 1, end)
+            hold = -1
+            for position, stop, corrupt in seen:
+                if position >= first:
+                    break
+                if stop > last:  # undecided when the frame taken ended (or the bytes ran out)
+                    hold = position
+                    break
+                self.errors += corrupt
+            if best is None:
                 break
-            sized = self._size(buffer, position, end)
-            if sized is None:  # no frame starts here
-                start = position + 1
-                continue
-            stop, decode = sized
-            complete = decode is not None and stop <= end
-            # a frame inside this candidate that ends before it (or before the bytes run out) completes first
-            inner = self._earliest(buffer, position + 1, stop if complete else end + 1)
-            if inner is not None:
-                message, where, start = inner
-                found.append(message)
-                self.garbage += where - done
-                done = start
-                continue
-            if not complete:
-                hold = position
-                break
-            assert decode is not None
-            try:
-                found.append(decode(buffer[position:stop], self.expected))
-            except DecodeError:
-                self.errors += 1
-                start = position + 1
-                continue
-            self.garbage += position - done
-            start = done = stop
+            message, first, stop = best
+            found.append(message)
+            self.garbage += first - start
+            start = stop
         if hold >= 0:
             cut = hold
         elif self._headers:
-            cut = max(done, end - self._keep)
+            cut = max(start, end - self._keep)
         else:
             cut = end
-        self.garbage += cut - done
+        self.garbage += cut - start
         self._pending = buffer[cut:]
         return found
 
-    def _size(self, buffer: bytes, position: int, end: int) -> tuple[int, Decode | None] | None:
-        """The candidate at `position`: (where its layout that completes first ends, that layout's decoder), the
-        decoder None while a layout's size is not known yet (it ends past `end`); None when no layout fits."""
-        best: tuple[int, Decode | None] | None = None
-        for sizer, decode in self._sizers:
+    def _size(self, buffer: bytes, position: int, end: int) -> tuple[int, Decode | None, Verify | None] | None:
+        """The candidate at `position`: (where its layout that completes first ends, that layout's decoder and
+        checksum test), the decoder None while it must wait for bytes (its size is not known yet, or it ends past
+        `end`); None when no layout fits."""
+        best: tuple[int, Decode | None, Verify | None] | None = None
+        for sizer, decode, verify in self._sizers:
             size = sizer(buffer, position, end)
             if size is None:
                 if best is None:
-                    best = (end + 1, None)
+                    best = (end + 1, None, None)
             elif size >= 0 and (best is None or position + size < best[0]):
-                best = (position + size, decode)
+                best = (position + size, decode, verify) if position + size <= end else (position + size, None, None)
         return best
-
-    def _earliest(self, buffer: bytes, first: int, bound: int) -> tuple[Message, int, int] | None:
-        """The frame that completes first (of two ending together, the first) among the valid frames that start at
-        or after `first` and end before `bound` (at most len(buffer) + 1): (message, start, end), or None."""
-        best = None
-        end = len(buffer)
-        smallest = self._smallest
-        while True:
-            position = self._starts(buffer, first)
-            if position < 0 or position + smallest >= bound:
-                return best
-            sized = self._size(buffer, position, end)
-            if sized is not None:
-                stop, decode = sized
-                if decode is not None and stop < bound:
-                    try:
-                        message = decode(buffer[position:stop], self.expected)
-                    except DecodeError:
-                        message = None
-                    if message is not None:
-                        best, bound = (message, position, stop), stop
-            first = position + 1
 
     def pending(self) -> bytes:
         return self._pending

@@ -201,6 +201,7 @@ class StreamParser:
         self._single = self._candidates[0] if len(self._candidates) == 1 else None
         self._pending = b""
         self._keep = max(len(f.header) for f in formats) - 1  # a tail that could be the start of a header
+        self._need = 0  # the size of the candidate held back while feed() waits for its bytes (0: none)
         self._smallest = min(c.smallest for c in self._candidates)
         # runs: pieces the next one takes at most, pieces to wait before it is tried, the wait after the next failure
         self._block, self._wait, self._backoff = _FIRST_RUN, 0, _SHORTEST_RUN
@@ -209,11 +210,25 @@ class StreamParser:
 
     def feed(self, data: bytes | bytearray | memoryview) -> list[Message]:
         # Work on immutable bytes: decoders slice their `bytes` fields straight out of the buffer.
-        buffer = self._pending + data if self._pending else data if type(data) is bytes else bytes(data)
+        pending = self._pending
+        buffer = pending + data if pending else data if type(data) is bytes else bytes(data)
         single = self._single
         if single is None:
             return self._scan(buffer)
         end = len(buffer)
+        need = self._need
+        if need:  # a candidate held back, its bytes not all here: nothing can change before they are
+            header = single.header
+            # unless a header comes in the new bytes (a frame inside the candidate may complete first)
+            if end < need and buffer.find(header, max(1, len(pending) - len(header) + 1)) < 0:
+                self._pending = buffer
+                return []
+            self._need = 0
+        if end < 64 and buffer.find(single.header) < 0:  # a short read of garbage (or of a header's first bytes)
+            cut = max(0, end - self._keep)
+            self.garbage += cut
+            self._pending = buffer[cut:]
+            return []
         if end >= single.prefix:
             # A transaction's read is usually one whole frame, first byte on: decode it without a scan. A frame
             # that fails goes through the scan, which counts it and resynchronises.
@@ -231,9 +246,19 @@ class StreamParser:
                 if message is not None:
                     self._pending = b""
                     return [message]
-        if single.splittable:
-            return self._split(buffer, single)
-        return self._scan(buffer)
+        found = self._split(buffer, single) if single.splittable else self._scan(buffer)
+        held = self._pending
+        if held.startswith(single.header) and held.find(single.header, 1) < 0:
+            # the candidate held back, with no header after its first byte: feed() waits for its bytes (or for the
+            # bytes that say how many there are)
+            if len(held) < single.prefix:
+                self._need = single.prefix
+            else:
+                key = held[single.length_offset]
+                if single.command_offset is not None:
+                    key |= held[single.command_offset] << 8
+                self._need = single.frame_sizes.get(key, 0)
+        return found
 
     def _split(self, buffer: bytes, current: _Candidate) -> list[Message]:
         """The batch scan of one frame format: split the buffer at every header (one pass in C) and take the pieces
@@ -302,7 +327,7 @@ class StreamParser:
                         rest <= after
                         and (allowed is None or allowed[piece[byte_at]])
                         and (not wide or current.plausible(buffer, position))
-                        and not piece.startswith(tails)  # no header overlapping this one: nothing starts inside
+                        and (not tails or not piece.startswith(tails))  # no header overlapping it: none inside
                     ):
                         if decode is not None:
                             message = decode(buffer, position)

@@ -11,6 +11,10 @@ from serialspec import __version__
 from serialspec.lang.errors import SpecErrors
 from serialspec.runtime.errors import SerialspecError
 
+DESCRIPTION = (
+    "serial protocols as YAML specs: generate codecs, typed clients, virtual devices and references from them; "
+    "decode, encode, simulate and watch frames"
+)
 # Each verb (its module, serialspec.cli.<verb>, is imported only to run it: `generate` loads no serial-port code)
 # and its one-line help.
 VERBS = {
@@ -28,7 +32,7 @@ VERBS = {
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="serialspec", description=__doc__.split(":")[0] if __doc__ else None)
+    parser = argparse.ArgumentParser(prog="serialspec", description=DESCRIPTION)
     parser.add_argument("--version", action="version", version=f"serialspec {__version__}")
     verbs = parser.add_subparsers(dest="verb", required=True, metavar="VERB")
     given = list(sys.argv[1:] if argv is None else argv)

@@ -17,6 +17,7 @@ from pathlib import Path
 from types import ModuleType
 
 from serialspec.lang import load_protocol
+from serialspec.lang.limits import read_spec
 from serialspec.lang.model import Protocol
 from serialspec.runtime.errors import SerialspecError
 
@@ -34,12 +35,13 @@ def open_spec(spec: str) -> tuple[Protocol, ModuleType]:
     path = Path(spec)
     if path.suffix in (".yaml", ".yml") or path.is_file() or "/" in spec:
         try:
-            key = (str(path.resolve()), spec, hashlib.sha256(path.read_bytes()).hexdigest())
+            raw = read_spec(spec)
         except OSError:
             raise SerialspecError(f"no such spec: {spec}") from None
+        key = (str(path.resolve()), spec, hashlib.sha256(raw).hexdigest())
         if key not in _BUILT:  # the same spec text again in this process (in-process callers, tests)
             protocol = load_protocol(spec)
-            package = generated_from_this(protocol, path.read_text(encoding="utf-8"))
+            package = generated_from_this(protocol, raw.decode("utf-8"))
             _BUILT[key] = protocol, package or package_in_memory(protocol)
         return _BUILT[key]
     return installed(spec)
@@ -117,4 +119,21 @@ def message_type(package: ModuleType, command: str, subcommand: str | None, dire
         if (cls.COMMAND, cls.SUBCOMMAND, cls.DIRECTION.value) == (command, subcommand, direction):
             return cls  # type: ignore[no-any-return]
     what = f"{command}.{subcommand}" if subcommand else command
-    raise SerialspecError(f"{package.__name__} has no {direction} {what!r}")
+    import difflib  # only for a name that is not there
+
+    names = sorted(
+        {
+            f"{c.COMMAND}.{c.SUBCOMMAND}" if c.SUBCOMMAND else c.COMMAND
+            for c in package.MESSAGE_TYPES
+            if c.DIRECTION.value == direction
+        }
+    )
+    close = difflib.get_close_matches(what, names, n=3)
+    hint = (
+        f" (did you mean {' or '.join(close)}?)"
+        if close
+        else f" (it has {', '.join(names)})"
+        if len(names) <= 12
+        else ""
+    )
+    raise SerialspecError(f"{package.__name__} has no {direction} {what!r}{hint}")

@@ -10,9 +10,12 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Iterator
 from dataclasses import field
-from typing import Any
+from typing import Any, assert_never
 
+from serialspec import checksums
+from serialspec.checksums.base import Key
 from serialspec.lang.frozen import mutable
+from serialspec.lang.limits import MAX_TEXT
 from serialspec.lang.loader import CONTROL, Path
 
 SCALAR_TYPES = ("u8", "i8", "u16", "i16", "u32", "i32", "f32")
@@ -38,6 +41,8 @@ class Str(Shape):
     def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
         if not isinstance(value, str):
             yield path, f"expected text, got {_kind(value)}"
+        elif len(value) > MAX_TEXT:
+            yield path, f"text of {len(value):,} characters (at most {MAX_TEXT:,})"
         elif bad := CONTROL.search(value):
             yield path, f"control character U+{ord(bad.group()):04X} in text (not allowed in a spec)"
         elif self.choices and value not in self.choices:
@@ -470,6 +475,13 @@ COMMAND = Obj(
         "request": MESSAGE,
         "response": MESSAGE,
         "broadcast": TEXT,
+        "probe": Bool(
+            "The command asks whether a device is there (PING): its client method returns True when the device "
+            "answers and False when none does, whatever the reply holds. Every other command with a reply raises "
+            "Timeout when none comes.",
+            default=False,
+            example=True,
+        ),
         "source": SOURCE,
         "selector": Obj(
             {
@@ -584,6 +596,35 @@ def span(description: str) -> OneOf:
     )
 
 
+def checksum_keys() -> dict[str, Shape]:
+    """The checksum element's keys that the algorithms own (serialspec/checksums/): `algorithm`, whose choices are
+    the registered algorithms, and each algorithm's own keys."""
+    found = checksums.algorithms()
+    described = "; ".join(f"`{name}`, {algorithm.summary}" for name, algorithm in found.items())
+    keys: dict[str, Shape] = {"algorithm": Str(f"checksum: what it computes: {described}.", choices=tuple(found))}
+    for algorithm in found.values():
+        keys |= {key.name: _shape(key) for key in algorithm.keys}
+    return keys
+
+
+def _shape(key: Key) -> Shape:
+    """The shape of an algorithm's key, as the checksum registry gives it (plain data)."""
+    match key.kind:
+        case "bool":
+            return Bool(key.description, default=key.default, example=key.example)
+        case "int":
+            return Int(
+                key.description, default=key.default, example=key.example, minimum=key.minimum, maximum=key.maximum
+            )
+        case "str":
+            return Str(key.description, default=key.default, example=key.example)
+        case "object":
+            keys = {k.name: _shape(k) for k in key.keys}
+            return Obj(keys, required=key.required, description=key.description)
+        case _:
+            assert_never(key.kind)
+
+
 FRAME_ELEMENT = Obj(
     {
         "role": Str(
@@ -626,28 +667,7 @@ FRAME_ELEMENT = Obj(
             "checksum: the span of elements covered. Outside a transparency span it sees the wire bytes, inside "
             "it the bytes before stuffing.",
         ),
-        "algorithm": Str(
-            "checksum: sum (of the bytes, modulo the width), xor (of the bytes) or crc.",
-            choices=("sum", "crc", "xor"),
-        ),
-        "invert": Bool("sum: bitwise NOT of the sum.", default=False),
-        "crc": Obj(
-            {
-                "name": Str("Catalogue name, e.g. CRC-16/MODBUS."),
-                "width": Int("Bits of the CRC."),
-                "poly": Int("Generator polynomial, normal form without the top bit (0x8005)."),
-                "init": Int("Register value before the first byte."),
-                "refin": Bool("Each input byte is reflected (least significant bit first)."),
-                "refout": Bool("The result is reflected before `xorout`."),
-                "xorout": Int("Value XORed into the result."),
-                "check": Int("The catalogue check value: the CRC of b'123456789'."),
-            },
-            required=("width", "poly", "init", "refin", "refout", "xorout", "check"),
-            description=(
-                "crc: the CRC by its catalogue parameters (reveng's CRC catalogue); the generator checks `check` "
-                "against the CRC of '123456789'."
-            ),
-        ),
+        **checksum_keys(),
     },
     required=("role",),
     description="One element of the frame, in wire order.",

@@ -11,6 +11,7 @@ from dataclasses import field
 from functools import cached_property
 from typing import Literal
 
+from serialspec.checksums.base import Algorithm
 from serialspec.lang import expression
 from serialspec.lang.expression import Expr
 from serialspec.lang.frozen import frozen
@@ -345,6 +346,7 @@ class Command:
     selector: Selector | None
     subcommands: tuple[Subcommand, ...]
     group_class: str = ""  # the client's class grouping the sub-commands' methods ("" without sub-commands)
+    probe: bool = False  # asks whether a device is there: clients return True/False, never raise Timeout
 
     def messages(self) -> tuple[Message, ...]:
         found = [m for m in (self.request, self.response) if m]
@@ -354,22 +356,8 @@ class Command:
 
 
 @frozen
-class Crc:
-    name: str
-    width: int
-    poly: int
-    init: int
-    refin: bool
-    refout: bool
-    xorout: int
-    check: int
-
-
-@frozen
 class Checksum:
-    algorithm: Literal["sum", "crc", "xor"]
-    invert: bool
-    crc: Crc | None
+    algorithm: Algorithm  # what it computes, with its parameters: one class per algorithm (serialspec/checksums/)
     first: str  # first frame element covered
     last: str  # last frame element covered
     type: ScalarType

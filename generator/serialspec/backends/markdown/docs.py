@@ -1,11 +1,14 @@
 """Emit the markdown reference of one protocol: frames, checksum, commands, tables, examples, errata.
 
 Every piece of spec text goes through `cell()` or `text()`, so a `|`, `<` or newline in a description can
-neither break a table nor inject HTML into the rendered page.
+neither break a table nor inject HTML into the rendered page, a `{` cannot add attributes (`{: onclick=...}` under
+the site's attr_list extension), and a link may only lead to http, https or mailto (`[x](javascript:...)` shows as
+text).
 """
 
 from __future__ import annotations
 
+import re
 from collections import Counter
 from typing import Any
 
@@ -37,10 +40,26 @@ from serialspec.lang.model import (
 )
 from serialspec.runtime.errors import SerialspecError
 
+# A `]` that closes a link's text, with the destination after it: `[x](dest` (and `[x]: dest`, see DEFINITION)
+LINK_END = re.compile(r"\](?=\s*[(:]\s*(?:&lt;)?\s*([^\s)]*))")
+# A reference definition, `[x]: dest` at the start of a line (the text's): it would vanish from the page and turn
+# `[y][x]` anywhere on it into a link, so it shows as text
+DEFINITION = re.compile(r"\[[^\]]*\]:")
+SCHEME = re.compile(r"([A-Za-z][A-Za-z0-9+.-]*):")
+SAFE_SCHEMES = frozenset({"http", "https", "mailto"})
+
+
+def _link_end(match: re.Match[str]) -> str:
+    scheme = SCHEME.match(match[1].replace("\\", ""))
+    return "\\]" if scheme and scheme[1].lower() not in SAFE_SCHEMES else "]"
+
 
 def text(value: str) -> str:
-    """Spec text for a markdown paragraph: one line, HTML-significant characters escaped."""
-    return collapse(value).replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
+    """Spec text for a markdown paragraph: one line, HTML-significant characters escaped, attribute lists and links
+    to other schemes than http, https and mailto (javascript:, data:, vbscript:, ...) shown as text."""
+    escaped = collapse(value).replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;").replace("{", "\\{")
+    escaped = LINK_END.sub(_link_end, escaped)
+    return "\\" + escaped if DEFINITION.match(escaped) else escaped
 
 
 def cell(value: object) -> str:
@@ -139,7 +158,7 @@ def message_context(protocol: Protocol, message: Message | None) -> dict[str, An
     content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
     size = size_text(message.min_size, message.max_size, content_limit(layout))
     rows = [
-        Row(str(layout.offsets[e.name]), e.name, e.type.name if e.type else "", "", "", text(e.description))
+        Row(str(layout.offsets[e.name]), e.name, e.type.name if e.type else "", "", "", e.description)
         for e in layout.value_elements
     ]
     rows += field_rows(message.fields, content_offset)
@@ -256,6 +275,7 @@ def command_context(protocol: Protocol, command: Command) -> dict[str, Any]:
         "title_cn": text(command.title_cn),
         "description": text(command.description),
         "broadcast": text(command.broadcast),
+        "probe": command.probe,
         "source": text(command.source),
         "anchor": anchor("command", command.name),
         "messages": same_once(
@@ -308,9 +328,9 @@ def frame_context(protocol: Protocol, layout: FrameLayout) -> dict[str, Any]:
         size = e.size
         variable = variable or e.name == first_variable
         if e.role == "header" and layout.classic:
-            description = f"{layout.header.hex(' ').upper()} — {e.description}"
+            description = " — ".join(p for p in (layout.header.hex(" ").upper(), e.description) if p)
         elif e.fixed:
-            description = f"{e.constant.hex(' ').upper()} — {e.description}"
+            description = " — ".join(p for p in (e.constant.hex(" ").upper(), e.description) if p)
         elif e.role == "checksum" and not layout.classic and e.checksum is not None:
             endian = "big-endian" if e.endian == ">" else "little-endian"
             description = f"over `{e.checksum.first}`..`{e.checksum.last}`, {endian}. {e.description}"
@@ -374,48 +394,38 @@ def checksum_context(protocol: Protocol, general: Checksum | None = None) -> dic
     example = next(iter(protocol.examples), None)
     worked = ""
     if general is not None and example is not None:
-        worked = f"every example's `{checksum.name}` verifies (e.g. `{example.name}`)"
+        verifies = f"every example's `{checksum.name}` verifies (e.g. `{example.name}`)"
+        worked = general_worked(protocol, general) or verifies
     elif example is not None:
         layout = protocol.framing.layouts[example.direction]
         covered = example.frame[layout.covered_from : len(example.frame) - layout.covered_to_end]
-        if checksum.algorithm == "sum":
-            total = sum(covered)
-            invert = "~" if checksum.invert else ""
-            worked = (
-                f"{invert}({' + '.join(f'0x{b:02X}' for b in covered)}) = {invert}{total:#x} "
-                f"→ 0x{example.frame[-1]:02X} (example `{example.name}`)"
-            )
-        else:
-            worked = f"CRC of {covered.hex(' ').upper()} = 0x{example.frame[-1]:02X} (example `{example.name}`)"
-    if checksum.algorithm == "sum":
-        what = (
-            "bitwise NOT of the sum" if checksum.invert else "sum"
-        ) + f" of the covered bytes, modulo {1 << (checksum.type.size * 8)}"
-        params = []
-    else:
-        assert checksum.crc is not None
-        c = checksum.crc
-        what = f"{c.name or 'CRC'} over the covered bytes"
-        params = [
-            ("width", c.width),
-            ("poly", f"{c.poly:#04x}"),
-            ("init", f"{c.init:#04x}"),
-            ("refin", c.refin),
-            ("refout", c.refout),
-            ("xorout", f"{c.xorout:#04x}"),
-            ("check ('123456789')", f"{c.check:#04x}"),
-        ]
-    if checksum.algorithm == "xor":
-        what = f"XOR of the covered bytes ({checksum.type.size * 8} bits)"
+        worked = f"{checksum.algorithm.worked(covered)} (example `{example.name}`)"
     label = f" `{checksum.name}`" if general is not None else ""
     return {
         "label": label,
-        "what": what,
+        "what": checksum.algorithm.describe(),
         "first": checksum.first,
         "last": checksum.last,
         "worked": worked,
-        "params": params,
+        "params": checksum.algorithm.parameters(),
     }
+
+
+def general_worked(protocol: Protocol, checksum: Checksum) -> str:
+    """The first example whose frame holds the checksum (and no stuffing), worked by the algorithm; "" for none."""
+    for example in protocol.examples:
+        layouts = runtime_layouts(protocol, example.direction)
+        layout = next((lay for lay in layouts if example.frame.startswith(lay.header)), layouts[0])
+        index = next((i for i, e in enumerate(layout.elements) if e.name == checksum.name), None)
+        if index is None or layout.transparency is not None:
+            continue
+        try:
+            parts = layout.unwrap(example.frame).parts
+        except SerialspecError:
+            continue
+        first, last = layout.elements[index].span
+        return f"{checksum.algorithm.worked(b''.join(parts[first : last + 1]))} (example `{example.name}`)"
+    return ""
 
 
 def general_breakdown(protocol: Protocol, example: Example, message: Message | None) -> list[dict[str, str]]:
@@ -642,6 +652,8 @@ def emit_docs(protocol: Protocol) -> str:
         matching=", ".join(protocol.matching),
         matching_description=text(protocol.matching_description),
         commands=commands,
+        # the index's column of the titles as the (Chinese) documents print them, where a command has one
+        titles_cn=any(c["title_cn"] or any(s["title_cn"] for s in c["subcommands"]) for c in commands),
         tables=tables,
         enums=enums,
         flags=flags,

@@ -9,14 +9,20 @@ from typing import Any
 
 from serialspec.backends.common.numbers import number
 from serialspec.backends.python.client import client_module
-from serialspec.backends.python.framecode import Target, direction_functions
-from serialspec.backends.python.frames import checksum_definitions, code_key, codec_lines, framing_imports
+from serialspec.backends.python.framecode import Target, checksum_name, direction_functions
+from serialspec.backends.python.frames import (
+    checksum_definitions,
+    code_key,
+    codec_lines,
+    framing_imports,
+    import_lines,
+)
 from serialspec.backends.python.pycode import (
     ClassCode,
     Lines,
     PackageCode,
     checksum_lines,
-    crc_setup,
+    checksum_setup,
     decoder_name,
     encoder_name,
     fuse_unpack,
@@ -41,7 +47,6 @@ from serialspec.lang.model import (
     replies_by_request,
     reply_to,
 )
-from serialspec.runtime.checksums import crc_table
 
 _IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 
@@ -263,7 +268,6 @@ def general_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
         "framing_imports": sorted({"EngineFormat", *framing_imports(every)}, key=import_order),
         "checksum_error": any("ChecksumError(" in line for line in every),
         "checksum_imports": imports,
-        "crc_hqx": any("_crc_hqx(" in line for line in every),  # a CRC the standard library computes, called directly
         "checksum_definitions": definitions,
         "directions": directions,
         "dispatchers": dispatchers,
@@ -300,7 +304,7 @@ def classic_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
     assert protocol.framing.checksum is not None
     checksum = protocol.framing.checksum
     assert checksum is not None  # classic frames have one
-    checksum_import, checksum_definition = crc_setup(checksum)
+    checksum_imports, checksum_definitions = checksum_setup(checksum)
     directions = []
     dispatchers = []
     frame_functions: list[dict[str, Any]] = []
@@ -398,8 +402,8 @@ def classic_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
     header_choices = " or ".join(layouts[d].header.hex(" ") for d in Direction)
     return {
         "classic": True,
-        "checksum_import": checksum_import,
-        "checksum_definition": checksum_definition,
+        "checksum_imports": import_lines(checksum_imports),
+        "checksum_definitions": checksum_definitions,
         "directions": directions,
         "frame_functions": frame_functions,
         "runs": any(d["runs"] for d in directions),
@@ -701,12 +705,9 @@ def rest_check_lines(protocol: Protocol, layout: FrameLayout) -> Lines:
     size = layout.checksum_offset_from_end
     stored = "buf[-1]" if size == 1 else f"int.from_bytes(buf[-{size}:], 'little')"
     header = layout.header[: layout.covered_from]
-    whole_sum = checksum.algorithm == "sum" and size == 1 == layout.covered_to_end == checksum.type.size
-    if whole_sum and len(header) == layout.covered_from:
-        less = f" - {sum(header):#x}" if header else ""
-        if not checksum.invert:
-            return [f"if (sum(buf){less} - 2 * buf[-1]) & 0xff:"]
-        return [f"if (sum(buf) - {sum(header) + 0xFF:#x}) & 0xff:  # inverted: the bytes and the check sum to 0xff"]
+    test = checksum.algorithm.frame_test("sum(buf)", sum(header), "buf[-1]")
+    if test is not None and size == 1 == layout.covered_to_end and len(header) == layout.covered_from:
+        return [f"if {test}:"]
     covered = f"buf[{layout.covered_from}:-{layout.covered_to_end}]"
     return [*checksum_lines(checksum, covered, "expected"), f"if expected != {stored}:"]
 
@@ -834,9 +835,10 @@ def summed_checksum(protocol: Protocol, layout: FrameLayout) -> str | None:
     """The stream parser's `summed`: (first byte covered, inverted) where the checksum is an 8-bit sum of every byte
     from there to the last, which it is; None for other checksums."""
     checksum = protocol.framing.checksum
-    if checksum is None or plain_check(protocol, layout) is None:
+    inverted = checksum.algorithm.summed() if checksum is not None else None
+    if inverted is None or plain_check(protocol, layout) is None:
         return None
-    return f"({layout.covered_from}, {checksum.invert})"
+    return f"({layout.covered_from}, {inverted})"
 
 
 def plain_check(protocol: Protocol, layout: FrameLayout) -> str | None:
@@ -844,14 +846,12 @@ def plain_check(protocol: Protocol, layout: FrameLayout) -> str | None:
     over the frame's bytes: an 8-bit sum over all but a constant header and the check. None for others."""
     checksum = protocol.framing.checksum
     header = layout.header[: layout.covered_from]
-    if checksum is None or checksum.algorithm != "sum" or len(header) != layout.covered_from:
+    if checksum is None or len(header) != layout.covered_from:
         return None
-    if not layout.checksum_offset_from_end == 1 == layout.covered_to_end == checksum.type.size:
+    if not layout.checksum_offset_from_end == 1 == layout.covered_to_end:
         return None
-    less = f" - {sum(header):#x}" if header else ""
-    if checksum.invert:  # the covered bytes and their inverted sum add up to 0xff
-        return f"not (sum(data) - {sum(header) + 0xFF:#x}) & 0xff"
-    return f"not (sum(data){less} - 2 * data[-1]) & 0xff"
+    test = checksum.algorithm.frame_test("sum(data)", sum(header), "data[-1]")
+    return None if test is None else f"not {test}"
 
 
 def run_frames(
@@ -907,10 +907,10 @@ def whole_frame_lines(
     lines = [_AT_START.sub(r"\1", line) for line in lines]
     checksum = protocol.framing.checksum
     assert checksum is not None  # classic frames have one
-    crc = checksum.crc
+    stepped = checksum.algorithm.byte_table(checksum_name(checksum))
     loop = _CRC_LOOP.match(lines[1]) if len(lines) > 1 else None
-    if crc is not None and crc.width == 8 and crc.refin == crc.refout and loop and not summed:
-        table = crc_table(8, crc.poly, crc.refin)
+    if stepped is not None and loop and not summed:
+        table_name, table = stepped
         state = int(lines[0].removeprefix("expected = "), 16)
         first = int(loop["first"])
         while first in known and first < int(loop["stop"]) - 1:
@@ -920,26 +920,22 @@ def whole_frame_lines(
         if stop - first > _MOST_UNROLLED:
             return [f"expected = {state:#x}", f"for byte in buf[{first} : {stop}]:", *lines[2:]]
         # a few bytes: one table step each, no slice and no loop
-        steps = [f"expected = _CRC_TABLE[{state:#x} ^ buf[{first}]]"]
-        steps += [f"expected = _CRC_TABLE[expected ^ buf[{offset}]]" for offset in range(first + 1, stop)]
+        steps = [f"expected = {table_name}[{state:#x} ^ buf[{first}]]"]
+        steps += [f"expected = {table_name}[expected ^ buf[{offset}]]" for offset in range(first + 1, stop)]
         return [*steps, *lines[3:]]  # in place of the loop and its one-line body
     header = layout.header[: layout.covered_from]
-    whole_sum = (
+    test = checksum.algorithm.frame_test("sum(buf)", sum(header), f"buf[{size - 1}]")
+    whole = (
         not summed
-        and checksum.algorithm == "sum"
-        and checksum.type.size == 1
+        and test is not None
         and layout.checksum_offset_from_end == 1
         and layout.covered_to_end == 1
         and len(header) == layout.covered_from
     )
-    if not whole_sum:
+    if not whole:
         return lines
     assert lines[0].startswith("expected = ") and lines[1].startswith("if expected != "), lines[:2]
-    less = f" - {sum(header):#x}" if header else ""
-    if not checksum.invert:  # sum(covered) = check (mod 256): the whole frame sums to twice the check, plus the rest
-        return [f"if (sum(buf){less} - 2 * buf[{size - 1}]) & 0xff:", *lines[2:]]
-    # inverted: the covered bytes and the check sum to 0xff, so the whole frame to that plus the header
-    return [f"if (sum(buf) - {sum(header) + 0xFF:#x}) & 0xff:", *lines[2:]]
+    return [f"if {test}:", *lines[2:]]
 
 
 _UNPACK = re.compile(r"^(?P<targets>.+) = (?P<struct>_S_\w+)\.unpack_from\(buf, o\)$")
@@ -962,7 +958,7 @@ def summed_frame(
     (constants, given the key) and one-byte frame values. None where the frame is not like that."""
     checksum = protocol.framing.checksum
     match = _UNPACK.match(body[0]) if body else None
-    if checksum is None or checksum.algorithm != "sum" or checksum.type.size != 1 or not match:
+    if checksum is None or checksum.algorithm.summed() is None or not match:
         return None
     if layout.checksum_offset_from_end != 1:
         return None
@@ -998,11 +994,10 @@ def summed_frame(
     if len(terms) > _MOST_TERMS:
         return None  # summing a slice of the frame in C is cheaper than this many terms in Python
     with_check = code.struct(match["struct"].removeprefix("_S_") + "_and_check", fmt + "B")
-    total = " + ".join([f"{constant:#x}", *terms])
-    invert = "~" if checksum.invert else ""
+    total = checksum.algorithm.byte_total(" + ".join([f"{constant:#x}", *terms]))
     return [
         f"{', '.join(targets)}, check = {with_check}.unpack_from(buf, start + {content_offset})",
-        f"if {invert}({total}) & 0xff != check:",
+        f"if {total} != check:",
         "    return None",
     ]
 
@@ -1050,14 +1045,17 @@ def frame_decode_lines(
     stored = "check"
     lines += checksum_lines(checksum, covered, "expected")
     header = layout.header[: layout.covered_from]
-    whole_sum = checksum.algorithm == "sum" and size == 1 == layout.covered_to_end == checksum.type.size
-    if start is None and whole_sum and len(header) == layout.covered_from:
+    less = f" - {sum(header):#x}" if header else ""
+    total = checksum.algorithm.byte_total(f"sum({buf}){less} - {stored}")
+    whole = size == 1 == layout.covered_to_end and len(header) == layout.covered_from
+    if start is None and total is not None and whole:
         # all but a checked header and the check: the sum of the whole frame less those, no slice made
-        less = f" - {sum(header):#x}" if header else ""
-        lines = [lines[0], f"expected = {'~' if checksum.invert else ''}(sum({buf}){less} - {stored}) & 0xff"]
+        lines = [lines[0], f"expected = {total}"]
     lines += [
         f"if expected != {stored}:",
-        f'    raise ChecksumError(f"bad checksum: the frame has {{{stored}:#04x}}, its bytes give {{expected:#04x}}")',
+        # as wide as the checksum: a u16 that reads 0 is 0x0000
+        f'    raise ChecksumError(f"bad checksum: the frame has {{{stored}:#0{2 + 2 * size}x}}, '
+        f'its bytes give {{expected:#0{2 + 2 * size}x}}")',
     ]
     if layout.command_offset is None:  # the one codeless command of this direction, if any
         if not dispatch:

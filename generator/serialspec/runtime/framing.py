@@ -641,7 +641,9 @@ class FrameStreamParser(StreamParser):
                         waiting = True
                     elif stop < bound:
                         message = None
-                        if verify is None or verify(buffer, position, stop):  # no message built when it fails
+                        # the checksum first (no message built when it fails), but for the candidate the scan
+                        # starts at, usually a frame: decoding it checks the checksum once
+                        if verify is None or position == start or verify(buffer, position, stop):
                             try:
                                 message = decode(buffer[position:stop], expected)
                             except DecodeError:

@@ -43,6 +43,11 @@ def emit(emitter: Emitter, protocol: Protocol) -> dict[str, str]:
     return {f"{emitter.folder}/{path}" if emitter.folder else path: text for path, text in emitted.items()}
 
 
+def target_names() -> tuple[str, ...]:
+    """The targets' names (their folders), without importing them."""
+    return tuple(sorted(i.name for i in pkgutil.iter_modules(__path__) if i.ispkg and i.name != "common"))
+
+
 @cache
 def emitters() -> tuple[Emitter, ...]:
     """Every target under serialspec.backends, in name order (common/ is the shared layer, not a target)."""

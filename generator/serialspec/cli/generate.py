@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import argparse
 import sys
-from dataclasses import replace
 from pathlib import Path
 
-from serialspec.cli.project import Project, expected_files, orphans, project, target_files
+from serialspec.backends import target_names
+from serialspec.cli.project import expected_files, orphans, project
 from serialspec.lang.errors import shown
 from serialspec.runtime.errors import SerialspecError
 
@@ -16,35 +16,26 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("specs", nargs="*", metavar="SPEC", help="spec files (default: the project's specs)")
     parser.add_argument("--out", metavar="DIR", help="output folder (default: the project's, else generated/)")
     parser.add_argument(
-        "--root", type=Path, help="project root (default: the nearest folder with a [tool.serialspec] table or specs/)"
+        "--target",
+        dest="targets",
+        action="append",
+        choices=target_names(),
+        help="only this output (repeatable; default: all of them): python (packages), markdown (references), "
+        "wireshark (DIR/<protocol>/<protocol>.lua, a Lua dissector), c (DIR/c/<protocol>/, C99 for firmware and hosts)",
     )
     parser.add_argument(
-        "--target",
-        metavar="NAME",
-        help="only this target's files (c, python, markdown, ...), written to DIR/<protocol>/ (--out DIR; default: "
-        "the target's folder of the project's output); default: every target",
+        "--root", type=Path, help="project root (default: the nearest folder with a [tool.serialspec] table or specs/)"
     )
 
 
-def run_target(proj: Project, target: str, out_given: bool) -> int:
-    """One target's files, into the output folder as given (no orphans removed: the folder may hold other files)."""
-    from serialspec.backends import emitters
-
-    chosen = next((e for e in emitters() if e.name == target), None)
-    if chosen is None:
-        names = ", ".join(e.name for e in emitters())
-        raise SerialspecError(f"no target {target!r}: the targets are {names}")
-    if not out_given and chosen.folder:
-        proj = replace(proj, out=proj.out / chosen.folder)
-    files, errors = target_files(proj, target)
-    written = _write(files)
-    print(f"{len(files)} {target} files generated in {proj.display(proj.out)}, {written} changed")
-    for line in shown(errors):
-        print(line, file=sys.stderr)
-    return 1 if errors else 0
-
-
-def _write(files: dict[Path, str]) -> int:
+def run(args: argparse.Namespace) -> int:
+    proj = project(args.root, args.specs, args.out)
+    files, errors = expected_files(proj, args.targets or ())
+    if proj.chosen and errors and all(path == proj.schema for path in files):
+        # every spec named has mistakes: nothing is written (not even the schema, into a generated/ of its own)
+        for line in shown(errors):
+            print(line, file=sys.stderr)
+        return 1
     written = 0
     for path, text in files.items():
         try:
@@ -54,21 +45,8 @@ def _write(files: dict[Path, str]) -> int:
                 written += 1
         except OSError as exc:
             raise SerialspecError(f"cannot write {path}: {exc.strerror or exc}") from None
-    return written
-
-
-def run(args: argparse.Namespace) -> int:
-    proj = project(args.root, args.specs, args.out)
-    if args.target:
-        return run_target(proj, args.target, bool(args.out))
-    files, errors = expected_files(proj)
-    if proj.chosen and errors and all(path == proj.schema for path in files):
-        # every spec named has mistakes: nothing is written (not even the schema, into a generated/ of its own)
-        for line in shown(errors):
-            print(line, file=sys.stderr)
-        return 1
-    written = _write(files)
-    removed = orphans(proj, files, {e.file for e in errors})
+    # Only the whole set of targets says which files nothing generates any more.
+    removed = [] if args.targets else orphans(proj, files, {e.file for e in errors})
     for path in removed:
         path.unlink()
         print(f"removed {proj.display(path)} (no spec generates it any more)", file=sys.stderr)

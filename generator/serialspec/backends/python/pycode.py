@@ -578,6 +578,13 @@ class PackageCode:
             if isinstance(f, Scalar) and f.value is not None:
                 expected = expression.render(f.value, self.local_named)
                 shown = one_line(expression.show(f.value)).replace("{", "{{").replace("}", "}}")
+                if expression.fails(f.value):  # a divisor of 0 or a negative shift from the wire: a bad frame
+                    lines.append("try:")
+                    lines.append(f"    expected_value = {expected}")
+                    lines.append("except (ZeroDivisionError, ValueError):")
+                    reason = f"{f.name}: {shown} has no value here (a division by 0 or a negative shift)"
+                    lines.append(f"    raise DecodeError({where} + f': {reason}') from None")
+                    expected = "expected_value"
                 lines.append(f"if {self.local(f)} != {expected}:")
                 reason = f"{f.name} is {{{self.local(f)}}}, but {shown} = {{{expected}}}"
                 lines.append(f"    raise DecodeError({where} + f': {reason}')")

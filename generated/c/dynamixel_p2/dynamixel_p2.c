@@ -1833,9 +1833,6 @@ static int dynamixel_p2__push(dynamixel_p2_parser_t *p, uint8_t byte, dynamixel_
             }
         } else if (r == DYNAMIXEL_P2__ACCEPT) {
             p->garbage += (uint32_t)(pos - done);
-#if !DYNAMIXEL_P2__CLASSIC
-            p->errors += deferred;
-#endif
             hold = (size_t)-1;
             deferred = 0u;
             start = done = pos + size;

@@ -4197,9 +4197,6 @@ static int fashionstar_uart__push(fashionstar_uart_parser_t *p, uint8_t byte, fa
             }
         } else if (r == FASHIONSTAR_UART__ACCEPT) {
             p->garbage += (uint32_t)(pos - done);
-#if !FASHIONSTAR_UART__CLASSIC
-            p->errors += deferred;
-#endif
             hold = (size_t)-1;
             deferred = 0u;
             start = done = pos + size;

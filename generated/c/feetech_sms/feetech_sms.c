@@ -1399,9 +1399,6 @@ static int feetech_sms__push(feetech_sms_parser_t *p, uint8_t byte, feetech_sms_
             }
         } else if (r == FEETECH_SMS__ACCEPT) {
             p->garbage += (uint32_t)(pos - done);
-#if !FEETECH_SMS__CLASSIC
-            p->errors += deferred;
-#endif
             hold = (size_t)-1;
             deferred = 0u;
             start = done = pos + size;

@@ -4085,9 +4085,6 @@ static int hiwonder_rrc__push(hiwonder_rrc_parser_t *p, uint8_t byte, hiwonder_r
             }
         } else if (r == HIWONDER_RRC__ACCEPT) {
             p->garbage += (uint32_t)(pos - done);
-#if !HIWONDER_RRC__CLASSIC
-            p->errors += deferred;
-#endif
             hold = (size_t)-1;
             deferred = 0u;
             start = done = pos + size;

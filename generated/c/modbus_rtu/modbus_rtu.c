@@ -2308,9 +2308,6 @@ static int modbus_rtu__push(modbus_rtu_parser_t *p, uint8_t byte, modbus_rtu_msg
             }
         } else if (r == MODBUS_RTU__ACCEPT) {
             p->garbage += (uint32_t)(pos - done);
-#if !MODBUS_RTU__CLASSIC
-            p->errors += deferred;
-#endif
             hold = (size_t)-1;
             deferred = 0u;
             start = done = pos + size;

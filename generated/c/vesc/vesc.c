@@ -1923,9 +1923,6 @@ static int vesc__push(vesc_parser_t *p, uint8_t byte, vesc_msg_t *out)
             }
         } else if (r == VESC__ACCEPT) {
             p->garbage += (uint32_t)(pos - done);
-#if !VESC__CLASSIC
-            p->errors += deferred;
-#endif
             hold = (size_t)-1;
             deferred = 0u;
             start = done = pos + size;

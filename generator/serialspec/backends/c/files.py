@@ -799,9 +799,6 @@ static int {p}__push({p}_parser_t *p, uint8_t byte, {p}_msg_t *out)
             }}
         }} else if (r == {P}__ACCEPT) {{
             p->garbage += (uint32_t)(pos - done);
-#if !{P}__CLASSIC
-            p->errors += deferred;
-#endif
             hold = (size_t)-1;
             deferred = 0u;
             start = done = pos + size;

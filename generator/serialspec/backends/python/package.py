@@ -19,9 +19,11 @@ from serialspec.backends.python.pycode import (
     crc_setup,
     decoder_name,
     encoder_name,
-    fuse_unpack,
     one_line,
     takes_the_rest,
+)
+from serialspec.backends.python.pycode import (
+    fuse_unpack_lines as fuse_unpack,
 )
 from serialspec.backends.python.registers import register_tables, registers_module
 from serialspec.backends.python.render import render
@@ -274,7 +276,7 @@ def general_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
 def plain_messages(single: dict[str, Message], code: PackageCode) -> list[tuple[int, int, str, str, str]]:
     """(code, content size, class, struct, its format) of the messages of one size whose decoder, past its size
     check, is one struct's unpack of the content as their message (framecode.whole_frames decodes them whole)."""
-    bodies = {name: lines for name, _, _, lines in code.decoders}
+    bodies = {name: lines for name, _, _, lines in code.decoder_lines()}
     found = []
     for key, message in single.items():
         lines = bodies[decoder_name(message)]
@@ -306,7 +308,7 @@ def classic_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
     frame_functions: list[dict[str, Any]] = []
     whole_functions: list[dict[str, Any]] = []
     whole_pickers: list[dict[str, Any]] = []
-    decoder_bodies = {name: (returns, extra, lines) for name, returns, extra, lines in code.decoders}
+    decoder_bodies = {name: (returns, extra, lines) for name, returns, extra, lines in code.decoder_lines()}
     for direction, layout in protocol.framing.layouts.items():
         dispatch = []
         sizes = []
@@ -413,7 +415,7 @@ def classic_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
 def common_codec_context(protocol: Protocol, code: PackageCode, exports: list[str]) -> dict[str, Any]:
     encoder_table = [(m.class_name, encoder_name(m)) for m in protocol.messages()]
     codec_names = names_used_in_codec(code)
-    used = "\n".join(line for _, _, _, lines in code.decoders for line in lines)
+    used = "\n".join(line for _, _, _, lines in code.decoder_lines() for line in lines)
     used += "\n".join(line for _, _, lines in code.encoders for line in lines)
     packing = [n for n in ("decode_text", "encode_text", "pack_bits", "unpack_bits") if f"_{n}(" in used]
     return {
@@ -426,7 +428,7 @@ def common_codec_context(protocol: Protocol, code: PackageCode, exports: list[st
         "member_maps": sorted(code.member_maps),
         "decoders": [
             {"name": n, "returns": r, "extra": e, "lines": fuse_unpack(lines, code.structs)}
-            for n, r, e, lines in code.decoders
+            for n, r, e, lines in code.decoder_lines()
         ],
         "encoders": [{"name": n, "type": t, "lines": lines} for n, t, lines in code.encoders],
         "encoder_table": encoder_table,
@@ -1013,9 +1015,9 @@ def names_used_in_codec(code: PackageCode) -> set[str]:
     Collected once per package: testing each exported name against every body line was quadratic in the number
     of commands (minutes for a few thousand).
     """
-    bodies = [line for _, _, _, lines in code.decoders for line in lines]
+    bodies = [line for _, _, _, lines in code.decoder_lines() for line in lines]
     bodies += [line for _, _, lines in code.encoders for line in lines]
-    types = {r for _, r, _, _ in code.decoders} | {t for _, t, _ in code.encoders}
+    types = {r for _, r, _, _ in code.decoder_lines()} | {t for _, t, _ in code.encoders}
     types |= set(code.built) | code.member_maps  # built by decoders; enums and flags looked up
     return types | set(_IDENTIFIER.findall("\n".join(bodies)))
 

@@ -16,6 +16,22 @@ from dataclasses import dataclass, field, replace
 from serialspec.backends.common.numbers import number
 from serialspec.backends.common.text import collapse
 from serialspec.backends.python.framecode import Straight, frame_encoder, straight_direction
+from serialspec.backends.python.ir import (
+    Advance,
+    Block,
+    Code,
+    ContentSize,
+    If,
+    LeftOver,
+    Loop,
+    Needs,
+    Raise,
+    ReturnNew,
+    Unpack,
+    fold_last_size_check,
+    render,
+    values_tuple,
+)
 from serialspec.backends.python.kinds import kind
 from serialspec.lang import expression
 from serialspec.lang.model import (
@@ -49,11 +65,6 @@ def encoder_name(message: Message) -> str:
     return f"_encode_{message.key.replace('.', '_')}_{message.direction.value}"
 
 
-def values_tuple(values: list[str]) -> str:
-    """A tuple display of expressions: `(a, b)`, `(a,)`, `()`."""
-    return f"({values[0]},)" if len(values) == 1 else f"({', '.join(values)})"
-
-
 def bound(f: Scalar, value: float) -> str:
     """A range bound as the literal a comparison with the field's values is quickest with: a float field's bounds
     as floats where they are exactly that (a float compared with float32's maximum written as a 39-digit integer
@@ -66,34 +77,6 @@ def bound(f: Scalar, value: float) -> str:
 _LOOP = re.compile(r"^(?P<indent> *)for (?P<var>[A-Za-z_]\w*) in .+:$")
 
 
-_NEEDS = re.compile(r"^if end - o < (?P<size>\w+):$")
-
-
-def fold_last_size_check(lines: Lines) -> Lines:
-    """A decoder's lines with the size check of its last field, read up to the content's end, and the check that
-    nothing is left after it made one comparison on the way of an intact frame (`end - o != size`), each error
-    still raised as before; the cursor is not moved past the last field, as nothing reads it."""
-    if len(lines) < 7 or not lines[-1].startswith("return ") or _CURSOR_WORD.search(lines[-1]):
-        return lines
-    needs, raised, read, moved, left, raised_left = lines[-7:-1]
-    found = _NEEDS.match(needs)
-    if found is None or moved != f"o += {found['size']}" or left != "if o != end:" or read.startswith(" "):
-        return lines
-    if not raised.startswith("    raise ") or not raised_left.endswith("bytes left after the last field')"):
-        return lines
-    size = found["size"]
-    return [
-        *lines[:-7],
-        f"if end - o != {size}:",
-        f"    {needs}",
-        f"    {raised}",
-        raised_left.replace("{end - o}", f"{{end - o - {size}}}"),
-        read,
-        lines[-1],
-    ]
-
-
-_CURSOR_WORD = re.compile(r"\bo\b")
 _DEFERRED = "#deferred "  # check_items' mark before the loop over a list whose item range is its type's
 
 
@@ -175,7 +158,7 @@ _UNPACKED = re.compile(r"^(?P<targets>[\w, ]+?),? = (?P<call>_S_\w+\.unpack_from
 _ONE_BYTE = re.compile(r"^(?P<indent> *)(?P<target>\w+), = (?P<struct>_S_\w+)\.unpack_from\(buf, (?P<at>.+)\)$")
 
 
-def fuse_unpack(lines: Lines, structs: dict[str, str]) -> Lines:
+def fuse_unpack_lines(lines: Lines, structs: dict[str, str]) -> Lines:
     """A decoder's final lines, made cheaper where the analysis of whole frames (package.fixed_frames) is done
     with them: an unpack into locals that are then built, in order, into the returned message becomes one line,
     `return _new(Cls, _S.unpack_from(buf, o))` (the tuple struct gives is the message's); a lone unsigned byte is
@@ -290,7 +273,7 @@ class PackageCode:
         self.structs: dict[str, str] = {}  # constant name -> format
         self.helper_classes: list[ClassCode] = []
         self.message_classes: list[ClassCode] = []
-        self.decoders: list[tuple[str, str, str, Lines]] = []  # name, return type, extra parameters, body
+        self.decoders: list[tuple[str, str, str, Block]] = []  # name, return type, extra parameters, body
         self.encoders: list[tuple[str, str, Lines]] = []  # name, parameter type, body
         # classes the decoders build through their slots (see `build`): class name -> field names in order
         self.built: dict[str, list[str]] = {}
@@ -300,6 +283,9 @@ class PackageCode:
         self._straight: dict[Direction, Straight | None] = {}
         for message in protocol.messages():
             self.message(message)
+
+    def decoder_lines(self) -> list[tuple[str, str, str, Lines]]:
+        return [(name, returns, extra, render(body)) for name, returns, extra, body in self.decoders]
 
     def straight(self, direction: Direction) -> Straight | None:
         """The direction's frames when straight-line code takes them (framecode.py), worked out once."""
@@ -467,44 +453,41 @@ class PackageCode:
     def where(self, message: Message) -> str:
         return repr(f"{message.key} {message.direction.value}")
 
-    def decoder(self, message: Message, all_fields: list[SpecField]) -> Lines:
+    def decoder(self, message: Message, all_fields: list[SpecField]) -> Block:
         """Body of `_decode_X(buf, o, end, *frame_values)`: content bytes buf[o:end] -> message."""
-        lines: Lines = []
+        body: Block = []
         where = self.where(message)
         low, high = message.min_size, message.max_size
-        if low == high:
-            lines.append(f"if end - o != {low}:")
-        elif high is None:
-            lines.append(f"if end - o < {low}:")
-        else:
-            lines.append(f"if not {low} <= end - o <= {high}:")
-        lines.append(f"    raise content_size_error({where}, end - o, {low}, {high})")
-        if low == 0 and high is None:
-            del lines[-2:]  # any size will do
+        if not (low == 0 and high is None):  # else any size will do
+            body.append(ContentSize(low, high, where))
         # Where the layout alone says the fields end at `end` (one fixed size, checked above, or a last field that
         # takes the rest), no check that they do is emitted, and nothing reads the cursor after the last field.
         exact = low == high and all(fixed_size(f) is not None for f in message.fields)
         exact = exact or takes_the_rest(message.fields[-1] if message.fields else None)
-        values = self.decode_fields(list(message.fields), message.class_name, lines, where, top=not exact)
-        if exact and (lines[-1].startswith("o += ") or lines[-1] == "o = end"):
-            lines.pop()
-        self.check_values(list(message.fields), lines, where)
+        values = self.decode_fields(list(message.fields), message.class_name, body, where, top=not exact)
+        if exact and body and isinstance(body[-1], Advance) and body[-1].to in ("", "end"):
+            body.pop()
+        self.check_values(list(message.fields), body, where)
         frame_fields = all_fields[: len(all_fields) - len(self.value_fields(message))]
-        frame_values = [self.after_unpack(f, f.name, lines, where) or f.name for f in frame_fields]
-        self.build(message.class_name, [f.name for f in all_fields], [*frame_values, *values], "m", lines)
-        lines[-1] = lines[-1].replace("m = ", "return ", 1)
-        return lines
+        frame_values = [self.after_unpack(f, f.name, body, where) or f.name for f in frame_fields]
+        names = [f.name for f in all_fields]
+        assert len(names) == len(frame_values) + len(values), (message.class_name, names, frame_values, values)
+        self.built[message.class_name] = names
+        body.append(ReturnNew(message.class_name, (*frame_values, *values)))
+        return body
 
-    def build(self, class_name: str, names: list[str], values: list[str], target: str, lines: Lines) -> None:
-        """The line that makes an instance of a generated class in `target` from its field values, in field order.
+    def build(self, class_name: str, names: list[str], values: list[str], target: str, body: Block) -> None:
+        """The statement that makes an instance of a generated class in `target` from its field values, in field
+        order.
 
-        Every decoder builds its messages here (one place, so a change of how messages are made reaches all of
-        them): `_new(Class, (values...))` is the runtime's `build`, one C call that stores the tuple of values as
-        the record (message.py); decoded values need none of the checks the class's __new__ would not make anyway.
+        Every decoder builds its messages here or as a ReturnNew (one place, so a change of how messages are made
+        reaches all of them): `_new(Class, (values...))` is the runtime's `build`, one C call that stores the tuple
+        of values as the record (message.py); decoded values need none of the checks the class's __new__ would not
+        make anyway.
         """
         assert len(names) == len(values), (class_name, names, values)
         self.built[class_name] = names
-        lines.append(f"{target} = _new({class_name}, {values_tuple(values)})")
+        body.append(Code(f"{target} = _new({class_name}, {values_tuple(values)})"))
 
     def build_each(self, class_name: str, names: list[str], tuples: str) -> str:
         """The expression of a tuple of instances of a generated class, one built (as `build` does) from each tuple
@@ -523,19 +506,18 @@ class PackageCode:
         self.member_maps.add(enum)
         return f"{members_name(enum)}.get({raw}, {raw})"
 
-    def flags_value(self, flags: str, raw: str, lines: Lines) -> str:
+    def flags_value(self, flags: str, raw: str, body: Block) -> str:
         """A flags member for a wire value: looked up, made by the flag class only the first time it is seen."""
         self.member_maps.add(flags)
         name = f"{raw}_flags"
-        lines.append(f"{name} = {members_name(flags)}.get({raw})")
-        lines.append(f"if {name} is None:")
-        lines.append(f"    {name} = {flags}({raw})")
+        body.append(Code(f"{name} = {members_name(flags)}.get({raw})"))
+        body.append(If(f"{name} is None", (Code(f"{name} = {flags}({raw})"),)))
         return name
 
     def decode_fields(
-        self, fields: list[SpecField], base: str, lines: Lines, where: str, top: bool, known: int | None = None
+        self, fields: list[SpecField], base: str, body: Block, where: str, top: bool, known: int | None = None
     ) -> list[str]:
-        """Append lines reading fields at cursor `o`; return the expressions of the non-hidden values.
+        """Append statements reading fields at cursor `o`; return the expressions of the non-hidden values.
 
         `known`: bytes known to be left at `o` (None: as many as the leading fixed fields take, which the content's
         size check covers). A run of fixed fields beyond them (after a variable field, in an item of varying size)
@@ -546,21 +528,19 @@ class PackageCode:
             if isinstance(item, list):
                 size = sum(fixed_size(f) or 0 for f in item)
                 if known is not None and size > known:
-                    lines.append(f"if end - o < {size}:")
                     reason = f"{item[0].name} needs {size} bytes, {{end - o}} left"
-                    lines.append(f"    raise DecodeError({where} + f': {reason}')")
+                    body.append(Needs(str(size), f"DecodeError({where} + f': {reason}')"))
                     known = size
                 known = None if known is None else known - size
-                values += self.decode_run(item, base, lines, where)
+                values += self.decode_run(item, base, body, where)
             else:
-                values.append(self.decode_variable(item, fields, base, lines, where))
+                values.append(self.decode_variable(item, fields, base, body, where))
                 known = 0
         if top:
-            lines.append("if o != end:")
-            lines.append(f"    raise DecodeError({where} + f': {{end - o}} bytes left after the last field')")
+            body.append(LeftOver(where))
         return values
 
-    def check_values(self, fields: list[SpecField], lines: Lines, where: str) -> None:
+    def check_values(self, fields: list[SpecField], body: Block, where: str) -> None:
         """Every value derived by an expression must hold what the expression gives for the decoded fields."""
         counted = {f.count: f.name for f in fields if isinstance(f, List) and isinstance(f.count, str)}
         # a byte size of a list of numbers: decoding read size // item items and refused a remainder
@@ -577,11 +557,10 @@ class PackageCode:
             if isinstance(f, Scalar) and f.value is not None:
                 expected = expression.render(f.value, self.local_named)
                 shown = one_line(expression.show(f.value)).replace("{", "{{").replace("}", "}}")
-                lines.append(f"if {self.local(f)} != {expected}:")
                 reason = f"{f.name} is {{{self.local(f)}}}, but {shown} = {{{expected}}}"
-                lines.append(f"    raise DecodeError({where} + f': {reason}')")
+                body.append(If(f"{self.local(f)} != {expected}", (Raise(f"DecodeError({where} + f': {reason}')"),)))
 
-    def decode_run(self, run: list[SpecField], base: str, lines: Lines, where: str) -> list[str]:
+    def decode_run(self, run: list[SpecField], base: str, body: Block, where: str) -> list[str]:
         endian = next((f.endian for f in run if isinstance(f, Scalar | Array | TableBlock)), "<")
         fmt = struct_format(endian, run)
         const_name = self.struct(f"{base}_{run[0].name}", fmt)
@@ -590,14 +569,13 @@ class PackageCode:
         values: list[str] = []
         if simple:
             names = [self.local(f) for f in run]
-            target = ", ".join(names) + ("," if len(names) == 1 else "")
-            lines.append(f"{target} = {const_name}.unpack_from(buf, o)")
+            body.append(Unpack(tuple(names), const_name, byte=fmt in ("<B", ">B")))
             for f, name in zip(run, names, strict=True):
-                expr = self.after_unpack(f, name, lines, where)
+                expr = self.after_unpack(f, name, body, where)
                 if expr is not None:
                     values.append(expr)
         else:
-            lines.append(f"t = {const_name}.unpack_from(buf, o)")
+            body.append(Unpack(("t",), const_name, tuple_target=True))
             position = 0
             for f in run:
                 if isinstance(f, Array):
@@ -609,36 +587,35 @@ class PackageCode:
                         item = f"t[{position}]"
                         items.append(self.enum_value(e.enum.class_name, item) if e.enum else item)
                         position += 1
-                    self.build(f.class_name, [e.name for e in f.entries], items, self.local(f), lines)
+                    self.build(f.class_name, [e.name for e in f.entries], items, self.local(f), body)
                     values.append(self.local(f))
                 else:
                     name = self.local(f)
-                    lines.append(f"{name} = t[{position}]")
+                    body.append(Code(f"{name} = t[{position}]"))
                     position += 1
-                    expr = self.after_unpack(f, name, lines, where)
+                    expr = self.after_unpack(f, name, body, where)
                     if expr is not None:
                         values.append(expr)
-        lines.append(f"o += {size}")
+        body.append(Advance(str(size)))
         return values
 
     @staticmethod
     def local(f: SpecField) -> str:
         return f"v_{f.name}"
 
-    def after_unpack(self, f: SpecField, name: str, lines: Lines, where: str) -> str | None:
+    def after_unpack(self, f: SpecField, name: str, body: Block, where: str) -> str | None:
         """Checks and conversions after a scalar is unpacked; the value expression, or None if hidden."""
         if not isinstance(f, Scalar):
             return name
         if f.const is not None:
-            lines.append(f"if {name} != {f.const}:")
-            lines.append(f"    raise DecodeError({where} + f': {f.name} is {{{name}:#x}}, expected {f.const:#x}')")
+            error = f"DecodeError({where} + f': {f.name} is {{{name}:#x}}, expected {f.const:#x}')"
+            body.append(If(f"{name} != {f.const}", (Raise(error),)))
             return None
         if f.derived or f.value is not None:
             return None
         if f.sign_magnitude:
             top = 1 << (f.type.size * 8 - 1)
-            lines.append(f"if {name} & {top:#x}:")
-            lines.append(f"    {name} = -({name} & {top - 1:#x})")
+            body.append(If(f"{name} & {top:#x}", (Code(f"{name} = -({name} & {top - 1:#x})"),)))
         if f.bits:
             used = 0
             parts = []
@@ -646,133 +623,130 @@ class PackageCode:
                 used |= bit.mask << bit.low
                 raw = f"({name} >> {bit.low}) & {bit.mask:#x}" if bit.low else f"{name} & {bit.mask:#x}"
                 if bit.enum:
-                    lines.append(f"{name}_{bit.name} = {raw}")
+                    body.append(Code(f"{name}_{bit.name} = {raw}"))
                     parts.append(self.enum_value(bit.enum.class_name, f"{name}_{bit.name}"))
                 else:
                     parts.append(raw)
             unused = ((1 << (f.type.size * 8)) - 1) & ~used
             if unused:
-                lines.append(f"if {name} & {unused:#x}:")
-                lines.append(f"    raise DecodeError({where} + f': unused bits of {f.name} are set ({{{name}:#04x}})')")
-            self.build(f.bits_class, [b.name for b in f.bits], parts, f"{name}_bits", lines)
+                error = f"DecodeError({where} + f': unused bits of {f.name} are set ({{{name}:#04x}})')"
+                body.append(If(f"{name} & {unused:#x}", (Raise(error),)))
+            self.build(f.bits_class, [b.name for b in f.bits], parts, f"{name}_bits", body)
             return f"{name}_bits"
         if f.enum:
             return self.enum_value(f.enum.class_name, name)
         if f.flags:
-            return self.flags_value(f.flags.class_name, name, lines)
+            return self.flags_value(f.flags.class_name, name, body)
         return name
 
-    def decode_variable(self, f: SpecField, siblings: list[SpecField], base: str, lines: Lines, where: str) -> str:
+    def decode_variable(self, f: SpecField, siblings: list[SpecField], base: str, body: Block, where: str) -> str:
         if isinstance(f, List):
-            return self.decode_list(f, lines, where, siblings)
+            return self.decode_list(f, body, where, siblings)
         if isinstance(f, Text):
-            return self.decode_text(f, lines, where)
+            return self.decode_text(f, body, where)
         if isinstance(f, Bytes):
             if f.size == "rest":
-                lines.append(f"{self.local(f)} = buf[o:end]")
-                lines.append("o = end")
+                body.append(Code(f"{self.local(f)} = buf[o:end]", cursor=True))
+                body.append(Advance(to="end"))
             else:
                 size = self.local_named(str(f.size))
-                lines.append(f"if end - o < {size}:")
-                lines.append(f"    raise DecodeError({where} + f': {f.name} needs {{{size}}} bytes, {{end - o}} left')")
-                lines.append(f"{self.local(f)} = buf[o : o + {size}]")
-                lines.append(f"o += {size}")
+                body.append(
+                    Needs(size, f"DecodeError({where} + f': {f.name} needs {{{size}}} bytes, {{end - o}} left')")
+                )
+                body.append(Code(f"{self.local(f)} = buf[o : o + {size}]", cursor=True))
+                body.append(Advance(size))
             return self.local(f)
         if isinstance(f, TableValue):
             table = f"_TABLE_{f.table.name.upper()}"
             key = self.local_named(f.key)
-            lines.append(f"s = {table}.get({key})")
-            lines.append("if s is None:")
-            lines.append(f"    raise DecodeError({where} + f': unknown {f.table.key_name} {{{key}}}')")
-            lines.append("if end - o < s.size:")
+            body.append(Code(f"s = {table}.get({key})"))
+            error = f"DecodeError({where} + f': unknown {f.table.key_name} {{{key}}}')"
+            body.append(If("s is None", (Raise(error),)))
             reason = f"{f.name} needs {{s.size}} bytes for {f.table.key_name} {{{key}}}"
-            lines.append(f"    raise DecodeError({where} + f': {reason}')")
-            lines.append(f"({self.local(f)},) = s.unpack_from(buf, o)")
-            lines.append("o += s.size")
+            body.append(If("end - o < s.size", (Raise(f"DecodeError({where} + f': {reason}')"),), cursor=True))
+            body.append(Code(f"({self.local(f)},) = s.unpack_from(buf, o)", cursor=True))
+            body.append(Advance("s.size"))
             return self.local(f)
         assert isinstance(f, Group)
         item_fields = list(f.fields)
         value = self.local(f)
         item_names = [i.name for i in item_fields if not (isinstance(i, Scalar) and i.hidden)]
-        lines.append(f"{value}_list = []")
+        start_list = Code(f"{value}_list = []")
+        body.append(start_list)
         if f.item_size is not None:
             item_fmt = struct_format(self.protocol_endian(), item_fields)
             item_struct = self.struct(f"{f.class_name}", item_fmt)
             if f.count == "rest":
-                lines.append(f"if (end - o) % {f.item_size}:")
                 reason = f"{{end - o}} bytes do not split into {f.name} items of {f.item_size}"
-                lines.append(f"    raise DecodeError({where} + f': {reason}')")
-                lines.append("n = end - o")
+                split = Raise(f"DecodeError({where} + f': {reason}')")
+                body.append(If(f"(end - o) % {f.item_size}", (split,), cursor=True))
+                body.append(Code("n = end - o", cursor=True))
             else:
                 count = str(f.count) if isinstance(f.count, int) else self.local_named(f.count)
-                lines.append(f"n = {count} * {f.item_size}")
-                lines.append("if end - o < n:")
-                lines.append(
-                    f"    raise DecodeError({where} + f': content too short for its count ({{{count}}} {f.name})')"
-                )
+                body.append(Code(f"n = {count} * {f.item_size}"))
+                reason = f"content too short for its count ({{{count}}} {f.name})"
+                body.append(Needs("n", f"DecodeError({where} + f': {reason}')"))
             names = [self.local(i) for i in item_fields]
-            item_lines: Lines = []
-            item_values = [self.after_unpack(i, n, item_lines, where) for i, n in zip(item_fields, names, strict=True)]
+            item_body: Block = []
+            item_values = [self.after_unpack(i, n, item_body, where) for i, n in zip(item_fields, names, strict=True)]
             values = [v for v in item_values if v is not None]
             items = f"{item_struct}.iter_unpack(buf[o : o + n])"
-            if not item_lines and values == names:  # the unpacked tuples are the items' values
-                lines.pop(lines.index(f"{value}_list = []"))
-                lines.append(f"{value} = {self.build_each(f.class_name, item_names, items)}")
-                lines.append("o += n")
+            if not item_body and values == names:  # the unpacked tuples are the items' values
+                body.remove(start_list)
+                body.append(Code(f"{value} = {self.build_each(f.class_name, item_names, items)}", cursor=True))
+                body.append(Advance("n"))
                 return value
-            self.build(f.class_name, item_names, values, "item", item_lines)
+            self.build(f.class_name, item_names, values, "item", item_body)
             target = ", ".join(names) + ("," if len(names) == 1 else "")
-            lines.append(f"for {target} in {items}:")
-            lines.extend("    " + line for line in item_lines)
-            lines.append(f"    {value}_list.append(item)")
-            lines.append(f"{value} = tuple({value}_list)")
-            lines.append("o += n")
+            item_body.append(Code(f"{value}_list.append(item)"))
+            body.append(Loop(f"for {target} in {items}", tuple(item_body), cursor=True))
+            body.append(Code(f"{value} = tuple({value}_list)"))
+            body.append(Advance("n"))
             return value
         # items of varying size: read them one by one
         if f.count == "rest":
-            lines.append("while o < end:")
+            header, cursor = "while o < end", True
         else:
             count = str(f.count) if isinstance(f.count, int) else self.local_named(f.count)
-            lines.append(f"for _ in range({count}):")
-        inner: Lines = []
+            header, cursor = f"for _ in range({count})", False
+        inner: Block = []
         # in `while o < end` one byte is known to be left, in `for _ in range(count)` none
         item_args = self.decode_fields(item_fields, f.class_name, inner, where, False, 1 if f.count == "rest" else 0)
         self.build(f.class_name, item_names, item_args, "item", inner)
-        lines.extend("    " + line for line in inner)
-        lines.append(f"    {value}_list.append(item)")
-        lines.append(f"{value} = tuple({value}_list)")
+        inner.append(Code(f"{value}_list.append(item)"))
+        body.append(Loop(header, tuple(inner), cursor=cursor))
+        body.append(Code(f"{value} = tuple({value}_list)"))
         return value
 
-    def decode_list(self, f: List, lines: Lines, where: str, siblings: list[SpecField]) -> str:
+    def decode_list(self, f: List, body: Block, where: str, siblings: list[SpecField]) -> str:
         """A list of numbers or bits: its count from a number, a count field, a byte-size field, or the rest."""
         value = self.local(f)
         item = 1 if f.item is None else f.item.size
         if f.size or f.count == "rest":
-            lines.append(f"nb = {self.local_named(f.size)}" if f.size else "nb = end - o")
+            body.append(Code(f"nb = {self.local_named(f.size)}") if f.size else Code("nb = end - o", cursor=True))
             if f.item is None:
-                lines.append("n = nb * 8")
+                body.append(Code("n = nb * 8"))
             else:
                 if item > 1:
-                    lines.append(f"if nb % {item}:")
                     reason = f"{{nb}} bytes do not split into {f.name} items of {item}"
-                    lines.append(f"    raise DecodeError({where} + f': {reason}')")
-                lines.append(f"n = nb // {item}" if item > 1 else "n = nb")
+                    body.append(If(f"nb % {item}", (Raise(f"DecodeError({where} + f': {reason}')"),)))
+                body.append(Code(f"n = nb // {item}" if item > 1 else "n = nb"))
         else:
-            lines.append(f"n = {f.count if isinstance(f.count, int) else self.local_named(str(f.count))}")
-            lines.append("nb = (n + 7) >> 3" if f.item is None else (f"nb = n * {item}" if item > 1 else "nb = n"))
-        lines.append("if end - o < nb:")
-        lines.append(f"    raise DecodeError({where} + f': {f.name} needs {{nb}} bytes, {{end - o}} left')")
+            body.append(Code(f"n = {f.count if isinstance(f.count, int) else self.local_named(str(f.count))}"))
+            body.append(Code("nb = (n + 7) >> 3" if f.item is None else (f"nb = n * {item}" if item > 1 else "nb = n")))
+        body.append(Needs("nb", f"DecodeError({where} + f': {f.name} needs {{nb}} bytes, {{end - o}} left')"))
         most = self.most_items(f, siblings)
         if f.item is None:
-            lines.append(f"{value} = _unpack_bits(buf, o, n)")
+            body.append(Code(f"{value} = _unpack_bits(buf, o, n)", cursor=True))
         elif most is not None and most <= _MOST_RUNS:  # a struct per count, made once
             name = f"_RUNS_{'BE' if f.endian == '>' else 'LE'}_{_STRUCT_NAMES[f.item.struct_char]}"
             known = self.unpack_runs.get(name, ("", 0))[1]
             self.unpack_runs[name] = (f"{f.endian}{f.item.struct_char}", max(most, known))
-            lines.append(f"{value} = {name}[n](buf, o)")
+            body.append(Code(f"{value} = {name}[n](buf, o)", cursor=True))
         else:
-            lines.append(f"{value} = struct.unpack_from(f'{f.endian}{{n}}{f.item.struct_char}', buf, o)")
-        lines.append("o += nb")
+            read = f"struct.unpack_from(f'{f.endian}{{n}}{f.item.struct_char}', buf, o)"
+            body.append(Code(f"{value} = {read}", cursor=True))
+        body.append(Advance("nb"))
         return value
 
     def most_items(self, f: List, siblings: list[SpecField]) -> int | None:
@@ -786,24 +760,22 @@ class PackageCode:
             return int(scalars[f.count].type.maximum)
         return None
 
-    def decode_text(self, f: Text, lines: Lines, where: str) -> str:
+    def decode_text(self, f: Text, body: Block, where: str) -> str:
         value = self.local(f)
         if f.size is None:
-            lines.append("stop = buf.find(b'\\0', o, end)")
-            lines.append("if stop < 0:")
-            lines.append(f"    raise DecodeError({where} + ': {f.name} has no NUL at its end')")
-            lines.append(f"{value} = _decode_text(buf[o:stop], {f.name!r}, {where})")
-            lines.append("o = stop + 1")
+            body.append(Code("stop = buf.find(b'\\0', o, end)", cursor=True))
+            body.append(If("stop < 0", (Raise(f"DecodeError({where} + ': {f.name} has no NUL at its end')"),)))
+            body.append(Code(f"{value} = _decode_text(buf[o:stop], {f.name!r}, {where})", cursor=True))
+            body.append(Advance(to="stop + 1"))
             return value
         if f.size == "rest":
-            lines.append(f"{value} = _decode_text(buf[o:end], {f.name!r}, {where})")
-            lines.append("o = end")
+            body.append(Code(f"{value} = _decode_text(buf[o:end], {f.name!r}, {where})", cursor=True))
+            body.append(Advance(to="end"))
             return value
         size = str(f.size) if isinstance(f.size, int) else self.local_named(f.size)
-        lines.append(f"if end - o < {size}:")
-        lines.append(f"    raise DecodeError({where} + f': {f.name} needs {{{size}}} bytes, {{end - o}} left')")
-        lines.append(f"{value} = _decode_text(buf[o : o + {size}], {f.name!r}, {where})")
-        lines.append(f"o += {size}")
+        body.append(Needs(size, f"DecodeError({where} + f': {f.name} needs {{{size}}} bytes, {{end - o}} left')"))
+        body.append(Code(f"{value} = _decode_text(buf[o : o + {size}], {f.name!r}, {where})", cursor=True))
+        body.append(Advance(size))
         return value
 
     def local_named(self, name: str) -> str:

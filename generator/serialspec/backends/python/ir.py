@@ -14,14 +14,17 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, replace
+from typing import assert_never
 
 
 @dataclass(frozen=True)
 class Code:
-    """A simple statement no rewrite looks into; `cursor`: it reads `o` or `end`."""
+    """A simple statement no rewrite looks into; `cursor`: it reads `o` or `end`; `reads`: the constant offsets of
+    `buf` it reads."""
 
     text: str
     cursor: bool = False
+    reads: tuple[int, ...] = ()
 
     def lines(self) -> list[str]:
         return [self.text]
@@ -44,9 +47,12 @@ class If:
     condition: str
     body: tuple[Statement, ...]
     cursor: bool = False  # the condition reads `o` or `end`
+    reads: tuple[int, ...] = ()  # the constant offsets of `buf` the condition reads
+    comment: str = ""
 
     def lines(self) -> list[str]:
-        return [f"if {self.condition}:", *indented(self.body)]
+        comment = f"  # {self.comment}" if self.comment else ""
+        return [f"if {self.condition}:{comment}", *indented(self.body)]
 
 
 @dataclass(frozen=True)
@@ -96,9 +102,46 @@ class Needs:
 
 
 @dataclass(frozen=True)
+class Expect:
+    """An unpacked value that must be one constant (a fixed field, a sub-command's code): else `error` is raised."""
+
+    name: str
+    value: str
+    error: str
+
+    def lines(self) -> list[str]:
+        return [f"if {self.name} != {self.value}:", f"    raise {self.error}"]
+
+
+@dataclass(frozen=True)
+class TakeRest:
+    """`target = buf[start:stop]`: bytes up to the content's end (`stop`)."""
+
+    target: str
+    start: str = "o"
+    stop: str = "end"
+
+    def lines(self) -> list[str]:
+        return [f"{self.target} = buf[{self.start}:{self.stop}]"]
+
+
+@dataclass(frozen=True)
+class SumCheck:
+    """`return None` unless an 8-bit sum over all of `buf` but its first bytes (their sum taken off: `less`) holds:
+    the covered bytes sum to the check byte at `check_at`, so the whole frame sums to twice it."""
+
+    less: str
+    check_at: str
+
+    def lines(self) -> list[str]:
+        return [f"if (sum(buf){self.less} - 2 * buf[{self.check_at}]) & 0xff:", "    return None"]
+
+
+@dataclass(frozen=True)
 class Unpack:
     """`targets = <struct>.unpack_from(buf, <at>)`; `tuple_target`: one target that takes the whole tuple (`t = `);
-    `byte`: the struct is one unsigned byte, read by indexing once `indexed` (see fuse_unpack)."""
+    `byte`: the struct is one unsigned byte, read by indexing once `indexed` (see fuse_unpack); `at` "": the struct
+    is the whole of `buf`."""
 
     targets: tuple[str, ...]
     struct: str
@@ -109,7 +152,7 @@ class Unpack:
 
     @property
     def call(self) -> str:
-        return f"{self.struct}.unpack_from(buf, {self.at})"
+        return f"{self.struct}.unpack_from(buf, {self.at})" if self.at else f"{self.struct}.unpack(buf)"
 
     def lines(self) -> list[str]:
         if self.indexed:
@@ -163,7 +206,22 @@ class ReturnNew:
         return [f"return _new({self.cls}, {values_tuple(list(self.values))})"]
 
 
-Statement = Code | Raise | If | Loop | ContentSize | Needs | Unpack | Advance | LeftOver | ReturnNew
+Statement = (
+    Code
+    | Raise
+    | If
+    | Loop
+    | ContentSize
+    | Needs
+    | Expect
+    | TakeRest
+    | SumCheck
+    | Unpack
+    | Advance
+    | LeftOver
+    | ReturnNew
+)
+RETURN_NONE = Code("return None")
 Block = list[Statement]
 
 
@@ -176,7 +234,7 @@ def indented(statements: Iterable[Statement], prefix: str = "    ") -> list[str]
     return [prefix + line for statement in statements for line in statement.lines()]
 
 
-def render(statements: Iterable[Statement]) -> list[str]:
+def lines_of(statements: Iterable[Statement]) -> list[str]:
     """The source lines of statements, at the indentation of their block."""
     return [line for statement in statements for line in statement.lines()]
 
@@ -191,7 +249,7 @@ def walk(statements: Iterable[Statement]) -> Iterator[Statement]:
 
 def raises(statements: Iterable[Statement]) -> bool:
     """Whether any of the statements raises an error (a check)."""
-    return any(isinstance(s, Raise | ContentSize | Needs | LeftOver) for s in walk(statements))
+    return any(isinstance(s, Raise | ContentSize | Needs | Expect | LeftOver) for s in walk(statements))
 
 
 def reads_cursor(statement: Statement) -> bool:
@@ -201,12 +259,16 @@ def reads_cursor(statement: Statement) -> bool:
             return statement.cursor
         case Unpack():
             return statement.at == "o"
+        case TakeRest():
+            return statement.start == "o" or statement.stop == "end"
         case ReturnNew():
             return statement.unpacked is not None and statement.unpacked.at == "o"
         case ContentSize() | Needs() | Advance() | LeftOver():
             return True
-        case Raise():
+        case Raise() | Expect() | SumCheck():
             return False
+        case _:
+            assert_never(statement)
 
 
 def fold_last_size_check(body: Block) -> Block:
@@ -227,7 +289,7 @@ def fold_last_size_check(body: Block) -> Block:
     return [*body[:-5], folded, read, returned]
 
 
-def fuse_unpack(body: Block, structs: dict[str, str] | None = None) -> Block:
+def fuse_unpack(body: Block) -> Block:
     """A decoder's final statements, made cheaper: an unpack into locals that are then built, in order, into the
     returned message becomes one statement, `return _new(Cls, _S.unpack_from(buf, o))` (the tuple struct gives is
     the message's); a lone unsigned byte is read by indexing, not unpacked (at any depth)."""

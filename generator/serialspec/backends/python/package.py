@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import re
 import struct
+from collections.abc import Callable
 from dataclasses import replace
 from typing import Any
 
@@ -11,6 +12,26 @@ from serialspec.backends.common.numbers import number
 from serialspec.backends.python.client import client_module
 from serialspec.backends.python.framecode import Target, direction_functions
 from serialspec.backends.python.frames import checksum_definitions, code_key, codec_lines, framing_imports
+from serialspec.backends.python.ir import (
+    RETURN_NONE,
+    Advance,
+    Block,
+    Code,
+    ContentSize,
+    Expect,
+    If,
+    Loop,
+    ReturnNew,
+    Statement,
+    SumCheck,
+    TakeRest,
+    Unpack,
+    fuse_unpack,
+    lines_of,
+    raises,
+    reads_cursor,
+    walk,
+)
 from serialspec.backends.python.pycode import (
     ClassCode,
     Lines,
@@ -20,10 +41,8 @@ from serialspec.backends.python.pycode import (
     decoder_name,
     encoder_name,
     one_line,
+    reflect,
     takes_the_rest,
-)
-from serialspec.backends.python.pycode import (
-    fuse_unpack_lines as fuse_unpack,
 )
 from serialspec.backends.python.registers import register_tables, registers_module
 from serialspec.backends.python.render import render
@@ -32,6 +51,7 @@ from serialspec.backends.python.structs import structs_module
 from serialspec.collection import without_cycle_collection
 from serialspec.lang.model import (
     Bytes,
+    Checksum,
     Command,
     Direction,
     FrameLayout,
@@ -276,18 +296,29 @@ def general_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
 def plain_messages(single: dict[str, Message], code: PackageCode) -> list[tuple[int, int, str, str, str]]:
     """(code, content size, class, struct, its format) of the messages of one size whose decoder, past its size
     check, is one struct's unpack of the content as their message (framecode.whole_frames decodes them whole)."""
-    bodies = {name: lines for name, _, _, lines in code.decoder_lines()}
+    bodies = {name: body for name, _, _, body in code.decoders}
     found = []
     for key, message in single.items():
-        lines = bodies[decoder_name(message)]
-        if key in ("None", "ERROR_REPLY") or message.min_size != message.max_size or len(lines) < 3:
+        body = bodies[decoder_name(message)]
+        if key in ("None", "ERROR_REPLY") or message.min_size != message.max_size or len(body) < 2:
             continue
-        fused = fuse_unpack(lines[2:], code.structs)
-        plain = _PLAIN.match(fused[0]) if len(fused) == 1 and lines[0].startswith("if end - o != ") else None
-        if plain is not None:
-            struct = plain["struct"]
-            found.append((int(key, 16), message.min_size or 0, plain["cls"], struct, code.structs[struct]))
+        if not (isinstance(body[0], ContentSize) and body[0].exact):
+            continue
+        unpacked = content_unpacked(body[1:])
+        if unpacked is not None:
+            cls, struct = unpacked
+            found.append((int(key, 16), message.min_size or 0, cls, struct, code.structs[struct]))
     return found
+
+
+def content_unpacked(body: Block) -> tuple[str, str] | None:
+    """(class, struct) where a decoder's statements past its size check are one struct's unpack of the content as
+    the message, as it is: `return _new(Cls, _S.unpack_from(buf, o))`; None for others."""
+    fused = fuse_unpack(body)
+    last = fused[0] if len(fused) == 1 else None
+    if isinstance(last, ReturnNew) and last.unpacked is not None and last.unpacked.at == "o":
+        return last.cls, last.unpacked.struct
+    return None
 
 
 def value_arguments(layout: FrameLayout) -> dict[str, str]:
@@ -308,7 +339,7 @@ def classic_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
     frame_functions: list[dict[str, Any]] = []
     whole_functions: list[dict[str, Any]] = []
     whole_pickers: list[dict[str, Any]] = []
-    decoder_bodies = {name: (returns, extra, lines) for name, returns, extra, lines in code.decoder_lines()}
+    decoder_bodies = {name: (returns, extra, body) for name, returns, extra, body in code.decoders}
     for direction, layout in protocol.framing.layouts.items():
         dispatch = []
         sizes = []
@@ -331,7 +362,7 @@ def classic_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
         sub_rests = subcommand_rest_frames(protocol, layout, decoder_bodies) if whole else []
         whole_functions += sub_rests
         if whole:  # decode() looks frames up by their first bytes
-            whole_functions += [f | {"whole_lines": fuse_unpack(f["whole_lines"], code.structs)} for f in sub_functions]
+            whole_functions += [f | {"whole_lines": fuse_unpack(f["whole_lines"])} for f in sub_functions]
             whole_pickers += pickers
         range_checks = value_range_checks(layout, protocol.byte_order)
         # decode() looks these frames up before any other check: where each decoder refuses a frame of another size
@@ -339,11 +370,11 @@ def classic_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
         whole_size = max(layout.length_offset, layout.command_offset or 0) + 1
         content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
         exact = bool(whole) and not sub_entries and not rests and not sub_rests and not range_checks
-        bodies = {f["whole_name"]: fuse_unpack(f["whole_lines"], code.structs) for _, _, f in fixed}
+        bodies = {f["whole_name"]: fuse_unpack(f["whole_lines"]) for _, _, f in fixed}
         if exact:
             bodies = {
-                name: exact_whole(lines, size, whole_size, code)
-                for (_, size, f), (name, lines) in zip(fixed, bodies.items(), strict=True)
+                name: exact_whole(body, size, whole_size, code)
+                for (_, size, f), (name, body) in zip(fixed, bodies.items(), strict=True)
             }
             whole = [
                 (
@@ -355,7 +386,7 @@ def classic_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
                 for key, size, name, plain in whole
             ]
         frame_functions += [
-            f | {"lines": fuse_unpack(f["lines"], code.structs), "whole_lines": bodies[f["whole_name"]], "exact": exact}
+            f | {"lines": fuse_unpack(f["lines"]), "whole_lines": bodies[f["whole_name"]], "exact": exact}
             for _, _, f in fixed
         ]
         slice_key = None if whole else key_slice(layout)
@@ -398,6 +429,12 @@ def classic_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
         )
     layouts = protocol.framing.layouts
     header_choices = " or ".join(layouts[d].header.hex(" ") for d in Direction)
+    for function in frame_functions:
+        function["lines"], function["whole_lines"] = lines_of(function["lines"]), lines_of(function["whole_lines"])
+    for function in whole_functions:
+        function["whole_lines"] = lines_of(function["whole_lines"])
+    for picker in whole_pickers:
+        picker["lines"] = lines_of(picker["lines"])
     return {
         "classic": True,
         "checksum_import": checksum_import,
@@ -415,7 +452,7 @@ def classic_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
 def common_codec_context(protocol: Protocol, code: PackageCode, exports: list[str]) -> dict[str, Any]:
     encoder_table = [(m.class_name, encoder_name(m)) for m in protocol.messages()]
     codec_names = names_used_in_codec(code)
-    used = "\n".join(line for _, _, _, lines in code.decoder_lines() for line in lines)
+    used = "\n".join(line for _, _, _, body in code.decoders for line in lines_of(body))
     used += "\n".join(line for _, _, lines in code.encoders for line in lines)
     packing = [n for n in ("decode_text", "encode_text", "pack_bits", "unpack_bits") if f"_{n}(" in used]
     return {
@@ -427,8 +464,8 @@ def common_codec_context(protocol: Protocol, code: PackageCode, exports: list[st
         ],
         "member_maps": sorted(code.member_maps),
         "decoders": [
-            {"name": n, "returns": r, "extra": e, "lines": fuse_unpack(lines, code.structs)}
-            for n, r, e, lines in code.decoder_lines()
+            {"name": n, "returns": r, "extra": e, "lines": lines_of(fuse_unpack(body))}
+            for n, r, e, body in code.decoders
         ],
         "encoders": [{"name": n, "type": t, "lines": lines} for n, t, lines in code.encoders],
         "encoder_table": encoder_table,
@@ -438,9 +475,6 @@ def common_codec_context(protocol: Protocol, code: PackageCode, exports: list[st
         ),
         "shared_header": protocol.framing.shared_header,
     }
-
-
-_CURSOR = re.compile(r"\b(o|end)\b")
 
 
 def frame_key(layout: FrameLayout, buf: str, start: str = "") -> str:
@@ -532,7 +566,7 @@ def whole_frames(
 
 
 def fixed_frames(
-    protocol: Protocol, layout: FrameLayout, bodies: dict[str, tuple[str, str, Lines]], code: PackageCode
+    protocol: Protocol, layout: FrameLayout, bodies: dict[str, tuple[str, str, Block]], code: PackageCode
 ) -> list[tuple[str, int, dict[str, Any]]]:
     """Whole-frame decoders for the frames of one size whose content is one run of fixed fields: (size key, frame
     size, function). Each checks the checksum, unpacks the content in one call and builds the message: no
@@ -552,7 +586,7 @@ def fixed_frames(
 
 
 def subcommand_frames(
-    protocol: Protocol, layout: FrameLayout, bodies: dict[str, tuple[str, str, Lines]], code: PackageCode
+    protocol: Protocol, layout: FrameLayout, bodies: dict[str, tuple[str, str, Block]], code: PackageCode
 ) -> tuple[list[dict[str, Any]], list[dict[str, Any]], list[tuple[str, int, dict[str, Any]]]]:
     """decode()'s whole-frame decoders of sub-command frames of one size (as fixed_frames, the sub-command's check
     dropped: its code picks the decoder) and, per command and frame size, the function that picks one by the
@@ -582,10 +616,13 @@ def subcommand_frames(
                 "where": f"{command.name} {layout.direction.value}",
                 "entries": [(f"{c:#04x}", f["whole_name"]) for c, f in subs],
             }
-            lines = picked_inline(subs, at, code)
+            lines = picked_inline(subs, at)
             if lines is None:  # each sub-command's own decoder, from a table
                 functions += [f for _, f in subs]
-                lines = [f"whole = {picker['table']}.get(buf[{at}])", "return None if whole is None else whole(buf)"]
+                lines = [
+                    Code(f"whole = {picker['table']}.get(buf[{at}])"),
+                    Code("return None if whole is None else whole(buf)"),
+                ]
             else:
                 picker["entries"] = []
             pickers.append(picker | {"lines": lines})
@@ -594,7 +631,7 @@ def subcommand_frames(
 
 
 def rest_frames(
-    protocol: Protocol, layout: FrameLayout, bodies: dict[str, tuple[str, str, Lines]], code: PackageCode
+    protocol: Protocol, layout: FrameLayout, bodies: dict[str, tuple[str, str, Block]], code: PackageCode
 ) -> list[dict[str, Any]]:
     """decode()'s whole-frame decoders of the frames whose content is fixed fields then bytes to its end (FEETECH
     WRITE: an address, then the data): any length byte from the smallest such content up names one, so decode()'s
@@ -613,29 +650,30 @@ def rest_frames(
             continue
         if not (isinstance(message.fields[-1], Bytes) and takes_the_rest(message.fields[-1])):
             continue
-        returns, extra, lines = bodies[decoder_name(message)]
-        if not lines[0].startswith("if end - o < "):
+        returns, extra, decoder = bodies[decoder_name(message)]
+        if not (decoder and isinstance(decoder[0], ContentSize) and decoder[0].high is None):
             continue
         offset, body = content_offset, []
-        for line in lines[2:]:  # the size check: the key implies it
-            moved = re.fullmatch(r"o \+= (\d+)", line)
-            if moved:
-                offset += int(moved[1])
+        for statement in decoder[1:]:  # the size check: the key implies it
+            if isinstance(statement, Advance) and statement.size.isdigit():
+                offset += int(statement.size)
                 continue
-            line = line.replace("buf[o:end]", f"buf[{offset}:-{tail}]").replace("(buf, o)", f"(buf, {offset})")
-            if "raise " in line or _CURSOR.search(line):
+            if isinstance(statement, Unpack) and statement.at == "o":
+                statement = replace(statement, at=str(offset))
+            elif isinstance(statement, TakeRest):
+                statement = replace(statement, start=str(offset), stop=f"-{tail}")
+            if raises([statement]) or any(reads_cursor(s) for s in walk([statement])):
                 break  # checked beyond its size, or read at a cursor: the general path
-            body.append(line)
+            body.append(statement)
         else:
-            check_lines = rest_check_lines(protocol, layout)
-            values = [f"{e.name} = buf[{layout.offsets[e.name]}]" for e in layout.value_elements]
+            values = [Code(f"{e.name} = buf[{layout.offsets[e.name]}]") for e in layout.value_elements]
             lowest = (message.min_size or 0) + layout.length_adds
             found.append(
                 {
                     "whole_name": "_whole" + decoder_name(message).removeprefix("_decode"),
                     "returns": returns,
                     "where": f"{message.key} {message.direction.value}",
-                    "whole_lines": fuse_unpack([*check_lines, "    return None", *values, *body], code.structs),
+                    "whole_lines": fuse_unpack([*rest_check(protocol, layout), *values, *body]),
                     "code": command.code,
                     "lengths": (lowest, length.type.maximum),
                     "adds": layout.overhead - layout.length_adds,  # frame size = length byte + this
@@ -645,14 +683,14 @@ def rest_frames(
 
 
 def subcommand_rest_frames(
-    protocol: Protocol, layout: FrameLayout, bodies: dict[str, tuple[str, str, Lines]]
+    protocol: Protocol, layout: FrameLayout, bodies: dict[str, tuple[str, str, Block]]
 ) -> list[dict[str, Any]]:
     """decode()'s whole-frame decoders of the sub-command frames of more than one size (a list its count sizes), one
     per command: any length byte from the smallest such content up names it (a key per length byte, as rest_frames).
     Each checks the checksum, then picks the sub-command by its byte and runs that sub-command's content decoder's
-    lines in place: no dispatch and no call. It returns None where the checksum fails or no such sub-command has the
-    code (decode()'s general path then says why); a frame its lines refuse raises what the general path raises, as
-    that path, with the same checks passed, runs the same lines."""
+    statements in place: no dispatch and no call. It returns None where the checksum fails or no such sub-command has
+    the code (decode()'s general path then says why); a frame its statements refuse raises what the general path
+    raises, as that path, with the same checks passed, runs the same statements."""
     checksum = protocol.framing.checksum
     length = layout.length
     if checksum is None or length is None or length.type is None or layout.value_elements:
@@ -669,15 +707,15 @@ def subcommand_rest_frames(
             message = sub.request if layout.direction == Direction.REQUEST else sub.response
             if message is None or message.min_size == message.max_size:
                 continue  # none, or of one size (subcommand_frames)
-            returns, extra, lines = bodies[decoder_name(message)]
+            returns, extra, body = bodies[decoder_name(message)]
             if not extra:
-                subs.append((sub.code, message, lines))
+                subs.append((sub.code, message, body))
         if not subs:
             continue
-        lines = [*rest_check_lines(protocol, layout), "    return None", f"sub = buf[{content_offset + at}]"]
+        lines: Block = [*rest_check(protocol, layout), Code(f"sub = buf[{content_offset + at}]")]
         for sub_code, _, body in subs:
-            lines += [f"if sub == {sub_code:#04x}:", f"    o, end = {content_offset}, len(buf) - {tail}"]
-            lines += [f"    {line}" for line in body]
+            cursor = Code(f"o, end = {content_offset}, len(buf) - {tail}")
+            lines.append(If(f"sub == {sub_code:#04x}", (cursor, *body)))
         smallest = min(message.min_size or 0 for _, message, _ in subs)
         sizes = [message.max_size for _, message, _ in subs]
         largest = length.type.maximum if None in sizes else max(s for s in sizes if s is not None) + layout.length_adds
@@ -686,7 +724,7 @@ def subcommand_rest_frames(
                 "whole_name": f"_whole_{command.name}_{layout.direction.value}",
                 "returns": "Message",
                 "where": f"{command.name} {layout.direction.value}",
-                "whole_lines": [*lines, "return None"],
+                "whole_lines": [*lines, RETURN_NONE],
                 "code": command.code,
                 # the sub-command's byte lies within the content: no smaller content reaches the picker
                 "lengths": (max(smallest, at + 1) + layout.length_adds, min(largest, length.type.maximum)),
@@ -696,8 +734,8 @@ def subcommand_rest_frames(
     return found
 
 
-def rest_check_lines(protocol: Protocol, layout: FrameLayout) -> Lines:
-    """The checksum test of a whole frame of any size (`buf` is the frame): true when it fails."""
+def rest_check(protocol: Protocol, layout: FrameLayout) -> Block:
+    """The checksum test of a whole frame of any size (`buf` is the frame), returning None when it fails."""
     checksum = protocol.framing.checksum
     assert checksum is not None  # classic frames have one
     size = layout.checksum_offset_from_end
@@ -707,29 +745,40 @@ def rest_check_lines(protocol: Protocol, layout: FrameLayout) -> Lines:
     if whole_sum and len(header) == layout.covered_from:
         less = f" - {sum(header):#x}" if header else ""
         if not checksum.invert:
-            return [f"if (sum(buf){less} - 2 * buf[-1]) & 0xff:"]
-        return [f"if (sum(buf) - {sum(header) + 0xFF:#x}) & 0xff:  # inverted: the bytes and the check sum to 0xff"]
+            return [SumCheck(less, "-1")]
+        inverted = "inverted: the bytes and the check sum to 0xff"
+        return [If(f"(sum(buf) - {sum(header) + 0xFF:#x}) & 0xff", (RETURN_NONE,), comment=inverted)]
     covered = f"buf[{layout.covered_from}:-{layout.covered_to_end}]"
-    return [*checksum_lines(checksum, covered, "expected"), f"if expected != {stored}:"]
+    check = [Code(line) for line in checksum_lines(checksum, covered, "expected")]
+    return [*check, If(f"expected != {stored}", (RETURN_NONE,))]
 
 
-def picked_inline(subs: list[tuple[int, dict[str, Any]]], at: int, code: PackageCode) -> Lines | None:
-    """One function's lines for the sub-command frames of one size, where their checksum does not depend on their
-    fields (a sum or CRC over the bytes, the same lines for all, given the key): the check once, then each
+def failed_check(body: Block) -> int | None:
+    """The index of a whole-frame decoder's checksum test (the first `if ...: return None`), or None."""
+    return next((i for i, s in enumerate(body) if isinstance(s, If | SumCheck) and returns_none(s)), None)
+
+
+def returns_none(statement: If | SumCheck) -> bool:
+    return isinstance(statement, SumCheck) or statement.body == (RETURN_NONE,)
+
+
+def picked_inline(subs: list[tuple[int, dict[str, Any]]], at: int) -> Block | None:
+    """One function's statements for the sub-command frames of one size, where their checksum does not depend on
+    their fields (a sum or CRC over the bytes, the same statements for all, given the key): the check once, then each
     sub-command's unpacking under an `if` on its code. None where the check is made from the unpacked values."""
-    first = subs[0][1]["whole_lines"]
-    if "    return None" not in first:
+    first: Block = subs[0][1]["whole_lines"]
+    index = failed_check(first)
+    if index is None:
         return None
-    checks = first[: first.index("    return None") + 1]
-    if any("unpack_from" in line for line in checks):
+    checks = first[: index + 1]
+    if any(isinstance(s, Unpack) for s in walk(checks)):
         return None
     if any(f["whole_lines"][: len(checks)] != checks for _, f in subs):
         return None
-    lines = [*checks, f"sub = buf[{at}]"]
+    lines: Block = [*checks, Code(f"sub = buf[{at}]")]
     for sub_code, f in subs:
-        body = fuse_unpack(f["whole_lines"][len(checks) :], code.structs)
-        lines += [f"if sub == {sub_code:#04x}:", *(f"    {line}" for line in body)]
-    return [*lines, "return None"]
+        lines.append(If(f"sub == {sub_code:#04x}", tuple(fuse_unpack(f["whole_lines"][len(checks) :]))))
+    return [*lines, RETURN_NONE]
 
 
 def frame_function(
@@ -737,7 +786,7 @@ def frame_function(
     layout: FrameLayout,
     command: Command,
     message: Message,
-    bodies: dict[str, tuple[str, str, Lines]],
+    bodies: dict[str, tuple[str, str, Block]],
     code: PackageCode,
     selector: str | None = None,
 ) -> tuple[int, int, dict[str, Any]] | None:
@@ -747,60 +796,126 @@ def frame_function(
     if checksum is None or message.min_size != message.max_size:
         return None  # classic frames have a checksum
     content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
-    returns, extra, lines = bodies[decoder_name(message)]
-    if not lines[0].startswith("if end - o != "):
+    returns, extra, decoder = bodies[decoder_name(message)]
+    if not (decoder and isinstance(decoder[0], ContentSize) and decoder[0].exact):
         return None
-    body = lines[2:]  # the content size check: the key implies the size
+    body = decoder[1:]  # the content size check: the key implies the size
     if selector is not None:  # the sub-command's check: the picker chose this decoder by it
-        at = next((i for i, line in enumerate(body) if line.startswith(f"if v_{selector} != ")), None)
+        at = next((i for i, s in enumerate(body) if isinstance(s, Expect) and s.name == f"v_{selector}"), None)
         if at is None:
             return None
-        body = body[:at] + body[at + 2 :]
-    text = "\n".join(body)
-    if text.count("(buf, o)") > 1 or _CURSOR.search(text.replace("(buf, o)", "")) or "raise " in text:
+        body = body[:at] + body[at + 1 :]
+    unpacks = [s for s in walk(body) if isinstance(s, Unpack) and s.at == "o"]
+    cursor = any(reads_cursor(s) for s in walk(body) if not isinstance(s, Unpack))
+    if len(unpacks) > 1 or cursor or raises(body):
         return None  # content read at a moving cursor, or checked beyond its size: the general path
     size = layout.overhead + (message.min_size or 0)
-    values = [f"{e.name} = buf[start + {layout.offsets[e.name]}]" for e in layout.value_elements]
     length_byte = (message.min_size or 0) + layout.length_adds
-    summed = summed_frame(protocol, layout, command.code, length_byte, size, body, code)
-    if summed is not None:
-        lines = [*values, *summed, *body[1:]]
-    else:
-        stored = (
-            f"buf[start + {size - 1}]"
-            if layout.checksum_offset_from_end == 1
-            else f"int.from_bytes(buf[start + {size - layout.checksum_offset_from_end} : start + {size}], 'little')"
-        )
-        covered = f"buf[start + {layout.covered_from} : start + {size - layout.covered_to_end}]"
-        lines = [
-            *checksum_lines(checksum, covered, "expected"),
-            f"if expected != {stored}:",
-            "    return None",
-            *values,
-            *(line.replace("(buf, o)", f"(buf, start + {content_offset})") for line in body),
-        ]
     known = dict(enumerate(layout.header)) | {layout.length_offset: length_byte}
     if layout.command_offset is not None:
         known[layout.command_offset] = command.code or 0
+
+    def statements(at: Callable[[int], str], whole: bool) -> tuple[Block, bool]:
+        """The decoder's statements with frame offsets `at` (buf[start:] or all of buf: `whole`), and whether its
+        checksum is checked from the unpacked values (summed_frame)."""
+        values: Block = [
+            Code(f"{e.name} = buf[{at(layout.offsets[e.name])}]", reads=(layout.offsets[e.name],))
+            for e in layout.value_elements
+        ]
+        summed = summed_frame(protocol, layout, command.code, length_byte, size, body, code, at)
+        if summed is not None:
+            return [*values, *summed, *body[1:]], True
+        check = whole_frame_check(protocol, layout, size, known, at) if whole else None
+        if check is None:
+            check = frame_check(checksum, layout, size, at)
+        return [*check, *values, *at_offset(body, at(content_offset))], False
+
+    lines, summed = statements(lambda offset: f"start + {offset}", False)
     function: dict[str, Any] = {
         "name": "_frame" + decoder_name(message).removeprefix("_decode"),
         "whole_name": "_whole" + decoder_name(message).removeprefix("_decode"),
         "returns": returns,
         "where": f"{message.key} {message.direction.value}",
         "lines": lines,
-        "whole_lines": whole_frame_lines(protocol, layout, size, lines, summed is not None, known),
+        "whole_lines": statements(str, True)[0],
     }
     # built in decode() where its whole-frame decoder sums the frame's bytes (one from the values is quicker yet)
-    plain = plain_frame(protocol, layout, body, code)
-    function["plain"] = plain if summed is None else None
+    plain = plain_frame(protocol, layout, body)
+    function["plain"] = plain if not summed else None
     function["run"] = run_frames(layout, message, size, plain, code)
     key = length_byte if layout.command_offset is None else (command.code or 0) << 8 | length_byte
     return key, size, function
 
 
-_UNPACK_AT = re.compile(r"\b(?P<name>_S_\w+)\.unpack_from\(buf, (?P<at>\d+)\)")
-_SUM_LAST = re.compile(r"^if \(sum\(buf\)(?P<less>.*) - 2 \* buf\[\d+\]\) & 0xff:$")
-_AT_CONSTANT = re.compile(r"\bbuf\[(\d+)\]")
+def at_offset(body: Block, at: str) -> Block:
+    """A content decoder's statements with the unpack at the cursor made at `at` (a frame offset)."""
+    return [replace(s, at=at) if isinstance(s, Unpack) and s.at == "o" else s for s in body]
+
+
+def frame_check(checksum: Checksum, layout: FrameLayout, size: int, at: Callable[[int], str]) -> Block:
+    """A whole frame's checksum test, returning None when it fails: the checksum over the covered bytes compared
+    with the stored one (frame offsets `at`)."""
+    reads: tuple[int, ...] = ()
+    if layout.checksum_offset_from_end == 1:
+        stored, reads = f"buf[{at(size - 1)}]", (size - 1,)
+    else:
+        stored, reads = f"int.from_bytes(buf[{at(size - layout.checksum_offset_from_end)} : {at(size)}], 'little')", ()
+    covered = f"buf[{at(layout.covered_from)} : {at(size - layout.covered_to_end)}]"
+    check = [Code(line) for line in checksum_lines(checksum, covered, "expected")]
+    return [*check, If(f"expected != {stored}", (RETURN_NONE,), reads=reads)]
+
+
+_MOST_UNROLLED = 12  # CRC-8 steps written out one by one in a whole-frame decoder; more take a loop
+
+
+def whole_frame_check(
+    protocol: Protocol, layout: FrameLayout, size: int, known: dict[int, int], at: Callable[[int], str]
+) -> Block | None:
+    """decode()'s version of a whole-frame decoder's checksum test, where it is cheaper than frame_check's: `buf` is
+    exactly the frame (decode checked its size), so an 8-bit sum over all but a constant header is the sum of the
+    whole frame less the header and the checksum byte (no slice is made); an 8-bit CRC starts from its value after
+    the covered bytes that the frame's key fixes (`known`: offset -> byte; header, command code, length byte).
+    None where neither applies."""
+    checksum = protocol.framing.checksum
+    assert checksum is not None  # classic frames have one
+    crc = checksum.crc
+    if crc is not None and crc.width == 8 and crc.refin == crc.refout:
+        table = crc_table(8, crc.poly, crc.refin)
+        state = reflect(crc.init, 8) if crc.refin else crc.init
+        first, stop = layout.covered_from, size - layout.covered_to_end
+        while first in known and first < stop - 1:
+            state = table[state ^ known[first]]
+            first += 1
+        steps: Block
+        if stop - first > _MOST_UNROLLED:
+            steps = [
+                Code(f"expected = {state:#x}"),
+                Loop(f"for byte in buf[{first} : {stop}]", (Code("expected = _CRC_TABLE[expected ^ byte]"),)),
+            ]
+        else:  # a few bytes: one table step each, no slice and no loop
+            steps = [Code(f"expected = _CRC_TABLE[{state:#x} ^ buf[{first}]]", reads=(first,))]
+            steps += [
+                Code(f"expected = _CRC_TABLE[expected ^ buf[{offset}]]", reads=(offset,))
+                for offset in range(first + 1, stop)
+            ]
+        if crc.xorout:
+            steps.append(Code(f"expected ^= {crc.xorout:#x}"))
+        return [*steps, frame_check(checksum, layout, size, at)[-1]]
+    header = layout.header[: layout.covered_from]
+    whole_sum = (
+        checksum.algorithm == "sum"
+        and checksum.type.size == 1
+        and layout.checksum_offset_from_end == 1
+        and layout.covered_to_end == 1
+        and len(header) == layout.covered_from
+    )
+    if not whole_sum:
+        return None
+    less = f" - {sum(header):#x}" if header else ""
+    if not checksum.invert:  # sum(covered) = check (mod 256): the whole frame sums to twice the check, plus the rest
+        return [SumCheck(less, str(size - 1))]
+    # inverted: the covered bytes and the check sum to 0xff, so the whole frame to that plus the header
+    return [If(f"(sum(buf) - {sum(header) + 0xFF:#x}) & 0xff", (RETURN_NONE,))]
 
 
 def exact_struct(name: str, size: int, content_offset: int, code: PackageCode) -> str:
@@ -814,22 +929,41 @@ def exact_struct(name: str, size: int, content_offset: int, code: PackageCode) -
     return exact
 
 
-def exact_whole(lines: Lines, size: int, known: int, code: PackageCode) -> Lines:
+def exact_whole(body: Block, size: int, known: int, code: PackageCode) -> Block:
     """A whole-frame decoder that refuses a frame of another size than `size` by itself: its one unpack made of the
     whole frame (struct.error), a sum's check byte read from the end; else a size check first, returning None.
     `known`: the bytes decode() has matched (its key), which any frame it is given holds."""
-    lines = [_SUM_LAST.sub(lambda m: f"if (sum(buf){m['less']} - 2 * buf[-1]) & 0xff:", line) for line in lines]
-    unpacks = [m for line in lines for m in _UNPACK_AT.finditer(line)]
-    before = lines[: next((i for i, line in enumerate(lines) if _UNPACK_AT.search(line)), len(lines))]
-    reads = [int(i) for line in before for i in _AT_CONSTANT.findall(line)]
-    if len(unpacks) != 1 or any(i >= known for i in reads):
-        return [f"if len(buf) != {size}:", "    return None", *lines]
-    found = unpacks[0]
-    exact = exact_struct(found["name"], size, int(found["at"]), code)
-    return [_UNPACK_AT.sub(f"{exact}.unpack(buf)", line) for line in lines]
+    body = [replace(s, check_at="-1") if isinstance(s, SumCheck) else s for s in body]
+    unpacks = [i for i, s in enumerate(body) if _unpack_at_offset(s) is not None]
+    before = body[: unpacks[0] if unpacks else len(body)]
+    if len(unpacks) != 1 or any(offset >= known for offset in _constant_reads(before)):
+        return [If(f"len(buf) != {size}", (RETURN_NONE,)), *body]
+    found = body[unpacks[0]]
+    unpack = _unpack_at_offset(found)
+    assert unpack is not None
+    whole = replace(unpack, struct=exact_struct(unpack.struct, size, int(unpack.at), code), at="")
+    body[unpacks[0]] = replace(found, unpacked=whole) if isinstance(found, ReturnNew) else whole
+    return body
 
 
-_PLAIN = re.compile(r"^return _new\((?P<cls>\w+), (?P<struct>_S_\w+)\.unpack_from\(buf, o\)\)$")
+def _unpack_at_offset(statement: Statement) -> Unpack | None:
+    """The struct unpack a statement makes at a constant offset of the frame, if any."""
+    if isinstance(statement, ReturnNew):
+        unpack = statement.unpacked
+    else:
+        unpack = statement if isinstance(statement, Unpack) else None
+    return unpack if unpack is not None and not unpack.indexed and unpack.at.isdigit() else None
+
+
+def _constant_reads(body: Block) -> list[int]:
+    """The constant offsets of `buf` that statements read (an unpack's struct aside)."""
+    reads: list[int] = []
+    for statement in walk(body):
+        if isinstance(statement, Code | If):
+            reads += statement.reads
+        elif isinstance(statement, Unpack) and statement.indexed and statement.at.isdigit():
+            reads.append(int(statement.at))
+    return reads
 
 
 def summed_checksum(protocol: Protocol, layout: FrameLayout) -> str | None:
@@ -883,68 +1017,16 @@ def run_frames(
     }
 
 
-def plain_frame(protocol: Protocol, layout: FrameLayout, body: Lines, code: PackageCode) -> tuple[str, str] | None:
+def plain_frame(protocol: Protocol, layout: FrameLayout, body: Block) -> tuple[str, str] | None:
     """(class, struct) of a frame whose message is the tuple one struct unpacks from its content, as it is, and
     whose checksum decode() tests in one expression (plain_check): decode() builds it itself, with no call.
     None for others (frame values, conversions, checks)."""
-    fused = fuse_unpack(body, code.structs)
-    plain = _PLAIN.match(fused[0]) if len(fused) == 1 else None
+    plain = content_unpacked(body)
     if plain is None or layout.value_elements or plain_check(protocol, layout) is None:
         return None
-    return plain["cls"], plain["struct"]
+    return plain
 
 
-_MOST_UNROLLED = 12  # CRC-8 steps written out one by one in a whole-frame decoder; more take a loop
-_CRC_LOOP = re.compile(r"^for byte in buf\[(?P<first>\d+) : (?P<stop>\d+)\]:$")
-_AT_START = re.compile(r"\bstart \+ (\d+)\b")
-
-
-def whole_frame_lines(
-    protocol: Protocol, layout: FrameLayout, size: int, lines: Lines, summed: bool, known: dict[int, int]
-) -> Lines:
-    """decode()'s version of a whole-frame decoder: `buf` is exactly the frame (decode checked its size), so
-    offsets are constants; an 8-bit sum over all but a constant header is the sum of the whole frame less the
-    header and the checksum byte (no slice is made); an 8-bit CRC starts from its value after the covered bytes
-    that the frame's key fixes (`known`: offset -> byte; header, command code, length byte)."""
-    lines = [_AT_START.sub(r"\1", line) for line in lines]
-    checksum = protocol.framing.checksum
-    assert checksum is not None  # classic frames have one
-    crc = checksum.crc
-    loop = _CRC_LOOP.match(lines[1]) if len(lines) > 1 else None
-    if crc is not None and crc.width == 8 and crc.refin == crc.refout and loop and not summed:
-        table = crc_table(8, crc.poly, crc.refin)
-        state = int(lines[0].removeprefix("expected = "), 16)
-        first = int(loop["first"])
-        while first in known and first < int(loop["stop"]) - 1:
-            state = table[state ^ known[first]]
-            first += 1
-        stop = int(loop["stop"])
-        if stop - first > _MOST_UNROLLED:
-            return [f"expected = {state:#x}", f"for byte in buf[{first} : {stop}]:", *lines[2:]]
-        # a few bytes: one table step each, no slice and no loop
-        steps = [f"expected = _CRC_TABLE[{state:#x} ^ buf[{first}]]"]
-        steps += [f"expected = _CRC_TABLE[expected ^ buf[{offset}]]" for offset in range(first + 1, stop)]
-        return [*steps, *lines[3:]]  # in place of the loop and its one-line body
-    header = layout.header[: layout.covered_from]
-    whole_sum = (
-        not summed
-        and checksum.algorithm == "sum"
-        and checksum.type.size == 1
-        and layout.checksum_offset_from_end == 1
-        and layout.covered_to_end == 1
-        and len(header) == layout.covered_from
-    )
-    if not whole_sum:
-        return lines
-    assert lines[0].startswith("expected = ") and lines[1].startswith("if expected != "), lines[:2]
-    less = f" - {sum(header):#x}" if header else ""
-    if not checksum.invert:  # sum(covered) = check (mod 256): the whole frame sums to twice the check, plus the rest
-        return [f"if (sum(buf){less} - 2 * buf[{size - 1}]) & 0xff:", *lines[2:]]
-    # inverted: the covered bytes and the check sum to 0xff, so the whole frame to that plus the header
-    return [f"if (sum(buf) - {sum(header) + 0xFF:#x}) & 0xff:", *lines[2:]]
-
-
-_UNPACK = re.compile(r"^(?P<targets>.+) = (?P<struct>_S_\w+)\.unpack_from\(buf, o\)$")
 _BYTES_OF = {"B": 1, "b": 1, "H": 2, "h": 2, "I": 4, "i": 4, "Q": 8, "q": 8}
 _MOST_TERMS = 4  # byte terms of a checksum computed from the values; beyond it the frame's bytes are summed
 
@@ -955,21 +1037,25 @@ def summed_frame(
     command: int | None,
     length_byte: int,
     size: int,
-    body: Lines,
+    body: Block,
     code: PackageCode,
-) -> Lines | None:
-    """For an 8-bit sum checksum right after integer-only content: lines that unpack the content and the checksum
-    in one call and check the sum from the values (a byte sum does not depend on byte order), so no slice of the
-    frame is made and summed. The frame's other covered bytes must be the header, command code and length byte
-    (constants, given the key) and one-byte frame values. None where the frame is not like that."""
+    at: Callable[[int], str],
+) -> Block | None:
+    """For an 8-bit sum checksum right after integer-only content: statements that unpack the content and the
+    checksum in one call (at frame offsets `at`) and check the sum from the values (a byte sum does not depend on
+    byte order), so no slice of the frame is made and summed. The frame's other covered bytes must be the header,
+    command code and length byte (constants, given the key) and one-byte frame values. None where the frame is not
+    like that."""
     checksum = protocol.framing.checksum
-    match = _UNPACK.match(body[0]) if body else None
-    if checksum is None or checksum.algorithm != "sum" or checksum.type.size != 1 or not match:
+    unpack = body[0] if body else None
+    if checksum is None or checksum.algorithm != "sum" or checksum.type.size != 1:
+        return None
+    if not isinstance(unpack, Unpack) or unpack.at != "o" or unpack.tuple_target:
         return None
     if layout.checksum_offset_from_end != 1:
         return None
-    fmt = code.structs[match["struct"]]
-    targets = [t.strip() for t in match["targets"].split(",") if t.strip()]
+    fmt = code.structs[unpack.struct]
+    targets = unpack.targets
     if len(targets) != len(fmt) - 1 or any(c not in _BYTES_OF for c in fmt[1:]):
         return None
     content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
@@ -999,13 +1085,12 @@ def summed_frame(
             terms += [f"({target} & 0xff)", *(f"({target} >> {8 * i} & 0xff)" for i in range(1, width))]
     if len(terms) > _MOST_TERMS:
         return None  # summing a slice of the frame in C is cheaper than this many terms in Python
-    with_check = code.struct(match["struct"].removeprefix("_S_") + "_and_check", fmt + "B")
+    with_check = code.struct(unpack.struct.removeprefix("_S_") + "_and_check", fmt + "B")
     total = " + ".join([f"{constant:#x}", *terms])
     invert = "~" if checksum.invert else ""
     return [
-        f"{', '.join(targets)}, check = {with_check}.unpack_from(buf, start + {content_offset})",
-        f"if {invert}({total}) & 0xff != check:",
-        "    return None",
+        Unpack((*targets, "check"), with_check, at=at(content_offset)),
+        If(f"{invert}({total}) & 0xff != check", (RETURN_NONE,)),
     ]
 
 
@@ -1015,9 +1100,9 @@ def names_used_in_codec(code: PackageCode) -> set[str]:
     Collected once per package: testing each exported name against every body line was quadratic in the number
     of commands (minutes for a few thousand).
     """
-    bodies = [line for _, _, _, lines in code.decoder_lines() for line in lines]
+    bodies = [line for _, _, _, body in code.decoders for line in lines_of(body)]
     bodies += [line for _, _, lines in code.encoders for line in lines]
-    types = {r for _, r, _, _ in code.decoder_lines()} | {t for _, t, _ in code.encoders}
+    types = {r for _, r, _, _ in code.decoders} | {t for _, t, _ in code.encoders}
     types |= set(code.built) | code.member_maps  # built by decoders; enums and flags looked up
     return types | set(_IDENTIFIER.findall("\n".join(bodies)))
 

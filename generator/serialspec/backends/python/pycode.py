@@ -21,15 +21,16 @@ from serialspec.backends.python.ir import (
     Block,
     Code,
     ContentSize,
+    Expect,
     If,
     LeftOver,
     Loop,
     Needs,
     Raise,
     ReturnNew,
+    TakeRest,
     Unpack,
     fold_last_size_check,
-    render,
     values_tuple,
 )
 from serialspec.backends.python.kinds import kind
@@ -152,34 +153,6 @@ def _loops_read_once(lines: Lines) -> Lines:
     return out
 
 
-_UNPACKED = re.compile(r"^(?P<targets>[\w, ]+?),? = (?P<call>_S_\w+\.unpack_from\(.+\))$")
-
-
-_ONE_BYTE = re.compile(r"^(?P<indent> *)(?P<target>\w+), = (?P<struct>_S_\w+)\.unpack_from\(buf, (?P<at>.+)\)$")
-
-
-def fuse_unpack_lines(lines: Lines, structs: dict[str, str]) -> Lines:
-    """A decoder's final lines, made cheaper where the analysis of whole frames (package.fixed_frames) is done
-    with them: an unpack into locals that are then built, in order, into the returned message becomes one line,
-    `return _new(Cls, _S.unpack_from(buf, o))` (the tuple struct gives is the message's); a lone unsigned byte is
-    read by indexing, not unpacked."""
-    out: Lines = []
-    for line in lines:
-        unpacked = _UNPACKED.match(out[-1]) if out else None
-        if unpacked and line.startswith("return _new("):
-            names = [name.strip() for name in unpacked["targets"].split(",")]
-            cls, _, rest = line.removeprefix("return _new(").partition(", ")
-            if rest == values_tuple(names) + ")":
-                out[-1] = f"return _new({cls}, {unpacked['call']})"
-                continue
-        out.append(line)
-    for index, line in enumerate(out):
-        one = _ONE_BYTE.match(line)
-        if one and structs.get(one["struct"]) in ("<B", ">B"):
-            out[index] = f"{one['indent']}{one['target']} = buf[{one['at']}]"
-    return out
-
-
 def members_name(class_name: str) -> str:
     """The codec's module-level value -> member map of an enum or flag class."""
     return f"_MEMBERS_{class_name}"
@@ -283,9 +256,6 @@ class PackageCode:
         self._straight: dict[Direction, Straight | None] = {}
         for message in protocol.messages():
             self.message(message)
-
-    def decoder_lines(self) -> list[tuple[str, str, str, Lines]]:
-        return [(name, returns, extra, render(body)) for name, returns, extra, body in self.decoders]
 
     def straight(self, direction: Direction) -> Straight | None:
         """The direction's frames when straight-line code takes them (framecode.py), worked out once."""
@@ -609,7 +579,7 @@ class PackageCode:
             return name
         if f.const is not None:
             error = f"DecodeError({where} + f': {f.name} is {{{name}:#x}}, expected {f.const:#x}')"
-            body.append(If(f"{name} != {f.const}", (Raise(error),)))
+            body.append(Expect(name, f"{f.const}", error))
             return None
         if f.derived or f.value is not None:
             return None
@@ -646,7 +616,7 @@ class PackageCode:
             return self.decode_text(f, body, where)
         if isinstance(f, Bytes):
             if f.size == "rest":
-                body.append(Code(f"{self.local(f)} = buf[o:end]", cursor=True))
+                body.append(TakeRest(self.local(f)))
                 body.append(Advance(to="end"))
             else:
                 size = self.local_named(str(f.size))

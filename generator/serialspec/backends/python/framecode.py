@@ -22,12 +22,12 @@ where `end` is the content's end. Lengths and checksums that see wire bytes read
 
 from __future__ import annotations
 
-import ast
 import re
 from collections.abc import Callable
 from dataclasses import dataclass
 
 from serialspec.backends.common.frames import runtime_layouts
+from serialspec.backends.python.ir import Block, Code, Literal, Pack, PackItems, Simple, packed_lists
 from serialspec.lang.model import Checksum, Direction, Protocol
 from serialspec.runtime.checksums import crc_in_one_call
 from serialspec.runtime.framing import Element, Layout
@@ -387,12 +387,12 @@ class _Wrap:
 
 
 def _packed(elements: tuple[Element, ...], indices: list[int], argument: Callable[[int], str], struct: Structs) -> str:
-    """One expression for the bytes of these elements: a literal, else one struct (neighbouring constants as one
-    `Ns` argument); `argument`: the expression of each non-constant element's value."""
+    """One expression for the bytes of these elements: a Literal, else one struct's Pack (neighbouring constants
+    as one `Ns` argument); `argument`: the expression of each non-constant element's value."""
     if not indices:
         return ""
     if all(elements[i].kind == "constant" for i in indices):
-        return repr(b"".join(elements[i].constant for i in indices))
+        return Literal(b"".join(elements[i].constant for i in indices))
     fmt, arguments = _order(elements, indices), []
     constant = b""
     for i in [*indices, -1]:
@@ -406,7 +406,7 @@ def _packed(elements: tuple[Element, ...], indices: list[int], argument: Callabl
         if i >= 0:
             fmt += _STRUCT_CHARS[elements[i].size]
             arguments.append(argument(i))
-    return f"{struct(fmt)}.pack({', '.join(arguments)})"
+    return Pack(struct(fmt), arguments)
 
 
 def _order(elements: tuple[Element, ...], indices: list[int]) -> str:
@@ -425,7 +425,7 @@ def _arguments(layout: Layout, code: str, values: list[str]) -> Callable[[int], 
         if element.kind == "command":
             return code
         if element.kind == "length":
-            return f"v_{element.name}"
+            return Simple(f"v_{element.name}")
         return value_of[index]
 
     return argument
@@ -651,11 +651,6 @@ def direction_functions(
     return lines, call
 
 
-_PACKED = re.compile(r"^(?P<name>_S_\w+)\.pack\((?P<arguments>.*)\)$")
-# a run of numbers whose count is known at run time, as the content's encoders pack it
-_RUN = re.compile(r"^struct\.pack\(f'(?P<order>[<>])(?P<format>[^'\\]*)', (?P<arguments>\*[\w.]+)\)$")
-
-
 def frame_encoder(
     frames: Straight,
     parts: list[str],
@@ -664,12 +659,12 @@ def frame_encoder(
     values: list[str],
     size: int | None,
     struct: Structs,
-) -> Lines | None:
+) -> Block | None:
     """An encoder's last lines, which return its message's frame made inline (no call of `_wrap_<direction>`):
     the head packed with the content's first struct in one call where their byte orders agree.
 
     `parts`: the content's byte expressions (`formats`: struct constant -> format, for those that are one
-    `_S_....pack(...)`); `code`, `values`: the command code's and the frame values' expressions; `size`: the
+    struct's Pack); `code`, `values`: the command code's and the frame values' expressions; `size`: the
     content's size when it has one. None (the wrap function does it) for stuffed frames, and for lengths that
     depend on a size known only at run time."""
     chosen = None
@@ -692,33 +687,48 @@ def frame_encoder(
     if chosen is None:
         return None  # no layout can count it: the wrap function says so
     layout, checks, lengths = chosen
+    lines = _frame_lines(layout, checks, lengths, parts, formats, code, values, struct)
+    # the frame is made in the first statement: the one that packs the content's lists
+    return [Code(lines[0], lists=packed_lists(parts)), *(Code(line) for line in lines[1:])]
+
+
+def _frame_lines(
+    layout: Layout,
+    checks: dict[int, str],
+    lengths: dict[int, int],
+    parts: list[str],
+    formats: dict[str, str],
+    code: str,
+    values: list[str],
+    struct: Structs,
+) -> Lines:
+    """frame_encoder's lines, in the layout chosen, whose `lengths` are known (element index -> value)."""
     elements = layout.elements
     argument = _arguments(layout, code, values)
 
     def constant_or(index: int) -> str:
-        return str(lengths[index]) if index in lengths else argument(index)
+        return Simple(lengths[index]) if index in lengths else argument(index)
 
     head = list(range(layout.content))
     prefix = _fixed_prefix(layout, lengths)
     if prefix is not None:  # the checksum covers all after constant bytes: they are a literal, not packed
         head = head[len(prefix[1]) :]
-    first = _PACKED.match(parts[0]) if parts else None
-    fmt = formats.get(first["name"], "") if first else ""
+    first = parts[0] if parts and isinstance(parts[0], Pack) else None
+    fmt = formats.get(first.struct, "") if first else ""
     order = _order(elements, head)
     packed = None  # (format, arguments) where the frame up to the checksum is one pack of them
     multi = any(elements[i].kind != "constant" and elements[i].size > 1 for i in head)
     if first and fmt[:1] in "<>" and (fmt[0] == order or not multi):
         # the head's elements joined to the content's first struct: one pack for both
-        fused = _packed(elements, head, constant_or, lambda f: f)
-        if fused.endswith(")"):
-            head_format, _, head_arguments = fused.partition(".pack(")
-            static, arguments = fmt[0] + head_format[1:] + fmt[1:], f"{head_arguments[:-1]}, {first['arguments']}"
-            run = _RUN.match(parts[1]) if len(parts) > 1 else None
-            if run and run["order"] == static[0]:  # and a run of numbers after it, in the same byte order
-                fstring = repr(static + run["format"]).replace("'", "f'", 1)
-                parts = [f"struct.pack({fstring}, {arguments}, {run['arguments']})", *parts[2:]]
+        fused = _packed(elements, head, constant_or, lambda f: f)  # named by its format
+        if isinstance(fused, Pack):
+            static, arguments = fmt[0] + fused.struct[1:] + fmt[1:], [*fused.arguments, *first.arguments]
+            run = parts[1] if len(parts) > 1 and isinstance(parts[1], PackItems) else None
+            if run and run.order == static[0]:  # and a run of numbers after it, in the same byte order
+                fstring = repr(static + run.counted_format).replace("'", "f'", 1)
+                parts = [f"struct.pack({fstring}, {', '.join(arguments)}, *{run.items})", *parts[2:]]
             else:
-                parts = [f"{struct(static)}.pack({arguments})", *parts[1:]]
+                parts = [Pack(struct(static), arguments), *parts[1:]]
                 packed = (static, arguments) if len(parts) == 1 else None
         else:  # constants only: a literal
             parts = [f"{fused} + {parts[0]}", *parts[1:]]
@@ -743,31 +753,31 @@ def frame_encoder(
     return _tail(layout, frame, checks, lambda indices: _packed(elements, indices, constant_or, struct))
 
 
-_SIMPLE_ARGUMENTS = re.compile(r"^[\w. ]+(, [\w. ]+)*$")  # names, attributes, numbers: cheap to give twice
 _CHECK_CODES = {1: "B", 2: "H", 4: "I"}
 _MOST_REPACKED = 4  # values packed a second time into the whole frame; more are joined
 
 
 def _repacked(
-    packed: tuple[str, str] | None, literal: bytes, element: Element, check: str, after: str | None
+    packed: tuple[str, list[str]] | None, literal: bytes, element: Element, check: str, after: str
 ) -> tuple[str, str] | None:
     """A struct format and its arguments for a whole frame that is `literal`, then one pack of simple values (the
-    bytes the checksum covers), then the checksum and constant bytes (`after`, a literal); None for others."""
-    if packed is None or not _SIMPLE_ARGUMENTS.match(packed[1]) or element.size not in _CHECK_CODES:
+    bytes the checksum covers; names, attributes, numbers: cheap to give twice), then the checksum and constant
+    bytes (`after`, a literal); None for others."""
+    if packed is None or not all(isinstance(a, Simple) for a in packed[1]) or element.size not in _CHECK_CODES:
         return None
-    if packed[1].count(",") >= _MOST_REPACKED:
+    if len(packed[1]) > _MOST_REPACKED:
         return None  # each value packed twice: for many, the join is cheaper
     fmt, arguments = packed
     if element.size > 1 and {"big": ">", "little": "<"}.get(element.endian or "") != fmt[0]:
         return None
     tail: bytes = b""
     if after:
-        if not after.startswith(("b'", 'b"')):
+        if not isinstance(after, Literal):
             return None
-        tail = ast.literal_eval(after)
+        tail = after.data
     whole = fmt[0] + (f"{len(literal)}s" if literal else "") + fmt[1:] + _CHECK_CODES[element.size]
     values = [repr(literal)] if literal else []
-    values += [arguments, check]
+    values += [*arguments, check]
     if after and tail:
         whole += f"{len(tail)}s"
         values.append(after)

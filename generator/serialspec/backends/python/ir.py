@@ -12,6 +12,7 @@ only the ones that do not.
 
 from __future__ import annotations
 
+from collections import Counter
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, replace
 from typing import assert_never
@@ -25,6 +26,7 @@ class Code:
     text: str
     cursor: bool = False
     reads: tuple[int, ...] = ()
+    lists: tuple[str, ...] = ()  # the lists of numbers whose items it packs (PackItems), by their expressions
 
     def lines(self) -> list[str]:
         return [self.text]
@@ -32,12 +34,12 @@ class Code:
 
 @dataclass(frozen=True)
 class Raise:
-    """`raise <error>`."""
+    """`raise <error>`; "" re-raises the exception being handled."""
 
     error: str
 
     def lines(self) -> list[str]:
-        return [f"raise {self.error}"]
+        return [f"raise {self.error}" if self.error else "raise"]
 
 
 @dataclass(frozen=True)
@@ -62,9 +64,47 @@ class Loop:
     header: str
     body: tuple[Statement, ...]
     cursor: bool = False  # the header reads `o` or `end`
+    variable: str = ""  # a `for` loop's one target, where rewrites may look at it
 
     def lines(self) -> list[str]:
         return [f"{self.header}:", *indented(self.body)]
+
+
+@dataclass(frozen=True)
+class ItemsCheck:
+    """A loop over a list of numbers (`items`) that raises `error` at the first not within low..high or a bool;
+    `deferrable`: struct.pack refuses what the loop would (the range is the item type's), so the loop may run only
+    when the pack fails (deferred_item_checks); `chained`: the error is raised from None (in an except clause)."""
+
+    item: str
+    items: str
+    low: str
+    high: str
+    error: str
+    deferrable: bool = False
+    chained: bool = False
+
+    def lines(self) -> list[str]:
+        raised = f"raise {self.error}" + (" from None" if self.chained else "")
+        return [
+            f"for {self.item} in {self.items}:",
+            f"    if not {self.low} <= {self.item} <= {self.high} or {self.item}.__class__ is bool:",
+            f"        {raised}",
+        ]
+
+
+@dataclass(frozen=True)
+class Try:
+    """`try:` its body, `except <caught>:` the handler."""
+
+    body: tuple[Statement, ...]
+    caught: str
+    handler: tuple[Statement, ...]
+    comment: str = ""
+
+    def lines(self) -> list[str]:
+        comment = f"  # {self.comment}" if self.comment else ""
+        return ["try:", *indented(self.body), f"except {self.caught}:{comment}", *indented(self.handler)]
 
 
 @dataclass(frozen=True)
@@ -211,6 +251,8 @@ Statement = (
     | Raise
     | If
     | Loop
+    | ItemsCheck
+    | Try
     | ContentSize
     | Needs
     | Expect
@@ -245,11 +287,14 @@ def walk(statements: Iterable[Statement]) -> Iterator[Statement]:
         yield statement
         if isinstance(statement, If | Loop):
             yield from walk(statement.body)
+        elif isinstance(statement, Try):
+            yield from walk(statement.body)
+            yield from walk(statement.handler)
 
 
 def raises(statements: Iterable[Statement]) -> bool:
     """Whether any of the statements raises an error (a check)."""
-    return any(isinstance(s, Raise | ContentSize | Needs | Expect | LeftOver) for s in walk(statements))
+    return any(isinstance(s, Raise | ContentSize | Needs | Expect | LeftOver | ItemsCheck) for s in walk(statements))
 
 
 def reads_cursor(statement: Statement) -> bool:
@@ -265,7 +310,7 @@ def reads_cursor(statement: Statement) -> bool:
             return statement.unpacked is not None and statement.unpacked.at == "o"
         case ContentSize() | Needs() | Advance() | LeftOver():
             return True
-        case Raise() | Expect() | SumCheck():
+        case Raise() | Expect() | SumCheck() | ItemsCheck() | Try():
             return False
         case _:
             assert_never(statement)
@@ -316,5 +361,198 @@ def _indexed(statement: Statement) -> Statement:
             return replace(statement, indexed=True)
         case If() | Loop():
             return replace(statement, body=tuple(_indexed(s) for s in statement.body))
+        case Try():
+            body, handler = tuple(_indexed(s) for s in statement.body), tuple(_indexed(s) for s in statement.handler)
+            return replace(statement, body=body, handler=handler)
         case _:
             return statement
+
+
+def deferred_item_checks(body: Block) -> Block:
+    """An encoder's statements with each deferrable items check (ItemsCheck) run only when the pack of its list
+    fails: the list's numbers span their type's whole range, so struct.pack refuses exactly what the loop would, but
+    True and False (which it takes as numbers: looked for first, the cheaper loop). The full loop then finds the item
+    at fault and raises what it raised before; a failure it does not explain (a float) goes on as struct's error. A
+    check whose list is packed inside a block, or after one, keeps its loop where it was."""
+    for index, check in enumerate(body):
+        if not (isinstance(check, ItemsCheck) and check.deferrable):
+            continue
+        rest = body[:index] + body[index + 1 :]
+        packs = next((s for s in walk(rest[index:]) if isinstance(s, Code) and check.items in s.lists), None)
+        at = next((i for i, s in enumerate(rest) if i >= index and s is packs), None)
+        if at is None or any(len(s.lines()) > 1 for s in rest[index:at]):
+            return deferred_item_checks([*body[:index], replace(check, deferrable=False), *body[index + 1 :]])
+        refused = "struct.pack takes True and False as numbers: refused below"
+        bools = If(f"{check.item}.__class__ is bool", (Raise("TypeError"),), comment=refused)
+        block = Try(
+            (Loop(f"for {check.item} in {check.items}", (bools,), variable=check.item), rest[at]),
+            "(TypeError, struct.error)",
+            (replace(check, deferrable=False, chained=True), Raise("")),
+            comment="the item at fault, looked for only when the pack fails",
+        )
+        return deferred_item_checks([*rest[:at], block, *rest[at + 1 :]])
+    return body
+
+
+# A field read in an encoder's text is a hole, `⟨var.name⟩`, until read_fields_once fills it: with `var.name`, or
+# with a local `var_name` that reads it once up front. The marks are characters no Python the backend writes holds
+# (names are identifiers; spec text reaches code only through repr() of ASCII keys and names).
+_OPEN, _CLOSE = "\u27e8", "\u27e9"
+
+
+def field_read(var: str, name: str) -> str:
+    """The expression of a read of field `name` of the record in `var` (see read_fields_once)."""
+    return f"{_OPEN}{var}.{name}{_CLOSE}"
+
+
+def read_fields_once(body: Block, names: list[str]) -> Block:
+    """An encoder's statements with each field of the message `m` that they read more than once read once, into a
+    local `m_<field>` first (of `names`, in their order), and likewise each field of a `for` loop's item
+    (`item_<field>`, in the order first read): a range check and the pack read a field two or three times, and a
+    local costs less than an attribute (a record's fields are read through a descriptor, ~15 ns each). Every other
+    read is the attribute."""
+    return [_filled(s, {}) for s in _loops_read_once(_read_once(body, "m", names))]
+
+
+def _read_once(body: Block, var: str, names: list[str] | None) -> Block:
+    reads = Counter(name for s in body for text in _texts(s) for v, name in _holes(text) if v == var)
+    again = [name for name in (names if names is not None else reads) if reads[name] > 1]
+    if not again:
+        return body
+    local = {field_read(var, name): f"{var}_{name}" for name in again}
+    return [*(Code(f"{var}_{name} = {var}.{name}") for name in again), *(_filled(s, local) for s in body)]
+
+
+def _loops_read_once(body: Block) -> Block:
+    out: Block = []
+    for statement in body:
+        if isinstance(statement, Loop) and statement.variable:
+            inner = _read_once(list(statement.body), statement.variable, None)
+            statement = replace(statement, body=tuple(_loops_read_once(inner)))
+        elif isinstance(statement, If | Loop):
+            statement = replace(statement, body=tuple(_loops_read_once(list(statement.body))))
+        elif isinstance(statement, Try):
+            body_, handler = _loops_read_once(list(statement.body)), _loops_read_once(list(statement.handler))
+            statement = replace(statement, body=tuple(body_), handler=tuple(handler))
+        out.append(statement)
+    return out
+
+
+def _holes(text: str) -> list[tuple[str, str]]:
+    """The field reads (var, name) in a text, in order."""
+    found = []
+    for piece in text.split(_OPEN)[1:]:
+        var, _, name = piece.partition(_CLOSE)[0].partition(".")
+        found.append((var, name))
+    return found
+
+
+def _texts(statement: Statement) -> list[str]:
+    """A statement's texts in source order, its body's included."""
+    match statement:
+        case Code() | Raise():
+            return [statement.text if isinstance(statement, Code) else statement.error]
+        case If():
+            return [statement.condition, *(t for s in statement.body for t in _texts(s))]
+        case Loop():
+            return [statement.header, *(t for s in statement.body for t in _texts(s))]
+        case ItemsCheck():
+            return [statement.items, statement.error]
+        case Try():
+            return [t for s in (*statement.body, *statement.handler) for t in _texts(s)]
+        case _:
+            return []  # content decoders' statements: no field reads
+
+
+def _filled(statement: Statement, local: dict[str, str]) -> Statement:
+    """A statement with the holes in `local` filled with their locals, and any others with the attribute read."""
+
+    def fill(text: str) -> str:
+        if _OPEN not in text:
+            return text
+        for hole, name in local.items():
+            text = text.replace(hole, name)
+        if not local:  # the last pass: every hole left is an attribute read
+            text = text.replace(_OPEN, "").replace(_CLOSE, "")
+        return text
+
+    match statement:
+        case Code():
+            return replace(statement, text=fill(statement.text))
+        case Raise():
+            return replace(statement, error=fill(statement.error))
+        case If():
+            return replace(statement, condition=fill(statement.condition), body=_filled_all(statement.body, local))
+        case Loop():
+            return replace(statement, header=fill(statement.header), body=_filled_all(statement.body, local))
+        case ItemsCheck():
+            return replace(statement, items=fill(statement.items), error=fill(statement.error))
+        case Try():
+            body, handler = _filled_all(statement.body, local), _filled_all(statement.handler, local)
+            return replace(statement, body=body, handler=handler)
+        case _:
+            return statement
+
+
+def _filled_all(statements: tuple[Statement, ...], local: dict[str, str]) -> tuple[Statement, ...]:
+    return tuple(_filled(s, local) for s in statements)
+
+
+def packed_lists(parts: Iterable[str]) -> tuple[str, ...]:
+    """The lists of numbers that byte parts of a content pack (PackItems), by their expressions."""
+    return tuple(part.items for part in parts if isinstance(part, PackItems))
+
+
+# --- expressions a rewrite looks into ------------------------------------------------------------------------------
+# Each is the expression's text (a str: it goes anywhere an expression goes) that also says what it is made of.
+
+
+class Simple(str):
+    """An expression that is a name, an attribute or a non-negative number: cheap to give twice."""
+
+    __slots__ = ()
+
+
+class Literal(str):
+    """A bytes literal, its bytes kept."""
+
+    __slots__ = ("data",)
+    data: bytes
+
+    def __new__(cls, data: bytes) -> Literal:
+        made = super().__new__(cls, repr(data))
+        made.data = data
+        return made
+
+
+class Pack(str):
+    """`<struct>.pack(<arguments>)`: bytes of fixed-size values in one struct call."""
+
+    __slots__ = ("arguments", "struct")
+    struct: str
+    arguments: tuple[str, ...]
+
+    def __new__(cls, struct: str, arguments: Iterable[str]) -> Pack:
+        arguments = tuple(arguments)
+        made = super().__new__(cls, f"{struct}.pack({', '.join(arguments)})")
+        made.struct, made.arguments = struct, arguments
+        return made
+
+
+class PackItems(str):
+    """`struct.pack(f'<order>{len(items)}<char>', *items)`: a list of numbers whose count is known at run time."""
+
+    __slots__ = ("char", "items", "order")
+    order: str
+    char: str
+    items: str
+
+    def __new__(cls, order: str, char: str, items: str) -> PackItems:
+        made = super().__new__(cls, f"struct.pack(f'{order}{{len({items})}}{char}', *{items})")
+        made.order, made.char, made.items = order, char, items
+        return made
+
+    @property
+    def counted_format(self) -> str:
+        """The struct format's text after the byte order, as an f-string's part."""
+        return f"{{len({self.items})}}{self.char}"

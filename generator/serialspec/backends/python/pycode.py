@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import re
 import struct
-from collections import Counter
 from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
 
@@ -23,14 +22,23 @@ from serialspec.backends.python.ir import (
     ContentSize,
     Expect,
     If,
+    ItemsCheck,
     LeftOver,
     Loop,
     Needs,
+    Pack,
+    PackItems,
     Raise,
     ReturnNew,
+    Simple,
     TakeRest,
     Unpack,
+    deferred_item_checks,
+    field_read,
     fold_last_size_check,
+    lines_of,
+    packed_lists,
+    read_fields_once,
     values_tuple,
 )
 from serialspec.backends.python.kinds import kind
@@ -75,84 +83,6 @@ def bound(f: Scalar, value: float) -> str:
     return number(value)
 
 
-_LOOP = re.compile(r"^(?P<indent> *)for (?P<var>[A-Za-z_]\w*) in .+:$")
-
-
-_DEFERRED = "#deferred "  # check_items' mark before the loop over a list whose item range is its type's
-
-
-def deferred_item_checks(lines: Lines) -> Lines:
-    """An encoder's lines with each loop that check_items marked run only when the pack of its list fails: the
-    list's numbers span their type's whole range, so struct.pack refuses exactly what the loop would, but True and
-    False (which it takes as numbers: looked for first, the cheaper loop). The full loop then finds the item at fault
-    and raises what it raised before; a failure it does not explain (a float) goes on as struct's error. A mark
-    whose list is packed inside a block keeps its loop where it was."""
-    for index, mark in enumerate(lines):
-        if not mark.startswith(_DEFERRED):
-            continue
-        expr = mark.removeprefix(_DEFERRED)
-        loop = lines[index + 1 : index + 4]
-        rest = lines[:index] + lines[index + 4 :]
-        at = next((i for i, line in enumerate(rest) if i >= index and f"*{expr})" in line), None)
-        if at is None or rest[at].startswith(" ") or any(line.startswith(" ") for line in rest[index:at]):
-            return deferred_item_checks(lines[:index] + lines[index + 1 :])
-        failed = [*loop[:-1], loop[-1] + " from None", "raise"]
-        item = loop[0].removeprefix("for ").partition(" in ")[0]
-        block = [
-            "try:",
-            f"    for {item} in {expr}:",
-            f"        if {item}.__class__ is bool:  # struct.pack takes True and False as numbers: refused below",
-            "            raise TypeError",
-            f"    {rest[at]}",
-            "except (TypeError, struct.error):  # the item at fault, looked for only when the pack fails",
-            *(f"    {line}" for line in failed),
-        ]
-        return deferred_item_checks(rest[:at] + block + rest[at + 1 :])
-    return lines
-
-
-def read_fields_once(lines: Lines, names: list[str]) -> Lines:
-    """An encoder's lines with each field of the message `m` that they read more than once read once, into a local
-    `m_<field>` first, and likewise each field of a loop's item (`item_<field>`): a range check and the pack read a
-    field two or three times, and a local costs less than an attribute (a record's fields are read through a
-    descriptor, ~15 ns each)."""
-    return _loops_read_once(_read_once(lines, "m", names, ""))
-
-
-def _read_once(lines: Lines, var: str, names: list[str] | None, indent: str) -> Lines:
-    """`lines` with the fields of `var` read more than once (of `names`, or any not called) read once up front."""
-    reads_of = re.compile(rf"(?<![\w.]){var}\.([A-Za-z_]\w*)\b(?!\()")
-    reads = Counter(name for line in lines for name in reads_of.findall(line))
-    again = [name for name in (names if names is not None else reads) if reads[name] > 1]
-    if not again:
-        return lines
-    local = {name: f"{var}_{name}" for name in again}
-
-    def replaced(match: re.Match[str]) -> str:
-        return local.get(match[1], match[0])
-
-    first = [f"{indent}{var}_{name} = {var}.{name}" for name in again]
-    return [*first, *(reads_of.sub(replaced, line) for line in lines)]
-
-
-def _loops_read_once(lines: Lines) -> Lines:
-    out: Lines = []
-    i = 0
-    while i < len(lines):
-        out.append(lines[i])
-        loop = _LOOP.match(lines[i])
-        i += 1
-        if loop is None:
-            continue
-        inner = loop["indent"] + "    "
-        end = i
-        while end < len(lines) and lines[end].startswith(inner):
-            end += 1
-        out += _loops_read_once(_read_once(lines[i:end], loop["var"], None, inner))
-        i = end
-    return out
-
-
 def members_name(class_name: str) -> str:
     """The codec's module-level value -> member map of an enum or flag class."""
     return f"_MEMBERS_{class_name}"
@@ -161,6 +91,11 @@ def members_name(class_name: str) -> str:
 def one_line(text: str) -> str:
     """Spec text made safe for a comment or docstring: one line, no backslashes or quotes that could close it."""
     return collapse(text).replace("\\", "\\\\").replace('"', "'")
+
+
+def run_endian(fields: list[SpecField]) -> str:
+    """The struct byte order of a run of fixed-size fields: its first multi-byte field's."""
+    return next((f.endian for f in fields if isinstance(f, Scalar | Array | TableBlock)), "<")
 
 
 def struct_format(endian: str, fields: list[SpecField]) -> str:
@@ -416,7 +351,8 @@ class PackageCode:
         decoder = fold_last_size_check(self.decoder(message, fields))
         self.decoders.append((decoder_name(message), message.class_name, extra, decoder))
         encoder = read_fields_once(deferred_item_checks(self.encoder(message, fields)), [f.name for f in fields])
-        self.encoders.append((encoder_name(message), message.class_name, encoder))
+        encoder_lines = lines_of(encoder)
+        self.encoders.append((encoder_name(message), message.class_name, encoder_lines))
 
     # --- decoding -------------------------------------------------------------------------------------------------
 
@@ -756,9 +692,9 @@ class PackageCode:
 
     # --- encoding -------------------------------------------------------------------------------------------------
 
-    def encoder(self, message: Message, all_fields: list[SpecField]) -> Lines:
+    def encoder(self, message: Message, all_fields: list[SpecField]) -> Block:
         """Body of `_encode_X(m) -> bytes`: range checks, then the frame's bytes."""
-        lines: Lines = []
+        body: Block = []
         where = self.where(message)
         frame_fields = all_fields[: len(all_fields) - len(self.value_fields(message))]
         layout = self.protocol.framing.layouts[message.direction]
@@ -768,23 +704,23 @@ class PackageCode:
         for f in frame_fields:
             assert isinstance(f, Scalar)
             if f.bits:
-                frame_values.append(self.wire_value(f, "m", [], lines, where))
+                frame_values.append(self.wire_value(f, "m", [], body, where))
                 continue
             if error is not None and f.name == error.element:  # the refused request's code: sent with the flag
-                self.check_scalar(f, f"m.{f.name}", lines, where)
+                self.check_scalar(f, field_read("m", f.name), body, where)
                 continue
-            self.check_scalar(f, f"m.{f.name}", lines, where, also=elements[f.name].broadcast)
-            frame_values.append(f"m.{f.name}")
+            self.check_scalar(f, field_read("m", f.name), body, where, also=elements[f.name].broadcast)
+            frame_values.append(Simple(field_read("m", f.name)))
         fields = list(message.fields)
-        self.check_count_from(message, lines, where)
+        self.check_count_from(message, body, where)
         command_code = self.protocol.command(message.command).code
         if not self.protocol.framing.classic:
             # the runtime's frame engine wraps the content (see backends/python/frames.py)
-            parts = self.encode_fields(fields, message.class_name, "m", lines, where)
+            parts = self.encode_fields(fields, message.class_name, "m", body, where)
             content = parts[0] if len(parts) == 1 else f"b''.join(({', '.join(parts)},))" if parts else "b''"
-            code = f"{command_code:#04x}" if command_code is not None and layout.has_command else "None"
+            code: str = Simple(f"{command_code:#04x}" if command_code is not None and layout.has_command else "None")
             if error is not None:
-                code = f"m.{error.element} | {error.flag:#04x}"
+                code = f"{field_read('m', error.element)} | {error.flag:#04x}"
             frames = self.straight(message.direction)
             size = message.min_size if message.min_size == message.max_size else None
             name = f"frame_{message.class_name}"
@@ -792,49 +728,49 @@ class PackageCode:
                 frames, parts, self.structs, code, frame_values, size, lambda fmt: self.struct(name, fmt)
             )
             if inline:  # the frame made here (backends/python/framecode.py): no call of the direction's wrap
-                return [*lines, *inline]
+                return [*body, *inline]
             arguments = ", ".join([content, code, *frame_values])
-            lines.append(f"return _wrap_{message.direction.value}({arguments})")  # backends/python/framecode.py
-            return lines
+            # backends/python/framecode.py
+            body.append(Code(f"return _wrap_{message.direction.value}({arguments})", lists=packed_lists(parts)))
+            return body
         code = str(command_code if command_code is not None else 0)
         if all(is_fixed_run_member(f) for f in fields):
             # one fixed size: the whole frame but its checksum is one struct, the length byte a constant
-            endian, content_format, args = self.encode_run_format(fields, "m", fields, lines, where)
+            endian, content_format, args = self.encode_run_format(fields, "m", fields, body, where)
             head = self.head_format(layout, endian, code, f"{message.min_size + layout.length_adds}", frame_values)
             if head is not None:
                 head_format, head_args = head
                 name = self.struct(f"frame_{message.class_name}", endian + head_format + content_format)
-                lines.append(f"body = {name}.pack({', '.join([*head_args, *args])})")
-                lines.extend(self.checksum_append(layout, "body"))
-                return lines
+                body.append(Code(f"body = {name}.pack({', '.join([*head_args, *args])})"))
+                body.extend(self.checksum_append(layout, "body"))
+                return body
             parts = []
             if fields:
                 name = self.struct(f"{message.class_name}_{fields[0].name}", endian + content_format)
-                parts.append(f"{name}.pack({', '.join(args)})")
+                parts.append(Pack(name, args))
         else:
             runs = list(fixed_runs(fields))
-            run_lines: Lines = []
             if len(runs) > 1 and isinstance(runs[0], list):
                 # a leading run of fixed fields is packed with the frame's head: one struct call and one bytes
                 # object less per frame (the head is little-endian, so the run must be too, or all single bytes)
-                endian, run_format, run_args = self.encode_run_format(runs[0], "m", fields, run_lines, where)
-                if endian == "<" or _SINGLE_BYTES.fullmatch(run_format):
-                    lines.extend(run_lines)
+                endian = run_endian(runs[0])
+                if endian == "<" or _SINGLE_BYTES.fullmatch(struct_format("", runs[0])):
+                    _, run_format, run_args = self.encode_run_format(runs[0], "m", fields, body, where)
                     rest = [
-                        self.encode_run(item, message.class_name, "m", fields, lines, where)
+                        self.encode_run(item, message.class_name, "m", fields, body, where)
                         if isinstance(item, list)
-                        else self.encode_variable(item, "m", lines, where)
+                        else self.encode_variable(item, "m", body, where)
                         for item in runs[1:]
                     ]
                     content = rest[0] if len(rest) == 1 else f"b''.join(({', '.join(rest)},))"
-                    lines.append(f"content = {content}")
-                    lines.extend(self.frame_lines(layout, code, frame_values, (run_format, run_args)))
-                    return lines
-            parts = self.encode_fields(fields, message.class_name, "m", lines, where)
+                    body.append(Code(f"content = {content}", lists=packed_lists(rest)))
+                    body.extend(self.frame_lines(layout, code, frame_values, (run_format, run_args)))
+                    return body
+            parts = self.encode_fields(fields, message.class_name, "m", body, where)
         content = parts[0] if len(parts) == 1 else f"b''.join(({', '.join(parts)},))"
-        lines.append(f"content = {content if parts else repr(b'')}")
-        lines.extend(self.frame_lines(layout, code, frame_values))
-        return lines
+        body.append(Code(f"content = {content if parts else repr(b'')}", lists=packed_lists(parts)))
+        body.extend(self.frame_lines(layout, code, frame_values))
+        return body
 
     def head_format(
         self, layout: FrameLayout, endian: str, code: str, length: str, values: list[str]
@@ -867,51 +803,48 @@ class PackageCode:
                 args.append(next(remaining))
         return "".join(chars), args
 
-    def checksum_append(self, layout: FrameLayout, body: str) -> Lines:
-        """Lines that return `body` (the frame without its checksum) with its checksum appended."""
+    def checksum_append(self, layout: FrameLayout, body: str) -> Block:
+        """Statements that return `body` (the frame without its checksum) with its checksum appended."""
         covered = f"{body}[{layout.covered_from}:]" if layout.covered_from else body
         size = layout.checksum_offset_from_end
         checksum = self.protocol.framing.checksum
         assert checksum is not None  # classic frames have one
-        lines = checksum_lines(checksum, covered, "check")
+        value = checksum_expression(checksum, covered)
         skipped = layout.header[: layout.covered_from]
         if checksum.algorithm == "sum" and layout.covered_from and len(skipped) == layout.covered_from:
             # the bytes before the covered ones are the header, a constant: the sum less it, no slice made
             mask = (1 << (checksum.type.size * 8)) - 1
-            lines = [f"check = {'~' if checksum.invert else ''}(sum({body}) - {sum(skipped):#x}) & {mask:#x}"]
-        if len(lines) == 1:  # a single expression: append it directly
-            value = lines[0].removeprefix("check = ")
-            lines = []
-        else:
-            value = "check"
+            value = f"{'~' if checksum.invert else ''}(sum({body}) - {sum(skipped):#x}) & {mask:#x}"
+        lines: Block = []
+        if value is None:  # computed by statements into `check`; else the one expression is appended directly
+            lines, value = [Code(line) for line in checksum_lines(checksum, covered, "check")], "check"
         tail = f"_BYTES[{value}]" if size == 1 else f"({value}).to_bytes({size}, 'little')"
-        return [*lines, f"return {body} + {tail}"]
+        return [*lines, Code(f"return {body} + {tail}")]
 
     def frame_lines(
         self, layout: FrameLayout, code: str, values: list[str], prefix: tuple[str, list[str]] | None = None
-    ) -> Lines:
-        """Lines that return the frame around the bytes in `content`: inline in each encoder, not a call per frame.
-
-        `prefix`: struct format (little-endian) and arguments of the content's first fields, packed with the head.
-        """
+    ) -> Block:
+        """Statements that return the frame around the bytes in `content`: inline in each encoder, not a call per
+        frame. `prefix`: struct format (little-endian) and arguments of the content's first fields, packed with the
+        head."""
         prefix_format, prefix_args = prefix or ("", [])
         adds = layout.length_adds + struct.calcsize("<" + prefix_format)
-        lines: Lines = [f"n = len(content) + {adds}" if adds else "n = len(content)"]
+        body: Block = [Code(f"n = len(content) + {adds}" if adds else "n = len(content)")]
         length = next(e for e in layout.elements if e.role == "length")
         assert length.type is not None
-        lines.append(f"if n > {int(length.type.maximum)}:")
         size = f"n - {layout.length_adds}" if layout.length_adds else "n"
-        lines.append(f"    raise EncodeError(f'content of {{{size}}} bytes does not fit the length field')")
+        error = f"EncodeError(f'content of {{{size}}} bytes does not fit the length field')"
+        body.append(If(f"n > {int(length.type.maximum)}", (Raise(error),)))
         head = self.head_format(layout, "<", code, "n", values)
         assert head is not None  # little-endian and a length computed at run time: always possible
         head_format, head_args = head
         base = f"head_{layout.direction.value}" + (f"_{prefix_format}" if prefix_format else "")
         name = self.struct(base, "<" + head_format + prefix_format)
-        lines.append(f"body = {name}.pack({', '.join([*head_args, *prefix_args])}) + content")
-        lines.extend(self.checksum_append(layout, "body"))
-        return lines
+        body.append(Code(f"body = {name}.pack({', '.join([*head_args, *prefix_args])}) + content"))
+        body.extend(self.checksum_append(layout, "body"))
+        return body
 
-    def check_scalar(self, f: Scalar, expr: str, lines: Lines, where: str, also: int | None = None) -> None:
+    def check_scalar(self, f: Scalar, expr: str, body: Block, where: str, also: int | None = None) -> None:
         """Range check; `also` is one more value allowed outside the range (an address's broadcast value)."""
         # an integer field refuses True and False too (bool is an int to Python, never to the wire)
         not_bool = "" if f.type.is_float else f" or {expr}.__class__ is bool"
@@ -920,17 +853,16 @@ class PackageCode:
         low, high = bound(f, f.minimum), bound(f, f.maximum)
         if also is not None and also in (f.minimum - 1, f.maximum + 1):  # next to the range: one comparison
             low, high = bound(f, min(also, f.minimum)), bound(f, max(also, f.maximum))
-            lines.append(f"if not {low} <= {expr} <= {high}{not_bool}:")
+            condition = f"not {low} <= {expr} <= {high}{not_bool}"
         elif also is not None and not f.minimum <= also <= f.maximum:
-            lines.append(f"if not ({low} <= {expr} <= {high} or {expr} == {also}){not_bool}:")
+            condition = f"not ({low} <= {expr} <= {high} or {expr} == {also}){not_bool}"
         else:
-            lines.append(f"if not {low} <= {expr} <= {high}{not_bool}:")
+            condition = f"not {low} <= {expr} <= {high}{not_bool}"
         broadcast = "" if also is None or f.minimum <= also <= f.maximum else f", {also}"
-        lines.append(
-            f"    raise out_of_range({where}, {f.name!r}, {expr}, {number(f.minimum)}, {number(f.maximum)}{broadcast})"
-        )
+        error = f"out_of_range({where}, {f.name!r}, {expr}, {number(f.minimum)}, {number(f.maximum)}{broadcast})"
+        body.append(If(condition, (Raise(error),)))
 
-    def check_count_from(self, message: Message, lines: Lines, where: str) -> None:
+    def check_count_from(self, message: Message, body: Block, where: str) -> None:
         """A response list whose count the request gives (`count_from`) holds no more items than the request's
         count field allows (Modbus: at most 2000 coils), so no frame is made that no request could have asked for."""
         for f in message.fields:
@@ -944,33 +876,30 @@ class PackageCode:
             count = next(c for c in request.fields if c.name == f.count_from)
             assert isinstance(count, Scalar)
             high = number(count.maximum)
-            lines.append(f"if len(m.{f.name}) > {high}:")
-            reason = (
-                f"{f.name} has {{len(m.{f.name})}} items, at most {high} (the limit of the request field {count.name})"
-            )
-            lines.append(f"    raise EncodeError({where} + f': {reason}')")
+            items = f"len({field_read('m', f.name)})"
+            reason = f"{f.name} has {{{items}}} items, at most {high} (the limit of the request field {count.name})"
+            body.append(If(f"{items} > {high}", (Raise(f"EncodeError({where} + f': {reason}')"),)))
 
-    def check_items(self, f: Array | List, expr: str, lines: Lines, where: str) -> None:
+    def check_items(self, f: Array | List, expr: str, body: Block, where: str) -> None:
         """Every number of a list within the item's range, and none a bool (True is not 1); the first at fault named.
 
-        A plain loop: any() over a generator costs a frame per call, twice the time for a few items."""
+        A plain loop: any() over a generator costs a frame per call, twice the time for a few items. Where the
+        range is the item type's, struct.pack checks it: the loop runs only if the pack fails (deferred_item_checks).
+        """
         low, high = number(f.minimum), number(f.maximum)
-        item = f"x_{f.name}"
         kind = f.item if isinstance(f, List) else None
-        if kind is not None and not kind.is_float and (f.minimum, f.maximum) == (kind.minimum, kind.maximum):
-            lines.append(f"{_DEFERRED}{expr}")  # struct.pack checks the range: the loop only if it fails (deferred)
-        lines.append(f"for {item} in {expr}:")
-        lines.append(f"    if not {low} <= {item} <= {high} or {item}.__class__ is bool:")
-        lines.append(f"        raise out_of_range({where}, {f.name!r}, {expr}, {low}, {high})")
+        deferrable = kind is not None and not kind.is_float and (f.minimum, f.maximum) == (kind.minimum, kind.maximum)
+        error = f"out_of_range({where}, {f.name!r}, {expr}, {low}, {high})"
+        body.append(ItemsCheck(f"x_{f.name}", expr, low, high, error, deferrable))
 
-    def encode_fields(self, fields: list[SpecField], base: str, obj: str, lines: Lines, where: str) -> list[str]:
+    def encode_fields(self, fields: list[SpecField], base: str, obj: str, body: Block, where: str) -> list[str]:
         """Append checks and local values; return expressions of the byte parts in order."""
         parts: list[str] = []
         for item in fixed_runs(fields):
             if isinstance(item, list):
-                parts.append(self.encode_run(item, base, obj, fields, lines, where))
+                parts.append(self.encode_run(item, base, obj, fields, body, where))
             else:
-                parts.append(self.encode_variable(item, obj, lines, where))
+                parts.append(self.encode_variable(item, obj, body, where))
         return parts
 
     def derived_source(self, f: Scalar, obj: str, siblings: list[SpecField]) -> str:
@@ -982,159 +911,160 @@ class PackageCode:
                 other = by_name[name]
                 if isinstance(other, Scalar) and (other.value is not None or other.derived):
                     return f"({self.derived_source(other, obj, siblings)})"
-                return f"{obj}.{name}"
+                return field_read(obj, name)
 
             return expression.render(f.value, source)
         kind, target = f.derived[0], f.derived[1]
         other = by_name.get(target)
         if kind == "size" and isinstance(other, List):
-            count = f"len({obj}.{target})"
+            count = f"len({field_read(obj, target)})"
             return f"(({count} + 7) >> 3)" if other.item is None else f"{count} * {other.item.size}"
         if kind == "size" and isinstance(other, Text):
-            return f"len({obj}.{target}.encode('utf-8'))"
-        return f"len({obj}.{target})"
+            return f"len({field_read(obj, target)}.encode('utf-8'))"
+        return f"len({field_read(obj, target)})"
 
-    def wire_value(self, f: Scalar, obj: str, siblings: list[SpecField], lines: Lines, where: str) -> str:
+    def wire_value(self, f: Scalar, obj: str, siblings: list[SpecField], body: Block, where: str) -> str:
         if f.const is not None:
-            return number(f.const)
+            return Simple(number(f.const)) if f.const >= 0 else number(f.const)
+
+        def out_of_range(value: str) -> Raise:
+            return Raise(f"out_of_range({where}, {f.name!r}, {value}, {number(f.minimum)}, {number(f.maximum)})")
+
         if f.value is not None or (f.derived and isinstance(self.sibling(siblings, f.derived[1]), List | Text)):
-            value = self.local(f) if obj == "m" else f"{obj}_{f.name}"
-            lines.append(f"{value} = {self.derived_source(f, obj, siblings)}")
-            lines.append(f"if not {number(f.minimum)} <= {value} <= {number(f.maximum)}:")
-            lines.append(
-                f"    raise out_of_range({where}, {f.name!r}, {value}, {number(f.minimum)}, {number(f.maximum)})"
-            )
+            value: str = Simple(self.local(f) if obj == "m" else f"{obj}_{f.name}")
+            body.append(Code(f"{value} = {self.derived_source(f, obj, siblings)}"))
+            condition = f"not {number(f.minimum)} <= {value} <= {number(f.maximum)}"
+            body.append(If(condition, (out_of_range(value),)))
             return value
         if f.derived:
             kind, target = f.derived[0], f.derived[1]
             if kind == "count" or any(s.name == target for s in siblings):  # a count, or bytes beside their size
-                value = f"len({obj}.{target})"
+                value = f"len({field_read(obj, target)})"
             else:
                 group = next(s for s in siblings if isinstance(s, Group) and any(i.name == target for i in s.fields))
-                value = self.local_named(f.name)
-                lines.append(f"{value} = len({obj}.{group.name}[0].{target}) if {obj}.{group.name} else 0")
-                lines.append(f"if any(len(item.{target}) != {value} for item in {obj}.{group.name}):")
-                lines.append(
-                    f"    raise EncodeError({where} + ': every {target} of {group.name} must have the same length')"
-                )
-            lines.append(f"if {value} > {number(f.maximum)}:")
-            lines.append(
-                f"    raise out_of_range({where}, {f.name!r}, {value}, {number(f.minimum)}, {number(f.maximum)})"
-            )
+                value = Simple(self.local_named(f.name))
+                items = field_read(obj, group.name)
+                body.append(Code(f"{value} = len({items}[0].{target}) if {items} else 0"))
+                error = f"EncodeError({where} + ': every {target} of {group.name} must have the same length')"
+                condition = f"any(len(item.{target}) != {value} for item in {items})"
+                body.append(If(condition, (Raise(error),)))
+            body.append(If(f"{value} > {number(f.maximum)}", (out_of_range(value),)))
             return value
-        expr = f"{obj}.{f.name}"
+        expr = field_read(obj, f.name)
         if f.bits:
             packed = []
             for bit in f.bits:
                 sub = f"{expr}.{bit.name}"
-                lines.append(f"if not 0 <= {sub} <= {bit.mask} or {sub}.__class__ is bool:")
-                lines.append(f"    raise out_of_range({where}, {f.name + '.' + bit.name!r}, {sub}, 0, {bit.mask})")
-                packed.append(f"({sub} << {bit.low})" if bit.low else sub)
-            return " | ".join(packed)
-        self.check_scalar(f, expr, lines, where)
+                error = f"out_of_range({where}, {f.name + '.' + bit.name!r}, {sub}, 0, {bit.mask})"
+                body.append(If(f"not 0 <= {sub} <= {bit.mask} or {sub}.__class__ is bool", (Raise(error),)))
+                packed.append(f"({sub} << {bit.low})" if bit.low else Simple(sub))
+            return packed[0] if len(packed) == 1 else " | ".join(packed)
+        self.check_scalar(f, expr, body, where)
         if f.sign_magnitude:
             top = 1 << (f.type.size * 8 - 1)
             return f"(-{expr} | {top:#x} if {expr} < 0 else {expr})"
-        return expr
+        return Simple(expr)
 
     @staticmethod
     def sibling(siblings: list[SpecField], name: str) -> SpecField | None:
         return next((s for s in siblings if s.name == name), None)
 
     def encode_run(
-        self, run: list[SpecField], base: str, obj: str, siblings: list[SpecField], lines: Lines, where: str
+        self, run: list[SpecField], base: str, obj: str, siblings: list[SpecField], body: Block, where: str
     ) -> str:
-        endian, fmt, args = self.encode_run_format(run, obj, siblings, lines, where)
+        endian, fmt, args = self.encode_run_format(run, obj, siblings, body, where)
         const_name = self.struct(f"{base}_{run[0].name}", endian + fmt)
-        return f"{const_name}.pack({', '.join(args)})"
+        return Pack(const_name, args)
 
     def encode_run_format(
-        self, run: list[SpecField], obj: str, siblings: list[SpecField], lines: Lines, where: str
+        self, run: list[SpecField], obj: str, siblings: list[SpecField], body: Block, where: str
     ) -> tuple[str, str, list[str]]:
-        """Byte order, struct format (without it) and pack arguments of a run of fixed-size fields; checks to lines."""
-        endian = next((f.endian for f in run if isinstance(f, Scalar | Array | TableBlock)), "<")
+        """Byte order, struct format (without it) and pack arguments of a run of fixed-size fields; checks to body."""
         args: list[str] = []
         for f in run:
             if isinstance(f, Scalar):
-                args.append(self.wire_value(f, obj, siblings, lines, where))
+                args.append(self.wire_value(f, obj, siblings, body, where))
             elif isinstance(f, Array):
-                expr = f"{obj}.{f.name}"
-                lines.append(f"if len({expr}) != {f.count}:")
-                lines.append(
-                    f"    raise EncodeError({where} + f': {f.name} needs {f.count} items, got {{len({expr})}}')"
-                )
-                self.check_items(f, expr, lines, where)
+                expr = field_read(obj, f.name)
+                error = f"EncodeError({where} + f': {f.name} needs {f.count} items, got {{len({expr})}}')"
+                body.append(If(f"len({expr}) != {f.count}", (Raise(error),)))
+                self.check_items(f, expr, body, where)
                 args.append(f"*{expr}")
             elif isinstance(f, Bytes):
-                expr = f"{obj}.{f.name}"
-                lines.append(f"if len({expr}) != {f.size}:")
-                lines.append(
-                    f"    raise EncodeError({where} + f': {f.name} needs {f.size} bytes, got {{len({expr})}}')"
-                )
-                args.append(expr)
+                expr = field_read(obj, f.name)
+                error = f"EncodeError({where} + f': {f.name} needs {f.size} bytes, got {{len({expr})}}')"
+                body.append(If(f"len({expr}) != {f.size}", (Raise(error),)))
+                args.append(Simple(expr))
             elif isinstance(f, TableBlock):
                 for e in f.entries:
-                    expr = f"{obj}.{f.name}.{e.name}"
-                    lines.append(f"if not {number(e.minimum)} <= {expr} <= {number(e.maximum)}:")
-                    lines.append(
-                        f"    raise out_of_range({where}, {f.name + '.' + e.name!r}, {expr}, "
-                        f"{number(e.minimum)}, {number(e.maximum)})"
-                    )
-                    args.append(expr)
-        return endian, struct_format("", run), args
+                    expr = f"{field_read(obj, f.name)}.{e.name}"
+                    name = f.name + "." + e.name
+                    error = f"out_of_range({where}, {name!r}, {expr}, {number(e.minimum)}, {number(e.maximum)})"
+                    body.append(If(f"not {number(e.minimum)} <= {expr} <= {number(e.maximum)}", (Raise(error),)))
+                    args.append(Simple(expr))
+        return run_endian(run), struct_format("", run), args
 
-    def encode_variable(self, f: SpecField, obj: str, lines: Lines, where: str) -> str:
-        expr = f"{obj}.{f.name}"
+    def encode_variable(self, f: SpecField, obj: str, body: Block, where: str) -> str:
+        expr = field_read(obj, f.name)
+        count = f.count if isinstance(f, List | Group) else None
+        count_error = f"EncodeError({where} + f': {f.name} needs {count} items, got {{len({expr})}}')"
         if isinstance(f, List):
             if isinstance(f.count, int):
-                lines.append(f"if len({expr}) != {f.count}:")
-                lines.append(
-                    f"    raise EncodeError({where} + f': {f.name} needs {f.count} items, got {{len({expr})}}')"
-                )
+                body.append(If(f"len({expr}) != {f.count}", (Raise(count_error),)))
             if f.item is None:
                 return f"_pack_bits({expr}, {f.name!r}, {where})"
-            self.check_items(f, expr, lines, where)
-            return f"struct.pack(f'{f.endian}{{len({expr})}}{f.item.struct_char}', *{expr})"
+            self.check_items(f, expr, body, where)
+            return PackItems(f.endian, f.item.struct_char, expr)
         if isinstance(f, Text):
             data = f"_encode_text({expr}, {f.name!r}, {where}, {f.size is None})"
             if isinstance(f.size, int):
-                lines.append(f"{self.local(f)} = {data}")
-                lines.append(f"if len({self.local(f)}) != {f.size}:")
+                body.append(Code(f"{self.local(f)} = {data}"))
                 reason = f"{f.name} needs {f.size} bytes of UTF-8, got {{len({self.local(f)})}}"
-                lines.append(f"    raise EncodeError({where} + f': {reason}')")
+                body.append(If(f"len({self.local(f)}) != {f.size}", (Raise(f"EncodeError({where} + f': {reason}')"),)))
                 return self.local(f)
             return data
         if isinstance(f, Bytes):  # bytes as they are (bytes(b) looks up b.__bytes__ first), anything else made bytes
-            lines.append(f"{self.local(f)} = {expr} if {expr}.__class__ is bytes else bytes({expr})")
+            body.append(Code(f"{self.local(f)} = {expr} if {expr}.__class__ is bytes else bytes({expr})"))
             return self.local(f)
         if isinstance(f, TableValue):
             table = f"_TABLE_{f.table.name.upper()}"
-            key = f"{obj}.{f.key}"
-            lines.append(f"s = {table}.get({key})")
-            lines.append("if s is None:")
-            lines.append(f"    raise EncodeError({where} + f': unknown {f.table.key_name} {{{key}}}')")
-            lines.append(f"low, high = _TABLE_{f.table.name.upper()}_RANGES[{key}]")
-            lines.append(f"if not low <= {expr} <= high:")
-            lines.append(f"    raise out_of_range({where}, {f.name!r}, {expr}, low, high)")
+            key = field_read(obj, f.key)
+            body.append(Code(f"s = {table}.get({key})"))
+            body.append(If("s is None", (Raise(f"EncodeError({where} + f': unknown {f.table.key_name} {{{key}}}')"),)))
+            body.append(Code(f"low, high = _TABLE_{f.table.name.upper()}_RANGES[{key}]"))
+            body.append(
+                If(f"not low <= {expr} <= high", (Raise(f"out_of_range({where}, {f.name!r}, {expr}, low, high)"),))
+            )
             return f"s.pack({expr})"
         assert isinstance(f, Group)
         if isinstance(f.count, int):
-            lines.append(f"if len({expr}) != {f.count}:")
-            lines.append(f"    raise EncodeError({where} + f': {f.name} needs {f.count} items, got {{len({expr})}}')")
+            body.append(If(f"len({expr}) != {f.count}", (Raise(count_error),)))
         # the items are checked and packed in a loop here, not by a function called per item
         item = "item" if obj == "m" else f"{obj}_item"
-        item_lines: Lines = []
-        parts = self.encode_fields(list(f.fields), f.class_name, item, item_lines, where)
+        item_body: Block = []
+        parts = self.encode_fields(list(f.fields), f.class_name, item, item_body, where)
         packed = f"b''.join(({', '.join(parts)},))" if len(parts) > 1 else parts[0]
-        lines.append(f"parts_{f.name} = []")
-        lines.append(f"for {item} in {expr}:")
-        lines.extend("    " + line for line in item_lines)
-        lines.append(f"    parts_{f.name}.append({packed})")
+        body.append(Code(f"parts_{f.name} = []"))
+        item_body.append(Code(f"parts_{f.name}.append({packed})", lists=packed_lists(parts)))
+        body.append(Loop(f"for {item} in {expr}", tuple(item_body), variable=item))
         return f"b''.join(parts_{f.name})"
 
 
 def reflect(value: int, width: int) -> int:
     return int(f"{value:0{width}b}"[::-1], 2)
+
+
+def checksum_expression(checksum: Checksum, covered: str) -> str | None:
+    """The one expression of a frame's checksum over the bytes `covered` (an expression) where it is one (see
+    checksum_lines); None where it takes statements."""
+    mask = (1 << (checksum.type.size * 8)) - 1
+    if checksum.algorithm == "sum":
+        return f"{'~' if checksum.invert else ''}sum({covered}) & {mask:#x}"
+    crc = checksum.crc
+    assert crc is not None
+    if crc.width != 8 or crc.refin != crc.refout:
+        return f"_crc({covered})"
+    return None
 
 
 def checksum_lines(checksum: Checksum, covered: str, target: str) -> Lines:
@@ -1143,13 +1073,11 @@ def checksum_lines(checksum: Checksum, covered: str, target: str) -> Lines:
     A sum is one expression; an 8-bit CRC a loop over a 256-entry table (`_CRC_TABLE`, which the codec defines) with
     no call per frame; any other CRC the runtime's table-driven function (`_crc`).
     """
-    mask = (1 << (checksum.type.size * 8)) - 1
-    if checksum.algorithm == "sum":
-        return [f"{target} = {'~' if checksum.invert else ''}sum({covered}) & {mask:#x}"]
+    value = checksum_expression(checksum, covered)
+    if value is not None:
+        return [f"{target} = {value}"]
     crc = checksum.crc
     assert crc is not None
-    if crc.width != 8 or crc.refin != crc.refout:
-        return [f"{target} = _crc({covered})"]
     # With 8 bits the table-driven step is table[crc ^ byte] whether the CRC is reflected or not.
     lines = [
         f"{target} = {reflect(crc.init, 8) if crc.refin else crc.init:#x}",

@@ -22,7 +22,6 @@ where `end` is the content's end. Lengths and checksums that see wire bytes read
 
 from __future__ import annotations
 
-import re
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -111,10 +110,13 @@ def _size(elements: tuple[Element, ...]) -> int:
 
 
 class _Places:
-    """Element positions in `buf` (plain bytes): a literal offset before the content, `end + k` after it."""
+    """Element positions in `buf` (plain bytes): a literal offset before the content, `end + k` after it; or, for a
+    frame known not to be stuffed (`from_end`), in `frame`, counted back from the frame's end after the content."""
 
-    def __init__(self, layout: Layout) -> None:
+    def __init__(self, layout: Layout, from_end: bool = False) -> None:
         self.layout = layout
+        self.from_end = from_end
+        self.buf = "frame" if from_end else "buf"
         self.first, self.last = _variable(layout)
         c = layout.content
         self.before = _size(layout.elements[: self.first])  # wire bytes before the variable part
@@ -140,24 +142,27 @@ class _Places:
         offset += extra
         if not behind:
             return str(offset)
+        if self.from_end:
+            return str(offset - self.behind)
         return f"end + {offset}" if offset else "end"
 
     def stop(self, index: int) -> str:
         """The position just after element `index`."""
         if index == self.layout.content:
-            return "end"
+            return str(-self.behind) if self.from_end else "end"
         return self.at(index, self.layout.elements[index].size)
 
     def read(self, index: int) -> str:
         """The element's value, read from `buf`."""
         element = self.layout.elements[index]
         at = [self.at(index, i) for i in range(element.size)]
+        buf = self.buf
         if element.size == 1:
-            return f"buf[{at[0]}]"
+            return f"{buf}[{at[0]}]"
         if element.size == 2:
             high, low = (at[0], at[1]) if element.endian == "big" else (at[1], at[0])
-            return f"buf[{high}] << 8 | buf[{low}]"
-        return f"int.from_bytes(buf[{at[0]}:{self.stop(index)}], {element.endian!r})"
+            return f"{buf}[{high}] << 8 | {buf}[{low}]"
+        return f"int.from_bytes({buf}[{at[0]}:{self.stop(index)}], {element.endian!r})"
 
     def counted(self, a: int, b: int) -> str:
         """Bytes of elements a..b as a length counts them (wire bytes, but plain ones inside the stuffed span)."""
@@ -179,7 +184,7 @@ class _Places:
             begin = _size(elements[:a])
             tail = _size(elements[b + 1 :])
             return f"frame[{begin or ''}:{-tail if tail else ''}]" if begin or tail else "frame"
-        return f"buf[{_start(self.at(a))}:{self.stop(b)}]"
+        return f"{self.buf}[{_start(self.at(a))}:{self.stop(b)}]"
 
 
 def _message_constant(element: Element, data: str) -> str:
@@ -824,9 +829,6 @@ def _choice(layouts: tuple[Layout, ...], d: str, bodies: list[Lines] | None = No
     return [*lines, f"raise DecodeError(f\"frame starts {{frame[:4].hex(' ')}}, expected {choices}\")"]
 
 
-_END = re.compile(r"\bend(?: \+ (\d+))?")
-
-
 def whole_frames(
     found: Straight, d: str, plain: list[tuple[int, int, str, str, str]], structs: dict[str, str]
 ) -> tuple[Lines, Lines]:
@@ -863,25 +865,23 @@ def whole_frames(
     if not entries:
         return [], []
 
-    def from_end(text: str) -> str:  # `end + k` (the content's end) counted back from the frame's end
-        return _END.sub(lambda m: str(int(m[1] or 0) - places.behind), text).replace("buf[", "frame[")
-
+    tail = _Places(layout, from_end=True)  # the elements after the content, counted back from the frame's end
     conditions: Lines = []
     for index, element in enumerate(elements[layout.content + 1 :], layout.content + 1):
         if element.kind == "constant" and element.size == 1:  # constants first: cheaper than a checksum
-            conditions.insert(0, f"{from_end(f'buf[{places.at(index)}]')} == {element.constant[0]:#04x}")
+            conditions.insert(0, f"frame[{tail.at(index)}] == {element.constant[0]:#04x}")
         elif element.kind == "constant":
-            data = from_end(f"buf[{places.at(index)}:{places.stop(index)}]").replace(":0]", ":]")
-            conditions.insert(0, f"{data} == {element.constant!r}")
+            stop = tail.stop(index)
+            conditions.insert(0, f"frame[{tail.at(index)}:{'' if stop == '0' else stop}] == {element.constant!r}")
         elif element.kind == "checksum":
             residue = _residue(element)
             a, b = element.span
             if residue is not None and b == index - 1:
-                call = checks[index].format(from_end(places.covered(a, index)))
+                call = checks[index].format(tail.covered(a, index))
                 conditions.append(f"{call} == {residue:#0{2 + 2 * element.size}x}")
             else:
-                call = checks[index].format(from_end(places.covered(a, b)))
-                conditions.append(f"{call} == {from_end(places.read(index))}")
+                call = checks[index].format(tail.covered(a, b))
+                conditions.append(f"{call} == {tail.read(index)}")
     table = f"_{d.upper()}_WHOLE"
     definition = [
         f"# {d.capitalize()} frames of one size whose message is their content as one struct unpacks it, by their",

@@ -65,8 +65,6 @@ from serialspec.lang.model import (
 )
 from serialspec.runtime.checksums import crc_table
 
-_IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
-
 
 def class_context(cls: ClassCode, where: str, keys: list[str], optional: list[str]) -> dict[str, Any]:
     return {
@@ -452,11 +450,8 @@ def classic_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
 def common_codec_context(protocol: Protocol, code: PackageCode, exports: list[str]) -> dict[str, Any]:
     encoder_table = [(m.class_name, encoder_name(m)) for m in protocol.messages()]
     codec_names = names_used_in_codec(code)
-    used = "\n".join(line for _, _, _, body in code.decoders for line in lines_of(body))
-    used += "\n".join(line for _, _, lines in code.encoders for line in lines)
-    packing = [n for n in ("decode_text", "encode_text", "pack_bits", "unpack_bits") if f"_{n}(" in used]
     return {
-        "packing_imports": sorted([*packing, *(["unpack_runs"] if code.unpack_runs else [])]),
+        "packing_imports": sorted([*code.packing, *(["unpack_runs"] if code.unpack_runs else [])]),
         "unpack_runs": sorted(code.unpack_runs.items()),
         "structs": sorted(code.structs.items()),
         "tables": [
@@ -1095,16 +1090,10 @@ def summed_frame(
 
 
 def names_used_in_codec(code: PackageCode) -> set[str]:
-    """Every identifier the codec's bodies mention, and the types they return or take.
-
-    Collected once per package: testing each exported name against every body line was quadratic in the number
-    of commands (minutes for a few thousand).
-    """
-    bodies = [line for _, _, _, body in code.decoders for line in lines_of(body)]
-    bodies += [line for _, _, lines in code.encoders for line in lines]
+    """The generated classes the codec's bodies name: the types they return or take, the classes the decoders build
+    (PackageCode.build) and the enum and flag classes whose members they look up (PackageCode.member_maps)."""
     types = {r for _, r, _, _ in code.decoders} | {t for _, t, _ in code.encoders}
-    types |= set(code.built) | code.member_maps  # built by decoders; enums and flags looked up
-    return types | set(_IDENTIFIER.findall("\n".join(bodies)))
+    return types | set(code.built) | code.member_maps
 
 
 def frame_decode_lines(

@@ -187,6 +187,7 @@ class PackageCode:
         self.built: dict[str, list[str]] = {}
         self.member_maps: set[str] = set()  # enum and flag classes whose value -> member map the decoders use
         self.unpack_runs: dict[str, tuple[str, int]] = {}  # unpack_runs tables the decoders use: name -> (format, most)
+        self.packing: set[str] = set()  # the runtime.packing functions the bodies call (as _<name>)
         self._seen_classes: set[str] = set()
         self._straight: dict[Direction, Straight | None] = {}
         for message in protocol.messages():
@@ -643,6 +644,7 @@ class PackageCode:
         body.append(Needs("nb", f"DecodeError({where} + f': {f.name} needs {{nb}} bytes, {{end - o}} left')"))
         most = self.most_items(f, siblings)
         if f.item is None:
+            self.packing.add("unpack_bits")
             body.append(Code(f"{value} = _unpack_bits(buf, o, n)", cursor=True))
         elif most is not None and most <= _MOST_RUNS:  # a struct per count, made once
             name = f"_RUNS_{'BE' if f.endian == '>' else 'LE'}_{_STRUCT_NAMES[f.item.struct_char]}"
@@ -668,6 +670,7 @@ class PackageCode:
 
     def decode_text(self, f: Text, body: Block, where: str) -> str:
         value = self.local(f)
+        self.packing.add("decode_text")
         if f.size is None:
             body.append(Code("stop = buf.find(b'\\0', o, end)", cursor=True))
             body.append(If("stop < 0", (Raise(f"DecodeError({where} + ': {f.name} has no NUL at its end')"),)))
@@ -1012,10 +1015,12 @@ class PackageCode:
             if isinstance(f.count, int):
                 body.append(If(f"len({expr}) != {f.count}", (Raise(count_error),)))
             if f.item is None:
+                self.packing.add("pack_bits")
                 return f"_pack_bits({expr}, {f.name!r}, {where})"
             self.check_items(f, expr, body, where)
             return PackItems(f.endian, f.item.struct_char, expr)
         if isinstance(f, Text):
+            self.packing.add("encode_text")
             data = f"_encode_text({expr}, {f.name!r}, {where}, {f.size is None})"
             if isinstance(f.size, int):
                 body.append(Code(f"{self.local(f)} = {data}"))

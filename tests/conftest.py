@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import importlib
 import os
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from types import ModuleType
@@ -79,3 +80,33 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
         name = item.path.name
         if name in SLOW_FILES or name.startswith("test_interop_"):
             item.add_marker(pytest.mark.slow)
+
+
+# Devices to talk to, shared by the client, SDK and peer tests. A module says which spec and ids it wants:
+#   SIM = ("feetech_sms.yaml", 1, 2, 3)          -> `port`: a `serialspec sim` process's pseudo-terminal path
+#   SIMULATOR = (FeetechSmsSimulator, [1, 2, 3]) -> `sim`: the generated simulator in this process, started
+@pytest.fixture(scope="module")
+def port(request: pytest.FixtureRequest) -> Iterator[str]:
+    from sim_process import serve
+
+    spec, *ids = request.module.SIM
+    with serve(spec, *ids) as path:
+        yield path
+
+
+@dataclass(frozen=True)
+class Running:
+    """A generated simulator serving on a pseudo-terminal in this process."""
+
+    device: Any
+    path: str
+
+
+@pytest.fixture
+def sim(request: pytest.FixtureRequest) -> Iterator[Running]:
+    simulator_class, ids = request.module.SIMULATOR
+    simulator = simulator_class(ids=ids)
+    try:
+        yield Running(simulator, simulator.start())
+    finally:
+        simulator.close()

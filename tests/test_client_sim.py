@@ -9,15 +9,11 @@ import pytest
 from fashionstar_uart import ResponseSwitch, Result, UserData
 from fashionstar_uart.client import FashionstarUartClient
 from serialspec.runtime.errors import EncodeError, Timeout
-from sim_process import serve
 
 TIMEOUT = 1.0
 
 
-@pytest.fixture(scope="module")
-def port() -> Iterator[str]:
-    with serve("fashionstar_uart.yaml", 1, 2, 3) as path:
-        yield path
+SIM = ("fashionstar_uart.yaml", 1, 2, 3)  # the `port` fixture (conftest.py): `serialspec sim` on a pseudo-terminal
 
 
 @pytest.fixture

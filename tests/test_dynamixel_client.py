@@ -6,6 +6,7 @@ import time
 from collections.abc import Iterator
 
 import pytest
+from conftest import Running
 from dynamixel_p2.client import DynamixelP2Client
 from dynamixel_p2.simulator import DynamixelP2Simulator
 from serialspec.runtime.errors import DecodeError, DeviceError, RangeError, Timeout
@@ -13,17 +14,12 @@ from serialspec.runtime.errors import DecodeError, DeviceError, RangeError, Time
 TIMEOUT = 1.0
 
 
-@pytest.fixture
-def sim() -> Iterator[DynamixelP2Simulator]:
-    simulator = DynamixelP2Simulator(ids=[1, 2, 3])
-    simulator.path = simulator.start()  # type: ignore[attr-defined]
-    yield simulator
-    simulator.close()
+SIMULATOR = (DynamixelP2Simulator, [1, 2, 3])  # the `sim` fixture (conftest.py)
 
 
 @pytest.fixture
-def client(sim: DynamixelP2Simulator) -> Iterator[DynamixelP2Client]:
-    with DynamixelP2Client(sim.path, timeout=TIMEOUT) as c:  # type: ignore[attr-defined]
+def client(sim: Running) -> Iterator[DynamixelP2Client]:
+    with DynamixelP2Client(sim.path, timeout=TIMEOUT) as c:
         yield c
 
 

@@ -17,7 +17,6 @@ import serial
 from fashionstar_uart.client import FashionstarUartClient
 from fashionstar_uart.simulator import FashionstarUartSimulator
 from serialspec.runtime.errors import EncodeError, RangeError
-from sim_process import serve
 
 uservo = pytest.importorskip("fashionstar_uart_sdk.uservo")
 pocket = pytest.importorskip("fashionstar_uart_sdk.uart_pocket_handler")
@@ -148,10 +147,7 @@ def test_our_replies_unpack_in_the_sdks_handlers() -> None:
 # --- the SDK against `serialspec sim` -----------------------------------------------------------------------------
 
 
-@pytest.fixture(scope="module")
-def port() -> Iterator[str]:
-    with serve("fashionstar_uart.yaml", 0, 1, 2, 3) as path:
-        yield path
+SIM = ("fashionstar_uart.yaml", 0, 1, 2, 3)  # the `port` fixture (conftest.py): `serialspec sim` on a pseudo-terminal
 
 
 @pytest.fixture

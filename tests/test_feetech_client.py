@@ -6,6 +6,7 @@ import time
 from collections.abc import Iterator
 
 import pytest
+from conftest import Running
 from feetech_sms.client import FeetechSmsClient
 from feetech_sms.registers import CONTROL_TABLE
 from feetech_sms.simulator import FeetechSmsSimulator
@@ -14,17 +15,12 @@ from serialspec.runtime.errors import DeviceError, EncodeError, RangeError, Time
 TIMEOUT = 1.0
 
 
-@pytest.fixture
-def sim() -> Iterator[FeetechSmsSimulator]:
-    simulator = FeetechSmsSimulator(ids=[1, 2, 3])
-    simulator.path = simulator.start()  # type: ignore[attr-defined]
-    yield simulator
-    simulator.close()
+SIMULATOR = (FeetechSmsSimulator, [1, 2, 3])  # the `sim` fixture (conftest.py)
 
 
 @pytest.fixture
-def client(sim: FeetechSmsSimulator) -> Iterator[FeetechSmsClient]:
-    with FeetechSmsClient(sim.path, timeout=TIMEOUT) as c:  # type: ignore[attr-defined]
+def client(sim: Running) -> Iterator[FeetechSmsClient]:
+    with FeetechSmsClient(sim.path, timeout=TIMEOUT) as c:
         yield c
 
 
@@ -45,12 +41,10 @@ def test_registers_by_name(client: FeetechSmsClient) -> None:
     }
 
 
-def test_a_read_by_name_sent_again_is_still_checked_before_a_byte(
-    client: FeetechSmsClient, sim: FeetechSmsSimulator
-) -> None:
+def test_a_read_by_name_sent_again_is_still_checked_before_a_byte(client: FeetechSmsClient, sim: Running) -> None:
     # the first read of (device, register) is checked and encoded; the next ones send that frame as it was
     assert client.read(1, "present_position") == client.read(1, "present_position")
-    sent = len(sim.log)
+    sent = len(sim.device.log)
     for bad in (True, 1.0):  # equal to 1 and hashed alike, yet not a device id
         with pytest.raises(EncodeError, match="id"):
             client.read(bad, "present_position")  # type: ignore[arg-type]
@@ -59,7 +53,7 @@ def test_a_read_by_name_sent_again_is_still_checked_before_a_byte(
     with pytest.raises(EncodeError, match="unknown register 'speed'"):
         client.read(1, "speed")  # type: ignore[arg-type]
     time.sleep(0.05)
-    assert len(sim.log) == sent
+    assert len(sim.device.log) == sent
     assert client.read(2, "torque_limit") == 1000  # another device's read: checked and encoded afresh
 
 
@@ -85,10 +79,10 @@ def test_reg_write_waits_for_action(client: FeetechSmsClient) -> None:
     assert client.read(2, "present_position") == 500
 
 
-def test_sync_write_by_register_name(client: FeetechSmsClient, sim: FeetechSmsSimulator) -> None:
+def test_sync_write_by_register_name(client: FeetechSmsClient, sim: Running) -> None:
     client.sync_write({1: {"goal_position": 100}, 3: {"goal_position": 300}})
     assert [client.read(servo, "goal_position") for servo in (1, 2, 3)] == [100, 0, 300]
-    frame = sim.log[-4]  # the SYNC WRITE itself, before the three reads
+    frame = sim.device.log[-4]  # the SYNC WRITE itself, before the three reads
     assert type(frame).__name__ == "SyncWriteRequest"
 
 
@@ -103,8 +97,8 @@ def test_sync_read_collects_every_listed_servo(client: FeetechSmsClient) -> None
     assert client.read(1, "torque_limit") == 100  # the bus is usable again
 
 
-def test_bad_arguments_are_refused_before_a_byte_is_written(client: FeetechSmsClient, sim: FeetechSmsSimulator) -> None:
-    sent = len(sim.log)
+def test_bad_arguments_are_refused_before_a_byte_is_written(client: FeetechSmsClient, sim: Running) -> None:
+    sent = len(sim.device.log)
     with pytest.raises(RangeError, match=r"torque_limit = 1001 is outside its range 0\.\.1000"):
         client.write(1, torque_limit=1001)
     with pytest.raises(EncodeError, match="present_position is read-only"):
@@ -118,18 +112,18 @@ def test_bad_arguments_are_refused_before_a_byte_is_written(client: FeetechSmsCl
     with pytest.raises(EncodeError, match="broadcast"):
         client.read(254, "present_position")
     time.sleep(0.05)
-    assert len(sim.log) == sent
+    assert len(sim.device.log) == sent
 
 
-def test_status_bits_raise_device_error(client: FeetechSmsClient, sim: FeetechSmsSimulator) -> None:
-    sim.devices[1].set("status", 1 << 2)  # the status register the device reports in every reply's error byte
+def test_status_bits_raise_device_error(client: FeetechSmsClient, sim: Running) -> None:
+    sim.device.devices[1].set("status", 1 << 2)  # the status register the device reports in every reply's error byte
     with pytest.raises(DeviceError, match="overheat"):
         client.read(1, "present_position")
-    sim.devices[1].set("status", 0)
+    sim.device.devices[1].set("status", 0)
     assert client.read(1, "present_position") == 0  # the bus is usable again
 
 
-def test_response_level_switches_replies_off(client: FeetechSmsClient, sim: FeetechSmsSimulator) -> None:
+def test_response_level_switches_replies_off(client: FeetechSmsClient, sim: Running) -> None:
     assert client.write(3, response_level=0) is True  # this reply still comes: the level changes after it
     started = time.monotonic()
     assert client.write(3, torque_limit=300) is None  # the client knows the servo stays silent: no wait

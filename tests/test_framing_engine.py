@@ -11,7 +11,9 @@ import pytest
 from conftest import examples
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from serialspec.runtime.checksums import crc_function, sum_function, xor_function
+from serialspec.checksums.crc import crc_function
+from serialspec.checksums.sum import sum_function
+from serialspec.checksums.xor import xor_function
 from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError
 from serialspec.runtime.framing import Element, FrameCodec, FrameStreamParser, Layout, SizeRule, Transparency
 

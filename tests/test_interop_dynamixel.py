@@ -21,10 +21,7 @@ SUCCESS = dxl.COMM_SUCCESS
 ADDRESS = {r.name: r.address for r in CONTROL_TABLE.by_address.values()}
 
 
-@pytest.fixture(scope="module")
-def port() -> Iterator[str]:
-    with serve("dynamixel_p2.yaml", 1, 2, 3) as path:
-        yield path
+SIM = ("dynamixel_p2.yaml", 1, 2, 3)  # the `port` fixture (conftest.py): `serialspec sim` on a pseudo-terminal
 
 
 @pytest.fixture

@@ -9,15 +9,11 @@ from collections.abc import Iterator
 import pytest
 import serial
 from fashionstar_uart.client import FashionstarUartClient
-from sim_process import serve
 
 uservo = pytest.importorskip("fashionstar_uart_sdk.uservo")
 
 
-@pytest.fixture(scope="module")
-def port() -> Iterator[str]:
-    with serve("fashionstar_uart.yaml", 0, 1) as path:
-        yield path
+SIM = ("fashionstar_uart.yaml", 0, 1)  # the `port` fixture (conftest.py): `serialspec sim` on a pseudo-terminal
 
 
 @pytest.fixture

@@ -9,7 +9,6 @@ from typing import Any
 
 import pytest
 from feetech_sms.registers import CONTROL_TABLE
-from sim_process import serve
 
 scservo_sdk = pytest.importorskip("scservo_sdk")
 
@@ -18,10 +17,7 @@ GOAL_POSITION = importlib.import_module("scservo_sdk.sms_sts").SMS_STS_GOAL_POSI
 TORQUE_LIMIT = CONTROL_TABLE["torque_limit"].address  # from the spec: the SDK names no constant for it
 
 
-@pytest.fixture(scope="module")
-def port() -> Iterator[str]:
-    with serve("feetech_sms.yaml", 1, 2, 3) as path:
-        yield path
+SIM = ("feetech_sms.yaml", 1, 2, 3)  # the `port` fixture (conftest.py): `serialspec sim` on a pseudo-terminal
 
 
 @pytest.fixture

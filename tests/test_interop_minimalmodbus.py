@@ -8,11 +8,9 @@ pseudo-terminals refuse even parity."""
 
 from __future__ import annotations
 
-from collections.abc import Iterator
 from typing import Any
 
 import pytest
-from sim_process import serve
 
 minimalmodbus = pytest.importorskip("minimalmodbus")
 
@@ -29,15 +27,12 @@ def instrument(path: str, unit: int) -> Any:
     return device
 
 
-@pytest.fixture(scope="module")
-def sim_port() -> Iterator[str]:
-    with serve("modbus_rtu.yaml", 1, 2) as path:
-        yield path
+SIM = ("modbus_rtu.yaml", 1, 2)  # the `port` fixture (conftest.py): `serialspec sim` on a pseudo-terminal
 
 
 @pytest.fixture
-def server(sim_port: str) -> Any:
-    return instrument(sim_port, 1)
+def server(port: str) -> Any:
+    return instrument(port, 1)
 
 
 def test_single_registers(server: Any) -> None:
@@ -102,20 +97,20 @@ def test_exception_replies_raise_minimalmodbus_exceptions(server: Any) -> None:
     assert server.read_registers(9998, 2) == [5, 6]
 
 
-def test_broadcast_write_gets_no_reply_and_reaches_every_server(sim_port: str) -> None:
-    everyone = instrument(sim_port, 0)  # minimalmodbus sends to address 0 and reads no reply
+def test_broadcast_write_gets_no_reply_and_reaches_every_server(port: str) -> None:
+    everyone = instrument(port, 0)  # minimalmodbus sends to address 0 and reads no reply
     everyone.write_register(500, 4242)
     everyone.write_registers(501, [7, 8])
     everyone.write_bit(600, 1)
     for unit in (1, 2):
-        server = instrument(sim_port, unit)
+        server = instrument(port, unit)
         assert server.read_registers(500, 3) == [4242, 7, 8]
         assert server.read_bit(600, functioncode=1) == 1
     assert everyone.serial.in_waiting == 0  # nobody answered the broadcasts
 
 
-def test_other_addresses_are_ignored(sim_port: str) -> None:
-    stranger = instrument(sim_port, 3)  # the sim serves units 1 and 2 only
+def test_other_addresses_are_ignored(port: str) -> None:
+    stranger = instrument(port, 3)  # the sim serves units 1 and 2 only
     stranger.serial.timeout = 0.3  # silence is expected: no need to wait the full timeout
     with pytest.raises(minimalmodbus.NoResponseError):
         stranger.read_register(0)

@@ -16,7 +16,7 @@ import pytest
 from conftest import ROOT
 from hiwonder_rrc.client import HiwonderRrcClient
 from hiwonder_rrc.simulator import HiwonderRrcSimulator
-from serialspec.runtime.checksums import crc_function
+from serialspec.checksums.crc import crc_function
 from serialspec.runtime.errors import RangeError
 
 BATTERY = "AA 55 00 03 04 1C 25 AB"

@@ -6,7 +6,7 @@ from __future__ import annotations
 import struct
 from collections.abc import Callable
 
-from serialspec.runtime.checksums import crc_function
+from serialspec.checksums.crc import crc_function
 from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError, content_size_error, out_of_range
 from serialspec.runtime.fields import wrong_type
 from serialspec.runtime.framing import Element, EngineFormat, FrameCodec, Layout, Transparency

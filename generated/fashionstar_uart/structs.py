@@ -35,10 +35,10 @@ from construct import (  # noqa: F401 - the set of names is the same for every p
     len_,
     this,
 )
-from serialspec.runtime.checksums import sum_function
+from serialspec.checksums.sum import sum_function
 from serialspec.runtime.constructs import PackedBits, SignMagnitude, Utf8  # noqa: F401
 
-_checksum = sum_function(8, invert=False)
+_checksum = sum_function(8, False)
 
 
 def _item_size(context: Any, field: str) -> int:

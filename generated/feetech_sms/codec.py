@@ -196,7 +196,7 @@ def _whole_reset_request(buf: bytes) -> ResetRequest | None:
 
 def _whole_write_request(buf: bytes) -> WriteRequest | None:
     """A whole write request frame, all of buf, its size and first bytes known: None if its checksum fails."""
-    if (sum(buf) - 0x2fd) & 0xff:  # inverted: the bytes and the check sum to 0xff
+    if (sum(buf) - 0x2fd) & 0xff:
         return None
     id = buf[2]
     v_address = buf[5]
@@ -206,7 +206,7 @@ def _whole_write_request(buf: bytes) -> WriteRequest | None:
 
 def _whole_reg_write_request(buf: bytes) -> RegWriteRequest | None:
     """A whole reg_write request frame, all of buf, its size and first bytes known: None if its checksum fails."""
-    if (sum(buf) - 0x2fd) & 0xff:  # inverted: the bytes and the check sum to 0xff
+    if (sum(buf) - 0x2fd) & 0xff:
         return None
     id = buf[2]
     v_address = buf[5]

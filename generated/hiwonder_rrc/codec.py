@@ -6,8 +6,8 @@ from __future__ import annotations
 import struct
 from collections.abc import Callable
 
+from serialspec.checksums.crc import crc_table
 from serialspec.runtime.checksums import BYTE_VALUES as _BYTES
-from serialspec.runtime.checksums import crc_table
 from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError, content_size_error, out_of_range
 from serialspec.runtime.fields import wrong_type
 from serialspec.runtime.message import Direction, Message, members
@@ -120,7 +120,7 @@ _S_U8_U8_U16 = struct.Struct('<BBH')
 _S_U8_U8_U16_U16 = struct.Struct('<BBHH')
 _S_U8_U8_U8 = struct.Struct('<BBB')
 _S_U8_U8_U8_U8 = struct.Struct('<BBBB')
-_CRC_TABLE = crc_table(8, 0x31, True)  # CRC-8/MAXIM
+_CHECK_CRC_TABLE = crc_table(8, 0x31, True)  # CRC-8/MAXIM
 
 _MEMBERS_ButtonEvent = members(ButtonEvent)
 _MEMBERS_GamepadButtons = members(GamepadButtons)
@@ -614,7 +614,7 @@ def _frame_led_request(buf: bytes, start: int) -> LedRequest | None:
     """A whole led request frame at buf[start:], size and header known: None if its checksum fails."""
     expected = 0x0
     for byte in buf[start + 2 : start + 11]:
-        expected = _CRC_TABLE[expected ^ byte]
+        expected = _CHECK_CRC_TABLE[expected ^ byte]
     if expected != buf[start + 11]:
         return None
     return _new(LedRequest, _S_U8_U16_U16_U16.unpack_from(buf, start + 4))
@@ -624,7 +624,7 @@ def _frame_buzzer_request(buf: bytes, start: int) -> BuzzerRequest | None:
     """A whole buzzer request frame at buf[start:], size and header known: None if its checksum fails."""
     expected = 0x0
     for byte in buf[start + 2 : start + 12]:
-        expected = _CRC_TABLE[expected ^ byte]
+        expected = _CHECK_CRC_TABLE[expected ^ byte]
     if expected != buf[start + 12]:
         return None
     return _new(BuzzerRequest, _S_U16_U16_U16_U16.unpack_from(buf, start + 4))
@@ -634,7 +634,7 @@ def _frame_key_response(buf: bytes, start: int) -> KeyResponse | None:
     """A whole key response frame at buf[start:], size and header known: None if its checksum fails."""
     expected = 0x0
     for byte in buf[start + 2 : start + 6]:
-        expected = _CRC_TABLE[expected ^ byte]
+        expected = _CHECK_CRC_TABLE[expected ^ byte]
     if expected != buf[start + 6]:
         return None
     v_button_id, v_event = _S_U8_U8.unpack_from(buf, start + 4)
@@ -645,7 +645,7 @@ def _frame_imu_response(buf: bytes, start: int) -> ImuResponse | None:
     """A whole imu response frame at buf[start:], size and header known: None if its checksum fails."""
     expected = 0x0
     for byte in buf[start + 2 : start + 28]:
-        expected = _CRC_TABLE[expected ^ byte]
+        expected = _CHECK_CRC_TABLE[expected ^ byte]
     if expected != buf[start + 28]:
         return None
     return _new(ImuResponse, _S_F32_F32_F32_F32_F32_F32.unpack_from(buf, start + 4))
@@ -655,7 +655,7 @@ def _frame_gamepad_response(buf: bytes, start: int) -> GamepadResponse | None:
     """A whole gamepad response frame at buf[start:], size and header known: None if its checksum fails."""
     expected = 0x0
     for byte in buf[start + 2 : start + 11]:
-        expected = _CRC_TABLE[expected ^ byte]
+        expected = _CHECK_CRC_TABLE[expected ^ byte]
     if expected != buf[start + 11]:
         return None
     v_buttons, v_hat, v_left_x, v_left_y, v_right_x, v_right_y = _S_U16_U8_I8_I8_I8_I8.unpack_from(buf, start + 4)
@@ -669,7 +669,7 @@ def _frame_sbus_response(buf: bytes, start: int) -> SbusResponse | None:
     """A whole sbus response frame at buf[start:], size and header known: None if its checksum fails."""
     expected = 0x0
     for byte in buf[start + 2 : start + 40]:
-        expected = _CRC_TABLE[expected ^ byte]
+        expected = _CHECK_CRC_TABLE[expected ^ byte]
     if expected != buf[start + 40]:
         return None
     t = _S_I16X16_U8_U8_U8_U8.unpack_from(buf, start + 4)
@@ -682,13 +682,13 @@ def _frame_sbus_response(buf: bytes, start: int) -> SbusResponse | None:
 
 def _whole_led_request(buf: bytes) -> LedRequest | None:
     """A whole led request frame, all of buf, size and header known: None if its checksum fails."""
-    expected = _CRC_TABLE[0x47 ^ buf[4]]
-    expected = _CRC_TABLE[expected ^ buf[5]]
-    expected = _CRC_TABLE[expected ^ buf[6]]
-    expected = _CRC_TABLE[expected ^ buf[7]]
-    expected = _CRC_TABLE[expected ^ buf[8]]
-    expected = _CRC_TABLE[expected ^ buf[9]]
-    expected = _CRC_TABLE[expected ^ buf[10]]
+    expected = _CHECK_CRC_TABLE[0x47 ^ buf[4]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[5]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[6]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[7]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[8]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[9]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[10]]
     if expected != buf[11]:
         return None
     return _new(LedRequest, _S_U8_U16_U16_U16.unpack_from(buf, 4))
@@ -696,14 +696,14 @@ def _whole_led_request(buf: bytes) -> LedRequest | None:
 
 def _whole_buzzer_request(buf: bytes) -> BuzzerRequest | None:
     """A whole buzzer request frame, all of buf, size and header known: None if its checksum fails."""
-    expected = _CRC_TABLE[0x53 ^ buf[4]]
-    expected = _CRC_TABLE[expected ^ buf[5]]
-    expected = _CRC_TABLE[expected ^ buf[6]]
-    expected = _CRC_TABLE[expected ^ buf[7]]
-    expected = _CRC_TABLE[expected ^ buf[8]]
-    expected = _CRC_TABLE[expected ^ buf[9]]
-    expected = _CRC_TABLE[expected ^ buf[10]]
-    expected = _CRC_TABLE[expected ^ buf[11]]
+    expected = _CHECK_CRC_TABLE[0x53 ^ buf[4]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[5]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[6]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[7]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[8]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[9]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[10]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[11]]
     if expected != buf[12]:
         return None
     return _new(BuzzerRequest, _S_U16_U16_U16_U16.unpack_from(buf, 4))
@@ -711,8 +711,8 @@ def _whole_buzzer_request(buf: bytes) -> BuzzerRequest | None:
 
 def _whole_key_response(buf: bytes) -> KeyResponse | None:
     """A whole key response frame, all of buf, size and header known: None if its checksum fails."""
-    expected = _CRC_TABLE[0x16 ^ buf[4]]
-    expected = _CRC_TABLE[expected ^ buf[5]]
+    expected = _CHECK_CRC_TABLE[0x16 ^ buf[4]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[5]]
     if expected != buf[6]:
         return None
     v_button_id, v_event = _S_U8_U8.unpack_from(buf, 4)
@@ -723,7 +723,7 @@ def _whole_imu_response(buf: bytes) -> ImuResponse | None:
     """A whole imu response frame, all of buf, size and header known: None if its checksum fails."""
     expected = 0x31
     for byte in buf[4 : 28]:
-        expected = _CRC_TABLE[expected ^ byte]
+        expected = _CHECK_CRC_TABLE[expected ^ byte]
     if expected != buf[28]:
         return None
     return _new(ImuResponse, _S_F32_F32_F32_F32_F32_F32.unpack_from(buf, 4))
@@ -731,13 +731,13 @@ def _whole_imu_response(buf: bytes) -> ImuResponse | None:
 
 def _whole_gamepad_response(buf: bytes) -> GamepadResponse | None:
     """A whole gamepad response frame, all of buf, size and header known: None if its checksum fails."""
-    expected = _CRC_TABLE[0xf5 ^ buf[4]]
-    expected = _CRC_TABLE[expected ^ buf[5]]
-    expected = _CRC_TABLE[expected ^ buf[6]]
-    expected = _CRC_TABLE[expected ^ buf[7]]
-    expected = _CRC_TABLE[expected ^ buf[8]]
-    expected = _CRC_TABLE[expected ^ buf[9]]
-    expected = _CRC_TABLE[expected ^ buf[10]]
+    expected = _CHECK_CRC_TABLE[0xf5 ^ buf[4]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[5]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[6]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[7]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[8]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[9]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[10]]
     if expected != buf[11]:
         return None
     v_buttons, v_hat, v_left_x, v_left_y, v_right_x, v_right_y = _S_U16_U8_I8_I8_I8_I8.unpack_from(buf, 4)
@@ -751,7 +751,7 @@ def _whole_sbus_response(buf: bytes) -> SbusResponse | None:
     """A whole sbus response frame, all of buf, size and header known: None if its checksum fails."""
     expected = 0xf0
     for byte in buf[4 : 40]:
-        expected = _CRC_TABLE[expected ^ byte]
+        expected = _CHECK_CRC_TABLE[expected ^ byte]
     if expected != buf[40]:
         return None
     t = _S_I16X16_U8_U8_U8_U8.unpack_from(buf, 4)
@@ -766,7 +766,7 @@ def _whole_motor_request(buf: bytes) -> Message | None:
     """A whole motor request frame, all of buf, its size and first bytes known: None if its checksum fails."""
     expected = 0x0
     for byte in buf[2:-1]:
-        expected = _CRC_TABLE[expected ^ byte]
+        expected = _CHECK_CRC_TABLE[expected ^ byte]
     if expected != buf[-1]:
         return None
     sub = buf[4]
@@ -807,7 +807,7 @@ def _whole_pwm_servo_request(buf: bytes) -> Message | None:
     """A whole pwm_servo request frame, all of buf, its size and first bytes known: None if its checksum fails."""
     expected = 0x0
     for byte in buf[2:-1]:
-        expected = _CRC_TABLE[expected ^ byte]
+        expected = _CHECK_CRC_TABLE[expected ^ byte]
     if expected != buf[-1]:
         return None
     sub = buf[4]
@@ -833,7 +833,7 @@ def _whole_bus_servo_request(buf: bytes) -> Message | None:
     """A whole bus_servo request frame, all of buf, its size and first bytes known: None if its checksum fails."""
     expected = 0x0
     for byte in buf[2:-1]:
-        expected = _CRC_TABLE[expected ^ byte]
+        expected = _CHECK_CRC_TABLE[expected ^ byte]
     if expected != buf[-1]:
         return None
     sub = buf[4]
@@ -874,7 +874,7 @@ def _whole_rgb_request(buf: bytes) -> Message | None:
     """A whole rgb request frame, all of buf, its size and first bytes known: None if its checksum fails."""
     expected = 0x0
     for byte in buf[2:-1]:
-        expected = _CRC_TABLE[expected ^ byte]
+        expected = _CHECK_CRC_TABLE[expected ^ byte]
     if expected != buf[-1]:
         return None
     sub = buf[4]
@@ -899,12 +899,12 @@ def _whole_rgb_request(buf: bytes) -> Message | None:
 def _whole_motor_request_11(buf: bytes) -> Message | None:
     """A whole motor request frame of 11 bytes, by its sub-command: None if its checksum fails or no
     sub-command of that size has its code (decode's general path then says why)."""
-    expected = _CRC_TABLE[0x88 ^ buf[4]]
-    expected = _CRC_TABLE[expected ^ buf[5]]
-    expected = _CRC_TABLE[expected ^ buf[6]]
-    expected = _CRC_TABLE[expected ^ buf[7]]
-    expected = _CRC_TABLE[expected ^ buf[8]]
-    expected = _CRC_TABLE[expected ^ buf[9]]
+    expected = _CHECK_CRC_TABLE[0x88 ^ buf[4]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[5]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[6]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[7]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[8]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[9]]
     if expected != buf[10]:
         return None
     sub = buf[4]
@@ -917,8 +917,8 @@ def _whole_motor_request_11(buf: bytes) -> Message | None:
 def _whole_motor_request_7(buf: bytes) -> Message | None:
     """A whole motor request frame of 7 bytes, by its sub-command: None if its checksum fails or no
     sub-command of that size has its code (decode's general path then says why)."""
-    expected = _CRC_TABLE[0xe9 ^ buf[4]]
-    expected = _CRC_TABLE[expected ^ buf[5]]
+    expected = _CHECK_CRC_TABLE[0xe9 ^ buf[4]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[5]]
     if expected != buf[6]:
         return None
     sub = buf[4]
@@ -937,12 +937,12 @@ def _whole_motor_request_7(buf: bytes) -> Message | None:
 def _whole_pwm_servo_request_11(buf: bytes) -> Message | None:
     """A whole pwm_servo request frame of 11 bytes, by its sub-command: None if its checksum fails or no
     sub-command of that size has its code (decode's general path then says why)."""
-    expected = _CRC_TABLE[0xe6 ^ buf[4]]
-    expected = _CRC_TABLE[expected ^ buf[5]]
-    expected = _CRC_TABLE[expected ^ buf[6]]
-    expected = _CRC_TABLE[expected ^ buf[7]]
-    expected = _CRC_TABLE[expected ^ buf[8]]
-    expected = _CRC_TABLE[expected ^ buf[9]]
+    expected = _CHECK_CRC_TABLE[0xe6 ^ buf[4]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[5]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[6]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[7]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[8]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[9]]
     if expected != buf[10]:
         return None
     sub = buf[4]
@@ -955,8 +955,8 @@ def _whole_pwm_servo_request_11(buf: bytes) -> Message | None:
 def _whole_pwm_servo_request_7(buf: bytes) -> Message | None:
     """A whole pwm_servo request frame of 7 bytes, by its sub-command: None if its checksum fails or no
     sub-command of that size has its code (decode's general path then says why)."""
-    expected = _CRC_TABLE[0x87 ^ buf[4]]
-    expected = _CRC_TABLE[expected ^ buf[5]]
+    expected = _CHECK_CRC_TABLE[0x87 ^ buf[4]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[5]]
     if expected != buf[6]:
         return None
     sub = buf[4]
@@ -972,9 +972,9 @@ def _whole_pwm_servo_request_7(buf: bytes) -> Message | None:
 def _whole_pwm_servo_request_8(buf: bytes) -> Message | None:
     """A whole pwm_servo request frame of 8 bytes, by its sub-command: None if its checksum fails or no
     sub-command of that size has its code (decode's general path then says why)."""
-    expected = _CRC_TABLE[0xd9 ^ buf[4]]
-    expected = _CRC_TABLE[expected ^ buf[5]]
-    expected = _CRC_TABLE[expected ^ buf[6]]
+    expected = _CHECK_CRC_TABLE[0xd9 ^ buf[4]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[5]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[6]]
     if expected != buf[7]:
         return None
     sub = buf[4]
@@ -987,8 +987,8 @@ def _whole_pwm_servo_request_8(buf: bytes) -> Message | None:
 def _whole_bus_servo_request_7(buf: bytes) -> Message | None:
     """A whole bus_servo request frame of 7 bytes, by its sub-command: None if its checksum fails or no
     sub-command of that size has its code (decode's general path then says why)."""
-    expected = _CRC_TABLE[0x43 ^ buf[4]]
-    expected = _CRC_TABLE[expected ^ buf[5]]
+    expected = _CHECK_CRC_TABLE[0x43 ^ buf[4]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[5]]
     if expected != buf[6]:
         return None
     sub = buf[4]
@@ -1034,9 +1034,9 @@ def _whole_bus_servo_request_7(buf: bytes) -> Message | None:
 def _whole_bus_servo_request_8(buf: bytes) -> Message | None:
     """A whole bus_servo request frame of 8 bytes, by its sub-command: None if its checksum fails or no
     sub-command of that size has its code (decode's general path then says why)."""
-    expected = _CRC_TABLE[0x1d ^ buf[4]]
-    expected = _CRC_TABLE[expected ^ buf[5]]
-    expected = _CRC_TABLE[expected ^ buf[6]]
+    expected = _CHECK_CRC_TABLE[0x1d ^ buf[4]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[5]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[6]]
     if expected != buf[7]:
         return None
     sub = buf[4]
@@ -1055,12 +1055,12 @@ def _whole_bus_servo_request_8(buf: bytes) -> Message | None:
 def _whole_bus_servo_request_11(buf: bytes) -> Message | None:
     """A whole bus_servo request frame of 11 bytes, by its sub-command: None if its checksum fails or no
     sub-command of that size has its code (decode's general path then says why)."""
-    expected = _CRC_TABLE[0x22 ^ buf[4]]
-    expected = _CRC_TABLE[expected ^ buf[5]]
-    expected = _CRC_TABLE[expected ^ buf[6]]
-    expected = _CRC_TABLE[expected ^ buf[7]]
-    expected = _CRC_TABLE[expected ^ buf[8]]
-    expected = _CRC_TABLE[expected ^ buf[9]]
+    expected = _CHECK_CRC_TABLE[0x22 ^ buf[4]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[5]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[6]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[7]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[8]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[9]]
     if expected != buf[10]:
         return None
     sub = buf[4]
@@ -1076,10 +1076,10 @@ def _whole_bus_servo_request_11(buf: bytes) -> Message | None:
 def _whole_pwm_servo_response_9(buf: bytes) -> Message | None:
     """A whole pwm_servo response frame of 9 bytes, by its sub-command: None if its checksum fails or no
     sub-command of that size has its code (decode's general path then says why)."""
-    expected = _CRC_TABLE[0x5a ^ buf[4]]
-    expected = _CRC_TABLE[expected ^ buf[5]]
-    expected = _CRC_TABLE[expected ^ buf[6]]
-    expected = _CRC_TABLE[expected ^ buf[7]]
+    expected = _CHECK_CRC_TABLE[0x5a ^ buf[4]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[5]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[6]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[7]]
     if expected != buf[8]:
         return None
     sub = buf[5]
@@ -1092,9 +1092,9 @@ def _whole_pwm_servo_response_9(buf: bytes) -> Message | None:
 def _whole_pwm_servo_response_8(buf: bytes) -> Message | None:
     """A whole pwm_servo response frame of 8 bytes, by its sub-command: None if its checksum fails or no
     sub-command of that size has its code (decode's general path then says why)."""
-    expected = _CRC_TABLE[0xd9 ^ buf[4]]
-    expected = _CRC_TABLE[expected ^ buf[5]]
-    expected = _CRC_TABLE[expected ^ buf[6]]
+    expected = _CHECK_CRC_TABLE[0xd9 ^ buf[4]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[5]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[6]]
     if expected != buf[7]:
         return None
     sub = buf[5]
@@ -1107,11 +1107,11 @@ def _whole_pwm_servo_response_8(buf: bytes) -> Message | None:
 def _whole_bus_servo_response_10(buf: bytes) -> Message | None:
     """A whole bus_servo response frame of 10 bytes, by its sub-command: None if its checksum fails or no
     sub-command of that size has its code (decode's general path then says why)."""
-    expected = _CRC_TABLE[0xc0 ^ buf[4]]
-    expected = _CRC_TABLE[expected ^ buf[5]]
-    expected = _CRC_TABLE[expected ^ buf[6]]
-    expected = _CRC_TABLE[expected ^ buf[7]]
-    expected = _CRC_TABLE[expected ^ buf[8]]
+    expected = _CHECK_CRC_TABLE[0xc0 ^ buf[4]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[5]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[6]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[7]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[8]]
     if expected != buf[9]:
         return None
     sub = buf[5]
@@ -1127,10 +1127,10 @@ def _whole_bus_servo_response_10(buf: bytes) -> Message | None:
 def _whole_bus_servo_response_9(buf: bytes) -> Message | None:
     """A whole bus_servo response frame of 9 bytes, by its sub-command: None if its checksum fails or no
     sub-command of that size has its code (decode's general path then says why)."""
-    expected = _CRC_TABLE[0x9e ^ buf[4]]
-    expected = _CRC_TABLE[expected ^ buf[5]]
-    expected = _CRC_TABLE[expected ^ buf[6]]
-    expected = _CRC_TABLE[expected ^ buf[7]]
+    expected = _CHECK_CRC_TABLE[0x9e ^ buf[4]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[5]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[6]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[7]]
     if expected != buf[8]:
         return None
     sub = buf[5]
@@ -1155,13 +1155,13 @@ def _whole_bus_servo_response_9(buf: bytes) -> Message | None:
 def _whole_bus_servo_response_12(buf: bytes) -> Message | None:
     """A whole bus_servo response frame of 12 bytes, by its sub-command: None if its checksum fails or no
     sub-command of that size has its code (decode's general path then says why)."""
-    expected = _CRC_TABLE[0x7c ^ buf[4]]
-    expected = _CRC_TABLE[expected ^ buf[5]]
-    expected = _CRC_TABLE[expected ^ buf[6]]
-    expected = _CRC_TABLE[expected ^ buf[7]]
-    expected = _CRC_TABLE[expected ^ buf[8]]
-    expected = _CRC_TABLE[expected ^ buf[9]]
-    expected = _CRC_TABLE[expected ^ buf[10]]
+    expected = _CHECK_CRC_TABLE[0x7c ^ buf[4]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[5]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[6]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[7]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[8]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[9]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[10]]
     if expected != buf[11]:
         return None
     sub = buf[5]
@@ -1177,9 +1177,9 @@ def _whole_bus_servo_response_12(buf: bytes) -> Message | None:
 def _whole_system_response_8(buf: bytes) -> Message | None:
     """A whole system response frame of 8 bytes, by its sub-command: None if its checksum fails or no
     sub-command of that size has its code (decode's general path then says why)."""
-    expected = _CRC_TABLE[0xe2 ^ buf[4]]
-    expected = _CRC_TABLE[expected ^ buf[5]]
-    expected = _CRC_TABLE[expected ^ buf[6]]
+    expected = _CHECK_CRC_TABLE[0xe2 ^ buf[4]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[5]]
+    expected = _CHECK_CRC_TABLE[expected ^ buf[6]]
     if expected != buf[7]:
         return None
     sub = buf[4]
@@ -1205,7 +1205,7 @@ def _encode_led_request(m: LedRequest) -> bytes:
     body = _S_FRAME_LEDREQUEST.pack(b'\xaaU', 1, 7, m_led_id, m_on_time, m_off_time, m_repeat)
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1225,7 +1225,7 @@ def _encode_buzzer_request(m: BuzzerRequest) -> bytes:
     body = _S_FRAME_BUZZERREQUEST.pack(b'\xaaU', 2, 8, m_frequency, m_on_time, m_off_time, m_repeat)
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1239,7 +1239,7 @@ def _encode_motor_set_speed_request(m: MotorSetSpeedRequest) -> bytes:
     body = _S_B2_U8_U8_U8_U8_F32.pack(b'\xaaU', 3, 6, 0, m_motor_id, m_speed)
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1263,7 +1263,7 @@ def _encode_motor_set_speeds_request(m: MotorSetSpeedsRequest) -> bytes:
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 3, n, 1, len(m_motors)) + content
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1274,7 +1274,7 @@ def _encode_motor_stop_request(m: MotorStopRequest) -> bytes:
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 3, 2, 2, m_motor_id)
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1298,7 +1298,7 @@ def _encode_motor_set_duties_request(m: MotorSetDutiesRequest) -> bytes:
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 3, n, 5, len(m_duties)) + content
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1309,7 +1309,7 @@ def _encode_motor_stop_mask_request(m: MotorStopMaskRequest) -> bytes:
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 3, 2, 3, m_mask)
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1336,7 +1336,7 @@ def _encode_pwm_servo_set_positions_request(m: PwmServoSetPositionsRequest) -> b
     body = _S_B2_U8_U8_U8_U16_U8.pack(b'\xaaU', 4, n, 1, m_duration, len(m_pwm_servos)) + content
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1353,7 +1353,7 @@ def _encode_pwm_servo_set_position_request(m: PwmServoSetPositionRequest) -> byt
     body = _S_FRAME_PWMSERVOSETPOSITIONREQUEST.pack(b'\xaaU', 4, 6, 3, m_duration, m_servo_id, m_pulse)
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1364,7 +1364,7 @@ def _encode_pwm_servo_read_position_request(m: PwmServoReadPositionRequest) -> b
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 4, 2, 5, m_servo_id)
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1378,7 +1378,7 @@ def _encode_pwm_servo_read_position_response(m: PwmServoReadPositionResponse) ->
     body = _S_B2_U8_U8_U8_U8_U16.pack(b'\xaaU', 4, 4, m_servo_id, 5, m_pulse)
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1392,7 +1392,7 @@ def _encode_pwm_servo_set_offset_request(m: PwmServoSetOffsetRequest) -> bytes:
     body = _S_B2_U8_U8_U8_U8_I8.pack(b'\xaaU', 4, 3, 7, m_servo_id, m_offset)
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1403,7 +1403,7 @@ def _encode_pwm_servo_read_offset_request(m: PwmServoReadOffsetRequest) -> bytes
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 4, 2, 9, m_servo_id)
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1417,7 +1417,7 @@ def _encode_pwm_servo_read_offset_response(m: PwmServoReadOffsetResponse) -> byt
     body = _S_B2_U8_U8_U8_U8_I8.pack(b'\xaaU', 4, 3, m_servo_id, 9, m_offset)
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1444,7 +1444,7 @@ def _encode_bus_servo_set_positions_request(m: BusServoSetPositionsRequest) -> b
     body = _S_B2_U8_U8_U8_U16_U8.pack(b'\xaaU', 5, n, 1, m_duration, len(m_bus_servos)) + content
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1455,7 +1455,7 @@ def _encode_bus_servo_read_position_request(m: BusServoReadPositionRequest) -> b
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 5, m_servo_id)
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1472,7 +1472,7 @@ def _encode_bus_servo_read_position_response(m: BusServoReadPositionResponse) ->
     body = _S_FRAME_BUSSERVOREADPOSITIONRESPONSE.pack(b'\xaaU', 5, 5, m_servo_id, 5, m_success, m_position)
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1483,7 +1483,7 @@ def _encode_bus_servo_read_voltage_request(m: BusServoReadVoltageRequest) -> byt
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 7, m_servo_id)
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1500,7 +1500,7 @@ def _encode_bus_servo_read_voltage_response(m: BusServoReadVoltageResponse) -> b
     body = _S_FRAME_BUSSERVOREADVOLTAGERESPONSE.pack(b'\xaaU', 5, 5, m_servo_id, 7, m_success, m_voltage)
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1511,7 +1511,7 @@ def _encode_bus_servo_read_temperature_request(m: BusServoReadTemperatureRequest
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 9, m_servo_id)
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1528,7 +1528,7 @@ def _encode_bus_servo_read_temperature_response(m: BusServoReadTemperatureRespon
     body = _S_FRAME_BUSSERVOREADTEMPERATURERESPONSE.pack(b'\xaaU', 5, 4, m_servo_id, 9, m_success, m_temperature)
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1549,7 +1549,7 @@ def _encode_bus_servo_stop_request(m: BusServoStopRequest) -> bytes:
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, n, 3, len(m_servos)) + content
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1560,7 +1560,7 @@ def _encode_bus_servo_read_torque_request(m: BusServoReadTorqueRequest) -> bytes
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 13, m_servo_id)
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1577,7 +1577,7 @@ def _encode_bus_servo_read_torque_response(m: BusServoReadTorqueResponse) -> byt
     body = _S_FRAME_BUSSERVOREADTORQUERESPONSE.pack(b'\xaaU', 5, 4, m_servo_id, 13, m_success, m_torque)
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1588,7 +1588,7 @@ def _encode_bus_servo_unload_request(m: BusServoUnloadRequest) -> bytes:
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 11, m_servo_id)
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1599,7 +1599,7 @@ def _encode_bus_servo_load_request(m: BusServoLoadRequest) -> bytes:
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 12, m_servo_id)
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1613,7 +1613,7 @@ def _encode_bus_servo_set_id_request(m: BusServoSetIdRequest) -> bytes:
     body = _S_B2_U8_U8_U8_U8_U8.pack(b'\xaaU', 5, 3, 16, m_servo_id, m_new_id)
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1624,7 +1624,7 @@ def _encode_bus_servo_read_id_request(m: BusServoReadIdRequest) -> bytes:
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 18, m_servo_id)
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1641,7 +1641,7 @@ def _encode_bus_servo_read_id_response(m: BusServoReadIdResponse) -> bytes:
     body = _S_FRAME_BUSSERVOREADTEMPERATURERESPONSE.pack(b'\xaaU', 5, 4, m_servo_id, 18, m_success, m_id)
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1655,7 +1655,7 @@ def _encode_bus_servo_set_offset_request(m: BusServoSetOffsetRequest) -> bytes:
     body = _S_B2_U8_U8_U8_U8_I8.pack(b'\xaaU', 5, 3, 32, m_servo_id, m_offset)
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1666,7 +1666,7 @@ def _encode_bus_servo_read_offset_request(m: BusServoReadOffsetRequest) -> bytes
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 34, m_servo_id)
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1683,7 +1683,7 @@ def _encode_bus_servo_read_offset_response(m: BusServoReadOffsetResponse) -> byt
     body = _S_FRAME_BUSSERVOREADTORQUERESPONSE.pack(b'\xaaU', 5, 4, m_servo_id, 34, m_success, m_offset)
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1694,7 +1694,7 @@ def _encode_bus_servo_save_offset_request(m: BusServoSaveOffsetRequest) -> bytes
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 36, m_servo_id)
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1711,7 +1711,7 @@ def _encode_bus_servo_set_position_limit_request(m: BusServoSetPositionLimitRequ
     body = _S_FRAME_BUSSERVOSETPOSITIONLIMITREQUEST.pack(b'\xaaU', 5, 6, 48, m_servo_id, m_low, m_high)
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1722,7 +1722,7 @@ def _encode_bus_servo_read_position_limit_request(m: BusServoReadPositionLimitRe
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 50, m_servo_id)
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1742,7 +1742,7 @@ def _encode_bus_servo_read_position_limit_response(m: BusServoReadPositionLimitR
     body = _S_FRAME_BUSSERVOREADPOSITIONLIMITRESPONSE.pack(b'\xaaU', 5, 7, m_servo_id, 50, m_success, m_low, m_high)
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1759,7 +1759,7 @@ def _encode_bus_servo_set_voltage_limit_request(m: BusServoSetVoltageLimitReques
     body = _S_FRAME_BUSSERVOSETPOSITIONLIMITREQUEST.pack(b'\xaaU', 5, 6, 52, m_servo_id, m_low, m_high)
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1770,7 +1770,7 @@ def _encode_bus_servo_read_voltage_limit_request(m: BusServoReadVoltageLimitRequ
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 54, m_servo_id)
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1790,7 +1790,7 @@ def _encode_bus_servo_read_voltage_limit_response(m: BusServoReadVoltageLimitRes
     body = _S_FRAME_BUSSERVOREADPOSITIONLIMITRESPONSE.pack(b'\xaaU', 5, 7, m_servo_id, 54, m_success, m_low, m_high)
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1804,7 +1804,7 @@ def _encode_bus_servo_set_temperature_limit_request(m: BusServoSetTemperatureLim
     body = _S_B2_U8_U8_U8_U8_U8.pack(b'\xaaU', 5, 3, 56, m_servo_id, m_limit)
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1815,7 +1815,7 @@ def _encode_bus_servo_read_temperature_limit_request(m: BusServoReadTemperatureL
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 5, 2, 58, m_servo_id)
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1832,7 +1832,7 @@ def _encode_bus_servo_read_temperature_limit_response(m: BusServoReadTemperature
     body = _S_FRAME_BUSSERVOREADTEMPERATURERESPONSE.pack(b'\xaaU', 5, 4, m_servo_id, 58, m_success, m_limit)
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1846,7 +1846,7 @@ def _encode_key_response(m: KeyResponse) -> bytes:
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 6, 2, m_button_id, m_event)
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1872,7 +1872,7 @@ def _encode_imu_response(m: ImuResponse) -> bytes:
     body = _S_FRAME_IMURESPONSE.pack(b'\xaaU', 7, 24, m_accel_x, m_accel_y, m_accel_z, m_gyro_x, m_gyro_y, m_gyro_z)
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1898,7 +1898,7 @@ def _encode_gamepad_response(m: GamepadResponse) -> bytes:
     body = _S_FRAME_GAMEPADRESPONSE.pack(b'\xaaU', 8, 7, m_buttons, m_hat, m_left_x, m_left_y, m_right_x, m_right_y)
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1924,7 +1924,7 @@ def _encode_sbus_response(m: SbusResponse) -> bytes:
     body = _S_FRAME_SBUSRESPONSE.pack(b'\xaaU', 9, 36, *m_channels, m_ch17, m_ch18, m_signal_loss, m_fail_safe)
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1935,7 +1935,7 @@ def _encode_system_battery_response(m: SystemBatteryResponse) -> bytes:
     body = _S_B2_U8_U8_U8_U16.pack(b'\xaaU', 0, 3, 4, m_voltage)
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1954,7 +1954,7 @@ def _encode_oled_request(m: OledRequest) -> bytes:
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 10, n, m_line, len(m_text)) + content
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -1984,7 +1984,7 @@ def _encode_rgb_set_pixels_request(m: RgbSetPixelsRequest) -> bytes:
     body = _S_B2_U8_U8_U8_U8.pack(b'\xaaU', 11, n, 1, len(m_pixels)) + content
     check = 0x0
     for byte in body[2:]:
-        check = _CRC_TABLE[check ^ byte]
+        check = _CHECK_CRC_TABLE[check ^ byte]
     return body + _BYTES[check]
 
 
@@ -2170,7 +2170,7 @@ def _decode_request_at(buf: bytes, start: int, stop: int) -> Message:
     check = buf[stop - 1]
     expected = 0x0
     for byte in buf[start + 2 : stop - 1]:
-        expected = _CRC_TABLE[expected ^ byte]
+        expected = _CHECK_CRC_TABLE[expected ^ byte]
     if expected != check:
         raise ChecksumError(f"bad checksum: the frame has {check:#04x}, its bytes give {expected:#04x}")
     decoder = _REQUEST_DECODERS.get(buf[start + 2])
@@ -2226,7 +2226,7 @@ def _decode_response_at(buf: bytes, start: int, stop: int) -> Message:
     check = buf[stop - 1]
     expected = 0x0
     for byte in buf[start + 2 : stop - 1]:
-        expected = _CRC_TABLE[expected ^ byte]
+        expected = _CHECK_CRC_TABLE[expected ^ byte]
     if expected != check:
         raise ChecksumError(f"bad checksum: the frame has {check:#04x}, its bytes give {expected:#04x}")
     decoder = _RESPONSE_DECODERS.get(buf[start + 2])
@@ -2335,7 +2335,7 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         check = data[-1]
         expected = 0x0
         for byte in data[2:-1]:
-            expected = _CRC_TABLE[expected ^ byte]
+            expected = _CHECK_CRC_TABLE[expected ^ byte]
         if expected != check:
             raise ChecksumError(f"bad checksum: the frame has {check:#04x}, its bytes give {expected:#04x}")
         decoder = _REQUEST_DECODERS.get(data[2])
@@ -2359,7 +2359,7 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         check = data[-1]
         expected = 0x0
         for byte in data[2:-1]:
-            expected = _CRC_TABLE[expected ^ byte]
+            expected = _CHECK_CRC_TABLE[expected ^ byte]
         if expected != check:
             raise ChecksumError(f"bad checksum: the frame has {check:#04x}, its bytes give {expected:#04x}")
         decoder = _RESPONSE_DECODERS.get(data[2])

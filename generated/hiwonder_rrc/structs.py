@@ -35,7 +35,7 @@ from construct import (  # noqa: F401 - the set of names is the same for every p
     len_,
     this,
 )
-from serialspec.runtime.checksums import crc_function
+from serialspec.checksums.crc import crc_function
 from serialspec.runtime.constructs import PackedBits, SignMagnitude, Utf8  # noqa: F401
 
 _checksum = crc_function(8, 0x31, 0x0, True, True, 0x0)

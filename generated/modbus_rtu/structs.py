@@ -36,7 +36,7 @@ from construct import (  # noqa: F401 - the set of names is the same for every p
     len_,
     this,
 )
-from serialspec.runtime.checksums import crc_function
+from serialspec.checksums.crc import crc_function
 from serialspec.runtime.constructs import Framed, PackedBits, SignMagnitude, Utf8  # noqa: F401
 from serialspec.runtime.framing import Element, FrameCodec, Layout
 

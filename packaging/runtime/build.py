@@ -25,7 +25,8 @@ def build(out: Path) -> Path:
         shutil.copy(HERE / "pyproject.toml", project)
         source = ROOT / "generator" / "serialspec"
         target = stage / "generator" / "serialspec"
-        shutil.copytree(source / "runtime", target / "runtime", ignore=shutil.ignore_patterns("__pycache__"))
+        for package in ("runtime", "checksums"):  # checksums: each algorithm's runtime function (its module)
+            shutil.copytree(source / package, target / package, ignore=shutil.ignore_patterns("__pycache__"))
         for name in ("__init__.py", "py.typed"):
             shutil.copy(source / name, target / name)
         command = [sys.executable, "-m", "pip", "wheel", "--no-build-isolation", "--no-deps", "-q", "-w", str(out)]

@@ -10,8 +10,10 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Iterator
 from dataclasses import field
-from typing import Any
+from typing import Any, assert_never
 
+from serialspec import checksums
+from serialspec.checksums.base import Key
 from serialspec.lang.frozen import mutable
 from serialspec.lang.loader import CONTROL, Path
 
@@ -581,6 +583,35 @@ def span(description: str) -> OneOf:
     )
 
 
+def checksum_keys() -> dict[str, Shape]:
+    """The checksum element's keys that the algorithms own (serialspec/checksums/): `algorithm`, whose choices are
+    the registered algorithms, and each algorithm's own keys."""
+    found = checksums.algorithms()
+    described = "; ".join(f"{name}: {algorithm.summary}" for name, algorithm in found.items())
+    keys: dict[str, Shape] = {"algorithm": Str(f"checksum: {described}.", choices=tuple(found))}
+    for algorithm in found.values():
+        keys |= {key.name: _shape(key) for key in algorithm.keys}
+    return keys
+
+
+def _shape(key: Key) -> Shape:
+    """The shape of an algorithm's key, as the checksum registry gives it (plain data)."""
+    match key.kind:
+        case "bool":
+            return Bool(key.description, default=key.default, example=key.example)
+        case "int":
+            return Int(
+                key.description, default=key.default, example=key.example, minimum=key.minimum, maximum=key.maximum
+            )
+        case "str":
+            return Str(key.description, default=key.default, example=key.example)
+        case "object":
+            keys = {k.name: _shape(k) for k in key.keys}
+            return Obj(keys, required=key.required, description=key.description)
+        case _:
+            assert_never(key.kind)
+
+
 FRAME_ELEMENT = Obj(
     {
         "role": Str(
@@ -623,28 +654,7 @@ FRAME_ELEMENT = Obj(
             "checksum: the span of elements covered. Outside a transparency span it sees the wire bytes, inside "
             "it the bytes before stuffing.",
         ),
-        "algorithm": Str(
-            "checksum: sum (of the bytes, modulo the width), xor (of the bytes) or crc.",
-            choices=("sum", "crc", "xor"),
-        ),
-        "invert": Bool("sum: bitwise NOT of the sum.", default=False),
-        "crc": Obj(
-            {
-                "name": Str("Catalogue name, e.g. CRC-16/MODBUS."),
-                "width": Int("Bits of the CRC."),
-                "poly": Int("Generator polynomial, normal form without the top bit (0x8005)."),
-                "init": Int("Register value before the first byte."),
-                "refin": Bool("Each input byte is reflected (least significant bit first)."),
-                "refout": Bool("The result is reflected before `xorout`."),
-                "xorout": Int("Value XORed into the result."),
-                "check": Int("The catalogue check value: the CRC of b'123456789'."),
-            },
-            required=("width", "poly", "init", "refin", "refout", "xorout", "check"),
-            description=(
-                "crc: the CRC by its catalogue parameters (reveng's CRC catalogue); the generator checks `check` "
-                "against the CRC of '123456789'."
-            ),
-        ),
+        **checksum_keys(),
     },
     required=("role",),
     description="One element of the frame, in wire order.",

@@ -11,6 +11,7 @@ from dataclasses import field
 from functools import cached_property
 from typing import Literal
 
+from serialspec.checksums.base import Algorithm
 from serialspec.lang import expression
 from serialspec.lang.expression import Expr
 from serialspec.lang.frozen import frozen
@@ -354,22 +355,8 @@ class Command:
 
 
 @frozen
-class Crc:
-    name: str
-    width: int
-    poly: int
-    init: int
-    refin: bool
-    refout: bool
-    xorout: int
-    check: int
-
-
-@frozen
 class Checksum:
-    algorithm: Literal["sum", "crc", "xor"]
-    invert: bool
-    crc: Crc | None
+    algorithm: Algorithm  # what it computes, with its parameters: one class per algorithm (serialspec/checksums/)
     first: str  # first frame element covered
     last: str  # last frame element covered
     type: ScalarType

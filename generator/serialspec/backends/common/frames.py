@@ -6,10 +6,7 @@ byte by byte). One mapping from model to engine, so the two cannot disagree.
 
 from __future__ import annotations
 
-from collections.abc import Callable
-
-from serialspec.lang.model import Checksum, Direction, FrameElement, FrameLayout, Protocol
-from serialspec.runtime.checksums import crc_function, sum_function, xor_function
+from serialspec.lang.model import Direction, FrameElement, FrameLayout, Protocol
 from serialspec.runtime.framing import Element, ElementKind, Layout, Transparency
 
 KINDS: dict[str, ElementKind] = {
@@ -25,17 +22,6 @@ KINDS: dict[str, ElementKind] = {
 }
 
 
-def checksum_function(checksum: Checksum) -> Callable[[bytes], int]:
-    width = checksum.type.size * 8
-    if checksum.algorithm == "crc":
-        c = checksum.crc
-        assert c is not None
-        return crc_function(c.width, c.poly, c.init, c.refin, c.refout, c.xorout)
-    if checksum.algorithm == "xor":
-        return xor_function(width)
-    return sum_function(width, checksum.invert)
-
-
 def runtime_element(layout: FrameLayout, element: FrameElement) -> Element:
     kind = KINDS[element.role]
     span = (0, 0)
@@ -45,7 +31,7 @@ def runtime_element(layout: FrameLayout, element: FrameElement) -> Element:
     elif kind == "checksum":
         assert element.checksum is not None
         span = (layout.index(element.checksum.first), layout.index(element.checksum.last))
-        function = checksum_function(element.checksum)
+        function = element.checksum.algorithm.function()
     return Element(
         name=element.name,
         kind=kind,

@@ -374,48 +374,38 @@ def checksum_context(protocol: Protocol, general: Checksum | None = None) -> dic
     example = next(iter(protocol.examples), None)
     worked = ""
     if general is not None and example is not None:
-        worked = f"every example's `{checksum.name}` verifies (e.g. `{example.name}`)"
+        verifies = f"every example's `{checksum.name}` verifies (e.g. `{example.name}`)"
+        worked = general_worked(protocol, general) or verifies
     elif example is not None:
         layout = protocol.framing.layouts[example.direction]
         covered = example.frame[layout.covered_from : len(example.frame) - layout.covered_to_end]
-        if checksum.algorithm == "sum":
-            total = sum(covered)
-            invert = "~" if checksum.invert else ""
-            worked = (
-                f"{invert}({' + '.join(f'0x{b:02X}' for b in covered)}) = {invert}{total:#x} "
-                f"→ 0x{example.frame[-1]:02X} (example `{example.name}`)"
-            )
-        else:
-            worked = f"CRC of {covered.hex(' ').upper()} = 0x{example.frame[-1]:02X} (example `{example.name}`)"
-    if checksum.algorithm == "sum":
-        what = (
-            "bitwise NOT of the sum" if checksum.invert else "sum"
-        ) + f" of the covered bytes, modulo {1 << (checksum.type.size * 8)}"
-        params = []
-    else:
-        assert checksum.crc is not None
-        c = checksum.crc
-        what = f"{c.name or 'CRC'} over the covered bytes"
-        params = [
-            ("width", c.width),
-            ("poly", f"{c.poly:#04x}"),
-            ("init", f"{c.init:#04x}"),
-            ("refin", c.refin),
-            ("refout", c.refout),
-            ("xorout", f"{c.xorout:#04x}"),
-            ("check ('123456789')", f"{c.check:#04x}"),
-        ]
-    if checksum.algorithm == "xor":
-        what = f"XOR of the covered bytes ({checksum.type.size * 8} bits)"
+        worked = f"{checksum.algorithm.worked(covered)} (example `{example.name}`)"
     label = f" `{checksum.name}`" if general is not None else ""
     return {
         "label": label,
-        "what": what,
+        "what": checksum.algorithm.describe(),
         "first": checksum.first,
         "last": checksum.last,
         "worked": worked,
-        "params": params,
+        "params": checksum.algorithm.parameters(),
     }
+
+
+def general_worked(protocol: Protocol, checksum: Checksum) -> str:
+    """The first example whose frame holds the checksum (and no stuffing), worked by the algorithm; "" for none."""
+    for example in protocol.examples:
+        layouts = runtime_layouts(protocol, example.direction)
+        layout = next((lay for lay in layouts if example.frame.startswith(lay.header)), layouts[0])
+        index = next((i for i, e in enumerate(layout.elements) if e.name == checksum.name), None)
+        if index is None or layout.transparency is not None:
+            continue
+        try:
+            parts = layout.unwrap(example.frame).parts
+        except SerialspecError:
+            continue
+        first, last = layout.elements[index].span
+        return f"{checksum.algorithm.worked(b''.join(parts[first : last + 1]))} (example `{example.name}`)"
+    return ""
 
 
 def general_breakdown(protocol: Protocol, example: Example, message: Message | None) -> list[dict[str, str]]:

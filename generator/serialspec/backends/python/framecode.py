@@ -28,7 +28,6 @@ from dataclasses import dataclass
 from serialspec.backends.common.frames import runtime_layouts
 from serialspec.backends.python.ir import Block, Code, Literal, Pack, PackItems, Simple, packed_lists
 from serialspec.lang.model import Checksum, Direction, Protocol
-from serialspec.runtime.checksums import crc_in_one_call
 from serialspec.runtime.framing import Element, Layout
 
 Lines = list[str]
@@ -41,14 +40,9 @@ def checksum_name(checksum: Checksum) -> str:
 
 
 def checksum_call(checksum: Checksum) -> str:
-    """The expression of a checksum over `{}` (a str.format template): the standard library's C function called
-    directly where it computes this CRC (no Python function between), else the module's checksum function."""
-    crc = checksum.crc
-    if checksum.algorithm == "crc" and crc is not None:
-        direct = crc_in_one_call(crc.width, crc.poly, crc.init, crc.refin, crc.refout, crc.xorout)
-        if direct is not None:
-            return direct
-    return checksum_name(checksum) + "({})"
+    """The expression of a checksum over `{}` (a str.format template), as its algorithm writes it: in line, a C
+    function called directly, or the module's checksum function (frames.checksum_definitions defines it)."""
+    return checksum.algorithm.python_call(checksum_name(checksum))
 
 
 def registry(structs: dict[str, str]) -> Structs:
@@ -298,10 +292,13 @@ def decode_lines(
 def _residue(element: Element) -> int | None:
     """The checksum over any bytes followed by their own checksum (as the element stores it), where that is one
     constant: a CRC stored in its own bit order (reflected: low byte first; else high byte first). None for the
-    others (sums, a CRC stored the other way round). Found by computing it, not by its parameters."""
+    others (sums, a CRC stored the other way round, an XOR of words stored the other way round). Found by computing
+    it, not by its parameters: over data of even and odd sizes, so that a checksum whose bytes land on other word
+    boundaries than the data's shows that it has none."""
     function = element.checksum
     assert function is not None
-    found = {function(data + element.pack(function(data))) for data in (b"", b"\x00", b"123456789", b"\xff" * 7)}
+    samples = (b"", b"\x00", b"\x01\x02", b"123456789", b"\xff" * 7, bytes(range(1, 18)))
+    found = {function(data + element.pack(function(data))) for data in samples}
     return found.pop() if len(found) == 1 else None
 
 

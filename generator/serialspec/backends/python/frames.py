@@ -9,9 +9,11 @@ runs on them; single frames are checked and built by straight-line code written 
 
 from __future__ import annotations
 
+from collections.abc import Iterable
+
 from serialspec.backends.common.frames import runtime_element
 from serialspec.backends.python.framecode import checksum_name
-from serialspec.backends.python.pycode import one_line
+from serialspec.checksums.base import Import
 from serialspec.lang.model import (
     Command,
     Direction,
@@ -23,30 +25,40 @@ from serialspec.lang.model import (
 )
 
 
-def checksum_definitions(protocol: Protocol) -> tuple[list[str], list[str]]:
-    """The runtime imports and module-level definitions of every checksum function the layouts use."""
-    imports: set[str] = set()
+def checksum_definitions(protocol: Protocol, straight: bool = True) -> tuple[list[str], list[str]]:
+    """The import lines and module-level definitions of every checksum the layouts use: its runtime function (the
+    engine's elements call it) and, for `straight` code, what its expression needs (framecode.checksum_call)."""
+    imports: set[Import] = set()
     definitions: dict[str, str] = {}
     for layouts in protocol.framing.alternatives.values():
         for layout in layouts:
             for checksum in layout.checksums:
-                width = checksum.type.size * 8
-                if checksum.algorithm == "crc":
-                    crc = checksum.crc
-                    assert crc is not None
-                    imports.add("crc_function")
-                    value = (
-                        f"crc_function({crc.width}, {crc.poly:#x}, {crc.init:#x}, {crc.refin}, {crc.refout}, "
-                        f"{crc.xorout:#x})  # {one_line(crc.name)}"
-                    )
-                elif checksum.algorithm == "xor":
-                    imports.add("xor_function")
-                    value = f"xor_function({width})"
-                else:
-                    imports.add("sum_function")
-                    value = f"sum_function({width}, {checksum.invert})"
-                definitions[checksum_name(checksum)] = f"{checksum_name(checksum)}: Callable[[bytes], int] = {value}"
-    return sorted(imports), [definitions[name] for name in sorted(definitions)]
+                name = checksum_name(checksum)
+                (module, function), call = checksum.algorithm.function_code()
+                title = checksum.algorithm.title()
+                imports.add((module, function))
+                definitions[name] = f"{name}: Callable[[bytes], int] = {call}" + (f"  # {title}" if title else "")
+                extra_imports, extra = checksum.algorithm.python_setup(name) if straight else ([], [])
+                imports.update(extra_imports)
+                definitions |= {line: line for line in extra if line != definitions[name]}
+    return import_lines(imports), list(definitions.values())
+
+
+def import_lines(imports: Iterable[Import]) -> list[str]:
+    """`from module import name` lines, as ruff's isort orders them: by module, then the plain names of a module
+    on one line before or after each aliased one by name."""
+    by_module: dict[str, list[str]] = {}
+    for module, name in sorted(set(imports)):
+        by_module.setdefault(module, []).append(name)
+    lines = []
+    for module, names in sorted(by_module.items()):
+        plain = sorted(n for n in names if " as " not in n)
+        statements = [[n] for n in sorted(n for n in names if " as " in n)]
+        if plain:
+            statements.append(plain)
+        for group in sorted(statements, key=lambda g: g[0]):
+            lines.append(f"from {module} import {', '.join(group)}")
+    return lines
 
 
 def element_expr(layout: FrameLayout, element: FrameElement) -> str:

@@ -166,15 +166,16 @@ class TakeRest:
 
 
 @dataclass(frozen=True)
-class SumCheck:
-    """`return None` unless an 8-bit sum over all of `buf` but its first bytes (their sum taken off: `less`) holds:
-    the covered bytes sum to the check byte at `check_at`, so the whole frame sums to twice it."""
+class FrameTest:
+    """`return None` unless a whole frame's checksum holds: `condition` (an int expression, 0 exactly when it does)
+    reads the check byte at its offset; `from_end` is the same test reading it from the frame's end (for a decoder
+    whose frame size nothing checked, see exact_whole)."""
 
-    less: str
-    check_at: str
+    condition: str
+    from_end: str
 
     def lines(self) -> list[str]:
-        return [f"if (sum(buf){self.less} - 2 * buf[{self.check_at}]) & 0xff:", "    return None"]
+        return [f"if {self.condition}:", "    return None"]
 
 
 @dataclass(frozen=True)
@@ -257,7 +258,7 @@ Statement = (
     | Needs
     | Expect
     | TakeRest
-    | SumCheck
+    | FrameTest
     | Unpack
     | Advance
     | LeftOver
@@ -310,7 +311,7 @@ def reads_cursor(statement: Statement) -> bool:
             return statement.unpacked is not None and statement.unpacked.at == "o"
         case ContentSize() | Needs() | Advance() | LeftOver():
             return True
-        case Raise() | Expect() | SumCheck() | ItemsCheck() | Try():
+        case Raise() | Expect() | FrameTest() | ItemsCheck() | Try():
             return False
         case _:
             assert_never(statement)

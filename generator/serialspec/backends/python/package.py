@@ -10,8 +10,14 @@ from typing import Any
 
 from serialspec.backends.common.numbers import number
 from serialspec.backends.python.client import client_module
-from serialspec.backends.python.framecode import Target, direction_functions
-from serialspec.backends.python.frames import checksum_definitions, code_key, codec_lines, framing_imports
+from serialspec.backends.python.framecode import Target, checksum_name, direction_functions
+from serialspec.backends.python.frames import (
+    checksum_definitions,
+    code_key,
+    codec_lines,
+    framing_imports,
+    import_lines,
+)
 from serialspec.backends.python.ir import (
     RETURN_NONE,
     Advance,
@@ -19,11 +25,11 @@ from serialspec.backends.python.ir import (
     Code,
     ContentSize,
     Expect,
+    FrameTest,
     If,
     Loop,
     ReturnNew,
     Statement,
-    SumCheck,
     TakeRest,
     Unpack,
     fuse_unpack,
@@ -37,11 +43,10 @@ from serialspec.backends.python.pycode import (
     Lines,
     PackageCode,
     checksum_lines,
-    crc_setup,
+    checksum_setup,
     decoder_name,
     encoder_name,
     one_line,
-    reflect,
     takes_the_rest,
 )
 from serialspec.backends.python.registers import register_tables, registers_module
@@ -63,7 +68,6 @@ from serialspec.lang.model import (
     replies_by_request,
     reply_to,
 )
-from serialspec.runtime.checksums import crc_table
 
 
 def class_context(cls: ClassCode, where: str, keys: list[str], optional: list[str]) -> dict[str, Any]:
@@ -283,7 +287,6 @@ def general_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
         "framing_imports": sorted({"EngineFormat", *framing_imports(every)}, key=import_order),
         "checksum_error": any("ChecksumError(" in line for line in every),
         "checksum_imports": imports,
-        "crc_hqx": any("_crc_hqx(" in line for line in every),  # a CRC the standard library computes, called directly
         "checksum_definitions": definitions,
         "directions": directions,
         "dispatchers": dispatchers,
@@ -331,7 +334,7 @@ def classic_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
     assert protocol.framing.checksum is not None
     checksum = protocol.framing.checksum
     assert checksum is not None  # classic frames have one
-    checksum_import, checksum_definition = crc_setup(checksum)
+    checksum_imports, checksum_definitions = checksum_setup(checksum)
     directions = []
     dispatchers = []
     frame_functions: list[dict[str, Any]] = []
@@ -435,8 +438,8 @@ def classic_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
         picker["lines"] = lines_of(picker["lines"])
     return {
         "classic": True,
-        "checksum_import": checksum_import,
-        "checksum_definition": checksum_definition,
+        "checksum_imports": import_lines(checksum_imports),
+        "checksum_definitions": checksum_definitions,
         "directions": directions,
         "frame_functions": frame_functions,
         "runs": any(d["runs"] for d in directions),
@@ -736,13 +739,9 @@ def rest_check(protocol: Protocol, layout: FrameLayout) -> Block:
     size = layout.checksum_offset_from_end
     stored = "buf[-1]" if size == 1 else f"int.from_bytes(buf[-{size}:], 'little')"
     header = layout.header[: layout.covered_from]
-    whole_sum = checksum.algorithm == "sum" and size == 1 == layout.covered_to_end == checksum.type.size
-    if whole_sum and len(header) == layout.covered_from:
-        less = f" - {sum(header):#x}" if header else ""
-        if not checksum.invert:
-            return [SumCheck(less, "-1")]
-        inverted = "inverted: the bytes and the check sum to 0xff"
-        return [If(f"(sum(buf) - {sum(header) + 0xFF:#x}) & 0xff", (RETURN_NONE,), comment=inverted)]
+    test = checksum.algorithm.frame_test("sum(buf)", sum(header), "buf[-1]")
+    if test is not None and size == 1 == layout.covered_to_end and len(header) == layout.covered_from:
+        return [FrameTest(test, test)]
     covered = f"buf[{layout.covered_from}:-{layout.covered_to_end}]"
     check = [Code(line) for line in checksum_lines(checksum, covered, "expected")]
     return [*check, If(f"expected != {stored}", (RETURN_NONE,))]
@@ -750,11 +749,11 @@ def rest_check(protocol: Protocol, layout: FrameLayout) -> Block:
 
 def failed_check(body: Block) -> int | None:
     """The index of a whole-frame decoder's checksum test (the first `if ...: return None`), or None."""
-    return next((i for i, s in enumerate(body) if isinstance(s, If | SumCheck) and returns_none(s)), None)
+    return next((i for i, s in enumerate(body) if isinstance(s, If | FrameTest) and returns_none(s)), None)
 
 
-def returns_none(statement: If | SumCheck) -> bool:
-    return isinstance(statement, SumCheck) or statement.body == (RETURN_NONE,)
+def returns_none(statement: If | FrameTest) -> bool:
+    return isinstance(statement, FrameTest) or statement.body == (RETURN_NONE,)
 
 
 def picked_inline(subs: list[tuple[int, dict[str, Any]]], at: int) -> Block | None:
@@ -867,50 +866,39 @@ def whole_frame_check(
     protocol: Protocol, layout: FrameLayout, size: int, known: dict[int, int], at: Callable[[int], str]
 ) -> Block | None:
     """decode()'s version of a whole-frame decoder's checksum test, where it is cheaper than frame_check's: `buf` is
-    exactly the frame (decode checked its size), so an 8-bit sum over all but a constant header is the sum of the
-    whole frame less the header and the checksum byte (no slice is made); an 8-bit CRC starts from its value after
-    the covered bytes that the frame's key fixes (`known`: offset -> byte; header, command code, length byte).
-    None where neither applies."""
+    exactly the frame (decode checked its size), so a checksum that is a sum over all but a constant header is
+    tested on the sum of the whole frame (no slice is made: the algorithm's frame_test); one computed by table steps
+    starts from its state after the covered bytes that the frame's key fixes (`known`: offset -> byte; header,
+    command code, length byte), and a few steps are written out. None where neither applies."""
     checksum = protocol.framing.checksum
     assert checksum is not None  # classic frames have one
-    crc = checksum.crc
-    if crc is not None and crc.width == 8 and crc.refin == crc.refout:
-        table = crc_table(8, crc.poly, crc.refin)
-        state = reflect(crc.init, 8) if crc.refin else crc.init
+    steps = checksum.algorithm.byte_table(checksum_name(checksum), "expected")
+    if steps is not None:
+        state = steps.start
         first, stop = layout.covered_from, size - layout.covered_to_end
         while first in known and first < stop - 1:
-            state = table[state ^ known[first]]
+            state = steps.entries[state ^ known[first]]
             first += 1
-        steps: Block
+        stepped: Block
         if stop - first > _MOST_UNROLLED:
-            steps = [
+            stepped = [
                 Code(f"expected = {state:#x}"),
-                Loop(f"for byte in buf[{first} : {stop}]", (Code("expected = _CRC_TABLE[expected ^ byte]"),)),
+                Loop(f"for byte in buf[{first} : {stop}]", (Code(f"expected = {steps.table}[expected ^ byte]"),)),
             ]
         else:  # a few bytes: one table step each, no slice and no loop
-            steps = [Code(f"expected = _CRC_TABLE[{state:#x} ^ buf[{first}]]", reads=(first,))]
-            steps += [
-                Code(f"expected = _CRC_TABLE[expected ^ buf[{offset}]]", reads=(offset,))
+            stepped = [Code(f"expected = {steps.table}[{state:#x} ^ buf[{first}]]", reads=(first,))]
+            stepped += [
+                Code(f"expected = {steps.table}[expected ^ buf[{offset}]]", reads=(offset,))
                 for offset in range(first + 1, stop)
             ]
-        if crc.xorout:
-            steps.append(Code(f"expected ^= {crc.xorout:#x}"))
-        return [*steps, frame_check(checksum, layout, size, at)[-1]]
+        stepped += [Code(line) for line in steps.finish]
+        return [*stepped, frame_check(checksum, layout, size, at)[-1]]
     header = layout.header[: layout.covered_from]
-    whole_sum = (
-        checksum.algorithm == "sum"
-        and checksum.type.size == 1
-        and layout.checksum_offset_from_end == 1
-        and layout.covered_to_end == 1
-        and len(header) == layout.covered_from
-    )
-    if not whole_sum:
+    test = checksum.algorithm.frame_test("sum(buf)", sum(header), f"buf[{size - 1}]")
+    whole = layout.checksum_offset_from_end == 1 and layout.covered_to_end == 1 and len(header) == layout.covered_from
+    if test is None or not whole:
         return None
-    less = f" - {sum(header):#x}" if header else ""
-    if not checksum.invert:  # sum(covered) = check (mod 256): the whole frame sums to twice the check, plus the rest
-        return [SumCheck(less, str(size - 1))]
-    # inverted: the covered bytes and the check sum to 0xff, so the whole frame to that plus the header
-    return [If(f"(sum(buf) - {sum(header) + 0xFF:#x}) & 0xff", (RETURN_NONE,))]
+    return [FrameTest(test, checksum.algorithm.frame_test("sum(buf)", sum(header), "buf[-1]") or test)]
 
 
 def exact_struct(name: str, size: int, content_offset: int, code: PackageCode) -> str:
@@ -928,7 +916,7 @@ def exact_whole(body: Block, size: int, known: int, code: PackageCode) -> Block:
     """A whole-frame decoder that refuses a frame of another size than `size` by itself: its one unpack made of the
     whole frame (struct.error), a sum's check byte read from the end; else a size check first, returning None.
     `known`: the bytes decode() has matched (its key), which any frame it is given holds."""
-    body = [replace(s, check_at="-1") if isinstance(s, SumCheck) else s for s in body]
+    body = [replace(s, condition=s.from_end) if isinstance(s, FrameTest) else s for s in body]
     unpacks = [i for i, s in enumerate(body) if _unpack_at_offset(s) is not None]
     before = body[: unpacks[0] if unpacks else len(body)]
     if len(unpacks) != 1 or any(offset >= known for offset in _constant_reads(before)):
@@ -965,9 +953,10 @@ def summed_checksum(protocol: Protocol, layout: FrameLayout) -> str | None:
     """The stream parser's `summed`: (first byte covered, inverted) where the checksum is an 8-bit sum of every byte
     from there to the last, which it is; None for other checksums."""
     checksum = protocol.framing.checksum
-    if checksum is None or plain_check(protocol, layout) is None:
+    inverted = checksum.algorithm.summed() if checksum is not None else None
+    if inverted is None or plain_check(protocol, layout) is None:
         return None
-    return f"({layout.covered_from}, {checksum.invert})"
+    return f"({layout.covered_from}, {inverted})"
 
 
 def plain_check(protocol: Protocol, layout: FrameLayout) -> str | None:
@@ -975,14 +964,12 @@ def plain_check(protocol: Protocol, layout: FrameLayout) -> str | None:
     over the frame's bytes: an 8-bit sum over all but a constant header and the check. None for others."""
     checksum = protocol.framing.checksum
     header = layout.header[: layout.covered_from]
-    if checksum is None or checksum.algorithm != "sum" or len(header) != layout.covered_from:
+    if checksum is None or len(header) != layout.covered_from:
         return None
-    if not layout.checksum_offset_from_end == 1 == layout.covered_to_end == checksum.type.size:
+    if not layout.checksum_offset_from_end == 1 == layout.covered_to_end:
         return None
-    less = f" - {sum(header):#x}" if header else ""
-    if checksum.invert:  # the covered bytes and their inverted sum add up to 0xff
-        return f"not (sum(data) - {sum(header) + 0xFF:#x}) & 0xff"
-    return f"not (sum(data){less} - 2 * data[-1]) & 0xff"
+    test = checksum.algorithm.frame_test("sum(data)", sum(header), "data[-1]")
+    return None if test is None else f"not {test}"
 
 
 def run_frames(
@@ -1043,7 +1030,7 @@ def summed_frame(
     like that."""
     checksum = protocol.framing.checksum
     unpack = body[0] if body else None
-    if checksum is None or checksum.algorithm != "sum" or checksum.type.size != 1:
+    if checksum is None or checksum.algorithm.summed() is None:
         return None
     if not isinstance(unpack, Unpack) or unpack.at != "o" or unpack.tuple_target:
         return None
@@ -1081,11 +1068,11 @@ def summed_frame(
     if len(terms) > _MOST_TERMS:
         return None  # summing a slice of the frame in C is cheaper than this many terms in Python
     with_check = code.struct(unpack.struct.removeprefix("_S_") + "_and_check", fmt + "B")
-    total = " + ".join([f"{constant:#x}", *terms])
-    invert = "~" if checksum.invert else ""
+    total = checksum.algorithm.byte_total(" + ".join([f"{constant:#x}", *terms]))
+    assert total is not None  # an 8-bit byte sum's
     return [
         Unpack((*targets, "check"), with_check, at=at(content_offset)),
-        If(f"{invert}({total}) & 0xff != check", (RETURN_NONE,)),
+        If(f"{total} != check", (RETURN_NONE,)),
     ]
 
 
@@ -1126,11 +1113,12 @@ def frame_decode_lines(
     stored = "check"
     lines += checksum_lines(checksum, covered, "expected")
     header = layout.header[: layout.covered_from]
-    whole_sum = checksum.algorithm == "sum" and size == 1 == layout.covered_to_end == checksum.type.size
-    if start is None and whole_sum and len(header) == layout.covered_from:
+    less = f" - {sum(header):#x}" if header else ""
+    total = checksum.algorithm.byte_total(f"sum({buf}){less} - {stored}")
+    whole = size == 1 == layout.covered_to_end and len(header) == layout.covered_from
+    if start is None and total is not None and whole:
         # all but a checked header and the check: the sum of the whole frame less those, no slice made
-        less = f" - {sum(header):#x}" if header else ""
-        lines = [lines[0], f"expected = {'~' if checksum.invert else ''}(sum({buf}){less} - {stored}) & 0xff"]
+        lines = [lines[0], f"expected = {total}"]
     lines += [
         f"if expected != {stored}:",
         f'    raise ChecksumError(f"bad checksum: the frame has {{{stored}:#04x}}, its bytes give {{expected:#04x}}")',

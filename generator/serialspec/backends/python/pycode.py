@@ -14,7 +14,7 @@ from dataclasses import dataclass, field, replace
 
 from serialspec.backends.common.numbers import number
 from serialspec.backends.common.text import collapse
-from serialspec.backends.python.framecode import Straight, frame_encoder, straight_direction
+from serialspec.backends.python.framecode import Straight, checksum_name, frame_encoder, straight_direction
 from serialspec.backends.python.ir import (
     Advance,
     Block,
@@ -42,6 +42,7 @@ from serialspec.backends.python.ir import (
     values_tuple,
 )
 from serialspec.backends.python.kinds import kind
+from serialspec.checksums.base import Import
 from serialspec.lang import expression
 from serialspec.lang.model import (
     Array,
@@ -814,10 +815,10 @@ class PackageCode:
         assert checksum is not None  # classic frames have one
         value = checksum_expression(checksum, covered)
         skipped = layout.header[: layout.covered_from]
-        if checksum.algorithm == "sum" and layout.covered_from and len(skipped) == layout.covered_from:
+        less = checksum.algorithm.byte_total(f"sum({body}) - {sum(skipped):#x}")
+        if less is not None and layout.covered_from and len(skipped) == layout.covered_from:
             # the bytes before the covered ones are the header, a constant: the sum less it, no slice made
-            mask = (1 << (checksum.type.size * 8)) - 1
-            value = f"{'~' if checksum.invert else ''}(sum({body}) - {sum(skipped):#x}) & {mask:#x}"
+            value = less
         lines: Block = []
         if value is None:  # computed by statements into `check`; else the one expression is appended directly
             lines, value = [Code(line) for line in checksum_lines(checksum, covered, "check")], "check"
@@ -1055,53 +1056,18 @@ class PackageCode:
         return f"b''.join(parts_{f.name})"
 
 
-def reflect(value: int, width: int) -> int:
-    return int(f"{value:0{width}b}"[::-1], 2)
-
-
 def checksum_expression(checksum: Checksum, covered: str) -> str | None:
-    """The one expression of a frame's checksum over the bytes `covered` (an expression) where it is one (see
-    checksum_lines); None where it takes statements."""
-    mask = (1 << (checksum.type.size * 8)) - 1
-    if checksum.algorithm == "sum":
-        return f"{'~' if checksum.invert else ''}sum({covered}) & {mask:#x}"
-    crc = checksum.crc
-    assert crc is not None
-    if crc.width != 8 or crc.refin != crc.refout:
-        return f"_crc({covered})"
-    return None
+    """The one expression of a frame's checksum over the bytes `covered` (an expression) that checksum_lines
+    assigns, where it is one; None where it takes statements."""
+    return checksum.algorithm.python_expression(checksum_name(checksum), covered)
 
 
 def checksum_lines(checksum: Checksum, covered: str, target: str) -> Lines:
-    """Lines that compute a frame's checksum over the bytes `covered` (an expression) into `target`.
-
-    A sum is one expression; an 8-bit CRC a loop over a 256-entry table (`_CRC_TABLE`, which the codec defines) with
-    no call per frame; any other CRC the runtime's table-driven function (`_crc`).
-    """
-    value = checksum_expression(checksum, covered)
-    if value is not None:
-        return [f"{target} = {value}"]
-    crc = checksum.crc
-    assert crc is not None
-    # With 8 bits the table-driven step is table[crc ^ byte] whether the CRC is reflected or not.
-    lines = [
-        f"{target} = {reflect(crc.init, 8) if crc.refin else crc.init:#x}",
-        f"for byte in {covered}:",
-        f"    {target} = _CRC_TABLE[{target} ^ byte]",
-    ]
-    if crc.xorout:
-        lines.append(f"{target} ^= {crc.xorout:#x}")
-    return lines
+    """Lines that compute a frame's checksum over the bytes `covered` (an expression) into `target`, as its
+    algorithm writes them (serialspec/checksums/; checksum_setup gives what they rely on)."""
+    return checksum.algorithm.python_lines(checksum_name(checksum), covered, target)
 
 
-def crc_setup(checksum: Checksum) -> tuple[str, str]:
-    """The runtime import and the module-level definition that `checksum_lines` relies on ('' for sums)."""
-    crc = checksum.crc
-    if checksum.algorithm == "sum" or crc is None:
-        return "", ""
-    if crc.width != 8 or crc.refin != crc.refout:
-        definition = (
-            f"crc_function({crc.width}, {crc.poly:#x}, {crc.init:#x}, {crc.refin}, {crc.refout}, {crc.xorout:#x})"
-        )
-        return "crc_function", f"_crc: Callable[[bytes], int] = {definition}  # {one_line(crc.name)}"
-    return "crc_table", f"_CRC_TABLE = crc_table(8, {crc.poly:#x}, {crc.refin})  # {one_line(crc.name)}"
+def checksum_setup(checksum: Checksum) -> tuple[list[Import], list[str]]:
+    """The runtime imports and module-level definitions that `checksum_lines` relies on."""
+    return checksum.algorithm.python_setup(checksum_name(checksum))

@@ -5,7 +5,7 @@ construct is the declarative reference the fast codec is tested against; it is n
 
 from __future__ import annotations
 
-from serialspec.backends.python.frames import checksum_definitions, codec_lines, framing_imports
+from serialspec.backends.python.frames import checksum_definitions, codec_lines, framing_imports, import_lines
 from serialspec.backends.python.kinds import kind, primitive
 from serialspec.backends.python.pycode import one_line
 from serialspec.backends.python.render import render
@@ -81,17 +81,12 @@ def structs_module(protocol: Protocol) -> str:
     if framing.classic:
         checksum = framing.checksum
         assert checksum is not None
-        if checksum.algorithm == "crc":
-            assert checksum.crc is not None
-            c = checksum.crc
-            checksum_expr = f"crc_function({c.width}, {c.poly:#x}, {c.init:#x}, {c.refin}, {c.refout}, {c.xorout:#x})"
-        else:
-            checksum_expr = f"sum_function({checksum.type.size * 8}, invert={checksum.invert})"
-        definitions.append(f"_checksum = {checksum_expr}")
-        checksum_imports = ["crc_function" if checksum.algorithm == "crc" else "sum_function"]
+        function_import, call = checksum.algorithm.function_code()
+        definitions.append(f"_checksum = {call}")
+        checksum_imports = import_lines([function_import])
         frames = [{"name": f"{d.name}_FRAME", "expr": frame_expr(layout)} for d, layout in framing.layouts.items()]
     else:
-        checksum_imports, definitions = checksum_definitions(protocol)
+        checksum_imports, definitions = checksum_definitions(protocol, straight=False)
         for direction in Direction:
             definitions += ["", *codec_lines(protocol, direction, [], {})]
         frames = [{"name": f"{d.name}_FRAME", "expr": f"Framed(_{d.name}_FRAMES)"} for d in Direction]

@@ -12,9 +12,9 @@ from types import ModuleType
 from typing import Any
 
 from serialspec.backends.python.memory import imported
+from serialspec.checksums.crc import Crc, crc_function
 from serialspec.lang.errors import SpecError
 from serialspec.lang.model import Erratum, Example, Protocol
-from serialspec.runtime.checksums import crc_function
 from serialspec.runtime.errors import SerialspecError
 from serialspec.runtime.hexbytes import parse_hex
 
@@ -99,10 +99,10 @@ class _Checker:
 
     def claimed_crc(self, erratum: Erratum) -> str:
         checksum = self.protocol.framing.checksum
-        crc = checksum.crc if checksum is not None else None
+        crc = checksum.algorithm if checksum is not None else None
         claimed = erratum.check.claimed
-        if crc is None or not isinstance(claimed, dict):
-            return ""
+        if not isinstance(crc, Crc) or not isinstance(claimed, dict):
+            return ""  # the erratum is about a CRC's parameters: the check's own validation says so
         parameters = {
             "width": crc.width,
             "poly": crc.poly,

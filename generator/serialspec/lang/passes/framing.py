@@ -9,11 +9,12 @@ from __future__ import annotations
 from dataclasses import replace
 from typing import Any, Literal
 
+from serialspec import checksums
+from serialspec.checksums import ChecksumProblem
 from serialspec.lang.errors import SpecError
 from serialspec.lang.loader import Path
 from serialspec.lang.model import (
     Checksum,
-    Crc,
     Direction,
     FrameElement,
     FrameLayout,
@@ -135,39 +136,13 @@ class FramingPass(FieldResolver):
     ) -> Checksum:
         if not item.get("covers"):
             raise self.fail(path, "a checksum needs `covers: [first, last]` (frame element names)")
-        algorithm = item.get("algorithm")
-        crc = None
-        if algorithm == "crc":
-            params = item.get("crc")
-            if not params:
-                raise self.fail(path, "algorithm crc needs `crc:` with width, poly, init, refin, refout, xorout, check")
-            crc = Crc(
-                str(params.get("name", "")),
-                params["width"],
-                params["poly"],
-                params["init"],
-                params["refin"],
-                params["refout"],
-                params["xorout"],
-                params["check"],
+        try:
+            algorithm = checksums.from_spec(
+                item, scalar.size, scalar.name, lambda keys, message: self.error((*path, *keys), message)
             )
-            if crc.width != scalar.size * 8:
-                raise self.fail((*path, "crc", "width"), f"a {crc.width}-bit CRC does not fill a {scalar.name}")
-            for key in ("poly", "init", "xorout", "check"):
-                if not 0 <= params[key] < 1 << crc.width:
-                    raise self.fail((*path, "crc", key), f"{key} {params[key]} does not fit {crc.width} bits")
-            from serialspec.runtime.checksums import crc_function
-
-            computed = crc_function(crc.width, crc.poly, crc.init, crc.refin, crc.refout, crc.xorout)(b"123456789")
-            if computed != crc.check:
-                self.error(
-                    (*path, "crc", "check"),
-                    f"these parameters give {computed:#x} for '123456789', not the check value {crc.check:#x}",
-                )
-        elif algorithm not in ("sum", "xor"):
-            raise self.fail(path, "a checksum needs `algorithm: sum`, `algorithm: xor` or `algorithm: crc`")
-        # the span is resolved per direction (`covers` may be given by direction); first/last filled in by layout
-        return Checksum(algorithm, bool(item.get("invert", False)), crc, "", "", scalar, endian, name)
+        except ChecksumProblem as problem:
+            raise self.fail((*path, *problem.keys), problem.message) from None
+        return Checksum(algorithm, "", "", scalar, endian, name)
 
     def span(
         self, raw: Any, direction: Direction, names: list[str], path: Path, default: tuple[str, str] | None = None

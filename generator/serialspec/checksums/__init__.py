@@ -1,0 +1,47 @@
+"""The checksum algorithms: one registry, one module per algorithm, each owning all of its behaviour (base.py).
+
+`algorithms()` finds them: it imports every module of this package and collects the Algorithm subclasses that set
+`name`, so a new algorithm is a new module and nothing else. The package imports nothing of the generator: generated
+code imports each algorithm's runtime function from its module (serialspec.checksums.crc.crc_function), and the
+runtime wheel ships the package. Importing it finds nothing yet: a generated codec pays only for the module it uses.
+"""
+
+from __future__ import annotations
+
+import importlib
+import pkgutil
+from collections.abc import Mapping
+from functools import cache
+from typing import Any
+
+from serialspec.checksums.base import _REGISTERED, Algorithm, ChecksumProblem, Report
+
+__all__ = ["Algorithm", "ChecksumProblem", "algorithms", "from_spec", "owned_keys"]
+
+
+@cache
+def algorithms() -> dict[str, type[Algorithm]]:
+    """Every algorithm by its `algorithm:` name, in name order."""
+    for module in pkgutil.iter_modules(__path__):
+        importlib.import_module(f"{__name__}.{module.name}")
+    return dict(sorted(_REGISTERED.items()))
+
+
+def owned_keys() -> dict[str, str]:
+    """Each algorithm-specific key of a checksum element -> the algorithm that owns it."""
+    return {key.name: name for name, algorithm in algorithms().items() for key in algorithm.keys}
+
+
+def from_spec(raw: Mapping[str, Any], size: int, type_name: str, report: Report) -> Algorithm:
+    """The algorithm of a checksum element (its keys as the grammar checked them) of `size` bytes of `type_name`.
+    Raises ChecksumProblem for a missing algorithm; `report` takes another algorithm's keys given with it."""
+    found = algorithms()
+    name = raw.get("algorithm")
+    if name not in found:
+        names = list(found)
+        choices = ", ".join(f"`algorithm: {n}`" for n in names[:-1]) + f" or `algorithm: {names[-1]}`"
+        raise ChecksumProblem((), f"a checksum needs {choices}")
+    for key, owner in owned_keys().items():
+        if key in raw and owner != name:
+            report((key,), f"`{key}` belongs to `algorithm: {owner}`, not {name}")
+    return found[name].from_spec(raw, size, type_name, report)

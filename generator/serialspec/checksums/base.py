@@ -1,0 +1,187 @@
+"""What every checksum algorithm is: the base class of the registry (see __init__.py) and the plain data it speaks.
+
+An algorithm is a value, a frozen dataclass of its parameters (`Sum(width=8, invert=True)`), made from a spec's
+checksum element by `from_spec`. Its class owns all that the algorithm means to every part of serialspec:
+
+- the language: its `algorithm:` name, the element keys it owns (`keys`, as plain data that lang/grammar.py turns
+  into the grammar, the JSON Schema and docs/language.md), their validation (`from_spec`);
+- the runtime: `function()`, the checksum of bytes, and `function_code()`, how generated code makes the same
+  function (the runtime function lives in the algorithm's module, which imports nothing of the generator: the
+  runtime wheel ships this package);
+- the Python backend: module-level set-up and statements for straight-line codecs (`python_setup`, `python_call`,
+  `python_lines`), and optional fast paths (`byte_total`, `frame_test`, `summed`, `byte_table`: None where the
+  algorithm has none);
+- the markdown backend: `describe()`, `parameters()` and `worked(covered)` for the checksum section;
+- tests: `samples`, one per documented option, which tests/test_matrix.py runs through every output.
+
+A new algorithm is one module of this package with one subclass that sets `name`: it is found by `algorithms()`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from typing import Any, ClassVar, Literal
+
+Import = tuple[str, str]  # generated code's `from <module> import <name>` (the name may be `x as _y`)
+Report = Callable[[tuple[str, ...], str], None]  # a problem with the spec: keys below the element, message
+
+
+class ChecksumProblem(Exception):
+    """A checksum element the algorithm cannot be made from: keys below the element, and a one-line reason."""
+
+    def __init__(self, keys: tuple[str, ...], message: str) -> None:
+        super().__init__(message)
+        self.keys = keys
+        self.message = message
+
+
+@dataclass(frozen=True)
+class Key:
+    """A key of the checksum element that an algorithm owns: its shape, as lang/grammar.py's shapes take it."""
+
+    name: str
+    kind: Literal["bool", "int", "str", "object"]
+    description: str
+    default: Any = None
+    example: Any = None  # shown in the language reference where no spec uses the key
+    minimum: int | None = None
+    maximum: int | None = None
+    keys: tuple[Key, ...] = ()  # an object's keys
+    required: tuple[str, ...] = ()  # an object's required keys
+
+
+@dataclass(frozen=True)
+class Sample:
+    """One documented option of an algorithm, as a spec writes it: the element's type and the algorithm's keys."""
+
+    label: str
+    type: str
+    keys: Mapping[str, Any] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class TableSteps:
+    """A checksum that python_lines computes by `target = table[target ^ byte]` over the covered bytes: the table's
+    name in the generated module, its entries, the value before the first byte, and the statements after the last
+    (into `target`)."""
+
+    table: str
+    entries: tuple[int, ...]
+    start: int
+    finish: tuple[str, ...] = ()
+
+
+_REGISTERED: dict[str, type[Algorithm]] = {}
+
+
+class Algorithm:
+    """A checksum algorithm with its parameters. Subclasses are frozen dataclasses that set the class variables."""
+
+    name: ClassVar[str]  # the `algorithm:` value
+    summary: ClassVar[str]  # what it computes, for the grammar's description of `algorithm`
+    keys: ClassVar[tuple[Key, ...]] = ()
+    samples: ClassVar[tuple[Sample, ...]] = ()
+    width: int  # bits of the checksum value
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        if "name" in cls.__dict__:
+            _REGISTERED[cls.name] = cls
+
+    # -- the language ------------------------------------------------------------------------------------------
+
+    @classmethod
+    def from_spec(cls, raw: Mapping[str, Any], size: int, type_name: str, report: Report) -> Algorithm:
+        """The algorithm of a checksum element `raw` (its keys as the grammar checked them) of `size` bytes of
+        type `type_name`. Raises ChecksumProblem where it cannot be made; `report` takes problems that do not stop
+        it (keys below the element, message)."""
+        raise NotImplementedError
+
+    # -- the runtime -------------------------------------------------------------------------------------------
+
+    def function(self) -> Callable[[bytes], int]:
+        """The checksum of the covered bytes, as the element holds it (an unsigned value of `width` bits)."""
+        raise NotImplementedError
+
+    def function_code(self) -> tuple[Import, str]:
+        """How generated code makes `function()`: the import, and the call that returns it."""
+        raise NotImplementedError
+
+    def title(self) -> str:
+        """A catalogue name for comments and docs (CRC-16/MODBUS), or ""."""
+        return ""
+
+    # -- the Python backend: straight-line codecs --------------------------------------------------------------
+
+    def python_setup(self, name: str) -> tuple[list[Import], list[str]]:
+        """Imports and module-level definitions that python_lines relies on, for the checksum named `name` in the
+        generated module (they define `name`, its runtime function, or names made from it, where they need one).
+        python_call relies on at most these and `name`: codecs that use it define the runtime function as `name`
+        (the frame engine's elements call it too)."""
+        module_import, call = self.function_code()
+        comment = f"  # {self.title()}" if self.title() else ""
+        return [module_import], [f"{name}: Callable[[bytes], int] = {call}{comment}"]
+
+    def python_call(self, name: str) -> str:
+        """The checksum of the bytes `{}` as one expression (a str.format template), an operand of any operator
+        (parenthesised where it is not an atom or a call)."""
+        return name + "({})"
+
+    def python_expression(self, name: str, covered: str) -> str | None:
+        """The checksum of the bytes `covered` as the one expression python_lines assigns; None where python_lines
+        takes more than one statement."""
+        return self.python_call(name).format(covered)
+
+    def python_lines(self, name: str, covered: str, target: str) -> list[str]:
+        """Statements that compute the checksum of the bytes `covered` (an expression) into the variable `target`."""
+        expression = self.python_expression(name, covered)
+        assert expression is not None  # an algorithm that takes statements writes them itself
+        return [f"{target} = {expression}"]
+
+    # -- the Python backend: optional fast paths (None where the algorithm has none) ---------------------------
+
+    def byte_total(self, total: str) -> str | None:
+        """The checksum as an expression of `total`, the sum of the covered bytes (an int expression), where it
+        depends on that sum alone: then a codec may sum a whole frame less constant bytes, or sum unpacked
+        values, instead of slicing the frame."""
+        return None
+
+    def frame_test(self, total: str, skipped: int, check: str) -> str | None:
+        """An int expression that is 0 exactly when a one-byte checksum `check` (an expression) is right, from
+        `total` less `skipped`: `total` the sum of the frame (an int expression), `skipped` the sum of its bytes
+        that are neither covered nor the checksum (constants). Lets a codec test a whole frame by summing it."""
+        return None
+
+    def summed(self) -> bool | None:
+        """The stream parser's summed-run path (runtime/stream.py FrameFormat.summed) takes 8-bit byte sums:
+        whether this one is inverted; None for every other checksum."""
+        return None
+
+    def byte_table(self, name: str, target: str) -> TableSteps | None:
+        """Where python_lines runs `target = TABLE[target ^ byte]` over the covered bytes from a constant start:
+        the steps (a codec may then fold known bytes into the start and unroll short runs); None for others."""
+        return None
+
+    # -- the markdown backend ----------------------------------------------------------------------------------
+
+    def describe(self) -> str:
+        """What it is, completing "The checksum is the ..., from `a` to `b` inclusive."."""
+        raise NotImplementedError
+
+    def parameters(self) -> list[tuple[str, str]]:
+        """Its parameters as (name, value) rows for the docs' table ([] for none)."""
+        return []
+
+    def worked(self, covered: bytes) -> str:
+        """A worked example: how the covered bytes give the checksum, ending in its value."""
+        raise NotImplementedError
+
+
+def hex_value(value: int, width: int) -> str:
+    """0x-prefixed, upper-case, as many digits as the width has nibbles (0x0E, 0x340E)."""
+    return f"0x{value:0{(width + 3) // 4}X}"
+
+
+def hex_bytes(data: bytes) -> str:
+    return data.hex(" ").upper() if data else "(no bytes)"

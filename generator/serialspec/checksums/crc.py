@@ -1,0 +1,378 @@
+"""`algorithm: crc`: a CRC by its catalogue parameters (width, poly, init, refin, refout, xorout; reveng's catalogue).
+
+The runtime function is the fastest form there is for the parameters (crc_function); generated codecs call the
+standard library's C function directly where it computes the CRC, and step an 8-bit CRC through its table in line.
+"""
+
+from __future__ import annotations
+
+import struct
+from binascii import crc_hqx as crc_hqx  # re-exported: generated code calls it directly (Crc.python_call)
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from functools import cache
+from typing import Any
+
+from serialspec.checksums.base import (
+    Algorithm,
+    ChecksumProblem,
+    Import,
+    Key,
+    Report,
+    Sample,
+    TableSteps,
+    hex_bytes,
+    hex_value,
+)
+
+
+def _reflect(value: int, width: int) -> int:
+    result = 0
+    for _ in range(width):
+        result = (result << 1) | (value & 1)
+        value >>= 1
+    return result
+
+
+@cache  # a table is computed once per CRC (generating a spec asks for its table many times)
+def crc_table(width: int, poly: int, refin: bool) -> tuple[int, ...]:
+    """The 256-entry table of a CRC in the Rocksoft/catalogue model (reflected table when refin)."""
+    mask = (1 << width) - 1
+    table = []
+    for byte in range(256):
+        if refin:
+            crc = byte
+            reflected_poly = _reflect(poly, width)
+            for _ in range(8):
+                crc = (crc >> 1) ^ reflected_poly if crc & 1 else crc >> 1
+        else:
+            crc = byte << (width - 8)
+            top = 1 << (width - 1)
+            for _ in range(8):
+                crc = ((crc << 1) ^ poly) if crc & top else crc << 1
+        table.append(crc & mask)
+    return tuple(table)
+
+
+def crc_function(width: int, poly: int, init: int, refin: bool, refout: bool, xorout: int) -> Callable[[bytes], int]:
+    """A CRC function from catalogue parameters (width, poly, init, refin, refout, xorout), widths 8..32.
+
+    The fastest form there is for the parameters: the standard library's C code where it computes the same CRC
+    (binascii.crc_hqx: poly 0x1021, unreflected, 16 bits; zlib.crc32: poly 0x04C11DB7, reflected, 32 bits), two
+    bytes per step for every other 16-bit CRC (`_crc16_words`), else a table-driven loop over the bytes.
+    """
+    mask = (1 << width) - 1
+    if crc_in_one_call(width, poly, init, refin, refout, xorout) is not None:
+        if not xorout:
+            return lambda data: crc_hqx(data, init)
+        return lambda data: crc_hqx(data, init) ^ xorout
+    if width == 32 and poly == 0x04C11DB7 and refin and refout:
+        from zlib import crc32  # imported here: a codec that does not need it does not pay for it
+
+        start = _reflect(init, width) ^ mask  # crc32 inverts the register before and after
+
+        return lambda data: crc32(data, start) ^ mask ^ xorout
+    if width == 16:
+        return _crc16_words(poly, init, refin, refout, xorout)
+    table = crc_table(width, poly, refin)
+    if refin:
+        start = _reflect(init, width)
+
+        def crc(data: bytes) -> int:
+            value = start
+            for byte in data:
+                value = table[(value ^ byte) & 0xFF] ^ (value >> 8)
+            if not refout:
+                value = _reflect(value, width)
+            return (value ^ xorout) & mask
+
+    else:
+        shift = width - 8
+
+        def crc(data: bytes) -> int:
+            value = init
+            for byte in data:
+                value = table[((value >> shift) ^ byte) & 0xFF] ^ ((value << 8) & mask)
+            if refout:
+                value = _reflect(value, width)
+            return (value ^ xorout) & mask
+
+    return crc
+
+
+def crc_in_one_call(width: int, poly: int, init: int, refin: bool, refout: bool, xorout: int) -> str | None:
+    """Generated code's expression of the CRC of `{}` where the standard library computes it in one C call
+    (binascii.crc_hqx, exported here: poly 0x1021, unreflected, 16 bits), so a codec calls it with no Python
+    function between; None for the others, which generated code calls through crc_function's result."""
+    if width == 16 and poly == 0x1021 and not refin and not refout:
+        call = f"_crc_hqx({{}}, {init:#x})"
+        return f"({call} ^ {xorout:#x})" if xorout else call
+    return None
+
+
+# Runs of k 16-bit words (k < _WORD_RUNS) are read by precompiled structs, made at the first CRC's first call.
+_WORD_RUNS = 128
+
+
+@cache
+def _unpack_words(order: str) -> tuple[Callable[[bytes], tuple[int, ...]], ...]:
+    """unpack_from of a struct reading k words in this byte order, for each k < _WORD_RUNS."""
+    return tuple(struct.Struct(f"{order}{k}H").unpack_from for k in range(_WORD_RUNS))
+
+
+@cache
+def _word_table(poly: int, refin: bool) -> tuple[int, ...]:
+    """Entry x: the 16-bit register x after two zero bytes. Feeding bytes is linear (XOR) in the register, so entry
+    x is the entry of its high byte's part XOR the entry of its low byte's: 65,536 XORs, about 2 ms."""
+    table = crc_table(16, poly, refin)
+    if refin:  # the low byte goes in first: entry (low) = table[low] >> 8 ^ table[table[low] & 0xFF]
+        low = [(t >> 8) ^ table[t & 0xFF] for t in table]
+        return tuple([h ^ entry for h in table for entry in low])  # entry (high << 8) is table[high]
+    high = [((t << 8) & 0xFFFF) ^ table[t >> 8] for t in table]  # entry (high << 8); entry (low) is table[low]
+    return tuple([h ^ entry for h in high for entry in table])
+
+
+def _crc16_words(poly: int, init: int, refin: bool, refout: bool, xorout: int) -> Callable[[bytes], int]:
+    """A 16-bit CRC two bytes per step: the register after two more bytes is table[register ^ those two bytes]
+    (the bytes as one word, low byte first when reflected), from a 65,536-entry table made at the first call (a
+    few milliseconds, not paid by an import, shared by every CRC of that polynomial); an odd last byte goes through
+    the 256-entry table."""
+    table = crc_table(16, poly, refin)
+    order = "<" if refin else ">"
+    unpack: tuple[Callable[[bytes], tuple[int, ...]], ...] = ()
+    start = _reflect(init, 16) if refin else init
+    pairs: tuple[int, ...] = ()
+    plain = refin == refout and not xorout  # the register is the CRC
+    longest = 2 * _WORD_RUNS  # bytes: longer data is read by a struct made for it
+
+    def finish(value: int) -> int:
+        return (_reflect(value, 16) if refin != refout else value) ^ xorout
+
+    def crc(data: bytes) -> int:
+        nonlocal pairs, unpack
+        if not pairs:
+            pairs, unpack = _word_table(poly, refin), _unpack_words(order)
+        value = start
+        n = len(data)
+        for word in unpack[n >> 1](data) if n < longest else struct.unpack_from(f"{order}{n >> 1}H", data):
+            value = pairs[value ^ word]
+        if n & 1:  # the last byte alone, as in crc_function's byte loop
+            last = data[-1]
+            value = (
+                (value >> 8) ^ table[(value ^ last) & 0xFF]
+                if refin
+                else (value & 0xFF) << 8 ^ table[(value >> 8) ^ last]
+            )
+        return value if plain else finish(value)
+
+    return crc
+
+
+_PARAMETERS = ("width", "poly", "init", "refin", "refout", "xorout", "check")
+
+
+@dataclass(frozen=True)
+class Crc(Algorithm):
+    width: int
+    poly: int
+    init: int
+    refin: bool
+    refout: bool
+    xorout: int
+    check: int
+    catalogue: str = ""  # the catalogue name, e.g. CRC-16/MODBUS
+
+    name = "crc"
+    summary = "a CRC given by its catalogue parameters in `crc:`"
+    keys = (
+        Key(
+            "crc",
+            "object",
+            "crc: the CRC by its catalogue parameters (reveng's CRC catalogue); the generator checks `check` against "
+            "the CRC of '123456789'.",
+            keys=(
+                Key("name", "str", "Catalogue name, e.g. CRC-16/MODBUS."),
+                Key("width", "int", "Bits of the CRC."),
+                Key("poly", "int", "Generator polynomial, normal form without the top bit (0x8005)."),
+                Key("init", "int", "Register value before the first byte."),
+                Key("refin", "bool", "Each input byte is reflected (least significant bit first)."),
+                Key("refout", "bool", "The result is reflected before `xorout`."),
+                Key("xorout", "int", "Value XORed into the result."),
+                Key("check", "int", "The catalogue check value: the CRC of b'123456789'."),
+            ),
+            required=_PARAMETERS,
+        ),
+    )
+    samples = (
+        Sample(
+            "CRC-8/MAXIM (reflected, a table step per byte)",
+            "u8",
+            {
+                "crc": {
+                    "name": "CRC-8/MAXIM",
+                    "width": 8,
+                    "poly": 0x31,
+                    "init": 0,
+                    "refin": True,
+                    "refout": True,
+                    "xorout": 0,
+                    "check": 0xA1,
+                }
+            },
+        ),
+        Sample(
+            "CRC-8/SMBUS (unreflected)",
+            "u8",
+            {
+                "crc": {
+                    "name": "CRC-8/SMBUS",
+                    "width": 8,
+                    "poly": 0x07,
+                    "init": 0,
+                    "refin": False,
+                    "refout": False,
+                    "xorout": 0,
+                    "check": 0xF4,
+                }
+            },
+        ),
+        Sample(
+            "CRC-16/MODBUS (two bytes a step)",
+            "u16",
+            {
+                "crc": {
+                    "name": "CRC-16/MODBUS",
+                    "width": 16,
+                    "poly": 0x8005,
+                    "init": 0xFFFF,
+                    "refin": True,
+                    "refout": True,
+                    "xorout": 0,
+                    "check": 0x4B37,
+                }
+            },
+        ),
+        Sample(
+            "CRC-16/XMODEM (binascii.crc_hqx)",
+            "u16",
+            {
+                "crc": {
+                    "name": "CRC-16/XMODEM",
+                    "width": 16,
+                    "poly": 0x1021,
+                    "init": 0,
+                    "refin": False,
+                    "refout": False,
+                    "xorout": 0,
+                    "check": 0x31C3,
+                }
+            },
+        ),
+        Sample(
+            "CRC-32/ISO-HDLC (zlib.crc32)",
+            "u32",
+            {
+                "crc": {
+                    "name": "CRC-32/ISO-HDLC",
+                    "width": 32,
+                    "poly": 0x04C11DB7,
+                    "init": 0xFFFFFFFF,
+                    "refin": True,
+                    "refout": True,
+                    "xorout": 0xFFFFFFFF,
+                    "check": 0xCBF43926,
+                }
+            },
+        ),
+    )
+
+    @classmethod
+    def from_spec(cls, raw: Mapping[str, Any], size: int, type_name: str, report: Report) -> Crc:
+        params = raw.get("crc")
+        if not params:
+            raise ChecksumProblem((), "algorithm crc needs `crc:` with width, poly, init, refin, refout, xorout, check")
+        crc = cls(**{key: params[key] for key in _PARAMETERS}, catalogue=str(params.get("name", "")))
+        if crc.width != size * 8:
+            raise ChecksumProblem(("crc", "width"), f"a {crc.width}-bit CRC does not fill a {type_name}")
+        for key in ("poly", "init", "xorout", "check"):
+            if not 0 <= params[key] < 1 << crc.width:
+                raise ChecksumProblem(("crc", key), f"{key} {params[key]} does not fit {crc.width} bits")
+        computed = crc.function()(b"123456789")
+        if computed != crc.check:
+            report(
+                ("crc", "check"),
+                f"these parameters give {computed:#x} for '123456789', not the check value {crc.check:#x}",
+            )
+        return crc
+
+    @property
+    def parameters_tuple(self) -> tuple[int, int, int, bool, bool, int]:
+        return self.width, self.poly, self.init, self.refin, self.refout, self.xorout
+
+    def function(self) -> Callable[[bytes], int]:
+        return crc_function(*self.parameters_tuple)
+
+    def function_code(self) -> tuple[Import, str]:
+        return ("serialspec.checksums.crc", "crc_function"), (
+            f"crc_function({self.width}, {self.poly:#x}, {self.init:#x}, {self.refin}, {self.refout}, {self.xorout:#x})"
+        )
+
+    def title(self) -> str:
+        return " ".join(self.catalogue.split())
+
+    @property
+    def stepped(self) -> bool:
+        """An 8-bit CRC as generated code computes it in line: `crc = table[crc ^ byte]` (reflected or not)."""
+        return self.width == 8 and self.refin == self.refout
+
+    def python_setup(self, name: str) -> tuple[list[Import], list[str]]:
+        if self.stepped:  # python_lines' table (python_call calls the function)
+            table = f"{name.upper()}_TABLE = crc_table(8, {self.poly:#x}, {self.refin})"
+            return [("serialspec.checksums.crc", "crc_table")], [
+                f"{table}  # {self.title()}" if self.title() else table
+            ]
+        if crc_in_one_call(*self.parameters_tuple) is not None:
+            return [("serialspec.checksums.crc", "crc_hqx as _crc_hqx")], []
+        return super().python_setup(name)
+
+    def python_call(self, name: str) -> str:
+        return crc_in_one_call(*self.parameters_tuple) or super().python_call(name)
+
+    def python_expression(self, name: str, covered: str) -> str | None:
+        return None if self.stepped else super().python_expression(name, covered)
+
+    def python_lines(self, name: str, covered: str, target: str) -> list[str]:
+        steps = self.byte_table(name, target)
+        if steps is None:
+            return super().python_lines(name, covered, target)
+        return [
+            f"{target} = {steps.start:#x}",
+            f"for byte in {covered}:",
+            f"    {target} = {steps.table}[{target} ^ byte]",
+            *steps.finish,
+        ]
+
+    def byte_table(self, name: str, target: str) -> TableSteps | None:
+        if not self.stepped:
+            return None
+        # With 8 bits the table-driven step is table[crc ^ byte] whether the CRC is reflected or not.
+        start = _reflect(self.init, 8) if self.refin else self.init
+        finish = (f"{target} ^= {self.xorout:#x}",) if self.xorout else ()
+        return TableSteps(f"{name.upper()}_TABLE", crc_table(8, self.poly, self.refin), start, finish)
+
+    def describe(self) -> str:
+        return f"{self.title() or 'CRC'} over the covered bytes"
+
+    def parameters(self) -> list[tuple[str, str]]:
+        return [
+            ("width", str(self.width)),
+            ("poly", f"{self.poly:#04x}"),
+            ("init", f"{self.init:#04x}"),
+            ("refin", str(self.refin)),
+            ("refout", str(self.refout)),
+            ("xorout", f"{self.xorout:#04x}"),
+            ("check ('123456789')", f"{self.check:#04x}"),
+        ]
+
+    def worked(self, covered: bytes) -> str:
+        return f"{self.title() or 'CRC'} of {hex_bytes(covered)} = {hex_value(self.function()(covered), self.width)}"

@@ -10,7 +10,16 @@ from typing import Any
 
 from serialspec.backends.common.numbers import number
 from serialspec.backends.python.client import client_module
-from serialspec.backends.python.framecode import Target, checksum_name, direction_functions
+from serialspec.backends.python.content import (
+    ClassCode,
+    Lines,
+    PackageCode,
+    checksum_lines,
+    checksum_setup,
+    decoder_name,
+    encoder_name,
+    takes_the_rest,
+)
 from serialspec.backends.python.frames import (
     checksum_definitions,
     code_key,
@@ -32,26 +41,16 @@ from serialspec.backends.python.ir import (
     Statement,
     TakeRest,
     Unpack,
-    fuse_unpack,
     lines_of,
     raises,
     reads_cursor,
     walk,
 )
-from serialspec.backends.python.pycode import (
-    ClassCode,
-    Lines,
-    PackageCode,
-    checksum_lines,
-    checksum_setup,
-    decoder_name,
-    encoder_name,
-    one_line,
-    takes_the_rest,
-)
+from serialspec.backends.python.optimize import fuse_unpack
 from serialspec.backends.python.registers import register_tables, registers_module
-from serialspec.backends.python.render import render
+from serialspec.backends.python.render import one_line, render
 from serialspec.backends.python.simulator import import_order, simulator_module
+from serialspec.backends.python.straight_frames import Target, checksum_name, direction_functions
 from serialspec.backends.python.structs import structs_module
 from serialspec.collection import without_cycle_collection
 from serialspec.lang.model import (
@@ -210,13 +209,13 @@ def message_doc(protocol: Protocol, message: Message) -> str:
 def codec_context(protocol: Protocol, code: PackageCode, exports: list[str]) -> dict[str, Any]:
     # the target's part first: the classic codec's whole-frame decoders add structs the common part lists
     classic = protocol.framing.classic
-    specific = classic_codec_context(protocol, code) if classic else general_codec_context(protocol, code)
+    specific = length_byte_codec_context(protocol, code) if classic else straight_codec_context(protocol, code)
     return common_codec_context(protocol, code, exports) | specific
 
 
-def general_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, Any]:
+def straight_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, Any]:
     """Frames of any other shape: straight-line frame functions per direction where the layouts allow them (see
-    framecode.py), else the runtime's frame engine; one FrameCodec per direction either way (the stream parser's),
+    straight_frames.py), else the runtime's frame engine; one FrameCodec per direction either way (the stream parser's),
     decoders by code (and by class)."""
     imports, definitions = checksum_definitions(protocol)
     directions: list[dict[str, Any]] = []
@@ -253,7 +252,7 @@ def general_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
             mask = (1 << (8 * element.type.size)) - 1
             flag = protocol.error_reply.flag
             frames = replace(frames, error_flag=flag, error_keep=mask & ~flag)
-        plain = plain_messages(single, code) if not expected and not frames.error_flag else []
+        plain = unpacked_messages(single, code) if not expected and not frames.error_flag else []
         functions, call = direction_functions(protocol, direction, frames, frame_structs, plain)
         directions.append(
             {
@@ -282,7 +281,7 @@ def general_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
     every = [line for d in directions for line in [*d["frames"], *d["functions"], *d["call"]]]
     every += [line for _, _, lines in code.encoders for line in lines]
     return {
-        "classic": False,
+        "length_byte_frames": False,
         "reply_layouts": reply_layouts,
         "framing_imports": sorted({"EngineFormat", *framing_imports(every)}, key=import_order),
         "checksum_error": any("ChecksumError(" in line for line in every),
@@ -294,9 +293,9 @@ def general_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
     }
 
 
-def plain_messages(single: dict[str, Message], code: PackageCode) -> list[tuple[int, int, str, str, str]]:
+def unpacked_messages(single: dict[str, Message], code: PackageCode) -> list[tuple[int, int, str, str, str]]:
     """(code, content size, class, struct, its format) of the messages of one size whose decoder, past its size
-    check, is one struct's unpack of the content as their message (framecode.whole_frames decodes them whole)."""
+    check, is one struct's unpack of the content as their message (straight_frames.whole_frames decodes them whole)."""
     bodies = {name: body for name, _, _, body in code.decoders}
     found = []
     for key, message in single.items():
@@ -329,7 +328,7 @@ def value_arguments(layout: FrameLayout) -> dict[str, str]:
     }
 
 
-def classic_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, Any]:
+def length_byte_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, Any]:
     """Straight-line frame checks for frames of the classic shape (see FrameLayout.classic)."""
     assert protocol.framing.checksum is not None
     checksum = protocol.framing.checksum
@@ -400,14 +399,14 @@ def classic_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
                 "exact": exact,
                 "fixed": [(key, size, function["name"]) for key, size, function in fixed],
                 "runs": runs,
-                "summed": summed_checksum(protocol, layout) if runs else None,
+                "summed": stream_sum(protocol, layout) if runs else None,
                 "fixed_whole": [(key, size, function["whole_name"]) for key, size, function in fixed],
                 "rest_keys": [rest_key(layout, r, bool(whole)) for r in rests],
                 # before the frames of one size: where a length byte names both, those keep their decoder
                 "sub_rest_keys": [rest_key(layout, r, True) for r in sub_rests],
                 "whole_frames": whole,
-                "plain": any(plain for *_, plain in whole),
-                "plain_check": plain_check(protocol, layout),
+                "unpacked": any(plain for *_, plain in whole),
+                "whole_check": whole_frame_test(protocol, layout),
                 "content_offset": content_offset,
                 "whole_size": whole_size,
                 "key": frame_key(layout, "data"),
@@ -437,7 +436,7 @@ def classic_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
     for picker in whole_pickers:
         picker["lines"] = lines_of(picker["lines"])
     return {
-        "classic": True,
+        "length_byte_frames": True,
         "checksum_imports": import_lines(checksum_imports),
         "checksum_definitions": checksum_definitions,
         "directions": directions,
@@ -811,12 +810,12 @@ def frame_function(
 
     def statements(at: Callable[[int], str], whole: bool) -> tuple[Block, bool]:
         """The decoder's statements with frame offsets `at` (buf[start:] or all of buf: `whole`), and whether its
-        checksum is checked from the unpacked values (summed_frame)."""
+        checksum is checked from the unpacked values (sum_from_values)."""
         values: Block = [
             Code(f"{e.name} = buf[{at(layout.offsets[e.name])}]", reads=(layout.offsets[e.name],))
             for e in layout.value_elements
         ]
-        summed = summed_frame(protocol, layout, command.code, length_byte, size, body, code, at)
+        summed = sum_from_values(protocol, layout, command.code, length_byte, size, body, code, at)
         if summed is not None:
             return [*values, *summed, *body[1:]], True
         check = whole_frame_check(protocol, layout, size, known, at) if whole else None
@@ -834,7 +833,7 @@ def frame_function(
         "whole_lines": statements(str, True)[0],
     }
     # built in decode() where its whole-frame decoder sums the frame's bytes (one from the values is quicker yet)
-    plain = plain_frame(protocol, layout, body)
+    plain = unpacked_frame(protocol, layout, body)
     function["plain"] = plain if not summed else None
     function["run"] = run_frames(layout, message, size, plain, code)
     key = length_byte if layout.command_offset is None else (command.code or 0) << 8 | length_byte
@@ -949,17 +948,17 @@ def _constant_reads(body: Block) -> list[int]:
     return reads
 
 
-def summed_checksum(protocol: Protocol, layout: FrameLayout) -> str | None:
+def stream_sum(protocol: Protocol, layout: FrameLayout) -> str | None:
     """The stream parser's `summed`: (first byte covered, inverted) where the checksum is an 8-bit sum of every byte
     from there to the last, which it is; None for other checksums."""
     checksum = protocol.framing.checksum
     inverted = checksum.algorithm.summed() if checksum is not None else None
-    if inverted is None or plain_check(protocol, layout) is None:
+    if inverted is None or whole_frame_test(protocol, layout) is None:
         return None
     return f"({layout.covered_from}, {inverted})"
 
 
-def plain_check(protocol: Protocol, layout: FrameLayout) -> str | None:
+def whole_frame_test(protocol: Protocol, layout: FrameLayout) -> str | None:
     """decode()'s test that a whole frame `data` (its size known) holds its checksum, where it is one expression
     over the frame's bytes: an 8-bit sum over all but a constant header and the check. None for others."""
     checksum = protocol.framing.checksum
@@ -975,7 +974,7 @@ def plain_check(protocol: Protocol, layout: FrameLayout) -> str | None:
 def run_frames(
     layout: FrameLayout, message: Message, size: int, plain: tuple[str, str] | None, code: PackageCode
 ) -> dict[str, str] | None:
-    """The stream parser's decoder of a run of a plain frame (plain_frame), checked already, laid end to end with
+    """The stream parser's decoder of a run of a plain frame (unpacked_frame), checked already, laid end to end with
     their headers left out: one struct over the bytes after the header (the command code, length byte and checksum
     skipped as padding) and a message built from each tuple it unpacks. None where the content is not the whole of
     the frame between those."""
@@ -999,12 +998,12 @@ def run_frames(
     }
 
 
-def plain_frame(protocol: Protocol, layout: FrameLayout, body: Block) -> tuple[str, str] | None:
+def unpacked_frame(protocol: Protocol, layout: FrameLayout, body: Block) -> tuple[str, str] | None:
     """(class, struct) of a frame whose message is the tuple one struct unpacks from its content, as it is, and
-    whose checksum decode() tests in one expression (plain_check): decode() builds it itself, with no call.
+    whose checksum decode() tests in one expression (whole_frame_test): decode() builds it itself, with no call.
     None for others (frame values, conversions, checks)."""
     plain = content_unpacked(body)
-    if plain is None or layout.value_elements or plain_check(protocol, layout) is None:
+    if plain is None or layout.value_elements or whole_frame_test(protocol, layout) is None:
         return None
     return plain
 
@@ -1013,7 +1012,7 @@ _BYTES_OF = {"B": 1, "b": 1, "H": 2, "h": 2, "I": 4, "i": 4, "Q": 8, "q": 8}
 _MOST_TERMS = 4  # byte terms of a checksum computed from the values; beyond it the frame's bytes are summed
 
 
-def summed_frame(
+def sum_from_values(
     protocol: Protocol,
     layout: FrameLayout,
     command: int | None,

@@ -103,7 +103,7 @@ def _size(elements: tuple[Element, ...]) -> int:
     return sum(e.size for e in elements)
 
 
-class _Places:
+class _Positions:
     """Element positions in `buf` (plain bytes): a literal offset before the content, `end + k` after it; or, for a
     frame known not to be stuffed (`from_end`), in `frame`, counted back from the frame's end after the content."""
 
@@ -195,7 +195,7 @@ def decode_lines(
     Transparency object (unstuffing, with its error for a frame that is not in stuffed form); `header_known`: the
     caller has matched the header (it chose the layout by it), so it is not compared again.
     """
-    places = _Places(layout)
+    positions = _Positions(layout)
     elements = layout.elements
     lines: Lines = [
         f"def {name}(frame: bytes, expect: type[Message] | None = None) -> Message:",
@@ -203,7 +203,7 @@ def decode_lines(
         "    n = len(frame)",
     ]
     body: Lines = []
-    smallest = places.before + places.after
+    smallest = positions.before + positions.after
     if smallest:
         body += [
             f"if n < {smallest}:",
@@ -211,34 +211,34 @@ def decode_lines(
             f'({layout.overhead})")',
         ]
     t = layout.transparency
-    body.append(f"end = n - {places.behind}" if places.behind else "end = n")
+    body.append(f"end = n - {positions.behind}" if positions.behind else "end = n")
     if t is None:
         body.append("buf = frame")
     else:
-        stop = f"n - {places.after}" if places.after else "n"
-        found = " or ".join(f"frame.find({s!r}, {places.before}, {stop}) >= 0" for s in _signs(t.replace))
+        stop = f"n - {positions.after}" if positions.after else "n"
+        found = " or ".join(f"frame.find({s!r}, {positions.before}, {stop}) >= 0" for s in _signs(t.replace))
         body += [
             "buf = frame",
             f"if {found}:  # stuffed: the plain bytes of the span",
-            f"    buf = frame[:{places.before}] + {transparency}.decode(frame[{places.before} : {stop}])"
-            + (f" + frame[{stop} :]" if places.after else ""),
-            f"    end = len(buf) - {places.behind}" if places.behind else "    end = len(buf)",
+            f"    buf = frame[:{positions.before}] + {transparency}.decode(frame[{positions.before} : {stop}])"
+            + (f" + frame[{stop} :]" if positions.after else ""),
+            f"    end = len(buf) - {positions.behind}" if positions.behind else "    end = len(buf)",
         ]
-        fixed = _size(elements[places.first : places.last + 1])
+        fixed = _size(elements[positions.first : positions.last + 1])
         if fixed:
-            inner = _plus("end", places.behind - places.after - places.before)
+            inner = _plus("end", positions.behind - positions.after - positions.before)
             body += [
-                f"if end < {places.content}:",
+                f"if end < {positions.content}:",
                 f'    raise DecodeError(f"{layout.name} frame: {{{inner}}} bytes where at least {fixed} belong")',
             ]
-    body += _constant_checks(places, 1 if header_known else 0)
+    body += _constant_checks(positions, 1 if header_known else 0)
     command = layout.command
     values: list[str] = []
     for index in layout.values:
         element = elements[index]
         value = f"v_{element.name}"
         values.append(value)
-        body.append(f"{value} = {places.read(index)}")
+        body.append(f"{value} = {positions.read(index)}")
         full = element.minimum <= 0 and element.maximum >= (1 << (8 * element.size)) - 1
         if full:
             continue
@@ -255,10 +255,10 @@ def decode_lines(
     for index, element in enumerate(elements):
         if element.kind != "length":
             continue
-        counted = places.counted(*element.span)
+        counted = positions.counted(*element.span)
         counted = _plus(counted, element.adds)
         body += [
-            f"length = {places.read(index)}",
+            f"length = {positions.read(index)}",
             f"if length != {counted}:",
             f'    raise DecodeError(f"{element.name} says {{length}} but the frame holds {{{counted}}}")',
         ]
@@ -267,25 +267,25 @@ def decode_lines(
             continue
         width = 2 + 2 * element.size
         failed = [
-            f"check = {checks[index].format(places.covered(*element.span))}",
-            f"stored = {places.read(index)}",
+            f"check = {checks[index].format(positions.covered(*element.span))}",
+            f"stored = {positions.read(index)}",
             "if check != stored:",
             f'    raise ChecksumError(f"bad {element.name}: the frame has {{stored:#0{width}x}}, '
             f'its bytes give {{check:#0{width}x}}")',
         ]
         residue = _residue(element)
         a, b = element.span
-        if residue is not None and b == index - 1 and a <= places.first:
+        if residue is not None and b == index - 1 and a <= positions.first:
             # over the covered bytes and the checksum itself, an intact frame's CRC is one constant: no slice, no
             # stored value to read; they are made only to say what is wrong
-            whole = places.covered(a, index)
+            whole = positions.covered(a, index)
             body += [f"if {checks[index].format(whole)} != {residue:#0{width}x}:", *(f"    {line}" for line in failed)]
         else:
             body += failed
     if command is not None:
-        body.append(f"code = {places.read(command)}")
+        body.append(f"code = {positions.read(command)}")
     code = "None" if command is None else "code"
-    body += _dispatch(target, code, ", ".join(["buf", str(places.content), "end", *values]), nullable=False)
+    body += _dispatch(target, code, ", ".join(["buf", str(positions.content), "end", *values]), nullable=False)
     return lines + [f"    {line}" for line in body], ["n = len(frame)", *body]
 
 
@@ -337,10 +337,10 @@ def _signs(replace: tuple[tuple[bytes, bytes], ...]) -> list[bytes]:
     return [s for i, s in enumerate(every) if not any(o in s for o in every[:i])]
 
 
-def _constant_checks(places: _Places, start: int = 0) -> Lines:
+def _constant_checks(positions: _Positions, start: int = 0) -> Lines:
     """Constant elements from `start` on (1: the header is known to match) checked in element order; neighbours
     compared at once, one by one only to say which."""
-    layout = places.layout
+    layout = positions.layout
     runs: list[list[int]] = []
     for index, element in enumerate(layout.elements):
         if element.kind != "constant" or index < start:
@@ -355,10 +355,10 @@ def _constant_checks(places: _Places, start: int = 0) -> Lines:
         single: list[tuple[str, str, str]] = []  # condition, message per element
         for index, element in each:
             if element.size == 1:
-                condition = f"buf[{places.at(index)}] != {element.constant[0]:#04x}"
-                data = f"buf[{places.at(index)}:{places.stop(index)}]"
+                condition = f"buf[{positions.at(index)}] != {element.constant[0]:#04x}"
+                data = f"buf[{positions.at(index)}:{positions.stop(index)}]"
             else:
-                data = f"buf[{_start(places.at(index))}:{places.stop(index)}]"
+                data = f"buf[{_start(positions.at(index))}:{positions.stop(index)}]"
                 condition = f"{data} != {element.constant!r}"
             single.append((condition, _message_constant(element, data), element.name))
         if len(each) == 1:
@@ -366,7 +366,7 @@ def _constant_checks(places: _Places, start: int = 0) -> Lines:
             lines += [f"if {condition}:", f"    raise DecodeError({message})"]
             continue
         whole = b"".join(element.constant for _, element in each)
-        lines.append(f"if buf[{_start(places.at(run[0]))}:{places.stop(run[-1])}] != {whole!r}:")
+        lines.append(f"if buf[{_start(positions.at(run[0]))}:{positions.stop(run[-1])}] != {whole!r}:")
         for condition, message, _ in single[:-1]:
             lines += [f"    if {condition}:", f"        raise DecodeError({message})"]
         lines.append(f"    raise DecodeError({single[-1][1]})")
@@ -378,7 +378,7 @@ def _start(position: str) -> str:
 
 
 @dataclass
-class _Wrap:
+class _LayoutEncoding:
     """One layout's encoding, in three parts: `prelude` computes the stuffed span and the lengths, `fits` says
     whether every length fits its element (with the EncodeError a layout raises when one does not), `rest` makes
     and returns the frame."""
@@ -433,10 +433,12 @@ def _arguments(layout: Layout, code: str, values: list[str]) -> Callable[[int], 
     return argument
 
 
-def wrap_parts(layout: Layout, target: Target, checks: dict[int, str], transparency: str, struct: Structs) -> _Wrap:
+def wrap_parts(
+    layout: Layout, target: Target, checks: dict[int, str], transparency: str, struct: Structs
+) -> _LayoutEncoding:
     """The frame around `content`, as Layout.wrap makes it. `checks` and `transparency` as for decode_lines;
     `struct` names the struct constants it uses."""
-    places = _Places(layout)
+    positions = _Positions(layout)
     elements = layout.elements
     prelude: Lines = []
     argument = _arguments(layout, "code", [f"v_{v}" for v in target.value_names])
@@ -444,7 +446,7 @@ def wrap_parts(layout: Layout, target: Target, checks: dict[int, str], transpare
     def packed(indices: list[int]) -> str:
         return _packed(elements, indices, argument, struct)
 
-    first, last = places.first, places.last
+    first, last = positions.first, positions.last
     c = layout.content
     around = (packed(list(range(first, c))), "content", packed(list(range(c + 1, last + 1))))
     variable = " + ".join(p for p in around if p)
@@ -482,11 +484,11 @@ def wrap_parts(layout: Layout, target: Target, checks: dict[int, str], transpare
             )
         )
     frame = " + ".join(p for p in (packed(list(range(first))), wire) if p)
-    rest = _tail(layout, frame, checks, packed)
-    return _Wrap(prelude, fits, rest)
+    rest = _closing_lines(layout, frame, checks, packed)
+    return _LayoutEncoding(prelude, fits, rest)
 
 
-def _tail(layout: Layout, frame: str, checks: dict[int, str], packed: Callable[[list[int]], str]) -> Lines:
+def _closing_lines(layout: Layout, frame: str, checks: dict[int, str], packed: Callable[[list[int]], str]) -> Lines:
     """Lines that return the frame `frame` (an expression: everything up to the variable part's end) with the
     elements after it: constants and values packed, each checksum computed over what is written before it."""
     elements = layout.elements
@@ -514,7 +516,7 @@ def _tail(layout: Layout, frame: str, checks: dict[int, str], packed: Callable[[
     return [*lines, f"return {frame}"]
 
 
-def wrap_lines(direction: str, layouts: list[_Wrap], target: Target) -> Lines:
+def wrap_lines(direction: str, layouts: list[_LayoutEncoding], target: Target) -> Lines:
     """`def _wrap_<direction>(content, code, *values) -> bytes`: the frame in the first layout whose lengths can
     count it (as FrameCodec.wrap chooses), each layout's code inline."""
     parameters = ", ".join(["content: bytes", "code: int | None", *(f"v_{v}: int" for v in target.value_names)])
@@ -584,7 +586,7 @@ def engine_lines(layouts: tuple[Layout, ...], target: Target) -> tuple[Lines, Li
 
 
 @dataclass(frozen=True)
-class Straight:
+class StraightLayouts:
     """A direction whose layouts all take straight-line code: the engine's layouts, each with its checksum
     elements' function names (by element index)."""
 
@@ -592,7 +594,7 @@ class Straight:
     checks: tuple[dict[int, str], ...]
 
 
-def straight_direction(protocol: Protocol, direction: Direction) -> Straight | None:
+def straight_direction(protocol: Protocol, direction: Direction) -> StraightLayouts | None:
     """The direction's layouts, when every one fits the straight-line form (and they carry the same values)."""
     layouts = runtime_layouts(protocol, direction)
     names = {tuple(e.name for e in (layout.elements[i] for i in layout.values)) for layout in layouts}
@@ -602,7 +604,7 @@ def straight_direction(protocol: Protocol, direction: Direction) -> Straight | N
         {index: checksum_call(e.checksum) for index, e in enumerate(model.elements) if e.checksum is not None}
         for model in protocol.framing.alternatives[direction]
     )
-    return Straight(layouts, checks)
+    return StraightLayouts(layouts, checks)
 
 
 def direction_functions(
@@ -622,7 +624,7 @@ def direction_functions(
     layouts = found.layouts
     several = len(layouts) > 1
     lines: Lines = []
-    wraps: list[_Wrap] = []
+    wraps: list[_LayoutEncoding] = []
     bodies: list[Lines] = []
     for layout, checks in zip(layouts, found.checks, strict=True):
         suffix = f"_{layout.name}" if several else ""
@@ -654,7 +656,7 @@ def direction_functions(
 
 
 def frame_encoder(
-    frames: Straight,
+    frames: StraightLayouts,
     parts: list[str],
     formats: dict[str, str],
     code: str,
@@ -752,7 +754,7 @@ def _frame_lines(
             # than joining the pieces
             return [f"body = {frame}", f"return {struct(whole[0])}.pack({whole[1]})"]
         return [f"body = {frame}", f"return b''.join(({', '.join(pieces)}))"]
-    return _tail(layout, frame, checks, lambda indices: _packed(elements, indices, constant_or, struct))
+    return _closing_lines(layout, frame, checks, lambda indices: _packed(elements, indices, constant_or, struct))
 
 
 _CHECK_CODES = {1: "B", 2: "H", 4: "I"}
@@ -827,7 +829,7 @@ def _choice(layouts: tuple[Layout, ...], d: str, bodies: list[Lines] | None = No
 
 
 def whole_frames(
-    found: Straight, d: str, plain: list[tuple[int, int, str, str, str]], structs: dict[str, str]
+    found: StraightLayouts, d: str, plain: list[tuple[int, int, str, str, str]], structs: dict[str, str]
 ) -> tuple[Lines, Lines]:
     """decode()'s fast path for frames of one size whose message is their content as one struct unpacks it: a table
     keyed by the bytes before the content (header, length, command code), and lines that check the rest of a frame
@@ -840,7 +842,7 @@ def whole_frames(
     elements = layout.elements
     if layout.transparency is not None or any(e.kind == "value" for e in elements):
         return [], []
-    places = _Places(layout)
+    positions = _Positions(layout)
     entries: list[tuple[bytes, str, str]] = []
     for code, size, cls, content, fmt in plain:
         head = b""
@@ -857,12 +859,12 @@ def whole_frames(
                 head += element.pack(counted)
         else:
             name = f"_F_{d.upper()}_WHOLE{content.removeprefix('_S')}"  # the content's struct in the frame
-            structs[name] = f"{fmt[0]}{places.content}x{fmt[1:]}{places.behind}x"
+            structs[name] = f"{fmt[0]}{positions.content}x{fmt[1:]}{positions.behind}x"
             entries.append((head, cls, name))
     if not entries:
         return [], []
 
-    tail = _Places(layout, from_end=True)  # the elements after the content, counted back from the frame's end
+    tail = _Positions(layout, from_end=True)  # the elements after the content, counted back from the frame's end
     conditions: Lines = []
     for index, element in enumerate(elements[layout.content + 1 :], layout.content + 1):
         if element.kind == "constant" and element.size == 1:  # constants first: cheaper than a checksum
@@ -888,7 +890,7 @@ def whole_frames(
         "}",
     ]
     lines = [
-        f"whole = {table}.get(frame[:{places.content}])",
+        f"whole = {table}.get(frame[:{positions.content}])",
         f"if whole is not None and {' and '.join(conditions)}:",
         "    try:",
         "        return _new(whole[0], whole[1](frame))",

@@ -13,8 +13,6 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
 
 from serialspec.backends.common.numbers import number
-from serialspec.backends.common.text import collapse
-from serialspec.backends.python.framecode import Straight, checksum_name, frame_encoder, straight_direction
 from serialspec.backends.python.ir import (
     Advance,
     Block,
@@ -33,15 +31,14 @@ from serialspec.backends.python.ir import (
     Simple,
     TakeRest,
     Unpack,
-    deferred_item_checks,
-    field_read,
-    fold_last_size_check,
     lines_of,
     packed_lists,
-    read_fields_once,
     values_tuple,
 )
 from serialspec.backends.python.kinds import kind
+from serialspec.backends.python.optimize import deferred_item_checks, field_read, fold_last_size_check, read_fields_once
+from serialspec.backends.python.render import one_line
+from serialspec.backends.python.straight_frames import StraightLayouts, checksum_name, frame_encoder, straight_direction
 from serialspec.checksums.base import Import
 from serialspec.lang import expression
 from serialspec.lang.model import (
@@ -87,11 +84,6 @@ def bound(f: Scalar, value: float) -> str:
 def members_name(class_name: str) -> str:
     """The codec's module-level value -> member map of an enum or flag class."""
     return f"_MEMBERS_{class_name}"
-
-
-def one_line(text: str) -> str:
-    """Spec text made safe for a comment or docstring: one line, no backslashes or quotes that could close it."""
-    return collapse(text).replace("\\", "\\\\").replace('"', "'")
 
 
 def run_endian(fields: list[SpecField]) -> str:
@@ -190,12 +182,12 @@ class PackageCode:
         self.unpack_runs: dict[str, tuple[str, int]] = {}  # unpack_runs tables the decoders use: name -> (format, most)
         self.packing: set[str] = set()  # the runtime.packing functions the bodies call (as _<name>)
         self._seen_classes: set[str] = set()
-        self._straight: dict[Direction, Straight | None] = {}
+        self._straight: dict[Direction, StraightLayouts | None] = {}
         for message in protocol.messages():
             self.message(message)
 
-    def straight(self, direction: Direction) -> Straight | None:
-        """The direction's frames when straight-line code takes them (framecode.py), worked out once."""
+    def straight(self, direction: Direction) -> StraightLayouts | None:
+        """The direction's frames when straight-line code takes them (straight_frames.py), worked out once."""
         if direction not in self._straight:
             self._straight[direction] = (
                 None if self.protocol.framing.classic else straight_direction(self.protocol, direction)
@@ -731,10 +723,10 @@ class PackageCode:
             inline = frames and frame_encoder(
                 frames, parts, self.structs, code, frame_values, size, lambda fmt: self.struct(name, fmt)
             )
-            if inline:  # the frame made here (backends/python/framecode.py): no call of the direction's wrap
+            if inline:  # the frame made here (backends/python/straight_frames.py): no call of the direction's wrap
                 return [*body, *inline]
             arguments = ", ".join([content, code, *frame_values])
-            # backends/python/framecode.py
+            # backends/python/straight_frames.py
             body.append(Code(f"return _wrap_{message.direction.value}({arguments})", lists=packed_lists(parts)))
             return body
         code = str(command_code if command_code is not None else 0)

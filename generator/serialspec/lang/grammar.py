@@ -587,8 +587,8 @@ def checksum_keys() -> dict[str, Shape]:
     """The checksum element's keys that the algorithms own (serialspec/checksums/): `algorithm`, whose choices are
     the registered algorithms, and each algorithm's own keys."""
     found = checksums.algorithms()
-    described = "; ".join(f"{name}: {algorithm.summary}" for name, algorithm in found.items())
-    keys: dict[str, Shape] = {"algorithm": Str(f"checksum: {described}.", choices=tuple(found))}
+    described = "; ".join(f"`{name}`, {algorithm.summary}" for name, algorithm in found.items())
+    keys: dict[str, Shape] = {"algorithm": Str(f"checksum: what it computes: {described}.", choices=tuple(found))}
     for algorithm in found.values():
         keys |= {key.name: _shape(key) for key in algorithm.keys}
     return keys

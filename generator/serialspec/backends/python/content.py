@@ -804,7 +804,7 @@ class PackageCode:
         covered = f"{body}[{layout.covered_from}:]" if layout.covered_from else body
         size = layout.checksum_offset_from_end
         checksum = self.protocol.framing.checksum
-        assert checksum is not None  # classic frames have one
+        assert checksum is not None  # length-byte frames have one
         value = checksum_expression(checksum, covered)
         skipped = layout.header[: layout.covered_from]
         less = checksum.algorithm.byte_total(f"sum({body}) - {sum(skipped):#x}")

@@ -211,3 +211,13 @@ def _filled(statement: Statement, local: dict[str, str]) -> Statement:
 
 def _filled_all(statements: tuple[Statement, ...], local: dict[str, str]) -> tuple[Statement, ...]:
     return tuple(_filled(s, local) for s in statements)
+
+
+def content_unpacked(body: Block) -> tuple[str, str] | None:
+    """(class, struct) where a decoder's statements past its size check are one struct's unpack of the content as
+    the message, as it is: `return _new(Cls, _S.unpack_from(buf, o))`; None for others."""
+    fused = fuse_unpack(body)
+    last = fused[0] if len(fused) == 1 else None
+    if isinstance(last, ReturnNew) and last.unpacked is not None and last.unpacked.at == "o":
+        return last.cls, last.unpacked.struct
+    return None

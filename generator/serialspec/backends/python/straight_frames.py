@@ -1,5 +1,5 @@
-"""Straight-line code for frames that are not of the classic shape (stuffing, u16 lengths over a span, CRC-16s, frames
-without a header or a length, alternative layouts told apart by their header).
+"""Straight-line code for frames that are not of the length-byte shape (length_byte_frames.py): stuffing, u16
+lengths over a span, CRC-16s, frames without a header or a length, alternative layouts told apart by their header.
 
 Each direction gets two functions: `_decode_<direction>(frame, expect)` checks a whole frame and calls the content
 decoder on the frame's own bytes, and `_wrap_<direction>(content, code, *values)` puts the frame around a content.

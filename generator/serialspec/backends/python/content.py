@@ -64,12 +64,17 @@ _MOST_RUNS = 256  # the most items of a list read by a struct made for each coun
 _STRUCT_NAMES = {"B": "U8", "b": "I8", "H": "U16", "h": "I16", "I": "U32", "i": "I32", "f": "F32"}
 
 
+def message_function(verb: str, message: Message) -> str:
+    """The codec's name of a function of one message (`_<verb>_<key>_<direction>`): its decoder, encoder, ..."""
+    return f"_{verb}_{message.key.replace('.', '_')}_{message.direction.value}"
+
+
 def decoder_name(message: Message) -> str:
-    return f"_decode_{message.key.replace('.', '_')}_{message.direction.value}"
+    return message_function("decode", message)
 
 
 def encoder_name(message: Message) -> str:
-    return f"_encode_{message.key.replace('.', '_')}_{message.direction.value}"
+    return message_function("encode", message)
 
 
 def bound(f: Scalar, value: float) -> str:

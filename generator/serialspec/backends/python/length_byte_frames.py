@@ -20,6 +20,7 @@ from serialspec.backends.python.content import (
     checksum_lines,
     checksum_setup,
     decoder_name,
+    message_function,
     takes_the_rest,
 )
 from serialspec.backends.python.dispatch import direction_entry, value_arguments
@@ -116,7 +117,7 @@ def length_byte_codec_context(protocol: Protocol, code: PackageCode) -> dict[str
                 "slice_key": slice_key,
                 "slice_fixed": [(slice_bytes(layout, key), size, f["whole_name"]) for key, size, f in fixed],
                 "slice_rests": [slice_rest(layout, r) for r in rests],
-                "accepted": [accepted(line.removeprefix("if ").removesuffix(":")) for line in range_checks[::2]],
+                "accepted": [inside for _, inside, _ in range_checks],
                 "exact": exact,
                 "fixed": [(key, size, function["name"]) for key, size, function in fixed],
                 "runs": runs,
@@ -141,7 +142,9 @@ def length_byte_codec_context(protocol: Protocol, code: PackageCode) -> dict[str
                 "length_adds": layout.length_adds,
                 "command_offset": layout.command_offset,
                 "value_ranges": value_ranges(layout, protocol.byte_order),
-                "range_checks": range_checks,
+                "range_checks": [
+                    line for refused, _, error in range_checks for line in (f"if {refused}:", f"    raise {error}")
+                ],
                 "dispatch": dispatch,
                 "sizes": sizes,
                 "whole": frame_decode_lines(protocol, layout, dispatch, "data", None),
@@ -177,15 +180,6 @@ def frame_key(layout: FrameLayout, buf: str, start: str = "") -> str:
     if layout.command_offset is None:
         return length
     return f"{buf}[{at}{layout.command_offset}] << 8 | {length}"
-
-
-def accepted(refused: str) -> str:
-    """The condition that a frame value is in range, from value_range_checks' condition that it is not."""
-    for op, opposite in ((" > ", " <= "), (" < ", " >= ")):
-        left, found, right = refused.partition(op)
-        if found and "(" not in refused:
-            return f"{left}{opposite}{right}"
-    return refused.removeprefix("not ") if refused.startswith("not (") else f"not {refused}"
 
 
 def key_slice(layout: FrameLayout) -> str | None:
@@ -363,7 +357,7 @@ def rest_frames(
             lowest = (message.min_size or 0) + layout.length_adds
             found.append(
                 {
-                    "whole_name": "_whole" + decoder_name(message).removeprefix("_decode"),
+                    "whole_name": message_function("whole", message),
                     "returns": returns,
                     "where": f"{message.key} {message.direction.value}",
                     "whole_lines": fuse_unpack([*rest_check(protocol, layout), *values, *body]),
@@ -521,8 +515,8 @@ def frame_function(
 
     lines, summed = statements(lambda offset: f"start + {offset}", False)
     function: dict[str, Any] = {
-        "name": "_frame" + decoder_name(message).removeprefix("_decode"),
-        "whole_name": "_whole" + decoder_name(message).removeprefix("_decode"),
+        "name": message_function("frame", message),
+        "whole_name": message_function("whole", message),
         "returns": returns,
         "where": f"{message.key} {message.direction.value}",
         "lines": lines,
@@ -687,7 +681,7 @@ def run_frames(
     frames = code.struct(content.removeprefix("_S_") + "_after_header", after)
     names = [f.name for f in message.fields]
     return {
-        "name": "_run" + decoder_name(message).removeprefix("_decode"),
+        "name": message_function("run", message),
         "build": code.build_all(cls, names, f"{frames}.iter_unpack(frames)"),
         "returns": cls,
         "where": f"{message.key} {message.direction.value}",
@@ -838,17 +832,19 @@ def value_ranges(layout: FrameLayout, byte_order: str) -> str:
     return "(" + ", ".join(ranges) + ("," if len(ranges) == 1 else "") + ")"
 
 
-def value_range_checks(layout: FrameLayout, byte_order: str) -> list[str]:
-    """Lines of `decode` refusing a frame whose frame-level value lies outside its declared range, as the stream
-    parser (value_ranges) refuses it; decode checks the header before them."""
-    lines = []
+def value_range_checks(layout: FrameLayout, byte_order: str) -> list[tuple[str, str, str]]:
+    """`decode`'s tests of the frame-level values whose declared range is narrower than their type, as the stream
+    parser (value_ranges) makes them; decode checks the header before them. Each: the condition that the value is
+    outside its range, the condition that it is inside, and the error raised for it."""
+    checks = []
     for e in layout.value_elements:
         if e.type is None or e.type.is_float or (e.minimum, e.maximum) == (e.type.minimum, e.type.maximum):
             continue
         offset, size = layout.offsets[e.name], e.type.size
+        indexed = size == 1 and not e.type.signed
         value = (
             f"data[{offset}]"
-            if size == 1 and not e.type.signed
+            if indexed
             else f"int.from_bytes(data[{offset}:{offset + size}], {byte_order!r}, signed={e.type.signed})"
         )
         low, high = int(e.minimum), int(e.maximum)
@@ -859,10 +855,13 @@ def value_range_checks(layout: FrameLayout, byte_order: str) -> list[str]:
         also = f" or {value} == {e.broadcast}" if e.broadcast is not None and lowest == low and highest == high else ""
         if lowest <= e.type.minimum and not also:  # no value of the type is below it
             refused = f"{value} > {highest}"
+            inside = f"{value} <= {highest}" if indexed else f"not {refused}"
         elif highest >= e.type.maximum and not also:
             refused = f"{value} < {lowest}"
+            inside = f"{value} >= {lowest}" if indexed else f"not {refused}"
         else:
-            refused = f"not ({lowest} <= {value} <= {highest}{also})"
-        lines.append(f"if {refused}:")
-        lines.append(f'    raise DecodeError(f"{e.name} = {{{value}}} is outside its range {low}..{high}{shown}")')
-    return lines
+            inside = f"({lowest} <= {value} <= {highest}{also})"
+            refused = f"not {inside}"
+        error = f'DecodeError(f"{e.name} = {{{value}}} is outside its range {low}..{high}{shown}")'
+        checks.append((refused, inside, error))
+    return checks

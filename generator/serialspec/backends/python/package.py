@@ -260,7 +260,14 @@ def straight_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, A
         "length_byte_frames": False,
         "reply_layouts": reply_layouts,
         "framing_imports": sorted({"EngineFormat", *framing_imports(every)}, key=import_order),
-        "checksum_error": any("ChecksumError(" in line for line in every),
+        # the straight-line frame checks raise it (the engine raises its own)
+        "checksum_error": any(
+            element.kind == "checksum"
+            for direction in protocol.framing.layouts
+            if (straight := code.straight(direction)) is not None
+            for layout in straight.layouts
+            for element in layout.elements
+        ),
         "checksum_imports": imports,
         "checksum_definitions": definitions,
         "directions": directions,

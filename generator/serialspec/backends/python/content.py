@@ -7,7 +7,6 @@ identifiers, and every piece of spec text reaches generated code through repr(),
 
 from __future__ import annotations
 
-import re
 import struct
 from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
@@ -38,7 +37,13 @@ from serialspec.backends.python.ir import (
 from serialspec.backends.python.kinds import kind
 from serialspec.backends.python.optimize import deferred_item_checks, field_read, fold_last_size_check, read_fields_once
 from serialspec.backends.python.render import one_line
-from serialspec.backends.python.straight_frames import StraightLayouts, checksum_name, frame_encoder, straight_direction
+from serialspec.backends.python.straight_frames import (
+    StraightLayouts,
+    checksum_name,
+    frame_encoder,
+    straight_direction,
+    struct_tokens,
+)
 from serialspec.checksums.base import Import
 from serialspec.lang import expression
 from serialspec.lang.model import (
@@ -115,7 +120,9 @@ def is_fixed_run_member(f: SpecField) -> bool:
     return kind(f).fixed(f)
 
 
-_SINGLE_BYTES = re.compile(r"(\d*[bBxs?c])*")  # a struct format whose byte order changes nothing
+def byte_order_free(fmt: str) -> bool:
+    """Whether a struct format holds single bytes only, so that its byte order changes nothing."""
+    return all(char in "bBxs?c" for _, char in struct_tokens(fmt))
 
 
 def fixed_runs(fields: list[SpecField]) -> Iterator[list[SpecField] | SpecField]:
@@ -207,7 +214,7 @@ class PackageCode:
             if existing == fmt:
                 return name
         tokens = []
-        for count, char in re.findall(r"(\d*)([a-zA-Z?])", fmt):
+        for count, char in struct_tokens(fmt):
             token = _STRUCT_NAMES.get(char, char.upper())
             tokens.append(f"{token}X{count}" if count and char != "s" else (f"B{count}" if char == "s" else token))
         layout = "_".join(tokens) if len(tokens) <= 6 else base_name.upper()
@@ -755,7 +762,7 @@ class PackageCode:
                 # a leading run of fixed fields is packed with the frame's head: one struct call and one bytes
                 # object less per frame (the head is little-endian, so the run must be too, or all single bytes)
                 endian = run_endian(runs[0])
-                if endian == "<" or _SINGLE_BYTES.fullmatch(struct_format("", runs[0])):
+                if endian == "<" or byte_order_free(struct_format("", runs[0])):
                     _, run_format, run_args = self.encode_run_format(runs[0], "m", fields, body, where)
                     rest = [
                         self.encode_run(item, message.class_name, "m", fields, body, where)

@@ -545,15 +545,16 @@ _STRUCT_CHARS = {1: "B", 2: "H", 4: "I", 8: "Q"}
 def _struct_name(fmt: str) -> str:
     """A struct constant's name from its format, prefixed to stay clear of the content's `_S_` constants."""
     tokens = ["BE" if fmt[0] == ">" else "LE"]
-    for count, char in _tokens(fmt[1:]):
+    for count, char in struct_tokens(fmt):
         tokens.append(f"{count}S" if char == "s" else {"B": "U8", "H": "U16", "I": "U32", "Q": "U64"}[char])
     return "_F_" + "_".join(tokens)
 
 
-def _tokens(fmt: str) -> list[tuple[str, str]]:
+def struct_tokens(fmt: str) -> list[tuple[str, str]]:
+    """A struct format's (count, code) pairs in order, its byte order left out: "<2sBH" -> ("2", "s"), ("", "B"), ..."""
     found: list[tuple[str, str]] = []
     count = ""
-    for char in fmt:
+    for char in fmt.lstrip("<>=!@"):
         if char.isdigit():
             count += char
         else:

@@ -135,6 +135,10 @@ def test_the_documentation_site_builds_strictly(tmp_path: Path) -> None:
     assert {"index.html", "tutorial.html", "language.html", "protocols/feetech_sms.html"} <= built
     index = (tmp_path / "site" / "index.html").read_text(encoding="utf-8")
     assert 'href="protocols/feetech_sms.html"' in index and 'href="tutorial.html"' in index
+    # serialspec's site builder (serialspec/docsite.py, as `serialspec docs`): its search works from disk too
+    assert "serialspecSearchIndex" in (tmp_path / "site" / "search" / "search_index.js").read_text(encoding="utf-8")
+    assert "serialspec: search that works from disk" in (tmp_path / "site" / "search" / "main.js").read_text()
+    assert (tmp_path / "site" / "docs" / "plot-example.png").is_file()  # the README's picture
 
 
 @pytest.mark.parametrize("spec", sorted((ROOT / "specs").glob("*.yaml")), ids=lambda p: p.stem)

@@ -160,3 +160,30 @@ def test_framing_mistakes_are_named(tmp_path: Path) -> None:
     spec.write_text(MODBUS_LIKE.format(name="bad").replace("start: u16", "address: u16"), encoding="utf-8")
     with pytest.raises(SpecErrors, match="'address' is already a frame element of every request"):
         load_protocol(str(spec))
+
+
+def test_a_checksum_inside_the_transparency_span_is_refused_not_miscounted(tmp_path: Path) -> None:
+    """Encode counted the length before stuffing the checksum, so the stream parser lost such frames: refused."""
+    spec = tmp_path / "slip.yaml"
+    spec.write_text(
+        """\
+protocol: slip
+title: SLIP-like
+description: Escaped frames.
+serial: {baudrate: 9600}
+byte_order: little
+framing:
+  elements:
+    header: {role: header, value: C0}
+    length: {role: length, type: u8, counts: [code, checksum]}
+    code: {role: command, type: u8}
+    content: {role: content}
+    checksum: {role: checksum, type: u8, algorithm: sum, covers: [code, content]}
+  transparency: {span: [code, checksum], replace: {C0: DB DC, DB: DB DD}}
+commands:
+  probe: {code: 1, request: {fields: {v: u8}}}
+""",
+        encoding="utf-8",
+    )
+    with pytest.raises(SpecErrors, match="a checksum inside the transparency span cannot be counted by a length"):
+        load_protocol(str(spec))

@@ -177,7 +177,7 @@ def test_a_project_table_in_pyproject_sets_specs_and_output(user: User) -> None:
     assert (project / "src" / "tinylamp" / "codec.py").is_file() and (
         project / "src" / "docs" / "tinylamp.md"
     ).is_file()
-    assert robot.serialspec("check").stdout.startswith("10 generated files match")
+    assert robot.serialspec("check").stdout.startswith("11 generated files match")
     (project / "src" / "tinylamp" / "codec.py").write_text("edited\n", encoding="utf-8")
     stale = robot.serialspec("check", check=False)
     assert stale.returncode == 1 and "src/tinylamp/codec.py: stale" in stale.stderr
@@ -277,9 +277,107 @@ def test_generated_code_runs_on_the_runtime_alone(
     robot = User(user.home, python)
     printed = robot.python_code(
         "import sys; sys.path.insert(0, 'lamps')\n"
-        "import tinylamp, tinylamp.client, tinylamp.simulator\n"
+        "import tinylamp, tinylamp.aio, tinylamp.client, tinylamp.simulator\n"
         "frame = tinylamp.encode(tinylamp.SetBrightnessRequest(lamp_id=1, brightness=50, fade=200))\n"
         "print(frame.hex(' '), 'serialspec.lang' in sys.modules)\n"
         "try:\n    import yaml\nexcept ImportError:\n    print('no yaml')\n"
     )
     assert printed.splitlines() == [f"{DIM} False", "no yaml"]
+
+
+def _distribution_packages(name: str, metadata_into: Path) -> list[str]:
+    """The top-level packages and modules of a distribution and of everything it requires (markers for no extra);
+    their metadata (entry points: mkdocs finds its themes by them) linked into `metadata_into`."""
+    from importlib import metadata
+
+    from packaging.requirements import Requirement
+
+    found: set[str] = set()
+    seen: set[str] = set()
+    todo = [name]
+    while todo:
+        wanted = todo.pop()
+        if wanted.lower() in seen:
+            continue
+        seen.add(wanted.lower())
+        try:
+            dist = metadata.distribution(wanted)
+        except metadata.PackageNotFoundError:
+            continue
+        for file in dist.files or []:
+            top = file.parts[0]
+            if top.endswith(".dist-info"):
+                if not (metadata_into / top).exists():
+                    (metadata_into / top).symlink_to(Path(str(dist.locate_file(top))))
+            elif len(file.parts) > 1 and not top.endswith(".data") and top not in ("..", "__pycache__"):
+                found.add(top)
+            elif len(file.parts) == 1 and top.endswith(".py"):
+                found.add(top.removesuffix(".py"))
+        for text in dist.requires or []:
+            requirement = Requirement(text)
+            if requirement.marker is None or requirement.marker.evaluate({"extra": ""}):
+                todo.append(requirement.name)
+    return sorted(n for n in found if importlib.util.find_spec(n) is not None)
+
+
+def _chromium() -> str | None:
+    return shutil.which("chromium") or shutil.which("chromium-browser") or shutil.which("google-chrome")
+
+
+def test_a_docs_site_of_ones_own_spec_with_the_docs_extra(
+    wheels: dict[str, Path], user: User, tmp_path_factory: pytest.TempPathFactory
+) -> None:
+    """`serialspec docs` from the wheel with mkdocs beside it (serialspec[docs]): the reference of one's own spec
+    and of a shipped protocol, the spec linked, and a search that works when the site is opened from disk."""
+    tmp = tmp_path_factory.mktemp("writer")
+    (tmp / "metadata").mkdir()
+    packages = _distribution_packages("mkdocs", tmp / "metadata")
+    deps = _link_packages(sorted({"yaml", "jinja2", "markupsafe", "construct", "serial", *packages}), tmp / "deps")
+    for info in (tmp / "metadata").iterdir():
+        (deps / info.name).symlink_to(info.resolve())
+    writer = User(user.home, _venv(tmp / "venv", deps))
+    _install(writer.python, wheels["serialspec"])
+    built = writer.serialspec("docs", "tinylamp.yaml", "vesc", "--out", "site", "--title", "My devices").stdout
+    assert built.splitlines() == [
+        "serialspec docs: 2 protocol(s) in site: open site/index.html",
+        "(search works from disk too; to serve the site instead: python -m http.server -d site)",
+    ]
+    site = user.home / "site"
+    index = (site / "index.html").read_text(encoding="utf-8")
+    assert "My devices" in index and 'href="protocols/tinylamp.html"' in index and 'href="specs/vesc.yaml"' in index
+    page = (site / "protocols" / "tinylamp.html").read_text(encoding="utf-8")
+    assert 'href="../specs/tinylamp.yaml"' in page and "set_brightness" in page
+    assert (site / "specs" / "tinylamp.yaml").read_text(encoding="utf-8") == (user.home / "tinylamp.yaml").read_text()
+    assert "set_brightness" in (site / "search" / "search_index.js").read_text(encoding="utf-8")
+    browser = _chromium()
+    if browser is None:
+        pytest.skip("no Chromium to open the site from disk (apt-get install chromium)")
+    dom = subprocess.run(
+        [
+            browser,
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--no-first-run",
+            "--disable-background-networking",
+            "--virtual-time-budget=5000",
+            "--dump-dom",
+            (site / "search.html").as_uri() + "?q=brightness+fade",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    ).stdout
+    results = dom.split('id="mkdocs-search-results"')[1]
+    assert '<a href="./protocols/tinylamp.html#set_brightness-0x02">set_brightness (0x02)</a>' in results, results[
+        :2000
+    ]
+
+
+def test_docs_without_mkdocs_says_how_to_install_it(user: User) -> None:
+    result = user.serialspec("docs", "tinylamp.yaml", "--out", "site", check=False)
+    assert (result.returncode, result.stdout) == (1, "")
+    assert (
+        result.stderr
+        == "serialspec docs: the docs site needs mkdocs, an optional extra: pip install 'serialspec[docs]'\n"
+    )

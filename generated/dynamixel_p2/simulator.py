@@ -260,7 +260,8 @@ class DynamixelP2Simulator(Simulator):
     ) -> None:
         """`model`: xm430_w350, xl430_w250, xl330_m288 (default xm430_w350) for every device, or id -> model."""
         super().__init__(
-            DEVICE, ids, encode=encode, parser=lambda: StreamParser(Direction.REQUEST), clock=clock, model=model        )
+            DEVICE, ids, encode=encode, parser=lambda: StreamParser(Direction.REQUEST), clock=clock, model=model
+        )
 
 
 #: The simulator class, under a name every generated package shares (serialspec sim uses it).

@@ -178,7 +178,8 @@ class FashionstarUartSimulator(Simulator):
     ) -> None:
         """`model`: the spec lists no models, so only None."""
         super().__init__(
-            DEVICE, ids, encode=encode, parser=lambda: StreamParser(Direction.REQUEST), clock=clock, model=model        )
+            DEVICE, ids, encode=encode, parser=lambda: StreamParser(Direction.REQUEST), clock=clock, model=model
+        )
 
 
 #: The simulator class, under a name every generated package shares (serialspec sim uses it).

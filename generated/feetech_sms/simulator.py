@@ -159,7 +159,8 @@ class FeetechSmsSimulator(Simulator):
     ) -> None:
         """`model`: sts3215, sts3250, sm8512bl (default sts3215) for every device, or id -> model."""
         super().__init__(
-            DEVICE, ids, encode=encode, parser=lambda: StreamParser(Direction.REQUEST), clock=clock, model=model        )
+            DEVICE, ids, encode=encode, parser=lambda: StreamParser(Direction.REQUEST), clock=clock, model=model
+        )
 
 
 #: The simulator class, under a name every generated package shares (serialspec sim uses it).

@@ -108,7 +108,8 @@ class ModbusRtuSimulator(Simulator):
     ) -> None:
         """`model`: the spec lists no models, so only None. `sizes`: data space -> number of items, where the spec's will not do."""
         super().__init__(
-            DEVICE, ids, encode=encode, parser=lambda: StreamParser(Direction.REQUEST), clock=clock, model=model, sizes=sizes        )
+            DEVICE, ids, encode=encode, parser=lambda: StreamParser(Direction.REQUEST), clock=clock, model=model, sizes=sizes
+        )
 
 
 #: The simulator class, under a name every generated package shares (serialspec sim uses it).

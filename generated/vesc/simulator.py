@@ -47,7 +47,7 @@ DEVICE = DeviceSpec(
     reply={'major': 6.0, 'minor': 5.0, 'hw_name': '60', 'uuid': '30 00 43 00 0f 51 33 30 38 37 36 33', 'hw_type': 0.0, 'fw_name': '', 'v_in': 240.0, 'temp_fet': 250.0, 'temp_motor': 250.0, 'temp_mos1': 250.0, 'temp_mos2': 250.0, 'temp_mos3': 250.0},
     commands=(
         # fw_version
-        CommandSpec(FwVersionRequest, FwVersionResponse),
+        CommandSpec(FwVersionRequest, FwVersionResponse, blanks={'hw_name': '', 'uuid': '00 00 00 00 00 00 00 00 00 00 00 00', 'fw_name': ''}),
         # get_values
         CommandSpec(GetValuesRequest, GetValuesResponse, reports={'rpm': 'rpm', 'duty_now': lambda get: (get('duty') // 100), 'pid_pos': 'position', 'status': 'timed_out'}),
         # set_duty
@@ -82,7 +82,8 @@ class VescSimulator(Simulator):
     ) -> None:
         """`model`: the spec lists no models, so only None."""
         super().__init__(
-            DEVICE, ids, encode=encode, parser=lambda: StreamParser(Direction.REQUEST), clock=clock, model=model        )
+            DEVICE, ids, encode=encode, parser=lambda: StreamParser(Direction.REQUEST), clock=clock, model=model
+        )
 
 
 #: The simulator class, under a name every generated package shares (serialspec sim uses it).

@@ -22,6 +22,8 @@ VERBS = {
     "encode": "encode a JSON object ({command, subcommand, direction, fields}) as a frame; prints hex",
     "sim": "serve virtual devices on a pseudo-terminal; prints the device path first, answers until stopped",
     "monitor": "print every frame seen on a port (device path or pyserial URL), one line each with a timestamp",
+    "docs": "build a documentation site (mkdocs) of specs: each protocol's reference and its spec, searchable",
+    "plot": "plot fields over time in their units, one panel each, from a capture or live from a port (PNG, SVG)",
 }
 
 

@@ -18,7 +18,7 @@ import sys
 import threading
 import time
 from collections import deque
-from collections.abc import Callable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Generator, Iterator, Mapping, Sequence
 from contextlib import suppress
 from dataclasses import dataclass, field
 from enum import Enum, IntEnum, IntFlag
@@ -31,6 +31,28 @@ from serialspec.runtime.message import Direction, Message, Record
 from serialspec.runtime.stream import StreamParser
 
 M = TypeVar("M", bound=Message)
+T = TypeVar("T")
+S = TypeVar("S")
+R = TypeVar("R")
+
+
+def drive(steps: Generator[S, R, T], step: Callable[[S], R]) -> T:
+    """Run a transaction's steps (a generator that yields what it needs, a wait or a read, and is sent what came
+    back) with a blocking `step`; an exception `step` raises is thrown into the steps. runtime/aio.py drives the
+    same steps with awaits."""
+    try:
+        wanted = next(steps)
+        while True:
+            try:
+                got = step(wanted)
+            except Exception as exc:
+                wanted = steps.throw(exc)
+            else:
+                wanted = steps.send(got)
+    except StopIteration as stop:
+        result: T = stop.value
+        return result
+
 
 _PARITY = {"none": serial.PARITY_NONE, "even": serial.PARITY_EVEN, "odd": serial.PARITY_ODD}
 
@@ -679,15 +701,15 @@ class Bus:
     def _check_echo(self, frame: bytes) -> None:
         """Read back the echo of a frame just written; frames in the bytes after it (the reply) go to the backlog,
         which the read that follows takes first."""
+        drive(self._echoing(frame), self._read_chunk)
+
+    def _echoing(self, frame: bytes) -> Generator[float, bytes, None]:
+        """_check_echo's steps: yields how long to wait for the next chunk and is sent it (see `drive`)."""
         deadline = time.monotonic() + self.timeout
         echoed = b""
         while len(echoed) < len(frame):
             remaining = deadline - time.monotonic()
-            try:
-                chunk = self._link.read(remaining) if remaining > 0 else b""
-            except Exception as exc:
-                self._port_failed("read", exc)
-                raise
+            chunk = (yield remaining) if remaining > 0 else b""
             if not chunk:
                 self._reset()
                 raise PortError(
@@ -704,6 +726,14 @@ class Bus:
         rest = echoed[len(frame) :]
         if rest:
             self._backlog.extend(self._parser.feed(rest))
+
+    def _read_chunk(self, wait: float) -> bytes:
+        """What arrives within `wait` seconds (b"" if nothing); a port failure is a PortError."""
+        try:
+            return self._link.read(wait)
+        except Exception as exc:
+            self._port_failed("read", exc)
+            raise
 
     def _drain(self) -> None:
         """Hand bytes that arrived between transactions (late replies, reports) to subscribers, without waiting."""
@@ -747,6 +777,18 @@ class Bus:
         keep: bool = False,
         errors: int | None = None,
     ) -> M:
+        """Read until the wanted frame has come: `_reading`'s steps, driven by blocking reads."""
+        return drive(self._reading(wait, request, expect, key, keep, errors), self._read_chunk)
+
+    def _reading(
+        self,
+        wait: float,
+        request: Message | None,
+        expect: type[M],
+        key: dict[str, Any] | None = None,
+        keep: bool = False,
+        errors: int | None = None,
+    ) -> Generator[float, bytes, M]:
         """Read until the wanted frame (see _wanted) has come, for up to `wait` seconds. Frames that came after it
         in the same read stay in the backlog (the next reply of a request_each); every other frame goes to
         subscribers, and to them too the wanted one when `keep`. Frames that fail their checks after the parser
@@ -795,11 +837,7 @@ class Bus:
                         f"incomplete reply to {request.COMMAND} from {self._device(request)}: {pending.hex(' ')}"
                     )
                 raise Timeout(request.COMMAND, self._device(request), wait)
-            try:
-                chunk = self._link.read(deadline - now)
-            except Exception as exc:
-                self._port_failed("read", exc)
-                raise
+            chunk = yield deadline - now
             if chunk and self._gap:
                 self._last_io = monotonic()
 
@@ -887,13 +925,15 @@ def _refused_setting(url: str, options: dict[str, Any]) -> str:
             port.close()
 
 
-class ClientBase:
-    """What every generated client shares: the bus, the context manager, broadcast and optional replies."""
+class ClientState:
+    """What every generated client shares, blocking or asyncio (runtime/aio.py): broadcast, the parameters that
+    switch optional replies, the checks made before a byte is written. Its subclasses do the I/O."""
 
     ADDRESS: str = ""  # the field holding the device id
     BROADCAST: int | None = None
+    bus: Any  # a Bus (ClientBase) or an AsyncBus
 
-    def __init__(self, bus: Bus, optional_replies: bool | None) -> None:
+    def __init__(self, bus: Any, optional_replies: bool | None) -> None:
         self.bus = bus
         self.optional_replies = optional_replies
         self._parameters: dict[tuple[int, int], float | None] = {}  # None while being read
@@ -908,18 +948,87 @@ class ClientBase:
     def close(self) -> None:
         self.bus.close()
 
+    def subscribe(self, callback: Subscriber) -> Callable[[], None]:
+        """Call `callback` with every frame that answers no request (device reports, stray replies)."""
+        subscribed: Callable[[], None] = self.bus.subscribe(callback)
+        return subscribed
+
+    def _is_broadcast(self, request: Message) -> bool:
+        return self.BROADCAST is not None and getattr(request, self.ADDRESS, None) == self.BROADCAST
+
+    def _answering(self, request: Message, optional: tuple[int, int, str]) -> Generator[tuple[int, int], float, bool]:
+        """Whether an optional reply is due. Steps (see `drive`): yields (address, key) of the parameter to read
+        when it is not known yet, and is sent its value (or thrown the read's Timeout)."""
+        if self.optional_replies is not None:
+            return self.optional_replies
+        key, value, op = optional
+        address = getattr(request, self.ADDRESS, 0)
+        current: Any = self._parameters.get((address, key), _ABSENT)
+        if current is _ABSENT:
+            self.bus.binding.encode(request)  # check every value before any byte (even a parameter read) is written
+            address = int(address)
+            # While the parameter is read, that read is asked as if it were answered (the read may itself be an
+            # optional reply: DYNAMIXEL READ at status_return_level 0); no answer means no optional replies.
+            self._due.clear()
+            self._parameters[(address, key)] = None
+            try:
+                current = self._parameters[(address, key)] = yield address, key
+            except Timeout:
+                del self._parameters[(address, key)]
+                return False
+            finally:
+                self._due.clear()
+        if current is None:
+            return True
+        due = self._due[(address, optional)] = _COMPARE[op](current, value)
+        return due
+
+    def _carrier(
+        self,
+        requests: Sequence[Message],
+        carried: Mapping[type[Message], tuple[int, type[Message] | None]],
+        content: slice,
+        build: Callable[[int, list[bytes]], Message],
+    ) -> tuple[Message, type[Message] | None, list[dict[str, Any]]]:
+        """Requests of one command inside one carrier request (a sync command): the carrier, the reply class each
+        device answers with (None: no reply), and the key of each reply.
+
+        `carried`: request class -> (its command code, the reply class each device answers with, or None);
+        `content`: where a request's content sits in its encoded frame; `build`: the carrier from code and contents.
+        """
+        kinds = {type(r) for r in requests}
+        if len(kinds) != 1:
+            raise EncodeError("a sync command carries requests of one command: give one or more, all of one type")
+        kind = kinds.pop()
+        if kind not in carried:
+            raise EncodeError(
+                f"{kind.__name__} cannot be carried (expected one of {', '.join(c.__name__ for c in carried)})"
+            )
+        code, reply = carried[kind]
+        request = build(code, [self.bus.binding.encode(r)[content] for r in requests])
+        return request, reply, [{self.ADDRESS: getattr(r, self.ADDRESS)} for r in requests]
+
+    def _remember(self, address: int, key: int, value: float) -> None:
+        self._due.clear()
+        if self.BROADCAST is not None and address == self.BROADCAST:
+            self._parameters = {k: v for k, v in self._parameters.items() if k[1] != key}
+        else:
+            self._parameters[(address, key)] = value
+
+
+class ClientBase(ClientState):
+    """What every generated (blocking) client shares: the bus, the context manager, broadcast and optional replies."""
+
+    bus: Bus
+
+    def __init__(self, bus: Bus, optional_replies: bool | None) -> None:
+        super().__init__(bus, optional_replies)
+
     def __enter__(self) -> ClientBase:
         return self
 
     def __exit__(self, *exc: object) -> None:
         self.close()
-
-    def subscribe(self, callback: Subscriber) -> Callable[[], None]:
-        """Call `callback` with every frame that answers no request (device reports, stray replies)."""
-        return self.bus.subscribe(callback)
-
-    def _is_broadcast(self, request: Message) -> bool:
-        return self.BROADCAST is not None and getattr(request, self.ADDRESS, None) == self.BROADCAST
 
     def _ask(self, request: Message, expect: type[M], after: str = "") -> M:
         if not after:
@@ -938,29 +1047,10 @@ class ClientBase:
         return self.bus.request(request, expect)
 
     def _answers(self, request: Message, optional: tuple[int, int, str]) -> bool:
-        if self.optional_replies is not None:
-            return self.optional_replies
-        key, value, op = optional
-        address = getattr(request, self.ADDRESS, 0)
-        current: Any = self._parameters.get((address, key), _ABSENT)
-        if current is _ABSENT:
-            self.bus.binding.encode(request)  # check every value before any byte (even a parameter read) is written
-            address = int(address)
-            # While the parameter is read, that read is asked as if it were answered (the read may itself be an
-            # optional reply: DYNAMIXEL READ at status_return_level 0); no answer means no optional replies.
-            self._due.clear()
-            self._parameters[(address, key)] = None
-            try:
-                current = self._parameters[(address, key)] = self._read_key(address, key)
-            except Timeout:
-                del self._parameters[(address, key)]
-                return False
-            finally:
-                self._due.clear()
-        if current is None:
-            return True
-        due = self._due[(address, optional)] = _COMPARE[op](current, value)
-        return due
+        return drive(self._answering(request, optional), self._read_parameter)
+
+    def _read_parameter(self, where: tuple[int, int]) -> float:
+        return self._read_key(*where)
 
     def _carry(
         self,
@@ -969,33 +1059,14 @@ class ClientBase:
         content: slice,
         build: Callable[[int, list[bytes]], Message],
     ) -> list[Message]:
-        """Send requests of one command inside one carrier request (a sync command); the replies, if any are due.
-
-        `carried`: request class -> (its command code, the reply class each device answers with, or None);
-        `content`: where a request's content sits in its encoded frame; `build`: the carrier from code and contents.
-        """
-        kinds = {type(r) for r in requests}
-        if len(kinds) != 1:
-            raise EncodeError("a sync command carries requests of one command: give one or more, all of one type")
-        kind = kinds.pop()
-        if kind not in carried:
-            raise EncodeError(
-                f"{kind.__name__} cannot be carried (expected one of {', '.join(c.__name__ for c in carried)})"
-            )
-        code, reply = carried[kind]
-        request = build(code, [self.bus.binding.encode(r)[content] for r in requests])
+        """Send requests of one command inside one carrier request (a sync command); the replies, if any are due
+        (see `_carrier`)."""
+        request, reply, keys = self._carrier(requests, carried, content, build)
         if reply is None:
             self.bus.send(request)
             return []
-        return list(self.bus.request_each(request, reply, [{self.ADDRESS: getattr(r, self.ADDRESS)} for r in requests]))
+        return list(self.bus.request_each(request, reply, keys))
 
     def _read_key(self, address: int, key: int) -> float:
         """Read one table entry by key (generated clients whose spec can read entries override this)."""
         raise NotImplementedError("this protocol cannot read the parameter that switches its optional replies")
-
-    def _remember(self, address: int, key: int, value: float) -> None:
-        self._due.clear()
-        if self.BROADCAST is not None and address == self.BROADCAST:
-            self._parameters = {k: v for k, v in self._parameters.items() if k[1] != key}
-        else:
-            self._parameters[(address, key)] = value

@@ -1,8 +1,10 @@
-"""The Python target: one package per protocol (messages, codec, structs, registers, client, simulator)."""
+"""The Python target: one package per protocol (messages, codec, structs, registers, client, its asyncio twin
+aio, simulator)."""
 
 from __future__ import annotations
 
 from serialspec.backends import Emitter
+from serialspec.backends.python.aio import aio_module
 from serialspec.backends.python.package import emit_package
 from serialspec.backends.python.verify import verify
 from serialspec.lang.errors import SpecError
@@ -10,7 +12,10 @@ from serialspec.lang.model import Protocol
 
 
 def files(protocol: Protocol) -> dict[str, str]:
-    return {f"{protocol.name}/{name}": text for name, text in emit_package(protocol).items()}
+    package = emit_package(protocol)
+    if "client.py" in package:
+        package["aio.py"] = aio_module(protocol, package["client.py"])
+    return {f"{protocol.name}/{name}": text for name, text in package.items()}
 
 
 def check(protocol: Protocol, emitted: dict[str, str]) -> list[SpecError]:

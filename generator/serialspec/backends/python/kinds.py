@@ -48,6 +48,12 @@ class Kind(Generic[F]):
         """The field's value from `data` (the generated `from_fields`), refusing a wrong kind of value."""
         return _get(f)
 
+    def blank(self, f: F) -> str:
+        """The field's value (JSON form) in a reply a virtual device builds without a value for it: zero, or the
+        empty value of its kind, of the size the kind fixes; a function of the request's fields where the request
+        says how many items are meant."""
+        return "0"
+
 
 def _numbers_from_json(f: Array | List) -> str:
     """A list of numbers (or bits) from JSON, each checked to be one."""
@@ -159,6 +165,9 @@ class ScalarKind(Kind[Scalar]):
         kind = "_number" if f.type.is_float else "_integer"
         return f"{kind}({get}, {f.name!r}, where)"
 
+    def blank(self, f: Scalar) -> str:
+        return "{" + ", ".join(f"{b.name!r}: 0" for b in f.bits) + "}" if f.bits else "0"
+
 
 class ArrayKind(Kind[Array]):
     model = Array
@@ -181,6 +190,9 @@ class ArrayKind(Kind[Array]):
     def from_json(self, f: Array) -> str:
         return _numbers_from_json(f)
 
+    def blank(self, f: Array) -> str:
+        return f"[0] * {f.count}"
+
 
 class ListKind(Kind[List]):
     model = List
@@ -196,6 +208,12 @@ class ListKind(Kind[List]):
 
     def from_json(self, f: List) -> str:
         return _numbers_from_json(f)
+
+    def blank(self, f: List) -> str:
+        item = "False" if f.item is None else "0"
+        if f.count_from:
+            return f"lambda request: [{item}] * request[{f.count_from!r}]"
+        return f"[{item}] * {f.count}" if isinstance(f.count, int) else "[]"
 
 
 class TextKind(Kind[Text]):
@@ -213,6 +231,9 @@ class TextKind(Kind[Text]):
 
     def from_json(self, f: Text) -> str:
         return f"_text({_get(f)}, {f.name!r}, where)"
+
+    def blank(self, f: Text) -> str:
+        return repr(" " * f.size) if isinstance(f.size, int) else "''"
 
 
 class BytesKind(Kind[Bytes]):
@@ -240,6 +261,9 @@ class BytesKind(Kind[Bytes]):
 
     def from_json(self, f: Bytes) -> str:
         return f"_bytes({_get(f)}, {f.name!r}, where)"
+
+    def blank(self, f: Bytes) -> str:
+        return repr(" ".join(["00"] * f.size)) if isinstance(f.size, int) else "''"
 
 
 class GroupKind(Kind[Group]):
@@ -276,6 +300,12 @@ class GroupKind(Kind[Group]):
             f"for item in _items({_get(f)}, {f.name!r}, where))"
         )
 
+    def blank(self, f: Group) -> str:
+        if not isinstance(f.count, int):
+            return "[]"
+        shown = [i for i in f.fields if not getattr(i, "hidden", False)]  # derived values are computed
+        return "[{" + ", ".join(f"{i.name!r}: {kind(i).blank(i)}" for i in shown) + f"}}] * {f.count}"
+
 
 class TableValueKind(Kind[TableValue]):
     model = TableValue
@@ -307,6 +337,9 @@ class TableBlockKind(Kind[TableBlock]):
 
     def from_json(self, f: TableBlock) -> str:
         return f"{f.class_name}.from_fields(_mapping({_get(f)}, {f.name!r}, where), where + {' ' + f.name!r})"
+
+    def blank(self, f: TableBlock) -> str:
+        return "{" + ", ".join(f"{e.name!r}: 0" for e in f.entries) + "}"
 
 
 kind: Registry[Kind[Any]] = Registry(Kind)

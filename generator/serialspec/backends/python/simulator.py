@@ -6,6 +6,7 @@ from typing import Any
 
 from serialspec.backends.common.numbers import number
 from serialspec.backends.common.pairing import request_response_pairs
+from serialspec.backends.python.kinds import kind
 from serialspec.backends.python.registers import map_name, register_tables
 from serialspec.backends.python.render import one_line, render
 from serialspec.lang import expression
@@ -214,6 +215,20 @@ def simulator_module(protocol: Protocol) -> str:
         tables = table_fields(request, response)
         if tables:
             args.append(f"tables={tables!r}")
+        # the values a device fills in itself; any other it does not give is its kind's blank
+        given = {*tables, *(behaviour.reads + tuple(behaviour.space_reads) if behaviour else ())}
+        blanks = {f.name: kind(f).blank(f) for f in response.fields if f.name not in given} if response else {}
+        blanks = {name: blank for name, blank in blanks.items() if blank != "0"}
+        if response:  # frame values made of bit fields (a status): each bit 0
+            layout = protocol.framing.layouts[response.direction]
+            named = {key.partition(".")[0] for key in (*device.reply, *device.status) if "." in key}  # the engine's
+            blanks |= {
+                e.name: "{" + ", ".join(f"{b.name!r}: 0" for b in e.bits) + "}"
+                for e in layout.value_elements
+                if e.bits and e.name not in {*given, *named}
+            }
+        if blanks:
+            args.append(f"blanks={{{', '.join(f'{k!r}: {v}' for k, v in blanks.items())}}}")
         commands.append({"key": request.key, "args": args})
     spaces = [
         f"SpaceSpec({s.name!r}, {s.size}, {s.item is None}, {1 if s.item is None else int(s.item.maximum)}, "

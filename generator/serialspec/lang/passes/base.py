@@ -73,6 +73,9 @@ RESERVED_FIELD_NAMES = (
 GENERATED_CLASS_NAMES = frozenset(
     {
         "Any",
+        "AsyncBus",
+        "AsyncClientBase",
+        "AsyncIterator",
         "Binding",
         "Bus",
         "Callable",
@@ -280,8 +283,10 @@ class Pass:
             self.error(path, f"{what} {value!r} is reserved (a Python keyword or a name generated code uses)")
         return str(value)
 
-    def class_name(self, name: str, path: Path, identity: object = None) -> str:
-        """Register a generated class (or constant) name; the same name may be reused only for the same definition."""
+    def class_name(self, name: str, path: Path, identity: object = None, scoped: bool = False) -> str:
+        """Register a generated class (or constant) name; the same name may be reused only for the same definition.
+        `scoped`: a field's class (bit fields, group items) whose name another definition has taken is named after
+        its place instead (`ProbeResponse` + `FlagsBits`), so two messages may both have a `flags` field."""
         class_names = self.ctx.class_names
         if name in GENERATED_CLASS_NAMES or name in GENERATED_CONSTANTS:
             self.error(path, f"generated name {name} would shadow the {name} that generated code uses; rename it")
@@ -289,6 +294,9 @@ class Pass:
         if name in class_names:
             other_path, other_identity = class_names[name]
             if other_path != path and (identity is None or identity != other_identity):
+                place = [p for p in path[:-1] if isinstance(p, str) and p not in ("commands", "subcommands", "fields")]
+                if scoped and place:
+                    return self.class_name(camel(*place) + name, path, identity)
                 self.error(path, f"generated class name {name} is already used by {dotted(other_path)}")
             return name
         class_names[name] = (path, identity)
@@ -312,6 +320,16 @@ class Pass:
             choices = [n for n, t in SCALARS.items() if allow_float or not t.is_float]
             raise self.fail(path, f"unknown type {value!r} (expected one of {', '.join(choices)})")
         return found
+
+    def stored(self, scalar: ScalarType, sign_magnitude: bool, path: Path) -> ScalarType:
+        """The wire type of a value: a sign-magnitude value is an unsigned word of its size (the sign is one of its
+        bits), whether the spec names the signed or the unsigned type."""
+        if not sign_magnitude:
+            return scalar
+        if scalar.is_float:
+            self.error(path, f"encoding sign_magnitude is for integers, not {scalar.name}")
+            return scalar
+        return SCALARS[f"u{scalar.size * 8}"]
 
     def bounds(
         self, scalar: ScalarType, sign_magnitude: bool, given: Any, path: Path, sign_bit: int | None = None

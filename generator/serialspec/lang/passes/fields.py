@@ -194,7 +194,7 @@ class FieldResolver(Pass):
             if isinstance(count, str) and count != "rest":
                 self.derive(count, ("count", name), siblings, path)
             item_size = sum_sizes(inner)
-            class_name = self.class_name(camel(name, "item"), path)
+            class_name = self.class_name(camel(name, "item"), path, identity=("group", inner), scoped=True)
             return Group(**common, class_name=class_name, count=count, fields=inner, item_size=item_size)
         if kind == "table_value":
             table = self.reference("table", self.tables, spec.get("table"), (*path, "table"))
@@ -275,8 +275,8 @@ class FieldResolver(Pass):
             raise self.fail(path, str(exc)) from None
 
     def scalar(self, common: dict[str, Any], spec: dict[str, Any], path: Path, endian: Literal["<", ">"]) -> Scalar:
-        scalar = SCALARS[spec["type"]]
         sign_magnitude = spec.get("encoding") == "sign_magnitude"
+        scalar = self.stored(SCALARS[spec["type"]], sign_magnitude, (*path, "encoding"))
         low, high = self.bounds(scalar, sign_magnitude, spec.get("range"), (*path, "range"))
         value_enum = self.reference("enum", self.enums, spec.get("enum"), (*path, "enum"))
         if value_enum is not None and spec.get("range") is None:
@@ -320,7 +320,7 @@ class FieldResolver(Pass):
             enum=value_enum,
             flags=self.reference("flags", self.flags, spec.get("flags"), (*path, "flags")),
             bits=tuple(bits),
-            bits_class=self.class_name(camel(common["name"], "bits"), path) if bits else "",
+            bits_class=self.class_name(camel(common["name"], "bits"), path, ("bits", *bits), True) if bits else "",
             sign_magnitude=sign_magnitude,
             status_ok=self.status_ok(spec.get("status"), scalar, low, high, (*path, "status")),
             value=self.derived_value(spec, scalar, path),

@@ -89,6 +89,7 @@ class Types(Pass):
                 self.error((*entry_path, "key"), f"key {item['key']} is already used by {keys[item['key']]!r}")
             keys[item["key"]] = entry_name
             sign_magnitude = item.get("encoding") == "sign_magnitude"
+            scalar = self.stored(scalar, sign_magnitude, (*entry_path, "encoding"))
             sign_bit = self.sign_bit(scalar, sign_magnitude, item.get("sign_bit"), (*entry_path, "sign_bit"))
             low, high = self.bounds(scalar, sign_magnitude, item.get("range"), (*entry_path, "range"), sign_bit)
             enum = self.reference("enum", self.enums, item.get("enum"), (*entry_path, "enum"))

@@ -110,6 +110,9 @@ class CommandSpec:
     modulo: dict[str, float] = field(default_factory=dict)  # state variable -> period: kept in 0..period-1
     restores: tuple[str, ...] = ()  # memory entries back to their initial values, their moves stopped (a reboot)
     broadcast_ignores: dict[str, float] = field(default_factory=dict)  # request field -> value: broadcast ignored
+    # response field -> its value when nothing else gives one, where that is not 0: the empty value of its kind
+    # (a list, text, bytes, items), or a function of the request's fields (as many items as the request asks for)
+    blanks: dict[str, Any] = field(default_factory=dict)
     refused_while_moving: str = ""  # state variable: while it moves, the request is refused ("busy")
     counts: dict[str, tuple[str, float]] = field(default_factory=dict)  # response field -> (state, per)
     every_device: bool = False  # a request without an address reaches every device, not only the first
@@ -577,7 +580,8 @@ class Engine(FaultInjection):
             elif name in self.spec.reply:
                 values[name] = self.spec.reply[name]
             else:
-                values[name] = 0
+                blank = command.blanks.get(name, 0)
+                values[name] = blank(given) if callable(blank) else blank
         nest(values, {k: v for k, v in self.spec.reply.items() if "." in k})
         nest(values, {k: int(bool(device.get(e))) for k, e in device.spec.status.items() if "." in k})
         nest(values, command.nothing_held if refused == "held" else self.spec.errors.get(refused, {}))

@@ -1,0 +1,539 @@
+"""Every alternative the language reference documents, through every output.
+
+Each case is a small spec that uses one alternative (a field type, an item type, a size or count form, an
+encoding, a byte order, a frame element role or shape). Each spec goes through every output: the front end and
+every target's files (with their verification), the markdown reference, the CLI's decode --json, the codec (random
+valid messages round trip, also through JSON), construct's structs (they agree with the codec), the stream parser
+(random frames among garbage, fed in random pieces, give what byte-at-a-time feeding gives) and the client against
+the generated simulator on a real pseudo-terminal. The coverage tests read the alternatives from the grammar, so an
+alternative the reference gains without a case here fails the suite: a documented key cannot crash an output
+unnoticed.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import copy
+import importlib
+import io
+import json
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from types import ModuleType
+from typing import Any
+
+import pytest
+import yaml
+from conftest import Generated, examples
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from serialspec import cli
+from serialspec.backends import emitters
+from serialspec.backends.python.memory import imported
+from serialspec.lang import SpecErrors, grammar
+from serialspec.lang.loader import load_text
+from serialspec.lang.model import Message, Protocol
+from serialspec.lang.passes.fields import FIELD_KINDS
+from serialspec.lang.resolve import resolve
+from serialspec.runtime.transport import Bus
+from strategies import message_fields
+from test_codec import check_against_construct
+
+HEADER = "AA 55"
+# The frame of most cases: header, address, command, length, content, an 8-bit sum.
+FRAMING: dict[str, Any] = {
+    "elements": {
+        "header": {"role": "header", "value": HEADER},
+        "id": {"role": "address", "type": "u8", "range": [0, 253], "broadcast": 254},
+        "code": {"role": "command", "type": "u8"},
+        "length": {"role": "length", "type": "u8"},
+        "content": {"role": "content"},
+        "checksum": {"role": "checksum", "type": "u8", "algorithm": "sum", "covers": ["id", "content"]},
+    }
+}
+SHARED: dict[str, Any] = {
+    "enums": {"mode": {"values": {"slow": 0, "fast": 1, "off": 7}}},
+    "flags": {"alarms": {"bits": {"hot": 0, "stall": 1, "low": 7}}},
+    "tables": {
+        "regs": {
+            "key": "address",
+            "entries": {
+                "position": {"key": 0, "type": "u16", "range": [0, 1000], "default": 0},
+                "speed": {"key": 2, "type": "u8", "range": [0, 100], "default": 10},
+                "torque": {"key": 3, "type": "i16", "default": 0},
+            },
+        }
+    },
+    "fields": {"angle": {"type": "i16", "range": [-900, 900], "unit": "0.1°", "scale": 0.1}},
+}
+
+
+@dataclass(frozen=True)
+class Case:
+    """One alternative: the request and response fields of the one command `probe` (or a whole framing)."""
+
+    request: dict[str, Any]
+    response: dict[str, Any]
+    framing: dict[str, Any] | None = None
+    commands: dict[str, Any] | None = None  # more commands beside `probe`
+
+
+def same(fields: dict[str, Any]) -> Case:
+    return Case(fields, copy.deepcopy(fields))
+
+
+def with_count(kind: dict[str, Any]) -> dict[str, Any]:
+    return {"n": {"type": "u8", "range": [0, 6]}, "items": {**kind, "count": "n"}}
+
+
+SCALAR = {t: same({"v": {"type": t}}) for t in grammar.SCALAR_TYPES} | {
+    f"{t} (short form)": same({"v": t}) for t in ("u8", "i32")
+}
+ITEMS = {f"array of {t}": same({"items": {"type": "array", "of": t, "count": 3}}) for t in grammar.SCALAR_TYPES}
+CASES: dict[str, Case] = {
+    **SCALAR,
+    **ITEMS,
+    "array of bit": same({"bits": {"type": "array", "of": "bit", "count": 16}}),
+    "array of bit, count field": same(with_count({"type": "array", "of": "bit"})),
+    "array, count field": same(with_count({"type": "array", "of": "u16"})),
+    "array, count rest": same({"items": {"type": "array", "of": "u16", "count": "rest"}}),
+    "array, size field": same(
+        {"size": {"type": "u8", "value": "2 * len(items)"}, "items": {"type": "array", "of": "u16", "size": "size"}}
+    ),
+    "bytes, fixed size": same({"data": {"type": "bytes", "size": 4}}),
+    "bytes, size rest": same({"data": {"type": "bytes", "size": "rest"}}),
+    "bytes, size field": same({"n": "u8", "data": {"type": "bytes", "size": "n"}, "tail": "u8"}),
+    "string, fixed size": same({"name": {"type": "string", "size": 6}}),
+    "string, size rest": same({"name": {"type": "string", "size": "rest"}}),
+    "string, size field": same({"n": "u8", "name": {"type": "string", "size": "n"}, "tail": "u8"}),
+    "cstring": same({"name": {"type": "cstring"}, "tail": "u16"}),
+    "group, fixed count": same({"g": {"type": "group", "count": 2, "fields": {"a": "u8", "b": "i16"}}}),
+    "group, count field": same(with_count({"type": "group", "fields": {"a": "u8", "b": "u16"}})),
+    "group, count rest": same({"g": {"type": "group", "count": "rest", "fields": {"a": "u8", "b": "u16"}}}),
+    "table_value": same({"address": "u8", "value": {"type": "table_value", "table": "regs", "key": "address"}}),
+    "table_block": same({"block": {"type": "table_block", "table": "regs", "expect_size": 5}}),
+    "bytes holding registers": Case(
+        {"address": "u8", "data": {"type": "bytes", "size": "rest", "table": "regs", "start": "address"}},
+        {"ok": "u8"},
+    ),
+    "bytes sized by the request": Case(
+        {"address": "u8", "length": {"type": "u8", "range": [1, 5]}},
+        {
+            "data": {
+                "type": "bytes",
+                "size": "rest",
+                "table": "regs",
+                "start": "request.address",
+                "size_from": "request.length",
+            }
+        },
+    ),
+    "array counted by the request": Case(
+        {"count": {"type": "u8", "range": [1, 16]}},
+        {
+            "byte_count": {"type": "u8", "value": "ceil(len(coils) / 8)"},
+            "coils": {"type": "array", "of": "bit", "size": "byte_count", "count_from": "request.count"},
+        },
+    ),
+    "enum": same({"mode": {"type": "u8", "enum": "mode"}}),
+    "flags": same({"alarms": {"type": "u8", "flags": "alarms"}}),
+    "bits": same({"word": {"type": "u16", "bits": {"hi": {"bits": [15, 12]}, "mode": {"bits": 2, "enum": "mode"}}}}),
+    "bits and groups defined apart in two commands": Case(
+        {
+            "word": {"type": "u8", "bits": {"hi": {"bits": [7, 4]}}},
+            "g": {"type": "group", "count": 1, "fields": {"a": "u8"}},
+        },
+        {"v": "u8"},
+        commands={
+            "other": {
+                "code": 2,
+                "request": {
+                    "fields": {
+                        "word": {"type": "u8", "bits": {"lo": {"bits": 0}}},
+                        "g": {"type": "group", "count": 1, "fields": {"b": "i8"}},
+                    }
+                },
+            }
+        },
+    ),
+    "encoding: plain": same({"v": {"type": "i16", "encoding": "plain"}}),
+    "encoding: sign_magnitude": same({"v": {"type": "i16", "encoding": "sign_magnitude"}}),
+    "endian: big": same({"v": {"type": "u32", "endian": "big"}, "w": {"type": "f32", "endian": "big"}}),
+    "endian: little": same({"v": {"type": "u32", "endian": "little"}}),
+    "value (derived)": same({"a": "u8", "b": "u8", "total": {"type": "u16", "value": "a + b * 2"}}),
+    "const": same({"sel": {"type": "u8", "const": 3}, "v": "u8"}),
+    "default": same({"v": {"type": "u8", "default": 20, "range": [0, 50]}}),
+    "range, unit, scale": same({"v": {"type": "i16", "range": [-100, 100], "unit": "mV", "scale": 0.5}}),
+    "use (shared field)": same({"angle": {"use": "angle"}, "also": "angle"}),
+    "status": Case({"v": "u8"}, {"success": {"type": "u8", "status": {"ok": 1}}, "v": "u8"}),
+    # frame shapes: every element role, multi-byte elements in both byte orders, stuffing, alternative layouts
+    "frame: trailer, constant, u16 big-endian length and checksum": Case(
+        {"v": "u16"},
+        {"v": "u16"},
+        {
+            "elements": {
+                "header": {"role": "header", "value": HEADER},
+                "reserved": {"role": "constant", "value": "00"},
+                "length": {"role": "length", "type": "u16", "endian": "big", "counts": ["code", "checksum"]},
+                "code": {"role": "command", "type": "u8"},
+                "content": {"role": "content"},
+                "checksum": {
+                    "role": "checksum",
+                    "type": "u16",
+                    "endian": "big",
+                    "algorithm": "sum",
+                    "covers": ["length", "content"],
+                },
+                "trailer": {"role": "trailer", "value": "0D 0A"},
+            }
+        },
+    ),
+    "frame: status flags, length adds": Case(
+        {"v": "u8"},
+        {"v": "u8"},
+        {
+            "elements": {
+                "header": {"role": "header", "value": HEADER},
+                "id": {"role": "address", "type": "u8"},
+                "length": {"role": "length", "type": "u8", "adds": 2},
+                "code": {"role": "command", "type": "u8", "value": {"response": "00"}},
+                "status": {"role": "status", "type": "u8", "flags": "alarms", "directions": ["response"]},
+                "content": {"role": "content"},
+                "checksum": {
+                    "role": "checksum",
+                    "type": "u8",
+                    "algorithm": "sum",
+                    "invert": True,
+                    "covers": ["id", "content"],
+                },
+            }
+        },
+    ),
+    "frame: status bits, error flag": Case(
+        {"v": "u8"},
+        {"v": "u8"},
+        {
+            "elements": {
+                "header": {"role": "header", "value": HEADER},
+                "code": {"role": "command", "type": "u8", "error_flag": 0x80},
+                "status": {
+                    "role": "status",
+                    "type": "u8",
+                    "directions": ["response"],
+                    "bits": {"alert": {"bits": 7}, "error": {"bits": [6, 0]}},
+                },
+                "length": {"role": "length", "type": "u8"},
+                "content": {"role": "content"},
+                "checksum": {"role": "checksum", "type": "u8", "algorithm": "sum", "covers": ["code", "content"]},
+            }
+        },
+        {"refused": {"response": {"error_reply": True, "fields": {"reason": {"type": "u8", "enum": "mode"}}}}},
+    ),
+    "frame: transparency": Case(
+        {"v": "u16", "data": {"type": "bytes", "size": "rest"}},
+        {"v": "u16"},
+        {
+            "elements": {
+                "header": {"role": "header", "value": "C0"},
+                "length": {"role": "length", "type": "u8", "counts": ["code", "checksum"]},
+                "code": {"role": "command", "type": "u8"},
+                "content": {"role": "content"},
+                "checksum": {"role": "checksum", "type": "u8", "algorithm": "sum", "covers": ["length", "content"]},
+            },
+            "transparency": {"span": ["code", "content"], "replace": {"C0": "DB DC", "DB": "DB DD"}},
+        },
+    ),
+    "frame: layouts": Case(
+        {"data": {"type": "bytes", "size": "rest"}},
+        {"data": {"type": "bytes", "size": "rest"}},
+        {
+            "layouts": {
+                "short": {
+                    "elements": {
+                        "start": {"role": "header", "value": "02"},
+                        "length": {"role": "length", "type": "u8", "counts": ["code", "content"]},
+                        "code": {"role": "command", "type": "u8"},
+                        "content": {"role": "content"},
+                        "checksum": {
+                            "role": "checksum",
+                            "type": "u8",
+                            "algorithm": "sum",
+                            "covers": ["code", "content"],
+                        },
+                        "end": {"role": "trailer", "value": "03"},
+                    }
+                },
+                "long": {
+                    "elements": {
+                        "start": {"role": "header", "value": "04"},
+                        "length": {"role": "length", "type": "u16", "counts": ["code", "content"]},
+                        "code": {"role": "command", "type": "u8"},
+                        "content": {"role": "content"},
+                        "checksum": {
+                            "role": "checksum",
+                            "type": "u8",
+                            "algorithm": "sum",
+                            "covers": ["code", "content"],
+                        },
+                        "end": {"role": "trailer", "value": "03"},
+                    }
+                },
+            }
+        },
+    ),
+}
+
+
+def spec_text(name: str, case: Case) -> str:
+    framing = case.framing or FRAMING
+    elements = next(iter(framing["layouts"].values()))["elements"] if "layouts" in framing else framing["elements"]
+    address = next((n for n, e in elements.items() if e["role"] == "address"), None)
+    matching = [address, "command"] if address else ["command"]
+    spec: dict[str, Any] = {
+        "protocol": "matrix_case",
+        "title": f"Matrix: {name}",
+        "description": f"The language matrix case {name!r}.",
+        "byte_order": "little",
+        "serial": {"baudrate": 115200},
+        "framing": framing,
+        "matching": {"by": matching},
+        **copy.deepcopy(SHARED),
+        "commands": {
+            "probe": {
+                "code": 1,
+                "title": "Probe",
+                "request": {"fields": case.request},
+                "response": {"fields": case.response},
+            },
+            **copy.deepcopy(case.commands or {}),
+        },
+        "device": {"memory": "regs", **({"address": address} if address else {})},
+    }
+    return yaml.safe_dump(spec, sort_keys=False, allow_unicode=True)
+
+
+@dataclass(frozen=True)
+class Built:
+    text: str
+    protocol: Protocol
+    files: dict[str, str]
+
+
+def build(name: str) -> Built:
+    text = spec_text(name, CASES[name])
+    try:
+        protocol = resolve(load_text(text, "matrix_case.yaml"))
+        files: dict[str, str] = {}
+        problems = []
+        for emitter in emitters():
+            emitted = emitter.files(protocol)
+            files.update(emitted)
+            if emitter.verify is not None:
+                problems.extend(emitter.verify(protocol, emitted))
+        if problems:
+            raise SpecErrors(problems)
+    except SpecErrors as exc:
+        pytest.fail(f"case {name!r}: the spec is refused:\n{exc}\n{text}")
+    return Built(text, protocol, files)
+
+
+@contextlib.contextmanager
+def package(built: Built) -> Iterator[Generated]:
+    modules = {path.split("/", 1)[1]: text for path, text in built.files.items() if path.startswith("matrix_case/")}
+    with imported("matrix_case", modules, "the language matrix") as root:
+        structs: ModuleType = importlib.import_module("matrix_case.structs")
+        yield Generated(built.protocol, root, structs)
+
+
+def message_class(g: Generated, message: Message) -> Any:
+    return next(c for c in g.package.MESSAGE_TYPES if c.__name__ == message.class_name)
+
+
+# Known to fail; each is a bug to fix, strict so that the fix is noticed (and the mark removed).
+KNOWN = {
+    "frame: transparency, checksum over exactly the span": "encode sums the stuffed bytes, decode the plain ones",
+}
+CASES["frame: transparency, checksum over exactly the span"] = Case(
+    {"v": "u16"},
+    {"v": "u16"},
+    {
+        **CASES["frame: transparency"].framing,  # type: ignore[dict-item]
+        "elements": {
+            **CASES["frame: transparency"].framing["elements"],  # type: ignore[index]
+            "checksum": {"role": "checksum", "type": "u8", "algorithm": "sum", "covers": ["code", "content"]},
+        },
+    },
+)
+PARAMS = [
+    pytest.param(name, marks=pytest.mark.xfail(reason=KNOWN[name], strict=True)) if name in KNOWN else name
+    for name in sorted(CASES)
+]
+
+
+def test_every_documented_alternative_has_a_case() -> None:
+    """The alternatives the grammar documents (and so docs/language.md), each used by some case."""
+    used: dict[str, set[Any]] = {
+        "type": set(),
+        "of": set(),
+        "encoding": set(),
+        "endian": set(),
+        "size": set(),
+        "count": set(),
+        "role": set(),
+        "element type": set(),
+        "element endian": set(),
+    }
+
+    def walk_fields(fields: dict[str, Any]) -> None:
+        for spec in fields.values():
+            spec = {"type": spec} if isinstance(spec, str) else spec
+            used["type"].add(spec.get("type", "use"))
+            for key in ("of", "encoding", "endian"):
+                if key in spec:
+                    used[key].add(spec[key])
+            for key in ("size", "count"):
+                if key in spec:
+                    used[key].add(
+                        spec[key]
+                        if spec[key] == "rest" or isinstance(spec[key], int) is False and spec[key] == "rest"
+                        else type(spec[key]).__name__
+                    )
+            walk_fields(spec.get("fields", {}))
+
+    for case in CASES.values():
+        walk_fields(case.request)
+        walk_fields(case.response)
+        framing = case.framing or FRAMING
+        layouts = framing["layouts"].values() if "layouts" in framing else [framing]
+        for layout in layouts:
+            for element in layout["elements"].values():
+                used["role"].add(element["role"])
+                used["element type"].add(element.get("type", "u8"))
+                used["element endian"].add(element.get("endian", "little"))
+    field = grammar._FIELD_LONG
+    element = grammar.FRAME_ELEMENT.keys
+    assert set(FIELD_KINDS) - used["type"] == set()
+    assert (set(grammar.SCALAR_TYPES) | {"bit"}) - used["of"] == set()
+    assert set(field["encoding"].choices) - used["encoding"] == set()  # type: ignore[attr-defined]
+    assert set(field["endian"].choices) - used["endian"] == set()  # type: ignore[attr-defined]
+    assert {"rest", "int", "str"} - used["size"] == set()
+    assert {"rest", "int", "str"} - used["count"] == set()
+    assert set(element["role"].choices) - used["role"] == set()  # type: ignore[attr-defined]
+    assert {"u8", "u16"} - used["element type"] == set()
+    assert set(element["endian"].choices) - used["element endian"] == set()  # type: ignore[attr-defined]
+
+
+@pytest.mark.parametrize("name", PARAMS)
+def test_every_output(name: str, tmp_path: Path) -> None:
+    built = build(name)
+    docs = next(text for path, text in built.files.items() if path.endswith(".md"))
+    assert "probe" in docs.lower() and "Traceback" not in docs
+    with package(built) as g:
+        for message in built.protocol.messages():
+            codec_and_structs(g, message)
+        stream(g)
+        client_against_simulator(g)
+        spec = tmp_path / "matrix_case.yaml"
+        spec.write_text(built.text, encoding="utf-8")
+        cli_decode(g, spec)
+
+
+SETTINGS = settings(max_examples=examples(15), deadline=None, suppress_health_check=list(HealthCheck))
+
+
+def codec_and_structs(g: Generated, message: Message) -> None:
+    cls = message_class(g, message)
+
+    @SETTINGS
+    @given(message_fields(g.protocol, message))
+    def round_trip(fields: dict[str, Any]) -> None:
+        frame = g.package.encode(cls.from_fields(fields))
+        decoded = g.package.decode(frame, message.direction.value, cls)
+        assert decoded.to_fields() == fields
+        assert g.package.encode(cls.from_fields(json.loads(json.dumps(decoded.to_fields())))) == frame
+        check_against_construct(g, message, frame, fields)
+
+    round_trip()
+
+
+def stream(g: Generated) -> None:
+    """Random frames among garbage that holds no header byte, in random pieces: all of them, in order."""
+    for direction in ("request", "response"):
+        stream_direction(g, direction)
+
+
+def stream_direction(g: Generated, direction: str) -> None:
+    headers = {
+        e.constant[0]
+        for layout in g.protocol.framing.layouts.values()
+        for e in layout.elements
+        if e.role == "header" and e.constant
+    }
+    garbage = st.binary(max_size=6).map(lambda b: bytes(x for x in b if x not in headers))
+    messages = [m for m in g.protocol.messages() if m.direction.value == direction]
+    drawn_messages = st.sampled_from(messages).flatmap(lambda m: st.tuples(st.just(m), message_fields(g.protocol, m)))
+
+    @SETTINGS
+    @given(st.lists(drawn_messages, min_size=1, max_size=4), st.lists(garbage, min_size=5, max_size=5), st.data())
+    def parse(drawn: list[tuple[Message, dict[str, Any]]], noise: list[bytes], data: st.DataObject) -> None:
+        frames = [g.package.encode(message_class(g, m).from_fields(f)) for m, f in drawn]
+        wire = b"".join(noise[i % 5] + frame for i, frame in enumerate(frames)) + noise[-1]
+        cuts = sorted(data.draw(st.lists(st.integers(0, len(wire)), max_size=6)))
+        parser = g.package.StreamParser(direction)
+        pieces = [wire[a:b] for a, b in zip([0, *cuts], [*cuts, len(wire)], strict=True)]
+        got = [m.to_fields() for piece in pieces for m in parser.feed(piece)]
+        trickle = g.package.StreamParser(direction)
+        one_by_one = [m.to_fields() for byte in wire for m in trickle.feed(bytes([byte]))]
+        assert got == one_by_one == [f for _, f in drawn]
+
+    parse()
+
+
+def client_against_simulator(g: Generated) -> None:
+    simulator_module = importlib.import_module("matrix_case.simulator")
+    client_module = importlib.import_module("matrix_case.client")
+    simulator_class = next(
+        v
+        for k, v in vars(simulator_module).items()
+        if k.endswith("Simulator") and k != "Simulator" and isinstance(v, type)
+    )
+    request = next(m for m in g.protocol.messages() if m.direction.value == "request" and m.command == "probe")
+    response = next(m for m in g.protocol.messages() if m.direction.value == "response" and m.command == "probe")
+    simulator = simulator_class(ids=[1])
+    path = simulator.start()
+    try:
+        with Bus(path, client_module.BINDING, timeout=1.0) as bus:
+            for fields in st_examples(message_fields(g.protocol, request), 3):
+                address = [
+                    e.name for e in g.protocol.framing.layouts[request.direction].value_elements if e.role == "address"
+                ]
+                fields = {**fields, **dict.fromkeys(address, 1)}
+                reply = bus.request(message_class(g, request).from_fields(fields), message_class(g, response))
+                assert type(reply) is message_class(g, response)
+    finally:
+        simulator.close()
+
+
+def st_examples(strategy: st.SearchStrategy[Any], count: int) -> list[Any]:
+    found: list[Any] = []
+
+    @settings(max_examples=count, deadline=None, suppress_health_check=list(HealthCheck), database=None)
+    @given(strategy)
+    def take(value: Any) -> None:
+        found.append(value)
+
+    take()
+    return found[:count]
+
+
+def cli_decode(g: Generated, spec: Path) -> None:
+    for message in g.protocol.messages():
+        fields = st_examples(message_fields(g.protocol, message), 1)[0]
+        frame = g.package.encode(message_class(g, message).from_fields(fields))
+        out = io.StringIO()
+        with contextlib.redirect_stdout(out):
+            code = cli.main(["decode", str(spec), frame.hex(" "), "--json", "--direction", message.direction.value])
+        assert code == 0, out.getvalue()
+        decoded = json.loads(out.getvalue())
+        assert decoded["command"] == message.command and decoded["direction"] == message.direction.value

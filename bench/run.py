@@ -1,7 +1,7 @@
 """Run every benchmark family, print one markdown table per family, and write them all to bench/results.md.
 
 Usage: `make bench`, or `.venv/bin/python -m bench.run [family ...]` from the project root (families: codec,
-stream, latency, generation; default all). Only a full run rewrites bench/results.md.
+stream, latency, generation, startup; default all). Only a full run rewrites bench/results.md.
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
-from bench import codec, generation, latency, stream
+from bench import codec, generation, latency, startup, stream
 from bench.timing import Table
 
 RESULTS = Path(__file__).resolve().parent / "results.md"
@@ -24,6 +24,7 @@ FAMILIES: dict[str, Callable[[], Table]] = {
     "stream": stream.run,
     "latency": latency.run,
     "generation": generation.run,
+    "startup": startup.run,
 }
 
 

@@ -210,7 +210,24 @@ CASES: list[tuple[str, str, Mutation | Text, str | None]] = [
         replace_text("title: Tiny\n", "title: Tiny\n? [a, b]\n: c\n"),
         "keys must be names or numbers",
     ),
-    ("boolean key", "tiny", replace_text("title: Tiny\n", "title: Tiny\nyes: 1\n"), "keys must be names or numbers"),
+    (
+        "boolean key",
+        "tiny",
+        replace_text("title: Tiny\n", "title: Tiny\nyes: 1\n"),
+        "the key yes reads as true in YAML: quote it ('yes')",
+    ),
+    (
+        "enum value named off",  # a newcomer's first enum: off/on are false/true in YAML 1.1
+        "tiny",
+        replace_text("mode: {values: {slow: 0, fast: 1}}", "mode: {values: {off: 0, fast: 1}}"),
+        "enums.mode.values: the key off reads as false in YAML: quote it ('off')",
+    ),
+    (
+        "null key",
+        "tiny",
+        replace_text("title: Tiny\n", "title: Tiny\n~: 1\n"),
+        "the key ~ reads as nothing in YAML: quote it ('~')",
+    ),
     # --- numbers: codes, sizes, scales, ranges, defaults, serial settings ----------------------------------------------
     (
         "code 256",
@@ -1018,7 +1035,46 @@ CASES: list[tuple[str, str, Mutation | Text, str | None]] = [
     ("hostile serial notes", "tiny", put("serial/notes", HOSTILE), None),
     ("trailing backslash", "tiny", put("commands/move/title", "Move \\"), None),
     ("triple quotes", "tiny", put("commands/move/description", "ends with '''\"\"\""), None),
-    ("long description", "tiny", put("description", "word " * 20000), None),
+    (
+        "matching by the command element's name",  # the tutorial matches by `command`; a spec of one's own names it
+        "tiny",
+        put("matching", {"by": ["id", "code"]}),
+        "matching.by[1]: 'code' is the command element: a reply's command is matched as `command`",
+    ),
+    (
+        "matching by the checksum",
+        "tiny",
+        put("matching", {"by": ["id", "checksum"]}),
+        "matching.by[1]: 'checksum' is the frame's checksum, not a value a reply repeats from its request",
+    ),
+    (
+        "example with a wrong 16-bit checksum",  # shown as wide as it is: 0x0000, not 0x00
+        "tiny",
+        both(
+            put("framing/elements/checksum/type", "u16"),
+            put("examples/move_request/printed", "AA 55 01 01 05 64 00 01 0A 00 00 00"),
+        ),
+        "examples.move_request: the frame does not decode: bad checksum: the frame has 0x0000, its bytes give 0x0076",
+    ),
+    (
+        "probe without a reply",
+        "tiny",
+        put("commands/write/probe", True),
+        "commands.write.probe: a probe needs a reply: a `response`, or `answered_by` on its request",
+    ),
+    ("long description", "tiny", put("description", "word " * 2000), None),
+    (
+        "description over the text limit",
+        "tiny",
+        put("commands/move/description", "word " * 2000 + "w"),
+        "commands.move.description: text of 10,001 characters (at most 10,000)",
+    ),
+    (
+        "file over the size limit",
+        "tiny",
+        Text(lambda t: (t + "# " + "x" * 1_000_000 + "\n").encode()),
+        "the file is larger than 1,000,000 bytes, the most a spec may have",
+    ),
     (
         "nul in a description",
         "tiny",

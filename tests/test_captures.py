@@ -35,7 +35,9 @@ def test_shared_header_frames_are_told_apart_by_pairing_replies_with_requests() 
         ("response", "reply"),
     ]
     assert b"".join(s.data for s in seen) == data
-    assert frames.feed(bytes.fromhex("ff ff 01 02 01 fa"))[-1].reason.startswith("1 frame(s) failed")
+    # reported once nothing held back can join the bad bytes: here at the end
+    bad = frames.feed(bytes.fromhex("ff ff 01 02 01 fa")) + frames.finish()
+    assert bad[-1].reason.startswith("1 frame(s) failed")
 
 
 @contextmanager
@@ -151,3 +153,102 @@ def test_decode_file_names_the_line_that_does_not_parse(tmp_path: Path, bad: str
         [sys.executable, "-m", "serialspec", "decode", FS, "--file", str(capture)], capture_output=True, text=True
     )
     assert result.returncode == 1 and "line 2" in result.stderr and "Traceback" not in result.stderr
+
+
+TINY = str(ROOT / "tests" / "hostile" / "tiny.yaml")
+MOVE = "aa 55 01 01 05 64 00 01 0a 00 76"  # a valid move request of the tiny spec
+
+
+def test_garbage_in_a_capture_is_counted_once_on_its_own_line(tmp_path: Path) -> None:
+    """`de ad` then a valid frame on the next line reported `1 byte(s) outside any frame in [de ad]` and then
+    `1 byte(s) outside any frame in [<the valid frame>]`: the byte held back (it might have begun a header) was
+    blamed on the line that completed it. Bad bytes are now shown themselves, once, under the line they are on."""
+    capture = tmp_path / "noisy.capture"
+    lines = ["de ad", MOVE, "01 aa", MOVE[3:].replace("76", "77") + " ff", "aa"]
+    capture.write_text(
+        "".join(f"2026-11-22T09:40:0{i}.000000+00:00 request {line}\n" for i, line in enumerate(lines)), "utf-8"
+    )
+    result = subprocess.run(
+        [sys.executable, "-m", "serialspec", "decode", TINY, "--file", str(capture), "--json"],
+        capture_output=True,
+        text=True,
+    )
+    assert [json.loads(line)["command"] for line in result.stdout.splitlines()] == ["move"]
+    assert result.stderr.splitlines() == [
+        "serialspec decode: line 1: 2 byte(s) outside any frame in [de ad]",
+        "serialspec decode: line 3: 1 frame(s) failed their checksum or content check in "
+        "[01 aa 55 01 01 05 64 00 01 0a 00 77 ff]",
+        f"serialspec decode: {capture} ends inside a frame: [aa]",
+    ]
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_every_byte_of_a_noisy_stream_is_a_frame_or_reported_bad_once_whatever_the_reads(seed: int) -> None:
+    """Frames and bad bytes, in stream order, are the stream itself, however it is cut into chunks; each bad byte is
+    reported under the chunk it came from."""
+    import random
+
+    protocol, package = open_spec(FS)
+    rng = random.Random(seed)
+    frames_in = [
+        package.encode(package.ReadAngleResponse(servo_id=rng.randrange(255), angle=rng.randrange(-1800, 1800)))
+        for _ in range(30)
+    ]
+    stream = b"".join(
+        bytes(rng.randrange(256) for _ in range(rng.choice([0, 0, 1, 2, 5]))) + frame for frame in frames_in
+    )
+    frames = Frames(package, "response", protocol.device.address if protocol.device else None)
+    seen = []
+    chunks = []
+    position = 0
+    while position < len(stream):
+        size = rng.randint(1, 12)
+        chunks.append((position, position + size))
+        seen += frames.feed(stream[position : position + size], len(chunks) - 1)
+        position += size
+    seen += frames.finish()
+    assert b"".join(s.data for s in seen) + frames.pending() == stream
+    assert [s.message for s in seen if s.message] == [package.decode(f) for f in frames_in][
+        : sum(1 for s in seen if s.message)
+    ]
+    offset = 0
+    for s in seen:  # each piece's origin is the chunk its first byte came from
+        start, stop = chunks[s.origin]  # type: ignore[index]
+        assert start <= offset < stop
+        offset += len(s.data)
+
+
+def test_a_spy_log_replays_with_register_names_from_the_request_before(tmp_path: Path) -> None:
+    """pyserial's spy:// log, which the README names beside captures, could not be decoded (`'000000.000' is not a
+    hex byte`), and a replayed READ reply showed `data 09 03`, not `model_number 777`, though its request is the
+    frame before: a reply is shown with the request it answers, in a capture and in a spy log alike."""
+    from feetech_sms.client import FeetechSmsClient
+    from feetech_sms.simulator import FeetechSmsSimulator
+
+    simulator = FeetechSmsSimulator(ids=[1])
+    path = simulator.start()
+    log = tmp_path / "spy.log"
+    try:
+        with FeetechSmsClient(f"spy://{path}?file={log}", optional_replies=True) as client:
+            assert client.read(1, "model_number") == 777
+            client.ping(1)  # a reply that answers no READ: shown without registers
+    finally:
+        simulator.close()
+    assert log.read_text(encoding="utf-8").startswith("000000.")
+    capture = tmp_path / "read.capture"
+    capture.write_text(
+        "2026-11-22T09:40:00.000000+00:00 request ff ff 01 04 02 03 02 f3\n"
+        "2026-11-22T09:40:00.001000+00:00 response ff ff 01 04 00 09 03 ee\n",
+        encoding="utf-8",
+    )
+    for replayed in (log, capture):
+        result = subprocess.run(
+            [sys.executable, "-m", "serialspec", "decode", SMS, "--file", str(replayed), "--json"],
+            capture_output=True,
+            text=True,
+        )
+        assert result.returncode == 0 and result.stderr == "", result.stderr
+        decoded = [json.loads(line) for line in result.stdout.splitlines()]
+        assert [(d["direction"], d["command"]) for d in decoded][:2] == [("request", "read"), ("response", "reply")]
+        assert decoded[1]["registers"] == {"model_number": 777}
+        assert all("registers" not in d for d in decoded[2:] if d["direction"] == "response")

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 import shutil
 import subprocess
 import sys
@@ -216,3 +217,44 @@ def test_sim_banner_says_what_is_served_in_words() -> None:
     assert banner("vesc", [0]) == "(one device: the protocol has no address)"
     assert banner("modbus_rtu", [1, 2]) == "unit 1, 2"
     assert banner("hiwonder_rrc", [1]) == "servo_id 1; pwm_servo servo_id 1, 2, 3, 4; motor motor_id 0, 1, 2, 3"
+
+
+def test_a_mistyped_command_or_a_missing_direction_says_what_to_type(capsys: pytest.CaptureFixture[str]) -> None:
+    """`encode --json '{"command": "rotat"}'` said only "has no request 'rotat'", and a shared-header frame "give the
+    direction" without naming the option (found following the README from the wheel)."""
+    assert main(["encode", "fashionstar_uart", "--json", '{"command": "rotat", "fields": {}}']) == 1
+    assert capsys.readouterr().err.strip() == (
+        "serialspec encode: fashionstar_uart has no request 'rotat' (did you mean rotate?)"
+    )
+    assert main(["decode", "feetech_sms", "ff ff 01 04 00 09 03 ee"]) == 1
+    assert capsys.readouterr().err.strip() == (
+        "serialspec decode: ff ff 01 04 00 09 03 ee: give the direction: requests and responses share the header "
+        "ff ff (--direction request|response)"
+    )
+
+
+@pytest.mark.parametrize("out", [".", "src", "build/out"])
+def test_a_reference_links_its_spec_from_wherever_it_is_generated(tmp_path: Path, out: str) -> None:
+    """The reference linked its spec as `../../SPEC` wherever it was written: from `generate tinylamp.yaml --out .`
+    (the tutorial's), `docs/tinylamp.md` pointed one folder above the project."""
+    shutil.copy(ROOT / "examples" / "tinylamp" / "tinylamp.yaml", tmp_path / "tinylamp.yaml")
+    assert serialspec("generate", "tinylamp.yaml", "--out", out, cwd=tmp_path).returncode == 0
+    page = tmp_path / out / "docs" / "tinylamp.md"
+    link = re.search(r"spec: \[`tinylamp\.yaml`\]\(([^)]+)\)", page.read_text(encoding="utf-8"))
+    assert link is not None
+    assert (page.parent / link[1]).resolve() == (tmp_path / "tinylamp.yaml").resolve()
+
+
+def test_check_without_specs_and_generate_of_a_missing_spec_say_so_and_write_nothing(tmp_path: Path) -> None:
+    """In a folder without specs, `check` said `generated/serialspec.schema.json: missing` and sent the user to
+    generate; `generate nope.yaml` reported the missing file but still made generated/ with the schema in it."""
+    result = serialspec("check", cwd=tmp_path)
+    assert result.returncode == 1
+    assert result.stderr.splitlines() == [
+        "serialspec check: no specs to check in .: name spec files, or list them in pyproject.toml's "
+        "[tool.serialspec] specs (default: specs/*.yaml)"
+    ]
+    result = serialspec("generate", "nope.yaml", cwd=tmp_path)
+    assert result.returncode == 1
+    assert result.stderr.splitlines() == ["nope.yaml:1:1: no such spec file"]
+    assert list(tmp_path.iterdir()) == []

@@ -89,10 +89,23 @@ def test_sync_read_and_write_by_name(client: DynamixelP2Client) -> None:
 
 def test_id_change_moves_the_servo(client: DynamixelP2Client) -> None:
     client.bus.timeout = 0.2
-    client.write_raw(2, 7, bytes([12]))  # the register named `id`; the status packet comes from id 12
+    assert client.write(2, id=12) is True  # the status packet comes from id 12: matched by it
     assert client.ping(12).model_number == 1020
     with pytest.raises(Timeout):
         client.ping(2)
+    # raw bytes into the register named `id`: the raw method does not know they change the id, and waits for a
+    # status packet from id 12 that comes from id 13
+    with pytest.raises(Timeout, match="no reply to write from id=12 within 200 ms"):
+        client.write_raw(12, 7, bytes([13]))
+    assert client.ping(13).model_number == 1020
+    # no servo 9: the read of its status_return_level goes unanswered too, as it would at level 0, where a WRITE
+    # gets no status packet: not waited for. Told that replies are on, the client waits, and times out.
+    assert client.write(9, led=1) is None
+    client.optional_replies = True
+    with pytest.raises(Timeout, match=r"^no reply to write from id=9 within 200 ms$"):
+        client.write(9, led=1)
+    with pytest.raises(Timeout, match=r"^no reply to write from id=9 \(as id=10\) within 200 ms$"):
+        client.write(9, id=10)
 
 
 def test_bulk_read_and_write_by_name(client: DynamixelP2Client) -> None:

@@ -30,6 +30,24 @@ def test_ping(client: FeetechSmsClient) -> None:
     assert client.ping(9) is False
 
 
+def test_a_command_with_an_empty_reply_raises_timeout_when_none_comes(client: FeetechSmsClient) -> None:
+    """WRITE, REG WRITE, ACTION and RESET are answered by a status packet that carries nothing else: they returned
+    False to an absent servo, as if it had refused. Only PING (`probe: true` in the spec) says False; every other
+    command whose reply is due raises Timeout, and one whose reply is not due (broadcast) returns None."""
+    client.bus.timeout = 0.05
+    for call in (
+        lambda: client.write(9, goal_position=2048),
+        lambda: client.write_raw(9, 0x2A, b"\x00\x08"),
+        lambda: client.reg_write(9, goal_position=2048),
+        lambda: client.action(9),
+        lambda: client.reset(9),
+    ):
+        with pytest.raises(Timeout, match="from id=9 within 50 ms"):
+            call()
+    assert client.write(1, goal_position=2048) is True
+    assert client.action(254) is None  # broadcast: no reply due, none waited for
+
+
 def test_registers_by_name(client: FeetechSmsClient) -> None:
     assert client.read(2, "torque_limit") == 1000  # the spec's default
     assert client.write(2, torque_limit=640) is True

@@ -11,7 +11,9 @@ import os
 import re
 import subprocess
 import sys
+from html.parser import HTMLParser
 from pathlib import Path
+from typing import Any
 
 import pytest
 from hostile_cases import CASES, HOSTILE, Mutation, Text, both, put
@@ -197,3 +199,61 @@ def test_sim_refuses_ids_no_device_can_have() -> None:
         )
         assert result.returncode == 1 and result.stdout == ""
         assert result.stderr.strip().splitlines() == [result.stderr.strip()] and words in result.stderr
+
+
+# --- spec text in the documentation site: no live link to a script, no attribute of its own --------------------------
+
+LINKS = (
+    "[a](javascript:alert(1)) [b](data:text/html,x) [c]( VBScript:msgbox(1)) ![d](JAVA\\script:1)"
+    ' [e](http://x.example){: onclick="alert(2)" } [f][r] {: onmouseover=alert(3) }'
+)
+TEXT_KEYS = {"description", "title", "title_cn", "name_cn", "text", "unit", "source", "notes", "optional", "inferred"}
+
+
+class Attributes(HTMLParser):
+    """Every attribute of every element of a page, as (tag, name, value)."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.found: list[tuple[str, str, str]] = []
+
+    def handle_starttag(self, tag: str, attrs: list[tuple[str, str | None]]) -> None:
+        self.found.extend((tag, name, value or "") for name, value in attrs)
+
+
+def linked(node: Any, key: str = "") -> Any:
+    """The spec's data with every free text (and every source document's name) replaced by LINKS, the first of
+    them opening with a reference definition."""
+    if isinstance(node, dict):
+        return {k: LINKS if key == "sources" else linked(v, k) for k, v in node.items()}
+    if isinstance(node, list):
+        return [linked(v, key) for v in node]
+    return LINKS if isinstance(node, str) and key in TEXT_KEYS else node
+
+
+@pytest.mark.parametrize("base_name", sorted(BASES))
+def test_spec_text_in_the_docs_site_links_nowhere_unsafe(base_name: str) -> None:
+    """`[x](javascript:...)` in a description used to be a live link in the site (and `{: onclick=...}` an attribute
+    under its attr_list extension): links to other schemes than http, https and mailto, reference definitions and
+    attribute lists in spec text are shown as text, on the page rendered as `make docs` renders it."""
+    import markdown
+
+    def mutate(data: dict[str, Any]) -> None:
+        changed = linked(data)
+        changed["description"] = "[r]: javascript:alert(4) " + LINKS
+        data.clear()
+        data.update(changed)
+
+    lines, files = outcome(base_name, mutate)
+    assert lines == []
+    page = next(text for path, text in files.items() if path.startswith("docs/") and path.endswith(".md"))
+    html = markdown.markdown(page, extensions=["tables", "attr_list", "toc"])
+    parser = Attributes()
+    parser.feed(html)
+    assert parser.found
+    for tag, name, value in parser.found:
+        assert not name.startswith("on"), (tag, name, value)
+        if name in {"href", "src"}:
+            scheme = re.match(r"\s*([a-z][a-z0-9+.-]*):", value.replace("\\", ""), re.IGNORECASE)
+            assert scheme is None or scheme[1].lower() in {"http", "https", "mailto"}, (tag, name, value)
+    assert "javascript:alert(1)" in html  # shown, as text

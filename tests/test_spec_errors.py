@@ -211,3 +211,71 @@ def test_a_table_with_no_entries_is_an_error_line(tmp_path: Path) -> None:
     lines = errors_of(tmp_path, MINIMAL.replace("        angle: i16\n", fields) + table)
     assert any("tables.params.entries: a table needs at least one entry that is not reserved" in x for x in lines)
     assert len(lines) == 1, lines
+
+
+def test_many_mistakes_show_the_first_50_and_count_the_rest(tmp_path: Path) -> None:
+    """A spec with 80 commands sharing one code gave 79 lines (50,000 commands: 50,000 lines, seconds to print): the
+    first 50 in file order, then one line counting the rest, from the exception and from `check` and `generate`."""
+    commands = "".join(f"  c{i}:\n    code: 1\n    request: {{fields: {{a: u8}}}}\n" for i in range(80))
+    text = MINIMAL.partition("commands:\n")[0] + "commands:\n" + commands
+    lines = str(load_errors(tmp_path, text)).splitlines()
+    assert len(lines) == 51
+    assert lines[0] == "tiny.yaml:17:5: commands.c1: code 0x01 in request frames is already used by 'c0'"
+    assert lines[49].startswith("tiny.yaml:164:5: commands.c50: ")
+    assert lines[50] == "... and 29 more errors (79 in all)"
+    for verb in ("check", "generate"):
+        result = subprocess.run(
+            [sys.executable, "-m", "serialspec", verb, "tiny.yaml", "--out", "out"],
+            capture_output=True,
+            text=True,
+            cwd=tmp_path,
+        )
+        assert result.returncode == 1
+        shown = [line for line in result.stderr.splitlines() if line.startswith("tiny.yaml:")]
+        assert shown == lines[:50], verb
+        assert "... and 29 more errors (79 in all)" in result.stderr.splitlines(), verb
+
+
+def load_errors(tmp_path: Path, text: str) -> SpecErrors:
+    spec = tmp_path / "tiny.yaml"
+    spec.write_text(text, encoding="utf-8")
+    with pytest.raises(SpecErrors) as failure:
+        load_protocol(str(spec), "tiny.yaml")
+    return failure.value
+
+
+def test_a_spec_file_over_the_limit_is_refused_without_reading_it_whole(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A 50 MB description was accepted using about 600 MB: a file over MAX_SPEC_BYTES is one line, read no
+    further than the limit (the memory the load takes stays within a few times the limit, whatever the file's size),
+    whether it is named by path to the loader, to `decode` or to `check`."""
+    import tracemalloc
+
+    from serialspec.cli import protocols
+    from serialspec.lang.limits import MAX_SPEC_BYTES
+
+    spec = tmp_path / "big.yaml"
+    with spec.open("w", encoding="utf-8") as stream:
+        stream.write(MINIMAL.replace("title: Tiny", "title: Tiny\ndescription: "))
+        for _ in range(30):
+            stream.write("word " * 200_000)  # 30 MB in all
+    expected = "big.yaml:1:1: the file is larger than 1,000,000 bytes, the most a spec may have"
+    monkeypatch.chdir(tmp_path)
+    for load in (lambda: load_protocol("big.yaml"), lambda: protocols.open_spec("big.yaml")):
+        tracemalloc.start()
+        try:
+            with pytest.raises(SpecErrors) as failure:
+                load()
+            _, peak = tracemalloc.get_traced_memory()
+        finally:
+            tracemalloc.stop()
+        assert str(failure.value) == expected
+        assert peak < 4 * MAX_SPEC_BYTES
+    result = subprocess.run(
+        [sys.executable, "-m", "serialspec", "check", "big.yaml", "--out", "out"],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+    )
+    assert result.stderr.splitlines()[0] == expected

@@ -44,8 +44,13 @@ def test_read_returns_as_soon_as_the_reply_is_complete(sim: tuple[FashionstarUar
 def test_timeout_names_command_and_id_and_bus_stays_usable(sim: tuple[FashionstarUartSimulator, str]) -> None:
     _, path = sim
     with Bus(path, BINDING, timeout=0.05) as bus:
-        with pytest.raises(Timeout, match=r"read_angle from servo_id=7"):
-            bus.request(ReadAngleRequest(servo_id=7), ReadAngleResponse)
+        for timeout in (None, 0.03):  # the bus's, then the call's own
+            with pytest.raises(Timeout) as failure:
+                bus.request(ReadAngleRequest(servo_id=7), ReadAngleResponse, timeout=timeout)
+            # the timeout, not what was left of it after the first read (`within -5 ms`, `-0 ms`)
+            wanted = 0.05 if timeout is None else timeout
+            assert str(failure.value) == f"no reply to read_angle from servo_id=7 within {wanted * 1000:.0f} ms"
+            assert failure.value.timeout == wanted
         assert bus.request(ReadAngleRequest(servo_id=2), ReadAngleResponse).servo_id == 2
 
 
@@ -201,3 +206,15 @@ def test_a_refused_setting_is_a_port_error_naming_it() -> None:
         serial.protocol_handler_packages.remove("refusing_ports")
         os.close(controller)
         os.close(device)
+
+
+def test_a_value_out_of_range_is_one_error_not_two_chained(sim: tuple[FashionstarUartSimulator, str]) -> None:
+    """The tutorial's last step printed its RangeError twice, joined by "During handling of the above exception,
+    another exception occurred": the fast encoder's error, then encode's own, raised inside its handler."""
+    _, path = sim
+    with Bus(path, BINDING, timeout=0.2) as bus:
+        with pytest.raises(RangeError) as failure:
+            bus.request(ReadAngleRequest(servo_id=300), ReadAngleResponse)
+        assert str(failure.value) == "read_angle request: servo_id = 300 is outside its range 0..254"
+        assert failure.value.__context__ is None and failure.value.__cause__ is None
+        assert bus.request(ReadAngleRequest(servo_id=1), ReadAngleResponse).servo_id == 1

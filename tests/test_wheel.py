@@ -7,6 +7,7 @@ repository's sources, tests and generated/ are not on their path.
 
 from __future__ import annotations
 
+import contextlib
 import importlib.util
 import json
 import os
@@ -100,7 +101,7 @@ class User:
 @pytest.fixture(scope="module")
 def user(wheels: dict[str, Path], tmp_path_factory: pytest.TempPathFactory) -> User:
     tmp = tmp_path_factory.mktemp("user")
-    deps = _link_packages(["yaml", "jinja2", "markupsafe", "construct", "serial"], tmp / "deps")
+    deps = _link_packages(["yaml", "jinja2", "markupsafe", "construct", "serial", "shtab"], tmp / "deps")
     python = _venv(tmp / "venv", deps)
     _install(python, wheels["serialspec"])
     home = tmp / "home"
@@ -193,11 +194,11 @@ def test_a_shipped_protocol_decodes_by_name(user: User) -> None:
     )
 
 
-@pytest.fixture
-def sim(user: User) -> Iterator[tuple[str, Path]]:
-    tap = user.home / "session.capture"
+@contextlib.contextmanager
+def serving(user: User, *arguments: str) -> Iterator[str]:
+    """`serialspec sim ARGUMENTS` of the installed wheel, yielding the port it prints, stopped after the block."""
     process = subprocess.Popen(
-        [str(user.bin / "serialspec"), "sim", "tinylamp.yaml", "--id", "1", "--tap", str(tap)],
+        [str(user.bin / "serialspec"), "sim", *arguments],
         cwd=user.home,
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
@@ -205,10 +206,17 @@ def sim(user: User) -> Iterator[tuple[str, Path]]:
     )
     try:
         assert process.stdout is not None
-        yield process.stdout.readline().strip(), tap
+        yield process.stdout.readline().strip()
     finally:
         process.send_signal(signal.SIGTERM)
         assert process.wait(5) == 0
+
+
+@pytest.fixture
+def sim(user: User) -> Iterator[tuple[str, Path]]:
+    tap = user.home / "session.capture"
+    with serving(user, "tinylamp.yaml", "--id", "1", "--tap", str(tap)) as port:
+        yield port, tap
 
 
 def test_sim_with_a_client_and_its_tap_replays(user: User, sim: tuple[str, Path]) -> None:
@@ -265,6 +273,24 @@ def test_a_capture_saved_by_monitor_replays_through_decode(user: User) -> None:
     assert [line.split()[1:3] for line in out.splitlines()] == [["request", "set_brightness"], ["response", "ping"]]
     replayed = user.serialspec("decode", "tinylamp.yaml", "--file", "monitor.capture")
     assert "tinylamp request set_brightness" in replayed.stdout and "tinylamp response ping" in replayed.stdout
+
+
+def test_the_tools_work_from_the_wheel(user: User) -> None:
+    """scan and replay against a shipped protocol's sim, completion, and the license in the wheel's metadata."""
+    tap = user.home / "scan.capture"
+    with serving(user, "feetech_sms", "--id", "3", "--quiet", "--tap", str(tap)) as port:
+        found = user.serialspec("scan", "feetech_sms", "--port", port, "--ids", "1-4", "--json")
+        replayed = user.serialspec("replay", str(tap), "--port", port, "--speed", "0")
+    assert [json.loads(line) for line in found.stdout.splitlines()] == [
+        {"id": 3, "baudrate": 1000000, "model": "sts3215"}
+    ]
+    assert replayed.stderr.startswith("serialspec replay: 5 request chunk(s), 32 byte(s) sent to ")
+    assert "_shtab_serialspec" in user.serialspec("completion", "bash").stdout
+    metadata = user.python_code(
+        "from importlib.metadata import distribution; d = distribution('serialspec'); "
+        "print(d.metadata['License-Expression']); print(any(f.name == 'LICENSE' for f in d.files))"
+    )
+    assert metadata.split() == ["MIT", "True"]
 
 
 def test_generated_code_runs_on_the_runtime_alone(

@@ -10,7 +10,7 @@ Generated from specs/dynamixel_p2.yaml: `decode`/`encode` frames with the fast c
 one frozen message class per command and direction in `messages`, construct structs in `structs`.
 """
 
-from serialspec.runtime.transport import SerialSettings
+from serialspec.runtime.settings import SerialSettings
 
 from dynamixel_p2.codec import StreamParser, decode, encode
 from dynamixel_p2.messages import *  # noqa: F403

@@ -17,7 +17,7 @@ from typing import Any
 
 import serial
 from serialspec.runtime.aio import AsyncBus, AsyncClientBase
-from serialspec.runtime.errors import EncodeError, Timeout
+from serialspec.runtime.errors import EncodeError
 from serialspec.runtime.registers import ModelRegisters
 
 from dynamixel_p2.client import BINDING
@@ -137,14 +137,11 @@ class AsyncDynamixelP2Client(AsyncClientBase):
             address: First control table address to write.
             data: The bytes written, item by item from `address` on.
 
-        Returns: True if the device answered, False if it stayed silent (timeout).
+        Returns: True once the device has answered; Timeout when it does not.
         None when no reply is due (broadcast gets no reply).
         """
         request = WriteRequest(id=id, address=address, data=data)
-        try:
-            reply = await self._maybe(request, StatusResponse, (68, 2, '>='))
-        except Timeout:
-            return False
+        reply = await self._maybe(request, StatusResponse, (68, 2, '>='))
         if reply is None:
             return None
         return True
@@ -161,14 +158,11 @@ class AsyncDynamixelP2Client(AsyncClientBase):
             address: First control table address to write.
             data: The bytes to write when ACTION arrives.
 
-        Returns: True if the device answered, False if it stayed silent (timeout).
+        Returns: True once the device has answered; Timeout when it does not.
         None when no reply is due (broadcast gets no reply).
         """
         request = RegWriteRequest(id=id, address=address, data=data)
-        try:
-            reply = await self._maybe(request, StatusResponse, (68, 2, '>='))
-        except Timeout:
-            return False
+        reply = await self._maybe(request, StatusResponse, (68, 2, '>='))
         if reply is None:
             return None
         return True
@@ -183,14 +177,11 @@ class AsyncDynamixelP2Client(AsyncClientBase):
         Args:
             id: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. (0..252)
 
-        Returns: True if the device answered, False if it stayed silent (timeout).
+        Returns: True once the device has answered; Timeout when it does not.
         None when no reply is due (broadcast gets no reply).
         """
         request = ActionRequest(id=id)
-        try:
-            reply = await self._maybe(request, StatusResponse, (68, 2, '>='))
-        except Timeout:
-            return False
+        reply = await self._maybe(request, StatusResponse, (68, 2, '>='))
         if reply is None:
             return None
         return True
@@ -206,14 +197,11 @@ class AsyncDynamixelP2Client(AsyncClientBase):
             id: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. (0..252)
             option: What to reset. (1..255)
 
-        Returns: True if the device answered, False if it stayed silent (timeout).
+        Returns: True once the device has answered; Timeout when it does not.
         None when no reply is due (broadcast gets no reply).
         """
         request = FactoryResetRequest(id=id, option=option)
-        try:
-            reply = await self._maybe(request, StatusResponse, (68, 2, '>='))
-        except Timeout:
-            return False
+        reply = await self._maybe(request, StatusResponse, (68, 2, '>='))
         if reply is None:
             return None
         return True
@@ -224,14 +212,11 @@ class AsyncDynamixelP2Client(AsyncClientBase):
         Args:
             id: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. (0..252)
 
-        Returns: True if the device answered, False if it stayed silent (timeout).
+        Returns: True once the device has answered; Timeout when it does not.
         None when no reply is due (broadcast gets no reply).
         """
         request = RebootRequest(id=id)
-        try:
-            reply = await self._maybe(request, StatusResponse, (68, 2, '>='))
-        except Timeout:
-            return False
+        reply = await self._maybe(request, StatusResponse, (68, 2, '>='))
         if reply is None:
             return None
         return True
@@ -245,14 +230,11 @@ class AsyncDynamixelP2Client(AsyncClientBase):
             id: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. (0..252)
             option: What to clear. (1..1)
 
-        Returns: True if the device answered, False if it stayed silent (timeout).
+        Returns: True once the device has answered; Timeout when it does not.
         None when no reply is due (broadcast gets no reply).
         """
         request = ClearRequest(id=id, option=option)
-        try:
-            reply = await self._maybe(request, StatusResponse, (68, 2, '>='))
-        except Timeout:
-            return False
+        reply = await self._maybe(request, StatusResponse, (68, 2, '>='))
         if reply is None:
             return None
         return True
@@ -383,7 +365,11 @@ class AsyncDynamixelP2Client(AsyncClientBase):
         against its register's range and access before a byte is written. `write_raw` takes raw bytes.
         """
         start, data = self._models.pack(id, values)
-        result = await self.write_raw(id, start, data)
+        if 'id' in values:  # answered, if at all, from the new id
+            request = WriteRequest(id=id, address=start, data=data)
+            result = await self._from_new_address(request, StatusResponse, values['id'], (68, 2, '>='))
+        else:
+            result = await self.write_raw(id, start, data)
         for name, value in values.items():
             self._remember(id, CONTROL_TABLE[name].address, value)
         return result

@@ -17,7 +17,7 @@ from collections.abc import Iterable, Mapping, Sequence
 from typing import Any
 
 import serial
-from serialspec.runtime.errors import EncodeError, Timeout
+from serialspec.runtime.errors import EncodeError
 from serialspec.runtime.registers import ModelRegisters
 from serialspec.runtime.transport import Binding, Bus, ClientBase
 
@@ -152,14 +152,11 @@ class DynamixelP2Client(ClientBase):
             address: First control table address to write.
             data: The bytes written, item by item from `address` on.
 
-        Returns: True if the device answered, False if it stayed silent (timeout).
+        Returns: True once the device has answered; Timeout when it does not.
         None when no reply is due (broadcast gets no reply).
         """
         request = WriteRequest(id=id, address=address, data=data)
-        try:
-            reply = self._maybe(request, StatusResponse, (68, 2, '>='))
-        except Timeout:
-            return False
+        reply = self._maybe(request, StatusResponse, (68, 2, '>='))
         if reply is None:
             return None
         return True
@@ -176,14 +173,11 @@ class DynamixelP2Client(ClientBase):
             address: First control table address to write.
             data: The bytes to write when ACTION arrives.
 
-        Returns: True if the device answered, False if it stayed silent (timeout).
+        Returns: True once the device has answered; Timeout when it does not.
         None when no reply is due (broadcast gets no reply).
         """
         request = RegWriteRequest(id=id, address=address, data=data)
-        try:
-            reply = self._maybe(request, StatusResponse, (68, 2, '>='))
-        except Timeout:
-            return False
+        reply = self._maybe(request, StatusResponse, (68, 2, '>='))
         if reply is None:
             return None
         return True
@@ -198,14 +192,11 @@ class DynamixelP2Client(ClientBase):
         Args:
             id: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. (0..252)
 
-        Returns: True if the device answered, False if it stayed silent (timeout).
+        Returns: True once the device has answered; Timeout when it does not.
         None when no reply is due (broadcast gets no reply).
         """
         request = ActionRequest(id=id)
-        try:
-            reply = self._maybe(request, StatusResponse, (68, 2, '>='))
-        except Timeout:
-            return False
+        reply = self._maybe(request, StatusResponse, (68, 2, '>='))
         if reply is None:
             return None
         return True
@@ -221,14 +212,11 @@ class DynamixelP2Client(ClientBase):
             id: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. (0..252)
             option: What to reset. (1..255)
 
-        Returns: True if the device answered, False if it stayed silent (timeout).
+        Returns: True once the device has answered; Timeout when it does not.
         None when no reply is due (broadcast gets no reply).
         """
         request = FactoryResetRequest(id=id, option=option)
-        try:
-            reply = self._maybe(request, StatusResponse, (68, 2, '>='))
-        except Timeout:
-            return False
+        reply = self._maybe(request, StatusResponse, (68, 2, '>='))
         if reply is None:
             return None
         return True
@@ -239,14 +227,11 @@ class DynamixelP2Client(ClientBase):
         Args:
             id: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. (0..252)
 
-        Returns: True if the device answered, False if it stayed silent (timeout).
+        Returns: True once the device has answered; Timeout when it does not.
         None when no reply is due (broadcast gets no reply).
         """
         request = RebootRequest(id=id)
-        try:
-            reply = self._maybe(request, StatusResponse, (68, 2, '>='))
-        except Timeout:
-            return False
+        reply = self._maybe(request, StatusResponse, (68, 2, '>='))
         if reply is None:
             return None
         return True
@@ -260,14 +245,11 @@ class DynamixelP2Client(ClientBase):
             id: Servo id 0..252; 254 (0xFE) is the broadcast id. 253 and 255 are not used, to keep clear of the header. (0..252)
             option: What to clear. (1..1)
 
-        Returns: True if the device answered, False if it stayed silent (timeout).
+        Returns: True once the device has answered; Timeout when it does not.
         None when no reply is due (broadcast gets no reply).
         """
         request = ClearRequest(id=id, option=option)
-        try:
-            reply = self._maybe(request, StatusResponse, (68, 2, '>='))
-        except Timeout:
-            return False
+        reply = self._maybe(request, StatusResponse, (68, 2, '>='))
         if reply is None:
             return None
         return True
@@ -398,7 +380,11 @@ class DynamixelP2Client(ClientBase):
         against its register's range and access before a byte is written. `write_raw` takes raw bytes.
         """
         start, data = self._models.pack(id, values)
-        result = self.write_raw(id, start, data)
+        if 'id' in values:  # answered, if at all, from the new id
+            request = WriteRequest(id=id, address=start, data=data)
+            result = self._from_new_address(request, StatusResponse, values['id'], (68, 2, '>='))
+        else:
+            result = self.write_raw(id, start, data)
         for name, value in values.items():
             self._remember(id, CONTROL_TABLE[name].address, value)
         return result

@@ -8,7 +8,7 @@ Generated from specs/fashionstar_uart.yaml: `decode`/`encode` frames with the fa
 one frozen message class per command and direction in `messages`, construct structs in `structs`.
 """
 
-from serialspec.runtime.transport import SerialSettings
+from serialspec.runtime.settings import SerialSettings
 
 from fashionstar_uart.codec import StreamParser, decode, encode
 from fashionstar_uart.messages import *  # noqa: F403

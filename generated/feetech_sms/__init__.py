@@ -11,7 +11,7 @@ Generated from specs/feetech_sms.yaml: `decode`/`encode` frames with the fast co
 one frozen message class per command and direction in `messages`, construct structs in `structs`.
 """
 
-from serialspec.runtime.transport import SerialSettings
+from serialspec.runtime.settings import SerialSettings
 
 from feetech_sms.codec import StreamParser, decode, encode
 from feetech_sms.messages import *  # noqa: F403

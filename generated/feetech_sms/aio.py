@@ -124,14 +124,11 @@ class AsyncFeetechSmsClient(AsyncClientBase):
             address: First register address to write.
             data: The bytes written, register by register from `address` on.
 
-        Returns: True if the device answered, False if it stayed silent (timeout).
+        Returns: True once the device has answered; Timeout when it does not.
         None when no reply is due (broadcast gets no reply).
         """
         request = WriteRequest(id=id, address=address, data=data)
-        try:
-            reply = await self._maybe(request, ReplyResponse, (8, 1, '=='))
-        except Timeout:
-            return False
+        reply = await self._maybe(request, ReplyResponse, (8, 1, '=='))
         if reply is None:
             return None
         return True
@@ -148,14 +145,11 @@ class AsyncFeetechSmsClient(AsyncClientBase):
             address: First register address to write.
             data: The bytes to write when ACTION arrives.
 
-        Returns: True if the device answered, False if it stayed silent (timeout).
+        Returns: True once the device has answered; Timeout when it does not.
         None when no reply is due (broadcast gets no reply).
         """
         request = RegWriteRequest(id=id, address=address, data=data)
-        try:
-            reply = await self._maybe(request, ReplyResponse, (8, 1, '=='))
-        except Timeout:
-            return False
+        reply = await self._maybe(request, ReplyResponse, (8, 1, '=='))
         if reply is None:
             return None
         return True
@@ -170,14 +164,11 @@ class AsyncFeetechSmsClient(AsyncClientBase):
         Args:
             id: Servo id 0..253; 254 (0xFE) is the broadcast id: every servo takes the instruction and none answers, except to PING. (0..253)
 
-        Returns: True if the device answered, False if it stayed silent (timeout).
+        Returns: True once the device has answered; Timeout when it does not.
         None when no reply is due (broadcast gets no reply).
         """
         request = ActionRequest(id=id)
-        try:
-            reply = await self._maybe(request, ReplyResponse, (8, 1, '=='))
-        except Timeout:
-            return False
+        reply = await self._maybe(request, ReplyResponse, (8, 1, '=='))
         if reply is None:
             return None
         return True
@@ -190,14 +181,11 @@ class AsyncFeetechSmsClient(AsyncClientBase):
         Args:
             id: Servo id 0..253; 254 (0xFE) is the broadcast id: every servo takes the instruction and none answers, except to PING. (0..253)
 
-        Returns: True if the device answered, False if it stayed silent (timeout).
+        Returns: True once the device has answered; Timeout when it does not.
         None when no reply is due (broadcast gets no reply).
         """
         request = ResetRequest(id=id)
-        try:
-            reply = await self._maybe(request, ReplyResponse, (8, 1, '=='))
-        except Timeout:
-            return False
+        reply = await self._maybe(request, ReplyResponse, (8, 1, '=='))
         if reply is None:
             return None
         return True
@@ -276,7 +264,11 @@ class AsyncFeetechSmsClient(AsyncClientBase):
         against its register's range and access before a byte is written. `write_raw` takes raw bytes.
         """
         start, data = self._models.pack(id, values)
-        result = await self.write_raw(id, start, data)
+        if 'id' in values:  # answered, if at all, from the new id
+            request = WriteRequest(id=id, address=start, data=data)
+            result = await self._from_new_address(request, ReplyResponse, values['id'], (8, 1, '=='))
+        else:
+            result = await self.write_raw(id, start, data)
         for name, value in values.items():
             self._remember(id, CONTROL_TABLE[name].address, value)
         return result

@@ -142,14 +142,11 @@ class FeetechSmsClient(ClientBase):
             address: First register address to write.
             data: The bytes written, register by register from `address` on.
 
-        Returns: True if the device answered, False if it stayed silent (timeout).
+        Returns: True once the device has answered; Timeout when it does not.
         None when no reply is due (broadcast gets no reply).
         """
         request = WriteRequest(id=id, address=address, data=data)
-        try:
-            reply = self._maybe(request, ReplyResponse, (8, 1, '=='))
-        except Timeout:
-            return False
+        reply = self._maybe(request, ReplyResponse, (8, 1, '=='))
         if reply is None:
             return None
         return True
@@ -166,14 +163,11 @@ class FeetechSmsClient(ClientBase):
             address: First register address to write.
             data: The bytes to write when ACTION arrives.
 
-        Returns: True if the device answered, False if it stayed silent (timeout).
+        Returns: True once the device has answered; Timeout when it does not.
         None when no reply is due (broadcast gets no reply).
         """
         request = RegWriteRequest(id=id, address=address, data=data)
-        try:
-            reply = self._maybe(request, ReplyResponse, (8, 1, '=='))
-        except Timeout:
-            return False
+        reply = self._maybe(request, ReplyResponse, (8, 1, '=='))
         if reply is None:
             return None
         return True
@@ -188,14 +182,11 @@ class FeetechSmsClient(ClientBase):
         Args:
             id: Servo id 0..253; 254 (0xFE) is the broadcast id: every servo takes the instruction and none answers, except to PING. (0..253)
 
-        Returns: True if the device answered, False if it stayed silent (timeout).
+        Returns: True once the device has answered; Timeout when it does not.
         None when no reply is due (broadcast gets no reply).
         """
         request = ActionRequest(id=id)
-        try:
-            reply = self._maybe(request, ReplyResponse, (8, 1, '=='))
-        except Timeout:
-            return False
+        reply = self._maybe(request, ReplyResponse, (8, 1, '=='))
         if reply is None:
             return None
         return True
@@ -208,14 +199,11 @@ class FeetechSmsClient(ClientBase):
         Args:
             id: Servo id 0..253; 254 (0xFE) is the broadcast id: every servo takes the instruction and none answers, except to PING. (0..253)
 
-        Returns: True if the device answered, False if it stayed silent (timeout).
+        Returns: True once the device has answered; Timeout when it does not.
         None when no reply is due (broadcast gets no reply).
         """
         request = ResetRequest(id=id)
-        try:
-            reply = self._maybe(request, ReplyResponse, (8, 1, '=='))
-        except Timeout:
-            return False
+        reply = self._maybe(request, ReplyResponse, (8, 1, '=='))
         if reply is None:
             return None
         return True
@@ -294,7 +282,11 @@ class FeetechSmsClient(ClientBase):
         against its register's range and access before a byte is written. `write_raw` takes raw bytes.
         """
         start, data = self._models.pack(id, values)
-        result = self.write_raw(id, start, data)
+        if 'id' in values:  # answered, if at all, from the new id
+            request = WriteRequest(id=id, address=start, data=data)
+            result = self._from_new_address(request, ReplyResponse, values['id'], (8, 1, '=='))
+        else:
+            result = self.write_raw(id, start, data)
         for name, value in values.items():
             self._remember(id, CONTROL_TABLE[name].address, value)
         return result

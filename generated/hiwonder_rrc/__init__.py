@@ -10,7 +10,7 @@ Generated from specs/hiwonder_rrc.yaml: `decode`/`encode` frames with the fast c
 one frozen message class per command and direction in `messages`, construct structs in `structs`.
 """
 
-from serialspec.runtime.transport import SerialSettings
+from serialspec.runtime.settings import SerialSettings
 
 from hiwonder_rrc.codec import StreamParser, decode, encode
 from hiwonder_rrc.messages import *  # noqa: F403

@@ -12,7 +12,7 @@ Generated from specs/modbus_rtu.yaml: `decode`/`encode` frames with the fast cod
 one frozen message class per command and direction in `messages`, construct structs in `structs`.
 """
 
-from serialspec.runtime.transport import SerialSettings
+from serialspec.runtime.settings import SerialSettings
 
 from modbus_rtu.codec import StreamParser, decode, encode
 from modbus_rtu.messages import *  # noqa: F403

@@ -16,7 +16,6 @@ from typing import Any
 
 import serial
 from serialspec.runtime.aio import AsyncBus, AsyncClientBase
-from serialspec.runtime.errors import Timeout
 
 from modbus_rtu.client import BINDING
 from modbus_rtu.messages import (
@@ -167,14 +166,11 @@ class AsyncModbusRtuClient(AsyncClientBase):
             address: Address of the first item (0x0000..0xFFFF; 'item N' is address N-1 in the data model).
             value: FF 00: ON, 00 00: OFF. (0..65280)
 
-        Returns: True if the device answered, False if it stayed silent (timeout).
+        Returns: True once the device has answered; Timeout when it does not.
         None when no reply is due (broadcast gets no reply).
         """
         request = WriteCoilRequest(unit=unit, address=address, value=value)
-        try:
-            reply = await self._maybe(request, WriteCoilResponse, None)
-        except Timeout:
-            return False
+        reply = await self._maybe(request, WriteCoilResponse, None)
         if reply is None:
             return None
         return True
@@ -191,14 +187,11 @@ class AsyncModbusRtuClient(AsyncClientBase):
             address: Address of the first item (0x0000..0xFFFF; 'item N' is address N-1 in the data model).
             value: The value to write.
 
-        Returns: True if the device answered, False if it stayed silent (timeout).
+        Returns: True once the device has answered; Timeout when it does not.
         None when no reply is due (broadcast gets no reply).
         """
         request = WriteRegisterRequest(unit=unit, address=address, value=value)
-        try:
-            reply = await self._maybe(request, WriteRegisterResponse, None)
-        except Timeout:
-            return False
+        reply = await self._maybe(request, WriteRegisterResponse, None)
         if reply is None:
             return None
         return True
@@ -258,14 +251,11 @@ class AsyncModbusRtuClient(AsyncClientBase):
             and_mask: Bits kept from the current value.
             or_mask: Bits set where and_mask is 0.
 
-        Returns: True if the device answered, False if it stayed silent (timeout).
+        Returns: True once the device has answered; Timeout when it does not.
         None when no reply is due (broadcast gets no reply).
         """
         request = MaskWriteRegisterRequest(unit=unit, address=address, and_mask=and_mask, or_mask=or_mask)
-        try:
-            reply = await self._maybe(request, MaskWriteRegisterResponse, None)
-        except Timeout:
-            return False
+        reply = await self._maybe(request, MaskWriteRegisterResponse, None)
         if reply is None:
             return None
         return True

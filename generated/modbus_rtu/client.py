@@ -18,7 +18,6 @@ from __future__ import annotations
 from typing import Any
 
 import serial
-from serialspec.runtime.errors import Timeout
 from serialspec.runtime.transport import Binding, Bus, ClientBase, ErrorReplies
 
 from modbus_rtu import MATCH_BY, SERIAL
@@ -187,14 +186,11 @@ class ModbusRtuClient(ClientBase):
             address: Address of the first item (0x0000..0xFFFF; 'item N' is address N-1 in the data model).
             value: FF 00: ON, 00 00: OFF. (0..65280)
 
-        Returns: True if the device answered, False if it stayed silent (timeout).
+        Returns: True once the device has answered; Timeout when it does not.
         None when no reply is due (broadcast gets no reply).
         """
         request = WriteCoilRequest(unit=unit, address=address, value=value)
-        try:
-            reply = self._maybe(request, WriteCoilResponse, None)
-        except Timeout:
-            return False
+        reply = self._maybe(request, WriteCoilResponse, None)
         if reply is None:
             return None
         return True
@@ -211,14 +207,11 @@ class ModbusRtuClient(ClientBase):
             address: Address of the first item (0x0000..0xFFFF; 'item N' is address N-1 in the data model).
             value: The value to write.
 
-        Returns: True if the device answered, False if it stayed silent (timeout).
+        Returns: True once the device has answered; Timeout when it does not.
         None when no reply is due (broadcast gets no reply).
         """
         request = WriteRegisterRequest(unit=unit, address=address, value=value)
-        try:
-            reply = self._maybe(request, WriteRegisterResponse, None)
-        except Timeout:
-            return False
+        reply = self._maybe(request, WriteRegisterResponse, None)
         if reply is None:
             return None
         return True
@@ -278,14 +271,11 @@ class ModbusRtuClient(ClientBase):
             and_mask: Bits kept from the current value.
             or_mask: Bits set where and_mask is 0.
 
-        Returns: True if the device answered, False if it stayed silent (timeout).
+        Returns: True once the device has answered; Timeout when it does not.
         None when no reply is due (broadcast gets no reply).
         """
         request = MaskWriteRegisterRequest(unit=unit, address=address, and_mask=and_mask, or_mask=or_mask)
-        try:
-            reply = self._maybe(request, MaskWriteRegisterResponse, None)
-        except Timeout:
-            return False
+        reply = self._maybe(request, MaskWriteRegisterResponse, None)
         if reply is None:
             return None
         return True

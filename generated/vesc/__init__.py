@@ -13,7 +13,7 @@ Generated from specs/vesc.yaml: `decode`/`encode` frames with the fast codec, `S
 one frozen message class per command and direction in `messages`, construct structs in `structs`.
 """
 
-from serialspec.runtime.transport import SerialSettings
+from serialspec.runtime.settings import SerialSettings
 
 from vesc.codec import StreamParser, decode, encode
 from vesc.messages import *  # noqa: F403

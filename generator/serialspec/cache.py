@@ -14,7 +14,6 @@ when Python is told not to write bytecode (PYTHONDONTWRITEBYTECODE, -B); what is
 from __future__ import annotations
 
 import contextlib
-import hashlib
 import importlib.util
 import marshal
 import os
@@ -22,6 +21,18 @@ import sys
 from functools import cache
 from pathlib import Path
 from types import CodeType
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from hashlib import sha256 as _sha256
+else:  # CPython's own SHA-256: hashlib's digests, without the OpenSSL library that importing hashlib loads
+    try:
+        from _sha2 import sha256 as _sha256  # Python 3.12+
+    except ImportError:
+        try:
+            from _sha256 import sha256 as _sha256  # Python 3.11
+        except ImportError:
+            from hashlib import sha256 as _sha256
 
 _PACKAGE = Path(__file__).resolve().parent
 _MAGIC = b"serialspec cache 1\n"
@@ -72,7 +83,7 @@ def load(name: str, wanted: bytes) -> bytes | None:
     if data[:start] != _MAGIC or data[start : start + 32] != wanted:
         return None
     payload = data[start + 64 :]
-    if hashlib.sha256(payload).digest() != data[start + 32 : start + 64]:
+    if _sha256(payload).digest() != data[start + 32 : start + 64]:
         return None  # damaged: truncated, or changed by something other than this module
     return payload
 
@@ -84,7 +95,7 @@ def store(name: str, stored: bytes, payload: bytes, *, keep: int = 0) -> None:
     if where is None or sys.dont_write_bytecode:
         return
     target = where / name
-    data = _MAGIC + stored + hashlib.sha256(payload).digest() + payload
+    data = _MAGIC + stored + _sha256(payload).digest() + payload
     temporary = target.with_name(f".{target.name}.{os.getpid()}")
     with contextlib.suppress(OSError):
         target.parent.mkdir(parents=True, exist_ok=True)
@@ -119,7 +130,7 @@ def _prune(where: Path, keep: int) -> None:
 
 def key(*parts: str | bytes) -> bytes:
     """A cache key: the hash of everything an entry depends on."""
-    digest = hashlib.sha256()
+    digest = _sha256()
     for part in parts:
         data = part if isinstance(part, bytes) else part.encode("utf-8", "surrogatepass")
         digest.update(len(data).to_bytes(8, "little"))
@@ -137,7 +148,7 @@ def compiled(source: str, filename: str, entry: str) -> CodeType:
     wanted = key(importlib.util.MAGIC_NUMBER, str(sys.flags.optimize), filename, source)
     # One entry per module and file name (a spec generated under two names does not evict itself); a changed
     # source replaces its entry; the entries written last are kept.
-    where = hashlib.sha256(filename.encode("utf-8", "surrogatepass")).hexdigest()[:12]
+    where = _sha256(filename.encode("utf-8", "surrogatepass")).hexdigest()[:12]
     name = f"code/{entry}.{where}.{sys.implementation.cache_tag}"
     payload = load(name, wanted)
     if payload is not None:
@@ -155,7 +166,7 @@ def compiled(source: str, filename: str, entry: str) -> CodeType:
 def generator() -> bytes:
     """A hash of everything generation depends on besides the spec: serialspec's own code and templates (every file
     of the package, whatever it is installed as), the jinja2 and PyYAML releases, and the Python release."""
-    digest = hashlib.sha256(_MAGIC + sys.version.encode())
+    digest = _sha256(_MAGIC + sys.version.encode())
     for top, folders, names in os.walk(_PACKAGE):
         folders[:] = sorted(f for f in folders if f != "__pycache__")
         for name in sorted(names):
@@ -167,6 +178,34 @@ def generator() -> bytes:
             found = importlib.util.find_spec(library)
             if found is not None and found.origin is not None:
                 digest.update(key(library, _contents(found.origin)))
+    return digest.digest()
+
+
+#: The folders of the package a resolved model depends on (backends/ and cli/ only read models).
+MODEL_PARTS = ("lang", "checksums", "runtime")
+
+
+@cache
+def language() -> bytes:
+    """A stamp of what a resolved spec model depends on besides the spec: the language's modules and those whose
+    objects a model holds (the checksum algorithms, the runtime's Direction), PyYAML's release and Python's. Like a
+    .pyc file's, by each file's size and time of change rather than its contents, so that a command that reads a
+    cached model (`decode`) stays cheap."""
+    digest = _sha256(_MAGIC + sys.version.encode())
+    paths = []
+    for top, folders, names in (step for part in MODEL_PARTS for step in os.walk(_PACKAGE / part)):
+        folders[:] = sorted(f for f in folders if f != "__pycache__")
+        paths += [os.path.join(top, name) for name in sorted(names) if name.endswith(".py")]
+    with contextlib.suppress(ImportError, ValueError):
+        found = importlib.util.find_spec("yaml")
+        if found is not None and found.origin is not None:
+            paths.append(found.origin)
+    for path in paths:
+        try:
+            stat = os.stat(path)
+            digest.update(key(os.path.relpath(path, _PACKAGE), str(stat.st_size), str(stat.st_mtime_ns)))
+        except OSError as exc:
+            digest.update(key(path, f"unreadable: {exc.errno}"))
     return digest.digest()
 
 

@@ -4,13 +4,16 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import sys
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 
 from serialspec import __version__
-from serialspec.lang.errors import SpecErrors
-from serialspec.runtime.errors import SerialspecError
 
+DESCRIPTION = (
+    "serial protocols as YAML specs: generate codecs, typed clients, virtual devices and references from them; "
+    "decode, encode, simulate and watch frames"
+)
 # Each verb (its module, serialspec.cli.<verb>, is imported only to run it: `generate` loads no serial-port code)
 # and its one-line help.
 VERBS = {
@@ -24,22 +27,45 @@ VERBS = {
     "monitor": "print every frame seen on a port (device path or pyserial URL), one line each with a timestamp",
     "docs": "build a documentation site (mkdocs) of specs: each protocol's reference and its spec, searchable",
     "plot": "plot fields over time in their units, one panel each, from a capture or live from a port (PNG, SVG)",
+    "ports": "list the serial ports: device path, description, VID:PID and serial number",
+    "scan": "find the devices on a bus: each id (and baud rate) answering the spec's presence request, with its model",
+    "replay": "send the frames of one direction of a capture to a port, with their timing",
+    "completion": "print the shell completion script for bash, zsh or fish",
 }
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="serialspec", description=__doc__.split(":")[0] if __doc__ else None)
+class _Formatter(argparse.HelpFormatter):
+    """argparse's help layout, sized without importing shutil (and with it lzma and bz2) on every start: the width
+    as shutil.get_terminal_size() gives it (COLUMNS, else the terminal's, else 80), less 2 as argparse does."""
+
+    def __init__(self, prog: str) -> None:
+        try:
+            columns = int(os.environ.get("COLUMNS", "")) or os.get_terminal_size().columns
+        except (ValueError, OSError):
+            columns = 80
+        super().__init__(prog, width=max(columns, 10) - 2)
+
+
+def build_parser(chosen: Iterable[str]) -> tuple[argparse.ArgumentParser, dict[str, argparse.ArgumentParser]]:
+    """The command's parser, with the arguments of the `chosen` verbs only (each verb's module is imported for its
+    arguments), and each verb's own parser."""
+    parser = argparse.ArgumentParser(prog="serialspec", description=DESCRIPTION, formatter_class=_Formatter)
     parser.add_argument("--version", action="version", version=f"serialspec {__version__}")
     verbs = parser.add_subparsers(dest="verb", required=True, metavar="VERB")
-    given = list(sys.argv[1:] if argv is None else argv)
-    chosen = next((word for word in given if not word.startswith("-")), None)  # options before it: --help, --version
     subparsers = {}
     for name, text in VERBS.items():
-        sub = subparsers[name] = verbs.add_parser(name, help=text, description=text)
-        if name == chosen:
+        sub = subparsers[name] = verbs.add_parser(name, help=text, description=text, formatter_class=_Formatter)
+        if name in chosen:
             module = importlib.import_module(f"{__name__}.{name}")
             module.add_arguments(sub)
             sub.set_defaults(run=module.run, verb=name)
+    return parser, subparsers
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    given = list(sys.argv[1:] if argv is None else argv)
+    chosen = next((word for word in given if not word.startswith("-")), None)  # options before it: --help, --version
+    parser, subparsers = build_parser(() if chosen is None else (chosen,))
     args, extra = parser.parse_known_args(argv)
     if extra:
         # Options between a verb's positional arguments (`decode SPEC --direction response HEX`): argparse only
@@ -47,14 +73,20 @@ def main(argv: Sequence[str] | None = None) -> int:
         args = subparsers[args.verb].parse_intermixed_args(given[given.index(args.verb) + 1 :])
     try:
         code: int = args.run(args)
-    except SpecErrors as exc:
-        print(exc, file=sys.stderr)
-        return 1
-    except SerialspecError as exc:
-        print(f"serialspec {args.verb}: {exc}", file=sys.stderr)
-        return 1
     except BrokenPipeError:
         return 0
+    except Exception as exc:  # the two kinds meant for the user are told in one line each; anything else is a bug
+        # (imported here: a command that fails in neither way does not pay for importing them)
+        from serialspec.lang.errors import SpecErrors
+        from serialspec.runtime.errors import SerialspecError
+
+        if isinstance(exc, SpecErrors):
+            print(exc, file=sys.stderr)
+            return 1
+        if isinstance(exc, SerialspecError):
+            print(f"serialspec {args.verb}: {exc}", file=sys.stderr)
+            return 1
+        raise
     return code
 
 

@@ -10,11 +10,18 @@ Each line holds a timestamp (ISO 8601, UTC), the direction (`request`, `response
 is not known) and the raw bytes in hex. A chunk need not hold whole frames: `decode --file` joins each direction's
 bytes again and splits them into frames. Lines starting with `#` are comments; a line of hex alone is a chunk of
 unknown direction, so a file of frames in hex, one per line, is a capture too.
+
+The log of a client opened on pyserial's `spy://PATH?file=LOG` (its hexdump format) reads as a capture too: `TX`
+lines are requests, `RX` lines responses (the client's view), timestamps in seconds from the port's opening; its
+lines about control signals and empty reads are left out.
+
+    000000.002 TX   0000  12 4C 01 01 03 63                                  .L...c
 """
 
 from __future__ import annotations
 
 import datetime
+import re
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from typing import TextIO
@@ -22,6 +29,10 @@ from typing import TextIO
 from serialspec.runtime.hexbytes import parse_hex
 
 DIRECTIONS = ("request", "response", "-")
+# pyserial's spy:// hexdump: a timestamp, a label of 4 (TX, RX, or a control signal's name), then for data the
+# offset and 16 bytes in a column 49 wide (a space after the eighth), then the bytes as ASCII
+SPY = re.compile(r"(?:\x1b\[[0-9;]*m)?(\d+\.\d{3}) (\S+)\s+(?:([0-9A-F]{4})  (.{1,49}))?")
+SPY_DIRECTIONS = {"TX": "request", "RX": "response"}
 
 
 @dataclass(frozen=True)
@@ -57,6 +68,13 @@ def read(lines: Iterable[str]) -> Iterator[tuple[int, Chunk]]:
     for number, line in enumerate(lines, 1):
         text = line.strip()
         if not text or text.startswith("#"):
+            continue
+        spy = SPY.match(line)
+        if spy is not None and (spy[2] not in SPY_DIRECTIONS or spy[3] is None):
+            continue  # a control signal, or an empty read
+        if spy is not None:
+            when, direction, rest = spy[1], SPY_DIRECTIONS[spy[2]], spy[4]
+            yield number, Chunk(when, direction, parse_hex(rest))  # the column holds hex and spaces only
             continue
         words = text.split(maxsplit=2)
         if len(words) == 3 and "T" in words[0] and words[1] in DIRECTIONS:

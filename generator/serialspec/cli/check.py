@@ -7,6 +7,8 @@ import sys
 from pathlib import Path
 
 from serialspec.cli.project import expected_files, orphans, project, strangers
+from serialspec.lang.errors import shown
+from serialspec.runtime.errors import SerialspecError
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -19,8 +21,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     proj = project(args.root, args.specs, args.out)
+    if not proj.specs:
+        raise SerialspecError(
+            f"no specs to check in {proj.display(proj.root) or '.'}: name spec files, or list them in pyproject.toml's "
+            "[tool.serialspec] specs (default: specs/*.yaml)"
+        )
     files, errors = expected_files(proj)
-    problems = [str(error) for error in errors]
+    problems: list[str] = []
     for path, text in files.items():
         if not path.exists():
             problems.append(f"{proj.display(path)}: missing")
@@ -30,11 +37,11 @@ def run(args: argparse.Namespace) -> int:
         problems.append(f"{proj.display(path)}: orphaned (no spec generates it any more)")
     for path in strangers(files):
         problems.append(f"{proj.display(path)}: not generated from any spec (move it out of the generated package)")
-    for problem in problems:
+    for problem in [*shown(errors), *problems]:
         print(problem, file=sys.stderr)
-    if len(problems) > len(errors):  # a file to regenerate, not only mistakes in specs
+    if problems:  # a file to regenerate, not only mistakes in specs
         print("run `serialspec generate` to bring the generated files up to date", file=sys.stderr)
-    if problems:
+    if problems or errors:
         return 1
-    print(f"{len(files)} generated files match the specs")
+    print(f"{len(files)} generated {'file matches' if len(files) == 1 else 'files match'} the specs")
     return 0

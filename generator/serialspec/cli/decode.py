@@ -3,13 +3,10 @@
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from types import ModuleType
-from typing import Any, TextIO
+from typing import TYPE_CHECKING, Any, TextIO
 
-from serialspec.cli import capture
-from serialspec.cli.frames import Frames
 from serialspec.cli.protocols import SPEC_HELP, open_spec
 from serialspec.cli.views import FlagNames, engineering, message_spec, register_view, unit_symbols, with_unit
 from serialspec.lang.model import Protocol, replies_by_request, reply_to
@@ -17,12 +14,17 @@ from serialspec.runtime.errors import DecodeError, SerialspecError
 from serialspec.runtime.hexbytes import parse_hex
 from serialspec.runtime.message import Message
 
+if TYPE_CHECKING:
+    from serialspec.cli.frames import Seen
+
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("spec", help=SPEC_HELP)
     parser.add_argument("hex", nargs="*", help="one frame per argument; - reads frames from stdin, one per line")
     parser.add_argument(
-        "--file", metavar="FILE", help="a capture (monitor --save, sim --tap) or hex lines to replay; - for stdin"
+        "--file",
+        metavar="FILE",
+        help="a capture (monitor --save, sim --tap), a spy:// log or hex lines to replay; - for stdin",
     )
     parser.add_argument("--json", action="store_true", help="one JSON object per frame")
     parser.add_argument(
@@ -53,7 +55,8 @@ def run(args: argparse.Namespace) -> int:
             frame = _hex(text)
             message = package.decode(frame, args.direction, expect)
         except (DecodeError, SerialspecError) as exc:
-            print(f"serialspec decode: {text.strip()}: {exc}", file=sys.stderr)
+            hint = " (--direction request|response)" if str(exc).startswith("give the direction") else ""
+            print(f"serialspec decode: {text.strip()}: {exc}{hint}", file=sys.stderr)
             failed += 1
             continue
         show(describe(protocol, message, frame, args.units, request), args.json)
@@ -61,37 +64,60 @@ def run(args: argparse.Namespace) -> int:
 
 
 def show(result: dict[str, Any], as_json: bool) -> None:
-    print(json.dumps(result, ensure_ascii=False) if as_json else readable(result), flush=True)
+    if as_json:
+        import json
+
+        print(json.dumps(result, ensure_ascii=False), flush=True)
+    else:
+        print(readable(result), flush=True)
 
 
 def replay(args: argparse.Namespace, protocol: Protocol, package: ModuleType) -> int:
-    """Decode a capture: each direction's bytes joined again and split into frames; bad bytes reported."""
+    """Decode a capture: each direction's bytes joined again and split into frames; bad bytes reported. A reply is
+    shown with the last request before it when it answers that request (registers by name, as `--request` does)."""
+    from serialspec.cli import capture
+    from serialspec.cli.frames import Frames
+
     address = protocol.device.address if protocol.device else None
     streams: dict[str | None, Frames] = {}
     failed = 0
+    replies = replies_by_request(protocol.messages())
+    asked: Message | None = None  # the last request seen
     stream = sys.stdin if args.file == "-" else _open(args.file)
     with stream:
         try:
             for number, chunk in capture.read(stream):
                 direction = chunk.direction or args.direction
                 frames = streams.get(direction) or streams.setdefault(direction, Frames(package, direction, address))
-                for seen in frames.feed(chunk.data):
+                for seen in frames.feed(chunk.data, number):
                     if seen.message is None:
                         failed += 1
-                        print(
-                            f"serialspec decode: line {number}: {seen.reason} in [{seen.data.hex(' ')}]",
-                            file=sys.stderr,
-                        )
+                        bad(seen)
                         continue
-                    result = describe(protocol, seen.message, seen.data, args.units, None)
+                    message, request = seen.message, None
+                    if message.DIRECTION.value == "request":
+                        asked = message
+                    elif asked is not None and reply_to(message_spec(protocol, asked), replies) is message_spec(
+                        protocol, message
+                    ):
+                        request = asked
+                    result = describe(protocol, message, seen.data, args.units, request)
                     show({"time": chunk.when, **result} if chunk.when else result, args.json)
         except ValueError as exc:
             raise SerialspecError(f"{args.file}: {exc}") from None
     for frames in streams.values():
+        for seen in frames.finish():
+            failed += 1
+            bad(seen)
         if frames.pending():
             failed += 1
             print(f"serialspec decode: {args.file} ends inside a frame: [{frames.pending().hex(' ')}]", file=sys.stderr)
     return 1 if failed else 0
+
+
+def bad(seen: Seen) -> None:
+    """Bad bytes of a capture, under the line their first byte is on."""
+    print(f"serialspec decode: line {seen.origin}: {seen.reason} in [{seen.data.hex(' ')}]", file=sys.stderr)
 
 
 def _open(path: str) -> TextIO:
@@ -150,5 +176,7 @@ def _value(value: Any) -> str:
     if isinstance(value, FlagNames):
         return str(value)
     if isinstance(value, dict | list):
+        import json
+
         return json.dumps(value, ensure_ascii=False)
     return str(value)

@@ -6,12 +6,12 @@ import argparse
 import json
 from typing import Any
 
-from serialspec.cli.protocols import message_type, open_spec
+from serialspec.cli.protocols import SPEC_HELP, message_type, open_spec
 from serialspec.runtime.errors import EncodeError
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("spec", help="the protocol's spec file")
+    parser.add_argument("spec", help=SPEC_HELP)
     parser.add_argument(
         "--json",
         required=True,

@@ -19,11 +19,27 @@ from serialspec.runtime.stream import FrameFormat
 
 @dataclass(frozen=True)
 class Seen:
-    """What a chunk of bytes held: a frame (message and bytes), or bad bytes (message None) with a reason."""
+    """What a chunk of bytes held: a frame (message and bytes), or bad bytes (message None, the bytes themselves)
+    with a reason; `origin` is what the caller gave with the chunk the (first) bytes came from (a line number)."""
 
     message: Message | None
     data: bytes
     reason: str = ""
+    origin: object = None
+
+
+@dataclass
+class _Run:
+    """Bad bytes in a row: the first one's origin, and how many failed frames they hold."""
+
+    data: bytes
+    origin: object
+    failed: int
+
+    def seen(self) -> Seen:
+        if self.failed:
+            return Seen(None, self.data, f"{self.failed} frame(s) failed their checksum or content check", self.origin)
+        return Seen(None, self.data, f"{len(self.data)} byte(s) outside any frame", self.origin)
 
 
 class Frames:
@@ -38,26 +54,80 @@ class Frames:
             self._paired = _Paired(codec.REQUEST_FORMAT, codec.RESPONSE_FORMAT, address)
             self._paired.reply_layouts = getattr(codec, "REPLY_LAYOUTS", {})
             self._parser = self._paired
-        self._after_error = False
+        # The bytes the parser holds back (a frame's start, or what may be one) with the origins of the chunks they
+        # came from, as (offset, origin); and the bad bytes just before them, not reported yet: held bytes that turn
+        # out bad too are reported with them, once, under the first one's origin.
+        self._held = b""
+        self._origins: list[tuple[int, object]] = []
+        self._run: _Run | None = None
 
-    def feed(self, chunk: bytes) -> list[Seen]:
-        errors, garbage = self._parser.errors, self._parser.garbage
+    def feed(self, chunk: bytes, origin: object = None) -> list[Seen]:
+        """The frames and bad bytes that `chunk` completes, in stream order: each run of bad bytes once, as the
+        bytes themselves, under the origin of the chunk its first byte came from (`de ad`, then a valid frame in
+        the next chunk: 2 bad bytes from the first, none blamed on the second)."""
+        errors = self._parser.errors
+        stream = self._held + chunk
+        origins = [*self._origins, (len(self._held), origin)]
         if self._paired is not None:
-            seen = [Seen(message, data) for message, data in self._paired.feed(chunk)]
+            frames = self._paired.feed(chunk)
         else:
-            seen = [Seen(message, self.package.encode(message)) for message in self._parser.feed(chunk)]
-        if self._parser.errors > errors:
-            self._after_error = True  # the rest of a bad frame is skipped as garbage: not reported twice
-            count = self._parser.errors - errors
-            seen.append(Seen(None, chunk, f"{count} frame(s) failed their checksum or content check"))
-        elif self._parser.garbage > garbage and not self._after_error:
-            seen.append(Seen(None, chunk, f"{self._parser.garbage - garbage} byte(s) outside any frame"))
-        else:
-            self._after_error = False
+            frames = [(message, self.package.encode(message)) for message in self._parser.feed(chunk)]
+        failed = self._parser.errors - errors
+        held = self.pending()
+        end = len(stream) - len(held)  # the bytes held back are the stream's last
+        seen: list[Seen] = []
+        cursor = 0
+        for message, data in frames:
+            position = stream.find(data, cursor, end)
+            if position < 0:  # not there as the codec encodes it (sent another way): its place is not known
+                position = cursor
+            if position > cursor:
+                seen += self._bad(stream[cursor:position], _at(origins, cursor), cursor == 0, failed)
+                failed = 0
+            seen += self.finish()  # a frame ends a run of bad bytes
+            seen.append(Seen(message, data, origin=_at(origins, position)))
+            cursor = max(cursor, position + len(data))
+        if cursor < end or failed:
+            seen += self._bad(stream[cursor:end], _at(origins, cursor), cursor == 0, failed)
+        if not held:  # nothing held back can join the run
+            seen += self.finish()
+        self._held = held
+        self._origins = [(max(0, offset - end), o) for offset, o in origins if _reaches(origins, offset, end, stream)]
         return seen
+
+    def _bad(self, data: bytes, origin: object, follows: bool, failed: int) -> list[Seen]:
+        """Bad bytes, added to the run carried from before where they follow it; a run they do not follow is
+        reported."""
+        if self._run is not None and follows:
+            self._run = _Run(self._run.data + data, self._run.origin, self._run.failed + failed)
+            return []
+        seen = self.finish()
+        self._run = _Run(data, origin, failed)
+        return seen
+
+    def finish(self) -> list[Seen]:
+        """The run of bad bytes not reported yet (at the end of a capture: nothing more can join it)."""
+        run, self._run = self._run, None
+        return [run.seen()] if run is not None else []
 
     def pending(self) -> bytes:
         return self._paired.buffer if self._paired is not None else bytes(self._parser.pending())
+
+
+def _at(origins: list[tuple[int, object]], offset: int) -> object:
+    """The origin of the byte at `offset`: that of the last chunk starting at or before it."""
+    found = origins[0][1]
+    for start, origin in origins:
+        if start > offset:
+            break
+        found = origin
+    return found
+
+
+def _reaches(origins: list[tuple[int, object]], offset: int, end: int, stream: bytes) -> bool:
+    """Whether the chunk starting at `offset` has bytes from `end` on (among those held back)."""
+    following = [start for start, _ in origins if start > offset]
+    return end < len(stream) and (min(following) if following else len(stream)) > end
 
 
 class _Direction:

@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 from serialspec.cli.project import expected_files, orphans, project
+from serialspec.lang.errors import shown
 from serialspec.runtime.errors import SerialspecError
 
 
@@ -21,6 +22,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     proj = project(args.root, args.specs, args.out)
     files, errors = expected_files(proj)
+    if proj.chosen and errors and all(path == proj.schema for path in files):
+        # every spec named has mistakes: nothing is written (not even the schema, into a generated/ of its own)
+        for line in shown(errors):
+            print(line, file=sys.stderr)
+        return 1
     written = 0
     for path, text in files.items():
         try:
@@ -40,7 +46,8 @@ def run(args: argparse.Namespace) -> int:
         shutil.rmtree(folder / "__pycache__", ignore_errors=True)
         if folder.is_dir() and not any(folder.iterdir()):
             folder.rmdir()
-    print(f"{len(files)} files generated in {proj.display(proj.out)}, {written} changed, {len(removed)} removed")
-    for error in errors:
-        print(error, file=sys.stderr)
+    files_generated = f"{len(files)} file{'' if len(files) == 1 else 's'} generated"
+    print(f"{files_generated} in {proj.display(proj.out)}, {written} changed, {len(removed)} removed")
+    for line in shown(errors):
+        print(line, file=sys.stderr)
     return 1 if errors else 0

@@ -135,6 +135,9 @@ def run(args: argparse.Namespace) -> int:
                 if printer.wanted(item):
                     seen += 1
                     printer.line(item)
+    for item in frames.finish():  # bad bytes at the end, that nothing came after
+        if printer.wanted(item):
+            printer.line(item)
     if save is not None:
         save.close()
     print(f"{protocol.name}: {seen} frame(s)", file=sys.stderr)

@@ -28,6 +28,7 @@ from serialspec import cache
 from serialspec.collection import without_cycle_collection
 from serialspec.lang.errors import SpecError, SpecErrors
 from serialspec.lang.frozen import frozen
+from serialspec.lang.limits import read_spec
 
 SCHEMA_NAME = "serialspec.schema.json"
 #: The first line of every generated text file names the spec it came from.
@@ -112,7 +113,7 @@ def expected_files(proj: Project) -> tuple[dict[Path, str], list[SpecError]]:
         except SpecErrors as exc:
             errors.extend(exc.errors)
             continue
-        files.update({proj.out / name: text for name, text in outputs.files.items()})
+        files.update({proj.out / name: _spec_link(proj, spec, name, text) for name, text in outputs.files.items()})
         errors.extend(outputs.errors)
         made.append(outputs)
     if proj.reference is not None and not errors:  # its examples come from every spec: none while one fails
@@ -144,7 +145,7 @@ def spec_outputs(spec: Path, display: str, *, with_data: bool = False) -> Output
     function of those alone, so the cached files, and the verdict of its examples and errata, are what generating it
     again would give. A spec with mistakes is never cached: it is loaded again, to report them."""
     try:
-        raw = spec.read_bytes()  # read once: what is generated is what the key names, whatever happens to the file
+        raw = read_spec(str(spec))  # read once: what is generated is what the key names, whatever happens to it
     except OSError:
         from serialspec.lang.loader import load_file
 
@@ -188,6 +189,16 @@ def _generate(raw: bytes, display: str, key: bytes) -> Outputs:
             errors.extend(emitter.verify(protocol, emitted))
     files[f"{protocol.name}/{SHIPPED_SPEC}"] = shipped_spec(protocol.spec_path, raw)
     return Outputs(files, errors, located.data, key)
+
+
+def _spec_link(proj: Project, spec: Path, name: str, text: str) -> str:
+    """A reference links its spec as `../../SPEC` (DIR/docs/ two folders below the project root, as generated/docs/
+    is): written relative to where it lands instead, wherever `out` and the spec are."""
+    if not (name.startswith("docs/") and name.endswith(".md")):
+        return text
+    written = f"](../../{proj.display(spec)})"
+    relative = os.path.relpath(spec, proj.out / "docs")
+    return text.replace(written, f"]({Path(relative).as_posix()})", 1) if written in text else text
 
 
 def _schema() -> str:

@@ -11,7 +11,7 @@ from types import FrameType
 from typing import Any
 
 from serialspec.cli import capture
-from serialspec.cli.protocols import SPEC_HELP, open_spec
+from serialspec.cli.protocols import SPEC_HELP, open_spec, submodule
 from serialspec.lang.model import FrameElement, Protocol, Scalar
 from serialspec.runtime.errors import SerialspecError
 
@@ -100,7 +100,7 @@ def model_choice(given: list[str] | None) -> str | dict[int, str] | None:
 
 def run(args: argparse.Namespace) -> int:
     protocol, package = open_spec(args.spec)
-    module = getattr(package, "simulator", None)
+    module = submodule(package, "simulator")
     if module is None or protocol.device is None:
         raise SerialspecError(f"{args.spec} has no `device:` section, so no simulator is generated")
     if args.ids and not protocol.device.address:

@@ -3,12 +3,14 @@
 from __future__ import annotations
 
 import re
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from serialspec.lang.model import Bytes, Field, Protocol, Scalar, Table, TableValue
 from serialspec.lang.model import Message as MessageSpec
 from serialspec.runtime.message import Message
-from serialspec.runtime.registers import Register, RegisterMap
+
+if TYPE_CHECKING:
+    from serialspec.runtime.registers import RegisterMap
 
 
 class FlagNames(list[str]):
@@ -117,6 +119,8 @@ def register_view(protocol: Protocol, message: Message, request: Message | None)
 
 def register_map(table: Table, byte_order: str) -> RegisterMap:
     """The runtime's register map of a model table (what generated `registers.py` holds, built from the spec)."""
+    from serialspec.runtime.registers import Register, RegisterMap
+
     registers = (
         Register(e.name, e.key, e.type.struct_char, e.minimum, e.maximum, e.access, e.sign_bit)
         for e in table.entries

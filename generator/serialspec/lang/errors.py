@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 from serialspec.lang.frozen import frozen
 
 
@@ -18,9 +20,23 @@ class SpecError:
         return f"{self.file}:{self.line}:{self.column}: {where}{self.message}"
 
 
+#: How many mistakes str(SpecErrors) shows, in file order; a last line counts the rest.
+MAX_SHOWN = 50
+
+
 class SpecErrors(Exception):
-    """Every mistake found in one spec; str() gives one line per mistake."""
+    """Every mistake found in one spec (`errors`); str() gives one line per mistake, the first MAX_SHOWN of them and
+    then a line counting the others."""
 
     def __init__(self, errors: list[SpecError]) -> None:
         self.errors = sorted(errors, key=lambda e: (e.file, e.line, e.column, e.message))
-        super().__init__("\n".join(str(e) for e in self.errors))
+        super().__init__("\n".join(shown(self.errors)))
+
+
+def shown(errors: Sequence[SpecError]) -> list[str]:
+    """The lines that report mistakes to people: the first MAX_SHOWN, then one counting the others."""
+    lines = [str(e) for e in errors[:MAX_SHOWN]]
+    if len(errors) > MAX_SHOWN:
+        rest = len(errors) - MAX_SHOWN
+        lines.append(f"... and {rest:,} more error{'s' if rest > 1 else ''} ({len(errors):,} in all)")
+    return lines

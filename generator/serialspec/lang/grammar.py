@@ -15,6 +15,7 @@ from typing import Any, assert_never
 from serialspec import checksums
 from serialspec.checksums.base import Key
 from serialspec.lang.frozen import mutable
+from serialspec.lang.limits import MAX_TEXT
 from serialspec.lang.loader import CONTROL, Path
 
 SCALAR_TYPES = ("u8", "i8", "u16", "i16", "u32", "i32", "f32")
@@ -40,6 +41,8 @@ class Str(Shape):
     def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
         if not isinstance(value, str):
             yield path, f"expected text, got {_kind(value)}"
+        elif len(value) > MAX_TEXT:
+            yield path, f"text of {len(value):,} characters (at most {MAX_TEXT:,})"
         elif bad := CONTROL.search(value):
             yield path, f"control character U+{ord(bad.group()):04X} in text (not allowed in a spec)"
         elif self.choices and value not in self.choices:
@@ -469,6 +472,13 @@ COMMAND = Obj(
         "request": MESSAGE,
         "response": MESSAGE,
         "broadcast": TEXT,
+        "probe": Bool(
+            "The command asks whether a device is there (PING): its client method returns True when the device "
+            "answers and False when none does, whatever the reply holds. Every other command with a reply raises "
+            "Timeout when none comes.",
+            default=False,
+            example=True,
+        ),
         "source": SOURCE,
         "selector": Obj(
             {
@@ -953,9 +963,50 @@ MODEL = Obj(
     description="One device model: its model number, factory values and where its table differs.",
 )
 
+PRESENCE = Obj(
+    {
+        "request": Str(
+            "The command (or command.subcommand) a device answers whenever it is there: any reply, an error reply "
+            "too, means a device has that id (FEETECH and DYNAMIXEL PING, a Modbus register read)."
+        ),
+        "fields": MapOf(Num(), "Request field -> its value, besides the id (a read's address and count)."),
+        "ids": ListOf(
+            Int(),
+            "The first and last id `serialspec scan` asks by default (default: the device's id range, without the "
+            "broadcast id).",
+            length=2,
+            example=[1, 247],
+        ),
+        "broadcast": Bool(
+            "Every device answers the request sent to the broadcast id, one after another (DYNAMIXEL broadcast "
+            "PING): one request finds them all; `scan` asks the ids one by one only when none answers it.",
+            default=False,
+        ),
+        "model": Obj(
+            {
+                "request": Str("The command whose reply holds the model (default: the presence request's own)."),
+                "fields": MapOf(Num(), "Request field -> its value, besides the id (the model register's address)."),
+                "field": Str(
+                    "The reply field holding the model: a number (a name from `models` by its `number`), text, or a "
+                    "run of registers holding the device's `model_entry`."
+                ),
+            },
+            required=("field",),
+            description="Where a device's model is read: a reply field, of the presence reply or of another request.",
+        ),
+        "description": TEXT,
+    },
+    required=("request",),
+    description=(
+        "How to find the devices on a bus (`serialspec scan`): the request each one answers, the ids to ask, and "
+        "where its model is."
+    ),
+)
+
 DEVICE = Obj(
     {
         "description": TEXT,
+        "presence": PRESENCE,
         "models": MapOf(
             MODEL,
             "Device models sharing the protocol and table (FEETECH STS3215, SM8512BL; DYNAMIXEL XM430, XL330): "
@@ -1090,6 +1141,12 @@ SPEC = Obj(
         "serial": Obj(
             {
                 "baudrate": Int("Bits per second.", minimum=1),
+                "baudrates": ListOf(
+                    Int(minimum=1),
+                    "Every rate a device can be set to, the default first (`serialspec scan --all-baudrates` tries "
+                    "each).",
+                    example=[1000000, 500000, 115200],
+                ),
                 "bytesize": Int("Data bits per character.", default=8, minimum=5, maximum=8),
                 "parity": Str("Parity bit.", choices=("none", "even", "odd"), default="none"),
                 "stopbits": Num("Stop bits.", default=1, choices=(1, 1.5, 2)),

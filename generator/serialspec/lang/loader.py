@@ -18,6 +18,7 @@ import yaml
 from serialspec.collection import without_cycle_collection
 from serialspec.lang.errors import SpecError, SpecErrors
 from serialspec.lang.frozen import mutable
+from serialspec.lang.limits import MAX_SPEC_BYTES, read_spec
 
 Path = tuple[str | int, ...]
 
@@ -77,8 +78,7 @@ CONTROL = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\x7f-\x9f]")
 def load_file(path: str, display_name: str | None = None) -> Located:
     file = display_name or path
     try:
-        with open(path, "rb") as stream:
-            raw = stream.read()
+        raw = read_spec(path)
     except IsADirectoryError:
         raise SpecErrors([SpecError(file, 1, 1, "", "is a folder, not a spec file")]) from None
     except OSError as exc:
@@ -87,7 +87,11 @@ def load_file(path: str, display_name: str | None = None) -> Located:
 
 
 def decode_text(raw: bytes, file: str) -> str:
-    """A spec file's bytes as text: UTF-8 (a byte order mark is allowed), and no NUL bytes (binary files)."""
+    """A spec file's bytes as text: within the size limit, UTF-8 (a byte order mark is allowed), and no NUL bytes
+    (binary files)."""
+    if len(raw) > MAX_SPEC_BYTES:
+        message = f"the file is larger than {MAX_SPEC_BYTES:,} bytes, the most a spec may have"
+        raise SpecErrors([SpecError(file, 1, 1, "", message)])
     if b"\x00" in raw:
         line, column = _line_column(raw, raw.index(b"\x00"))
         raise SpecErrors([SpecError(file, line, column, "", "a binary file (NUL bytes), not YAML text")])
@@ -268,7 +272,16 @@ class _Converter:
                 else:
                     key = _scalar(key_node) if isinstance(key_node, yaml.ScalarNode) else None
                     if not isinstance(key, str | int) or isinstance(key, bool):
-                        self.fail(key_node, path, "keys must be names or numbers")
+                        if isinstance(key_node, yaml.ScalarNode) and isinstance(
+                            key, bool | None
+                        ):  # YAML 1.1 reads on/off/yes/no/null as true/false/nothing
+                            shown = "nothing" if key is None else str(key).lower()
+                            message = (
+                                f"the key {key_node.value} reads as {shown} in YAML: quote it ('{key_node.value}')"
+                            )
+                        else:
+                            message = "keys must be names or numbers"
+                        self.fail(key_node, path, message)
                         continue
                 inner = (*path, key)
                 if key in result:

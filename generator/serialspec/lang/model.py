@@ -346,6 +346,7 @@ class Command:
     selector: Selector | None
     subcommands: tuple[Subcommand, ...]
     group_class: str = ""  # the client's class grouping the sub-commands' methods ("" without sub-commands)
+    probe: bool = False  # asks whether a device is there: clients return True/False, never raise Timeout
 
     def messages(self) -> tuple[Message, ...]:
         found = [m for m in (self.request, self.response) if m]
@@ -476,6 +477,7 @@ class Serial:
     parity: str
     stopbits: float
     notes: str
+    baudrates: tuple[int, ...] = ()  # every rate a device can be set to, the default first ((): the default alone)
 
 
 @frozen
@@ -668,6 +670,22 @@ class DeviceModel:
 
 
 @frozen
+class Presence:
+    """How to find the devices on a bus (`serialspec scan`): a request every device answers, and its model."""
+
+    request: str  # the command key (command or command.subcommand) of the request
+    fields: dict[str, float]  # request field -> value, besides the id
+    id_field: str  # the request field holding the id ("": one device per port, no id)
+    ids: tuple[int, int] | None  # first and last id asked by default (None: no id)
+    broadcast: bool  # every device answers the request sent to the broadcast id
+    model_request: str = ""  # the command whose reply holds the model ("": no model)
+    model_fields: dict[str, float] = field(default_factory=dict)
+    model_field: str = ""  # the reply field holding it
+    model_register: TableEntry | None = None  # when that field is a run of registers: the entry holding the model
+    description: str = ""
+
+
+@frozen
 class Device:
     """How a device behaves, for the simulator (and the address/broadcast rule, for the client)."""
 
@@ -690,6 +708,7 @@ class Device:
     models: tuple[DeviceModel, ...] = ()  # the first is the default model
     moving: dict[str, tuple[str, int | None]] = field(default_factory=dict)  # entry -> (state variable, bit)
     model_entry: str = ""  # the memory entry holding the model number
+    presence: Presence | None = None  # how `serialspec scan` finds devices
 
     def behaviour(self, key: str) -> Behaviour | None:
         return next((b for b in self.behaviours if b.command == key), None)

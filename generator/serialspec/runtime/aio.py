@@ -96,6 +96,9 @@ class AsyncBus:
     def matches(self, request: Message, reply: Message) -> bool:
         return self.sync.matches(request, reply)
 
+    def _device(self, request: Message) -> str:
+        return self.sync._device(request)
+
     # --- transactions ---------------------------------------------------------------------------------------------
 
     async def send(self, request: Message) -> None:
@@ -253,6 +256,19 @@ class AsyncClientBase(ClientState):
             await self.bus.send(request)  # which checks every value before a byte is written
             return None
         return await self._ask(request, expect, after)
+
+    async def _from_new_address(
+        self, request: Message, expect: type[Message], address: int, optional: tuple[int, int, str] | None
+    ) -> bool | None:
+        """A write of the device's own id, whose reply comes (if it is due) from the new id: True once it has."""
+        if self._is_broadcast(request) or (optional is not None and not await self._answers(request, optional)):
+            await self.bus.send(request)
+            return None
+        try:
+            await self.bus.request_each(request, expect, [{self.ADDRESS: address}])
+        except Timeout as exc:
+            raise self._new_address_timeout(request, address, exc) from None
+        return True
 
     async def _answers(self, request: Message, optional: tuple[int, int, str]) -> bool:
         return await drive(self._answering(request, optional), self._read_parameter)

@@ -28,6 +28,7 @@ import serial
 
 from serialspec.runtime.errors import CorruptReply, DeviceError, EncodeError, PortError, Timeout
 from serialspec.runtime.message import Direction, Message, Record
+from serialspec.runtime.settings import SerialSettings as SerialSettings  # packages generated before import it here
 from serialspec.runtime.stream import StreamParser
 
 M = TypeVar("M", bound=Message)
@@ -70,17 +71,6 @@ except ImportError:  # Windows
 _POSIX_SERIAL: type | None = getattr(getattr(serial, "serialposix", None), "Serial", None)
 _OPEN_FAILURES: tuple[type[Exception], ...] = (*_PORT_FAILURES, ValueError)  # ValueError: a bad setting
 _RESET_FAILURES: tuple[type[Exception], ...] = (*_PORT_FAILURES, NotImplementedError)  # URLs without a buffer
-
-
-@dataclass(frozen=True)
-class SerialSettings:
-    """The spec's `serial:` section: defaults for opening a port."""
-
-    baudrate: int
-    bytesize: int = 8
-    parity: str = "none"
-    stopbits: float = 1
-    gap: float = 0.0  # silence the protocol needs between frames, in character times (Modbus RTU: 3.5)
 
 
 @dataclass(frozen=True)
@@ -468,7 +458,9 @@ class Bus:
             encoder = self._encoders.get(request.__class__)
             try:
                 frame = encoder(request)  # type: ignore[misc]  # None: encode says why
-            except Exception:  # encode raises it again, as one line naming the field (EncodeError, RangeError)
+            except Exception:  # encode raises it again, as one line naming the field (EncodeError, RangeError),
+                frame = None  # outside this handler: one error, not two chained
+            if frame is None:
                 frame = self.binding.encode(request)
         wait = self.timeout if timeout is None else timeout
         lock = self._lock
@@ -550,7 +542,7 @@ class Bus:
                 self._backlog.extend(messages)  # _read_until takes them first
             if expects:
                 self._parser.expect(expect)
-            reply = self._read_until(wait - (time.monotonic() - started), request, expect, errors=0)
+            reply = self._read_until(wait - (time.monotonic() - started), request, expect, errors=0, timeout=wait)
             if self._backlog:
                 self._flush_backlog()
         finally:
@@ -776,9 +768,10 @@ class Bus:
         key: dict[str, Any] | None = None,
         keep: bool = False,
         errors: int | None = None,
+        timeout: float | None = None,
     ) -> M:
         """Read until the wanted frame has come: `_reading`'s steps, driven by blocking reads."""
-        return drive(self._reading(wait, request, expect, key, keep, errors), self._read_chunk)
+        return drive(self._reading(wait, request, expect, key, keep, errors, timeout), self._read_chunk)
 
     def _reading(
         self,
@@ -788,11 +781,13 @@ class Bus:
         key: dict[str, Any] | None = None,
         keep: bool = False,
         errors: int | None = None,
+        timeout: float | None = None,
     ) -> Generator[float, bytes, M]:
         """Read until the wanted frame (see _wanted) has come, for up to `wait` seconds. Frames that came after it
         in the same read stay in the backlog (the next reply of a request_each); every other frame goes to
         subscribers, and to them too the wanted one when `keep`. Frames that fail their checks after the parser
-        counted `errors` (by default: from now on) make it a CorruptReply."""
+        counted `errors` (by default: from now on) make it a CorruptReply. A Timeout names `timeout`, the whole
+        transaction's (by default `wait`: what is left of it when part was spent before, maybe less than nothing)."""
         backlog = self._backlog
         while backlog:  # frames that came with the previous reply of this transaction
             message = backlog.popleft()
@@ -830,13 +825,15 @@ class Bus:
             if now >= deadline:
                 pending = parser.pending()
                 self._reset()
+                if timeout is None:
+                    timeout = wait
                 if request is None:
-                    raise Timeout("", "", wait)
+                    raise Timeout("", "", timeout)
                 if pending:
                     raise CorruptReply(
                         f"incomplete reply to {request.COMMAND} from {self._device(request)}: {pending.hex(' ')}"
                     )
-                raise Timeout(request.COMMAND, self._device(request), wait)
+                raise Timeout(request.COMMAND, self._device(request), timeout)
             chunk = yield deadline - now
             if chunk and self._gap:
                 self._last_io = monotonic()
@@ -944,6 +941,7 @@ class ClientState:
         # (address, optional condition) -> whether those replies are due, from the parameters as last read or
         # written (emptied whenever they change): what a read sent again asks, without a call
         self._due: dict[tuple[Any, ...], bool] = {}
+        self._read_was_optional = False  # the parameter read under way asked whether its own reply is due
 
     def close(self) -> None:
         self.bus.close()
@@ -971,14 +969,18 @@ class ClientState:
             # optional reply: DYNAMIXEL READ at status_return_level 0); no answer means no optional replies.
             self._due.clear()
             self._parameters[(address, key)] = None
+            self._read_was_optional = False
             try:
                 current = self._parameters[(address, key)] = yield address, key
-            except Timeout:
+            except Timeout as exc:
                 del self._parameters[(address, key)]
-                return False
+                if not self._read_was_optional:  # a read that is always answered was not: no device is there
+                    raise Timeout(request.COMMAND, self.bus._device(request), exc.timeout) from None
+                return False  # silence may be the parameter's doing (DYNAMIXEL status_return_level 0)
             finally:
                 self._due.clear()
         if current is None:
+            self._read_was_optional = True
             return True
         due = self._due[(address, optional)] = _COMPARE[op](current, value)
         return due
@@ -1007,6 +1009,10 @@ class ClientState:
         code, reply = carried[kind]
         request = build(code, [self.bus.binding.encode(r)[content] for r in requests])
         return request, reply, [{self.ADDRESS: getattr(r, self.ADDRESS)} for r in requests]
+
+    def _new_address_timeout(self, request: Message, address: int, exc: Timeout) -> Timeout:
+        """The Timeout of a write of the id, naming the device written to and the id it was to answer from."""
+        return Timeout(request.COMMAND, f"{self.bus._device(request)} (as {self.ADDRESS}={address})", exc.timeout)
 
     def _remember(self, address: int, key: int, value: float) -> None:
         self._due.clear()
@@ -1045,6 +1051,19 @@ class ClientBase(ClientState):
         if after:
             return self._ask(request, expect, after)
         return self.bus.request(request, expect)
+
+    def _from_new_address(
+        self, request: Message, expect: type[Message], address: int, optional: tuple[int, int, str] | None
+    ) -> bool | None:
+        """A write of the device's own id, whose reply comes (if it is due) from the new id: True once it has."""
+        if self._is_broadcast(request) or (optional is not None and not self._answers(request, optional)):
+            self.bus.send(request)
+            return None
+        try:
+            self.bus.request_each(request, expect, [{self.ADDRESS: address}])
+        except Timeout as exc:
+            raise self._new_address_timeout(request, address, exc) from None
+        return True
 
     def _answers(self, request: Message, optional: tuple[int, int, str]) -> bool:
         return drive(self._answering(request, optional), self._read_parameter)

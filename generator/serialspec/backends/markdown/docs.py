@@ -1,11 +1,14 @@
 """Emit the markdown reference of one protocol: frames, checksum, commands, tables, examples, errata.
 
 Every piece of spec text goes through `cell()` or `text()`, so a `|`, `<` or newline in a description can
-neither break a table nor inject HTML into the rendered page.
+neither break a table nor inject HTML into the rendered page, a `{` cannot add attributes (`{: onclick=...}` under
+the site's attr_list extension), and a link may only lead to http, https or mailto (`[x](javascript:...)` shows as
+text).
 """
 
 from __future__ import annotations
 
+import re
 from collections import Counter
 from typing import Any
 
@@ -37,10 +40,26 @@ from serialspec.lang.model import (
 )
 from serialspec.runtime.errors import SerialspecError
 
+# A `]` that closes a link's text, with the destination after it: `[x](dest` (and `[x]: dest`, see DEFINITION)
+LINK_END = re.compile(r"\](?=\s*[(:]\s*(?:&lt;)?\s*([^\s)]*))")
+# A reference definition, `[x]: dest` at the start of a line (the text's): it would vanish from the page and turn
+# `[y][x]` anywhere on it into a link, so it shows as text
+DEFINITION = re.compile(r"\[[^\]]*\]:")
+SCHEME = re.compile(r"([A-Za-z][A-Za-z0-9+.-]*):")
+SAFE_SCHEMES = frozenset({"http", "https", "mailto"})
+
+
+def _link_end(match: re.Match[str]) -> str:
+    scheme = SCHEME.match(match[1].replace("\\", ""))
+    return "\\]" if scheme and scheme[1].lower() not in SAFE_SCHEMES else "]"
+
 
 def text(value: str) -> str:
-    """Spec text for a markdown paragraph: one line, HTML-significant characters escaped."""
-    return collapse(value).replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
+    """Spec text for a markdown paragraph: one line, HTML-significant characters escaped, attribute lists and links
+    to other schemes than http, https and mailto (javascript:, data:, vbscript:, ...) shown as text."""
+    escaped = collapse(value).replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;").replace("{", "\\{")
+    escaped = LINK_END.sub(_link_end, escaped)
+    return "\\" + escaped if DEFINITION.match(escaped) else escaped
 
 
 def cell(value: object) -> str:
@@ -139,7 +158,7 @@ def message_context(protocol: Protocol, message: Message | None) -> dict[str, An
     content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
     size = size_text(message.min_size, message.max_size, content_limit(layout))
     rows = [
-        Row(str(layout.offsets[e.name]), e.name, e.type.name if e.type else "", "", "", text(e.description))
+        Row(str(layout.offsets[e.name]), e.name, e.type.name if e.type else "", "", "", e.description)
         for e in layout.value_elements
     ]
     rows += field_rows(message.fields, content_offset)
@@ -256,6 +275,7 @@ def command_context(protocol: Protocol, command: Command) -> dict[str, Any]:
         "title_cn": text(command.title_cn),
         "description": text(command.description),
         "broadcast": text(command.broadcast),
+        "probe": command.probe,
         "source": text(command.source),
         "anchor": anchor("command", command.name),
         "messages": same_once(
@@ -308,9 +328,9 @@ def frame_context(protocol: Protocol, layout: FrameLayout) -> dict[str, Any]:
         size = e.size
         variable = variable or e.name == first_variable
         if e.role == "header" and layout.classic:
-            description = f"{layout.header.hex(' ').upper()} — {e.description}"
+            description = " — ".join(p for p in (layout.header.hex(" ").upper(), e.description) if p)
         elif e.fixed:
-            description = f"{e.constant.hex(' ').upper()} — {e.description}"
+            description = " — ".join(p for p in (e.constant.hex(" ").upper(), e.description) if p)
         elif e.role == "checksum" and not layout.classic and e.checksum is not None:
             endian = "big-endian" if e.endian == ">" else "little-endian"
             description = f"over `{e.checksum.first}`..`{e.checksum.last}`, {endian}. {e.description}"
@@ -613,12 +633,14 @@ def emit_docs(protocol: Protocol) -> str:
         sources=[(k, text(v)) for k, v in protocol.sources.items()],
         serial=[
             ("baud rate", serial.baudrate),
+            *([("baud rates a device can be set to", ", ".join(map(str, serial.baudrates)))] * bool(serial.baudrates)),
             ("data bits", serial.bytesize),
             ("parity", serial.parity),
             ("stop bits", number(serial.stopbits)),
             ("byte order", protocol.byte_order + "-endian"),
         ],
         serial_notes=text(serial.notes),
+        presence=presence_text(protocol),
         framing=text(protocol.framing.description),
         frames=same_once(
             [frame_context(protocol, lay) for lays in protocol.framing.alternatives.values() for lay in lays]
@@ -632,12 +654,52 @@ def emit_docs(protocol: Protocol) -> str:
         matching=", ".join(protocol.matching),
         matching_description=text(protocol.matching_description),
         commands=commands,
+        # the index's column of the titles as the (Chinese) documents print them, where a command has one
+        titles_cn=any(c["title_cn"] or any(s["title_cn"] for s in c["subcommands"]) for c in commands),
         tables=tables,
         enums=enums,
         flags=flags,
         examples=examples,
         errata=errata,
     )
+
+
+def presence_text(protocol: Protocol) -> str:
+    """The device's `presence:` in words: what `serialspec scan` asks, which ids, and where the model is."""
+    presence = protocol.device.presence if protocol.device else None
+    if presence is None:
+        return ""
+
+    def request(key: str, values: dict[str, float]) -> str:
+        given = ", ".join(f"{name} = {number(value)}" for name, value in values.items())
+        return f"`{key}`" + (f" ({given})" if given else "")
+
+    if presence.ids is not None:
+        first, last = presence.ids
+        asked = f"sends {request(presence.request, presence.fields)} to each id {first}..{last}"
+        if presence.broadcast:
+            asked = (
+                f"sends {request(presence.request, presence.fields)} to the broadcast id once, which every device "
+                f"answers in turn (and {asked.removeprefix('sends ')} when none does)"
+            )
+    else:
+        asked = f"sends {request(presence.request, presence.fields)} (one device per port: no id)"
+    words = [f"`serialspec scan {protocol.spec_path} --port PORT` {asked}; any reply, an error reply too, is a device."]
+    if presence.model_field:
+        where = f"`{presence.model_field}`"
+        if presence.model_register is not None:
+            where = f"register `{presence.model_register.name}` in {where}"
+        source = (
+            "its reply"
+            if presence.model_request == presence.request and not presence.model_fields
+            else (f"the reply to {request(presence.model_request, presence.model_fields)}")
+        )
+        words.append(f"The model is {where} of {source}.")
+    if protocol.serial.baudrates:
+        words.append("`--all-baudrates` tries every rate above.")
+    if presence.description:
+        words.append(text(presence.description))
+    return " ".join(words)
 
 
 def model_context(device: Device, model: DeviceModel) -> dict[str, Any]:

@@ -20,7 +20,7 @@ from serialspec.lang.model import Protocol
 
 # What moves bytes, called on the bus or on the client base (`self.` or, in a group class, `self._client.`).
 BUS_IO = frozenset({"request", "request_each", "send", "receive"})
-CLIENT_IO = frozenset({"_maybe", "_ask", "_carry", "_answers", "_read_key"})
+CLIENT_IO = frozenset({"_maybe", "_ask", "_carry", "_answers", "_read_key", "_from_new_address"})
 RENAMED = {"Bus": "AsyncBus", "ClientBase": "AsyncClientBase", "Iterator": "AsyncIterator"}
 LINE = 120  # ruff's line length: a longer import is wrapped as ruff's isort wraps it
 

@@ -3,7 +3,8 @@
 Decisions made here, the same for every protocol:
 - arguments and results are wire units, like the messages (the spec's `unit`/`scale` are in the docstrings);
 - a method returns the reply's one field that is not an echo of the request, the whole reply when there are
-  several, and True/False (answered or not) when there are none;
+  several, and True when there are none; a reply that does not come raises Timeout, except for a command the spec
+  marks `probe` (PING), whose method returns True/False (answered or not) whatever the reply holds;
 - a reply that can be absent (broadcast address, `optional_when`) makes the method return None then;
 - a table that one command reads by key and another writes by key gets read_<entry>/write_<entry> by name:
   `read_parameter(id, "voltage")`;
@@ -236,6 +237,7 @@ def register_commands(protocol: Protocol, methods: list[dict[str, Any]]) -> list
             "address": address,
             "broadcast": broadcast,
             "title": method["doc"][0].rstrip("."),
+            "id_entry": "",
         }
         run = next(
             (f for f in request.fields if isinstance(f, Bytes) and f.table and f.start and f.size == "rest"), None
@@ -249,6 +251,16 @@ def register_commands(protocol: Protocol, methods: list[dict[str, Any]]) -> list
         fields = [f.name for f in value_fields(protocol, request)]
         if run is not None and run.table is not None and fields == [address, run.start, run.name]:
             context.update(kind="write", map=map_name(run.table), alias=names_alias(run.table))
+            # a write of the device's own id is answered (if at all) from the new id: matched by it (not a buffered
+            # write: the id changes later, on the command that commits it)
+            device = protocol.device
+            behaviour = device.behaviour(request.key) if device is not None else None
+            id_entry = device.id_entry if device is not None and not (behaviour and behaviour.buffered) else ""
+            if method["kind"] == "ack" and any(e.name == id_entry for e in run.table.entries):
+                optional = method["optional"] if method["silent"] else "None"
+                build = f"{address}={address}, {run.start}=start, {run.name}=data"
+                context.update(id_entry=id_entry, request=method["request"], response=method["response"])
+                context.update(build=build, optional=optional)
         elif read is not None and read.table is not None and group is None and len(fields) == 3:
             start, size = read.start, read.size_from
             if fields != [address, start, size]:
@@ -444,8 +456,10 @@ def client_module(protocol: Protocol) -> str:
             imports.add(response.class_name)
             echoes = {f.name for f in fields} | {f.name for f in statuses} | unused_fields(protocol, request, response)
             rest = [f for f in value_fields(protocol, response) if f.name not in echoes]
-            if not rest:
+            if command.probe and not sub:
                 kind, returns = ("bool", "bool")
+            elif not rest:
+                kind, returns = ("ack", "bool")
             elif len(rest) == 1 and isinstance(rest[0], List):
                 # a list comes back as a list; padding items (bits to a whole byte) are cut to the number asked
                 only = rest[0]
@@ -462,6 +476,8 @@ def client_module(protocol: Protocol) -> str:
             doc.append("")
             if kind == "bool":
                 doc.append("Returns: True if the device answered, False if it stayed silent (timeout).")
+            elif kind == "ack":
+                doc.append("Returns: True once the device has answered; Timeout when it does not.")
             elif kind == "value":
                 doc.append(f"Returns: {rest[0].name}: {describe(rest[0])}")
             else:

@@ -803,7 +803,9 @@ def frame_decode_lines(
         lines = [lines[0], f"expected = {total}"]
     lines += [
         f"if expected != {stored}:",
-        f'    raise ChecksumError(f"bad checksum: the frame has {{{stored}:#04x}}, its bytes give {{expected:#04x}}")',
+        # as wide as the checksum: a u16 that reads 0 is 0x0000
+        f'    raise ChecksumError(f"bad checksum: the frame has {{{stored}:#0{2 + 2 * size}x}}, '
+        f'its bytes give {{expected:#0{2 + 2 * size}x}}")',
     ]
     if layout.command_offset is None:  # the one codeless command of this direction, if any
         if not dispatch:

@@ -112,9 +112,17 @@ class Commands(FieldResolver):
         if framing is None:
             return  # the frame's elements are unknown: its problems are reported
         names |= self.ctx.broken
+        roles = {e.name: e.role for layout in framing.layouts.values() for e in layout.elements}
         for index, name in enumerate(self.ctx.matching):
-            if name not in names:
-                self.error(("matching", "by", index), f"unknown field {name!r} (no frame element or field has it)")
+            if name in names:
+                continue
+            if roles.get(name) == "command":
+                message = f"{name!r} is the command element: a reply's command is matched as `command`"
+            elif name in roles:
+                message = f"{name!r} is the frame's {roles[name]}, not a value a reply repeats from its request"
+            else:
+                message = f"unknown field {name!r} (no frame element or field has it)"
+            self.error(("matching", "by", index), message)
 
     def command(self, name: str, value: dict[str, Any], path: Path) -> Command:
         self.name(name, path, "command name")
@@ -182,6 +190,11 @@ class Commands(FieldResolver):
             for d in Direction
             if d.value in value and "subcommands" not in value
         }
+        probe = bool(value.get("probe", False))
+        if probe and ("subcommands" in value or "request" not in value):
+            self.error((*path, "probe"), "a probe is a command with a request (and a reply), not sub-commands")
+        elif probe and "response" not in value and "answered_by" not in (value["request"] or {}):
+            self.error((*path, "probe"), "a probe needs a reply: a `response`, or `answered_by` on its request")
         return Command(
             name=name,
             code=value.get("code"),
@@ -195,6 +208,7 @@ class Commands(FieldResolver):
             selector=selector,
             subcommands=tuple(subcommands),
             group_class=self.class_name(camel(name, "commands"), path) if subcommands else "",
+            probe=probe,
         )
 
     def check_answered_by(self, commands: list[Command]) -> None:

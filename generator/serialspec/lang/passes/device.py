@@ -11,6 +11,7 @@ from serialspec.lang.loader import Path
 from serialspec.lang.model import (
     SCALARS,
     Behaviour,
+    Bytes,
     Command,
     Device,
     DeviceErrors,
@@ -24,9 +25,11 @@ from serialspec.lang.model import (
     Message,
     ModelEntry,
     Motion,
+    Presence,
     Scalar,
     Space,
     SpaceAccess,
+    Table,
     TableEntry,
     replies_by_request,
     reply_to,
@@ -233,7 +236,115 @@ class DevicePass(Pass):
             models=self.models(value, path, entries, state),
             moving=self.moving(value, path, entries, state),
             model_entry=str(value.get("model_entry", "")),
+            presence=self.presence(
+                value.get("presence"),
+                (*path, "presence"),
+                (address, broadcast, self.id_bounds(value, address, framing, commands)),
+                requests,
+                replies,
+                memory,
+                str(value.get("model_entry", "")),
+            ),
         )
+
+    def id_bounds(
+        self, value: dict[str, Any], address: str, framing: Framing, commands: list[Command]
+    ) -> tuple[int, int]:
+        """The ids a device may have: its address element's or field's range (else 0..255)."""
+        elements = (e for layout in framing.layouts.values() for e in layout.value_elements if e.name == address)
+        fields = (f for c in commands for m in c.messages() for f in m.fields if f.name == address)
+        found = next(elements, None) or next(fields, None)
+        low, high = getattr(found, "minimum", None), getattr(found, "maximum", None)
+        return (0 if low is None else int(low), 255 if high is None else int(high))
+
+    def presence(
+        self,
+        value: Any,
+        path: Path,
+        address: tuple[str, int | None, tuple[int, int]],
+        requests: dict[str, Message],
+        replies: dict[str, Message],
+        memory: Table | None,
+        model_entry: str,
+    ) -> Presence | None:
+        """`presence:`: the request every device answers (its id in the device's address), and where the model is."""
+        if value is None:
+            return None
+        address_name, broadcast, (low, high) = address
+        key = str(value["request"])
+        request = requests.get(key)
+        if request is None:
+            if key not in self.ctx.broken:
+                self.error((*path, "request"), f"unknown command {key!r} (or it has no request)")
+            return None
+        carries = self.carried_by(request)
+        id_field = address_name if address_name in carries else ""
+        fields = self.preset(value.get("fields"), (*path, "fields"), key, carries, id_field)
+        ids: tuple[int, int] | None = None
+        if id_field:
+            first, last = value.get("ids") or (low, high if broadcast != high else high - 1)
+            for index, number in enumerate((first, last)):
+                if not low <= number <= high:
+                    self.error((*path, "ids", index), f"id {number} is outside the id range {low}..{high}")
+            if first > last:
+                self.error((*path, "ids"), f"the first id {first} is above the last {last}")
+            ids = (int(first), int(last))
+        elif "ids" in value:
+            self.error((*path, "ids"), f"{key} carries no device id ({address_name or 'the device has no address'})")
+        if value.get("broadcast") and (broadcast is None or not id_field):
+            self.error((*path, "broadcast"), "the device has no broadcast id (device.broadcast)")
+        model = value.get("model") or {}
+        model_key = str(model.get("request", key)) if model else ""
+        model_request = requests.get(model_key) if model else None
+        model_fields: dict[str, float] = {}
+        register = None
+        if model and model_request is None:
+            self.error((*path, "model", "request"), f"unknown command {model_key!r} (or it has no request)")
+        elif model_request is not None:
+            reply = reply_to(model_request, replies)
+            model_fields = self.preset(
+                model.get("fields"), (*path, "model", "fields"), model_key, self.carried_by(model_request), id_field
+            )
+            name = str(model["field"])
+            found = next((f for f in reply.fields if f.name == name), None) if reply else None
+            if found is None:
+                self.error((*path, "model", "field"), f"the reply to {model_key} has no field {name!r}")
+            elif isinstance(found, Bytes) and found.table is not None:
+                register = next((e for e in found.table.entries if e.name == model_entry), None)
+                if register is None:
+                    self.error(
+                        (*path, "model", "field"),
+                        f"{name!r} holds registers of {found.table.name}: device.model_entry must name one of them",
+                    )
+        return Presence(
+            request=key,
+            fields=fields,
+            id_field=id_field,
+            ids=ids,
+            broadcast=bool(value.get("broadcast", False)),
+            model_request=model_key,
+            model_fields=model_fields,
+            model_field=str(model.get("field", "")),
+            model_register=register,
+            description=str(value.get("description", "")),
+        )
+
+    def carried_by(self, request: Message) -> set[str]:
+        """The values a request carries: its content fields and the frame's address elements."""
+        framing = self.ctx.framing
+        layouts = framing.layouts.values() if framing is not None else ()
+        elements = {e.name for layout in layouts for e in layout.value_elements if e.role == "address"}
+        return {f.name for f in request.fields} | elements
+
+    def preset(self, value: Any, path: Path, key: str, carried: set[str], id_field: str) -> dict[str, float]:
+        found = {}
+        for name, number in (value or {}).items():
+            if name == id_field:
+                self.error((*path, name), f"{name!r} is the device id: `scan` sets it")
+            elif name not in carried:
+                self.error((*path, name), f"{key} has no request field {name!r}")
+            found[str(name)] = float(number)
+        return found
 
     def check_ids(self, value: dict[str, Any], path: Path, commands: list[Command], framing: Framing) -> None:
         """`address` (and each kind's) names an integer the requests carry; `reply`, `refused`, `status` name what

@@ -30,10 +30,17 @@ class Settings(Pass):
         return self.problems
 
     def serial(self, serial: dict[str, object]) -> Serial:
+        rates = serial.get("baudrates")
+        if isinstance(rates, list) and rates:
+            if len(set(rates)) != len(rates):
+                self.error(("serial", "baudrates"), "a rate is listed twice")
+            if serial.get("baudrate") not in rates:
+                self.error(("serial", "baudrates"), f"the default rate {serial.get('baudrate')} is not among them")
         return Serial(
             baudrate=int(serial.get("baudrate", 0)),  # type: ignore[call-overload]
             bytesize=int(serial.get("bytesize", 8)),  # type: ignore[call-overload]
             parity=str(serial.get("parity", "none")),
             stopbits=float(serial.get("stopbits", 1)),  # type: ignore[arg-type]
             notes=str(serial.get("notes", "")),
+            baudrates=tuple(int(rate) for rate in serial.get("baudrates") or ()),  # type: ignore[attr-defined]
         )

@@ -5,7 +5,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 BENCH_STAMP := $(VENV)/.installed-bench
 
-.PHONY: generate test test-fast constraints check lint typecheck clean demo stress bench wheel runtime-wheel docs
+.PHONY: generate test test-fast test-tools constraints check lint typecheck clean demo stress bench wheel runtime-wheel docs
 
 CONSTRAINTS := requirements/constraints.txt
 
@@ -19,8 +19,23 @@ $(STAMP): pyproject.toml $(CONSTRAINTS)
 	echo "$(CURDIR)/generated" > "$$($(BIN)/python -c "import sysconfig; print(sysconfig.get_paths()['purelib'])")/serialspec-generated.pth"
 	touch $(STAMP)
 
-generate: $(STAMP)
+generate: $(STAMP) test-tools
 	$(BIN)/serialspec generate
+
+# Programs the tests drive as a user would: tshark (the Wireshark dissectors) and tmux (`serialspec watch` on a
+# screen). Installed with apt-get where they are missing and this runs as root; elsewhere the tests that need them
+# are skipped, saying why.
+TEST_TOOLS := tshark tmux
+test-tools:
+	@missing=""; for tool in $(TEST_TOOLS); do command -v $$tool >/dev/null || missing="$$missing $$tool"; done; \
+	if [ -z "$$missing" ]; then exit 0; fi; \
+	if [ "$$(id -u)" != 0 ] || ! command -v apt-get >/dev/null; then \
+		echo "not installed:$$missing (apt-get as root installs them): the tests that need them are skipped"; exit 0; fi; \
+	echo "installing$$missing (apt-get)"; \
+	export DEBIAN_FRONTEND=noninteractive; \
+	apt-get install -y -q $$missing >/dev/null 2>&1 || { apt-get update -q >/dev/null 2>&1 && \
+		apt-get install -y -q $$missing >/dev/null 2>&1; } || \
+		echo "could not install$$missing: the tests that need them are skipped"
 
 check: $(STAMP)
 	$(BIN)/serialspec check
@@ -34,10 +49,10 @@ typecheck: $(STAMP)
 
 # The whole suite on every core (pytest-xdist); `make test-fast` leaves out the tests marked slow (wheels, docs site,
 # vendors' SDKs over pseudo-terminals) for the inner loop of an edit.
-test: $(STAMP) check lint typecheck
+test: $(STAMP) test-tools check lint typecheck
 	$(BIN)/pytest -q -n auto
 
-test-fast: $(STAMP) check
+test-fast: $(STAMP) test-tools check
 	$(BIN)/pytest -q -n auto -m "not slow"
 
 # Pin what the development install resolved to (after changing pyproject.toml's extras), for CI and fresh clones.

@@ -900,6 +900,18 @@ CASES: list[tuple[str, str, Mutation | Text, str | None]] = [
         "enums.tiny_client: generated class name TinyClient is already used by protocol",
     ),
     (
+        "enum named like the asyncio client",
+        "tiny",
+        put("enums/async_tiny_client", {"values": {"a": 0}}),
+        "enums.async_tiny_client: generated class name AsyncTinyClient is already used by protocol",
+    ),
+    (
+        "enum named like an asyncio group class",
+        "rrc",
+        put("enums/async_bus_servo_commands", {"values": {"a": 0}}),
+        "commands.bus_servo: generated class name AsyncBusServoCommands is already used by enums.async_bus_servo_commands",
+    ),
+    (
         "flags named like a message",
         "tiny",
         put("flags/move_request", {"bits": {"a": 0}}),

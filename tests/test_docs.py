@@ -17,7 +17,8 @@ ROOT = Path(__file__).resolve().parent.parent
 TUTORIAL = ROOT / "docs" / "tutorial.md"
 TINYLAMP = ROOT / "examples" / "tinylamp" / "tinylamp.yaml"
 PRINTED_PORT = "/dev/pts/5"
-SERVERS = ("sim", "monitor")  # run until stopped: their sessions are checked below and in test_readme.py
+# run until stopped: their sessions are checked below, in test_readme.py and test_watch.py (watch, in tmux)
+SERVERS = ("sim", "monitor", "watch")
 ON_A_BUS = ("scan", "replay")  # need the README session's port: tests/test_tools.py runs them against a sim
 
 

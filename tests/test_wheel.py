@@ -101,7 +101,10 @@ class User:
 @pytest.fixture(scope="module")
 def user(wheels: dict[str, Path], tmp_path_factory: pytest.TempPathFactory) -> User:
     tmp = tmp_path_factory.mktemp("user")
-    deps = _link_packages(["yaml", "jinja2", "markupsafe", "construct", "serial", "shtab"], tmp / "deps")
+    deps = _link_packages(
+        ["yaml", "jinja2", "markupsafe", "construct", "serial", "shtab", "rich", "markdown_it", "mdurl", "pygments"],
+        tmp / "deps",
+    )
     python = _venv(tmp / "venv", deps)
     _install(python, wheels["serialspec"])
     home = tmp / "home"
@@ -178,7 +181,7 @@ def test_a_project_table_in_pyproject_sets_specs_and_output(user: User) -> None:
     assert (project / "src" / "tinylamp" / "codec.py").is_file() and (
         project / "src" / "docs" / "tinylamp.md"
     ).is_file()
-    assert robot.serialspec("check").stdout.startswith("11 generated files match")
+    assert robot.serialspec("check").stdout.startswith("12 generated files match")
     (project / "src" / "tinylamp" / "codec.py").write_text("edited\n", encoding="utf-8")
     stale = robot.serialspec("check", check=False)
     assert stale.returncode == 1 and "src/tinylamp/codec.py: stale" in stale.stderr
@@ -242,6 +245,33 @@ def test_sim_with_a_client_and_its_tap_replays(user: User, sim: tuple[str, Path]
         ("request", "read_brightness"),
         ("response", "read_brightness"),
     ]
+
+
+def test_watch_export_and_the_dissector_from_the_wheel(user: User, sim: tuple[str, Path]) -> None:
+    port, tap = sim
+    user.serialspec("generate", "tinylamp.yaml", "--out", "lamps2")
+    user.python_code(
+        "import sys; sys.path.insert(0, 'lamps2')\n"
+        "from tinylamp.client import TinylampClient\n"
+        f"with TinylampClient({port!r}) as lamps:\n"
+        "    lamps.set_brightness(1, 80, 0)\n"
+    )
+    # not on a terminal: watch prints its table once, when it stops
+    table = user.serialspec("watch", "tinylamp.yaml", "--tap", str(tap), "--duration", "1").stdout
+    assert any("set_brightness" in line and "80 %" in line for line in table.splitlines()), table
+    user.serialspec("generate", "tinylamp.yaml", "--target", "wireshark", "--out", "dissectors")
+    assert sorted(p.name for p in (user.home / "dissectors").rglob("*") if p.is_file()) == ["tinylamp.lua"]
+    user.serialspec("export", str(tap), "--pcap", "session.pcap")
+    assert (user.home / "session.pcap").read_bytes()[20:24] == (147).to_bytes(4, "little")  # DLT_USER0
+    shipped = user.python_code(
+        "import importlib.resources; print((importlib.resources.files('feetech_sms') / 'feetech_sms.lua').is_file())"
+    )
+    assert shipped.strip() == "True"
+    tshark = shutil.which("tshark")
+    if tshark is not None:
+        lua = f"lua_script:{user.home / 'dissectors' / 'tinylamp' / 'tinylamp.lua'}"
+        shown = user.run(tshark, "-X", lua, "-r", "session.pcap", "-T", "fields", "-e", "tinylamp.command").stdout
+        assert "set_brightness" in shown.split()
 
 
 def test_sim_refuses_an_id_outside_the_spec(user: User) -> None:

@@ -4,7 +4,7 @@
 Every method of `feetech_sms.client.FeetechSmsClient` is here under the same name and with the same arguments,
 checks and errors; the ones that talk to a device are coroutines (`await client.ping(1)`), `reports()` is an async
 iterator. Several tasks may share one client (one bus, several devices): transactions never interleave, each reply
-reaches the task that asked for it. Made from the blocking client by serialspec (backends/python/aio.py).
+reaches the task that asked for it. Generated with the blocking client from one template, so the two cannot drift.
 
     async with AsyncFeetechSmsClient("/dev/ttyUSB0") as client:
         ...

@@ -23,6 +23,11 @@ class Emitter:
     verify: Callable[[Protocol, dict[str, str]], list[SpecError]] | None = None
 
 
+def target_names() -> tuple[str, ...]:
+    """The targets' names (their folders), without importing them."""
+    return tuple(sorted(i.name for i in pkgutil.iter_modules(__path__) if i.ispkg and i.name != "common"))
+
+
 @cache
 def emitters() -> tuple[Emitter, ...]:
     """Every target under serialspec.backends, in name order (common/ is the shared layer, not a target)."""

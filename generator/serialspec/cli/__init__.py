@@ -31,6 +31,8 @@ VERBS = {
     "scan": "find the devices on a bus: each id (and baud rate) answering the spec's presence request, with its model",
     "replay": "send the frames of one direction of a capture to a port, with their timing",
     "completion": "print the shell completion script for bash, zsh or fish",
+    "watch": "a live full-screen view of a port: one row per device and command, last values in units, rates, errors",
+    "export": "write captures (monitor --save, sim --tap) as one pcap file for Wireshark (generate --target wireshark)",
 }
 
 

@@ -26,6 +26,7 @@ from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from typing import TextIO
 
+from serialspec.runtime.errors import SerialspecError
 from serialspec.runtime.hexbytes import parse_hex
 
 DIRECTIONS = ("request", "response", "-")
@@ -61,6 +62,14 @@ class Writer:
         if data:
             self.stream.write(f"{stamp(moment)} {direction or '-'} {data.hex(' ')}\n")
             self.stream.flush()
+
+
+def open_text(path: str) -> TextIO:
+    """A capture file opened for reading; SerialspecError naming it when it cannot be."""
+    try:
+        return open(path, encoding="utf-8")
+    except OSError as exc:
+        raise SerialspecError(f"cannot read {path}: {exc.strerror}") from None
 
 
 def read(lines: Iterable[str]) -> Iterator[tuple[int, Chunk]]:

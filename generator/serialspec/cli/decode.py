@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 from types import ModuleType
-from typing import TYPE_CHECKING, Any, TextIO
+from typing import TYPE_CHECKING, Any
 
 from serialspec.cli.protocols import SPEC_HELP, open_spec
 from serialspec.cli.views import FlagNames, engineering, message_spec, register_view, unit_symbols, with_unit
@@ -83,7 +83,7 @@ def replay(args: argparse.Namespace, protocol: Protocol, package: ModuleType) ->
     failed = 0
     replies = replies_by_request(protocol.messages())
     asked: Message | None = None  # the last request seen
-    stream = sys.stdin if args.file == "-" else _open(args.file)
+    stream = sys.stdin if args.file == "-" else capture.open_text(args.file)
     with stream:
         try:
             for number, chunk in capture.read(stream):
@@ -118,13 +118,6 @@ def replay(args: argparse.Namespace, protocol: Protocol, package: ModuleType) ->
 def bad(seen: Seen) -> None:
     """Bad bytes of a capture, under the line their first byte is on."""
     print(f"serialspec decode: line {seen.origin}: {seen.reason} in [{seen.data.hex(' ')}]", file=sys.stderr)
-
-
-def _open(path: str) -> TextIO:
-    try:
-        return open(path, encoding="utf-8")
-    except OSError as exc:
-        raise SerialspecError(f"cannot read {path}: {exc.strerror}") from None
 
 
 def _hex(text: str) -> bytes:

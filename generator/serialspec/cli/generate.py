@@ -6,6 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
+from serialspec.backends import target_names
 from serialspec.cli.project import expected_files, orphans, project
 from serialspec.lang.errors import shown
 from serialspec.runtime.errors import SerialspecError
@@ -15,13 +16,21 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("specs", nargs="*", metavar="SPEC", help="spec files (default: the project's specs)")
     parser.add_argument("--out", metavar="DIR", help="output folder (default: the project's, else generated/)")
     parser.add_argument(
+        "--target",
+        dest="targets",
+        action="append",
+        choices=target_names(),
+        help="only this output (repeatable; default: all of them): python (packages), markdown (references), "
+        "wireshark (DIR/<protocol>/<protocol>.lua, a Lua dissector)",
+    )
+    parser.add_argument(
         "--root", type=Path, help="project root (default: the nearest folder with a [tool.serialspec] table or specs/)"
     )
 
 
 def run(args: argparse.Namespace) -> int:
     proj = project(args.root, args.specs, args.out)
-    files, errors = expected_files(proj)
+    files, errors = expected_files(proj, args.targets or ())
     if proj.chosen and errors and all(path == proj.schema for path in files):
         # every spec named has mistakes: nothing is written (not even the schema, into a generated/ of its own)
         for line in shown(errors):
@@ -36,7 +45,8 @@ def run(args: argparse.Namespace) -> int:
                 written += 1
         except OSError as exc:
             raise SerialspecError(f"cannot write {path}: {exc.strerror or exc}") from None
-    removed = orphans(proj, files, {e.file for e in errors})
+    # Only the whole set of targets says which files nothing generates any more.
+    removed = [] if args.targets else orphans(proj, files, {e.file for e in errors})
     for path in removed:
         path.unlink()
         print(f"removed {proj.display(path)} (no spec generates it any more)", file=sys.stderr)

@@ -4,16 +4,15 @@ from __future__ import annotations
 
 import argparse
 import json
-import signal
 import sys
 import time
-from types import FrameType
 from typing import Any, TextIO
 
 import serial
 
 from serialspec.cli import capture
 from serialspec.cli.frames import Frames, Seen
+from serialspec.cli.listening import Stopping, open_port
 from serialspec.cli.protocols import SPEC_HELP, open_spec
 from serialspec.cli.views import engineering, unit_symbols, with_unit
 from serialspec.lang.model import Protocol
@@ -88,30 +87,13 @@ def run(args: argparse.Namespace) -> int:
     settings = package.SERIAL
     address = protocol.device.address if protocol.device else None
     frames = Frames(package, args.direction, address)
-    try:
-        port = serial.serial_for_url(
-            args.port,
-            baudrate=args.baudrate or settings.baudrate,
-            bytesize=settings.bytesize,
-            parity={"none": "N", "even": "E", "odd": "O"}.get(settings.parity, "N"),
-            stopbits=settings.stopbits,
-            timeout=0.5,
-        )
-    except (serial.SerialException, OSError, ValueError) as exc:
-        raise PortError(f"cannot open {args.port}: {exc}") from None
+    port = open_port(args.port, args.baudrate, settings, 0.5)
     try:
         save = open(args.save, "w", encoding="utf-8") if args.save else None  # noqa: SIM115 (closed below)
     except OSError as exc:
         raise SerialspecError(f"cannot write {args.save}: {exc.strerror}") from None
     writer = capture.Writer(save, protocol.name) if save else None
-    stopping = False
-
-    def stop(signum: int, frame: FrameType | None) -> None:
-        nonlocal stopping
-        stopping = True
-
-    signal.signal(signal.SIGINT, stop)
-    signal.signal(signal.SIGTERM, stop)
+    stopping = Stopping()
     end = time.monotonic() + args.duration if args.duration else None
     printer = Printer(args, protocol)
     seen = 0

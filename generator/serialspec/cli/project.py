@@ -97,10 +97,11 @@ def project(root: Path | None, specs: Sequence[str] = (), out: str | None = None
     return Project(root, tuple(files), out_dir, schema, root / str(reference) if reference else None, bool(specs))
 
 
-def expected_files(proj: Project) -> tuple[dict[Path, str], list[SpecError]]:
-    """Every generated file, by path, from the project's valid specs; and every mistake in the others."""
+def expected_files(proj: Project, targets: Sequence[str] = ()) -> tuple[dict[Path, str], list[SpecError]]:
+    """Every generated file, by path, from the project's valid specs; and every mistake in the others. Given
+    `targets` (emitter names), only those targets' files: no schema, no language reference."""
     files: dict[Path, str] = {}
-    if proj.schema is not None:
+    if proj.schema is not None and not targets:
         files[proj.schema] = _cached_text("schema", cache.generator(), _schema)
     errors = []
     made = []
@@ -113,10 +114,13 @@ def expected_files(proj: Project) -> tuple[dict[Path, str], list[SpecError]]:
         except SpecErrors as exc:
             errors.extend(exc.errors)
             continue
-        files.update({proj.out / name: _spec_link(proj, spec, name, text) for name, text in outputs.files.items()})
+        chosen = {name: text for name, text in outputs.files.items() if not targets or outputs.targets[name] in targets}
+        files.update({proj.out / name: _spec_link(proj, spec, name, text) for name, text in chosen.items()})
         errors.extend(outputs.errors)
         made.append(outputs)
-    if proj.reference is not None and not errors:  # its examples come from every spec: none while one fails
+    if (
+        proj.reference is not None and not errors and not targets
+    ):  # its examples come from every spec: none while one fails
 
         def reference() -> str:
             from serialspec.lang.reference import reference_markdown
@@ -137,6 +141,7 @@ class Outputs:
     errors: list[SpecError]
     data: Any
     key: bytes  # of the spec's text and name, and the generator
+    targets: dict[str, str]  # file name -> the target (emitter) that writes it
 
 
 def spec_outputs(spec: Path, display: str, *, with_data: bool = False) -> Outputs:
@@ -157,16 +162,16 @@ def spec_outputs(spec: Path, display: str, *, with_data: bool = False) -> Output
     payload = cache.load(entry, wanted)
     if payload is not None:
         with contextlib.suppress(ValueError, EOFError, TypeError):
-            files, errors, data, has_data = marshal.loads(payload)
-            cached = Outputs(dict(files), [SpecError(*error) for error in errors], data, wanted)
+            files, errors, data, has_data, targets = marshal.loads(payload)
+            cached = Outputs(dict(files), [SpecError(*error) for error in errors], data, wanted, dict(targets))
             if has_data or not with_data:
                 return cached
     outputs = _generate(raw, display, wanted)
     errors = [(e.file, e.line, e.column, e.path, e.message) for e in outputs.errors]
     try:
-        payload = marshal.dumps((outputs.files, errors, outputs.data, True))
+        payload = marshal.dumps((outputs.files, errors, outputs.data, True, outputs.targets))
     except ValueError:  # values marshal cannot hold (a YAML timestamp): cached without them
-        payload = marshal.dumps((outputs.files, errors, None, False))
+        payload = marshal.dumps((outputs.files, errors, None, False, outputs.targets))
     cache.store(entry, wanted, payload, keep=KEEP_OUTPUTS)
     return outputs
 
@@ -181,14 +186,17 @@ def _generate(raw: bytes, display: str, key: bytes) -> Outputs:
     located = load_text(decode_text(raw, display), display)
     protocol = resolve(located)
     files: dict[str, str] = {}
+    targets: dict[str, str] = {}
     errors: list[SpecError] = []
     for emitter in emitters():
         emitted = emitter.files(protocol)
         files.update(emitted)
+        targets.update(dict.fromkeys(emitted, emitter.name))
         if emitter.verify is not None:
             errors.extend(emitter.verify(protocol, emitted))
     files[f"{protocol.name}/{SHIPPED_SPEC}"] = shipped_spec(protocol.spec_path, raw)
-    return Outputs(files, errors, located.data, key)
+    targets[f"{protocol.name}/{SHIPPED_SPEC}"] = "python"  # the package ships it (`serialspec decode NAME`)
+    return Outputs(files, errors, located.data, key, targets)
 
 
 def _spec_link(proj: Project, spec: Path, name: str, text: str) -> str:

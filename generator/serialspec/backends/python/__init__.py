@@ -14,7 +14,7 @@ from serialspec.lang.model import Protocol
 def files(protocol: Protocol) -> dict[str, str]:
     package = emit_package(protocol)
     if "client.py" in package:
-        package["aio.py"] = aio_module(protocol, package["client.py"])
+        package["aio.py"] = aio_module(protocol)
     return {f"{protocol.name}/{name}": text for name, text in package.items()}
 
 

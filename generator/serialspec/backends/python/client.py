@@ -349,7 +349,6 @@ def carry_method(protocol: Protocol, request: Message, imports: set[str]) -> dic
             continue
         reply = replies.get(inner)
         expected = reply if reply is not None and reply_condition(inner, reply) is None else None
-        imports.update(n for n in (inner.class_name, expected.class_name if expected else "") if n)
         carried.append((inner.class_name, command.code, expected.class_name if expected else "None"))
     imports.add(group.class_name)
     title = protocol.command(request.command).title or request.key
@@ -379,8 +378,16 @@ def carry_method(protocol: Protocol, request: Message, imports: set[str]) -> dic
 
 
 def client_module(protocol: Protocol) -> str:
-    imports: set[str] = set()
-    methods = []
+    return render("client.py.j2", **client_context(protocol), aio=False)
+
+
+def client_context(protocol: Protocol) -> dict[str, Any]:
+    """What client.py.j2 needs, and the asyncio client's aio.py.j2 (both render the classes of _client_classes.j2).
+
+    `class_imports` are the names the classes use; `imports` adds those only the module-level tables use."""
+    imports: set[str] = set()  # what the classes use
+    module_imports: set[str] = {"Direction"}  # what only BINDING and the module's tables use
+    methods: list[dict[str, Any]] = []
     optional_keys: set[int] = set()
     tables = table_commands(protocol)
     writers = {t["writer"]: t for t in tables}
@@ -551,7 +558,7 @@ def client_module(protocol: Protocol) -> str:
             reports.append({"name": method_name(message), "class_name": message.class_name, "title": one_line(title)})
     registers = register_commands(protocol, methods)
     flags_literal = status_flags(protocol)
-    imports.update(e.flags.class_name for e in status_elements(protocol) if e.flags is not None)
+    module_imports.update(e.flags.class_name for e in status_elements(protocol) if e.flags is not None)
     everything = [*methods, *(m for g in groups.values() for m in g["methods"])]
     address, broadcast = address_of(protocol)
     class_name = protocol.client_class
@@ -559,7 +566,7 @@ def client_module(protocol: Protocol) -> str:
     if protocol.error_reply is not None:
         reply = protocol.command(protocol.error_reply.command).response
         assert reply is not None
-        imports.add(reply.class_name)
+        module_imports.add(reply.class_name)
         reason = next((f.name for f in reply.fields if not (isinstance(f, Scalar) and f.hidden)), "")
         codes = {c.name: c.code for c in protocol.commands if c.code is not None and c.request is not None}
         errors = {
@@ -577,8 +584,12 @@ def client_module(protocol: Protocol) -> str:
         and any(r["map"] == map_name(device.memory) for r in registers)
         else ""
     )
-    return render(
-        "client.py.j2",
+    carriers = [m for m in methods if m["kind"] == "carry"]
+    module_imports.update(name for m in carriers for request, _, reply in m["carried"] for name in (request, reply))
+    module_imports.discard("None")
+    checks_status = any(m["statuses"] for m in everything)
+    class_transport = [*(["check_status"] if checks_status else []), *(["table_key"] if tables else [])]
+    return dict(
         errors=errors,
         model_map=model_map,
         model_names=", ".join(m.name for m in device.models) if device is not None else "",
@@ -591,18 +602,32 @@ def client_module(protocol: Protocol) -> str:
         broadcast=repr(broadcast),
         status=repr(tuple(e.name for e in status_elements(protocol))),
         methods=methods,
-        carriers=[m for m in methods if m["kind"] == "carry"],
+        carriers=carriers,
         groups=list(groups.values()),
         registers=registers,
         status_flags=flags_literal,
         register_imports=sorted(
-            {r["map"] for r in registers} | {r["alias"] for r in registers} | ({model_map + "_MODELS"} - {"_MODELS"}),
+            {r["map"] for r in registers}
+            | {r["alias"] for r in registers if r["kind"] in ("read", "each_read", "items_read")}  # reads take names
+            | ({model_map + "_MODELS"} - {"_MODELS"}),
             key=import_order,
         ),
         reports=reports,
         tables=tables,
         optional_keys=sorted(optional_keys),
-        imports=sorted(imports | {"Direction"}, key=import_order),
+        imports=sorted(imports | module_imports, key=import_order),
+        class_imports=sorted(imports, key=import_order),
+        # the names client.py defines at module level, which aio.py imports from it
+        module_names=sorted(
+            [
+                "BINDING",
+                *(m["carried_name"] for m in carriers),
+                *(n for t in tables for n in (t["upper"], f"{t['upper']}_READ_ONLY")),
+            ],
+            key=import_order,
+        ),
+        checks_status=checks_status,
+        quick_reads=any(r.get("quick") for r in registers),
         error_imports=[
             name
             for name, used in (
@@ -611,15 +636,18 @@ def client_module(protocol: Protocol) -> str:
             )
             if used
         ],
-        transport_imports=[
-            "Binding",
-            "Bus",
-            "ClientBase",
-            *(["ErrorReplies"] if errors else []),
-            *(["check_status"] if any(m["statuses"] for m in everything) else []),
-            *(["flag_names"] if status_flags(protocol) else []),
-            *(["table_key"] if tables else []),
-        ],
+        class_transport_imports=class_transport,
+        transport_imports=sorted(
+            [
+                "Binding",
+                "Bus",
+                "ClientBase",
+                *(["ErrorReplies"] if errors else []),
+                *(["flag_names"] if flags_literal else []),
+                *class_transport,
+            ],
+            key=import_order,
+        ),
         uses_message=any(m["kind"] == "carry" for m in everything),
         abc_imports=sorted(
             {

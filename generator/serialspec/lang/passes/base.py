@@ -302,6 +302,12 @@ class Pass:
         class_names[name] = (path, identity)
         return name
 
+    def client_class_name(self, name: str, path: Path) -> str:
+        """Register a class of the generated client, and its asyncio twin `Async<name>` (aio.py) with it."""
+        name = self.class_name(name, path)
+        self.class_name(f"Async{name}", path)
+        return name
+
     def reference(self, kind: str, registry: dict[str, Any], value: Any, path: Path) -> Any:
         if value is None:
             return None

@@ -207,7 +207,7 @@ class Commands(FieldResolver):
             response=messages.get(Direction.RESPONSE),
             selector=selector,
             subcommands=tuple(subcommands),
-            group_class=self.class_name(camel(name, "commands"), path) if subcommands else "",
+            group_class=self.client_class_name(camel(name, "commands"), path) if subcommands else "",
             probe=probe,
         )
 

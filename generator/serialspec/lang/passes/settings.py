@@ -16,7 +16,7 @@ class Settings(Pass):
         if name in RESERVED_PACKAGES:
             self.error(("protocol",), f"protocol {name!r} would shadow the module {name!r} (pick another package name)")
         # the client and simulator classes take the protocol's name: no enum, message or group may take theirs
-        self.ctx.client_class = self.class_name(camel(name, "client"), ("protocol",))
+        self.ctx.client_class = self.client_class_name(camel(name, "client"), ("protocol",))
         self.ctx.simulator_class = self.class_name(camel(name, "simulator"), ("protocol",))
         self.ctx.endian = ">" if data.get("byte_order") == "big" else "<"
         self.ctx.shared_fields = self.section("fields")

@@ -1,0 +1,14 @@
+"""The Wireshark target: one Lua dissector per protocol, `<protocol>/<protocol>.lua` (see dissector.py)."""
+
+from __future__ import annotations
+
+from serialspec.backends import Emitter
+from serialspec.backends.wireshark.dissector import emit_dissector
+from serialspec.lang.model import Protocol
+
+
+def files(protocol: Protocol) -> dict[str, str]:
+    return {f"{protocol.name}/{protocol.name}.lua": emit_dissector(protocol)}
+
+
+EMITTER = Emitter("wireshark", files)

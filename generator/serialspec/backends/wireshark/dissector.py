@@ -1,0 +1,359 @@
+"""A Wireshark dissector in Lua for one protocol: the spec as a Lua table, read by one engine (dissector.lua.j2).
+
+The table holds what the Python codec is written from: each direction's frame layouts (elements, the spans lengths
+count and checksums cover, byte stuffing), the messages by command code (and sub-command selector), and every
+message's fields with their types, units, scales, enums, flags and bit fields. The engine in the template finds the
+frames in a packet (several per packet), checks constants, lengths and checksums, and shows each frame's command
+and fields under the names `<protocol>.<command>[.<subcommand>].<direction>.<field>`.
+"""
+
+from __future__ import annotations
+
+from typing import Any, assert_never
+
+from serialspec.backends.common.frames import runtime_layout
+from serialspec.backends.common.render import render
+from serialspec.checksums.crc import Crc
+from serialspec.checksums.fletcher import Fletcher
+from serialspec.checksums.sum import Sum
+from serialspec.checksums.xor import Xor
+from serialspec.cli.views import engineering_unit
+from serialspec.lang.frozen import frozen
+from serialspec.lang.model import (
+    Array,
+    BitField,
+    Bytes,
+    Checksum,
+    Direction,
+    EnumDef,
+    Field,
+    FlagsDef,
+    FrameLayout,
+    Group,
+    List,
+    Message,
+    Protocol,
+    Scalar,
+    TableBlock,
+    TableEntry,
+    TableValue,
+    Text,
+    content_bounds,
+    size_terms,
+)
+
+
+def emit_dissector(protocol: Protocol) -> str:
+    directions = {d.value: _direction(protocol, d) for d in protocol.framing.alternatives}
+    used = {
+        f.table.name
+        for m in protocol.messages()
+        for f in _all_fields(m.fields)
+        if isinstance(f, TableValue | TableBlock)
+    }
+    tables = {t.name: {e.key: _entry(e) for e in t.entries} for t in protocol.tables if t.name in used}
+    layouts = [d["layouts"] for d in directions.values()]
+    shared = None
+    if len(layouts) == 2 and layouts[0] == layouts[1]:  # the same frames both ways: written once
+        shared = layouts[0]
+        for direction in directions.values():
+            direction["layouts"] = Ref("LAYOUTS")
+    data = {
+        "name": protocol.name,
+        "title": protocol.title,
+        "big": protocol.byte_order == "big",
+        "directions": directions,
+    }
+    return render(
+        "serialspec.backends.wireshark",
+        "dissector.lua.j2",
+        protocol=protocol,
+        enums=lua({e.name: _enum_values(e) for e in protocol.enums}, 0),
+        tables=lua(tables, 0),
+        layouts=lua(shared, 0),
+        data=lua(data, 0),
+    )
+
+
+def _all_fields(fields: tuple[Field, ...]) -> list[Field]:
+    found: list[Field] = []
+    for item in fields:
+        found.append(item)
+        if isinstance(item, Group):
+            found += _all_fields(item.fields)
+    return found
+
+
+@frozen
+class Ref:
+    """A Lua expression in place of a literal: a table written once and shared (ENUMS, TABLES, LAYOUTS)."""
+
+    expression: str
+
+
+def _direction(protocol: Protocol, direction: Direction) -> dict[str, Any]:
+    layouts = protocol.framing.alternatives[direction]
+    coded = any(layout.has_command for layout in layouts)  # else every message of this direction is codeless
+    codes: dict[int | str, Any] = {}
+    for command in protocol.commands:
+        selector = command.selector
+        if selector is not None and direction in selector.offsets:
+            subs = {}
+            for sub in command.subcommands:
+                message = sub.request if direction == Direction.REQUEST else sub.response
+                if message is not None:
+                    subs[sub.code] = _message(protocol, message)
+            if subs:
+                entry: dict[str, Any] = {
+                    "selector": {"offset": selector.offsets[direction], "size": selector.type.size},
+                    "subs": subs,
+                }
+                sizes = {(m["min"], m["max"]) for m in subs.values()}
+                entry["min"] = min(low for low, _ in sizes)
+                entry["max"] = None if any(high is None for _, high in sizes) else max(h for _, h in sizes if h)
+                codes.setdefault(_code(command.code if coded else None), entry)
+                continue
+        message = command.request if direction == Direction.REQUEST else command.response
+        if message is None:
+            continue
+        key = _code(command.code if coded else None)
+        if protocol.error_reply is not None and command.name == protocol.error_reply.command:
+            key = "error"
+        if key in codes and not message.default_reply:
+            continue  # replies sharing a code: the one decoded without its request (the default) is shown
+        codes[key] = {"message": _message(protocol, message)}
+        codes[key]["min"], codes[key]["max"] = codes[key]["message"]["min"], codes[key]["message"]["max"]
+    result: dict[str, Any] = {"layouts": [_layout(layout) for layout in layouts], "codes": codes}
+    if protocol.error_reply is not None:
+        result["error_flag"] = protocol.error_reply.flag
+        result["error_element"] = protocol.error_reply.element
+    return result
+
+
+def _code(code: int | None) -> int | str:
+    return "none" if code is None else code
+
+
+def _layout(layout: FrameLayout) -> dict[str, Any]:
+    engine = runtime_layout(layout)
+    elements = []
+    for element, runtime in zip(layout.elements, engine.elements, strict=True):
+        item: dict[str, Any] = {"name": element.name, "role": element.role, "size": element.size or 0}
+        item["big"] = element.endian == ">"
+        if element.fixed:
+            item["constant"] = element.constant
+        if element.role in ("address", "status", "command"):
+            item["min"], item["max"] = int(element.minimum), int(element.maximum)
+            if element.broadcast is not None:
+                item["broadcast"] = element.broadcast
+            item.update(_scalar_extras(element.flags, element.bits, None))
+        if element.role == "length":
+            item["span"] = [runtime.span[0] + 1, runtime.span[1] + 1]
+            item["adds"] = element.adds
+        if element.checksum is not None:
+            item["span"] = [runtime.span[0] + 1, runtime.span[1] + 1]
+            item["checksum"] = _checksum(element.checksum)
+        item["description"] = element.description
+        elements.append(item)
+    result: dict[str, Any] = {"elements": elements}
+    if engine.transparency is not None:
+        first, last = engine.transparency.span
+        result["transparency"] = {
+            "first": first + 1,
+            "last": last + 1,
+            "replace": [[plain, wire] for plain, wire in engine.transparency.replace],
+        }
+    return result
+
+
+def _checksum(checksum: Checksum) -> dict[str, Any]:
+    """The algorithm and its parameters, for the engine's own Lua code of each (checksum() in the template)."""
+    algorithm = checksum.algorithm
+    match algorithm:
+        case Sum():
+            return {"algorithm": "sum", "invert": algorithm.invert}
+        case Xor():
+            return {"algorithm": "xor"}
+        case Fletcher():
+            return {"algorithm": "fletcher", "modulus": algorithm.modulus}
+        case Crc():
+            parameters = ("width", "poly", "init", "refin", "refout", "xorout")
+            return {"algorithm": "crc", "name": algorithm.catalogue} | {p: getattr(algorithm, p) for p in parameters}
+    # an algorithm this backend has no Lua for yet: the dissector shows the value, unverified, and says why
+    return {"algorithm": algorithm.name, "unverified": True}
+
+
+def _message(protocol: Protocol, message: Message) -> dict[str, Any]:
+    parts = [message.command, message.subcommand, message.direction.value]
+    low, high = content_bounds(message.fields)
+    result: dict[str, Any] = {
+        "command": message.command,
+        "subcommand": message.subcommand,
+        "title": message.title,
+        "prefix": ".".join([protocol.name, *(p for p in parts if p)]),
+        "fields": _fields(message.fields),
+        "min": low,
+        "max": high,
+    }
+    terms = size_terms(message.fields)
+    if terms is not None:
+        fixed, sized = terms
+        result["size"] = {"fixed": fixed, "terms": [[o + 1, s, e == "big", f] for o, s, e, f in sized]}
+    if message.error_reply and protocol.error_reply is not None:
+        result["refused"] = protocol.error_reply.element
+    return result
+
+
+def _fields(fields: tuple[Field, ...]) -> list[dict[str, Any]]:
+    return [_field(item, content_bounds(fields[index + 1 :])[0]) for index, item in enumerate(fields)]
+
+
+def _field(item: Field, tail: int) -> dict[str, Any]:
+    """One field as the engine reads it; `tail`: the fewest bytes the fields after it take (for `rest`)."""
+    common: dict[str, Any] = {"name": item.name, "description": item.description, "tail": tail}
+    match item:
+        case Scalar():
+            unit = engineering_unit(item.unit, item.scale)
+            common.update(kind="scalar", type=item.type.name, big=item.endian == ">", unit=unit, scale=item.scale)
+            common.update(_scalar_extras(item.flags, item.bits, item.enum), hidden=item.hidden)
+            common["sign_magnitude"] = item.sign_magnitude
+        case Array():
+            common.update(kind="list", type=item.item.name, big=item.endian == ">", count=item.count, unit=item.unit)
+        case List():
+            common.update(kind="list", type=item.item.name if item.item else "bit", big=item.endian == ">")
+            common.update(count=item.count or None, size=item.size or None, unit=item.unit)
+        case Text():
+            common.update(kind="text", size=item.size)
+        case Bytes():
+            common.update(kind="bytes", size=item.size)
+        case Group():
+            common.update(kind="group", count=item.count, fields=_fields(item.fields))
+        case TableValue():
+            common.update(kind="table_value", key=item.key, entries=Ref(f"TABLES[{_lua_name(item.table.name)}]"))
+        case TableBlock():
+            table = Ref(f"TABLES[{_lua_name(item.table.name)}]")
+            common.update(kind="table_block", table=table, keys=[e.key for e in item.entries], big=item.endian == ">")
+        case _:
+            assert_never(item)
+    return common
+
+
+def _scalar_extras(flags: FlagsDef | None, bits: tuple[BitField, ...], enum: EnumDef | None) -> dict[str, Any]:
+    extras: dict[str, Any] = {}
+    if enum is not None:
+        extras["enum"] = _enum(enum)
+    if flags is not None:
+        extras["flags"] = [{"name": b.name.lower(), "bit": b.bit, "description": b.text} for b in flags.bits]
+    if bits:
+        extras["bits"] = [
+            {"name": b.name, "high": b.high, "low": b.low, "enum": _enum(b.enum), "description": b.description}
+            for b in bits
+        ]
+    return extras
+
+
+def _entry(entry: TableEntry) -> dict[str, Any]:
+    return {
+        "name": entry.name,
+        "type": entry.type.name,
+        "unit": engineering_unit(entry.unit, entry.scale),
+        "scale": entry.scale,
+        "description": entry.description,
+        "sign_magnitude": entry.sign_magnitude,
+        **_scalar_extras(entry.flags, (), entry.enum),
+    }
+
+
+def _enum(enum: EnumDef | None) -> Ref | dict[int, str] | None:
+    return None if enum is None else Ref(f"ENUMS[{_lua_name(enum.name)}]")
+
+
+def _enum_values(enum: EnumDef) -> dict[int, str]:
+    return {v.value: v.name.lower() for v in enum.values}
+
+
+def _lua_name(name: str) -> str:
+    return _lua_string(name.encode("utf-8"))
+
+
+def lua(value: object, depth: int) -> str:
+    """A Lua literal of a value made of dicts, lists, text, bytes, numbers, booleans and None (nil)."""
+    pad = "  " * (depth + 1)
+    match value:
+        case None:
+            return "nil"
+        case Ref():
+            return value.expression
+        case bool():
+            return "true" if value else "false"
+        case int():
+            return str(value)
+        case float():
+            return repr(value)
+        case str():
+            return _lua_string(value.encode("utf-8"))
+        case bytes():
+            return _lua_string(value)
+        case list() | tuple():
+            if not value:
+                return "{}"
+            items = [lua(v, depth + 1) for v in value]
+            if all("\n" not in i for i in items) and sum(len(i) for i in items) < 80:
+                return "{" + ", ".join(items) + "}"
+            return "{\n" + "".join(f"{pad}{i},\n" for i in items) + "  " * depth + "}"
+        case dict():
+            entries = []
+            for key, item in value.items():
+                if item is None:
+                    continue
+                name = (
+                    key if isinstance(key, str) and key.isidentifier() and key not in _KEYWORDS else f"[{lua(key, 0)}]"
+                )
+                entries.append(f"{name} = {lua(item, depth + 1)}")
+            if not entries:
+                return "{}"
+            if all("\n" not in e for e in entries) and sum(len(e) for e in entries) < 80:
+                return "{" + ", ".join(entries) + "}"
+            return "{\n" + "".join(f"{pad}{e},\n" for e in entries) + "  " * depth + "}"
+    raise TypeError(f"no Lua literal for {value!r}")
+
+
+_KEYWORDS = frozenset(
+    [
+        "and",
+        "break",
+        "do",
+        "else",
+        "elseif",
+        "end",
+        "false",
+        "for",
+        "function",
+        "goto",
+        "if",
+        "in",
+        "local",
+        "nil",
+        "not",
+        "or",
+        "repeat",
+        "return",
+        "then",
+        "true",
+        "until",
+        "while",
+    ]
+)
+
+
+def _lua_string(data: bytes) -> str:
+    out = []
+    for byte in data:
+        char = chr(byte)
+        if char in '"\\':
+            out.append("\\" + char)
+        elif 0x20 <= byte < 0x7F:
+            out.append(char)
+        else:
+            out.append(f"\\x{byte:02x}")
+    return '"' + "".join(out) + '"'

@@ -1,0 +1,420 @@
+"""The Wireshark dissectors, run by tshark as a user would: `serialspec generate --target wireshark`, a capture
+exported with `serialspec export --pcap`, every shipped spec's example frames shown with the command and field values
+`serialspec decode --json` gives, several frames a packet, bad checksums flagged."""
+
+from __future__ import annotations
+
+import contextlib
+import datetime
+import io
+import json
+import math
+import re
+import shlex
+import shutil
+import subprocess
+import sys
+import xml.etree.ElementTree as ET
+from pathlib import Path
+from typing import Any
+
+import pytest
+from conftest import ALL, ROOT, Generated, examples
+from hypothesis import HealthCheck, Phase, given, settings
+from hypothesis import strategies as st
+from serialspec import cli
+from serialspec.cli.decode import describe
+from serialspec.lang.model import (
+    Array,
+    Bytes,
+    Field,
+    Group,
+    List,
+    Message,
+    Protocol,
+    Scalar,
+    TableBlock,
+    TableValue,
+    Text,
+)
+from strategies import message_fields
+
+pytestmark = pytest.mark.slow
+TSHARK = shutil.which("tshark")
+SERIALSPEC = [sys.executable, "-m", "serialspec"]
+
+
+def run(*args: str) -> str:
+    done = subprocess.run(args, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    return done.stdout
+
+
+def decoded(protocol: Protocol, direction: str, frames: list[bytes]) -> list[dict[str, Any]]:
+    """`serialspec decode SPEC --json --direction D HEX...`, run in this process (the CLI's own code)."""
+    spec = str(ROOT / protocol.spec_path)
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        assert cli.main(["decode", spec, "--json", "--direction", direction, *(f.hex(" ") for f in frames)]) == 0
+    return [json.loads(line) for line in out.getvalue().splitlines()]
+
+
+def example_frames(protocol: Protocol) -> dict[str, list[bytes]]:
+    """Every example frame of the spec by direction, those the codec decodes (erratum examples as printed do not)."""
+    frames: dict[str, list[bytes]] = {"request": [], "response": []}
+    for example in protocol.examples:
+        if not example.erratum and example.frame not in frames[example.direction.value]:
+            frames[example.direction.value].append(example.frame)
+    return frames
+
+
+def pdml_frames(xml: str) -> list[ET.Element]:
+    """Every frame the dissectors found, in order: the protocol trees after each packet's serialspec header."""
+    names = {g.protocol.name for g in ALL}
+    return [proto for packet in ET.fromstring(xml).iter("packet") for proto in packet if proto.get("name") in names]
+
+
+def children(element: ET.Element, name: str) -> list[ET.Element]:
+    return [child for child in element if child.get("name") == name]
+
+
+def child(element: ET.Element, name: str) -> ET.Element:
+    found = children(element, name)
+    assert len(found) == 1, f"{name}: {len(found)} in {ET.tostring(element, encoding='unicode')[:2000]}"
+    return found[0]
+
+
+def number(text: str) -> int | float:
+    value = float(text)
+    return int(value) if "." not in text and "e" not in text else value
+
+
+def value(field: Field, shown: ET.Element, abbr: str) -> Any:
+    """A field's value as the dissector shows it, in `decode --json`'s form."""
+    match field:
+        case Scalar():
+            if field.bits:
+                return {b.name: int(child(shown, f"{abbr}.{b.name}").get("show") or 0) for b in field.bits}
+            return number(shown.get("show") or "")
+        case Array() | List():
+            items = children(shown, f"{abbr}.value")
+            if isinstance(field, List) and field.bits:
+                return [item.get("show") == "1" for item in items]
+            return [number(item.get("show") or "") for item in items]
+        case Text():
+            return shown.get("show")
+        case Bytes():
+            data = bytes.fromhex(shown.get("value") or "")
+            return data.hex(" ")
+        case Group():
+            return [fields_of(field.fields, item, abbr) for item in children(shown, f"{abbr}.item")]
+        case TableValue():
+            return number(shown.get("show") or "")
+        case TableBlock():
+            return {e.name: number(child(shown, f"{abbr}.{e.name}").get("show") or "") for e in field.entries}
+    raise AssertionError(field)
+
+
+def fields_of(fields: tuple[Field, ...], tree: ET.Element, prefix: str) -> dict[str, Any]:
+    return {
+        f.name: value(f, child(tree, f"{prefix}.{f.name}"), f"{prefix}.{f.name}")
+        for f in fields
+        if not (isinstance(f, Scalar) and f.hidden)
+    }
+
+
+def message_of(protocol: Protocol, direction: str, command: str, subcommand: str | None) -> Message:
+    return next(
+        m
+        for m in protocol.messages()
+        if (m.command, m.subcommand, m.direction.value) == (command, subcommand, direction)
+    )
+
+
+def shown(protocol: Protocol, tree: ET.Element) -> dict[str, Any]:
+    """What the dissector shows of one frame, as `decode --json` puts it."""
+    name = protocol.name
+    direction = child(tree, f"{name}.direction").get("show") or ""
+    command = child(tree, f"{name}.command").get("show") or ""
+    subs = children(tree, f"{name}.subcommand")
+    subcommand = subs[0].get("show") if subs else None
+    message = message_of(protocol, direction, command, subcommand)
+    prefix = ".".join(p for p in (name, command, subcommand, direction) if p)
+    fields: dict[str, Any] = {}
+    for element in protocol.framing.layouts[message.direction].value_elements:
+        if element.bits:
+            item = child(tree, f"{name}.frame.{element.name}")
+            fields[element.name] = {
+                b.name: int(child(item, f"{name}.frame.{element.name}.{b.name}").get("show") or 0) for b in element.bits
+            }
+        else:
+            fields[element.name] = int(child(tree, f"{name}.frame.{element.name}").get("show") or "")
+    if message.error_reply and protocol.error_reply:
+        refused = protocol.error_reply.element
+        fields[refused] = int(child(tree, f"{prefix}.{refused}").get("show") or "")
+    fields.update(fields_of(message.fields, tree, prefix))
+    checksum_ok = child(tree, f"{name}.checksum_ok").get("show") == "1"
+    return {
+        "direction": direction,
+        "command": command,
+        "subcommand": subcommand,
+        "fields": fields,
+        "checksum_ok": checksum_ok,
+    }
+
+
+@pytest.mark.skipif(
+    TSHARK is None, reason="tshark is not installed (make generate installs it where it can: root and apt-get)"
+)
+def test_tshark_shows_every_example_frame_as_decode_json_does(tmp_path: Path) -> None:
+    assert TSHARK is not None
+    specs = [str(ROOT / g.protocol.spec_path) for g in ALL]
+    run(*SERIALSPEC, "generate", *specs, "--target", "wireshark", "--out", str(tmp_path / "out"))
+    captures = []
+    wanted: list[dict[str, Any]] = []
+    moment = datetime.datetime(2026, 11, 25, 10, tzinfo=datetime.UTC)
+    for g in ALL:
+        protocol = g.protocol
+        capture = [f"# serialspec capture: {protocol.name}"]
+        for direction, frames in example_frames(protocol).items():
+            if not frames:
+                continue
+            results = decoded(protocol, direction, frames)
+            assert len(results) == len(frames)
+            # one frame a packet, then all of them in one packet
+            for data in [*frames, b"".join(frames)]:
+                moment += datetime.timedelta(milliseconds=1)
+                capture.append(f"{moment.isoformat(timespec='microseconds')} {direction} {data.hex(' ')}")
+            wanted += [{"protocol": protocol.name, **r} for r in results] * 2
+        path = tmp_path / f"{protocol.name}.capture"
+        path.write_text("\n".join(capture) + "\n", encoding="utf-8")
+        captures.append(str(path))
+    # every spec's capture in one pcap, read by one tshark with every dissector loaded (they share the link type)
+    run(*SERIALSPEC, "export", *captures, "--pcap", str(tmp_path / "examples.pcap"))
+    scripts = [f"lua_script:{tmp_path / 'out' / g.protocol.name / f'{g.protocol.name}.lua'}" for g in ALL]
+    options = [word for script in scripts for word in ("-X", script)]
+    trees = pdml_frames(run(TSHARK, *options, "-r", str(tmp_path / "examples.pcap"), "-T", "pdml"))
+    assert len(trees) == len(wanted)
+    protocols = {g.protocol.name: g.protocol for g in ALL}
+    for tree, expected in zip(trees, wanted, strict=True):
+        seen = shown(protocols[expected["protocol"]], tree)
+        assert seen == {key: expected[key] for key in seen}, expected["hex"]
+    assert sum(len(example_frames(g.protocol)["request"]) for g in ALL) > 50
+
+
+@pytest.mark.skipif(
+    TSHARK is None, reason="tshark is not installed (make generate installs it where it can: root and apt-get)"
+)
+def test_tshark_flags_a_bad_checksum_bytes_outside_frames_and_a_short_content(tmp_path: Path) -> None:
+    assert TSHARK is not None
+    spec = str(ROOT / "specs" / "fashionstar_uart.yaml")
+    run(*SERIALSPEC, "generate", spec, "--target", "wireshark", "--out", str(tmp_path))
+    capture = tmp_path / "bad.capture"
+    capture.write_text(
+        "# serialspec capture: fashionstar_uart\n"
+        "2026-11-25T10:00:00.000000+00:00 request 12 4c 01 01 03 64 99 12 4c 01 01 03 63\n"
+        "2026-11-25T10:00:01.000000+00:00 request 12 4c 08 01 02 69\n",  # a ROTATE of one byte: its sum is right
+        encoding="utf-8",
+    )
+    run(*SERIALSPEC, "export", str(capture), "--pcap", str(tmp_path / "bad.pcap"))
+    script = f"lua_script:{tmp_path / 'fashionstar_uart' / 'fashionstar_uart.lua'}"
+    out = run(TSHARK, "-X", script, "-r", str(tmp_path / "bad.pcap"), "-V")
+    assert "checksum: 0x64 [incorrect, should be 0x63]" in out
+    assert "Bytes outside any frame: 99" in out
+    assert out.count("request ping") == 2
+    assert "[angle: 2 byte(s) needed at offset 1, the content has 1]" in out
+    fields = run(
+        TSHARK, "-X", script, "-r", str(tmp_path / "bad.pcap"), "-T", "fields", "-e", "fashionstar_uart.checksum_ok"
+    )
+    assert fields.split() == ["0,1", "1"]
+
+
+@pytest.mark.skipif(
+    TSHARK is None, reason="tshark is not installed (make generate installs it where it can: root and apt-get)"
+)
+def test_the_readme_wireshark_commands_show_what_the_readme_shows(tmp_path: Path) -> None:
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    section = readme[readme.index("**Captures in Wireshark.**") :]
+    section = section[: section.index("\n## ")]
+    console = re.findall(r"```console\n(.*?)```", section, flags=re.S)[0].splitlines()
+    script = re.findall(r"```sh\n(.*?)```", section, flags=re.S)[0].splitlines()
+    shown = re.findall(r"```text\n(.*?)```", section, flags=re.S)[0].splitlines()
+    shutil.copytree(ROOT / "specs", tmp_path / "specs")
+    shutil.copytree(ROOT / "examples" / "captures", tmp_path / "examples" / "captures")
+    commands = [line.removeprefix("$ ") for line in console if line.startswith("$ ")] + script
+    out = ""
+    for command in commands:
+        words = shlex.split(command)
+        words = [*SERIALSPEC, *words[1:]] if words[0] == ".venv/bin/serialspec" else words
+        done = subprocess.run(words, cwd=tmp_path, capture_output=True, text=True, timeout=300)
+        assert done.returncode == 0, (command, done.stderr)
+        out = done.stdout
+    assert console[1] == "9 packet(s) written to build/fashionstar_session.pcap"
+    lines = out.splitlines()
+    start = lines.index(shown[0])
+    assert lines[start : start + len(shown)] == shown, out
+
+
+@pytest.mark.skipif(
+    TSHARK is None, reason="tshark is not installed (make generate installs it where it can: root and apt-get)"
+)
+def test_a_frame_cut_between_packets_is_shown_whole_where_it_ends(tmp_path: Path) -> None:
+    assert TSHARK is not None
+    spec = str(ROOT / "specs" / "fashionstar_uart.yaml")
+    run(*SERIALSPEC, "generate", spec, "--target", "wireshark", "--out", str(tmp_path))
+    capture = tmp_path / "cut.capture"
+    capture.write_text(  # a ROTATE in two chunks, a reply between them (the other direction), then a PING
+        "# serialspec capture: fashionstar_uart\n"
+        "2026-11-25T10:00:00.000000+00:00 request 12 4c 08 07 02\n"
+        "2026-11-25T10:00:00.000100+00:00 response 05 1c 0a 03 00 86 03 b7\n"
+        "2026-11-25T10:00:00.000200+00:00 request 84 03 f4 01 00 00 eb 12 4c 01\n"
+        "2026-11-25T10:00:00.000300+00:00 request 01 03 63\n",
+        encoding="utf-8",
+    )
+    run(*SERIALSPEC, "export", str(capture), "--pcap", str(tmp_path / "cut.pcap"))
+    script = f"lua_script:{tmp_path / 'fashionstar_uart' / 'fashionstar_uart.lua'}"
+    fields = ["-e", "fashionstar_uart.command", "-e", "fashionstar_uart.rotate.request.angle"]
+    out = run(TSHARK, "-X", script, "-r", str(tmp_path / "cut.pcap"), "-T", "fields", *fields)
+    assert out.splitlines() == ["\t", "read_angle\t", "rotate\t900", "ping\t"]
+
+
+def same(seen: Any, wanted: Any) -> bool:
+    """Equal, floats to the 6 significant digits Wireshark shows of a float32."""
+    if isinstance(wanted, float):
+        return isinstance(seen, int | float) and math.isclose(seen, wanted, rel_tol=5e-6, abs_tol=1e-37)
+    if isinstance(wanted, dict):
+        return isinstance(seen, dict) and seen.keys() == wanted.keys() and all(same(seen[k], wanted[k]) for k in wanted)
+    if isinstance(wanted, list):
+        return isinstance(seen, list) and len(seen) == len(wanted) and all(map(same, seen, wanted))
+    return bool(seen == wanted)
+
+
+@pytest.mark.skipif(
+    TSHARK is None, reason="tshark is not installed (make generate installs it where it can: root and apt-get)"
+)
+@pytest.mark.parametrize("g", ALL, ids=[g.protocol.name for g in ALL])
+def test_tshark_shows_random_messages_of_every_command_as_decode_does(g: Generated, tmp_path: Path) -> None:
+    """Every message of the spec with random valid fields (stuffed bytes, groups, lists, texts, table values), all
+    in one capture: tshark shows what the codec decodes."""
+    assert TSHARK is not None
+    protocol = g.protocol
+    run(*SERIALSPEC, "generate", str(ROOT / protocol.spec_path), "--target", "wireshark", "--out", str(tmp_path))
+    script = f"lua_script:{tmp_path / protocol.name / f'{protocol.name}.lua'}"
+    specs = [m for m in protocol.messages() if not m.unsolicited or m.direction.value == "response"]
+
+    # no shrinking: each example runs tshark (a failure shows its frame and both views)
+    @settings(
+        max_examples=examples(2),
+        deadline=None,
+        suppress_health_check=list(HealthCheck),
+        phases=(Phase.explicit, Phase.reuse, Phase.generate),
+    )
+    @given(st.data())
+    def shown_as_decoded(data: st.DataObject) -> None:
+        lines = [f"# serialspec capture: {protocol.name}"]
+        wanted = []
+        for spec in specs:
+            cls = next(c for c in g.package.MESSAGE_TYPES if c.__name__ == spec.class_name)
+            frame = g.package.encode(cls.from_fields(data.draw(message_fields(protocol, spec), label=spec.key)))
+            message = g.package.decode(frame, spec.direction.value)  # as a frame without its request decodes
+            wanted.append(describe(protocol, message, frame, False, None))
+            lines.append(f"2026-11-25T10:00:00.000000+00:00 {spec.direction.value} {frame.hex(' ')}")
+        (tmp_path / "random.capture").write_text("\n".join(lines) + "\n", encoding="utf-8")
+        run(*SERIALSPEC, "export", str(tmp_path / "random.capture"), "--pcap", str(tmp_path / "random.pcap"))
+        trees = pdml_frames(run(TSHARK, "-X", script, "-r", str(tmp_path / "random.pcap"), "-T", "pdml"))
+        assert len(trees) == len(wanted)
+        for tree, expected in zip(trees, wanted, strict=True):
+            seen = shown(protocol, tree)
+            assert same(seen, {key: expected[key] for key in seen}), (expected["hex"], seen, expected)
+
+    shown_as_decoded()
+
+
+def through_tshark(tmp_path: Path, specs: list[str], corrupt: bool = False) -> None:
+    """Specs (YAML texts, each its own protocol and dissector, all loaded in one tshark): a random message of every
+    command and direction, shown as decoded; with `corrupt`, each also with its last byte changed, flagged bad."""
+    assert TSHARK is not None
+    from serialspec.backends.python import files as python_files
+    from serialspec.backends.python.memory import imported
+    from serialspec.backends.wireshark.dissector import emit_dissector
+    from serialspec.lang.loader import load_text
+    from serialspec.lang.resolve import resolve
+
+    with contextlib.ExitStack() as stack:
+        built: list[tuple[Protocol, Any]] = []
+        for text in specs:
+            protocol = resolve(load_text(text, "case.yaml"))
+            modules = {path.split("/", 1)[1]: code for path, code in python_files(protocol).items()}
+            built.append((protocol, stack.enter_context(imported(protocol.name, modules, "a tshark case"))))
+            (tmp_path / f"{protocol.name}.lua").write_text(emit_dissector(protocol), encoding="utf-8")
+        options = [word for protocol, _ in built for word in ("-X", f"lua_script:{tmp_path / protocol.name}.lua")]
+
+        @settings(
+            max_examples=examples(1),
+            deadline=None,
+            suppress_health_check=list(HealthCheck),
+            phases=(Phase.explicit, Phase.reuse, Phase.generate),
+        )
+        @given(st.data())
+        def shown_as_decoded(data: st.DataObject) -> None:
+            captures, wanted = [], []
+            for protocol, package in built:
+                lines = [f"# serialspec capture: {protocol.name}"]
+                for spec in protocol.messages():
+                    cls = next(c for c in package.MESSAGE_TYPES if c.__name__ == spec.class_name)
+                    fields = data.draw(message_fields(protocol, spec), label=f"{protocol.title} {spec.key}")
+                    frame = package.encode(cls.from_fields(fields))
+                    message = package.decode(frame, spec.direction.value)
+                    wanted.append((protocol, describe(protocol, message, frame, False, None)))
+                    lines.append(f"2026-11-25T10:00:00.000000+00:00 {spec.direction.value} {frame.hex(' ')}")
+                    if corrupt:
+                        bad = frame[:-1] + bytes([frame[-1] ^ 0x5A])
+                        wanted.append((protocol, {**wanted[-1][1], "checksum_ok": False, "hex": bad.hex(" ")}))
+                        lines.append(f"2026-11-25T10:00:00.000000+00:00 {spec.direction.value} {bad.hex(' ')}")
+                (tmp_path / f"{protocol.name}.capture").write_text("\n".join(lines) + "\n", encoding="utf-8")
+                captures.append(str(tmp_path / f"{protocol.name}.capture"))
+            run(*SERIALSPEC, "export", *captures, "--pcap", str(tmp_path / "cases.pcap"))
+            xml = run(TSHARK, *options, "-r", str(tmp_path / "cases.pcap"), "-T", "pdml")
+            names = {protocol.name for protocol, _ in built}
+            trees = [
+                proto for packet in ET.fromstring(xml).iter("packet") for proto in packet if proto.get("name") in names
+            ]
+            assert [t.get("name") for t in trees] == [protocol.name for protocol, _ in wanted]
+            for tree, (protocol, expected) in zip(trees, wanted, strict=True):
+                seen = shown(protocol, tree)
+                assert same(seen, {key: expected[key] for key in seen}), (protocol.title, expected["hex"], seen)
+
+        shown_as_decoded()
+
+
+@pytest.mark.skipif(
+    TSHARK is None, reason="tshark is not installed (make generate installs it where it can: root and apt-get)"
+)
+def test_tshark_shows_every_language_matrix_case_as_decode_does(tmp_path: Path) -> None:
+    """Every alternative the language documents (tests/test_language_matrix.py's cases)."""
+    from test_language_matrix import CASES, KNOWN, spec_text
+
+    names = [name for name in sorted(CASES) if name not in KNOWN]
+    specs = [
+        spec_text(name, CASES[name]).replace("protocol: matrix_case", f"protocol: matrix_{number}")
+        for number, name in enumerate(names)
+    ]
+    through_tshark(tmp_path, specs)
+
+
+@pytest.mark.skipif(
+    TSHARK is None, reason="tshark is not installed (make generate installs it where it can: root and apt-get)"
+)
+def test_tshark_verifies_every_checksum_algorithm(tmp_path: Path) -> None:
+    """Every registered checksum algorithm with each documented option (tests/test_matrix.py's cases): right frames
+    pass, a frame with its last byte changed is flagged."""
+    from serialspec.checksums import algorithms
+    from test_matrix import SHAPES, spec_text
+
+    specs = [
+        spec_text(f"checksum_{name}_{index}_{shape}", name, sample, shape)
+        for name, algorithm in algorithms().items()
+        for index, sample in enumerate(algorithm.samples)
+        for shape in SHAPES
+    ]
+    through_tshark(tmp_path, specs, corrupt=True)

@@ -26,6 +26,7 @@ from bench.timing import Operation, Table, compare, times, us, verdict
 ROOT = Path(__file__).resolve().parent.parent
 HANDWRITTEN_TARGET = 1.0  # generated time ≤ hand-written time
 CONSTRUCT_TARGET = 10.0  # generated ≥ 10 × faster than construct
+MINIMAL_TARGET = 1.0  # generated decode time ≤ a minimal hand-written struct decoder's
 
 
 @dataclass(frozen=True)
@@ -36,16 +37,25 @@ class Case:
     decode: Callable[[bytes], Any]  # hand-written
     encode: Callable[[Any], bytes]  # hand-written
     construct: bool = True  # whether the generated structs.py can parse and build the whole frame
+    minimal: Callable[[bytes], Any] | None = None  # a minimal hand-written decoder (handwritten.py), where there is one
 
 
 CASES = [
-    Case("fashionstar_uart", "rotate_request", "FS ROTATE request", hw.fs_decode_rotate, hw.fs_encode_rotate),
+    Case(
+        "fashionstar_uart",
+        "rotate_request",
+        "FS ROTATE request",
+        hw.fs_decode_rotate,
+        hw.fs_encode_rotate,
+        minimal=hw.fs_minimal_rotate,
+    ),
     Case(
         "fashionstar_uart",
         "read_angle_response",
         "FS READ_ANGLE response",
         hw.fs_decode_read_angle_reply,
         hw.fs_encode_read_angle_reply,
+        minimal=hw.fs_minimal_read_angle_reply,
     ),
     Case(
         "hiwonder_rrc",
@@ -67,6 +77,7 @@ CASES = [
         "SMS READ reply (2 bytes)",
         hw.sms_decode_reply,
         hw.sms_encode_reply,
+        minimal=hw.sms_minimal_reply,
     ),
     Case("feetech_sms", "write_goal", "SMS WRITE request (6 data bytes)", hw.sms_decode_write, hw.sms_encode_write),
     Case(
@@ -207,6 +218,8 @@ def run() -> Table:
             competitors = {"generated": generated, "handwritten": handwritten, "mavlink": mavlink_op}
             if construct is not None:
                 competitors["construct"] = construct
+            if op == "decode" and case.minimal is not None:
+                competitors["minimal"] = (case.minimal, (frame,))
             timed = compare(competitors)
             gen = timed["generated"].best_ns
             over_hand = gen / timed["handwritten"].best_ns
@@ -220,6 +233,9 @@ def run() -> Table:
                     us(timed["handwritten"].best_ns),
                     times(over_hand),
                     verdict(over_hand <= HANDWRITTEN_TARGET),
+                    us(timed["minimal"].best_ns) if "minimal" in timed else "—",
+                    times(gen / timed["minimal"].best_ns) if "minimal" in timed else "—",
+                    verdict(gen <= timed["minimal"].best_ns * MINIMAL_TARGET) if "minimal" in timed else "—",
                     us(timed["construct"].best_ns) if over_construct is not None else "—",
                     times(over_construct) if over_construct is not None else "—",
                     verdict(over_construct >= CONSTRUCT_TARGET) if over_construct is not None else "—",
@@ -238,6 +254,9 @@ def run() -> Table:
             "hand-written µs",
             f"gen ÷ hand (≤ {HANDWRITTEN_TARGET}×)",
             "",
+            "minimal µs",
+            f"gen ÷ minimal (≤ {MINIMAL_TARGET}×)",
+            "",
             "construct µs",
             f"construct ÷ gen (≥ {CONSTRUCT_TARGET:.0f}×)",
             "",
@@ -251,6 +270,9 @@ def run() -> Table:
             "values.",
             "hand-written: bench/handwritten.py, one function per frame with a precompiled struct.Struct for the "
             "whole frame where its size is fixed, the same checks, a slotted dataclass, enum/flag members.",
+            "minimal: the least a person writes for one frame (bench/handwritten.py `*_minimal_*`): one struct "
+            "unpack, the checksum and command code checked, a NamedTuple; no length, header or range checks, no enum "
+            "members (decode only, fixed-size classic frames).",
             "construct: the generated `structs.py` (frame struct with RawCopy + Checksum, then the command's content "
             "struct); decode yields construct Containers (no typed message), encode builds content then frame. "
             "DYNAMIXEL, Modbus and VESC: — (their structs.py describes the content, not the stuffed, header-less or "

@@ -14,6 +14,7 @@ import binascii
 import struct
 from dataclasses import dataclass
 from enum import IntEnum, IntFlag
+from typing import NamedTuple
 
 # --- Fashion Star: header 12 4C (request) / 05 1C (response), cmd, length, content, sum mod 256 -----------------
 
@@ -524,3 +525,46 @@ def vesc_encode_set_duty(message: VescSetDuty) -> bytes:
         raise ValueError(f"duty {message.duty} outside -100000..100000")
     payload = _VESC_SET_DUTY_PAYLOAD.pack(VESC_SET_DUTY, message.duty)
     return b"\x02\x05" + payload + binascii.crc_hqx(payload, 0).to_bytes(2, "big") + b"\x03"
+
+
+# --- minimal decoders: the least a person writes for one frame (issue 25's second comparison) ------------------------
+# One struct unpack of the whole frame, the checksum and the command code checked, a NamedTuple of the fields: no
+# length byte, header or range checks, no enum members. What the generated decode is also measured against.
+
+
+class MinimalReadAngle(NamedTuple):
+    servo_id: int
+    angle: int
+
+
+class MinimalRotate(NamedTuple):
+    servo_id: int
+    angle: int
+    interval: int
+    power: int
+
+
+class MinimalSmsReply(NamedTuple):
+    servo_id: int
+    error: int
+    data: bytes
+
+
+def fs_minimal_read_angle_reply(frame: bytes) -> MinimalReadAngle:
+    _, code, _, servo_id, angle, checksum = _FS_READ_ANGLE_FRAME.unpack(frame)
+    if code != FS_READ_ANGLE or sum(frame[:-1]) & 0xFF != checksum:
+        raise ValueError("not a READ_ANGLE reply")
+    return MinimalReadAngle(servo_id, angle)
+
+
+def fs_minimal_rotate(frame: bytes) -> MinimalRotate:
+    _, code, _, servo_id, angle, interval, power, checksum = _FS_ROTATE_FRAME.unpack(frame)
+    if code != FS_ROTATE or sum(frame[:-1]) & 0xFF != checksum:
+        raise ValueError("not a ROTATE request")
+    return MinimalRotate(servo_id, angle, interval, power)
+
+
+def sms_minimal_reply(frame: bytes) -> MinimalSmsReply:
+    if ~sum(frame[2:-1]) & 0xFF != frame[-1]:
+        raise ValueError("bad checksum")
+    return MinimalSmsReply(frame[2], frame[4], frame[5:-1])

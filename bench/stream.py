@@ -25,6 +25,12 @@ from bench.timing import Table, compare, times, us, verdict
 
 CHUNK = 4096
 GARBAGE_FRACTION = 0.10
+# the noisy stream a serial port hands over: before each frame, a garbage run (1-8 random bytes) one time in five and
+# the truncated start of another frame (its first 2 to 7 bytes) one time in five; reads of 1-256 bytes, or of 1
+NOISY_GARBAGE = 0.20
+NOISY_TRUNCATED = 0.20
+SMALL_READS = (1, 256)
+ONE_BYTE_STREAM = 64 * 1024  # the 1-byte-read rows' stream (a quarter of the others: a feed per byte is slow)
 STREAM_BYTES = 256 * 1024
 ROUNDS = 5
 TARGET_MB_S = 10.0
@@ -91,6 +97,38 @@ def noisy_stream(
     return b"".join(parts), len(parts) // 2
 
 
+def damaged_stream(
+    encode: Callable[[Message], bytes], make: Callable[[], Message], rng: random.Random, size: int
+) -> tuple[bytes, int]:
+    """Frames until the stream holds `size` bytes, each after a garbage run (NOISY_GARBAGE of them) or the truncated
+    start of another frame (NOISY_TRUNCATED); frame count."""
+    parts = []
+    total = 0
+    while total < size:
+        frame = encode(make())
+        roll = rng.random()
+        if roll < NOISY_GARBAGE:
+            damage = rng.randbytes(rng.randint(1, 8))
+        elif roll < NOISY_GARBAGE + NOISY_TRUNCATED:
+            damage = encode(make())[: rng.randint(2, len(frame) - 1)]
+        else:
+            damage = b""
+        parts += [damage, frame]
+        total += len(damage) + len(frame)
+    return b"".join(parts), len(parts) // 2
+
+
+def reads_of(stream: bytes, low: int, high: int, rng: random.Random) -> list[bytes]:
+    """The stream in reads of `low` to `high` bytes (random sizes)."""
+    reads = []
+    position = 0
+    while position < len(stream):
+        size = rng.randint(low, high)
+        reads.append(stream[position : position + size])
+        position += size
+    return reads
+
+
 def _chunks(stream: bytes) -> list[bytes]:
     return [stream[i : i + CHUNK] for i in range(0, len(stream), CHUNK)]
 
@@ -111,16 +149,61 @@ def parse_handwritten(chunks: list[bytes]) -> int:
     return found
 
 
-def beside_handwritten(package: Any, chunks: list[bytes]) -> tuple[float, float, int]:
+def beside_handwritten(package: Any, chunks: list[bytes], rounds: int = ROUNDS) -> tuple[float, float, int, int]:
     """The hand-written parser and the generated one side by side, round after round: best seconds of each, and
-    the frames the hand-written one found."""
+    the frames each found."""
     hand_best = generated_best = float("inf")
-    hand_found = 0
-    for _ in range(ROUNDS):
+    hand_found = generated_found = 0
+    for _ in range(rounds):
         hand_seconds, hand_found = best_seconds(lambda: parse_handwritten(chunks), 1)
-        generated_seconds, _ = best_seconds(functools.partial(parse_generated, package.StreamParser, chunks), 1)
+        parse = functools.partial(parse_generated, package.StreamParser, chunks)
+        generated_seconds, generated_found = best_seconds(parse, 1)
         hand_best, generated_best = min(hand_best, hand_seconds), min(generated_best, generated_seconds)
-    return hand_best, generated_best, hand_found
+    return hand_best, generated_best, hand_found, generated_found
+
+
+def noisy_rows(package: Any, make: Callable[[], Message], rng: random.Random) -> list[list[str]]:
+    """The Fashion Star stream damaged as a serial line damages it, fed as a serial port hands it over: generated
+    and hand-written side by side, in reads of 1-256 bytes and in reads of one byte."""
+    rows = []
+    for low, high, size, target in ((*SMALL_READS, STREAM_BYTES, True), (1, 1, ONE_BYTE_STREAM, False)):
+        stream, frames = damaged_stream(package.encode, make, rng, size)
+        reads = reads_of(stream, low, high, rng)
+        hand, generated, hand_found, found = beside_handwritten(package, reads, ROUNDS if high > 1 else 3)
+        what = f"reads of {low}-{high} B" if high > 1 else "reads of 1 B"
+        stream_text = (
+            f"{len(stream) / 1024:.0f} KiB, {NOISY_GARBAGE:.0%} garbage runs, {NOISY_TRUNCATED:.0%} cut starts"
+        )
+        mb_s = len(stream) / generated / 1e6
+        rows.append(
+            [
+                "fashionstar_uart",
+                f"generated StreamParser: READ_ANGLE replies, {what}",
+                "8",
+                stream_text,
+                f"{found}/{frames}",
+                f"{mb_s:.2f}",
+                f"{found / generated / 1000:.0f}k",
+                "—",
+                f"≥ {TARGET_MB_S:.0f} MB/s: {verdict(mb_s >= TARGET_MB_S)}" if target else "—",
+            ]
+        )
+        rows.append(
+            [
+                "fashionstar_uart",
+                f"hand-written pure-Python parser (`FsReplyStream`), same stream, {what}",
+                "8",
+                stream_text,
+                f"{hand_found}/{frames}",
+                f"{len(stream) / hand / 1e6:.2f}",
+                f"{hand_found / hand / 1000:.0f}k",
+                times(hand / generated),
+                f"generated ≥ {HANDWRITTEN_TARGET}× as fast: {verdict(hand / generated >= HANDWRITTEN_TARGET)}"
+                if target
+                else "—",
+            ]
+        )
+    return rows
 
 
 def parse_sdk(chunks: list[bytes]) -> int:
@@ -170,7 +253,7 @@ def run() -> Table:
         chunks = _chunks(stream)
         seconds, found = best_seconds(functools.partial(parse_generated, package.StreamParser, chunks), ROUNDS)
         if name == "fashionstar_uart":  # its rounds beside the hand-written parser's count too (best of all)
-            hand_best, generated_best, hand_found = beside_handwritten(package, chunks)
+            hand_best, generated_best, hand_found, _ = beside_handwritten(package, chunks)
             seconds = min(seconds, generated_best)
         results[name] = (seconds, found)
         mb_s = len(stream) / seconds / 1e6
@@ -205,6 +288,7 @@ def run() -> Table:
             f"generated ≥ {HANDWRITTEN_TARGET}× as fast: {verdict(over_hand >= HANDWRITTEN_TARGET)}",
         ]
     )
+    rows += noisy_rows(importlib.import_module("fashionstar_uart"), _reply_makers(rng)["fashionstar_uart"][1], rng)
     seconds, found = best_seconds(lambda: parse_sdk(fs_chunks), 2)
     # what the target leaves per frame, against decoding one frame with no stream work at all
     fs = importlib.import_module("fashionstar_uart")
@@ -232,7 +316,10 @@ def run() -> Table:
         ]
     )
     return Table(
-        title="Stream parse: noisy stream of short replies, 4 KiB chunks, decoded to typed messages (best of rounds)",
+        title=(
+            "Stream parse: noisy streams of short replies, 4 KiB chunks and serial-port reads, decoded to typed "
+            "messages (best of rounds)"
+        ),
         header=["protocol", "parser", "frame B", "stream", "frames found", "MB/s", "frames/s", "time ÷ generated", ""],
         rows=rows,
         notes=[
@@ -257,6 +344,11 @@ def run() -> Table:
             "returning typed messages. SDK: best of 2 runs of its per-byte loop (see bench/stream.py docstring); "
             "its splitter looks for the response header only, and once it has seen one it takes the bytes that follow "
             "as that frame, so a false header in the noise costs the frame after it (that was rare here).",
+            "Noisy rows (the stream a serial port hands over): Fashion Star READ_ANGLE replies, each after a run of "
+            f"1-8 random bytes one time in {1 / NOISY_GARBAGE:.0f} and after the first 2-7 bytes of another reply "
+            f"(a cut frame start) one time in {1 / NOISY_TRUNCATED:.0f}; fed in reads of random sizes from "
+            f"{SMALL_READS[0]} to {SMALL_READS[1]} bytes, and in reads of one byte "
+            f"({ONE_BYTE_STREAM // 1024} KiB, 3 rounds); generated and hand-written timed round-robin as above.",
             "Creating a parser (`StreamParser(Direction.RESPONSE)`, as every reset and reopen of a bus does; its size "
             "tables are built once per frame format): "
             + ", ".join(f"{name} {us(timing.best_ns)} µs" for name, timing in created.items())

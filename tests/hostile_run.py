@@ -38,6 +38,14 @@ def outcome(base_name: str, mutation: Mutation | Text) -> tuple[list[str], dict[
             data = copy.deepcopy(located.data)
             mutation(data)
             located = Located(located.file, data, located.marks, located.key_marks)
+    except SpecErrors as exc:
+        return str(exc).splitlines(), {}
+    return generated(located)
+
+
+def generated(located: Located) -> tuple[list[str], dict[str, str]]:
+    """A loaded spec's error lines (empty when valid) and, when valid, the files every target generates from it."""
+    try:
         protocol = resolve(located)
         files: dict[str, str] = {}
         problems = []

@@ -37,7 +37,7 @@ from construct import (  # noqa: F401 - the set of names is the same for every p
     this,
 )
 from serialspec.checksums.crc import crc_function
-from serialspec.runtime.constructs import Framed, PackedBits, SignMagnitude, Utf8  # noqa: F401
+from serialspec.runtime.constructs import Framed, PackedBits, SignMagnitude, Utf8, derived  # noqa: F401
 from serialspec.runtime.framing import Element, FrameCodec, Layout
 
 _CHECK_CRC: Callable[[bytes], int] = crc_function(16, 0x8005, 0xffff, True, True, 0x0)  # CRC-16/MODBUS
@@ -93,6 +93,7 @@ ReadCoilsRequestContent = Struct(
 ReadCoilsResponseContent = Struct(
     'byte_count' / Rebuild(Int8ub, lambda ctx: (-(-len(ctx['coils']) // 8))),
     'coils' / PackedBits(Bytes(this.byte_count)),
+    derived('byte_count', lambda ctx: (-(-len(ctx['coils']) // 8))),
 )
 
 ReadDiscreteInputsRequestContent = Struct(
@@ -103,6 +104,7 @@ ReadDiscreteInputsRequestContent = Struct(
 ReadDiscreteInputsResponseContent = Struct(
     'byte_count' / Rebuild(Int8ub, lambda ctx: (-(-len(ctx['inputs']) // 8))),
     'inputs' / PackedBits(Bytes(this.byte_count)),
+    derived('byte_count', lambda ctx: (-(-len(ctx['inputs']) // 8))),
 )
 
 ReadHoldingRegistersRequestContent = Struct(
@@ -113,6 +115,7 @@ ReadHoldingRegistersRequestContent = Struct(
 ReadHoldingRegistersResponseContent = Struct(
     'byte_count' / Rebuild(Int8ub, lambda ctx: (2 * len(ctx['registers']))),
     'registers' / Array(this.byte_count // 2, Int16ub),
+    derived('byte_count', lambda ctx: (2 * len(ctx['registers']))),
 )
 
 ReadInputRegistersRequestContent = Struct(
@@ -123,6 +126,7 @@ ReadInputRegistersRequestContent = Struct(
 ReadInputRegistersResponseContent = Struct(
     'byte_count' / Rebuild(Int8ub, lambda ctx: (2 * len(ctx['registers']))),
     'registers' / Array(this.byte_count // 2, Int16ub),
+    derived('byte_count', lambda ctx: (2 * len(ctx['registers']))),
 )
 
 WriteCoilRequestContent = Struct(
@@ -150,6 +154,8 @@ WriteCoilsRequestContent = Struct(
     'count' / Rebuild(Int16ub, lambda ctx: len(ctx['values'])),
     'byte_count' / Rebuild(Int8ub, lambda ctx: (-(-ctx['count'] // 8))),
     'values' / PackedBits(Bytes((this.count + 7) // 8), this.count),
+    derived('count', lambda ctx: len(ctx['values'])),
+    derived('byte_count', lambda ctx: (-(-ctx['count'] // 8))),
 )
 
 WriteCoilsResponseContent = Struct(
@@ -162,6 +168,8 @@ WriteRegistersRequestContent = Struct(
     'count' / Rebuild(Int16ub, lambda ctx: len(ctx['values'])),
     'byte_count' / Rebuild(Int8ub, lambda ctx: (2 * ctx['count'])),
     'values' / Array(this.count, Int16ub),
+    derived('count', lambda ctx: len(ctx['values'])),
+    derived('byte_count', lambda ctx: (2 * ctx['count'])),
 )
 
 WriteRegistersResponseContent = Struct(
@@ -188,11 +196,14 @@ ReadWriteRegistersRequestContent = Struct(
     'write_count' / Rebuild(Int16ub, lambda ctx: len(ctx['values'])),
     'byte_count' / Rebuild(Int8ub, lambda ctx: (2 * ctx['write_count'])),
     'values' / Array(this.write_count, Int16ub),
+    derived('write_count', lambda ctx: len(ctx['values'])),
+    derived('byte_count', lambda ctx: (2 * ctx['write_count'])),
 )
 
 ReadWriteRegistersResponseContent = Struct(
     'byte_count' / Rebuild(Int8ub, lambda ctx: (2 * len(ctx['registers']))),
     'registers' / Array(this.byte_count // 2, Int16ub),
+    derived('byte_count', lambda ctx: (2 * len(ctx['registers']))),
 )
 
 ExceptionResponseContent = Struct(

@@ -763,7 +763,7 @@ def encode(message: Message) -> bytes:
         return encoder(message)
     except EncodeError:
         raise
-    except (TypeError, AttributeError, ValueError, OverflowError, struct.error) as exc:
+    except (TypeError, AttributeError, ValueError, OverflowError, ZeroDivisionError, struct.error) as exc:
         raise wrong_type(message, exc) from None  # one line naming the field, not Python's words
 
 

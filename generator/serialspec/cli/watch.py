@@ -224,7 +224,8 @@ class PortSource:
                 chunk += self.port.read(self.port.in_waiting)
         except self.errors as exc:
             raise PortError(f"{self.name}: {exc}") from None
-        return self.frames.feed(chunk) if chunk else []
+        # a quiet line settles the bad bytes so far: the view counts them now, not when the next frame comes
+        return self.frames.feed(chunk) if chunk else self.frames.finish()
 
     def close(self) -> None:
         self.port.close()
@@ -242,9 +243,9 @@ class TapSource:
 
     def read(self) -> list[Seen]:
         text = self.stream.read()
-        if not text:
+        if not text:  # nothing new: the bad bytes so far are settled (see PortSource.read)
             time.sleep(REFRESH / 2)
-            return []
+            return [seen for frames in self.streams.values() for seen in frames.finish()]
         text = self.partial + text
         lines = text.split("\n")
         self.partial = lines.pop()  # a line still being written

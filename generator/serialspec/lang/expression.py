@@ -6,6 +6,13 @@ An expression is parsed once, when the spec is resolved, into a small immutable 
 of earlier fields, `len(list_field)`, `+ - * / % & | << >>`, `ceil(a / b)`, `min`, `max` and parentheses.
 `/` is integer division (exact division is what specs mean; a decoder recomputes every derived value and
 refuses a frame whose value differs, so an inexact division cannot pass unnoticed); `ceil(a / b)` rounds up.
+
+Limits, so that no spec and no frame can make an expression exhaust the checker or a decoder: at most MAX_TEXT
+characters and MAX_DEPTH levels of nesting (a flat chain of 3,000 `*` is refused in one line, not by Python's
+recursion limit), and every value it can take for any values of its fields' types, intermediate results included,
+within MAX_BITS bits (`bounds`): `1 << (n * 100000000)` is refused when the spec is checked, since one wire byte
+could ask for a 3 GB integer. What only the wire decides (a divisor that can be 0, a shift count that can be
+negative: `fails`) is a DecodeError of the frame, an EncodeError of the message.
 """
 
 from __future__ import annotations
@@ -28,6 +35,10 @@ _OPERATORS: dict[type[ast.operator], str] = {
     ast.RShift: ">>",
 }
 _FUNCTIONS = ("ceil", "len", "min", "max")
+MAX_TEXT = 500  # characters
+MAX_DEPTH = 50  # levels of nesting
+MAX_BITS = 512  # of any value an expression can take, intermediate results included
+MAX_ITEMS = 1 << 16  # what len() of a field can be, at most (more than any frame holds)
 
 
 class ExpressionError(ValueError):
@@ -88,10 +99,21 @@ def parse(text: str) -> Expr:
     """Parse an expression; raises ExpressionError naming what is not allowed."""
     if not isinstance(text, str):
         raise ExpressionError(f"expected an expression as text, got {text!r}")
+    if len(text) > MAX_TEXT:
+        raise ExpressionError(f"an expression of {len(text)} characters is too long (at most {MAX_TEXT})")
     try:
         tree = ast.parse(text.strip(), mode="eval")
     except SyntaxError:
-        raise ExpressionError(f"{text!r} is not an expression") from None
+        raise ExpressionError(f"{text[:60]!r} is not an expression") from None
+    except (RecursionError, MemoryError):  # Python's own parser, on deep nesting within the length limit
+        raise ExpressionError(f"{text[:60]!r}... is nested too deeply (at most {MAX_DEPTH} levels)") from None
+    # depth first, without recursion: the conversion below recurses once per level
+    stack: list[tuple[ast.AST, int]] = [(tree.body, 1)]
+    while stack:
+        node, depth = stack.pop()
+        if depth > MAX_DEPTH:
+            raise ExpressionError(f"{text[:60]!r}... is nested too deeply (at most {MAX_DEPTH} levels)")
+        stack.extend((child, depth + 1) for child in ast.iter_child_nodes(node))
     return _convert(tree.body, text)
 
 
@@ -218,3 +240,105 @@ _APPLY: dict[str, Callable[[int, int], int]] = {
     "<<": lambda a, b: a << b,
     ">>": lambda a, b: a >> b,
 }
+
+
+Bounds = tuple[int, int]
+
+
+def bounds(expr: Expr, names: Mapping[str, Bounds]) -> Bounds:
+    """The least and greatest values the expression can take when each name's value lies within its bounds (and
+    each len() within 0..MAX_ITEMS), worked out without computing anything large: ExpressionError when a value, an
+    intermediate one included, could need more than MAX_BITS bits. A division by a divisor that can be 0, or a shift
+    by a count that can be negative, leaves that value out (`fails` says whether it can happen)."""
+    if isinstance(expr, Const):
+        return _fits(expr.value, expr.value, expr)
+    if isinstance(expr, Name):
+        return names[expr.name]
+    if isinstance(expr, Length):
+        return 0, MAX_ITEMS
+    if isinstance(expr, Invert):
+        low, high = bounds(expr.operand, names)
+        return -high - 1, -low - 1
+    if isinstance(expr, MinMax):
+        found = [bounds(arg, names) for arg in expr.args]
+        pick = min if expr.function == "min" else max
+        return pick(b[0] for b in found), pick(b[1] for b in found)
+    if isinstance(expr, Ceil):
+        low, high = bounds(expr.numerator, names)
+        below, above = _divide((-high, -low), bounds(expr.denominator, names))
+        return -above, -below
+    a, b = bounds(expr.left, names), bounds(expr.right, names)
+    op = expr.op
+    if op == "+":
+        return _fits(a[0] + b[0], a[1] + b[1], expr)
+    if op == "-":
+        return _fits(a[0] - b[1], a[1] - b[0], expr)
+    if op == "*":
+        if _bits(a) + _bits(b) > MAX_BITS + 1:
+            raise _too_large(expr)
+        products = [x * y for x in a for y in b]
+        return _fits(min(products), max(products), expr)
+    if op == "/":
+        return _divide(a, b)
+    if op == "%":
+        low, high = b
+        return (low + 1 if low < 0 else 0), (high - 1 if high > 0 else 0)
+    if op in ("&", "|"):
+        top = 1 << max(_bits(a), _bits(b))
+        return (-top if min(a[0], b[0]) < 0 else 0), top - 1
+    low, high = max(b[0], 0), max(b[1], 0)  # a negative count fails: `fails` says so
+    if op == "<<":
+        if _bits(a) + high > MAX_BITS + 1:
+            raise _too_large(expr)
+        shifted = [x << y for x in a for y in (low, high)]
+        return _fits(min(shifted), max(shifted), expr)
+    shifted = [x >> min(y, MAX_BITS + 1) for x in a for y in (low, high)]
+    return min(shifted), max(shifted)
+
+
+def fails(expr: Expr) -> bool:
+    """Whether the expression may have no value for some field values: a division (`/`, `%`, ceil) by anything but
+    a constant other than 0, a shift by anything but a constant of at least 0. Decided from its form alone."""
+    if isinstance(expr, BinOp):
+        right = expr.right
+        if expr.op in ("/", "%") and not (isinstance(right, Const) and right.value != 0):
+            return True
+        if expr.op in ("<<", ">>") and not (isinstance(right, Const) and right.value >= 0):
+            return True
+        return fails(expr.left) or fails(right)
+    if isinstance(expr, Ceil):
+        divisor = expr.denominator
+        return not (isinstance(divisor, Const) and divisor.value != 0) or fails(expr.numerator) or fails(divisor)
+    if isinstance(expr, Invert):
+        return fails(expr.operand)
+    if isinstance(expr, MinMax):
+        return any(fails(arg) for arg in expr.args)
+    return False
+
+
+def _bits(b: Bounds) -> int:
+    return max(b[0].bit_length(), b[1].bit_length())
+
+
+def _fits(low: int, high: int, expr: Expr) -> Bounds:
+    if max(low.bit_length(), high.bit_length()) > MAX_BITS:
+        raise _too_large(expr)
+    return low, high
+
+
+def _too_large(expr: Expr) -> ExpressionError:
+    shown = show(expr)
+    shown = shown if len(shown) <= 60 else shown[:57] + "..."
+    if next(names(expr), None) is None:
+        return ExpressionError(f"{shown!r} is a number of more than {MAX_BITS} bits")
+    return ExpressionError(f"{shown!r} can exceed {MAX_BITS} bits for some values of its fields (the wire's)")
+
+
+def _divide(a: Bounds, b: Bounds) -> Bounds:
+    """Bounds of a // b over the divisors other than 0 (floor division is monotonic in each operand on either side
+    of 0, so the corners hold the extremes)."""
+    divisors = [d for d in (b[0], min(b[1], -1), max(b[0], 1), b[1]) if d != 0 and b[0] <= d <= b[1]]
+    if not divisors:
+        return 0, 0  # always a division by 0: `fails` says so
+    quotients = [x // d for x in a for d in divisors]
+    return min(quotients), max(quotients)

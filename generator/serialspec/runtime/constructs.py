@@ -2,9 +2,24 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
-from construct import Adapter, Container, GreedyBytes
+from construct import Adapter, Check, Container, GreedyBytes
+
+
+def derived(name: str, compute: Callable[[Any], int]) -> Any:
+    """construct's Check, placed after every field, that the field `name` derived by a `value:` expression holds what
+    the expression gives for the others (as the codec checks on decode; Modbus byte_count = 2 * count). An expression
+    with no value for those fields (a division by 0, a negative shift) does not hold."""
+
+    def holds(context: Any) -> bool:
+        try:
+            return bool(context[name] == compute(context))
+        except (ZeroDivisionError, ValueError):
+            return False
+
+    return Check(holds)
 
 
 class SignMagnitude(Adapter):  # type: ignore[misc]

@@ -422,6 +422,58 @@ class FrameCodec:
             return -1
         return layout.overhead + content_size
 
+    def verifier(self, layout: Layout) -> Callable[[bytes, int, int], bool] | None:
+        """Whether the checksum of the frame buffer[start:stop] of `layout` holds, without decoding it (no exception
+        to raise and catch for the many candidates that fail): for a layout with one checksum after its content,
+        covering elements from its fixed head on, no stuffing. None for other layouts (decoding decides)."""
+        plan: dict[str, Any] = layout._plan  # type: ignore[attr-defined]
+        if layout.transparency is not None or len(plan["checksums"]) != 1:
+            return None
+        index, element = plan["checksums"][0]
+        head = {i: begin for i, begin, _ in plan["head"]}
+        tail = {i: (begin, finish) for i, begin, finish in plan["tail"]}
+        first, last = element.span
+        if index not in tail or first not in head or last + 1 not in tail or element.checksum is None:
+            return None
+        begin, covered_end, (stored, stored_end) = head[first], tail[last + 1][0], tail[index]
+        checksum, endian = element.checksum, element.endian
+
+        def verify(buffer: bytes, start: int, stop: int) -> bool:
+            value = int.from_bytes(buffer[stop - stored : stop - stored_end], endian)
+            return bool(checksum(buffer[start + begin : stop - covered_end]) == value)
+
+        return verify
+
+    def head_pattern(self, layout: Layout) -> bytes | None:
+        """A regular expression for where a plausible frame of `layout` can start: each byte of its fixed head that
+        the sizer checks (constants, one-byte commands and values) as the class of the bytes it allows, a head the
+        buffer ends in matching as far as it goes (the sizer then waits for more). b"" when any byte can start one;
+        None when no frame of the layout is plausible. The stream parser finds its candidates with it, in C."""
+        if layout.command is None and None not in self.content_sizes:
+            return None
+        plan: dict[str, Any] = layout._plan  # type: ignore[attr-defined]
+        classes: list[bytes] = []
+        for element, first, stop in plan["probe_head"]:
+            allowed: list[list[int]] = [list(range(256))] * (stop - first)
+            if element.kind == "constant":
+                allowed = [[byte] for byte in element.constant]
+            elif element.kind == "command" and stop == first + 1:
+                codes = self.content_sizes
+                allowed = [[v for v in range(256) if (ERROR_REPLY if v & self.error_flag else v) in codes]]
+            elif element.kind == "value" and stop == first + 1:
+                allowed = [[v for v in range(256) if element.plausible(v)]]
+            for values in allowed:
+                if not values:
+                    return None
+                whole = len(values) == 256
+                classes.append(b"." if whole else b"[" + b"".join(re.escape(bytes([v])) for v in values) + b"]")
+        while classes and classes[-1] == b".":
+            classes.pop()
+        pattern = b""
+        for each in reversed(classes):  # each byte, or the end of the buffer before it
+            pattern = each + (b"(?:" + pattern + b"|\\Z)" if pattern else b"")
+        return pattern
+
     def _sizer(self, layout: Layout) -> Callable[[bytes, int, int], int | None]:
         """probe(layout, ...) as a closure over what it reads of the layout's plan, worked out once.
 
@@ -502,6 +554,16 @@ class FrameCodec:
 
 
 Decode = Callable[[bytes, "type[Message] | None"], Message]
+Verify = Callable[[bytes, int, int], bool]
+
+
+def _finder(formats: Iterable[tuple[FrameCodec, Decode]]) -> re.Pattern[bytes] | None:
+    """Where a candidate of any layout can start (FrameCodec.head_pattern), as one pattern; None: at every byte."""
+    patterns = [codec.head_pattern(layout) for codec, _ in formats for layout in codec.layouts]
+    found = [pattern for pattern in patterns if pattern is not None]
+    if not found or not all(found):  # a layout any byte can start (or none at all): every byte is a candidate
+        return None
+    return re.compile(b"(?=" + b"|".join(b"(?:" + pattern + b")" for pattern in found) + b")", re.DOTALL)
 
 
 class FrameStreamParser(StreamParser):
@@ -512,7 +574,10 @@ class FrameStreamParser(StreamParser):
     Every header occurrence (every byte, for frames without a header) is a candidate frame start. A candidate must
     be plausible (constants, values in range, a known command, a length its command allows) before its size is
     trusted, and must decode (stuffing, checksums, content) before it is accepted; a candidate that fails costs one
-    byte. A candidate still waiting for bytes never hides a complete valid frame that starts inside it.
+    byte. The rule of runtime/stream.py decides between overlapping candidates, whatever the reads: the frame that
+    completes first wins (of two ending on the same byte, the first), so a candidate, complete or still waiting for
+    bytes, never hides a valid frame that starts inside it and ends before it. Where several layouts fit at one
+    position, the one that completes first decides it.
     """
 
     def __init__(self, *formats: tuple[FrameCodec, Decode]) -> None:
@@ -520,11 +585,19 @@ class FrameStreamParser(StreamParser):
             raise ValueError("a stream parser needs at least one frame format")
         self._formats = formats
         # every layout's sizer with its format's decoder, in the order candidates try them
-        self._sizers = tuple((sizer, decode) for codec, decode in formats for sizer in codec.sizers)
+        # and a checksum test before a candidate is decoded, where the layout allows one (FrameCodec.verifier)
+        self._sizers = tuple(
+            (sizer, decode, codec.verifier(layout))
+            for codec, decode in formats
+            for sizer, layout in zip(codec.sizers, codec.layouts, strict=True)
+        )
         self._pending = b""
         headers = [layout.header for codec, _ in formats for layout in codec.layouts]
-        self._headers = tuple(sorted({h for h in headers}, key=len)) if all(headers) else ()
+        self._headers = bool(all(headers))
         self._keep = max((len(h) for h in headers), default=1) - 1
+        # no frame is shorter than its layout's fixed elements
+        self._smallest = max(1, min(layout.overhead for codec, _ in formats for layout in codec.layouts))
+        self._finder = _finder(formats)
         self.errors = 0
         self.garbage = 0
         self.expected: type[Message] | None = None
@@ -533,74 +606,93 @@ class FrameStreamParser(StreamParser):
         """The reply class the next frames answer, where several reply layouts share a code (PING's vs READ's)."""
         self.expected = cls
 
-    def _starts(self, buffer: bytes, start: int) -> int:
-        if not self._headers:
-            return start
-        best = -1
-        for header in self._headers:
-            position = buffer.find(header, start)
-            if position >= 0 and (best < 0 or position < best):
-                best = position
-        return best
-
     def feed(self, data: bytes | bytearray | memoryview) -> list[Message]:
+        """One pass over the candidates from the last frame taken on: the valid frame that ends first (then starts
+        first) among them is the next one taken, and no candidate after it needs a look once none can end before it.
+        A corrupt candidate counts as an error when the byte-by-byte scan would have decided it before taking that
+        frame: when it and every candidate before it had all their bytes by the time that frame ended."""
         buffer = self._pending + bytes(data)
         end = len(buffer)
         found: list[Message] = []
-        start = done = 0  # scanning from `start`; bytes before `done` are accounted for
-        hold = -1  # the first candidate still waiting for bytes
-        # Corrupt candidates after one still waiting for its bytes count only once a frame after them is accepted
-        # (the waiting one was no frame): without a header every byte is a candidate, and those inside a frame
-        # that a read has cut are no errors. Left uncounted at the end, they are scanned again with the next bytes.
-        deferred = 0
-        while start < end:
-            position = self._starts(buffer, start)
-            if position < 0:
-                break
-            accepted = self._try(buffer, position, end, found)
-            if accepted is None or accepted < 0:
-                if accepted is None and hold < 0:
-                    hold = position
-                if accepted == -2:
-                    if hold < 0:
-                        self.errors += 1
+        search = self._finder.search if self._finder is not None else None
+        smallest, expected = self._smallest, self.expected
+        start = 0
+        while True:
+            best: tuple[Message, int, int] | None = None
+            bound = end + 1  # where the best frame so far ends: a frame must end before it to win
+            seen: list[tuple[int, int, bool]] = []  # candidates before it: (start, end or end + 1, corrupt)
+            waiting = False
+            position = start
+            while True:
+                if search is not None:
+                    match = search(buffer, position)
+                    if match is None:
+                        break
+                    position = match.start()
+                # no frame from here can end before the best one (or, none found, in the bytes there are, once one
+                # candidate is known to be waiting for more)
+                if position >= end or (position + smallest >= bound and (best is not None or waiting)):
+                    break
+                sized = self._size(buffer, position, end)
+                if sized is not None:
+                    stop, decode, verify = sized
+                    if decode is None:  # still waiting for bytes
+                        seen.append((position, end + 1, False))
+                        waiting = True
+                    elif stop < bound:
+                        message = None
+                        # the checksum first (no message built when it fails), but for the candidate the scan
+                        # starts at, usually a frame: decoding it checks the checksum once
+                        if verify is None or position == start or verify(buffer, position, stop):
+                            try:
+                                message = decode(buffer[position:stop], expected)
+                            except DecodeError:
+                                message = None
+                        if message is None:
+                            seen.append((position, stop, True))
+                        else:
+                            best, bound = (message, position, stop), stop
                     else:
-                        deferred += 1
-                start = position + 1
-                continue
-            self.garbage += position - done
-            self.errors += deferred
-            hold, deferred = -1, 0
-            start = done = accepted
+                        seen.append((position, stop, False))
+                position += 1
+            first, last = (best[1], best[2]) if best is not None else (end + 1, end)
+            hold = -1
+            for position, stop, corrupt in seen:
+                if position >= first:
+                    break
+                if stop > last:  # undecided when the frame taken ended (or the bytes ran out)
+                    hold = position
+                    break
+                self.errors += corrupt
+            if best is None:
+                break
+            message, first, stop = best
+            found.append(message)
+            self.garbage += first - start
+            start = stop
         if hold >= 0:
             cut = hold
         elif self._headers:
-            cut = max(done, end - self._keep)
+            cut = max(start, end - self._keep)
         else:
             cut = end
-        self.garbage += cut - done
+        self.garbage += cut - start
         self._pending = buffer[cut:]
         return found
 
-    def _try(self, buffer: bytes, position: int, end: int, found: list[Message]) -> int | None:
-        """End of the frame accepted at position, None to wait for bytes, -1 implausible, -2 corrupt."""
-        waiting = False
-        for sizer, decode in self._sizers:
+    def _size(self, buffer: bytes, position: int, end: int) -> tuple[int, Decode | None, Verify | None] | None:
+        """The candidate at `position`: (where its layout that completes first ends, that layout's decoder and
+        checksum test), the decoder None while it must wait for bytes (its size is not known yet, or it ends past
+        `end`); None when no layout fits."""
+        best: tuple[int, Decode | None, Verify | None] | None = None
+        for sizer, decode, verify in self._sizers:
             size = sizer(buffer, position, end)
             if size is None:
-                waiting = True
-                continue
-            if size < 0:
-                continue
-            if position + size > end:
-                waiting = True
-                continue
-            try:
-                found.append(decode(buffer[position : position + size], self.expected))
-            except DecodeError:
-                return -2
-            return position + size
-        return None if waiting else -1
+                if best is None:
+                    best = (end + 1, None, None)
+            elif size >= 0 and (best is None or position + size < best[0]):
+                best = (position + size, decode, verify) if position + size <= end else (position + size, None, None)
+        return best
 
     def pending(self) -> bytes:
         return self._pending

@@ -3,8 +3,13 @@
 A candidate frame starts at a header. Before it is accepted it must be plausible: a known command whose content
 size fits the length byte, frame-level values (an address) within their declared range; then its checksum must
 verify. Whenever a candidate fails, scanning resumes one byte after its header, so a stray header or a truncated
-frame never swallows the intact frame that follows it. A candidate still waiting for bytes never hides a complete,
-valid frame that starts inside it: that frame is delivered, and the candidate counted as garbage.
+frame never swallows the intact frame that follows it.
+
+One rule decides between candidates that overlap, whatever the reads: the frame that completes first wins (of two
+ending on the same byte, the one that starts first), as a scan fed one byte at a time finds it. A candidate, complete
+or still waiting for bytes, never hides a valid frame that starts inside it and ends before it: that frame is
+delivered, and the candidate counted as garbage (a false candidate whose 8-bit sum matches by chance cannot swallow
+the real frame inside it). So any split of a stream into reads gives the same frames, errors and skipped bytes.
 """
 
 from __future__ import annotations
@@ -69,6 +74,8 @@ class _Candidate:
         "key_bytes",
         "sum_from",
         "sum_table",
+        "smallest",
+        "tails",
     )
 
     def __init__(self, frame_format: FrameFormat) -> None:
@@ -105,6 +112,9 @@ class _Candidate:
         after = min(frame_format.length_offset, frame_format.command_offset or width)
         self.splittable = bool(header) and after >= width
         self.shifts = tuple(k for k in range(1, width) if header[k:] == header[: width - k])
+        # a piece (the bytes after a header) starting with one of these holds a header overlapping the one before it
+        self.tails = tuple(header[width - k :] for k in self.shifts)
+        self.smallest = min(self.frame_sizes.values(), default=1 << 30)  # the smallest plausible frame
         # Every plausible frame as the batch scan reads it: size key -> (frame size, its bytes after the header, the
         # decoder of the frames decoded whole, or None for decode_at).
         self.pieces = {key: (size, size - width, self.fixed.get(key)) for key, size in self.frame_sizes.items()}
@@ -191,6 +201,8 @@ class StreamParser:
         self._single = self._candidates[0] if len(self._candidates) == 1 else None
         self._pending = b""
         self._keep = max(len(f.header) for f in formats) - 1  # a tail that could be the start of a header
+        self._need = 0  # the size of the candidate held back while feed() waits for its bytes (0: none)
+        self._smallest = min(c.smallest for c in self._candidates)
         # runs: pieces the next one takes at most, pieces to wait before it is tried, the wait after the next failure
         self._block, self._wait, self._backoff = _FIRST_RUN, 0, _SHORTEST_RUN
         self.errors = 0
@@ -198,11 +210,25 @@ class StreamParser:
 
     def feed(self, data: bytes | bytearray | memoryview) -> list[Message]:
         # Work on immutable bytes: decoders slice their `bytes` fields straight out of the buffer.
-        buffer = self._pending + data if self._pending else data if type(data) is bytes else bytes(data)
+        pending = self._pending
+        buffer = pending + data if pending else data if type(data) is bytes else bytes(data)
         single = self._single
         if single is None:
             return self._scan(buffer)
         end = len(buffer)
+        need = self._need
+        if need:  # a candidate held back, its bytes not all here: nothing can change before they are
+            header = single.header
+            # unless a header comes in the new bytes (a frame inside the candidate may complete first)
+            if end < need and buffer.find(header, max(1, len(pending) - len(header) + 1)) < 0:
+                self._pending = buffer
+                return []
+            self._need = 0
+        if end < 64 and buffer.find(single.header) < 0:  # a short read of garbage (or of a header's first bytes)
+            cut = max(0, end - self._keep)
+            self.garbage += cut
+            self._pending = buffer[cut:]
+            return []
         if end >= single.prefix:
             # A transaction's read is usually one whole frame, first byte on: decode it without a scan. A frame
             # that fails goes through the scan, which counts it and resynchronises.
@@ -213,14 +239,26 @@ class StreamParser:
                 single.frame_sizes.get(key) == end
                 and buffer.startswith(single.header)
                 and (not single.ranges or single.plausible(buffer, 0))  # a value out of range: the scan skips it
+                # no header inside where a frame ending before this one could start: it would win
+                and buffer.find(single.header, 1, end - 1 - single.smallest + len(single.header)) < 0
             ):
                 message = single.take(key, buffer, 0, end)
                 if message is not None:
                     self._pending = b""
                     return [message]
-        if single.splittable:
-            return self._split(buffer, single)
-        return self._scan(buffer)
+        found = self._split(buffer, single) if single.splittable else self._scan(buffer)
+        held = self._pending
+        if held.startswith(single.header) and held.find(single.header, 1) < 0:
+            # the candidate held back, with no header after its first byte: feed() waits for its bytes (or for the
+            # bytes that say how many there are)
+            if len(held) < single.prefix:
+                self._need = single.prefix
+            else:
+                key = held[single.length_offset]
+                if single.command_offset is not None:
+                    key |= held[single.command_offset] << 8
+                self._need = single.frame_sizes.get(key, 0)
+        return found
 
     def _split(self, buffer: bytes, current: _Candidate) -> list[Message]:
         """The batch scan of one frame format: split the buffer at every header (one pass in C) and take the pieces
@@ -228,9 +266,10 @@ class StreamParser:
         exactly what the byte-by-byte scan (`_scan`) would: a candidate that fails resumes at the next header (one
         that overlaps its own header included), an accepted frame skips any header inside it.
 
-        The usual piece holds one plausible frame, then perhaps garbage: that takes one lookup and one call.
-        Anything else (a frame cut by the next header, a value out of range, a corrupt frame, headers overlapping
-        one another, the end of the buffer) takes the general path below it.
+        The usual piece holds one plausible frame, then perhaps garbage: that takes one lookup and one call (no
+        header starts inside that frame, so no frame can complete before it). Anything else (a frame cut by the next
+        header, a value out of range, a corrupt frame, headers overlapping one another, the end of the buffer) takes
+        the general path below it, which decides each candidate as the byte-by-byte scan does (`_decide`).
         """
         header = current.header
         width = len(header)
@@ -242,7 +281,7 @@ class StreamParser:
         command_at = -1 if current.command_offset is None else current.command_offset - width
         byte_at, allowed = current.byte_at, current.allowed
         wide = current.wide
-        shifts = current.shifts
+        shifts, tails = current.shifts, current.tails
         found: list[Message] = []
         append = found.append
         position = len(pieces[0])  # of the header before the piece
@@ -288,6 +327,7 @@ class StreamParser:
                         rest <= after
                         and (allowed is None or allowed[piece[byte_at]])
                         and (not wide or current.plausible(buffer, position))
+                        and (not tails or not piece.startswith(tails))  # no header overlapping it: none inside
                     ):
                         if decode is not None:
                             message = decode(buffer, position)
@@ -312,20 +352,14 @@ class StreamParser:
             for at in ats:
                 if at < start or (at != position and not buffer.startswith(header, at)):
                     continue
-                taking = self._take_at(buffer, at, current)
-                if taking is None:  # incomplete: wait for more bytes, unless a complete frame starts inside it
-                    inner = self._complete_frame_after(buffer, at + 1)
-                    if inner >= 0:
-                        self.garbage += inner - taken
-                        self.errors += errors
-                        self._wait = max(0, retry - len(pieces))
-                        return found + self._scan(buffer[inner:])
+                decided = self._decide(buffer, at, current)
+                if decided is None:  # incomplete, and no frame completes inside it: wait for more bytes
                     cut = at
                     break
-                message, stop = taking
-                if message is not None:
+                message, where, stop = decided
+                if message is not None:  # this candidate, or a frame inside it that completes first
                     append(message)
-                    taken += stop - at
+                    taken += stop - where
                     start = stop
                 else:
                     errors += stop  # 1: a corrupt frame; 0: no frame
@@ -361,6 +395,13 @@ class StreamParser:
         for at, shift in current.key_bytes:
             column = frames[at::rest]
             count = min(count, len(column) - len(column.lstrip(bytes((key >> shift & 0xFF,)))))
+        for tail in current.tails:  # a header overlapping a frame's own one may start a frame inside it: not a run
+            column = frames[::rest]
+            index = column.find(tail[0], 0, count)
+            while index >= 0 and not frames.startswith(tail, index * rest):
+                index = column.find(tail[0], index + 1, count)
+            if index >= 0:
+                count = index
         if count < 2:
             return 0, b""
         frames = frames[: count * rest]
@@ -377,107 +418,95 @@ class StreamParser:
             frames = frames[: count * rest]
         return count, frames
 
-    def _take_at(self, buffer: bytes, at: int, current: _Candidate) -> tuple[Message | None, int] | None:
-        """The candidate whose header is at `at`: (message, where it ends) when it is a frame; (None, 1) when it is
-        corrupt, (None, 0) when it is no frame (implausible); None when it is plausible but its bytes have not all
-        come."""
+    def _decide(self, buffer: bytes, at: int, current: _Candidate) -> tuple[Message | None, int, int] | None:
+        """The candidate whose header is at `at`, as the byte-by-byte scan decides it: (message, start, end) of the
+        frame taken (this one, or the one inside it that completes first); (None, at, 1) when it is corrupt and
+        (None, at, 0) when it is no frame (implausible); None when it must wait for more bytes."""
         end = len(buffer)
-        if end - at < current.prefix:
-            return None
-        key = buffer[at + current.length_offset]
-        if current.command_offset is not None:
-            key |= buffer[at + current.command_offset] << 8
-        size = current.frame_sizes.get(key)
-        if size is None or (current.ranges and not current.plausible(buffer, at)):
-            return None, 0
-        if at + size > end:
+        size = None
+        if end - at >= current.prefix:
+            key = buffer[at + current.length_offset]
+            if current.command_offset is not None:
+                key |= buffer[at + current.command_offset] << 8
+            size = current.frame_sizes.get(key)
+            if size is None or (current.ranges and not current.plausible(buffer, at)):
+                return None, at, 0
+            if at + size > end:
+                size = None
+        # a frame inside this candidate that ends before it (or before the bytes run out) completes first
+        inner = self._earliest(buffer, at + 1, end + 1 if size is None else at + size)
+        if inner is not None:
+            return inner
+        if size is None:
             return None
         message = current.take(key, buffer, at, at + size)
-        return (None, 1) if message is None else (message, at + size)
+        return (None, at, 1) if message is None else (message, at, at + size)
+
+    def _earliest(self, buffer: bytes, first: int, bound: int) -> tuple[Message, int, int] | None:
+        """The frame that completes first (of two ending together, the first) among the valid frames that start at
+        or after `first` and end before `bound` (at most len(buffer) + 1): (message, start, end), or None."""
+        best = None
+        end = len(buffer)
+        single = self._single
+        smallest = self._smallest
+        while True:
+            if single is not None:  # only headers where a frame ending before `bound` can start
+                position = buffer.find(single.header, first, bound - 1 - smallest + len(single.header))
+                candidate = single
+            else:
+                position, candidate = self._next_header(buffer, first)
+            if position < 0 or position + smallest >= bound:
+                return best
+            if end - position >= candidate.prefix:
+                key = buffer[position + candidate.length_offset]
+                if candidate.command_offset is not None:
+                    key |= buffer[position + candidate.command_offset] << 8
+                size = candidate.frame_sizes.get(key)
+                if (
+                    size is not None
+                    and position + size < bound
+                    and (not candidate.ranges or candidate.plausible(buffer, position))
+                ):
+                    message = candidate.take(key, buffer, position, position + size)
+                    if message is not None:
+                        best, bound = (message, position, position + size), position + size
+            first = position + 1
 
     def _scan(self, buffer: bytes) -> list[Message]:
-        """The byte-by-byte scan: the nearest header of any frame format, its key, its frame."""
+        """The byte-by-byte scan: the nearest header of any frame format, then `_decide`."""
         end = len(buffer)
         single = self._single
         found: list[Message] = []
         append = found.append
-        find = buffer.find
-        # one frame format (the usual case): its parameters stay in locals for the whole scan
         current = self._candidates[0]
-        header, prefix, command_offset, length_offset = (
-            current.header,
-            current.prefix,
-            current.command_offset,
-            current.length_offset,
-        )
-        frame_sizes = current.frame_sizes
         garbage = errors = start = 0
         while True:
             if single is not None:
-                position = find(header, start)
+                position = buffer.find(current.header, start)
             else:
                 position, current = self._next_header(buffer, start)
-                header, prefix, command_offset, length_offset = (
-                    current.header,
-                    current.prefix,
-                    current.command_offset,
-                    current.length_offset,
-                )
-                frame_sizes = current.frame_sizes
             if position < 0:
                 cut = max(start, end - self._keep)
                 garbage += cut - start
                 self._pending = buffer[cut:]
                 break
-            garbage += position - start
-            if end - position < prefix:  # plausible so far but incomplete: wait for more bytes
+            decided = self._decide(buffer, position, current)
+            if decided is None:  # wait for more bytes
+                garbage += position - start
                 self._pending = buffer[position:]
                 break
-            key = buffer[position + length_offset]
-            if command_offset is not None:
-                key |= buffer[position + command_offset] << 8
-            size = frame_sizes.get(key)
-            if size is None or (current.ranges and not current.plausible(buffer, position)):
-                # implausible (unknown command, a content size it never has, a value out of range): no frame start
+            message, where, stop = decided
+            if message is None:  # no frame, or a corrupt one: resume one byte after its header
+                errors += stop
+                garbage += position + 1 - start
                 start = position + 1
-                garbage += 1
-                continue
-            stop = position + size
-            if stop > end:
-                inner = self._complete_frame_after(buffer, position + 1)
-                if inner < 0:
-                    self._pending = buffer[position:]
-                    break
-                garbage += inner - position  # a stray header: the complete frame inside it is the real one
-                start = inner
-                continue
-            message = current.take(key, buffer, position, stop)
-            if message is None:
-                errors += 1
-                start = position + 1
-                garbage += 1
                 continue
             append(message)
+            garbage += where - start
             start = stop
         self.garbage += garbage
         self.errors += errors
         return found
-
-    def _complete_frame_after(self, buffer: bytes, start: int) -> int:
-        """Where the first complete frame that decodes starts at or after `start`; -1 if there is none."""
-        end = len(buffer)
-        while True:
-            position, candidate = self._next_header(buffer, start)
-            if position < 0 or end - position < candidate.prefix:
-                return -1
-            key = buffer[position + candidate.length_offset]
-            if candidate.command_offset is not None:
-                key |= buffer[position + candidate.command_offset] << 8
-            size = candidate.frame_sizes.get(key)
-            complete = size is not None and position + size <= end and candidate.plausible(buffer, position)
-            if complete and size is not None and candidate.take(key, buffer, position, position + size) is not None:
-                return position
-            start = position + 1
 
     def _next_header(self, buffer: bytes, start: int) -> tuple[int, _Candidate]:
         best, best_candidate = -1, self._candidates[0]

@@ -29,6 +29,7 @@ from serialspec.backends.python.ir import (
     ReturnNew,
     Simple,
     TakeRest,
+    Try,
     Unpack,
     lines_of,
     packed_lists,
@@ -469,6 +470,16 @@ class PackageCode:
             if isinstance(f, Scalar) and f.value is not None:
                 expected = expression.render(f.value, self.local_named)
                 shown = one_line(expression.show(f.value)).replace("{", "{{").replace("}", "}}")
+                if expression.fails(f.value):  # a divisor of 0 or a negative shift from the wire: a bad frame
+                    reason = f"{f.name}: {shown} has no value here (a division by 0 or a negative shift)"
+                    body.append(
+                        Try(
+                            (Code(f"expected_value = {expected}"),),
+                            "(ZeroDivisionError, ValueError)",
+                            (Raise(f"DecodeError({where} + f': {reason}') from None"),),
+                        )
+                    )
+                    expected = "expected_value"
                 reason = f"{f.name} is {{{self.local(f)}}}, but {shown} = {{{expected}}}"
                 body.append(If(f"{self.local(f)} != {expected}", (Raise(f"DecodeError({where} + f': {reason}')"),)))
 

@@ -7,6 +7,7 @@ fast decode/encode statements (content.py), the simulator's and client's field l
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any, Generic
 
 from serialspec.backends.common.kinds import F, Registry
@@ -266,19 +267,26 @@ class BytesKind(Kind[Bytes]):
         return repr(" ".join(["00"] * f.size)) if isinstance(f.size, int) else "''"
 
 
+def derived_checks(fields: Sequence[SpecField]) -> list[str]:
+    """construct elements to put after `fields`: a Check of each value derived by a `value:` expression (Rebuild
+    computes it on build, and reads whatever the frame holds on parse)."""
+    return [
+        f"derived({f.name!r}, lambda ctx: {expression.render(f.value, lambda name: f'ctx[{name!r}]')})"
+        for f in fields
+        if isinstance(f, Scalar) and f.value is not None
+    ]
+
+
 class GroupKind(Kind[Group]):
     model = Group
 
     def construct(self, f: Group, parent: str) -> str:
         names = {i.name for i in f.fields}
-        item = (
-            "Struct("
-            + ", ".join(
-                f"{i.name!r} / {kind(i).construct(i, 'this' if isinstance(i, Bytes) and i.size in names else 'item')}"
-                for i in f.fields
-            )
-            + ")"
-        )
+        parts = [
+            f"{i.name!r} / {kind(i).construct(i, 'this' if isinstance(i, Bytes) and i.size in names else 'item')}"
+            for i in f.fields
+        ]
+        item = "Struct(" + ", ".join(parts + derived_checks(f.fields)) + ")"
         if f.count == "rest":
             return f"GreedyRange({item})"
         count = f.count if isinstance(f.count, int) else f"this.{f.count}"

@@ -6,7 +6,7 @@ construct is the declarative reference the fast codec is tested against; it is n
 from __future__ import annotations
 
 from serialspec.backends.python.frames import checksum_definitions, codec_lines, framing_imports, import_lines
-from serialspec.backends.python.kinds import kind, primitive
+from serialspec.backends.python.kinds import derived_checks, kind, primitive
 from serialspec.backends.python.render import one_line, render
 from serialspec.lang.model import (
     Direction,
@@ -52,7 +52,7 @@ def frame_expr(layout: FrameLayout) -> str:
 def structs_module(protocol: Protocol) -> str:
     contents = []
     for message in protocol.messages():
-        fields = [f"{f.name!r} / {field_expr(f)}" for f in message.fields]
+        fields = [f"{f.name!r} / {field_expr(f)}" for f in message.fields] + derived_checks(message.fields)
         contents.append(
             {
                 "name": message.struct_name,

@@ -88,6 +88,52 @@ class FieldResolver(Pass):
                     seen.update(cycle)
                     chain = " -> ".join(cycle)
                     self.error((*path, field.name, "value"), f"derived values depend on each other: {chain}")
+        if not seen:
+            self.check_value_bounds(fields, by_name, path)
+
+    def check_value_bounds(self, fields: list[Field], by_name: dict[str, Field], path: Path) -> None:
+        """Every derived value can fit its field, and no value it can take for any wire values of its fields is
+        huge (expression.bounds); a constant one is checked against the field's range."""
+        found: dict[str, expression.Bounds | None] = {}
+
+        def of(field: Field) -> expression.Bounds | None:
+            """The values a field can hold: its type's (from the wire), and its expression's (on encode)."""
+            if field.name in found:
+                return found[field.name]
+            found[field.name] = None
+            if not isinstance(field, Scalar) or field.type.is_float:
+                return None
+            wire = (int(field.type.minimum), int(field.type.maximum))
+            if field.value is None:
+                found[field.name] = wire
+                return wire
+            names: dict[str, expression.Bounds] = {}
+            for name in expression.names(field.value):
+                other = by_name.get(name)
+                known = None if other is None else of(other)
+                if known is None and not isinstance(other, LISTS):
+                    return None  # an error said so already
+                names[name] = known or (0, 0)
+            where = (*path, field.name, "value")
+            try:
+                low, high = expression.bounds(field.value, names)
+            except expression.ExpressionError as exc:
+                self.error(where, str(exc))
+                return None
+            shown = expression.show(field.value)
+            shown = shown if len(shown) <= 60 else shown[:57] + "..."
+            first, last = int(field.minimum), int(field.maximum)
+            if low == high and not first <= low <= last:
+                said = shown if isinstance(field.value, expression.Const) else f"{shown} = {low}"
+                self.error(where, f"{said} does not fit {field.name} ({field.type.name}, {first}..{last})")
+            elif high < first or low > last:
+                self.error(where, f"{shown} is always outside {field.name}'s {first}..{last}: it is {low}..{high}")
+            found[field.name] = (min(low, wire[0]), max(high, wire[1]))
+            return found[field.name]
+
+        for field in fields:
+            if isinstance(field, Scalar) and field.value is not None:
+                of(field)
 
     def expand(self, item: Any, path: Path) -> dict[str, Any]:
         """A field's mapping, with the short forms and `use:` references expanded."""

@@ -1,0 +1,106 @@
+"""The adversarial corpus (tests/adversarial/, see its README): every reproducer of a bug found, run by `make test`."""
+
+from __future__ import annotations
+
+import importlib
+import re
+from pathlib import Path
+from typing import Any
+
+import pytest
+import yaml
+from conftest import ALL
+from construct import ConstructError, Struct, Terminated
+from hostile_run import generated
+from serialspec.backends.python.memory import imported
+from serialspec.lang import SpecErrors
+from serialspec.lang.loader import load_file
+from serialspec.runtime.errors import DecodeError
+from test_codec import frame_content
+
+CORPUS = Path(__file__).resolve().parent / "adversarial"
+LINE = re.compile(r"^(?P<file>[\w.]+\.yaml):(?P<line>[1-9]\d*):(?P<column>[1-9]\d*): (?P<rest>.+)$")
+
+
+def cases(kind: str) -> list[Any]:
+    return [pytest.param(path, id=path.stem) for path in sorted((CORPUS / kind).glob("*.yaml"))]
+
+
+def hex_bytes(text: str) -> bytes:
+    return bytes.fromhex(" ".join(text.split()))
+
+
+def test_the_corpus_has_every_kind() -> None:
+    assert all(cases(kind) for kind in ("streams", "frames", "specs"))
+
+
+@pytest.mark.parametrize("path", cases("streams"))
+def test_stream(path: Path) -> None:
+    case = yaml.safe_load(path.read_text(encoding="utf-8"))
+    package = importlib.import_module(case["protocol"])
+    direction = None if case["direction"] == "both" else case["direction"]
+    stream = hex_bytes(case["stream"])
+    expected = [hex_bytes(frame) for frame in case["frames"]]
+    splits = [[stream], [bytes([b]) for b in stream]]
+    splits += [[stream[:cut], stream[cut:]] for cut in range(1, len(stream))]
+    for reads in splits:
+        parser = package.StreamParser(direction)
+        found = [package.encode(message) for chunk in reads for message in parser.feed(chunk)]
+        assert found == expected, [len(r) for r in reads]
+
+
+@pytest.mark.parametrize("path", cases("frames"))
+def test_frame(path: Path) -> None:
+    case = yaml.safe_load(path.read_text(encoding="utf-8"))
+    g = next(g for g in ALL if g.protocol.name == case["protocol"])
+    package, structs = g.package, g.structs
+    frame = hex_bytes(case["frame"])
+    if case.get("decode"):
+        with pytest.raises(DecodeError) as refused:
+            package.decode(frame, case["direction"])
+        assert str(refused.value) == case["decode"]
+    else:
+        package.decode(frame, case["direction"])
+    if "structs" in case:
+        content = frame_content(g, frame, case["direction"])
+        whole = Struct("content" / structs.CONTENTS[(case["message"], case["direction"])], Terminated)
+        try:
+            whole.parse(content)
+            outcome = "accepted"
+        except ConstructError:
+            outcome = "refused"
+        assert outcome == case["structs"]
+
+
+@pytest.mark.parametrize("path", cases("specs"))
+def test_spec(path: Path) -> None:
+    text = path.read_text(encoding="utf-8")
+    notes = [line[2:] for line in text.splitlines() if line.startswith("# ")]
+    refused = [note.removeprefix("refused: ") for note in notes if note.startswith("refused: ")]
+    try:
+        lines, files = generated(load_file(str(path), path.name))
+    except SpecErrors as exc:  # refused by the loader
+        lines, files = str(exc).splitlines(), {}
+    if refused:
+        assert len(lines) == 1, lines
+        match = LINE.match(lines[0])
+        assert match and match["file"] == path.name, lines[0]
+        assert match["rest"] == refused[0]
+        return
+    assert lines == []
+    package_name = next(name.partition("/")[0] for name in files if name.endswith("/__init__.py"))
+    modules = {name.partition("/")[2]: body for name, body in files.items() if name.startswith(package_name + "/")}
+    with imported(package_name, modules) as package:
+        for note in notes:
+            if not note.startswith("decode "):
+                continue
+            direction, _, rest = note.removeprefix("decode ").partition(": ")
+            frame_text, _, reason = rest.partition(": ")
+            frame = hex_bytes(frame_text)
+            if reason:
+                with pytest.raises(DecodeError) as failed:
+                    package.decode(frame, direction)
+                assert str(failed.value) == reason
+            else:
+                package.decode(frame, direction)
+            package.StreamParser(direction).feed(frame * 2)

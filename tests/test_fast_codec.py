@@ -14,7 +14,7 @@ from typing import Any
 import pytest
 from conftest import ALL, Generated, by_protocol, examples
 from hypothesis import HealthCheck, given, settings
-from serialspec.backends.python.pycode import PackageCode
+from serialspec.backends.python.content import PackageCode
 from serialspec.lang.model import Message
 from serialspec.runtime.errors import ChecksumError
 from serialspec.runtime.message import field_names, slot_setters

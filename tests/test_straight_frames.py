@@ -1,4 +1,5 @@
-"""Straight-line frame code (backends/python/framecode.py) against the interpreted frame engine (runtime/framing.py).
+"""Straight-line frame code (backends/python/straight_frames.py) against the interpreted frame engine
+(runtime/framing.py).
 
 Codecs of frames that are not of the classic shape check and build their frames in generated straight-line code;
 the engine's FrameCodec (which the stream parser still uses to size frames) stays the reference. On random frames,

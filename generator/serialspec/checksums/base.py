@@ -60,6 +60,18 @@ class Sample:
     keys: Mapping[str, Any] = field(default_factory=dict)
 
 
+@dataclass(frozen=True)
+class TableSteps:
+    """A checksum that python_lines computes by `target = table[target ^ byte]` over the covered bytes: the table's
+    name in the generated module, its entries, the value before the first byte, and the statements after the last
+    (into `target`)."""
+
+    table: str
+    entries: tuple[int, ...]
+    start: int
+    finish: tuple[str, ...] = ()
+
+
 _REGISTERED: dict[str, type[Algorithm]] = {}
 
 
@@ -116,9 +128,16 @@ class Algorithm:
         (parenthesised where it is not an atom or a call)."""
         return name + "({})"
 
+    def python_expression(self, name: str, covered: str) -> str | None:
+        """The checksum of the bytes `covered` as the one expression python_lines assigns; None where python_lines
+        takes more than one statement."""
+        return self.python_call(name).format(covered)
+
     def python_lines(self, name: str, covered: str, target: str) -> list[str]:
         """Statements that compute the checksum of the bytes `covered` (an expression) into the variable `target`."""
-        return [f"{target} = {self.python_call(name).format(covered)}"]
+        expression = self.python_expression(name, covered)
+        assert expression is not None  # an algorithm that takes statements writes them itself
+        return [f"{target} = {expression}"]
 
     # -- the Python backend: optional fast paths (None where the algorithm has none) ---------------------------
 
@@ -139,10 +158,9 @@ class Algorithm:
         whether this one is inverted; None for every other checksum."""
         return None
 
-    def byte_table(self, name: str) -> tuple[str, tuple[int, ...]] | None:
-        """Where python_lines runs `state = TABLE[state ^ byte]` over the covered bytes from a constant start:
-        the table's name in the generated module and its entries (a codec may then fold known bytes into the
-        start and unroll short runs); None for others."""
+    def byte_table(self, name: str, target: str) -> TableSteps | None:
+        """Where python_lines runs `target = TABLE[target ^ byte]` over the covered bytes from a constant start:
+        the steps (a codec may then fold known bytes into the start and unroll short runs); None for others."""
         return None
 
     # -- the markdown backend ----------------------------------------------------------------------------------

@@ -13,7 +13,17 @@ from dataclasses import dataclass
 from functools import cache
 from typing import Any
 
-from serialspec.checksums.base import Algorithm, ChecksumProblem, Import, Key, Report, Sample, hex_bytes, hex_value
+from serialspec.checksums.base import (
+    Algorithm,
+    ChecksumProblem,
+    Import,
+    Key,
+    Report,
+    Sample,
+    TableSteps,
+    hex_bytes,
+    hex_value,
+)
 
 
 def _reflect(value: int, width: int) -> int:
@@ -328,23 +338,27 @@ class Crc(Algorithm):
     def python_call(self, name: str) -> str:
         return crc_in_one_call(*self.parameters_tuple) or super().python_call(name)
 
-    def python_lines(self, name: str, covered: str, target: str) -> list[str]:
-        if not self.stepped:
-            return super().python_lines(name, covered, target)
-        # With 8 bits the table-driven step is table[crc ^ byte] whether the CRC is reflected or not.
-        lines = [
-            f"{target} = {_reflect(self.init, 8) if self.refin else self.init:#x}",
-            f"for byte in {covered}:",
-            f"    {target} = {name.upper()}_TABLE[{target} ^ byte]",
-        ]
-        if self.xorout:
-            lines.append(f"{target} ^= {self.xorout:#x}")
-        return lines
+    def python_expression(self, name: str, covered: str) -> str | None:
+        return None if self.stepped else super().python_expression(name, covered)
 
-    def byte_table(self, name: str) -> tuple[str, tuple[int, ...]] | None:
+    def python_lines(self, name: str, covered: str, target: str) -> list[str]:
+        steps = self.byte_table(name, target)
+        if steps is None:
+            return super().python_lines(name, covered, target)
+        return [
+            f"{target} = {steps.start:#x}",
+            f"for byte in {covered}:",
+            f"    {target} = {steps.table}[{target} ^ byte]",
+            *steps.finish,
+        ]
+
+    def byte_table(self, name: str, target: str) -> TableSteps | None:
         if not self.stepped:
             return None
-        return f"{name.upper()}_TABLE", crc_table(8, self.poly, self.refin)
+        # With 8 bits the table-driven step is table[crc ^ byte] whether the CRC is reflected or not.
+        start = _reflect(self.init, 8) if self.refin else self.init
+        finish = (f"{target} ^= {self.xorout:#x}",) if self.xorout else ()
+        return TableSteps(f"{name.upper()}_TABLE", crc_table(8, self.poly, self.refin), start, finish)
 
     def describe(self) -> str:
         return f"{self.title() or 'CRC'} over the covered bytes"

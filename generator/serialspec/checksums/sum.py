@@ -51,8 +51,8 @@ class Sum(Algorithm):
     def python_call(self, name: str) -> str:
         return f"({self.python_sum('{}')})"
 
-    def python_lines(self, name: str, covered: str, target: str) -> list[str]:
-        return [f"{target} = {self.python_sum(covered)}"]
+    def python_expression(self, name: str, covered: str) -> str:
+        return self.python_sum(covered)
 
     def python_sum(self, covered: str) -> str:
         return f"{'~' if self.invert else ''}sum({covered}) & {self.mask:#x}"

@@ -21,9 +21,9 @@ from typing import Any
 
 from serialspec.backends.common.numbers import number
 from serialspec.backends.common.pairing import request_response_pairs
-from serialspec.backends.python.pycode import annotation, one_line
+from serialspec.backends.python.content import annotation
 from serialspec.backends.python.registers import map_name, names_alias
-from serialspec.backends.python.render import render
+from serialspec.backends.python.render import one_line, render
 from serialspec.backends.python.simulator import import_order
 from serialspec.lang.model import (
     Bytes,

@@ -4,7 +4,7 @@ Classic frames (a header, a one-byte length, one final checksum, no stuffing) ge
 package.py); every other framing is described here as `serialspec.runtime.framing` objects: the layouts of each
 direction, the content size bounds by command, and size rules for frames that carry no length. The stream parser
 runs on them; single frames are checked and built by straight-line code written from the same layouts
-(framecode.py).
+(straight_frames.py).
 """
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ from __future__ import annotations
 from collections.abc import Iterable
 
 from serialspec.backends.common.frames import runtime_element
-from serialspec.backends.python.framecode import checksum_name
+from serialspec.backends.python.straight_frames import checksum_name
 from serialspec.checksums.base import Import
 from serialspec.lang.model import (
     Command,
@@ -27,7 +27,7 @@ from serialspec.lang.model import (
 
 def checksum_definitions(protocol: Protocol, straight: bool = True) -> tuple[list[str], list[str]]:
     """The import lines and module-level definitions of every checksum the layouts use: its runtime function (the
-    engine's elements call it) and, for `straight` code, what its expression needs (framecode.checksum_call)."""
+    engine's elements call it) and, for `straight` code, what its expression needs (straight_frames.checksum_call)."""
     imports: set[Import] = set()
     definitions: dict[str, str] = {}
     for layouts in protocol.framing.alternatives.values():

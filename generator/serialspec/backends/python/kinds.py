@@ -2,7 +2,7 @@
 
 An emitter asks `kind(f)` instead of switching on the field's class: the attribute type, the to/from JSON
 expressions, the struct format and the construct expression of each kind live here. Still switches elsewhere: the
-fast decode/encode statements (pycode.py), the simulator's and client's field look-ups, the CLI views.
+fast decode/encode statements (content.py), the simulator's and client's field look-ups, the CLI views.
 """
 
 from __future__ import annotations

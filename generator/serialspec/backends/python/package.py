@@ -3,42 +3,38 @@
 from __future__ import annotations
 
 import re
-import struct
 from dataclasses import replace
 from typing import Any
 
 from serialspec.backends.common.numbers import number
 from serialspec.backends.python.client import client_module
-from serialspec.backends.python.framecode import Target, checksum_name, direction_functions
+from serialspec.backends.python.content import (
+    ClassCode,
+    PackageCode,
+    decoder_name,
+    encoder_name,
+)
+from serialspec.backends.python.dispatch import direction_entry, value_arguments
 from serialspec.backends.python.frames import (
     checksum_definitions,
     code_key,
     codec_lines,
     framing_imports,
-    import_lines,
 )
-from serialspec.backends.python.pycode import (
-    ClassCode,
-    Lines,
-    PackageCode,
-    checksum_lines,
-    checksum_setup,
-    decoder_name,
-    encoder_name,
-    fuse_unpack,
-    one_line,
-    takes_the_rest,
+from serialspec.backends.python.ir import (
+    ContentSize,
+    lines_of,
 )
+from serialspec.backends.python.length_byte_frames import length_byte_codec_context
+from serialspec.backends.python.optimize import content_unpacked, fuse_unpack
 from serialspec.backends.python.registers import register_tables, registers_module
-from serialspec.backends.python.render import render
+from serialspec.backends.python.render import one_line, render
 from serialspec.backends.python.simulator import import_order, simulator_module
+from serialspec.backends.python.straight_frames import Target, direction_functions
 from serialspec.backends.python.structs import structs_module
 from serialspec.collection import without_cycle_collection
 from serialspec.lang.model import (
-    Bytes,
-    Command,
     Direction,
-    FrameLayout,
     Message,
     Protocol,
     Scalar,
@@ -47,8 +43,6 @@ from serialspec.lang.model import (
     replies_by_request,
     reply_to,
 )
-
-_IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 
 
 def class_context(cls: ClassCode, where: str, keys: list[str], optional: list[str]) -> dict[str, Any]:
@@ -189,15 +183,15 @@ def message_doc(protocol: Protocol, message: Message) -> str:
 
 
 def codec_context(protocol: Protocol, code: PackageCode, exports: list[str]) -> dict[str, Any]:
-    # the target's part first: the classic codec's whole-frame decoders add structs the common part lists
-    classic = protocol.framing.classic
-    specific = classic_codec_context(protocol, code) if classic else general_codec_context(protocol, code)
+    # the frames' part first: the length-byte codec's whole-frame decoders add structs the common part lists
+    length_byte = protocol.framing.classic  # every layout has the length-byte shape (length_byte_frames.py)
+    specific = length_byte_codec_context(protocol, code) if length_byte else straight_codec_context(protocol, code)
     return common_codec_context(protocol, code, exports) | specific
 
 
-def general_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, Any]:
+def straight_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, Any]:
     """Frames of any other shape: straight-line frame functions per direction where the layouts allow them (see
-    framecode.py), else the runtime's frame engine; one FrameCodec per direction either way (the stream parser's),
+    straight_frames.py), else the runtime's frame engine; one FrameCodec per direction either way (the stream parser's),
     decoders by code (and by class)."""
     imports, definitions = checksum_definitions(protocol)
     directions: list[dict[str, Any]] = []
@@ -234,7 +228,7 @@ def general_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
             mask = (1 << (8 * element.type.size)) - 1
             flag = protocol.error_reply.flag
             frames = replace(frames, error_flag=flag, error_keep=mask & ~flag)
-        plain = plain_messages(single, code) if not expected and not frames.error_flag else []
+        plain = unpacked_messages(single, code) if not expected and not frames.error_flag else []
         functions, call = direction_functions(protocol, direction, frames, frame_structs, plain)
         directions.append(
             {
@@ -263,10 +257,17 @@ def general_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
     every = [line for d in directions for line in [*d["frames"], *d["functions"], *d["call"]]]
     every += [line for _, _, lines in code.encoders for line in lines]
     return {
-        "classic": False,
+        "length_byte_frames": False,
         "reply_layouts": reply_layouts,
         "framing_imports": sorted({"EngineFormat", *framing_imports(every)}, key=import_order),
-        "checksum_error": any("ChecksumError(" in line for line in every),
+        # the straight-line frame checks raise it (the engine raises its own)
+        "checksum_error": any(
+            element.kind == "checksum"
+            for direction in protocol.framing.layouts
+            if (straight := code.straight(direction)) is not None
+            for layout in straight.layouts
+            for element in layout.elements
+        ),
         "checksum_imports": imports,
         "checksum_definitions": definitions,
         "directions": directions,
@@ -275,153 +276,29 @@ def general_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, An
     }
 
 
-def plain_messages(single: dict[str, Message], code: PackageCode) -> list[tuple[int, int, str, str, str]]:
+def unpacked_messages(single: dict[str, Message], code: PackageCode) -> list[tuple[int, int, str, str, str]]:
     """(code, content size, class, struct, its format) of the messages of one size whose decoder, past its size
-    check, is one struct's unpack of the content as their message (framecode.whole_frames decodes them whole)."""
-    bodies = {name: lines for name, _, _, lines in code.decoders}
+    check, is one struct's unpack of the content as their message (straight_frames.whole_frames decodes them whole)."""
+    bodies = {name: body for name, _, _, body in code.decoders}
     found = []
     for key, message in single.items():
-        lines = bodies[decoder_name(message)]
-        if key in ("None", "ERROR_REPLY") or message.min_size != message.max_size or len(lines) < 3:
+        body = bodies[decoder_name(message)]
+        if key in ("None", "ERROR_REPLY") or message.min_size != message.max_size or len(body) < 2:
             continue
-        fused = fuse_unpack(lines[2:], code.structs)
-        plain = _PLAIN.match(fused[0]) if len(fused) == 1 and lines[0].startswith("if end - o != ") else None
-        if plain is not None:
-            struct = plain["struct"]
-            found.append((int(key, 16), message.min_size or 0, plain["cls"], struct, code.structs[struct]))
+        if not (isinstance(body[0], ContentSize) and body[0].exact):
+            continue
+        unpacked = content_unpacked(body[1:])
+        if unpacked is not None:
+            cls, struct = unpacked
+            found.append((int(key, 16), message.min_size or 0, cls, struct, code.structs[struct]))
     return found
-
-
-def value_arguments(layout: FrameLayout) -> dict[str, str]:
-    return {
-        "extra": "".join(f", {e.name}: int" for e in layout.value_elements),
-        "args": "".join(f", {e.name}" for e in layout.value_elements),
-    }
-
-
-def classic_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, Any]:
-    """Straight-line frame checks for frames of the classic shape (see FrameLayout.classic)."""
-    assert protocol.framing.checksum is not None
-    checksum = protocol.framing.checksum
-    assert checksum is not None  # classic frames have one
-    checksum_imports, checksum_definitions = checksum_setup(checksum)
-    directions = []
-    dispatchers = []
-    frame_functions: list[dict[str, Any]] = []
-    whole_functions: list[dict[str, Any]] = []
-    whole_pickers: list[dict[str, Any]] = []
-    decoder_bodies = {name: (returns, extra, lines) for name, returns, extra, lines in code.decoders}
-    for direction, layout in protocol.framing.layouts.items():
-        dispatch = []
-        sizes = []
-        for command in protocol.commands:
-            entry = direction_entry(command, direction)
-            if entry is None:
-                continue
-            target, low, high, sub_dispatch = entry
-            key = "None" if command.code is None else f"{command.code:#04x}"
-            dispatch.append((key, target))
-            sizes.append((key, low, high))
-            if sub_dispatch:
-                dispatchers.append(sub_dispatch | value_arguments(layout))
-        fixed = fixed_frames(protocol, layout, decoder_bodies, code)
-        runs = [(key, function["run"]["name"]) for key, _, function in fixed if function.get("run")]
-        sub_functions, pickers, sub_entries = subcommand_frames(protocol, layout, decoder_bodies, code)
-        whole = whole_frames(layout, [*fixed, *sub_entries])
-        rests = rest_frames(protocol, layout, decoder_bodies, code) if whole or fixed else []
-        whole_functions += rests
-        sub_rests = subcommand_rest_frames(protocol, layout, decoder_bodies) if whole else []
-        whole_functions += sub_rests
-        if whole:  # decode() looks frames up by their first bytes
-            whole_functions += [f | {"whole_lines": fuse_unpack(f["whole_lines"], code.structs)} for f in sub_functions]
-            whole_pickers += pickers
-        range_checks = value_range_checks(layout, protocol.byte_order)
-        # decode() looks these frames up before any other check: where each decoder refuses a frame of another size
-        # itself (struct.error from an unpack of the whole frame), decode() need not compare sizes first
-        whole_size = max(layout.length_offset, layout.command_offset or 0) + 1
-        content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
-        exact = bool(whole) and not sub_entries and not rests and not sub_rests and not range_checks
-        bodies = {f["whole_name"]: fuse_unpack(f["whole_lines"], code.structs) for _, _, f in fixed}
-        if exact:
-            bodies = {
-                name: exact_whole(lines, size, whole_size, code)
-                for (_, size, f), (name, lines) in zip(fixed, bodies.items(), strict=True)
-            }
-            whole = [
-                (
-                    key,
-                    size,
-                    name,
-                    None if plain is None else (plain[0], exact_struct(plain[1], size, content_offset, code)),
-                )
-                for key, size, name, plain in whole
-            ]
-        frame_functions += [
-            f | {"lines": fuse_unpack(f["lines"], code.structs), "whole_lines": bodies[f["whole_name"]], "exact": exact}
-            for _, _, f in fixed
-        ]
-        slice_key = None if whole else key_slice(layout)
-        directions.append(
-            {
-                "slice_key": slice_key,
-                "slice_fixed": [(slice_bytes(layout, key), size, f["whole_name"]) for key, size, f in fixed],
-                "slice_rests": [slice_rest(layout, r) for r in rests],
-                "accepted": [accepted(line.removeprefix("if ").removesuffix(":")) for line in range_checks[::2]],
-                "exact": exact,
-                "fixed": [(key, size, function["name"]) for key, size, function in fixed],
-                "runs": runs,
-                "summed": summed_checksum(protocol, layout) if runs else None,
-                "fixed_whole": [(key, size, function["whole_name"]) for key, size, function in fixed],
-                "rest_keys": [rest_key(layout, r, bool(whole)) for r in rests],
-                # before the frames of one size: where a length byte names both, those keep their decoder
-                "sub_rest_keys": [rest_key(layout, r, True) for r in sub_rests],
-                "whole_frames": whole,
-                "plain": any(plain for *_, plain in whole),
-                "plain_check": plain_check(protocol, layout),
-                "content_offset": content_offset,
-                "whole_size": whole_size,
-                "key": frame_key(layout, "data"),
-                "name": direction.value,
-                "upper": direction.name,
-                "header": repr(layout.header),
-                "header_hex": layout.header.hex(" "),
-                "header_size": len(layout.header),
-                "overhead": layout.overhead,
-                "length_offset": layout.length_offset,
-                "length_adds": layout.length_adds,
-                "command_offset": layout.command_offset,
-                "value_ranges": value_ranges(layout, protocol.byte_order),
-                "range_checks": range_checks,
-                "dispatch": dispatch,
-                "sizes": sizes,
-                "whole": frame_decode_lines(protocol, layout, dispatch, "data", None),
-                "at": frame_decode_lines(protocol, layout, dispatch, "buf", "start"),
-            }
-        )
-    layouts = protocol.framing.layouts
-    header_choices = " or ".join(layouts[d].header.hex(" ") for d in Direction)
-    return {
-        "classic": True,
-        "checksum_imports": import_lines(checksum_imports),
-        "checksum_definitions": checksum_definitions,
-        "directions": directions,
-        "frame_functions": frame_functions,
-        "runs": any(d["runs"] for d in directions),
-        "whole_functions": whole_functions,
-        "whole_pickers": whole_pickers,
-        "dispatchers": dispatchers,
-        "header_choices": header_choices,
-    }
 
 
 def common_codec_context(protocol: Protocol, code: PackageCode, exports: list[str]) -> dict[str, Any]:
     encoder_table = [(m.class_name, encoder_name(m)) for m in protocol.messages()]
     codec_names = names_used_in_codec(code)
-    used = "\n".join(line for _, _, _, lines in code.decoders for line in lines)
-    used += "\n".join(line for _, _, lines in code.encoders for line in lines)
-    packing = [n for n in ("decode_text", "encode_text", "pack_bits", "unpack_bits") if f"_{n}(" in used]
     return {
-        "packing_imports": sorted([*packing, *(["unpack_runs"] if code.unpack_runs else [])]),
+        "packing_imports": sorted([*code.packing, *(["unpack_runs"] if code.unpack_runs else [])]),
         "unpack_runs": sorted(code.unpack_runs.items()),
         "structs": sorted(code.structs.items()),
         "tables": [
@@ -429,8 +306,8 @@ def common_codec_context(protocol: Protocol, code: PackageCode, exports: list[st
         ],
         "member_maps": sorted(code.member_maps),
         "decoders": [
-            {"name": n, "returns": r, "extra": e, "lines": fuse_unpack(lines, code.structs)}
-            for n, r, e, lines in code.decoders
+            {"name": n, "returns": r, "extra": e, "lines": lines_of(fuse_unpack(body))}
+            for n, r, e, body in code.decoders
         ],
         "encoders": [{"name": n, "type": t, "lines": lines} for n, t, lines in code.encoders],
         "encoder_table": encoder_table,
@@ -442,676 +319,11 @@ def common_codec_context(protocol: Protocol, code: PackageCode, exports: list[st
     }
 
 
-_CURSOR = re.compile(r"\b(o|end)\b")
-
-
-def frame_key(layout: FrameLayout, buf: str, start: str = "") -> str:
-    """The expression of a frame's size key (command code and length byte) as the stream parser's tables use it."""
-    at = f"{start} + " if start else ""
-    length = f"{buf}[{at}{layout.length_offset}]"
-    if layout.command_offset is None:
-        return length
-    return f"{buf}[{at}{layout.command_offset}] << 8 | {length}"
-
-
-def accepted(refused: str) -> str:
-    """The condition that a frame value is in range, from value_range_checks' condition that it is not."""
-    for op, opposite in ((" > ", " <= "), (" < ", " >= ")):
-        left, found, right = refused.partition(op)
-        if found and "(" not in refused:
-            return f"{left}{opposite}{right}"
-    return refused.removeprefix("not ") if refused.startswith("not (") else f"not {refused}"
-
-
-def key_slice(layout: FrameLayout) -> str | None:
-    """Where a frame's command code and length byte are neighbours after its header (FEETECH: an id between): the
-    slice of `data` holding them, decode()'s key for its whole frames (a short frame's is shorter: it matches
-    none, so the lookup comes before any check). None where they are not neighbours."""
-    if layout.command_offset is None:
-        return None
-    low = min(layout.command_offset, layout.length_offset)
-    if max(layout.command_offset, layout.length_offset) != low + 1 or low < len(layout.header):
-        return None
-    return f"data[{low}:{low + 2}]"
-
-
-def slice_bytes(layout: FrameLayout, key: str) -> str:
-    """A size key (command code << 8 | length byte, as fixed_frames makes it) as the bytes key_slice reads."""
-    value = int(key, 16)
-    assert layout.command_offset is not None  # key_slice holds it
-    by_offset = {layout.command_offset: value >> 8, layout.length_offset: value & 0xFF}
-    return repr(bytes(by_offset[o] for o in sorted(by_offset)))
-
-
-def slice_rest(layout: FrameLayout, rest: dict[str, Any]) -> dict[str, Any]:
-    """rest_key's entries as the bytes key_slice reads: the key's expression in the length byte `n`."""
-    assert layout.command_offset is not None  # key_slice holds it
-    by_offset = {layout.command_offset: f"{rest['code'] or 0:#04x}", layout.length_offset: "n"}
-    key = f"bytes(({', '.join(by_offset[o] for o in sorted(by_offset))}))"
-    low, high = rest["lengths"]
-    return {"key": key, "low": low, "high": high, "adds": rest["adds"], "name": rest["whole_name"]}
-
-
-def rest_key(layout: FrameLayout, rest: dict[str, Any], by_bytes: bool) -> dict[str, Any]:
-    """decode()'s table entries of a frame that takes the rest (rest_frames), one per length byte `n`: the key's
-    expression in `n` (first bytes as whole_frames makes them, or the size key as frame_key), the range of `n`,
-    and the frame size less `n`."""
-    code = rest["code"] or 0
-    if by_bytes:  # header, then command code and length byte in offset order
-        key = " + ".join(
-            [
-                repr(layout.header),
-                *(
-                    "bytes((n,))" if o == layout.length_offset else repr(bytes([code]))
-                    for o in sorted(o for o in (layout.command_offset, layout.length_offset) if o is not None)
-                ),
-            ]
-        )
-    else:
-        key = f"{code:#04x} << 8 | n" if layout.command_offset is not None else "n"
-    low, high = rest["lengths"]
-    return {"key": key, "low": low, "high": high, "adds": rest["adds"], "name": rest["whole_name"]}
-
-
-def whole_frames(
-    layout: FrameLayout, fixed: list[tuple[str, int, dict[str, Any]]]
-) -> list[tuple[str, int, str, tuple[str, str] | None]]:
-    """decode()'s table of the frames decoded whole, keyed by their first bytes when those are the header, command
-    code and length byte (one slice, one lookup, and the header is checked with them); [] where they are not."""
-    width = len(layout.header)
-    offsets = sorted(o for o in (layout.command_offset, layout.length_offset) if o is not None)
-    if offsets != list(range(width, width + len(offsets))):
-        return []
-    entries = []
-    for key, size, function in fixed:
-        value = int(key, 16)
-        bytes_at = {layout.length_offset: value & 0xFF}
-        if layout.command_offset is not None:
-            bytes_at[layout.command_offset] = value >> 8
-        key_bytes = repr(layout.header + bytes(bytes_at[o] for o in offsets))
-        entries.append((key_bytes, size, function["whole_name"], function.get("plain")))
-    return entries
-
-
-def fixed_frames(
-    protocol: Protocol, layout: FrameLayout, bodies: dict[str, tuple[str, str, Lines]], code: PackageCode
-) -> list[tuple[str, int, dict[str, Any]]]:
-    """Whole-frame decoders for the frames of one size whose content is one run of fixed fields: (size key, frame
-    size, function). Each checks the checksum, unpacks the content in one call and builds the message: no
-    dispatch, no size checks (the key is the command code and length byte, so the size is known), one call per
-    frame. It returns None for a frame whose checksum fails, so callers word the error (decode) or count it (the
-    stream parser); it raises nothing. Frames of any other kind keep the general path."""
-    found = []
-    for command in protocol.commands:
-        message = command.request if layout.direction == Direction.REQUEST else command.response
-        if command.selector is not None or message is None:
-            continue
-        made = frame_function(protocol, layout, command, message, bodies, code)
-        if made is not None:
-            key, size, function = made
-            found.append((f"{key:#06x}", size, function))
-    return found
-
-
-def subcommand_frames(
-    protocol: Protocol, layout: FrameLayout, bodies: dict[str, tuple[str, str, Lines]], code: PackageCode
-) -> tuple[list[dict[str, Any]], list[dict[str, Any]], list[tuple[str, int, dict[str, Any]]]]:
-    """decode()'s whole-frame decoders of sub-command frames of one size (as fixed_frames, the sub-command's check
-    dropped: its code picks the decoder) and, per command and frame size, the function that picks one by the
-    sub-command byte: (decoders, pickers, decode's table entries of the pickers, as fixed_frames gives them)."""
-    content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
-    functions: list[dict[str, Any]] = []
-    pickers: list[dict[str, Any]] = []
-    entries = []
-    for command in protocol.commands:
-        if command.selector is None or layout.direction not in command.selector.offsets:
-            continue
-        by_size: dict[tuple[int, int], list[tuple[int, dict[str, Any]]]] = {}
-        for sub in command.subcommands:
-            message = sub.request if layout.direction == Direction.REQUEST else sub.response
-            if message is None:
-                continue
-            made = frame_function(protocol, layout, command, message, bodies, code, command.selector.name)
-            if made is not None:
-                key, size, function = made
-                by_size.setdefault((key, size), []).append((sub.code, function))
-        at = content_offset + command.selector.offsets[layout.direction]
-        for (key, size), subs in by_size.items():
-            picker = {
-                "whole_name": f"_whole_{command.name}_{layout.direction.value}_{size}",
-                "table": f"_{command.name.upper()}_{layout.direction.name}_WHOLE_{size}",
-                "size": size,
-                "where": f"{command.name} {layout.direction.value}",
-                "entries": [(f"{c:#04x}", f["whole_name"]) for c, f in subs],
-            }
-            lines = picked_inline(subs, at, code)
-            if lines is None:  # each sub-command's own decoder, from a table
-                functions += [f for _, f in subs]
-                lines = [f"whole = {picker['table']}.get(buf[{at}])", "return None if whole is None else whole(buf)"]
-            else:
-                picker["entries"] = []
-            pickers.append(picker | {"lines": lines})
-            entries.append((f"{key:#06x}", size, picker))
-    return functions, pickers, entries
-
-
-def rest_frames(
-    protocol: Protocol, layout: FrameLayout, bodies: dict[str, tuple[str, str, Lines]], code: PackageCode
-) -> list[dict[str, Any]]:
-    """decode()'s whole-frame decoders of the frames whose content is fixed fields then bytes to its end (FEETECH
-    WRITE: an address, then the data): any length byte from the smallest such content up names one, so decode()'s
-    table holds a key per length byte. Each checks the checksum, reads the fields at constant offsets and the bytes
-    up to the frame's tail: no dispatch, no content decoder's call. Others keep the general path."""
-    checksum = protocol.framing.checksum
-    length = layout.length
-    if checksum is None or length is None or length.type is None:
-        return []
-    content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
-    tail = layout.overhead - content_offset  # bytes after the content
-    found = []
-    for command in protocol.commands:
-        message = command.request if layout.direction == Direction.REQUEST else command.response
-        if command.selector is not None or message is None or message.max_size is not None or not message.fields:
-            continue
-        if not (isinstance(message.fields[-1], Bytes) and takes_the_rest(message.fields[-1])):
-            continue
-        returns, extra, lines = bodies[decoder_name(message)]
-        if not lines[0].startswith("if end - o < "):
-            continue
-        offset, body = content_offset, []
-        for line in lines[2:]:  # the size check: the key implies it
-            moved = re.fullmatch(r"o \+= (\d+)", line)
-            if moved:
-                offset += int(moved[1])
-                continue
-            line = line.replace("buf[o:end]", f"buf[{offset}:-{tail}]").replace("(buf, o)", f"(buf, {offset})")
-            if "raise " in line or _CURSOR.search(line):
-                break  # checked beyond its size, or read at a cursor: the general path
-            body.append(line)
-        else:
-            check_lines = rest_check_lines(protocol, layout)
-            values = [f"{e.name} = buf[{layout.offsets[e.name]}]" for e in layout.value_elements]
-            lowest = (message.min_size or 0) + layout.length_adds
-            found.append(
-                {
-                    "whole_name": "_whole" + decoder_name(message).removeprefix("_decode"),
-                    "returns": returns,
-                    "where": f"{message.key} {message.direction.value}",
-                    "whole_lines": fuse_unpack([*check_lines, "    return None", *values, *body], code.structs),
-                    "code": command.code,
-                    "lengths": (lowest, length.type.maximum),
-                    "adds": layout.overhead - layout.length_adds,  # frame size = length byte + this
-                }
-            )
-    return found
-
-
-def subcommand_rest_frames(
-    protocol: Protocol, layout: FrameLayout, bodies: dict[str, tuple[str, str, Lines]]
-) -> list[dict[str, Any]]:
-    """decode()'s whole-frame decoders of the sub-command frames of more than one size (a list its count sizes), one
-    per command: any length byte from the smallest such content up names it (a key per length byte, as rest_frames).
-    Each checks the checksum, then picks the sub-command by its byte and runs that sub-command's content decoder's
-    lines in place: no dispatch and no call. It returns None where the checksum fails or no such sub-command has the
-    code (decode()'s general path then says why); a frame its lines refuse raises what the general path raises, as
-    that path, with the same checks passed, runs the same lines."""
-    checksum = protocol.framing.checksum
-    length = layout.length
-    if checksum is None or length is None or length.type is None or layout.value_elements:
-        return []
-    content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
-    tail = layout.overhead - content_offset  # bytes after the content
-    found = []
-    for command in protocol.commands:
-        if command.selector is None or layout.direction not in command.selector.offsets:
-            continue
-        at = command.selector.offsets[layout.direction]
-        subs = []
-        for sub in command.subcommands:
-            message = sub.request if layout.direction == Direction.REQUEST else sub.response
-            if message is None or message.min_size == message.max_size:
-                continue  # none, or of one size (subcommand_frames)
-            returns, extra, lines = bodies[decoder_name(message)]
-            if not extra:
-                subs.append((sub.code, message, lines))
-        if not subs:
-            continue
-        lines = [*rest_check_lines(protocol, layout), "    return None", f"sub = buf[{content_offset + at}]"]
-        for sub_code, _, body in subs:
-            lines += [f"if sub == {sub_code:#04x}:", f"    o, end = {content_offset}, len(buf) - {tail}"]
-            lines += [f"    {line}" for line in body]
-        smallest = min(message.min_size or 0 for _, message, _ in subs)
-        sizes = [message.max_size for _, message, _ in subs]
-        largest = length.type.maximum if None in sizes else max(s for s in sizes if s is not None) + layout.length_adds
-        found.append(
-            {
-                "whole_name": f"_whole_{command.name}_{layout.direction.value}",
-                "returns": "Message",
-                "where": f"{command.name} {layout.direction.value}",
-                "whole_lines": [*lines, "return None"],
-                "code": command.code,
-                # the sub-command's byte lies within the content: no smaller content reaches the picker
-                "lengths": (max(smallest, at + 1) + layout.length_adds, min(largest, length.type.maximum)),
-                "adds": layout.overhead - layout.length_adds,  # frame size = length byte + this
-            }
-        )
-    return found
-
-
-def rest_check_lines(protocol: Protocol, layout: FrameLayout) -> Lines:
-    """The checksum test of a whole frame of any size (`buf` is the frame): true when it fails."""
-    checksum = protocol.framing.checksum
-    assert checksum is not None  # classic frames have one
-    size = layout.checksum_offset_from_end
-    stored = "buf[-1]" if size == 1 else f"int.from_bytes(buf[-{size}:], 'little')"
-    header = layout.header[: layout.covered_from]
-    test = checksum.algorithm.frame_test("sum(buf)", sum(header), "buf[-1]")
-    if test is not None and size == 1 == layout.covered_to_end and len(header) == layout.covered_from:
-        return [f"if {test}:"]
-    covered = f"buf[{layout.covered_from}:-{layout.covered_to_end}]"
-    return [*checksum_lines(checksum, covered, "expected"), f"if expected != {stored}:"]
-
-
-def picked_inline(subs: list[tuple[int, dict[str, Any]]], at: int, code: PackageCode) -> Lines | None:
-    """One function's lines for the sub-command frames of one size, where their checksum does not depend on their
-    fields (a sum or CRC over the bytes, the same lines for all, given the key): the check once, then each
-    sub-command's unpacking under an `if` on its code. None where the check is made from the unpacked values."""
-    first = subs[0][1]["whole_lines"]
-    if "    return None" not in first:
-        return None
-    checks = first[: first.index("    return None") + 1]
-    if any("unpack_from" in line for line in checks):
-        return None
-    if any(f["whole_lines"][: len(checks)] != checks for _, f in subs):
-        return None
-    lines = [*checks, f"sub = buf[{at}]"]
-    for sub_code, f in subs:
-        body = fuse_unpack(f["whole_lines"][len(checks) :], code.structs)
-        lines += [f"if sub == {sub_code:#04x}:", *(f"    {line}" for line in body)]
-    return [*lines, "return None"]
-
-
-def frame_function(
-    protocol: Protocol,
-    layout: FrameLayout,
-    command: Command,
-    message: Message,
-    bodies: dict[str, tuple[str, str, Lines]],
-    code: PackageCode,
-    selector: str | None = None,
-) -> tuple[int, int, dict[str, Any]] | None:
-    """The whole-frame decoders of one message (see fixed_frames): size key, frame size, function; None where the
-    message's frames need the general path. `selector`: the sub-command field, whose check the key makes."""
-    checksum = protocol.framing.checksum
-    if checksum is None or message.min_size != message.max_size:
-        return None  # classic frames have a checksum
-    content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
-    returns, extra, lines = bodies[decoder_name(message)]
-    if not lines[0].startswith("if end - o != "):
-        return None
-    body = lines[2:]  # the content size check: the key implies the size
-    if selector is not None:  # the sub-command's check: the picker chose this decoder by it
-        at = next((i for i, line in enumerate(body) if line.startswith(f"if v_{selector} != ")), None)
-        if at is None:
-            return None
-        body = body[:at] + body[at + 2 :]
-    text = "\n".join(body)
-    if text.count("(buf, o)") > 1 or _CURSOR.search(text.replace("(buf, o)", "")) or "raise " in text:
-        return None  # content read at a moving cursor, or checked beyond its size: the general path
-    size = layout.overhead + (message.min_size or 0)
-    values = [f"{e.name} = buf[start + {layout.offsets[e.name]}]" for e in layout.value_elements]
-    length_byte = (message.min_size or 0) + layout.length_adds
-    summed = summed_frame(protocol, layout, command.code, length_byte, size, body, code)
-    if summed is not None:
-        lines = [*values, *summed, *body[1:]]
-    else:
-        stored = (
-            f"buf[start + {size - 1}]"
-            if layout.checksum_offset_from_end == 1
-            else f"int.from_bytes(buf[start + {size - layout.checksum_offset_from_end} : start + {size}], 'little')"
-        )
-        covered = f"buf[start + {layout.covered_from} : start + {size - layout.covered_to_end}]"
-        lines = [
-            *checksum_lines(checksum, covered, "expected"),
-            f"if expected != {stored}:",
-            "    return None",
-            *values,
-            *(line.replace("(buf, o)", f"(buf, start + {content_offset})") for line in body),
-        ]
-    known = dict(enumerate(layout.header)) | {layout.length_offset: length_byte}
-    if layout.command_offset is not None:
-        known[layout.command_offset] = command.code or 0
-    function: dict[str, Any] = {
-        "name": "_frame" + decoder_name(message).removeprefix("_decode"),
-        "whole_name": "_whole" + decoder_name(message).removeprefix("_decode"),
-        "returns": returns,
-        "where": f"{message.key} {message.direction.value}",
-        "lines": lines,
-        "whole_lines": whole_frame_lines(protocol, layout, size, lines, summed is not None, known),
-    }
-    # built in decode() where its whole-frame decoder sums the frame's bytes (one from the values is quicker yet)
-    plain = plain_frame(protocol, layout, body, code)
-    function["plain"] = plain if summed is None else None
-    function["run"] = run_frames(layout, message, size, plain, code)
-    key = length_byte if layout.command_offset is None else (command.code or 0) << 8 | length_byte
-    return key, size, function
-
-
-_UNPACK_AT = re.compile(r"\b(?P<name>_S_\w+)\.unpack_from\(buf, (?P<at>\d+)\)")
-_SUM_LAST = re.compile(r"^if \(sum\(buf\)(?P<less>.*) - 2 \* buf\[\d+\]\) & 0xff:$")
-_AT_CONSTANT = re.compile(r"\bbuf\[(\d+)\]")
-
-
-def exact_struct(name: str, size: int, content_offset: int, code: PackageCode) -> str:
-    """A struct of a whole frame of `size` bytes that unpacks what struct `name` unpacks at the content's offset,
-    the bytes around it skipped: its unpack refuses (struct.error) a frame of any other size."""
-    fmt = code.structs[name]
-    after = size - content_offset - struct.calcsize(fmt)
-    whole = f"{fmt[0]}{content_offset}x{fmt[1:]}" + (f"{after}x" if after else "")
-    exact = f"{name}_IN_{size}"
-    code.structs[exact] = whole
-    return exact
-
-
-def exact_whole(lines: Lines, size: int, known: int, code: PackageCode) -> Lines:
-    """A whole-frame decoder that refuses a frame of another size than `size` by itself: its one unpack made of the
-    whole frame (struct.error), a sum's check byte read from the end; else a size check first, returning None.
-    `known`: the bytes decode() has matched (its key), which any frame it is given holds."""
-    lines = [_SUM_LAST.sub(lambda m: f"if (sum(buf){m['less']} - 2 * buf[-1]) & 0xff:", line) for line in lines]
-    unpacks = [m for line in lines for m in _UNPACK_AT.finditer(line)]
-    before = lines[: next((i for i, line in enumerate(lines) if _UNPACK_AT.search(line)), len(lines))]
-    reads = [int(i) for line in before for i in _AT_CONSTANT.findall(line)]
-    if len(unpacks) != 1 or any(i >= known for i in reads):
-        return [f"if len(buf) != {size}:", "    return None", *lines]
-    found = unpacks[0]
-    exact = exact_struct(found["name"], size, int(found["at"]), code)
-    return [_UNPACK_AT.sub(f"{exact}.unpack(buf)", line) for line in lines]
-
-
-_PLAIN = re.compile(r"^return _new\((?P<cls>\w+), (?P<struct>_S_\w+)\.unpack_from\(buf, o\)\)$")
-
-
-def summed_checksum(protocol: Protocol, layout: FrameLayout) -> str | None:
-    """The stream parser's `summed`: (first byte covered, inverted) where the checksum is an 8-bit sum of every byte
-    from there to the last, which it is; None for other checksums."""
-    checksum = protocol.framing.checksum
-    inverted = checksum.algorithm.summed() if checksum is not None else None
-    if inverted is None or plain_check(protocol, layout) is None:
-        return None
-    return f"({layout.covered_from}, {inverted})"
-
-
-def plain_check(protocol: Protocol, layout: FrameLayout) -> str | None:
-    """decode()'s test that a whole frame `data` (its size known) holds its checksum, where it is one expression
-    over the frame's bytes: an 8-bit sum over all but a constant header and the check. None for others."""
-    checksum = protocol.framing.checksum
-    header = layout.header[: layout.covered_from]
-    if checksum is None or len(header) != layout.covered_from:
-        return None
-    if not layout.checksum_offset_from_end == 1 == layout.covered_to_end:
-        return None
-    test = checksum.algorithm.frame_test("sum(data)", sum(header), "data[-1]")
-    return None if test is None else f"not {test}"
-
-
-def run_frames(
-    layout: FrameLayout, message: Message, size: int, plain: tuple[str, str] | None, code: PackageCode
-) -> dict[str, str] | None:
-    """The stream parser's decoder of a run of a plain frame (plain_frame), checked already, laid end to end with
-    their headers left out: one struct over the bytes after the header (the command code, length byte and checksum
-    skipped as padding) and a message built from each tuple it unpacks. None where the content is not the whole of
-    the frame between those."""
-    if plain is None:
-        return None
-    cls, content = plain
-    fmt = code.structs[content]
-    width = len(layout.header)
-    content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
-    if content_offset < width or content_offset + struct.calcsize(fmt) != size - 1:
-        return None
-    lead = content_offset - width
-    after = fmt[0] + (f"{lead}x" if lead else "") + fmt[1:] + "x"
-    frames = code.struct(content.removeprefix("_S_") + "_after_header", after)
-    names = [f.name for f in message.fields]
-    return {
-        "name": "_run" + decoder_name(message).removeprefix("_decode"),
-        "build": code.build_all(cls, names, f"{frames}.iter_unpack(frames)"),
-        "returns": cls,
-        "where": f"{message.key} {message.direction.value}",
-    }
-
-
-def plain_frame(protocol: Protocol, layout: FrameLayout, body: Lines, code: PackageCode) -> tuple[str, str] | None:
-    """(class, struct) of a frame whose message is the tuple one struct unpacks from its content, as it is, and
-    whose checksum decode() tests in one expression (plain_check): decode() builds it itself, with no call.
-    None for others (frame values, conversions, checks)."""
-    fused = fuse_unpack(body, code.structs)
-    plain = _PLAIN.match(fused[0]) if len(fused) == 1 else None
-    if plain is None or layout.value_elements or plain_check(protocol, layout) is None:
-        return None
-    return plain["cls"], plain["struct"]
-
-
-_MOST_UNROLLED = 12  # CRC-8 steps written out one by one in a whole-frame decoder; more take a loop
-_CRC_LOOP = re.compile(r"^for byte in buf\[(?P<first>\d+) : (?P<stop>\d+)\]:$")
-_AT_START = re.compile(r"\bstart \+ (\d+)\b")
-
-
-def whole_frame_lines(
-    protocol: Protocol, layout: FrameLayout, size: int, lines: Lines, summed: bool, known: dict[int, int]
-) -> Lines:
-    """decode()'s version of a whole-frame decoder: `buf` is exactly the frame (decode checked its size), so
-    offsets are constants; an 8-bit sum over all but a constant header is the sum of the whole frame less the
-    header and the checksum byte (no slice is made); an 8-bit CRC starts from its value after the covered bytes
-    that the frame's key fixes (`known`: offset -> byte; header, command code, length byte)."""
-    lines = [_AT_START.sub(r"\1", line) for line in lines]
-    checksum = protocol.framing.checksum
-    assert checksum is not None  # classic frames have one
-    stepped = checksum.algorithm.byte_table(checksum_name(checksum))
-    loop = _CRC_LOOP.match(lines[1]) if len(lines) > 1 else None
-    if stepped is not None and loop and not summed:
-        table_name, table = stepped
-        state = int(lines[0].removeprefix("expected = "), 16)
-        first = int(loop["first"])
-        while first in known and first < int(loop["stop"]) - 1:
-            state = table[state ^ known[first]]
-            first += 1
-        stop = int(loop["stop"])
-        if stop - first > _MOST_UNROLLED:
-            return [f"expected = {state:#x}", f"for byte in buf[{first} : {stop}]:", *lines[2:]]
-        # a few bytes: one table step each, no slice and no loop
-        steps = [f"expected = {table_name}[{state:#x} ^ buf[{first}]]"]
-        steps += [f"expected = {table_name}[expected ^ buf[{offset}]]" for offset in range(first + 1, stop)]
-        return [*steps, *lines[3:]]  # in place of the loop and its one-line body
-    header = layout.header[: layout.covered_from]
-    test = checksum.algorithm.frame_test("sum(buf)", sum(header), f"buf[{size - 1}]")
-    whole = (
-        not summed
-        and test is not None
-        and layout.checksum_offset_from_end == 1
-        and layout.covered_to_end == 1
-        and len(header) == layout.covered_from
-    )
-    if not whole:
-        return lines
-    assert lines[0].startswith("expected = ") and lines[1].startswith("if expected != "), lines[:2]
-    return [f"if {test}:", *lines[2:]]
-
-
-_UNPACK = re.compile(r"^(?P<targets>.+) = (?P<struct>_S_\w+)\.unpack_from\(buf, o\)$")
-_BYTES_OF = {"B": 1, "b": 1, "H": 2, "h": 2, "I": 4, "i": 4, "Q": 8, "q": 8}
-_MOST_TERMS = 4  # byte terms of a checksum computed from the values; beyond it the frame's bytes are summed
-
-
-def summed_frame(
-    protocol: Protocol,
-    layout: FrameLayout,
-    command: int | None,
-    length_byte: int,
-    size: int,
-    body: Lines,
-    code: PackageCode,
-) -> Lines | None:
-    """For an 8-bit sum checksum right after integer-only content: lines that unpack the content and the checksum
-    in one call and check the sum from the values (a byte sum does not depend on byte order), so no slice of the
-    frame is made and summed. The frame's other covered bytes must be the header, command code and length byte
-    (constants, given the key) and one-byte frame values. None where the frame is not like that."""
-    checksum = protocol.framing.checksum
-    match = _UNPACK.match(body[0]) if body else None
-    if checksum is None or checksum.algorithm.summed() is None or not match:
-        return None
-    if layout.checksum_offset_from_end != 1:
-        return None
-    fmt = code.structs[match["struct"]]
-    targets = [t.strip() for t in match["targets"].split(",") if t.strip()]
-    if len(targets) != len(fmt) - 1 or any(c not in _BYTES_OF for c in fmt[1:]):
-        return None
-    content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
-    if content_offset + sum(_BYTES_OF[c] for c in fmt[1:]) != size - 1:
-        return None  # the checksum does not follow the content
-    constant = 0
-    terms = []
-    for offset in range(layout.covered_from, size - layout.covered_to_end):
-        if offset < len(layout.header):
-            constant += layout.header[offset]
-        elif offset == layout.command_offset:
-            constant += command or 0
-        elif offset == layout.length_offset:
-            constant += length_byte
-        elif content_offset <= offset < size - 1:
-            continue  # the content's values, below
-        else:
-            element = next((e for e in layout.value_elements if layout.offsets[e.name] == offset and e.size == 1), None)
-            if element is None:
-                return None
-            terms.append(element.name)
-    for target, char in zip(targets, fmt[1:], strict=True):
-        width = _BYTES_OF[char]
-        if width == 1:
-            terms.append(target if char == "B" else f"({target} & 0xff)")
-        else:
-            terms += [f"({target} & 0xff)", *(f"({target} >> {8 * i} & 0xff)" for i in range(1, width))]
-    if len(terms) > _MOST_TERMS:
-        return None  # summing a slice of the frame in C is cheaper than this many terms in Python
-    with_check = code.struct(match["struct"].removeprefix("_S_") + "_and_check", fmt + "B")
-    total = checksum.algorithm.byte_total(" + ".join([f"{constant:#x}", *terms]))
-    return [
-        f"{', '.join(targets)}, check = {with_check}.unpack_from(buf, start + {content_offset})",
-        f"if {total} != check:",
-        "    return None",
-    ]
-
-
 def names_used_in_codec(code: PackageCode) -> set[str]:
-    """Every identifier the codec's bodies mention, and the types they return or take.
-
-    Collected once per package: testing each exported name against every body line was quadratic in the number
-    of commands (minutes for a few thousand).
-    """
-    bodies = [line for _, _, _, lines in code.decoders for line in lines]
-    bodies += [line for _, _, lines in code.encoders for line in lines]
+    """The generated classes the codec's bodies name: the types they return or take, the classes the decoders build
+    (PackageCode.build) and the enum and flag classes whose members they look up (PackageCode.member_maps)."""
     types = {r for _, r, _, _ in code.decoders} | {t for _, t, _ in code.encoders}
-    types |= set(code.built) | code.member_maps  # built by decoders; enums and flags looked up
-    return types | set(_IDENTIFIER.findall("\n".join(bodies)))
-
-
-def frame_decode_lines(
-    protocol: Protocol, layout: FrameLayout, dispatch: list[tuple[str, str]], buf: str, start: str | None
-) -> Lines:
-    """Checksum check, then dispatch to the content decoder, of a frame whose header and length are checked.
-
-    `start` None: the frame is the whole of `buf` (whose length is `n`); else it is buf[start:stop].
-    """
-    size = layout.checksum_offset_from_end
-    offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
-    after = layout.overhead - offset
-
-    def at(position: int) -> str:
-        return f"{buf}[{position}]" if start is None else f"{buf}[{start} + {position}]"
-
-    checksum = protocol.framing.checksum
-    assert checksum is not None  # classic frames have one
-    if start is None:
-        covered = f"{buf}[{layout.covered_from or ''}:-{layout.covered_to_end}]"
-        stored = f"{buf}[-1]" if size == 1 else f"int.from_bytes({buf}[-{size}:], 'little')"
-        content = f"{offset}, n - {after}"
-    else:
-        first = f"{start} + {layout.covered_from}" if layout.covered_from else start
-        covered = f"{buf}[{first} : stop - {layout.covered_to_end}]"
-        stored = f"{buf}[stop - 1]" if size == 1 else f"int.from_bytes({buf}[stop - {size} : stop], 'little')"
-        content = f"{start} + {offset}, stop - {after}"
-    args = f"{buf}, {content}" + "".join(f", {at(layout.offsets[e.name])}" for e in layout.value_elements)
-    lines = [f"check = {stored}"]  # read once: the sum and the comparison both use it
-    stored = "check"
-    lines += checksum_lines(checksum, covered, "expected")
-    header = layout.header[: layout.covered_from]
-    less = f" - {sum(header):#x}" if header else ""
-    total = checksum.algorithm.byte_total(f"sum({buf}){less} - {stored}")
-    whole = size == 1 == layout.covered_to_end and len(header) == layout.covered_from
-    if start is None and total is not None and whole:
-        # all but a checked header and the check: the sum of the whole frame less those, no slice made
-        lines = [lines[0], f"expected = {total}"]
-    lines += [
-        f"if expected != {stored}:",
-        # as wide as the checksum: a u16 that reads 0 is 0x0000
-        f'    raise ChecksumError(f"bad checksum: the frame has {{{stored}:#0{2 + 2 * size}x}}, '
-        f'its bytes give {{expected:#0{2 + 2 * size}x}}")',
-    ]
-    if layout.command_offset is None:  # the one codeless command of this direction, if any
-        if not dispatch:
-            return [*lines, f'raise DecodeError("no {layout.direction.value} is defined")']
-        return [*lines, f"return {dispatch[0][1]}({args})"]
-    code = at(layout.command_offset)
-    return [
-        *lines,
-        f"decoder = _{layout.direction.name}_DECODERS.get({code})",
-        "if decoder is None:",
-        f'    raise DecodeError(f"unknown command {{{code}:#04x}}")',
-        f"return decoder({args})",
-    ]
-
-
-def value_ranges(layout: FrameLayout, byte_order: str) -> str:
-    """The frame-level values whose declared range is narrower than their type (an address 0..253, broadcast 254),
-    as FrameFormat.value_ranges: (offset, size, byte order, signed, low, high, also allowed); a stream candidate
-    holding a value outside its range is no frame."""
-    ranges = [
-        f"({layout.offsets[e.name]}, {e.type.size}, {byte_order!r}, {e.type.signed}, {int(e.minimum)}, "
-        f"{int(e.maximum)}, {e.broadcast})"
-        for e in layout.value_elements
-        if e.type is not None and not e.type.is_float and (e.minimum, e.maximum) != (e.type.minimum, e.type.maximum)
-    ]
-    return "(" + ", ".join(ranges) + ("," if len(ranges) == 1 else "") + ")"
-
-
-def value_range_checks(layout: FrameLayout, byte_order: str) -> list[str]:
-    """Lines of `decode` refusing a frame whose frame-level value lies outside its declared range, as the stream
-    parser (value_ranges) refuses it; decode checks the header before them."""
-    lines = []
-    for e in layout.value_elements:
-        if e.type is None or e.type.is_float or (e.minimum, e.maximum) == (e.type.minimum, e.type.maximum):
-            continue
-        offset, size = layout.offsets[e.name], e.type.size
-        value = (
-            f"data[{offset}]"
-            if size == 1 and not e.type.signed
-            else f"int.from_bytes(data[{offset}:{offset + size}], {byte_order!r}, signed={e.type.signed})"
-        )
-        low, high = int(e.minimum), int(e.maximum)
-        shown = f" (or {e.broadcast})" if e.broadcast is not None else ""
-        lowest, highest = low, high
-        if e.broadcast in (low - 1, high + 1):  # next to the range: one comparison
-            lowest, highest = min(low, e.broadcast), max(high, e.broadcast)
-        also = f" or {value} == {e.broadcast}" if e.broadcast is not None and lowest == low and highest == high else ""
-        if lowest <= e.type.minimum and not also:  # no value of the type is below it
-            refused = f"{value} > {highest}"
-        elif highest >= e.type.maximum and not also:
-            refused = f"{value} < {lowest}"
-        else:
-            refused = f"not ({lowest} <= {value} <= {highest}{also})"
-        lines.append(f"if {refused}:")
-        lines.append(f'    raise DecodeError(f"{e.name} = {{{value}}} is outside its range {low}..{high}{shown}")')
-    return lines
+    return types | set(code.built) | code.member_maps
 
 
 def uses_table(message: Message, table: str) -> bool:
@@ -1125,34 +337,3 @@ def table_context(table: Table) -> dict[str, Any]:
         "structs": [(e.key, "<" + e.type.struct_char) for e in entries],
         "ranges": [(e.key, number(e.minimum), number(e.maximum)) for e in entries],
     }
-
-
-def direction_entry(command: Command, direction: Direction) -> tuple[str, int, int | None, dict[str, Any]] | None:
-    """The decoder a command code dispatches to in one direction, the content size bounds, any sub-dispatch."""
-    if command.selector is None:
-        message = command.request if direction == Direction.REQUEST else command.response
-        if message is None:
-            return None
-        return decoder_name(message), message.min_size, message.max_size, {}
-    messages = [
-        m for s in command.subcommands if (m := s.request if direction == Direction.REQUEST else s.response) is not None
-    ]
-    if not messages:
-        return None
-    low = min(m.min_size for m in messages)
-    high = None if any(m.max_size is None for m in messages) else max(m.max_size or 0 for m in messages)
-    name = f"_decode_{command.name}_{direction.value}"
-    table = f"_{command.name.upper()}_{direction.name}_SUBCOMMANDS"
-    entries = [
-        (f"{s.code:#04x}", decoder_name(m))
-        for s in command.subcommands
-        if (m := s.request if direction == Direction.REQUEST else s.response) is not None
-    ]
-    sub = {
-        "name": name,
-        "offset": command.selector.offsets[direction],
-        "table": table,
-        "entries": entries,
-        "where": f"{command.name} {direction.value}",
-    }
-    return name, low, high, sub

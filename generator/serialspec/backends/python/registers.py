@@ -3,8 +3,7 @@
 from __future__ import annotations
 
 from serialspec.backends.common.numbers import number
-from serialspec.backends.python.pycode import one_line
-from serialspec.backends.python.render import render
+from serialspec.backends.python.render import one_line, render
 from serialspec.lang.model import Bytes, Group, Protocol, Table
 
 

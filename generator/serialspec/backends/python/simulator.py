@@ -7,9 +7,8 @@ from typing import Any
 from serialspec.backends.common.numbers import number
 from serialspec.backends.common.pairing import request_response_pairs
 from serialspec.backends.python.kinds import kind
-from serialspec.backends.python.pycode import one_line
 from serialspec.backends.python.registers import map_name, register_tables
-from serialspec.backends.python.render import render
+from serialspec.backends.python.render import one_line, render
 from serialspec.lang import expression
 from serialspec.lang.model import (
     Bytes,

@@ -7,8 +7,7 @@ from __future__ import annotations
 
 from serialspec.backends.python.frames import checksum_definitions, codec_lines, framing_imports, import_lines
 from serialspec.backends.python.kinds import derived_checks, kind, primitive
-from serialspec.backends.python.pycode import one_line
-from serialspec.backends.python.render import render
+from serialspec.backends.python.render import one_line, render
 from serialspec.lang.model import (
     Direction,
     Field,

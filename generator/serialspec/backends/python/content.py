@@ -7,16 +7,44 @@ identifiers, and every piece of spec text reaches generated code through repr(),
 
 from __future__ import annotations
 
-import re
 import struct
-from collections import Counter
 from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
 
 from serialspec.backends.common.numbers import number
-from serialspec.backends.common.text import collapse
-from serialspec.backends.python.framecode import Straight, checksum_name, frame_encoder, straight_direction
+from serialspec.backends.python.ir import (
+    Advance,
+    Block,
+    Code,
+    ContentSize,
+    Expect,
+    If,
+    ItemsCheck,
+    LeftOver,
+    Loop,
+    Needs,
+    Pack,
+    PackItems,
+    Raise,
+    ReturnNew,
+    Simple,
+    TakeRest,
+    Try,
+    Unpack,
+    lines_of,
+    packed_lists,
+    values_tuple,
+)
 from serialspec.backends.python.kinds import kind
+from serialspec.backends.python.optimize import deferred_item_checks, field_read, fold_last_size_check, read_fields_once
+from serialspec.backends.python.render import one_line
+from serialspec.backends.python.straight_frames import (
+    StraightLayouts,
+    checksum_name,
+    frame_encoder,
+    straight_direction,
+    struct_tokens,
+)
 from serialspec.checksums.base import Import
 from serialspec.lang import expression
 from serialspec.lang.model import (
@@ -42,17 +70,17 @@ _MOST_RUNS = 256  # the most items of a list read by a struct made for each coun
 _STRUCT_NAMES = {"B": "U8", "b": "I8", "H": "U16", "h": "I16", "I": "U32", "i": "I32", "f": "F32"}
 
 
+def message_function(verb: str, message: Message) -> str:
+    """The codec's name of a function of one message (`_<verb>_<key>_<direction>`): its decoder, encoder, ..."""
+    return f"_{verb}_{message.key.replace('.', '_')}_{message.direction.value}"
+
+
 def decoder_name(message: Message) -> str:
-    return f"_decode_{message.key.replace('.', '_')}_{message.direction.value}"
+    return message_function("decode", message)
 
 
 def encoder_name(message: Message) -> str:
-    return f"_encode_{message.key.replace('.', '_')}_{message.direction.value}"
-
-
-def values_tuple(values: list[str]) -> str:
-    """A tuple display of expressions: `(a, b)`, `(a,)`, `()`."""
-    return f"({values[0]},)" if len(values) == 1 else f"({', '.join(values)})"
+    return message_function("encode", message)
 
 
 def bound(f: Scalar, value: float) -> str:
@@ -64,148 +92,14 @@ def bound(f: Scalar, value: float) -> str:
     return number(value)
 
 
-_LOOP = re.compile(r"^(?P<indent> *)for (?P<var>[A-Za-z_]\w*) in .+:$")
-
-
-_NEEDS = re.compile(r"^if end - o < (?P<size>\w+):$")
-
-
-def fold_last_size_check(lines: Lines) -> Lines:
-    """A decoder's lines with the size check of its last field, read up to the content's end, and the check that
-    nothing is left after it made one comparison on the way of an intact frame (`end - o != size`), each error
-    still raised as before; the cursor is not moved past the last field, as nothing reads it."""
-    if len(lines) < 7 or not lines[-1].startswith("return ") or _CURSOR_WORD.search(lines[-1]):
-        return lines
-    needs, raised, read, moved, left, raised_left = lines[-7:-1]
-    found = _NEEDS.match(needs)
-    if found is None or moved != f"o += {found['size']}" or left != "if o != end:" or read.startswith(" "):
-        return lines
-    if not raised.startswith("    raise ") or not raised_left.endswith("bytes left after the last field')"):
-        return lines
-    size = found["size"]
-    return [
-        *lines[:-7],
-        f"if end - o != {size}:",
-        f"    {needs}",
-        f"    {raised}",
-        raised_left.replace("{end - o}", f"{{end - o - {size}}}"),
-        read,
-        lines[-1],
-    ]
-
-
-_CURSOR_WORD = re.compile(r"\bo\b")
-_DEFERRED = "#deferred "  # check_items' mark before the loop over a list whose item range is its type's
-
-
-def deferred_item_checks(lines: Lines) -> Lines:
-    """An encoder's lines with each loop that check_items marked run only when the pack of its list fails: the
-    list's numbers span their type's whole range, so struct.pack refuses exactly what the loop would, but True and
-    False (which it takes as numbers: looked for first, the cheaper loop). The full loop then finds the item at fault
-    and raises what it raised before; a failure it does not explain (a float) goes on as struct's error. A mark
-    whose list is packed inside a block keeps its loop where it was."""
-    for index, mark in enumerate(lines):
-        if not mark.startswith(_DEFERRED):
-            continue
-        expr = mark.removeprefix(_DEFERRED)
-        loop = lines[index + 1 : index + 4]
-        rest = lines[:index] + lines[index + 4 :]
-        at = next((i for i, line in enumerate(rest) if i >= index and f"*{expr})" in line), None)
-        if at is None or rest[at].startswith(" ") or any(line.startswith(" ") for line in rest[index:at]):
-            return deferred_item_checks(lines[:index] + lines[index + 1 :])
-        failed = [*loop[:-1], loop[-1] + " from None", "raise"]
-        item = loop[0].removeprefix("for ").partition(" in ")[0]
-        block = [
-            "try:",
-            f"    for {item} in {expr}:",
-            f"        if {item}.__class__ is bool:  # struct.pack takes True and False as numbers: refused below",
-            "            raise TypeError",
-            f"    {rest[at]}",
-            "except (TypeError, struct.error):  # the item at fault, looked for only when the pack fails",
-            *(f"    {line}" for line in failed),
-        ]
-        return deferred_item_checks(rest[:at] + block + rest[at + 1 :])
-    return lines
-
-
-def read_fields_once(lines: Lines, names: list[str]) -> Lines:
-    """An encoder's lines with each field of the message `m` that they read more than once read once, into a local
-    `m_<field>` first, and likewise each field of a loop's item (`item_<field>`): a range check and the pack read a
-    field two or three times, and a local costs less than an attribute (a record's fields are read through a
-    descriptor, ~15 ns each)."""
-    return _loops_read_once(_read_once(lines, "m", names, ""))
-
-
-def _read_once(lines: Lines, var: str, names: list[str] | None, indent: str) -> Lines:
-    """`lines` with the fields of `var` read more than once (of `names`, or any not called) read once up front."""
-    reads_of = re.compile(rf"(?<![\w.]){var}\.([A-Za-z_]\w*)\b(?!\()")
-    reads = Counter(name for line in lines for name in reads_of.findall(line))
-    again = [name for name in (names if names is not None else reads) if reads[name] > 1]
-    if not again:
-        return lines
-    local = {name: f"{var}_{name}" for name in again}
-
-    def replaced(match: re.Match[str]) -> str:
-        return local.get(match[1], match[0])
-
-    first = [f"{indent}{var}_{name} = {var}.{name}" for name in again]
-    return [*first, *(reads_of.sub(replaced, line) for line in lines)]
-
-
-def _loops_read_once(lines: Lines) -> Lines:
-    out: Lines = []
-    i = 0
-    while i < len(lines):
-        out.append(lines[i])
-        loop = _LOOP.match(lines[i])
-        i += 1
-        if loop is None:
-            continue
-        inner = loop["indent"] + "    "
-        end = i
-        while end < len(lines) and lines[end].startswith(inner):
-            end += 1
-        out += _loops_read_once(_read_once(lines[i:end], loop["var"], None, inner))
-        i = end
-    return out
-
-
-_UNPACKED = re.compile(r"^(?P<targets>[\w, ]+?),? = (?P<call>_S_\w+\.unpack_from\(.+\))$")
-
-
-_ONE_BYTE = re.compile(r"^(?P<indent> *)(?P<target>\w+), = (?P<struct>_S_\w+)\.unpack_from\(buf, (?P<at>.+)\)$")
-
-
-def fuse_unpack(lines: Lines, structs: dict[str, str]) -> Lines:
-    """A decoder's final lines, made cheaper where the analysis of whole frames (package.fixed_frames) is done
-    with them: an unpack into locals that are then built, in order, into the returned message becomes one line,
-    `return _new(Cls, _S.unpack_from(buf, o))` (the tuple struct gives is the message's); a lone unsigned byte is
-    read by indexing, not unpacked."""
-    out: Lines = []
-    for line in lines:
-        unpacked = _UNPACKED.match(out[-1]) if out else None
-        if unpacked and line.startswith("return _new("):
-            names = [name.strip() for name in unpacked["targets"].split(",")]
-            cls, _, rest = line.removeprefix("return _new(").partition(", ")
-            if rest == values_tuple(names) + ")":
-                out[-1] = f"return _new({cls}, {unpacked['call']})"
-                continue
-        out.append(line)
-    for index, line in enumerate(out):
-        one = _ONE_BYTE.match(line)
-        if one and structs.get(one["struct"]) in ("<B", ">B"):
-            out[index] = f"{one['indent']}{one['target']} = buf[{one['at']}]"
-    return out
-
-
 def members_name(class_name: str) -> str:
     """The codec's module-level value -> member map of an enum or flag class."""
     return f"_MEMBERS_{class_name}"
 
 
-def one_line(text: str) -> str:
-    """Spec text made safe for a comment or docstring: one line, no backslashes or quotes that could close it."""
-    return collapse(text).replace("\\", "\\\\").replace('"', "'")
+def run_endian(fields: list[SpecField]) -> str:
+    """The struct byte order of a run of fixed-size fields: its first multi-byte field's."""
+    return next((f.endian for f in fields if isinstance(f, Scalar | Array | TableBlock)), "<")
 
 
 def struct_format(endian: str, fields: list[SpecField]) -> str:
@@ -227,7 +121,9 @@ def is_fixed_run_member(f: SpecField) -> bool:
     return kind(f).fixed(f)
 
 
-_SINGLE_BYTES = re.compile(r"(\d*[bBxs?c])*")  # a struct format whose byte order changes nothing
+def byte_order_free(fmt: str) -> bool:
+    """Whether a struct format holds single bytes only, so that its byte order changes nothing."""
+    return all(char in "bBxs?c" for _, char in struct_tokens(fmt))
 
 
 def fixed_runs(fields: list[SpecField]) -> Iterator[list[SpecField] | SpecField]:
@@ -291,19 +187,20 @@ class PackageCode:
         self.structs: dict[str, str] = {}  # constant name -> format
         self.helper_classes: list[ClassCode] = []
         self.message_classes: list[ClassCode] = []
-        self.decoders: list[tuple[str, str, str, Lines]] = []  # name, return type, extra parameters, body
+        self.decoders: list[tuple[str, str, str, Block]] = []  # name, return type, extra parameters, body
         self.encoders: list[tuple[str, str, Lines]] = []  # name, parameter type, body
         # classes the decoders build through their slots (see `build`): class name -> field names in order
         self.built: dict[str, list[str]] = {}
         self.member_maps: set[str] = set()  # enum and flag classes whose value -> member map the decoders use
         self.unpack_runs: dict[str, tuple[str, int]] = {}  # unpack_runs tables the decoders use: name -> (format, most)
+        self.packing: set[str] = set()  # the runtime.packing functions the bodies call (as _<name>)
         self._seen_classes: set[str] = set()
-        self._straight: dict[Direction, Straight | None] = {}
+        self._straight: dict[Direction, StraightLayouts | None] = {}
         for message in protocol.messages():
             self.message(message)
 
-    def straight(self, direction: Direction) -> Straight | None:
-        """The direction's frames when straight-line code takes them (framecode.py), worked out once."""
+    def straight(self, direction: Direction) -> StraightLayouts | None:
+        """The direction's frames when straight-line code takes them (straight_frames.py), worked out once."""
         if direction not in self._straight:
             self._straight[direction] = (
                 None if self.protocol.framing.classic else straight_direction(self.protocol, direction)
@@ -318,7 +215,7 @@ class PackageCode:
             if existing == fmt:
                 return name
         tokens = []
-        for count, char in re.findall(r"(\d*)([a-zA-Z?])", fmt):
+        for count, char in struct_tokens(fmt):
             token = _STRUCT_NAMES.get(char, char.upper())
             tokens.append(f"{token}X{count}" if count and char != "s" else (f"B{count}" if char == "s" else token))
         layout = "_".join(tokens) if len(tokens) <= 6 else base_name.upper()
@@ -461,51 +358,49 @@ class PackageCode:
         decoder = fold_last_size_check(self.decoder(message, fields))
         self.decoders.append((decoder_name(message), message.class_name, extra, decoder))
         encoder = read_fields_once(deferred_item_checks(self.encoder(message, fields)), [f.name for f in fields])
-        self.encoders.append((encoder_name(message), message.class_name, encoder))
+        encoder_lines = lines_of(encoder)
+        self.encoders.append((encoder_name(message), message.class_name, encoder_lines))
 
     # --- decoding -------------------------------------------------------------------------------------------------
 
     def where(self, message: Message) -> str:
         return repr(f"{message.key} {message.direction.value}")
 
-    def decoder(self, message: Message, all_fields: list[SpecField]) -> Lines:
+    def decoder(self, message: Message, all_fields: list[SpecField]) -> Block:
         """Body of `_decode_X(buf, o, end, *frame_values)`: content bytes buf[o:end] -> message."""
-        lines: Lines = []
+        body: Block = []
         where = self.where(message)
         low, high = message.min_size, message.max_size
-        if low == high:
-            lines.append(f"if end - o != {low}:")
-        elif high is None:
-            lines.append(f"if end - o < {low}:")
-        else:
-            lines.append(f"if not {low} <= end - o <= {high}:")
-        lines.append(f"    raise content_size_error({where}, end - o, {low}, {high})")
-        if low == 0 and high is None:
-            del lines[-2:]  # any size will do
+        if not (low == 0 and high is None):  # else any size will do
+            body.append(ContentSize(low, high, where))
         # Where the layout alone says the fields end at `end` (one fixed size, checked above, or a last field that
         # takes the rest), no check that they do is emitted, and nothing reads the cursor after the last field.
         exact = low == high and all(fixed_size(f) is not None for f in message.fields)
         exact = exact or takes_the_rest(message.fields[-1] if message.fields else None)
-        values = self.decode_fields(list(message.fields), message.class_name, lines, where, top=not exact)
-        if exact and (lines[-1].startswith("o += ") or lines[-1] == "o = end"):
-            lines.pop()
-        self.check_values(list(message.fields), lines, where)
+        values = self.decode_fields(list(message.fields), message.class_name, body, where, top=not exact)
+        if exact and body and isinstance(body[-1], Advance) and body[-1].to in ("", "end"):
+            body.pop()
+        self.check_values(list(message.fields), body, where)
         frame_fields = all_fields[: len(all_fields) - len(self.value_fields(message))]
-        frame_values = [self.after_unpack(f, f.name, lines, where) or f.name for f in frame_fields]
-        self.build(message.class_name, [f.name for f in all_fields], [*frame_values, *values], "m", lines)
-        lines[-1] = lines[-1].replace("m = ", "return ", 1)
-        return lines
+        frame_values = [self.after_unpack(f, f.name, body, where) or f.name for f in frame_fields]
+        names = [f.name for f in all_fields]
+        assert len(names) == len(frame_values) + len(values), (message.class_name, names, frame_values, values)
+        self.built[message.class_name] = names
+        body.append(ReturnNew(message.class_name, (*frame_values, *values)))
+        return body
 
-    def build(self, class_name: str, names: list[str], values: list[str], target: str, lines: Lines) -> None:
-        """The line that makes an instance of a generated class in `target` from its field values, in field order.
+    def build(self, class_name: str, names: list[str], values: list[str], target: str, body: Block) -> None:
+        """The statement that makes an instance of a generated class in `target` from its field values, in field
+        order.
 
-        Every decoder builds its messages here (one place, so a change of how messages are made reaches all of
-        them): `_new(Class, (values...))` is the runtime's `build`, one C call that stores the tuple of values as
-        the record (message.py); decoded values need none of the checks the class's __new__ would not make anyway.
+        Every decoder builds its messages here or as a ReturnNew (one place, so a change of how messages are made
+        reaches all of them): `_new(Class, (values...))` is the runtime's `build`, one C call that stores the tuple
+        of values as the record (message.py); decoded values need none of the checks the class's __new__ would not
+        make anyway.
         """
         assert len(names) == len(values), (class_name, names, values)
         self.built[class_name] = names
-        lines.append(f"{target} = _new({class_name}, {values_tuple(values)})")
+        body.append(Code(f"{target} = _new({class_name}, {values_tuple(values)})"))
 
     def build_each(self, class_name: str, names: list[str], tuples: str) -> str:
         """The expression of a tuple of instances of a generated class, one built (as `build` does) from each tuple
@@ -524,19 +419,18 @@ class PackageCode:
         self.member_maps.add(enum)
         return f"{members_name(enum)}.get({raw}, {raw})"
 
-    def flags_value(self, flags: str, raw: str, lines: Lines) -> str:
+    def flags_value(self, flags: str, raw: str, body: Block) -> str:
         """A flags member for a wire value: looked up, made by the flag class only the first time it is seen."""
         self.member_maps.add(flags)
         name = f"{raw}_flags"
-        lines.append(f"{name} = {members_name(flags)}.get({raw})")
-        lines.append(f"if {name} is None:")
-        lines.append(f"    {name} = {flags}({raw})")
+        body.append(Code(f"{name} = {members_name(flags)}.get({raw})"))
+        body.append(If(f"{name} is None", (Code(f"{name} = {flags}({raw})"),)))
         return name
 
     def decode_fields(
-        self, fields: list[SpecField], base: str, lines: Lines, where: str, top: bool, known: int | None = None
+        self, fields: list[SpecField], base: str, body: Block, where: str, top: bool, known: int | None = None
     ) -> list[str]:
-        """Append lines reading fields at cursor `o`; return the expressions of the non-hidden values.
+        """Append statements reading fields at cursor `o`; return the expressions of the non-hidden values.
 
         `known`: bytes known to be left at `o` (None: as many as the leading fixed fields take, which the content's
         size check covers). A run of fixed fields beyond them (after a variable field, in an item of varying size)
@@ -547,21 +441,19 @@ class PackageCode:
             if isinstance(item, list):
                 size = sum(fixed_size(f) or 0 for f in item)
                 if known is not None and size > known:
-                    lines.append(f"if end - o < {size}:")
                     reason = f"{item[0].name} needs {size} bytes, {{end - o}} left"
-                    lines.append(f"    raise DecodeError({where} + f': {reason}')")
+                    body.append(Needs(str(size), f"DecodeError({where} + f': {reason}')"))
                     known = size
                 known = None if known is None else known - size
-                values += self.decode_run(item, base, lines, where)
+                values += self.decode_run(item, base, body, where)
             else:
-                values.append(self.decode_variable(item, fields, base, lines, where))
+                values.append(self.decode_variable(item, fields, base, body, where))
                 known = 0
         if top:
-            lines.append("if o != end:")
-            lines.append(f"    raise DecodeError({where} + f': {{end - o}} bytes left after the last field')")
+            body.append(LeftOver(where))
         return values
 
-    def check_values(self, fields: list[SpecField], lines: Lines, where: str) -> None:
+    def check_values(self, fields: list[SpecField], body: Block, where: str) -> None:
         """Every value derived by an expression must hold what the expression gives for the decoded fields."""
         counted = {f.count: f.name for f in fields if isinstance(f, List) and isinstance(f.count, str)}
         # a byte size of a list of numbers: decoding read size // item items and refused a remainder
@@ -579,17 +471,19 @@ class PackageCode:
                 expected = expression.render(f.value, self.local_named)
                 shown = one_line(expression.show(f.value)).replace("{", "{{").replace("}", "}}")
                 if expression.fails(f.value):  # a divisor of 0 or a negative shift from the wire: a bad frame
-                    lines.append("try:")
-                    lines.append(f"    expected_value = {expected}")
-                    lines.append("except (ZeroDivisionError, ValueError):")
                     reason = f"{f.name}: {shown} has no value here (a division by 0 or a negative shift)"
-                    lines.append(f"    raise DecodeError({where} + f': {reason}') from None")
+                    body.append(
+                        Try(
+                            (Code(f"expected_value = {expected}"),),
+                            "(ZeroDivisionError, ValueError)",
+                            (Raise(f"DecodeError({where} + f': {reason}') from None"),),
+                        )
+                    )
                     expected = "expected_value"
-                lines.append(f"if {self.local(f)} != {expected}:")
                 reason = f"{f.name} is {{{self.local(f)}}}, but {shown} = {{{expected}}}"
-                lines.append(f"    raise DecodeError({where} + f': {reason}')")
+                body.append(If(f"{self.local(f)} != {expected}", (Raise(f"DecodeError({where} + f': {reason}')"),)))
 
-    def decode_run(self, run: list[SpecField], base: str, lines: Lines, where: str) -> list[str]:
+    def decode_run(self, run: list[SpecField], base: str, body: Block, where: str) -> list[str]:
         endian = next((f.endian for f in run if isinstance(f, Scalar | Array | TableBlock)), "<")
         fmt = struct_format(endian, run)
         const_name = self.struct(f"{base}_{run[0].name}", fmt)
@@ -598,14 +492,13 @@ class PackageCode:
         values: list[str] = []
         if simple:
             names = [self.local(f) for f in run]
-            target = ", ".join(names) + ("," if len(names) == 1 else "")
-            lines.append(f"{target} = {const_name}.unpack_from(buf, o)")
+            body.append(Unpack(tuple(names), const_name, byte=fmt in ("<B", ">B")))
             for f, name in zip(run, names, strict=True):
-                expr = self.after_unpack(f, name, lines, where)
+                expr = self.after_unpack(f, name, body, where)
                 if expr is not None:
                     values.append(expr)
         else:
-            lines.append(f"t = {const_name}.unpack_from(buf, o)")
+            body.append(Unpack(("t",), const_name, tuple_target=True))
             position = 0
             for f in run:
                 if isinstance(f, Array):
@@ -617,36 +510,35 @@ class PackageCode:
                         item = f"t[{position}]"
                         items.append(self.enum_value(e.enum.class_name, item) if e.enum else item)
                         position += 1
-                    self.build(f.class_name, [e.name for e in f.entries], items, self.local(f), lines)
+                    self.build(f.class_name, [e.name for e in f.entries], items, self.local(f), body)
                     values.append(self.local(f))
                 else:
                     name = self.local(f)
-                    lines.append(f"{name} = t[{position}]")
+                    body.append(Code(f"{name} = t[{position}]"))
                     position += 1
-                    expr = self.after_unpack(f, name, lines, where)
+                    expr = self.after_unpack(f, name, body, where)
                     if expr is not None:
                         values.append(expr)
-        lines.append(f"o += {size}")
+        body.append(Advance(str(size)))
         return values
 
     @staticmethod
     def local(f: SpecField) -> str:
         return f"v_{f.name}"
 
-    def after_unpack(self, f: SpecField, name: str, lines: Lines, where: str) -> str | None:
+    def after_unpack(self, f: SpecField, name: str, body: Block, where: str) -> str | None:
         """Checks and conversions after a scalar is unpacked; the value expression, or None if hidden."""
         if not isinstance(f, Scalar):
             return name
         if f.const is not None:
-            lines.append(f"if {name} != {f.const}:")
-            lines.append(f"    raise DecodeError({where} + f': {f.name} is {{{name}:#x}}, expected {f.const:#x}')")
+            error = f"DecodeError({where} + f': {f.name} is {{{name}:#x}}, expected {f.const:#x}')"
+            body.append(Expect(name, f"{f.const}", error))
             return None
         if f.derived or f.value is not None:
             return None
         if f.sign_magnitude:
             top = 1 << (f.type.size * 8 - 1)
-            lines.append(f"if {name} & {top:#x}:")
-            lines.append(f"    {name} = -({name} & {top - 1:#x})")
+            body.append(If(f"{name} & {top:#x}", (Code(f"{name} = -({name} & {top - 1:#x})"),)))
         if f.bits:
             used = 0
             parts = []
@@ -654,133 +546,131 @@ class PackageCode:
                 used |= bit.mask << bit.low
                 raw = f"({name} >> {bit.low}) & {bit.mask:#x}" if bit.low else f"{name} & {bit.mask:#x}"
                 if bit.enum:
-                    lines.append(f"{name}_{bit.name} = {raw}")
+                    body.append(Code(f"{name}_{bit.name} = {raw}"))
                     parts.append(self.enum_value(bit.enum.class_name, f"{name}_{bit.name}"))
                 else:
                     parts.append(raw)
             unused = ((1 << (f.type.size * 8)) - 1) & ~used
             if unused:
-                lines.append(f"if {name} & {unused:#x}:")
-                lines.append(f"    raise DecodeError({where} + f': unused bits of {f.name} are set ({{{name}:#04x}})')")
-            self.build(f.bits_class, [b.name for b in f.bits], parts, f"{name}_bits", lines)
+                error = f"DecodeError({where} + f': unused bits of {f.name} are set ({{{name}:#04x}})')"
+                body.append(If(f"{name} & {unused:#x}", (Raise(error),)))
+            self.build(f.bits_class, [b.name for b in f.bits], parts, f"{name}_bits", body)
             return f"{name}_bits"
         if f.enum:
             return self.enum_value(f.enum.class_name, name)
         if f.flags:
-            return self.flags_value(f.flags.class_name, name, lines)
+            return self.flags_value(f.flags.class_name, name, body)
         return name
 
-    def decode_variable(self, f: SpecField, siblings: list[SpecField], base: str, lines: Lines, where: str) -> str:
+    def decode_variable(self, f: SpecField, siblings: list[SpecField], base: str, body: Block, where: str) -> str:
         if isinstance(f, List):
-            return self.decode_list(f, lines, where, siblings)
+            return self.decode_list(f, body, where, siblings)
         if isinstance(f, Text):
-            return self.decode_text(f, lines, where)
+            return self.decode_text(f, body, where)
         if isinstance(f, Bytes):
             if f.size == "rest":
-                lines.append(f"{self.local(f)} = buf[o:end]")
-                lines.append("o = end")
+                body.append(TakeRest(self.local(f)))
+                body.append(Advance(to="end"))
             else:
                 size = self.local_named(str(f.size))
-                lines.append(f"if end - o < {size}:")
-                lines.append(f"    raise DecodeError({where} + f': {f.name} needs {{{size}}} bytes, {{end - o}} left')")
-                lines.append(f"{self.local(f)} = buf[o : o + {size}]")
-                lines.append(f"o += {size}")
+                body.append(
+                    Needs(size, f"DecodeError({where} + f': {f.name} needs {{{size}}} bytes, {{end - o}} left')")
+                )
+                body.append(Code(f"{self.local(f)} = buf[o : o + {size}]", cursor=True))
+                body.append(Advance(size))
             return self.local(f)
         if isinstance(f, TableValue):
             table = f"_TABLE_{f.table.name.upper()}"
             key = self.local_named(f.key)
-            lines.append(f"s = {table}.get({key})")
-            lines.append("if s is None:")
-            lines.append(f"    raise DecodeError({where} + f': unknown {f.table.key_name} {{{key}}}')")
-            lines.append("if end - o < s.size:")
+            body.append(Code(f"s = {table}.get({key})"))
+            error = f"DecodeError({where} + f': unknown {f.table.key_name} {{{key}}}')"
+            body.append(If("s is None", (Raise(error),)))
             reason = f"{f.name} needs {{s.size}} bytes for {f.table.key_name} {{{key}}}"
-            lines.append(f"    raise DecodeError({where} + f': {reason}')")
-            lines.append(f"({self.local(f)},) = s.unpack_from(buf, o)")
-            lines.append("o += s.size")
+            body.append(If("end - o < s.size", (Raise(f"DecodeError({where} + f': {reason}')"),), cursor=True))
+            body.append(Code(f"({self.local(f)},) = s.unpack_from(buf, o)", cursor=True))
+            body.append(Advance("s.size"))
             return self.local(f)
         assert isinstance(f, Group)
         item_fields = list(f.fields)
         value = self.local(f)
         item_names = [i.name for i in item_fields if not (isinstance(i, Scalar) and i.hidden)]
-        lines.append(f"{value}_list = []")
+        start_list = Code(f"{value}_list = []")
+        body.append(start_list)
         if f.item_size is not None:
             item_fmt = struct_format(self.protocol_endian(), item_fields)
             item_struct = self.struct(f"{f.class_name}", item_fmt)
             if f.count == "rest":
-                lines.append(f"if (end - o) % {f.item_size}:")
                 reason = f"{{end - o}} bytes do not split into {f.name} items of {f.item_size}"
-                lines.append(f"    raise DecodeError({where} + f': {reason}')")
-                lines.append("n = end - o")
+                split = Raise(f"DecodeError({where} + f': {reason}')")
+                body.append(If(f"(end - o) % {f.item_size}", (split,), cursor=True))
+                body.append(Code("n = end - o", cursor=True))
             else:
                 count = str(f.count) if isinstance(f.count, int) else self.local_named(f.count)
-                lines.append(f"n = {count} * {f.item_size}")
-                lines.append("if end - o < n:")
-                lines.append(
-                    f"    raise DecodeError({where} + f': content too short for its count ({{{count}}} {f.name})')"
-                )
+                body.append(Code(f"n = {count} * {f.item_size}"))
+                reason = f"content too short for its count ({{{count}}} {f.name})"
+                body.append(Needs("n", f"DecodeError({where} + f': {reason}')"))
             names = [self.local(i) for i in item_fields]
-            item_lines: Lines = []
-            item_values = [self.after_unpack(i, n, item_lines, where) for i, n in zip(item_fields, names, strict=True)]
+            item_body: Block = []
+            item_values = [self.after_unpack(i, n, item_body, where) for i, n in zip(item_fields, names, strict=True)]
             values = [v for v in item_values if v is not None]
             items = f"{item_struct}.iter_unpack(buf[o : o + n])"
-            if not item_lines and values == names:  # the unpacked tuples are the items' values
-                lines.pop(lines.index(f"{value}_list = []"))
-                lines.append(f"{value} = {self.build_each(f.class_name, item_names, items)}")
-                lines.append("o += n")
+            if not item_body and values == names:  # the unpacked tuples are the items' values
+                body.remove(start_list)
+                body.append(Code(f"{value} = {self.build_each(f.class_name, item_names, items)}", cursor=True))
+                body.append(Advance("n"))
                 return value
-            self.build(f.class_name, item_names, values, "item", item_lines)
+            self.build(f.class_name, item_names, values, "item", item_body)
             target = ", ".join(names) + ("," if len(names) == 1 else "")
-            lines.append(f"for {target} in {items}:")
-            lines.extend("    " + line for line in item_lines)
-            lines.append(f"    {value}_list.append(item)")
-            lines.append(f"{value} = tuple({value}_list)")
-            lines.append("o += n")
+            item_body.append(Code(f"{value}_list.append(item)"))
+            body.append(Loop(f"for {target} in {items}", tuple(item_body), cursor=True))
+            body.append(Code(f"{value} = tuple({value}_list)"))
+            body.append(Advance("n"))
             return value
         # items of varying size: read them one by one
         if f.count == "rest":
-            lines.append("while o < end:")
+            header, cursor = "while o < end", True
         else:
             count = str(f.count) if isinstance(f.count, int) else self.local_named(f.count)
-            lines.append(f"for _ in range({count}):")
-        inner: Lines = []
+            header, cursor = f"for _ in range({count})", False
+        inner: Block = []
         # in `while o < end` one byte is known to be left, in `for _ in range(count)` none
         item_args = self.decode_fields(item_fields, f.class_name, inner, where, False, 1 if f.count == "rest" else 0)
         self.build(f.class_name, item_names, item_args, "item", inner)
-        lines.extend("    " + line for line in inner)
-        lines.append(f"    {value}_list.append(item)")
-        lines.append(f"{value} = tuple({value}_list)")
+        inner.append(Code(f"{value}_list.append(item)"))
+        body.append(Loop(header, tuple(inner), cursor=cursor))
+        body.append(Code(f"{value} = tuple({value}_list)"))
         return value
 
-    def decode_list(self, f: List, lines: Lines, where: str, siblings: list[SpecField]) -> str:
+    def decode_list(self, f: List, body: Block, where: str, siblings: list[SpecField]) -> str:
         """A list of numbers or bits: its count from a number, a count field, a byte-size field, or the rest."""
         value = self.local(f)
         item = 1 if f.item is None else f.item.size
         if f.size or f.count == "rest":
-            lines.append(f"nb = {self.local_named(f.size)}" if f.size else "nb = end - o")
+            body.append(Code(f"nb = {self.local_named(f.size)}") if f.size else Code("nb = end - o", cursor=True))
             if f.item is None:
-                lines.append("n = nb * 8")
+                body.append(Code("n = nb * 8"))
             else:
                 if item > 1:
-                    lines.append(f"if nb % {item}:")
                     reason = f"{{nb}} bytes do not split into {f.name} items of {item}"
-                    lines.append(f"    raise DecodeError({where} + f': {reason}')")
-                lines.append(f"n = nb // {item}" if item > 1 else "n = nb")
+                    body.append(If(f"nb % {item}", (Raise(f"DecodeError({where} + f': {reason}')"),)))
+                body.append(Code(f"n = nb // {item}" if item > 1 else "n = nb"))
         else:
-            lines.append(f"n = {f.count if isinstance(f.count, int) else self.local_named(str(f.count))}")
-            lines.append("nb = (n + 7) >> 3" if f.item is None else (f"nb = n * {item}" if item > 1 else "nb = n"))
-        lines.append("if end - o < nb:")
-        lines.append(f"    raise DecodeError({where} + f': {f.name} needs {{nb}} bytes, {{end - o}} left')")
+            body.append(Code(f"n = {f.count if isinstance(f.count, int) else self.local_named(str(f.count))}"))
+            body.append(Code("nb = (n + 7) >> 3" if f.item is None else (f"nb = n * {item}" if item > 1 else "nb = n")))
+        body.append(Needs("nb", f"DecodeError({where} + f': {f.name} needs {{nb}} bytes, {{end - o}} left')"))
         most = self.most_items(f, siblings)
         if f.item is None:
-            lines.append(f"{value} = _unpack_bits(buf, o, n)")
+            self.packing.add("unpack_bits")
+            body.append(Code(f"{value} = _unpack_bits(buf, o, n)", cursor=True))
         elif most is not None and most <= _MOST_RUNS:  # a struct per count, made once
             name = f"_RUNS_{'BE' if f.endian == '>' else 'LE'}_{_STRUCT_NAMES[f.item.struct_char]}"
             known = self.unpack_runs.get(name, ("", 0))[1]
             self.unpack_runs[name] = (f"{f.endian}{f.item.struct_char}", max(most, known))
-            lines.append(f"{value} = {name}[n](buf, o)")
+            body.append(Code(f"{value} = {name}[n](buf, o)", cursor=True))
         else:
-            lines.append(f"{value} = struct.unpack_from(f'{f.endian}{{n}}{f.item.struct_char}', buf, o)")
-        lines.append("o += nb")
+            read = f"struct.unpack_from(f'{f.endian}{{n}}{f.item.struct_char}', buf, o)"
+            body.append(Code(f"{value} = {read}", cursor=True))
+        body.append(Advance("nb"))
         return value
 
     def most_items(self, f: List, siblings: list[SpecField]) -> int | None:
@@ -794,24 +684,23 @@ class PackageCode:
             return int(scalars[f.count].type.maximum)
         return None
 
-    def decode_text(self, f: Text, lines: Lines, where: str) -> str:
+    def decode_text(self, f: Text, body: Block, where: str) -> str:
         value = self.local(f)
+        self.packing.add("decode_text")
         if f.size is None:
-            lines.append("stop = buf.find(b'\\0', o, end)")
-            lines.append("if stop < 0:")
-            lines.append(f"    raise DecodeError({where} + ': {f.name} has no NUL at its end')")
-            lines.append(f"{value} = _decode_text(buf[o:stop], {f.name!r}, {where})")
-            lines.append("o = stop + 1")
+            body.append(Code("stop = buf.find(b'\\0', o, end)", cursor=True))
+            body.append(If("stop < 0", (Raise(f"DecodeError({where} + ': {f.name} has no NUL at its end')"),)))
+            body.append(Code(f"{value} = _decode_text(buf[o:stop], {f.name!r}, {where})", cursor=True))
+            body.append(Advance(to="stop + 1"))
             return value
         if f.size == "rest":
-            lines.append(f"{value} = _decode_text(buf[o:end], {f.name!r}, {where})")
-            lines.append("o = end")
+            body.append(Code(f"{value} = _decode_text(buf[o:end], {f.name!r}, {where})", cursor=True))
+            body.append(Advance(to="end"))
             return value
         size = str(f.size) if isinstance(f.size, int) else self.local_named(f.size)
-        lines.append(f"if end - o < {size}:")
-        lines.append(f"    raise DecodeError({where} + f': {f.name} needs {{{size}}} bytes, {{end - o}} left')")
-        lines.append(f"{value} = _decode_text(buf[o : o + {size}], {f.name!r}, {where})")
-        lines.append(f"o += {size}")
+        body.append(Needs(size, f"DecodeError({where} + f': {f.name} needs {{{size}}} bytes, {{end - o}} left')"))
+        body.append(Code(f"{value} = _decode_text(buf[o : o + {size}], {f.name!r}, {where})", cursor=True))
+        body.append(Advance(size))
         return value
 
     def local_named(self, name: str) -> str:
@@ -822,9 +711,9 @@ class PackageCode:
 
     # --- encoding -------------------------------------------------------------------------------------------------
 
-    def encoder(self, message: Message, all_fields: list[SpecField]) -> Lines:
+    def encoder(self, message: Message, all_fields: list[SpecField]) -> Block:
         """Body of `_encode_X(m) -> bytes`: range checks, then the frame's bytes."""
-        lines: Lines = []
+        body: Block = []
         where = self.where(message)
         frame_fields = all_fields[: len(all_fields) - len(self.value_fields(message))]
         layout = self.protocol.framing.layouts[message.direction]
@@ -834,73 +723,73 @@ class PackageCode:
         for f in frame_fields:
             assert isinstance(f, Scalar)
             if f.bits:
-                frame_values.append(self.wire_value(f, "m", [], lines, where))
+                frame_values.append(self.wire_value(f, "m", [], body, where))
                 continue
             if error is not None and f.name == error.element:  # the refused request's code: sent with the flag
-                self.check_scalar(f, f"m.{f.name}", lines, where)
+                self.check_scalar(f, field_read("m", f.name), body, where)
                 continue
-            self.check_scalar(f, f"m.{f.name}", lines, where, also=elements[f.name].broadcast)
-            frame_values.append(f"m.{f.name}")
+            self.check_scalar(f, field_read("m", f.name), body, where, also=elements[f.name].broadcast)
+            frame_values.append(Simple(field_read("m", f.name)))
         fields = list(message.fields)
-        self.check_count_from(message, lines, where)
+        self.check_count_from(message, body, where)
         command_code = self.protocol.command(message.command).code
         if not self.protocol.framing.classic:
             # the runtime's frame engine wraps the content (see backends/python/frames.py)
-            parts = self.encode_fields(fields, message.class_name, "m", lines, where)
+            parts = self.encode_fields(fields, message.class_name, "m", body, where)
             content = parts[0] if len(parts) == 1 else f"b''.join(({', '.join(parts)},))" if parts else "b''"
-            code = f"{command_code:#04x}" if command_code is not None and layout.has_command else "None"
+            code: str = Simple(f"{command_code:#04x}" if command_code is not None and layout.has_command else "None")
             if error is not None:
-                code = f"m.{error.element} | {error.flag:#04x}"
+                code = f"{field_read('m', error.element)} | {error.flag:#04x}"
             frames = self.straight(message.direction)
             size = message.min_size if message.min_size == message.max_size else None
             name = f"frame_{message.class_name}"
             inline = frames and frame_encoder(
                 frames, parts, self.structs, code, frame_values, size, lambda fmt: self.struct(name, fmt)
             )
-            if inline:  # the frame made here (backends/python/framecode.py): no call of the direction's wrap
-                return [*lines, *inline]
+            if inline:  # the frame made here (backends/python/straight_frames.py): no call of the direction's wrap
+                return [*body, *inline]
             arguments = ", ".join([content, code, *frame_values])
-            lines.append(f"return _wrap_{message.direction.value}({arguments})")  # backends/python/framecode.py
-            return lines
+            # backends/python/straight_frames.py
+            body.append(Code(f"return _wrap_{message.direction.value}({arguments})", lists=packed_lists(parts)))
+            return body
         code = str(command_code if command_code is not None else 0)
         if all(is_fixed_run_member(f) for f in fields):
             # one fixed size: the whole frame but its checksum is one struct, the length byte a constant
-            endian, content_format, args = self.encode_run_format(fields, "m", fields, lines, where)
+            endian, content_format, args = self.encode_run_format(fields, "m", fields, body, where)
             head = self.head_format(layout, endian, code, f"{message.min_size + layout.length_adds}", frame_values)
             if head is not None:
                 head_format, head_args = head
                 name = self.struct(f"frame_{message.class_name}", endian + head_format + content_format)
-                lines.append(f"body = {name}.pack({', '.join([*head_args, *args])})")
-                lines.extend(self.checksum_append(layout, "body"))
-                return lines
+                body.append(Code(f"body = {name}.pack({', '.join([*head_args, *args])})"))
+                body.extend(self.checksum_append(layout, "body"))
+                return body
             parts = []
             if fields:
                 name = self.struct(f"{message.class_name}_{fields[0].name}", endian + content_format)
-                parts.append(f"{name}.pack({', '.join(args)})")
+                parts.append(Pack(name, args))
         else:
             runs = list(fixed_runs(fields))
-            run_lines: Lines = []
             if len(runs) > 1 and isinstance(runs[0], list):
                 # a leading run of fixed fields is packed with the frame's head: one struct call and one bytes
                 # object less per frame (the head is little-endian, so the run must be too, or all single bytes)
-                endian, run_format, run_args = self.encode_run_format(runs[0], "m", fields, run_lines, where)
-                if endian == "<" or _SINGLE_BYTES.fullmatch(run_format):
-                    lines.extend(run_lines)
+                endian = run_endian(runs[0])
+                if endian == "<" or byte_order_free(struct_format("", runs[0])):
+                    _, run_format, run_args = self.encode_run_format(runs[0], "m", fields, body, where)
                     rest = [
-                        self.encode_run(item, message.class_name, "m", fields, lines, where)
+                        self.encode_run(item, message.class_name, "m", fields, body, where)
                         if isinstance(item, list)
-                        else self.encode_variable(item, "m", lines, where)
+                        else self.encode_variable(item, "m", body, where)
                         for item in runs[1:]
                     ]
                     content = rest[0] if len(rest) == 1 else f"b''.join(({', '.join(rest)},))"
-                    lines.append(f"content = {content}")
-                    lines.extend(self.frame_lines(layout, code, frame_values, (run_format, run_args)))
-                    return lines
-            parts = self.encode_fields(fields, message.class_name, "m", lines, where)
+                    body.append(Code(f"content = {content}", lists=packed_lists(rest)))
+                    body.extend(self.frame_lines(layout, code, frame_values, (run_format, run_args)))
+                    return body
+            parts = self.encode_fields(fields, message.class_name, "m", body, where)
         content = parts[0] if len(parts) == 1 else f"b''.join(({', '.join(parts)},))"
-        lines.append(f"content = {content if parts else repr(b'')}")
-        lines.extend(self.frame_lines(layout, code, frame_values))
-        return lines
+        body.append(Code(f"content = {content if parts else repr(b'')}", lists=packed_lists(parts)))
+        body.extend(self.frame_lines(layout, code, frame_values))
+        return body
 
     def head_format(
         self, layout: FrameLayout, endian: str, code: str, length: str, values: list[str]
@@ -933,51 +822,48 @@ class PackageCode:
                 args.append(next(remaining))
         return "".join(chars), args
 
-    def checksum_append(self, layout: FrameLayout, body: str) -> Lines:
-        """Lines that return `body` (the frame without its checksum) with its checksum appended."""
+    def checksum_append(self, layout: FrameLayout, body: str) -> Block:
+        """Statements that return `body` (the frame without its checksum) with its checksum appended."""
         covered = f"{body}[{layout.covered_from}:]" if layout.covered_from else body
         size = layout.checksum_offset_from_end
         checksum = self.protocol.framing.checksum
-        assert checksum is not None  # classic frames have one
-        lines = checksum_lines(checksum, covered, "check")
+        assert checksum is not None  # length-byte frames have one
+        value = checksum_expression(checksum, covered)
         skipped = layout.header[: layout.covered_from]
         less = checksum.algorithm.byte_total(f"sum({body}) - {sum(skipped):#x}")
         if less is not None and layout.covered_from and len(skipped) == layout.covered_from:
             # the bytes before the covered ones are the header, a constant: the sum less it, no slice made
-            lines = [f"check = {less}"]
-        if len(lines) == 1:  # a single expression: append it directly
-            value = lines[0].removeprefix("check = ")
-            lines = []
-        else:
-            value = "check"
+            value = less
+        lines: Block = []
+        if value is None:  # computed by statements into `check`; else the one expression is appended directly
+            lines, value = [Code(line) for line in checksum_lines(checksum, covered, "check")], "check"
         tail = f"_BYTES[{value}]" if size == 1 else f"({value}).to_bytes({size}, 'little')"
-        return [*lines, f"return {body} + {tail}"]
+        return [*lines, Code(f"return {body} + {tail}")]
 
     def frame_lines(
         self, layout: FrameLayout, code: str, values: list[str], prefix: tuple[str, list[str]] | None = None
-    ) -> Lines:
-        """Lines that return the frame around the bytes in `content`: inline in each encoder, not a call per frame.
-
-        `prefix`: struct format (little-endian) and arguments of the content's first fields, packed with the head.
-        """
+    ) -> Block:
+        """Statements that return the frame around the bytes in `content`: inline in each encoder, not a call per
+        frame. `prefix`: struct format (little-endian) and arguments of the content's first fields, packed with the
+        head."""
         prefix_format, prefix_args = prefix or ("", [])
         adds = layout.length_adds + struct.calcsize("<" + prefix_format)
-        lines: Lines = [f"n = len(content) + {adds}" if adds else "n = len(content)"]
+        body: Block = [Code(f"n = len(content) + {adds}" if adds else "n = len(content)")]
         length = next(e for e in layout.elements if e.role == "length")
         assert length.type is not None
-        lines.append(f"if n > {int(length.type.maximum)}:")
         size = f"n - {layout.length_adds}" if layout.length_adds else "n"
-        lines.append(f"    raise EncodeError(f'content of {{{size}}} bytes does not fit the length field')")
+        error = f"EncodeError(f'content of {{{size}}} bytes does not fit the length field')"
+        body.append(If(f"n > {int(length.type.maximum)}", (Raise(error),)))
         head = self.head_format(layout, "<", code, "n", values)
         assert head is not None  # little-endian and a length computed at run time: always possible
         head_format, head_args = head
         base = f"head_{layout.direction.value}" + (f"_{prefix_format}" if prefix_format else "")
         name = self.struct(base, "<" + head_format + prefix_format)
-        lines.append(f"body = {name}.pack({', '.join([*head_args, *prefix_args])}) + content")
-        lines.extend(self.checksum_append(layout, "body"))
-        return lines
+        body.append(Code(f"body = {name}.pack({', '.join([*head_args, *prefix_args])}) + content"))
+        body.extend(self.checksum_append(layout, "body"))
+        return body
 
-    def check_scalar(self, f: Scalar, expr: str, lines: Lines, where: str, also: int | None = None) -> None:
+    def check_scalar(self, f: Scalar, expr: str, body: Block, where: str, also: int | None = None) -> None:
         """Range check; `also` is one more value allowed outside the range (an address's broadcast value)."""
         # an integer field refuses True and False too (bool is an int to Python, never to the wire)
         not_bool = "" if f.type.is_float else f" or {expr}.__class__ is bool"
@@ -986,17 +872,16 @@ class PackageCode:
         low, high = bound(f, f.minimum), bound(f, f.maximum)
         if also is not None and also in (f.minimum - 1, f.maximum + 1):  # next to the range: one comparison
             low, high = bound(f, min(also, f.minimum)), bound(f, max(also, f.maximum))
-            lines.append(f"if not {low} <= {expr} <= {high}{not_bool}:")
+            condition = f"not {low} <= {expr} <= {high}{not_bool}"
         elif also is not None and not f.minimum <= also <= f.maximum:
-            lines.append(f"if not ({low} <= {expr} <= {high} or {expr} == {also}){not_bool}:")
+            condition = f"not ({low} <= {expr} <= {high} or {expr} == {also}){not_bool}"
         else:
-            lines.append(f"if not {low} <= {expr} <= {high}{not_bool}:")
+            condition = f"not {low} <= {expr} <= {high}{not_bool}"
         broadcast = "" if also is None or f.minimum <= also <= f.maximum else f", {also}"
-        lines.append(
-            f"    raise out_of_range({where}, {f.name!r}, {expr}, {number(f.minimum)}, {number(f.maximum)}{broadcast})"
-        )
+        error = f"out_of_range({where}, {f.name!r}, {expr}, {number(f.minimum)}, {number(f.maximum)}{broadcast})"
+        body.append(If(condition, (Raise(error),)))
 
-    def check_count_from(self, message: Message, lines: Lines, where: str) -> None:
+    def check_count_from(self, message: Message, body: Block, where: str) -> None:
         """A response list whose count the request gives (`count_from`) holds no more items than the request's
         count field allows (Modbus: at most 2000 coils), so no frame is made that no request could have asked for."""
         for f in message.fields:
@@ -1010,33 +895,30 @@ class PackageCode:
             count = next(c for c in request.fields if c.name == f.count_from)
             assert isinstance(count, Scalar)
             high = number(count.maximum)
-            lines.append(f"if len(m.{f.name}) > {high}:")
-            reason = (
-                f"{f.name} has {{len(m.{f.name})}} items, at most {high} (the limit of the request field {count.name})"
-            )
-            lines.append(f"    raise EncodeError({where} + f': {reason}')")
+            items = f"len({field_read('m', f.name)})"
+            reason = f"{f.name} has {{{items}}} items, at most {high} (the limit of the request field {count.name})"
+            body.append(If(f"{items} > {high}", (Raise(f"EncodeError({where} + f': {reason}')"),)))
 
-    def check_items(self, f: Array | List, expr: str, lines: Lines, where: str) -> None:
+    def check_items(self, f: Array | List, expr: str, body: Block, where: str) -> None:
         """Every number of a list within the item's range, and none a bool (True is not 1); the first at fault named.
 
-        A plain loop: any() over a generator costs a frame per call, twice the time for a few items."""
+        A plain loop: any() over a generator costs a frame per call, twice the time for a few items. Where the
+        range is the item type's, struct.pack checks it: the loop runs only if the pack fails (deferred_item_checks).
+        """
         low, high = number(f.minimum), number(f.maximum)
-        item = f"x_{f.name}"
         kind = f.item if isinstance(f, List) else None
-        if kind is not None and not kind.is_float and (f.minimum, f.maximum) == (kind.minimum, kind.maximum):
-            lines.append(f"{_DEFERRED}{expr}")  # struct.pack checks the range: the loop only if it fails (deferred)
-        lines.append(f"for {item} in {expr}:")
-        lines.append(f"    if not {low} <= {item} <= {high} or {item}.__class__ is bool:")
-        lines.append(f"        raise out_of_range({where}, {f.name!r}, {expr}, {low}, {high})")
+        deferrable = kind is not None and not kind.is_float and (f.minimum, f.maximum) == (kind.minimum, kind.maximum)
+        error = f"out_of_range({where}, {f.name!r}, {expr}, {low}, {high})"
+        body.append(ItemsCheck(f"x_{f.name}", expr, low, high, error, deferrable))
 
-    def encode_fields(self, fields: list[SpecField], base: str, obj: str, lines: Lines, where: str) -> list[str]:
+    def encode_fields(self, fields: list[SpecField], base: str, obj: str, body: Block, where: str) -> list[str]:
         """Append checks and local values; return expressions of the byte parts in order."""
         parts: list[str] = []
         for item in fixed_runs(fields):
             if isinstance(item, list):
-                parts.append(self.encode_run(item, base, obj, fields, lines, where))
+                parts.append(self.encode_run(item, base, obj, fields, body, where))
             else:
-                parts.append(self.encode_variable(item, obj, lines, where))
+                parts.append(self.encode_variable(item, obj, body, where))
         return parts
 
     def derived_source(self, f: Scalar, obj: str, siblings: list[SpecField]) -> str:
@@ -1048,155 +930,151 @@ class PackageCode:
                 other = by_name[name]
                 if isinstance(other, Scalar) and (other.value is not None or other.derived):
                     return f"({self.derived_source(other, obj, siblings)})"
-                return f"{obj}.{name}"
+                return field_read(obj, name)
 
             return expression.render(f.value, source)
         kind, target = f.derived[0], f.derived[1]
         other = by_name.get(target)
         if kind == "size" and isinstance(other, List):
-            count = f"len({obj}.{target})"
+            count = f"len({field_read(obj, target)})"
             return f"(({count} + 7) >> 3)" if other.item is None else f"{count} * {other.item.size}"
         if kind == "size" and isinstance(other, Text):
-            return f"len({obj}.{target}.encode('utf-8'))"
-        return f"len({obj}.{target})"
+            return f"len({field_read(obj, target)}.encode('utf-8'))"
+        return f"len({field_read(obj, target)})"
 
-    def wire_value(self, f: Scalar, obj: str, siblings: list[SpecField], lines: Lines, where: str) -> str:
+    def wire_value(self, f: Scalar, obj: str, siblings: list[SpecField], body: Block, where: str) -> str:
         if f.const is not None:
-            return number(f.const)
+            return Simple(number(f.const)) if f.const >= 0 else number(f.const)
+
+        def out_of_range(value: str) -> Raise:
+            return Raise(f"out_of_range({where}, {f.name!r}, {value}, {number(f.minimum)}, {number(f.maximum)})")
+
         if f.value is not None or (f.derived and isinstance(self.sibling(siblings, f.derived[1]), List | Text)):
-            value = self.local(f) if obj == "m" else f"{obj}_{f.name}"
-            lines.append(f"{value} = {self.derived_source(f, obj, siblings)}")
-            lines.append(f"if not {number(f.minimum)} <= {value} <= {number(f.maximum)}:")
-            lines.append(
-                f"    raise out_of_range({where}, {f.name!r}, {value}, {number(f.minimum)}, {number(f.maximum)})"
-            )
+            value: str = Simple(self.local(f) if obj == "m" else f"{obj}_{f.name}")
+            body.append(Code(f"{value} = {self.derived_source(f, obj, siblings)}"))
+            condition = f"not {number(f.minimum)} <= {value} <= {number(f.maximum)}"
+            body.append(If(condition, (out_of_range(value),)))
             return value
         if f.derived:
             kind, target = f.derived[0], f.derived[1]
             if kind == "count" or any(s.name == target for s in siblings):  # a count, or bytes beside their size
-                value = f"len({obj}.{target})"
+                value = f"len({field_read(obj, target)})"
             else:
                 group = next(s for s in siblings if isinstance(s, Group) and any(i.name == target for i in s.fields))
-                value = self.local_named(f.name)
-                lines.append(f"{value} = len({obj}.{group.name}[0].{target}) if {obj}.{group.name} else 0")
-                lines.append(f"if any(len(item.{target}) != {value} for item in {obj}.{group.name}):")
-                lines.append(
-                    f"    raise EncodeError({where} + ': every {target} of {group.name} must have the same length')"
-                )
-            lines.append(f"if {value} > {number(f.maximum)}:")
-            lines.append(
-                f"    raise out_of_range({where}, {f.name!r}, {value}, {number(f.minimum)}, {number(f.maximum)})"
-            )
+                value = Simple(self.local_named(f.name))
+                items = field_read(obj, group.name)
+                body.append(Code(f"{value} = len({items}[0].{target}) if {items} else 0"))
+                error = f"EncodeError({where} + ': every {target} of {group.name} must have the same length')"
+                condition = f"any(len(item.{target}) != {value} for item in {items})"
+                body.append(If(condition, (Raise(error),)))
+            body.append(If(f"{value} > {number(f.maximum)}", (out_of_range(value),)))
             return value
-        expr = f"{obj}.{f.name}"
+        expr = field_read(obj, f.name)
         if f.bits:
             packed = []
             for bit in f.bits:
                 sub = f"{expr}.{bit.name}"
-                lines.append(f"if not 0 <= {sub} <= {bit.mask} or {sub}.__class__ is bool:")
-                lines.append(f"    raise out_of_range({where}, {f.name + '.' + bit.name!r}, {sub}, 0, {bit.mask})")
-                packed.append(f"({sub} << {bit.low})" if bit.low else sub)
-            return " | ".join(packed)
-        self.check_scalar(f, expr, lines, where)
+                error = f"out_of_range({where}, {f.name + '.' + bit.name!r}, {sub}, 0, {bit.mask})"
+                body.append(If(f"not 0 <= {sub} <= {bit.mask} or {sub}.__class__ is bool", (Raise(error),)))
+                packed.append(f"({sub} << {bit.low})" if bit.low else Simple(sub))
+            return packed[0] if len(packed) == 1 else " | ".join(packed)
+        self.check_scalar(f, expr, body, where)
         if f.sign_magnitude:
             top = 1 << (f.type.size * 8 - 1)
             return f"(-{expr} | {top:#x} if {expr} < 0 else {expr})"
-        return expr
+        return Simple(expr)
 
     @staticmethod
     def sibling(siblings: list[SpecField], name: str) -> SpecField | None:
         return next((s for s in siblings if s.name == name), None)
 
     def encode_run(
-        self, run: list[SpecField], base: str, obj: str, siblings: list[SpecField], lines: Lines, where: str
+        self, run: list[SpecField], base: str, obj: str, siblings: list[SpecField], body: Block, where: str
     ) -> str:
-        endian, fmt, args = self.encode_run_format(run, obj, siblings, lines, where)
+        endian, fmt, args = self.encode_run_format(run, obj, siblings, body, where)
         const_name = self.struct(f"{base}_{run[0].name}", endian + fmt)
-        return f"{const_name}.pack({', '.join(args)})"
+        return Pack(const_name, args)
 
     def encode_run_format(
-        self, run: list[SpecField], obj: str, siblings: list[SpecField], lines: Lines, where: str
+        self, run: list[SpecField], obj: str, siblings: list[SpecField], body: Block, where: str
     ) -> tuple[str, str, list[str]]:
-        """Byte order, struct format (without it) and pack arguments of a run of fixed-size fields; checks to lines."""
-        endian = next((f.endian for f in run if isinstance(f, Scalar | Array | TableBlock)), "<")
+        """Byte order, struct format (without it) and pack arguments of a run of fixed-size fields; checks to body."""
         args: list[str] = []
         for f in run:
             if isinstance(f, Scalar):
-                args.append(self.wire_value(f, obj, siblings, lines, where))
+                args.append(self.wire_value(f, obj, siblings, body, where))
             elif isinstance(f, Array):
-                expr = f"{obj}.{f.name}"
-                lines.append(f"if len({expr}) != {f.count}:")
-                lines.append(
-                    f"    raise EncodeError({where} + f': {f.name} needs {f.count} items, got {{len({expr})}}')"
-                )
-                self.check_items(f, expr, lines, where)
+                expr = field_read(obj, f.name)
+                error = f"EncodeError({where} + f': {f.name} needs {f.count} items, got {{len({expr})}}')"
+                body.append(If(f"len({expr}) != {f.count}", (Raise(error),)))
+                self.check_items(f, expr, body, where)
                 args.append(f"*{expr}")
             elif isinstance(f, Bytes):
-                expr = f"{obj}.{f.name}"
-                lines.append(f"if len({expr}) != {f.size}:")
-                lines.append(
-                    f"    raise EncodeError({where} + f': {f.name} needs {f.size} bytes, got {{len({expr})}}')"
-                )
-                args.append(expr)
+                expr = field_read(obj, f.name)
+                error = f"EncodeError({where} + f': {f.name} needs {f.size} bytes, got {{len({expr})}}')"
+                body.append(If(f"len({expr}) != {f.size}", (Raise(error),)))
+                args.append(Simple(expr))
             elif isinstance(f, TableBlock):
                 for e in f.entries:
-                    expr = f"{obj}.{f.name}.{e.name}"
-                    lines.append(f"if not {number(e.minimum)} <= {expr} <= {number(e.maximum)}:")
-                    lines.append(
-                        f"    raise out_of_range({where}, {f.name + '.' + e.name!r}, {expr}, "
-                        f"{number(e.minimum)}, {number(e.maximum)})"
-                    )
-                    args.append(expr)
-        return endian, struct_format("", run), args
+                    expr = f"{field_read(obj, f.name)}.{e.name}"
+                    name = f.name + "." + e.name
+                    error = f"out_of_range({where}, {name!r}, {expr}, {number(e.minimum)}, {number(e.maximum)})"
+                    body.append(If(f"not {number(e.minimum)} <= {expr} <= {number(e.maximum)}", (Raise(error),)))
+                    args.append(Simple(expr))
+        return run_endian(run), struct_format("", run), args
 
-    def encode_variable(self, f: SpecField, obj: str, lines: Lines, where: str) -> str:
-        expr = f"{obj}.{f.name}"
+    def encode_variable(self, f: SpecField, obj: str, body: Block, where: str) -> str:
+        expr = field_read(obj, f.name)
+        count = f.count if isinstance(f, List | Group) else None
+        count_error = f"EncodeError({where} + f': {f.name} needs {count} items, got {{len({expr})}}')"
         if isinstance(f, List):
             if isinstance(f.count, int):
-                lines.append(f"if len({expr}) != {f.count}:")
-                lines.append(
-                    f"    raise EncodeError({where} + f': {f.name} needs {f.count} items, got {{len({expr})}}')"
-                )
+                body.append(If(f"len({expr}) != {f.count}", (Raise(count_error),)))
             if f.item is None:
+                self.packing.add("pack_bits")
                 return f"_pack_bits({expr}, {f.name!r}, {where})"
-            self.check_items(f, expr, lines, where)
-            return f"struct.pack(f'{f.endian}{{len({expr})}}{f.item.struct_char}', *{expr})"
+            self.check_items(f, expr, body, where)
+            return PackItems(f.endian, f.item.struct_char, expr)
         if isinstance(f, Text):
+            self.packing.add("encode_text")
             data = f"_encode_text({expr}, {f.name!r}, {where}, {f.size is None})"
             if isinstance(f.size, int):
-                lines.append(f"{self.local(f)} = {data}")
-                lines.append(f"if len({self.local(f)}) != {f.size}:")
+                body.append(Code(f"{self.local(f)} = {data}"))
                 reason = f"{f.name} needs {f.size} bytes of UTF-8, got {{len({self.local(f)})}}"
-                lines.append(f"    raise EncodeError({where} + f': {reason}')")
+                body.append(If(f"len({self.local(f)}) != {f.size}", (Raise(f"EncodeError({where} + f': {reason}')"),)))
                 return self.local(f)
             return data
         if isinstance(f, Bytes):  # bytes as they are (bytes(b) looks up b.__bytes__ first), anything else made bytes
-            lines.append(f"{self.local(f)} = {expr} if {expr}.__class__ is bytes else bytes({expr})")
+            body.append(Code(f"{self.local(f)} = {expr} if {expr}.__class__ is bytes else bytes({expr})"))
             return self.local(f)
         if isinstance(f, TableValue):
             table = f"_TABLE_{f.table.name.upper()}"
-            key = f"{obj}.{f.key}"
-            lines.append(f"s = {table}.get({key})")
-            lines.append("if s is None:")
-            lines.append(f"    raise EncodeError({where} + f': unknown {f.table.key_name} {{{key}}}')")
-            lines.append(f"low, high = _TABLE_{f.table.name.upper()}_RANGES[{key}]")
-            lines.append(f"if not low <= {expr} <= high:")
-            lines.append(f"    raise out_of_range({where}, {f.name!r}, {expr}, low, high)")
+            key = field_read(obj, f.key)
+            body.append(Code(f"s = {table}.get({key})"))
+            body.append(If("s is None", (Raise(f"EncodeError({where} + f': unknown {f.table.key_name} {{{key}}}')"),)))
+            body.append(Code(f"low, high = _TABLE_{f.table.name.upper()}_RANGES[{key}]"))
+            body.append(
+                If(f"not low <= {expr} <= high", (Raise(f"out_of_range({where}, {f.name!r}, {expr}, low, high)"),))
+            )
             return f"s.pack({expr})"
         assert isinstance(f, Group)
         if isinstance(f.count, int):
-            lines.append(f"if len({expr}) != {f.count}:")
-            lines.append(f"    raise EncodeError({where} + f': {f.name} needs {f.count} items, got {{len({expr})}}')")
+            body.append(If(f"len({expr}) != {f.count}", (Raise(count_error),)))
         # the items are checked and packed in a loop here, not by a function called per item
         item = "item" if obj == "m" else f"{obj}_item"
-        item_lines: Lines = []
-        parts = self.encode_fields(list(f.fields), f.class_name, item, item_lines, where)
+        item_body: Block = []
+        parts = self.encode_fields(list(f.fields), f.class_name, item, item_body, where)
         packed = f"b''.join(({', '.join(parts)},))" if len(parts) > 1 else parts[0]
-        lines.append(f"parts_{f.name} = []")
-        lines.append(f"for {item} in {expr}:")
-        lines.extend("    " + line for line in item_lines)
-        lines.append(f"    parts_{f.name}.append({packed})")
+        body.append(Code(f"parts_{f.name} = []"))
+        item_body.append(Code(f"parts_{f.name}.append({packed})", lists=packed_lists(parts)))
+        body.append(Loop(f"for {item} in {expr}", tuple(item_body), variable=item))
         return f"b''.join(parts_{f.name})"
+
+
+def checksum_expression(checksum: Checksum, covered: str) -> str | None:
+    """The one expression of a frame's checksum over the bytes `covered` (an expression) that checksum_lines
+    assigns, where it is one; None where it takes statements."""
+    return checksum.algorithm.python_expression(checksum_name(checksum), covered)
 
 
 def checksum_lines(checksum: Checksum, covered: str, target: str) -> Lines:

@@ -1,5 +1,5 @@
-"""Straight-line code for frames that are not of the classic shape (stuffing, u16 lengths over a span, CRC-16s, frames
-without a header or a length, alternative layouts told apart by their header).
+"""Straight-line code for frames that are not of the length-byte shape (length_byte_frames.py): stuffing, u16
+lengths over a span, CRC-16s, frames without a header or a length, alternative layouts told apart by their header.
 
 Each direction gets two functions: `_decode_<direction>(frame, expect)` checks a whole frame and calls the content
 decoder on the frame's own bytes, and `_wrap_<direction>(content, code, *values)` puts the frame around a content.
@@ -22,12 +22,11 @@ where `end` is the content's end. Lengths and checksums that see wire bytes read
 
 from __future__ import annotations
 
-import ast
-import re
 from collections.abc import Callable
 from dataclasses import dataclass
 
 from serialspec.backends.common.frames import runtime_layouts
+from serialspec.backends.python.ir import Block, Code, Literal, Pack, PackItems, Simple, packed_lists
 from serialspec.lang.model import Checksum, Direction, Protocol
 from serialspec.runtime.framing import Element, Layout
 
@@ -104,11 +103,14 @@ def _size(elements: tuple[Element, ...]) -> int:
     return sum(e.size for e in elements)
 
 
-class _Places:
-    """Element positions in `buf` (plain bytes): a literal offset before the content, `end + k` after it."""
+class _Positions:
+    """Element positions in `buf` (plain bytes): a literal offset before the content, `end + k` after it; or, for a
+    frame known not to be stuffed (`from_end`), in `frame`, counted back from the frame's end after the content."""
 
-    def __init__(self, layout: Layout) -> None:
+    def __init__(self, layout: Layout, from_end: bool = False) -> None:
         self.layout = layout
+        self.from_end = from_end
+        self.buf = "frame" if from_end else "buf"
         self.first, self.last = _variable(layout)
         c = layout.content
         self.before = _size(layout.elements[: self.first])  # wire bytes before the variable part
@@ -134,24 +136,27 @@ class _Places:
         offset += extra
         if not behind:
             return str(offset)
+        if self.from_end:
+            return str(offset - self.behind)
         return f"end + {offset}" if offset else "end"
 
     def stop(self, index: int) -> str:
         """The position just after element `index`."""
         if index == self.layout.content:
-            return "end"
+            return str(-self.behind) if self.from_end else "end"
         return self.at(index, self.layout.elements[index].size)
 
     def read(self, index: int) -> str:
         """The element's value, read from `buf`."""
         element = self.layout.elements[index]
         at = [self.at(index, i) for i in range(element.size)]
+        buf = self.buf
         if element.size == 1:
-            return f"buf[{at[0]}]"
+            return f"{buf}[{at[0]}]"
         if element.size == 2:
             high, low = (at[0], at[1]) if element.endian == "big" else (at[1], at[0])
-            return f"buf[{high}] << 8 | buf[{low}]"
-        return f"int.from_bytes(buf[{at[0]}:{self.stop(index)}], {element.endian!r})"
+            return f"{buf}[{high}] << 8 | {buf}[{low}]"
+        return f"int.from_bytes({buf}[{at[0]}:{self.stop(index)}], {element.endian!r})"
 
     def counted(self, a: int, b: int) -> str:
         """Bytes of elements a..b as a length counts them (wire bytes, but plain ones inside the stuffed span)."""
@@ -173,7 +178,7 @@ class _Places:
             begin = _size(elements[:a])
             tail = _size(elements[b + 1 :])
             return f"frame[{begin or ''}:{-tail if tail else ''}]" if begin or tail else "frame"
-        return f"buf[{_start(self.at(a))}:{self.stop(b)}]"
+        return f"{self.buf}[{_start(self.at(a))}:{self.stop(b)}]"
 
 
 def _message_constant(element: Element, data: str) -> str:
@@ -190,7 +195,7 @@ def decode_lines(
     Transparency object (unstuffing, with its error for a frame that is not in stuffed form); `header_known`: the
     caller has matched the header (it chose the layout by it), so it is not compared again.
     """
-    places = _Places(layout)
+    positions = _Positions(layout)
     elements = layout.elements
     lines: Lines = [
         f"def {name}(frame: bytes, expect: type[Message] | None = None) -> Message:",
@@ -198,7 +203,7 @@ def decode_lines(
         "    n = len(frame)",
     ]
     body: Lines = []
-    smallest = places.before + places.after
+    smallest = positions.before + positions.after
     if smallest:
         body += [
             f"if n < {smallest}:",
@@ -206,34 +211,34 @@ def decode_lines(
             f'({layout.overhead})")',
         ]
     t = layout.transparency
-    body.append(f"end = n - {places.behind}" if places.behind else "end = n")
+    body.append(f"end = n - {positions.behind}" if positions.behind else "end = n")
     if t is None:
         body.append("buf = frame")
     else:
-        stop = f"n - {places.after}" if places.after else "n"
-        found = " or ".join(f"frame.find({s!r}, {places.before}, {stop}) >= 0" for s in _signs(t.replace))
+        stop = f"n - {positions.after}" if positions.after else "n"
+        found = " or ".join(f"frame.find({s!r}, {positions.before}, {stop}) >= 0" for s in _signs(t.replace))
         body += [
             "buf = frame",
             f"if {found}:  # stuffed: the plain bytes of the span",
-            f"    buf = frame[:{places.before}] + {transparency}.decode(frame[{places.before} : {stop}])"
-            + (f" + frame[{stop} :]" if places.after else ""),
-            f"    end = len(buf) - {places.behind}" if places.behind else "    end = len(buf)",
+            f"    buf = frame[:{positions.before}] + {transparency}.decode(frame[{positions.before} : {stop}])"
+            + (f" + frame[{stop} :]" if positions.after else ""),
+            f"    end = len(buf) - {positions.behind}" if positions.behind else "    end = len(buf)",
         ]
-        fixed = _size(elements[places.first : places.last + 1])
+        fixed = _size(elements[positions.first : positions.last + 1])
         if fixed:
-            inner = _plus("end", places.behind - places.after - places.before)
+            inner = _plus("end", positions.behind - positions.after - positions.before)
             body += [
-                f"if end < {places.content}:",
+                f"if end < {positions.content}:",
                 f'    raise DecodeError(f"{layout.name} frame: {{{inner}}} bytes where at least {fixed} belong")',
             ]
-    body += _constant_checks(places, 1 if header_known else 0)
+    body += _constant_checks(positions, 1 if header_known else 0)
     command = layout.command
     values: list[str] = []
     for index in layout.values:
         element = elements[index]
         value = f"v_{element.name}"
         values.append(value)
-        body.append(f"{value} = {places.read(index)}")
+        body.append(f"{value} = {positions.read(index)}")
         full = element.minimum <= 0 and element.maximum >= (1 << (8 * element.size)) - 1
         if full:
             continue
@@ -250,10 +255,10 @@ def decode_lines(
     for index, element in enumerate(elements):
         if element.kind != "length":
             continue
-        counted = places.counted(*element.span)
+        counted = positions.counted(*element.span)
         counted = _plus(counted, element.adds)
         body += [
-            f"length = {places.read(index)}",
+            f"length = {positions.read(index)}",
             f"if length != {counted}:",
             f'    raise DecodeError(f"{element.name} says {{length}} but the frame holds {{{counted}}}")',
         ]
@@ -262,25 +267,25 @@ def decode_lines(
             continue
         width = 2 + 2 * element.size
         failed = [
-            f"check = {checks[index].format(places.covered(*element.span))}",
-            f"stored = {places.read(index)}",
+            f"check = {checks[index].format(positions.covered(*element.span))}",
+            f"stored = {positions.read(index)}",
             "if check != stored:",
             f'    raise ChecksumError(f"bad {element.name}: the frame has {{stored:#0{width}x}}, '
             f'its bytes give {{check:#0{width}x}}")',
         ]
         residue = _residue(element)
         a, b = element.span
-        if residue is not None and b == index - 1 and a <= places.first:
+        if residue is not None and b == index - 1 and a <= positions.first:
             # over the covered bytes and the checksum itself, an intact frame's CRC is one constant: no slice, no
             # stored value to read; they are made only to say what is wrong
-            whole = places.covered(a, index)
+            whole = positions.covered(a, index)
             body += [f"if {checks[index].format(whole)} != {residue:#0{width}x}:", *(f"    {line}" for line in failed)]
         else:
             body += failed
     if command is not None:
-        body.append(f"code = {places.read(command)}")
+        body.append(f"code = {positions.read(command)}")
     code = "None" if command is None else "code"
-    body += _dispatch(target, code, ", ".join(["buf", str(places.content), "end", *values]), nullable=False)
+    body += _dispatch(target, code, ", ".join(["buf", str(positions.content), "end", *values]), nullable=False)
     return lines + [f"    {line}" for line in body], ["n = len(frame)", *body]
 
 
@@ -332,10 +337,10 @@ def _signs(replace: tuple[tuple[bytes, bytes], ...]) -> list[bytes]:
     return [s for i, s in enumerate(every) if not any(o in s for o in every[:i])]
 
 
-def _constant_checks(places: _Places, start: int = 0) -> Lines:
+def _constant_checks(positions: _Positions, start: int = 0) -> Lines:
     """Constant elements from `start` on (1: the header is known to match) checked in element order; neighbours
     compared at once, one by one only to say which."""
-    layout = places.layout
+    layout = positions.layout
     runs: list[list[int]] = []
     for index, element in enumerate(layout.elements):
         if element.kind != "constant" or index < start:
@@ -350,10 +355,10 @@ def _constant_checks(places: _Places, start: int = 0) -> Lines:
         single: list[tuple[str, str, str]] = []  # condition, message per element
         for index, element in each:
             if element.size == 1:
-                condition = f"buf[{places.at(index)}] != {element.constant[0]:#04x}"
-                data = f"buf[{places.at(index)}:{places.stop(index)}]"
+                condition = f"buf[{positions.at(index)}] != {element.constant[0]:#04x}"
+                data = f"buf[{positions.at(index)}:{positions.stop(index)}]"
             else:
-                data = f"buf[{_start(places.at(index))}:{places.stop(index)}]"
+                data = f"buf[{_start(positions.at(index))}:{positions.stop(index)}]"
                 condition = f"{data} != {element.constant!r}"
             single.append((condition, _message_constant(element, data), element.name))
         if len(each) == 1:
@@ -361,7 +366,7 @@ def _constant_checks(places: _Places, start: int = 0) -> Lines:
             lines += [f"if {condition}:", f"    raise DecodeError({message})"]
             continue
         whole = b"".join(element.constant for _, element in each)
-        lines.append(f"if buf[{_start(places.at(run[0]))}:{places.stop(run[-1])}] != {whole!r}:")
+        lines.append(f"if buf[{_start(positions.at(run[0]))}:{positions.stop(run[-1])}] != {whole!r}:")
         for condition, message, _ in single[:-1]:
             lines += [f"    if {condition}:", f"        raise DecodeError({message})"]
         lines.append(f"    raise DecodeError({single[-1][1]})")
@@ -373,7 +378,7 @@ def _start(position: str) -> str:
 
 
 @dataclass
-class _Wrap:
+class _LayoutEncoding:
     """One layout's encoding, in three parts: `prelude` computes the stuffed span and the lengths, `fits` says
     whether every length fits its element (with the EncodeError a layout raises when one does not), `rest` makes
     and returns the frame."""
@@ -384,12 +389,12 @@ class _Wrap:
 
 
 def _packed(elements: tuple[Element, ...], indices: list[int], argument: Callable[[int], str], struct: Structs) -> str:
-    """One expression for the bytes of these elements: a literal, else one struct (neighbouring constants as one
-    `Ns` argument); `argument`: the expression of each non-constant element's value."""
+    """One expression for the bytes of these elements: a Literal, else one struct's Pack (neighbouring constants
+    as one `Ns` argument); `argument`: the expression of each non-constant element's value."""
     if not indices:
         return ""
     if all(elements[i].kind == "constant" for i in indices):
-        return repr(b"".join(elements[i].constant for i in indices))
+        return Literal(b"".join(elements[i].constant for i in indices))
     fmt, arguments = _order(elements, indices), []
     constant = b""
     for i in [*indices, -1]:
@@ -403,7 +408,7 @@ def _packed(elements: tuple[Element, ...], indices: list[int], argument: Callabl
         if i >= 0:
             fmt += _STRUCT_CHARS[elements[i].size]
             arguments.append(argument(i))
-    return f"{struct(fmt)}.pack({', '.join(arguments)})"
+    return Pack(struct(fmt), arguments)
 
 
 def _order(elements: tuple[Element, ...], indices: list[int]) -> str:
@@ -422,16 +427,18 @@ def _arguments(layout: Layout, code: str, values: list[str]) -> Callable[[int], 
         if element.kind == "command":
             return code
         if element.kind == "length":
-            return f"v_{element.name}"
+            return Simple(f"v_{element.name}")
         return value_of[index]
 
     return argument
 
 
-def wrap_parts(layout: Layout, target: Target, checks: dict[int, str], transparency: str, struct: Structs) -> _Wrap:
+def wrap_parts(
+    layout: Layout, target: Target, checks: dict[int, str], transparency: str, struct: Structs
+) -> _LayoutEncoding:
     """The frame around `content`, as Layout.wrap makes it. `checks` and `transparency` as for decode_lines;
     `struct` names the struct constants it uses."""
-    places = _Places(layout)
+    positions = _Positions(layout)
     elements = layout.elements
     prelude: Lines = []
     argument = _arguments(layout, "code", [f"v_{v}" for v in target.value_names])
@@ -439,7 +446,7 @@ def wrap_parts(layout: Layout, target: Target, checks: dict[int, str], transpare
     def packed(indices: list[int]) -> str:
         return _packed(elements, indices, argument, struct)
 
-    first, last = places.first, places.last
+    first, last = positions.first, positions.last
     c = layout.content
     around = (packed(list(range(first, c))), "content", packed(list(range(c + 1, last + 1))))
     variable = " + ".join(p for p in around if p)
@@ -477,11 +484,11 @@ def wrap_parts(layout: Layout, target: Target, checks: dict[int, str], transpare
             )
         )
     frame = " + ".join(p for p in (packed(list(range(first))), wire) if p)
-    rest = _tail(layout, frame, checks, packed)
-    return _Wrap(prelude, fits, rest)
+    rest = _closing_lines(layout, frame, checks, packed)
+    return _LayoutEncoding(prelude, fits, rest)
 
 
-def _tail(layout: Layout, frame: str, checks: dict[int, str], packed: Callable[[list[int]], str]) -> Lines:
+def _closing_lines(layout: Layout, frame: str, checks: dict[int, str], packed: Callable[[list[int]], str]) -> Lines:
     """Lines that return the frame `frame` (an expression: everything up to the variable part's end) with the
     elements after it: constants and values packed, each checksum computed over what is written before it."""
     elements = layout.elements
@@ -509,7 +516,7 @@ def _tail(layout: Layout, frame: str, checks: dict[int, str], packed: Callable[[
     return [*lines, f"return {frame}"]
 
 
-def wrap_lines(direction: str, layouts: list[_Wrap], target: Target) -> Lines:
+def wrap_lines(direction: str, layouts: list[_LayoutEncoding], target: Target) -> Lines:
     """`def _wrap_<direction>(content, code, *values) -> bytes`: the frame in the first layout whose lengths can
     count it (as FrameCodec.wrap chooses), each layout's code inline."""
     parameters = ", ".join(["content: bytes", "code: int | None", *(f"v_{v}: int" for v in target.value_names)])
@@ -538,15 +545,16 @@ _STRUCT_CHARS = {1: "B", 2: "H", 4: "I", 8: "Q"}
 def _struct_name(fmt: str) -> str:
     """A struct constant's name from its format, prefixed to stay clear of the content's `_S_` constants."""
     tokens = ["BE" if fmt[0] == ">" else "LE"]
-    for count, char in _tokens(fmt[1:]):
+    for count, char in struct_tokens(fmt):
         tokens.append(f"{count}S" if char == "s" else {"B": "U8", "H": "U16", "I": "U32", "Q": "U64"}[char])
     return "_F_" + "_".join(tokens)
 
 
-def _tokens(fmt: str) -> list[tuple[str, str]]:
+def struct_tokens(fmt: str) -> list[tuple[str, str]]:
+    """A struct format's (count, code) pairs in order, its byte order left out: "<2sBH" -> ("2", "s"), ("", "B"), ..."""
     found: list[tuple[str, str]] = []
     count = ""
-    for char in fmt:
+    for char in fmt.lstrip("<>=!@"):
         if char.isdigit():
             count += char
         else:
@@ -579,7 +587,7 @@ def engine_lines(layouts: tuple[Layout, ...], target: Target) -> tuple[Lines, Li
 
 
 @dataclass(frozen=True)
-class Straight:
+class StraightLayouts:
     """A direction whose layouts all take straight-line code: the engine's layouts, each with its checksum
     elements' function names (by element index)."""
 
@@ -587,7 +595,7 @@ class Straight:
     checks: tuple[dict[int, str], ...]
 
 
-def straight_direction(protocol: Protocol, direction: Direction) -> Straight | None:
+def straight_direction(protocol: Protocol, direction: Direction) -> StraightLayouts | None:
     """The direction's layouts, when every one fits the straight-line form (and they carry the same values)."""
     layouts = runtime_layouts(protocol, direction)
     names = {tuple(e.name for e in (layout.elements[i] for i in layout.values)) for layout in layouts}
@@ -597,7 +605,7 @@ def straight_direction(protocol: Protocol, direction: Direction) -> Straight | N
         {index: checksum_call(e.checksum) for index, e in enumerate(model.elements) if e.checksum is not None}
         for model in protocol.framing.alternatives[direction]
     )
-    return Straight(layouts, checks)
+    return StraightLayouts(layouts, checks)
 
 
 def direction_functions(
@@ -617,7 +625,7 @@ def direction_functions(
     layouts = found.layouts
     several = len(layouts) > 1
     lines: Lines = []
-    wraps: list[_Wrap] = []
+    wraps: list[_LayoutEncoding] = []
     bodies: list[Lines] = []
     for layout, checks in zip(layouts, found.checks, strict=True):
         suffix = f"_{layout.name}" if several else ""
@@ -648,25 +656,20 @@ def direction_functions(
     return lines, call
 
 
-_PACKED = re.compile(r"^(?P<name>_S_\w+)\.pack\((?P<arguments>.*)\)$")
-# a run of numbers whose count is known at run time, as the content's encoders pack it
-_RUN = re.compile(r"^struct\.pack\(f'(?P<order>[<>])(?P<format>[^'\\]*)', (?P<arguments>\*[\w.]+)\)$")
-
-
 def frame_encoder(
-    frames: Straight,
+    frames: StraightLayouts,
     parts: list[str],
     formats: dict[str, str],
     code: str,
     values: list[str],
     size: int | None,
     struct: Structs,
-) -> Lines | None:
+) -> Block | None:
     """An encoder's last lines, which return its message's frame made inline (no call of `_wrap_<direction>`):
     the head packed with the content's first struct in one call where their byte orders agree.
 
     `parts`: the content's byte expressions (`formats`: struct constant -> format, for those that are one
-    `_S_....pack(...)`); `code`, `values`: the command code's and the frame values' expressions; `size`: the
+    struct's Pack); `code`, `values`: the command code's and the frame values' expressions; `size`: the
     content's size when it has one. None (the wrap function does it) for stuffed frames, and for lengths that
     depend on a size known only at run time."""
     chosen = None
@@ -689,33 +692,48 @@ def frame_encoder(
     if chosen is None:
         return None  # no layout can count it: the wrap function says so
     layout, checks, lengths = chosen
+    lines = _frame_lines(layout, checks, lengths, parts, formats, code, values, struct)
+    # the frame is made in the first statement: the one that packs the content's lists
+    return [Code(lines[0], lists=packed_lists(parts)), *(Code(line) for line in lines[1:])]
+
+
+def _frame_lines(
+    layout: Layout,
+    checks: dict[int, str],
+    lengths: dict[int, int],
+    parts: list[str],
+    formats: dict[str, str],
+    code: str,
+    values: list[str],
+    struct: Structs,
+) -> Lines:
+    """frame_encoder's lines, in the layout chosen, whose `lengths` are known (element index -> value)."""
     elements = layout.elements
     argument = _arguments(layout, code, values)
 
     def constant_or(index: int) -> str:
-        return str(lengths[index]) if index in lengths else argument(index)
+        return Simple(lengths[index]) if index in lengths else argument(index)
 
     head = list(range(layout.content))
     prefix = _fixed_prefix(layout, lengths)
     if prefix is not None:  # the checksum covers all after constant bytes: they are a literal, not packed
         head = head[len(prefix[1]) :]
-    first = _PACKED.match(parts[0]) if parts else None
-    fmt = formats.get(first["name"], "") if first else ""
+    first = parts[0] if parts and isinstance(parts[0], Pack) else None
+    fmt = formats.get(first.struct, "") if first else ""
     order = _order(elements, head)
     packed = None  # (format, arguments) where the frame up to the checksum is one pack of them
     multi = any(elements[i].kind != "constant" and elements[i].size > 1 for i in head)
     if first and fmt[:1] in "<>" and (fmt[0] == order or not multi):
         # the head's elements joined to the content's first struct: one pack for both
-        fused = _packed(elements, head, constant_or, lambda f: f)
-        if fused.endswith(")"):
-            head_format, _, head_arguments = fused.partition(".pack(")
-            static, arguments = fmt[0] + head_format[1:] + fmt[1:], f"{head_arguments[:-1]}, {first['arguments']}"
-            run = _RUN.match(parts[1]) if len(parts) > 1 else None
-            if run and run["order"] == static[0]:  # and a run of numbers after it, in the same byte order
-                fstring = repr(static + run["format"]).replace("'", "f'", 1)
-                parts = [f"struct.pack({fstring}, {arguments}, {run['arguments']})", *parts[2:]]
+        fused = _packed(elements, head, constant_or, lambda f: f)  # named by its format
+        if isinstance(fused, Pack):
+            static, arguments = fmt[0] + fused.struct[1:] + fmt[1:], [*fused.arguments, *first.arguments]
+            run = parts[1] if len(parts) > 1 and isinstance(parts[1], PackItems) else None
+            if run and run.order == static[0]:  # and a run of numbers after it, in the same byte order
+                fstring = repr(static + run.counted_format).replace("'", "f'", 1)
+                parts = [f"struct.pack({fstring}, {', '.join(arguments)}, *{run.items})", *parts[2:]]
             else:
-                parts = [f"{struct(static)}.pack({arguments})", *parts[1:]]
+                parts = [Pack(struct(static), arguments), *parts[1:]]
                 packed = (static, arguments) if len(parts) == 1 else None
         else:  # constants only: a literal
             parts = [f"{fused} + {parts[0]}", *parts[1:]]
@@ -737,34 +755,34 @@ def frame_encoder(
             # than joining the pieces
             return [f"body = {frame}", f"return {struct(whole[0])}.pack({whole[1]})"]
         return [f"body = {frame}", f"return b''.join(({', '.join(pieces)}))"]
-    return _tail(layout, frame, checks, lambda indices: _packed(elements, indices, constant_or, struct))
+    return _closing_lines(layout, frame, checks, lambda indices: _packed(elements, indices, constant_or, struct))
 
 
-_SIMPLE_ARGUMENTS = re.compile(r"^[\w. ]+(, [\w. ]+)*$")  # names, attributes, numbers: cheap to give twice
 _CHECK_CODES = {1: "B", 2: "H", 4: "I"}
 _MOST_REPACKED = 4  # values packed a second time into the whole frame; more are joined
 
 
 def _repacked(
-    packed: tuple[str, str] | None, literal: bytes, element: Element, check: str, after: str | None
+    packed: tuple[str, list[str]] | None, literal: bytes, element: Element, check: str, after: str
 ) -> tuple[str, str] | None:
     """A struct format and its arguments for a whole frame that is `literal`, then one pack of simple values (the
-    bytes the checksum covers), then the checksum and constant bytes (`after`, a literal); None for others."""
-    if packed is None or not _SIMPLE_ARGUMENTS.match(packed[1]) or element.size not in _CHECK_CODES:
+    bytes the checksum covers; names, attributes, numbers: cheap to give twice), then the checksum and constant
+    bytes (`after`, a literal); None for others."""
+    if packed is None or not all(isinstance(a, Simple) for a in packed[1]) or element.size not in _CHECK_CODES:
         return None
-    if packed[1].count(",") >= _MOST_REPACKED:
+    if len(packed[1]) > _MOST_REPACKED:
         return None  # each value packed twice: for many, the join is cheaper
     fmt, arguments = packed
     if element.size > 1 and {"big": ">", "little": "<"}.get(element.endian or "") != fmt[0]:
         return None
     tail: bytes = b""
     if after:
-        if not after.startswith(("b'", 'b"')):
+        if not isinstance(after, Literal):
             return None
-        tail = ast.literal_eval(after)
+        tail = after.data
     whole = fmt[0] + (f"{len(literal)}s" if literal else "") + fmt[1:] + _CHECK_CODES[element.size]
     values = [repr(literal)] if literal else []
-    values += [arguments, check]
+    values += [*arguments, check]
     if after and tail:
         whole += f"{len(tail)}s"
         values.append(after)
@@ -811,11 +829,8 @@ def _choice(layouts: tuple[Layout, ...], d: str, bodies: list[Lines] | None = No
     return [*lines, f"raise DecodeError(f\"frame starts {{frame[:4].hex(' ')}}, expected {choices}\")"]
 
 
-_END = re.compile(r"\bend(?: \+ (\d+))?")
-
-
 def whole_frames(
-    found: Straight, d: str, plain: list[tuple[int, int, str, str, str]], structs: dict[str, str]
+    found: StraightLayouts, d: str, plain: list[tuple[int, int, str, str, str]], structs: dict[str, str]
 ) -> tuple[Lines, Lines]:
     """decode()'s fast path for frames of one size whose message is their content as one struct unpacks it: a table
     keyed by the bytes before the content (header, length, command code), and lines that check the rest of a frame
@@ -828,7 +843,7 @@ def whole_frames(
     elements = layout.elements
     if layout.transparency is not None or any(e.kind == "value" for e in elements):
         return [], []
-    places = _Places(layout)
+    positions = _Positions(layout)
     entries: list[tuple[bytes, str, str]] = []
     for code, size, cls, content, fmt in plain:
         head = b""
@@ -845,30 +860,28 @@ def whole_frames(
                 head += element.pack(counted)
         else:
             name = f"_F_{d.upper()}_WHOLE{content.removeprefix('_S')}"  # the content's struct in the frame
-            structs[name] = f"{fmt[0]}{places.content}x{fmt[1:]}{places.behind}x"
+            structs[name] = f"{fmt[0]}{positions.content}x{fmt[1:]}{positions.behind}x"
             entries.append((head, cls, name))
     if not entries:
         return [], []
 
-    def from_end(text: str) -> str:  # `end + k` (the content's end) counted back from the frame's end
-        return _END.sub(lambda m: str(int(m[1] or 0) - places.behind), text).replace("buf[", "frame[")
-
+    tail = _Positions(layout, from_end=True)  # the elements after the content, counted back from the frame's end
     conditions: Lines = []
     for index, element in enumerate(elements[layout.content + 1 :], layout.content + 1):
         if element.kind == "constant" and element.size == 1:  # constants first: cheaper than a checksum
-            conditions.insert(0, f"{from_end(f'buf[{places.at(index)}]')} == {element.constant[0]:#04x}")
+            conditions.insert(0, f"frame[{tail.at(index)}] == {element.constant[0]:#04x}")
         elif element.kind == "constant":
-            data = from_end(f"buf[{places.at(index)}:{places.stop(index)}]").replace(":0]", ":]")
-            conditions.insert(0, f"{data} == {element.constant!r}")
+            stop = tail.stop(index)
+            conditions.insert(0, f"frame[{tail.at(index)}:{'' if stop == '0' else stop}] == {element.constant!r}")
         elif element.kind == "checksum":
             residue = _residue(element)
             a, b = element.span
             if residue is not None and b == index - 1:
-                call = checks[index].format(from_end(places.covered(a, index)))
+                call = checks[index].format(tail.covered(a, index))
                 conditions.append(f"{call} == {residue:#0{2 + 2 * element.size}x}")
             else:
-                call = checks[index].format(from_end(places.covered(a, b)))
-                conditions.append(f"{call} == {from_end(places.read(index))}")
+                call = checks[index].format(tail.covered(a, b))
+                conditions.append(f"{call} == {tail.read(index)}")
     table = f"_{d.upper()}_WHOLE"
     definition = [
         f"# {d.capitalize()} frames of one size whose message is their content as one struct unpacks it, by their",
@@ -878,7 +891,7 @@ def whole_frames(
         "}",
     ]
     lines = [
-        f"whole = {table}.get(frame[:{places.content}])",
+        f"whole = {table}.get(frame[:{positions.content}])",
         f"if whole is not None and {' and '.join(conditions)}:",
         "    try:",
         "        return _new(whole[0], whole[1](frame))",

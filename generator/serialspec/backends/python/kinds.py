@@ -56,6 +56,11 @@ class Kind(Generic[F]):
         return "0"
 
 
+def zero_bits(bits: Sequence[Any]) -> str:
+    """Bit fields (of a field or a frame element) all 0, as JSON: what a device sends when nothing sets them."""
+    return "{" + ", ".join(f"{b.name!r}: 0" for b in bits) + "}"
+
+
 def _numbers_from_json(f: Array | List) -> str:
     """A list of numbers (or bits) from JSON, each checked to be one."""
     kind = "_bits" if f.item is None else "_numbers" if f.item.is_float else "_integers"
@@ -167,7 +172,7 @@ class ScalarKind(Kind[Scalar]):
         return f"{kind}({get}, {f.name!r}, where)"
 
     def blank(self, f: Scalar) -> str:
-        return "{" + ", ".join(f"{b.name!r}: 0" for b in f.bits) + "}" if f.bits else "0"
+        return zero_bits(f.bits) if f.bits else "0"
 
 
 class ArrayKind(Kind[Array]):

@@ -6,7 +6,7 @@ from typing import Any
 
 from serialspec.backends.common.numbers import number
 from serialspec.backends.common.pairing import request_response_pairs
-from serialspec.backends.python.kinds import kind
+from serialspec.backends.python.kinds import kind, zero_bits
 from serialspec.backends.python.registers import map_name, register_tables
 from serialspec.backends.python.render import one_line, render
 from serialspec.lang import expression
@@ -132,6 +132,19 @@ def run_spec(run: SpaceAccess) -> str:
     return f"RunSpec({', '.join(args)})"
 
 
+def reply_blanks(protocol: Protocol, response: Message, filled: set[str]) -> dict[str, str]:
+    """The reply values a device has no value for, where its kind's blank is not 0: response fields other than the
+    `filled` ones (the device fills those in itself), and frame values made of bit fields that the spec's reply and
+    status values do not name (the engine fills those in bit by bit)."""
+    device = protocol.device
+    assert device is not None  # a simulator is made only for a spec with a device
+    blanks = {f.name: kind(f).blank(f) for f in response.fields if f.name not in filled}
+    named = {key.partition(".")[0] for key in (*device.reply, *device.status) if "." in key}
+    layout = protocol.framing.layouts[response.direction]
+    blanks |= {e.name: zero_bits(e.bits) for e in layout.value_elements if e.bits and e.name not in {*filled, *named}}
+    return {name: blank for name, blank in blanks.items() if blank != "0"}
+
+
 def import_order(name: str) -> tuple[int, str]:
     """The order ruff's isort gives names in one `from` import: constants, classes, others; case-insensitive."""
     return (0 if name.isupper() else 1 if name[:1].isupper() else 2, name.lower())
@@ -215,18 +228,8 @@ def simulator_module(protocol: Protocol) -> str:
         tables = table_fields(request, response)
         if tables:
             args.append(f"tables={tables!r}")
-        # the values a device fills in itself; any other it does not give is its kind's blank
-        given = {*tables, *(behaviour.reads + tuple(behaviour.space_reads) if behaviour else ())}
-        blanks = {f.name: kind(f).blank(f) for f in response.fields if f.name not in given} if response else {}
-        blanks = {name: blank for name, blank in blanks.items() if blank != "0"}
-        if response:  # frame values made of bit fields (a status): each bit 0
-            layout = protocol.framing.layouts[response.direction]
-            named = {key.partition(".")[0] for key in (*device.reply, *device.status) if "." in key}  # the engine's
-            blanks |= {
-                e.name: "{" + ", ".join(f"{b.name!r}: 0" for b in e.bits) + "}"
-                for e in layout.value_elements
-                if e.bits and e.name not in {*given, *named}
-            }
+        filled = {*tables, *(behaviour.reads + tuple(behaviour.space_reads) if behaviour else ())}
+        blanks = reply_blanks(protocol, response, filled) if response else {}
         if blanks:
             args.append(f"blanks={{{', '.join(f'{k!r}: {v}' for k, v in blanks.items())}}}")
         commands.append({"key": request.key, "args": args})

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define DYNAMIXEL_P2_SPEC_SHA256 "d252d31a975efdda245819458474c9e7b89a514d7ed50a6062332df68fe0b1d5"
+#define DYNAMIXEL_P2_SPEC_SHA256 "c1abf1c8886285436a9053588b577ef0acc0670e85cbe2379a1d166baa8d48f2"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef DYNAMIXEL_P2_ENABLE_ENCODE

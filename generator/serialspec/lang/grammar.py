@@ -181,6 +181,7 @@ class MapOf(Shape):
     value: Shape
     description: str = ""
     int_keys: bool = False
+    example: Any = None  # shown in the reference where no spec uses the key
 
     def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
         if not isinstance(value, dict):
@@ -1133,7 +1134,9 @@ DEVICE = Obj(
             Obj(
                 {
                     "memory": Str("The memory whose entries are locked.", choices=("eeprom", "sram")),
-                    "entries": ListOf(Str(), "Memory entries locked (besides those of `memory`)."),
+                    "entries": ListOf(
+                        Str(), "Memory entries locked (besides those of `memory`).", example=["id", "baud_rate"]
+                    ),
                     "while": Str(
                         "A memory entry (or state variable): the entries are locked while it is non-zero.",
                         example="torque_enable",
@@ -1152,21 +1155,27 @@ DEVICE = Obj(
                 {
                     "every": Int("Period in ms: the device sends the message this often.", minimum=1, example=1000),
                     "after": ListOf(
-                        Str(), "Commands (or command.subcommand) after whose reply the device also sends it."
+                        Str(),
+                        "Commands (or command.subcommand) after whose reply the device also sends it.",
+                        example=["set_rate"],
                     ),
                     "changes": ListOf(
-                        Str(), "State variables or memory entries: the device also sends it when one of them changes."
+                        Str(),
+                        "State variables or memory entries: the device also sends it when one of them changes.",
+                        example=["mode"],
                     ),
                     "while": Str(
                         "A state variable or memory entry: the device sends it only while it is non-zero (default: "
-                        "always)."
+                        "always).",
+                        example="streaming",
                     ),
                     "values": MapOf(
                         Str(),
                         "Field -> an expression of state variables and memory entries it holds (other fields: the "
-                        "device's `reply` values, the entries of the same name, else 0).",
+                        "device's `reply` values, else 0).",
+                        example={"uptime": "ticks / 1000"},
                     ),
-                    "description": TEXT,
+                    "description": Str(TEXT.description, example="A heartbeat every second while armed."),
                 },
                 description="When the device sends one message on its own.",
             ),

@@ -312,7 +312,8 @@ class DevicePass(Pass):
                     names.append(str(name))
             if not names:
                 self.error((*path, index), "locks no memory entry (give `memory` or `entries`)")
-            found |= {name: locker for name in names if name != locker}
+            # read-only entries are refused anyway: only writable ones are locked
+            found |= {name: locker for name in names if name != locker and entries[name].access != "r"}
         return found
 
     def sends(

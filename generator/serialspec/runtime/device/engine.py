@@ -396,12 +396,13 @@ class Engine(FaultInjection):
         self.log: list[Message] = []  # every request received, in order
         self._lock = threading.Lock()
         self._answering_as: Fault | None = None  # an other_id fault while the reply it spoils is built
-        # sends: (device id, index) -> when the next periodic one is due, and the watched values last sent with
-        self._next_send: dict[tuple[int, int], float] = {}
-        self._watched: dict[tuple[int, int], tuple[float, ...]] = {}
+        # sends: (device, index) -> when the next periodic one is due, and the watched values last sent with (by
+        # the device itself, whose id a request may change)
+        self._next_send: dict[tuple[VirtualDevice, int], float] = {}
+        self._watched: dict[tuple[VirtualDevice, int], tuple[float, ...]] = {}
         for device in self.devices.values():
             for index, send in enumerate(spec.sends):
-                self._watched[device.id, index] = tuple(device.get(n) for n in send.changes)
+                self._watched[device, index] = tuple(device.get(n) for n in send.changes)
         FaultInjection.__init__(self)
 
     # --- requests -------------------------------------------------------------------------------------------------
@@ -441,7 +442,7 @@ class Engine(FaultInjection):
             now = self.clock()
             for device in list(self.devices.values()):
                 for index, send in enumerate(self.spec.sends):
-                    key = (device.id, index)
+                    key = (device, index)
                     sending = False
                     if send.every:
                         next_time = self._next_send.get(key, now)
@@ -465,7 +466,11 @@ class Engine(FaultInjection):
         """When due() next has something periodic to send (None: nothing is periodic); watched values are polled
         every 10 ms."""
         times = [t for t in self._next_send.values()]
-        if any(s.every and (i, n) not in self._next_send for n, s in enumerate(self.spec.sends) for i in self.devices):
+        if any(
+            s.every and (d, n) not in self._next_send
+            for n, s in enumerate(self.spec.sends)
+            for d in self.devices.values()
+        ):
             times.append(self.clock())
         if any(s.changes for s in self.spec.sends):
             times.append(self.clock() + 0.01)

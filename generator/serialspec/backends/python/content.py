@@ -15,6 +15,7 @@ from serialspec.backends.common.numbers import number
 from serialspec.backends.python.ir import (
     Advance,
     Block,
+    Calls,
     Code,
     ContentSize,
     Expect,
@@ -31,6 +32,7 @@ from serialspec.backends.python.ir import (
     TakeRest,
     Try,
     Unpack,
+    helpers_of,
     lines_of,
     packed_lists,
     values_tuple,
@@ -177,6 +179,12 @@ class ClassCode:
     class_vars: Lines = field(default_factory=list)
     to_fields: Lines = field(default_factory=list)
     from_fields: Lines = field(default_factory=list)
+    helpers: frozenset[str] = frozenset()  # the runtime.fields helpers from_fields calls (as _<name>)
+
+    def read_from(self, values: list[Calls]) -> None:
+        """from_fields' arguments: each field's value from data, with the helpers they call."""
+        self.from_fields = [f"{value}," for value in values]
+        self.helpers = frozenset().union(*(helpers_of(value) for value in values))
 
 
 class PackageCode:
@@ -297,7 +305,7 @@ class PackageCode:
                 attributes.append(Attribute(bit.name, kind, f"{one_line(bit.description or bit.name)} ({where})"))
             code = ClassCode(f.bits_class, f"Bit fields of {f.name}.", "", attributes)
             code.to_fields = [f"{b.name!r}: int(self.{b.name})," for b in f.bits]
-            code.from_fields = [self.from_value_expr(b.name, b.enum.class_name if b.enum else None) for b in f.bits]
+            code.read_from([self.from_value_expr(b.name, b.enum.class_name if b.enum else None) for b in f.bits])
             self.helper_classes.append(code)
         elif isinstance(f, Group) and f.class_name not in self._seen_classes:
             self._seen_classes.add(f.class_name)
@@ -306,7 +314,7 @@ class PackageCode:
             inner_fields = [i for i in f.fields if not (isinstance(i, Scalar) and i.hidden)]
             code = ClassCode(f.class_name, f"One item of {f.name}.", "", self.attributes(inner_fields, False))
             code.to_fields = [f"{i.name!r}: {self.to_json(i, 'self.' + i.name)}," for i in inner_fields]
-            code.from_fields = [f"{self.from_json(i)}," for i in inner_fields]
+            code.read_from([self.from_json(i) for i in inner_fields])
             self.helper_classes.append(code)
         elif isinstance(f, TableBlock) and f.class_name not in self._seen_classes:
             self._seen_classes.add(f.class_name)
@@ -320,22 +328,26 @@ class PackageCode:
             code.to_fields = [
                 f"{e.name!r}: {'int(self.' + e.name + ')' if e.enum else 'self.' + e.name}," for e in f.entries
             ]
-            code.from_fields = [
-                self.from_value_expr(e.name, e.enum.class_name if e.enum else None, e.type.is_float) for e in f.entries
-            ]
+            code.read_from(
+                [
+                    self.from_value_expr(e.name, e.enum.class_name if e.enum else None, e.type.is_float)
+                    for e in f.entries
+                ]
+            )
             self.helper_classes.append(code)
 
-    def from_value_expr(self, name: str, enum: str | None, is_float: bool = False) -> str:
+    def from_value_expr(self, name: str, enum: str | None, is_float: bool = False) -> Calls:
         """A value of a bit field or table block entry, from data: an enum member or an integer (or a number)."""
         get = f"_get(data, {name!r}, where)"
         if enum:
-            return f"_as_enum({enum}, {get}, {name!r}, where),"
-        return f"{'_number' if is_float else '_integer'}({get}, {name!r}, where),"
+            return Calls(f"_as_enum({enum}, {get}, {name!r}, where)", ["_as_enum", "_get"])
+        helper = "_number" if is_float else "_integer"
+        return Calls(f"{helper}({get}, {name!r}, where)", [helper, "_get"])
 
     def to_json(self, f: SpecField, expr: str) -> str:
         return kind(f).to_json(f, expr)
 
-    def from_json(self, f: SpecField) -> str:
+    def from_json(self, f: SpecField) -> Calls:
         return kind(f).from_json(f)
 
     def message(self, message: Message) -> None:
@@ -351,7 +363,7 @@ class PackageCode:
             f"DIRECTION: ClassVar[Direction] = Direction.{message.direction.name}",
         ]
         code.to_fields = [f"{f.name!r}: {self.to_json(f, 'self.' + f.name)}," for f in fields]
-        code.from_fields = [f"{self.from_json(f)}," for f in fields]
+        code.read_from([self.from_json(f) for f in fields])
         self.message_classes.append(code)
         frame_names = [f.name for f in self.frame_values(message.direction, message)]
         extra = "".join(f", {name}: int" for name in frame_names)

@@ -10,6 +10,7 @@ from __future__ import annotations
 import struct
 from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
+from typing import assert_never
 
 from serialspec.backends.common.numbers import number
 from serialspec.backends.python.ir import (
@@ -575,34 +576,43 @@ class PackageCode:
         return name
 
     def decode_variable(self, f: SpecField, siblings: list[SpecField], base: str, body: Block, where: str) -> str:
-        if isinstance(f, List):
-            return self.decode_list(f, body, where, siblings)
-        if isinstance(f, Text):
-            return self.decode_text(f, body, where)
-        if isinstance(f, Bytes):
-            if f.size == "rest":
-                body.append(TakeRest(self.local(f)))
-                body.append(Advance(to="end"))
-            else:
-                size = self.local_named(str(f.size))
-                body.append(
-                    Needs(size, f"DecodeError({where} + f': {f.name} needs {{{size}}} bytes, {{end - o}} left')")
-                )
-                body.append(Code(f"{self.local(f)} = buf[o : o + {size}]", cursor=True))
-                body.append(Advance(size))
-            return self.local(f)
-        if isinstance(f, TableValue):
-            table = f"_TABLE_{f.table.name.upper()}"
-            key = self.local_named(f.key)
-            body.append(Code(f"s = {table}.get({key})"))
-            error = f"DecodeError({where} + f': unknown {f.table.key_name} {{{key}}}')"
-            body.append(If("s is None", (Raise(error),)))
-            reason = f"{f.name} needs {{s.size}} bytes for {f.table.key_name} {{{key}}}"
-            body.append(If("end - o < s.size", (Raise(f"DecodeError({where} + f': {reason}')"),), cursor=True))
-            body.append(Code(f"({self.local(f)},) = s.unpack_from(buf, o)", cursor=True))
-            body.append(Advance("s.size"))
-            return self.local(f)
-        assert isinstance(f, Group)
+        match f:
+            case List():
+                return self.decode_list(f, body, where, siblings)
+            case Text():
+                return self.decode_text(f, body, where)
+            case Bytes():
+                if f.size == "rest":
+                    body.append(TakeRest(self.local(f)))
+                    body.append(Advance(to="end"))
+                else:
+                    size = self.local_named(str(f.size))
+                    body.append(
+                        Needs(size, f"DecodeError({where} + f': {f.name} needs {{{size}}} bytes, {{end - o}} left')")
+                    )
+                    body.append(Code(f"{self.local(f)} = buf[o : o + {size}]", cursor=True))
+                    body.append(Advance(size))
+                return self.local(f)
+            case TableValue():
+                table = f"_TABLE_{f.table.name.upper()}"
+                key = self.local_named(f.key)
+                body.append(Code(f"s = {table}.get({key})"))
+                error = f"DecodeError({where} + f': unknown {f.table.key_name} {{{key}}}')"
+                body.append(If("s is None", (Raise(error),)))
+                reason = f"{f.name} needs {{s.size}} bytes for {f.table.key_name} {{{key}}}"
+                body.append(If("end - o < s.size", (Raise(f"DecodeError({where} + f': {reason}')"),), cursor=True))
+                body.append(Code(f"({self.local(f)},) = s.unpack_from(buf, o)", cursor=True))
+                body.append(Advance("s.size"))
+                return self.local(f)
+            case Group():
+                return self.decode_group(f, body, where)
+            case Scalar() | Array() | TableBlock():
+                raise AssertionError(f"{f.name}: a field of fixed size is decoded in a run (decode_run)")
+            case _:
+                assert_never(f)
+
+    def decode_group(self, f: Group, body: Block, where: str) -> str:
+        """A group's items: unpacked in a loop where they have one size, else read one by one."""
         item_fields = list(f.fields)
         value = self.local(f)
         item_names = [i.name for i in item_fields if not (isinstance(i, Scalar) and i.hidden)]
@@ -1013,63 +1023,81 @@ class PackageCode:
         """Byte order, struct format (without it) and pack arguments of a run of fixed-size fields; checks to body."""
         args: list[str] = []
         for f in run:
-            if isinstance(f, Scalar):
-                args.append(self.wire_value(f, obj, siblings, body, where))
-            elif isinstance(f, Array):
-                expr = field_read(obj, f.name)
-                error = f"EncodeError({where} + f': {f.name} needs {f.count} items, got {{len({expr})}}')"
-                body.append(If(f"len({expr}) != {f.count}", (Raise(error),)))
-                self.check_items(f, expr, body, where)
-                args.append(f"*{expr}")
-            elif isinstance(f, Bytes):
-                expr = field_read(obj, f.name)
-                error = f"EncodeError({where} + f': {f.name} needs {f.size} bytes, got {{len({expr})}}')"
-                body.append(If(f"len({expr}) != {f.size}", (Raise(error),)))
-                args.append(Simple(expr))
-            elif isinstance(f, TableBlock):
-                for e in f.entries:
-                    expr = f"{field_read(obj, f.name)}.{e.name}"
-                    name = f.name + "." + e.name
-                    error = f"out_of_range({where}, {name!r}, {expr}, {number(e.minimum)}, {number(e.maximum)})"
-                    body.append(If(f"not {number(e.minimum)} <= {expr} <= {number(e.maximum)}", (Raise(error),)))
+            match f:
+                case Scalar():
+                    args.append(self.wire_value(f, obj, siblings, body, where))
+                case Array():
+                    expr = field_read(obj, f.name)
+                    error = f"EncodeError({where} + f': {f.name} needs {f.count} items, got {{len({expr})}}')"
+                    body.append(If(f"len({expr}) != {f.count}", (Raise(error),)))
+                    self.check_items(f, expr, body, where)
+                    args.append(f"*{expr}")
+                case Bytes():
+                    expr = field_read(obj, f.name)
+                    error = f"EncodeError({where} + f': {f.name} needs {f.size} bytes, got {{len({expr})}}')"
+                    body.append(If(f"len({expr}) != {f.size}", (Raise(error),)))
                     args.append(Simple(expr))
+                case TableBlock():
+                    for e in f.entries:
+                        expr = f"{field_read(obj, f.name)}.{e.name}"
+                        name = f.name + "." + e.name
+                        error = f"out_of_range({where}, {name!r}, {expr}, {number(e.minimum)}, {number(e.maximum)})"
+                        body.append(If(f"not {number(e.minimum)} <= {expr} <= {number(e.maximum)}", (Raise(error),)))
+                        args.append(Simple(expr))
+                case List() | Text() | Group() | TableValue():
+                    raise AssertionError(f"{f.name}: a field of varying size is encoded alone (encode_variable)")
+                case _:
+                    assert_never(f)
         return run_endian(run), struct_format("", run), args
 
     def encode_variable(self, f: SpecField, obj: str, body: Block, where: str) -> str:
         expr = field_read(obj, f.name)
         count = f.count if isinstance(f, List | Group) else None
         count_error = f"EncodeError({where} + f': {f.name} needs {count} items, got {{len({expr})}}')"
-        if isinstance(f, List):
-            if isinstance(f.count, int):
-                body.append(If(f"len({expr}) != {f.count}", (Raise(count_error),)))
-            if f.item is None:
-                self.packing.add("pack_bits")
-                return f"_pack_bits({expr}, {f.name!r}, {where})"
-            self.check_items(f, expr, body, where)
-            return PackItems(f.endian, f.item.struct_char, expr)
-        if isinstance(f, Text):
-            self.packing.add("encode_text")
-            data = f"_encode_text({expr}, {f.name!r}, {where}, {f.size is None})"
-            if isinstance(f.size, int):
-                body.append(Code(f"{self.local(f)} = {data}"))
-                reason = f"{f.name} needs {f.size} bytes of UTF-8, got {{len({self.local(f)})}}"
-                body.append(If(f"len({self.local(f)}) != {f.size}", (Raise(f"EncodeError({where} + f': {reason}')"),)))
+        match f:
+            case List():
+                if isinstance(f.count, int):
+                    body.append(If(f"len({expr}) != {f.count}", (Raise(count_error),)))
+                if f.item is None:
+                    self.packing.add("pack_bits")
+                    return f"_pack_bits({expr}, {f.name!r}, {where})"
+                self.check_items(f, expr, body, where)
+                return PackItems(f.endian, f.item.struct_char, expr)
+            case Text():
+                self.packing.add("encode_text")
+                data = f"_encode_text({expr}, {f.name!r}, {where}, {f.size is None})"
+                if isinstance(f.size, int):
+                    body.append(Code(f"{self.local(f)} = {data}"))
+                    reason = f"{f.name} needs {f.size} bytes of UTF-8, got {{len({self.local(f)})}}"
+                    body.append(
+                        If(f"len({self.local(f)}) != {f.size}", (Raise(f"EncodeError({where} + f': {reason}')"),))
+                    )
+                    return self.local(f)
+                return data
+            case Bytes():  # bytes as they are (bytes(b) looks up b.__bytes__ first), anything else made bytes
+                body.append(Code(f"{self.local(f)} = {expr} if {expr}.__class__ is bytes else bytes({expr})"))
                 return self.local(f)
-            return data
-        if isinstance(f, Bytes):  # bytes as they are (bytes(b) looks up b.__bytes__ first), anything else made bytes
-            body.append(Code(f"{self.local(f)} = {expr} if {expr}.__class__ is bytes else bytes({expr})"))
-            return self.local(f)
-        if isinstance(f, TableValue):
-            table = f"_TABLE_{f.table.name.upper()}"
-            key = field_read(obj, f.key)
-            body.append(Code(f"s = {table}.get({key})"))
-            body.append(If("s is None", (Raise(f"EncodeError({where} + f': unknown {f.table.key_name} {{{key}}}')"),)))
-            body.append(Code(f"low, high = _TABLE_{f.table.name.upper()}_RANGES[{key}]"))
-            body.append(
-                If(f"not low <= {expr} <= high", (Raise(f"out_of_range({where}, {f.name!r}, {expr}, low, high)"),))
-            )
-            return f"s.pack({expr})"
-        assert isinstance(f, Group)
+            case TableValue():
+                table = f"_TABLE_{f.table.name.upper()}"
+                key = field_read(obj, f.key)
+                body.append(Code(f"s = {table}.get({key})"))
+                body.append(
+                    If("s is None", (Raise(f"EncodeError({where} + f': unknown {f.table.key_name} {{{key}}}')"),))
+                )
+                body.append(Code(f"low, high = _TABLE_{f.table.name.upper()}_RANGES[{key}]"))
+                body.append(
+                    If(f"not low <= {expr} <= high", (Raise(f"out_of_range({where}, {f.name!r}, {expr}, low, high)"),))
+                )
+                return f"s.pack({expr})"
+            case Group():
+                return self.encode_group(f, obj, body, where, expr, count_error)
+            case Scalar() | Array() | TableBlock():
+                raise AssertionError(f"{f.name}: a field of fixed size is encoded in a run (encode_run_format)")
+            case _:
+                assert_never(f)
+
+    def encode_group(self, f: Group, obj: str, body: Block, where: str, expr: str, count_error: str) -> str:
+        """A group's items, checked and packed in a loop."""
         if isinstance(f.count, int):
             body.append(If(f"len({expr}) != {f.count}", (Raise(count_error),)))
         # the items are checked and packed in a loop here, not by a function called per item

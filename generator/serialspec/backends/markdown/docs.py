@@ -35,7 +35,6 @@ from serialspec.lang.model import (
     Scalar,
     TableBlock,
     TableEntry,
-    TableValue,
     fixed_size,
 )
 from serialspec.runtime.errors import SerialspecError
@@ -518,9 +517,7 @@ def content_rows(
                 count = len(items) if isinstance(items, list) else 0
                 item = f.item_size
                 size = count * item if item is not None else end - offset
-            elif isinstance(f, TableValue):
-                size = end - offset
-            else:
+            else:  # the rest of the content
                 size = end - offset
         rows.append(
             {

@@ -17,7 +17,7 @@ Decisions made here, the same for every protocol:
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, assert_never
 
 from serialspec.backends.common.numbers import number
 from serialspec.backends.common.pairing import request_response_pairs
@@ -26,6 +26,7 @@ from serialspec.backends.python.registers import map_name, names_alias
 from serialspec.backends.python.render import one_line, render
 from serialspec.backends.python.simulator import import_order
 from serialspec.lang.model import (
+    Array,
     Bytes,
     Direction,
     Field,
@@ -39,6 +40,7 @@ from serialspec.lang.model import (
     TableBlock,
     TableEntry,
     TableValue,
+    Text,
     reply_condition,
 )
 
@@ -90,12 +92,17 @@ def value_fields(protocol: Protocol, message: Message) -> list[Field]:
 
 
 def type_names(f: Field) -> list[str]:
-    if isinstance(f, Scalar):
-        names = (f.bits_class, f.enum.class_name if f.enum else "", f.flags.class_name if f.flags else "")
-        return [n for n in names if n]
-    if isinstance(f, Group | TableBlock):
-        return [f.class_name]
-    return []
+    """The generated classes a field's value is made of (the client imports them)."""
+    match f:
+        case Scalar():
+            names = (f.bits_class, f.enum.class_name if f.enum else "", f.flags.class_name if f.flags else "")
+            return [n for n in names if n]
+        case Group() | TableBlock():
+            return [f.class_name]
+        case Array() | List() | Text() | Bytes() | TableValue():
+            return []
+        case _:
+            assert_never(f)
 
 
 def describe(f: Field) -> str:

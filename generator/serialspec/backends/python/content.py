@@ -297,45 +297,52 @@ class PackageCode:
 
     def helper(self, f: SpecField) -> None:
         """Dataclasses for the nested values of a field: bit fields, group items, table blocks."""
-        if isinstance(f, Scalar) and f.bits and f.bits_class not in self._seen_classes:
-            self._seen_classes.add(f.bits_class)
-            attributes = []
-            for bit in f.bits:
-                kind = f"{bit.enum.class_name} | int" if bit.enum else "int"
-                where = f"bit {bit.low}" if bit.high == bit.low else f"bits {bit.high}..{bit.low}"
-                attributes.append(Attribute(bit.name, kind, f"{one_line(bit.description or bit.name)} ({where})"))
-            code = ClassCode(f.bits_class, f"Bit fields of {f.name}.", "", attributes)
-            code.to_fields = [f"{b.name!r}: int(self.{b.name})," for b in f.bits]
-            code.read_from([self.from_value_expr(b.name, b.enum.class_name if b.enum else None) for b in f.bits])
-            self.helper_classes.append(code)
-        elif isinstance(f, Group) and f.class_name not in self._seen_classes:
-            self._seen_classes.add(f.class_name)
-            for inner in f.fields:
-                self.helper(inner)
-            inner_fields = [i for i in f.fields if not (isinstance(i, Scalar) and i.hidden)]
-            code = ClassCode(f.class_name, f"One item of {f.name}.", "", self.attributes(inner_fields, False))
-            code.to_fields = [f"{i.name!r}: {self.to_json(i, 'self.' + i.name)}," for i in inner_fields]
-            code.read_from([self.from_json(i) for i in inner_fields])
-            self.helper_classes.append(code)
-        elif isinstance(f, TableBlock) and f.class_name not in self._seen_classes:
-            self._seen_classes.add(f.class_name)
-            attributes = []
-            for e in f.entries:
-                kind = f"{e.enum.class_name} | int" if e.enum else ("float" if e.type.is_float else "int")
-                unit = f" [{e.unit}]" if e.unit else ""
-                doc = one_line(f"{f.table.key_name} {e.key}: {e.description or e.name}{unit}")
-                attributes.append(Attribute(e.name, kind, doc))
-            code = ClassCode(f.class_name, one_line(f"{f.description or f.name} ({f.table.title})."), "", attributes)
-            code.to_fields = [
-                f"{e.name!r}: {'int(self.' + e.name + ')' if e.enum else 'self.' + e.name}," for e in f.entries
-            ]
-            code.read_from(
-                [
-                    self.from_value_expr(e.name, e.enum.class_name if e.enum else None, e.type.is_float)
-                    for e in f.entries
+        match f:
+            case Scalar() if f.bits and f.bits_class not in self._seen_classes:
+                self._seen_classes.add(f.bits_class)
+                attributes = []
+                for bit in f.bits:
+                    kind = f"{bit.enum.class_name} | int" if bit.enum else "int"
+                    where = f"bit {bit.low}" if bit.high == bit.low else f"bits {bit.high}..{bit.low}"
+                    attributes.append(Attribute(bit.name, kind, f"{one_line(bit.description or bit.name)} ({where})"))
+                code = ClassCode(f.bits_class, f"Bit fields of {f.name}.", "", attributes)
+                code.to_fields = [f"{b.name!r}: int(self.{b.name})," for b in f.bits]
+                code.read_from([self.from_value_expr(b.name, b.enum.class_name if b.enum else None) for b in f.bits])
+                self.helper_classes.append(code)
+            case Group() if f.class_name not in self._seen_classes:
+                self._seen_classes.add(f.class_name)
+                for inner in f.fields:
+                    self.helper(inner)
+                inner_fields = [i for i in f.fields if not (isinstance(i, Scalar) and i.hidden)]
+                code = ClassCode(f.class_name, f"One item of {f.name}.", "", self.attributes(inner_fields, False))
+                code.to_fields = [f"{i.name!r}: {self.to_json(i, 'self.' + i.name)}," for i in inner_fields]
+                code.read_from([self.from_json(i) for i in inner_fields])
+                self.helper_classes.append(code)
+            case TableBlock() if f.class_name not in self._seen_classes:
+                self._seen_classes.add(f.class_name)
+                attributes = []
+                for e in f.entries:
+                    kind = f"{e.enum.class_name} | int" if e.enum else ("float" if e.type.is_float else "int")
+                    unit = f" [{e.unit}]" if e.unit else ""
+                    doc = one_line(f"{f.table.key_name} {e.key}: {e.description or e.name}{unit}")
+                    attributes.append(Attribute(e.name, kind, doc))
+                code = ClassCode(
+                    f.class_name, one_line(f"{f.description or f.name} ({f.table.title})."), "", attributes
+                )
+                code.to_fields = [
+                    f"{e.name!r}: {'int(self.' + e.name + ')' if e.enum else 'self.' + e.name}," for e in f.entries
                 ]
-            )
-            self.helper_classes.append(code)
+                code.read_from(
+                    [
+                        self.from_value_expr(e.name, e.enum.class_name if e.enum else None, e.type.is_float)
+                        for e in f.entries
+                    ]
+                )
+                self.helper_classes.append(code)
+            case Scalar() | Group() | TableBlock() | Array() | List() | Text() | Bytes() | TableValue():
+                pass  # no nested values, or their class is made already
+            case _:
+                assert_never(f)
 
     def from_value_expr(self, name: str, enum: str | None, is_float: bool = False) -> Calls:
         """A value of a bit field or table block entry, from data: an enum member or an integer (or a number)."""

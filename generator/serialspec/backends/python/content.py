@@ -194,6 +194,9 @@ class PackageCode:
     def __init__(self, protocol: Protocol) -> None:
         self.protocol = protocol
         self.structs: dict[str, str] = {}  # constant name -> format
+        self.stems: dict[
+            str, str
+        ] = {}  # the name of each struct `struct` made, less its prefix (for names made from it)
         self.helper_classes: list[ClassCode] = []
         self.message_classes: list[ClassCode] = []
         self.decoders: list[tuple[str, str, str, Block]] = []  # name, return type, extra parameters, body
@@ -228,11 +231,15 @@ class PackageCode:
             token = _STRUCT_NAMES.get(char, char.upper())
             tokens.append(f"{token}X{count}" if count and char != "s" else (f"B{count}" if char == "s" else token))
         layout = "_".join(tokens) if len(tokens) <= 6 else base_name.upper()
-        name = "_S_" + ("BE_" if fmt.startswith(">") else "") + layout
-        if name in self.structs:  # another format got the same name (a long layout named after its message, ...)
-            taken = name
-            name = next(f"{taken}_{n}" for n in range(2, len(self.structs) + 3) if f"{taken}_{n}" not in self.structs)
+        stem = ("BE_" if fmt.startswith(">") else "") + layout
+        if "_S_" + stem in self.structs:  # another format got the same name (a long layout named after its message)
+            taken = stem
+            stem = next(
+                f"{taken}_{n}" for n in range(2, len(self.structs) + 3) if f"_S_{taken}_{n}" not in self.structs
+            )
+        name = "_S_" + stem
         self.structs[name] = fmt
+        self.stems[name] = stem
         return name
 
     # --- classes --------------------------------------------------------------------------------------------------

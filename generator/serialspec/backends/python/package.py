@@ -282,8 +282,9 @@ def straight_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, A
 
 
 def unpacked_messages(single: dict[str, Message], code: PackageCode) -> list[tuple[int, int, str, str, str]]:
-    """(code, content size, class, struct, its format) of the messages of one size whose decoder, past its size
-    check, is one struct's unpack of the content as their message (straight_frames.whole_frames decodes them whole)."""
+    """(code, content size, class, struct's name stem, its format) of the messages of one size whose decoder, past its
+    size check, is one struct's unpack of the content as their message (straight_frames.whole_frames decodes them
+    whole)."""
     bodies = {name: body for name, _, _, body in code.decoders}
     found = []
     for key, message in single.items():
@@ -295,7 +296,7 @@ def unpacked_messages(single: dict[str, Message], code: PackageCode) -> list[tup
         unpacked = content_unpacked(body[1:])
         if unpacked is not None:
             cls, struct = unpacked
-            found.append((int(key, 16), message.min_size or 0, cls, struct, code.structs[struct]))
+            found.append((int(key, 16), message.min_size or 0, cls, code.stems[struct], code.structs[struct]))
     return found
 
 

@@ -19,9 +19,9 @@ import serial
 from serialspec.runtime.aio import AsyncBus, AsyncClientBase
 from serialspec.runtime.transport import check_status
 
-from hiwonder_rrc import MATCH_BY
-from hiwonder_rrc.client import BINDING
-from hiwonder_rrc.messages import (
+from . import MATCH_BY
+from .client import BINDING
+from .messages import (
     BusServoLoadRequest,
     BusServoReadIdRequest,
     BusServoReadIdResponse,

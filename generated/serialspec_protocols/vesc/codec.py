@@ -17,7 +17,7 @@ from serialspec.runtime.message import build as _new  # a message from the tuple
 from serialspec.runtime.packing import decode_text as _decode_text
 from serialspec.runtime.packing import encode_text as _encode_text
 
-from vesc.messages import (
+from .messages import (
     AliveRequest,
     FaultCode,
     ForwardCanRequest,

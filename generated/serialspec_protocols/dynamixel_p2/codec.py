@@ -14,7 +14,7 @@ from serialspec.runtime.framing import FrameStreamParser as _FrameStreamParser
 from serialspec.runtime.message import Direction, Message, members
 from serialspec.runtime.message import build as _new  # a message from the tuple of its field values, in one call
 
-from dynamixel_p2.messages import (
+from .messages import (
     ActionRequest,
     BulkReadRequest,
     BulkWriteRequest,

@@ -17,7 +17,7 @@ from serialspec.runtime.packing import pack_bits as _pack_bits
 from serialspec.runtime.packing import unpack_bits as _unpack_bits
 from serialspec.runtime.packing import unpack_runs as _unpack_runs
 
-from modbus_rtu.messages import (
+from .messages import (
     CoilState,
     ExceptionCode,
     ExceptionResponse,

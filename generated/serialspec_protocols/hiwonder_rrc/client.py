@@ -19,10 +19,10 @@ from typing import Any
 import serial
 from serialspec.runtime.transport import Binding, Bus, ClientBase, check_status
 
-from hiwonder_rrc import MATCH_BY, SERIAL
-from hiwonder_rrc.codec import _ENCODERS as ENCODERS  # each request class's encoder, for the bus to call at once
-from hiwonder_rrc.codec import StreamParser, decode, encode
-from hiwonder_rrc.messages import (
+from . import MATCH_BY, SERIAL
+from .codec import _ENCODERS as ENCODERS  # each request class's encoder, for the bus to call at once
+from .codec import StreamParser, decode, encode
+from .messages import (
     BusServoLoadRequest,
     BusServoReadIdRequest,
     BusServoReadIdResponse,

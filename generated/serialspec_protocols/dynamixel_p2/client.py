@@ -21,10 +21,10 @@ from serialspec.runtime.errors import EncodeError
 from serialspec.runtime.registers import ModelRegisters
 from serialspec.runtime.transport import Binding, Bus, ClientBase
 
-from dynamixel_p2 import MATCH_BY, SERIAL
-from dynamixel_p2.codec import _ENCODERS as ENCODERS  # each request class's encoder, for the bus to call at once
-from dynamixel_p2.codec import StreamParser, decode, encode
-from dynamixel_p2.messages import (
+from . import MATCH_BY, SERIAL
+from .codec import _ENCODERS as ENCODERS  # each request class's encoder, for the bus to call at once
+from .codec import StreamParser, decode, encode
+from .messages import (
     ActionRequest,
     BulkReadRequest,
     BulkWriteRequest,
@@ -49,7 +49,7 @@ from dynamixel_p2.messages import (
     WriteRequest,
     WritesItem,
 )
-from dynamixel_p2.registers import CONTROL_TABLE, CONTROL_TABLE_MODELS, ControlTableName
+from .registers import CONTROL_TABLE, CONTROL_TABLE_MODELS, ControlTableName
 
 __all__ = ["BINDING", "DynamixelP2Client"]
 

@@ -17,8 +17,8 @@ from typing import Any
 import serial
 from serialspec.runtime.aio import AsyncBus, AsyncClientBase
 
-from modbus_rtu.client import BINDING
-from modbus_rtu.messages import (
+from .client import BINDING
+from .messages import (
     CoilState,
     MaskWriteRegisterRequest,
     MaskWriteRegisterResponse,

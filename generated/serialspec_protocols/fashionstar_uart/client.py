@@ -19,10 +19,10 @@ from serialspec.runtime.errors import EncodeError, Timeout
 from serialspec.runtime.message import Message
 from serialspec.runtime.transport import Binding, Bus, ClientBase, table_key
 
-from fashionstar_uart import MATCH_BY, SERIAL
-from fashionstar_uart.codec import _ENCODERS as ENCODERS  # each request class's encoder, for the bus to call at once
-from fashionstar_uart.codec import StreamParser, decode, encode
-from fashionstar_uart.messages import (
+from . import MATCH_BY, SERIAL
+from .codec import _ENCODERS as ENCODERS  # each request class's encoder, for the bus to call at once
+from .codec import StreamParser, decode, encode
+from .messages import (
     AsyncEnd,
     BeginAsyncRequest,
     BlocksItem,

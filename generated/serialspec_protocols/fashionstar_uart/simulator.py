@@ -19,8 +19,8 @@ from collections.abc import Callable, Iterable, Mapping
 
 from serialspec.runtime.device import CommandSpec, DeviceSpec, EntrySpec, Simulator
 
-from fashionstar_uart.codec import _REQUEST_DECODERS, StreamParser, encode
-from fashionstar_uart.messages import (
+from .codec import _REQUEST_DECODERS, StreamParser, encode
+from .messages import (
     BeginAsyncRequest,
     DampingRequest,
     DampingResponse,

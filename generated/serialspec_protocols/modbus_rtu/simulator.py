@@ -19,8 +19,8 @@ from collections.abc import Callable, Iterable, Mapping
 
 from serialspec.runtime.device import CommandSpec, DeviceSpec, ErrorSpec, RunSpec, Simulator, SpaceSpec
 
-from modbus_rtu.codec import _REQUEST_FRAMES, StreamParser, encode
-from modbus_rtu.messages import (
+from .codec import _REQUEST_FRAMES, StreamParser, encode
+from .messages import (
     Direction,
     ExceptionResponse,
     MaskWriteRegisterRequest,

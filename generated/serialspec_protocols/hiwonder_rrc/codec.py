@@ -15,7 +15,7 @@ from serialspec.runtime.message import build as _new  # a message from the tuple
 from serialspec.runtime.stream import FrameFormat
 from serialspec.runtime.stream import StreamParser as _StreamParser
 
-from hiwonder_rrc.messages import (
+from .messages import (
     BusServoLoadRequest,
     BusServoReadIdRequest,
     BusServoReadIdResponse,

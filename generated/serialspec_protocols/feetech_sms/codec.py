@@ -14,7 +14,7 @@ from serialspec.runtime.message import build as _new  # a message from the tuple
 from serialspec.runtime.stream import FrameFormat
 from serialspec.runtime.stream import StreamParser as _StreamParser
 
-from feetech_sms.messages import (
+from .messages import (
     ActionRequest,
     ErrorStatus,
     IdsItem,

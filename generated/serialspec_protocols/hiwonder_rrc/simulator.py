@@ -22,8 +22,8 @@ from collections.abc import Callable, Iterable, Mapping
 
 from serialspec.runtime.device import CommandSpec, DeviceSpec, KindSpec, Simulator
 
-from hiwonder_rrc.codec import StreamParser, encode
-from hiwonder_rrc.messages import (
+from .codec import StreamParser, encode
+from .messages import (
     BusServoLoadRequest,
     BusServoReadIdRequest,
     BusServoReadIdResponse,

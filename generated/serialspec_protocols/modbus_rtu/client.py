@@ -20,10 +20,10 @@ from typing import Any
 import serial
 from serialspec.runtime.transport import Binding, Bus, ClientBase, ErrorReplies
 
-from modbus_rtu import MATCH_BY, SERIAL
-from modbus_rtu.codec import _ENCODERS as ENCODERS  # each request class's encoder, for the bus to call at once
-from modbus_rtu.codec import StreamParser, decode, encode
-from modbus_rtu.messages import (
+from . import MATCH_BY, SERIAL
+from .codec import _ENCODERS as ENCODERS  # each request class's encoder, for the bus to call at once
+from .codec import StreamParser, decode, encode
+from .messages import (
     CoilState,
     Direction,
     ExceptionResponse,

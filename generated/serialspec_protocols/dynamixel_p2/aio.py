@@ -20,9 +20,9 @@ from serialspec.runtime.aio import AsyncBus, AsyncClientBase
 from serialspec.runtime.errors import EncodeError
 from serialspec.runtime.registers import ModelRegisters
 
-from dynamixel_p2.client import BINDING
-from dynamixel_p2.codec import encode
-from dynamixel_p2.messages import (
+from .client import BINDING
+from .codec import encode
+from .messages import (
     ActionRequest,
     BulkReadRequest,
     BulkWriteRequest,
@@ -46,7 +46,7 @@ from dynamixel_p2.messages import (
     WriteRequest,
     WritesItem,
 )
-from dynamixel_p2.registers import CONTROL_TABLE, CONTROL_TABLE_MODELS, ControlTableName
+from .registers import CONTROL_TABLE, CONTROL_TABLE_MODELS, ControlTableName
 
 __all__ = ["AsyncDynamixelP2Client"]
 

@@ -21,8 +21,8 @@ from serialspec.runtime.errors import EncodeError, Timeout
 from serialspec.runtime.message import Message
 from serialspec.runtime.transport import table_key
 
-from fashionstar_uart.client import BINDING, PARAMETERS, PARAMETERS_READ_ONLY, SYNC_COMMAND_CARRIES
-from fashionstar_uart.messages import (
+from .client import BINDING, PARAMETERS, PARAMETERS_READ_ONLY, SYNC_COMMAND_CARRIES
+from .messages import (
     AsyncEnd,
     BeginAsyncRequest,
     BlocksItem,

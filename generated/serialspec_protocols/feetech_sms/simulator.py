@@ -17,8 +17,8 @@ from collections.abc import Callable, Iterable, Mapping
 
 from serialspec.runtime.device import CommandSpec, DeviceSpec, EntrySpec, ModelSpec, Simulator
 
-from feetech_sms.codec import StreamParser, encode
-from feetech_sms.messages import (
+from .codec import StreamParser, encode
+from .messages import (
     ActionRequest,
     Direction,
     PingRequest,
@@ -30,7 +30,7 @@ from feetech_sms.messages import (
     SyncWriteRequest,
     WriteRequest,
 )
-from feetech_sms.registers import CONTROL_TABLE
+from .registers import CONTROL_TABLE
 
 __all__ = ["DEVICE", "SIMULATOR", "FeetechSmsSimulator"]
 

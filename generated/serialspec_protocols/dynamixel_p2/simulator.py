@@ -23,8 +23,8 @@ from collections.abc import Callable, Iterable, Mapping
 
 from serialspec.runtime.device import CommandSpec, DeviceSpec, EntrySpec, ModelSpec, Simulator
 
-from dynamixel_p2.codec import StreamParser, encode
-from dynamixel_p2.messages import (
+from .codec import StreamParser, encode
+from .messages import (
     ActionRequest,
     BulkReadRequest,
     BulkWriteRequest,
@@ -42,7 +42,7 @@ from dynamixel_p2.messages import (
     SyncWriteRequest,
     WriteRequest,
 )
-from dynamixel_p2.registers import CONTROL_TABLE
+from .registers import CONTROL_TABLE
 
 __all__ = ["DEVICE", "SIMULATOR", "DynamixelP2Simulator"]
 

@@ -17,8 +17,8 @@ from collections.abc import Callable, Iterable, Mapping
 
 from serialspec.runtime.device import CommandSpec, DeviceSpec, Simulator, TimeoutSpec
 
-from vesc.codec import StreamParser, encode
-from vesc.messages import (
+from .codec import StreamParser, encode
+from .messages import (
     AliveRequest,
     Direction,
     ForwardCanRequest,

@@ -447,7 +447,8 @@ class FrameCodec:
     def first_byte(self, layout: Layout) -> int | None:
         """The byte every frame of `layout` begins with (the first of a constant its head starts with), or None."""
         plan: dict[str, Any] = layout._plan  # type: ignore[attr-defined]
-        for element, first, _ in plan["probe_head"]:
+        head: tuple[tuple[Element, int, int], ...] = plan["probe_head"]
+        for element, first, _ in head:
             if first == 0 and element.kind == "constant" and element.constant:
                 return element.constant[0]
         return None

@@ -9,6 +9,7 @@ a small test spec stands in. Timing is counted over a simulated clock, never mea
 from __future__ import annotations
 
 import asyncio
+import importlib
 import threading
 from collections.abc import Iterator
 from types import ModuleType
@@ -232,3 +233,18 @@ def test_device_mistakes_in_one_line(change: dict[str, Any], said: str) -> None:
         files(spec)
     assert said in str(caught.value)
     assert "Traceback" not in str(caught.value)
+
+
+def test_a_value_dividing_by_a_written_zero_sends_nothing(caplog: pytest.LogCaptureFixture) -> None:
+    sends = {**SPEC["device"]["sends"], "telemetry": {"after": ["arm"], "values": {"double": "100 / level"}}}
+    spec = {**SPEC, "device": {**SPEC["device"], "sends": sends}}
+    with imported("beacon", files(spec), "the sends test") as package:
+        m = importlib.import_module("beacon.messages")
+        sim = importlib.import_module("beacon.simulator").BeaconSimulator(ids=[1], clock=Clock())
+        codec = importlib.import_module("beacon.codec")
+        decode = codec.StreamParser(m.Direction.RESPONSE)
+        sim.feed(codec.encode(m.SetLevelRequest(id=1, level=0)))
+        sent = [x for _, frame in sim.feed(codec.encode(m.ArmRequest(id=1, on=1))) for x in decode.feed(frame)]
+        assert sent == [m.ArmResponse(id=1, on=1)]  # the reply, and no telemetry: 100 / 0 has no value
+        assert "no TelemetryResponse sent" in caplog.text
+        del package

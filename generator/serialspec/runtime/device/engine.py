@@ -399,10 +399,10 @@ class Engine(FaultInjection):
         # sends: (device, index) -> when the next periodic one is due, and the watched values last sent with (by
         # the device itself, whose id a request may change)
         self._next_send: dict[tuple[VirtualDevice, int], float] = {}
-        self._watched: dict[tuple[VirtualDevice, int], tuple[float, ...]] = {}
+        self._watched: dict[tuple[VirtualDevice, int], tuple[float | None, ...]] = {}
         for device in self.devices.values():
             for index, send in enumerate(spec.sends):
-                self._watched[device, index] = tuple(device.get(n) for n in send.changes)
+                self._watched[device, index] = tuple(self._value(device, n) for n in send.changes)
         FaultInjection.__init__(self)
 
     # --- requests -------------------------------------------------------------------------------------------------
@@ -452,15 +452,34 @@ class Engine(FaultInjection):
                             following = next_time + send.every
                             self._next_send[key] = following if following > now else now + send.every
                     if send.changes:
-                        values = tuple(device.get(n) for n in send.changes)
+                        values = tuple(self._value(device, n) for n in send.changes)
                         if values != self._watched.get(key):
                             self._watched[key] = values
                             sending = True
-                    if sending and (not send.while_ or device.get(send.while_)):
-                        frame = self._reply(device, send.command, {}, "")
-                        if frame is not None:
-                            out.append((now, frame))
+                    frame = self._sent(device, send) if sending else None
+                    if frame is not None:
+                        out.append((now, frame))
         return out
+
+    def _value(self, device: VirtualDevice, name: str) -> float | None:
+        """A watched value; None where an expression of the spec has none (a division by a value written as 0)."""
+        try:
+            return device.get(name)
+        except (ZeroDivisionError, ValueError):
+            return None
+
+    def _sent(self, device: VirtualDevice, send: SendSpec) -> bytes | None:
+        """The message a device sends on its own, if `while_` lets it; where an expression of the spec has no value
+        (a division by a value written as 0), nothing is sent and one line says why, as for a reply."""
+        try:
+            if send.while_ and not device.get(send.while_):
+                return None
+            return self._reply(device, send.command, {}, "")
+        except (ZeroDivisionError, ValueError) as exc:
+            LOG.warning(
+                "simulator: no %s sent: a value of the spec has no value here (%s)", send.response.__name__, exc
+            )
+            return None
 
     def next_due(self) -> float | None:
         """When due() next has something periodic to send (None: nothing is periodic); watched values are polled
@@ -480,9 +499,8 @@ class Engine(FaultInjection):
         """The messages a device sends on its own after answering this request (`sends: after`)."""
         frames = []
         for send in self.spec.sends:
-            if isinstance(request, send.after) and (not send.while_ or device.get(send.while_)):
-                frame = self._reply(device, send.command, {}, "")
-                frames += [frame] if frame is not None else []
+            frame = self._sent(device, send) if isinstance(request, send.after) else None
+            frames += [frame] if frame is not None else []
         return frames
 
     def tick(self) -> None:

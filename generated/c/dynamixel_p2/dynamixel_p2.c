@@ -21,6 +21,9 @@ typedef char dynamixel_p2__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define DYNAMIXEL_P2__CLASSIC 0
 #define DYNAMIXEL_P2__HEADERS 1 /* every layout starts with a header: candidates start at headers only */
 #define DYNAMIXEL_P2__KEEP 2u      /* bytes kept at the end that could begin a header */
+#define DYNAMIXEL_P2__STUFFED 1 /* some layout has byte stuffing */
+#define DYNAMIXEL_P2__LENGTHS 1 /* every layout has a length element */
+#define DYNAMIXEL_P2__SINGLE 1 /* one layout per direction */
 
 /* ---- checksums ---- */
 /* CRC-16/UMTS (CRC-16/BUYPASS): width 16, poly 0x8005, init 0x0, refin false, refout false, xorout 0x0 (check 0xfee8). Incremental: start with 0x0, feed pieces, then use it as is. Bitwise: no table, no static data. */
@@ -57,6 +60,9 @@ static uint32_t dynamixel_p2__check(uint8_t which, const uint8_t *d, size_t n)
 #define DYNAMIXEL_P2__ROLE_LENGTH 3u
 #define DYNAMIXEL_P2__ROLE_CONTENT 4u
 #define DYNAMIXEL_P2__ROLE_CHECKSUM 5u
+
+/* Byte stuffing over part of a layout (constant 0 when no layout has it: that code left out) */
+#define DYNAMIXEL_P2__T(L) (DYNAMIXEL_P2__STUFFED && (L)->has_t)
 
 #define DYNAMIXEL_P2__WAIT (-2L)
 #define DYNAMIXEL_P2__NONE (-1L)
@@ -138,7 +144,7 @@ static void dynamixel_p2__put(uint8_t *b, uint8_t size, uint8_t big, uint32_t v)
 /* The elements before the variable part (the stuffed span, else the content) and after it. */
 static uint8_t dynamixel_p2__inner_first(const dynamixel_p2__layout_t *L)
 {
-    if (L->has_t) {
+    if (DYNAMIXEL_P2__T(L)) {
         return L->t_first;
     }
     return L->content >= 0 ? (uint8_t)L->content : L->count;
@@ -146,7 +152,7 @@ static uint8_t dynamixel_p2__inner_first(const dynamixel_p2__layout_t *L)
 
 static int dynamixel_p2__inner_last(const dynamixel_p2__layout_t *L)
 {
-    if (L->has_t) {
+    if (DYNAMIXEL_P2__T(L)) {
         return (int)L->t_last;
     }
     return L->content >= 0 ? (int)L->content : (int)L->count - 1;
@@ -206,7 +212,7 @@ static int dynamixel_p2__rewrite(const dynamixel_p2__layout_t *L, int to_wire, c
 static const uint8_t *dynamixel_p2__range(const dynamixel_p2__layout_t *L, const dynamixel_p2__where_t *w, const uint8_t *wire,
                                  const uint8_t *plain, uint8_t a, uint8_t b, size_t *n)
 {
-    if (L->has_t && a >= L->t_first && b <= L->t_last) {
+    if (DYNAMIXEL_P2__T(L) && a >= L->t_first && b <= L->t_last) {
         *n = w->pe[b] - w->ps[a];
         return plain + w->ps[a];
     }
@@ -227,7 +233,7 @@ static int dynamixel_p2__wrap(const dynamixel_p2__layout_t *L, uint8_t *out, siz
     int last = dynamixel_p2__inner_last(L);
     const uint8_t *bytes;
     /* plain bytes of the stuffed span: its elements laid out around the content, inner checksums over them */
-    if (L->has_t) {
+    if (DYNAMIXEL_P2__T(L)) {
         size_t p = 0u;
         for (k = L->t_first; k <= L->t_last; k++) {
             const dynamixel_p2__element_t *e = &L->e[k];
@@ -266,7 +272,7 @@ static int dynamixel_p2__wrap(const dynamixel_p2__layout_t *L, uint8_t *out, siz
     v = 0u;
     for (k = 0u; k < L->count; k++) {
         const dynamixel_p2__element_t *e = &L->e[k];
-        if (L->has_t && k == L->t_first) {
+        if (DYNAMIXEL_P2__T(L) && k == L->t_first) {
             size_t made;
             if (!dynamixel_p2__rewrite(L, 1, span, w.pe[L->t_last], out + pos, NULL, cap - pos, &made)) {
                 return DYNAMIXEL_P2_E_BUFFER;
@@ -319,7 +325,7 @@ static int dynamixel_p2__wrap(const dynamixel_p2__layout_t *L, uint8_t *out, siz
     }
     for (k = 0u; k < L->count; k++) {
         const dynamixel_p2__element_t *e = &L->e[k];
-        if (e->role == DYNAMIXEL_P2__ROLE_CHECKSUM && !(L->has_t && k >= L->t_first && k <= L->t_last)) {
+        if (e->role == DYNAMIXEL_P2__ROLE_CHECKSUM && !(DYNAMIXEL_P2__T(L) && k >= L->t_first && k <= L->t_last)) {
             bytes = dynamixel_p2__range(L, &w, out, span, e->first, e->last, &sz);
             dynamixel_p2__put(out + w.ws[k], e->size, e->big, dynamixel_p2__check(e->check, bytes, sz));
         }
@@ -359,7 +365,7 @@ static int dynamixel_p2__unwrap(const dynamixel_p2__layout_t *L, const uint8_t *
         pos -= L->e[k - 1u].size;
         w.ws[k - 1u] = pos;
     }
-    if (L->has_t) {
+    if (DYNAMIXEL_P2__T(L)) {
         size_t pn, fixed = 0u, p = 0u;
         if (!dynamixel_p2__rewrite(L, 0, frame + before, n - before - after, plain, NULL, DYNAMIXEL_P2_MAX_FRAME, &pn)) {
             return DYNAMIXEL_P2_E_CAPACITY;
@@ -387,7 +393,7 @@ static int dynamixel_p2__unwrap(const dynamixel_p2__layout_t *L, const uint8_t *
     }
     for (k = 0u; k < L->count; k++) {
         const dynamixel_p2__element_t *e = &L->e[k];
-        bytes = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+        bytes = DYNAMIXEL_P2__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
         if (e->role == DYNAMIXEL_P2__ROLE_CONSTANT && memcmp(bytes, e->constant, e->size) != 0) {
             return DYNAMIXEL_P2_E_FRAME;
         }
@@ -395,7 +401,7 @@ static int dynamixel_p2__unwrap(const dynamixel_p2__layout_t *L, const uint8_t *
     *code = 0u;
     for (k = 0u; k < L->count; k++) {
         const dynamixel_p2__element_t *e = &L->e[k];
-        bytes = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+        bytes = DYNAMIXEL_P2__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
         if (e->role == DYNAMIXEL_P2__ROLE_COMMAND) {
             *code = dynamixel_p2__get(bytes, e->size, e->big);
         } else if (e->role == DYNAMIXEL_P2__ROLE_VALUE) {
@@ -409,7 +415,7 @@ static int dynamixel_p2__unwrap(const dynamixel_p2__layout_t *L, const uint8_t *
     for (k = 0u; k < L->count; k++) {
         const dynamixel_p2__element_t *e = &L->e[k];
         if (e->role == DYNAMIXEL_P2__ROLE_LENGTH) {
-            bytes = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+            bytes = DYNAMIXEL_P2__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
             (void)dynamixel_p2__range(L, &w, frame, body, e->first, e->last, &sz);
             if ((int32_t)dynamixel_p2__get(bytes, e->size, e->big) != (int32_t)sz + e->adds) {
                 return DYNAMIXEL_P2_E_LENGTH;
@@ -419,7 +425,7 @@ static int dynamixel_p2__unwrap(const dynamixel_p2__layout_t *L, const uint8_t *
     for (k = 0u; k < L->count; k++) {
         const dynamixel_p2__element_t *e = &L->e[k];
         if (e->role == DYNAMIXEL_P2__ROLE_CHECKSUM) {
-            const uint8_t *stored = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+            const uint8_t *stored = DYNAMIXEL_P2__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
             bytes = dynamixel_p2__range(L, &w, frame, body, e->first, e->last, &sz);
             if (dynamixel_p2__check(e->check, bytes, sz) != dynamixel_p2__get(stored, e->size, e->big)) {
                 return DYNAMIXEL_P2_E_CHECKSUM;
@@ -427,7 +433,7 @@ static int dynamixel_p2__unwrap(const dynamixel_p2__layout_t *L, const uint8_t *
         }
     }
     if (L->content >= 0) {
-        int inside = L->has_t && L->content >= (int)L->t_first && L->content <= (int)L->t_last;
+        int inside = DYNAMIXEL_P2__T(L) && L->content >= (int)L->t_first && L->content <= (int)L->t_last;
         *content = inside ? body + w.ps[L->content] : frame + w.ws[L->content];
         *clen = inside ? w.pe[L->content] - w.ps[L->content] : w.we[L->content] - w.ws[L->content];
     } else {
@@ -486,16 +492,16 @@ static long dynamixel_p2__probe(const dynamixel_p2__layout_t *L, dynamixel_p2_di
         low = 0u; /* the code lies in the stuffed span: no bounds before the frame is unstuffed */
         bounded = 0;
     }
-    if (L->length >= 0) {
+    if (DYNAMIXEL_P2__LENGTHS || L->length >= 0) {
         const dynamixel_p2__element_t *e = &L->e[L->length];
         long counted = (long)dynamixel_p2__get(b + L->length_off, e->size, e->big) - (long)e->adds;
         long content = counted - (long)L->counted;
-        if (content < (long)low || (!L->has_t && bounded && content > (long)high)) {
+        if (content < (long)low || (!DYNAMIXEL_P2__T(L) && bounded && content > (long)high)) {
             return DYNAMIXEL_P2__NONE;
         }
         return (long)(L->overhead - L->counted) + counted;
     }
-    if (L->has_t && L->e[L->count - 1u].role == DYNAMIXEL_P2__ROLE_CONSTANT && L->count > 1u) {
+    if (DYNAMIXEL_P2__T(L) && L->e[L->count - 1u].role == DYNAMIXEL_P2__ROLE_CONSTANT && L->count > 1u) {
         const dynamixel_p2__element_t *t = &L->e[L->count - 1u];
         size_t i;
         for (i = before; i + t->size <= avail; i++) {
@@ -1081,7 +1087,7 @@ int dynamixel_p2_decode_expect(const uint8_t *frame, size_t len, dynamixel_p2_di
     if (layouts == NULL) {
         return DYNAMIXEL_P2_E_ARG;
     }
-    if (count == 1u) {
+    if (DYNAMIXEL_P2__SINGLE || count == 1u) {
         L = layouts[0];
     } else {
         for (k = 0u; k < count; k++) {
@@ -1468,11 +1474,11 @@ static int dynamixel_p2__frame(dynamixel_p2_direction_t dir, uint32_t code, cons
         size_t before = 0u, clen = 0u;
         uint8_t *dst;
         size_t room;
-        uint8_t from = L->has_t ? L->t_first : 0u;
+        uint8_t from = DYNAMIXEL_P2__T(L) ? L->t_first : 0u;
         for (i = from; (int)i < L->content; i++) {
             before += L->e[i].size;
         }
-        if (L->has_t) {
+        if (DYNAMIXEL_P2__T(L)) {
             if (before > DYNAMIXEL_P2_MAX_FRAME) {
                 return DYNAMIXEL_P2_E_BUFFER;
             }
@@ -1863,11 +1869,56 @@ static int dynamixel_p2__push(dynamixel_p2_parser_t *p, uint8_t byte, dynamixel_
     return got;
 }
 
+#if DYNAMIXEL_P2__HEADERS
+/* A whole frame at data[0..len) while no byte is held: taken at once, its bytes not pushed one by one, when that gives
+ * what pushing them would (one layout; a plausible frame that fits and decodes; no header inside it, so no other
+ * candidate could end first). Else 0: the bytes go through dynamixel_p2__push. */
+static size_t dynamixel_p2__whole(dynamixel_p2_parser_t *p, const uint8_t *data, size_t len, dynamixel_p2_msg_t *out)
+{
+    uint8_t count;
+    const dynamixel_p2__layout_t *const *layouts = dynamixel_p2__layouts(p->dir, &count);
+    const dynamixel_p2__layout_t *L;
+    size_t i, size;
+    long s;
+    if (!DYNAMIXEL_P2__SINGLE && count != 1u) {
+        return 0u;
+    }
+    L = layouts[0];
+    if (len < L->header_len || memcmp(data, L->e[0].constant, L->header_len) != 0) {
+        return 0u;
+    }
+    s = dynamixel_p2__probe(L, p->dir, data, len);
+    if (s <= 0 || (unsigned long)s > DYNAMIXEL_P2_MAX_FRAME || (size_t)s > len) {
+        return 0u;
+    }
+    size = (size_t)s;
+    for (i = 1u; i + L->header_len <= size; i++) {
+        if (data[i] == L->e[0].constant[0] && memcmp(data + i, L->e[0].constant, L->header_len) == 0) {
+            return 0u;
+        }
+    }
+    if (dynamixel_p2_decode(data, size, p->dir, out) != DYNAMIXEL_P2_OK) {
+        return 0u;
+    }
+    p->frames++;
+    return size;
+}
+#endif
+
 size_t dynamixel_p2_parser_feed(dynamixel_p2_parser_t *parser, const uint8_t *data, size_t len, dynamixel_p2_msg_t *out, bool *got)
 {
     size_t i;
     *got = false;
     for (i = 0u; i < len; i++) {
+#if DYNAMIXEL_P2__HEADERS
+        if (parser->n == 0u) {
+            size_t size = dynamixel_p2__whole(parser, data + i, len - i, out);
+            if (size > 0u) {
+                *got = true;
+                return i + size;
+            }
+        }
+#endif
         if (dynamixel_p2__push(parser, data[i], out)) {
             *got = true;
             return i + 1u;

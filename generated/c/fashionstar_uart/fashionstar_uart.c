@@ -21,6 +21,9 @@ typedef char fashionstar_uart__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define FASHIONSTAR_UART__CLASSIC 1
 #define FASHIONSTAR_UART__HEADERS 1 /* every layout starts with a header: candidates start at headers only */
 #define FASHIONSTAR_UART__KEEP 1u      /* bytes kept at the end that could begin a header */
+#define FASHIONSTAR_UART__STUFFED 0 /* some layout has byte stuffing */
+#define FASHIONSTAR_UART__LENGTHS 1 /* every layout has a length element */
+#define FASHIONSTAR_UART__SINGLE 1 /* one layout per direction */
 
 /* ---- checksums ---- */
 /* Sum of the bytes modulo 2^8. Incremental: start with 0; the frame's checksum is the sum. */
@@ -53,6 +56,9 @@ static uint32_t fashionstar_uart__check(uint8_t which, const uint8_t *d, size_t 
 #define FASHIONSTAR_UART__ROLE_LENGTH 3u
 #define FASHIONSTAR_UART__ROLE_CONTENT 4u
 #define FASHIONSTAR_UART__ROLE_CHECKSUM 5u
+
+/* Byte stuffing over part of a layout (constant 0 when no layout has it: that code left out) */
+#define FASHIONSTAR_UART__T(L) (FASHIONSTAR_UART__STUFFED && (L)->has_t)
 
 #define FASHIONSTAR_UART__WAIT (-2L)
 #define FASHIONSTAR_UART__NONE (-1L)
@@ -134,7 +140,7 @@ static void fashionstar_uart__put(uint8_t *b, uint8_t size, uint8_t big, uint32_
 /* The elements before the variable part (the stuffed span, else the content) and after it. */
 static uint8_t fashionstar_uart__inner_first(const fashionstar_uart__layout_t *L)
 {
-    if (L->has_t) {
+    if (FASHIONSTAR_UART__T(L)) {
         return L->t_first;
     }
     return L->content >= 0 ? (uint8_t)L->content : L->count;
@@ -142,7 +148,7 @@ static uint8_t fashionstar_uart__inner_first(const fashionstar_uart__layout_t *L
 
 static int fashionstar_uart__inner_last(const fashionstar_uart__layout_t *L)
 {
-    if (L->has_t) {
+    if (FASHIONSTAR_UART__T(L)) {
         return (int)L->t_last;
     }
     return L->content >= 0 ? (int)L->content : (int)L->count - 1;
@@ -202,7 +208,7 @@ static int fashionstar_uart__rewrite(const fashionstar_uart__layout_t *L, int to
 static const uint8_t *fashionstar_uart__range(const fashionstar_uart__layout_t *L, const fashionstar_uart__where_t *w, const uint8_t *wire,
                                  const uint8_t *plain, uint8_t a, uint8_t b, size_t *n)
 {
-    if (L->has_t && a >= L->t_first && b <= L->t_last) {
+    if (FASHIONSTAR_UART__T(L) && a >= L->t_first && b <= L->t_last) {
         *n = w->pe[b] - w->ps[a];
         return plain + w->ps[a];
     }
@@ -223,7 +229,7 @@ static int fashionstar_uart__wrap(const fashionstar_uart__layout_t *L, uint8_t *
     int last = fashionstar_uart__inner_last(L);
     const uint8_t *bytes;
     /* plain bytes of the stuffed span: its elements laid out around the content, inner checksums over them */
-    if (L->has_t) {
+    if (FASHIONSTAR_UART__T(L)) {
         size_t p = 0u;
         for (k = L->t_first; k <= L->t_last; k++) {
             const fashionstar_uart__element_t *e = &L->e[k];
@@ -262,7 +268,7 @@ static int fashionstar_uart__wrap(const fashionstar_uart__layout_t *L, uint8_t *
     v = 0u;
     for (k = 0u; k < L->count; k++) {
         const fashionstar_uart__element_t *e = &L->e[k];
-        if (L->has_t && k == L->t_first) {
+        if (FASHIONSTAR_UART__T(L) && k == L->t_first) {
             size_t made;
             if (!fashionstar_uart__rewrite(L, 1, span, w.pe[L->t_last], out + pos, NULL, cap - pos, &made)) {
                 return FASHIONSTAR_UART_E_BUFFER;
@@ -315,7 +321,7 @@ static int fashionstar_uart__wrap(const fashionstar_uart__layout_t *L, uint8_t *
     }
     for (k = 0u; k < L->count; k++) {
         const fashionstar_uart__element_t *e = &L->e[k];
-        if (e->role == FASHIONSTAR_UART__ROLE_CHECKSUM && !(L->has_t && k >= L->t_first && k <= L->t_last)) {
+        if (e->role == FASHIONSTAR_UART__ROLE_CHECKSUM && !(FASHIONSTAR_UART__T(L) && k >= L->t_first && k <= L->t_last)) {
             bytes = fashionstar_uart__range(L, &w, out, span, e->first, e->last, &sz);
             fashionstar_uart__put(out + w.ws[k], e->size, e->big, fashionstar_uart__check(e->check, bytes, sz));
         }
@@ -355,7 +361,7 @@ static int fashionstar_uart__unwrap(const fashionstar_uart__layout_t *L, const u
         pos -= L->e[k - 1u].size;
         w.ws[k - 1u] = pos;
     }
-    if (L->has_t) {
+    if (FASHIONSTAR_UART__T(L)) {
         size_t pn, fixed = 0u, p = 0u;
         if (!fashionstar_uart__rewrite(L, 0, frame + before, n - before - after, plain, NULL, FASHIONSTAR_UART_MAX_FRAME, &pn)) {
             return FASHIONSTAR_UART_E_CAPACITY;
@@ -383,7 +389,7 @@ static int fashionstar_uart__unwrap(const fashionstar_uart__layout_t *L, const u
     }
     for (k = 0u; k < L->count; k++) {
         const fashionstar_uart__element_t *e = &L->e[k];
-        bytes = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+        bytes = FASHIONSTAR_UART__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
         if (e->role == FASHIONSTAR_UART__ROLE_CONSTANT && memcmp(bytes, e->constant, e->size) != 0) {
             return FASHIONSTAR_UART_E_FRAME;
         }
@@ -391,7 +397,7 @@ static int fashionstar_uart__unwrap(const fashionstar_uart__layout_t *L, const u
     *code = 0u;
     for (k = 0u; k < L->count; k++) {
         const fashionstar_uart__element_t *e = &L->e[k];
-        bytes = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+        bytes = FASHIONSTAR_UART__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
         if (e->role == FASHIONSTAR_UART__ROLE_COMMAND) {
             *code = fashionstar_uart__get(bytes, e->size, e->big);
         } else if (e->role == FASHIONSTAR_UART__ROLE_VALUE) {
@@ -405,7 +411,7 @@ static int fashionstar_uart__unwrap(const fashionstar_uart__layout_t *L, const u
     for (k = 0u; k < L->count; k++) {
         const fashionstar_uart__element_t *e = &L->e[k];
         if (e->role == FASHIONSTAR_UART__ROLE_LENGTH) {
-            bytes = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+            bytes = FASHIONSTAR_UART__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
             (void)fashionstar_uart__range(L, &w, frame, body, e->first, e->last, &sz);
             if ((int32_t)fashionstar_uart__get(bytes, e->size, e->big) != (int32_t)sz + e->adds) {
                 return FASHIONSTAR_UART_E_LENGTH;
@@ -415,7 +421,7 @@ static int fashionstar_uart__unwrap(const fashionstar_uart__layout_t *L, const u
     for (k = 0u; k < L->count; k++) {
         const fashionstar_uart__element_t *e = &L->e[k];
         if (e->role == FASHIONSTAR_UART__ROLE_CHECKSUM) {
-            const uint8_t *stored = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+            const uint8_t *stored = FASHIONSTAR_UART__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
             bytes = fashionstar_uart__range(L, &w, frame, body, e->first, e->last, &sz);
             if (fashionstar_uart__check(e->check, bytes, sz) != fashionstar_uart__get(stored, e->size, e->big)) {
                 return FASHIONSTAR_UART_E_CHECKSUM;
@@ -423,7 +429,7 @@ static int fashionstar_uart__unwrap(const fashionstar_uart__layout_t *L, const u
         }
     }
     if (L->content >= 0) {
-        int inside = L->has_t && L->content >= (int)L->t_first && L->content <= (int)L->t_last;
+        int inside = FASHIONSTAR_UART__T(L) && L->content >= (int)L->t_first && L->content <= (int)L->t_last;
         *content = inside ? body + w.ps[L->content] : frame + w.ws[L->content];
         *clen = inside ? w.pe[L->content] - w.ps[L->content] : w.we[L->content] - w.ws[L->content];
     } else {
@@ -482,16 +488,16 @@ static long fashionstar_uart__probe(const fashionstar_uart__layout_t *L, fashion
         low = 0u; /* the code lies in the stuffed span: no bounds before the frame is unstuffed */
         bounded = 0;
     }
-    if (L->length >= 0) {
+    if (FASHIONSTAR_UART__LENGTHS || L->length >= 0) {
         const fashionstar_uart__element_t *e = &L->e[L->length];
         long counted = (long)fashionstar_uart__get(b + L->length_off, e->size, e->big) - (long)e->adds;
         long content = counted - (long)L->counted;
-        if (content < (long)low || (!L->has_t && bounded && content > (long)high)) {
+        if (content < (long)low || (!FASHIONSTAR_UART__T(L) && bounded && content > (long)high)) {
             return FASHIONSTAR_UART__NONE;
         }
         return (long)(L->overhead - L->counted) + counted;
     }
-    if (L->has_t && L->e[L->count - 1u].role == FASHIONSTAR_UART__ROLE_CONSTANT && L->count > 1u) {
+    if (FASHIONSTAR_UART__T(L) && L->e[L->count - 1u].role == FASHIONSTAR_UART__ROLE_CONSTANT && L->count > 1u) {
         const fashionstar_uart__element_t *t = &L->e[L->count - 1u];
         size_t i;
         for (i = before; i + t->size <= avail; i++) {
@@ -2157,7 +2163,7 @@ int fashionstar_uart_decode_expect(const uint8_t *frame, size_t len, fashionstar
     if (layouts == NULL) {
         return FASHIONSTAR_UART_E_ARG;
     }
-    if (count == 1u) {
+    if (FASHIONSTAR_UART__SINGLE || count == 1u) {
         L = layouts[0];
     } else {
         for (k = 0u; k < count; k++) {
@@ -3549,11 +3555,11 @@ static int fashionstar_uart__frame(fashionstar_uart_direction_t dir, uint32_t co
         size_t before = 0u, clen = 0u;
         uint8_t *dst;
         size_t room;
-        uint8_t from = L->has_t ? L->t_first : 0u;
+        uint8_t from = FASHIONSTAR_UART__T(L) ? L->t_first : 0u;
         for (i = from; (int)i < L->content; i++) {
             before += L->e[i].size;
         }
-        if (L->has_t) {
+        if (FASHIONSTAR_UART__T(L)) {
             if (before > FASHIONSTAR_UART_MAX_FRAME) {
                 return FASHIONSTAR_UART_E_BUFFER;
             }
@@ -4227,11 +4233,56 @@ static int fashionstar_uart__push(fashionstar_uart_parser_t *p, uint8_t byte, fa
     return got;
 }
 
+#if FASHIONSTAR_UART__HEADERS
+/* A whole frame at data[0..len) while no byte is held: taken at once, its bytes not pushed one by one, when that gives
+ * what pushing them would (one layout; a plausible frame that fits and decodes; no header inside it, so no other
+ * candidate could end first). Else 0: the bytes go through fashionstar_uart__push. */
+static size_t fashionstar_uart__whole(fashionstar_uart_parser_t *p, const uint8_t *data, size_t len, fashionstar_uart_msg_t *out)
+{
+    uint8_t count;
+    const fashionstar_uart__layout_t *const *layouts = fashionstar_uart__layouts(p->dir, &count);
+    const fashionstar_uart__layout_t *L;
+    size_t i, size;
+    long s;
+    if (!FASHIONSTAR_UART__SINGLE && count != 1u) {
+        return 0u;
+    }
+    L = layouts[0];
+    if (len < L->header_len || memcmp(data, L->e[0].constant, L->header_len) != 0) {
+        return 0u;
+    }
+    s = fashionstar_uart__probe(L, p->dir, data, len);
+    if (s <= 0 || (unsigned long)s > FASHIONSTAR_UART_MAX_FRAME || (size_t)s > len) {
+        return 0u;
+    }
+    size = (size_t)s;
+    for (i = 1u; i + L->header_len <= size; i++) {
+        if (data[i] == L->e[0].constant[0] && memcmp(data + i, L->e[0].constant, L->header_len) == 0) {
+            return 0u;
+        }
+    }
+    if (fashionstar_uart_decode(data, size, p->dir, out) != FASHIONSTAR_UART_OK) {
+        return 0u;
+    }
+    p->frames++;
+    return size;
+}
+#endif
+
 size_t fashionstar_uart_parser_feed(fashionstar_uart_parser_t *parser, const uint8_t *data, size_t len, fashionstar_uart_msg_t *out, bool *got)
 {
     size_t i;
     *got = false;
     for (i = 0u; i < len; i++) {
+#if FASHIONSTAR_UART__HEADERS
+        if (parser->n == 0u) {
+            size_t size = fashionstar_uart__whole(parser, data + i, len - i, out);
+            if (size > 0u) {
+                *got = true;
+                return i + size;
+            }
+        }
+#endif
         if (fashionstar_uart__push(parser, data[i], out)) {
             *got = true;
             return i + 1u;

@@ -21,6 +21,9 @@ typedef char hiwonder_rrc__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define HIWONDER_RRC__CLASSIC 1
 #define HIWONDER_RRC__HEADERS 1 /* every layout starts with a header: candidates start at headers only */
 #define HIWONDER_RRC__KEEP 1u      /* bytes kept at the end that could begin a header */
+#define HIWONDER_RRC__STUFFED 0 /* some layout has byte stuffing */
+#define HIWONDER_RRC__LENGTHS 1 /* every layout has a length element */
+#define HIWONDER_RRC__SINGLE 1 /* one layout per direction */
 
 /* ---- checksums ---- */
 /* CRC-8/MAXIM: width 8, poly 0x31, init 0x0, refin true, refout true, xorout 0x0 (check 0xa1). Incremental: start with 0x0, feed pieces, then use it as is. Bitwise: no table, no static data. */
@@ -57,6 +60,9 @@ static uint32_t hiwonder_rrc__check(uint8_t which, const uint8_t *d, size_t n)
 #define HIWONDER_RRC__ROLE_LENGTH 3u
 #define HIWONDER_RRC__ROLE_CONTENT 4u
 #define HIWONDER_RRC__ROLE_CHECKSUM 5u
+
+/* Byte stuffing over part of a layout (constant 0 when no layout has it: that code left out) */
+#define HIWONDER_RRC__T(L) (HIWONDER_RRC__STUFFED && (L)->has_t)
 
 #define HIWONDER_RRC__WAIT (-2L)
 #define HIWONDER_RRC__NONE (-1L)
@@ -138,7 +144,7 @@ static void hiwonder_rrc__put(uint8_t *b, uint8_t size, uint8_t big, uint32_t v)
 /* The elements before the variable part (the stuffed span, else the content) and after it. */
 static uint8_t hiwonder_rrc__inner_first(const hiwonder_rrc__layout_t *L)
 {
-    if (L->has_t) {
+    if (HIWONDER_RRC__T(L)) {
         return L->t_first;
     }
     return L->content >= 0 ? (uint8_t)L->content : L->count;
@@ -146,7 +152,7 @@ static uint8_t hiwonder_rrc__inner_first(const hiwonder_rrc__layout_t *L)
 
 static int hiwonder_rrc__inner_last(const hiwonder_rrc__layout_t *L)
 {
-    if (L->has_t) {
+    if (HIWONDER_RRC__T(L)) {
         return (int)L->t_last;
     }
     return L->content >= 0 ? (int)L->content : (int)L->count - 1;
@@ -206,7 +212,7 @@ static int hiwonder_rrc__rewrite(const hiwonder_rrc__layout_t *L, int to_wire, c
 static const uint8_t *hiwonder_rrc__range(const hiwonder_rrc__layout_t *L, const hiwonder_rrc__where_t *w, const uint8_t *wire,
                                  const uint8_t *plain, uint8_t a, uint8_t b, size_t *n)
 {
-    if (L->has_t && a >= L->t_first && b <= L->t_last) {
+    if (HIWONDER_RRC__T(L) && a >= L->t_first && b <= L->t_last) {
         *n = w->pe[b] - w->ps[a];
         return plain + w->ps[a];
     }
@@ -227,7 +233,7 @@ static int hiwonder_rrc__wrap(const hiwonder_rrc__layout_t *L, uint8_t *out, siz
     int last = hiwonder_rrc__inner_last(L);
     const uint8_t *bytes;
     /* plain bytes of the stuffed span: its elements laid out around the content, inner checksums over them */
-    if (L->has_t) {
+    if (HIWONDER_RRC__T(L)) {
         size_t p = 0u;
         for (k = L->t_first; k <= L->t_last; k++) {
             const hiwonder_rrc__element_t *e = &L->e[k];
@@ -266,7 +272,7 @@ static int hiwonder_rrc__wrap(const hiwonder_rrc__layout_t *L, uint8_t *out, siz
     v = 0u;
     for (k = 0u; k < L->count; k++) {
         const hiwonder_rrc__element_t *e = &L->e[k];
-        if (L->has_t && k == L->t_first) {
+        if (HIWONDER_RRC__T(L) && k == L->t_first) {
             size_t made;
             if (!hiwonder_rrc__rewrite(L, 1, span, w.pe[L->t_last], out + pos, NULL, cap - pos, &made)) {
                 return HIWONDER_RRC_E_BUFFER;
@@ -319,7 +325,7 @@ static int hiwonder_rrc__wrap(const hiwonder_rrc__layout_t *L, uint8_t *out, siz
     }
     for (k = 0u; k < L->count; k++) {
         const hiwonder_rrc__element_t *e = &L->e[k];
-        if (e->role == HIWONDER_RRC__ROLE_CHECKSUM && !(L->has_t && k >= L->t_first && k <= L->t_last)) {
+        if (e->role == HIWONDER_RRC__ROLE_CHECKSUM && !(HIWONDER_RRC__T(L) && k >= L->t_first && k <= L->t_last)) {
             bytes = hiwonder_rrc__range(L, &w, out, span, e->first, e->last, &sz);
             hiwonder_rrc__put(out + w.ws[k], e->size, e->big, hiwonder_rrc__check(e->check, bytes, sz));
         }
@@ -359,7 +365,7 @@ static int hiwonder_rrc__unwrap(const hiwonder_rrc__layout_t *L, const uint8_t *
         pos -= L->e[k - 1u].size;
         w.ws[k - 1u] = pos;
     }
-    if (L->has_t) {
+    if (HIWONDER_RRC__T(L)) {
         size_t pn, fixed = 0u, p = 0u;
         if (!hiwonder_rrc__rewrite(L, 0, frame + before, n - before - after, plain, NULL, HIWONDER_RRC_MAX_FRAME, &pn)) {
             return HIWONDER_RRC_E_CAPACITY;
@@ -387,7 +393,7 @@ static int hiwonder_rrc__unwrap(const hiwonder_rrc__layout_t *L, const uint8_t *
     }
     for (k = 0u; k < L->count; k++) {
         const hiwonder_rrc__element_t *e = &L->e[k];
-        bytes = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+        bytes = HIWONDER_RRC__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
         if (e->role == HIWONDER_RRC__ROLE_CONSTANT && memcmp(bytes, e->constant, e->size) != 0) {
             return HIWONDER_RRC_E_FRAME;
         }
@@ -395,7 +401,7 @@ static int hiwonder_rrc__unwrap(const hiwonder_rrc__layout_t *L, const uint8_t *
     *code = 0u;
     for (k = 0u; k < L->count; k++) {
         const hiwonder_rrc__element_t *e = &L->e[k];
-        bytes = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+        bytes = HIWONDER_RRC__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
         if (e->role == HIWONDER_RRC__ROLE_COMMAND) {
             *code = hiwonder_rrc__get(bytes, e->size, e->big);
         } else if (e->role == HIWONDER_RRC__ROLE_VALUE) {
@@ -409,7 +415,7 @@ static int hiwonder_rrc__unwrap(const hiwonder_rrc__layout_t *L, const uint8_t *
     for (k = 0u; k < L->count; k++) {
         const hiwonder_rrc__element_t *e = &L->e[k];
         if (e->role == HIWONDER_RRC__ROLE_LENGTH) {
-            bytes = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+            bytes = HIWONDER_RRC__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
             (void)hiwonder_rrc__range(L, &w, frame, body, e->first, e->last, &sz);
             if ((int32_t)hiwonder_rrc__get(bytes, e->size, e->big) != (int32_t)sz + e->adds) {
                 return HIWONDER_RRC_E_LENGTH;
@@ -419,7 +425,7 @@ static int hiwonder_rrc__unwrap(const hiwonder_rrc__layout_t *L, const uint8_t *
     for (k = 0u; k < L->count; k++) {
         const hiwonder_rrc__element_t *e = &L->e[k];
         if (e->role == HIWONDER_RRC__ROLE_CHECKSUM) {
-            const uint8_t *stored = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+            const uint8_t *stored = HIWONDER_RRC__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
             bytes = hiwonder_rrc__range(L, &w, frame, body, e->first, e->last, &sz);
             if (hiwonder_rrc__check(e->check, bytes, sz) != hiwonder_rrc__get(stored, e->size, e->big)) {
                 return HIWONDER_RRC_E_CHECKSUM;
@@ -427,7 +433,7 @@ static int hiwonder_rrc__unwrap(const hiwonder_rrc__layout_t *L, const uint8_t *
         }
     }
     if (L->content >= 0) {
-        int inside = L->has_t && L->content >= (int)L->t_first && L->content <= (int)L->t_last;
+        int inside = HIWONDER_RRC__T(L) && L->content >= (int)L->t_first && L->content <= (int)L->t_last;
         *content = inside ? body + w.ps[L->content] : frame + w.ws[L->content];
         *clen = inside ? w.pe[L->content] - w.ps[L->content] : w.we[L->content] - w.ws[L->content];
     } else {
@@ -486,16 +492,16 @@ static long hiwonder_rrc__probe(const hiwonder_rrc__layout_t *L, hiwonder_rrc_di
         low = 0u; /* the code lies in the stuffed span: no bounds before the frame is unstuffed */
         bounded = 0;
     }
-    if (L->length >= 0) {
+    if (HIWONDER_RRC__LENGTHS || L->length >= 0) {
         const hiwonder_rrc__element_t *e = &L->e[L->length];
         long counted = (long)hiwonder_rrc__get(b + L->length_off, e->size, e->big) - (long)e->adds;
         long content = counted - (long)L->counted;
-        if (content < (long)low || (!L->has_t && bounded && content > (long)high)) {
+        if (content < (long)low || (!HIWONDER_RRC__T(L) && bounded && content > (long)high)) {
             return HIWONDER_RRC__NONE;
         }
         return (long)(L->overhead - L->counted) + counted;
     }
-    if (L->has_t && L->e[L->count - 1u].role == HIWONDER_RRC__ROLE_CONSTANT && L->count > 1u) {
+    if (HIWONDER_RRC__T(L) && L->e[L->count - 1u].role == HIWONDER_RRC__ROLE_CONSTANT && L->count > 1u) {
         const hiwonder_rrc__element_t *t = &L->e[L->count - 1u];
         size_t i;
         for (i = before; i + t->size <= avail; i++) {
@@ -2071,7 +2077,7 @@ int hiwonder_rrc_decode_expect(const uint8_t *frame, size_t len, hiwonder_rrc_di
     if (layouts == NULL) {
         return HIWONDER_RRC_E_ARG;
     }
-    if (count == 1u) {
+    if (HIWONDER_RRC__SINGLE || count == 1u) {
         L = layouts[0];
     } else {
         for (k = 0u; k < count; k++) {
@@ -3329,11 +3335,11 @@ static int hiwonder_rrc__frame(hiwonder_rrc_direction_t dir, uint32_t code, cons
         size_t before = 0u, clen = 0u;
         uint8_t *dst;
         size_t room;
-        uint8_t from = L->has_t ? L->t_first : 0u;
+        uint8_t from = HIWONDER_RRC__T(L) ? L->t_first : 0u;
         for (i = from; (int)i < L->content; i++) {
             before += L->e[i].size;
         }
-        if (L->has_t) {
+        if (HIWONDER_RRC__T(L)) {
             if (before > HIWONDER_RRC_MAX_FRAME) {
                 return HIWONDER_RRC_E_BUFFER;
             }
@@ -4115,11 +4121,56 @@ static int hiwonder_rrc__push(hiwonder_rrc_parser_t *p, uint8_t byte, hiwonder_r
     return got;
 }
 
+#if HIWONDER_RRC__HEADERS
+/* A whole frame at data[0..len) while no byte is held: taken at once, its bytes not pushed one by one, when that gives
+ * what pushing them would (one layout; a plausible frame that fits and decodes; no header inside it, so no other
+ * candidate could end first). Else 0: the bytes go through hiwonder_rrc__push. */
+static size_t hiwonder_rrc__whole(hiwonder_rrc_parser_t *p, const uint8_t *data, size_t len, hiwonder_rrc_msg_t *out)
+{
+    uint8_t count;
+    const hiwonder_rrc__layout_t *const *layouts = hiwonder_rrc__layouts(p->dir, &count);
+    const hiwonder_rrc__layout_t *L;
+    size_t i, size;
+    long s;
+    if (!HIWONDER_RRC__SINGLE && count != 1u) {
+        return 0u;
+    }
+    L = layouts[0];
+    if (len < L->header_len || memcmp(data, L->e[0].constant, L->header_len) != 0) {
+        return 0u;
+    }
+    s = hiwonder_rrc__probe(L, p->dir, data, len);
+    if (s <= 0 || (unsigned long)s > HIWONDER_RRC_MAX_FRAME || (size_t)s > len) {
+        return 0u;
+    }
+    size = (size_t)s;
+    for (i = 1u; i + L->header_len <= size; i++) {
+        if (data[i] == L->e[0].constant[0] && memcmp(data + i, L->e[0].constant, L->header_len) == 0) {
+            return 0u;
+        }
+    }
+    if (hiwonder_rrc_decode(data, size, p->dir, out) != HIWONDER_RRC_OK) {
+        return 0u;
+    }
+    p->frames++;
+    return size;
+}
+#endif
+
 size_t hiwonder_rrc_parser_feed(hiwonder_rrc_parser_t *parser, const uint8_t *data, size_t len, hiwonder_rrc_msg_t *out, bool *got)
 {
     size_t i;
     *got = false;
     for (i = 0u; i < len; i++) {
+#if HIWONDER_RRC__HEADERS
+        if (parser->n == 0u) {
+            size_t size = hiwonder_rrc__whole(parser, data + i, len - i, out);
+            if (size > 0u) {
+                *got = true;
+                return i + size;
+            }
+        }
+#endif
         if (hiwonder_rrc__push(parser, data[i], out)) {
             *got = true;
             return i + 1u;

@@ -469,6 +469,9 @@ def source(ctx: Ctx) -> str:
         for d in directions(protocol)
     )
     any_stuffed = any(stuffed.values())
+    every = [layout for d in directions(protocol) for layout in protocol.framing.alternatives[d]]
+    all_lengths = int(all(layout.length is not None for layout in every))
+    single = int(all(n == 1 for n in n_layouts.values()))
     return f"""{banner(protocol)}
 #include "{p}.h"
 
@@ -488,6 +491,9 @@ typedef char {p}__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define {P}__CLASSIC {classic}
 #define {P}__HEADERS {has_headers} /* every layout starts with a header: candidates start at headers only */
 #define {P}__KEEP {keep}u      /* bytes kept at the end that could begin a header */
+#define {P}__STUFFED {int(any_stuffed)} /* some layout has byte stuffing */
+#define {P}__LENGTHS {all_lengths} /* every layout has a length element */
+#define {P}__SINGLE {single} /* one layout per direction */
 
 /* ---- checksums ---- */
 {check_defs}
@@ -579,7 +585,7 @@ int {p}_decode_expect(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}
     if (layouts == NULL) {{
         return {P}_E_ARG;
     }}
-    if (count == 1u) {{
+    if ({P}__SINGLE || count == 1u) {{
         L = layouts[0];
     }} else {{
         for (k = 0u; k < count; k++) {{
@@ -629,11 +635,11 @@ static int {p}__frame({p}_direction_t dir, uint32_t code, const uint32_t *values
         size_t before = 0u, clen = 0u;
         uint8_t *dst;
         size_t room;
-        uint8_t from = L->has_t ? L->t_first : 0u;
+        uint8_t from = {P}__T(L) ? L->t_first : 0u;
         for (i = from; (int)i < L->content; i++) {{
             before += L->e[i].size;
         }}
-        if (L->has_t) {{
+        if ({P}__T(L)) {{
             if (before > {P}_MAX_FRAME) {{
                 return {P}_E_BUFFER;
             }}
@@ -829,11 +835,56 @@ static int {p}__push({p}_parser_t *p, uint8_t byte, {p}_msg_t *out)
     return got;
 }}
 
+#if {P}__HEADERS
+/* A whole frame at data[0..len) while no byte is held: taken at once, its bytes not pushed one by one, when that gives
+ * what pushing them would (one layout; a plausible frame that fits and decodes; no header inside it, so no other
+ * candidate could end first). Else 0: the bytes go through {p}__push. */
+static size_t {p}__whole({p}_parser_t *p, const uint8_t *data, size_t len, {p}_msg_t *out)
+{{
+    uint8_t count;
+    const {p}__layout_t *const *layouts = {p}__layouts(p->dir, &count);
+    const {p}__layout_t *L;
+    size_t i, size;
+    long s;
+    if (!{P}__SINGLE && count != 1u) {{
+        return 0u;
+    }}
+    L = layouts[0];
+    if (len < L->header_len || memcmp(data, L->e[0].constant, L->header_len) != 0) {{
+        return 0u;
+    }}
+    s = {p}__probe(L, p->dir, data, len);
+    if (s <= 0 || (unsigned long)s > {P}_MAX_FRAME || (size_t)s > len) {{
+        return 0u;
+    }}
+    size = (size_t)s;
+    for (i = 1u; i + L->header_len <= size; i++) {{
+        if (data[i] == L->e[0].constant[0] && memcmp(data + i, L->e[0].constant, L->header_len) == 0) {{
+            return 0u;
+        }}
+    }}
+    if ({p}_decode(data, size, p->dir, out) != {P}_OK) {{
+        return 0u;
+    }}
+    p->frames++;
+    return size;
+}}
+#endif
+
 size_t {p}_parser_feed({p}_parser_t *parser, const uint8_t *data, size_t len, {p}_msg_t *out, bool *got)
 {{
     size_t i;
     *got = false;
     for (i = 0u; i < len; i++) {{
+#if {P}__HEADERS
+        if (parser->n == 0u) {{
+            size_t size = {p}__whole(parser, data + i, len - i, out);
+            if (size > 0u) {{
+                *got = true;
+                return i + size;
+            }}
+        }}
+#endif
         if ({p}__push(parser, data[i], out)) {{
             *got = true;
             return i + 1u;

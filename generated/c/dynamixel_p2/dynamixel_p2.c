@@ -141,6 +141,7 @@ static void dynamixel_p2__put(uint8_t *b, uint8_t size, uint8_t big, uint32_t v)
 }
 #endif
 
+#if DYNAMIXEL_P2_ENABLE_ENCODE || DYNAMIXEL_P2__STUFFED || DYNAMIXEL_P2_ENABLE_PARSER
 /* The elements before the variable part (the stuffed span, else the content) and after it. */
 static uint8_t dynamixel_p2__inner_first(const dynamixel_p2__layout_t *L)
 {
@@ -149,7 +150,9 @@ static uint8_t dynamixel_p2__inner_first(const dynamixel_p2__layout_t *L)
     }
     return L->content >= 0 ? (uint8_t)L->content : L->count;
 }
+#endif
 
+#if DYNAMIXEL_P2_ENABLE_ENCODE || DYNAMIXEL_P2__STUFFED
 static int dynamixel_p2__inner_last(const dynamixel_p2__layout_t *L)
 {
     if (DYNAMIXEL_P2__T(L)) {
@@ -157,7 +160,9 @@ static int dynamixel_p2__inner_last(const dynamixel_p2__layout_t *L)
     }
     return L->content >= 0 ? (int)L->content : (int)L->count - 1;
 }
+#endif
 
+#if DYNAMIXEL_P2_ENABLE_ENCODE || DYNAMIXEL_P2__STUFFED
 /* Each plain sequence rewritten as its wire sequence (to_wire) or back, leftmost first, the pairs tried in order at
  * each position. With cmp: compare the result with cmp[0..cap) instead of writing it (1: equal). */
 static int dynamixel_p2__rewrite(const dynamixel_p2__layout_t *L, int to_wire, const uint8_t *src, size_t n, uint8_t *dst,
@@ -207,7 +212,9 @@ static int dynamixel_p2__rewrite(const dynamixel_p2__layout_t *L, int to_wire, c
     *out = o;
     return cmp == NULL || o == cap;
 }
+#endif
 
+#if DYNAMIXEL_P2_ENABLE_ENCODE || DYNAMIXEL_P2__STUFFED
 /* The bytes of elements a..b: the plain bytes when they lie inside the stuffed span, else the wire bytes. */
 static const uint8_t *dynamixel_p2__range(const dynamixel_p2__layout_t *L, const dynamixel_p2__where_t *w, const uint8_t *wire,
                                  const uint8_t *plain, uint8_t a, uint8_t b, size_t *n)
@@ -219,6 +226,7 @@ static const uint8_t *dynamixel_p2__range(const dynamixel_p2__layout_t *L, const
     *n = w->we[b] - w->ws[a];
     return wire + w->ws[a];
 }
+#endif
 
 #if DYNAMIXEL_P2_ENABLE_ENCODE
 /* The frame around a content already in place (at out + prefix, or in span + its offset when stuffed): the frame
@@ -335,7 +343,7 @@ static int dynamixel_p2__wrap(const dynamixel_p2__layout_t *L, uint8_t *out, siz
 }
 #endif
 
-#if DYNAMIXEL_P2_ENABLE_DECODE
+#if DYNAMIXEL_P2_ENABLE_DECODE && DYNAMIXEL_P2__STUFFED
 /* Check a complete frame (constants, values, lengths, stuffing, checksums) and take it apart: the frame engine's
  * unwrap (runtime/framing.py Layout.unwrap). plain: room for the unstuffed span. */
 static int dynamixel_p2__unwrap(const dynamixel_p2__layout_t *L, const uint8_t *frame, size_t n, uint8_t *plain, uint32_t *code,
@@ -665,6 +673,26 @@ static int dynamixel_p2__bounds(dynamixel_p2_direction_t dir, long code, size_t 
 #endif
 
 #if DYNAMIXEL_P2_ENABLE_DECODE
+/* ---- frames taken apart: straight line where a layout has no byte stuffing ---- */
+
+static int dynamixel_p2__unwrap_at(dynamixel_p2_direction_t dir, uint8_t k, const dynamixel_p2__layout_t *L, const uint8_t *frame, size_t n,
+                          uint8_t *plain, uint32_t *code, uint32_t *values, const uint8_t **content, size_t *clen)
+{
+    (void)k;
+    (void)L;
+    (void)plain;
+    switch (dir) {
+
+    default:
+        break;
+    }
+#if DYNAMIXEL_P2__STUFFED
+    return dynamixel_p2__unwrap(L, frame, n, plain, code, values, content, clen);
+#else
+    return DYNAMIXEL_P2_E_ARG;
+#endif
+}
+
 /* ---- content decoders ---- */
 /* The content of ping (request): fields in wire order. */
 static int dynamixel_p2__dec_ping_request(const uint8_t *c, size_t n, dynamixel_p2_ping_request_t *m)
@@ -1074,7 +1102,7 @@ int dynamixel_p2_decode_expect(const uint8_t *frame, size_t len, dynamixel_p2_di
     uint8_t count, k;
     const dynamixel_p2__layout_t *const *layouts;
     const dynamixel_p2__layout_t *L = NULL;
-    uint32_t code = 0u, values[DYNAMIXEL_P2__MAX_ELEMENTS];
+    uint32_t code = 0u, values[DYNAMIXEL_P2__MAX_ELEMENTS] = {0u};
     const uint8_t *c = NULL;
     size_t clen = 0u;
     int r;
@@ -1087,6 +1115,7 @@ int dynamixel_p2_decode_expect(const uint8_t *frame, size_t len, dynamixel_p2_di
     if (layouts == NULL) {
         return DYNAMIXEL_P2_E_ARG;
     }
+    k = 0u;
     if (DYNAMIXEL_P2__SINGLE || count == 1u) {
         L = layouts[0];
     } else {
@@ -1101,7 +1130,7 @@ int dynamixel_p2_decode_expect(const uint8_t *frame, size_t len, dynamixel_p2_di
             return DYNAMIXEL_P2_E_FRAME;
         }
     }
-    r = dynamixel_p2__unwrap(L, frame, len, plain, &code, values, &c, &clen);
+    r = dynamixel_p2__unwrap_at(dir, k, L, frame, len, plain, &code, values, &c, &clen);
     if (r != DYNAMIXEL_P2_OK) {
         return r;
     }

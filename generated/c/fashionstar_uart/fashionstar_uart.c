@@ -137,6 +137,7 @@ static void fashionstar_uart__put(uint8_t *b, uint8_t size, uint8_t big, uint32_
 }
 #endif
 
+#if FASHIONSTAR_UART_ENABLE_ENCODE || FASHIONSTAR_UART__STUFFED || FASHIONSTAR_UART_ENABLE_PARSER
 /* The elements before the variable part (the stuffed span, else the content) and after it. */
 static uint8_t fashionstar_uart__inner_first(const fashionstar_uart__layout_t *L)
 {
@@ -145,7 +146,9 @@ static uint8_t fashionstar_uart__inner_first(const fashionstar_uart__layout_t *L
     }
     return L->content >= 0 ? (uint8_t)L->content : L->count;
 }
+#endif
 
+#if FASHIONSTAR_UART_ENABLE_ENCODE || FASHIONSTAR_UART__STUFFED
 static int fashionstar_uart__inner_last(const fashionstar_uart__layout_t *L)
 {
     if (FASHIONSTAR_UART__T(L)) {
@@ -153,7 +156,9 @@ static int fashionstar_uart__inner_last(const fashionstar_uart__layout_t *L)
     }
     return L->content >= 0 ? (int)L->content : (int)L->count - 1;
 }
+#endif
 
+#if FASHIONSTAR_UART_ENABLE_ENCODE || FASHIONSTAR_UART__STUFFED
 /* Each plain sequence rewritten as its wire sequence (to_wire) or back, leftmost first, the pairs tried in order at
  * each position. With cmp: compare the result with cmp[0..cap) instead of writing it (1: equal). */
 static int fashionstar_uart__rewrite(const fashionstar_uart__layout_t *L, int to_wire, const uint8_t *src, size_t n, uint8_t *dst,
@@ -203,7 +208,9 @@ static int fashionstar_uart__rewrite(const fashionstar_uart__layout_t *L, int to
     *out = o;
     return cmp == NULL || o == cap;
 }
+#endif
 
+#if FASHIONSTAR_UART_ENABLE_ENCODE || FASHIONSTAR_UART__STUFFED
 /* The bytes of elements a..b: the plain bytes when they lie inside the stuffed span, else the wire bytes. */
 static const uint8_t *fashionstar_uart__range(const fashionstar_uart__layout_t *L, const fashionstar_uart__where_t *w, const uint8_t *wire,
                                  const uint8_t *plain, uint8_t a, uint8_t b, size_t *n)
@@ -215,6 +222,7 @@ static const uint8_t *fashionstar_uart__range(const fashionstar_uart__layout_t *
     *n = w->we[b] - w->ws[a];
     return wire + w->ws[a];
 }
+#endif
 
 #if FASHIONSTAR_UART_ENABLE_ENCODE
 /* The frame around a content already in place (at out + prefix, or in span + its offset when stuffed): the frame
@@ -331,7 +339,7 @@ static int fashionstar_uart__wrap(const fashionstar_uart__layout_t *L, uint8_t *
 }
 #endif
 
-#if FASHIONSTAR_UART_ENABLE_DECODE
+#if FASHIONSTAR_UART_ENABLE_DECODE && FASHIONSTAR_UART__STUFFED
 /* Check a complete frame (constants, values, lengths, stuffing, checksums) and take it apart: the frame engine's
  * unwrap (runtime/framing.py Layout.unwrap). plain: room for the unstuffed span. */
 static int fashionstar_uart__unwrap(const fashionstar_uart__layout_t *L, const uint8_t *frame, size_t n, uint8_t *plain, uint32_t *code,
@@ -780,6 +788,78 @@ static int fashionstar_uart__bounds(fashionstar_uart_direction_t dir, long code,
 #endif
 
 #if FASHIONSTAR_UART_ENABLE_DECODE
+/* ---- frames taken apart: straight line where a layout has no byte stuffing ---- */
+/* The request frame: unwrap, straight line. */
+static int fashionstar_uart__unwrap_request_0(const uint8_t *f, size_t n, uint32_t *code, uint32_t *values,
+                                 const uint8_t **content, size_t *clen)
+{
+    (void)values;
+    *code = 0u;
+    if (n < 5u) {
+        return FASHIONSTAR_UART_E_LENGTH;
+    }
+    if (f[0u] != 0x12u) { return FASHIONSTAR_UART_E_FRAME; } /* header */
+    if (f[1u] != 0x4cu) { return FASHIONSTAR_UART_E_FRAME; } /* header */
+    *code = (uint32_t)f[2u]; /* cmd_id */
+    if ((int32_t)((uint32_t)f[3u]) != (int32_t)(n - 5u) + 0) { return FASHIONSTAR_UART_E_LENGTH; } /* length */
+    if (fashionstar_uart__check(0u, f + 0u, (n - 1u)) != ((uint32_t)f[n - 1u])) { return FASHIONSTAR_UART_E_CHECKSUM; } /* checksum */
+    *content = f + 4u;
+    *clen = n - 5u;
+    return FASHIONSTAR_UART_OK;
+}
+
+/* The response frame: unwrap, straight line. */
+static int fashionstar_uart__unwrap_response_0(const uint8_t *f, size_t n, uint32_t *code, uint32_t *values,
+                                 const uint8_t **content, size_t *clen)
+{
+    (void)values;
+    *code = 0u;
+    if (n < 5u) {
+        return FASHIONSTAR_UART_E_LENGTH;
+    }
+    if (f[0u] != 0x05u) { return FASHIONSTAR_UART_E_FRAME; } /* header */
+    if (f[1u] != 0x1cu) { return FASHIONSTAR_UART_E_FRAME; } /* header */
+    *code = (uint32_t)f[2u]; /* cmd_id */
+    if ((int32_t)((uint32_t)f[3u]) != (int32_t)(n - 5u) + 0) { return FASHIONSTAR_UART_E_LENGTH; } /* length */
+    if (fashionstar_uart__check(0u, f + 0u, (n - 1u)) != ((uint32_t)f[n - 1u])) { return FASHIONSTAR_UART_E_CHECKSUM; } /* checksum */
+    *content = f + 4u;
+    *clen = n - 5u;
+    return FASHIONSTAR_UART_OK;
+}
+
+static int fashionstar_uart__unwrap_at(fashionstar_uart_direction_t dir, uint8_t k, const fashionstar_uart__layout_t *L, const uint8_t *frame, size_t n,
+                          uint8_t *plain, uint32_t *code, uint32_t *values, const uint8_t **content, size_t *clen)
+{
+    (void)k;
+    (void)L;
+    (void)plain;
+    switch (dir) {
+    case FASHIONSTAR_UART_REQUEST:
+        switch (k) {
+        case 0u:
+            return fashionstar_uart__unwrap_request_0(frame, n, code, values, content, clen);
+        default:
+            break;
+        }
+        break;
+    case FASHIONSTAR_UART_RESPONSE:
+        switch (k) {
+        case 0u:
+            return fashionstar_uart__unwrap_response_0(frame, n, code, values, content, clen);
+        default:
+            break;
+        }
+        break;
+    default:
+        break;
+    }
+#if FASHIONSTAR_UART__STUFFED
+    return fashionstar_uart__unwrap(L, frame, n, plain, code, values, content, clen);
+#else
+    return FASHIONSTAR_UART_E_ARG;
+#endif
+}
+
 /* ---- content decoders ---- */
 /* The content of ping (request): fields in wire order. */
 static int fashionstar_uart__dec_ping_request(const uint8_t *c, size_t n, fashionstar_uart_ping_request_t *m)
@@ -2150,7 +2230,7 @@ int fashionstar_uart_decode_expect(const uint8_t *frame, size_t len, fashionstar
     uint8_t count, k;
     const fashionstar_uart__layout_t *const *layouts;
     const fashionstar_uart__layout_t *L = NULL;
-    uint32_t code = 0u, values[FASHIONSTAR_UART__MAX_ELEMENTS];
+    uint32_t code = 0u, values[FASHIONSTAR_UART__MAX_ELEMENTS] = {0u};
     const uint8_t *c = NULL;
     size_t clen = 0u;
     int r;
@@ -2163,6 +2243,7 @@ int fashionstar_uart_decode_expect(const uint8_t *frame, size_t len, fashionstar
     if (layouts == NULL) {
         return FASHIONSTAR_UART_E_ARG;
     }
+    k = 0u;
     if (FASHIONSTAR_UART__SINGLE || count == 1u) {
         L = layouts[0];
     } else {
@@ -2177,7 +2258,7 @@ int fashionstar_uart_decode_expect(const uint8_t *frame, size_t len, fashionstar
             return FASHIONSTAR_UART_E_FRAME;
         }
     }
-    r = fashionstar_uart__unwrap(L, frame, len, plain, &code, values, &c, &clen);
+    r = fashionstar_uart__unwrap_at(dir, k, L, frame, len, plain, &code, values, &c, &clen);
     if (r != FASHIONSTAR_UART_OK) {
         return r;
     }

@@ -137,6 +137,7 @@ static void feetech_sms__put(uint8_t *b, uint8_t size, uint8_t big, uint32_t v)
 }
 #endif
 
+#if FEETECH_SMS_ENABLE_ENCODE || FEETECH_SMS__STUFFED || FEETECH_SMS_ENABLE_PARSER
 /* The elements before the variable part (the stuffed span, else the content) and after it. */
 static uint8_t feetech_sms__inner_first(const feetech_sms__layout_t *L)
 {
@@ -145,7 +146,9 @@ static uint8_t feetech_sms__inner_first(const feetech_sms__layout_t *L)
     }
     return L->content >= 0 ? (uint8_t)L->content : L->count;
 }
+#endif
 
+#if FEETECH_SMS_ENABLE_ENCODE || FEETECH_SMS__STUFFED
 static int feetech_sms__inner_last(const feetech_sms__layout_t *L)
 {
     if (FEETECH_SMS__T(L)) {
@@ -153,7 +156,9 @@ static int feetech_sms__inner_last(const feetech_sms__layout_t *L)
     }
     return L->content >= 0 ? (int)L->content : (int)L->count - 1;
 }
+#endif
 
+#if FEETECH_SMS_ENABLE_ENCODE || FEETECH_SMS__STUFFED
 /* Each plain sequence rewritten as its wire sequence (to_wire) or back, leftmost first, the pairs tried in order at
  * each position. With cmp: compare the result with cmp[0..cap) instead of writing it (1: equal). */
 static int feetech_sms__rewrite(const feetech_sms__layout_t *L, int to_wire, const uint8_t *src, size_t n, uint8_t *dst,
@@ -203,7 +208,9 @@ static int feetech_sms__rewrite(const feetech_sms__layout_t *L, int to_wire, con
     *out = o;
     return cmp == NULL || o == cap;
 }
+#endif
 
+#if FEETECH_SMS_ENABLE_ENCODE || FEETECH_SMS__STUFFED
 /* The bytes of elements a..b: the plain bytes when they lie inside the stuffed span, else the wire bytes. */
 static const uint8_t *feetech_sms__range(const feetech_sms__layout_t *L, const feetech_sms__where_t *w, const uint8_t *wire,
                                  const uint8_t *plain, uint8_t a, uint8_t b, size_t *n)
@@ -215,6 +222,7 @@ static const uint8_t *feetech_sms__range(const feetech_sms__layout_t *L, const f
     *n = w->we[b] - w->ws[a];
     return wire + w->ws[a];
 }
+#endif
 
 #if FEETECH_SMS_ENABLE_ENCODE
 /* The frame around a content already in place (at out + prefix, or in span + its offset when stuffed): the frame
@@ -331,7 +339,7 @@ static int feetech_sms__wrap(const feetech_sms__layout_t *L, uint8_t *out, size_
 }
 #endif
 
-#if FEETECH_SMS_ENABLE_DECODE
+#if FEETECH_SMS_ENABLE_DECODE && FEETECH_SMS__STUFFED
 /* Check a complete frame (constants, values, lengths, stuffing, checksums) and take it apart: the frame engine's
  * unwrap (runtime/framing.py Layout.unwrap). plain: room for the unstuffed span. */
 static int feetech_sms__unwrap(const feetech_sms__layout_t *L, const uint8_t *frame, size_t n, uint8_t *plain, uint32_t *code,
@@ -632,6 +640,82 @@ static int feetech_sms__bounds(feetech_sms_direction_t dir, long code, size_t *l
 #endif
 
 #if FEETECH_SMS_ENABLE_DECODE
+/* ---- frames taken apart: straight line where a layout has no byte stuffing ---- */
+/* The request frame: unwrap, straight line. */
+static int feetech_sms__unwrap_request_0(const uint8_t *f, size_t n, uint32_t *code, uint32_t *values,
+                                 const uint8_t **content, size_t *clen)
+{
+    (void)values;
+    *code = 0u;
+    if (n < 6u) {
+        return FEETECH_SMS_E_LENGTH;
+    }
+    if (f[0u] != 0xffu) { return FEETECH_SMS_E_FRAME; } /* header */
+    if (f[1u] != 0xffu) { return FEETECH_SMS_E_FRAME; } /* header */
+    values[0] = (uint32_t)f[2u]; /* id */
+    if ((values[0] > 253u) && values[0] != 254u) { return FEETECH_SMS_E_RANGE; }
+    *code = (uint32_t)f[4u]; /* instruction */
+    if ((int32_t)((uint32_t)f[3u]) != (int32_t)(n - 6u) + 2) { return FEETECH_SMS_E_LENGTH; } /* length */
+    if (feetech_sms__check(0u, f + 2u, (n - 3u)) != ((uint32_t)f[n - 1u])) { return FEETECH_SMS_E_CHECKSUM; } /* checksum */
+    *content = f + 5u;
+    *clen = n - 6u;
+    return FEETECH_SMS_OK;
+}
+
+/* The response frame: unwrap, straight line. */
+static int feetech_sms__unwrap_response_0(const uint8_t *f, size_t n, uint32_t *code, uint32_t *values,
+                                 const uint8_t **content, size_t *clen)
+{
+    (void)values;
+    *code = 0u;
+    if (n < 6u) {
+        return FEETECH_SMS_E_LENGTH;
+    }
+    if (f[0u] != 0xffu) { return FEETECH_SMS_E_FRAME; } /* header */
+    if (f[1u] != 0xffu) { return FEETECH_SMS_E_FRAME; } /* header */
+    values[0] = (uint32_t)f[2u]; /* id */
+    if ((values[0] > 253u) && values[0] != 254u) { return FEETECH_SMS_E_RANGE; }
+    values[1] = (uint32_t)f[4u]; /* error */
+    if ((int32_t)((uint32_t)f[3u]) != (int32_t)(n - 6u) + 2) { return FEETECH_SMS_E_LENGTH; } /* length */
+    if (feetech_sms__check(0u, f + 2u, (n - 3u)) != ((uint32_t)f[n - 1u])) { return FEETECH_SMS_E_CHECKSUM; } /* checksum */
+    *content = f + 5u;
+    *clen = n - 6u;
+    return FEETECH_SMS_OK;
+}
+
+static int feetech_sms__unwrap_at(feetech_sms_direction_t dir, uint8_t k, const feetech_sms__layout_t *L, const uint8_t *frame, size_t n,
+                          uint8_t *plain, uint32_t *code, uint32_t *values, const uint8_t **content, size_t *clen)
+{
+    (void)k;
+    (void)L;
+    (void)plain;
+    switch (dir) {
+    case FEETECH_SMS_REQUEST:
+        switch (k) {
+        case 0u:
+            return feetech_sms__unwrap_request_0(frame, n, code, values, content, clen);
+        default:
+            break;
+        }
+        break;
+    case FEETECH_SMS_RESPONSE:
+        switch (k) {
+        case 0u:
+            return feetech_sms__unwrap_response_0(frame, n, code, values, content, clen);
+        default:
+            break;
+        }
+        break;
+    default:
+        break;
+    }
+#if FEETECH_SMS__STUFFED
+    return feetech_sms__unwrap(L, frame, n, plain, code, values, content, clen);
+#else
+    return FEETECH_SMS_E_ARG;
+#endif
+}
+
 /* ---- content decoders ---- */
 /* The content of ping (request): fields in wire order. */
 static int feetech_sms__dec_ping_request(const uint8_t *c, size_t n, feetech_sms_ping_request_t *m)
@@ -871,7 +955,7 @@ int feetech_sms_decode_expect(const uint8_t *frame, size_t len, feetech_sms_dire
     uint8_t count, k;
     const feetech_sms__layout_t *const *layouts;
     const feetech_sms__layout_t *L = NULL;
-    uint32_t code = 0u, values[FEETECH_SMS__MAX_ELEMENTS];
+    uint32_t code = 0u, values[FEETECH_SMS__MAX_ELEMENTS] = {0u};
     const uint8_t *c = NULL;
     size_t clen = 0u;
     int r;
@@ -884,6 +968,7 @@ int feetech_sms_decode_expect(const uint8_t *frame, size_t len, feetech_sms_dire
     if (layouts == NULL) {
         return FEETECH_SMS_E_ARG;
     }
+    k = 0u;
     if (FEETECH_SMS__SINGLE || count == 1u) {
         L = layouts[0];
     } else {
@@ -898,7 +983,7 @@ int feetech_sms_decode_expect(const uint8_t *frame, size_t len, feetech_sms_dire
             return FEETECH_SMS_E_FRAME;
         }
     }
-    r = feetech_sms__unwrap(L, frame, len, plain, &code, values, &c, &clen);
+    r = feetech_sms__unwrap_at(dir, k, L, frame, len, plain, &code, values, &c, &clen);
     if (r != FEETECH_SMS_OK) {
         return r;
     }

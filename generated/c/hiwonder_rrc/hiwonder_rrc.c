@@ -141,6 +141,7 @@ static void hiwonder_rrc__put(uint8_t *b, uint8_t size, uint8_t big, uint32_t v)
 }
 #endif
 
+#if HIWONDER_RRC_ENABLE_ENCODE || HIWONDER_RRC__STUFFED || HIWONDER_RRC_ENABLE_PARSER
 /* The elements before the variable part (the stuffed span, else the content) and after it. */
 static uint8_t hiwonder_rrc__inner_first(const hiwonder_rrc__layout_t *L)
 {
@@ -149,7 +150,9 @@ static uint8_t hiwonder_rrc__inner_first(const hiwonder_rrc__layout_t *L)
     }
     return L->content >= 0 ? (uint8_t)L->content : L->count;
 }
+#endif
 
+#if HIWONDER_RRC_ENABLE_ENCODE || HIWONDER_RRC__STUFFED
 static int hiwonder_rrc__inner_last(const hiwonder_rrc__layout_t *L)
 {
     if (HIWONDER_RRC__T(L)) {
@@ -157,7 +160,9 @@ static int hiwonder_rrc__inner_last(const hiwonder_rrc__layout_t *L)
     }
     return L->content >= 0 ? (int)L->content : (int)L->count - 1;
 }
+#endif
 
+#if HIWONDER_RRC_ENABLE_ENCODE || HIWONDER_RRC__STUFFED
 /* Each plain sequence rewritten as its wire sequence (to_wire) or back, leftmost first, the pairs tried in order at
  * each position. With cmp: compare the result with cmp[0..cap) instead of writing it (1: equal). */
 static int hiwonder_rrc__rewrite(const hiwonder_rrc__layout_t *L, int to_wire, const uint8_t *src, size_t n, uint8_t *dst,
@@ -207,7 +212,9 @@ static int hiwonder_rrc__rewrite(const hiwonder_rrc__layout_t *L, int to_wire, c
     *out = o;
     return cmp == NULL || o == cap;
 }
+#endif
 
+#if HIWONDER_RRC_ENABLE_ENCODE || HIWONDER_RRC__STUFFED
 /* The bytes of elements a..b: the plain bytes when they lie inside the stuffed span, else the wire bytes. */
 static const uint8_t *hiwonder_rrc__range(const hiwonder_rrc__layout_t *L, const hiwonder_rrc__where_t *w, const uint8_t *wire,
                                  const uint8_t *plain, uint8_t a, uint8_t b, size_t *n)
@@ -219,6 +226,7 @@ static const uint8_t *hiwonder_rrc__range(const hiwonder_rrc__layout_t *L, const
     *n = w->we[b] - w->ws[a];
     return wire + w->ws[a];
 }
+#endif
 
 #if HIWONDER_RRC_ENABLE_ENCODE
 /* The frame around a content already in place (at out + prefix, or in span + its offset when stuffed): the frame
@@ -335,7 +343,7 @@ static int hiwonder_rrc__wrap(const hiwonder_rrc__layout_t *L, uint8_t *out, siz
 }
 #endif
 
-#if HIWONDER_RRC_ENABLE_DECODE
+#if HIWONDER_RRC_ENABLE_DECODE && HIWONDER_RRC__STUFFED
 /* Check a complete frame (constants, values, lengths, stuffing, checksums) and take it apart: the frame engine's
  * unwrap (runtime/framing.py Layout.unwrap). plain: room for the unstuffed span. */
 static int hiwonder_rrc__unwrap(const hiwonder_rrc__layout_t *L, const uint8_t *frame, size_t n, uint8_t *plain, uint32_t *code,
@@ -696,6 +704,78 @@ static int hiwonder_rrc__bounds(hiwonder_rrc_direction_t dir, long code, size_t 
 #endif
 
 #if HIWONDER_RRC_ENABLE_DECODE
+/* ---- frames taken apart: straight line where a layout has no byte stuffing ---- */
+/* The request frame: unwrap, straight line. */
+static int hiwonder_rrc__unwrap_request_0(const uint8_t *f, size_t n, uint32_t *code, uint32_t *values,
+                                 const uint8_t **content, size_t *clen)
+{
+    (void)values;
+    *code = 0u;
+    if (n < 5u) {
+        return HIWONDER_RRC_E_LENGTH;
+    }
+    if (f[0u] != 0xaau) { return HIWONDER_RRC_E_FRAME; } /* header */
+    if (f[1u] != 0x55u) { return HIWONDER_RRC_E_FRAME; } /* header */
+    *code = (uint32_t)f[2u]; /* function */
+    if ((int32_t)((uint32_t)f[3u]) != (int32_t)(n - 5u) + 0) { return HIWONDER_RRC_E_LENGTH; } /* length */
+    if (hiwonder_rrc__check(0u, f + 2u, (n - 3u)) != ((uint32_t)f[n - 1u])) { return HIWONDER_RRC_E_CHECKSUM; } /* crc */
+    *content = f + 4u;
+    *clen = n - 5u;
+    return HIWONDER_RRC_OK;
+}
+
+/* The response frame: unwrap, straight line. */
+static int hiwonder_rrc__unwrap_response_0(const uint8_t *f, size_t n, uint32_t *code, uint32_t *values,
+                                 const uint8_t **content, size_t *clen)
+{
+    (void)values;
+    *code = 0u;
+    if (n < 5u) {
+        return HIWONDER_RRC_E_LENGTH;
+    }
+    if (f[0u] != 0xaau) { return HIWONDER_RRC_E_FRAME; } /* header */
+    if (f[1u] != 0x55u) { return HIWONDER_RRC_E_FRAME; } /* header */
+    *code = (uint32_t)f[2u]; /* function */
+    if ((int32_t)((uint32_t)f[3u]) != (int32_t)(n - 5u) + 0) { return HIWONDER_RRC_E_LENGTH; } /* length */
+    if (hiwonder_rrc__check(0u, f + 2u, (n - 3u)) != ((uint32_t)f[n - 1u])) { return HIWONDER_RRC_E_CHECKSUM; } /* crc */
+    *content = f + 4u;
+    *clen = n - 5u;
+    return HIWONDER_RRC_OK;
+}
+
+static int hiwonder_rrc__unwrap_at(hiwonder_rrc_direction_t dir, uint8_t k, const hiwonder_rrc__layout_t *L, const uint8_t *frame, size_t n,
+                          uint8_t *plain, uint32_t *code, uint32_t *values, const uint8_t **content, size_t *clen)
+{
+    (void)k;
+    (void)L;
+    (void)plain;
+    switch (dir) {
+    case HIWONDER_RRC_REQUEST:
+        switch (k) {
+        case 0u:
+            return hiwonder_rrc__unwrap_request_0(frame, n, code, values, content, clen);
+        default:
+            break;
+        }
+        break;
+    case HIWONDER_RRC_RESPONSE:
+        switch (k) {
+        case 0u:
+            return hiwonder_rrc__unwrap_response_0(frame, n, code, values, content, clen);
+        default:
+            break;
+        }
+        break;
+    default:
+        break;
+    }
+#if HIWONDER_RRC__STUFFED
+    return hiwonder_rrc__unwrap(L, frame, n, plain, code, values, content, clen);
+#else
+    return HIWONDER_RRC_E_ARG;
+#endif
+}
+
 /* ---- content decoders ---- */
 /* The content of led (request): fields in wire order. */
 static int hiwonder_rrc__dec_led_request(const uint8_t *c, size_t n, hiwonder_rrc_led_request_t *m)
@@ -2064,7 +2144,7 @@ int hiwonder_rrc_decode_expect(const uint8_t *frame, size_t len, hiwonder_rrc_di
     uint8_t count, k;
     const hiwonder_rrc__layout_t *const *layouts;
     const hiwonder_rrc__layout_t *L = NULL;
-    uint32_t code = 0u, values[HIWONDER_RRC__MAX_ELEMENTS];
+    uint32_t code = 0u, values[HIWONDER_RRC__MAX_ELEMENTS] = {0u};
     const uint8_t *c = NULL;
     size_t clen = 0u;
     int r;
@@ -2077,6 +2157,7 @@ int hiwonder_rrc_decode_expect(const uint8_t *frame, size_t len, hiwonder_rrc_di
     if (layouts == NULL) {
         return HIWONDER_RRC_E_ARG;
     }
+    k = 0u;
     if (HIWONDER_RRC__SINGLE || count == 1u) {
         L = layouts[0];
     } else {
@@ -2091,7 +2172,7 @@ int hiwonder_rrc_decode_expect(const uint8_t *frame, size_t len, hiwonder_rrc_di
             return HIWONDER_RRC_E_FRAME;
         }
     }
-    r = hiwonder_rrc__unwrap(L, frame, len, plain, &code, values, &c, &clen);
+    r = hiwonder_rrc__unwrap_at(dir, k, L, frame, len, plain, &code, values, &c, &clen);
     if (r != HIWONDER_RRC_OK) {
         return r;
     }

@@ -141,6 +141,7 @@ static void modbus_rtu__put(uint8_t *b, uint8_t size, uint8_t big, uint32_t v)
 }
 #endif
 
+#if MODBUS_RTU_ENABLE_ENCODE || MODBUS_RTU__STUFFED || MODBUS_RTU_ENABLE_PARSER
 /* The elements before the variable part (the stuffed span, else the content) and after it. */
 static uint8_t modbus_rtu__inner_first(const modbus_rtu__layout_t *L)
 {
@@ -149,7 +150,9 @@ static uint8_t modbus_rtu__inner_first(const modbus_rtu__layout_t *L)
     }
     return L->content >= 0 ? (uint8_t)L->content : L->count;
 }
+#endif
 
+#if MODBUS_RTU_ENABLE_ENCODE || MODBUS_RTU__STUFFED
 static int modbus_rtu__inner_last(const modbus_rtu__layout_t *L)
 {
     if (MODBUS_RTU__T(L)) {
@@ -157,7 +160,9 @@ static int modbus_rtu__inner_last(const modbus_rtu__layout_t *L)
     }
     return L->content >= 0 ? (int)L->content : (int)L->count - 1;
 }
+#endif
 
+#if MODBUS_RTU_ENABLE_ENCODE || MODBUS_RTU__STUFFED
 /* Each plain sequence rewritten as its wire sequence (to_wire) or back, leftmost first, the pairs tried in order at
  * each position. With cmp: compare the result with cmp[0..cap) instead of writing it (1: equal). */
 static int modbus_rtu__rewrite(const modbus_rtu__layout_t *L, int to_wire, const uint8_t *src, size_t n, uint8_t *dst,
@@ -207,7 +212,9 @@ static int modbus_rtu__rewrite(const modbus_rtu__layout_t *L, int to_wire, const
     *out = o;
     return cmp == NULL || o == cap;
 }
+#endif
 
+#if MODBUS_RTU_ENABLE_ENCODE || MODBUS_RTU__STUFFED
 /* The bytes of elements a..b: the plain bytes when they lie inside the stuffed span, else the wire bytes. */
 static const uint8_t *modbus_rtu__range(const modbus_rtu__layout_t *L, const modbus_rtu__where_t *w, const uint8_t *wire,
                                  const uint8_t *plain, uint8_t a, uint8_t b, size_t *n)
@@ -219,6 +226,7 @@ static const uint8_t *modbus_rtu__range(const modbus_rtu__layout_t *L, const mod
     *n = w->we[b] - w->ws[a];
     return wire + w->ws[a];
 }
+#endif
 
 #if MODBUS_RTU_ENABLE_ENCODE
 /* The frame around a content already in place (at out + prefix, or in span + its offset when stuffed): the frame
@@ -335,7 +343,7 @@ static int modbus_rtu__wrap(const modbus_rtu__layout_t *L, uint8_t *out, size_t 
 }
 #endif
 
-#if MODBUS_RTU_ENABLE_DECODE
+#if MODBUS_RTU_ENABLE_DECODE && MODBUS_RTU__STUFFED
 /* Check a complete frame (constants, values, lengths, stuffing, checksums) and take it apart: the frame engine's
  * unwrap (runtime/framing.py Layout.unwrap). plain: room for the unstuffed span. */
 static int modbus_rtu__unwrap(const modbus_rtu__layout_t *L, const uint8_t *frame, size_t n, uint8_t *plain, uint32_t *code,
@@ -708,6 +716,76 @@ static int modbus_rtu__bounds(modbus_rtu_direction_t dir, long code, size_t *low
 #endif
 
 #if MODBUS_RTU_ENABLE_DECODE
+/* ---- frames taken apart: straight line where a layout has no byte stuffing ---- */
+/* The request frame: unwrap, straight line. */
+static int modbus_rtu__unwrap_request_0(const uint8_t *f, size_t n, uint32_t *code, uint32_t *values,
+                                 const uint8_t **content, size_t *clen)
+{
+    (void)values;
+    *code = 0u;
+    if (n < 4u) {
+        return MODBUS_RTU_E_LENGTH;
+    }
+    values[0] = (uint32_t)f[0u]; /* unit */
+    if ((values[0] < 1u || values[0] > 247u) && values[0] != 0u) { return MODBUS_RTU_E_RANGE; }
+    *code = (uint32_t)f[1u]; /* function */
+    if (modbus_rtu__check(0u, f + 0u, (n - 2u)) != (((uint32_t)f[n - 1u] << 8u) | (uint32_t)f[n - 2u])) { return MODBUS_RTU_E_CHECKSUM; } /* crc */
+    *content = f + 2u;
+    *clen = n - 4u;
+    return MODBUS_RTU_OK;
+}
+
+/* The response frame: unwrap, straight line. */
+static int modbus_rtu__unwrap_response_0(const uint8_t *f, size_t n, uint32_t *code, uint32_t *values,
+                                 const uint8_t **content, size_t *clen)
+{
+    (void)values;
+    *code = 0u;
+    if (n < 4u) {
+        return MODBUS_RTU_E_LENGTH;
+    }
+    values[0] = (uint32_t)f[0u]; /* unit */
+    if ((values[0] < 1u || values[0] > 247u) && values[0] != 0u) { return MODBUS_RTU_E_RANGE; }
+    *code = (uint32_t)f[1u]; /* function */
+    if (modbus_rtu__check(0u, f + 0u, (n - 2u)) != (((uint32_t)f[n - 1u] << 8u) | (uint32_t)f[n - 2u])) { return MODBUS_RTU_E_CHECKSUM; } /* crc */
+    *content = f + 2u;
+    *clen = n - 4u;
+    return MODBUS_RTU_OK;
+}
+
+static int modbus_rtu__unwrap_at(modbus_rtu_direction_t dir, uint8_t k, const modbus_rtu__layout_t *L, const uint8_t *frame, size_t n,
+                          uint8_t *plain, uint32_t *code, uint32_t *values, const uint8_t **content, size_t *clen)
+{
+    (void)k;
+    (void)L;
+    (void)plain;
+    switch (dir) {
+    case MODBUS_RTU_REQUEST:
+        switch (k) {
+        case 0u:
+            return modbus_rtu__unwrap_request_0(frame, n, code, values, content, clen);
+        default:
+            break;
+        }
+        break;
+    case MODBUS_RTU_RESPONSE:
+        switch (k) {
+        case 0u:
+            return modbus_rtu__unwrap_response_0(frame, n, code, values, content, clen);
+        default:
+            break;
+        }
+        break;
+    default:
+        break;
+    }
+#if MODBUS_RTU__STUFFED
+    return modbus_rtu__unwrap(L, frame, n, plain, code, values, content, clen);
+#else
+    return MODBUS_RTU_E_ARG;
+#endif
+}
+
 /* ---- content decoders ---- */
 /* The content of read_coils (request): fields in wire order. */
 static int modbus_rtu__dec_read_coils_request(const uint8_t *c, size_t n, modbus_rtu_read_coils_request_t *m)
@@ -1305,7 +1383,7 @@ int modbus_rtu_decode_expect(const uint8_t *frame, size_t len, modbus_rtu_direct
     uint8_t count, k;
     const modbus_rtu__layout_t *const *layouts;
     const modbus_rtu__layout_t *L = NULL;
-    uint32_t code = 0u, values[MODBUS_RTU__MAX_ELEMENTS];
+    uint32_t code = 0u, values[MODBUS_RTU__MAX_ELEMENTS] = {0u};
     const uint8_t *c = NULL;
     size_t clen = 0u;
     int r;
@@ -1318,6 +1396,7 @@ int modbus_rtu_decode_expect(const uint8_t *frame, size_t len, modbus_rtu_direct
     if (layouts == NULL) {
         return MODBUS_RTU_E_ARG;
     }
+    k = 0u;
     if (MODBUS_RTU__SINGLE || count == 1u) {
         L = layouts[0];
     } else {
@@ -1332,7 +1411,7 @@ int modbus_rtu_decode_expect(const uint8_t *frame, size_t len, modbus_rtu_direct
             return MODBUS_RTU_E_FRAME;
         }
     }
-    r = modbus_rtu__unwrap(L, frame, len, plain, &code, values, &c, &clen);
+    r = modbus_rtu__unwrap_at(dir, k, L, frame, len, plain, &code, values, &c, &clen);
     if (r != MODBUS_RTU_OK) {
         return r;
     }

@@ -141,6 +141,7 @@ static void vesc__put(uint8_t *b, uint8_t size, uint8_t big, uint32_t v)
 }
 #endif
 
+#if VESC_ENABLE_ENCODE || VESC__STUFFED || VESC_ENABLE_PARSER
 /* The elements before the variable part (the stuffed span, else the content) and after it. */
 static uint8_t vesc__inner_first(const vesc__layout_t *L)
 {
@@ -149,7 +150,9 @@ static uint8_t vesc__inner_first(const vesc__layout_t *L)
     }
     return L->content >= 0 ? (uint8_t)L->content : L->count;
 }
+#endif
 
+#if VESC_ENABLE_ENCODE || VESC__STUFFED
 static int vesc__inner_last(const vesc__layout_t *L)
 {
     if (VESC__T(L)) {
@@ -157,7 +160,9 @@ static int vesc__inner_last(const vesc__layout_t *L)
     }
     return L->content >= 0 ? (int)L->content : (int)L->count - 1;
 }
+#endif
 
+#if VESC_ENABLE_ENCODE || VESC__STUFFED
 /* Each plain sequence rewritten as its wire sequence (to_wire) or back, leftmost first, the pairs tried in order at
  * each position. With cmp: compare the result with cmp[0..cap) instead of writing it (1: equal). */
 static int vesc__rewrite(const vesc__layout_t *L, int to_wire, const uint8_t *src, size_t n, uint8_t *dst,
@@ -207,7 +212,9 @@ static int vesc__rewrite(const vesc__layout_t *L, int to_wire, const uint8_t *sr
     *out = o;
     return cmp == NULL || o == cap;
 }
+#endif
 
+#if VESC_ENABLE_ENCODE || VESC__STUFFED
 /* The bytes of elements a..b: the plain bytes when they lie inside the stuffed span, else the wire bytes. */
 static const uint8_t *vesc__range(const vesc__layout_t *L, const vesc__where_t *w, const uint8_t *wire,
                                  const uint8_t *plain, uint8_t a, uint8_t b, size_t *n)
@@ -219,6 +226,7 @@ static const uint8_t *vesc__range(const vesc__layout_t *L, const vesc__where_t *
     *n = w->we[b] - w->ws[a];
     return wire + w->ws[a];
 }
+#endif
 
 #if VESC_ENABLE_ENCODE
 /* The frame around a content already in place (at out + prefix, or in span + its offset when stuffed): the frame
@@ -335,7 +343,7 @@ static int vesc__wrap(const vesc__layout_t *L, uint8_t *out, size_t cap, uint8_t
 }
 #endif
 
-#if VESC_ENABLE_DECODE
+#if VESC_ENABLE_DECODE && VESC__STUFFED
 /* Check a complete frame (constants, values, lengths, stuffing, checksums) and take it apart: the frame engine's
  * unwrap (runtime/framing.py Layout.unwrap). plain: room for the unstuffed span. */
 static int vesc__unwrap(const vesc__layout_t *L, const uint8_t *frame, size_t n, uint8_t *plain, uint32_t *code,
@@ -754,6 +762,120 @@ static int vesc__bounds(vesc_direction_t dir, long code, size_t *low, size_t *hi
 #endif
 
 #if VESC_ENABLE_DECODE
+/* ---- frames taken apart: straight line where a layout has no byte stuffing ---- */
+/* The request frame short: unwrap, straight line. */
+static int vesc__unwrap_request_0(const uint8_t *f, size_t n, uint32_t *code, uint32_t *values,
+                                 const uint8_t **content, size_t *clen)
+{
+    (void)values;
+    *code = 0u;
+    if (n < 6u) {
+        return VESC_E_LENGTH;
+    }
+    if (f[0u] != 0x02u) { return VESC_E_FRAME; } /* start */
+    if (f[n - 1u] != 0x03u) { return VESC_E_FRAME; } /* end */
+    *code = (uint32_t)f[2u]; /* command */
+    if ((int32_t)((uint32_t)f[1u]) != (int32_t)(n - 5u) + 0) { return VESC_E_LENGTH; } /* length */
+    if (vesc__check(0u, f + 2u, (n - 5u)) != (((uint32_t)f[n - 3u] << 8u) | (uint32_t)f[n - 2u])) { return VESC_E_CHECKSUM; } /* crc */
+    *content = f + 3u;
+    *clen = n - 6u;
+    return VESC_OK;
+}
+
+/* The request frame long: unwrap, straight line. */
+static int vesc__unwrap_request_1(const uint8_t *f, size_t n, uint32_t *code, uint32_t *values,
+                                 const uint8_t **content, size_t *clen)
+{
+    (void)values;
+    *code = 0u;
+    if (n < 7u) {
+        return VESC_E_LENGTH;
+    }
+    if (f[0u] != 0x03u) { return VESC_E_FRAME; } /* start */
+    if (f[n - 1u] != 0x03u) { return VESC_E_FRAME; } /* end */
+    *code = (uint32_t)f[3u]; /* command */
+    if ((int32_t)(((uint32_t)f[1u] << 8u) | (uint32_t)f[2u]) != (int32_t)(n - 6u) + 0) { return VESC_E_LENGTH; } /* length */
+    if (vesc__check(0u, f + 3u, (n - 6u)) != (((uint32_t)f[n - 3u] << 8u) | (uint32_t)f[n - 2u])) { return VESC_E_CHECKSUM; } /* crc */
+    *content = f + 4u;
+    *clen = n - 7u;
+    return VESC_OK;
+}
+
+/* The response frame short: unwrap, straight line. */
+static int vesc__unwrap_response_0(const uint8_t *f, size_t n, uint32_t *code, uint32_t *values,
+                                 const uint8_t **content, size_t *clen)
+{
+    (void)values;
+    *code = 0u;
+    if (n < 6u) {
+        return VESC_E_LENGTH;
+    }
+    if (f[0u] != 0x02u) { return VESC_E_FRAME; } /* start */
+    if (f[n - 1u] != 0x03u) { return VESC_E_FRAME; } /* end */
+    *code = (uint32_t)f[2u]; /* command */
+    if ((int32_t)((uint32_t)f[1u]) != (int32_t)(n - 5u) + 0) { return VESC_E_LENGTH; } /* length */
+    if (vesc__check(0u, f + 2u, (n - 5u)) != (((uint32_t)f[n - 3u] << 8u) | (uint32_t)f[n - 2u])) { return VESC_E_CHECKSUM; } /* crc */
+    *content = f + 3u;
+    *clen = n - 6u;
+    return VESC_OK;
+}
+
+/* The response frame long: unwrap, straight line. */
+static int vesc__unwrap_response_1(const uint8_t *f, size_t n, uint32_t *code, uint32_t *values,
+                                 const uint8_t **content, size_t *clen)
+{
+    (void)values;
+    *code = 0u;
+    if (n < 7u) {
+        return VESC_E_LENGTH;
+    }
+    if (f[0u] != 0x03u) { return VESC_E_FRAME; } /* start */
+    if (f[n - 1u] != 0x03u) { return VESC_E_FRAME; } /* end */
+    *code = (uint32_t)f[3u]; /* command */
+    if ((int32_t)(((uint32_t)f[1u] << 8u) | (uint32_t)f[2u]) != (int32_t)(n - 6u) + 0) { return VESC_E_LENGTH; } /* length */
+    if (vesc__check(0u, f + 3u, (n - 6u)) != (((uint32_t)f[n - 3u] << 8u) | (uint32_t)f[n - 2u])) { return VESC_E_CHECKSUM; } /* crc */
+    *content = f + 4u;
+    *clen = n - 7u;
+    return VESC_OK;
+}
+
+static int vesc__unwrap_at(vesc_direction_t dir, uint8_t k, const vesc__layout_t *L, const uint8_t *frame, size_t n,
+                          uint8_t *plain, uint32_t *code, uint32_t *values, const uint8_t **content, size_t *clen)
+{
+    (void)k;
+    (void)L;
+    (void)plain;
+    switch (dir) {
+    case VESC_REQUEST:
+        switch (k) {
+        case 0u:
+            return vesc__unwrap_request_0(frame, n, code, values, content, clen);
+        case 1u:
+            return vesc__unwrap_request_1(frame, n, code, values, content, clen);
+        default:
+            break;
+        }
+        break;
+    case VESC_RESPONSE:
+        switch (k) {
+        case 0u:
+            return vesc__unwrap_response_0(frame, n, code, values, content, clen);
+        case 1u:
+            return vesc__unwrap_response_1(frame, n, code, values, content, clen);
+        default:
+            break;
+        }
+        break;
+    default:
+        break;
+    }
+#if VESC__STUFFED
+    return vesc__unwrap(L, frame, n, plain, code, values, content, clen);
+#else
+    return VESC_E_ARG;
+#endif
+}
+
 /* ---- content decoders ---- */
 /* The content of fw_version (request): fields in wire order. */
 static int vesc__dec_fw_version_request(const uint8_t *c, size_t n, vesc_fw_version_request_t *m)
@@ -1193,7 +1315,7 @@ int vesc_decode_expect(const uint8_t *frame, size_t len, vesc_direction_t dir, v
     uint8_t count, k;
     const vesc__layout_t *const *layouts;
     const vesc__layout_t *L = NULL;
-    uint32_t code = 0u, values[VESC__MAX_ELEMENTS];
+    uint32_t code = 0u, values[VESC__MAX_ELEMENTS] = {0u};
     const uint8_t *c = NULL;
     size_t clen = 0u;
     int r;
@@ -1206,6 +1328,7 @@ int vesc_decode_expect(const uint8_t *frame, size_t len, vesc_direction_t dir, v
     if (layouts == NULL) {
         return VESC_E_ARG;
     }
+    k = 0u;
     if (VESC__SINGLE || count == 1u) {
         L = layouts[0];
     } else {
@@ -1220,7 +1343,7 @@ int vesc_decode_expect(const uint8_t *frame, size_t len, vesc_direction_t dir, v
             return VESC_E_FRAME;
         }
     }
-    r = vesc__unwrap(L, frame, len, plain, &code, values, &c, &clen);
+    r = vesc__unwrap_at(dir, k, L, frame, len, plain, &code, values, &c, &clen);
     if (r != VESC_OK) {
         return r;
     }

@@ -90,6 +90,7 @@ static void pfx__put(uint8_t *b, uint8_t size, uint8_t big, uint32_t v)
 }
 #endif
 
+#if PFX_ENABLE_ENCODE || PFX__STUFFED || PFX_ENABLE_PARSER
 /* The elements before the variable part (the stuffed span, else the content) and after it. */
 static uint8_t pfx__inner_first(const pfx__layout_t *L)
 {
@@ -98,7 +99,9 @@ static uint8_t pfx__inner_first(const pfx__layout_t *L)
     }
     return L->content >= 0 ? (uint8_t)L->content : L->count;
 }
+#endif
 
+#if PFX_ENABLE_ENCODE || PFX__STUFFED
 static int pfx__inner_last(const pfx__layout_t *L)
 {
     if (PFX__T(L)) {
@@ -106,7 +109,9 @@ static int pfx__inner_last(const pfx__layout_t *L)
     }
     return L->content >= 0 ? (int)L->content : (int)L->count - 1;
 }
+#endif
 
+#if PFX_ENABLE_ENCODE || PFX__STUFFED
 /* Each plain sequence rewritten as its wire sequence (to_wire) or back, leftmost first, the pairs tried in order at
  * each position. With cmp: compare the result with cmp[0..cap) instead of writing it (1: equal). */
 static int pfx__rewrite(const pfx__layout_t *L, int to_wire, const uint8_t *src, size_t n, uint8_t *dst,
@@ -156,7 +161,9 @@ static int pfx__rewrite(const pfx__layout_t *L, int to_wire, const uint8_t *src,
     *out = o;
     return cmp == NULL || o == cap;
 }
+#endif
 
+#if PFX_ENABLE_ENCODE || PFX__STUFFED
 /* The bytes of elements a..b: the plain bytes when they lie inside the stuffed span, else the wire bytes. */
 static const uint8_t *pfx__range(const pfx__layout_t *L, const pfx__where_t *w, const uint8_t *wire,
                                  const uint8_t *plain, uint8_t a, uint8_t b, size_t *n)
@@ -168,6 +175,7 @@ static const uint8_t *pfx__range(const pfx__layout_t *L, const pfx__where_t *w, 
     *n = w->we[b] - w->ws[a];
     return wire + w->ws[a];
 }
+#endif
 
 #if PFX_ENABLE_ENCODE
 /* The frame around a content already in place (at out + prefix, or in span + its offset when stuffed): the frame
@@ -284,7 +292,7 @@ static int pfx__wrap(const pfx__layout_t *L, uint8_t *out, size_t cap, uint8_t *
 }
 #endif
 
-#if PFX_ENABLE_DECODE
+#if PFX_ENABLE_DECODE && PFX__STUFFED
 /* Check a complete frame (constants, values, lengths, stuffing, checksums) and take it apart: the frame engine's
  * unwrap (runtime/framing.py Layout.unwrap). plain: room for the unstuffed span. */
 static int pfx__unwrap(const pfx__layout_t *L, const uint8_t *frame, size_t n, uint8_t *plain, uint32_t *code,

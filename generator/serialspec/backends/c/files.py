@@ -296,6 +296,119 @@ def layout_tables(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) -
     return "\n".join(lines), name
 
 
+def _wire_value(where: tuple[bool, int], size: int, big: bool) -> str:
+    """A frame element's value from its bytes in f (at an offset from the start, or back from the end n), built with
+    shifts (any host byte order)."""
+    from_end, offset = where
+
+    def byte(i: int) -> str:
+        return f"f[n - {offset - i}u]" if from_end else f"f[{offset + i}u]"
+
+    order = list(range(size)) if big else list(range(size - 1, -1, -1))
+    return " | ".join(
+        f"((uint32_t){byte(i)} << {8 * (size - 1 - j)}u)" if j < size - 1 else f"(uint32_t){byte(i)}"
+        for j, i in enumerate(order)
+    )
+
+
+def straight_unwrap(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) -> str:
+    """The frame engine's unwrap (runtime/framing.py Layout.unwrap) for one layout without byte stuffing, straight
+    line: every offset known (from the start before the content, from the end after it), the same checks in the same
+    order (constants, then values and the command, then lengths, then checksums)."""
+    p, P = ctx.p, ctx.P
+    elements = layout.elements
+    names = [e.name for e in elements]
+    sizes = [len(e.constant) if e.role in ("header", "trailer", "constant") else e.size or 0 for e in elements]
+    content = next((i for i, e in enumerate(elements) if e.role == "content"), -1)
+    first = content if content >= 0 else len(elements)
+    last = content if content >= 0 else len(elements) - 1
+    before, after = sum(sizes[:first]), sum(sizes[last + 1 :])
+    # each element's start and end: (from_end, offset): offset from the frame's start, or back from its end
+    start: list[tuple[bool, int]] = []
+    end: list[tuple[bool, int]] = []
+    for i in range(len(elements)):
+        if i < first:
+            start.append((False, sum(sizes[:i])))
+            end.append((False, sum(sizes[: i + 1])))
+        elif i > last:
+            start.append((True, sum(sizes[i:])))
+            end.append((True, sum(sizes[i + 1 :])))
+        else:
+            start.append((False, before))
+            end.append((True, after))
+
+    def at(where: tuple[bool, int]) -> str:
+        from_end, offset = where
+        return f"(n - {offset}u)" if from_end else f"{offset}u"
+
+    def span(a: int, b: int) -> str:
+        (end_a, off_a), (end_b, off_b) = start[a], end[b]
+        if not end_a and not end_b:
+            return f"{off_b - off_a}u"
+        if end_a and end_b:
+            return f"{off_a - off_b}u"
+        return f"(n - {off_b + off_a}u)"
+
+    lines = [
+        f"/* The {direction.value} frame{' ' + layout.name if layout.name else ''}: unwrap, straight line. */",
+        f"static int {p}__unwrap_{direction.value}_{k}(const uint8_t *f, size_t n, uint32_t *code, uint32_t *values,",
+        "                                 const uint8_t **content, size_t *clen)",
+        "{",
+        "    (void)values;",
+        "    *code = 0u;",
+        f"    if (n < {before + after}u) {{",
+        f"        return {P}_E_LENGTH;",
+        "    }",
+    ]
+    for i, e in enumerate(elements):
+        if e.role in ("header", "trailer", "constant"):
+            for j, byte in enumerate(e.constant):
+                index = _wire_value(start[i], j + 1, True).rsplit("(uint32_t)", 1)[1]
+                lines.append(f"    if ({index} != 0x{byte:02x}u) {{ return {P}_E_FRAME; }} /* {e.name} */")
+    v = 0
+    for i, e in enumerate(elements):
+        value = _wire_value(start[i], sizes[i], e.endian == ">")
+        if e.role == "command":
+            lines.append(f"    *code = {value}; /* {e.name} */")
+        elif e.role in ("address", "status"):
+            assert e.type is not None
+            test = []
+            if int(e.minimum) > 0:
+                test.append(f"values[{v}] < {int(e.minimum)}u")
+            if int(e.maximum) < (1 << (8 * sizes[i])) - 1:
+                test.append(f"values[{v}] > {int(e.maximum)}u")
+            lines.append(f"    values[{v}] = {value}; /* {e.name} */")
+            if test:
+                cond = " || ".join(test)
+                if e.broadcast is not None:
+                    cond = f"({cond}) && values[{v}] != {e.broadcast}u"
+                lines.append(f"    if ({cond}) {{ return {P}_E_RANGE; }}")
+            v += 1
+    for i, e in enumerate(elements):
+        if e.role == "length":
+            a, b = names.index(e.counts[0]), names.index(e.counts[1])
+            value = _wire_value(start[i], sizes[i], e.endian == ">")
+            lines.append(
+                f"    if ((int32_t)({value}) != (int32_t){span(a, b)} + {e.adds}) {{ return {P}_E_LENGTH; }} "
+                f"/* {e.name} */"
+            )
+    for i, e in enumerate(elements):
+        if e.role == "checksum" and e.checksum is not None:
+            a, b = names.index(e.checksum.first), names.index(e.checksum.last)
+            check = ctx.check_index(e.checksum)
+            value = _wire_value(start[i], sizes[i], e.endian == ">")
+            lines.append(
+                f"    if ({p}__check({check}u, f + {at(start[a])}, {span(a, b)}) != ({value})) {{ "
+                f"return {P}_E_CHECKSUM; }} /* {e.name} */"
+            )
+    if content >= 0:
+        lines += [f"    *content = f + {before}u;", f"    *clen = n - {before + after}u;"]
+    else:
+        lines += ["    *content = f;", "    *clen = 0u;"]
+    lines += [f"    return {P}_OK;", "}", ""]
+    return "\n".join(lines)
+
+
 def source(ctx: Ctx) -> str:
     protocol, p, P = ctx.protocol, ctx.p, ctx.P
     msgs = messages(protocol)
@@ -315,6 +428,23 @@ def source(ctx: Ctx) -> str:
     max_elements = max(len(layout.elements) for ls in protocol.framing.alternatives.values() for layout in ls)
     decoders = "\n".join(decoder(ctx, m) for m in msgs)
     encoders = "\n".join(encoder(ctx, m) for m in msgs)
+    straight: list[str] = []
+    unwrap_cases: list[str] = []
+    for d in directions(protocol):
+        rows = []
+        for k, layout in enumerate(protocol.framing.alternatives[d]):
+            if layout.transparency is None:
+                straight.append(straight_unwrap(ctx, d, k, layout))
+                rows.append(
+                    f"        case {k}u:\n"
+                    f"            return {p}__unwrap_{d.value}_{k}(frame, n, code, values, content, clen);"
+                )
+        if rows:
+            unwrap_cases.append(
+                f"    case {P}_{d.name}:\n        switch (k) {{\n"
+                + "\n".join(rows)
+                + "\n        default:\n            break;\n        }\n        break;"
+            )
     # checksums
     check_defs = "\n".join(dict.fromkeys(c.definition for _, c in ctx.checks))
     cases = "\n".join(
@@ -552,6 +682,26 @@ static int {p}__bounds({p}_direction_t dir, long code, size_t *low, size_t *high
 #endif
 
 #if {P}_ENABLE_DECODE
+/* ---- frames taken apart: straight line where a layout has no byte stuffing ---- */
+{chr(10).join(straight)}
+static int {p}__unwrap_at({p}_direction_t dir, uint8_t k, const {p}__layout_t *L, const uint8_t *frame, size_t n,
+                          uint8_t *plain, uint32_t *code, uint32_t *values, const uint8_t **content, size_t *clen)
+{{
+    (void)k;
+    (void)L;
+    (void)plain;
+    switch (dir) {{
+{chr(10).join(unwrap_cases)}
+    default:
+        break;
+    }}
+#if {P}__STUFFED
+    return {p}__unwrap(L, frame, n, plain, code, values, content, clen);
+#else
+    return {P}_E_ARG;
+#endif
+}}
+
 /* ---- content decoders ---- */
 {decoders}
 static int {p}__decode_content({p}_direction_t dir, long code, {p}_kind_t expect, const uint8_t *c, size_t n,
@@ -572,7 +722,7 @@ int {p}_decode_expect(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}
     uint8_t count, k;
     const {p}__layout_t *const *layouts;
     const {p}__layout_t *L = NULL;
-    uint32_t code = 0u, values[{P}__MAX_ELEMENTS];
+    uint32_t code = 0u, values[{P}__MAX_ELEMENTS] = {{0u}};
     const uint8_t *c = NULL;
     size_t clen = 0u;
     int r;
@@ -585,6 +735,7 @@ int {p}_decode_expect(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}
     if (layouts == NULL) {{
         return {P}_E_ARG;
     }}
+    k = 0u;
     if ({P}__SINGLE || count == 1u) {{
         L = layouts[0];
     }} else {{
@@ -599,7 +750,7 @@ int {p}_decode_expect(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}
             return {P}_E_FRAME;
         }}
     }}
-    r = {p}__unwrap(L, frame, len, plain, &code, values, &c, &clen);
+    r = {p}__unwrap_at(dir, k, L, frame, len, plain, &code, values, &c, &clen);
     if (r != {P}_OK) {{
         return r;
     }}

@@ -25,10 +25,10 @@ generate: $(STAMP) test-tools
 # Programs the tests drive as a user would: tshark (the Wireshark dissectors) and tmux (`serialspec watch` on a
 # screen). Installed with apt-get where they are missing and this runs as root; elsewhere the tests that need them
 # are skipped, saying why.
+# The C target's tests also build with clang and with gcc -m32 (gcc-multilib: 32-bit size_t and long), the same way.
 TEST_TOOLS := tshark tmux
-test-tools:
-	@missing=""; for tool in $(TEST_TOOLS); do command -v $$tool >/dev/null || missing="$$missing $$tool"; done; \
-	if [ -z "$$missing" ]; then exit 0; fi; \
+# apt-get install of the packages in $$missing, as root; elsewhere it says which tests are skipped
+INSTALL_MISSING = if [ -z "$$missing" ]; then exit 0; fi; \
 	if [ "$$(id -u)" != 0 ] || ! command -v apt-get >/dev/null; then \
 		echo "not installed:$$missing (apt-get as root installs them): the tests that need them are skipped"; exit 0; fi; \
 	echo "installing$$missing (apt-get)"; \
@@ -36,6 +36,11 @@ test-tools:
 	apt-get install -y -q $$missing >/dev/null 2>&1 || { apt-get update -q >/dev/null 2>&1 && \
 		apt-get install -y -q $$missing >/dev/null 2>&1; } || \
 		echo "could not install$$missing: the tests that need them are skipped"
+test-tools:
+	@missing=""; for tool in $(TEST_TOOLS); do command -v $$tool >/dev/null || missing="$$missing $$tool"; done; \
+	command -v clang >/dev/null || missing="$$missing clang"; \
+	printf 'int main(void) { return 0; }\n' | gcc -m32 -x c - -o /dev/null 2>/dev/null || missing="$$missing gcc-multilib"; \
+	$(INSTALL_MISSING)
 
 check: $(STAMP)
 	$(BIN)/serialspec check
@@ -55,11 +60,13 @@ test: $(STAMP) test-tools check lint typecheck
 test-fast: $(STAMP) test-tools check
 	$(BIN)/pytest -q -n auto -m "not slow"
 
-# The C target alone (generated/c/<protocol>/): every spec's C compiled with gcc -std=c99 and the strict warnings as
-# errors at -O0/-Os/-O2, the headers as C++11, then a driver built with -fsanitize=address,undefined checked against
-# the Python codec (examples, random messages, mutated frames, noisy streams in random pieces). `make test` runs the
-# same tests with the rest of the suite. Needs gcc and g++ (apt-get install gcc g++).
-c-check: $(STAMP) check
+# The C target alone (generated/c/<protocol>/): every spec's C compiled with gcc, clang and gcc -m32, -std=c99 and the
+# strict warnings as errors at -O0/-Os/-O2, the headers as C++11, then a driver built with -fsanitize=address,undefined
+# checked against the Python codec (examples, random messages, mutated frames, noisy streams in random pieces), the
+# examples and a noisy stream again on clang and -m32 builds. `make test` runs the same tests with the rest of the
+# suite. Needs gcc and g++ (apt-get install gcc g++); clang and gcc-multilib are installed as root (test-tools), else
+# those builds are skipped, saying why.
+c-check: $(STAMP) test-tools check
 	$(BIN)/pytest -q -n auto tests/test_c_backend.py
 
 # Pin what the development install resolved to (after changing pyproject.toml's extras), for CI and fresh clones.

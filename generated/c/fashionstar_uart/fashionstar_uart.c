@@ -2851,11 +2851,11 @@ static int fashionstar_uart__enc_read_batch_data_response(const void *mv, uint8_
     o += 1u;
     fashionstar_uart__put(c + o, 2u, 0u, (uint32_t)(m->user_data.soft_start_time)); /* 50 */
     o += 2u;
-    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->user_data.angle_limit_high) & 0xffffUL)); /* 51 */
+    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->user_data.angle_limit_high) & 0xffffu)); /* 51 */
     o += 2u;
-    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->user_data.angle_limit_low) & 0xffffUL)); /* 52 */
+    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->user_data.angle_limit_low) & 0xffffu)); /* 52 */
     o += 2u;
-    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->user_data.angle_mid_offset) & 0xffffUL)); /* 53 */
+    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->user_data.angle_mid_offset) & 0xffffu)); /* 53 */
     o += 2u;
     *n = o;
     return FASHIONSTAR_UART_OK;
@@ -2922,11 +2922,11 @@ static int fashionstar_uart__enc_write_batch_data_request(const void *mv, uint8_
     o += 1u;
     fashionstar_uart__put(c + o, 2u, 0u, (uint32_t)(m->user_data.soft_start_time)); /* 50 */
     o += 2u;
-    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->user_data.angle_limit_high) & 0xffffUL)); /* 51 */
+    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->user_data.angle_limit_high) & 0xffffu)); /* 51 */
     o += 2u;
-    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->user_data.angle_limit_low) & 0xffffUL)); /* 52 */
+    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->user_data.angle_limit_low) & 0xffffu)); /* 52 */
     o += 2u;
-    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->user_data.angle_mid_offset) & 0xffffUL)); /* 53 */
+    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->user_data.angle_mid_offset) & 0xffffu)); /* 53 */
     o += 2u;
     *n = o;
     return FASHIONSTAR_UART_OK;
@@ -3014,7 +3014,7 @@ static int fashionstar_uart__enc_rotate_request(const void *mv, uint8_t *c, size
     fashionstar_uart__put(c + o, 1u, 0u, (uint32_t)(m->servo_id)); /* servo_id */
     o += 1u;
     if (cap - o < 2u) { return FASHIONSTAR_UART_E_BUFFER; }
-    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->angle) & 0xffffUL)); /* angle */
+    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->angle) & 0xffffu)); /* angle */
     o += 2u;
     if (cap - o < 2u) { return FASHIONSTAR_UART_E_BUFFER; }
     fashionstar_uart__put(c + o, 2u, 0u, (uint32_t)(m->interval)); /* interval */
@@ -3118,7 +3118,7 @@ static int fashionstar_uart__enc_read_angle_response(const void *mv, uint8_t *c,
     fashionstar_uart__put(c + o, 1u, 0u, (uint32_t)(m->servo_id)); /* servo_id */
     o += 1u;
     if (cap - o < 2u) { return FASHIONSTAR_UART_E_BUFFER; }
-    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->angle) & 0xffffUL)); /* angle */
+    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->angle) & 0xffffu)); /* angle */
     o += 2u;
     *n = o;
     return FASHIONSTAR_UART_OK;
@@ -3139,7 +3139,7 @@ static int fashionstar_uart__enc_move_by_interval_request(const void *mv, uint8_
     fashionstar_uart__put(c + o, 1u, 0u, (uint32_t)(m->servo_id)); /* servo_id */
     o += 1u;
     if (cap - o < 2u) { return FASHIONSTAR_UART_E_BUFFER; }
-    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->angle) & 0xffffUL)); /* angle */
+    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->angle) & 0xffffu)); /* angle */
     o += 2u;
     if (cap - o < 2u) { return FASHIONSTAR_UART_E_BUFFER; }
     fashionstar_uart__put(c + o, 2u, 0u, (uint32_t)(m->interval)); /* interval */
@@ -3194,7 +3194,7 @@ static int fashionstar_uart__enc_move_by_velocity_request(const void *mv, uint8_
     fashionstar_uart__put(c + o, 1u, 0u, (uint32_t)(m->servo_id)); /* servo_id */
     o += 1u;
     if (cap - o < 2u) { return FASHIONSTAR_UART_E_BUFFER; }
-    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->angle) & 0xffffUL)); /* angle */
+    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->angle) & 0xffffu)); /* angle */
     o += 2u;
     if (cap - o < 2u) { return FASHIONSTAR_UART_E_BUFFER; }
     fashionstar_uart__put(c + o, 2u, 0u, (uint32_t)(m->velocity)); /* velocity */
@@ -3249,7 +3249,7 @@ static int fashionstar_uart__enc_move_mturn_request(const void *mv, uint8_t *c, 
     fashionstar_uart__put(c + o, 1u, 0u, (uint32_t)(m->servo_id)); /* servo_id */
     o += 1u;
     if (cap - o < 4u) { return FASHIONSTAR_UART_E_BUFFER; }
-    fashionstar_uart__put(c + o, 4u, 0u, ((uint32_t)(int32_t)(m->angle) & 0xffffffffUL)); /* angle */
+    fashionstar_uart__put(c + o, 4u, 0u, ((uint32_t)(int32_t)(m->angle) & 0xffffffffu)); /* angle */
     o += 4u;
     if (cap - o < 4u) { return FASHIONSTAR_UART_E_BUFFER; }
     fashionstar_uart__put(c + o, 4u, 0u, (uint32_t)(m->interval)); /* interval */
@@ -3298,7 +3298,7 @@ static int fashionstar_uart__enc_move_mturn_by_interval_request(const void *mv, 
     fashionstar_uart__put(c + o, 1u, 0u, (uint32_t)(m->servo_id)); /* servo_id */
     o += 1u;
     if (cap - o < 4u) { return FASHIONSTAR_UART_E_BUFFER; }
-    fashionstar_uart__put(c + o, 4u, 0u, ((uint32_t)(int32_t)(m->angle) & 0xffffffffUL)); /* angle */
+    fashionstar_uart__put(c + o, 4u, 0u, ((uint32_t)(int32_t)(m->angle) & 0xffffffffu)); /* angle */
     o += 4u;
     if (cap - o < 4u) { return FASHIONSTAR_UART_E_BUFFER; }
     fashionstar_uart__put(c + o, 4u, 0u, (uint32_t)(m->interval)); /* interval */
@@ -3353,7 +3353,7 @@ static int fashionstar_uart__enc_move_mturn_by_velocity_request(const void *mv, 
     fashionstar_uart__put(c + o, 1u, 0u, (uint32_t)(m->servo_id)); /* servo_id */
     o += 1u;
     if (cap - o < 4u) { return FASHIONSTAR_UART_E_BUFFER; }
-    fashionstar_uart__put(c + o, 4u, 0u, ((uint32_t)(int32_t)(m->angle) & 0xffffffffUL)); /* angle */
+    fashionstar_uart__put(c + o, 4u, 0u, ((uint32_t)(int32_t)(m->angle) & 0xffffffffu)); /* angle */
     o += 4u;
     if (cap - o < 2u) { return FASHIONSTAR_UART_E_BUFFER; }
     fashionstar_uart__put(c + o, 2u, 0u, (uint32_t)(m->velocity)); /* velocity */
@@ -3424,10 +3424,10 @@ static int fashionstar_uart__enc_read_mturn_angle_response(const void *mv, uint8
     fashionstar_uart__put(c + o, 1u, 0u, (uint32_t)(m->servo_id)); /* servo_id */
     o += 1u;
     if (cap - o < 4u) { return FASHIONSTAR_UART_E_BUFFER; }
-    fashionstar_uart__put(c + o, 4u, 0u, ((uint32_t)(int32_t)(m->angle) & 0xffffffffUL)); /* angle */
+    fashionstar_uart__put(c + o, 4u, 0u, ((uint32_t)(int32_t)(m->angle) & 0xffffffffu)); /* angle */
     o += 4u;
     if (cap - o < 2u) { return FASHIONSTAR_UART_E_BUFFER; }
-    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->turns) & 0xffffUL)); /* turns */
+    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->turns) & 0xffffu)); /* turns */
     o += 2u;
     *n = o;
     return FASHIONSTAR_UART_OK;
@@ -3527,10 +3527,10 @@ static int fashionstar_uart__enc_monitor_response(const void *mv, uint8_t *c, si
     fashionstar_uart__put(c + o, 1u, 0u, (uint32_t)(m->status)); /* status */
     o += 1u;
     if (cap - o < 4u) { return FASHIONSTAR_UART_E_BUFFER; }
-    fashionstar_uart__put(c + o, 4u, 0u, ((uint32_t)(int32_t)(m->angle) & 0xffffffffUL)); /* angle */
+    fashionstar_uart__put(c + o, 4u, 0u, ((uint32_t)(int32_t)(m->angle) & 0xffffffffu)); /* angle */
     o += 4u;
     if (cap - o < 2u) { return FASHIONSTAR_UART_E_BUFFER; }
-    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->turns) & 0xffffUL)); /* turns */
+    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->turns) & 0xffffu)); /* turns */
     o += 2u;
     *n = o;
     return FASHIONSTAR_UART_OK;

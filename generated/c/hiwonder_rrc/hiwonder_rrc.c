@@ -2496,7 +2496,7 @@ static int hiwonder_rrc__enc_pwm_servo_set_offset_request(const void *mv, uint8_
     hiwonder_rrc__put(c + o, 1u, 0u, (uint32_t)(m->servo_id)); /* servo_id */
     o += 1u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }
-    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->offset) & 0xffUL)); /* offset */
+    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->offset) & 0xffu)); /* offset */
     o += 1u;
     *n = o;
     return HIWONDER_RRC_OK;
@@ -2537,7 +2537,7 @@ static int hiwonder_rrc__enc_pwm_servo_read_offset_response(const void *mv, uint
     hiwonder_rrc__put(c + o, 1u, 0u, 9UL); /* subcommand_code */
     o += 1u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }
-    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->offset) & 0xffUL)); /* offset */
+    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->offset) & 0xffu)); /* offset */
     o += 1u;
     *n = o;
     return HIWONDER_RRC_OK;
@@ -2617,10 +2617,10 @@ static int hiwonder_rrc__enc_bus_servo_read_position_response(const void *mv, ui
     hiwonder_rrc__put(c + o, 1u, 0u, 5UL); /* subcommand_code */
     o += 1u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }
-    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->success) & 0xffUL)); /* success */
+    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->success) & 0xffu)); /* success */
     o += 1u;
     if (cap - o < 2u) { return HIWONDER_RRC_E_BUFFER; }
-    hiwonder_rrc__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->position) & 0xffffUL)); /* position */
+    hiwonder_rrc__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->position) & 0xffffu)); /* position */
     o += 2u;
     *n = o;
     return HIWONDER_RRC_OK;
@@ -2662,7 +2662,7 @@ static int hiwonder_rrc__enc_bus_servo_read_voltage_response(const void *mv, uin
     hiwonder_rrc__put(c + o, 1u, 0u, 7UL); /* subcommand_code */
     o += 1u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }
-    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->success) & 0xffUL)); /* success */
+    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->success) & 0xffu)); /* success */
     o += 1u;
     if (cap - o < 2u) { return HIWONDER_RRC_E_BUFFER; }
     hiwonder_rrc__put(c + o, 2u, 0u, (uint32_t)(m->voltage)); /* voltage */
@@ -2707,7 +2707,7 @@ static int hiwonder_rrc__enc_bus_servo_read_temperature_response(const void *mv,
     hiwonder_rrc__put(c + o, 1u, 0u, 9UL); /* subcommand_code */
     o += 1u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }
-    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->success) & 0xffUL)); /* success */
+    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->success) & 0xffu)); /* success */
     o += 1u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }
     hiwonder_rrc__put(c + o, 1u, 0u, (uint32_t)(m->temperature)); /* temperature */
@@ -2781,10 +2781,10 @@ static int hiwonder_rrc__enc_bus_servo_read_torque_response(const void *mv, uint
     hiwonder_rrc__put(c + o, 1u, 0u, 13UL); /* subcommand_code */
     o += 1u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }
-    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->success) & 0xffUL)); /* success */
+    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->success) & 0xffu)); /* success */
     o += 1u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }
-    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->torque) & 0xffUL)); /* torque */
+    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->torque) & 0xffu)); /* torque */
     o += 1u;
     *n = o;
     return HIWONDER_RRC_OK;
@@ -2886,7 +2886,7 @@ static int hiwonder_rrc__enc_bus_servo_read_id_response(const void *mv, uint8_t 
     hiwonder_rrc__put(c + o, 1u, 0u, 18UL); /* subcommand_code */
     o += 1u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }
-    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->success) & 0xffUL)); /* success */
+    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->success) & 0xffu)); /* success */
     o += 1u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }
     hiwonder_rrc__put(c + o, 1u, 0u, (uint32_t)(m->id)); /* id */
@@ -2912,7 +2912,7 @@ static int hiwonder_rrc__enc_bus_servo_set_offset_request(const void *mv, uint8_
     hiwonder_rrc__put(c + o, 1u, 0u, (uint32_t)(m->servo_id)); /* servo_id */
     o += 1u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }
-    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->offset) & 0xffUL)); /* offset */
+    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->offset) & 0xffu)); /* offset */
     o += 1u;
     *n = o;
     return HIWONDER_RRC_OK;
@@ -2954,10 +2954,10 @@ static int hiwonder_rrc__enc_bus_servo_read_offset_response(const void *mv, uint
     hiwonder_rrc__put(c + o, 1u, 0u, 34UL); /* subcommand_code */
     o += 1u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }
-    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->success) & 0xffUL)); /* success */
+    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->success) & 0xffu)); /* success */
     o += 1u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }
-    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->offset) & 0xffUL)); /* offset */
+    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->offset) & 0xffu)); /* offset */
     o += 1u;
     *n = o;
     return HIWONDER_RRC_OK;
@@ -3045,7 +3045,7 @@ static int hiwonder_rrc__enc_bus_servo_read_position_limit_response(const void *
     hiwonder_rrc__put(c + o, 1u, 0u, 50UL); /* subcommand_code */
     o += 1u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }
-    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->success) & 0xffUL)); /* success */
+    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->success) & 0xffu)); /* success */
     o += 1u;
     if (cap - o < 2u) { return HIWONDER_RRC_E_BUFFER; }
     hiwonder_rrc__put(c + o, 2u, 0u, (uint32_t)(m->low)); /* low */
@@ -3120,7 +3120,7 @@ static int hiwonder_rrc__enc_bus_servo_read_voltage_limit_response(const void *m
     hiwonder_rrc__put(c + o, 1u, 0u, 54UL); /* subcommand_code */
     o += 1u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }
-    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->success) & 0xffUL)); /* success */
+    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->success) & 0xffu)); /* success */
     o += 1u;
     if (cap - o < 2u) { return HIWONDER_RRC_E_BUFFER; }
     hiwonder_rrc__put(c + o, 2u, 0u, (uint32_t)(m->low)); /* low */
@@ -3191,7 +3191,7 @@ static int hiwonder_rrc__enc_bus_servo_read_temperature_limit_response(const voi
     hiwonder_rrc__put(c + o, 1u, 0u, 58UL); /* subcommand_code */
     o += 1u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }
-    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->success) & 0xffUL)); /* success */
+    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->success) & 0xffu)); /* success */
     o += 1u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }
     hiwonder_rrc__put(c + o, 1u, 0u, (uint32_t)(m->limit)); /* limit */
@@ -3273,16 +3273,16 @@ static int hiwonder_rrc__enc_gamepad_response(const void *mv, uint8_t *c, size_t
     hiwonder_rrc__put(c + o, 1u, 0u, (uint32_t)(m->hat)); /* hat */
     o += 1u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }
-    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->left_x) & 0xffUL)); /* left_x */
+    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->left_x) & 0xffu)); /* left_x */
     o += 1u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }
-    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->left_y) & 0xffUL)); /* left_y */
+    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->left_y) & 0xffu)); /* left_y */
     o += 1u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }
-    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->right_x) & 0xffUL)); /* right_x */
+    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->right_x) & 0xffu)); /* right_x */
     o += 1u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }
-    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->right_y) & 0xffUL)); /* right_y */
+    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->right_y) & 0xffu)); /* right_y */
     o += 1u;
     *n = o;
     return HIWONDER_RRC_OK;
@@ -3300,7 +3300,7 @@ static int hiwonder_rrc__enc_sbus_response(const void *mv, uint8_t *c, size_t ca
     (void)cap;
     if (cap - o < 32u) { return HIWONDER_RRC_E_BUFFER; }
     for (i1 = 0u; i1 < 16u; i1++) {
-        hiwonder_rrc__put(c + o + i1 * 2u, 2u, 0u, ((uint32_t)(int32_t)(m->channels[i1]) & 0xffffUL));
+        hiwonder_rrc__put(c + o + i1 * 2u, 2u, 0u, ((uint32_t)(int32_t)(m->channels[i1]) & 0xffffu));
     }
     o += 32u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }

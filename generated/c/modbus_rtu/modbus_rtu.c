@@ -20,7 +20,7 @@ typedef char modbus_rtu__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 /* counting as serialspec.runtime.stream.StreamParser (1), else as framing.FrameStreamParser */
 #define MODBUS_RTU__CLASSIC 0
 #define MODBUS_RTU__HEADERS 0 /* every layout starts with a header: candidates start at headers only */
-#define MODBUS_RTU__KEEP -1u      /* bytes kept at the end that could begin a header */
+#define MODBUS_RTU__KEEP 0u      /* bytes kept at the end that could begin a header */
 #define MODBUS_RTU__STUFFED 0 /* some layout has byte stuffing */
 #define MODBUS_RTU__LENGTHS 0 /* every layout has a length element */
 #define MODBUS_RTU__SINGLE 1 /* one layout per direction */

@@ -1463,73 +1463,73 @@ static int vesc__enc_get_values_response(const void *mv, uint8_t *c, size_t cap,
     (void)cap;
     if (m->fault > 33u) { return VESC_E_RANGE; } /* fault */
     if (cap - o < 2u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 2u, 1u, ((uint32_t)(int32_t)(m->temp_fet) & 0xffffUL)); /* temp_fet */
+    vesc__put(c + o, 2u, 1u, ((uint32_t)(int32_t)(m->temp_fet) & 0xffffu)); /* temp_fet */
     o += 2u;
     if (cap - o < 2u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 2u, 1u, ((uint32_t)(int32_t)(m->temp_motor) & 0xffffUL)); /* temp_motor */
+    vesc__put(c + o, 2u, 1u, ((uint32_t)(int32_t)(m->temp_motor) & 0xffffu)); /* temp_motor */
     o += 2u;
     if (cap - o < 4u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->avg_motor_current) & 0xffffffffUL)); /* avg_motor_current */
+    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->avg_motor_current) & 0xffffffffu)); /* avg_motor_current */
     o += 4u;
     if (cap - o < 4u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->avg_input_current) & 0xffffffffUL)); /* avg_input_current */
+    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->avg_input_current) & 0xffffffffu)); /* avg_input_current */
     o += 4u;
     if (cap - o < 4u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->avg_id) & 0xffffffffUL)); /* avg_id */
+    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->avg_id) & 0xffffffffu)); /* avg_id */
     o += 4u;
     if (cap - o < 4u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->avg_iq) & 0xffffffffUL)); /* avg_iq */
+    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->avg_iq) & 0xffffffffu)); /* avg_iq */
     o += 4u;
     if (cap - o < 2u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 2u, 1u, ((uint32_t)(int32_t)(m->duty_now) & 0xffffUL)); /* duty_now */
+    vesc__put(c + o, 2u, 1u, ((uint32_t)(int32_t)(m->duty_now) & 0xffffu)); /* duty_now */
     o += 2u;
     if (cap - o < 4u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->rpm) & 0xffffffffUL)); /* rpm */
+    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->rpm) & 0xffffffffu)); /* rpm */
     o += 4u;
     if (cap - o < 2u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 2u, 1u, ((uint32_t)(int32_t)(m->v_in) & 0xffffUL)); /* v_in */
+    vesc__put(c + o, 2u, 1u, ((uint32_t)(int32_t)(m->v_in) & 0xffffu)); /* v_in */
     o += 2u;
     if (cap - o < 4u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->amp_hours) & 0xffffffffUL)); /* amp_hours */
+    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->amp_hours) & 0xffffffffu)); /* amp_hours */
     o += 4u;
     if (cap - o < 4u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->amp_hours_charged) & 0xffffffffUL)); /* amp_hours_charged */
+    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->amp_hours_charged) & 0xffffffffu)); /* amp_hours_charged */
     o += 4u;
     if (cap - o < 4u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->watt_hours) & 0xffffffffUL)); /* watt_hours */
+    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->watt_hours) & 0xffffffffu)); /* watt_hours */
     o += 4u;
     if (cap - o < 4u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->watt_hours_charged) & 0xffffffffUL)); /* watt_hours_charged */
+    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->watt_hours_charged) & 0xffffffffu)); /* watt_hours_charged */
     o += 4u;
     if (cap - o < 4u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->tachometer) & 0xffffffffUL)); /* tachometer */
+    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->tachometer) & 0xffffffffu)); /* tachometer */
     o += 4u;
     if (cap - o < 4u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->tachometer_abs) & 0xffffffffUL)); /* tachometer_abs */
+    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->tachometer_abs) & 0xffffffffu)); /* tachometer_abs */
     o += 4u;
     if (cap - o < 1u) { return VESC_E_BUFFER; }
     vesc__put(c + o, 1u, 1u, (uint32_t)(m->fault)); /* fault */
     o += 1u;
     if (cap - o < 4u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->pid_pos) & 0xffffffffUL)); /* pid_pos */
+    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->pid_pos) & 0xffffffffu)); /* pid_pos */
     o += 4u;
     if (cap - o < 1u) { return VESC_E_BUFFER; }
     vesc__put(c + o, 1u, 1u, (uint32_t)(m->controller_id)); /* controller_id */
     o += 1u;
     if (cap - o < 2u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 2u, 1u, ((uint32_t)(int32_t)(m->temp_mos1) & 0xffffUL)); /* temp_mos1 */
+    vesc__put(c + o, 2u, 1u, ((uint32_t)(int32_t)(m->temp_mos1) & 0xffffu)); /* temp_mos1 */
     o += 2u;
     if (cap - o < 2u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 2u, 1u, ((uint32_t)(int32_t)(m->temp_mos2) & 0xffffUL)); /* temp_mos2 */
+    vesc__put(c + o, 2u, 1u, ((uint32_t)(int32_t)(m->temp_mos2) & 0xffffu)); /* temp_mos2 */
     o += 2u;
     if (cap - o < 2u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 2u, 1u, ((uint32_t)(int32_t)(m->temp_mos3) & 0xffffUL)); /* temp_mos3 */
+    vesc__put(c + o, 2u, 1u, ((uint32_t)(int32_t)(m->temp_mos3) & 0xffffu)); /* temp_mos3 */
     o += 2u;
     if (cap - o < 4u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->avg_vd) & 0xffffffffUL)); /* avg_vd */
+    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->avg_vd) & 0xffffffffu)); /* avg_vd */
     o += 4u;
     if (cap - o < 4u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->avg_vq) & 0xffffffffUL)); /* avg_vq */
+    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->avg_vq) & 0xffffffffu)); /* avg_vq */
     o += 4u;
     if (cap - o < 1u) { return VESC_E_BUFFER; }
     vesc__put(c + o, 1u, 1u, (uint32_t)(m->status)); /* status */
@@ -1549,7 +1549,7 @@ static int vesc__enc_set_duty_request(const void *mv, uint8_t *c, size_t cap, si
     (void)cap;
     if (m->duty < -100000L || m->duty > 100000L) { return VESC_E_RANGE; } /* duty */
     if (cap - o < 4u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->duty) & 0xffffffffUL)); /* duty */
+    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->duty) & 0xffffffffu)); /* duty */
     o += 4u;
     *n = o;
     return VESC_OK;
@@ -1565,7 +1565,7 @@ static int vesc__enc_set_current_request(const void *mv, uint8_t *c, size_t cap,
     (void)c;
     (void)cap;
     if (cap - o < 4u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->current) & 0xffffffffUL)); /* current */
+    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->current) & 0xffffffffu)); /* current */
     o += 4u;
     *n = o;
     return VESC_OK;
@@ -1581,7 +1581,7 @@ static int vesc__enc_set_current_brake_request(const void *mv, uint8_t *c, size_
     (void)c;
     (void)cap;
     if (cap - o < 4u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->current) & 0xffffffffUL)); /* current */
+    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->current) & 0xffffffffu)); /* current */
     o += 4u;
     *n = o;
     return VESC_OK;
@@ -1597,7 +1597,7 @@ static int vesc__enc_set_rpm_request(const void *mv, uint8_t *c, size_t cap, siz
     (void)c;
     (void)cap;
     if (cap - o < 4u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->rpm) & 0xffffffffUL)); /* rpm */
+    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->rpm) & 0xffffffffu)); /* rpm */
     o += 4u;
     *n = o;
     return VESC_OK;
@@ -1613,7 +1613,7 @@ static int vesc__enc_set_pos_request(const void *mv, uint8_t *c, size_t cap, siz
     (void)c;
     (void)cap;
     if (cap - o < 4u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->position) & 0xffffffffUL)); /* position */
+    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->position) & 0xffffffffu)); /* position */
     o += 4u;
     *n = o;
     return VESC_OK;
@@ -1629,7 +1629,7 @@ static int vesc__enc_set_handbrake_request(const void *mv, uint8_t *c, size_t ca
     (void)c;
     (void)cap;
     if (cap - o < 4u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->current) & 0xffffffffUL)); /* current */
+    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->current) & 0xffffffffu)); /* current */
     o += 4u;
     *n = o;
     return VESC_OK;
@@ -1663,7 +1663,7 @@ static int vesc__enc_rotor_position_response(const void *mv, uint8_t *c, size_t 
     (void)c;
     (void)cap;
     if (cap - o < 4u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->position) & 0xffffffffUL)); /* position */
+    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->position) & 0xffffffffu)); /* position */
     o += 4u;
     *n = o;
     return VESC_OK;

@@ -663,7 +663,7 @@ def scalar_bits(ctx: Ctx, t: ScalarType, expr: str) -> str:
         return f"{ctx.p}__f32bits({expr})"
     if t.signed:
         mask = (1 << (8 * t.size)) - 1
-        return f"((uint32_t)(int32_t)({expr}) & 0x{mask:x}UL)"
+        return f"((uint32_t)(int32_t)({expr}) & 0x{mask:x}u)"
     return f"(uint32_t)({expr})"
 
 

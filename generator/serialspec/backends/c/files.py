@@ -593,7 +593,7 @@ def source(ctx: Ctx) -> str:
     classic = 1 if protocol.framing.classic else 0
     headers = [layout.header for d in directions(protocol) for layout in protocol.framing.alternatives[d]]
     has_headers = 1 if all(headers) else 0
-    keep = max((len(h) for h in headers), default=1) - 1
+    keep = max(0, max((len(h) for h in headers), default=1) - 1)
     dir_layouts = "\n".join(
         f"    case {P}_{d.name}:\n        *count = {n_layouts[d]}u;\n        return {p}__layouts_{d.value};"
         for d in directions(protocol)

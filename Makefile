@@ -5,7 +5,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 BENCH_STAMP := $(VENV)/.installed-bench
 
-.PHONY: generate test test-fast test-tools constraints check lint typecheck clean demo stress bench wheel runtime-wheel docs c-check
+.PHONY: generate test test-fast test-tools constraints check lint typecheck clean demo stress bench bench-c wheel runtime-wheel docs c-check
 
 CONSTRAINTS := requirements/constraints.txt
 
@@ -102,6 +102,10 @@ $(BENCH_STAMP): $(STAMP) pyproject.toml
 
 bench: $(BENCH_STAMP)
 	$(BIN)/python -m bench.run
+
+# The C target's two tables alone (flash and RAM on Cortex-M0+, parse throughput), replaced in bench/results.md.
+bench-c: $(STAMP)
+	$(BIN)/python -m bench.run c-size c-speed
 
 # The documentation site in site/: README, tutorial, language reference and every protocol's reference (mkdocs, strict).
 docs: $(STAMP)

@@ -25,7 +25,8 @@ generate: $(STAMP) test-tools
 # Programs the tests drive as a user would: tshark (the Wireshark dissectors) and tmux (`serialspec watch` on a
 # screen). Installed with apt-get where they are missing and this runs as root; elsewhere the tests that need them
 # are skipped, saying why.
-# The C target's tests also build with clang and with gcc -m32 (gcc-multilib: 32-bit size_t and long), the same way.
+# The C target's tests also build with clang, with gcc -m32 (gcc-multilib: 32-bit size_t and long) and for big-endian
+# PowerPC (a cross gcc; qemu-user runs the programs): installed the same way.
 TEST_TOOLS := tshark tmux
 # apt-get install of the packages in $$missing, as root; elsewhere it says which tests are skipped
 INSTALL_MISSING = if [ -z "$$missing" ]; then exit 0; fi; \
@@ -40,6 +41,8 @@ test-tools:
 	@missing=""; for tool in $(TEST_TOOLS); do command -v $$tool >/dev/null || missing="$$missing $$tool"; done; \
 	command -v clang >/dev/null || missing="$$missing clang"; \
 	printf 'int main(void) { return 0; }\n' | gcc -m32 -x c - -o /dev/null 2>/dev/null || missing="$$missing gcc-multilib"; \
+	command -v powerpc-linux-gnu-gcc >/dev/null || missing="$$missing gcc-powerpc-linux-gnu libc6-dev-powerpc-cross"; \
+	command -v qemu-ppc >/dev/null || missing="$$missing qemu-user"; \
 	$(INSTALL_MISSING)
 
 check: $(STAMP)
@@ -60,12 +63,12 @@ test: $(STAMP) test-tools check lint typecheck
 test-fast: $(STAMP) test-tools check
 	$(BIN)/pytest -q -n auto -m "not slow"
 
-# The C target alone (generated/c/<protocol>/): every spec's C compiled with gcc, clang and gcc -m32, -std=c99 and the
-# strict warnings as errors at -O0/-Os/-O2, the headers as C++11, then a driver built with -fsanitize=address,undefined
-# checked against the Python codec (examples, random messages, mutated frames, noisy streams in random pieces), the
-# examples and a noisy stream again on clang and -m32 builds. `make test` runs the same tests with the rest of the
-# suite. Needs gcc and g++ (apt-get install gcc g++); clang and gcc-multilib are installed as root (test-tools), else
-# those builds are skipped, saying why.
+# The C target alone (generated/c/<protocol>/): every spec's C compiled with gcc, clang, gcc -m32 and a PowerPC gcc,
+# -std=c99 and the strict warnings as errors at -O0/-Os/-O2, the headers as C++11, then a driver built with
+# -fsanitize=address,undefined checked against the Python codec (examples, random messages, mutated frames, noisy
+# streams in random pieces), the examples and a noisy stream again on clang, -m32 and big-endian PowerPC (qemu) builds.
+# `make test` runs the same tests with the rest of the suite. Needs gcc and g++ (apt-get install gcc g++); the other
+# compilers and qemu are installed as root (test-tools), else those builds are skipped, saying why.
 c-check: $(STAMP) test-tools check
 	$(BIN)/pytest -q -n auto tests/test_c_backend.py
 

@@ -70,8 +70,11 @@ def m32_builds() -> bool:
     return run.returncode == 0
 
 
-# Besides gcc on this host: clang, and gcc -m32 (a 32-bit size_t and long). `make c-check` installs both as root.
-BUILDS = ["gcc", "clang", "gcc-m32"]
+# Besides gcc on this host: clang, gcc -m32 (a 32-bit size_t and long) and big-endian PowerPC (a cross gcc, the
+# programs run under qemu-ppc). `make c-check` installs them as root (test-tools).
+BUILDS = ["gcc", "clang", "gcc-m32", "powerpc-be"]
+PPC_GCC = shutil.which("powerpc-linux-gnu-gcc")
+QEMU_PPC = shutil.which("qemu-ppc")
 
 
 def compiler(build: str) -> list[str]:
@@ -85,7 +88,23 @@ def compiler(build: str) -> list[str]:
         if not m32_builds():
             pytest.skip("gcc -m32 cannot link (apt-get install gcc-multilib; make c-check installs it as root)")
         return [GCC, "-m32"]
+    if build == "powerpc-be":
+        if PPC_GCC is None or QEMU_PPC is None:
+            pytest.skip(
+                "no big-endian build: powerpc-linux-gnu-gcc or qemu-ppc missing (apt-get install gcc-powerpc-linux-gnu "
+                "libc6-dev-powerpc-cross qemu-user; make c-check installs them as root)"
+            )
+        return [PPC_GCC, "-static"]
     return [GCC]
+
+
+def runner(build: str) -> tuple[tuple[str, ...], list[str]]:
+    """How a build's programs run (a prefix: qemu for another CPU) and the sanitizer flags it builds them with (none
+    where the target has no sanitizer runtime)."""
+    if build == "powerpc-be":
+        assert QEMU_PPC is not None
+        return (QEMU_PPC,), []
+    return (), SANITIZE
 
 
 def sources(g: Generated) -> tuple[Path, Path]:
@@ -129,9 +148,12 @@ def test_several_protocols_link_into_one_program(tmp_path: Path) -> None:
 class Driver:
     """The driver program for one protocol, built with the sanitizers, kept running: one command a line."""
 
-    def __init__(self, name: str, source: Path, folder: Path, command: tuple[str, ...] = ()) -> None:
+    def __init__(
+        self, name: str, source: Path, folder: Path, command: tuple[str, ...] = (), build: str = "gcc"
+    ) -> None:
         """Build tests/c/driver.c with the C of protocol `name` found in `source`, into `folder`, and start it;
-        with `command` (a compiler and its flags: clang, gcc -m32), else gcc."""
+        with `command` (a compiler and its flags: clang, gcc -m32) for `build` (BUILDS), else gcc."""
+        prefix, sanitize = runner(build)
         assert GCC is not None
         exe = folder / f"driver_{name}"
         c, j = source / f"{name}.c", source / f"{name}_json.c"
@@ -139,7 +161,7 @@ class Driver:
         command = [
             *(command or (GCC,)),
             "-std=c99",
-            *SANITIZE,
+            *sanitize,
             *big,
             "-I",
             str(c.parent),
@@ -155,7 +177,9 @@ class Driver:
         ]
         run = subprocess.run(command, capture_output=True)
         assert run.returncode == 0, run.stderr.decode()
-        self.process = subprocess.Popen([str(exe)], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True, bufsize=1)
+        self.process = subprocess.Popen(
+            [*prefix, str(exe)], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True, bufsize=1
+        )
 
     def close(self) -> None:
         assert self.process.stdin is not None
@@ -176,11 +200,11 @@ class Driver:
 
 
 @cache
-def driver(name: str, command: tuple[str, ...] = ()) -> Driver:
+def driver(name: str, command: tuple[str, ...] = (), build: str = "gcc") -> Driver:
     import tempfile
 
     folder = Path(tempfile.mkdtemp(prefix="serialspec-c-"))
-    return Driver(name, GENERATED_C / name, folder, command)
+    return Driver(name, GENERATED_C / name, folder, command, build)
 
 
 def agrees_with_python(run: Driver, g: Generated, spec: Message, fields: dict[str, Any]) -> bytes:
@@ -240,11 +264,11 @@ def test_every_example_decodes_to_the_spec_values_and_encodes_back(g: Generated,
 
 @pytest.mark.parametrize("build", BUILDS[1:])
 @pytest.mark.parametrize("g", C_SPECS, ids=IDS)
-def test_examples_and_a_noisy_stream_give_the_same_on_clang_and_32_bit_builds(g: Generated, build: str) -> None:
-    """The driver built with clang, and with gcc -m32 (32-bit size_t and long), both with the sanitizers: every
-    example decoded to the spec's values and encoded back, and the examples in a noisy stream cut in random pieces
-    parsed as Python parses them."""
-    run = driver(g.protocol.name, tuple(compiler(build)))
+def test_examples_and_a_noisy_stream_give_the_same_on_other_builds(g: Generated, build: str) -> None:
+    """The driver built with clang and with gcc -m32 (32-bit size_t and long), both with the sanitizers, and for
+    big-endian PowerPC (run under qemu-ppc): every example decoded to the spec's values and encoded back, and the
+    examples in a noisy stream cut in pieces parsed as Python parses them."""
+    run = driver(g.protocol.name, tuple(compiler(build)), build)
     for example in g.protocol.examples:
         cls = example_class(g, example)
         kind = kind_of(g, cls)

@@ -57,6 +57,18 @@ static uint32_t fashionstar_uart__check(uint8_t which, const uint8_t *d, size_t 
 #define FASHIONSTAR_UART__ROLE_CONTENT 4u
 #define FASHIONSTAR_UART__ROLE_CHECKSUM 5u
 
+/* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
+static int fashionstar_uart__same(const uint8_t *a, const uint8_t *b, size_t n)
+{
+    size_t i;
+    for (i = 0u; i < n; i++) {
+        if (a[i] != b[i]) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
 /* Byte stuffing over part of a layout (constant 0 when no layout has it: that code left out) */
 #define FASHIONSTAR_UART__T(L) (FASHIONSTAR_UART__STUFFED && (L)->has_t)
 
@@ -173,12 +185,12 @@ static int fashionstar_uart__rewrite(const fashionstar_uart__layout_t *L, int to
             size_t flen = to_wire ? L->pairs[k].plain_len : L->pairs[k].wire_len;
             const uint8_t *to = to_wire ? L->pairs[k].wire : L->pairs[k].plain;
             size_t tlen = to_wire ? L->pairs[k].wire_len : L->pairs[k].plain_len;
-            if (flen <= n - i && memcmp(src + i, from, flen) == 0) {
+            if (flen <= n - i && fashionstar_uart__same(src + i, from, flen)) {
                 if (tlen > cap - o) {
                     return 0;
                 }
                 if (cmp != NULL) {
-                    if (memcmp(cmp + o, to, tlen) != 0) {
+                    if (!fashionstar_uart__same(cmp + o, to, tlen)) {
                         return 0;
                     }
                 } else {
@@ -398,7 +410,7 @@ static int fashionstar_uart__unwrap(const fashionstar_uart__layout_t *L, const u
     for (k = 0u; k < L->count; k++) {
         const fashionstar_uart__element_t *e = &L->e[k];
         bytes = FASHIONSTAR_UART__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
-        if (e->role == FASHIONSTAR_UART__ROLE_CONSTANT && memcmp(bytes, e->constant, e->size) != 0) {
+        if (e->role == FASHIONSTAR_UART__ROLE_CONSTANT && !fashionstar_uart__same(bytes, e->constant, e->size)) {
             return FASHIONSTAR_UART_E_FRAME;
         }
     }
@@ -470,7 +482,7 @@ static long fashionstar_uart__probe(const fashionstar_uart__layout_t *L, fashion
             return FASHIONSTAR_UART__WAIT;
         }
         if (e->role == FASHIONSTAR_UART__ROLE_CONSTANT) {
-            if (memcmp(b + pos, e->constant, e->size) != 0) {
+            if (!fashionstar_uart__same(b + pos, e->constant, e->size)) {
                 return FASHIONSTAR_UART__NONE;
             }
         } else if (e->role == FASHIONSTAR_UART__ROLE_COMMAND) {
@@ -509,7 +521,7 @@ static long fashionstar_uart__probe(const fashionstar_uart__layout_t *L, fashion
         const fashionstar_uart__element_t *t = &L->e[L->count - 1u];
         size_t i;
         for (i = before; i + t->size <= avail; i++) {
-            if (memcmp(b + i, t->constant, t->size) == 0) {
+            if (fashionstar_uart__same(b + i, t->constant, t->size)) {
                 return (long)(i + t->size);
             }
         }
@@ -2249,7 +2261,7 @@ int fashionstar_uart_decode_expect(const uint8_t *frame, size_t len, fashionstar
     } else {
         for (k = 0u; k < count; k++) {
             const fashionstar_uart__layout_t *A = layouts[k];
-            if (A->header_len <= len && memcmp(frame, A->e[0].constant, A->header_len) == 0) {
+            if (A->header_len <= len && fashionstar_uart__same(frame, A->e[0].constant, A->header_len)) {
                 L = A;
                 break;
             }
@@ -4235,7 +4247,7 @@ static size_t fashionstar_uart__next(fashionstar_uart_parser_t *p, size_t start)
             const fashionstar_uart__layout_t *L = layouts[k];
             if (L->header_len > p->n - pos) {
                 whole = 0;
-            } else if (memcmp(p->buf + pos, L->e[0].constant, L->header_len) == 0) {
+            } else if (fashionstar_uart__same(p->buf + pos, L->e[0].constant, L->header_len)) {
                 return pos;
             }
         }
@@ -4329,7 +4341,7 @@ static size_t fashionstar_uart__whole(fashionstar_uart_parser_t *p, const uint8_
         return 0u;
     }
     L = layouts[0];
-    if (len < L->header_len || memcmp(data, L->e[0].constant, L->header_len) != 0) {
+    if (len < L->header_len || !fashionstar_uart__same(data, L->e[0].constant, L->header_len)) {
         return 0u;
     }
     s = fashionstar_uart__probe(L, p->dir, data, len);
@@ -4338,7 +4350,7 @@ static size_t fashionstar_uart__whole(fashionstar_uart_parser_t *p, const uint8_
     }
     size = (size_t)s;
     for (i = 1u; i + L->header_len <= size; i++) {
-        if (data[i] == L->e[0].constant[0] && memcmp(data + i, L->e[0].constant, L->header_len) == 0) {
+        if (data[i] == L->e[0].constant[0] && fashionstar_uart__same(data + i, L->e[0].constant, L->header_len)) {
             return 0u;
         }
     }

@@ -57,6 +57,18 @@ static uint32_t feetech_sms__check(uint8_t which, const uint8_t *d, size_t n)
 #define FEETECH_SMS__ROLE_CONTENT 4u
 #define FEETECH_SMS__ROLE_CHECKSUM 5u
 
+/* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
+static int feetech_sms__same(const uint8_t *a, const uint8_t *b, size_t n)
+{
+    size_t i;
+    for (i = 0u; i < n; i++) {
+        if (a[i] != b[i]) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
 /* Byte stuffing over part of a layout (constant 0 when no layout has it: that code left out) */
 #define FEETECH_SMS__T(L) (FEETECH_SMS__STUFFED && (L)->has_t)
 
@@ -173,12 +185,12 @@ static int feetech_sms__rewrite(const feetech_sms__layout_t *L, int to_wire, con
             size_t flen = to_wire ? L->pairs[k].plain_len : L->pairs[k].wire_len;
             const uint8_t *to = to_wire ? L->pairs[k].wire : L->pairs[k].plain;
             size_t tlen = to_wire ? L->pairs[k].wire_len : L->pairs[k].plain_len;
-            if (flen <= n - i && memcmp(src + i, from, flen) == 0) {
+            if (flen <= n - i && feetech_sms__same(src + i, from, flen)) {
                 if (tlen > cap - o) {
                     return 0;
                 }
                 if (cmp != NULL) {
-                    if (memcmp(cmp + o, to, tlen) != 0) {
+                    if (!feetech_sms__same(cmp + o, to, tlen)) {
                         return 0;
                     }
                 } else {
@@ -398,7 +410,7 @@ static int feetech_sms__unwrap(const feetech_sms__layout_t *L, const uint8_t *fr
     for (k = 0u; k < L->count; k++) {
         const feetech_sms__element_t *e = &L->e[k];
         bytes = FEETECH_SMS__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
-        if (e->role == FEETECH_SMS__ROLE_CONSTANT && memcmp(bytes, e->constant, e->size) != 0) {
+        if (e->role == FEETECH_SMS__ROLE_CONSTANT && !feetech_sms__same(bytes, e->constant, e->size)) {
             return FEETECH_SMS_E_FRAME;
         }
     }
@@ -470,7 +482,7 @@ static long feetech_sms__probe(const feetech_sms__layout_t *L, feetech_sms_direc
             return FEETECH_SMS__WAIT;
         }
         if (e->role == FEETECH_SMS__ROLE_CONSTANT) {
-            if (memcmp(b + pos, e->constant, e->size) != 0) {
+            if (!feetech_sms__same(b + pos, e->constant, e->size)) {
                 return FEETECH_SMS__NONE;
             }
         } else if (e->role == FEETECH_SMS__ROLE_COMMAND) {
@@ -509,7 +521,7 @@ static long feetech_sms__probe(const feetech_sms__layout_t *L, feetech_sms_direc
         const feetech_sms__element_t *t = &L->e[L->count - 1u];
         size_t i;
         for (i = before; i + t->size <= avail; i++) {
-            if (memcmp(b + i, t->constant, t->size) == 0) {
+            if (feetech_sms__same(b + i, t->constant, t->size)) {
                 return (long)(i + t->size);
             }
         }
@@ -974,7 +986,7 @@ int feetech_sms_decode_expect(const uint8_t *frame, size_t len, feetech_sms_dire
     } else {
         for (k = 0u; k < count; k++) {
             const feetech_sms__layout_t *A = layouts[k];
-            if (A->header_len <= len && memcmp(frame, A->e[0].constant, A->header_len) == 0) {
+            if (A->header_len <= len && feetech_sms__same(frame, A->e[0].constant, A->header_len)) {
                 L = A;
                 break;
             }
@@ -1441,7 +1453,7 @@ static size_t feetech_sms__next(feetech_sms_parser_t *p, size_t start)
             const feetech_sms__layout_t *L = layouts[k];
             if (L->header_len > p->n - pos) {
                 whole = 0;
-            } else if (memcmp(p->buf + pos, L->e[0].constant, L->header_len) == 0) {
+            } else if (feetech_sms__same(p->buf + pos, L->e[0].constant, L->header_len)) {
                 return pos;
             }
         }
@@ -1535,7 +1547,7 @@ static size_t feetech_sms__whole(feetech_sms_parser_t *p, const uint8_t *data, s
         return 0u;
     }
     L = layouts[0];
-    if (len < L->header_len || memcmp(data, L->e[0].constant, L->header_len) != 0) {
+    if (len < L->header_len || !feetech_sms__same(data, L->e[0].constant, L->header_len)) {
         return 0u;
     }
     s = feetech_sms__probe(L, p->dir, data, len);
@@ -1544,7 +1556,7 @@ static size_t feetech_sms__whole(feetech_sms_parser_t *p, const uint8_t *data, s
     }
     size = (size_t)s;
     for (i = 1u; i + L->header_len <= size; i++) {
-        if (data[i] == L->e[0].constant[0] && memcmp(data + i, L->e[0].constant, L->header_len) == 0) {
+        if (data[i] == L->e[0].constant[0] && feetech_sms__same(data + i, L->e[0].constant, L->header_len)) {
             return 0u;
         }
     }

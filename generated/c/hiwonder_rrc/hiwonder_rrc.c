@@ -61,6 +61,18 @@ static uint32_t hiwonder_rrc__check(uint8_t which, const uint8_t *d, size_t n)
 #define HIWONDER_RRC__ROLE_CONTENT 4u
 #define HIWONDER_RRC__ROLE_CHECKSUM 5u
 
+/* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
+static int hiwonder_rrc__same(const uint8_t *a, const uint8_t *b, size_t n)
+{
+    size_t i;
+    for (i = 0u; i < n; i++) {
+        if (a[i] != b[i]) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
 /* Byte stuffing over part of a layout (constant 0 when no layout has it: that code left out) */
 #define HIWONDER_RRC__T(L) (HIWONDER_RRC__STUFFED && (L)->has_t)
 
@@ -177,12 +189,12 @@ static int hiwonder_rrc__rewrite(const hiwonder_rrc__layout_t *L, int to_wire, c
             size_t flen = to_wire ? L->pairs[k].plain_len : L->pairs[k].wire_len;
             const uint8_t *to = to_wire ? L->pairs[k].wire : L->pairs[k].plain;
             size_t tlen = to_wire ? L->pairs[k].wire_len : L->pairs[k].plain_len;
-            if (flen <= n - i && memcmp(src + i, from, flen) == 0) {
+            if (flen <= n - i && hiwonder_rrc__same(src + i, from, flen)) {
                 if (tlen > cap - o) {
                     return 0;
                 }
                 if (cmp != NULL) {
-                    if (memcmp(cmp + o, to, tlen) != 0) {
+                    if (!hiwonder_rrc__same(cmp + o, to, tlen)) {
                         return 0;
                     }
                 } else {
@@ -402,7 +414,7 @@ static int hiwonder_rrc__unwrap(const hiwonder_rrc__layout_t *L, const uint8_t *
     for (k = 0u; k < L->count; k++) {
         const hiwonder_rrc__element_t *e = &L->e[k];
         bytes = HIWONDER_RRC__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
-        if (e->role == HIWONDER_RRC__ROLE_CONSTANT && memcmp(bytes, e->constant, e->size) != 0) {
+        if (e->role == HIWONDER_RRC__ROLE_CONSTANT && !hiwonder_rrc__same(bytes, e->constant, e->size)) {
             return HIWONDER_RRC_E_FRAME;
         }
     }
@@ -474,7 +486,7 @@ static long hiwonder_rrc__probe(const hiwonder_rrc__layout_t *L, hiwonder_rrc_di
             return HIWONDER_RRC__WAIT;
         }
         if (e->role == HIWONDER_RRC__ROLE_CONSTANT) {
-            if (memcmp(b + pos, e->constant, e->size) != 0) {
+            if (!hiwonder_rrc__same(b + pos, e->constant, e->size)) {
                 return HIWONDER_RRC__NONE;
             }
         } else if (e->role == HIWONDER_RRC__ROLE_COMMAND) {
@@ -513,7 +525,7 @@ static long hiwonder_rrc__probe(const hiwonder_rrc__layout_t *L, hiwonder_rrc_di
         const hiwonder_rrc__element_t *t = &L->e[L->count - 1u];
         size_t i;
         for (i = before; i + t->size <= avail; i++) {
-            if (memcmp(b + i, t->constant, t->size) == 0) {
+            if (hiwonder_rrc__same(b + i, t->constant, t->size)) {
                 return (long)(i + t->size);
             }
         }
@@ -2163,7 +2175,7 @@ int hiwonder_rrc_decode_expect(const uint8_t *frame, size_t len, hiwonder_rrc_di
     } else {
         for (k = 0u; k < count; k++) {
             const hiwonder_rrc__layout_t *A = layouts[k];
-            if (A->header_len <= len && memcmp(frame, A->e[0].constant, A->header_len) == 0) {
+            if (A->header_len <= len && hiwonder_rrc__same(frame, A->e[0].constant, A->header_len)) {
                 L = A;
                 break;
             }
@@ -4123,7 +4135,7 @@ static size_t hiwonder_rrc__next(hiwonder_rrc_parser_t *p, size_t start)
             const hiwonder_rrc__layout_t *L = layouts[k];
             if (L->header_len > p->n - pos) {
                 whole = 0;
-            } else if (memcmp(p->buf + pos, L->e[0].constant, L->header_len) == 0) {
+            } else if (hiwonder_rrc__same(p->buf + pos, L->e[0].constant, L->header_len)) {
                 return pos;
             }
         }
@@ -4217,7 +4229,7 @@ static size_t hiwonder_rrc__whole(hiwonder_rrc_parser_t *p, const uint8_t *data,
         return 0u;
     }
     L = layouts[0];
-    if (len < L->header_len || memcmp(data, L->e[0].constant, L->header_len) != 0) {
+    if (len < L->header_len || !hiwonder_rrc__same(data, L->e[0].constant, L->header_len)) {
         return 0u;
     }
     s = hiwonder_rrc__probe(L, p->dir, data, len);
@@ -4226,7 +4238,7 @@ static size_t hiwonder_rrc__whole(hiwonder_rrc_parser_t *p, const uint8_t *data,
     }
     size = (size_t)s;
     for (i = 1u; i + L->header_len <= size; i++) {
-        if (data[i] == L->e[0].constant[0] && memcmp(data + i, L->e[0].constant, L->header_len) == 0) {
+        if (data[i] == L->e[0].constant[0] && hiwonder_rrc__same(data + i, L->e[0].constant, L->header_len)) {
             return 0u;
         }
     }

@@ -61,6 +61,18 @@ static uint32_t modbus_rtu__check(uint8_t which, const uint8_t *d, size_t n)
 #define MODBUS_RTU__ROLE_CONTENT 4u
 #define MODBUS_RTU__ROLE_CHECKSUM 5u
 
+/* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
+static int modbus_rtu__same(const uint8_t *a, const uint8_t *b, size_t n)
+{
+    size_t i;
+    for (i = 0u; i < n; i++) {
+        if (a[i] != b[i]) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
 /* Byte stuffing over part of a layout (constant 0 when no layout has it: that code left out) */
 #define MODBUS_RTU__T(L) (MODBUS_RTU__STUFFED && (L)->has_t)
 
@@ -177,12 +189,12 @@ static int modbus_rtu__rewrite(const modbus_rtu__layout_t *L, int to_wire, const
             size_t flen = to_wire ? L->pairs[k].plain_len : L->pairs[k].wire_len;
             const uint8_t *to = to_wire ? L->pairs[k].wire : L->pairs[k].plain;
             size_t tlen = to_wire ? L->pairs[k].wire_len : L->pairs[k].plain_len;
-            if (flen <= n - i && memcmp(src + i, from, flen) == 0) {
+            if (flen <= n - i && modbus_rtu__same(src + i, from, flen)) {
                 if (tlen > cap - o) {
                     return 0;
                 }
                 if (cmp != NULL) {
-                    if (memcmp(cmp + o, to, tlen) != 0) {
+                    if (!modbus_rtu__same(cmp + o, to, tlen)) {
                         return 0;
                     }
                 } else {
@@ -402,7 +414,7 @@ static int modbus_rtu__unwrap(const modbus_rtu__layout_t *L, const uint8_t *fram
     for (k = 0u; k < L->count; k++) {
         const modbus_rtu__element_t *e = &L->e[k];
         bytes = MODBUS_RTU__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
-        if (e->role == MODBUS_RTU__ROLE_CONSTANT && memcmp(bytes, e->constant, e->size) != 0) {
+        if (e->role == MODBUS_RTU__ROLE_CONSTANT && !modbus_rtu__same(bytes, e->constant, e->size)) {
             return MODBUS_RTU_E_FRAME;
         }
     }
@@ -474,7 +486,7 @@ static long modbus_rtu__probe(const modbus_rtu__layout_t *L, modbus_rtu_directio
             return MODBUS_RTU__WAIT;
         }
         if (e->role == MODBUS_RTU__ROLE_CONSTANT) {
-            if (memcmp(b + pos, e->constant, e->size) != 0) {
+            if (!modbus_rtu__same(b + pos, e->constant, e->size)) {
                 return MODBUS_RTU__NONE;
             }
         } else if (e->role == MODBUS_RTU__ROLE_COMMAND) {
@@ -513,7 +525,7 @@ static long modbus_rtu__probe(const modbus_rtu__layout_t *L, modbus_rtu_directio
         const modbus_rtu__element_t *t = &L->e[L->count - 1u];
         size_t i;
         for (i = before; i + t->size <= avail; i++) {
-            if (memcmp(b + i, t->constant, t->size) == 0) {
+            if (modbus_rtu__same(b + i, t->constant, t->size)) {
                 return (long)(i + t->size);
             }
         }
@@ -1402,7 +1414,7 @@ int modbus_rtu_decode_expect(const uint8_t *frame, size_t len, modbus_rtu_direct
     } else {
         for (k = 0u; k < count; k++) {
             const modbus_rtu__layout_t *A = layouts[k];
-            if (A->header_len <= len && memcmp(frame, A->e[0].constant, A->header_len) == 0) {
+            if (A->header_len <= len && modbus_rtu__same(frame, A->e[0].constant, A->header_len)) {
                 L = A;
                 break;
             }
@@ -2344,7 +2356,7 @@ static size_t modbus_rtu__next(modbus_rtu_parser_t *p, size_t start)
             const modbus_rtu__layout_t *L = layouts[k];
             if (L->header_len > p->n - pos) {
                 whole = 0;
-            } else if (memcmp(p->buf + pos, L->e[0].constant, L->header_len) == 0) {
+            } else if (modbus_rtu__same(p->buf + pos, L->e[0].constant, L->header_len)) {
                 return pos;
             }
         }
@@ -2438,7 +2450,7 @@ static size_t modbus_rtu__whole(modbus_rtu_parser_t *p, const uint8_t *data, siz
         return 0u;
     }
     L = layouts[0];
-    if (len < L->header_len || memcmp(data, L->e[0].constant, L->header_len) != 0) {
+    if (len < L->header_len || !modbus_rtu__same(data, L->e[0].constant, L->header_len)) {
         return 0u;
     }
     s = modbus_rtu__probe(L, p->dir, data, len);
@@ -2447,7 +2459,7 @@ static size_t modbus_rtu__whole(modbus_rtu_parser_t *p, const uint8_t *data, siz
     }
     size = (size_t)s;
     for (i = 1u; i + L->header_len <= size; i++) {
-        if (data[i] == L->e[0].constant[0] && memcmp(data + i, L->e[0].constant, L->header_len) == 0) {
+        if (data[i] == L->e[0].constant[0] && modbus_rtu__same(data + i, L->e[0].constant, L->header_len)) {
             return 0u;
         }
     }

@@ -61,6 +61,18 @@ static uint32_t vesc__check(uint8_t which, const uint8_t *d, size_t n)
 #define VESC__ROLE_CONTENT 4u
 #define VESC__ROLE_CHECKSUM 5u
 
+/* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
+static int vesc__same(const uint8_t *a, const uint8_t *b, size_t n)
+{
+    size_t i;
+    for (i = 0u; i < n; i++) {
+        if (a[i] != b[i]) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
 /* Byte stuffing over part of a layout (constant 0 when no layout has it: that code left out) */
 #define VESC__T(L) (VESC__STUFFED && (L)->has_t)
 
@@ -177,12 +189,12 @@ static int vesc__rewrite(const vesc__layout_t *L, int to_wire, const uint8_t *sr
             size_t flen = to_wire ? L->pairs[k].plain_len : L->pairs[k].wire_len;
             const uint8_t *to = to_wire ? L->pairs[k].wire : L->pairs[k].plain;
             size_t tlen = to_wire ? L->pairs[k].wire_len : L->pairs[k].plain_len;
-            if (flen <= n - i && memcmp(src + i, from, flen) == 0) {
+            if (flen <= n - i && vesc__same(src + i, from, flen)) {
                 if (tlen > cap - o) {
                     return 0;
                 }
                 if (cmp != NULL) {
-                    if (memcmp(cmp + o, to, tlen) != 0) {
+                    if (!vesc__same(cmp + o, to, tlen)) {
                         return 0;
                     }
                 } else {
@@ -402,7 +414,7 @@ static int vesc__unwrap(const vesc__layout_t *L, const uint8_t *frame, size_t n,
     for (k = 0u; k < L->count; k++) {
         const vesc__element_t *e = &L->e[k];
         bytes = VESC__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
-        if (e->role == VESC__ROLE_CONSTANT && memcmp(bytes, e->constant, e->size) != 0) {
+        if (e->role == VESC__ROLE_CONSTANT && !vesc__same(bytes, e->constant, e->size)) {
             return VESC_E_FRAME;
         }
     }
@@ -474,7 +486,7 @@ static long vesc__probe(const vesc__layout_t *L, vesc_direction_t dir, const uin
             return VESC__WAIT;
         }
         if (e->role == VESC__ROLE_CONSTANT) {
-            if (memcmp(b + pos, e->constant, e->size) != 0) {
+            if (!vesc__same(b + pos, e->constant, e->size)) {
                 return VESC__NONE;
             }
         } else if (e->role == VESC__ROLE_COMMAND) {
@@ -513,7 +525,7 @@ static long vesc__probe(const vesc__layout_t *L, vesc_direction_t dir, const uin
         const vesc__element_t *t = &L->e[L->count - 1u];
         size_t i;
         for (i = before; i + t->size <= avail; i++) {
-            if (memcmp(b + i, t->constant, t->size) == 0) {
+            if (vesc__same(b + i, t->constant, t->size)) {
                 return (long)(i + t->size);
             }
         }
@@ -1334,7 +1346,7 @@ int vesc_decode_expect(const uint8_t *frame, size_t len, vesc_direction_t dir, v
     } else {
         for (k = 0u; k < count; k++) {
             const vesc__layout_t *A = layouts[k];
-            if (A->header_len <= len && memcmp(frame, A->e[0].constant, A->header_len) == 0) {
+            if (A->header_len <= len && vesc__same(frame, A->e[0].constant, A->header_len)) {
                 L = A;
                 break;
             }
@@ -2003,7 +2015,7 @@ static size_t vesc__next(vesc_parser_t *p, size_t start)
             const vesc__layout_t *L = layouts[k];
             if (L->header_len > p->n - pos) {
                 whole = 0;
-            } else if (memcmp(p->buf + pos, L->e[0].constant, L->header_len) == 0) {
+            } else if (vesc__same(p->buf + pos, L->e[0].constant, L->header_len)) {
                 return pos;
             }
         }
@@ -2097,7 +2109,7 @@ static size_t vesc__whole(vesc_parser_t *p, const uint8_t *data, size_t len, ves
         return 0u;
     }
     L = layouts[0];
-    if (len < L->header_len || memcmp(data, L->e[0].constant, L->header_len) != 0) {
+    if (len < L->header_len || !vesc__same(data, L->e[0].constant, L->header_len)) {
         return 0u;
     }
     s = vesc__probe(L, p->dir, data, len);
@@ -2106,7 +2118,7 @@ static size_t vesc__whole(vesc_parser_t *p, const uint8_t *data, size_t len, ves
     }
     size = (size_t)s;
     for (i = 1u; i + L->header_len <= size; i++) {
-        if (data[i] == L->e[0].constant[0] && memcmp(data + i, L->e[0].constant, L->header_len) == 0) {
+        if (data[i] == L->e[0].constant[0] && vesc__same(data + i, L->e[0].constant, L->header_len)) {
             return 0u;
         }
     }

@@ -10,6 +10,18 @@ ENGINE = r"""/* ---- the frame engine: the spec's layouts as tables (runtime/fra
 #define PFX__ROLE_CONTENT 4u
 #define PFX__ROLE_CHECKSUM 5u
 
+/* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
+static int pfx__same(const uint8_t *a, const uint8_t *b, size_t n)
+{
+    size_t i;
+    for (i = 0u; i < n; i++) {
+        if (a[i] != b[i]) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
 /* Byte stuffing over part of a layout (constant 0 when no layout has it: that code left out) */
 #define PFX__T(L) (PFX__STUFFED && (L)->has_t)
 
@@ -126,12 +138,12 @@ static int pfx__rewrite(const pfx__layout_t *L, int to_wire, const uint8_t *src,
             size_t flen = to_wire ? L->pairs[k].plain_len : L->pairs[k].wire_len;
             const uint8_t *to = to_wire ? L->pairs[k].wire : L->pairs[k].plain;
             size_t tlen = to_wire ? L->pairs[k].wire_len : L->pairs[k].plain_len;
-            if (flen <= n - i && memcmp(src + i, from, flen) == 0) {
+            if (flen <= n - i && pfx__same(src + i, from, flen)) {
                 if (tlen > cap - o) {
                     return 0;
                 }
                 if (cmp != NULL) {
-                    if (memcmp(cmp + o, to, tlen) != 0) {
+                    if (!pfx__same(cmp + o, to, tlen)) {
                         return 0;
                     }
                 } else {
@@ -351,7 +363,7 @@ static int pfx__unwrap(const pfx__layout_t *L, const uint8_t *frame, size_t n, u
     for (k = 0u; k < L->count; k++) {
         const pfx__element_t *e = &L->e[k];
         bytes = PFX__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
-        if (e->role == PFX__ROLE_CONSTANT && memcmp(bytes, e->constant, e->size) != 0) {
+        if (e->role == PFX__ROLE_CONSTANT && !pfx__same(bytes, e->constant, e->size)) {
             return PFX_E_FRAME;
         }
     }
@@ -423,7 +435,7 @@ static long pfx__probe(const pfx__layout_t *L, pfx_direction_t dir, const uint8_
             return PFX__WAIT;
         }
         if (e->role == PFX__ROLE_CONSTANT) {
-            if (memcmp(b + pos, e->constant, e->size) != 0) {
+            if (!pfx__same(b + pos, e->constant, e->size)) {
                 return PFX__NONE;
             }
         } else if (e->role == PFX__ROLE_COMMAND) {
@@ -462,7 +474,7 @@ static long pfx__probe(const pfx__layout_t *L, pfx_direction_t dir, const uint8_
         const pfx__element_t *t = &L->e[L->count - 1u];
         size_t i;
         for (i = before; i + t->size <= avail; i++) {
-            if (memcmp(b + i, t->constant, t->size) == 0) {
+            if (pfx__same(b + i, t->constant, t->size)) {
                 return (long)(i + t->size);
             }
         }

@@ -741,7 +741,7 @@ int {p}_decode_expect(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}
     }} else {{
         for (k = 0u; k < count; k++) {{
             const {p}__layout_t *A = layouts[k];
-            if (A->header_len <= len && memcmp(frame, A->e[0].constant, A->header_len) == 0) {{
+            if (A->header_len <= len && {p}__same(frame, A->e[0].constant, A->header_len)) {{
                 L = A;
                 break;
             }}
@@ -907,7 +907,7 @@ static size_t {p}__next({p}_parser_t *p, size_t start)
             const {p}__layout_t *L = layouts[k];
             if (L->header_len > p->n - pos) {{
                 whole = 0;
-            }} else if (memcmp(p->buf + pos, L->e[0].constant, L->header_len) == 0) {{
+            }} else if ({p}__same(p->buf + pos, L->e[0].constant, L->header_len)) {{
                 return pos;
             }}
         }}
@@ -1001,7 +1001,7 @@ static size_t {p}__whole({p}_parser_t *p, const uint8_t *data, size_t len, {p}_m
         return 0u;
     }}
     L = layouts[0];
-    if (len < L->header_len || memcmp(data, L->e[0].constant, L->header_len) != 0) {{
+    if (len < L->header_len || !{p}__same(data, L->e[0].constant, L->header_len)) {{
         return 0u;
     }}
     s = {p}__probe(L, p->dir, data, len);
@@ -1010,7 +1010,7 @@ static size_t {p}__whole({p}_parser_t *p, const uint8_t *data, size_t len, {p}_m
     }}
     size = (size_t)s;
     for (i = 1u; i + L->header_len <= size; i++) {{
-        if (data[i] == L->e[0].constant[0] && memcmp(data + i, L->e[0].constant, L->header_len) == 0) {{
+        if (data[i] == L->e[0].constant[0] && {p}__same(data + i, L->e[0].constant, L->header_len)) {{
             return 0u;
         }}
     }}

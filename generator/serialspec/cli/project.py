@@ -8,6 +8,8 @@ table, or that holds a `specs/` folder. The table may set:
     out = "generated"                         # where DIR/<protocol>/ and DIR/docs/<protocol>.md are written
     schema = "specs/serialspec.schema.json"   # the language's JSON Schema, for editors ("" for none)
     reference = "docs/language.md"            # the language reference, examples from the specs (default: none)
+    namespace = "acme_protocols"              # packages go to DIR/acme_protocols/<protocol>/ (not with --out DIR)
+    old_names = true                          # and DIR/<protocol>/__init__.py aliases the old import name, warning
 
 Spec paths and `--out` given on the command line replace `specs` and `out`.
 """
@@ -29,6 +31,7 @@ from serialspec.collection import without_cycle_collection
 from serialspec.lang.errors import SpecError, SpecErrors
 from serialspec.lang.frozen import frozen
 from serialspec.lang.limits import read_spec
+from serialspec.runtime.errors import SerialspecError
 
 SCHEMA_NAME = "serialspec.schema.json"
 #: The first line of every generated text file names the spec it came from.
@@ -45,6 +48,12 @@ class Project:
     schema: Path | None
     reference: Path | None
     chosen: bool  # the specs were named on the command line (not the project's whole set)
+    namespace: str = ""  # the package every protocol package sits in ("" for top-level packages)
+    old_names: bool = False  # with a namespace: a module under each protocol's top-level name aliases it
+
+    def package_folder(self, name: str) -> str:
+        """Where a generated package's files go, relative to the output folder."""
+        return f"{self.namespace.replace('.', '/')}/{name}" if self.namespace else name
 
     def display(self, path: Path) -> str:
         """A path as people read it: relative to the project root where possible."""
@@ -94,7 +103,20 @@ def project(root: Path | None, specs: Sequence[str] = (), out: str | None = None
         schema = root / str(schema_setting) if schema_setting else None
     # The reference's examples come from the project's whole set of specs: not written from a few named ones.
     reference = None if specs else config.get("reference")
-    return Project(root, tuple(files), out_dir, schema, root / str(reference) if reference else None, bool(specs))
+    # An output folder named on the command line holds top-level packages: the namespace is the project's layout.
+    namespace = "" if out else config.get("namespace", "")
+    if not isinstance(namespace, str) or not all(part.isidentifier() for part in namespace.split(".") if namespace):
+        raise SerialspecError(f"[tool.serialspec] namespace must be a dotted Python package name, not {namespace!r}")
+    return Project(
+        root,
+        tuple(files),
+        out_dir,
+        schema,
+        root / str(reference) if reference else None,
+        bool(specs),
+        namespace,
+        bool(config.get("old_names", False)) and bool(namespace),
+    )
 
 
 def expected_files(
@@ -124,10 +146,19 @@ def expected_files(
             errors.extend(exc.errors)
             continue
         chosen = {name: text for name, text in outputs.files.items() if not targets or outputs.targets[name] in targets}
-        for name, text in chosen.items():
-            folder = folders.get(outputs.targets[name], "")
-            path = name.removeprefix(f"{folder}/") if folder else name
-            files[proj.out / path] = _spec_link(proj, spec, name, text)
+        if folders:  # each target's files without its folder (bare: --out names the folder)
+            chosen = {
+                name.removeprefix(f"{folders[outputs.targets[name]]}/")
+                if folders.get(outputs.targets[name])
+                else name: text
+                for name, text in chosen.items()
+            }
+        package = next(name for name in outputs.files if name.endswith(f"/{SHIPPED_SPEC}")).split("/")[0]
+        if proj.namespace:
+            chosen = {_in_namespace(proj, package, name): text for name, text in chosen.items()}
+            if proj.old_names and (not targets or "python" in targets):
+                chosen[f"{package}/__init__.py"] = _old_name(proj, spec, package)
+        files.update({proj.out / name: _spec_link(proj, spec, name, text) for name, text in chosen.items()})
         errors.extend(outputs.errors)
         for target in targets:
             if target in outputs.refused:
@@ -219,6 +250,23 @@ def _generate(raw: bytes, display: str, key: bytes) -> Outputs:
     files[f"{protocol.name}/{SHIPPED_SPEC}"] = shipped_spec(protocol.spec_path, raw)
     targets[f"{protocol.name}/{SHIPPED_SPEC}"] = "python"  # the package ships it (`serialspec decode NAME`)
     return Outputs(files, errors, located.data, key, targets, refused)
+
+
+def _in_namespace(proj: Project, package: str, name: str) -> str:
+    """A package's file moved into the project's namespace; the other outputs (docs/, c/) stay where they are."""
+    first, _, rest = name.partition("/")
+    return f"{proj.package_folder(package)}/{rest}" if first == package else name
+
+
+def _old_name(proj: Project, spec: Path, package: str) -> str:
+    """The module left under a package's top-level name: the package under its new name, with a warning."""
+    new = f"{proj.namespace}.{package}"
+    return (
+        f"# Generated by serialspec from {proj.display(spec)}; do not edit. Change the spec and run `serialspec "
+        f"generate`.\n"
+        f'"""`{package}` is an old name of `{new}`: import that instead (this alias goes in the next release)."""\n\n'
+        f'from serialspec.runtime.moved import moved\n\nmoved(__name__, "{new}")\n'
+    )
 
 
 def _spec_link(proj: Project, spec: Path, name: str, text: str) -> str:

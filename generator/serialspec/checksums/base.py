@@ -13,6 +13,7 @@ checksum element by `from_spec`. Its class owns all that the algorithm means to 
   algorithm has none);
 - the C backend: `c_code(prefix)`, the algorithm as an incremental C99 function (NoCode where it has none yet);
 - the markdown backend: `describe()`, `parameters()` and `worked(covered)` for the checksum section;
+- the Wireshark backend: `lua_function()` and `lua_parameters()`, the dissector's Lua code of the algorithm;
 - tests: `samples`, one per documented option, which tests/test_matrix.py runs through every output.
 
 A new algorithm is one module of this package with one subclass that sets `name`: it is found by `algorithms()`.
@@ -194,6 +195,19 @@ class Algorithm:
         """The checksum as C99, its names prefixed with the protocol's `prefix` (`feetech_sms`: `feetech_sms_sum8`):
         bitwise, no tables, no static data. Raises NoCode, one line naming what, where it has none."""
         raise NoCode(f"algorithm {self.name}")
+
+    # -- the Wireshark backend ---------------------------------------------------------------------------------
+
+    @classmethod
+    def lua_function(cls) -> str | None:
+        """Lua source of `function(spec, size, data)`: the checksum of the string `data` for a `size`-byte element
+        whose parameters (lua_parameters) are the table `spec`; band, bor, bxor, lshift, rshift and width_mask are
+        in scope. None where the dissector has no code for it: it shows the value, unverified."""
+        return None
+
+    def lua_parameters(self) -> dict[str, Any]:
+        """The parameters lua_function reads from `spec`, as the dissector's data holds them."""
+        return {}
 
     # -- the markdown backend ----------------------------------------------------------------------------------
 

@@ -89,6 +89,10 @@ uint8_t {name}(uint8_t acc, const uint8_t *data, size_t n)
         prototype = f"{t} {name}({t} acc, const uint8_t *data, size_t n);"
         return CCode(name, t, body, prototype, "0u", "(uint32_t)({a})")
 
+    @classmethod
+    def lua_function(cls) -> str:
+        return _LUA
+
     def describe(self) -> str:
         if self.width == 8:
             return "XOR of the covered bytes"
@@ -100,3 +104,17 @@ uint8_t {name}(uint8_t acc, const uint8_t *data, size_t n)
         words = [int.from_bytes(padded[i : i + size], "big") for i in range(0, len(padded), size)]
         terms = " ^ ".join(hex_value(w, self.width) for w in words) or "0"
         return f"{terms} = {hex_value(self.function()(covered), self.width)}"
+
+
+# the dissector's code (Algorithm.lua_function): words of `size` bytes, high byte first, the last one zero-padded
+_LUA = """function(spec, size, data)
+  local total = 0
+  for i = 1, #data, size do
+    local word = 0
+    for j = i, i + size - 1 do
+      word = word * 256 + (data:byte(j) or 0)
+    end
+    total = bxor(total, word)
+  end
+  return total
+end"""

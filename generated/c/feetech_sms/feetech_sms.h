@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define FEETECH_SMS_SPEC_SHA256 "1c0c350e3d004b0bba59b1a7be0e8a6a998dc5214de9925408e5b41838cba278"
+#define FEETECH_SMS_SPEC_SHA256 "e454eea266866106288a23f6dc59e71973fe574bd84e7808c5556d732ff04c74"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef FEETECH_SMS_ENABLE_ENCODE

@@ -14,15 +14,17 @@ minutes), and a sentence remembers how many fields it had (trailing empty fields
 
 from __future__ import annotations
 
+import dataclasses
 import datetime
 import re
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from decimal import Decimal, InvalidOperation
 from enum import Enum
-from typing import Any, Literal
+from typing import Any, ClassVar, Literal
 
 from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError, RangeError, shown
+from serialspec.runtime.message import Direction
 
 TextKind = Literal["decimal", "integer", "angle", "char", "text", "time", "date"]
 
@@ -477,6 +479,21 @@ _encoders: dict[str, Callable[[TextField, Any, str], str]] = {
 }
 
 
+def texts(sentence: TextSentence, values: Mapping[str, Any]) -> dict[str, Any]:
+    """Each field's text as encode writes it ("" for None; a repeat as a list of dicts of texts)."""
+    found: dict[str, Any] = {}
+    for item in sentence.fields:
+        value = values.get(item.name)
+        if isinstance(item, TextField):
+            found[item.name] = encode_field(sentence.where, item, value)
+        else:
+            rows = [row if isinstance(row, Mapping) else dataclasses.asdict(row) for row in value or ()]
+            found[item.name] = [
+                {f.name: encode_field(sentence.where, f, row.get(f.name)) for f in item.fields} for row in rows
+            ]
+    return found
+
+
 def _ascii(frame: bytes | str) -> str:
     if isinstance(frame, str):
         return frame
@@ -541,3 +558,80 @@ class TextStreamParser:
 def frames(framing: TextFraming, sentences: Iterable[Sentence]) -> bytes:
     """Several sentences as one stream."""
     return b"".join(framing.encode_sentence(s) for s in sentences)
+
+
+# --- generated messages -------------------------------------------------------------------------------------------
+
+
+class TextRecord:
+    """Base of the generated message classes of a text protocol (frozen dataclasses): `talker`, the fields in
+    order, and `sent` (how many fields the frame had; -1 writes every declared one)."""
+
+    COMMAND: ClassVar[str]
+    CODE: ClassVar[str]
+    DIRECTION: ClassVar[Direction]
+    SUBCOMMAND: ClassVar[str | None] = None
+    GROUPS: ClassVar[dict[str, type]] = {}  # repeat field -> the class of one group
+    FRAMING: ClassVar[TextFraming]
+    talker: str
+    sent: int
+
+    def to_fields(self) -> dict[str, Any]:
+        """The field values by name (groups as dicts), without talker and sent."""
+        values = {}
+        for f in dataclasses.fields(self):  # type: ignore[arg-type]
+            if f.name in ("talker", "sent"):
+                continue
+            value = getattr(self, f.name)
+            if f.name in self.GROUPS:
+                value = [dataclasses.asdict(row) for row in value]
+            values[f.name] = value
+        return values
+
+    @classmethod
+    def from_fields(cls, values: Mapping[str, Any], talker: str = "", sent: int = -1) -> Any:
+        known = {f.name for f in dataclasses.fields(cls)}  # type: ignore[arg-type]
+        unknown = set(values) - known
+        if unknown:
+            raise EncodeError(f"{cls.CODE}: unknown field {sorted(unknown)[0]!r}")
+        given = dict(values)
+        for name, group in cls.GROUPS.items():
+            if name in given:
+                given[name] = tuple(row if isinstance(row, group) else group(**row) for row in given[name])
+        if talker:
+            given["talker"] = talker
+        factory: Any = cls  # a generated dataclass: its fields are keyword arguments
+        return factory(**given, sent=sent)
+
+    def encode(self) -> bytes:
+        return self.FRAMING.encode(self.CODE, self.to_fields(), self.talker, self.sent)
+
+
+class TextCodec:
+    """decode, encode and the stream parser of one text protocol, over its generated message classes."""
+
+    def __init__(self, framing: TextFraming, classes: Iterable[type[TextRecord]]) -> None:
+        self.framing = framing
+        self.classes = {cls.CODE: cls for cls in classes}
+
+    def message(self, sentence: Sentence) -> Any:
+        return self.classes[sentence.code].from_fields(sentence.values, sentence.talker, sentence.sent)
+
+    def decode(self, frame: bytes | str) -> Any:
+        """One frame -> its message; DecodeError (ChecksumError) says in one line why not."""
+        return self.message(self.framing.decode(frame))
+
+    def encode(self, message: TextRecord) -> bytes:
+        """A message -> its frame; EncodeError (RangeError) names the field at fault before any text is written."""
+        return message.encode()
+
+
+class TextMessageParser(TextStreamParser):
+    """The stream parser giving generated messages."""
+
+    def __init__(self, codec: TextCodec) -> None:
+        super().__init__(codec.framing)
+        self.codec = codec
+
+    def feed(self, data: bytes | bytearray | memoryview) -> list[Any]:
+        return [self.codec.message(s) for s in super().feed(data)]

@@ -7,7 +7,9 @@ pynmea2's attribute for the same field (PEER names them). The golden sentences a
 
 from __future__ import annotations
 
+import contextlib
 import datetime
+import io
 import math
 import random
 from dataclasses import replace
@@ -493,3 +495,16 @@ def test_an_example_that_does_not_decode_as_recorded_is_a_spec_error() -> None:
     assert EMITTER.verify is not None
     problems = EMITTER.verify(protocol, EMITTER.files(protocol))
     assert [p.message for p in problems] == ["the frame decodes to other values: hdop is '0.9', not '0.90'"]
+
+
+def test_the_tutorial_text_session_prints_what_it_says() -> None:
+    from conftest import ROOT
+
+    page = (ROOT / "docs" / "tutorial.md").read_text(encoding="utf-8")
+    session = page.split("```python\nimport nmea0183\n", 1)[1].split("```", 1)[0]
+    code = "import nmea0183\n" + session
+    printed = [line.removeprefix("# ") for line in session.splitlines() if line.startswith("# ")]
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        exec(compile(code, "tutorial.md", "exec"), {})
+    assert out.getvalue().splitlines() == printed

@@ -508,3 +508,18 @@ def test_the_tutorial_text_session_prints_what_it_says() -> None:
     with contextlib.redirect_stdout(out):
         exec(compile(code, "tutorial.md", "exec"), {})
     assert out.getvalue().splitlines() == printed
+
+
+@pytest.mark.parametrize("verb", [["decode", "24"], ["monitor", "--port", "/dev/null"], ["encode", "--json", "{}"]])
+def test_verbs_that_read_bytes_refuse_a_text_protocol_in_one_line(verb: list[str]) -> None:
+    import subprocess
+    import sys
+
+    from conftest import ROOT
+
+    spec = str(ROOT / "specs" / "nmea0183.yaml")
+    result = subprocess.run(
+        [sys.executable, "-m", "serialspec", verb[0], spec, *verb[1:]], capture_output=True, text=True, check=False
+    )
+    assert result.returncode != 0
+    assert result.stderr.count("\n") == 1 and "is a text protocol" in result.stderr, result.stderr

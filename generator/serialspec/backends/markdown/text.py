@@ -78,7 +78,7 @@ def _page(protocol: Protocol, frame: TextFrame) -> Iterator[str]:
         f"{serial.stopbits:g} stop bit{'s' if serial.stopbits != 1 else ''}."
     )
     yield ""
-    yield "## The frame"
+    yield "## Frame layout"
     yield ""
     if frame.description:
         yield text(frame.description)
@@ -99,7 +99,7 @@ def _page(protocol: Protocol, frame: TextFrame) -> Iterator[str]:
         )
     yield f"| end | {_shown(frame.end)} | ends every frame (at most {frame.max_length} characters before it) |"
     yield ""
-    yield "## Messages"
+    yield "## Command index"
     yield ""
     yield "| code | command | direction | title |"
     yield "| --- | --- | --- | --- |"
@@ -121,21 +121,27 @@ def _page(protocol: Protocol, frame: TextFrame) -> Iterator[str]:
         yield "| # | field | written as | range | meaning |"
         yield "| --- | --- | --- | --- | --- |"
         yield from _rows(message)
-    if frame.examples:
+    yield ""
+    yield "## Examples"
+    if not frame.examples:
         yield ""
-        yield "## Examples"
-        for example in frame.examples:
+        yield "None recorded."
+    for example in frame.examples:
+        yield ""
+        yield f"### {example.name}"
+        yield ""
+        yield f"{code_span(example.printed)} ({example.command}, {example.direction.value}; {text(example.source)})"
+        yield ""
+        if example.description:
+            yield text(example.description)
             yield ""
-            yield f"### {example.name}"
-            yield ""
-            yield f"{code_span(example.printed)} ({example.command}, {example.direction.value}; {text(example.source)})"
-            yield ""
-            if example.description:
-                yield text(example.description)
-                yield ""
-            yield "| characters | part |"
-            yield "| --- | --- |"
-            yield from _characters(frame, example.printed, example.fields)
+        yield "| characters | part |"
+        yield "| --- | --- |"
+        yield from _characters(frame, example.printed, example.fields)
+    yield ""
+    yield "## Errata"
+    yield ""
+    yield "None recorded (errata are not available in text frames yet)."
 
 
 def _characters(frame: TextFrame, printed: str, fields: dict[str, object]) -> Iterator[str]:

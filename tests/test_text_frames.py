@@ -17,7 +17,6 @@ from decimal import Decimal
 from enum import Enum
 from typing import Any
 
-import nmea0183
 import pynmea2
 import pytest
 from hypothesis import given, settings
@@ -35,6 +34,7 @@ from serialspec.runtime.text import (
     TextSentence,
     TextStreamParser,
 )
+from serialspec_protocols import nmea0183
 
 NMEA = nmea0183.FRAMING  # what specs/nmea0183.yaml declares
 NorthSouth, EastWest = nmea0183.NorthSouth, nmea0183.EastWest
@@ -501,8 +501,9 @@ def test_the_tutorial_text_session_prints_what_it_says() -> None:
     from conftest import ROOT
 
     page = (ROOT / "docs" / "tutorial.md").read_text(encoding="utf-8")
-    session = page.split("```python\nimport nmea0183\n", 1)[1].split("```", 1)[0]
-    code = "import nmea0183\n" + session
+    first = "from serialspec_protocols import nmea0183\n"
+    session = page.split("```python\n" + first, 1)[1].split("```", 1)[0]
+    code = first + session
     printed = [line.removeprefix("# ") for line in session.splitlines() if line.startswith("# ")]
     out = io.StringIO()
     with contextlib.redirect_stdout(out):

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define FEETECH_SMS_SPEC_SHA256 "e454eea266866106288a23f6dc59e71973fe574bd84e7808c5556d732ff04c74"
+#define FEETECH_SMS_SPEC_SHA256 "98d9eebfb4d6df7434e70aff5de830a0631dafd773160fe5a12330266ed882cf"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef FEETECH_SMS_ENABLE_ENCODE

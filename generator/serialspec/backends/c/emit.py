@@ -163,6 +163,8 @@ class Ctx:
 
 def refuse_unsupported(protocol: Protocol) -> None:
     """Raise Unsupported naming the first feature of the spec the C target cannot generate yet."""
+    if protocol.text is not None:
+        raise Unsupported("text framing (`framing: {kind: text}`)")
     for command in protocol.commands:
         if command.selector is not None and command.selector.type.size != 1:
             raise Unsupported(f"sub-command selectors of more than one byte (command {command.name})")

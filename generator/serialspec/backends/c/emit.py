@@ -29,6 +29,7 @@ from serialspec.lang.model import (
     Group,
     List,
     Message,
+    Packed,
     Protocol,
     Scalar,
     ScalarType,
@@ -200,13 +201,21 @@ def refuse_fields(fields: tuple[Field, ...], where: str, nested: bool = False) -
             case Scalar():
                 if f.value is not None and nested:
                     raise Unsupported(f"{where}: {f.name}: a value computed by an expression inside a group")
+                if f.type.size not in (1, 2, 4):
+                    raise Unsupported(f"{where}: {f.name}: fields of type {f.type.name}")
             case Array():
-                pass
+                if f.item.size not in (1, 2, 4):
+                    raise Unsupported(f"{where}: {f.name}: arrays of {f.item.name}")
+            case Packed():
+                raise Unsupported(f"{where}: {f.name}: packed arrays of {f.bits}-bit integers")
             case List():
+                if f.item is not None and f.item.size not in (1, 2, 4):
+                    raise Unsupported(f"{where}: {f.name}: lists of {f.item.name}")
                 if f.item is not None and f.item.is_float:
                     raise Unsupported(f"{where}: {f.name}: lists of floats")
             case Text():
-                pass
+                if f.pad is not None:
+                    raise Unsupported(f"{where}: {f.name}: padded strings")
             case Bytes():
                 pass
             case Group():
@@ -294,6 +303,8 @@ def field_doc(f: Field) -> str:
         parts.append(f"unit: {f.unit}")
     if isinstance(f, Scalar) and f.scale:
         parts.append(f"scale: {f.scale:g} per unit")
+    if isinstance(f, Scalar) and f.offset:
+        parts.append(f"offset: {f.offset:+g}")
     if isinstance(f, Scalar | Array) and not (isinstance(f, Scalar) and f.type.is_float):
         parts.append(f"range {f.minimum:g}..{f.maximum:g}")
     if isinstance(f, Scalar) and f.enum:

@@ -65,7 +65,6 @@ RESERVED_FIELD_NAMES = (
         "sum",
         "super",
         "tuple",
-        "type",
     }
 )
 # Names the generated modules (messages, codec, client, simulator, registers, __init__) import or define next to

@@ -20,7 +20,7 @@ from serialspec.lang.loader import CONTROL, Path
 
 SCALAR_TYPES = ("u8", "i8", "u16", "i16", "u32", "i32", "f32")
 # what a field (not a frame element, enum, flag set or table entry) can be besides those
-FIELD_SCALAR_TYPES = (*SCALAR_TYPES, "u24", "i24", "u64", "i64", "f64")
+FIELD_SCALAR_TYPES = ("u8", "i8", "u16", "i16", "u24", "i24", "u32", "i32", "u64", "i64", "f32", "f64")
 BIT_ORDERS = ("lsb_first", "msb_first")
 
 

@@ -34,15 +34,15 @@ SCALARS: dict[str, ScalarType] = {
     "i8": ScalarType("i8", 1, "b", True, False, -0x80, 0x7F),
     "u16": ScalarType("u16", 2, "H", False, False, 0, 0xFFFF),
     "i16": ScalarType("i16", 2, "h", True, False, -0x8000, 0x7FFF),
-    "u32": ScalarType("u32", 4, "I", False, False, 0, 0xFFFFFFFF),
-    "i32": ScalarType("i32", 4, "i", True, False, -0x80000000, 0x7FFFFFFF),
-    "f32": ScalarType("f32", 4, "f", True, True, -3.4028234663852886e38, 3.4028234663852886e38),
-    # fields only (not frame elements, enums, flags or tables): 3-byte integers are read as 3 bytes ("3s") and
-    # converted (runtime.packing), the others are struct's own
+    # 3-byte integers (fields only, as the 64-bit types: not frame elements, enums, flags or tables) are read as 3
+    # bytes ("3s") and converted, since struct has no format for them
     "u24": ScalarType("u24", 3, "3s", False, False, 0, 0xFFFFFF),
     "i24": ScalarType("i24", 3, "3s", True, False, -0x800000, 0x7FFFFF),
+    "u32": ScalarType("u32", 4, "I", False, False, 0, 0xFFFFFFFF),
+    "i32": ScalarType("i32", 4, "i", True, False, -0x80000000, 0x7FFFFFFF),
     "u64": ScalarType("u64", 8, "Q", False, False, 0, 0xFFFFFFFFFFFFFFFF),
     "i64": ScalarType("i64", 8, "q", True, False, -0x8000000000000000, 0x7FFFFFFFFFFFFFFF),
+    "f32": ScalarType("f32", 4, "f", True, True, -3.4028234663852886e38, 3.4028234663852886e38),
     "f64": ScalarType("f64", 8, "d", True, True, -1.7976931348623157e308, 1.7976931348623157e308),
 }
 

@@ -71,7 +71,12 @@ class ScalarKind(Kind[Scalar]):
             )
         if f.bits:
             return ""
-        return scalar_range(f.type, f.minimum, f.maximum)
+        shown = scalar_range(f.type, f.minimum, f.maximum)
+        if f.offset is not None and not f.type.is_float:  # the engineering values too: wire × scale + offset
+            scale = 1 if f.scale is None else f.scale
+            low, high = sorted((f.minimum * scale + f.offset, f.maximum * scale + f.offset))
+            shown += f" (engineering {number(round(low, 6))}..{number(round(high, 6))})"
+        return shown
 
     def meaning(self, f: Scalar) -> list[str]:
         parts = []

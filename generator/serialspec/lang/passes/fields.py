@@ -222,7 +222,7 @@ class FieldResolver(Pass):
         if kind == "array" and (spec.get("of") == "bit" or not isinstance(spec.get("count"), int) or "size" in spec):
             return self.list_field(common, spec, path, endian, siblings)
         if kind == "array":
-            item_type = self.scalar_type(spec.get("of"), (*path, "of"))
+            item_type = self.scalar_type(spec.get("of"), (*path, "of"), for_field=True)
             count = spec.get("count")
             if not isinstance(count, int) or count < 1:
                 raise self.fail((*path, "count"), "an array needs a fixed `count` (use a group for counted items)")
@@ -322,7 +322,7 @@ class FieldResolver(Pass):
         """An array whose count varies (a count field, a byte-size field, the rest), or an array of bits."""
         name = common["name"]
         bits = spec.get("of") == "bit"
-        item_type = None if bits else self.scalar_type(spec.get("of"), (*path, "of"))
+        item_type = None if bits else self.scalar_type(spec.get("of"), (*path, "of"), for_field=True)
         if item_type is not None and item_type.size == 3:
             raise self.fail((*path, "count"), f"an array of {item_type.name} items needs a fixed `count` (a number)")
         count = spec.get("count", "")

@@ -374,6 +374,8 @@ def members(ctx: Ctx, fields: tuple[Field, ...], path: str, room: int) -> list[M
                     macro = cap_macro(ctx, f"{path}_{f.name}", most)
                     found.append(Member(name, f"{ctype(f.item)} {name}[{macro}];", doc))
                     found.append(Member(f"{name}_count", f"size_t {name}_count;", f"items in {f.name}"))
+            case Packed():  # refused by refuse_fields
+                raise Unsupported(f"{f.name}: packed arrays")
             case _:
                 assert_never(f)
     return found
@@ -564,6 +566,8 @@ def decode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                     out.append(f"{pad}    {tgt}[i{depth}] = {value};")
                     out.append(f"{pad}}}")
                 out.append(f"{pad}o += len;")
+            case Packed():  # refused by refuse_fields
+                raise Unsupported(f"{f.name}: packed arrays")
             case _:
                 assert_never(f)
 
@@ -759,6 +763,8 @@ def check_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[st
                         out.append(f"{pad}for (i{depth} = 0u; i{depth} < {tgt}_count; i{depth}++) {{")
                         out.append(f"{pad}    if ({test}) {{ return {ctx.P}_E_RANGE; }} /* {f.name} */")
                         out.append(f"{pad}}}")
+            case Packed():  # refused by refuse_fields
+                raise Unsupported(f"{f.name}: packed arrays")
             case _:
                 assert_never(f)
 
@@ -906,6 +912,8 @@ def encode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                     out.append(f"{pad}    {ctx.p}__put(c + o, {size}u, {big}u, {value}); /* {f.name} */")
                     out.append(f"{pad}    o += {size}u;")
                     out.append(f"{pad}}}")
+            case Packed():  # refused by refuse_fields
+                raise Unsupported(f"{f.name}: packed arrays")
             case _:
                 assert_never(f)
 
@@ -1042,6 +1050,8 @@ def json_fields(ctx: Ctx, fields: tuple[Field, ...], target: str, out: list[str]
                     out.append(f"{pad}    " + json_number(ctx, f.item, f"{tgt}[i{depth}]"))
                 out.append(f"{pad}}}")
                 out.append(f'{pad}{ctx.p}__ws(w, "]");')
+            case Packed():  # refused by refuse_fields
+                raise Unsupported(f"{f.name}: packed arrays")
             case _:
                 assert_never(f)
     return first

@@ -111,12 +111,11 @@ def members_name(class_name: str) -> str:
 
 def run_endian(fields: list[SpecField]) -> str:
     """The struct byte order of a run of fixed-size fields: its first multi-byte field's."""
-    return next((f.endian for f in fields if isinstance(f, Array | TableBlock) or _struct_scalar(f)), "<")
-
-
-def _struct_scalar(f: SpecField) -> bool:
-    """A scalar struct reads in the run's byte order (a 3-byte one is read as bytes and converted in its own)."""
-    return isinstance(f, Scalar) and not f.odd_width
+    for f in fields:
+        # a 3-byte scalar is read as bytes and converted in its own byte order
+        if isinstance(f, Array | TableBlock) or (isinstance(f, Scalar) and not f.odd_width):
+            return f.endian
+    return "<"
 
 
 def struct_format(endian: str, fields: list[SpecField]) -> str:

@@ -209,7 +209,7 @@ class FieldResolver(Pass):
             if kind == "cstring":
                 if size is not None:
                     self.error((*path, "size"), "a cstring ends at its NUL byte: it takes no `size`")
-                return Text(**common, size=None)
+                return Text(**common, size=None, pad=None)
             if size is None:
                 raise self.fail(path, "a string needs `size`: a number, `rest`, or a field name (or use cstring)")
             if isinstance(size, str) and size != "rest":

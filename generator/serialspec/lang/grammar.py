@@ -428,7 +428,13 @@ FIELD = OneOf(
     ),
     "A field: a wire type or the name of a shared field (short form), or a mapping (long form).",
 )
-FIELDS: Shape = MapOf(FIELD, "Fields in wire order: name -> type or mapping.")
+FIELDS: Shape = MapOf(
+    FIELD,
+    "Fields in wire order: name -> type or mapping. A name is any lower-case identifier the protocol uses (`type`, "
+    "`id`, `data`) except Python keywords and the few names generated code uses itself (`self`, `request`, `reply`, "
+    "`to_fields`, builtins a client method calls such as `len`): those are refused, one line naming them; rename "
+    "the field (`class_`).",
+)
 
 OPTIONAL_WHEN = Obj(
     {

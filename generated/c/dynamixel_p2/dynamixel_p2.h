@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define DYNAMIXEL_P2_SPEC_SHA256 "4f51f1747acd7865747c1fc86e094376590aea756c253f718704f92f1f1ab956"
+#define DYNAMIXEL_P2_SPEC_SHA256 "6475a44b042a59f6ed7cff2ef420be39b130a9730d1231c2c3f42b0d6a9178a8"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef DYNAMIXEL_P2_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define FEETECH_SMS_SPEC_SHA256 "54e99ce9c13325dfdaa6c8116eb62051094b7f84d16dfff30d47c04ee7a76f2f"
+#define FEETECH_SMS_SPEC_SHA256 "5180810e1d694984d9cd808330aa6693d6f67ba2416b9395dcb1d79bb677558c"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef FEETECH_SMS_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define HIWONDER_RRC_SPEC_SHA256 "771e42878ebbc55d97ac9c2a5279d2e143aef267f763c39321014855e82f4d16"
+#define HIWONDER_RRC_SPEC_SHA256 "9a03844fe7981fc4f23d36deb95bec362fdb18736cd40bcdb95d1d739c06c301"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef HIWONDER_RRC_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define VESC_SPEC_SHA256 "ac6753bce60623d9f3c112c98d94e3843593c28b7a4be863933dc53a6174d593"
+#define VESC_SPEC_SHA256 "0070f778d40e6bfeb0f0b7d0d4d1945e6fad55c800f5381f9647475a6b411979"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef VESC_ENABLE_ENCODE

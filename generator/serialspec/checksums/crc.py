@@ -15,12 +15,15 @@ from typing import Any
 
 from serialspec.checksums.base import (
     Algorithm,
+    CCode,
     ChecksumProblem,
     Import,
     Key,
+    NoCode,
     Report,
     Sample,
     TableSteps,
+    c_uint,
     hex_bytes,
     hex_value,
 )
@@ -360,6 +363,74 @@ class Crc(Algorithm):
         finish = (f"{target} ^= {self.xorout:#x}",) if self.xorout else ()
         return TableSteps(f"{name.upper()}_TABLE", crc_table(8, self.poly, self.refin), start, finish)
 
+    def c_code(self, prefix: str) -> CCode:
+        if not 8 <= self.width <= 32:
+            raise NoCode(f"a CRC of {self.width} bits")
+        title = self.title()
+        slug = "".join(ch if ch.isalnum() else "_" for ch in title.split(" ")[0].lower()).strip("_") if title else ""
+        if not slug:
+            slug = f"crc{self.width}_{self.poly:x}_{self.init:x}_{int(self.refin)}{int(self.refout)}_{self.xorout:x}"
+        name = f"{prefix}_{slug}"
+        mask = (1 << self.width) - 1
+        t = c_uint(self.width)
+        if (
+            self.refin
+        ):  # the register kept in the input's bit order (reflected); finish reflects it where refout differs
+            start = _reflect(self.init, self.width)
+            poly = _reflect(self.poly, self.width)
+            loop = (
+                "        r ^= data[i];\n"
+                "        for (bit = 0; bit < 8; bit++) {\n"
+                f"            r = (r & 1u) ? ((r >> 1) ^ 0x{poly:x}u) : (r >> 1);\n"
+                "        }"
+            )
+        else:
+            start = self.init
+            top = 1 << (self.width - 1)
+            loop = (
+                f"        r ^= (uint32_t)data[i] << {self.width - 8};\n"
+                "        for (bit = 0; bit < 8; bit++) {\n"
+                f"            r = (r & 0x{top:x}u) ? (((r << 1) ^ 0x{self.poly:x}u) & 0x{mask:x}u)"
+                f" : ((r << 1) & 0x{mask:x}u);\n"
+                "        }"
+            )
+        reflect = self.refin != self.refout
+        finish = f"{prefix}__reflect((uint32_t)({{a}}), {self.width})" if reflect else "(uint32_t)({a})"
+        if self.xorout:
+            finish = f"(({finish}) ^ 0x{self.xorout:x}u)"
+        steps = ("reflect the result over its width, " if reflect else "") + (
+            f"xor it with 0x{self.xorout:x}" if self.xorout else "use it as is"
+        )
+        doc = (
+            f"/* {title or 'CRC'}: width {self.width}, poly 0x{self.poly:x}, init 0x{self.init:x}, refin "
+            f"{str(self.refin).lower()}, refout {str(self.refout).lower()}, xorout 0x{self.xorout:x} (check "
+            f"0x{self.check:x}). Incremental: start with 0x{start:x}, feed pieces, then {steps}. Bitwise: no table, "
+            "no static data. */"
+        )
+        body = f"""{doc}
+{t} {name}({t} acc, const uint8_t *data, size_t n)
+{{
+    uint32_t r = acc;
+    size_t i;
+    int bit;
+    for (i = 0; i < n; i++) {{
+{loop}
+    }}
+    return ({t})(r & 0x{mask:x}u);
+}}
+"""
+        prototype = f"{t} {name}({t} acc, const uint8_t *data, size_t n);"
+        return CCode(name, t, body, prototype, f"0x{start:x}u", finish)
+
+    @classmethod
+    def lua_function(cls) -> str:
+        return _LUA
+
+    def lua_parameters(self) -> dict[str, Any]:
+        return {"name": self.catalogue} | {
+            p: getattr(self, p) for p in ("width", "poly", "init", "refin", "refout", "xorout")
+        }
+
     def describe(self) -> str:
         return f"{self.title() or 'CRC'} over the covered bytes"
 
@@ -376,3 +447,39 @@ class Crc(Algorithm):
 
     def worked(self, covered: bytes) -> str:
         return f"{self.title() or 'CRC'} of {hex_bytes(covered)} = {hex_value(self.function()(covered), self.width)}"
+
+
+# the dissector's code (Algorithm.lua_function): bit by bit, from the catalogue parameters
+_LUA = """function(spec, size, data)
+  local function reflect(value, width)
+    local result = 0
+    for _ = 1, width do
+      result = bor(lshift(result, 1), band(value, 1))
+      value = rshift(value, 1)
+    end
+    return result
+  end
+  local width = spec.width
+  local top, crc_mask = lshift(1, width - 1), width_mask(width)
+  local crc = spec.init
+  for i = 1, #data do
+    local byte = data:byte(i)
+    if spec.refin then
+      byte = reflect(byte, 8)
+    end
+    for bit = 7, 0, -1 do
+      local feedback = band(crc, top) ~= 0
+      if band(rshift(byte, bit), 1) == 1 then
+        feedback = not feedback
+      end
+      crc = band(lshift(crc, 1), crc_mask)
+      if feedback then
+        crc = bxor(crc, spec.poly)
+      end
+    end
+  end
+  if spec.refout then
+    crc = reflect(crc, width)
+  end
+  return band(bxor(crc, spec.xorout), crc_mask)
+end"""

@@ -12,7 +12,17 @@ from dataclasses import dataclass
 from itertools import accumulate
 from typing import Any
 
-from serialspec.checksums.base import Algorithm, ChecksumProblem, Import, Key, Report, Sample, hex_bytes, hex_value
+from serialspec.checksums.base import (
+    Algorithm,
+    CCode,
+    ChecksumProblem,
+    Import,
+    Key,
+    Report,
+    Sample,
+    hex_bytes,
+    hex_value,
+)
 
 
 def fletcher_function(modulus: int) -> Callable[[bytes], int]:
@@ -60,6 +70,32 @@ class Fletcher(Algorithm):
     def function_code(self) -> tuple[Import, str]:
         return ("serialspec.checksums.fletcher", "fletcher_function"), f"fletcher_function({self.modulus})"
 
+    def c_code(self, prefix: str) -> CCode:
+        m = self.modulus
+        name = f"{prefix}_fletcher{m}"
+        body = f"""/* Fletcher modulo {m}: CK_A the sum of the bytes, CK_B the sum of CK_A after each byte; the value is
+ * CK_B << 8 | CK_A. Incremental: acc holds CK_B << 8 | CK_A, start with 0. */
+uint16_t {name}(uint16_t acc, const uint8_t *data, size_t n)
+{{
+    uint32_t a = acc & 0xFFu, b = (uint32_t)acc >> 8;
+    size_t i;
+    for (i = 0; i < n; i++) {{
+        a = (a + data[i]) % {m}u;
+        b = (b + a) % {m}u;
+    }}
+    return (uint16_t)((b << 8) | a);
+}}
+"""
+        prototype = f"uint16_t {name}(uint16_t acc, const uint8_t *data, size_t n);"
+        return CCode(name, "uint16_t", body, prototype, "0u", "(uint32_t)({a})")
+
+    @classmethod
+    def lua_function(cls) -> str:
+        return _LUA
+
+    def lua_parameters(self) -> dict[str, Any]:
+        return {"modulus": self.modulus}
+
     def describe(self) -> str:
         return (
             f"Fletcher checksum modulo {self.modulus} over the covered bytes: CK_A the sum of the bytes, CK_B the "
@@ -70,3 +106,14 @@ class Fletcher(Algorithm):
         value = self.function()(covered)
         sums = f"CK_A = 0x{value & 0xFF:02X}, CK_B = 0x{value >> 8:02X}"
         return f"over {hex_bytes(covered)}: {sums} → {hex_value(value, 16)}"
+
+
+# the dissector's code (Algorithm.lua_function): CK_B << 8 | CK_A
+_LUA = """function(spec, size, data)
+  local a, b = 0, 0
+  for i = 1, #data do
+    a = (a + data:byte(i)) % spec.modulus
+    b = (b + a) % spec.modulus
+  end
+  return b * 256 + a
+end"""

@@ -6,7 +6,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from serialspec.checksums.base import Algorithm, Import, Key, Report, Sample, hex_value
+from serialspec.checksums.base import Algorithm, CCode, Import, Key, Report, Sample, c_uint, hex_value
 
 
 def sum_function(width: int, invert: bool) -> Callable[[bytes], int]:
@@ -72,6 +72,36 @@ class Sum(Algorithm):
     def summed(self) -> bool | None:
         return self.invert if self.width == 8 else None
 
+    def c_code(self, prefix: str) -> CCode:
+        t = c_uint(self.width)
+        name = f"{prefix}_sum{self.width}"
+        mask = (1 << self.width) - 1
+        final = "the sum inverted" if self.invert else "the sum"
+        doc = (
+            f"/* Sum of the bytes modulo 2^{self.width}. Incremental: start with 0; the frame's checksum is {final}. */"
+        )
+        body = f"""{doc}
+{t} {name}({t} acc, const uint8_t *data, size_t n)
+{{
+    uint32_t s = acc;
+    size_t i;
+    for (i = 0; i < n; i++) {{
+        s += data[i];
+    }}
+    return ({t})(s & 0x{mask:x}u);
+}}
+"""
+        finish = f"(~(uint32_t)({{a}}) & 0x{mask:x}u)" if self.invert else "(uint32_t)({a})"
+        prototype = f"{t} {name}({t} acc, const uint8_t *data, size_t n);"
+        return CCode(name, t, body, prototype, "0u", finish)
+
+    @classmethod
+    def lua_function(cls) -> str:
+        return _LUA
+
+    def lua_parameters(self) -> dict[str, Any]:
+        return {"invert": self.invert}
+
     def describe(self) -> str:
         what = "bitwise NOT of the sum" if self.invert else "sum"
         return f"{what} of the covered bytes, modulo {1 << self.width}"
@@ -80,3 +110,14 @@ class Sum(Algorithm):
         invert = "~" if self.invert else ""
         terms = " + ".join(f"0x{b:02X}" for b in covered) or "0"
         return f"{invert}({terms}) = {invert}{sum(covered):#x} → {hex_value(self.function()(covered), self.width)}"
+
+
+# the dissector's code (Algorithm.lua_function)
+_LUA = """function(spec, size, data)
+  local mask = width_mask(size * 8)
+  local total = 0
+  for i = 1, #data do
+    total = (total + data:byte(i)) % (mask + 1)
+  end
+  return spec.invert and mask - total or total
+end"""

@@ -14,8 +14,9 @@ from dataclasses import dataclass, field
 from typing import assert_never
 
 from serialspec.backends import Unsupported
-from serialspec.backends.c.checksums import CChecksum, c_checksum
+from serialspec.backends.c.checksums import c_checksum
 from serialspec.backends.common.text import collapse
+from serialspec.checksums.base import CCode
 from serialspec.lang import expression
 from serialspec.lang.expression import Expr
 from serialspec.lang.model import (
@@ -142,7 +143,7 @@ class Ctx:
     protocol: Protocol
     p: str
     P: str
-    checks: list[tuple[Checksum, CChecksum]] = field(default_factory=list)
+    checks: list[tuple[Checksum, CCode]] = field(default_factory=list)
     caps: list[str] = field(default_factory=list)  # #ifndef capacity defaults for the header
     structs: list[str] = field(default_factory=list)
     helpers: set[str] = field(default_factory=set)
@@ -677,7 +678,7 @@ def scalar_bits(ctx: Ctx, t: ScalarType, expr: str) -> str:
         return f"{ctx.p}__f32bits({expr})"
     if t.signed:
         mask = (1 << (8 * t.size)) - 1
-        return f"((uint32_t)(int32_t)({expr}) & 0x{mask:x}UL)"
+        return f"((uint32_t)(int32_t)({expr}) & 0x{mask:x}u)"
     return f"(uint32_t)({expr})"
 
 

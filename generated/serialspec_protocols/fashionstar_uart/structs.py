@@ -46,7 +46,15 @@ from construct import (  # noqa: F401 - the set of names is the same for every p
     this,
 )
 from serialspec.checksums.sum import sum_function
-from serialspec.runtime.constructs import PackedBits, PackedInts, PaddedUtf8, SignMagnitude, Utf8, derived, valued  # noqa: F401
+from serialspec.runtime.constructs import (  # noqa: F401
+    PackedBits,
+    PackedInts,
+    PaddedUtf8,
+    SignMagnitude,
+    Utf8,
+    derived,
+    valued,
+)
 
 _checksum = sum_function(8, False)
 

@@ -35,6 +35,7 @@ from serialspec.lang.model import (
     Group,
     List,
     Message,
+    Packed,
     Protocol,
     Scalar,
     TableBlock,
@@ -153,7 +154,7 @@ def field_rows(fields: tuple[Field, ...], start: int | None, prefix: str = "") -
                     )
                     for e in f.entries
                 ]
-            case Scalar() | Array() | List() | Text() | Bytes() | TableValue():
+            case Scalar() | Array() | Packed() | List() | Text() | Bytes() | TableValue():
                 pass  # one row
             case _:
                 assert_never(f)

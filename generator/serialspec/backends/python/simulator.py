@@ -18,6 +18,7 @@ from serialspec.lang.model import (
     Group,
     List,
     Message,
+    Packed,
     Protocol,
     Scalar,
     SpaceAccess,
@@ -82,7 +83,7 @@ def table_fields(*messages: Message | None) -> dict[str, tuple[str, ...]]:
                 found[f.name] = ("run", f.start, f.size_from)
             case Group():
                 stack.extend(reversed(f.fields))
-            case Scalar() | Array() | List() | Text() | Bytes():
+            case Scalar() | Array() | Packed() | List() | Text() | Bytes():
                 pass  # no table entries
             case _:
                 assert_never(f)

@@ -892,7 +892,7 @@ def whole_frames(
     ]
     lines = [
         f"whole = {table}.get(frame[:{positions.content}])",
-        f"if whole is not None and {' and '.join(conditions)}:",
+        f"if {' and '.join(['whole is not None', *conditions])}:",
         "    try:",
         "        return _new(whole[0], whole[1](frame))",
         "    except struct.error:",

@@ -1,0 +1,104 @@
+"""Specs that `serialspec check` accepts and that a verb then failed on (a traceback or a wrong result), each
+written as a new user writes one from docs/language.md (issue 21, "Bugs hit on specs that check accepts")."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from serialspec.cli import main
+
+HEAD = """\
+protocol: {name}
+title: A spec a new user writes
+byte_order: little
+serial:
+  baudrate: 9600
+"""
+
+# A header, the command, a length and the content: no checksum.
+NO_CHECKSUM = """\
+framing:
+  elements:
+    header: {role: header, value: "AA"}
+    command: {role: command, type: u8}
+    length: {role: length, type: u8}
+    content: {role: content}
+commands:
+  heartbeat:
+    code: 1
+    request:
+      fields: {kind: u8, mode: u8}
+    response:
+      fields: {kind: u8, mode: u8}
+  status:
+    code: 7
+    response:
+      unsolicited: true
+      fields: {level: u8}
+"""
+
+
+def spec(tmp_path: Path, name: str, body: str) -> str:
+    path = tmp_path / f"{name}.yaml"
+    path.write_text(HEAD.format(name=name) + body)
+    return str(path)
+
+
+def test_a_protocol_without_a_checksum_decodes_and_says_no_checksum_was_checked(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`decode --json` said "checksum_ok": true where the frames carry no checksum (and the codec of such a
+    length-byte framing did not compile: `if whole is not None and :`)."""
+    path = spec(tmp_path, "nock", NO_CHECKSUM)
+    assert main(["decode", path, "aa 01 02 05 06", "--json", "--direction", "request"]) == 0
+    decoded = json.loads(capsys.readouterr().out)
+    assert decoded["fields"] == {"kind": 5, "mode": 6}
+    assert decoded["checksum_ok"] is None
+
+
+def test_decode_without_a_direction_takes_the_one_direction_a_frame_decodes_in(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A reply whose code only replies have was refused without --direction ("give the direction")."""
+    path = spec(tmp_path, "onlyreply", NO_CHECKSUM)
+    assert main(["decode", path, "aa 07 01 05", "--json"]) == 0
+    decoded = json.loads(capsys.readouterr().out)
+    assert (decoded["direction"], decoded["command"], decoded["fields"]) == ("response", "status", {"level": 5})
+    # a frame both directions decode still needs the direction; one that neither does says why
+    assert main(["decode", path, "aa 01 02 05 06"]) == 1
+    assert "give the direction" in capsys.readouterr().err
+    assert main(["decode", path, "aa 09 01 05"]) == 1
+    assert capsys.readouterr().err.strip() == "serialspec decode: aa 09 01 05: unknown command 9"
+
+
+def test_yaml_merge_keys_bring_in_the_anchored_keys(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """`<<: *common` gave a traceback (no constructor for tag:yaml.org,2002:merge)."""
+    body = """\
+framing:
+  elements:
+    header: {role: header, value: "AA"}
+    command: {role: command, type: u8}
+    length: {role: length, type: u8}
+    content: {role: content}
+    checksum: {role: checksum, type: u8, algorithm: sum, covers: [command, content]}
+fields:
+  common: &common
+    type: u8
+    range: [0, 10]
+commands:
+  one:
+    code: 1
+    request:
+      fields:
+        a:
+          <<: *common
+          description: first
+        b: {<<: *common, range: [0, 5]}
+"""
+    path = spec(tmp_path, "mergek", body)
+    assert main(["encode", path, "--json", '{"command": "one", "fields": {"a": 3, "b": 4}}']) == 0
+    assert capsys.readouterr().out.strip() == "aa 01 02 03 04 0a"
+    assert main(["encode", path, "--json", '{"command": "one", "fields": {"a": 3, "b": 7}}']) == 1
+    assert capsys.readouterr().err.strip() == "serialspec encode: one request: b = 7 is outside its range 0..5"

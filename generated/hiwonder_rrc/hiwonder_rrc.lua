@@ -2773,6 +2773,16 @@ local function reflect(value, width)
   return result
 end
 
+-- a sum or XOR inverted (one's complement) or negated (two's complement) within its bits, then masked
+local function finish(spec, value, mask)
+  if spec.invert then
+    value = mask - value
+  elseif spec.negate then
+    value = (mask + 1 - value) % (mask + 1)
+  end
+  return spec.mask and band(value, spec.mask) or value
+end
+
 local function checksum(spec, size, data)
   local mask = width_mask(size * 8)
   if spec.algorithm == "sum" then
@@ -2780,7 +2790,7 @@ local function checksum(spec, size, data)
     for i = 1, #data do
       total = (total + data:byte(i)) % (mask + 1)
     end
-    return spec.invert and mask - total or total
+    return finish(spec, total, mask)
   elseif spec.algorithm == "fletcher" then -- CK_B << 8 | CK_A
     local a, b = 0, 0
     for i = 1, #data do
@@ -2797,7 +2807,7 @@ local function checksum(spec, size, data)
       end
       total = bxor(total, word)
     end
-    return total
+    return finish(spec, total, mask)
   end
   local width = spec.width
   local top, crc_mask = lshift(1, width - 1), width_mask(width)

@@ -72,6 +72,36 @@ class TableSteps:
     finish: tuple[str, ...] = ()
 
 
+# Keys more than one algorithm owns: how the result is finished (`finish` below), after the bytes are taken in.
+INVERT = Key("invert", "bool", "sum, xor: the result bitwise inverted (one's complement).", default=False)
+MASK = Key(
+    "mask",
+    "int",
+    "sum, xor: ANDed with the result, after `invert` or `negate` (HerkuleX: 0xFE clears bit 0).",
+    example=0xFE,
+    minimum=1,
+)
+
+
+def finish(value: int, width: int, invert: bool, negate: bool, mask: int | None) -> int:
+    """A result inverted (one's complement) or negated (two's complement) within `width` bits, then masked."""
+    if invert:
+        value = ~value
+    elif negate:
+        value = -value
+    return value & ((1 << width) - 1) & (mask if mask is not None else -1)
+
+
+def finish_problem(raw: Mapping[str, Any], width: int) -> ChecksumProblem | None:
+    """Why `invert`, `negate` and `mask` of a checksum element of `width` bits do not go together, or None."""
+    if raw.get("invert") and raw.get("negate"):
+        return ChecksumProblem(("negate",), "give `invert` (one's complement) or `negate` (two's complement), not both")
+    mask = raw.get("mask")
+    if mask is not None and not 0 < mask < 1 << width:
+        return ChecksumProblem(("mask",), f"mask {mask:#x} does not fit the checksum's {width} bits")
+    return None
+
+
 _REGISTERED: dict[str, type[Algorithm]] = {}
 
 

@@ -130,7 +130,10 @@ def _hex(text: str) -> bytes:
 def _has_checksum(protocol: Protocol, direction: str) -> bool:
     """Whether the frames of a direction carry a checksum (in any of its layouts)."""
     return any(
-        layout.checksums for d, layouts in protocol.framing.alternatives.items() if d.value == direction for layout in layouts
+        layout.checksums
+        for d, layouts in protocol.framing.alternatives.items()
+        if d.value == direction
+        for layout in layouts
     )
 
 

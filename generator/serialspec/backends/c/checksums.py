@@ -107,7 +107,8 @@ def _sum(prefix: str, checksum: Checksum) -> CChecksum:
     t = _ctype(width)
     name = f"{prefix}_sum{width}"
     mask = (1 << width) - 1
-    final = "the sum inverted" if algorithm.invert else "the sum"
+    final = "the sum inverted" if algorithm.invert else "the sum negated" if algorithm.negate else "the sum"
+    final += f", ANDed with 0x{algorithm.mask:x}" if algorithm.mask is not None else ""
     body = f"""/* Sum of the bytes modulo 2^{width}. Incremental: start with 0; the frame's checksum is {final}. */
 {t} {name}({t} acc, const uint8_t *data, size_t n)
 {{
@@ -119,15 +120,24 @@ def _sum(prefix: str, checksum: Checksum) -> CChecksum:
     return ({t})(s & 0x{mask:x}u);
 }}
 """
-    finish = f"(~(uint32_t)({{a}}) & 0x{mask:x}u)" if algorithm.invert else "(uint32_t)({a})"
     prototype = f"{t} {name}({t} acc, const uint8_t *data, size_t n);"
-    return CChecksum(name, t, body, prototype, "0u", finish)
+    return CChecksum(name, t, body, prototype, "0u", _finish(algorithm.sign, algorithm.whole))
+
+
+def _finish(sign: str, whole: int) -> str:
+    """The C finish of an accumulator inverted (~), negated (-) or kept (""), within the bits of `whole`."""
+    if not sign and whole == 0xFFFFFFFF:
+        return "(uint32_t)({a})"
+    return f"({sign}(uint32_t)({{a}}) & 0x{whole:x}u)"
 
 
 def _xor(prefix: str, checksum: Checksum) -> CChecksum:
     algorithm = checksum.algorithm
     assert isinstance(algorithm, Xor)
     width = algorithm.width
+    whole = (1 << width) - 1 & (algorithm.mask if algorithm.mask is not None else -1)
+    plain = not algorithm.invert and algorithm.mask is None
+    xor_finish = "(uint32_t)({a})" if plain else _finish("~" if algorithm.invert else "", whole)
     if width == 8:
         name = f"{prefix}_xor8"
         body = f"""/* XOR of the bytes. Incremental: start with 0. */
@@ -142,7 +152,7 @@ uint8_t {name}(uint8_t acc, const uint8_t *data, size_t n)
 }}
 """
         prototype = f"uint8_t {name}(uint8_t acc, const uint8_t *data, size_t n);"
-        return CChecksum(name, "uint8_t", body, prototype, "0u", "(uint32_t)({a})")
+        return CChecksum(name, "uint8_t", body, prototype, "0u", xor_finish)
     size = width // 8
     t = _ctype(width)
     name = f"{prefix}_xor{width}"
@@ -163,7 +173,7 @@ uint8_t {name}(uint8_t acc, const uint8_t *data, size_t n)
 }}
 """
     prototype = f"{t} {name}({t} acc, const uint8_t *data, size_t n);"
-    return CChecksum(name, t, body, prototype, "0u", "(uint32_t)({a})")
+    return CChecksum(name, t, body, prototype, "0u", xor_finish)
 
 
 def _fletcher(prefix: str, checksum: Checksum) -> CChecksum:

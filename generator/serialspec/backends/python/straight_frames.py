@@ -299,7 +299,16 @@ def _residue(element: Element) -> int | None:
     assert function is not None
     samples = (b"", b"\x00", b"\x01\x02", b"123456789", b"\xff" * 7, bytes(range(1, 18)))
     found = {function(data + element.pack(function(data))) for data in samples}
-    return found.pop() if len(found) == 1 else None
+    if len(found) != 1:
+        return None
+    residue = found.pop()
+    # and only the right checksum gives it: a masked one (HerkuleX `& 0xFE`) gives it for a wrong bit 0 as well
+    for data in samples:
+        check = function(data)
+        for bit in range(8 * element.size):
+            if function(data + element.pack(check ^ 1 << bit)) == residue:
+                return None
+    return residue
 
 
 def _dispatch(target: Target, code: str, arguments: str, nullable: bool) -> Lines:

@@ -171,9 +171,9 @@ def _checksum(checksum: Checksum) -> dict[str, Any]:
     algorithm = checksum.algorithm
     match algorithm:
         case Sum():
-            return {"algorithm": "sum", "invert": algorithm.invert}
+            return {"algorithm": "sum", "invert": algorithm.invert, "negate": algorithm.negate} | _mask(algorithm.mask)
         case Xor():
-            return {"algorithm": "xor"}
+            return {"algorithm": "xor", "invert": algorithm.invert} | _mask(algorithm.mask)
         case Fletcher():
             return {"algorithm": "fletcher", "modulus": algorithm.modulus}
         case Crc():
@@ -181,6 +181,11 @@ def _checksum(checksum: Checksum) -> dict[str, Any]:
             return {"algorithm": "crc", "name": algorithm.catalogue} | {p: getattr(algorithm, p) for p in parameters}
     # an algorithm this backend has no Lua for yet: the dissector shows the value, unverified, and says why
     return {"algorithm": algorithm.name, "unverified": True}
+
+
+def _mask(mask: int | None) -> dict[str, int]:
+    """A checksum's `mask`, ANDed with its result (after inverting or negating), where it has one."""
+    return {} if mask is None else {"mask": mask}
 
 
 def _message(protocol: Protocol, message: Message) -> dict[str, Any]:

@@ -82,7 +82,8 @@ class Xor(Algorithm):
         masked = f", ANDed with {hex_value(self.mask, self.width)}" if self.mask is not None else ""
         if self.width == 8:
             return f"{what} of the covered bytes{masked}"
-        return f"{what} of the covered bytes taken as big-endian {self.width}-bit words (the last padded with zeros){masked}"
+        words = f"big-endian {self.width}-bit words (the last padded with zeros)"
+        return f"{what} of the covered bytes taken as {words}{masked}"
 
     def parameters(self) -> list[tuple[str, str]]:
         return [("mask", hex_value(self.mask, self.width))] if self.mask is not None else []

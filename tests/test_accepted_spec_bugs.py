@@ -102,3 +102,66 @@ commands:
     assert capsys.readouterr().out.strip() == "aa 01 02 03 04 0a"
     assert main(["encode", path, "--json", '{"command": "one", "fields": {"a": 3, "b": 7}}']) == 1
     assert capsys.readouterr().err.strip() == "serialspec encode: one request: b = 7 is outside its range 0..5"
+
+
+def test_encode_a_reply_whose_direction_has_no_address_or_command(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Per-direction `covers`, with the address and command in requests only: encoding a reply failed with "bad
+    operand type for unary +: 'bytes'" (the codec wrote `body =  + ...`)."""
+    body = """\
+framing:
+  elements:
+    header: {role: header, value: "80"}
+    address: {role: address, type: u8, directions: [request]}
+    command: {role: command, type: u8, directions: [request]}
+    content: {role: content}
+    crc:
+      role: checksum
+      type: u16
+      endian: big
+      algorithm: crc
+      covers: {request: [address, content], response: [content, content]}
+      crc: {name: CRC-16/XMODEM, width: 16, poly: 0x1021, init: 0, refin: false, refout: false, xorout: 0, check: 0x31C3}
+commands:
+  read_speed:
+    code: 18
+    request:
+      fields: {}
+    response:
+      fields: {speed: u32, status: u8}
+"""
+    path = spec(tmp_path, "perdir", body)
+    reply = '{"command": "read_speed", "fields": {"speed": 5, "status": 1}}'
+    assert main(["encode", path, "--direction", "response", "--json", reply]) == 0
+    assert capsys.readouterr().out.strip() == "80 05 00 00 00 01 33 76"  # CRC-16/XMODEM of 05 00 00 00 01
+    assert main(["decode", path, "--direction", "response", "80 05 00 00 00 01 33 76", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["fields"] == {"speed": 5, "status": 1}
+
+
+def test_docs_of_a_value_element_after_a_content_whose_size_varies(tmp_path: Path) -> None:
+    """A status element after the content, whose size differs by command: the reference failed with KeyError
+    (the element has no offset from the frame's start)."""
+    body = """\
+framing:
+  elements:
+    header: {role: header, value: "B5 62"}
+    command: {role: command, type: u8}
+    length: {role: length, type: u16}
+    content: {role: content}
+    status: {role: status, type: u8}
+    ck: {role: checksum, type: u16, algorithm: fletcher, covers: [command, status]}
+commands:
+  short:
+    code: 1
+    request:
+      fields: {a: u8}
+  long:
+    code: 2
+    request:
+      fields: {a: u8, b: u32, c: u16}
+"""
+    path = spec(tmp_path, "mdvalue", body)
+    assert main(["generate", path, "--out", str(tmp_path / "out")]) == 0
+    docs = (tmp_path / "out" / "docs" / "mdvalue.md").read_text(encoding="utf-8")
+    assert "| 3 from the end | status | u8 |" in docs

@@ -28,6 +28,7 @@ from serialspec.lang.model import (
     ErratumCheck,
     Example,
     Field,
+    FrameElement,
     FrameLayout,
     Group,
     Message,
@@ -158,7 +159,7 @@ def message_context(protocol: Protocol, message: Message | None) -> dict[str, An
     content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
     size = size_text(message.min_size, message.max_size, content_limit(layout))
     rows = [
-        Row(str(layout.offsets[e.name]), e.name, e.type.name if e.type else "", "", "", e.description)
+        Row(_value_offset(layout, e), e.name, e.type.name if e.type else "", "", "", e.description)
         for e in layout.value_elements
     ]
     rows += field_rows(message.fields, content_offset)
@@ -172,6 +173,15 @@ def message_context(protocol: Protocol, message: Message | None) -> dict[str, An
         "reply": reply_text(message, protocol) or error_reply_text(protocol, message),
         "description": text(message.description),
     }
+
+
+def _value_offset(layout: FrameLayout, element: FrameElement) -> str:
+    """Where a frame-level value sits: its offset, or (after a content whose size varies) its place from the end."""
+    if element.name in layout.offsets:
+        return str(layout.offsets[element.name])
+    index = layout.elements.index(element)
+    back = sum(e.size or 0 for e in layout.elements[index:])
+    return f"{back} from the end"
 
 
 def content_limit(layout: FrameLayout) -> int | None:
@@ -348,6 +358,8 @@ def frame_context(protocol: Protocol, layout: FrameLayout) -> dict[str, Any]:
             where = "last" if e.role == "checksum" else where
         if variable and e.role not in ("content", "checksum"):
             where = "after the content" if e.role == "trailer" or layout.offsets.get(e.name) is None else where
+        if e.role in ("address", "status", "command", "length") and e.name not in layout.offsets:
+            where = _value_offset(layout, e)  # after a content whose size varies
         rows.append(
             {
                 "offset": cell(where),

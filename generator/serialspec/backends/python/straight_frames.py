@@ -732,7 +732,7 @@ def _frame_lines(
     order = _order(elements, head)
     packed = None  # (format, arguments) where the frame up to the checksum is one pack of them
     multi = any(elements[i].kind != "constant" and elements[i].size > 1 for i in head)
-    if first and fmt[:1] in "<>" and (fmt[0] == order or not multi):
+    if head and first and fmt[:1] in "<>" and (fmt[0] == order or not multi):
         # the head's elements joined to the content's first struct: one pack for both
         fused = _packed(elements, head, constant_or, lambda f: f)  # named by its format
         if isinstance(fused, Pack):

@@ -122,7 +122,8 @@ framing:
       endian: big
       algorithm: crc
       covers: {request: [address, content], response: [content, content]}
-      crc: {name: CRC-16/XMODEM, width: 16, poly: 0x1021, init: 0, refin: false, refout: false, xorout: 0, check: 0x31C3}
+      crc: {name: CRC-16/XMODEM, width: 16, poly: 0x1021, init: 0, refin: false, refout: false, xorout: 0,
+            check: 0x31C3}
 commands:
   read_speed:
     code: 18

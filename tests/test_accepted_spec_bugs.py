@@ -166,3 +166,85 @@ commands:
     assert main(["generate", path, "--out", str(tmp_path / "out")]) == 0
     docs = (tmp_path / "out" / "docs" / "mdvalue.md").read_text(encoding="utf-8")
     assert "| 3 from the end | status | u8 |" in docs
+
+
+GROUPS = """\
+framing:
+  elements:
+    header: {role: header, value: "AA"}
+    command: {role: command, type: u8}
+    length: {role: length, type: u8}
+    content: {role: content}
+    checksum: {role: checksum, type: u8, algorithm: sum, covers: [command, content]}
+tables:
+  config:
+    key: key_id
+    entries:
+      rate: {key: 1, type: u16}
+      mode: {key: 2, type: u8}
+      gain: {key: 3, type: i32}
+commands:
+  set_values:
+    code: 1
+    request:
+      fields:
+        count: u8
+        items:
+          type: group
+          count: count
+          fields:
+            key_id: u16
+            value: {type: table_value, table: config, key: key_id}
+  names:
+    code: 2
+    request:
+      fields:
+        n: u8
+        entries:
+          type: group
+          count: n
+          fields:
+            id: u8
+            name: {type: string, size: 8}
+  all_names:
+    code: 3
+    request:
+      fields:
+        entries:
+          type: group
+          count: rest
+          fields:
+            id: u8
+            name: {type: string, size: 4}
+"""
+
+
+@pytest.mark.parametrize(
+    ("message", "frame"),
+    [
+        # a table_value inside a group: NameError _TABLE_CONFIG (the table's structs were made only for values at
+        # the top of a message)
+        (
+            {"command": "set_values", "fields": {"items": [{"key_id": 1, "value": 500}, {"key_id": 3, "value": -2}]}},
+            "aa 01 0b 02 01 00 f4 01 03 00 fe ff ff ff 02",
+        ),
+        # strings of a fixed size in group items: decoded by a struct of the items' numbers alone (IndexError)
+        (
+            {"command": "names", "fields": {"entries": [{"id": 1, "name": "abcdefgh"}, {"id": 2, "name": "12345678"}]}},
+            "aa 02 13 02 01 61 62 63 64 65 66 67 68 02 31 32 33 34 35 36 37 38 e2",
+        ),
+        (
+            {"command": "all_names", "fields": {"entries": [{"id": 7, "name": "left"}, {"id": 8, "name": "righ"}]}},
+            "aa 03 0a 07 6c 65 66 74 08 72 69 67 68 71",
+        ),
+    ],
+)
+def test_group_items_with_table_values_and_strings(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], message: dict[str, object], frame: str
+) -> None:
+    path = spec(tmp_path, "groups", GROUPS)
+    assert main(["encode", path, "--json", json.dumps(message)]) == 0
+    assert capsys.readouterr().out.strip() == frame
+    assert main(["decode", path, frame, "--json"]) == 0
+    fields = json.loads(capsys.readouterr().out)["fields"]
+    assert {k: v for k, v in fields.items() if k in ("items", "entries")} == message["fields"]

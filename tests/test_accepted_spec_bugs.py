@@ -3,8 +3,11 @@ written as a new user writes one from docs/language.md (issue 21, "Bugs hit on s
 
 from __future__ import annotations
 
+import importlib
 import json
+import sys
 from pathlib import Path
+from types import ModuleType
 
 import pytest
 from serialspec.cli import main
@@ -248,3 +251,130 @@ def test_group_items_with_table_values_and_strings(
     assert main(["decode", path, frame, "--json"]) == 0
     fields = json.loads(capsys.readouterr().out)["fields"]
     assert {k: v for k, v in fields.items() if k in ("items", "entries")} == message["fields"]
+
+
+def generated_package(tmp_path: Path, name: str, body: str) -> ModuleType:
+    """The spec generated as a user runs `serialspec generate`, its package imported."""
+    path = spec(tmp_path, name, body)
+    out = tmp_path / "out"
+    assert main(["generate", path, "--out", str(out)]) == 0
+    sys.path.insert(0, str(out))
+    try:
+        return importlib.import_module(name)
+    finally:
+        sys.path.remove(str(out))
+
+
+def answers(package: ModuleType, request: object) -> list[object]:
+    """The replies the package's simulator (one device, id 0) sends to a request, decoded."""
+    simulator = importlib.import_module(f"{package.__name__}.simulator")
+    cls = next(v for k, v in vars(simulator).items() if k.endswith("Simulator") and k != "Simulator")
+    return [package.decode(frame, "response") for _, frame in cls([0]).feed(package.encode(request))]
+
+
+SIM_READS = """\
+framing:
+  elements:
+    header: {role: header, value: "AA"}
+    command: {role: command, type: u8}
+    length: {role: length, type: u8}
+    content: {role: content}
+    checksum: {role: checksum, type: u8, algorithm: sum, covers: [command, content]}
+tables:
+  config:
+    key: key_id
+    entries:
+      rate: {key: 1, type: u16, default: 1000}
+      mode: {key: 2, type: u8, default: 3}
+      gain: {key: 3, type: i32, default: -5}
+commands:
+  get_values:
+    code: 1
+    request:
+      fields:
+        keys: {type: group, count: rest, fields: {key_id: u16}}
+    response:
+      fields:
+        cfg_values:
+          type: group
+          count: rest
+          fields:
+            key_id: u16
+            value: {type: table_value, table: config, key: key_id}
+  read_block:
+    code: 2
+    request:
+      fields: {address: u8, count: u8}
+    response:
+      fields:
+        address: u8
+        size: u8
+        data: {type: bytes, size: size, table: config, start: address}
+device:
+  memory: config
+  commands:
+    get_values:
+      reads: [cfg_values]
+    read_block:
+      reads: [data]
+"""
+
+
+def test_the_simulator_reads_a_group_of_table_values_and_table_bytes_sized_by_a_reply_field(tmp_path: Path) -> None:
+    """A device read of a group of table values failed with KeyError: 'cfg_values'; table bytes whose size is an
+    earlier reply field (not `size_from` a request field) with KeyError: ''."""
+    p = generated_package(tmp_path, "simreads", SIM_READS)
+    m = importlib.import_module("simreads.messages")
+    (reply,) = answers(p, m.GetValuesRequest(keys=(m.KeysItem(key_id=1), m.KeysItem(key_id=3))))
+    assert [(item.key_id, item.value) for item in reply.cfg_values] == [(1, 1000), (3, -5)]
+    (reply,) = answers(p, m.ReadBlockRequest(address=1, count=2))
+    assert (reply.address, reply.data) == (1, (1000).to_bytes(2, "little"))  # the entry at the start: rate, a u16
+
+
+SIM_ECHO = """\
+framing:
+  elements:
+    header: {role: header, value: "FD"}
+    length: {role: length, type: u8}
+    sender: {role: address, type: u8}
+    command: {role: command, type: u8}
+    content: {role: content}
+    checksum: {role: checksum, type: u8, algorithm: xor, covers: [length, content]}
+commands:
+  heartbeat:
+    code: 0
+    request:
+      fields:
+        kind: {type: u8, description: What the sender is.}
+        autopilot: u8
+        mode: {type: u8, default: 4}
+    response:
+      fields:
+        kind: {type: u8, description: What the sender is.}
+        autopilot: u8
+        mode: {type: u8, default: 4}
+  set_value:
+    code: 1
+    request:
+      fields: {slot: u8, value: u16}
+    response:
+      fields: {slot: u8, value: u16}
+device:
+  reply: {kind: 2}
+  state: {autopilot: 3}
+  commands:
+    set_value:
+      echoes: [slot, value]
+"""
+
+
+def test_the_simulator_answers_with_its_own_values_not_the_requests(tmp_path: Path) -> None:
+    """A device answered HEARTBEAT with the sender's own values (every request field copied into the reply field
+    of the same name): reply fields come from the device (`reply`, its state) or the field's default, and echo
+    the request only where the spec says so (`echoes`, the address, the fields replies are matched by)."""
+    p = generated_package(tmp_path, "simecho", SIM_ECHO)
+    m = importlib.import_module("simecho.messages")
+    (reply,) = answers(p, m.HeartbeatRequest(sender=0, kind=6, autopilot=8, mode=1))
+    assert (reply.sender, reply.kind, reply.autopilot, reply.mode) == (0, 2, 3, 4)
+    (reply,) = answers(p, m.SetValueRequest(sender=0, slot=5, value=700))
+    assert (reply.slot, reply.value) == (5, 700)

@@ -31,7 +31,7 @@ from conftest import Generated, examples
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from serialspec import cli
-from serialspec.backends import emitters
+from serialspec.backends import Unsupported, emitters
 from serialspec.backends.python.memory import imported
 from serialspec.lang import SpecErrors, grammar
 from serialspec.lang.loader import load_text
@@ -246,6 +246,36 @@ CASES: dict[str, Case] = {
             "transparency": {"span": ["code", "content"], "replace": {"C0": "DB DC", "DB": "DB DD"}},
         },
     ),
+    # HerkuleX: both checksums in the header; the first covers the whole frame but them (XOR & 0xFE), the second
+    # is computed from the first (~checksum1 & 0xFE)
+    "frame: checksums inside their span, a checksum of a checksum": Case(
+        {"v": "u16", "data": {"type": "bytes", "size": "rest"}},
+        {"v": "u8"},
+        {
+            "elements": {
+                "header": {"role": "header", "value": "FF FF"},
+                "size": {"role": "length", "type": "u8", "counts": ["id", "content"], "adds": 3},
+                "id": {"role": "address", "type": "u8", "range": [0, 253], "broadcast": 254},
+                "code": {"role": "command", "type": "u8"},
+                "checksum1": {
+                    "role": "checksum",
+                    "type": "u8",
+                    "algorithm": "xor",
+                    "mask": 0xFE,
+                    "covers": ["size", "content"],
+                },
+                "checksum2": {
+                    "role": "checksum",
+                    "type": "u8",
+                    "algorithm": "xor",
+                    "invert": True,
+                    "mask": 0xFE,
+                    "covers": ["checksum1", "checksum1"],
+                },
+                "content": {"role": "content"},
+            }
+        },
+    ),
     "frame: layouts": Case(
         {"data": {"type": "bytes", "size": "rest"}},
         {"data": {"type": "bytes", "size": "rest"}},
@@ -329,7 +359,10 @@ def build(name: str) -> Built:
         files: dict[str, str] = {}
         problems = []
         for emitter in emitters():
-            emitted = emitter.files(protocol)
+            try:
+                emitted = emitter.files(protocol)
+            except Unsupported:  # a target that cannot generate the case yet (NO_C lists the cases)
+                continue
             files.update({f"{emitter.folder}/{path}" if emitter.folder else path: t for path, t in emitted.items()})
             if emitter.verify is not None:
                 problems.extend(emitter.verify(protocol, emitted))
@@ -351,6 +384,9 @@ def package(built: Built) -> Iterator[Generated]:
 def message_class(g: Generated, message: Message) -> Any:
     return next(c for c in g.package.MESSAGE_TYPES if c.__name__ == message.class_name)
 
+
+# Cases the C target refuses (Unsupported: generate writes no C for them), each a feature it lacks yet.
+NO_C = {"frame: checksums inside their span, a checksum of a checksum"}
 
 # Known to fail; each is a bug to fix, strict so that the fix is noticed (and the mark removed).
 KNOWN = {
@@ -435,15 +471,19 @@ def test_every_output(name: str, tmp_path: Path) -> None:
         spec = tmp_path / "matrix_case.yaml"
         spec.write_text(built.text, encoding="utf-8")
         cli_decode(g, spec)
-        c_target(g, built, tmp_path)
+        c_target(g, built, tmp_path, name)
 
 
-def c_target(g: Generated, built: Built, tmp_path: Path) -> None:
+def c_target(g: Generated, built: Built, tmp_path: Path, name: str) -> None:
     """The case's C (tests/test_c_backend.py's driver, with the sanitizers) against the Python codec: random messages
     give the same values and bytes, and a stream of them among garbage in pieces gives the same messages."""
     from test_c_backend import GCC, Driver, agrees_with_python, stream_agrees_with_python
 
     if GCC is None:
+        return
+    c_files = [path for path in built.files if path.startswith("c/matrix_case/")]
+    assert bool(c_files) != (name in NO_C), f"{name}: C files {c_files}"
+    if not c_files:
         return
     source = tmp_path / "c"
     source.mkdir()

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define FEETECH_SMS_SPEC_SHA256 "fd49518d331e583226eb4571e7aaaf99a0fe6c68bd6f123ea06291ed6bba8152"
+#define FEETECH_SMS_SPEC_SHA256 "a7a890df939a81c75e3c577d5abc08c5b316efc27519706c19759cf50f61ca3b"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef FEETECH_SMS_ENABLE_ENCODE

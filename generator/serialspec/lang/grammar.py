@@ -923,6 +923,14 @@ DEVICE_COMMAND = Obj(
         ),
         "kind": Str("The entry of `kinds:` whose devices the command addresses (default: the devices of --id)."),
         "stores": MapOf(Str(), "Request field -> the state variable it is stored in (where names differ)."),
+        "echoes": ListOf(
+            Str(),
+            "Response fields that repeat the request's field of the same name (a write's reply confirming what was "
+            "written: Modbus WRITE SINGLE REGISTER). Other response fields never copy the request: they come from "
+            "the device (its reads, reports, `reply`, memory and state) or else the field's `default` (else 0); "
+            "the fields replies are matched by (`matching.by`), the address and a table value's key echo anyway.",
+            example=["address", "value"],
+        ),
         "sets": MapOf(Num(), "State variable -> the value the command sets it to."),
         "absent": MapOf(
             Num(),

@@ -343,7 +343,9 @@ def frame_context(protocol: Protocol, layout: FrameLayout) -> dict[str, Any]:
             description = " — ".join(p for p in (e.constant.hex(" ").upper(), e.description) if p)
         elif e.role == "checksum" and not layout.classic and e.checksum is not None:
             endian = "big-endian" if e.endian == ">" else "little-endian"
-            description = f"over `{e.checksum.first}`..`{e.checksum.last}`, {endian}. {e.description}"
+            left_out = ", ".join(f"`{name}`" for name in e.checksum.skips)
+            skips = f" leaving out {left_out}" if left_out else ""
+            description = f"over `{e.checksum.first}`..`{e.checksum.last}`{skips}, {endian}. {e.description}"
         else:
             description = e.description
         kind = e.type.name if e.type else ("bytes" if e.fixed else "n bytes")
@@ -355,7 +357,7 @@ def frame_context(protocol: Protocol, layout: FrameLayout) -> dict[str, Any]:
             kind += f" = bytes `{e.counts[0]}`..`{e.counts[1]}` as sent{adds}{endian}"
         where = f"{offset}.." if size is None else (str(offset) if size == 1 else f"{offset}..{offset + size - 1}")
         if e.role in ("checksum",) or (offset is None):
-            where = "last" if e.role == "checksum" else where
+            where = "last" if e.role == "checksum" and e.name not in layout.offsets else where
         if variable and e.role not in ("content", "checksum"):
             where = "after the content" if e.role == "trailer" or layout.offsets.get(e.name) is None else where
         if e.role in ("address", "status", "command", "length") and e.name not in layout.offsets:
@@ -418,6 +420,11 @@ def checksum_context(protocol: Protocol, general: Checksum | None = None) -> dic
         "what": checksum.algorithm.describe(),
         "first": checksum.first,
         "last": checksum.last,
+        "skips": (
+            " but for " + ", ".join(f"`{name}`" for name in checksum.skips) + " (checksums inside the span)"
+            if checksum.skips
+            else ""
+        ),
         "worked": worked,
         "params": checksum.algorithm.parameters(),
     }
@@ -436,7 +443,9 @@ def general_worked(protocol: Protocol, checksum: Checksum) -> str:
         except SerialspecError:
             continue
         first, last = layout.elements[index].span
-        return f"{checksum.algorithm.worked(b''.join(parts[first : last + 1]))} (example `{example.name}`)"
+        skip = layout.elements[index].skip
+        covered = b"".join(parts[i] for i in range(first, last + 1) if i not in skip)
+        return f"{checksum.algorithm.worked(covered)} (example `{example.name}`)"
     return ""
 
 

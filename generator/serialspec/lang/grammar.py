@@ -665,7 +665,10 @@ FRAME_ELEMENT = Obj(
         ),
         "covers": span(
             "checksum: the span of elements covered. Outside a transparency span it sees the wire bytes, inside "
-            "it the bytes before stuffing.",
+            "it the bytes before stuffing. Checksums strictly inside the span (itself too) are left out of it "
+            "(HerkuleX: `checksum1` in the header covers [size, data]); one at an end is covered, so a checksum "
+            "can be computed from another that comes before it (HerkuleX `checksum2: {algorithm: xor, invert: "
+            "true, mask: 0xFE, covers: [checksum1, checksum1]}`).",
         ),
         **checksum_keys(),
     },

@@ -9,7 +9,6 @@ from itertools import repeat
 
 from serialspec.runtime.checksums import BYTE_VALUES as _BYTES
 from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError, content_size_error, out_of_range
-from serialspec.runtime.errors import either_direction as _either
 from serialspec.runtime.fields import wrong_type
 from serialspec.runtime.message import Direction, Message, members
 from serialspec.runtime.message import build as _new  # a message from the tuple of its field values, in one call

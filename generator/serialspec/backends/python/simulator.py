@@ -256,7 +256,10 @@ def simulator_module(protocol: Protocol) -> str:
         echoed = echoes(protocol, request, response, tables, derived, behaviour.echoes if behaviour else ())
         if echoed:
             args.append(f"echoes={echoed!r}")
-        filled = {*tables, *(behaviour.reads + tuple(behaviour.space_reads) if behaviour else ())}
+        # what the device fills in itself: what it reads, and runs of registers (empty unless read); a table value
+        # or block it does not read gets its kind's blank, as any other field
+        runs = {name for name, table in tables.items() if table[0] == "run"}
+        filled = {*runs, *(behaviour.reads + tuple(behaviour.space_reads) if behaviour else ())}
         blanks = reply_blanks(protocol, response, filled) if response else {}
         if blanks:
             args.append(f"blanks={{{', '.join(f'{k!r}: {v}' for k, v in blanks.items())}}}")

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define DYNAMIXEL_P2_SPEC_SHA256 "039f1ba472cada98720f3d22bce0103e734181b39cf65fba5ec6a2a76064004f"
+#define DYNAMIXEL_P2_SPEC_SHA256 "f35bde394c147add2bef8a050967a05e03f3c3de74b77386040c472855392bb1"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef DYNAMIXEL_P2_ENABLE_ENCODE

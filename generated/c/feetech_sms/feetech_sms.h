@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define FEETECH_SMS_SPEC_SHA256 "a7a890df939a81c75e3c577d5abc08c5b316efc27519706c19759cf50f61ca3b"
+#define FEETECH_SMS_SPEC_SHA256 "38b30ffd4db5fbca4eefe952c4df5587159c62c5fe9728097c07646d9351e745"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef FEETECH_SMS_ENABLE_ENCODE

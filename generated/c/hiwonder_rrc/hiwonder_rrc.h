@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define HIWONDER_RRC_SPEC_SHA256 "659123bc2299a76a9186aa4c92c81ef750b594e515e6db22ecd96d8bc6026201"
+#define HIWONDER_RRC_SPEC_SHA256 "b8540b3a3748c61ab5a8f18d136a2f5285a106dc15bdcd93547d2040ea242ae7"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef HIWONDER_RRC_ENABLE_ENCODE

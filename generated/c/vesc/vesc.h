@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define VESC_SPEC_SHA256 "24e99131ef119cad0be0a423f091717cfc7def4c85bb697ef39be6f14f8fc0ee"
+#define VESC_SPEC_SHA256 "d27d8303846a209dd7c6e57f9ea5eb4e222af0b3fadc4dac1cec33009c4c1284"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef VESC_ENABLE_ENCODE

@@ -105,6 +105,14 @@ class Sum(Algorithm):
     def summed(self) -> bool | None:
         return self.invert if self.width == 8 and not self.negate and self.mask is None else None
 
+    @classmethod
+    def lua_function(cls) -> str:
+        return _LUA
+
+    def lua_parameters(self) -> dict[str, Any]:
+        masked = {} if self.mask is None else {"mask": self.mask}
+        return {"invert": self.invert, "negate": self.negate} | masked
+
     def describe(self) -> str:
         what = "bitwise NOT of the sum" if self.invert else "two's complement of the sum" if self.negate else "sum"
         masked = f", ANDed with {hex_value(self.mask, self.width)}" if self.mask is not None else ""
@@ -119,3 +127,19 @@ class Sum(Algorithm):
         masked = f" & {hex_value(self.mask, self.width)}" if self.mask is not None else ""
         value = hex_value(finish(sum(covered), self.width, self.invert, self.negate, self.mask), self.width)
         return f"{sign}({terms}){masked} = {sign}{sum(covered):#x}{masked} → {value}"
+
+
+# the dissector's code (Algorithm.lua_function)
+_LUA = """function(spec, size, data)
+  local mask = width_mask(size * 8)
+  local total = 0
+  for i = 1, #data do
+    total = (total + data:byte(i)) % (mask + 1)
+  end
+  if spec.invert then
+    total = mask - total
+  elseif spec.negate then
+    total = (mask + 1 - total) % (mask + 1)
+  end
+  return spec.mask and band(total, spec.mask) or total
+end"""

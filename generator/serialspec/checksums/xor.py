@@ -77,6 +77,13 @@ class Xor(Algorithm):
         extra = (", invert=True" if self.invert else "") + (f", mask={self.mask:#x}" if self.mask is not None else "")
         return ("serialspec.checksums.xor", "xor_function"), f"xor_function({self.width}{extra})"
 
+    @classmethod
+    def lua_function(cls) -> str:
+        return _LUA
+
+    def lua_parameters(self) -> dict[str, Any]:
+        return {"invert": self.invert} | ({} if self.mask is None else {"mask": self.mask})
+
     def describe(self) -> str:
         what = "bitwise NOT of the XOR" if self.invert else "XOR"
         masked = f", ANDed with {hex_value(self.mask, self.width)}" if self.mask is not None else ""
@@ -98,3 +105,20 @@ class Xor(Algorithm):
             masked = f" & {hex_value(self.mask, self.width)}" if self.mask is not None else ""
             terms = f"{sign}({terms}){masked}"
         return f"{terms} = {hex_value(self.function()(covered), self.width)}"
+
+
+# the dissector's code (Algorithm.lua_function): words of `size` bytes, high byte first, the last one zero-padded
+_LUA = """function(spec, size, data)
+  local total = 0
+  for i = 1, #data, size do
+    local word = 0
+    for j = i, i + size - 1 do
+      word = word * 256 + (data:byte(j) or 0)
+    end
+    total = bxor(total, word)
+  end
+  if spec.invert then
+    total = width_mask(size * 8) - total
+  end
+  return spec.mask and band(total, spec.mask) or total
+end"""

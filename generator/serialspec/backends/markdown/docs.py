@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import re
 from collections import Counter
-from typing import Any
+from typing import Any, assert_never
 
 from serialspec.backends.common import render as common
 from serialspec.backends.common.frames import runtime_layouts
@@ -18,8 +18,11 @@ from serialspec.backends.common.numbers import number
 from serialspec.backends.common.text import collapse
 from serialspec.backends.markdown.kinds import anchor, kind, scalar_range
 from serialspec.collection import without_cycle_collection
+from serialspec.lang import expression
 from serialspec.lang.frozen import mutable
 from serialspec.lang.model import (
+    Array,
+    Bytes,
     Checksum,
     Command,
     Device,
@@ -31,12 +34,14 @@ from serialspec.lang.model import (
     FrameElement,
     FrameLayout,
     Group,
+    List,
     Message,
     Protocol,
     Scalar,
     TableBlock,
     TableEntry,
     TableValue,
+    Text,
     fixed_size,
 )
 from serialspec.runtime.errors import SerialspecError
@@ -134,20 +139,25 @@ def field_rows(fields: tuple[Field, ...], start: int | None, prefix: str = "") -
         if offset is not None and size is None:
             where = f"{offset}.."
         rows.append(Row(where, prefix + f.name, type_name(f), kind(f).unit(f), range_text(f), meaning(f)))
-        if isinstance(f, Group):
-            rows += field_rows(f.fields, None, prefix + f.name + "[].")
-        if isinstance(f, TableBlock):
-            rows += [
-                Row(
-                    "",
-                    f"{prefix}{f.name}.{e.name}",
-                    e.type.name,
-                    e.unit,
-                    scalar_range(e.type, e.minimum, e.maximum),
-                    f"{f.table.key_name} {e.key}: {e.description}",
-                )
-                for e in f.entries
-            ]
+        match f:  # the rows of what it holds
+            case Group():
+                rows += field_rows(f.fields, None, prefix + f.name + "[].")
+            case TableBlock():
+                rows += [
+                    Row(
+                        "",
+                        f"{prefix}{f.name}.{e.name}",
+                        e.type.name,
+                        e.unit,
+                        scalar_range(e.type, e.minimum, e.maximum),
+                        f"{f.table.key_name} {e.key}: {e.description}",
+                    )
+                    for e in f.entries
+                ]
+            case Scalar() | Array() | List() | Text() | Bytes() | TableValue():
+                pass  # one row
+            case _:
+                assert_never(f)
         offset = None if offset is None or size is None else offset + size
     return rows
 
@@ -168,7 +178,8 @@ def message_context(protocol: Protocol, message: Message | None) -> dict[str, An
         "rows": [{k: cell(v) for k, v in vars(r).items()} for r in rows],
         "size": size,
         "optional": text(message.optional),
-        "unsolicited": message.unsolicited,
+        "unsolicited": message.unsolicited or sends_text(protocol, message) != "",
+        "sends": sends_text(protocol, message),
         "answers": message.answers,
         "reply": reply_text(message, protocol) or error_reply_text(protocol, message),
         "description": text(message.description),
@@ -182,6 +193,31 @@ def _value_offset(layout: FrameLayout, element: FrameElement) -> str:
     index = layout.elements.index(element)
     back = sum(e.size or 0 for e in layout.elements[index:])
     return f"{back} from the end"
+
+
+def device_rule_text(protocol: Protocol, name: str) -> str:
+    """What the device's rules say of one memory entry: what it reads as, and when it cannot be written."""
+    device = protocol.device
+    if device is None or device.memory is None:
+        return ""
+    found = ""
+    if name in device.derived:
+        found += f" Reads as {expression.show(device.derived[name])}."
+    if name in device.locks:
+        found += f" Not writable while {device.locks[name]} is non-zero."
+    return found
+
+
+def sends_text(protocol: Protocol, message: Message) -> str:
+    """When the device sends this response on its own (`device.sends`), or ""."""
+    device = protocol.device
+    send = next((s for s in device.sends if s.command == message.key), None) if device else None
+    if send is None or message.direction != Direction.RESPONSE:
+        return ""
+    when = [f"every {send.every} ms"] if send.every else []
+    when += [f"after the reply to {', '.join(f'`{n}`' for n in send.after)}"] if send.after else []
+    when += [f"when {', '.join(f'`{n}`' for n in send.changes)} changes"] if send.changes else []
+    return " or ".join(when) + (f", while `{send.while_}` is non-zero" if send.while_ else "")
 
 
 def content_limit(layout: FrameLayout) -> int | None:
@@ -539,9 +575,7 @@ def content_rows(
                 count = len(items) if isinstance(items, list) else 0
                 item = f.item_size
                 size = count * item if item is not None else end - offset
-            elif isinstance(f, TableValue):
-                size = end - offset
-            else:
+            else:  # the rest of the content
                 size = end - offset
         rows.append(
             {
@@ -604,6 +638,7 @@ def emit_docs(protocol: Protocol) -> str:
                     "meaning": cell(
                         e.description
                         + (f" Values: [{e.enum.class_name}](#enum-{anchor(e.enum.name)})." if e.enum else "")
+                        + device_rule_text(protocol, e.name)
                     ),
                 }
                 for e in t.entries

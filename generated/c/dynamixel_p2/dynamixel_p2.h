@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define DYNAMIXEL_P2_SPEC_SHA256 "4099b84682feeba1fde71e6425518b5666d0da3e4ace344d693bf0cf3d60929d"
+#define DYNAMIXEL_P2_SPEC_SHA256 "216c4f169c1322c53080079059958162f03830c06ea5d3a8782bda83b08723b2"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef DYNAMIXEL_P2_ENABLE_ENCODE

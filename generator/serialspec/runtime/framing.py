@@ -15,7 +15,7 @@ lies inside it or outside it.
 
 from __future__ import annotations
 
-import functools
+import importlib
 import re
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
@@ -24,6 +24,8 @@ from typing import Any, Literal
 from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError
 from serialspec.runtime.message import Message
 from serialspec.runtime.stream import StreamParser
+from serialspec.transforms.base import SpanTransform
+from serialspec.transforms.replace import Transparency as Transparency  # generated code imports it from here
 
 ElementKind = Literal["constant", "value", "command", "length", "content", "checksum"]
 
@@ -55,46 +57,12 @@ class Element:
 
 
 @dataclass(frozen=True)
-class Transparency:
-    """Byte stuffing or escaping over a span: each plain sequence becomes its wire sequence, leftmost first."""
-
-    span: tuple[int, int]
-    replace: tuple[tuple[bytes, bytes], ...]
-
-    def encode(self, data: bytes) -> bytes:
-        return _rewrite(data, self.replace)
-
-    def decode(self, data: bytes) -> bytes:
-        """The plain bytes; DecodeError unless `data` is what encode gives for them (no lone escape)."""
-        plain = _rewrite(data, tuple((wire, plain) for plain, wire in self.replace))
-        if self.encode(plain) != data:
-            raise DecodeError(f"bad stuffing: {data.hex(' ')} is not the stuffed form of any bytes")
-        return plain
-
-
-def _rewrite(data: bytes, pairs: tuple[tuple[bytes, bytes], ...]) -> bytes:
-    """Each `old` sequence of `data` replaced by its `new`, scanning left to right (the leftmost match first, the
-    pairs tried in order at each position): one bytes.replace for one pair, else one regular expression."""
-    if len(pairs) == 1:
-        old, new = pairs[0]
-        return data.replace(old, new)
-    return _rewriter(pairs)(data)
-
-
-@functools.cache
-def _rewriter(pairs: tuple[tuple[bytes, bytes], ...]) -> Callable[[bytes], bytes]:
-    table = dict(pairs)
-    pattern = re.compile(b"|".join(re.escape(old) for old, _ in pairs))
-    return lambda data: pattern.sub(lambda match: table[match.group()], data)
-
-
-@dataclass(frozen=True)
 class Layout:
     """One frame layout of one direction."""
 
     name: str
     elements: tuple[Element, ...]
-    transparency: Transparency | None = None
+    transparency: SpanTransform | None = None
     # derived in __post_init__
     content: int = field(init=False, default=-1)
     values: tuple[int, ...] = field(init=False, default=())
@@ -722,3 +690,13 @@ class EngineFormat:
 
     def decode_at(self, buffer: bytes, start: int, stop: int, expect: type[Message] | None = None) -> Message:
         return self.decode(buffer[start:stop], expect)
+
+
+def __getattr__(name: str) -> Any:
+    # each transform's runtime class (serialspec/transforms/), imported from here by generated code, loaded when asked
+    from serialspec.transforms import runtime_classes
+
+    found = runtime_classes().get(name)
+    if found is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    return getattr(importlib.import_module(found[0]), found[1])

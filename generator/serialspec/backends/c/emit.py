@@ -179,6 +179,8 @@ def refuse_layout(layout: FrameLayout) -> None:
         if e.type is not None and (e.type.size > 4 or e.type.signed or e.type.is_float):
             raise Unsupported(f"{where}: element {e.name} of type {e.type.name}")
     t = layout.transparency
+    if t is not None and t.transform.c_refusal():
+        raise Unsupported(f"{where}: {t.transform.c_refusal()}")
     names = [e.name for e in elements]
     content = next((i for i, e in enumerate(elements) if e.role == "content"), -1)
     first = names.index(t.first) if t else content if content >= 0 else len(elements)

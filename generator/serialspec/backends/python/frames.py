@@ -23,6 +23,7 @@ from serialspec.lang.model import (
     Protocol,
     size_terms,
 )
+from serialspec.transforms import runtime_classes
 
 
 def checksum_definitions(protocol: Protocol, straight: bool = True) -> tuple[list[str], list[str]]:
@@ -93,10 +94,10 @@ def layout_lines(layout: FrameLayout) -> list[str]:
         lines.append(")),")
         return lines
     t = layout.transparency
-    pairs = ", ".join(f"({plain!r}, {wire!r})" for plain, wire in t.replace)
-    lines.append("), Transparency(")
-    lines.append(f"    ({layout.index(t.first)}, {layout.index(t.last)}),")
-    lines.append(f"    ({pairs},),")
+    lines.append(f"), {t.transform.runtime_name}(")
+    lines += [
+        f"    {argument}," for argument in t.transform.python_arguments((layout.index(t.first), layout.index(t.last)))
+    ]
     lines.append(")),")
     return lines
 
@@ -149,6 +150,6 @@ def code_key(command: Command, layout: FrameLayout) -> str:
 def framing_imports(lines: list[str]) -> list[str]:
     """The runtime.framing names that definitions use."""
     text = "\n".join(lines)
-    names = ("Element", "FrameCodec", "Layout", "SizeRule", "Transparency")
+    names = sorted(("Element", "FrameCodec", "Layout", "SizeRule", *runtime_classes()))
     found = [name for name in names if f"{name}(" in text]
     return ["ERROR_REPLY", *found] if "ERROR_REPLY" in text else found

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from typing import Any, assert_never
 
+from serialspec.backends import Unsupported
 from serialspec.backends.common.frames import runtime_layout
 from serialspec.backends.common.render import render
 from serialspec.checksums.crc import Crc
@@ -156,13 +157,13 @@ def _layout(layout: FrameLayout) -> dict[str, Any]:
         item["description"] = element.description
         elements.append(item)
     result: dict[str, Any] = {"elements": elements}
-    if engine.transparency is not None:
+    t = layout.transparency
+    if t is not None and engine.transparency is not None:
         first, last = engine.transparency.span
-        result["transparency"] = {
-            "first": first + 1,
-            "last": last + 1,
-            "replace": [[plain, wire] for plain, wire in engine.transparency.replace],
-        }
+        lua = t.transform.lua()
+        if lua is None:
+            raise Unsupported(f"frames with `method: {t.transform.name}`")
+        result["transparency"] = {"first": first + 1, "last": last + 1, **lua}
     return result
 
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 from dataclasses import replace
 from typing import Any, Literal
 
-from serialspec import checksums
+from serialspec import checksums, transforms
 from serialspec.checksums import ChecksumProblem
 from serialspec.lang.errors import SpecError
 from serialspec.lang.loader import Path
@@ -24,6 +24,7 @@ from serialspec.lang.model import (
 )
 from serialspec.lang.passes.fields import FieldResolver
 from serialspec.runtime.hexbytes import parse_hex
+from serialspec.transforms import TransformProblem
 
 CONSTANT_ROLES = ("header", "trailer", "constant")
 _CLASSIC_ROLES = {"header", "address", "command", "status", "length", "content", "checksum"}
@@ -214,17 +215,19 @@ class FramingPass(FieldResolver):
         if transparency_raw is not None:
             t_path: Path = (*framing_path, "transparency")
             first, last = self.span(transparency_raw.get("span"), direction, names, (*t_path, "span"))
-            pairs = []
-            for plain, wire in (transparency_raw.get("replace") or {}).items():
-                try:
-                    pairs.append((parse_hex(str(plain)), parse_hex(str(wire))))
-                except ValueError as exc:
-                    raise self.fail((*t_path, "replace", plain), str(exc)) from None
-            if not pairs or any(not p or not w for p, w in pairs):
-                raise self.fail((*t_path, "replace"), "give plain -> wire byte sequences, none empty")
+            try:
+                transform = transforms.from_spec(
+                    transparency_raw, lambda keys, message: self.error((*t_path, *keys), message)
+                )
+            except TransformProblem as problem:
+                raise self.fail((*t_path, *problem.keys), problem.message) from None
             if not names.index(first) <= content_index <= names.index(last):
                 raise self.fail((*t_path, "span"), "the transparency span must hold the content")
-            transparency = Transparency(first, last, tuple(pairs), str(transparency_raw.get("description", "")))
+            constants = [e.constant for e in elements]
+            refused = transform.check_layout(roles, constants, names.index(first), names.index(last))
+            if refused:
+                raise self.fail(t_path, refused)
+            transparency = Transparency(first, last, transform, str(transparency_raw.get("description", "")))
         t_first, t_last = (
             (names.index(transparency.first), names.index(transparency.last)) if transparency else (-1, -1)
         )

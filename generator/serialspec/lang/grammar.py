@@ -657,8 +657,8 @@ FRAME_ELEMENT = Obj(
             "reply has the layout of the command whose response is the `error_reply`."
         ),
         "counts": span(
-            "length: the span of elements it counts (inside a transparency span the plain bytes, outside it the bytes "
-            "as sent); default the content only.",
+            "length: the span of elements it counts (within a transparency span their plain bytes, over more than "
+            "it the bytes as sent); default the content only.",
         ),
         "adds": Int("length: added to the counted size (SMS: 2 = instruction + checksum); may be negative.", default=0),
         "description": TEXT,
@@ -669,8 +669,8 @@ FRAME_ELEMENT = Obj(
             "status (or address): bit fields packed into the element (DYNAMIXEL: alert bit 7, error number 6..0)."
         ),
         "covers": span(
-            "checksum: the span of elements covered. Outside a transparency span it sees the wire bytes, inside "
-            "it the bytes before the transform.",
+            "checksum: the span of elements covered. Within a transparency span (all of it, or part) it sees the "
+            "bytes before the transform, over more than it or outside it the bytes as sent.",
         ),
         **checksum_keys(),
     },
@@ -708,8 +708,9 @@ TRANSPARENCY = Obj(
     required=("span",),
     description=(
         "A transform of the bytes of a span (byte stuffing, escaping, COBS), applied by encode and removed by "
-        "decode and the stream parser. A length or checksum inside the span sees the plain bytes (before the "
-        "transform), one outside it the bytes as sent."
+        "decode and the stream parser. A length or checksum over elements within the span (all of it, or part) "
+        "counts and covers their plain bytes, before the transform; one over more than the span, or outside it, the "
+        "bytes as sent. A length or checksum that lies inside the span is transformed with it."
     ),
 )
 

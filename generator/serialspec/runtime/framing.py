@@ -106,6 +106,11 @@ class Layout:
         )
         plan["inner_checksums"] = inside
         plan["outer_checksums"] = tuple(c for c in plan["checksums"] if c not in inside)
+        counted_inside = tuple(
+            (i, e) for i, e in plan["lengths"] if t is not None and t.span[0] <= e.span[0] and e.span[1] <= t.span[1]
+        )
+        plan["inner_lengths"] = counted_inside  # made before the span is transformed: they count plain bytes
+        plan["outer_lengths"] = tuple(c for c in plan["lengths"] if c not in counted_inside)
         # What FrameCodec.probe reads, worked out once: the fixed elements before the variable part with their
         # offsets, and the length element's offset, size, byte order, adds and the sizes around what it counts.
         probe_head, position = [], 0
@@ -114,7 +119,16 @@ class Layout:
             position += element.size
         plan["probe_head"] = tuple(probe_head)
         plan["probe_length"] = None
-        if self.length is not None:
+        plan["probe_inner"] = None  # a length of plain bytes inside the transformed span: read through the transform
+        if self.length is not None and self.length in dict(counted_inside):
+            length = self.elements[self.length]
+            a, b = length.span
+            in_span = self.length >= first  # else at a fixed offset before the span
+            at = sum(e.size for e in self.elements[first : self.length]) if in_span else self.offset(self.length)
+            counted_fixed = sum(e.size for e in self.elements[a : b + 1])
+            uncounted = sum(e.size for e in self.elements[first : last + 1]) - counted_fixed
+            plan["probe_inner"] = (in_span, at, length, uncounted, counted_fixed)
+        elif self.length is not None:
             length = self.elements[self.length]
             offset = self.offset(self.length)
             a, b = length.span
@@ -172,12 +186,17 @@ class Layout:
             plain[index] = _pack(elements[index], value)
         wire: dict[int, bytes] = {}
         t = self.transparency
+        for index, element in plan["inner_lengths"]:  # inside the transformed span: the plain bytes
+            value = sum(len(part) for part in plain[element.span[0] : element.span[1] + 1]) + element.adds
+            if not 0 <= value < 1 << (8 * element.size):
+                raise EncodeError(f"{self.name} frame: length {value} does not fit its {element.size}-byte field")
+            plain[index] = element.pack(value)
         for index, element in plan["inner_checksums"]:  # inside the stuffed span: over the bytes before stuffing
             plain[index] = self._checksum(element, b"".join(plain[element.span[0] : element.span[1] + 1]))
         if t is not None:
             first, last = t.span
             wire[first] = t.encode(b"".join(plain[first : last + 1]))
-        for index, element in plan["lengths"]:
+        for index, element in plan["outer_lengths"]:
             value = len(self._wire(plain, wire, *element.span)) + element.adds
             if not 0 <= value < 1 << (8 * element.size):
                 raise EncodeError(f"{self.name} frame: length {value} does not fit its {element.size}-byte field")
@@ -267,6 +286,43 @@ def _pack(element: Element, value: int) -> bytes:
         return element.pack(value)
     except OverflowError:
         raise EncodeError(f"{element.name} = {value} does not fit {element.size} byte(s)") from None
+
+
+def _inner_size(
+    layout: Layout, plan: dict[str, Any], buffer: bytes, start: int, end: int, low: int, high: int | None
+) -> int | None:
+    """probe() for a layout whose length counts plain bytes inside the transformed span (XBee API mode 2: escaped
+    itself, counting the plain bytes): its value read (through the transform where it lies inside the span), then
+    as many plain bytes of the span as it says."""
+    t = layout.transparency
+    assert t is not None
+    inside, at, element, uncounted, counted_fixed = plan["probe_inner"]
+    begin = start + plan["prefix"]
+    try:
+        if inside:
+            head = t.plain_prefix(buffer, begin, end, at + element.size)
+            if head is None:
+                return None
+            if len(head[0]) < at + element.size:
+                return -1
+            value = element.unpack(head[0][at:])
+        elif end - start < at + element.size:
+            return None
+        else:
+            value = element.unpack(buffer[start + at : start + at + element.size])
+        counted = value - element.adds
+        content = counted - counted_fixed  # the length counts the content (lang/passes/framing.py)
+        if content < low or (high is not None and content > high):
+            return -1
+        whole = t.plain_prefix(buffer, begin, end, uncounted + counted)
+    except DecodeError:
+        return -1
+    if whole is None:
+        return None
+    if len(whole[0]) < uncounted + counted:
+        return -1
+    prefix: int = plan["prefix"]
+    return prefix + whole[1] + layout.suffix()
 
 
 @dataclass(frozen=True)
@@ -369,6 +425,8 @@ class FrameCodec:
             if None not in self.content_sizes:
                 return -1
         low, high = self.content_sizes.get(code, (0, None))
+        if plan["probe_inner"] is not None:
+            return _inner_size(layout, plan, buffer, start, end, low, high)
         length: tuple[int, Element, int, int] | None = plan["probe_length"]
         if length is not None:
             offset, element, outside, inside_fixed = length
@@ -450,6 +508,8 @@ class FrameCodec:
         the answer is always probe()'s: tests/test_frame_sizers.py draws candidates and holds the two to it.
         """
         plan: dict[str, Any] = layout._plan  # type: ignore[attr-defined]
+        if plan["probe_inner"] is not None:  # sized by reading into the transformed span: probe() decides
+            return lambda buffer, start, end: self.probe(layout, buffer, start, end)
         head: tuple[tuple[Element, int, int], ...] = plan["probe_head"]
         need = max((stop for _, _, stop in head), default=0)
         constants = tuple((first, e.constant) for e, first, _ in head if e.kind == "constant")

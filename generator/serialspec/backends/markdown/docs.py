@@ -371,7 +371,8 @@ def transparency_text(protocol: Protocol) -> str:
     t = found[0]
     return text(
         f"From `{t.first}` to `{t.last}`, {t.transform.describe()}: encode applies it, decode and the stream parser "
-        f"remove it. Lengths count the bytes as sent; checksums outside the span cover them as sent. {t.description}"
+        f"remove it. A length or checksum over elements within the span counts and covers their plain bytes, one over "
+        f"more than the span the bytes as sent. {t.description}"
     )
 
 

@@ -78,7 +78,7 @@ def straight(layout: Layout) -> bool:
     if not first <= layout.content <= last:
         return False
     for index, element in enumerate(layout.elements):
-        if element.kind == "length" and index >= first:
+        if element.kind == "length" and (index >= first or _inside(layout, *element.span)):
             return False
         if element.kind == "checksum":
             a, b = element.span
@@ -100,9 +100,10 @@ def _stuffing(layout: Layout) -> Transparency | None:
 
 
 def _inside(layout: Layout, a: int, b: int) -> bool:
-    """Whether elements a..b lie inside the stuffed span without holding all of it (they see the plain bytes)."""
+    """Whether elements a..b lie within the stuffed span (all of it, or part): a length or checksum over them sees
+    the plain bytes."""
     t = layout.transparency
-    return t is not None and t.span[0] <= a and b <= t.span[1] and (a, b) != t.span
+    return t is not None and t.span[0] <= a and b <= t.span[1]
 
 
 def _size(elements: tuple[Element, ...]) -> int:

@@ -246,8 +246,17 @@ class FramingPass(FieldResolver):
                 default = (names[content_index], names[content_index]) if content_index >= 0 else None
                 counts = self.span(item.get("counts"), direction, names, (*e_path, "counts"), default)
                 a, b = names.index(counts[0]), names.index(counts[1])
-                if index >= a or (transparency and index >= t_first):
-                    raise self.fail(e_path, "the length must come before what it counts (and before any stuffing)")
+                if index >= a or (transparency and index > t_last):
+                    raise self.fail(e_path, "the length must come before what it counts (and before the span's end)")
+                within = transparency is not None and t_first <= a and b <= t_last  # it counts plain bytes
+                if transparency and t_first <= index and not within:
+                    raise self.fail(
+                        (*e_path, "counts"), "a length inside the transparency span counts elements inside it"
+                    )
+                if within and not a <= content_index <= b:
+                    raise self.fail(
+                        (*e_path, "counts"), "a length of bytes inside the transparency span counts the content"
+                    )
                 if overlaps_badly(a, b):
                     raise self.fail((*e_path, "counts"), "the counted span must hold the transparency span or miss it")
                 elements[index] = replace(element, counts=counts)
@@ -256,19 +265,15 @@ class FramingPass(FieldResolver):
                 a, b = names.index(covers[0]), names.index(covers[1])
                 if a <= index <= b:
                     raise self.fail((*e_path, "covers"), "a checksum cannot cover itself")
+                if transparency and t_first <= index <= t_last and not (t_first <= a and b <= t_last):
+                    raise self.fail(
+                        (*e_path, "covers"),
+                        "a checksum inside the transparency span covers elements inside it (their plain bytes)",
+                    )
                 if overlaps_badly(a, b):
                     raise self.fail((*e_path, "covers"), "the covered span must hold the transparency span or miss it")
                 checksum = replace(element.checksum, first=covers[0], last=covers[1])
                 elements[index] = replace(element, checksum=checksum)
-        for length in (e for e in elements if e.role == "length" and transparency is not None):
-            a, b = names.index(length.counts[0]), names.index(length.counts[1])
-            for index in range(max(a, t_first), min(b, t_last) + 1):
-                if elements[index].role == "checksum":  # its stuffed size is known only after the length is set
-                    raise self.fail(
-                        (*elements_path, elements[index].name),
-                        "a checksum inside the transparency span cannot be counted by a length (not supported yet: "
-                        "end the span before the checksum, or count up to the content)",
-                    )
         checksums = tuple(e.checksum for e in elements if e.checksum is not None)
         flagged = any("error_flag" in item for item in raws.values())
         return self.classic_fields(direction, layout_name, tuple(elements), transparency, checksums, flagged)

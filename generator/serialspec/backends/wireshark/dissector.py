@@ -164,6 +164,17 @@ def _layout(layout: FrameLayout) -> dict[str, Any]:
         if lua is None:
             raise Unsupported(f"frames with `method: {t.transform.name}`")
         result["transparency"] = {"first": first + 1, "last": last + 1, **lua}
+        inner = engine._plan["probe_inner"]  # type: ignore[attr-defined]
+        if inner is not None:  # a length of plain bytes within the span (runtime/framing.py _inner_size)
+            in_span, at, _, uncounted, counted_fixed = inner
+            assert engine.length is not None
+            result["inner_length"] = {
+                "index": engine.length + 1,
+                "in_span": in_span,
+                "at": at,
+                "uncounted": uncounted,
+                "counted_fixed": counted_fixed,
+            }
     return result
 
 

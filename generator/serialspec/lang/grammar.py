@@ -206,6 +206,9 @@ class Obj(Shape):
     keys: dict[str, Shape]
     required: tuple[str, ...] = ()
     description: str = ""
+    # more examples for the language reference, beyond the shipped specs': (label, YAML under the parent key, a
+    # line that works it through) for each documented variant (the transforms' samples)
+    variants: tuple[tuple[str, dict[str, Any], str], ...] = ()
 
     def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
         if not isinstance(value, dict):
@@ -706,6 +709,11 @@ TRANSPARENCY = Obj(
         "description": TEXT,
     },
     required=("span",),
+    variants=tuple(
+        (f"`method: {name}`, {sample.label}", dict(sample.framing), transform.worked_sample(sample))
+        for name, transform in transforms.transforms().items()
+        for sample in transform.samples
+    ),
     description=(
         "A transform of the bytes of a span (byte stuffing, escaping, COBS), applied by encode and removed by "
         "decode and the stream parser. A length or checksum over elements within the span (all of it, or part) "

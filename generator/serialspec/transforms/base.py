@@ -59,6 +59,7 @@ class Sample:
 
     label: str
     framing: Mapping[str, Any] = field(default_factory=dict)
+    plain: bytes = b""  # the span's plain bytes of a frame, for the worked example in the language reference
 
 
 class SpanTransform(Protocol):
@@ -126,7 +127,13 @@ class Transform:
     def worked(self, plain: bytes) -> str:
         """A worked example: the plain bytes and what goes on the wire."""
         wire = self.runtime((0, 0)).encode(plain)
-        return f"{_hex(plain)} is sent as {_hex(wire)}"
+        return f"the span's bytes {_hex(plain)} are sent as {_hex(wire)}"
+
+    @classmethod
+    def worked_sample(cls, sample: Sample) -> str:
+        """The worked example of a sample, as the language reference shows it."""
+        made = cls.from_spec(sample.framing["transparency"], lambda keys, message: None)
+        return f"For example, {made.worked(sample.plain)}."
 
     # -- other backends ----------------------------------------------------------------------------------------
 

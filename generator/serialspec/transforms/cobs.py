@@ -110,6 +110,7 @@ class Cobs(Transform):
                 },
                 "transparency": {"method": "cobs", "span": ["code", "check"]},
             },
+            plain=bytes.fromhex("01 00 12 00 00 34 47 82"),
         ),
         Sample(
             "after a header, with a length inside the span (it counts the plain bytes)",
@@ -124,6 +125,7 @@ class Cobs(Transform):
                 },
                 "transparency": {"method": "cobs", "span": ["length", "checksum"]},
             },
+            plain=bytes.fromhex("03 01 00 05 06"),
         ),
     )
 

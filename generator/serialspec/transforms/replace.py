@@ -43,7 +43,7 @@ class Transparency:
             if position >= end:
                 return None
             for old, wire in pairs:
-                if buffer.startswith(wire, position):
+                if buffer.startswith(wire, position, end):
                     plain += old
                     position += len(wire)
                     break
@@ -116,6 +116,7 @@ class Replace(Transform):
                     "replace": {"7E": "7D 5E", "7D": "7D 5D", "11": "7D 31", "13": "7D 33"},
                 },
             },
+            plain=bytes.fromhex("00 05 10 7E 11 13 7D D0"),
         ),
         Sample(
             "a frame ended by a delimiter, no length, the delimiter escaped (SLIP style)",
@@ -128,6 +129,7 @@ class Replace(Transform):
                 },
                 "transparency": {"span": ["code", "checksum"], "replace": {"C0": "DB DC", "DB": "DB DD"}},
             },
+            plain=bytes.fromhex("01 C0 DB 02 18"),
         ),
     )
 

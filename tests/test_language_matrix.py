@@ -247,6 +247,19 @@ CASES: dict[str, Case] = {
             "transparency": {"span": ["code", "content"], "replace": {"C0": "DB DC", "DB": "DB DD"}},
         },
     ),
+    "frame: ended by a terminator, no length": Case(
+        {"v": "u16", "data": {"type": "bytes", "size": "rest"}},
+        {"v": "u16"},
+        {
+            "elements": {
+                "header": {"role": "header", "value": "3A"},
+                "code": {"role": "command", "type": "u8"},
+                "content": {"role": "content"},
+                "checksum": {"role": "checksum", "type": "u8", "algorithm": "xor", "covers": ["code", "content"]},
+                "end": {"role": "trailer", "value": "0D"},
+            }
+        },
+    ),
     "frame: layouts": Case(
         {"data": {"type": "bytes", "size": "rest"}},
         {"data": {"type": "bytes", "size": "rest"}},
@@ -362,6 +375,7 @@ def message_class(g: Generated, message: Message) -> Any:
 KNOWN: dict[str, str] = {}
 # Cases a target refuses with a one-line Unsupported (backends/__init__.py): (case, target) -> words of the refusal.
 REFUSED: dict[tuple[str, str], str] = {
+    ("frame: ended by a terminator, no length", "c"): "ended by its trailer alone",
     ("transform: replace, escaping after the start byte, over the length and checksum (XBee API mode 2)", "c"): (
         "a length after the variable part"
     ),

@@ -1274,6 +1274,30 @@ local function plausible(element, value)
   return (value >= element.min and value <= element.max) or value == element.broadcast
 end
 
+-- Whether `frame`, of an untransformed `layout`, has its constants and checksums right (each element's bytes found
+-- from the frame's start before the content, from its end after it).
+local function frame_checks(layout, frame)
+  local parts = {}
+  for index, element in ipairs(layout.elements) do
+    if layout.before[index] and index < layout.first then
+      parts[index] = frame:sub(layout.before[index] + 1, layout.before[index] + element.size)
+    elseif layout.after[index] and index > layout.last then
+      local stop = #frame - layout.after[index]
+      parts[index] = frame:sub(stop - element.size + 1, stop)
+    else
+      parts[index] = frame:sub(layout.prefix + 1, #frame - layout.suffix)
+    end
+  end
+  for index, element in ipairs(layout.elements) do
+    if element.constant and parts[index] ~= element.constant then return false end
+    if element.role == "checksum" and not element.checksum.unverified then
+      local covered = table.concat(parts, "", element.span[1], element.span[2])
+      if checksum(element.checksum, element.size, covered) ~= unsigned(parts[index], element.big) then return false end
+    end
+  end
+  return true
+end
+
 -- The size of a frame of `layout` at data[pos], nil when none starts there, false when the packet ends first.
 local function frame_size(direction, layout, data, pos)
   local available = #data - pos + 1
@@ -1344,6 +1368,15 @@ local function frame_size(direction, layout, data, pos)
       if at + term[2] - 1 > #data then return false end
       content = content + term[4] * unsigned(data:sub(at, at + term[2] - 1), term[3])
     end
+  elseif final.role == "trailer" and #layout.elements > 1 then
+    -- ended by its trailer alone: the first one at which the frame checks (runtime/framing.py _terminated)
+    local stop = data:find(final.constant, pos + layout.overhead - #final.constant, true)
+    while stop do
+      local size = stop + #final.constant - pos
+      if frame_checks(layout, data:sub(pos, pos + size - 1)) then return size, entry end
+      stop = data:find(final.constant, stop + 1, true)
+    end
+    return false
   else
     return available, entry -- sized by nothing but the packet: the rest of it
   end

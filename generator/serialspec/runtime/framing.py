@@ -325,6 +325,26 @@ def _inner_size(
     return prefix + whole[1] + layout.suffix()
 
 
+def _terminated(layout: Layout, buffer: bytes, start: int, end: int, low: int, high: int | None) -> int | None:
+    """probe() for a frame ended by its trailer with nothing else to size it (no length, no transform, no size
+    rule): the first occurrence of the trailer at which the frame checks (constants, checksums), so a trailer byte
+    inside the content or a checksum does not end it; None while none has come, -1 past the largest content."""
+    trailer = layout.trailer
+    largest = None if high is None else layout.overhead + high
+    position = buffer.find(trailer, start + layout.overhead + low - len(trailer), end)
+    while position >= 0:
+        size = position + len(trailer) - start
+        if largest is not None and size > largest:
+            return -1
+        try:
+            layout.unwrap(buffer[start : start + size])
+        except DecodeError:
+            position = buffer.find(trailer, position + 1, end)
+            continue
+        return size
+    return -1 if largest is not None and end - start > largest else None
+
+
 @dataclass(frozen=True)
 class Unwrapped:
     layout: Layout
@@ -440,7 +460,7 @@ class FrameCodec:
             return None if stop < 0 else stop + len(layout.trailer) - start
         rule = self.size_rules.get(code)
         if rule is None:
-            return -1
+            return _terminated(layout, buffer, start, end, low, high) if layout.trailer else -1
         content_size = rule.size(buffer, start + plan["prefix"], end)
         if content_size is None:
             return None
@@ -530,6 +550,7 @@ class FrameCodec:
             offset, element, outside, inside_fixed = length
             measured = (offset, offset + element.size, element.endian, element.adds, outside, inside_fixed)
         trailer = layout.trailer if layout.trailer and layout.transparency is not None else b""
+        terminated = bool(layout.trailer)
         before, prefix, overhead, bounded = plan["before"], plan["prefix"], layout.overhead, layout.transparency is None
 
         def sizer(buffer: bytes, start: int, end: int) -> int | None:
@@ -570,7 +591,7 @@ class FrameCodec:
                 return None if stop < 0 else stop + len(trailer) - start
             rule = size_rules.get(code)
             if rule is None:
-                return -1
+                return _terminated(layout, buffer, start, end, low, high) if terminated else -1
             content_size = rule.size(buffer, start + prefix, end)
             if content_size is None:
                 return None

@@ -377,7 +377,7 @@ KNOWN: dict[str, str] = {}
 REFUSED: dict[tuple[str, str], str] = {
     ("frame: ended by a terminator, no length", "c"): "ended by its trailer alone",
     ("transform: replace, escaping after the start byte, over the length and checksum (XBee API mode 2)", "c"): (
-        "a length after the variable part"
+        "a length inside the transformed span"
     ),
     (
         "transform: cobs, the whole packet, a checksum inside it, then the 00 delimiter (PacketSerial)",
@@ -385,6 +385,20 @@ REFUSED: dict[tuple[str, str], str] = {
     ): "method: cobs",
     ("transform: cobs, after a header, with a length inside the span (it counts the plain bytes)", "c"): "method: cobs",
 }
+CASES["frame: transparency, a length of the span's plain bytes, the checksum inside it"] = Case(
+    {"v": "u16", "data": {"type": "bytes", "size": "rest"}},
+    {"v": "u16"},
+    {
+        "elements": {
+            "header": {"role": "header", "value": "C0"},
+            "length": {"role": "length", "type": "u8", "counts": ["code", "checksum"]},
+            "code": {"role": "command", "type": "u8"},
+            "content": {"role": "content"},
+            "checksum": {"role": "checksum", "type": "u8", "algorithm": "sum", "covers": ["code", "content"]},
+        },
+        "transparency": {"span": ["code", "checksum"], "replace": {"C0": "DB DC", "DB": "DB DD"}},
+    },
+)
 CASES["frame: transparency, checksum over exactly the span"] = Case(
     {"v": "u16"},
     {"v": "u16"},
@@ -446,6 +460,12 @@ def test_every_documented_alternative_has_a_case() -> None:
                 used["element endian"].add(element.get("endian", "little"))
     field = grammar._FIELD_LONG
     element = grammar.FRAME_ELEMENT.keys
+    methods = {
+        case.framing["transparency"].get("method", "replace")
+        for case in CASES.values()
+        if case.framing and "transparency" in case.framing
+    }
+    assert set(transforms()) - methods == set()  # every frame transform (the grammar's `method` choices)
     assert set(FIELD_KINDS) - used["type"] == set()
     assert (set(grammar.SCALAR_TYPES) | {"bit"}) - used["of"] == set()
     assert set(field["encoding"].choices) - used["encoding"] == set()  # type: ignore[attr-defined]

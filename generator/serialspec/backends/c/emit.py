@@ -192,6 +192,8 @@ def refuse_layout(layout: FrameLayout) -> None:
     first = names.index(t.first) if t else content if content >= 0 else len(elements)
     last = names.index(t.last) if t else content if content >= 0 else len(elements) - 1
     length = next((i for i, e in enumerate(elements) if e.role == "length"), -1)
+    if length >= 0 and t is not None and first <= length <= last:
+        raise Unsupported(f"{where}: a length inside the transformed span")
     if length >= 0 and length >= first:
         raise Unsupported(f"{where}: a length after the variable part of the frame")
     for i, e in enumerate(elements):

@@ -386,14 +386,11 @@ REFUSED: dict[tuple[str, str], str] = {
     ("transform: cobs, after a header, with a length inside the span (it counts the plain bytes)", "c"): "method: cobs",
 }
 CASES["frame: transparency, a length of the span's plain bytes, the checksum inside it"] = Case(
-    {"v": "u16", "data": {"type": "bytes", "size": "rest"}},
+    CASES["frame: transparency"].request,
     {"v": "u16"},
     {
         "elements": {
-            "header": {"role": "header", "value": "C0"},
-            "length": {"role": "length", "type": "u8", "counts": ["code", "checksum"]},
-            "code": {"role": "command", "type": "u8"},
-            "content": {"role": "content"},
+            **CASES["frame: transparency"].framing["elements"],  # type: ignore[index]
             "checksum": {"role": "checksum", "type": "u8", "algorithm": "sum", "covers": ["code", "content"]},
         },
         "transparency": {"span": ["code", "checksum"], "replace": {"C0": "DB DC", "DB": "DB DD"}},

@@ -157,7 +157,7 @@ class ConstructCodec:
 
 
 def construct_codec(protocol_name: str, frame: bytes, direction: Direction, message: Message) -> ConstructCodec:
-    structs = importlib.import_module(f"{protocol_name}.structs")
+    structs = importlib.import_module(f"serialspec_protocols.{protocol_name}.structs")
     spec = next(m for m in protocol(protocol_name).messages() if m.class_name == type(message).__name__)
     frame_struct = getattr(structs, f"{direction.name}_FRAME")
     content_struct = structs.CONTENTS[(spec.key, direction.value)]
@@ -191,7 +191,7 @@ def run() -> Table:
     rows = []
     worst_handwritten = 0.0
     for case in CASES:
-        package = importlib.import_module(case.protocol)
+        package = importlib.import_module(f"serialspec_protocols.{case.protocol}")
         frame, direction = example_frame(case.protocol, case.example)
         message = package.decode(frame, direction)
         mine = case.decode(frame)

@@ -12,10 +12,8 @@ import timeit
 from collections.abc import Callable
 from typing import Any
 
-import dynamixel_p2
-import feetech_sms
-import modbus_rtu
 from serialspec.runtime.message import Message
+from serialspec_protocols import dynamixel_p2, feetech_sms, modbus_rtu
 
 
 def per_frame(action: Callable[[], object], number: int = 20000) -> float:

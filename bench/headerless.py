@@ -10,9 +10,9 @@ import random
 import time
 from collections.abc import Callable
 
-import modbus_rtu as mb
-import vesc
 from serialspec.runtime.message import field_names
+from serialspec_protocols import modbus_rtu as mb
+from serialspec_protocols import vesc
 
 ROUNDS = 20000
 

@@ -149,7 +149,7 @@ def reply_size(port: serial.Serial, request: bytes) -> int:
 
 
 def fashionstar(path: str) -> dict[str, Result]:
-    fs = importlib.import_module("fashionstar_uart")
+    fs = importlib.import_module("serialspec_protocols.fashionstar_uart")
     client_module = importlib.import_module("fashionstar_uart.client")
     from fashionstar_uart_sdk import uservo
     from fashionstar_uart_sdk.uart_pocket_handler import PortHandler
@@ -187,7 +187,7 @@ def fashionstar(path: str) -> dict[str, Result]:
 
 
 def feetech(path: str) -> tuple[dict[str, Result], str]:
-    sms = importlib.import_module("feetech_sms")
+    sms = importlib.import_module("serialspec_protocols.feetech_sms")
     client_module = importlib.import_module("feetech_sms.client")
     from scservo_sdk import PortHandler, sms_sts
 

@@ -39,12 +39,12 @@ HANDWRITTEN_TARGET = 1.5  # the generated parser ≥ 1.5 × as fast as the hand-
 
 def _reply_makers(rng: random.Random) -> dict[str, tuple[str, Callable[[], Message]]]:
     """Protocol -> (what the frames are, a maker of one random reply message)."""
-    fs = importlib.import_module("fashionstar_uart")
-    rrc = importlib.import_module("hiwonder_rrc")
-    sms = importlib.import_module("feetech_sms")
-    dxl = importlib.import_module("dynamixel_p2")
-    modbus = importlib.import_module("modbus_rtu")
-    vesc = importlib.import_module("vesc")
+    fs = importlib.import_module("serialspec_protocols.fashionstar_uart")
+    rrc = importlib.import_module("serialspec_protocols.hiwonder_rrc")
+    sms = importlib.import_module("serialspec_protocols.feetech_sms")
+    dxl = importlib.import_module("serialspec_protocols.dynamixel_p2")
+    modbus = importlib.import_module("serialspec_protocols.modbus_rtu")
+    vesc = importlib.import_module("serialspec_protocols.vesc")
     return {
         "fashionstar_uart": (
             "READ_ANGLE replies",
@@ -288,10 +288,12 @@ def run() -> Table:
             f"generated ≥ {HANDWRITTEN_TARGET}× as fast: {verdict(over_hand >= HANDWRITTEN_TARGET)}",
         ]
     )
-    rows += noisy_rows(importlib.import_module("fashionstar_uart"), _reply_makers(rng)["fashionstar_uart"][1], rng)
+    rows += noisy_rows(
+        importlib.import_module("serialspec_protocols.fashionstar_uart"), _reply_makers(rng)["fashionstar_uart"][1], rng
+    )
     seconds, found = best_seconds(lambda: parse_sdk(fs_chunks), 2)
     # what the target leaves per frame, against decoding one frame with no stream work at all
-    fs = importlib.import_module("fashionstar_uart")
+    fs = importlib.import_module("serialspec_protocols.fashionstar_uart")
     reply = fs.encode(fs.ReadAngleResponse(servo_id=1, angle=900))
     alone = compare(
         {"generated": (fs.decode, (reply, Direction.RESPONSE)), "handwritten": (fs_decode_read_angle_reply, (reply,))}

@@ -12,7 +12,7 @@ import sys
 import time
 from pathlib import Path
 
-from fashionstar_uart.client import FashionstarUartClient
+from serialspec_protocols.fashionstar_uart.client import FashionstarUartClient
 
 SPEC = Path(__file__).resolve().parent.parent / "specs" / "fashionstar_uart.yaml"
 

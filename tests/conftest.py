@@ -33,6 +33,9 @@ def examples(default: int) -> int:
 
 
 ROOT = Path(__file__).resolve().parent.parent
+#: The namespace the shipped protocol packages are generated into (pyproject.toml's [tool.serialspec] namespace).
+SHIPPED = "serialspec_protocols"
+PACKAGES = ROOT / "generated" / SHIPPED
 SPECS = sorted((ROOT / "specs").glob("*.yaml"))
 
 
@@ -45,8 +48,8 @@ class Generated:
 
 def load(spec: Path) -> Generated:
     protocol = load_protocol(str(spec), str(spec.relative_to(ROOT)))
-    package = importlib.import_module(protocol.name)
-    structs = importlib.import_module(f"{protocol.name}.structs")
+    package = importlib.import_module(f"{SHIPPED}.{protocol.name}")
+    structs = importlib.import_module(f"{SHIPPED}.{protocol.name}.structs")
     return Generated(protocol, package, structs)
 
 

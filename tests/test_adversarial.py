@@ -9,7 +9,7 @@ from typing import Any
 
 import pytest
 import yaml
-from conftest import ALL
+from conftest import ALL, SHIPPED
 from construct import ConstructError, Struct, Terminated
 from hostile_run import generated
 from serialspec.backends.python.memory import imported
@@ -37,7 +37,7 @@ def test_the_corpus_has_every_kind() -> None:
 @pytest.mark.parametrize("path", cases("streams"))
 def test_stream(path: Path) -> None:
     case = yaml.safe_load(path.read_text(encoding="utf-8"))
-    package = importlib.import_module(case["protocol"])
+    package = importlib.import_module(f"{SHIPPED}.{case['protocol']}")
     direction = None if case["direction"] == "both" else case["direction"]
     stream = hex_bytes(case["stream"])
     expected = [hex_bytes(frame) for frame in case["frames"]]

@@ -10,22 +10,24 @@ import inspect
 from pathlib import Path
 
 import pytest
+from conftest import PACKAGES, SHIPPED
 from serialspec.cli import capture
 from serialspec.runtime.errors import DeviceError, EncodeError, RangeError, Timeout
 from sim_process import ROOT, serve
 
 TIMEOUT = 1.0  # generous: tests wait for replies, they never time them
-PROTOCOLS = sorted(p.name for p in (ROOT / "generated").iterdir() if (p / "aio.py").is_file())
+PROTOCOLS = sorted(p.name for p in PACKAGES.iterdir() if (p / "aio.py").is_file())
 
 
 def clients(protocol: str) -> list[tuple[type, type]]:
     """(blocking class, asyncio class) of every client class of a package: the client and its groups."""
-    sync, aio = importlib.import_module(f"{protocol}.client"), importlib.import_module(f"{protocol}.aio")
+    sync = importlib.import_module(f"{SHIPPED}.{protocol}.client")
+    aio = importlib.import_module(f"{SHIPPED}.{protocol}.aio")
     return [(getattr(sync, name.removeprefix("Async")), getattr(aio, name)) for name in aio.__all__]
 
 
 def test_every_generated_package_has_an_aio_module() -> None:
-    assert sorted(p.parent.name for p in (ROOT / "generated").glob("*/client.py")) == PROTOCOLS
+    assert sorted(p.parent.name for p in PACKAGES.glob("*/client.py")) == PROTOCOLS
     assert len(PROTOCOLS) == 6
 
 
@@ -58,7 +60,7 @@ def requests_in(tap: Path) -> list[bytes]:
 
 
 def test_feetech_servos_registers_errors_and_checks_before_a_byte(tmp_path: Path) -> None:
-    from feetech_sms.aio import AsyncFeetechSmsClient
+    from serialspec_protocols.feetech_sms.aio import AsyncFeetechSmsClient
 
     tap = tmp_path / "session.capture"
 
@@ -97,7 +99,7 @@ def test_feetech_servos_registers_errors_and_checks_before_a_byte(tmp_path: Path
 def test_concurrent_tasks_on_one_bus_each_get_their_own_devices_replies() -> None:
     """Three servos with different positions, read by 3 x 40 tasks at once: every task gets its own servo's value
     (one lock per bus: a transaction's request and reply are never split by another task's)."""
-    from feetech_sms.aio import AsyncFeetechSmsClient
+    from serialspec_protocols.feetech_sms.aio import AsyncFeetechSmsClient
 
     async def session(path: str) -> None:
         async with AsyncFeetechSmsClient(path, timeout=TIMEOUT) as servos:
@@ -117,7 +119,7 @@ def test_concurrent_tasks_on_one_bus_each_get_their_own_devices_replies() -> Non
 
 
 def test_the_loop_runs_while_a_reply_is_awaited_and_a_cancelled_read_leaves_the_bus_ready() -> None:
-    from dynamixel_p2.aio import AsyncDynamixelP2Client
+    from serialspec_protocols.dynamixel_p2.aio import AsyncDynamixelP2Client
 
     async def session(path: str) -> None:
         async with AsyncDynamixelP2Client(path, timeout=TIMEOUT) as servos:
@@ -140,7 +142,7 @@ def test_the_loop_runs_while_a_reply_is_awaited_and_a_cancelled_read_leaves_the_
 
 
 def test_modbus_exceptions_and_broadcast() -> None:
-    from modbus_rtu.aio import AsyncModbusRtuClient
+    from serialspec_protocols.modbus_rtu.aio import AsyncModbusRtuClient
 
     async def session(path: str) -> None:
         # no parity and 2 stop bits: some kernels' pseudo-terminals refuse the default even parity
@@ -163,9 +165,9 @@ def test_modbus_exceptions_and_broadcast() -> None:
 
 
 def test_board_groups_and_reports_as_an_async_iterator() -> None:
-    from hiwonder_rrc.aio import AsyncHiwonderRrcClient
-    from hiwonder_rrc.messages import KeyResponse
-    from hiwonder_rrc.simulator import HiwonderRrcSimulator
+    from serialspec_protocols.hiwonder_rrc.aio import AsyncHiwonderRrcClient
+    from serialspec_protocols.hiwonder_rrc.messages import KeyResponse
+    from serialspec_protocols.hiwonder_rrc.simulator import HiwonderRrcSimulator
 
     simulator = HiwonderRrcSimulator(ids=[1, 2])
     path = simulator.start()
@@ -208,7 +210,7 @@ def test_a_port_without_a_descriptor_for_the_loop_reads_in_a_worker_thread() -> 
     import socket
     import threading
 
-    from modbus_rtu.aio import AsyncModbusRtuClient
+    from serialspec_protocols.modbus_rtu.aio import AsyncModbusRtuClient
 
     with serve("modbus_rtu.yaml", 1) as path, socket.create_server(("127.0.0.1", 0)) as server:
         device = os.open(path, os.O_RDWR | os.O_NOCTTY)

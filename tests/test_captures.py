@@ -101,7 +101,7 @@ def test_sim_logs_requests_unless_quiet() -> None:
         process = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         assert process.stdout is not None
         path = process.stdout.readline().strip()
-        import fashionstar_uart.client as fsc
+        import serialspec_protocols.fashionstar_uart.client as fsc
 
         with fsc.FashionstarUartClient(path) as client:
             assert client.ping(1)
@@ -111,8 +111,8 @@ def test_sim_logs_requests_unless_quiet() -> None:
 
 
 def test_a_spy_client_logs_what_it_receives_too(tmp_path: Path) -> None:
-    import fashionstar_uart.client as fsc
-    import fashionstar_uart.simulator as fss
+    import serialspec_protocols.fashionstar_uart.client as fsc
+    import serialspec_protocols.fashionstar_uart.simulator as fss
 
     simulator = fss.SIMULATOR([1])
     path = simulator.start()
@@ -222,8 +222,8 @@ def test_a_spy_log_replays_with_register_names_from_the_request_before(tmp_path:
     """pyserial's spy:// log, which the README names beside captures, could not be decoded (`'000000.000' is not a
     hex byte`), and a replayed READ reply showed `data 09 03`, not `model_number 777`, though its request is the
     frame before: a reply is shown with the request it answers, in a capture and in a spy log alike."""
-    from feetech_sms.client import FeetechSmsClient
-    from feetech_sms.simulator import FeetechSmsSimulator
+    from serialspec_protocols.feetech_sms.client import FeetechSmsClient
+    from serialspec_protocols.feetech_sms.simulator import FeetechSmsSimulator
 
     simulator = FeetechSmsSimulator(ids=[1])
     path = simulator.start()

@@ -14,6 +14,8 @@ from conftest import ALL, ROOT, Generated
 from serialspec.cli import main
 
 FS = str(ROOT / "specs" / "fashionstar_uart.yaml")
+#: The repository's [tool.serialspec] namespace settings, for a copy of its specs and generated/ elsewhere.
+PACKAGES_WHERE = '[tool.serialspec]\nnamespace = "serialspec_protocols"\nold_names = true\n'
 
 
 def serialspec(*args: str, cwd: Path = ROOT) -> subprocess.CompletedProcess[str]:
@@ -96,6 +98,7 @@ def test_every_example_round_trips_through_the_cli(g: Generated, capsys: pytest.
 def test_check_fails_when_a_generated_file_is_stale(tmp_path: Path) -> None:
     shutil.copytree(ROOT / "specs", tmp_path / "specs")
     shutil.copytree(ROOT / "generated", tmp_path / "generated", ignore=shutil.ignore_patterns("__pycache__"))
+    (tmp_path / "pyproject.toml").write_text(PACKAGES_WHERE, encoding="utf-8")
     assert serialspec("check", "--root", str(tmp_path)).returncode == 0
     docs = tmp_path / "generated" / "docs" / "fashionstar_uart.md"
     docs.write_text(docs.read_text(encoding="utf-8") + "edited by hand\n", encoding="utf-8")
@@ -155,19 +158,24 @@ def test_options_may_come_between_the_spec_and_the_frames() -> None:
 def test_check_names_a_hand_written_file_inside_a_generated_package(tmp_path: Path) -> None:
     shutil.copytree(ROOT / "specs", tmp_path / "specs")
     shutil.copytree(ROOT / "generated", tmp_path / "generated", ignore=shutil.ignore_patterns("__pycache__"))
-    (tmp_path / "generated" / "feetech_sms" / "mine.py").write_text("x = 1\n", encoding="utf-8")
+    (tmp_path / "pyproject.toml").write_text(PACKAGES_WHERE, encoding="utf-8")
+    (tmp_path / "generated" / "serialspec_protocols" / "feetech_sms" / "mine.py").write_text(
+        "x = 1\n", encoding="utf-8"
+    )
     result = serialspec("check", "--root", str(tmp_path))
     assert result.returncode == 1
-    assert "generated/feetech_sms/mine.py: not generated from any spec" in result.stderr
+    assert "generated/serialspec_protocols/feetech_sms/mine.py: not generated from any spec" in result.stderr
     assert serialspec("generate", "--root", str(tmp_path)).returncode == 0
-    assert (tmp_path / "generated" / "feetech_sms" / "mine.py").exists()  # generate never removes it
+    assert (
+        tmp_path / "generated" / "serialspec_protocols" / "feetech_sms" / "mine.py"
+    ).exists()  # generate never removes it
 
 
 def test_a_spec_path_uses_the_generated_package_only_when_it_was_generated_from_that_very_text(tmp_path: Path) -> None:
     from serialspec.cli.protocols import open_spec
 
     _, package = open_spec(FS)
-    assert package.__file__ == str(ROOT / "generated" / "fashionstar_uart" / "__init__.py")
+    assert package.__file__ == str(ROOT / "generated" / "serialspec_protocols" / "fashionstar_uart" / "__init__.py")
     edited = tmp_path / "fashionstar_uart.yaml"
     edited.write_text(Path(FS).read_text(encoding="utf-8").replace("range: [0, 254]", "range: [0, 255]", 1))
     _, live = open_spec(str(edited))

@@ -6,9 +6,9 @@ import time
 from collections.abc import Iterator
 
 import pytest
-from fashionstar_uart import ResponseSwitch, Result, UserData
-from fashionstar_uart.client import FashionstarUartClient
 from serialspec.runtime.errors import EncodeError, Timeout
+from serialspec_protocols.fashionstar_uart import ResponseSwitch, Result, UserData
+from serialspec_protocols.fashionstar_uart.client import FashionstarUartClient
 
 TIMEOUT = 1.0
 

@@ -15,14 +15,14 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from feetech_sms import MODELS
-from feetech_sms.client import FeetechSmsClient
-from feetech_sms.codec import StreamParser, encode
-from feetech_sms.messages import Direction, ResetRequest, WriteRequest
-from feetech_sms.registers import CONTROL_TABLE
-from feetech_sms.simulator import DEVICE, FeetechSmsSimulator
 from serialspec.lang import SpecErrors, load_protocol
 from serialspec.runtime.device import ModelSpec, Simulator
+from serialspec_protocols.feetech_sms import MODELS
+from serialspec_protocols.feetech_sms.client import FeetechSmsClient
+from serialspec_protocols.feetech_sms.codec import StreamParser, encode
+from serialspec_protocols.feetech_sms.messages import Direction, ResetRequest, WriteRequest
+from serialspec_protocols.feetech_sms.registers import CONTROL_TABLE
+from serialspec_protocols.feetech_sms.simulator import DEVICE, FeetechSmsSimulator
 from sim_process import ROOT, serve
 
 scservo_sdk = pytest.importorskip("scservo_sdk")

@@ -7,9 +7,9 @@ from collections.abc import Iterator
 
 import pytest
 from conftest import Running
-from dynamixel_p2.client import DynamixelP2Client
-from dynamixel_p2.simulator import DynamixelP2Simulator
 from serialspec.runtime.errors import DecodeError, DeviceError, RangeError, Timeout
+from serialspec_protocols.dynamixel_p2.client import DynamixelP2Client
+from serialspec_protocols.dynamixel_p2.simulator import DynamixelP2Simulator
 
 TIMEOUT = 1.0
 

@@ -6,11 +6,11 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 
-import fashionstar_uart as fs
 import pytest
-from fashionstar_uart.client import FashionstarUartClient
-from feetech_sms.client import FeetechSmsClient
 from serialspec.runtime.errors import CorruptReply, DeviceError, PortError, Timeout
+from serialspec_protocols import fashionstar_uart as fs
+from serialspec_protocols.fashionstar_uart.client import FashionstarUartClient
+from serialspec_protocols.feetech_sms.client import FeetechSmsClient
 from sim_process import serve
 
 

@@ -11,12 +11,12 @@ import time
 from collections.abc import Iterator
 from typing import Any
 
-import fashionstar_uart as fs
 import pytest
 import serial
-from fashionstar_uart.client import FashionstarUartClient
-from fashionstar_uart.simulator import FashionstarUartSimulator
 from serialspec.runtime.errors import EncodeError, RangeError
+from serialspec_protocols import fashionstar_uart as fs
+from serialspec_protocols.fashionstar_uart.client import FashionstarUartClient
+from serialspec_protocols.fashionstar_uart.simulator import FashionstarUartSimulator
 
 uservo = pytest.importorskip("fashionstar_uart_sdk.uservo")
 pocket = pytest.importorskip("fashionstar_uart_sdk.uart_pocket_handler")

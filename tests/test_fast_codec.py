@@ -126,8 +126,8 @@ def test_two_formats_never_share_a_struct_constant() -> None:
 
 
 def test_replace_copies_a_message_with_changed_fields_and_refuses_unknown_names() -> None:
-    import fashionstar_uart as fs
     from serialspec.runtime.message import field_names, replace
+    from serialspec_protocols import fashionstar_uart as fs
 
     message = fs.RotateRequest(servo_id=2, angle=900, interval=500)
     moved = replace(message, angle=0)

@@ -20,12 +20,18 @@ from typing import Any
 
 import pytest
 import serial
-from fashionstar_uart import ReadAngleRequest, ReadAngleResponse, ReadDataRequest, ReadDataResponse, Result
-from fashionstar_uart.client import BINDING, PARAMETERS, FashionstarUartClient
-from fashionstar_uart.simulator import FashionstarUartSimulator
 from serialspec.runtime.errors import CorruptReply, PortError, Timeout, TransportError
 from serialspec.runtime.message import Message
 from serialspec.runtime.transport import Bus
+from serialspec_protocols.fashionstar_uart import (
+    ReadAngleRequest,
+    ReadAngleResponse,
+    ReadDataRequest,
+    ReadDataResponse,
+    Result,
+)
+from serialspec_protocols.fashionstar_uart.client import BINDING, PARAMETERS, FashionstarUartClient
+from serialspec_protocols.fashionstar_uart.simulator import FashionstarUartSimulator
 from sim_process import serve
 
 TIMEOUTS = [0.05, 0.2]

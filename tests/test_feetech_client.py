@@ -7,10 +7,10 @@ from collections.abc import Iterator
 
 import pytest
 from conftest import Running
-from feetech_sms.client import FeetechSmsClient
-from feetech_sms.registers import CONTROL_TABLE
-from feetech_sms.simulator import FeetechSmsSimulator
 from serialspec.runtime.errors import DeviceError, EncodeError, RangeError, Timeout
+from serialspec_protocols.feetech_sms.client import FeetechSmsClient
+from serialspec_protocols.feetech_sms.registers import CONTROL_TABLE
+from serialspec_protocols.feetech_sms.simulator import FeetechSmsSimulator
 
 TIMEOUT = 1.0
 

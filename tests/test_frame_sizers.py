@@ -20,7 +20,7 @@ from serialspec.runtime.framing import FrameCodec
 CODECS = [
     (g, name, value)
     for g in ALL
-    for name, value in vars(importlib.import_module(f"{g.protocol.name}.codec")).items()
+    for name, value in vars(importlib.import_module(f"{g.package.__name__}.codec")).items()
     if isinstance(value, FrameCodec)
 ]
 

@@ -10,9 +10,9 @@ import time
 from collections.abc import Iterator
 from typing import Any
 
-import dynamixel_p2
 import pytest
-from dynamixel_p2.registers import CONTROL_TABLE
+from serialspec_protocols import dynamixel_p2
+from serialspec_protocols.dynamixel_p2.registers import CONTROL_TABLE
 from sim_process import serve
 
 dxl = pytest.importorskip("dynamixel_sdk")

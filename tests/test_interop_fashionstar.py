@@ -8,7 +8,7 @@ from collections.abc import Iterator
 
 import pytest
 import serial
-from fashionstar_uart.client import FashionstarUartClient
+from serialspec_protocols.fashionstar_uart.client import FashionstarUartClient
 
 uservo = pytest.importorskip("fashionstar_uart_sdk.uservo")
 

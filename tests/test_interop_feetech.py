@@ -8,7 +8,7 @@ from collections.abc import Iterator
 from typing import Any
 
 import pytest
-from feetech_sms.registers import CONTROL_TABLE
+from serialspec_protocols.feetech_sms.registers import CONTROL_TABLE
 
 scservo_sdk = pytest.importorskip("scservo_sdk")
 

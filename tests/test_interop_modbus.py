@@ -12,10 +12,10 @@ from collections.abc import Iterator
 from typing import Any
 
 import pytest
-from modbus_rtu import CoilState
-from modbus_rtu.client import ModbusRtuClient
 from pty_pair import pty_pair
 from serialspec.runtime.errors import DeviceError
+from serialspec_protocols.modbus_rtu import CoilState
+from serialspec_protocols.modbus_rtu.client import ModbusRtuClient
 from sim_process import serve
 
 pymodbus = pytest.importorskip("pymodbus")

@@ -6,11 +6,11 @@ from __future__ import annotations
 from collections.abc import Callable, Iterator
 
 import pytest
-from fashionstar_uart import ReadAngleRequest, ReadAngleResponse
-from fashionstar_uart.client import BINDING
-from fashionstar_uart.simulator import FashionstarUartSimulator
 from serialspec.runtime.errors import Timeout
 from serialspec.runtime.transport import Bus, FdLink, Link
+from serialspec_protocols.fashionstar_uart import ReadAngleRequest, ReadAngleResponse
+from serialspec_protocols.fashionstar_uart.client import BINDING
+from serialspec_protocols.fashionstar_uart.simulator import FashionstarUartSimulator
 
 
 @pytest.fixture

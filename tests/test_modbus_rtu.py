@@ -6,10 +6,10 @@ from __future__ import annotations
 import random
 from typing import Any
 
-import modbus_rtu as mb
 import pytest
-from modbus_rtu.simulator import ModbusRtuSimulator
 from serialspec.runtime.errors import ChecksumError, DecodeError, RangeError
+from serialspec_protocols import modbus_rtu as mb
+from serialspec_protocols.modbus_rtu.simulator import ModbusRtuSimulator
 
 pymodbus_pdu = pytest.importorskip("pymodbus.pdu")
 from pymodbus.framer import FramerRTU  # noqa: E402
@@ -262,8 +262,8 @@ def test_broadcast_writes_reach_every_server_and_get_no_reply() -> None:
 
 
 def test_the_client_reads_writes_and_names_exceptions() -> None:
-    from modbus_rtu.client import ModbusRtuClient
     from serialspec.runtime.errors import DeviceError, Timeout
+    from serialspec_protocols.modbus_rtu.client import ModbusRtuClient
 
     server = ModbusRtuSimulator(ids=[1, 2], sizes={"holding_registers": 200})
     path = server.start()
@@ -291,8 +291,8 @@ def test_the_client_reads_writes_and_names_exceptions() -> None:
 
 def test_a_port_that_refuses_even_parity_is_a_port_error_naming_it() -> None:
     """The serial line specification's default is even parity; where a port refuses it, the error says so."""
-    from modbus_rtu.client import ModbusRtuClient
     from serialspec.runtime.errors import PortError
+    from serialspec_protocols.modbus_rtu.client import ModbusRtuClient
 
     server = ModbusRtuSimulator()
     path = server.start()

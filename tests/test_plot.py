@@ -28,7 +28,7 @@ def serialspec(*args: str, env: dict[str, str] | None = None) -> subprocess.Comp
 @pytest.fixture(scope="module")
 def session(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """Two Fashion Star servos turned (to 90.0° and -45.0°) and read while they move, recorded by the sim's tap."""
-    from fashionstar_uart.client import FashionstarUartClient
+    from serialspec_protocols.fashionstar_uart.client import FashionstarUartClient
 
     tap = tmp_path_factory.mktemp("plot") / "session.capture"
     with (
@@ -73,7 +73,7 @@ def test_values_are_in_the_specs_units(session: Path) -> None:
 
 
 def test_registers_read_through_a_table_are_fields_of_their_reply(tmp_path: Path) -> None:
-    from feetech_sms.client import FeetechSmsClient
+    from serialspec_protocols.feetech_sms.client import FeetechSmsClient
 
     tap = tmp_path / "sms.capture"
     with serve("feetech_sms.yaml", 1, options=["--tap", str(tap)]) as path, FeetechSmsClient(path, timeout=1.0) as sms:

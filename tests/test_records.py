@@ -76,7 +76,7 @@ def test_a_message_behaves_as_a_frozen_record_not_a_tuple(g: Generated, spec: Me
 
 
 def test_a_message_without_fields_is_true_and_matches_by_class() -> None:
-    import fashionstar_uart as fs
+    from serialspec_protocols import fashionstar_uart as fs
 
     message = fs.BeginAsyncRequest()
     assert field_names(message) == () and bool(message) is True
@@ -90,8 +90,8 @@ def test_a_message_without_fields_is_true_and_matches_by_class() -> None:
 
 def test_a_record_where_a_number_or_list_belongs_is_refused_in_one_line() -> None:
     """A record is a tuple underneath; the runtime's list checks must not take it for a list of values."""
-    import fashionstar_uart as fs
-    import hiwonder_rrc as rrc
+    from serialspec_protocols import fashionstar_uart as fs
+    from serialspec_protocols import hiwonder_rrc as rrc
 
     stray = fs.PingRequest(servo_id=1)
     with pytest.raises(EncodeError, match="^rotate request: [^\n]*PingRequest[^\n]*$"):

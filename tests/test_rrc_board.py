@@ -11,7 +11,9 @@ from pathlib import Path
 
 import pytest
 from conftest import ROOT
-from hiwonder_rrc import (
+from serialspec.lang import SpecErrors, load_protocol
+from serialspec.runtime.errors import DeviceError, RangeError, Timeout
+from serialspec_protocols.hiwonder_rrc import (
     BusServoReadPositionResponse,
     BusServoSetPositionsRequest,
     BusServosItem,
@@ -23,10 +25,8 @@ from hiwonder_rrc import (
     ReadResult,
     encode,
 )
-from hiwonder_rrc.client import HiwonderRrcClient
-from hiwonder_rrc.simulator import HiwonderRrcSimulator
-from serialspec.lang import SpecErrors, load_protocol
-from serialspec.runtime.errors import DeviceError, RangeError, Timeout
+from serialspec_protocols.hiwonder_rrc.client import HiwonderRrcClient
+from serialspec_protocols.hiwonder_rrc.simulator import HiwonderRrcSimulator
 from sim_process import serve
 
 TIMEOUT = 1.0  # generous: tests wait for replies, they never time them

@@ -11,13 +11,13 @@ import sys
 import time
 from collections.abc import Iterator
 
-import hiwonder_rrc as rrc
 import pytest
 from conftest import ROOT
-from hiwonder_rrc.client import HiwonderRrcClient
-from hiwonder_rrc.simulator import HiwonderRrcSimulator
 from serialspec.checksums.crc import crc_function
 from serialspec.runtime.errors import RangeError
+from serialspec_protocols import hiwonder_rrc as rrc
+from serialspec_protocols.hiwonder_rrc.client import HiwonderRrcClient
+from serialspec_protocols.hiwonder_rrc.simulator import HiwonderRrcSimulator
 
 BATTERY = "AA 55 00 03 04 1C 25 AB"
 # The SDK's table-driven checksum_crc8: the reflected 0x31 table, init 0, no final XOR (CRC-8/MAXIM).

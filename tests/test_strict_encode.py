@@ -97,7 +97,7 @@ def nothing_written(controller: int) -> bool:
 
 @pytest.mark.parametrize("bad", [True, 1.5, float("nan"), "90", None, 10**40, 40000])
 def test_client_refuses_before_writing(line: tuple[int, str], bad: Any) -> None:
-    from fashionstar_uart.client import FashionstarUartClient
+    from serialspec_protocols.fashionstar_uart.client import FashionstarUartClient
 
     controller, path = line
     with FashionstarUartClient(path, timeout=0.05) as client, pytest.raises(EncodeError) as failure:
@@ -109,7 +109,7 @@ def test_client_refuses_before_writing(line: tuple[int, str], bad: Any) -> None:
 @pytest.mark.parametrize("bad", [True, 1.5, "1", None, 10**40, 300])
 def test_a_request_awaiting_its_reply_is_refused_before_writing(line: tuple[int, str], bad: Any) -> None:
     """Bus.request calls the command's encoder at once; what it refuses is refused as encode refuses it."""
-    from fashionstar_uart.client import FashionstarUartClient
+    from serialspec_protocols.fashionstar_uart.client import FashionstarUartClient
 
     controller, path = line
     with FashionstarUartClient(path, timeout=0.05) as client, pytest.raises(EncodeError) as failure:
@@ -120,7 +120,7 @@ def test_a_request_awaiting_its_reply_is_refused_before_writing(line: tuple[int,
 
 def test_feetech_client_writes_a_register_named_like_its_address_parameter(line: tuple[int, str]) -> None:
     """`write(id, /, **values)`: the register `id` is a keyword, the servo id positional; range checked first."""
-    from feetech_sms.client import FeetechSmsClient
+    from serialspec_protocols.feetech_sms.client import FeetechSmsClient
 
     controller, path = line
     with FeetechSmsClient(path, timeout=0.05) as client:

@@ -120,7 +120,7 @@ def line() -> Iterator[tuple[int, str]]:
     ],
 )
 def test_client_refuses_before_writing(line: tuple[int, str], method: str, values: Any, words: str) -> None:
-    from modbus_rtu.client import ModbusRtuClient
+    from serialspec_protocols.modbus_rtu.client import ModbusRtuClient
 
     controller, path = line
     with ModbusRtuClient(path, timeout=0.05) as client, pytest.raises(EncodeError) as failure:
@@ -208,7 +208,7 @@ def drain(controller: int) -> bytes:
 def test_client_checks_writes_against_the_model(line: tuple[int, str]) -> None:
     """The XL430-W250 has no current control (goal_current 0..0): refused before a byte is written; the table's
     range (the XM430-W350's, the default) takes 1000; a mixed bus names a model per id, a broadcast suits all."""
-    from dynamixel_p2.client import DynamixelP2Client
+    from serialspec_protocols.dynamixel_p2.client import DynamixelP2Client
 
     controller, path = line
     with DynamixelP2Client(path, timeout=0.05, optional_replies=False, model="xl430_w250") as client:
@@ -238,7 +238,7 @@ def test_client_checks_writes_against_the_model(line: tuple[int, str]) -> None:
 
 
 def test_client_refuses_an_unknown_model(line: tuple[int, str]) -> None:
-    from dynamixel_p2.client import DynamixelP2Client
+    from serialspec_protocols.dynamixel_p2.client import DynamixelP2Client
 
     with pytest.raises(ValueError, match=r"model 'xl999' is not one of the spec's models \(xm430_w350, "):
         DynamixelP2Client(line[1], model={1: "xl999"})

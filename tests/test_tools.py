@@ -185,7 +185,7 @@ def test_scan_shows_a_progress_bar_on_a_terminal_only() -> None:
 
 def session_capture(tmp_path: Path) -> Path:
     """A real session recorded by `sim --tap`: three reads by the client, 0.2 s apart."""
-    from feetech_sms.client import FeetechSmsClient
+    from serialspec_protocols.feetech_sms.client import FeetechSmsClient
 
     tap = tmp_path / "session.tap"
     with serve("feetech_sms.yaml", 1, options=["--tap", str(tap)]) as port, FeetechSmsClient(port) as client:

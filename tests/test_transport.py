@@ -11,12 +11,12 @@ import tty
 from collections.abc import Iterator
 
 import pytest
-from fashionstar_uart import PingRequest, ReadAngleRequest, ReadAngleResponse, encode
-from fashionstar_uart.client import BINDING, FashionstarUartClient
-from fashionstar_uart.simulator import FashionstarUartSimulator
 from serialspec.runtime.errors import CorruptReply, PortError, RangeError, Timeout
 from serialspec.runtime.message import Message
 from serialspec.runtime.transport import Bus
+from serialspec_protocols.fashionstar_uart import PingRequest, ReadAngleRequest, ReadAngleResponse, encode
+from serialspec_protocols.fashionstar_uart.client import BINDING, FashionstarUartClient
+from serialspec_protocols.fashionstar_uart.simulator import FashionstarUartSimulator
 from sim_process import ROOT
 
 TIMEOUT = 1.0  # generous: the tests assert that replies come well before it, never an absolute speed

@@ -7,10 +7,10 @@ import random
 from typing import Any
 
 import pytest
-import vesc
 from serialspec.runtime.errors import ChecksumError, DecodeError
-from vesc.client import VescClient
-from vesc.simulator import VescSimulator
+from serialspec_protocols import vesc
+from serialspec_protocols.vesc.client import VescClient
+from serialspec_protocols.vesc.simulator import VescSimulator
 
 pyvesc = pytest.importorskip("pyvesc")  # needs pythoncrc (its PyCRC module)
 from pyvesc.messages import setters  # noqa: E402

@@ -83,7 +83,7 @@ def test_watch_follows_a_running_sim_and_shows_each_command_and_register_in_unit
     with serve("feetech_sms.yaml", 1, 2, options=["--tap", str(tap)]) as path, pane("tap") as screen:
         screen.start(watch)
         assert "serialspec watch: feetech_sms" in screen.wait_for(lambda s: "0 frames" in s)
-        from feetech_sms.client import FeetechSmsClient
+        from serialspec_protocols.feetech_sms.client import FeetechSmsClient
 
         with FeetechSmsClient(path) as servos:  # the program that owns the port: watch takes nothing from it
             assert servos.ping(1) and not servos.ping(7)

@@ -3,13 +3,13 @@ exactly as the general path refuses them (the whole-frame decoder returns None, 
 
 from __future__ import annotations
 
-import feetech_sms as sms
-import hiwonder_rrc as rrc
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 from serialspec.runtime.errors import ChecksumError, DecodeError
 from serialspec.runtime.message import Direction
+from serialspec_protocols import feetech_sms as sms
+from serialspec_protocols import hiwonder_rrc as rrc
 
 
 @given(st.binary(max_size=40), st.integers(0, 253), st.integers(0, 255))

@@ -30,6 +30,9 @@ def pages() -> dict[str, str]:
         "docs/tutorial.md": "tutorial.md",
         "docs/language.md": "language.md",
         "docs/c.md": "c.md",
+        "docs/architecture.md": "architecture.md",
+        "docs/performance.md": "performance.md",
+        "docs/testing.md": "testing.md",
     }
     for doc in sorted((ROOT / "generated" / "docs").glob("*.md")):
         found[f"generated/docs/{doc.name}"] = f"protocols/{doc.name}"
@@ -66,6 +69,13 @@ def main(site: Path) -> int:
         {"Language reference": "language.md"},
         {"C target": "c.md"},
         {"Protocols": protocols},
+        {
+            "Working on serialspec": [
+                {"Architecture": "architecture.md"},
+                {"Performance": "performance.md"},
+                {"Testing": "testing.md"},
+            ]
+        },
     ]
     try:
         build(texts, nav, site, name="serialspec", files=files)

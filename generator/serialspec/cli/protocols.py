@@ -23,6 +23,9 @@ if TYPE_CHECKING:
     from serialspec.lang.model import Protocol
 
 SHIPPED_SPEC = "spec.yaml"
+#: Where serialspec's own protocol packages are installed (the repository's pyproject.toml `namespace`): a protocol
+#: name is looked up there too, so `serialspec decode vesc …` needs no namespace.
+SHIPPED_NAMESPACE = "serialspec_protocols"
 SPEC_HELP = (
     "a spec file (built from it in memory, never stale), or a generated protocol package's name (in the current "
     "folder or installed)"
@@ -96,12 +99,12 @@ def submodule(package: ModuleType, name: str) -> ModuleType | None:
 
 
 def installed(name: str) -> tuple[Protocol, ModuleType]:
-    """A generated package by protocol name, with the spec it ships as package data: found as `python -c "import
-    NAME"` would find it, the current folder first, then the installed packages."""
+    """A generated package by protocol name, with the spec it ships as package data: a package NAME/ in the current
+    folder first, then the installed serialspec_protocols.NAME, then an installed top-level NAME."""
     here = str(Path.cwd())
     sys.path.insert(0, here)
     try:
-        package = importlib.import_module(name)
+        package = importlib.import_module(_import_name(name))
     except ImportError:
         raise SerialspecError(
             f"no such spec file, nor a protocol package {name}/ in this folder or installed: give the spec file "
@@ -120,11 +123,24 @@ def installed(name: str) -> tuple[Protocol, ModuleType]:
     return resolved(str(shipped), f"{name}/{SHIPPED_SPEC}", data), package
 
 
+def _import_name(name: str) -> str:
+    """The name to import a protocol's package by (the current folder is on the path): the folder's own package,
+    else the shipped one under its namespace (not the old top-level alias, which warns), else NAME as it is."""
+    if not name.isidentifier() or Path(name, "__init__.py").is_file():
+        return name
+    try:
+        shipped = importlib.util.find_spec(f"{SHIPPED_NAMESPACE}.{name}")
+    except ImportError:
+        shipped = None
+    return f"{SHIPPED_NAMESPACE}.{name}" if shipped is not None else name
+
+
 def generated_from_this(protocol: Protocol, spec_text: str) -> ModuleType | None:
     """The importable generated package of this protocol, if it was generated from exactly this spec text (the copy
     of the spec it ships says so); else None, and the caller builds the package from the spec instead."""
+    name = _import_name(protocol.name)
     try:
-        found = importlib.util.find_spec(protocol.name)
+        found = importlib.util.find_spec(name)
     except (ImportError, ValueError):
         return None
     if found is None or not found.submodule_search_locations:
@@ -136,7 +152,7 @@ def generated_from_this(protocol: Protocol, spec_text: str) -> ModuleType | None
         return None
     if generated_from != spec_text:
         return None
-    return importlib.import_module(protocol.name)
+    return importlib.import_module(name)
 
 
 def package_in_memory(protocol: Protocol) -> ModuleType:
@@ -174,4 +190,4 @@ def message_type(package: ModuleType, command: str, subcommand: str | None, dire
         if len(names) <= 12
         else ""
     )
-    raise SerialspecError(f"{package.__name__} has no {direction} {what!r}{hint}")
+    raise SerialspecError(f"{getattr(package, 'PROTOCOL', package.__name__)} has no {direction} {what!r}{hint}")

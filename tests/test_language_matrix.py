@@ -379,11 +379,9 @@ REFUSED: dict[tuple[str, str], str] = {
     ("transform: replace, escaping after the start byte, over the length and checksum (XBee API mode 2)", "c"): (
         "a length inside the transformed span"
     ),
-    (
-        "transform: cobs, the whole packet, a checksum inside it, then the 00 delimiter (PacketSerial)",
-        "c",
-    ): "method: cobs",
-    ("transform: cobs, after a header, with a length inside the span (it counts the plain bytes)", "c"): "method: cobs",
+    ("transform: cobs, after a header, with a length inside the span (it counts the plain bytes)", "c"): (
+        "a length inside the transformed span"
+    ),
 }
 CASES["frame: transparency, a length of the span's plain bytes, the checksum inside it"] = Case(
     CASES["frame: transparency"].request,

@@ -150,5 +150,8 @@ class Cobs(Transform):
             "after it + 1, stands for the 00 that ends the run; runs of 254 bytes take a code byte FF and no 00)"
         )
 
+    def c_refusal(self) -> str:
+        return ""
+
     def lua(self) -> dict[str, Any] | None:
         return {"method": "cobs"}

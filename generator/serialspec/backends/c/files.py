@@ -22,6 +22,7 @@ from serialspec.backends.c.emit import (
 )
 from serialspec.backends.c.engine import ENGINE
 from serialspec.lang.model import Direction, FrameLayout, Message, Protocol, size_terms
+from serialspec.transforms.cobs import Cobs
 from serialspec.transforms.replace import Replace
 
 DIRECTIONS = (Direction.REQUEST, Direction.RESPONSE)
@@ -253,8 +254,10 @@ def layout_tables(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) -
     t = layout.transparency
     pairs = "NULL"
     pair_count = 0
+    method = 0  # the engine's has_t: 0 none, 1 substitution (pairs), 2 COBS (emit.refuse_layout refused others)
     if t is not None:
-        assert isinstance(t.transform, Replace)  # emit.refuse_layout refused the others
+        method = 2 if isinstance(t.transform, Cobs) else 1
+    if t is not None and isinstance(t.transform, Replace):
         prows = []
         pair_count = len(t.transform.pairs)
         for j, (plain, wire) in enumerate(t.transform.pairs):
@@ -292,7 +295,7 @@ def layout_tables(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) -
                 break
     lines.append(
         f"static const {p}__layout_t {name} = {{{name}_e, {len(layout.elements)}u, {content}, {command}, "
-        f"{1 if t else 0}u, {tf}u, {tl}u, {pairs}, {pair_count}u, {header_len}u, {prefix}u, "
+        f"{method}u, {tf}u, {tl}u, {pairs}, {pair_count}u, {header_len}u, {prefix}u, "
         f"{error_flag}UL, {overhead}u, {before}u, {after}u, {length}, {length_off}u, {counted}u}};"
     )
     if t:

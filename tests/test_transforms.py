@@ -5,6 +5,7 @@ tests/test_language_matrix.py (and through tshark in tests/test_wireshark.py).""
 
 from __future__ import annotations
 
+import ast
 import importlib
 import json
 from collections.abc import Mapping
@@ -199,3 +200,16 @@ def test_the_runtime_classes_load_from_runtime_framing() -> None:
     framing = importlib.import_module("serialspec.runtime.framing")
     for transform in transforms().values():
         assert getattr(framing, transform.runtime_name).__module__ == transform.__module__
+
+
+def test_the_registry_imports_nothing_of_the_generator() -> None:
+    """The runtime wheel ships the package (packaging/runtime): its modules import the standard library, the runtime,
+    the checksum registry's plain data and each other only."""
+    folder = Path(importlib.import_module("serialspec.transforms").__file__ or "").parent
+    allowed = ("serialspec.transforms", "serialspec.runtime", "serialspec.checksums")
+    for path in sorted(folder.glob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            names = [a.name for a in node.names] if isinstance(node, ast.Import) else []
+            names += [node.module or ""] if isinstance(node, ast.ImportFrom) else []
+            for name in names:
+                assert name.split(".")[0] != "serialspec" or name.startswith(allowed), (path.name, name)

@@ -1139,64 +1139,45 @@ proto.experts = {e_checksum, e_malformed, e_garbage}
 
 -- --- checksums and byte stuffing ------------------------------------------------------------------------------------
 
-local function reflect(value, width)
-  local result = 0
-  for _ = 1, width do
-    result = bor(lshift(result, 1), band(value, 1))
-    value = rshift(value, 1)
-  end
-  return result
-end
+-- each algorithm's function (serialspec.checksums: Algorithm.lua_function), by its name
+local CHECKSUMS = {
+  ["crc"] = function(spec, size, data)
+    local function reflect(value, width)
+      local result = 0
+      for _ = 1, width do
+        result = bor(lshift(result, 1), band(value, 1))
+        value = rshift(value, 1)
+      end
+      return result
+    end
+    local width = spec.width
+    local top, crc_mask = lshift(1, width - 1), width_mask(width)
+    local crc = spec.init
+    for i = 1, #data do
+      local byte = data:byte(i)
+      if spec.refin then
+        byte = reflect(byte, 8)
+      end
+      for bit = 7, 0, -1 do
+        local feedback = band(crc, top) ~= 0
+        if band(rshift(byte, bit), 1) == 1 then
+          feedback = not feedback
+        end
+        crc = band(lshift(crc, 1), crc_mask)
+        if feedback then
+          crc = bxor(crc, spec.poly)
+        end
+      end
+    end
+    if spec.refout then
+      crc = reflect(crc, width)
+    end
+    return band(bxor(crc, spec.xorout), crc_mask)
+  end,
+}
 
 local function checksum(spec, size, data)
-  local mask = width_mask(size * 8)
-  if spec.algorithm == "sum" then
-    local total = 0
-    for i = 1, #data do
-      total = (total + data:byte(i)) % (mask + 1)
-    end
-    return spec.invert and mask - total or total
-  elseif spec.algorithm == "fletcher" then -- CK_B << 8 | CK_A
-    local a, b = 0, 0
-    for i = 1, #data do
-      a = (a + data:byte(i)) % spec.modulus
-      b = (b + a) % spec.modulus
-    end
-    return b * 256 + a
-  elseif spec.algorithm == "xor" then
-    local total = 0
-    for i = 1, #data, size do
-      local word = 0
-      for j = i, i + size - 1 do
-        word = word * 256 + (data:byte(j) or 0)
-      end
-      total = bxor(total, word)
-    end
-    return total
-  end
-  local width = spec.width
-  local top, crc_mask = lshift(1, width - 1), width_mask(width)
-  local crc = spec.init
-  for i = 1, #data do
-    local byte = data:byte(i)
-    if spec.refin then
-      byte = reflect(byte, 8)
-    end
-    for bit = 7, 0, -1 do
-      local feedback = band(crc, top) ~= 0
-      if band(rshift(byte, bit), 1) == 1 then
-        feedback = not feedback
-      end
-      crc = band(lshift(crc, 1), crc_mask)
-      if feedback then
-        crc = bxor(crc, spec.poly)
-      end
-    end
-  end
-  if spec.refout then
-    crc = reflect(crc, width)
-  end
-  return band(bxor(crc, spec.xorout), crc_mask)
+  return CHECKSUMS[spec.algorithm](spec, size, data)
 end
 
 local function rewrite(data, pairs_, from, to)

@@ -12,6 +12,7 @@ checksum element by `from_spec`. Its class owns all that the algorithm means to 
   `python_lines`), and optional fast paths (`byte_total`, `frame_test`, `summed`, `byte_table`: None where the
   algorithm has none);
 - the markdown backend: `describe()`, `parameters()` and `worked(covered)` for the checksum section;
+- the Wireshark backend: `lua_function()` and `lua_parameters()`, the dissector's Lua code of the algorithm;
 - tests: `samples`, one per documented option, which tests/test_matrix.py runs through every output.
 
 A new algorithm is one module of this package with one subclass that sets `name`: it is found by `algorithms()`.
@@ -162,6 +163,19 @@ class Algorithm:
         """Where python_lines runs `target = TABLE[target ^ byte]` over the covered bytes from a constant start:
         the steps (a codec may then fold known bytes into the start and unroll short runs); None for others."""
         return None
+
+    # -- the Wireshark backend ---------------------------------------------------------------------------------
+
+    @classmethod
+    def lua_function(cls) -> str | None:
+        """Lua source of `function(spec, size, data)`: the checksum of the string `data` for a `size`-byte element
+        whose parameters (lua_parameters) are the table `spec`; band, bor, bxor, lshift, rshift and width_mask are
+        in scope. None where the dissector has no code for it: it shows the value, unverified."""
+        return None
+
+    def lua_parameters(self) -> dict[str, Any]:
+        """The parameters lua_function reads from `spec`, as the dissector's data holds them."""
+        return {}
 
     # -- the markdown backend ----------------------------------------------------------------------------------
 

@@ -360,6 +360,15 @@ class Crc(Algorithm):
         finish = (f"{target} ^= {self.xorout:#x}",) if self.xorout else ()
         return TableSteps(f"{name.upper()}_TABLE", crc_table(8, self.poly, self.refin), start, finish)
 
+    @classmethod
+    def lua_function(cls) -> str:
+        return _LUA
+
+    def lua_parameters(self) -> dict[str, Any]:
+        return {"name": self.catalogue} | {
+            p: getattr(self, p) for p in ("width", "poly", "init", "refin", "refout", "xorout")
+        }
+
     def describe(self) -> str:
         return f"{self.title() or 'CRC'} over the covered bytes"
 
@@ -376,3 +385,39 @@ class Crc(Algorithm):
 
     def worked(self, covered: bytes) -> str:
         return f"{self.title() or 'CRC'} of {hex_bytes(covered)} = {hex_value(self.function()(covered), self.width)}"
+
+
+# the dissector's code (Algorithm.lua_function): bit by bit, from the catalogue parameters
+_LUA = """function(spec, size, data)
+  local function reflect(value, width)
+    local result = 0
+    for _ = 1, width do
+      result = bor(lshift(result, 1), band(value, 1))
+      value = rshift(value, 1)
+    end
+    return result
+  end
+  local width = spec.width
+  local top, crc_mask = lshift(1, width - 1), width_mask(width)
+  local crc = spec.init
+  for i = 1, #data do
+    local byte = data:byte(i)
+    if spec.refin then
+      byte = reflect(byte, 8)
+    end
+    for bit = 7, 0, -1 do
+      local feedback = band(crc, top) ~= 0
+      if band(rshift(byte, bit), 1) == 1 then
+        feedback = not feedback
+      end
+      crc = band(lshift(crc, 1), crc_mask)
+      if feedback then
+        crc = bxor(crc, spec.poly)
+      end
+    end
+  end
+  if spec.refout then
+    crc = reflect(crc, width)
+  end
+  return band(bxor(crc, spec.xorout), crc_mask)
+end"""

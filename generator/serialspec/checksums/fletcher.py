@@ -60,6 +60,13 @@ class Fletcher(Algorithm):
     def function_code(self) -> tuple[Import, str]:
         return ("serialspec.checksums.fletcher", "fletcher_function"), f"fletcher_function({self.modulus})"
 
+    @classmethod
+    def lua_function(cls) -> str:
+        return _LUA
+
+    def lua_parameters(self) -> dict[str, Any]:
+        return {"modulus": self.modulus}
+
     def describe(self) -> str:
         return (
             f"Fletcher checksum modulo {self.modulus} over the covered bytes: CK_A the sum of the bytes, CK_B the "
@@ -70,3 +77,14 @@ class Fletcher(Algorithm):
         value = self.function()(covered)
         sums = f"CK_A = 0x{value & 0xFF:02X}, CK_B = 0x{value >> 8:02X}"
         return f"over {hex_bytes(covered)}: {sums} → {hex_value(value, 16)}"
+
+
+# the dissector's code (Algorithm.lua_function): CK_B << 8 | CK_A
+_LUA = """function(spec, size, data)
+  local a, b = 0, 0
+  for i = 1, #data do
+    a = (a + data:byte(i)) % spec.modulus
+    b = (b + a) % spec.modulus
+  end
+  return b * 256 + a
+end"""

@@ -72,6 +72,13 @@ class Sum(Algorithm):
     def summed(self) -> bool | None:
         return self.invert if self.width == 8 else None
 
+    @classmethod
+    def lua_function(cls) -> str:
+        return _LUA
+
+    def lua_parameters(self) -> dict[str, Any]:
+        return {"invert": self.invert}
+
     def describe(self) -> str:
         what = "bitwise NOT of the sum" if self.invert else "sum"
         return f"{what} of the covered bytes, modulo {1 << self.width}"
@@ -80,3 +87,14 @@ class Sum(Algorithm):
         invert = "~" if self.invert else ""
         terms = " + ".join(f"0x{b:02X}" for b in covered) or "0"
         return f"{invert}({terms}) = {invert}{sum(covered):#x} → {hex_value(self.function()(covered), self.width)}"
+
+
+# the dissector's code (Algorithm.lua_function)
+_LUA = """function(spec, size, data)
+  local mask = width_mask(size * 8)
+  local total = 0
+  for i = 1, #data do
+    total = (total + data:byte(i)) % (mask + 1)
+  end
+  return spec.invert and mask - total or total
+end"""

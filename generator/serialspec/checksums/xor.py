@@ -51,6 +51,10 @@ class Xor(Algorithm):
     def function_code(self) -> tuple[Import, str]:
         return ("serialspec.checksums.xor", "xor_function"), f"xor_function({self.width})"
 
+    @classmethod
+    def lua_function(cls) -> str:
+        return _LUA
+
     def describe(self) -> str:
         if self.width == 8:
             return "XOR of the covered bytes"
@@ -62,3 +66,17 @@ class Xor(Algorithm):
         words = [int.from_bytes(padded[i : i + size], "big") for i in range(0, len(padded), size)]
         terms = " ^ ".join(hex_value(w, self.width) for w in words) or "0"
         return f"{terms} = {hex_value(self.function()(covered), self.width)}"
+
+
+# the dissector's code (Algorithm.lua_function): words of `size` bytes, high byte first, the last one zero-padded
+_LUA = """function(spec, size, data)
+  local total = 0
+  for i = 1, #data, size do
+    local word = 0
+    for j = i, i + size - 1 do
+      word = word * 256 + (data:byte(j) or 0)
+    end
+    total = bxor(total, word)
+  end
+  return total
+end"""

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import re
 from collections import Counter
-from typing import Any
+from typing import Any, assert_never
 
 from serialspec.backends.common import render as common
 from serialspec.backends.common.frames import runtime_layouts
@@ -20,6 +20,8 @@ from serialspec.backends.markdown.kinds import anchor, kind, scalar_range
 from serialspec.collection import without_cycle_collection
 from serialspec.lang.frozen import mutable
 from serialspec.lang.model import (
+    Array,
+    Bytes,
     Checksum,
     Command,
     Device,
@@ -30,12 +32,14 @@ from serialspec.lang.model import (
     Field,
     FrameLayout,
     Group,
+    List,
     Message,
     Protocol,
     Scalar,
     TableBlock,
     TableEntry,
     TableValue,
+    Text,
     fixed_size,
 )
 from serialspec.runtime.errors import SerialspecError
@@ -133,20 +137,25 @@ def field_rows(fields: tuple[Field, ...], start: int | None, prefix: str = "") -
         if offset is not None and size is None:
             where = f"{offset}.."
         rows.append(Row(where, prefix + f.name, type_name(f), kind(f).unit(f), range_text(f), meaning(f)))
-        if isinstance(f, Group):
-            rows += field_rows(f.fields, None, prefix + f.name + "[].")
-        if isinstance(f, TableBlock):
-            rows += [
-                Row(
-                    "",
-                    f"{prefix}{f.name}.{e.name}",
-                    e.type.name,
-                    e.unit,
-                    scalar_range(e.type, e.minimum, e.maximum),
-                    f"{f.table.key_name} {e.key}: {e.description}",
-                )
-                for e in f.entries
-            ]
+        match f:  # the rows of what it holds
+            case Group():
+                rows += field_rows(f.fields, None, prefix + f.name + "[].")
+            case TableBlock():
+                rows += [
+                    Row(
+                        "",
+                        f"{prefix}{f.name}.{e.name}",
+                        e.type.name,
+                        e.unit,
+                        scalar_range(e.type, e.minimum, e.maximum),
+                        f"{f.table.key_name} {e.key}: {e.description}",
+                    )
+                    for e in f.entries
+                ]
+            case Scalar() | Array() | List() | Text() | Bytes() | TableValue():
+                pass  # one row
+            case _:
+                assert_never(f)
         offset = None if offset is None or size is None else offset + size
     return rows
 
@@ -518,9 +527,7 @@ def content_rows(
                 count = len(items) if isinstance(items, list) else 0
                 item = f.item_size
                 size = count * item if item is not None else end - offset
-            elif isinstance(f, TableValue):
-                size = end - offset
-            else:
+            else:  # the rest of the content
                 size = end - offset
         rows.append(
             {

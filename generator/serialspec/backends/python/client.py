@@ -17,7 +17,7 @@ Decisions made here, the same for every protocol:
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, assert_never
 
 from serialspec.backends.common.numbers import number
 from serialspec.backends.common.pairing import request_response_pairs
@@ -26,6 +26,7 @@ from serialspec.backends.python.registers import map_name, names_alias
 from serialspec.backends.python.render import one_line, render
 from serialspec.backends.python.simulator import import_order
 from serialspec.lang.model import (
+    Array,
     Bytes,
     Direction,
     Field,
@@ -39,6 +40,7 @@ from serialspec.lang.model import (
     TableBlock,
     TableEntry,
     TableValue,
+    Text,
     reply_condition,
 )
 
@@ -90,12 +92,17 @@ def value_fields(protocol: Protocol, message: Message) -> list[Field]:
 
 
 def type_names(f: Field) -> list[str]:
-    if isinstance(f, Scalar):
-        names = (f.bits_class, f.enum.class_name if f.enum else "", f.flags.class_name if f.flags else "")
-        return [n for n in names if n]
-    if isinstance(f, Group | TableBlock):
-        return [f.class_name]
-    return []
+    """The generated classes a field's value is made of (the client imports them)."""
+    match f:
+        case Scalar():
+            names = (f.bits_class, f.enum.class_name if f.enum else "", f.flags.class_name if f.flags else "")
+            return [n for n in names if n]
+        case Group() | TableBlock():
+            return [f.class_name]
+        case Array() | List() | Text() | Bytes() | TableValue():
+            return []
+        case _:
+            assert_never(f)
 
 
 def describe(f: Field) -> str:
@@ -458,6 +465,7 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
         kind = "send"
         returns = "None"
         result_expr = ""
+        cut = ""  # the part of a list the reply's value keeps: what the request asked
         statuses = status_fields(response) if response else []
         if response is not None:
             imports.add(response.class_name)
@@ -472,10 +480,11 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
                 only = rest[0]
                 kind, returns = "value", annotation(only).replace("tuple[", "list[").replace(", ...]", "]")
                 wanted = only.count_from if any(f.name == only.count_from for f in request.fields) else ""
-                result_expr = f"list(reply.{only.name}[: request.{wanted}])" if wanted else f"list(reply.{only.name})"
+                cut = f"[: request.{wanted}]" if wanted else ""
+                result_expr = reply_value(only, "reply", cut)
             elif len(rest) == 1:
                 imports.update(type_names(rest[0]))
-                kind, returns, result_expr = "value", annotation(rest[0]), f"reply.{rest[0].name}"
+                kind, returns, result_expr = "value", annotation(rest[0]), reply_value(rest[0], "reply", "")
             else:
                 kind, returns, result_expr = "message", response.class_name, "reply"
             if silent:
@@ -503,11 +512,10 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
         if each is not None and response is not None and kind == "value":
             # Every listed device answers in turn (SYNC READ): one reply per item, matched by its address.
             kind, silent = "each", False
-            value = result_expr.removeprefix("reply.")
             returns = f"dict[int, {annotation(rest[0])}]"
-            result_expr = f"{{reply.{address}: reply.{value} for reply in replies}}"
+            result_expr = f"{{reply.{address}: {reply_value(rest[0], 'reply', cut)} for reply in replies}}"
             each_keys = f"[{{{address!r}: item.{address}}} for item in {each.name}]"
-            doc[-1] = f"Returns: {address} -> {value} of every listed device, in the order they answer."
+            doc[-1] = f"Returns: {address} -> {rest[0].name} of every listed device, in the order they answer."
         table = writers.get(method_name(request))
         method = {
             "name": method_name(request),
@@ -664,3 +672,9 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
             }
         ),
     )
+
+
+def reply_value(f: Field, reply: str, cut: str) -> str:
+    """The value a method returns of a reply (named `reply`) with one field to give: the field, a list as a list
+    (`cut`: the slice of it the request asked for)."""
+    return f"list({reply}.{f.name}{cut})" if isinstance(f, List) else f"{reply}.{f.name}"

@@ -10,11 +10,13 @@ from __future__ import annotations
 import struct
 from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
+from typing import assert_never
 
 from serialspec.backends.common.numbers import number
 from serialspec.backends.python.ir import (
     Advance,
     Block,
+    Calls,
     Code,
     ContentSize,
     Expect,
@@ -31,6 +33,7 @@ from serialspec.backends.python.ir import (
     TakeRest,
     Try,
     Unpack,
+    helpers_of,
     lines_of,
     packed_lists,
     values_tuple,
@@ -177,6 +180,12 @@ class ClassCode:
     class_vars: Lines = field(default_factory=list)
     to_fields: Lines = field(default_factory=list)
     from_fields: Lines = field(default_factory=list)
+    helpers: frozenset[str] = frozenset()  # the runtime.fields helpers from_fields calls (as _<name>)
+
+    def read_from(self, values: list[Calls]) -> None:
+        """from_fields' arguments: each field's value from data, with the helpers they call."""
+        self.from_fields = [f"{value}," for value in values]
+        self.helpers = frozenset().union(*(helpers_of(value) for value in values))
 
 
 class PackageCode:
@@ -185,6 +194,9 @@ class PackageCode:
     def __init__(self, protocol: Protocol) -> None:
         self.protocol = protocol
         self.structs: dict[str, str] = {}  # constant name -> format
+        self.stems: dict[
+            str, str
+        ] = {}  # the name of each struct `struct` made, less its prefix (for names made from it)
         self.helper_classes: list[ClassCode] = []
         self.message_classes: list[ClassCode] = []
         self.decoders: list[tuple[str, str, str, Block]] = []  # name, return type, extra parameters, body
@@ -219,11 +231,15 @@ class PackageCode:
             token = _STRUCT_NAMES.get(char, char.upper())
             tokens.append(f"{token}X{count}" if count and char != "s" else (f"B{count}" if char == "s" else token))
         layout = "_".join(tokens) if len(tokens) <= 6 else base_name.upper()
-        name = "_S_" + ("BE_" if fmt.startswith(">") else "") + layout
-        if name in self.structs:  # another format got the same name (a long layout named after its message, ...)
-            taken = name
-            name = next(f"{taken}_{n}" for n in range(2, len(self.structs) + 3) if f"{taken}_{n}" not in self.structs)
+        stem = ("BE_" if fmt.startswith(">") else "") + layout
+        if "_S_" + stem in self.structs:  # another format got the same name (a long layout named after its message)
+            taken = stem
+            stem = next(
+                f"{taken}_{n}" for n in range(2, len(self.structs) + 3) if f"_S_{taken}_{n}" not in self.structs
+            )
+        name = "_S_" + stem
         self.structs[name] = fmt
+        self.stems[name] = stem
         return name
 
     # --- classes --------------------------------------------------------------------------------------------------
@@ -288,54 +304,65 @@ class PackageCode:
 
     def helper(self, f: SpecField) -> None:
         """Dataclasses for the nested values of a field: bit fields, group items, table blocks."""
-        if isinstance(f, Scalar) and f.bits and f.bits_class not in self._seen_classes:
-            self._seen_classes.add(f.bits_class)
-            attributes = []
-            for bit in f.bits:
-                kind = f"{bit.enum.class_name} | int" if bit.enum else "int"
-                where = f"bit {bit.low}" if bit.high == bit.low else f"bits {bit.high}..{bit.low}"
-                attributes.append(Attribute(bit.name, kind, f"{one_line(bit.description or bit.name)} ({where})"))
-            code = ClassCode(f.bits_class, f"Bit fields of {f.name}.", "", attributes)
-            code.to_fields = [f"{b.name!r}: int(self.{b.name})," for b in f.bits]
-            code.from_fields = [self.from_value_expr(b.name, b.enum.class_name if b.enum else None) for b in f.bits]
-            self.helper_classes.append(code)
-        elif isinstance(f, Group) and f.class_name not in self._seen_classes:
-            self._seen_classes.add(f.class_name)
-            for inner in f.fields:
-                self.helper(inner)
-            inner_fields = [i for i in f.fields if not (isinstance(i, Scalar) and i.hidden)]
-            code = ClassCode(f.class_name, f"One item of {f.name}.", "", self.attributes(inner_fields, False))
-            code.to_fields = [f"{i.name!r}: {self.to_json(i, 'self.' + i.name)}," for i in inner_fields]
-            code.from_fields = [f"{self.from_json(i)}," for i in inner_fields]
-            self.helper_classes.append(code)
-        elif isinstance(f, TableBlock) and f.class_name not in self._seen_classes:
-            self._seen_classes.add(f.class_name)
-            attributes = []
-            for e in f.entries:
-                kind = f"{e.enum.class_name} | int" if e.enum else ("float" if e.type.is_float else "int")
-                unit = f" [{e.unit}]" if e.unit else ""
-                doc = one_line(f"{f.table.key_name} {e.key}: {e.description or e.name}{unit}")
-                attributes.append(Attribute(e.name, kind, doc))
-            code = ClassCode(f.class_name, one_line(f"{f.description or f.name} ({f.table.title})."), "", attributes)
-            code.to_fields = [
-                f"{e.name!r}: {'int(self.' + e.name + ')' if e.enum else 'self.' + e.name}," for e in f.entries
-            ]
-            code.from_fields = [
-                self.from_value_expr(e.name, e.enum.class_name if e.enum else None, e.type.is_float) for e in f.entries
-            ]
-            self.helper_classes.append(code)
+        match f:
+            case Scalar() if f.bits and f.bits_class not in self._seen_classes:
+                self._seen_classes.add(f.bits_class)
+                attributes = []
+                for bit in f.bits:
+                    kind = f"{bit.enum.class_name} | int" if bit.enum else "int"
+                    where = f"bit {bit.low}" if bit.high == bit.low else f"bits {bit.high}..{bit.low}"
+                    attributes.append(Attribute(bit.name, kind, f"{one_line(bit.description or bit.name)} ({where})"))
+                code = ClassCode(f.bits_class, f"Bit fields of {f.name}.", "", attributes)
+                code.to_fields = [f"{b.name!r}: int(self.{b.name})," for b in f.bits]
+                code.read_from([self.from_value_expr(b.name, b.enum.class_name if b.enum else None) for b in f.bits])
+                self.helper_classes.append(code)
+            case Group() if f.class_name not in self._seen_classes:
+                self._seen_classes.add(f.class_name)
+                for inner in f.fields:
+                    self.helper(inner)
+                inner_fields = [i for i in f.fields if not (isinstance(i, Scalar) and i.hidden)]
+                code = ClassCode(f.class_name, f"One item of {f.name}.", "", self.attributes(inner_fields, False))
+                code.to_fields = [f"{i.name!r}: {self.to_json(i, 'self.' + i.name)}," for i in inner_fields]
+                code.read_from([self.from_json(i) for i in inner_fields])
+                self.helper_classes.append(code)
+            case TableBlock() if f.class_name not in self._seen_classes:
+                self._seen_classes.add(f.class_name)
+                attributes = []
+                for e in f.entries:
+                    kind = f"{e.enum.class_name} | int" if e.enum else ("float" if e.type.is_float else "int")
+                    unit = f" [{e.unit}]" if e.unit else ""
+                    doc = one_line(f"{f.table.key_name} {e.key}: {e.description or e.name}{unit}")
+                    attributes.append(Attribute(e.name, kind, doc))
+                code = ClassCode(
+                    f.class_name, one_line(f"{f.description or f.name} ({f.table.title})."), "", attributes
+                )
+                code.to_fields = [
+                    f"{e.name!r}: {'int(self.' + e.name + ')' if e.enum else 'self.' + e.name}," for e in f.entries
+                ]
+                code.read_from(
+                    [
+                        self.from_value_expr(e.name, e.enum.class_name if e.enum else None, e.type.is_float)
+                        for e in f.entries
+                    ]
+                )
+                self.helper_classes.append(code)
+            case Scalar() | Group() | TableBlock() | Array() | List() | Text() | Bytes() | TableValue():
+                pass  # no nested values, or their class is made already
+            case _:
+                assert_never(f)
 
-    def from_value_expr(self, name: str, enum: str | None, is_float: bool = False) -> str:
+    def from_value_expr(self, name: str, enum: str | None, is_float: bool = False) -> Calls:
         """A value of a bit field or table block entry, from data: an enum member or an integer (or a number)."""
         get = f"_get(data, {name!r}, where)"
         if enum:
-            return f"_as_enum({enum}, {get}, {name!r}, where),"
-        return f"{'_number' if is_float else '_integer'}({get}, {name!r}, where),"
+            return Calls(f"_as_enum({enum}, {get}, {name!r}, where)", ["_as_enum", "_get"])
+        helper = "_number" if is_float else "_integer"
+        return Calls(f"{helper}({get}, {name!r}, where)", [helper, "_get"])
 
     def to_json(self, f: SpecField, expr: str) -> str:
         return kind(f).to_json(f, expr)
 
-    def from_json(self, f: SpecField) -> str:
+    def from_json(self, f: SpecField) -> Calls:
         return kind(f).from_json(f)
 
     def message(self, message: Message) -> None:
@@ -351,7 +378,7 @@ class PackageCode:
             f"DIRECTION: ClassVar[Direction] = Direction.{message.direction.name}",
         ]
         code.to_fields = [f"{f.name!r}: {self.to_json(f, 'self.' + f.name)}," for f in fields]
-        code.from_fields = [f"{self.from_json(f)}," for f in fields]
+        code.read_from([self.from_json(f) for f in fields])
         self.message_classes.append(code)
         frame_names = [f.name for f in self.frame_values(message.direction, message)]
         extra = "".join(f", {name}: int" for name in frame_names)
@@ -563,34 +590,43 @@ class PackageCode:
         return name
 
     def decode_variable(self, f: SpecField, siblings: list[SpecField], base: str, body: Block, where: str) -> str:
-        if isinstance(f, List):
-            return self.decode_list(f, body, where, siblings)
-        if isinstance(f, Text):
-            return self.decode_text(f, body, where)
-        if isinstance(f, Bytes):
-            if f.size == "rest":
-                body.append(TakeRest(self.local(f)))
-                body.append(Advance(to="end"))
-            else:
-                size = self.local_named(str(f.size))
-                body.append(
-                    Needs(size, f"DecodeError({where} + f': {f.name} needs {{{size}}} bytes, {{end - o}} left')")
-                )
-                body.append(Code(f"{self.local(f)} = buf[o : o + {size}]", cursor=True))
-                body.append(Advance(size))
-            return self.local(f)
-        if isinstance(f, TableValue):
-            table = f"_TABLE_{f.table.name.upper()}"
-            key = self.local_named(f.key)
-            body.append(Code(f"s = {table}.get({key})"))
-            error = f"DecodeError({where} + f': unknown {f.table.key_name} {{{key}}}')"
-            body.append(If("s is None", (Raise(error),)))
-            reason = f"{f.name} needs {{s.size}} bytes for {f.table.key_name} {{{key}}}"
-            body.append(If("end - o < s.size", (Raise(f"DecodeError({where} + f': {reason}')"),), cursor=True))
-            body.append(Code(f"({self.local(f)},) = s.unpack_from(buf, o)", cursor=True))
-            body.append(Advance("s.size"))
-            return self.local(f)
-        assert isinstance(f, Group)
+        match f:
+            case List():
+                return self.decode_list(f, body, where, siblings)
+            case Text():
+                return self.decode_text(f, body, where)
+            case Bytes():
+                if f.size == "rest":
+                    body.append(TakeRest(self.local(f)))
+                    body.append(Advance(to="end"))
+                else:
+                    size = self.local_named(str(f.size))
+                    body.append(
+                        Needs(size, f"DecodeError({where} + f': {f.name} needs {{{size}}} bytes, {{end - o}} left')")
+                    )
+                    body.append(Code(f"{self.local(f)} = buf[o : o + {size}]", cursor=True))
+                    body.append(Advance(size))
+                return self.local(f)
+            case TableValue():
+                table = f"_TABLE_{f.table.name.upper()}"
+                key = self.local_named(f.key)
+                body.append(Code(f"s = {table}.get({key})"))
+                error = f"DecodeError({where} + f': unknown {f.table.key_name} {{{key}}}')"
+                body.append(If("s is None", (Raise(error),)))
+                reason = f"{f.name} needs {{s.size}} bytes for {f.table.key_name} {{{key}}}"
+                body.append(If("end - o < s.size", (Raise(f"DecodeError({where} + f': {reason}')"),), cursor=True))
+                body.append(Code(f"({self.local(f)},) = s.unpack_from(buf, o)", cursor=True))
+                body.append(Advance("s.size"))
+                return self.local(f)
+            case Group():
+                return self.decode_group(f, body, where)
+            case Scalar() | Array() | TableBlock():
+                raise AssertionError(f"{f.name}: a field of fixed size is decoded in a run (decode_run)")
+            case _:
+                assert_never(f)
+
+    def decode_group(self, f: Group, body: Block, where: str) -> str:
+        """A group's items: unpacked in a loop where they have one size, else read one by one."""
         item_fields = list(f.fields)
         value = self.local(f)
         item_names = [i.name for i in item_fields if not (isinstance(i, Scalar) and i.hidden)]
@@ -1001,63 +1037,81 @@ class PackageCode:
         """Byte order, struct format (without it) and pack arguments of a run of fixed-size fields; checks to body."""
         args: list[str] = []
         for f in run:
-            if isinstance(f, Scalar):
-                args.append(self.wire_value(f, obj, siblings, body, where))
-            elif isinstance(f, Array):
-                expr = field_read(obj, f.name)
-                error = f"EncodeError({where} + f': {f.name} needs {f.count} items, got {{len({expr})}}')"
-                body.append(If(f"len({expr}) != {f.count}", (Raise(error),)))
-                self.check_items(f, expr, body, where)
-                args.append(f"*{expr}")
-            elif isinstance(f, Bytes):
-                expr = field_read(obj, f.name)
-                error = f"EncodeError({where} + f': {f.name} needs {f.size} bytes, got {{len({expr})}}')"
-                body.append(If(f"len({expr}) != {f.size}", (Raise(error),)))
-                args.append(Simple(expr))
-            elif isinstance(f, TableBlock):
-                for e in f.entries:
-                    expr = f"{field_read(obj, f.name)}.{e.name}"
-                    name = f.name + "." + e.name
-                    error = f"out_of_range({where}, {name!r}, {expr}, {number(e.minimum)}, {number(e.maximum)})"
-                    body.append(If(f"not {number(e.minimum)} <= {expr} <= {number(e.maximum)}", (Raise(error),)))
+            match f:
+                case Scalar():
+                    args.append(self.wire_value(f, obj, siblings, body, where))
+                case Array():
+                    expr = field_read(obj, f.name)
+                    error = f"EncodeError({where} + f': {f.name} needs {f.count} items, got {{len({expr})}}')"
+                    body.append(If(f"len({expr}) != {f.count}", (Raise(error),)))
+                    self.check_items(f, expr, body, where)
+                    args.append(f"*{expr}")
+                case Bytes():
+                    expr = field_read(obj, f.name)
+                    error = f"EncodeError({where} + f': {f.name} needs {f.size} bytes, got {{len({expr})}}')"
+                    body.append(If(f"len({expr}) != {f.size}", (Raise(error),)))
                     args.append(Simple(expr))
+                case TableBlock():
+                    for e in f.entries:
+                        expr = f"{field_read(obj, f.name)}.{e.name}"
+                        name = f.name + "." + e.name
+                        error = f"out_of_range({where}, {name!r}, {expr}, {number(e.minimum)}, {number(e.maximum)})"
+                        body.append(If(f"not {number(e.minimum)} <= {expr} <= {number(e.maximum)}", (Raise(error),)))
+                        args.append(Simple(expr))
+                case List() | Text() | Group() | TableValue():
+                    raise AssertionError(f"{f.name}: a field of varying size is encoded alone (encode_variable)")
+                case _:
+                    assert_never(f)
         return run_endian(run), struct_format("", run), args
 
     def encode_variable(self, f: SpecField, obj: str, body: Block, where: str) -> str:
         expr = field_read(obj, f.name)
         count = f.count if isinstance(f, List | Group) else None
         count_error = f"EncodeError({where} + f': {f.name} needs {count} items, got {{len({expr})}}')"
-        if isinstance(f, List):
-            if isinstance(f.count, int):
-                body.append(If(f"len({expr}) != {f.count}", (Raise(count_error),)))
-            if f.item is None:
-                self.packing.add("pack_bits")
-                return f"_pack_bits({expr}, {f.name!r}, {where})"
-            self.check_items(f, expr, body, where)
-            return PackItems(f.endian, f.item.struct_char, expr)
-        if isinstance(f, Text):
-            self.packing.add("encode_text")
-            data = f"_encode_text({expr}, {f.name!r}, {where}, {f.size is None})"
-            if isinstance(f.size, int):
-                body.append(Code(f"{self.local(f)} = {data}"))
-                reason = f"{f.name} needs {f.size} bytes of UTF-8, got {{len({self.local(f)})}}"
-                body.append(If(f"len({self.local(f)}) != {f.size}", (Raise(f"EncodeError({where} + f': {reason}')"),)))
+        match f:
+            case List():
+                if isinstance(f.count, int):
+                    body.append(If(f"len({expr}) != {f.count}", (Raise(count_error),)))
+                if f.item is None:
+                    self.packing.add("pack_bits")
+                    return f"_pack_bits({expr}, {f.name!r}, {where})"
+                self.check_items(f, expr, body, where)
+                return PackItems(f.endian, f.item.struct_char, expr)
+            case Text():
+                self.packing.add("encode_text")
+                data = f"_encode_text({expr}, {f.name!r}, {where}, {f.size is None})"
+                if isinstance(f.size, int):
+                    body.append(Code(f"{self.local(f)} = {data}"))
+                    reason = f"{f.name} needs {f.size} bytes of UTF-8, got {{len({self.local(f)})}}"
+                    body.append(
+                        If(f"len({self.local(f)}) != {f.size}", (Raise(f"EncodeError({where} + f': {reason}')"),))
+                    )
+                    return self.local(f)
+                return data
+            case Bytes():  # bytes as they are (bytes(b) looks up b.__bytes__ first), anything else made bytes
+                body.append(Code(f"{self.local(f)} = {expr} if {expr}.__class__ is bytes else bytes({expr})"))
                 return self.local(f)
-            return data
-        if isinstance(f, Bytes):  # bytes as they are (bytes(b) looks up b.__bytes__ first), anything else made bytes
-            body.append(Code(f"{self.local(f)} = {expr} if {expr}.__class__ is bytes else bytes({expr})"))
-            return self.local(f)
-        if isinstance(f, TableValue):
-            table = f"_TABLE_{f.table.name.upper()}"
-            key = field_read(obj, f.key)
-            body.append(Code(f"s = {table}.get({key})"))
-            body.append(If("s is None", (Raise(f"EncodeError({where} + f': unknown {f.table.key_name} {{{key}}}')"),)))
-            body.append(Code(f"low, high = _TABLE_{f.table.name.upper()}_RANGES[{key}]"))
-            body.append(
-                If(f"not low <= {expr} <= high", (Raise(f"out_of_range({where}, {f.name!r}, {expr}, low, high)"),))
-            )
-            return f"s.pack({expr})"
-        assert isinstance(f, Group)
+            case TableValue():
+                table = f"_TABLE_{f.table.name.upper()}"
+                key = field_read(obj, f.key)
+                body.append(Code(f"s = {table}.get({key})"))
+                body.append(
+                    If("s is None", (Raise(f"EncodeError({where} + f': unknown {f.table.key_name} {{{key}}}')"),))
+                )
+                body.append(Code(f"low, high = _TABLE_{f.table.name.upper()}_RANGES[{key}]"))
+                body.append(
+                    If(f"not low <= {expr} <= high", (Raise(f"out_of_range({where}, {f.name!r}, {expr}, low, high)"),))
+                )
+                return f"s.pack({expr})"
+            case Group():
+                return self.encode_group(f, obj, body, where, expr, count_error)
+            case Scalar() | Array() | TableBlock():
+                raise AssertionError(f"{f.name}: a field of fixed size is encoded in a run (encode_run_format)")
+            case _:
+                assert_never(f)
+
+    def encode_group(self, f: Group, obj: str, body: Block, where: str, expr: str, count_error: str) -> str:
+        """A group's items, checked and packed in a loop."""
         if isinstance(f.count, int):
             body.append(If(f"len({expr}) != {f.count}", (Raise(count_error),)))
         # the items are checked and packed in a loop here, not by a function called per item

@@ -25,6 +25,10 @@ from serialspec.lang.model import (
 )
 from serialspec.transforms import runtime_classes
 
+ERROR_REPLY = "ERROR_REPLY"  # the codes key of error replies (runtime.framing.ERROR_REPLY)
+# runtime.framing's classes (each transform's runtime class among them), in the order isort wants
+FRAMING_NAMES = tuple(sorted(("Element", "FrameCodec", "Layout", "SizeRule", *runtime_classes())))
+
 
 def checksum_definitions(protocol: Protocol, straight: bool = True) -> tuple[list[str], list[str]]:
     """The import lines and module-level definitions of every checksum the layouts use: its runtime function (the
@@ -119,37 +123,42 @@ def codec_lines(
     direction: Direction,
     sizes: list[tuple[str, int, int | None]],
     messages: dict[str, Message],
-) -> list[str]:
+) -> tuple[list[str], set[str]]:
     """`_<DIRECTION>_FRAMES = FrameCodec(...)`: the layouts, content sizes by code and, without a length, size
-    rules by code (`messages`: the one message of each code, where there is one)."""
+    rules by code (`messages`: the one message of each code, where there is one); and the runtime.framing names
+    the lines use."""
     layouts = protocol.framing.alternatives[direction]
+    names = {"FrameCodec", "Layout", "Element"}
     lines = [f"_{direction.name}_FRAMES = FrameCodec(", "    ("]
     for layout in layouts:
         lines += [f"        {line}" for line in layout_lines(layout)]
+        names |= {layout.transparency.transform.runtime_name} if layout.transparency is not None else set()
     lines.append("    ),")
     # content size bounds by command code (None: unbounded)
     lines.append("    {")
     lines += [f"        {code}: ({low}, {high})," for code, low, high in sizes]
     lines.append("    },")
+    codes = [code for code, _, _ in sizes]
     if any(layout.length is None for layout in layouts):
         rules = [(code, rule) for code, message in messages.items() if (rule := size_rule(message))]
         lines.append("    {" + ", ".join(f"{code}: {rule}" for code, rule in rules) + "},")
+        names |= {"SizeRule"} if rules else set()
+        codes += [code for code, _ in rules]
+    names |= {ERROR_REPLY} if ERROR_REPLY in codes else set()
     error = protocol.error_reply
     if error is not None and direction == Direction.RESPONSE:
         lines.append(f"    error_flag={error.flag:#04x},")
-    lines.append(")")
-    return lines
+    return [*lines, ")"], names
 
 
 def code_key(command: Command, layout: FrameLayout) -> str:
     if any(m.error_reply for m in command.messages()):
-        return "ERROR_REPLY"  # any code with the error flag (runtime.framing)
+        return ERROR_REPLY  # any code with the error flag (runtime.framing)
     return "None" if command.code is None or not layout.has_command else f"{command.code:#04x}"
 
 
-def framing_imports(lines: list[str]) -> list[str]:
-    """The runtime.framing names that definitions use."""
-    text = "\n".join(lines)
-    names = sorted(("Element", "FrameCodec", "Layout", "SizeRule", *runtime_classes()))
-    found = [name for name in names if f"{name}(" in text]
-    return ["ERROR_REPLY", *found] if "ERROR_REPLY" in text else found
+def framing_imports(names: Iterable[str]) -> list[str]:
+    """The runtime.framing names of an import line, in the order isort wants."""
+    used = set(names)
+    assert used <= {ERROR_REPLY, *FRAMING_NAMES}, used
+    return [name for name in (ERROR_REPLY, *FRAMING_NAMES) if name in used]

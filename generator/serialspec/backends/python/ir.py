@@ -331,6 +331,25 @@ class Simple(str):
     __slots__ = ()
 
 
+class Calls(str):
+    """An expression with the runtime helpers it calls, by the names generated code gives them (`_get`, ...): the
+    module that holds it imports those (package.field_imports)."""
+
+    __slots__ = ("helpers",)
+    helpers: frozenset[str]
+
+    def __new__(cls, text: str, helpers: Iterable[str], *inner: str) -> Calls:
+        """`text` calls `helpers` and holds the expressions `inner` (their helpers are its too)."""
+        made = super().__new__(cls, text)
+        made.helpers = frozenset(helpers).union(*(helpers_of(part) for part in inner))
+        return made
+
+
+def helpers_of(expression: str) -> frozenset[str]:
+    """The runtime helpers an expression calls (none unless it is a Calls)."""
+    return expression.helpers if isinstance(expression, Calls) else frozenset()
+
+
 class Literal(str):
     """A bytes literal, its bytes kept."""
 

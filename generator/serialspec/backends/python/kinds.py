@@ -12,14 +12,16 @@ from typing import Any, Generic
 
 from serialspec.backends.common.kinds import F, Registry
 from serialspec.backends.common.numbers import number
+from serialspec.backends.python.ir import Calls
+from serialspec.backends.python.render import one_line
 from serialspec.lang import expression
 from serialspec.lang.model import Array, Bytes, Group, List, Scalar, ScalarType, TableBlock, TableValue, Text
 from serialspec.lang.model import Field as SpecField
 
 
-def _get(f: SpecField) -> str:
+def _get(f: SpecField) -> Calls:
     """The expression reading a field's JSON value from `data` (the generated `from_fields`)."""
-    return f"_get(data, {f.name!r}, where)"
+    return Calls(f"_get(data, {f.name!r}, where)", ["_get"])
 
 
 class Kind(Generic[F]):
@@ -45,8 +47,9 @@ class Kind(Generic[F]):
         """The JSON value of `expr`, a value of the field (the generated `to_fields`)."""
         return expr
 
-    def from_json(self, f: F) -> str:
-        """The field's value from `data` (the generated `from_fields`), refusing a wrong kind of value."""
+    def from_json(self, f: F) -> Calls:
+        """The field's value from `data` (the generated `from_fields`), refusing a wrong kind of value; with the
+        runtime helpers it calls."""
         return _get(f)
 
     def blank(self, f: F) -> str:
@@ -61,10 +64,11 @@ def zero_bits(bits: Sequence[Any]) -> str:
     return "{" + ", ".join(f"{b.name!r}: 0" for b in bits) + "}"
 
 
-def _numbers_from_json(f: Array | List) -> str:
+def _numbers_from_json(f: Array | List) -> Calls:
     """A list of numbers (or bits) from JSON, each checked to be one."""
     kind = "_bits" if f.item is None else "_numbers" if f.item.is_float else "_integers"
-    return f"{kind}({_get(f)}, {f.name!r}, where)"
+    get = _get(f)
+    return Calls(f"{kind}({get}, {f.name!r}, where)", [kind], get)
 
 
 def _numbers(is_float: bool) -> str:
@@ -124,7 +128,10 @@ class ScalarKind(Kind[Scalar]):
         if f.const is not None:
             return f"Const({f.const}, {base})"
         if f.value is not None:
-            return f"Rebuild({base}, lambda ctx: {expression.render(f.value, lambda name: f'ctx[{name!r}]')})"
+            compute = f"lambda ctx: {expression.render(f.value, lambda name: f'ctx[{name!r}]')}"
+            if expression.fails(f.value):  # a divisor of 0 or a negative shift: a one-line refusal to build
+                compute = f"valued({f.name!r}, {one_line(expression.show(f.value))!r}, {compute})"
+            return f"Rebuild({base}, {compute})"
         if f.derived:
             derived, target = f.derived[0], f.derived[1]
             if derived == "count":
@@ -157,19 +164,22 @@ class ScalarKind(Kind[Scalar]):
             return f"{expr}.to_fields()"
         return f"int({expr})" if (f.enum or f.flags) else expr
 
-    def from_json(self, f: Scalar) -> str:
+    def from_json(self, f: Scalar) -> Calls:
         get = _get(f)
         if f.bits:
             # errors inside name the field too: "spin request method: direction must be an integer"
-            return f"{f.bits_class}.from_fields(_mapping({get}, {f.name!r}, where), where + {' ' + f.name!r})"
+            text = f"{f.bits_class}.from_fields(_mapping({get}, {f.name!r}, where), where + {' ' + f.name!r})"
+            return Calls(text, ["_mapping"], get)
         if f.enum:
-            return f"_as_enum({f.enum.class_name}, {get}, {f.name!r}, where)"
+            return Calls(f"_as_enum({f.enum.class_name}, {get}, {f.name!r}, where)", ["_as_enum"], get)
         if f.flags:
-            return f"_as_flags({f.flags.class_name}, {get}, {int(f.maximum)}, {f.name!r}, where)"
+            return Calls(
+                f"_as_flags({f.flags.class_name}, {get}, {int(f.maximum)}, {f.name!r}, where)", ["_as_flags"], get
+            )
         if f.default is not None:
-            get = f"data.get({f.name!r}, {number(f.default)})"
+            get = Calls(f"data.get({f.name!r}, {number(f.default)})", [])
         kind = "_number" if f.type.is_float else "_integer"
-        return f"{kind}({get}, {f.name!r}, where)"
+        return Calls(f"{kind}({get}, {f.name!r}, where)", [kind], get)
 
     def blank(self, f: Scalar) -> str:
         return zero_bits(f.bits) if f.bits else "0"
@@ -193,7 +203,7 @@ class ArrayKind(Kind[Array]):
     def to_json(self, f: Array, expr: str) -> str:
         return f"list({expr})"
 
-    def from_json(self, f: Array) -> str:
+    def from_json(self, f: Array) -> Calls:
         return _numbers_from_json(f)
 
     def blank(self, f: Array) -> str:
@@ -212,7 +222,7 @@ class ListKind(Kind[List]):
     def to_json(self, f: List, expr: str) -> str:
         return f"list({expr})"
 
-    def from_json(self, f: List) -> str:
+    def from_json(self, f: List) -> Calls:
         return _numbers_from_json(f)
 
     def blank(self, f: List) -> str:
@@ -235,8 +245,9 @@ class TextKind(Kind[Text]):
     def annotation(self, f: Text) -> str:
         return "str"
 
-    def from_json(self, f: Text) -> str:
-        return f"_text({_get(f)}, {f.name!r}, where)"
+    def from_json(self, f: Text) -> Calls:
+        get = _get(f)
+        return Calls(f"_text({get}, {f.name!r}, where)", ["_text"], get)
 
     def blank(self, f: Text) -> str:
         return repr(" " * f.size) if isinstance(f.size, int) else "''"
@@ -265,8 +276,9 @@ class BytesKind(Kind[Bytes]):
     def to_json(self, f: Bytes, expr: str) -> str:
         return f"{expr}.hex(' ')"
 
-    def from_json(self, f: Bytes) -> str:
-        return f"_bytes({_get(f)}, {f.name!r}, where)"
+    def from_json(self, f: Bytes) -> Calls:
+        get = _get(f)
+        return Calls(f"_bytes({get}, {f.name!r}, where)", ["_bytes"], get)
 
     def blank(self, f: Bytes) -> str:
         return repr(" ".join(["00"] * f.size)) if isinstance(f.size, int) else "''"
@@ -307,11 +319,13 @@ class GroupKind(Kind[Group]):
     def to_json(self, f: Group, expr: str) -> str:
         return f"[item.to_fields() for item in {expr}]"
 
-    def from_json(self, f: Group) -> str:
-        return (
+    def from_json(self, f: Group) -> Calls:
+        get = _get(f)
+        text = (
             f"tuple({f.class_name}.from_fields(_mapping(item, {f.name!r}, where), where) "
-            f"for item in _items({_get(f)}, {f.name!r}, where))"
+            f"for item in _items({get}, {f.name!r}, where))"
         )
+        return Calls(text, ["_mapping", "_items"], get)
 
     def blank(self, f: Group) -> str:
         if not isinstance(f.count, int):
@@ -348,8 +362,10 @@ class TableBlockKind(Kind[TableBlock]):
     def to_json(self, f: TableBlock, expr: str) -> str:
         return f"{expr}.to_fields()"
 
-    def from_json(self, f: TableBlock) -> str:
-        return f"{f.class_name}.from_fields(_mapping({_get(f)}, {f.name!r}, where), where + {' ' + f.name!r})"
+    def from_json(self, f: TableBlock) -> Calls:
+        get = _get(f)
+        text = f"{f.class_name}.from_fields(_mapping({get}, {f.name!r}, where), where + {' ' + f.name!r})"
+        return Calls(text, ["_mapping"], get)
 
     def blank(self, f: TableBlock) -> str:
         return "{" + ", ".join(f"{e.name!r}: 0" for e in f.entries) + "}"

@@ -678,7 +678,7 @@ def run_frames(
         return None
     lead = content_offset - width
     after = fmt[0] + (f"{lead}x" if lead else "") + fmt[1:] + "x"
-    frames = code.struct(content.removeprefix("_S_") + "_after_header", after)
+    frames = code.struct(code.stems[content] + "_after_header", after)
     names = [f.name for f in message.fields]
     return {
         "name": message_function("run", message),
@@ -756,7 +756,7 @@ def sum_from_values(
             terms += [f"({target} & 0xff)", *(f"({target} >> {8 * i} & 0xff)" for i in range(1, width))]
     if len(terms) > _MOST_TERMS:
         return None  # summing a slice of the frame in C is cheaper than this many terms in Python
-    with_check = code.struct(unpack.struct.removeprefix("_S_") + "_and_check", fmt + "B")
+    with_check = code.struct(code.stems[unpack.struct] + "_and_check", fmt + "B")
     total = checksum.algorithm.byte_total(" + ".join([f"{constant:#x}", *terms]))
     assert total is not None  # an 8-bit byte sum's
     return [

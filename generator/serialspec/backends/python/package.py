@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import re
 from dataclasses import replace
 from typing import Any
 
@@ -16,10 +15,10 @@ from serialspec.backends.python.content import (
 )
 from serialspec.backends.python.dispatch import direction_entry, value_arguments
 from serialspec.backends.python.frames import (
+    ERROR_REPLY,
     checksum_definitions,
     code_key,
     codec_lines,
-    framing_imports,
 )
 from serialspec.backends.python.ir import (
     ContentSize,
@@ -78,6 +77,7 @@ def emit_package(protocol: Protocol) -> dict[str, str]:
         if message:
             cls.doc = one_line(message_doc(protocol, message))
         classes.append(class_context(cls, where, _keys(cls), optional))
+    helpers = frozenset().union(*(cls.helpers for cls in [*code.helper_classes, *code.message_classes]))
     enums = [
         {
             "class_name": e.class_name,
@@ -107,7 +107,7 @@ def emit_package(protocol: Protocol) -> dict[str, str]:
     files = {
         "messages.py": render(
             "messages.py.j2",
-            field_imports=field_imports(classes),
+            field_imports=field_imports(helpers, bool(classes)),
             **base,
             enums=enums,
             flag_sets=flag_sets,
@@ -161,11 +161,12 @@ FIELD_HELPERS = (
 )
 
 
-def field_imports(classes: list[dict[str, Any]]) -> list[tuple[str, str]]:
-    """The helpers the classes' to_fields/from_fields call, as (name, alias), in the order isort wants."""
-    used = "\n".join(line for c in classes for line in [*c["to_fields"], *c["from_fields"]])
-    used += "\n_check_keys(" if classes else ""  # every from_fields checks its keys (the template calls it)
-    return [(name, alias) for name, alias in FIELD_HELPERS if re.search(rf"(?<![\w.]){alias}\(", used)]
+def field_imports(helpers: frozenset[str], classes: bool) -> list[tuple[str, str]]:
+    """The helpers the classes' from_fields call (ClassCode.helpers), as (name, alias), in the order isort wants;
+    `classes`: there are classes, whose from_fields check their keys (the template calls _check_keys)."""
+    used = helpers | {"_check_keys"} if classes else helpers
+    assert used <= {alias for _, alias in FIELD_HELPERS}, used - {alias for _, alias in FIELD_HELPERS}
+    return [(name, alias) for name, alias in FIELD_HELPERS if alias in used]
 
 
 def message_doc(protocol: Protocol, message: Message) -> str:
@@ -197,6 +198,9 @@ def straight_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, A
     directions: list[dict[str, Any]] = []
     dispatchers = []
     frame_structs: dict[str, str] = {}
+    # the runtime.framing names the codec uses: the FrameCodecs' (the straight-line functions' Transparency objects are
+    # those of the same layouts) and ERROR_REPLY where error replies are told by their flag
+    names = {"EngineFormat"}
     for direction, layout in protocol.framing.layouts.items():
         by_code: dict[str, list[tuple[Message | None, str, int, int | None]]] = {}
         for command in protocol.commands:
@@ -230,13 +234,16 @@ def straight_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, A
             frames = replace(frames, error_flag=flag, error_keep=mask & ~flag)
         plain = unpacked_messages(single, code) if not expected and not frames.error_flag else []
         functions, call = direction_functions(protocol, direction, frames, frame_structs, plain)
+        names |= {ERROR_REPLY} if frames.error_flag else set()
+        frame_codec, used = codec_lines(protocol, direction, sizes, single)
+        names |= used
         directions.append(
             {
                 "name": direction.value,
                 "upper": direction.name,
                 "dispatch": dispatch,
                 "expected": expected,
-                "frames": codec_lines(protocol, direction, sizes, single),
+                "frames": frame_codec,
                 "functions": functions,
                 "call": call,
                 "headers": sorted({layout.header for layout in protocol.framing.alternatives[direction]}),
@@ -254,12 +261,10 @@ def straight_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, A
         and not reply.default_reply
     ]
     code.structs.update(frame_structs)  # listed with the content's structs (common_codec_context)
-    every = [line for d in directions for line in [*d["frames"], *d["functions"], *d["call"]]]
-    every += [line for _, _, lines in code.encoders for line in lines]
     return {
         "length_byte_frames": False,
         "reply_layouts": reply_layouts,
-        "framing_imports": sorted({"EngineFormat", *framing_imports(every)}, key=import_order),
+        "framing_imports": sorted(names, key=import_order),
         # the straight-line frame checks raise it (the engine raises its own)
         "checksum_error": any(
             element.kind == "checksum"
@@ -277,20 +282,21 @@ def straight_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, A
 
 
 def unpacked_messages(single: dict[str, Message], code: PackageCode) -> list[tuple[int, int, str, str, str]]:
-    """(code, content size, class, struct, its format) of the messages of one size whose decoder, past its size
-    check, is one struct's unpack of the content as their message (straight_frames.whole_frames decodes them whole)."""
+    """(code, content size, class, struct's name stem, its format) of the messages of one size whose decoder, past its
+    size check, is one struct's unpack of the content as their message (straight_frames.whole_frames decodes them
+    whole)."""
     bodies = {name: body for name, _, _, body in code.decoders}
     found = []
     for key, message in single.items():
         body = bodies[decoder_name(message)]
-        if key in ("None", "ERROR_REPLY") or message.min_size != message.max_size or len(body) < 2:
+        if key in ("None", ERROR_REPLY) or message.min_size != message.max_size or len(body) < 2:
             continue
         if not (isinstance(body[0], ContentSize) and body[0].exact):
             continue
         unpacked = content_unpacked(body[1:])
         if unpacked is not None:
             cls, struct = unpacked
-            found.append((int(key, 16), message.min_size or 0, cls, struct, code.structs[struct]))
+            found.append((int(key, 16), message.min_size or 0, cls, code.stems[struct], code.structs[struct]))
     return found
 
 

@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+from typing import assert_never
+
 from serialspec.backends.common.numbers import number
 from serialspec.backends.python.render import one_line, render
-from serialspec.lang.model import Bytes, Group, Protocol, Table
+from serialspec.lang.model import Array, Bytes, Group, List, Protocol, Scalar, Table, TableBlock, TableValue, Text
 
 
 def register_tables(protocol: Protocol) -> list[Table]:
@@ -14,10 +16,15 @@ def register_tables(protocol: Protocol) -> list[Table]:
         stack = list(message.fields)
         while stack:
             f = stack.pop()
-            if isinstance(f, Bytes) and f.table is not None:
-                used.add(f.table.name)
-            elif isinstance(f, Group):
-                stack.extend(f.fields)
+            match f:
+                case Bytes() if f.table is not None:
+                    used.add(f.table.name)
+                case Group():
+                    stack.extend(f.fields)
+                case Scalar() | Array() | List() | Text() | Bytes() | TableValue() | TableBlock():
+                    pass  # no run of registers
+                case _:
+                    assert_never(f)
     return [t for t in protocol.tables if t.name in used]
 
 

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, assert_never
 
 from serialspec.backends.common.numbers import number
 from serialspec.backends.common.pairing import request_response_pairs
@@ -11,6 +11,7 @@ from serialspec.backends.python.registers import map_name, register_tables
 from serialspec.backends.python.render import one_line, render
 from serialspec.lang import expression
 from serialspec.lang.model import (
+    Array,
     Bytes,
     DeviceModel,
     Group,
@@ -21,6 +22,7 @@ from serialspec.lang.model import (
     SpaceAccess,
     TableBlock,
     TableValue,
+    Text,
     reply_condition,
 )
 
@@ -69,15 +71,20 @@ def table_fields(*messages: Message | None) -> dict[str, tuple[str, ...]]:
     stack = [f for message in messages if message for f in reversed(message.fields)]
     while stack:
         f = stack.pop()
-        if isinstance(f, TableValue):
-            found[f.name] = ("value", f.key)
-        elif isinstance(f, TableBlock):
-            found[f.name] = ("block", *(e.name for e in f.entries))
-        elif isinstance(f, Bytes) and f.table is not None and f.start:
-            # the request's fields are the device's `given` values, so `request.address` is `address` there
-            found[f.name] = ("run", f.start, f.size_from)
-        elif isinstance(f, Group):
-            stack.extend(reversed(f.fields))
+        match f:
+            case TableValue():
+                found[f.name] = ("value", f.key)
+            case TableBlock():
+                found[f.name] = ("block", *(e.name for e in f.entries))
+            case Bytes() if f.table is not None and f.start:
+                # the request's fields are the device's `given` values, so `request.address` is `address` there
+                found[f.name] = ("run", f.start, f.size_from)
+            case Group():
+                stack.extend(reversed(f.fields))
+            case Scalar() | Array() | List() | Text() | Bytes():
+                pass  # no table entries
+            case _:
+                assert_never(f)
     return found
 
 

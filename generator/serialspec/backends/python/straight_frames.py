@@ -844,7 +844,8 @@ def whole_frames(
     `frame` (constants and checksums after the content, counted from its end) and build the message with no call
     but the unpack: a struct of the whole frame (the bytes around the content skipped as padding), whose unpack
     refuses a frame of another size. A frame that fails any check goes on to the general path, which says why.
-    `plain`: (code, content size, class, content struct and its format) of each such message; `structs` gets the whole
+    `plain`: (code, content size, class, the content struct's name stem (PackageCode.stems) and its format) of each
+    such message; `structs` gets the whole
     frames' structs. ([], []) where the direction's first layout has values or is stuffed, or no message fits."""
     layout, checks = found.layouts[0], found.checks[0]
     elements = layout.elements
@@ -866,7 +867,7 @@ def whole_frames(
                     break
                 head += element.pack(counted)
         else:
-            name = f"_F_{d.upper()}_WHOLE{content.removeprefix('_S')}"  # the content's struct in the frame
+            name = f"_F_{d.upper()}_WHOLE_{content}"  # the content's struct in the frame
             structs[name] = f"{fmt[0]}{positions.content}x{fmt[1:]}{positions.behind}x"
             entries.append((head, cls, name))
     if not entries:

@@ -77,6 +77,7 @@ def structs_module(protocol: Protocol) -> str:
                 ]
     framing = protocol.framing
     definitions: list[str] = []
+    names: set[str] = set()  # the runtime.framing names the definitions use
     if framing.classic:
         checksum = framing.checksum
         assert checksum is not None
@@ -87,7 +88,9 @@ def structs_module(protocol: Protocol) -> str:
     else:
         checksum_imports, definitions = checksum_definitions(protocol, straight=False)
         for direction in Direction:
-            definitions += ["", *codec_lines(protocol, direction, [], {})]
+            lines, used = codec_lines(protocol, direction, [], {})
+            definitions += ["", *lines]
+            names |= used
         frames = [{"name": f"{d.name}_FRAME", "expr": f"Framed(_{d.name}_FRAMES)"} for d in Direction]
     return render(
         "structs.py.j2",
@@ -99,7 +102,7 @@ def structs_module(protocol: Protocol) -> str:
         frames=frames,
         definitions=definitions,
         checksum_imports=checksum_imports,
-        framing_imports=framing_imports(definitions),
+        framing_imports=framing_imports(names),
         classic=framing.classic,
     )
 

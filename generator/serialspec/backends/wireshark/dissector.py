@@ -14,10 +14,6 @@ from typing import Any, assert_never
 from serialspec.backends import Unsupported
 from serialspec.backends.common.frames import runtime_layout
 from serialspec.backends.common.render import render
-from serialspec.checksums.crc import Crc
-from serialspec.checksums.fletcher import Fletcher
-from serialspec.checksums.sum import Sum
-from serialspec.checksums.xor import Xor
 from serialspec.cli.views import engineering_unit
 from serialspec.lang.frozen import frozen
 from serialspec.lang.model import (
@@ -73,6 +69,7 @@ def emit_dissector(protocol: Protocol) -> str:
         tables=lua(tables, 0),
         layouts=lua(shared, 0),
         data=lua(data, 0),
+        checksums=_checksum_functions(protocol),
     )
 
 
@@ -179,20 +176,24 @@ def _layout(layout: FrameLayout) -> dict[str, Any]:
 
 
 def _checksum(checksum: Checksum) -> dict[str, Any]:
-    """The algorithm and its parameters, for the engine's own Lua code of each (checksum() in the template)."""
+    """The algorithm and its parameters, for the algorithm's own Lua code (its lua_function, in CHECKSUMS)."""
     algorithm = checksum.algorithm
-    match algorithm:
-        case Sum():
-            return {"algorithm": "sum", "invert": algorithm.invert}
-        case Xor():
-            return {"algorithm": "xor"}
-        case Fletcher():
-            return {"algorithm": "fletcher", "modulus": algorithm.modulus}
-        case Crc():
-            parameters = ("width", "poly", "init", "refin", "refout", "xorout")
-            return {"algorithm": "crc", "name": algorithm.catalogue} | {p: getattr(algorithm, p) for p in parameters}
-    # an algorithm this backend has no Lua for yet: the dissector shows the value, unverified, and says why
-    return {"algorithm": algorithm.name, "unverified": True}
+    if algorithm.lua_function() is None:
+        # an algorithm with no Lua code yet: the dissector shows the value, unverified, and says why
+        return {"algorithm": algorithm.name, "unverified": True}
+    return {"algorithm": algorithm.name} | algorithm.lua_parameters()
+
+
+def _checksum_functions(protocol: Protocol) -> list[tuple[str, str]]:
+    """(algorithm name as a Lua string, its Lua function) of each algorithm the frames use that has one."""
+    found = {
+        checksum.algorithm.name: code
+        for layouts in protocol.framing.alternatives.values()
+        for layout in layouts
+        for checksum in layout.checksums
+        if (code := checksum.algorithm.lua_function()) is not None
+    }
+    return [(_lua_name(name), code) for name, code in sorted(found.items())]
 
 
 def _message(protocol: Protocol, message: Message) -> dict[str, Any]:

@@ -436,7 +436,7 @@ class Engine(FaultInjection):
                 targets = list(devices.values())
             else:
                 targets = [devices[address]] if address in devices else []
-            frames = [self.act(device, command, request, given) for device in targets]
+            frames = [self._acted(device, command, request, given) for device in targets]
             if not targets and command.absent:
                 frames = [self._absent(command, given)]
             for frame in frames:
@@ -444,6 +444,19 @@ class Engine(FaultInjection):
                     delay = float(getattr(request, command.after, 0)) / 1000 if command.after else 0.0
                     replies.append((self.clock() + delay, frame))
         return replies
+
+    def _acted(
+        self, device: VirtualDevice, command: CommandSpec, request: Message, given: dict[str, Any]
+    ) -> bytes | None:
+        """act(), where an expression of the spec with no value for what came off the wire (a division by a value
+        written as 0, a negative shift) answers nothing and logs one line, as a frame the device cannot act on."""
+        try:
+            return self.act(device, command, request, given)
+        except (ZeroDivisionError, ValueError) as exc:
+            LOG.warning(
+                "simulator: no reply to %s: a value of the spec has no value here (%s)", type(request).__name__, exc
+            )
+            return None
 
     def _carried(self, given: dict[str, Any], code_field: str, content_field: str) -> Message | None:
         """The request a sync command carries for one device: its content parsed as that command's request."""

@@ -7,6 +7,7 @@ import re
 import shutil
 import subprocess
 import sys
+import tomllib
 from pathlib import Path
 
 import pytest
@@ -15,7 +16,8 @@ from serialspec.cli import main
 
 FS = str(ROOT / "specs" / "fashionstar_uart.yaml")
 #: The repository's [tool.serialspec] namespace settings, for a copy of its specs and generated/ elsewhere.
-PACKAGES_WHERE = '[tool.serialspec]\nnamespace = "serialspec_protocols"\nold_names = true\n'
+_SETTINGS = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["tool"]["serialspec"]
+PACKAGES_WHERE = f"[tool.serialspec]\nnamespace = {_SETTINGS['namespace']!r}\nold_names = {_SETTINGS['old_names']!r}\n"
 
 
 def serialspec(*args: str, cwd: Path = ROOT) -> subprocess.CompletedProcess[str]:

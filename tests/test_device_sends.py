@@ -78,7 +78,7 @@ SPEC: dict[str, Any] = {
             "changed": {"changes": ["level"], "values": {"level": "level"}},
         },
         "commands": {
-            "arm": {"stores": {"on": "armed"}},
+            "arm": {"stores": {"on": "armed"}, "echoes": ["on"]},
             "set_level": {"stores": {"level": "level"}, "reports": {"level": "level"}},
             "read_level": {"reports": {"level": "level"}},
         },

@@ -494,6 +494,39 @@ def texts(sentence: TextSentence, values: Mapping[str, Any]) -> dict[str, Any]:
     return found
 
 
+def from_texts(sentence: TextSentence, texts: Mapping[str, Any]) -> dict[str, Any]:
+    """Each field's value from its text (what `texts` gives; a missing field is empty): DecodeError names the field."""
+    unknown = set(texts) - {f.name for f in sentence.fields}
+    if unknown:
+        raise DecodeError(f"{sentence.where}: unknown field {sorted(unknown)[0]!r}")
+    values: dict[str, Any] = {}
+    for item in sentence.fields:
+        given = texts.get(item.name)
+        if isinstance(item, TextField):
+            values[item.name] = decode_field(sentence.where, item, _field_text(sentence, item.name, given))
+            continue
+        if not isinstance(given, list | tuple | type(None)):
+            raise DecodeError(f"{sentence.where}: {item.name} must be a list of objects, got {shown(given)}")
+        rows = []
+        for index, row in enumerate(given or ()):
+            if not isinstance(row, Mapping):
+                raise DecodeError(f"{sentence.where}: {item.name}[{index}] must be an object, got {shown(row)}")
+            where = f"{sentence.where}: {item.name}[{index}]"
+            rows.append(
+                {f.name: decode_field(where, f, _field_text(sentence, f.name, row.get(f.name))) for f in item.fields}
+            )
+        values[item.name] = rows
+    return values
+
+
+def _field_text(sentence: TextSentence, name: str, given: Any) -> str:
+    if given is None:
+        return ""
+    if isinstance(given, bool) or not isinstance(given, str | int | float):
+        raise DecodeError(f"{sentence.where}: {name} must be the field's text, got {shown(given)}")
+    return given if isinstance(given, str) else str(given)
+
+
 def _ascii(frame: bytes | str) -> str:
     if isinstance(frame, str):
         return frame

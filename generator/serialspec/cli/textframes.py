@@ -85,7 +85,7 @@ def encode(package: ModuleType, data: dict[str, Any], direction: str | None, as_
     framing: TextFraming = package.FRAMING
     command = data["command"]
     cls = next(
-        (c for c in package.MESSAGE_TYPES if c.COMMAND == command and direction in (None, c.DIRECTION.value)),
+        (c for c in package.MESSAGE_TYPES if command == c.COMMAND and direction in (None, c.DIRECTION.value)),
         None,
     )
     if cls is None:

@@ -1255,6 +1255,11 @@ DEVICE = Obj(
                         "always).",
                         example="streaming",
                     ),
+                    "step": Str(
+                        "A state variable the device adds 1 to before each time it sends the message (a sequence "
+                        "number; a fix counter that `values` expressions move a position along).",
+                        example="fix",
+                    ),
                     "values": MapOf(
                         Str(),
                         "Field -> an expression of state variables and memory entries it holds (other fields: the "

@@ -628,6 +628,9 @@ class TextRecord:
         if unknown:
             raise EncodeError(f"{cls.CODE}: unknown field {sorted(unknown)[0]!r}")
         given = dict(values)
+        # talker and sent may come with the values (a simulator builds a message from all its attributes)
+        talker = str(given.pop("talker", None) or talker)
+        sent = int(given.pop("sent", sent))
         for name, group in cls.GROUPS.items():
             if name in given:
                 given[name] = tuple(row if isinstance(row, group) else group(**row) for row in given[name])

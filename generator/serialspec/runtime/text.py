@@ -17,7 +17,7 @@ from __future__ import annotations
 import dataclasses
 import datetime
 import re
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass, field
 from decimal import Decimal, InvalidOperation
 from enum import Enum
@@ -671,3 +671,82 @@ class TextMessageParser(TextStreamParser):
 
     def feed(self, data: bytes | bytearray | memoryview) -> list[Any]:
         return [self.codec.message(s) for s in super().feed(data)]
+
+
+# --- the client ---------------------------------------------------------------------------------------------------
+
+
+class TextClient:
+    """A text device on a serial port (a path, any URL pyserial opens, or an open port): the messages it sends on
+    its own, by iteration (`for message in client`, or `messages(timeout)`), and by callbacks subscribed with
+    `on(callback, *types)`, called as the messages are read. `send` writes a message. Generated packages bind
+    `CODEC` and `SERIAL` in their `Client`."""
+
+    CODEC: ClassVar[TextCodec]
+    SERIAL: ClassVar[Any]
+
+    def __init__(self, port: Any, *, baudrate: int | None = None) -> None:
+        from serialspec.runtime.transport import _PARITY, link
+
+        if isinstance(port, str):
+            import serial  # type: ignore[import-untyped]
+
+            settings = self.SERIAL
+            port = serial.serial_for_url(
+                port,
+                baudrate=baudrate or settings.baudrate,
+                bytesize=settings.bytesize,
+                parity=_PARITY[settings.parity],
+                stopbits=settings.stopbits,
+                timeout=1.0,
+            )
+        self.port = port
+        self._link = link(port)
+        self.parser = TextMessageParser(self.CODEC)
+        self._callbacks: list[tuple[Callable[[Any], None], tuple[type, ...]]] = []
+
+    def on(self, callback: Callable[[Any], None], *types: type) -> Callable[[], None]:
+        """Call `callback(message)` for every message read (of these types; none given: all); returns a function
+        that ends the subscription."""
+        entry = (callback, types)
+        self._callbacks.append(entry)
+        return lambda: self._callbacks.remove(entry) if entry in self._callbacks else None
+
+    def read(self, timeout: float = 1.0) -> list[Any]:
+        """The messages complete in what arrives within `timeout` seconds of the first byte (callbacks called)."""
+        messages = self.parser.feed(self._link.read(timeout))
+        for message in messages:
+            for callback, types in list(self._callbacks):
+                if not types or isinstance(message, types):
+                    callback(message)
+        return messages
+
+    def messages(self, timeout: float | None = None) -> Iterator[Any]:
+        """The messages as they arrive; ends when none has come for `timeout` seconds (None: never)."""
+        import time
+
+        last = time.monotonic()
+        while True:
+            found = self.read(0.2 if timeout is None else max(0.0, min(0.2, last + timeout - time.monotonic())))
+            yield from found
+            now = time.monotonic()
+            if found:
+                last = now
+            elif timeout is not None and now - last >= timeout:
+                return
+
+    def __iter__(self) -> Iterator[Any]:
+        return self.messages()
+
+    def send(self, message: TextRecord) -> None:
+        """Write one message (range checks first: nothing is written when a value is refused)."""
+        self._link.write(self.CODEC.encode(message))
+
+    def close(self) -> None:
+        self.port.close()
+
+    def __enter__(self) -> TextClient:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()

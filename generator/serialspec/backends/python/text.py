@@ -147,6 +147,7 @@ def _module(protocol: Protocol, text: TextFrame) -> Iterator[str]:
         "from serialspec.runtime.settings import SerialSettings",
         "from serialspec.runtime.text import (",
         "    Angle,",
+        "    TextClient,",
         "    TextCodec,",
         "    TextField,",
         "    TextFraming,",
@@ -260,6 +261,13 @@ def _module(protocol: Protocol, text: TextFrame) -> Iterator[str]:
     yield "decode = CODEC.decode"
     yield "#: A message -> its frame (range checks first)."
     yield "encode = CODEC.encode"
+    yield ""
+    yield ""
+    yield "class Client(TextClient):"
+    yield '    """The device on a serial port: `for message in Client(port)`, `on(callback, *types)`, `send(message)`."""'
+    yield ""
+    yield "    CODEC = CODEC"
+    yield "    SERIAL = SERIAL"
     yield ""
     yield ""
     yield "class StreamParser(TextMessageParser):"

@@ -71,7 +71,7 @@ def test_the_simulator_at_a_faster_rate_sends_sentences_pynmea2_parses() -> None
         fixes.setdefault(parsed.sentence_type, []).append(parsed.latitude)
     assert set(fixes) == {"GGA", "RMC"}
     # the RMC right after a GGA is of the same fix: the same position
-    pairs = [(a, b) for a, b in zip(got, got[1:]) if isinstance(a, nmea0183.GgaResponse)]
+    pairs = [(a, b) for a, b in zip(got, got[1:], strict=False) if isinstance(a, nmea0183.GgaResponse)]
     assert pairs and all(isinstance(b, nmea0183.RmcResponse) and a.latitude == b.latitude for a, b in pairs)
 
 

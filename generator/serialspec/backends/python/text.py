@@ -264,7 +264,7 @@ def _module(protocol: Protocol, text: TextFrame) -> Iterator[str]:
     yield ""
     yield ""
     yield "class Client(TextClient):"
-    yield '    """The device on a serial port: `for message in Client(port)`, `on(callback, *types)`, `send(message)`."""'
+    yield '    """The device on a serial port: `for message in Client(port)`, `on(callback, *types)`, `send()`."""'
     yield ""
     yield "    CODEC = CODEC"
     yield "    SERIAL = SERIAL"

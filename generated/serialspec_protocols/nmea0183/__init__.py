@@ -403,7 +403,7 @@ encode = CODEC.encode
 
 
 class Client(TextClient):
-    """The device on a serial port: `for message in Client(port)`, `on(callback, *types)`, `send(message)`."""
+    """The device on a serial port: `for message in Client(port)`, `on(callback, *types)`, `send()`."""
 
     CODEC = CODEC
     SERIAL = SERIAL

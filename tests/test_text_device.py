@@ -9,6 +9,7 @@ import dataclasses
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 import pynmea2
 import pytest
@@ -45,13 +46,13 @@ def test_the_cli_sim_streams_fixes_that_pynmea2_parses_and_the_client_iterates_o
     # the receiver moves: each fix is further north than the last
     latitudes = [m.latitude.value for m in ggas]
     assert latitudes == sorted(latitudes) and len(set(latitudes)) == len(latitudes)
+    # and each fix is a second after the one before
+    seconds = [m.utc.hour * 3600 + m.utc.minute * 60 + m.utc.second for m in ggas]
+    assert [b - a for a, b in zip(seconds, seconds[1:], strict=False)] == [1] * (len(seconds) - 1)
 
 
 def test_the_simulator_at_a_faster_rate_sends_sentences_pynmea2_parses() -> None:
-    fast = dataclasses.replace(
-        simulator.DEVICE, sends=tuple(dataclasses.replace(s, every=0.02) for s in simulator.DEVICE.sends)
-    )
-    device = simulator.Simulator(fast, (0,), encode=nmea0183.CODEC.encode, parser=lambda: nmea0183.StreamParser())
+    device = fast_device()
     path = device.start()
     try:
         with nmea0183.Client(path) as client:
@@ -92,3 +93,51 @@ def test_decode_and_encode_take_a_sentence_as_typed_or_as_hex() -> None:
         text=True,
     )
     assert refused.returncode != 0 and "satellites" in refused.stderr and "Traceback" not in refused.stderr
+
+
+def fast_device() -> simulator.Simulator:
+    fast = dataclasses.replace(
+        simulator.DEVICE, sends=tuple(dataclasses.replace(s, every=0.02) for s in simulator.DEVICE.sends)
+    )
+    return simulator.Simulator(fast, (0,), encode=nmea0183.CODEC.encode, parser=lambda: nmea0183.StreamParser())
+
+
+def test_monitor_shows_the_sentences_a_text_device_sends() -> None:
+    device = fast_device()
+    path = device.start()
+    try:
+        out = subprocess.run(
+            [*CLI, "monitor", SPEC, "--port", path, "--count", "6"], capture_output=True, text=True, timeout=60
+        )
+    finally:
+        device.close()
+    lines = out.stdout.splitlines()
+    assert out.returncode == 0 and len(lines) == 6, out.stderr
+    for line in lines:
+        sentence = line.rsplit(" ", 1)[1]
+        parsed = pynmea2.parse(sentence)
+        fields = json.loads(line.split(" ", 3)[3].rsplit(" ", 1)[0])
+        assert fields["latitude"] == parsed.lat and f"response {parsed.sentence_type.lower()} " in line
+
+
+def test_a_text_device_section_with_mistakes_gets_one_line_each(tmp_path: Path) -> None:
+    spec = Path(SPEC).read_text(encoding="utf-8")
+    spec = spec.replace("step: fix\n", "step: fixx\n").replace("altitude: altitude}", "altitude: nope, bogus: fix}")
+    spec = spec.replace("reply: {talker: GP,", "reply: {talker: XX, colour: 1,")
+    spec = spec.replace("    rmc:\n      every: 1000\n", "    rmc:\n      after: [gga]\n")
+    bad = tmp_path / "nmea.yaml"
+    bad.write_text(spec, encoding="utf-8")
+    out = subprocess.run([*CLI, "check", str(bad)], capture_output=True, text=True)
+    errors = out.stderr.strip().splitlines()
+    assert out.returncode != 0 and "Traceback" not in out.stderr
+    expected = [
+        "device.reply.talker: talker 'XX' is not one of GP, GN, GL, GA, BD",
+        "device.reply.colour: no sentence has a field 'colour'",
+        "device.sends.gga.step: unknown state variable 'fixx'",
+        "device.sends.gga.values.altitude: unknown name 'nope' (not a state variable)",
+        "device.sends.gga.values.bogus: gga has no field 'bogus'",
+        "device.sends.rmc: says not when: give `every`",
+        "device.sends.rmc.after: `after` is not available in a text protocol's device yet",
+    ]
+    assert [e.split(": ", 1)[1] for e in errors] == expected, errors
+    assert all(e.startswith(f"{bad}:") for e in errors)

@@ -15,12 +15,12 @@ DEVICE = DeviceSpec(
     id_entry="",
     broadcast=None,
     entries=(),
-    state={'fix': 0.0, 'start_latitude': 48.1173, 'start_longitude': 11.5167, 'step': 0.0001, 'altitude': 545.4, 'speed': 22.0, 'course': 45.0},
+    state={'fix': 0.0, 'start_time': 45319.0, 'start_latitude': 48.1173, 'start_longitude': 11.5167, 'step': 0.0001, 'altitude': 545.4, 'speed': 22.0, 'course': 45.0},
     reply={'talker': 'GP', 'lat_hemisphere': 'N', 'lon_hemisphere': 'E', 'quality': 1.0, 'satellites': 8.0, 'hdop': 0.9, 'altitude_unit': 'M', 'separation': 46.9, 'separation_unit': 'M', 'status': 'A', 'mode': 'A'},
     commands=(),
     sends=(
-        SendSpec(GgaResponse, every=1.0, step='fix', values={'latitude': lambda get: (get('start_latitude') + (get('fix') * get('step'))), 'longitude': lambda get: (get('start_longitude') + (get('fix') * get('step'))), 'altitude': 'altitude'}, blanks={'utc': None, 'latitude': None, 'lat_hemisphere': None, 'longitude': None, 'lon_hemisphere': None, 'quality': None, 'satellites': None, 'hdop': None, 'altitude': None, 'altitude_unit': None, 'separation': None, 'separation_unit': None, 'dgps_age': None, 'dgps_station': None, 'talker': 'GP', 'sent': -1}),
-        SendSpec(RmcResponse, every=1.0, values={'latitude': lambda get: (get('start_latitude') + (get('fix') * get('step'))), 'longitude': lambda get: (get('start_longitude') + (get('fix') * get('step'))), 'speed': 'speed', 'course': 'course'}, blanks={'utc': None, 'status': None, 'latitude': None, 'lat_hemisphere': None, 'longitude': None, 'lon_hemisphere': None, 'speed': None, 'course': None, 'date': None, 'variation': None, 'variation_direction': None, 'mode': None, 'talker': 'GP', 'sent': -1}),
+        SendSpec(GgaResponse, every=1.0, step='fix', values={'utc': lambda get: (get('start_time') + get('fix')), 'latitude': lambda get: (get('start_latitude') + (get('fix') * get('step'))), 'longitude': lambda get: (get('start_longitude') + (get('fix') * get('step'))), 'altitude': 'altitude'}, blanks={'utc': None, 'latitude': None, 'lat_hemisphere': None, 'longitude': None, 'lon_hemisphere': None, 'quality': None, 'satellites': None, 'hdop': None, 'altitude': None, 'altitude_unit': None, 'separation': None, 'separation_unit': None, 'dgps_age': None, 'dgps_station': None, 'talker': 'GP', 'sent': -1}),
+        SendSpec(RmcResponse, every=1.0, values={'utc': lambda get: (get('start_time') + get('fix')), 'latitude': lambda get: (get('start_latitude') + (get('fix') * get('step'))), 'longitude': lambda get: (get('start_longitude') + (get('fix') * get('step'))), 'speed': 'speed', 'course': 'course'}, blanks={'utc': None, 'status': None, 'latitude': None, 'lat_hemisphere': None, 'longitude': None, 'lon_hemisphere': None, 'speed': None, 'course': None, 'date': None, 'variation': None, 'variation_direction': None, 'mode': None, 'talker': 'GP', 'sent': -1}),
     ),
 )
 

@@ -1290,7 +1290,11 @@ DEVICE = Obj(
             "motors); a command names its kind with `kind:`. The devices --id creates are the default kind.",
         ),
     },
-    description="How the device behaves: what the generated simulator does, and the address rule the client uses.",
+    description=(
+        "How the device behaves: what the generated simulator does, and the address rule the client uses. In a text "
+        "protocol (`framing: {kind: text}`): `description`, `state`, `reply` (values every sentence carries, "
+        "`talker` too) and `sends` with `every`, `step`, `while` and `values`."
+    ),
 )
 
 SPEC = Obj(

@@ -453,8 +453,13 @@ def _put_text(spec: TextField, value: Any, where: str) -> str:
 
 
 def _put_time(spec: TextField, value: Any, where: str) -> str:
+    if isinstance(value, int | float) and not isinstance(value, bool) and 0 <= value < 86400:
+        # seconds since midnight (what a simulated device's expressions give)
+        seconds = int(value)
+        micro = round((value - seconds) * 1_000_000)
+        value = datetime.time(seconds // 3600, seconds // 60 % 60, seconds % 60, min(micro, 999_999))
     if not isinstance(value, datetime.time):
-        raise EncodeError(f"{where} must be a datetime.time, got {shown(value)}")
+        raise EncodeError(f"{where} must be a datetime.time (or seconds since midnight), got {shown(value)}")
     digits = value.digits if isinstance(value, Clock) else spec.precision
     text = f"{value.hour:02d}{value.minute:02d}{value.second:02d}"
     if digits:
@@ -580,6 +585,11 @@ class TextStreamParser:
             except DecodeError as error:
                 self._dropped(str(error))
 
+    @property
+    def errors(self) -> int:
+        """Frames dropped (what binary stream parsers call errors)."""
+        return self.corrupt
+
     def _dropped(self, reason: str) -> None:
         self.corrupt += 1
         self.last_error = reason
@@ -689,7 +699,7 @@ class TextClient:
         from serialspec.runtime.transport import _PARITY, link
 
         if isinstance(port, str):
-            import serial  # type: ignore[import-untyped]
+            import serial
 
             settings = self.SERIAL
             port = serial.serial_for_url(

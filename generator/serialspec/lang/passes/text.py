@@ -260,9 +260,9 @@ class TextPass(Pass):
                     self.error((*where, bad), f"`{bad}` is not available in a text protocol's device yet")
             if "every" not in item:
                 self.error(where, "says not when: give `every`")
-            for name in (item.get("step"), item.get("while")):
-                if name is not None and str(name) not in state:
-                    self.error(where, f"unknown state variable {name!r}")
+            for named in ("step", "while"):
+                if named in item and str(item[named]) not in state:
+                    self.error((*where, named), f"unknown state variable {item[named]!r}")
             fields = {f.name for f in message.fields if isinstance(f, TextField)}
             values = {}
             for name, source in (item.get("values") or {}).items():

@@ -7,6 +7,7 @@ from typing import Any
 
 from serialspec.runtime.device import DeviceSpec, SendSpec, Simulator
 from serialspec.runtime.text import TextMessageParser
+
 from . import CODEC, PROTOCOL, GgaResponse, RmcResponse
 
 DEVICE = DeviceSpec(

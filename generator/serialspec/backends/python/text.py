@@ -35,6 +35,7 @@ def _simulator(protocol: Protocol, text: TextFrame, device: TextDevice) -> Itera
     yield ""
     yield "from serialspec.runtime.device import DeviceSpec, SendSpec, Simulator"
     yield "from serialspec.runtime.text import TextMessageParser"
+    yield ""
     classes = sorted({text.message(s.command).class_name for s in device.sends})
     yield f"from . import CODEC, {', '.join(['PROTOCOL', *classes])}"
     yield ""

@@ -3,13 +3,15 @@
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, cast
 
 from serialspec.runtime.device import DeviceSpec, SendSpec, Simulator
 from serialspec.runtime.text import TextMessageParser
 
 from . import CODEC, PROTOCOL, GgaResponse, RmcResponse
 
+# The engine is typed for binary messages; text records offer what it uses of them (from_fields, to_fields,
+# the fields in order), and the text codec and stream parser stand for the binary ones.
 DEVICE = DeviceSpec(
     protocol=PROTOCOL,
     address="",
@@ -20,8 +22,8 @@ DEVICE = DeviceSpec(
     reply={'talker': 'GP', 'lat_hemisphere': 'N', 'lon_hemisphere': 'E', 'quality': 1.0, 'satellites': 8.0, 'hdop': 0.9, 'altitude_unit': 'M', 'separation': 46.9, 'separation_unit': 'M', 'status': 'A', 'mode': 'A'},
     commands=(),
     sends=(
-        SendSpec(GgaResponse, every=1.0, step='fix', values={'utc': lambda get: (get('start_time') + get('fix')), 'latitude': lambda get: (get('start_latitude') + (get('fix') * get('step'))), 'longitude': lambda get: (get('start_longitude') + (get('fix') * get('step'))), 'altitude': 'altitude'}, blanks={'utc': None, 'latitude': None, 'lat_hemisphere': None, 'longitude': None, 'lon_hemisphere': None, 'quality': None, 'satellites': None, 'hdop': None, 'altitude': None, 'altitude_unit': None, 'separation': None, 'separation_unit': None, 'dgps_age': None, 'dgps_station': None, 'talker': 'GP', 'sent': -1}),
-        SendSpec(RmcResponse, every=1.0, values={'utc': lambda get: (get('start_time') + get('fix')), 'latitude': lambda get: (get('start_latitude') + (get('fix') * get('step'))), 'longitude': lambda get: (get('start_longitude') + (get('fix') * get('step'))), 'speed': 'speed', 'course': 'course'}, blanks={'utc': None, 'status': None, 'latitude': None, 'lat_hemisphere': None, 'longitude': None, 'lon_hemisphere': None, 'speed': None, 'course': None, 'date': None, 'variation': None, 'variation_direction': None, 'mode': None, 'talker': 'GP', 'sent': -1}),
+        SendSpec(cast(Any, GgaResponse), every=1.0, step='fix', values={'utc': lambda get: (get('start_time') + get('fix')), 'latitude': lambda get: (get('start_latitude') + (get('fix') * get('step'))), 'longitude': lambda get: (get('start_longitude') + (get('fix') * get('step'))), 'altitude': 'altitude'}, blanks={'utc': None, 'latitude': None, 'lat_hemisphere': None, 'longitude': None, 'lon_hemisphere': None, 'quality': None, 'satellites': None, 'hdop': None, 'altitude': None, 'altitude_unit': None, 'separation': None, 'separation_unit': None, 'dgps_age': None, 'dgps_station': None, 'talker': 'GP', 'sent': -1}),
+        SendSpec(cast(Any, RmcResponse), every=1.0, values={'utc': lambda get: (get('start_time') + get('fix')), 'latitude': lambda get: (get('start_latitude') + (get('fix') * get('step'))), 'longitude': lambda get: (get('start_longitude') + (get('fix') * get('step'))), 'speed': 'speed', 'course': 'course'}, blanks={'utc': None, 'status': None, 'latitude': None, 'lat_hemisphere': None, 'longitude': None, 'lon_hemisphere': None, 'speed': None, 'course': None, 'date': None, 'variation': None, 'variation_direction': None, 'mode': None, 'talker': 'GP', 'sent': -1}),
     ),
 )
 
@@ -29,5 +31,9 @@ DEVICE = DeviceSpec(
 def SIMULATOR(ids: Any = (0,), **options: Any) -> Simulator:  # noqa: N802 (the name binary packages use)
     """The device, to serve on a pseudo-terminal (`start()`) or to feed bytes (`feed`, `due`)."""
     return Simulator(
-        DEVICE, ids or (0,), encode=CODEC.encode, parser=lambda: TextMessageParser(CODEC), **options
+        DEVICE,
+        ids or (0,),
+        encode=cast(Any, CODEC.encode),
+        parser=cast(Any, lambda: TextMessageParser(CODEC)),
+        **options,
     )

@@ -31,7 +31,7 @@ def _simulator(protocol: Protocol, text: TextFrame, device: TextDevice) -> Itera
     yield ""
     yield "from __future__ import annotations"
     yield ""
-    yield "from typing import Any"
+    yield "from typing import Any, cast"
     yield ""
     yield "from serialspec.runtime.device import DeviceSpec, SendSpec, Simulator"
     yield "from serialspec.runtime.text import TextMessageParser"
@@ -39,6 +39,8 @@ def _simulator(protocol: Protocol, text: TextFrame, device: TextDevice) -> Itera
     classes = sorted({text.message(s.command).class_name for s in device.sends})
     yield f"from . import CODEC, {', '.join(['PROTOCOL', *classes])}"
     yield ""
+    yield "# The engine is typed for binary messages; text records offer what it uses of them (from_fields, to_fields,"
+    yield "# the fields in order), and the text codec and stream parser stand for the binary ones."
     yield "DEVICE = DeviceSpec("
     yield "    protocol=PROTOCOL,"
     yield '    address="",'
@@ -54,7 +56,7 @@ def _simulator(protocol: Protocol, text: TextFrame, device: TextDevice) -> Itera
         message = text.message(send.command)
         blanks: dict[str, object] = {f.name: () if isinstance(f, TextRepeat) else None for f in message.fields}
         blanks |= {"talker": default_talker, "sent": -1}
-        args = [message.class_name, f"every={send.every / 1000!r}"]
+        args = [f"cast(Any, {message.class_name})", f"every={send.every / 1000!r}"]
         if send.while_:
             args.append(f"while_={send.while_!r}")
         if send.step:
@@ -70,7 +72,11 @@ def _simulator(protocol: Protocol, text: TextFrame, device: TextDevice) -> Itera
     yield "def SIMULATOR(ids: Any = (0,), **options: Any) -> Simulator:  # noqa: N802 (the name binary packages use)"
     yield '    """The device, to serve on a pseudo-terminal (`start()`) or to feed bytes (`feed`, `due`)."""'
     yield "    return Simulator("
-    yield "        DEVICE, ids or (0,), encode=CODEC.encode, parser=lambda: TextMessageParser(CODEC), **options"
+    yield "        DEVICE,"
+    yield "        ids or (0,),"
+    yield "        encode=cast(Any, CODEC.encode),"
+    yield "        parser=cast(Any, lambda: TextMessageParser(CODEC)),"
+    yield "        **options,"
     yield "    )"
 
 

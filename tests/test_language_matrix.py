@@ -485,11 +485,11 @@ CASES["device: derived, locks, sends, moves.to"] = Case(
         "go": {"code": 10, "title": "Go", "request": {"fields": {"target": "u16"}}, "response": {}},
     },
     device={
-        "state": {"held": 0},
+        "state": {"held": 0, "beats": 0},
         "derived": {"torque": "position + speed"},
         "locks": [{"entries": ["speed"], "while": "held"}],
         "errors": {"locked": {"v": 1}},
-        "sends": {"beat": {"every": 5, "values": {"where": "torque"}}, "probe": {"after": ["go"]}},
+        "sends": {"beat": {"every": 5, "step": "beats", "values": {"where": "torque"}}, "probe": {"after": ["go"]}},
         "commands": {"go": {"moves": {"state": "position", "target": "target", "to": "target / 2"}}},
     },
 )

@@ -511,7 +511,7 @@ def test_the_tutorial_text_session_prints_what_it_says() -> None:
     assert out.getvalue().splitlines() == printed
 
 
-@pytest.mark.parametrize("verb", [["decode", "24"], ["monitor", "--port", "/dev/null"], ["encode", "--json", "{}"]])
+@pytest.mark.parametrize("verb", [["watch", "--port", "/dev/null"], ["scan", "--port", "/dev/null"]])
 def test_verbs_that_read_bytes_refuse_a_text_protocol_in_one_line(verb: list[str]) -> None:
     import subprocess
     import sys

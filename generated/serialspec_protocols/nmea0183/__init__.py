@@ -24,6 +24,7 @@ from serialspec.runtime.message import Direction
 from serialspec.runtime.settings import SerialSettings
 from serialspec.runtime.text import (
     Angle,
+    TextClient,
     TextCodec,
     TextField,
     TextFraming,
@@ -399,6 +400,13 @@ CODEC = TextCodec(FRAMING, MESSAGE_TYPES)
 decode = CODEC.decode
 #: A message -> its frame (range checks first).
 encode = CODEC.encode
+
+
+class Client(TextClient):
+    """The device on a serial port: `for message in Client(port)`, `on(callback, *types)`, `send()`."""
+
+    CODEC = CODEC
+    SERIAL = SERIAL
 
 
 class StreamParser(TextMessageParser):

@@ -7,7 +7,7 @@ import sys
 from types import ModuleType
 from typing import TYPE_CHECKING, Any
 
-from serialspec.cli.protocols import SPEC_HELP, open_binary_spec
+from serialspec.cli.protocols import SPEC_HELP, open_spec
 from serialspec.cli.views import FlagNames, engineering, message_spec, register_view, unit_symbols, with_unit
 from serialspec.lang.model import Protocol, replies_by_request, reply_to
 from serialspec.runtime.errors import DecodeError, SerialspecError
@@ -20,7 +20,11 @@ if TYPE_CHECKING:
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("spec", help=SPEC_HELP)
-    parser.add_argument("hex", nargs="*", help="one frame per argument; - reads frames from stdin, one per line")
+    parser.add_argument(
+        "hex",
+        nargs="*",
+        help="one frame per argument (as hex; a text protocol's sentence as typed too); - reads stdin, one per line",
+    )
     parser.add_argument(
         "--file",
         metavar="FILE",
@@ -39,7 +43,17 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     if not args.hex and not args.file:
         raise SerialspecError("give frames as hex arguments, - to read them from stdin, or --file CAPTURE")
-    protocol, package = open_binary_spec(args.spec, "decode")
+    protocol, package = open_spec(args.spec)
+    if protocol.text is not None:
+        if args.file or args.request or args.units or args.direction:
+            raise SerialspecError(
+                "a text protocol's sentences are decoded as given (as typed or as hex): --file, --request, --units "
+                "and --direction are for binary frames"
+            )
+        from serialspec.cli import textframes
+
+        sentences = [line for line in sys.stdin if line.strip()] if args.hex == ["-"] else args.hex
+        return textframes.decode(protocol, package, sentences, args.json)
     request = None
     expect = None  # the reply layout the request gets, where replies share a code
     if args.request:

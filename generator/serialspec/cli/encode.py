@@ -6,7 +6,7 @@ import argparse
 import json
 from typing import Any
 
-from serialspec.cli.protocols import SPEC_HELP, message_type, open_binary_spec
+from serialspec.cli.protocols import SPEC_HELP, message_type, open_spec
 from serialspec.runtime.errors import EncodeError
 
 
@@ -19,10 +19,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="the object decode --json prints; length, checksum, counts and hex may be left out",
     )
     parser.add_argument("--direction", choices=("request", "response"), help="overrides the object's direction")
+    parser.add_argument("--hex", action="store_true", help="a text protocol's sentence as hex, not as text")
 
 
 def run(args: argparse.Namespace) -> int:
-    _, package = open_binary_spec(args.spec, "encode")
+    protocol, package = open_spec(args.spec)
     try:
         data: Any = json.loads(args.json)
     except json.JSONDecodeError as exc:
@@ -34,6 +35,10 @@ def run(args: argparse.Namespace) -> int:
     direction = args.direction or data.get("direction") or "request"
     if direction not in ("request", "response"):
         raise EncodeError(f"`direction` must be 'request' or 'response', got {direction!r}")
+    if protocol.text is not None:
+        from serialspec.cli import textframes
+
+        return textframes.encode(package, data, args.direction or data.get("direction"), args.hex)
     cls = message_type(package, data["command"], data.get("subcommand"), direction)
     fields = data.get("fields", {})
     if not isinstance(fields, dict):

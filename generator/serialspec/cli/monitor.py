@@ -13,10 +13,11 @@ import serial
 from serialspec.cli import capture
 from serialspec.cli.frames import Frames, Seen
 from serialspec.cli.listening import Stopping, open_port
-from serialspec.cli.protocols import SPEC_HELP, open_binary_spec
+from serialspec.cli.protocols import SPEC_HELP, open_spec
 from serialspec.cli.views import engineering, unit_symbols, with_unit
 from serialspec.lang.model import Protocol
 from serialspec.runtime.errors import PortError, SerialspecError
+from serialspec.runtime.text import texts
 
 COLOURS = {"request": "\033[36m", "response": "\033[32m", "BAD": "\033[31m"}
 
@@ -77,13 +78,21 @@ class Printer:
                     for name, value in engineering(self.protocol, message, fields).items()
                 }
             what = message.COMMAND + (f".{message.SUBCOMMAND}" if message.SUBCOMMAND else "")
-            text = f"{what} {json.dumps(fields, ensure_ascii=False)} [{seen.data.hex(' ')}]"
+            if self.protocol.text is not None:  # a sentence: its fields as the texts sent, and the line itself
+                record: Any = message  # a text record: its frame's descriptor of its code
+                fields = texts(record.FRAMING.by_code[record.CODE], fields)
+                line = seen.data.decode("ascii").rstrip("\r\n")
+                text = f"{what} {json.dumps(fields, ensure_ascii=False)} {line}"
+            else:
+                text = f"{what} {json.dumps(fields, ensure_ascii=False)} [{seen.data.hex(' ')}]"
         label = f"{COLOURS[kind]}{kind}\033[0m" if self.colour else kind
         print(f"{capture.stamp()} {label} {text}", file=self.out, flush=True)
 
 
 def run(args: argparse.Namespace) -> int:
-    protocol, package = open_binary_spec(args.spec, "monitor")
+    protocol, package = open_spec(args.spec)
+    if protocol.text is not None and (args.units or args.ids):
+        raise SerialspecError("--units and --id are for binary frames: a text protocol's sentences carry no device id")
     settings = package.SERIAL
     address = protocol.device.address if protocol.device else None
     frames = Frames(package, args.direction, address)

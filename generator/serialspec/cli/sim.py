@@ -101,6 +101,14 @@ def model_choice(given: list[str] | None) -> str | dict[int, str] | None:
 def run(args: argparse.Namespace) -> int:
     protocol, package = open_spec(args.spec)
     module = submodule(package, "simulator")
+    if protocol.text is not None:
+        if module is None:
+            raise SerialspecError(f"{args.spec} has no `device:` section, so no simulator is generated")
+        if args.ids or args.models or args.sizes or args.tap or args.echo:
+            raise SerialspecError(
+                "a text protocol's simulator is one device: --id, --model, --size, --tap and --echo do not apply"
+            )
+        return _serve(protocol, module.SIMULATOR())
     if module is None or protocol.device is None:
         raise SerialspecError(f"{args.spec} has no `device:` section, so no simulator is generated")
     if args.ids and not protocol.device.address:
@@ -167,6 +175,21 @@ def run(args: argparse.Namespace) -> int:
     finally:
         if tap is not None:
             tap.close()
+    return 0
+
+
+def _serve(protocol: Protocol, simulator: Any) -> int:
+    """Serve a text protocol's device on a new pseudo-terminal until Ctrl-C: it sends its sentences on its own."""
+    controller, path = simulator.open_pty()
+
+    def stop(signum: int, frame: FrameType | None) -> None:
+        simulator.stop()
+
+    signal.signal(signal.SIGINT, stop)
+    signal.signal(signal.SIGTERM, stop)
+    print(path, flush=True)
+    print(f"serialspec sim: {protocol.name} device on {path}; Ctrl-C to stop", file=sys.stderr, flush=True)
+    simulator.serve(controller)
     return 0
 
 

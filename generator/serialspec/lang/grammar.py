@@ -1328,6 +1328,11 @@ DEVICE = Obj(
                         "always).",
                         example="streaming",
                     ),
+                    "step": Str(
+                        "A state variable the device adds 1 to before each time it sends the message (a sequence "
+                        "number; a fix counter that `values` expressions move a position along).",
+                        example="fix",
+                    ),
                     "values": MapOf(
                         Str(),
                         "Field -> an expression of state variables and memory entries it holds (other fields: the "
@@ -1358,7 +1363,11 @@ DEVICE = Obj(
             "motors); a command names its kind with `kind:`. The devices --id creates are the default kind.",
         ),
     },
-    description="How the device behaves: what the generated simulator does, and the address rule the client uses.",
+    description=(
+        "How the device behaves: what the generated simulator does, and the address rule the client uses. In a text "
+        "protocol (`framing: {kind: text}`): `description`, `state`, `reply` (values every sentence carries, "
+        "`talker` too) and `sends` with `every`, `step`, `while` and `values`."
+    ),
 )
 
 SPEC = Obj(

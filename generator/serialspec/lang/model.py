@@ -675,6 +675,7 @@ class Unsolicited:
     while_: str = ""
     values: dict[str, Expr] = field(default_factory=dict)  # response field -> expression of state and memory
     description: str = ""
+    step: str = ""  # state variable: 1 is added to it before each send
 
 
 @frozen
@@ -835,6 +836,17 @@ class TextExample:
 
 
 @frozen
+class TextDevice:
+    """A text protocol's virtual device (`device:`): its state variables, the values every sentence it sends
+    carries (`reply`), and the sentences it sends on its own."""
+
+    description: str
+    state: dict[str, float]
+    reply: dict[str, str | float]
+    sends: tuple[Unsolicited, ...]
+
+
+@frozen
 class TextFrame:
     """Line-oriented text frames: start + talker + code + separated fields + [marker + checksum as hex] + end."""
 
@@ -852,6 +864,10 @@ class TextFrame:
     messages: tuple[TextMessage, ...]
     examples: tuple[TextExample, ...] = ()
     digits: int = 2
+    device: TextDevice | None = None
+
+    def message(self, key: str) -> TextMessage:
+        return next(m for m in self.messages if m.key == key)
 
     def letter_sets(self) -> dict[str, tuple[tuple[str, str], ...]]:
         """Each generated letter Enum's name -> its (label, letter) pairs, in order of first use."""

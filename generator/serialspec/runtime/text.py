@@ -17,7 +17,7 @@ from __future__ import annotations
 import dataclasses
 import datetime
 import re
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass, field
 from decimal import Decimal, InvalidOperation
 from enum import Enum
@@ -453,8 +453,13 @@ def _put_text(spec: TextField, value: Any, where: str) -> str:
 
 
 def _put_time(spec: TextField, value: Any, where: str) -> str:
+    if isinstance(value, int | float) and not isinstance(value, bool) and 0 <= value < 86400:
+        # seconds since midnight (what a simulated device's expressions give)
+        seconds = int(value)
+        micro = round((value - seconds) * 1_000_000)
+        value = datetime.time(seconds // 3600, seconds // 60 % 60, seconds % 60, min(micro, 999_999))
     if not isinstance(value, datetime.time):
-        raise EncodeError(f"{where} must be a datetime.time, got {shown(value)}")
+        raise EncodeError(f"{where} must be a datetime.time (or seconds since midnight), got {shown(value)}")
     digits = value.digits if isinstance(value, Clock) else spec.precision
     text = f"{value.hour:02d}{value.minute:02d}{value.second:02d}"
     if digits:
@@ -492,6 +497,39 @@ def texts(sentence: TextSentence, values: Mapping[str, Any]) -> dict[str, Any]:
                 {f.name: encode_field(sentence.where, f, row.get(f.name)) for f in item.fields} for row in rows
             ]
     return found
+
+
+def from_texts(sentence: TextSentence, texts: Mapping[str, Any]) -> dict[str, Any]:
+    """Each field's value from its text (what `texts` gives; a missing field is empty): DecodeError names the field."""
+    unknown = set(texts) - {f.name for f in sentence.fields}
+    if unknown:
+        raise DecodeError(f"{sentence.where}: unknown field {sorted(unknown)[0]!r}")
+    values: dict[str, Any] = {}
+    for item in sentence.fields:
+        given = texts.get(item.name)
+        if isinstance(item, TextField):
+            values[item.name] = decode_field(sentence.where, item, _field_text(sentence, item.name, given))
+            continue
+        if not isinstance(given, list | tuple | type(None)):
+            raise DecodeError(f"{sentence.where}: {item.name} must be a list of objects, got {shown(given)}")
+        rows = []
+        for index, row in enumerate(given or ()):
+            if not isinstance(row, Mapping):
+                raise DecodeError(f"{sentence.where}: {item.name}[{index}] must be an object, got {shown(row)}")
+            where = f"{sentence.where}: {item.name}[{index}]"
+            rows.append(
+                {f.name: decode_field(where, f, _field_text(sentence, f.name, row.get(f.name))) for f in item.fields}
+            )
+        values[item.name] = rows
+    return values
+
+
+def _field_text(sentence: TextSentence, name: str, given: Any) -> str:
+    if given is None:
+        return ""
+    if isinstance(given, bool) or not isinstance(given, str | int | float):
+        raise DecodeError(f"{sentence.where}: {name} must be the field's text, got {shown(given)}")
+    return given if isinstance(given, str) else str(given)
 
 
 def _ascii(frame: bytes | str) -> str:
@@ -547,6 +585,11 @@ class TextStreamParser:
             except DecodeError as error:
                 self._dropped(str(error))
 
+    @property
+    def errors(self) -> int:
+        """Frames dropped (what binary stream parsers call errors)."""
+        return self.corrupt
+
     def _dropped(self, reason: str) -> None:
         self.corrupt += 1
         self.last_error = reason
@@ -595,6 +638,9 @@ class TextRecord:
         if unknown:
             raise EncodeError(f"{cls.CODE}: unknown field {sorted(unknown)[0]!r}")
         given = dict(values)
+        # talker and sent may come with the values (a simulator builds a message from all its attributes)
+        talker = str(given.pop("talker", None) or talker)
+        sent = int(given.pop("sent", sent))
         for name, group in cls.GROUPS.items():
             if name in given:
                 given[name] = tuple(row if isinstance(row, group) else group(**row) for row in given[name])
@@ -635,3 +681,82 @@ class TextMessageParser(TextStreamParser):
 
     def feed(self, data: bytes | bytearray | memoryview) -> list[Any]:
         return [self.codec.message(s) for s in super().feed(data)]
+
+
+# --- the client ---------------------------------------------------------------------------------------------------
+
+
+class TextClient:
+    """A text device on a serial port (a path, any URL pyserial opens, or an open port): the messages it sends on
+    its own, by iteration (`for message in client`, or `messages(timeout)`), and by callbacks subscribed with
+    `on(callback, *types)`, called as the messages are read. `send` writes a message. Generated packages bind
+    `CODEC` and `SERIAL` in their `Client`."""
+
+    CODEC: ClassVar[TextCodec]
+    SERIAL: ClassVar[Any]
+
+    def __init__(self, port: Any, *, baudrate: int | None = None) -> None:
+        from serialspec.runtime.transport import _PARITY, link
+
+        if isinstance(port, str):
+            import serial
+
+            settings = self.SERIAL
+            port = serial.serial_for_url(
+                port,
+                baudrate=baudrate or settings.baudrate,
+                bytesize=settings.bytesize,
+                parity=_PARITY[settings.parity],
+                stopbits=settings.stopbits,
+                timeout=1.0,
+            )
+        self.port = port
+        self._link = link(port)
+        self.parser = TextMessageParser(self.CODEC)
+        self._callbacks: list[tuple[Callable[[Any], None], tuple[type, ...]]] = []
+
+    def on(self, callback: Callable[[Any], None], *types: type) -> Callable[[], None]:
+        """Call `callback(message)` for every message read (of these types; none given: all); returns a function
+        that ends the subscription."""
+        entry = (callback, types)
+        self._callbacks.append(entry)
+        return lambda: self._callbacks.remove(entry) if entry in self._callbacks else None
+
+    def read(self, timeout: float = 1.0) -> list[Any]:
+        """The messages complete in what arrives within `timeout` seconds of the first byte (callbacks called)."""
+        messages = self.parser.feed(self._link.read(timeout))
+        for message in messages:
+            for callback, types in list(self._callbacks):
+                if not types or isinstance(message, types):
+                    callback(message)
+        return messages
+
+    def messages(self, timeout: float | None = None) -> Iterator[Any]:
+        """The messages as they arrive; ends when none has come for `timeout` seconds (None: never)."""
+        import time
+
+        last = time.monotonic()
+        while True:
+            found = self.read(0.2 if timeout is None else max(0.0, min(0.2, last + timeout - time.monotonic())))
+            yield from found
+            now = time.monotonic()
+            if found:
+                last = now
+            elif timeout is not None and now - last >= timeout:
+                return
+
+    def __iter__(self) -> Iterator[Any]:
+        return self.messages()
+
+    def send(self, message: TextRecord) -> None:
+        """Write one message (range checks first: nothing is written when a value is refused)."""
+        self._link.write(self.CODEC.encode(message))
+
+    def close(self) -> None:
+        self.port.close()
+
+    def __enter__(self) -> TextClient:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()

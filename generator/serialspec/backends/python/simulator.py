@@ -323,6 +323,8 @@ def simulator_module(protocol: Protocol) -> str:
             args.append(f"changes={send.changes!r}")
         if send.while_:
             args.append(f"while_={send.while_!r}")
+        if send.step:
+            args.append(f"step={send.step!r}")
         if send.values:
             args.append(f"values={{{', '.join(f'{k!r}: {report_source(v)}' for k, v in send.values.items())}}}")
         blanks = reply_blanks(protocol, response, set())

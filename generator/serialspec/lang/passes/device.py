@@ -339,6 +339,8 @@ class DevicePass(Pass):
                     self.error((*where, "after", index), f"unknown command {name!r} (or it has no request)")
             for index, name in enumerate(item.get("changes") or ()):
                 self.known(str(name), variables, (*where, "changes", index), "memory entry or state variable")
+            if "step" in item:
+                self.known(str(item["step"]), variables, (*where, "step"), "memory entry or state variable")
             if "while" in item:
                 self.known(str(item["while"]), variables, (*where, "while"), "memory entry or state variable")
             if not any(k in item for k in ("every", "after", "changes")):
@@ -359,6 +361,7 @@ class DevicePass(Pass):
                     str(item.get("while", "")),
                     values,
                     str(item.get("description", "")),
+                    str(item.get("step", "")),
                 )
             )
         return tuple(found)

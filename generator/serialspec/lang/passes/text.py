@@ -11,16 +11,19 @@ from typing import Any, cast
 
 from serialspec import checksums
 from serialspec.checksums import ChecksumProblem
+from serialspec.lang import expression
 from serialspec.lang.errors import SpecError
 from serialspec.lang.loader import Path
 from serialspec.lang.model import (
     Direction,
     Framing,
+    TextDevice,
     TextExample,
     TextField,
     TextFrame,
     TextMessage,
     TextRepeat,
+    Unsolicited,
 )
 from serialspec.lang.passes.base import Bad, Pass, camel
 
@@ -38,7 +41,10 @@ KIND_KEYS = {
 COMMON_KEYS = {"type", "use", "description", "unit"}
 BINARY_ONLY = ("elements", "layouts", "transparency", "gap")
 TEXT_ONLY_FRAMING = ("start", "separator", "end", "checksum", "talker", "max_length")
-NOT_YET = ("matching", "enums", "flags", "tables", "errata", "device")
+NOT_YET = ("matching", "enums", "flags", "tables", "errata")
+# What a text device may say (the binary device's memory, ids, models and behaviours are not available yet)
+DEVICE_KEYS = ("description", "state", "reply", "sends")
+SEND_KEYS = ("every", "step", "while", "values", "description")
 
 
 def is_text(data: Any) -> bool:
@@ -75,7 +81,8 @@ class TextPass(Pass):
         if frame is not None:
             frame = replace(frame, messages=tuple(messages))
             examples = tuple(self.examples(frame))
-            self.ctx.text = replace(frame, examples=examples)
+            device = self.guard(("device",), self.device, data["device"], frame) if "device" in data else None
+            self.ctx.text = replace(frame, examples=examples, device=device)
             self.ctx.framing = Framing(
                 description=frame.description, layouts={}, checksum=None, shared_header=False, alternatives={}
             )
@@ -222,6 +229,66 @@ class TextPass(Pass):
             letters=letters,
             letters_class=letters_class,
         )
+
+    def device(self, raw: dict[str, Any], frame: TextFrame) -> TextDevice:
+        """`device:` the state, the values every sentence carries and the sentences sent on their own."""
+        path: Path = ("device",)
+        for key in raw:
+            if key not in DEVICE_KEYS:
+                self.error((*path, key), f"`{key}` is not available in a text protocol's device yet")
+        state = {str(k): float(v) for k, v in (raw.get("state") or {}).items()}
+        messages = {m.key: m for m in frame.messages}
+        names = {f.name for m in frame.messages for f in m.fields} | ({"talker"} if frame.talker else set())
+        reply: dict[str, str | float] = {}
+        for name, value in (raw.get("reply") or {}).items():
+            if name not in names:
+                self.error((*path, "reply", name), f"no sentence has a field {name!r}")
+            reply[str(name)] = value if isinstance(value, str) else float(value)
+        if frame.talkers and reply.get("talker", frame.talkers[0]) not in frame.talkers:
+            self.error(
+                (*path, "reply", "talker"), f"talker {reply['talker']!r} is not one of {', '.join(frame.talkers)}"
+            )
+        sends = []
+        for key, item in (raw.get("sends") or {}).items():
+            where = (*path, "sends", key)
+            message = messages.get(key)
+            if message is None:
+                self.error(where, f"unknown command {key!r}")
+                continue
+            for bad in item:
+                if bad not in SEND_KEYS:
+                    self.error((*where, bad), f"`{bad}` is not available in a text protocol's device yet")
+            if "every" not in item:
+                self.error(where, "says not when: give `every`")
+            for named in ("step", "while"):
+                if named in item and str(item[named]) not in state:
+                    self.error((*where, named), f"unknown state variable {item[named]!r}")
+            fields = {f.name for f in message.fields if isinstance(f, TextField)}
+            values = {}
+            for name, source in (item.get("values") or {}).items():
+                at = (*where, "values", name)
+                if name not in fields:
+                    self.error(at, f"{key} has no field {name!r}")
+                    continue
+                try:
+                    parsed = expression.parse(str(source))
+                except expression.ExpressionError as exc:
+                    self.error(at, str(exc))
+                    continue
+                for used in sorted(set(expression.names(parsed)) - set(state)):
+                    self.error(at, f"unknown name {used!r} (not a state variable)")
+                values[str(name)] = parsed
+            sends.append(
+                Unsolicited(
+                    str(key),
+                    int(item.get("every", 0)),
+                    while_=str(item.get("while", "")),
+                    values=values,
+                    description=str(item.get("description", "")),
+                    step=str(item.get("step", "")),
+                )
+            )
+        return TextDevice(str(raw.get("description", "")), state, reply, tuple(sends))
 
     def examples(self, frame: TextFrame) -> list[TextExample]:
         found = []

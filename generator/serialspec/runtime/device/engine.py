@@ -138,6 +138,7 @@ class SendSpec:
     # field -> the state variable or memory entry it holds, or a function of `get` (as CommandSpec.reports)
     values: dict[str, str | Callable[[Callable[[str], float]], float]] = field(default_factory=dict)
     blanks: dict[str, Any] = field(default_factory=dict)  # as CommandSpec.blanks
+    step: str = ""  # state variable: 1 is added to it before each send
 
     @property
     def command(self) -> CommandSpec:
@@ -475,6 +476,8 @@ class Engine(FaultInjection):
         try:
             if send.while_ and not device.get(send.while_):
                 return None
+            if send.step:
+                device.set(send.step, device.get(send.step) + 1)
             return self._reply(device, send.command, {}, "")
         except (ZeroDivisionError, ValueError) as exc:
             LOG.warning(

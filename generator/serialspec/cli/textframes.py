@@ -1,0 +1,110 @@
+"""decode and encode for text protocols (`framing: {kind: text}`): a sentence as typed or as hex, to the JSON shape
+binary frames have (command, direction, fields), each field as the text the device sent; and back."""
+
+from __future__ import annotations
+
+import sys
+from types import ModuleType
+from typing import Any
+
+from serialspec.lang.model import Protocol
+from serialspec.runtime.errors import DecodeError, EncodeError, SerialspecError
+from serialspec.runtime.hexbytes import parse_hex
+from serialspec.runtime.text import TextFraming, from_texts, texts
+
+
+def frame_of(framing: TextFraming, given: str) -> bytes:
+    """A frame given on the command line: as typed (starting with the start character; the line ending may be
+    left out, or written as \\r\\n) or as hex."""
+    text = given.strip()
+    if text.startswith(framing.start):
+        text = text.replace("\\r", "\r").replace("\\n", "\n")
+        try:
+            return text.encode("ascii")
+        except UnicodeEncodeError:
+            raise DecodeError(f"{text[:20]!r}... holds a character that is not ASCII") from None
+    try:
+        return parse_hex(text)
+    except ValueError as exc:
+        raise DecodeError(f"neither a sentence starting with {framing.start!r} nor hex: {exc}") from None
+
+
+def describe(protocol: Protocol, package: ModuleType, frame: bytes) -> dict[str, Any]:
+    framing: TextFraming = package.FRAMING
+    sentence = framing.decode(frame)
+    cls = package.CODEC.classes[sentence.code]
+    body = frame.decode("ascii")
+    return {
+        "protocol": protocol.name,
+        "direction": cls.DIRECTION.value,
+        "command": cls.COMMAND,
+        "subcommand": None,
+        "talker": sentence.talker,
+        "fields": texts(framing.by_code[sentence.code], sentence.values),
+        "sent": sentence.sent,
+        "checksum_ok": True,  # a frame whose checksum fails does not decode
+        "text": body[: -len(framing.end)] if body.endswith(framing.end) else body,
+    }
+
+
+def decode(protocol: Protocol, package: ModuleType, frames: list[str], as_json: bool) -> int:
+    failed = 0
+    for given in frames:
+        try:
+            result = describe(protocol, package, frame_of(package.FRAMING, given))
+        except (DecodeError, SerialspecError) as exc:
+            print(f"serialspec decode: {given.strip()}: {exc}", file=sys.stderr)
+            failed += 1
+            continue
+        if as_json:
+            import json
+
+            print(json.dumps(result, ensure_ascii=False), flush=True)
+        else:
+            print(readable(result), flush=True)
+    return 1 if failed else 0
+
+
+def readable(result: dict[str, Any]) -> str:
+    lines = [f"{result['protocol']} {result['direction']} {result['command']}  {result['text']}"]
+    if result["talker"]:
+        lines.append(f"  {'talker':<20} {result['talker']}")
+    for name, value in result["fields"].items():
+        if isinstance(value, list):
+            for index, row in enumerate(value):
+                shown = " ".join(f"{k}={v}" for k, v in row.items())
+                lines.append(f"  {f'{name}[{index}]':<20} {shown}")
+        else:
+            lines.append(f"  {name:<20} {value}")
+    return "\n".join(lines)
+
+
+def encode(package: ModuleType, data: dict[str, Any], direction: str | None, as_hex: bool) -> int:
+    """The JSON object decode --json prints (fields as their texts; talker and sent may be left out) -> the frame,
+    as text (without its line ending) or as hex."""
+    framing: TextFraming = package.FRAMING
+    command = data["command"]
+    cls = next(
+        (c for c in package.MESSAGE_TYPES if command == c.COMMAND and direction in (None, c.DIRECTION.value)),
+        None,
+    )
+    if cls is None:
+        names = ", ".join(sorted(c.COMMAND for c in package.MESSAGE_TYPES if direction in (None, c.DIRECTION.value)))
+        raise EncodeError(f"no {direction or 'message'} of command {command!r} (it has {names or 'none'})")
+    fields = data.get("fields", {})
+    if not isinstance(fields, dict):
+        raise EncodeError("`fields` must be an object")
+    talker = data.get("talker", cls.talker)
+    sent = data.get("sent", -1)
+    if not isinstance(talker, str) or isinstance(sent, bool) or not isinstance(sent, int):
+        raise EncodeError("`talker` must be text and `sent` an integer")
+    try:
+        values = from_texts(framing.by_code[cls.CODE], fields)
+    except DecodeError as exc:
+        raise EncodeError(str(exc)) from None
+    frame = framing.encode(cls.CODE, values, talker, sent)
+    if as_hex:
+        print(frame.hex(" "))
+    else:
+        print(frame.decode("ascii").removesuffix(framing.end))
+    return 0

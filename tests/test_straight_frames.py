@@ -126,7 +126,7 @@ def engine_decode(codec: ModuleType, direction: str, frame: bytes, expect: type[
         if alternative is not None and expected == code:
             decoder = alternative
     if decoder is None:
-        raise DecodeError(f"unknown command {code!r}")
+        raise DecodeError("unknown command None" if code is None else f"unknown command {code:#04x}")
     return decoder(content, 0, len(content), *unwrapped.values)
 
 

@@ -104,3 +104,22 @@ def test_spec(path: Path) -> None:
             else:
                 package.decode(frame, direction)
             package.StreamParser(direction).feed(frame * 2)
+        for note in notes:
+            if note.startswith("structs build "):  # the content struct refuses these values in one line
+                what, _, rest = note.removeprefix("structs build ").partition(": ")
+                direction, _, command = what.partition(" ")
+                values, _, reason = rest.partition("}: ")  # the values: a YAML flow mapping
+                content = importlib.import_module(f"{package_name}.structs").CONTENTS[(command, direction)]
+                with pytest.raises(ConstructError) as refused:
+                    content.build(yaml.safe_load(values + "}"))
+                assert reason in str(refused.value)
+            elif note.startswith("simulate "):  # fed these frames in turn, the simulator answers or not, never raises
+                listed = note.partition(": ")[2]
+                frames = [hex_bytes(frame) for frame in listed.removesuffix(" (answered)").split("|")]
+                simulator = importlib.import_module(f"{package_name}.simulator")
+                cls = next(v for k, v in vars(simulator).items() if k.endswith("Simulator") and k != "Simulator")
+                device = cls([1])
+                answered = [device.feed(frame) for frame in frames]
+                assert answered[:-1] == [[]] * (len(frames) - 1)
+                if listed.endswith(" (answered)"):  # the last one is answered
+                    assert answered[-1]

@@ -79,6 +79,7 @@ class Case:
     response: dict[str, Any]
     framing: dict[str, Any] | None = None
     commands: dict[str, Any] | None = None  # more commands beside `probe`
+    device: dict[str, Any] | None = None  # more of the `device:` section
 
 
 def same(fields: dict[str, Any]) -> Case:
@@ -310,7 +311,7 @@ def spec_text(name: str, case: Case) -> str:
             },
             **copy.deepcopy(case.commands or {}),
         },
-        "device": {"memory": "regs", **({"address": address} if address else {})},
+        "device": {"memory": "regs", **({"address": address} if address else {}), **copy.deepcopy(case.device or {})},
     }
     return yaml.safe_dump(spec, sort_keys=False, allow_unicode=True)
 
@@ -367,6 +368,25 @@ CASES["frame: transparency, checksum over exactly the span"] = Case(
         },
     },
 )
+# The device rules and unsolicited output: the simulator sends `beat` every 5 ms while the client's requests are
+# matched to their replies (client_against_simulator), a derived entry, a lock, a move to an expression.
+CASES["device: derived, locks, sends, moves.to"] = Case(
+    {"v": "u16"},
+    {"v": "u16"},
+    commands={
+        "beat": {"code": 9, "title": "Beat", "response": {"unsolicited": True, "fields": {"where": "u16"}}},
+        "go": {"code": 10, "title": "Go", "request": {"fields": {"target": "u16"}}, "response": {}},
+    },
+    device={
+        "state": {"held": 0},
+        "derived": {"torque": "position + speed"},
+        "locks": [{"entries": ["speed"], "while": "held"}],
+        "errors": {"locked": {"v": 1}},
+        "sends": {"beat": {"every": 5, "values": {"where": "torque"}}, "probe": {"after": ["go"]}},
+        "commands": {"go": {"moves": {"state": "position", "target": "target", "to": "target / 2"}}},
+    },
+)
+DEVICE_KEYS = ("derived", "locks", "sends")  # the device keys a matrix case must use
 PARAMS = [
     pytest.param(name, marks=pytest.mark.xfail(reason=KNOWN[name], strict=True)) if name in KNOWN else name
     for name in sorted(CASES)
@@ -409,6 +429,8 @@ def test_every_documented_alternative_has_a_case() -> None:
                 used["role"].add(element["role"])
                 used["element type"].add(element.get("type", "u8"))
                 used["element endian"].add(element.get("endian", "little"))
+    used_device = {key for case in CASES.values() for key in case.device or {}}
+    assert set(DEVICE_KEYS) <= set(grammar.DEVICE.keys) and set(DEVICE_KEYS) - used_device == set()
     field = grammar._FIELD_LONG
     element = grammar.FRAME_ELEMENT.keys
     assert set(FIELD_KINDS) - used["type"] == set()

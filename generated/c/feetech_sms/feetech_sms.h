@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define FEETECH_SMS_SPEC_SHA256 "1c0c350e3d004b0bba59b1a7be0e8a6a998dc5214de9925408e5b41838cba278"
+#define FEETECH_SMS_SPEC_SHA256 "876b88c64b4f72ce2d09bbf91d6bd76b0979dd6f3e72dbfa0fbf69133aff1f2f"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef FEETECH_SMS_ENABLE_ENCODE

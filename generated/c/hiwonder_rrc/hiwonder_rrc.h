@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define HIWONDER_RRC_SPEC_SHA256 "737e77965bead5105f3e885e2f3fc1ffaefc44704f8531efeda8064dbb19c653"
+#define HIWONDER_RRC_SPEC_SHA256 "80dd5ea6385ebcaac7c9f848a0a7f9fad5ad639e0a44257f922e79038070a335"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef HIWONDER_RRC_ENABLE_ENCODE

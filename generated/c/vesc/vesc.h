@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define VESC_SPEC_SHA256 "a8c1810c0b4a221ea2ce3fd861441698501ec60e3e580f3afc31f780541148ce"
+#define VESC_SPEC_SHA256 "054d37052749674cb9e372a888ccbb787ab454b29361bd4b28537d017b124389"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef VESC_ENABLE_ENCODE

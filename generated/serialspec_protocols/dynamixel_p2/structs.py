@@ -37,7 +37,7 @@ from construct import (  # noqa: F401 - the set of names is the same for every p
     this,
 )
 from serialspec.checksums.crc import crc_function
-from serialspec.runtime.constructs import Framed, PackedBits, SignMagnitude, Utf8, derived  # noqa: F401
+from serialspec.runtime.constructs import Framed, PackedBits, SignMagnitude, Utf8, derived, valued  # noqa: F401
 from serialspec.runtime.framing import Element, FrameCodec, Layout, Transparency
 
 _CHECK_CRC: Callable[[bytes], int] = crc_function(16, 0x8005, 0x0, False, False, 0x0)  # CRC-16/UMTS (CRC-16/BUYPASS)

@@ -36,7 +36,7 @@ from construct import (  # noqa: F401 - the set of names is the same for every p
     this,
 )
 from serialspec.checksums.sum import sum_function
-from serialspec.runtime.constructs import PackedBits, SignMagnitude, Utf8, derived  # noqa: F401
+from serialspec.runtime.constructs import PackedBits, SignMagnitude, Utf8, derived, valued  # noqa: F401
 
 _checksum = sum_function(8, False)
 

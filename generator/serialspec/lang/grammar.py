@@ -181,6 +181,7 @@ class MapOf(Shape):
     value: Shape
     description: str = ""
     int_keys: bool = False
+    example: Any = None  # shown in the reference where no spec uses the key
 
     def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
         if not isinstance(value, dict):
@@ -842,6 +843,12 @@ DEVICE_COMMAND = Obj(
                 ),
                 "accel": Str("The request field with the acceleration time (ms) at the start of the move."),
                 "decel": Str("The request field with the deceleration time (ms) at the end of the move."),
+                "to": Str(
+                    "Where the state goes, as an expression of request fields, memory entries and state variables "
+                    "(default: the target's value): a goal given in terms of a derived entry (DYNAMIXEL: "
+                    "`goal_position - homing_offset`, since the goal is compared with the present position).",
+                    example="goal_position - homing_offset",
+                ),
             },
             required=("state", "target"),
             description="The device moves a state variable to a target, over a duration or at a speed.",
@@ -1097,6 +1104,11 @@ DEVICE = Obj(
                     "Reply values when a command that is `refused_while_moving` arrives during the move (DYNAMIXEL "
                     "CLEAR: error.number: 1, result fail).",
                 ),
+                "locked": MapOf(
+                    Num(),
+                    "Reply values when a write reaches an entry that `locks` locks at the moment (DYNAMIXEL "
+                    "error.number: 7, access error: EEPROM written while the torque is on).",
+                ),
                 "unsupported": MapOf(
                     Num(),
                     "Reply values for a request whose code no command has, recognised when it arrives whole and "
@@ -1112,6 +1124,64 @@ DEVICE = Obj(
                 "their ranges and enums before the device acts. For a reason not listed the request is still not "
                 "carried out, and the reply says nothing of it (with an error reply: no reply)."
             ),
+        ),
+        "derived": MapOf(
+            Str(),
+            "Memory entry -> what it reads as: an expression of state variables and other memory entries (DYNAMIXEL "
+            "present_position: `position + homing_offset`); every read, reply and report sees that value.",
+        ),
+        "locks": ListOf(
+            Obj(
+                {
+                    "memory": Str("The memory whose entries are locked.", choices=("eeprom", "sram")),
+                    "entries": ListOf(
+                        Str(), "Memory entries locked (besides those of `memory`).", example=["id", "baud_rate"]
+                    ),
+                    "while": Str(
+                        "A memory entry (or state variable): the entries are locked while it is non-zero.",
+                        example="torque_enable",
+                    ),
+                    "description": TEXT,
+                },
+                required=("while",),
+                description="Entries a request cannot write while a value is non-zero.",
+            ),
+            "Access rules that depend on state: a write to a locked entry is refused with `errors.locked` and "
+            "changes nothing (DYNAMIXEL: the EEPROM area while torque_enable is 1, access error 7).",
+            example=[{"memory": "eeprom", "while": "torque_enable"}],
+        ),
+        "sends": MapOf(
+            Obj(
+                {
+                    "every": Int("Period in ms: the device sends the message this often.", minimum=1, example=1000),
+                    "after": ListOf(
+                        Str(),
+                        "Commands (or command.subcommand) after whose reply the device also sends it.",
+                        example=["set_rate"],
+                    ),
+                    "changes": ListOf(
+                        Str(),
+                        "State variables or memory entries: the device also sends it when one of them changes.",
+                        example=["mode"],
+                    ),
+                    "while": Str(
+                        "A state variable or memory entry: the device sends it only while it is non-zero (default: "
+                        "always).",
+                        example="streaming",
+                    ),
+                    "values": MapOf(
+                        Str(),
+                        "Field -> an expression of state variables and memory entries it holds (other fields: the "
+                        "device's `reply` values, else 0).",
+                        example={"uptime": "ticks / 1000"},
+                    ),
+                    "description": Str(TEXT.description, example="A heartbeat every second while armed."),
+                },
+                description="When the device sends one message on its own.",
+            ),
+            "Unsolicited output: command (or command.subcommand) -> when the device sends that command's response "
+            "without a request (a heartbeat every second, a fix at the measurement rate, telemetry after a "
+            "command), besides answering requests. Clients offer these messages as an iterator and a subscription.",
         ),
         "kinds": MapOf(
             Obj(

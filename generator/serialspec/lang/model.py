@@ -542,6 +542,7 @@ class Motion:
     enabled_by: str = ""  # a memory entry (or state variable): the move happens only while it is non-zero
     accel: str = ""  # request field: acceleration time (ms) at the start
     decel: str = ""  # request field: deceleration time (ms) at the end
+    to: Expr | None = None  # where the state goes, from request fields, memory and state (default: the target)
 
 
 @frozen
@@ -575,10 +576,11 @@ class DeviceErrors:
     read_only: dict[str, float] = field(default_factory=dict)
     unsupported: dict[str, float] = field(default_factory=dict)
     busy: dict[str, float] = field(default_factory=dict)
+    locked: dict[str, float] = field(default_factory=dict)
 
     def by_reason(self) -> dict[str, dict[str, float]]:
         """The reasons given, by name (the device runtime's reasons)."""
-        reasons = ("out_of_space", "out_of_range", "read_only", "unsupported", "busy")
+        reasons = ("out_of_space", "out_of_range", "read_only", "unsupported", "busy", "locked")
         return {reason: getattr(self, reason) for reason in reasons if getattr(self, reason)}
 
 
@@ -617,6 +619,20 @@ class Behaviour:
     carries: tuple[str, str] | None = None  # (command code field, content field) of a carried request
     carried: tuple[str, ...] = ()  # the commands it can carry (empty: every command with a code)
     nothing_held: dict[str, float] = field(default_factory=dict)  # commits: reply values when nothing is held
+
+
+@frozen
+class Unsolicited:
+    """A message the device sends on its own: a command's response, every `every` ms, after some requests, or when
+    a value changes; only while `while_` (a state variable or memory entry) is non-zero, when it is given."""
+
+    command: str  # command (or command.subcommand) key whose response is sent
+    every: int = 0  # period in ms (0: not periodic)
+    after: tuple[str, ...] = ()  # request keys after whose reply it is sent
+    changes: tuple[str, ...] = ()  # state variables or memory entries: sent when one of them changes
+    while_: str = ""
+    values: dict[str, Expr] = field(default_factory=dict)  # response field -> expression of state and memory
+    description: str = ""
 
 
 @frozen
@@ -709,6 +725,9 @@ class Device:
     moving: dict[str, tuple[str, int | None]] = field(default_factory=dict)  # entry -> (state variable, bit)
     model_entry: str = ""  # the memory entry holding the model number
     presence: Presence | None = None  # how `serialspec scan` finds devices
+    derived: dict[str, Expr] = field(default_factory=dict)  # memory entry -> what it reads as (of others)
+    locks: dict[str, str] = field(default_factory=dict)  # memory entry -> variable: not writable while non-zero
+    sends: tuple[Unsolicited, ...] = ()  # what the device sends on its own
 
     def behaviour(self, key: str) -> Behaviour | None:
         return next((b for b in self.behaviours if b.command == key), None)

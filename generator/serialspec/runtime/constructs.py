@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from construct import Adapter, Check, Container, GreedyBytes
+from construct import Adapter, Check, Container, ExplicitError, GreedyBytes
 
 
 def derived(name: str, compute: Callable[[Any], int]) -> Any:
@@ -20,6 +20,19 @@ def derived(name: str, compute: Callable[[Any], int]) -> Any:
             return False
 
     return Check(holds)
+
+
+def valued(name: str, shown: str, compute: Callable[[Any], int]) -> Callable[[Any], int]:
+    """The value a Rebuild of the field `name` computes by its `value:` expression (`shown`), where an expression
+    with no value for the fields given (a division by 0, a negative shift) refuses to build in one line."""
+
+    def value(context: Any) -> int:
+        try:
+            return compute(context)
+        except (ZeroDivisionError, ValueError):
+            raise ExplicitError(f"{name}: {shown} has no value here (a division by 0 or a negative shift)") from None
+
+    return value
 
 
 class SignMagnitude(Adapter):  # type: ignore[misc]

@@ -444,6 +444,15 @@ class FrameCodec:
 
         return verify
 
+    def first_byte(self, layout: Layout) -> int | None:
+        """The byte every frame of `layout` begins with (the first of a constant its head starts with), or None."""
+        plan: dict[str, Any] = layout._plan  # type: ignore[attr-defined]
+        head: tuple[tuple[Element, int, int], ...] = plan["probe_head"]
+        for element, first, _ in head:
+            if first == 0 and element.kind == "constant" and element.constant:
+                return element.constant[0]
+        return None
+
     def head_pattern(self, layout: Layout) -> bytes | None:
         """A regular expression for where a plausible frame of `layout` can start: each byte of its fixed head that
         the sizer checks (constants, one-byte commands and values) as the class of the bytes it allows, a head the
@@ -591,12 +600,26 @@ class FrameStreamParser(StreamParser):
             for codec, decode in formats
             for sizer, layout in zip(codec.sizers, codec.layouts, strict=True)
         )
+        # by a candidate's first byte, the sizers of the layouts that can start with it (a layout whose head begins
+        # with a constant answers -1 for every other byte: it is not asked)
+        firsts = [codec.first_byte(layout) for codec, _ in formats for layout in codec.layouts]
+        self._sizers_by_first = tuple(
+            tuple(entry for entry, first in zip(self._sizers, firsts, strict=True) if first is None or first == byte)
+            for byte in range(256)
+        )
         self._pending = b""
         headers = [layout.header for codec, _ in formats for layout in codec.layouts]
         self._headers = bool(all(headers))
         self._keep = max((len(h) for h in headers), default=1) - 1
-        # no frame is shorter than its layout's fixed elements
-        self._smallest = max(1, min(layout.overhead for codec, _ in formats for layout in codec.layouts))
+        # no frame is shorter than its layout's fixed elements and the smallest content any command allows
+        self._smallest = max(
+            1,
+            min(
+                layout.overhead + min((low for low, _ in codec.content_sizes.values()), default=0)
+                for codec, _ in formats
+                for layout in codec.layouts
+            ),
+        )
         self._finder = _finder(formats)
         self.errors = 0
         self.garbage = 0
@@ -617,6 +640,7 @@ class FrameStreamParser(StreamParser):
         search = self._finder.search if self._finder is not None else None
         smallest, expected = self._smallest, self.expected
         start = 0
+        ahead = -1  # the candidate the last search found (a match of the pattern does not depend on where it began)
         while True:
             best: tuple[Message, int, int] | None = None
             bound = end + 1  # where the best frame so far ends: a frame must end before it to win
@@ -625,10 +649,12 @@ class FrameStreamParser(StreamParser):
             position = start
             while True:
                 if search is not None:
-                    match = search(buffer, position)
-                    if match is None:
+                    if ahead < position:  # the next candidate from `position` on is not known yet
+                        match = search(buffer, position)
+                        ahead = end + 1 if match is None else match.start()
+                    if ahead > end:
                         break
-                    position = match.start()
+                    position = ahead
                 # no frame from here can end before the best one (or, none found, in the bytes there are, once one
                 # candidate is known to be waiting for more)
                 if position >= end or (position + smallest >= bound and (best is not None or waiting)):
@@ -685,7 +711,7 @@ class FrameStreamParser(StreamParser):
         checksum test), the decoder None while it must wait for bytes (its size is not known yet, or it ends past
         `end`); None when no layout fits."""
         best: tuple[int, Decode | None, Verify | None] | None = None
-        for sizer, decode, verify in self._sizers:
+        for sizer, decode, verify in self._sizers_by_first[buffer[position]]:
             size = sizer(buffer, position, end)
             if size is None:
                 if best is None:

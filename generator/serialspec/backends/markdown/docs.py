@@ -18,6 +18,7 @@ from serialspec.backends.common.numbers import number
 from serialspec.backends.common.text import collapse
 from serialspec.backends.markdown.kinds import anchor, kind, scalar_range
 from serialspec.collection import without_cycle_collection
+from serialspec.lang import expression
 from serialspec.lang.frozen import mutable
 from serialspec.lang.model import (
     Array,
@@ -176,11 +177,37 @@ def message_context(protocol: Protocol, message: Message | None) -> dict[str, An
         "rows": [{k: cell(v) for k, v in vars(r).items()} for r in rows],
         "size": size,
         "optional": text(message.optional),
-        "unsolicited": message.unsolicited,
+        "unsolicited": message.unsolicited or sends_text(protocol, message) != "",
+        "sends": sends_text(protocol, message),
         "answers": message.answers,
         "reply": reply_text(message, protocol) or error_reply_text(protocol, message),
         "description": text(message.description),
     }
+
+
+def device_rule_text(protocol: Protocol, name: str) -> str:
+    """What the device's rules say of one memory entry: what it reads as, and when it cannot be written."""
+    device = protocol.device
+    if device is None or device.memory is None:
+        return ""
+    found = ""
+    if name in device.derived:
+        found += f" Reads as {expression.show(device.derived[name])}."
+    if name in device.locks:
+        found += f" Not writable while {device.locks[name]} is non-zero."
+    return found
+
+
+def sends_text(protocol: Protocol, message: Message) -> str:
+    """When the device sends this response on its own (`device.sends`), or ""."""
+    device = protocol.device
+    send = next((s for s in device.sends if s.command == message.key), None) if device else None
+    if send is None or message.direction != Direction.RESPONSE:
+        return ""
+    when = [f"every {send.every} ms"] if send.every else []
+    when += [f"after the reply to {', '.join(f'`{n}`' for n in send.after)}"] if send.after else []
+    when += [f"when {', '.join(f'`{n}`' for n in send.changes)} changes"] if send.changes else []
+    return " or ".join(when) + (f", while `{send.while_}` is non-zero" if send.while_ else "")
 
 
 def content_limit(layout: FrameLayout) -> int | None:
@@ -590,6 +617,7 @@ def emit_docs(protocol: Protocol) -> str:
                     "meaning": cell(
                         e.description
                         + (f" Values: [{e.enum.class_name}](#enum-{anchor(e.enum.name)})." if e.enum else "")
+                        + device_rule_text(protocol, e.name)
                     ),
                 }
                 for e in t.entries

@@ -13,6 +13,7 @@ from typing import Any, Generic
 from serialspec.backends.common.kinds import F, Registry
 from serialspec.backends.common.numbers import number
 from serialspec.backends.python.ir import Calls
+from serialspec.backends.python.render import one_line
 from serialspec.lang import expression
 from serialspec.lang.model import Array, Bytes, Group, List, Scalar, ScalarType, TableBlock, TableValue, Text
 from serialspec.lang.model import Field as SpecField
@@ -127,7 +128,10 @@ class ScalarKind(Kind[Scalar]):
         if f.const is not None:
             return f"Const({f.const}, {base})"
         if f.value is not None:
-            return f"Rebuild({base}, lambda ctx: {expression.render(f.value, lambda name: f'ctx[{name!r}]')})"
+            compute = f"lambda ctx: {expression.render(f.value, lambda name: f'ctx[{name!r}]')}"
+            if expression.fails(f.value):  # a divisor of 0 or a negative shift: a one-line refusal to build
+                compute = f"valued({f.name!r}, {one_line(expression.show(f.value))!r}, {compute})"
+            return f"Rebuild({base}, {compute})"
         if f.derived:
             derived, target = f.derived[0], f.derived[1]
             if derived == "count":

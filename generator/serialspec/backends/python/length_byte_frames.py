@@ -4,7 +4,9 @@ command code at fixed offsets, a one-byte length before the content and one chec
 frames without a call per element: each message of one size gets a whole-frame decoder made from its content
 decoder's statements (the content size check dropped, the cursor made a constant offset), which checks the
 checksum the cheapest way its algorithm allows (checksums/: frame_test, byte_total, byte_table), and decode()
-looks them up by the frame's first bytes. Frames of any other shape take straight_frames.py.
+looks them up by the frame's first bytes. A frame none of those takes is checked and dispatched by the lines
+straight_frames.decode_lines writes for every framing (the engine's checks, in its order and words); frames of
+any other shape take straight_frames.py altogether.
 """
 
 from __future__ import annotations

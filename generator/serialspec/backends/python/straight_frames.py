@@ -1,5 +1,7 @@
-"""Straight-line code for frames that are not of the length-byte shape (length_byte_frames.py): stuffing, u16
-lengths over a span, CRC-16s, frames without a header or a length, alternative layouts told apart by their header.
+"""Straight-line frame code: stuffing, u16 lengths over a span, CRC-16s, frames without a header or a length,
+alternative layouts told apart by their header. decode_lines writes every framing's frame checks and dispatch (the
+length-byte codecs' decode() runs them past its whole-frame lookups, length_byte_frames.py); the rest serves the
+frames that are not of the length-byte shape.
 
 Each direction gets two functions: `_decode_<direction>(frame, expect)` checks a whole frame and calls the content
 decoder on the frame's own bytes, and `_wrap_<direction>(content, code, *values)` puts the frame around a content.
@@ -15,8 +17,8 @@ form (a length after the content, a checksum over bytes inside the stuffed span,
 engine instead, so every layout the language describes works and the straight-line form is only ever a faster way to
 the same result (tests/test_straight_frames.py holds them to it).
 
-Positions are expressions over `buf`, the frame with its stuffed span replaced by the plain bytes (the frame itself
-when nothing is stuffed): an element before the content at a literal offset, an element after it at `end + k`,
+Positions are expressions over `buf`, the frame with its stuffed span replaced by the plain bytes (`frame` itself
+where nothing can be stuffed): an element before the content at a literal offset, an element after it at `end + k`,
 where `end` is the content's end. Lengths and checksums that see wire bytes read `frame`.
 """
 

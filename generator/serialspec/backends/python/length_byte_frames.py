@@ -16,6 +16,7 @@ from collections.abc import Callable
 from dataclasses import replace
 from typing import Any
 
+from serialspec.backends.common.frames import runtime_layout
 from serialspec.backends.python.content import (
     Lines,
     PackageCode,
@@ -47,7 +48,13 @@ from serialspec.backends.python.ir import (
     walk,
 )
 from serialspec.backends.python.optimize import content_unpacked, fuse_unpack
-from serialspec.backends.python.straight_frames import Target, checksum_name, decode_lines, straight_direction
+from serialspec.backends.python.straight_frames import (
+    Target,
+    checksum_name,
+    decode_lines,
+    frame_sum_test,
+    straight_direction,
+)
 from serialspec.lang.model import Bytes, Checksum, Command, Direction, FrameLayout, Message, Protocol
 
 
@@ -664,14 +671,9 @@ def stream_sum(protocol: Protocol, layout: FrameLayout) -> str | None:
 
 def whole_frame_test(protocol: Protocol, layout: FrameLayout) -> str | None:
     """decode()'s test that a whole frame `data` (its size known) holds its checksum, where it is one expression
-    over the frame's bytes: an 8-bit sum over all but a constant header and the check. None for others."""
-    checksum = protocol.framing.checksum
-    header = layout.header[: layout.covered_from]
-    if checksum is None or len(header) != layout.covered_from:
-        return None
-    if not layout.checksum_offset_from_end == 1 == layout.covered_to_end:
-        return None
-    test = checksum.algorithm.frame_test("sum(data)", sum(header), "data[-1]")
+    over the frame's bytes (straight_frames.frame_sum_test, as every framing's checks make it). None for others."""
+    engine = runtime_layout(layout)
+    test = frame_sum_test(engine, len(engine.elements) - 1, protocol.framing.checksum, "data")
     return None if test is None else f"not {test}"
 
 

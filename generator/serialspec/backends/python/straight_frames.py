@@ -289,7 +289,7 @@ def decode_lines(
         ]
         residue = _residue(element)
         a, b = element.span
-        test = _frame_test(layout, index, (algorithms or {}).get(index))
+        test = frame_sum_test(layout, index, (algorithms or {}).get(index))
         if test is not None:  # the sum of the whole frame, no slice made; the rest only says what is wrong
             body += [f"if {test}:", *(f"    {line}" for line in [*failed[:2], failed[3].strip()])]
         elif residue is not None and b == index - 1 and a <= positions.first:
@@ -306,17 +306,17 @@ def decode_lines(
     return lines + [f"    {line}" for line in body], ["n = len(frame)", *body]
 
 
-def _frame_test(layout: Layout, index: int, checksum: Checksum | None) -> str | None:
+def frame_sum_test(layout: Layout, index: int, checksum: Checksum | None, frame: str = "frame") -> str | None:
     """A test, true for a bad frame, of a one-byte checksum (element `index`) as one expression over the sum of the
-    whole unstuffed frame, where its algorithm has one (checksums/: frame_test) and it is the frame's last byte
-    and covers all before it but constants (checked before it). None for others."""
+    whole unstuffed frame `frame`, where its algorithm has one (checksums/: frame_test) and it is the frame's last
+    byte and covers all before it but constants (checked before it). None for others."""
     elements = layout.elements
     a, b = elements[index].span
     if checksum is None or layout.transparency is not None or elements[index].size != 1:
         return None
     if index != len(elements) - 1 or b != index - 1 or any(e.kind != "constant" for e in elements[:a]):
         return None
-    return checksum.algorithm.frame_test("sum(frame)", sum(sum(e.constant) for e in elements[:a]), "frame[-1]")
+    return checksum.algorithm.frame_test(f"sum({frame})", sum(sum(e.constant) for e in elements[:a]), f"{frame}[-1]")
 
 
 def _residue(element: Element) -> int | None:

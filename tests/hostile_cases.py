@@ -241,7 +241,12 @@ CASES: list[tuple[str, str, Mutation | Text, str | None]] = [
         put("commands/move/code", -8),
         "commands.move.code: code -8 does not fit the u8 command element (0..255)",
     ),
-    ("code as text", "tiny", put("commands/move/code", "one"), "commands.move.code: expected an integer, got text"),
+    (
+        "code as text",
+        "tiny",
+        put("commands/move/code", "one"),
+        "commands.move.code: expected an integer, got text (text codes belong to `framing: {kind: text}`)",
+    ),
     ("code true", "tiny", put("commands/move/code", True), "commands.move.code: expected an integer, got true/false"),
     ("code float", "tiny", put("commands/move/code", 1.5), "commands.move.code: expected an integer, got a number"),
     (

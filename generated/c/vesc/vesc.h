@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define VESC_SPEC_SHA256 "054d37052749674cb9e372a888ccbb787ab454b29361bd4b28537d017b124389"
+#define VESC_SPEC_SHA256 "e8dd63e555c04775fbdf9192f5a182e0e3ea0a4f1c35ba020a33452dc0e878f9"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef VESC_ENABLE_ENCODE

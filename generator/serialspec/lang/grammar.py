@@ -268,6 +268,15 @@ class OneOf(Shape):
         return {"anyOf": options, "description": self.description}
 
 
+@mutable
+class IntOrText(OneOf):
+    """An integer, or text where the spec's framing is text (a command's code): the checks of the passes say which."""
+
+    def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
+        if not isinstance(value, str):
+            yield from Int().check(value, path)
+
+
 def _described(shape: Shape, parent: str) -> dict[str, Any]:
     return _fill(shape.json_schema(), parent)
 
@@ -341,7 +350,9 @@ def bit_fields(description: str) -> MapOf:
 _FIELD_LONG: dict[str, Shape] = {
     "type": Str(
         "Wire type: u8, i8, u16, i16, u32, i32, f32, bytes, string, cstring (NUL-terminated text), array, group, "
-        "table_value, table_block."
+        "table_value, table_block. In text frames: decimal, integer, angle (ddmm.mmmm degrees and minutes), char, "
+        "text, time (hhmmss.ss), date (ddmmyy), repeat (a group of `fields` repeated `count` times, or up to "
+        "`max_count` times at the end); an empty field is None."
     ),
     "use": Str("Name of an entry in `fields:` (top level) to copy; keys given here override it."),
     "description": TEXT,
@@ -387,6 +398,22 @@ _FIELD_LONG: dict[str, Shape] = {
     "select": MapOf(Any_(), "table_block: entry attributes an entry must have to be in the block, e.g. {access: rw}."),
     "expect_size": Int("table_block: the block's size in bytes, asserted by the generator."),
     "inferred": TEXT,
+    "precision": Int(
+        "text decimal, angle, time: fraction digits written for a value that does not carry its own (a float; a "
+        "decoded value keeps the digits it was sent with).",
+        minimum=0,
+        example=4,
+    ),
+    "width": Int(
+        "text integer, decimal: digits before the point, zero-padded; angle: digits of the degrees (2 for a "
+        "latitude, 3 for a longitude).",
+        minimum=1,
+        example=3,
+    ),
+    "letters": MapOf(
+        Str(), "text char: label -> the letter that stands for it; decoded letters become members of a generated Enum."
+    ),
+    "max_count": Int("text repeat at the end of a message: at most this many groups.", minimum=1, example=4),
     "status": Obj(
         {"ok": Int("The value that means success; any other value is a device error.")},
         required=("ok",),
@@ -466,9 +493,10 @@ SUBCOMMAND = Obj(
 
 COMMAND = Obj(
     {
-        "code": Int(
-            "Value of the frame's command field; omit for the one response of a protocol whose replies "
-            "carry no command field."
+        "code": IntOrText(
+            (Int(), Str()),
+            "Value of the frame's command field; omit for the one response of a protocol whose replies carry no "
+            "command field. In text frames: the text code after the talker (NMEA's sentence id, GGA).",
         ),
         "title": TITLE,
         "title_cn": TITLE_CN,
@@ -711,8 +739,66 @@ FRAMING = Obj(
         "transparency": TRANSPARENCY,
         "gap": Num("Silence between frames, in character times (Modbus RTU: 3.5).", example=3.5),
         "description": TEXT,
+        "kind": Str(
+            "binary: frames of bytes described by `elements` or `layouts`; text: line-oriented text frames "
+            "(`start`, `separator`, `checksum`, `end`, `talker`), each message chosen by its command's text `code`.",
+            choices=("binary", "text"),
+            default="binary",
+            example="text",
+        ),
+        "start": Str("text: the character that starts every frame.", example="$"),
+        "separator": Str("text: the character between fields.", example=","),
+        "end": Str("text: the line ending that closes every frame.", example="\r\n"),
+        "checksum": Obj(
+            {
+                "algorithm": Str(
+                    "What it computes over the characters: `xor`, the XOR of their bytes (NMEA 0183); `sum`, their "
+                    "sum modulo 256 (as a checksum element's).",
+                    choices=("sum", "xor"),
+                ),
+                "invert": Bool("sum: bitwise NOT of the sum.", default=False, example=True),
+                "marker": Str("The character before the checksum's hex digits.", default="*"),
+                "format": Str(
+                    "How the checksum is written: hex2, two upper-case hex digits (an 8-bit checksum).",
+                    choices=("hex2",),
+                    default="hex2",
+                ),
+                "required": Bool(
+                    "Frames without a checksum are refused (false: accepted unchecked, as NMEA 0183 allows for "
+                    "some sentences).",
+                    default=True,
+                    example=False,
+                ),
+            },
+            required=("algorithm",),
+            description=(
+                "text: the checksum over the characters between `start` and `marker`, written after `marker` as "
+                "hex digits, before the line ending."
+            ),
+        ),
+        "talker": Obj(
+            {
+                "size": Int("Characters of the talker at the start of the address field.", minimum=1),
+                "values": ListOf(Str(), "The talkers encode accepts (every one when left out).", example=["GP"]),
+                "description": TEXT,
+            },
+            required=("size",),
+            description=(
+                "text: a frame-level value at the start of the first field, before the text code (NMEA's talker "
+                "id: GP in $GPGGA); every message carries it as `talker`."
+            ),
+        ),
+        "max_length": Int(
+            "text: the longest frame in characters, start to checksum (NMEA 0183: 82 with the line ending): the "
+            "stream parser drops a line that grows longer.",
+            minimum=1,
+            example=82,
+        ),
     },
-    description="The frame every command travels in: `elements` (one layout) or `layouts` (alternatives).",
+    description=(
+        "The frame every command travels in: `elements` (one layout) or `layouts` (alternatives), or with "
+        "`kind: text` a line of text fields."
+    ),
 )
 
 EXAMPLE = Obj(
@@ -1209,7 +1295,9 @@ SPEC = Obj(
         "description": TEXT,
         "sources": MapOf(Str(), "Document id -> what it is."),
         "byte_order": Str(
-            "Byte order of every multi-byte value, unless a field's `endian` says otherwise.", choices=("little", "big")
+            "Byte order of every multi-byte value, unless a field's `endian` says otherwise (required in binary "
+            "framing).",
+            choices=("little", "big"),
         ),
         "serial": Obj(
             {
@@ -1245,7 +1333,7 @@ SPEC = Obj(
         "errata": MapOf(ERRATUM, "Mistakes in the documents, each pinned by a test."),
         "device": DEVICE,
     },
-    required=("protocol", "title", "byte_order", "serial", "framing", "commands"),
+    required=("protocol", "title", "serial", "framing", "commands"),
     description="A serialspec protocol spec.",
 )
 

@@ -733,6 +733,95 @@ class Device:
         return next((b for b in self.behaviours if b.command == key), None)
 
 
+# --- text frames (framing kind: text) ----------------------------------------------------------------------------
+
+
+@frozen
+class TextField:
+    """One field of a text frame (runtime/text.py's TextField, as declared)."""
+
+    name: str
+    kind: Literal["decimal", "integer", "angle", "char", "text", "time", "date"]
+    description: str = ""
+    unit: str = ""
+    precision: int = 0
+    width: int = 0
+    minimum: float | None = None
+    maximum: float | None = None
+    letters: tuple[tuple[str, str], ...] = ()  # char: (label, letter)
+    letters_class: str = ""  # char with letters: the generated Enum's name
+
+
+@frozen
+class TextRepeat:
+    """A group of text fields repeated `count` times, or up to `max_count` times at the end of a message."""
+
+    name: str
+    fields: tuple[TextField, ...]
+    description: str = ""
+    count: int = 0
+    max_count: int = 0
+
+
+@frozen
+class TextMessage:
+    """One direction of a command in a text protocol: chosen by its text code."""
+
+    key: str  # the command's name
+    code: str
+    title: str
+    description: str
+    direction: Direction
+    class_name: str
+    fields: tuple[TextField | TextRepeat, ...]
+    unsolicited: bool = False
+    source: str = ""
+
+
+@frozen
+class TextExample:
+    """A frame as a document prints it (text) and the text of each field it carries."""
+
+    name: str
+    source: str
+    description: str
+    direction: Direction
+    printed: str
+    command: str
+    fields: dict[str, object]
+    position: tuple[int, int] = (1, 1)  # line and column in the spec, for errors found after resolution
+
+
+@frozen
+class TextFrame:
+    """Line-oriented text frames: start + talker + code + separated fields + [marker + checksum as hex] + end."""
+
+    description: str
+    start: str
+    separator: str
+    end: str
+    checksum: Algorithm | None
+    marker: str
+    required: bool
+    talker: int  # characters of the talker at the start of the address field (0: none)
+    talkers: tuple[str, ...]
+    talker_description: str
+    max_length: int
+    messages: tuple[TextMessage, ...]
+    examples: tuple[TextExample, ...] = ()
+    digits: int = 2
+
+    def letter_sets(self) -> dict[str, tuple[tuple[str, str], ...]]:
+        """Each generated letter Enum's name -> its (label, letter) pairs, in order of first use."""
+        found: dict[str, tuple[tuple[str, str], ...]] = {}
+        for message in self.messages:
+            for item in message.fields:
+                for f in item.fields if isinstance(item, TextRepeat) else (item,):
+                    if f.letters_class:
+                        found.setdefault(f.letters_class, f.letters)
+        return found
+
+
 @frozen
 class Protocol:
     name: str
@@ -755,6 +844,7 @@ class Protocol:
     client_class: str = ""  # the generated client's and simulator's class names
     simulator_class: str = ""
     error_reply: ErrorReply | None = None
+    text: TextFrame | None = None  # framing kind text: its frames and messages (commands is then empty)
 
     def messages(self) -> tuple[Message, ...]:
         return tuple(m for c in self.commands for m in c.messages())

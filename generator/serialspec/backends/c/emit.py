@@ -14,8 +14,9 @@ from dataclasses import dataclass, field
 from typing import assert_never
 
 from serialspec.backends import Unsupported
-from serialspec.backends.c.checksums import CChecksum, c_checksum
+from serialspec.backends.c.checksums import c_checksum
 from serialspec.backends.common.text import collapse
+from serialspec.checksums.base import CCode
 from serialspec.lang import expression
 from serialspec.lang.expression import Expr
 from serialspec.lang.model import (
@@ -141,7 +142,7 @@ class Ctx:
     protocol: Protocol
     p: str
     P: str
-    checks: list[tuple[Checksum, CChecksum]] = field(default_factory=list)
+    checks: list[tuple[Checksum, CCode]] = field(default_factory=list)
     caps: list[str] = field(default_factory=list)  # #ifndef capacity defaults for the header
     structs: list[str] = field(default_factory=list)
     helpers: set[str] = field(default_factory=set)
@@ -162,6 +163,8 @@ class Ctx:
 
 def refuse_unsupported(protocol: Protocol) -> None:
     """Raise Unsupported naming the first feature of the spec the C target cannot generate yet."""
+    if protocol.text is not None:
+        raise Unsupported("text framing (`framing: {kind: text}`)")
     for command in protocol.commands:
         if command.selector is not None and command.selector.type.size != 1:
             raise Unsupported(f"sub-command selectors of more than one byte (command {command.name})")
@@ -662,7 +665,7 @@ def scalar_bits(ctx: Ctx, t: ScalarType, expr: str) -> str:
         return f"{ctx.p}__f32bits({expr})"
     if t.signed:
         mask = (1 << (8 * t.size)) - 1
-        return f"((uint32_t)(int32_t)({expr}) & 0x{mask:x}UL)"
+        return f"((uint32_t)(int32_t)({expr}) & 0x{mask:x}u)"
     return f"(uint32_t)({expr})"
 
 

@@ -579,6 +579,10 @@ def _show(value: Any) -> str:
 
 @without_cycle_collection
 def emit_docs(protocol: Protocol) -> str:
+    if protocol.text is not None:  # a text protocol's page (it takes this module's text helpers)
+        from serialspec.backends.markdown.text import text_docs
+
+        return text_docs(protocol, protocol.text)
     commands = [command_context(protocol, c) for c in protocol.commands]
     examples = [
         {

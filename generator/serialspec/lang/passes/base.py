@@ -29,6 +29,7 @@ from serialspec.lang.model import (
     ScalarType,
     Serial,
     Table,
+    TextFrame,
 )
 
 NAME = re.compile(r"^[a-z][a-z0-9_]*$")
@@ -180,6 +181,7 @@ class Context:
     examples: tuple[Example, ...] = ()
     device: Device | None = None
     error_reply: ErrorReply | None = None
+    text: TextFrame | None = None  # framing kind text
 
     @property
     def data(self) -> Any:

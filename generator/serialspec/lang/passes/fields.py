@@ -36,6 +36,10 @@ FIELD_KINDS = (
 )
 
 
+# Keys of text fields (framing kind text) that a binary field must not have
+TEXT_ONLY_FIELD_KEYS = ("precision", "width", "letters", "max_count")
+
+
 class FieldResolver(Pass):
     """Resolves a message's fields; the commands pass uses it for every message."""
 
@@ -162,6 +166,11 @@ class FieldResolver(Pass):
     def field(self, name: str, item: Any, path: Path, siblings: list[Field], parent: list[Field] | None) -> Field:
         spec = self.expand(item, path)
         kind = spec["type"]
+        for text_key in TEXT_ONLY_FIELD_KEYS:
+            if text_key in spec:
+                self.error(
+                    (*path, text_key), f"`{text_key}` belongs to fields of text frames (`framing: {{kind: text}}`)"
+                )
         common = dict(
             name=name,
             description=str(spec.get("description", "")),

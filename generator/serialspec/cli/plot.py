@@ -212,7 +212,7 @@ def field_values(protocol: Protocol, message: Message, request: Message | None) 
         if isinstance(value, bool) or not isinstance(value, int | float):
             continue
         if isinstance(f, Scalar) and not (f.enum or f.flags or f.bits):
-            found[f.name] = _scaled(value, f.scale), engineering_unit(f.unit, f.scale)
+            found[f.name] = _scaled(value, f.scale) + (f.offset or 0), engineering_unit(f.unit, f.scale)
         elif isinstance(f, TableValue):
             entry = f.table.entry(fields.get(f.key, -1))
             if entry is not None and entry.enum is None and entry.flags is None:

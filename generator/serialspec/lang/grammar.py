@@ -19,6 +19,9 @@ from serialspec.lang.limits import MAX_TEXT
 from serialspec.lang.loader import CONTROL, Path
 
 SCALAR_TYPES = ("u8", "i8", "u16", "i16", "u32", "i32", "f32")
+# what a field (not a frame element, enum, flag set or table entry) can be besides those
+FIELD_SCALAR_TYPES = ("u8", "i8", "u16", "i16", "u24", "i24", "u32", "i32", "u64", "i64", "f32", "f64")
+BIT_ORDERS = ("lsb_first", "msb_first")
 
 
 class Shape:
@@ -349,16 +352,21 @@ def bit_fields(description: str) -> MapOf:
 
 _FIELD_LONG: dict[str, Shape] = {
     "type": Str(
-        "Wire type: u8, i8, u16, i16, u32, i32, f32, bytes, string, cstring (NUL-terminated text), array, group, "
-        "table_value, table_block. In text frames: decimal, integer, angle (ddmm.mmmm degrees and minutes), char, "
-        "text, time (hhmmss.ss), date (ddmmyy), repeat (a group of `fields` repeated `count` times, or up to "
-        "`max_count` times at the end); an empty field is None."
+        "Wire type: u8, i8, u16, i16, u24, i24, u32, i32, u64, i64, f32, f64, bytes, string, cstring "
+        "(NUL-terminated text), array, group, table_value, table_block. In text frames: decimal, integer, angle "
+        "(ddmm.mmmm degrees and minutes), char, text, time (hhmmss.ss), date (ddmmyy), repeat (a group of `fields` "
+        "repeated `count` times, or up to `max_count` times at the end); an empty field is None."
     ),
     "use": Str("Name of an entry in `fields:` (top level) to copy; keys given here override it."),
     "description": TEXT,
     "description_cn": Str("Description as printed in the (Chinese) document."),
     "unit": Str("Unit of one wire step, e.g. mV, ms, 0.1°."),
     "scale": Num("Engineering value = wire value × scale (e.g. 0.1 for 0.1° steps)."),
+    "offset": Num(
+        "Added after `scale`: engineering value = wire value × scale + offset (CRSF GPS altitude: wire metres "
+        "+ 1000, so offset -1000). `range` stays in wire units.",
+        example=-1000,
+    ),
     "range": RANGE,
     "const": Int("The field always has this value (sub-command selectors, fixed addresses).", example=1),
     "default": Num("Value used when a message is built without this field."),
@@ -378,7 +386,25 @@ _FIELD_LONG: dict[str, Shape] = {
         "holding the array's size in bytes (Modbus byte_count)",
     ),
     "count": OneOf((Int(), Str()), "array/group: a number, `rest`, or the name of an earlier count field"),
-    "of": Str("array: the item type (a scalar type, or `bit`: bools packed 8 to a byte, lowest bit first)."),
+    "of": Str(
+        "array: the item type: a scalar type; `bit` (bools packed 8 to a byte, lowest bit first); or `uN`/`iN` for "
+        "integers of N bits (1..64) packed with no gaps, e.g. u11 (CRSF/SBUS RC channels: 16 × 11 bits), with a "
+        "fixed `count`; see `bit_order`.",
+        example="u11",
+    ),
+    "bit_order": Str(
+        "array of uN/iN items: `lsb_first`, the first item in the lowest bits of the first byte, each item's lowest "
+        "bit first (CRSF, SBUS); `msb_first`, the first item in the highest bits, highest bit first. Default: "
+        "lsb_first in a little-endian field, msb_first in a big-endian one (so `of: u24` is 3-byte integers).",
+        choices=BIT_ORDERS,
+        example="lsb_first",
+    ),
+    "pad": Str(
+        "string of a fixed size: the byte (hex) that fills it after shorter text, e.g. '00' (NUL-padded); decoding "
+        "drops the trailing pad bytes, encoding refuses text longer than the size. Without it the text must fill "
+        "the size.",
+        example="00",
+    ),
     "count_from": Str(
         "array of a response: the request field (request.<field>) saying how many items are meant, when the array "
         "holds more (Modbus coils padded to a multiple of 8): clients keep that many."
@@ -430,7 +456,13 @@ FIELD = OneOf(
     ),
     "A field: a wire type or the name of a shared field (short form), or a mapping (long form).",
 )
-FIELDS: Shape = MapOf(FIELD, "Fields in wire order: name -> type or mapping.")
+FIELDS: Shape = MapOf(
+    FIELD,
+    "Fields in wire order: name -> type or mapping. A name is any lower-case identifier the protocol uses (`type`, "
+    "`id`, `data`) except Python keywords and the few names generated code uses itself (`self`, `request`, `reply`, "
+    "`to_fields`, builtins a client method calls such as `len`): those are refused, one line naming them; rename "
+    "the field (`class_`).",
+)
 
 OPTIONAL_WHEN = Obj(
     {
@@ -694,7 +726,10 @@ FRAME_ELEMENT = Obj(
         ),
         "covers": span(
             "checksum: the span of elements covered. Outside a transparency span it sees the wire bytes, inside "
-            "it the bytes before stuffing.",
+            "it the bytes before stuffing. Checksums strictly inside the span (itself too) are left out of it "
+            "(HerkuleX: `checksum1` in the header covers [size, data]); one at an end is covered, so a checksum "
+            "can be computed from another that comes before it (HerkuleX `checksum2: {algorithm: xor, invert: "
+            "true, mask: 0xFE, covers: [checksum1, checksum1]}`).",
         ),
         **checksum_keys(),
     },
@@ -1016,6 +1051,14 @@ DEVICE_COMMAND = Obj(
         ),
         "kind": Str("The entry of `kinds:` whose devices the command addresses (default: the devices of --id)."),
         "stores": MapOf(Str(), "Request field -> the state variable it is stored in (where names differ)."),
+        "echoes": ListOf(
+            Str(),
+            "Response fields that repeat the request's field of the same name (a write's reply confirming what was "
+            "written: Modbus WRITE SINGLE REGISTER). Other response fields never copy the request: they come from "
+            "the device (its reads, reports, `reply`, memory and state) or else the field's `default` (else 0); "
+            "the fields replies are matched by (`matching.by`), the address and a table value's key echo anyway.",
+            example=["address", "value"],
+        ),
         "sets": MapOf(Num(), "State variable -> the value the command sets it to."),
         "absent": MapOf(
             Num(),

@@ -34,9 +34,16 @@ SCALARS: dict[str, ScalarType] = {
     "i8": ScalarType("i8", 1, "b", True, False, -0x80, 0x7F),
     "u16": ScalarType("u16", 2, "H", False, False, 0, 0xFFFF),
     "i16": ScalarType("i16", 2, "h", True, False, -0x8000, 0x7FFF),
+    # 3-byte integers (fields only, as the 64-bit types: not frame elements, enums, flags or tables) are read as 3
+    # bytes ("3s") and converted, since struct has no format for them
+    "u24": ScalarType("u24", 3, "3s", False, False, 0, 0xFFFFFF),
+    "i24": ScalarType("i24", 3, "3s", True, False, -0x800000, 0x7FFFFF),
     "u32": ScalarType("u32", 4, "I", False, False, 0, 0xFFFFFFFF),
     "i32": ScalarType("i32", 4, "i", True, False, -0x80000000, 0x7FFFFFFF),
+    "u64": ScalarType("u64", 8, "Q", False, False, 0, 0xFFFFFFFFFFFFFFFF),
+    "i64": ScalarType("i64", 8, "q", True, False, -0x8000000000000000, 0x7FFFFFFFFFFFFFFF),
     "f32": ScalarType("f32", 4, "f", True, True, -3.4028234663852886e38, 3.4028234663852886e38),
+    "f64": ScalarType("f64", 8, "d", True, True, -1.7976931348623157e308, 1.7976931348623157e308),
 }
 
 
@@ -117,6 +124,12 @@ class Scalar(Common):
     status_ok: int | None = None
     # Derived by an expression over the other fields (`byte_count = 2 * count`): computed on encode, checked on decode.
     value: Expr | None = None
+    offset: float | None = None  # engineering value = wire value × scale + offset
+
+    @property
+    def odd_width(self) -> bool:
+        """A 3-byte integer: read as 3 bytes and converted, since struct has no format for it."""
+        return self.type.size == 3
 
     @property
     def hidden(self) -> bool:
@@ -161,10 +174,36 @@ class List(Common):
 
 
 @frozen
+class Packed(Common):
+    """A fixed number of integers of `bits` bits each, packed with no gaps (CRSF RC channels: 16 × 11 bits).
+
+    `lsb_first`: the first item starts at the lowest bit of the first byte, each item's lowest bit first (CRSF,
+    SBUS; a little-endian u24 array is the same); else the first item starts at the highest bit, its highest bit
+    first (a big-endian u24 array is the same). The last byte is padded with zero bits.
+    """
+
+    bits: int
+    signed: bool
+    count: int
+    lsb_first: bool
+    unit: str
+    minimum: float
+    maximum: float
+
+    @property
+    def byte_size(self) -> int:
+        return -(-self.bits * self.count // 8)
+
+
+@frozen
 class Text(Common):
-    """Text: NUL-terminated (`size` None; the NUL is not part of the value), or sized like bytes."""
+    """Text: NUL-terminated (`size` None; the NUL is not part of the value), or sized like bytes.
+
+    `pad`: a fixed-size text shorter than its size is sent followed by this byte (NUL-padded names), and read
+    without the trailing pad bytes; None: the text must fill its size exactly."""
 
     size: int | str | None  # a number, "rest", a field name, or None for NUL-terminated
+    pad: int | None = None
 
     @property
     def terminated(self) -> bool:
@@ -203,7 +242,7 @@ class TableBlock(Common):
     struct_name: str = ""  # the construct struct of the block
 
 
-Field = Scalar | Array | List | Text | Bytes | Group | TableValue | TableBlock
+Field = Scalar | Array | Packed | List | Text | Bytes | Group | TableValue | TableBlock
 
 
 @frozen
@@ -363,6 +402,7 @@ class Checksum:
     type: ScalarType
     endian: Literal["<", ">"] = "<"
     name: str = ""  # the frame element holding it
+    skips: tuple[str, ...] = ()  # elements inside first..last left out: itself, and the checksums strictly inside
 
 
 @frozen
@@ -619,6 +659,7 @@ class Behaviour:
     carries: tuple[str, str] | None = None  # (command code field, content field) of a carried request
     carried: tuple[str, ...] = ()  # the commands it can carry (empty: every command with a code)
     nothing_held: dict[str, float] = field(default_factory=dict)  # commits: reply values when nothing is held
+    echoes: tuple[str, ...] = ()  # response fields that repeat the request's field of the same name
 
 
 @frozen
@@ -865,6 +906,8 @@ def fixed_size(field: Field) -> int | None:
         return field.type.size
     if isinstance(field, Array):
         return field.item.size * field.count
+    if isinstance(field, Packed):
+        return field.byte_size
     if isinstance(field, Bytes | Text):
         return field.size if isinstance(field.size, int) else None
     if isinstance(field, List):

@@ -85,8 +85,8 @@ def straight(layout: Layout) -> bool:
             return False
         if element.kind == "checksum":
             a, b = element.span
-            if index <= last or b >= index or _inside(layout, a, b):
-                return False
+            if index <= last or b >= index or _inside(layout, a, b) or element.skip:
+                return False  # (a span that leaves out checksums inside it: the engine's covered bytes)
     packed = [e for e in layout.elements if e.kind in ("value", "command", "length") and e.size > 1]
     return len({e.endian for e in packed}) <= 1
 
@@ -312,7 +312,7 @@ def frame_sum_test(layout: Layout, index: int, checksum: Checksum | None, frame:
     byte and covers all before it but constants (checked before it). None for others."""
     elements = layout.elements
     a, b = elements[index].span
-    if checksum is None or layout.transparency is not None or elements[index].size != 1:
+    if checksum is None or layout.transparency is not None or elements[index].size != 1 or elements[index].skip:
         return None
     if index != len(elements) - 1 or b != index - 1 or any(e.kind != "constant" for e in elements[:a]):
         return None
@@ -329,7 +329,16 @@ def _residue(element: Element) -> int | None:
     assert function is not None
     samples = (b"", b"\x00", b"\x01\x02", b"123456789", b"\xff" * 7, bytes(range(1, 18)))
     found = {function(data + element.pack(function(data))) for data in samples}
-    return found.pop() if len(found) == 1 else None
+    if len(found) != 1:
+        return None
+    residue = found.pop()
+    # and only the right checksum gives it: a masked one (HerkuleX `& 0xFE`) gives it for a wrong bit 0 as well
+    for data in samples:
+        check = function(data)
+        for bit in range(8 * element.size):
+            if function(data + element.pack(check ^ 1 << bit)) == residue:
+                return None
+    return residue
 
 
 def _dispatch(target: Target, code: str, arguments: str, nullable: bool) -> Lines:
@@ -757,7 +766,7 @@ def _frame_lines(
     order = _order(elements, head)
     packed = None  # (format, arguments) where the frame up to the checksum is one pack of them
     multi = any(elements[i].kind != "constant" and elements[i].size > 1 for i in head)
-    if first and fmt[:1] in "<>" and (fmt[0] == order or not multi):
+    if head and first and fmt[:1] in "<>" and (fmt[0] == order or not multi):
         # the head's elements joined to the content's first struct: one pack for both
         fused = _packed(elements, head, constant_or, lambda f: f)  # named by its format
         if isinstance(fused, Pack):
@@ -927,7 +936,7 @@ def whole_frames(
     ]
     lines = [
         f"whole = {table}.get(frame[:{positions.content}])",
-        f"if whole is not None and {' and '.join(conditions)}:",
+        f"if {' and '.join(['whole is not None', *conditions])}:",
         "    try:",
         "        return _new(whole[0], whole[1](frame))",
         "    except struct.error:",

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define DYNAMIXEL_P2_SPEC_SHA256 "554f17218787ecfbf4f18261b4fccf3c307bc273ab9dd344bf444a5ac95db9c9"
+#define DYNAMIXEL_P2_SPEC_SHA256 "8626f42c4b17a3c11b48ed2fc47ec39bc479417b52fb1e1ba8f1f9477745bb2e"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef DYNAMIXEL_P2_ENABLE_ENCODE

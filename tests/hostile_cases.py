@@ -1139,7 +1139,7 @@ CASES: list[tuple[str, str, Mutation | Text, str | None]] = [
         "example truncated",
         "tiny",
         put("examples/move_request/printed", "AA 55 01 01 05 64 00"),
-        "examples.move_request: the frame does not decode: length byte says 5 content bytes but the frame holds 1",
+        "examples.move_request: the frame does not decode: length says 5 but the frame holds 1",
     ),
     (
         "example not hex",

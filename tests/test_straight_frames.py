@@ -7,21 +7,23 @@ intact and damaged, both must give the same message or the same error, word for 
 and frame values both must build the same bytes or refuse with the same error. The shipped DYNAMIXEL 2.0, Modbus
 RTU and VESC codecs, and small specs with what those do not have (escaping with two rules, a constant and a length
 with `adds` inside a stuffed span, a big-endian u16 length, a trailer) and one the straight-line form cannot take
-(a checksum inside the stuffed span, which keeps the engine).
+(a checksum inside the stuffed span, which keeps the engine). Length-byte codecs too: their decode() runs the same
+generated checks past its whole-frame tables.
 """
 
 from __future__ import annotations
 
 import sys
 from pathlib import Path
-from types import ModuleType
+from types import ModuleType, SimpleNamespace
 from typing import Any
 
 import pytest
 from conftest import ALL, Generated, by_protocol, examples
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from serialspec.lang.model import Message
+from serialspec.backends.common.frames import runtime_layouts
+from serialspec.lang.model import Direction, Message
 from serialspec.runtime.errors import DecodeError
 from serialspec.runtime.framing import ERROR_REPLY, FrameCodec
 from strategies import message_fields
@@ -126,7 +128,7 @@ def engine_decode(codec: ModuleType, direction: str, frame: bytes, expect: type[
         if alternative is not None and expected == code:
             decoder = alternative
     if decoder is None:
-        raise DecodeError(f"unknown command {code!r}")
+        raise DecodeError("unknown command None" if code is None else f"unknown command {code:#04x}")
     return decoder(content, 0, len(content), *unwrapped.values)
 
 
@@ -242,6 +244,35 @@ def test_an_item_cut_short_is_a_decode_error() -> None:
     frame = bytes.fromhex("ff ff fd 00 fe 07 00 93 ff ff fd fd dc 18")
     with pytest.raises(DecodeError, match="bulk_write request: id needs 5 bytes, 3 left"):
         dynamixel_p2.decode(frame, "request")
+
+
+LENGTH_BYTE = [g for g in ALL if g.protocol.text is None and g.protocol.framing.classic]
+
+
+@pytest.mark.parametrize("direction", ["request", "response"])
+@pytest.mark.parametrize("g", LENGTH_BYTE, ids=[g.protocol.name for g in LENGTH_BYTE])
+@settings(max_examples=examples(150), suppress_health_check=[HealthCheck.too_slow])
+@given(data=st.data())
+def test_length_byte_codecs_agree_with_the_engine(g: Generated, direction: str, data: st.DataObject) -> None:
+    """A length-byte codec's decode() (its whole-frame tables first, then the checks straight_frames writes for every
+    framing) gives the engine's message or error, word for word, on intact and damaged frames; the engine made from
+    the same layouts (backends/common/frames.py) and the codec's content sizes."""
+    codec, upper = g.package.codec, direction.upper()
+    layouts = runtime_layouts(g.protocol, Direction(direction))
+    engine = SimpleNamespace(
+        **{
+            f"_{upper}_FRAMES": FrameCodec(layouts, getattr(codec, f"_{upper}_SIZES")),
+            f"_{upper}_DECODERS": getattr(codec, f"_{upper}_DECODERS"),
+        }
+    )
+    content, code, values = data.draw(frame_cases(engine, direction))
+    frames: FrameCodec = getattr(engine, f"_{upper}_FRAMES")
+    built = outcome(frames.wrap, content, code, values)
+    frame = frames.wrap(content, code, values) if built[0] == "ok" else data.draw(st.binary(max_size=30))
+    frame = data.draw(damaged(frame))
+    assert outcome(codec.decode, frame, direction, None) == outcome(engine_decode, engine, direction, frame, None), (
+        frame.hex(" ")
+    )
 
 
 GENERAL = by_protocol([(g, m) for g in ALL if not g.protocol.framing.classic for m in g.protocol.messages()])

@@ -499,7 +499,7 @@ def _decode_request(frame: bytes, expect: type[Message] | None = None) -> Messag
     try:
         decoder = _REQUEST_DECODERS[code]
     except KeyError:
-        raise DecodeError(f"unknown command {code!r}") from None
+        raise DecodeError(f"unknown command {code:#04x}") from None
     return decoder(buf, 8, end, v_id)
 
 
@@ -653,7 +653,7 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         try:
             decoder = _REQUEST_DECODERS[code]
         except KeyError:
-            raise DecodeError(f"unknown command {code!r}") from None
+            raise DecodeError(f"unknown command {code:#04x}") from None
         return decoder(buf, 8, end, v_id)
     if direction is _RESPONSE or direction == 'response':  # a Direction (told by identity, first) or its value
         frame = data if data.__class__ is bytes else bytes(data)

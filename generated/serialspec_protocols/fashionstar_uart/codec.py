@@ -2144,22 +2144,26 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
                     return _new(cls, unpack(data))
             except struct.error:
                 pass  # not the size its first bytes say: the checks below say what is wrong
-        n = len(data)
+        frame = data if data.__class__ is bytes else bytes(data)
+        n = len(frame)
         if n < 5:
-            raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (5 bytes)")
-        if data[:2] != b'\x12L':
-            raise DecodeError(f"request header is {data[:2].hex(' ')}, expected 12 4c")
-        size = data[3]
-        if n != 5 + size:
-            raise DecodeError(f"length byte says {size} content bytes but the frame holds {n - 5}")
-        check = data[-1]
-        expected = (sum(data) - check) & 0xff
-        if expected != check:
-            raise ChecksumError(f"bad checksum: the frame has {check:#04x}, its bytes give {expected:#04x}")
-        decoder = _REQUEST_DECODERS.get(data[2])
-        if decoder is None:
-            raise DecodeError(f"unknown command {data[2]:#04x}")
-        return decoder(data, 4, n - 1)
+            raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (5)")
+        end = n - 1
+        if frame[:2] != b'\x12L':
+            raise DecodeError(f"header is {frame[:2].hex(' ')}, expected 12 4c")
+        length = frame[3]
+        if length != n - 5:
+            raise DecodeError(f"length says {length} but the frame holds {n - 5}")
+        if (sum(frame) - 2 * frame[-1]) & 0xff:
+            check = (sum(frame[:-1]) & 0xff)
+            stored = frame[end]
+            raise ChecksumError(f"bad checksum: the frame has {stored:#04x}, its bytes give {check:#04x}")
+        code = frame[2]
+        try:
+            decoder = _REQUEST_DECODERS[code]
+        except KeyError:
+            raise DecodeError(f"unknown command {code:#04x}") from None
+        return decoder(frame, 4, end)
     if direction is _RESPONSE:
         fixed = _RESPONSE_WHOLE.get(data[:4])  # no key is shorter: a short frame matches none
         if fixed is not None:
@@ -2173,22 +2177,26 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
                     return _new(cls, unpack(data))
             except struct.error:
                 pass  # not the size its first bytes say: the checks below say what is wrong
-        n = len(data)
+        frame = data if data.__class__ is bytes else bytes(data)
+        n = len(frame)
         if n < 5:
-            raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (5 bytes)")
-        if data[:2] != b'\x05\x1c':
-            raise DecodeError(f"response header is {data[:2].hex(' ')}, expected 05 1c")
-        size = data[3]
-        if n != 5 + size:
-            raise DecodeError(f"length byte says {size} content bytes but the frame holds {n - 5}")
-        check = data[-1]
-        expected = (sum(data) - check) & 0xff
-        if expected != check:
-            raise ChecksumError(f"bad checksum: the frame has {check:#04x}, its bytes give {expected:#04x}")
-        decoder = _RESPONSE_DECODERS.get(data[2])
-        if decoder is None:
-            raise DecodeError(f"unknown command {data[2]:#04x}")
-        return decoder(data, 4, n - 1)
+            raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (5)")
+        end = n - 1
+        if frame[:2] != b'\x05\x1c':
+            raise DecodeError(f"header is {frame[:2].hex(' ')}, expected 05 1c")
+        length = frame[3]
+        if length != n - 5:
+            raise DecodeError(f"length says {length} but the frame holds {n - 5}")
+        if (sum(frame) - 2 * frame[-1]) & 0xff:
+            check = (sum(frame[:-1]) & 0xff)
+            stored = frame[end]
+            raise ChecksumError(f"bad checksum: the frame has {stored:#04x}, its bytes give {check:#04x}")
+        code = frame[2]
+        try:
+            decoder = _RESPONSE_DECODERS[code]
+        except KeyError:
+            raise DecodeError(f"unknown command {code:#04x}") from None
+        return decoder(frame, 4, end)
     if direction == 'request':  # its value as text
         return decode(data, _REQUEST, expect)
     if direction == 'response':  # its value as text

@@ -482,40 +482,49 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
             message = fixed[1](data)
             if message is not None:
                 return message
-        n = len(data)
+        frame = data if data.__class__ is bytes else bytes(data)
+        n = len(frame)
         if n < 6:
-            raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (6 bytes)")
-        if data[:2] != b'\xff\xff':
-            raise DecodeError(f"request header is {data[:2].hex(' ')}, expected ff ff")
-        if data[2] > 254:
-            raise DecodeError(f"id = {data[2]} is outside its range 0..253 (or 254)")
-        size = data[3] - 2
-        if size < 0 or n != 6 + size:
-            raise DecodeError(f"length byte says {size} content bytes but the frame holds {n - 6}")
-        check = data[-1]
-        expected = ~(sum(data) - 0x1fe - check) & 0xff
-        if expected != check:
-            raise ChecksumError(f"bad checksum: the frame has {check:#04x}, its bytes give {expected:#04x}")
-        decoder = _REQUEST_DECODERS.get(data[4])
-        if decoder is None:
-            raise DecodeError(f"unknown command {data[4]:#04x}")
-        return decoder(data, 5, n - 1, data[2])
+            raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (6)")
+        end = n - 1
+        if frame[:2] != b'\xff\xff':
+            raise DecodeError(f"header is {frame[:2].hex(' ')}, expected ff ff")
+        v_id = frame[2]
+        if v_id > 254:
+            raise DecodeError(f"id = {v_id} is outside its range 0..253 (or 254)")
+        length = frame[3]
+        if length != n - 4:
+            raise DecodeError(f"length says {length} but the frame holds {n - 4}")
+        if (sum(frame) - 0x2fd) & 0xff:
+            check = (~sum(frame[2:-1]) & 0xff)
+            stored = frame[end]
+            raise ChecksumError(f"bad checksum: the frame has {stored:#04x}, its bytes give {check:#04x}")
+        code = frame[4]
+        try:
+            decoder = _REQUEST_DECODERS[code]
+        except KeyError:
+            raise DecodeError(f"unknown command {code:#04x}") from None
+        return decoder(frame, 5, end, v_id)
     if direction is _RESPONSE:
-        n = len(data)
+        frame = data if data.__class__ is bytes else bytes(data)
+        n = len(frame)
         if n < 6:
-            raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (6 bytes)")
-        if data[:2] != b'\xff\xff':
-            raise DecodeError(f"response header is {data[:2].hex(' ')}, expected ff ff")
-        if data[2] > 254:
-            raise DecodeError(f"id = {data[2]} is outside its range 0..253 (or 254)")
-        size = data[3] - 2
-        if size < 0 or n != 6 + size:
-            raise DecodeError(f"length byte says {size} content bytes but the frame holds {n - 6}")
-        check = data[-1]
-        expected = ~(sum(data) - 0x1fe - check) & 0xff
-        if expected != check:
-            raise ChecksumError(f"bad checksum: the frame has {check:#04x}, its bytes give {expected:#04x}")
-        return _decode_reply_response(data, 5, n - 1, data[2], data[4])
+            raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (6)")
+        end = n - 1
+        if frame[:2] != b'\xff\xff':
+            raise DecodeError(f"header is {frame[:2].hex(' ')}, expected ff ff")
+        v_id = frame[2]
+        if v_id > 254:
+            raise DecodeError(f"id = {v_id} is outside its range 0..253 (or 254)")
+        v_error = frame[4]
+        length = frame[3]
+        if length != n - 4:
+            raise DecodeError(f"length says {length} but the frame holds {n - 4}")
+        if (sum(frame) - 0x2fd) & 0xff:
+            check = (~sum(frame[2:-1]) & 0xff)
+            stored = frame[end]
+            raise ChecksumError(f"bad checksum: the frame has {stored:#04x}, its bytes give {check:#04x}")
+        return _decode_reply_response(frame, 5, end, v_id, v_error)
     if direction == 'request':  # its value as text
         return decode(data, _REQUEST, expect)
     if direction == 'response':  # its value as text

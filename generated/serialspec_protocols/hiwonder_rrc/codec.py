@@ -6,7 +6,7 @@ from __future__ import annotations
 import struct
 from collections.abc import Callable
 
-from serialspec.checksums.crc import crc_table
+from serialspec.checksums.crc import crc_function, crc_table
 from serialspec.runtime.checksums import BYTE_VALUES as _BYTES
 from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError, content_size_error, out_of_range
 from serialspec.runtime.errors import either_direction as _either
@@ -121,6 +121,7 @@ _S_U8_U8_U16 = struct.Struct('<BBH')
 _S_U8_U8_U16_U16 = struct.Struct('<BBHH')
 _S_U8_U8_U8 = struct.Struct('<BBB')
 _S_U8_U8_U8_U8 = struct.Struct('<BBBB')
+_CHECK_CRC: Callable[[bytes], int] = crc_function(8, 0x31, 0x0, True, True, 0x0)  # CRC-8/MAXIM
 _CHECK_CRC_TABLE = crc_table(8, 0x31, True)  # CRC-8/MAXIM
 
 _MEMBERS_ButtonEvent = members(ButtonEvent)
@@ -2325,48 +2326,54 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
             message = fixed[1](data)
             if message is not None:
                 return message
-        n = len(data)
+        frame = data if data.__class__ is bytes else bytes(data)
+        n = len(frame)
         if n < 5:
-            raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (5 bytes)")
-        if data[:2] != b'\xaaU':
-            raise DecodeError(f"request header is {data[:2].hex(' ')}, expected aa 55")
-        size = data[3]
-        if n != 5 + size:
-            raise DecodeError(f"length byte says {size} content bytes but the frame holds {n - 5}")
-        check = data[-1]
-        expected = 0x0
-        for byte in data[2:-1]:
-            expected = _CHECK_CRC_TABLE[expected ^ byte]
-        if expected != check:
-            raise ChecksumError(f"bad checksum: the frame has {check:#04x}, its bytes give {expected:#04x}")
-        decoder = _REQUEST_DECODERS.get(data[2])
-        if decoder is None:
-            raise DecodeError(f"unknown command {data[2]:#04x}")
-        return decoder(data, 4, n - 1)
+            raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (5)")
+        end = n - 1
+        if frame[:2] != b'\xaaU':
+            raise DecodeError(f"header is {frame[:2].hex(' ')}, expected aa 55")
+        length = frame[3]
+        if length != n - 5:
+            raise DecodeError(f"length says {length} but the frame holds {n - 5}")
+        if _CHECK_CRC(frame[2:]) != 0x00:
+            check = _CHECK_CRC(frame[2:-1])
+            stored = frame[end]
+            if check != stored:
+                raise ChecksumError(f"bad crc: the frame has {stored:#04x}, its bytes give {check:#04x}")
+        code = frame[2]
+        try:
+            decoder = _REQUEST_DECODERS[code]
+        except KeyError:
+            raise DecodeError(f"unknown command {code:#04x}") from None
+        return decoder(frame, 4, end)
     if direction is _RESPONSE:
         fixed = _RESPONSE_WHOLE.get(data[:4])  # no key is shorter: a short frame matches none
         if fixed is not None and fixed[0] == len(data):
             message = fixed[1](data)
             if message is not None:
                 return message
-        n = len(data)
+        frame = data if data.__class__ is bytes else bytes(data)
+        n = len(frame)
         if n < 5:
-            raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (5 bytes)")
-        if data[:2] != b'\xaaU':
-            raise DecodeError(f"response header is {data[:2].hex(' ')}, expected aa 55")
-        size = data[3]
-        if n != 5 + size:
-            raise DecodeError(f"length byte says {size} content bytes but the frame holds {n - 5}")
-        check = data[-1]
-        expected = 0x0
-        for byte in data[2:-1]:
-            expected = _CHECK_CRC_TABLE[expected ^ byte]
-        if expected != check:
-            raise ChecksumError(f"bad checksum: the frame has {check:#04x}, its bytes give {expected:#04x}")
-        decoder = _RESPONSE_DECODERS.get(data[2])
-        if decoder is None:
-            raise DecodeError(f"unknown command {data[2]:#04x}")
-        return decoder(data, 4, n - 1)
+            raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (5)")
+        end = n - 1
+        if frame[:2] != b'\xaaU':
+            raise DecodeError(f"header is {frame[:2].hex(' ')}, expected aa 55")
+        length = frame[3]
+        if length != n - 5:
+            raise DecodeError(f"length says {length} but the frame holds {n - 5}")
+        if _CHECK_CRC(frame[2:]) != 0x00:
+            check = _CHECK_CRC(frame[2:-1])
+            stored = frame[end]
+            if check != stored:
+                raise ChecksumError(f"bad crc: the frame has {stored:#04x}, its bytes give {check:#04x}")
+        code = frame[2]
+        try:
+            decoder = _RESPONSE_DECODERS[code]
+        except KeyError:
+            raise DecodeError(f"unknown command {code:#04x}") from None
+        return decoder(frame, 4, end)
     if direction == 'request':  # its value as text
         return decode(data, _REQUEST, expect)
     if direction == 'response':  # its value as text

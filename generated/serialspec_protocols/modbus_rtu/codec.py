@@ -695,21 +695,20 @@ def _decode_request(frame: bytes, expect: type[Message] | None = None) -> Messag
     if n < 4:
         raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (4)")
     end = n - 2
-    buf = frame
-    v_unit = buf[0]
-    if not 0 <= v_unit <= 247:
+    v_unit = frame[0]
+    if v_unit > 247:
         raise DecodeError(f"unit = {v_unit} is outside its range 1..247 (or 0)")
     if _CHECK_CRC(frame) != 0x0000:
         check = _CHECK_CRC(frame[:-2])
-        stored = buf[end + 1] << 8 | buf[end]
+        stored = frame[end + 1] << 8 | frame[end]
         if check != stored:
             raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
-    code = buf[1]
+    code = frame[1]
     try:
         decoder = _REQUEST_DECODERS[code]
     except KeyError:
-        raise DecodeError(f"unknown command {code!r}") from None
-    return decoder(buf, 2, end, v_unit)
+        raise DecodeError(f"unknown command {code:#04x}") from None
+    return decoder(frame, 2, end, v_unit)
 
 
 def _wrap_request(content: bytes, code: int | None, v_unit: int) -> bytes:
@@ -764,23 +763,22 @@ def _decode_response(frame: bytes, expect: type[Message] | None = None) -> Messa
     if n < 4:
         raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (4)")
     end = n - 2
-    buf = frame
-    v_unit = buf[0]
-    if not 0 <= v_unit <= 247:
+    v_unit = frame[0]
+    if v_unit > 247:
         raise DecodeError(f"unit = {v_unit} is outside its range 1..247 (or 0)")
     if _CHECK_CRC(frame) != 0x0000:
         check = _CHECK_CRC(frame[:-2])
-        stored = buf[end + 1] << 8 | buf[end]
+        stored = frame[end + 1] << 8 | frame[end]
         if check != stored:
             raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
-    code = buf[1]
+    code = frame[1]
     if code & 0x80:  # an error reply: it refuses the request of code & ~flag
-        return _RESPONSE_DECODERS[ERROR_REPLY](buf, 2, end, v_unit, code & 0x7f)
+        return _RESPONSE_DECODERS[ERROR_REPLY](frame, 2, end, v_unit, code & 0x7f)
     try:
         decoder = _RESPONSE_DECODERS[code]
     except KeyError:
-        raise DecodeError(f"unknown command {code!r}") from None
-    return decoder(buf, 2, end, v_unit)
+        raise DecodeError(f"unknown command {code:#04x}") from None
+    return decoder(frame, 2, end, v_unit)
 
 
 def _wrap_response(content: bytes, code: int | None, v_unit: int) -> bytes:
@@ -826,44 +824,42 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         if n < 4:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (4)")
         end = n - 2
-        buf = frame
-        v_unit = buf[0]
-        if not 0 <= v_unit <= 247:
+        v_unit = frame[0]
+        if v_unit > 247:
             raise DecodeError(f"unit = {v_unit} is outside its range 1..247 (or 0)")
         if _CHECK_CRC(frame) != 0x0000:
             check = _CHECK_CRC(frame[:-2])
-            stored = buf[end + 1] << 8 | buf[end]
+            stored = frame[end + 1] << 8 | frame[end]
             if check != stored:
                 raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
-        code = buf[1]
+        code = frame[1]
         try:
             decoder = _REQUEST_DECODERS[code]
         except KeyError:
-            raise DecodeError(f"unknown command {code!r}") from None
-        return decoder(buf, 2, end, v_unit)
+            raise DecodeError(f"unknown command {code:#04x}") from None
+        return decoder(frame, 2, end, v_unit)
     if direction is _RESPONSE or direction == 'response':  # a Direction (told by identity, first) or its value
         frame = data if data.__class__ is bytes else bytes(data)
         n = len(frame)
         if n < 4:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (4)")
         end = n - 2
-        buf = frame
-        v_unit = buf[0]
-        if not 0 <= v_unit <= 247:
+        v_unit = frame[0]
+        if v_unit > 247:
             raise DecodeError(f"unit = {v_unit} is outside its range 1..247 (or 0)")
         if _CHECK_CRC(frame) != 0x0000:
             check = _CHECK_CRC(frame[:-2])
-            stored = buf[end + 1] << 8 | buf[end]
+            stored = frame[end + 1] << 8 | frame[end]
             if check != stored:
                 raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
-        code = buf[1]
+        code = frame[1]
         if code & 0x80:  # an error reply: it refuses the request of code & ~flag
-            return _RESPONSE_DECODERS[ERROR_REPLY](buf, 2, end, v_unit, code & 0x7f)
+            return _RESPONSE_DECODERS[ERROR_REPLY](frame, 2, end, v_unit, code & 0x7f)
         try:
             decoder = _RESPONSE_DECODERS[code]
         except KeyError:
-            raise DecodeError(f"unknown command {code!r}") from None
-        return decoder(buf, 2, end, v_unit)
+            raise DecodeError(f"unknown command {code:#04x}") from None
+        return decoder(frame, 2, end, v_unit)
     if direction is None:  # last: a caller that knows the direction does not pay for this
         return _either(lambda d: decode(data, d, expect), "give the direction: requests and responses cannot be told apart by their first bytes")
     raise ValueError(f"direction must be request or response, not {direction!r}")

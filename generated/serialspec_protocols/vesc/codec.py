@@ -428,23 +428,22 @@ def _decode_request_short(frame: bytes, expect: type[Message] | None = None) -> 
     if n < 6:
         raise DecodeError(f"frame of {n} bytes is shorter than the smallest short frame (6)")
     end = n - 3
-    buf = frame
-    if buf[end + 2] != 0x03:
-        raise DecodeError(f"end is {buf[end + 2:end + 3].hex(' ')}, expected 03")
-    length = buf[1]
+    if frame[end + 2] != 0x03:
+        raise DecodeError(f"end is {frame[end + 2:end + 3].hex(' ')}, expected 03")
+    length = frame[1]
     if length != n - 5:
         raise DecodeError(f"length says {length} but the frame holds {n - 5}")
     if _crc_hqx(frame[2:-1], 0x0) != 0x0000:
         check = _crc_hqx(frame[2:-3], 0x0)
-        stored = buf[end] << 8 | buf[end + 1]
+        stored = frame[end] << 8 | frame[end + 1]
         if check != stored:
             raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
-    code = buf[2]
+    code = frame[2]
     try:
         decoder = _REQUEST_DECODERS[code]
     except KeyError:
-        raise DecodeError(f"unknown command {code!r}") from None
-    return decoder(buf, 3, end)
+        raise DecodeError(f"unknown command {code:#04x}") from None
+    return decoder(frame, 3, end)
 
 
 def _decode_request_long(frame: bytes, expect: type[Message] | None = None) -> Message:
@@ -453,23 +452,22 @@ def _decode_request_long(frame: bytes, expect: type[Message] | None = None) -> M
     if n < 7:
         raise DecodeError(f"frame of {n} bytes is shorter than the smallest long frame (7)")
     end = n - 3
-    buf = frame
-    if buf[end + 2] != 0x03:
-        raise DecodeError(f"end is {buf[end + 2:end + 3].hex(' ')}, expected 03")
-    length = buf[1] << 8 | buf[2]
+    if frame[end + 2] != 0x03:
+        raise DecodeError(f"end is {frame[end + 2:end + 3].hex(' ')}, expected 03")
+    length = frame[1] << 8 | frame[2]
     if length != n - 6:
         raise DecodeError(f"length says {length} but the frame holds {n - 6}")
     if _crc_hqx(frame[3:-1], 0x0) != 0x0000:
         check = _crc_hqx(frame[3:-3], 0x0)
-        stored = buf[end] << 8 | buf[end + 1]
+        stored = frame[end] << 8 | frame[end + 1]
         if check != stored:
             raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
-    code = buf[3]
+    code = frame[3]
     try:
         decoder = _REQUEST_DECODERS[code]
     except KeyError:
-        raise DecodeError(f"unknown command {code!r}") from None
-    return decoder(buf, 4, end)
+        raise DecodeError(f"unknown command {code:#04x}") from None
+    return decoder(frame, 4, end)
 
 
 def _decode_request(frame: bytes, expect: type[Message] | None = None) -> Message:
@@ -546,23 +544,22 @@ def _decode_response_short(frame: bytes, expect: type[Message] | None = None) ->
     if n < 6:
         raise DecodeError(f"frame of {n} bytes is shorter than the smallest short frame (6)")
     end = n - 3
-    buf = frame
-    if buf[end + 2] != 0x03:
-        raise DecodeError(f"end is {buf[end + 2:end + 3].hex(' ')}, expected 03")
-    length = buf[1]
+    if frame[end + 2] != 0x03:
+        raise DecodeError(f"end is {frame[end + 2:end + 3].hex(' ')}, expected 03")
+    length = frame[1]
     if length != n - 5:
         raise DecodeError(f"length says {length} but the frame holds {n - 5}")
     if _crc_hqx(frame[2:-1], 0x0) != 0x0000:
         check = _crc_hqx(frame[2:-3], 0x0)
-        stored = buf[end] << 8 | buf[end + 1]
+        stored = frame[end] << 8 | frame[end + 1]
         if check != stored:
             raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
-    code = buf[2]
+    code = frame[2]
     try:
         decoder = _RESPONSE_DECODERS[code]
     except KeyError:
-        raise DecodeError(f"unknown command {code!r}") from None
-    return decoder(buf, 3, end)
+        raise DecodeError(f"unknown command {code:#04x}") from None
+    return decoder(frame, 3, end)
 
 
 def _decode_response_long(frame: bytes, expect: type[Message] | None = None) -> Message:
@@ -571,23 +568,22 @@ def _decode_response_long(frame: bytes, expect: type[Message] | None = None) -> 
     if n < 7:
         raise DecodeError(f"frame of {n} bytes is shorter than the smallest long frame (7)")
     end = n - 3
-    buf = frame
-    if buf[end + 2] != 0x03:
-        raise DecodeError(f"end is {buf[end + 2:end + 3].hex(' ')}, expected 03")
-    length = buf[1] << 8 | buf[2]
+    if frame[end + 2] != 0x03:
+        raise DecodeError(f"end is {frame[end + 2:end + 3].hex(' ')}, expected 03")
+    length = frame[1] << 8 | frame[2]
     if length != n - 6:
         raise DecodeError(f"length says {length} but the frame holds {n - 6}")
     if _crc_hqx(frame[3:-1], 0x0) != 0x0000:
         check = _crc_hqx(frame[3:-3], 0x0)
-        stored = buf[end] << 8 | buf[end + 1]
+        stored = frame[end] << 8 | frame[end + 1]
         if check != stored:
             raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
-    code = buf[3]
+    code = frame[3]
     try:
         decoder = _RESPONSE_DECODERS[code]
     except KeyError:
-        raise DecodeError(f"unknown command {code!r}") from None
-    return decoder(buf, 4, end)
+        raise DecodeError(f"unknown command {code:#04x}") from None
+    return decoder(frame, 4, end)
 
 
 def _decode_response(frame: bytes, expect: type[Message] | None = None) -> Message:
@@ -656,45 +652,43 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
             if n < 6:
                 raise DecodeError(f"frame of {n} bytes is shorter than the smallest short frame (6)")
             end = n - 3
-            buf = frame
-            if buf[end + 2] != 0x03:
-                raise DecodeError(f"end is {buf[end + 2:end + 3].hex(' ')}, expected 03")
-            length = buf[1]
+            if frame[end + 2] != 0x03:
+                raise DecodeError(f"end is {frame[end + 2:end + 3].hex(' ')}, expected 03")
+            length = frame[1]
             if length != n - 5:
                 raise DecodeError(f"length says {length} but the frame holds {n - 5}")
             if _crc_hqx(frame[2:-1], 0x0) != 0x0000:
                 check = _crc_hqx(frame[2:-3], 0x0)
-                stored = buf[end] << 8 | buf[end + 1]
+                stored = frame[end] << 8 | frame[end + 1]
                 if check != stored:
                     raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
-            code = buf[2]
+            code = frame[2]
             try:
                 decoder = _REQUEST_DECODERS[code]
             except KeyError:
-                raise DecodeError(f"unknown command {code!r}") from None
-            return decoder(buf, 3, end)
+                raise DecodeError(f"unknown command {code:#04x}") from None
+            return decoder(frame, 3, end)
         if frame.startswith(b'\x03'):
             n = len(frame)
             if n < 7:
                 raise DecodeError(f"frame of {n} bytes is shorter than the smallest long frame (7)")
             end = n - 3
-            buf = frame
-            if buf[end + 2] != 0x03:
-                raise DecodeError(f"end is {buf[end + 2:end + 3].hex(' ')}, expected 03")
-            length = buf[1] << 8 | buf[2]
+            if frame[end + 2] != 0x03:
+                raise DecodeError(f"end is {frame[end + 2:end + 3].hex(' ')}, expected 03")
+            length = frame[1] << 8 | frame[2]
             if length != n - 6:
                 raise DecodeError(f"length says {length} but the frame holds {n - 6}")
             if _crc_hqx(frame[3:-1], 0x0) != 0x0000:
                 check = _crc_hqx(frame[3:-3], 0x0)
-                stored = buf[end] << 8 | buf[end + 1]
+                stored = frame[end] << 8 | frame[end + 1]
                 if check != stored:
                     raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
-            code = buf[3]
+            code = frame[3]
             try:
                 decoder = _REQUEST_DECODERS[code]
             except KeyError:
-                raise DecodeError(f"unknown command {code!r}") from None
-            return decoder(buf, 4, end)
+                raise DecodeError(f"unknown command {code:#04x}") from None
+            return decoder(frame, 4, end)
         raise DecodeError(f"frame starts {frame[:4].hex(' ')}, expected 02 or 03")
     if direction is _RESPONSE or direction == 'response':  # a Direction (told by identity, first) or its value
         frame = data if data.__class__ is bytes else bytes(data)
@@ -709,45 +703,43 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
             if n < 6:
                 raise DecodeError(f"frame of {n} bytes is shorter than the smallest short frame (6)")
             end = n - 3
-            buf = frame
-            if buf[end + 2] != 0x03:
-                raise DecodeError(f"end is {buf[end + 2:end + 3].hex(' ')}, expected 03")
-            length = buf[1]
+            if frame[end + 2] != 0x03:
+                raise DecodeError(f"end is {frame[end + 2:end + 3].hex(' ')}, expected 03")
+            length = frame[1]
             if length != n - 5:
                 raise DecodeError(f"length says {length} but the frame holds {n - 5}")
             if _crc_hqx(frame[2:-1], 0x0) != 0x0000:
                 check = _crc_hqx(frame[2:-3], 0x0)
-                stored = buf[end] << 8 | buf[end + 1]
+                stored = frame[end] << 8 | frame[end + 1]
                 if check != stored:
                     raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
-            code = buf[2]
+            code = frame[2]
             try:
                 decoder = _RESPONSE_DECODERS[code]
             except KeyError:
-                raise DecodeError(f"unknown command {code!r}") from None
-            return decoder(buf, 3, end)
+                raise DecodeError(f"unknown command {code:#04x}") from None
+            return decoder(frame, 3, end)
         if frame.startswith(b'\x03'):
             n = len(frame)
             if n < 7:
                 raise DecodeError(f"frame of {n} bytes is shorter than the smallest long frame (7)")
             end = n - 3
-            buf = frame
-            if buf[end + 2] != 0x03:
-                raise DecodeError(f"end is {buf[end + 2:end + 3].hex(' ')}, expected 03")
-            length = buf[1] << 8 | buf[2]
+            if frame[end + 2] != 0x03:
+                raise DecodeError(f"end is {frame[end + 2:end + 3].hex(' ')}, expected 03")
+            length = frame[1] << 8 | frame[2]
             if length != n - 6:
                 raise DecodeError(f"length says {length} but the frame holds {n - 6}")
             if _crc_hqx(frame[3:-1], 0x0) != 0x0000:
                 check = _crc_hqx(frame[3:-3], 0x0)
-                stored = buf[end] << 8 | buf[end + 1]
+                stored = frame[end] << 8 | frame[end + 1]
                 if check != stored:
                     raise ChecksumError(f"bad crc: the frame has {stored:#06x}, its bytes give {check:#06x}")
-            code = buf[3]
+            code = frame[3]
             try:
                 decoder = _RESPONSE_DECODERS[code]
             except KeyError:
-                raise DecodeError(f"unknown command {code!r}") from None
-            return decoder(buf, 4, end)
+                raise DecodeError(f"unknown command {code:#04x}") from None
+            return decoder(frame, 4, end)
         raise DecodeError(f"frame starts {frame[:4].hex(' ')}, expected 02 or 03")
     if direction is None:  # last: a caller that knows the direction does not pay for this
         return _either(lambda d: decode(data, d, expect), "give the direction: requests and responses cannot be told apart by their first bytes")

@@ -4,7 +4,9 @@ command code at fixed offsets, a one-byte length before the content and one chec
 frames without a call per element: each message of one size gets a whole-frame decoder made from its content
 decoder's statements (the content size check dropped, the cursor made a constant offset), which checks the
 checksum the cheapest way its algorithm allows (checksums/: frame_test, byte_total, byte_table), and decode()
-looks them up by the frame's first bytes. Frames of any other shape take straight_frames.py.
+looks them up by the frame's first bytes. A frame none of those takes is checked and dispatched by the lines
+straight_frames.decode_lines writes for every framing (the engine's checks, in its order and words); frames of
+any other shape take straight_frames.py altogether.
 """
 
 from __future__ import annotations
@@ -14,6 +16,7 @@ from collections.abc import Callable
 from dataclasses import replace
 from typing import Any
 
+from serialspec.backends.common.frames import runtime_layout
 from serialspec.backends.python.content import (
     Lines,
     PackageCode,
@@ -24,7 +27,7 @@ from serialspec.backends.python.content import (
     takes_the_rest,
 )
 from serialspec.backends.python.dispatch import direction_entry, value_arguments
-from serialspec.backends.python.frames import import_lines
+from serialspec.backends.python.frames import checksum_definitions, import_lines
 from serialspec.backends.python.ir import (
     RETURN_NONE,
     Advance,
@@ -45,7 +48,13 @@ from serialspec.backends.python.ir import (
     walk,
 )
 from serialspec.backends.python.optimize import content_unpacked, fuse_unpack
-from serialspec.backends.python.straight_frames import checksum_name
+from serialspec.backends.python.straight_frames import (
+    Target,
+    checksum_name,
+    decode_lines,
+    frame_sum_test,
+    straight_direction,
+)
 from serialspec.lang.model import Bytes, Checksum, Command, Direction, FrameLayout, Message, Protocol
 
 
@@ -55,7 +64,7 @@ def length_byte_codec_context(protocol: Protocol, code: PackageCode) -> dict[str
     assert protocol.framing.checksum is not None
     checksum = protocol.framing.checksum
     assert checksum is not None  # length-byte frames have one
-    checksum_imports, checksum_definitions = checksum_setup(checksum)
+    checksum_imports, definitions = checksum_setup(checksum)
     directions = []
     dispatchers = []
     frame_functions: list[dict[str, Any]] = []
@@ -112,6 +121,13 @@ def length_byte_codec_context(protocol: Protocol, code: PackageCode) -> dict[str
             for _, _, f in fixed
         ]
         slice_key = None if whole else key_slice(layout)
+        # past the lookups, a frame is checked and dispatched as every framing's is (straight_frames.py)
+        straight = straight_direction(protocol, direction)
+        assert straight is not None and len(straight.layouts) == 1  # a length-byte layout is straight-line
+        only = dispatch[0][1] if layout.command_offset is None and len(dispatch) == 1 else ""
+        frames = Target(direction.name, tuple(e.name for e in layout.value_elements), only=only)
+        engine, checks, algorithms = straight.layouts[0], straight.checks[0], straight.algorithms[0]
+        _, general = decode_lines(engine, f"_decode_{direction.value}", frames, checks, "", algorithms=algorithms)
         directions.append(
             {
                 "slice_key": slice_key,
@@ -147,8 +163,8 @@ def length_byte_codec_context(protocol: Protocol, code: PackageCode) -> dict[str
                 ],
                 "dispatch": dispatch,
                 "sizes": sizes,
-                "whole": frame_decode_lines(protocol, layout, dispatch, "data", None),
-                "at": frame_decode_lines(protocol, layout, dispatch, "buf", "start"),
+                "general": general,
+                "at": frame_decode_lines(protocol, layout, dispatch),
             }
         )
     layouts = protocol.framing.layouts
@@ -159,10 +175,15 @@ def length_byte_codec_context(protocol: Protocol, code: PackageCode) -> dict[str
         function["whole_lines"] = lines_of(function["whole_lines"])
     for picker in whole_pickers:
         picker["lines"] = lines_of(picker["lines"])
+    imports = import_lines(checksum_imports)
+    name = checksum_name(checksum)
+    if name in checksum.algorithm.python_call(name):
+        # the general path calls the checksum's function (as every framing's does): defined with what it needs
+        imports, definitions = checksum_definitions(protocol)
     return {
         "length_byte_frames": True,
-        "checksum_imports": import_lines(checksum_imports),
-        "checksum_definitions": checksum_definitions,
+        "checksum_imports": imports,
+        "checksum_definitions": definitions,
         "directions": directions,
         "frame_functions": frame_functions,
         "runs": any(d["runs"] for d in directions),
@@ -650,14 +671,9 @@ def stream_sum(protocol: Protocol, layout: FrameLayout) -> str | None:
 
 def whole_frame_test(protocol: Protocol, layout: FrameLayout) -> str | None:
     """decode()'s test that a whole frame `data` (its size known) holds its checksum, where it is one expression
-    over the frame's bytes: an 8-bit sum over all but a constant header and the check. None for others."""
-    checksum = protocol.framing.checksum
-    header = layout.header[: layout.covered_from]
-    if checksum is None or len(header) != layout.covered_from:
-        return None
-    if not layout.checksum_offset_from_end == 1 == layout.covered_to_end:
-        return None
-    test = checksum.algorithm.frame_test("sum(data)", sum(header), "data[-1]")
+    over the frame's bytes (straight_frames.frame_sum_test, as every framing's checks make it). None for others."""
+    engine = runtime_layout(layout)
+    test = frame_sum_test(engine, len(engine.elements) - 1, protocol.framing.checksum, "data")
     return None if test is None else f"not {test}"
 
 
@@ -765,46 +781,29 @@ def sum_from_values(
     ]
 
 
-def frame_decode_lines(
-    protocol: Protocol, layout: FrameLayout, dispatch: list[tuple[str, str]], buf: str, start: str | None
-) -> Lines:
-    """Checksum check, then dispatch to the content decoder, of a frame whose header and length are checked.
-
-    `start` None: the frame is the whole of `buf` (whose length is `n`); else it is buf[start:stop].
-    """
+def frame_decode_lines(protocol: Protocol, layout: FrameLayout, dispatch: list[tuple[str, str]]) -> Lines:
+    """Checksum check, then dispatch to the content decoder, of a frame buf[start:stop] whose header and length the
+    stream parser has checked (decode() checks whole frames as every framing does: straight_frames.decode_lines)."""
     size = layout.checksum_offset_from_end
     offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
     after = layout.overhead - offset
 
     def at(position: int) -> str:
-        return f"{buf}[{position}]" if start is None else f"{buf}[{start} + {position}]"
+        return f"buf[start + {position}]"
 
     checksum = protocol.framing.checksum
     assert checksum is not None  # length-byte frames have one
-    if start is None:
-        covered = f"{buf}[{layout.covered_from or ''}:-{layout.covered_to_end}]"
-        stored = f"{buf}[-1]" if size == 1 else f"int.from_bytes({buf}[-{size}:], 'little')"
-        content = f"{offset}, n - {after}"
-    else:
-        first = f"{start} + {layout.covered_from}" if layout.covered_from else start
-        covered = f"{buf}[{first} : stop - {layout.covered_to_end}]"
-        stored = f"{buf}[stop - 1]" if size == 1 else f"int.from_bytes({buf}[stop - {size} : stop], 'little')"
-        content = f"{start} + {offset}, stop - {after}"
-    args = f"{buf}, {content}" + "".join(f", {at(layout.offsets[e.name])}" for e in layout.value_elements)
+    first = f"start + {layout.covered_from}" if layout.covered_from else "start"
+    covered = f"buf[{first} : stop - {layout.covered_to_end}]"
+    stored = "buf[stop - 1]" if size == 1 else f"int.from_bytes(buf[stop - {size} : stop], 'little')"
+    content = f"start + {offset}, stop - {after}"
+    args = f"buf, {content}" + "".join(f", {at(layout.offsets[e.name])}" for e in layout.value_elements)
     lines = [f"check = {stored}"]  # read once: the sum and the comparison both use it
-    stored = "check"
     lines += checksum_lines(checksum, covered, "expected")
-    header = layout.header[: layout.covered_from]
-    less = f" - {sum(header):#x}" if header else ""
-    total = checksum.algorithm.byte_total(f"sum({buf}){less} - {stored}")
-    whole = size == 1 == layout.covered_to_end and len(header) == layout.covered_from
-    if start is None and total is not None and whole:
-        # all but a checked header and the check: the sum of the whole frame less those, no slice made
-        lines = [lines[0], f"expected = {total}"]
     lines += [
-        f"if expected != {stored}:",
+        "if expected != check:",
         # as wide as the checksum: a u16 that reads 0 is 0x0000
-        f'    raise ChecksumError(f"bad checksum: the frame has {{{stored}:#0{2 + 2 * size}x}}, '
+        f'    raise ChecksumError(f"bad checksum: the frame has {{check:#0{2 + 2 * size}x}}, '
         f'its bytes give {{expected:#0{2 + 2 * size}x}}")',
     ]
     if layout.command_offset is None:  # the one codeless command of this direction, if any

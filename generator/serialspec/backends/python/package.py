@@ -226,7 +226,9 @@ def straight_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, A
             if len(users) == 1 and users[0][0] is not None:
                 single[key] = users[0][0]
             expected += [(m.class_name, key, target) for m, target, _, _ in users if m is not None and len(users) > 1]
-        frames = Target(direction.name, tuple(e.name for e in layout.value_elements), expected=bool(expected))
+        only = dispatch[0][1] if not layout.has_command and len(dispatch) == 1 and not expected else ""
+        values = tuple(e.name for e in layout.value_elements)
+        frames = Target(direction.name, values, expected=bool(expected), only=only)
         if protocol.error_reply is not None and direction == Direction.RESPONSE:
             element = next(e for e in layout.elements if e.name == protocol.error_reply.element)
             assert element.type is not None

@@ -1,5 +1,7 @@
-"""Straight-line code for frames that are not of the length-byte shape (length_byte_frames.py): stuffing, u16
-lengths over a span, CRC-16s, frames without a header or a length, alternative layouts told apart by their header.
+"""Straight-line frame code: stuffing, u16 lengths over a span, CRC-16s, frames without a header or a length,
+alternative layouts told apart by their header. decode_lines writes every framing's frame checks and dispatch (the
+length-byte codecs' decode() runs them past its whole-frame lookups, length_byte_frames.py); the rest serves the
+frames that are not of the length-byte shape.
 
 Each direction gets two functions: `_decode_<direction>(frame, expect)` checks a whole frame and calls the content
 decoder on the frame's own bytes, and `_wrap_<direction>(content, code, *values)` puts the frame around a content.
@@ -15,8 +17,8 @@ form (a length after the content, a checksum over bytes inside the stuffed span,
 engine instead, so every layout the language describes works and the straight-line form is only ever a faster way to
 the same result (tests/test_straight_frames.py holds them to it).
 
-Positions are expressions over `buf`, the frame with its stuffed span replaced by the plain bytes (the frame itself
-when nothing is stuffed): an element before the content at a literal offset, an element after it at `end + k`,
+Positions are expressions over `buf`, the frame with its stuffed span replaced by the plain bytes (`frame` itself
+where nothing can be stuffed): an element before the content at a literal offset, an element after it at `end + k`,
 where `end` is the content's end. Lengths and checksums that see wire bytes read `frame`.
 """
 
@@ -66,6 +68,7 @@ class Target:
     error_flag: int = 0
     error_keep: int = 0
     expected: bool = False
+    only: str = ""  # the one content decoder of frames that carry no command code: called directly
 
 
 def straight(layout: Layout) -> bool:
@@ -82,8 +85,8 @@ def straight(layout: Layout) -> bool:
             return False
         if element.kind == "checksum":
             a, b = element.span
-            if index <= last or b >= index or _inside(layout, a, b):
-                return False
+            if index <= last or b >= index or _inside(layout, a, b) or element.skip:
+                return False  # (a span that leaves out checksums inside it: the engine's covered bytes)
     packed = [e for e in layout.elements if e.kind in ("value", "command", "length") and e.size > 1]
     return len({e.endian for e in packed}) <= 1
 
@@ -117,7 +120,8 @@ class _Positions:
     def __init__(self, layout: Layout, from_end: bool = False) -> None:
         self.layout = layout
         self.from_end = from_end
-        self.buf = "frame" if from_end else "buf"
+        # the plain bytes: the frame itself where nothing can be stuffed
+        self.buf = "frame" if from_end or layout.transparency is None else "buf"
         self.first, self.last = _variable(layout)
         c = layout.content
         self.before = _size(layout.elements[: self.first])  # wire bytes before the variable part
@@ -165,18 +169,19 @@ class _Positions:
             return f"{buf}[{high}] << 8 | {buf}[{low}]"
         return f"int.from_bytes({buf}[{at[0]}:{self.stop(index)}], {element.endian!r})"
 
-    def counted(self, a: int, b: int) -> str:
-        """Bytes of elements a..b as a length counts them (wire bytes, but plain ones inside the stuffed span)."""
+    def counted(self, a: int, b: int, adds: int = 0) -> str:
+        """Bytes of elements a..b as a length counts them (wire bytes, but plain ones inside the stuffed span),
+        plus `adds`."""
         elements = self.layout.elements
         if a <= self.first and self.last <= b:  # holds the variable part: the wire frame minus what lies outside
             outside = (
                 self.before + self.after - _size(elements[a : self.first]) - _size(elements[self.last + 1 : b + 1])
             )
-            return _plus("n", -outside)
+            return _plus("n", adds - outside)
         c = self.layout.content
         if a <= c <= b:  # inside the stuffed span: plain bytes
-            return _plus("end", _size(elements[a:c]) + _size(elements[c + 1 : b + 1]) - self.content)
-        return str(_size(elements[a : b + 1]))
+            return _plus("end", _size(elements[a:c]) + _size(elements[c + 1 : b + 1]) - self.content + adds)
+        return str(_size(elements[a : b + 1]) + adds)
 
     def covered(self, a: int, b: int) -> str:
         """The bytes a checksum over elements a..b sees: wire bytes of `frame` when they hold the variable part."""
@@ -193,14 +198,21 @@ def _message_constant(element: Element, data: str) -> str:
 
 
 def decode_lines(
-    layout: Layout, name: str, target: Target, checks: dict[int, str], transparency: str, header_known: bool = False
+    layout: Layout,
+    name: str,
+    target: Target,
+    checks: dict[int, str],
+    transparency: str,
+    header_known: bool = False,
+    algorithms: dict[int, Checksum] | None = None,
 ) -> tuple[Lines, Lines]:
     """`def <name>(frame, expect)`: one layout's frame checked in the engine's order, its content decoded; and
     the function's body alone (for decode(), which runs it inline: one call less per frame).
 
     `checks`: element index -> the checksum function's name; `transparency`: the name of the layout's
     Transparency object (unstuffing, with its error for a frame that is not in stuffed form); `header_known`: the
-    caller has matched the header (it chose the layout by it), so it is not compared again.
+    caller has matched the header (it chose the layout by it), so it is not compared again; `algorithms`: element
+    index -> the checksum (its algorithm may test a whole frame by its byte sum).
     """
     positions = _Positions(layout)
     elements = layout.elements
@@ -219,9 +231,7 @@ def decode_lines(
         ]
     t = _stuffing(layout)
     body.append(f"end = n - {positions.behind}" if positions.behind else "end = n")
-    if t is None:
-        body.append("buf = frame")
-    else:
+    if t is not None:
         stop = f"n - {positions.after}" if positions.after else "n"
         found = " or ".join(f"frame.find({s!r}, {positions.before}, {stop}) >= 0" for s in _signs(t.replace))
         body += [
@@ -251,19 +261,23 @@ def decode_lines(
             continue
         low, high, also = element.minimum, element.maximum, element.also
         shown = f" (or {also})" if also is not None else ""
-        if also in (low - 1, high + 1):  # next to the range: one chained comparison
-            condition = f"{min(low, also)} <= {value} <= {max(high, also)}"
+        if also in (low - 1, high + 1):  # next to the range: one bound of it
+            low, high, also = min(low, also), max(high, also), None
+        if also is None and low <= 0:  # no value of the element is below it
+            refused = f"{value} > {high}"
+        elif also is None:
+            refused = f"not {low} <= {value} <= {high}"
         else:
-            condition = f"({low} <= {value} <= {high}" + (f" or {value} == {also})" if also is not None else ")")
+            refused = f"not ({low} <= {value} <= {high} or {value} == {also})"
+        low, high = element.minimum, element.maximum  # as the engine words it
         body += [
-            f"if not {condition}:",
+            f"if {refused}:",
             f'    raise DecodeError(f"{element.name} = {{{value}}} is outside its range {low}..{high}{shown}")',
         ]
     for index, element in enumerate(elements):
         if element.kind != "length":
             continue
-        counted = positions.counted(*element.span)
-        counted = _plus(counted, element.adds)
+        counted = positions.counted(*element.span, element.adds)
         body += [
             f"length = {positions.read(index)}",
             f"if length != {counted}:",
@@ -282,7 +296,10 @@ def decode_lines(
         ]
         residue = _residue(element)
         a, b = element.span
-        if residue is not None and b == index - 1 and a <= positions.first:
+        test = frame_sum_test(layout, index, (algorithms or {}).get(index))
+        if test is not None:  # the sum of the whole frame, no slice made; the rest only says what is wrong
+            body += [f"if {test}:", *(f"    {line}" for line in [*failed[:2], failed[3].strip()])]
+        elif residue is not None and b == index - 1 and a <= positions.first:
             # over the covered bytes and the checksum itself, an intact frame's CRC is one constant: no slice, no
             # stored value to read; they are made only to say what is wrong
             whole = positions.covered(a, index)
@@ -292,8 +309,21 @@ def decode_lines(
     if command is not None:
         body.append(f"code = {positions.read(command)}")
     code = "None" if command is None else "code"
-    body += _dispatch(target, code, ", ".join(["buf", str(positions.content), "end", *values]), nullable=False)
+    body += _dispatch(target, code, ", ".join([positions.buf, str(positions.content), "end", *values]), nullable=False)
     return lines + [f"    {line}" for line in body], ["n = len(frame)", *body]
+
+
+def frame_sum_test(layout: Layout, index: int, checksum: Checksum | None, frame: str = "frame") -> str | None:
+    """A test, true for a bad frame, of a one-byte checksum (element `index`) as one expression over the sum of the
+    whole unstuffed frame `frame`, where its algorithm has one (checksums/: frame_test) and it is the frame's last
+    byte and covers all before it but constants (checked before it). None for others."""
+    elements = layout.elements
+    a, b = elements[index].span
+    if checksum is None or layout.transparency is not None or elements[index].size != 1 or elements[index].skip:
+        return None
+    if index != len(elements) - 1 or b != index - 1 or any(e.kind != "constant" for e in elements[:a]):
+        return None
+    return checksum.algorithm.frame_test(f"sum({frame})", sum(sum(e.constant) for e in elements[:a]), f"{frame}[-1]")
 
 
 def _residue(element: Element) -> int | None:
@@ -322,6 +352,8 @@ def _dispatch(target: Target, code: str, arguments: str, nullable: bool) -> Line
     """Lines that decode the content with the decoder of `code` (an expression; "None" where frames carry none):
     an error reply's where the error flag is set, the expected reply's where replies share a code."""
     table = f"_{target.upper}_DECODERS"
+    if code == "None" and target.only and not target.expected:
+        return [f"return {target.only}({arguments})"]
     lines: Lines = []
     if target.error_flag and code != "None":
         known = f"{code} is not None and " if nullable else ""
@@ -329,7 +361,7 @@ def _dispatch(target: Target, code: str, arguments: str, nullable: bool) -> Line
             f"if {known}{code} & {target.error_flag:#04x}:  # an error reply: it refuses the request of code & ~flag",
             f"    return {table}[ERROR_REPLY]({arguments}, {code} & {target.error_keep:#04x})",
         ]
-    unknown = f'f"unknown command {{{code}!r}}"' if code != "None" else '"unknown command None"'
+    unknown = f'f"unknown command {{{code}:#04x}}"' if code != "None" else '"unknown command None"'
     lines += [
         "try:",
         f"    decoder = {table}[{code}]",
@@ -356,7 +388,7 @@ def _signs(replace: tuple[tuple[bytes, bytes], ...]) -> list[bytes]:
 def _constant_checks(positions: _Positions, start: int = 0) -> Lines:
     """Constant elements from `start` on (1: the header is known to match) checked in element order; neighbours
     compared at once, one by one only to say which."""
-    layout = positions.layout
+    layout, buf = positions.layout, positions.buf
     runs: list[list[int]] = []
     for index, element in enumerate(layout.elements):
         if element.kind != "constant" or index < start:
@@ -371,10 +403,10 @@ def _constant_checks(positions: _Positions, start: int = 0) -> Lines:
         single: list[tuple[str, str, str]] = []  # condition, message per element
         for index, element in each:
             if element.size == 1:
-                condition = f"buf[{positions.at(index)}] != {element.constant[0]:#04x}"
-                data = f"buf[{positions.at(index)}:{positions.stop(index)}]"
+                condition = f"{buf}[{positions.at(index)}] != {element.constant[0]:#04x}"
+                data = f"{buf}[{positions.at(index)}:{positions.stop(index)}]"
             else:
-                data = f"buf[{_start(positions.at(index))}:{positions.stop(index)}]"
+                data = f"{buf}[{_start(positions.at(index))}:{positions.stop(index)}]"
                 condition = f"{data} != {element.constant!r}"
             single.append((condition, _message_constant(element, data), element.name))
         if len(each) == 1:
@@ -382,7 +414,7 @@ def _constant_checks(positions: _Positions, start: int = 0) -> Lines:
             lines += [f"if {condition}:", f"    raise DecodeError({message})"]
             continue
         whole = b"".join(element.constant for _, element in each)
-        lines.append(f"if buf[{_start(positions.at(run[0]))}:{positions.stop(run[-1])}] != {whole!r}:")
+        lines.append(f"if {buf}[{_start(positions.at(run[0]))}:{positions.stop(run[-1])}] != {whole!r}:")
         for condition, message, _ in single[:-1]:
             lines += [f"    if {condition}:", f"        raise DecodeError({message})"]
         lines.append(f"    raise DecodeError({single[-1][1]})")
@@ -609,6 +641,7 @@ class StraightLayouts:
 
     layouts: tuple[Layout, ...]
     checks: tuple[dict[int, str], ...]
+    algorithms: tuple[dict[int, Checksum], ...]  # the same checksums
 
 
 def straight_direction(protocol: Protocol, direction: Direction) -> StraightLayouts | None:
@@ -617,11 +650,12 @@ def straight_direction(protocol: Protocol, direction: Direction) -> StraightLayo
     names = {tuple(e.name for e in (layout.elements[i] for i in layout.values)) for layout in layouts}
     if not all(straight(layout) for layout in layouts) or len(names) != 1:
         return None
-    checks = tuple(
-        {index: checksum_call(e.checksum) for index, e in enumerate(model.elements) if e.checksum is not None}
+    algorithms = tuple(
+        {index: e.checksum for index, e in enumerate(model.elements) if e.checksum is not None}
         for model in protocol.framing.alternatives[direction]
     )
-    return StraightLayouts(layouts, checks)
+    checks = tuple({index: checksum_call(checksum) for index, checksum in found.items()} for found in algorithms)
+    return StraightLayouts(layouts, checks, algorithms)
 
 
 def direction_functions(
@@ -643,7 +677,7 @@ def direction_functions(
     lines: Lines = []
     wraps: list[_LayoutEncoding] = []
     bodies: list[Lines] = []
-    for layout, checks in zip(layouts, found.checks, strict=True):
+    for layout, checks, algorithms in zip(layouts, found.checks, found.algorithms, strict=True):
         suffix = f"_{layout.name}" if several else ""
         stuffing = f"_{target.upper}{suffix.upper()}_TRANSPARENCY"
         t = _stuffing(layout)
@@ -651,7 +685,7 @@ def direction_functions(
             pairs = ", ".join(f"({plain!r}, {wire!r})" for plain, wire in t.replace)
             lines += [f"{stuffing} = Transparency({t.span}, ({pairs},))", "", ""]
         # of several layouts, each is decoded once its header has chosen it (_choice)
-        function, body = decode_lines(layout, f"_decode_{d}{suffix}", target, checks, stuffing, several)
+        function, body = decode_lines(layout, f"_decode_{d}{suffix}", target, checks, stuffing, several, algorithms)
         lines += [*function, "", ""]
         bodies.append(body)
         wraps.append(wrap_parts(layout, target, checks, stuffing, registry(structs)))

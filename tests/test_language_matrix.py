@@ -35,7 +35,7 @@ from serialspec.backends import emitters
 from serialspec.backends.python.memory import imported
 from serialspec.lang import SpecErrors, grammar
 from serialspec.lang.loader import load_text
-from serialspec.lang.model import Message, Protocol
+from serialspec.lang.model import Message, Protocol, replies_by_request, reply_to
 from serialspec.lang.passes.fields import FIELD_KINDS
 from serialspec.lang.resolve import resolve
 from serialspec.runtime.transport import Bus
@@ -79,6 +79,7 @@ class Case:
     response: dict[str, Any]
     framing: dict[str, Any] | None = None
     commands: dict[str, Any] | None = None  # more commands beside `probe`
+    request_keys: dict[str, Any] | None = None  # more keys of probe's request (answered_by)
 
 
 def same(fields: dict[str, Any]) -> Case:
@@ -169,6 +170,15 @@ CASES: dict[str, Case] = {
     "range, unit, scale": same({"v": {"type": "i16", "range": [-100, 100], "unit": "mV", "scale": 0.5}}),
     "use (shared field)": same({"angle": {"use": "angle"}, "also": "angle"}),
     "status": Case({"v": "u8"}, {"success": {"type": "u8", "status": {"ok": 1}}, "v": "u8"}),
+    "answered_by another code, refused_by, request_code": Case(
+        {"v": {"type": "u8", "range": [0, 100]}},
+        {"v": "u8"},
+        commands={
+            "ack": {"code": 5, "response": {"request_code": "acked", "fields": {"acked": "u8", "n": "u16"}}},
+            "nak": {"code": 6, "response": {"request_code": "refused", "fields": {"refused": "u8"}}},
+        },
+        request_keys={"answered_by": {"command": "ack", "refused_by": ["nak"]}},
+    ),
     # frame shapes: every element role, multi-byte elements in both byte orders, stuffing, alternative layouts
     "frame: trailer, constant, u16 big-endian length and checksum": Case(
         {"v": "u16"},
@@ -305,7 +315,7 @@ def spec_text(name: str, case: Case) -> str:
             "probe": {
                 "code": 1,
                 "title": "Probe",
-                "request": {"fields": case.request},
+                "request": {"fields": case.request, **copy.deepcopy(case.request_keys or {})},
                 "response": {"fields": case.response},
             },
             **copy.deepcopy(case.commands or {}),
@@ -541,7 +551,8 @@ def client_against_simulator(g: Generated) -> None:
         if k.endswith("Simulator") and k != "Simulator" and isinstance(v, type)
     )
     request = next(m for m in g.protocol.messages() if m.direction.value == "request" and m.command == "probe")
-    response = next(m for m in g.protocol.messages() if m.direction.value == "response" and m.command == "probe")
+    response = reply_to(request, replies_by_request(g.protocol.messages()))
+    assert response is not None
     simulator = simulator_class(ids=[1])
     path = simulator.start()
     try:

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define DYNAMIXEL_P2_SPEC_SHA256 "4099b84682feeba1fde71e6425518b5666d0da3e4ace344d693bf0cf3d60929d"
+#define DYNAMIXEL_P2_SPEC_SHA256 "0ee6df23c48b5cddf8f403cd1ca43abd6b3f0bb8994cc0b67fbb23f0bec15ae6"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef DYNAMIXEL_P2_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define FEETECH_SMS_SPEC_SHA256 "1c0c350e3d004b0bba59b1a7be0e8a6a998dc5214de9925408e5b41838cba278"
+#define FEETECH_SMS_SPEC_SHA256 "dae57a870990d7323f7ff303ec3a24fc699b467ad256f12817ea7643741f76f5"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef FEETECH_SMS_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define HIWONDER_RRC_SPEC_SHA256 "3eec351430e25eb83a9fbf50a1e2472607d616a771e0dc7ee45fa77d30c44df8"
+#define HIWONDER_RRC_SPEC_SHA256 "f09b6236af133d6ab19f8f395f481eba30f757f75f8d0739edefebd08cf6a2c1"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef HIWONDER_RRC_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define VESC_SPEC_SHA256 "a8c1810c0b4a221ea2ce3fd861441698501ec60e3e580f3afc31f780541148ce"
+#define VESC_SPEC_SHA256 "1092ffcec9f6bfcbf26b19686ffa79a19abc8784c1d6671a5231a217975b7bae"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef VESC_ENABLE_ENCODE

@@ -430,9 +430,21 @@ MESSAGE = Obj(
         ),
         "optional_when": OPTIONAL_WHEN,
         "after": Str("For a response: the request field (in ms) after which the device answers, e.g. a move's time."),
+        "request_code": Str(
+            "For a response that answers other commands' requests (`answered_by`): its integer field holding the "
+            "command code of the request it answers (u-blox ACK: the acknowledged class and id). The client "
+            "matches it, the simulator fills it in.",
+            example="acked",
+        ),
         "answered_by": Obj(
             {
                 "command": Str("The command whose response answers this request (one reply layout for many)."),
+                "refused_by": ListOf(
+                    Str(),
+                    "Commands whose responses refuse this request instead (u-blox ACK-NAK): the client waits for "
+                    "the `command`'s reply or one of these, and raises DeviceError naming the refusal.",
+                    example=["nak"],
+                ),
                 "optional_when": OPTIONAL_WHEN,
             },
             required=("command",),

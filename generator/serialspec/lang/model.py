@@ -288,6 +288,8 @@ class Message:
     reply_when: OptionalWhen | None = None  # a request whose reply is sent only when a device parameter has a value
     struct_name: str = ""  # the construct struct of its content
     default_reply: bool = False  # among replies sharing a code: the one a frame is decoded as without its request
+    refused_by: tuple[str, ...] = ()  # a request: the commands whose responses refuse it (it raises DeviceError)
+    request_code: str = ""  # a response: its field holding the code of the request it answers (u-blox ACK)
 
     @property
     def key(self) -> str:
@@ -306,6 +308,11 @@ def replies_by_request(responses: Iterable[Message]) -> dict[str, Message]:
 def reply_to(request: Message, replies: dict[str, Message]) -> Message | None:
     """The response that answers a request (from `replies_by_request`), or the one it is `answered_by`."""
     return replies.get(request.answered_by or request.key)
+
+
+def refusals_of(request: Message, replies: dict[str, Message]) -> tuple[Message, ...]:
+    """The responses that refuse a request (its `refused_by`), from `replies_by_request`."""
+    return tuple(replies[name] for name in request.refused_by if name in replies)
 
 
 def reply_condition(request: Message, response: Message | None) -> OptionalWhen | None:

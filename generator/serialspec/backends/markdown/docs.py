@@ -201,12 +201,17 @@ def reply_text(message: Message, protocol: Protocol | None = None) -> str:
     """For a request answered by another command's response: which, and the parameter that switches it; for a
     response that shares its code with other replies: how a reply is told to have this layout."""
     if message.direction == Direction.RESPONSE and protocol is not None:
-        return shared_reply_text(protocol, message)
-    if not message.answered_by:
+        parts = [shared_reply_text(protocol, message)]
+        if message.request_code:
+            parts.append(f"`{message.request_code}` holds the code of the request it answers")
+        return "; ".join(p for p in parts if p)
+    if not message.answered_by and not message.refused_by:
         return ""
     switch = message.reply_when
     when = f", sent only while `{switch.entry}` {switch.symbol} {switch.equals}" if switch else ""
-    return f"answered by the `{message.answered_by}` response{when}"
+    refusals = ", ".join(f"`{name}`" for name in message.refused_by)
+    refused = f"; refused by the {refusals} response (the client raises DeviceError)" if refusals else ""
+    return f"answered by the `{message.answered_by or message.key}` response{when}{refused}"
 
 
 def error_reply_text(protocol: Protocol, message: Message) -> str:

@@ -23,6 +23,8 @@ from serialspec.lang.model import (
     TableBlock,
     TableValue,
     Text,
+    refusals_of,
+    replies_by_request,
     reply_condition,
 )
 
@@ -218,11 +220,20 @@ def simulator_module(protocol: Protocol) -> str:
                 if runs:
                     args.append(f"{name}={{{', '.join(f'{k!r}: {run_spec(r)}' for k, r in runs.items())}}}")
         derived = derived_values(request, response)
+        refusals = refusals_of(request, replies_by_request(protocol.messages()))
+        code = protocol.command(request.command).code
+        for reply in (response, *refusals[:1]):
+            if reply is not None and reply.request_code and code is not None:
+                derived[reply.request_code] = f"lambda fields: {code:#04x}"  # the code of the request it answers
+        if refusals:
+            # a refused request (a value outside its range or enum, a refused write) gets the first refusal
+            imports.add(refusals[0].class_name)
+            args.append(f"refusal={refusals[0].class_name}")
         if derived:
             args.append(f"derived={{{', '.join(f'{k!r}: {v}' for k, v in derived.items())}}}")
-        if device.errors is not None and protocol.error_reply is not None:
-            code = protocol.command(request.command).code
-            args.append(f"code={code!r}")
+        if (device.errors is not None and protocol.error_reply is not None) or refusals:
+            if protocol.error_reply is not None:
+                args.append(f"code={code!r}")
             checked = limits(request)
             if checked:
                 shown = ", ".join(f"{k!r}: ({number(lo)}, {number(hi)}, {v!r})" for k, (lo, hi, v) in checked.items())

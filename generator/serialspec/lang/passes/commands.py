@@ -215,11 +215,14 @@ class Commands(FieldResolver):
         responses = {m.key: m for c in commands for m in c.messages() if m.direction == Direction.RESPONSE}
         for command in commands:
             for message in command.messages():
+                path = (*message_path(message), "answered_by")
                 if message.answered_by and message.answered_by not in responses:
-                    self.error(
-                        ("commands", command.name, "request", "answered_by", "command"),
-                        f"{message.answered_by!r} is not a command with a response",
-                    )
+                    self.error((*path, "command"), f"{message.answered_by!r} is not a command with a response")
+                for index, name in enumerate(message.refused_by):
+                    if name not in responses:
+                        self.error((*path, "refused_by", index), f"{name!r} is not a command with a response")
+                    elif name == (message.answered_by or message.key):
+                        self.error((*path, "refused_by", index), f"{name!r} is the reply that answers it")
 
     def check_codes(self, commands: list[Command], framing: Framing) -> None:
         for command in commands:
@@ -334,6 +337,8 @@ class Commands(FieldResolver):
             optional_when=self.optional_when(value.get("optional_when"), (*path, "optional_when")),
             after=self.after(value.get("after"), fields, direction, path),
             answered_by=str(answered_by.get("command", "")),
+            refused_by=tuple(str(name) for name in answered_by.get("refused_by") or ()),
+            request_code=self.request_code(value.get("request_code"), fields, direction, path),
             default_reply=bool(value.get("default", False)),
             reply_when=self.optional_when(answered_by.get("optional_when"), (*path, "answered_by", "optional_when")),
             struct_name=struct_name,
@@ -359,6 +364,16 @@ class Commands(FieldResolver):
             raise self.fail(path, f"give one comparison: {', '.join(OPTIONAL_WHEN_OPS)}")
         key, op = given[0]
         return OptionalWhen(table.name, entry.name, entry.key, int(value[key]), op)
+
+    def request_code(self, value: Any, fields: tuple[Field, ...], direction: Direction, path: Path) -> str:
+        if value is None:
+            return ""
+        if direction != Direction.RESPONSE:
+            self.error((*path, "request_code"), "`request_code` names a field of a response")
+        elif not any(isinstance(f, Scalar) and not (f.hidden or f.type.is_float) and f.name == value for f in fields):
+            names = ", ".join(f.name for f in fields if isinstance(f, Scalar) and not f.hidden) or "none"
+            self.error((*path, "request_code"), f"no integer field {value!r} in this response (it has: {names})")
+        return str(value)
 
     def after(self, value: Any, fields: tuple[Field, ...], direction: Direction, path: Path) -> str:
         if value is None:

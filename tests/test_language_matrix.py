@@ -377,6 +377,19 @@ CASES["frame: transparency, checksum over exactly the span"] = Case(
         },
     },
 )
+# Requests that share a code, told apart by their content size (0, 2, 3 or more bytes), in the usual frame and in
+# one the frame engine reads
+SHARED_CODE = {
+    "poll": {"code": 1, "request": {"fields": {}}},
+    "long": {"code": 1, "request": {"fields": {"a": "u8", "b": "u16", "data": {"type": "bytes", "size": "rest"}}}},
+}
+CASES["requests sharing a code, by content size"] = Case({"v": "u16"}, {"w": "u8"}, commands=SHARED_CODE)
+CASES["requests sharing a code, by content size, frame engine"] = Case(
+    {"v": "u16"},
+    {"w": "u16"},
+    CASES["frame: trailer, constant, u16 big-endian length and checksum"].framing,
+    commands=SHARED_CODE,
+)
 PARAMS = [
     pytest.param(name, marks=pytest.mark.xfail(reason=KNOWN[name], strict=True)) if name in KNOWN else name
     for name in sorted(CASES)

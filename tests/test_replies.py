@@ -1,9 +1,12 @@
-"""Replies of other commands: a request answered by another command's response (`answered_by`) under frames matched
-by command, refusals (`refused_by`: the client raises DeviceError naming them, the simulator sends them for a refused
-request) and replies carrying the code of the request they answer (`request_code`)."""
+"""Commands and replies beyond one request and one reply per code: requests that share a code, told apart by their
+content size (a poll and a set); a request answered by another command's response (`answered_by`) under frames
+matched by command, refusals (`refused_by`: the client raises DeviceError naming them, the simulator sends them for a
+refused request) and replies carrying the code of the request they answer (`request_code`)."""
 
 from __future__ import annotations
 
+import contextlib
+import importlib
 import os
 import threading
 import tty
@@ -16,11 +19,10 @@ from serialspec.backends.python.memory import imported
 from serialspec.lang import SpecErrors
 from serialspec.lang.loader import load_text
 from serialspec.lang.resolve import resolve
-from serialspec.runtime.errors import DeviceError
+from serialspec.runtime.errors import DecodeError, DeviceError
 
-SPEC = """
-protocol: acks
-title: Acknowledged settings
+# u-blox-like frames: B5 62, the code, a length byte, the content and a sum
+FRAME = """
 byte_order: little
 serial: {baudrate: 115200}
 framing:
@@ -32,7 +34,14 @@ framing:
     checksum: {role: checksum, type: u8, algorithm: sum, covers: [code, content]}
 matching:
   by: [command]
-commands:
+"""
+SPEC = (
+    """
+protocol: acks
+title: Acknowledged settings
+"""
+    + FRAME
+    + """commands:
   set_rate:
     code: 0x10
     request:
@@ -60,6 +69,7 @@ commands:
 device:
   state: {rate: 1}
 """
+)
 
 
 def frame(code: int, content: bytes) -> bytes:
@@ -67,15 +77,100 @@ def frame(code: int, content: bytes) -> bytes:
     return b"\xb5\x62" + body + bytes([sum(body) & 0xFF])
 
 
-@pytest.fixture(scope="module")
-def acks() -> Iterator[ModuleType]:
-    protocol = resolve(load_text(SPEC, "acks.yaml"))
+@contextlib.contextmanager
+def package(text: str, name: str) -> Iterator[ModuleType]:
+    protocol = resolve(load_text(text, f"{name}.yaml"))
     files = {
         path: text for emitter in emitters() if not emitter.folder for path, text in emitter.files(protocol).items()
     }
-    modules = {path.partition("/")[2]: text for path, text in files.items() if path.startswith("acks/")}
-    with imported("acks", modules) as package:
-        yield package
+    modules = {path.partition("/")[2]: text for path, text in files.items() if path.startswith(f"{name}/")}
+    with imported(name, modules) as generated:
+        yield generated
+
+
+@pytest.fixture(scope="module")
+def acks() -> Iterator[ModuleType]:
+    with package(SPEC, "acks") as generated:
+        yield generated
+
+
+POLLS = (
+    """
+protocol: polls
+title: A poll and a set under one code
+"""
+    + FRAME
+    + """commands:
+  poll_rate:
+    code: 0x08
+    request: {fields: {}}
+    response:
+      fields:
+        rate: u16
+        nav: u16
+  set_rate:
+    code: 0x08
+    request:
+      fields:
+        rate: {type: u16, range: [1, 1000]}
+        nav: u16
+  write_name:
+    code: 0x09
+    request:
+      fields:
+        slot: u8
+  write_long_name:
+    code: 0x09
+    request:
+      fields:
+        slot: u8
+        flags: u8
+        name: {type: bytes, size: rest}
+device:
+  state: {rate: 1000, nav: 1}
+  commands:
+    set_rate: {stores: {rate: rate, nav: nav}}
+    poll_rate: {reports: {rate: rate, nav: nav}}
+"""
+)
+
+
+def test_requests_that_share_a_code_are_told_apart_by_their_content_size() -> None:
+    """Each layout its own class, encoded under the one code, decoded (and parsed) by its size; the client polls
+    and sets the simulator."""
+    with package(POLLS, "polls") as polls:
+        m = polls.messages
+        for message in (
+            m.PollRateRequest(),
+            m.SetRateRequest(rate=5, nav=2),
+            m.WriteNameRequest(slot=1),
+            m.WriteLongNameRequest(slot=1, flags=2, name=b""),
+            m.WriteLongNameRequest(slot=1, flags=2, name=b"abc"),
+        ):
+            encoded = polls.encode(message)
+            assert polls.decode(encoded, "request") == message
+            assert polls.StreamParser("request").feed(b"\x00" + encoded + encoded) == [message, message]
+        with pytest.raises(DecodeError, match="content of 2 bytes fits none of its layouts"):
+            polls.decode(frame(0x08, b"\x01\x02"), "request")
+        simulator = importlib.import_module("polls.simulator").PollsSimulator(ids=[0])
+        path = simulator.start()
+        try:
+            with importlib.import_module("polls.client").PollsClient(path, timeout=1.0) as client:
+                assert client.poll_rate() == m.PollRateResponse(rate=1000, nav=1)
+                client.set_rate(7, 3)
+                assert client.poll_rate() == m.PollRateResponse(rate=7, nav=3)
+        finally:
+            simulator.close()
+
+
+def test_requests_that_share_a_code_need_sizes_that_differ() -> None:
+    text = POLLS.replace("        flags: u8\n", "")
+    with pytest.raises(SpecErrors) as caught:
+        resolve(load_text(text, "polls.yaml"))
+    assert str(caught.value).endswith(
+        "commands.write_long_name: code 0x09 in request frames is already used by 'write_name', and a content of 1 "
+        "byte fits both (requests that share a code are told apart by their content size: 1 byte and 1 byte or more)"
+    )
 
 
 def test_the_client_gets_another_commands_reply_from_the_simulator(acks: ModuleType) -> None:
@@ -139,12 +234,12 @@ def test_a_refusal_raises_by_name_and_another_requests_ack_is_not_taken(acks: Mo
     [
         (
             ("refused_by: [nak]}", "refused_by: [nack]}"),
-            "acks.yaml:21:48: commands.set_rate.request.answered_by.refused_by[0]: 'nack' is not a command with a "
+            "acks.yaml:22:48: commands.set_rate.request.answered_by.refused_by[0]: 'nack' is not a command with a "
             "response",
         ),
         (
             ("refused_by: [nak]}", "refused_by: [ack]}"),
-            "acks.yaml:21:48: commands.set_rate.request.answered_by.refused_by[0]: 'ack' is the reply that answers it",
+            "acks.yaml:22:48: commands.set_rate.request.answered_by.refused_by[0]: 'ack' is the reply that answers it",
         ),
         (("request_code: acked", "request_code: ackd"), "no integer field 'ackd' in this response (it has: acked)"),
     ],

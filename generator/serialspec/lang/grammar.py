@@ -479,7 +479,9 @@ COMMAND = Obj(
     {
         "code": Int(
             "Value of the frame's command field; omit for the one response of a protocol whose replies "
-            "carry no command field."
+            "carry no command field. The requests of several commands may share a code when no content size fits "
+            "two of them: each is its own message, decoded by its size (u-blox: an empty payload polls, a full one "
+            "sets)."
         ),
         "title": TITLE,
         "title_cn": TITLE_CN,

@@ -296,6 +296,14 @@ class Message:
         return f"{self.command}.{self.subcommand}" if self.subcommand else self.command
 
 
+def sizes_text(message: Message) -> str:
+    """A message's content sizes, as people read them: 4 bytes, 0..8 bytes, 2 bytes or more."""
+    low, high = message.min_size, message.max_size
+    if low == high:
+        return f"{low} byte" + ("" if low == 1 else "s")
+    return f"{low}..{high} bytes" if high is not None else f"{low} byte{'' if low == 1 else 's'} or more"
+
+
 def replies_by_request(responses: Iterable[Message]) -> dict[str, Message]:
     """Responses by the request they answer: their own command's, or the one they say they `answers`."""
     index: dict[str, Message] = {}

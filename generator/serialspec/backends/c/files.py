@@ -387,6 +387,14 @@ def source(ctx: Ctx) -> str:
                         body.append(f"            case {sub.code}u: {dec_call(ctx, m, values)}")
                 body.append(f"            default: return {P}_E_UNKNOWN;")
                 body.append("            }")
+            elif d == Direction.REQUEST and len(users) > 1:  # requests that share a code: by their content size
+                for u in sorted(users, key=lambda u: u.min_size):
+                    fits = f"n >= {u.min_size}u" if u.min_size else ""
+                    if u.max_size is not None:
+                        fits = f"n == {u.min_size}u" if u.max_size == u.min_size else f"{fits} && n <= {u.max_size}u"
+                    fits = (fits or "1").removeprefix(" && ")
+                    body.append(f"            if ({fits}) {{ {dec_call(ctx, u, values)} }}")
+                body.append(f"            return {P}_E_LENGTH;")
             else:
                 default = next((u for u in users if u.default_reply), users[0])
                 for u in users:

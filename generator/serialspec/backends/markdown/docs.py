@@ -178,9 +178,32 @@ def message_context(protocol: Protocol, message: Message | None) -> dict[str, An
         "optional": text(message.optional),
         "unsolicited": message.unsolicited,
         "answers": message.answers,
-        "reply": reply_text(message, protocol) or error_reply_text(protocol, message),
+        "reply": "; ".join(
+            part
+            for part in (
+                shared_request_text(protocol, message),
+                reply_text(message, protocol) or error_reply_text(protocol, message),
+            )
+            if part
+        ),
         "description": text(message.description),
     }
+
+
+def shared_request_text(protocol: Protocol, message: Message) -> str:
+    """A request that shares its code with others: told apart by its content size."""
+    if message.direction != Direction.REQUEST or message.subcommand is not None:
+        return ""
+    code = protocol.command(message.command).code
+    others = [
+        m.command
+        for c in protocol.commands
+        if c.code == code and c.name != message.command and (m := c.request) is not None
+    ]
+    if code is None or not others:
+        return ""
+    names = ", ".join(f"`{name}`" for name in others)
+    return f"shares code {code:#04x} with {names}, told apart by the content size"
 
 
 def content_limit(layout: FrameLayout) -> int | None:

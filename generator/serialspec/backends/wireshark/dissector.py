@@ -116,6 +116,14 @@ def _direction(protocol: Protocol, direction: Direction) -> dict[str, Any]:
         key = _code(command.code if coded else None)
         if protocol.error_reply is not None and command.name == protocol.error_reply.command:
             key = "error"
+        if key in codes and direction == Direction.REQUEST:  # requests sharing a code: by their content size
+            shared = codes[key]
+            layouts_by_size = shared.get("by_size") or [shared.pop("message")]
+            shared["by_size"] = [*layouts_by_size, _message(protocol, message)]
+            highs = [m["max"] for m in shared["by_size"]]
+            shared["min"] = min(m["min"] for m in shared["by_size"])
+            shared["max"] = None if None in highs else max(highs)
+            continue
         if key in codes and not message.default_reply:
             continue  # replies sharing a code: the one decoded without its request (the default) is shown
         codes[key] = {"message": _message(protocol, message)}

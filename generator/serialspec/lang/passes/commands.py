@@ -23,6 +23,7 @@ from serialspec.lang.model import (
     fixed_size,
     replies_by_request,
     reply_to,
+    sizes_text,
 )
 from serialspec.lang.passes.base import camel
 from serialspec.lang.passes.fields import FieldResolver
@@ -270,7 +271,17 @@ class Commands(FieldResolver):
                 if len(users) < 2:
                     continue
                 what = f"code {code:#04x}" if code is not None else "a codeless reply"
-                if direction == Direction.REQUEST or any(c.selector for c, _ in users):
+                if direction == Direction.REQUEST and not any(c.selector for c, _ in users):
+                    if any(alt.length is None for alt in framing.alternatives.get(direction, (layout,))):
+                        self.error(
+                            ("commands", users[1][0].name),
+                            f"{what} in request frames is already used by {users[0][0].name!r}; requests that share "
+                            "a code are told apart by their content size, which needs a length element",
+                        )
+                    else:
+                        self.check_sizes_differ(what, users)
+                    continue
+                if any(c.selector for c, _ in users):
                     for command, _ in users[1:]:
                         self.error(
                             ("commands", command.name),
@@ -285,6 +296,21 @@ class Commands(FieldResolver):
                         f"{what} is shared by the replies of {names}: mark one of them `default: true` (the "
                         "layout a reply is decoded as when its request is unknown)",
                     )
+
+    def check_sizes_differ(self, what: str, users: list[tuple[Command, Message]]) -> None:
+        """Requests that share a code are told apart by their content size: no size may fit two of them."""
+        for index, (command, message) in enumerate(users):
+            for other, earlier in users[:index]:
+                low = max(message.min_size, earlier.min_size)
+                highs = [h for h in (message.max_size, earlier.max_size) if h is not None]
+                if not highs or low <= min(highs):
+                    self.error(
+                        ("commands", command.name),
+                        f"{what} in request frames is already used by {other.name!r}, and a content of {low} "
+                        f"byte{'' if low == 1 else 's'} fits both (requests that share a code are told apart by "
+                        f"their content size: {sizes_text(earlier)} and {sizes_text(message)})",
+                    )
+                    break  # one line a command
 
     def message(
         self,

@@ -5,7 +5,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 BENCH_STAMP := $(VENV)/.installed-bench
 
-.PHONY: generate test test-fast test-tools constraints check lint typecheck clean demo stress bench wheel runtime-wheel docs c-check
+.PHONY: generate test test-fast test-tools constraints check lint typecheck clean demo stress bench bench-c wheel runtime-wheel docs c-check
 
 CONSTRAINTS := requirements/constraints.txt
 
@@ -25,10 +25,11 @@ generate: $(STAMP) test-tools
 # Programs the tests drive as a user would: tshark (the Wireshark dissectors) and tmux (`serialspec watch` on a
 # screen). Installed with apt-get where they are missing and this runs as root; elsewhere the tests that need them
 # are skipped, saying why.
+# The C target's tests also build with clang, with gcc -m32 (gcc-multilib: 32-bit size_t and long) and for big-endian
+# PowerPC (a cross gcc; qemu-user runs the programs): installed the same way.
 TEST_TOOLS := tshark tmux
-test-tools:
-	@missing=""; for tool in $(TEST_TOOLS); do command -v $$tool >/dev/null || missing="$$missing $$tool"; done; \
-	if [ -z "$$missing" ]; then exit 0; fi; \
+# apt-get install of the packages in $$missing, as root; elsewhere it says which tests are skipped
+INSTALL_MISSING = if [ -z "$$missing" ]; then exit 0; fi; \
 	if [ "$$(id -u)" != 0 ] || ! command -v apt-get >/dev/null; then \
 		echo "not installed:$$missing (apt-get as root installs them): the tests that need them are skipped"; exit 0; fi; \
 	echo "installing$$missing (apt-get)"; \
@@ -36,6 +37,13 @@ test-tools:
 	apt-get install -y -q $$missing >/dev/null 2>&1 || { apt-get update -q >/dev/null 2>&1 && \
 		apt-get install -y -q $$missing >/dev/null 2>&1; } || \
 		echo "could not install$$missing: the tests that need them are skipped"
+test-tools:
+	@missing=""; for tool in $(TEST_TOOLS); do command -v $$tool >/dev/null || missing="$$missing $$tool"; done; \
+	command -v clang >/dev/null || missing="$$missing clang"; \
+	printf 'int main(void) { return 0; }\n' | gcc -m32 -x c - -o /dev/null 2>/dev/null || missing="$$missing gcc-multilib"; \
+	command -v powerpc-linux-gnu-gcc >/dev/null || missing="$$missing gcc-powerpc-linux-gnu libc6-dev-powerpc-cross"; \
+	command -v qemu-ppc >/dev/null || missing="$$missing qemu-user"; \
+	$(INSTALL_MISSING)
 
 check: $(STAMP)
 	$(BIN)/serialspec check
@@ -55,11 +63,13 @@ test: $(STAMP) test-tools check lint typecheck
 test-fast: $(STAMP) test-tools check
 	$(BIN)/pytest -q -n auto -m "not slow"
 
-# The C target alone (generated/c/<protocol>/): every spec's C compiled with gcc -std=c99 and the strict warnings as
-# errors at -O0/-Os/-O2, the headers as C++11, then a driver built with -fsanitize=address,undefined checked against
-# the Python codec (examples, random messages, mutated frames, noisy streams in random pieces). `make test` runs the
-# same tests with the rest of the suite. Needs gcc and g++ (apt-get install gcc g++).
-c-check: $(STAMP) check
+# The C target alone (generated/c/<protocol>/): every spec's C compiled with gcc, clang, gcc -m32 and a PowerPC gcc,
+# -std=c99 and the strict warnings as errors at -O0/-Os/-O2, the headers as C++11, then a driver built with
+# -fsanitize=address,undefined checked against the Python codec (examples, random messages, mutated frames, noisy
+# streams in random pieces), the examples and a noisy stream again on clang, -m32 and big-endian PowerPC (qemu) builds.
+# `make test` runs the same tests with the rest of the suite. Needs gcc and g++ (apt-get install gcc g++); the other
+# compilers and qemu are installed as root (test-tools), else those builds are skipped, saying why.
+c-check: $(STAMP) test-tools check
 	$(BIN)/pytest -q -n auto tests/test_c_backend.py
 
 # Pin what the development install resolved to (after changing pyproject.toml's extras), for CI and fresh clones.
@@ -95,6 +105,10 @@ $(BENCH_STAMP): $(STAMP) pyproject.toml
 
 bench: $(BENCH_STAMP)
 	$(BIN)/python -m bench.run
+
+# The C target's two tables alone (flash and RAM on Cortex-M0+, parse throughput), replaced in bench/results.md.
+bench-c: $(STAMP)
+	$(BIN)/python -m bench.run c-size c-speed
 
 # The documentation site in site/: README, tutorial, language reference and every protocol's reference (mkdocs, strict).
 docs: $(STAMP)

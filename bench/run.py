@@ -1,7 +1,8 @@
 """Run every benchmark family, print one markdown table per family, and write them all to bench/results.md.
 
 Usage: `make bench`, or `.venv/bin/python -m bench.run [family ...]` from the project root (families: codec,
-stream, latency, generation, startup, c-size, c-speed; default all). Only a full run rewrites bench/results.md.
+stream, latency, generation, startup, c-size, c-speed; default all). A full run rewrites bench/results.md; a run of
+some families (`make bench-c`: the C target's two) replaces their tables in it, each noting when and where it ran.
 """
 
 from __future__ import annotations
@@ -76,8 +77,27 @@ def main(argv: list[str] | None = None) -> int:
     if chosen == list(FAMILIES):
         elapsed = f"- Whole run: {time.perf_counter() - started:.0f} s"
         RESULTS.write_text("\n".join([*header[:-1], elapsed, "", *sections]), encoding="utf-8")
-        print(f"written to {RESULTS.relative_to(Path.cwd()) if RESULTS.is_relative_to(Path.cwd()) else RESULTS}")
+    elif RESULTS.is_file():
+        stamp = f"- Run alone (`python -m bench.run {' '.join(chosen)}`): {header[3][2:]}; {header[2][2:]}.\n"
+        text = RESULTS.read_text(encoding="utf-8")
+        for section in sections:
+            text = replace_section(text, section + stamp)
+        RESULTS.write_text(text, encoding="utf-8")
+    else:
+        return 0
+    print(f"written to {RESULTS.relative_to(Path.cwd()) if RESULTS.is_relative_to(Path.cwd()) else RESULTS}")
     return 0
+
+
+def replace_section(text: str, section: str) -> str:
+    """results.md with the table of the same title (its `### ` line) replaced by `section`, or `section` added at
+    the end."""
+    title = section.split("\n", 1)[0] + "\n"
+    start = text.find(title)
+    if start < 0:
+        return text.rstrip("\n") + "\n\n" + section
+    stop = text.find("\n### ", start + len(title))
+    return text[:start] + section + ("" if stop < 0 else text[stop:])
 
 
 if __name__ == "__main__":

@@ -24,6 +24,7 @@ from strategies import message_fields
 
 GCC = shutil.which("gcc")
 GXX = shutil.which("g++")
+CLANG = shutil.which("clang")
 pytestmark = pytest.mark.skipif(GCC is None, reason="gcc is not installed")
 
 FLAGS = [
@@ -57,17 +58,69 @@ C_SPECS = [g for g in ALL if supported(g)]
 IDS = [g.protocol.name for g in C_SPECS]
 
 
+@cache
+def m32_builds() -> bool:
+    """gcc -m32 links a program here (gcc-multilib installed)."""
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as tmp:
+        source = Path(tmp) / "m.c"
+        source.write_text("int main(void) { return 0; }\n")
+        run = subprocess.run([str(GCC), "-m32", str(source), "-o", str(Path(tmp) / "m")], capture_output=True)
+    return run.returncode == 0
+
+
+# Besides gcc on this host: clang, gcc -m32 (a 32-bit size_t and long) and big-endian PowerPC (a cross gcc, the
+# programs run under qemu-ppc). `make c-check` installs them as root (test-tools).
+BUILDS = ["gcc", "clang", "gcc-m32", "powerpc-be"]
+PPC_GCC = shutil.which("powerpc-linux-gnu-gcc")
+QEMU_PPC = shutil.which("qemu-ppc")
+
+
+def compiler(build: str) -> list[str]:
+    """The command that compiles for a build, or a skip that says what is missing."""
+    assert GCC is not None
+    if build == "clang":
+        if CLANG is None:
+            pytest.skip("clang is not installed (apt-get install clang; make c-check installs it as root)")
+        return [CLANG]
+    if build == "gcc-m32":
+        if not m32_builds():
+            pytest.skip("gcc -m32 cannot link (apt-get install gcc-multilib; make c-check installs it as root)")
+        return [GCC, "-m32"]
+    if build == "powerpc-be":
+        if PPC_GCC is None or QEMU_PPC is None:
+            pytest.skip(
+                "no big-endian build: powerpc-linux-gnu-gcc or qemu-ppc missing (apt-get install gcc-powerpc-linux-gnu "
+                "libc6-dev-powerpc-cross qemu-user; make c-check installs them as root)"
+            )
+        return [PPC_GCC, "-static"]
+    return [GCC]
+
+
+def runner(build: str) -> tuple[tuple[str, ...], list[str]]:
+    """How a build's programs run (a prefix: qemu for another CPU) and the sanitizer flags it builds them with (none
+    where the target has no sanitizer runtime)."""
+    if build == "powerpc-be":
+        assert QEMU_PPC is not None
+        return (QEMU_PPC,), []
+    return (), SANITIZE
+
+
 def sources(g: Generated) -> tuple[Path, Path]:
     folder = GENERATED_C / g.protocol.name
     return folder / f"{g.protocol.name}.c", folder / f"{g.protocol.name}_json.c"
 
 
+@pytest.mark.parametrize("build", BUILDS)
 @pytest.mark.parametrize("level", ["-O0", "-Os", "-O2"])
 @pytest.mark.parametrize("g", C_SPECS, ids=IDS)
-def test_compiles_without_a_warning(g: Generated, level: str, tmp_path: Path) -> None:
-    assert GCC is not None
+def test_compiles_without_a_warning(g: Generated, level: str, build: str, tmp_path: Path) -> None:
+    command = compiler(build)
     for source in sources(g):
-        run = subprocess.run([GCC, *FLAGS, level, "-c", str(source), "-o", str(tmp_path / "x.o")], capture_output=True)
+        run = subprocess.run(
+            [*command, *FLAGS, level, "-c", str(source), "-o", str(tmp_path / "x.o")], capture_output=True
+        )
         assert run.returncode == 0, run.stderr.decode()
         assert not run.stderr, run.stderr.decode()
 
@@ -95,16 +148,20 @@ def test_several_protocols_link_into_one_program(tmp_path: Path) -> None:
 class Driver:
     """The driver program for one protocol, built with the sanitizers, kept running: one command a line."""
 
-    def __init__(self, name: str, source: Path, folder: Path) -> None:
-        """Build tests/c/driver.c with the C of protocol `name` found in `source`, into `folder`, and start it."""
+    def __init__(
+        self, name: str, source: Path, folder: Path, command: tuple[str, ...] = (), build: str = "gcc"
+    ) -> None:
+        """Build tests/c/driver.c with the C of protocol `name` found in `source`, into `folder`, and start it;
+        with `command` (a compiler and its flags: clang, gcc -m32) for `build` (BUILDS), else gcc."""
+        prefix, sanitize = runner(build)
         assert GCC is not None
         exe = folder / f"driver_{name}"
         c, j = source / f"{name}.c", source / f"{name}_json.c"
         big = [f"-D{name.upper()}_MAX_FRAME=70000u"]  # no frame the tests make exceeds the parser's buffer
         command = [
-            GCC,
+            *(command or (GCC,)),
             "-std=c99",
-            *SANITIZE,
+            *sanitize,
             *big,
             "-I",
             str(c.parent),
@@ -120,7 +177,9 @@ class Driver:
         ]
         run = subprocess.run(command, capture_output=True)
         assert run.returncode == 0, run.stderr.decode()
-        self.process = subprocess.Popen([str(exe)], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True, bufsize=1)
+        self.process = subprocess.Popen(
+            [*prefix, str(exe)], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True, bufsize=1
+        )
 
     def close(self) -> None:
         assert self.process.stdin is not None
@@ -141,11 +200,11 @@ class Driver:
 
 
 @cache
-def driver(name: str) -> Driver:
+def driver(name: str, command: tuple[str, ...] = (), build: str = "gcc") -> Driver:
     import tempfile
 
     folder = Path(tempfile.mkdtemp(prefix="serialspec-c-"))
-    return Driver(name, GENERATED_C / name, folder)
+    return Driver(name, GENERATED_C / name, folder, command, build)
 
 
 def agrees_with_python(run: Driver, g: Generated, spec: Message, fields: dict[str, Any]) -> bytes:
@@ -201,6 +260,27 @@ def test_every_example_decodes_to_the_spec_values_and_encodes_back(g: Generated,
     assert decoded == python_json(expected)
     (answer,) = driver(g.protocol.name).ask(f"rt {example.direction.value} {example.frame.hex()} {kind_of(g, cls)}")
     assert answer == f"ok {example.frame.hex()}"
+
+
+@pytest.mark.parametrize("build", BUILDS[1:])
+@pytest.mark.parametrize("g", C_SPECS, ids=IDS)
+def test_examples_and_a_noisy_stream_give_the_same_on_other_builds(g: Generated, build: str) -> None:
+    """The driver built with clang and with gcc -m32 (32-bit size_t and long), both with the sanitizers, and for
+    big-endian PowerPC (run under qemu-ppc): every example decoded to the spec's values and encoded back, and the
+    examples in a noisy stream cut in pieces parsed as Python parses them."""
+    run = driver(g.protocol.name, tuple(compiler(build)), build)
+    for example in g.protocol.examples:
+        cls = example_class(g, example)
+        kind = kind_of(g, cls)
+        (answer,) = run.ask(f"dec {example.direction.value} {example.frame.hex()} {kind}")
+        expected = python_json(g.package.decode(example.frame, example.direction.value, cls))
+        assert answer.startswith("ok ") and json.loads(answer[3:]) == expected, (answer, expected)
+        (answer,) = run.ask(f"rt {example.direction.value} {example.frame.hex()} {kind}")
+        assert answer == f"ok {example.frame.hex()}"
+    for direction in (Direction.REQUEST, Direction.RESPONSE):
+        frames = [e.frame for e in g.protocol.examples if e.direction == direction]
+        stream = b"\x00\xff".join(frames) + bytes([0xFF, 0x55]) + b"".join(frames)
+        stream_agrees_with_python(run, g, direction, stream, "1,2,3,5,8,13")
 
 
 MESSAGES = by_protocol([(g, m) for g in C_SPECS for m in g.protocol.messages()])

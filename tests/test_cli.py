@@ -266,3 +266,35 @@ def test_check_without_specs_and_generate_of_a_missing_spec_say_so_and_write_not
     assert result.returncode == 1
     assert result.stderr.splitlines() == ["nope.yaml:1:1: no such spec file"]
     assert list(tmp_path.iterdir()) == []
+
+
+def test_generate_target_c_out_writes_each_protocol_folder_in_dir(tmp_path: Path) -> None:
+    """`generate --target c --out DIR` writes DIR/<protocol>/ (as the Python target writes DIR/<protocol>/), not the
+    DIR/c/<protocol>/ the project's generated/ holds beside the Python packages."""
+    result = serialspec("generate", "specs/feetech_sms.yaml", "--target", "c", "--out", str(tmp_path))
+    assert result.returncode == 0, result.stderr
+    assert sorted(p.name for p in (tmp_path / "feetech_sms").iterdir()) == [
+        "feetech_sms.c",
+        "feetech_sms.h",
+        "feetech_sms_json.c",
+        "feetech_sms_json.h",
+    ]
+    assert not (tmp_path / "c").exists()
+
+
+def test_a_spec_the_c_target_cannot_generate_is_refused_in_one_line_naming_the_feature(tmp_path: Path) -> None:
+    """A feature the C target does not have (here a signed length element) refuses `generate --target c` with one
+    line and nothing written; a run of every target writes the others (tinylamp.yaml's own outputs)."""
+    text = (ROOT / "examples" / "tinylamp" / "tinylamp.yaml").read_text(encoding="utf-8")
+    signed = text.replace("      role: length\n      type: u8", "      role: length\n      type: i8")
+    assert signed != text
+    (tmp_path / "lamp.yaml").write_text(signed, encoding="utf-8")
+    result = serialspec("generate", "lamp.yaml", "--target", "c", "--out", "out", cwd=tmp_path)
+    assert result.returncode == 1
+    assert result.stderr.splitlines() == [
+        "lamp.yaml:1:1: the c target cannot generate this spec: the request frame: element length of type i8"
+    ]
+    assert not (tmp_path / "out").exists()
+    everything = serialspec("generate", "lamp.yaml", "--out", "all", cwd=tmp_path)
+    assert everything.returncode == 0, everything.stderr
+    assert (tmp_path / "all" / "tinylamp" / "__init__.py").is_file() and not (tmp_path / "all" / "c").exists()

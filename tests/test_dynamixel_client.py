@@ -53,6 +53,24 @@ def test_device_errors_name_the_error_number(client: DynamixelP2Client) -> None:
     assert client.read(1, "status_return_level") == 2  # a refused write changes nothing
 
 
+def test_homing_offset_and_the_eeprom_lock(client: DynamixelP2Client) -> None:
+    # the spec's device rules: present_position = position + homing_offset; EEPROM refused (7) while torque is on
+    before = client.read(2, "present_position")
+    assert client.write(2, homing_offset=-300) is True
+    assert client.read(2, "present_position") == before - 300
+    assert client.write(2, torque_enable=1) is True
+    with pytest.raises(DeviceError, match="access_error"):
+        client.write(2, homing_offset=0)
+    with pytest.raises(DeviceError, match="access_error"):
+        client.write(2, baud_rate=3)
+    assert client.read_many(2, "homing_offset", "baud_rate") == {"homing_offset": -300, "baud_rate": 1}
+    assert client.write(2, goal_position=before + 50) is True  # in present_position's terms
+    assert client.read(2, "present_position") == before + 50
+    assert client.write(2, torque_enable=0) is True
+    assert client.write(2, homing_offset=0) is True
+    assert client.read(2, "present_position") == before + 350
+
+
 def test_status_return_level_switches_replies(client: DynamixelP2Client) -> None:
     assert client.write(3, status_return_level=1) is True  # answered: the level was 2 when the write arrived
     assert client.write(3, led=1) is None  # level 1: a WRITE gets no status packet, the client does not wait

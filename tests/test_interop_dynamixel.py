@@ -211,3 +211,69 @@ def test_fast_sync_read_packet_is_the_sdks() -> None:
     )
     assert port.written == dynamixel_p2.encode(request)
     assert dynamixel_p2.decode(port.written, "request") == request
+
+
+# LeRobot's Koch arm (koch_follower): XL430-W250 at the shoulder and elbow, XL330-M288 at the wrist and gripper.
+KOCH = {1: "xl430_w250", 2: "xl430_w250", 3: "xl430_w250", 4: "xl330_m288", 5: "xl330_m288", 6: "xl330_m288"}
+HALF_TURN = 2047  # LeRobot: (4096 - 1) // 2, the position every joint reads after half-turn homing
+
+
+def sync_write(handler: Any, packet: Any, name: str, size: int, values: dict[int, int]) -> None:
+    writer = dxl.GroupSyncWrite(handler, packet, ADDRESS[name], size)
+    for servo, value in values.items():
+        assert writer.addParam(servo, list((value & (1 << 8 * size) - 1).to_bytes(size, "little")))
+    assert writer.txPacket() == SUCCESS
+
+
+def sync_read(handler: Any, packet: Any, name: str, size: int, servos: list[int]) -> dict[int, int]:
+    reader = dxl.GroupSyncRead(handler, packet, ADDRESS[name], size)
+    for servo in servos:
+        assert reader.addParam(servo)
+    assert reader.txRxPacket() == SUCCESS
+    values = {servo: reader.getData(servo, ADDRESS[name], size) for servo in servos}
+    return {servo: value - (1 << 8 * size) if value >> (8 * size - 1) else value for servo, value in values.items()}
+
+
+def test_koch_arm_calibration_as_lerobot_does_it() -> None:
+    # DynamixelMotorsBus's calibration: torque off, homing offsets reset, Present_Position read, Homing_Offset =
+    # half turn - position, Present_Position read back at half turn; the e-manual's rules the spec's device states:
+    # present position = actual position + homing offset, and EEPROM items refused (error 7) while torque is on.
+    options = [arg for servo, model in KOCH.items() for arg in ("--model", f"{servo}={model}")]
+    with serve("dynamixel_p2.yaml", *KOCH, options=options) as path:
+        handler = dxl.PortHandler(path)
+        assert handler.openPort()
+        packet = dxl.PacketHandler(2.0)
+        servos = list(KOCH)
+        try:
+            # someone has put the arm in some pose: the joints are where they happen to be
+            pose = {1: 1024, 2: 3000, 3: 150, 4: 2500, 5: 4000, 6: 2047}
+            sync_write(handler, packet, "torque_enable", 1, dict.fromkeys(servos, 1))
+            sync_write(handler, packet, "goal_position", 4, pose)  # profile_velocity 0: there at once
+            # an EEPROM item under torque: access error 7, and the value stays
+            assert packet.write4ByteTxRx(handler, 1, ADDRESS["homing_offset"], 100) == (SUCCESS, 7)
+            assert packet.write1ByteTxRx(handler, 2, ADDRESS["operating_mode"], 4) == (SUCCESS, 7)
+            assert packet.read4ByteTxRx(handler, 1, ADDRESS["homing_offset"]) == (0, SUCCESS, 0)
+            assert packet.read1ByteTxRx(handler, 2, ADDRESS["operating_mode"]) == (3, SUCCESS, 0)
+            # calibrate: disable_torque, reset_calibration, set_half_turn_homings
+            sync_write(handler, packet, "torque_enable", 1, dict.fromkeys(servos, 0))
+            for servo in servos:
+                assert packet.write4ByteTxRx(handler, servo, ADDRESS["homing_offset"], 0) == (SUCCESS, 0)
+                assert packet.write4ByteTxRx(handler, servo, ADDRESS["min_position_limit"], 0) == (SUCCESS, 0)
+                assert packet.write4ByteTxRx(handler, servo, ADDRESS["max_position_limit"], 4095) == (SUCCESS, 0)
+            actual = sync_read(handler, packet, "present_position", 4, servos)
+            assert actual == pose
+            offsets = {servo: HALF_TURN - position for servo, position in actual.items()}
+            for servo, offset in offsets.items():
+                assert packet.write4ByteTxRx(handler, servo, ADDRESS["homing_offset"], offset & 0xFFFFFFFF) == (
+                    SUCCESS,
+                    0,
+                )
+            assert sync_read(handler, packet, "present_position", 4, servos) == dict.fromkeys(servos, HALF_TURN)
+            assert sync_read(handler, packet, "homing_offset", 4, servos) == offsets
+            # with torque on again, a goal is in present_position's terms (offset included)
+            sync_write(handler, packet, "torque_enable", 1, dict.fromkeys(servos, 1))
+            sync_write(handler, packet, "goal_position", 4, dict.fromkeys(servos, HALF_TURN + 100))
+            assert sync_read(handler, packet, "present_position", 4, servos) == dict.fromkeys(servos, HALF_TURN + 100)
+            assert packet.write4ByteTxRx(handler, 3, ADDRESS["homing_offset"], 0) == (SUCCESS, 7)
+        finally:
+            handler.closePort()

@@ -21,6 +21,9 @@ typedef char dynamixel_p2__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define DYNAMIXEL_P2__CLASSIC 0
 #define DYNAMIXEL_P2__HEADERS 1 /* every layout starts with a header: candidates start at headers only */
 #define DYNAMIXEL_P2__KEEP 2u      /* bytes kept at the end that could begin a header */
+#define DYNAMIXEL_P2__STUFFED 1 /* some layout has byte stuffing */
+#define DYNAMIXEL_P2__LENGTHS 1 /* every layout has a length element */
+#define DYNAMIXEL_P2__SINGLE 1 /* one layout per direction */
 
 /* ---- checksums ---- */
 /* CRC-16/UMTS (CRC-16/BUYPASS): width 16, poly 0x8005, init 0x0, refin false, refout false, xorout 0x0 (check 0xfee8). Incremental: start with 0x0, feed pieces, then use it as is. Bitwise: no table, no static data. */
@@ -57,6 +60,21 @@ static uint32_t dynamixel_p2__check(uint8_t which, const uint8_t *d, size_t n)
 #define DYNAMIXEL_P2__ROLE_LENGTH 3u
 #define DYNAMIXEL_P2__ROLE_CONTENT 4u
 #define DYNAMIXEL_P2__ROLE_CHECKSUM 5u
+
+/* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
+static int dynamixel_p2__same(const uint8_t *a, const uint8_t *b, size_t n)
+{
+    size_t i;
+    for (i = 0u; i < n; i++) {
+        if (a[i] != b[i]) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+/* Byte stuffing over part of a layout (constant 0 when no layout has it: that code left out) */
+#define DYNAMIXEL_P2__T(L) (DYNAMIXEL_P2__STUFFED && (L)->has_t)
 
 #define DYNAMIXEL_P2__WAIT (-2L)
 #define DYNAMIXEL_P2__NONE (-1L)
@@ -135,23 +153,28 @@ static void dynamixel_p2__put(uint8_t *b, uint8_t size, uint8_t big, uint32_t v)
 }
 #endif
 
+#if DYNAMIXEL_P2_ENABLE_ENCODE || DYNAMIXEL_P2__STUFFED || DYNAMIXEL_P2_ENABLE_PARSER
 /* The elements before the variable part (the stuffed span, else the content) and after it. */
 static uint8_t dynamixel_p2__inner_first(const dynamixel_p2__layout_t *L)
 {
-    if (L->has_t) {
+    if (DYNAMIXEL_P2__T(L)) {
         return L->t_first;
     }
     return L->content >= 0 ? (uint8_t)L->content : L->count;
 }
+#endif
 
+#if DYNAMIXEL_P2_ENABLE_ENCODE || DYNAMIXEL_P2__STUFFED
 static int dynamixel_p2__inner_last(const dynamixel_p2__layout_t *L)
 {
-    if (L->has_t) {
+    if (DYNAMIXEL_P2__T(L)) {
         return (int)L->t_last;
     }
     return L->content >= 0 ? (int)L->content : (int)L->count - 1;
 }
+#endif
 
+#if DYNAMIXEL_P2_ENABLE_ENCODE || DYNAMIXEL_P2__STUFFED
 /* Each plain sequence rewritten as its wire sequence (to_wire) or back, leftmost first, the pairs tried in order at
  * each position. With cmp: compare the result with cmp[0..cap) instead of writing it (1: equal). */
 static int dynamixel_p2__rewrite(const dynamixel_p2__layout_t *L, int to_wire, const uint8_t *src, size_t n, uint8_t *dst,
@@ -166,12 +189,12 @@ static int dynamixel_p2__rewrite(const dynamixel_p2__layout_t *L, int to_wire, c
             size_t flen = to_wire ? L->pairs[k].plain_len : L->pairs[k].wire_len;
             const uint8_t *to = to_wire ? L->pairs[k].wire : L->pairs[k].plain;
             size_t tlen = to_wire ? L->pairs[k].wire_len : L->pairs[k].plain_len;
-            if (flen <= n - i && memcmp(src + i, from, flen) == 0) {
+            if (flen <= n - i && dynamixel_p2__same(src + i, from, flen)) {
                 if (tlen > cap - o) {
                     return 0;
                 }
                 if (cmp != NULL) {
-                    if (memcmp(cmp + o, to, tlen) != 0) {
+                    if (!dynamixel_p2__same(cmp + o, to, tlen)) {
                         return 0;
                     }
                 } else {
@@ -201,18 +224,21 @@ static int dynamixel_p2__rewrite(const dynamixel_p2__layout_t *L, int to_wire, c
     *out = o;
     return cmp == NULL || o == cap;
 }
+#endif
 
+#if DYNAMIXEL_P2_ENABLE_ENCODE || DYNAMIXEL_P2__STUFFED
 /* The bytes of elements a..b: the plain bytes when they lie inside the stuffed span, else the wire bytes. */
 static const uint8_t *dynamixel_p2__range(const dynamixel_p2__layout_t *L, const dynamixel_p2__where_t *w, const uint8_t *wire,
                                  const uint8_t *plain, uint8_t a, uint8_t b, size_t *n)
 {
-    if (L->has_t && a >= L->t_first && b <= L->t_last) {
+    if (DYNAMIXEL_P2__T(L) && a >= L->t_first && b <= L->t_last) {
         *n = w->pe[b] - w->ps[a];
         return plain + w->ps[a];
     }
     *n = w->we[b] - w->ws[a];
     return wire + w->ws[a];
 }
+#endif
 
 #if DYNAMIXEL_P2_ENABLE_ENCODE
 /* The frame around a content already in place (at out + prefix, or in span + its offset when stuffed): the frame
@@ -227,7 +253,7 @@ static int dynamixel_p2__wrap(const dynamixel_p2__layout_t *L, uint8_t *out, siz
     int last = dynamixel_p2__inner_last(L);
     const uint8_t *bytes;
     /* plain bytes of the stuffed span: its elements laid out around the content, inner checksums over them */
-    if (L->has_t) {
+    if (DYNAMIXEL_P2__T(L)) {
         size_t p = 0u;
         for (k = L->t_first; k <= L->t_last; k++) {
             const dynamixel_p2__element_t *e = &L->e[k];
@@ -266,7 +292,7 @@ static int dynamixel_p2__wrap(const dynamixel_p2__layout_t *L, uint8_t *out, siz
     v = 0u;
     for (k = 0u; k < L->count; k++) {
         const dynamixel_p2__element_t *e = &L->e[k];
-        if (L->has_t && k == L->t_first) {
+        if (DYNAMIXEL_P2__T(L) && k == L->t_first) {
             size_t made;
             if (!dynamixel_p2__rewrite(L, 1, span, w.pe[L->t_last], out + pos, NULL, cap - pos, &made)) {
                 return DYNAMIXEL_P2_E_BUFFER;
@@ -319,7 +345,7 @@ static int dynamixel_p2__wrap(const dynamixel_p2__layout_t *L, uint8_t *out, siz
     }
     for (k = 0u; k < L->count; k++) {
         const dynamixel_p2__element_t *e = &L->e[k];
-        if (e->role == DYNAMIXEL_P2__ROLE_CHECKSUM && !(L->has_t && k >= L->t_first && k <= L->t_last)) {
+        if (e->role == DYNAMIXEL_P2__ROLE_CHECKSUM && !(DYNAMIXEL_P2__T(L) && k >= L->t_first && k <= L->t_last)) {
             bytes = dynamixel_p2__range(L, &w, out, span, e->first, e->last, &sz);
             dynamixel_p2__put(out + w.ws[k], e->size, e->big, dynamixel_p2__check(e->check, bytes, sz));
         }
@@ -329,7 +355,7 @@ static int dynamixel_p2__wrap(const dynamixel_p2__layout_t *L, uint8_t *out, siz
 }
 #endif
 
-#if DYNAMIXEL_P2_ENABLE_DECODE
+#if DYNAMIXEL_P2_ENABLE_DECODE && DYNAMIXEL_P2__STUFFED
 /* Check a complete frame (constants, values, lengths, stuffing, checksums) and take it apart: the frame engine's
  * unwrap (runtime/framing.py Layout.unwrap). plain: room for the unstuffed span. */
 static int dynamixel_p2__unwrap(const dynamixel_p2__layout_t *L, const uint8_t *frame, size_t n, uint8_t *plain, uint32_t *code,
@@ -359,7 +385,7 @@ static int dynamixel_p2__unwrap(const dynamixel_p2__layout_t *L, const uint8_t *
         pos -= L->e[k - 1u].size;
         w.ws[k - 1u] = pos;
     }
-    if (L->has_t) {
+    if (DYNAMIXEL_P2__T(L)) {
         size_t pn, fixed = 0u, p = 0u;
         if (!dynamixel_p2__rewrite(L, 0, frame + before, n - before - after, plain, NULL, DYNAMIXEL_P2_MAX_FRAME, &pn)) {
             return DYNAMIXEL_P2_E_CAPACITY;
@@ -387,15 +413,15 @@ static int dynamixel_p2__unwrap(const dynamixel_p2__layout_t *L, const uint8_t *
     }
     for (k = 0u; k < L->count; k++) {
         const dynamixel_p2__element_t *e = &L->e[k];
-        bytes = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
-        if (e->role == DYNAMIXEL_P2__ROLE_CONSTANT && memcmp(bytes, e->constant, e->size) != 0) {
+        bytes = DYNAMIXEL_P2__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+        if (e->role == DYNAMIXEL_P2__ROLE_CONSTANT && !dynamixel_p2__same(bytes, e->constant, e->size)) {
             return DYNAMIXEL_P2_E_FRAME;
         }
     }
     *code = 0u;
     for (k = 0u; k < L->count; k++) {
         const dynamixel_p2__element_t *e = &L->e[k];
-        bytes = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+        bytes = DYNAMIXEL_P2__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
         if (e->role == DYNAMIXEL_P2__ROLE_COMMAND) {
             *code = dynamixel_p2__get(bytes, e->size, e->big);
         } else if (e->role == DYNAMIXEL_P2__ROLE_VALUE) {
@@ -409,7 +435,7 @@ static int dynamixel_p2__unwrap(const dynamixel_p2__layout_t *L, const uint8_t *
     for (k = 0u; k < L->count; k++) {
         const dynamixel_p2__element_t *e = &L->e[k];
         if (e->role == DYNAMIXEL_P2__ROLE_LENGTH) {
-            bytes = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+            bytes = DYNAMIXEL_P2__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
             (void)dynamixel_p2__range(L, &w, frame, body, e->first, e->last, &sz);
             if ((int32_t)dynamixel_p2__get(bytes, e->size, e->big) != (int32_t)sz + e->adds) {
                 return DYNAMIXEL_P2_E_LENGTH;
@@ -419,7 +445,7 @@ static int dynamixel_p2__unwrap(const dynamixel_p2__layout_t *L, const uint8_t *
     for (k = 0u; k < L->count; k++) {
         const dynamixel_p2__element_t *e = &L->e[k];
         if (e->role == DYNAMIXEL_P2__ROLE_CHECKSUM) {
-            const uint8_t *stored = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+            const uint8_t *stored = DYNAMIXEL_P2__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
             bytes = dynamixel_p2__range(L, &w, frame, body, e->first, e->last, &sz);
             if (dynamixel_p2__check(e->check, bytes, sz) != dynamixel_p2__get(stored, e->size, e->big)) {
                 return DYNAMIXEL_P2_E_CHECKSUM;
@@ -427,7 +453,7 @@ static int dynamixel_p2__unwrap(const dynamixel_p2__layout_t *L, const uint8_t *
         }
     }
     if (L->content >= 0) {
-        int inside = L->has_t && L->content >= (int)L->t_first && L->content <= (int)L->t_last;
+        int inside = DYNAMIXEL_P2__T(L) && L->content >= (int)L->t_first && L->content <= (int)L->t_last;
         *content = inside ? body + w.ps[L->content] : frame + w.ws[L->content];
         *clen = inside ? w.pe[L->content] - w.ps[L->content] : w.we[L->content] - w.ws[L->content];
     } else {
@@ -460,7 +486,7 @@ static long dynamixel_p2__probe(const dynamixel_p2__layout_t *L, dynamixel_p2_di
             return DYNAMIXEL_P2__WAIT;
         }
         if (e->role == DYNAMIXEL_P2__ROLE_CONSTANT) {
-            if (memcmp(b + pos, e->constant, e->size) != 0) {
+            if (!dynamixel_p2__same(b + pos, e->constant, e->size)) {
                 return DYNAMIXEL_P2__NONE;
             }
         } else if (e->role == DYNAMIXEL_P2__ROLE_COMMAND) {
@@ -486,20 +512,20 @@ static long dynamixel_p2__probe(const dynamixel_p2__layout_t *L, dynamixel_p2_di
         low = 0u; /* the code lies in the stuffed span: no bounds before the frame is unstuffed */
         bounded = 0;
     }
-    if (L->length >= 0) {
+    if (DYNAMIXEL_P2__LENGTHS || L->length >= 0) {
         const dynamixel_p2__element_t *e = &L->e[L->length];
         long counted = (long)dynamixel_p2__get(b + L->length_off, e->size, e->big) - (long)e->adds;
         long content = counted - (long)L->counted;
-        if (content < (long)low || (!L->has_t && bounded && content > (long)high)) {
+        if (content < (long)low || (!DYNAMIXEL_P2__T(L) && bounded && content > (long)high)) {
             return DYNAMIXEL_P2__NONE;
         }
         return (long)(L->overhead - L->counted) + counted;
     }
-    if (L->has_t && L->e[L->count - 1u].role == DYNAMIXEL_P2__ROLE_CONSTANT && L->count > 1u) {
+    if (DYNAMIXEL_P2__T(L) && L->e[L->count - 1u].role == DYNAMIXEL_P2__ROLE_CONSTANT && L->count > 1u) {
         const dynamixel_p2__element_t *t = &L->e[L->count - 1u];
         size_t i;
         for (i = before; i + t->size <= avail; i++) {
-            if (memcmp(b + i, t->constant, t->size) == 0) {
+            if (dynamixel_p2__same(b + i, t->constant, t->size)) {
                 return (long)(i + t->size);
             }
         }
@@ -659,6 +685,26 @@ static int dynamixel_p2__bounds(dynamixel_p2_direction_t dir, long code, size_t 
 #endif
 
 #if DYNAMIXEL_P2_ENABLE_DECODE
+/* ---- frames taken apart: straight line where a layout has no byte stuffing ---- */
+
+static int dynamixel_p2__unwrap_at(dynamixel_p2_direction_t dir, uint8_t k, const dynamixel_p2__layout_t *L, const uint8_t *frame, size_t n,
+                          uint8_t *plain, uint32_t *code, uint32_t *values, const uint8_t **content, size_t *clen)
+{
+    (void)k;
+    (void)L;
+    (void)plain;
+    switch (dir) {
+
+    default:
+        break;
+    }
+#if DYNAMIXEL_P2__STUFFED
+    return dynamixel_p2__unwrap(L, frame, n, plain, code, values, content, clen);
+#else
+    return DYNAMIXEL_P2_E_ARG;
+#endif
+}
+
 /* ---- content decoders ---- */
 /* The content of ping (request): fields in wire order. */
 static int dynamixel_p2__dec_ping_request(const uint8_t *c, size_t n, dynamixel_p2_ping_request_t *m)
@@ -1068,7 +1114,7 @@ int dynamixel_p2_decode_expect(const uint8_t *frame, size_t len, dynamixel_p2_di
     uint8_t count, k;
     const dynamixel_p2__layout_t *const *layouts;
     const dynamixel_p2__layout_t *L = NULL;
-    uint32_t code = 0u, values[DYNAMIXEL_P2__MAX_ELEMENTS];
+    uint32_t code = 0u, values[DYNAMIXEL_P2__MAX_ELEMENTS] = {0u};
     const uint8_t *c = NULL;
     size_t clen = 0u;
     int r;
@@ -1081,12 +1127,13 @@ int dynamixel_p2_decode_expect(const uint8_t *frame, size_t len, dynamixel_p2_di
     if (layouts == NULL) {
         return DYNAMIXEL_P2_E_ARG;
     }
-    if (count == 1u) {
+    k = 0u;
+    if (DYNAMIXEL_P2__SINGLE || count == 1u) {
         L = layouts[0];
     } else {
         for (k = 0u; k < count; k++) {
             const dynamixel_p2__layout_t *A = layouts[k];
-            if (A->header_len <= len && memcmp(frame, A->e[0].constant, A->header_len) == 0) {
+            if (A->header_len <= len && dynamixel_p2__same(frame, A->e[0].constant, A->header_len)) {
                 L = A;
                 break;
             }
@@ -1095,7 +1142,7 @@ int dynamixel_p2_decode_expect(const uint8_t *frame, size_t len, dynamixel_p2_di
             return DYNAMIXEL_P2_E_FRAME;
         }
     }
-    r = dynamixel_p2__unwrap(L, frame, len, plain, &code, values, &c, &clen);
+    r = dynamixel_p2__unwrap_at(dir, k, L, frame, len, plain, &code, values, &c, &clen);
     if (r != DYNAMIXEL_P2_OK) {
         return r;
     }
@@ -1468,11 +1515,11 @@ static int dynamixel_p2__frame(dynamixel_p2_direction_t dir, uint32_t code, cons
         size_t before = 0u, clen = 0u;
         uint8_t *dst;
         size_t room;
-        uint8_t from = L->has_t ? L->t_first : 0u;
+        uint8_t from = DYNAMIXEL_P2__T(L) ? L->t_first : 0u;
         for (i = from; (int)i < L->content; i++) {
             before += L->e[i].size;
         }
-        if (L->has_t) {
+        if (DYNAMIXEL_P2__T(L)) {
             if (before > DYNAMIXEL_P2_MAX_FRAME) {
                 return DYNAMIXEL_P2_E_BUFFER;
             }
@@ -1784,7 +1831,7 @@ static size_t dynamixel_p2__next(dynamixel_p2_parser_t *p, size_t start)
             const dynamixel_p2__layout_t *L = layouts[k];
             if (L->header_len > p->n - pos) {
                 whole = 0;
-            } else if (memcmp(p->buf + pos, L->e[0].constant, L->header_len) == 0) {
+            } else if (dynamixel_p2__same(p->buf + pos, L->e[0].constant, L->header_len)) {
                 return pos;
             }
         }
@@ -1863,11 +1910,56 @@ static int dynamixel_p2__push(dynamixel_p2_parser_t *p, uint8_t byte, dynamixel_
     return got;
 }
 
+#if DYNAMIXEL_P2__HEADERS
+/* A whole frame at data[0..len) while no byte is held: taken at once, its bytes not pushed one by one, when that gives
+ * what pushing them would (one layout; a plausible frame that fits and decodes; no header inside it, so no other
+ * candidate could end first). Else 0: the bytes go through dynamixel_p2__push. */
+static size_t dynamixel_p2__whole(dynamixel_p2_parser_t *p, const uint8_t *data, size_t len, dynamixel_p2_msg_t *out)
+{
+    uint8_t count;
+    const dynamixel_p2__layout_t *const *layouts = dynamixel_p2__layouts(p->dir, &count);
+    const dynamixel_p2__layout_t *L;
+    size_t i, size;
+    long s;
+    if (!DYNAMIXEL_P2__SINGLE && count != 1u) {
+        return 0u;
+    }
+    L = layouts[0];
+    if (len < L->header_len || !dynamixel_p2__same(data, L->e[0].constant, L->header_len)) {
+        return 0u;
+    }
+    s = dynamixel_p2__probe(L, p->dir, data, len);
+    if (s <= 0 || (unsigned long)s > DYNAMIXEL_P2_MAX_FRAME || (size_t)s > len) {
+        return 0u;
+    }
+    size = (size_t)s;
+    for (i = 1u; i + L->header_len <= size; i++) {
+        if (data[i] == L->e[0].constant[0] && dynamixel_p2__same(data + i, L->e[0].constant, L->header_len)) {
+            return 0u;
+        }
+    }
+    if (dynamixel_p2_decode(data, size, p->dir, out) != DYNAMIXEL_P2_OK) {
+        return 0u;
+    }
+    p->frames++;
+    return size;
+}
+#endif
+
 size_t dynamixel_p2_parser_feed(dynamixel_p2_parser_t *parser, const uint8_t *data, size_t len, dynamixel_p2_msg_t *out, bool *got)
 {
     size_t i;
     *got = false;
     for (i = 0u; i < len; i++) {
+#if DYNAMIXEL_P2__HEADERS
+        if (parser->n == 0u) {
+            size_t size = dynamixel_p2__whole(parser, data + i, len - i, out);
+            if (size > 0u) {
+                *got = true;
+                return i + size;
+            }
+        }
+#endif
         if (dynamixel_p2__push(parser, data[i], out)) {
             *got = true;
             return i + 1u;

@@ -21,6 +21,9 @@ typedef char fashionstar_uart__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define FASHIONSTAR_UART__CLASSIC 1
 #define FASHIONSTAR_UART__HEADERS 1 /* every layout starts with a header: candidates start at headers only */
 #define FASHIONSTAR_UART__KEEP 1u      /* bytes kept at the end that could begin a header */
+#define FASHIONSTAR_UART__STUFFED 0 /* some layout has byte stuffing */
+#define FASHIONSTAR_UART__LENGTHS 1 /* every layout has a length element */
+#define FASHIONSTAR_UART__SINGLE 1 /* one layout per direction */
 
 /* ---- checksums ---- */
 /* Sum of the bytes modulo 2^8. Incremental: start with 0; the frame's checksum is the sum. */
@@ -53,6 +56,21 @@ static uint32_t fashionstar_uart__check(uint8_t which, const uint8_t *d, size_t 
 #define FASHIONSTAR_UART__ROLE_LENGTH 3u
 #define FASHIONSTAR_UART__ROLE_CONTENT 4u
 #define FASHIONSTAR_UART__ROLE_CHECKSUM 5u
+
+/* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
+static int fashionstar_uart__same(const uint8_t *a, const uint8_t *b, size_t n)
+{
+    size_t i;
+    for (i = 0u; i < n; i++) {
+        if (a[i] != b[i]) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+/* Byte stuffing over part of a layout (constant 0 when no layout has it: that code left out) */
+#define FASHIONSTAR_UART__T(L) (FASHIONSTAR_UART__STUFFED && (L)->has_t)
 
 #define FASHIONSTAR_UART__WAIT (-2L)
 #define FASHIONSTAR_UART__NONE (-1L)
@@ -131,23 +149,28 @@ static void fashionstar_uart__put(uint8_t *b, uint8_t size, uint8_t big, uint32_
 }
 #endif
 
+#if FASHIONSTAR_UART_ENABLE_ENCODE || FASHIONSTAR_UART__STUFFED || FASHIONSTAR_UART_ENABLE_PARSER
 /* The elements before the variable part (the stuffed span, else the content) and after it. */
 static uint8_t fashionstar_uart__inner_first(const fashionstar_uart__layout_t *L)
 {
-    if (L->has_t) {
+    if (FASHIONSTAR_UART__T(L)) {
         return L->t_first;
     }
     return L->content >= 0 ? (uint8_t)L->content : L->count;
 }
+#endif
 
+#if FASHIONSTAR_UART_ENABLE_ENCODE || FASHIONSTAR_UART__STUFFED
 static int fashionstar_uart__inner_last(const fashionstar_uart__layout_t *L)
 {
-    if (L->has_t) {
+    if (FASHIONSTAR_UART__T(L)) {
         return (int)L->t_last;
     }
     return L->content >= 0 ? (int)L->content : (int)L->count - 1;
 }
+#endif
 
+#if FASHIONSTAR_UART_ENABLE_ENCODE || FASHIONSTAR_UART__STUFFED
 /* Each plain sequence rewritten as its wire sequence (to_wire) or back, leftmost first, the pairs tried in order at
  * each position. With cmp: compare the result with cmp[0..cap) instead of writing it (1: equal). */
 static int fashionstar_uart__rewrite(const fashionstar_uart__layout_t *L, int to_wire, const uint8_t *src, size_t n, uint8_t *dst,
@@ -162,12 +185,12 @@ static int fashionstar_uart__rewrite(const fashionstar_uart__layout_t *L, int to
             size_t flen = to_wire ? L->pairs[k].plain_len : L->pairs[k].wire_len;
             const uint8_t *to = to_wire ? L->pairs[k].wire : L->pairs[k].plain;
             size_t tlen = to_wire ? L->pairs[k].wire_len : L->pairs[k].plain_len;
-            if (flen <= n - i && memcmp(src + i, from, flen) == 0) {
+            if (flen <= n - i && fashionstar_uart__same(src + i, from, flen)) {
                 if (tlen > cap - o) {
                     return 0;
                 }
                 if (cmp != NULL) {
-                    if (memcmp(cmp + o, to, tlen) != 0) {
+                    if (!fashionstar_uart__same(cmp + o, to, tlen)) {
                         return 0;
                     }
                 } else {
@@ -197,18 +220,21 @@ static int fashionstar_uart__rewrite(const fashionstar_uart__layout_t *L, int to
     *out = o;
     return cmp == NULL || o == cap;
 }
+#endif
 
+#if FASHIONSTAR_UART_ENABLE_ENCODE || FASHIONSTAR_UART__STUFFED
 /* The bytes of elements a..b: the plain bytes when they lie inside the stuffed span, else the wire bytes. */
 static const uint8_t *fashionstar_uart__range(const fashionstar_uart__layout_t *L, const fashionstar_uart__where_t *w, const uint8_t *wire,
                                  const uint8_t *plain, uint8_t a, uint8_t b, size_t *n)
 {
-    if (L->has_t && a >= L->t_first && b <= L->t_last) {
+    if (FASHIONSTAR_UART__T(L) && a >= L->t_first && b <= L->t_last) {
         *n = w->pe[b] - w->ps[a];
         return plain + w->ps[a];
     }
     *n = w->we[b] - w->ws[a];
     return wire + w->ws[a];
 }
+#endif
 
 #if FASHIONSTAR_UART_ENABLE_ENCODE
 /* The frame around a content already in place (at out + prefix, or in span + its offset when stuffed): the frame
@@ -223,7 +249,7 @@ static int fashionstar_uart__wrap(const fashionstar_uart__layout_t *L, uint8_t *
     int last = fashionstar_uart__inner_last(L);
     const uint8_t *bytes;
     /* plain bytes of the stuffed span: its elements laid out around the content, inner checksums over them */
-    if (L->has_t) {
+    if (FASHIONSTAR_UART__T(L)) {
         size_t p = 0u;
         for (k = L->t_first; k <= L->t_last; k++) {
             const fashionstar_uart__element_t *e = &L->e[k];
@@ -262,7 +288,7 @@ static int fashionstar_uart__wrap(const fashionstar_uart__layout_t *L, uint8_t *
     v = 0u;
     for (k = 0u; k < L->count; k++) {
         const fashionstar_uart__element_t *e = &L->e[k];
-        if (L->has_t && k == L->t_first) {
+        if (FASHIONSTAR_UART__T(L) && k == L->t_first) {
             size_t made;
             if (!fashionstar_uart__rewrite(L, 1, span, w.pe[L->t_last], out + pos, NULL, cap - pos, &made)) {
                 return FASHIONSTAR_UART_E_BUFFER;
@@ -315,7 +341,7 @@ static int fashionstar_uart__wrap(const fashionstar_uart__layout_t *L, uint8_t *
     }
     for (k = 0u; k < L->count; k++) {
         const fashionstar_uart__element_t *e = &L->e[k];
-        if (e->role == FASHIONSTAR_UART__ROLE_CHECKSUM && !(L->has_t && k >= L->t_first && k <= L->t_last)) {
+        if (e->role == FASHIONSTAR_UART__ROLE_CHECKSUM && !(FASHIONSTAR_UART__T(L) && k >= L->t_first && k <= L->t_last)) {
             bytes = fashionstar_uart__range(L, &w, out, span, e->first, e->last, &sz);
             fashionstar_uart__put(out + w.ws[k], e->size, e->big, fashionstar_uart__check(e->check, bytes, sz));
         }
@@ -325,7 +351,7 @@ static int fashionstar_uart__wrap(const fashionstar_uart__layout_t *L, uint8_t *
 }
 #endif
 
-#if FASHIONSTAR_UART_ENABLE_DECODE
+#if FASHIONSTAR_UART_ENABLE_DECODE && FASHIONSTAR_UART__STUFFED
 /* Check a complete frame (constants, values, lengths, stuffing, checksums) and take it apart: the frame engine's
  * unwrap (runtime/framing.py Layout.unwrap). plain: room for the unstuffed span. */
 static int fashionstar_uart__unwrap(const fashionstar_uart__layout_t *L, const uint8_t *frame, size_t n, uint8_t *plain, uint32_t *code,
@@ -355,7 +381,7 @@ static int fashionstar_uart__unwrap(const fashionstar_uart__layout_t *L, const u
         pos -= L->e[k - 1u].size;
         w.ws[k - 1u] = pos;
     }
-    if (L->has_t) {
+    if (FASHIONSTAR_UART__T(L)) {
         size_t pn, fixed = 0u, p = 0u;
         if (!fashionstar_uart__rewrite(L, 0, frame + before, n - before - after, plain, NULL, FASHIONSTAR_UART_MAX_FRAME, &pn)) {
             return FASHIONSTAR_UART_E_CAPACITY;
@@ -383,15 +409,15 @@ static int fashionstar_uart__unwrap(const fashionstar_uart__layout_t *L, const u
     }
     for (k = 0u; k < L->count; k++) {
         const fashionstar_uart__element_t *e = &L->e[k];
-        bytes = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
-        if (e->role == FASHIONSTAR_UART__ROLE_CONSTANT && memcmp(bytes, e->constant, e->size) != 0) {
+        bytes = FASHIONSTAR_UART__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+        if (e->role == FASHIONSTAR_UART__ROLE_CONSTANT && !fashionstar_uart__same(bytes, e->constant, e->size)) {
             return FASHIONSTAR_UART_E_FRAME;
         }
     }
     *code = 0u;
     for (k = 0u; k < L->count; k++) {
         const fashionstar_uart__element_t *e = &L->e[k];
-        bytes = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+        bytes = FASHIONSTAR_UART__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
         if (e->role == FASHIONSTAR_UART__ROLE_COMMAND) {
             *code = fashionstar_uart__get(bytes, e->size, e->big);
         } else if (e->role == FASHIONSTAR_UART__ROLE_VALUE) {
@@ -405,7 +431,7 @@ static int fashionstar_uart__unwrap(const fashionstar_uart__layout_t *L, const u
     for (k = 0u; k < L->count; k++) {
         const fashionstar_uart__element_t *e = &L->e[k];
         if (e->role == FASHIONSTAR_UART__ROLE_LENGTH) {
-            bytes = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+            bytes = FASHIONSTAR_UART__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
             (void)fashionstar_uart__range(L, &w, frame, body, e->first, e->last, &sz);
             if ((int32_t)fashionstar_uart__get(bytes, e->size, e->big) != (int32_t)sz + e->adds) {
                 return FASHIONSTAR_UART_E_LENGTH;
@@ -415,7 +441,7 @@ static int fashionstar_uart__unwrap(const fashionstar_uart__layout_t *L, const u
     for (k = 0u; k < L->count; k++) {
         const fashionstar_uart__element_t *e = &L->e[k];
         if (e->role == FASHIONSTAR_UART__ROLE_CHECKSUM) {
-            const uint8_t *stored = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+            const uint8_t *stored = FASHIONSTAR_UART__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
             bytes = fashionstar_uart__range(L, &w, frame, body, e->first, e->last, &sz);
             if (fashionstar_uart__check(e->check, bytes, sz) != fashionstar_uart__get(stored, e->size, e->big)) {
                 return FASHIONSTAR_UART_E_CHECKSUM;
@@ -423,7 +449,7 @@ static int fashionstar_uart__unwrap(const fashionstar_uart__layout_t *L, const u
         }
     }
     if (L->content >= 0) {
-        int inside = L->has_t && L->content >= (int)L->t_first && L->content <= (int)L->t_last;
+        int inside = FASHIONSTAR_UART__T(L) && L->content >= (int)L->t_first && L->content <= (int)L->t_last;
         *content = inside ? body + w.ps[L->content] : frame + w.ws[L->content];
         *clen = inside ? w.pe[L->content] - w.ps[L->content] : w.we[L->content] - w.ws[L->content];
     } else {
@@ -456,7 +482,7 @@ static long fashionstar_uart__probe(const fashionstar_uart__layout_t *L, fashion
             return FASHIONSTAR_UART__WAIT;
         }
         if (e->role == FASHIONSTAR_UART__ROLE_CONSTANT) {
-            if (memcmp(b + pos, e->constant, e->size) != 0) {
+            if (!fashionstar_uart__same(b + pos, e->constant, e->size)) {
                 return FASHIONSTAR_UART__NONE;
             }
         } else if (e->role == FASHIONSTAR_UART__ROLE_COMMAND) {
@@ -482,20 +508,20 @@ static long fashionstar_uart__probe(const fashionstar_uart__layout_t *L, fashion
         low = 0u; /* the code lies in the stuffed span: no bounds before the frame is unstuffed */
         bounded = 0;
     }
-    if (L->length >= 0) {
+    if (FASHIONSTAR_UART__LENGTHS || L->length >= 0) {
         const fashionstar_uart__element_t *e = &L->e[L->length];
         long counted = (long)fashionstar_uart__get(b + L->length_off, e->size, e->big) - (long)e->adds;
         long content = counted - (long)L->counted;
-        if (content < (long)low || (!L->has_t && bounded && content > (long)high)) {
+        if (content < (long)low || (!FASHIONSTAR_UART__T(L) && bounded && content > (long)high)) {
             return FASHIONSTAR_UART__NONE;
         }
         return (long)(L->overhead - L->counted) + counted;
     }
-    if (L->has_t && L->e[L->count - 1u].role == FASHIONSTAR_UART__ROLE_CONSTANT && L->count > 1u) {
+    if (FASHIONSTAR_UART__T(L) && L->e[L->count - 1u].role == FASHIONSTAR_UART__ROLE_CONSTANT && L->count > 1u) {
         const fashionstar_uart__element_t *t = &L->e[L->count - 1u];
         size_t i;
         for (i = before; i + t->size <= avail; i++) {
-            if (memcmp(b + i, t->constant, t->size) == 0) {
+            if (fashionstar_uart__same(b + i, t->constant, t->size)) {
                 return (long)(i + t->size);
             }
         }
@@ -774,6 +800,78 @@ static int fashionstar_uart__bounds(fashionstar_uart_direction_t dir, long code,
 #endif
 
 #if FASHIONSTAR_UART_ENABLE_DECODE
+/* ---- frames taken apart: straight line where a layout has no byte stuffing ---- */
+/* The request frame: unwrap, straight line. */
+static int fashionstar_uart__unwrap_request_0(const uint8_t *f, size_t n, uint32_t *code, uint32_t *values,
+                                 const uint8_t **content, size_t *clen)
+{
+    (void)values;
+    *code = 0u;
+    if (n < 5u) {
+        return FASHIONSTAR_UART_E_LENGTH;
+    }
+    if (f[0u] != 0x12u) { return FASHIONSTAR_UART_E_FRAME; } /* header */
+    if (f[1u] != 0x4cu) { return FASHIONSTAR_UART_E_FRAME; } /* header */
+    *code = (uint32_t)f[2u]; /* cmd_id */
+    if ((int32_t)((uint32_t)f[3u]) != (int32_t)(n - 5u) + 0) { return FASHIONSTAR_UART_E_LENGTH; } /* length */
+    if (fashionstar_uart__check(0u, f + 0u, (n - 1u)) != ((uint32_t)f[n - 1u])) { return FASHIONSTAR_UART_E_CHECKSUM; } /* checksum */
+    *content = f + 4u;
+    *clen = n - 5u;
+    return FASHIONSTAR_UART_OK;
+}
+
+/* The response frame: unwrap, straight line. */
+static int fashionstar_uart__unwrap_response_0(const uint8_t *f, size_t n, uint32_t *code, uint32_t *values,
+                                 const uint8_t **content, size_t *clen)
+{
+    (void)values;
+    *code = 0u;
+    if (n < 5u) {
+        return FASHIONSTAR_UART_E_LENGTH;
+    }
+    if (f[0u] != 0x05u) { return FASHIONSTAR_UART_E_FRAME; } /* header */
+    if (f[1u] != 0x1cu) { return FASHIONSTAR_UART_E_FRAME; } /* header */
+    *code = (uint32_t)f[2u]; /* cmd_id */
+    if ((int32_t)((uint32_t)f[3u]) != (int32_t)(n - 5u) + 0) { return FASHIONSTAR_UART_E_LENGTH; } /* length */
+    if (fashionstar_uart__check(0u, f + 0u, (n - 1u)) != ((uint32_t)f[n - 1u])) { return FASHIONSTAR_UART_E_CHECKSUM; } /* checksum */
+    *content = f + 4u;
+    *clen = n - 5u;
+    return FASHIONSTAR_UART_OK;
+}
+
+static int fashionstar_uart__unwrap_at(fashionstar_uart_direction_t dir, uint8_t k, const fashionstar_uart__layout_t *L, const uint8_t *frame, size_t n,
+                          uint8_t *plain, uint32_t *code, uint32_t *values, const uint8_t **content, size_t *clen)
+{
+    (void)k;
+    (void)L;
+    (void)plain;
+    switch (dir) {
+    case FASHIONSTAR_UART_REQUEST:
+        switch (k) {
+        case 0u:
+            return fashionstar_uart__unwrap_request_0(frame, n, code, values, content, clen);
+        default:
+            break;
+        }
+        break;
+    case FASHIONSTAR_UART_RESPONSE:
+        switch (k) {
+        case 0u:
+            return fashionstar_uart__unwrap_response_0(frame, n, code, values, content, clen);
+        default:
+            break;
+        }
+        break;
+    default:
+        break;
+    }
+#if FASHIONSTAR_UART__STUFFED
+    return fashionstar_uart__unwrap(L, frame, n, plain, code, values, content, clen);
+#else
+    return FASHIONSTAR_UART_E_ARG;
+#endif
+}
+
 /* ---- content decoders ---- */
 /* The content of ping (request): fields in wire order. */
 static int fashionstar_uart__dec_ping_request(const uint8_t *c, size_t n, fashionstar_uart_ping_request_t *m)
@@ -2144,7 +2242,7 @@ int fashionstar_uart_decode_expect(const uint8_t *frame, size_t len, fashionstar
     uint8_t count, k;
     const fashionstar_uart__layout_t *const *layouts;
     const fashionstar_uart__layout_t *L = NULL;
-    uint32_t code = 0u, values[FASHIONSTAR_UART__MAX_ELEMENTS];
+    uint32_t code = 0u, values[FASHIONSTAR_UART__MAX_ELEMENTS] = {0u};
     const uint8_t *c = NULL;
     size_t clen = 0u;
     int r;
@@ -2157,12 +2255,13 @@ int fashionstar_uart_decode_expect(const uint8_t *frame, size_t len, fashionstar
     if (layouts == NULL) {
         return FASHIONSTAR_UART_E_ARG;
     }
-    if (count == 1u) {
+    k = 0u;
+    if (FASHIONSTAR_UART__SINGLE || count == 1u) {
         L = layouts[0];
     } else {
         for (k = 0u; k < count; k++) {
             const fashionstar_uart__layout_t *A = layouts[k];
-            if (A->header_len <= len && memcmp(frame, A->e[0].constant, A->header_len) == 0) {
+            if (A->header_len <= len && fashionstar_uart__same(frame, A->e[0].constant, A->header_len)) {
                 L = A;
                 break;
             }
@@ -2171,7 +2270,7 @@ int fashionstar_uart_decode_expect(const uint8_t *frame, size_t len, fashionstar
             return FASHIONSTAR_UART_E_FRAME;
         }
     }
-    r = fashionstar_uart__unwrap(L, frame, len, plain, &code, values, &c, &clen);
+    r = fashionstar_uart__unwrap_at(dir, k, L, frame, len, plain, &code, values, &c, &clen);
     if (r != FASHIONSTAR_UART_OK) {
         return r;
     }
@@ -2764,11 +2863,11 @@ static int fashionstar_uart__enc_read_batch_data_response(const void *mv, uint8_
     o += 1u;
     fashionstar_uart__put(c + o, 2u, 0u, (uint32_t)(m->user_data.soft_start_time)); /* 50 */
     o += 2u;
-    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->user_data.angle_limit_high) & 0xffffUL)); /* 51 */
+    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->user_data.angle_limit_high) & 0xffffu)); /* 51 */
     o += 2u;
-    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->user_data.angle_limit_low) & 0xffffUL)); /* 52 */
+    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->user_data.angle_limit_low) & 0xffffu)); /* 52 */
     o += 2u;
-    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->user_data.angle_mid_offset) & 0xffffUL)); /* 53 */
+    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->user_data.angle_mid_offset) & 0xffffu)); /* 53 */
     o += 2u;
     *n = o;
     return FASHIONSTAR_UART_OK;
@@ -2835,11 +2934,11 @@ static int fashionstar_uart__enc_write_batch_data_request(const void *mv, uint8_
     o += 1u;
     fashionstar_uart__put(c + o, 2u, 0u, (uint32_t)(m->user_data.soft_start_time)); /* 50 */
     o += 2u;
-    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->user_data.angle_limit_high) & 0xffffUL)); /* 51 */
+    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->user_data.angle_limit_high) & 0xffffu)); /* 51 */
     o += 2u;
-    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->user_data.angle_limit_low) & 0xffffUL)); /* 52 */
+    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->user_data.angle_limit_low) & 0xffffu)); /* 52 */
     o += 2u;
-    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->user_data.angle_mid_offset) & 0xffffUL)); /* 53 */
+    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->user_data.angle_mid_offset) & 0xffffu)); /* 53 */
     o += 2u;
     *n = o;
     return FASHIONSTAR_UART_OK;
@@ -2927,7 +3026,7 @@ static int fashionstar_uart__enc_rotate_request(const void *mv, uint8_t *c, size
     fashionstar_uart__put(c + o, 1u, 0u, (uint32_t)(m->servo_id)); /* servo_id */
     o += 1u;
     if (cap - o < 2u) { return FASHIONSTAR_UART_E_BUFFER; }
-    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->angle) & 0xffffUL)); /* angle */
+    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->angle) & 0xffffu)); /* angle */
     o += 2u;
     if (cap - o < 2u) { return FASHIONSTAR_UART_E_BUFFER; }
     fashionstar_uart__put(c + o, 2u, 0u, (uint32_t)(m->interval)); /* interval */
@@ -3031,7 +3130,7 @@ static int fashionstar_uart__enc_read_angle_response(const void *mv, uint8_t *c,
     fashionstar_uart__put(c + o, 1u, 0u, (uint32_t)(m->servo_id)); /* servo_id */
     o += 1u;
     if (cap - o < 2u) { return FASHIONSTAR_UART_E_BUFFER; }
-    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->angle) & 0xffffUL)); /* angle */
+    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->angle) & 0xffffu)); /* angle */
     o += 2u;
     *n = o;
     return FASHIONSTAR_UART_OK;
@@ -3052,7 +3151,7 @@ static int fashionstar_uart__enc_move_by_interval_request(const void *mv, uint8_
     fashionstar_uart__put(c + o, 1u, 0u, (uint32_t)(m->servo_id)); /* servo_id */
     o += 1u;
     if (cap - o < 2u) { return FASHIONSTAR_UART_E_BUFFER; }
-    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->angle) & 0xffffUL)); /* angle */
+    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->angle) & 0xffffu)); /* angle */
     o += 2u;
     if (cap - o < 2u) { return FASHIONSTAR_UART_E_BUFFER; }
     fashionstar_uart__put(c + o, 2u, 0u, (uint32_t)(m->interval)); /* interval */
@@ -3107,7 +3206,7 @@ static int fashionstar_uart__enc_move_by_velocity_request(const void *mv, uint8_
     fashionstar_uart__put(c + o, 1u, 0u, (uint32_t)(m->servo_id)); /* servo_id */
     o += 1u;
     if (cap - o < 2u) { return FASHIONSTAR_UART_E_BUFFER; }
-    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->angle) & 0xffffUL)); /* angle */
+    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->angle) & 0xffffu)); /* angle */
     o += 2u;
     if (cap - o < 2u) { return FASHIONSTAR_UART_E_BUFFER; }
     fashionstar_uart__put(c + o, 2u, 0u, (uint32_t)(m->velocity)); /* velocity */
@@ -3162,7 +3261,7 @@ static int fashionstar_uart__enc_move_mturn_request(const void *mv, uint8_t *c, 
     fashionstar_uart__put(c + o, 1u, 0u, (uint32_t)(m->servo_id)); /* servo_id */
     o += 1u;
     if (cap - o < 4u) { return FASHIONSTAR_UART_E_BUFFER; }
-    fashionstar_uart__put(c + o, 4u, 0u, ((uint32_t)(int32_t)(m->angle) & 0xffffffffUL)); /* angle */
+    fashionstar_uart__put(c + o, 4u, 0u, ((uint32_t)(int32_t)(m->angle) & 0xffffffffu)); /* angle */
     o += 4u;
     if (cap - o < 4u) { return FASHIONSTAR_UART_E_BUFFER; }
     fashionstar_uart__put(c + o, 4u, 0u, (uint32_t)(m->interval)); /* interval */
@@ -3211,7 +3310,7 @@ static int fashionstar_uart__enc_move_mturn_by_interval_request(const void *mv, 
     fashionstar_uart__put(c + o, 1u, 0u, (uint32_t)(m->servo_id)); /* servo_id */
     o += 1u;
     if (cap - o < 4u) { return FASHIONSTAR_UART_E_BUFFER; }
-    fashionstar_uart__put(c + o, 4u, 0u, ((uint32_t)(int32_t)(m->angle) & 0xffffffffUL)); /* angle */
+    fashionstar_uart__put(c + o, 4u, 0u, ((uint32_t)(int32_t)(m->angle) & 0xffffffffu)); /* angle */
     o += 4u;
     if (cap - o < 4u) { return FASHIONSTAR_UART_E_BUFFER; }
     fashionstar_uart__put(c + o, 4u, 0u, (uint32_t)(m->interval)); /* interval */
@@ -3266,7 +3365,7 @@ static int fashionstar_uart__enc_move_mturn_by_velocity_request(const void *mv, 
     fashionstar_uart__put(c + o, 1u, 0u, (uint32_t)(m->servo_id)); /* servo_id */
     o += 1u;
     if (cap - o < 4u) { return FASHIONSTAR_UART_E_BUFFER; }
-    fashionstar_uart__put(c + o, 4u, 0u, ((uint32_t)(int32_t)(m->angle) & 0xffffffffUL)); /* angle */
+    fashionstar_uart__put(c + o, 4u, 0u, ((uint32_t)(int32_t)(m->angle) & 0xffffffffu)); /* angle */
     o += 4u;
     if (cap - o < 2u) { return FASHIONSTAR_UART_E_BUFFER; }
     fashionstar_uart__put(c + o, 2u, 0u, (uint32_t)(m->velocity)); /* velocity */
@@ -3337,10 +3436,10 @@ static int fashionstar_uart__enc_read_mturn_angle_response(const void *mv, uint8
     fashionstar_uart__put(c + o, 1u, 0u, (uint32_t)(m->servo_id)); /* servo_id */
     o += 1u;
     if (cap - o < 4u) { return FASHIONSTAR_UART_E_BUFFER; }
-    fashionstar_uart__put(c + o, 4u, 0u, ((uint32_t)(int32_t)(m->angle) & 0xffffffffUL)); /* angle */
+    fashionstar_uart__put(c + o, 4u, 0u, ((uint32_t)(int32_t)(m->angle) & 0xffffffffu)); /* angle */
     o += 4u;
     if (cap - o < 2u) { return FASHIONSTAR_UART_E_BUFFER; }
-    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->turns) & 0xffffUL)); /* turns */
+    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->turns) & 0xffffu)); /* turns */
     o += 2u;
     *n = o;
     return FASHIONSTAR_UART_OK;
@@ -3440,10 +3539,10 @@ static int fashionstar_uart__enc_monitor_response(const void *mv, uint8_t *c, si
     fashionstar_uart__put(c + o, 1u, 0u, (uint32_t)(m->status)); /* status */
     o += 1u;
     if (cap - o < 4u) { return FASHIONSTAR_UART_E_BUFFER; }
-    fashionstar_uart__put(c + o, 4u, 0u, ((uint32_t)(int32_t)(m->angle) & 0xffffffffUL)); /* angle */
+    fashionstar_uart__put(c + o, 4u, 0u, ((uint32_t)(int32_t)(m->angle) & 0xffffffffu)); /* angle */
     o += 4u;
     if (cap - o < 2u) { return FASHIONSTAR_UART_E_BUFFER; }
-    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->turns) & 0xffffUL)); /* turns */
+    fashionstar_uart__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->turns) & 0xffffu)); /* turns */
     o += 2u;
     *n = o;
     return FASHIONSTAR_UART_OK;
@@ -3549,11 +3648,11 @@ static int fashionstar_uart__frame(fashionstar_uart_direction_t dir, uint32_t co
         size_t before = 0u, clen = 0u;
         uint8_t *dst;
         size_t room;
-        uint8_t from = L->has_t ? L->t_first : 0u;
+        uint8_t from = FASHIONSTAR_UART__T(L) ? L->t_first : 0u;
         for (i = from; (int)i < L->content; i++) {
             before += L->e[i].size;
         }
-        if (L->has_t) {
+        if (FASHIONSTAR_UART__T(L)) {
             if (before > FASHIONSTAR_UART_MAX_FRAME) {
                 return FASHIONSTAR_UART_E_BUFFER;
             }
@@ -4148,7 +4247,7 @@ static size_t fashionstar_uart__next(fashionstar_uart_parser_t *p, size_t start)
             const fashionstar_uart__layout_t *L = layouts[k];
             if (L->header_len > p->n - pos) {
                 whole = 0;
-            } else if (memcmp(p->buf + pos, L->e[0].constant, L->header_len) == 0) {
+            } else if (fashionstar_uart__same(p->buf + pos, L->e[0].constant, L->header_len)) {
                 return pos;
             }
         }
@@ -4227,11 +4326,56 @@ static int fashionstar_uart__push(fashionstar_uart_parser_t *p, uint8_t byte, fa
     return got;
 }
 
+#if FASHIONSTAR_UART__HEADERS
+/* A whole frame at data[0..len) while no byte is held: taken at once, its bytes not pushed one by one, when that gives
+ * what pushing them would (one layout; a plausible frame that fits and decodes; no header inside it, so no other
+ * candidate could end first). Else 0: the bytes go through fashionstar_uart__push. */
+static size_t fashionstar_uart__whole(fashionstar_uart_parser_t *p, const uint8_t *data, size_t len, fashionstar_uart_msg_t *out)
+{
+    uint8_t count;
+    const fashionstar_uart__layout_t *const *layouts = fashionstar_uart__layouts(p->dir, &count);
+    const fashionstar_uart__layout_t *L;
+    size_t i, size;
+    long s;
+    if (!FASHIONSTAR_UART__SINGLE && count != 1u) {
+        return 0u;
+    }
+    L = layouts[0];
+    if (len < L->header_len || !fashionstar_uart__same(data, L->e[0].constant, L->header_len)) {
+        return 0u;
+    }
+    s = fashionstar_uart__probe(L, p->dir, data, len);
+    if (s <= 0 || (unsigned long)s > FASHIONSTAR_UART_MAX_FRAME || (size_t)s > len) {
+        return 0u;
+    }
+    size = (size_t)s;
+    for (i = 1u; i + L->header_len <= size; i++) {
+        if (data[i] == L->e[0].constant[0] && fashionstar_uart__same(data + i, L->e[0].constant, L->header_len)) {
+            return 0u;
+        }
+    }
+    if (fashionstar_uart_decode(data, size, p->dir, out) != FASHIONSTAR_UART_OK) {
+        return 0u;
+    }
+    p->frames++;
+    return size;
+}
+#endif
+
 size_t fashionstar_uart_parser_feed(fashionstar_uart_parser_t *parser, const uint8_t *data, size_t len, fashionstar_uart_msg_t *out, bool *got)
 {
     size_t i;
     *got = false;
     for (i = 0u; i < len; i++) {
+#if FASHIONSTAR_UART__HEADERS
+        if (parser->n == 0u) {
+            size_t size = fashionstar_uart__whole(parser, data + i, len - i, out);
+            if (size > 0u) {
+                *got = true;
+                return i + size;
+            }
+        }
+#endif
         if (fashionstar_uart__push(parser, data[i], out)) {
             *got = true;
             return i + 1u;

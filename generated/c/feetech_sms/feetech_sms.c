@@ -21,6 +21,9 @@ typedef char feetech_sms__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define FEETECH_SMS__CLASSIC 1
 #define FEETECH_SMS__HEADERS 1 /* every layout starts with a header: candidates start at headers only */
 #define FEETECH_SMS__KEEP 1u      /* bytes kept at the end that could begin a header */
+#define FEETECH_SMS__STUFFED 0 /* some layout has byte stuffing */
+#define FEETECH_SMS__LENGTHS 1 /* every layout has a length element */
+#define FEETECH_SMS__SINGLE 1 /* one layout per direction */
 
 /* ---- checksums ---- */
 /* Sum of the bytes modulo 2^8. Incremental: start with 0; the frame's checksum is the sum inverted. */
@@ -53,6 +56,21 @@ static uint32_t feetech_sms__check(uint8_t which, const uint8_t *d, size_t n)
 #define FEETECH_SMS__ROLE_LENGTH 3u
 #define FEETECH_SMS__ROLE_CONTENT 4u
 #define FEETECH_SMS__ROLE_CHECKSUM 5u
+
+/* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
+static int feetech_sms__same(const uint8_t *a, const uint8_t *b, size_t n)
+{
+    size_t i;
+    for (i = 0u; i < n; i++) {
+        if (a[i] != b[i]) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+/* Byte stuffing over part of a layout (constant 0 when no layout has it: that code left out) */
+#define FEETECH_SMS__T(L) (FEETECH_SMS__STUFFED && (L)->has_t)
 
 #define FEETECH_SMS__WAIT (-2L)
 #define FEETECH_SMS__NONE (-1L)
@@ -131,23 +149,28 @@ static void feetech_sms__put(uint8_t *b, uint8_t size, uint8_t big, uint32_t v)
 }
 #endif
 
+#if FEETECH_SMS_ENABLE_ENCODE || FEETECH_SMS__STUFFED || FEETECH_SMS_ENABLE_PARSER
 /* The elements before the variable part (the stuffed span, else the content) and after it. */
 static uint8_t feetech_sms__inner_first(const feetech_sms__layout_t *L)
 {
-    if (L->has_t) {
+    if (FEETECH_SMS__T(L)) {
         return L->t_first;
     }
     return L->content >= 0 ? (uint8_t)L->content : L->count;
 }
+#endif
 
+#if FEETECH_SMS_ENABLE_ENCODE || FEETECH_SMS__STUFFED
 static int feetech_sms__inner_last(const feetech_sms__layout_t *L)
 {
-    if (L->has_t) {
+    if (FEETECH_SMS__T(L)) {
         return (int)L->t_last;
     }
     return L->content >= 0 ? (int)L->content : (int)L->count - 1;
 }
+#endif
 
+#if FEETECH_SMS_ENABLE_ENCODE || FEETECH_SMS__STUFFED
 /* Each plain sequence rewritten as its wire sequence (to_wire) or back, leftmost first, the pairs tried in order at
  * each position. With cmp: compare the result with cmp[0..cap) instead of writing it (1: equal). */
 static int feetech_sms__rewrite(const feetech_sms__layout_t *L, int to_wire, const uint8_t *src, size_t n, uint8_t *dst,
@@ -162,12 +185,12 @@ static int feetech_sms__rewrite(const feetech_sms__layout_t *L, int to_wire, con
             size_t flen = to_wire ? L->pairs[k].plain_len : L->pairs[k].wire_len;
             const uint8_t *to = to_wire ? L->pairs[k].wire : L->pairs[k].plain;
             size_t tlen = to_wire ? L->pairs[k].wire_len : L->pairs[k].plain_len;
-            if (flen <= n - i && memcmp(src + i, from, flen) == 0) {
+            if (flen <= n - i && feetech_sms__same(src + i, from, flen)) {
                 if (tlen > cap - o) {
                     return 0;
                 }
                 if (cmp != NULL) {
-                    if (memcmp(cmp + o, to, tlen) != 0) {
+                    if (!feetech_sms__same(cmp + o, to, tlen)) {
                         return 0;
                     }
                 } else {
@@ -197,18 +220,21 @@ static int feetech_sms__rewrite(const feetech_sms__layout_t *L, int to_wire, con
     *out = o;
     return cmp == NULL || o == cap;
 }
+#endif
 
+#if FEETECH_SMS_ENABLE_ENCODE || FEETECH_SMS__STUFFED
 /* The bytes of elements a..b: the plain bytes when they lie inside the stuffed span, else the wire bytes. */
 static const uint8_t *feetech_sms__range(const feetech_sms__layout_t *L, const feetech_sms__where_t *w, const uint8_t *wire,
                                  const uint8_t *plain, uint8_t a, uint8_t b, size_t *n)
 {
-    if (L->has_t && a >= L->t_first && b <= L->t_last) {
+    if (FEETECH_SMS__T(L) && a >= L->t_first && b <= L->t_last) {
         *n = w->pe[b] - w->ps[a];
         return plain + w->ps[a];
     }
     *n = w->we[b] - w->ws[a];
     return wire + w->ws[a];
 }
+#endif
 
 #if FEETECH_SMS_ENABLE_ENCODE
 /* The frame around a content already in place (at out + prefix, or in span + its offset when stuffed): the frame
@@ -223,7 +249,7 @@ static int feetech_sms__wrap(const feetech_sms__layout_t *L, uint8_t *out, size_
     int last = feetech_sms__inner_last(L);
     const uint8_t *bytes;
     /* plain bytes of the stuffed span: its elements laid out around the content, inner checksums over them */
-    if (L->has_t) {
+    if (FEETECH_SMS__T(L)) {
         size_t p = 0u;
         for (k = L->t_first; k <= L->t_last; k++) {
             const feetech_sms__element_t *e = &L->e[k];
@@ -262,7 +288,7 @@ static int feetech_sms__wrap(const feetech_sms__layout_t *L, uint8_t *out, size_
     v = 0u;
     for (k = 0u; k < L->count; k++) {
         const feetech_sms__element_t *e = &L->e[k];
-        if (L->has_t && k == L->t_first) {
+        if (FEETECH_SMS__T(L) && k == L->t_first) {
             size_t made;
             if (!feetech_sms__rewrite(L, 1, span, w.pe[L->t_last], out + pos, NULL, cap - pos, &made)) {
                 return FEETECH_SMS_E_BUFFER;
@@ -315,7 +341,7 @@ static int feetech_sms__wrap(const feetech_sms__layout_t *L, uint8_t *out, size_
     }
     for (k = 0u; k < L->count; k++) {
         const feetech_sms__element_t *e = &L->e[k];
-        if (e->role == FEETECH_SMS__ROLE_CHECKSUM && !(L->has_t && k >= L->t_first && k <= L->t_last)) {
+        if (e->role == FEETECH_SMS__ROLE_CHECKSUM && !(FEETECH_SMS__T(L) && k >= L->t_first && k <= L->t_last)) {
             bytes = feetech_sms__range(L, &w, out, span, e->first, e->last, &sz);
             feetech_sms__put(out + w.ws[k], e->size, e->big, feetech_sms__check(e->check, bytes, sz));
         }
@@ -325,7 +351,7 @@ static int feetech_sms__wrap(const feetech_sms__layout_t *L, uint8_t *out, size_
 }
 #endif
 
-#if FEETECH_SMS_ENABLE_DECODE
+#if FEETECH_SMS_ENABLE_DECODE && FEETECH_SMS__STUFFED
 /* Check a complete frame (constants, values, lengths, stuffing, checksums) and take it apart: the frame engine's
  * unwrap (runtime/framing.py Layout.unwrap). plain: room for the unstuffed span. */
 static int feetech_sms__unwrap(const feetech_sms__layout_t *L, const uint8_t *frame, size_t n, uint8_t *plain, uint32_t *code,
@@ -355,7 +381,7 @@ static int feetech_sms__unwrap(const feetech_sms__layout_t *L, const uint8_t *fr
         pos -= L->e[k - 1u].size;
         w.ws[k - 1u] = pos;
     }
-    if (L->has_t) {
+    if (FEETECH_SMS__T(L)) {
         size_t pn, fixed = 0u, p = 0u;
         if (!feetech_sms__rewrite(L, 0, frame + before, n - before - after, plain, NULL, FEETECH_SMS_MAX_FRAME, &pn)) {
             return FEETECH_SMS_E_CAPACITY;
@@ -383,15 +409,15 @@ static int feetech_sms__unwrap(const feetech_sms__layout_t *L, const uint8_t *fr
     }
     for (k = 0u; k < L->count; k++) {
         const feetech_sms__element_t *e = &L->e[k];
-        bytes = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
-        if (e->role == FEETECH_SMS__ROLE_CONSTANT && memcmp(bytes, e->constant, e->size) != 0) {
+        bytes = FEETECH_SMS__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+        if (e->role == FEETECH_SMS__ROLE_CONSTANT && !feetech_sms__same(bytes, e->constant, e->size)) {
             return FEETECH_SMS_E_FRAME;
         }
     }
     *code = 0u;
     for (k = 0u; k < L->count; k++) {
         const feetech_sms__element_t *e = &L->e[k];
-        bytes = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+        bytes = FEETECH_SMS__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
         if (e->role == FEETECH_SMS__ROLE_COMMAND) {
             *code = feetech_sms__get(bytes, e->size, e->big);
         } else if (e->role == FEETECH_SMS__ROLE_VALUE) {
@@ -405,7 +431,7 @@ static int feetech_sms__unwrap(const feetech_sms__layout_t *L, const uint8_t *fr
     for (k = 0u; k < L->count; k++) {
         const feetech_sms__element_t *e = &L->e[k];
         if (e->role == FEETECH_SMS__ROLE_LENGTH) {
-            bytes = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+            bytes = FEETECH_SMS__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
             (void)feetech_sms__range(L, &w, frame, body, e->first, e->last, &sz);
             if ((int32_t)feetech_sms__get(bytes, e->size, e->big) != (int32_t)sz + e->adds) {
                 return FEETECH_SMS_E_LENGTH;
@@ -415,7 +441,7 @@ static int feetech_sms__unwrap(const feetech_sms__layout_t *L, const uint8_t *fr
     for (k = 0u; k < L->count; k++) {
         const feetech_sms__element_t *e = &L->e[k];
         if (e->role == FEETECH_SMS__ROLE_CHECKSUM) {
-            const uint8_t *stored = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+            const uint8_t *stored = FEETECH_SMS__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
             bytes = feetech_sms__range(L, &w, frame, body, e->first, e->last, &sz);
             if (feetech_sms__check(e->check, bytes, sz) != feetech_sms__get(stored, e->size, e->big)) {
                 return FEETECH_SMS_E_CHECKSUM;
@@ -423,7 +449,7 @@ static int feetech_sms__unwrap(const feetech_sms__layout_t *L, const uint8_t *fr
         }
     }
     if (L->content >= 0) {
-        int inside = L->has_t && L->content >= (int)L->t_first && L->content <= (int)L->t_last;
+        int inside = FEETECH_SMS__T(L) && L->content >= (int)L->t_first && L->content <= (int)L->t_last;
         *content = inside ? body + w.ps[L->content] : frame + w.ws[L->content];
         *clen = inside ? w.pe[L->content] - w.ps[L->content] : w.we[L->content] - w.ws[L->content];
     } else {
@@ -456,7 +482,7 @@ static long feetech_sms__probe(const feetech_sms__layout_t *L, feetech_sms_direc
             return FEETECH_SMS__WAIT;
         }
         if (e->role == FEETECH_SMS__ROLE_CONSTANT) {
-            if (memcmp(b + pos, e->constant, e->size) != 0) {
+            if (!feetech_sms__same(b + pos, e->constant, e->size)) {
                 return FEETECH_SMS__NONE;
             }
         } else if (e->role == FEETECH_SMS__ROLE_COMMAND) {
@@ -482,20 +508,20 @@ static long feetech_sms__probe(const feetech_sms__layout_t *L, feetech_sms_direc
         low = 0u; /* the code lies in the stuffed span: no bounds before the frame is unstuffed */
         bounded = 0;
     }
-    if (L->length >= 0) {
+    if (FEETECH_SMS__LENGTHS || L->length >= 0) {
         const feetech_sms__element_t *e = &L->e[L->length];
         long counted = (long)feetech_sms__get(b + L->length_off, e->size, e->big) - (long)e->adds;
         long content = counted - (long)L->counted;
-        if (content < (long)low || (!L->has_t && bounded && content > (long)high)) {
+        if (content < (long)low || (!FEETECH_SMS__T(L) && bounded && content > (long)high)) {
             return FEETECH_SMS__NONE;
         }
         return (long)(L->overhead - L->counted) + counted;
     }
-    if (L->has_t && L->e[L->count - 1u].role == FEETECH_SMS__ROLE_CONSTANT && L->count > 1u) {
+    if (FEETECH_SMS__T(L) && L->e[L->count - 1u].role == FEETECH_SMS__ROLE_CONSTANT && L->count > 1u) {
         const feetech_sms__element_t *t = &L->e[L->count - 1u];
         size_t i;
         for (i = before; i + t->size <= avail; i++) {
-            if (memcmp(b + i, t->constant, t->size) == 0) {
+            if (feetech_sms__same(b + i, t->constant, t->size)) {
                 return (long)(i + t->size);
             }
         }
@@ -626,6 +652,82 @@ static int feetech_sms__bounds(feetech_sms_direction_t dir, long code, size_t *l
 #endif
 
 #if FEETECH_SMS_ENABLE_DECODE
+/* ---- frames taken apart: straight line where a layout has no byte stuffing ---- */
+/* The request frame: unwrap, straight line. */
+static int feetech_sms__unwrap_request_0(const uint8_t *f, size_t n, uint32_t *code, uint32_t *values,
+                                 const uint8_t **content, size_t *clen)
+{
+    (void)values;
+    *code = 0u;
+    if (n < 6u) {
+        return FEETECH_SMS_E_LENGTH;
+    }
+    if (f[0u] != 0xffu) { return FEETECH_SMS_E_FRAME; } /* header */
+    if (f[1u] != 0xffu) { return FEETECH_SMS_E_FRAME; } /* header */
+    values[0] = (uint32_t)f[2u]; /* id */
+    if ((values[0] > 253u) && values[0] != 254u) { return FEETECH_SMS_E_RANGE; }
+    *code = (uint32_t)f[4u]; /* instruction */
+    if ((int32_t)((uint32_t)f[3u]) != (int32_t)(n - 6u) + 2) { return FEETECH_SMS_E_LENGTH; } /* length */
+    if (feetech_sms__check(0u, f + 2u, (n - 3u)) != ((uint32_t)f[n - 1u])) { return FEETECH_SMS_E_CHECKSUM; } /* checksum */
+    *content = f + 5u;
+    *clen = n - 6u;
+    return FEETECH_SMS_OK;
+}
+
+/* The response frame: unwrap, straight line. */
+static int feetech_sms__unwrap_response_0(const uint8_t *f, size_t n, uint32_t *code, uint32_t *values,
+                                 const uint8_t **content, size_t *clen)
+{
+    (void)values;
+    *code = 0u;
+    if (n < 6u) {
+        return FEETECH_SMS_E_LENGTH;
+    }
+    if (f[0u] != 0xffu) { return FEETECH_SMS_E_FRAME; } /* header */
+    if (f[1u] != 0xffu) { return FEETECH_SMS_E_FRAME; } /* header */
+    values[0] = (uint32_t)f[2u]; /* id */
+    if ((values[0] > 253u) && values[0] != 254u) { return FEETECH_SMS_E_RANGE; }
+    values[1] = (uint32_t)f[4u]; /* error */
+    if ((int32_t)((uint32_t)f[3u]) != (int32_t)(n - 6u) + 2) { return FEETECH_SMS_E_LENGTH; } /* length */
+    if (feetech_sms__check(0u, f + 2u, (n - 3u)) != ((uint32_t)f[n - 1u])) { return FEETECH_SMS_E_CHECKSUM; } /* checksum */
+    *content = f + 5u;
+    *clen = n - 6u;
+    return FEETECH_SMS_OK;
+}
+
+static int feetech_sms__unwrap_at(feetech_sms_direction_t dir, uint8_t k, const feetech_sms__layout_t *L, const uint8_t *frame, size_t n,
+                          uint8_t *plain, uint32_t *code, uint32_t *values, const uint8_t **content, size_t *clen)
+{
+    (void)k;
+    (void)L;
+    (void)plain;
+    switch (dir) {
+    case FEETECH_SMS_REQUEST:
+        switch (k) {
+        case 0u:
+            return feetech_sms__unwrap_request_0(frame, n, code, values, content, clen);
+        default:
+            break;
+        }
+        break;
+    case FEETECH_SMS_RESPONSE:
+        switch (k) {
+        case 0u:
+            return feetech_sms__unwrap_response_0(frame, n, code, values, content, clen);
+        default:
+            break;
+        }
+        break;
+    default:
+        break;
+    }
+#if FEETECH_SMS__STUFFED
+    return feetech_sms__unwrap(L, frame, n, plain, code, values, content, clen);
+#else
+    return FEETECH_SMS_E_ARG;
+#endif
+}
+
 /* ---- content decoders ---- */
 /* The content of ping (request): fields in wire order. */
 static int feetech_sms__dec_ping_request(const uint8_t *c, size_t n, feetech_sms_ping_request_t *m)
@@ -865,7 +967,7 @@ int feetech_sms_decode_expect(const uint8_t *frame, size_t len, feetech_sms_dire
     uint8_t count, k;
     const feetech_sms__layout_t *const *layouts;
     const feetech_sms__layout_t *L = NULL;
-    uint32_t code = 0u, values[FEETECH_SMS__MAX_ELEMENTS];
+    uint32_t code = 0u, values[FEETECH_SMS__MAX_ELEMENTS] = {0u};
     const uint8_t *c = NULL;
     size_t clen = 0u;
     int r;
@@ -878,12 +980,13 @@ int feetech_sms_decode_expect(const uint8_t *frame, size_t len, feetech_sms_dire
     if (layouts == NULL) {
         return FEETECH_SMS_E_ARG;
     }
-    if (count == 1u) {
+    k = 0u;
+    if (FEETECH_SMS__SINGLE || count == 1u) {
         L = layouts[0];
     } else {
         for (k = 0u; k < count; k++) {
             const feetech_sms__layout_t *A = layouts[k];
-            if (A->header_len <= len && memcmp(frame, A->e[0].constant, A->header_len) == 0) {
+            if (A->header_len <= len && feetech_sms__same(frame, A->e[0].constant, A->header_len)) {
                 L = A;
                 break;
             }
@@ -892,7 +995,7 @@ int feetech_sms_decode_expect(const uint8_t *frame, size_t len, feetech_sms_dire
             return FEETECH_SMS_E_FRAME;
         }
     }
-    r = feetech_sms__unwrap(L, frame, len, plain, &code, values, &c, &clen);
+    r = feetech_sms__unwrap_at(dir, k, L, frame, len, plain, &code, values, &c, &clen);
     if (r != FEETECH_SMS_OK) {
         return r;
     }
@@ -1113,11 +1216,11 @@ static int feetech_sms__frame(feetech_sms_direction_t dir, uint32_t code, const 
         size_t before = 0u, clen = 0u;
         uint8_t *dst;
         size_t room;
-        uint8_t from = L->has_t ? L->t_first : 0u;
+        uint8_t from = FEETECH_SMS__T(L) ? L->t_first : 0u;
         for (i = from; (int)i < L->content; i++) {
             before += L->e[i].size;
         }
-        if (L->has_t) {
+        if (FEETECH_SMS__T(L)) {
             if (before > FEETECH_SMS_MAX_FRAME) {
                 return FEETECH_SMS_E_BUFFER;
             }
@@ -1350,7 +1453,7 @@ static size_t feetech_sms__next(feetech_sms_parser_t *p, size_t start)
             const feetech_sms__layout_t *L = layouts[k];
             if (L->header_len > p->n - pos) {
                 whole = 0;
-            } else if (memcmp(p->buf + pos, L->e[0].constant, L->header_len) == 0) {
+            } else if (feetech_sms__same(p->buf + pos, L->e[0].constant, L->header_len)) {
                 return pos;
             }
         }
@@ -1429,11 +1532,56 @@ static int feetech_sms__push(feetech_sms_parser_t *p, uint8_t byte, feetech_sms_
     return got;
 }
 
+#if FEETECH_SMS__HEADERS
+/* A whole frame at data[0..len) while no byte is held: taken at once, its bytes not pushed one by one, when that gives
+ * what pushing them would (one layout; a plausible frame that fits and decodes; no header inside it, so no other
+ * candidate could end first). Else 0: the bytes go through feetech_sms__push. */
+static size_t feetech_sms__whole(feetech_sms_parser_t *p, const uint8_t *data, size_t len, feetech_sms_msg_t *out)
+{
+    uint8_t count;
+    const feetech_sms__layout_t *const *layouts = feetech_sms__layouts(p->dir, &count);
+    const feetech_sms__layout_t *L;
+    size_t i, size;
+    long s;
+    if (!FEETECH_SMS__SINGLE && count != 1u) {
+        return 0u;
+    }
+    L = layouts[0];
+    if (len < L->header_len || !feetech_sms__same(data, L->e[0].constant, L->header_len)) {
+        return 0u;
+    }
+    s = feetech_sms__probe(L, p->dir, data, len);
+    if (s <= 0 || (unsigned long)s > FEETECH_SMS_MAX_FRAME || (size_t)s > len) {
+        return 0u;
+    }
+    size = (size_t)s;
+    for (i = 1u; i + L->header_len <= size; i++) {
+        if (data[i] == L->e[0].constant[0] && feetech_sms__same(data + i, L->e[0].constant, L->header_len)) {
+            return 0u;
+        }
+    }
+    if (feetech_sms_decode(data, size, p->dir, out) != FEETECH_SMS_OK) {
+        return 0u;
+    }
+    p->frames++;
+    return size;
+}
+#endif
+
 size_t feetech_sms_parser_feed(feetech_sms_parser_t *parser, const uint8_t *data, size_t len, feetech_sms_msg_t *out, bool *got)
 {
     size_t i;
     *got = false;
     for (i = 0u; i < len; i++) {
+#if FEETECH_SMS__HEADERS
+        if (parser->n == 0u) {
+            size_t size = feetech_sms__whole(parser, data + i, len - i, out);
+            if (size > 0u) {
+                *got = true;
+                return i + size;
+            }
+        }
+#endif
         if (feetech_sms__push(parser, data[i], out)) {
             *got = true;
             return i + 1u;

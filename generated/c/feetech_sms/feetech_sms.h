@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define FEETECH_SMS_SPEC_SHA256 "dae57a870990d7323f7ff303ec3a24fc699b467ad256f12817ea7643741f76f5"
+#define FEETECH_SMS_SPEC_SHA256 "50799b5fdc9da692a8e206f719e4ad881d15f057d49bcebad520e0f298c40278"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef FEETECH_SMS_ENABLE_ENCODE

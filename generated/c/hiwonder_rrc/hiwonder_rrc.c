@@ -21,6 +21,9 @@ typedef char hiwonder_rrc__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define HIWONDER_RRC__CLASSIC 1
 #define HIWONDER_RRC__HEADERS 1 /* every layout starts with a header: candidates start at headers only */
 #define HIWONDER_RRC__KEEP 1u      /* bytes kept at the end that could begin a header */
+#define HIWONDER_RRC__STUFFED 0 /* some layout has byte stuffing */
+#define HIWONDER_RRC__LENGTHS 1 /* every layout has a length element */
+#define HIWONDER_RRC__SINGLE 1 /* one layout per direction */
 
 /* ---- checksums ---- */
 /* CRC-8/MAXIM: width 8, poly 0x31, init 0x0, refin true, refout true, xorout 0x0 (check 0xa1). Incremental: start with 0x0, feed pieces, then use it as is. Bitwise: no table, no static data. */
@@ -57,6 +60,21 @@ static uint32_t hiwonder_rrc__check(uint8_t which, const uint8_t *d, size_t n)
 #define HIWONDER_RRC__ROLE_LENGTH 3u
 #define HIWONDER_RRC__ROLE_CONTENT 4u
 #define HIWONDER_RRC__ROLE_CHECKSUM 5u
+
+/* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
+static int hiwonder_rrc__same(const uint8_t *a, const uint8_t *b, size_t n)
+{
+    size_t i;
+    for (i = 0u; i < n; i++) {
+        if (a[i] != b[i]) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+/* Byte stuffing over part of a layout (constant 0 when no layout has it: that code left out) */
+#define HIWONDER_RRC__T(L) (HIWONDER_RRC__STUFFED && (L)->has_t)
 
 #define HIWONDER_RRC__WAIT (-2L)
 #define HIWONDER_RRC__NONE (-1L)
@@ -135,23 +153,28 @@ static void hiwonder_rrc__put(uint8_t *b, uint8_t size, uint8_t big, uint32_t v)
 }
 #endif
 
+#if HIWONDER_RRC_ENABLE_ENCODE || HIWONDER_RRC__STUFFED || HIWONDER_RRC_ENABLE_PARSER
 /* The elements before the variable part (the stuffed span, else the content) and after it. */
 static uint8_t hiwonder_rrc__inner_first(const hiwonder_rrc__layout_t *L)
 {
-    if (L->has_t) {
+    if (HIWONDER_RRC__T(L)) {
         return L->t_first;
     }
     return L->content >= 0 ? (uint8_t)L->content : L->count;
 }
+#endif
 
+#if HIWONDER_RRC_ENABLE_ENCODE || HIWONDER_RRC__STUFFED
 static int hiwonder_rrc__inner_last(const hiwonder_rrc__layout_t *L)
 {
-    if (L->has_t) {
+    if (HIWONDER_RRC__T(L)) {
         return (int)L->t_last;
     }
     return L->content >= 0 ? (int)L->content : (int)L->count - 1;
 }
+#endif
 
+#if HIWONDER_RRC_ENABLE_ENCODE || HIWONDER_RRC__STUFFED
 /* Each plain sequence rewritten as its wire sequence (to_wire) or back, leftmost first, the pairs tried in order at
  * each position. With cmp: compare the result with cmp[0..cap) instead of writing it (1: equal). */
 static int hiwonder_rrc__rewrite(const hiwonder_rrc__layout_t *L, int to_wire, const uint8_t *src, size_t n, uint8_t *dst,
@@ -166,12 +189,12 @@ static int hiwonder_rrc__rewrite(const hiwonder_rrc__layout_t *L, int to_wire, c
             size_t flen = to_wire ? L->pairs[k].plain_len : L->pairs[k].wire_len;
             const uint8_t *to = to_wire ? L->pairs[k].wire : L->pairs[k].plain;
             size_t tlen = to_wire ? L->pairs[k].wire_len : L->pairs[k].plain_len;
-            if (flen <= n - i && memcmp(src + i, from, flen) == 0) {
+            if (flen <= n - i && hiwonder_rrc__same(src + i, from, flen)) {
                 if (tlen > cap - o) {
                     return 0;
                 }
                 if (cmp != NULL) {
-                    if (memcmp(cmp + o, to, tlen) != 0) {
+                    if (!hiwonder_rrc__same(cmp + o, to, tlen)) {
                         return 0;
                     }
                 } else {
@@ -201,18 +224,21 @@ static int hiwonder_rrc__rewrite(const hiwonder_rrc__layout_t *L, int to_wire, c
     *out = o;
     return cmp == NULL || o == cap;
 }
+#endif
 
+#if HIWONDER_RRC_ENABLE_ENCODE || HIWONDER_RRC__STUFFED
 /* The bytes of elements a..b: the plain bytes when they lie inside the stuffed span, else the wire bytes. */
 static const uint8_t *hiwonder_rrc__range(const hiwonder_rrc__layout_t *L, const hiwonder_rrc__where_t *w, const uint8_t *wire,
                                  const uint8_t *plain, uint8_t a, uint8_t b, size_t *n)
 {
-    if (L->has_t && a >= L->t_first && b <= L->t_last) {
+    if (HIWONDER_RRC__T(L) && a >= L->t_first && b <= L->t_last) {
         *n = w->pe[b] - w->ps[a];
         return plain + w->ps[a];
     }
     *n = w->we[b] - w->ws[a];
     return wire + w->ws[a];
 }
+#endif
 
 #if HIWONDER_RRC_ENABLE_ENCODE
 /* The frame around a content already in place (at out + prefix, or in span + its offset when stuffed): the frame
@@ -227,7 +253,7 @@ static int hiwonder_rrc__wrap(const hiwonder_rrc__layout_t *L, uint8_t *out, siz
     int last = hiwonder_rrc__inner_last(L);
     const uint8_t *bytes;
     /* plain bytes of the stuffed span: its elements laid out around the content, inner checksums over them */
-    if (L->has_t) {
+    if (HIWONDER_RRC__T(L)) {
         size_t p = 0u;
         for (k = L->t_first; k <= L->t_last; k++) {
             const hiwonder_rrc__element_t *e = &L->e[k];
@@ -266,7 +292,7 @@ static int hiwonder_rrc__wrap(const hiwonder_rrc__layout_t *L, uint8_t *out, siz
     v = 0u;
     for (k = 0u; k < L->count; k++) {
         const hiwonder_rrc__element_t *e = &L->e[k];
-        if (L->has_t && k == L->t_first) {
+        if (HIWONDER_RRC__T(L) && k == L->t_first) {
             size_t made;
             if (!hiwonder_rrc__rewrite(L, 1, span, w.pe[L->t_last], out + pos, NULL, cap - pos, &made)) {
                 return HIWONDER_RRC_E_BUFFER;
@@ -319,7 +345,7 @@ static int hiwonder_rrc__wrap(const hiwonder_rrc__layout_t *L, uint8_t *out, siz
     }
     for (k = 0u; k < L->count; k++) {
         const hiwonder_rrc__element_t *e = &L->e[k];
-        if (e->role == HIWONDER_RRC__ROLE_CHECKSUM && !(L->has_t && k >= L->t_first && k <= L->t_last)) {
+        if (e->role == HIWONDER_RRC__ROLE_CHECKSUM && !(HIWONDER_RRC__T(L) && k >= L->t_first && k <= L->t_last)) {
             bytes = hiwonder_rrc__range(L, &w, out, span, e->first, e->last, &sz);
             hiwonder_rrc__put(out + w.ws[k], e->size, e->big, hiwonder_rrc__check(e->check, bytes, sz));
         }
@@ -329,7 +355,7 @@ static int hiwonder_rrc__wrap(const hiwonder_rrc__layout_t *L, uint8_t *out, siz
 }
 #endif
 
-#if HIWONDER_RRC_ENABLE_DECODE
+#if HIWONDER_RRC_ENABLE_DECODE && HIWONDER_RRC__STUFFED
 /* Check a complete frame (constants, values, lengths, stuffing, checksums) and take it apart: the frame engine's
  * unwrap (runtime/framing.py Layout.unwrap). plain: room for the unstuffed span. */
 static int hiwonder_rrc__unwrap(const hiwonder_rrc__layout_t *L, const uint8_t *frame, size_t n, uint8_t *plain, uint32_t *code,
@@ -359,7 +385,7 @@ static int hiwonder_rrc__unwrap(const hiwonder_rrc__layout_t *L, const uint8_t *
         pos -= L->e[k - 1u].size;
         w.ws[k - 1u] = pos;
     }
-    if (L->has_t) {
+    if (HIWONDER_RRC__T(L)) {
         size_t pn, fixed = 0u, p = 0u;
         if (!hiwonder_rrc__rewrite(L, 0, frame + before, n - before - after, plain, NULL, HIWONDER_RRC_MAX_FRAME, &pn)) {
             return HIWONDER_RRC_E_CAPACITY;
@@ -387,15 +413,15 @@ static int hiwonder_rrc__unwrap(const hiwonder_rrc__layout_t *L, const uint8_t *
     }
     for (k = 0u; k < L->count; k++) {
         const hiwonder_rrc__element_t *e = &L->e[k];
-        bytes = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
-        if (e->role == HIWONDER_RRC__ROLE_CONSTANT && memcmp(bytes, e->constant, e->size) != 0) {
+        bytes = HIWONDER_RRC__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+        if (e->role == HIWONDER_RRC__ROLE_CONSTANT && !hiwonder_rrc__same(bytes, e->constant, e->size)) {
             return HIWONDER_RRC_E_FRAME;
         }
     }
     *code = 0u;
     for (k = 0u; k < L->count; k++) {
         const hiwonder_rrc__element_t *e = &L->e[k];
-        bytes = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+        bytes = HIWONDER_RRC__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
         if (e->role == HIWONDER_RRC__ROLE_COMMAND) {
             *code = hiwonder_rrc__get(bytes, e->size, e->big);
         } else if (e->role == HIWONDER_RRC__ROLE_VALUE) {
@@ -409,7 +435,7 @@ static int hiwonder_rrc__unwrap(const hiwonder_rrc__layout_t *L, const uint8_t *
     for (k = 0u; k < L->count; k++) {
         const hiwonder_rrc__element_t *e = &L->e[k];
         if (e->role == HIWONDER_RRC__ROLE_LENGTH) {
-            bytes = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+            bytes = HIWONDER_RRC__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
             (void)hiwonder_rrc__range(L, &w, frame, body, e->first, e->last, &sz);
             if ((int32_t)hiwonder_rrc__get(bytes, e->size, e->big) != (int32_t)sz + e->adds) {
                 return HIWONDER_RRC_E_LENGTH;
@@ -419,7 +445,7 @@ static int hiwonder_rrc__unwrap(const hiwonder_rrc__layout_t *L, const uint8_t *
     for (k = 0u; k < L->count; k++) {
         const hiwonder_rrc__element_t *e = &L->e[k];
         if (e->role == HIWONDER_RRC__ROLE_CHECKSUM) {
-            const uint8_t *stored = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+            const uint8_t *stored = HIWONDER_RRC__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
             bytes = hiwonder_rrc__range(L, &w, frame, body, e->first, e->last, &sz);
             if (hiwonder_rrc__check(e->check, bytes, sz) != hiwonder_rrc__get(stored, e->size, e->big)) {
                 return HIWONDER_RRC_E_CHECKSUM;
@@ -427,7 +453,7 @@ static int hiwonder_rrc__unwrap(const hiwonder_rrc__layout_t *L, const uint8_t *
         }
     }
     if (L->content >= 0) {
-        int inside = L->has_t && L->content >= (int)L->t_first && L->content <= (int)L->t_last;
+        int inside = HIWONDER_RRC__T(L) && L->content >= (int)L->t_first && L->content <= (int)L->t_last;
         *content = inside ? body + w.ps[L->content] : frame + w.ws[L->content];
         *clen = inside ? w.pe[L->content] - w.ps[L->content] : w.we[L->content] - w.ws[L->content];
     } else {
@@ -460,7 +486,7 @@ static long hiwonder_rrc__probe(const hiwonder_rrc__layout_t *L, hiwonder_rrc_di
             return HIWONDER_RRC__WAIT;
         }
         if (e->role == HIWONDER_RRC__ROLE_CONSTANT) {
-            if (memcmp(b + pos, e->constant, e->size) != 0) {
+            if (!hiwonder_rrc__same(b + pos, e->constant, e->size)) {
                 return HIWONDER_RRC__NONE;
             }
         } else if (e->role == HIWONDER_RRC__ROLE_COMMAND) {
@@ -486,20 +512,20 @@ static long hiwonder_rrc__probe(const hiwonder_rrc__layout_t *L, hiwonder_rrc_di
         low = 0u; /* the code lies in the stuffed span: no bounds before the frame is unstuffed */
         bounded = 0;
     }
-    if (L->length >= 0) {
+    if (HIWONDER_RRC__LENGTHS || L->length >= 0) {
         const hiwonder_rrc__element_t *e = &L->e[L->length];
         long counted = (long)hiwonder_rrc__get(b + L->length_off, e->size, e->big) - (long)e->adds;
         long content = counted - (long)L->counted;
-        if (content < (long)low || (!L->has_t && bounded && content > (long)high)) {
+        if (content < (long)low || (!HIWONDER_RRC__T(L) && bounded && content > (long)high)) {
             return HIWONDER_RRC__NONE;
         }
         return (long)(L->overhead - L->counted) + counted;
     }
-    if (L->has_t && L->e[L->count - 1u].role == HIWONDER_RRC__ROLE_CONSTANT && L->count > 1u) {
+    if (HIWONDER_RRC__T(L) && L->e[L->count - 1u].role == HIWONDER_RRC__ROLE_CONSTANT && L->count > 1u) {
         const hiwonder_rrc__element_t *t = &L->e[L->count - 1u];
         size_t i;
         for (i = before; i + t->size <= avail; i++) {
-            if (memcmp(b + i, t->constant, t->size) == 0) {
+            if (hiwonder_rrc__same(b + i, t->constant, t->size)) {
                 return (long)(i + t->size);
             }
         }
@@ -690,6 +716,78 @@ static int hiwonder_rrc__bounds(hiwonder_rrc_direction_t dir, long code, size_t 
 #endif
 
 #if HIWONDER_RRC_ENABLE_DECODE
+/* ---- frames taken apart: straight line where a layout has no byte stuffing ---- */
+/* The request frame: unwrap, straight line. */
+static int hiwonder_rrc__unwrap_request_0(const uint8_t *f, size_t n, uint32_t *code, uint32_t *values,
+                                 const uint8_t **content, size_t *clen)
+{
+    (void)values;
+    *code = 0u;
+    if (n < 5u) {
+        return HIWONDER_RRC_E_LENGTH;
+    }
+    if (f[0u] != 0xaau) { return HIWONDER_RRC_E_FRAME; } /* header */
+    if (f[1u] != 0x55u) { return HIWONDER_RRC_E_FRAME; } /* header */
+    *code = (uint32_t)f[2u]; /* function */
+    if ((int32_t)((uint32_t)f[3u]) != (int32_t)(n - 5u) + 0) { return HIWONDER_RRC_E_LENGTH; } /* length */
+    if (hiwonder_rrc__check(0u, f + 2u, (n - 3u)) != ((uint32_t)f[n - 1u])) { return HIWONDER_RRC_E_CHECKSUM; } /* crc */
+    *content = f + 4u;
+    *clen = n - 5u;
+    return HIWONDER_RRC_OK;
+}
+
+/* The response frame: unwrap, straight line. */
+static int hiwonder_rrc__unwrap_response_0(const uint8_t *f, size_t n, uint32_t *code, uint32_t *values,
+                                 const uint8_t **content, size_t *clen)
+{
+    (void)values;
+    *code = 0u;
+    if (n < 5u) {
+        return HIWONDER_RRC_E_LENGTH;
+    }
+    if (f[0u] != 0xaau) { return HIWONDER_RRC_E_FRAME; } /* header */
+    if (f[1u] != 0x55u) { return HIWONDER_RRC_E_FRAME; } /* header */
+    *code = (uint32_t)f[2u]; /* function */
+    if ((int32_t)((uint32_t)f[3u]) != (int32_t)(n - 5u) + 0) { return HIWONDER_RRC_E_LENGTH; } /* length */
+    if (hiwonder_rrc__check(0u, f + 2u, (n - 3u)) != ((uint32_t)f[n - 1u])) { return HIWONDER_RRC_E_CHECKSUM; } /* crc */
+    *content = f + 4u;
+    *clen = n - 5u;
+    return HIWONDER_RRC_OK;
+}
+
+static int hiwonder_rrc__unwrap_at(hiwonder_rrc_direction_t dir, uint8_t k, const hiwonder_rrc__layout_t *L, const uint8_t *frame, size_t n,
+                          uint8_t *plain, uint32_t *code, uint32_t *values, const uint8_t **content, size_t *clen)
+{
+    (void)k;
+    (void)L;
+    (void)plain;
+    switch (dir) {
+    case HIWONDER_RRC_REQUEST:
+        switch (k) {
+        case 0u:
+            return hiwonder_rrc__unwrap_request_0(frame, n, code, values, content, clen);
+        default:
+            break;
+        }
+        break;
+    case HIWONDER_RRC_RESPONSE:
+        switch (k) {
+        case 0u:
+            return hiwonder_rrc__unwrap_response_0(frame, n, code, values, content, clen);
+        default:
+            break;
+        }
+        break;
+    default:
+        break;
+    }
+#if HIWONDER_RRC__STUFFED
+    return hiwonder_rrc__unwrap(L, frame, n, plain, code, values, content, clen);
+#else
+    return HIWONDER_RRC_E_ARG;
+#endif
+}
+
 /* ---- content decoders ---- */
 /* The content of led (request): fields in wire order. */
 static int hiwonder_rrc__dec_led_request(const uint8_t *c, size_t n, hiwonder_rrc_led_request_t *m)
@@ -2058,7 +2156,7 @@ int hiwonder_rrc_decode_expect(const uint8_t *frame, size_t len, hiwonder_rrc_di
     uint8_t count, k;
     const hiwonder_rrc__layout_t *const *layouts;
     const hiwonder_rrc__layout_t *L = NULL;
-    uint32_t code = 0u, values[HIWONDER_RRC__MAX_ELEMENTS];
+    uint32_t code = 0u, values[HIWONDER_RRC__MAX_ELEMENTS] = {0u};
     const uint8_t *c = NULL;
     size_t clen = 0u;
     int r;
@@ -2071,12 +2169,13 @@ int hiwonder_rrc_decode_expect(const uint8_t *frame, size_t len, hiwonder_rrc_di
     if (layouts == NULL) {
         return HIWONDER_RRC_E_ARG;
     }
-    if (count == 1u) {
+    k = 0u;
+    if (HIWONDER_RRC__SINGLE || count == 1u) {
         L = layouts[0];
     } else {
         for (k = 0u; k < count; k++) {
             const hiwonder_rrc__layout_t *A = layouts[k];
-            if (A->header_len <= len && memcmp(frame, A->e[0].constant, A->header_len) == 0) {
+            if (A->header_len <= len && hiwonder_rrc__same(frame, A->e[0].constant, A->header_len)) {
                 L = A;
                 break;
             }
@@ -2085,7 +2184,7 @@ int hiwonder_rrc_decode_expect(const uint8_t *frame, size_t len, hiwonder_rrc_di
             return HIWONDER_RRC_E_FRAME;
         }
     }
-    r = hiwonder_rrc__unwrap(L, frame, len, plain, &code, values, &c, &clen);
+    r = hiwonder_rrc__unwrap_at(dir, k, L, frame, len, plain, &code, values, &c, &clen);
     if (r != HIWONDER_RRC_OK) {
         return r;
     }
@@ -2409,7 +2508,7 @@ static int hiwonder_rrc__enc_pwm_servo_set_offset_request(const void *mv, uint8_
     hiwonder_rrc__put(c + o, 1u, 0u, (uint32_t)(m->servo_id)); /* servo_id */
     o += 1u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }
-    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->offset) & 0xffUL)); /* offset */
+    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->offset) & 0xffu)); /* offset */
     o += 1u;
     *n = o;
     return HIWONDER_RRC_OK;
@@ -2450,7 +2549,7 @@ static int hiwonder_rrc__enc_pwm_servo_read_offset_response(const void *mv, uint
     hiwonder_rrc__put(c + o, 1u, 0u, 9UL); /* subcommand_code */
     o += 1u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }
-    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->offset) & 0xffUL)); /* offset */
+    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->offset) & 0xffu)); /* offset */
     o += 1u;
     *n = o;
     return HIWONDER_RRC_OK;
@@ -2530,10 +2629,10 @@ static int hiwonder_rrc__enc_bus_servo_read_position_response(const void *mv, ui
     hiwonder_rrc__put(c + o, 1u, 0u, 5UL); /* subcommand_code */
     o += 1u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }
-    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->success) & 0xffUL)); /* success */
+    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->success) & 0xffu)); /* success */
     o += 1u;
     if (cap - o < 2u) { return HIWONDER_RRC_E_BUFFER; }
-    hiwonder_rrc__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->position) & 0xffffUL)); /* position */
+    hiwonder_rrc__put(c + o, 2u, 0u, ((uint32_t)(int32_t)(m->position) & 0xffffu)); /* position */
     o += 2u;
     *n = o;
     return HIWONDER_RRC_OK;
@@ -2575,7 +2674,7 @@ static int hiwonder_rrc__enc_bus_servo_read_voltage_response(const void *mv, uin
     hiwonder_rrc__put(c + o, 1u, 0u, 7UL); /* subcommand_code */
     o += 1u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }
-    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->success) & 0xffUL)); /* success */
+    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->success) & 0xffu)); /* success */
     o += 1u;
     if (cap - o < 2u) { return HIWONDER_RRC_E_BUFFER; }
     hiwonder_rrc__put(c + o, 2u, 0u, (uint32_t)(m->voltage)); /* voltage */
@@ -2620,7 +2719,7 @@ static int hiwonder_rrc__enc_bus_servo_read_temperature_response(const void *mv,
     hiwonder_rrc__put(c + o, 1u, 0u, 9UL); /* subcommand_code */
     o += 1u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }
-    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->success) & 0xffUL)); /* success */
+    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->success) & 0xffu)); /* success */
     o += 1u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }
     hiwonder_rrc__put(c + o, 1u, 0u, (uint32_t)(m->temperature)); /* temperature */
@@ -2694,10 +2793,10 @@ static int hiwonder_rrc__enc_bus_servo_read_torque_response(const void *mv, uint
     hiwonder_rrc__put(c + o, 1u, 0u, 13UL); /* subcommand_code */
     o += 1u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }
-    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->success) & 0xffUL)); /* success */
+    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->success) & 0xffu)); /* success */
     o += 1u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }
-    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->torque) & 0xffUL)); /* torque */
+    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->torque) & 0xffu)); /* torque */
     o += 1u;
     *n = o;
     return HIWONDER_RRC_OK;
@@ -2799,7 +2898,7 @@ static int hiwonder_rrc__enc_bus_servo_read_id_response(const void *mv, uint8_t 
     hiwonder_rrc__put(c + o, 1u, 0u, 18UL); /* subcommand_code */
     o += 1u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }
-    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->success) & 0xffUL)); /* success */
+    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->success) & 0xffu)); /* success */
     o += 1u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }
     hiwonder_rrc__put(c + o, 1u, 0u, (uint32_t)(m->id)); /* id */
@@ -2825,7 +2924,7 @@ static int hiwonder_rrc__enc_bus_servo_set_offset_request(const void *mv, uint8_
     hiwonder_rrc__put(c + o, 1u, 0u, (uint32_t)(m->servo_id)); /* servo_id */
     o += 1u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }
-    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->offset) & 0xffUL)); /* offset */
+    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->offset) & 0xffu)); /* offset */
     o += 1u;
     *n = o;
     return HIWONDER_RRC_OK;
@@ -2867,10 +2966,10 @@ static int hiwonder_rrc__enc_bus_servo_read_offset_response(const void *mv, uint
     hiwonder_rrc__put(c + o, 1u, 0u, 34UL); /* subcommand_code */
     o += 1u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }
-    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->success) & 0xffUL)); /* success */
+    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->success) & 0xffu)); /* success */
     o += 1u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }
-    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->offset) & 0xffUL)); /* offset */
+    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->offset) & 0xffu)); /* offset */
     o += 1u;
     *n = o;
     return HIWONDER_RRC_OK;
@@ -2958,7 +3057,7 @@ static int hiwonder_rrc__enc_bus_servo_read_position_limit_response(const void *
     hiwonder_rrc__put(c + o, 1u, 0u, 50UL); /* subcommand_code */
     o += 1u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }
-    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->success) & 0xffUL)); /* success */
+    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->success) & 0xffu)); /* success */
     o += 1u;
     if (cap - o < 2u) { return HIWONDER_RRC_E_BUFFER; }
     hiwonder_rrc__put(c + o, 2u, 0u, (uint32_t)(m->low)); /* low */
@@ -3033,7 +3132,7 @@ static int hiwonder_rrc__enc_bus_servo_read_voltage_limit_response(const void *m
     hiwonder_rrc__put(c + o, 1u, 0u, 54UL); /* subcommand_code */
     o += 1u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }
-    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->success) & 0xffUL)); /* success */
+    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->success) & 0xffu)); /* success */
     o += 1u;
     if (cap - o < 2u) { return HIWONDER_RRC_E_BUFFER; }
     hiwonder_rrc__put(c + o, 2u, 0u, (uint32_t)(m->low)); /* low */
@@ -3104,7 +3203,7 @@ static int hiwonder_rrc__enc_bus_servo_read_temperature_limit_response(const voi
     hiwonder_rrc__put(c + o, 1u, 0u, 58UL); /* subcommand_code */
     o += 1u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }
-    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->success) & 0xffUL)); /* success */
+    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->success) & 0xffu)); /* success */
     o += 1u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }
     hiwonder_rrc__put(c + o, 1u, 0u, (uint32_t)(m->limit)); /* limit */
@@ -3186,16 +3285,16 @@ static int hiwonder_rrc__enc_gamepad_response(const void *mv, uint8_t *c, size_t
     hiwonder_rrc__put(c + o, 1u, 0u, (uint32_t)(m->hat)); /* hat */
     o += 1u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }
-    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->left_x) & 0xffUL)); /* left_x */
+    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->left_x) & 0xffu)); /* left_x */
     o += 1u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }
-    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->left_y) & 0xffUL)); /* left_y */
+    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->left_y) & 0xffu)); /* left_y */
     o += 1u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }
-    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->right_x) & 0xffUL)); /* right_x */
+    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->right_x) & 0xffu)); /* right_x */
     o += 1u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }
-    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->right_y) & 0xffUL)); /* right_y */
+    hiwonder_rrc__put(c + o, 1u, 0u, ((uint32_t)(int32_t)(m->right_y) & 0xffu)); /* right_y */
     o += 1u;
     *n = o;
     return HIWONDER_RRC_OK;
@@ -3213,7 +3312,7 @@ static int hiwonder_rrc__enc_sbus_response(const void *mv, uint8_t *c, size_t ca
     (void)cap;
     if (cap - o < 32u) { return HIWONDER_RRC_E_BUFFER; }
     for (i1 = 0u; i1 < 16u; i1++) {
-        hiwonder_rrc__put(c + o + i1 * 2u, 2u, 0u, ((uint32_t)(int32_t)(m->channels[i1]) & 0xffffUL));
+        hiwonder_rrc__put(c + o + i1 * 2u, 2u, 0u, ((uint32_t)(int32_t)(m->channels[i1]) & 0xffffu));
     }
     o += 32u;
     if (cap - o < 1u) { return HIWONDER_RRC_E_BUFFER; }
@@ -3329,11 +3428,11 @@ static int hiwonder_rrc__frame(hiwonder_rrc_direction_t dir, uint32_t code, cons
         size_t before = 0u, clen = 0u;
         uint8_t *dst;
         size_t room;
-        uint8_t from = L->has_t ? L->t_first : 0u;
+        uint8_t from = HIWONDER_RRC__T(L) ? L->t_first : 0u;
         for (i = from; (int)i < L->content; i++) {
             before += L->e[i].size;
         }
-        if (L->has_t) {
+        if (HIWONDER_RRC__T(L)) {
             if (before > HIWONDER_RRC_MAX_FRAME) {
                 return HIWONDER_RRC_E_BUFFER;
             }
@@ -4036,7 +4135,7 @@ static size_t hiwonder_rrc__next(hiwonder_rrc_parser_t *p, size_t start)
             const hiwonder_rrc__layout_t *L = layouts[k];
             if (L->header_len > p->n - pos) {
                 whole = 0;
-            } else if (memcmp(p->buf + pos, L->e[0].constant, L->header_len) == 0) {
+            } else if (hiwonder_rrc__same(p->buf + pos, L->e[0].constant, L->header_len)) {
                 return pos;
             }
         }
@@ -4115,11 +4214,56 @@ static int hiwonder_rrc__push(hiwonder_rrc_parser_t *p, uint8_t byte, hiwonder_r
     return got;
 }
 
+#if HIWONDER_RRC__HEADERS
+/* A whole frame at data[0..len) while no byte is held: taken at once, its bytes not pushed one by one, when that gives
+ * what pushing them would (one layout; a plausible frame that fits and decodes; no header inside it, so no other
+ * candidate could end first). Else 0: the bytes go through hiwonder_rrc__push. */
+static size_t hiwonder_rrc__whole(hiwonder_rrc_parser_t *p, const uint8_t *data, size_t len, hiwonder_rrc_msg_t *out)
+{
+    uint8_t count;
+    const hiwonder_rrc__layout_t *const *layouts = hiwonder_rrc__layouts(p->dir, &count);
+    const hiwonder_rrc__layout_t *L;
+    size_t i, size;
+    long s;
+    if (!HIWONDER_RRC__SINGLE && count != 1u) {
+        return 0u;
+    }
+    L = layouts[0];
+    if (len < L->header_len || !hiwonder_rrc__same(data, L->e[0].constant, L->header_len)) {
+        return 0u;
+    }
+    s = hiwonder_rrc__probe(L, p->dir, data, len);
+    if (s <= 0 || (unsigned long)s > HIWONDER_RRC_MAX_FRAME || (size_t)s > len) {
+        return 0u;
+    }
+    size = (size_t)s;
+    for (i = 1u; i + L->header_len <= size; i++) {
+        if (data[i] == L->e[0].constant[0] && hiwonder_rrc__same(data + i, L->e[0].constant, L->header_len)) {
+            return 0u;
+        }
+    }
+    if (hiwonder_rrc_decode(data, size, p->dir, out) != HIWONDER_RRC_OK) {
+        return 0u;
+    }
+    p->frames++;
+    return size;
+}
+#endif
+
 size_t hiwonder_rrc_parser_feed(hiwonder_rrc_parser_t *parser, const uint8_t *data, size_t len, hiwonder_rrc_msg_t *out, bool *got)
 {
     size_t i;
     *got = false;
     for (i = 0u; i < len; i++) {
+#if HIWONDER_RRC__HEADERS
+        if (parser->n == 0u) {
+            size_t size = hiwonder_rrc__whole(parser, data + i, len - i, out);
+            if (size > 0u) {
+                *got = true;
+                return i + size;
+            }
+        }
+#endif
         if (hiwonder_rrc__push(parser, data[i], out)) {
             *got = true;
             return i + 1u;

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define HIWONDER_RRC_SPEC_SHA256 "f09b6236af133d6ab19f8f395f481eba30f757f75f8d0739edefebd08cf6a2c1"
+#define HIWONDER_RRC_SPEC_SHA256 "cfa789e98d7941b6841e87121ada8b505a29bb9d0988d7c95f66d75f3dbed0ac"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef HIWONDER_RRC_ENABLE_ENCODE

@@ -20,7 +20,10 @@ typedef char modbus_rtu__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 /* counting as serialspec.runtime.stream.StreamParser (1), else as framing.FrameStreamParser */
 #define MODBUS_RTU__CLASSIC 0
 #define MODBUS_RTU__HEADERS 0 /* every layout starts with a header: candidates start at headers only */
-#define MODBUS_RTU__KEEP -1u      /* bytes kept at the end that could begin a header */
+#define MODBUS_RTU__KEEP 0u      /* bytes kept at the end that could begin a header */
+#define MODBUS_RTU__STUFFED 0 /* some layout has byte stuffing */
+#define MODBUS_RTU__LENGTHS 0 /* every layout has a length element */
+#define MODBUS_RTU__SINGLE 1 /* one layout per direction */
 
 /* ---- checksums ---- */
 /* CRC-16/MODBUS: width 16, poly 0x8005, init 0xffff, refin true, refout true, xorout 0x0 (check 0x4b37). Incremental: start with 0xffff, feed pieces, then use it as is. Bitwise: no table, no static data. */
@@ -57,6 +60,21 @@ static uint32_t modbus_rtu__check(uint8_t which, const uint8_t *d, size_t n)
 #define MODBUS_RTU__ROLE_LENGTH 3u
 #define MODBUS_RTU__ROLE_CONTENT 4u
 #define MODBUS_RTU__ROLE_CHECKSUM 5u
+
+/* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
+static int modbus_rtu__same(const uint8_t *a, const uint8_t *b, size_t n)
+{
+    size_t i;
+    for (i = 0u; i < n; i++) {
+        if (a[i] != b[i]) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+/* Byte stuffing over part of a layout (constant 0 when no layout has it: that code left out) */
+#define MODBUS_RTU__T(L) (MODBUS_RTU__STUFFED && (L)->has_t)
 
 #define MODBUS_RTU__WAIT (-2L)
 #define MODBUS_RTU__NONE (-1L)
@@ -135,23 +153,28 @@ static void modbus_rtu__put(uint8_t *b, uint8_t size, uint8_t big, uint32_t v)
 }
 #endif
 
+#if MODBUS_RTU_ENABLE_ENCODE || MODBUS_RTU__STUFFED || MODBUS_RTU_ENABLE_PARSER
 /* The elements before the variable part (the stuffed span, else the content) and after it. */
 static uint8_t modbus_rtu__inner_first(const modbus_rtu__layout_t *L)
 {
-    if (L->has_t) {
+    if (MODBUS_RTU__T(L)) {
         return L->t_first;
     }
     return L->content >= 0 ? (uint8_t)L->content : L->count;
 }
+#endif
 
+#if MODBUS_RTU_ENABLE_ENCODE || MODBUS_RTU__STUFFED
 static int modbus_rtu__inner_last(const modbus_rtu__layout_t *L)
 {
-    if (L->has_t) {
+    if (MODBUS_RTU__T(L)) {
         return (int)L->t_last;
     }
     return L->content >= 0 ? (int)L->content : (int)L->count - 1;
 }
+#endif
 
+#if MODBUS_RTU_ENABLE_ENCODE || MODBUS_RTU__STUFFED
 /* Each plain sequence rewritten as its wire sequence (to_wire) or back, leftmost first, the pairs tried in order at
  * each position. With cmp: compare the result with cmp[0..cap) instead of writing it (1: equal). */
 static int modbus_rtu__rewrite(const modbus_rtu__layout_t *L, int to_wire, const uint8_t *src, size_t n, uint8_t *dst,
@@ -166,12 +189,12 @@ static int modbus_rtu__rewrite(const modbus_rtu__layout_t *L, int to_wire, const
             size_t flen = to_wire ? L->pairs[k].plain_len : L->pairs[k].wire_len;
             const uint8_t *to = to_wire ? L->pairs[k].wire : L->pairs[k].plain;
             size_t tlen = to_wire ? L->pairs[k].wire_len : L->pairs[k].plain_len;
-            if (flen <= n - i && memcmp(src + i, from, flen) == 0) {
+            if (flen <= n - i && modbus_rtu__same(src + i, from, flen)) {
                 if (tlen > cap - o) {
                     return 0;
                 }
                 if (cmp != NULL) {
-                    if (memcmp(cmp + o, to, tlen) != 0) {
+                    if (!modbus_rtu__same(cmp + o, to, tlen)) {
                         return 0;
                     }
                 } else {
@@ -201,18 +224,21 @@ static int modbus_rtu__rewrite(const modbus_rtu__layout_t *L, int to_wire, const
     *out = o;
     return cmp == NULL || o == cap;
 }
+#endif
 
+#if MODBUS_RTU_ENABLE_ENCODE || MODBUS_RTU__STUFFED
 /* The bytes of elements a..b: the plain bytes when they lie inside the stuffed span, else the wire bytes. */
 static const uint8_t *modbus_rtu__range(const modbus_rtu__layout_t *L, const modbus_rtu__where_t *w, const uint8_t *wire,
                                  const uint8_t *plain, uint8_t a, uint8_t b, size_t *n)
 {
-    if (L->has_t && a >= L->t_first && b <= L->t_last) {
+    if (MODBUS_RTU__T(L) && a >= L->t_first && b <= L->t_last) {
         *n = w->pe[b] - w->ps[a];
         return plain + w->ps[a];
     }
     *n = w->we[b] - w->ws[a];
     return wire + w->ws[a];
 }
+#endif
 
 #if MODBUS_RTU_ENABLE_ENCODE
 /* The frame around a content already in place (at out + prefix, or in span + its offset when stuffed): the frame
@@ -227,7 +253,7 @@ static int modbus_rtu__wrap(const modbus_rtu__layout_t *L, uint8_t *out, size_t 
     int last = modbus_rtu__inner_last(L);
     const uint8_t *bytes;
     /* plain bytes of the stuffed span: its elements laid out around the content, inner checksums over them */
-    if (L->has_t) {
+    if (MODBUS_RTU__T(L)) {
         size_t p = 0u;
         for (k = L->t_first; k <= L->t_last; k++) {
             const modbus_rtu__element_t *e = &L->e[k];
@@ -266,7 +292,7 @@ static int modbus_rtu__wrap(const modbus_rtu__layout_t *L, uint8_t *out, size_t 
     v = 0u;
     for (k = 0u; k < L->count; k++) {
         const modbus_rtu__element_t *e = &L->e[k];
-        if (L->has_t && k == L->t_first) {
+        if (MODBUS_RTU__T(L) && k == L->t_first) {
             size_t made;
             if (!modbus_rtu__rewrite(L, 1, span, w.pe[L->t_last], out + pos, NULL, cap - pos, &made)) {
                 return MODBUS_RTU_E_BUFFER;
@@ -319,7 +345,7 @@ static int modbus_rtu__wrap(const modbus_rtu__layout_t *L, uint8_t *out, size_t 
     }
     for (k = 0u; k < L->count; k++) {
         const modbus_rtu__element_t *e = &L->e[k];
-        if (e->role == MODBUS_RTU__ROLE_CHECKSUM && !(L->has_t && k >= L->t_first && k <= L->t_last)) {
+        if (e->role == MODBUS_RTU__ROLE_CHECKSUM && !(MODBUS_RTU__T(L) && k >= L->t_first && k <= L->t_last)) {
             bytes = modbus_rtu__range(L, &w, out, span, e->first, e->last, &sz);
             modbus_rtu__put(out + w.ws[k], e->size, e->big, modbus_rtu__check(e->check, bytes, sz));
         }
@@ -329,7 +355,7 @@ static int modbus_rtu__wrap(const modbus_rtu__layout_t *L, uint8_t *out, size_t 
 }
 #endif
 
-#if MODBUS_RTU_ENABLE_DECODE
+#if MODBUS_RTU_ENABLE_DECODE && MODBUS_RTU__STUFFED
 /* Check a complete frame (constants, values, lengths, stuffing, checksums) and take it apart: the frame engine's
  * unwrap (runtime/framing.py Layout.unwrap). plain: room for the unstuffed span. */
 static int modbus_rtu__unwrap(const modbus_rtu__layout_t *L, const uint8_t *frame, size_t n, uint8_t *plain, uint32_t *code,
@@ -359,7 +385,7 @@ static int modbus_rtu__unwrap(const modbus_rtu__layout_t *L, const uint8_t *fram
         pos -= L->e[k - 1u].size;
         w.ws[k - 1u] = pos;
     }
-    if (L->has_t) {
+    if (MODBUS_RTU__T(L)) {
         size_t pn, fixed = 0u, p = 0u;
         if (!modbus_rtu__rewrite(L, 0, frame + before, n - before - after, plain, NULL, MODBUS_RTU_MAX_FRAME, &pn)) {
             return MODBUS_RTU_E_CAPACITY;
@@ -387,15 +413,15 @@ static int modbus_rtu__unwrap(const modbus_rtu__layout_t *L, const uint8_t *fram
     }
     for (k = 0u; k < L->count; k++) {
         const modbus_rtu__element_t *e = &L->e[k];
-        bytes = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
-        if (e->role == MODBUS_RTU__ROLE_CONSTANT && memcmp(bytes, e->constant, e->size) != 0) {
+        bytes = MODBUS_RTU__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+        if (e->role == MODBUS_RTU__ROLE_CONSTANT && !modbus_rtu__same(bytes, e->constant, e->size)) {
             return MODBUS_RTU_E_FRAME;
         }
     }
     *code = 0u;
     for (k = 0u; k < L->count; k++) {
         const modbus_rtu__element_t *e = &L->e[k];
-        bytes = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+        bytes = MODBUS_RTU__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
         if (e->role == MODBUS_RTU__ROLE_COMMAND) {
             *code = modbus_rtu__get(bytes, e->size, e->big);
         } else if (e->role == MODBUS_RTU__ROLE_VALUE) {
@@ -409,7 +435,7 @@ static int modbus_rtu__unwrap(const modbus_rtu__layout_t *L, const uint8_t *fram
     for (k = 0u; k < L->count; k++) {
         const modbus_rtu__element_t *e = &L->e[k];
         if (e->role == MODBUS_RTU__ROLE_LENGTH) {
-            bytes = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+            bytes = MODBUS_RTU__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
             (void)modbus_rtu__range(L, &w, frame, body, e->first, e->last, &sz);
             if ((int32_t)modbus_rtu__get(bytes, e->size, e->big) != (int32_t)sz + e->adds) {
                 return MODBUS_RTU_E_LENGTH;
@@ -419,7 +445,7 @@ static int modbus_rtu__unwrap(const modbus_rtu__layout_t *L, const uint8_t *fram
     for (k = 0u; k < L->count; k++) {
         const modbus_rtu__element_t *e = &L->e[k];
         if (e->role == MODBUS_RTU__ROLE_CHECKSUM) {
-            const uint8_t *stored = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+            const uint8_t *stored = MODBUS_RTU__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
             bytes = modbus_rtu__range(L, &w, frame, body, e->first, e->last, &sz);
             if (modbus_rtu__check(e->check, bytes, sz) != modbus_rtu__get(stored, e->size, e->big)) {
                 return MODBUS_RTU_E_CHECKSUM;
@@ -427,7 +453,7 @@ static int modbus_rtu__unwrap(const modbus_rtu__layout_t *L, const uint8_t *fram
         }
     }
     if (L->content >= 0) {
-        int inside = L->has_t && L->content >= (int)L->t_first && L->content <= (int)L->t_last;
+        int inside = MODBUS_RTU__T(L) && L->content >= (int)L->t_first && L->content <= (int)L->t_last;
         *content = inside ? body + w.ps[L->content] : frame + w.ws[L->content];
         *clen = inside ? w.pe[L->content] - w.ps[L->content] : w.we[L->content] - w.ws[L->content];
     } else {
@@ -460,7 +486,7 @@ static long modbus_rtu__probe(const modbus_rtu__layout_t *L, modbus_rtu_directio
             return MODBUS_RTU__WAIT;
         }
         if (e->role == MODBUS_RTU__ROLE_CONSTANT) {
-            if (memcmp(b + pos, e->constant, e->size) != 0) {
+            if (!modbus_rtu__same(b + pos, e->constant, e->size)) {
                 return MODBUS_RTU__NONE;
             }
         } else if (e->role == MODBUS_RTU__ROLE_COMMAND) {
@@ -486,20 +512,20 @@ static long modbus_rtu__probe(const modbus_rtu__layout_t *L, modbus_rtu_directio
         low = 0u; /* the code lies in the stuffed span: no bounds before the frame is unstuffed */
         bounded = 0;
     }
-    if (L->length >= 0) {
+    if (MODBUS_RTU__LENGTHS || L->length >= 0) {
         const modbus_rtu__element_t *e = &L->e[L->length];
         long counted = (long)modbus_rtu__get(b + L->length_off, e->size, e->big) - (long)e->adds;
         long content = counted - (long)L->counted;
-        if (content < (long)low || (!L->has_t && bounded && content > (long)high)) {
+        if (content < (long)low || (!MODBUS_RTU__T(L) && bounded && content > (long)high)) {
             return MODBUS_RTU__NONE;
         }
         return (long)(L->overhead - L->counted) + counted;
     }
-    if (L->has_t && L->e[L->count - 1u].role == MODBUS_RTU__ROLE_CONSTANT && L->count > 1u) {
+    if (MODBUS_RTU__T(L) && L->e[L->count - 1u].role == MODBUS_RTU__ROLE_CONSTANT && L->count > 1u) {
         const modbus_rtu__element_t *t = &L->e[L->count - 1u];
         size_t i;
         for (i = before; i + t->size <= avail; i++) {
-            if (memcmp(b + i, t->constant, t->size) == 0) {
+            if (modbus_rtu__same(b + i, t->constant, t->size)) {
                 return (long)(i + t->size);
             }
         }
@@ -702,6 +728,76 @@ static int modbus_rtu__bounds(modbus_rtu_direction_t dir, long code, size_t *low
 #endif
 
 #if MODBUS_RTU_ENABLE_DECODE
+/* ---- frames taken apart: straight line where a layout has no byte stuffing ---- */
+/* The request frame: unwrap, straight line. */
+static int modbus_rtu__unwrap_request_0(const uint8_t *f, size_t n, uint32_t *code, uint32_t *values,
+                                 const uint8_t **content, size_t *clen)
+{
+    (void)values;
+    *code = 0u;
+    if (n < 4u) {
+        return MODBUS_RTU_E_LENGTH;
+    }
+    values[0] = (uint32_t)f[0u]; /* unit */
+    if ((values[0] < 1u || values[0] > 247u) && values[0] != 0u) { return MODBUS_RTU_E_RANGE; }
+    *code = (uint32_t)f[1u]; /* function */
+    if (modbus_rtu__check(0u, f + 0u, (n - 2u)) != (((uint32_t)f[n - 1u] << 8u) | (uint32_t)f[n - 2u])) { return MODBUS_RTU_E_CHECKSUM; } /* crc */
+    *content = f + 2u;
+    *clen = n - 4u;
+    return MODBUS_RTU_OK;
+}
+
+/* The response frame: unwrap, straight line. */
+static int modbus_rtu__unwrap_response_0(const uint8_t *f, size_t n, uint32_t *code, uint32_t *values,
+                                 const uint8_t **content, size_t *clen)
+{
+    (void)values;
+    *code = 0u;
+    if (n < 4u) {
+        return MODBUS_RTU_E_LENGTH;
+    }
+    values[0] = (uint32_t)f[0u]; /* unit */
+    if ((values[0] < 1u || values[0] > 247u) && values[0] != 0u) { return MODBUS_RTU_E_RANGE; }
+    *code = (uint32_t)f[1u]; /* function */
+    if (modbus_rtu__check(0u, f + 0u, (n - 2u)) != (((uint32_t)f[n - 1u] << 8u) | (uint32_t)f[n - 2u])) { return MODBUS_RTU_E_CHECKSUM; } /* crc */
+    *content = f + 2u;
+    *clen = n - 4u;
+    return MODBUS_RTU_OK;
+}
+
+static int modbus_rtu__unwrap_at(modbus_rtu_direction_t dir, uint8_t k, const modbus_rtu__layout_t *L, const uint8_t *frame, size_t n,
+                          uint8_t *plain, uint32_t *code, uint32_t *values, const uint8_t **content, size_t *clen)
+{
+    (void)k;
+    (void)L;
+    (void)plain;
+    switch (dir) {
+    case MODBUS_RTU_REQUEST:
+        switch (k) {
+        case 0u:
+            return modbus_rtu__unwrap_request_0(frame, n, code, values, content, clen);
+        default:
+            break;
+        }
+        break;
+    case MODBUS_RTU_RESPONSE:
+        switch (k) {
+        case 0u:
+            return modbus_rtu__unwrap_response_0(frame, n, code, values, content, clen);
+        default:
+            break;
+        }
+        break;
+    default:
+        break;
+    }
+#if MODBUS_RTU__STUFFED
+    return modbus_rtu__unwrap(L, frame, n, plain, code, values, content, clen);
+#else
+    return MODBUS_RTU_E_ARG;
+#endif
+}
+
 /* ---- content decoders ---- */
 /* The content of read_coils (request): fields in wire order. */
 static int modbus_rtu__dec_read_coils_request(const uint8_t *c, size_t n, modbus_rtu_read_coils_request_t *m)
@@ -1299,7 +1395,7 @@ int modbus_rtu_decode_expect(const uint8_t *frame, size_t len, modbus_rtu_direct
     uint8_t count, k;
     const modbus_rtu__layout_t *const *layouts;
     const modbus_rtu__layout_t *L = NULL;
-    uint32_t code = 0u, values[MODBUS_RTU__MAX_ELEMENTS];
+    uint32_t code = 0u, values[MODBUS_RTU__MAX_ELEMENTS] = {0u};
     const uint8_t *c = NULL;
     size_t clen = 0u;
     int r;
@@ -1312,12 +1408,13 @@ int modbus_rtu_decode_expect(const uint8_t *frame, size_t len, modbus_rtu_direct
     if (layouts == NULL) {
         return MODBUS_RTU_E_ARG;
     }
-    if (count == 1u) {
+    k = 0u;
+    if (MODBUS_RTU__SINGLE || count == 1u) {
         L = layouts[0];
     } else {
         for (k = 0u; k < count; k++) {
             const modbus_rtu__layout_t *A = layouts[k];
-            if (A->header_len <= len && memcmp(frame, A->e[0].constant, A->header_len) == 0) {
+            if (A->header_len <= len && modbus_rtu__same(frame, A->e[0].constant, A->header_len)) {
                 L = A;
                 break;
             }
@@ -1326,7 +1423,7 @@ int modbus_rtu_decode_expect(const uint8_t *frame, size_t len, modbus_rtu_direct
             return MODBUS_RTU_E_FRAME;
         }
     }
-    r = modbus_rtu__unwrap(L, frame, len, plain, &code, values, &c, &clen);
+    r = modbus_rtu__unwrap_at(dir, k, L, frame, len, plain, &code, values, &c, &clen);
     if (r != MODBUS_RTU_OK) {
         return r;
     }
@@ -1866,11 +1963,11 @@ static int modbus_rtu__frame(modbus_rtu_direction_t dir, uint32_t code, const ui
         size_t before = 0u, clen = 0u;
         uint8_t *dst;
         size_t room;
-        uint8_t from = L->has_t ? L->t_first : 0u;
+        uint8_t from = MODBUS_RTU__T(L) ? L->t_first : 0u;
         for (i = from; (int)i < L->content; i++) {
             before += L->e[i].size;
         }
-        if (L->has_t) {
+        if (MODBUS_RTU__T(L)) {
             if (before > MODBUS_RTU_MAX_FRAME) {
                 return MODBUS_RTU_E_BUFFER;
             }
@@ -2259,7 +2356,7 @@ static size_t modbus_rtu__next(modbus_rtu_parser_t *p, size_t start)
             const modbus_rtu__layout_t *L = layouts[k];
             if (L->header_len > p->n - pos) {
                 whole = 0;
-            } else if (memcmp(p->buf + pos, L->e[0].constant, L->header_len) == 0) {
+            } else if (modbus_rtu__same(p->buf + pos, L->e[0].constant, L->header_len)) {
                 return pos;
             }
         }
@@ -2338,11 +2435,56 @@ static int modbus_rtu__push(modbus_rtu_parser_t *p, uint8_t byte, modbus_rtu_msg
     return got;
 }
 
+#if MODBUS_RTU__HEADERS
+/* A whole frame at data[0..len) while no byte is held: taken at once, its bytes not pushed one by one, when that gives
+ * what pushing them would (one layout; a plausible frame that fits and decodes; no header inside it, so no other
+ * candidate could end first). Else 0: the bytes go through modbus_rtu__push. */
+static size_t modbus_rtu__whole(modbus_rtu_parser_t *p, const uint8_t *data, size_t len, modbus_rtu_msg_t *out)
+{
+    uint8_t count;
+    const modbus_rtu__layout_t *const *layouts = modbus_rtu__layouts(p->dir, &count);
+    const modbus_rtu__layout_t *L;
+    size_t i, size;
+    long s;
+    if (!MODBUS_RTU__SINGLE && count != 1u) {
+        return 0u;
+    }
+    L = layouts[0];
+    if (len < L->header_len || !modbus_rtu__same(data, L->e[0].constant, L->header_len)) {
+        return 0u;
+    }
+    s = modbus_rtu__probe(L, p->dir, data, len);
+    if (s <= 0 || (unsigned long)s > MODBUS_RTU_MAX_FRAME || (size_t)s > len) {
+        return 0u;
+    }
+    size = (size_t)s;
+    for (i = 1u; i + L->header_len <= size; i++) {
+        if (data[i] == L->e[0].constant[0] && modbus_rtu__same(data + i, L->e[0].constant, L->header_len)) {
+            return 0u;
+        }
+    }
+    if (modbus_rtu_decode(data, size, p->dir, out) != MODBUS_RTU_OK) {
+        return 0u;
+    }
+    p->frames++;
+    return size;
+}
+#endif
+
 size_t modbus_rtu_parser_feed(modbus_rtu_parser_t *parser, const uint8_t *data, size_t len, modbus_rtu_msg_t *out, bool *got)
 {
     size_t i;
     *got = false;
     for (i = 0u; i < len; i++) {
+#if MODBUS_RTU__HEADERS
+        if (parser->n == 0u) {
+            size_t size = modbus_rtu__whole(parser, data + i, len - i, out);
+            if (size > 0u) {
+                *got = true;
+                return i + size;
+            }
+        }
+#endif
         if (modbus_rtu__push(parser, data[i], out)) {
             *got = true;
             return i + 1u;

@@ -21,6 +21,9 @@ typedef char vesc__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define VESC__CLASSIC 0
 #define VESC__HEADERS 1 /* every layout starts with a header: candidates start at headers only */
 #define VESC__KEEP 0u      /* bytes kept at the end that could begin a header */
+#define VESC__STUFFED 0 /* some layout has byte stuffing */
+#define VESC__LENGTHS 1 /* every layout has a length element */
+#define VESC__SINGLE 0 /* one layout per direction */
 
 /* ---- checksums ---- */
 /* CRC-16/XMODEM: width 16, poly 0x1021, init 0x0, refin false, refout false, xorout 0x0 (check 0x31c3). Incremental: start with 0x0, feed pieces, then use it as is. Bitwise: no table, no static data. */
@@ -57,6 +60,21 @@ static uint32_t vesc__check(uint8_t which, const uint8_t *d, size_t n)
 #define VESC__ROLE_LENGTH 3u
 #define VESC__ROLE_CONTENT 4u
 #define VESC__ROLE_CHECKSUM 5u
+
+/* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
+static int vesc__same(const uint8_t *a, const uint8_t *b, size_t n)
+{
+    size_t i;
+    for (i = 0u; i < n; i++) {
+        if (a[i] != b[i]) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+/* Byte stuffing over part of a layout (constant 0 when no layout has it: that code left out) */
+#define VESC__T(L) (VESC__STUFFED && (L)->has_t)
 
 #define VESC__WAIT (-2L)
 #define VESC__NONE (-1L)
@@ -135,23 +153,28 @@ static void vesc__put(uint8_t *b, uint8_t size, uint8_t big, uint32_t v)
 }
 #endif
 
+#if VESC_ENABLE_ENCODE || VESC__STUFFED || VESC_ENABLE_PARSER
 /* The elements before the variable part (the stuffed span, else the content) and after it. */
 static uint8_t vesc__inner_first(const vesc__layout_t *L)
 {
-    if (L->has_t) {
+    if (VESC__T(L)) {
         return L->t_first;
     }
     return L->content >= 0 ? (uint8_t)L->content : L->count;
 }
+#endif
 
+#if VESC_ENABLE_ENCODE || VESC__STUFFED
 static int vesc__inner_last(const vesc__layout_t *L)
 {
-    if (L->has_t) {
+    if (VESC__T(L)) {
         return (int)L->t_last;
     }
     return L->content >= 0 ? (int)L->content : (int)L->count - 1;
 }
+#endif
 
+#if VESC_ENABLE_ENCODE || VESC__STUFFED
 /* Each plain sequence rewritten as its wire sequence (to_wire) or back, leftmost first, the pairs tried in order at
  * each position. With cmp: compare the result with cmp[0..cap) instead of writing it (1: equal). */
 static int vesc__rewrite(const vesc__layout_t *L, int to_wire, const uint8_t *src, size_t n, uint8_t *dst,
@@ -166,12 +189,12 @@ static int vesc__rewrite(const vesc__layout_t *L, int to_wire, const uint8_t *sr
             size_t flen = to_wire ? L->pairs[k].plain_len : L->pairs[k].wire_len;
             const uint8_t *to = to_wire ? L->pairs[k].wire : L->pairs[k].plain;
             size_t tlen = to_wire ? L->pairs[k].wire_len : L->pairs[k].plain_len;
-            if (flen <= n - i && memcmp(src + i, from, flen) == 0) {
+            if (flen <= n - i && vesc__same(src + i, from, flen)) {
                 if (tlen > cap - o) {
                     return 0;
                 }
                 if (cmp != NULL) {
-                    if (memcmp(cmp + o, to, tlen) != 0) {
+                    if (!vesc__same(cmp + o, to, tlen)) {
                         return 0;
                     }
                 } else {
@@ -201,18 +224,21 @@ static int vesc__rewrite(const vesc__layout_t *L, int to_wire, const uint8_t *sr
     *out = o;
     return cmp == NULL || o == cap;
 }
+#endif
 
+#if VESC_ENABLE_ENCODE || VESC__STUFFED
 /* The bytes of elements a..b: the plain bytes when they lie inside the stuffed span, else the wire bytes. */
 static const uint8_t *vesc__range(const vesc__layout_t *L, const vesc__where_t *w, const uint8_t *wire,
                                  const uint8_t *plain, uint8_t a, uint8_t b, size_t *n)
 {
-    if (L->has_t && a >= L->t_first && b <= L->t_last) {
+    if (VESC__T(L) && a >= L->t_first && b <= L->t_last) {
         *n = w->pe[b] - w->ps[a];
         return plain + w->ps[a];
     }
     *n = w->we[b] - w->ws[a];
     return wire + w->ws[a];
 }
+#endif
 
 #if VESC_ENABLE_ENCODE
 /* The frame around a content already in place (at out + prefix, or in span + its offset when stuffed): the frame
@@ -227,7 +253,7 @@ static int vesc__wrap(const vesc__layout_t *L, uint8_t *out, size_t cap, uint8_t
     int last = vesc__inner_last(L);
     const uint8_t *bytes;
     /* plain bytes of the stuffed span: its elements laid out around the content, inner checksums over them */
-    if (L->has_t) {
+    if (VESC__T(L)) {
         size_t p = 0u;
         for (k = L->t_first; k <= L->t_last; k++) {
             const vesc__element_t *e = &L->e[k];
@@ -266,7 +292,7 @@ static int vesc__wrap(const vesc__layout_t *L, uint8_t *out, size_t cap, uint8_t
     v = 0u;
     for (k = 0u; k < L->count; k++) {
         const vesc__element_t *e = &L->e[k];
-        if (L->has_t && k == L->t_first) {
+        if (VESC__T(L) && k == L->t_first) {
             size_t made;
             if (!vesc__rewrite(L, 1, span, w.pe[L->t_last], out + pos, NULL, cap - pos, &made)) {
                 return VESC_E_BUFFER;
@@ -319,7 +345,7 @@ static int vesc__wrap(const vesc__layout_t *L, uint8_t *out, size_t cap, uint8_t
     }
     for (k = 0u; k < L->count; k++) {
         const vesc__element_t *e = &L->e[k];
-        if (e->role == VESC__ROLE_CHECKSUM && !(L->has_t && k >= L->t_first && k <= L->t_last)) {
+        if (e->role == VESC__ROLE_CHECKSUM && !(VESC__T(L) && k >= L->t_first && k <= L->t_last)) {
             bytes = vesc__range(L, &w, out, span, e->first, e->last, &sz);
             vesc__put(out + w.ws[k], e->size, e->big, vesc__check(e->check, bytes, sz));
         }
@@ -329,7 +355,7 @@ static int vesc__wrap(const vesc__layout_t *L, uint8_t *out, size_t cap, uint8_t
 }
 #endif
 
-#if VESC_ENABLE_DECODE
+#if VESC_ENABLE_DECODE && VESC__STUFFED
 /* Check a complete frame (constants, values, lengths, stuffing, checksums) and take it apart: the frame engine's
  * unwrap (runtime/framing.py Layout.unwrap). plain: room for the unstuffed span. */
 static int vesc__unwrap(const vesc__layout_t *L, const uint8_t *frame, size_t n, uint8_t *plain, uint32_t *code,
@@ -359,7 +385,7 @@ static int vesc__unwrap(const vesc__layout_t *L, const uint8_t *frame, size_t n,
         pos -= L->e[k - 1u].size;
         w.ws[k - 1u] = pos;
     }
-    if (L->has_t) {
+    if (VESC__T(L)) {
         size_t pn, fixed = 0u, p = 0u;
         if (!vesc__rewrite(L, 0, frame + before, n - before - after, plain, NULL, VESC_MAX_FRAME, &pn)) {
             return VESC_E_CAPACITY;
@@ -387,15 +413,15 @@ static int vesc__unwrap(const vesc__layout_t *L, const uint8_t *frame, size_t n,
     }
     for (k = 0u; k < L->count; k++) {
         const vesc__element_t *e = &L->e[k];
-        bytes = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
-        if (e->role == VESC__ROLE_CONSTANT && memcmp(bytes, e->constant, e->size) != 0) {
+        bytes = VESC__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+        if (e->role == VESC__ROLE_CONSTANT && !vesc__same(bytes, e->constant, e->size)) {
             return VESC_E_FRAME;
         }
     }
     *code = 0u;
     for (k = 0u; k < L->count; k++) {
         const vesc__element_t *e = &L->e[k];
-        bytes = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+        bytes = VESC__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
         if (e->role == VESC__ROLE_COMMAND) {
             *code = vesc__get(bytes, e->size, e->big);
         } else if (e->role == VESC__ROLE_VALUE) {
@@ -409,7 +435,7 @@ static int vesc__unwrap(const vesc__layout_t *L, const uint8_t *frame, size_t n,
     for (k = 0u; k < L->count; k++) {
         const vesc__element_t *e = &L->e[k];
         if (e->role == VESC__ROLE_LENGTH) {
-            bytes = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+            bytes = VESC__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
             (void)vesc__range(L, &w, frame, body, e->first, e->last, &sz);
             if ((int32_t)vesc__get(bytes, e->size, e->big) != (int32_t)sz + e->adds) {
                 return VESC_E_LENGTH;
@@ -419,7 +445,7 @@ static int vesc__unwrap(const vesc__layout_t *L, const uint8_t *frame, size_t n,
     for (k = 0u; k < L->count; k++) {
         const vesc__element_t *e = &L->e[k];
         if (e->role == VESC__ROLE_CHECKSUM) {
-            const uint8_t *stored = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+            const uint8_t *stored = VESC__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
             bytes = vesc__range(L, &w, frame, body, e->first, e->last, &sz);
             if (vesc__check(e->check, bytes, sz) != vesc__get(stored, e->size, e->big)) {
                 return VESC_E_CHECKSUM;
@@ -427,7 +453,7 @@ static int vesc__unwrap(const vesc__layout_t *L, const uint8_t *frame, size_t n,
         }
     }
     if (L->content >= 0) {
-        int inside = L->has_t && L->content >= (int)L->t_first && L->content <= (int)L->t_last;
+        int inside = VESC__T(L) && L->content >= (int)L->t_first && L->content <= (int)L->t_last;
         *content = inside ? body + w.ps[L->content] : frame + w.ws[L->content];
         *clen = inside ? w.pe[L->content] - w.ps[L->content] : w.we[L->content] - w.ws[L->content];
     } else {
@@ -460,7 +486,7 @@ static long vesc__probe(const vesc__layout_t *L, vesc_direction_t dir, const uin
             return VESC__WAIT;
         }
         if (e->role == VESC__ROLE_CONSTANT) {
-            if (memcmp(b + pos, e->constant, e->size) != 0) {
+            if (!vesc__same(b + pos, e->constant, e->size)) {
                 return VESC__NONE;
             }
         } else if (e->role == VESC__ROLE_COMMAND) {
@@ -486,20 +512,20 @@ static long vesc__probe(const vesc__layout_t *L, vesc_direction_t dir, const uin
         low = 0u; /* the code lies in the stuffed span: no bounds before the frame is unstuffed */
         bounded = 0;
     }
-    if (L->length >= 0) {
+    if (VESC__LENGTHS || L->length >= 0) {
         const vesc__element_t *e = &L->e[L->length];
         long counted = (long)vesc__get(b + L->length_off, e->size, e->big) - (long)e->adds;
         long content = counted - (long)L->counted;
-        if (content < (long)low || (!L->has_t && bounded && content > (long)high)) {
+        if (content < (long)low || (!VESC__T(L) && bounded && content > (long)high)) {
             return VESC__NONE;
         }
         return (long)(L->overhead - L->counted) + counted;
     }
-    if (L->has_t && L->e[L->count - 1u].role == VESC__ROLE_CONSTANT && L->count > 1u) {
+    if (VESC__T(L) && L->e[L->count - 1u].role == VESC__ROLE_CONSTANT && L->count > 1u) {
         const vesc__element_t *t = &L->e[L->count - 1u];
         size_t i;
         for (i = before; i + t->size <= avail; i++) {
-            if (memcmp(b + i, t->constant, t->size) == 0) {
+            if (vesc__same(b + i, t->constant, t->size)) {
                 return (long)(i + t->size);
             }
         }
@@ -748,6 +774,120 @@ static int vesc__bounds(vesc_direction_t dir, long code, size_t *low, size_t *hi
 #endif
 
 #if VESC_ENABLE_DECODE
+/* ---- frames taken apart: straight line where a layout has no byte stuffing ---- */
+/* The request frame short: unwrap, straight line. */
+static int vesc__unwrap_request_0(const uint8_t *f, size_t n, uint32_t *code, uint32_t *values,
+                                 const uint8_t **content, size_t *clen)
+{
+    (void)values;
+    *code = 0u;
+    if (n < 6u) {
+        return VESC_E_LENGTH;
+    }
+    if (f[0u] != 0x02u) { return VESC_E_FRAME; } /* start */
+    if (f[n - 1u] != 0x03u) { return VESC_E_FRAME; } /* end */
+    *code = (uint32_t)f[2u]; /* command */
+    if ((int32_t)((uint32_t)f[1u]) != (int32_t)(n - 5u) + 0) { return VESC_E_LENGTH; } /* length */
+    if (vesc__check(0u, f + 2u, (n - 5u)) != (((uint32_t)f[n - 3u] << 8u) | (uint32_t)f[n - 2u])) { return VESC_E_CHECKSUM; } /* crc */
+    *content = f + 3u;
+    *clen = n - 6u;
+    return VESC_OK;
+}
+
+/* The request frame long: unwrap, straight line. */
+static int vesc__unwrap_request_1(const uint8_t *f, size_t n, uint32_t *code, uint32_t *values,
+                                 const uint8_t **content, size_t *clen)
+{
+    (void)values;
+    *code = 0u;
+    if (n < 7u) {
+        return VESC_E_LENGTH;
+    }
+    if (f[0u] != 0x03u) { return VESC_E_FRAME; } /* start */
+    if (f[n - 1u] != 0x03u) { return VESC_E_FRAME; } /* end */
+    *code = (uint32_t)f[3u]; /* command */
+    if ((int32_t)(((uint32_t)f[1u] << 8u) | (uint32_t)f[2u]) != (int32_t)(n - 6u) + 0) { return VESC_E_LENGTH; } /* length */
+    if (vesc__check(0u, f + 3u, (n - 6u)) != (((uint32_t)f[n - 3u] << 8u) | (uint32_t)f[n - 2u])) { return VESC_E_CHECKSUM; } /* crc */
+    *content = f + 4u;
+    *clen = n - 7u;
+    return VESC_OK;
+}
+
+/* The response frame short: unwrap, straight line. */
+static int vesc__unwrap_response_0(const uint8_t *f, size_t n, uint32_t *code, uint32_t *values,
+                                 const uint8_t **content, size_t *clen)
+{
+    (void)values;
+    *code = 0u;
+    if (n < 6u) {
+        return VESC_E_LENGTH;
+    }
+    if (f[0u] != 0x02u) { return VESC_E_FRAME; } /* start */
+    if (f[n - 1u] != 0x03u) { return VESC_E_FRAME; } /* end */
+    *code = (uint32_t)f[2u]; /* command */
+    if ((int32_t)((uint32_t)f[1u]) != (int32_t)(n - 5u) + 0) { return VESC_E_LENGTH; } /* length */
+    if (vesc__check(0u, f + 2u, (n - 5u)) != (((uint32_t)f[n - 3u] << 8u) | (uint32_t)f[n - 2u])) { return VESC_E_CHECKSUM; } /* crc */
+    *content = f + 3u;
+    *clen = n - 6u;
+    return VESC_OK;
+}
+
+/* The response frame long: unwrap, straight line. */
+static int vesc__unwrap_response_1(const uint8_t *f, size_t n, uint32_t *code, uint32_t *values,
+                                 const uint8_t **content, size_t *clen)
+{
+    (void)values;
+    *code = 0u;
+    if (n < 7u) {
+        return VESC_E_LENGTH;
+    }
+    if (f[0u] != 0x03u) { return VESC_E_FRAME; } /* start */
+    if (f[n - 1u] != 0x03u) { return VESC_E_FRAME; } /* end */
+    *code = (uint32_t)f[3u]; /* command */
+    if ((int32_t)(((uint32_t)f[1u] << 8u) | (uint32_t)f[2u]) != (int32_t)(n - 6u) + 0) { return VESC_E_LENGTH; } /* length */
+    if (vesc__check(0u, f + 3u, (n - 6u)) != (((uint32_t)f[n - 3u] << 8u) | (uint32_t)f[n - 2u])) { return VESC_E_CHECKSUM; } /* crc */
+    *content = f + 4u;
+    *clen = n - 7u;
+    return VESC_OK;
+}
+
+static int vesc__unwrap_at(vesc_direction_t dir, uint8_t k, const vesc__layout_t *L, const uint8_t *frame, size_t n,
+                          uint8_t *plain, uint32_t *code, uint32_t *values, const uint8_t **content, size_t *clen)
+{
+    (void)k;
+    (void)L;
+    (void)plain;
+    switch (dir) {
+    case VESC_REQUEST:
+        switch (k) {
+        case 0u:
+            return vesc__unwrap_request_0(frame, n, code, values, content, clen);
+        case 1u:
+            return vesc__unwrap_request_1(frame, n, code, values, content, clen);
+        default:
+            break;
+        }
+        break;
+    case VESC_RESPONSE:
+        switch (k) {
+        case 0u:
+            return vesc__unwrap_response_0(frame, n, code, values, content, clen);
+        case 1u:
+            return vesc__unwrap_response_1(frame, n, code, values, content, clen);
+        default:
+            break;
+        }
+        break;
+    default:
+        break;
+    }
+#if VESC__STUFFED
+    return vesc__unwrap(L, frame, n, plain, code, values, content, clen);
+#else
+    return VESC_E_ARG;
+#endif
+}
+
 /* ---- content decoders ---- */
 /* The content of fw_version (request): fields in wire order. */
 static int vesc__dec_fw_version_request(const uint8_t *c, size_t n, vesc_fw_version_request_t *m)
@@ -1187,7 +1327,7 @@ int vesc_decode_expect(const uint8_t *frame, size_t len, vesc_direction_t dir, v
     uint8_t count, k;
     const vesc__layout_t *const *layouts;
     const vesc__layout_t *L = NULL;
-    uint32_t code = 0u, values[VESC__MAX_ELEMENTS];
+    uint32_t code = 0u, values[VESC__MAX_ELEMENTS] = {0u};
     const uint8_t *c = NULL;
     size_t clen = 0u;
     int r;
@@ -1200,12 +1340,13 @@ int vesc_decode_expect(const uint8_t *frame, size_t len, vesc_direction_t dir, v
     if (layouts == NULL) {
         return VESC_E_ARG;
     }
-    if (count == 1u) {
+    k = 0u;
+    if (VESC__SINGLE || count == 1u) {
         L = layouts[0];
     } else {
         for (k = 0u; k < count; k++) {
             const vesc__layout_t *A = layouts[k];
-            if (A->header_len <= len && memcmp(frame, A->e[0].constant, A->header_len) == 0) {
+            if (A->header_len <= len && vesc__same(frame, A->e[0].constant, A->header_len)) {
                 L = A;
                 break;
             }
@@ -1214,7 +1355,7 @@ int vesc_decode_expect(const uint8_t *frame, size_t len, vesc_direction_t dir, v
             return VESC_E_FRAME;
         }
     }
-    r = vesc__unwrap(L, frame, len, plain, &code, values, &c, &clen);
+    r = vesc__unwrap_at(dir, k, L, frame, len, plain, &code, values, &c, &clen);
     if (r != VESC_OK) {
         return r;
     }
@@ -1334,73 +1475,73 @@ static int vesc__enc_get_values_response(const void *mv, uint8_t *c, size_t cap,
     (void)cap;
     if (m->fault > 33u) { return VESC_E_RANGE; } /* fault */
     if (cap - o < 2u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 2u, 1u, ((uint32_t)(int32_t)(m->temp_fet) & 0xffffUL)); /* temp_fet */
+    vesc__put(c + o, 2u, 1u, ((uint32_t)(int32_t)(m->temp_fet) & 0xffffu)); /* temp_fet */
     o += 2u;
     if (cap - o < 2u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 2u, 1u, ((uint32_t)(int32_t)(m->temp_motor) & 0xffffUL)); /* temp_motor */
+    vesc__put(c + o, 2u, 1u, ((uint32_t)(int32_t)(m->temp_motor) & 0xffffu)); /* temp_motor */
     o += 2u;
     if (cap - o < 4u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->avg_motor_current) & 0xffffffffUL)); /* avg_motor_current */
+    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->avg_motor_current) & 0xffffffffu)); /* avg_motor_current */
     o += 4u;
     if (cap - o < 4u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->avg_input_current) & 0xffffffffUL)); /* avg_input_current */
+    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->avg_input_current) & 0xffffffffu)); /* avg_input_current */
     o += 4u;
     if (cap - o < 4u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->avg_id) & 0xffffffffUL)); /* avg_id */
+    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->avg_id) & 0xffffffffu)); /* avg_id */
     o += 4u;
     if (cap - o < 4u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->avg_iq) & 0xffffffffUL)); /* avg_iq */
+    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->avg_iq) & 0xffffffffu)); /* avg_iq */
     o += 4u;
     if (cap - o < 2u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 2u, 1u, ((uint32_t)(int32_t)(m->duty_now) & 0xffffUL)); /* duty_now */
+    vesc__put(c + o, 2u, 1u, ((uint32_t)(int32_t)(m->duty_now) & 0xffffu)); /* duty_now */
     o += 2u;
     if (cap - o < 4u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->rpm) & 0xffffffffUL)); /* rpm */
+    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->rpm) & 0xffffffffu)); /* rpm */
     o += 4u;
     if (cap - o < 2u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 2u, 1u, ((uint32_t)(int32_t)(m->v_in) & 0xffffUL)); /* v_in */
+    vesc__put(c + o, 2u, 1u, ((uint32_t)(int32_t)(m->v_in) & 0xffffu)); /* v_in */
     o += 2u;
     if (cap - o < 4u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->amp_hours) & 0xffffffffUL)); /* amp_hours */
+    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->amp_hours) & 0xffffffffu)); /* amp_hours */
     o += 4u;
     if (cap - o < 4u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->amp_hours_charged) & 0xffffffffUL)); /* amp_hours_charged */
+    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->amp_hours_charged) & 0xffffffffu)); /* amp_hours_charged */
     o += 4u;
     if (cap - o < 4u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->watt_hours) & 0xffffffffUL)); /* watt_hours */
+    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->watt_hours) & 0xffffffffu)); /* watt_hours */
     o += 4u;
     if (cap - o < 4u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->watt_hours_charged) & 0xffffffffUL)); /* watt_hours_charged */
+    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->watt_hours_charged) & 0xffffffffu)); /* watt_hours_charged */
     o += 4u;
     if (cap - o < 4u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->tachometer) & 0xffffffffUL)); /* tachometer */
+    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->tachometer) & 0xffffffffu)); /* tachometer */
     o += 4u;
     if (cap - o < 4u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->tachometer_abs) & 0xffffffffUL)); /* tachometer_abs */
+    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->tachometer_abs) & 0xffffffffu)); /* tachometer_abs */
     o += 4u;
     if (cap - o < 1u) { return VESC_E_BUFFER; }
     vesc__put(c + o, 1u, 1u, (uint32_t)(m->fault)); /* fault */
     o += 1u;
     if (cap - o < 4u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->pid_pos) & 0xffffffffUL)); /* pid_pos */
+    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->pid_pos) & 0xffffffffu)); /* pid_pos */
     o += 4u;
     if (cap - o < 1u) { return VESC_E_BUFFER; }
     vesc__put(c + o, 1u, 1u, (uint32_t)(m->controller_id)); /* controller_id */
     o += 1u;
     if (cap - o < 2u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 2u, 1u, ((uint32_t)(int32_t)(m->temp_mos1) & 0xffffUL)); /* temp_mos1 */
+    vesc__put(c + o, 2u, 1u, ((uint32_t)(int32_t)(m->temp_mos1) & 0xffffu)); /* temp_mos1 */
     o += 2u;
     if (cap - o < 2u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 2u, 1u, ((uint32_t)(int32_t)(m->temp_mos2) & 0xffffUL)); /* temp_mos2 */
+    vesc__put(c + o, 2u, 1u, ((uint32_t)(int32_t)(m->temp_mos2) & 0xffffu)); /* temp_mos2 */
     o += 2u;
     if (cap - o < 2u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 2u, 1u, ((uint32_t)(int32_t)(m->temp_mos3) & 0xffffUL)); /* temp_mos3 */
+    vesc__put(c + o, 2u, 1u, ((uint32_t)(int32_t)(m->temp_mos3) & 0xffffu)); /* temp_mos3 */
     o += 2u;
     if (cap - o < 4u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->avg_vd) & 0xffffffffUL)); /* avg_vd */
+    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->avg_vd) & 0xffffffffu)); /* avg_vd */
     o += 4u;
     if (cap - o < 4u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->avg_vq) & 0xffffffffUL)); /* avg_vq */
+    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->avg_vq) & 0xffffffffu)); /* avg_vq */
     o += 4u;
     if (cap - o < 1u) { return VESC_E_BUFFER; }
     vesc__put(c + o, 1u, 1u, (uint32_t)(m->status)); /* status */
@@ -1420,7 +1561,7 @@ static int vesc__enc_set_duty_request(const void *mv, uint8_t *c, size_t cap, si
     (void)cap;
     if (m->duty < -100000L || m->duty > 100000L) { return VESC_E_RANGE; } /* duty */
     if (cap - o < 4u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->duty) & 0xffffffffUL)); /* duty */
+    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->duty) & 0xffffffffu)); /* duty */
     o += 4u;
     *n = o;
     return VESC_OK;
@@ -1436,7 +1577,7 @@ static int vesc__enc_set_current_request(const void *mv, uint8_t *c, size_t cap,
     (void)c;
     (void)cap;
     if (cap - o < 4u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->current) & 0xffffffffUL)); /* current */
+    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->current) & 0xffffffffu)); /* current */
     o += 4u;
     *n = o;
     return VESC_OK;
@@ -1452,7 +1593,7 @@ static int vesc__enc_set_current_brake_request(const void *mv, uint8_t *c, size_
     (void)c;
     (void)cap;
     if (cap - o < 4u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->current) & 0xffffffffUL)); /* current */
+    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->current) & 0xffffffffu)); /* current */
     o += 4u;
     *n = o;
     return VESC_OK;
@@ -1468,7 +1609,7 @@ static int vesc__enc_set_rpm_request(const void *mv, uint8_t *c, size_t cap, siz
     (void)c;
     (void)cap;
     if (cap - o < 4u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->rpm) & 0xffffffffUL)); /* rpm */
+    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->rpm) & 0xffffffffu)); /* rpm */
     o += 4u;
     *n = o;
     return VESC_OK;
@@ -1484,7 +1625,7 @@ static int vesc__enc_set_pos_request(const void *mv, uint8_t *c, size_t cap, siz
     (void)c;
     (void)cap;
     if (cap - o < 4u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->position) & 0xffffffffUL)); /* position */
+    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->position) & 0xffffffffu)); /* position */
     o += 4u;
     *n = o;
     return VESC_OK;
@@ -1500,7 +1641,7 @@ static int vesc__enc_set_handbrake_request(const void *mv, uint8_t *c, size_t ca
     (void)c;
     (void)cap;
     if (cap - o < 4u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->current) & 0xffffffffUL)); /* current */
+    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->current) & 0xffffffffu)); /* current */
     o += 4u;
     *n = o;
     return VESC_OK;
@@ -1534,7 +1675,7 @@ static int vesc__enc_rotor_position_response(const void *mv, uint8_t *c, size_t 
     (void)c;
     (void)cap;
     if (cap - o < 4u) { return VESC_E_BUFFER; }
-    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->position) & 0xffffffffUL)); /* position */
+    vesc__put(c + o, 4u, 1u, ((uint32_t)(int32_t)(m->position) & 0xffffffffu)); /* position */
     o += 4u;
     *n = o;
     return VESC_OK;
@@ -1587,11 +1728,11 @@ static int vesc__frame(vesc_direction_t dir, uint32_t code, const uint32_t *valu
         size_t before = 0u, clen = 0u;
         uint8_t *dst;
         size_t room;
-        uint8_t from = L->has_t ? L->t_first : 0u;
+        uint8_t from = VESC__T(L) ? L->t_first : 0u;
         for (i = from; (int)i < L->content; i++) {
             before += L->e[i].size;
         }
-        if (L->has_t) {
+        if (VESC__T(L)) {
             if (before > VESC_MAX_FRAME) {
                 return VESC_E_BUFFER;
             }
@@ -1874,7 +2015,7 @@ static size_t vesc__next(vesc_parser_t *p, size_t start)
             const vesc__layout_t *L = layouts[k];
             if (L->header_len > p->n - pos) {
                 whole = 0;
-            } else if (memcmp(p->buf + pos, L->e[0].constant, L->header_len) == 0) {
+            } else if (vesc__same(p->buf + pos, L->e[0].constant, L->header_len)) {
                 return pos;
             }
         }
@@ -1953,11 +2094,56 @@ static int vesc__push(vesc_parser_t *p, uint8_t byte, vesc_msg_t *out)
     return got;
 }
 
+#if VESC__HEADERS
+/* A whole frame at data[0..len) while no byte is held: taken at once, its bytes not pushed one by one, when that gives
+ * what pushing them would (one layout; a plausible frame that fits and decodes; no header inside it, so no other
+ * candidate could end first). Else 0: the bytes go through vesc__push. */
+static size_t vesc__whole(vesc_parser_t *p, const uint8_t *data, size_t len, vesc_msg_t *out)
+{
+    uint8_t count;
+    const vesc__layout_t *const *layouts = vesc__layouts(p->dir, &count);
+    const vesc__layout_t *L;
+    size_t i, size;
+    long s;
+    if (!VESC__SINGLE && count != 1u) {
+        return 0u;
+    }
+    L = layouts[0];
+    if (len < L->header_len || !vesc__same(data, L->e[0].constant, L->header_len)) {
+        return 0u;
+    }
+    s = vesc__probe(L, p->dir, data, len);
+    if (s <= 0 || (unsigned long)s > VESC_MAX_FRAME || (size_t)s > len) {
+        return 0u;
+    }
+    size = (size_t)s;
+    for (i = 1u; i + L->header_len <= size; i++) {
+        if (data[i] == L->e[0].constant[0] && vesc__same(data + i, L->e[0].constant, L->header_len)) {
+            return 0u;
+        }
+    }
+    if (vesc_decode(data, size, p->dir, out) != VESC_OK) {
+        return 0u;
+    }
+    p->frames++;
+    return size;
+}
+#endif
+
 size_t vesc_parser_feed(vesc_parser_t *parser, const uint8_t *data, size_t len, vesc_msg_t *out, bool *got)
 {
     size_t i;
     *got = false;
     for (i = 0u; i < len; i++) {
+#if VESC__HEADERS
+        if (parser->n == 0u) {
+            size_t size = vesc__whole(parser, data + i, len - i, out);
+            if (size > 0u) {
+                *got = true;
+                return i + size;
+            }
+        }
+#endif
         if (vesc__push(parser, data[i], out)) {
             *got = true;
             return i + 1u;

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define VESC_SPEC_SHA256 "1092ffcec9f6bfcbf26b19686ffa79a19abc8784c1d6671a5231a217975b7bae"
+#define VESC_SPEC_SHA256 "d4ddb1f340d58cc67142e4f5dcd7f791eab293f6053f08b4ef5f9868fe139657"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef VESC_ENABLE_ENCODE

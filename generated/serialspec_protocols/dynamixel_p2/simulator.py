@@ -7,11 +7,15 @@ READ). PING is always answered; READ while status_return_level ≥ 1; every othe
 2. Writing a read-only or unknown item gives the access error (7), a value outside an item's range the data
 range error (4); the alert bit reports a non-zero hardware_error_status. REG WRITE holds its data (and sets
 registered_instruction) until ACTION (an ACTION with nothing held gets the instruction error, 2); writing the
-id moves the servo to its new id. With the torque on, a new goal_position moves present_position at
-profile_velocity (at once when it is 0). CLEAR brings present_position within one turn (0..4095), only while
-it is not moving (result fail, 1, otherwise); REBOOT puts the RAM items back to their initial values
-(present_position within one turn) and keeps EEPROM; FACTORY RESET of everything (0xFF) sent to the broadcast
-id is ignored. The firmware version 52 is an example, not a documented value.
+id moves the servo to its new id. EEPROM items (addresses below 64) written while torque_enable is 1 give the
+access error (7) and keep their value. The horn's position is the state variable `position`; present_position
+reads as position + homing_offset (e-manual: Present Position = Actual Position + Homing Offset), so writing
+homing_offset moves what present_position reports. With the torque on, a new goal_position (in
+present_position's terms) moves the horn at profile_velocity (at once when it is 0). CLEAR brings
+present_position within one turn (0..4095), only while it is not moving (result fail, 1, otherwise); REBOOT
+puts the RAM items back to their initial values (present_position within one turn) and keeps EEPROM; FACTORY
+RESET of everything (0xFF) sent to the broadcast id is ignored. The firmware version 52 is an example, not a
+documented value.
 
 `DynamixelP2Simulator(ids=[1, 2]).start()` serves the devices on a new pseudo-terminal and returns its path;
 `serialspec sim specs/dynamixel_p2.yaml --id 1 --id 2` does the same from the shell. Values are wire units.
@@ -162,40 +166,40 @@ DEVICE = DeviceSpec(
         EntrySpec('indirect_data_27', 250, 0, 'rw', 0, 255),
         EntrySpec('indirect_data_28', 251, 0, 'rw', 0, 255),
     ),
-    state={},
+    state={'position': 0.0},
     reply={'error.alert': 0.0, 'error.number': 0.0},
-    errors={'out_of_space': {'error.number': 7.0}, 'out_of_range': {'error.number': 4.0}, 'read_only': {'error.number': 7.0}, 'busy': {'error.number': 1.0}},
+    errors={'out_of_space': {'error.number': 7.0}, 'out_of_range': {'error.number': 4.0}, 'read_only': {'error.number': 7.0}, 'busy': {'error.number': 1.0}, 'locked': {'error.number': 7.0}},
     commands=(
         # ping
         CommandSpec(PingRequest, PingResponse, reports={'model_number': 'model_number', 'firmware_version': 'firmware_version'}, broadcast_reply=True),
         # read
         CommandSpec(ReadRequest, StatusResponse, reads=('data',), optional_when=('status_return_level', 1, '>='), tables={'data': ('run', 'address', 'length')}),
         # write
-        CommandSpec(WriteRequest, StatusResponse, writes=('data',), moves=('present_position', 'goal_position', '', 'profile_velocity'), speed_scale=15.6331, move_enabled_by='torque_enable', optional_when=('status_return_level', 2, '>='), tables={'data': ('run', 'address', '')}),
+        CommandSpec(WriteRequest, StatusResponse, writes=('data',), moves=('position', 'goal_position', '', 'profile_velocity'), speed_scale=15.6331, move_enabled_by='torque_enable', move_to=lambda get: (get('goal_position') - get('homing_offset')), optional_when=('status_return_level', 2, '>='), tables={'data': ('run', 'address', '')}),
         # reg_write
         CommandSpec(RegWriteRequest, StatusResponse, writes=('data',), sets={'registered_instruction': 1.0}, buffered=True, optional_when=('status_return_level', 2, '>='), tables={'data': ('run', 'address', '')}),
         # action
-        CommandSpec(ActionRequest, StatusResponse, moves=('present_position', 'goal_position', '', 'profile_velocity'), speed_scale=15.6331, move_enabled_by='torque_enable', sets={'registered_instruction': 0.0}, commits=True, nothing_held={'error.number': 2.0}, optional_when=('status_return_level', 2, '>='), tables={'data': ('run', 'address', 'length')}),
+        CommandSpec(ActionRequest, StatusResponse, moves=('position', 'goal_position', '', 'profile_velocity'), speed_scale=15.6331, move_enabled_by='torque_enable', move_to=lambda get: (get('goal_position') - get('homing_offset')), sets={'registered_instruction': 0.0}, commits=True, nothing_held={'error.number': 2.0}, optional_when=('status_return_level', 2, '>='), tables={'data': ('run', 'address', 'length')}),
         # factory_reset
         CommandSpec(FactoryResetRequest, StatusResponse, resets=True, keeps=('option', {1: ('id',), 2: ('id', 'baud_rate'), 255: ()}), broadcast_ignores={'option': 255.0}, optional_when=('status_return_level', 2, '>='), tables={'data': ('run', 'address', 'length')}),
         # reboot
-        CommandSpec(RebootRequest, StatusResponse, modulo={'present_position': 4096.0}, restores=('torque_enable', 'led', 'status_return_level', 'registered_instruction', 'hardware_error_status', 'velocity_i_gain', 'velocity_p_gain', 'position_d_gain', 'position_i_gain', 'position_p_gain', 'feedforward_2nd_gain', 'feedforward_1st_gain', 'bus_watchdog', 'goal_pwm', 'goal_current', 'goal_velocity', 'profile_acceleration', 'profile_velocity', 'goal_position', 'realtime_tick', 'moving', 'moving_status', 'present_pwm', 'present_current', 'present_velocity', 'velocity_trajectory', 'position_trajectory', 'present_input_voltage', 'present_temperature', 'backup_ready', 'indirect_data_1', 'indirect_data_2', 'indirect_data_3', 'indirect_data_4', 'indirect_data_5', 'indirect_data_6', 'indirect_data_7', 'indirect_data_8', 'indirect_data_9', 'indirect_data_10', 'indirect_data_11', 'indirect_data_12', 'indirect_data_13', 'indirect_data_14', 'indirect_data_15', 'indirect_data_16', 'indirect_data_17', 'indirect_data_18', 'indirect_data_19', 'indirect_data_20', 'indirect_data_21', 'indirect_data_22', 'indirect_data_23', 'indirect_data_24', 'indirect_data_25', 'indirect_data_26', 'indirect_data_27', 'indirect_data_28'), optional_when=('status_return_level', 2, '>='), tables={'data': ('run', 'address', 'length')}),
+        CommandSpec(RebootRequest, StatusResponse, modulo={'position': 4096.0}, restores=('torque_enable', 'led', 'status_return_level', 'registered_instruction', 'hardware_error_status', 'velocity_i_gain', 'velocity_p_gain', 'position_d_gain', 'position_i_gain', 'position_p_gain', 'feedforward_2nd_gain', 'feedforward_1st_gain', 'bus_watchdog', 'goal_pwm', 'goal_current', 'goal_velocity', 'profile_acceleration', 'profile_velocity', 'goal_position', 'realtime_tick', 'moving', 'moving_status', 'present_pwm', 'present_current', 'present_velocity', 'velocity_trajectory', 'position_trajectory', 'present_input_voltage', 'present_temperature', 'backup_ready', 'indirect_data_1', 'indirect_data_2', 'indirect_data_3', 'indirect_data_4', 'indirect_data_5', 'indirect_data_6', 'indirect_data_7', 'indirect_data_8', 'indirect_data_9', 'indirect_data_10', 'indirect_data_11', 'indirect_data_12', 'indirect_data_13', 'indirect_data_14', 'indirect_data_15', 'indirect_data_16', 'indirect_data_17', 'indirect_data_18', 'indirect_data_19', 'indirect_data_20', 'indirect_data_21', 'indirect_data_22', 'indirect_data_23', 'indirect_data_24', 'indirect_data_25', 'indirect_data_26', 'indirect_data_27', 'indirect_data_28'), optional_when=('status_return_level', 2, '>='), tables={'data': ('run', 'address', 'length')}),
         # clear
-        CommandSpec(ClearRequest, StatusResponse, modulo={'present_position': 4096.0}, refused_while_moving='present_position', optional_when=('status_return_level', 2, '>='), tables={'data': ('run', 'address', 'length')}),
+        CommandSpec(ClearRequest, StatusResponse, modulo={'position': 4096.0}, refused_while_moving='position', optional_when=('status_return_level', 2, '>='), tables={'data': ('run', 'address', 'length')}),
         # sync_read
         CommandSpec(SyncReadRequest, StatusResponse, reads=('data',), each='ids', tables={'data': ('run', 'address', 'length')}),
         # fast_sync_read
         CommandSpec(FastSyncReadRequest, None),
         # sync_write
-        CommandSpec(SyncWriteRequest, None, writes=('data',), moves=('present_position', 'goal_position', '', 'profile_velocity'), speed_scale=15.6331, move_enabled_by='torque_enable', each='servos', tables={'data': ('run', 'address', '')}),
+        CommandSpec(SyncWriteRequest, None, writes=('data',), moves=('position', 'goal_position', '', 'profile_velocity'), speed_scale=15.6331, move_enabled_by='torque_enable', move_to=lambda get: (get('goal_position') - get('homing_offset')), each='servos', tables={'data': ('run', 'address', '')}),
         # bulk_read
         CommandSpec(BulkReadRequest, StatusResponse, reads=('data',), each='reads', tables={'data': ('run', 'address', 'length')}),
         # bulk_write
-        CommandSpec(BulkWriteRequest, None, writes=('data',), moves=('present_position', 'goal_position', '', 'profile_velocity'), speed_scale=15.6331, move_enabled_by='torque_enable', each='writes', tables={'data': ('run', 'address', '')}),
+        CommandSpec(BulkWriteRequest, None, writes=('data',), moves=('position', 'goal_position', '', 'profile_velocity'), speed_scale=15.6331, move_enabled_by='torque_enable', move_to=lambda get: (get('goal_position') - get('homing_offset')), each='writes', tables={'data': ('run', 'address', '')}),
     ),
     registers=CONTROL_TABLE,
     status={'error.alert': 'hardware_error_status'},
-    moving={'moving': ('present_position', None)},
+    moving={'moving': ('position', None)},
     models=(
         ModelSpec(
             'xm430_w350',
@@ -246,6 +250,8 @@ DEVICE = DeviceSpec(
             },
         ),
     ),
+    derived={'present_position': lambda get: (get('position') + get('homing_offset'))},
+    locks={'id': 'torque_enable', 'baud_rate': 'torque_enable', 'return_delay_time': 'torque_enable', 'drive_mode': 'torque_enable', 'operating_mode': 'torque_enable', 'secondary_id': 'torque_enable', 'protocol_type': 'torque_enable', 'homing_offset': 'torque_enable', 'moving_threshold': 'torque_enable', 'temperature_limit': 'torque_enable', 'max_voltage_limit': 'torque_enable', 'min_voltage_limit': 'torque_enable', 'pwm_limit': 'torque_enable', 'current_limit': 'torque_enable', 'velocity_limit': 'torque_enable', 'max_position_limit': 'torque_enable', 'min_position_limit': 'torque_enable', 'startup_configuration': 'torque_enable', 'shutdown': 'torque_enable', 'indirect_address_1': 'torque_enable', 'indirect_address_2': 'torque_enable', 'indirect_address_3': 'torque_enable', 'indirect_address_4': 'torque_enable', 'indirect_address_5': 'torque_enable', 'indirect_address_6': 'torque_enable', 'indirect_address_7': 'torque_enable', 'indirect_address_8': 'torque_enable', 'indirect_address_9': 'torque_enable', 'indirect_address_10': 'torque_enable', 'indirect_address_11': 'torque_enable', 'indirect_address_12': 'torque_enable', 'indirect_address_13': 'torque_enable', 'indirect_address_14': 'torque_enable', 'indirect_address_15': 'torque_enable', 'indirect_address_16': 'torque_enable', 'indirect_address_17': 'torque_enable', 'indirect_address_18': 'torque_enable', 'indirect_address_19': 'torque_enable', 'indirect_address_20': 'torque_enable', 'indirect_address_21': 'torque_enable', 'indirect_address_22': 'torque_enable', 'indirect_address_23': 'torque_enable', 'indirect_address_24': 'torque_enable', 'indirect_address_25': 'torque_enable', 'indirect_address_26': 'torque_enable', 'indirect_address_27': 'torque_enable', 'indirect_address_28': 'torque_enable'},
 )
 
 

@@ -36,11 +36,23 @@ class Emitter:
 def emit(emitter: Emitter, protocol: Protocol) -> dict[str, str]:
     """A target's files for a protocol by path under generated/ (its folder first); none where the target cannot
     generate the spec yet (Unsupported: `generate --target NAME` says why)."""
+    return emit_or_refuse(emitter, protocol)[0]
+
+
+def emit_or_refuse(emitter: Emitter, protocol: Protocol) -> tuple[dict[str, str], str | None]:
+    """emit(), and the one-line reason (Unsupported's message) when the target cannot generate the spec."""
     try:
         emitted = emitter.files(protocol)
-    except Unsupported:
-        return {}
-    return {f"{emitter.folder}/{path}" if emitter.folder else path: text for path, text in emitted.items()}
+    except Unsupported as exc:
+        return {}, str(exc)
+    return {f"{emitter.folder}/{path}" if emitter.folder else path: text for path, text in emitted.items()}, None
+
+
+def target_folder(name: str) -> str:
+    """The folder a target's files go to under the project's generated/ (Emitter.folder), importing that target
+    alone."""
+    emitter: Emitter = importlib.import_module(f"{__name__}.{name}").EMITTER
+    return emitter.folder
 
 
 def target_names() -> tuple[str, ...]:

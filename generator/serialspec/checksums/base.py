@@ -11,6 +11,7 @@ checksum element by `from_spec`. Its class owns all that the algorithm means to 
 - the Python backend: module-level set-up and statements for straight-line codecs (`python_setup`, `python_call`,
   `python_lines`), and optional fast paths (`byte_total`, `frame_test`, `summed`, `byte_table`: None where the
   algorithm has none);
+- the C backend: `c_code(prefix)`, the algorithm as an incremental C99 function (NoCode where it has none yet);
 - the markdown backend: `describe()`, `parameters()` and `worked(covered)` for the checksum section;
 - the Wireshark backend: `lua_function()` and `lua_parameters()`, the dissector's Lua code of the algorithm;
 - tests: `samples`, one per documented option, which tests/test_matrix.py runs through every output.
@@ -26,6 +27,11 @@ from typing import Any, ClassVar, Literal
 
 Import = tuple[str, str]  # generated code's `from <module> import <name>` (the name may be `x as _y`)
 Report = Callable[[tuple[str, ...], str], None]  # a problem with the spec: keys below the element, message
+
+
+class NoCode(Exception):
+    """The algorithm (with these parameters) has no code for a backend yet: one line naming what (the C target
+    refuses the spec with it)."""
 
 
 class ChecksumProblem(Exception):
@@ -71,6 +77,25 @@ class TableSteps:
     entries: tuple[int, ...]
     start: int
     finish: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class CCode:
+    """A checksum as C99: a public, incremental function `acc = name(acc, data, n)` (a firmware author checksums a
+    frame in pieces with it; the generated frame engine calls the same code), its start value and its final step."""
+
+    name: str  # the public function's name, prefixed
+    ctype: str  # the accumulator's C type
+    definition: str  # the function's C text (a comment saying what it computes first)
+    prototype: str
+    start: str  # C expression of the accumulator's start value
+    finish: str  # C expression of the checksum from the accumulator (a str.format template with {a}); it may call
+    # `<prefix>__reflect(value, width)`, the low `width` bits of value in reverse order, which the C backend defines
+
+
+def c_uint(width: int) -> str:
+    """The narrowest C unsigned type of at least `width` bits (up to 32)."""
+    return "uint8_t" if width <= 8 else "uint16_t" if width <= 16 else "uint32_t"
 
 
 _REGISTERED: dict[str, type[Algorithm]] = {}
@@ -163,6 +188,13 @@ class Algorithm:
         """Where python_lines runs `target = TABLE[target ^ byte]` over the covered bytes from a constant start:
         the steps (a codec may then fold known bytes into the start and unroll short runs); None for others."""
         return None
+
+    # -- the C backend -----------------------------------------------------------------------------------------
+
+    def c_code(self, prefix: str) -> CCode:
+        """The checksum as C99, its names prefixed with the protocol's `prefix` (`feetech_sms`: `feetech_sms_sum8`):
+        bitwise, no tables, no static data. Raises NoCode, one line naming what, where it has none."""
+        raise NoCode(f"algorithm {self.name}")
 
     # -- the Wireshark backend ---------------------------------------------------------------------------------
 

@@ -15,12 +15,15 @@ from typing import Any
 
 from serialspec.checksums.base import (
     Algorithm,
+    CCode,
     ChecksumProblem,
     Import,
     Key,
+    NoCode,
     Report,
     Sample,
     TableSteps,
+    c_uint,
     hex_bytes,
     hex_value,
 )
@@ -359,6 +362,65 @@ class Crc(Algorithm):
         start = _reflect(self.init, 8) if self.refin else self.init
         finish = (f"{target} ^= {self.xorout:#x}",) if self.xorout else ()
         return TableSteps(f"{name.upper()}_TABLE", crc_table(8, self.poly, self.refin), start, finish)
+
+    def c_code(self, prefix: str) -> CCode:
+        if not 8 <= self.width <= 32:
+            raise NoCode(f"a CRC of {self.width} bits")
+        title = self.title()
+        slug = "".join(ch if ch.isalnum() else "_" for ch in title.split(" ")[0].lower()).strip("_") if title else ""
+        if not slug:
+            slug = f"crc{self.width}_{self.poly:x}_{self.init:x}_{int(self.refin)}{int(self.refout)}_{self.xorout:x}"
+        name = f"{prefix}_{slug}"
+        mask = (1 << self.width) - 1
+        t = c_uint(self.width)
+        if (
+            self.refin
+        ):  # the register kept in the input's bit order (reflected); finish reflects it where refout differs
+            start = _reflect(self.init, self.width)
+            poly = _reflect(self.poly, self.width)
+            loop = (
+                "        r ^= data[i];\n"
+                "        for (bit = 0; bit < 8; bit++) {\n"
+                f"            r = (r & 1u) ? ((r >> 1) ^ 0x{poly:x}u) : (r >> 1);\n"
+                "        }"
+            )
+        else:
+            start = self.init
+            top = 1 << (self.width - 1)
+            loop = (
+                f"        r ^= (uint32_t)data[i] << {self.width - 8};\n"
+                "        for (bit = 0; bit < 8; bit++) {\n"
+                f"            r = (r & 0x{top:x}u) ? (((r << 1) ^ 0x{self.poly:x}u) & 0x{mask:x}u)"
+                f" : ((r << 1) & 0x{mask:x}u);\n"
+                "        }"
+            )
+        reflect = self.refin != self.refout
+        finish = f"{prefix}__reflect((uint32_t)({{a}}), {self.width})" if reflect else "(uint32_t)({a})"
+        if self.xorout:
+            finish = f"(({finish}) ^ 0x{self.xorout:x}u)"
+        steps = ("reflect the result over its width, " if reflect else "") + (
+            f"xor it with 0x{self.xorout:x}" if self.xorout else "use it as is"
+        )
+        doc = (
+            f"/* {title or 'CRC'}: width {self.width}, poly 0x{self.poly:x}, init 0x{self.init:x}, refin "
+            f"{str(self.refin).lower()}, refout {str(self.refout).lower()}, xorout 0x{self.xorout:x} (check "
+            f"0x{self.check:x}). Incremental: start with 0x{start:x}, feed pieces, then {steps}. Bitwise: no table, "
+            "no static data. */"
+        )
+        body = f"""{doc}
+{t} {name}({t} acc, const uint8_t *data, size_t n)
+{{
+    uint32_t r = acc;
+    size_t i;
+    int bit;
+    for (i = 0; i < n; i++) {{
+{loop}
+    }}
+    return ({t})(r & 0x{mask:x}u);
+}}
+"""
+        prototype = f"{t} {name}({t} acc, const uint8_t *data, size_t n);"
+        return CCode(name, t, body, prototype, f"0x{start:x}u", finish)
 
     @classmethod
     def lua_function(cls) -> str:

@@ -12,7 +12,17 @@ from dataclasses import dataclass
 from itertools import accumulate
 from typing import Any
 
-from serialspec.checksums.base import Algorithm, ChecksumProblem, Import, Key, Report, Sample, hex_bytes, hex_value
+from serialspec.checksums.base import (
+    Algorithm,
+    CCode,
+    ChecksumProblem,
+    Import,
+    Key,
+    Report,
+    Sample,
+    hex_bytes,
+    hex_value,
+)
 
 
 def fletcher_function(modulus: int) -> Callable[[bytes], int]:
@@ -59,6 +69,25 @@ class Fletcher(Algorithm):
 
     def function_code(self) -> tuple[Import, str]:
         return ("serialspec.checksums.fletcher", "fletcher_function"), f"fletcher_function({self.modulus})"
+
+    def c_code(self, prefix: str) -> CCode:
+        m = self.modulus
+        name = f"{prefix}_fletcher{m}"
+        body = f"""/* Fletcher modulo {m}: CK_A the sum of the bytes, CK_B the sum of CK_A after each byte; the value is
+ * CK_B << 8 | CK_A. Incremental: acc holds CK_B << 8 | CK_A, start with 0. */
+uint16_t {name}(uint16_t acc, const uint8_t *data, size_t n)
+{{
+    uint32_t a = acc & 0xFFu, b = (uint32_t)acc >> 8;
+    size_t i;
+    for (i = 0; i < n; i++) {{
+        a = (a + data[i]) % {m}u;
+        b = (b + a) % {m}u;
+    }}
+    return (uint16_t)((b << 8) | a);
+}}
+"""
+        prototype = f"uint16_t {name}(uint16_t acc, const uint8_t *data, size_t n);"
+        return CCode(name, "uint16_t", body, prototype, "0u", "(uint32_t)({a})")
 
     @classmethod
     def lua_function(cls) -> str:

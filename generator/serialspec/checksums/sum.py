@@ -6,7 +6,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from serialspec.checksums.base import Algorithm, Import, Key, Report, Sample, hex_value
+from serialspec.checksums.base import Algorithm, CCode, Import, Key, Report, Sample, c_uint, hex_value
 
 
 def sum_function(width: int, invert: bool) -> Callable[[bytes], int]:
@@ -71,6 +71,29 @@ class Sum(Algorithm):
 
     def summed(self) -> bool | None:
         return self.invert if self.width == 8 else None
+
+    def c_code(self, prefix: str) -> CCode:
+        t = c_uint(self.width)
+        name = f"{prefix}_sum{self.width}"
+        mask = (1 << self.width) - 1
+        final = "the sum inverted" if self.invert else "the sum"
+        doc = (
+            f"/* Sum of the bytes modulo 2^{self.width}. Incremental: start with 0; the frame's checksum is {final}. */"
+        )
+        body = f"""{doc}
+{t} {name}({t} acc, const uint8_t *data, size_t n)
+{{
+    uint32_t s = acc;
+    size_t i;
+    for (i = 0; i < n; i++) {{
+        s += data[i];
+    }}
+    return ({t})(s & 0x{mask:x}u);
+}}
+"""
+        finish = f"(~(uint32_t)({{a}}) & 0x{mask:x}u)" if self.invert else "(uint32_t)({a})"
+        prototype = f"{t} {name}({t} acc, const uint8_t *data, size_t n);"
+        return CCode(name, t, body, prototype, "0u", finish)
 
     @classmethod
     def lua_function(cls) -> str:

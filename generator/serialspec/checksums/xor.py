@@ -6,7 +6,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from serialspec.checksums.base import Algorithm, Import, Report, Sample, hex_value
+from serialspec.checksums.base import Algorithm, CCode, Import, Report, Sample, c_uint, hex_value
 
 
 def xor_function(width: int) -> Callable[[bytes], int]:
@@ -50,6 +50,44 @@ class Xor(Algorithm):
 
     def function_code(self) -> tuple[Import, str]:
         return ("serialspec.checksums.xor", "xor_function"), f"xor_function({self.width})"
+
+    def c_code(self, prefix: str) -> CCode:
+        if self.width == 8:
+            name = f"{prefix}_xor8"
+            body = f"""/* XOR of the bytes. Incremental: start with 0. */
+uint8_t {name}(uint8_t acc, const uint8_t *data, size_t n)
+{{
+    uint8_t x = acc;
+    size_t i;
+    for (i = 0; i < n; i++) {{
+        x = (uint8_t)(x ^ data[i]);
+    }}
+    return x;
+}}
+"""
+            prototype = f"uint8_t {name}(uint8_t acc, const uint8_t *data, size_t n);"
+            return CCode(name, "uint8_t", body, prototype, "0u", "(uint32_t)({a})")
+        size = self.width // 8
+        t = c_uint(self.width)
+        name = f"{prefix}_xor{self.width}"
+        body = f"""/* XOR of the bytes taken as big-endian {self.width}-bit words, the last padded with zeros.
+ * Incremental in pieces of whole words: start with 0. */
+{t} {name}({t} acc, const uint8_t *data, size_t n)
+{{
+    uint32_t x = acc;
+    size_t i, k;
+    for (i = 0; i < n; i += {size}u) {{
+        uint32_t word = 0u;
+        for (k = 0; k < {size}u; k++) {{
+            word = (word << 8) | (i + k < n ? data[i + k] : 0u);
+        }}
+        x ^= word;
+    }}
+    return ({t})x;
+}}
+"""
+        prototype = f"{t} {name}({t} acc, const uint8_t *data, size_t n);"
+        return CCode(name, t, body, prototype, "0u", "(uint32_t)({a})")
 
     @classmethod
     def lua_function(cls) -> str:

@@ -21,7 +21,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         action="append",
         choices=target_names(),
         help="only this output (repeatable; default: all of them): python (packages), markdown (references), "
-        "wireshark (DIR/<protocol>/<protocol>.lua, a Lua dissector), c (DIR/c/<protocol>/, C99 for firmware and hosts)",
+        "wireshark (DIR/<protocol>/<protocol>.lua, a Lua dissector), c (DIR/<protocol>/ given --out, else "
+        "generated/c/<protocol>/: C99 for firmware and hosts)",
     )
     parser.add_argument(
         "--root", type=Path, help="project root (default: the nearest folder with a [tool.serialspec] table or specs/)"
@@ -30,7 +31,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     proj = project(args.root, args.specs, args.out)
-    files, errors = expected_files(proj, args.targets or ())
+    files, errors = expected_files(proj, args.targets or (), bare=args.out is not None)
     if proj.chosen and errors and all(path == proj.schema for path in files):
         # every spec named has mistakes: nothing is written (not even the schema, into a generated/ of its own)
         for line in shown(errors):

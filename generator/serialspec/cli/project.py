@@ -9,7 +9,8 @@ table, or that holds a `specs/` folder. The table may set:
     schema = "specs/serialspec.schema.json"   # the language's JSON Schema, for editors ("" for none)
     reference = "docs/language.md"            # the language reference, examples from the specs (default: none)
     namespace = "acme_protocols"              # packages go to DIR/acme_protocols/<protocol>/ (not with --out DIR)
-    old_names = true                          # and DIR/<protocol>/__init__.py aliases the old import name, warning
+    old_names = ["tinylamp"]                  # and DIR/tinylamp/__init__.py aliases its old import name, warning
+                                              # (true: every protocol's)
 
 Spec paths and `--out` given on the command line replace `specs` and `out`.
 """
@@ -49,7 +50,8 @@ class Project:
     reference: Path | None
     chosen: bool  # the specs were named on the command line (not the project's whole set)
     namespace: str = ""  # the package every protocol package sits in ("" for top-level packages)
-    old_names: bool = False  # with a namespace: a module under each protocol's top-level name aliases it
+    #: With a namespace: protocols whose top-level name gets a module aliasing the package ("*": every one).
+    old_names: frozenset[str] = frozenset()
 
     def package_folder(self, name: str) -> str:
         """Where a generated package's files go, relative to the output folder."""
@@ -115,14 +117,35 @@ def project(root: Path | None, specs: Sequence[str] = (), out: str | None = None
         root / str(reference) if reference else None,
         bool(specs),
         namespace,
-        bool(config.get("old_names", False)) and bool(namespace),
+        _old_names(config.get("old_names", False)) if namespace else frozenset(),
     )
 
 
-def expected_files(proj: Project, targets: Sequence[str] = ()) -> tuple[dict[Path, str], list[SpecError]]:
+def _old_names(setting: object) -> frozenset[str]:
+    if setting is True:
+        return frozenset({"*"})
+    if setting is False:
+        return frozenset()
+    if isinstance(setting, list) and all(isinstance(name, str) and name.isidentifier() for name in setting):
+        return frozenset(setting)
+    raise SerialspecError(
+        f"[tool.serialspec] old_names must be true, false or a list of protocol names, not {setting!r}"
+    )
+
+
+def expected_files(
+    proj: Project, targets: Sequence[str] = (), *, bare: bool = False
+) -> tuple[dict[Path, str], list[SpecError]]:
     """Every generated file, by path, from the project's valid specs; and every mistake in the others. Given
-    `targets` (emitter names), only those targets' files: no schema, no language reference."""
+    `targets` (emitter names), only those targets' files: no schema, no language reference; a spec a chosen target
+    cannot generate is a mistake (the target's one-line reason). `bare`: each target's files without its folder under
+    the output folder (`generate --target c --out DIR` writes DIR/<protocol>/, not DIR/c/<protocol>/)."""
     files: dict[Path, str] = {}
+    folders = {}
+    if bare:
+        from serialspec.backends import target_folder
+
+        folders = {name: target_folder(name) for name in targets}
     if proj.schema is not None and not targets:
         files[proj.schema] = _cached_text("schema", cache.generator(), _schema)
     errors = []
@@ -137,13 +160,24 @@ def expected_files(proj: Project, targets: Sequence[str] = ()) -> tuple[dict[Pat
             errors.extend(exc.errors)
             continue
         chosen = {name: text for name, text in outputs.files.items() if not targets or outputs.targets[name] in targets}
+        if folders:  # each target's files without its folder (bare: --out names the folder)
+            chosen = {
+                name.removeprefix(f"{folders[outputs.targets[name]]}/")
+                if folders.get(outputs.targets[name])
+                else name: text
+                for name, text in chosen.items()
+            }
         package = next(name for name in outputs.files if name.endswith(f"/{SHIPPED_SPEC}")).split("/")[0]
         if proj.namespace:
             chosen = {_in_namespace(proj, package, name): text for name, text in chosen.items()}
-            if proj.old_names and (not targets or "python" in targets):
+            if {"*", package} & proj.old_names and (not targets or "python" in targets):
                 chosen[f"{package}/__init__.py"] = _old_name(proj, spec, package)
         files.update({proj.out / name: _spec_link(proj, spec, name, text) for name, text in chosen.items()})
         errors.extend(outputs.errors)
+        for target in targets:
+            if target in outputs.refused:
+                message = f"the {target} target cannot generate this spec: {outputs.refused[target]}"
+                errors.append(SpecError(proj.display(spec), 1, 1, "", message))
         made.append(outputs)
     if (
         proj.reference is not None and not errors and not targets
@@ -169,6 +203,7 @@ class Outputs:
     data: Any
     key: bytes  # of the spec's text and name, and the generator
     targets: dict[str, str]  # file name -> the target (emitter) that writes it
+    refused: dict[str, str]  # target -> why it cannot generate the spec (one line)
 
 
 def spec_outputs(spec: Path, display: str, *, with_data: bool = False) -> Outputs:
@@ -189,16 +224,18 @@ def spec_outputs(spec: Path, display: str, *, with_data: bool = False) -> Output
     payload = cache.load(entry, wanted)
     if payload is not None:
         with contextlib.suppress(ValueError, EOFError, TypeError):
-            files, errors, data, has_data, targets = marshal.loads(payload)
-            cached = Outputs(dict(files), [SpecError(*error) for error in errors], data, wanted, dict(targets))
+            files, errors, data, has_data, targets, refused = marshal.loads(payload)
+            cached = Outputs(
+                dict(files), [SpecError(*error) for error in errors], data, wanted, dict(targets), dict(refused)
+            )
             if has_data or not with_data:
                 return cached
     outputs = _generate(raw, display, wanted)
     errors = [(e.file, e.line, e.column, e.path, e.message) for e in outputs.errors]
     try:
-        payload = marshal.dumps((outputs.files, errors, outputs.data, True, outputs.targets))
+        payload = marshal.dumps((outputs.files, errors, outputs.data, True, outputs.targets, outputs.refused))
     except ValueError:  # values marshal cannot hold (a YAML timestamp): cached without them
-        payload = marshal.dumps((outputs.files, errors, None, False, outputs.targets))
+        payload = marshal.dumps((outputs.files, errors, None, False, outputs.targets, outputs.refused))
     cache.store(entry, wanted, payload, keep=KEEP_OUTPUTS)
     return outputs
 
@@ -206,7 +243,7 @@ def spec_outputs(spec: Path, display: str, *, with_data: bool = False) -> Output
 @without_cycle_collection  # the emitters' imports (first spec), rendering and the examples' checks too
 def _generate(raw: bytes, display: str, key: bytes) -> Outputs:
     """Load and resolve one spec, run every emitter over it and check its examples and errata (raises SpecErrors)."""
-    from serialspec.backends import emit, emitters
+    from serialspec.backends import emit_or_refuse, emitters
     from serialspec.lang.loader import decode_text, load_text
     from serialspec.lang.resolve import resolve
 
@@ -214,16 +251,19 @@ def _generate(raw: bytes, display: str, key: bytes) -> Outputs:
     protocol = resolve(located)
     files: dict[str, str] = {}
     targets: dict[str, str] = {}
+    refused: dict[str, str] = {}
     errors: list[SpecError] = []
     for emitter in emitters():
-        emitted = emit(emitter, protocol)  # none from a target that cannot generate this spec yet
+        emitted, reason = emit_or_refuse(emitter, protocol)  # none from a target that cannot generate this spec yet
+        if reason is not None:
+            refused[emitter.name] = reason
         files.update(emitted)
         targets.update(dict.fromkeys(emitted, emitter.name))
         if emitter.verify is not None and emitted:
             errors.extend(emitter.verify(protocol, emitted))
     files[f"{protocol.name}/{SHIPPED_SPEC}"] = shipped_spec(protocol.spec_path, raw)
     targets[f"{protocol.name}/{SHIPPED_SPEC}"] = "python"  # the package ships it (`serialspec decode NAME`)
-    return Outputs(files, errors, located.data, key, targets)
+    return Outputs(files, errors, located.data, key, targets, refused)
 
 
 def _in_namespace(proj: Project, package: str, name: str) -> str:

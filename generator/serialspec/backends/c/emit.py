@@ -14,8 +14,9 @@ from dataclasses import dataclass, field
 from typing import assert_never
 
 from serialspec.backends import Unsupported
-from serialspec.backends.c.checksums import CChecksum, c_checksum
+from serialspec.backends.c.checksums import c_checksum
 from serialspec.backends.common.text import collapse
+from serialspec.checksums.base import CCode
 from serialspec.lang import expression
 from serialspec.lang.expression import Expr
 from serialspec.lang.model import (
@@ -29,6 +30,7 @@ from serialspec.lang.model import (
     Group,
     List,
     Message,
+    Packed,
     Protocol,
     Scalar,
     ScalarType,
@@ -141,7 +143,7 @@ class Ctx:
     protocol: Protocol
     p: str
     P: str
-    checks: list[tuple[Checksum, CChecksum]] = field(default_factory=list)
+    checks: list[tuple[Checksum, CCode]] = field(default_factory=list)
     caps: list[str] = field(default_factory=list)  # #ifndef capacity defaults for the header
     structs: list[str] = field(default_factory=list)
     helpers: set[str] = field(default_factory=set)
@@ -162,6 +164,8 @@ class Ctx:
 
 def refuse_unsupported(protocol: Protocol) -> None:
     """Raise Unsupported naming the first feature of the spec the C target cannot generate yet."""
+    if protocol.text is not None:
+        raise Unsupported("text framing (`framing: {kind: text}`)")
     for command in protocol.commands:
         if command.selector is not None and command.selector.type.size != 1:
             raise Unsupported(f"sub-command selectors of more than one byte (command {command.name})")
@@ -200,13 +204,21 @@ def refuse_fields(fields: tuple[Field, ...], where: str, nested: bool = False) -
             case Scalar():
                 if f.value is not None and nested:
                     raise Unsupported(f"{where}: {f.name}: a value computed by an expression inside a group")
+                if f.type.size not in (1, 2, 4):
+                    raise Unsupported(f"{where}: {f.name}: fields of type {f.type.name}")
             case Array():
-                pass
+                if f.item.size not in (1, 2, 4):
+                    raise Unsupported(f"{where}: {f.name}: arrays of {f.item.name}")
+            case Packed():
+                raise Unsupported(f"{where}: {f.name}: packed arrays of {f.bits}-bit integers")
             case List():
+                if f.item is not None and f.item.size not in (1, 2, 4):
+                    raise Unsupported(f"{where}: {f.name}: lists of {f.item.name}")
                 if f.item is not None and f.item.is_float:
                     raise Unsupported(f"{where}: {f.name}: lists of floats")
             case Text():
-                pass
+                if f.pad is not None:
+                    raise Unsupported(f"{where}: {f.name}: padded strings")
             case Bytes():
                 pass
             case Group():
@@ -294,6 +306,8 @@ def field_doc(f: Field) -> str:
         parts.append(f"unit: {f.unit}")
     if isinstance(f, Scalar) and f.scale:
         parts.append(f"scale: {f.scale:g} per unit")
+    if isinstance(f, Scalar) and f.offset:
+        parts.append(f"offset: {f.offset:+g}")
     if isinstance(f, Scalar | Array) and not (isinstance(f, Scalar) and f.type.is_float):
         parts.append(f"range {f.minimum:g}..{f.maximum:g}")
     if isinstance(f, Scalar) and f.enum:
@@ -363,6 +377,8 @@ def members(ctx: Ctx, fields: tuple[Field, ...], path: str, room: int) -> list[M
                     macro = cap_macro(ctx, f"{path}_{f.name}", most)
                     found.append(Member(name, f"{ctype(f.item)} {name}[{macro}];", doc))
                     found.append(Member(f"{name}_count", f"size_t {name}_count;", f"items in {f.name}"))
+            case Packed():  # refused by refuse_fields
+                raise Unsupported(f"{f.name}: packed arrays")
             case _:
                 assert_never(f)
     return found
@@ -553,6 +569,8 @@ def decode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                     out.append(f"{pad}    {tgt}[i{depth}] = {value};")
                     out.append(f"{pad}}}")
                 out.append(f"{pad}o += len;")
+            case Packed():  # refused by refuse_fields
+                raise Unsupported(f"{f.name}: packed arrays")
             case _:
                 assert_never(f)
 
@@ -662,7 +680,7 @@ def scalar_bits(ctx: Ctx, t: ScalarType, expr: str) -> str:
         return f"{ctx.p}__f32bits({expr})"
     if t.signed:
         mask = (1 << (8 * t.size)) - 1
-        return f"((uint32_t)(int32_t)({expr}) & 0x{mask:x}UL)"
+        return f"((uint32_t)(int32_t)({expr}) & 0x{mask:x}u)"
     return f"(uint32_t)({expr})"
 
 
@@ -748,6 +766,8 @@ def check_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[st
                         out.append(f"{pad}for (i{depth} = 0u; i{depth} < {tgt}_count; i{depth}++) {{")
                         out.append(f"{pad}    if ({test}) {{ return {ctx.P}_E_RANGE; }} /* {f.name} */")
                         out.append(f"{pad}}}")
+            case Packed():  # refused by refuse_fields
+                raise Unsupported(f"{f.name}: packed arrays")
             case _:
                 assert_never(f)
 
@@ -895,6 +915,8 @@ def encode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                     out.append(f"{pad}    {ctx.p}__put(c + o, {size}u, {big}u, {value}); /* {f.name} */")
                     out.append(f"{pad}    o += {size}u;")
                     out.append(f"{pad}}}")
+            case Packed():  # refused by refuse_fields
+                raise Unsupported(f"{f.name}: packed arrays")
             case _:
                 assert_never(f)
 
@@ -1031,6 +1053,8 @@ def json_fields(ctx: Ctx, fields: tuple[Field, ...], target: str, out: list[str]
                     out.append(f"{pad}    " + json_number(ctx, f.item, f"{tgt}[i{depth}]"))
                 out.append(f"{pad}}}")
                 out.append(f'{pad}{ctx.p}__ws(w, "]");')
+            case Packed():  # refused by refuse_fields
+                raise Unsupported(f"{f.name}: packed arrays")
             case _:
                 assert_never(f)
     return first

@@ -10,6 +10,21 @@ ENGINE = r"""/* ---- the frame engine: the spec's layouts as tables (runtime/fra
 #define PFX__ROLE_CONTENT 4u
 #define PFX__ROLE_CHECKSUM 5u
 
+/* 1 when a[0..n) and b[0..n) hold the same bytes (memcmp's test, without the library's memcmp in the build) */
+static int pfx__same(const uint8_t *a, const uint8_t *b, size_t n)
+{
+    size_t i;
+    for (i = 0u; i < n; i++) {
+        if (a[i] != b[i]) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+/* Byte stuffing over part of a layout (constant 0 when no layout has it: that code left out) */
+#define PFX__T(L) (PFX__STUFFED && (L)->has_t)
+
 #define PFX__WAIT (-2L)
 #define PFX__NONE (-1L)
 
@@ -87,23 +102,28 @@ static void pfx__put(uint8_t *b, uint8_t size, uint8_t big, uint32_t v)
 }
 #endif
 
+#if PFX_ENABLE_ENCODE || PFX__STUFFED || PFX_ENABLE_PARSER
 /* The elements before the variable part (the stuffed span, else the content) and after it. */
 static uint8_t pfx__inner_first(const pfx__layout_t *L)
 {
-    if (L->has_t) {
+    if (PFX__T(L)) {
         return L->t_first;
     }
     return L->content >= 0 ? (uint8_t)L->content : L->count;
 }
+#endif
 
+#if PFX_ENABLE_ENCODE || PFX__STUFFED
 static int pfx__inner_last(const pfx__layout_t *L)
 {
-    if (L->has_t) {
+    if (PFX__T(L)) {
         return (int)L->t_last;
     }
     return L->content >= 0 ? (int)L->content : (int)L->count - 1;
 }
+#endif
 
+#if PFX_ENABLE_ENCODE || PFX__STUFFED
 /* Each plain sequence rewritten as its wire sequence (to_wire) or back, leftmost first, the pairs tried in order at
  * each position. With cmp: compare the result with cmp[0..cap) instead of writing it (1: equal). */
 static int pfx__rewrite(const pfx__layout_t *L, int to_wire, const uint8_t *src, size_t n, uint8_t *dst,
@@ -118,12 +138,12 @@ static int pfx__rewrite(const pfx__layout_t *L, int to_wire, const uint8_t *src,
             size_t flen = to_wire ? L->pairs[k].plain_len : L->pairs[k].wire_len;
             const uint8_t *to = to_wire ? L->pairs[k].wire : L->pairs[k].plain;
             size_t tlen = to_wire ? L->pairs[k].wire_len : L->pairs[k].plain_len;
-            if (flen <= n - i && memcmp(src + i, from, flen) == 0) {
+            if (flen <= n - i && pfx__same(src + i, from, flen)) {
                 if (tlen > cap - o) {
                     return 0;
                 }
                 if (cmp != NULL) {
-                    if (memcmp(cmp + o, to, tlen) != 0) {
+                    if (!pfx__same(cmp + o, to, tlen)) {
                         return 0;
                     }
                 } else {
@@ -153,18 +173,21 @@ static int pfx__rewrite(const pfx__layout_t *L, int to_wire, const uint8_t *src,
     *out = o;
     return cmp == NULL || o == cap;
 }
+#endif
 
+#if PFX_ENABLE_ENCODE || PFX__STUFFED
 /* The bytes of elements a..b: the plain bytes when they lie inside the stuffed span, else the wire bytes. */
 static const uint8_t *pfx__range(const pfx__layout_t *L, const pfx__where_t *w, const uint8_t *wire,
                                  const uint8_t *plain, uint8_t a, uint8_t b, size_t *n)
 {
-    if (L->has_t && a >= L->t_first && b <= L->t_last) {
+    if (PFX__T(L) && a >= L->t_first && b <= L->t_last) {
         *n = w->pe[b] - w->ps[a];
         return plain + w->ps[a];
     }
     *n = w->we[b] - w->ws[a];
     return wire + w->ws[a];
 }
+#endif
 
 #if PFX_ENABLE_ENCODE
 /* The frame around a content already in place (at out + prefix, or in span + its offset when stuffed): the frame
@@ -179,7 +202,7 @@ static int pfx__wrap(const pfx__layout_t *L, uint8_t *out, size_t cap, uint8_t *
     int last = pfx__inner_last(L);
     const uint8_t *bytes;
     /* plain bytes of the stuffed span: its elements laid out around the content, inner checksums over them */
-    if (L->has_t) {
+    if (PFX__T(L)) {
         size_t p = 0u;
         for (k = L->t_first; k <= L->t_last; k++) {
             const pfx__element_t *e = &L->e[k];
@@ -218,7 +241,7 @@ static int pfx__wrap(const pfx__layout_t *L, uint8_t *out, size_t cap, uint8_t *
     v = 0u;
     for (k = 0u; k < L->count; k++) {
         const pfx__element_t *e = &L->e[k];
-        if (L->has_t && k == L->t_first) {
+        if (PFX__T(L) && k == L->t_first) {
             size_t made;
             if (!pfx__rewrite(L, 1, span, w.pe[L->t_last], out + pos, NULL, cap - pos, &made)) {
                 return PFX_E_BUFFER;
@@ -271,7 +294,7 @@ static int pfx__wrap(const pfx__layout_t *L, uint8_t *out, size_t cap, uint8_t *
     }
     for (k = 0u; k < L->count; k++) {
         const pfx__element_t *e = &L->e[k];
-        if (e->role == PFX__ROLE_CHECKSUM && !(L->has_t && k >= L->t_first && k <= L->t_last)) {
+        if (e->role == PFX__ROLE_CHECKSUM && !(PFX__T(L) && k >= L->t_first && k <= L->t_last)) {
             bytes = pfx__range(L, &w, out, span, e->first, e->last, &sz);
             pfx__put(out + w.ws[k], e->size, e->big, pfx__check(e->check, bytes, sz));
         }
@@ -281,7 +304,7 @@ static int pfx__wrap(const pfx__layout_t *L, uint8_t *out, size_t cap, uint8_t *
 }
 #endif
 
-#if PFX_ENABLE_DECODE
+#if PFX_ENABLE_DECODE && PFX__STUFFED
 /* Check a complete frame (constants, values, lengths, stuffing, checksums) and take it apart: the frame engine's
  * unwrap (runtime/framing.py Layout.unwrap). plain: room for the unstuffed span. */
 static int pfx__unwrap(const pfx__layout_t *L, const uint8_t *frame, size_t n, uint8_t *plain, uint32_t *code,
@@ -311,7 +334,7 @@ static int pfx__unwrap(const pfx__layout_t *L, const uint8_t *frame, size_t n, u
         pos -= L->e[k - 1u].size;
         w.ws[k - 1u] = pos;
     }
-    if (L->has_t) {
+    if (PFX__T(L)) {
         size_t pn, fixed = 0u, p = 0u;
         if (!pfx__rewrite(L, 0, frame + before, n - before - after, plain, NULL, PFX_MAX_FRAME, &pn)) {
             return PFX_E_CAPACITY;
@@ -339,15 +362,15 @@ static int pfx__unwrap(const pfx__layout_t *L, const uint8_t *frame, size_t n, u
     }
     for (k = 0u; k < L->count; k++) {
         const pfx__element_t *e = &L->e[k];
-        bytes = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
-        if (e->role == PFX__ROLE_CONSTANT && memcmp(bytes, e->constant, e->size) != 0) {
+        bytes = PFX__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+        if (e->role == PFX__ROLE_CONSTANT && !pfx__same(bytes, e->constant, e->size)) {
             return PFX_E_FRAME;
         }
     }
     *code = 0u;
     for (k = 0u; k < L->count; k++) {
         const pfx__element_t *e = &L->e[k];
-        bytes = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+        bytes = PFX__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
         if (e->role == PFX__ROLE_COMMAND) {
             *code = pfx__get(bytes, e->size, e->big);
         } else if (e->role == PFX__ROLE_VALUE) {
@@ -361,7 +384,7 @@ static int pfx__unwrap(const pfx__layout_t *L, const uint8_t *frame, size_t n, u
     for (k = 0u; k < L->count; k++) {
         const pfx__element_t *e = &L->e[k];
         if (e->role == PFX__ROLE_LENGTH) {
-            bytes = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+            bytes = PFX__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
             (void)pfx__range(L, &w, frame, body, e->first, e->last, &sz);
             if ((int32_t)pfx__get(bytes, e->size, e->big) != (int32_t)sz + e->adds) {
                 return PFX_E_LENGTH;
@@ -371,7 +394,7 @@ static int pfx__unwrap(const pfx__layout_t *L, const uint8_t *frame, size_t n, u
     for (k = 0u; k < L->count; k++) {
         const pfx__element_t *e = &L->e[k];
         if (e->role == PFX__ROLE_CHECKSUM) {
-            const uint8_t *stored = L->has_t && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
+            const uint8_t *stored = PFX__T(L) && k >= L->t_first && k <= L->t_last ? body + w.ps[k] : frame + w.ws[k];
             bytes = pfx__range(L, &w, frame, body, e->first, e->last, &sz);
             if (pfx__check(e->check, bytes, sz) != pfx__get(stored, e->size, e->big)) {
                 return PFX_E_CHECKSUM;
@@ -379,7 +402,7 @@ static int pfx__unwrap(const pfx__layout_t *L, const uint8_t *frame, size_t n, u
         }
     }
     if (L->content >= 0) {
-        int inside = L->has_t && L->content >= (int)L->t_first && L->content <= (int)L->t_last;
+        int inside = PFX__T(L) && L->content >= (int)L->t_first && L->content <= (int)L->t_last;
         *content = inside ? body + w.ps[L->content] : frame + w.ws[L->content];
         *clen = inside ? w.pe[L->content] - w.ps[L->content] : w.we[L->content] - w.ws[L->content];
     } else {
@@ -412,7 +435,7 @@ static long pfx__probe(const pfx__layout_t *L, pfx_direction_t dir, const uint8_
             return PFX__WAIT;
         }
         if (e->role == PFX__ROLE_CONSTANT) {
-            if (memcmp(b + pos, e->constant, e->size) != 0) {
+            if (!pfx__same(b + pos, e->constant, e->size)) {
                 return PFX__NONE;
             }
         } else if (e->role == PFX__ROLE_COMMAND) {
@@ -438,20 +461,20 @@ static long pfx__probe(const pfx__layout_t *L, pfx_direction_t dir, const uint8_
         low = 0u; /* the code lies in the stuffed span: no bounds before the frame is unstuffed */
         bounded = 0;
     }
-    if (L->length >= 0) {
+    if (PFX__LENGTHS || L->length >= 0) {
         const pfx__element_t *e = &L->e[L->length];
         long counted = (long)pfx__get(b + L->length_off, e->size, e->big) - (long)e->adds;
         long content = counted - (long)L->counted;
-        if (content < (long)low || (!L->has_t && bounded && content > (long)high)) {
+        if (content < (long)low || (!PFX__T(L) && bounded && content > (long)high)) {
             return PFX__NONE;
         }
         return (long)(L->overhead - L->counted) + counted;
     }
-    if (L->has_t && L->e[L->count - 1u].role == PFX__ROLE_CONSTANT && L->count > 1u) {
+    if (PFX__T(L) && L->e[L->count - 1u].role == PFX__ROLE_CONSTANT && L->count > 1u) {
         const pfx__element_t *t = &L->e[L->count - 1u];
         size_t i;
         for (i = before; i + t->size <= avail; i++) {
-            if (memcmp(b + i, t->constant, t->size) == 0) {
+            if (pfx__same(b + i, t->constant, t->size)) {
                 return (long)(i + t->size);
             }
         }

@@ -296,6 +296,119 @@ def layout_tables(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) -
     return "\n".join(lines), name
 
 
+def _wire_value(where: tuple[bool, int], size: int, big: bool) -> str:
+    """A frame element's value from its bytes in f (at an offset from the start, or back from the end n), built with
+    shifts (any host byte order)."""
+    from_end, offset = where
+
+    def byte(i: int) -> str:
+        return f"f[n - {offset - i}u]" if from_end else f"f[{offset + i}u]"
+
+    order = list(range(size)) if big else list(range(size - 1, -1, -1))
+    return " | ".join(
+        f"((uint32_t){byte(i)} << {8 * (size - 1 - j)}u)" if j < size - 1 else f"(uint32_t){byte(i)}"
+        for j, i in enumerate(order)
+    )
+
+
+def straight_unwrap(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) -> str:
+    """The frame engine's unwrap (runtime/framing.py Layout.unwrap) for one layout without byte stuffing, straight
+    line: every offset known (from the start before the content, from the end after it), the same checks in the same
+    order (constants, then values and the command, then lengths, then checksums)."""
+    p, P = ctx.p, ctx.P
+    elements = layout.elements
+    names = [e.name for e in elements]
+    sizes = [len(e.constant) if e.role in ("header", "trailer", "constant") else e.size or 0 for e in elements]
+    content = next((i for i, e in enumerate(elements) if e.role == "content"), -1)
+    first = content if content >= 0 else len(elements)
+    last = content if content >= 0 else len(elements) - 1
+    before, after = sum(sizes[:first]), sum(sizes[last + 1 :])
+    # each element's start and end: (from_end, offset): offset from the frame's start, or back from its end
+    start: list[tuple[bool, int]] = []
+    end: list[tuple[bool, int]] = []
+    for i in range(len(elements)):
+        if i < first:
+            start.append((False, sum(sizes[:i])))
+            end.append((False, sum(sizes[: i + 1])))
+        elif i > last:
+            start.append((True, sum(sizes[i:])))
+            end.append((True, sum(sizes[i + 1 :])))
+        else:
+            start.append((False, before))
+            end.append((True, after))
+
+    def at(where: tuple[bool, int]) -> str:
+        from_end, offset = where
+        return f"(n - {offset}u)" if from_end else f"{offset}u"
+
+    def span(a: int, b: int) -> str:
+        (end_a, off_a), (end_b, off_b) = start[a], end[b]
+        if not end_a and not end_b:
+            return f"{off_b - off_a}u"
+        if end_a and end_b:
+            return f"{off_a - off_b}u"
+        return f"(n - {off_b + off_a}u)"
+
+    lines = [
+        f"/* The {direction.value} frame{' ' + layout.name if layout.name else ''}: unwrap, straight line. */",
+        f"static int {p}__unwrap_{direction.value}_{k}(const uint8_t *f, size_t n, uint32_t *code, uint32_t *values,",
+        "                                 const uint8_t **content, size_t *clen)",
+        "{",
+        "    (void)values;",
+        "    *code = 0u;",
+        f"    if (n < {before + after}u) {{",
+        f"        return {P}_E_LENGTH;",
+        "    }",
+    ]
+    for i, e in enumerate(elements):
+        if e.role in ("header", "trailer", "constant"):
+            for j, byte in enumerate(e.constant):
+                index = _wire_value(start[i], j + 1, True).rsplit("(uint32_t)", 1)[1]
+                lines.append(f"    if ({index} != 0x{byte:02x}u) {{ return {P}_E_FRAME; }} /* {e.name} */")
+    v = 0
+    for i, e in enumerate(elements):
+        value = _wire_value(start[i], sizes[i], e.endian == ">")
+        if e.role == "command":
+            lines.append(f"    *code = {value}; /* {e.name} */")
+        elif e.role in ("address", "status"):
+            assert e.type is not None
+            test = []
+            if int(e.minimum) > 0:
+                test.append(f"values[{v}] < {int(e.minimum)}u")
+            if int(e.maximum) < (1 << (8 * sizes[i])) - 1:
+                test.append(f"values[{v}] > {int(e.maximum)}u")
+            lines.append(f"    values[{v}] = {value}; /* {e.name} */")
+            if test:
+                cond = " || ".join(test)
+                if e.broadcast is not None:
+                    cond = f"({cond}) && values[{v}] != {e.broadcast}u"
+                lines.append(f"    if ({cond}) {{ return {P}_E_RANGE; }}")
+            v += 1
+    for i, e in enumerate(elements):
+        if e.role == "length":
+            a, b = names.index(e.counts[0]), names.index(e.counts[1])
+            value = _wire_value(start[i], sizes[i], e.endian == ">")
+            lines.append(
+                f"    if ((int32_t)({value}) != (int32_t){span(a, b)} + {e.adds}) {{ return {P}_E_LENGTH; }} "
+                f"/* {e.name} */"
+            )
+    for i, e in enumerate(elements):
+        if e.role == "checksum" and e.checksum is not None:
+            a, b = names.index(e.checksum.first), names.index(e.checksum.last)
+            check = ctx.check_index(e.checksum)
+            value = _wire_value(start[i], sizes[i], e.endian == ">")
+            lines.append(
+                f"    if ({p}__check({check}u, f + {at(start[a])}, {span(a, b)}) != ({value})) {{ "
+                f"return {P}_E_CHECKSUM; }} /* {e.name} */"
+            )
+    if content >= 0:
+        lines += [f"    *content = f + {before}u;", f"    *clen = n - {before + after}u;"]
+    else:
+        lines += ["    *content = f;", "    *clen = 0u;"]
+    lines += [f"    return {P}_OK;", "}", ""]
+    return "\n".join(lines)
+
+
 def source(ctx: Ctx) -> str:
     protocol, p, P = ctx.protocol, ctx.p, ctx.P
     msgs = messages(protocol)
@@ -315,6 +428,23 @@ def source(ctx: Ctx) -> str:
     max_elements = max(len(layout.elements) for ls in protocol.framing.alternatives.values() for layout in ls)
     decoders = "\n".join(decoder(ctx, m) for m in msgs)
     encoders = "\n".join(encoder(ctx, m) for m in msgs)
+    straight: list[str] = []
+    unwrap_cases: list[str] = []
+    for d in directions(protocol):
+        rows = []
+        for k, layout in enumerate(protocol.framing.alternatives[d]):
+            if layout.transparency is None:
+                straight.append(straight_unwrap(ctx, d, k, layout))
+                rows.append(
+                    f"        case {k}u:\n"
+                    f"            return {p}__unwrap_{d.value}_{k}(frame, n, code, values, content, clen);"
+                )
+        if rows:
+            unwrap_cases.append(
+                f"    case {P}_{d.name}:\n        switch (k) {{\n"
+                + "\n".join(rows)
+                + "\n        default:\n            break;\n        }\n        break;"
+            )
     # checksums
     check_defs = "\n".join(dict.fromkeys(c.definition for _, c in ctx.checks))
     cases = "\n".join(
@@ -471,12 +601,15 @@ def source(ctx: Ctx) -> str:
     classic = 1 if protocol.framing.classic else 0
     headers = [layout.header for d in directions(protocol) for layout in protocol.framing.alternatives[d]]
     has_headers = 1 if all(headers) else 0
-    keep = max((len(h) for h in headers), default=1) - 1
+    keep = max(0, max((len(h) for h in headers), default=1) - 1)
     dir_layouts = "\n".join(
         f"    case {P}_{d.name}:\n        *count = {n_layouts[d]}u;\n        return {p}__layouts_{d.value};"
         for d in directions(protocol)
     )
     any_stuffed = any(stuffed.values())
+    every = [layout for d in directions(protocol) for layout in protocol.framing.alternatives[d]]
+    all_lengths = int(all(layout.length is not None for layout in every))
+    single = int(all(n == 1 for n in n_layouts.values()))
     return f"""{banner(protocol)}
 #include "{p}.h"
 
@@ -496,6 +629,9 @@ typedef char {p}__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define {P}__CLASSIC {classic}
 #define {P}__HEADERS {has_headers} /* every layout starts with a header: candidates start at headers only */
 #define {P}__KEEP {keep}u      /* bytes kept at the end that could begin a header */
+#define {P}__STUFFED {int(any_stuffed)} /* some layout has byte stuffing */
+#define {P}__LENGTHS {all_lengths} /* every layout has a length element */
+#define {P}__SINGLE {single} /* one layout per direction */
 
 /* ---- checksums ---- */
 {check_defs}
@@ -554,6 +690,26 @@ static int {p}__bounds({p}_direction_t dir, long code, size_t *low, size_t *high
 #endif
 
 #if {P}_ENABLE_DECODE
+/* ---- frames taken apart: straight line where a layout has no byte stuffing ---- */
+{chr(10).join(straight)}
+static int {p}__unwrap_at({p}_direction_t dir, uint8_t k, const {p}__layout_t *L, const uint8_t *frame, size_t n,
+                          uint8_t *plain, uint32_t *code, uint32_t *values, const uint8_t **content, size_t *clen)
+{{
+    (void)k;
+    (void)L;
+    (void)plain;
+    switch (dir) {{
+{chr(10).join(unwrap_cases)}
+    default:
+        break;
+    }}
+#if {P}__STUFFED
+    return {p}__unwrap(L, frame, n, plain, code, values, content, clen);
+#else
+    return {P}_E_ARG;
+#endif
+}}
+
 /* ---- content decoders ---- */
 {decoders}
 static int {p}__decode_content({p}_direction_t dir, long code, {p}_kind_t expect, const uint8_t *c, size_t n,
@@ -574,7 +730,7 @@ int {p}_decode_expect(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}
     uint8_t count, k;
     const {p}__layout_t *const *layouts;
     const {p}__layout_t *L = NULL;
-    uint32_t code = 0u, values[{P}__MAX_ELEMENTS];
+    uint32_t code = 0u, values[{P}__MAX_ELEMENTS] = {{0u}};
     const uint8_t *c = NULL;
     size_t clen = 0u;
     int r;
@@ -587,12 +743,13 @@ int {p}_decode_expect(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}
     if (layouts == NULL) {{
         return {P}_E_ARG;
     }}
-    if (count == 1u) {{
+    k = 0u;
+    if ({P}__SINGLE || count == 1u) {{
         L = layouts[0];
     }} else {{
         for (k = 0u; k < count; k++) {{
             const {p}__layout_t *A = layouts[k];
-            if (A->header_len <= len && memcmp(frame, A->e[0].constant, A->header_len) == 0) {{
+            if (A->header_len <= len && {p}__same(frame, A->e[0].constant, A->header_len)) {{
                 L = A;
                 break;
             }}
@@ -601,7 +758,7 @@ int {p}_decode_expect(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}
             return {P}_E_FRAME;
         }}
     }}
-    r = {p}__unwrap(L, frame, len, plain, &code, values, &c, &clen);
+    r = {p}__unwrap_at(dir, k, L, frame, len, plain, &code, values, &c, &clen);
     if (r != {P}_OK) {{
         return r;
     }}
@@ -637,11 +794,11 @@ static int {p}__frame({p}_direction_t dir, uint32_t code, const uint32_t *values
         size_t before = 0u, clen = 0u;
         uint8_t *dst;
         size_t room;
-        uint8_t from = L->has_t ? L->t_first : 0u;
+        uint8_t from = {P}__T(L) ? L->t_first : 0u;
         for (i = from; (int)i < L->content; i++) {{
             before += L->e[i].size;
         }}
-        if (L->has_t) {{
+        if ({P}__T(L)) {{
             if (before > {P}_MAX_FRAME) {{
                 return {P}_E_BUFFER;
             }}
@@ -758,7 +915,7 @@ static size_t {p}__next({p}_parser_t *p, size_t start)
             const {p}__layout_t *L = layouts[k];
             if (L->header_len > p->n - pos) {{
                 whole = 0;
-            }} else if (memcmp(p->buf + pos, L->e[0].constant, L->header_len) == 0) {{
+            }} else if ({p}__same(p->buf + pos, L->e[0].constant, L->header_len)) {{
                 return pos;
             }}
         }}
@@ -837,11 +994,56 @@ static int {p}__push({p}_parser_t *p, uint8_t byte, {p}_msg_t *out)
     return got;
 }}
 
+#if {P}__HEADERS
+/* A whole frame at data[0..len) while no byte is held: taken at once, its bytes not pushed one by one, when that gives
+ * what pushing them would (one layout; a plausible frame that fits and decodes; no header inside it, so no other
+ * candidate could end first). Else 0: the bytes go through {p}__push. */
+static size_t {p}__whole({p}_parser_t *p, const uint8_t *data, size_t len, {p}_msg_t *out)
+{{
+    uint8_t count;
+    const {p}__layout_t *const *layouts = {p}__layouts(p->dir, &count);
+    const {p}__layout_t *L;
+    size_t i, size;
+    long s;
+    if (!{P}__SINGLE && count != 1u) {{
+        return 0u;
+    }}
+    L = layouts[0];
+    if (len < L->header_len || !{p}__same(data, L->e[0].constant, L->header_len)) {{
+        return 0u;
+    }}
+    s = {p}__probe(L, p->dir, data, len);
+    if (s <= 0 || (unsigned long)s > {P}_MAX_FRAME || (size_t)s > len) {{
+        return 0u;
+    }}
+    size = (size_t)s;
+    for (i = 1u; i + L->header_len <= size; i++) {{
+        if (data[i] == L->e[0].constant[0] && {p}__same(data + i, L->e[0].constant, L->header_len)) {{
+            return 0u;
+        }}
+    }}
+    if ({p}_decode(data, size, p->dir, out) != {P}_OK) {{
+        return 0u;
+    }}
+    p->frames++;
+    return size;
+}}
+#endif
+
 size_t {p}_parser_feed({p}_parser_t *parser, const uint8_t *data, size_t len, {p}_msg_t *out, bool *got)
 {{
     size_t i;
     *got = false;
     for (i = 0u; i < len; i++) {{
+#if {P}__HEADERS
+        if (parser->n == 0u) {{
+            size_t size = {p}__whole(parser, data + i, len - i, out);
+            if (size > 0u) {{
+                *got = true;
+                return i + size;
+            }}
+        }}
+#endif
         if ({p}__push(parser, data[i], out)) {{
             *got = true;
             return i + 1u;

@@ -18,6 +18,7 @@ from serialspec.backends.common.numbers import number
 from serialspec.backends.common.text import collapse
 from serialspec.backends.markdown.kinds import anchor, kind, scalar_range
 from serialspec.collection import without_cycle_collection
+from serialspec.lang import expression
 from serialspec.lang.frozen import mutable
 from serialspec.lang.model import (
     Array,
@@ -34,6 +35,7 @@ from serialspec.lang.model import (
     Group,
     List,
     Message,
+    Packed,
     Protocol,
     Scalar,
     TableBlock,
@@ -152,7 +154,7 @@ def field_rows(fields: tuple[Field, ...], start: int | None, prefix: str = "") -
                     )
                     for e in f.entries
                 ]
-            case Scalar() | Array() | List() | Text() | Bytes() | TableValue():
+            case Scalar() | Array() | Packed() | List() | Text() | Bytes() | TableValue():
                 pass  # one row
             case _:
                 assert_never(f)
@@ -176,7 +178,8 @@ def message_context(protocol: Protocol, message: Message | None) -> dict[str, An
         "rows": [{k: cell(v) for k, v in vars(r).items()} for r in rows],
         "size": size,
         "optional": text(message.optional),
-        "unsolicited": message.unsolicited,
+        "unsolicited": message.unsolicited or sends_text(protocol, message) != "",
+        "sends": sends_text(protocol, message),
         "answers": message.answers,
         "reply": "; ".join(
             part
@@ -200,10 +203,35 @@ def shared_request_text(protocol: Protocol, message: Message) -> str:
         for c in protocol.commands
         if c.code == code and c.name != message.command and (m := c.request) is not None
     ]
-    if code is None or not others:
+    if not isinstance(code, int) or not others:
         return ""
     names = ", ".join(f"`{name}`" for name in others)
     return f"shares code {code:#04x} with {names}, told apart by the content size"
+
+
+def device_rule_text(protocol: Protocol, name: str) -> str:
+    """What the device's rules say of one memory entry: what it reads as, and when it cannot be written."""
+    device = protocol.device
+    if device is None or device.memory is None:
+        return ""
+    found = ""
+    if name in device.derived:
+        found += f" Reads as {expression.show(device.derived[name])}."
+    if name in device.locks:
+        found += f" Not writable while {device.locks[name]} is non-zero."
+    return found
+
+
+def sends_text(protocol: Protocol, message: Message) -> str:
+    """When the device sends this response on its own (`device.sends`), or ""."""
+    device = protocol.device
+    send = next((s for s in device.sends if s.command == message.key), None) if device else None
+    if send is None or message.direction != Direction.RESPONSE:
+        return ""
+    when = [f"every {send.every} ms"] if send.every else []
+    when += [f"after the reply to {', '.join(f'`{n}`' for n in send.after)}"] if send.after else []
+    when += [f"when {', '.join(f'`{n}`' for n in send.changes)} changes"] if send.changes else []
+    return " or ".join(when) + (f", while `{send.while_}` is non-zero" if send.while_ else "")
 
 
 def content_limit(layout: FrameLayout) -> int | None:
@@ -580,6 +608,10 @@ def _show(value: Any) -> str:
 
 @without_cycle_collection
 def emit_docs(protocol: Protocol) -> str:
+    if protocol.text is not None:  # a text protocol's page (it takes this module's text helpers)
+        from serialspec.backends.markdown.text import text_docs
+
+        return text_docs(protocol, protocol.text)
     commands = [command_context(protocol, c) for c in protocol.commands]
     examples = [
         {
@@ -618,6 +650,7 @@ def emit_docs(protocol: Protocol) -> str:
                     "meaning": cell(
                         e.description
                         + (f" Values: [{e.enum.class_name}](#enum-{anchor(e.enum.name)})." if e.enum else "")
+                        + device_rule_text(protocol, e.name)
                     ),
                 }
                 for e in t.entries

@@ -34,6 +34,7 @@ from serialspec.lang.model import (
     Group,
     List,
     Message,
+    Packed,
     Protocol,
     Scalar,
     Table,
@@ -101,7 +102,7 @@ def type_names(f: Field) -> list[str]:
             return [n for n in names if n]
         case Group() | TableBlock():
             return [f.class_name]
-        case Array() | List() | Text() | Bytes() | TableValue():
+        case Array() | Packed() | List() | Text() | Bytes() | TableValue():
             return []
         case _:
             assert_never(f)
@@ -562,8 +563,9 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
         if carrier is not None:
             methods.append(carrier)
     reports = []
+    sent = {send.command for send in protocol.device.sends} if protocol.device else set()
     for message in protocol.messages():
-        if message.direction == Direction.RESPONSE and message.unsolicited:
+        if message.direction == Direction.RESPONSE and (message.unsolicited or message.key in sent):
             imports.add(message.class_name)
             title = message.title or protocol.command(message.command).title or message.key
             reports.append({"name": method_name(message), "class_name": message.class_name, "title": one_line(title)})

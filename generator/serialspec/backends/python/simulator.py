@@ -14,9 +14,11 @@ from serialspec.lang.model import (
     Array,
     Bytes,
     DeviceModel,
+    Direction,
     Group,
     List,
     Message,
+    Packed,
     Protocol,
     Scalar,
     SpaceAccess,
@@ -83,7 +85,7 @@ def table_fields(*messages: Message | None) -> dict[str, tuple[str, ...]]:
                 found[f.name] = ("run", f.start, f.size_from)
             case Group():
                 stack.extend(reversed(f.fields))
-            case Scalar() | Array() | List() | Text() | Bytes():
+            case Scalar() | Array() | Packed() | List() | Text() | Bytes():
                 pass  # no table entries
             case _:
                 assert_never(f)
@@ -112,6 +114,11 @@ def report_source(parsed: expression.Expr) -> str:
     """A reported state variable by name, or a conversion of state variables as a function of `get`."""
     if isinstance(parsed, expression.Name):
         return repr(parsed.name)
+    return function_of_get(parsed)
+
+
+def function_of_get(parsed: expression.Expr) -> str:
+    """An expression of state variables and memory entries as a function of `get`."""
     return f"lambda get: {expression.render(parsed, lambda n: f'get({n!r})')}"
 
 
@@ -210,6 +217,8 @@ def simulator_module(protocol: Protocol) -> str:
                     args.append(f"move_enabled_by={m.enabled_by!r}")
                 if m.accel or m.decel:
                     args.append(f"ramp={(m.accel, m.decel)!r}")
+                if m.to is not None:
+                    args.append(f"move_to={function_of_get(m.to)}")
             if behaviour.broadcast_reply:
                 args.append("broadcast_reply=True")
             for name in BEHAVIOUR_ARGUMENTS:
@@ -269,6 +278,7 @@ def simulator_module(protocol: Protocol) -> str:
     runtime += ["KindSpec"] if device.kinds else []
     runtime += ["ModelSpec"] if device.models else []
     runtime += ["RunSpec"] if any(b.space_reads or b.space_writes for b in device.behaviours) else []
+    runtime += ["SendSpec"] if device.sends else []
     runtime += ["Simulator"]
     runtime += ["SpaceSpec"] if spaces else []
     runtime += ["TimeoutSpec"] if device.timeout else []
@@ -278,8 +288,32 @@ def simulator_module(protocol: Protocol) -> str:
         classes = ", ".join(m.class_name for m in kept if m is not None)
         imports.update(m.class_name for m in kept if m is not None)
         timeout = f"TimeoutSpec({device.timeout.after / 1000!r}, ({classes},), {device.timeout.sets!r})"
+    sends = []
+    for send in device.sends:
+        response = next(m for m in protocol.messages() if m.direction == Direction.RESPONSE and m.key == send.command)
+        imports.add(response.class_name)
+        args = [response.class_name]
+        if send.every:
+            args.append(f"every={send.every / 1000!r}")
+        requests = [m for m in protocol.messages() if m.key in send.after and m.direction == Direction.REQUEST]
+        if requests:
+            imports.update(m.class_name for m in requests)
+            args.append(f"after=({''.join(f'{m.class_name}, ' for m in requests)})")
+        if send.changes:
+            args.append(f"changes={send.changes!r}")
+        if send.while_:
+            args.append(f"while_={send.while_!r}")
+        if send.values:
+            args.append(f"values={{{', '.join(f'{k!r}: {report_source(v)}' for k, v in send.values.items())}}}")
+        blanks = reply_blanks(protocol, response, set())
+        if blanks:
+            args.append(f"blanks={{{', '.join(f'{k!r}: {v}' for k, v in blanks.items())}}}")
+        sends.append(f"SendSpec({', '.join(args)}),")
     return render(
         "simulator.py.j2",
+        derived=", ".join(f"{k!r}: {function_of_get(v)}" for k, v in device.derived.items()),
+        locks=repr(device.locks) if device.locks else "",
+        sends=sends,
         runtime_imports=", ".join(runtime),
         spaces=spaces,
         error=error,

@@ -31,6 +31,7 @@ from serialspec.lang.model import (
     SpaceAccess,
     Table,
     TableEntry,
+    Unsolicited,
     replies_by_request,
     reply_to,
 )
@@ -154,6 +155,9 @@ class DevicePass(Pass):
                     str(moves.get("enabled_by", "")),
                     str(moves.get("accel", "")),
                     str(moves.get("decel", "")),
+                    self.expression(
+                        moves.get("to"), (*item_path, "moves", "to"), (request_names, entries, known_state)
+                    ),
                 )
                 if motion.speed_scale <= 0:
                     self.error((*item_path, "moves", "speed_scale"), "must be positive")
@@ -216,7 +220,25 @@ class DevicePass(Pass):
         for field_name, entry_name in status.items():
             if entry_name not in entries:
                 self.error((*path, "status", field_name), f"unknown memory entry {entry_name!r}")
+        variables: Container[str] = {*entries, *state}
         return Device(
+            derived={
+                str(name): parsed
+                for name, source in (value.get("derived") or {}).items()
+                if self.known(name, entries, (*path, "derived", name), "memory entry")
+                for parsed in [self.expression(source, (*path, "derived", name), (variables,))]
+                if parsed is not None
+            },
+            # a derived entry reads others, never a derived one: no chain, no loop
+            **self.no_chains(value.get("derived") or {}, (*path, "derived")),
+            locks=self.locks(value.get("locks") or (), (*path, "locks"), entries, variables),
+            sends=self.sends(
+                value.get("sends") or {},
+                (*path, "sends"),
+                requests,
+                {m.key: m for c in commands for m in c.messages() if m.direction == Direction.RESPONSE},
+                variables,
+            ),
             description=str(value.get("description", "")),
             memory=memory,
             initial={str(k): float(v) for k, v in (value.get("initial") or {}).items()},
@@ -246,6 +268,99 @@ class DevicePass(Pass):
                 str(value.get("model_entry", "")),
             ),
         )
+
+    def known(self, name: str, names: Container[str], path: Path, what: str) -> bool:
+        if name not in names:
+            self.error(path, f"unknown {what} {name!r}")
+        return name in names
+
+    def expression(self, source: Any, path: Path, names: tuple[Container[str], ...]) -> expression.Expr | None:
+        """An expression of the given names (request fields, memory entries, state variables), or None."""
+        if source is None:
+            return None
+        try:
+            parsed = expression.parse(str(source))
+        except expression.ExpressionError as exc:
+            self.error(path, str(exc))
+            return None
+        for name in sorted(set(expression.names(parsed))):
+            if not any(name in known for known in names):
+                self.error(path, f"unknown name {name!r} (not a request field, memory entry or state variable)")
+        return parsed
+
+    def no_chains(self, value: dict[str, Any], path: Path) -> dict[str, Any]:
+        for name, source in value.items():
+            try:
+                used = set(expression.names(expression.parse(str(source))))
+            except expression.ExpressionError:
+                continue  # reported with the entry
+            for other in sorted(used & set(value)):
+                self.error((*path, name), f"{name} reads the derived entry {other!r}: derive it from plain values")
+        return {}
+
+    def locks(
+        self, value: Any, path: Path, entries: dict[str, TableEntry], variables: Container[str]
+    ) -> dict[str, str]:
+        """`locks:` as memory entry -> the variable that locks it while non-zero."""
+        found: dict[str, str] = {}
+        for index, item in enumerate(value):
+            locker = str(item["while"])
+            self.known(locker, variables, (*path, index, "while"), "memory entry or state variable")
+            names = [e.name for e in entries.values() if item.get("memory") and e.memory == item["memory"]]
+            for name in item.get("entries") or ():
+                if self.known(str(name), entries, (*path, index, "entries"), "memory entry"):
+                    names.append(str(name))
+            if not names:
+                self.error((*path, index), "locks no memory entry (give `memory` or `entries`)")
+            # read-only entries are refused anyway: only writable ones are locked
+            found |= {name: locker for name in names if name != locker and entries[name].access != "r"}
+        return found
+
+    def sends(
+        self,
+        value: dict[str, Any],
+        path: Path,
+        requests: dict[str, Message],
+        responses: dict[str, Message],
+        variables: Container[str],
+    ) -> tuple[Unsolicited, ...]:
+        """`sends:` what the device sends on its own: a command's response, and when."""
+        found = []
+        for key, item in value.items():
+            where = (*path, key)
+            response = responses.get(key)
+            if response is None:
+                if key not in self.ctx.broken:
+                    self.error(where, f"unknown command {key!r} (or it has no response)")
+                continue
+            for index, name in enumerate(item.get("after") or ()):
+                if name not in requests:
+                    self.error((*where, "after", index), f"unknown command {name!r} (or it has no request)")
+            for index, name in enumerate(item.get("changes") or ()):
+                self.known(str(name), variables, (*where, "changes", index), "memory entry or state variable")
+            if "while" in item:
+                self.known(str(item["while"]), variables, (*where, "while"), "memory entry or state variable")
+            if not any(k in item for k in ("every", "after", "changes")):
+                self.error(where, "says not when: give `every`, `after` or `changes`")
+            fields = {f.name for f in response.fields}
+            values = {}
+            for name, source in (item.get("values") or {}).items():
+                if self.known(str(name), fields, (*where, "values", name), f"{response.command} response field"):
+                    parsed = self.expression(source, (*where, "values", name), (variables,))
+                    if parsed is not None:
+                        values[str(name)] = parsed
+            found.append(
+                Unsolicited(
+                    str(key),
+                    int(item.get("every", 0)),
+                    tuple(str(n) for n in item.get("after") or ()),
+                    tuple(str(n) for n in item.get("changes") or ()),
+                    str(item.get("while", "")),
+                    values,
+                    str(item.get("description", "")),
+                )
+            )
+        return tuple(found)
 
     def id_bounds(
         self, value: dict[str, Any], address: str, framing: Framing, commands: list[Command]

@@ -37,6 +37,9 @@ class FramingPass(FieldResolver):
         return self.problems
 
     def framing(self, value: dict[str, Any], path: Path) -> Framing:
+        for key in ("start", "separator", "end", "checksum", "talker", "max_length"):
+            if key in value:
+                self.error((*path, key), f"`{key}` belongs to text frames: add `kind: text`")
         if "layouts" in value and "elements" in value:
             raise self.fail(path, "give either `elements` (one layout) or `layouts` (alternatives), not both")
         if "layouts" in value:

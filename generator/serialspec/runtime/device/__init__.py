@@ -28,6 +28,10 @@ pseudo-terminal) and is the same for every protocol:
   that writes a read-only space gets the protocol's error reply (Modbus exceptions 3 and 2);
 - a `timeout`: a device that has had none of its keep-alive requests for a while sets state variables (VESC
   releases its motor when setpoints stop coming);
+- `derived` entries read as an expression of others (a present position with a homing offset added), and `locks`
+  refuse writes to entries while a value is non-zero (EEPROM while the torque is on: `errors.locked`);
+- `sends`: messages a device sends on its own, periodically, after some requests or when values change, while
+  it keeps answering requests (`due()` gives them; the server sends them at their time);
 - `emit()` sends a message on the device's own initiative (reports, key events) for tests.
 """
 
@@ -40,6 +44,7 @@ from serialspec.runtime.device.engine import (
     KindSpec,
     ModelSpec,
     RunSpec,
+    SendSpec,
     SpaceSpec,
     TimeoutSpec,
     VirtualDevice,
@@ -58,6 +63,7 @@ __all__ = [
     "KindSpec",
     "ModelSpec",
     "RunSpec",
+    "SendSpec",
     "Simulator",
     "SpaceSpec",
     "TimeoutSpec",

@@ -121,6 +121,28 @@ class CommandSpec:
     cancel_when: dict[str, float] = field(default_factory=dict)  # with releases: the values that drop them
     carries: tuple[str, str] | None = None  # (code field, content field): another command's request content
     refusal: type[Message] | None = None  # the reply of another command a refused request gets (`refused_by`)
+    # moves: where the state goes, a function of `get` (request fields, then memory and state); default: the target
+    move_to: Callable[[Callable[[str], float]], float] | None = None
+
+
+@dataclass(frozen=True)
+class SendSpec:
+    """A message a device sends on its own (`device.sends`): every `every` seconds, after a reply to one of the
+    `after` requests, or when one of the `changes` values changes; only while `while_` is non-zero (when given)."""
+
+    response: type[Message]
+    every: float = 0.0
+    after: tuple[type[Message], ...] = ()
+    changes: tuple[str, ...] = ()
+    while_: str = ""
+    # field -> the state variable or memory entry it holds, or a function of `get` (as CommandSpec.reports)
+    values: dict[str, str | Callable[[Callable[[str], float]], float]] = field(default_factory=dict)
+    blanks: dict[str, Any] = field(default_factory=dict)  # as CommandSpec.blanks
+
+    @property
+    def command(self) -> CommandSpec:
+        """The message built as a reply is: its values, then the device's id, `reply` values, blanks."""
+        return CommandSpec(self.response, self.response, reports=self.values, blanks=self.blanks)
 
 
 @dataclass(frozen=True)
@@ -179,6 +201,10 @@ class DeviceSpec:
     moving: dict[str, tuple[str, int | None]] = field(default_factory=dict)  # entry -> (state variable, bit)
     # command code -> the codec's decoder of that request's content (buf, start, end), for requests carried by another
     carried: dict[int, Callable[[bytes, int, int], Message]] = field(default_factory=dict)
+    # memory entry -> what it reads as, a function of `get` (DYNAMIXEL present_position: position + homing_offset)
+    derived: dict[str, Callable[[Callable[[str], float]], float]] = field(default_factory=dict)
+    locks: dict[str, str] = field(default_factory=dict)  # memory entry -> variable: not writable while non-zero
+    sends: tuple[SendSpec, ...] = ()  # what the devices send on their own
 
     def model(self, name: str | None) -> ModelSpec | None:
         """The model of this name (None: the default one); a ValueError names the known models."""
@@ -273,7 +299,11 @@ class VirtualDevice:
         self.memory.update(kept)
 
     def get(self, name: str) -> float:
-        """A state variable or memory entry, with any motion in progress taken into account."""
+        """A state variable or memory entry, with any motion in progress taken into account; a derived entry is
+        what its expression gives."""
+        derive = self.spec.derived.get(name)
+        if derive is not None:
+            return derive(self.get)
         motion = self.motions.get(name)
         if motion is not None:
             value = motion.value(self.clock())
@@ -313,6 +343,9 @@ class VirtualDevice:
             return "out_of_space"
         if entry.access == "r":
             return "read_only"
+        locker = self.spec.locks.get(entry.name)
+        if locker and self.get(locker):
+            return "locked"
         if not isinstance(value, int | float):
             return "out_of_range"
         return "" if entry.minimum <= value <= entry.maximum else "out_of_range"
@@ -364,6 +397,13 @@ class Engine(FaultInjection):
         self.log: list[Message] = []  # every request received, in order
         self._lock = threading.Lock()
         self._answering_as: Fault | None = None  # an other_id fault while the reply it spoils is built
+        # sends: (device, index) -> when the next periodic one is due, and the watched values last sent with (by
+        # the device itself, whose id a request may change)
+        self._next_send: dict[tuple[VirtualDevice, int], float] = {}
+        self._watched: dict[tuple[VirtualDevice, int], tuple[float | None, ...]] = {}
+        for device in self.devices.values():
+            for index, send in enumerate(spec.sends):
+                self._watched[device, index] = tuple(self._value(device, n) for n in send.changes)
         FaultInjection.__init__(self)
 
     # --- requests -------------------------------------------------------------------------------------------------
@@ -392,6 +432,77 @@ class Engine(FaultInjection):
                 for when, frame in replies:
                     out.extend([(when, frame)] if answered_as is not None else self._spoil(when, frame))
         return out
+
+    # --- messages sent on the device's own initiative ---------------------------------------------------------------
+
+    def due(self) -> list[tuple[float, bytes]]:
+        """The messages the devices send on their own now (`sends`): periodic ones whose time has come (one per
+        call, however many periods went by), and those whose watched values changed since they were last sent."""
+        out: list[tuple[float, bytes]] = []
+        with self._lock:
+            now = self.clock()
+            for device in list(self.devices.values()):
+                for index, send in enumerate(self.spec.sends):
+                    key = (device, index)
+                    sending = False
+                    if send.every:
+                        next_time = self._next_send.get(key, now)
+                        if next_time <= now:
+                            sending = True
+                            # the next one a period on, or a period from now when the clock jumped further
+                            following = next_time + send.every
+                            self._next_send[key] = following if following > now else now + send.every
+                    if send.changes:
+                        values = tuple(self._value(device, n) for n in send.changes)
+                        if values != self._watched.get(key):
+                            self._watched[key] = values
+                            sending = True
+                    frame = self._sent(device, send) if sending else None
+                    if frame is not None:
+                        out.append((now, frame))
+        return out
+
+    def _value(self, device: VirtualDevice, name: str) -> float | None:
+        """A watched value; None where an expression of the spec has none (a division by a value written as 0)."""
+        try:
+            return device.get(name)
+        except (ZeroDivisionError, ValueError):
+            return None
+
+    def _sent(self, device: VirtualDevice, send: SendSpec) -> bytes | None:
+        """The message a device sends on its own, if `while_` lets it; where an expression of the spec has no value
+        (a division by a value written as 0), nothing is sent and one line says why, as for a reply."""
+        try:
+            if send.while_ and not device.get(send.while_):
+                return None
+            return self._reply(device, send.command, {}, "")
+        except (ZeroDivisionError, ValueError) as exc:
+            LOG.warning(
+                "simulator: no %s sent: a value of the spec has no value here (%s)", send.response.__name__, exc
+            )
+            return None
+
+    def next_due(self) -> float | None:
+        """When due() next has something periodic to send (None: nothing is periodic); watched values are polled
+        every 10 ms."""
+        times = [t for t in self._next_send.values()]
+        if any(
+            s.every and (d, n) not in self._next_send
+            for n, s in enumerate(self.spec.sends)
+            for d in self.devices.values()
+        ):
+            times.append(self.clock())
+        if any(s.changes for s in self.spec.sends):
+            times.append(self.clock() + 0.01)
+        return min(times) if times else None
+
+    def _sent_after(self, device: VirtualDevice, request: Message) -> list[bytes]:
+        """The messages a device sends on its own after answering this request (`sends: after`)."""
+        frames = []
+        for send in self.spec.sends:
+            frame = self._sent(device, send) if isinstance(request, send.after) else None
+            frames += [frame] if frame is not None else []
+        return frames
 
     def tick(self) -> None:
         """Let the timeout of every device expire that is due (requests do this too, as they arrive)."""
@@ -444,6 +555,9 @@ class Engine(FaultInjection):
                 if frame is not None and (not broadcast or command.broadcast_reply):
                     delay = float(getattr(request, command.after, 0)) / 1000 if command.after else 0.0
                     replies.append((self.clock() + delay, frame))
+            if self.spec.sends and not command.kind:
+                at = max((when for when, _ in replies), default=self.clock())
+                replies += [(at, frame) for device in targets for frame in self._sent_after(device, request)]
         return replies
 
     def _acted(
@@ -538,7 +652,7 @@ class Engine(FaultInjection):
         for name, run in command.space_writes.items():
             self._write_space(device, run, given[name], given)
         if command.moves and (not command.move_enabled_by or device.get(command.move_enabled_by)):
-            self._move(device, command.moves, given, written, command.ramp, command.speed_scale)
+            self._move(device, command, given, written)
         for name, state in command.stores.items():
             device.set(state, given[name])
         for state, value in command.sets.items():
@@ -674,21 +788,15 @@ class Engine(FaultInjection):
             stored = run.value(current, given) if run.value is not None else int(item)
             items[start + offset] = (1 if stored else 0) if space.bits else stored & space.maximum
 
-    def _move(
-        self,
-        device: VirtualDevice,
-        moves: tuple[str, str, str, str],
-        given: dict[str, Any],
-        written: set[str],
-        ramp: tuple[str, str] | None = None,
-        speed_scale: float = 1.0,
-    ) -> None:
+    def _move(self, device: VirtualDevice, command: CommandSpec, given: dict[str, Any], written: set[str]) -> None:
         """Start a move to the target: a request field, or a memory entry this command has just written.
 
         With a ramp, the speed rises over the acceleration time and falls over the deceleration time; a move at a
         speed then lasts distance / speed plus half of each ramp, so that it cruises at that speed.
         """
-        state, target, duration_name, speed_name = moves
+        assert command.moves is not None
+        state, target, duration_name, speed_name = command.moves
+        ramp, speed_scale = command.ramp, command.speed_scale
         if target not in given and target not in written:
             return
 
@@ -696,7 +804,7 @@ class Engine(FaultInjection):
             return float(given[name] if name in given else device.get(name))
 
         accel, decel = (value(ramp[0]) / 1000, value(ramp[1]) / 1000) if ramp else (0.0, 0.0)
-        goal = value(target)
+        goal = command.move_to(value) if command.move_to is not None else value(target)
         if duration_name and value(duration_name):
             duration = value(duration_name) / 1000
         elif speed_name and value(speed_name):
@@ -772,14 +880,13 @@ class Engine(FaultInjection):
             return ""
         if table[:1] == ("block",):
             block = given[name]
-            ok = all(
-                device.writable(device.by_name.get(n), block[n]) or device.by_name[n].access == "r" for n in table[1:]
-            )
-            if ok:
+            reasons = [device.refusal(device.by_name.get(n), block[n]) for n in table[1:]]
+            reasons = [r for r in reasons if r and r != "read_only"]  # a block's read-only entries are skipped
+            if not reasons:
                 for n in table[1:]:
                     if device.by_name[n].access != "r":
                         device.set(n, block[n])
-            return "" if ok else "out_of_range"
+            return next((r for r in reasons if r != "out_of_range"), reasons[0] if reasons else "")
         device.set(name, given[name])
         return ""
 

@@ -59,11 +59,18 @@ class Simulator(Engine):
 
     def serve(self, fd: int) -> None:
         """Answer requests read from `fd` until stop(); replies are written at their time (no polling)."""
+        sends = bool(self.spec.sends)
         while not self._stop.is_set():
+            if sends:
+                for when, frame in self.due():
+                    self._seq += 1
+                    heapq.heappush(self._outbox, _Scheduled(when, self._seq, frame))
             now = self.clock()
             while self._outbox and self._outbox[0].when <= now:
                 os.write(fd, heapq.heappop(self._outbox).data)
-            wait = max(0.0, self._outbox[0].when - now) if self._outbox else None
+            times = [self._outbox[0].when] if self._outbox else []
+            times += [t for t in [self.next_due() if sends else None] if t is not None]
+            wait = max(0.0, min(times) - now) if times else None
             readable, _, _ = select.select([fd, self._wake_r], [], [], wait)
             if self._wake_r in readable:
                 os.read(self._wake_r, 64)

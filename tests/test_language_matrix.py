@@ -424,6 +424,23 @@ CASES["frame: transparency, checksum over exactly the span"] = Case(
         },
     },
 )
+# Plain frame values: a sequence number the client fills in, a flags byte given in every message
+CASES["frame: plain values, a sequence"] = Case(
+    {"v": "u16"},
+    {"w": "u8"},
+    {
+        "elements": {
+            "header": {"role": "header", "value": HEADER},
+            "id": {"role": "address", "type": "u8", "range": [0, 253], "broadcast": 254},
+            "seq": {"role": "value", "type": "u16", "endian": "big", "range": [1, 999], "sequence": True},
+            "flags": {"role": "value", "type": "u8"},
+            "code": {"role": "command", "type": "u8"},
+            "length": {"role": "length", "type": "u8"},
+            "content": {"role": "content"},
+            "checksum": {"role": "checksum", "type": "u8", "algorithm": "sum", "covers": ["id", "content"]},
+        }
+    },
+)
 # Requests that share a code, told apart by their content size (0, 2, 3 or more bytes), in the usual frame and in
 # one the frame engine reads
 SHARED_CODE = {

@@ -248,3 +248,82 @@ def test_mistakes_are_named(change: tuple[str, str], message: str) -> None:
     with pytest.raises(SpecErrors) as caught:
         resolve(load_text(SPEC.replace(*change, 1), "acks.yaml"))
     assert message in str(caught.value)
+
+
+SEQUENCED = """
+protocol: sequenced
+title: Frames numbered by the client
+byte_order: little
+serial: {baudrate: 115200}
+framing:
+  elements:
+    header: {role: header, value: AA 55}
+    seq: {role: value, type: u8, range: [0, 2], sequence: true}
+    flags: {role: value, type: u8}
+    code: {role: command, type: u8}
+    length: {role: length, type: u8}
+    content: {role: content}
+    checksum: {role: checksum, type: u8, algorithm: xor, covers: [seq, content]}
+matching:
+  by: [seq, command]
+commands:
+  read:
+    code: 1
+    request:
+      fields:
+        index: u8
+    response:
+      fields:
+        value: u16
+device:
+  state: {value: 0}
+  commands:
+    read: {reports: {value: value}}
+"""
+
+
+def sequenced_frame(seq: int, flags: int, code: int, content: bytes) -> bytes:
+    body = bytes([seq, flags, code, len(content)]) + content
+    check = 0
+    for byte in body:
+        check ^= byte
+    return b"\xaa\x55" + body + bytes([check])
+
+
+def test_a_plain_frame_value_and_a_sequence_the_client_fills_in() -> None:
+    """`flags` is a plain value (given, and the simulator's reply repeats it); `seq` counts 0, 1, 2, 0 ... per request
+    and a reply is matched by it: one with an old number is not taken."""
+    with package(SEQUENCED, "sequenced") as sequenced:
+        m = sequenced.messages
+        message = m.ReadRequest(seq=2, flags=0x81, index=7)
+        assert sequenced.decode(sequenced.encode(message), "request") == message
+        simulator = importlib.import_module("sequenced.simulator").SequencedSimulator(ids=[0])
+        path = simulator.start()
+        try:
+            with importlib.import_module("sequenced.client").SequencedClient(path, timeout=1.0) as client:
+                assert [client.read(0x81, 1) for _ in range(2)] == [0, 0]
+        finally:
+            simulator.close()
+        controller, device = os.openpty()
+        tty.setraw(device)
+        try:
+            with importlib.import_module("sequenced.client").SequencedClient(os.ttyname(device), timeout=1.0) as client:
+                sent = []
+                for number in range(4):
+                    # a late reply of the request before first (numbered one less), then this one's
+                    late = sequenced_frame((number + 2) % 3, 0, 1, (1000 + number).to_bytes(2, "little"))
+                    answer = sequenced_frame(number % 3, 0, 1, number.to_bytes(2, "little"))
+
+                    def run(late: bytes = late, answer: bytes = answer) -> None:
+                        sent.append(os.read(controller, 64))
+                        os.write(controller, late + answer)
+
+                    thread = threading.Thread(target=run, daemon=True)
+                    thread.start()
+                    assert client.read(5, 9) == number
+                    thread.join()
+                assert [frame[2] for frame in sent] == [0, 1, 2, 0]  # seq: wraps past its range
+                assert {frame[3] for frame in sent} == {5}  # flags as given
+        finally:
+            os.close(controller)
+            os.close(device)

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define DYNAMIXEL_P2_SPEC_SHA256 "86b8a8055819338b56fe67a1d64284b531d80f637fd13eb6a10ab7696a26ffa0"
+#define DYNAMIXEL_P2_SPEC_SHA256 "fb89190953f44d0ab2e0f78435e21aa98040709c7ae657b932165888ab5ba3f9"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef DYNAMIXEL_P2_ENABLE_ENCODE

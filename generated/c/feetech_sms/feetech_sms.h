@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define FEETECH_SMS_SPEC_SHA256 "50799b5fdc9da692a8e206f719e4ad881d15f057d49bcebad520e0f298c40278"
+#define FEETECH_SMS_SPEC_SHA256 "91001ab0fdbc9cd3ee75350476d69167c6187639819ce3c126cbc1f9f0d92ebd"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef FEETECH_SMS_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define HIWONDER_RRC_SPEC_SHA256 "cfa789e98d7941b6841e87121ada8b505a29bb9d0988d7c95f66d75f3dbed0ac"
+#define HIWONDER_RRC_SPEC_SHA256 "cb4b7f68cb06fce185224a256bc0752264828922139b3bf0bc450087be8592eb"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef HIWONDER_RRC_ENABLE_ENCODE

@@ -3096,7 +3096,7 @@ local function frame_size(direction, layout, data, pos)
     elseif element.role == "command" then
       entry = entry_of(direction, unsigned(bytes, element.big))
       if entry == nil then return nil end
-    elseif element.role == "address" or element.role == "status" then
+    elseif element.role == "address" or element.role == "status" or element.role == "value" then
       if not plausible(element, unsigned(bytes, element.big)) then return nil end
     end
   end

@@ -704,8 +704,20 @@ FRAME_ELEMENT = Obj(
     {
         "role": Str(
             "What the element is: constant bytes (header first, trailer last, constant anywhere, e.g. a reserved "
-            "byte), a frame-level value (address, command, status), the length, the content or a checksum.",
-            choices=("header", "trailer", "constant", "command", "length", "content", "checksum", "address", "status"),
+            "byte), a frame-level value (address, command, status, or a plain `value` every message carries: a "
+            "sequence number, a flags byte), the length, the content or a checksum.",
+            choices=(
+                "header",
+                "trailer",
+                "constant",
+                "command",
+                "length",
+                "content",
+                "checksum",
+                "address",
+                "status",
+                "value",
+            ),
         ),
         "type": Str("Wire type of a value, length or checksum (default u8).", choices=SCALAR_TYPES),
         "endian": Str(
@@ -734,6 +746,13 @@ FRAME_ELEMENT = Obj(
         "description": TEXT,
         "range": RANGE,
         "broadcast": Int("address: the broadcast value."),
+        "sequence": Bool(
+            "value: a sequence number the client fills in: 0 in its first request, one more in each request after "
+            "it, back to 0 past the element's largest value. A reply repeats it; name it in `matching.by` to match "
+            "replies by it.",
+            default=False,
+            example=True,
+        ),
         "flags": Str("status: name of an entry in `flags:`."),
         "bits": bit_fields(
             "status (or address): bit fields packed into the element (DYNAMIXEL: alert bit 7, error number 6..0)."

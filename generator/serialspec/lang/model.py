@@ -419,6 +419,9 @@ class Checksum:
     name: str = ""  # the frame element holding it
 
 
+VALUE_ROLES = ("address", "status", "value")  # frame elements whose value every message of the frame carries
+
+
 @frozen
 class FrameElement:
     name: str
@@ -438,6 +441,7 @@ class FrameElement:
     counts: tuple[str, str] = ("", "")  # length: the first and last element counted
     adds: int = 0  # length: added to the counted size
     checksum: Checksum | None = None  # checksum: what it is and what it covers
+    sequence: bool = False  # value: a sequence number the client fills in (one more per request, wrapping)
 
     @property
     def fixed(self) -> bool:
@@ -475,7 +479,7 @@ class FrameLayout:
     checksum_offset_from_end: int
     covered_from: int  # first covered byte
     covered_to_end: int  # bytes after the last covered byte
-    value_elements: tuple[FrameElement, ...]  # address/status: frame-level values every message carries
+    value_elements: tuple[FrameElement, ...]  # address/status/value: frame-level values every message carries
     name: str = ""  # the layout's name among alternatives ("" for the one layout)
     transparency: Transparency | None = None
     checksums: tuple[Checksum, ...] = ()

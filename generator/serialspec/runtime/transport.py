@@ -974,6 +974,15 @@ class ClientState:
         # written (emptied whenever they change): what a read sent again asks, without a call
         self._due: dict[tuple[Any, ...], bool] = {}
         self._read_was_optional = False  # the parameter read under way asked whether its own reply is due
+        self._sequences: dict[str, int] = {}  # frame value -> the last sequence number sent in it
+
+    def _sequence(self, name: str, low: int, high: int) -> int:
+        """The next sequence number of a frame value the client fills in: `low` first, then one more each time,
+        back to `low` past `high`."""
+        last = self._sequences.get(name)
+        value = low if last is None or last >= high else last + 1
+        self._sequences[name] = value
+        return value
 
     def close(self) -> None:
         self.bus.close()

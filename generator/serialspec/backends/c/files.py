@@ -21,7 +21,7 @@ from serialspec.backends.c.emit import (
     value_elements,
 )
 from serialspec.backends.c.engine import ENGINE
-from serialspec.lang.model import Direction, FrameLayout, Message, Protocol, size_terms
+from serialspec.lang.model import VALUE_ROLES, Direction, FrameLayout, Message, Protocol, size_terms
 
 DIRECTIONS = (Direction.REQUEST, Direction.RESPONSE)
 
@@ -227,6 +227,7 @@ def layout_tables(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) -
             "constant": "CONSTANT",
             "address": "VALUE",
             "status": "VALUE",
+            "value": "VALUE",
             "command": "COMMAND",
             "length": "LENGTH",
             "content": "CONTENT",
@@ -239,7 +240,7 @@ def layout_tables(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) -
         if e.role == "checksum" and e.checksum is not None:
             first, last = names.index(e.checksum.first), names.index(e.checksum.last)
             check = ctx.check_index(e.checksum)
-        value = e.role in ("address", "status", "command")
+        value = e.role in (*VALUE_ROLES, "command")
         minimum = int(e.minimum) if value else 0
         maximum = int(e.maximum) if value else 0
         also = e.broadcast if value and e.broadcast is not None else None
@@ -281,7 +282,7 @@ def layout_tables(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) -
         offset = 0
         for e in layout.elements:
             narrowed = e.type is not None and (e.minimum, e.maximum) != (e.type.minimum, e.type.maximum)
-            if e.role in ("length", "command") or (e.role in ("address", "status") and narrowed):
+            if e.role in ("length", "command") or (e.role in VALUE_ROLES and narrowed):
                 prefix = max(prefix, offset + (e.size or 0))
             offset += e.size or 0
             if e.role == "content":
@@ -370,7 +371,7 @@ def straight_unwrap(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout)
         value = _wire_value(start[i], sizes[i], e.endian == ">")
         if e.role == "command":
             lines.append(f"    *code = {value}; /* {e.name} */")
-        elif e.role in ("address", "status"):
+        elif e.role in VALUE_ROLES:
             assert e.type is not None
             test = []
             if int(e.minimum) > 0:

@@ -399,6 +399,10 @@ def frame_context(protocol: Protocol, layout: FrameLayout) -> dict[str, Any]:
         elif e.role == "checksum" and not layout.classic and e.checksum is not None:
             endian = "big-endian" if e.endian == ">" else "little-endian"
             description = f"over `{e.checksum.first}`..`{e.checksum.last}`, {endian}. {e.description}"
+        elif e.sequence:
+            low, high = number(e.minimum), number(e.maximum)
+            counts = f"sequence number the client fills in: {low} first, one more per request, {low} again after {high}"
+            description = ". ".join(p for p in (counts, e.description) if p)
         else:
             description = e.description
         kind = e.type.name if e.type else ("bytes" if e.fixed else "n bytes")

@@ -402,6 +402,12 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
     tables = table_commands(protocol)
     writers = {t["writer"]: t for t in tables}
     groups: dict[str, dict[str, Any]] = {}
+    # frame values the client fills in, one more per request: name -> the call that gives the next
+    sequences = {
+        e.name: f"self._sequence({e.name!r}, {number(e.minimum)}, {number(e.maximum)})"
+        for e in protocol.framing.layouts[Direction.REQUEST].value_elements
+        if e.sequence
+    }
     for request, response in request_response_pairs(protocol):
         command = protocol.command(request.command)
         sub = next((s for s in command.subcommands if s.name == request.subcommand), None)
@@ -420,6 +426,8 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
         pairs = []
         singles = []
         for f in fields:
+            if f.name in sequences:
+                continue  # the client fills it in
             imports.update(type_names(f))
             default = f" = {defaults[f.name]}" if f.name in defaults else ""
             pair = pair_group(f)
@@ -450,7 +458,7 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
             doc.append("Broadcast: " + one_line(command.broadcast))
         doc.append("")
         doc.append("Args:")
-        doc.extend(f"    {f.name}: {describe(f)}" for f in fields)
+        doc.extend(f"    {f.name}: {describe(f)}" for f in fields if f.name not in sequences)
         doc.extend(
             f"    ({p['name']} also takes a mapping {{{p['first']}: {p['second']}}}, one entry per item.)"
             for p in pairs
@@ -528,7 +536,7 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
             "doc": doc,
             "request": request.class_name,
             "response": response.class_name if response else "",
-            "build": ", ".join(f"{f.name}={f.name}" for f in fields),
+            "build": ", ".join(f"{f.name}={sequences.get(f.name, f.name)}" for f in fields),
             "kind": kind,
             "silent": silent,
             "optional": f"({optional.key}, {optional.equals}, {optional.op!r})" if optional else "None",

@@ -16,6 +16,7 @@ from serialspec.backends.common.render import render
 from serialspec.cli.views import engineering_unit
 from serialspec.lang.frozen import frozen
 from serialspec.lang.model import (
+    VALUE_ROLES,
     Array,
     BitField,
     Bytes,
@@ -148,7 +149,7 @@ def _layout(layout: FrameLayout) -> dict[str, Any]:
         item["big"] = element.endian == ">"
         if element.fixed:
             item["constant"] = element.constant
-        if element.role in ("address", "status", "command"):
+        if element.role in (*VALUE_ROLES, "command"):
             item["min"], item["max"] = int(element.minimum), int(element.maximum)
             if element.broadcast is not None:
                 item["broadcast"] = element.broadcast

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define DYNAMIXEL_P2_SPEC_SHA256 "fb89190953f44d0ab2e0f78435e21aa98040709c7ae657b932165888ab5ba3f9"
+#define DYNAMIXEL_P2_SPEC_SHA256 "4b8258a3f35a91e2da0c6c433773a2937a75fb883b659722632bb41a1c4d919a"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef DYNAMIXEL_P2_ENABLE_ENCODE

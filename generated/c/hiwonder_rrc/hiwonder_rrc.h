@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define HIWONDER_RRC_SPEC_SHA256 "cb4b7f68cb06fce185224a256bc0752264828922139b3bf0bc450087be8592eb"
+#define HIWONDER_RRC_SPEC_SHA256 "ad7ad0eb212f153f9107f4f2f265ea78067274f47fae26f640ade7a2270ee0f5"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef HIWONDER_RRC_ENABLE_ENCODE

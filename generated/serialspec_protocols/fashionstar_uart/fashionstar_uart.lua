@@ -329,7 +329,7 @@ local SPEC = {
               size = 1,
               big = false,
               span = {1, 4},
-              checksum = {algorithm = "sum", invert = false},
+              checksum = {algorithm = "sum", invert = false, negate = false},
               description = "(sum of bytes 0 .. 4+n-1) mod 256.",
             },
           },
@@ -1406,7 +1406,7 @@ local SPEC = {
               size = 1,
               big = false,
               span = {1, 4},
-              checksum = {algorithm = "sum", invert = false},
+              checksum = {algorithm = "sum", invert = false, negate = false},
               description = "(sum of bytes 0 .. 4+n-1) mod 256.",
             },
           },
@@ -2358,7 +2358,12 @@ local CHECKSUMS = {
     for i = 1, #data do
       total = (total + data:byte(i)) % (mask + 1)
     end
-    return spec.invert and mask - total or total
+    if spec.invert then
+      total = mask - total
+    elseif spec.negate then
+      total = (mask + 1 - total) % (mask + 1)
+    end
+    return spec.mask and band(total, spec.mask) or total
   end,
 }
 
@@ -2690,6 +2695,18 @@ local function wire_of(layout, plain, stuffed, first, last)
   return table.concat(plain, "", first, t.first - 1) .. stuffed .. table.concat(plain, "", t.last + 1, last)
 end
 
+local function covered_by(layout, plain, stuffed, element)
+  -- the bytes a checksum covers: its span's, less the elements it leaves out (checksums inside it, never stuffed)
+  if element.skip == nil then
+    return wire_of(layout, plain, stuffed, element.span[1], element.span[2])
+  end
+  local parts = {}
+  for i = element.span[1], element.span[2] do
+    if not element.skip[i] then parts[#parts + 1] = plain[i] end
+  end
+  return table.concat(parts)
+end
+
 local function decode_content(message, range, length, tree)
   local content = length > 0 and range:tvb() or nil
   if content == nil and #message.fields > 0 then
@@ -2807,7 +2824,7 @@ local function dissect_frame(direction_name, direction, layout, entry, tvb, data
         end
       elseif role == "checksum" then
         local expected = not element.checksum.unverified and checksum(element.checksum, element.size,
-          wire_of(layout, plain, stuffed, element.span[1], element.span[2]))
+          covered_by(layout, plain, stuffed, element))
         if not expected then
           item:append_text(" [not verified: this dissector has no code for algorithm " .. element.checksum.algorithm
             .. "]")

@@ -3142,6 +3142,18 @@ local function wire_of(layout, plain, stuffed, first, last)
   return table.concat(plain, "", first, t.first - 1) .. stuffed .. table.concat(plain, "", t.last + 1, last)
 end
 
+local function covered_by(layout, plain, stuffed, element)
+  -- the bytes a checksum covers: its span's, less the elements it leaves out (checksums inside it, never stuffed)
+  if element.skip == nil then
+    return wire_of(layout, plain, stuffed, element.span[1], element.span[2])
+  end
+  local parts = {}
+  for i = element.span[1], element.span[2] do
+    if not element.skip[i] then parts[#parts + 1] = plain[i] end
+  end
+  return table.concat(parts)
+end
+
 local function decode_content(message, range, length, tree)
   local content = length > 0 and range:tvb() or nil
   if content == nil and #message.fields > 0 then
@@ -3259,7 +3271,7 @@ local function dissect_frame(direction_name, direction, layout, entry, tvb, data
         end
       elseif role == "checksum" then
         local expected = not element.checksum.unverified and checksum(element.checksum, element.size,
-          wire_of(layout, plain, stuffed, element.span[1], element.span[2]))
+          covered_by(layout, plain, stuffed, element))
         if not expected then
           item:append_text(" [not verified: this dissector has no code for algorithm " .. element.checksum.algorithm
             .. "]")

@@ -759,7 +759,10 @@ FRAME_ELEMENT = Obj(
         ),
         "covers": span(
             "checksum: the span of elements covered. Outside a transparency span it sees the wire bytes, inside "
-            "it the bytes before stuffing.",
+            "it the bytes before stuffing. Checksums strictly inside the span (itself too) are left out of it "
+            "(HerkuleX: `checksum1` in the header covers [size, data]); one at an end is covered, so a checksum "
+            "can be computed from another that comes before it (HerkuleX `checksum2: {algorithm: xor, invert: "
+            "true, mask: 0xFE, covers: [checksum1, checksum1]}`).",
         ),
         **checksum_keys(),
     },
@@ -1081,6 +1084,14 @@ DEVICE_COMMAND = Obj(
         ),
         "kind": Str("The entry of `kinds:` whose devices the command addresses (default: the devices of --id)."),
         "stores": MapOf(Str(), "Request field -> the state variable it is stored in (where names differ)."),
+        "echoes": ListOf(
+            Str(),
+            "Response fields that repeat the request's field of the same name (a write's reply confirming what was "
+            "written: Modbus WRITE SINGLE REGISTER). Other response fields never copy the request: they come from "
+            "the device (its reads, reports, `reply`, memory and state) or else the field's `default` (else 0); "
+            "the fields replies are matched by (`matching.by`), the address and a table value's key echo anyway.",
+            example=["address", "value"],
+        ),
         "sets": MapOf(Num(), "State variable -> the value the command sets it to."),
         "absent": MapOf(
             Num(),

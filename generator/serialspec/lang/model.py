@@ -417,6 +417,7 @@ class Checksum:
     type: ScalarType
     endian: Literal["<", ">"] = "<"
     name: str = ""  # the frame element holding it
+    skips: tuple[str, ...] = ()  # elements inside first..last left out: itself, and the checksums strictly inside
 
 
 VALUE_ROLES = ("address", "status", "value")  # frame elements whose value every message of the frame carries
@@ -677,6 +678,7 @@ class Behaviour:
     carries: tuple[str, str] | None = None  # (command code field, content field) of a carried request
     carried: tuple[str, ...] = ()  # the commands it can carry (empty: every command with a code)
     nothing_held: dict[str, float] = field(default_factory=dict)  # commits: reply values when nothing is held
+    echoes: tuple[str, ...] = ()  # response fields that repeat the request's field of the same name
 
 
 @frozen

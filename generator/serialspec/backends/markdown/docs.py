@@ -31,6 +31,7 @@ from serialspec.lang.model import (
     ErratumCheck,
     Example,
     Field,
+    FrameElement,
     FrameLayout,
     Group,
     List,
@@ -169,7 +170,7 @@ def message_context(protocol: Protocol, message: Message | None) -> dict[str, An
     content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
     size = size_text(message.min_size, message.max_size, content_limit(layout))
     rows = [
-        Row(str(layout.offsets[e.name]), e.name, e.type.name if e.type else "", "", "", e.description)
+        Row(_value_offset(layout, e), e.name, e.type.name if e.type else "", "", "", e.description)
         for e in layout.value_elements
     ]
     rows += field_rows(message.fields, content_offset)
@@ -207,6 +208,15 @@ def shared_request_text(protocol: Protocol, message: Message) -> str:
         return ""
     names = ", ".join(f"`{name}`" for name in others)
     return f"shares code {code:#04x} with {names}, told apart by the content size"
+
+
+def _value_offset(layout: FrameLayout, element: FrameElement) -> str:
+    """Where a frame-level value sits: its offset, or (after a content whose size varies) its place from the end."""
+    if element.name in layout.offsets:
+        return str(layout.offsets[element.name])
+    index = layout.elements.index(element)
+    back = sum(e.size or 0 for e in layout.elements[index:])
+    return f"{back} from the end"
 
 
 def device_rule_text(protocol: Protocol, name: str) -> str:
@@ -398,7 +408,9 @@ def frame_context(protocol: Protocol, layout: FrameLayout) -> dict[str, Any]:
             description = " — ".join(p for p in (e.constant.hex(" ").upper(), e.description) if p)
         elif e.role == "checksum" and not layout.classic and e.checksum is not None:
             endian = "big-endian" if e.endian == ">" else "little-endian"
-            description = f"over `{e.checksum.first}`..`{e.checksum.last}`, {endian}. {e.description}"
+            left_out = ", ".join(f"`{name}`" for name in e.checksum.skips)
+            skips = f" leaving out {left_out}" if left_out else ""
+            description = f"over `{e.checksum.first}`..`{e.checksum.last}`{skips}, {endian}. {e.description}"
         elif e.sequence:
             low, high = number(e.minimum), number(e.maximum)
             counts = f"sequence number the client fills in: {low} first, one more per request, {low} again after {high}"
@@ -414,9 +426,11 @@ def frame_context(protocol: Protocol, layout: FrameLayout) -> dict[str, Any]:
             kind += f" = bytes `{e.counts[0]}`..`{e.counts[1]}` as sent{adds}{endian}"
         where = f"{offset}.." if size is None else (str(offset) if size == 1 else f"{offset}..{offset + size - 1}")
         if e.role in ("checksum",) or (offset is None):
-            where = "last" if e.role == "checksum" else where
+            where = "last" if e.role == "checksum" and e.name not in layout.offsets else where
         if variable and e.role not in ("content", "checksum"):
             where = "after the content" if e.role == "trailer" or layout.offsets.get(e.name) is None else where
+        if e.role in ("address", "status", "command", "length") and e.name not in layout.offsets:
+            where = _value_offset(layout, e)  # after a content whose size varies
         rows.append(
             {
                 "offset": cell(where),
@@ -475,6 +489,11 @@ def checksum_context(protocol: Protocol, general: Checksum | None = None) -> dic
         "what": checksum.algorithm.describe(),
         "first": checksum.first,
         "last": checksum.last,
+        "skips": (
+            " but for " + ", ".join(f"`{name}`" for name in checksum.skips) + " (checksums inside the span)"
+            if checksum.skips
+            else ""
+        ),
         "worked": worked,
         "params": checksum.algorithm.parameters(),
     }
@@ -493,7 +512,9 @@ def general_worked(protocol: Protocol, checksum: Checksum) -> str:
         except SerialspecError:
             continue
         first, last = layout.elements[index].span
-        return f"{checksum.algorithm.worked(b''.join(parts[first : last + 1]))} (example `{example.name}`)"
+        skip = layout.elements[index].skip
+        covered = b"".join(parts[i] for i in range(first, last + 1) if i not in skip)
+        return f"{checksum.algorithm.worked(covered)} (example `{example.name}`)"
     return ""
 
 

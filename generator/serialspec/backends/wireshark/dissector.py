@@ -160,6 +160,8 @@ def _layout(layout: FrameLayout) -> dict[str, Any]:
         if element.checksum is not None:
             item["span"] = [runtime.span[0] + 1, runtime.span[1] + 1]
             item["checksum"] = _checksum(element.checksum)
+            if runtime.skip:  # the elements it leaves out, as a set: skip[i] is true
+                item["skip"] = {i + 1: True for i in runtime.skip}
         item["description"] = element.description
         elements.append(item)
     result: dict[str, Any] = {"elements": elements}

@@ -169,8 +169,12 @@ def echoes(
     assert protocol.device is not None
     keys = {name for table in tables.values() if table[0] in ("value", "run") for name in table[1:3]}
     allowed = {*named, *protocol.matching, protocol.device.address, *keys, *derived}
-    given = {f.name for f in request.fields} | set(derived)
-    return tuple(f.name for f in response.fields if f.name in allowed and f.name in given)
+    layouts = protocol.framing.layouts  # plain frame values (a sequence number) are repeated like fields
+    plain = [e.name for e in layouts[response.direction].value_elements if e.role == "value"]
+    sent = {e.name for e in layouts[request.direction].value_elements}
+    given = {f.name for f in request.fields} | set(derived) | sent
+    replied = [*plain, *(f.name for f in response.fields)]
+    return tuple(name for name in replied if name in allowed and name in given)
 
 
 def reply_blanks(protocol: Protocol, response: Message, filled: set[str]) -> dict[str, str]:
@@ -281,6 +285,7 @@ def simulator_module(protocol: Protocol) -> str:
         if tables:
             args.append(f"tables={tables!r}")
         echoed = echoes(protocol, request, response, tables, derived, behaviour.echoes if behaviour else ())
+        echoed += tuple(m.request_code for m in refusals[:1] if m.request_code)  # a refusal names what it refuses
         if echoed:
             args.append(f"echoes={echoed!r}")
         # what the device fills in itself: what it reads, and runs of registers (empty unless read); a table value

@@ -169,6 +169,7 @@ def echoes(
     assert protocol.device is not None
     keys = {name for table in tables.values() if table[0] in ("value", "run") for name in table[1:3]}
     allowed = {*named, *protocol.matching, protocol.device.address, *keys, *derived}
+    allowed |= {e.name for e in protocol.framing.layouts[request.direction].value_elements if e.sequence}
     layouts = protocol.framing.layouts  # plain frame values (a sequence number) are repeated like fields
     plain = [e.name for e in layouts[response.direction].value_elements if e.role == "value"]
     sent = {e.name for e in layouts[request.direction].value_elements}

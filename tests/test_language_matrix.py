@@ -39,6 +39,7 @@ from serialspec.lang.model import Message, Protocol, replies_by_request, reply_t
 from serialspec.lang.passes.fields import FIELD_KINDS
 from serialspec.lang.resolve import resolve
 from serialspec.runtime.transport import Bus
+from serialspec.transforms import transforms
 from strategies import message_fields
 from test_codec import check_against_construct
 
@@ -312,6 +313,19 @@ CASES: dict[str, Case] = {
             }
         },
     ),
+    "frame: ended by a terminator, no length": Case(
+        {"v": "u16", "data": {"type": "bytes", "size": "rest"}},
+        {"v": "u16"},
+        {
+            "elements": {
+                "header": {"role": "header", "value": "3A"},
+                "code": {"role": "command", "type": "u8"},
+                "content": {"role": "content"},
+                "checksum": {"role": "checksum", "type": "u8", "algorithm": "xor", "covers": ["code", "content"]},
+                "end": {"role": "trailer", "value": "0D"},
+            }
+        },
+    ),
     "frame: layouts": Case(
         {"data": {"type": "bytes", "size": "rest"}},
         {"data": {"type": "bytes", "size": "rest"}},
@@ -401,6 +415,13 @@ C_REFUSES = {
     "scale and offset": "fields of type u24",
     "field named type": "fields of type u24",
     "frame: checksums inside their span, a checksum of a checksum": "over a span that leaves out",
+    "frame: ended by a terminator, no length": "ended by its trailer alone",
+    "transform: replace, escaping after the start byte, over the length and checksum (XBee API mode 2)": (
+        "a length inside the transformed span"
+    ),
+    "transform: cobs, after a header, with a length inside the span (it counts the plain bytes)": (
+        "a length inside the transformed span"
+    ),
 }
 
 
@@ -440,12 +461,19 @@ def message_class(g: Generated, message: Message) -> Any:
     return next(c for c in g.package.MESSAGE_TYPES if c.__name__ == message.class_name)
 
 
-# Cases the C target refuses (Unsupported: generate writes no C for them), each a feature it lacks yet.
-
 # Known to fail; each is a bug to fix, strict so that the fix is noticed (and the mark removed).
-KNOWN = {
-    "frame: transparency, checksum over exactly the span": "encode sums the stuffed bytes, decode the plain ones",
-}
+KNOWN: dict[str, str] = {}
+CASES["frame: transparency, a length of the span's plain bytes, the checksum inside it"] = Case(
+    CASES["frame: transparency"].request,
+    {"v": "u16"},
+    {
+        "elements": {
+            **CASES["frame: transparency"].framing["elements"],  # type: ignore[index]
+            "checksum": {"role": "checksum", "type": "u8", "algorithm": "sum", "covers": ["code", "content"]},
+        },
+        "transparency": {"span": ["code", "checksum"], "replace": {"C0": "DB DC", "DB": "DB DD"}},
+    },
+)
 CASES["frame: transparency, checksum over exactly the span"] = Case(
     {"v": "u16"},
     {"v": "u16"},
@@ -506,6 +534,12 @@ CASES["device: derived, locks, sends, moves.to"] = Case(
     },
 )
 DEVICE_KEYS = ("derived", "locks", "sends")  # the device keys a matrix case must use
+# Every documented option of every frame transform (serialspec/transforms/), as its sample framing.
+for _method, _transform in transforms().items():
+    for _sample in _transform.samples:
+        CASES[f"transform: {_method}, {_sample.label}"] = Case(
+            {"v": "u16", "data": {"type": "bytes", "size": "rest"}}, {"v": "u16"}, dict(_sample.framing)
+        )
 PARAMS = [
     pytest.param(name, marks=pytest.mark.xfail(reason=KNOWN[name], strict=True)) if name in KNOWN else name
     for name in sorted(CASES)
@@ -554,6 +588,12 @@ def test_every_documented_alternative_has_a_case() -> None:
     assert set(DEVICE_KEYS) <= set(grammar.DEVICE.keys) and set(DEVICE_KEYS) - used_device == set()
     field = grammar._FIELD_LONG
     element = grammar.FRAME_ELEMENT.keys
+    methods = {
+        case.framing["transparency"].get("method", "replace")
+        for case in CASES.values()
+        if case.framing and "transparency" in case.framing
+    }
+    assert set(transforms()) - methods == set()  # every frame transform (the grammar's `method` choices)
     assert set(FIELD_KINDS) - used["type"] == set()
     assert (set(grammar.FIELD_SCALAR_TYPES) | {"bit"}) - used["of"] == set()
     assert set(field["bit_order"].choices) - used["bit_order"] == set()  # type: ignore[attr-defined]

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define DYNAMIXEL_P2_SPEC_SHA256 "4b8258a3f35a91e2da0c6c433773a2937a75fb883b659722632bb41a1c4d919a"
+#define DYNAMIXEL_P2_SPEC_SHA256 "c387c20373f4df66b6ec814e8ebbe0294215eb7978641deb79401d8bbcb573be"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef DYNAMIXEL_P2_ENABLE_ENCODE

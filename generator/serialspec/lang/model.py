@@ -16,6 +16,7 @@ from serialspec.lang import expression
 from serialspec.lang.expression import Expr
 from serialspec.lang.frozen import frozen
 from serialspec.runtime.message import Direction as Direction  # the model and the runtime share it
+from serialspec.transforms.base import Transform
 
 
 @frozen
@@ -452,11 +453,11 @@ class FrameElement:
 
 @frozen
 class Transparency:
-    """Byte stuffing or escaping over a span of elements: each plain sequence is sent as its wire sequence."""
+    """A transform of the bytes of a span of elements (serialspec/transforms/: stuffing, escaping, COBS)."""
 
     first: str
     last: str
-    replace: tuple[tuple[bytes, bytes], ...]
+    transform: Transform
     description: str = ""
 
 

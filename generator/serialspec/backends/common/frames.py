@@ -7,7 +7,7 @@ byte by byte). One mapping from model to engine, so the two cannot disagree.
 from __future__ import annotations
 
 from serialspec.lang.model import Direction, FrameElement, FrameLayout, Protocol
-from serialspec.runtime.framing import Element, ElementKind, Layout, Transparency
+from serialspec.runtime.framing import Element, ElementKind, Layout
 
 KINDS: dict[str, ElementKind] = {
     "header": "constant",
@@ -53,7 +53,7 @@ def runtime_element(layout: FrameLayout, element: FrameElement) -> Element:
 
 def runtime_layout(layout: FrameLayout) -> Layout:
     t = layout.transparency
-    transparency = Transparency((layout.index(t.first), layout.index(t.last)), t.replace) if t else None
+    transparency = t.transform.runtime((layout.index(t.first), layout.index(t.last))) if t else None
     elements = tuple(runtime_element(layout, e) for e in layout.elements)
     return Layout(layout.name or layout.direction.value, elements, transparency)
 

@@ -452,10 +452,10 @@ def transparency_text(protocol: Protocol) -> str:
     if not found:
         return ""
     t = found[0]
-    pairs = ", ".join(f"{plain.hex(' ').upper()} is sent as {wire.hex(' ').upper()}" for plain, wire in t.replace)
     return text(
-        f"From `{t.first}` to `{t.last}`, {pairs}: encode applies it, decode and the stream parser remove it. "
-        f"Lengths count the bytes as sent; checksums outside the span cover them as sent. {t.description}"
+        f"From `{t.first}` to `{t.last}`, {t.transform.describe()}: encode applies it, decode and the stream parser "
+        f"remove it. A length or checksum over elements within the span counts and covers their plain bytes, one over "
+        f"more than the span the bytes as sent. {t.description}"
     )
 
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from typing import Any, assert_never
 
+from serialspec.backends import Unsupported
 from serialspec.backends.common.frames import runtime_layout
 from serialspec.backends.common.render import render
 from serialspec.cli.views import engineering_unit
@@ -165,13 +166,24 @@ def _layout(layout: FrameLayout) -> dict[str, Any]:
         item["description"] = element.description
         elements.append(item)
     result: dict[str, Any] = {"elements": elements}
-    if engine.transparency is not None:
+    t = layout.transparency
+    if t is not None and engine.transparency is not None:
         first, last = engine.transparency.span
-        result["transparency"] = {
-            "first": first + 1,
-            "last": last + 1,
-            "replace": [[plain, wire] for plain, wire in engine.transparency.replace],
-        }
+        lua = t.transform.lua()
+        if lua is None:
+            raise Unsupported(f"frames with `method: {t.transform.name}`")
+        result["transparency"] = {"first": first + 1, "last": last + 1, **lua}
+        inner = engine._plan["probe_inner"]  # type: ignore[attr-defined]
+        if inner is not None:  # a length of plain bytes within the span (runtime/framing.py _inner_size)
+            in_span, at, _, uncounted, counted_fixed = inner
+            assert engine.length is not None
+            result["inner_length"] = {
+                "index": engine.length + 1,
+                "in_span": in_span,
+                "at": at,
+                "uncounted": uncounted,
+                "counted_fixed": counted_fixed,
+            }
     return result
 
 

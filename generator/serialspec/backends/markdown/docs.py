@@ -21,6 +21,7 @@ from serialspec.collection import without_cycle_collection
 from serialspec.lang import expression
 from serialspec.lang.frozen import mutable
 from serialspec.lang.model import (
+    VALUE_ROLES,
     Array,
     Bytes,
     Checksum,
@@ -429,7 +430,7 @@ def frame_context(protocol: Protocol, layout: FrameLayout) -> dict[str, Any]:
             where = "last" if e.role == "checksum" and e.name not in layout.offsets else where
         if variable and e.role not in ("content", "checksum"):
             where = "after the content" if e.role == "trailer" or layout.offsets.get(e.name) is None else where
-        if e.role in ("address", "status", "command", "length") and e.name not in layout.offsets:
+        if e.role in (*VALUE_ROLES, "command", "length") and e.name not in layout.offsets:
             where = _value_offset(layout, e)  # after a content whose size varies
         rows.append(
             {

@@ -35,7 +35,7 @@ from serialspec.backends import Unsupported, emitters
 from serialspec.backends.python.memory import imported
 from serialspec.lang import SpecErrors, grammar
 from serialspec.lang.loader import load_text
-from serialspec.lang.model import Message, Protocol
+from serialspec.lang.model import Message, Protocol, replies_by_request, reply_to
 from serialspec.lang.passes.fields import FIELD_KINDS
 from serialspec.lang.resolve import resolve
 from serialspec.runtime.transport import Bus
@@ -80,6 +80,7 @@ class Case:
     response: dict[str, Any]
     framing: dict[str, Any] | None = None
     commands: dict[str, Any] | None = None  # more commands beside `probe`
+    request_keys: dict[str, Any] | None = None  # more keys of probe's request (answered_by)
     device: dict[str, Any] | None = None  # more of the `device:` section
 
 
@@ -196,6 +197,15 @@ CASES: dict[str, Case] = {
     "field named type": same({"type": "u8", "v": {"type": "u24", "endian": "big"}}),
     "use (shared field)": same({"angle": {"use": "angle"}, "also": "angle"}),
     "status": Case({"v": "u8"}, {"success": {"type": "u8", "status": {"ok": 1}}, "v": "u8"}),
+    "answered_by another code, refused_by, request_code": Case(
+        {"v": {"type": "u8", "range": [0, 100]}},
+        {"v": "u8"},
+        commands={
+            "ack": {"code": 5, "response": {"request_code": "acked", "fields": {"acked": "u8", "n": "u16"}}},
+            "nak": {"code": 6, "response": {"request_code": "refused", "fields": {"refused": "u8"}}},
+        },
+        request_keys={"answered_by": {"command": "ack", "refused_by": ["nak"]}},
+    ),
     # frame shapes: every element role, multi-byte elements in both byte orders, stuffing, alternative layouts
     "frame: trailer, constant, u16 big-endian length and checksum": Case(
         {"v": "u16"},
@@ -375,7 +385,7 @@ def spec_text(name: str, case: Case) -> str:
             "probe": {
                 "code": 1,
                 "title": "Probe",
-                "request": {"fields": case.request},
+                "request": {"fields": case.request, **copy.deepcopy(case.request_keys or {})},
                 "response": {"fields": case.response},
             },
             **copy.deepcopy(case.commands or {}),
@@ -474,6 +484,36 @@ CASES["frame: transparency, checksum over exactly the span"] = Case(
             "checksum": {"role": "checksum", "type": "u8", "algorithm": "sum", "covers": ["code", "content"]},
         },
     },
+)
+# Plain frame values: a sequence number the client fills in, a flags byte given in every message
+CASES["frame: plain values, a sequence"] = Case(
+    {"v": "u16"},
+    {"w": "u8"},
+    {
+        "elements": {
+            "header": {"role": "header", "value": HEADER},
+            "id": {"role": "address", "type": "u8", "range": [0, 253], "broadcast": 254},
+            "seq": {"role": "value", "type": "u16", "endian": "big", "range": [1, 999], "sequence": True},
+            "flags": {"role": "value", "type": "u8"},
+            "code": {"role": "command", "type": "u8"},
+            "length": {"role": "length", "type": "u8"},
+            "content": {"role": "content"},
+            "checksum": {"role": "checksum", "type": "u8", "algorithm": "sum", "covers": ["id", "content"]},
+        }
+    },
+)
+# Requests that share a code, told apart by their content size (0, 2, 3 or more bytes), in the usual frame and in
+# one the frame engine reads
+SHARED_CODE = {
+    "poll": {"code": 1, "request": {"fields": {}}},
+    "long": {"code": 1, "request": {"fields": {"a": "u8", "b": "u16", "data": {"type": "bytes", "size": "rest"}}}},
+}
+CASES["requests sharing a code, by content size"] = Case({"v": "u16"}, {"w": "u8"}, commands=SHARED_CODE)
+CASES["requests sharing a code, by content size, frame engine"] = Case(
+    {"v": "u16"},
+    {"w": "u16"},
+    CASES["frame: trailer, constant, u16 big-endian length and checksum"].framing,
+    commands=SHARED_CODE,
 )
 # The device rules and unsolicited output: the simulator sends `beat` every 5 ms while the client's requests are
 # matched to their replies (client_against_simulator), a derived entry, a lock, a move to an expression.
@@ -691,7 +731,8 @@ def client_against_simulator(g: Generated) -> None:
         if k.endswith("Simulator") and k != "Simulator" and isinstance(v, type)
     )
     request = next(m for m in g.protocol.messages() if m.direction.value == "request" and m.command == "probe")
-    response = next(m for m in g.protocol.messages() if m.direction.value == "response" and m.command == "probe")
+    response = reply_to(request, replies_by_request(g.protocol.messages()))
+    assert response is not None
     simulator = simulator_class(ids=[1])
     path = simulator.start()
     try:

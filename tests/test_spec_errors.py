@@ -131,7 +131,7 @@ def test_duplicate_command_codes_and_overlapping_registers(tmp_path: Path) -> No
         + """\
   stop:
     code: 1
-    request: {fields: {servo_id: u8}}
+    request: {fields: {servo_id: u8, speed: i16}}
 tables:
   regs:
     key: address
@@ -228,7 +228,10 @@ def test_many_mistakes_show_the_first_50_and_count_the_rest(tmp_path: Path) -> N
     text = MINIMAL.partition("commands:\n")[0] + "commands:\n" + commands
     lines = str(load_errors(tmp_path, text)).splitlines()
     assert len(lines) == 51
-    assert lines[0] == "tiny.yaml:17:5: commands.c1: code 0x01 in request frames is already used by 'c0'"
+    assert lines[0] == (
+        "tiny.yaml:17:5: commands.c1: code 0x01 in request frames is already used by 'c0', and a content of 1 byte "
+        "fits both (requests that share a code are told apart by their content size: 1 byte and 1 byte)"
+    )
     assert lines[49].startswith("tiny.yaml:164:5: commands.c50: ")
     assert lines[50] == "... and 29 more errors (79 in all)"
     for verb in ("check", "generate"):

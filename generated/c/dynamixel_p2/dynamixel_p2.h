@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define DYNAMIXEL_P2_SPEC_SHA256 "8626f42c4b17a3c11b48ed2fc47ec39bc479417b52fb1e1ba8f1f9477745bb2e"
+#define DYNAMIXEL_P2_SPEC_SHA256 "c387c20373f4df66b6ec814e8ebbe0294215eb7978641deb79401d8bbcb573be"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef DYNAMIXEL_P2_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define VESC_SPEC_SHA256 "82bf2ef3b3564067cbfdb077b6363d71b1b62e1b9b503dbdb418827f353fd528"
+#define VESC_SPEC_SHA256 "db84479597ad10015d5a773e8ca32f9c036e6076e6a0b0a630f8f079de6d795d"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef VESC_ENABLE_ENCODE

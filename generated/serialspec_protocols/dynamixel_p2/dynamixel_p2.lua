@@ -920,6 +920,9 @@ for _, direction in pairs(SPEC.directions) do
     for _, message in pairs(entry.subs or {}) do
       declare_message(message)
     end
+    for _, message in ipairs(entry.by_size or {}) do
+      declare_message(message)
+    end
   end
 end
 
@@ -1338,7 +1341,7 @@ local function frame_size(direction, layout, data, pos)
     elseif element.role == "command" then
       entry = entry_of(direction, unsigned(bytes, element.big))
       if entry == nil then return nil end
-    elseif element.role == "address" or element.role == "status" then
+    elseif element.role == "address" or element.role == "status" or element.role == "value" then
       if not plausible(element, unsigned(bytes, element.big)) then return nil end
     end
   end
@@ -1500,6 +1503,13 @@ local function dissect_frame(direction_name, direction, layout, entry, tvb, data
     local selector = unsigned(plain[content_index]:sub(at + 1, at + entry.selector.size), SPEC.big)
     message = entry.subs[selector]
     if message == nil then error(string.format("no sub-command %d of this command", selector), 0) end
+  end
+  if entry.by_size then  -- requests that share the code: told apart by their content size
+    local n = #plain[content_index]
+    for _, layout in ipairs(entry.by_size) do
+      if n >= layout.min and (layout.max == nil or n <= layout.max) then message = layout end
+    end
+    if message == nil then error(string.format("no request of this code has %d content bytes", n), 0) end
   end
   local title = message.command .. (message.subcommand and "." .. message.subcommand or "")
   root:set_text(string.format("%s %s %s", SPEC.title, direction_name, title))

@@ -494,9 +494,21 @@ MESSAGE = Obj(
         ),
         "optional_when": OPTIONAL_WHEN,
         "after": Str("For a response: the request field (in ms) after which the device answers, e.g. a move's time."),
+        "request_code": Str(
+            "For a response that answers other commands' requests (`answered_by`): its integer field holding the "
+            "command code of the request it answers (u-blox ACK: the acknowledged class and id). The client "
+            "matches it, the simulator fills it in.",
+            example="acked",
+        ),
         "answered_by": Obj(
             {
                 "command": Str("The command whose response answers this request (one reply layout for many)."),
+                "refused_by": ListOf(
+                    Str(),
+                    "Commands whose responses refuse this request instead (u-blox ACK-NAK): the client waits for "
+                    "the `command`'s reply or one of these, and raises DeviceError naming the refusal.",
+                    example=["nak"],
+                ),
                 "optional_when": OPTIONAL_WHEN,
             },
             required=("command",),
@@ -532,7 +544,9 @@ COMMAND = Obj(
         "code": IntOrText(
             (Int(), Str()),
             "Value of the frame's command field; omit for the one response of a protocol whose replies carry no "
-            "command field. In text frames: the text code after the talker (NMEA's sentence id, GGA).",
+            "command field. In text frames: the text code after the talker (NMEA's sentence id, GGA). The requests "
+            "of several commands may share a code when no content size fits two of them: each is its own message, "
+            "decoded by its size (u-blox: an empty payload polls, a full one sets).",
         ),
         "title": TITLE,
         "title_cn": TITLE_CN,
@@ -697,8 +711,20 @@ FRAME_ELEMENT = Obj(
     {
         "role": Str(
             "What the element is: constant bytes (header first, trailer last, constant anywhere, e.g. a reserved "
-            "byte), a frame-level value (address, command, status), the length, the content or a checksum.",
-            choices=("header", "trailer", "constant", "command", "length", "content", "checksum", "address", "status"),
+            "byte), a frame-level value (address, command, status, or a plain `value` every message carries: a "
+            "sequence number, a flags byte), the length, the content or a checksum.",
+            choices=(
+                "header",
+                "trailer",
+                "constant",
+                "command",
+                "length",
+                "content",
+                "checksum",
+                "address",
+                "status",
+                "value",
+            ),
         ),
         "type": Str("Wire type of a value, length or checksum (default u8).", choices=SCALAR_TYPES),
         "endian": Str(
@@ -728,6 +754,13 @@ FRAME_ELEMENT = Obj(
         "description": TEXT,
         "range": RANGE,
         "broadcast": Int("address: the broadcast value."),
+        "sequence": Bool(
+            "value: a sequence number the client fills in: 0 in its first request, one more in each request after "
+            "it, back to 0 past the element's largest value. A reply repeats it; name it in `matching.by` to match "
+            "replies by it.",
+            default=False,
+            example=True,
+        ),
         "flags": Str("status: name of an entry in `flags:`."),
         "bits": bit_fields(
             "status (or address): bit fields packed into the element (DYNAMIXEL: alert bit 7, error number 6..0)."

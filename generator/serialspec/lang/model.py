@@ -328,10 +328,20 @@ class Message:
     reply_when: OptionalWhen | None = None  # a request whose reply is sent only when a device parameter has a value
     struct_name: str = ""  # the construct struct of its content
     default_reply: bool = False  # among replies sharing a code: the one a frame is decoded as without its request
+    refused_by: tuple[str, ...] = ()  # a request: the commands whose responses refuse it (it raises DeviceError)
+    request_code: str = ""  # a response: its field holding the code of the request it answers (u-blox ACK)
 
     @property
     def key(self) -> str:
         return f"{self.command}.{self.subcommand}" if self.subcommand else self.command
+
+
+def sizes_text(message: Message) -> str:
+    """A message's content sizes, as people read them: 4 bytes, 0..8 bytes, 2 bytes or more."""
+    low, high = message.min_size, message.max_size
+    if low == high:
+        return f"{low} byte" + ("" if low == 1 else "s")
+    return f"{low}..{high} bytes" if high is not None else f"{low} byte{'' if low == 1 else 's'} or more"
 
 
 def replies_by_request(responses: Iterable[Message]) -> dict[str, Message]:
@@ -346,6 +356,11 @@ def replies_by_request(responses: Iterable[Message]) -> dict[str, Message]:
 def reply_to(request: Message, replies: dict[str, Message]) -> Message | None:
     """The response that answers a request (from `replies_by_request`), or the one it is `answered_by`."""
     return replies.get(request.answered_by or request.key)
+
+
+def refusals_of(request: Message, replies: dict[str, Message]) -> tuple[Message, ...]:
+    """The responses that refuse a request (its `refused_by`), from `replies_by_request`."""
+    return tuple(replies[name] for name in request.refused_by if name in replies)
 
 
 def reply_condition(request: Message, response: Message | None) -> OptionalWhen | None:
@@ -406,6 +421,9 @@ class Checksum:
     skips: tuple[str, ...] = ()  # elements inside first..last left out: itself, and the checksums strictly inside
 
 
+VALUE_ROLES = ("address", "status", "value")  # frame elements whose value every message of the frame carries
+
+
 @frozen
 class FrameElement:
     name: str
@@ -425,6 +443,7 @@ class FrameElement:
     counts: tuple[str, str] = ("", "")  # length: the first and last element counted
     adds: int = 0  # length: added to the counted size
     checksum: Checksum | None = None  # checksum: what it is and what it covers
+    sequence: bool = False  # value: a sequence number the client fills in (one more per request, wrapping)
 
     @property
     def fixed(self) -> bool:
@@ -462,7 +481,7 @@ class FrameLayout:
     checksum_offset_from_end: int
     covered_from: int  # first covered byte
     covered_to_end: int  # bytes after the last covered byte
-    value_elements: tuple[FrameElement, ...]  # address/status: frame-level values every message carries
+    value_elements: tuple[FrameElement, ...]  # address/status/value: frame-level values every message carries
     name: str = ""  # the layout's name among alternatives ("" for the one layout)
     transparency: Transparency | None = None
     checksums: tuple[Checksum, ...] = ()

@@ -111,6 +111,14 @@ class Binding:
     # request class -> the codec's encoder of that class, which `encode` calls: the bus calls it at once, and
     # `encode` only for a request that one refuses (for encode's one-line error)
     encoders: Mapping[type, Callable[[Any], bytes]] = field(default_factory=dict)
+    # request class -> the reply classes of other commands that answer or refuse it (the spec's `answered_by`): they
+    # match it whatever `command` matching says
+    answered_by: Mapping[type, tuple[type, ...]] = field(default_factory=dict)
+    # request class -> the reply classes that refuse it (`refused_by`): the bus raises DeviceError naming them
+    refused_by: Mapping[type, tuple[type, ...]] = field(default_factory=dict)
+    # reply class -> its field holding the code of the request it answers (`request_code`), and each command's code
+    code_fields: Mapping[type, str] = field(default_factory=dict)
+    codes: Mapping[str, int] = field(default_factory=dict)
 
 
 def check_status(request: Message, reply: Message, name: str, ok: int, match_by: tuple[str, ...]) -> None:
@@ -553,14 +561,20 @@ class Bus:
         return reply
 
     def _refused(self, request: Message, reply: Message) -> None:
-        """An error reply that refuses the request (the spec's `errors:`) is a DeviceError."""
+        """An error reply that refuses the request (the spec's `errors:`), or a reply it is `refused_by`, is a
+        DeviceError."""
         errors = self.binding.errors
         if errors is not None and errors.refuses(request, reply):
             raise DeviceError(errors.describe(request, reply), reply)
+        if reply.__class__ in self.binding.refused_by.get(request.__class__, ()):
+            what = ".".join(part for part in (reply.COMMAND, reply.SUBCOMMAND) if part)
+            raise DeviceError(f"{request.COMMAND}: the device refuses it: {what}", reply)
 
     def _refusal(self, request: Message, reply: Message) -> bool:
         """Whether `reply`, not of the expected type, is an error reply refusing `request` (from the same device)."""
         errors = self.binding.errors
+        if reply.__class__ in self.binding.refused_by.get(request.__class__, ()):
+            return self.matches(request, reply)
         if errors is None or not errors.refuses(request, reply):
             return False
         return all(
@@ -595,8 +609,18 @@ class Bus:
         return replies
 
     def matches(self, request: Message, reply: Message) -> bool:
-        """The spec's matching rule: the named attributes are equal where both messages have them."""
-        if self._match_command and reply.COMMAND != request.COMMAND:
+        """The spec's matching rule: the named attributes are equal where both messages have them. A reply of
+        another command that the spec says answers the request matches its command; one that carries the code of
+        the request it answers (`request_code`) matches when the code is the request's."""
+        binding = self.binding
+        if (
+            self._match_command
+            and reply.COMMAND != request.COMMAND
+            and reply.__class__ not in binding.answered_by.get(request.__class__, ())
+        ):
+            return False
+        code_field = binding.code_fields.get(reply.__class__)
+        if code_field is not None and getattr(reply, code_field) != binding.codes.get(request.COMMAND):
             return False
         if self._match_subcommand and reply.SUBCOMMAND != request.SUBCOMMAND:
             return False
@@ -615,11 +639,19 @@ class Bus:
         reply_type = type(reply)
         rule = self._all_rules.get((request_type, reply_type))
         if rule is None:
-            possible = not (
-                self._match_command and getattr(reply_type, "COMMAND", None) != getattr(request_type, "COMMAND", None)
-            ) and not (
-                self._match_subcommand
-                and getattr(reply_type, "SUBCOMMAND", None) != getattr(request_type, "SUBCOMMAND", None)
+            binding = self.binding
+            possible = (
+                not (
+                    self._match_command
+                    and getattr(reply_type, "COMMAND", None) != getattr(request_type, "COMMAND", None)
+                    and reply_type not in binding.answered_by.get(request_type, ())
+                )
+                and not (
+                    self._match_subcommand
+                    and getattr(reply_type, "SUBCOMMAND", None) != getattr(request_type, "SUBCOMMAND", None)
+                )
+                # a reply carrying its request's code is matched by `matches`, the code compared each time
+                and reply_type not in binding.code_fields
             )
             names = [n for n in self._match_fields if hasattr(request_type, n) and hasattr(reply_type, n)]
             getter = operator.attrgetter(*names) if names else None
@@ -942,6 +974,15 @@ class ClientState:
         # written (emptied whenever they change): what a read sent again asks, without a call
         self._due: dict[tuple[Any, ...], bool] = {}
         self._read_was_optional = False  # the parameter read under way asked whether its own reply is due
+        self._sequences: dict[str, int] = {}  # frame value -> the last sequence number sent in it
+
+    def _sequence(self, name: str, low: int, high: int) -> int:
+        """The next sequence number of a frame value the client fills in: `low` first, then one more each time,
+        back to `low` past `high`."""
+        last = self._sequences.get(name)
+        value = low if last is None or last >= high else last + 1
+        self._sequences[name] = value
+        return value
 
     def close(self) -> None:
         self.bus.close()

@@ -21,7 +21,7 @@ from serialspec.backends.c.emit import (
     value_elements,
 )
 from serialspec.backends.c.engine import ENGINE
-from serialspec.lang.model import Direction, FrameLayout, Message, Protocol, size_terms
+from serialspec.lang.model import VALUE_ROLES, Direction, FrameLayout, Message, Protocol, size_terms
 from serialspec.transforms.cobs import Cobs
 from serialspec.transforms.replace import Replace
 
@@ -229,6 +229,7 @@ def layout_tables(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) -
             "constant": "CONSTANT",
             "address": "VALUE",
             "status": "VALUE",
+            "value": "VALUE",
             "command": "COMMAND",
             "length": "LENGTH",
             "content": "CONTENT",
@@ -241,7 +242,7 @@ def layout_tables(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) -
         if e.role == "checksum" and e.checksum is not None:
             first, last = names.index(e.checksum.first), names.index(e.checksum.last)
             check = ctx.check_index(e.checksum)
-        value = e.role in ("address", "status", "command")
+        value = e.role in (*VALUE_ROLES, "command")
         minimum = int(e.minimum) if value else 0
         maximum = int(e.maximum) if value else 0
         also = e.broadcast if value and e.broadcast is not None else None
@@ -288,7 +289,7 @@ def layout_tables(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) -
         offset = 0
         for e in layout.elements:
             narrowed = e.type is not None and (e.minimum, e.maximum) != (e.type.minimum, e.type.maximum)
-            if e.role in ("length", "command") or (e.role in ("address", "status") and narrowed):
+            if e.role in ("length", "command") or (e.role in VALUE_ROLES and narrowed):
                 prefix = max(prefix, offset + (e.size or 0))
             offset += e.size or 0
             if e.role == "content":
@@ -377,7 +378,7 @@ def straight_unwrap(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout)
         value = _wire_value(start[i], sizes[i], e.endian == ">")
         if e.role == "command":
             lines.append(f"    *code = {value}; /* {e.name} */")
-        elif e.role in ("address", "status"):
+        elif e.role in VALUE_ROLES:
             assert e.type is not None
             test = []
             if int(e.minimum) > 0:
@@ -524,6 +525,14 @@ def source(ctx: Ctx) -> str:
                         body.append(f"            case {sub.code}u: {dec_call(ctx, m, values)}")
                 body.append(f"            default: return {P}_E_UNKNOWN;")
                 body.append("            }")
+            elif d == Direction.REQUEST and len(users) > 1:  # requests that share a code: by their content size
+                for u in sorted(users, key=lambda u: u.min_size):
+                    fits = f"n >= {u.min_size}u" if u.min_size else ""
+                    if u.max_size is not None:
+                        fits = f"n == {u.min_size}u" if u.max_size == u.min_size else f"{fits} && n <= {u.max_size}u"
+                    fits = (fits or "1").removeprefix(" && ")
+                    body.append(f"            if ({fits}) {{ {dec_call(ctx, u, values)} }}")
+                body.append(f"            return {P}_E_LENGTH;")
             else:
                 default = next((u for u in users if u.default_reply), users[0])
                 for u in users:

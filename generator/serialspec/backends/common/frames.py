@@ -15,6 +15,7 @@ KINDS: dict[str, ElementKind] = {
     "constant": "constant",
     "address": "value",
     "status": "value",
+    "value": "value",
     "command": "command",
     "length": "length",
     "content": "content",

@@ -21,6 +21,7 @@ from serialspec.collection import without_cycle_collection
 from serialspec.lang import expression
 from serialspec.lang.frozen import mutable
 from serialspec.lang.model import (
+    VALUE_ROLES,
     Array,
     Bytes,
     Checksum,
@@ -182,9 +183,32 @@ def message_context(protocol: Protocol, message: Message | None) -> dict[str, An
         "unsolicited": message.unsolicited or sends_text(protocol, message) != "",
         "sends": sends_text(protocol, message),
         "answers": message.answers,
-        "reply": reply_text(message, protocol) or error_reply_text(protocol, message),
+        "reply": "; ".join(
+            part
+            for part in (
+                shared_request_text(protocol, message),
+                reply_text(message, protocol) or error_reply_text(protocol, message),
+            )
+            if part
+        ),
         "description": text(message.description),
     }
+
+
+def shared_request_text(protocol: Protocol, message: Message) -> str:
+    """A request that shares its code with others: told apart by its content size."""
+    if message.direction != Direction.REQUEST or message.subcommand is not None:
+        return ""
+    code = protocol.command(message.command).code
+    others = [
+        m.command
+        for c in protocol.commands
+        if c.code == code and c.name != message.command and (m := c.request) is not None
+    ]
+    if not isinstance(code, int) or not others:
+        return ""
+    names = ", ".join(f"`{name}`" for name in others)
+    return f"shares code {code:#04x} with {names}, told apart by the content size"
 
 
 def _value_offset(layout: FrameLayout, element: FrameElement) -> str:
@@ -239,12 +263,17 @@ def reply_text(message: Message, protocol: Protocol | None = None) -> str:
     """For a request answered by another command's response: which, and the parameter that switches it; for a
     response that shares its code with other replies: how a reply is told to have this layout."""
     if message.direction == Direction.RESPONSE and protocol is not None:
-        return shared_reply_text(protocol, message)
-    if not message.answered_by:
+        parts = [shared_reply_text(protocol, message)]
+        if message.request_code:
+            parts.append(f"`{message.request_code}` holds the code of the request it answers")
+        return "; ".join(p for p in parts if p)
+    if not message.answered_by and not message.refused_by:
         return ""
     switch = message.reply_when
     when = f", sent only while `{switch.entry}` {switch.symbol} {switch.equals}" if switch else ""
-    return f"answered by the `{message.answered_by}` response{when}"
+    refusals = ", ".join(f"`{name}`" for name in message.refused_by)
+    refused = f"; refused by the {refusals} response (the client raises DeviceError)" if refusals else ""
+    return f"answered by the `{message.answered_by or message.key}` response{when}{refused}"
 
 
 def error_reply_text(protocol: Protocol, message: Message) -> str:
@@ -383,6 +412,10 @@ def frame_context(protocol: Protocol, layout: FrameLayout) -> dict[str, Any]:
             left_out = ", ".join(f"`{name}`" for name in e.checksum.skips)
             skips = f" leaving out {left_out}" if left_out else ""
             description = f"over `{e.checksum.first}`..`{e.checksum.last}`{skips}, {endian}. {e.description}"
+        elif e.sequence:
+            low, high = number(e.minimum), number(e.maximum)
+            counts = f"sequence number the client fills in: {low} first, one more per request, {low} again after {high}"
+            description = ". ".join(p for p in (counts, e.description) if p)
         else:
             description = e.description
         kind = e.type.name if e.type else ("bytes" if e.fixed else "n bytes")
@@ -397,7 +430,7 @@ def frame_context(protocol: Protocol, layout: FrameLayout) -> dict[str, Any]:
             where = "last" if e.role == "checksum" and e.name not in layout.offsets else where
         if variable and e.role not in ("content", "checksum"):
             where = "after the content" if e.role == "trailer" or layout.offsets.get(e.name) is None else where
-        if e.role in ("address", "status", "command", "length") and e.name not in layout.offsets:
+        if e.role in (*VALUE_ROLES, "command", "length") and e.name not in layout.offsets:
             where = _value_offset(layout, e)  # after a content whose size varies
         rows.append(
             {

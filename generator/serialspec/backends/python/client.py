@@ -42,6 +42,8 @@ from serialspec.lang.model import (
     TableEntry,
     TableValue,
     Text,
+    refusals_of,
+    replies_by_request,
     reply_condition,
 )
 
@@ -400,6 +402,12 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
     tables = table_commands(protocol)
     writers = {t["writer"]: t for t in tables}
     groups: dict[str, dict[str, Any]] = {}
+    # frame values the client fills in, one more per request: name -> the call that gives the next
+    sequences = {
+        e.name: f"self._sequence({e.name!r}, {number(e.minimum)}, {number(e.maximum)})"
+        for e in protocol.framing.layouts[Direction.REQUEST].value_elements
+        if e.sequence
+    }
     for request, response in request_response_pairs(protocol):
         command = protocol.command(request.command)
         sub = next((s for s in command.subcommands if s.name == request.subcommand), None)
@@ -418,6 +426,8 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
         pairs = []
         singles = []
         for f in fields:
+            if f.name in sequences:
+                continue  # the client fills it in
             imports.update(type_names(f))
             default = f" = {defaults[f.name]}" if f.name in defaults else ""
             pair = pair_group(f)
@@ -448,7 +458,7 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
             doc.append("Broadcast: " + one_line(command.broadcast))
         doc.append("")
         doc.append("Args:")
-        doc.extend(f"    {f.name}: {describe(f)}" for f in fields)
+        doc.extend(f"    {f.name}: {describe(f)}" for f in fields if f.name not in sequences)
         doc.extend(
             f"    ({p['name']} also takes a mapping {{{p['first']}: {p['second']}}}, one entry per item.)"
             for p in pairs
@@ -471,6 +481,7 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
         if response is not None:
             imports.add(response.class_name)
             echoes = {f.name for f in fields} | {f.name for f in statuses} | unused_fields(protocol, request, response)
+            echoes |= {response.request_code} - {""}  # the request's own code, matched by the bus
             rest = [f for f in value_fields(protocol, response) if f.name not in echoes]
             if command.probe and not sub:
                 kind, returns = ("bool", "bool")
@@ -525,7 +536,7 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
             "doc": doc,
             "request": request.class_name,
             "response": response.class_name if response else "",
-            "build": ", ".join(f"{f.name}={f.name}" for f in fields),
+            "build": ", ".join(f"{f.name}={sequences.get(f.name, f.name)}" for f in fields),
             "kind": kind,
             "silent": silent,
             "optional": f"({optional.key}, {optional.equals}, {optional.op!r})" if optional else "None",
@@ -585,6 +596,10 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
             "reason_field": reason,
             "codes": "{" + ", ".join(f"{name!r}: {code:#04x}" for name, code in codes.items()) + "}",
         }
+    replies = other_replies(protocol)
+    for _, names in (*replies["answered_by"], *replies["refused_by"]):
+        module_imports.update(names.strip("(,)").split(", "))
+    module_imports.update(name for name, _ in replies["code_fields"])
     device = protocol.device
     model_map = (
         map_name(device.memory)
@@ -600,6 +615,7 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
     checks_status = any(m["statuses"] for m in everything)
     class_transport = [*(["check_status"] if checks_status else []), *(["table_key"] if tables else [])]
     return dict(
+        replies=replies,
         errors=errors,
         model_map=model_map,
         model_names=", ".join(m.name for m in device.models) if device is not None else "",
@@ -674,6 +690,43 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
             }
         ),
     )
+
+
+def class_tuple(names: list[str]) -> str:
+    """A tuple of classes as Python source."""
+    return f"({names[0]},)" if len(names) == 1 else f"({', '.join(names)})"
+
+
+def other_replies(protocol: Protocol) -> dict[str, list[Any]]:
+    """The Binding's replies of other commands: request class -> the reply classes of other commands that answer or
+    refuse it (`answered_by`, `refused_by`; the first only where replies are matched by command); reply class -> its
+    field holding the request's code (`request_code`), and the codes of the commands whose requests such replies
+    answer."""
+    answered: list[tuple[str, str]] = []
+    refused: list[tuple[str, str]] = []
+    code_fields: list[tuple[str, str]] = []
+    codes: list[tuple[str, int]] = []
+    replies = replies_by_request(protocol.messages())
+    for request, response in request_response_pairs(protocol):
+        refusing = refusals_of(request, replies)
+        refusals = [m.class_name for m in refusing]
+        others = [m.class_name for m in (response, *refusing) if m and m.command != request.command]
+        if others and "command" in protocol.matching:  # only matching by command needs telling
+            answered.append((request.class_name, class_tuple(others)))
+        if refusals:
+            refused.append((request.class_name, class_tuple(refusals)))
+        for reply in (response, *refusing):
+            if reply is not None and reply.request_code and (reply.class_name, reply.request_code) not in code_fields:
+                code_fields.append((reply.class_name, reply.request_code))
+        command = protocol.command(request.command)
+        if command.code is not None and (command.name, command.code) not in codes:
+            codes.append((command.name, command.code))
+    return {
+        "answered_by": answered,
+        "refused_by": refused,
+        "code_fields": code_fields,
+        "codes": codes if code_fields else [],
+    }
 
 
 def reply_value(f: Field, reply: str, cut: str) -> str:

@@ -5,7 +5,7 @@ from __future__ import annotations
 from typing import Any
 
 from serialspec.backends.python.content import decoder_name
-from serialspec.lang.model import Command, Direction, FrameLayout
+from serialspec.lang.model import Command, Direction, FrameLayout, Message, Protocol, sizes_text
 
 
 def value_arguments(layout: FrameLayout) -> dict[str, str]:
@@ -44,3 +44,27 @@ def direction_entry(command: Command, direction: Direction) -> tuple[str, int, i
         "where": f"{command.name} {direction.value}",
     }
     return name, low, high, sub
+
+
+def size_dispatch(key: str, direction: Direction, messages: list[Message]) -> dict[str, Any]:
+    """Requests that share one code, told apart by their content size (the resolver checked that no size fits two):
+    the decoder that picks one by the size, for the code's entry in the dispatch table."""
+    code = "none" if key == "None" else key.removeprefix("0x")
+    return {
+        "name": f"_decode_{direction.value}_{code}_by_size",
+        "ranges": [(m.min_size, m.max_size, decoder_name(m)) for m in sorted(messages, key=lambda m: m.min_size)],
+        "where": f"{direction.value} {key}",
+        "sizes": ", ".join(f"{m.command}: {sizes_text(m)}" for m in messages),
+    }
+
+
+def shared_codes(protocol: Protocol, direction: Direction) -> set[int]:
+    """The codes several requests share (told apart by their content size); none in responses."""
+    if direction != Direction.REQUEST:
+        return set()
+    seen: set[int] = set()
+    shared: set[int] = set()
+    for command in protocol.commands:
+        if command.request is not None and command.code is not None:
+            (shared if command.code in seen else seen).add(command.code)
+    return shared

@@ -26,7 +26,7 @@ from serialspec.backends.python.content import (
     message_function,
     takes_the_rest,
 )
-from serialspec.backends.python.dispatch import direction_entry, value_arguments
+from serialspec.backends.python.dispatch import direction_entry, shared_codes, size_dispatch, value_arguments
 from serialspec.backends.python.frames import checksum_definitions, import_lines
 from serialspec.backends.python.ir import (
     RETURN_NONE,
@@ -71,19 +71,33 @@ def length_byte_codec_context(protocol: Protocol, code: PackageCode) -> dict[str
     whole_functions: list[dict[str, Any]] = []
     whole_pickers: list[dict[str, Any]] = []
     decoder_bodies = {name: (returns, extra, body) for name, returns, extra, body in code.decoders}
+    size_dispatchers: list[dict[str, Any]] = []
     for direction, layout in protocol.framing.layouts.items():
         dispatch = []
         sizes = []
+        shared: dict[str, list[Message]] = {}  # requests that share a code: told apart by their content size
         for command in protocol.commands:
             entry = direction_entry(command, direction)
             if entry is None:
                 continue
             target, low, high, sub_dispatch = entry
             key = "None" if command.code is None else f"{command.code:#04x}"
+            if direction == Direction.REQUEST and command.request is not None and command.selector is None:
+                shared.setdefault(key, []).append(command.request)
             dispatch.append((key, target))
             sizes.append((key, low, high))
             if sub_dispatch:
                 dispatchers.append(sub_dispatch | value_arguments(layout))
+        for key, messages in shared.items():
+            if len(messages) < 2:
+                continue
+            by_size = size_dispatch(key, direction, messages) | value_arguments(layout)
+            size_dispatchers.append(by_size)
+            highs = [h for k, _, h in sizes if k == key]
+            high = None if None in highs else max(h or 0 for h in highs)
+            low = min(lo for k, lo, _ in sizes if k == key)
+            dispatch = [(k, t) for k, t in dispatch if k != key] + [(key, by_size["name"])]
+            sizes = [entry for entry in sizes if entry[0] != key] + [(key, low, high)]
         fixed = fixed_frames(protocol, layout, decoder_bodies, code)
         runs = [(key, function["run"]["name"]) for key, _, function in fixed if function.get("run")]
         sub_functions, pickers, sub_entries = subcommand_frames(protocol, layout, decoder_bodies, code)
@@ -190,6 +204,7 @@ def length_byte_codec_context(protocol: Protocol, code: PackageCode) -> dict[str
         "whole_functions": whole_functions,
         "whole_pickers": whole_pickers,
         "dispatchers": dispatchers,
+        "size_dispatchers": size_dispatchers,
         "header_choices": header_choices,
     }
 
@@ -352,7 +367,10 @@ def rest_frames(
     content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
     tail = layout.overhead - content_offset  # bytes after the content
     found = []
+    shared = shared_codes(protocol, layout.direction)
     for command in protocol.commands:
+        if command.code in shared:
+            continue  # its length bytes may name a request of the same code: its size dispatch picks
         message = command.request if layout.direction == Direction.REQUEST else command.response
         if command.selector is not None or message is None or message.max_size is not None or not message.fields:
             continue

@@ -13,7 +13,7 @@ from serialspec.backends.python.content import (
     decoder_name,
     encoder_name,
 )
-from serialspec.backends.python.dispatch import direction_entry, value_arguments
+from serialspec.backends.python.dispatch import direction_entry, size_dispatch, value_arguments
 from serialspec.backends.python.frames import (
     ERROR_REPLY,
     checksum_definitions,
@@ -198,6 +198,7 @@ def straight_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, A
     imports, definitions = checksum_definitions(protocol)
     directions: list[dict[str, Any]] = []
     dispatchers = []
+    size_dispatchers: list[dict[str, Any]] = []
     frame_structs: dict[str, str] = {}
     # the runtime.framing names the codec uses: the FrameCodecs' (the straight-line functions' Transparency objects are
     # those of the same layouts) and ERROR_REPLY where error replies are told by their flag
@@ -218,14 +219,20 @@ def straight_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, A
         sizes: list[tuple[str, int, int | None]] = []
         single: dict[str, Message] = {}
         for key, users in by_code.items():
-            # the resolver allows several only for plain replies, one of them marked default
+            # the resolver allows several only for plain replies, one of them marked default, and for requests told
+            # apart by their content size
             chosen = next((u for u in users if u[0] is not None and u[0].default_reply), users[0])
+            if direction == Direction.REQUEST and len(users) > 1:
+                by_size = size_dispatch(key, direction, [m for m, _, _, _ in users if m is not None])
+                size_dispatchers.append(by_size | value_arguments(layout))
+                chosen = (None, by_size["name"], 0, None)
             dispatch.append((key, chosen[1]))
             highs = [u[3] for u in users]
             sizes.append((key, min(u[2] for u in users), None if None in highs else max(h or 0 for h in highs)))
             if len(users) == 1 and users[0][0] is not None:
                 single[key] = users[0][0]
-            expected += [(m.class_name, key, target) for m, target, _, _ in users if m is not None and len(users) > 1]
+            if direction == Direction.RESPONSE:
+                expected += [(m.class_name, key, t) for m, t, _, _ in users if m is not None and len(users) > 1]
         only = dispatch[0][1] if not layout.has_command and len(dispatch) == 1 and not expected else ""
         values = tuple(e.name for e in layout.value_elements)
         frames = Target(direction.name, values, expected=bool(expected), only=only)
@@ -280,6 +287,7 @@ def straight_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, A
         "checksum_definitions": definitions,
         "directions": directions,
         "dispatchers": dispatchers,
+        "size_dispatchers": size_dispatchers,
         "by_header": all(headers) and len(set(headers)) == len(headers),
     }
 

@@ -25,6 +25,8 @@ from serialspec.lang.model import (
     TableBlock,
     TableValue,
     Text,
+    refusals_of,
+    replies_by_request,
     reply_condition,
 )
 
@@ -167,8 +169,13 @@ def echoes(
     assert protocol.device is not None
     keys = {name for table in tables.values() if table[0] in ("value", "run") for name in table[1:3]}
     allowed = {*named, *protocol.matching, protocol.device.address, *keys, *derived}
-    given = {f.name for f in request.fields} | set(derived)
-    return tuple(f.name for f in response.fields if f.name in allowed and f.name in given)
+    allowed |= {e.name for e in protocol.framing.layouts[request.direction].value_elements if e.sequence}
+    layouts = protocol.framing.layouts  # plain frame values (a sequence number) are repeated like fields
+    plain = [e.name for e in layouts[response.direction].value_elements if e.role == "value"]
+    sent = {e.name for e in layouts[request.direction].value_elements}
+    given = {f.name for f in request.fields} | set(derived) | sent
+    replied = [*plain, *(f.name for f in response.fields)]
+    return tuple(name for name in replied if name in allowed and name in given)
 
 
 def reply_blanks(protocol: Protocol, response: Message, filled: set[str]) -> dict[str, str]:
@@ -252,11 +259,20 @@ def simulator_module(protocol: Protocol) -> str:
                 if runs:
                     args.append(f"{name}={{{', '.join(f'{k!r}: {run_spec(r)}' for k, r in runs.items())}}}")
         derived = derived_values(request, response)
+        refusals = refusals_of(request, replies_by_request(protocol.messages()))
+        code = protocol.command(request.command).code
+        for reply in (response, *refusals[:1]):
+            if reply is not None and reply.request_code and code is not None:
+                derived[reply.request_code] = f"lambda fields: {code:#04x}"  # the code of the request it answers
+        if refusals:
+            # a refused request (a value outside its range or enum, a refused write) gets the first refusal
+            imports.add(refusals[0].class_name)
+            args.append(f"refusal={refusals[0].class_name}")
         if derived:
             args.append(f"derived={{{', '.join(f'{k!r}: {v}' for k, v in derived.items())}}}")
-        if device.errors is not None and protocol.error_reply is not None:
-            code = protocol.command(request.command).code
-            args.append(f"code={code!r}")
+        if (device.errors is not None and protocol.error_reply is not None) or refusals:
+            if protocol.error_reply is not None:
+                args.append(f"code={code!r}")
             checked = limits(request)
             if checked:
                 shown = ", ".join(f"{k!r}: ({number(lo)}, {number(hi)}, {v!r})" for k, (lo, hi, v) in checked.items())
@@ -270,6 +286,7 @@ def simulator_module(protocol: Protocol) -> str:
         if tables:
             args.append(f"tables={tables!r}")
         echoed = echoes(protocol, request, response, tables, derived, behaviour.echoes if behaviour else ())
+        echoed += tuple(m.request_code for m in refusals[:1] if m.request_code)  # a refusal names what it refuses
         if echoed:
             args.append(f"echoes={echoed!r}")
         # what the device fills in itself: what it reads, and runs of registers (empty unless read); a table value

@@ -17,6 +17,7 @@ from serialspec.backends.common.render import render
 from serialspec.cli.views import engineering_unit
 from serialspec.lang.frozen import frozen
 from serialspec.lang.model import (
+    VALUE_ROLES,
     Array,
     BitField,
     Bytes,
@@ -118,6 +119,14 @@ def _direction(protocol: Protocol, direction: Direction) -> dict[str, Any]:
         key = _code(command.code if coded else None)
         if protocol.error_reply is not None and command.name == protocol.error_reply.command:
             key = "error"
+        if key in codes and direction == Direction.REQUEST:  # requests sharing a code: by their content size
+            shared = codes[key]
+            layouts_by_size = shared.get("by_size") or [shared.pop("message")]
+            shared["by_size"] = [*layouts_by_size, _message(protocol, message)]
+            highs = [m["max"] for m in shared["by_size"]]
+            shared["min"] = min(m["min"] for m in shared["by_size"])
+            shared["max"] = None if None in highs else max(highs)
+            continue
         if key in codes and not message.default_reply:
             continue  # replies sharing a code: the one decoded without its request (the default) is shown
         codes[key] = {"message": _message(protocol, message)}
@@ -141,7 +150,7 @@ def _layout(layout: FrameLayout) -> dict[str, Any]:
         item["big"] = element.endian == ">"
         if element.fixed:
             item["constant"] = element.constant
-        if element.role in ("address", "status", "command"):
+        if element.role in (*VALUE_ROLES, "command"):
             item["min"], item["max"] = int(element.minimum), int(element.maximum)
             if element.broadcast is not None:
                 item["broadcast"] = element.broadcast

@@ -23,6 +23,7 @@ from serialspec.lang.model import (
     fixed_size,
     replies_by_request,
     reply_to,
+    sizes_text,
 )
 from serialspec.lang.passes.base import camel
 from serialspec.lang.passes.fields import FieldResolver
@@ -217,11 +218,14 @@ class Commands(FieldResolver):
         responses = {m.key: m for c in commands for m in c.messages() if m.direction == Direction.RESPONSE}
         for command in commands:
             for message in command.messages():
+                path = (*message_path(message), "answered_by")
                 if message.answered_by and message.answered_by not in responses:
-                    self.error(
-                        ("commands", command.name, "request", "answered_by", "command"),
-                        f"{message.answered_by!r} is not a command with a response",
-                    )
+                    self.error((*path, "command"), f"{message.answered_by!r} is not a command with a response")
+                for index, name in enumerate(message.refused_by):
+                    if name not in responses:
+                        self.error((*path, "refused_by", index), f"{name!r} is not a command with a response")
+                    elif name == (message.answered_by or message.key):
+                        self.error((*path, "refused_by", index), f"{name!r} is the reply that answers it")
 
     def check_codes(self, commands: list[Command], framing: Framing) -> None:
         for command in commands:
@@ -269,7 +273,17 @@ class Commands(FieldResolver):
                 if len(users) < 2:
                     continue
                 what = f"code {code:#04x}" if code is not None else "a codeless reply"
-                if direction == Direction.REQUEST or any(c.selector for c, _ in users):
+                if direction == Direction.REQUEST and not any(c.selector for c, _ in users):
+                    if any(alt.length is None for alt in framing.alternatives.get(direction, (layout,))):
+                        self.error(
+                            ("commands", users[1][0].name),
+                            f"{what} in request frames is already used by {users[0][0].name!r}; requests that share "
+                            "a code are told apart by their content size, which needs a length element",
+                        )
+                    else:
+                        self.check_sizes_differ(what, users)
+                    continue
+                if any(c.selector for c, _ in users):
                     for command, _ in users[1:]:
                         self.error(
                             ("commands", command.name),
@@ -284,6 +298,21 @@ class Commands(FieldResolver):
                         f"{what} is shared by the replies of {names}: mark one of them `default: true` (the "
                         "layout a reply is decoded as when its request is unknown)",
                     )
+
+    def check_sizes_differ(self, what: str, users: list[tuple[Command, Message]]) -> None:
+        """Requests that share a code are told apart by their content size: no size may fit two of them."""
+        for index, (command, message) in enumerate(users):
+            for other, earlier in users[:index]:
+                low = max(message.min_size, earlier.min_size)
+                highs = [h for h in (message.max_size, earlier.max_size) if h is not None]
+                if not highs or low <= min(highs):
+                    self.error(
+                        ("commands", command.name),
+                        f"{what} in request frames is already used by {other.name!r}, and a content of {low} "
+                        f"byte{'' if low == 1 else 's'} fits both (requests that share a code are told apart by "
+                        f"their content size: {sizes_text(earlier)} and {sizes_text(message)})",
+                    )
+                    break  # one line a command
 
     def message(
         self,
@@ -336,6 +365,8 @@ class Commands(FieldResolver):
             optional_when=self.optional_when(value.get("optional_when"), (*path, "optional_when")),
             after=self.after(value.get("after"), fields, direction, path),
             answered_by=str(answered_by.get("command", "")),
+            refused_by=tuple(str(name) for name in answered_by.get("refused_by") or ()),
+            request_code=self.request_code(value.get("request_code"), fields, direction, path),
             default_reply=bool(value.get("default", False)),
             reply_when=self.optional_when(answered_by.get("optional_when"), (*path, "answered_by", "optional_when")),
             struct_name=struct_name,
@@ -361,6 +392,16 @@ class Commands(FieldResolver):
             raise self.fail(path, f"give one comparison: {', '.join(OPTIONAL_WHEN_OPS)}")
         key, op = given[0]
         return OptionalWhen(table.name, entry.name, entry.key, int(value[key]), op)
+
+    def request_code(self, value: Any, fields: tuple[Field, ...], direction: Direction, path: Path) -> str:
+        if value is None:
+            return ""
+        if direction != Direction.RESPONSE:
+            self.error((*path, "request_code"), "`request_code` names a field of a response")
+        elif not any(isinstance(f, Scalar) and not (f.hidden or f.type.is_float) and f.name == value for f in fields):
+            names = ", ".join(f.name for f in fields if isinstance(f, Scalar) and not f.hidden) or "none"
+            self.error((*path, "request_code"), f"no integer field {value!r} in this response (it has: {names})")
+        return str(value)
 
     def after(self, value: Any, fields: tuple[Field, ...], direction: Direction, path: Path) -> str:
         if value is None:

@@ -14,6 +14,7 @@ from serialspec.checksums import ChecksumProblem
 from serialspec.lang.errors import SpecError
 from serialspec.lang.loader import Path
 from serialspec.lang.model import (
+    VALUE_ROLES,
     Checksum,
     Direction,
     FrameElement,
@@ -27,7 +28,7 @@ from serialspec.runtime.hexbytes import parse_hex
 from serialspec.transforms import TransformProblem
 
 CONSTANT_ROLES = ("header", "trailer", "constant")
-_CLASSIC_ROLES = {"header", "address", "command", "status", "length", "content", "checksum"}
+_CLASSIC_ROLES = {"header", "address", "command", "status", "value", "length", "content", "checksum"}
 
 
 class FramingPass(FieldResolver):
@@ -114,7 +115,7 @@ class FramingPass(FieldResolver):
             resolved = self.scalar(common, {"type": scalar.name, "bits": item["bits"]}, path, endian)
             bits, bits_class = resolved.bits, resolved.bits_class
         checksum = self.checksum(item, name, scalar, endian, path) if role == "checksum" and scalar else None
-        for key, allowed in (("adds", "length"), ("counts", "length"), ("covers", "checksum")):
+        for key, allowed in (("adds", "length"), ("counts", "length"), ("covers", "checksum"), ("sequence", "value")):
             if key in item and role != allowed:
                 self.error((*path, key), f"`{key}` belongs to a {allowed} element")
         return FrameElement(
@@ -128,6 +129,7 @@ class FramingPass(FieldResolver):
             maximum=high,
             broadcast=item.get("broadcast"),
             flags=self.reference("flags", self.flags, item.get("flags"), (*path, "flags")),
+            sequence=bool(item.get("sequence", False)),
             endian=endian,
             bits=bits,
             bits_class=bits_class,
@@ -349,7 +351,7 @@ class FramingPass(FieldResolver):
             checksum_offset_from_end=final.size or 1 if final is not None and final.role == "checksum" else 0,
             covered_from=covered_from,
             covered_to_end=covered_to_end,
-            value_elements=tuple(e for e in elements if e.role in ("address", "status")),
+            value_elements=tuple(e for e in elements if e.role in VALUE_ROLES),
             name=layout_name,
             transparency=transparency,
             checksums=checksums,

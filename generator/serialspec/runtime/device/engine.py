@@ -121,6 +121,7 @@ class CommandSpec:
     releases: str = ""  # state variable: cleared, and the requests held meanwhile carried out
     cancel_when: dict[str, float] = field(default_factory=dict)  # with releases: the values that drop them
     carries: tuple[str, str] | None = None  # (code field, content field): another command's request content
+    refusal: type[Message] | None = None  # the reply of another command a refused request gets (`refused_by`)
     # moves: where the state goes, a function of `get` (request fields, then memory and state); default: the target
     move_to: Callable[[Callable[[str], float]], float] | None = None
 
@@ -681,10 +682,11 @@ class Engine(FaultInjection):
 
     def _reply(self, device: VirtualDevice, command: CommandSpec, given: dict[str, Any], refused: str) -> bytes | None:
         """The response to a request carried out (or refused: `refused` says why) on one device."""
-        if command.response is None:
+        response = command.refusal if refused and command.refusal is not None else command.response
+        if response is None:
             return None
         values: dict[str, Any] = {}
-        for name in field_names(command.response):
+        for name in field_names(response):
             if name in command.space_reads and not refused:
                 values[name] = self._read_space(device, command.space_reads[name], given)
             elif name in command.reads and not refused:
@@ -718,7 +720,7 @@ class Engine(FaultInjection):
         nest(values, {k: v for k, v in self.spec.reply.items() if "." in k})
         nest(values, {k: int(bool(device.get(e))) for k, e in device.spec.status.items() if "." in k})
         nest(values, command.nothing_held if refused == "held" else self.spec.errors.get(refused, {}))
-        return self._encode_reply(command.response, values)
+        return self._encode_reply(response, values)
 
     # --- data spaces and error replies ------------------------------------------------------------------------------
 

@@ -4402,6 +4402,20 @@ static size_t fashionstar_uart__next(fashionstar_uart_parser_t *p, size_t start)
 #endif
 }
 
+
+/* The fewest bytes any layout of the direction needs before the classic parser judges a candidate. */
+static size_t fashionstar_uart__least(fashionstar_uart_direction_t dir)
+{
+    switch (dir) {
+    case FASHIONSTAR_UART_REQUEST:
+        return 4u;
+    case FASHIONSTAR_UART_RESPONSE:
+        return 4u;
+    default:
+        return 0u;
+    }
+}
+
 /* The first cut bytes held dropped, with their verdicts: a loop, kept one (GCC would make it two calls of the
  * library's memmove, which a parser-only build has no other use for). */
 #if defined(__GNUC__) && !defined(__clang__)
@@ -4434,6 +4448,12 @@ static int fashionstar_uart__push(fashionstar_uart_parser_t *p, uint8_t byte, fa
     while (start < p->n) {
         pos = fashionstar_uart__next(p, start);
         if (pos >= p->n) {
+            break;
+        }
+        if (p->n - pos < fashionstar_uart__least(p->dir)) { /* waiting, too short for any layout, and so is every later one */
+            if (hold == (size_t)-1) {
+                hold = pos;
+            }
             break;
         }
         r = fashionstar_uart__try(p, pos, out, &size);

@@ -1610,6 +1610,20 @@ static size_t feetech_sms__next(feetech_sms_parser_t *p, size_t start)
 #endif
 }
 
+
+/* The fewest bytes any layout of the direction needs before the classic parser judges a candidate. */
+static size_t feetech_sms__least(feetech_sms_direction_t dir)
+{
+    switch (dir) {
+    case FEETECH_SMS_REQUEST:
+        return 5u;
+    case FEETECH_SMS_RESPONSE:
+        return 4u;
+    default:
+        return 0u;
+    }
+}
+
 /* The first cut bytes held dropped, with their verdicts: a loop, kept one (GCC would make it two calls of the
  * library's memmove, which a parser-only build has no other use for). */
 #if defined(__GNUC__) && !defined(__clang__)
@@ -1642,6 +1656,12 @@ static int feetech_sms__push(feetech_sms_parser_t *p, uint8_t byte, feetech_sms_
     while (start < p->n) {
         pos = feetech_sms__next(p, start);
         if (pos >= p->n) {
+            break;
+        }
+        if (p->n - pos < feetech_sms__least(p->dir)) { /* waiting, too short for any layout, and so is every later one */
+            if (hold == (size_t)-1) {
+                hold = pos;
+            }
             break;
         }
         r = feetech_sms__try(p, pos, out, &size);

@@ -4290,6 +4290,20 @@ static size_t hiwonder_rrc__next(hiwonder_rrc_parser_t *p, size_t start)
 #endif
 }
 
+
+/* The fewest bytes any layout of the direction needs before the classic parser judges a candidate. */
+static size_t hiwonder_rrc__least(hiwonder_rrc_direction_t dir)
+{
+    switch (dir) {
+    case HIWONDER_RRC_REQUEST:
+        return 4u;
+    case HIWONDER_RRC_RESPONSE:
+        return 4u;
+    default:
+        return 0u;
+    }
+}
+
 /* The first cut bytes held dropped, with their verdicts: a loop, kept one (GCC would make it two calls of the
  * library's memmove, which a parser-only build has no other use for). */
 #if defined(__GNUC__) && !defined(__clang__)
@@ -4322,6 +4336,12 @@ static int hiwonder_rrc__push(hiwonder_rrc_parser_t *p, uint8_t byte, hiwonder_r
     while (start < p->n) {
         pos = hiwonder_rrc__next(p, start);
         if (pos >= p->n) {
+            break;
+        }
+        if (p->n - pos < hiwonder_rrc__least(p->dir)) { /* waiting, too short for any layout, and so is every later one */
+            if (hold == (size_t)-1) {
+                hold = pos;
+            }
             break;
         }
         r = hiwonder_rrc__try(p, pos, out, &size);

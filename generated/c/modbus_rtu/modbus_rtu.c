@@ -2504,6 +2504,7 @@ static size_t modbus_rtu__next(modbus_rtu_parser_t *p, size_t start)
 #endif
 }
 
+
 /* The first cut bytes held dropped, with their verdicts: a loop, kept one (GCC would make it two calls of the
  * library's memmove, which a parser-only build has no other use for). */
 #if defined(__GNUC__) && !defined(__clang__)

@@ -2222,6 +2222,7 @@ static size_t vesc__next(vesc_parser_t *p, size_t start)
 #endif
 }
 
+
 /* The first cut bytes held dropped, with their verdicts: a loop, kept one (GCC would make it two calls of the
  * library's memmove, which a parser-only build has no other use for). */
 #if defined(__GNUC__) && !defined(__clang__)

@@ -535,8 +535,10 @@ def source(ctx: Ctx) -> str:
     header_cases: list[str] = []
     command_cases: list[str] = []
     count_cases: list[str] = []
+    least_cases: list[str] = []
     for d in directions(protocol):
         alternatives = protocol.framing.alternatives[d]
+        least_cases.append(f"    case {P}_{d.name}:\n        return {min(_prefix(ctx, a) for a in alternatives)}u;")
         count_cases.append(f"    case {P}_{d.name}:\n        return {len(alternatives)}u;")
         mask = sum(1 << k for k, layout in enumerate(alternatives) if layout.has_command)
         command_cases.append(f"    case {P}_{d.name}:\n        return (({mask}UL >> k) & 1u) != 0u;")
@@ -731,6 +733,26 @@ def source(ctx: Ctx) -> str:
         for d in directions(protocol)
     )
     any_stuffed = any(stuffed.values())
+    least, least_check = "", ""
+    if any(c.split("return ")[1] != "0u;" for c in least_cases):  # the classic parser waits for a prefix
+        least = f"""
+/* The fewest bytes any layout of the direction needs before the classic parser judges a candidate. */
+static size_t {p}__least({p}_direction_t dir)
+{{
+    switch (dir) {{
+{chr(10).join(least_cases)}
+    default:
+        return 0u;
+    }}
+}}
+"""
+        least_check = f"""
+        if (p->n - pos < {p}__least(p->dir)) {{ /* waiting, too short for any layout, and so is every later one */
+            if (hold == (size_t)-1) {{
+                hold = pos;
+            }}
+            break;
+        }}"""
     every = [layout for d in directions(protocol) for layout in protocol.framing.alternatives[d]]
     all_lengths = int(all(layout.length is not None for layout in every))
     single = int(all(n == 1 for n in n_layouts.values()))
@@ -1120,6 +1142,7 @@ static size_t {p}__next({p}_parser_t *p, size_t start)
 #endif
 }}
 
+{least}
 /* The first cut bytes held dropped, with their verdicts: a loop, kept one (GCC would make it two calls of the
  * library's memmove, which a parser-only build has no other use for). */
 #if defined(__GNUC__) && !defined(__clang__)
@@ -1153,7 +1176,7 @@ static int {p}__push({p}_parser_t *p, uint8_t byte, {p}_msg_t *out)
         pos = {p}__next(p, start);
         if (pos >= p->n) {{
             break;
-        }}
+        }}{least_check}
         r = {p}__try(p, pos, out, &size);
         if (r == {P}__V_WAIT) {{
             if (hold == (size_t)-1) {{

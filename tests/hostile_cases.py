@@ -241,7 +241,12 @@ CASES: list[tuple[str, str, Mutation | Text, str | None]] = [
         put("commands/move/code", -8),
         "commands.move.code: code -8 does not fit the u8 command element (0..255)",
     ),
-    ("code as text", "tiny", put("commands/move/code", "one"), "commands.move.code: expected an integer, got text"),
+    (
+        "code as text",
+        "tiny",
+        put("commands/move/code", "one"),
+        "commands.move.code: expected an integer, got text (text codes belong to `framing: {kind: text}`)",
+    ),
     ("code true", "tiny", put("commands/move/code", True), "commands.move.code: expected an integer, got true/false"),
     ("code float", "tiny", put("commands/move/code", 1.5), "commands.move.code: expected an integer, got a number"),
     (
@@ -382,10 +387,10 @@ CASES: list[tuple[str, str, Mutation | Text, str | None]] = [
         "commands.move.request.fields.extra.count: an array needs a fixed `count` (use a group for counted items)",
     ),
     (
-        "array of f64",
+        "array of f128",
         "tiny",
-        put("commands/move/request/fields/extra", {"type": "array", "of": "f64", "count": 2}),
-        "commands.move.request.fields.extra.of: unknown type 'f64' (expected one of u8, i8, u16, i16, u32, i32, f32)",
+        put("commands/move/request/fields/extra", {"type": "array", "of": "f128", "count": 2}),
+        "commands.move.request.fields.extra.of: unknown type 'f128' (expected one of u8, i8, u16, i16, u24, i24, u32, i32, u64, i64, f32, f64)",
     ),
     ("enum value 256", "tiny", put("enums/mode/values/fast", 256), "enums.mode.values.fast: value 256 does not fit u8"),
     ("enum value -1", "tiny", put("enums/mode/values/fast", -1), "enums.mode.values.fast: value -1 does not fit u8"),
@@ -661,7 +666,7 @@ CASES: list[tuple[str, str, Mutation | Text, str | None]] = [
         "type typo",
         "tiny",
         put("commands/move/request/fields/extra", "uint16"),
-        "commands.move.request.fields.extra: unknown type 'uint16' (expected one of u8, i8, u16, i16, u32, i32, f32, bytes, string, cstring, array, group, table_value, table_block, or a field from `fields:`)",
+        "commands.move.request.fields.extra: unknown type 'uint16' (expected one of u8, i8, u16, i16, u24, i24, u32, i32, u64, i64, f32, f64, bytes, string, cstring, array, group, table_value, table_block, or a field from `fields:`)",
     ),
     (
         "frame element flags typo",

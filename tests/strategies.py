@@ -12,6 +12,7 @@ from serialspec.lang.model import (
     Group,
     List,
     Message,
+    Packed,
     Protocol,
     Scalar,
     ScalarType,
@@ -27,7 +28,7 @@ TEXT = st.text(st.characters(min_codepoint=0x20, max_codepoint=0x7E), max_size=1
 
 def number(scalar: ScalarType, low: float, high: float) -> st.SearchStrategy[Any]:
     if scalar.is_float:
-        return st.floats(low, high, width=32, allow_nan=False, allow_infinity=False)
+        return st.floats(low, high, width=scalar.size * 8, allow_nan=False, allow_infinity=False)
     return st.integers(int(low), int(high))
 
 
@@ -51,6 +52,9 @@ def fields_values(fields: tuple[Field, ...], rest_budget: int) -> st.SearchStrat
                 values[f.name] = draw(
                     st.lists(number(f.item, f.minimum, f.maximum), min_size=f.count, max_size=f.count)
                 )
+            elif isinstance(f, Packed):
+                items = st.integers(int(f.minimum), int(f.maximum))
+                values[f.name] = draw(st.lists(items, min_size=f.count, max_size=f.count))
             elif isinstance(f, Bytes):
                 if isinstance(f.size, int):
                     size = f.size
@@ -62,7 +66,10 @@ def fields_values(fields: tuple[Field, ...], rest_budget: int) -> st.SearchStrat
             elif isinstance(f, List):
                 values[f.name] = draw(list_value(f, fields))
             elif isinstance(f, Text):
-                if isinstance(f.size, int):
+                if isinstance(f.size, int) and f.pad is not None:  # shorter text, never ending in the pad byte
+                    text = draw(st.text(st.characters(min_codepoint=0x20, max_codepoint=0x7E), max_size=f.size))
+                    values[f.name] = text.rstrip(chr(f.pad))
+                elif isinstance(f.size, int):
                     values[f.name] = draw(
                         st.text(st.characters(min_codepoint=0x20, max_codepoint=0x7E), min_size=f.size, max_size=f.size)
                     )

@@ -134,7 +134,7 @@ def _line(text: str, needle: str) -> int:
 
 def test_every_shipped_bus_declares_how_to_find_its_devices() -> None:
     """The shipped specs whose documents give a presence request declare it; the RRC board (one board per port,
-    answering no request that is only a presence check) does not."""
+    answering no request that is only a presence check) and NMEA 0183 (receivers talk on their own) do not."""
     declared = {}
     for spec in sorted((ROOT / "specs").glob("*.yaml")):
         protocol = load_protocol(str(spec))
@@ -146,5 +146,6 @@ def test_every_shipped_bus_declares_how_to_find_its_devices() -> None:
         "feetech_sms": "ping",
         "hiwonder_rrc": None,
         "modbus_rtu": "read_holding_registers",
+        "nmea0183": None,
         "vesc": "fw_version",
     }

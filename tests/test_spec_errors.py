@@ -94,6 +94,14 @@ def test_three_mistakes_give_three_lines(tmp_path: Path) -> None:
         (("angle: i16", "name: {type: string}"), "a string needs `size`"),
         (("angle: i16", "name: {type: cstring, size: 4}"), "a cstring ends at its NUL byte"),
         (("type: u8}", "type: u8, error_flag: 0x80}"), "`error_flag` needs a command whose response is marked"),
+        (("angle: i16", "rc: {type: array, of: u11, count: n}"), "an array of u11 items needs a fixed `count`"),
+        (("angle: i16", "rc: {type: array, of: u65, count: 2}"), "u65: packed integers take 1..64 bits"),
+        (("angle: i16", "rc: {type: array, of: u11, count: 2, range: [0, 4096]}"), "does not fit u11 (0..2047)"),
+        (("angle: i16", "rc: {type: array, of: u24, count: rest}"), "an array of u24 items needs a fixed `count`"),
+        (("angle: i16", "rc: {type: array, of: u16, count: 2, bit_order: lsb_first}"), "`bit_order` goes with"),
+        (("angle: i16", "name: {type: string, size: 8, pad: 'zz'}"), "pad 'zz' must be one byte in hex"),
+        (("angle: i16", "name: {type: cstring, pad: '00'}"), "`pad` goes with a string of a fixed size"),
+        (("angle: i16", "m: {type: u8, enum: e, offset: 3}\nenums: {e: {values: {a: 1}}}"), "`offset` goes with"),
     ],
 )
 def test_each_mistake_is_named_with_its_position(tmp_path: Path, change: tuple[str, str], expected: str) -> None:

@@ -31,6 +31,7 @@ from serialspec.lang.model import (
     Group,
     List,
     Message,
+    Packed,
     Protocol,
     Scalar,
     TableBlock,
@@ -96,9 +97,9 @@ def value(field: Field, shown: ET.Element, abbr: str) -> Any:
             if field.bits:
                 return {b.name: int(child(shown, f"{abbr}.{b.name}").get("show") or 0) for b in field.bits}
             return number(shown.get("show") or "")
-        case Array() | List():
+        case Array() | List() | Packed():
             items = children(shown, f"{abbr}.value")
-            if isinstance(field, List) and field.bits:
+            if isinstance(field, List) and field.item is None:
                 return [item.get("show") == "1" for item in items]
             return [number(item.get("show") or "") for item in items]
         case Text():

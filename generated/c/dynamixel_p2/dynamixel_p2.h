@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define DYNAMIXEL_P2_SPEC_SHA256 "c1abf1c8886285436a9053588b577ef0acc0670e85cbe2379a1d166baa8d48f2"
+#define DYNAMIXEL_P2_SPEC_SHA256 "554f17218787ecfbf4f18261b4fccf3c307bc273ab9dd344bf444a5ac95db9c9"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef DYNAMIXEL_P2_ENABLE_ENCODE

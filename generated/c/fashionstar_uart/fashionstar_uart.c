@@ -44,7 +44,7 @@ static uint32_t fashionstar_uart__check(uint8_t which, const uint8_t *d, size_t 
 {
     switch (which) {
     case 0u:
-        return (uint32_t)(fashionstar_uart_sum8(0u, d, n));
+        return ((uint32_t)(fashionstar_uart_sum8(0u, d, n)) & 0xffu);
     default:
         return 0u;
     }

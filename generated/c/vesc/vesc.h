@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define VESC_SPEC_SHA256 "054d37052749674cb9e372a888ccbb787ab454b29361bd4b28537d017b124389"
+#define VESC_SPEC_SHA256 "82bf2ef3b3564067cbfdb077b6363d71b1b62e1b9b503dbdb418827f353fd528"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef VESC_ENABLE_ENCODE

@@ -17,6 +17,8 @@ from construct import (  # noqa: F401 - the set of names is the same for every p
     CString,
     Float32b,
     Float32l,
+    Float64b,
+    Float64l,
     GreedyBytes,
     GreedyRange,
     Int8sb,
@@ -25,10 +27,18 @@ from construct import (  # noqa: F401 - the set of names is the same for every p
     Int16sl,
     Int16ub,
     Int16ul,
+    Int24sb,
+    Int24sl,
+    Int24ub,
+    Int24ul,
     Int32sb,
     Int32sl,
     Int32ub,
     Int32ul,
+    Int64sb,
+    Int64sl,
+    Int64ub,
+    Int64ul,
     RawCopy,
     Rebuild,
     Struct,
@@ -37,7 +47,16 @@ from construct import (  # noqa: F401 - the set of names is the same for every p
     this,
 )
 from serialspec.checksums.crc import crc_function
-from serialspec.runtime.constructs import Framed, PackedBits, SignMagnitude, Utf8, derived, valued  # noqa: F401
+from serialspec.runtime.constructs import (  # noqa: F401
+    Framed,
+    PackedBits,
+    PackedInts,
+    PaddedUtf8,
+    SignMagnitude,
+    Utf8,
+    derived,
+    valued,
+)
 from serialspec.runtime.framing import Element, FrameCodec, Layout, Transparency
 
 _CHECK_CRC: Callable[[bytes], int] = crc_function(16, 0x8005, 0x0, False, False, 0x0)  # CRC-16/UMTS (CRC-16/BUYPASS)

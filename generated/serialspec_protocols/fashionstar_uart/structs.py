@@ -16,6 +16,8 @@ from construct import (  # noqa: F401 - the set of names is the same for every p
     CString,
     Float32b,
     Float32l,
+    Float64b,
+    Float64l,
     GreedyBytes,
     GreedyRange,
     Int8sb,
@@ -24,10 +26,18 @@ from construct import (  # noqa: F401 - the set of names is the same for every p
     Int16sl,
     Int16ub,
     Int16ul,
+    Int24sb,
+    Int24sl,
+    Int24ub,
+    Int24ul,
     Int32sb,
     Int32sl,
     Int32ub,
     Int32ul,
+    Int64sb,
+    Int64sl,
+    Int64ub,
+    Int64ul,
     RawCopy,
     Rebuild,
     Struct,
@@ -36,7 +46,15 @@ from construct import (  # noqa: F401 - the set of names is the same for every p
     this,
 )
 from serialspec.checksums.sum import sum_function
-from serialspec.runtime.constructs import PackedBits, SignMagnitude, Utf8, derived, valued  # noqa: F401
+from serialspec.runtime.constructs import (  # noqa: F401
+    PackedBits,
+    PackedInts,
+    PaddedUtf8,
+    SignMagnitude,
+    Utf8,
+    derived,
+    valued,
+)
 
 _checksum = sum_function(8, False)
 

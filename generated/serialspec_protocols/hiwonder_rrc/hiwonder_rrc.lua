@@ -2586,10 +2586,11 @@ end
 
 local P = SPEC.name
 local proto = Proto(P, SPEC.title .. " (serialspec)")
-local SIZES = {u8 = 1, i8 = 1, u16 = 2, i16 = 2, u32 = 4, i32 = 4, f32 = 4}
+local SIZES = {u8 = 1, i8 = 1, u16 = 2, i16 = 2, u24 = 3, i24 = 3, u32 = 4, i32 = 4, f32 = 4, u64 = 8, i64 = 8, f64 = 8}
 local MAKERS = {
   u8 = ProtoField.uint8, i8 = ProtoField.int8, u16 = ProtoField.uint16, i16 = ProtoField.int16,
-  u32 = ProtoField.uint32, i32 = ProtoField.int32,
+  u24 = ProtoField.uint24, i24 = ProtoField.int24, u32 = ProtoField.uint32, i32 = ProtoField.int32,
+  u64 = ProtoField.uint64, i64 = ProtoField.int64,
 }
 local UNSIGNED = {[1] = ProtoField.uint8, [2] = ProtoField.uint16, [3] = ProtoField.uint24, [4] = ProtoField.uint32}
 local DIRECTIONS = {[0] = "request", [1] = "response"}
@@ -2613,6 +2614,9 @@ end
 local function scalar_field(abbr, label, spec_type, enum, mask, description)
   if spec_type == "f32" then
     return ProtoField.float(abbr, label, nil, description)
+  end
+  if spec_type == "f64" then
+    return ProtoField.double(abbr, label, nil, description)
   end
   return MAKERS[spec_type](abbr, label, base.DEC, enum, mask, description)
 end
@@ -2646,6 +2650,12 @@ local function declare_field(f, abbr)
     else
       f.item = new(item, function() return scalar_field(item, f.name, f.type, nil, nil, f.description) end)
     end
+  elseif kind == "packed" then
+    f.pf = new(abbr, function() return ProtoField.none(abbr, f.name, f.description) end)
+    local item = abbr .. ".value"
+    f.item = new(item, function()
+      return (f.signed and ProtoField.int64 or ProtoField.uint64)(item, f.name, base.DEC, nil, nil, f.description)
+    end)
   elseif kind == "text" then
     f.pf = new(abbr, function() return ProtoField.string(abbr, f.name, base.UNICODE, f.description) end)
   elseif kind == "bytes" then
@@ -2839,7 +2849,11 @@ end
 -- --- fields ----------------------------------------------------------------------------------------------------------
 
 local function number(range, spec_type, big)
-  if spec_type == "f32" then
+  if SIZES[spec_type] == 8 and spec_type ~= "f64" then -- as a Lua number: exact up to 2^53
+    if spec_type == "i64" then return (big and range:int64() or range:le_int64()):tonumber() end
+    return (big and range:uint64() or range:le_uint64()):tonumber()
+  end
+  if spec_type == "f32" or spec_type == "f64" then
     if big then return range:float() end
     return range:le_float()
   end
@@ -2888,8 +2902,8 @@ local function add_scalar(f, tree, range, scope)
   for _, b in ipairs(f.bits or {}) do add(item, b.pf, range, f.big) end
   for _, flag in ipairs(f.flags or {}) do add(item, flag.pf, range, f.big) end
   if f.unit and f.unit ~= "" and not (f.enum or f.flags or f.bits) then
-    if f.scale then
-      item:append_text(" (" .. with_unit(engineering(value * f.scale), f.unit) .. ")")
+    if f.scale or f.offset then
+      item:append_text(" (" .. with_unit(engineering(value * (f.scale or 1) + (f.offset or 0)), f.unit) .. ")")
     else
       item:append_text(" " .. f.unit)
     end
@@ -2905,9 +2919,37 @@ local function size_of(f, scope, rest)
   return value
 end
 
+-- item i of integers of `bits` bits packed with no gaps from byte `pos`: lsb_first, the first in the lowest bits of
+-- the first byte, lowest bit first; else the first in the highest bits, highest bit first
+local function packed_item(tvb, pos, i, bits, lsb_first, signed)
+  local value = 0
+  for j = 0, bits - 1 do
+    local at = i * bits + j -- the item's j-th bit in wire order
+    local byte = tvb(pos + math.floor(at / 8), 1):uint()
+    if lsb_first then
+      if band(rshift(byte, at % 8), 1) == 1 then value = value + 2 ^ j end
+    elseif band(rshift(byte, 7 - at % 8), 1) == 1 then
+      value = value + 2 ^ (bits - 1 - j)
+    end
+  end
+  if signed and value >= 2 ^ (bits - 1) then value = value - 2 ^ bits end
+  return value
+end
+
 local function decode_field(f, tvb, pos, stop, tree, scope)
   local kind, rest = f.kind, stop - pos - (f.tail or 0)
-  if kind == "scalar" then
+  if kind == "packed" then
+    local size = math.ceil(f.count * f.bits / 8)
+    local list = tree:add(f.pf, need(tvb, pos, size, stop, f.name))
+    list:append_text(string.format(": %d item(s) of %d bits", f.count, f.bits))
+    for i = 0, f.count - 1 do
+      local first = math.floor(i * f.bits / 8)
+      local last = math.floor(((i + 1) * f.bits - 1) / 8)
+      local value = packed_item(tvb, pos, i, f.bits, f.lsb_first, f.signed)
+      list:add(f.item, tvb(pos + first, last - first + 1), f.signed and Int64(value) or UInt64(value))
+    end
+    return pos + size
+  elseif kind == "scalar" then
     add_scalar(f, tree, need(tvb, pos, SIZES[f.type], stop, f.name), scope)
     return pos + SIZES[f.type]
   elseif kind == "list" then
@@ -2956,6 +2998,10 @@ local function decode_field(f, tvb, pos, stop, tree, scope)
     end
     local range = need(tvb, pos, size, stop, f.name)
     local text = shown > 0 and tvb(pos, shown):raw() or ""
+    if f.pad then -- the pad bytes after the text are not part of it
+      local pad = string.char(f.pad)
+      while text:sub(-1) == pad do text = text:sub(1, -2) end
+    end
     tree:add(f.pf, range, text)
     scope[f.name] = text
     return pos + size
@@ -3093,6 +3139,18 @@ local function wire_of(layout, plain, stuffed, first, last)
   return table.concat(plain, "", first, t.first - 1) .. stuffed .. table.concat(plain, "", t.last + 1, last)
 end
 
+local function covered_by(layout, plain, stuffed, element)
+  -- the bytes a checksum covers: its span's, less the elements it leaves out (checksums inside it, never stuffed)
+  if element.skip == nil then
+    return wire_of(layout, plain, stuffed, element.span[1], element.span[2])
+  end
+  local parts = {}
+  for i = element.span[1], element.span[2] do
+    if not element.skip[i] then parts[#parts + 1] = plain[i] end
+  end
+  return table.concat(parts)
+end
+
 local function decode_content(message, range, length, tree)
   local content = length > 0 and range:tvb() or nil
   if content == nil and #message.fields > 0 then
@@ -3203,7 +3261,7 @@ local function dissect_frame(direction_name, direction, layout, entry, tvb, data
         end
       elseif role == "checksum" then
         local expected = not element.checksum.unverified and checksum(element.checksum, element.size,
-          wire_of(layout, plain, stuffed, element.span[1], element.span[2]))
+          covered_by(layout, plain, stuffed, element))
         if not expected then
           item:append_text(" [not verified: this dissector has no code for algorithm " .. element.checksum.algorithm
             .. "]")

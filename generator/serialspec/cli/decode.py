@@ -7,7 +7,7 @@ import sys
 from types import ModuleType
 from typing import TYPE_CHECKING, Any
 
-from serialspec.cli.protocols import SPEC_HELP, open_spec
+from serialspec.cli.protocols import SPEC_HELP, open_binary_spec
 from serialspec.cli.views import FlagNames, engineering, message_spec, register_view, unit_symbols, with_unit
 from serialspec.lang.model import Protocol, replies_by_request, reply_to
 from serialspec.runtime.errors import DecodeError, SerialspecError
@@ -39,7 +39,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     if not args.hex and not args.file:
         raise SerialspecError("give frames as hex arguments, - to read them from stdin, or --file CAPTURE")
-    protocol, package = open_spec(args.spec)
+    protocol, package = open_binary_spec(args.spec, "decode")
     request = None
     expect = None  # the reply layout the request gets, where replies share a code
     if args.request:
@@ -127,6 +127,16 @@ def _hex(text: str) -> bytes:
         raise DecodeError(str(exc)) from None
 
 
+def _has_checksum(protocol: Protocol, direction: str) -> bool:
+    """Whether the frames of a direction carry a checksum (in any of its layouts)."""
+    return any(
+        layout.checksums
+        for d, layouts in protocol.framing.alternatives.items()
+        if d.value == direction
+        for layout in layouts
+    )
+
+
 def describe(
     protocol: Protocol, message: Message, frame: bytes, units: bool, request: Message | None
 ) -> dict[str, Any]:
@@ -141,7 +151,8 @@ def describe(
         "command": message.COMMAND,
         "subcommand": message.SUBCOMMAND,
         "fields": fields,
-        "checksum_ok": True,  # a frame whose checksum fails does not decode
+        # a frame whose checksum fails does not decode; null where its direction's frames carry none
+        "checksum_ok": True if _has_checksum(protocol, message.DIRECTION.value) else None,
         "hex": frame.hex(" "),
     }
     if symbols:

@@ -6,7 +6,7 @@ import argparse
 import json
 from typing import Any
 
-from serialspec.cli.protocols import SPEC_HELP, message_type, open_spec
+from serialspec.cli.protocols import SPEC_HELP, message_type, open_binary_spec
 from serialspec.runtime.errors import EncodeError
 
 
@@ -22,7 +22,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    _, package = open_spec(args.spec)
+    _, package = open_binary_spec(args.spec, "encode")
     try:
         data: Any = json.loads(args.json)
     except json.JSONDecodeError as exc:

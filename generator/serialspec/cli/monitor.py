@@ -13,7 +13,7 @@ import serial
 from serialspec.cli import capture
 from serialspec.cli.frames import Frames, Seen
 from serialspec.cli.listening import Stopping, open_port
-from serialspec.cli.protocols import SPEC_HELP, open_spec
+from serialspec.cli.protocols import SPEC_HELP, open_binary_spec
 from serialspec.cli.views import engineering, unit_symbols, with_unit
 from serialspec.lang.model import Protocol
 from serialspec.runtime.errors import PortError, SerialspecError
@@ -83,7 +83,7 @@ class Printer:
 
 
 def run(args: argparse.Namespace) -> int:
-    protocol, package = open_spec(args.spec)
+    protocol, package = open_binary_spec(args.spec, "monitor")
     settings = package.SERIAL
     address = protocol.device.address if protocol.device else None
     frames = Frames(package, args.direction, address)

@@ -20,7 +20,7 @@ from typing import Any
 
 from serialspec.cli import capture
 from serialspec.cli.frames import Frames
-from serialspec.cli.protocols import SPEC_HELP, open_spec
+from serialspec.cli.protocols import SPEC_HELP, open_binary_spec
 from serialspec.cli.views import engineering_unit, message_spec, register_view
 from serialspec.lang.model import Bytes, Protocol, Scalar, Table, TableValue
 from serialspec.runtime.errors import PortError, SerialspecError
@@ -73,12 +73,12 @@ def run(args: argparse.Namespace) -> int:
     if args.port:
         if not args.spec:
             raise SerialspecError("--port needs --spec SPEC (the protocol on the port)")
-        protocol, package = open_spec(args.spec)
+        protocol, package = open_binary_spec(args.spec, "plot")
         chunks = record(args.port, package, args.baudrate, args.duration)
         source = args.port
     else:
         chunks = read_capture(args.capture)
-        protocol, package = open_spec(args.spec or _named_protocol(args.capture))
+        protocol, package = open_binary_spec(args.spec or _named_protocol(args.capture), "plot")
         source = Path(args.capture).name
     panels = collect(protocol, package, chunks, args.fields, set(args.ids or ()))
     draw(pyplot, panels, f"{protocol.name}: {source}", out)
@@ -212,7 +212,7 @@ def field_values(protocol: Protocol, message: Message, request: Message | None) 
         if isinstance(value, bool) or not isinstance(value, int | float):
             continue
         if isinstance(f, Scalar) and not (f.enum or f.flags or f.bits):
-            found[f.name] = _scaled(value, f.scale), engineering_unit(f.unit, f.scale)
+            found[f.name] = _scaled(value, f.scale) + (f.offset or 0), engineering_unit(f.unit, f.scale)
         elif isinstance(f, TableValue):
             entry = f.table.entry(fields.get(f.key, -1))
             if entry is not None and entry.enum is None and entry.flags is None:

@@ -9,7 +9,8 @@ table, or that holds a `specs/` folder. The table may set:
     schema = "specs/serialspec.schema.json"   # the language's JSON Schema, for editors ("" for none)
     reference = "docs/language.md"            # the language reference, examples from the specs (default: none)
     namespace = "acme_protocols"              # packages go to DIR/acme_protocols/<protocol>/ (not with --out DIR)
-    old_names = true                          # and DIR/<protocol>/__init__.py aliases the old import name, warning
+    old_names = ["tinylamp"]                  # and DIR/tinylamp/__init__.py aliases its old import name, warning
+                                              # (true: every protocol's)
 
 Spec paths and `--out` given on the command line replace `specs` and `out`.
 """
@@ -49,7 +50,8 @@ class Project:
     reference: Path | None
     chosen: bool  # the specs were named on the command line (not the project's whole set)
     namespace: str = ""  # the package every protocol package sits in ("" for top-level packages)
-    old_names: bool = False  # with a namespace: a module under each protocol's top-level name aliases it
+    #: With a namespace: protocols whose top-level name gets a module aliasing the package ("*": every one).
+    old_names: frozenset[str] = frozenset()
 
     def package_folder(self, name: str) -> str:
         """Where a generated package's files go, relative to the output folder."""
@@ -115,7 +117,19 @@ def project(root: Path | None, specs: Sequence[str] = (), out: str | None = None
         root / str(reference) if reference else None,
         bool(specs),
         namespace,
-        bool(config.get("old_names", False)) and bool(namespace),
+        _old_names(config.get("old_names", False)) if namespace else frozenset(),
+    )
+
+
+def _old_names(setting: object) -> frozenset[str]:
+    if setting is True:
+        return frozenset({"*"})
+    if setting is False:
+        return frozenset()
+    if isinstance(setting, list) and all(isinstance(name, str) and name.isidentifier() for name in setting):
+        return frozenset(setting)
+    raise SerialspecError(
+        f"[tool.serialspec] old_names must be true, false or a list of protocol names, not {setting!r}"
     )
 
 
@@ -156,7 +170,7 @@ def expected_files(
         package = next(name for name in outputs.files if name.endswith(f"/{SHIPPED_SPEC}")).split("/")[0]
         if proj.namespace:
             chosen = {_in_namespace(proj, package, name): text for name, text in chosen.items()}
-            if proj.old_names and (not targets or "python" in targets):
+            if {"*", package} & proj.old_names and (not targets or "python" in targets):
                 chosen[f"{package}/__init__.py"] = _old_name(proj, spec, package)
         files.update({proj.out / name: _spec_link(proj, spec, name, text) for name, text in chosen.items()})
         errors.extend(outputs.errors)

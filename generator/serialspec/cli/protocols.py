@@ -55,6 +55,17 @@ def open_spec(spec: str) -> tuple[Protocol, ModuleType]:
 _BUILT: dict[tuple[str, str, bytes], tuple[Protocol, ModuleType]] = {}
 
 
+def open_binary_spec(spec: str, verb: str) -> tuple[Protocol, ModuleType]:
+    """`open_spec` for the verbs that read frames of bytes: a text protocol is refused in one line."""
+    protocol, package = open_spec(spec)
+    if protocol.text is not None:
+        raise SerialspecError(
+            f"{spec} is a text protocol (`framing: {{kind: text}}`): `serialspec {verb}` does not handle text frames "
+            "yet (its generated package's decode, encode and StreamParser do)"
+        )
+    return protocol, package
+
+
 def resolved(path: str, display: str, data: bytes) -> Protocol:
     """`load_protocol(path, display)` for a spec whose text is `data`: from the cache when it holds the model resolved
     from exactly that text and name by exactly this spec language (the commands that only read a spec, `decode`

@@ -20,7 +20,7 @@ from types import ModuleType
 from typing import Any
 
 from serialspec.cli import port_options
-from serialspec.cli.protocols import SPEC_HELP, open_spec
+from serialspec.cli.protocols import SPEC_HELP, open_binary_spec
 from serialspec.lang.model import Bytes, Direction, Presence, Protocol, replies_by_request, reply_to
 from serialspec.runtime.errors import PortError, SerialspecError
 from serialspec.runtime.message import Message
@@ -69,7 +69,7 @@ class Found:
 
 
 def run(args: argparse.Namespace) -> int:
-    protocol, package = open_spec(args.spec)
+    protocol, package = open_binary_spec(args.spec, "scan")
     presence = protocol.device.presence if protocol.device else None
     if presence is None:
         raise SerialspecError(f"{protocol.name} declares no way to find its devices (device.presence in the spec)")

@@ -32,7 +32,7 @@ def message_spec(protocol: Protocol, message: Message) -> MessageSpec:
 
 
 def engineering(protocol: Protocol, message: Message, fields: dict[str, Any]) -> dict[str, Any]:
-    """Scaled values (wire × scale) and enum/flag names in place of raw numbers."""
+    """Scaled values (wire × scale + offset) and enum/flag names in place of raw numbers."""
     spec = message_spec(protocol, message)
     result = dict(fields)
     for f in spec.fields:
@@ -79,8 +79,8 @@ def _field_units(f: Field, value: Any, siblings: dict[str, Any]) -> Any:
             return _enum_name(f.enum, value)
         if f.flags:
             return _flag_names(f.flags, value)
-        if f.scale is not None:
-            return round(value * f.scale, 6)
+        if f.scale is not None or f.offset is not None:
+            return round(value * (1 if f.scale is None else f.scale) + (f.offset or 0), 6)
     if isinstance(f, TableValue):
         entry = f.table.entry(siblings[f.key])
         if entry is not None and entry.enum:

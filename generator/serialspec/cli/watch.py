@@ -20,7 +20,7 @@ from typing import Any, TextIO
 from serialspec.cli import capture
 from serialspec.cli.frames import Frames, Seen
 from serialspec.cli.listening import Stopping, open_port
-from serialspec.cli.protocols import SPEC_HELP, open_spec
+from serialspec.cli.protocols import SPEC_HELP, open_binary_spec
 from serialspec.cli.views import (
     FlagNames,
     engineering,
@@ -268,7 +268,7 @@ def run(args: argparse.Namespace) -> int:
     from rich.console import Console
     from rich.live import Live
 
-    protocol, package = open_spec(args.spec)
+    protocol, package = open_binary_spec(args.spec, "watch")
     address = protocol.device.address if protocol.device else None
     source: PortSource | TapSource = (
         PortSource(args, package, address) if args.port else TapSource(args.tap, package, address)

@@ -19,6 +19,9 @@ from serialspec.lang.limits import MAX_TEXT
 from serialspec.lang.loader import CONTROL, Path
 
 SCALAR_TYPES = ("u8", "i8", "u16", "i16", "u32", "i32", "f32")
+# what a field (not a frame element, enum, flag set or table entry) can be besides those
+FIELD_SCALAR_TYPES = ("u8", "i8", "u16", "i16", "u24", "i24", "u32", "i32", "u64", "i64", "f32", "f64")
+BIT_ORDERS = ("lsb_first", "msb_first")
 
 
 class Shape:
@@ -268,6 +271,15 @@ class OneOf(Shape):
         return {"anyOf": options, "description": self.description}
 
 
+@mutable
+class IntOrText(OneOf):
+    """An integer, or text where the spec's framing is text (a command's code): the checks of the passes say which."""
+
+    def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
+        if not isinstance(value, str):
+            yield from Int().check(value, path)
+
+
 def _described(shape: Shape, parent: str) -> dict[str, Any]:
     return _fill(shape.json_schema(), parent)
 
@@ -340,14 +352,21 @@ def bit_fields(description: str) -> MapOf:
 
 _FIELD_LONG: dict[str, Shape] = {
     "type": Str(
-        "Wire type: u8, i8, u16, i16, u32, i32, f32, bytes, string, cstring (NUL-terminated text), array, group, "
-        "table_value, table_block."
+        "Wire type: u8, i8, u16, i16, u24, i24, u32, i32, u64, i64, f32, f64, bytes, string, cstring "
+        "(NUL-terminated text), array, group, table_value, table_block. In text frames: decimal, integer, angle "
+        "(ddmm.mmmm degrees and minutes), char, text, time (hhmmss.ss), date (ddmmyy), repeat (a group of `fields` "
+        "repeated `count` times, or up to `max_count` times at the end); an empty field is None."
     ),
     "use": Str("Name of an entry in `fields:` (top level) to copy; keys given here override it."),
     "description": TEXT,
     "description_cn": Str("Description as printed in the (Chinese) document."),
     "unit": Str("Unit of one wire step, e.g. mV, ms, 0.1°."),
     "scale": Num("Engineering value = wire value × scale (e.g. 0.1 for 0.1° steps)."),
+    "offset": Num(
+        "Added after `scale`: engineering value = wire value × scale + offset (CRSF GPS altitude: wire metres "
+        "+ 1000, so offset -1000). `range` stays in wire units.",
+        example=-1000,
+    ),
     "range": RANGE,
     "const": Int("The field always has this value (sub-command selectors, fixed addresses).", example=1),
     "default": Num("Value used when a message is built without this field."),
@@ -367,7 +386,25 @@ _FIELD_LONG: dict[str, Shape] = {
         "holding the array's size in bytes (Modbus byte_count)",
     ),
     "count": OneOf((Int(), Str()), "array/group: a number, `rest`, or the name of an earlier count field"),
-    "of": Str("array: the item type (a scalar type, or `bit`: bools packed 8 to a byte, lowest bit first)."),
+    "of": Str(
+        "array: the item type: a scalar type; `bit` (bools packed 8 to a byte, lowest bit first); or `uN`/`iN` for "
+        "integers of N bits (1..64) packed with no gaps, e.g. u11 (CRSF/SBUS RC channels: 16 × 11 bits), with a "
+        "fixed `count`; see `bit_order`.",
+        example="u11",
+    ),
+    "bit_order": Str(
+        "array of uN/iN items: `lsb_first`, the first item in the lowest bits of the first byte, each item's lowest "
+        "bit first (CRSF, SBUS); `msb_first`, the first item in the highest bits, highest bit first. Default: "
+        "lsb_first in a little-endian field, msb_first in a big-endian one (so `of: u24` is 3-byte integers).",
+        choices=BIT_ORDERS,
+        example="lsb_first",
+    ),
+    "pad": Str(
+        "string of a fixed size: the byte (hex) that fills it after shorter text, e.g. '00' (NUL-padded); decoding "
+        "drops the trailing pad bytes, encoding refuses text longer than the size. Without it the text must fill "
+        "the size.",
+        example="00",
+    ),
     "count_from": Str(
         "array of a response: the request field (request.<field>) saying how many items are meant, when the array "
         "holds more (Modbus coils padded to a multiple of 8): clients keep that many."
@@ -387,6 +424,22 @@ _FIELD_LONG: dict[str, Shape] = {
     "select": MapOf(Any_(), "table_block: entry attributes an entry must have to be in the block, e.g. {access: rw}."),
     "expect_size": Int("table_block: the block's size in bytes, asserted by the generator."),
     "inferred": TEXT,
+    "precision": Int(
+        "text decimal, angle, time: fraction digits written for a value that does not carry its own (a float; a "
+        "decoded value keeps the digits it was sent with).",
+        minimum=0,
+        example=4,
+    ),
+    "width": Int(
+        "text integer, decimal: digits before the point, zero-padded; angle: digits of the degrees (2 for a "
+        "latitude, 3 for a longitude).",
+        minimum=1,
+        example=3,
+    ),
+    "letters": MapOf(
+        Str(), "text char: label -> the letter that stands for it; decoded letters become members of a generated Enum."
+    ),
+    "max_count": Int("text repeat at the end of a message: at most this many groups.", minimum=1, example=4),
     "status": Obj(
         {"ok": Int("The value that means success; any other value is a device error.")},
         required=("ok",),
@@ -403,7 +456,13 @@ FIELD = OneOf(
     ),
     "A field: a wire type or the name of a shared field (short form), or a mapping (long form).",
 )
-FIELDS: Shape = MapOf(FIELD, "Fields in wire order: name -> type or mapping.")
+FIELDS: Shape = MapOf(
+    FIELD,
+    "Fields in wire order: name -> type or mapping. A name is any lower-case identifier the protocol uses (`type`, "
+    "`id`, `data`) except Python keywords and the few names generated code uses itself (`self`, `request`, `reply`, "
+    "`to_fields`, builtins a client method calls such as `len`): those are refused, one line naming them; rename "
+    "the field (`class_`).",
+)
 
 OPTIONAL_WHEN = Obj(
     {
@@ -466,9 +525,10 @@ SUBCOMMAND = Obj(
 
 COMMAND = Obj(
     {
-        "code": Int(
-            "Value of the frame's command field; omit for the one response of a protocol whose replies "
-            "carry no command field."
+        "code": IntOrText(
+            (Int(), Str()),
+            "Value of the frame's command field; omit for the one response of a protocol whose replies carry no "
+            "command field. In text frames: the text code after the talker (NMEA's sentence id, GGA).",
         ),
         "title": TITLE,
         "title_cn": TITLE_CN,
@@ -666,7 +726,10 @@ FRAME_ELEMENT = Obj(
         ),
         "covers": span(
             "checksum: the span of elements covered. Outside a transparency span it sees the wire bytes, inside "
-            "it the bytes before stuffing.",
+            "it the bytes before stuffing. Checksums strictly inside the span (itself too) are left out of it "
+            "(HerkuleX: `checksum1` in the header covers [size, data]); one at an end is covered, so a checksum "
+            "can be computed from another that comes before it (HerkuleX `checksum2: {algorithm: xor, invert: "
+            "true, mask: 0xFE, covers: [checksum1, checksum1]}`).",
         ),
         **checksum_keys(),
     },
@@ -711,8 +774,66 @@ FRAMING = Obj(
         "transparency": TRANSPARENCY,
         "gap": Num("Silence between frames, in character times (Modbus RTU: 3.5).", example=3.5),
         "description": TEXT,
+        "kind": Str(
+            "binary: frames of bytes described by `elements` or `layouts`; text: line-oriented text frames "
+            "(`start`, `separator`, `checksum`, `end`, `talker`), each message chosen by its command's text `code`.",
+            choices=("binary", "text"),
+            default="binary",
+            example="text",
+        ),
+        "start": Str("text: the character that starts every frame.", example="$"),
+        "separator": Str("text: the character between fields.", example=","),
+        "end": Str("text: the line ending that closes every frame.", example="\r\n"),
+        "checksum": Obj(
+            {
+                "algorithm": Str(
+                    "What it computes over the characters: `xor`, the XOR of their bytes (NMEA 0183); `sum`, their "
+                    "sum modulo 256 (as a checksum element's).",
+                    choices=("sum", "xor"),
+                ),
+                "invert": Bool("sum: bitwise NOT of the sum.", default=False, example=True),
+                "marker": Str("The character before the checksum's hex digits.", default="*"),
+                "format": Str(
+                    "How the checksum is written: hex2, two upper-case hex digits (an 8-bit checksum).",
+                    choices=("hex2",),
+                    default="hex2",
+                ),
+                "required": Bool(
+                    "Frames without a checksum are refused (false: accepted unchecked, as NMEA 0183 allows for "
+                    "some sentences).",
+                    default=True,
+                    example=False,
+                ),
+            },
+            required=("algorithm",),
+            description=(
+                "text: the checksum over the characters between `start` and `marker`, written after `marker` as "
+                "hex digits, before the line ending."
+            ),
+        ),
+        "talker": Obj(
+            {
+                "size": Int("Characters of the talker at the start of the address field.", minimum=1),
+                "values": ListOf(Str(), "The talkers encode accepts (every one when left out).", example=["GP"]),
+                "description": TEXT,
+            },
+            required=("size",),
+            description=(
+                "text: a frame-level value at the start of the first field, before the text code (NMEA's talker "
+                "id: GP in $GPGGA); every message carries it as `talker`."
+            ),
+        ),
+        "max_length": Int(
+            "text: the longest frame in characters, start to checksum (NMEA 0183: 82 with the line ending): the "
+            "stream parser drops a line that grows longer.",
+            minimum=1,
+            example=82,
+        ),
     },
-    description="The frame every command travels in: `elements` (one layout) or `layouts` (alternatives).",
+    description=(
+        "The frame every command travels in: `elements` (one layout) or `layouts` (alternatives), or with "
+        "`kind: text` a line of text fields."
+    ),
 )
 
 EXAMPLE = Obj(
@@ -930,6 +1051,14 @@ DEVICE_COMMAND = Obj(
         ),
         "kind": Str("The entry of `kinds:` whose devices the command addresses (default: the devices of --id)."),
         "stores": MapOf(Str(), "Request field -> the state variable it is stored in (where names differ)."),
+        "echoes": ListOf(
+            Str(),
+            "Response fields that repeat the request's field of the same name (a write's reply confirming what was "
+            "written: Modbus WRITE SINGLE REGISTER). Other response fields never copy the request: they come from "
+            "the device (its reads, reports, `reply`, memory and state) or else the field's `default` (else 0); "
+            "the fields replies are matched by (`matching.by`), the address and a table value's key echo anyway.",
+            example=["address", "value"],
+        ),
         "sets": MapOf(Num(), "State variable -> the value the command sets it to."),
         "absent": MapOf(
             Num(),
@@ -1209,7 +1338,9 @@ SPEC = Obj(
         "description": TEXT,
         "sources": MapOf(Str(), "Document id -> what it is."),
         "byte_order": Str(
-            "Byte order of every multi-byte value, unless a field's `endian` says otherwise.", choices=("little", "big")
+            "Byte order of every multi-byte value, unless a field's `endian` says otherwise (required in binary "
+            "framing).",
+            choices=("little", "big"),
         ),
         "serial": Obj(
             {
@@ -1245,7 +1376,7 @@ SPEC = Obj(
         "errata": MapOf(ERRATUM, "Mistakes in the documents, each pinned by a test."),
         "device": DEVICE,
     },
-    required=("protocol", "title", "byte_order", "serial", "framing", "commands"),
+    required=("protocol", "title", "serial", "framing", "commands"),
     description="A serialspec protocol spec.",
 )
 

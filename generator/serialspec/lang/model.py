@@ -34,9 +34,16 @@ SCALARS: dict[str, ScalarType] = {
     "i8": ScalarType("i8", 1, "b", True, False, -0x80, 0x7F),
     "u16": ScalarType("u16", 2, "H", False, False, 0, 0xFFFF),
     "i16": ScalarType("i16", 2, "h", True, False, -0x8000, 0x7FFF),
+    # 3-byte integers (fields only, as the 64-bit types: not frame elements, enums, flags or tables) are read as 3
+    # bytes ("3s") and converted, since struct has no format for them
+    "u24": ScalarType("u24", 3, "3s", False, False, 0, 0xFFFFFF),
+    "i24": ScalarType("i24", 3, "3s", True, False, -0x800000, 0x7FFFFF),
     "u32": ScalarType("u32", 4, "I", False, False, 0, 0xFFFFFFFF),
     "i32": ScalarType("i32", 4, "i", True, False, -0x80000000, 0x7FFFFFFF),
+    "u64": ScalarType("u64", 8, "Q", False, False, 0, 0xFFFFFFFFFFFFFFFF),
+    "i64": ScalarType("i64", 8, "q", True, False, -0x8000000000000000, 0x7FFFFFFFFFFFFFFF),
     "f32": ScalarType("f32", 4, "f", True, True, -3.4028234663852886e38, 3.4028234663852886e38),
+    "f64": ScalarType("f64", 8, "d", True, True, -1.7976931348623157e308, 1.7976931348623157e308),
 }
 
 
@@ -117,6 +124,12 @@ class Scalar(Common):
     status_ok: int | None = None
     # Derived by an expression over the other fields (`byte_count = 2 * count`): computed on encode, checked on decode.
     value: Expr | None = None
+    offset: float | None = None  # engineering value = wire value × scale + offset
+
+    @property
+    def odd_width(self) -> bool:
+        """A 3-byte integer: read as 3 bytes and converted, since struct has no format for it."""
+        return self.type.size == 3
 
     @property
     def hidden(self) -> bool:
@@ -161,10 +174,36 @@ class List(Common):
 
 
 @frozen
+class Packed(Common):
+    """A fixed number of integers of `bits` bits each, packed with no gaps (CRSF RC channels: 16 × 11 bits).
+
+    `lsb_first`: the first item starts at the lowest bit of the first byte, each item's lowest bit first (CRSF,
+    SBUS; a little-endian u24 array is the same); else the first item starts at the highest bit, its highest bit
+    first (a big-endian u24 array is the same). The last byte is padded with zero bits.
+    """
+
+    bits: int
+    signed: bool
+    count: int
+    lsb_first: bool
+    unit: str
+    minimum: float
+    maximum: float
+
+    @property
+    def byte_size(self) -> int:
+        return -(-self.bits * self.count // 8)
+
+
+@frozen
 class Text(Common):
-    """Text: NUL-terminated (`size` None; the NUL is not part of the value), or sized like bytes."""
+    """Text: NUL-terminated (`size` None; the NUL is not part of the value), or sized like bytes.
+
+    `pad`: a fixed-size text shorter than its size is sent followed by this byte (NUL-padded names), and read
+    without the trailing pad bytes; None: the text must fill its size exactly."""
 
     size: int | str | None  # a number, "rest", a field name, or None for NUL-terminated
+    pad: int | None = None
 
     @property
     def terminated(self) -> bool:
@@ -203,7 +242,7 @@ class TableBlock(Common):
     struct_name: str = ""  # the construct struct of the block
 
 
-Field = Scalar | Array | List | Text | Bytes | Group | TableValue | TableBlock
+Field = Scalar | Array | Packed | List | Text | Bytes | Group | TableValue | TableBlock
 
 
 @frozen
@@ -363,6 +402,7 @@ class Checksum:
     type: ScalarType
     endian: Literal["<", ">"] = "<"
     name: str = ""  # the frame element holding it
+    skips: tuple[str, ...] = ()  # elements inside first..last left out: itself, and the checksums strictly inside
 
 
 @frozen
@@ -619,6 +659,7 @@ class Behaviour:
     carries: tuple[str, str] | None = None  # (command code field, content field) of a carried request
     carried: tuple[str, ...] = ()  # the commands it can carry (empty: every command with a code)
     nothing_held: dict[str, float] = field(default_factory=dict)  # commits: reply values when nothing is held
+    echoes: tuple[str, ...] = ()  # response fields that repeat the request's field of the same name
 
 
 @frozen
@@ -733,6 +774,95 @@ class Device:
         return next((b for b in self.behaviours if b.command == key), None)
 
 
+# --- text frames (framing kind: text) ----------------------------------------------------------------------------
+
+
+@frozen
+class TextField:
+    """One field of a text frame (runtime/text.py's TextField, as declared)."""
+
+    name: str
+    kind: Literal["decimal", "integer", "angle", "char", "text", "time", "date"]
+    description: str = ""
+    unit: str = ""
+    precision: int = 0
+    width: int = 0
+    minimum: float | None = None
+    maximum: float | None = None
+    letters: tuple[tuple[str, str], ...] = ()  # char: (label, letter)
+    letters_class: str = ""  # char with letters: the generated Enum's name
+
+
+@frozen
+class TextRepeat:
+    """A group of text fields repeated `count` times, or up to `max_count` times at the end of a message."""
+
+    name: str
+    fields: tuple[TextField, ...]
+    description: str = ""
+    count: int = 0
+    max_count: int = 0
+
+
+@frozen
+class TextMessage:
+    """One direction of a command in a text protocol: chosen by its text code."""
+
+    key: str  # the command's name
+    code: str
+    title: str
+    description: str
+    direction: Direction
+    class_name: str
+    fields: tuple[TextField | TextRepeat, ...]
+    unsolicited: bool = False
+    source: str = ""
+
+
+@frozen
+class TextExample:
+    """A frame as a document prints it (text) and the text of each field it carries."""
+
+    name: str
+    source: str
+    description: str
+    direction: Direction
+    printed: str
+    command: str
+    fields: dict[str, object]
+    position: tuple[int, int] = (1, 1)  # line and column in the spec, for errors found after resolution
+
+
+@frozen
+class TextFrame:
+    """Line-oriented text frames: start + talker + code + separated fields + [marker + checksum as hex] + end."""
+
+    description: str
+    start: str
+    separator: str
+    end: str
+    checksum: Algorithm | None
+    marker: str
+    required: bool
+    talker: int  # characters of the talker at the start of the address field (0: none)
+    talkers: tuple[str, ...]
+    talker_description: str
+    max_length: int
+    messages: tuple[TextMessage, ...]
+    examples: tuple[TextExample, ...] = ()
+    digits: int = 2
+
+    def letter_sets(self) -> dict[str, tuple[tuple[str, str], ...]]:
+        """Each generated letter Enum's name -> its (label, letter) pairs, in order of first use."""
+        found: dict[str, tuple[tuple[str, str], ...]] = {}
+        for message in self.messages:
+            for item in message.fields:
+                for f in item.fields if isinstance(item, TextRepeat) else (item,):
+                    if f.letters_class:
+                        found.setdefault(f.letters_class, f.letters)
+        return found
+
+
 @frozen
 class Protocol:
     name: str
@@ -755,6 +885,7 @@ class Protocol:
     client_class: str = ""  # the generated client's and simulator's class names
     simulator_class: str = ""
     error_reply: ErrorReply | None = None
+    text: TextFrame | None = None  # framing kind text: its frames and messages (commands is then empty)
 
     def messages(self) -> tuple[Message, ...]:
         return tuple(m for c in self.commands for m in c.messages())
@@ -775,6 +906,8 @@ def fixed_size(field: Field) -> int | None:
         return field.type.size
     if isinstance(field, Array):
         return field.item.size * field.count
+    if isinstance(field, Packed):
+        return field.byte_size
     if isinstance(field, Bytes | Text):
         return field.size if isinstance(field.size, int) else None
     if isinstance(field, List):

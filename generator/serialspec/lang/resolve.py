@@ -12,7 +12,8 @@ from serialspec.collection import without_cycle_collection
 from serialspec.lang.errors import SpecError, SpecErrors
 from serialspec.lang.loader import Located, load_file
 from serialspec.lang.model import Protocol
-from serialspec.lang.passes import PASSES, Context
+from serialspec.lang.passes import PASSES, TEXT_PASSES, Context
+from serialspec.lang.passes.text import is_text
 
 
 def load_protocol(path: str, display_name: str | None = None) -> Protocol:
@@ -26,7 +27,7 @@ def resolve(located: Located) -> Protocol:
     """Run every pass over a loaded spec; raises SpecErrors listing every problem they found."""
     ctx = Context(located)
     problems: list[SpecError] = []
-    for step in PASSES:
+    for step in TEXT_PASSES if is_text(ctx.data) else PASSES:
         problems.extend(step(ctx).run())
         if not isinstance(ctx.data, dict):
             break  # not even a mapping: the structural check has said so, nothing else applies
@@ -54,4 +55,5 @@ def resolve(located: Located) -> Protocol:
         client_class=ctx.client_class,
         simulator_class=ctx.simulator_class,
         error_reply=ctx.error_reply,
+        text=ctx.text,
     )

@@ -5,7 +5,9 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from construct import Adapter, Check, Container, ExplicitError, GreedyBytes
+from construct import Adapter, Bytes, Check, Container, ExplicitError, GreedyBytes
+
+from serialspec.runtime.packing import pack_ints, unpack_ints
 
 
 def derived(name: str, compute: Callable[[Any], int]) -> Any:
@@ -69,6 +71,37 @@ class PackedBits(Adapter):  # type: ignore[misc]
             if value:
                 out[i >> 3] |= 1 << (i & 7)
         return bytes(out)
+
+
+class PackedInts(Adapter):  # type: ignore[misc]
+    """`count` integers of `bits` bits packed with no gaps (runtime.packing.unpack_ints), as a list of ints."""
+
+    def __init__(self, count: int, bits: int, lsb_first: bool, signed: bool) -> None:
+        super().__init__(Bytes(-(-bits * count // 8)))
+        self.shape = (bits, count, lsb_first)
+        self.signed = signed
+
+    def _decode(self, obj: bytes, context: Any, path: Any) -> list[int]:
+        bits, count, lsb_first = self.shape
+        return list(unpack_ints(obj, bits, count, lsb_first, self.signed))
+
+    def _encode(self, obj: list[int], context: Any, path: Any) -> bytes:
+        return pack_ints(obj, *self.shape)
+
+
+class PaddedUtf8(Adapter):  # type: ignore[misc]
+    """Fixed-size bytes holding UTF-8 text followed by pad bytes."""
+
+    def __init__(self, size: int, pad: int) -> None:
+        super().__init__(Bytes(size))
+        self.size, self.pad = size, pad
+
+    def _decode(self, obj: bytes, context: Any, path: Any) -> str:
+        return obj.rstrip(bytes((self.pad,))).decode("utf-8")
+
+    def _encode(self, obj: str, context: Any, path: Any) -> bytes:
+        data = obj.encode("utf-8")
+        return data + bytes((self.pad,)) * (self.size - len(data))
 
 
 class Utf8(Adapter):  # type: ignore[misc]

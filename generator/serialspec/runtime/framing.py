@@ -43,6 +43,7 @@ class Element:
     minimum: int = 0  # value/command: plausible values (a stray byte out of range is no frame start)
     maximum: int = 0
     also: int | None = None  # value: one more value allowed (an address's broadcast)
+    skip: tuple[int, ...] = ()  # checksum: elements inside the span left out (itself, other checksums)
 
     def pack(self, value: int) -> bytes:
         return value.to_bytes(self.size, self.endian)
@@ -215,8 +216,15 @@ class Layout:
                 raise EncodeError(f"{self.name} frame: length {value} does not fit its {element.size}-byte field")
             plain[index] = element.pack(value)
         for index, element in plan["outer_checksums"]:
-            plain[index] = self._checksum(element, self._wire(plain, wire, *element.span))
+            plain[index] = self._checksum(element, self._covered(plain, wire, element))
         return self._wire(plain, wire, 0, len(elements) - 1)
+
+    def _covered(self, plain: list[bytes], wire: dict[int, bytes], element: Element) -> bytes:
+        """The bytes a checksum covers: its span's, less the elements it skips (which lie outside any stuffing)."""
+        if not element.skip:
+            return self._wire(plain, wire, *element.span)
+        first, last = element.span
+        return b"".join(plain[i] for i in range(first, last + 1) if i not in element.skip)
 
     def _wire(self, plain: list[bytes], wire: dict[int, bytes], first: int, last: int) -> bytes:
         """Wire bytes of elements first..last (plain bytes when the transparency span is not in play)."""
@@ -278,7 +286,7 @@ class Layout:
             if value != counted:
                 raise DecodeError(f"{element.name} says {value} but the frame holds {counted}")
         for index, element in plan["checksums"]:
-            expected = element.checksum(self._wire(plain, wire, *element.span))
+            expected = element.checksum(self._covered(plain, wire, element))
             stored = element.unpack(plain[index])
             if expected != stored:
                 raise ChecksumError(
@@ -430,6 +438,8 @@ class FrameCodec:
         if layout.transparency is not None or len(plan["checksums"]) != 1:
             return None
         index, element = plan["checksums"][0]
+        if element.skip:
+            return None
         head = {i: begin for i, begin, _ in plan["head"]}
         tail = {i: (begin, finish) for i, begin, finish in plan["tail"]}
         first, last = element.span

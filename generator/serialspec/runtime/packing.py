@@ -1,4 +1,4 @@
-"""Field kinds that struct cannot pack alone: bits packed 8 to a byte, and text."""
+"""Field kinds that struct cannot pack alone: bits packed 8 to a byte, packed integers of any width, and text."""
 
 from __future__ import annotations
 
@@ -55,3 +55,47 @@ def encode_text(value: str, name: str, where: str, terminated: bool) -> bytes:
             raise EncodeError(f"{where}: {name} holds a NUL, which would end it early")
         return data + b"\0"
     return data
+
+
+def unpack_ints(data: bytes, bits: int, count: int, lsb_first: bool, signed: bool) -> tuple[int, ...]:
+    """`count` integers of `bits` bits packed with no gaps in `data`: lsb_first, the first in the lowest bits of the
+    first byte (the bytes a little-endian integer); else the first in the highest bits (a big-endian integer)."""
+    whole = int.from_bytes(data, "little" if lsb_first else "big")
+    mask = (1 << bits) - 1
+    if lsb_first:
+        values = [(whole >> (i * bits)) & mask for i in range(count)]
+    else:
+        top = len(data) * 8 - bits
+        values = [(whole >> (top - i * bits)) & mask for i in range(count)]
+    if signed:
+        sign = 1 << (bits - 1)
+        return tuple(v - (v & sign) * 2 for v in values)
+    return tuple(values)
+
+
+def pack_ints(values: Any, bits: int, count: int, lsb_first: bool) -> bytes:
+    """The inverse of unpack_ints (the values checked already); unused bits of the last byte are 0."""
+    mask = (1 << bits) - 1
+    size = -(-bits * count // 8)
+    whole = 0
+    if lsb_first:
+        for i, value in enumerate(values):
+            whole |= (value & mask) << (i * bits)
+        return whole.to_bytes(size, "little")
+    top = size * 8 - bits
+    for i, value in enumerate(values):
+        whole |= (value & mask) << (top - i * bits)
+    return whole.to_bytes(size, "big")
+
+
+def unpad_text(data: bytes, pad: int, name: str, where: str) -> str:
+    """Fixed-size text without the pad bytes after it."""
+    return decode_text(data.rstrip(bytes((pad,))), name, where)
+
+
+def pad_text(value: str, size: int, pad: int, name: str, where: str) -> bytes:
+    """Text padded to `size` bytes with `pad`; longer text is refused, naming the field and the most it holds."""
+    data = encode_text(value, name, where, False)
+    if len(data) > size:
+        raise EncodeError(f"{where}: {name} takes at most {size} bytes of UTF-8, got {len(data)}")
+    return data + bytes((pad,)) * (size - len(data))

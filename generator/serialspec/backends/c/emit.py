@@ -30,6 +30,7 @@ from serialspec.lang.model import (
     Group,
     List,
     Message,
+    Packed,
     Protocol,
     Scalar,
     ScalarType,
@@ -163,6 +164,8 @@ class Ctx:
 
 def refuse_unsupported(protocol: Protocol) -> None:
     """Raise Unsupported naming the first feature of the spec the C target cannot generate yet."""
+    if protocol.text is not None:
+        raise Unsupported("text framing (`framing: {kind: text}`)")
     for command in protocol.commands:
         if command.selector is not None and command.selector.type.size != 1:
             raise Unsupported(f"sub-command selectors of more than one byte (command {command.name})")
@@ -188,6 +191,8 @@ def refuse_layout(layout: FrameLayout) -> None:
     if length >= 0 and length >= first:
         raise Unsupported(f"{where}: a length after the variable part of the frame")
     for i, e in enumerate(elements):
+        if e.checksum is not None and e.checksum.skips:
+            raise Unsupported(f"{where}: checksum {e.name} over a span that leaves out {', '.join(e.checksum.skips)}")
         if e.role == "checksum" and t is not None and e.checksum is not None:
             a, b = names.index(e.checksum.first), names.index(e.checksum.last)
             inside = first <= i <= last
@@ -201,13 +206,21 @@ def refuse_fields(fields: tuple[Field, ...], where: str, nested: bool = False) -
             case Scalar():
                 if f.value is not None and nested:
                     raise Unsupported(f"{where}: {f.name}: a value computed by an expression inside a group")
+                if f.type.size not in (1, 2, 4):
+                    raise Unsupported(f"{where}: {f.name}: fields of type {f.type.name}")
             case Array():
-                pass
+                if f.item.size not in (1, 2, 4):
+                    raise Unsupported(f"{where}: {f.name}: arrays of {f.item.name}")
+            case Packed():
+                raise Unsupported(f"{where}: {f.name}: packed arrays of {f.bits}-bit integers")
             case List():
+                if f.item is not None and f.item.size not in (1, 2, 4):
+                    raise Unsupported(f"{where}: {f.name}: lists of {f.item.name}")
                 if f.item is not None and f.item.is_float:
                     raise Unsupported(f"{where}: {f.name}: lists of floats")
             case Text():
-                pass
+                if f.pad is not None:
+                    raise Unsupported(f"{where}: {f.name}: padded strings")
             case Bytes():
                 pass
             case Group():
@@ -295,6 +308,8 @@ def field_doc(f: Field) -> str:
         parts.append(f"unit: {f.unit}")
     if isinstance(f, Scalar) and f.scale:
         parts.append(f"scale: {f.scale:g} per unit")
+    if isinstance(f, Scalar) and f.offset:
+        parts.append(f"offset: {f.offset:+g}")
     if isinstance(f, Scalar | Array) and not (isinstance(f, Scalar) and f.type.is_float):
         parts.append(f"range {f.minimum:g}..{f.maximum:g}")
     if isinstance(f, Scalar) and f.enum:
@@ -364,6 +379,8 @@ def members(ctx: Ctx, fields: tuple[Field, ...], path: str, room: int) -> list[M
                     macro = cap_macro(ctx, f"{path}_{f.name}", most)
                     found.append(Member(name, f"{ctype(f.item)} {name}[{macro}];", doc))
                     found.append(Member(f"{name}_count", f"size_t {name}_count;", f"items in {f.name}"))
+            case Packed():  # refused by refuse_fields
+                raise Unsupported(f"{f.name}: packed arrays")
             case _:
                 assert_never(f)
     return found
@@ -554,6 +571,8 @@ def decode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                     out.append(f"{pad}    {tgt}[i{depth}] = {value};")
                     out.append(f"{pad}}}")
                 out.append(f"{pad}o += len;")
+            case Packed():  # refused by refuse_fields
+                raise Unsupported(f"{f.name}: packed arrays")
             case _:
                 assert_never(f)
 
@@ -749,6 +768,8 @@ def check_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[st
                         out.append(f"{pad}for (i{depth} = 0u; i{depth} < {tgt}_count; i{depth}++) {{")
                         out.append(f"{pad}    if ({test}) {{ return {ctx.P}_E_RANGE; }} /* {f.name} */")
                         out.append(f"{pad}}}")
+            case Packed():  # refused by refuse_fields
+                raise Unsupported(f"{f.name}: packed arrays")
             case _:
                 assert_never(f)
 
@@ -896,6 +917,8 @@ def encode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                     out.append(f"{pad}    {ctx.p}__put(c + o, {size}u, {big}u, {value}); /* {f.name} */")
                     out.append(f"{pad}    o += {size}u;")
                     out.append(f"{pad}}}")
+            case Packed():  # refused by refuse_fields
+                raise Unsupported(f"{f.name}: packed arrays")
             case _:
                 assert_never(f)
 
@@ -1032,6 +1055,8 @@ def json_fields(ctx: Ctx, fields: tuple[Field, ...], target: str, out: list[str]
                     out.append(f"{pad}    " + json_number(ctx, f.item, f"{tgt}[i{depth}]"))
                 out.append(f"{pad}}}")
                 out.append(f'{pad}{ctx.p}__ws(w, "]");')
+            case Packed():  # refused by refuse_fields
+                raise Unsupported(f"{f.name}: packed arrays")
             case _:
                 assert_never(f)
     return first

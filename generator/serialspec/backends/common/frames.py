@@ -25,6 +25,7 @@ KINDS: dict[str, ElementKind] = {
 def runtime_element(layout: FrameLayout, element: FrameElement) -> Element:
     kind = KINDS[element.role]
     span = (0, 0)
+    skip: tuple[int, ...] = ()
     function = None
     if kind == "length":
         span = (layout.index(element.counts[0]), layout.index(element.counts[1]))
@@ -32,6 +33,7 @@ def runtime_element(layout: FrameLayout, element: FrameElement) -> Element:
         assert element.checksum is not None
         span = (layout.index(element.checksum.first), layout.index(element.checksum.last))
         function = element.checksum.algorithm.function()
+        skip = tuple(layout.index(name) for name in element.checksum.skips)
     return Element(
         name=element.name,
         kind=kind,
@@ -44,6 +46,7 @@ def runtime_element(layout: FrameLayout, element: FrameElement) -> Element:
         minimum=int(element.minimum) if kind in ("value", "command") else 0,
         maximum=int(element.maximum) if kind in ("value", "command") else 0,
         also=element.broadcast if kind in ("value", "command") else None,
+        skip=skip,
     )
 
 

@@ -10,7 +10,7 @@ from typing import Any, Generic
 from serialspec.backends.common.kinds import F, Registry
 from serialspec.backends.common.numbers import number
 from serialspec.lang import expression
-from serialspec.lang.model import Array, Bytes, Group, List, Scalar, TableBlock, TableValue, Text
+from serialspec.lang.model import Array, Bytes, Group, List, Packed, Scalar, TableBlock, TableValue, Text
 
 
 def anchor(*parts: str) -> str:
@@ -71,7 +71,12 @@ class ScalarKind(Kind[Scalar]):
             )
         if f.bits:
             return ""
-        return scalar_range(f.type, f.minimum, f.maximum)
+        shown = scalar_range(f.type, f.minimum, f.maximum)
+        if f.offset is not None and not f.type.is_float:  # the engineering values too: wire × scale + offset
+            scale = 1 if f.scale is None else f.scale
+            low, high = sorted((f.minimum * scale + f.offset, f.maximum * scale + f.offset))
+            shown += f" (engineering {number(round(low, 6))}..{number(round(high, 6))})"
+        return shown
 
     def meaning(self, f: Scalar) -> list[str]:
         parts = []
@@ -83,6 +88,9 @@ class ScalarKind(Kind[Scalar]):
             parts.append("Other bits must be zero.")
         if f.status_ok is not None:
             parts.append(f"**Status:** {f.status_ok} is success; any other value is a device error (DeviceError).")
+        if f.offset is not None:
+            step = f"wire value × {number(f.scale)}" if f.scale is not None else "wire value"
+            parts.append(f"Engineering value = {step} {'-' if f.offset < 0 else '+'} {number(abs(f.offset))}.")
         return parts
 
 
@@ -97,6 +105,20 @@ class ArrayKind(Kind[Array]):
 
     def range_text(self, f: Array) -> str:
         return scalar_range(f.item, f.minimum, f.maximum)
+
+
+class PackedKind(Kind[Packed]):
+    model = Packed
+
+    def type_name(self, f: Packed) -> str:
+        order = "lowest bit first" if f.lsb_first else "highest bit first"
+        return f"{'i' if f.signed else 'u'}{f.bits}[{f.count}], packed ({f.byte_size} bytes, {order})"
+
+    def unit(self, f: Packed) -> str:
+        return f.unit
+
+    def range_text(self, f: Packed) -> str:
+        return f"{number(f.minimum)}..{number(f.maximum)}"
 
 
 class ListKind(Kind[List]):
@@ -121,7 +143,9 @@ class TextKind(Kind[Text]):
     def type_name(self, f: Text) -> str:
         if f.size is None:
             return "text, NUL-terminated"
-        return "text (rest of content)" if f.size == "rest" else f"text ({f.size} bytes)"
+        if f.size == "rest":
+            return "text (rest of content)"
+        return f"text ({f.size} bytes{f', padded with {f.pad:02X}' if f.pad is not None else ''})"
 
 
 class BytesKind(Kind[Bytes]):

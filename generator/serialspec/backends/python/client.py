@@ -34,6 +34,7 @@ from serialspec.lang.model import (
     Group,
     List,
     Message,
+    Packed,
     Protocol,
     Scalar,
     Table,
@@ -99,7 +100,7 @@ def type_names(f: Field) -> list[str]:
             return [n for n in names if n]
         case Group() | TableBlock():
             return [f.class_name]
-        case Array() | List() | Text() | Bytes() | TableValue():
+        case Array() | Packed() | List() | Text() | Bytes() | TableValue():
             return []
         case _:
             assert_never(f)

@@ -59,6 +59,7 @@ from serialspec.lang.model import (
     Group,
     List,
     Message,
+    Packed,
     Protocol,
     Scalar,
     TableBlock,
@@ -70,7 +71,18 @@ from serialspec.lang.model import Field as SpecField
 
 Lines = list[str]
 _MOST_RUNS = 256  # the most items of a list read by a struct made for each count (see unpack_runs)
-_STRUCT_NAMES = {"B": "U8", "b": "I8", "H": "U16", "h": "I16", "I": "U32", "i": "I32", "f": "F32"}
+_STRUCT_NAMES = {
+    "B": "U8",
+    "b": "I8",
+    "H": "U16",
+    "h": "I16",
+    "I": "U32",
+    "i": "I32",
+    "f": "F32",
+    "Q": "U64",
+    "q": "I64",
+    "d": "F64",
+}
 
 
 def message_function(verb: str, message: Message) -> str:
@@ -102,7 +114,11 @@ def members_name(class_name: str) -> str:
 
 def run_endian(fields: list[SpecField]) -> str:
     """The struct byte order of a run of fixed-size fields: its first multi-byte field's."""
-    return next((f.endian for f in fields if isinstance(f, Scalar | Array | TableBlock)), "<")
+    for f in fields:
+        # a 3-byte scalar is read as bytes and converted in its own byte order
+        if isinstance(f, Array | TableBlock) or (isinstance(f, Scalar) and not f.odd_width):
+            return f.endian
+    return "<"
 
 
 def struct_format(endian: str, fields: list[SpecField]) -> str:
@@ -346,7 +362,7 @@ class PackageCode:
                     ]
                 )
                 self.helper_classes.append(code)
-            case Scalar() | Group() | TableBlock() | Array() | List() | Text() | Bytes() | TableValue():
+            case Scalar() | Group() | TableBlock() | Array() | Packed() | List() | Text() | Bytes() | TableValue():
                 pass  # no nested values, or their class is made already
             case _:
                 assert_never(f)
@@ -511,7 +527,7 @@ class PackageCode:
                 body.append(If(f"{self.local(f)} != {expected}", (Raise(f"DecodeError({where} + f': {reason}')"),)))
 
     def decode_run(self, run: list[SpecField], base: str, body: Block, where: str) -> list[str]:
-        endian = next((f.endian for f in run if isinstance(f, Scalar | Array | TableBlock)), "<")
+        endian = run_endian(run)
         fmt = struct_format(endian, run)
         const_name = self.struct(f"{base}_{run[0].name}", fmt)
         size = sum(fixed_size(f) or 0 for f in run)
@@ -555,8 +571,20 @@ class PackageCode:
 
     def after_unpack(self, f: SpecField, name: str, body: Block, where: str) -> str | None:
         """Checks and conversions after a scalar is unpacked; the value expression, or None if hidden."""
+        if isinstance(f, Packed):
+            self.packing.add("unpack_ints")
+            return f"_unpack_ints({name}, {f.bits}, {f.count}, {f.lsb_first}, {f.signed})"
+        if isinstance(f, Text) and isinstance(f.size, int):  # read as bytes by the run's struct
+            if f.pad is not None:
+                self.packing.add("unpad_text")
+                return f"_unpad_text({name}, {f.pad}, {f.name!r}, {where})"
+            self.packing.add("decode_text")
+            return f"_decode_text({name}, {f.name!r}, {where})"
         if not isinstance(f, Scalar):
             return name
+        if f.odd_width:  # read as 3 bytes
+            order = "big" if f.endian == ">" else "little"
+            body.append(Code(f"{name} = int.from_bytes({name}, {order!r}, signed={f.type.signed})"))
         if f.const is not None:
             error = f"DecodeError({where} + f': {f.name} is {{{name}:#x}}, expected {f.const:#x}')"
             body.append(Expect(name, f"{f.const}", error))
@@ -620,7 +648,7 @@ class PackageCode:
                 return self.local(f)
             case Group():
                 return self.decode_group(f, body, where)
-            case Scalar() | Array() | TableBlock():
+            case Scalar() | Array() | Packed() | TableBlock():
                 raise AssertionError(f"{f.name}: a field of fixed size is decoded in a run (decode_run)")
             case _:
                 assert_never(f)
@@ -632,7 +660,7 @@ class PackageCode:
         item_names = [i.name for i in item_fields if not (isinstance(i, Scalar) and i.hidden)]
         start_list = Code(f"{value}_list = []")
         body.append(start_list)
-        if f.item_size is not None:
+        if f.item_size is not None and all(is_fixed_run_member(i) for i in item_fields):  # one struct per item
             item_fmt = struct_format(self.protocol_endian(), item_fields)
             item_struct = self.struct(f"{f.class_name}", item_fmt)
             if f.count == "rest":
@@ -935,7 +963,7 @@ class PackageCode:
             reason = f"{f.name} has {{{items}}} items, at most {high} (the limit of the request field {count.name})"
             body.append(If(f"{items} > {high}", (Raise(f"EncodeError({where} + f': {reason}')"),)))
 
-    def check_items(self, f: Array | List, expr: str, body: Block, where: str) -> None:
+    def check_items(self, f: Array | List | Packed, expr: str, body: Block, where: str) -> None:
         """Every number of a list within the item's range, and none a bool (True is not 1); the first at fault named.
 
         A plain loop: any() over a generator costs a frame per call, twice the time for a few items. Where the
@@ -1038,8 +1066,21 @@ class PackageCode:
         args: list[str] = []
         for f in run:
             match f:
+                case Scalar() if f.odd_width:
+                    order = "big" if f.endian == ">" else "little"
+                    wire = self.wire_value(f, obj, siblings, body, where)
+                    args.append(f"({wire}).to_bytes(3, {order!r}, signed={f.type.signed})")
                 case Scalar():
                     args.append(self.wire_value(f, obj, siblings, body, where))
+                case Packed():
+                    expr = field_read(obj, f.name)
+                    error = f"EncodeError({where} + f': {f.name} needs {f.count} items, got {{len({expr})}}')"
+                    body.append(If(f"len({expr}) != {f.count}", (Raise(error),)))
+                    self.check_items(f, expr, body, where)
+                    self.packing.add("pack_ints")
+                    args.append(f"_pack_ints({expr}, {f.bits}, {f.count}, {f.lsb_first})")
+                case Text():
+                    args.append(self.encode_text(f, obj, body, where))
                 case Array():
                     expr = field_read(obj, f.name)
                     error = f"EncodeError({where} + f': {f.name} needs {f.count} items, got {{len({expr})}}')"
@@ -1058,11 +1099,27 @@ class PackageCode:
                         error = f"out_of_range({where}, {name!r}, {expr}, {number(e.minimum)}, {number(e.maximum)})"
                         body.append(If(f"not {number(e.minimum)} <= {expr} <= {number(e.maximum)}", (Raise(error),)))
                         args.append(Simple(expr))
-                case List() | Text() | Group() | TableValue():
+                case List() | Group() | TableValue():
                     raise AssertionError(f"{f.name}: a field of varying size is encoded alone (encode_variable)")
                 case _:
                     assert_never(f)
         return run_endian(run), struct_format("", run), args
+
+    def encode_text(self, f: Text, obj: str, body: Block, where: str) -> str:
+        """The bytes of a text field: fixed-size text padded or checked to fill its size."""
+        expr = field_read(obj, f.name)
+        if isinstance(f.size, int) and f.pad is not None:
+            self.packing.add("pad_text")
+            return f"_pad_text({expr}, {f.size}, {f.pad}, {f.name!r}, {where})"
+        self.packing.add("encode_text")
+        data = f"_encode_text({expr}, {f.name!r}, {where}, {f.size is None})"
+        if isinstance(f.size, int):
+            local = self.local(f) if obj == "m" else f"{obj}_{f.name}"
+            body.append(Code(f"{local} = {data}"))
+            reason = f"{f.name} needs {f.size} bytes of UTF-8, got {{len({local})}}"
+            body.append(If(f"len({local}) != {f.size}", (Raise(f"EncodeError({where} + f': {reason}')"),)))
+            return local
+        return data
 
     def encode_variable(self, f: SpecField, obj: str, body: Block, where: str) -> str:
         expr = field_read(obj, f.name)
@@ -1078,16 +1135,7 @@ class PackageCode:
                 self.check_items(f, expr, body, where)
                 return PackItems(f.endian, f.item.struct_char, expr)
             case Text():
-                self.packing.add("encode_text")
-                data = f"_encode_text({expr}, {f.name!r}, {where}, {f.size is None})"
-                if isinstance(f.size, int):
-                    body.append(Code(f"{self.local(f)} = {data}"))
-                    reason = f"{f.name} needs {f.size} bytes of UTF-8, got {{len({self.local(f)})}}"
-                    body.append(
-                        If(f"len({self.local(f)}) != {f.size}", (Raise(f"EncodeError({where} + f': {reason}')"),))
-                    )
-                    return self.local(f)
-                return data
+                return self.encode_text(f, obj, body, where)
             case Bytes():  # bytes as they are (bytes(b) looks up b.__bytes__ first), anything else made bytes
                 body.append(Code(f"{self.local(f)} = {expr} if {expr}.__class__ is bytes else bytes({expr})"))
                 return self.local(f)
@@ -1105,7 +1153,7 @@ class PackageCode:
                 return f"s.pack({expr})"
             case Group():
                 return self.encode_group(f, obj, body, where, expr, count_error)
-            case Scalar() | Array() | TableBlock():
+            case Scalar() | Array() | Packed() | TableBlock():
                 raise AssertionError(f"{f.name}: a field of fixed size is encoded in a run (encode_run_format)")
             case _:
                 assert_never(f)

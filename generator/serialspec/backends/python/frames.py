@@ -85,6 +85,8 @@ def element_expr(layout: FrameLayout, element: FrameElement) -> str:
     if e.kind == "checksum":
         assert element.checksum is not None
         args.append(f"checksum={checksum_name(element.checksum)}")
+        if e.skip:
+            args.append(f"skip={e.skip}")
     return f"Element({', '.join(args)})"
 
 

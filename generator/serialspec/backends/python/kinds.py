@@ -15,7 +15,7 @@ from serialspec.backends.common.numbers import number
 from serialspec.backends.python.ir import Calls
 from serialspec.backends.python.render import one_line
 from serialspec.lang import expression
-from serialspec.lang.model import Array, Bytes, Group, List, Scalar, ScalarType, TableBlock, TableValue, Text
+from serialspec.lang.model import Array, Bytes, Group, List, Packed, Scalar, ScalarType, TableBlock, TableValue, Text
 from serialspec.lang.model import Field as SpecField
 
 
@@ -75,13 +75,13 @@ def _numbers(is_float: bool) -> str:
     return "tuple[float, ...]" if is_float else "tuple[int, ...]"
 
 
-_INT = {1: "Int8", 2: "Int16", 4: "Int32"}
+_INT = {1: "Int8", 2: "Int16", 3: "Int24", 4: "Int32", 8: "Int64"}
 
 
 def primitive(scalar: ScalarType, endian: str) -> str:
     suffix = "b" if endian == ">" else "l"
     if scalar.is_float:
-        return f"Float32{suffix}"
+        return f"Float{scalar.size * 8}{suffix}"
     if scalar.size == 1:
         return "Int8sb" if scalar.signed else "Int8ub"
     return f"{_INT[scalar.size]}{'s' if scalar.signed else 'u'}{suffix}"
@@ -182,7 +182,9 @@ class ScalarKind(Kind[Scalar]):
         return Calls(f"{kind}({get}, {f.name!r}, where)", [kind], get)
 
     def blank(self, f: Scalar) -> str:
-        return zero_bits(f.bits) if f.bits else "0"
+        if f.bits:
+            return zero_bits(f.bits)
+        return number(f.default) if f.default is not None else "0"
 
 
 class ArrayKind(Kind[Array]):
@@ -208,6 +210,32 @@ class ArrayKind(Kind[Array]):
 
     def blank(self, f: Array) -> str:
         return f"[0] * {f.count}"
+
+
+class PackedKind(Kind[Packed]):
+    model = Packed
+
+    def construct(self, f: Packed, parent: str) -> str:
+        return f"PackedInts({f.count}, {f.bits}, {f.lsb_first}, {f.signed})"
+
+    def fixed(self, f: Packed) -> bool:
+        return True
+
+    def struct_chars(self, f: Packed) -> str:
+        return f"{f.byte_size}s"  # unpacked to integers after the struct call (content.py)
+
+    def annotation(self, f: Packed) -> str:
+        return "tuple[int, ...]"
+
+    def to_json(self, f: Packed, expr: str) -> str:
+        return f"list({expr})"
+
+    def from_json(self, f: Packed) -> Calls:
+        get = _get(f)
+        return Calls(f"_integers({get}, {f.name!r}, where)", ["_integers"], get)
+
+    def blank(self, f: Packed) -> str:
+        return f"[{number(max(f.minimum, min(0, f.maximum)))}] * {f.count}"
 
 
 class ListKind(Kind[List]):
@@ -236,11 +264,19 @@ class TextKind(Kind[Text]):
     model = Text
 
     def construct(self, f: Text, parent: str) -> str:
+        if isinstance(f.size, int) and f.pad is not None:
+            return f"PaddedUtf8({f.size}, {f.pad})"
         if f.size is None:
             return "CString('utf8')"
         if f.size == "rest":
             return "Utf8(GreedyBytes)"
         return f"Utf8(Bytes({f.size if isinstance(f.size, int) else 'this.' + f.size}))"
+
+    def fixed(self, f: Text) -> bool:
+        return isinstance(f.size, int)
+
+    def struct_chars(self, f: Text) -> str:
+        return f"{f.size}s"  # decoded to text after the struct call (content.py)
 
     def annotation(self, f: Text) -> str:
         return "str"
@@ -250,7 +286,7 @@ class TextKind(Kind[Text]):
         return Calls(f"_text({get}, {f.name!r}, where)", ["_text"], get)
 
     def blank(self, f: Text) -> str:
-        return repr(" " * f.size) if isinstance(f.size, int) else "''"
+        return repr(" " * f.size) if isinstance(f.size, int) and f.pad is None else "''"
 
 
 class BytesKind(Kind[Bytes]):

@@ -6,7 +6,19 @@ from typing import assert_never
 
 from serialspec.backends.common.numbers import number
 from serialspec.backends.python.render import one_line, render
-from serialspec.lang.model import Array, Bytes, Group, List, Protocol, Scalar, Table, TableBlock, TableValue, Text
+from serialspec.lang.model import (
+    Array,
+    Bytes,
+    Group,
+    List,
+    Packed,
+    Protocol,
+    Scalar,
+    Table,
+    TableBlock,
+    TableValue,
+    Text,
+)
 
 
 def register_tables(protocol: Protocol) -> list[Table]:
@@ -21,7 +33,7 @@ def register_tables(protocol: Protocol) -> list[Table]:
                     used.add(f.table.name)
                 case Group():
                     stack.extend(f.fields)
-                case Scalar() | Array() | List() | Text() | Bytes() | TableValue() | TableBlock():
+                case Scalar() | Array() | Packed() | List() | Text() | Bytes() | TableValue() | TableBlock():
                     pass  # no run of registers
                 case _:
                     assert_never(f)

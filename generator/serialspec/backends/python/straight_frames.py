@@ -299,7 +299,16 @@ def _residue(element: Element) -> int | None:
     assert function is not None
     samples = (b"", b"\x00", b"\x01\x02", b"123456789", b"\xff" * 7, bytes(range(1, 18)))
     found = {function(data + element.pack(function(data))) for data in samples}
-    return found.pop() if len(found) == 1 else None
+    if len(found) != 1:
+        return None
+    residue = found.pop()
+    # and only the right checksum gives it: a masked one (HerkuleX `& 0xFE`) gives it for a wrong bit 0 as well
+    for data in samples:
+        check = function(data)
+        for bit in range(8 * element.size):
+            if function(data + element.pack(check ^ 1 << bit)) == residue:
+                return None
+    return residue
 
 
 def _dispatch(target: Target, code: str, arguments: str, nullable: bool) -> Lines:
@@ -723,7 +732,7 @@ def _frame_lines(
     order = _order(elements, head)
     packed = None  # (format, arguments) where the frame up to the checksum is one pack of them
     multi = any(elements[i].kind != "constant" and elements[i].size > 1 for i in head)
-    if first and fmt[:1] in "<>" and (fmt[0] == order or not multi):
+    if head and first and fmt[:1] in "<>" and (fmt[0] == order or not multi):
         # the head's elements joined to the content's first struct: one pack for both
         fused = _packed(elements, head, constant_or, lambda f: f)  # named by its format
         if isinstance(fused, Pack):
@@ -893,7 +902,7 @@ def whole_frames(
     ]
     lines = [
         f"whole = {table}.get(frame[:{positions.content}])",
-        f"if whole is not None and {' and '.join(conditions)}:",
+        f"if {' and '.join(['whole is not None', *conditions])}:",
         "    try:",
         "        return _new(whole[0], whole[1](frame))",
         "    except struct.error:",

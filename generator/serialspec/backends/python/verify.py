@@ -14,9 +14,10 @@ from typing import Any
 from serialspec.backends.python.memory import imported
 from serialspec.checksums.crc import Crc, crc_function
 from serialspec.lang.errors import SpecError
-from serialspec.lang.model import Erratum, Example, Protocol
+from serialspec.lang.model import Erratum, Example, Protocol, TextExample, TextFrame
 from serialspec.runtime.errors import SerialspecError
 from serialspec.runtime.hexbytes import parse_hex
+from serialspec.runtime.text import texts
 
 
 def _difference(found: dict[str, Any], recorded: dict[str, object]) -> str:
@@ -145,3 +146,40 @@ def verify(protocol: Protocol, files: dict[str, str]) -> list[SpecError]:
                 line, column = erratum.position
                 problems.append(SpecError(protocol.spec_path, line, column, f"errata.{erratum.name}.check", wrong))
     return problems
+
+
+def verify_text(protocol: Protocol, text: TextFrame, files: dict[str, str]) -> list[SpecError]:
+    """Every example of a text protocol: its printed frame decodes to the text of each field it records, and the
+    message encodes back to the frame."""
+    problems: list[SpecError] = []
+    if not text.examples:
+        return problems
+    with imported(protocol.name, files, protocol.spec_path, "__init__") as package:
+        for example in text.examples:
+            if wrong := _text_example(package, text, example):
+                line, column = example.position
+                problems.append(SpecError(protocol.spec_path, line, column, f"examples.{example.name}", wrong))
+    return problems
+
+
+def _text_example(package: ModuleType, text: TextFrame, example: TextExample) -> str:
+    try:
+        message = package.decode(example.printed)
+    except SerialspecError as exc:
+        return f"the frame does not decode: {exc}"
+    if example.command != message.COMMAND or example.direction != message.DIRECTION:
+        return f"the frame decodes as {message.COMMAND} {message.DIRECTION.value}, not {example.command}"
+    found = texts(package.FRAMING.by_code[message.CODE], message.to_fields())
+    recorded = {name: _recorded(value) for name, value in example.fields.items()}
+    if found != recorded:
+        return f"the frame decodes to other values: {_difference(found, recorded)}"
+    encoded = package.encode(message)
+    if encoded != (example.printed + text.end).encode("ascii"):
+        return f"its values encode to {encoded!r}, not the frame"
+    return ""
+
+
+def _recorded(value: object) -> Any:
+    if isinstance(value, list):
+        return [{str(k): _recorded(v) for k, v in row.items()} if isinstance(row, dict) else row for row in value]
+    return "" if value is None else str(value)

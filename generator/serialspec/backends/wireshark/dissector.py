@@ -28,6 +28,7 @@ from serialspec.lang.model import (
     Group,
     List,
     Message,
+    Packed,
     Protocol,
     Scalar,
     TableBlock,
@@ -150,6 +151,8 @@ def _layout(layout: FrameLayout) -> dict[str, Any]:
         if element.checksum is not None:
             item["span"] = [runtime.span[0] + 1, runtime.span[1] + 1]
             item["checksum"] = _checksum(element.checksum)
+            if runtime.skip:  # the elements it leaves out, as a set: skip[i] is true
+                item["skip"] = {i + 1: True for i in runtime.skip}
         item["description"] = element.description
         elements.append(item)
     result: dict[str, Any] = {"elements": elements}
@@ -216,6 +219,7 @@ def _field(item: Field, tail: int) -> dict[str, Any]:
         case Scalar():
             unit = engineering_unit(item.unit, item.scale)
             common.update(kind="scalar", type=item.type.name, big=item.endian == ">", unit=unit, scale=item.scale)
+            common["offset"] = item.offset
             common.update(_scalar_extras(item.flags, item.bits, item.enum), hidden=item.hidden)
             common["sign_magnitude"] = item.sign_magnitude
         case Array():
@@ -223,8 +227,11 @@ def _field(item: Field, tail: int) -> dict[str, Any]:
         case List():
             common.update(kind="list", type=item.item.name if item.item else "bit", big=item.endian == ">")
             common.update(count=item.count or None, size=item.size or None, unit=item.unit)
+        case Packed():
+            common.update(kind="packed", bits=item.bits, count=item.count, lsb_first=item.lsb_first, unit=item.unit)
+            common["signed"] = item.signed
         case Text():
-            common.update(kind="text", size=item.size)
+            common.update(kind="text", size=item.size, pad=item.pad)
         case Bytes():
             common.update(kind="bytes", size=item.size)
         case Group():

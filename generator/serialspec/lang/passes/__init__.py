@@ -8,6 +8,8 @@ commands   commands, sub-commands, messages and their fields (fields.py), codes,
 errors     error replies: the command element's error_flag and the error_reply response
 examples   errata and examples
 device     the virtual device's behaviour, checked against the commands
+
+text       instead of types..device for a text protocol: its frame, commands and examples
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ from serialspec.lang.passes.examples import Examples
 from serialspec.lang.passes.framing import FramingPass
 from serialspec.lang.passes.settings import Settings
 from serialspec.lang.passes.structure import Structure
+from serialspec.lang.passes.text import TextPass
 from serialspec.lang.passes.types import Types
 
 PASSES: tuple[type[Pass], ...] = (
@@ -33,4 +36,7 @@ PASSES: tuple[type[Pass], ...] = (
     DevicePass,
 )
 
-__all__ = ["PASSES", "Context", "Pass"]
+# A text protocol (`framing: {kind: text}`): its own pass after the shared ones.
+TEXT_PASSES: tuple[type[Pass], ...] = (Structure, Settings, TextPass)
+
+__all__ = ["PASSES", "TEXT_PASSES", "Context", "Pass"]

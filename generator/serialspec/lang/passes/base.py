@@ -13,6 +13,7 @@ import sys
 from dataclasses import field
 from typing import Any, Literal
 
+from serialspec.lang import grammar
 from serialspec.lang.errors import SpecError
 from serialspec.lang.frozen import mutable
 from serialspec.lang.loader import Located, Path, dotted
@@ -29,6 +30,7 @@ from serialspec.lang.model import (
     ScalarType,
     Serial,
     Table,
+    TextFrame,
 )
 
 NAME = re.compile(r"^[a-z][a-z0-9_]*$")
@@ -65,7 +67,6 @@ RESERVED_FIELD_NAMES = (
         "sum",
         "super",
         "tuple",
-        "type",
     }
 )
 # Names the generated modules (messages, codec, client, simulator, registers, __init__) import or define next to
@@ -180,6 +181,7 @@ class Context:
     examples: tuple[Example, ...] = ()
     device: Device | None = None
     error_reply: ErrorReply | None = None
+    text: TextFrame | None = None  # framing kind text
 
     @property
     def data(self) -> Any:
@@ -320,10 +322,12 @@ class Pass:
 
     # --- types and ranges -----------------------------------------------------------------------------------------
 
-    def scalar_type(self, value: Any, path: Path, allow_float: bool = True) -> ScalarType:
-        found = SCALARS.get(value) if isinstance(value, str) else None
+    def scalar_type(self, value: Any, path: Path, allow_float: bool = True, for_field: bool = False) -> ScalarType:
+        """A wire type by name: one of a field's (`for_field`), or of a frame element, enum, flags or table entry."""
+        names = grammar.FIELD_SCALAR_TYPES if for_field else grammar.SCALAR_TYPES
+        found = SCALARS.get(value) if isinstance(value, str) and value in names else None
         if found is None or (found.is_float and not allow_float):
-            choices = [n for n, t in SCALARS.items() if allow_float or not t.is_float]
+            choices = [n for n in names if allow_float or not SCALARS[n].is_float]
             raise self.fail(path, f"unknown type {value!r} (expected one of {', '.join(choices)})")
         return found
 

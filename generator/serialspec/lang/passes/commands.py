@@ -195,6 +195,8 @@ class Commands(FieldResolver):
             self.error((*path, "probe"), "a probe is a command with a request (and a reply), not sub-commands")
         elif probe and "response" not in value and "answered_by" not in (value["request"] or {}):
             self.error((*path, "probe"), "a probe needs a reply: a `response`, or `answered_by` on its request")
+        if isinstance(value.get("code"), str):
+            self.error((*path, "code"), "expected an integer, got text (text codes belong to `framing: {kind: text}`)")
         return Command(
             name=name,
             code=value.get("code"),

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from dataclasses import replace
 from typing import Any, Literal
 
@@ -15,6 +16,7 @@ from serialspec.lang.model import (
     Field,
     Group,
     List,
+    Packed,
     Scalar,
     ScalarType,
     TableBlock,
@@ -25,7 +27,7 @@ from serialspec.lang.model import (
 from serialspec.lang.passes.base import RESERVED_FIELD_NAMES, Bad, Pass, camel, enum_span
 
 FIELD_KINDS = (
-    *grammar.SCALAR_TYPES,
+    *grammar.FIELD_SCALAR_TYPES,
     "bytes",
     "string",
     "cstring",
@@ -34,6 +36,10 @@ FIELD_KINDS = (
     "table_value",
     "table_block",
 )
+
+
+# Keys of text fields (framing kind text) that a binary field must not have
+TEXT_ONLY_FIELD_KEYS = ("precision", "width", "letters", "max_count")
 
 
 class FieldResolver(Pass):
@@ -162,6 +168,11 @@ class FieldResolver(Pass):
     def field(self, name: str, item: Any, path: Path, siblings: list[Field], parent: list[Field] | None) -> Field:
         spec = self.expand(item, path)
         kind = spec["type"]
+        for text_key in TEXT_ONLY_FIELD_KEYS:
+            if text_key in spec:
+                self.error(
+                    (*path, text_key), f"`{text_key}` belongs to fields of text frames (`framing: {{kind: text}}`)"
+                )
         common = dict(
             name=name,
             description=str(spec.get("description", "")),
@@ -202,19 +213,25 @@ class FieldResolver(Pass):
             )
         if kind in ("string", "cstring"):
             size = spec.get("size")
+            if "pad" in spec and (kind == "cstring" or not isinstance(size, int)):
+                self.error((*path, "pad"), "`pad` goes with a string of a fixed size (a number)")
             if kind == "cstring":
                 if size is not None:
                     self.error((*path, "size"), "a cstring ends at its NUL byte: it takes no `size`")
-                return Text(**common, size=None)
+                return Text(**common, size=None, pad=None)
             if size is None:
                 raise self.fail(path, "a string needs `size`: a number, `rest`, or a field name (or use cstring)")
             if isinstance(size, str) and size != "rest":
                 self.size_field(size, name, siblings, parent, path)
-            return Text(**common, size=size)
+            return Text(**common, size=size, pad=self.pad(spec.get("pad"), size, (*path, "pad")))
+        if kind == "array" and _PACKED.match(str(spec.get("of", ""))) and str(spec["of"]) not in _BYTE_ALIGNED:
+            return self.packed(common, spec, path, endian)
+        if "bit_order" in spec:
+            self.error((*path, "bit_order"), "`bit_order` goes with an array of uN or iN items (e.g. of: u11)")
         if kind == "array" and (spec.get("of") == "bit" or not isinstance(spec.get("count"), int) or "size" in spec):
             return self.list_field(common, spec, path, endian, siblings)
         if kind == "array":
-            item_type = self.scalar_type(spec.get("of"), (*path, "of"))
+            item_type = self.scalar_type(spec.get("of"), (*path, "of"), for_field=True)
             count = spec.get("count")
             if not isinstance(count, int) or count < 1:
                 raise self.fail((*path, "count"), "an array needs a fixed `count` (use a group for counted items)")
@@ -267,13 +284,56 @@ class FieldResolver(Pass):
             )
         raise self.fail((*path, "type"), f"unknown type {kind!r} (expected one of {', '.join(FIELD_KINDS)})")
 
+    def pad(self, pad: Any, size: Any, path: Path) -> int | None:
+        """The pad byte of a fixed-size string, from its hex ('00')."""
+        if pad is None or not isinstance(size, int):
+            return None
+        try:
+            value = bytes.fromhex(str(pad))
+        except ValueError:
+            value = b""
+        if len(value) != 1:
+            raise self.fail(path, f"pad {pad!r} must be one byte in hex, e.g. '00'")
+        return value[0]
+
+    def packed(self, common: dict[str, Any], spec: dict[str, Any], path: Path, endian: Literal["<", ">"]) -> Packed:
+        """An array of integers of any number of bits (1..64), packed with no gaps."""
+        of = str(spec["of"])
+        bits = int(of[1:])
+        if not 1 <= bits <= 64:
+            raise self.fail((*path, "of"), f"{of}: packed integers take 1..64 bits")
+        count = spec.get("count")
+        if not isinstance(count, int) or count < 1 or "size" in spec:
+            raise self.fail((*path, "count"), f"an array of {of} items needs a fixed `count` (a number)")
+        signed = of.startswith("i")
+        low_type, high_type = (-(1 << (bits - 1)), (1 << (bits - 1)) - 1) if signed else (0, (1 << bits) - 1)
+        low, high = float(low_type), float(high_type)
+        given = spec.get("range")
+        if given is not None:
+            low, high = float(given[0]), float(given[1])
+            if not low_type <= low <= high <= high_type:
+                self.error((*path, "range"), f"range {low:g}..{high:g} does not fit {of} ({low_type}..{high_type})")
+        order = spec.get("bit_order", "lsb_first" if endian == "<" else "msb_first")
+        return Packed(
+            **common,
+            bits=bits,
+            signed=signed,
+            count=count,
+            lsb_first=order == "lsb_first",
+            unit=str(spec.get("unit", "")),
+            minimum=low,
+            maximum=high,
+        )
+
     def list_field(
         self, common: dict[str, Any], spec: dict[str, Any], path: Path, endian: Literal["<", ">"], siblings: list[Field]
     ) -> List:
         """An array whose count varies (a count field, a byte-size field, the rest), or an array of bits."""
         name = common["name"]
         bits = spec.get("of") == "bit"
-        item_type = None if bits else self.scalar_type(spec.get("of"), (*path, "of"))
+        item_type = None if bits else self.scalar_type(spec.get("of"), (*path, "of"), for_field=True)
+        if item_type is not None and item_type.size == 3:
+            raise self.fail((*path, "count"), f"an array of {item_type.name} items needs a fixed `count` (a number)")
         count = spec.get("count", "")
         size = spec.get("size", "")
         if bool(count) == bool(size):
@@ -332,6 +392,8 @@ class FieldResolver(Pass):
             self.error((*path, "const"), f"constant {const} is outside {low:g}..{high:g}")
         if spec.get("scale") == 0:
             self.error((*path, "scale"), "scale 0 would make every value 0 (give the size of one wire step)")
+        if "offset" in spec and any(k in spec for k in ("enum", "flags", "bits")):
+            self.error((*path, "offset"), "`offset` goes with a number, not an enum, flags or bit fields")
         default = spec.get("default")
         if default is not None and not low <= default <= high:
             self.error((*path, "default"), f"default {default} is outside the range {low:g}..{high:g}")
@@ -370,6 +432,7 @@ class FieldResolver(Pass):
             sign_magnitude=sign_magnitude,
             status_ok=self.status_ok(spec.get("status"), scalar, low, high, (*path, "status")),
             value=self.derived_value(spec, scalar, path),
+            offset=spec.get("offset"),
         )
 
     def derived_value(self, spec: dict[str, Any], scalar: ScalarType, path: Path) -> expression.Expr | None:
@@ -411,7 +474,9 @@ class FieldResolver(Pass):
             self.derive(size, ("size", name), siblings, path)
 
 
-LISTS = (Array, List, Bytes, Text, Group)
+LISTS = (Array, Packed, List, Bytes, Text, Group)
+_PACKED = re.compile(r"^[ui][0-9]{1,3}$")  # `of: u11`: packed integers (u8, u16, ... are byte-aligned arrays)
+_BYTE_ALIGNED = ("u8", "i8", "u16", "i16", "u32", "i32", "u64", "i64")
 
 
 def _nodes(expr: expression.Expr) -> list[expression.Expr]:

@@ -37,6 +37,9 @@ class FramingPass(FieldResolver):
         return self.problems
 
     def framing(self, value: dict[str, Any], path: Path) -> Framing:
+        for key in ("start", "separator", "end", "checksum", "talker", "max_length"):
+            if key in value:
+                self.error((*path, key), f"`{key}` belongs to text frames: add `kind: text`")
         if "layouts" in value and "elements" in value:
             raise self.fail(path, "give either `elements` (one layout) or `layouts` (alternatives), not both")
         if "layouts" in value:
@@ -251,11 +254,22 @@ class FramingPass(FieldResolver):
             elif element.role == "checksum" and element.checksum is not None:
                 covers = self.span(item.get("covers"), direction, names, (*e_path, "covers"))
                 a, b = names.index(covers[0]), names.index(covers[1])
-                if a <= index <= b:
-                    raise self.fail((*e_path, "covers"), "a checksum cannot cover itself")
+                if index in (a, b):
+                    raise self.fail((*e_path, "covers"), "a checksum cannot begin or end the span it covers")
                 if overlaps_badly(a, b):
                     raise self.fail((*e_path, "covers"), "the covered span must hold the transparency span or miss it")
-                checksum = replace(element.checksum, first=covers[0], last=covers[1])
+                # checksums strictly inside the span (itself too) are left out of it; one at an end is covered
+                skips = tuple(names[i] for i in range(a + 1, b) if elements[i].role == "checksum")
+                if skips and transparency and not (b < t_first or a > t_last):
+                    raise self.fail(
+                        (*e_path, "covers"), "a span that leaves out checksums cannot overlap the transparency span"
+                    )
+                for end in {a, b}:
+                    if elements[end].role == "checksum" and end > index:
+                        raise self.fail(
+                            (*e_path, "covers"), f"a checksum covering {names[end]} must come after it in the frame"
+                        )
+                checksum = replace(element.checksum, first=covers[0], last=covers[1], skips=skips)
                 elements[index] = replace(element, checksum=checksum)
         for length in (e for e in elements if e.role == "length" and transparency is not None):
             a, b = names.index(length.counts[0]), names.index(length.counts[1])

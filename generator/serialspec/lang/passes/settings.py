@@ -19,6 +19,9 @@ class Settings(Pass):
         self.ctx.client_class = self.client_class_name(camel(name, "client"), ("protocol",))
         self.ctx.simulator_class = self.class_name(camel(name, "simulator"), ("protocol",))
         self.ctx.endian = ">" if data.get("byte_order") == "big" else "<"
+        framing = data.get("framing")
+        if "byte_order" not in data and not (isinstance(framing, dict) and framing.get("kind") == "text"):
+            self.error((), "missing key 'byte_order' (every binary protocol needs one)")
         self.ctx.shared_fields = self.section("fields")
         serial = data.get("serial") or {}
         if isinstance(serial, dict):

@@ -1,0 +1,252 @@
+"""Text protocols (`framing: {kind: text}`): the frame, the commands' text codes and fields, and the examples.
+
+A text spec runs this pass instead of the binary ones (framing, commands, errors, examples, device): keys that only
+binary frames have yet are refused one line each, so that nothing a spec says is silently ignored.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from typing import Any, cast
+
+from serialspec import checksums
+from serialspec.checksums import ChecksumProblem
+from serialspec.lang.errors import SpecError
+from serialspec.lang.loader import Path
+from serialspec.lang.model import (
+    Direction,
+    Framing,
+    TextExample,
+    TextField,
+    TextFrame,
+    TextMessage,
+    TextRepeat,
+)
+from serialspec.lang.passes.base import Bad, Pass, camel
+
+KINDS = ("decimal", "integer", "angle", "char", "text", "time", "date")
+# Keys a text field may have, by kind (besides type, use, description, unit)
+KIND_KEYS = {
+    "decimal": {"precision", "width", "range"},
+    "integer": {"width", "range"},
+    "angle": {"precision", "width", "range"},
+    "char": {"letters"},
+    "text": set(),
+    "time": {"precision"},
+    "date": set(),
+}
+COMMON_KEYS = {"type", "use", "description", "unit"}
+BINARY_ONLY = ("elements", "layouts", "transparency", "gap")
+TEXT_ONLY_FRAMING = ("start", "separator", "end", "checksum", "talker", "max_length")
+NOT_YET = ("matching", "enums", "flags", "tables", "errata", "device")
+
+
+def is_text(data: Any) -> bool:
+    framing = data.get("framing") if isinstance(data, dict) else None
+    return isinstance(framing, dict) and framing.get("kind") == "text"
+
+
+class TextPass(Pass):
+    """Resolve a text protocol's framing, commands and examples into `ctx.text`."""
+
+    def run(self) -> list[SpecError]:
+        data = self.ctx.data
+        for key in NOT_YET:
+            if key in data:
+                self.error((key,), f"`{key}` is not available in text frames yet")
+        framing = data.get("framing") or {}
+        frame = self.guard(("framing",), self.frame, framing)
+        messages = []
+        for name, command in self.section("commands").items():
+            path = ("commands", name)
+            self.name(name, path, "command name")
+            for direction in Direction:
+                if isinstance(command, dict) and direction.value in command:
+                    message = self.guard((*path, direction.value), self.message, name, command, direction)
+                    if message is not None:
+                        messages.append(message)
+        codes: dict[str, TextMessage] = {}
+        for message in messages:
+            other = codes.setdefault(message.code, message)
+            if other.key != message.key:
+                self.error(("commands", message.key, "code"), f"code {message.code!r} is also {other.key}'s")
+            elif other is not message:  # a frame does not say its direction: one message per code
+                self.error(("commands", message.key), "a text command has a request or a response, not both (yet)")
+        if frame is not None:
+            frame = replace(frame, messages=tuple(messages))
+            examples = tuple(self.examples(frame))
+            self.ctx.text = replace(frame, examples=examples)
+            self.ctx.framing = Framing(
+                description=frame.description, layouts={}, checksum=None, shared_header=False, alternatives={}
+            )
+        return self.problems
+
+    def frame(self, raw: dict[str, Any]) -> TextFrame:
+        path: Path = ("framing",)
+        for key in BINARY_ONLY:
+            if key in raw:
+                self.error((*path, key), f"`{key}` belongs to binary framing, not `kind: text`")
+        for key in ("start", "separator", "end"):
+            if not raw.get(key):
+                self.error(path, f"missing key {key!r} (a text frame needs `start`, `separator` and `end`)")
+        start, separator, end = (str(raw.get(k) or "?") for k in ("start", "separator", "end"))
+        if len(start) != 1 or len(separator) != 1:
+            self.error(path, "`start` and `separator` must be one character each")
+        checksum_raw = raw.get("checksum")
+        algorithm = None
+        marker = "*"
+        required = True
+        if isinstance(checksum_raw, dict):
+            marker = str(checksum_raw.get("marker", "*"))
+            required = bool(checksum_raw.get("required", True))
+            where = (*path, "checksum")
+            try:
+                algorithm = checksums.from_spec(checksum_raw, 1, "u8", lambda at, text: self.error((*where, *at), text))
+            except ChecksumProblem as problem:
+                self.error((*where, *problem.keys), problem.message)
+            if len(marker) != 1:
+                self.error((*where, "marker"), "the marker must be one character")
+        talker = raw.get("talker") or {}
+        size = int(talker.get("size", 0))
+        talkers = tuple(str(t) for t in talker.get("values") or ())
+        for index, value in enumerate(talkers):
+            if len(value) != size:
+                self.error((*path, "talker", "values", index), f"talker {value!r} is not {size} characters")
+        special = [start, separator, *set(end)] + ([marker] if algorithm is not None else [])
+        if len(set(special)) != len(special):
+            self.error(path, "`start`, `separator`, the checksum's `marker` and the characters of `end` must differ")
+        return TextFrame(
+            description=str(raw.get("description", "")),
+            start=start,
+            separator=separator,
+            end=end,
+            checksum=algorithm,
+            marker=marker,
+            required=required,
+            talker=size,
+            talkers=talkers,
+            talker_description=str(talker.get("description", "")),
+            max_length=int(raw.get("max_length", 82)),
+            messages=(),
+        )
+
+    def message(self, key: str, command: dict[str, Any], direction: Direction) -> TextMessage:
+        path: Path = ("commands", key)
+        for bad in ("subcommands", "selector", "probe", "broadcast"):
+            if bad in command:
+                self.error((*path, bad), f"`{bad}` is not available in text frames yet")
+        code = command.get("code")
+        if not isinstance(code, str) or not code or not code.isalnum():
+            raise self.fail((*path, "code"), f"a text command needs a text `code` (letters and digits), got {code!r}")
+        raw = command.get(direction.value) or {}
+        where = (*path, direction.value)
+        for bad in ("answers", "error_reply", "optional_when", "after", "answered_by", "default", "optional"):
+            if bad in raw:
+                self.error((*where, bad), f"`{bad}` is not available in text frames yet")
+        fields = self.fields(raw.get("fields") or {}, (*where, "fields"), top=True)
+        class_name = camel(key, direction.value)
+        self.class_name(class_name, where)
+        return TextMessage(
+            key=key,
+            code=code,
+            title=str(command.get("title", "")),
+            description=str(raw.get("description") or command.get("description", "")),
+            direction=direction,
+            class_name=class_name,
+            fields=fields,
+            unsolicited=bool(raw.get("unsolicited", False)),
+            source=str(raw.get("source") or command.get("source", "")),
+        )
+
+    def fields(self, raw: dict[str, Any], path: Path, top: bool) -> tuple[TextField | TextRepeat, ...]:
+        found: list[TextField | TextRepeat] = []
+        for name, value in raw.items():
+            item = self.guard((*path, name), self.field, name, value, (*path, name), top)
+            if item is not None:
+                found.append(item)
+        variable = [i for i, f in enumerate(found) if isinstance(f, TextRepeat) and not f.count]
+        if variable and variable[0] != len(found) - 1:
+            self.error((*path, found[variable[0]].name), "a repeat with `max_count` must be the last field")
+        return tuple(found)
+
+    def field(self, name: str, value: Any, path: Path, top: bool) -> TextField | TextRepeat:
+        self.name(name, path, "field name")
+        spec: dict[str, Any] = {"type": value} if isinstance(value, str) else dict(value)
+        origin = name  # what a letter Enum is named after: the shared field it comes from, else the field
+        if "use" in spec:
+            origin = spec.pop("use")
+            shared = self.shared_fields.get(origin)
+            if shared is None:
+                raise self.fail((*path, "use"), f"no shared field {origin!r} in `fields:`")
+            spec = {**({"type": shared} if isinstance(shared, str) else shared), **spec}
+        elif isinstance(value, str) and value not in (*KINDS, "repeat"):
+            origin = value
+            shared = self.shared_fields.get(value)
+            if shared is None:
+                raise self.fail(path, f"unknown text field type {value!r} (expected one of {', '.join(KINDS)})")
+            spec = {"type": shared} if isinstance(shared, str) else dict(shared)
+        kind = spec.get("type")
+        if kind == "repeat":
+            if not top:
+                raise self.fail(path, "a repeat inside a repeat is not available")
+            count, most = int(spec.get("count", 0)), int(spec.get("max_count", 0))
+            if bool(count) == bool(most):
+                raise self.fail(path, "a repeat needs `count` (always sent) or `max_count` (at the end), not both")
+            inner = self.fields(spec.get("fields") or {}, (*path, "fields"), top=False)
+            return TextRepeat(name, cast(tuple[TextField, ...], inner), str(spec.get("description", "")), count, most)
+        if kind not in KINDS:
+            raise self.fail(path, f"unknown text field type {kind!r} (expected one of {', '.join(KINDS)}, repeat)")
+        for key in spec:
+            if key not in COMMON_KEYS and key not in KIND_KEYS[kind]:
+                self.error((*path, key), f"`{key}` does not apply to a {kind} field in a text frame")
+        low, high = (spec.get("range") or (None, None))[:2]
+        letters = tuple((str(label), str(letter)) for label, letter in (spec.get("letters") or {}).items())
+        for label, letter in letters:
+            self.name(label, (*path, "letters", label), "letter label")
+            if len(letter) != 1:
+                self.error((*path, "letters", label), f"{letter!r} is not one letter")
+        if len({letter for _, letter in letters}) != len(letters):
+            self.error((*path, "letters"), "two labels share a letter")
+        letters_class = ""
+        if letters:
+            letters_class = self.class_name(camel(origin), path, identity=letters, scoped=True)
+        return TextField(
+            name=name,
+            kind=kind,
+            description=str(spec.get("description", "")),
+            unit=str(spec.get("unit", "")),
+            precision=int(spec.get("precision", 0)),
+            width=int(spec.get("width", 0)),
+            minimum=low,
+            maximum=high,
+            letters=letters,
+            letters_class=letters_class,
+        )
+
+    def examples(self, frame: TextFrame) -> list[TextExample]:
+        found = []
+        by_key = {(m.key, m.direction.value) for m in frame.messages}
+        for name, raw in self.section("examples").items():
+            path = ("examples", name)
+            try:
+                for bad in ("frame", "printed_span", "erratum", "completed", "subcommand", "request"):
+                    if bad in raw:
+                        self.error((*path, bad), f"`{bad}` is not available in text frames yet")
+                if (raw["command"], raw["direction"]) not in by_key:
+                    raise self.fail((*path, "command"), f"no {raw['direction']} of command {raw['command']!r}")
+                found.append(
+                    TextExample(
+                        name=name,
+                        source=str(raw.get("source", "")),
+                        description=str(raw.get("description", "")),
+                        direction=Direction(raw["direction"]),
+                        printed=str(raw["printed"]),
+                        command=str(raw["command"]),
+                        fields=dict(raw.get("fields") or {}),
+                        position=self.doc.where(path),
+                    )
+                )
+            except (Bad, KeyError, TypeError, ValueError):
+                if not self.ctx.malformed_near(path) and not self.problems:
+                    raise
+        return found

@@ -1,0 +1,637 @@
+"""Line-oriented text frames (NMEA 0183: `$GPGGA,…*hh\\r\\n`) and the text fields they carry.
+
+A text frame is a start character, an address field (a frame-level value such as NMEA's talker, then the text code
+that chooses the message), fields separated by a delimiter, optionally a checksum written as hex digits after a
+marker, and a line ending. Everything here is driven by descriptors (what generated code declares from a spec); no
+protocol fact lives in this module.
+
+Decoded values keep the digits a device sent, so re-encoding a decoded sentence gives the same text: decimals are
+`Fixed` (a `Decimal` that remembers its leading zeros: "000.90" stays "000.90"), times are `Clock` (a
+`datetime.time` that remembers its fraction digits), ddmm.mmmm coordinates are `Angle` (degrees and `Decimal`
+minutes), and a sentence remembers how many fields it had (trailing empty fields included). An empty field is
+`None`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import datetime
+import re
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass, field
+from decimal import Decimal, InvalidOperation
+from enum import Enum
+from typing import Any, ClassVar, Literal
+
+from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError, RangeError, shown
+from serialspec.runtime.message import Direction
+
+TextKind = Literal["decimal", "integer", "angle", "char", "text", "time", "date"]
+
+
+class Clock(datetime.time):
+    """A time of day read from text (hhmmss[.ss]); `digits` is how many fraction digits of a second it was sent
+    with, so encoding it again writes the same text."""
+
+    digits: int
+
+    def __new__(cls, hour: int, minute: int, second: int, microsecond: int = 0, digits: int = 0) -> Clock:
+        self = super().__new__(cls, hour, minute, second, microsecond)
+        self.digits = digits
+        return self
+
+    def __reduce__(self) -> Any:
+        return (Clock, (self.hour, self.minute, self.second, self.microsecond, self.digits))
+
+
+class Fixed(Decimal):
+    """A decimal read from text; `width` is how many digits it was sent with before the point (000.5 has 3), so
+    encoding it again writes the same leading zeros. Arithmetic gives plain Decimals."""
+
+    width: int
+
+    def __new__(cls, text: str) -> Fixed:
+        self = super().__new__(cls, text)
+        self.width = len(text.lstrip("+-").split(".")[0])
+        return self
+
+    def __reduce__(self) -> Any:
+        return (Fixed, (_padded(format(self, "f"), self.width),))
+
+
+def _padded(text: str, width: int) -> str:
+    """`text` (a number) with zeros after its sign so that its integer part has at least `width` digits."""
+    sign = text[:1] if text[:1] in "+-" else ""
+    digits = text[len(sign) :]
+    whole = len(digits.split(".")[0])
+    return sign + "0" * (width - whole) + digits
+
+
+@dataclass(frozen=True)
+class Angle:
+    """A coordinate written as degrees and minutes (NMEA ddmm.mmmm latitude, dddmm.mmmm longitude); the sign is a
+    separate hemisphere field. `minutes` keeps the digits the device sent."""
+
+    degrees: int
+    minutes: Decimal
+
+    @property
+    def value(self) -> float:
+        """Decimal degrees (unsigned)."""
+        return self.degrees + float(self.minutes) / 60
+
+    @classmethod
+    def from_degrees(cls, value: float, digits: int) -> Angle:
+        """The angle of `value` decimal degrees, its minutes rounded to `digits` fraction digits."""
+        degrees = int(value)
+        minutes = round(Decimal(repr(value - degrees)) * 60, digits)
+        if minutes >= 60:
+            degrees, minutes = degrees + 1, minutes - 60
+        return cls(degrees, minutes)
+
+
+@dataclass(frozen=True)
+class TextField:
+    """One text field: its kind and how it is written.
+
+    precision: decimal, angle (of the minutes), time (of the seconds): fraction digits written for a value that
+    does not carry its own (a float, an int, a `datetime.time`). width: integer, decimal: digits before the point,
+    zero-padded, for a value that does not carry its own; angle: digits of the degrees (2 for a latitude, 3 for a
+    longitude). letters: char: the enum whose values are the letters allowed.
+    """
+
+    name: str
+    kind: TextKind
+    precision: int = 0
+    width: int = 0  # integer, decimal: integer digits, zero-padded; angle: digits of the degrees
+    minimum: float | None = None
+    maximum: float | None = None
+    letters: type[Enum] | None = None
+
+
+@dataclass(frozen=True)
+class TextRepeat:
+    """Fields repeated as a group: `count` groups always (GSA's twelve satellite ids, empty ones included), or up to
+    `maximum` groups at the end of a sentence (GSV's satellites). Its value is a list of dicts, one per group."""
+
+    name: str
+    fields: tuple[TextField, ...]
+    count: int = 0  # fixed number of groups (0: as many as the sentence has, up to maximum)
+    maximum: int = 0
+
+
+@dataclass(frozen=True)
+class TextSentence:
+    """One message: the text code that chooses it (NMEA's sentence id) and its fields in order."""
+
+    code: str
+    fields: tuple[TextField | TextRepeat, ...]
+    name: str = ""
+
+    @property
+    def where(self) -> str:
+        return self.name or self.code
+
+
+@dataclass(frozen=True)
+class Sentence:
+    """A decoded frame: the frame-level value (talker), the message's code, its values and how many fields the
+    frame had (so encoding it again writes the same trailing empty fields)."""
+
+    talker: str
+    code: str
+    values: dict[str, Any]
+    sent: int = -1  # fields after the address (-1: every declared field)
+
+
+@dataclass(frozen=True)
+class TextFraming:
+    """The frame: `start` + address (talker + code) + separator-joined fields + [marker + checksum as hex] + `end`.
+
+    checksum: the function over the characters between start and marker (from the checksum registry); `required`
+    says whether a frame without one is refused. talker: how many leading characters of the address are the
+    frame-level value (0: none). max_length: longest frame the stream parser waits for, in characters.
+    """
+
+    start: str
+    separator: str
+    end: str
+    sentences: tuple[TextSentence, ...]
+    checksum: Callable[[bytes], int] | None = None
+    marker: str = "*"
+    digits: int = 2
+    required: bool = True
+    talker: int = 0
+    talkers: tuple[str, ...] = ()  # the talker values encode accepts (empty: any)
+    max_length: int = 82
+    by_code: dict[str, TextSentence] = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "by_code", {s.code: s for s in self.sentences})
+
+    # --- decoding --------------------------------------------------------------------------------------------------
+
+    def decode(self, frame: bytes | str) -> Sentence:
+        """One frame (with or without its line ending) -> its sentence; DecodeError says in one line why not."""
+        text = _ascii(frame)
+        if text.endswith(self.end):
+            text = text[: -len(self.end)]
+        if not text.startswith(self.start):
+            raise DecodeError(f"text frame does not start with {self.start!r}: {shown(text[:20])}")
+        body = text[len(self.start) :]
+        body = self._checked(body)
+        parts = body.split(self.separator)
+        address = parts[0]
+        talker, code = address[: self.talker], address[self.talker :]
+        sentence = self.by_code.get(code)
+        if sentence is None:
+            raise DecodeError(f"unknown text code {code!r} (expected one of {', '.join(self.by_code)})")
+        values = _decode_fields(sentence, parts[1:])
+        return Sentence(talker, code, values, len(parts) - 1)
+
+    def _checked(self, body: str) -> str:
+        if self.checksum is None:
+            return body
+        at = body.rfind(self.marker)
+        if at < 0:
+            if self.required:
+                raise ChecksumError(f"text frame has no checksum (no {self.marker!r})")
+            return body
+        written, covered = body[at + len(self.marker) :], body[:at]
+        if len(written) != self.digits or not re.fullmatch(r"[0-9A-Fa-f]+", written):
+            raise ChecksumError(f"checksum {shown(written)} is not {self.digits} hex digits")
+        computed = self.checksum(covered.encode("ascii"))
+        if int(written, 16) != computed:
+            raise ChecksumError(f"checksum {written} does not match the frame's {computed:0{self.digits}X}")
+        return covered
+
+    # --- encoding --------------------------------------------------------------------------------------------------
+
+    def encode(self, code: str, values: Mapping[str, Any], talker: str = "", sent: int = -1) -> bytes:
+        """A sentence's values -> the frame; EncodeError (RangeError) names the field at fault before any text is
+        written. `sent` is the number of fields to write (a decoded Sentence's); -1 writes every declared one."""
+        sentence = self.by_code.get(code)
+        if sentence is None:
+            raise EncodeError(f"unknown text code {code!r} (expected one of {', '.join(self.by_code)})")
+        if len(talker) != self.talker or (self.talkers and talker not in self.talkers):
+            allowed = ", ".join(self.talkers) if self.talkers else f"{self.talker} characters"
+            raise EncodeError(f"{sentence.where}: talker {talker!r} is not one of {allowed}")
+        unknown = set(values) - {f.name for f in sentence.fields}
+        if unknown:
+            raise EncodeError(f"{sentence.where}: unknown field {sorted(unknown)[0]!r}")
+        parts = _encode_fields(sentence, values, self._forbidden())
+        if sent >= 0:
+            if any(parts[sent:]):
+                raise EncodeError(f"{sentence.where}: {sent} fields asked for, but field {sent + 1} has a value")
+            parts = (parts + [""] * sent)[:sent]
+        body = self.separator.join([talker + code, *parts])
+        return self.frame(body)
+
+    def frame(self, body: str) -> bytes:
+        """The text between start and checksum marker, framed."""
+        text = self.start + body
+        if self.checksum is not None:
+            text += f"{self.marker}{self.checksum(body.encode('ascii')):0{self.digits}X}"
+        return (text + self.end).encode("ascii")
+
+    def encode_sentence(self, sentence: Sentence) -> bytes:
+        return self.encode(sentence.code, sentence.values, sentence.talker, sentence.sent)
+
+    def _forbidden(self) -> str:
+        return "".join({self.start, self.separator, self.marker, *self.end})
+
+
+# --- fields -------------------------------------------------------------------------------------------------------
+
+_DECIMAL = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)")
+_INTEGER = re.compile(r"[+-]?\d+")
+_TIME = re.compile(r"(\d\d)(\d\d)(\d\d)(?:\.(\d*))?")
+_DATE = re.compile(r"(\d\d)(\d\d)(\d\d)")
+
+
+def _decode_fields(sentence: TextSentence, parts: list[str]) -> dict[str, Any]:
+    values: dict[str, Any] = {}
+    at = 0
+    for item in sentence.fields:
+        if isinstance(item, TextField):
+            values[item.name] = decode_field(sentence.where, item, parts[at] if at < len(parts) else "")
+            at += 1
+            continue
+        size = len(item.fields)
+        groups = item.count or min(item.maximum, -(-(len(parts) - at) // size))
+        rows = []
+        for _ in range(max(groups, 0)):
+            row = {
+                f.name: decode_field(sentence.where, f, parts[at + i] if at + i < len(parts) else "")
+                for i, f in enumerate(item.fields)
+            }
+            rows.append(row)
+            at += size
+        values[item.name] = rows
+    if at < len(parts):
+        raise DecodeError(f"{sentence.where}: {len(parts)} fields, expected at most {at}")
+    return values
+
+
+def decode_field(where: str, spec: TextField, text: str) -> Any:
+    """One field's text -> its value (None when empty); DecodeError names the field and what it should look like."""
+    if text == "":
+        return None
+    try:
+        return _decoders[spec.kind](spec, text)
+    except (ValueError, InvalidOperation):
+        raise DecodeError(f"{where}: {spec.name} = {shown(text)} is not {_looks(spec)}") from None
+
+
+def _decimal(spec: TextField, text: str) -> Fixed:
+    if not _DECIMAL.fullmatch(text):
+        raise ValueError(text)
+    return Fixed(text)
+
+
+def _integer(spec: TextField, text: str) -> int:
+    if not _INTEGER.fullmatch(text):
+        raise ValueError(text)
+    return int(text)
+
+
+def _angle(spec: TextField, text: str) -> Angle:
+    width = spec.width or 2
+    match = re.fullmatch(rf"(\d{{1,{width}}})(\d\d(?:\.\d*)?)", text)
+    if not match or Decimal(match[2]) >= 60:
+        raise ValueError(text)
+    return Angle(int(match[1]), Decimal(match[2]))
+
+
+def _char(spec: TextField, text: str) -> Any:
+    if len(text) != 1:
+        raise ValueError(text)
+    return spec.letters(text) if spec.letters is not None else text
+
+
+def _text(spec: TextField, text: str) -> str:
+    return text
+
+
+def _time(spec: TextField, text: str) -> Clock:
+    match = _TIME.fullmatch(text)
+    if not match:
+        raise ValueError(text)
+    fraction = match[4] or ""
+    micro = int((fraction + "000000")[:6]) if fraction else 0
+    return Clock(int(match[1]), int(match[2]), int(match[3]), micro, len(fraction))
+
+
+def _date(spec: TextField, text: str) -> datetime.date:
+    if not _DATE.fullmatch(text):
+        raise ValueError(text)
+    return datetime.datetime.strptime(text, "%d%m%y").date()
+
+
+_decoders: dict[str, Callable[[TextField, str], Any]] = {
+    "decimal": _decimal,
+    "integer": _integer,
+    "angle": _angle,
+    "char": _char,
+    "text": _text,
+    "time": _time,
+    "date": _date,
+}
+
+
+def _looks(spec: TextField) -> str:
+    match spec.kind:
+        case "angle":
+            return f"{'d' * (spec.width or 2)}mm.mmmm (degrees and minutes)"
+        case "char" if spec.letters is not None:
+            return "one of " + ", ".join(str(m.value) for m in spec.letters)
+        case "char":
+            return "one character"
+        case "time":
+            return "hhmmss[.ss]"
+        case "date":
+            return "ddmmyy"
+        case _:
+            return f"a{'n' if spec.kind[0] in 'aeiou' else ''} {spec.kind}"
+
+
+def _encode_fields(sentence: TextSentence, values: Mapping[str, Any], forbidden: str) -> list[str]:
+    parts: list[str] = []
+    for item in sentence.fields:
+        value = values.get(item.name)
+        if isinstance(item, TextField):
+            parts.append(encode_field(sentence.where, item, value, forbidden))
+            continue
+        rows = list(value or ())
+        limit = item.count or item.maximum
+        if len(rows) > limit:
+            raise RangeError(f"{sentence.where}: {item.name} has {len(rows)} groups, at most {limit}")
+        rows += [{}] * (item.count - len(rows))
+        for index, row in enumerate(rows):
+            if not isinstance(row, Mapping):
+                raise EncodeError(f"{sentence.where}: {item.name}[{index}] must be a mapping, got {shown(row)}")
+            for f in item.fields:
+                where = f"{sentence.where}: {item.name}[{index}]"
+                parts.append(encode_field(where, f, row.get(f.name), forbidden))
+    return parts
+
+
+def encode_field(where: str, spec: TextField, value: Any, forbidden: str = "") -> str:
+    """One value -> its text ("" for None), refused with the field's name when it cannot be written."""
+    if value is None:
+        return ""
+    where_name = f"{where}.{spec.name}" if ":" in where else f"{where}: {spec.name}"
+    text = _encoders[spec.kind](spec, value, where_name)
+    if bad := next((c for c in text if c in forbidden or not " " <= c <= "~"), None):
+        raise EncodeError(f"{where_name}: {shown(value)} holds {bad!r}, which a text frame cannot carry")
+    return text
+
+
+def _number(spec: TextField, value: Any, where: str) -> Decimal:
+    if isinstance(value, bool) or not isinstance(value, int | float | Decimal):
+        raise EncodeError(f"{where} must be a number, got {shown(value)}")
+    number = value if isinstance(value, Decimal) else Decimal(repr(value))
+    if not number.is_finite():
+        raise EncodeError(f"{where} must be a finite number, got {shown(value)}")
+    low = -float("inf") if spec.minimum is None else spec.minimum
+    high = float("inf") if spec.maximum is None else spec.maximum
+    if not low <= number <= high:
+        raise RangeError(f"{where} = {shown(value)} is outside its range {_bound(low)}..{_bound(high)}")
+    return number
+
+
+def _bound(value: float) -> str:
+    return str(int(value)) if float(value).is_integer() else str(value)
+
+
+def _put_decimal(spec: TextField, value: Any, where: str) -> str:
+    number = _number(spec, value, where)
+    if isinstance(value, Fixed):
+        return _padded(format(number, "f"), value.width)
+    if isinstance(value, Decimal):
+        return _padded(format(number, "f"), spec.width)
+    return _padded(f"{number:.{spec.precision}f}", spec.width)
+
+
+def _put_integer(spec: TextField, value: Any, where: str) -> str:
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise EncodeError(f"{where} must be an integer, got {shown(value)}")
+    _number(spec, value, where)
+    sign = "-" if value < 0 else ""
+    return f"{sign}{abs(value):0{spec.width}d}"
+
+
+def _put_angle(spec: TextField, value: Any, where: str) -> str:
+    if not isinstance(value, Angle):
+        value = Angle.from_degrees(float(_number(spec, value, where)), spec.precision)
+    else:
+        _number(spec, value.value, where)
+    if not 0 <= value.minutes < 60 or value.degrees < 0:
+        raise RangeError(f"{where}: minutes {value.minutes} are outside 0..60")
+    minutes = format(value.minutes, "f")
+    whole = minutes.split(".")[0]
+    return f"{value.degrees:0{spec.width or 2}d}{'0' * (2 - len(whole))}{minutes}"
+
+
+def _put_char(spec: TextField, value: Any, where: str) -> str:
+    if spec.letters is not None:
+        if isinstance(value, spec.letters):
+            return str(value.value)
+        allowed = {str(m.value) for m in spec.letters}
+        if isinstance(value, str) and value in allowed:
+            return value
+        raise EncodeError(f"{where} must be one of {', '.join(sorted(allowed))}, got {shown(value)}")
+    if not isinstance(value, str) or len(value) != 1:
+        raise EncodeError(f"{where} must be one character, got {shown(value)}")
+    return value
+
+
+def _put_text(spec: TextField, value: Any, where: str) -> str:
+    if not isinstance(value, str):
+        raise EncodeError(f"{where} must be text, got {shown(value)}")
+    return value
+
+
+def _put_time(spec: TextField, value: Any, where: str) -> str:
+    if not isinstance(value, datetime.time):
+        raise EncodeError(f"{where} must be a datetime.time, got {shown(value)}")
+    digits = value.digits if isinstance(value, Clock) else spec.precision
+    text = f"{value.hour:02d}{value.minute:02d}{value.second:02d}"
+    if digits:
+        text += "." + f"{value.microsecond:06d}"[:digits].ljust(digits, "0")
+    return text
+
+
+def _put_date(spec: TextField, value: Any, where: str) -> str:
+    if not isinstance(value, datetime.date):
+        raise EncodeError(f"{where} must be a datetime.date, got {shown(value)}")
+    return f"{value.day:02d}{value.month:02d}{value.year % 100:02d}"
+
+
+_encoders: dict[str, Callable[[TextField, Any, str], str]] = {
+    "decimal": _put_decimal,
+    "integer": _put_integer,
+    "angle": _put_angle,
+    "char": _put_char,
+    "text": _put_text,
+    "time": _put_time,
+    "date": _put_date,
+}
+
+
+def texts(sentence: TextSentence, values: Mapping[str, Any]) -> dict[str, Any]:
+    """Each field's text as encode writes it ("" for None; a repeat as a list of dicts of texts)."""
+    found: dict[str, Any] = {}
+    for item in sentence.fields:
+        value = values.get(item.name)
+        if isinstance(item, TextField):
+            found[item.name] = encode_field(sentence.where, item, value)
+        else:
+            rows = [row if isinstance(row, Mapping) else dataclasses.asdict(row) for row in value or ()]
+            found[item.name] = [
+                {f.name: encode_field(sentence.where, f, row.get(f.name)) for f in item.fields} for row in rows
+            ]
+    return found
+
+
+def _ascii(frame: bytes | str) -> str:
+    if isinstance(frame, str):
+        return frame
+    try:
+        return bytes(frame).decode("ascii")
+    except UnicodeDecodeError as error:
+        raise DecodeError(f"text frame holds a non-ASCII byte {frame[error.start]:02X}") from None
+
+
+# --- the stream parser --------------------------------------------------------------------------------------------
+
+
+class TextStreamParser:
+    """Frames out of a byte stream read in any pieces: noise between frames is skipped, a frame cut short by a new
+    start character or grown past `max_length` is dropped, and a frame that does not decode is counted in
+    `corrupt` (its reason kept in `last_error`)."""
+
+    def __init__(self, framing: TextFraming) -> None:
+        self.framing = framing
+        self._start = framing.start.encode("ascii")
+        self._end = framing.end.encode("ascii")
+        self._buffer = b""
+        self.corrupt = 0
+        self.last_error = ""
+
+    def feed(self, data: bytes | bytearray | memoryview) -> list[Sentence]:
+        self._buffer += bytes(data)
+        found: list[Sentence] = []
+        limit = self.framing.max_length + len(self._end)
+        while True:
+            start = self._buffer.find(self._start)
+            if start < 0:
+                self._buffer = self._buffer[-(len(self._start) - 1) :] if len(self._start) > 1 else b""
+                return found
+            self._buffer = self._buffer[start:]
+            end = self._buffer.find(self._end, len(self._start))
+            restart = self._buffer.find(self._start, len(self._start))
+            if end < 0 or (0 <= restart < end):
+                if restart >= 0 and (end < 0 or restart < end):
+                    self._dropped("text frame cut short by a new start")
+                    self._buffer = self._buffer[restart:]
+                    continue
+                if len(self._buffer) > limit:
+                    self._dropped(f"no line ending within {self.framing.max_length} characters")
+                    self._buffer = self._buffer[len(self._start) :]
+                    continue
+                return found
+            frame, self._buffer = self._buffer[: end + len(self._end)], self._buffer[end + len(self._end) :]
+            try:
+                found.append(self.framing.decode(frame))
+            except DecodeError as error:
+                self._dropped(str(error))
+
+    def _dropped(self, reason: str) -> None:
+        self.corrupt += 1
+        self.last_error = reason
+
+    def pending(self) -> bytes:
+        return self._buffer
+
+
+def frames(framing: TextFraming, sentences: Iterable[Sentence]) -> bytes:
+    """Several sentences as one stream."""
+    return b"".join(framing.encode_sentence(s) for s in sentences)
+
+
+# --- generated messages -------------------------------------------------------------------------------------------
+
+
+class TextRecord:
+    """Base of the generated message classes of a text protocol (frozen dataclasses): `talker`, the fields in
+    order, and `sent` (how many fields the frame had; -1 writes every declared one)."""
+
+    COMMAND: ClassVar[str]
+    CODE: ClassVar[str]
+    DIRECTION: ClassVar[Direction]
+    SUBCOMMAND: ClassVar[str | None] = None
+    GROUPS: ClassVar[dict[str, type]] = {}  # repeat field -> the class of one group
+    FRAMING: ClassVar[TextFraming]
+    talker: str
+    sent: int
+
+    def to_fields(self) -> dict[str, Any]:
+        """The field values by name (groups as dicts), without talker and sent."""
+        values = {}
+        for f in dataclasses.fields(self):  # type: ignore[arg-type]
+            if f.name in ("talker", "sent"):
+                continue
+            value = getattr(self, f.name)
+            if f.name in self.GROUPS:
+                value = [dataclasses.asdict(row) for row in value]
+            values[f.name] = value
+        return values
+
+    @classmethod
+    def from_fields(cls, values: Mapping[str, Any], talker: str = "", sent: int = -1) -> Any:
+        known = {f.name for f in dataclasses.fields(cls)}  # type: ignore[arg-type]
+        unknown = set(values) - known
+        if unknown:
+            raise EncodeError(f"{cls.CODE}: unknown field {sorted(unknown)[0]!r}")
+        given = dict(values)
+        for name, group in cls.GROUPS.items():
+            if name in given:
+                given[name] = tuple(row if isinstance(row, group) else group(**row) for row in given[name])
+        if talker:
+            given["talker"] = talker
+        factory: Any = cls  # a generated dataclass: its fields are keyword arguments
+        return factory(**given, sent=sent)
+
+    def encode(self) -> bytes:
+        return self.FRAMING.encode(self.CODE, self.to_fields(), self.talker, self.sent)
+
+
+class TextCodec:
+    """decode, encode and the stream parser of one text protocol, over its generated message classes."""
+
+    def __init__(self, framing: TextFraming, classes: Iterable[type[TextRecord]]) -> None:
+        self.framing = framing
+        self.classes = {cls.CODE: cls for cls in classes}
+
+    def message(self, sentence: Sentence) -> Any:
+        return self.classes[sentence.code].from_fields(sentence.values, sentence.talker, sentence.sent)
+
+    def decode(self, frame: bytes | str) -> Any:
+        """One frame -> its message; DecodeError (ChecksumError) says in one line why not."""
+        return self.message(self.framing.decode(frame))
+
+    def encode(self, message: TextRecord) -> bytes:
+        """A message -> its frame; EncodeError (RangeError) names the field at fault before any text is written."""
+        return message.encode()
+
+
+class TextMessageParser(TextStreamParser):
+    """The stream parser giving generated messages."""
+
+    def __init__(self, codec: TextCodec) -> None:
+        super().__init__(codec.framing)
+        self.codec = codec
+
+    def feed(self, data: bytes | bytearray | memoryview) -> list[Any]:
+        return [self.codec.message(s) for s in super().feed(data)]

@@ -24,6 +24,7 @@ typedef char dynamixel_p2__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define DYNAMIXEL_P2__STUFFED 1 /* some layout has byte stuffing */
 #define DYNAMIXEL_P2__LENGTHS 1 /* every layout has a length element */
 #define DYNAMIXEL_P2__SINGLE 1 /* one layout per direction */
+#define DYNAMIXEL_P2__TABLES (DYNAMIXEL_P2_ENABLE_ENCODE || DYNAMIXEL_P2__STUFFED) /* the layouts as tables: encode and stuffing walk them */
 
 /* ---- checksums ---- */
 /* CRC-16/UMTS (CRC-16/BUYPASS): width 16, poly 0x8005, init 0x0, refin false, refout false, xorout 0x0 (check 0xfee8). Incremental: start with 0x0, feed pieces, then use it as is. Bitwise: no table, no static data. */
@@ -153,7 +154,7 @@ static void dynamixel_p2__put(uint8_t *b, uint8_t size, uint8_t big, uint32_t v)
 }
 #endif
 
-#if DYNAMIXEL_P2_ENABLE_ENCODE || DYNAMIXEL_P2__STUFFED || DYNAMIXEL_P2_ENABLE_PARSER
+#if DYNAMIXEL_P2_ENABLE_ENCODE || DYNAMIXEL_P2__STUFFED
 /* The elements before the variable part (the stuffed span, else the content) and after it. */
 static uint8_t dynamixel_p2__inner_first(const dynamixel_p2__layout_t *L)
 {
@@ -534,7 +535,7 @@ static int dynamixel_p2__unwrap(const dynamixel_p2__layout_t *L, const uint8_t *
 }
 #endif
 
-#if DYNAMIXEL_P2_ENABLE_PARSER
+#if DYNAMIXEL_P2_ENABLE_PARSER && DYNAMIXEL_P2__STUFFED
 static int dynamixel_p2__bounds(dynamixel_p2_direction_t dir, long code, size_t *low, size_t *high, int *bounded);
 static long dynamixel_p2__content_size(dynamixel_p2_direction_t dir, long code, const uint8_t *c, size_t avail);
 
@@ -616,7 +617,8 @@ static long dynamixel_p2__probe(const dynamixel_p2__layout_t *L, dynamixel_p2_di
 #endif
 
 
-/* ---- the layouts of the spec ---- */
+#if DYNAMIXEL_P2__TABLES
+/* ---- the layouts of the spec (what the encoder and the engine for stuffed layouts walk) ---- */
 /* The request frame. */
 /* Byte stuffing (protocol2 §Packet Process): from the instruction to the last parameter, every FF FF FD is sent as FF FF FD FD, so the header appears nowhere else in a packet. */
 static const uint8_t dynamixel_p2__l_request_0_c0[] = {0xffu, 0xffu, 0xfdu};
@@ -677,9 +679,10 @@ static const dynamixel_p2__layout_t *const *dynamixel_p2__layouts(dynamixel_p2_d
     }
 }
 #endif
+#endif
 
 
-#if DYNAMIXEL_P2_ENABLE_PARSER
+#if DYNAMIXEL_P2_ENABLE_PARSER && (DYNAMIXEL_P2__STUFFED || !DYNAMIXEL_P2__LENGTHS)
 /* Frames without a length: the content size from its own leading fields, by code (WAIT: those have not come). */
 static long dynamixel_p2__content_size(dynamixel_p2_direction_t dir, long code, const uint8_t *c, size_t avail)
 {
@@ -721,7 +724,9 @@ static long dynamixel_p2__content_size(dynamixel_p2_direction_t dir, long code, 
         return DYNAMIXEL_P2__NONE;
     }
 }
+#endif
 
+#if DYNAMIXEL_P2_ENABLE_PARSER
 /* Content size bounds by command code: a candidate whose code or size is outside them is no frame. */
 static int dynamixel_p2__bounds(dynamixel_p2_direction_t dir, long code, size_t *low, size_t *high, int *bounded)
 {
@@ -752,16 +757,99 @@ static int dynamixel_p2__bounds(dynamixel_p2_direction_t dir, long code, size_t 
         return 0;
     }
 }
+
+/* ---- candidates sized: straight line where a layout has no byte stuffing, without the tables ---- */
+
+/* The size of a plausible frame of the direction's layout k at b[0..avail): DYNAMIXEL_P2__WAIT for more bytes, DYNAMIXEL_P2__NONE when
+ * none starts there. */
+static long dynamixel_p2__probe_at(dynamixel_p2_direction_t dir, uint8_t k, const uint8_t *b, size_t avail)
+{
+    switch (dir) {
+
+    default:
+        break;
+    }
+#if DYNAMIXEL_P2__STUFFED
+    {
+        uint8_t count;
+        const dynamixel_p2__layout_t *const *layouts = dynamixel_p2__layouts(dir, &count);
+        return k < count ? dynamixel_p2__probe(layouts[k], dir, b, avail) : DYNAMIXEL_P2__NONE;
+    }
+#else
+    (void)k;
+    (void)b;
+    (void)avail;
+    return DYNAMIXEL_P2__NONE;
+#endif
+}
 #endif
 
 #if DYNAMIXEL_P2_ENABLE_DECODE
+/* ---- what the decoder and the parser ask of a layout, without the tables ---- */
+static const uint8_t dynamixel_p2__h_request_0[] = {0xffu, 0xffu, 0xfdu};
+static const uint8_t dynamixel_p2__h_response_0[] = {0xffu, 0xffu, 0xfdu};
+
+/* How many layouts a direction has (0: no such direction). */
+static uint8_t dynamixel_p2__count(dynamixel_p2_direction_t dir)
+{
+    switch (dir) {
+    case DYNAMIXEL_P2_REQUEST:
+        return 1u;
+    case DYNAMIXEL_P2_RESPONSE:
+        return 1u;
+    default:
+        return 0u;
+    }
+}
+
+/* The leading constant of the direction's layout k (NULL and 0: none). */
+static const uint8_t *dynamixel_p2__header(dynamixel_p2_direction_t dir, uint8_t k, size_t *len)
+{
+    switch (dir) {
+    case DYNAMIXEL_P2_REQUEST:
+        switch (k) {
+        case 0u:
+            *len = 3u;
+            return dynamixel_p2__h_request_0;
+        default:
+            break;
+        }
+        break;
+    case DYNAMIXEL_P2_RESPONSE:
+        switch (k) {
+        case 0u:
+            *len = 3u;
+            return dynamixel_p2__h_response_0;
+        default:
+            break;
+        }
+        break;
+    default:
+        break;
+    }
+    *len = 0u;
+    return NULL;
+}
+
+/* 1 when the direction's layout k carries a command code. */
+static int dynamixel_p2__has_command(dynamixel_p2_direction_t dir, uint8_t k)
+{
+    switch (dir) {
+    case DYNAMIXEL_P2_REQUEST:
+        return ((1UL >> k) & 1u) != 0u;
+    case DYNAMIXEL_P2_RESPONSE:
+        return ((0UL >> k) & 1u) != 0u;
+    default:
+        return 0;
+    }
+}
+
 /* ---- frames taken apart: straight line where a layout has no byte stuffing ---- */
 
-static int dynamixel_p2__unwrap_at(dynamixel_p2_direction_t dir, uint8_t k, const dynamixel_p2__layout_t *L, const uint8_t *frame, size_t n,
+static int dynamixel_p2__unwrap_at(dynamixel_p2_direction_t dir, uint8_t k, const uint8_t *frame, size_t n,
                           uint8_t *plain, uint32_t *code, uint32_t *values, const uint8_t **content, size_t *clen)
 {
     (void)k;
-    (void)L;
     (void)plain;
     switch (dir) {
 
@@ -769,7 +857,14 @@ static int dynamixel_p2__unwrap_at(dynamixel_p2_direction_t dir, uint8_t k, cons
         break;
     }
 #if DYNAMIXEL_P2__STUFFED
-    return dynamixel_p2__unwrap(L, frame, n, plain, code, values, content, clen);
+    {
+        uint8_t count;
+        const dynamixel_p2__layout_t *const *layouts = dynamixel_p2__layouts(dir, &count);
+        if (k < count) {
+            return dynamixel_p2__unwrap(layouts[k], frame, n, plain, code, values, content, clen);
+        }
+    }
+    return DYNAMIXEL_P2_E_ARG;
 #else
     return DYNAMIXEL_P2_E_ARG;
 #endif
@@ -1182,8 +1277,6 @@ static int dynamixel_p2__decode_content(dynamixel_p2_direction_t dir, long code,
 int dynamixel_p2_decode_expect(const uint8_t *frame, size_t len, dynamixel_p2_direction_t dir, dynamixel_p2_kind_t expect, dynamixel_p2_msg_t *out)
 {
     uint8_t count, k;
-    const dynamixel_p2__layout_t *const *layouts;
-    const dynamixel_p2__layout_t *L = NULL;
     uint32_t code = 0u, values[DYNAMIXEL_P2__MAX_ELEMENTS] = {0u};
     const uint8_t *c = NULL;
     size_t clen = 0u;
@@ -1193,30 +1286,28 @@ int dynamixel_p2_decode_expect(const uint8_t *frame, size_t len, dynamixel_p2_di
         return DYNAMIXEL_P2_E_ARG;
     }
     out->kind = DYNAMIXEL_P2_KIND_NONE;
-    layouts = dynamixel_p2__layouts(dir, &count);
-    if (layouts == NULL) {
+    count = dynamixel_p2__count(dir);
+    if (count == 0u) {
         return DYNAMIXEL_P2_E_ARG;
     }
     k = 0u;
-    if (DYNAMIXEL_P2__SINGLE || count == 1u) {
-        L = layouts[0];
-    } else {
+    if (!DYNAMIXEL_P2__SINGLE && count != 1u) {
         for (k = 0u; k < count; k++) {
-            const dynamixel_p2__layout_t *A = layouts[k];
-            if (A->header_len <= len && dynamixel_p2__same(frame, A->e[0].constant, A->header_len)) {
-                L = A;
+            size_t hl;
+            const uint8_t *h = dynamixel_p2__header(dir, k, &hl);
+            if (hl <= len && dynamixel_p2__same(frame, h, hl)) {
                 break;
             }
         }
-        if (L == NULL) {
+        if (k == count) {
             return DYNAMIXEL_P2_E_FRAME;
         }
     }
-    r = dynamixel_p2__unwrap_at(dir, k, L, frame, len, plain, &code, values, &c, &clen);
+    r = dynamixel_p2__unwrap_at(dir, k, frame, len, plain, &code, values, &c, &clen);
     if (r != DYNAMIXEL_P2_OK) {
         return r;
     }
-    r = dynamixel_p2__decode_content(dir, L->command >= 0 ? (long)code : DYNAMIXEL_P2__NO_CODE, expect, c, clen, values, out);
+    r = dynamixel_p2__decode_content(dir, dynamixel_p2__has_command(dir, k) ? (long)code : DYNAMIXEL_P2__NO_CODE, expect, c, clen, values, out);
     if (r != DYNAMIXEL_P2_OK) {
         out->kind = DYNAMIXEL_P2_KIND_NONE;
     }
@@ -1844,8 +1935,7 @@ void dynamixel_p2_parser_init(dynamixel_p2_parser_t *parser, dynamixel_p2_direct
 /* The candidate at pos: accepted (its size in *size, its message in out), waiting, no frame, or corrupt. */
 static int dynamixel_p2__try(dynamixel_p2_parser_t *p, size_t pos, dynamixel_p2_msg_t *out, size_t *size)
 {
-    uint8_t count, k;
-    const dynamixel_p2__layout_t *const *layouts = dynamixel_p2__layouts(p->dir, &count);
+    uint8_t count = dynamixel_p2__count(p->dir), k;
     int waiting = 0;
     if (p->verdict[pos] != 0u) {
         return p->verdict[pos];
@@ -1854,7 +1944,7 @@ static int dynamixel_p2__try(dynamixel_p2_parser_t *p, size_t pos, dynamixel_p2_
         return DYNAMIXEL_P2__V_WAIT;
     }
     for (k = 0u; k < count; k++) {
-        long s = dynamixel_p2__probe(layouts[k], p->dir, p->buf + pos, p->n - pos);
+        long s = dynamixel_p2__probe_at(p->dir, k, p->buf + pos, p->n - pos);
         if (pos == 0u && count == 1u && s > 0) {
             p->first = (size_t)s;
         }
@@ -1889,8 +1979,7 @@ static int dynamixel_p2__try(dynamixel_p2_parser_t *p, size_t pos, dynamixel_p2_
 static size_t dynamixel_p2__next(dynamixel_p2_parser_t *p, size_t start)
 {
 #if DYNAMIXEL_P2__HEADERS
-    uint8_t count, k;
-    const dynamixel_p2__layout_t *const *layouts = dynamixel_p2__layouts(p->dir, &count);
+    uint8_t count = dynamixel_p2__count(p->dir), k;
     size_t pos;
     for (pos = start; pos < p->n; pos++) {
         int whole = 1; /* every header could be read here: a position none matches is never a candidate */
@@ -1898,10 +1987,11 @@ static size_t dynamixel_p2__next(dynamixel_p2_parser_t *p, size_t start)
             continue;
         }
         for (k = 0u; k < count; k++) {
-            const dynamixel_p2__layout_t *L = layouts[k];
-            if (L->header_len > p->n - pos) {
+            size_t hl;
+            const uint8_t *h = dynamixel_p2__header(p->dir, k, &hl);
+            if (hl > p->n - pos) {
                 whole = 0;
-            } else if (dynamixel_p2__same(p->buf + pos, L->e[0].constant, L->header_len)) {
+            } else if (dynamixel_p2__same(p->buf + pos, h, hl)) {
                 return pos;
             }
         }
@@ -1916,6 +2006,22 @@ static size_t dynamixel_p2__next(dynamixel_p2_parser_t *p, size_t start)
 #endif
 }
 
+
+/* The first cut bytes held dropped, with their verdicts: a loop, kept one (GCC would make it two calls of the
+ * library's memmove, which a parser-only build has no other use for). */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("no-tree-loop-distribute-patterns")))
+#endif
+static void dynamixel_p2__drop(dynamixel_p2_parser_t *p, size_t cut)
+{
+    size_t i;
+    for (i = cut; i < p->n; i++) {
+        p->buf[i - cut] = p->buf[i];
+        p->verdict[i - cut] = p->verdict[i];
+    }
+    p->n -= cut;
+}
+
 /* One byte in: the Python parser's scan over the bytes held, each candidate's verdict kept once final. */
 static int dynamixel_p2__push(dynamixel_p2_parser_t *p, uint8_t byte, dynamixel_p2_msg_t *out)
 {
@@ -1923,9 +2029,7 @@ static int dynamixel_p2__push(dynamixel_p2_parser_t *p, uint8_t byte, dynamixel_
     uint32_t deferred = 0u;
     int got = 0, r;
     if (p->n >= DYNAMIXEL_P2_MAX_FRAME) { /* only a candidate longer than DYNAMIXEL_P2_MAX_FRAME can fill it: drop its first byte */
-        memmove(p->buf, p->buf + 1, p->n - 1u);
-        memmove(p->verdict, p->verdict + 1, p->n - 1u);
-        p->n--;
+        dynamixel_p2__drop(p, 1u);
         p->garbage++;
         p->first = 0u;
     }
@@ -1972,9 +2076,7 @@ static int dynamixel_p2__push(dynamixel_p2_parser_t *p, uint8_t byte, dynamixel_
     }
     p->garbage += (uint32_t)(cut - done);
     if (cut > 0u) {
-        memmove(p->buf, p->buf + cut, p->n - cut);
-        memmove(p->verdict, p->verdict + cut, p->n - cut);
-        p->n -= cut;
+        dynamixel_p2__drop(p, cut);
         p->first = 0u;
     }
     return got;
@@ -1986,25 +2088,23 @@ static int dynamixel_p2__push(dynamixel_p2_parser_t *p, uint8_t byte, dynamixel_
  * candidate could end first). Else 0: the bytes go through dynamixel_p2__push. */
 static size_t dynamixel_p2__whole(dynamixel_p2_parser_t *p, const uint8_t *data, size_t len, dynamixel_p2_msg_t *out)
 {
-    uint8_t count;
-    const dynamixel_p2__layout_t *const *layouts = dynamixel_p2__layouts(p->dir, &count);
-    const dynamixel_p2__layout_t *L;
-    size_t i, size;
+    size_t i, size, hl;
+    const uint8_t *h;
     long s;
-    if (!DYNAMIXEL_P2__SINGLE && count != 1u) {
+    if (!DYNAMIXEL_P2__SINGLE && dynamixel_p2__count(p->dir) != 1u) {
         return 0u;
     }
-    L = layouts[0];
-    if (len < L->header_len || !dynamixel_p2__same(data, L->e[0].constant, L->header_len)) {
+    h = dynamixel_p2__header(p->dir, 0u, &hl);
+    if (h == NULL || len < hl || !dynamixel_p2__same(data, h, hl)) {
         return 0u;
     }
-    s = dynamixel_p2__probe(L, p->dir, data, len);
+    s = dynamixel_p2__probe_at(p->dir, 0u, data, len);
     if (s <= 0 || (unsigned long)s > DYNAMIXEL_P2_MAX_FRAME || (size_t)s > len) {
         return 0u;
     }
     size = (size_t)s;
-    for (i = 1u; i + L->header_len <= size; i++) {
-        if (data[i] == L->e[0].constant[0] && dynamixel_p2__same(data + i, L->e[0].constant, L->header_len)) {
+    for (i = 1u; i + hl <= size; i++) {
+        if (data[i] == h[0] && dynamixel_p2__same(data + i, h, hl)) {
             return 0u;
         }
     }

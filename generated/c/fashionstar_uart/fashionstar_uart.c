@@ -24,6 +24,7 @@ typedef char fashionstar_uart__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define FASHIONSTAR_UART__STUFFED 0 /* some layout has byte stuffing */
 #define FASHIONSTAR_UART__LENGTHS 1 /* every layout has a length element */
 #define FASHIONSTAR_UART__SINGLE 1 /* one layout per direction */
+#define FASHIONSTAR_UART__TABLES (FASHIONSTAR_UART_ENABLE_ENCODE || FASHIONSTAR_UART__STUFFED) /* the layouts as tables: encode and stuffing walk them */
 
 /* ---- checksums ---- */
 /* Sum of the bytes modulo 2^8. Incremental: start with 0; the frame's checksum is the sum. */
@@ -149,7 +150,7 @@ static void fashionstar_uart__put(uint8_t *b, uint8_t size, uint8_t big, uint32_
 }
 #endif
 
-#if FASHIONSTAR_UART_ENABLE_ENCODE || FASHIONSTAR_UART__STUFFED || FASHIONSTAR_UART_ENABLE_PARSER
+#if FASHIONSTAR_UART_ENABLE_ENCODE || FASHIONSTAR_UART__STUFFED
 /* The elements before the variable part (the stuffed span, else the content) and after it. */
 static uint8_t fashionstar_uart__inner_first(const fashionstar_uart__layout_t *L)
 {
@@ -530,7 +531,7 @@ static int fashionstar_uart__unwrap(const fashionstar_uart__layout_t *L, const u
 }
 #endif
 
-#if FASHIONSTAR_UART_ENABLE_PARSER
+#if FASHIONSTAR_UART_ENABLE_PARSER && FASHIONSTAR_UART__STUFFED
 static int fashionstar_uart__bounds(fashionstar_uart_direction_t dir, long code, size_t *low, size_t *high, int *bounded);
 static long fashionstar_uart__content_size(fashionstar_uart_direction_t dir, long code, const uint8_t *c, size_t avail);
 
@@ -612,7 +613,8 @@ static long fashionstar_uart__probe(const fashionstar_uart__layout_t *L, fashion
 #endif
 
 
-/* ---- the layouts of the spec ---- */
+#if FASHIONSTAR_UART__TABLES
+/* ---- the layouts of the spec (what the encoder and the engine for stuffed layouts walk) ---- */
 /* The request frame. */
 static const uint8_t fashionstar_uart__l_request_0_c0[] = {0x12u, 0x4cu};
 static const fashionstar_uart__element_t fashionstar_uart__l_request_0_e[] = {
@@ -653,6 +655,7 @@ static const fashionstar_uart__layout_t *const *fashionstar_uart__layouts(fashio
     }
 }
 #endif
+#endif
 
 #if FASHIONSTAR_UART_ENABLE_DECODE
 /* A 16-bit two's complement value from its wire bits (no implementation-defined conversion). */
@@ -676,7 +679,7 @@ static int32_t fashionstar_uart__s32(uint32_t v)
 }
 #endif
 
-#if FASHIONSTAR_UART_ENABLE_PARSER
+#if FASHIONSTAR_UART_ENABLE_PARSER && (FASHIONSTAR_UART__STUFFED || !FASHIONSTAR_UART__LENGTHS)
 /* Frames without a length: the content size from its own leading fields, by code (WAIT: those have not come). */
 static long fashionstar_uart__content_size(fashionstar_uart_direction_t dir, long code, const uint8_t *c, size_t avail)
 {
@@ -810,7 +813,9 @@ static long fashionstar_uart__content_size(fashionstar_uart_direction_t dir, lon
         return FASHIONSTAR_UART__NONE;
     }
 }
+#endif
 
+#if FASHIONSTAR_UART_ENABLE_PARSER
 /* Content size bounds by command code: a candidate whose code or size is outside them is no frame. */
 static int fashionstar_uart__bounds(fashionstar_uart_direction_t dir, long code, size_t *low, size_t *high, int *bounded)
 {
@@ -867,9 +872,143 @@ static int fashionstar_uart__bounds(fashionstar_uart_direction_t dir, long code,
         return 0;
     }
 }
+
+/* ---- candidates sized: straight line where a layout has no byte stuffing, without the tables ---- */
+/* The request frame: probe, straight line. */
+static long fashionstar_uart__probe_request_0(const uint8_t *f, size_t avail)
+{
+    size_t low = 0u, high = 0u;
+    int bounded = 0;
+    long code = FASHIONSTAR_UART__NO_CODE;
+    (void)code;
+    if (avail < 4u) { return FASHIONSTAR_UART__WAIT; }
+    if (f[0u] != 0x12u) { return FASHIONSTAR_UART__NONE; } /* header */
+    if (f[1u] != 0x4cu) { return FASHIONSTAR_UART__NONE; } /* header */
+    code = (long)((uint32_t)f[2u]); /* cmd_id */
+    if (!fashionstar_uart__bounds(FASHIONSTAR_UART_REQUEST, code, &low, &high, &bounded)) { return FASHIONSTAR_UART__NONE; }
+    { long counted = (long)((uint32_t)f[3u]) - 0L; /* length */
+      long content = counted - 0L;
+      if (content < (long)low || (bounded && content > (long)high)) { return FASHIONSTAR_UART__NONE; }
+      return 5L + counted; }
+}
+
+/* The response frame: probe, straight line. */
+static long fashionstar_uart__probe_response_0(const uint8_t *f, size_t avail)
+{
+    size_t low = 0u, high = 0u;
+    int bounded = 0;
+    long code = FASHIONSTAR_UART__NO_CODE;
+    (void)code;
+    if (avail < 4u) { return FASHIONSTAR_UART__WAIT; }
+    if (f[0u] != 0x05u) { return FASHIONSTAR_UART__NONE; } /* header */
+    if (f[1u] != 0x1cu) { return FASHIONSTAR_UART__NONE; } /* header */
+    code = (long)((uint32_t)f[2u]); /* cmd_id */
+    if (!fashionstar_uart__bounds(FASHIONSTAR_UART_RESPONSE, code, &low, &high, &bounded)) { return FASHIONSTAR_UART__NONE; }
+    { long counted = (long)((uint32_t)f[3u]) - 0L; /* length */
+      long content = counted - 0L;
+      if (content < (long)low || (bounded && content > (long)high)) { return FASHIONSTAR_UART__NONE; }
+      return 5L + counted; }
+}
+
+/* The size of a plausible frame of the direction's layout k at b[0..avail): FASHIONSTAR_UART__WAIT for more bytes, FASHIONSTAR_UART__NONE when
+ * none starts there. */
+static long fashionstar_uart__probe_at(fashionstar_uart_direction_t dir, uint8_t k, const uint8_t *b, size_t avail)
+{
+    switch (dir) {
+    case FASHIONSTAR_UART_REQUEST:
+        switch (k) {
+        case 0u:
+            return fashionstar_uart__probe_request_0(b, avail);
+        default:
+            break;
+        }
+        break;
+    case FASHIONSTAR_UART_RESPONSE:
+        switch (k) {
+        case 0u:
+            return fashionstar_uart__probe_response_0(b, avail);
+        default:
+            break;
+        }
+        break;
+    default:
+        break;
+    }
+#if FASHIONSTAR_UART__STUFFED
+    {
+        uint8_t count;
+        const fashionstar_uart__layout_t *const *layouts = fashionstar_uart__layouts(dir, &count);
+        return k < count ? fashionstar_uart__probe(layouts[k], dir, b, avail) : FASHIONSTAR_UART__NONE;
+    }
+#else
+    (void)k;
+    (void)b;
+    (void)avail;
+    return FASHIONSTAR_UART__NONE;
+#endif
+}
 #endif
 
 #if FASHIONSTAR_UART_ENABLE_DECODE
+/* ---- what the decoder and the parser ask of a layout, without the tables ---- */
+static const uint8_t fashionstar_uart__h_request_0[] = {0x12u, 0x4cu};
+static const uint8_t fashionstar_uart__h_response_0[] = {0x05u, 0x1cu};
+
+/* How many layouts a direction has (0: no such direction). */
+static uint8_t fashionstar_uart__count(fashionstar_uart_direction_t dir)
+{
+    switch (dir) {
+    case FASHIONSTAR_UART_REQUEST:
+        return 1u;
+    case FASHIONSTAR_UART_RESPONSE:
+        return 1u;
+    default:
+        return 0u;
+    }
+}
+
+/* The leading constant of the direction's layout k (NULL and 0: none). */
+static const uint8_t *fashionstar_uart__header(fashionstar_uart_direction_t dir, uint8_t k, size_t *len)
+{
+    switch (dir) {
+    case FASHIONSTAR_UART_REQUEST:
+        switch (k) {
+        case 0u:
+            *len = 2u;
+            return fashionstar_uart__h_request_0;
+        default:
+            break;
+        }
+        break;
+    case FASHIONSTAR_UART_RESPONSE:
+        switch (k) {
+        case 0u:
+            *len = 2u;
+            return fashionstar_uart__h_response_0;
+        default:
+            break;
+        }
+        break;
+    default:
+        break;
+    }
+    *len = 0u;
+    return NULL;
+}
+
+/* 1 when the direction's layout k carries a command code. */
+static int fashionstar_uart__has_command(fashionstar_uart_direction_t dir, uint8_t k)
+{
+    switch (dir) {
+    case FASHIONSTAR_UART_REQUEST:
+        return ((1UL >> k) & 1u) != 0u;
+    case FASHIONSTAR_UART_RESPONSE:
+        return ((1UL >> k) & 1u) != 0u;
+    default:
+        return 0;
+    }
+}
+
 /* ---- frames taken apart: straight line where a layout has no byte stuffing ---- */
 /* The request frame: unwrap, straight line. */
 static int fashionstar_uart__unwrap_request_0(const uint8_t *f, size_t n, uint32_t *code, uint32_t *values,
@@ -909,11 +1048,10 @@ static int fashionstar_uart__unwrap_response_0(const uint8_t *f, size_t n, uint3
     return FASHIONSTAR_UART_OK;
 }
 
-static int fashionstar_uart__unwrap_at(fashionstar_uart_direction_t dir, uint8_t k, const fashionstar_uart__layout_t *L, const uint8_t *frame, size_t n,
+static int fashionstar_uart__unwrap_at(fashionstar_uart_direction_t dir, uint8_t k, const uint8_t *frame, size_t n,
                           uint8_t *plain, uint32_t *code, uint32_t *values, const uint8_t **content, size_t *clen)
 {
     (void)k;
-    (void)L;
     (void)plain;
     switch (dir) {
     case FASHIONSTAR_UART_REQUEST:
@@ -936,7 +1074,14 @@ static int fashionstar_uart__unwrap_at(fashionstar_uart_direction_t dir, uint8_t
         break;
     }
 #if FASHIONSTAR_UART__STUFFED
-    return fashionstar_uart__unwrap(L, frame, n, plain, code, values, content, clen);
+    {
+        uint8_t count;
+        const fashionstar_uart__layout_t *const *layouts = fashionstar_uart__layouts(dir, &count);
+        if (k < count) {
+            return fashionstar_uart__unwrap(layouts[k], frame, n, plain, code, values, content, clen);
+        }
+    }
+    return FASHIONSTAR_UART_E_ARG;
 #else
     return FASHIONSTAR_UART_E_ARG;
 #endif
@@ -2310,8 +2455,6 @@ static int fashionstar_uart__decode_content(fashionstar_uart_direction_t dir, lo
 int fashionstar_uart_decode_expect(const uint8_t *frame, size_t len, fashionstar_uart_direction_t dir, fashionstar_uart_kind_t expect, fashionstar_uart_msg_t *out)
 {
     uint8_t count, k;
-    const fashionstar_uart__layout_t *const *layouts;
-    const fashionstar_uart__layout_t *L = NULL;
     uint32_t code = 0u, values[FASHIONSTAR_UART__MAX_ELEMENTS] = {0u};
     const uint8_t *c = NULL;
     size_t clen = 0u;
@@ -2321,30 +2464,28 @@ int fashionstar_uart_decode_expect(const uint8_t *frame, size_t len, fashionstar
         return FASHIONSTAR_UART_E_ARG;
     }
     out->kind = FASHIONSTAR_UART_KIND_NONE;
-    layouts = fashionstar_uart__layouts(dir, &count);
-    if (layouts == NULL) {
+    count = fashionstar_uart__count(dir);
+    if (count == 0u) {
         return FASHIONSTAR_UART_E_ARG;
     }
     k = 0u;
-    if (FASHIONSTAR_UART__SINGLE || count == 1u) {
-        L = layouts[0];
-    } else {
+    if (!FASHIONSTAR_UART__SINGLE && count != 1u) {
         for (k = 0u; k < count; k++) {
-            const fashionstar_uart__layout_t *A = layouts[k];
-            if (A->header_len <= len && fashionstar_uart__same(frame, A->e[0].constant, A->header_len)) {
-                L = A;
+            size_t hl;
+            const uint8_t *h = fashionstar_uart__header(dir, k, &hl);
+            if (hl <= len && fashionstar_uart__same(frame, h, hl)) {
                 break;
             }
         }
-        if (L == NULL) {
+        if (k == count) {
             return FASHIONSTAR_UART_E_FRAME;
         }
     }
-    r = fashionstar_uart__unwrap_at(dir, k, L, frame, len, plain, &code, values, &c, &clen);
+    r = fashionstar_uart__unwrap_at(dir, k, frame, len, plain, &code, values, &c, &clen);
     if (r != FASHIONSTAR_UART_OK) {
         return r;
     }
-    r = fashionstar_uart__decode_content(dir, L->command >= 0 ? (long)code : FASHIONSTAR_UART__NO_CODE, expect, c, clen, values, out);
+    r = fashionstar_uart__decode_content(dir, fashionstar_uart__has_command(dir, k) ? (long)code : FASHIONSTAR_UART__NO_CODE, expect, c, clen, values, out);
     if (r != FASHIONSTAR_UART_OK) {
         out->kind = FASHIONSTAR_UART_KIND_NONE;
     }
@@ -4260,8 +4401,7 @@ void fashionstar_uart_parser_init(fashionstar_uart_parser_t *parser, fashionstar
 /* The candidate at pos: accepted (its size in *size, its message in out), waiting, no frame, or corrupt. */
 static int fashionstar_uart__try(fashionstar_uart_parser_t *p, size_t pos, fashionstar_uart_msg_t *out, size_t *size)
 {
-    uint8_t count, k;
-    const fashionstar_uart__layout_t *const *layouts = fashionstar_uart__layouts(p->dir, &count);
+    uint8_t count = fashionstar_uart__count(p->dir), k;
     int waiting = 0;
     if (p->verdict[pos] != 0u) {
         return p->verdict[pos];
@@ -4270,7 +4410,7 @@ static int fashionstar_uart__try(fashionstar_uart_parser_t *p, size_t pos, fashi
         return FASHIONSTAR_UART__V_WAIT;
     }
     for (k = 0u; k < count; k++) {
-        long s = fashionstar_uart__probe(layouts[k], p->dir, p->buf + pos, p->n - pos);
+        long s = fashionstar_uart__probe_at(p->dir, k, p->buf + pos, p->n - pos);
         if (pos == 0u && count == 1u && s > 0) {
             p->first = (size_t)s;
         }
@@ -4305,8 +4445,7 @@ static int fashionstar_uart__try(fashionstar_uart_parser_t *p, size_t pos, fashi
 static size_t fashionstar_uart__next(fashionstar_uart_parser_t *p, size_t start)
 {
 #if FASHIONSTAR_UART__HEADERS
-    uint8_t count, k;
-    const fashionstar_uart__layout_t *const *layouts = fashionstar_uart__layouts(p->dir, &count);
+    uint8_t count = fashionstar_uart__count(p->dir), k;
     size_t pos;
     for (pos = start; pos < p->n; pos++) {
         int whole = 1; /* every header could be read here: a position none matches is never a candidate */
@@ -4314,10 +4453,11 @@ static size_t fashionstar_uart__next(fashionstar_uart_parser_t *p, size_t start)
             continue;
         }
         for (k = 0u; k < count; k++) {
-            const fashionstar_uart__layout_t *L = layouts[k];
-            if (L->header_len > p->n - pos) {
+            size_t hl;
+            const uint8_t *h = fashionstar_uart__header(p->dir, k, &hl);
+            if (hl > p->n - pos) {
                 whole = 0;
-            } else if (fashionstar_uart__same(p->buf + pos, L->e[0].constant, L->header_len)) {
+            } else if (fashionstar_uart__same(p->buf + pos, h, hl)) {
                 return pos;
             }
         }
@@ -4332,6 +4472,35 @@ static size_t fashionstar_uart__next(fashionstar_uart_parser_t *p, size_t start)
 #endif
 }
 
+
+/* The fewest bytes any layout of the direction needs before the classic parser judges a candidate. */
+static size_t fashionstar_uart__least(fashionstar_uart_direction_t dir)
+{
+    switch (dir) {
+    case FASHIONSTAR_UART_REQUEST:
+        return 4u;
+    case FASHIONSTAR_UART_RESPONSE:
+        return 4u;
+    default:
+        return 0u;
+    }
+}
+
+/* The first cut bytes held dropped, with their verdicts: a loop, kept one (GCC would make it two calls of the
+ * library's memmove, which a parser-only build has no other use for). */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("no-tree-loop-distribute-patterns")))
+#endif
+static void fashionstar_uart__drop(fashionstar_uart_parser_t *p, size_t cut)
+{
+    size_t i;
+    for (i = cut; i < p->n; i++) {
+        p->buf[i - cut] = p->buf[i];
+        p->verdict[i - cut] = p->verdict[i];
+    }
+    p->n -= cut;
+}
+
 /* One byte in: the Python parser's scan over the bytes held, each candidate's verdict kept once final. */
 static int fashionstar_uart__push(fashionstar_uart_parser_t *p, uint8_t byte, fashionstar_uart_msg_t *out)
 {
@@ -4339,9 +4508,7 @@ static int fashionstar_uart__push(fashionstar_uart_parser_t *p, uint8_t byte, fa
     uint32_t deferred = 0u;
     int got = 0, r;
     if (p->n >= FASHIONSTAR_UART_MAX_FRAME) { /* only a candidate longer than FASHIONSTAR_UART_MAX_FRAME can fill it: drop its first byte */
-        memmove(p->buf, p->buf + 1, p->n - 1u);
-        memmove(p->verdict, p->verdict + 1, p->n - 1u);
-        p->n--;
+        fashionstar_uart__drop(p, 1u);
         p->garbage++;
         p->first = 0u;
     }
@@ -4351,6 +4518,12 @@ static int fashionstar_uart__push(fashionstar_uart_parser_t *p, uint8_t byte, fa
     while (start < p->n) {
         pos = fashionstar_uart__next(p, start);
         if (pos >= p->n) {
+            break;
+        }
+        if (p->n - pos < fashionstar_uart__least(p->dir)) { /* waiting, too short for any layout, and so is every later one */
+            if (hold == (size_t)-1) {
+                hold = pos;
+            }
             break;
         }
         r = fashionstar_uart__try(p, pos, out, &size);
@@ -4388,9 +4561,7 @@ static int fashionstar_uart__push(fashionstar_uart_parser_t *p, uint8_t byte, fa
     }
     p->garbage += (uint32_t)(cut - done);
     if (cut > 0u) {
-        memmove(p->buf, p->buf + cut, p->n - cut);
-        memmove(p->verdict, p->verdict + cut, p->n - cut);
-        p->n -= cut;
+        fashionstar_uart__drop(p, cut);
         p->first = 0u;
     }
     return got;
@@ -4402,25 +4573,23 @@ static int fashionstar_uart__push(fashionstar_uart_parser_t *p, uint8_t byte, fa
  * candidate could end first). Else 0: the bytes go through fashionstar_uart__push. */
 static size_t fashionstar_uart__whole(fashionstar_uart_parser_t *p, const uint8_t *data, size_t len, fashionstar_uart_msg_t *out)
 {
-    uint8_t count;
-    const fashionstar_uart__layout_t *const *layouts = fashionstar_uart__layouts(p->dir, &count);
-    const fashionstar_uart__layout_t *L;
-    size_t i, size;
+    size_t i, size, hl;
+    const uint8_t *h;
     long s;
-    if (!FASHIONSTAR_UART__SINGLE && count != 1u) {
+    if (!FASHIONSTAR_UART__SINGLE && fashionstar_uart__count(p->dir) != 1u) {
         return 0u;
     }
-    L = layouts[0];
-    if (len < L->header_len || !fashionstar_uart__same(data, L->e[0].constant, L->header_len)) {
+    h = fashionstar_uart__header(p->dir, 0u, &hl);
+    if (h == NULL || len < hl || !fashionstar_uart__same(data, h, hl)) {
         return 0u;
     }
-    s = fashionstar_uart__probe(L, p->dir, data, len);
+    s = fashionstar_uart__probe_at(p->dir, 0u, data, len);
     if (s <= 0 || (unsigned long)s > FASHIONSTAR_UART_MAX_FRAME || (size_t)s > len) {
         return 0u;
     }
     size = (size_t)s;
-    for (i = 1u; i + L->header_len <= size; i++) {
-        if (data[i] == L->e[0].constant[0] && fashionstar_uart__same(data + i, L->e[0].constant, L->header_len)) {
+    for (i = 1u; i + hl <= size; i++) {
+        if (data[i] == h[0] && fashionstar_uart__same(data + i, h, hl)) {
             return 0u;
         }
     }

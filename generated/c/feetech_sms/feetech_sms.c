@@ -24,6 +24,7 @@ typedef char feetech_sms__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define FEETECH_SMS__STUFFED 0 /* some layout has byte stuffing */
 #define FEETECH_SMS__LENGTHS 1 /* every layout has a length element */
 #define FEETECH_SMS__SINGLE 1 /* one layout per direction */
+#define FEETECH_SMS__TABLES (FEETECH_SMS_ENABLE_ENCODE || FEETECH_SMS__STUFFED) /* the layouts as tables: encode and stuffing walk them */
 
 /* ---- checksums ---- */
 /* Sum of the bytes modulo 2^8. Incremental: start with 0; the frame's checksum is the sum inverted. */
@@ -149,7 +150,7 @@ static void feetech_sms__put(uint8_t *b, uint8_t size, uint8_t big, uint32_t v)
 }
 #endif
 
-#if FEETECH_SMS_ENABLE_ENCODE || FEETECH_SMS__STUFFED || FEETECH_SMS_ENABLE_PARSER
+#if FEETECH_SMS_ENABLE_ENCODE || FEETECH_SMS__STUFFED
 /* The elements before the variable part (the stuffed span, else the content) and after it. */
 static uint8_t feetech_sms__inner_first(const feetech_sms__layout_t *L)
 {
@@ -530,7 +531,7 @@ static int feetech_sms__unwrap(const feetech_sms__layout_t *L, const uint8_t *fr
 }
 #endif
 
-#if FEETECH_SMS_ENABLE_PARSER
+#if FEETECH_SMS_ENABLE_PARSER && FEETECH_SMS__STUFFED
 static int feetech_sms__bounds(feetech_sms_direction_t dir, long code, size_t *low, size_t *high, int *bounded);
 static long feetech_sms__content_size(feetech_sms_direction_t dir, long code, const uint8_t *c, size_t avail);
 
@@ -612,7 +613,8 @@ static long feetech_sms__probe(const feetech_sms__layout_t *L, feetech_sms_direc
 #endif
 
 
-/* ---- the layouts of the spec ---- */
+#if FEETECH_SMS__TABLES
+/* ---- the layouts of the spec (what the encoder and the engine for stuffed layouts walk) ---- */
 /* The request frame. */
 static const uint8_t feetech_sms__l_request_0_c0[] = {0xffu, 0xffu};
 static const feetech_sms__element_t feetech_sms__l_request_0_e[] = {
@@ -655,9 +657,10 @@ static const feetech_sms__layout_t *const *feetech_sms__layouts(feetech_sms_dire
     }
 }
 #endif
+#endif
 
 
-#if FEETECH_SMS_ENABLE_PARSER
+#if FEETECH_SMS_ENABLE_PARSER && (FEETECH_SMS__STUFFED || !FEETECH_SMS__LENGTHS)
 /* Frames without a length: the content size from its own leading fields, by code (WAIT: those have not come). */
 static long feetech_sms__content_size(feetech_sms_direction_t dir, long code, const uint8_t *c, size_t avail)
 {
@@ -693,7 +696,9 @@ static long feetech_sms__content_size(feetech_sms_direction_t dir, long code, co
         return FEETECH_SMS__NONE;
     }
 }
+#endif
 
+#if FEETECH_SMS_ENABLE_PARSER
 /* Content size bounds by command code: a candidate whose code or size is outside them is no frame. */
 static int feetech_sms__bounds(feetech_sms_direction_t dir, long code, size_t *low, size_t *high, int *bounded)
 {
@@ -719,9 +724,145 @@ static int feetech_sms__bounds(feetech_sms_direction_t dir, long code, size_t *l
         return 0;
     }
 }
+
+/* ---- candidates sized: straight line where a layout has no byte stuffing, without the tables ---- */
+/* The request frame: probe, straight line. */
+static long feetech_sms__probe_request_0(const uint8_t *f, size_t avail)
+{
+    size_t low = 0u, high = 0u;
+    int bounded = 0;
+    long code = FEETECH_SMS__NO_CODE;
+    (void)code;
+    if (avail < 5u) { return FEETECH_SMS__WAIT; }
+    if (f[0u] != 0xffu) { return FEETECH_SMS__NONE; } /* header */
+    if (f[1u] != 0xffu) { return FEETECH_SMS__NONE; } /* header */
+    { uint32_t v = (uint32_t)f[2u]; if ((v > 253u) && v != 254u) { return FEETECH_SMS__NONE; } } /* id */
+    code = (long)((uint32_t)f[4u]); /* instruction */
+    if (!feetech_sms__bounds(FEETECH_SMS_REQUEST, code, &low, &high, &bounded)) { return FEETECH_SMS__NONE; }
+    { long counted = (long)((uint32_t)f[3u]) - 2L; /* length */
+      long content = counted - 0L;
+      if (content < (long)low || (bounded && content > (long)high)) { return FEETECH_SMS__NONE; }
+      return 6L + counted; }
+}
+
+/* The response frame: probe, straight line. */
+static long feetech_sms__probe_response_0(const uint8_t *f, size_t avail)
+{
+    size_t low = 0u, high = 0u;
+    int bounded = 0;
+    long code = FEETECH_SMS__NO_CODE;
+    (void)code;
+    if (avail < 4u) { return FEETECH_SMS__WAIT; }
+    if (f[0u] != 0xffu) { return FEETECH_SMS__NONE; } /* header */
+    if (f[1u] != 0xffu) { return FEETECH_SMS__NONE; } /* header */
+    { uint32_t v = (uint32_t)f[2u]; if ((v > 253u) && v != 254u) { return FEETECH_SMS__NONE; } } /* id */
+    if (avail < 5u) { return FEETECH_SMS__WAIT; }
+    if (!feetech_sms__bounds(FEETECH_SMS_RESPONSE, FEETECH_SMS__NO_CODE, &low, &high, &bounded)) { return FEETECH_SMS__NONE; }
+    { long counted = (long)((uint32_t)f[3u]) - 2L; /* length */
+      long content = counted - 0L;
+      if (content < (long)low || (bounded && content > (long)high)) { return FEETECH_SMS__NONE; }
+      return 6L + counted; }
+}
+
+/* The size of a plausible frame of the direction's layout k at b[0..avail): FEETECH_SMS__WAIT for more bytes, FEETECH_SMS__NONE when
+ * none starts there. */
+static long feetech_sms__probe_at(feetech_sms_direction_t dir, uint8_t k, const uint8_t *b, size_t avail)
+{
+    switch (dir) {
+    case FEETECH_SMS_REQUEST:
+        switch (k) {
+        case 0u:
+            return feetech_sms__probe_request_0(b, avail);
+        default:
+            break;
+        }
+        break;
+    case FEETECH_SMS_RESPONSE:
+        switch (k) {
+        case 0u:
+            return feetech_sms__probe_response_0(b, avail);
+        default:
+            break;
+        }
+        break;
+    default:
+        break;
+    }
+#if FEETECH_SMS__STUFFED
+    {
+        uint8_t count;
+        const feetech_sms__layout_t *const *layouts = feetech_sms__layouts(dir, &count);
+        return k < count ? feetech_sms__probe(layouts[k], dir, b, avail) : FEETECH_SMS__NONE;
+    }
+#else
+    (void)k;
+    (void)b;
+    (void)avail;
+    return FEETECH_SMS__NONE;
+#endif
+}
 #endif
 
 #if FEETECH_SMS_ENABLE_DECODE
+/* ---- what the decoder and the parser ask of a layout, without the tables ---- */
+static const uint8_t feetech_sms__h_request_0[] = {0xffu, 0xffu};
+static const uint8_t feetech_sms__h_response_0[] = {0xffu, 0xffu};
+
+/* How many layouts a direction has (0: no such direction). */
+static uint8_t feetech_sms__count(feetech_sms_direction_t dir)
+{
+    switch (dir) {
+    case FEETECH_SMS_REQUEST:
+        return 1u;
+    case FEETECH_SMS_RESPONSE:
+        return 1u;
+    default:
+        return 0u;
+    }
+}
+
+/* The leading constant of the direction's layout k (NULL and 0: none). */
+static const uint8_t *feetech_sms__header(feetech_sms_direction_t dir, uint8_t k, size_t *len)
+{
+    switch (dir) {
+    case FEETECH_SMS_REQUEST:
+        switch (k) {
+        case 0u:
+            *len = 2u;
+            return feetech_sms__h_request_0;
+        default:
+            break;
+        }
+        break;
+    case FEETECH_SMS_RESPONSE:
+        switch (k) {
+        case 0u:
+            *len = 2u;
+            return feetech_sms__h_response_0;
+        default:
+            break;
+        }
+        break;
+    default:
+        break;
+    }
+    *len = 0u;
+    return NULL;
+}
+
+/* 1 when the direction's layout k carries a command code. */
+static int feetech_sms__has_command(feetech_sms_direction_t dir, uint8_t k)
+{
+    switch (dir) {
+    case FEETECH_SMS_REQUEST:
+        return ((1UL >> k) & 1u) != 0u;
+    case FEETECH_SMS_RESPONSE:
+        return ((0UL >> k) & 1u) != 0u;
+    default:
+        return 0;
+    }
+}
+
 /* ---- frames taken apart: straight line where a layout has no byte stuffing ---- */
 /* The request frame: unwrap, straight line. */
 static int feetech_sms__unwrap_request_0(const uint8_t *f, size_t n, uint32_t *code, uint32_t *values,
@@ -765,11 +906,10 @@ static int feetech_sms__unwrap_response_0(const uint8_t *f, size_t n, uint32_t *
     return FEETECH_SMS_OK;
 }
 
-static int feetech_sms__unwrap_at(feetech_sms_direction_t dir, uint8_t k, const feetech_sms__layout_t *L, const uint8_t *frame, size_t n,
+static int feetech_sms__unwrap_at(feetech_sms_direction_t dir, uint8_t k, const uint8_t *frame, size_t n,
                           uint8_t *plain, uint32_t *code, uint32_t *values, const uint8_t **content, size_t *clen)
 {
     (void)k;
-    (void)L;
     (void)plain;
     switch (dir) {
     case FEETECH_SMS_REQUEST:
@@ -792,7 +932,14 @@ static int feetech_sms__unwrap_at(feetech_sms_direction_t dir, uint8_t k, const 
         break;
     }
 #if FEETECH_SMS__STUFFED
-    return feetech_sms__unwrap(L, frame, n, plain, code, values, content, clen);
+    {
+        uint8_t count;
+        const feetech_sms__layout_t *const *layouts = feetech_sms__layouts(dir, &count);
+        if (k < count) {
+            return feetech_sms__unwrap(layouts[k], frame, n, plain, code, values, content, clen);
+        }
+    }
+    return FEETECH_SMS_E_ARG;
 #else
     return FEETECH_SMS_E_ARG;
 #endif
@@ -1035,8 +1182,6 @@ static int feetech_sms__decode_content(feetech_sms_direction_t dir, long code, f
 int feetech_sms_decode_expect(const uint8_t *frame, size_t len, feetech_sms_direction_t dir, feetech_sms_kind_t expect, feetech_sms_msg_t *out)
 {
     uint8_t count, k;
-    const feetech_sms__layout_t *const *layouts;
-    const feetech_sms__layout_t *L = NULL;
     uint32_t code = 0u, values[FEETECH_SMS__MAX_ELEMENTS] = {0u};
     const uint8_t *c = NULL;
     size_t clen = 0u;
@@ -1046,30 +1191,28 @@ int feetech_sms_decode_expect(const uint8_t *frame, size_t len, feetech_sms_dire
         return FEETECH_SMS_E_ARG;
     }
     out->kind = FEETECH_SMS_KIND_NONE;
-    layouts = feetech_sms__layouts(dir, &count);
-    if (layouts == NULL) {
+    count = feetech_sms__count(dir);
+    if (count == 0u) {
         return FEETECH_SMS_E_ARG;
     }
     k = 0u;
-    if (FEETECH_SMS__SINGLE || count == 1u) {
-        L = layouts[0];
-    } else {
+    if (!FEETECH_SMS__SINGLE && count != 1u) {
         for (k = 0u; k < count; k++) {
-            const feetech_sms__layout_t *A = layouts[k];
-            if (A->header_len <= len && feetech_sms__same(frame, A->e[0].constant, A->header_len)) {
-                L = A;
+            size_t hl;
+            const uint8_t *h = feetech_sms__header(dir, k, &hl);
+            if (hl <= len && feetech_sms__same(frame, h, hl)) {
                 break;
             }
         }
-        if (L == NULL) {
+        if (k == count) {
             return FEETECH_SMS_E_FRAME;
         }
     }
-    r = feetech_sms__unwrap_at(dir, k, L, frame, len, plain, &code, values, &c, &clen);
+    r = feetech_sms__unwrap_at(dir, k, frame, len, plain, &code, values, &c, &clen);
     if (r != FEETECH_SMS_OK) {
         return r;
     }
-    r = feetech_sms__decode_content(dir, L->command >= 0 ? (long)code : FEETECH_SMS__NO_CODE, expect, c, clen, values, out);
+    r = feetech_sms__decode_content(dir, feetech_sms__has_command(dir, k) ? (long)code : FEETECH_SMS__NO_CODE, expect, c, clen, values, out);
     if (r != FEETECH_SMS_OK) {
         out->kind = FEETECH_SMS_KIND_NONE;
     }
@@ -1466,8 +1609,7 @@ void feetech_sms_parser_init(feetech_sms_parser_t *parser, feetech_sms_direction
 /* The candidate at pos: accepted (its size in *size, its message in out), waiting, no frame, or corrupt. */
 static int feetech_sms__try(feetech_sms_parser_t *p, size_t pos, feetech_sms_msg_t *out, size_t *size)
 {
-    uint8_t count, k;
-    const feetech_sms__layout_t *const *layouts = feetech_sms__layouts(p->dir, &count);
+    uint8_t count = feetech_sms__count(p->dir), k;
     int waiting = 0;
     if (p->verdict[pos] != 0u) {
         return p->verdict[pos];
@@ -1476,7 +1618,7 @@ static int feetech_sms__try(feetech_sms_parser_t *p, size_t pos, feetech_sms_msg
         return FEETECH_SMS__V_WAIT;
     }
     for (k = 0u; k < count; k++) {
-        long s = feetech_sms__probe(layouts[k], p->dir, p->buf + pos, p->n - pos);
+        long s = feetech_sms__probe_at(p->dir, k, p->buf + pos, p->n - pos);
         if (pos == 0u && count == 1u && s > 0) {
             p->first = (size_t)s;
         }
@@ -1511,8 +1653,7 @@ static int feetech_sms__try(feetech_sms_parser_t *p, size_t pos, feetech_sms_msg
 static size_t feetech_sms__next(feetech_sms_parser_t *p, size_t start)
 {
 #if FEETECH_SMS__HEADERS
-    uint8_t count, k;
-    const feetech_sms__layout_t *const *layouts = feetech_sms__layouts(p->dir, &count);
+    uint8_t count = feetech_sms__count(p->dir), k;
     size_t pos;
     for (pos = start; pos < p->n; pos++) {
         int whole = 1; /* every header could be read here: a position none matches is never a candidate */
@@ -1520,10 +1661,11 @@ static size_t feetech_sms__next(feetech_sms_parser_t *p, size_t start)
             continue;
         }
         for (k = 0u; k < count; k++) {
-            const feetech_sms__layout_t *L = layouts[k];
-            if (L->header_len > p->n - pos) {
+            size_t hl;
+            const uint8_t *h = feetech_sms__header(p->dir, k, &hl);
+            if (hl > p->n - pos) {
                 whole = 0;
-            } else if (feetech_sms__same(p->buf + pos, L->e[0].constant, L->header_len)) {
+            } else if (feetech_sms__same(p->buf + pos, h, hl)) {
                 return pos;
             }
         }
@@ -1538,6 +1680,35 @@ static size_t feetech_sms__next(feetech_sms_parser_t *p, size_t start)
 #endif
 }
 
+
+/* The fewest bytes any layout of the direction needs before the classic parser judges a candidate. */
+static size_t feetech_sms__least(feetech_sms_direction_t dir)
+{
+    switch (dir) {
+    case FEETECH_SMS_REQUEST:
+        return 5u;
+    case FEETECH_SMS_RESPONSE:
+        return 4u;
+    default:
+        return 0u;
+    }
+}
+
+/* The first cut bytes held dropped, with their verdicts: a loop, kept one (GCC would make it two calls of the
+ * library's memmove, which a parser-only build has no other use for). */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("no-tree-loop-distribute-patterns")))
+#endif
+static void feetech_sms__drop(feetech_sms_parser_t *p, size_t cut)
+{
+    size_t i;
+    for (i = cut; i < p->n; i++) {
+        p->buf[i - cut] = p->buf[i];
+        p->verdict[i - cut] = p->verdict[i];
+    }
+    p->n -= cut;
+}
+
 /* One byte in: the Python parser's scan over the bytes held, each candidate's verdict kept once final. */
 static int feetech_sms__push(feetech_sms_parser_t *p, uint8_t byte, feetech_sms_msg_t *out)
 {
@@ -1545,9 +1716,7 @@ static int feetech_sms__push(feetech_sms_parser_t *p, uint8_t byte, feetech_sms_
     uint32_t deferred = 0u;
     int got = 0, r;
     if (p->n >= FEETECH_SMS_MAX_FRAME) { /* only a candidate longer than FEETECH_SMS_MAX_FRAME can fill it: drop its first byte */
-        memmove(p->buf, p->buf + 1, p->n - 1u);
-        memmove(p->verdict, p->verdict + 1, p->n - 1u);
-        p->n--;
+        feetech_sms__drop(p, 1u);
         p->garbage++;
         p->first = 0u;
     }
@@ -1557,6 +1726,12 @@ static int feetech_sms__push(feetech_sms_parser_t *p, uint8_t byte, feetech_sms_
     while (start < p->n) {
         pos = feetech_sms__next(p, start);
         if (pos >= p->n) {
+            break;
+        }
+        if (p->n - pos < feetech_sms__least(p->dir)) { /* waiting, too short for any layout, and so is every later one */
+            if (hold == (size_t)-1) {
+                hold = pos;
+            }
             break;
         }
         r = feetech_sms__try(p, pos, out, &size);
@@ -1594,9 +1769,7 @@ static int feetech_sms__push(feetech_sms_parser_t *p, uint8_t byte, feetech_sms_
     }
     p->garbage += (uint32_t)(cut - done);
     if (cut > 0u) {
-        memmove(p->buf, p->buf + cut, p->n - cut);
-        memmove(p->verdict, p->verdict + cut, p->n - cut);
-        p->n -= cut;
+        feetech_sms__drop(p, cut);
         p->first = 0u;
     }
     return got;
@@ -1608,25 +1781,23 @@ static int feetech_sms__push(feetech_sms_parser_t *p, uint8_t byte, feetech_sms_
  * candidate could end first). Else 0: the bytes go through feetech_sms__push. */
 static size_t feetech_sms__whole(feetech_sms_parser_t *p, const uint8_t *data, size_t len, feetech_sms_msg_t *out)
 {
-    uint8_t count;
-    const feetech_sms__layout_t *const *layouts = feetech_sms__layouts(p->dir, &count);
-    const feetech_sms__layout_t *L;
-    size_t i, size;
+    size_t i, size, hl;
+    const uint8_t *h;
     long s;
-    if (!FEETECH_SMS__SINGLE && count != 1u) {
+    if (!FEETECH_SMS__SINGLE && feetech_sms__count(p->dir) != 1u) {
         return 0u;
     }
-    L = layouts[0];
-    if (len < L->header_len || !feetech_sms__same(data, L->e[0].constant, L->header_len)) {
+    h = feetech_sms__header(p->dir, 0u, &hl);
+    if (h == NULL || len < hl || !feetech_sms__same(data, h, hl)) {
         return 0u;
     }
-    s = feetech_sms__probe(L, p->dir, data, len);
+    s = feetech_sms__probe_at(p->dir, 0u, data, len);
     if (s <= 0 || (unsigned long)s > FEETECH_SMS_MAX_FRAME || (size_t)s > len) {
         return 0u;
     }
     size = (size_t)s;
-    for (i = 1u; i + L->header_len <= size; i++) {
-        if (data[i] == L->e[0].constant[0] && feetech_sms__same(data + i, L->e[0].constant, L->header_len)) {
+    for (i = 1u; i + hl <= size; i++) {
+        if (data[i] == h[0] && feetech_sms__same(data + i, h, hl)) {
             return 0u;
         }
     }

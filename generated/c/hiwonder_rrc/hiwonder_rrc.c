@@ -24,6 +24,7 @@ typedef char hiwonder_rrc__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define HIWONDER_RRC__STUFFED 0 /* some layout has byte stuffing */
 #define HIWONDER_RRC__LENGTHS 1 /* every layout has a length element */
 #define HIWONDER_RRC__SINGLE 1 /* one layout per direction */
+#define HIWONDER_RRC__TABLES (HIWONDER_RRC_ENABLE_ENCODE || HIWONDER_RRC__STUFFED) /* the layouts as tables: encode and stuffing walk them */
 
 /* ---- checksums ---- */
 /* CRC-8/MAXIM: width 8, poly 0x31, init 0x0, refin true, refout true, xorout 0x0 (check 0xa1). Incremental: start with 0x0, feed pieces, then use it as is. Bitwise: no table, no static data. */
@@ -153,7 +154,7 @@ static void hiwonder_rrc__put(uint8_t *b, uint8_t size, uint8_t big, uint32_t v)
 }
 #endif
 
-#if HIWONDER_RRC_ENABLE_ENCODE || HIWONDER_RRC__STUFFED || HIWONDER_RRC_ENABLE_PARSER
+#if HIWONDER_RRC_ENABLE_ENCODE || HIWONDER_RRC__STUFFED
 /* The elements before the variable part (the stuffed span, else the content) and after it. */
 static uint8_t hiwonder_rrc__inner_first(const hiwonder_rrc__layout_t *L)
 {
@@ -534,7 +535,7 @@ static int hiwonder_rrc__unwrap(const hiwonder_rrc__layout_t *L, const uint8_t *
 }
 #endif
 
-#if HIWONDER_RRC_ENABLE_PARSER
+#if HIWONDER_RRC_ENABLE_PARSER && HIWONDER_RRC__STUFFED
 static int hiwonder_rrc__bounds(hiwonder_rrc_direction_t dir, long code, size_t *low, size_t *high, int *bounded);
 static long hiwonder_rrc__content_size(hiwonder_rrc_direction_t dir, long code, const uint8_t *c, size_t avail);
 
@@ -616,7 +617,8 @@ static long hiwonder_rrc__probe(const hiwonder_rrc__layout_t *L, hiwonder_rrc_di
 #endif
 
 
-/* ---- the layouts of the spec ---- */
+#if HIWONDER_RRC__TABLES
+/* ---- the layouts of the spec (what the encoder and the engine for stuffed layouts walk) ---- */
 /* The request frame. */
 static const uint8_t hiwonder_rrc__l_request_0_c0[] = {0xaau, 0x55u};
 static const hiwonder_rrc__element_t hiwonder_rrc__l_request_0_e[] = {
@@ -656,6 +658,7 @@ static const hiwonder_rrc__layout_t *const *hiwonder_rrc__layouts(hiwonder_rrc_d
         return NULL;
     }
 }
+#endif
 #endif
 
 #if HIWONDER_RRC_ENABLE_DECODE
@@ -698,7 +701,7 @@ static uint32_t hiwonder_rrc__f32bits(float f)
 }
 #endif
 
-#if HIWONDER_RRC_ENABLE_PARSER
+#if HIWONDER_RRC_ENABLE_PARSER && (HIWONDER_RRC__STUFFED || !HIWONDER_RRC__LENGTHS)
 /* Frames without a length: the content size from its own leading fields, by code (WAIT: those have not come). */
 static long hiwonder_rrc__content_size(hiwonder_rrc_direction_t dir, long code, const uint8_t *c, size_t avail)
 {
@@ -752,7 +755,9 @@ static long hiwonder_rrc__content_size(hiwonder_rrc_direction_t dir, long code, 
         return HIWONDER_RRC__NONE;
     }
 }
+#endif
 
+#if HIWONDER_RRC_ENABLE_PARSER
 /* Content size bounds by command code: a candidate whose code or size is outside them is no frame. */
 static int hiwonder_rrc__bounds(hiwonder_rrc_direction_t dir, long code, size_t *low, size_t *high, int *bounded)
 {
@@ -783,9 +788,143 @@ static int hiwonder_rrc__bounds(hiwonder_rrc_direction_t dir, long code, size_t 
         return 0;
     }
 }
+
+/* ---- candidates sized: straight line where a layout has no byte stuffing, without the tables ---- */
+/* The request frame: probe, straight line. */
+static long hiwonder_rrc__probe_request_0(const uint8_t *f, size_t avail)
+{
+    size_t low = 0u, high = 0u;
+    int bounded = 0;
+    long code = HIWONDER_RRC__NO_CODE;
+    (void)code;
+    if (avail < 4u) { return HIWONDER_RRC__WAIT; }
+    if (f[0u] != 0xaau) { return HIWONDER_RRC__NONE; } /* header */
+    if (f[1u] != 0x55u) { return HIWONDER_RRC__NONE; } /* header */
+    code = (long)((uint32_t)f[2u]); /* function */
+    if (!hiwonder_rrc__bounds(HIWONDER_RRC_REQUEST, code, &low, &high, &bounded)) { return HIWONDER_RRC__NONE; }
+    { long counted = (long)((uint32_t)f[3u]) - 0L; /* length */
+      long content = counted - 0L;
+      if (content < (long)low || (bounded && content > (long)high)) { return HIWONDER_RRC__NONE; }
+      return 5L + counted; }
+}
+
+/* The response frame: probe, straight line. */
+static long hiwonder_rrc__probe_response_0(const uint8_t *f, size_t avail)
+{
+    size_t low = 0u, high = 0u;
+    int bounded = 0;
+    long code = HIWONDER_RRC__NO_CODE;
+    (void)code;
+    if (avail < 4u) { return HIWONDER_RRC__WAIT; }
+    if (f[0u] != 0xaau) { return HIWONDER_RRC__NONE; } /* header */
+    if (f[1u] != 0x55u) { return HIWONDER_RRC__NONE; } /* header */
+    code = (long)((uint32_t)f[2u]); /* function */
+    if (!hiwonder_rrc__bounds(HIWONDER_RRC_RESPONSE, code, &low, &high, &bounded)) { return HIWONDER_RRC__NONE; }
+    { long counted = (long)((uint32_t)f[3u]) - 0L; /* length */
+      long content = counted - 0L;
+      if (content < (long)low || (bounded && content > (long)high)) { return HIWONDER_RRC__NONE; }
+      return 5L + counted; }
+}
+
+/* The size of a plausible frame of the direction's layout k at b[0..avail): HIWONDER_RRC__WAIT for more bytes, HIWONDER_RRC__NONE when
+ * none starts there. */
+static long hiwonder_rrc__probe_at(hiwonder_rrc_direction_t dir, uint8_t k, const uint8_t *b, size_t avail)
+{
+    switch (dir) {
+    case HIWONDER_RRC_REQUEST:
+        switch (k) {
+        case 0u:
+            return hiwonder_rrc__probe_request_0(b, avail);
+        default:
+            break;
+        }
+        break;
+    case HIWONDER_RRC_RESPONSE:
+        switch (k) {
+        case 0u:
+            return hiwonder_rrc__probe_response_0(b, avail);
+        default:
+            break;
+        }
+        break;
+    default:
+        break;
+    }
+#if HIWONDER_RRC__STUFFED
+    {
+        uint8_t count;
+        const hiwonder_rrc__layout_t *const *layouts = hiwonder_rrc__layouts(dir, &count);
+        return k < count ? hiwonder_rrc__probe(layouts[k], dir, b, avail) : HIWONDER_RRC__NONE;
+    }
+#else
+    (void)k;
+    (void)b;
+    (void)avail;
+    return HIWONDER_RRC__NONE;
+#endif
+}
 #endif
 
 #if HIWONDER_RRC_ENABLE_DECODE
+/* ---- what the decoder and the parser ask of a layout, without the tables ---- */
+static const uint8_t hiwonder_rrc__h_request_0[] = {0xaau, 0x55u};
+static const uint8_t hiwonder_rrc__h_response_0[] = {0xaau, 0x55u};
+
+/* How many layouts a direction has (0: no such direction). */
+static uint8_t hiwonder_rrc__count(hiwonder_rrc_direction_t dir)
+{
+    switch (dir) {
+    case HIWONDER_RRC_REQUEST:
+        return 1u;
+    case HIWONDER_RRC_RESPONSE:
+        return 1u;
+    default:
+        return 0u;
+    }
+}
+
+/* The leading constant of the direction's layout k (NULL and 0: none). */
+static const uint8_t *hiwonder_rrc__header(hiwonder_rrc_direction_t dir, uint8_t k, size_t *len)
+{
+    switch (dir) {
+    case HIWONDER_RRC_REQUEST:
+        switch (k) {
+        case 0u:
+            *len = 2u;
+            return hiwonder_rrc__h_request_0;
+        default:
+            break;
+        }
+        break;
+    case HIWONDER_RRC_RESPONSE:
+        switch (k) {
+        case 0u:
+            *len = 2u;
+            return hiwonder_rrc__h_response_0;
+        default:
+            break;
+        }
+        break;
+    default:
+        break;
+    }
+    *len = 0u;
+    return NULL;
+}
+
+/* 1 when the direction's layout k carries a command code. */
+static int hiwonder_rrc__has_command(hiwonder_rrc_direction_t dir, uint8_t k)
+{
+    switch (dir) {
+    case HIWONDER_RRC_REQUEST:
+        return ((1UL >> k) & 1u) != 0u;
+    case HIWONDER_RRC_RESPONSE:
+        return ((1UL >> k) & 1u) != 0u;
+    default:
+        return 0;
+    }
+}
+
 /* ---- frames taken apart: straight line where a layout has no byte stuffing ---- */
 /* The request frame: unwrap, straight line. */
 static int hiwonder_rrc__unwrap_request_0(const uint8_t *f, size_t n, uint32_t *code, uint32_t *values,
@@ -825,11 +964,10 @@ static int hiwonder_rrc__unwrap_response_0(const uint8_t *f, size_t n, uint32_t 
     return HIWONDER_RRC_OK;
 }
 
-static int hiwonder_rrc__unwrap_at(hiwonder_rrc_direction_t dir, uint8_t k, const hiwonder_rrc__layout_t *L, const uint8_t *frame, size_t n,
+static int hiwonder_rrc__unwrap_at(hiwonder_rrc_direction_t dir, uint8_t k, const uint8_t *frame, size_t n,
                           uint8_t *plain, uint32_t *code, uint32_t *values, const uint8_t **content, size_t *clen)
 {
     (void)k;
-    (void)L;
     (void)plain;
     switch (dir) {
     case HIWONDER_RRC_REQUEST:
@@ -852,7 +990,14 @@ static int hiwonder_rrc__unwrap_at(hiwonder_rrc_direction_t dir, uint8_t k, cons
         break;
     }
 #if HIWONDER_RRC__STUFFED
-    return hiwonder_rrc__unwrap(L, frame, n, plain, code, values, content, clen);
+    {
+        uint8_t count;
+        const hiwonder_rrc__layout_t *const *layouts = hiwonder_rrc__layouts(dir, &count);
+        if (k < count) {
+            return hiwonder_rrc__unwrap(layouts[k], frame, n, plain, code, values, content, clen);
+        }
+    }
+    return HIWONDER_RRC_E_ARG;
 #else
     return HIWONDER_RRC_E_ARG;
 #endif
@@ -2224,8 +2369,6 @@ static int hiwonder_rrc__decode_content(hiwonder_rrc_direction_t dir, long code,
 int hiwonder_rrc_decode_expect(const uint8_t *frame, size_t len, hiwonder_rrc_direction_t dir, hiwonder_rrc_kind_t expect, hiwonder_rrc_msg_t *out)
 {
     uint8_t count, k;
-    const hiwonder_rrc__layout_t *const *layouts;
-    const hiwonder_rrc__layout_t *L = NULL;
     uint32_t code = 0u, values[HIWONDER_RRC__MAX_ELEMENTS] = {0u};
     const uint8_t *c = NULL;
     size_t clen = 0u;
@@ -2235,30 +2378,28 @@ int hiwonder_rrc_decode_expect(const uint8_t *frame, size_t len, hiwonder_rrc_di
         return HIWONDER_RRC_E_ARG;
     }
     out->kind = HIWONDER_RRC_KIND_NONE;
-    layouts = hiwonder_rrc__layouts(dir, &count);
-    if (layouts == NULL) {
+    count = hiwonder_rrc__count(dir);
+    if (count == 0u) {
         return HIWONDER_RRC_E_ARG;
     }
     k = 0u;
-    if (HIWONDER_RRC__SINGLE || count == 1u) {
-        L = layouts[0];
-    } else {
+    if (!HIWONDER_RRC__SINGLE && count != 1u) {
         for (k = 0u; k < count; k++) {
-            const hiwonder_rrc__layout_t *A = layouts[k];
-            if (A->header_len <= len && hiwonder_rrc__same(frame, A->e[0].constant, A->header_len)) {
-                L = A;
+            size_t hl;
+            const uint8_t *h = hiwonder_rrc__header(dir, k, &hl);
+            if (hl <= len && hiwonder_rrc__same(frame, h, hl)) {
                 break;
             }
         }
-        if (L == NULL) {
+        if (k == count) {
             return HIWONDER_RRC_E_FRAME;
         }
     }
-    r = hiwonder_rrc__unwrap_at(dir, k, L, frame, len, plain, &code, values, &c, &clen);
+    r = hiwonder_rrc__unwrap_at(dir, k, frame, len, plain, &code, values, &c, &clen);
     if (r != HIWONDER_RRC_OK) {
         return r;
     }
-    r = hiwonder_rrc__decode_content(dir, L->command >= 0 ? (long)code : HIWONDER_RRC__NO_CODE, expect, c, clen, values, out);
+    r = hiwonder_rrc__decode_content(dir, hiwonder_rrc__has_command(dir, k) ? (long)code : HIWONDER_RRC__NO_CODE, expect, c, clen, values, out);
     if (r != HIWONDER_RRC_OK) {
         out->kind = HIWONDER_RRC_KIND_NONE;
     }
@@ -4148,8 +4289,7 @@ void hiwonder_rrc_parser_init(hiwonder_rrc_parser_t *parser, hiwonder_rrc_direct
 /* The candidate at pos: accepted (its size in *size, its message in out), waiting, no frame, or corrupt. */
 static int hiwonder_rrc__try(hiwonder_rrc_parser_t *p, size_t pos, hiwonder_rrc_msg_t *out, size_t *size)
 {
-    uint8_t count, k;
-    const hiwonder_rrc__layout_t *const *layouts = hiwonder_rrc__layouts(p->dir, &count);
+    uint8_t count = hiwonder_rrc__count(p->dir), k;
     int waiting = 0;
     if (p->verdict[pos] != 0u) {
         return p->verdict[pos];
@@ -4158,7 +4298,7 @@ static int hiwonder_rrc__try(hiwonder_rrc_parser_t *p, size_t pos, hiwonder_rrc_
         return HIWONDER_RRC__V_WAIT;
     }
     for (k = 0u; k < count; k++) {
-        long s = hiwonder_rrc__probe(layouts[k], p->dir, p->buf + pos, p->n - pos);
+        long s = hiwonder_rrc__probe_at(p->dir, k, p->buf + pos, p->n - pos);
         if (pos == 0u && count == 1u && s > 0) {
             p->first = (size_t)s;
         }
@@ -4193,8 +4333,7 @@ static int hiwonder_rrc__try(hiwonder_rrc_parser_t *p, size_t pos, hiwonder_rrc_
 static size_t hiwonder_rrc__next(hiwonder_rrc_parser_t *p, size_t start)
 {
 #if HIWONDER_RRC__HEADERS
-    uint8_t count, k;
-    const hiwonder_rrc__layout_t *const *layouts = hiwonder_rrc__layouts(p->dir, &count);
+    uint8_t count = hiwonder_rrc__count(p->dir), k;
     size_t pos;
     for (pos = start; pos < p->n; pos++) {
         int whole = 1; /* every header could be read here: a position none matches is never a candidate */
@@ -4202,10 +4341,11 @@ static size_t hiwonder_rrc__next(hiwonder_rrc_parser_t *p, size_t start)
             continue;
         }
         for (k = 0u; k < count; k++) {
-            const hiwonder_rrc__layout_t *L = layouts[k];
-            if (L->header_len > p->n - pos) {
+            size_t hl;
+            const uint8_t *h = hiwonder_rrc__header(p->dir, k, &hl);
+            if (hl > p->n - pos) {
                 whole = 0;
-            } else if (hiwonder_rrc__same(p->buf + pos, L->e[0].constant, L->header_len)) {
+            } else if (hiwonder_rrc__same(p->buf + pos, h, hl)) {
                 return pos;
             }
         }
@@ -4220,6 +4360,35 @@ static size_t hiwonder_rrc__next(hiwonder_rrc_parser_t *p, size_t start)
 #endif
 }
 
+
+/* The fewest bytes any layout of the direction needs before the classic parser judges a candidate. */
+static size_t hiwonder_rrc__least(hiwonder_rrc_direction_t dir)
+{
+    switch (dir) {
+    case HIWONDER_RRC_REQUEST:
+        return 4u;
+    case HIWONDER_RRC_RESPONSE:
+        return 4u;
+    default:
+        return 0u;
+    }
+}
+
+/* The first cut bytes held dropped, with their verdicts: a loop, kept one (GCC would make it two calls of the
+ * library's memmove, which a parser-only build has no other use for). */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("no-tree-loop-distribute-patterns")))
+#endif
+static void hiwonder_rrc__drop(hiwonder_rrc_parser_t *p, size_t cut)
+{
+    size_t i;
+    for (i = cut; i < p->n; i++) {
+        p->buf[i - cut] = p->buf[i];
+        p->verdict[i - cut] = p->verdict[i];
+    }
+    p->n -= cut;
+}
+
 /* One byte in: the Python parser's scan over the bytes held, each candidate's verdict kept once final. */
 static int hiwonder_rrc__push(hiwonder_rrc_parser_t *p, uint8_t byte, hiwonder_rrc_msg_t *out)
 {
@@ -4227,9 +4396,7 @@ static int hiwonder_rrc__push(hiwonder_rrc_parser_t *p, uint8_t byte, hiwonder_r
     uint32_t deferred = 0u;
     int got = 0, r;
     if (p->n >= HIWONDER_RRC_MAX_FRAME) { /* only a candidate longer than HIWONDER_RRC_MAX_FRAME can fill it: drop its first byte */
-        memmove(p->buf, p->buf + 1, p->n - 1u);
-        memmove(p->verdict, p->verdict + 1, p->n - 1u);
-        p->n--;
+        hiwonder_rrc__drop(p, 1u);
         p->garbage++;
         p->first = 0u;
     }
@@ -4239,6 +4406,12 @@ static int hiwonder_rrc__push(hiwonder_rrc_parser_t *p, uint8_t byte, hiwonder_r
     while (start < p->n) {
         pos = hiwonder_rrc__next(p, start);
         if (pos >= p->n) {
+            break;
+        }
+        if (p->n - pos < hiwonder_rrc__least(p->dir)) { /* waiting, too short for any layout, and so is every later one */
+            if (hold == (size_t)-1) {
+                hold = pos;
+            }
             break;
         }
         r = hiwonder_rrc__try(p, pos, out, &size);
@@ -4276,9 +4449,7 @@ static int hiwonder_rrc__push(hiwonder_rrc_parser_t *p, uint8_t byte, hiwonder_r
     }
     p->garbage += (uint32_t)(cut - done);
     if (cut > 0u) {
-        memmove(p->buf, p->buf + cut, p->n - cut);
-        memmove(p->verdict, p->verdict + cut, p->n - cut);
-        p->n -= cut;
+        hiwonder_rrc__drop(p, cut);
         p->first = 0u;
     }
     return got;
@@ -4290,25 +4461,23 @@ static int hiwonder_rrc__push(hiwonder_rrc_parser_t *p, uint8_t byte, hiwonder_r
  * candidate could end first). Else 0: the bytes go through hiwonder_rrc__push. */
 static size_t hiwonder_rrc__whole(hiwonder_rrc_parser_t *p, const uint8_t *data, size_t len, hiwonder_rrc_msg_t *out)
 {
-    uint8_t count;
-    const hiwonder_rrc__layout_t *const *layouts = hiwonder_rrc__layouts(p->dir, &count);
-    const hiwonder_rrc__layout_t *L;
-    size_t i, size;
+    size_t i, size, hl;
+    const uint8_t *h;
     long s;
-    if (!HIWONDER_RRC__SINGLE && count != 1u) {
+    if (!HIWONDER_RRC__SINGLE && hiwonder_rrc__count(p->dir) != 1u) {
         return 0u;
     }
-    L = layouts[0];
-    if (len < L->header_len || !hiwonder_rrc__same(data, L->e[0].constant, L->header_len)) {
+    h = hiwonder_rrc__header(p->dir, 0u, &hl);
+    if (h == NULL || len < hl || !hiwonder_rrc__same(data, h, hl)) {
         return 0u;
     }
-    s = hiwonder_rrc__probe(L, p->dir, data, len);
+    s = hiwonder_rrc__probe_at(p->dir, 0u, data, len);
     if (s <= 0 || (unsigned long)s > HIWONDER_RRC_MAX_FRAME || (size_t)s > len) {
         return 0u;
     }
     size = (size_t)s;
-    for (i = 1u; i + L->header_len <= size; i++) {
-        if (data[i] == L->e[0].constant[0] && hiwonder_rrc__same(data + i, L->e[0].constant, L->header_len)) {
+    for (i = 1u; i + hl <= size; i++) {
+        if (data[i] == h[0] && hiwonder_rrc__same(data + i, h, hl)) {
             return 0u;
         }
     }

@@ -24,6 +24,7 @@ typedef char modbus_rtu__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define MODBUS_RTU__STUFFED 0 /* some layout has byte stuffing */
 #define MODBUS_RTU__LENGTHS 0 /* every layout has a length element */
 #define MODBUS_RTU__SINGLE 1 /* one layout per direction */
+#define MODBUS_RTU__TABLES (MODBUS_RTU_ENABLE_ENCODE || MODBUS_RTU__STUFFED) /* the layouts as tables: encode and stuffing walk them */
 
 /* ---- checksums ---- */
 /* CRC-16/MODBUS: width 16, poly 0x8005, init 0xffff, refin true, refout true, xorout 0x0 (check 0x4b37). Incremental: start with 0xffff, feed pieces, then use it as is. Bitwise: no table, no static data. */
@@ -153,7 +154,7 @@ static void modbus_rtu__put(uint8_t *b, uint8_t size, uint8_t big, uint32_t v)
 }
 #endif
 
-#if MODBUS_RTU_ENABLE_ENCODE || MODBUS_RTU__STUFFED || MODBUS_RTU_ENABLE_PARSER
+#if MODBUS_RTU_ENABLE_ENCODE || MODBUS_RTU__STUFFED
 /* The elements before the variable part (the stuffed span, else the content) and after it. */
 static uint8_t modbus_rtu__inner_first(const modbus_rtu__layout_t *L)
 {
@@ -534,7 +535,7 @@ static int modbus_rtu__unwrap(const modbus_rtu__layout_t *L, const uint8_t *fram
 }
 #endif
 
-#if MODBUS_RTU_ENABLE_PARSER
+#if MODBUS_RTU_ENABLE_PARSER && MODBUS_RTU__STUFFED
 static int modbus_rtu__bounds(modbus_rtu_direction_t dir, long code, size_t *low, size_t *high, int *bounded);
 static long modbus_rtu__content_size(modbus_rtu_direction_t dir, long code, const uint8_t *c, size_t avail);
 
@@ -616,7 +617,8 @@ static long modbus_rtu__probe(const modbus_rtu__layout_t *L, modbus_rtu_directio
 #endif
 
 
-/* ---- the layouts of the spec ---- */
+#if MODBUS_RTU__TABLES
+/* ---- the layouts of the spec (what the encoder and the engine for stuffed layouts walk) ---- */
 /* The request frame. */
 static const modbus_rtu__element_t modbus_rtu__l_request_0_e[] = {
     {MODBUS_RTU__ROLE_VALUE, 1u, 0u, 0u, 0u, 0u, 1u, 0L, 1UL, 247UL, 0UL, NULL},  /* unit */
@@ -653,9 +655,10 @@ static const modbus_rtu__layout_t *const *modbus_rtu__layouts(modbus_rtu_directi
     }
 }
 #endif
+#endif
 
 
-#if MODBUS_RTU_ENABLE_PARSER
+#if MODBUS_RTU_ENABLE_PARSER && (MODBUS_RTU__STUFFED || !MODBUS_RTU__LENGTHS)
 /* Frames without a length: the content size from its own leading fields, by code (WAIT: those have not come). */
 static long modbus_rtu__content_size(modbus_rtu_direction_t dir, long code, const uint8_t *c, size_t avail)
 {
@@ -757,7 +760,9 @@ static long modbus_rtu__content_size(modbus_rtu_direction_t dir, long code, cons
         return MODBUS_RTU__NONE;
     }
 }
+#endif
 
+#if MODBUS_RTU_ENABLE_PARSER
 /* Content size bounds by command code: a candidate whose code or size is outside them is no frame. */
 static int modbus_rtu__bounds(modbus_rtu_direction_t dir, long code, size_t *low, size_t *high, int *bounded)
 {
@@ -795,9 +800,136 @@ static int modbus_rtu__bounds(modbus_rtu_direction_t dir, long code, size_t *low
         return 0;
     }
 }
+
+/* ---- candidates sized: straight line where a layout has no byte stuffing, without the tables ---- */
+/* The request frame: probe, straight line. */
+static long modbus_rtu__probe_request_0(const uint8_t *f, size_t avail)
+{
+    size_t low = 0u, high = 0u;
+    int bounded = 0;
+    long code = MODBUS_RTU__NO_CODE;
+    (void)code;
+    if (avail < 1u) { return MODBUS_RTU__WAIT; }
+    { uint32_t v = (uint32_t)f[0u]; if ((v < 1u || v > 247u) && v != 0u) { return MODBUS_RTU__NONE; } } /* unit */
+    if (avail < 2u) { return MODBUS_RTU__WAIT; }
+    code = (long)((uint32_t)f[1u]); /* function */
+    if (!modbus_rtu__bounds(MODBUS_RTU_REQUEST, code, &low, &high, &bounded)) { return MODBUS_RTU__NONE; }
+    { long size = modbus_rtu__content_size(MODBUS_RTU_REQUEST, code, f + 2u, avail - 2u);
+      if (size < 0) { return size; }
+      if ((size_t)size < low || (bounded && (size_t)size > high)) { return MODBUS_RTU__NONE; }
+      return 4L + size; }
+}
+
+/* The response frame: probe, straight line. */
+static long modbus_rtu__probe_response_0(const uint8_t *f, size_t avail)
+{
+    size_t low = 0u, high = 0u;
+    int bounded = 0;
+    long code = MODBUS_RTU__NO_CODE;
+    (void)code;
+    if (avail < 1u) { return MODBUS_RTU__WAIT; }
+    { uint32_t v = (uint32_t)f[0u]; if ((v < 1u || v > 247u) && v != 0u) { return MODBUS_RTU__NONE; } } /* unit */
+    if (avail < 2u) { return MODBUS_RTU__WAIT; }
+    code = (((uint32_t)f[1u]) & 128UL) != 0u ? MODBUS_RTU__ERROR_CODE : (long)((uint32_t)f[1u]); /* function */
+    if (!modbus_rtu__bounds(MODBUS_RTU_RESPONSE, code, &low, &high, &bounded)) { return MODBUS_RTU__NONE; }
+    { long size = modbus_rtu__content_size(MODBUS_RTU_RESPONSE, code, f + 2u, avail - 2u);
+      if (size < 0) { return size; }
+      if ((size_t)size < low || (bounded && (size_t)size > high)) { return MODBUS_RTU__NONE; }
+      return 4L + size; }
+}
+
+/* The size of a plausible frame of the direction's layout k at b[0..avail): MODBUS_RTU__WAIT for more bytes, MODBUS_RTU__NONE when
+ * none starts there. */
+static long modbus_rtu__probe_at(modbus_rtu_direction_t dir, uint8_t k, const uint8_t *b, size_t avail)
+{
+    switch (dir) {
+    case MODBUS_RTU_REQUEST:
+        switch (k) {
+        case 0u:
+            return modbus_rtu__probe_request_0(b, avail);
+        default:
+            break;
+        }
+        break;
+    case MODBUS_RTU_RESPONSE:
+        switch (k) {
+        case 0u:
+            return modbus_rtu__probe_response_0(b, avail);
+        default:
+            break;
+        }
+        break;
+    default:
+        break;
+    }
+#if MODBUS_RTU__STUFFED
+    {
+        uint8_t count;
+        const modbus_rtu__layout_t *const *layouts = modbus_rtu__layouts(dir, &count);
+        return k < count ? modbus_rtu__probe(layouts[k], dir, b, avail) : MODBUS_RTU__NONE;
+    }
+#else
+    (void)k;
+    (void)b;
+    (void)avail;
+    return MODBUS_RTU__NONE;
+#endif
+}
 #endif
 
 #if MODBUS_RTU_ENABLE_DECODE
+/* ---- what the decoder and the parser ask of a layout, without the tables ---- */
+
+
+/* How many layouts a direction has (0: no such direction). */
+static uint8_t modbus_rtu__count(modbus_rtu_direction_t dir)
+{
+    switch (dir) {
+    case MODBUS_RTU_REQUEST:
+        return 1u;
+    case MODBUS_RTU_RESPONSE:
+        return 1u;
+    default:
+        return 0u;
+    }
+}
+
+/* The leading constant of the direction's layout k (NULL and 0: none). */
+static const uint8_t *modbus_rtu__header(modbus_rtu_direction_t dir, uint8_t k, size_t *len)
+{
+    switch (dir) {
+    case MODBUS_RTU_REQUEST:
+        switch (k) {
+        default:
+            break;
+        }
+        break;
+    case MODBUS_RTU_RESPONSE:
+        switch (k) {
+        default:
+            break;
+        }
+        break;
+    default:
+        break;
+    }
+    *len = 0u;
+    return NULL;
+}
+
+/* 1 when the direction's layout k carries a command code. */
+static int modbus_rtu__has_command(modbus_rtu_direction_t dir, uint8_t k)
+{
+    switch (dir) {
+    case MODBUS_RTU_REQUEST:
+        return ((1UL >> k) & 1u) != 0u;
+    case MODBUS_RTU_RESPONSE:
+        return ((1UL >> k) & 1u) != 0u;
+    default:
+        return 0;
+    }
+}
+
 /* ---- frames taken apart: straight line where a layout has no byte stuffing ---- */
 /* The request frame: unwrap, straight line. */
 static int modbus_rtu__unwrap_request_0(const uint8_t *f, size_t n, uint32_t *code, uint32_t *values,
@@ -835,11 +967,10 @@ static int modbus_rtu__unwrap_response_0(const uint8_t *f, size_t n, uint32_t *c
     return MODBUS_RTU_OK;
 }
 
-static int modbus_rtu__unwrap_at(modbus_rtu_direction_t dir, uint8_t k, const modbus_rtu__layout_t *L, const uint8_t *frame, size_t n,
+static int modbus_rtu__unwrap_at(modbus_rtu_direction_t dir, uint8_t k, const uint8_t *frame, size_t n,
                           uint8_t *plain, uint32_t *code, uint32_t *values, const uint8_t **content, size_t *clen)
 {
     (void)k;
-    (void)L;
     (void)plain;
     switch (dir) {
     case MODBUS_RTU_REQUEST:
@@ -862,7 +993,14 @@ static int modbus_rtu__unwrap_at(modbus_rtu_direction_t dir, uint8_t k, const mo
         break;
     }
 #if MODBUS_RTU__STUFFED
-    return modbus_rtu__unwrap(L, frame, n, plain, code, values, content, clen);
+    {
+        uint8_t count;
+        const modbus_rtu__layout_t *const *layouts = modbus_rtu__layouts(dir, &count);
+        if (k < count) {
+            return modbus_rtu__unwrap(layouts[k], frame, n, plain, code, values, content, clen);
+        }
+    }
+    return MODBUS_RTU_E_ARG;
 #else
     return MODBUS_RTU_E_ARG;
 #endif
@@ -1463,8 +1601,6 @@ static int modbus_rtu__decode_content(modbus_rtu_direction_t dir, long code, mod
 int modbus_rtu_decode_expect(const uint8_t *frame, size_t len, modbus_rtu_direction_t dir, modbus_rtu_kind_t expect, modbus_rtu_msg_t *out)
 {
     uint8_t count, k;
-    const modbus_rtu__layout_t *const *layouts;
-    const modbus_rtu__layout_t *L = NULL;
     uint32_t code = 0u, values[MODBUS_RTU__MAX_ELEMENTS] = {0u};
     const uint8_t *c = NULL;
     size_t clen = 0u;
@@ -1474,30 +1610,28 @@ int modbus_rtu_decode_expect(const uint8_t *frame, size_t len, modbus_rtu_direct
         return MODBUS_RTU_E_ARG;
     }
     out->kind = MODBUS_RTU_KIND_NONE;
-    layouts = modbus_rtu__layouts(dir, &count);
-    if (layouts == NULL) {
+    count = modbus_rtu__count(dir);
+    if (count == 0u) {
         return MODBUS_RTU_E_ARG;
     }
     k = 0u;
-    if (MODBUS_RTU__SINGLE || count == 1u) {
-        L = layouts[0];
-    } else {
+    if (!MODBUS_RTU__SINGLE && count != 1u) {
         for (k = 0u; k < count; k++) {
-            const modbus_rtu__layout_t *A = layouts[k];
-            if (A->header_len <= len && modbus_rtu__same(frame, A->e[0].constant, A->header_len)) {
-                L = A;
+            size_t hl;
+            const uint8_t *h = modbus_rtu__header(dir, k, &hl);
+            if (hl <= len && modbus_rtu__same(frame, h, hl)) {
                 break;
             }
         }
-        if (L == NULL) {
+        if (k == count) {
             return MODBUS_RTU_E_FRAME;
         }
     }
-    r = modbus_rtu__unwrap_at(dir, k, L, frame, len, plain, &code, values, &c, &clen);
+    r = modbus_rtu__unwrap_at(dir, k, frame, len, plain, &code, values, &c, &clen);
     if (r != MODBUS_RTU_OK) {
         return r;
     }
-    r = modbus_rtu__decode_content(dir, L->command >= 0 ? (long)code : MODBUS_RTU__NO_CODE, expect, c, clen, values, out);
+    r = modbus_rtu__decode_content(dir, modbus_rtu__has_command(dir, k) ? (long)code : MODBUS_RTU__NO_CODE, expect, c, clen, values, out);
     if (r != MODBUS_RTU_OK) {
         out->kind = MODBUS_RTU_KIND_NONE;
     }
@@ -2369,8 +2503,7 @@ void modbus_rtu_parser_init(modbus_rtu_parser_t *parser, modbus_rtu_direction_t 
 /* The candidate at pos: accepted (its size in *size, its message in out), waiting, no frame, or corrupt. */
 static int modbus_rtu__try(modbus_rtu_parser_t *p, size_t pos, modbus_rtu_msg_t *out, size_t *size)
 {
-    uint8_t count, k;
-    const modbus_rtu__layout_t *const *layouts = modbus_rtu__layouts(p->dir, &count);
+    uint8_t count = modbus_rtu__count(p->dir), k;
     int waiting = 0;
     if (p->verdict[pos] != 0u) {
         return p->verdict[pos];
@@ -2379,7 +2512,7 @@ static int modbus_rtu__try(modbus_rtu_parser_t *p, size_t pos, modbus_rtu_msg_t 
         return MODBUS_RTU__V_WAIT;
     }
     for (k = 0u; k < count; k++) {
-        long s = modbus_rtu__probe(layouts[k], p->dir, p->buf + pos, p->n - pos);
+        long s = modbus_rtu__probe_at(p->dir, k, p->buf + pos, p->n - pos);
         if (pos == 0u && count == 1u && s > 0) {
             p->first = (size_t)s;
         }
@@ -2414,8 +2547,7 @@ static int modbus_rtu__try(modbus_rtu_parser_t *p, size_t pos, modbus_rtu_msg_t 
 static size_t modbus_rtu__next(modbus_rtu_parser_t *p, size_t start)
 {
 #if MODBUS_RTU__HEADERS
-    uint8_t count, k;
-    const modbus_rtu__layout_t *const *layouts = modbus_rtu__layouts(p->dir, &count);
+    uint8_t count = modbus_rtu__count(p->dir), k;
     size_t pos;
     for (pos = start; pos < p->n; pos++) {
         int whole = 1; /* every header could be read here: a position none matches is never a candidate */
@@ -2423,10 +2555,11 @@ static size_t modbus_rtu__next(modbus_rtu_parser_t *p, size_t start)
             continue;
         }
         for (k = 0u; k < count; k++) {
-            const modbus_rtu__layout_t *L = layouts[k];
-            if (L->header_len > p->n - pos) {
+            size_t hl;
+            const uint8_t *h = modbus_rtu__header(p->dir, k, &hl);
+            if (hl > p->n - pos) {
                 whole = 0;
-            } else if (modbus_rtu__same(p->buf + pos, L->e[0].constant, L->header_len)) {
+            } else if (modbus_rtu__same(p->buf + pos, h, hl)) {
                 return pos;
             }
         }
@@ -2441,6 +2574,22 @@ static size_t modbus_rtu__next(modbus_rtu_parser_t *p, size_t start)
 #endif
 }
 
+
+/* The first cut bytes held dropped, with their verdicts: a loop, kept one (GCC would make it two calls of the
+ * library's memmove, which a parser-only build has no other use for). */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("no-tree-loop-distribute-patterns")))
+#endif
+static void modbus_rtu__drop(modbus_rtu_parser_t *p, size_t cut)
+{
+    size_t i;
+    for (i = cut; i < p->n; i++) {
+        p->buf[i - cut] = p->buf[i];
+        p->verdict[i - cut] = p->verdict[i];
+    }
+    p->n -= cut;
+}
+
 /* One byte in: the Python parser's scan over the bytes held, each candidate's verdict kept once final. */
 static int modbus_rtu__push(modbus_rtu_parser_t *p, uint8_t byte, modbus_rtu_msg_t *out)
 {
@@ -2448,9 +2597,7 @@ static int modbus_rtu__push(modbus_rtu_parser_t *p, uint8_t byte, modbus_rtu_msg
     uint32_t deferred = 0u;
     int got = 0, r;
     if (p->n >= MODBUS_RTU_MAX_FRAME) { /* only a candidate longer than MODBUS_RTU_MAX_FRAME can fill it: drop its first byte */
-        memmove(p->buf, p->buf + 1, p->n - 1u);
-        memmove(p->verdict, p->verdict + 1, p->n - 1u);
-        p->n--;
+        modbus_rtu__drop(p, 1u);
         p->garbage++;
         p->first = 0u;
     }
@@ -2497,9 +2644,7 @@ static int modbus_rtu__push(modbus_rtu_parser_t *p, uint8_t byte, modbus_rtu_msg
     }
     p->garbage += (uint32_t)(cut - done);
     if (cut > 0u) {
-        memmove(p->buf, p->buf + cut, p->n - cut);
-        memmove(p->verdict, p->verdict + cut, p->n - cut);
-        p->n -= cut;
+        modbus_rtu__drop(p, cut);
         p->first = 0u;
     }
     return got;
@@ -2511,25 +2656,23 @@ static int modbus_rtu__push(modbus_rtu_parser_t *p, uint8_t byte, modbus_rtu_msg
  * candidate could end first). Else 0: the bytes go through modbus_rtu__push. */
 static size_t modbus_rtu__whole(modbus_rtu_parser_t *p, const uint8_t *data, size_t len, modbus_rtu_msg_t *out)
 {
-    uint8_t count;
-    const modbus_rtu__layout_t *const *layouts = modbus_rtu__layouts(p->dir, &count);
-    const modbus_rtu__layout_t *L;
-    size_t i, size;
+    size_t i, size, hl;
+    const uint8_t *h;
     long s;
-    if (!MODBUS_RTU__SINGLE && count != 1u) {
+    if (!MODBUS_RTU__SINGLE && modbus_rtu__count(p->dir) != 1u) {
         return 0u;
     }
-    L = layouts[0];
-    if (len < L->header_len || !modbus_rtu__same(data, L->e[0].constant, L->header_len)) {
+    h = modbus_rtu__header(p->dir, 0u, &hl);
+    if (h == NULL || len < hl || !modbus_rtu__same(data, h, hl)) {
         return 0u;
     }
-    s = modbus_rtu__probe(L, p->dir, data, len);
+    s = modbus_rtu__probe_at(p->dir, 0u, data, len);
     if (s <= 0 || (unsigned long)s > MODBUS_RTU_MAX_FRAME || (size_t)s > len) {
         return 0u;
     }
     size = (size_t)s;
-    for (i = 1u; i + L->header_len <= size; i++) {
-        if (data[i] == L->e[0].constant[0] && modbus_rtu__same(data + i, L->e[0].constant, L->header_len)) {
+    for (i = 1u; i + hl <= size; i++) {
+        if (data[i] == h[0] && modbus_rtu__same(data + i, h, hl)) {
             return 0u;
         }
     }

@@ -24,6 +24,7 @@ typedef char vesc__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define VESC__STUFFED 0 /* some layout has byte stuffing */
 #define VESC__LENGTHS 1 /* every layout has a length element */
 #define VESC__SINGLE 0 /* one layout per direction */
+#define VESC__TABLES (VESC_ENABLE_ENCODE || VESC__STUFFED) /* the layouts as tables: encode and stuffing walk them */
 
 /* ---- checksums ---- */
 /* CRC-16/XMODEM: width 16, poly 0x1021, init 0x0, refin false, refout false, xorout 0x0 (check 0x31c3). Incremental: start with 0x0, feed pieces, then use it as is. Bitwise: no table, no static data. */
@@ -153,7 +154,7 @@ static void vesc__put(uint8_t *b, uint8_t size, uint8_t big, uint32_t v)
 }
 #endif
 
-#if VESC_ENABLE_ENCODE || VESC__STUFFED || VESC_ENABLE_PARSER
+#if VESC_ENABLE_ENCODE || VESC__STUFFED
 /* The elements before the variable part (the stuffed span, else the content) and after it. */
 static uint8_t vesc__inner_first(const vesc__layout_t *L)
 {
@@ -534,7 +535,7 @@ static int vesc__unwrap(const vesc__layout_t *L, const uint8_t *frame, size_t n,
 }
 #endif
 
-#if VESC_ENABLE_PARSER
+#if VESC_ENABLE_PARSER && VESC__STUFFED
 static int vesc__bounds(vesc_direction_t dir, long code, size_t *low, size_t *high, int *bounded);
 static long vesc__content_size(vesc_direction_t dir, long code, const uint8_t *c, size_t avail);
 
@@ -616,7 +617,8 @@ static long vesc__probe(const vesc__layout_t *L, vesc_direction_t dir, const uin
 #endif
 
 
-/* ---- the layouts of the spec ---- */
+#if VESC__TABLES
+/* ---- the layouts of the spec (what the encoder and the engine for stuffed layouts walk) ---- */
 /* The request frame short. */
 static const uint8_t vesc__l_request_0_c0[] = {0x02u};
 static const uint8_t vesc__l_request_0_c5[] = {0x03u};
@@ -687,6 +689,7 @@ static const vesc__layout_t *const *vesc__layouts(vesc_direction_t dir, uint8_t 
     }
 }
 #endif
+#endif
 
 #if VESC_ENABLE_DECODE
 /* A 16-bit two's complement value from its wire bits (no implementation-defined conversion). */
@@ -754,7 +757,7 @@ static int vesc__utf8(const uint8_t *s, size_t n)
 }
 #endif
 
-#if VESC_ENABLE_PARSER
+#if VESC_ENABLE_PARSER && (VESC__STUFFED || !VESC__LENGTHS)
 /* Frames without a length: the content size from its own leading fields, by code (WAIT: those have not come). */
 static long vesc__content_size(vesc_direction_t dir, long code, const uint8_t *c, size_t avail)
 {
@@ -810,7 +813,9 @@ static long vesc__content_size(vesc_direction_t dir, long code, const uint8_t *c
         return VESC__NONE;
     }
 }
+#endif
 
+#if VESC_ENABLE_PARSER
 /* Content size bounds by command code: a candidate whose code or size is outside them is no frame. */
 static int vesc__bounds(vesc_direction_t dir, long code, size_t *low, size_t *high, int *bounded)
 {
@@ -841,9 +846,195 @@ static int vesc__bounds(vesc_direction_t dir, long code, size_t *low, size_t *hi
         return 0;
     }
 }
+
+/* ---- candidates sized: straight line where a layout has no byte stuffing, without the tables ---- */
+/* The request frame short: probe, straight line. */
+static long vesc__probe_request_0(const uint8_t *f, size_t avail)
+{
+    size_t low = 0u, high = 0u;
+    int bounded = 0;
+    long code = VESC__NO_CODE;
+    (void)code;
+    if (avail < 1u) { return VESC__WAIT; }
+    if (f[0u] != 0x02u) { return VESC__NONE; } /* start */
+    if (avail < 2u) { return VESC__WAIT; }
+    if (avail < 3u) { return VESC__WAIT; }
+    code = (long)((uint32_t)f[2u]); /* command */
+    if (!vesc__bounds(VESC_REQUEST, code, &low, &high, &bounded)) { return VESC__NONE; }
+    { long counted = (long)((uint32_t)f[1u]) - 0L; /* length */
+      long content = counted - 1L;
+      if (content < (long)low || (bounded && content > (long)high)) { return VESC__NONE; }
+      return 5L + counted; }
+}
+
+/* The request frame long: probe, straight line. */
+static long vesc__probe_request_1(const uint8_t *f, size_t avail)
+{
+    size_t low = 0u, high = 0u;
+    int bounded = 0;
+    long code = VESC__NO_CODE;
+    (void)code;
+    if (avail < 1u) { return VESC__WAIT; }
+    if (f[0u] != 0x03u) { return VESC__NONE; } /* start */
+    if (avail < 3u) { return VESC__WAIT; }
+    if (avail < 4u) { return VESC__WAIT; }
+    code = (long)((uint32_t)f[3u]); /* command */
+    if (!vesc__bounds(VESC_REQUEST, code, &low, &high, &bounded)) { return VESC__NONE; }
+    { long counted = (long)(((uint32_t)f[1u] << 8u) | (uint32_t)f[2u]) - 0L; /* length */
+      long content = counted - 1L;
+      if (content < (long)low || (bounded && content > (long)high)) { return VESC__NONE; }
+      return 6L + counted; }
+}
+
+/* The response frame short: probe, straight line. */
+static long vesc__probe_response_0(const uint8_t *f, size_t avail)
+{
+    size_t low = 0u, high = 0u;
+    int bounded = 0;
+    long code = VESC__NO_CODE;
+    (void)code;
+    if (avail < 1u) { return VESC__WAIT; }
+    if (f[0u] != 0x02u) { return VESC__NONE; } /* start */
+    if (avail < 2u) { return VESC__WAIT; }
+    if (avail < 3u) { return VESC__WAIT; }
+    code = (long)((uint32_t)f[2u]); /* command */
+    if (!vesc__bounds(VESC_RESPONSE, code, &low, &high, &bounded)) { return VESC__NONE; }
+    { long counted = (long)((uint32_t)f[1u]) - 0L; /* length */
+      long content = counted - 1L;
+      if (content < (long)low || (bounded && content > (long)high)) { return VESC__NONE; }
+      return 5L + counted; }
+}
+
+/* The response frame long: probe, straight line. */
+static long vesc__probe_response_1(const uint8_t *f, size_t avail)
+{
+    size_t low = 0u, high = 0u;
+    int bounded = 0;
+    long code = VESC__NO_CODE;
+    (void)code;
+    if (avail < 1u) { return VESC__WAIT; }
+    if (f[0u] != 0x03u) { return VESC__NONE; } /* start */
+    if (avail < 3u) { return VESC__WAIT; }
+    if (avail < 4u) { return VESC__WAIT; }
+    code = (long)((uint32_t)f[3u]); /* command */
+    if (!vesc__bounds(VESC_RESPONSE, code, &low, &high, &bounded)) { return VESC__NONE; }
+    { long counted = (long)(((uint32_t)f[1u] << 8u) | (uint32_t)f[2u]) - 0L; /* length */
+      long content = counted - 1L;
+      if (content < (long)low || (bounded && content > (long)high)) { return VESC__NONE; }
+      return 6L + counted; }
+}
+
+/* The size of a plausible frame of the direction's layout k at b[0..avail): VESC__WAIT for more bytes, VESC__NONE when
+ * none starts there. */
+static long vesc__probe_at(vesc_direction_t dir, uint8_t k, const uint8_t *b, size_t avail)
+{
+    switch (dir) {
+    case VESC_REQUEST:
+        switch (k) {
+        case 0u:
+            return vesc__probe_request_0(b, avail);
+        case 1u:
+            return vesc__probe_request_1(b, avail);
+        default:
+            break;
+        }
+        break;
+    case VESC_RESPONSE:
+        switch (k) {
+        case 0u:
+            return vesc__probe_response_0(b, avail);
+        case 1u:
+            return vesc__probe_response_1(b, avail);
+        default:
+            break;
+        }
+        break;
+    default:
+        break;
+    }
+#if VESC__STUFFED
+    {
+        uint8_t count;
+        const vesc__layout_t *const *layouts = vesc__layouts(dir, &count);
+        return k < count ? vesc__probe(layouts[k], dir, b, avail) : VESC__NONE;
+    }
+#else
+    (void)k;
+    (void)b;
+    (void)avail;
+    return VESC__NONE;
+#endif
+}
 #endif
 
 #if VESC_ENABLE_DECODE
+/* ---- what the decoder and the parser ask of a layout, without the tables ---- */
+static const uint8_t vesc__h_request_0[] = {0x02u};
+static const uint8_t vesc__h_request_1[] = {0x03u};
+static const uint8_t vesc__h_response_0[] = {0x02u};
+static const uint8_t vesc__h_response_1[] = {0x03u};
+
+/* How many layouts a direction has (0: no such direction). */
+static uint8_t vesc__count(vesc_direction_t dir)
+{
+    switch (dir) {
+    case VESC_REQUEST:
+        return 2u;
+    case VESC_RESPONSE:
+        return 2u;
+    default:
+        return 0u;
+    }
+}
+
+/* The leading constant of the direction's layout k (NULL and 0: none). */
+static const uint8_t *vesc__header(vesc_direction_t dir, uint8_t k, size_t *len)
+{
+    switch (dir) {
+    case VESC_REQUEST:
+        switch (k) {
+        case 0u:
+            *len = 1u;
+            return vesc__h_request_0;
+        case 1u:
+            *len = 1u;
+            return vesc__h_request_1;
+        default:
+            break;
+        }
+        break;
+    case VESC_RESPONSE:
+        switch (k) {
+        case 0u:
+            *len = 1u;
+            return vesc__h_response_0;
+        case 1u:
+            *len = 1u;
+            return vesc__h_response_1;
+        default:
+            break;
+        }
+        break;
+    default:
+        break;
+    }
+    *len = 0u;
+    return NULL;
+}
+
+/* 1 when the direction's layout k carries a command code. */
+static int vesc__has_command(vesc_direction_t dir, uint8_t k)
+{
+    switch (dir) {
+    case VESC_REQUEST:
+        return ((3UL >> k) & 1u) != 0u;
+    case VESC_RESPONSE:
+        return ((3UL >> k) & 1u) != 0u;
+    default:
+        return 0;
+    }
+}
+
 /* ---- frames taken apart: straight line where a layout has no byte stuffing ---- */
 /* The request frame short: unwrap, straight line. */
 static int vesc__unwrap_request_0(const uint8_t *f, size_t n, uint32_t *code, uint32_t *values,
@@ -921,11 +1112,10 @@ static int vesc__unwrap_response_1(const uint8_t *f, size_t n, uint32_t *code, u
     return VESC_OK;
 }
 
-static int vesc__unwrap_at(vesc_direction_t dir, uint8_t k, const vesc__layout_t *L, const uint8_t *frame, size_t n,
+static int vesc__unwrap_at(vesc_direction_t dir, uint8_t k, const uint8_t *frame, size_t n,
                           uint8_t *plain, uint32_t *code, uint32_t *values, const uint8_t **content, size_t *clen)
 {
     (void)k;
-    (void)L;
     (void)plain;
     switch (dir) {
     case VESC_REQUEST:
@@ -952,7 +1142,14 @@ static int vesc__unwrap_at(vesc_direction_t dir, uint8_t k, const vesc__layout_t
         break;
     }
 #if VESC__STUFFED
-    return vesc__unwrap(L, frame, n, plain, code, values, content, clen);
+    {
+        uint8_t count;
+        const vesc__layout_t *const *layouts = vesc__layouts(dir, &count);
+        if (k < count) {
+            return vesc__unwrap(layouts[k], frame, n, plain, code, values, content, clen);
+        }
+    }
+    return VESC_E_ARG;
 #else
     return VESC_E_ARG;
 #endif
@@ -1395,8 +1592,6 @@ static int vesc__decode_content(vesc_direction_t dir, long code, vesc_kind_t exp
 int vesc_decode_expect(const uint8_t *frame, size_t len, vesc_direction_t dir, vesc_kind_t expect, vesc_msg_t *out)
 {
     uint8_t count, k;
-    const vesc__layout_t *const *layouts;
-    const vesc__layout_t *L = NULL;
     uint32_t code = 0u, values[VESC__MAX_ELEMENTS] = {0u};
     const uint8_t *c = NULL;
     size_t clen = 0u;
@@ -1406,30 +1601,28 @@ int vesc_decode_expect(const uint8_t *frame, size_t len, vesc_direction_t dir, v
         return VESC_E_ARG;
     }
     out->kind = VESC_KIND_NONE;
-    layouts = vesc__layouts(dir, &count);
-    if (layouts == NULL) {
+    count = vesc__count(dir);
+    if (count == 0u) {
         return VESC_E_ARG;
     }
     k = 0u;
-    if (VESC__SINGLE || count == 1u) {
-        L = layouts[0];
-    } else {
+    if (!VESC__SINGLE && count != 1u) {
         for (k = 0u; k < count; k++) {
-            const vesc__layout_t *A = layouts[k];
-            if (A->header_len <= len && vesc__same(frame, A->e[0].constant, A->header_len)) {
-                L = A;
+            size_t hl;
+            const uint8_t *h = vesc__header(dir, k, &hl);
+            if (hl <= len && vesc__same(frame, h, hl)) {
                 break;
             }
         }
-        if (L == NULL) {
+        if (k == count) {
             return VESC_E_FRAME;
         }
     }
-    r = vesc__unwrap_at(dir, k, L, frame, len, plain, &code, values, &c, &clen);
+    r = vesc__unwrap_at(dir, k, frame, len, plain, &code, values, &c, &clen);
     if (r != VESC_OK) {
         return r;
     }
-    r = vesc__decode_content(dir, L->command >= 0 ? (long)code : VESC__NO_CODE, expect, c, clen, values, out);
+    r = vesc__decode_content(dir, vesc__has_command(dir, k) ? (long)code : VESC__NO_CODE, expect, c, clen, values, out);
     if (r != VESC_OK) {
         out->kind = VESC_KIND_NONE;
     }
@@ -2028,8 +2221,7 @@ void vesc_parser_init(vesc_parser_t *parser, vesc_direction_t dir)
 /* The candidate at pos: accepted (its size in *size, its message in out), waiting, no frame, or corrupt. */
 static int vesc__try(vesc_parser_t *p, size_t pos, vesc_msg_t *out, size_t *size)
 {
-    uint8_t count, k;
-    const vesc__layout_t *const *layouts = vesc__layouts(p->dir, &count);
+    uint8_t count = vesc__count(p->dir), k;
     int waiting = 0;
     if (p->verdict[pos] != 0u) {
         return p->verdict[pos];
@@ -2038,7 +2230,7 @@ static int vesc__try(vesc_parser_t *p, size_t pos, vesc_msg_t *out, size_t *size
         return VESC__V_WAIT;
     }
     for (k = 0u; k < count; k++) {
-        long s = vesc__probe(layouts[k], p->dir, p->buf + pos, p->n - pos);
+        long s = vesc__probe_at(p->dir, k, p->buf + pos, p->n - pos);
         if (pos == 0u && count == 1u && s > 0) {
             p->first = (size_t)s;
         }
@@ -2073,8 +2265,7 @@ static int vesc__try(vesc_parser_t *p, size_t pos, vesc_msg_t *out, size_t *size
 static size_t vesc__next(vesc_parser_t *p, size_t start)
 {
 #if VESC__HEADERS
-    uint8_t count, k;
-    const vesc__layout_t *const *layouts = vesc__layouts(p->dir, &count);
+    uint8_t count = vesc__count(p->dir), k;
     size_t pos;
     for (pos = start; pos < p->n; pos++) {
         int whole = 1; /* every header could be read here: a position none matches is never a candidate */
@@ -2082,10 +2273,11 @@ static size_t vesc__next(vesc_parser_t *p, size_t start)
             continue;
         }
         for (k = 0u; k < count; k++) {
-            const vesc__layout_t *L = layouts[k];
-            if (L->header_len > p->n - pos) {
+            size_t hl;
+            const uint8_t *h = vesc__header(p->dir, k, &hl);
+            if (hl > p->n - pos) {
                 whole = 0;
-            } else if (vesc__same(p->buf + pos, L->e[0].constant, L->header_len)) {
+            } else if (vesc__same(p->buf + pos, h, hl)) {
                 return pos;
             }
         }
@@ -2100,6 +2292,22 @@ static size_t vesc__next(vesc_parser_t *p, size_t start)
 #endif
 }
 
+
+/* The first cut bytes held dropped, with their verdicts: a loop, kept one (GCC would make it two calls of the
+ * library's memmove, which a parser-only build has no other use for). */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("no-tree-loop-distribute-patterns")))
+#endif
+static void vesc__drop(vesc_parser_t *p, size_t cut)
+{
+    size_t i;
+    for (i = cut; i < p->n; i++) {
+        p->buf[i - cut] = p->buf[i];
+        p->verdict[i - cut] = p->verdict[i];
+    }
+    p->n -= cut;
+}
+
 /* One byte in: the Python parser's scan over the bytes held, each candidate's verdict kept once final. */
 static int vesc__push(vesc_parser_t *p, uint8_t byte, vesc_msg_t *out)
 {
@@ -2107,9 +2315,7 @@ static int vesc__push(vesc_parser_t *p, uint8_t byte, vesc_msg_t *out)
     uint32_t deferred = 0u;
     int got = 0, r;
     if (p->n >= VESC_MAX_FRAME) { /* only a candidate longer than VESC_MAX_FRAME can fill it: drop its first byte */
-        memmove(p->buf, p->buf + 1, p->n - 1u);
-        memmove(p->verdict, p->verdict + 1, p->n - 1u);
-        p->n--;
+        vesc__drop(p, 1u);
         p->garbage++;
         p->first = 0u;
     }
@@ -2156,9 +2362,7 @@ static int vesc__push(vesc_parser_t *p, uint8_t byte, vesc_msg_t *out)
     }
     p->garbage += (uint32_t)(cut - done);
     if (cut > 0u) {
-        memmove(p->buf, p->buf + cut, p->n - cut);
-        memmove(p->verdict, p->verdict + cut, p->n - cut);
-        p->n -= cut;
+        vesc__drop(p, cut);
         p->first = 0u;
     }
     return got;
@@ -2170,25 +2374,23 @@ static int vesc__push(vesc_parser_t *p, uint8_t byte, vesc_msg_t *out)
  * candidate could end first). Else 0: the bytes go through vesc__push. */
 static size_t vesc__whole(vesc_parser_t *p, const uint8_t *data, size_t len, vesc_msg_t *out)
 {
-    uint8_t count;
-    const vesc__layout_t *const *layouts = vesc__layouts(p->dir, &count);
-    const vesc__layout_t *L;
-    size_t i, size;
+    size_t i, size, hl;
+    const uint8_t *h;
     long s;
-    if (!VESC__SINGLE && count != 1u) {
+    if (!VESC__SINGLE && vesc__count(p->dir) != 1u) {
         return 0u;
     }
-    L = layouts[0];
-    if (len < L->header_len || !vesc__same(data, L->e[0].constant, L->header_len)) {
+    h = vesc__header(p->dir, 0u, &hl);
+    if (h == NULL || len < hl || !vesc__same(data, h, hl)) {
         return 0u;
     }
-    s = vesc__probe(L, p->dir, data, len);
+    s = vesc__probe_at(p->dir, 0u, data, len);
     if (s <= 0 || (unsigned long)s > VESC_MAX_FRAME || (size_t)s > len) {
         return 0u;
     }
     size = (size_t)s;
-    for (i = 1u; i + L->header_len <= size; i++) {
-        if (data[i] == L->e[0].constant[0] && vesc__same(data + i, L->e[0].constant, L->header_len)) {
+    for (i = 1u; i + hl <= size; i++) {
+        if (data[i] == h[0] && vesc__same(data + i, h, hl)) {
             return 0u;
         }
     }

@@ -2,7 +2,9 @@
 incremental parser) and `<p>_json.h`, `<p>_json.c` (a formatter for hosts, logs and tests).
 
 Everything comes from the resolved model. The frame layouts become static const tables that a small frame engine
-(engine.py, the runtime's framing.py as C) walks; each message's content becomes straight-line code. Features the
+(engine.py, the runtime's framing.py as C) walks to encode and to take stuffed frames apart; a layout without byte
+stuffing is also sized and taken apart by straight-line code (files.py), so a build that only parses and decodes
+carries no table; each message's content becomes straight-line code. Features the
 C target cannot generate yet raise Unsupported naming the feature (`serialspec generate --target c` refuses the spec).
 """
 

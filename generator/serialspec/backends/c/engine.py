@@ -102,7 +102,7 @@ static void pfx__put(uint8_t *b, uint8_t size, uint8_t big, uint32_t v)
 }
 #endif
 
-#if PFX_ENABLE_ENCODE || PFX__STUFFED || PFX_ENABLE_PARSER
+#if PFX_ENABLE_ENCODE || PFX__STUFFED
 /* The elements before the variable part (the stuffed span, else the content) and after it. */
 static uint8_t pfx__inner_first(const pfx__layout_t *L)
 {
@@ -483,7 +483,7 @@ static int pfx__unwrap(const pfx__layout_t *L, const uint8_t *frame, size_t n, u
 }
 #endif
 
-#if PFX_ENABLE_PARSER
+#if PFX_ENABLE_PARSER && PFX__STUFFED
 static int pfx__bounds(pfx_direction_t dir, long code, size_t *low, size_t *high, int *bounded);
 static long pfx__content_size(pfx_direction_t dir, long code, const uint8_t *c, size_t avail);
 

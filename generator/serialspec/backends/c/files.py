@@ -21,7 +21,7 @@ from serialspec.backends.c.emit import (
     value_elements,
 )
 from serialspec.backends.c.engine import ENGINE
-from serialspec.lang.model import VALUE_ROLES, Direction, FrameLayout, Message, Protocol, size_terms
+from serialspec.lang.model import VALUE_ROLES, Direction, FrameElement, FrameLayout, Message, Protocol, size_terms
 from serialspec.transforms.cobs import Cobs
 from serialspec.transforms.replace import Replace
 
@@ -284,16 +284,7 @@ def layout_tables(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) -
     if length >= 0:
         a, b = names.index(layout.elements[length].counts[0]), names.index(layout.elements[length].counts[1])
         counted = sum(sizes[a : b + 1])
-    prefix = 0
-    if ctx.protocol.framing.classic:  # stream.StreamParser: a candidate waits until its key and values have come
-        offset = 0
-        for e in layout.elements:
-            narrowed = e.type is not None and (e.minimum, e.maximum) != (e.type.minimum, e.type.maximum)
-            if e.role in ("length", "command") or (e.role in VALUE_ROLES and narrowed):
-                prefix = max(prefix, offset + (e.size or 0))
-            offset += e.size or 0
-            if e.role == "content":
-                break
+    prefix = _prefix(ctx, layout)
     lines.append(
         f"static const {p}__layout_t {name} = {{{name}_e, {len(layout.elements)}u, {content}, {command}, "
         f"{method}u, {tf}u, {tl}u, {pairs}, {pair_count}u, {header_len}u, {prefix}u, "
@@ -317,6 +308,114 @@ def _wire_value(where: tuple[bool, int], size: int, big: bool) -> str:
         f"((uint32_t){byte(i)} << {8 * (size - 1 - j)}u)" if j < size - 1 else f"(uint32_t){byte(i)}"
         for j, i in enumerate(order)
     )
+
+
+def _prefix(ctx: Ctx, layout: FrameLayout) -> int:
+    """How many bytes the classic parser (stream.StreamParser) waits for before it judges a candidate: until its key
+    and narrowed values have come (0 for the frame engine's parser)."""
+    prefix = 0
+    if ctx.protocol.framing.classic:
+        offset = 0
+        for e in layout.elements:
+            narrowed = e.type is not None and (e.minimum, e.maximum) != (e.type.minimum, e.type.maximum)
+            if e.role in ("length", "command") or (e.role in VALUE_ROLES and narrowed):
+                prefix = max(prefix, offset + (e.size or 0))
+            offset += e.size or 0
+            if e.role == "content":
+                break
+    return prefix
+
+
+def _range_test(e: FrameElement, value: str, size: int) -> str | None:
+    """The C test that a frame value is outside its element's range (None: every value of its size is in it)."""
+    test = []
+    if int(e.minimum) > 0:
+        test.append(f"{value} < {int(e.minimum)}u")
+    if int(e.maximum) < (1 << (8 * size)) - 1:
+        test.append(f"{value} > {int(e.maximum)}u")
+    if not test:
+        return None
+    cond = " || ".join(test)
+    if e.broadcast is not None:
+        cond = f"({cond}) && {value} != {e.broadcast}u"
+    return cond
+
+
+def straight_probe(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) -> str:
+    """The frame engine's probe (runtime/framing.py FrameCodec.probe; engine.py's table walk) for one layout without
+    byte stuffing, straight line: every offset known, the same verdicts in the same order (wait for the prefix, then
+    element by element before the content: wait, constant, command and its content bounds, value range; then the
+    size from the length element or the content's own size rule). The parser needs no table then."""
+    p, P = ctx.p, ctx.P
+    elements = layout.elements
+    names = [e.name for e in elements]
+    sizes = [len(e.constant) if e.role in ("header", "trailer", "constant") else e.size or 0 for e in elements]
+    content = next((i for i, e in enumerate(elements) if e.role == "content"), -1)
+    first = content if content >= 0 else len(elements)
+    command = next((i for i, e in enumerate(elements) if e.role == "command"), -1)
+    prefix = _prefix(ctx, layout)
+    error = ctx.protocol.error_reply
+    flag = error.flag if error is not None and direction == Direction.RESPONSE else 0
+    lines = [
+        f"/* The {direction.value} frame{' ' + layout.name if layout.name else ''}: probe, straight line. */",
+        f"static long {p}__probe_{direction.value}_{k}(const uint8_t *f, size_t avail)",
+        "{",
+        "    size_t low = 0u, high = 0u;",
+        "    int bounded = 0;",
+        f"    long code = {P}__NO_CODE;",
+        "    (void)code;",
+    ]
+    waited = prefix
+    if prefix:
+        lines.append(f"    if (avail < {prefix}u) {{ return {P}__WAIT; }}")
+    offset = 0
+    for i in range(first):
+        e, stop = elements[i], offset + sizes[i]
+        if stop > waited:
+            lines.append(f"    if (avail < {stop}u) {{ return {P}__WAIT; }}")
+            waited = stop
+        value = _wire_value((False, offset), sizes[i], e.endian == ">")
+        if e.role in ("header", "trailer", "constant"):
+            for j, byte in enumerate(e.constant):
+                lines.append(f"    if (f[{offset + j}u] != 0x{byte:02x}u) {{ return {P}__NONE; }} /* {e.name} */")
+        elif e.role == "command":
+            code = f"(({value}) & {flag}UL) != 0u ? {P}__ERROR_CODE : (long)({value})" if flag else f"(long)({value})"
+            lines.append(f"    code = {code}; /* {e.name} */")
+            lines.append(
+                f"    if (!{p}__bounds({P}_{direction.name}, code, &low, &high, &bounded)) {{ return {P}__NONE; }}"
+            )
+        elif e.role in VALUE_ROLES:
+            test = _range_test(e, "v", sizes[i])
+            if test is not None:
+                lines.append(f"    {{ uint32_t v = {value}; if ({test}) {{ return {P}__NONE; }} }} /* {e.name} */")
+        offset = stop
+    if command < 0:
+        lines.append(
+            f"    if (!{p}__bounds({P}_{direction.name}, {P}__NO_CODE, &low, &high, &bounded)) {{ return {P}__NONE; }}"
+        )
+    elif command > first:  # the code after the content: no bounds before the frame is taken apart
+        lines += ["    low = 0u;", "    bounded = 0;"]
+    length = next((i for i, e in enumerate(elements) if e.role == "length"), -1)
+    if length >= 0:
+        e = elements[length]
+        a, b = names.index(e.counts[0]), names.index(e.counts[1])
+        counted = sum(sizes[a : b + 1])
+        value = _wire_value((False, sum(sizes[:length])), sizes[length], e.endian == ">")
+        lines += [
+            f"    {{ long counted = (long)({value}) - {e.adds}L; /* {e.name} */",
+            f"      long content = counted - {counted}L;",
+            f"      if (content < (long)low || (bounded && content > (long)high)) {{ return {P}__NONE; }}",
+            f"      return {sum(sizes) - counted}L + counted; }}",
+        ]
+    else:
+        lines += [
+            f"    {{ long size = {p}__content_size({P}_{direction.name}, code, f + {offset}u, avail - {offset}u);",
+            "      if (size < 0) { return size; }",
+            f"      if ((size_t)size < low || (bounded && (size_t)size > high)) {{ return {P}__NONE; }}",
+            f"      return {sum(sizes)}L + size; }}",
+        ]
+    lines += ["}", ""]
+    return "\n".join(lines)
 
 
 def straight_unwrap(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) -> str:
@@ -438,9 +537,44 @@ def source(ctx: Ctx) -> str:
     encoders = "\n".join(encoder(ctx, m) for m in msgs)
     straight: list[str] = []
     unwrap_cases: list[str] = []
+    probes: list[str] = []
+    probe_cases: list[str] = []
+    header_arrays: list[str] = []
+    header_cases: list[str] = []
+    command_cases: list[str] = []
+    count_cases: list[str] = []
+    least_cases: list[str] = []
     for d in directions(protocol):
+        alternatives = protocol.framing.alternatives[d]
+        least_cases.append(f"    case {P}_{d.name}:\n        return {min(_prefix(ctx, a) for a in alternatives)}u;")
+        count_cases.append(f"    case {P}_{d.name}:\n        return {len(alternatives)}u;")
+        mask = sum(1 << k for k, layout in enumerate(alternatives) if layout.has_command)
+        command_cases.append(f"    case {P}_{d.name}:\n        return (({mask}UL >> k) & 1u) != 0u;")
+        hrows, prows = [], []
+        for k, layout in enumerate(alternatives):
+            if layout.header:
+                hname = f"{p}__h_{d.value}_{k}"
+                header_arrays.append(
+                    f"static const uint8_t {hname}[] = {{{', '.join(f'0x{b:02x}u' for b in layout.header)}}};"
+                )
+                size = len(layout.header)
+                hrows.append(f"        case {k}u:\n            *len = {size}u;\n            return {hname};")
+            if layout.transparency is None:
+                probes.append(straight_probe(ctx, d, k, layout))
+                prows.append(f"        case {k}u:\n            return {p}__probe_{d.value}_{k}(b, avail);")
+        header_cases.append(
+            f"    case {P}_{d.name}:\n        switch (k) {{\n"
+            + "".join(row + "\n" for row in hrows)
+            + "        default:\n            break;\n        }\n        break;"
+        )
+        if prows:
+            probe_cases.append(
+                f"    case {P}_{d.name}:\n        switch (k) {{\n"
+                + "\n".join(prows)
+                + "\n        default:\n            break;\n        }\n        break;"
+            )
         rows = []
-        for k, layout in enumerate(protocol.framing.alternatives[d]):
+        for k, layout in enumerate(alternatives):
             if layout.transparency is None:
                 straight.append(straight_unwrap(ctx, d, k, layout))
                 rows.append(
@@ -615,6 +749,26 @@ def source(ctx: Ctx) -> str:
         for d in directions(protocol)
     )
     any_stuffed = any(stuffed.values())
+    least, least_check = "", ""
+    if any(c.split("return ")[1] != "0u;" for c in least_cases):  # the classic parser waits for a prefix
+        least = f"""
+/* The fewest bytes any layout of the direction needs before the classic parser judges a candidate. */
+static size_t {p}__least({p}_direction_t dir)
+{{
+    switch (dir) {{
+{chr(10).join(least_cases)}
+    default:
+        return 0u;
+    }}
+}}
+"""
+        least_check = f"""
+        if (p->n - pos < {p}__least(p->dir)) {{ /* waiting, too short for any layout, and so is every later one */
+            if (hold == (size_t)-1) {{
+                hold = pos;
+            }}
+            break;
+        }}"""
     every = [layout for d in directions(protocol) for layout in protocol.framing.alternatives[d]]
     all_lengths = int(all(layout.length is not None for layout in every))
     single = int(all(n == 1 for n in n_layouts.values()))
@@ -640,6 +794,7 @@ typedef char {p}__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 #define {P}__STUFFED {int(any_stuffed)} /* some layout has byte stuffing */
 #define {P}__LENGTHS {all_lengths} /* every layout has a length element */
 #define {P}__SINGLE {single} /* one layout per direction */
+#define {P}__TABLES ({P}_ENABLE_ENCODE || {P}__STUFFED) /* the layouts as tables: encode and stuffing walk them */
 
 /* ---- checksums ---- */
 {check_defs}
@@ -655,7 +810,8 @@ static uint32_t {p}__check(uint8_t which, const uint8_t *d, size_t n)
 }}
 {engine}
 
-/* ---- the layouts of the spec ---- */
+#if {P}__TABLES
+/* ---- the layouts of the spec (what the encoder and the engine for stuffed layouts walk) ---- */
 {chr(10).join(tables)}
 {chr(10).join(layout_lists)}
 
@@ -669,9 +825,10 @@ static const {p}__layout_t *const *{p}__layouts({p}_direction_t dir, uint8_t *co
     }}
 }}
 #endif
+#endif
 
 {helpers}
-#if {P}_ENABLE_PARSER
+#if {P}_ENABLE_PARSER && ({P}__STUFFED || !{P}__LENGTHS)
 /* Frames without a length: the content size from its own leading fields, by code (WAIT: those have not come). */
 static long {p}__content_size({p}_direction_t dir, long code, const uint8_t *c, size_t avail)
 {{
@@ -685,7 +842,9 @@ static long {p}__content_size({p}_direction_t dir, long code, const uint8_t *c, 
         return {P}__NONE;
     }}
 }}
+#endif
 
+#if {P}_ENABLE_PARSER
 /* Content size bounds by command code: a candidate whose code or size is outside them is no frame. */
 static int {p}__bounds({p}_direction_t dir, long code, size_t *low, size_t *high, int *bounded)
 {{
@@ -695,16 +854,75 @@ static int {p}__bounds({p}_direction_t dir, long code, size_t *low, size_t *high
         return 0;
     }}
 }}
+
+/* ---- candidates sized: straight line where a layout has no byte stuffing, without the tables ---- */
+{chr(10).join(probes)}
+/* The size of a plausible frame of the direction's layout k at b[0..avail): {P}__WAIT for more bytes, {P}__NONE when
+ * none starts there. */
+static long {p}__probe_at({p}_direction_t dir, uint8_t k, const uint8_t *b, size_t avail)
+{{
+    switch (dir) {{
+{chr(10).join(probe_cases)}
+    default:
+        break;
+    }}
+#if {P}__STUFFED
+    {{
+        uint8_t count;
+        const {p}__layout_t *const *layouts = {p}__layouts(dir, &count);
+        return k < count ? {p}__probe(layouts[k], dir, b, avail) : {P}__NONE;
+    }}
+#else
+    (void)k;
+    (void)b;
+    (void)avail;
+    return {P}__NONE;
+#endif
+}}
 #endif
 
 #if {P}_ENABLE_DECODE
+/* ---- what the decoder and the parser ask of a layout, without the tables ---- */
+{chr(10).join(header_arrays)}
+
+/* How many layouts a direction has (0: no such direction). */
+static uint8_t {p}__count({p}_direction_t dir)
+{{
+    switch (dir) {{
+{chr(10).join(count_cases)}
+    default:
+        return 0u;
+    }}
+}}
+
+/* The leading constant of the direction's layout k (NULL and 0: none). */
+static const uint8_t *{p}__header({p}_direction_t dir, uint8_t k, size_t *len)
+{{
+    switch (dir) {{
+{chr(10).join(header_cases)}
+    default:
+        break;
+    }}
+    *len = 0u;
+    return NULL;
+}}
+
+/* 1 when the direction's layout k carries a command code. */
+static int {p}__has_command({p}_direction_t dir, uint8_t k)
+{{
+    switch (dir) {{
+{chr(10).join(command_cases)}
+    default:
+        return 0;
+    }}
+}}
+
 /* ---- frames taken apart: straight line where a layout has no byte stuffing ---- */
 {chr(10).join(straight)}
-static int {p}__unwrap_at({p}_direction_t dir, uint8_t k, const {p}__layout_t *L, const uint8_t *frame, size_t n,
+static int {p}__unwrap_at({p}_direction_t dir, uint8_t k, const uint8_t *frame, size_t n,
                           uint8_t *plain, uint32_t *code, uint32_t *values, const uint8_t **content, size_t *clen)
 {{
     (void)k;
-    (void)L;
     (void)plain;
     switch (dir) {{
 {chr(10).join(unwrap_cases)}
@@ -712,7 +930,14 @@ static int {p}__unwrap_at({p}_direction_t dir, uint8_t k, const {p}__layout_t *L
         break;
     }}
 #if {P}__STUFFED
-    return {p}__unwrap(L, frame, n, plain, code, values, content, clen);
+    {{
+        uint8_t count;
+        const {p}__layout_t *const *layouts = {p}__layouts(dir, &count);
+        if (k < count) {{
+            return {p}__unwrap(layouts[k], frame, n, plain, code, values, content, clen);
+        }}
+    }}
+    return {P}_E_ARG;
 #else
     return {P}_E_ARG;
 #endif
@@ -736,8 +961,6 @@ static int {p}__decode_content({p}_direction_t dir, long code, {p}_kind_t expect
 int {p}_decode_expect(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}_kind_t expect, {p}_msg_t *out)
 {{
     uint8_t count, k;
-    const {p}__layout_t *const *layouts;
-    const {p}__layout_t *L = NULL;
     uint32_t code = 0u, values[{P}__MAX_ELEMENTS] = {{0u}};
     const uint8_t *c = NULL;
     size_t clen = 0u;
@@ -747,30 +970,28 @@ int {p}_decode_expect(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}
         return {P}_E_ARG;
     }}
     out->kind = {P}_KIND_NONE;
-    layouts = {p}__layouts(dir, &count);
-    if (layouts == NULL) {{
+    count = {p}__count(dir);
+    if (count == 0u) {{
         return {P}_E_ARG;
     }}
     k = 0u;
-    if ({P}__SINGLE || count == 1u) {{
-        L = layouts[0];
-    }} else {{
+    if (!{P}__SINGLE && count != 1u) {{
         for (k = 0u; k < count; k++) {{
-            const {p}__layout_t *A = layouts[k];
-            if (A->header_len <= len && {p}__same(frame, A->e[0].constant, A->header_len)) {{
-                L = A;
+            size_t hl;
+            const uint8_t *h = {p}__header(dir, k, &hl);
+            if (hl <= len && {p}__same(frame, h, hl)) {{
                 break;
             }}
         }}
-        if (L == NULL) {{
+        if (k == count) {{
             return {P}_E_FRAME;
         }}
     }}
-    r = {p}__unwrap_at(dir, k, L, frame, len, plain, &code, values, &c, &clen);
+    r = {p}__unwrap_at(dir, k, frame, len, plain, &code, values, &c, &clen);
     if (r != {P}_OK) {{
         return r;
     }}
-    r = {p}__decode_content(dir, L->command >= 0 ? (long)code : {P}__NO_CODE, expect, c, clen, values, out);
+    r = {p}__decode_content(dir, {p}__has_command(dir, k) ? (long)code : {P}__NO_CODE, expect, c, clen, values, out);
     if (r != {P}_OK) {{
         out->kind = {P}_KIND_NONE;
     }}
@@ -866,8 +1087,7 @@ void {p}_parser_init({p}_parser_t *parser, {p}_direction_t dir)
 /* The candidate at pos: accepted (its size in *size, its message in out), waiting, no frame, or corrupt. */
 static int {p}__try({p}_parser_t *p, size_t pos, {p}_msg_t *out, size_t *size)
 {{
-    uint8_t count, k;
-    const {p}__layout_t *const *layouts = {p}__layouts(p->dir, &count);
+    uint8_t count = {p}__count(p->dir), k;
     int waiting = 0;
     if (p->verdict[pos] != 0u) {{
         return p->verdict[pos];
@@ -876,7 +1096,7 @@ static int {p}__try({p}_parser_t *p, size_t pos, {p}_msg_t *out, size_t *size)
         return {P}__V_WAIT;
     }}
     for (k = 0u; k < count; k++) {{
-        long s = {p}__probe(layouts[k], p->dir, p->buf + pos, p->n - pos);
+        long s = {p}__probe_at(p->dir, k, p->buf + pos, p->n - pos);
         if (pos == 0u && count == 1u && s > 0) {{
             p->first = (size_t)s;
         }}
@@ -911,8 +1131,7 @@ static int {p}__try({p}_parser_t *p, size_t pos, {p}_msg_t *out, size_t *size)
 static size_t {p}__next({p}_parser_t *p, size_t start)
 {{
 #if {P}__HEADERS
-    uint8_t count, k;
-    const {p}__layout_t *const *layouts = {p}__layouts(p->dir, &count);
+    uint8_t count = {p}__count(p->dir), k;
     size_t pos;
     for (pos = start; pos < p->n; pos++) {{
         int whole = 1; /* every header could be read here: a position none matches is never a candidate */
@@ -920,10 +1139,11 @@ static size_t {p}__next({p}_parser_t *p, size_t start)
             continue;
         }}
         for (k = 0u; k < count; k++) {{
-            const {p}__layout_t *L = layouts[k];
-            if (L->header_len > p->n - pos) {{
+            size_t hl;
+            const uint8_t *h = {p}__header(p->dir, k, &hl);
+            if (hl > p->n - pos) {{
                 whole = 0;
-            }} else if ({p}__same(p->buf + pos, L->e[0].constant, L->header_len)) {{
+            }} else if ({p}__same(p->buf + pos, h, hl)) {{
                 return pos;
             }}
         }}
@@ -938,6 +1158,22 @@ static size_t {p}__next({p}_parser_t *p, size_t start)
 #endif
 }}
 
+{least}
+/* The first cut bytes held dropped, with their verdicts: a loop, kept one (GCC would make it two calls of the
+ * library's memmove, which a parser-only build has no other use for). */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("no-tree-loop-distribute-patterns")))
+#endif
+static void {p}__drop({p}_parser_t *p, size_t cut)
+{{
+    size_t i;
+    for (i = cut; i < p->n; i++) {{
+        p->buf[i - cut] = p->buf[i];
+        p->verdict[i - cut] = p->verdict[i];
+    }}
+    p->n -= cut;
+}}
+
 /* One byte in: the Python parser's scan over the bytes held, each candidate's verdict kept once final. */
 static int {p}__push({p}_parser_t *p, uint8_t byte, {p}_msg_t *out)
 {{
@@ -945,9 +1181,7 @@ static int {p}__push({p}_parser_t *p, uint8_t byte, {p}_msg_t *out)
     uint32_t deferred = 0u;
     int got = 0, r;
     if (p->n >= {P}_MAX_FRAME) {{ /* only a candidate longer than {P}_MAX_FRAME can fill it: drop its first byte */
-        memmove(p->buf, p->buf + 1, p->n - 1u);
-        memmove(p->verdict, p->verdict + 1, p->n - 1u);
-        p->n--;
+        {p}__drop(p, 1u);
         p->garbage++;
         p->first = 0u;
     }}
@@ -958,7 +1192,7 @@ static int {p}__push({p}_parser_t *p, uint8_t byte, {p}_msg_t *out)
         pos = {p}__next(p, start);
         if (pos >= p->n) {{
             break;
-        }}
+        }}{least_check}
         r = {p}__try(p, pos, out, &size);
         if (r == {P}__V_WAIT) {{
             if (hold == (size_t)-1) {{
@@ -994,9 +1228,7 @@ static int {p}__push({p}_parser_t *p, uint8_t byte, {p}_msg_t *out)
     }}
     p->garbage += (uint32_t)(cut - done);
     if (cut > 0u) {{
-        memmove(p->buf, p->buf + cut, p->n - cut);
-        memmove(p->verdict, p->verdict + cut, p->n - cut);
-        p->n -= cut;
+        {p}__drop(p, cut);
         p->first = 0u;
     }}
     return got;
@@ -1008,25 +1240,23 @@ static int {p}__push({p}_parser_t *p, uint8_t byte, {p}_msg_t *out)
  * candidate could end first). Else 0: the bytes go through {p}__push. */
 static size_t {p}__whole({p}_parser_t *p, const uint8_t *data, size_t len, {p}_msg_t *out)
 {{
-    uint8_t count;
-    const {p}__layout_t *const *layouts = {p}__layouts(p->dir, &count);
-    const {p}__layout_t *L;
-    size_t i, size;
+    size_t i, size, hl;
+    const uint8_t *h;
     long s;
-    if (!{P}__SINGLE && count != 1u) {{
+    if (!{P}__SINGLE && {p}__count(p->dir) != 1u) {{
         return 0u;
     }}
-    L = layouts[0];
-    if (len < L->header_len || !{p}__same(data, L->e[0].constant, L->header_len)) {{
+    h = {p}__header(p->dir, 0u, &hl);
+    if (h == NULL || len < hl || !{p}__same(data, h, hl)) {{
         return 0u;
     }}
-    s = {p}__probe(L, p->dir, data, len);
+    s = {p}__probe_at(p->dir, 0u, data, len);
     if (s <= 0 || (unsigned long)s > {P}_MAX_FRAME || (size_t)s > len) {{
         return 0u;
     }}
     size = (size_t)s;
-    for (i = 1u; i + L->header_len <= size; i++) {{
-        if (data[i] == L->e[0].constant[0] && {p}__same(data + i, L->e[0].constant, L->header_len)) {{
+    for (i = 1u; i + hl <= size; i++) {{
+        if (data[i] == h[0] && {p}__same(data + i, h, hl)) {{
             return 0u;
         }}
     }}

@@ -140,6 +140,8 @@ class Message(Record):
     COMMAND: ClassVar[str]
     SUBCOMMAND: ClassVar[str | None]
     DIRECTION: ClassVar[Direction]
+    #: A response that answers another command's request (the spec's `answers`): that command and sub-command.
+    ANSWERS: ClassVar[tuple[str, str | None] | None] = None
 
     def to_fields(self) -> dict[str, Any]:
         """Field values as plain JSON-able data: raw wire values, nested objects as dicts, lists as lists."""

@@ -113,6 +113,14 @@ class Binding:
     encoders: Mapping[type, Callable[[Any], bytes]] = field(default_factory=dict)
 
 
+def answered(reply_type: type) -> tuple[str | None, str | None]:
+    """The command and sub-command of the request a reply type answers: its own, or the one its spec `answers`."""
+    answers = getattr(reply_type, "ANSWERS", None)
+    if answers is not None:
+        return answers  # type: ignore[no-any-return]
+    return getattr(reply_type, "COMMAND", None), getattr(reply_type, "SUBCOMMAND", None)
+
+
 def check_status(request: Message, reply: Message, name: str, ok: int, match_by: tuple[str, ...]) -> None:
     """A reply whose status field (the spec's `status: {ok: N}`) does not hold N is a device error."""
     value = getattr(reply, name)
@@ -595,10 +603,12 @@ class Bus:
         return replies
 
     def matches(self, request: Message, reply: Message) -> bool:
-        """The spec's matching rule: the named attributes are equal where both messages have them."""
-        if self._match_command and reply.COMMAND != request.COMMAND:
+        """The spec's matching rule: the named attributes are equal where both messages have them (a reply that
+        `answers` another command's request has that command's)."""
+        command, subcommand = answered(type(reply))
+        if self._match_command and command != request.COMMAND:
             return False
-        if self._match_subcommand and reply.SUBCOMMAND != request.SUBCOMMAND:
+        if self._match_subcommand and subcommand != request.SUBCOMMAND:
             return False
         for name in self._match_fields:
             mine = getattr(request, name, _ABSENT)
@@ -615,11 +625,9 @@ class Bus:
         reply_type = type(reply)
         rule = self._all_rules.get((request_type, reply_type))
         if rule is None:
-            possible = not (
-                self._match_command and getattr(reply_type, "COMMAND", None) != getattr(request_type, "COMMAND", None)
-            ) and not (
-                self._match_subcommand
-                and getattr(reply_type, "SUBCOMMAND", None) != getattr(request_type, "SUBCOMMAND", None)
+            command, subcommand = answered(reply_type)
+            possible = not (self._match_command and command != getattr(request_type, "COMMAND", None)) and not (
+                self._match_subcommand and subcommand != getattr(request_type, "SUBCOMMAND", None)
             )
             names = [n for n in self._match_fields if hasattr(request_type, n) and hasattr(reply_type, n)]
             getter = operator.attrgetter(*names) if names else None

@@ -393,6 +393,10 @@ class PackageCode:
             f"SUBCOMMAND: ClassVar[str | None] = {message.subcommand!r}",
             f"DIRECTION: ClassVar[Direction] = Direction.{message.direction.name}",
         ]
+        command, _, subcommand = message.answers.partition(".")
+        answers = (command, subcommand or None)
+        if command and answers != (message.command, message.subcommand):  # another request's: matched as that one
+            code.class_vars.append(f"ANSWERS: ClassVar[tuple[str, str | None] | None] = {answers!r}")
         code.to_fields = [f"{f.name!r}: {self.to_json(f, 'self.' + f.name)}," for f in fields]
         code.read_from([self.from_json(f) for f in fields])
         self.message_classes.append(code)

@@ -234,11 +234,14 @@ def test_a_mistyped_command_or_a_missing_direction_says_what_to_type(capsys: pyt
     assert capsys.readouterr().err.strip() == (
         "serialspec encode: fashionstar_uart has no request 'rotat' (did you mean rotate?)"
     )
-    assert main(["decode", "feetech_sms", "ff ff 01 04 00 09 03 ee"]) == 1
+    # a PING request that reads as a reply too (error 1, no data); a frame only one direction decodes needs none
+    assert main(["decode", "feetech_sms", "ff ff 01 02 01 fb"]) == 1
     assert capsys.readouterr().err.strip() == (
-        "serialspec decode: ff ff 01 04 00 09 03 ee: give the direction: requests and responses share the header "
+        "serialspec decode: ff ff 01 02 01 fb: give the direction: requests and responses share the header "
         "ff ff (--direction request|response)"
     )
+    assert main(["decode", "feetech_sms", "ff ff 01 04 00 09 03 ee"]) == 0
+    assert capsys.readouterr().out.startswith("feetech_sms response reply")
 
 
 @pytest.mark.parametrize("out", [".", "src", "build/out"])

@@ -39,6 +39,7 @@ from serialspec.lang.model import Message, Protocol
 from serialspec.lang.passes.fields import FIELD_KINDS
 from serialspec.lang.resolve import resolve
 from serialspec.runtime.transport import Bus
+from serialspec.transforms import transforms
 from strategies import message_fields
 from test_codec import check_against_construct
 
@@ -272,6 +273,49 @@ CASES: dict[str, Case] = {
             "transparency": {"span": ["code", "content"], "replace": {"C0": "DB DC", "DB": "DB DD"}},
         },
     ),
+    # HerkuleX: both checksums in the header; the first covers the whole frame but them (XOR & 0xFE), the second
+    # is computed from the first (~checksum1 & 0xFE)
+    "frame: checksums inside their span, a checksum of a checksum": Case(
+        {"v": "u16", "data": {"type": "bytes", "size": "rest"}},
+        {"v": "u8"},
+        {
+            "elements": {
+                "header": {"role": "header", "value": "FF FF"},
+                "size": {"role": "length", "type": "u8", "counts": ["id", "content"], "adds": 3},
+                "id": {"role": "address", "type": "u8", "range": [0, 253], "broadcast": 254},
+                "code": {"role": "command", "type": "u8"},
+                "checksum1": {
+                    "role": "checksum",
+                    "type": "u8",
+                    "algorithm": "xor",
+                    "mask": 0xFE,
+                    "covers": ["size", "content"],
+                },
+                "checksum2": {
+                    "role": "checksum",
+                    "type": "u8",
+                    "algorithm": "xor",
+                    "invert": True,
+                    "mask": 0xFE,
+                    "covers": ["checksum1", "checksum1"],
+                },
+                "content": {"role": "content"},
+            }
+        },
+    ),
+    "frame: ended by a terminator, no length": Case(
+        {"v": "u16", "data": {"type": "bytes", "size": "rest"}},
+        {"v": "u16"},
+        {
+            "elements": {
+                "header": {"role": "header", "value": "3A"},
+                "code": {"role": "command", "type": "u8"},
+                "content": {"role": "content"},
+                "checksum": {"role": "checksum", "type": "u8", "algorithm": "xor", "covers": ["code", "content"]},
+                "end": {"role": "trailer", "value": "0D"},
+            }
+        },
+    ),
     "frame: layouts": Case(
         {"data": {"type": "bytes", "size": "rest"}},
         {"data": {"type": "bytes", "size": "rest"}},
@@ -360,6 +404,14 @@ C_REFUSES = {
     "strings in group items": "padded strings",
     "scale and offset": "fields of type u24",
     "field named type": "fields of type u24",
+    "frame: checksums inside their span, a checksum of a checksum": "over a span that leaves out",
+    "frame: ended by a terminator, no length": "ended by its trailer alone",
+    "transform: replace, escaping after the start byte, over the length and checksum (XBee API mode 2)": (
+        "a length inside the transformed span"
+    ),
+    "transform: cobs, after a header, with a length inside the span (it counts the plain bytes)": (
+        "a length inside the transformed span"
+    ),
 }
 
 
@@ -400,9 +452,18 @@ def message_class(g: Generated, message: Message) -> Any:
 
 
 # Known to fail; each is a bug to fix, strict so that the fix is noticed (and the mark removed).
-KNOWN = {
-    "frame: transparency, checksum over exactly the span": "encode sums the stuffed bytes, decode the plain ones",
-}
+KNOWN: dict[str, str] = {}
+CASES["frame: transparency, a length of the span's plain bytes, the checksum inside it"] = Case(
+    CASES["frame: transparency"].request,
+    {"v": "u16"},
+    {
+        "elements": {
+            **CASES["frame: transparency"].framing["elements"],  # type: ignore[index]
+            "checksum": {"role": "checksum", "type": "u8", "algorithm": "sum", "covers": ["code", "content"]},
+        },
+        "transparency": {"span": ["code", "checksum"], "replace": {"C0": "DB DC", "DB": "DB DD"}},
+    },
+)
 CASES["frame: transparency, checksum over exactly the span"] = Case(
     {"v": "u16"},
     {"v": "u16"},
@@ -433,6 +494,12 @@ CASES["device: derived, locks, sends, moves.to"] = Case(
     },
 )
 DEVICE_KEYS = ("derived", "locks", "sends")  # the device keys a matrix case must use
+# Every documented option of every frame transform (serialspec/transforms/), as its sample framing.
+for _method, _transform in transforms().items():
+    for _sample in _transform.samples:
+        CASES[f"transform: {_method}, {_sample.label}"] = Case(
+            {"v": "u16", "data": {"type": "bytes", "size": "rest"}}, {"v": "u16"}, dict(_sample.framing)
+        )
 PARAMS = [
     pytest.param(name, marks=pytest.mark.xfail(reason=KNOWN[name], strict=True)) if name in KNOWN else name
     for name in sorted(CASES)
@@ -481,6 +548,12 @@ def test_every_documented_alternative_has_a_case() -> None:
     assert set(DEVICE_KEYS) <= set(grammar.DEVICE.keys) and set(DEVICE_KEYS) - used_device == set()
     field = grammar._FIELD_LONG
     element = grammar.FRAME_ELEMENT.keys
+    methods = {
+        case.framing["transparency"].get("method", "replace")
+        for case in CASES.values()
+        if case.framing and "transparency" in case.framing
+    }
+    assert set(transforms()) - methods == set()  # every frame transform (the grammar's `method` choices)
     assert set(FIELD_KINDS) - used["type"] == set()
     assert (set(grammar.FIELD_SCALAR_TYPES) | {"bit"}) - used["of"] == set()
     assert set(field["bit_order"].choices) - used["bit_order"] == set()  # type: ignore[attr-defined]
@@ -520,6 +593,8 @@ def c_target(g: Generated, built: Built, tmp_path: Path) -> None:
 
     if GCC is None:
         return
+    c_files = [path for path in built.files if path.startswith("c/matrix_case/")]
+    assert c_files, "C files"
     source = tmp_path / "c"
     source.mkdir()
     for path, text in built.files.items():

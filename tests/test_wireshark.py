@@ -331,9 +331,10 @@ def test_tshark_shows_random_messages_of_every_command_as_decode_does(g: Generat
     shown_as_decoded()
 
 
-def through_tshark(tmp_path: Path, specs: list[str], corrupt: bool = False) -> None:
+def through_tshark(tmp_path: Path, specs: list[str], corrupt: bool = False, twice: bool = False) -> None:
     """Specs (YAML texts, each its own protocol and dissector, all loaded in one tshark): a random message of every
-    command and direction, shown as decoded; with `corrupt`, each also with its last byte changed, flagged bad."""
+    command and direction, shown as decoded; with `corrupt`, each also with its last byte changed, flagged bad; with
+    `twice`, each frame twice in one packet (two frames found in it)."""
     assert TSHARK is not None
     from serialspec.backends.python import files as python_files
     from serialspec.backends.python.memory import imported
@@ -367,7 +368,10 @@ def through_tshark(tmp_path: Path, specs: list[str], corrupt: bool = False) -> N
                     frame = package.encode(cls.from_fields(fields))
                     message = package.decode(frame, spec.direction.value)
                     wanted.append((protocol, describe(protocol, message, frame, False, None)))
-                    lines.append(f"2026-11-25T10:00:00.000000+00:00 {spec.direction.value} {frame.hex(' ')}")
+                    if twice:
+                        wanted.append(wanted[-1])
+                    packet = frame + frame if twice else frame
+                    lines.append(f"2026-11-25T10:00:00.000000+00:00 {spec.direction.value} {packet.hex(' ')}")
                     if corrupt:
                         bad = frame[:-1] + bytes([frame[-1] ^ 0x5A])
                         wanted.append((protocol, {**wanted[-1][1], "checksum_ok": False, "hex": bad.hex(" ")}))
@@ -401,6 +405,22 @@ def test_tshark_shows_every_language_matrix_case_as_decode_does(tmp_path: Path) 
         for number, name in enumerate(names)
     ]
     through_tshark(tmp_path, specs)
+
+
+@pytest.mark.skipif(
+    TSHARK is None, reason="tshark is not installed (make generate installs it where it can: root and apt-get)"
+)
+def test_tshark_finds_two_frames_in_a_packet_of_every_transform_and_terminator(tmp_path: Path) -> None:
+    """Frames sized through a transform (serialspec/transforms/) or ended by a delimiter: two in one packet are two
+    frames, not one (the dissector sizes each as the stream parser does)."""
+    from test_language_matrix import CASES, spec_text
+
+    names = [name for name in sorted(CASES) if name.startswith(("transform: ", "frame: ended by", "frame: transp"))]
+    specs = [
+        spec_text(name, CASES[name]).replace("protocol: matrix_case", f"protocol: twice_{number}")
+        for number, name in enumerate(names)
+    ]
+    through_tshark(tmp_path, specs, twice=True)
 
 
 @pytest.mark.skipif(

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define DYNAMIXEL_P2_SPEC_SHA256 "f41f87712000aa17a2d567882e801bfa7804f42665ec8e1838216c4fdf1e37af"
+#define DYNAMIXEL_P2_SPEC_SHA256 "8626f42c4b17a3c11b48ed2fc47ec39bc479417b52fb1e1ba8f1f9477745bb2e"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef DYNAMIXEL_P2_ENABLE_ENCODE

@@ -43,7 +43,7 @@ static uint32_t fashionstar_uart__check(uint8_t which, const uint8_t *d, size_t 
 {
     switch (which) {
     case 0u:
-        return (uint32_t)(fashionstar_uart_sum8(0u, d, n));
+        return ((uint32_t)(fashionstar_uart_sum8(0u, d, n)) & 0xffu);
     default:
         return 0u;
     }
@@ -102,7 +102,7 @@ typedef struct {
     uint8_t count;
     int8_t content;    /* index of the content, -1 without */
     int8_t command;    /* index of the command code, -1 without */
-    uint8_t has_t;     /* transparency (byte stuffing) over elements t_first..t_last */
+    uint8_t has_t;     /* a transform over elements t_first..t_last: 1 substitution (pairs), 2 COBS; 0 none */
     uint8_t t_first;
     uint8_t t_last;
     const fashionstar_uart__pair_t *pairs;
@@ -171,6 +171,73 @@ static int fashionstar_uart__inner_last(const fashionstar_uart__layout_t *L)
 #endif
 
 #if FASHIONSTAR_UART_ENABLE_ENCODE || FASHIONSTAR_UART__STUFFED
+/* COBS (method: cobs): the plain bytes as a code byte before each run of up to 254 non-zero bytes (to_wire), or back
+ * (0 for bytes that are no COBS form: a 00, a run past the end). Decoding checks the form itself: with cmp (the
+ * re-encoding check of fashionstar_uart__rewrite) it is not repeated. */
+static int fashionstar_uart__cobs(int to_wire, const uint8_t *src, size_t n, uint8_t *dst, const uint8_t *cmp, size_t cap,
+                     size_t *out)
+{
+    size_t i, o = 0u;
+    if (to_wire && cmp != NULL) {
+        *out = cap;
+        return 1;
+    }
+    if (to_wire) {
+        size_t code_at = 0u;
+        uint8_t code = 1u;
+        if (cap < 1u) {
+            return 0;
+        }
+        o = 1u;
+        for (i = 0u; i < n; i++) {
+            if (src[i] != 0u) {
+                if (o >= cap) {
+                    return 0;
+                }
+                dst[o++] = src[i];
+                if (++code != 0xFFu) {
+                    continue;
+                }
+            }
+            dst[code_at] = code;
+            code_at = o;
+            if (o >= cap) {
+                return 0;
+            }
+            dst[o++] = 0u;
+            code = 1u;
+        }
+        dst[code_at] = code;
+        *out = o;
+        return 1;
+    }
+    if (n == 0u) {
+        return 0;
+    }
+    i = 0u;
+    while (i < n) {
+        size_t code = src[i], j;
+        if (code == 0u || i + code > n) {
+            return 0;
+        }
+        for (j = 1u; j < code; j++) {
+            if (src[i + j] == 0u || o >= cap) {
+                return 0;
+            }
+            dst[o++] = src[i + j];
+        }
+        i += code;
+        if (code < 0xFFu && i < n) {
+            if (o >= cap) {
+                return 0;
+            }
+            dst[o++] = 0u;
+        }
+    }
+    *out = o;
+    return 1;
+}
+
 /* Each plain sequence rewritten as its wire sequence (to_wire) or back, leftmost first, the pairs tried in order at
  * each position. With cmp: compare the result with cmp[0..cap) instead of writing it (1: equal). */
 static int fashionstar_uart__rewrite(const fashionstar_uart__layout_t *L, int to_wire, const uint8_t *src, size_t n, uint8_t *dst,
@@ -178,6 +245,9 @@ static int fashionstar_uart__rewrite(const fashionstar_uart__layout_t *L, int to
 {
     size_t i = 0u, o = 0u;
     uint8_t k;
+    if (L->has_t == 2u) {
+        return fashionstar_uart__cobs(to_wire, src, n, dst, cmp, cap, out);
+    }
     while (i < n) {
         int matched = 0;
         for (k = 0u; k < L->npairs; k++) {
@@ -384,7 +454,7 @@ static int fashionstar_uart__unwrap(const fashionstar_uart__layout_t *L, const u
     if (FASHIONSTAR_UART__T(L)) {
         size_t pn, fixed = 0u, p = 0u;
         if (!fashionstar_uart__rewrite(L, 0, frame + before, n - before - after, plain, NULL, FASHIONSTAR_UART_MAX_FRAME, &pn)) {
-            return FASHIONSTAR_UART_E_CAPACITY;
+            return L->has_t == 2u ? FASHIONSTAR_UART_E_FRAME : FASHIONSTAR_UART_E_CAPACITY; /* COBS: no COBS form (never longer than it) */
         }
         if (!fashionstar_uart__rewrite(L, 1, plain, pn, NULL, frame + before, n - before - after, &sz)) {
             return FASHIONSTAR_UART_E_FRAME; /* bad stuffing: not the stuffed form of any bytes */

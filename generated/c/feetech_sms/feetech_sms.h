@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define FEETECH_SMS_SPEC_SHA256 "6ca405cda6e37c15a1f46ba17b0264d193db61f52a0ae145211802843346ab39"
+#define FEETECH_SMS_SPEC_SHA256 "01de7dae6b31576700164699cf8f750bc4b5b2fba92c04e9857c21f3d215b6cc"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef FEETECH_SMS_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define HIWONDER_RRC_SPEC_SHA256 "9b57dec37ebaa410e2e024dcfea3004ce2c2f3e25f89ab136babea5254056336"
+#define HIWONDER_RRC_SPEC_SHA256 "bebdabd497a7965ff8d83907820e56cf69c56c8989fd1a2d5f813aced231bbfc"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef HIWONDER_RRC_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define VESC_SPEC_SHA256 "7e47cdee4327160dbc768738fb6e68fade8a0fcdfb07f337ae32206d6e75856b"
+#define VESC_SPEC_SHA256 "82bf2ef3b3564067cbfdb077b6363d71b1b62e1b9b503dbdb418827f353fd528"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef VESC_ENABLE_ENCODE

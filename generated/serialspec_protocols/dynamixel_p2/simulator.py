@@ -191,11 +191,11 @@ DEVICE = DeviceSpec(
         # fast_sync_read
         CommandSpec(FastSyncReadRequest, None),
         # sync_write
-        CommandSpec(SyncWriteRequest, None, writes=('data',), moves=('position', 'goal_position', '', 'profile_velocity'), speed_scale=15.6331, move_enabled_by='torque_enable', move_to=lambda get: (get('goal_position') - get('homing_offset')), each='servos', tables={'data': ('run', 'address', '')}),
+        CommandSpec(SyncWriteRequest, None, writes=('data',), moves=('position', 'goal_position', '', 'profile_velocity'), speed_scale=15.6331, move_enabled_by='torque_enable', move_to=lambda get: (get('goal_position') - get('homing_offset')), each='servos', tables={'data': ('run', 'address', 'length')}),
         # bulk_read
         CommandSpec(BulkReadRequest, StatusResponse, reads=('data',), each='reads', tables={'data': ('run', 'address', 'length')}),
         # bulk_write
-        CommandSpec(BulkWriteRequest, None, writes=('data',), moves=('position', 'goal_position', '', 'profile_velocity'), speed_scale=15.6331, move_enabled_by='torque_enable', move_to=lambda get: (get('goal_position') - get('homing_offset')), each='writes', tables={'data': ('run', 'address', '')}),
+        CommandSpec(BulkWriteRequest, None, writes=('data',), moves=('position', 'goal_position', '', 'profile_velocity'), speed_scale=15.6331, move_enabled_by='torque_enable', move_to=lambda get: (get('goal_position') - get('homing_offset')), each='writes', tables={'data': ('run', 'address', 'length')}),
     ),
     registers=CONTROL_TABLE,
     status={'error.alert': 'hardware_error_status'},

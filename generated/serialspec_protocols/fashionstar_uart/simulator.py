@@ -108,37 +108,37 @@ DEVICE = DeviceSpec(
     errors={'out_of_space': {'result': 0.0}, 'out_of_range': {'result': 0.0}, 'read_only': {'result': 0.0}},
     commands=(
         # ping
-        CommandSpec(PingRequest, PingResponse),
+        CommandSpec(PingRequest, PingResponse, echoes=('servo_id',)),
         # reset_user_data
-        CommandSpec(ResetUserDataRequest, ResetUserDataResponse, resets=True),
+        CommandSpec(ResetUserDataRequest, ResetUserDataResponse, resets=True, echoes=('servo_id',)),
         # read_data
-        CommandSpec(ReadDataRequest, ReadDataResponse, reads=('data',), tables={'data': ('value', 'data_id')}),
+        CommandSpec(ReadDataRequest, ReadDataResponse, reads=('data',), tables={'data': ('value', 'data_id')}, echoes=('servo_id', 'data_id')),
         # write_data
-        CommandSpec(WriteDataRequest, WriteDataResponse, writes=('data',), tables={'data': ('value', 'data_id')}),
+        CommandSpec(WriteDataRequest, WriteDataResponse, writes=('data',), tables={'data': ('value', 'data_id')}, echoes=('servo_id', 'data_id')),
         # read_batch_data
-        CommandSpec(ReadBatchDataRequest, ReadBatchDataResponse, reads=('user_data',), tables={'user_data': ('block', 'reserved_32', 'response_switch', 'servo_id', 'reserved_35', 'baudrate', 'stall_protect_mode', 'stall_power_limit', 'over_volt_low', 'over_volt_high', 'over_temperature', 'over_power', 'over_current', 'accel_switch', 'reserved_45', 'po_lock_switch', 'wb_lock_switch', 'angle_limit_switch', 'soft_start_switch', 'soft_start_time', 'angle_limit_high', 'angle_limit_low', 'angle_mid_offset')}),
+        CommandSpec(ReadBatchDataRequest, ReadBatchDataResponse, reads=('user_data',), tables={'user_data': ('block', 'reserved_32', 'response_switch', 'servo_id', 'reserved_35', 'baudrate', 'stall_protect_mode', 'stall_power_limit', 'over_volt_low', 'over_volt_high', 'over_temperature', 'over_power', 'over_current', 'accel_switch', 'reserved_45', 'po_lock_switch', 'wb_lock_switch', 'angle_limit_switch', 'soft_start_switch', 'soft_start_time', 'angle_limit_high', 'angle_limit_low', 'angle_mid_offset')}, echoes=('servo_id',)),
         # write_batch_data
-        CommandSpec(WriteBatchDataRequest, WriteBatchDataResponse, writes=('user_data',), tables={'user_data': ('block', 'reserved_32', 'response_switch', 'servo_id', 'reserved_35', 'baudrate', 'stall_protect_mode', 'stall_power_limit', 'over_volt_low', 'over_volt_high', 'over_temperature', 'over_power', 'over_current', 'accel_switch', 'reserved_45', 'po_lock_switch', 'wb_lock_switch', 'angle_limit_switch', 'soft_start_switch', 'soft_start_time', 'angle_limit_high', 'angle_limit_low', 'angle_mid_offset')}),
+        CommandSpec(WriteBatchDataRequest, WriteBatchDataResponse, writes=('user_data',), tables={'user_data': ('block', 'reserved_32', 'response_switch', 'servo_id', 'reserved_35', 'baudrate', 'stall_protect_mode', 'stall_power_limit', 'over_volt_low', 'over_volt_high', 'over_temperature', 'over_power', 'over_current', 'accel_switch', 'reserved_45', 'po_lock_switch', 'wb_lock_switch', 'angle_limit_switch', 'soft_start_switch', 'soft_start_time', 'angle_limit_high', 'angle_limit_low', 'angle_mid_offset')}, echoes=('servo_id',)),
         # spin
-        CommandSpec(SpinRequest, SpinResponse, optional_when=('response_switch', 1, '==')),
+        CommandSpec(SpinRequest, SpinResponse, optional_when=('response_switch', 1, '=='), echoes=('servo_id',)),
         # rotate
-        CommandSpec(RotateRequest, RotateResponse, moves=('angle', 'angle', 'interval', ''), held_while='holding', optional_when=('response_switch', 1, '=='), after='interval'),
+        CommandSpec(RotateRequest, RotateResponse, moves=('angle', 'angle', 'interval', ''), held_while='holding', optional_when=('response_switch', 1, '=='), after='interval', echoes=('servo_id',)),
         # damping
-        CommandSpec(DampingRequest, DampingResponse, optional_when=('response_switch', 1, '==')),
+        CommandSpec(DampingRequest, DampingResponse, optional_when=('response_switch', 1, '=='), echoes=('servo_id',)),
         # read_angle
-        CommandSpec(ReadAngleRequest, ReadAngleResponse, reports={'angle': 'angle'}),
+        CommandSpec(ReadAngleRequest, ReadAngleResponse, reports={'angle': 'angle'}, echoes=('servo_id',)),
         # move_by_interval
-        CommandSpec(MoveByIntervalRequest, MoveByIntervalResponse, moves=('angle', 'angle', 'interval', ''), ramp=('t_acc', 't_dec'), held_while='holding', optional_when=('response_switch', 1, '==')),
+        CommandSpec(MoveByIntervalRequest, MoveByIntervalResponse, moves=('angle', 'angle', 'interval', ''), ramp=('t_acc', 't_dec'), held_while='holding', optional_when=('response_switch', 1, '=='), echoes=('servo_id',)),
         # move_by_velocity
-        CommandSpec(MoveByVelocityRequest, MoveByVelocityResponse, moves=('angle', 'angle', '', 'velocity'), ramp=('t_acc', 't_dec'), held_while='holding', optional_when=('response_switch', 1, '==')),
+        CommandSpec(MoveByVelocityRequest, MoveByVelocityResponse, moves=('angle', 'angle', '', 'velocity'), ramp=('t_acc', 't_dec'), held_while='holding', optional_when=('response_switch', 1, '=='), echoes=('servo_id',)),
         # move_mturn
-        CommandSpec(MoveMturnRequest, MoveMturnResponse, moves=('angle', 'angle', 'interval', ''), held_while='holding', optional_when=('response_switch', 1, '==')),
+        CommandSpec(MoveMturnRequest, MoveMturnResponse, moves=('angle', 'angle', 'interval', ''), held_while='holding', optional_when=('response_switch', 1, '=='), echoes=('servo_id',)),
         # move_mturn_by_interval
-        CommandSpec(MoveMturnByIntervalRequest, MoveMturnByIntervalResponse, moves=('angle', 'angle', 'interval', ''), ramp=('t_acc', 't_dec'), held_while='holding', optional_when=('response_switch', 1, '==')),
+        CommandSpec(MoveMturnByIntervalRequest, MoveMturnByIntervalResponse, moves=('angle', 'angle', 'interval', ''), ramp=('t_acc', 't_dec'), held_while='holding', optional_when=('response_switch', 1, '=='), echoes=('servo_id',)),
         # move_mturn_by_velocity
-        CommandSpec(MoveMturnByVelocityRequest, MoveMturnByVelocityResponse, moves=('angle', 'angle', '', 'velocity'), ramp=('t_acc', 't_dec'), held_while='holding', optional_when=('response_switch', 1, '==')),
+        CommandSpec(MoveMturnByVelocityRequest, MoveMturnByVelocityResponse, moves=('angle', 'angle', '', 'velocity'), ramp=('t_acc', 't_dec'), held_while='holding', optional_when=('response_switch', 1, '=='), echoes=('servo_id',)),
         # read_mturn_angle
-        CommandSpec(ReadMturnAngleRequest, ReadMturnAngleResponse, reports={'angle': 'angle'}, counts={'turns': ('angle', 3600.0)}),
+        CommandSpec(ReadMturnAngleRequest, ReadMturnAngleResponse, reports={'angle': 'angle'}, counts={'turns': ('angle', 3600.0)}, echoes=('servo_id',)),
         # reset_mturn_angle
         CommandSpec(ResetMturnAngleRequest, None, wraps={'angle': 3600.0}),
         # begin_async
@@ -146,7 +146,7 @@ DEVICE = DeviceSpec(
         # end_async
         CommandSpec(EndAsyncRequest, None, every_device=True, releases='holding', cancel_when={'mode': 1.0}),
         # monitor
-        CommandSpec(MonitorRequest, MonitorResponse, reports={'voltage': 'voltage', 'current': 'current', 'power': 'power', 'temperature': 'temperature', 'status': 'servo_status', 'angle': 'angle'}, counts={'turns': ('angle', 3600.0)}),
+        CommandSpec(MonitorRequest, MonitorResponse, reports={'voltage': 'voltage', 'current': 'current', 'power': 'power', 'temperature': 'temperature', 'status': 'servo_status', 'angle': 'angle'}, counts={'turns': ('angle', 3600.0)}, echoes=('servo_id',)),
         # set_origin_point
         CommandSpec(SetOriginPointRequest, None, sets={'angle': 0.0}),
         # stop_on_control_mode

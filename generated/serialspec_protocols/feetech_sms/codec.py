@@ -8,6 +8,7 @@ from collections.abc import Callable
 
 from serialspec.runtime.checksums import BYTE_VALUES as _BYTES
 from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError, content_size_error, out_of_range
+from serialspec.runtime.errors import either_direction as _either
 from serialspec.runtime.fields import wrong_type
 from serialspec.runtime.message import Direction, Message, members
 from serialspec.runtime.message import build as _new  # a message from the tuple of its field values, in one call
@@ -520,7 +521,7 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
     if direction == 'response':  # its value as text
         return decode(data, _RESPONSE, expect)
     if direction is None:  # last: a caller that knows the direction does not pay for this
-        raise DecodeError("give the direction: requests and responses share the header ff ff")
+        return _either(lambda d: decode(data, d, expect), "give the direction: requests and responses share the header ff ff")
     raise ValueError(f"direction must be request or response, not {direction!r}")
 
 

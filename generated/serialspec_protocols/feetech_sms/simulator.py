@@ -107,7 +107,7 @@ DEVICE = DeviceSpec(
         # sync_read
         CommandSpec(SyncReadRequest, ReplyResponse, reads=('data',), each='ids', tables={'data': ('run', 'address', 'length')}),
         # sync_write
-        CommandSpec(SyncWriteRequest, None, writes=('data',), moves=('present_position', 'goal_position', 'goal_time', 'goal_speed'), each='servos', tables={'data': ('run', 'address', '')}),
+        CommandSpec(SyncWriteRequest, None, writes=('data',), moves=('present_position', 'goal_position', 'goal_time', 'goal_speed'), each='servos', tables={'data': ('run', 'address', 'data_length')}),
     ),
     registers=CONTROL_TABLE,
     status={'error': 'status'},

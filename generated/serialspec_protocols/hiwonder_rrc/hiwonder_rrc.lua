@@ -2837,6 +2837,69 @@ local function rewrite(data, pairs_, from, to)
   return table.concat(out)
 end
 
+local function cobs_decode(wire)
+  -- the plain bytes of COBS bytes (a code byte before each run of non-zero bytes), nil when they are none
+  local out, i = {}, 1
+  if #wire == 0 then return nil end
+  while i <= #wire do
+    local code = wire:byte(i)
+    if code == 0 or i + code - 1 > #wire then return nil end
+    local run = wire:sub(i + 1, i + code - 1)
+    if run:find("\0", 1, true) then return nil end
+    out[#out + 1] = run
+    i = i + code
+    if code < 255 and i <= #wire then out[#out + 1] = "\0" end
+  end
+  return table.concat(out)
+end
+
+local function untransform(t, wire)
+  -- the plain bytes of a transformed span (serialspec/transforms/: replace, cobs); an error when there are none
+  if t.method == "cobs" then
+    local plain = cobs_decode(wire)
+    if plain == nil then error("bad COBS: not the COBS form of any bytes", 0) end
+    return plain
+  end
+  local plain = rewrite(wire, t.replace, 2, 1)
+  if rewrite(plain, t.replace, 1, 2) ~= wire then
+    error("bad byte stuffing: not the stuffed form of any bytes", 0)
+  end
+  return plain
+end
+
+local function plain_prefix(t, data, pos, count)
+  -- the first `count` plain bytes of the span at data[pos] and the wire bytes they take (fewer where a COBS span
+  -- ends first); false while the packet ends first, nil when no transformed bytes start there
+  local out, i, n = {}, pos, 0
+  while n < count do
+    if i > #data then return false end
+    if t.method == "cobs" then
+      local code = data:byte(i)
+      if code == 0 then break end
+      if i + code - 1 > #data then return false end
+      local run = data:sub(i + 1, i + code - 1)
+      if run:find("\0", 1, true) then return nil end
+      out[#out + 1], n, i = run, n + #run, i + code
+      if code < 255 and n < count then
+        if i > #data then return false end
+        if data:byte(i) ~= 0 then out[#out + 1], n = "\0", n + 1 end
+      end
+    else
+      local matched = false
+      for _, pair in ipairs(t.replace) do
+        local wire = pair[2]
+        if data:sub(i, i + #wire - 1) == wire then
+          out[#out + 1], n, i, matched = pair[1], n + #pair[1], i + #wire, true
+          break
+        end
+        if i + #wire - 1 > #data and wire:sub(1, #data - i + 1) == data:sub(i) then return false end
+      end
+      if not matched then out[#out + 1], n, i = data:sub(i, i), n + 1, i + 1 end
+    end
+  end
+  return table.concat(out):sub(1, count), i - pos
+end
+
 local function unsigned(data, big)
   local value = 0
   for i = 1, #data do
@@ -3080,6 +3143,30 @@ local function plausible(element, value)
   return (value >= element.min and value <= element.max) or value == element.broadcast
 end
 
+-- Whether `frame`, of an untransformed `layout`, has its constants and checksums right (each element's bytes found
+-- from the frame's start before the content, from its end after it).
+local function frame_checks(layout, frame)
+  local parts = {}
+  for index, element in ipairs(layout.elements) do
+    if layout.before[index] and index < layout.first then
+      parts[index] = frame:sub(layout.before[index] + 1, layout.before[index] + element.size)
+    elseif layout.after[index] and index > layout.last then
+      local stop = #frame - layout.after[index]
+      parts[index] = frame:sub(stop - element.size + 1, stop)
+    else
+      parts[index] = frame:sub(layout.prefix + 1, #frame - layout.suffix)
+    end
+  end
+  for index, element in ipairs(layout.elements) do
+    if element.constant and parts[index] ~= element.constant then return false end
+    if element.role == "checksum" and not element.checksum.unverified then
+      local covered = table.concat(parts, "", element.span[1], element.span[2])
+      if checksum(element.checksum, element.size, covered) ~= unsigned(parts[index], element.big) then return false end
+    end
+  end
+  return true
+end
+
 -- The size of a frame of `layout` at data[pos], nil when none starts there, false when the packet ends first.
 local function frame_size(direction, layout, data, pos)
   local available = #data - pos + 1
@@ -3102,6 +3189,26 @@ local function frame_size(direction, layout, data, pos)
     has_command = has_command or element.role == "command"
   end
   if not has_command then entry = direction.codes.none end
+  local inner = layout.inner_length
+  if inner then -- a length of plain bytes within the transformed span: read through the transform
+    local t, element = layout.transparency, layout.elements[inner.index]
+    local value
+    if inner.in_span then
+      local head = plain_prefix(t, data, pos + layout.prefix, inner.at + element.size)
+      if head == false then return false end
+      if head == nil or #head < inner.at + element.size then return nil end
+      value = unsigned(head:sub(inner.at + 1, inner.at + element.size), element.big)
+    else
+      if available < inner.at + element.size then return false end
+      value = unsigned(data:sub(pos + inner.at, pos + inner.at + element.size - 1), element.big)
+    end
+    local counted = value - element.adds
+    if counted < inner.counted_fixed then return nil end
+    local whole, used = plain_prefix(t, data, pos + layout.prefix, inner.uncounted + counted)
+    if whole == false then return false end
+    if whole == nil or #whole < inner.uncounted + counted then return nil end
+    return layout.prefix + used + layout.suffix, entry
+  end
   for index, element in ipairs(layout.elements) do
     if element.role == "length" then
       local offset, first, last = layout.before[index], element.span[1], element.span[2]
@@ -3111,6 +3218,12 @@ local function frame_size(direction, layout, data, pos)
       if counted < 0 then return nil end
       return layout.before[first] + counted + layout.after[last], entry
     end
+  end
+  local final = layout.elements[#layout.elements]
+  if layout.transparency and final.role == "trailer" and #layout.elements > 1 then -- ended by its delimiter
+    local stop = data:find(final.constant, pos + layout.prefix, true)
+    if stop == nil then return false end
+    return stop + #final.constant - pos, entry
   end
   if entry == nil then return nil end
   local content
@@ -3124,6 +3237,15 @@ local function frame_size(direction, layout, data, pos)
       if at + term[2] - 1 > #data then return false end
       content = content + term[4] * unsigned(data:sub(at, at + term[2] - 1), term[3])
     end
+  elseif final.role == "trailer" and #layout.elements > 1 then
+    -- ended by its trailer alone: the first one at which the frame checks (runtime/framing.py _terminated)
+    local stop = data:find(final.constant, pos + layout.overhead - #final.constant, true)
+    while stop do
+      local size = stop + #final.constant - pos
+      if frame_checks(layout, data:sub(pos, pos + size - 1)) then return size, entry end
+      stop = data:find(final.constant, stop + 1, true)
+    end
+    return false
   else
     return available, entry -- sized by nothing but the packet: the rest of it
   end
@@ -3137,6 +3259,18 @@ local function wire_of(layout, plain, stuffed, first, last)
     return table.concat(plain, "", first, last)
   end
   return table.concat(plain, "", first, t.first - 1) .. stuffed .. table.concat(plain, "", t.last + 1, last)
+end
+
+local function covered_by(layout, plain, stuffed, element)
+  -- the bytes a checksum covers: its span's, less the elements it leaves out (checksums inside it, never stuffed)
+  if element.skip == nil then
+    return wire_of(layout, plain, stuffed, element.span[1], element.span[2])
+  end
+  local parts = {}
+  for i = element.span[1], element.span[2] do
+    if not element.skip[i] then parts[#parts + 1] = plain[i] end
+  end
+  return table.concat(parts)
 end
 
 local function decode_content(message, range, length, tree)
@@ -3173,10 +3307,7 @@ local function dissect_frame(direction_name, direction, layout, entry, tvb, data
   local t = layout.transparency
   if t then
     stuffed = middle
-    middle = rewrite(stuffed, t.replace, 2, 1)
-    if rewrite(middle, t.replace, 1, 2) ~= stuffed then
-      error("bad byte stuffing: not the stuffed form of any bytes", 0)
-    end
+    middle = untransform(t, stuffed)
     if #middle > 0 then
       inner = ByteArray.new(middle, true):tvb("Unstuffed " .. P .. " frame")
     end
@@ -3249,7 +3380,7 @@ local function dissect_frame(direction_name, direction, layout, entry, tvb, data
         end
       elseif role == "checksum" then
         local expected = not element.checksum.unverified and checksum(element.checksum, element.size,
-          wire_of(layout, plain, stuffed, element.span[1], element.span[2]))
+          covered_by(layout, plain, stuffed, element))
         if not expected then
           item:append_text(" [not verified: this dissector has no code for algorithm " .. element.checksum.algorithm
             .. "]")

@@ -102,23 +102,23 @@ DEVICE = DeviceSpec(
         # pwm_servo.set_position
         CommandSpec(PwmServoSetPositionRequest, None, moves=('pulse', 'pulse', 'duration', ''), kind='pwm_servo'),
         # pwm_servo.read_position
-        CommandSpec(PwmServoReadPositionRequest, PwmServoReadPositionResponse, reports={'pulse': 'pulse'}, kind='pwm_servo'),
+        CommandSpec(PwmServoReadPositionRequest, PwmServoReadPositionResponse, reports={'pulse': 'pulse'}, kind='pwm_servo', echoes=('servo_id',)),
         # pwm_servo.set_offset
         CommandSpec(PwmServoSetOffsetRequest, None, writes=('offset',), kind='pwm_servo'),
         # pwm_servo.read_offset
-        CommandSpec(PwmServoReadOffsetRequest, PwmServoReadOffsetResponse, reports={'offset': 'offset'}, kind='pwm_servo'),
+        CommandSpec(PwmServoReadOffsetRequest, PwmServoReadOffsetResponse, reports={'offset': 'offset'}, kind='pwm_servo', echoes=('servo_id',)),
         # bus_servo.set_positions
         CommandSpec(BusServoSetPositionsRequest, None, moves=('position', 'position', 'duration', ''), each='bus_servos'),
         # bus_servo.read_position
-        CommandSpec(BusServoReadPositionRequest, BusServoReadPositionResponse, reports={'position': 'position'}, broadcast_reply=True, absent={'success': -1.0}),
+        CommandSpec(BusServoReadPositionRequest, BusServoReadPositionResponse, reports={'position': 'position'}, broadcast_reply=True, absent={'success': -1.0}, echoes=('servo_id',)),
         # bus_servo.read_voltage
-        CommandSpec(BusServoReadVoltageRequest, BusServoReadVoltageResponse, reports={'voltage': 'voltage'}, broadcast_reply=True, absent={'success': -1.0}),
+        CommandSpec(BusServoReadVoltageRequest, BusServoReadVoltageResponse, reports={'voltage': 'voltage'}, broadcast_reply=True, absent={'success': -1.0}, echoes=('servo_id',)),
         # bus_servo.read_temperature
-        CommandSpec(BusServoReadTemperatureRequest, BusServoReadTemperatureResponse, reports={'temperature': 'temperature'}, broadcast_reply=True, absent={'success': -1.0}),
+        CommandSpec(BusServoReadTemperatureRequest, BusServoReadTemperatureResponse, reports={'temperature': 'temperature'}, broadcast_reply=True, absent={'success': -1.0}, echoes=('servo_id',)),
         # bus_servo.stop
         CommandSpec(BusServoStopRequest, None, each='servos', stops=('position',)),
         # bus_servo.read_torque
-        CommandSpec(BusServoReadTorqueRequest, BusServoReadTorqueResponse, reports={'torque': 'torque'}, broadcast_reply=True, absent={'success': -1.0}),
+        CommandSpec(BusServoReadTorqueRequest, BusServoReadTorqueResponse, reports={'torque': 'torque'}, broadcast_reply=True, absent={'success': -1.0}, echoes=('servo_id',)),
         # bus_servo.unload
         CommandSpec(BusServoUnloadRequest, None, sets={'torque': 0.0}),
         # bus_servo.load
@@ -126,25 +126,25 @@ DEVICE = DeviceSpec(
         # bus_servo.set_id
         CommandSpec(BusServoSetIdRequest, None, stores={'new_id': 'id'}),
         # bus_servo.read_id
-        CommandSpec(BusServoReadIdRequest, BusServoReadIdResponse, reports={'id': 'id'}, broadcast_reply=True, absent={'success': -1.0}),
+        CommandSpec(BusServoReadIdRequest, BusServoReadIdResponse, reports={'id': 'id'}, broadcast_reply=True, absent={'success': -1.0}, echoes=('servo_id',)),
         # bus_servo.set_offset
         CommandSpec(BusServoSetOffsetRequest, None, writes=('offset',)),
         # bus_servo.read_offset
-        CommandSpec(BusServoReadOffsetRequest, BusServoReadOffsetResponse, reports={'offset': 'offset'}, broadcast_reply=True, absent={'success': -1.0}),
+        CommandSpec(BusServoReadOffsetRequest, BusServoReadOffsetResponse, reports={'offset': 'offset'}, broadcast_reply=True, absent={'success': -1.0}, echoes=('servo_id',)),
         # bus_servo.save_offset
         CommandSpec(BusServoSaveOffsetRequest, None),
         # bus_servo.set_position_limit
         CommandSpec(BusServoSetPositionLimitRequest, None, stores={'low': 'position_low', 'high': 'position_high'}),
         # bus_servo.read_position_limit
-        CommandSpec(BusServoReadPositionLimitRequest, BusServoReadPositionLimitResponse, reports={'low': 'position_low', 'high': 'position_high'}, broadcast_reply=True, absent={'success': -1.0}),
+        CommandSpec(BusServoReadPositionLimitRequest, BusServoReadPositionLimitResponse, reports={'low': 'position_low', 'high': 'position_high'}, broadcast_reply=True, absent={'success': -1.0}, echoes=('servo_id',)),
         # bus_servo.set_voltage_limit
         CommandSpec(BusServoSetVoltageLimitRequest, None, stores={'low': 'voltage_low', 'high': 'voltage_high'}),
         # bus_servo.read_voltage_limit
-        CommandSpec(BusServoReadVoltageLimitRequest, BusServoReadVoltageLimitResponse, reports={'low': 'voltage_low', 'high': 'voltage_high'}, broadcast_reply=True, absent={'success': -1.0}),
+        CommandSpec(BusServoReadVoltageLimitRequest, BusServoReadVoltageLimitResponse, reports={'low': 'voltage_low', 'high': 'voltage_high'}, broadcast_reply=True, absent={'success': -1.0}, echoes=('servo_id',)),
         # bus_servo.set_temperature_limit
         CommandSpec(BusServoSetTemperatureLimitRequest, None, stores={'limit': 'temperature_limit'}),
         # bus_servo.read_temperature_limit
-        CommandSpec(BusServoReadTemperatureLimitRequest, BusServoReadTemperatureLimitResponse, reports={'limit': 'temperature_limit'}, broadcast_reply=True, absent={'success': -1.0}),
+        CommandSpec(BusServoReadTemperatureLimitRequest, BusServoReadTemperatureLimitResponse, reports={'limit': 'temperature_limit'}, broadcast_reply=True, absent={'success': -1.0}, echoes=('servo_id',)),
         # oled
         CommandSpec(OledRequest, None),
         # rgb.set_pixels

@@ -74,17 +74,17 @@ DEVICE = DeviceSpec(
         # read_input_registers
         CommandSpec(ReadInputRegistersRequest, ReadInputRegistersResponse, space_reads={'registers': RunSpec('input_registers', 'address', count='count')}, code=4, limits={'count': (1, 125, ())}),
         # write_coil
-        CommandSpec(WriteCoilRequest, WriteCoilResponse, space_writes={'value': RunSpec('coils', 'address')}, code=5, limits={'value': (0, 65280, (0, 65280))}),
+        CommandSpec(WriteCoilRequest, WriteCoilResponse, space_writes={'value': RunSpec('coils', 'address')}, code=5, limits={'value': (0, 65280, (0, 65280))}, echoes=('address', 'value')),
         # write_register
-        CommandSpec(WriteRegisterRequest, WriteRegisterResponse, space_writes={'value': RunSpec('holding_registers', 'address')}, code=6),
+        CommandSpec(WriteRegisterRequest, WriteRegisterResponse, space_writes={'value': RunSpec('holding_registers', 'address')}, code=6, echoes=('address', 'value')),
         # write_coils
-        CommandSpec(WriteCoilsRequest, WriteCoilsResponse, space_writes={'values': RunSpec('coils', 'address')}, derived={'count': lambda fields: len(fields['values']), 'byte_count': lambda fields: (-(-fields['count'] // 8))}, code=15, limits={'values': (1, 1968, ())}),
+        CommandSpec(WriteCoilsRequest, WriteCoilsResponse, space_writes={'values': RunSpec('coils', 'address')}, derived={'count': lambda fields: len(fields['values']), 'byte_count': lambda fields: (-(-fields['count'] // 8))}, code=15, limits={'values': (1, 1968, ())}, echoes=('address', 'count')),
         # write_registers
-        CommandSpec(WriteRegistersRequest, WriteRegistersResponse, space_writes={'values': RunSpec('holding_registers', 'address')}, derived={'count': lambda fields: len(fields['values']), 'byte_count': lambda fields: (2 * fields['count'])}, code=16, limits={'values': (1, 123, ())}),
+        CommandSpec(WriteRegistersRequest, WriteRegistersResponse, space_writes={'values': RunSpec('holding_registers', 'address')}, derived={'count': lambda fields: len(fields['values']), 'byte_count': lambda fields: (2 * fields['count'])}, code=16, limits={'values': (1, 123, ())}, echoes=('address', 'count')),
         # mask_write_register
-        CommandSpec(MaskWriteRegisterRequest, MaskWriteRegisterResponse, space_writes={'and_mask': RunSpec('holding_registers', 'address', value=lambda current, fields: ((current & fields['and_mask']) | (fields['or_mask'] & (~fields['and_mask']))))}, code=22),
+        CommandSpec(MaskWriteRegisterRequest, MaskWriteRegisterResponse, space_writes={'and_mask': RunSpec('holding_registers', 'address', value=lambda current, fields: ((current & fields['and_mask']) | (fields['or_mask'] & (~fields['and_mask']))))}, code=22, echoes=('address', 'and_mask', 'or_mask')),
         # read_write_registers
-        CommandSpec(ReadWriteRegistersRequest, ReadWriteRegistersResponse, space_reads={'registers': RunSpec('holding_registers', 'read_address', count='read_count')}, space_writes={'values': RunSpec('holding_registers', 'write_address')}, derived={'write_count': lambda fields: len(fields['values']), 'byte_count': lambda fields: (2 * fields['write_count'])}, code=23, limits={'read_count': (1, 125, ()), 'values': (1, 121, ())}),
+        CommandSpec(ReadWriteRegistersRequest, ReadWriteRegistersResponse, space_reads={'registers': RunSpec('holding_registers', 'read_address', count='read_count')}, space_writes={'values': RunSpec('holding_registers', 'write_address')}, derived={'write_count': lambda fields: len(fields['values']), 'byte_count': lambda fields: (2 * fields['write_count'])}, code=23, limits={'read_count': (1, 125, ()), 'values': (1, 121, ())}, echoes=('byte_count',)),
     ),
     spaces=(
         SpaceSpec('coils', 10000, True, 1, 'rw'),

@@ -9,6 +9,7 @@ from collections.abc import Callable
 from serialspec.checksums.crc import crc_function
 from serialspec.checksums.crc import crc_hqx as _crc_hqx
 from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError, content_size_error, out_of_range
+from serialspec.runtime.errors import either_direction as _either
 from serialspec.runtime.fields import wrong_type
 from serialspec.runtime.framing import Element, EngineFormat, FrameCodec, Layout
 from serialspec.runtime.framing import FrameStreamParser as _FrameStreamParser
@@ -749,7 +750,7 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
             return decoder(buf, 4, end)
         raise DecodeError(f"frame starts {frame[:4].hex(' ')}, expected 02 or 03")
     if direction is None:  # last: a caller that knows the direction does not pay for this
-        raise DecodeError("give the direction: requests and responses cannot be told apart by their first bytes")
+        return _either(lambda d: decode(data, d, expect), "give the direction: requests and responses cannot be told apart by their first bytes")
     raise ValueError(f"direction must be request or response, not {direction!r}")
 
 

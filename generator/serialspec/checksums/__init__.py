@@ -27,9 +27,13 @@ def algorithms() -> dict[str, type[Algorithm]]:
     return dict(sorted(_REGISTERED.items()))
 
 
-def owned_keys() -> dict[str, str]:
-    """Each algorithm-specific key of a checksum element -> the algorithm that owns it."""
-    return {key.name: name for name, algorithm in algorithms().items() for key in algorithm.keys}
+def owned_keys() -> dict[str, tuple[str, ...]]:
+    """Each algorithm-specific key of a checksum element -> the algorithms that own it (`mask`: sum and xor)."""
+    owners: dict[str, tuple[str, ...]] = {}
+    for name, algorithm in algorithms().items():
+        for key in algorithm.keys:
+            owners[key.name] = (*owners.get(key.name, ()), name)
+    return owners
 
 
 def from_spec(raw: Mapping[str, Any], size: int, type_name: str, report: Report) -> Algorithm:
@@ -41,7 +45,7 @@ def from_spec(raw: Mapping[str, Any], size: int, type_name: str, report: Report)
         names = list(found)
         choices = ", ".join(f"`algorithm: {n}`" for n in names[:-1]) + f" or `algorithm: {names[-1]}`"
         raise ChecksumProblem((), f"a checksum needs {choices}")
-    for key, owner in owned_keys().items():
-        if key in raw and owner != name:
-            report((key,), f"`{key}` belongs to `algorithm: {owner}`, not {name}")
+    for key, owners in owned_keys().items():
+        if key in raw and name not in owners:
+            report((key,), f"`{key}` belongs to `algorithm: {' or '.join(owners)}`, not {name}")
     return found[name].from_spec(raw, size, type_name, report)

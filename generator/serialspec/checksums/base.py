@@ -93,9 +93,47 @@ class CCode:
     # `<prefix>__reflect(value, width)`, the low `width` bits of value in reverse order, which the C backend defines
 
 
+def c_finish(sign: str, whole: int) -> str:
+    """The C finish (a str.format template with {a}) of an accumulator inverted ("~"), negated ("-") or kept (""),
+    within the bits of `whole` (the width's mask, ANDed with a `mask:`)."""
+    if not sign and whole == 0xFFFFFFFF:
+        return "(uint32_t)({a})"
+    return f"({sign}(uint32_t)({{a}}) & 0x{whole:x}u)"
+
+
 def c_uint(width: int) -> str:
     """The narrowest C unsigned type of at least `width` bits (up to 32)."""
     return "uint8_t" if width <= 8 else "uint16_t" if width <= 16 else "uint32_t"
+
+
+# Keys more than one algorithm owns: how the result is finished (`finish` below), after the bytes are taken in.
+INVERT = Key("invert", "bool", "sum, xor: the result bitwise inverted (one's complement).", default=False)
+MASK = Key(
+    "mask",
+    "int",
+    "sum, xor: ANDed with the result, after `invert` or `negate` (HerkuleX: 0xFE clears bit 0).",
+    example=0xFE,
+    minimum=1,
+)
+
+
+def finish(value: int, width: int, invert: bool, negate: bool, mask: int | None) -> int:
+    """A result inverted (one's complement) or negated (two's complement) within `width` bits, then masked."""
+    if invert:
+        value = ~value
+    elif negate:
+        value = -value
+    return value & ((1 << width) - 1) & (mask if mask is not None else -1)
+
+
+def finish_problem(raw: Mapping[str, Any], width: int) -> ChecksumProblem | None:
+    """Why `invert`, `negate` and `mask` of a checksum element of `width` bits do not go together, or None."""
+    if raw.get("invert") and raw.get("negate"):
+        return ChecksumProblem(("negate",), "give `invert` (one's complement) or `negate` (two's complement), not both")
+    mask = raw.get("mask")
+    if mask is not None and not 0 < mask < 1 << width:
+        return ChecksumProblem(("mask",), f"mask {mask:#x} does not fit the checksum's {width} bits")
+    return None
 
 
 _REGISTERED: dict[str, type[Algorithm]] = {}

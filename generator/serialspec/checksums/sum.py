@@ -1,4 +1,5 @@
-"""`algorithm: sum`: the sum of the covered bytes modulo 2**width, optionally bitwise inverted (one's complement)."""
+"""`algorithm: sum`: the sum of the covered bytes modulo 2**width, optionally inverted (one's complement) or negated
+(two's complement), then optionally masked (HerkuleX: `& 0xFE`)."""
 
 from __future__ import annotations
 
@@ -6,44 +7,77 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from serialspec.checksums.base import Algorithm, CCode, Import, Key, Report, Sample, c_uint, hex_value
+from serialspec.checksums.base import (
+    INVERT,
+    MASK,
+    Algorithm,
+    CCode,
+    Import,
+    Key,
+    Report,
+    Sample,
+    c_finish,
+    c_uint,
+    finish,
+    finish_problem,
+    hex_value,
+)
 
 
-def sum_function(width: int, invert: bool) -> Callable[[bytes], int]:
-    """Sum of the bytes modulo 2**width, optionally bitwise inverted."""
-    mask = (1 << width) - 1
+def sum_function(width: int, invert: bool, negate: bool = False, mask: int | None = None) -> Callable[[bytes], int]:
+    """Sum of the bytes modulo 2**width, optionally bitwise inverted or negated, then ANDed with `mask`."""
+    whole = (1 << width) - 1 & (mask if mask is not None else -1)
     if invert:
-        return lambda data: ~sum(data) & mask
-    return lambda data: sum(data) & mask
+        return lambda data: ~sum(data) & whole
+    if negate:
+        return lambda data: -sum(data) & whole
+    return lambda data: sum(data) & whole
 
 
 @dataclass(frozen=True)
 class Sum(Algorithm):
     width: int
     invert: bool = False
+    negate: bool = False
+    mask: int | None = None  # ANDed with the result (None: none beyond the width)
 
     name = "sum"
     summary = "the sum of the bytes, modulo 2 to the checksum's bits"
-    keys = (Key("invert", "bool", "sum: bitwise NOT of the sum.", default=False),)
+    keys = (
+        INVERT,
+        Key("negate", "bool", "sum: the sum negated (two's complement).", default=False, example=True),
+        MASK,
+    )
     samples = (
         Sample("8-bit sum", "u8"),
         Sample("8-bit inverted sum", "u8", {"invert": True}),
+        Sample("8-bit negated sum (two's complement)", "u8", {"negate": True}),
+        Sample("8-bit inverted sum, masked", "u8", {"invert": True, "mask": 0xFE}),
         Sample("16-bit sum", "u16"),
     )
 
     @classmethod
     def from_spec(cls, raw: Mapping[str, Any], size: int, type_name: str, report: Report) -> Sum:
-        return cls(size * 8, bool(raw.get("invert", False)))
+        problem = finish_problem(raw, size * 8)
+        if problem is not None:
+            raise problem
+        return cls(size * 8, bool(raw.get("invert", False)), bool(raw.get("negate", False)), raw.get("mask"))
 
     @property
-    def mask(self) -> int:
-        return (1 << self.width) - 1
+    def whole(self) -> int:
+        """The mask of the result: the width's, and `mask` within it."""
+        return (1 << self.width) - 1 & (self.mask if self.mask is not None else -1)
+
+    @property
+    def sign(self) -> str:
+        return "~" if self.invert else "-" if self.negate else ""
 
     def function(self) -> Callable[[bytes], int]:
-        return sum_function(self.width, self.invert)
+        return sum_function(self.width, self.invert, self.negate, self.mask)
 
     def function_code(self) -> tuple[Import, str]:
-        return ("serialspec.checksums.sum", "sum_function"), f"sum_function({self.width}, {self.invert})"
+        extra = (", negate=True" if self.negate else "") + (f", mask={self.mask:#x}" if self.mask is not None else "")
+        return ("serialspec.checksums.sum", "sum_function"), f"sum_function({self.width}, {self.invert}{extra})"
 
     def python_setup(self, name: str) -> tuple[list[Import], list[str]]:
         return [], []  # the built-in sum(), in line
@@ -55,28 +89,31 @@ class Sum(Algorithm):
         return self.python_sum(covered)
 
     def python_sum(self, covered: str) -> str:
-        return f"{'~' if self.invert else ''}sum({covered}) & {self.mask:#x}"
+        return f"{self.sign}sum({covered}) & {self.whole:#x}"
 
     def byte_total(self, total: str) -> str:
-        return f"{'~' if self.invert else ''}({total}) & {self.mask:#x}"
+        return f"{self.sign}({total}) & {self.whole:#x}"
 
     def frame_test(self, total: str, skipped: int, check: str) -> str | None:
-        if self.width != 8:
-            return None  # a wider check is more than one byte of the frame's sum
+        if self.width != 8 or self.mask is not None:
+            return None  # a wider check is more than one byte of the frame's sum; a mask loses bits
         if self.invert:  # the covered bytes and their inverted sum add up to 0xff
             return f"({total} - {skipped + 0xFF:#x}) & 0xff"
+        if self.negate:  # the covered bytes and their negated sum add up to 0
+            return f"({total} - {skipped:#x}) & 0xff" if skipped else f"{total} & 0xff"
         # the covered bytes sum to the check: the frame to twice the check plus the skipped bytes
         less = f" - {skipped:#x}" if skipped else ""
         return f"({total}{less} - 2 * {check}) & 0xff"
 
     def summed(self) -> bool | None:
-        return self.invert if self.width == 8 else None
+        return self.invert if self.width == 8 and not self.negate and self.mask is None else None
 
     def c_code(self, prefix: str) -> CCode:
         t = c_uint(self.width)
         name = f"{prefix}_sum{self.width}"
         mask = (1 << self.width) - 1
-        final = "the sum inverted" if self.invert else "the sum"
+        final = "the sum inverted" if self.invert else "the sum negated" if self.negate else "the sum"
+        final += f", ANDed with 0x{self.mask:x}" if self.mask is not None else ""
         doc = (
             f"/* Sum of the bytes modulo 2^{self.width}. Incremental: start with 0; the frame's checksum is {final}. */"
         )
@@ -91,7 +128,7 @@ class Sum(Algorithm):
     return ({t})(s & 0x{mask:x}u);
 }}
 """
-        finish = f"(~(uint32_t)({{a}}) & 0x{mask:x}u)" if self.invert else "(uint32_t)({a})"
+        finish = c_finish(self.sign, self.whole)
         prototype = f"{t} {name}({t} acc, const uint8_t *data, size_t n);"
         return CCode(name, t, body, prototype, "0u", finish)
 
@@ -100,16 +137,23 @@ class Sum(Algorithm):
         return _LUA
 
     def lua_parameters(self) -> dict[str, Any]:
-        return {"invert": self.invert}
+        masked = {} if self.mask is None else {"mask": self.mask}
+        return {"invert": self.invert, "negate": self.negate} | masked
 
     def describe(self) -> str:
-        what = "bitwise NOT of the sum" if self.invert else "sum"
-        return f"{what} of the covered bytes, modulo {1 << self.width}"
+        what = "bitwise NOT of the sum" if self.invert else "two's complement of the sum" if self.negate else "sum"
+        masked = f", ANDed with {hex_value(self.mask, self.width)}" if self.mask is not None else ""
+        return f"{what} of the covered bytes, modulo {1 << self.width}{masked}"
+
+    def parameters(self) -> list[tuple[str, str]]:
+        return [("mask", hex_value(self.mask, self.width))] if self.mask is not None else []
 
     def worked(self, covered: bytes) -> str:
-        invert = "~" if self.invert else ""
+        sign = self.sign
         terms = " + ".join(f"0x{b:02X}" for b in covered) or "0"
-        return f"{invert}({terms}) = {invert}{sum(covered):#x} → {hex_value(self.function()(covered), self.width)}"
+        masked = f" & {hex_value(self.mask, self.width)}" if self.mask is not None else ""
+        value = hex_value(finish(sum(covered), self.width, self.invert, self.negate, self.mask), self.width)
+        return f"{sign}({terms}){masked} = {sign}{sum(covered):#x}{masked} → {value}"
 
 
 # the dissector's code (Algorithm.lua_function)
@@ -119,5 +163,10 @@ _LUA = """function(spec, size, data)
   for i = 1, #data do
     total = (total + data:byte(i)) % (mask + 1)
   end
-  return spec.invert and mask - total or total
+  if spec.invert then
+    total = mask - total
+  elseif spec.negate then
+    total = (mask + 1 - total) % (mask + 1)
+  end
+  return spec.mask and band(total, spec.mask) or total
 end"""

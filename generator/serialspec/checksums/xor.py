@@ -1,4 +1,5 @@
-"""`algorithm: xor`: the XOR of the covered bytes, or of the covered data as big-endian words of the checksum's size."""
+"""`algorithm: xor`: the XOR of the covered bytes, or of the covered data as big-endian words of the checksum's size,
+optionally inverted, then optionally masked (HerkuleX: `& 0xFE`)."""
 
 from __future__ import annotations
 
@@ -6,12 +7,28 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from serialspec.checksums.base import Algorithm, CCode, Import, Report, Sample, c_uint, hex_value
+from serialspec.checksums.base import (
+    INVERT,
+    MASK,
+    Algorithm,
+    CCode,
+    Import,
+    Report,
+    Sample,
+    c_finish,
+    c_uint,
+    finish,
+    finish_problem,
+    hex_value,
+)
 
 
-def xor_function(width: int) -> Callable[[bytes], int]:
+def xor_function(width: int, invert: bool = False, mask: int | None = None) -> Callable[[bytes], int]:
     """XOR of the bytes (width 8), or of the data taken as big-endian words of width / 8 bytes (the last one padded
-    with zero bytes)."""
+    with zero bytes); optionally inverted, then ANDed with `mask`."""
+    if invert or mask is not None:
+        plain = xor_function(width)
+        return lambda data: finish(plain(data), width, invert, False, mask)
     if width == 8:
 
         def xor8(data: bytes) -> int:
@@ -36,22 +53,37 @@ def xor_function(width: int) -> Callable[[bytes], int]:
 @dataclass(frozen=True)
 class Xor(Algorithm):
     width: int
+    invert: bool = False
+    mask: int | None = None  # ANDed with the result (None: none beyond the width)
 
     name = "xor"
     summary = "the XOR of the bytes (of big-endian words as wide as the checksum, when it is wider than a byte)"
-    samples = (Sample("8-bit XOR", "u8"), Sample("16-bit XOR of words", "u16"))
+    keys = (INVERT, MASK)
+    samples = (
+        Sample("8-bit XOR", "u8"),
+        Sample("8-bit XOR, masked (HerkuleX)", "u8", {"mask": 0xFE}),
+        Sample("8-bit inverted XOR", "u8", {"invert": True}),
+        Sample("16-bit XOR of words", "u16"),
+    )
 
     @classmethod
     def from_spec(cls, raw: Mapping[str, Any], size: int, type_name: str, report: Report) -> Xor:
-        return cls(size * 8)
+        problem = finish_problem({**raw, "negate": False}, size * 8)
+        if problem is not None:
+            raise problem
+        return cls(size * 8, bool(raw.get("invert", False)), raw.get("mask"))
 
     def function(self) -> Callable[[bytes], int]:
-        return xor_function(self.width)
+        return xor_function(self.width, self.invert, self.mask)
 
     def function_code(self) -> tuple[Import, str]:
-        return ("serialspec.checksums.xor", "xor_function"), f"xor_function({self.width})"
+        extra = (", invert=True" if self.invert else "") + (f", mask={self.mask:#x}" if self.mask is not None else "")
+        return ("serialspec.checksums.xor", "xor_function"), f"xor_function({self.width}{extra})"
 
     def c_code(self, prefix: str) -> CCode:
+        whole = (1 << self.width) - 1 & (self.mask if self.mask is not None else -1)
+        plain = not self.invert and self.mask is None
+        finish = "(uint32_t)({a})" if plain else c_finish("~" if self.invert else "", whole)
         if self.width == 8:
             name = f"{prefix}_xor8"
             body = f"""/* XOR of the bytes. Incremental: start with 0. */
@@ -66,7 +98,7 @@ uint8_t {name}(uint8_t acc, const uint8_t *data, size_t n)
 }}
 """
             prototype = f"uint8_t {name}(uint8_t acc, const uint8_t *data, size_t n);"
-            return CCode(name, "uint8_t", body, prototype, "0u", "(uint32_t)({a})")
+            return CCode(name, "uint8_t", body, prototype, "0u", finish)
         size = self.width // 8
         t = c_uint(self.width)
         name = f"{prefix}_xor{self.width}"
@@ -87,22 +119,35 @@ uint8_t {name}(uint8_t acc, const uint8_t *data, size_t n)
 }}
 """
         prototype = f"{t} {name}({t} acc, const uint8_t *data, size_t n);"
-        return CCode(name, t, body, prototype, "0u", "(uint32_t)({a})")
+        return CCode(name, t, body, prototype, "0u", finish)
 
     @classmethod
     def lua_function(cls) -> str:
         return _LUA
 
+    def lua_parameters(self) -> dict[str, Any]:
+        return {"invert": self.invert} | ({} if self.mask is None else {"mask": self.mask})
+
     def describe(self) -> str:
+        what = "bitwise NOT of the XOR" if self.invert else "XOR"
+        masked = f", ANDed with {hex_value(self.mask, self.width)}" if self.mask is not None else ""
         if self.width == 8:
-            return "XOR of the covered bytes"
-        return f"XOR of the covered bytes taken as big-endian {self.width}-bit words (the last padded with zeros)"
+            return f"{what} of the covered bytes{masked}"
+        words = f"big-endian {self.width}-bit words (the last padded with zeros)"
+        return f"{what} of the covered bytes taken as {words}{masked}"
+
+    def parameters(self) -> list[tuple[str, str]]:
+        return [("mask", hex_value(self.mask, self.width))] if self.mask is not None else []
 
     def worked(self, covered: bytes) -> str:
         size = self.width // 8
         padded = covered + bytes(-len(covered) % size)
         words = [int.from_bytes(padded[i : i + size], "big") for i in range(0, len(padded), size)]
         terms = " ^ ".join(hex_value(w, self.width) for w in words) or "0"
+        if self.invert or self.mask is not None:
+            sign = "~" if self.invert else ""
+            masked = f" & {hex_value(self.mask, self.width)}" if self.mask is not None else ""
+            terms = f"{sign}({terms}){masked}"
         return f"{terms} = {hex_value(self.function()(covered), self.width)}"
 
 
@@ -116,5 +161,8 @@ _LUA = """function(spec, size, data)
     end
     total = bxor(total, word)
   end
-  return total
+  if spec.invert then
+    total = width_mask(size * 8) - total
+  end
+  return spec.mask and band(total, spec.mask) or total
 end"""

@@ -127,6 +127,16 @@ def _hex(text: str) -> bytes:
         raise DecodeError(str(exc)) from None
 
 
+def _has_checksum(protocol: Protocol, direction: str) -> bool:
+    """Whether the frames of a direction carry a checksum (in any of its layouts)."""
+    return any(
+        layout.checksums
+        for d, layouts in protocol.framing.alternatives.items()
+        if d.value == direction
+        for layout in layouts
+    )
+
+
 def describe(
     protocol: Protocol, message: Message, frame: bytes, units: bool, request: Message | None
 ) -> dict[str, Any]:
@@ -141,7 +151,8 @@ def describe(
         "command": message.COMMAND,
         "subcommand": message.SUBCOMMAND,
         "fields": fields,
-        "checksum_ok": True,  # a frame whose checksum fails does not decode
+        # a frame whose checksum fails does not decode; null where its direction's frames carry none
+        "checksum_ok": True if _has_checksum(protocol, message.DIRECTION.value) else None,
         "hex": frame.hex(" "),
     }
     if symbols:

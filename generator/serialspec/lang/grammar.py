@@ -12,11 +12,12 @@ from collections.abc import Callable, Iterator
 from dataclasses import field
 from typing import Any, assert_never
 
-from serialspec import checksums
+from serialspec import checksums, transforms
 from serialspec.checksums.base import Key
 from serialspec.lang.frozen import mutable
 from serialspec.lang.limits import MAX_TEXT
 from serialspec.lang.loader import CONTROL, Path
+from serialspec.transforms.base import Key as TransformKey
 
 SCALAR_TYPES = ("u8", "i8", "u16", "i16", "u32", "i32", "f32")
 # what a field (not a frame element, enum, flag set or table entry) can be besides those
@@ -209,6 +210,9 @@ class Obj(Shape):
     keys: dict[str, Shape]
     required: tuple[str, ...] = ()
     description: str = ""
+    # more examples for the language reference, beyond the shipped specs': (label, YAML under the parent key, a
+    # line that works it through) for each documented variant (the transforms' samples)
+    variants: tuple[tuple[str, dict[str, Any], str], ...] = ()
 
     def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
         if not isinstance(value, dict):
@@ -668,8 +672,8 @@ def checksum_keys() -> dict[str, Shape]:
     return keys
 
 
-def _shape(key: Key) -> Shape:
-    """The shape of an algorithm's key, as the checksum registry gives it (plain data)."""
+def _shape(key: Key | TransformKey) -> Shape:
+    """The shape of a checksum algorithm's or a transform's key, as its registry gives it (plain data)."""
     match key.kind:
         case "bool":
             return Bool(key.description, default=key.default, example=key.example)
@@ -677,9 +681,12 @@ def _shape(key: Key) -> Shape:
             return Int(
                 key.description, default=key.default, example=key.example, minimum=key.minimum, maximum=key.maximum
             )
-        case "str":
+        case "str" | "hex":
             return Str(key.description, default=key.default, example=key.example)
+        case "hex_map":
+            return MapOf(HEX_BYTES, key.description)
         case "object":
+            assert isinstance(key, Key)
             keys = {k.name: _shape(k) for k in key.keys}
             return Obj(keys, required=key.required, description=key.description)
         case _:
@@ -714,7 +721,8 @@ FRAME_ELEMENT = Obj(
             "reply has the layout of the command whose response is the `error_reply`."
         ),
         "counts": span(
-            "length: the span of elements it counts, on the wire (after stuffing); default the content only.",
+            "length: the span of elements it counts (within a transparency span their plain bytes, over more than "
+            "it the bytes as sent); default the content only.",
         ),
         "adds": Int("length: added to the counted size (SMS: 2 = instruction + checksum); may be negative.", default=0),
         "description": TEXT,
@@ -725,8 +733,11 @@ FRAME_ELEMENT = Obj(
             "status (or address): bit fields packed into the element (DYNAMIXEL: alert bit 7, error number 6..0)."
         ),
         "covers": span(
-            "checksum: the span of elements covered. Outside a transparency span it sees the wire bytes, inside "
-            "it the bytes before stuffing.",
+            "checksum: the span of elements covered. Within a transparency span (all of it, or part) it sees the "
+            "bytes before the transform, over more than it or outside it the bytes as sent. Checksums strictly "
+            "inside the span (itself too) are left out of it (HerkuleX: `checksum1` in the header covers [size, "
+            "data]); one at an end is covered, so a checksum can be computed from another that comes before it "
+            "(HerkuleX `checksum2: {algorithm: xor, invert: true, mask: 0xFE, covers: [checksum1, checksum1]}`).",
         ),
         **checksum_keys(),
     },
@@ -736,20 +747,42 @@ FRAME_ELEMENT = Obj(
 
 FRAME_ELEMENTS = MapOf(FRAME_ELEMENT, "The frame's elements in wire order: name -> element.")
 
+
+def transform_keys() -> dict[str, Shape]:
+    """The `transparency:` keys that the transforms own (serialspec/transforms/): `method`, whose choices are the
+    registered transforms, and each transform's own keys."""
+    found = transforms.transforms()
+    described = "; ".join(f"`{name}`, {transform.summary}" for name, transform in found.items())
+    keys: dict[str, Shape] = {
+        "method": Str(
+            f"How the span is rewritten: {described}.",
+            choices=tuple(found),
+            default=transforms.DEFAULT,
+            example=max(found, key=lambda name: name != transforms.DEFAULT),
+        )
+    }
+    for transform in found.values():
+        keys |= {key.name: _shape(key) for key in transform.keys}
+    return keys
+
+
 TRANSPARENCY = Obj(
     {
-        "span": span("The elements whose bytes are stuffed or escaped."),
-        "replace": MapOf(
-            HEX_BYTES,
-            "Plain hex bytes -> the hex bytes sent instead, leftmost match first (DYNAMIXEL: 'FF FF FD' -> "
-            "'FF FF FD FD'; SLIP: 'C0' -> 'DB DC', 'DB' -> 'DB DD').",
-        ),
+        "span": span("The elements whose bytes are rewritten."),
+        **transform_keys(),
         "description": TEXT,
     },
-    required=("span", "replace"),
+    required=("span",),
+    variants=tuple(
+        (f"`method: {name}`, {sample.label}", dict(sample.framing), transform.worked_sample(sample))
+        for name, transform in transforms.transforms().items()
+        for sample in transform.samples
+    ),
     description=(
-        "Byte stuffing or escaping over a span, applied by encode and removed by decode and the stream parser. "
-        "Lengths count the bytes as sent."
+        "A transform of the bytes of a span (byte stuffing, escaping, COBS), applied by encode and removed by "
+        "decode and the stream parser. A length or checksum over elements within the span (all of it, or part) "
+        "counts and covers their plain bytes, before the transform; one over more than the span, or outside it, the "
+        "bytes as sent. A length or checksum that lies inside the span is transformed with it."
     ),
 )
 
@@ -1048,6 +1081,14 @@ DEVICE_COMMAND = Obj(
         ),
         "kind": Str("The entry of `kinds:` whose devices the command addresses (default: the devices of --id)."),
         "stores": MapOf(Str(), "Request field -> the state variable it is stored in (where names differ)."),
+        "echoes": ListOf(
+            Str(),
+            "Response fields that repeat the request's field of the same name (a write's reply confirming what was "
+            "written: Modbus WRITE SINGLE REGISTER). Other response fields never copy the request: they come from "
+            "the device (its reads, reports, `reply`, memory and state) or else the field's `default` (else 0); "
+            "the fields replies are matched by (`matching.by`), the address and a table value's key echo anyway.",
+            example=["address", "value"],
+        ),
         "sets": MapOf(Num(), "State variable -> the value the command sets it to."),
         "absent": MapOf(
             Num(),

@@ -52,6 +52,7 @@ def dotted(path: Path) -> str:
 _CONSTRUCTOR = yaml.SafeLoader("")
 _COMPOSER: type[yaml.SafeLoader] = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 _STR = "tag:yaml.org,2002:str"
+_MERGE = "tag:yaml.org,2002:merge"
 _ScalarNode = yaml.ScalarNode
 # The safe loader's constructor of each scalar tag, called directly: construct_object's bookkeeping (recursion
 # guard, a cache of every node built) is for mappings and lists, which _convert walks itself.
@@ -236,6 +237,19 @@ class _Converter:
         except _Expansion:
             return None
 
+    def _merge(self, node: yaml.Node, path: Path) -> dict[Any, Any]:
+        """The keys a YAML merge key (`<<`) brings in: one mapping, or a list of them (the first wins)."""
+        sources = node.value if isinstance(node, yaml.SequenceNode) else [node]
+        merged: dict[Any, Any] = {}
+        for source in sources:
+            if not isinstance(source, yaml.MappingNode):
+                self.fail(source, path, "`<<` merges a mapping (`<<: *anchor`) or a list of them")
+                continue
+            value = self._convert(source, path)
+            if isinstance(value, dict):
+                merged = {**value, **merged}
+        return merged
+
     def _convert(self, node: yaml.Node, path: Path) -> Any:
         located = self.located
         self.budget -= 1
@@ -266,7 +280,11 @@ class _Converter:
         if isinstance(node, yaml.MappingNode):
             self.open.add(id(node))
             result: dict[Any, Any] = {}
+            merged: dict[Any, Any] = {}  # the keys of `<<: *anchor` (or a list of them), which keys given here override
             for key_node, value_node in node.value:
+                if key_node.tag == _MERGE:
+                    merged = {**self._merge(value_node, path), **merged}
+                    continue
                 if key_node.__class__ is _ScalarNode and key_node.tag == _STR:
                     key = key_node.value  # a name: most keys
                 else:
@@ -300,7 +318,7 @@ class _Converter:
                 else:
                     result[key] = self._convert(value_node, inner)
             self.open.discard(id(node))
-            return result
+            return {**merged, **result} if merged else result
         if isinstance(node, yaml.SequenceNode):
             self.open.add(id(node))
             items = []

@@ -16,6 +16,7 @@ from serialspec.lang import expression
 from serialspec.lang.expression import Expr
 from serialspec.lang.frozen import frozen
 from serialspec.runtime.message import Direction as Direction  # the model and the runtime share it
+from serialspec.transforms.base import Transform
 
 
 @frozen
@@ -402,6 +403,7 @@ class Checksum:
     type: ScalarType
     endian: Literal["<", ">"] = "<"
     name: str = ""  # the frame element holding it
+    skips: tuple[str, ...] = ()  # elements inside first..last left out: itself, and the checksums strictly inside
 
 
 @frozen
@@ -432,11 +434,11 @@ class FrameElement:
 
 @frozen
 class Transparency:
-    """Byte stuffing or escaping over a span of elements: each plain sequence is sent as its wire sequence."""
+    """A transform of the bytes of a span of elements (serialspec/transforms/: stuffing, escaping, COBS)."""
 
     first: str
     last: str
-    replace: tuple[tuple[bytes, bytes], ...]
+    transform: Transform
     description: str = ""
 
 
@@ -658,6 +660,7 @@ class Behaviour:
     carries: tuple[str, str] | None = None  # (command code field, content field) of a carried request
     carried: tuple[str, ...] = ()  # the commands it can carry (empty: every command with a code)
     nothing_held: dict[str, float] = field(default_factory=dict)  # commits: reply values when nothing is held
+    echoes: tuple[str, ...] = ()  # response fields that repeat the request's field of the same name
 
 
 @frozen

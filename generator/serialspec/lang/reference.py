@@ -221,6 +221,8 @@ def reference_markdown(specs: Sequence[Any] = ()) -> str:
         example = _example(occurrences[id(shape)], specs) if path else None
         if example is not None and isinstance(example, dict):
             lines += ["", "For example:", "", "```yaml", *_yaml_lines(path, example), "```"]
+        for label, framing, worked in shape.variants:
+            lines += ["", f"{label}:", "", "```yaml", *_yaml_lines(path[:-1], framing, 40), "```", "", worked]
         lines.append("")
     return "\n".join(lines).rstrip() + "\n"
 

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
-from serialspec.runtime.message import is_sequence
+from collections.abc import Callable
+
+from serialspec.runtime.message import Direction, Message, is_sequence
 
 
 class SerialspecError(Exception):
@@ -98,3 +100,22 @@ class DeviceError(TransportError):
 
 class PortError(TransportError, OSError):
     """The port could not be opened, read or written."""
+
+
+def either_direction(decode: Callable[[Direction], Message], ambiguous: str) -> Message:
+    """The message a frame decodes to in the one direction it decodes in, where the first bytes do not tell requests
+    from responses (a reply whose code only replies have); `ambiguous` is the error when both or neither decode."""
+    found: list[Message] = []
+    reasons: dict[str, str] = {}
+    for direction in Direction:
+        try:
+            found.append(decode(direction))
+        except DecodeError as exc:
+            reasons[direction.value] = str(exc)
+    if len(found) == 1:
+        return found[0]
+    if found:
+        raise DecodeError(ambiguous)
+    if len(set(reasons.values())) == 1:
+        raise DecodeError(reasons[Direction.REQUEST.value])
+    raise DecodeError("neither a request ({request}) nor a response ({response})".format_map(reasons))

@@ -15,7 +15,7 @@ lies inside it or outside it.
 
 from __future__ import annotations
 
-import functools
+import importlib
 import re
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
@@ -24,6 +24,8 @@ from typing import Any, Literal
 from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError
 from serialspec.runtime.message import Message
 from serialspec.runtime.stream import StreamParser
+from serialspec.transforms.base import SpanTransform
+from serialspec.transforms.replace import Transparency as Transparency  # generated code imports it from here
 
 ElementKind = Literal["constant", "value", "command", "length", "content", "checksum"]
 
@@ -43,6 +45,7 @@ class Element:
     minimum: int = 0  # value/command: plausible values (a stray byte out of range is no frame start)
     maximum: int = 0
     also: int | None = None  # value: one more value allowed (an address's broadcast)
+    skip: tuple[int, ...] = ()  # checksum: elements inside the span left out (itself, other checksums)
 
     def pack(self, value: int) -> bytes:
         return value.to_bytes(self.size, self.endian)
@@ -55,46 +58,12 @@ class Element:
 
 
 @dataclass(frozen=True)
-class Transparency:
-    """Byte stuffing or escaping over a span: each plain sequence becomes its wire sequence, leftmost first."""
-
-    span: tuple[int, int]
-    replace: tuple[tuple[bytes, bytes], ...]
-
-    def encode(self, data: bytes) -> bytes:
-        return _rewrite(data, self.replace)
-
-    def decode(self, data: bytes) -> bytes:
-        """The plain bytes; DecodeError unless `data` is what encode gives for them (no lone escape)."""
-        plain = _rewrite(data, tuple((wire, plain) for plain, wire in self.replace))
-        if self.encode(plain) != data:
-            raise DecodeError(f"bad stuffing: {data.hex(' ')} is not the stuffed form of any bytes")
-        return plain
-
-
-def _rewrite(data: bytes, pairs: tuple[tuple[bytes, bytes], ...]) -> bytes:
-    """Each `old` sequence of `data` replaced by its `new`, scanning left to right (the leftmost match first, the
-    pairs tried in order at each position): one bytes.replace for one pair, else one regular expression."""
-    if len(pairs) == 1:
-        old, new = pairs[0]
-        return data.replace(old, new)
-    return _rewriter(pairs)(data)
-
-
-@functools.cache
-def _rewriter(pairs: tuple[tuple[bytes, bytes], ...]) -> Callable[[bytes], bytes]:
-    table = dict(pairs)
-    pattern = re.compile(b"|".join(re.escape(old) for old, _ in pairs))
-    return lambda data: pattern.sub(lambda match: table[match.group()], data)
-
-
-@dataclass(frozen=True)
 class Layout:
     """One frame layout of one direction."""
 
     name: str
     elements: tuple[Element, ...]
-    transparency: Transparency | None = None
+    transparency: SpanTransform | None = None
     # derived in __post_init__
     content: int = field(init=False, default=-1)
     values: tuple[int, ...] = field(init=False, default=())
@@ -138,6 +107,11 @@ class Layout:
         )
         plan["inner_checksums"] = inside
         plan["outer_checksums"] = tuple(c for c in plan["checksums"] if c not in inside)
+        counted_inside = tuple(
+            (i, e) for i, e in plan["lengths"] if t is not None and t.span[0] <= e.span[0] and e.span[1] <= t.span[1]
+        )
+        plan["inner_lengths"] = counted_inside  # made before the span is transformed: they count plain bytes
+        plan["outer_lengths"] = tuple(c for c in plan["lengths"] if c not in counted_inside)
         # What FrameCodec.probe reads, worked out once: the fixed elements before the variable part with their
         # offsets, and the length element's offset, size, byte order, adds and the sizes around what it counts.
         probe_head, position = [], 0
@@ -146,7 +120,16 @@ class Layout:
             position += element.size
         plan["probe_head"] = tuple(probe_head)
         plan["probe_length"] = None
-        if self.length is not None:
+        plan["probe_inner"] = None  # a length of plain bytes inside the transformed span: read through the transform
+        if self.length is not None and self.length in dict(counted_inside):
+            length = self.elements[self.length]
+            a, b = length.span
+            in_span = self.length >= first  # else at a fixed offset before the span
+            at = sum(e.size for e in self.elements[first : self.length]) if in_span else self.offset(self.length)
+            counted_fixed = sum(e.size for e in self.elements[a : b + 1])
+            uncounted = sum(e.size for e in self.elements[first : last + 1]) - counted_fixed
+            plan["probe_inner"] = (in_span, at, length, uncounted, counted_fixed)
+        elif self.length is not None:
             length = self.elements[self.length]
             offset = self.offset(self.length)
             a, b = length.span
@@ -204,19 +187,31 @@ class Layout:
             plain[index] = _pack(elements[index], value)
         wire: dict[int, bytes] = {}
         t = self.transparency
+        for index, element in plan["inner_lengths"]:  # inside the transformed span: the plain bytes
+            value = sum(len(part) for part in plain[element.span[0] : element.span[1] + 1]) + element.adds
+            if not 0 <= value < 1 << (8 * element.size):
+                raise EncodeError(f"{self.name} frame: length {value} does not fit its {element.size}-byte field")
+            plain[index] = element.pack(value)
         for index, element in plan["inner_checksums"]:  # inside the stuffed span: over the bytes before stuffing
             plain[index] = self._checksum(element, b"".join(plain[element.span[0] : element.span[1] + 1]))
         if t is not None:
             first, last = t.span
             wire[first] = t.encode(b"".join(plain[first : last + 1]))
-        for index, element in plan["lengths"]:
+        for index, element in plan["outer_lengths"]:
             value = len(self._wire(plain, wire, *element.span)) + element.adds
             if not 0 <= value < 1 << (8 * element.size):
                 raise EncodeError(f"{self.name} frame: length {value} does not fit its {element.size}-byte field")
             plain[index] = element.pack(value)
         for index, element in plan["outer_checksums"]:
-            plain[index] = self._checksum(element, self._wire(plain, wire, *element.span))
+            plain[index] = self._checksum(element, self._covered(plain, wire, element))
         return self._wire(plain, wire, 0, len(elements) - 1)
+
+    def _covered(self, plain: list[bytes], wire: dict[int, bytes], element: Element) -> bytes:
+        """The bytes a checksum covers: its span's, less the elements it skips (which lie outside any stuffing)."""
+        if not element.skip:
+            return self._wire(plain, wire, *element.span)
+        first, last = element.span
+        return b"".join(plain[i] for i in range(first, last + 1) if i not in element.skip)
 
     def _wire(self, plain: list[bytes], wire: dict[int, bytes], first: int, last: int) -> bytes:
         """Wire bytes of elements first..last (plain bytes when the transparency span is not in play)."""
@@ -278,7 +273,7 @@ class Layout:
             if value != counted:
                 raise DecodeError(f"{element.name} says {value} but the frame holds {counted}")
         for index, element in plan["checksums"]:
-            expected = element.checksum(self._wire(plain, wire, *element.span))
+            expected = element.checksum(self._covered(plain, wire, element))
             stored = element.unpack(plain[index])
             if expected != stored:
                 raise ChecksumError(
@@ -299,6 +294,63 @@ def _pack(element: Element, value: int) -> bytes:
         return element.pack(value)
     except OverflowError:
         raise EncodeError(f"{element.name} = {value} does not fit {element.size} byte(s)") from None
+
+
+def _inner_size(
+    layout: Layout, plan: dict[str, Any], buffer: bytes, start: int, end: int, low: int, high: int | None
+) -> int | None:
+    """probe() for a layout whose length counts plain bytes inside the transformed span (XBee API mode 2: escaped
+    itself, counting the plain bytes): its value read (through the transform where it lies inside the span), then
+    as many plain bytes of the span as it says."""
+    t = layout.transparency
+    assert t is not None
+    inside, at, element, uncounted, counted_fixed = plan["probe_inner"]
+    begin = start + plan["prefix"]
+    try:
+        if inside:
+            head = t.plain_prefix(buffer, begin, end, at + element.size)
+            if head is None:
+                return None
+            if len(head[0]) < at + element.size:
+                return -1
+            value = element.unpack(head[0][at:])
+        elif end - start < at + element.size:
+            return None
+        else:
+            value = element.unpack(buffer[start + at : start + at + element.size])
+        counted = value - element.adds
+        content = counted - counted_fixed  # the length counts the content (lang/passes/framing.py)
+        if content < low or (high is not None and content > high):
+            return -1
+        whole = t.plain_prefix(buffer, begin, end, uncounted + counted)
+    except DecodeError:
+        return -1
+    if whole is None:
+        return None
+    if len(whole[0]) < uncounted + counted:
+        return -1
+    prefix: int = plan["prefix"]
+    return prefix + whole[1] + layout.suffix()
+
+
+def _terminated(layout: Layout, buffer: bytes, start: int, end: int, low: int, high: int | None) -> int | None:
+    """probe() for a frame ended by its trailer with nothing else to size it (no length, no transform, no size
+    rule): the first occurrence of the trailer at which the frame checks (constants, checksums), so a trailer byte
+    inside the content or a checksum does not end it; None while none has come, -1 past the largest content."""
+    trailer = layout.trailer
+    largest = None if high is None else layout.overhead + high
+    position = buffer.find(trailer, start + layout.overhead + low - len(trailer), end)
+    while position >= 0:
+        size = position + len(trailer) - start
+        if largest is not None and size > largest:
+            return -1
+        try:
+            layout.unwrap(buffer[start : start + size])
+        except DecodeError:
+            position = buffer.find(trailer, position + 1, end)
+            continue
+        return size
+    return -1 if largest is not None and end - start > largest else None
 
 
 @dataclass(frozen=True)
@@ -401,6 +453,8 @@ class FrameCodec:
             if None not in self.content_sizes:
                 return -1
         low, high = self.content_sizes.get(code, (0, None))
+        if plan["probe_inner"] is not None:
+            return _inner_size(layout, plan, buffer, start, end, low, high)
         length: tuple[int, Element, int, int] | None = plan["probe_length"]
         if length is not None:
             offset, element, outside, inside_fixed = length
@@ -414,7 +468,7 @@ class FrameCodec:
             return None if stop < 0 else stop + len(layout.trailer) - start
         rule = self.size_rules.get(code)
         if rule is None:
-            return -1
+            return _terminated(layout, buffer, start, end, low, high) if layout.trailer else -1
         content_size = rule.size(buffer, start + plan["prefix"], end)
         if content_size is None:
             return None
@@ -430,6 +484,8 @@ class FrameCodec:
         if layout.transparency is not None or len(plan["checksums"]) != 1:
             return None
         index, element = plan["checksums"][0]
+        if element.skip:
+            return None
         head = {i: begin for i, begin, _ in plan["head"]}
         tail = {i: (begin, finish) for i, begin, finish in plan["tail"]}
         first, last = element.span
@@ -491,6 +547,8 @@ class FrameCodec:
         the answer is always probe()'s: tests/test_frame_sizers.py draws candidates and holds the two to it.
         """
         plan: dict[str, Any] = layout._plan  # type: ignore[attr-defined]
+        if plan["probe_inner"] is not None:  # sized by reading into the transformed span: probe() decides
+            return lambda buffer, start, end: self.probe(layout, buffer, start, end)
         head: tuple[tuple[Element, int, int], ...] = plan["probe_head"]
         need = max((stop for _, _, stop in head), default=0)
         constants = tuple((first, e.constant) for e, first, _ in head if e.kind == "constant")
@@ -511,6 +569,7 @@ class FrameCodec:
             offset, element, outside, inside_fixed = length
             measured = (offset, offset + element.size, element.endian, element.adds, outside, inside_fixed)
         trailer = layout.trailer if layout.trailer and layout.transparency is not None else b""
+        terminated = bool(layout.trailer)
         before, prefix, overhead, bounded = plan["before"], plan["prefix"], layout.overhead, layout.transparency is None
 
         def sizer(buffer: bytes, start: int, end: int) -> int | None:
@@ -551,7 +610,7 @@ class FrameCodec:
                 return None if stop < 0 else stop + len(trailer) - start
             rule = size_rules.get(code)
             if rule is None:
-                return -1
+                return _terminated(layout, buffer, start, end, low, high) if terminated else -1
             content_size = rule.size(buffer, start + prefix, end)
             if content_size is None:
                 return None
@@ -748,3 +807,13 @@ class EngineFormat:
 
     def decode_at(self, buffer: bytes, start: int, stop: int, expect: type[Message] | None = None) -> Message:
         return self.decode(buffer[start:stop], expect)
+
+
+def __getattr__(name: str) -> Any:
+    # each transform's runtime class (serialspec/transforms/), imported from here by generated code, loaded when asked
+    from serialspec.transforms import runtime_classes
+
+    found = runtime_classes().get(name)
+    if found is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    return getattr(importlib.import_module(found[0]), found[1])

@@ -37,6 +37,7 @@ from serialspec.lang.model import (
     TableBlock,
     TableValue,
     Text,
+    size_terms,
 )
 
 #: Default capacities where the spec sets no smaller bound (each overridable with #define before the header).
@@ -172,6 +173,11 @@ def refuse_unsupported(protocol: Protocol) -> None:
     for layouts in protocol.framing.alternatives.values():
         for layout in layouts:
             refuse_layout(layout)
+            roles = [e.role for e in layout.elements]
+            terminated = roles[-1] == "trailer" and len(roles) > 1 and "length" not in roles
+            unsized = any(size_terms(m.fields) is None for m in protocol.messages() if m.direction == layout.direction)
+            if terminated and layout.transparency is None and unsized:
+                raise Unsupported(f"the {layout.direction.value} frame: ended by its trailer alone (no length)")
     for message in protocol.messages():
         refuse_fields(message.fields, message.key)
 
@@ -183,14 +189,20 @@ def refuse_layout(layout: FrameLayout) -> None:
         if e.type is not None and (e.type.size > 4 or e.type.signed or e.type.is_float):
             raise Unsupported(f"{where}: element {e.name} of type {e.type.name}")
     t = layout.transparency
+    if t is not None and t.transform.c_refusal():
+        raise Unsupported(f"{where}: {t.transform.c_refusal()}")
     names = [e.name for e in elements]
     content = next((i for i, e in enumerate(elements) if e.role == "content"), -1)
     first = names.index(t.first) if t else content if content >= 0 else len(elements)
     last = names.index(t.last) if t else content if content >= 0 else len(elements) - 1
     length = next((i for i, e in enumerate(elements) if e.role == "length"), -1)
+    if length >= 0 and t is not None and first <= length <= last:
+        raise Unsupported(f"{where}: a length inside the transformed span")
     if length >= 0 and length >= first:
         raise Unsupported(f"{where}: a length after the variable part of the frame")
     for i, e in enumerate(elements):
+        if e.checksum is not None and e.checksum.skips:
+            raise Unsupported(f"{where}: checksum {e.name} over a span that leaves out {', '.join(e.checksum.skips)}")
         if e.role == "checksum" and t is not None and e.checksum is not None:
             a, b = names.index(e.checksum.first), names.index(e.checksum.last)
             inside = first <= i <= last

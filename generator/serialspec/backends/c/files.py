@@ -22,6 +22,8 @@ from serialspec.backends.c.emit import (
 )
 from serialspec.backends.c.engine import ENGINE
 from serialspec.lang.model import Direction, FrameLayout, Message, Protocol, size_terms
+from serialspec.transforms.cobs import Cobs
+from serialspec.transforms.replace import Replace
 
 DIRECTIONS = (Direction.REQUEST, Direction.RESPONSE)
 
@@ -251,9 +253,14 @@ def layout_tables(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) -
     lines.append(f"static const {p}__element_t {name}_e[] = {{\n" + "\n".join(rows) + "\n};")
     t = layout.transparency
     pairs = "NULL"
+    pair_count = 0
+    method = 0  # the engine's has_t: 0 none, 1 substitution (pairs), 2 COBS (emit.refuse_layout refused others)
     if t is not None:
+        method = 2 if isinstance(t.transform, Cobs) else 1
+    if t is not None and isinstance(t.transform, Replace):
         prows = []
-        for j, (plain, wire) in enumerate(t.replace):
+        pair_count = len(t.transform.pairs)
+        for j, (plain, wire) in enumerate(t.transform.pairs):
             lines.append(f"static const uint8_t {name}_p{j}[] = {{{', '.join(f'0x{b:02x}u' for b in plain)}}};")
             lines.append(f"static const uint8_t {name}_w{j}[] = {{{', '.join(f'0x{b:02x}u' for b in wire)}}};")
             prows.append(f"    {{{name}_p{j}, {name}_w{j}, {len(plain)}u, {len(wire)}u}},")
@@ -288,7 +295,7 @@ def layout_tables(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) -
                 break
     lines.append(
         f"static const {p}__layout_t {name} = {{{name}_e, {len(layout.elements)}u, {content}, {command}, "
-        f"{1 if t else 0}u, {tf}u, {tl}u, {pairs}, {len(t.replace) if t else 0}u, {header_len}u, {prefix}u, "
+        f"{method}u, {tf}u, {tl}u, {pairs}, {pair_count}u, {header_len}u, {prefix}u, "
         f"{error_flag}UL, {overhead}u, {before}u, {after}u, {length}, {length_off}u, {counted}u}};"
     )
     if t:

@@ -7,7 +7,7 @@ byte by byte). One mapping from model to engine, so the two cannot disagree.
 from __future__ import annotations
 
 from serialspec.lang.model import Direction, FrameElement, FrameLayout, Protocol
-from serialspec.runtime.framing import Element, ElementKind, Layout, Transparency
+from serialspec.runtime.framing import Element, ElementKind, Layout
 
 KINDS: dict[str, ElementKind] = {
     "header": "constant",
@@ -25,6 +25,7 @@ KINDS: dict[str, ElementKind] = {
 def runtime_element(layout: FrameLayout, element: FrameElement) -> Element:
     kind = KINDS[element.role]
     span = (0, 0)
+    skip: tuple[int, ...] = ()
     function = None
     if kind == "length":
         span = (layout.index(element.counts[0]), layout.index(element.counts[1]))
@@ -32,6 +33,7 @@ def runtime_element(layout: FrameLayout, element: FrameElement) -> Element:
         assert element.checksum is not None
         span = (layout.index(element.checksum.first), layout.index(element.checksum.last))
         function = element.checksum.algorithm.function()
+        skip = tuple(layout.index(name) for name in element.checksum.skips)
     return Element(
         name=element.name,
         kind=kind,
@@ -44,12 +46,13 @@ def runtime_element(layout: FrameLayout, element: FrameElement) -> Element:
         minimum=int(element.minimum) if kind in ("value", "command") else 0,
         maximum=int(element.maximum) if kind in ("value", "command") else 0,
         also=element.broadcast if kind in ("value", "command") else None,
+        skip=skip,
     )
 
 
 def runtime_layout(layout: FrameLayout) -> Layout:
     t = layout.transparency
-    transparency = Transparency((layout.index(t.first), layout.index(t.last)), t.replace) if t else None
+    transparency = t.transform.runtime((layout.index(t.first), layout.index(t.last))) if t else None
     elements = tuple(runtime_element(layout, e) for e in layout.elements)
     return Layout(layout.name or layout.direction.value, elements, transparency)
 

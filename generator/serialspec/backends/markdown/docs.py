@@ -31,6 +31,7 @@ from serialspec.lang.model import (
     ErratumCheck,
     Example,
     Field,
+    FrameElement,
     FrameLayout,
     Group,
     List,
@@ -169,7 +170,7 @@ def message_context(protocol: Protocol, message: Message | None) -> dict[str, An
     content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
     size = size_text(message.min_size, message.max_size, content_limit(layout))
     rows = [
-        Row(str(layout.offsets[e.name]), e.name, e.type.name if e.type else "", "", "", e.description)
+        Row(_value_offset(layout, e), e.name, e.type.name if e.type else "", "", "", e.description)
         for e in layout.value_elements
     ]
     rows += field_rows(message.fields, content_offset)
@@ -184,6 +185,15 @@ def message_context(protocol: Protocol, message: Message | None) -> dict[str, An
         "reply": reply_text(message, protocol) or error_reply_text(protocol, message),
         "description": text(message.description),
     }
+
+
+def _value_offset(layout: FrameLayout, element: FrameElement) -> str:
+    """Where a frame-level value sits: its offset, or (after a content whose size varies) its place from the end."""
+    if element.name in layout.offsets:
+        return str(layout.offsets[element.name])
+    index = layout.elements.index(element)
+    back = sum(e.size or 0 for e in layout.elements[index:])
+    return f"{back} from the end"
 
 
 def device_rule_text(protocol: Protocol, name: str) -> str:
@@ -370,7 +380,9 @@ def frame_context(protocol: Protocol, layout: FrameLayout) -> dict[str, Any]:
             description = " — ".join(p for p in (e.constant.hex(" ").upper(), e.description) if p)
         elif e.role == "checksum" and not layout.classic and e.checksum is not None:
             endian = "big-endian" if e.endian == ">" else "little-endian"
-            description = f"over `{e.checksum.first}`..`{e.checksum.last}`, {endian}. {e.description}"
+            left_out = ", ".join(f"`{name}`" for name in e.checksum.skips)
+            skips = f" leaving out {left_out}" if left_out else ""
+            description = f"over `{e.checksum.first}`..`{e.checksum.last}`{skips}, {endian}. {e.description}"
         else:
             description = e.description
         kind = e.type.name if e.type else ("bytes" if e.fixed else "n bytes")
@@ -382,9 +394,11 @@ def frame_context(protocol: Protocol, layout: FrameLayout) -> dict[str, Any]:
             kind += f" = bytes `{e.counts[0]}`..`{e.counts[1]}` as sent{adds}{endian}"
         where = f"{offset}.." if size is None else (str(offset) if size == 1 else f"{offset}..{offset + size - 1}")
         if e.role in ("checksum",) or (offset is None):
-            where = "last" if e.role == "checksum" else where
+            where = "last" if e.role == "checksum" and e.name not in layout.offsets else where
         if variable and e.role not in ("content", "checksum"):
             where = "after the content" if e.role == "trailer" or layout.offsets.get(e.name) is None else where
+        if e.role in ("address", "status", "command", "length") and e.name not in layout.offsets:
+            where = _value_offset(layout, e)  # after a content whose size varies
         rows.append(
             {
                 "offset": cell(where),
@@ -406,10 +420,10 @@ def transparency_text(protocol: Protocol) -> str:
     if not found:
         return ""
     t = found[0]
-    pairs = ", ".join(f"{plain.hex(' ').upper()} is sent as {wire.hex(' ').upper()}" for plain, wire in t.replace)
     return text(
-        f"From `{t.first}` to `{t.last}`, {pairs}: encode applies it, decode and the stream parser remove it. "
-        f"Lengths count the bytes as sent; checksums outside the span cover them as sent. {t.description}"
+        f"From `{t.first}` to `{t.last}`, {t.transform.describe()}: encode applies it, decode and the stream parser "
+        f"remove it. A length or checksum over elements within the span counts and covers their plain bytes, one over "
+        f"more than the span the bytes as sent. {t.description}"
     )
 
 
@@ -443,6 +457,11 @@ def checksum_context(protocol: Protocol, general: Checksum | None = None) -> dic
         "what": checksum.algorithm.describe(),
         "first": checksum.first,
         "last": checksum.last,
+        "skips": (
+            " but for " + ", ".join(f"`{name}`" for name in checksum.skips) + " (checksums inside the span)"
+            if checksum.skips
+            else ""
+        ),
         "worked": worked,
         "params": checksum.algorithm.parameters(),
     }
@@ -461,7 +480,9 @@ def general_worked(protocol: Protocol, checksum: Checksum) -> str:
         except SerialspecError:
             continue
         first, last = layout.elements[index].span
-        return f"{checksum.algorithm.worked(b''.join(parts[first : last + 1]))} (example `{example.name}`)"
+        skip = layout.elements[index].skip
+        covered = b"".join(parts[i] for i in range(first, last + 1) if i not in skip)
+        return f"{checksum.algorithm.worked(covered)} (example `{example.name}`)"
     return ""
 
 

@@ -664,7 +664,7 @@ class PackageCode:
         item_names = [i.name for i in item_fields if not (isinstance(i, Scalar) and i.hidden)]
         start_list = Code(f"{value}_list = []")
         body.append(start_list)
-        if f.item_size is not None:
+        if f.item_size is not None and all(is_fixed_run_member(i) for i in item_fields):  # one struct per item
             item_fmt = struct_format(self.protocol_endian(), item_fields)
             item_struct = self.struct(f"{f.class_name}", item_fmt)
             if f.count == "rest":

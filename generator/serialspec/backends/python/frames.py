@@ -23,9 +23,11 @@ from serialspec.lang.model import (
     Protocol,
     size_terms,
 )
+from serialspec.transforms import runtime_classes
 
 ERROR_REPLY = "ERROR_REPLY"  # the codes key of error replies (runtime.framing.ERROR_REPLY)
-FRAMING_NAMES = ("Element", "FrameCodec", "Layout", "SizeRule", "Transparency")  # runtime.framing's classes
+# runtime.framing's classes (each transform's runtime class among them), in the order isort wants
+FRAMING_NAMES = tuple(sorted(("Element", "FrameCodec", "Layout", "SizeRule", *runtime_classes())))
 
 
 def checksum_definitions(protocol: Protocol, straight: bool = True) -> tuple[list[str], list[str]]:
@@ -85,6 +87,8 @@ def element_expr(layout: FrameLayout, element: FrameElement) -> str:
     if e.kind == "checksum":
         assert element.checksum is not None
         args.append(f"checksum={checksum_name(element.checksum)}")
+        if e.skip:
+            args.append(f"skip={e.skip}")
     return f"Element({', '.join(args)})"
 
 
@@ -96,10 +100,10 @@ def layout_lines(layout: FrameLayout) -> list[str]:
         lines.append(")),")
         return lines
     t = layout.transparency
-    pairs = ", ".join(f"({plain!r}, {wire!r})" for plain, wire in t.replace)
-    lines.append("), Transparency(")
-    lines.append(f"    ({layout.index(t.first)}, {layout.index(t.last)}),")
-    lines.append(f"    ({pairs},),")
+    lines.append(f"), {t.transform.runtime_name}(")
+    lines += [
+        f"    {argument}," for argument in t.transform.python_arguments((layout.index(t.first), layout.index(t.last)))
+    ]
     lines.append(")),")
     return lines
 
@@ -130,7 +134,7 @@ def codec_lines(
     lines = [f"_{direction.name}_FRAMES = FrameCodec(", "    ("]
     for layout in layouts:
         lines += [f"        {line}" for line in layout_lines(layout)]
-        names |= {"Transparency"} if layout.transparency is not None else set()
+        names |= {layout.transparency.transform.runtime_name} if layout.transparency is not None else set()
     lines.append("    ),")
     # content size bounds by command code (None: unbounded)
     lines.append("    {")

@@ -182,7 +182,9 @@ class ScalarKind(Kind[Scalar]):
         return Calls(f"{kind}({get}, {f.name!r}, where)", [kind], get)
 
     def blank(self, f: Scalar) -> str:
-        return zero_bits(f.bits) if f.bits else "0"
+        if f.bits:
+            return zero_bits(f.bits)
+        return number(f.default) if f.default is not None else "0"
 
 
 class ArrayKind(Kind[Array]):

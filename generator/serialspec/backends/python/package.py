@@ -34,6 +34,7 @@ from serialspec.backends.python.structs import structs_module
 from serialspec.collection import without_cycle_collection
 from serialspec.lang.model import (
     Direction,
+    Group,
     Message,
     Protocol,
     Scalar,
@@ -333,7 +334,15 @@ def names_used_in_codec(code: PackageCode) -> set[str]:
 
 
 def uses_table(message: Message, table: str) -> bool:
-    return any(isinstance(f, TableValue) and f.table.name == table for f in message.fields)
+    """Whether a field of the message (or of a group's items) holds a value of the table by its key."""
+    stack = list(message.fields)
+    while stack:
+        f = stack.pop()
+        if isinstance(f, TableValue) and f.table.name == table:
+            return True
+        if isinstance(f, Group):
+            stack.extend(f.fields)
+    return False
 
 
 def table_context(table: Table) -> dict[str, Any]:

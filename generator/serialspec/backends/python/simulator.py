@@ -80,9 +80,14 @@ def table_fields(*messages: Message | None) -> dict[str, tuple[str, ...]]:
                 found[f.name] = ("block", *(e.name for e in f.entries))
             case Bytes() if f.table is not None and f.start:
                 # the request's fields are the device's `given` values, so `request.address` is `address` there
-                found[f.name] = ("run", f.start, f.size_from)
+                # its size: the request field `size_from` names, else a request field named as the reply's size
+                # field (the engine reads the one entry at the start where the request has neither)
+                sized_by = f.size if isinstance(f.size, str) and f.size != "rest" else ""
+                found[f.name] = ("run", f.start, f.size_from or sized_by)
             case Group():
                 stack.extend(reversed(f.fields))
+                if any(isinstance(i, TableValue) for i in f.fields):  # a read fills its items, each by its key
+                    found[f.name] = ("group", *(i.name for i in f.fields))
             case Scalar() | Array() | Packed() | List() | Text() | Bytes():
                 pass  # no table entries
             case _:
@@ -144,6 +149,26 @@ def run_spec(run: SpaceAccess) -> str:
         body = expression.render(run.value, lambda n: "current" if n == "current" else f"fields[{n!r}]")
         args.append(f"value=lambda current, fields: {body}")
     return f"RunSpec({', '.join(args)})"
+
+
+def echoes(
+    protocol: Protocol,
+    request: Message,
+    response: Message | None,
+    tables: dict[str, tuple[str, ...]],
+    derived: dict[str, str],
+    named: tuple[str, ...],
+) -> tuple[str, ...]:
+    """The response fields a device copies from the request's field of the same name: those the spec names
+    (`echoes`), those replies are matched by, the device address, the keys and starts of the table values a reply
+    holds, and counts the request derives. Every other reply field comes from the device, never the request."""
+    if response is None:
+        return ()
+    assert protocol.device is not None
+    keys = {name for table in tables.values() if table[0] in ("value", "run") for name in table[1:3]}
+    allowed = {*named, *protocol.matching, protocol.device.address, *keys, *derived}
+    given = {f.name for f in request.fields} | set(derived)
+    return tuple(f.name for f in response.fields if f.name in allowed and f.name in given)
 
 
 def reply_blanks(protocol: Protocol, response: Message, filled: set[str]) -> dict[str, str]:
@@ -244,7 +269,13 @@ def simulator_module(protocol: Protocol) -> str:
         tables = table_fields(request, response)
         if tables:
             args.append(f"tables={tables!r}")
-        filled = {*tables, *(behaviour.reads + tuple(behaviour.space_reads) if behaviour else ())}
+        echoed = echoes(protocol, request, response, tables, derived, behaviour.echoes if behaviour else ())
+        if echoed:
+            args.append(f"echoes={echoed!r}")
+        # what the device fills in itself: what it reads, and runs of registers (empty unless read); a table value
+        # or block it does not read gets its kind's blank, as any other field
+        runs = {name for name, table in tables.items() if table[0] == "run"}
+        filled = {*runs, *(behaviour.reads + tuple(behaviour.space_reads) if behaviour else ())}
         blanks = reply_blanks(protocol, response, filled) if response else {}
         if blanks:
             args.append(f"blanks={{{', '.join(f'{k!r}: {v}' for k, v in blanks.items())}}}")

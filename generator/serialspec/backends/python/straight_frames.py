@@ -28,7 +28,7 @@ from dataclasses import dataclass
 from serialspec.backends.common.frames import runtime_layouts
 from serialspec.backends.python.ir import Block, Code, Literal, Pack, PackItems, Simple, packed_lists
 from serialspec.lang.model import Checksum, Direction, Protocol
-from serialspec.runtime.framing import Element, Layout
+from serialspec.runtime.framing import Element, Layout, Transparency
 
 Lines = list[str]
 Structs = Callable[[str], str]  # a struct format -> the name of the module's struct constant for it
@@ -72,13 +72,13 @@ def straight(layout: Layout) -> bool:
     """Whether the layout fits the straight-line form: one content inside the variable part (the stuffed span, else
     the content), lengths at fixed offsets before it, checksums after it and after what they cover, none of them
     over bytes inside the stuffed span only, multi-byte elements at fixed offsets in one byte order."""
-    if layout.content < 0:
-        return False
+    if layout.content < 0 or not isinstance(layout.transparency, Transparency | None):
+        return False  # other transforms than substitution: the engine codes them
     first, last = _variable(layout)
     if not first <= layout.content <= last:
         return False
     for index, element in enumerate(layout.elements):
-        if element.kind == "length" and index >= first:
+        if element.kind == "length" and (index >= first or _inside(layout, *element.span)):
             return False
         if element.kind == "checksum":
             a, b = element.span
@@ -93,10 +93,17 @@ def _variable(layout: Layout) -> tuple[int, int]:
     return layout.transparency.span if layout.transparency is not None else (layout.content, layout.content)
 
 
+def _stuffing(layout: Layout) -> Transparency | None:
+    """The layout's substitution, of a straight layout (straight() takes no other transform)."""
+    assert isinstance(layout.transparency, Transparency | None)
+    return layout.transparency
+
+
 def _inside(layout: Layout, a: int, b: int) -> bool:
-    """Whether elements a..b lie inside the stuffed span without holding all of it (they see the plain bytes)."""
+    """Whether elements a..b lie within the stuffed span (all of it, or part): a length or checksum over them sees
+    the plain bytes."""
     t = layout.transparency
-    return t is not None and t.span[0] <= a and b <= t.span[1] and (a, b) != t.span
+    return t is not None and t.span[0] <= a and b <= t.span[1]
 
 
 def _size(elements: tuple[Element, ...]) -> int:
@@ -210,7 +217,7 @@ def decode_lines(
             f'    raise DecodeError(f"frame of {{n}} bytes is shorter than the smallest {layout.name} frame '
             f'({layout.overhead})")',
         ]
-    t = layout.transparency
+    t = _stuffing(layout)
     body.append(f"end = n - {positions.behind}" if positions.behind else "end = n")
     if t is None:
         body.append("buf = frame")
@@ -299,7 +306,16 @@ def _residue(element: Element) -> int | None:
     assert function is not None
     samples = (b"", b"\x00", b"\x01\x02", b"123456789", b"\xff" * 7, bytes(range(1, 18)))
     found = {function(data + element.pack(function(data))) for data in samples}
-    return found.pop() if len(found) == 1 else None
+    if len(found) != 1:
+        return None
+    residue = found.pop()
+    # and only the right checksum gives it: a masked one (HerkuleX `& 0xFE`) gives it for a wrong bit 0 as well
+    for data in samples:
+        check = function(data)
+        for bit in range(8 * element.size):
+            if function(data + element.pack(check ^ 1 << bit)) == residue:
+                return None
+    return residue
 
 
 def _dispatch(target: Target, code: str, arguments: str, nullable: bool) -> Lines:
@@ -450,7 +466,7 @@ def wrap_parts(
     c = layout.content
     around = (packed(list(range(first, c))), "content", packed(list(range(c + 1, last + 1))))
     variable = " + ".join(p for p in around if p)
-    t = layout.transparency
+    t = _stuffing(layout)
     if t is None:
         wire = variable
     else:
@@ -630,8 +646,8 @@ def direction_functions(
     for layout, checks in zip(layouts, found.checks, strict=True):
         suffix = f"_{layout.name}" if several else ""
         stuffing = f"_{target.upper}{suffix.upper()}_TRANSPARENCY"
-        if layout.transparency is not None:
-            t = layout.transparency
+        t = _stuffing(layout)
+        if t is not None:
             pairs = ", ".join(f"({plain!r}, {wire!r})" for plain, wire in t.replace)
             lines += [f"{stuffing} = Transparency({t.span}, ({pairs},))", "", ""]
         # of several layouts, each is decoded once its header has chosen it (_choice)
@@ -723,7 +739,7 @@ def _frame_lines(
     order = _order(elements, head)
     packed = None  # (format, arguments) where the frame up to the checksum is one pack of them
     multi = any(elements[i].kind != "constant" and elements[i].size > 1 for i in head)
-    if first and fmt[:1] in "<>" and (fmt[0] == order or not multi):
+    if head and first and fmt[:1] in "<>" and (fmt[0] == order or not multi):
         # the head's elements joined to the content's first struct: one pack for both
         fused = _packed(elements, head, constant_or, lambda f: f)  # named by its format
         if isinstance(fused, Pack):
@@ -893,7 +909,7 @@ def whole_frames(
     ]
     lines = [
         f"whole = {table}.get(frame[:{positions.content}])",
-        f"if whole is not None and {' and '.join(conditions)}:",
+        f"if {' and '.join(['whole is not None', *conditions])}:",
         "    try:",
         "        return _new(whole[0], whole[1](frame))",
         "    except struct.error:",

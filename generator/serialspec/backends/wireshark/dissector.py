@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from typing import Any, assert_never
 
+from serialspec.backends import Unsupported
 from serialspec.backends.common.frames import runtime_layout
 from serialspec.backends.common.render import render
 from serialspec.cli.views import engineering_unit
@@ -151,16 +152,29 @@ def _layout(layout: FrameLayout) -> dict[str, Any]:
         if element.checksum is not None:
             item["span"] = [runtime.span[0] + 1, runtime.span[1] + 1]
             item["checksum"] = _checksum(element.checksum)
+            if runtime.skip:  # the elements it leaves out, as a set: skip[i] is true
+                item["skip"] = {i + 1: True for i in runtime.skip}
         item["description"] = element.description
         elements.append(item)
     result: dict[str, Any] = {"elements": elements}
-    if engine.transparency is not None:
+    t = layout.transparency
+    if t is not None and engine.transparency is not None:
         first, last = engine.transparency.span
-        result["transparency"] = {
-            "first": first + 1,
-            "last": last + 1,
-            "replace": [[plain, wire] for plain, wire in engine.transparency.replace],
-        }
+        lua = t.transform.lua()
+        if lua is None:
+            raise Unsupported(f"frames with `method: {t.transform.name}`")
+        result["transparency"] = {"first": first + 1, "last": last + 1, **lua}
+        inner = engine._plan["probe_inner"]  # type: ignore[attr-defined]
+        if inner is not None:  # a length of plain bytes within the span (runtime/framing.py _inner_size)
+            in_span, at, _, uncounted, counted_fixed = inner
+            assert engine.length is not None
+            result["inner_length"] = {
+                "index": engine.length + 1,
+                "in_span": in_span,
+                "at": at,
+                "uncounted": uncounted,
+                "counted_fixed": counted_fixed,
+            }
     return result
 
 

@@ -214,6 +214,7 @@ class DevicePass(Pass):
                         known_state if isinstance(known_state, _Everything) else {**entries, **known_state},
                     ),
                     nothing_held={str(k): float(v) for k, v in (item.get("nothing_held") or {}).items()},
+                    echoes=self.echoes(item, item_path, key, request_names, response_names),
                 )
             )
         status = {str(k): str(v) for k, v in (value.get("status") or {}).items()}
@@ -618,6 +619,20 @@ class DevicePass(Pass):
                 self.error((*where, "bit"), f"bit {bit} is outside {name}'s {entry.type.size * 8} bits")
             found[str(name)] = (str(item["state"]), None if bit is None else int(bit))
         return found
+
+    def echoes(
+        self,
+        item: dict[str, Any],
+        path: Path,
+        key: str,
+        request_names: Container[str],
+        response_names: Container[str],
+    ) -> tuple[str, ...]:
+        """The response fields that repeat the request's field of the same name, each checked to be in both."""
+        for index, name in enumerate(item.get("echoes") or ()):
+            if name not in response_names or name not in request_names:
+                self.error((*path, "echoes", index), f"{key} has no request and response field {name!r}")
+        return tuple(str(name) for name in item.get("echoes") or ())
 
     def behaviour_extras(
         self,

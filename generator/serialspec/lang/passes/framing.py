@@ -9,7 +9,7 @@ from __future__ import annotations
 from dataclasses import replace
 from typing import Any, Literal
 
-from serialspec import checksums
+from serialspec import checksums, transforms
 from serialspec.checksums import ChecksumProblem
 from serialspec.lang.errors import SpecError
 from serialspec.lang.loader import Path
@@ -24,6 +24,7 @@ from serialspec.lang.model import (
 )
 from serialspec.lang.passes.fields import FieldResolver
 from serialspec.runtime.hexbytes import parse_hex
+from serialspec.transforms import TransformProblem
 
 CONSTANT_ROLES = ("header", "trailer", "constant")
 _CLASSIC_ROLES = {"header", "address", "command", "status", "length", "content", "checksum"}
@@ -217,17 +218,19 @@ class FramingPass(FieldResolver):
         if transparency_raw is not None:
             t_path: Path = (*framing_path, "transparency")
             first, last = self.span(transparency_raw.get("span"), direction, names, (*t_path, "span"))
-            pairs = []
-            for plain, wire in (transparency_raw.get("replace") or {}).items():
-                try:
-                    pairs.append((parse_hex(str(plain)), parse_hex(str(wire))))
-                except ValueError as exc:
-                    raise self.fail((*t_path, "replace", plain), str(exc)) from None
-            if not pairs or any(not p or not w for p, w in pairs):
-                raise self.fail((*t_path, "replace"), "give plain -> wire byte sequences, none empty")
+            try:
+                transform = transforms.from_spec(
+                    transparency_raw, lambda keys, message: self.error((*t_path, *keys), message)
+                )
+            except TransformProblem as problem:
+                raise self.fail((*t_path, *problem.keys), problem.message) from None
             if not names.index(first) <= content_index <= names.index(last):
                 raise self.fail((*t_path, "span"), "the transparency span must hold the content")
-            transparency = Transparency(first, last, tuple(pairs), str(transparency_raw.get("description", "")))
+            constants = [e.constant for e in elements]
+            refused = transform.check_layout(roles, constants, names.index(first), names.index(last))
+            if refused:
+                raise self.fail(t_path, refused)
+            transparency = Transparency(first, last, transform, str(transparency_raw.get("description", "")))
         t_first, t_last = (
             (names.index(transparency.first), names.index(transparency.last)) if transparency else (-1, -1)
         )
@@ -246,29 +249,45 @@ class FramingPass(FieldResolver):
                 default = (names[content_index], names[content_index]) if content_index >= 0 else None
                 counts = self.span(item.get("counts"), direction, names, (*e_path, "counts"), default)
                 a, b = names.index(counts[0]), names.index(counts[1])
-                if index >= a or (transparency and index >= t_first):
-                    raise self.fail(e_path, "the length must come before what it counts (and before any stuffing)")
+                if index >= a or (transparency and index > t_last):
+                    raise self.fail(e_path, "the length must come before what it counts (and before the span's end)")
+                within = transparency is not None and t_first <= a and b <= t_last  # it counts plain bytes
+                if transparency and t_first <= index and not within:
+                    raise self.fail(
+                        (*e_path, "counts"), "a length inside the transparency span counts elements inside it"
+                    )
+                if within and not a <= content_index <= b:
+                    raise self.fail(
+                        (*e_path, "counts"), "a length of bytes inside the transparency span counts the content"
+                    )
                 if overlaps_badly(a, b):
                     raise self.fail((*e_path, "counts"), "the counted span must hold the transparency span or miss it")
                 elements[index] = replace(element, counts=counts)
             elif element.role == "checksum" and element.checksum is not None:
                 covers = self.span(item.get("covers"), direction, names, (*e_path, "covers"))
                 a, b = names.index(covers[0]), names.index(covers[1])
-                if a <= index <= b:
-                    raise self.fail((*e_path, "covers"), "a checksum cannot cover itself")
+                if index in (a, b):
+                    raise self.fail((*e_path, "covers"), "a checksum cannot begin or end the span it covers")
+                if transparency and t_first <= index <= t_last and not (t_first <= a and b <= t_last):
+                    raise self.fail(
+                        (*e_path, "covers"),
+                        "a checksum inside the transparency span covers elements inside it (their plain bytes)",
+                    )
                 if overlaps_badly(a, b):
                     raise self.fail((*e_path, "covers"), "the covered span must hold the transparency span or miss it")
-                checksum = replace(element.checksum, first=covers[0], last=covers[1])
-                elements[index] = replace(element, checksum=checksum)
-        for length in (e for e in elements if e.role == "length" and transparency is not None):
-            a, b = names.index(length.counts[0]), names.index(length.counts[1])
-            for index in range(max(a, t_first), min(b, t_last) + 1):
-                if elements[index].role == "checksum":  # its stuffed size is known only after the length is set
+                # checksums strictly inside the span (itself too) are left out of it; one at an end is covered
+                skips = tuple(names[i] for i in range(a + 1, b) if elements[i].role == "checksum")
+                if skips and transparency and not (b < t_first or a > t_last):
                     raise self.fail(
-                        (*elements_path, elements[index].name),
-                        "a checksum inside the transparency span cannot be counted by a length (not supported yet: "
-                        "end the span before the checksum, or count up to the content)",
+                        (*e_path, "covers"), "a span that leaves out checksums cannot overlap the transparency span"
                     )
+                for end in {a, b}:
+                    if elements[end].role == "checksum" and end > index:
+                        raise self.fail(
+                            (*e_path, "covers"), f"a checksum covering {names[end]} must come after it in the frame"
+                        )
+                checksum = replace(element.checksum, first=covers[0], last=covers[1], skips=skips)
+                elements[index] = replace(element, checksum=checksum)
         checksums = tuple(e.checksum for e in elements if e.checksum is not None)
         flagged = any("error_flag" in item for item in raws.values())
         return self.classic_fields(direction, layout_name, tuple(elements), transparency, checksums, flagged)

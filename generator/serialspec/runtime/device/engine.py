@@ -113,6 +113,7 @@ class CommandSpec:
     # response field -> its value when nothing else gives one, where that is not 0: the empty value of its kind
     # (a list, text, bytes, items), or a function of the request's fields (as many items as the request asks for)
     blanks: dict[str, Any] = field(default_factory=dict)
+    echoes: tuple[str, ...] = ()  # response fields that repeat the request's field of the same name
     refused_while_moving: str = ""  # state variable: while it moves, the request is refused ("busy")
     counts: dict[str, tuple[str, float]] = field(default_factory=dict)  # response field -> (state, per)
     every_device: bool = False  # a request without an address reaches every device, not only the first
@@ -702,10 +703,12 @@ class Engine(FaultInjection):
                 values[name] = {}  # bit fields, filled in below
             elif command.tables.get(name, ())[:1] == ("run",):
                 values[name] = b""  # a run of registers in a reply holds what was read: nothing here
-            elif name in given:
+            elif name in given and name in command.echoes:
                 values[name] = given[name]
             elif name in self.spec.reply:
                 values[name] = self.spec.reply[name]
+            elif name in device.by_name or name in device.state:
+                values[name] = device.get(name)  # the device's own value, never the request's
             else:
                 blank = command.blanks.get(name, 0)
                 values[name] = blank(given) if callable(blank) else blank
@@ -814,13 +817,48 @@ class Engine(FaultInjection):
     def _read(self, device: VirtualDevice, command: CommandSpec, name: str, given: dict[str, Any]) -> Any:
         table = command.tables.get(name, ())
         if table[:1] == ("run",) and self.spec.registers is not None:
-            return self._read_run(device, self.spec.registers, int(given[table[1]]), int(given[table[2]]))
+            start = int(given[table[1]])
+            if table[2] in given:
+                return self._read_run(device, self.spec.registers, start, int(given[table[2]]))
+            # the request does not say how many bytes: the entry at the start (none: nothing)
+            register = self.spec.registers.by_address.get(start)
+            return self._read_run(device, self.spec.registers, start, register.size if register else 0)
         if table[:1] == ("value",):
             entry = device.by_key.get(int(given[table[1]]))
             return None if entry is None else device.get(entry.name)
         if table[:1] == ("block",):
             return {n: device.get(n) for n in table[1:]}
+        if table[:1] == ("group",):
+            return self._read_items(device, command, table[1:], given)
         return device.get(name)
+
+    def _read_items(
+        self, device: VirtualDevice, command: CommandSpec, names: tuple[str, ...], given: dict[str, Any]
+    ) -> list[dict[str, Any]] | None:
+        """A group of table values read by key: an item for each item of the request's group that names a key (its
+        fields the reply's items share copied), else for every entry of the memory; None for an unknown key."""
+        keyed = {n: command.tables[n][1] for n in names if command.tables.get(n, ())[:1] == ("value",)}
+        keys = set(keyed.values())
+        asked = next(
+            (v for v in given.values() if isinstance(v, list) and v and isinstance(v[0], dict) and keys <= set(v[0])),
+            None,
+        )
+        if asked is None:  # every entry, by its key
+            (key,) = keys if len(keys) == 1 else (None,)
+            asked = [{key: entry.key} for entry in device.by_key.values()] if key else []
+        items = []
+        for request_item in asked:
+            item: dict[str, Any] = {}
+            for n in names:
+                if n in keyed:
+                    entry = device.by_key.get(int(request_item[keyed[n]]))
+                    if entry is None:
+                        return None  # an unknown key: a device stays silent
+                    item[n] = device.get(entry.name)
+                else:
+                    item[n] = request_item.get(n, 0)
+            items.append(item)
+        return items
 
     def _read_run(self, device: VirtualDevice, registers: RegisterMap, start: int, size: int) -> bytes:
         """`size` bytes of memory from register `start` on; bytes of no register read as 0."""

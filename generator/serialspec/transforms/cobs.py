@@ -1,0 +1,157 @@
+"""`method: cobs`: Consistent Overhead Byte Stuffing (PacketSerial style). The span is sent without any 00 byte: each
+run of up to 254 non-zero bytes is preceded by a code byte (the run's length + 1) that stands for the 00 after it,
+and the frame ends with a trailer 00, the delimiter (lang/passes/framing.py checks it comes right after the span)."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from serialspec.runtime.errors import DecodeError
+from serialspec.transforms.base import Report, Sample, Transform
+
+
+def cobs_encode(data: bytes) -> bytes:
+    """COBS: a code byte before each run of non-zero bytes (254 at most), no 00 in the result."""
+    out = bytearray(b"\x00")
+    code_at, code = 0, 1
+    for byte in data:
+        if byte:
+            out.append(byte)
+            code += 1
+            if code == 0xFF:
+                out[code_at], code_at, code = code, len(out), 1
+                out.append(0)
+        else:
+            out[code_at], code_at, code = code, len(out), 1
+            out.append(0)
+    out[code_at] = code
+    return bytes(out)
+
+
+def cobs_decode(data: bytes) -> bytes:
+    """The bytes cobs_encode made `data` from; DecodeError for bytes that are no COBS form. A last run of 254 bytes
+    may end the data without the code byte 01 after it (the form some encoders make): it decodes the same."""
+    plain, used, _ = _decode(data, 0, len(data), None)
+    if used != len(data) or not data:
+        raise DecodeError(f"bad COBS: {data.hex(' ')} is not the COBS form of any bytes")
+    return plain
+
+
+def _decode(data: bytes, start: int, end: int, count: int | None) -> tuple[bytes, int, bool]:
+    """Plain bytes of the COBS bytes data[start:end] (up to `count` when given), the bytes read, and whether the
+    span ended (a 00, the delimiter, or the end of `data`) before `count` plain bytes were read."""
+    plain = bytearray()
+    position = start
+    while count is None or len(plain) < count:
+        if position >= end:
+            return bytes(plain), position - start, count is None
+        code = data[position]
+        if code == 0:
+            return bytes(plain), position - start, True
+        run = data[position + 1 : min(position + code, end)]
+        if 0 in run:
+            raise DecodeError(f"bad COBS: a 00 inside a run of {code - 1} bytes")
+        plain += run
+        if position + code > end:
+            if count is None:
+                raise DecodeError(f"bad COBS: a run of {code - 1} bytes goes past the end of the span")
+            return bytes(plain), end - start, False
+        position += code
+        if code < 0xFF and not (position >= len(data) or data[position] == 0):
+            plain.append(0)  # the 00 the code byte stands for (none after the last run)
+        elif code < 0xFF and count is not None and position >= end:
+            return bytes(plain), position - start, False  # the span may go on: is the 00 there or not?
+    return bytes(plain[:count]), position - start, False
+
+
+@dataclass(frozen=True)
+class CobsSpan:
+    """COBS over a span of elements: the runtime object of `method: cobs`."""
+
+    span: tuple[int, int]
+
+    def encode(self, data: bytes) -> bytes:
+        return cobs_encode(data)
+
+    def decode(self, data: bytes) -> bytes:
+        return cobs_decode(data)
+
+    def plain_prefix(self, buffer: bytes, start: int, end: int, count: int) -> tuple[bytes, int] | None:
+        plain, used, ended = _decode(buffer, start, end, count)
+        if len(plain) >= count or ended:
+            return plain[:count], used
+        return None
+
+
+@dataclass(frozen=True)
+class Cobs(Transform):
+    name = "cobs"
+    summary = (
+        "COBS, Consistent Overhead Byte Stuffing (PacketSerial): no 00 in the span, a code byte before each run of "
+        "up to 254 non-zero bytes; a trailer 00 right after the span ends the frame"
+    )
+    runtime_name = "CobsSpan"
+    samples = (
+        Sample(
+            "the whole packet, a checksum inside it, then the 00 delimiter (PacketSerial)",
+            {
+                "elements": {
+                    "code": {"role": "command", "type": "u8"},
+                    "content": {"role": "content"},
+                    "check": {
+                        "role": "checksum",
+                        "type": "u16",
+                        "algorithm": "fletcher",
+                        "covers": ["code", "content"],
+                    },
+                    "delimiter": {"role": "trailer", "value": "00"},
+                },
+                "transparency": {"method": "cobs", "span": ["code", "check"]},
+            },
+            plain=bytes.fromhex("01 00 12 00 00 34 47 82"),
+        ),
+        Sample(
+            "after a header, with a length inside the span (it counts the plain bytes)",
+            {
+                "elements": {
+                    "start": {"role": "header", "value": "AA"},
+                    "length": {"role": "length", "type": "u8", "counts": ["code", "content"]},
+                    "code": {"role": "command", "type": "u8"},
+                    "content": {"role": "content"},
+                    "checksum": {"role": "checksum", "type": "u8", "algorithm": "sum", "covers": ["code", "content"]},
+                    "delimiter": {"role": "trailer", "value": "00"},
+                },
+                "transparency": {"method": "cobs", "span": ["length", "checksum"]},
+            },
+            plain=bytes.fromhex("03 01 00 05 06"),
+        ),
+    )
+
+    @classmethod
+    def from_spec(cls, raw: Mapping[str, Any], report: Report) -> Cobs:
+        return cls()
+
+    def check_layout(self, roles: list[str], constants: list[bytes], first: int, last: int) -> str:
+        if last + 1 >= len(roles) or roles[last + 1] != "trailer" or constants[last + 1] != b"\x00":
+            return "COBS needs the delimiter right after its span: a trailer with `value: '00'`"
+        return ""
+
+    def runtime(self, span: tuple[int, int]) -> CobsSpan:
+        return CobsSpan(span)
+
+    def python_arguments(self, span: tuple[int, int]) -> list[str]:
+        return [f"({span[0]}, {span[1]})"]
+
+    def describe(self) -> str:
+        return (
+            "the bytes are sent in COBS form (no 00 among them: a code byte, the length of the run of non-zero bytes "
+            "after it + 1, stands for the 00 that ends the run; runs of 254 bytes take a code byte FF and no 00)"
+        )
+
+    def c_refusal(self) -> str:
+        return ""
+
+    def lua(self) -> dict[str, Any] | None:
+        return {"method": "cobs"}

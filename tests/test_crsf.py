@@ -162,8 +162,9 @@ def peer_reads(port: serial.Serial, wanted: set[int]) -> dict[int, list[Any]]:
             assert frame[0] == FC and crsf_frame_crc(frame) == frame[-1], frame.hex(" ")
             if frame[2] in PEER_PARSES:
                 got: list[tuple[Any, PacketValidationStatus]] = []
-                parser = CRSFParser(lambda content, status: got.append((content, status)))
-                parser.parse_stream(bytearray(frame))
+                CRSFParser(lambda content, status, into=got: into.append((content, status))).parse_stream(
+                    bytearray(frame)
+                )
                 assert [status for _, status in got] == [PacketValidationStatus.VALID], frame.hex(" ")
                 seen.setdefault(frame[2], []).append(got[0][0].payload)
             else:

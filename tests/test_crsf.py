@@ -54,8 +54,8 @@ OURS_LINK = {
 
 def test_documented_rc_frame_is_channel_1_first() -> None:
     printed = bytes.fromhex("c8 18 16 e0 03 1f f8 c0 07 3e f0 81 0f 7c e0 03 1f f8 c0 07 3e f0 81 0f 7c ad")
-    assert crsf.decode(printed, "response") == crsf.RcChannelsResponse(address=FC, channels=(992,) * 16)
-    ramp = crsf.encode(crsf.RcChannelsRequest(address=FC, channels=tuple(range(1, 17))))
+    assert crsf.decode(printed, "response") == crsf.RcChannelsResponse(channels=(992,) * 16)
+    ramp = crsf.encode(crsf.RcChannelsRequest(channels=tuple(range(1, 17))))
     assert ramp[3] == 1 and ramp[4] == 2 << 3  # channel 1 in the first byte's low bits, channel 2 after its 11 bits
 
 
@@ -63,7 +63,7 @@ def test_documented_rc_frame_is_channel_1_first() -> None:
 def test_peer_rc_channels_decode_and_re_encode(direction: str) -> None:
     frame = bytes(crsf_build_frame(PacketsTypes.RC_CHANNELS_PACKED, {"channels": list(reversed(CHANNELS))}))
     message = crsf.decode(frame, direction)
-    assert message.channels == CHANNELS and message.address == FC
+    assert message.channels == CHANNELS
     assert crsf.encode(message) == frame
 
 
@@ -71,12 +71,12 @@ def test_peer_battery_and_link_statistics_decode_and_re_encode() -> None:
     battery = {"voltage": 168, "current": 1234, "capacity": 0xABCDEF, "remaining": 80}
     frame = bytes(crsf_build_frame(PacketsTypes.BATTERY_SENSOR, battery))
     message = crsf.decode(frame, "response")
-    assert message == crsf.BatteryResponse(address=FC, **battery)
+    assert message == crsf.BatteryResponse(**battery)
     assert crsf.encode(message) == frame
     assert message.capacity == 0xABCDEF  # u24
     frame = bytes(crsf_build_frame(PacketsTypes.LINK_STATISTICS, LINK))
     message = crsf.decode(frame, "response")
-    assert message == crsf.LinkStatisticsResponse(address=FC, **OURS_LINK)
+    assert message == crsf.LinkStatisticsResponse(**OURS_LINK)
     assert crsf.encode(message) == frame
 
 
@@ -87,11 +87,11 @@ def peer_parses(frame: bytes) -> Any:
 
 
 def test_peer_parses_our_rc_channels_link_statistics_and_battery() -> None:
-    parsed = peer_parses(crsf.encode(crsf.RcChannelsResponse(address=FC, channels=CHANNELS)))
+    parsed = peer_parses(crsf.encode(crsf.RcChannelsResponse(channels=CHANNELS)))
     assert list(parsed.payload.channels) == list(reversed(CHANNELS))
-    parsed = peer_parses(crsf.encode(crsf.LinkStatisticsRequest(address=FC, **OURS_LINK)))
+    parsed = peer_parses(crsf.encode(crsf.LinkStatisticsRequest(**OURS_LINK)))
     assert {k: v if isinstance(v, int) else str(v) for k, v in parsed.payload.items() if k != "_io"} == LINK
-    parsed = peer_parses(crsf.encode(crsf.BatteryRequest(address=FC, voltage=1, current=2, capacity=3, remaining=4)))
+    parsed = peer_parses(crsf.encode(crsf.BatteryRequest(voltage=1, current=2, capacity=3, remaining=4)))
     assert (parsed.payload.voltage, parsed.payload.current, parsed.payload.capacity, parsed.payload.remaining) == (
         1,
         2,
@@ -105,7 +105,6 @@ def test_peer_parses_our_rc_channels_link_statistics_and_battery() -> None:
     [
         (
             crsf.GpsResponse(
-                address=FC,
                 latitude=473977418,
                 longitude=-85455939,
                 groundspeed=123,
@@ -115,12 +114,11 @@ def test_peer_parses_our_rc_channels_link_statistics_and_battery() -> None:
             ),
             "1c 40 52 4a fa e8 0b bd 00 7b 69 78 05 d0 0c",
         ),
-        (crsf.AttitudeRequest(address=FC, pitch=-1571, roll=15708, yaw=0), "f9 dd 3d 5c 00 00"),
-        (crsf.FlightModeResponse(address=FC, mode="ANGL*"), "41 4e 47 4c 2a 00"),
-        (crsf.DevicePingRequest(address=FC, destination=crsf.Address.CRSF_RECEIVER, origin=0xEA), "ec ea"),
+        (crsf.AttitudeRequest(pitch=-1571, roll=15708, yaw=0), "f9 dd 3d 5c 00 00"),
+        (crsf.FlightModeResponse(mode="ANGL*"), "41 4e 47 4c 2a 00"),
+        (crsf.DevicePingRequest(destination=crsf.Address.CRSF_RECEIVER, origin=0xEA), "ec ea"),
         (
             crsf.DeviceInfoResponse(
-                address=FC,
                 destination=0xEA,
                 origin=0xEC,
                 name="ELRS RX",
@@ -173,7 +171,7 @@ def peer_reads(port: serial.Serial, wanted: set[int]) -> dict[int, list[Any]]:
 
 
 def test_sim_streams_frames_the_peer_parses() -> None:
-    with serve("crsf.yaml", FC) as path, serial.Serial(path, 420000, timeout=0.1) as port:
+    with serve("crsf.yaml") as path, serial.Serial(path, 420000, timeout=0.1) as port:
         seen = peer_reads(port, {0x02, 0x08, 0x14, 0x16, 0x1E, 0x21})
     battery = seen[0x08][0]
     assert (battery.voltage, battery.current, battery.capacity, battery.remaining) == (168, 12, 350, 80)
@@ -184,18 +182,18 @@ def test_sim_streams_frames_the_peer_parses() -> None:
 
 
 def test_our_client_pings_the_sim_among_its_stream() -> None:
-    with serve("crsf.yaml", FC) as path, CrsfClient(path, timeout=2.0) as client:
-        info = client.device_ping(FC, crsf.Address.CRSF_RECEIVER, crsf.Address.FLIGHT_CONTROLLER)
+    with serve("crsf.yaml") as path, CrsfClient(path, timeout=2.0) as client:
+        info = client.device_ping(crsf.Address.CRSF_RECEIVER, crsf.Address.FLIGHT_CONTROLLER)
         assert (info.name, info.serial_number, info.parameter_count) == ("ELRS RX", 0x454C5253, 20)
         assert (info.destination, info.origin) == (crsf.Address.FLIGHT_CONTROLLER, crsf.Address.CRSF_RECEIVER)
         reports = client.reports(timeout=2.0)
         seen = {type(next(reports)) for _ in range(30)}
         assert {crsf.RcChannelsResponse, crsf.LinkStatisticsResponse} <= seen
-        client.rc_channels(FC, CHANNELS)  # sent on its own, nothing answers
+        client.rc_channels(CHANNELS)  # sent on its own, nothing answers
 
 
 def test_bad_crc_is_refused_in_one_line() -> None:
-    frame = bytearray(crsf.encode(crsf.RcChannelsResponse(address=FC, channels=CHANNELS)))
+    frame = bytearray(crsf.encode(crsf.RcChannelsResponse(channels=CHANNELS)))
     frame[-1] ^= 1
     with pytest.raises(Exception, match="(?i)checksum|crc") as caught:
         crsf.decode(bytes(frame), "response")

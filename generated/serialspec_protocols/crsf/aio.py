@@ -50,7 +50,7 @@ class AsyncCrsfClient(AsyncClientBase):
     Broadcast requests never wait for a reply.
     """
 
-    ADDRESS = 'address'
+    ADDRESS = ''
     BROADCAST = None
 
     def __init__(
@@ -74,13 +74,12 @@ class AsyncCrsfClient(AsyncClientBase):
     async def __aenter__(self) -> AsyncCrsfClient:
         return self
 
-    async def gps(self, address: int, latitude: int, longitude: int, groundspeed: int, heading: int, altitude: int, satellites: int) -> None:
+    async def gps(self, latitude: int, longitude: int, groundspeed: int, heading: int, altitude: int, satellites: int) -> None:
         """GPS (CRSF_FRAMETYPE_GPS).
 
         The GPS fix, sent by the flight controller as telemetry (and streamed by the simulated device).
 
         Args:
-            address: The address of the device the frame goes to, serving as sync byte: 0xC8 (the flight controller) on a receiver-to-flight-controller link both ways; 0xEE (the transmitter module) from a handset, 0xEA (the handset) from a module.
             latitude: Latitude in degrees × 10^7. [0.0000001°]
             longitude: Longitude in degrees × 10^7. [0.0000001°]
             groundspeed: Ground speed in km/h × 10. [0.1 km/h]
@@ -90,16 +89,15 @@ class AsyncCrsfClient(AsyncClientBase):
 
         The device does not answer.
         """
-        request = GpsRequest(address=address, latitude=latitude, longitude=longitude, groundspeed=groundspeed, heading=heading, altitude=altitude, satellites=satellites)
+        request = GpsRequest(latitude=latitude, longitude=longitude, groundspeed=groundspeed, heading=heading, altitude=altitude, satellites=satellites)
         await self.bus.send(request)
 
-    async def battery(self, address: int, voltage: int, current: int, capacity: int, remaining: int) -> None:
+    async def battery(self, voltage: int, current: int, capacity: int, remaining: int) -> None:
         """Battery sensor (CRSF_FRAMETYPE_BATTERY_SENSOR).
 
         The flight battery, sent as telemetry.
 
         Args:
-            address: The address of the device the frame goes to, serving as sync byte: 0xC8 (the flight controller) on a receiver-to-flight-controller link both ways; 0xEE (the transmitter module) from a handset, 0xEA (the handset) from a module.
             voltage: Voltage in V × 10. [0.1 V]
             current: Current in A × 10. [0.1 A]
             capacity: Charge drawn in mAh. [mAh]
@@ -107,16 +105,15 @@ class AsyncCrsfClient(AsyncClientBase):
 
         The device does not answer.
         """
-        request = BatteryRequest(address=address, voltage=voltage, current=current, capacity=capacity, remaining=remaining)
+        request = BatteryRequest(voltage=voltage, current=current, capacity=capacity, remaining=remaining)
         await self.bus.send(request)
 
-    async def link_statistics(self, address: int, uplink_rssi_ant1: int, uplink_rssi_ant2: int, uplink_link_quality: int, uplink_snr: int, active_antenna: int, rf_mode: int, uplink_tx_power: TxPower | int, downlink_rssi: int, downlink_link_quality: int, downlink_snr: int) -> None:
+    async def link_statistics(self, uplink_rssi_ant1: int, uplink_rssi_ant2: int, uplink_link_quality: int, uplink_snr: int, active_antenna: int, rf_mode: int, uplink_tx_power: TxPower | int, downlink_rssi: int, downlink_link_quality: int, downlink_snr: int) -> None:
         """Link statistics (CRSF_FRAMETYPE_LINK_STATISTICS).
 
         The radio link's state, sent by the receiver to the flight controller (and by the module to the handset). RSSI values are in dBm × -1 (a value of 60 is -60 dBm).
 
         Args:
-            address: The address of the device the frame goes to, serving as sync byte: 0xC8 (the flight controller) on a receiver-to-flight-controller link both ways; 0xEE (the transmitter module) from a handset, 0xEA (the handset) from a module.
             uplink_rssi_ant1: Uplink RSSI, antenna 1 (dBm × -1). [-1 dBm]
             uplink_rssi_ant2: Uplink RSSI, antenna 2 (dBm × -1). [-1 dBm]
             uplink_link_quality: Uplink packet success rate. [%] (0..100)
@@ -130,66 +127,62 @@ class AsyncCrsfClient(AsyncClientBase):
 
         The device does not answer.
         """
-        request = LinkStatisticsRequest(address=address, uplink_rssi_ant1=uplink_rssi_ant1, uplink_rssi_ant2=uplink_rssi_ant2, uplink_link_quality=uplink_link_quality, uplink_snr=uplink_snr, active_antenna=active_antenna, rf_mode=rf_mode, uplink_tx_power=uplink_tx_power, downlink_rssi=downlink_rssi, downlink_link_quality=downlink_link_quality, downlink_snr=downlink_snr)
+        request = LinkStatisticsRequest(uplink_rssi_ant1=uplink_rssi_ant1, uplink_rssi_ant2=uplink_rssi_ant2, uplink_link_quality=uplink_link_quality, uplink_snr=uplink_snr, active_antenna=active_antenna, rf_mode=rf_mode, uplink_tx_power=uplink_tx_power, downlink_rssi=downlink_rssi, downlink_link_quality=downlink_link_quality, downlink_snr=downlink_snr)
         await self.bus.send(request)
 
-    async def rc_channels(self, address: int, channels: tuple[int, ...]) -> None:
+    async def rc_channels(self, channels: tuple[int, ...]) -> None:
         """RC channels (CRSF_FRAMETYPE_RC_CHANNELS_PACKED).
 
         The 16 RC channels, sent by the receiver to the flight controller at the packet rate (every 4 to 20 ms, 250 to 50 Hz) and by the handset to its module. 172 is 988 µs, 992 is 1500 µs, 1811 is 2012 µs (µs = value × 5/8 + 880).
 
         Args:
-            address: The address of the device the frame goes to, serving as sync byte: 0xC8 (the flight controller) on a receiver-to-flight-controller link both ways; 0xEE (the transmitter module) from a handset, 0xEA (the handset) from a module.
             channels: Channels 1..16, 11 bits each, packed with no gaps: channel 1 in the lowest bits of the first byte, each value's lowest bit first (22 bytes).
 
         The device does not answer.
         """
-        request = RcChannelsRequest(address=address, channels=channels)
+        request = RcChannelsRequest(channels=channels)
         await self.bus.send(request)
 
-    async def attitude(self, address: int, pitch: int, roll: int, yaw: int) -> None:
+    async def attitude(self, pitch: int, roll: int, yaw: int) -> None:
         """Attitude (CRSF_FRAMETYPE_ATTITUDE).
 
         The aircraft's attitude, sent as telemetry.
 
         Args:
-            address: The address of the device the frame goes to, serving as sync byte: 0xC8 (the flight controller) on a receiver-to-flight-controller link both ways; 0xEE (the transmitter module) from a handset, 0xEA (the handset) from a module.
             pitch: Pitch in radians × 10000. [100 µrad]
             roll: Roll in radians × 10000. [100 µrad]
             yaw: Yaw in radians × 10000. [100 µrad]
 
         The device does not answer.
         """
-        request = AttitudeRequest(address=address, pitch=pitch, roll=roll, yaw=yaw)
+        request = AttitudeRequest(pitch=pitch, roll=roll, yaw=yaw)
         await self.bus.send(request)
 
-    async def flight_mode(self, address: int, mode: str) -> None:
+    async def flight_mode(self, mode: str) -> None:
         """Flight mode (CRSF_FRAMETYPE_FLIGHT_MODE).
 
         The flight controller's flight mode as text (ACRO, ANGL, HOR, ...; a trailing * when disarmed).
 
         Args:
-            address: The address of the device the frame goes to, serving as sync byte: 0xC8 (the flight controller) on a receiver-to-flight-controller link both ways; 0xEE (the transmitter module) from a handset, 0xEA (the handset) from a module.
             mode: The flight mode, NUL-terminated.
 
         The device does not answer.
         """
-        request = FlightModeRequest(address=address, mode=mode)
+        request = FlightModeRequest(mode=mode)
         await self.bus.send(request)
 
-    async def device_ping(self, address: int, destination: Address | int, origin: Address | int) -> DeviceInfoResponse:
+    async def device_ping(self, destination: Address | int, origin: Address | int) -> DeviceInfoResponse:
         """Device ping (CRSF_FRAMETYPE_DEVICE_PING).
 
         Asks the devices of the network to introduce themselves: every device the destination reaches (all of them for 0x00) answers with device info.
 
         Args:
-            address: The address of the device the frame goes to, serving as sync byte: 0xC8 (the flight controller) on a receiver-to-flight-controller link both ways; 0xEE (the transmitter module) from a handset, 0xEA (the handset) from a module.
             destination: Extended header: the address of the device the frame is for (0x00 for every device). (0..239)
             origin: Extended header: the address of the device that sent the frame. (0..239)
 
         Returns: the DeviceInfoResponse reply.
         """
-        request = DevicePingRequest(address=address, destination=destination, origin=origin)
+        request = DevicePingRequest(destination=destination, origin=origin)
         reply = await self.bus.request(request, DeviceInfoResponse)
         return reply
 

@@ -40,20 +40,26 @@ from .messages import (
 
 __all__ = ["StreamParser", "decode", "encode"]
 
-_F_LE_U8_U8_U8 = struct.Struct('<BBB')
+_F_LE_1S_U8_U8 = struct.Struct('<1sBB')
+_F_REQUEST_WHOLE_BE_I16_I16_I16 = struct.Struct('>3xhhh1x')
+_F_REQUEST_WHOLE_BE_I32_I32_U16_U16_U16_U8 = struct.Struct('>3xiiHHHB1x')
+_F_RESPONSE_WHOLE_BE_I16_I16_I16 = struct.Struct('>3xhhh1x')
+_F_RESPONSE_WHOLE_BE_I32_I32_U16_U16_U16_U8 = struct.Struct('>3xiiHHHB1x')
 _S_B22 = struct.Struct('<22s')
-_S_BE_FRAME_BATTERYREQUEST = struct.Struct('>BBBHH3sB')
-_S_BE_FRAME_GPSREQUEST = struct.Struct('>BBBiiHHHB')
-_S_BE_FRAME_LINKSTATISTICSREQUEST = struct.Struct('>BBBBBBbBBBBBb')
+_S_BE_B2_U8_I16_I16_I16_U8 = struct.Struct('>2sBhhhB')
+_S_BE_B2_U8_U8_U8_U8 = struct.Struct('>2sBBBB')
+_S_BE_FRAME_GPSREQUEST = struct.Struct('>BiiHHHB')
+_S_BE_FRAME_LINKSTATISTICSREQUEST = struct.Struct('>BBBBbBBBBBb')
 _S_BE_I16_I16_I16 = struct.Struct('>hhh')
 _S_BE_I32_I32_U16_U16_U16_U8 = struct.Struct('>iiHHHB')
 _S_BE_LINKSTATISTICSREQUEST_UPLINK_RSSI_ANT1 = struct.Struct('>BBBbBBBBBb')
 _S_BE_U16_U16_B3_U8 = struct.Struct('>HH3sB')
 _S_BE_U32_U32_U32_U8_U8 = struct.Struct('>IIIBB')
+_S_BE_U8_I16_I16_I16 = struct.Struct('>Bhhh')
+_S_BE_U8_U16_U16_B3_U8 = struct.Struct('>BHH3sB')
 _S_BE_U8_U8 = struct.Struct('>BB')
-_S_BE_U8_U8_U8_I16_I16_I16 = struct.Struct('>BBBhhh')
-_S_BE_U8_U8_U8_U8_U8 = struct.Struct('>BBBBB')
-_S_U8_U8_U8_B22 = struct.Struct('<BBB22s')
+_S_BE_U8_U8_U8 = struct.Struct('>BBB')
+_S_U8_B22 = struct.Struct('<B22s')
 _CHECK_CRC: Callable[[bytes], int] = crc_function(8, 0xd5, 0x0, False, False, 0x0)  # CRC-8/DVB-S2
 _CHECK_CRC_TABLE = crc_table(8, 0xd5, False)  # CRC-8/DVB-S2
 
@@ -61,81 +67,77 @@ _MEMBERS_Address = members(Address)
 _MEMBERS_TxPower = members(TxPower)
 
 
-def _decode_gps_request(buf: bytes, o: int, end: int, address: int) -> GpsRequest:
+def _decode_gps_request(buf: bytes, o: int, end: int) -> GpsRequest:
     if end - o != 15:
         raise content_size_error('gps request', end - o, 15, 15)
-    v_latitude, v_longitude, v_groundspeed, v_heading, v_altitude, v_satellites = _S_BE_I32_I32_U16_U16_U16_U8.unpack_from(buf, o)
-    return _new(GpsRequest, (address, v_latitude, v_longitude, v_groundspeed, v_heading, v_altitude, v_satellites))
+    return _new(GpsRequest, _S_BE_I32_I32_U16_U16_U16_U8.unpack_from(buf, o))
 
 
-def _decode_gps_response(buf: bytes, o: int, end: int, address: int) -> GpsResponse:
+def _decode_gps_response(buf: bytes, o: int, end: int) -> GpsResponse:
     if end - o != 15:
         raise content_size_error('gps response', end - o, 15, 15)
-    v_latitude, v_longitude, v_groundspeed, v_heading, v_altitude, v_satellites = _S_BE_I32_I32_U16_U16_U16_U8.unpack_from(buf, o)
-    return _new(GpsResponse, (address, v_latitude, v_longitude, v_groundspeed, v_heading, v_altitude, v_satellites))
+    return _new(GpsResponse, _S_BE_I32_I32_U16_U16_U16_U8.unpack_from(buf, o))
 
 
-def _decode_battery_request(buf: bytes, o: int, end: int, address: int) -> BatteryRequest:
+def _decode_battery_request(buf: bytes, o: int, end: int) -> BatteryRequest:
     if end - o != 8:
         raise content_size_error('battery request', end - o, 8, 8)
     v_voltage, v_current, v_capacity, v_remaining = _S_BE_U16_U16_B3_U8.unpack_from(buf, o)
     v_capacity = int.from_bytes(v_capacity, 'big', signed=False)
-    return _new(BatteryRequest, (address, v_voltage, v_current, v_capacity, v_remaining))
+    return _new(BatteryRequest, (v_voltage, v_current, v_capacity, v_remaining))
 
 
-def _decode_battery_response(buf: bytes, o: int, end: int, address: int) -> BatteryResponse:
+def _decode_battery_response(buf: bytes, o: int, end: int) -> BatteryResponse:
     if end - o != 8:
         raise content_size_error('battery response', end - o, 8, 8)
     v_voltage, v_current, v_capacity, v_remaining = _S_BE_U16_U16_B3_U8.unpack_from(buf, o)
     v_capacity = int.from_bytes(v_capacity, 'big', signed=False)
-    return _new(BatteryResponse, (address, v_voltage, v_current, v_capacity, v_remaining))
+    return _new(BatteryResponse, (v_voltage, v_current, v_capacity, v_remaining))
 
 
-def _decode_link_statistics_request(buf: bytes, o: int, end: int, address: int) -> LinkStatisticsRequest:
+def _decode_link_statistics_request(buf: bytes, o: int, end: int) -> LinkStatisticsRequest:
     if end - o != 10:
         raise content_size_error('link_statistics request', end - o, 10, 10)
     v_uplink_rssi_ant1, v_uplink_rssi_ant2, v_uplink_link_quality, v_uplink_snr, v_active_antenna, v_rf_mode, v_uplink_tx_power, v_downlink_rssi, v_downlink_link_quality, v_downlink_snr = _S_BE_LINKSTATISTICSREQUEST_UPLINK_RSSI_ANT1.unpack_from(buf, o)
-    return _new(LinkStatisticsRequest, (address, v_uplink_rssi_ant1, v_uplink_rssi_ant2, v_uplink_link_quality, v_uplink_snr, v_active_antenna, v_rf_mode, _MEMBERS_TxPower.get(v_uplink_tx_power, v_uplink_tx_power), v_downlink_rssi, v_downlink_link_quality, v_downlink_snr))
+    return _new(LinkStatisticsRequest, (v_uplink_rssi_ant1, v_uplink_rssi_ant2, v_uplink_link_quality, v_uplink_snr, v_active_antenna, v_rf_mode, _MEMBERS_TxPower.get(v_uplink_tx_power, v_uplink_tx_power), v_downlink_rssi, v_downlink_link_quality, v_downlink_snr))
 
 
-def _decode_link_statistics_response(buf: bytes, o: int, end: int, address: int) -> LinkStatisticsResponse:
+def _decode_link_statistics_response(buf: bytes, o: int, end: int) -> LinkStatisticsResponse:
     if end - o != 10:
         raise content_size_error('link_statistics response', end - o, 10, 10)
     v_uplink_rssi_ant1, v_uplink_rssi_ant2, v_uplink_link_quality, v_uplink_snr, v_active_antenna, v_rf_mode, v_uplink_tx_power, v_downlink_rssi, v_downlink_link_quality, v_downlink_snr = _S_BE_LINKSTATISTICSREQUEST_UPLINK_RSSI_ANT1.unpack_from(buf, o)
-    return _new(LinkStatisticsResponse, (address, v_uplink_rssi_ant1, v_uplink_rssi_ant2, v_uplink_link_quality, v_uplink_snr, v_active_antenna, v_rf_mode, _MEMBERS_TxPower.get(v_uplink_tx_power, v_uplink_tx_power), v_downlink_rssi, v_downlink_link_quality, v_downlink_snr))
+    return _new(LinkStatisticsResponse, (v_uplink_rssi_ant1, v_uplink_rssi_ant2, v_uplink_link_quality, v_uplink_snr, v_active_antenna, v_rf_mode, _MEMBERS_TxPower.get(v_uplink_tx_power, v_uplink_tx_power), v_downlink_rssi, v_downlink_link_quality, v_downlink_snr))
 
 
-def _decode_rc_channels_request(buf: bytes, o: int, end: int, address: int) -> RcChannelsRequest:
+def _decode_rc_channels_request(buf: bytes, o: int, end: int) -> RcChannelsRequest:
     if end - o != 22:
         raise content_size_error('rc_channels request', end - o, 22, 22)
     t = _S_B22.unpack_from(buf, o)
     v_channels = t[0]
-    return _new(RcChannelsRequest, (address, _unpack_ints(v_channels, 11, 16, True, False)))
+    return _new(RcChannelsRequest, (_unpack_ints(v_channels, 11, 16, True, False),))
 
 
-def _decode_rc_channels_response(buf: bytes, o: int, end: int, address: int) -> RcChannelsResponse:
+def _decode_rc_channels_response(buf: bytes, o: int, end: int) -> RcChannelsResponse:
     if end - o != 22:
         raise content_size_error('rc_channels response', end - o, 22, 22)
     t = _S_B22.unpack_from(buf, o)
     v_channels = t[0]
-    return _new(RcChannelsResponse, (address, _unpack_ints(v_channels, 11, 16, True, False)))
+    return _new(RcChannelsResponse, (_unpack_ints(v_channels, 11, 16, True, False),))
 
 
-def _decode_attitude_request(buf: bytes, o: int, end: int, address: int) -> AttitudeRequest:
+def _decode_attitude_request(buf: bytes, o: int, end: int) -> AttitudeRequest:
     if end - o != 6:
         raise content_size_error('attitude request', end - o, 6, 6)
-    v_pitch, v_roll, v_yaw = _S_BE_I16_I16_I16.unpack_from(buf, o)
-    return _new(AttitudeRequest, (address, v_pitch, v_roll, v_yaw))
+    return _new(AttitudeRequest, _S_BE_I16_I16_I16.unpack_from(buf, o))
 
 
-def _decode_attitude_response(buf: bytes, o: int, end: int, address: int) -> AttitudeResponse:
+def _decode_attitude_response(buf: bytes, o: int, end: int) -> AttitudeResponse:
     if end - o != 6:
         raise content_size_error('attitude response', end - o, 6, 6)
-    v_pitch, v_roll, v_yaw = _S_BE_I16_I16_I16.unpack_from(buf, o)
-    return _new(AttitudeResponse, (address, v_pitch, v_roll, v_yaw))
+    return _new(AttitudeResponse, _S_BE_I16_I16_I16.unpack_from(buf, o))
 
 
-def _decode_flight_mode_request(buf: bytes, o: int, end: int, address: int) -> FlightModeRequest:
+def _decode_flight_mode_request(buf: bytes, o: int, end: int) -> FlightModeRequest:
     if end - o < 1:
         raise content_size_error('flight_mode request', end - o, 1, None)
     stop = buf.find(b'\0', o, end)
@@ -145,10 +147,10 @@ def _decode_flight_mode_request(buf: bytes, o: int, end: int, address: int) -> F
     o = stop + 1
     if o != end:
         raise DecodeError('flight_mode request' + f': {end - o} bytes left after the last field')
-    return _new(FlightModeRequest, (address, v_mode))
+    return _new(FlightModeRequest, (v_mode,))
 
 
-def _decode_flight_mode_response(buf: bytes, o: int, end: int, address: int) -> FlightModeResponse:
+def _decode_flight_mode_response(buf: bytes, o: int, end: int) -> FlightModeResponse:
     if end - o < 1:
         raise content_size_error('flight_mode response', end - o, 1, None)
     stop = buf.find(b'\0', o, end)
@@ -158,17 +160,17 @@ def _decode_flight_mode_response(buf: bytes, o: int, end: int, address: int) -> 
     o = stop + 1
     if o != end:
         raise DecodeError('flight_mode response' + f': {end - o} bytes left after the last field')
-    return _new(FlightModeResponse, (address, v_mode))
+    return _new(FlightModeResponse, (v_mode,))
 
 
-def _decode_device_ping_request(buf: bytes, o: int, end: int, address: int) -> DevicePingRequest:
+def _decode_device_ping_request(buf: bytes, o: int, end: int) -> DevicePingRequest:
     if end - o != 2:
         raise content_size_error('device_ping request', end - o, 2, 2)
     v_destination, v_origin = _S_BE_U8_U8.unpack_from(buf, o)
-    return _new(DevicePingRequest, (address, _MEMBERS_Address.get(v_destination, v_destination), _MEMBERS_Address.get(v_origin, v_origin)))
+    return _new(DevicePingRequest, (_MEMBERS_Address.get(v_destination, v_destination), _MEMBERS_Address.get(v_origin, v_origin)))
 
 
-def _decode_device_info_response(buf: bytes, o: int, end: int, address: int) -> DeviceInfoResponse:
+def _decode_device_info_response(buf: bytes, o: int, end: int) -> DeviceInfoResponse:
     if end - o < 17:
         raise content_size_error('device_info response', end - o, 17, None)
     v_destination, v_origin = _S_BE_U8_U8.unpack_from(buf, o)
@@ -183,19 +185,16 @@ def _decode_device_info_response(buf: bytes, o: int, end: int, address: int) -> 
             raise DecodeError('device_info response' + f': serial_number needs 14 bytes, {end - o} left')
         raise DecodeError('device_info response' + f': {end - o - 14} bytes left after the last field')
     v_serial_number, v_hardware_id, v_firmware_id, v_parameter_count, v_parameter_version = _S_BE_U32_U32_U32_U8_U8.unpack_from(buf, o)
-    return _new(DeviceInfoResponse, (address, _MEMBERS_Address.get(v_destination, v_destination), _MEMBERS_Address.get(v_origin, v_origin), v_name, v_serial_number, v_hardware_id, v_firmware_id, v_parameter_count, v_parameter_version))
+    return _new(DeviceInfoResponse, (_MEMBERS_Address.get(v_destination, v_destination), _MEMBERS_Address.get(v_origin, v_origin), v_name, v_serial_number, v_hardware_id, v_firmware_id, v_parameter_count, v_parameter_version))
 
 
 def _encode_gps_request(m: GpsRequest) -> bytes:
-    m_address = m.address
     m_latitude = m.latitude
     m_longitude = m.longitude
     m_groundspeed = m.groundspeed
     m_heading = m.heading
     m_altitude = m.altitude
     m_satellites = m.satellites
-    if not 0 <= m_address <= 255 or m_address.__class__ is bool:
-        raise out_of_range('gps request', 'address', m_address, 0, 255)
     if not -2147483648 <= m_latitude <= 2147483647 or m_latitude.__class__ is bool:
         raise out_of_range('gps request', 'latitude', m_latitude, -2147483648, 2147483647)
     if not -2147483648 <= m_longitude <= 2147483647 or m_longitude.__class__ is bool:
@@ -208,20 +207,17 @@ def _encode_gps_request(m: GpsRequest) -> bytes:
         raise out_of_range('gps request', 'altitude', m_altitude, 0, 65535)
     if not 0 <= m_satellites <= 255 or m_satellites.__class__ is bool:
         raise out_of_range('gps request', 'satellites', m_satellites, 0, 255)
-    frame = _S_BE_FRAME_GPSREQUEST.pack(m_address, 17, 0x02, m_latitude, m_longitude, m_groundspeed, m_heading, m_altitude, m_satellites)
-    return frame + _CHECK_CRC(frame[2:]).to_bytes(1, 'little')
+    body = _S_BE_FRAME_GPSREQUEST.pack(0x02, m_latitude, m_longitude, m_groundspeed, m_heading, m_altitude, m_satellites)
+    return b''.join((b'\xc8\x11', body, _CHECK_CRC(body).to_bytes(1, 'little')))
 
 
 def _encode_gps_response(m: GpsResponse) -> bytes:
-    m_address = m.address
     m_latitude = m.latitude
     m_longitude = m.longitude
     m_groundspeed = m.groundspeed
     m_heading = m.heading
     m_altitude = m.altitude
     m_satellites = m.satellites
-    if not 0 <= m_address <= 255 or m_address.__class__ is bool:
-        raise out_of_range('gps response', 'address', m_address, 0, 255)
     if not -2147483648 <= m_latitude <= 2147483647 or m_latitude.__class__ is bool:
         raise out_of_range('gps response', 'latitude', m_latitude, -2147483648, 2147483647)
     if not -2147483648 <= m_longitude <= 2147483647 or m_longitude.__class__ is bool:
@@ -234,18 +230,15 @@ def _encode_gps_response(m: GpsResponse) -> bytes:
         raise out_of_range('gps response', 'altitude', m_altitude, 0, 65535)
     if not 0 <= m_satellites <= 255 or m_satellites.__class__ is bool:
         raise out_of_range('gps response', 'satellites', m_satellites, 0, 255)
-    frame = _S_BE_FRAME_GPSREQUEST.pack(m_address, 17, 0x02, m_latitude, m_longitude, m_groundspeed, m_heading, m_altitude, m_satellites)
-    return frame + _CHECK_CRC(frame[2:]).to_bytes(1, 'little')
+    body = _S_BE_FRAME_GPSREQUEST.pack(0x02, m_latitude, m_longitude, m_groundspeed, m_heading, m_altitude, m_satellites)
+    return b''.join((b'\xc8\x11', body, _CHECK_CRC(body).to_bytes(1, 'little')))
 
 
 def _encode_battery_request(m: BatteryRequest) -> bytes:
-    m_address = m.address
     m_voltage = m.voltage
     m_current = m.current
     m_capacity = m.capacity
     m_remaining = m.remaining
-    if not 0 <= m_address <= 255 or m_address.__class__ is bool:
-        raise out_of_range('battery request', 'address', m_address, 0, 255)
     if not 0 <= m_voltage <= 65535 or m_voltage.__class__ is bool:
         raise out_of_range('battery request', 'voltage', m_voltage, 0, 65535)
     if not 0 <= m_current <= 65535 or m_current.__class__ is bool:
@@ -254,18 +247,15 @@ def _encode_battery_request(m: BatteryRequest) -> bytes:
         raise out_of_range('battery request', 'capacity', m_capacity, 0, 16777215)
     if not 0 <= m_remaining <= 100 or m_remaining.__class__ is bool:
         raise out_of_range('battery request', 'remaining', m_remaining, 0, 100)
-    frame = _S_BE_FRAME_BATTERYREQUEST.pack(m_address, 10, 0x08, m_voltage, m_current, (m_capacity).to_bytes(3, 'big', signed=False), m_remaining)
-    return frame + _CHECK_CRC(frame[2:]).to_bytes(1, 'little')
+    body = _S_BE_U8_U16_U16_B3_U8.pack(0x08, m_voltage, m_current, (m_capacity).to_bytes(3, 'big', signed=False), m_remaining)
+    return b''.join((b'\xc8\n', body, _CHECK_CRC(body).to_bytes(1, 'little')))
 
 
 def _encode_battery_response(m: BatteryResponse) -> bytes:
-    m_address = m.address
     m_voltage = m.voltage
     m_current = m.current
     m_capacity = m.capacity
     m_remaining = m.remaining
-    if not 0 <= m_address <= 255 or m_address.__class__ is bool:
-        raise out_of_range('battery response', 'address', m_address, 0, 255)
     if not 0 <= m_voltage <= 65535 or m_voltage.__class__ is bool:
         raise out_of_range('battery response', 'voltage', m_voltage, 0, 65535)
     if not 0 <= m_current <= 65535 or m_current.__class__ is bool:
@@ -274,12 +264,11 @@ def _encode_battery_response(m: BatteryResponse) -> bytes:
         raise out_of_range('battery response', 'capacity', m_capacity, 0, 16777215)
     if not 0 <= m_remaining <= 100 or m_remaining.__class__ is bool:
         raise out_of_range('battery response', 'remaining', m_remaining, 0, 100)
-    frame = _S_BE_FRAME_BATTERYREQUEST.pack(m_address, 10, 0x08, m_voltage, m_current, (m_capacity).to_bytes(3, 'big', signed=False), m_remaining)
-    return frame + _CHECK_CRC(frame[2:]).to_bytes(1, 'little')
+    body = _S_BE_U8_U16_U16_B3_U8.pack(0x08, m_voltage, m_current, (m_capacity).to_bytes(3, 'big', signed=False), m_remaining)
+    return b''.join((b'\xc8\n', body, _CHECK_CRC(body).to_bytes(1, 'little')))
 
 
 def _encode_link_statistics_request(m: LinkStatisticsRequest) -> bytes:
-    m_address = m.address
     m_uplink_rssi_ant1 = m.uplink_rssi_ant1
     m_uplink_rssi_ant2 = m.uplink_rssi_ant2
     m_uplink_link_quality = m.uplink_link_quality
@@ -290,8 +279,6 @@ def _encode_link_statistics_request(m: LinkStatisticsRequest) -> bytes:
     m_downlink_rssi = m.downlink_rssi
     m_downlink_link_quality = m.downlink_link_quality
     m_downlink_snr = m.downlink_snr
-    if not 0 <= m_address <= 255 or m_address.__class__ is bool:
-        raise out_of_range('link_statistics request', 'address', m_address, 0, 255)
     if not 0 <= m_uplink_rssi_ant1 <= 255 or m_uplink_rssi_ant1.__class__ is bool:
         raise out_of_range('link_statistics request', 'uplink_rssi_ant1', m_uplink_rssi_ant1, 0, 255)
     if not 0 <= m_uplink_rssi_ant2 <= 255 or m_uplink_rssi_ant2.__class__ is bool:
@@ -312,12 +299,11 @@ def _encode_link_statistics_request(m: LinkStatisticsRequest) -> bytes:
         raise out_of_range('link_statistics request', 'downlink_link_quality', m_downlink_link_quality, 0, 100)
     if not -128 <= m_downlink_snr <= 127 or m_downlink_snr.__class__ is bool:
         raise out_of_range('link_statistics request', 'downlink_snr', m_downlink_snr, -128, 127)
-    frame = _S_BE_FRAME_LINKSTATISTICSREQUEST.pack(m_address, 12, 0x14, m_uplink_rssi_ant1, m_uplink_rssi_ant2, m_uplink_link_quality, m_uplink_snr, m_active_antenna, m_rf_mode, m_uplink_tx_power, m_downlink_rssi, m_downlink_link_quality, m_downlink_snr)
-    return frame + _CHECK_CRC(frame[2:]).to_bytes(1, 'little')
+    body = _S_BE_FRAME_LINKSTATISTICSREQUEST.pack(0x14, m_uplink_rssi_ant1, m_uplink_rssi_ant2, m_uplink_link_quality, m_uplink_snr, m_active_antenna, m_rf_mode, m_uplink_tx_power, m_downlink_rssi, m_downlink_link_quality, m_downlink_snr)
+    return b''.join((b'\xc8\x0c', body, _CHECK_CRC(body).to_bytes(1, 'little')))
 
 
 def _encode_link_statistics_response(m: LinkStatisticsResponse) -> bytes:
-    m_address = m.address
     m_uplink_rssi_ant1 = m.uplink_rssi_ant1
     m_uplink_rssi_ant2 = m.uplink_rssi_ant2
     m_uplink_link_quality = m.uplink_link_quality
@@ -328,8 +314,6 @@ def _encode_link_statistics_response(m: LinkStatisticsResponse) -> bytes:
     m_downlink_rssi = m.downlink_rssi
     m_downlink_link_quality = m.downlink_link_quality
     m_downlink_snr = m.downlink_snr
-    if not 0 <= m_address <= 255 or m_address.__class__ is bool:
-        raise out_of_range('link_statistics response', 'address', m_address, 0, 255)
     if not 0 <= m_uplink_rssi_ant1 <= 255 or m_uplink_rssi_ant1.__class__ is bool:
         raise out_of_range('link_statistics response', 'uplink_rssi_ant1', m_uplink_rssi_ant1, 0, 255)
     if not 0 <= m_uplink_rssi_ant2 <= 255 or m_uplink_rssi_ant2.__class__ is bool:
@@ -350,102 +334,80 @@ def _encode_link_statistics_response(m: LinkStatisticsResponse) -> bytes:
         raise out_of_range('link_statistics response', 'downlink_link_quality', m_downlink_link_quality, 0, 100)
     if not -128 <= m_downlink_snr <= 127 or m_downlink_snr.__class__ is bool:
         raise out_of_range('link_statistics response', 'downlink_snr', m_downlink_snr, -128, 127)
-    frame = _S_BE_FRAME_LINKSTATISTICSREQUEST.pack(m_address, 12, 0x14, m_uplink_rssi_ant1, m_uplink_rssi_ant2, m_uplink_link_quality, m_uplink_snr, m_active_antenna, m_rf_mode, m_uplink_tx_power, m_downlink_rssi, m_downlink_link_quality, m_downlink_snr)
-    return frame + _CHECK_CRC(frame[2:]).to_bytes(1, 'little')
+    body = _S_BE_FRAME_LINKSTATISTICSREQUEST.pack(0x14, m_uplink_rssi_ant1, m_uplink_rssi_ant2, m_uplink_link_quality, m_uplink_snr, m_active_antenna, m_rf_mode, m_uplink_tx_power, m_downlink_rssi, m_downlink_link_quality, m_downlink_snr)
+    return b''.join((b'\xc8\x0c', body, _CHECK_CRC(body).to_bytes(1, 'little')))
 
 
 def _encode_rc_channels_request(m: RcChannelsRequest) -> bytes:
-    m_address = m.address
     m_channels = m.channels
-    if not 0 <= m_address <= 255 or m_address.__class__ is bool:
-        raise out_of_range('rc_channels request', 'address', m_address, 0, 255)
     if len(m_channels) != 16:
         raise EncodeError('rc_channels request' + f': channels needs 16 items, got {len(m_channels)}')
     for x_channels in m_channels:
         if not 0 <= x_channels <= 2047 or x_channels.__class__ is bool:
             raise out_of_range('rc_channels request', 'channels', m_channels, 0, 2047)
-    frame = _S_U8_U8_U8_B22.pack(m_address, 24, 0x16, _pack_ints(m_channels, 11, 16, True))
-    return frame + _CHECK_CRC(frame[2:]).to_bytes(1, 'little')
+    body = _S_U8_B22.pack(0x16, _pack_ints(m_channels, 11, 16, True))
+    return b''.join((b'\xc8\x18', body, _CHECK_CRC(body).to_bytes(1, 'little')))
 
 
 def _encode_rc_channels_response(m: RcChannelsResponse) -> bytes:
-    m_address = m.address
     m_channels = m.channels
-    if not 0 <= m_address <= 255 or m_address.__class__ is bool:
-        raise out_of_range('rc_channels response', 'address', m_address, 0, 255)
     if len(m_channels) != 16:
         raise EncodeError('rc_channels response' + f': channels needs 16 items, got {len(m_channels)}')
     for x_channels in m_channels:
         if not 0 <= x_channels <= 2047 or x_channels.__class__ is bool:
             raise out_of_range('rc_channels response', 'channels', m_channels, 0, 2047)
-    frame = _S_U8_U8_U8_B22.pack(m_address, 24, 0x16, _pack_ints(m_channels, 11, 16, True))
-    return frame + _CHECK_CRC(frame[2:]).to_bytes(1, 'little')
+    body = _S_U8_B22.pack(0x16, _pack_ints(m_channels, 11, 16, True))
+    return b''.join((b'\xc8\x18', body, _CHECK_CRC(body).to_bytes(1, 'little')))
 
 
 def _encode_attitude_request(m: AttitudeRequest) -> bytes:
-    m_address = m.address
     m_pitch = m.pitch
     m_roll = m.roll
     m_yaw = m.yaw
-    if not 0 <= m_address <= 255 or m_address.__class__ is bool:
-        raise out_of_range('attitude request', 'address', m_address, 0, 255)
     if not -32768 <= m_pitch <= 32767 or m_pitch.__class__ is bool:
         raise out_of_range('attitude request', 'pitch', m_pitch, -32768, 32767)
     if not -32768 <= m_roll <= 32767 or m_roll.__class__ is bool:
         raise out_of_range('attitude request', 'roll', m_roll, -32768, 32767)
     if not -32768 <= m_yaw <= 32767 or m_yaw.__class__ is bool:
         raise out_of_range('attitude request', 'yaw', m_yaw, -32768, 32767)
-    frame = _S_BE_U8_U8_U8_I16_I16_I16.pack(m_address, 8, 0x1e, m_pitch, m_roll, m_yaw)
-    return frame + _CHECK_CRC(frame[2:]).to_bytes(1, 'little')
+    body = _S_BE_U8_I16_I16_I16.pack(0x1e, m_pitch, m_roll, m_yaw)
+    return _S_BE_B2_U8_I16_I16_I16_U8.pack(b'\xc8\x08', 0x1e, m_pitch, m_roll, m_yaw, _CHECK_CRC(body))
 
 
 def _encode_attitude_response(m: AttitudeResponse) -> bytes:
-    m_address = m.address
     m_pitch = m.pitch
     m_roll = m.roll
     m_yaw = m.yaw
-    if not 0 <= m_address <= 255 or m_address.__class__ is bool:
-        raise out_of_range('attitude response', 'address', m_address, 0, 255)
     if not -32768 <= m_pitch <= 32767 or m_pitch.__class__ is bool:
         raise out_of_range('attitude response', 'pitch', m_pitch, -32768, 32767)
     if not -32768 <= m_roll <= 32767 or m_roll.__class__ is bool:
         raise out_of_range('attitude response', 'roll', m_roll, -32768, 32767)
     if not -32768 <= m_yaw <= 32767 or m_yaw.__class__ is bool:
         raise out_of_range('attitude response', 'yaw', m_yaw, -32768, 32767)
-    frame = _S_BE_U8_U8_U8_I16_I16_I16.pack(m_address, 8, 0x1e, m_pitch, m_roll, m_yaw)
-    return frame + _CHECK_CRC(frame[2:]).to_bytes(1, 'little')
+    body = _S_BE_U8_I16_I16_I16.pack(0x1e, m_pitch, m_roll, m_yaw)
+    return _S_BE_B2_U8_I16_I16_I16_U8.pack(b'\xc8\x08', 0x1e, m_pitch, m_roll, m_yaw, _CHECK_CRC(body))
 
 
 def _encode_flight_mode_request(m: FlightModeRequest) -> bytes:
-    m_address = m.address
-    if not 0 <= m_address <= 255 or m_address.__class__ is bool:
-        raise out_of_range('flight_mode request', 'address', m_address, 0, 255)
-    return _wrap_request(_encode_text(m.mode, 'mode', 'flight_mode request', True), 0x21, m_address)
+    return _wrap_request(_encode_text(m.mode, 'mode', 'flight_mode request', True), 0x21)
 
 
 def _encode_flight_mode_response(m: FlightModeResponse) -> bytes:
-    m_address = m.address
-    if not 0 <= m_address <= 255 or m_address.__class__ is bool:
-        raise out_of_range('flight_mode response', 'address', m_address, 0, 255)
-    return _wrap_response(_encode_text(m.mode, 'mode', 'flight_mode response', True), 0x21, m_address)
+    return _wrap_response(_encode_text(m.mode, 'mode', 'flight_mode response', True), 0x21)
 
 
 def _encode_device_ping_request(m: DevicePingRequest) -> bytes:
-    m_address = m.address
     m_destination = m.destination
     m_origin = m.origin
-    if not 0 <= m_address <= 255 or m_address.__class__ is bool:
-        raise out_of_range('device_ping request', 'address', m_address, 0, 255)
     if not 0 <= m_destination <= 239 or m_destination.__class__ is bool:
         raise out_of_range('device_ping request', 'destination', m_destination, 0, 239)
     if not 0 <= m_origin <= 239 or m_origin.__class__ is bool:
         raise out_of_range('device_ping request', 'origin', m_origin, 0, 239)
-    frame = _S_BE_U8_U8_U8_U8_U8.pack(m_address, 4, 0x28, m_destination, m_origin)
-    return frame + _CHECK_CRC(frame[2:]).to_bytes(1, 'little')
+    body = _S_BE_U8_U8_U8.pack(0x28, m_destination, m_origin)
+    return _S_BE_B2_U8_U8_U8_U8.pack(b'\xc8\x04', 0x28, m_destination, m_origin, _CHECK_CRC(body))
 
 
 def _encode_device_info_response(m: DeviceInfoResponse) -> bytes:
-    m_address = m.address
     m_destination = m.destination
     m_origin = m.origin
     m_serial_number = m.serial_number
@@ -453,8 +415,6 @@ def _encode_device_info_response(m: DeviceInfoResponse) -> bytes:
     m_firmware_id = m.firmware_id
     m_parameter_count = m.parameter_count
     m_parameter_version = m.parameter_version
-    if not 0 <= m_address <= 255 or m_address.__class__ is bool:
-        raise out_of_range('device_info response', 'address', m_address, 0, 255)
     if not 0 <= m_destination <= 239 or m_destination.__class__ is bool:
         raise out_of_range('device_info response', 'destination', m_destination, 0, 239)
     if not 0 <= m_origin <= 239 or m_origin.__class__ is bool:
@@ -469,7 +429,7 @@ def _encode_device_info_response(m: DeviceInfoResponse) -> bytes:
         raise out_of_range('device_info response', 'parameter_count', m_parameter_count, 0, 255)
     if not 0 <= m_parameter_version <= 255 or m_parameter_version.__class__ is bool:
         raise out_of_range('device_info response', 'parameter_version', m_parameter_version, 0, 255)
-    return _wrap_response(b''.join((_S_BE_U8_U8.pack(m_destination, m_origin), _encode_text(m.name, 'name', 'device_info response', True), _S_BE_U32_U32_U32_U8_U8.pack(m_serial_number, m_hardware_id, m_firmware_id, m_parameter_count, m_parameter_version),)), 0x29, m_address)
+    return _wrap_response(b''.join((_S_BE_U8_U8.pack(m_destination, m_origin), _encode_text(m.name, 'name', 'device_info response', True), _S_BE_U32_U32_U32_U8_U8.pack(m_serial_number, m_hardware_id, m_firmware_id, m_parameter_count, m_parameter_version),)), 0x29)
 
 
 _REQUEST_DECODERS: dict[int | None, Callable[..., Message]] = {
@@ -484,7 +444,7 @@ _REQUEST_DECODERS: dict[int | None, Callable[..., Message]] = {
 _REQUEST_FRAMES = FrameCodec(
     (
         Layout('request', (
-            Element('address', 'value', 1, minimum=0, maximum=255),
+            Element('sync', 'constant', 1, constant=b'\xc8'),
             Element('length', 'length', 1, span=(2, 4)),
             Element('type', 'command', 1, minimum=0, maximum=255),
             Element('payload', 'content'),
@@ -510,7 +470,8 @@ def _decode_request(frame: bytes, expect: type[Message] | None = None) -> Messag
         raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (4)")
     end = n - 1
     buf = frame
-    v_address = buf[0]
+    if buf[0] != 0xc8:
+        raise DecodeError(f"sync is {buf[0:1].hex(' ')}, expected c8")
     length = buf[1]
     if length != n - 2:
         raise DecodeError(f"length says {length} but the frame holds {n - 2}")
@@ -524,15 +485,23 @@ def _decode_request(frame: bytes, expect: type[Message] | None = None) -> Messag
         decoder = _REQUEST_DECODERS[code]
     except KeyError:
         raise DecodeError(f"unknown command {code!r}") from None
-    return decoder(buf, 3, end, v_address)
+    return decoder(buf, 3, end)
 
 
-def _wrap_request(content: bytes, code: int | None, v_address: int) -> bytes:
+# Request frames of one size whose message is their content as one struct unpacks it, by their
+# first bytes (up to the content): class, unpack of the whole frame.
+_REQUEST_WHOLE: dict[bytes, tuple[type[Message], Callable[[bytes], tuple[object, ...]]]] = {
+    b'\xc8\x11\x02': (GpsRequest, _F_REQUEST_WHOLE_BE_I32_I32_U16_U16_U16_U8.unpack),
+    b'\xc8\x08\x1e': (AttitudeRequest, _F_REQUEST_WHOLE_BE_I16_I16_I16.unpack),
+}
+
+
+def _wrap_request(content: bytes, code: int | None) -> bytes:
     """The request frame around `content`, EncodeError if it cannot be."""
     v_length = len(content) + 2
     if not v_length < 256:
         raise EncodeError(f"request frame: length {v_length} does not fit its 1-byte field")
-    frame = _F_LE_U8_U8_U8.pack(v_address, v_length, code) + content
+    frame = _F_LE_1S_U8_U8.pack(b'\xc8', v_length, code) + content
     return frame + _CHECK_CRC(frame[2:]).to_bytes(1, 'little')
 
 
@@ -548,7 +517,7 @@ _RESPONSE_DECODERS: dict[int | None, Callable[..., Message]] = {
 _RESPONSE_FRAMES = FrameCodec(
     (
         Layout('response', (
-            Element('address', 'value', 1, minimum=0, maximum=255),
+            Element('sync', 'constant', 1, constant=b'\xc8'),
             Element('length', 'length', 1, span=(2, 4)),
             Element('type', 'command', 1, minimum=0, maximum=255),
             Element('payload', 'content'),
@@ -574,7 +543,8 @@ def _decode_response(frame: bytes, expect: type[Message] | None = None) -> Messa
         raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (4)")
     end = n - 1
     buf = frame
-    v_address = buf[0]
+    if buf[0] != 0xc8:
+        raise DecodeError(f"sync is {buf[0:1].hex(' ')}, expected c8")
     length = buf[1]
     if length != n - 2:
         raise DecodeError(f"length says {length} but the frame holds {n - 2}")
@@ -588,15 +558,23 @@ def _decode_response(frame: bytes, expect: type[Message] | None = None) -> Messa
         decoder = _RESPONSE_DECODERS[code]
     except KeyError:
         raise DecodeError(f"unknown command {code!r}") from None
-    return decoder(buf, 3, end, v_address)
+    return decoder(buf, 3, end)
 
 
-def _wrap_response(content: bytes, code: int | None, v_address: int) -> bytes:
+# Response frames of one size whose message is their content as one struct unpacks it, by their
+# first bytes (up to the content): class, unpack of the whole frame.
+_RESPONSE_WHOLE: dict[bytes, tuple[type[Message], Callable[[bytes], tuple[object, ...]]]] = {
+    b'\xc8\x11\x02': (GpsResponse, _F_RESPONSE_WHOLE_BE_I32_I32_U16_U16_U16_U8.unpack),
+    b'\xc8\x08\x1e': (AttitudeResponse, _F_RESPONSE_WHOLE_BE_I16_I16_I16.unpack),
+}
+
+
+def _wrap_response(content: bytes, code: int | None) -> bytes:
     """The response frame around `content`, EncodeError if it cannot be."""
     v_length = len(content) + 2
     if not v_length < 256:
         raise EncodeError(f"response frame: length {v_length} does not fit its 1-byte field")
-    frame = _F_LE_U8_U8_U8.pack(v_address, v_length, code) + content
+    frame = _F_LE_1S_U8_U8.pack(b'\xc8', v_length, code) + content
     return frame + _CHECK_CRC(frame[2:]).to_bytes(1, 'little')
 
 
@@ -626,12 +604,19 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
     """
     if direction is _REQUEST or direction == 'request':  # a Direction (told by identity, first) or its value
         frame = data if data.__class__ is bytes else bytes(data)
+        whole = _REQUEST_WHOLE.get(frame[:3])
+        if whole is not None and _CHECK_CRC(frame[2:]) == 0x00:
+            try:
+                return _new(whole[0], whole[1](frame))
+            except struct.error:
+                pass  # a frame of another size: the general path says what is wrong
         n = len(frame)
         if n < 4:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (4)")
         end = n - 1
         buf = frame
-        v_address = buf[0]
+        if buf[0] != 0xc8:
+            raise DecodeError(f"sync is {buf[0:1].hex(' ')}, expected c8")
         length = buf[1]
         if length != n - 2:
             raise DecodeError(f"length says {length} but the frame holds {n - 2}")
@@ -645,15 +630,22 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
             decoder = _REQUEST_DECODERS[code]
         except KeyError:
             raise DecodeError(f"unknown command {code!r}") from None
-        return decoder(buf, 3, end, v_address)
+        return decoder(buf, 3, end)
     if direction is _RESPONSE or direction == 'response':  # a Direction (told by identity, first) or its value
         frame = data if data.__class__ is bytes else bytes(data)
+        whole = _RESPONSE_WHOLE.get(frame[:3])
+        if whole is not None and _CHECK_CRC(frame[2:]) == 0x00:
+            try:
+                return _new(whole[0], whole[1](frame))
+            except struct.error:
+                pass  # a frame of another size: the general path says what is wrong
         n = len(frame)
         if n < 4:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (4)")
         end = n - 1
         buf = frame
-        v_address = buf[0]
+        if buf[0] != 0xc8:
+            raise DecodeError(f"sync is {buf[0:1].hex(' ')}, expected c8")
         length = buf[1]
         if length != n - 2:
             raise DecodeError(f"length says {length} but the frame holds {n - 2}")
@@ -667,7 +659,7 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
             decoder = _RESPONSE_DECODERS[code]
         except KeyError:
             raise DecodeError(f"unknown command {code!r}") from None
-        return decoder(buf, 3, end, v_address)
+        return decoder(buf, 3, end)
     if direction is None:  # last: a caller that knows the direction does not pay for this
         return _either(lambda d: decode(data, d, expect), "give the direction: requests and responses cannot be told apart by their first bytes")
     raise ValueError(f"direction must be request or response, not {direction!r}")

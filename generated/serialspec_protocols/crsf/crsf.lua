@@ -43,13 +43,12 @@ local LAYOUTS = {
   {
     elements = {
       {
-        name = "address",
-        role = "address",
+        name = "sync",
+        role = "header",
         size = 1,
         big = false,
-        min = 0,
-        max = 255,
-        description = "The address of the device the frame goes to, serving as sync byte: 0xC8 (the flight controller) on a receiver-to-flight-controller link both ways; 0xEE (the transmitter module) from a handset, 0xEA (the handset) from a module.",
+        constant = "\xc8",
+        description = "The sync byte: the address of the device the frame goes to, 0xC8 (the flight controller) on a receiver-to-flight-controller link both ways (handset links use 0xEE and 0xEA, not covered here).",
       },
       {
         name = "length",

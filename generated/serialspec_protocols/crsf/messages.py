@@ -83,13 +83,11 @@ class GpsRequest(Message):
     """GPS (CRSF_FRAMETYPE_GPS) (request)."""
 
     __slots__ = ()
-    __match_args__ = ('address', 'latitude', 'longitude', 'groundspeed', 'heading', 'altitude', 'satellites')
+    __match_args__ = ('latitude', 'longitude', 'groundspeed', 'heading', 'altitude', 'satellites')
     PROTOCOL: ClassVar[str] = 'crsf'
     COMMAND: ClassVar[str] = 'gps'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    #: The address of the device the frame goes to, serving as sync byte: 0xC8 (the flight controller) on a receiver-to-flight-controller link both ways; 0xEE (the transmitter module) from a handset, 0xEA (the handset) from a module.
-    address: int
     #: Latitude in degrees × 10^7. [0.0000001°]
     latitude: int
     #: Longitude in degrees × 10^7. [0.0000001°]
@@ -105,7 +103,6 @@ class GpsRequest(Message):
 
     def __new__(
         cls,
-        address: int,
         latitude: int,
         longitude: int,
         groundspeed: int,
@@ -113,11 +110,10 @@ class GpsRequest(Message):
         altitude: int,
         satellites: int,
     ) -> Self:
-        return _build(cls, (address, latitude, longitude, groundspeed, heading, altitude, satellites))
+        return _build(cls, (latitude, longitude, groundspeed, heading, altitude, satellites))
 
     def to_fields(self) -> dict[str, Any]:
         return {
-            'address': self.address,
             'latitude': self.latitude,
             'longitude': self.longitude,
             'groundspeed': self.groundspeed,
@@ -128,9 +124,8 @@ class GpsRequest(Message):
 
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'gps request') -> Self:
-        _check_keys(data, ('address', 'latitude', 'longitude', 'groundspeed', 'heading', 'altitude', 'satellites'), (), where)
+        _check_keys(data, ('latitude', 'longitude', 'groundspeed', 'heading', 'altitude', 'satellites'), (), where)
         return cls(
-            _integer(_get(data, 'address', where), 'address', where),
             _integer(_get(data, 'latitude', where), 'latitude', where),
             _integer(_get(data, 'longitude', where), 'longitude', where),
             _integer(_get(data, 'groundspeed', where), 'groundspeed', where),
@@ -144,13 +139,11 @@ class GpsResponse(Message):
     """GPS (CRSF_FRAMETYPE_GPS) (response). Sent by the device on its own."""
 
     __slots__ = ()
-    __match_args__ = ('address', 'latitude', 'longitude', 'groundspeed', 'heading', 'altitude', 'satellites')
+    __match_args__ = ('latitude', 'longitude', 'groundspeed', 'heading', 'altitude', 'satellites')
     PROTOCOL: ClassVar[str] = 'crsf'
     COMMAND: ClassVar[str] = 'gps'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    #: The address of the device the frame goes to, serving as sync byte: 0xC8 (the flight controller) on a receiver-to-flight-controller link both ways; 0xEE (the transmitter module) from a handset, 0xEA (the handset) from a module.
-    address: int
     #: Latitude in degrees × 10^7. [0.0000001°]
     latitude: int
     #: Longitude in degrees × 10^7. [0.0000001°]
@@ -166,7 +159,6 @@ class GpsResponse(Message):
 
     def __new__(
         cls,
-        address: int,
         latitude: int,
         longitude: int,
         groundspeed: int,
@@ -174,11 +166,10 @@ class GpsResponse(Message):
         altitude: int,
         satellites: int,
     ) -> Self:
-        return _build(cls, (address, latitude, longitude, groundspeed, heading, altitude, satellites))
+        return _build(cls, (latitude, longitude, groundspeed, heading, altitude, satellites))
 
     def to_fields(self) -> dict[str, Any]:
         return {
-            'address': self.address,
             'latitude': self.latitude,
             'longitude': self.longitude,
             'groundspeed': self.groundspeed,
@@ -189,9 +180,8 @@ class GpsResponse(Message):
 
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'gps response') -> Self:
-        _check_keys(data, ('address', 'latitude', 'longitude', 'groundspeed', 'heading', 'altitude', 'satellites'), (), where)
+        _check_keys(data, ('latitude', 'longitude', 'groundspeed', 'heading', 'altitude', 'satellites'), (), where)
         return cls(
-            _integer(_get(data, 'address', where), 'address', where),
             _integer(_get(data, 'latitude', where), 'latitude', where),
             _integer(_get(data, 'longitude', where), 'longitude', where),
             _integer(_get(data, 'groundspeed', where), 'groundspeed', where),
@@ -205,13 +195,11 @@ class BatteryRequest(Message):
     """Battery sensor (CRSF_FRAMETYPE_BATTERY_SENSOR) (request)."""
 
     __slots__ = ()
-    __match_args__ = ('address', 'voltage', 'current', 'capacity', 'remaining')
+    __match_args__ = ('voltage', 'current', 'capacity', 'remaining')
     PROTOCOL: ClassVar[str] = 'crsf'
     COMMAND: ClassVar[str] = 'battery'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    #: The address of the device the frame goes to, serving as sync byte: 0xC8 (the flight controller) on a receiver-to-flight-controller link both ways; 0xEE (the transmitter module) from a handset, 0xEA (the handset) from a module.
-    address: int
     #: Voltage in V × 10. [0.1 V]
     voltage: int
     #: Current in A × 10. [0.1 A]
@@ -223,17 +211,15 @@ class BatteryRequest(Message):
 
     def __new__(
         cls,
-        address: int,
         voltage: int,
         current: int,
         capacity: int,
         remaining: int,
     ) -> Self:
-        return _build(cls, (address, voltage, current, capacity, remaining))
+        return _build(cls, (voltage, current, capacity, remaining))
 
     def to_fields(self) -> dict[str, Any]:
         return {
-            'address': self.address,
             'voltage': self.voltage,
             'current': self.current,
             'capacity': self.capacity,
@@ -242,9 +228,8 @@ class BatteryRequest(Message):
 
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'battery request') -> Self:
-        _check_keys(data, ('address', 'voltage', 'current', 'capacity', 'remaining'), (), where)
+        _check_keys(data, ('voltage', 'current', 'capacity', 'remaining'), (), where)
         return cls(
-            _integer(_get(data, 'address', where), 'address', where),
             _integer(_get(data, 'voltage', where), 'voltage', where),
             _integer(_get(data, 'current', where), 'current', where),
             _integer(_get(data, 'capacity', where), 'capacity', where),
@@ -256,13 +241,11 @@ class BatteryResponse(Message):
     """Battery sensor (CRSF_FRAMETYPE_BATTERY_SENSOR) (response). Sent by the device on its own."""
 
     __slots__ = ()
-    __match_args__ = ('address', 'voltage', 'current', 'capacity', 'remaining')
+    __match_args__ = ('voltage', 'current', 'capacity', 'remaining')
     PROTOCOL: ClassVar[str] = 'crsf'
     COMMAND: ClassVar[str] = 'battery'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    #: The address of the device the frame goes to, serving as sync byte: 0xC8 (the flight controller) on a receiver-to-flight-controller link both ways; 0xEE (the transmitter module) from a handset, 0xEA (the handset) from a module.
-    address: int
     #: Voltage in V × 10. [0.1 V]
     voltage: int
     #: Current in A × 10. [0.1 A]
@@ -274,17 +257,15 @@ class BatteryResponse(Message):
 
     def __new__(
         cls,
-        address: int,
         voltage: int,
         current: int,
         capacity: int,
         remaining: int,
     ) -> Self:
-        return _build(cls, (address, voltage, current, capacity, remaining))
+        return _build(cls, (voltage, current, capacity, remaining))
 
     def to_fields(self) -> dict[str, Any]:
         return {
-            'address': self.address,
             'voltage': self.voltage,
             'current': self.current,
             'capacity': self.capacity,
@@ -293,9 +274,8 @@ class BatteryResponse(Message):
 
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'battery response') -> Self:
-        _check_keys(data, ('address', 'voltage', 'current', 'capacity', 'remaining'), (), where)
+        _check_keys(data, ('voltage', 'current', 'capacity', 'remaining'), (), where)
         return cls(
-            _integer(_get(data, 'address', where), 'address', where),
             _integer(_get(data, 'voltage', where), 'voltage', where),
             _integer(_get(data, 'current', where), 'current', where),
             _integer(_get(data, 'capacity', where), 'capacity', where),
@@ -307,13 +287,11 @@ class LinkStatisticsRequest(Message):
     """Link statistics (CRSF_FRAMETYPE_LINK_STATISTICS) (request)."""
 
     __slots__ = ()
-    __match_args__ = ('address', 'uplink_rssi_ant1', 'uplink_rssi_ant2', 'uplink_link_quality', 'uplink_snr', 'active_antenna', 'rf_mode', 'uplink_tx_power', 'downlink_rssi', 'downlink_link_quality', 'downlink_snr')
+    __match_args__ = ('uplink_rssi_ant1', 'uplink_rssi_ant2', 'uplink_link_quality', 'uplink_snr', 'active_antenna', 'rf_mode', 'uplink_tx_power', 'downlink_rssi', 'downlink_link_quality', 'downlink_snr')
     PROTOCOL: ClassVar[str] = 'crsf'
     COMMAND: ClassVar[str] = 'link_statistics'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    #: The address of the device the frame goes to, serving as sync byte: 0xC8 (the flight controller) on a receiver-to-flight-controller link both ways; 0xEE (the transmitter module) from a handset, 0xEA (the handset) from a module.
-    address: int
     #: Uplink RSSI, antenna 1 (dBm × -1). [-1 dBm]
     uplink_rssi_ant1: int
     #: Uplink RSSI, antenna 2 (dBm × -1). [-1 dBm]
@@ -337,7 +315,6 @@ class LinkStatisticsRequest(Message):
 
     def __new__(
         cls,
-        address: int,
         uplink_rssi_ant1: int,
         uplink_rssi_ant2: int,
         uplink_link_quality: int,
@@ -349,11 +326,10 @@ class LinkStatisticsRequest(Message):
         downlink_link_quality: int,
         downlink_snr: int,
     ) -> Self:
-        return _build(cls, (address, uplink_rssi_ant1, uplink_rssi_ant2, uplink_link_quality, uplink_snr, active_antenna, rf_mode, uplink_tx_power, downlink_rssi, downlink_link_quality, downlink_snr))
+        return _build(cls, (uplink_rssi_ant1, uplink_rssi_ant2, uplink_link_quality, uplink_snr, active_antenna, rf_mode, uplink_tx_power, downlink_rssi, downlink_link_quality, downlink_snr))
 
     def to_fields(self) -> dict[str, Any]:
         return {
-            'address': self.address,
             'uplink_rssi_ant1': self.uplink_rssi_ant1,
             'uplink_rssi_ant2': self.uplink_rssi_ant2,
             'uplink_link_quality': self.uplink_link_quality,
@@ -368,9 +344,8 @@ class LinkStatisticsRequest(Message):
 
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'link_statistics request') -> Self:
-        _check_keys(data, ('address', 'uplink_rssi_ant1', 'uplink_rssi_ant2', 'uplink_link_quality', 'uplink_snr', 'active_antenna', 'rf_mode', 'uplink_tx_power', 'downlink_rssi', 'downlink_link_quality', 'downlink_snr'), (), where)
+        _check_keys(data, ('uplink_rssi_ant1', 'uplink_rssi_ant2', 'uplink_link_quality', 'uplink_snr', 'active_antenna', 'rf_mode', 'uplink_tx_power', 'downlink_rssi', 'downlink_link_quality', 'downlink_snr'), (), where)
         return cls(
-            _integer(_get(data, 'address', where), 'address', where),
             _integer(_get(data, 'uplink_rssi_ant1', where), 'uplink_rssi_ant1', where),
             _integer(_get(data, 'uplink_rssi_ant2', where), 'uplink_rssi_ant2', where),
             _integer(_get(data, 'uplink_link_quality', where), 'uplink_link_quality', where),
@@ -388,13 +363,11 @@ class LinkStatisticsResponse(Message):
     """Link statistics (CRSF_FRAMETYPE_LINK_STATISTICS) (response). Sent by the device on its own."""
 
     __slots__ = ()
-    __match_args__ = ('address', 'uplink_rssi_ant1', 'uplink_rssi_ant2', 'uplink_link_quality', 'uplink_snr', 'active_antenna', 'rf_mode', 'uplink_tx_power', 'downlink_rssi', 'downlink_link_quality', 'downlink_snr')
+    __match_args__ = ('uplink_rssi_ant1', 'uplink_rssi_ant2', 'uplink_link_quality', 'uplink_snr', 'active_antenna', 'rf_mode', 'uplink_tx_power', 'downlink_rssi', 'downlink_link_quality', 'downlink_snr')
     PROTOCOL: ClassVar[str] = 'crsf'
     COMMAND: ClassVar[str] = 'link_statistics'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    #: The address of the device the frame goes to, serving as sync byte: 0xC8 (the flight controller) on a receiver-to-flight-controller link both ways; 0xEE (the transmitter module) from a handset, 0xEA (the handset) from a module.
-    address: int
     #: Uplink RSSI, antenna 1 (dBm × -1). [-1 dBm]
     uplink_rssi_ant1: int
     #: Uplink RSSI, antenna 2 (dBm × -1). [-1 dBm]
@@ -418,7 +391,6 @@ class LinkStatisticsResponse(Message):
 
     def __new__(
         cls,
-        address: int,
         uplink_rssi_ant1: int,
         uplink_rssi_ant2: int,
         uplink_link_quality: int,
@@ -430,11 +402,10 @@ class LinkStatisticsResponse(Message):
         downlink_link_quality: int,
         downlink_snr: int,
     ) -> Self:
-        return _build(cls, (address, uplink_rssi_ant1, uplink_rssi_ant2, uplink_link_quality, uplink_snr, active_antenna, rf_mode, uplink_tx_power, downlink_rssi, downlink_link_quality, downlink_snr))
+        return _build(cls, (uplink_rssi_ant1, uplink_rssi_ant2, uplink_link_quality, uplink_snr, active_antenna, rf_mode, uplink_tx_power, downlink_rssi, downlink_link_quality, downlink_snr))
 
     def to_fields(self) -> dict[str, Any]:
         return {
-            'address': self.address,
             'uplink_rssi_ant1': self.uplink_rssi_ant1,
             'uplink_rssi_ant2': self.uplink_rssi_ant2,
             'uplink_link_quality': self.uplink_link_quality,
@@ -449,9 +420,8 @@ class LinkStatisticsResponse(Message):
 
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'link_statistics response') -> Self:
-        _check_keys(data, ('address', 'uplink_rssi_ant1', 'uplink_rssi_ant2', 'uplink_link_quality', 'uplink_snr', 'active_antenna', 'rf_mode', 'uplink_tx_power', 'downlink_rssi', 'downlink_link_quality', 'downlink_snr'), (), where)
+        _check_keys(data, ('uplink_rssi_ant1', 'uplink_rssi_ant2', 'uplink_link_quality', 'uplink_snr', 'active_antenna', 'rf_mode', 'uplink_tx_power', 'downlink_rssi', 'downlink_link_quality', 'downlink_snr'), (), where)
         return cls(
-            _integer(_get(data, 'address', where), 'address', where),
             _integer(_get(data, 'uplink_rssi_ant1', where), 'uplink_rssi_ant1', where),
             _integer(_get(data, 'uplink_rssi_ant2', where), 'uplink_rssi_ant2', where),
             _integer(_get(data, 'uplink_link_quality', where), 'uplink_link_quality', where),
@@ -469,34 +439,29 @@ class RcChannelsRequest(Message):
     """RC channels (CRSF_FRAMETYPE_RC_CHANNELS_PACKED) (request)."""
 
     __slots__ = ()
-    __match_args__ = ('address', 'channels')
+    __match_args__ = ('channels',)
     PROTOCOL: ClassVar[str] = 'crsf'
     COMMAND: ClassVar[str] = 'rc_channels'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    #: The address of the device the frame goes to, serving as sync byte: 0xC8 (the flight controller) on a receiver-to-flight-controller link both ways; 0xEE (the transmitter module) from a handset, 0xEA (the handset) from a module.
-    address: int
     #: Channels 1..16, 11 bits each, packed with no gaps: channel 1 in the lowest bits of the first byte, each value's lowest bit first (22 bytes).
     channels: tuple[int, ...]
 
     def __new__(
         cls,
-        address: int,
         channels: tuple[int, ...],
     ) -> Self:
-        return _build(cls, (address, channels))
+        return _build(cls, (channels,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
-            'address': self.address,
             'channels': list(self.channels),
         }
 
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'rc_channels request') -> Self:
-        _check_keys(data, ('address', 'channels'), (), where)
+        _check_keys(data, ('channels',), (), where)
         return cls(
-            _integer(_get(data, 'address', where), 'address', where),
             _integers(_get(data, 'channels', where), 'channels', where),
         )
 
@@ -505,34 +470,29 @@ class RcChannelsResponse(Message):
     """RC channels (CRSF_FRAMETYPE_RC_CHANNELS_PACKED) (response). Sent by the device on its own."""
 
     __slots__ = ()
-    __match_args__ = ('address', 'channels')
+    __match_args__ = ('channels',)
     PROTOCOL: ClassVar[str] = 'crsf'
     COMMAND: ClassVar[str] = 'rc_channels'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    #: The address of the device the frame goes to, serving as sync byte: 0xC8 (the flight controller) on a receiver-to-flight-controller link both ways; 0xEE (the transmitter module) from a handset, 0xEA (the handset) from a module.
-    address: int
     #: Channels 1..16, 11 bits each, packed with no gaps: channel 1 in the lowest bits of the first byte, each value's lowest bit first (22 bytes).
     channels: tuple[int, ...]
 
     def __new__(
         cls,
-        address: int,
         channels: tuple[int, ...],
     ) -> Self:
-        return _build(cls, (address, channels))
+        return _build(cls, (channels,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
-            'address': self.address,
             'channels': list(self.channels),
         }
 
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'rc_channels response') -> Self:
-        _check_keys(data, ('address', 'channels'), (), where)
+        _check_keys(data, ('channels',), (), where)
         return cls(
-            _integer(_get(data, 'address', where), 'address', where),
             _integers(_get(data, 'channels', where), 'channels', where),
         )
 
@@ -541,13 +501,11 @@ class AttitudeRequest(Message):
     """Attitude (CRSF_FRAMETYPE_ATTITUDE) (request)."""
 
     __slots__ = ()
-    __match_args__ = ('address', 'pitch', 'roll', 'yaw')
+    __match_args__ = ('pitch', 'roll', 'yaw')
     PROTOCOL: ClassVar[str] = 'crsf'
     COMMAND: ClassVar[str] = 'attitude'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    #: The address of the device the frame goes to, serving as sync byte: 0xC8 (the flight controller) on a receiver-to-flight-controller link both ways; 0xEE (the transmitter module) from a handset, 0xEA (the handset) from a module.
-    address: int
     #: Pitch in radians × 10000. [100 µrad]
     pitch: int
     #: Roll in radians × 10000. [100 µrad]
@@ -557,16 +515,14 @@ class AttitudeRequest(Message):
 
     def __new__(
         cls,
-        address: int,
         pitch: int,
         roll: int,
         yaw: int,
     ) -> Self:
-        return _build(cls, (address, pitch, roll, yaw))
+        return _build(cls, (pitch, roll, yaw))
 
     def to_fields(self) -> dict[str, Any]:
         return {
-            'address': self.address,
             'pitch': self.pitch,
             'roll': self.roll,
             'yaw': self.yaw,
@@ -574,9 +530,8 @@ class AttitudeRequest(Message):
 
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'attitude request') -> Self:
-        _check_keys(data, ('address', 'pitch', 'roll', 'yaw'), (), where)
+        _check_keys(data, ('pitch', 'roll', 'yaw'), (), where)
         return cls(
-            _integer(_get(data, 'address', where), 'address', where),
             _integer(_get(data, 'pitch', where), 'pitch', where),
             _integer(_get(data, 'roll', where), 'roll', where),
             _integer(_get(data, 'yaw', where), 'yaw', where),
@@ -587,13 +542,11 @@ class AttitudeResponse(Message):
     """Attitude (CRSF_FRAMETYPE_ATTITUDE) (response). Sent by the device on its own."""
 
     __slots__ = ()
-    __match_args__ = ('address', 'pitch', 'roll', 'yaw')
+    __match_args__ = ('pitch', 'roll', 'yaw')
     PROTOCOL: ClassVar[str] = 'crsf'
     COMMAND: ClassVar[str] = 'attitude'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    #: The address of the device the frame goes to, serving as sync byte: 0xC8 (the flight controller) on a receiver-to-flight-controller link both ways; 0xEE (the transmitter module) from a handset, 0xEA (the handset) from a module.
-    address: int
     #: Pitch in radians × 10000. [100 µrad]
     pitch: int
     #: Roll in radians × 10000. [100 µrad]
@@ -603,16 +556,14 @@ class AttitudeResponse(Message):
 
     def __new__(
         cls,
-        address: int,
         pitch: int,
         roll: int,
         yaw: int,
     ) -> Self:
-        return _build(cls, (address, pitch, roll, yaw))
+        return _build(cls, (pitch, roll, yaw))
 
     def to_fields(self) -> dict[str, Any]:
         return {
-            'address': self.address,
             'pitch': self.pitch,
             'roll': self.roll,
             'yaw': self.yaw,
@@ -620,9 +571,8 @@ class AttitudeResponse(Message):
 
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'attitude response') -> Self:
-        _check_keys(data, ('address', 'pitch', 'roll', 'yaw'), (), where)
+        _check_keys(data, ('pitch', 'roll', 'yaw'), (), where)
         return cls(
-            _integer(_get(data, 'address', where), 'address', where),
             _integer(_get(data, 'pitch', where), 'pitch', where),
             _integer(_get(data, 'roll', where), 'roll', where),
             _integer(_get(data, 'yaw', where), 'yaw', where),
@@ -633,34 +583,29 @@ class FlightModeRequest(Message):
     """Flight mode (CRSF_FRAMETYPE_FLIGHT_MODE) (request)."""
 
     __slots__ = ()
-    __match_args__ = ('address', 'mode')
+    __match_args__ = ('mode',)
     PROTOCOL: ClassVar[str] = 'crsf'
     COMMAND: ClassVar[str] = 'flight_mode'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    #: The address of the device the frame goes to, serving as sync byte: 0xC8 (the flight controller) on a receiver-to-flight-controller link both ways; 0xEE (the transmitter module) from a handset, 0xEA (the handset) from a module.
-    address: int
     #: The flight mode, NUL-terminated.
     mode: str
 
     def __new__(
         cls,
-        address: int,
         mode: str,
     ) -> Self:
-        return _build(cls, (address, mode))
+        return _build(cls, (mode,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
-            'address': self.address,
             'mode': self.mode,
         }
 
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'flight_mode request') -> Self:
-        _check_keys(data, ('address', 'mode'), (), where)
+        _check_keys(data, ('mode',), (), where)
         return cls(
-            _integer(_get(data, 'address', where), 'address', where),
             _text(_get(data, 'mode', where), 'mode', where),
         )
 
@@ -669,34 +614,29 @@ class FlightModeResponse(Message):
     """Flight mode (CRSF_FRAMETYPE_FLIGHT_MODE) (response). Sent by the device on its own."""
 
     __slots__ = ()
-    __match_args__ = ('address', 'mode')
+    __match_args__ = ('mode',)
     PROTOCOL: ClassVar[str] = 'crsf'
     COMMAND: ClassVar[str] = 'flight_mode'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
-    #: The address of the device the frame goes to, serving as sync byte: 0xC8 (the flight controller) on a receiver-to-flight-controller link both ways; 0xEE (the transmitter module) from a handset, 0xEA (the handset) from a module.
-    address: int
     #: The flight mode, NUL-terminated.
     mode: str
 
     def __new__(
         cls,
-        address: int,
         mode: str,
     ) -> Self:
-        return _build(cls, (address, mode))
+        return _build(cls, (mode,))
 
     def to_fields(self) -> dict[str, Any]:
         return {
-            'address': self.address,
             'mode': self.mode,
         }
 
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'flight_mode response') -> Self:
-        _check_keys(data, ('address', 'mode'), (), where)
+        _check_keys(data, ('mode',), (), where)
         return cls(
-            _integer(_get(data, 'address', where), 'address', where),
             _text(_get(data, 'mode', where), 'mode', where),
         )
 
@@ -705,13 +645,11 @@ class DevicePingRequest(Message):
     """Device ping (CRSF_FRAMETYPE_DEVICE_PING) (request)."""
 
     __slots__ = ()
-    __match_args__ = ('address', 'destination', 'origin')
+    __match_args__ = ('destination', 'origin')
     PROTOCOL: ClassVar[str] = 'crsf'
     COMMAND: ClassVar[str] = 'device_ping'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.REQUEST
-    #: The address of the device the frame goes to, serving as sync byte: 0xC8 (the flight controller) on a receiver-to-flight-controller link both ways; 0xEE (the transmitter module) from a handset, 0xEA (the handset) from a module.
-    address: int
     #: Extended header: the address of the device the frame is for (0x00 for every device). range 0..239
     destination: Address | int
     #: Extended header: the address of the device that sent the frame. range 0..239
@@ -719,24 +657,21 @@ class DevicePingRequest(Message):
 
     def __new__(
         cls,
-        address: int,
         destination: Address | int,
         origin: Address | int,
     ) -> Self:
-        return _build(cls, (address, destination, origin))
+        return _build(cls, (destination, origin))
 
     def to_fields(self) -> dict[str, Any]:
         return {
-            'address': self.address,
             'destination': int(self.destination),
             'origin': int(self.origin),
         }
 
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'device_ping request') -> Self:
-        _check_keys(data, ('address', 'destination', 'origin'), (), where)
+        _check_keys(data, ('destination', 'origin'), (), where)
         return cls(
-            _integer(_get(data, 'address', where), 'address', where),
             _as_enum(Address, _get(data, 'destination', where), 'destination', where),
             _as_enum(Address, _get(data, 'origin', where), 'origin', where),
         )
@@ -746,14 +681,12 @@ class DeviceInfoResponse(Message):
     """Device info (CRSF_FRAMETYPE_DEVICE_INFO) (response)."""
 
     __slots__ = ()
-    __match_args__ = ('address', 'destination', 'origin', 'name', 'serial_number', 'hardware_id', 'firmware_id', 'parameter_count', 'parameter_version')
+    __match_args__ = ('destination', 'origin', 'name', 'serial_number', 'hardware_id', 'firmware_id', 'parameter_count', 'parameter_version')
     PROTOCOL: ClassVar[str] = 'crsf'
     COMMAND: ClassVar[str] = 'device_info'
     SUBCOMMAND: ClassVar[str | None] = None
     DIRECTION: ClassVar[Direction] = Direction.RESPONSE
     ANSWERS: ClassVar[tuple[str, str | None] | None] = ('device_ping', None)
-    #: The address of the device the frame goes to, serving as sync byte: 0xC8 (the flight controller) on a receiver-to-flight-controller link both ways; 0xEE (the transmitter module) from a handset, 0xEA (the handset) from a module.
-    address: int
     #: Extended header: the address of the device the frame is for (0x00 for every device). range 0..239
     destination: Address | int
     #: Extended header: the address of the device that sent the frame. range 0..239
@@ -773,7 +706,6 @@ class DeviceInfoResponse(Message):
 
     def __new__(
         cls,
-        address: int,
         destination: Address | int,
         origin: Address | int,
         name: str,
@@ -783,11 +715,10 @@ class DeviceInfoResponse(Message):
         parameter_count: int,
         parameter_version: int,
     ) -> Self:
-        return _build(cls, (address, destination, origin, name, serial_number, hardware_id, firmware_id, parameter_count, parameter_version))
+        return _build(cls, (destination, origin, name, serial_number, hardware_id, firmware_id, parameter_count, parameter_version))
 
     def to_fields(self) -> dict[str, Any]:
         return {
-            'address': self.address,
             'destination': int(self.destination),
             'origin': int(self.origin),
             'name': self.name,
@@ -800,9 +731,8 @@ class DeviceInfoResponse(Message):
 
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'device_info response') -> Self:
-        _check_keys(data, ('address', 'destination', 'origin', 'name', 'serial_number', 'hardware_id', 'firmware_id', 'parameter_count', 'parameter_version'), (), where)
+        _check_keys(data, ('destination', 'origin', 'name', 'serial_number', 'hardware_id', 'firmware_id', 'parameter_count', 'parameter_version'), (), where)
         return cls(
-            _integer(_get(data, 'address', where), 'address', where),
             _as_enum(Address, _get(data, 'destination', where), 'destination', where),
             _as_enum(Address, _get(data, 'origin', where), 'origin', where),
             _text(_get(data, 'name', where), 'name', where),

@@ -4,9 +4,9 @@
 A receiver on a flight controller's UART, as the flight controller sees it. It streams the RC channels every
 20 ms (the 50 Hz packet rate), the link statistics every 100 ms and, as a test stand-in for the telemetry a
 flight controller relays, battery, GPS, attitude and flight mode every 500 ms. It answers a device ping with
-its device info, addressed to the ping's origin, from the receiver's address (0xEC). Its frames carry the
-address 0xC8 (the flight controller). The rates are this model's choice; a real receiver's follow its packet
-rate and telemetry ratio.
+its device info, addressed to the ping's origin, from the receiver's address (0xEC). Its frames start with
+0xC8 (the flight controller). The rates are this model's choice; a real receiver's follow its packet rate and
+telemetry ratio.
 
 `CrsfSimulator(ids=[1, 2]).start()` serves the devices on a new pseudo-terminal and returns its path;
 `serialspec sim specs/crsf.yaml --id 1 --id 2` does the same from the shell. Values are wire units.
@@ -41,7 +41,7 @@ __all__ = ["DEVICE", "SIMULATOR", "CrsfSimulator"]
 
 DEVICE = DeviceSpec(
     protocol='crsf',
-    address='address',
+    address='',
     id_entry='',
     broadcast=None,
     entries=(
@@ -80,7 +80,7 @@ class CrsfSimulator(Simulator):
 
     def __init__(
         self,
-        ids: Iterable[int] = (200,),
+        ids: Iterable[int] = (0,),
         clock: Callable[[], float] | None = None,
         model: str | Mapping[int, str] | None = None,
     ) -> None:

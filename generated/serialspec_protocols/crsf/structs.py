@@ -64,7 +64,7 @@ _CHECK_CRC: Callable[[bytes], int] = crc_function(8, 0xd5, 0x0, False, False, 0x
 _REQUEST_FRAMES = FrameCodec(
     (
         Layout('request', (
-            Element('address', 'value', 1, minimum=0, maximum=255),
+            Element('sync', 'constant', 1, constant=b'\xc8'),
             Element('length', 'length', 1, span=(2, 4)),
             Element('type', 'command', 1, minimum=0, maximum=255),
             Element('payload', 'content'),
@@ -78,7 +78,7 @@ _REQUEST_FRAMES = FrameCodec(
 _RESPONSE_FRAMES = FrameCodec(
     (
         Layout('response', (
-            Element('address', 'value', 1, minimum=0, maximum=255),
+            Element('sync', 'constant', 1, constant=b'\xc8'),
             Element('length', 'length', 1, span=(2, 4)),
             Element('type', 'command', 1, minimum=0, maximum=255),
             Element('payload', 'content'),

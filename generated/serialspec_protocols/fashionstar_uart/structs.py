@@ -124,8 +124,8 @@ UserDataBlock = Struct(
     'angle_mid_offset' / Int16sl,
 )
 
-REQUEST_FRAME = Struct('body' / RawCopy(Struct('header' / Const(b'\x12L'), 'cmd_id' / Int8ub, 'length' / Rebuild(Int8ub, len_(this.content)), 'content' / Bytes(this.length))), 'checksum' / Checksum(Int8ub, _checksum, this.body.data[0:]))
-RESPONSE_FRAME = Struct('body' / RawCopy(Struct('header' / Const(b'\x05\x1c'), 'cmd_id' / Int8ub, 'length' / Rebuild(Int8ub, len_(this.content)), 'content' / Bytes(this.length))), 'checksum' / Checksum(Int8ub, _checksum, this.body.data[0:]))
+REQUEST_FRAME = Struct('body' / RawCopy(Struct('header' / Const(b'\x12L'), 'cmd_id' / Int8ub, 'length' / Rebuild(Int8ub, len_(this.content)), 'content' / Bytes(this.length))), 'checksum' / Checksum(Int8ub, _checksum, lambda ctx: ctx.body.data[0:]))
+RESPONSE_FRAME = Struct('body' / RawCopy(Struct('header' / Const(b'\x05\x1c'), 'cmd_id' / Int8ub, 'length' / Rebuild(Int8ub, len_(this.content)), 'content' / Bytes(this.length))), 'checksum' / Checksum(Int8ub, _checksum, lambda ctx: ctx.body.data[0:]))
 
 PingRequestContent = Struct(
     'servo_id' / Int8ub,

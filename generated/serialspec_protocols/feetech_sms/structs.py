@@ -120,8 +120,8 @@ CONTROL_TABLE_VALUE: dict[int, Any] = {
     69: Int16ul,
 }
 
-REQUEST_FRAME = Struct('body' / RawCopy(Struct('header' / Const(b'\xff\xff'), 'id' / Int8ub, 'length' / Rebuild(Int8ub, len_(this.content) + 2), 'instruction' / Int8ub, 'content' / Bytes(this.length - 2))), 'checksum' / Checksum(Int8ub, _checksum, this.body.data[2:]))
-RESPONSE_FRAME = Struct('body' / RawCopy(Struct('header' / Const(b'\xff\xff'), 'id' / Int8ub, 'length' / Rebuild(Int8ub, len_(this.content) + 2), 'error' / Int8ub, 'content' / Bytes(this.length - 2))), 'checksum' / Checksum(Int8ub, _checksum, this.body.data[2:]))
+REQUEST_FRAME = Struct('body' / RawCopy(Struct('header' / Const(b'\xff\xff'), 'id' / Int8ub, 'length' / Rebuild(Int8ub, len_(this.content) + 2), 'instruction' / Int8ub, 'content' / Bytes(this.length - 2))), 'checksum' / Checksum(Int8ub, _checksum, lambda ctx: ctx.body.data[2:]))
+RESPONSE_FRAME = Struct('body' / RawCopy(Struct('header' / Const(b'\xff\xff'), 'id' / Int8ub, 'length' / Rebuild(Int8ub, len_(this.content) + 2), 'error' / Int8ub, 'content' / Bytes(this.length - 2))), 'checksum' / Checksum(Int8ub, _checksum, lambda ctx: ctx.body.data[2:]))
 
 PingRequestContent = Struct(
 )

@@ -69,8 +69,8 @@ def _item_size(context: Any, field: str) -> int:
     return 0
 
 
-REQUEST_FRAME = Struct('body' / RawCopy(Struct('header' / Const(b'\xaaU'), 'function' / Int8ub, 'length' / Rebuild(Int8ub, len_(this.content)), 'content' / Bytes(this.length))), 'crc' / Checksum(Int8ub, _checksum, this.body.data[2:]))
-RESPONSE_FRAME = Struct('body' / RawCopy(Struct('header' / Const(b'\xaaU'), 'function' / Int8ub, 'length' / Rebuild(Int8ub, len_(this.content)), 'content' / Bytes(this.length))), 'crc' / Checksum(Int8ub, _checksum, this.body.data[2:]))
+REQUEST_FRAME = Struct('body' / RawCopy(Struct('header' / Const(b'\xaaU'), 'function' / Int8ub, 'length' / Rebuild(Int8ub, len_(this.content)), 'content' / Bytes(this.length))), 'crc' / Checksum(Int8ub, _checksum, lambda ctx: ctx.body.data[2:]))
+RESPONSE_FRAME = Struct('body' / RawCopy(Struct('header' / Const(b'\xaaU'), 'function' / Int8ub, 'length' / Rebuild(Int8ub, len_(this.content)), 'content' / Bytes(this.length))), 'crc' / Checksum(Int8ub, _checksum, lambda ctx: ctx.body.data[2:]))
 
 LedRequestContent = Struct(
     'led_id' / Int8ub,

@@ -37,7 +37,7 @@ def valued(name: str, shown: str, compute: Callable[[Any], int]) -> Callable[[An
     return value
 
 
-class SignMagnitude(Adapter):  # type: ignore[misc]
+class SignMagnitude(Adapter):  # type: ignore[misc, type-arg, unused-ignore]
     """An unsigned integer whose top bit is the sign and the rest the magnitude (FEETECH position/speed)."""
 
     def __init__(self, subcon: Any, bits: int) -> None:
@@ -51,7 +51,7 @@ class SignMagnitude(Adapter):  # type: ignore[misc]
         return (-obj) | self.sign if obj < 0 else obj
 
 
-class PackedBits(Adapter):  # type: ignore[misc]
+class PackedBits(Adapter):  # type: ignore[misc, type-arg, unused-ignore]
     """Bits packed 8 to a byte, the first in the lowest bit (Modbus coils), as a list of bools; `count` (a number or
     a function of the context) keeps only that many, else every bit of the bytes."""
 
@@ -73,7 +73,7 @@ class PackedBits(Adapter):  # type: ignore[misc]
         return bytes(out)
 
 
-class PackedInts(Adapter):  # type: ignore[misc]
+class PackedInts(Adapter):  # type: ignore[misc, type-arg, unused-ignore]
     """`count` integers of `bits` bits packed with no gaps (runtime.packing.unpack_ints), as a list of ints."""
 
     def __init__(self, count: int, bits: int, lsb_first: bool, signed: bool) -> None:
@@ -89,7 +89,7 @@ class PackedInts(Adapter):  # type: ignore[misc]
         return pack_ints(obj, *self.shape)
 
 
-class PaddedUtf8(Adapter):  # type: ignore[misc]
+class PaddedUtf8(Adapter):  # type: ignore[misc, type-arg, unused-ignore]
     """Fixed-size bytes holding UTF-8 text followed by pad bytes."""
 
     def __init__(self, size: int, pad: int) -> None:
@@ -104,7 +104,7 @@ class PaddedUtf8(Adapter):  # type: ignore[misc]
         return data + bytes((self.pad,)) * (self.size - len(data))
 
 
-class Utf8(Adapter):  # type: ignore[misc]
+class Utf8(Adapter):  # type: ignore[misc, type-arg, unused-ignore]
     """Bytes holding UTF-8 text."""
 
     def _decode(self, obj: bytes, context: Any, path: Any) -> str:
@@ -114,7 +114,7 @@ class Utf8(Adapter):  # type: ignore[misc]
         return obj.encode("utf-8")
 
 
-class Framed(Adapter):  # type: ignore[misc]
+class Framed(Adapter):  # type: ignore[misc, type-arg, unused-ignore]
     """A whole frame of any layout (stuffing, lengths and checksums anywhere), by the runtime's frame engine.
 
     Parses to a Container of `layout` (its name), `code`, `values` (the address/status elements) and `content`; builds
@@ -125,7 +125,7 @@ class Framed(Adapter):  # type: ignore[misc]
         super().__init__(GreedyBytes)
         self.codec = codec
 
-    def _decode(self, obj: bytes, context: Any, path: Any) -> Container:
+    def _decode(self, obj: bytes, context: Any, path: Any) -> Container:  # type: ignore[type-arg, unused-ignore]
         unwrapped = self.codec.unwrap(bytes(obj))
         return Container(
             layout=unwrapped.layout.name, code=unwrapped.code, values=list(unwrapped.values), content=unwrapped.content

@@ -42,7 +42,9 @@ def frame_expr(layout: FrameLayout) -> str:
     checksum = next(e for e in layout.elements if e.role == "checksum")
     assert checksum.type is not None
     trim = layout.covered_to_end - layout.checksum_offset_from_end
-    covered = f"this.body.data[{layout.covered_from}:{-trim if trim else ''}]"
+    # a function of the context, not `this.body.data[a:b]`: construct's typed stubs (construct-typing) index a path
+    # by name only
+    covered = f"lambda ctx: ctx.body.data[{layout.covered_from}:{-trim if trim else ''}]"
     return (
         f"Struct('body' / RawCopy(Struct({', '.join(body)})), "
         f"'{checksum.name}' / Checksum({primitive(checksum.type, '<')}, _checksum, {covered}))"

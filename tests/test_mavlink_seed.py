@@ -146,3 +146,24 @@ def test_every_command_gives_its_seed(tmp_path: Path) -> None:
         load_protocol(str(spec))
     (line,) = str(raised.value).splitlines()
     assert "commands.attitude: `seed: per_command` on checksum: give `checksum_seed`" in line
+
+
+def test_a_seed_needs_a_seeded_checksum(tmp_path: Path) -> None:
+    spec = tmp_path / "mav_min.yaml"
+    spec.write_text(MAVLINK.replace("      seed: per_command\n", ""), encoding="utf-8")
+    with pytest.raises(SpecErrors) as raised:
+        load_protocol(str(spec))
+    lines = str(raised.value).splitlines()
+    assert [line.split(": ", 1)[1] for line in lines] == [
+        "commands.heartbeat.checksum_seed: no checksum of the frame has `seed: per_command`",
+        "commands.attitude.checksum_seed: no checksum of the frame has `seed: per_command`",
+    ]
+
+
+def test_the_seed_needs_the_command_in_the_covered_span(tmp_path: Path) -> None:
+    spec = tmp_path / "mav_min.yaml"
+    spec.write_text(MAVLINK.replace("covers: [length, payload]", "covers: [msgid_high, payload]"), encoding="utf-8")
+    with pytest.raises(SpecErrors) as raised:
+        load_protocol(str(spec))
+    (line,) = str(raised.value).splitlines()
+    assert line.endswith("a per-command seed needs the command element inside the covered span")

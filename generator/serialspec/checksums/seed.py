@@ -10,9 +10,9 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import Any, ClassVar
+from typing import Any, ClassVar, Literal
 
-from serialspec.checksums.base import Algorithm, CCode, Import, NoCode, Report, hex_bytes, hex_value
+from serialspec.checksums.base import Algorithm, CCode, Import, Report, hex_bytes, hex_value
 
 
 def seeded_function(
@@ -21,7 +21,7 @@ def seeded_function(
     """`inner` over the covered bytes and then the seed byte of the code at covered[offset : offset + size]."""
     table = {code: bytes((seed,)) for code, seed in seeds.items()}
     end = offset + size
-    order = "little" if little else "big"
+    order: Literal["little", "big"] = "little" if little else "big"
 
     def checksum(covered: bytes) -> int:
         return inner(bytes(covered) + table.get(int.from_bytes(covered[offset:end], order), b""))
@@ -70,7 +70,54 @@ class Seeded(Algorithm):
         return self.inner.title()
 
     def c_code(self, prefix: str) -> CCode:
-        raise NoCode("a checksum with a per-command seed (`seed: per_command`)")
+        """The inner algorithm's C (its own copy, named with `<prefix>_seeded`), and a function over the whole
+        covered bytes that takes in the seed of the code it finds in them: one call, not incremental."""
+        inner = self.inner.c_code(prefix)
+        core = self.inner.c_code(f"{prefix}_seeded")
+        name = f"{inner.name}_seeded"
+        t = inner.ctype
+        code = " | ".join(
+            f"((uint32_t)data[{self.offset + i}] << {8 * (i if self.little else self.code_size - 1 - i)})"
+            for i in range(self.code_size)
+        )
+        cases = "".join(f"    case {c}u:\n        seed = {s}u;\n        break;\n" for c, s in self.seeds)
+        seeds = ", ".join(f"{c}: {s}" for c, s in self.seeds) or "none"
+        body = f"""{core.definition}
+/* {self.title() or self.inner.name} over the covered bytes, then the seed byte of the command whose code sits at
+   offset {self.offset} of them ({self.code_size} byte(s), {"little" if self.little else "big"}-endian); seeds by
+   code: {seeds}. Not incremental: call it once, with {inner.start} and all the covered bytes. */
+{t} {name}({t} acc, const uint8_t *data, size_t n)
+{{
+    uint32_t code;
+    uint8_t seed;
+    acc = {core.name}(acc, data, n);
+    if (n < {self.offset + self.code_size}u) {{
+        return acc;
+    }}
+    code = {code};
+    switch (code) {{
+{cases}    default:
+        return acc;
+    }}
+    return {core.name}(acc, &seed, 1);
+}}
+"""
+        prototype = f"{core.prototype}\n{t} {name}({t} acc, const uint8_t *data, size_t n);"
+        return CCode(name, t, body, prototype, inner.start, inner.finish)
+
+    @classmethod
+    def lua_function(cls) -> str:
+        return _LUA
+
+    def lua_parameters(self) -> dict[str, Any]:
+        inner = self.inner
+        return {
+            "inner": {"algorithm": inner.name, **inner.lua_parameters()} if inner.lua_function() else None,
+            "offset": self.offset,
+            "code_size": self.code_size,
+            "little": self.little,
+            "seeds": dict(self.seeds),
+        }
 
     def describe(self) -> str:
         return f"{self.inner.describe()}, then the command's seed byte (`checksum_seed`)"
@@ -89,3 +136,23 @@ class Seeded(Algorithm):
             f"{self.title() or self.inner.name} of {hex_bytes(covered)} then the seed {seed:#04x} of command {code}"
             f" = {hex_value(value, self.width)}"
         )
+
+
+# the dissector's code (Algorithm.lua_function): the inner algorithm's function (in CHECKSUMS) over the covered bytes
+# and the seed byte of the code found in them
+_LUA = """function(spec, size, data)
+  local code = 0
+  for i = 1, spec.code_size do
+    local byte = data:byte(spec.offset + i) or 0
+    if spec.little then
+      code = bor(code, lshift(byte, 8 * (i - 1)))
+    else
+      code = bor(lshift(code, 8), byte)
+    end
+  end
+  local seed = spec.seeds[code]
+  if seed ~= nil and #data >= spec.offset + spec.code_size then
+    data = data .. string.char(seed)
+  end
+  return CHECKSUMS[spec.inner.algorithm](spec.inner, size, data)
+end"""

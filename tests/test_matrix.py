@@ -159,9 +159,13 @@ def spec_text(name: str, algorithm: str, sample: Sample, shape: str) -> str:
     header, elements, covers, _ = SHAPES[shape]
     checksum = {"role": "checksum", "type": sample.type, "algorithm": algorithm, "covers": covers, **sample.keys}
     lines = "\n".join(f"    {key}: {value}" for key, value in elements.items())
-    return SPEC.format(
+    text = SPEC.format(
         name=name, label=f"{sample.label}, {shape}", header=header, elements=lines, checksum=json.dumps(checksum)
     )
+    if sample.keys.get("seed") == "per_command":  # the element's `seed`: each command gives its byte
+        for code, seed in ((1, 50), (2, 39), (3, 0), (4, 255)):
+            text = text.replace(f"    code: {code}\n", f"    code: {code}\n    checksum_seed: {seed}\n")
+    return text
 
 
 _MADE: dict[str, Case] = {}

@@ -640,21 +640,20 @@ proto.experts = {e_checksum, e_malformed, e_garbage}
 -- --- checksums and byte stuffing ------------------------------------------------------------------------------------
 
 -- each algorithm's function (serialspec.checksums: Algorithm.lua_function), by its name
-local CHECKSUMS = {
-  ["sum"] = function(spec, size, data)
-    local mask = width_mask(size * 8)
-    local total = 0
-    for i = 1, #data do
-      total = (total + data:byte(i)) % (mask + 1)
-    end
-    if spec.invert then
-      total = mask - total
-    elseif spec.negate then
-      total = (mask + 1 - total) % (mask + 1)
-    end
-    return spec.mask and band(total, spec.mask) or total
-  end,
-}
+local CHECKSUMS = {}
+CHECKSUMS["sum"] = function(spec, size, data)
+  local mask = width_mask(size * 8)
+  local total = 0
+  for i = 1, #data do
+    total = (total + data:byte(i)) % (mask + 1)
+  end
+  if spec.invert then
+    total = mask - total
+  elseif spec.negate then
+    total = (mask + 1 - total) % (mask + 1)
+  end
+  return spec.mask and band(total, spec.mask) or total
+end
 
 local function checksum(spec, size, data)
   return CHECKSUMS[spec.algorithm](spec, size, data)

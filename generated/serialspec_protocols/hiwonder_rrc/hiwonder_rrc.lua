@@ -2778,41 +2778,40 @@ proto.experts = {e_checksum, e_malformed, e_garbage}
 -- --- checksums and byte stuffing ------------------------------------------------------------------------------------
 
 -- each algorithm's function (serialspec.checksums: Algorithm.lua_function), by its name
-local CHECKSUMS = {
-  ["crc"] = function(spec, size, data)
-    local function reflect(value, width)
-      local result = 0
-      for _ = 1, width do
-        result = bor(lshift(result, 1), band(value, 1))
-        value = rshift(value, 1)
-      end
-      return result
+local CHECKSUMS = {}
+CHECKSUMS["crc"] = function(spec, size, data)
+  local function reflect(value, width)
+    local result = 0
+    for _ = 1, width do
+      result = bor(lshift(result, 1), band(value, 1))
+      value = rshift(value, 1)
     end
-    local width = spec.width
-    local top, crc_mask = lshift(1, width - 1), width_mask(width)
-    local crc = spec.init
-    for i = 1, #data do
-      local byte = data:byte(i)
-      if spec.refin then
-        byte = reflect(byte, 8)
+    return result
+  end
+  local width = spec.width
+  local top, crc_mask = lshift(1, width - 1), width_mask(width)
+  local crc = spec.init
+  for i = 1, #data do
+    local byte = data:byte(i)
+    if spec.refin then
+      byte = reflect(byte, 8)
+    end
+    for bit = 7, 0, -1 do
+      local feedback = band(crc, top) ~= 0
+      if band(rshift(byte, bit), 1) == 1 then
+        feedback = not feedback
       end
-      for bit = 7, 0, -1 do
-        local feedback = band(crc, top) ~= 0
-        if band(rshift(byte, bit), 1) == 1 then
-          feedback = not feedback
-        end
-        crc = band(lshift(crc, 1), crc_mask)
-        if feedback then
-          crc = bxor(crc, spec.poly)
-        end
+      crc = band(lshift(crc, 1), crc_mask)
+      if feedback then
+        crc = bxor(crc, spec.poly)
       end
     end
-    if spec.refout then
-      crc = reflect(crc, width)
-    end
-    return band(bxor(crc, spec.xorout), crc_mask)
-  end,
-}
+  end
+  if spec.refout then
+    crc = reflect(crc, width)
+  end
+  return band(bxor(crc, spec.xorout), crc_mask)
+end
 
 local function checksum(spec, size, data)
   return CHECKSUMS[spec.algorithm](spec, size, data)

@@ -143,6 +143,7 @@ class Algorithm:
     """A checksum algorithm with its parameters. Subclasses are frozen dataclasses that set the class variables."""
 
     name: ClassVar[str]  # the `algorithm:` value
+    registered: ClassVar[bool] = True  # False: not an `algorithm:` of its own (seed.Seeded wraps one)
     summary: ClassVar[str]  # what it computes, for the grammar's description of `algorithm`
     keys: ClassVar[tuple[Key, ...]] = ()
     samples: ClassVar[tuple[Sample, ...]] = ()
@@ -150,7 +151,7 @@ class Algorithm:
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
         super().__init_subclass__(**kwargs)
-        if "name" in cls.__dict__:
+        if "name" in cls.__dict__ and cls.__dict__.get("registered", True):
             _REGISTERED[cls.name] = cls
 
     # -- the language ------------------------------------------------------------------------------------------
@@ -171,6 +172,10 @@ class Algorithm:
     def function_code(self) -> tuple[Import, str]:
         """How generated code makes `function()`: the import, and the call that returns it."""
         raise NotImplementedError
+
+    def function_imports(self) -> list[Import]:
+        """Every import function_code's call needs (its own, and a wrapped algorithm's)."""
+        return [self.function_code()[0]]
 
     def title(self) -> str:
         """A catalogue name for comments and docs (CRC-16/MODBUS), or ""."""

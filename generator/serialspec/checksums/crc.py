@@ -272,6 +272,23 @@ class Crc(Algorithm):
             },
         ),
         Sample(
+            "CRC-16/MCRF4XX with a per-command seed byte (MAVLink v2's CRC_EXTRA; the element's `seed`)",
+            "u16",
+            {
+                "crc": {
+                    "name": "CRC-16/MCRF4XX",
+                    "width": 16,
+                    "poly": 0x1021,
+                    "init": 0xFFFF,
+                    "refin": True,
+                    "refout": True,
+                    "xorout": 0,
+                    "check": 0x6F91,
+                },
+                "seed": "per_command",
+            },
+        ),
+        Sample(
             "CRC-32/ISO-HDLC (zlib.crc32)",
             "u32",
             {

@@ -554,6 +554,13 @@ COMMAND = Obj(
         "request": MESSAGE,
         "response": MESSAGE,
         "broadcast": TEXT,
+        "checksum_seed": Int(
+            "The byte taken in after the covered bytes by a checksum with `seed: per_command` (MAVLink's "
+            "CRC_EXTRA of the message id); every command needs one when the frame has such a checksum.",
+            example=50,
+            minimum=0,
+            maximum=255,
+        ),
         "probe": Bool(
             "The command asks whether a device is there (PING): its client method returns True when the device "
             "answers and False when none does, whatever the reply holds. Every other command with a reply raises "
@@ -771,6 +778,13 @@ FRAME_ELEMENT = Obj(
             "inside the span (itself too) are left out of it (HerkuleX: `checksum1` in the header covers [size, "
             "data]); one at an end is covered, so a checksum can be computed from another that comes before it "
             "(HerkuleX `checksum2: {algorithm: xor, invert: true, mask: 0xFE, covers: [checksum1, checksum1]}`).",
+        ),
+        "seed": Str(
+            "checksum: `per_command`, one byte that each command gives in `checksum_seed` is taken in after the "
+            "covered bytes (MAVLink's CRC_EXTRA); the command element must lie in the covered span, after "
+            "elements of fixed size only. A frame whose code no command has gets no seed.",
+            choices=("per_command",),
+            example="per_command",
         ),
         **checksum_keys(),
     },

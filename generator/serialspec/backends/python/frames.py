@@ -39,9 +39,9 @@ def checksum_definitions(protocol: Protocol, straight: bool = True) -> tuple[lis
         for layout in layouts:
             for checksum in layout.checksums:
                 name = checksum_name(checksum)
-                (module, function), call = checksum.algorithm.function_code()
+                _, call = checksum.algorithm.function_code()
                 title = checksum.algorithm.title()
-                imports.add((module, function))
+                imports.update(checksum.algorithm.function_imports())
                 definitions[name] = f"{name}: Callable[[bytes], int] = {call}" + (f"  # {title}" if title else "")
                 extra_imports, extra = checksum.algorithm.python_setup(name) if straight else ([], [])
                 imports.update(extra_imports)

@@ -83,9 +83,9 @@ def structs_module(protocol: Protocol) -> str:
     if framing.classic:
         checksum = framing.checksum
         assert checksum is not None
-        function_import, call = checksum.algorithm.function_code()
+        _, call = checksum.algorithm.function_code()
         definitions.append(f"_checksum = {call}")
-        checksum_imports = import_lines([function_import])
+        checksum_imports = import_lines(checksum.algorithm.function_imports())
         frames = [{"name": f"{d.name}_FRAME", "expr": frame_expr(layout)} for d, layout in framing.layouts.items()]
     else:
         checksum_imports, definitions = checksum_definitions(protocol, straight=False)

@@ -190,7 +190,7 @@ def _layout(layout: FrameLayout) -> dict[str, Any]:
 def _checksum(checksum: Checksum) -> dict[str, Any]:
     """The algorithm and its parameters, for the algorithm's own Lua code (its lua_function, in CHECKSUMS)."""
     algorithm = checksum.algorithm
-    if algorithm.lua_function() is None:
+    if algorithm.lua_function() is None or algorithm.lua_parameters().get("inner", True) is None:
         # an algorithm with no Lua code yet: the dissector shows the value, unverified, and says why
         return {"algorithm": algorithm.name, "unverified": True}
     return {"algorithm": algorithm.name} | algorithm.lua_parameters()
@@ -199,11 +199,12 @@ def _checksum(checksum: Checksum) -> dict[str, Any]:
 def _checksum_functions(protocol: Protocol) -> list[tuple[str, str]]:
     """(algorithm name as a Lua string, its Lua function) of each algorithm the frames use that has one."""
     found = {
-        checksum.algorithm.name: code
+        algorithm.name: code
         for layouts in protocol.framing.alternatives.values()
         for layout in layouts
         for checksum in layout.checksums
-        if (code := checksum.algorithm.lua_function()) is not None
+        for algorithm in (checksum.algorithm, getattr(checksum.algorithm, "inner", None))
+        if algorithm is not None and (code := algorithm.lua_function()) is not None
     }
     return [(_lua_name(name), code) for name, code in sorted(found.items())]
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from typing import Any, Literal
 
+from serialspec.checksums.seed import Seeded
 from serialspec.lang.errors import SpecError
 from serialspec.lang.loader import Path
 from serialspec.lang.model import (
@@ -47,10 +48,20 @@ class Commands(FieldResolver):
         if self.ctx.framing:
             self.check_codes(self.ctx.commands, self.ctx.framing)
             self.check_lengths(self.ctx.commands, self.ctx.framing)
+            self.check_seeds(self.ctx.framing)
         self.check_answered_by(self.ctx.commands)
         self.check_request_references(self.ctx.commands)
         self.check_matching(self.ctx.commands, self.ctx.framing)
         return self.problems
+
+    def check_seeds(self, framing: Framing) -> None:
+        """A command's `checksum_seed` belongs to a frame with a `seed: per_command` checksum."""
+        layouts = [layout for found in framing.alternatives.values() for layout in found]
+        if any(isinstance(c.algorithm, Seeded) for layout in layouts for c in layout.checksums):
+            return
+        for key, value in self.section("commands").items():
+            if isinstance(value, dict) and "checksum_seed" in value:
+                self.error(("commands", key, "checksum_seed"), "no checksum of the frame has `seed: per_command`")
 
     def check_lengths(self, commands: list[Command], framing: Framing) -> None:
         """Every message's smallest content must be countable by its frame's length element."""

@@ -11,6 +11,7 @@ from typing import Any, Literal
 
 from serialspec import checksums, transforms
 from serialspec.checksums import ChecksumProblem
+from serialspec.checksums.seed import Seeded
 from serialspec.lang.errors import SpecError
 from serialspec.lang.loader import Path
 from serialspec.lang.model import (
@@ -149,6 +150,34 @@ class FramingPass(FieldResolver):
         except ChecksumProblem as problem:
             raise self.fail((*path, *problem.keys), problem.message) from None
         return Checksum(algorithm, "", "", scalar, endian, name)
+
+    def seeded(self, checksum: Checksum, elements: list[FrameElement], a: int, b: int, path: Path) -> Checksum:
+        """A checksum with `seed: per_command`: its algorithm wrapped with each command's `checksum_seed`, found
+        by the command's code at its fixed offset in the covered bytes."""
+        found = [i for i in range(a, b + 1) if elements[i].role == "command"]
+        if not found:
+            raise self.fail(path, "a per-command seed needs the command element inside the covered span")
+        before = elements[a : found[0]]
+        if any(e.role in ("content", "checksum") or e.size is None for e in before):
+            raise self.fail(path, "a per-command seed needs elements of fixed size before the command element")
+        command = elements[found[0]]
+        assert command.size is not None
+        seeds: dict[int, int] = {}
+        for name, raw in self.section("commands").items():
+            if not isinstance(raw, dict) or not isinstance(raw.get("code"), int):
+                continue
+            seed = raw.get("checksum_seed")
+            if seed is None and not any(p.message.endswith("give `checksum_seed`") for p in self.problems):
+                self.error(("commands", name), f"`seed: per_command` on {checksum.name}: give `checksum_seed`")
+            elif isinstance(seed, int) and raw["code"] in seeds and seeds[raw["code"]] != seed:
+                self.error(("commands", name, "checksum_seed"), f"code {raw['code']} has another seed already")
+            elif isinstance(seed, int):
+                seeds[raw["code"]] = seed
+        offset = sum(e.size or 0 for e in before)
+        algorithm = Seeded(
+            checksum.algorithm, offset, command.size, command.endian == "<", tuple(sorted(seeds.items()))
+        )
+        return replace(checksum, algorithm=algorithm)
 
     def span(
         self, raw: Any, direction: Direction, names: list[str], path: Path, default: tuple[str, str] | None = None
@@ -289,6 +318,8 @@ class FramingPass(FieldResolver):
                             (*e_path, "covers"), f"a checksum covering {names[end]} must come after it in the frame"
                         )
                 checksum = replace(element.checksum, first=covers[0], last=covers[1], skips=skips)
+                if item.get("seed") == "per_command":
+                    checksum = self.seeded(checksum, elements, a, b, (*e_path, "seed"))
                 elements[index] = replace(element, checksum=checksum)
         checksums = tuple(e.checksum for e in elements if e.checksum is not None)
         flagged = any("error_flag" in item for item in raws.values())

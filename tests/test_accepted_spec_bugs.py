@@ -73,7 +73,7 @@ def test_decode_without_a_direction_takes_the_one_direction_a_frame_decodes_in(
     assert main(["decode", path, "aa 01 02 05 06"]) == 1
     assert "give the direction" in capsys.readouterr().err
     assert main(["decode", path, "aa 09 01 05"]) == 1
-    assert capsys.readouterr().err.strip() == "serialspec decode: aa 09 01 05: unknown command 9"
+    assert capsys.readouterr().err.strip() == "serialspec decode: aa 09 01 05: unknown command 0x09"
 
 
 def test_yaml_merge_keys_bring_in_the_anchored_keys(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

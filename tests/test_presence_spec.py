@@ -147,5 +147,6 @@ def test_every_shipped_bus_declares_how_to_find_its_devices() -> None:
         "hiwonder_rrc": None,
         "modbus_rtu": "read_holding_registers",
         "nmea0183": None,
+        "crsf": None,
         "vesc": "fw_version",
     }

@@ -126,7 +126,9 @@ def run(args: argparse.Namespace) -> int:
                 if printer.wanted(item):
                     seen += 1
                     printer.line(item)
-    for item in frames.finish():  # bad bytes at the end, that nothing came after
+                    if seen == args.count:  # exactly that many, however many frames one read brought
+                        break
+    for item in frames.finish() if args.count is None or seen < args.count else ():  # bytes nothing came after
         if printer.wanted(item):
             printer.line(item)
     if save is not None:

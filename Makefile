@@ -34,8 +34,8 @@ INSTALL_MISSING = if [ -z "$$missing" ]; then exit 0; fi; \
 		echo "not installed:$$missing (apt-get as root installs them): the tests that need them are skipped"; exit 0; fi; \
 	echo "installing$$missing (apt-get)"; \
 	export DEBIAN_FRONTEND=noninteractive; \
-	apt-get install -y -q $$missing >/dev/null 2>&1 || { apt-get update -q >/dev/null 2>&1 && \
-		apt-get install -y -q $$missing >/dev/null 2>&1; } || \
+	apt-get -o DPkg::Lock::Timeout=300 install -y -q $$missing >/dev/null 2>&1 || { apt-get -o DPkg::Lock::Timeout=300 update -q >/dev/null 2>&1 && \
+		apt-get -o DPkg::Lock::Timeout=300 install -y -q $$missing >/dev/null 2>&1; } || \
 		echo "could not install$$missing: the tests that need them are skipped"
 test-tools:
 	@missing=""; for tool in $(TEST_TOOLS); do command -v $$tool >/dev/null || missing="$$missing $$tool"; done; \

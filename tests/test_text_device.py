@@ -32,7 +32,10 @@ def test_the_cli_sim_streams_fixes_that_pynmea2_parses_and_the_client_iterates_o
             messages = []
             for message in client.messages(timeout=10):
                 messages.append(message)
-                if sum(isinstance(m, nmea0183.RmcResponse) for m in messages) >= 2:
+                # the client may open the port after the first burst began: count both kinds, not just RMCs
+                ggas_so_far = sum(isinstance(m, nmea0183.GgaResponse) for m in messages)
+                rmcs_so_far = sum(isinstance(m, nmea0183.RmcResponse) for m in messages)
+                if ggas_so_far >= 2 and rmcs_so_far >= 2:
                     break
     finally:
         sim.terminate()

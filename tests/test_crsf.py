@@ -9,6 +9,10 @@ channels[0] is channel 16); the CRSF documentation's example frame pins which en
 
 from __future__ import annotations
 
+import json
+import subprocess
+import sys
+from pathlib import Path
 from typing import Any
 
 import pytest
@@ -179,6 +183,20 @@ def test_sim_streams_frames_the_peer_parses() -> None:
     assert (link.uplink_rssi_ant_1, link.uplink_link_quality, int(link.uplink_tx_power)) == (45, 100, 3)
     assert len(seen[0x16][0].channels) == 16
     assert len(seen[0x16]) > len(seen[0x08])  # RC channels come 25 times as often as the battery
+
+
+def test_sim_tap_records_the_reports_the_device_sends_on_its_own(tmp_path: Path) -> None:
+    tap = tmp_path / "link.capture"
+    with serve("crsf.yaml", options=["--tap", str(tap)]) as path, serial.Serial(path, 420000, timeout=0.1) as port:
+        peer_reads(port, {0x08, 0x14, 0x16})
+    out = subprocess.run(
+        [sys.executable, "-m", "serialspec", "decode", "specs/crsf.yaml", "--file", str(tap), "--json"],
+        capture_output=True,
+        text=True,
+    )
+    commands = [json.loads(line)["command"] for line in out.stdout.splitlines()]
+    assert out.returncode == 0 and out.stderr == "", out.stderr
+    assert {"rc_channels", "link_statistics", "battery"} <= set(commands)
 
 
 def test_our_client_pings_the_sim_among_its_stream() -> None:

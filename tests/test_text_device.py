@@ -7,8 +7,11 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import os
+import shutil
 import subprocess
 import sys
+import tty
 from pathlib import Path
 
 import pynmea2
@@ -144,3 +147,117 @@ def test_a_text_device_section_with_mistakes_gets_one_line_each(tmp_path: Path) 
     ]
     assert [e.split(": ", 1)[1] for e in errors] == expected, errors
     assert all(e.startswith(f"{bad}:") for e in errors)
+
+
+def test_sim_tap_records_the_sentences_sent_and_decode_file_reads_them_back(tmp_path: Path) -> None:
+    tap = tmp_path / "fixes.capture"
+    sim = subprocess.Popen(
+        [*CLI, "sim", SPEC, "--tap", str(tap), "--quiet"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+    )
+    try:
+        assert sim.stdout is not None
+        path = sim.stdout.readline().strip()
+        assert path.startswith("/dev/"), sim.stderr.read() if sim.stderr else ""
+        with nmea0183.Client(path) as client:
+            received = []
+            for message in client.messages(timeout=10):
+                received.append(message)
+                if len(received) >= 3:
+                    break
+    finally:
+        sim.terminate()
+        sim.wait(10)
+    out = subprocess.run([*CLI, "decode", SPEC, "--file", str(tap), "--json"], capture_output=True, text=True)
+    assert out.returncode == 0 and out.stderr == "", out.stderr
+    decoded = [json.loads(line) for line in out.stdout.splitlines()]
+    assert len(decoded) >= len(received) and all(d["direction"] == "response" and d["time"] for d in decoded)
+    sent = [d["text"] for d in decoded]
+    for message in received:  # every sentence the client got is in the recording, as it was sent
+        assert nmea0183.encode(message).decode("ascii").strip() in sent
+    assert all(pynmea2.parse(text).sentence_type in ("GGA", "RMC") for text in sent)
+    readable = subprocess.run([*CLI, "decode", SPEC, "--file", str(tap)], capture_output=True, text=True, check=True)
+    assert readable.stdout.count("nmea0183 response gga") == sum(d["command"] == "gga" for d in decoded)
+
+
+def test_decode_file_of_a_text_capture_reports_garbage_and_a_cut_sentence_on_their_lines(tmp_path: Path) -> None:
+    good = b"$GPRMC,225446,A,4916.45,N,12311.12,W,000.5,054.7,191194,020.3,E*68\r\n"
+    capture = tmp_path / "noisy.capture"
+    capture.write_text(
+        "# serialspec capture: nmea0183\n" + f"{b'xx'.hex(' ')}\n{good.hex(' ')}\n{good[:20].hex(' ')}\n",
+        encoding="utf-8",
+    )
+    out = subprocess.run([*CLI, "decode", SPEC, "--file", str(capture), "--json"], capture_output=True, text=True)
+    assert out.returncode == 1 and "Traceback" not in out.stderr
+    assert [json.loads(line)["command"] for line in out.stdout.splitlines()] == ["rmc"]
+    errors = out.stderr.strip().splitlines()
+    assert len(errors) == 2 and "line 2" in errors[0] and "'xx'" in errors[0], errors
+    assert "ends inside a sentence" in errors[1] and "$GPRMC,225446" in errors[1], errors
+
+
+GGA = b"$GPGGA,123519,4807.038,N,01131.000,E,1,08,0.9,545.4,M,46.9,M,,*47\r\n"
+RMC = b"$GPRMC,123519,A,4807.038,N,01131.000,E,022.4,084.4,230394,003.1,W*6A\r\n"
+
+
+def test_plot_draws_a_text_capture_s_numbers_in_their_units(tmp_path: Path) -> None:
+    capture = tmp_path / "fixes.capture"
+    lines = ["# serialspec capture: nmea0183"]
+    for second, sentence in enumerate((GGA, RMC, GGA, RMC)):
+        lines.append(f"2026-11-27T12:00:0{second}.000000+00:00 response {sentence.hex(' ')}")
+    capture.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    out = tmp_path / "fixes.svg"
+    fields = ["--field", "latitude", "--field", "gga.altitude", "--field", "speed"]
+    done = subprocess.run(
+        [*CLI, "plot", str(capture), "--spec", SPEC, *fields, "--out", str(out)], capture_output=True, text=True
+    )
+    assert done.returncode == 0, done.stderr
+    assert "8 values of 3 field(s)" in done.stdout  # latitude from 2 GGA + 2 RMC, altitude 2, speed 2
+    svg = out.read_text(encoding="utf-8")
+    assert "altitude (m)" in svg and "speed (kn)" in svg and "latitude (°)" in svg
+    refused = subprocess.run(
+        [*CLI, "plot", str(capture), "--spec", SPEC, "--field", "utc", "--out", str(out)],
+        capture_output=True,
+        text=True,
+    )
+    assert refused.returncode != 0 and "numbers seen: altitude" in refused.stderr and "Traceback" not in refused.stderr
+
+
+def test_replay_sends_a_text_capture_that_monitor_reads_back(tmp_path: Path) -> None:
+    capture = tmp_path / "fixes.capture"
+    capture.write_text(f"{GGA.hex(' ')}\n{RMC.hex(' ')}\n", encoding="utf-8")  # unknown direction: the spec splits
+    controller, device = os.openpty()
+    tty.setraw(controller)
+    tty.setraw(device)
+    try:
+        path = os.ttyname(device)
+        done = subprocess.run(
+            [*CLI, "replay", str(capture), "--port", path, "--spec", SPEC, "--direction", "response", "--speed", "0"],
+            capture_output=True,
+            text=True,
+            timeout=60,
+        )
+        assert done.returncode == 0, done.stderr
+        received = b""
+        while len(received) < len(GGA + RMC):
+            received += os.read(controller, 4096)
+    finally:
+        os.close(controller)
+        os.close(device)
+    assert received == GGA + RMC
+
+
+@pytest.mark.skipif(shutil.which("tmux") is None, reason="tmux is not installed (make generate installs it)")
+def test_watch_shows_a_text_device_s_sentences_with_units() -> None:
+    from test_watch import pane, row
+
+    device = fast_device()
+    path = device.start()
+    try:
+        with pane("nmea") as screen:
+            screen.start([*CLI, "watch", SPEC, "--port", path])
+            # a row's values wrap onto the lines below it in a 160-column pane
+            text = screen.wait_for(lambda s: "altitude=545.4 m" in s and "speed=22.0 kn" in s)
+    finally:
+        device.close()
+    assert row(text, "gga", "utc=") and row(text, "rmc", "utc="), text
+    assert "altitude=545.4 m" in text and "speed=22.0 kn" in text and "course=45.0°" in text, text
+    assert "0 bad" in text and "Traceback" not in text

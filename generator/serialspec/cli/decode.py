@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Callable
 from types import ModuleType
 from typing import TYPE_CHECKING, Any
 
@@ -45,13 +46,15 @@ def run(args: argparse.Namespace) -> int:
         raise SerialspecError("give frames as hex arguments, - to read them from stdin, or --file CAPTURE")
     protocol, package = open_spec(args.spec)
     if protocol.text is not None:
-        if args.file or args.request or args.units or args.direction:
+        if args.request or args.units or args.direction:
             raise SerialspecError(
-                "a text protocol's sentences are decoded as given (as typed or as hex): --file, --request, --units "
+                "a text protocol's sentences say which message they are and carry no registers: --request, --units "
                 "and --direction are for binary frames"
             )
         from serialspec.cli import textframes
 
+        if args.file:
+            return replay(args, protocol, package)
         sentences = [line for line in sys.stdin if line.strip()] if args.hex == ["-"] else args.hex
         return textframes.decode(protocol, package, sentences, args.json)
     request = None
@@ -77,21 +80,24 @@ def run(args: argparse.Namespace) -> int:
     return 1 if failed else 0
 
 
-def show(result: dict[str, Any], as_json: bool) -> None:
+def show(result: dict[str, Any], as_json: bool, lines: Callable[[dict[str, Any]], str] | None = None) -> None:
+    """A decoded frame as JSON, or as `lines` writes it for a person (default: `readable`)."""
     if as_json:
         import json
 
         print(json.dumps(result, ensure_ascii=False), flush=True)
     else:
-        print(readable(result), flush=True)
+        print((lines or readable)(result), flush=True)
 
 
 def replay(args: argparse.Namespace, protocol: Protocol, package: ModuleType) -> int:
-    """Decode a capture: each direction's bytes joined again and split into frames; bad bytes reported. A reply is
-    shown with the last request before it when it answers that request (registers by name, as `--request` does)."""
-    from serialspec.cli import capture
+    """Decode a capture: each direction's bytes joined again and split into frames (a text protocol's into
+    sentences); bad bytes reported. A reply is shown with the last request before it when it answers that request
+    (registers by name, as `--request` does)."""
+    from serialspec.cli import capture, textframes
     from serialspec.cli.frames import Frames
 
+    text = protocol.text is not None
     address = protocol.device.address if protocol.device else None
     streams: dict[str | None, Frames] = {}
     failed = 0
@@ -106,32 +112,44 @@ def replay(args: argparse.Namespace, protocol: Protocol, package: ModuleType) ->
                 for seen in frames.feed(chunk.data, number):
                     if seen.message is None:
                         failed += 1
-                        bad(seen)
+                        bad(seen, text)
                         continue
                     message, request = seen.message, None
-                    if message.DIRECTION.value == "request":
-                        asked = message
-                    elif asked is not None and reply_to(message_spec(protocol, asked), replies) is message_spec(
-                        protocol, message
-                    ):
-                        request = asked
-                    result = describe(protocol, message, seen.data, args.units, request)
-                    show({"time": chunk.when, **result} if chunk.when else result, args.json)
+                    if text:
+                        result = textframes.describe(protocol, package, seen.data)
+                    else:
+                        if message.DIRECTION.value == "request":
+                            asked = message
+                        elif asked is not None and reply_to(message_spec(protocol, asked), replies) is message_spec(
+                            protocol, message
+                        ):
+                            request = asked
+                        result = describe(protocol, message, seen.data, args.units, request)
+                    result = {"time": chunk.when, **result} if chunk.when else result
+                    show(result, args.json, textframes.readable if text else readable)
         except ValueError as exc:
             raise SerialspecError(f"{args.file}: {exc}") from None
     for frames in streams.values():
         for seen in frames.finish():
             failed += 1
-            bad(seen)
+            bad(seen, text)
         if frames.pending():
             failed += 1
-            print(f"serialspec decode: {args.file} ends inside a frame: [{frames.pending().hex(' ')}]", file=sys.stderr)
+            what = "a sentence" if text else "a frame"
+            print(
+                f"serialspec decode: {args.file} ends inside {what}: {_bytes(frames.pending(), text)}", file=sys.stderr
+            )
     return 1 if failed else 0
 
 
-def bad(seen: Seen) -> None:
+def bad(seen: Seen, text: bool) -> None:
     """Bad bytes of a capture, under the line their first byte is on."""
-    print(f"serialspec decode: line {seen.origin}: {seen.reason} in [{seen.data.hex(' ')}]", file=sys.stderr)
+    print(f"serialspec decode: line {seen.origin}: {seen.reason} in {_bytes(seen.data, text)}", file=sys.stderr)
+
+
+def _bytes(data: bytes, text: bool) -> str:
+    """Bytes in a message: characters in quotes for a text protocol, hex in brackets for a binary one."""
+    return "'" + data.decode("ascii", "backslashreplace") + "'" if text else f"[{data.hex(' ')}]"
 
 
 def _hex(text: str) -> bytes:

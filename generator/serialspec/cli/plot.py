@@ -16,13 +16,13 @@ from collections import defaultdict
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import ModuleType
-from typing import Any
+from typing import Any, assert_never
 
 from serialspec.cli import capture
 from serialspec.cli.frames import Frames
-from serialspec.cli.protocols import SPEC_HELP, open_binary_spec
+from serialspec.cli.protocols import SPEC_HELP, open_spec
 from serialspec.cli.views import engineering_unit, message_spec, register_view
-from serialspec.lang.model import Bytes, Protocol, Scalar, Table, TableValue
+from serialspec.lang.model import Bytes, Protocol, Scalar, Table, TableValue, TextField, TextFrame
 from serialspec.runtime.errors import PortError, SerialspecError
 from serialspec.runtime.message import Message
 
@@ -73,12 +73,12 @@ def run(args: argparse.Namespace) -> int:
     if args.port:
         if not args.spec:
             raise SerialspecError("--port needs --spec SPEC (the protocol on the port)")
-        protocol, package = open_binary_spec(args.spec, "plot")
+        protocol, package = open_spec(args.spec)
         chunks = record(args.port, package, args.baudrate, args.duration)
         source = args.port
     else:
         chunks = read_capture(args.capture)
-        protocol, package = open_binary_spec(args.spec or _named_protocol(args.capture), "plot")
+        protocol, package = open_spec(args.spec or _named_protocol(args.capture))
         source = Path(args.capture).name
     panels = collect(protocol, package, chunks, args.fields, set(args.ids or ()))
     draw(pyplot, panels, f"{protocol.name}: {source}", out)
@@ -205,6 +205,8 @@ def _moment(text: str) -> datetime.datetime | None:
 def field_values(protocol: Protocol, message: Message, request: Message | None) -> dict[str, tuple[float, str]]:
     """name -> (value in the spec's units, unit symbol) of every plain number a message holds: its fields (scaled),
     and the registers of a reply that carries a run of them. Enums, flags, texts and lists are left out."""
+    if protocol.text is not None:
+        return _text_values(protocol.text, message)
     fields = message.to_fields()
     found: dict[str, tuple[float, str]] = {}
     for f in message_spec(protocol, message).fields:
@@ -227,6 +229,30 @@ def field_values(protocol: Protocol, message: Message, request: Message | None) 
     return found
 
 
+def _text_values(text: TextFrame, message: Message) -> dict[str, tuple[float, str]]:
+    """name -> (value, unit) of every number a text sentence holds: decimals and integers as sent, angles in decimal
+    degrees (unsigned: the hemisphere is a field of its own); empty fields, letters, texts, times and dates left out."""
+    spec = next((m for m in text.messages if m.class_name == type(message).__name__), None)
+    values = message.to_fields()
+    found: dict[str, tuple[float, str]] = {}
+    for f in spec.fields if spec is not None else ():
+        if not isinstance(f, TextField):
+            continue  # a repeated group: a list, left out as lists of binary frames are
+        value = values.get(f.name)
+        if value is None:
+            continue
+        match f.kind:
+            case "decimal" | "integer":
+                found[f.name] = float(value), f.unit
+            case "angle":
+                found[f.name] = round(value.value, 9), f.unit or "°"
+            case "char" | "text" | "time" | "date":
+                pass
+            case unknown:
+                assert_never(unknown)
+    return found
+
+
 def _register_table(protocol: Protocol, message: Message) -> Table | None:
     return next(
         (f.table for f in message_spec(protocol, message).fields if isinstance(f, Bytes) and f.table is not None),
@@ -245,6 +271,7 @@ def draw(pyplot: Any, panels: list[Panel], title: str, out: Path) -> None:
     for panel, ax in zip(panels, axes[:, 0], strict=True):
         for label, line in panel.lines.items():
             ax.plot(line.times, line.values, marker=".", linewidth=1.2, label=label)
+        ax.ticklabel_format(axis="y", useOffset=False)  # 48.1174°, not +4.8117e1 and 0.0004 on the axis
         ax.set_ylabel(f"{panel.name} ({panel.unit})" if panel.unit else panel.name)
         ax.grid(True, alpha=0.3)
         ax.legend(loc="best", fontsize="small")

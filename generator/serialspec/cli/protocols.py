@@ -56,12 +56,12 @@ _BUILT: dict[tuple[str, str, bytes], tuple[Protocol, ModuleType]] = {}
 
 
 def open_binary_spec(spec: str, verb: str) -> tuple[Protocol, ModuleType]:
-    """`open_spec` for the verbs that read frames of bytes: a text protocol is refused in one line."""
+    """`open_spec` for the verbs that address devices by id (`scan`): a text protocol is refused in one line."""
     protocol, package = open_spec(spec)
     if protocol.text is not None:
         raise SerialspecError(
-            f"{spec} is a text protocol (`framing: {{kind: text}}`): `serialspec {verb}` does not handle text frames "
-            "yet (its generated package's decode, encode and StreamParser do)"
+            f"{spec} is a text protocol (`framing: {{kind: text}}`): its sentences carry no device id to "
+            f"`serialspec {verb}` for (`monitor` and `watch` show what its devices send)"
         )
     return protocol, package
 

@@ -101,10 +101,10 @@ def _package(spec: str | None, required: bool) -> tuple[Any, str | None]:
                 "the capture has bytes of unknown direction ('-') and names no protocol: give --spec SPEC"
             )
         return None, None
-    from serialspec.cli.protocols import open_binary_spec
+    from serialspec.cli.protocols import open_spec
 
     try:
-        protocol, package = open_binary_spec(spec, "replay")
+        protocol, package = open_spec(spec)
     except SerialspecError:
         if required:
             raise

@@ -6,8 +6,7 @@ import argparse
 import json
 import signal
 import sys
-import time
-from types import FrameType
+from types import FrameType, ModuleType
 from typing import Any
 
 from serialspec.cli import capture
@@ -101,16 +100,63 @@ def model_choice(given: list[str] | None) -> str | dict[int, str] | None:
 def run(args: argparse.Namespace) -> int:
     protocol, package = open_spec(args.spec)
     module = submodule(package, "simulator")
-    if protocol.text is not None:
-        if module is None:
-            raise SerialspecError(f"{args.spec} has no `device:` section, so no simulator is generated")
-        if args.ids or args.models or args.sizes or args.tap or args.echo:
-            raise SerialspecError(
-                "a text protocol's simulator is one device: --id, --model, --size, --tap and --echo do not apply"
-            )
-        return _serve(protocol, module.SIMULATOR())
-    if module is None or protocol.device is None:
+    if module is None or (protocol.text is None and protocol.device is None):
         raise SerialspecError(f"{args.spec} has no `device:` section, so no simulator is generated")
+    simulator = _text_device(args, module) if protocol.text is not None else _bus(args, protocol, module)
+    simulator.echo = args.echo
+    tap = None
+    if args.tap:
+        try:
+            tap = open(args.tap, "w", encoding="utf-8")  # noqa: SIM115 (closed below)
+        except OSError as exc:
+            raise SerialspecError(f"cannot write {args.tap}: {exc.strerror}") from None
+    if tap is not None:
+        # every byte that crosses the pseudo-terminal, as it does: replies and the device's own reports alike
+        simulator.tap = capture.Writer(tap, protocol.name).write
+    if not args.quiet:
+        feed = simulator.feed
+
+        def logged(data: bytes) -> list[tuple[float, bytes]]:
+            before = len(simulator.log)
+            replies: list[tuple[float, bytes]] = feed(data)
+            for request in simulator.log[before:]:
+                print(f"request  {_text(request)}", file=sys.stderr, flush=True)
+            for _, frame in replies:
+                print(f"response {_shown(protocol, frame)}", file=sys.stderr, flush=True)
+            return replies
+
+        simulator.feed = logged
+    controller, path = simulator.open_pty()
+
+    def stop(signum: int, frame: FrameType | None) -> None:
+        simulator.stop()
+
+    signal.signal(signal.SIGINT, stop)
+    signal.signal(signal.SIGTERM, stop)
+    print(path, flush=True)
+    shown = "device" if protocol.text is not None else served(protocol, simulator.devices)
+    print(f"serialspec sim: {protocol.name} {shown} on {path}; Ctrl-C to stop", file=sys.stderr, flush=True)
+    try:
+        simulator.serve(controller)
+    finally:
+        if tap is not None:
+            tap.close()
+    return 0
+
+
+def _text_device(args: argparse.Namespace, module: ModuleType) -> Any:
+    """A text protocol's device: one on the line, so no ids, models or data spaces to choose."""
+    given = [
+        option for option, value in (("--id", args.ids), ("--model", args.models), ("--size", args.sizes)) if value
+    ]
+    if given:
+        raise SerialspecError(f"a text protocol's simulator is one device: {', '.join(given)} do(es) not apply")
+    return module.SIMULATOR()
+
+
+def _bus(args: argparse.Namespace, protocol: Protocol, module: ModuleType) -> Any:
+    """The devices on a binary protocol's bus, as --id, --model and --size choose."""
+    assert protocol.device is not None
     if args.ids and not protocol.device.address:
         raise SerialspecError(f"--id: {protocol.name} frames carry no device address, so the bus has one device")
     ids = args.ids or list(protocol.device.ids)
@@ -131,66 +177,17 @@ def run(args: argparse.Namespace) -> int:
             raise SerialspecError(f"--size: {protocol.name} devices keep no data spaces")
         options["sizes"] = sizes
     try:
-        simulator = module.SIMULATOR(ids, **options)
+        return module.SIMULATOR(ids, **options)
     except ValueError as exc:  # an unknown model or data space, or a model for an id not on the bus
         option = "--size" if "data space" in str(exc) else "--model"
         raise SerialspecError(f"{option}: {exc}") from None
-    simulator.echo = args.echo
-    tap = None
-    if args.tap:
-        try:
-            tap = open(args.tap, "w", encoding="utf-8")  # noqa: SIM115 (closed below)
-        except OSError as exc:
-            raise SerialspecError(f"cannot write {args.tap}: {exc.strerror}") from None
-    writer = capture.Writer(tap, protocol.name) if tap else None
-    feed = simulator.feed
-
-    def logged(data: bytes) -> list[tuple[float, bytes]]:
-        before, moment, offset = len(simulator.log), time.time(), time.time() - simulator.clock()
-        replies: list[tuple[float, bytes]] = feed(data)
-        if writer is not None:
-            writer.write("request", data, moment)
-            for when, frame in replies:
-                writer.write("response", frame, max(moment, when + offset))
-        if not args.quiet:
-            for request in simulator.log[before:]:
-                print(f"request  {_text(request)}", file=sys.stderr, flush=True)
-            for _, frame in replies:
-                print(f"response [{frame.hex(' ')}]", file=sys.stderr, flush=True)
-        return replies
-
-    simulator.feed = logged
-    controller, path = simulator.open_pty()
-
-    def stop(signum: int, frame: FrameType | None) -> None:
-        simulator.stop()
-
-    signal.signal(signal.SIGINT, stop)
-    signal.signal(signal.SIGTERM, stop)
-    print(path, flush=True)
-    shown = served(protocol, simulator.devices)
-    print(f"serialspec sim: {protocol.name} {shown} on {path}; Ctrl-C to stop", file=sys.stderr, flush=True)
-    try:
-        simulator.serve(controller)
-    finally:
-        if tap is not None:
-            tap.close()
-    return 0
 
 
-def _serve(protocol: Protocol, simulator: Any) -> int:
-    """Serve a text protocol's device on a new pseudo-terminal until Ctrl-C: it sends its sentences on its own."""
-    controller, path = simulator.open_pty()
-
-    def stop(signum: int, frame: FrameType | None) -> None:
-        simulator.stop()
-
-    signal.signal(signal.SIGINT, stop)
-    signal.signal(signal.SIGTERM, stop)
-    print(path, flush=True)
-    print(f"serialspec sim: {protocol.name} device on {path}; Ctrl-C to stop", file=sys.stderr, flush=True)
-    simulator.serve(controller)
-    return 0
+def _shown(protocol: Protocol, frame: bytes) -> str:
+    """A frame sent, for the log: a text sentence as its line, binary bytes as hex."""
+    if protocol.text is not None:
+        return frame.decode("ascii", "replace").rstrip("\r\n")
+    return f"[{frame.hex(' ')}]"
 
 
 def _text(message: object) -> str:

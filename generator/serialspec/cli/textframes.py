@@ -66,7 +66,8 @@ def decode(protocol: Protocol, package: ModuleType, frames: list[str], as_json: 
 
 
 def readable(result: dict[str, Any]) -> str:
-    lines = [f"{result['protocol']} {result['direction']} {result['command']}  {result['text']}"]
+    when = f"{result['time']} " if result.get("time") else ""
+    lines = [f"{when}{result['protocol']} {result['direction']} {result['command']}  {result['text']}"]
     if result["talker"]:
         lines.append(f"  {'talker':<20} {result['talker']}")
     for name, value in result["fields"].items():

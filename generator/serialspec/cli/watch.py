@@ -20,7 +20,7 @@ from typing import Any, TextIO
 from serialspec.cli import capture
 from serialspec.cli.frames import Frames, Seen
 from serialspec.cli.listening import Stopping, open_port
-from serialspec.cli.protocols import SPEC_HELP, open_binary_spec
+from serialspec.cli.protocols import SPEC_HELP, open_spec
 from serialspec.cli.views import (
     FlagNames,
     engineering,
@@ -30,9 +30,10 @@ from serialspec.cli.views import (
     unit_symbols,
     with_unit,
 )
-from serialspec.lang.model import Protocol, Scalar, TableEntry
+from serialspec.lang.model import Protocol, Scalar, TableEntry, TextField
 from serialspec.runtime.errors import PortError, SerialspecError
 from serialspec.runtime.message import Message
+from serialspec.runtime.text import texts
 
 RATE_WINDOW = 5.0  # seconds over which a row's rate is counted
 REFRESH = 0.25  # seconds between redraws
@@ -102,6 +103,9 @@ class Board:
         direction = message.DIRECTION.value
         name = message.COMMAND + (f".{message.SUBCOMMAND}" if message.SUBCOMMAND else "")
         row = self.row(str(device), name, direction)
+        if self.protocol.text is not None:  # a sentence: its fields as the device wrote them, no registers
+            row.seen(now, self.sentence(message, fields), False)
+            return
         row.seen(now, self.values(message, fields), self.error(message, fields))
         request = self.requests.get(device) if direction == "response" else None
         registers = register_view(self.protocol, message, request)
@@ -127,6 +131,19 @@ class Board:
             text = _text(value)
             words.append(f"{name}={with_unit(text, symbols[name]) if name in symbols else text}")
         return " ".join(words)
+
+    def sentence(self, message: Message, fields: dict[str, Any]) -> str:
+        """A text sentence's fields as sent (`latitude=4807.0560 °`), empty ones left out."""
+        record: Any = message  # a text record: its frame's descriptor of its code
+        assert self.protocol.text is not None
+        spec = next(m for m in self.protocol.text.messages if m.class_name == type(message).__name__)
+        units = {f.name: f.unit for f in spec.fields if isinstance(f, TextField) and f.unit and not self.raw}
+        sent = texts(record.FRAMING.by_code[record.CODE], fields)
+        return " ".join(
+            f"{name}={with_unit(text, units[name]) if name in units else _text(text)}"
+            for name, text in sent.items()
+            if text not in ("", None, [])
+        )
 
     def register(self, name: str, value: Any) -> str:
         entry = self.entries.get(name)
@@ -268,7 +285,7 @@ def run(args: argparse.Namespace) -> int:
     from rich.console import Console
     from rich.live import Live
 
-    protocol, package = open_binary_spec(args.spec, "watch")
+    protocol, package = open_spec(args.spec)
     address = protocol.device.address if protocol.device else None
     source: PortSource | TapSource = (
         PortSource(args, package, address) if args.port else TapSource(args.tap, package, address)

@@ -49,6 +49,9 @@ class Simulator(Engine):
         self._released = False  # close() has closed the pseudo-terminal and the wake-up pipe
         # Like a one-wire half-duplex adapter: every byte the client sends comes back to it before any reply.
         self.echo = False
+        # Called with ("request", bytes read) and ("response", bytes written) as they cross the pseudo-terminal:
+        # replies, reports sent on the device's own (`device.sends`) and emit()ted frames alike (`sim --tap`).
+        self.tap: Callable[[str, bytes], None] | None = None
 
     def emit(self, message: Message) -> None:
         """Send a message on the device's own initiative (a report, a key event) as soon as possible."""
@@ -67,7 +70,10 @@ class Simulator(Engine):
                     heapq.heappush(self._outbox, _Scheduled(when, self._seq, frame))
             now = self.clock()
             while self._outbox and self._outbox[0].when <= now:
-                os.write(fd, heapq.heappop(self._outbox).data)
+                frame = heapq.heappop(self._outbox).data
+                os.write(fd, frame)
+                if self.tap is not None:
+                    self.tap("response", frame)
             times = [self._outbox[0].when] if self._outbox else []
             times += [t for t in [self.next_due() if sends else None] if t is not None]
             wait = max(0.0, min(times) - now) if times else None
@@ -86,6 +92,8 @@ class Simulator(Engine):
                 if not data:
                     self._stop.wait(0.01)
                     continue
+                if self.tap is not None:
+                    self.tap("request", data)
                 if self.echo:
                     os.write(fd, data)
                 for when, frame in self.feed(data):

@@ -813,6 +813,31 @@ TEXT_CASE: dict[str, Any] = {
             },
         },
         "answer": {"code": "OK", "response": {"unsolicited": True, "fields": {"ok": {"use": "side"}}}},
+        "dial": {
+            "code": "DL",
+            "title": "A request answered under the same code",
+            "request": {"fields": {"level": {"type": "integer", "range": [0, 99]}, "note": "text"}},
+            "response": {
+                "fields": {
+                    "level": {"type": "integer", "range": [0, 99]},
+                    "volts": {"type": "decimal", "precision": 1, "range": [0, 50]},
+                    "count": {"type": "integer", "range": [0, 999]},
+                    "note": "text",
+                }
+            },
+        },
+    },
+    "device": {
+        "state": {"level": 0, "supply": 12.5, "dials": 0},
+        "commands": {
+            "dial": {
+                "description": "Every key a text device's answer has.",
+                "stores": {"level": "level"},
+                "sets": {"dials": 1},
+                "reports": {"volts": "supply * 2", "count": "dials + level"},
+                "echoes": ["note"],
+            }
+        },
     },
 }
 
@@ -846,15 +871,25 @@ def test_every_text_alternative_through_every_output() -> None:
     modules = {p.split("/", 1)[1]: t for p, t in files.items() if p.startswith("matrix_text/")}
     with imported("matrix_text", modules, "the language matrix") as package:
         for cls in package.MESSAGE_TYPES:
-            sentence = package.FRAMING.by_code[cls.CODE]
+            direction = cls.DIRECTION.value
+            sentence = package.FRAMING.sentence(cls.CODE, direction)
             assert all(isinstance(f, TextField | TextRepeat) for f in sentence.fields)
             frames, messages = b"", []
             for values in st_examples(sentence_values(sentence), 20):
                 message = cls.from_fields(values, talker="B")
                 frame = package.encode(message)
-                assert package.decode(frame) == message
-                assert package.encode(package.decode(frame)) == frame
+                assert package.decode(frame, direction) == message
+                assert package.encode(package.decode(frame, direction)) == frame
                 frames += b"\x00garbage#\n" + frame
                 messages.append(message)
-            parser = package.StreamParser()
+            parser = package.StreamParser(direction)
             assert [m for byte in frames for m in parser.feed(bytes([byte]))] == messages
+        # the device answers the request under its code, as `device.commands.dial` says
+        device = importlib.import_module("matrix_text.simulator").SIMULATOR()
+        asked = package.DialRequest(talker="A", level=7, note="hi")
+        [(_, frame)] = device.feed(package.encode(asked))
+        answer = package.decode(frame, "response")
+        assert (answer.level, answer.volts, answer.count, answer.note) == (7, 25, 8, "hi"), answer
+        # both directions in one stream (a monitor's): the answer right after its request is the response
+        both = package.StreamParser()
+        assert both.feed(package.encode(asked) + frame) == [asked, answer]

@@ -148,6 +148,7 @@ FRAMING = TextFraming(
                 TextField('dgps_station', 'integer', width=4, minimum=0, maximum=1023),
             ),
             name='GGA',
+            direction='response',
         ),
         TextSentence(
             'RMC',
@@ -166,6 +167,7 @@ FRAMING = TextFraming(
                 TextField('mode', 'char', letters=Mode),
             ),
             name='RMC',
+            direction='response',
         ),
         TextSentence(
             'VTG',
@@ -181,6 +183,7 @@ FRAMING = TextFraming(
                 TextField('mode', 'char', letters=Mode),
             ),
             name='VTG',
+            direction='response',
         ),
         TextSentence(
             'GSA',
@@ -193,6 +196,7 @@ FRAMING = TextFraming(
                 TextField('vdop', 'decimal', precision=1, minimum=0, maximum=99.9),
             ),
             name='GSA',
+            direction='response',
         ),
         TextSentence(
             'GSV',
@@ -203,6 +207,7 @@ FRAMING = TextFraming(
                 TextRepeat('satellites', (TextField('prn', 'integer', width=2, minimum=1, maximum=999), TextField('elevation', 'integer', width=2, minimum=0, maximum=90), TextField('azimuth', 'integer', width=3, minimum=0, maximum=359), TextField('snr', 'integer', width=2, minimum=0, maximum=99),), count=0, maximum=4),
             ),
             name='GSV',
+            direction='response',
         ),
     ),
 )
@@ -412,5 +417,5 @@ class Client(TextClient):
 class StreamParser(TextMessageParser):
     """Messages out of a byte stream read in any pieces (noise skipped, broken frames counted)."""
 
-    def __init__(self) -> None:
-        super().__init__(CODEC)
+    def __init__(self, direction: str | None = None) -> None:
+        super().__init__(CODEC, direction)

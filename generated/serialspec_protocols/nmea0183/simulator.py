@@ -34,6 +34,6 @@ def SIMULATOR(ids: Any = (0,), **options: Any) -> Simulator:  # noqa: N802 (the 
         DEVICE,
         ids or (0,),
         encode=cast(Any, CODEC.encode),
-        parser=cast(Any, lambda: TextMessageParser(CODEC)),
+        parser=cast(Any, lambda: TextMessageParser(CODEC, "request")),
         **options,
     )

@@ -46,17 +46,17 @@ def run(args: argparse.Namespace) -> int:
         raise SerialspecError("give frames as hex arguments, - to read them from stdin, or --file CAPTURE")
     protocol, package = open_spec(args.spec)
     if protocol.text is not None:
-        if args.request or args.units or args.direction:
+        if args.request or args.units:
             raise SerialspecError(
-                "a text protocol's sentences say which message they are and carry no registers: --request, --units "
-                "and --direction are for binary frames"
+                "a text protocol's sentences carry no registers or scaled values: --request and --units are for "
+                "binary frames"
             )
         from serialspec.cli import textframes
 
         if args.file:
             return replay(args, protocol, package)
         sentences = [line for line in sys.stdin if line.strip()] if args.hex == ["-"] else args.hex
-        return textframes.decode(protocol, package, sentences, args.json)
+        return textframes.decode(protocol, package, sentences, args.json, args.direction)
     request = None
     expect = None  # the reply layout the request gets, where replies share a code
     if args.request:
@@ -116,7 +116,7 @@ def replay(args: argparse.Namespace, protocol: Protocol, package: ModuleType) ->
                         continue
                     message, request = seen.message, None
                     if text:
-                        result = textframes.describe(protocol, package, seen.data)
+                        result = textframes.describe(protocol, package, seen.data, message.DIRECTION.value)
                     else:
                         if message.DIRECTION.value == "request":
                             asked = message

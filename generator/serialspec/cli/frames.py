@@ -15,7 +15,6 @@ from serialspec.runtime.errors import DecodeError
 from serialspec.runtime.framing import EngineFormat
 from serialspec.runtime.message import Message
 from serialspec.runtime.stream import FrameFormat
-from serialspec.runtime.text import TextFraming
 
 
 @dataclass(frozen=True)
@@ -49,9 +48,7 @@ class Frames:
         self.address = address
         self._paired: _Paired | None = None
         try:
-            # a text protocol's parser takes no direction: a sentence's code says which message it is
-            text = isinstance(getattr(package, "FRAMING", None), TextFraming)
-            self._parser: Any = package.StreamParser() if text else package.StreamParser(direction)
+            self._parser: Any = package.StreamParser(direction)
         except ValueError:
             codec = package.codec
             self._paired = _Paired(codec.REQUEST_FORMAT, codec.RESPONSE_FORMAT, address)

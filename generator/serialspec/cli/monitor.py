@@ -80,7 +80,7 @@ class Printer:
             what = message.COMMAND + (f".{message.SUBCOMMAND}" if message.SUBCOMMAND else "")
             if self.protocol.text is not None:  # a sentence: its fields as the texts sent, and the line itself
                 record: Any = message  # a text record: its frame's descriptor of its code
-                fields = texts(record.FRAMING.by_code[record.CODE], fields)
+                fields = texts(record.FRAMING.sentence(record.CODE, record.DIRECTION.value), fields)
                 line = seen.data.decode("ascii").rstrip("\r\n")
                 text = f"{what} {json.dumps(fields, ensure_ascii=False)} {line}"
             else:

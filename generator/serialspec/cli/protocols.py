@@ -170,8 +170,9 @@ def package_in_memory(protocol: Protocol) -> ModuleType:
     """The protocol's package generated from the resolved spec and imported from memory (nothing on disk)."""
     from serialspec.backends.python.memory import imported
     from serialspec.backends.python.package import emit_package
+    from serialspec.backends.python.text import text_package
 
-    files = emit_package(protocol)
+    files = emit_package(protocol) if protocol.text is None else text_package(protocol, protocol.text)
     with imported(protocol.name, files, protocol.spec_path) as package:
         for module in _MODULES:
             if f"{module}.py" in files:

@@ -10,7 +10,7 @@ from typing import Any
 from serialspec.lang.model import Protocol
 from serialspec.runtime.errors import DecodeError, EncodeError, SerialspecError
 from serialspec.runtime.hexbytes import parse_hex
-from serialspec.runtime.text import TextFraming, from_texts, texts
+from serialspec.runtime.text import DirectionNeeded, TextFraming, from_texts, texts
 
 
 def frame_of(framing: TextFraming, given: str) -> bytes:
@@ -29,10 +29,10 @@ def frame_of(framing: TextFraming, given: str) -> bytes:
         raise DecodeError(f"neither a sentence starting with {framing.start!r} nor hex: {exc}") from None
 
 
-def describe(protocol: Protocol, package: ModuleType, frame: bytes) -> dict[str, Any]:
+def describe(protocol: Protocol, package: ModuleType, frame: bytes, direction: str | None = None) -> dict[str, Any]:
     framing: TextFraming = package.FRAMING
-    sentence = framing.decode(frame)
-    cls = package.CODEC.classes[sentence.code]
+    sentence = framing.decode(frame, direction)
+    cls = package.CODEC.classes[sentence.code, sentence.direction]
     body = frame.decode("ascii")
     return {
         "protocol": protocol.name,
@@ -40,20 +40,23 @@ def describe(protocol: Protocol, package: ModuleType, frame: bytes) -> dict[str,
         "command": cls.COMMAND,
         "subcommand": None,
         "talker": sentence.talker,
-        "fields": texts(framing.by_code[sentence.code], sentence.values),
+        "fields": texts(framing.sentence(sentence.code, sentence.direction), sentence.values),
         "sent": sentence.sent,
         "checksum_ok": True,  # a frame whose checksum fails does not decode
         "text": body[: -len(framing.end)] if body.endswith(framing.end) else body,
     }
 
 
-def decode(protocol: Protocol, package: ModuleType, frames: list[str], as_json: bool) -> int:
+def decode(
+    protocol: Protocol, package: ModuleType, frames: list[str], as_json: bool, direction: str | None = None
+) -> int:
     failed = 0
     for given in frames:
         try:
-            result = describe(protocol, package, frame_of(package.FRAMING, given))
+            result = describe(protocol, package, frame_of(package.FRAMING, given), direction)
         except (DecodeError, SerialspecError) as exc:
-            print(f"serialspec decode: {given.strip()}: {exc}", file=sys.stderr)
+            hint = " (--direction request|response)" if isinstance(exc, DirectionNeeded) else ""
+            print(f"serialspec decode: {given.strip()}: {exc}{hint}", file=sys.stderr)
             failed += 1
             continue
         if as_json:
@@ -100,10 +103,10 @@ def encode(package: ModuleType, data: dict[str, Any], direction: str | None, as_
     if not isinstance(talker, str) or isinstance(sent, bool) or not isinstance(sent, int):
         raise EncodeError("`talker` must be text and `sent` an integer")
     try:
-        values = from_texts(framing.by_code[cls.CODE], fields)
+        values = from_texts(framing.sentence(cls.CODE, cls.DIRECTION.value), fields)
     except DecodeError as exc:
         raise EncodeError(str(exc)) from None
-    frame = framing.encode(cls.CODE, values, talker, sent)
+    frame = framing.encode(cls.CODE, values, talker, sent, cls.DIRECTION.value)
     if as_hex:
         print(frame.hex(" "))
     else:

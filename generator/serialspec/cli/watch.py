@@ -138,7 +138,7 @@ class Board:
         assert self.protocol.text is not None
         spec = next(m for m in self.protocol.text.messages if m.class_name == type(message).__name__)
         units = {f.name: f.unit for f in spec.fields if isinstance(f, TextField) and f.unit and not self.raw}
-        sent = texts(record.FRAMING.by_code[record.CODE], fields)
+        sent = texts(record.FRAMING.sentence(record.CODE, record.DIRECTION.value), fields)
         return " ".join(
             f"{name}={with_unit(text, units[name]) if name in units else _text(text)}"
             for name, text in sent.items()

@@ -853,7 +853,10 @@ FRAMING = Obj(
         "description": TEXT,
         "kind": Str(
             "binary: frames of bytes described by `elements` or `layouts`; text: line-oriented text frames "
-            "(`start`, `separator`, `checksum`, `end`, `talker`), each message chosen by its command's text `code`.",
+            "(`start`, `separator`, `checksum`, `end`, `talker`), each message chosen by its command's text `code`; "
+            "a command's request and its response share the code (decode takes the direction; the simulator reads "
+            "requests, the client answers; a text device answers as its `device.commands` entry says: `stores`, "
+            "`sets`, `reports`, `echoes`).",
             choices=("binary", "text"),
             default="binary",
             example="text",

@@ -855,14 +855,29 @@ class TextExample:
 
 
 @frozen
+class TextAnswer:
+    """How a text device answers one command's request (`device.commands.NAME`): request fields kept in state
+    variables, state variables set, and the answer's fields from expressions of the state or from the request."""
+
+    command: str
+    description: str = ""
+    stores: dict[str, str] = field(default_factory=dict)  # request field -> state variable
+    sets: dict[str, float] = field(default_factory=dict)  # state variable -> value
+    reports: dict[str, Expr] = field(default_factory=dict)  # response field -> expression of state variables
+    echoes: tuple[str, ...] = ()  # response fields that repeat the request's field of the same name
+
+
+@frozen
 class TextDevice:
     """A text protocol's virtual device (`device:`): its state variables, the values every sentence it sends
-    carries (`reply`), and the sentences it sends on its own."""
+    carries (`reply`), the sentences it sends on its own, and how it answers requests (`commands`: every command
+    with a request and a response is answered, as its entry there says)."""
 
     description: str
     state: dict[str, float]
     reply: dict[str, str | float]
     sends: tuple[Unsolicited, ...]
+    commands: tuple[TextAnswer, ...] = ()
 
 
 @frozen
@@ -885,8 +900,12 @@ class TextFrame:
     digits: int = 2
     device: TextDevice | None = None
 
-    def message(self, key: str) -> TextMessage:
-        return next(m for m in self.messages if m.key == key)
+    def message(self, key: str, direction: Direction = Direction.RESPONSE) -> TextMessage:
+        """The command's message in `direction` (its response by default: what a device sends)."""
+        return next(m for m in self.messages if m.key == key and m.direction == direction)
+
+    def request(self, key: str) -> TextMessage | None:
+        return next((m for m in self.messages if m.key == key and m.direction == Direction.REQUEST), None)
 
     def letter_sets(self) -> dict[str, tuple[tuple[str, str], ...]]:
         """Each generated letter Enum's name -> its (label, letter) pairs, in order of first use."""

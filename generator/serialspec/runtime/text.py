@@ -127,10 +127,20 @@ class TextSentence:
     code: str
     fields: tuple[TextField | TextRepeat, ...]
     name: str = ""
+    #: "request" or "response": a code may name one message each way (a command and its answer)
+    direction: str = "response"
 
     @property
     def where(self) -> str:
         return self.name or self.code
+
+
+class DirectionNeeded(DecodeError):
+    """A frame whose code names a request and a response, decoded without saying which."""
+
+    def __init__(self, code: str) -> None:
+        super().__init__(f"give the direction: {code!r} is both a request and a response")
+        self.code = code
 
 
 @dataclass(frozen=True)
@@ -142,6 +152,7 @@ class Sentence:
     code: str
     values: dict[str, Any]
     sent: int = -1  # fields after the address (-1: every declared field)
+    direction: str = "response"
 
 
 @dataclass(frozen=True)
@@ -164,15 +175,32 @@ class TextFraming:
     talker: int = 0
     talkers: tuple[str, ...] = ()  # the talker values encode accepts (empty: any)
     max_length: int = 82
-    by_code: dict[str, TextSentence] = field(init=False, repr=False, compare=False)
+    # code -> direction -> its sentence
+    by_code: dict[str, dict[str, TextSentence]] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "by_code", {s.code: s for s in self.sentences})
+        by_code: dict[str, dict[str, TextSentence]] = {}
+        for sentence in self.sentences:
+            by_code.setdefault(sentence.code, {})[sentence.direction] = sentence
+        object.__setattr__(self, "by_code", by_code)
+
+    def sentence(self, code: str, direction: str | None = None) -> TextSentence:
+        """The message a code names, in `direction` where the code names one each way; DecodeError where there is
+        none, or where the code names two and no direction is given."""
+        found = self.by_code.get(code)
+        if not found:
+            raise DecodeError(f"unknown text code {code!r} (expected one of {', '.join(self.by_code)})")
+        if len(found) == 1:  # the code says the direction (an answer-only code read by a request parser too)
+            return next(iter(found.values()))
+        if direction is None:
+            raise DirectionNeeded(code)
+        return found[direction]
 
     # --- decoding --------------------------------------------------------------------------------------------------
 
-    def decode(self, frame: bytes | str) -> Sentence:
-        """One frame (with or without its line ending) -> its sentence; DecodeError says in one line why not."""
+    def decode(self, frame: bytes | str, direction: str | None = None) -> Sentence:
+        """One frame (with or without its line ending) -> its sentence; DecodeError says in one line why not.
+        `direction` is needed only for a code that names a request and a response."""
         text = _ascii(frame)
         if text.endswith(self.end):
             text = text[: -len(self.end)]
@@ -183,11 +211,9 @@ class TextFraming:
         parts = body.split(self.separator)
         address = parts[0]
         talker, code = address[: self.talker], address[self.talker :]
-        sentence = self.by_code.get(code)
-        if sentence is None:
-            raise DecodeError(f"unknown text code {code!r} (expected one of {', '.join(self.by_code)})")
+        sentence = self.sentence(code, direction)
         values = _decode_fields(sentence, parts[1:])
-        return Sentence(talker, code, values, len(parts) - 1)
+        return Sentence(talker, code, values, len(parts) - 1, sentence.direction)
 
     def _checked(self, body: str) -> str:
         if self.checksum is None:
@@ -207,12 +233,15 @@ class TextFraming:
 
     # --- encoding --------------------------------------------------------------------------------------------------
 
-    def encode(self, code: str, values: Mapping[str, Any], talker: str = "", sent: int = -1) -> bytes:
+    def encode(
+        self, code: str, values: Mapping[str, Any], talker: str = "", sent: int = -1, direction: str | None = None
+    ) -> bytes:
         """A sentence's values -> the frame; EncodeError (RangeError) names the field at fault before any text is
         written. `sent` is the number of fields to write (a decoded Sentence's); -1 writes every declared one."""
-        sentence = self.by_code.get(code)
-        if sentence is None:
-            raise EncodeError(f"unknown text code {code!r} (expected one of {', '.join(self.by_code)})")
+        try:
+            sentence = self.sentence(code, direction)
+        except DecodeError as exc:
+            raise EncodeError(str(exc)) from None
         if len(talker) != self.talker or (self.talkers and talker not in self.talkers):
             allowed = ", ".join(self.talkers) if self.talkers else f"{self.talker} characters"
             raise EncodeError(f"{sentence.where}: talker {talker!r} is not one of {allowed}")
@@ -235,7 +264,7 @@ class TextFraming:
         return (text + self.end).encode("ascii")
 
     def encode_sentence(self, sentence: Sentence) -> bytes:
-        return self.encode(sentence.code, sentence.values, sentence.talker, sentence.sent)
+        return self.encode(sentence.code, sentence.values, sentence.talker, sentence.sent, sentence.direction)
 
     def _forbidden(self) -> str:
         return "".join({self.start, self.separator, self.marker, *self.end})
@@ -549,8 +578,10 @@ class TextStreamParser:
     start character or grown past `max_length` is dropped, and a frame that does not decode is counted in
     `corrupt` (its reason kept in `last_error`)."""
 
-    def __init__(self, framing: TextFraming) -> None:
+    def __init__(self, framing: TextFraming, direction: str | None = None) -> None:
         self.framing = framing
+        self.direction = direction  # for codes that name a request and a response: which this stream carries
+        self._asked: str | None = None  # the code of the request just read (both directions in one stream)
         self._start = framing.start.encode("ascii")
         self._end = framing.end.encode("ascii")
         self._buffer = b""
@@ -581,9 +612,20 @@ class TextStreamParser:
                 return found
             frame, self._buffer = self._buffer[: end + len(self._end)], self._buffer[end + len(self._end) :]
             try:
-                found.append(self.framing.decode(frame))
+                found.append(self._decoded(frame))
             except DecodeError as error:
                 self._dropped(str(error))
+
+    def _decoded(self, frame: bytes) -> Sentence:
+        """A frame's sentence. Both directions in one stream (a monitor's): a code that names a request and a
+        response is the response right after that request, the request otherwise."""
+        try:
+            sentence = self.framing.decode(frame, self.direction)
+        except DirectionNeeded as needed:
+            direction = "response" if self._asked == needed.code else "request"
+            sentence = self.framing.decode(frame, direction)
+        self._asked = sentence.code if sentence.direction == "request" else None
+        return sentence
 
     @property
     def errors(self) -> int:
@@ -650,7 +692,7 @@ class TextRecord:
         return factory(**given, sent=sent)
 
     def encode(self) -> bytes:
-        return self.FRAMING.encode(self.CODE, self.to_fields(), self.talker, self.sent)
+        return self.FRAMING.encode(self.CODE, self.to_fields(), self.talker, self.sent, self.DIRECTION.value)
 
 
 class TextCodec:
@@ -658,14 +700,16 @@ class TextCodec:
 
     def __init__(self, framing: TextFraming, classes: Iterable[type[TextRecord]]) -> None:
         self.framing = framing
-        self.classes = {cls.CODE: cls for cls in classes}
+        self.classes = {(cls.CODE, cls.DIRECTION.value): cls for cls in classes}
 
     def message(self, sentence: Sentence) -> Any:
-        return self.classes[sentence.code].from_fields(sentence.values, sentence.talker, sentence.sent)
+        cls = self.classes[sentence.code, sentence.direction]
+        return cls.from_fields(sentence.values, sentence.talker, sentence.sent)
 
-    def decode(self, frame: bytes | str) -> Any:
-        """One frame -> its message; DecodeError (ChecksumError) says in one line why not."""
-        return self.message(self.framing.decode(frame))
+    def decode(self, frame: bytes | str, direction: str | None = None) -> Any:
+        """One frame -> its message; DecodeError (ChecksumError) says in one line why not. `direction` ("request"
+        or "response") is needed only for a code that names both."""
+        return self.message(self.framing.decode(frame, direction))
 
     def encode(self, message: TextRecord) -> bytes:
         """A message -> its frame; EncodeError (RangeError) names the field at fault before any text is written."""
@@ -675,8 +719,8 @@ class TextCodec:
 class TextMessageParser(TextStreamParser):
     """The stream parser giving generated messages."""
 
-    def __init__(self, codec: TextCodec) -> None:
-        super().__init__(codec.framing)
+    def __init__(self, codec: TextCodec, direction: str | None = None) -> None:
+        super().__init__(codec.framing, direction)
         self.codec = codec
 
     def feed(self, data: bytes | bytearray | memoryview) -> list[Any]:
@@ -712,8 +756,9 @@ class TextClient:
             )
         self.port = port
         self._link = link(port)
-        self.parser = TextMessageParser(self.CODEC)
+        self.parser = TextMessageParser(self.CODEC, "response")
         self._callbacks: list[tuple[Callable[[Any], None], tuple[type, ...]]] = []
+        self._unread: list[Any] = []  # messages read while waiting for an answer, for `messages()` and `read()`
 
     def on(self, callback: Callable[[Any], None], *types: type) -> Callable[[], None]:
         """Call `callback(message)` for every message read (of these types; none given: all); returns a function
@@ -724,12 +769,38 @@ class TextClient:
 
     def read(self, timeout: float = 1.0) -> list[Any]:
         """The messages complete in what arrives within `timeout` seconds of the first byte (callbacks called)."""
+        if self._unread:  # read while a request waited for its answer: their callbacks were called then
+            unread, self._unread = self._unread, []
+            return unread
+        return self._arrived(timeout)
+
+    def _arrived(self, timeout: float) -> list[Any]:
         messages = self.parser.feed(self._link.read(timeout))
         for message in messages:
             for callback, types in list(self._callbacks):
                 if not types or isinstance(message, types):
                     callback(message)
         return messages
+
+    def request(self, message: TextRecord, timeout: float = 1.0) -> Any:
+        """Send a request and return the device's answer (its command's response); Timeout when none comes within
+        `timeout` seconds. What else arrives meanwhile (messages the device sends on its own) goes to the
+        callbacks at once and to `read()`/`messages()` later, in order."""
+        import time
+
+        from serialspec.runtime.errors import Timeout
+
+        answer = self.CODEC.classes.get((message.CODE, "response"))
+        self.send(message)
+        if answer is None:
+            return None  # a command the device does not answer
+        deadline = time.monotonic() + timeout
+        while (left := deadline - time.monotonic()) > 0:
+            for arrived in self._arrived(min(left, 0.2)):
+                if isinstance(arrived, answer):
+                    return arrived
+                self._unread.append(arrived)
+        raise Timeout(f"{message.COMMAND} ({message.CODE})", "", timeout)
 
     def messages(self, timeout: float | None = None) -> Iterator[Any]:
         """The messages as they arrive; ends when none has come for `timeout` seconds (None: never)."""

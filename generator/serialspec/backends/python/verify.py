@@ -164,12 +164,12 @@ def verify_text(protocol: Protocol, text: TextFrame, files: dict[str, str]) -> l
 
 def _text_example(package: ModuleType, text: TextFrame, example: TextExample) -> str:
     try:
-        message = package.decode(example.printed)
+        message = package.decode(example.printed, example.direction.value)
     except SerialspecError as exc:
         return f"the frame does not decode: {exc}"
     if example.command != message.COMMAND or example.direction != message.DIRECTION:
         return f"the frame decodes as {message.COMMAND} {message.DIRECTION.value}, not {example.command}"
-    found = texts(package.FRAMING.by_code[message.CODE], message.to_fields())
+    found = texts(package.FRAMING.sentence(message.CODE, message.DIRECTION.value), message.to_fields())
     recorded = {name: _recorded(value) for name, value in example.fields.items()}
     if found != recorded:
         return f"the frame decodes to other values: {_difference(found, recorded)}"

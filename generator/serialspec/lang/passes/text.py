@@ -17,6 +17,7 @@ from serialspec.lang.loader import Path
 from serialspec.lang.model import (
     Direction,
     Framing,
+    TextAnswer,
     TextDevice,
     TextExample,
     TextField,
@@ -43,8 +44,9 @@ BINARY_ONLY = ("elements", "layouts", "transparency", "gap")
 TEXT_ONLY_FRAMING = ("start", "separator", "end", "checksum", "talker", "max_length")
 NOT_YET = ("matching", "enums", "flags", "tables", "errata")
 # What a text device may say (the binary device's memory, ids, models and behaviours are not available yet)
-DEVICE_KEYS = ("description", "state", "reply", "sends")
+DEVICE_KEYS = ("description", "state", "reply", "sends", "commands")
 SEND_KEYS = ("every", "step", "while", "values", "description")
+ANSWER_KEYS = ("description", "stores", "sets", "reports", "echoes")
 
 
 def is_text(data: Any) -> bool:
@@ -72,12 +74,10 @@ class TextPass(Pass):
                     if message is not None:
                         messages.append(message)
         codes: dict[str, TextMessage] = {}
-        for message in messages:
+        for message in messages:  # a command's request and response share its code
             other = codes.setdefault(message.code, message)
             if other.key != message.key:
                 self.error(("commands", message.key, "code"), f"code {message.code!r} is also {other.key}'s")
-            elif other is not message:  # a frame does not say its direction: one message per code
-                self.error(("commands", message.key), "a text command has a request or a response, not both (yet)")
         if frame is not None:
             frame = replace(frame, messages=tuple(messages))
             examples = tuple(self.examples(frame))
@@ -288,7 +288,74 @@ class TextPass(Pass):
                     step=str(item.get("step", "")),
                 )
             )
-        return TextDevice(str(raw.get("description", "")), state, reply, tuple(sends))
+        answers = self.answers(raw.get("commands") or {}, frame, state)
+        return TextDevice(str(raw.get("description", "")), state, reply, tuple(sends), answers)
+
+    def answers(self, raw: dict[str, Any], frame: TextFrame, state: dict[str, float]) -> tuple[TextAnswer, ...]:
+        """`device.commands`: how the device answers each command's request (a command with a request and a
+        response and no entry here is answered too: its response's fields from the state variables of the same
+        name and `reply`)."""
+        path: Path = ("device", "commands")
+        if not isinstance(raw, dict):
+            self.error(path, "expected a mapping: command -> what the device does with its request")
+            return ()
+        found = []
+        for key, item in raw.items():
+            where = (*path, str(key))
+            request = frame.request(str(key))
+            response = next((m for m in frame.messages if m.key == key and m.direction == Direction.RESPONSE), None)
+            if request is None or response is None:
+                self.error(where, f"{key!r} is not a command with a request and a response")
+                continue
+            item = item or {}
+            if not isinstance(item, dict):
+                self.error(where, "expected a mapping (stores, sets, reports, echoes, description)")
+                continue
+            for bad in item:
+                if bad not in ANSWER_KEYS:
+                    self.error((*where, bad), f"`{bad}` is not available in a text protocol's device yet")
+            asked = {f.name for f in request.fields}
+            answered = {f.name for f in response.fields}
+            stores = {}
+            for name, variable in (item.get("stores") or {}).items():
+                if name not in asked:
+                    self.error((*where, "stores", name), f"{key}'s request has no field {name!r}")
+                elif str(variable) not in state:
+                    self.error((*where, "stores", name), f"unknown state variable {variable!r}")
+                else:
+                    stores[str(name)] = str(variable)
+            sets = {}
+            for variable, value in (item.get("sets") or {}).items():
+                if variable not in state:
+                    self.error((*where, "sets", variable), f"unknown state variable {variable!r}")
+                elif isinstance(value, bool) or not isinstance(value, int | float):
+                    self.error((*where, "sets", variable), f"expected a number, got {value!r}")
+                else:
+                    sets[str(variable)] = float(value)
+            reports = {}
+            for name, source in (item.get("reports") or {}).items():
+                at = (*where, "reports", name)
+                if name not in answered:
+                    self.error(at, f"{key}'s response has no field {name!r}")
+                    continue
+                try:
+                    parsed = expression.parse(str(source))
+                except expression.ExpressionError as exc:
+                    self.error(at, str(exc))
+                    continue
+                for used in sorted(set(expression.names(parsed)) - set(state)):
+                    self.error(at, f"unknown name {used!r} (not a state variable)")
+                reports[str(name)] = parsed
+            echoes = []
+            for index, name in enumerate(item.get("echoes") or ()):
+                if name not in asked or name not in answered:
+                    self.error(
+                        (*where, "echoes", index), f"{name!r} is not a field of both {key}'s request and response"
+                    )
+                else:
+                    echoes.append(str(name))
+            found.append(TextAnswer(str(key), str(item.get("description", "")), stores, sets, reports, tuple(echoes)))
+        return tuple(found)
 
     def examples(self, frame: TextFrame) -> list[TextExample]:
         found = []

@@ -434,7 +434,8 @@ commands:
     ("change", "expected"),
     [
         (("kind: text", "kind: text\n  gap: 3.5"), "framing.gap: `gap` belongs to binary framing, not `kind: text`"),
-        (('  start: "$"\n', ""), "framing: missing key 'start'"),
+        (('  start: "$"\n', '  start: "$$"\n'), "framing: `start` (when given) and `separator` must be one character"),
+        (('  separator: ","\n', ""), "framing: missing key 'separator'"),
         (("values: [GP]", "values: [GPS]"), "framing.talker.values[0]: talker 'GPS' is not 2 characters"),
         (("algorithm: xor", "algorithm: crc"), "framing.checksum.algorithm: unknown value 'crc'"),
         (("code: FIX", "code: 7"), "commands.fix.code: a text command needs a text `code`"),

@@ -13,10 +13,14 @@ import subprocess
 import sys
 import tty
 from collections.abc import Iterator
+from decimal import Decimal
 from pathlib import Path
+from typing import Any
 
 import pytest
 from conftest import ROOT
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 CLI = [sys.executable, "-m", "serialspec"]
 SPEC = ROOT / "examples" / "textlamp" / "textlamp.yaml"
@@ -109,3 +113,94 @@ def test_monitor_pairs_each_answer_with_the_request_before_it(lamp: tuple[Path, 
         ["request", "read_temperature"],
         ["response", "read_temperature"],
     ], out + err
+
+
+BENCH_SUPPLY = """\
+protocol: bench_supply
+title: A bench supply
+description: Lines `CODE=value` ended by CR LF; no start character, no checksum.
+serial: {baudrate: 9600}
+framing:
+  kind: text
+  separator: "="
+  end: "\\r\\n"
+  max_length: 40
+commands:
+  voltage:
+    code: V
+    title: Output voltage
+    request: {}
+    response:
+      fields:
+        volts: {type: decimal, precision: 2, unit: V, range: [0, 30]}
+  set_voltage:
+    code: SV
+    title: Set the output voltage
+    request:
+      fields:
+        volts: {type: decimal, precision: 2, unit: V, range: [0, 30]}
+    response:
+      fields:
+        volts: {type: decimal, precision: 2, unit: V, range: [0, 30]}
+examples:
+  reading:
+    source: made up
+    printed: "V=12.10"
+    direction: response
+    command: voltage
+    fields: {volts: "12.10"}
+device:
+  state: {volts: 5}
+  commands:
+    set_voltage: {stores: {volts: volts}, reports: {volts: volts}}
+    voltage: {reports: {volts: volts}}
+"""
+
+
+@pytest.fixture(scope="module")
+def supply(tmp_path_factory: pytest.TempPathFactory) -> Iterator[object]:
+    folder = tmp_path_factory.mktemp("bench_supply")
+    spec = folder / "bench_supply.yaml"
+    spec.write_text(BENCH_SUPPLY, encoding="utf-8")
+    done = subprocess.run([*CLI, "generate", str(spec), "--out", str(folder)], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    sys.path.insert(0, str(folder))
+    try:
+        yield importlib.import_module("bench_supply")
+    finally:
+        sys.path.remove(str(folder))
+
+
+def test_lines_without_a_start_character_are_frames_answered_by_the_sim(supply: Any) -> None:
+    assert supply.encode(supply.VoltageRequest()) == b"V\r\n"
+    assert supply.encode(supply.SetVoltageRequest(volts=12.5)) == b"SV=12.50\r\n"
+    device = importlib.import_module("bench_supply.simulator").SIMULATOR()
+    path = device.start()
+    try:
+        with supply.Client(path) as client:
+            assert client.voltage().volts == 5
+            assert client.set_voltage(12.5).volts == Decimal("12.50")
+            assert client.voltage().volts == Decimal("12.50")
+    finally:
+        device.close()
+
+
+@given(st.data())
+@settings(max_examples=150, deadline=None)
+def test_lines_without_a_start_character_resynchronise_however_the_bytes_are_split(supply: Any, data: Any) -> None:
+    """Garbage lines, empty lines, an over-long line and a CR LF where a line ends: the same frames whatever the
+    reads, and every good line comes back."""
+    readings = data.draw(st.lists(st.integers(0, 3000), min_size=1, max_size=6))
+    noise = [b"garbage\r\n", b"\r\n", b"X" * 70 + b"\r\n", b"\n", b"=\r\n"]
+    stream, expected = b"", []
+    for centivolts in readings:
+        stream += data.draw(st.sampled_from(noise))
+        message = supply.VoltageResponse(volts=Decimal(centivolts) / 100)
+        stream += supply.encode(message)
+        expected.append(message)
+    cuts = sorted(data.draw(st.lists(st.integers(0, len(stream)), max_size=12)))
+    parser, got, last = supply.StreamParser("response"), [], 0
+    for cut in [*cuts, len(stream)]:
+        got += parser.feed(stream[last:cut])
+        last = cut
+    assert got == expected

@@ -861,7 +861,11 @@ FRAMING = Obj(
             default="binary",
             example="text",
         ),
-        "start": Str("text: the character that starts every frame.", example="$"),
+        "start": Str(
+            "text: the character that starts every frame; without one, each line is a frame (`V=12.1` then the "
+            "line ending) and the stream parser resynchronises at the next line ending.",
+            example="$",
+        ),
         "separator": Str("text: the character between fields.", example=","),
         "end": Str("text: the line ending that closes every frame.", example="\r\n"),
         "checksum": Obj(

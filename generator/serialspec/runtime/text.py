@@ -582,6 +582,7 @@ class TextStreamParser:
         self.framing = framing
         self.direction = direction  # for codes that name a request and a response: which this stream carries
         self._asked: str | None = None  # the code of the request just read (both directions in one stream)
+        self._overlong = False  # frames without a start character: the line being read was dropped as too long
         self._start = framing.start.encode("ascii")
         self._end = framing.end.encode("ascii")
         self._buffer = b""
@@ -592,6 +593,8 @@ class TextStreamParser:
         self._buffer += bytes(data)
         found: list[Sentence] = []
         limit = self.framing.max_length + len(self._end)
+        if not self._start:
+            return self._lines(found, limit)
         while True:
             start = self._buffer.find(self._start)
             if start < 0:
@@ -613,6 +616,29 @@ class TextStreamParser:
             frame, self._buffer = self._buffer[: end + len(self._end)], self._buffer[end + len(self._end) :]
             try:
                 found.append(self._decoded(frame))
+            except DecodeError as error:
+                self._dropped(str(error))
+
+    def _lines(self, found: list[Sentence], limit: int) -> list[Sentence]:
+        """Frames without a start character: each line is a frame. A line that grows past `max_length` is dropped
+        to its end; an empty line (a device's CR LF where the spec says CR) is skipped."""
+        while True:
+            end = self._buffer.find(self._end)
+            if end < 0:
+                if len(self._buffer) > limit:
+                    self._dropped(f"no line ending within {self.framing.max_length} characters")
+                    keep = len(self._end) - 1  # the start of a line ending split between reads
+                    self._buffer, self._overlong = self._buffer[len(self._buffer) - keep :], True
+                return found
+            frame, self._buffer = self._buffer[: end + len(self._end)], self._buffer[end + len(self._end) :]
+            if self._overlong:  # the rest of a line already dropped
+                self._overlong = False
+                continue
+            if not frame[:end].strip():
+                continue
+            try:
+                # CR or LF before a line: the rest of a line ending longer than the spec's (CR LF where it says CR)
+                found.append(self._decoded(frame.lstrip(b"\r\n")))
             except DecodeError as error:
                 self._dropped(str(error))
 

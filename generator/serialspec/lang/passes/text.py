@@ -93,12 +93,13 @@ class TextPass(Pass):
         for key in BINARY_ONLY:
             if key in raw:
                 self.error((*path, key), f"`{key}` belongs to binary framing, not `kind: text`")
-        for key in ("start", "separator", "end"):
+        for key in ("separator", "end"):
             if not raw.get(key):
-                self.error(path, f"missing key {key!r} (a text frame needs `start`, `separator` and `end`)")
-        start, separator, end = (str(raw.get(k) or "?") for k in ("start", "separator", "end"))
-        if len(start) != 1 or len(separator) != 1:
-            self.error(path, "`start` and `separator` must be one character each")
+                self.error(path, f"missing key {key!r} (a text frame needs `separator` and `end`)")
+        start = str(raw.get("start") or "")  # none: every line is a frame
+        separator, end = (str(raw.get(k) or "?") for k in ("separator", "end"))
+        if len(start) > 1 or len(separator) != 1:
+            self.error(path, "`start` (when given) and `separator` must be one character each")
         checksum_raw = raw.get("checksum")
         algorithm = None
         marker = "*"
@@ -119,7 +120,7 @@ class TextPass(Pass):
         for index, value in enumerate(talkers):
             if len(value) != size:
                 self.error((*path, "talker", "values", index), f"talker {value!r} is not {size} characters")
-        special = [start, separator, *set(end)] + ([marker] if algorithm is not None else [])
+        special = [*([start] if start else []), separator, *set(end)] + ([marker] if algorithm is not None else [])
         if len(set(special)) != len(special):
             self.error(path, "`start`, `separator`, the checksum's `marker` and the characters of `end` must differ")
         return TextFrame(

@@ -204,3 +204,45 @@ def test_lines_without_a_start_character_resynchronise_however_the_bytes_are_spl
         got += parser.feed(stream[last:cut])
         last = cut
     assert got == expected
+
+
+def test_the_asyncio_client_awaits_answers_and_iterates_over_what_the_device_sends(supply: Any) -> None:
+    import asyncio
+
+    from serialspec_protocols import nmea0183
+
+    device = importlib.import_module("bench_supply.simulator").SIMULATOR()
+    path = device.start()
+
+    async def session() -> list[Any]:
+        async with supply.AsyncClient(path) as client:
+            first = await client.voltage()
+            answer = await client.set_voltage(7.25)
+            with pytest.raises(ValueError, match="volts"):
+                await client.set_voltage(31)  # refused before a byte is written
+            return [first.volts, answer.volts, (await client.voltage()).volts]
+
+    try:
+        assert asyncio.run(session()) == [5, Decimal("7.25"), Decimal("7.25")]
+    finally:
+        device.close()
+    gps = importlib.import_module("serialspec_protocols.nmea0183.simulator").SIMULATOR()
+    gps_path = gps.start()
+
+    async def fixes() -> list[Any]:
+        seen: list[Any] = []
+        async with nmea0183.AsyncClient(gps_path) as client:
+            client.on(seen.append, nmea0183.RmcResponse)
+            got = []
+            async for message in client.messages(timeout=10):
+                got.append(message)
+                if len(got) >= 3:
+                    break
+        return [got, seen]
+
+    try:
+        got, seen = asyncio.run(fixes())
+    finally:
+        gps.close()
+    assert len(got) == 3 and {type(m) for m in got} <= {nmea0183.GgaResponse, nmea0183.RmcResponse}
+    assert seen == [m for m in got if isinstance(m, nmea0183.RmcResponse)]

@@ -24,6 +24,7 @@ from serialspec.runtime.message import Direction
 from serialspec.runtime.settings import SerialSettings
 from serialspec.runtime.text import (
     Angle,
+    AsyncTextClient,
     TextClient,
     TextCodec,
     TextField,
@@ -409,6 +410,13 @@ encode = CODEC.encode
 
 class Client(TextClient):
     """The device on a serial port: `for message in Client(port)`, `on(callback, *types)`, `send()`."""
+
+    CODEC = CODEC
+    SERIAL = SERIAL
+
+
+class AsyncClient(AsyncTextClient):
+    """The device for asyncio: `async for message in AsyncClient(port)`, awaited requests."""
 
     CODEC = CODEC
     SERIAL = SERIAL

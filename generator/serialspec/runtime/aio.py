@@ -23,7 +23,7 @@ import serial
 
 from serialspec.runtime.errors import Timeout
 from serialspec.runtime.message import Message
-from serialspec.runtime.transport import Binding, Bus, ClientState, FdLink, Subscriber
+from serialspec.runtime.transport import Binding, Bus, ClientState, FdLink, Link, Subscriber
 
 M = TypeVar("M", bound=Message)
 T = TypeVar("T")
@@ -50,6 +50,26 @@ async def drive(steps: Generator[S, R, T], step: Callable[[S], Awaitable[R]]) ->
 def _wake(ready: asyncio.Future[None]) -> None:
     if not ready.done():
         ready.set_result(None)
+
+
+async def read_available(link: Link, port: Any, wait: float) -> bytes:
+    """What arrives on `port` (read through `link`) within `wait` seconds, b"" if nothing: the loop watches a
+    POSIX port's descriptor; other ports read in a worker thread."""
+    if not isinstance(link, FdLink):
+        return await asyncio.to_thread(link.read, wait)
+    fd = port.fd
+    if fd is None:
+        raise serial.SerialException("the port is closed")
+    loop = asyncio.get_running_loop()
+    ready: asyncio.Future[None] = loop.create_future()
+    loop.add_reader(fd, _wake, ready)
+    deadline = loop.call_later(wait, _wake, ready)  # woken by the first byte or the deadline, whichever comes
+    try:
+        await ready
+    finally:
+        deadline.cancel()
+        loop.remove_reader(fd)
+    return link.read(0.0)  # what is there (b"" at the deadline); a port that hung up fails here
 
 
 class AsyncBus:
@@ -191,25 +211,7 @@ class AsyncBus:
             raise
 
     async def _read(self, wait: float) -> bytes:
-        """What arrives within `wait` seconds, b"" if nothing: the loop watches a POSIX port's descriptor; other
-        ports read in a worker thread."""
-        bus = self.sync
-        link = bus._link
-        if not isinstance(link, FdLink):
-            return await asyncio.to_thread(link.read, wait)
-        fd = bus._port.fd
-        if fd is None:
-            raise serial.SerialException("the port is closed")
-        loop = asyncio.get_running_loop()
-        ready: asyncio.Future[None] = loop.create_future()
-        loop.add_reader(fd, _wake, ready)
-        deadline = loop.call_later(wait, _wake, ready)  # woken by the first byte or the deadline, whichever comes
-        try:
-            await ready
-        finally:
-            deadline.cancel()
-            loop.remove_reader(fd)
-        return link.read(0.0)  # what is there (b"" at the deadline); a port that hung up fails here
+        return await read_available(self.sync._link, self.sync._port, wait)
 
     async def _write(self, frame: bytes) -> None:
         bus = self.sync

@@ -17,7 +17,7 @@ from __future__ import annotations
 import dataclasses
 import datetime
 import re
-from collections.abc import Callable, Iterable, Iterator, Mapping
+from collections.abc import AsyncIterator, Callable, Generator, Iterable, Iterator, Mapping
 from dataclasses import dataclass, field
 from decimal import Decimal, InvalidOperation
 from enum import Enum
@@ -795,38 +795,18 @@ class TextClient:
 
     def read(self, timeout: float = 1.0) -> list[Any]:
         """The messages complete in what arrives within `timeout` seconds of the first byte (callbacks called)."""
-        if self._unread:  # read while a request waited for its answer: their callbacks were called then
-            unread, self._unread = self._unread, []
-            return unread
-        return self._arrived(timeout)
+        from serialspec.runtime.transport import drive
 
-    def _arrived(self, timeout: float) -> list[Any]:
-        messages = self.parser.feed(self._link.read(timeout))
-        for message in messages:
-            for callback, types in list(self._callbacks):
-                if not types or isinstance(message, types):
-                    callback(message)
-        return messages
+        return drive(self._reading(timeout), self._link.read)
 
     def request(self, message: TextRecord, timeout: float = 1.0) -> Any:
         """Send a request and return the device's answer (its command's response); Timeout when none comes within
         `timeout` seconds. What else arrives meanwhile (messages the device sends on its own) goes to the
         callbacks at once and to `read()`/`messages()` later, in order."""
-        import time
+        from serialspec.runtime.transport import drive
 
-        from serialspec.runtime.errors import Timeout
-
-        answer = self.CODEC.classes.get((message.CODE, "response"))
         self.send(message)
-        if answer is None:
-            return None  # a command the device does not answer
-        deadline = time.monotonic() + timeout
-        while (left := deadline - time.monotonic()) > 0:
-            for arrived in self._arrived(min(left, 0.2)):
-                if isinstance(arrived, answer):
-                    return arrived
-                self._unread.append(arrived)
-        raise Timeout(f"{message.COMMAND} ({message.CODE})", "", timeout)
+        return drive(self._answer(message, timeout), self._link.read)
 
     def messages(self, timeout: float | None = None) -> Iterator[Any]:
         """The messages as they arrive; ends when none has come for `timeout` seconds (None: never)."""
@@ -845,6 +825,39 @@ class TextClient:
     def __iter__(self) -> Iterator[Any]:
         return self.messages()
 
+    # The steps of reading and of waiting for an answer, as generators that yield how long to wait for bytes and
+    # are sent what arrived: `transport.drive` runs them blocking, `AsyncTextClient` with awaits.
+
+    def _reading(self, timeout: float) -> Generator[float, bytes, list[Any]]:
+        if self._unread:  # read while a request waited for its answer: their callbacks were called then
+            unread, self._unread = self._unread, []
+            return unread
+        return self._arrived((yield timeout))
+
+    def _answer(self, message: TextRecord, timeout: float) -> Generator[float, bytes, Any]:
+        import time
+
+        from serialspec.runtime.errors import Timeout
+
+        answer = self.CODEC.classes.get((message.CODE, "response"))
+        if answer is None:
+            return None  # a command the device does not answer
+        deadline = time.monotonic() + timeout
+        while (left := deadline - time.monotonic()) > 0:
+            for arrived in self._arrived((yield min(left, 0.2))):
+                if isinstance(arrived, answer):
+                    return arrived
+                self._unread.append(arrived)
+        raise Timeout(f"{message.COMMAND} ({message.CODE})", "", timeout)
+
+    def _arrived(self, data: bytes) -> list[Any]:
+        messages = self.parser.feed(data)
+        for message in messages:
+            for callback, types in list(self._callbacks):
+                if not types or isinstance(message, types):
+                    callback(message)
+        return messages
+
     def send(self, message: TextRecord) -> None:
         """Write one message (range checks first: nothing is written when a value is refused)."""
         self._link.write(self.CODEC.encode(message))
@@ -856,4 +869,69 @@ class TextClient:
         return self
 
     def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+class AsyncTextClient:
+    """TextClient for asyncio: the same port, parser, callbacks and answers, with every read awaited (a POSIX
+    port's descriptor is watched by the event loop, other ports read in a worker thread; runtime/aio.py).
+    Generated packages bind `CODEC` and `SERIAL` in their `AsyncClient`."""
+
+    CODEC: ClassVar[TextCodec]
+    SERIAL: ClassVar[Any]
+
+    def __init__(self, port: Any, *, baudrate: int | None = None) -> None:
+        bound = type("Client", (TextClient,), {"CODEC": self.CODEC, "SERIAL": self.SERIAL})
+        self.sync: TextClient = bound(port, baudrate=baudrate)
+
+    def on(self, callback: Callable[[Any], None], *types: type) -> Callable[[], None]:
+        """`TextClient.on`: call `callback(message)` for every message read (of these types)."""
+        return self.sync.on(callback, *types)
+
+    async def read(self, timeout: float = 1.0) -> list[Any]:
+        from serialspec.runtime.aio import drive
+
+        return await drive(self.sync._reading(timeout), self._wait)
+
+    async def request(self, message: TextRecord, timeout: float = 1.0) -> Any:
+        """`TextClient.request`, awaited."""
+        from serialspec.runtime.aio import drive
+
+        await self.send(message)
+        return await drive(self.sync._answer(message, timeout), self._wait)
+
+    async def messages(self, timeout: float | None = None) -> AsyncIterator[Any]:
+        """The messages as they arrive; ends when none has come for `timeout` seconds (None: never)."""
+        import time
+
+        last = time.monotonic()
+        while True:
+            found = await self.read(0.2 if timeout is None else max(0.0, min(0.2, last + timeout - time.monotonic())))
+            for message in found:
+                yield message
+            now = time.monotonic()
+            if found:
+                last = now
+            elif timeout is not None and now - last >= timeout:
+                return
+
+    def __aiter__(self) -> AsyncIterator[Any]:
+        return self.messages()
+
+    async def send(self, message: TextRecord) -> None:
+        """Write one message (range checks first: nothing is written when a value is refused)."""
+        self.sync.send(message)
+
+    async def _wait(self, wait: float) -> bytes:
+        from serialspec.runtime.aio import read_available
+
+        return await read_available(self.sync._link, self.sync.port, wait)
+
+    def close(self) -> None:
+        self.sync.close()
+
+    async def __aenter__(self) -> AsyncTextClient:
+        return self
+
+    async def __aexit__(self, *exc: object) -> None:
         self.close()

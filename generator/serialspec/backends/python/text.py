@@ -199,6 +199,7 @@ def _module(protocol: Protocol, text: TextFrame) -> Iterator[str]:
         "from serialspec.runtime.settings import SerialSettings",
         "from serialspec.runtime.text import (",
         "    Angle,",
+        "    AsyncTextClient,",
         "    TextClient,",
         "    TextCodec,",
         "    TextField,",
@@ -321,7 +322,15 @@ def _module(protocol: Protocol, text: TextFrame) -> Iterator[str]:
     yield ""
     yield "    CODEC = CODEC"
     yield "    SERIAL = SERIAL"
-    yield from _client_methods(text)
+    yield from _client_methods(text, asynchronous=False)
+    yield ""
+    yield ""
+    yield "class AsyncClient(AsyncTextClient):"
+    yield '    """The device for asyncio: `async for message in AsyncClient(port)`, awaited requests."""'
+    yield ""
+    yield "    CODEC = CODEC"
+    yield "    SERIAL = SERIAL"
+    yield from _client_methods(text, asynchronous=True)
     yield ""
     yield ""
     yield "class StreamParser(TextMessageParser):"
@@ -335,9 +344,10 @@ def _module(protocol: Protocol, text: TextFrame) -> Iterator[str]:
 CLIENT_NAMES = frozenset({"on", "read", "messages", "request", "send", "close", "port", "parser"})
 
 
-def _client_methods(text: TextFrame) -> Iterator[str]:
+def _client_methods(text: TextFrame, asynchronous: bool) -> Iterator[str]:
     """One method per command with a request: sends it (range checks first) and returns the device's answer,
-    or None for a command without a response."""
+    or None for a command without a response (coroutines for the asyncio client)."""
+    define, wait = ("async def", "await ") if asynchronous else ("def", "")
     for request in text.messages:
         if request.direction != Direction.REQUEST:
             continue
@@ -351,14 +361,14 @@ def _client_methods(text: TextFrame) -> Iterator[str]:
                 params.append(f"{item.name}: {_annotation(item)} = None")
         returns = response.class_name if response is not None else "None"
         yield ""
-        yield f"    def {name}(self, {''.join(p + ', ' for p in params)}*, timeout: float = 1.0) -> {returns}:"
+        yield f"    {define} {name}(self, {''.join(p + ', ' for p in params)}*, timeout: float = 1.0) -> {returns}:"
         title = one_line(request.title or request.key)
         answer = "and returns the answer" if response is not None else "(the device does not answer)"
         yield f'        """{request.code}: {title.rstrip(".")}. Sends the request {answer}."""'
         values = ", ".join(f"{item.name}={item.name}" for item in request.fields)
-        call = f"self.request({request.class_name}({values}), timeout)"
+        call = f"{wait}self.request({request.class_name}({values}), timeout)"
         if response is None:
-            yield f"        self.send({request.class_name}({values}))"
+            yield f"        {wait}self.send({request.class_name}({values}))"
         else:
             yield f"        answer: {returns} = {call}"
             yield "        return answer"

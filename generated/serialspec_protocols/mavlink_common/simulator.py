@@ -2,10 +2,11 @@
 """MAVLink v2 (PX4 / ArduPilot), common messages: a virtual device generated from the spec's `device:` section.
 
 An autopilot's MAVLink port, system 1, component 1 (the autopilot). It sends its heartbeat every second (a
-quadrotor running PX4, standing by). It keeps one parameter value: PARAM_SET stores it (and its type) and
-answers with PARAM_VALUE carrying the name it was given and the value now in force; PARAM_REQUEST_READ answers
-with that value under the name asked for. A COMMAND_LONG is acknowledged as accepted. Its replies repeat the
-request's sequence number (a real autopilot numbers its frames on its own).
+quadrotor running PX4, standing by), numbered 0, 1, 2, ... (wrapping past 255). It keeps one parameter value:
+PARAM_SET stores it (and its type) and answers with PARAM_VALUE carrying the name it was given and the value
+now in force; PARAM_REQUEST_READ answers with that value under the name asked for. A COMMAND_LONG is
+acknowledged as accepted. Its replies repeat the request's sequence number (a real autopilot numbers its
+frames on its own).
 
 `MavlinkCommonSimulator(ids=[1, 2]).start()` serves the devices on a new pseudo-terminal and returns its path;
 `serialspec sim specs/mavlink_common.yaml --id 1 --id 2` does the same from the shell. Values are wire units.
@@ -37,7 +38,7 @@ DEVICE = DeviceSpec(
     broadcast=None,
     entries=(
     ),
-    state={'value': 0.0, 'value_type': 9.0},
+    state={'value': 0.0, 'value_type': 9.0, 'beats': -1.0},
     reply={'sysid': 1.0, 'compid': 1.0, 'type': 2.0, 'autopilot': 12.0, 'base_mode': 0.0, 'system_status': 3.0, 'mavlink_version': 3.0, 'param_count': 1.0, 'param_index': 65535.0, 'result': 0.0},
     commands=(
         # param_request_read
@@ -48,7 +49,7 @@ DEVICE = DeviceSpec(
         CommandSpec(CommandLongRequest, CommandAckResponse, echoes=('seq', 'command')),
     ),
     sends=(
-        SendSpec(HeartbeatResponse, every=1.0),
+        SendSpec(HeartbeatResponse, every=1.0, step='beats', values={'seq': lambda get: (get('beats') % 256)}),
     ),
 )
 

@@ -231,8 +231,8 @@ def _encode_sys_status_response(m: SysStatusResponse) -> bytes:
         raise out_of_range('sys_status response', 'onboard_control_sensors_enabled', m_onboard_control_sensors_enabled, 0, 4294967295)
     if not 0 <= m_onboard_control_sensors_health <= 4294967295 or m_onboard_control_sensors_health.__class__ is bool:
         raise out_of_range('sys_status response', 'onboard_control_sensors_health', m_onboard_control_sensors_health, 0, 4294967295)
-    if not 0 <= m_load <= 1000 or m_load.__class__ is bool:
-        raise out_of_range('sys_status response', 'load', m_load, 0, 1000)
+    if not 0 <= m_load <= 65535 or m_load.__class__ is bool:
+        raise out_of_range('sys_status response', 'load', m_load, 0, 65535)
     if not 0 <= m_voltage_battery <= 65535 or m_voltage_battery.__class__ is bool:
         raise out_of_range('sys_status response', 'voltage_battery', m_voltage_battery, 0, 65535)
     if not -32768 <= m_current_battery <= 32767 or m_current_battery.__class__ is bool:
@@ -249,8 +249,8 @@ def _encode_sys_status_response(m: SysStatusResponse) -> bytes:
         raise out_of_range('sys_status response', 'errors_count3', m_errors_count3, 0, 65535)
     if not 0 <= m_errors_count4 <= 65535 or m_errors_count4.__class__ is bool:
         raise out_of_range('sys_status response', 'errors_count4', m_errors_count4, 0, 65535)
-    if not -1 <= m_battery_remaining <= 100 or m_battery_remaining.__class__ is bool:
-        raise out_of_range('sys_status response', 'battery_remaining', m_battery_remaining, -1, 100)
+    if not -128 <= m_battery_remaining <= 127 or m_battery_remaining.__class__ is bool:
+        raise out_of_range('sys_status response', 'battery_remaining', m_battery_remaining, -128, 127)
     if not 0 <= m_onboard_control_sensors_present_extended <= 4294967295 or m_onboard_control_sensors_present_extended.__class__ is bool:
         raise out_of_range('sys_status response', 'onboard_control_sensors_present_extended', m_onboard_control_sensors_present_extended, 0, 4294967295)
     if not 0 <= m_onboard_control_sensors_enabled_extended <= 4294967295 or m_onboard_control_sensors_enabled_extended.__class__ is bool:

@@ -671,7 +671,7 @@ local SPEC = {
               },
               {
                 name = "load",
-                description = "Main loop load (1000 = 100 %).",
+                description = "Main loop load, 0..1000 (1000 = 100 %).",
                 tail = 29,
                 kind = "scalar",
                 type = "u16",
@@ -773,7 +773,7 @@ local SPEC = {
               },
               {
                 name = "battery_remaining",
-                description = "Battery energy left (-1 when unknown).",
+                description = "Battery energy left, 0..100 (-1 when unknown).",
                 tail = 12,
                 kind = "scalar",
                 type = "i8",

@@ -396,7 +396,7 @@ class SysStatusResponse(Message):
     onboard_control_sensors_enabled: int
     #: MAV_SYS_STATUS_SENSOR bits of the sensors healthy (1: healthy).
     onboard_control_sensors_health: int
-    #: Main loop load (1000 = 100 %). [0.1%] range 0..1000
+    #: Main loop load, 0..1000 (1000 = 100 %). [0.1%]
     load: int
     #: Battery voltage (65535 when unknown). [mV]
     voltage_battery: int
@@ -414,7 +414,7 @@ class SysStatusResponse(Message):
     errors_count3: int
     #: Autopilot-specific error count.
     errors_count4: int
-    #: Battery energy left (-1 when unknown). [%] range -1..100
+    #: Battery energy left, 0..100 (-1 when unknown). [%]
     battery_remaining: int
     #: Extension: MAV_SYS_STATUS_SENSOR_EXTENDED bits of the sensors present.
     onboard_control_sensors_present_extended: int

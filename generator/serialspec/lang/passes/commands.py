@@ -349,7 +349,7 @@ class Commands(FieldResolver):
         self.check_rest(fields, (*path, "fields"))
         low, high = content_bounds(fields)
         padded = None
-        if framing is not None and framing.layouts[direction].truncates and high:
+        if framing is not None and framing.layouts[direction].truncates and high != 0:
             if low != high:
                 self.error(
                     (*path, "fields"),

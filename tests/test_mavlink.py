@@ -177,7 +177,10 @@ def test_pymavlink_drives_the_virtual_autopilot() -> None:
     """mavutil on the sim's pseudo-terminal: two heartbeats one after the other (numbered by the device), a
     parameter set and read back, an arm command acknowledged."""
     with serve("mavlink_common.yaml") as path:
-        connection = mavutil.mavlink_connection(path, baud=57600, source_system=255, source_component=190)
+        connection = mavutil.mavlink_connection(
+            path, baud=57600, source_system=255, source_component=190, dialect="common"
+        )
+        assert mavutil.mavlink.WIRE_PROTOCOL_VERSION == "2.0"  # MAVLINK20 was set before the import
         try:
             beats = [connection.recv_match(type="HEARTBEAT", blocking=True, timeout=10) for _ in range(2)]
             assert all(b is not None for b in beats)

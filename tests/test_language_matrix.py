@@ -416,6 +416,7 @@ C_REFUSES = {
     "field named type": "fields of type u24",
     "frame: checksums inside their span, a checksum of a checksum": "over a span that leaves out",
     "frame: ended by a terminator, no length": "ended by its trailer alone",
+    "frame: truncate: trailing_zeros": "a truncated content (truncate: trailing_zeros)",
     "transform: replace, escaping after the start byte, over the length and checksum (XBee API mode 2)": (
         "a length inside the transformed span"
     ),
@@ -501,6 +502,36 @@ CASES["frame: plain values, a sequence"] = Case(
             "checksum": {"role": "checksum", "type": "u8", "algorithm": "sum", "covers": ["id", "content"]},
         }
     },
+)
+# A content sent without its trailing zero bytes (MAVLink v2)
+CASES["frame: truncate: trailing_zeros"] = Case(
+    {"v": "u16", "w": "u32", "name": {"type": "string", "size": 4, "pad": "00"}, "z": "u8"},
+    {"x": "f32", "y": {"type": "i8", "range": [-3, 3]}},
+    {
+        "elements": {
+            "header": {"role": "header", "value": "FD"},
+            "length": {"role": "length", "type": "u8"},
+            "id": {"role": "address", "type": "u8", "range": [0, 253], "broadcast": 254},
+            "code": {"role": "command", "type": "u16"},
+            "content": {"role": "content", "truncate": "trailing_zeros"},
+            "checksum": {
+                "role": "checksum",
+                "type": "u16",
+                "algorithm": "crc",
+                "crc": {
+                    "width": 16,
+                    "poly": 0x1021,
+                    "init": 0xFFFF,
+                    "refin": True,
+                    "refout": True,
+                    "xorout": 0,
+                    "check": 0x6F91,
+                },
+                "covers": ["length", "content"],
+            },
+        }
+    },
+    commands={"empty": {"code": 0x1234, "request": {"fields": {"n": "u8"}}, "response": {}}},
 )
 # Requests that share a code, told apart by their content size (0, 2, 3 or more bytes), in the usual frame and in
 # one the frame engine reads

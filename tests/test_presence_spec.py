@@ -148,5 +148,6 @@ def test_every_shipped_bus_declares_how_to_find_its_devices() -> None:
         "modbus_rtu": "read_holding_registers",
         "nmea0183": None,
         "crsf": None,
+        "mavlink_common": None,
         "vesc": "fw_version",
     }

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define HIWONDER_RRC_SPEC_SHA256 "5ba045edaf9a40006eef7ad6c418f5bb211f853321ec7bc1e95c17952e44dc38"
+#define HIWONDER_RRC_SPEC_SHA256 "d72dda653f1bb314ef5b3853a6d3b62c83f298ad6ffe9b7695ea1deee966776c"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef HIWONDER_RRC_ENABLE_ENCODE

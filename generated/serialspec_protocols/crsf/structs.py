@@ -53,6 +53,7 @@ from serialspec.runtime.constructs import (  # noqa: F401
     PackedInts,
     PaddedUtf8,
     SignMagnitude,
+    TrailingZeros,
     Utf8,
     derived,
     valued,

@@ -3277,6 +3277,13 @@ end
 
 local function decode_content(message, range, length, tree)
   local content = length > 0 and range:tvb() or nil
+  if message.padded and length < message.padded then
+    -- sent without its trailing zero bytes (truncate: trailing_zeros): read padded back to its size
+    local bytes = length > 0 and range:bytes() or ByteArray.new()
+    bytes:set_size(message.padded)
+    content = bytes:tvb("Content padded with zeros")
+    length = message.padded
+  end
   if content == nil and #message.fields > 0 then
     -- an empty content: the fields (all of size 0 if the frame is right) read from an empty buffer
     content = ByteArray.new("00"):tvb("Empty content")

@@ -786,6 +786,13 @@ FRAME_ELEMENT = Obj(
             choices=("per_command",),
             example="per_command",
         ),
+        "truncate": Str(
+            "content: `trailing_zeros`, encode drops the content's trailing zero bytes (keeping at least one) and "
+            "the length says the size sent; decode pads a shorter content with zero bytes to its command's size "
+            "(MAVLink v2 payload truncation). Every command's content must have one size.",
+            choices=("trailing_zeros",),
+            example="trailing_zeros",
+        ),
         **checksum_keys(),
     },
     required=("role",),

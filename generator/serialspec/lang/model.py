@@ -330,6 +330,9 @@ class Message:
     default_reply: bool = False  # among replies sharing a code: the one a frame is decoded as without its request
     refused_by: tuple[str, ...] = ()  # a request: the commands whose responses refuse it (it raises DeviceError)
     request_code: str = ""  # a response: its field holding the code of the request it answers (u-blox ACK)
+    # a content sent without its trailing zero bytes (`truncate: trailing_zeros`): its full size, to which decoding
+    # pads it (min_size is then the smallest size sent); None where the frame sends contents whole
+    padded: int | None = None
 
     @property
     def key(self) -> str:
@@ -444,6 +447,7 @@ class FrameElement:
     adds: int = 0  # length: added to the counted size
     checksum: Checksum | None = None  # checksum: what it is and what it covers
     sequence: bool = False  # value: a sequence number the client fills in (one more per request, wrapping)
+    truncate: bool = False  # content: trailing zero bytes dropped on encode, padded back on decode (MAVLink v2)
 
     @property
     def fixed(self) -> bool:
@@ -498,6 +502,11 @@ class FrameLayout:
     @property
     def length(self) -> FrameElement | None:
         return next((e for e in self.elements if e.role == "length"), None)
+
+    @property
+    def truncates(self) -> bool:
+        """The content is sent without its trailing zero bytes (`truncate: trailing_zeros`)."""
+        return any(e.truncate for e in self.elements if e.role == "content")
 
     @property
     def trailer(self) -> bytes:

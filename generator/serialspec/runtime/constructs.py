@@ -114,6 +114,23 @@ class Utf8(Adapter):  # type: ignore[misc, type-arg, unused-ignore]
         return obj.encode("utf-8")
 
 
+class TrailingZeros(Adapter):  # type: ignore[misc, type-arg, unused-ignore]
+    """A content of `size` bytes sent without its trailing zero bytes, at least one kept (`truncate:
+    trailing_zeros`, MAVLink v2): parsed padded back to `size` by `subcon`, built by it and then cut."""
+
+    def __init__(self, subcon: Any, size: int) -> None:
+        super().__init__(GreedyBytes)
+        self.inner, self.size = subcon, size
+
+    def _decode(self, obj: bytes, context: Any, path: Any) -> Any:
+        if len(obj) > self.size:
+            raise ExplicitError(f"a content of {len(obj)} bytes is longer than its {self.size}")
+        return self.inner.parse(bytes(obj) + bytes(self.size - len(obj)))
+
+    def _encode(self, obj: Any, context: Any, path: Any) -> bytes:
+        return bytes(self.inner.build(obj)).rstrip(b"\x00") or b"\x00"
+
+
 class Framed(Adapter):  # type: ignore[misc, type-arg, unused-ignore]
     """A whole frame of any layout (stuffing, lengths and checksums anywhere), by the runtime's frame engine.
 

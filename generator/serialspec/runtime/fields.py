@@ -164,6 +164,8 @@ def _value_problem(value: Any, annotation: str, name: str) -> str:
         )
     if kinds and not any(k[:1].isupper() for k in kinds):
         return ""
+    if type(value).__name__ in kinds:  # a member of the field's own enum or flags (every value of its type named)
+        return ""
     if not isinstance(value, Record):  # a class of the package: bit fields, a table block, a group item
         return f"{name} must be {annotation.split(' |')[0]}, got {shown(value)}"
     return ""

@@ -170,6 +170,8 @@ def message_context(protocol: Protocol, message: Message | None) -> dict[str, An
     layout = protocol.framing.layouts[message.direction]
     content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
     size = size_text(message.min_size, message.max_size, content_limit(layout))
+    if message.padded is not None:
+        size = f"{size_text(message.padded, message.padded, None)}, sent without its trailing zero bytes (at least 1)"
     rows = [
         Row(_value_offset(layout, e), e.name, e.type.name if e.type else "", "", "", e.description)
         for e in layout.value_elements

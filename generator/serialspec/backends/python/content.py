@@ -414,6 +414,10 @@ class PackageCode:
         body: Block = []
         where = self.where(message)
         low, high = message.min_size, message.max_size
+        if message.padded is not None:  # sent without its trailing zero bytes: padded back to its one size
+            low = high = message.padded
+            pad = (Code(f"buf = bytes(buf[o:end]) + bytes({low} - end + o)"), Code(f"o, end = 0, {low}"))
+            body.append(If(f"end - o < {low}", pad, cursor=True, comment="truncate: trailing_zeros"))
         if not (low == 0 and high is None):  # else any size will do
             body.append(ContentSize(low, high, where))
         # Where the layout alone says the fields end at `end` (one fixed size, checked above, or a last field that
@@ -801,11 +805,14 @@ class PackageCode:
             # the runtime's frame engine wraps the content (see backends/python/frames.py)
             parts = self.encode_fields(fields, message.class_name, "m", body, where)
             content = parts[0] if len(parts) == 1 else f"b''.join(({', '.join(parts)},))" if parts else "b''"
+            if message.padded is not None:  # truncate: trailing_zeros, at least one byte kept
+                body.append(Code(f"content = {content}.rstrip(b'\\x00') or b'\\x00'", lists=packed_lists(parts)))
+                content, parts = "content", ["content"]
             code: str = Simple(f"{command_code:#04x}" if command_code is not None and layout.has_command else "None")
             if error is not None:
                 code = f"{field_read('m', error.element)} | {error.flag:#04x}"
             frames = self.straight(message.direction)
-            size = message.min_size if message.min_size == message.max_size else None
+            size = message.min_size if message.min_size == message.max_size and message.padded is None else None
             name = f"frame_{message.class_name}"
             inline = frames and frame_encoder(
                 frames, parts, self.structs, code, frame_values, size, lambda fmt: self.struct(name, fmt)

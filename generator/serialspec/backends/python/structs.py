@@ -61,6 +61,7 @@ def structs_module(protocol: Protocol) -> str:
                 "fields": fields,
                 "key": message.key,
                 "direction": message.direction.value,
+                "padded": message.padded,
             }
         )
     tables = [

@@ -227,6 +227,8 @@ def _message(protocol: Protocol, message: Message) -> dict[str, Any]:
         result["size"] = {"fixed": fixed, "terms": [[o + 1, s, e == "big", f] for o, s, e, f in sized]}
     if message.error_reply and protocol.error_reply is not None:
         result["refused"] = protocol.error_reply.element
+    if message.padded is not None:  # truncate: trailing_zeros
+        result["padded"] = message.padded
     return result
 
 

@@ -348,6 +348,15 @@ class Commands(FieldResolver):
             fields = self.insert_selector(fields, selector, direction, code, path)
         self.check_rest(fields, (*path, "fields"))
         low, high = content_bounds(fields)
+        padded = None
+        if framing is not None and framing.layouts[direction].truncates and high != 0:
+            if low != high:
+                self.error(
+                    (*path, "fields"),
+                    "a truncated content (`truncate: trailing_zeros`) has one size; this one's size varies",
+                )
+            else:
+                padded, low = high, 1
         class_name = self.class_name(camel(command, subcommand or "", direction.value), path)
         struct_name = self.class_name(f"{class_name}Content", path)
         answered_by = value.get("answered_by") or {}
@@ -372,6 +381,7 @@ class Commands(FieldResolver):
             answers=str(value.get("answers", "")),
             min_size=low,
             max_size=high,
+            padded=padded,
             source=str(value.get("source", "")),
             optional_when=self.optional_when(value.get("optional_when"), (*path, "optional_when")),
             after=self.after(value.get("after"), fields, direction, path),

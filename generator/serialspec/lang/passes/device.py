@@ -346,6 +346,9 @@ class DevicePass(Pass):
             if not any(k in item for k in ("every", "after", "changes")):
                 self.error(where, "says not when: give `every`, `after` or `changes`")
             fields = {f.name for f in response.fields}
+            if self.ctx.framing is not None:  # and the plain frame values every response carries (a sequence number)
+                layout = self.ctx.framing.layouts[response.direction]
+                fields |= {e.name for e in layout.value_elements if e.role == "value"}
             values = {}
             for name, source in (item.get("values") or {}).items():
                 if self.known(str(name), fields, (*where, "values", name), f"{response.command} response field"):

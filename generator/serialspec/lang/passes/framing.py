@@ -116,7 +116,13 @@ class FramingPass(FieldResolver):
             resolved = self.scalar(common, {"type": scalar.name, "bits": item["bits"]}, path, endian)
             bits, bits_class = resolved.bits, resolved.bits_class
         checksum = self.checksum(item, name, scalar, endian, path) if role == "checksum" and scalar else None
-        for key, allowed in (("adds", "length"), ("counts", "length"), ("covers", "checksum"), ("sequence", "value")):
+        for key, allowed in (
+            ("adds", "length"),
+            ("counts", "length"),
+            ("covers", "checksum"),
+            ("sequence", "value"),
+            ("truncate", "content"),
+        ):
             if key in item and role != allowed:
                 self.error((*path, key), f"`{key}` belongs to a {allowed} element")
         return FrameElement(
@@ -131,6 +137,7 @@ class FramingPass(FieldResolver):
             broadcast=item.get("broadcast"),
             flags=self.reference("flags", self.flags, item.get("flags"), (*path, "flags")),
             sequence=bool(item.get("sequence", False)),
+            truncate=role == "content" and item.get("truncate") == "trailing_zeros",
             endian=endian,
             bits=bits,
             bits_class=bits_class,
@@ -322,6 +329,11 @@ class FramingPass(FieldResolver):
                     checksum = self.seeded(checksum, elements, a, b, (*e_path, "seed"))
                 elements[index] = replace(element, checksum=checksum)
         checksums = tuple(e.checksum for e in elements if e.checksum is not None)
+        if content_index >= 0 and elements[content_index].truncate and "length" not in roles:
+            raise self.fail(
+                (*elements_path, names[content_index], "truncate"),
+                "a truncated content needs a length element: the frame must say how much of it was sent",
+            )
         flagged = any("error_flag" in item for item in raws.values())
         return self.classic_fields(direction, layout_name, tuple(elements), transparency, checksums, flagged)
 
@@ -341,6 +353,7 @@ class FramingPass(FieldResolver):
         final = elements[-1] if elements else None  # none: an error said so already
         classic = (
             not layout_name
+            and not any(e.truncate for e in elements)  # contents of one size sent shorter: the frame engine's way
             and not error_flag  # error replies carry code | flag: no constant command byte to look frames up by
             and transparency is None
             and set(roles) <= _CLASSIC_ROLES

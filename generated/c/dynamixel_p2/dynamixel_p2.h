@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define DYNAMIXEL_P2_SPEC_SHA256 "c387c20373f4df66b6ec814e8ebbe0294215eb7978641deb79401d8bbcb573be"
+#define DYNAMIXEL_P2_SPEC_SHA256 "eb4fbfc864091ce25250aa3e14f69e9b86b64028a1cc31b080f9b4cb93cd3ddc"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef DYNAMIXEL_P2_ENABLE_ENCODE

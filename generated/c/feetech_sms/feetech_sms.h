@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define FEETECH_SMS_SPEC_SHA256 "fc57826862e988ebe01e24edfe40d476436fbb68bec8c7ee10d6b710d1442d69"
+#define FEETECH_SMS_SPEC_SHA256 "63630bb4e4a0e4316f97213aefd5c678468eaa2e73ed8030270e261b54a4f384"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef FEETECH_SMS_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define HIWONDER_RRC_SPEC_SHA256 "5ba045edaf9a40006eef7ad6c418f5bb211f853321ec7bc1e95c17952e44dc38"
+#define HIWONDER_RRC_SPEC_SHA256 "e727290a9ba995312c800160fe1f5cfd9205e2fe2a0599df46a3a923344a5bad"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef HIWONDER_RRC_ENABLE_ENCODE

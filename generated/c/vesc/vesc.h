@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define VESC_SPEC_SHA256 "db84479597ad10015d5a773e8ca32f9c036e6076e6a0b0a630f8f079de6d795d"
+#define VESC_SPEC_SHA256 "148bf599598853ea879651f8da65d8ca8ac0846b6243deb3f573697c0b79a970"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef VESC_ENABLE_ENCODE

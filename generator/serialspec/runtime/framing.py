@@ -362,12 +362,12 @@ def _to_trailer(layout: Layout, buffer: bytes, begin: int, start: int, end: int)
     if span_end is None:
         stop = buffer.find(trailer, begin)
         return None if stop < 0 else stop + len(trailer) - start
-    stop = span_end(buffer, begin, end)
-    if stop is None:
+    ended = span_end(buffer, begin, end)
+    if ended is None:
         return None
-    if buffer.startswith(trailer, stop, end):
-        return stop + len(trailer) - start
-    return None if end - stop < len(trailer) and trailer.startswith(buffer[stop:end]) else -1
+    if buffer.startswith(trailer, ended, end):
+        return ended + len(trailer) - start
+    return None if end - ended < len(trailer) and trailer.startswith(buffer[ended:end]) else -1
 
 
 @dataclass(frozen=True)

@@ -126,3 +126,6 @@ class HexAsciiTransform(Transform):
     def worked(self, plain: bytes) -> str:
         wire = self.runtime((0, 0)).encode(plain)
         return f"the span's bytes {plain.hex(' ').upper()} are sent as the text {wire.decode('ascii')}"
+
+    def lua(self) -> dict[str, Any] | None:
+        return {"method": "hex_ascii"}

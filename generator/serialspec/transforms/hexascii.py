@@ -9,6 +9,7 @@ so the element after it must be a trailer that does not start with a hex digit (
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -19,6 +20,7 @@ from serialspec.transforms.base import Report, Sample, Transform
 _DIGITS = b"0123456789ABCDEFabcdef"
 _HEX = frozenset(_DIGITS)
 _NOT_HEX = bytes(byte for byte in range(256) if byte not in _HEX)  # bytes.translate's delete: the hex digits kept
+_RUN = re.compile(b"[0-9A-Fa-f]*")
 
 
 def hex_decode(data: bytes) -> bytes:
@@ -33,10 +35,9 @@ def hex_decode(data: bytes) -> bytes:
 
 def hex_run(buffer: bytes, start: int, end: int) -> int:
     """Where the run of hex digits at buffer[start:end] ends (`end` when it goes on to the end of the buffer)."""
-    position = start
-    while position < end and buffer[position] in _HEX:
-        position += 1
-    return position
+    found = _RUN.match(buffer, start, end)
+    assert found is not None  # a run of no digits matches too
+    return found.end()
 
 
 @dataclass(frozen=True)

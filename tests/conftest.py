@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import importlib
 import os
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from types import ModuleType
@@ -13,7 +13,7 @@ from typing import Any
 import pytest
 from hypothesis import settings
 from serialspec.lang import load_protocol
-from serialspec.lang.model import Example, Protocol
+from serialspec.lang.model import Example, FrameLayout, Protocol
 
 # Hypothesis policy. `make test` (and CI, which runs it once on a clean clone) must give the same answer every time:
 # a fuzzer that fails one run in five blocks everyone and teaches people to rerun until green. So by default every
@@ -77,6 +77,29 @@ def example_class(g: Generated, example: Example) -> Any:
         if (example.command, example.subcommand, example.direction) == (cls.COMMAND, cls.SUBCOMMAND, cls.DIRECTION):
             return cls
     raise AssertionError(f"no message class for example {example.name}")
+
+
+def set_plain_byte(layout: FrameLayout, frame: bytes, offset: int, value: Callable[[int], int]) -> tuple[bytes, int]:
+    """The frame with the byte at `offset` (counted in the frame's plain bytes, before any transform; negative: from
+    the end) set to value(old), the transformed span written again (a hex-ASCII span gets another hex digit pair,
+    not a non-hex byte), and that byte's wire offset (from the start)."""
+    t = layout.transparency
+    if t is None:
+        at = offset % len(frame)
+        return frame[:at] + bytes([value(frame[at])]) + frame[at + 1 :], at
+    first, last = layout.index(t.first), layout.index(t.last)
+    before = sum(e.size or 0 for e in layout.elements[:first])
+    after = sum(e.size or 0 for e in layout.elements[last + 1 :])
+    runtime = t.transform.runtime((first, last))
+    plain = frame[:before] + runtime.decode(frame[before : len(frame) - after]) + frame[len(frame) - after :]
+    at = offset % len(plain)
+    if not before <= at < len(plain) - after:  # outside the span: on the wire as it is
+        wire_at = at if at < before else len(frame) - (len(plain) - at)
+        return frame[:wire_at] + bytes([value(frame[wire_at])]) + frame[wire_at + 1 :], wire_at
+    changed = plain[:at] + bytes([value(plain[at])]) + plain[at + 1 :]
+    span = runtime.encode(changed[before : len(changed) - after])
+    wire_at = before + len(runtime.encode(plain[before:at]))
+    return frame[:before] + span + frame[len(frame) - after :], wire_at
 
 
 # What `make test-fast` leaves out: whole-program runs that take seconds each (wheels built and installed, the docs

@@ -12,7 +12,7 @@ import pickle
 from typing import Any
 
 import pytest
-from conftest import ALL, Generated, by_protocol, examples
+from conftest import ALL, Generated, by_protocol, examples, set_plain_byte
 from hypothesis import HealthCheck, given, settings
 from serialspec.backends.python.content import PackageCode
 from serialspec.lang.model import Message
@@ -64,8 +64,8 @@ def test_fast_paths_agree_with_the_plain_ones(g: Generated, spec: Message) -> No
         assert parser.feed(stray_byte(layout) + frame + frame[: len(layout.header)]) == [decoded]
         assert parser.errors == 0 and parser.pending() == frame[: len(layout.header)]
         # a frame with a wrong checksum fails both ways
-        at = len(frame) - 1 - trailer_size(layout)  # the checksum's last byte
-        damaged = frame[:at] + bytes([frame[at] ^ 0x01]) + frame[at + 1 :]
+        # the checksum's last byte (in a transformed span, its plain byte: the span written again)
+        damaged, _ = set_plain_byte(layout, frame, -1 - trailer_size(layout), lambda byte: byte ^ 0x01)
         with pytest.raises(ChecksumError):
             g.package.decode(damaged, direction)
         parser = g.package.StreamParser(direction)

@@ -42,8 +42,8 @@ def test_example_values_encode_to_its_bytes(g: Generated, example: Example) -> N
 
 @pytest.mark.parametrize(("g", "example"), EXAMPLES)
 def test_example_printed_bytes_are_the_frame_unless_an_erratum_says_otherwise(g: Generated, example: Example) -> None:
-    try:
-        printed = parse_hex(example.printed)
+    try:  # hex, or (`printed_as: text`) the frame's characters
+        printed = example.printed_text if example.printed_text is not None else parse_hex(example.printed)
     except ValueError:
         printed = None
     if example.erratum:

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import pytest
-from conftest import ALL, Generated, by_protocol
+from conftest import ALL, Generated, by_protocol, set_plain_byte
 from serialspec.lang.model import Example
 
 
@@ -29,17 +29,19 @@ def strays(g: Generated, example: Example) -> list[bytes]:
     frame = example.frame
     # (a frame cut inside its content is left out: with the next frame's first bytes it may pass an 8-bit checksum
     # by chance, and a valid frame is a frame; test_stress.py measures how rarely)
-    found = [layout.header, layout.header * 2, *(frame[:k] for k in range(1, layout.length_offset + 2))]
-    long_candidate = bytearray(frame[: layout.length_offset + 1])
-    long_candidate[layout.length_offset] = 0xFF
-    found.append(bytes(long_candidate))
+    # (a frame without a length, ended by its trailer, cut anywhere: Modbus ASCII's ':' and hex digits)
+    cut = layout.length_offset + 2 if layout.length_offset >= 0 else len(frame)
+    found = [layout.header, layout.header * 2, *(frame[:k] for k in range(1, cut))]
+    if layout.length_offset >= 0:
+        long_candidate = bytearray(frame[: layout.length_offset + 1])
+        long_candidate[layout.length_offset] = 0xFF
+        found.append(bytes(long_candidate))
     for element in layout.value_elements:
         assert element.type is not None
         if element.type.size == 1 and element.maximum < element.type.maximum:
-            bad = bytearray(frame)
-            offset = layout.offsets[element.name]
-            bad[offset] = next(v for v in range(255, -1, -1) if v != element.broadcast and v > element.maximum)
-            found.extend([bytes(bad), bytes(bad[: offset + 2])])
+            value = next(v for v in range(255, -1, -1) if v != element.broadcast and v > element.maximum)
+            bad, offset = set_plain_byte(layout, frame, layout.offsets[element.name], lambda _, v=value: v)
+            found.extend([bad, bad[: offset + 2]])
     return found
 
 

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define DYNAMIXEL_P2_SPEC_SHA256 "660e7f4481cf33b497c8f93925dd75a1f1e21ac0c6f8a81ea8f7e45b5e7058e8"
+#define DYNAMIXEL_P2_SPEC_SHA256 "3d4f31ef54a784ed0ecdb8f29aff917755bd3f3b8511a0c0ae0ba2cebf4360dd"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef DYNAMIXEL_P2_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define FEETECH_SMS_SPEC_SHA256 "d00c71aec21f59d36245ba463980f2c7acc30928769af57db95b3e60bb963d46"
+#define FEETECH_SMS_SPEC_SHA256 "6fa11acb221185384cd04217edb7a443dae9fdbba1d7b76973cbcd7e6cc68ddf"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef FEETECH_SMS_ENABLE_ENCODE

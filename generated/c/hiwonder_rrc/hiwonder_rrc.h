@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define HIWONDER_RRC_SPEC_SHA256 "d72dda653f1bb314ef5b3853a6d3b62c83f298ad6ffe9b7695ea1deee966776c"
+#define HIWONDER_RRC_SPEC_SHA256 "7813f887ccfc83587fabc8e3cd02ed8fc5d728c85aa91b05caf5bc8663394ee8"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef HIWONDER_RRC_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define VESC_SPEC_SHA256 "6fd2bd71ad5a1dfbc31fd8ae1516bccdc416abed50011e7d3699b4a1f3bac7c4"
+#define VESC_SPEC_SHA256 "cdd7185440e84459070fd6b5e3539801202af86d8e80283ac855e2b7b7667fe1"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef VESC_ENABLE_ENCODE

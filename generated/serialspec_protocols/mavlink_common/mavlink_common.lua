@@ -1486,11 +1486,15 @@ local function cobs_decode(wire)
 end
 
 local function untransform(t, wire)
-  -- the plain bytes of a transformed span (serialspec/transforms/: replace, cobs); an error when there are none
+  -- the plain bytes of a transformed span (serialspec/transforms/: replace, cobs, hex_ascii); an error when there are none
   if t.method == "cobs" then
     local plain = cobs_decode(wire)
     if plain == nil then error("bad COBS: not the COBS form of any bytes", 0) end
     return plain
+  end
+  if t.method == "hex_ascii" then
+    if wire:find("[^0-9A-Fa-f]") or #wire % 2 == 1 then error("bad hex-ASCII: not pairs of hex digits", 0) end
+    return (wire:gsub("%x%x", function(pair) return string.char(tonumber(pair, 16)) end))
   end
   local plain = rewrite(wire, t.replace, 2, 1)
   if rewrite(plain, t.replace, 1, 2) ~= wire then
@@ -1516,6 +1520,11 @@ local function plain_prefix(t, data, pos, count)
         if i > #data then return false end
         if data:byte(i) ~= 0 then out[#out + 1], n = "\0", n + 1 end
       end
+    elseif t.method == "hex_ascii" then
+      if not data:sub(i, i):find("^%x") then break end -- the digits end: so does the span
+      if i + 1 > #data then return false end
+      if not data:sub(i + 1, i + 1):find("^%x") then return nil end
+      out[#out + 1], n, i = string.char(tonumber(data:sub(i, i + 1), 16)), n + 1, i + 2
     else
       local matched = false
       for _, pair in ipairs(t.replace) do

@@ -933,6 +933,14 @@ EXAMPLE = Obj(
         "description": TEXT,
         "direction": Str("The direction the frame travels in.", choices=("request", "response")),
         "printed": Str("The frame exactly as the document prints it."),
+        "printed_as": Str(
+            "How `printed` (and the frame, where `frame` is not given) is read: hex bytes, or the frame's ASCII "
+            "characters for frames sent as text (hex-ASCII spans, Modbus ASCII: `:010300000001FB`), its trailer "
+            "(CR LF) left out as documents print it.",
+            choices=("hex", "text"),
+            default="hex",
+            example="text",
+        ),
         "printed_span": ListOf(
             Str(),
             "When the document prints only part of the frame (Modbus prints the PDU: function and data), the first "

@@ -566,6 +566,7 @@ class Example:
     # bytes of the frame before and after the part the document prints (`printed_span`; (0, 0): the whole frame)
     printed_span: tuple[int, int] = (0, 0)
     position: tuple[int, int] = (1, 1)  # line and column in the spec, for errors found after resolution
+    printed_text: bytes | None = None  # `printed_as: text`: the bytes of the printed characters and the trailer
 
     @property
     def printed_part(self) -> bytes:

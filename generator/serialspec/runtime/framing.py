@@ -353,6 +353,23 @@ def _terminated(layout: Layout, buffer: bytes, start: int, end: int, low: int, h
     return -1 if largest is not None and end - start > largest else None
 
 
+def _to_trailer(layout: Layout, buffer: bytes, begin: int, start: int, end: int) -> int | None:
+    """probe() for a frame whose transformed span (from `begin` on) runs to its trailer: where a transform can tell
+    where its span ends (`span_end`, hex-ASCII: at the first byte that is no hex digit), the trailer must follow
+    right there, else no frame starts at `start`; otherwise the frame ends at the first trailer. None: wait."""
+    trailer = layout.trailer
+    span_end: Callable[[bytes, int, int], int | None] | None = getattr(layout.transparency, "span_end", None)
+    if span_end is None:
+        stop = buffer.find(trailer, begin)
+        return None if stop < 0 else stop + len(trailer) - start
+    ended = span_end(buffer, begin, end)
+    if ended is None:
+        return None
+    if buffer.startswith(trailer, ended, end):
+        return ended + len(trailer) - start
+    return None if end - ended < len(trailer) and trailer.startswith(buffer[ended:end]) else -1
+
+
 @dataclass(frozen=True)
 class Unwrapped:
     layout: Layout
@@ -464,8 +481,7 @@ class FrameCodec:
                 return -1
             return outside + counted
         if layout.trailer and layout.transparency is not None:
-            stop = buffer.find(layout.trailer, start + plan["before"])
-            return None if stop < 0 else stop + len(layout.trailer) - start
+            return _to_trailer(layout, buffer, start + plan["before"], start, end)
         rule = self.size_rules.get(code)
         if rule is None:
             return _terminated(layout, buffer, start, end, low, high) if layout.trailer else -1
@@ -606,8 +622,7 @@ class FrameCodec:
                     return -1
                 return outside + counted
             if trailer:
-                stop = buffer.find(trailer, start + before)
-                return None if stop < 0 else stop + len(trailer) - start
+                return _to_trailer(layout, buffer, start + before, start, end)
             rule = size_rules.get(code)
             if rule is None:
                 return _terminated(layout, buffer, start, end, low, high) if terminated else -1

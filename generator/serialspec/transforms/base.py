@@ -8,7 +8,9 @@ class owns all that the transform means to every part of serialspec:
   the JSON Schema and docs/language.md), their validation (`from_spec`, `check_layout`);
 - the runtime: `runtime(span)`, the object the frame engine (runtime/framing.py Layout) calls: `encode(plain)`,
   `decode(wire)` (DecodeError for bytes that are not the transform of any bytes) and `plain_prefix` (how the stream
-  parser reads a length inside the span before the frame is complete); the runtime class lives in the
+  parser reads a length inside the span before the frame is complete), and optionally `span_end` (where the span
+  ends on the wire, for a transform that can tell: the stream parser then drops a candidate whose trailer is not
+  right there, instead of waiting for the next trailer); the runtime class lives in the
   transform's module, which imports nothing of the generator (the runtime wheel ships this package);
 - the Python backend: `runtime_name` and `python_arguments(span)`, how generated code builds the runtime object;
 - the markdown backend: `describe()` and `worked(plain)`;

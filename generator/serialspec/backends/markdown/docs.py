@@ -651,6 +651,7 @@ def emit_docs(protocol: Protocol) -> str:
             "anchor": anchor("command", e.command, e.subcommand or ""),
             "printed": code_span(e.printed),
             "frame": e.frame.hex(" ").upper(),
+            "text": e.printed_text is not None,
             "erratum": e.erratum,
             "partial": e.printed_span != (0, 0),
             "completed": text(e.completed),

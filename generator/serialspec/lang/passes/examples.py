@@ -85,13 +85,20 @@ class Examples(Pass):
         direction = Direction(value["direction"])
         self.find_message(commands, value["command"], value.get("subcommand"), direction, path)
         printed = value["printed"]
-        frame_text = value.get("frame", printed)
-        frame = self.frame_bytes(frame_text, (*path, "frame" if "frame" in value else "printed"))
+        as_text = value.get("printed_as") == "text"
+        if as_text and not str(printed).isascii():
+            raise self.fail((*path, "printed"), "`printed_as: text` takes ASCII characters only")
+        text = str(printed).encode("ascii") + self.trailer(direction) if as_text else b""
+        if as_text and "frame" not in value:
+            frame = text
+        else:
+            frame = self.frame_bytes(value.get("frame", printed), (*path, "frame" if "frame" in value else "printed"))
         erratum = str(value.get("erratum", ""))
         span = self.printed_span(value.get("printed_span"), direction, len(frame), (*path, "printed_span"))
         before, after = span
         try:
-            printed_ok = parse_hex(printed) == frame[before : len(frame) - after]
+            shown = text if as_text else parse_hex(printed)
+            printed_ok = shown == frame[before : len(frame) - after]
         except ValueError:
             printed_ok = False
         completed = str(value.get("completed", ""))
@@ -118,7 +125,15 @@ class Examples(Pass):
             completed,
             span,
             self.doc.where(path),
+            text if as_text else None,
         )
+
+    def trailer(self, direction: Direction) -> bytes:
+        """The trailer of the direction's frames (b"" for none): what an example printed as text leaves out."""
+        if self.ctx.framing is None:
+            return b""
+        last = self.ctx.framing.layouts[direction].elements[-1]
+        return last.constant if last.role == "trailer" else b""
 
     def printed_span(self, span: Any, direction: Direction, size: int, path: Path) -> tuple[int, int]:
         """Bytes before and after the frame elements first..last that a document prints (the content among them)."""

@@ -245,4 +245,5 @@ def test_the_asyncio_client_awaits_answers_and_iterates_over_what_the_device_sen
     finally:
         gps.close()
     assert len(got) == 3 and {type(m) for m in got} <= {nmea0183.GgaResponse, nmea0183.RmcResponse}
-    assert seen == [m for m in got if isinstance(m, nmea0183.RmcResponse)]
+    rmcs = [m for m in got if isinstance(m, nmea0183.RmcResponse)]
+    assert seen[: len(rmcs)] == rmcs  # called as read: a read may bring more than the loop took

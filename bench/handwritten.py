@@ -302,6 +302,43 @@ def sms_decode_reply(frame: bytes) -> SmsReply:
     return SmsReply(servo_id, SmsError(error), frame[_SMS_HEAD.size : -1])
 
 
+class SmsReplyStream:
+    """A straightforward hand-written stream parser for FEETECH replies (any number of data bytes): find the header,
+    check the id and length byte, wait for the whole frame, check the checksum, unpack; after a mismatch, look again
+    one byte after that header."""
+
+    def __init__(self) -> None:
+        self.pending = b""
+
+    def feed(self, data: bytes) -> list[SmsReply]:
+        buffer = self.pending + data if self.pending else data
+        end = len(buffer)
+        found = []
+        start = 0
+        while True:
+            position = buffer.find(SMS_HEADER, start)
+            if position < 0:
+                self.pending = buffer[max(start, end - 1) :]  # the last byte may begin a header
+                return found
+            if end - position < 6:  # header, id, length, error, checksum
+                self.pending = buffer[position:]
+                return found
+            servo_id = buffer[position + 2]
+            length = buffer[position + 3]
+            if servo_id > 254 or length < 2:
+                start = position + 1
+                continue
+            stop = position + 4 + length
+            if stop > end:
+                self.pending = buffer[position:]
+                return found
+            if ~sum(buffer[position + 2 : stop - 1]) & 0xFF != buffer[stop - 1]:
+                start = position + 1
+                continue
+            found.append(SmsReply(servo_id, SmsError(buffer[position + 4]), buffer[position + 5 : stop - 1]))
+            start = stop
+
+
 def sms_encode_reply(message: SmsReply) -> bytes:
     if not 0 <= message.servo_id <= 254 or message.servo_id.__class__ is bool:
         raise ValueError(f"id {message.servo_id} outside 0..254")

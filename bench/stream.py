@@ -20,7 +20,7 @@ from typing import Any
 
 from serialspec.runtime.message import Direction, Message
 
-from bench.handwritten import FsReplyStream, fs_decode_read_angle_reply
+from bench.handwritten import FsReplyStream, SmsReplyStream, fs_decode_read_angle_reply
 from bench.timing import Table, compare, times, us, verdict
 
 CHUNK = 4096
@@ -141,35 +141,47 @@ def parse_generated(parser_type: Callable[[Direction], Any], chunks: list[bytes]
     return found
 
 
-def parse_handwritten(chunks: list[bytes]) -> int:
-    parser = FsReplyStream()
+def parse_handwritten(chunks: list[bytes], parser_type: Callable[[], Any] = FsReplyStream) -> int:
+    parser = parser_type()
     found = 0
     for chunk in chunks:
         found += len(parser.feed(chunk))
     return found
 
 
-def beside_handwritten(package: Any, chunks: list[bytes], rounds: int = ROUNDS) -> tuple[float, float, int, int]:
+def beside_handwritten(
+    package: Any, chunks: list[bytes], rounds: int = ROUNDS, hand_type: Callable[[], Any] = FsReplyStream
+) -> tuple[float, float, int, int]:
     """The hand-written parser and the generated one side by side, round after round: best seconds of each, and
     the frames each found."""
     hand_best = generated_best = float("inf")
     hand_found = generated_found = 0
     for _ in range(rounds):
-        hand_seconds, hand_found = best_seconds(lambda: parse_handwritten(chunks), 1)
+        hand_seconds, hand_found = best_seconds(lambda: parse_handwritten(chunks, hand_type), 1)
         parse = functools.partial(parse_generated, package.StreamParser, chunks)
         generated_seconds, generated_found = best_seconds(parse, 1)
         hand_best, generated_best = min(hand_best, hand_seconds), min(generated_best, generated_seconds)
     return hand_best, generated_best, hand_found, generated_found
 
 
-def noisy_rows(package: Any, make: Callable[[], Message], rng: random.Random) -> list[list[str]]:
-    """The Fashion Star stream damaged as a serial line damages it, fed as a serial port hands it over: generated
-    and hand-written side by side, in reads of 1-256 bytes and in reads of one byte."""
+# the noisy rows' protocols: what the frames are, the hand-written parser beside the generated one
+NOISY = {
+    "fashionstar_uart": ("READ_ANGLE replies", "FsReplyStream", FsReplyStream),
+    "feetech_sms": ("READ replies, 2 data bytes", "SmsReplyStream", SmsReplyStream),
+}
+
+
+def noisy_rows(name: str, make: Callable[[], Message], rng: random.Random) -> list[list[str]]:
+    """A stream of 8-byte replies damaged as a serial line damages it, fed as a serial port hands it over:
+    generated and hand-written side by side, in reads of 1-256 bytes and in reads of one byte."""
+    package = importlib.import_module(f"serialspec_protocols.{name}")
+    what_frames, hand_name, hand_type = NOISY[name]
     rows = []
     for low, high, size, target in ((*SMALL_READS, STREAM_BYTES, True), (1, 1, ONE_BYTE_STREAM, False)):
         stream, frames = damaged_stream(package.encode, make, rng, size)
         reads = reads_of(stream, low, high, rng)
-        hand, generated, hand_found, found = beside_handwritten(package, reads, ROUNDS if high > 1 else 3)
+        rounds = ROUNDS if high > 1 else 3
+        hand, generated, hand_found, found = beside_handwritten(package, reads, rounds, hand_type)
         what = f"reads of {low}-{high} B" if high > 1 else "reads of 1 B"
         stream_text = (
             f"{len(stream) / 1024:.0f} KiB, {NOISY_GARBAGE:.0%} garbage runs, {NOISY_TRUNCATED:.0%} cut starts"
@@ -177,8 +189,8 @@ def noisy_rows(package: Any, make: Callable[[], Message], rng: random.Random) ->
         mb_s = len(stream) / generated / 1e6
         rows.append(
             [
-                "fashionstar_uart",
-                f"generated StreamParser: READ_ANGLE replies, {what}",
+                name,
+                f"generated StreamParser: {what_frames}, {what}",
                 "8",
                 stream_text,
                 f"{found}/{frames}",
@@ -190,8 +202,8 @@ def noisy_rows(package: Any, make: Callable[[], Message], rng: random.Random) ->
         )
         rows.append(
             [
-                "fashionstar_uart",
-                f"hand-written pure-Python parser (`FsReplyStream`), same stream, {what}",
+                name,
+                f"hand-written pure-Python parser (`{hand_name}`), same stream, {what}",
                 "8",
                 stream_text,
                 f"{hand_found}/{frames}",
@@ -288,9 +300,8 @@ def run() -> Table:
             f"generated ≥ {HANDWRITTEN_TARGET}× as fast: {verdict(over_hand >= HANDWRITTEN_TARGET)}",
         ]
     )
-    rows += noisy_rows(
-        importlib.import_module("serialspec_protocols.fashionstar_uart"), _reply_makers(rng)["fashionstar_uart"][1], rng
-    )
+    for name in NOISY:
+        rows += noisy_rows(name, _reply_makers(rng)[name][1], rng)
     seconds, found = best_seconds(lambda: parse_sdk(fs_chunks), 2)
     # what the target leaves per frame, against decoding one frame with no stream work at all
     fs = importlib.import_module("serialspec_protocols.fashionstar_uart")
@@ -346,7 +357,10 @@ def run() -> Table:
             "returning typed messages. SDK: best of 2 runs of its per-byte loop (see bench/stream.py docstring); "
             "its splitter looks for the response header only, and once it has seen one it takes the bytes that follow "
             "as that frame, so a false header in the noise costs the frame after it (that was rare here).",
-            "Noisy rows (the stream a serial port hands over): Fashion Star READ_ANGLE replies, each after a run of "
+            "Noisy rows (the stream a serial port hands over): Fashion Star READ_ANGLE replies and FEETECH READ "
+            "replies with 2 data bytes (8-byte frames; hand-written beside them: `FsReplyStream` and `SmsReplyStream`, "
+            "which checks the id, length byte and checksum, and builds the reply as `sms_decode_reply` does), each "
+            "after a run of "
             f"1-8 random bytes one time in {1 / NOISY_GARBAGE:.0f} and after the first 2-7 bytes of another reply "
             f"(a cut frame start) one time in {1 / NOISY_TRUNCATED:.0f}; fed in reads of random sizes from "
             f"{SMALL_READS[0]} to {SMALL_READS[1]} bytes, and in reads of one byte "

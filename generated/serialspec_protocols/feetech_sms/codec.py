@@ -195,6 +195,32 @@ def _whole_reset_request(buf: bytes) -> ResetRequest | None:
     return _new(ResetRequest, (id,))
 
 
+def _stream_write_request(buf: bytes, start: int) -> WriteRequest | None:
+    """A whole write request frame at buf[start:], its first bytes known (its size by its length byte): None if its
+    checksum fails."""
+    stop = start + 4 + buf[start + 3]
+    expected = ~sum(buf[start + 2 : stop - 1]) & 0xff
+    if expected != buf[stop - 1]:
+        return None
+    id = buf[start + 2]
+    v_address = buf[start + 5]
+    v_data = buf[start + 6:stop - 1]
+    return _new(WriteRequest, (id, v_address, v_data))
+
+
+def _stream_reg_write_request(buf: bytes, start: int) -> RegWriteRequest | None:
+    """A whole reg_write request frame at buf[start:], its first bytes known (its size by its length byte): None if its
+    checksum fails."""
+    stop = start + 4 + buf[start + 3]
+    expected = ~sum(buf[start + 2 : stop - 1]) & 0xff
+    if expected != buf[stop - 1]:
+        return None
+    id = buf[start + 2]
+    v_address = buf[start + 5]
+    v_data = buf[start + 6:stop - 1]
+    return _new(RegWriteRequest, (id, v_address, v_data))
+
+
 def _whole_write_request(buf: bytes) -> WriteRequest | None:
     """A whole write request frame, all of buf, its size and first bytes known: None if its checksum fails."""
     if (sum(buf) - 0x2fd) & 0xff:
@@ -213,6 +239,22 @@ def _whole_reg_write_request(buf: bytes) -> RegWriteRequest | None:
     v_address = buf[5]
     v_data = buf[6:-1]
     return _new(RegWriteRequest, (id, v_address, v_data))
+
+
+def _stream_reply_response(buf: bytes, start: int) -> ReplyResponse | None:
+    """A whole reply response frame at buf[start:], its first bytes known (its size by its length byte): None if its
+    checksum fails."""
+    stop = start + 4 + buf[start + 3]
+    expected = ~sum(buf[start + 2 : stop - 1]) & 0xff
+    if expected != buf[stop - 1]:
+        return None
+    id = buf[start + 2]
+    error = buf[start + 4]
+    v_data = buf[start + 5:stop - 1]
+    error_flags = _MEMBERS_ErrorStatus.get(error)
+    if error_flags is None:
+        error_flags = ErrorStatus(error)
+    return _new(ReplyResponse, (id, error_flags, v_data))
 
 
 def _encode_ping_request(m: PingRequest) -> bytes:
@@ -379,6 +421,8 @@ _REQUEST_SIZES: dict[int | None, tuple[int, int | None]] = {
 }
 # Frames of one size decoded whole, by size key (command code << 8 | length byte): frame size, decoder.
 _REQUEST_FIXED: dict[int, tuple[int, Callable[[bytes, int], Message | None]]] = {
+    **{0x03 << 8 | n: (n + 4, _stream_write_request) for n in range(3, 256)},
+    **{0x04 << 8 | n: (n + 4, _stream_reg_write_request) for n in range(3, 256)},
     0x0102: (6, _frame_ping_request),
     0x0204: (8, _frame_read_request),
     0x0502: (6, _frame_action_request),
@@ -417,6 +461,7 @@ _RESPONSE_SIZES: dict[int | None, tuple[int, int | None]] = {
 }
 # Frames of one size decoded whole, by size key (command code << 8 | length byte): frame size, decoder.
 _RESPONSE_FIXED: dict[int, tuple[int, Callable[[bytes, int], Message | None]]] = {
+    **{n: (n + 4, _stream_reply_response) for n in range(2, 256)},
 }
 
 

@@ -68,6 +68,9 @@ class _Candidate:
         "pieces",
         "shifts",
         "byte_at",
+        "value_at",
+        "command_at",
+        "entries",
         "allowed",
         "wide",
         "runs",
@@ -118,14 +121,17 @@ class _Candidate:
         # Every plausible frame as the batch scan reads it: size key -> (frame size, its bytes after the header, the
         # decoder of the frames decoded whole, or None for decode_at).
         self.pieces = {key: (size, size - width, self.fixed.get(key)) for key, size in self.frame_sizes.items()}
+        # the same for the walk (_walk): size key -> (frame size, decoder of the frames decoded whole, or None)
+        self.entries = {key: (size, self.fixed.get(key)) for key, size in self.frame_sizes.items()}
+        self.command_at = -1 if frame_format.command_offset is None else frame_format.command_offset
         # The usual value range (one unsigned byte after the header: an address) as a table of 256 yes/no bytes
         # read in the piece; other ranges (`wide`) go through plausible().
         single = [r for r in self.ranges if r[1] == 1 and not r[3] and r[0] >= width]
         self.wide = len(single) != len(self.ranges) or len(single) > 1
-        self.byte_at, self.allowed = -1, None
+        self.byte_at, self.value_at, self.allowed = -1, -1, None
         if len(single) == 1:
             offset, _, _, _, low, high, also = single[0]
-            self.byte_at = offset - width
+            self.byte_at, self.value_at = offset - width, offset
             self.allowed = bytes(low <= value <= high or value == also for value in range(256))
         # Runs of frames of one size key, checked together (see _run): where each key byte is in the piece, the
         # first byte the checksum sums there, and a table taking a sum of the piece's bytes to the check byte.
@@ -176,6 +182,8 @@ _CANDIDATES: dict[int, _Candidate] = {}
 # which doubles each time (up to _LONGEST_RUN) and is back to _SHORTEST_RUN after a run that paid. Where frames of
 # different keys alternate, the stream takes the usual path, at most one try in _LONGEST_RUN pieces lost. A run takes
 # _FIRST_RUN pieces at most at first, and twice as many after each run that took at least half of them.
+# Buffers of _SPLIT_FROM bytes or more take the batch scan (StreamParser._split), shorter ones the walk (_walk).
+_SPLIT_FROM = 512
 _SHORTEST_RUN = 24
 _FIRST_RUN = 32
 _LONGEST_RUN = 1024
@@ -216,37 +224,43 @@ class StreamParser:
         if single is None:
             return self._scan(buffer)
         end = len(buffer)
+        header = single.header
         need = self._need
         if need:  # a candidate held back, its bytes not all here: nothing can change before they are
-            header = single.header
             # unless a header comes in the new bytes (a frame inside the candidate may complete first)
             if end < need and buffer.find(header, max(1, len(pending) - len(header) + 1)) < 0:
                 self._pending = buffer
                 return []
             self._need = 0
-        if end < 64 and buffer.find(single.header) < 0:  # a short read of garbage (or of a header's first bytes)
-            cut = max(0, end - self._keep)
-            self.garbage += cut
-            self._pending = buffer[cut:]
-            return []
-        if end >= single.prefix:
-            # A transaction's read is usually one whole frame, first byte on: decode it without a scan. A frame
-            # that fails goes through the scan, which counts it and resynchronises.
+        first = buffer.find(header)
+        if first:
+            if first < 0 and end < 64:  # a short read of garbage (or of a header's first bytes)
+                cut = max(0, end - self._keep)
+                self.garbage += cut
+                self._pending = buffer[cut:]
+                return []
+        elif buffer.find(header, 1) < 0:
+            # One candidate, from the first byte on (no header after it: no frame inside it), as small reads bring
+            # it: it waits for its bytes without a scan, and a transaction's read of one whole frame is decoded
+            # without one. A frame that fails goes through the scan, which counts it and resynchronises.
+            if end < single.prefix:
+                self._pending, self._need = buffer, single.prefix
+                return []
             key = buffer[single.length_offset]
-            if single.command_offset is not None:
-                key |= buffer[single.command_offset] << 8
-            if (
-                single.frame_sizes.get(key) == end
-                and buffer.startswith(single.header)
-                and (not single.ranges or single.plausible(buffer, 0))  # a value out of range: the scan skips it
-                # no header inside where a frame ending before this one could start: it would win
-                and buffer.find(single.header, 1, end - 1 - single.smallest + len(single.header)) < 0
-            ):
-                message = single.take(key, buffer, 0, end)
-                if message is not None:
-                    self._pending = b""
-                    return [message]
-        found = self._split(buffer, single) if single.splittable else self._scan(buffer)
+            if single.command_at >= 0:
+                key |= buffer[single.command_at] << 8
+            entry = single.entries.get(key)
+            if entry is not None and (not single.ranges or single.plausible(buffer, 0)):
+                size = entry[0]
+                if end < size:
+                    self._pending, self._need = buffer, size
+                    return []
+                if end == size:
+                    message = single.take(key, buffer, 0, end)
+                    if message is not None:
+                        self._pending = b""
+                        return [message]
+        found = self._split(buffer, single) if single.splittable and end >= _SPLIT_FROM else self._walk(buffer, single)
         held = self._pending
         if held.startswith(single.header) and held.find(single.header, 1) < 0:
             # the candidate held back, with no header after its first byte: feed() waits for its bytes (or for the
@@ -258,6 +272,78 @@ class StreamParser:
                 if single.command_offset is not None:
                     key |= held[single.command_offset] << 8
                 self._need = single.frame_sizes.get(key, 0)
+        return found
+
+    def _walk(self, buffer: bytes, current: _Candidate) -> list[Message]:
+        """The byte-by-byte scan (`_scan`) of one frame format, with `_decide`'s usual outcomes in line: a candidate
+        whose frame is all here, with no header where a frame ending before it could start, is taken or refused on
+        the spot (one search, one lookup, one call); an implausible one is skipped. Only a candidate that must wait
+        for bytes or holds a header that may start an earlier frame goes through `_decide`. The search for the next
+        header, from one byte after this one, also tells whether one lies inside this candidate. A short read (a few
+        frames) costs little to set up, where the batch scan (`_split`) pays off on long ones."""
+        header = current.header
+        find = buffer.find
+        end = len(buffer)
+        entries = current.entries
+        length_at, command_at, prefix = current.length_offset, current.command_at, current.prefix
+        decode_at = current.decode
+        allowed, value_at, wide = current.allowed, current.value_at, current.wide
+        reach = len(header) - 1 - current.smallest  # a frame ending before `stop` starts before `stop + reach`
+        found: list[Message] = []
+        append = found.append
+        start = taken = errors = 0  # start: where the scan would look next once no header is left
+        position = find(header)
+        while position >= 0:
+            after = find(header, position + 1)
+            if end - position >= prefix:
+                key = buffer[position + length_at]
+                if command_at >= 0:
+                    key |= buffer[position + command_at] << 8
+                entry = entries.get(key)
+                if (
+                    entry is None
+                    or (allowed is not None and not allowed[buffer[position + value_at]])
+                    or (wide and not current.plausible(buffer, position))
+                ):  # no frame: look again one byte on
+                    position = after
+                    continue
+                size, decode = entry
+                stop = position + size
+                if stop <= end and (after < 0 or after >= stop + reach):
+                    if decode is not None:
+                        message = decode(buffer, position)
+                    else:
+                        try:
+                            message = decode_at(buffer, position, stop)
+                        except DecodeError:
+                            message = None
+                    if message is None:  # corrupt: look again one byte on
+                        errors += 1
+                        position = after
+                        continue
+                    append(message)
+                    taken += size
+                    start = stop
+                    position = after if after >= stop or after < 0 else find(header, stop)
+                    continue
+            decided = self._decide(buffer, position, current)
+            if decided is None:  # incomplete, and no frame completes inside it: wait for more bytes
+                cut = position
+                break
+            message, where, stop = decided
+            if message is not None:  # this candidate, or a frame inside it that completes first
+                append(message)
+                taken += stop - where
+                start = stop
+                position = find(header, stop)
+            else:
+                errors += stop  # 1: a corrupt frame; 0: no frame
+                position = after
+        else:  # keep a tail that could begin a header
+            cut = max(start, end - len(header) + 1)
+        self._pending = buffer[cut:]
+        self.garbage += cut - taken
+        self.errors += errors
         return found
 
     def _split(self, buffer: bytes, current: _Candidate) -> list[Message]:

@@ -103,6 +103,8 @@ def length_byte_codec_context(protocol: Protocol, code: PackageCode) -> dict[str
         sub_functions, pickers, sub_entries = subcommand_frames(protocol, layout, decoder_bodies, code)
         whole = whole_frames(layout, [*fixed, *sub_entries])
         rests = rest_frames(protocol, layout, decoder_bodies, code) if whole or fixed else []
+        stream_rests = rest_frames(protocol, layout, decoder_bodies, code, stream=True)
+        whole_functions += stream_rests
         whole_functions += rests
         sub_rests = subcommand_rest_frames(protocol, layout, decoder_bodies) if whole else []
         whole_functions += sub_rests
@@ -150,6 +152,8 @@ def length_byte_codec_context(protocol: Protocol, code: PackageCode) -> dict[str
                 "accepted": [inside for _, inside, _ in range_checks],
                 "exact": exact,
                 "fixed": [(key, size, function["name"]) for key, size, function in fixed],
+                # before the frames of one size: where a length byte names both, those keep their decoder
+                "stream_rests": [rest_key(layout, r, False) for r in stream_rests],
                 "runs": runs,
                 "summed": stream_sum(protocol, layout) if runs else None,
                 "fixed_whole": [(key, size, function["whole_name"]) for key, size, function in fixed],
@@ -354,12 +358,20 @@ def subcommand_frames(
 
 
 def rest_frames(
-    protocol: Protocol, layout: FrameLayout, bodies: dict[str, tuple[str, str, Block]], code: PackageCode
+    protocol: Protocol,
+    layout: FrameLayout,
+    bodies: dict[str, tuple[str, str, Block]],
+    code: PackageCode,
+    stream: bool = False,
 ) -> list[dict[str, Any]]:
     """decode()'s whole-frame decoders of the frames whose content is fixed fields then bytes to its end (FEETECH
     WRITE: an address, then the data): any length byte from the smallest such content up names one, so decode()'s
     table holds a key per length byte. Each checks the checksum, reads the fields at constant offsets and the bytes
-    up to the frame's tail: no dispatch, no content decoder's call. Others keep the general path."""
+    up to the frame's tail: no dispatch, no content decoder's call. Others keep the general path.
+
+    `stream`: the same decoders for the stream parser's table of frames decoded whole (FrameFormat.fixed), of the
+    frame at buf[start:] (its end from its length byte), also for contents of any size (FEETECH's reply: an
+    error byte in the frame, then the data), which have no size check to drop: one call per frame."""
     checksum = protocol.framing.checksum
     length = layout.length
     if checksum is None or length is None or length.type is None:
@@ -377,29 +389,39 @@ def rest_frames(
         if not (isinstance(message.fields[-1], Bytes) and takes_the_rest(message.fields[-1])):
             continue
         returns, extra, decoder = bodies[decoder_name(message)]
-        if not (decoder and isinstance(decoder[0], ContentSize) and decoder[0].high is None):
+        if decoder and isinstance(decoder[0], ContentSize) and decoder[0].high is None:
+            statements = decoder[1:]  # the size check: the key implies it
+        elif stream and not message.min_size and not any(isinstance(s, ContentSize) for s in walk(decoder)):
+            statements = decoder
+        else:
             continue
+
+        def at(offset: int) -> str:
+            return f"start + {offset}" if stream else str(offset)
+
         offset, body = content_offset, []
-        for statement in decoder[1:]:  # the size check: the key implies it
+        for statement in statements:
             if isinstance(statement, Advance) and statement.size.isdigit():
                 offset += int(statement.size)
                 continue
             if isinstance(statement, Unpack) and statement.at == "o":
-                statement = replace(statement, at=str(offset))
+                statement = replace(statement, at=at(offset))
             elif isinstance(statement, TakeRest):
-                statement = replace(statement, start=str(offset), stop=f"-{tail}")
+                statement = replace(statement, start=at(offset), stop=f"stop - {tail}" if stream else f"-{tail}")
             if raises([statement]) or any(reads_cursor(s) for s in walk([statement])):
                 break  # checked beyond its size, or read at a cursor: the general path
             body.append(statement)
         else:
-            values = [Code(f"{e.name} = buf[{layout.offsets[e.name]}]") for e in layout.value_elements]
+            values = [Code(f"{e.name} = buf[{at(layout.offsets[e.name])}]") for e in layout.value_elements]
             lowest = (message.min_size or 0) + layout.length_adds
+            check = stream_rest_check(protocol, layout) if stream else rest_check(protocol, layout)
             found.append(
                 {
-                    "whole_name": message_function("whole", message),
+                    "whole_name": message_function("stream" if stream else "whole", message),
+                    "stream": stream,
                     "returns": returns,
                     "where": f"{message.key} {message.direction.value}",
-                    "whole_lines": fuse_unpack([*rest_check(protocol, layout), *values, *body]),
+                    "whole_lines": fuse_unpack([*check, *values, *body]),
                     "code": command.code,
                     "lengths": (lowest, length.type.maximum),
                     "adds": layout.overhead - layout.length_adds,  # frame size = length byte + this
@@ -473,6 +495,21 @@ def rest_check(protocol: Protocol, layout: FrameLayout) -> Block:
     covered = f"buf[{layout.covered_from}:-{layout.covered_to_end}]"
     check = [Code(line) for line in checksum_lines(checksum, covered, "expected")]
     return [*check, If(f"expected != {stored}", (RETURN_NONE,))]
+
+
+def stream_rest_check(protocol: Protocol, layout: FrameLayout) -> Block:
+    """The checksum test of the frame of any size at buf[start:], its end (`stop`) from its length byte, returning
+    None when it fails."""
+    checksum = protocol.framing.checksum
+    assert checksum is not None  # length-byte frames have one
+    size = layout.checksum_offset_from_end
+    stored = "buf[stop - 1]" if size == 1 else f"int.from_bytes(buf[stop - {size} : stop], 'little')"
+    first = f"start + {layout.covered_from}" if layout.covered_from else "start"
+    covered = f"buf[{first} : stop - {layout.covered_to_end}]"
+    adds = layout.overhead - layout.length_adds  # frame size = length byte + this
+    check = [Code(line) for line in checksum_lines(checksum, covered, "expected")]
+    stop = Code(f"stop = start + {adds} + buf[start + {layout.length_offset}]")
+    return [stop, *check, If(f"expected != {stored}", (RETURN_NONE,))]
 
 
 def failed_check(body: Block) -> int | None:

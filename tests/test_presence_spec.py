@@ -148,7 +148,6 @@ def test_every_shipped_bus_declares_how_to_find_its_devices() -> None:
         "hiwonder_rrc": None,
         "modbus_ascii": "read_holding_registers",
         "modbus_rtu": "read_holding_registers",
-        "modbus_ascii": "read_holding_registers",
         "nmea0183": None,
         "crsf": None,
         "mavlink_common": None,

@@ -1932,35 +1932,32 @@ void dynamixel_p2_parser_init(dynamixel_p2_parser_t *parser, dynamixel_p2_direct
     parser->dir = dir;
 }
 
-/* The candidate at pos: accepted (its size in *size, its message in out), waiting, no frame, or corrupt. */
+/* The candidate at pos: accepted (its size in *size, its message in out), waiting (in *size the bytes it needs
+ * before it can be judged again, 0 when that is not known), no frame, or corrupt. */
 static int dynamixel_p2__try(dynamixel_p2_parser_t *p, size_t pos, dynamixel_p2_msg_t *out, size_t *size)
 {
     uint8_t count = dynamixel_p2__count(p->dir), k;
-    int waiting = 0;
+    size_t need = (size_t)-1; /* the fewest bytes a waiting layout needs: (size_t)-1 none waits, 0 not known */
     if (p->verdict[pos] != 0u) {
         return p->verdict[pos];
     }
-    if (pos == 0u && p->first > p->n) { /* its size is known and its bytes have not all come */
-        return DYNAMIXEL_P2__V_WAIT;
-    }
     for (k = 0u; k < count; k++) {
         long s = dynamixel_p2__probe_at(p->dir, k, p->buf + pos, p->n - pos);
-        if (pos == 0u && count == 1u && s > 0) {
-            p->first = (size_t)s;
-        }
         if (s == DYNAMIXEL_P2__WAIT) {
-            waiting = 1;
+            need = 0u;
             continue;
         }
         if (s < 0 || (unsigned long)s > DYNAMIXEL_P2_MAX_FRAME) {
             continue;
         }
         if ((size_t)s > p->n - pos) {
-            waiting = 1;
+            if ((size_t)s < need) {
+                need = (size_t)s;
+            }
             continue;
         }
         if (dynamixel_p2_decode(p->buf + pos, (size_t)s, p->dir, out) != DYNAMIXEL_P2_OK) {
-            if (!waiting) {
+            if (need == (size_t)-1) {
                 p->verdict[pos] = DYNAMIXEL_P2__V_CORRUPT;
             }
             return DYNAMIXEL_P2__V_CORRUPT;
@@ -1968,7 +1965,8 @@ static int dynamixel_p2__try(dynamixel_p2_parser_t *p, size_t pos, dynamixel_p2_
         *size = (size_t)s;
         return DYNAMIXEL_P2__ACCEPT;
     }
-    if (waiting) {
+    if (need != (size_t)-1) {
+        *size = need;
         return DYNAMIXEL_P2__V_WAIT;
     }
     p->verdict[pos] = DYNAMIXEL_P2__V_NONE;
@@ -2022,20 +2020,42 @@ static void dynamixel_p2__drop(dynamixel_p2_parser_t *p, size_t cut)
     p->n -= cut;
 }
 
-/* One byte in: the Python parser's scan over the bytes held, each candidate's verdict kept once final. */
+#if DYNAMIXEL_P2__HEADERS
+/* 1 when the bytes held end with a header of any layout (a candidate begins). */
+static int dynamixel_p2__ends_header(const dynamixel_p2_parser_t *p)
+{
+    uint8_t count = dynamixel_p2__count(p->dir), k;
+    for (k = 0u; k < count; k++) {
+        size_t hl;
+        const uint8_t *h = dynamixel_p2__header(p->dir, k, &hl);
+        if (hl <= p->n && dynamixel_p2__same(p->buf + p->n - hl, h, hl)) {
+            return 1;
+        }
+    }
+    return 0;
+}
+#endif
+
+/* One byte in: the Python parser's scan over the bytes held, each candidate's verdict kept once final. While a
+ * candidate waits, the scan is left out until one held can be judged (p->wake bytes held) or a header comes: nothing
+ * the scan decides could change before then. */
 static int dynamixel_p2__push(dynamixel_p2_parser_t *p, uint8_t byte, dynamixel_p2_msg_t *out)
 {
-    size_t start = 0u, done = 0u, pos, size = 0u, cut, hold = (size_t)-1;
-    uint32_t deferred = 0u;
+    size_t start = 0u, done = 0u, pos, size = 0u, cut, hold = (size_t)-1, wake = (size_t)-1;
     int got = 0, r;
     if (p->n >= DYNAMIXEL_P2_MAX_FRAME) { /* only a candidate longer than DYNAMIXEL_P2_MAX_FRAME can fill it: drop its first byte */
         dynamixel_p2__drop(p, 1u);
         p->garbage++;
-        p->first = 0u;
+        p->wake = 0u;
     }
     p->buf[p->n] = byte;
     p->verdict[p->n] = 0u;
     p->n++;
+#if DYNAMIXEL_P2__HEADERS
+    if (p->n < p->wake && !dynamixel_p2__ends_header(p)) {
+        return 0;
+    }
+#endif
     while (start < p->n) {
         pos = dynamixel_p2__next(p, start);
         if (pos >= p->n) {
@@ -2046,16 +2066,21 @@ static int dynamixel_p2__push(dynamixel_p2_parser_t *p, uint8_t byte, dynamixel_
             if (hold == (size_t)-1) {
                 hold = pos;
             }
+            if (size == 0u) {
+                wake = 0u;
+            } else if (pos + size < wake) {
+                wake = pos + size;
+            }
         } else if (r == DYNAMIXEL_P2__V_CORRUPT) {
             if (hold == (size_t)-1) {
                 p->errors++;
-            } else {
-                deferred++;
+            }
+            if (p->verdict[pos] == 0u) { /* corrupt as one layout, while another waits: judged again */
+                wake = 0u;
             }
         } else if (r == DYNAMIXEL_P2__ACCEPT) {
             p->garbage += (uint32_t)(pos - done);
             hold = (size_t)-1;
-            deferred = 0u;
             start = done = pos + size;
             got = 1;
             p->frames++;
@@ -2063,9 +2088,12 @@ static int dynamixel_p2__push(dynamixel_p2_parser_t *p, uint8_t byte, dynamixel_
         }
         start = pos + 1u;
     }
-    (void)deferred;
+    p->wake = 0u;
     if (hold != (size_t)-1) {
         cut = hold;
+        if (wake != 0u) {
+            p->wake = wake - cut;
+        }
     } else if (DYNAMIXEL_P2__HEADERS && !got) {
         cut = p->n > DYNAMIXEL_P2__KEEP ? p->n - DYNAMIXEL_P2__KEEP : 0u;
         if (cut < done) {
@@ -2077,7 +2105,6 @@ static int dynamixel_p2__push(dynamixel_p2_parser_t *p, uint8_t byte, dynamixel_
     p->garbage += (uint32_t)(cut - done);
     if (cut > 0u) {
         dynamixel_p2__drop(p, cut);
-        p->first = 0u;
     }
     return got;
 }

@@ -681,6 +681,20 @@ static const dynamixel_p2__layout_t *const *dynamixel_p2__layouts(dynamixel_p2_d
 #endif
 #endif
 
+#if DYNAMIXEL_P2_ENABLE_DECODE
+/* n bytes from src to dst: a loop, kept one (newlib's memcpy is 142 B of flash on Cortex-M0+; GCC would call it). */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("no-tree-loop-distribute-patterns")))
+#endif
+static void dynamixel_p2__copy(void *dst, const uint8_t *src, size_t n)
+{
+    uint8_t *d = (uint8_t *)dst;
+    size_t i;
+    for (i = 0u; i < n; i++) {
+        d[i] = src[i];
+    }
+}
+#endif
 
 #if DYNAMIXEL_P2_ENABLE_PARSER && (DYNAMIXEL_P2__STUFFED || !DYNAMIXEL_P2__LENGTHS)
 /* Frames without a length: the content size from its own leading fields, by code (WAIT: those have not come). */
@@ -936,7 +950,7 @@ static int dynamixel_p2__dec_write_request(const uint8_t *c, size_t n, dynamixel
     len = n - o;
     if (n - o < len) { return DYNAMIXEL_P2_E_LENGTH; }
     if (len > sizeof(m->data)) { return DYNAMIXEL_P2_E_CAPACITY; }
-    memcpy(m->data, c + o, len);
+    dynamixel_p2__copy(m->data, c + o, len);
     m->data_len = len;
     o += len;
     if (o != n) { return DYNAMIXEL_P2_E_LENGTH; }
@@ -959,7 +973,7 @@ static int dynamixel_p2__dec_reg_write_request(const uint8_t *c, size_t n, dynam
     len = n - o;
     if (n - o < len) { return DYNAMIXEL_P2_E_LENGTH; }
     if (len > sizeof(m->data)) { return DYNAMIXEL_P2_E_CAPACITY; }
-    memcpy(m->data, c + o, len);
+    dynamixel_p2__copy(m->data, c + o, len);
     m->data_len = len;
     o += len;
     if (o != n) { return DYNAMIXEL_P2_E_LENGTH; }
@@ -1112,7 +1126,7 @@ static int dynamixel_p2__dec_sync_write_request(const uint8_t *c, size_t n, dyna
         len = (size_t)d1_length;
         if (n - o < len) { return DYNAMIXEL_P2_E_LENGTH; }
         if (len > sizeof(m->servos[i1].data)) { return DYNAMIXEL_P2_E_CAPACITY; }
-        memcpy(m->servos[i1].data, c + o, len);
+        dynamixel_p2__copy(m->servos[i1].data, c + o, len);
         m->servos[i1].data_len = len;
         o += len;
         m->servos_count = i1 + 1u;
@@ -1181,7 +1195,7 @@ static int dynamixel_p2__dec_bulk_write_request(const uint8_t *c, size_t n, dyna
         len = (size_t)d2_length;
         if (n - o < len) { return DYNAMIXEL_P2_E_LENGTH; }
         if (len > sizeof(m->writes[i1].data)) { return DYNAMIXEL_P2_E_CAPACITY; }
-        memcpy(m->writes[i1].data, c + o, len);
+        dynamixel_p2__copy(m->writes[i1].data, c + o, len);
         m->writes[i1].data_len = len;
         o += len;
         m->writes_count = i1 + 1u;
@@ -1202,7 +1216,7 @@ static int dynamixel_p2__dec_status_response(const uint8_t *c, size_t n, dynamix
     len = n - o;
     if (n - o < len) { return DYNAMIXEL_P2_E_LENGTH; }
     if (len > sizeof(m->data)) { return DYNAMIXEL_P2_E_CAPACITY; }
-    memcpy(m->data, c + o, len);
+    dynamixel_p2__copy(m->data, c + o, len);
     m->data_len = len;
     o += len;
     if (o != n) { return DYNAMIXEL_P2_E_LENGTH; }

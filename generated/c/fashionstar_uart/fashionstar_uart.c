@@ -679,6 +679,21 @@ static int32_t fashionstar_uart__s32(uint32_t v)
 }
 #endif
 
+#if FASHIONSTAR_UART_ENABLE_DECODE
+/* n bytes from src to dst: a loop, kept one (newlib's memcpy is 142 B of flash on Cortex-M0+; GCC would call it). */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("no-tree-loop-distribute-patterns")))
+#endif
+static void fashionstar_uart__copy(void *dst, const uint8_t *src, size_t n)
+{
+    uint8_t *d = (uint8_t *)dst;
+    size_t i;
+    for (i = 0u; i < n; i++) {
+        d[i] = src[i];
+    }
+}
+#endif
+
 #if FASHIONSTAR_UART_ENABLE_PARSER && (FASHIONSTAR_UART__STUFFED || !FASHIONSTAR_UART__LENGTHS)
 /* Frames without a length: the content size from its own leading fields, by code (WAIT: those have not come). */
 static long fashionstar_uart__content_size(fashionstar_uart_direction_t dir, long code, const uint8_t *c, size_t avail)
@@ -2304,7 +2319,7 @@ static int fashionstar_uart__dec_sync_command_request(const uint8_t *c, size_t n
         len = (size_t)d1_block_size;
         if (n - o < len) { return FASHIONSTAR_UART_E_LENGTH; }
         if (len > sizeof(m->blocks[i1].content)) { return FASHIONSTAR_UART_E_CAPACITY; }
-        memcpy(m->blocks[i1].content, c + o, len);
+        fashionstar_uart__copy(m->blocks[i1].content, c + o, len);
         m->blocks[i1].content_len = len;
         o += len;
     }

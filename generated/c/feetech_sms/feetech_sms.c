@@ -659,6 +659,20 @@ static const feetech_sms__layout_t *const *feetech_sms__layouts(feetech_sms_dire
 #endif
 #endif
 
+#if FEETECH_SMS_ENABLE_DECODE
+/* n bytes from src to dst: a loop, kept one (newlib's memcpy is 142 B of flash on Cortex-M0+; GCC would call it). */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("no-tree-loop-distribute-patterns")))
+#endif
+static void feetech_sms__copy(void *dst, const uint8_t *src, size_t n)
+{
+    uint8_t *d = (uint8_t *)dst;
+    size_t i;
+    for (i = 0u; i < n; i++) {
+        d[i] = src[i];
+    }
+}
+#endif
 
 #if FEETECH_SMS_ENABLE_PARSER && (FEETECH_SMS__STUFFED || !FEETECH_SMS__LENGTHS)
 /* Frames without a length: the content size from its own leading fields, by code (WAIT: those have not come). */
@@ -992,7 +1006,7 @@ static int feetech_sms__dec_write_request(const uint8_t *c, size_t n, feetech_sm
     len = n - o;
     if (n - o < len) { return FEETECH_SMS_E_LENGTH; }
     if (len > sizeof(m->data)) { return FEETECH_SMS_E_CAPACITY; }
-    memcpy(m->data, c + o, len);
+    feetech_sms__copy(m->data, c + o, len);
     m->data_len = len;
     o += len;
     if (o != n) { return FEETECH_SMS_E_LENGTH; }
@@ -1015,7 +1029,7 @@ static int feetech_sms__dec_reg_write_request(const uint8_t *c, size_t n, feetec
     len = n - o;
     if (n - o < len) { return FEETECH_SMS_E_LENGTH; }
     if (len > sizeof(m->data)) { return FEETECH_SMS_E_CAPACITY; }
-    memcpy(m->data, c + o, len);
+    feetech_sms__copy(m->data, c + o, len);
     m->data_len = len;
     o += len;
     if (o != n) { return FEETECH_SMS_E_LENGTH; }
@@ -1104,7 +1118,7 @@ static int feetech_sms__dec_sync_write_request(const uint8_t *c, size_t n, feete
         len = (size_t)d1_data_length;
         if (n - o < len) { return FEETECH_SMS_E_LENGTH; }
         if (len > sizeof(m->servos[i1].data)) { return FEETECH_SMS_E_CAPACITY; }
-        memcpy(m->servos[i1].data, c + o, len);
+        feetech_sms__copy(m->servos[i1].data, c + o, len);
         m->servos[i1].data_len = len;
         o += len;
         m->servos_count = i1 + 1u;
@@ -1125,7 +1139,7 @@ static int feetech_sms__dec_reply_response(const uint8_t *c, size_t n, feetech_s
     len = n - o;
     if (n - o < len) { return FEETECH_SMS_E_LENGTH; }
     if (len > sizeof(m->data)) { return FEETECH_SMS_E_CAPACITY; }
-    memcpy(m->data, c + o, len);
+    feetech_sms__copy(m->data, c + o, len);
     m->data_len = len;
     o += len;
     if (o != n) { return FEETECH_SMS_E_LENGTH; }

@@ -684,6 +684,21 @@ static int16_t hiwonder_rrc__s16(uint32_t v)
 #endif
 
 #if HIWONDER_RRC_ENABLE_DECODE
+/* n bytes from src to dst: a loop, kept one (newlib's memcpy is 142 B of flash on Cortex-M0+; GCC would call it). */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("no-tree-loop-distribute-patterns")))
+#endif
+static void hiwonder_rrc__copy(void *dst, const uint8_t *src, size_t n)
+{
+    uint8_t *d = (uint8_t *)dst;
+    size_t i;
+    for (i = 0u; i < n; i++) {
+        d[i] = src[i];
+    }
+}
+#endif
+
+#if HIWONDER_RRC_ENABLE_DECODE
 static float hiwonder_rrc__f32(uint32_t bits)
 {
     float f;
@@ -2192,7 +2207,7 @@ static int hiwonder_rrc__dec_oled_request(const uint8_t *c, size_t n, hiwonder_r
     len = (size_t)d1_length;
     if (n - o < len) { return HIWONDER_RRC_E_LENGTH; }
     if (len > sizeof(m->text)) { return HIWONDER_RRC_E_CAPACITY; }
-    memcpy(m->text, c + o, len);
+    hiwonder_rrc__copy(m->text, c + o, len);
     m->text_len = len;
     o += len;
     if (o != n) { return HIWONDER_RRC_E_LENGTH; }

@@ -713,6 +713,21 @@ static int32_t vesc__s32(uint32_t v)
 }
 #endif
 
+#if VESC_ENABLE_DECODE
+/* n bytes from src to dst: a loop, kept one (newlib's memcpy is 142 B of flash on Cortex-M0+; GCC would call it). */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("no-tree-loop-distribute-patterns")))
+#endif
+static void vesc__copy(void *dst, const uint8_t *src, size_t n)
+{
+    uint8_t *d = (uint8_t *)dst;
+    size_t i;
+    for (i = 0u; i < n; i++) {
+        d[i] = src[i];
+    }
+}
+#endif
+
 #if VESC_ENABLE_ENCODE || VESC_ENABLE_DECODE
 /* Strict UTF-8 (as Python's bytes.decode): no overlong forms, no surrogates, nothing past U+10FFFF. */
 static int vesc__utf8(const uint8_t *s, size_t n)
@@ -1190,14 +1205,14 @@ static int vesc__dec_fw_version_response(const uint8_t *c, size_t n, vesc_fw_ver
     len = k - o;
     if (len > sizeof(m->hw_name) - 1u) { return VESC_E_CAPACITY; }
     if (!vesc__utf8(c + o, len)) { return VESC_E_CONTENT; }
-    memcpy(m->hw_name, c + o, len);
+    vesc__copy(m->hw_name, c + o, len);
     m->hw_name[len] = '\0';
     m->hw_name_len = len;
     o += len + 1u;
     /* uuid: The STM32's 96-bit unique id (plus 1 for a second motor). */
     len = 12u;
     if (n - o < len) { return VESC_E_LENGTH; }
-    memcpy(m->uuid, c + o, len);
+    vesc__copy(m->uuid, c + o, len);
     o += len;
     /* pairing_done: 1 once NRF pairing is done. */
     if (n - o < 1u) { return VESC_E_LENGTH; }
@@ -1237,7 +1252,7 @@ static int vesc__dec_fw_version_response(const uint8_t *c, size_t n, vesc_fw_ver
     len = k - o;
     if (len > sizeof(m->fw_name) - 1u) { return VESC_E_CAPACITY; }
     if (!vesc__utf8(c + o, len)) { return VESC_E_CONTENT; }
-    memcpy(m->fw_name, c + o, len);
+    vesc__copy(m->fw_name, c + o, len);
     m->fw_name[len] = '\0';
     m->fw_name_len = len;
     o += len + 1u;
@@ -1470,7 +1485,7 @@ static int vesc__dec_print_response(const uint8_t *c, size_t n, vesc_print_respo
     if (n - o < len) { return VESC_E_LENGTH; }
     if (len > sizeof(m->text) - 1u) { return VESC_E_CAPACITY; }
     if (!vesc__utf8(c + o, len)) { return VESC_E_CONTENT; }
-    memcpy(m->text, c + o, len);
+    vesc__copy(m->text, c + o, len);
     m->text[len] = '\0';
     m->text_len = len;
     o += len;
@@ -1520,7 +1535,7 @@ static int vesc__dec_forward_can_request(const uint8_t *c, size_t n, vesc_forwar
     len = n - o;
     if (n - o < len) { return VESC_E_LENGTH; }
     if (len > sizeof(m->payload)) { return VESC_E_CAPACITY; }
-    memcpy(m->payload, c + o, len);
+    vesc__copy(m->payload, c + o, len);
     m->payload_len = len;
     o += len;
     if (o != n) { return VESC_E_LENGTH; }

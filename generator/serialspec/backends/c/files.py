@@ -1417,6 +1417,24 @@ static int{bits}_t {p}__s{bits}(uint32_t v)
 #endif
 """
             )
+    if "copy" in ctx.helpers:
+        parts.append(
+            f"""#if {P}_ENABLE_DECODE
+/* n bytes from src to dst: a loop, kept one (newlib's memcpy is 142 B of flash on Cortex-M0+; GCC would call it). */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("no-tree-loop-distribute-patterns")))
+#endif
+static void {p}__copy(void *dst, const uint8_t *src, size_t n)
+{{
+    uint8_t *d = (uint8_t *)dst;
+    size_t i;
+    for (i = 0u; i < n; i++) {{
+        d[i] = src[i];
+    }}
+}}
+#endif
+"""
+        )
     if "sm" in ctx.helpers:
         parts.append(
             f"""#if {P}_ENABLE_DECODE

@@ -181,10 +181,11 @@ def throughput() -> Table:
         "clean: the spec's request examples end to end; corrupt: every 10th frame with a byte changed; adversarial: "
         "the first header byte repeated.",
         "The generated parser takes a whole frame at once when it holds no byte and no other header lies inside the "
-        "frame; otherwise it rescans the bytes it holds at every byte, up to the first candidate too short for any "
-        "layout to judge (the Python parser's results, byte for byte, however the stream is cut: corrupt and "
-        "adversarial streams go that way); the hand-written one does not rescan, and loses the frames a stray header "
-        "hides.",
+        "frame; otherwise it holds the bytes and rescans them only when a held candidate can be judged (its prefix or "
+        "its size reached) or a header comes, up to the first candidate too short for any layout to judge (the Python "
+        "parser's results, byte for byte, however the stream is cut: corrupt and adversarial streams go that way; "
+        "the adversarial stream is a header at every byte, so it rescans at every byte); the hand-written one does "
+        "not rescan, and loses the frames a stray header hides.",
     ]
     header = ["protocol", "stream", "generated C (MB/s)", "hand-written C (MB/s)", "Python (MB/s)", "generated ÷ hand"]
     return Table("C target: parse throughput on this host", header, rows, notes)

@@ -679,6 +679,21 @@ static int32_t fashionstar_uart__s32(uint32_t v)
 }
 #endif
 
+#if FASHIONSTAR_UART_ENABLE_DECODE
+/* n bytes from src to dst: a loop, kept one (newlib's memcpy is 142 B of flash on Cortex-M0+; GCC would call it). */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("no-tree-loop-distribute-patterns")))
+#endif
+static void fashionstar_uart__copy(void *dst, const uint8_t *src, size_t n)
+{
+    uint8_t *d = (uint8_t *)dst;
+    size_t i;
+    for (i = 0u; i < n; i++) {
+        d[i] = src[i];
+    }
+}
+#endif
+
 #if FASHIONSTAR_UART_ENABLE_PARSER && (FASHIONSTAR_UART__STUFFED || !FASHIONSTAR_UART__LENGTHS)
 /* Frames without a length: the content size from its own leading fields, by code (WAIT: those have not come). */
 static long fashionstar_uart__content_size(fashionstar_uart_direction_t dir, long code, const uint8_t *c, size_t avail)
@@ -2304,7 +2319,7 @@ static int fashionstar_uart__dec_sync_command_request(const uint8_t *c, size_t n
         len = (size_t)d1_block_size;
         if (n - o < len) { return FASHIONSTAR_UART_E_LENGTH; }
         if (len > sizeof(m->blocks[i1].content)) { return FASHIONSTAR_UART_E_CAPACITY; }
-        memcpy(m->blocks[i1].content, c + o, len);
+        fashionstar_uart__copy(m->blocks[i1].content, c + o, len);
         m->blocks[i1].content_len = len;
         o += len;
     }
@@ -4398,35 +4413,32 @@ void fashionstar_uart_parser_init(fashionstar_uart_parser_t *parser, fashionstar
     parser->dir = dir;
 }
 
-/* The candidate at pos: accepted (its size in *size, its message in out), waiting, no frame, or corrupt. */
+/* The candidate at pos: accepted (its size in *size, its message in out), waiting (in *size the bytes it needs
+ * before it can be judged again, 0 when that is not known), no frame, or corrupt. */
 static int fashionstar_uart__try(fashionstar_uart_parser_t *p, size_t pos, fashionstar_uart_msg_t *out, size_t *size)
 {
     uint8_t count = fashionstar_uart__count(p->dir), k;
-    int waiting = 0;
+    size_t need = (size_t)-1; /* the fewest bytes a waiting layout needs: (size_t)-1 none waits, 0 not known */
     if (p->verdict[pos] != 0u) {
         return p->verdict[pos];
     }
-    if (pos == 0u && p->first > p->n) { /* its size is known and its bytes have not all come */
-        return FASHIONSTAR_UART__V_WAIT;
-    }
     for (k = 0u; k < count; k++) {
         long s = fashionstar_uart__probe_at(p->dir, k, p->buf + pos, p->n - pos);
-        if (pos == 0u && count == 1u && s > 0) {
-            p->first = (size_t)s;
-        }
         if (s == FASHIONSTAR_UART__WAIT) {
-            waiting = 1;
+            need = 0u;
             continue;
         }
         if (s < 0 || (unsigned long)s > FASHIONSTAR_UART_MAX_FRAME) {
             continue;
         }
         if ((size_t)s > p->n - pos) {
-            waiting = 1;
+            if ((size_t)s < need) {
+                need = (size_t)s;
+            }
             continue;
         }
         if (fashionstar_uart_decode(p->buf + pos, (size_t)s, p->dir, out) != FASHIONSTAR_UART_OK) {
-            if (!waiting) {
+            if (need == (size_t)-1) {
                 p->verdict[pos] = FASHIONSTAR_UART__V_CORRUPT;
             }
             return FASHIONSTAR_UART__V_CORRUPT;
@@ -4434,7 +4446,8 @@ static int fashionstar_uart__try(fashionstar_uart_parser_t *p, size_t pos, fashi
         *size = (size_t)s;
         return FASHIONSTAR_UART__ACCEPT;
     }
-    if (waiting) {
+    if (need != (size_t)-1) {
+        *size = need;
         return FASHIONSTAR_UART__V_WAIT;
     }
     p->verdict[pos] = FASHIONSTAR_UART__V_NONE;
@@ -4501,20 +4514,42 @@ static void fashionstar_uart__drop(fashionstar_uart_parser_t *p, size_t cut)
     p->n -= cut;
 }
 
-/* One byte in: the Python parser's scan over the bytes held, each candidate's verdict kept once final. */
+#if FASHIONSTAR_UART__HEADERS
+/* 1 when the bytes held end with a header of any layout (a candidate begins). */
+static int fashionstar_uart__ends_header(const fashionstar_uart_parser_t *p)
+{
+    uint8_t count = fashionstar_uart__count(p->dir), k;
+    for (k = 0u; k < count; k++) {
+        size_t hl;
+        const uint8_t *h = fashionstar_uart__header(p->dir, k, &hl);
+        if (hl <= p->n && fashionstar_uart__same(p->buf + p->n - hl, h, hl)) {
+            return 1;
+        }
+    }
+    return 0;
+}
+#endif
+
+/* One byte in: the Python parser's scan over the bytes held, each candidate's verdict kept once final. While a
+ * candidate waits, the scan is left out until one held can be judged (p->wake bytes held) or a header comes: nothing
+ * the scan decides could change before then. */
 static int fashionstar_uart__push(fashionstar_uart_parser_t *p, uint8_t byte, fashionstar_uart_msg_t *out)
 {
-    size_t start = 0u, done = 0u, pos, size = 0u, cut, hold = (size_t)-1;
-    uint32_t deferred = 0u;
+    size_t start = 0u, done = 0u, pos, size = 0u, cut, hold = (size_t)-1, wake = (size_t)-1;
     int got = 0, r;
     if (p->n >= FASHIONSTAR_UART_MAX_FRAME) { /* only a candidate longer than FASHIONSTAR_UART_MAX_FRAME can fill it: drop its first byte */
         fashionstar_uart__drop(p, 1u);
         p->garbage++;
-        p->first = 0u;
+        p->wake = 0u;
     }
     p->buf[p->n] = byte;
     p->verdict[p->n] = 0u;
     p->n++;
+#if FASHIONSTAR_UART__HEADERS
+    if (p->n < p->wake && !fashionstar_uart__ends_header(p)) {
+        return 0;
+    }
+#endif
     while (start < p->n) {
         pos = fashionstar_uart__next(p, start);
         if (pos >= p->n) {
@@ -4524,6 +4559,9 @@ static int fashionstar_uart__push(fashionstar_uart_parser_t *p, uint8_t byte, fa
             if (hold == (size_t)-1) {
                 hold = pos;
             }
+            if (pos + fashionstar_uart__least(p->dir) < wake) {
+                wake = pos + fashionstar_uart__least(p->dir);
+            }
             break;
         }
         r = fashionstar_uart__try(p, pos, out, &size);
@@ -4531,16 +4569,21 @@ static int fashionstar_uart__push(fashionstar_uart_parser_t *p, uint8_t byte, fa
             if (hold == (size_t)-1) {
                 hold = pos;
             }
+            if (size == 0u) {
+                wake = 0u;
+            } else if (pos + size < wake) {
+                wake = pos + size;
+            }
         } else if (r == FASHIONSTAR_UART__V_CORRUPT) {
             if (hold == (size_t)-1) {
                 p->errors++;
-            } else {
-                deferred++;
+            }
+            if (p->verdict[pos] == 0u) { /* corrupt as one layout, while another waits: judged again */
+                wake = 0u;
             }
         } else if (r == FASHIONSTAR_UART__ACCEPT) {
             p->garbage += (uint32_t)(pos - done);
             hold = (size_t)-1;
-            deferred = 0u;
             start = done = pos + size;
             got = 1;
             p->frames++;
@@ -4548,9 +4591,12 @@ static int fashionstar_uart__push(fashionstar_uart_parser_t *p, uint8_t byte, fa
         }
         start = pos + 1u;
     }
-    (void)deferred;
+    p->wake = 0u;
     if (hold != (size_t)-1) {
         cut = hold;
+        if (wake != 0u) {
+            p->wake = wake - cut;
+        }
     } else if (FASHIONSTAR_UART__HEADERS && !got) {
         cut = p->n > FASHIONSTAR_UART__KEEP ? p->n - FASHIONSTAR_UART__KEEP : 0u;
         if (cut < done) {
@@ -4562,7 +4608,6 @@ static int fashionstar_uart__push(fashionstar_uart_parser_t *p, uint8_t byte, fa
     p->garbage += (uint32_t)(cut - done);
     if (cut > 0u) {
         fashionstar_uart__drop(p, cut);
-        p->first = 0u;
     }
     return got;
 }

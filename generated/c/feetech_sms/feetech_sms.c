@@ -659,6 +659,20 @@ static const feetech_sms__layout_t *const *feetech_sms__layouts(feetech_sms_dire
 #endif
 #endif
 
+#if FEETECH_SMS_ENABLE_DECODE
+/* n bytes from src to dst: a loop, kept one (newlib's memcpy is 142 B of flash on Cortex-M0+; GCC would call it). */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("no-tree-loop-distribute-patterns")))
+#endif
+static void feetech_sms__copy(void *dst, const uint8_t *src, size_t n)
+{
+    uint8_t *d = (uint8_t *)dst;
+    size_t i;
+    for (i = 0u; i < n; i++) {
+        d[i] = src[i];
+    }
+}
+#endif
 
 #if FEETECH_SMS_ENABLE_PARSER && (FEETECH_SMS__STUFFED || !FEETECH_SMS__LENGTHS)
 /* Frames without a length: the content size from its own leading fields, by code (WAIT: those have not come). */
@@ -992,7 +1006,7 @@ static int feetech_sms__dec_write_request(const uint8_t *c, size_t n, feetech_sm
     len = n - o;
     if (n - o < len) { return FEETECH_SMS_E_LENGTH; }
     if (len > sizeof(m->data)) { return FEETECH_SMS_E_CAPACITY; }
-    memcpy(m->data, c + o, len);
+    feetech_sms__copy(m->data, c + o, len);
     m->data_len = len;
     o += len;
     if (o != n) { return FEETECH_SMS_E_LENGTH; }
@@ -1015,7 +1029,7 @@ static int feetech_sms__dec_reg_write_request(const uint8_t *c, size_t n, feetec
     len = n - o;
     if (n - o < len) { return FEETECH_SMS_E_LENGTH; }
     if (len > sizeof(m->data)) { return FEETECH_SMS_E_CAPACITY; }
-    memcpy(m->data, c + o, len);
+    feetech_sms__copy(m->data, c + o, len);
     m->data_len = len;
     o += len;
     if (o != n) { return FEETECH_SMS_E_LENGTH; }
@@ -1104,7 +1118,7 @@ static int feetech_sms__dec_sync_write_request(const uint8_t *c, size_t n, feete
         len = (size_t)d1_data_length;
         if (n - o < len) { return FEETECH_SMS_E_LENGTH; }
         if (len > sizeof(m->servos[i1].data)) { return FEETECH_SMS_E_CAPACITY; }
-        memcpy(m->servos[i1].data, c + o, len);
+        feetech_sms__copy(m->servos[i1].data, c + o, len);
         m->servos[i1].data_len = len;
         o += len;
         m->servos_count = i1 + 1u;
@@ -1125,7 +1139,7 @@ static int feetech_sms__dec_reply_response(const uint8_t *c, size_t n, feetech_s
     len = n - o;
     if (n - o < len) { return FEETECH_SMS_E_LENGTH; }
     if (len > sizeof(m->data)) { return FEETECH_SMS_E_CAPACITY; }
-    memcpy(m->data, c + o, len);
+    feetech_sms__copy(m->data, c + o, len);
     m->data_len = len;
     o += len;
     if (o != n) { return FEETECH_SMS_E_LENGTH; }
@@ -1606,35 +1620,32 @@ void feetech_sms_parser_init(feetech_sms_parser_t *parser, feetech_sms_direction
     parser->dir = dir;
 }
 
-/* The candidate at pos: accepted (its size in *size, its message in out), waiting, no frame, or corrupt. */
+/* The candidate at pos: accepted (its size in *size, its message in out), waiting (in *size the bytes it needs
+ * before it can be judged again, 0 when that is not known), no frame, or corrupt. */
 static int feetech_sms__try(feetech_sms_parser_t *p, size_t pos, feetech_sms_msg_t *out, size_t *size)
 {
     uint8_t count = feetech_sms__count(p->dir), k;
-    int waiting = 0;
+    size_t need = (size_t)-1; /* the fewest bytes a waiting layout needs: (size_t)-1 none waits, 0 not known */
     if (p->verdict[pos] != 0u) {
         return p->verdict[pos];
     }
-    if (pos == 0u && p->first > p->n) { /* its size is known and its bytes have not all come */
-        return FEETECH_SMS__V_WAIT;
-    }
     for (k = 0u; k < count; k++) {
         long s = feetech_sms__probe_at(p->dir, k, p->buf + pos, p->n - pos);
-        if (pos == 0u && count == 1u && s > 0) {
-            p->first = (size_t)s;
-        }
         if (s == FEETECH_SMS__WAIT) {
-            waiting = 1;
+            need = 0u;
             continue;
         }
         if (s < 0 || (unsigned long)s > FEETECH_SMS_MAX_FRAME) {
             continue;
         }
         if ((size_t)s > p->n - pos) {
-            waiting = 1;
+            if ((size_t)s < need) {
+                need = (size_t)s;
+            }
             continue;
         }
         if (feetech_sms_decode(p->buf + pos, (size_t)s, p->dir, out) != FEETECH_SMS_OK) {
-            if (!waiting) {
+            if (need == (size_t)-1) {
                 p->verdict[pos] = FEETECH_SMS__V_CORRUPT;
             }
             return FEETECH_SMS__V_CORRUPT;
@@ -1642,7 +1653,8 @@ static int feetech_sms__try(feetech_sms_parser_t *p, size_t pos, feetech_sms_msg
         *size = (size_t)s;
         return FEETECH_SMS__ACCEPT;
     }
-    if (waiting) {
+    if (need != (size_t)-1) {
+        *size = need;
         return FEETECH_SMS__V_WAIT;
     }
     p->verdict[pos] = FEETECH_SMS__V_NONE;
@@ -1709,20 +1721,42 @@ static void feetech_sms__drop(feetech_sms_parser_t *p, size_t cut)
     p->n -= cut;
 }
 
-/* One byte in: the Python parser's scan over the bytes held, each candidate's verdict kept once final. */
+#if FEETECH_SMS__HEADERS
+/* 1 when the bytes held end with a header of any layout (a candidate begins). */
+static int feetech_sms__ends_header(const feetech_sms_parser_t *p)
+{
+    uint8_t count = feetech_sms__count(p->dir), k;
+    for (k = 0u; k < count; k++) {
+        size_t hl;
+        const uint8_t *h = feetech_sms__header(p->dir, k, &hl);
+        if (hl <= p->n && feetech_sms__same(p->buf + p->n - hl, h, hl)) {
+            return 1;
+        }
+    }
+    return 0;
+}
+#endif
+
+/* One byte in: the Python parser's scan over the bytes held, each candidate's verdict kept once final. While a
+ * candidate waits, the scan is left out until one held can be judged (p->wake bytes held) or a header comes: nothing
+ * the scan decides could change before then. */
 static int feetech_sms__push(feetech_sms_parser_t *p, uint8_t byte, feetech_sms_msg_t *out)
 {
-    size_t start = 0u, done = 0u, pos, size = 0u, cut, hold = (size_t)-1;
-    uint32_t deferred = 0u;
+    size_t start = 0u, done = 0u, pos, size = 0u, cut, hold = (size_t)-1, wake = (size_t)-1;
     int got = 0, r;
     if (p->n >= FEETECH_SMS_MAX_FRAME) { /* only a candidate longer than FEETECH_SMS_MAX_FRAME can fill it: drop its first byte */
         feetech_sms__drop(p, 1u);
         p->garbage++;
-        p->first = 0u;
+        p->wake = 0u;
     }
     p->buf[p->n] = byte;
     p->verdict[p->n] = 0u;
     p->n++;
+#if FEETECH_SMS__HEADERS
+    if (p->n < p->wake && !feetech_sms__ends_header(p)) {
+        return 0;
+    }
+#endif
     while (start < p->n) {
         pos = feetech_sms__next(p, start);
         if (pos >= p->n) {
@@ -1732,6 +1766,9 @@ static int feetech_sms__push(feetech_sms_parser_t *p, uint8_t byte, feetech_sms_
             if (hold == (size_t)-1) {
                 hold = pos;
             }
+            if (pos + feetech_sms__least(p->dir) < wake) {
+                wake = pos + feetech_sms__least(p->dir);
+            }
             break;
         }
         r = feetech_sms__try(p, pos, out, &size);
@@ -1739,16 +1776,21 @@ static int feetech_sms__push(feetech_sms_parser_t *p, uint8_t byte, feetech_sms_
             if (hold == (size_t)-1) {
                 hold = pos;
             }
+            if (size == 0u) {
+                wake = 0u;
+            } else if (pos + size < wake) {
+                wake = pos + size;
+            }
         } else if (r == FEETECH_SMS__V_CORRUPT) {
             if (hold == (size_t)-1) {
                 p->errors++;
-            } else {
-                deferred++;
+            }
+            if (p->verdict[pos] == 0u) { /* corrupt as one layout, while another waits: judged again */
+                wake = 0u;
             }
         } else if (r == FEETECH_SMS__ACCEPT) {
             p->garbage += (uint32_t)(pos - done);
             hold = (size_t)-1;
-            deferred = 0u;
             start = done = pos + size;
             got = 1;
             p->frames++;
@@ -1756,9 +1798,12 @@ static int feetech_sms__push(feetech_sms_parser_t *p, uint8_t byte, feetech_sms_
         }
         start = pos + 1u;
     }
-    (void)deferred;
+    p->wake = 0u;
     if (hold != (size_t)-1) {
         cut = hold;
+        if (wake != 0u) {
+            p->wake = wake - cut;
+        }
     } else if (FEETECH_SMS__HEADERS && !got) {
         cut = p->n > FEETECH_SMS__KEEP ? p->n - FEETECH_SMS__KEEP : 0u;
         if (cut < done) {
@@ -1770,7 +1815,6 @@ static int feetech_sms__push(feetech_sms_parser_t *p, uint8_t byte, feetech_sms_
     p->garbage += (uint32_t)(cut - done);
     if (cut > 0u) {
         feetech_sms__drop(p, cut);
-        p->first = 0u;
     }
     return got;
 }

@@ -684,6 +684,21 @@ static int16_t hiwonder_rrc__s16(uint32_t v)
 #endif
 
 #if HIWONDER_RRC_ENABLE_DECODE
+/* n bytes from src to dst: a loop, kept one (newlib's memcpy is 142 B of flash on Cortex-M0+; GCC would call it). */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("no-tree-loop-distribute-patterns")))
+#endif
+static void hiwonder_rrc__copy(void *dst, const uint8_t *src, size_t n)
+{
+    uint8_t *d = (uint8_t *)dst;
+    size_t i;
+    for (i = 0u; i < n; i++) {
+        d[i] = src[i];
+    }
+}
+#endif
+
+#if HIWONDER_RRC_ENABLE_DECODE
 static float hiwonder_rrc__f32(uint32_t bits)
 {
     float f;
@@ -2192,7 +2207,7 @@ static int hiwonder_rrc__dec_oled_request(const uint8_t *c, size_t n, hiwonder_r
     len = (size_t)d1_length;
     if (n - o < len) { return HIWONDER_RRC_E_LENGTH; }
     if (len > sizeof(m->text)) { return HIWONDER_RRC_E_CAPACITY; }
-    memcpy(m->text, c + o, len);
+    hiwonder_rrc__copy(m->text, c + o, len);
     m->text_len = len;
     o += len;
     if (o != n) { return HIWONDER_RRC_E_LENGTH; }
@@ -4286,35 +4301,32 @@ void hiwonder_rrc_parser_init(hiwonder_rrc_parser_t *parser, hiwonder_rrc_direct
     parser->dir = dir;
 }
 
-/* The candidate at pos: accepted (its size in *size, its message in out), waiting, no frame, or corrupt. */
+/* The candidate at pos: accepted (its size in *size, its message in out), waiting (in *size the bytes it needs
+ * before it can be judged again, 0 when that is not known), no frame, or corrupt. */
 static int hiwonder_rrc__try(hiwonder_rrc_parser_t *p, size_t pos, hiwonder_rrc_msg_t *out, size_t *size)
 {
     uint8_t count = hiwonder_rrc__count(p->dir), k;
-    int waiting = 0;
+    size_t need = (size_t)-1; /* the fewest bytes a waiting layout needs: (size_t)-1 none waits, 0 not known */
     if (p->verdict[pos] != 0u) {
         return p->verdict[pos];
     }
-    if (pos == 0u && p->first > p->n) { /* its size is known and its bytes have not all come */
-        return HIWONDER_RRC__V_WAIT;
-    }
     for (k = 0u; k < count; k++) {
         long s = hiwonder_rrc__probe_at(p->dir, k, p->buf + pos, p->n - pos);
-        if (pos == 0u && count == 1u && s > 0) {
-            p->first = (size_t)s;
-        }
         if (s == HIWONDER_RRC__WAIT) {
-            waiting = 1;
+            need = 0u;
             continue;
         }
         if (s < 0 || (unsigned long)s > HIWONDER_RRC_MAX_FRAME) {
             continue;
         }
         if ((size_t)s > p->n - pos) {
-            waiting = 1;
+            if ((size_t)s < need) {
+                need = (size_t)s;
+            }
             continue;
         }
         if (hiwonder_rrc_decode(p->buf + pos, (size_t)s, p->dir, out) != HIWONDER_RRC_OK) {
-            if (!waiting) {
+            if (need == (size_t)-1) {
                 p->verdict[pos] = HIWONDER_RRC__V_CORRUPT;
             }
             return HIWONDER_RRC__V_CORRUPT;
@@ -4322,7 +4334,8 @@ static int hiwonder_rrc__try(hiwonder_rrc_parser_t *p, size_t pos, hiwonder_rrc_
         *size = (size_t)s;
         return HIWONDER_RRC__ACCEPT;
     }
-    if (waiting) {
+    if (need != (size_t)-1) {
+        *size = need;
         return HIWONDER_RRC__V_WAIT;
     }
     p->verdict[pos] = HIWONDER_RRC__V_NONE;
@@ -4389,20 +4402,42 @@ static void hiwonder_rrc__drop(hiwonder_rrc_parser_t *p, size_t cut)
     p->n -= cut;
 }
 
-/* One byte in: the Python parser's scan over the bytes held, each candidate's verdict kept once final. */
+#if HIWONDER_RRC__HEADERS
+/* 1 when the bytes held end with a header of any layout (a candidate begins). */
+static int hiwonder_rrc__ends_header(const hiwonder_rrc_parser_t *p)
+{
+    uint8_t count = hiwonder_rrc__count(p->dir), k;
+    for (k = 0u; k < count; k++) {
+        size_t hl;
+        const uint8_t *h = hiwonder_rrc__header(p->dir, k, &hl);
+        if (hl <= p->n && hiwonder_rrc__same(p->buf + p->n - hl, h, hl)) {
+            return 1;
+        }
+    }
+    return 0;
+}
+#endif
+
+/* One byte in: the Python parser's scan over the bytes held, each candidate's verdict kept once final. While a
+ * candidate waits, the scan is left out until one held can be judged (p->wake bytes held) or a header comes: nothing
+ * the scan decides could change before then. */
 static int hiwonder_rrc__push(hiwonder_rrc_parser_t *p, uint8_t byte, hiwonder_rrc_msg_t *out)
 {
-    size_t start = 0u, done = 0u, pos, size = 0u, cut, hold = (size_t)-1;
-    uint32_t deferred = 0u;
+    size_t start = 0u, done = 0u, pos, size = 0u, cut, hold = (size_t)-1, wake = (size_t)-1;
     int got = 0, r;
     if (p->n >= HIWONDER_RRC_MAX_FRAME) { /* only a candidate longer than HIWONDER_RRC_MAX_FRAME can fill it: drop its first byte */
         hiwonder_rrc__drop(p, 1u);
         p->garbage++;
-        p->first = 0u;
+        p->wake = 0u;
     }
     p->buf[p->n] = byte;
     p->verdict[p->n] = 0u;
     p->n++;
+#if HIWONDER_RRC__HEADERS
+    if (p->n < p->wake && !hiwonder_rrc__ends_header(p)) {
+        return 0;
+    }
+#endif
     while (start < p->n) {
         pos = hiwonder_rrc__next(p, start);
         if (pos >= p->n) {
@@ -4412,6 +4447,9 @@ static int hiwonder_rrc__push(hiwonder_rrc_parser_t *p, uint8_t byte, hiwonder_r
             if (hold == (size_t)-1) {
                 hold = pos;
             }
+            if (pos + hiwonder_rrc__least(p->dir) < wake) {
+                wake = pos + hiwonder_rrc__least(p->dir);
+            }
             break;
         }
         r = hiwonder_rrc__try(p, pos, out, &size);
@@ -4419,16 +4457,21 @@ static int hiwonder_rrc__push(hiwonder_rrc_parser_t *p, uint8_t byte, hiwonder_r
             if (hold == (size_t)-1) {
                 hold = pos;
             }
+            if (size == 0u) {
+                wake = 0u;
+            } else if (pos + size < wake) {
+                wake = pos + size;
+            }
         } else if (r == HIWONDER_RRC__V_CORRUPT) {
             if (hold == (size_t)-1) {
                 p->errors++;
-            } else {
-                deferred++;
+            }
+            if (p->verdict[pos] == 0u) { /* corrupt as one layout, while another waits: judged again */
+                wake = 0u;
             }
         } else if (r == HIWONDER_RRC__ACCEPT) {
             p->garbage += (uint32_t)(pos - done);
             hold = (size_t)-1;
-            deferred = 0u;
             start = done = pos + size;
             got = 1;
             p->frames++;
@@ -4436,9 +4479,12 @@ static int hiwonder_rrc__push(hiwonder_rrc_parser_t *p, uint8_t byte, hiwonder_r
         }
         start = pos + 1u;
     }
-    (void)deferred;
+    p->wake = 0u;
     if (hold != (size_t)-1) {
         cut = hold;
+        if (wake != 0u) {
+            p->wake = wake - cut;
+        }
     } else if (HIWONDER_RRC__HEADERS && !got) {
         cut = p->n > HIWONDER_RRC__KEEP ? p->n - HIWONDER_RRC__KEEP : 0u;
         if (cut < done) {
@@ -4450,7 +4496,6 @@ static int hiwonder_rrc__push(hiwonder_rrc_parser_t *p, uint8_t byte, hiwonder_r
     p->garbage += (uint32_t)(cut - done);
     if (cut > 0u) {
         hiwonder_rrc__drop(p, cut);
-        p->first = 0u;
     }
     return got;
 }

@@ -657,6 +657,20 @@ static const modbus_rtu__layout_t *const *modbus_rtu__layouts(modbus_rtu_directi
 #endif
 #endif
 
+#if MODBUS_RTU_ENABLE_DECODE
+/* n bytes from src to dst: a loop, kept one (newlib's memcpy is 142 B of flash on Cortex-M0+; GCC would call it). */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("no-tree-loop-distribute-patterns")))
+#endif
+static void modbus_rtu__copy(void *dst, const uint8_t *src, size_t n)
+{
+    uint8_t *d = (uint8_t *)dst;
+    size_t i;
+    for (i = 0u; i < n; i++) {
+        d[i] = src[i];
+    }
+}
+#endif
 
 #if MODBUS_RTU_ENABLE_PARSER && (MODBUS_RTU__STUFFED || !MODBUS_RTU__LENGTHS)
 /* Frames without a length: the content size from its own leading fields, by code (WAIT: those have not come). */
@@ -1044,7 +1058,7 @@ static int modbus_rtu__dec_read_coils_response(const uint8_t *c, size_t n, modbu
     if (n - o < len) { return MODBUS_RTU_E_LENGTH; }
     m->coils_count = len * 8u;
     if (len > sizeof(m->coils)) { return MODBUS_RTU_E_CAPACITY; }
-    memcpy(m->coils, c + o, len);
+    modbus_rtu__copy(m->coils, c + o, len);
     o += len;
     if (o != n) { return MODBUS_RTU_E_LENGTH; }
     if ((int64_t)d1_byte_count != (((int64_t)m->coils_count + (int64_t)8 - 1) / (int64_t)8)) { return MODBUS_RTU_E_CONTENT; } /* byte_count */
@@ -1088,7 +1102,7 @@ static int modbus_rtu__dec_read_discrete_inputs_response(const uint8_t *c, size_
     if (n - o < len) { return MODBUS_RTU_E_LENGTH; }
     m->inputs_count = len * 8u;
     if (len > sizeof(m->inputs)) { return MODBUS_RTU_E_CAPACITY; }
-    memcpy(m->inputs, c + o, len);
+    modbus_rtu__copy(m->inputs, c + o, len);
     o += len;
     if (o != n) { return MODBUS_RTU_E_LENGTH; }
     if ((int64_t)d1_byte_count != (((int64_t)m->inputs_count + (int64_t)8 - 1) / (int64_t)8)) { return MODBUS_RTU_E_CONTENT; } /* byte_count */
@@ -1294,7 +1308,7 @@ static int modbus_rtu__dec_write_coils_request(const uint8_t *c, size_t n, modbu
     len = (m->values_count + 7u) / 8u;
     if (n - o < len) { return MODBUS_RTU_E_LENGTH; }
     if (len > sizeof(m->values)) { return MODBUS_RTU_E_CAPACITY; }
-    memcpy(m->values, c + o, len);
+    modbus_rtu__copy(m->values, c + o, len);
     o += len;
     if (o != n) { return MODBUS_RTU_E_LENGTH; }
     if ((int64_t)d1_count != (int64_t)m->values_count) { return MODBUS_RTU_E_CONTENT; } /* count */
@@ -2500,35 +2514,32 @@ void modbus_rtu_parser_init(modbus_rtu_parser_t *parser, modbus_rtu_direction_t 
     parser->dir = dir;
 }
 
-/* The candidate at pos: accepted (its size in *size, its message in out), waiting, no frame, or corrupt. */
+/* The candidate at pos: accepted (its size in *size, its message in out), waiting (in *size the bytes it needs
+ * before it can be judged again, 0 when that is not known), no frame, or corrupt. */
 static int modbus_rtu__try(modbus_rtu_parser_t *p, size_t pos, modbus_rtu_msg_t *out, size_t *size)
 {
     uint8_t count = modbus_rtu__count(p->dir), k;
-    int waiting = 0;
+    size_t need = (size_t)-1; /* the fewest bytes a waiting layout needs: (size_t)-1 none waits, 0 not known */
     if (p->verdict[pos] != 0u) {
         return p->verdict[pos];
     }
-    if (pos == 0u && p->first > p->n) { /* its size is known and its bytes have not all come */
-        return MODBUS_RTU__V_WAIT;
-    }
     for (k = 0u; k < count; k++) {
         long s = modbus_rtu__probe_at(p->dir, k, p->buf + pos, p->n - pos);
-        if (pos == 0u && count == 1u && s > 0) {
-            p->first = (size_t)s;
-        }
         if (s == MODBUS_RTU__WAIT) {
-            waiting = 1;
+            need = 0u;
             continue;
         }
         if (s < 0 || (unsigned long)s > MODBUS_RTU_MAX_FRAME) {
             continue;
         }
         if ((size_t)s > p->n - pos) {
-            waiting = 1;
+            if ((size_t)s < need) {
+                need = (size_t)s;
+            }
             continue;
         }
         if (modbus_rtu_decode(p->buf + pos, (size_t)s, p->dir, out) != MODBUS_RTU_OK) {
-            if (!waiting) {
+            if (need == (size_t)-1) {
                 p->verdict[pos] = MODBUS_RTU__V_CORRUPT;
             }
             return MODBUS_RTU__V_CORRUPT;
@@ -2536,7 +2547,8 @@ static int modbus_rtu__try(modbus_rtu_parser_t *p, size_t pos, modbus_rtu_msg_t 
         *size = (size_t)s;
         return MODBUS_RTU__ACCEPT;
     }
-    if (waiting) {
+    if (need != (size_t)-1) {
+        *size = need;
         return MODBUS_RTU__V_WAIT;
     }
     p->verdict[pos] = MODBUS_RTU__V_NONE;
@@ -2590,20 +2602,42 @@ static void modbus_rtu__drop(modbus_rtu_parser_t *p, size_t cut)
     p->n -= cut;
 }
 
-/* One byte in: the Python parser's scan over the bytes held, each candidate's verdict kept once final. */
+#if MODBUS_RTU__HEADERS
+/* 1 when the bytes held end with a header of any layout (a candidate begins). */
+static int modbus_rtu__ends_header(const modbus_rtu_parser_t *p)
+{
+    uint8_t count = modbus_rtu__count(p->dir), k;
+    for (k = 0u; k < count; k++) {
+        size_t hl;
+        const uint8_t *h = modbus_rtu__header(p->dir, k, &hl);
+        if (hl <= p->n && modbus_rtu__same(p->buf + p->n - hl, h, hl)) {
+            return 1;
+        }
+    }
+    return 0;
+}
+#endif
+
+/* One byte in: the Python parser's scan over the bytes held, each candidate's verdict kept once final. While a
+ * candidate waits, the scan is left out until one held can be judged (p->wake bytes held) or a header comes: nothing
+ * the scan decides could change before then. */
 static int modbus_rtu__push(modbus_rtu_parser_t *p, uint8_t byte, modbus_rtu_msg_t *out)
 {
-    size_t start = 0u, done = 0u, pos, size = 0u, cut, hold = (size_t)-1;
-    uint32_t deferred = 0u;
+    size_t start = 0u, done = 0u, pos, size = 0u, cut, hold = (size_t)-1, wake = (size_t)-1;
     int got = 0, r;
     if (p->n >= MODBUS_RTU_MAX_FRAME) { /* only a candidate longer than MODBUS_RTU_MAX_FRAME can fill it: drop its first byte */
         modbus_rtu__drop(p, 1u);
         p->garbage++;
-        p->first = 0u;
+        p->wake = 0u;
     }
     p->buf[p->n] = byte;
     p->verdict[p->n] = 0u;
     p->n++;
+#if MODBUS_RTU__HEADERS
+    if (p->n < p->wake && !modbus_rtu__ends_header(p)) {
+        return 0;
+    }
+#endif
     while (start < p->n) {
         pos = modbus_rtu__next(p, start);
         if (pos >= p->n) {
@@ -2614,16 +2648,21 @@ static int modbus_rtu__push(modbus_rtu_parser_t *p, uint8_t byte, modbus_rtu_msg
             if (hold == (size_t)-1) {
                 hold = pos;
             }
+            if (size == 0u) {
+                wake = 0u;
+            } else if (pos + size < wake) {
+                wake = pos + size;
+            }
         } else if (r == MODBUS_RTU__V_CORRUPT) {
             if (hold == (size_t)-1) {
                 p->errors++;
-            } else {
-                deferred++;
+            }
+            if (p->verdict[pos] == 0u) { /* corrupt as one layout, while another waits: judged again */
+                wake = 0u;
             }
         } else if (r == MODBUS_RTU__ACCEPT) {
             p->garbage += (uint32_t)(pos - done);
             hold = (size_t)-1;
-            deferred = 0u;
             start = done = pos + size;
             got = 1;
             p->frames++;
@@ -2631,9 +2670,12 @@ static int modbus_rtu__push(modbus_rtu_parser_t *p, uint8_t byte, modbus_rtu_msg
         }
         start = pos + 1u;
     }
-    (void)deferred;
+    p->wake = 0u;
     if (hold != (size_t)-1) {
         cut = hold;
+        if (wake != 0u) {
+            p->wake = wake - cut;
+        }
     } else if (MODBUS_RTU__HEADERS && !got) {
         cut = p->n > MODBUS_RTU__KEEP ? p->n - MODBUS_RTU__KEEP : 0u;
         if (cut < done) {
@@ -2645,7 +2687,6 @@ static int modbus_rtu__push(modbus_rtu_parser_t *p, uint8_t byte, modbus_rtu_msg
     p->garbage += (uint32_t)(cut - done);
     if (cut > 0u) {
         modbus_rtu__drop(p, cut);
-        p->first = 0u;
     }
     return got;
 }

@@ -713,6 +713,21 @@ static int32_t vesc__s32(uint32_t v)
 }
 #endif
 
+#if VESC_ENABLE_DECODE
+/* n bytes from src to dst: a loop, kept one (newlib's memcpy is 142 B of flash on Cortex-M0+; GCC would call it). */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("no-tree-loop-distribute-patterns")))
+#endif
+static void vesc__copy(void *dst, const uint8_t *src, size_t n)
+{
+    uint8_t *d = (uint8_t *)dst;
+    size_t i;
+    for (i = 0u; i < n; i++) {
+        d[i] = src[i];
+    }
+}
+#endif
+
 #if VESC_ENABLE_ENCODE || VESC_ENABLE_DECODE
 /* Strict UTF-8 (as Python's bytes.decode): no overlong forms, no surrogates, nothing past U+10FFFF. */
 static int vesc__utf8(const uint8_t *s, size_t n)
@@ -1190,14 +1205,14 @@ static int vesc__dec_fw_version_response(const uint8_t *c, size_t n, vesc_fw_ver
     len = k - o;
     if (len > sizeof(m->hw_name) - 1u) { return VESC_E_CAPACITY; }
     if (!vesc__utf8(c + o, len)) { return VESC_E_CONTENT; }
-    memcpy(m->hw_name, c + o, len);
+    vesc__copy(m->hw_name, c + o, len);
     m->hw_name[len] = '\0';
     m->hw_name_len = len;
     o += len + 1u;
     /* uuid: The STM32's 96-bit unique id (plus 1 for a second motor). */
     len = 12u;
     if (n - o < len) { return VESC_E_LENGTH; }
-    memcpy(m->uuid, c + o, len);
+    vesc__copy(m->uuid, c + o, len);
     o += len;
     /* pairing_done: 1 once NRF pairing is done. */
     if (n - o < 1u) { return VESC_E_LENGTH; }
@@ -1237,7 +1252,7 @@ static int vesc__dec_fw_version_response(const uint8_t *c, size_t n, vesc_fw_ver
     len = k - o;
     if (len > sizeof(m->fw_name) - 1u) { return VESC_E_CAPACITY; }
     if (!vesc__utf8(c + o, len)) { return VESC_E_CONTENT; }
-    memcpy(m->fw_name, c + o, len);
+    vesc__copy(m->fw_name, c + o, len);
     m->fw_name[len] = '\0';
     m->fw_name_len = len;
     o += len + 1u;
@@ -1470,7 +1485,7 @@ static int vesc__dec_print_response(const uint8_t *c, size_t n, vesc_print_respo
     if (n - o < len) { return VESC_E_LENGTH; }
     if (len > sizeof(m->text) - 1u) { return VESC_E_CAPACITY; }
     if (!vesc__utf8(c + o, len)) { return VESC_E_CONTENT; }
-    memcpy(m->text, c + o, len);
+    vesc__copy(m->text, c + o, len);
     m->text[len] = '\0';
     m->text_len = len;
     o += len;
@@ -1520,7 +1535,7 @@ static int vesc__dec_forward_can_request(const uint8_t *c, size_t n, vesc_forwar
     len = n - o;
     if (n - o < len) { return VESC_E_LENGTH; }
     if (len > sizeof(m->payload)) { return VESC_E_CAPACITY; }
-    memcpy(m->payload, c + o, len);
+    vesc__copy(m->payload, c + o, len);
     m->payload_len = len;
     o += len;
     if (o != n) { return VESC_E_LENGTH; }
@@ -2218,35 +2233,32 @@ void vesc_parser_init(vesc_parser_t *parser, vesc_direction_t dir)
     parser->dir = dir;
 }
 
-/* The candidate at pos: accepted (its size in *size, its message in out), waiting, no frame, or corrupt. */
+/* The candidate at pos: accepted (its size in *size, its message in out), waiting (in *size the bytes it needs
+ * before it can be judged again, 0 when that is not known), no frame, or corrupt. */
 static int vesc__try(vesc_parser_t *p, size_t pos, vesc_msg_t *out, size_t *size)
 {
     uint8_t count = vesc__count(p->dir), k;
-    int waiting = 0;
+    size_t need = (size_t)-1; /* the fewest bytes a waiting layout needs: (size_t)-1 none waits, 0 not known */
     if (p->verdict[pos] != 0u) {
         return p->verdict[pos];
     }
-    if (pos == 0u && p->first > p->n) { /* its size is known and its bytes have not all come */
-        return VESC__V_WAIT;
-    }
     for (k = 0u; k < count; k++) {
         long s = vesc__probe_at(p->dir, k, p->buf + pos, p->n - pos);
-        if (pos == 0u && count == 1u && s > 0) {
-            p->first = (size_t)s;
-        }
         if (s == VESC__WAIT) {
-            waiting = 1;
+            need = 0u;
             continue;
         }
         if (s < 0 || (unsigned long)s > VESC_MAX_FRAME) {
             continue;
         }
         if ((size_t)s > p->n - pos) {
-            waiting = 1;
+            if ((size_t)s < need) {
+                need = (size_t)s;
+            }
             continue;
         }
         if (vesc_decode(p->buf + pos, (size_t)s, p->dir, out) != VESC_OK) {
-            if (!waiting) {
+            if (need == (size_t)-1) {
                 p->verdict[pos] = VESC__V_CORRUPT;
             }
             return VESC__V_CORRUPT;
@@ -2254,7 +2266,8 @@ static int vesc__try(vesc_parser_t *p, size_t pos, vesc_msg_t *out, size_t *size
         *size = (size_t)s;
         return VESC__ACCEPT;
     }
-    if (waiting) {
+    if (need != (size_t)-1) {
+        *size = need;
         return VESC__V_WAIT;
     }
     p->verdict[pos] = VESC__V_NONE;
@@ -2308,20 +2321,42 @@ static void vesc__drop(vesc_parser_t *p, size_t cut)
     p->n -= cut;
 }
 
-/* One byte in: the Python parser's scan over the bytes held, each candidate's verdict kept once final. */
+#if VESC__HEADERS
+/* 1 when the bytes held end with a header of any layout (a candidate begins). */
+static int vesc__ends_header(const vesc_parser_t *p)
+{
+    uint8_t count = vesc__count(p->dir), k;
+    for (k = 0u; k < count; k++) {
+        size_t hl;
+        const uint8_t *h = vesc__header(p->dir, k, &hl);
+        if (hl <= p->n && vesc__same(p->buf + p->n - hl, h, hl)) {
+            return 1;
+        }
+    }
+    return 0;
+}
+#endif
+
+/* One byte in: the Python parser's scan over the bytes held, each candidate's verdict kept once final. While a
+ * candidate waits, the scan is left out until one held can be judged (p->wake bytes held) or a header comes: nothing
+ * the scan decides could change before then. */
 static int vesc__push(vesc_parser_t *p, uint8_t byte, vesc_msg_t *out)
 {
-    size_t start = 0u, done = 0u, pos, size = 0u, cut, hold = (size_t)-1;
-    uint32_t deferred = 0u;
+    size_t start = 0u, done = 0u, pos, size = 0u, cut, hold = (size_t)-1, wake = (size_t)-1;
     int got = 0, r;
     if (p->n >= VESC_MAX_FRAME) { /* only a candidate longer than VESC_MAX_FRAME can fill it: drop its first byte */
         vesc__drop(p, 1u);
         p->garbage++;
-        p->first = 0u;
+        p->wake = 0u;
     }
     p->buf[p->n] = byte;
     p->verdict[p->n] = 0u;
     p->n++;
+#if VESC__HEADERS
+    if (p->n < p->wake && !vesc__ends_header(p)) {
+        return 0;
+    }
+#endif
     while (start < p->n) {
         pos = vesc__next(p, start);
         if (pos >= p->n) {
@@ -2332,16 +2367,21 @@ static int vesc__push(vesc_parser_t *p, uint8_t byte, vesc_msg_t *out)
             if (hold == (size_t)-1) {
                 hold = pos;
             }
+            if (size == 0u) {
+                wake = 0u;
+            } else if (pos + size < wake) {
+                wake = pos + size;
+            }
         } else if (r == VESC__V_CORRUPT) {
             if (hold == (size_t)-1) {
                 p->errors++;
-            } else {
-                deferred++;
+            }
+            if (p->verdict[pos] == 0u) { /* corrupt as one layout, while another waits: judged again */
+                wake = 0u;
             }
         } else if (r == VESC__ACCEPT) {
             p->garbage += (uint32_t)(pos - done);
             hold = (size_t)-1;
-            deferred = 0u;
             start = done = pos + size;
             got = 1;
             p->frames++;
@@ -2349,9 +2389,12 @@ static int vesc__push(vesc_parser_t *p, uint8_t byte, vesc_msg_t *out)
         }
         start = pos + 1u;
     }
-    (void)deferred;
+    p->wake = 0u;
     if (hold != (size_t)-1) {
         cut = hold;
+        if (wake != 0u) {
+            p->wake = wake - cut;
+        }
     } else if (VESC__HEADERS && !got) {
         cut = p->n > VESC__KEEP ? p->n - VESC__KEEP : 0u;
         if (cut < done) {
@@ -2363,7 +2406,6 @@ static int vesc__push(vesc_parser_t *p, uint8_t byte, vesc_msg_t *out)
     p->garbage += (uint32_t)(cut - done);
     if (cut > 0u) {
         vesc__drop(p, cut);
-        p->first = 0u;
     }
     return got;
 }

@@ -486,14 +486,16 @@ def decode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                     out.append(f"{pad}if (len > sizeof({tgt}) - 1u) {{ return {ctx.P}_E_CAPACITY; }}")
                     out.append(f"{pad}if (!{ctx.p}__utf8(c + o, len)) {{ return {ctx.P}_E_CONTENT; }}")
                     ctx.helpers.add("utf8")
-                    out.append(f"{pad}memcpy({tgt}, c + o, len);")
+                    out.append(f"{pad}{ctx.p}__copy({tgt}, c + o, len);")
+                    ctx.helpers.add("copy")
                     out.append(f"{pad}{tgt}[len] = '\\0';")
                     out.append(f"{pad}{tgt}_len = len;")
                     out.append(f"{pad}o += len{' + 1u' if terminated else ''};")
                 else:
                     if not isinstance(f.size, int):
                         out.append(f"{pad}if (len > sizeof({tgt})) {{ return {ctx.P}_E_CAPACITY; }}")
-                    out.append(f"{pad}memcpy({tgt}, c + o, len);")
+                    out.append(f"{pad}{ctx.p}__copy({tgt}, c + o, len);")
+                    ctx.helpers.add("copy")
                     if not isinstance(f.size, int):
                         out.append(f"{pad}{tgt}_len = len;")
                     out.append(f"{pad}o += len;")
@@ -578,7 +580,8 @@ def decode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                     f"{pad}if ({'len' if not item else tgt + '_count'} > {capacity}) {{ return {ctx.P}_E_CAPACITY; }}"
                 )
                 if f.item is None:
-                    out.append(f"{pad}memcpy({tgt}, c + o, len);")
+                    out.append(f"{pad}{ctx.p}__copy({tgt}, c + o, len);")
+                    ctx.helpers.add("copy")
                 else:
                     out.append(f"{pad}for (i{depth} = 0u; i{depth} < {tgt}_count; i{depth}++) {{")
                     value = read_scalar(ctx, f.item, f.endian, f"c + o + i{depth} * {item}u")

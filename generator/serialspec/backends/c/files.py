@@ -167,7 +167,7 @@ typedef struct {{
     uint32_t frames;                  /* messages delivered */
     uint32_t garbage;                 /* bytes skipped that belonged to no message */
     uint32_t errors;                  /* corrupt candidates (a bad checksum, content that does not decode) */
-    size_t first;                     /* the size of the candidate at buf[0] once known (one layout), else 0 */
+    size_t wake;                      /* while a candidate waits: bytes held before any can be judged (0: now) */
     uint8_t buf[{P}_MAX_FRAME];        /* bytes held: the candidate frames still waiting for bytes */
     uint8_t verdict[{P}_MAX_FRAME];    /* per byte held: 0 undecided, 1 no frame starts here, 2 a corrupt one */
 }} {p}_parser_t;
@@ -767,6 +767,9 @@ static size_t {p}__least({p}_direction_t dir)
             if (hold == (size_t)-1) {{
                 hold = pos;
             }}
+            if (pos + {p}__least(p->dir) < wake) {{
+                wake = pos + {p}__least(p->dir);
+            }}
             break;
         }}"""
     every = [layout for d in directions(protocol) for layout in protocol.framing.alternatives[d]]
@@ -1084,35 +1087,32 @@ void {p}_parser_init({p}_parser_t *parser, {p}_direction_t dir)
     parser->dir = dir;
 }}
 
-/* The candidate at pos: accepted (its size in *size, its message in out), waiting, no frame, or corrupt. */
+/* The candidate at pos: accepted (its size in *size, its message in out), waiting (in *size the bytes it needs
+ * before it can be judged again, 0 when that is not known), no frame, or corrupt. */
 static int {p}__try({p}_parser_t *p, size_t pos, {p}_msg_t *out, size_t *size)
 {{
     uint8_t count = {p}__count(p->dir), k;
-    int waiting = 0;
+    size_t need = (size_t)-1; /* the fewest bytes a waiting layout needs: (size_t)-1 none waits, 0 not known */
     if (p->verdict[pos] != 0u) {{
         return p->verdict[pos];
     }}
-    if (pos == 0u && p->first > p->n) {{ /* its size is known and its bytes have not all come */
-        return {P}__V_WAIT;
-    }}
     for (k = 0u; k < count; k++) {{
         long s = {p}__probe_at(p->dir, k, p->buf + pos, p->n - pos);
-        if (pos == 0u && count == 1u && s > 0) {{
-            p->first = (size_t)s;
-        }}
         if (s == {P}__WAIT) {{
-            waiting = 1;
+            need = 0u;
             continue;
         }}
         if (s < 0 || (unsigned long)s > {P}_MAX_FRAME) {{
             continue;
         }}
         if ((size_t)s > p->n - pos) {{
-            waiting = 1;
+            if ((size_t)s < need) {{
+                need = (size_t)s;
+            }}
             continue;
         }}
         if ({p}_decode(p->buf + pos, (size_t)s, p->dir, out) != {P}_OK) {{
-            if (!waiting) {{
+            if (need == (size_t)-1) {{
                 p->verdict[pos] = {P}__V_CORRUPT;
             }}
             return {P}__V_CORRUPT;
@@ -1120,7 +1120,8 @@ static int {p}__try({p}_parser_t *p, size_t pos, {p}_msg_t *out, size_t *size)
         *size = (size_t)s;
         return {P}__ACCEPT;
     }}
-    if (waiting) {{
+    if (need != (size_t)-1) {{
+        *size = need;
         return {P}__V_WAIT;
     }}
     p->verdict[pos] = {P}__V_NONE;
@@ -1174,20 +1175,42 @@ static void {p}__drop({p}_parser_t *p, size_t cut)
     p->n -= cut;
 }}
 
-/* One byte in: the Python parser's scan over the bytes held, each candidate's verdict kept once final. */
+#if {P}__HEADERS
+/* 1 when the bytes held end with a header of any layout (a candidate begins). */
+static int {p}__ends_header(const {p}_parser_t *p)
+{{
+    uint8_t count = {p}__count(p->dir), k;
+    for (k = 0u; k < count; k++) {{
+        size_t hl;
+        const uint8_t *h = {p}__header(p->dir, k, &hl);
+        if (hl <= p->n && {p}__same(p->buf + p->n - hl, h, hl)) {{
+            return 1;
+        }}
+    }}
+    return 0;
+}}
+#endif
+
+/* One byte in: the Python parser's scan over the bytes held, each candidate's verdict kept once final. While a
+ * candidate waits, the scan is left out until one held can be judged (p->wake bytes held) or a header comes: nothing
+ * the scan decides could change before then. */
 static int {p}__push({p}_parser_t *p, uint8_t byte, {p}_msg_t *out)
 {{
-    size_t start = 0u, done = 0u, pos, size = 0u, cut, hold = (size_t)-1;
-    uint32_t deferred = 0u;
+    size_t start = 0u, done = 0u, pos, size = 0u, cut, hold = (size_t)-1, wake = (size_t)-1;
     int got = 0, r;
     if (p->n >= {P}_MAX_FRAME) {{ /* only a candidate longer than {P}_MAX_FRAME can fill it: drop its first byte */
         {p}__drop(p, 1u);
         p->garbage++;
-        p->first = 0u;
+        p->wake = 0u;
     }}
     p->buf[p->n] = byte;
     p->verdict[p->n] = 0u;
     p->n++;
+#if {P}__HEADERS
+    if (p->n < p->wake && !{p}__ends_header(p)) {{
+        return 0;
+    }}
+#endif
     while (start < p->n) {{
         pos = {p}__next(p, start);
         if (pos >= p->n) {{
@@ -1198,16 +1221,21 @@ static int {p}__push({p}_parser_t *p, uint8_t byte, {p}_msg_t *out)
             if (hold == (size_t)-1) {{
                 hold = pos;
             }}
+            if (size == 0u) {{
+                wake = 0u;
+            }} else if (pos + size < wake) {{
+                wake = pos + size;
+            }}
         }} else if (r == {P}__V_CORRUPT) {{
             if (hold == (size_t)-1) {{
                 p->errors++;
-            }} else {{
-                deferred++;
+            }}
+            if (p->verdict[pos] == 0u) {{ /* corrupt as one layout, while another waits: judged again */
+                wake = 0u;
             }}
         }} else if (r == {P}__ACCEPT) {{
             p->garbage += (uint32_t)(pos - done);
             hold = (size_t)-1;
-            deferred = 0u;
             start = done = pos + size;
             got = 1;
             p->frames++;
@@ -1215,9 +1243,12 @@ static int {p}__push({p}_parser_t *p, uint8_t byte, {p}_msg_t *out)
         }}
         start = pos + 1u;
     }}
-    (void)deferred;
+    p->wake = 0u;
     if (hold != (size_t)-1) {{
         cut = hold;
+        if (wake != 0u) {{
+            p->wake = wake - cut;
+        }}
     }} else if ({P}__HEADERS && !got) {{
         cut = p->n > {P}__KEEP ? p->n - {P}__KEEP : 0u;
         if (cut < done) {{
@@ -1229,7 +1260,6 @@ static int {p}__push({p}_parser_t *p, uint8_t byte, {p}_msg_t *out)
     p->garbage += (uint32_t)(cut - done);
     if (cut > 0u) {{
         {p}__drop(p, cut);
-        p->first = 0u;
     }}
     return got;
 }}
@@ -1387,6 +1417,24 @@ static int{bits}_t {p}__s{bits}(uint32_t v)
 #endif
 """
             )
+    if "copy" in ctx.helpers:
+        parts.append(
+            f"""#if {P}_ENABLE_DECODE
+/* n bytes from src to dst: a loop, kept one (newlib's memcpy is 142 B of flash on Cortex-M0+; GCC would call it). */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("no-tree-loop-distribute-patterns")))
+#endif
+static void {p}__copy(void *dst, const uint8_t *src, size_t n)
+{{
+    uint8_t *d = (uint8_t *)dst;
+    size_t i;
+    for (i = 0u; i < n; i++) {{
+        d[i] = src[i];
+    }}
+}}
+#endif
+"""
+        )
     if "sm" in ctx.helpers:
         parts.append(
             f"""#if {P}_ENABLE_DECODE

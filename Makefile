@@ -5,7 +5,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 BENCH_STAMP := $(VENV)/.installed-bench
 
-.PHONY: generate test test-fast test-tools constraints check lint typecheck clean demo stress bench bench-c wheel runtime-wheel docs c-check
+.PHONY: generate test test-fast test-tools bench-tools constraints check lint typecheck clean demo stress bench bench-c wheel runtime-wheel docs c-check
 
 CONSTRAINTS := requirements/constraints.txt
 
@@ -26,8 +26,8 @@ generate: $(STAMP) test-tools
 # screen). Installed with apt-get where they are missing and this runs as root; elsewhere the tests that need them
 # are skipped, saying why.
 # The C target's tests also build with clang, with gcc -m32 (gcc-multilib: 32-bit size_t and long) and for big-endian
-# PowerPC (a cross gcc; qemu-user runs the programs): installed the same way, and so is the Arm gcc `make bench-c`
-# measures the C's flash with (gcc-arm-none-eabi, newlib-nano included).
+# PowerPC (a cross gcc; qemu-user runs the programs): installed the same way. The Arm gcc `make bench-c` measures
+# the C's flash with (gcc-arm-none-eabi, newlib-nano included) is installed by `make bench-tools`: no test needs it.
 TEST_TOOLS := tshark tmux
 # apt-get install of the packages in $$missing, as root; elsewhere it says which tests are skipped
 INSTALL_MISSING = if [ -z "$$missing" ]; then exit 0; fi; \
@@ -44,7 +44,10 @@ test-tools:
 	printf 'int main(void) { return 0; }\n' | gcc -m32 -x c - -o /dev/null 2>/dev/null || missing="$$missing gcc-multilib"; \
 	command -v powerpc-linux-gnu-gcc >/dev/null || missing="$$missing gcc-powerpc-linux-gnu libc6-dev-powerpc-cross"; \
 	command -v qemu-ppc >/dev/null || missing="$$missing qemu-user"; \
-	command -v arm-none-eabi-gcc >/dev/null || missing="$$missing gcc-arm-none-eabi"; \
+	$(INSTALL_MISSING)
+
+bench-tools: test-tools
+	@missing=""; command -v arm-none-eabi-gcc >/dev/null || missing="$$missing gcc-arm-none-eabi"; \
 	$(INSTALL_MISSING)
 
 check: $(STAMP)
@@ -105,11 +108,11 @@ $(BENCH_STAMP): $(STAMP) pyproject.toml
 	PYTHONWARNINGS='ignore:Editable installation' $(BIN)/pip install --quiet -c $(CONSTRAINTS) -e '.[test,bench]'
 	touch $(BENCH_STAMP)
 
-bench: $(BENCH_STAMP)
+bench: $(BENCH_STAMP) bench-tools
 	$(BIN)/python -m bench.run
 
 # The C target's two tables alone (flash and RAM on Cortex-M0+, parse throughput), replaced in bench/results.md.
-bench-c: $(STAMP) test-tools
+bench-c: $(STAMP) bench-tools
 	$(BIN)/python -m bench.run c-size c-speed
 
 # The documentation site in site/: README, tutorial, language reference and every protocol's reference (mkdocs, strict).

@@ -502,6 +502,29 @@ CASES["frame: plain values, a sequence"] = Case(
         }
     },
 )
+# Replies under a code computed from the request's (HerkuleX: code | 0x40), in the usual frame and in one the frame
+# engine reads; a reply-only command's frames carry the computed code too
+REPLY_CODED = {
+    "other": {"code": 2, "request": {"fields": {"a": "u8"}}, "response": {"fields": {"b": "i16"}}},
+    "told": {"code": 3, "response": {"unsolicited": True, "fields": {"c": "u8"}}},
+}
+CASES["frame: reply_code, a reply code computed from the request code"] = Case(
+    {"v": "u16"},
+    {"w": "u8"},
+    {"elements": {**FRAMING["elements"], "code": {"role": "command", "type": "u8", "reply_code": "code | 0x40"}}},
+    commands=REPLY_CODED,
+)
+CASES["frame: reply_code, frame engine"] = Case(
+    {"v": "u16"},
+    {"w": "u16"},
+    {
+        "elements": {
+            **CASES["frame: trailer, constant, u16 big-endian length and checksum"].framing["elements"],  # type: ignore[index]
+            "code": {"role": "command", "type": "u8", "reply_code": "(code + 0x80) & 0xFF"},
+        }
+    },
+    commands=REPLY_CODED,
+)
 # Requests that share a code, told apart by their content size (0, 2, 3 or more bytes), in the usual frame and in
 # one the frame engine reads
 SHARED_CODE = {

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define DYNAMIXEL_P2_SPEC_SHA256 "c387c20373f4df66b6ec814e8ebbe0294215eb7978641deb79401d8bbcb573be"
+#define DYNAMIXEL_P2_SPEC_SHA256 "45f0dadc1e41271b7e97cc0e543a66649cd5119b085ad1eed420b97bf7fe40f3"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef DYNAMIXEL_P2_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define FEETECH_SMS_SPEC_SHA256 "fc57826862e988ebe01e24edfe40d476436fbb68bec8c7ee10d6b710d1442d69"
+#define FEETECH_SMS_SPEC_SHA256 "6bd817b8c844dba6423fa34cc8afab0c897306d9194d8180ddc7741af9d95a69"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef FEETECH_SMS_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define HIWONDER_RRC_SPEC_SHA256 "5ba045edaf9a40006eef7ad6c418f5bb211f853321ec7bc1e95c17952e44dc38"
+#define HIWONDER_RRC_SPEC_SHA256 "8e5399fa64b47bda5c3b986550b6ae22884b411ccdda35ab2fe1d2e671b64aba"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef HIWONDER_RRC_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define VESC_SPEC_SHA256 "db84479597ad10015d5a773e8ca32f9c036e6076e6a0b0a630f8f079de6d795d"
+#define VESC_SPEC_SHA256 "5f71b5d9c53eb3b37da96c0c2e79043e9cc20d5bd2072ba0472b0347d93540d4"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef VESC_ENABLE_ENCODE

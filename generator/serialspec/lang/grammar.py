@@ -753,6 +753,13 @@ FRAME_ELEMENT = Obj(
             "command: a bit a device sets in the code of a reply that refuses the request (Modbus: 0x80); such a "
             "reply has the layout of the command whose response is the `error_reply`."
         ),
+        "reply_code": Str(
+            "command: the code response frames carry, as an expression of the request's `code` (HerkuleX: "
+            "`code | 0x40`, so STAT 0x07 is answered under 0x47). Every command's reply then has that code, computed "
+            "when the spec is read: encode writes it, decode (without `--direction` too) and the stream parser read "
+            "a reply by it, the simulator answers with it and clients match replies as usual (by command).",
+            example="code | 0x40",
+        ),
         "counts": span(
             "length: the span of elements it counts (within a transparency span their plain bytes, over more than "
             "it the bytes as sent); default the content only.",

@@ -796,7 +796,7 @@ class PackageCode:
             frame_values.append(Simple(field_read("m", f.name)))
         fields = list(message.fields)
         self.check_count_from(message, body, where)
-        command_code = self.protocol.command(message.command).code
+        command_code = self.protocol.command(message.command).wire_code(message.direction)
         if not self.protocol.framing.classic:
             # the runtime's frame engine wraps the content (see backends/python/frames.py)
             parts = self.encode_fields(fields, message.class_name, "m", body, where)

@@ -10,12 +10,12 @@ import importlib
 import io
 import json
 import os
-import sys
 from functools import reduce
 from pathlib import Path
 from types import ModuleType
 
 import pytest
+from conftest import generate_and_import
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from serialspec.cli import main as serialspec_main
@@ -36,13 +36,7 @@ def packet(pid: int, cmd: int, data: bytes = b"") -> bytes:
 
 @pytest.fixture(scope="module")
 def hx(tmp_path_factory: pytest.TempPathFactory) -> ModuleType:
-    out = tmp_path_factory.mktemp("herkulex")
-    assert serialspec_main(["generate", str(SPEC), "--out", str(out)]) == 0
-    sys.path.insert(0, str(out))
-    try:
-        return importlib.import_module("herkulex")
-    finally:
-        sys.path.remove(str(out))
+    return generate_and_import(SPEC, tmp_path_factory.mktemp("herkulex"), "herkulex")
 
 
 MANUAL = [  # (frame as the manual prints it, direction, class, fields)

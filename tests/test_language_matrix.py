@@ -195,6 +195,22 @@ CASES: dict[str, Case] = {
     "range, unit, scale": same({"v": {"type": "i16", "range": [-100, 100], "unit": "mV", "scale": 0.5}}),
     "scale and offset": same({"alt": {"type": "u16", "unit": "m", "scale": 1, "offset": -1000}, "v": "u24"}),
     "field named type": same({"type": "u8", "v": {"type": "u24", "endian": "big"}}),
+    # Python keywords as field names (the attribute is `class_`, JSON keeps `class`), referenced by a count, a size
+    # and an expression, inside a group item too; two messages each with a `flags` field of their own bit fields
+    "fields named after Python keywords": Case(
+        {
+            "class": "u8",
+            "from": "u8",
+            "in": {"type": "bytes", "size": "from"},
+            "flags": {"type": "u8", "bits": {"a": {"bits": 0}, "b": {"bits": [3, 1]}}},
+        },
+        {
+            "is": {"type": "u8", "value": "len(pass)"},
+            "pass": {"type": "array", "of": "u16", "count": "is"},
+            "flags": {"type": "u8", "bits": {"c": {"bits": 7}}},
+            "g": {"type": "group", "count": 2, "fields": {"lambda": "i8", "with": {"type": "u8", "enum": "mode"}}},
+        },
+    ),
     "use (shared field)": same({"angle": {"use": "angle"}, "also": "angle"}),
     "status": Case({"v": "u8"}, {"success": {"type": "u8", "status": {"ok": 1}}, "v": "u8"}),
     "answered_by another code, refused_by, request_code": Case(

@@ -463,9 +463,12 @@ FIELD = OneOf(
 FIELDS: Shape = MapOf(
     FIELD,
     "Fields in wire order: name -> type or mapping. A name is any lower-case identifier the protocol uses (`type`, "
-    "`id`, `data`) except Python keywords and the few names generated code uses itself (`self`, `request`, `reply`, "
-    "`to_fields`, builtins a client method calls such as `len`): those are refused, one line naming them; rename "
-    "the field (`class_`).",
+    "`id`, `data`, and Python keywords: `class`, `from`, `in`) except the few names generated code uses itself "
+    "(`self`, `request`, `reply`, `to_fields`, builtins a client method calls such as `len`), which are refused, "
+    "one line naming them. A field named after a Python keyword keeps its name in the spec's references, JSON "
+    "(`decode --json`, `to_fields`/`from_fields`), the reference, Wireshark and C (where a C or C++ keyword also "
+    "gets a trailing underscore); in generated Python, its attribute, client argument and construct struct field "
+    "take a trailing underscore (`message.class_`), so `class_` itself is not a field name.",
 )
 
 OPTIONAL_WHEN = Obj(

@@ -46,6 +46,7 @@ from serialspec.lang.model import (
     Text,
     fixed_size,
 )
+from serialspec.lang.names import mangled, python_name
 from serialspec.runtime.errors import SerialspecError
 
 # A `]` that closes a link's text, with the destination after it: `[x](dest` (and `[x]: dest`, see DEFINITION)
@@ -117,6 +118,8 @@ def range_text(f: Field) -> str:
 
 def meaning(f: Field) -> str:
     parts = [f.description, *kind(f).meaning(f)]
+    if mangled(f.name) and not (isinstance(f, Scalar) and f.hidden):  # a hidden field is no attribute
+        parts.append(f"(In Python: `{python_name(f.name)}`.)")
     if f.inferred:
         parts.append(f"**Inferred layout:** {f.inferred}")
     return " ".join(p for p in parts if p)

@@ -142,3 +142,17 @@ def sim(request: pytest.FixtureRequest) -> Iterator[Running]:
         yield Running(simulator, simulator.start())
     finally:
         simulator.close()
+
+
+def generate_and_import(spec: Path, out: Path, name: str) -> ModuleType:
+    """`serialspec generate SPEC --out OUT`, then the package `name` imported from OUT (a spec of a test's own)."""
+    import sys
+
+    from serialspec.cli import main as serialspec_main
+
+    assert serialspec_main(["generate", str(spec), "--out", str(out)]) == 0
+    sys.path.insert(0, str(out))
+    try:
+        return importlib.import_module(name)
+    finally:
+        sys.path.remove(str(out))

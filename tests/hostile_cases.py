@@ -815,10 +815,10 @@ CASES: list[tuple[str, str, Mutation | Text, str | None]] = [
         "commands.move.request.fields.self: field name 'self' is reserved (a Python keyword or a name generated code uses)",
     ),
     (
-        "field named class",
+        "field named class_",
         "tiny",
-        rename("commands/move/request/fields/mode", "class"),
-        "commands.move.request.fields.class: field name 'class' is reserved (a Python keyword or a name generated code uses)",
+        rename("commands/move/request/fields/mode", "class_"),
+        "commands.move.request.fields.class_: field name 'class_' is the Python name of a field 'class': call it 'class'",
     ),
     (
         "field named to_fields",

@@ -9,6 +9,7 @@ from conftest import ALL, Generated, by_protocol, example_class, examples
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from serialspec.lang.model import Example, Message, Scalar
+from serialspec.lang.names import spec_name
 from serialspec.runtime.errors import DecodeError, RangeError
 from strategies import message_fields
 
@@ -49,10 +50,19 @@ def message_type(g: Generated, spec: Message) -> Any:
     return next(c for c in g.package.MESSAGE_TYPES if c.__name__ == spec.class_name)
 
 
+def spec_names(value: Any) -> Any:
+    """Construct's containers keyed by the fields' spec names (the structs name a keyword's field `class_`)."""
+    if isinstance(value, dict):
+        return {spec_name(k): spec_names(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [spec_names(v) for v in value]
+    return value
+
+
 def check_against_construct(g: Generated, spec: Message, frame: bytes, fields: dict[str, Any]) -> None:
     content = frame_content(g, frame, spec.direction.value)
     content_struct = g.structs.CONTENTS[(spec.key, spec.direction.value)]
-    parsed = plain(content_struct.parse(content))
+    parsed = spec_names(plain(content_struct.parse(content)))
     frame_names = {e.name for e in g.protocol.framing.layouts[spec.direction].value_elements}
     error = g.protocol.error_reply
     if spec.error_reply and error is not None:

@@ -195,6 +195,22 @@ CASES: dict[str, Case] = {
     "range, unit, scale": same({"v": {"type": "i16", "range": [-100, 100], "unit": "mV", "scale": 0.5}}),
     "scale and offset": same({"alt": {"type": "u16", "unit": "m", "scale": 1, "offset": -1000}, "v": "u24"}),
     "field named type": same({"type": "u8", "v": {"type": "u24", "endian": "big"}}),
+    # Python keywords as field names (the attribute is `class_`, JSON keeps `class`), referenced by a count, a size
+    # and an expression, inside a group item too; two messages each with a `flags` field of their own bit fields
+    "fields named after Python keywords": Case(
+        {
+            "class": "u8",
+            "from": "u8",
+            "in": {"type": "bytes", "size": "from"},
+            "flags": {"type": "u8", "bits": {"a": {"bits": 0}, "b": {"bits": [3, 1]}}},
+        },
+        {
+            "is": {"type": "u8", "value": "len(pass)"},
+            "pass": {"type": "array", "of": "u16", "count": "is"},
+            "flags": {"type": "u8", "bits": {"c": {"bits": 7}}},
+            "g": {"type": "group", "count": 2, "fields": {"lambda": "i8", "with": {"type": "u8", "enum": "mode"}}},
+        },
+    ),
     "use (shared field)": same({"angle": {"use": "angle"}, "also": "angle"}),
     "status": Case({"v": "u8"}, {"success": {"type": "u8", "status": {"ok": 1}}, "v": "u8"}),
     "answered_by another code, refused_by, request_code": Case(
@@ -534,6 +550,29 @@ CASES["frame: truncate: trailing_zeros"] = Case(
         }
     },
     commands={"empty": {"code": 0x1234, "request": {"fields": {"n": "u8"}}, "response": {}}},
+)
+# Replies under a code computed from the request's (HerkuleX: code | 0x40), in the usual frame and in one the frame
+# engine reads; a reply-only command's frames carry the computed code too
+REPLY_CODED = {
+    "other": {"code": 2, "request": {"fields": {"a": "u8"}}, "response": {"fields": {"b": "i16"}}},
+    "told": {"code": 3, "response": {"unsolicited": True, "fields": {"c": "u8"}}},
+}
+CASES["frame: reply_code, a reply code computed from the request code"] = Case(
+    {"v": "u16"},
+    {"w": "u8"},
+    {"elements": {**FRAMING["elements"], "code": {"role": "command", "type": "u8", "reply_code": "code | 0x40"}}},
+    commands=REPLY_CODED,
+)
+CASES["frame: reply_code, frame engine"] = Case(
+    {"v": "u16"},
+    {"w": "u16"},
+    {
+        "elements": {
+            **CASES["frame: trailer, constant, u16 big-endian length and checksum"].framing["elements"],  # type: ignore[index]
+            "code": {"role": "command", "type": "u8", "reply_code": "(code + 0x80) & 0xFF"},
+        }
+    },
+    commands=REPLY_CODED,
 )
 # Requests that share a code, told apart by their content size (0, 2, 3 or more bytes), in the usual frame and in
 # one the frame engine reads

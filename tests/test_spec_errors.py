@@ -73,7 +73,8 @@ def test_three_mistakes_give_three_lines(tmp_path: Path) -> None:
     [
         (("title: Move", "title: Move\n    colour: red"), "unknown key 'colour'"),
         (("angle: i16", "angle: i16\n        angle: u8"), "duplicate key 'angle'"),
-        (("angle: i16", "class: i16"), "reserved"),
+        (("angle: i16", "self: i16"), "reserved"),
+        (("angle: i16", "from_: i16"), "is the Python name of a field 'from': call it 'from'"),
         (("angle: i16", "Angle: i16"), "lower-case identifier"),
         (("angle: i16", "angle: {type: u8, enum: colours}"), "unknown enum 'colours'"),
         (("covers: [code, content]", "covers: [code, body]"), "unknown frame element 'body'"),

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define DYNAMIXEL_P2_SPEC_SHA256 "3d4f31ef54a784ed0ecdb8f29aff917755bd3f3b8511a0c0ae0ba2cebf4360dd"
+#define DYNAMIXEL_P2_SPEC_SHA256 "bf5f137cee13a83e6a4fd7b04191b4e4826b17c59f23e61520d326205abba1d5"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef DYNAMIXEL_P2_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define VESC_SPEC_SHA256 "cdd7185440e84459070fd6b5e3539801202af86d8e80283ac855e2b7b7667fe1"
+#define VESC_SPEC_SHA256 "8b81e99373abdce14618f6db43901cd76c40005661b878eaf3dfd6d6471f7b7d"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef VESC_ENABLE_ENCODE

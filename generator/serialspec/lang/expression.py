@@ -18,6 +18,8 @@ negative: `fails`) is a DecodeError of the frame, an EncodeError of the message.
 from __future__ import annotations
 
 import ast
+import keyword
+import re
 from collections.abc import Callable, Iterator, Mapping
 
 from serialspec.lang.frozen import frozen
@@ -101,6 +103,8 @@ def parse(text: str) -> Expr:
         raise ExpressionError(f"expected an expression as text, got {text!r}")
     if len(text) > MAX_TEXT:
         raise ExpressionError(f"an expression of {len(text)} characters is too long (at most {MAX_TEXT})")
+    # a field named after a Python keyword (`len(from)`): parsed under another name, named back in _convert
+    text = _IDENTIFIER.sub(lambda m: m[0] + _KEYWORD_MARK if keyword.iskeyword(m[0]) else m[0], text)
     try:
         tree = ast.parse(text.strip(), mode="eval")
     except SyntaxError:
@@ -117,11 +121,21 @@ def parse(text: str) -> Expr:
     return _convert(tree.body, text)
 
 
+_IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+_KEYWORD_MARK = "__keyword"  # appended to a keyword for Python's parser
+
+
+def _field(name: str) -> str:
+    """A name as the spec gives it: a keyword marked by parse() unmarked."""
+    base = name.removesuffix(_KEYWORD_MARK)
+    return base if base != name and keyword.iskeyword(base) else name
+
+
 def _convert(node: ast.expr, text: str) -> Expr:
     if isinstance(node, ast.Constant) and isinstance(node.value, int) and not isinstance(node.value, bool):
         return Const(node.value)
     if isinstance(node, ast.Name):
-        return Name(node.id)
+        return Name(_field(node.id))
     if isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.USub):
         return BinOp("-", Const(0), _convert(node.operand, text))
     if isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.Invert):
@@ -131,7 +145,7 @@ def _convert(node: ast.expr, text: str) -> Expr:
     if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and not node.keywords:
         function, args = node.func.id, node.args
         if function == "len" and len(args) == 1 and isinstance(args[0], ast.Name):
-            return Length(args[0].id)
+            return Length(_field(args[0].id))
         if function == "ceil" and len(args) == 1:
             inner = args[0]
             if isinstance(inner, ast.BinOp) and isinstance(inner.op, ast.Div | ast.FloorDiv):

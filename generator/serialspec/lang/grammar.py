@@ -463,9 +463,12 @@ FIELD = OneOf(
 FIELDS: Shape = MapOf(
     FIELD,
     "Fields in wire order: name -> type or mapping. A name is any lower-case identifier the protocol uses (`type`, "
-    "`id`, `data`) except Python keywords and the few names generated code uses itself (`self`, `request`, `reply`, "
-    "`to_fields`, builtins a client method calls such as `len`): those are refused, one line naming them; rename "
-    "the field (`class_`).",
+    "`id`, `data`, and Python keywords: `class`, `from`, `in`) except the few names generated code uses itself "
+    "(`self`, `request`, `reply`, `to_fields`, builtins a client method calls such as `len`), which are refused, "
+    "one line naming them. A field named after a Python keyword keeps its name in the spec's references, JSON "
+    "(`decode --json`, `to_fields`/`from_fields`), the reference, Wireshark and C (where a C or C++ keyword also "
+    "gets a trailing underscore); in generated Python, its attribute, client argument and construct struct field "
+    "take a trailing underscore (`message.class_`), so `class_` itself is not a field name.",
 )
 
 OPTIONAL_WHEN = Obj(
@@ -752,6 +755,13 @@ FRAME_ELEMENT = Obj(
         "error_flag": Int(
             "command: a bit a device sets in the code of a reply that refuses the request (Modbus: 0x80); such a "
             "reply has the layout of the command whose response is the `error_reply`."
+        ),
+        "reply_code": Str(
+            "command: the code response frames carry, as an expression of the request's `code` (HerkuleX: "
+            "`code | 0x40`, so STAT 0x07 is answered under 0x47). Every command's reply then has that code, computed "
+            "when the spec is read: encode writes it, decode (without `--direction` too) and the stream parser read "
+            "a reply by it, the simulator answers with it and clients match replies as usual (by command).",
+            example="code | 0x40",
         ),
         "counts": span(
             "length: the span of elements it counts (within a transparency span their plain bytes, over more than "

@@ -405,6 +405,13 @@ class Command:
     subcommands: tuple[Subcommand, ...]
     group_class: str = ""  # the client's class grouping the sub-commands' methods ("" without sub-commands)
     probe: bool = False  # asks whether a device is there: clients return True/False, never raise Timeout
+    response_code: int | None = None  # the code of its response frames, where it differs (HerkuleX: code | 0x40)
+
+    def wire_code(self, direction: Direction) -> int | None:
+        """The code its frames of one direction carry: `code`, or in responses the command element's `reply_code`."""
+        if direction == Direction.RESPONSE and self.response_code is not None:
+            return self.response_code
+        return self.code
 
     def messages(self) -> tuple[Message, ...]:
         found = [m for m in (self.request, self.response) if m]
@@ -522,6 +529,7 @@ class Framing:
     shared_header: bool
     alternatives: dict[Direction, tuple[FrameLayout, ...]] = field(default_factory=dict)  # every layout, in order
     gap: float = 0.0  # silence between frames, in character times (0: none defined)
+    reply_code: str = ""  # the command element's `reply_code`, as shown (`code | 0x40`): see Command.response_code
 
     @property
     def classic(self) -> bool:

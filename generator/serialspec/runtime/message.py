@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import keyword
 from collections import _tuplegetter  # type: ignore[attr-defined]
 from collections.abc import Callable
 from dataclasses import FrozenInstanceError
@@ -121,6 +122,17 @@ def is_sequence(value: object) -> TypeGuard[tuple[Any, ...] | list[Any]]:
 def field_names(record: Record | type[Record]) -> tuple[str, ...]:
     """The field names of a generated class or instance, in order (what dataclasses.fields gave before)."""
     return record.__match_args__
+
+
+def spec_name(name: str) -> str:
+    """A field's name in the spec and in to_fields()/JSON, from its attribute's: a field named after a Python keyword
+    has the attribute `class_` (serialspec.lang.names.python_name), every other field its own name."""
+    return name[:-1] if name.endswith("_") and keyword.iskeyword(name[:-1]) else name
+
+
+def field_keys(record: Record | type[Record]) -> tuple[str, ...]:
+    """The keys of a generated class's to_fields() and from_fields(), in order: its fields' spec names."""
+    return tuple(spec_name(name) for name in record.__match_args__)
 
 
 def replace(record: R, **changes: Any) -> R:

@@ -689,7 +689,7 @@ def source(ctx: Ctx) -> str:
         mid = msg_id(m)
         layout = protocol.framing.layouts[m.direction]
         values = value_elements(protocol, m.direction)
-        number = protocol.command(m.command).code if layout.has_command else None
+        number = protocol.command(m.command).wire_code(m.direction) if layout.has_command else None
         wire_code = f"{number if number is not None else 0}UL"
         vchecks = []
         vsets = []
@@ -1354,7 +1354,8 @@ def messages_by_code(protocol: Protocol, direction: Direction) -> dict[int | Non
     found: dict[int | None, list[Message]] = {}
     for m in messages(protocol):
         if m.direction == direction:
-            code = ERROR_CODE if m.error_reply else protocol.command(m.command).code if layout.has_command else None
+            wire = protocol.command(m.command).wire_code(direction)
+            code = ERROR_CODE if m.error_reply else wire if layout.has_command else None
             found.setdefault(code, []).append(m)
     return found
 

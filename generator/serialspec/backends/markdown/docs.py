@@ -46,6 +46,7 @@ from serialspec.lang.model import (
     Text,
     fixed_size,
 )
+from serialspec.lang.names import mangled, python_name
 from serialspec.runtime.errors import SerialspecError
 
 # A `]` that closes a link's text, with the destination after it: `[x](dest` (and `[x]: dest`, see DEFINITION)
@@ -117,6 +118,8 @@ def range_text(f: Field) -> str:
 
 def meaning(f: Field) -> str:
     parts = [f.description, *kind(f).meaning(f)]
+    if mangled(f.name) and not (isinstance(f, Scalar) and f.hidden):  # a hidden field is no attribute
+        parts.append(f"(In Python: `{python_name(f.name)}`.)")
     if f.inferred:
         parts.append(f"**Inferred layout:** {f.inferred}")
     return " ".join(p for p in parts if p)
@@ -292,7 +295,7 @@ def error_reply_text(protocol: Protocol, message: Message) -> str:
 def shared_reply_text(protocol: Protocol, message: Message) -> str:
     """A reply layout that shares its code (or its having none) with others: chosen by the request it answers."""
     layout = protocol.framing.layouts[Direction.RESPONSE]
-    code = protocol.command(message.command).code if layout.has_command else None
+    code = protocol.command(message.command).wire_code(Direction.RESPONSE) if layout.has_command else None
     sharing, asking = reply_sharing(protocol)
     if sharing[code] < 2:
         return ""
@@ -322,10 +325,18 @@ def reply_sharing(protocol: Protocol) -> tuple[Counter[int | None], dict[str, se
             if m.direction == Direction.REQUEST:
                 asking.setdefault(m.answered_by or m.key, set()).add(m.command)
             elif not m.unsolicited and not protocol.command(m.command).subcommands:
-                sharing[protocol.command(m.command).code if has_command else None] += 1
+                sharing[protocol.command(m.command).wire_code(Direction.RESPONSE) if has_command else None] += 1
         _SHARING.clear()  # one protocol at a time: the cache never holds on to old models
         cached = _SHARING[id(protocol)] = (protocol, sharing, asking)
     return cached[1], cached[2]
+
+
+def code_text(command: Command) -> str:
+    """A command's code as the reference shows it, with its replies' own where the command element computes one."""
+    if command.code is None:
+        return "—"
+    reply = command.wire_code(Direction.RESPONSE)
+    return f"{command.code:#04x}" + (f", reply {reply:#04x}" if reply != command.code else "")
 
 
 def command_context(protocol: Protocol, command: Command) -> dict[str, Any]:
@@ -348,7 +359,7 @@ def command_context(protocol: Protocol, command: Command) -> dict[str, Any]:
         )
     return {
         "name": command.name,
-        "code": f"{command.code:#04x}" if command.code is not None else "—",
+        "code": code_text(command),
         "title": text(command.title),
         "title_cn": text(command.title_cn),
         "description": text(command.description),
@@ -414,6 +425,9 @@ def frame_context(protocol: Protocol, layout: FrameLayout) -> dict[str, Any]:
             left_out = ", ".join(f"`{name}`" for name in e.checksum.skips)
             skips = f" leaving out {left_out}" if left_out else ""
             description = f"over `{e.checksum.first}`..`{e.checksum.last}`{skips}, {endian}. {e.description}"
+        elif e.role == "command" and layout.direction == Direction.RESPONSE and protocol.framing.reply_code:
+            computed = f"the code of the request it answers, as `{protocol.framing.reply_code}`"
+            description = ". ".join(p for p in (computed, e.description) if p)
         elif e.sequence:
             low, high = number(e.minimum), number(e.maximum)
             counts = f"sequence number the client fills in: {low} first, one more per request, {low} again after {high}"
@@ -746,6 +760,7 @@ def emit_docs(protocol: Protocol) -> str:
         transparency=transparency_text(protocol),
         shared_header=protocol.framing.shared_header,
         has_header=any(layout.header for layout in protocol.framing.layouts.values()),
+        reply_code=text(protocol.framing.reply_code),
         gap=number(protocol.framing.gap) if protocol.framing.gap else "",
         checksums=checksums_context(protocol),
         matching=", ".join(protocol.matching),

@@ -8,10 +8,11 @@ from __future__ import annotations
 from serialspec.backends.python.client import client_context
 from serialspec.backends.python.render import render
 from serialspec.lang.model import Protocol
+from serialspec.lang.names import python_view
 
 
 def aio_module(protocol: Protocol) -> str:
-    context = client_context(protocol)
+    context = client_context(python_view(protocol))
     # the names the classes use, with the blocking client's Iterator awaited
     abc_imports = sorted("AsyncIterator" if name == "Iterator" else name for name in context.pop("abc_imports"))
     return render("aio.py.j2", **context, abc_imports=abc_imports, aio=True)

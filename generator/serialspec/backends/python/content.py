@@ -68,6 +68,7 @@ from serialspec.lang.model import (
     fixed_size,
 )
 from serialspec.lang.model import Field as SpecField
+from serialspec.lang.names import spec_key
 
 Lines = list[str]
 _MOST_RUNS = 256  # the most items of a list read by a struct made for each count (see unpack_runs)
@@ -338,7 +339,7 @@ class PackageCode:
                     self.helper(inner)
                 inner_fields = [i for i in f.fields if not (isinstance(i, Scalar) and i.hidden)]
                 code = ClassCode(f.class_name, f"One item of {f.name}.", "", self.attributes(inner_fields, False))
-                code.to_fields = [f"{i.name!r}: {self.to_json(i, 'self.' + i.name)}," for i in inner_fields]
+                code.to_fields = [f"{spec_key(i.name)}: {self.to_json(i, 'self.' + i.name)}," for i in inner_fields]
                 code.read_from([self.from_json(i) for i in inner_fields])
                 self.helper_classes.append(code)
             case TableBlock() if f.class_name not in self._seen_classes:
@@ -393,7 +394,7 @@ class PackageCode:
             f"SUBCOMMAND: ClassVar[str | None] = {message.subcommand!r}",
             f"DIRECTION: ClassVar[Direction] = Direction.{message.direction.name}",
         ]
-        code.to_fields = [f"{f.name!r}: {self.to_json(f, 'self.' + f.name)}," for f in fields]
+        code.to_fields = [f"{spec_key(f.name)}: {self.to_json(f, 'self.' + f.name)}," for f in fields]
         code.read_from([self.from_json(f) for f in fields])
         self.message_classes.append(code)
         frame_names = [f.name for f in self.frame_values(message.direction, message)]
@@ -581,9 +582,9 @@ class PackageCode:
         if isinstance(f, Text) and isinstance(f.size, int):  # read as bytes by the run's struct
             if f.pad is not None:
                 self.packing.add("unpad_text")
-                return f"_unpad_text({name}, {f.pad}, {f.name!r}, {where})"
+                return f"_unpad_text({name}, {f.pad}, {spec_key(f.name)}, {where})"
             self.packing.add("decode_text")
-            return f"_decode_text({name}, {f.name!r}, {where})"
+            return f"_decode_text({name}, {spec_key(f.name)}, {where})"
         if not isinstance(f, Scalar):
             return name
         if f.odd_width:  # read as 3 bytes
@@ -758,16 +759,16 @@ class PackageCode:
         if f.size is None:
             body.append(Code("stop = buf.find(b'\\0', o, end)", cursor=True))
             body.append(If("stop < 0", (Raise(f"DecodeError({where} + ': {f.name} has no NUL at its end')"),)))
-            body.append(Code(f"{value} = _decode_text(buf[o:stop], {f.name!r}, {where})", cursor=True))
+            body.append(Code(f"{value} = _decode_text(buf[o:stop], {spec_key(f.name)}, {where})", cursor=True))
             body.append(Advance(to="stop + 1"))
             return value
         if f.size == "rest":
-            body.append(Code(f"{value} = _decode_text(buf[o:end], {f.name!r}, {where})", cursor=True))
+            body.append(Code(f"{value} = _decode_text(buf[o:end], {spec_key(f.name)}, {where})", cursor=True))
             body.append(Advance(to="end"))
             return value
         size = str(f.size) if isinstance(f.size, int) else self.local_named(f.size)
         body.append(Needs(size, f"DecodeError({where} + f': {f.name} needs {{{size}}} bytes, {{end - o}} left')"))
-        body.append(Code(f"{value} = _decode_text(buf[o : o + {size}], {f.name!r}, {where})", cursor=True))
+        body.append(Code(f"{value} = _decode_text(buf[o : o + {size}], {spec_key(f.name)}, {where})", cursor=True))
         body.append(Advance(size))
         return value
 
@@ -800,7 +801,7 @@ class PackageCode:
             frame_values.append(Simple(field_read("m", f.name)))
         fields = list(message.fields)
         self.check_count_from(message, body, where)
-        command_code = self.protocol.command(message.command).code
+        command_code = self.protocol.command(message.command).wire_code(message.direction)
         if not self.protocol.framing.classic:
             # the runtime's frame engine wraps the content (see backends/python/frames.py)
             parts = self.encode_fields(fields, message.class_name, "m", body, where)
@@ -949,7 +950,9 @@ class PackageCode:
         else:
             condition = f"not {low} <= {expr} <= {high}{not_bool}"
         broadcast = "" if also is None or f.minimum <= also <= f.maximum else f", {also}"
-        error = f"out_of_range({where}, {f.name!r}, {expr}, {number(f.minimum)}, {number(f.maximum)}{broadcast})"
+        error = (
+            f"out_of_range({where}, {spec_key(f.name)}, {expr}, {number(f.minimum)}, {number(f.maximum)}{broadcast})"
+        )
         body.append(If(condition, (Raise(error),)))
 
     def check_count_from(self, message: Message, body: Block, where: str) -> None:
@@ -979,7 +982,7 @@ class PackageCode:
         low, high = number(f.minimum), number(f.maximum)
         kind = f.item if isinstance(f, List) else None
         deferrable = kind is not None and not kind.is_float and (f.minimum, f.maximum) == (kind.minimum, kind.maximum)
-        error = f"out_of_range({where}, {f.name!r}, {expr}, {low}, {high})"
+        error = f"out_of_range({where}, {spec_key(f.name)}, {expr}, {low}, {high})"
         body.append(ItemsCheck(f"x_{f.name}", expr, low, high, error, deferrable))
 
     def encode_fields(self, fields: list[SpecField], base: str, obj: str, body: Block, where: str) -> list[str]:
@@ -1018,7 +1021,9 @@ class PackageCode:
             return Simple(number(f.const)) if f.const >= 0 else number(f.const)
 
         def out_of_range(value: str) -> Raise:
-            return Raise(f"out_of_range({where}, {f.name!r}, {value}, {number(f.minimum)}, {number(f.maximum)})")
+            return Raise(
+                f"out_of_range({where}, {spec_key(f.name)}, {value}, {number(f.minimum)}, {number(f.maximum)})"
+            )
 
         if f.value is not None or (f.derived and isinstance(self.sibling(siblings, f.derived[1]), List | Text)):
             value: str = Simple(self.local(f) if obj == "m" else f"{obj}_{f.name}")
@@ -1117,9 +1122,9 @@ class PackageCode:
         expr = field_read(obj, f.name)
         if isinstance(f.size, int) and f.pad is not None:
             self.packing.add("pad_text")
-            return f"_pad_text({expr}, {f.size}, {f.pad}, {f.name!r}, {where})"
+            return f"_pad_text({expr}, {f.size}, {f.pad}, {spec_key(f.name)}, {where})"
         self.packing.add("encode_text")
-        data = f"_encode_text({expr}, {f.name!r}, {where}, {f.size is None})"
+        data = f"_encode_text({expr}, {spec_key(f.name)}, {where}, {f.size is None})"
         if isinstance(f.size, int):
             local = self.local(f) if obj == "m" else f"{obj}_{f.name}"
             body.append(Code(f"{local} = {data}"))
@@ -1138,7 +1143,7 @@ class PackageCode:
                     body.append(If(f"len({expr}) != {f.count}", (Raise(count_error),)))
                 if f.item is None:
                     self.packing.add("pack_bits")
-                    return f"_pack_bits({expr}, {f.name!r}, {where})"
+                    return f"_pack_bits({expr}, {spec_key(f.name)}, {where})"
                 self.check_items(f, expr, body, where)
                 return PackItems(f.endian, f.item.struct_char, expr)
             case Text():
@@ -1155,7 +1160,10 @@ class PackageCode:
                 )
                 body.append(Code(f"low, high = _TABLE_{f.table.name.upper()}_RANGES[{key}]"))
                 body.append(
-                    If(f"not low <= {expr} <= high", (Raise(f"out_of_range({where}, {f.name!r}, {expr}, low, high)"),))
+                    If(
+                        f"not low <= {expr} <= high",
+                        (Raise(f"out_of_range({where}, {spec_key(f.name)}, {expr}, low, high)"),),
+                    )
                 )
                 return f"s.pack({expr})"
             case Group():

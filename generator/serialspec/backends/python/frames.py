@@ -156,7 +156,8 @@ def codec_lines(
 def code_key(command: Command, layout: FrameLayout) -> str:
     if any(m.error_reply for m in command.messages()):
         return ERROR_REPLY  # any code with the error flag (runtime.framing)
-    return "None" if command.code is None or not layout.has_command else f"{command.code:#04x}"
+    code = command.wire_code(layout.direction)
+    return "None" if code is None or not layout.has_command else f"{code:#04x}"
 
 
 def framing_imports(names: Iterable[str]) -> list[str]:

@@ -17,11 +17,12 @@ from serialspec.backends.python.render import one_line
 from serialspec.lang import expression
 from serialspec.lang.model import Array, Bytes, Group, List, Packed, Scalar, ScalarType, TableBlock, TableValue, Text
 from serialspec.lang.model import Field as SpecField
+from serialspec.lang.names import spec_key
 
 
 def _get(f: SpecField) -> Calls:
     """The expression reading a field's JSON value from `data` (the generated `from_fields`)."""
-    return Calls(f"_get(data, {f.name!r}, where)", ["_get"])
+    return Calls(f"_get(data, {spec_key(f.name)}, where)", ["_get"])
 
 
 class Kind(Generic[F]):
@@ -68,7 +69,7 @@ def _numbers_from_json(f: Array | List) -> Calls:
     """A list of numbers (or bits) from JSON, each checked to be one."""
     kind = "_bits" if f.item is None else "_numbers" if f.item.is_float else "_integers"
     get = _get(f)
-    return Calls(f"{kind}({get}, {f.name!r}, where)", [kind], get)
+    return Calls(f"{kind}({get}, {spec_key(f.name)}, where)", [kind], get)
 
 
 def _numbers(is_float: bool) -> str:
@@ -168,18 +169,20 @@ class ScalarKind(Kind[Scalar]):
         get = _get(f)
         if f.bits:
             # errors inside name the field too: "spin request method: direction must be an integer"
-            text = f"{f.bits_class}.from_fields(_mapping({get}, {f.name!r}, where), where + {' ' + f.name!r})"
+            text = f"{f.bits_class}.from_fields(_mapping({get}, {spec_key(f.name)}, where), where + {' ' + f.name!r})"
             return Calls(text, ["_mapping"], get)
         if f.enum:
-            return Calls(f"_as_enum({f.enum.class_name}, {get}, {f.name!r}, where)", ["_as_enum"], get)
+            return Calls(f"_as_enum({f.enum.class_name}, {get}, {spec_key(f.name)}, where)", ["_as_enum"], get)
         if f.flags:
             return Calls(
-                f"_as_flags({f.flags.class_name}, {get}, {int(f.maximum)}, {f.name!r}, where)", ["_as_flags"], get
+                f"_as_flags({f.flags.class_name}, {get}, {int(f.maximum)}, {spec_key(f.name)}, where)",
+                ["_as_flags"],
+                get,
             )
         if f.default is not None:
-            get = Calls(f"data.get({f.name!r}, {number(f.default)})", [])
+            get = Calls(f"data.get({spec_key(f.name)}, {number(f.default)})", [])
         kind = "_number" if f.type.is_float else "_integer"
-        return Calls(f"{kind}({get}, {f.name!r}, where)", [kind], get)
+        return Calls(f"{kind}({get}, {spec_key(f.name)}, where)", [kind], get)
 
     def blank(self, f: Scalar) -> str:
         if f.bits:
@@ -232,7 +235,7 @@ class PackedKind(Kind[Packed]):
 
     def from_json(self, f: Packed) -> Calls:
         get = _get(f)
-        return Calls(f"_integers({get}, {f.name!r}, where)", ["_integers"], get)
+        return Calls(f"_integers({get}, {spec_key(f.name)}, where)", ["_integers"], get)
 
     def blank(self, f: Packed) -> str:
         return f"[{number(max(f.minimum, min(0, f.maximum)))}] * {f.count}"
@@ -283,7 +286,7 @@ class TextKind(Kind[Text]):
 
     def from_json(self, f: Text) -> Calls:
         get = _get(f)
-        return Calls(f"_text({get}, {f.name!r}, where)", ["_text"], get)
+        return Calls(f"_text({get}, {spec_key(f.name)}, where)", ["_text"], get)
 
     def blank(self, f: Text) -> str:
         return repr(" " * f.size) if isinstance(f.size, int) and f.pad is None else "''"
@@ -314,7 +317,7 @@ class BytesKind(Kind[Bytes]):
 
     def from_json(self, f: Bytes) -> Calls:
         get = _get(f)
-        return Calls(f"_bytes({get}, {f.name!r}, where)", ["_bytes"], get)
+        return Calls(f"_bytes({get}, {spec_key(f.name)}, where)", ["_bytes"], get)
 
     def blank(self, f: Bytes) -> str:
         return repr(" ".join(["00"] * f.size)) if isinstance(f.size, int) else "''"
@@ -358,8 +361,8 @@ class GroupKind(Kind[Group]):
     def from_json(self, f: Group) -> Calls:
         get = _get(f)
         text = (
-            f"tuple({f.class_name}.from_fields(_mapping(item, {f.name!r}, where), where) "
-            f"for item in _items({get}, {f.name!r}, where))"
+            f"tuple({f.class_name}.from_fields(_mapping(item, {spec_key(f.name)}, where), where) "
+            f"for item in _items({get}, {spec_key(f.name)}, where))"
         )
         return Calls(text, ["_mapping", "_items"], get)
 
@@ -400,7 +403,7 @@ class TableBlockKind(Kind[TableBlock]):
 
     def from_json(self, f: TableBlock) -> Calls:
         get = _get(f)
-        text = f"{f.class_name}.from_fields(_mapping({get}, {f.name!r}, where), where + {' ' + f.name!r})"
+        text = f"{f.class_name}.from_fields(_mapping({get}, {spec_key(f.name)}, where), where + {' ' + f.name!r})"
         return Calls(text, ["_mapping"], get)
 
     def blank(self, f: TableBlock) -> str:

@@ -81,7 +81,8 @@ def length_byte_codec_context(protocol: Protocol, code: PackageCode) -> dict[str
             if entry is None:
                 continue
             target, low, high, sub_dispatch = entry
-            key = "None" if command.code is None else f"{command.code:#04x}"
+            wire = command.wire_code(direction)
+            key = "None" if wire is None else f"{wire:#04x}"
             if direction == Direction.REQUEST and command.request is not None and command.selector is None:
                 shared.setdefault(key, []).append(command.request)
             dispatch.append((key, target))
@@ -381,7 +382,7 @@ def rest_frames(
     found = []
     shared = shared_codes(protocol, layout.direction)
     for command in protocol.commands:
-        if command.code in shared:
+        if command.wire_code(layout.direction) in shared:
             continue  # its length bytes may name a request of the same code: its size dispatch picks
         message = command.request if layout.direction == Direction.REQUEST else command.response
         if command.selector is not None or message is None or message.max_size is not None or not message.fields:
@@ -422,7 +423,7 @@ def rest_frames(
                     "returns": returns,
                     "where": f"{message.key} {message.direction.value}",
                     "whole_lines": fuse_unpack([*check, *values, *body]),
-                    "code": command.code,
+                    "code": command.wire_code(layout.direction),
                     "lengths": (lowest, length.type.maximum),
                     "adds": layout.overhead - layout.length_adds,  # frame size = length byte + this
                 }
@@ -473,7 +474,7 @@ def subcommand_rest_frames(
                 "returns": "Message",
                 "where": f"{command.name} {layout.direction.value}",
                 "whole_lines": [*lines, RETURN_NONE],
-                "code": command.code,
+                "code": command.wire_code(layout.direction),
                 # the sub-command's byte lies within the content: no smaller content reaches the picker
                 "lengths": (max(smallest, at + 1) + layout.length_adds, min(largest, length.type.maximum)),
                 "adds": layout.overhead - layout.length_adds,  # frame size = length byte + this
@@ -572,7 +573,7 @@ def frame_function(
     length_byte = (message.min_size or 0) + layout.length_adds
     known = dict(enumerate(layout.header)) | {layout.length_offset: length_byte}
     if layout.command_offset is not None:
-        known[layout.command_offset] = command.code or 0
+        known[layout.command_offset] = command.wire_code(layout.direction) or 0
 
     def statements(at: Callable[[int], str], whole: bool) -> tuple[Block, bool]:
         """The decoder's statements with frame offsets `at` (buf[start:] or all of buf: `whole`), and whether its
@@ -581,7 +582,9 @@ def frame_function(
             Code(f"{e.name} = buf[{at(layout.offsets[e.name])}]", reads=(layout.offsets[e.name],))
             for e in layout.value_elements
         ]
-        summed = sum_from_values(protocol, layout, command.code, length_byte, size, body, code, at)
+        summed = sum_from_values(
+            protocol, layout, command.wire_code(layout.direction), length_byte, size, body, code, at
+        )
         if summed is not None:
             return [*values, *summed, *body[1:]], True
         check = whole_frame_check(protocol, layout, size, known, at) if whole else None
@@ -602,7 +605,9 @@ def frame_function(
     plain = unpacked_frame(protocol, layout, body)
     function["plain"] = plain if not summed else None
     function["run"] = run_frames(layout, message, size, plain, code)
-    key = length_byte if layout.command_offset is None else (command.code or 0) << 8 | length_byte
+    key = (
+        length_byte if layout.command_offset is None else (command.wire_code(layout.direction) or 0) << 8 | length_byte
+    )
     return key, size, function
 
 

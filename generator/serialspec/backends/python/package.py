@@ -43,6 +43,7 @@ from serialspec.lang.model import (
     replies_by_request,
     reply_to,
 )
+from serialspec.lang.names import python_view, spec_name
 
 
 def class_context(cls: ClassCode, where: str, keys: list[str], optional: list[str]) -> dict[str, Any]:
@@ -56,7 +57,8 @@ def class_context(cls: ClassCode, where: str, keys: list[str], optional: list[st
         "from_fields": cls.from_fields,
         "where": where,
         "keys": repr(tuple(keys)),
-        "optional_keys": repr(tuple(optional)),
+        "json_keys": repr(tuple(spec_name(key) for key in keys)),  # a keyword's field: its spec name in JSON
+        "optional_keys": repr(tuple(spec_name(key) for key in optional)),
     }
 
 
@@ -67,6 +69,8 @@ def _keys(cls: ClassCode) -> list[str]:
 @without_cycle_collection
 def emit_package(protocol: Protocol) -> dict[str, str]:
     """File name (relative to the package folder) -> text."""
+    spec = protocol  # the spec's names, for the simulator: it works on to_fields()'s dicts, keyed by them
+    protocol = python_view(protocol)  # fields named after Python keywords: their attributes (`class_`)
     code = PackageCode(protocol)
     base = {"spec_path": protocol.spec_path, "title": one_line(protocol.title), "package": protocol.name}
     messages = {m.class_name: m for m in protocol.messages()}
@@ -140,7 +144,7 @@ def emit_package(protocol: Protocol) -> dict[str, str]:
     if register_tables(protocol):
         files["registers.py"] = registers_module(protocol)
     if protocol.device is not None:
-        files["simulator.py"] = simulator_module(protocol)
+        files["simulator.py"] = simulator_module(spec)
     return files
 
 

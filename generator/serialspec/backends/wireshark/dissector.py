@@ -111,12 +111,12 @@ def _direction(protocol: Protocol, direction: Direction) -> dict[str, Any]:
                 sizes = {(m["min"], m["max"]) for m in subs.values()}
                 entry["min"] = min(low for low, _ in sizes)
                 entry["max"] = None if any(high is None for _, high in sizes) else max(h for _, h in sizes if h)
-                codes.setdefault(_code(command.code if coded else None), entry)
+                codes.setdefault(_code(command.wire_code(direction) if coded else None), entry)
                 continue
         message = command.request if direction == Direction.REQUEST else command.response
         if message is None:
             continue
-        key = _code(command.code if coded else None)
+        key = _code(command.wire_code(direction) if coded else None)
         if protocol.error_reply is not None and command.name == protocol.error_reply.command:
             key = "error"
         if key in codes and direction == Direction.REQUEST:  # requests sharing a code: by their content size

@@ -275,13 +275,24 @@ class Pass:
 
     # --- names and references -------------------------------------------------------------------------------------
 
-    def name(self, value: str, path: Path, what: str = "name", reserved: frozenset[str] = RESERVED_NAMES) -> str:
+    def name(
+        self,
+        value: str,
+        path: Path,
+        what: str = "name",
+        reserved: frozenset[str] = RESERVED_NAMES,
+        keywords: bool = False,
+    ) -> str:
+        """A name the spec gives; `keywords`: a Python keyword is allowed (a field: generated Python calls it
+        `class_`, see lang/names.py), and a keyword with an underscore after it is not (that is its Python name)."""
         if not isinstance(value, str) or not NAME.match(value):
             self.error(
                 path,
                 f"{what} {value!r} must be a lower-case identifier (a-z, 0-9, _; starting with a letter)",
             )
-        elif keyword.iskeyword(value) or value in reserved:
+        elif keywords and value.endswith("_") and keyword.iskeyword(value[:-1]):
+            self.error(path, f"{what} {value!r} is the Python name of a field {value[:-1]!r}: call it {value[:-1]!r}")
+        elif (keyword.iskeyword(value) and not keywords) or value in reserved:
             self.error(path, f"{what} {value!r} is reserved (a Python keyword or a name generated code uses)")
         return str(value)
 

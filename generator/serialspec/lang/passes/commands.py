@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Any, Literal
 
 from serialspec.checksums.seed import Seeded
+from serialspec.lang import expression
 from serialspec.lang.errors import SpecError
 from serialspec.lang.loader import Path
 from serialspec.lang.model import (
@@ -46,6 +48,7 @@ class Commands(FieldResolver):
             if command:
                 self.ctx.commands.append(command)
         if self.ctx.framing:
+            self.ctx.commands[:] = self.reply_codes(self.ctx.commands, self.ctx.framing)
             self.check_codes(self.ctx.commands, self.ctx.framing)
             self.check_lengths(self.ctx.commands, self.ctx.framing)
             self.check_seeds(self.ctx.framing)
@@ -53,6 +56,73 @@ class Commands(FieldResolver):
         self.check_request_references(self.ctx.commands)
         self.check_matching(self.ctx.commands, self.ctx.framing)
         return self.problems
+
+    def reply_codes(self, commands: list[Command], framing: Framing) -> list[Command]:
+        """The command element's `reply_code`: each command's response code, computed from its code."""
+        raw = self.section("framing")
+        sources: list[tuple[Path, Any]] = [(("framing", "elements"), raw.get("elements"))]
+        layouts = raw.get("layouts")
+        for name, layout in layouts.items() if isinstance(layouts, dict) else ():
+            if isinstance(layout, dict):
+                sources.append((("framing", "layouts", name, "elements"), layout.get("elements")))
+        found: list[tuple[Path, str]] = []
+        for path, elements in sources:
+            for name, item in elements.items() if isinstance(elements, dict) else ():
+                if isinstance(item, dict) and "reply_code" in item:
+                    where = (*path, name, "reply_code")
+                    if item.get("role") != "command":
+                        self.error(where, "`reply_code` goes on the command element")
+                    else:
+                        found.append((where, str(item["reply_code"])))
+        if not found:
+            return commands
+        if len({text for _, text in found}) > 1:
+            self.error(found[1][0], "every layout's command element must give the same `reply_code`")
+        where, text = found[0]
+        try:
+            expr = expression.parse(text)
+        except expression.ExpressionError as exc:
+            self.error(where, str(exc))
+            return commands
+        if set(expression.names(expr)) != {"code"}:
+            self.error(where, "an expression of `code` (the request's code), e.g. `code | 0x40`")
+            return commands
+        element = next((e for e in framing.layouts[Direction.RESPONSE].elements if e.role == "command"), None)
+        if element is None or element.type is None or element.constant:
+            self.error(where, "response frames carry no command code (the element is limited to requests or constant)")
+            return commands
+        low, high = int(element.type.minimum), int(element.type.maximum)
+        try:
+            expression.bounds(expr, {"code": (low, high)})  # refuses what could grow without limit
+        except expression.ExpressionError as exc:
+            self.error(where, str(exc))
+            return commands
+        shown = " ".join(text.split())
+        self.ctx.framing = replace(framing, reply_code=shown)
+        resolved = []
+        for command in commands:
+            replies = any(m.direction == Direction.RESPONSE for m in command.messages())
+            if (
+                isinstance(command.code, int)
+                and not isinstance(command.code, bool)
+                and low <= command.code <= high
+                and replies
+            ):
+                try:
+                    code = expression.evaluate(expr, {"code": command.code})
+                except (ZeroDivisionError, ValueError) as exc:
+                    self.error(("commands", command.name, "code"), f"its reply code {shown}: {exc}")
+                else:
+                    if low <= code <= high:
+                        command = replace(command, response_code=code)
+                    else:
+                        self.error(
+                            ("commands", command.name, "code"),
+                            f"its reply code {code} ({shown}) does not fit the {element.type.name} "
+                            f"command element ({low}..{high})",
+                        )
+            resolved.append(command)
+        return resolved
 
     def check_seeds(self, framing: Framing) -> None:
         """A command's `checksum_seed` belongs to a frame with a `seed: per_command` checksum."""
@@ -278,7 +348,7 @@ class Commands(FieldResolver):
                         ("commands", command.name),
                         f"missing key 'code' ({direction.value} frames carry a command field)",
                     )
-                code = command.code if layout.has_command else None
+                code = command.wire_code(direction) if layout.has_command else None
                 sharing.setdefault(code, []).append((command, messages[0]))
             for code, users in sharing.items():
                 if len(users) < 2:

@@ -57,7 +57,7 @@ class FieldResolver(Pass):
         resolved: list[Field] = []
         for name, item in raw.items():
             field_path = (*path, name)
-            self.name(name, field_path, "field name", RESERVED_FIELD_NAMES)
+            self.name(name, field_path, "field name", RESERVED_FIELD_NAMES, keywords=True)
             if any(f.name == name for f in resolved):
                 self.error(field_path, f"duplicate field {name!r}")
             field = self.guard(field_path, self.field, name, item, field_path, resolved, parent)

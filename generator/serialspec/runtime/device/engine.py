@@ -14,7 +14,7 @@ from typing import Any
 
 from serialspec.runtime.device.faults import Fault, FaultInjection
 from serialspec.runtime.errors import DecodeError, EncodeError
-from serialspec.runtime.message import Message, compare, field_names, is_sequence
+from serialspec.runtime.message import Message, compare, field_keys, is_sequence
 from serialspec.runtime.registers import RegisterMap
 from serialspec.runtime.stream import StreamParser
 
@@ -557,7 +557,7 @@ class Engine(FaultInjection):
                 frames = [self._absent(command, given)]
             for frame in frames:
                 if frame is not None and (not broadcast or command.broadcast_reply):
-                    delay = float(getattr(request, command.after, 0)) / 1000 if command.after else 0.0
+                    delay = float(given.get(command.after, 0)) / 1000 if command.after else 0.0
                     replies.append((self.clock() + delay, frame))
             if self.spec.sends and not command.kind:
                 at = max((when for when, _ in replies), default=self.clock())
@@ -593,7 +593,7 @@ class Engine(FaultInjection):
         """The reply a bus master gives for an id no device has: the request's fields, `absent` values, else 0."""
         if command.response is None:
             return None
-        values = {name: command.absent.get(name, given.get(name, 0)) for name in field_names(command.response)}
+        values = {name: command.absent.get(name, given.get(name, 0)) for name in field_keys(command.response)}
         return self._encode_reply(command.response, values)
 
     def _encode_reply(self, response: type[Message], values: dict[str, Any]) -> bytes | None:
@@ -686,7 +686,7 @@ class Engine(FaultInjection):
         if response is None:
             return None
         values: dict[str, Any] = {}
-        for name in field_names(response):
+        for name in field_keys(response):
             if name in command.space_reads and not refused:
                 values[name] = self._read_space(device, command.space_reads[name], given)
             elif name in command.reads and not refused:

@@ -111,6 +111,7 @@ CASES: dict[str, Case] = {
     "array of bit, count field": same(with_count({"type": "array", "of": "bit"})),
     "array, count field": same(with_count({"type": "array", "of": "u16"})),
     "array, count rest": same({"items": {"type": "array", "of": "u16", "count": "rest"}}),
+    "array of i64, count rest": same({"items": {"type": "array", "of": "i64", "count": "rest"}}),
     "array, size field": same(
         {"size": {"type": "u8", "value": "2 * len(items)"}, "items": {"type": "array", "of": "u16", "size": "size"}}
     ),

@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 from typing import assert_never
 
 from serialspec.backends import Unsupported
+from serialspec.backends.c import packed
 from serialspec.backends.c.checksums import c_checksum
 from serialspec.backends.common.text import collapse
 from serialspec.checksums.base import CCode
@@ -124,16 +125,29 @@ def value_type(f: Scalar) -> ScalarType:
 
 
 def ctype(t: ScalarType) -> str:
+    """The C type holding a scalar's value: 3-byte integers in 32 bits, f64 as double."""
     if t.is_float:
-        return "float"
-    return f"{'int' if t.signed else 'uint'}{t.size * 8}_t"
+        return "double" if t.size == 8 else "float"
+    bits = {1: 8, 2: 16, 3: 32, 4: 32, 8: 64}[t.size]
+    return f"{'int' if t.signed else 'uint'}{bits}_t"
+
+
+def wide(t: ScalarType) -> bool:
+    """A scalar read and written as 64 bits (uint64_t on the wire side)."""
+    return t.size == 8
 
 
 def cint(value: float, t: ScalarType) -> str:
     """A literal of a scalar's type (float bounds as float literals, integers with their suffix)."""
+    if t.is_float and wide(t):
+        return f"{float(value)!r}"
     if t.is_float:
         return f"{float(value)!r}f" if abs(value) < 3.4e38 else ("3.40282347e+38f" if value > 0 else "-3.40282347e+38f")
     v = int(value)
+    if wide(t):
+        if t.signed:
+            return f"({v + 1}LL - 1LL)" if v == -(1 << 63) else f"{v}LL"
+        return f"{v}ULL"
     if t.signed:
         return f"({v + 1}L - 1L)" if v == -0x80000000 else f"{v}L"
     return f"{v}UL" if v > 0xFFFF else f"{v}u"
@@ -220,22 +234,16 @@ def refuse_fields(fields: tuple[Field, ...], where: str, nested: bool = False) -
             case Scalar():
                 if f.value is not None and nested:
                     raise Unsupported(f"{where}: {f.name}: a value computed by an expression inside a group")
-                if f.type.size not in (1, 2, 4):
-                    raise Unsupported(f"{where}: {f.name}: fields of type {f.type.name}")
-            case Array():
-                if f.item.size not in (1, 2, 4):
-                    raise Unsupported(f"{where}: {f.name}: arrays of {f.item.name}")
-            case Packed():
-                raise Unsupported(f"{where}: {f.name}: packed arrays of {f.bits}-bit integers")
+                if f.sign_magnitude and wide(f.type):
+                    raise Unsupported(f"{where}: {f.name}: sign-magnitude {f.type.name}")
+            case Array() | Packed():
+                pass
             case List():
-                if f.item is not None and f.item.size not in (1, 2, 4):
+                if f.item is not None and f.item.size not in (1, 2, 4, 8):
                     raise Unsupported(f"{where}: {f.name}: lists of {f.item.name}")
                 if f.item is not None and f.item.is_float:
                     raise Unsupported(f"{where}: {f.name}: lists of floats")
-            case Text():
-                if f.pad is not None:
-                    raise Unsupported(f"{where}: {f.name}: padded strings")
-            case Bytes():
+            case Text() | Bytes():
                 pass
             case Group():
                 refuse_fields(f.fields, where, True)
@@ -393,8 +401,8 @@ def members(ctx: Ctx, fields: tuple[Field, ...], path: str, room: int) -> list[M
                     macro = cap_macro(ctx, f"{path}_{f.name}", most)
                     found.append(Member(name, f"{ctype(f.item)} {name}[{macro}];", doc))
                     found.append(Member(f"{name}_count", f"size_t {name}_count;", f"items in {f.name}"))
-            case Packed():  # refused by refuse_fields
-                raise Unsupported(f"{f.name}: packed arrays")
+            case Packed():
+                found.append(Member(name, f"{ctype(packed.item_type(f))} {name}[{f.count}];", doc))
             case _:
                 assert_never(f)
     return found
@@ -420,15 +428,36 @@ class Scope:
         raise Unsupported(f"a size or count from field {name}, which the C target cannot reach")
 
 
+def get_raw(ctx: Ctx, t: ScalarType, endian: str, at: str) -> str:
+    """A scalar's wire bits: uint32_t, or uint64_t for 8-byte types (built with shifts, whatever the host)."""
+    if wide(t):
+        ctx.helpers.add("get64")
+        return f"{ctx.p}__get64({at}, {1 if endian == '>' else 0}u)"
+    return f"{ctx.p}__get({at}, {t.size}u, {1 if endian == '>' else 0}u)"
+
+
+def put_call(ctx: Ctx, t: ScalarType, endian: str, at: str, value: str) -> str:
+    """The statement writing a scalar's wire bits (scalar_bits) at `at`."""
+    if wide(t):
+        ctx.helpers.add("put64")
+        return f"{ctx.p}__put64({at}, {1 if endian == '>' else 0}u, {value});"
+    return f"{ctx.p}__put({at}, {t.size}u, {1 if endian == '>' else 0}u, {value});"
+
+
 def read_scalar(ctx: Ctx, t: ScalarType, endian: str, at: str) -> str:
-    raw = f"{ctx.p}__get({at}, {t.size}u, {1 if endian == '>' else 0}u)"
+    raw = get_raw(ctx, t, endian, at)
     if t.is_float:
-        ctx.helpers.add("f32")
-        return f"{ctx.p}__f32({raw})"
+        ctx.helpers.add(f"f{t.size * 8}")
+        return f"{ctx.p}__f{t.size * 8}({raw})"
     if t.signed:
         ctx.helpers.add(f"s{t.size * 8}")
         return f"{ctx.p}__s{t.size * 8}({raw})"
-    return raw if t.size == 4 else f"({ctype(t)}){raw}"
+    return raw if t.size in (3, 4, 8) else f"({ctype(t)}){raw}"
+
+
+def hidden_type(f: Scalar) -> str:
+    """The local holding a hidden value's wire bits while decoding."""
+    return "uint64_t" if wide(f.type) else "uint32_t"
 
 
 def decode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[str], depth: int) -> None:
@@ -449,16 +478,16 @@ def decode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                     ctx.helpers.add("sm")
                 if f.const is not None:
                     out.append(
-                        f"{pad}if ({ctx.p}__get(c + o, {size}u, {1 if f.endian == '>' else 0}u) != "
-                        f"{f.const}UL) {{ return {ctx.P}_E_CONTENT; }}"
+                        f"{pad}if ({get_raw(ctx, f.type, f.endian, 'c + o')} != "
+                        f"{f.const}{'ULL' if wide(f.type) else 'UL'}) {{ return {ctx.P}_E_CONTENT; }}"
                     )
                 elif f.hidden:
                     local = f"d{depth}_{name}"
-                    out.append(f"{pad}{local} = {ctx.p}__get(c + o, {size}u, {1 if f.endian == '>' else 0}u);")
+                    out.append(f"{pad}{local} = {get_raw(ctx, f.type, f.endian, 'c + o')};")
                     scope.names[f.name] = local
                 else:
                     out.append(f"{pad}{tgt} = {value};")
-                    scope.names[f.name] = f"(uint32_t){tgt}" if not f.type.is_float else tgt
+                    scope.names[f.name] = f"(uint32_t){tgt}" if not (f.type.is_float or wide(f.type)) else tgt
                 out.append(f"{pad}o += {size}u;")
             case Array():
                 total = f.count * f.item.size
@@ -482,7 +511,16 @@ def decode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                     out.append(f"{pad}len = (size_t){scope.lookup(f.size)};")
                 if not terminated:
                     out.append(f"{pad}if (n - o < len) {{ return {ctx.P}_E_LENGTH; }}")
-                if isinstance(f, Text):
+                if isinstance(f, Text) and f.pad is not None:  # the text without the pad bytes after it
+                    out.append(f"{pad}for (k = len; k > 0u && c[o + k - 1u] == 0x{f.pad:02x}u; k--) {{ }}")
+                    out.append(f"{pad}if (k > sizeof({tgt}) - 1u) {{ return {ctx.P}_E_CAPACITY; }}")
+                    out.append(f"{pad}if (!{ctx.p}__utf8(c + o, k)) {{ return {ctx.P}_E_CONTENT; }}")
+                    ctx.helpers.add("utf8")
+                    out.append(f"{pad}memcpy({tgt}, c + o, k);")
+                    out.append(f"{pad}{tgt}[k] = '\\0';")
+                    out.append(f"{pad}{tgt}_len = k;")
+                    out.append(f"{pad}o += len;")
+                elif isinstance(f, Text):
                     out.append(f"{pad}if (len > sizeof({tgt}) - 1u) {{ return {ctx.P}_E_CAPACITY; }}")
                     out.append(f"{pad}if (!{ctx.p}__utf8(c + o, len)) {{ return {ctx.P}_E_CONTENT; }}")
                     ctx.helpers.add("utf8")
@@ -505,7 +543,7 @@ def decode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                 body: list[str] = []
                 hidden = [x for x in f.fields if isinstance(x, Scalar) and x.hidden and x.const is None]
                 for h in hidden:
-                    body.append(f"{pad}    uint32_t d{depth + 1}_{ident(h.name)};")
+                    body.append(f"{pad}    {hidden_type(h)} d{depth + 1}_{ident(h.name)};")
                 decode_fields(ctx, f.fields, item_scope, body, depth + 1)
                 capacity = f"(sizeof({tgt}) / sizeof({tgt}[0]))"
                 if isinstance(f.count, int) or f.count != "rest":
@@ -588,8 +626,8 @@ def decode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                     out.append(f"{pad}    {tgt}[i{depth}] = {value};")
                     out.append(f"{pad}}}")
                 out.append(f"{pad}o += len;")
-            case Packed():  # refused by refuse_fields
-                raise Unsupported(f"{f.name}: packed arrays")
+            case Packed():
+                out.extend(packed.decode(ctx.p, ctx.P, f, tgt, pad, f"i{depth}", ctx.helpers))
             case _:
                 assert_never(f)
 
@@ -642,6 +680,14 @@ def uses(fields: tuple[Field, ...], kinds: tuple[type, ...]) -> bool:
     return False
 
 
+def uses_k(fields: tuple[Field, ...]) -> bool:
+    """A text whose end is found by a scan (NUL-terminated, or padded) at any depth: the decoder's `k`."""
+    return any(
+        (isinstance(f, Text) and (f.terminated or f.pad is not None)) or (isinstance(f, Group) and uses_k(f.fields))
+        for f in fields
+    )
+
+
 def depth_of(fields: tuple[Field, ...]) -> int:
     return max((1 + depth_of(f.fields) for f in fields if isinstance(f, Group)), default=0)
 
@@ -654,14 +700,14 @@ def decoder(ctx: Ctx, message: Message) -> str:
     locals_ = ["    size_t o = 0u;"]
     if uses(message.fields, (Bytes, Text, List)):
         locals_.append("    size_t len;")
-    if any(isinstance(f, Text) and f.terminated for f in message.fields):
+    if uses_k(message.fields):
         locals_.append("    size_t k;")
     for d in range(1, depth_of(message.fields) + 2):
         if any(f"i{d}" in line for line in body):
             locals_.append(f"    size_t i{d};")
     for f in message.fields:
         if isinstance(f, Scalar) and f.hidden and f.const is None:
-            locals_.append(f"    uint32_t d1_{ident(f.name)};")
+            locals_.append(f"    {hidden_type(f)} d1_{ident(f.name)};")
     low, high = message.min_size, message.max_size
     size_check = (
         f"    if (n != {low}u) {{ return {ctx.P}_E_LENGTH; }}"
@@ -693,10 +739,13 @@ def decoder(ctx: Ctx, message: Message) -> str:
 
 
 def scalar_bits(ctx: Ctx, t: ScalarType, expr: str) -> str:
-    """The wire value of a scalar as uint32_t (two's complement for signed, IEEE bits for f32)."""
+    """The wire value of a scalar as uint32_t, uint64_t for 8-byte types (two's complement for signed, IEEE bits
+    for floats)."""
     if t.is_float:
-        ctx.helpers.add("f32bits")
-        return f"{ctx.p}__f32bits({expr})"
+        ctx.helpers.add(f"f{t.size * 8}bits")
+        return f"{ctx.p}__f{t.size * 8}bits({expr})"
+    if wide(t):
+        return f"(uint64_t)({expr})"
     if t.signed:
         mask = (1 << (8 * t.size)) - 1
         return f"((uint32_t)(int32_t)({expr}) & 0x{mask:x}u)"
@@ -740,7 +789,8 @@ def check_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[st
             case Text():
                 out.append(f"{pad}if ({tgt}_len > sizeof({tgt}) - 1u) {{ return {ctx.P}_E_RANGE; }} /* {f.name} */")
                 if isinstance(f.size, int):
-                    out.append(f"{pad}if ({tgt}_len != {f.size}u) {{ return {ctx.P}_E_RANGE; }} /* {f.name} */")
+                    fits = ">" if f.pad is not None else "!="  # padded: at most its size, else exactly
+                    out.append(f"{pad}if ({tgt}_len {fits} {f.size}u) {{ return {ctx.P}_E_RANGE; }} /* {f.name} */")
                 ctx.helpers.add("utf8")
                 nul = f" || memchr({tgt}, 0, {tgt}_len) != NULL" if f.terminated else ""
                 out.append(
@@ -785,8 +835,12 @@ def check_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[st
                         out.append(f"{pad}for (i{depth} = 0u; i{depth} < {tgt}_count; i{depth}++) {{")
                         out.append(f"{pad}    if ({test}) {{ return {ctx.P}_E_RANGE; }} /* {f.name} */")
                         out.append(f"{pad}}}")
-            case Packed():  # refused by refuse_fields
-                raise Unsupported(f"{f.name}: packed arrays")
+            case Packed():
+                test = range_test(f.minimum, f.maximum, packed.item_type(f), f"{tgt}[i{depth}]")
+                if test:
+                    out.append(f"{pad}for (i{depth} = 0u; i{depth} < {f.count}u; i{depth}++) {{")
+                    out.append(f"{pad}    if ({test}) {{ return {ctx.P}_E_RANGE; }} /* {f.name} */")
+                    out.append(f"{pad}}}")
             case _:
                 assert_never(f)
 
@@ -837,30 +891,25 @@ def encode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
             case Scalar():
                 size = f.type.size
                 if f.const is not None:
-                    value = f"{f.const}UL"
+                    value = f"{f.const}{'ULL' if wide(f.type) else 'UL'}"
                 elif f.derived:
                     value = scope.lookup(f.name)
                 elif f.value is not None:
-                    value = f"(uint32_t){scope.lookup(f.name)}"
+                    value = f"(uint{64 if wide(f.type) else 32}_t){scope.lookup(f.name)}"
                 else:
                     value = scalar_bits(ctx, f.type, tgt)
                     if f.sign_magnitude:
                         top = 1 << (8 * size - 1)
                         value = f"({tgt} < 0 ? ((uint32_t)(-(int32_t){tgt}) | 0x{top:x}UL) : (uint32_t){tgt})"
                 out.append(f"{pad}if (cap - o < {size}u) {{ return {ctx.P}_E_BUFFER; }}")
-                out.append(
-                    f"{pad}{ctx.p}__put(c + o, {size}u, {1 if f.endian == '>' else 0}u, {value}); /* {f.name} */"
-                )
+                out.append(f"{pad}{put_call(ctx, f.type, f.endian, 'c + o', value)} /* {f.name} */")
                 out.append(f"{pad}o += {size}u;")
             case Array():
                 total = f.count * f.item.size
                 out.append(f"{pad}if (cap - o < {total}u) {{ return {ctx.P}_E_BUFFER; }}")
                 out.append(f"{pad}for (i{depth} = 0u; i{depth} < {f.count}u; i{depth}++) {{")
                 value = scalar_bits(ctx, f.item, f"{tgt}[i{depth}]")
-                big = 1 if f.endian == ">" else 0
-                out.append(
-                    f"{pad}    {ctx.p}__put(c + o + i{depth} * {f.item.size}u, {f.item.size}u, {big}u, {value});"
-                )
+                out.append(f"{pad}    {put_call(ctx, f.item, f.endian, f'c + o + i{depth} * {f.item.size}u', value)}")
                 out.append(f"{pad}}}")
                 out.append(f"{pad}o += {total}u;")
             case Bytes() | Text():
@@ -868,6 +917,12 @@ def encode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                 extra = " + 1u" if isinstance(f, Text) and f.terminated else ""
                 if isinstance(f.size, str) and f.size != "rest" and f.size not in scope.names:
                     pass  # sized by a field of an outer scope: the derived check made every item agree
+                if isinstance(f, Text) and f.pad is not None:  # the text, then pad bytes up to its size
+                    out.append(f"{pad}if (cap - o < {f.size}u) {{ return {ctx.P}_E_BUFFER; }}")
+                    out.append(f"{pad}memcpy(c + o, {tgt}, {length}); /* {f.name} */")
+                    out.append(f"{pad}memset(c + o + {length}, 0x{f.pad:02x}, {f.size}u - {length});")
+                    out.append(f"{pad}o += {f.size}u;")
+                    continue
                 out.append(f"{pad}if (cap - o < {length}{extra}) {{ return {ctx.P}_E_BUFFER; }}")
                 out.append(f"{pad}memcpy(c + o, {tgt}, {length}); /* {f.name} */")
                 out.append(f"{pad}o += {length};")
@@ -912,7 +967,7 @@ def encode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                 out.append(f"{pad}if (cap - o < {total}u) {{ return {ctx.P}_E_BUFFER; }}")
                 for e in f.entries:
                     value = scalar_bits(ctx, e.type, f"{tgt}.{ident(e.name)}")
-                    out.append(f"{pad}{ctx.p}__put(c + o, {e.type.size}u, {big}u, {value}); /* {e.key} */")
+                    out.append(f"{pad}{put_call(ctx, e.type, f.endian, 'c + o', value)} /* {e.key} */")
                     out.append(f"{pad}o += {e.type.size}u;")
             case List():
                 if f.item is None:
@@ -931,11 +986,11 @@ def encode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                     out.append(f"{pad}if ((cap - o) / {size}u < {tgt}_count) {{ return {ctx.P}_E_BUFFER; }}")
                     out.append(f"{pad}for (i{depth} = 0u; i{depth} < {tgt}_count; i{depth}++) {{")
                     value = scalar_bits(ctx, f.item, f"{tgt}[i{depth}]")
-                    out.append(f"{pad}    {ctx.p}__put(c + o, {size}u, {big}u, {value}); /* {f.name} */")
+                    out.append(f"{pad}    {put_call(ctx, f.item, f.endian, 'c + o', value)} /* {f.name} */")
                     out.append(f"{pad}    o += {size}u;")
                     out.append(f"{pad}}}")
-            case Packed():  # refused by refuse_fields
-                raise Unsupported(f"{f.name}: packed arrays")
+            case Packed():
+                out.extend(packed.encode(ctx.p, ctx.P, f, tgt, pad, f"i{depth}", ctx.helpers))
             case _:
                 assert_never(f)
 
@@ -1072,8 +1127,13 @@ def json_fields(ctx: Ctx, fields: tuple[Field, ...], target: str, out: list[str]
                     out.append(f"{pad}    " + json_number(ctx, f.item, f"{tgt}[i{depth}]"))
                 out.append(f"{pad}}}")
                 out.append(f'{pad}{ctx.p}__ws(w, "]");')
-            case Packed():  # refused by refuse_fields
-                raise Unsupported(f"{f.name}: packed arrays")
+            case Packed():
+                out.append(f'{pad}{ctx.p}__ws(w, "[");')
+                out.append(f"{pad}for (i{depth} = 0u; i{depth} < {f.count}u; i{depth}++) {{")
+                out.append(f'{pad}    if (i{depth}) {{ {ctx.p}__ws(w, ", "); }}')
+                out.append(f"{pad}    " + json_number(ctx, packed.item_type(f), f"{tgt}[i{depth}]"))
+                out.append(f"{pad}}}")
+                out.append(f'{pad}{ctx.p}__ws(w, "]");')
             case _:
                 assert_never(f)
     return first
@@ -1094,6 +1154,8 @@ def json_bits(ctx: Ctx, bits: tuple[BitField, ...], value: str, out: list[str], 
 def json_number(ctx: Ctx, t: ScalarType, expr: str) -> str:
     if t.is_float:
         return f"{ctx.p}__wf(w, (double){expr});"
+    if wide(t):
+        return f"{ctx.p}__w{'i' if t.signed else 'u'}64(w, {expr});"
     if t.signed:
         return f"{ctx.p}__wi(w, (int32_t){expr});"
     return f"{ctx.p}__wu(w, (uint32_t){expr});"
@@ -1158,6 +1220,13 @@ def files(protocol: Protocol) -> dict[str, str]:
     p = protocol.name
     h = header(ctx)
     c = source(ctx)
+    from serialspec.backends.c.engine import ENGINE
+
+    stuffed = any(layout.transparency for layouts in protocol.framing.alternatives.values() for layout in layouts)
+    if not stuffed and c.count(f"{p}__get(") == ENGINE.count("pfx__get("):
+        # read only by the engine's code for stuffed layouts, which this spec leaves out (fields of 8 bytes or packed)
+        start = c.index(f"static uint32_t {p}__get(")
+        c = c[:start] + c[c.index("\n}\n", start) + 3 :].lstrip("\n")
     return {
         f"{p}/{p}.h": h,
         f"{p}/{p}.c": c,

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from serialspec import __version__
+from serialspec.backends.c import packed
 from serialspec.backends.c.emit import (
     DEFAULT_MAX_FRAME,
     Ctx,
@@ -1401,19 +1402,21 @@ def dec_call(ctx: Ctx, m: Message, values: tuple[tuple[str, object], ...]) -> st
 def helper_functions(ctx: Ctx) -> str:
     p, P = ctx.p, ctx.P
     parts: list[str] = []
-    for bits in (8, 16, 32):
+    for bits in (8, 16, 24, 32, 64):
         if f"s{bits}" in ctx.helpers:
             top = 1 << (bits - 1)
             mask = (1 << bits) - 1
+            c, w, suffix = ("32", "32", "UL") if bits <= 32 else ("64", "64", "ULL")
+            own = {24: "32"}.get(bits, str(bits))
             parts.append(
                 f"""#if {P}_ENABLE_DECODE
 /* A {bits}-bit two's complement value from its wire bits (no implementation-defined conversion). */
-static int{bits}_t {p}__s{bits}(uint32_t v)
+static int{own}_t {p}__s{bits}(uint{w}_t v)
 {{
-    if (v & 0x{top:x}UL) {{
-        return (int{bits}_t)(-(int32_t)((~v) & 0x{mask:x}UL) - 1);
+    if (v & 0x{top:x}{suffix}) {{
+        return (int{own}_t)(-(int{c}_t)((~v) & 0x{mask:x}{suffix}) - 1);
     }}
-    return (int{bits}_t)v;
+    return (int{own}_t)v;
 }}
 #endif
 """
@@ -1436,6 +1439,42 @@ static void {p}__copy(void *dst, const uint8_t *src, size_t n)
 #endif
 """
         )
+    parts.extend(packed.helpers(p, P, ctx.helpers))
+    if "get64" in ctx.helpers:
+        parts.append(
+            f"""#if {P}_ENABLE_DECODE
+/* An 8-byte value from the wire, built with shifts (the host's byte order does not matter). */
+static uint64_t {p}__get64(const uint8_t *b, uint8_t big)
+{{
+    uint64_t v = 0u;
+    uint8_t i;
+    for (i = 0u; i < 8u; i++) {{
+        v = (v << 8) | b[big ? i : (uint8_t)(7u - i)];
+    }}
+    return v;
+}}
+#endif
+"""
+        )
+    if "put64" in ctx.helpers:
+        parts.append(
+            f"""#if {P}_ENABLE_ENCODE
+static void {p}__put64(uint8_t *b, uint8_t big, uint64_t v)
+{{
+    uint8_t i;
+    for (i = 0u; i < 8u; i++) {{
+        b[big ? (uint8_t)(7u - i) : i] = (uint8_t)((v >> (8u * i)) & 0xFFu);
+    }}
+}}
+#endif
+"""
+        )
+    if "f64" in ctx.helpers or "f64bits" in ctx.helpers:
+        parts.append(
+            f"""/* f64 goes through memcpy to and from uint64_t: double must be IEEE double precision, 8 bytes */
+typedef char {p}__double_is_8_bytes[(sizeof(double) == 8u) ? 1 : -1];
+"""
+        )
     if "sm" in ctx.helpers:
         parts.append(
             f"""#if {P}_ENABLE_DECODE
@@ -1450,30 +1489,31 @@ static int32_t {p}__sm(uint32_t raw, uint32_t top)
 #endif
 """
         )
-    if "f32" in ctx.helpers:
-        parts.append(
-            f"""#if {P}_ENABLE_DECODE
-static float {p}__f32(uint32_t bits)
+    for bits, real in ((32, "float"), (64, "double")):  # floats through memcpy of their wire bits
+        if f"f{bits}" in ctx.helpers:
+            parts.append(
+                f"""#if {P}_ENABLE_DECODE
+static {real} {p}__f{bits}(uint{bits}_t bits)
 {{
-    float f;
+    {real} f;
     memcpy(&f, &bits, sizeof(f));
     return f;
 }}
 #endif
 """
-        )
-    if "f32bits" in ctx.helpers:
-        parts.append(
-            f"""#if {P}_ENABLE_ENCODE
-static uint32_t {p}__f32bits(float f)
+            )
+        if f"f{bits}bits" in ctx.helpers:
+            parts.append(
+                f"""#if {P}_ENABLE_ENCODE
+static uint{bits}_t {p}__f{bits}bits({real} f)
 {{
-    uint32_t bits;
+    uint{bits}_t bits;
     memcpy(&bits, &f, sizeof(bits));
     return bits;
 }}
 #endif
 """
-        )
+            )
     if "utf8" in ctx.helpers:
         parts.append(
             f"""#if {P}_ENABLE_ENCODE || {P}_ENABLE_DECODE
@@ -1563,6 +1603,7 @@ def json_source(ctx: Ctx) -> str:
             f"        {p}__json_{msg_id(m)}(&w, &msg->u.{msg_id(m)});\n"
             "        break;"
         )
+    integers = "".join(json_integers(p, suffix, bits) for suffix, bits in (("", 32), ("64", 64)))
     text = f"""{banner(protocol)}
 #include "{p}_json.h"
 
@@ -1590,30 +1631,7 @@ static void {p}__ws({p}__w_t *w, const char *s)
     }}
 }}
 
-static void {p}__wu({p}__w_t *w, uint32_t v)
-{{
-    char t[12];
-    int i = 0;
-    do {{
-        t[i++] = (char)('0' + (int)(v % 10u));
-        v /= 10u;
-    }} while (v != 0u);
-    while (i > 0) {{
-        {p}__wc(w, t[--i]);
-    }}
-}}
-
-static void {p}__wi({p}__w_t *w, int32_t v)
-{{
-    if (v < 0) {{
-        {p}__wc(w, '-');
-        {p}__wu(w, (uint32_t)(-(v + 1)) + 1u);
-    }} else {{
-        {p}__wu(w, (uint32_t)v);
-    }}
-}}
-
-static void {p}__wf({p}__w_t *w, double v)
+{integers}static void {p}__wf({p}__w_t *w, double v)
 {{
     char t[40];
     if (v != v) {{
@@ -1703,15 +1721,44 @@ size_t {p}_to_json(const {p}_msg_t *msg, char *out, size_t cap)
     return w.n;
 }}
 """
-    return drop_unused(text, p, ("wi", "wf", "wbytes", "wtext"), functions)
+    return drop_unused(text, p, ("wi64", "wu64", "wi", "wf", "wbytes", "wtext"), functions)
+
+
+def json_integers(p: str, suffix: str, bits: int) -> str:
+    """The JSON writer's unsigned and signed decimal integers of `bits` bits (p__wu, p__wi; p__wu64, p__wi64)."""
+    return f"""static void {p}__wu{suffix}({p}__w_t *w, uint{bits}_t v)
+{{
+    char t[{12 if bits == 32 else 21}];
+    int i = 0;
+    do {{
+        t[i++] = (char)('0' + (int)(v % 10u));
+        v /= 10u;
+    }} while (v != 0u);
+    while (i > 0) {{
+        {p}__wc(w, t[--i]);
+    }}
+}}
+
+static void {p}__wi{suffix}({p}__w_t *w, int{bits}_t v)
+{{
+    if (v < 0) {{
+        {p}__wc(w, '-');
+        {p}__wu{suffix}(w, (uint{bits}_t)(-(v + 1)) + 1u);
+    }} else {{
+        {p}__wu{suffix}(w, (uint{bits}_t)v);
+    }}
+}}
+
+"""
 
 
 def drop_unused(text: str, p: str, names: tuple[str, ...], users: str) -> str:
     """The static helpers no generated function calls left out (-Wunused-function)."""
-    for name in names:
-        if f"{p}__{name}(" in users:
-            continue
+    for name in names:  # callers before the helpers they call
         start = text.index(f"static void {p}__{name}(")
         stop = text.index("\n}\n", start) + 3
+        if f"{p}__{name}(" in users:
+            users += text[start:stop]
+            continue
         text = text[:start] + text[stop:].lstrip("\n")
     return text

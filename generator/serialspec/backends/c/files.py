@@ -1721,7 +1721,7 @@ size_t {p}_to_json(const {p}_msg_t *msg, char *out, size_t cap)
     return w.n;
 }}
 """
-    return drop_unused(text, p, ("wi64", "wu64", "wi", "wf", "wbytes", "wtext"), functions)
+    return drop_unused(text, p, ("wi64", "wu64", "wi", "wu", "wf", "wbytes", "wtext"), functions)
 
 
 def json_integers(p: str, suffix: str, bits: int) -> str:

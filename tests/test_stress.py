@@ -25,7 +25,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import pytest
-from conftest import ALL, Generated
+from conftest import ALL, Generated, set_plain_byte
 from hypothesis import HealthCheck, Phase, given, settings
 from serialspec.lang.model import Direction, FrameLayout, Message
 from serialspec.runtime.errors import DecodeError
@@ -101,11 +101,10 @@ def damaged(rng: random.Random, pool: list[bytes], layout: FrameLayout) -> tuple
         return frame[: start_size(layout)], False
     if roll < 0.3:
         return bytes(rng.randrange(256) for _ in range(rng.randrange(1, 12))), False
-    if roll < 0.4:  # the same frame with its checksum corrupted
-        position = len(frame) - checksum_from_end(layout)
-        spoiled = bytearray(frame)
-        spoiled[position] ^= rng.randrange(1, 256)
-        return bytes(spoiled), True
+    if roll < 0.4:  # the same frame with its checksum corrupted (in its plain bytes: a hex-ASCII span stays hex)
+        flip = rng.randrange(1, 256)
+        spoiled, _ = set_plain_byte(layout, frame, -checksum_from_end(layout), lambda old: old ^ flip)
+        return spoiled, True
     return None
 
 

@@ -925,6 +925,9 @@ class TextFrame:
     def request(self, key: str) -> TextMessage | None:
         return next((m for m in self.messages if m.key == key and m.direction == Direction.REQUEST), None)
 
+    def response(self, key: str) -> TextMessage | None:
+        return next((m for m in self.messages if m.key == key and m.direction == Direction.RESPONSE), None)
+
     def letter_sets(self) -> dict[str, tuple[tuple[str, str], ...]]:
         """Each generated letter Enum's name -> its (label, letter) pairs, in order of first use."""
         found: dict[str, tuple[tuple[str, str], ...]] = {}

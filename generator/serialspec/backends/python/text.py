@@ -119,7 +119,7 @@ def _answered(text: TextFrame, device: TextDevice) -> list[tuple[TextMessage, Te
     for request in text.messages:
         if request.direction != Direction.REQUEST:
             continue
-        response = next((m for m in text.messages if m.key == request.key and m.direction == Direction.RESPONSE), None)
+        response = text.response(request.key)
         if response is not None:
             found.append((request, response, entries.get(request.key)))
     return found
@@ -351,7 +351,7 @@ def _client_methods(text: TextFrame, asynchronous: bool) -> Iterator[str]:
     for request in text.messages:
         if request.direction != Direction.REQUEST:
             continue
-        response = next((m for m in text.messages if m.key == request.key and m.direction == Direction.RESPONSE), None)
+        response = text.response(request.key)
         name = request.key + "_" if request.key in CLIENT_NAMES else request.key
         params = []
         for item in request.fields:

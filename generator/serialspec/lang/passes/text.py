@@ -304,7 +304,7 @@ class TextPass(Pass):
         for key, item in raw.items():
             where = (*path, str(key))
             request = frame.request(str(key))
-            response = next((m for m in frame.messages if m.key == key and m.direction == Direction.RESPONSE), None)
+            response = frame.response(str(key))
             if request is None or response is None:
                 self.error(where, f"{key!r} is not a command with a request and a response")
                 continue

@@ -1,0 +1,278 @@
+"""Field kinds and types: scalars, arrays, lists, packed integers, text, bytes, groups, table values; enums and
+flags; the parameter tables."""
+
+from __future__ import annotations
+
+from typing import Literal
+
+from serialspec.lang.expression import Expr
+from serialspec.lang.frozen import frozen
+
+
+@frozen
+class ScalarType:
+    name: str
+    size: int
+    struct_char: str
+    signed: bool
+    is_float: bool
+    minimum: float
+    maximum: float
+
+
+SCALARS: dict[str, ScalarType] = {
+    "u8": ScalarType("u8", 1, "B", False, False, 0, 0xFF),
+    "i8": ScalarType("i8", 1, "b", True, False, -0x80, 0x7F),
+    "u16": ScalarType("u16", 2, "H", False, False, 0, 0xFFFF),
+    "i16": ScalarType("i16", 2, "h", True, False, -0x8000, 0x7FFF),
+    # 3-byte integers (fields only, as the 64-bit types: not frame elements, enums, flags or tables) are read as 3
+    # bytes ("3s") and converted, since struct has no format for them
+    "u24": ScalarType("u24", 3, "3s", False, False, 0, 0xFFFFFF),
+    "i24": ScalarType("i24", 3, "3s", True, False, -0x800000, 0x7FFFFF),
+    "u32": ScalarType("u32", 4, "I", False, False, 0, 0xFFFFFFFF),
+    "i32": ScalarType("i32", 4, "i", True, False, -0x80000000, 0x7FFFFFFF),
+    "u64": ScalarType("u64", 8, "Q", False, False, 0, 0xFFFFFFFFFFFFFFFF),
+    "i64": ScalarType("i64", 8, "q", True, False, -0x8000000000000000, 0x7FFFFFFFFFFFFFFF),
+    "f32": ScalarType("f32", 4, "f", True, True, -3.4028234663852886e38, 3.4028234663852886e38),
+    "f64": ScalarType("f64", 8, "d", True, True, -1.7976931348623157e308, 1.7976931348623157e308),
+}
+
+
+@frozen
+class EnumValue:
+    name: str
+    value: int
+    text: str
+
+
+@frozen
+class EnumDef:
+    name: str
+    class_name: str
+    type: ScalarType
+    description: str
+    values: tuple[EnumValue, ...]
+
+
+@frozen
+class FlagBit:
+    name: str
+    bit: int
+    text: str
+
+
+@frozen
+class FlagsDef:
+    name: str
+    class_name: str
+    type: ScalarType
+    description: str
+    bits: tuple[FlagBit, ...]
+
+
+@frozen
+class BitField:
+    name: str
+    high: int
+    low: int
+    enum: EnumDef | None
+    description: str
+
+    @property
+    def mask(self) -> int:
+        return (1 << (self.high - self.low + 1)) - 1
+
+
+@frozen
+class Common:
+    """What every field kind carries."""
+
+    name: str
+    description: str
+    description_cn: str
+    inferred: str
+
+
+@frozen
+class Scalar(Common):
+    type: ScalarType
+    endian: Literal["<", ">"]
+    unit: str
+    scale: float | None
+    minimum: float
+    maximum: float
+    const: int | None
+    default: float | None
+    enum: EnumDef | None
+    flags: FlagsDef | None
+    bits: tuple[BitField, ...]
+    bits_class: str
+    sign_magnitude: bool
+    # Derived fields are computed on encode and checked on decode, never given by the user:
+    # ("count", group) is the number of items of a group; ("size", group, field) the size of bytes in each item.
+    derived: tuple[str, ...] = ()
+    # A response field reporting success: any value but this one is a device error (the client raises DeviceError).
+    status_ok: int | None = None
+    # Derived by an expression over the other fields (`byte_count = 2 * count`): computed on encode, checked on decode.
+    value: Expr | None = None
+    offset: float | None = None  # engineering value = wire value × scale + offset
+
+    @property
+    def odd_width(self) -> bool:
+        """A 3-byte integer: read as 3 bytes and converted, since struct has no format for it."""
+        return self.type.size == 3
+
+    @property
+    def hidden(self) -> bool:
+        """Not a member of the message: constant or derived."""
+        return self.const is not None or bool(self.derived) or self.value is not None
+
+
+@frozen
+class Array(Common):
+    item: ScalarType
+    endian: Literal["<", ">"]
+    count: int
+    unit: str
+    minimum: float
+    maximum: float
+
+
+@frozen
+class List(Common):
+    """A list of numbers or bits whose count varies: from a count field, from a byte-size field, or the rest.
+
+    `item` None means bits packed 8 to a byte, the first in the lowest bit, the last byte padded with zeros
+    (Modbus coils). The count comes from `count` (a number, `rest`, or a field) or, when that is "", from the
+    byte size in the field named by `size`.
+    """
+
+    item: ScalarType | None
+    endian: Literal["<", ">"]
+    count: int | str
+    size: str
+    unit: str
+    minimum: float
+    maximum: float
+    count_from: str = ""  # a response's: the request field saying how many items are meant (the rest is padding)
+
+    @property
+    def bits(self) -> bool:
+        return self.item is None
+
+    def byte_size(self, count: int) -> int:
+        return -(-count // 8) if self.item is None else count * self.item.size
+
+
+@frozen
+class Packed(Common):
+    """A fixed number of integers of `bits` bits each, packed with no gaps (CRSF RC channels: 16 × 11 bits).
+
+    `lsb_first`: the first item starts at the lowest bit of the first byte, each item's lowest bit first (CRSF,
+    SBUS; a little-endian u24 array is the same); else the first item starts at the highest bit, its highest bit
+    first (a big-endian u24 array is the same). The last byte is padded with zero bits.
+    """
+
+    bits: int
+    signed: bool
+    count: int
+    lsb_first: bool
+    unit: str
+    minimum: float
+    maximum: float
+
+    @property
+    def byte_size(self) -> int:
+        return -(-self.bits * self.count // 8)
+
+
+@frozen
+class Text(Common):
+    """Text: NUL-terminated (`size` None; the NUL is not part of the value), or sized like bytes.
+
+    `pad`: a fixed-size text shorter than its size is sent followed by this byte (NUL-padded names), and read
+    without the trailing pad bytes; None: the text must fill its size exactly."""
+
+    size: int | str | None  # a number, "rest", a field name, or None for NUL-terminated
+    pad: int | None = None
+
+    @property
+    def terminated(self) -> bool:
+        return self.size is None
+
+
+@frozen
+class Bytes(Common):
+    size: int | str  # a number, "rest", or the name of a field holding it
+    table: Table | None = None  # when the bytes are a run of registers of this table
+    start: str = ""  # the field holding the first register's key: a field of this content, or of the request
+    start_in_request: bool = False  # `start: request.<field>`: the field is the request's (the resolver checked it)
+    size_from: str = ""  # a response's `rest` bytes: the request field giving their number (`request.<field>`)
+
+
+@frozen
+class Group(Common):
+    class_name: str
+    count: int | str  # a number, "rest", or the name of a count field
+    fields: tuple[Field, ...]
+    item_size: int | None  # None when an item holds bytes sized by another field
+
+
+@frozen
+class TableValue(Common):
+    table: Table
+    key: str
+
+
+@frozen
+class TableBlock(Common):
+    table: Table
+    class_name: str
+    entries: tuple[TableEntry, ...]
+    endian: Literal["<", ">"]
+    struct_name: str = ""  # the construct struct of the block
+
+
+Field = Scalar | Array | Packed | List | Text | Bytes | Group | TableValue | TableBlock
+
+
+@frozen
+class TableEntry:
+    name: str
+    key: int
+    type: ScalarType
+    name_cn: str
+    description: str
+    unit: str
+    scale: float | None
+    minimum: float
+    maximum: float
+    default: float | str | None
+    access: str
+    memory: str
+    enum: EnumDef | None
+    flags: FlagsDef | None
+    sign_magnitude: bool
+    reserved: bool
+    source: str
+    sign_bit: int | None = None  # sign_magnitude: the sign's bit (the top bit unless the spec says otherwise)
+
+
+@frozen
+class Table:
+    name: str
+    title: str
+    key_name: str
+    description: str
+    source: str
+    entries: tuple[TableEntry, ...]
+    # generated names: the register map (or the table's constant), the switch of its values by key, the name alias
+    constant: str = ""
+    value_constant: str = ""
+    names_class: str = ""
+
+    def entry(self, key: int) -> TableEntry | None:
+        for entry in self.entries:
+            if entry.key == key:
+                return entry
+        return None

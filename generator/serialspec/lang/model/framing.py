@@ -1,0 +1,149 @@
+"""How a message is framed on the wire: elements, layouts, checksums, transparency and transforms; serial settings."""
+
+from __future__ import annotations
+
+from dataclasses import field
+from typing import Literal
+
+from serialspec.checksums.base import Algorithm
+from serialspec.lang.frozen import frozen
+from serialspec.lang.model.fields import BitField, FlagsDef, ScalarType
+from serialspec.runtime.message import Direction
+from serialspec.transforms.base import Transform
+
+
+@frozen
+class Checksum:
+    algorithm: Algorithm  # what it computes, with its parameters: one class per algorithm (serialspec/checksums/)
+    first: str  # first frame element covered
+    last: str  # last frame element covered
+    type: ScalarType
+    endian: Literal["<", ">"] = "<"
+    name: str = ""  # the frame element holding it
+    skips: tuple[str, ...] = ()  # elements inside first..last left out: itself, and the checksums strictly inside
+
+
+VALUE_ROLES = ("address", "status", "value")  # frame elements whose value every message of the frame carries
+
+
+@frozen
+class FrameElement:
+    name: str
+    role: str  # header, trailer, constant, address, command, status, length, content, checksum
+    type: ScalarType | None
+    size: int | None  # None for content
+    directions: tuple[Direction, ...]
+    description: str
+    minimum: float
+    maximum: float
+    broadcast: int | None
+    flags: FlagsDef | None
+    endian: Literal["<", ">"] = "<"
+    constant: bytes = b""  # header, trailer, constant: the bytes in this direction
+    bits: tuple[BitField, ...] = ()  # a status (or address, command) made of bit fields
+    bits_class: str = ""
+    counts: tuple[str, str] = ("", "")  # length: the first and last element counted
+    adds: int = 0  # length: added to the counted size
+    checksum: Checksum | None = None  # checksum: what it is and what it covers
+    sequence: bool = False  # value: a sequence number the client fills in (one more per request, wrapping)
+    truncate: bool = False  # content: trailing zero bytes dropped on encode, padded back on decode (MAVLink v2)
+
+    @property
+    def fixed(self) -> bool:
+        """Constant bytes: a header, a trailer, a reserved byte, or a command's constant in this direction."""
+        return self.role in ("header", "trailer", "constant")
+
+
+@frozen
+class Transparency:
+    """A transform of the bytes of a span of elements (serialspec/transforms/: stuffing, escaping, COBS)."""
+
+    first: str
+    last: str
+    transform: Transform
+    description: str = ""
+
+
+@frozen
+class FrameLayout:
+    """The frame in one direction: elements in order with their byte offsets (content's at its start).
+
+    The offsets and the classic fields (length_offset .. covered_to_end) describe frames of the classic shape (a
+    header, a one-byte length before the content, one final checksum, no transparency); `classic` says whether this
+    layout has it. Every layout is fully described by its elements, `transparency` and `checksums`.
+    """
+
+    direction: Direction
+    header: bytes
+    elements: tuple[FrameElement, ...]
+    offsets: dict[str, int]
+    overhead: int  # frame size minus content size (on the wire, before stuffing)
+    length_offset: int
+    length_adds: int
+    command_offset: int | None
+    checksum_offset_from_end: int
+    covered_from: int  # first covered byte
+    covered_to_end: int  # bytes after the last covered byte
+    value_elements: tuple[FrameElement, ...]  # address/status/value: frame-level values every message carries
+    name: str = ""  # the layout's name among alternatives ("" for the one layout)
+    transparency: Transparency | None = None
+    checksums: tuple[Checksum, ...] = ()
+    classic: bool = True
+
+    def index(self, name: str) -> int:
+        return next(i for i, e in enumerate(self.elements) if e.name == name)
+
+    @property
+    def has_command(self) -> bool:
+        """Frames of this direction carry a command code (else every message of it is codeless)."""
+        return any(e.role == "command" for e in self.elements)
+
+    @property
+    def length(self) -> FrameElement | None:
+        return next((e for e in self.elements if e.role == "length"), None)
+
+    @property
+    def truncates(self) -> bool:
+        """The content is sent without its trailing zero bytes (`truncate: trailing_zeros`)."""
+        return any(e.truncate for e in self.elements if e.role == "content")
+
+    @property
+    def trailer(self) -> bytes:
+        last = self.elements[-1]
+        return last.constant if last.role == "trailer" else b""
+
+
+@frozen
+class Framing:
+    description: str
+    layouts: dict[Direction, FrameLayout]  # the (first) layout of each direction
+    checksum: Checksum | None  # the first layout's first checksum
+    shared_header: bool
+    alternatives: dict[Direction, tuple[FrameLayout, ...]] = field(default_factory=dict)  # every layout, in order
+    gap: float = 0.0  # silence between frames, in character times (0: none defined)
+    reply_code: str = ""  # the command element's `reply_code`, as shown (`code | 0x40`): see Command.response_code
+
+    @property
+    def classic(self) -> bool:
+        """Every layout has the classic shape (see FrameLayout): generated codecs use straight-line code."""
+        return all(layout.classic for layouts in self.alternatives.values() for layout in layouts)
+
+
+@frozen
+class ErrorReply:
+    """Replies that refuse a request: its code with `flag` set in the command element, laid out as `command`'s
+    response (Modbus exception replies: function | 0x80, then an exception code)."""
+
+    flag: int
+    element: str  # the command element; the error reply's message carries the refused code under this name
+    command: str  # the command whose response is the error reply
+
+
+@frozen
+class Serial:
+    baudrate: int
+    bytesize: int
+    parity: str
+    stopbits: float
+    notes: str
+    baudrates: tuple[int, ...] = ()  # every rate a device can be set to, the default first ((): the default alone)

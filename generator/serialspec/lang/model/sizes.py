@@ -1,0 +1,118 @@
+"""Sizes computed from fields, for the resolver and every backend: fixed sizes, content bounds, size terms."""
+
+from __future__ import annotations
+
+from serialspec.lang import expression
+from serialspec.lang.expression import Expr
+from serialspec.lang.model.fields import Array, Bytes, Field, Group, List, Packed, Scalar, TableBlock, TableValue, Text
+
+
+def fixed_size(field: Field) -> int | None:
+    if isinstance(field, Scalar):
+        return field.type.size
+    if isinstance(field, Array):
+        return field.item.size * field.count
+    if isinstance(field, Packed):
+        return field.byte_size
+    if isinstance(field, Bytes | Text):
+        return field.size if isinstance(field.size, int) else None
+    if isinstance(field, List):
+        return field.byte_size(field.count) if isinstance(field.count, int) else None
+    if isinstance(field, Group):
+        if isinstance(field.count, int) and field.item_size is not None:
+            return field.count * field.item_size
+        return None
+    if isinstance(field, TableBlock):
+        return sum(e.type.size for e in field.entries)
+    return None
+
+
+def sum_sizes(fields: tuple[Field, ...]) -> int | None:
+    total = 0
+    for item in fields:
+        size = fixed_size(item)
+        if size is None:
+            return None
+        total += size
+    return total
+
+
+def content_bounds(fields: tuple[Field, ...]) -> tuple[int, int | None]:
+    """Smallest and largest content size (None: unbounded) the fields allow."""
+    low = 0
+    high: int | None = 0
+    by_name = {f.name: f for f in fields}
+    for item in fields:
+        size = fixed_size(item)
+        if size is not None:
+            low += size
+            high = None if high is None else high + size
+            continue
+        if isinstance(item, TableValue):
+            sizes = [e.type.size for e in item.table.entries if not e.reserved]
+            low += min(sizes)
+            high = None if high is None else high + max(sizes)
+        elif isinstance(item, Group) and isinstance(item.count, str) and item.count != "rest" and item.item_size:
+            counter = by_name.get(item.count)
+            most = int(counter.maximum) if isinstance(counter, Scalar) else None
+            high = None if high is None or most is None else high + most * item.item_size
+        elif isinstance(item, List) and (item.size or item.count not in ("", "rest")):
+            counter = by_name.get(item.size or str(item.count))
+            most = int(counter.maximum) if isinstance(counter, Scalar) else None
+            high = None if high is None or most is None else high + (most if item.size else item.byte_size(most))
+        elif isinstance(item, Text) and item.terminated:
+            low += 1
+            high = None
+        elif isinstance(item, Bytes | Text) and isinstance(item.size, str) and item.size != "rest":
+            counter = by_name.get(item.size)
+            most = int(counter.maximum) if isinstance(counter, Scalar) else None
+            high = None if high is None or most is None else high + most
+        else:
+            high = None
+    return low, high
+
+
+def byte_size_expression(item: List) -> Expr | None:
+    """The size in bytes of a list counted by a field, as an expression of that field (ceil(n / 8), n * 2)."""
+    if not isinstance(item.count, str) or item.count in ("", "rest"):
+        return None
+    count = expression.Name(item.count)
+    if item.item is None:
+        return expression.Ceil(count, expression.Const(8))
+    return count if item.item.size == 1 else expression.BinOp("*", expression.Const(item.item.size), count)
+
+
+def size_terms(fields: tuple[Field, ...]) -> tuple[int, tuple[tuple[int, int, str, int], ...]] | None:
+    """A content's size from its own leading fields, for frames that carry no length (Modbus RTU): fixed bytes
+    plus, for each part sized by an earlier field at a fixed offset, (offset, size, byte order, bytes per unit).
+    None when the size cannot be told that way (a part that takes the rest, a NUL-terminated text)."""
+    fixed = 0
+    terms: list[tuple[int, int, str, int]] = []
+    offsets: dict[str, tuple[int, Scalar]] = {}
+    offset: int | None = 0
+    for item in fields:
+        if isinstance(item, Scalar) and offset is not None:
+            offsets[item.name] = (offset, item)
+        size = fixed_size(item)
+        if size is not None:
+            fixed += size
+            offset = None if offset is None else offset + size
+            continue
+        offset = None
+        sizer: str = ""
+        factor = 1
+        if isinstance(item, List):
+            wanted = byte_size_expression(item)
+            same = next((name for name, (_, f) in offsets.items() if wanted is not None and f.value == wanted), "")
+            sizer = item.size or same
+            if not sizer and isinstance(item.count, str) and item.count not in ("", "rest") and item.item is not None:
+                sizer, factor = item.count, item.item.size
+        elif isinstance(item, Bytes | Text) and isinstance(item.size, str) and item.size != "rest":
+            sizer = item.size
+        elif isinstance(item, Group) and isinstance(item.count, str) and item.count != "rest" and item.item_size:
+            sizer, factor = item.count, item.item_size
+        if sizer not in offsets:
+            return None
+        where, scalar = offsets[sizer]
+        terms.append((where, scalar.type.size, "big" if scalar.endian == ">" else "little", factor))
+    return fixed, tuple(terms)

@@ -1,0 +1,135 @@
+"""Text protocols (`framing: text`): sentences of delimited fields, their examples and the device answering them."""
+
+from __future__ import annotations
+
+from dataclasses import field
+from typing import Literal
+
+from serialspec.checksums.base import Algorithm
+from serialspec.lang.expression import Expr
+from serialspec.lang.frozen import frozen
+from serialspec.lang.model.device import Unsolicited
+from serialspec.runtime.message import Direction
+
+
+@frozen
+class TextField:
+    """One field of a text frame (runtime/text.py's TextField, as declared)."""
+
+    name: str
+    kind: Literal["decimal", "integer", "angle", "char", "text", "time", "date"]
+    description: str = ""
+    unit: str = ""
+    precision: int = 0
+    width: int = 0
+    minimum: float | None = None
+    maximum: float | None = None
+    letters: tuple[tuple[str, str], ...] = ()  # char: (label, letter)
+    letters_class: str = ""  # char with letters: the generated Enum's name
+
+
+@frozen
+class TextRepeat:
+    """A group of text fields repeated `count` times, or up to `max_count` times at the end of a message."""
+
+    name: str
+    fields: tuple[TextField, ...]
+    description: str = ""
+    count: int = 0
+    max_count: int = 0
+
+
+@frozen
+class TextMessage:
+    """One direction of a command in a text protocol: chosen by its text code."""
+
+    key: str  # the command's name
+    code: str
+    title: str
+    description: str
+    direction: Direction
+    class_name: str
+    fields: tuple[TextField | TextRepeat, ...]
+    unsolicited: bool = False
+    source: str = ""
+
+
+@frozen
+class TextExample:
+    """A frame as a document prints it (text) and the text of each field it carries."""
+
+    name: str
+    source: str
+    description: str
+    direction: Direction
+    printed: str
+    command: str
+    fields: dict[str, object]
+    position: tuple[int, int] = (1, 1)  # line and column in the spec, for errors found after resolution
+
+
+@frozen
+class TextAnswer:
+    """How a text device answers one command's request (`device.commands.NAME`): request fields kept in state
+    variables, state variables set, and the answer's fields from expressions of the state or from the request."""
+
+    command: str
+    description: str = ""
+    stores: dict[str, str] = field(default_factory=dict)  # request field -> state variable
+    sets: dict[str, float] = field(default_factory=dict)  # state variable -> value
+    reports: dict[str, Expr] = field(default_factory=dict)  # response field -> expression of state variables
+    echoes: tuple[str, ...] = ()  # response fields that repeat the request's field of the same name
+
+
+@frozen
+class TextDevice:
+    """A text protocol's virtual device (`device:`): its state variables, the values every sentence it sends
+    carries (`reply`), the sentences it sends on its own, and how it answers requests (`commands`: every command
+    with a request and a response is answered, as its entry there says)."""
+
+    description: str
+    state: dict[str, float]
+    reply: dict[str, str | float]
+    sends: tuple[Unsolicited, ...]
+    commands: tuple[TextAnswer, ...] = ()
+
+
+@frozen
+class TextFrame:
+    """Line-oriented text frames: start + talker + code + separated fields + [marker + checksum as hex] + end."""
+
+    description: str
+    start: str
+    separator: str
+    end: str
+    checksum: Algorithm | None
+    marker: str
+    required: bool
+    talker: int  # characters of the talker at the start of the address field (0: none)
+    talkers: tuple[str, ...]
+    talker_description: str
+    max_length: int
+    messages: tuple[TextMessage, ...]
+    examples: tuple[TextExample, ...] = ()
+    digits: int = 2
+    device: TextDevice | None = None
+
+    def message(self, key: str, direction: Direction = Direction.RESPONSE) -> TextMessage:
+        """The command's message in `direction` (its response by default: what a device sends)."""
+        return next(m for m in self.messages if m.key == key and m.direction == direction)
+
+    def request(self, key: str) -> TextMessage | None:
+        return next((m for m in self.messages if m.key == key and m.direction == Direction.REQUEST), None)
+
+    def response(self, key: str) -> TextMessage | None:
+        return next((m for m in self.messages if m.key == key and m.direction == Direction.RESPONSE), None)
+
+    def letter_sets(self) -> dict[str, tuple[tuple[str, str], ...]]:
+        """Each generated letter Enum's name -> its (label, letter) pairs, in order of first use."""
+        found: dict[str, tuple[tuple[str, str], ...]] = {}
+        for message in self.messages:
+            for item in message.fields:
+                for f in item.fields if isinstance(item, TextRepeat) else (item,):
+                    if f.letters_class:
+                        found.setdefault(f.letters_class, f.letters)
+        return found

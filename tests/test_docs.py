@@ -195,6 +195,14 @@ def test_frame_layout_states_the_gap_once(spec: Path) -> None:
 
 
 @pytest.mark.parametrize("spec", sorted((ROOT / "specs").glob("*.yaml")), ids=lambda p: p.stem)
+def test_a_one_byte_checksum_has_no_byte_order(spec: Path) -> None:
+    """A frame table gives a checksum's byte order only where it has two bytes or more (an LRC or a CRC-8 has none)."""
+    for line in (ROOT / "generated" / "docs" / f"{spec.stem}.md").read_text(encoding="utf-8").splitlines():
+        if line.startswith("| last |") and "| u8 |" in line:
+            assert "endian" not in line, line
+
+
+@pytest.mark.parametrize("spec", sorted((ROOT / "specs").glob("*.yaml")), ids=lambda p: p.stem)
 def test_published_reference_cites_only_what_readers_can_find(spec: Path) -> None:
     """No internal note, local file name, issue number or this repository's test files in a published reference:
     sources are named as their publishers name them."""

@@ -421,10 +421,11 @@ def frame_context(protocol: Protocol, layout: FrameLayout) -> dict[str, Any]:
         elif e.fixed:
             description = " — ".join(p for p in (e.constant.hex(" ").upper(), e.description) if p)
         elif e.role == "checksum" and not layout.classic and e.checksum is not None:
-            endian = "big-endian" if e.endian == ">" else "little-endian"
+            # a byte order only where there are bytes to order
+            endian = "" if e.checksum.type.size == 1 else ", big-endian" if e.endian == ">" else ", little-endian"
             left_out = ", ".join(f"`{name}`" for name in e.checksum.skips)
             skips = f" leaving out {left_out}" if left_out else ""
-            description = f"over `{e.checksum.first}`..`{e.checksum.last}`{skips}, {endian}. {e.description}"
+            description = f"over `{e.checksum.first}`..`{e.checksum.last}`{skips}{endian}. {e.description}"
         elif e.role == "command" and layout.direction == Direction.RESPONSE and protocol.framing.reply_code:
             computed = f"the code of the request it answers, as `{protocol.framing.reply_code}`"
             description = ". ".join(p for p in (computed, e.description) if p)

@@ -65,3 +65,45 @@ def test_sdk_reg_write_waits_for_action(sdk: Any) -> None:
     assert sdk.read2ByteTxRx(3, GOAL_POSITION)[0] != 777  # held until ACTION
     assert sdk.RegAction() == SUCCESS  # broadcast: no servo answers, so the SDK only sends
     assert sdk.read2ByteTxRx(3, GOAL_POSITION)[0] == 777
+
+
+def _sign_magnitude(value: int, sign_bit: int) -> int:
+    """LeRobot's encode_sign_magnitude: the magnitude, with the sign in `sign_bit`."""
+    return (1 << sign_bit) | -value if value < 0 else value
+
+
+def _sync_read_positions(sdk: Any, servos: tuple[int, ...]) -> list[int]:
+    reader = scservo_sdk.GroupSyncRead(sdk, CONTROL_TABLE["present_position"].address, 2)
+    for servo in servos:
+        assert reader.addParam(servo)
+    assert reader.txRxPacket() == SUCCESS
+    return [reader.getData(servo, CONTROL_TABLE["present_position"].address, 2) for servo in servos]
+
+
+def test_so100_calibration_as_lerobot_does_it(sdk: Any) -> None:
+    """LeRobot's FeetechMotorsBus on an SO-100 arm: torque off and EEPROM unlocked, the homing offset reset, the
+    present positions read, Homing_Offset = position - 2047 written (sign-magnitude, sign in bit 11), after which
+    every joint reads 2047 (Present_Position = Actual_Position - Homing_Offset) and goals are in those terms."""
+    servos = (1, 2, 3)
+    table = {name: CONTROL_TABLE[name].address for name in ("torque_enable", "lock", "position_offset")}
+    for servo, start in zip(servos, (1000, 3000, 2047), strict=True):
+        assert sdk.WritePosEx(servo, start, 0, 0) == (SUCCESS, 0)  # speed 0 and time 0: at once
+    for servo in servos:  # disable_torque, then reset_calibration
+        assert sdk.write1ByteTxRx(servo, table["torque_enable"], 0) == (SUCCESS, 0)
+        assert sdk.write1ByteTxRx(servo, table["lock"], 0) == (SUCCESS, 0)
+        assert sdk.write2ByteTxRx(servo, table["position_offset"], 0) == (SUCCESS, 0)
+    positions = _sync_read_positions(sdk, servos)
+    assert positions == [1000, 3000, 2047]
+    for servo, position in zip(servos, positions, strict=True):  # set_half_turn_homings
+        offset = _sign_magnitude(position - 2047, 11)
+        assert sdk.write2ByteTxRx(servo, table["position_offset"], offset) == (SUCCESS, 0)
+        assert sdk.read2ByteTxRx(servo, table["position_offset"])[0] == offset
+    assert _sync_read_positions(sdk, servos) == [2047, 2047, 2047]
+    for servo in servos:
+        assert sdk.write1ByteTxRx(servo, table["lock"], 1) == (SUCCESS, 0)
+        assert sdk.write1ByteTxRx(servo, table["torque_enable"], 1) == (SUCCESS, 0)
+    assert sdk.WritePosEx(1, 2147, 0, 0) == (SUCCESS, 0)  # a goal in calibrated terms
+    assert sdk.ReadPos(1)[0] == 2147
+    # an offset larger than the position: what the servo reports wraps within one turn
+    assert sdk.write2ByteTxRx(1, table["position_offset"], 2000) == (SUCCESS, 0)  # the horn is at 1100
+    assert sdk.ReadPos(1)[0] == 1100 - 2000 + 4096

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define FEETECH_SMS_SPEC_SHA256 "64feaa90f2e655407b07f8e66e8ff46c602e42508d3a0711e92de69bc635e88d"
+#define FEETECH_SMS_SPEC_SHA256 "82d818db96687966aef71480cc4ccc496f661af707fa4a4c02c2a2fb6e61f410"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef FEETECH_SMS_ENABLE_ENCODE

@@ -5,7 +5,9 @@ A servo keeps the control table (registers from their defaults, read-only values
 its id, obeys broadcast (254) without answering except to PING, reports its status register (0x41) in the
 error byte of every reply, holds REG WRITE data until ACTION, answers instructions other than READ and PING
 only while response_level is 1, and moves its present position to a written goal position over goal_time (ms),
-or at goal_speed (steps/s) when goal_time is 0; moving (0x42) reads 1 on the way.
+or at goal_speed (steps/s) when goal_time is 0; moving (0x42) reads 1 on the way. The horn's position is the
+state variable `position`; present_position reads as position - position_offset within one turn (0..4095), so
+writing position_offset moves what present_position reports, and goals are in its terms.
 
 `FeetechSmsSimulator(ids=[1, 2]).start()` serves the devices on a new pseudo-terminal and returns its path;
 `serialspec sim specs/feetech_sms.yaml --id 1 --id 2` does the same from the shell. Values are wire units.
@@ -89,7 +91,7 @@ DEVICE = DeviceSpec(
         EntrySpec('moving', 66, 0, 'r', 0, 1),
         EntrySpec('present_current', 69, 0, 'r', 0, 65535),
     ),
-    state={},
+    state={'position': 0.0},
     reply={},
     commands=(
         # ping
@@ -97,21 +99,21 @@ DEVICE = DeviceSpec(
         # read
         CommandSpec(ReadRequest, ReplyResponse, reads=('data',), tables={'data': ('run', 'address', 'length')}),
         # write
-        CommandSpec(WriteRequest, ReplyResponse, writes=('data',), moves=('present_position', 'goal_position', 'goal_time', 'goal_speed'), optional_when=('response_level', 1, '=='), tables={'data': ('run', 'address', '')}),
+        CommandSpec(WriteRequest, ReplyResponse, writes=('data',), moves=('position', 'goal_position', 'goal_time', 'goal_speed'), move_to=lambda get: ((get('goal_position') + get('position_offset')) % 4096), optional_when=('response_level', 1, '=='), tables={'data': ('run', 'address', '')}),
         # reg_write
         CommandSpec(RegWriteRequest, ReplyResponse, writes=('data',), buffered=True, optional_when=('response_level', 1, '=='), tables={'data': ('run', 'address', '')}),
         # action
-        CommandSpec(ActionRequest, ReplyResponse, moves=('present_position', 'goal_position', 'goal_time', 'goal_speed'), commits=True, optional_when=('response_level', 1, '=='), tables={'data': ('run', 'address', 'length')}),
+        CommandSpec(ActionRequest, ReplyResponse, moves=('position', 'goal_position', 'goal_time', 'goal_speed'), move_to=lambda get: ((get('goal_position') + get('position_offset')) % 4096), commits=True, optional_when=('response_level', 1, '=='), tables={'data': ('run', 'address', 'length')}),
         # reset
         CommandSpec(ResetRequest, ReplyResponse, resets=True, optional_when=('response_level', 1, '=='), tables={'data': ('run', 'address', 'length')}),
         # sync_read
         CommandSpec(SyncReadRequest, ReplyResponse, reads=('data',), each='ids', tables={'data': ('run', 'address', 'length')}),
         # sync_write
-        CommandSpec(SyncWriteRequest, None, writes=('data',), moves=('present_position', 'goal_position', 'goal_time', 'goal_speed'), each='servos', tables={'data': ('run', 'address', 'data_length')}),
+        CommandSpec(SyncWriteRequest, None, writes=('data',), moves=('position', 'goal_position', 'goal_time', 'goal_speed'), move_to=lambda get: ((get('goal_position') + get('position_offset')) % 4096), each='servos', tables={'data': ('run', 'address', 'data_length')}),
     ),
     registers=CONTROL_TABLE,
     status={'error': 'status'},
-    moving={'moving': ('present_position', None)},
+    moving={'moving': ('position', None)},
     models=(
         ModelSpec(
             'sts3215',
@@ -145,6 +147,7 @@ DEVICE = DeviceSpec(
             },
         ),
     ),
+    derived={'present_position': lambda get: ((get('position') - get('position_offset')) % 4096)},
 )
 
 

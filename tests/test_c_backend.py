@@ -447,3 +447,37 @@ def test_example_host_program_talks_to_a_virtual_servo(tmp_path: Path) -> None:
     ping, read = (json.loads(line) for line in run.stdout.splitlines())
     assert ping["fields"] == {"id": 1, "error": 0, "data": ""}
     assert read["command"] == "reply" and len(bytes.fromhex(read["fields"]["data"])) == 6
+
+
+@pytest.mark.parametrize("build", BUILDS)
+@pytest.mark.parametrize("g", C_SPECS, ids=IDS)
+def test_the_shipped_golden_vector_check_passes_on_every_build(g: Generated, build: str, tmp_path: Path) -> None:
+    """<protocol>/test/check_vectors.c, the program a firmware developer builds beside the vendored C, built with the
+    strict warnings (and the sanitizers where the target has them) at -O0: every example decodes to its message,
+    encodes back byte for byte and is found by the parser fed byte by byte; every erratum frame is refused."""
+    folder = GENERATED_C / g.protocol.name
+    prefix, sanitize = runner(build)
+    exe = tmp_path / "check_vectors"
+    subprocess.run(
+        [
+            *compiler(build),
+            *FLAGS,
+            *sanitize,
+            "-O0",
+            "-I",
+            str(folder),
+            str(folder / "test" / "check_vectors.c"),
+            str(folder / f"{g.protocol.name}.c"),
+            "-o",
+            str(exe),
+        ],
+        check=True,
+        capture_output=True,
+    )
+    run = subprocess.run([*prefix, str(exe)], capture_output=True, text=True, timeout=120)
+    examples = sum(1 for e in g.protocol.examples)
+    refused = sum(1 for e in g.protocol.errata if e.check.kind == "frame_fails" and e.check.frame is not None)
+    assert (run.returncode, run.stdout) == (
+        0,
+        f"{g.protocol.name}: {examples} vectors, {refused} refused frames, 0 failed\n",
+    ), run.stdout + run.stderr

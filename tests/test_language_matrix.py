@@ -704,10 +704,18 @@ def c_target(name: str, g: Generated, built: Built, tmp_path: Path) -> None:
     source.mkdir()
     for path, text in built.files.items():
         if path.startswith("c/matrix_case/"):
-            (source / path.rsplit("/", 1)[1]).write_text(text, encoding="utf-8")
+            target = source / path.removeprefix("c/matrix_case/")
+            target.parent.mkdir(exist_ok=True)
+            target.write_text(text, encoding="utf-8")
     for c in ("matrix_case.c", "matrix_case_json.c"):  # the shipped specs' warning flags hold for every case
         strict = subprocess.run([GCC, *FLAGS, "-c", str(source / c), "-o", os.devnull], capture_output=True, text=True)
         assert strict.returncode == 0, strict.stderr
+    # the golden-vector program shipped beside the C: the case's examples decode, encode back and parse
+    check = tmp_path / "check_vectors"
+    build = [GCC, *FLAGS, str(source / "test" / "check_vectors.c"), str(source / "matrix_case.c"), "-o", str(check)]
+    subprocess.run(build, check=True, capture_output=True)
+    checked = subprocess.run([str(check)], capture_output=True, text=True, timeout=60)
+    assert checked.returncode == 0 and checked.stdout.endswith(" 0 failed\n"), checked.stdout + checked.stderr
     builds: list[tuple[tuple[str, ...], str]] = [((), "gcc")]
     if PPC_GCC and QEMU_PPC and any(word in name for word in BYTE_ORDER_WORDS):  # values built from bytes and bits
         builds.append(((PPC_GCC, "-static"), "powerpc-be"))

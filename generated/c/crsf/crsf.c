@@ -719,9 +719,9 @@ static uint32_t crsf__bits32(const uint8_t *b, size_t at, uint8_t n, uint8_t lsb
     for (j = 0u; j < n; j++) {
         size_t k = at + j;
         if (lsb) {
-            v |= (uint32_t)((b[k >> 3] >> (k & 7u)) & 1u) << j;
+            v |= (uint32_t)(((unsigned)b[k >> 3] >> (k & 7u)) & 1u) << j;
         } else {
-            v = (v << 1) | (uint32_t)((b[k >> 3] >> (7u - (k & 7u))) & 1u);
+            v = (v << 1) | (uint32_t)(((unsigned)b[k >> 3] >> (7u - (k & 7u))) & 1u);
         }
     }
     return v;

@@ -1216,6 +1216,7 @@ def files(protocol: Protocol) -> dict[str, str]:
                 if e.checksum is not None:
                     ctx.check_index(e.checksum)
     from serialspec.backends.c.files import header, json_header, json_source, source
+    from serialspec.backends.c.vectors import check_vectors, vectors_header
 
     p = protocol.name
     h = header(ctx)
@@ -1232,4 +1233,6 @@ def files(protocol: Protocol) -> dict[str, str]:
         f"{p}/{p}.c": c,
         f"{p}/{p}_json.h": json_header(ctx),
         f"{p}/{p}_json.c": json_source(ctx),
+        f"{p}/test/vectors.h": vectors_header(ctx),
+        f"{p}/test/check_vectors.c": check_vectors(ctx),
     }

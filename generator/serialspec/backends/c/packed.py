@@ -73,9 +73,9 @@ static uint{w}_t {p}__bits{w}(const uint8_t *b, size_t at, uint8_t n, uint8_t ls
     for (j = 0u; j < n; j++) {{
         size_t k = at + j;
         if (lsb) {{
-            v |= (uint{w}_t)((b[k >> 3] >> (k & 7u)) & 1u) << j;
+            v |= (uint{w}_t)(((unsigned)b[k >> 3] >> (k & 7u)) & 1u) << j;
         }} else {{
-            v = (v << 1) | (uint{w}_t)((b[k >> 3] >> (7u - (k & 7u))) & 1u);
+            v = (v << 1) | (uint{w}_t)(((unsigned)b[k >> 3] >> (7u - (k & 7u))) & 1u);
         }}
     }}
     return v;

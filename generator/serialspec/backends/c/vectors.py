@@ -1,0 +1,153 @@
+"""Golden vectors for the C target: `<protocol>/test/vectors.h` and `<protocol>/test/check_vectors.c`.
+
+Firmware developers vendor the generated C without serialspec; these two files let their own build check it: every
+example frame the spec records (decoded to its message, encoded back byte for byte, and found by the parser fed one
+byte at a time) and every frame an erratum says the document prints wrong (refused by the decoder). The same
+program runs in our tests under every compiler of the matrix.
+"""
+
+from __future__ import annotations
+
+from serialspec.backends.c.emit import Ctx, msg_id
+from serialspec.backends.c.files import banner
+from serialspec.lang.model import Direction, Message, Protocol
+
+_PER_LINE = 12  # bytes per line of a frame's initializer
+
+
+def _message(protocol: Protocol, command: str, subcommand: str | None, direction: Direction) -> Message | None:
+    return next(
+        (m for m in protocol.messages() if (m.command, m.subcommand, m.direction) == (command, subcommand, direction)),
+        None,
+    )
+
+
+def _bytes(frame: bytes) -> str:
+    rows = [", ".join(f"0x{b:02X}" for b in frame[i : i + _PER_LINE]) for i in range(0, len(frame), _PER_LINE)]
+    return ",\n    ".join(rows)
+
+
+def _c_string(text: str) -> str:
+    return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
+
+
+def vectors(ctx: Ctx) -> tuple[list[tuple[str, Direction, str, bytes]], list[tuple[str, Direction, bytes]]]:
+    """(name, direction, kind constant, frame) of every example; (name, direction, frame) of every `frame_fails`
+    erratum frame. (A `frame_decodes_as` erratum frame may hold values out of range: decoded, but not encoded back.)"""
+    protocol, P = ctx.protocol, ctx.P
+    good: list[tuple[str, Direction, str, bytes]] = []
+    for example in protocol.examples:
+        message = _message(protocol, example.command, example.subcommand, example.direction)
+        if message is not None:
+            good.append((example.name, example.direction, f"{P}_{msg_id(message).upper()}", example.frame))
+    refused: list[tuple[str, Direction, bytes]] = []
+    for erratum in protocol.errata:
+        check = erratum.check
+        if check.frame is None or check.direction is None:
+            continue
+        if check.kind == "frame_fails":
+            refused.append((erratum.name, check.direction, check.frame))
+    return good, refused
+
+
+def vectors_header(ctx: Ctx) -> str:
+    protocol, p, P = ctx.protocol, ctx.p, ctx.P
+    good, refused = vectors(ctx)
+    arrays: list[str] = []
+    rows: list[str] = []
+    for i, (name, direction, kind, frame) in enumerate(good):
+        arrays.append(f"static const uint8_t {p}__vector_{i}[] = {{\n    {_bytes(frame)}\n}};")
+        rows.append(f"    {{{_c_string(name)}, {P}_{direction.name}, {kind}, {p}__vector_{i}, {len(frame)}u}},")
+    refused_rows: list[str] = []
+    for i, (name, direction, frame) in enumerate(refused):
+        arrays.append(f"static const uint8_t {p}__refused_{i}[] = {{\n    {_bytes(frame)}\n}};")
+        refused_rows.append(
+            f"    {{{_c_string(name)}, {P}_{direction.name}, {P}_KIND_NONE, {p}__refused_{i}, {len(frame)}u}},"
+        )
+    end = f"    {{NULL, {P}_REQUEST, {P}_KIND_NONE, NULL, 0u}} /* end */"
+    return (
+        banner(protocol)
+        + f"/* Golden vectors of {protocol.title}: every example frame the spec records (a frame, its direction and\n"
+        " * the message it decodes to) and every frame an erratum says the document prints wrong (the decoder refuses\n"
+        " * it). test/check_vectors.c checks the codec and the parser against them. */\n\n"
+        f"#ifndef {P}_VECTORS_H\n#define {P}_VECTORS_H\n\n"
+        f'#include "../{p}.h"\n\n'
+        "typedef struct {\n"
+        "    const char *name;      /* its name in the spec */\n"
+        f"    {p}_direction_t direction;\n"
+        f"    {p}_kind_t kind;        /* the message it decodes to ({P}_KIND_NONE: refused) */\n"
+        "    const uint8_t *frame;\n"
+        "    size_t len;\n"
+        f"}} {p}_vector_t;\n\n" + "".join(a + "\n\n" for a in arrays) + f"#define {P}_VECTOR_COUNT {len(good)}u\n"
+        f"static const {p}_vector_t {p}_vectors[] = {{\n" + "".join(r + "\n" for r in rows) + end + "\n};\n\n"
+        f"#define {P}_REFUSED_COUNT {len(refused)}u\n"
+        f"static const {p}_vector_t {p}_refused[] = {{\n"
+        + "".join(r + "\n" for r in refused_rows)
+        + end
+        + "\n};\n\n"
+        + f"#endif /* {P}_VECTORS_H */\n"
+    )
+
+
+def check_vectors(ctx: Ctx) -> str:
+    protocol, p, P = ctx.protocol, ctx.p, ctx.P
+    return (
+        banner(protocol)
+        + f"/* Checks the generated {protocol.title} C against the spec's golden vectors: build it with\n"
+        f" *     cc -std=c99 -I.. check_vectors.c ../{p}.c -o check_vectors && ./check_vectors\n"
+        " * It prints one line per failure and a summary, and exits 1 when anything failed. */\n\n"
+        "#include <stdio.h>\n#include <string.h>\n\n"
+        '#include "vectors.h"\n\n'
+        f"static void {p}__fail(unsigned *failed, const char *name, const char *what, int result)\n"
+        "{\n"
+        f'    printf("FAIL %s: %s (%s)\\n", name, what, {p}_result_name(result));\n'
+        "    (*failed)++;\n"
+        "}\n\n"
+        "int main(void)\n"
+        "{\n"
+        "    unsigned failed = 0;\n"
+        f"    const {p}_vector_t *v;\n"
+        f"    for (v = {p}_vectors; v->frame != NULL; v++) {{\n"
+        f"        {p}_msg_t msg;\n"
+        f"#if {P}_ENABLE_DECODE\n"
+        f"        int result = {p}_decode_expect(v->frame, v->len, v->direction, v->kind, &msg);\n"
+        f"        if (result != {P}_OK || msg.kind != v->kind) {{\n"
+        f'            {p}__fail(&failed, v->name, "decode", result);\n'
+        "            continue;\n"
+        "        }\n"
+        f"#if {P}_ENABLE_ENCODE\n"
+        "        {\n"
+        f"            uint8_t buf[{P}_MAX_FRAME];\n"
+        "            size_t len = 0;\n"
+        f"            result = {p}_encode(&msg, buf, sizeof buf, &len);\n"
+        f"            if (result != {P}_OK || len != v->len || memcmp(buf, v->frame, len) != 0)\n"
+        f'                {p}__fail(&failed, v->name, "encode gives other bytes", result);\n'
+        "        }\n"
+        "#endif\n"
+        "#endif\n"
+        f"#if {P}_ENABLE_PARSER\n"
+        "        {\n"
+        f"            {p}_parser_t parser;\n"
+        "            size_t at = 0;\n"
+        "            bool got = false;\n"
+        f"            {p}_parser_init(&parser, v->direction);\n"
+        "            while (at < v->len && !got)  /* one byte at a time, as a UART interrupt hands them over */\n"
+        f"                at += {p}_parser_feed(&parser, v->frame + at, 1, &msg, &got);\n"
+        "            if (!got || at != v->len)\n"
+        f'                {p}__fail(&failed, v->name, "the parser does not find the frame", {P}_OK);\n'
+        "        }\n"
+        "#endif\n"
+        "        (void)msg;\n"
+        "    }\n"
+        f"#if {P}_ENABLE_DECODE\n"
+        f"    for (v = {p}_refused; v->frame != NULL; v++) {{\n"
+        f"        {p}_msg_t msg;\n"
+        f"        if ({p}_decode(v->frame, v->len, v->direction, &msg) == {P}_OK)\n"
+        f'            {p}__fail(&failed, v->name, "a frame the documents print wrong is accepted", {P}_OK);\n'
+        "    }\n"
+        "#endif\n"
+        f'    printf("{p}: %u vectors, %u refused frames, %u failed\\n", (unsigned){P}_VECTOR_COUNT,\n'
+        f"           (unsigned){P}_REFUSED_COUNT, failed);\n"
+        f"    return failed == 0 ? 0 : 1;\n"
+        "}\n"
+    )

@@ -2129,7 +2129,7 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
 
     Each direction's checks are inline here rather than in a function per direction: one call less per frame. A
     Direction is told by identity, first; its value as text ("request") costs one call more.
-    `expect` (the reply class a frame answers) matters only where replies share a code; here none do.
+    `expect`: the reply class the frame answers; it matters only where several reply layouts share a code.
     """
     if direction is _REQUEST:
         fixed = _REQUEST_WHOLE.get(data[:4])  # no key is shorter: a short frame matches none
@@ -2202,9 +2202,9 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
     if direction == 'response':  # its value as text
         return decode(data, _RESPONSE, expect)
     if direction is None:  # last: a caller that knows the direction does not pay for this
-        if data[:2] == b'\x12L':
+        if data.startswith(b'\x12L'):
             return decode(data, _REQUEST, expect)
-        if data[:2] == b'\x05\x1c':
+        if data.startswith(b'\x05\x1c'):
             return decode(data, _RESPONSE, expect)
         raise DecodeError(f"header is {data[:2].hex(' ')}, expected 12 4c or 05 1c")
     raise ValueError(f"direction must be request or response, not {direction!r}")

@@ -13,6 +13,8 @@ from dataclasses import dataclass, field, replace
 from typing import assert_never
 
 from serialspec.backends.common.numbers import number
+from serialspec.backends.python.checksum_code import checksum_expression, checksum_lines
+from serialspec.backends.python.dispatch import decoder_name, encoder_name
 from serialspec.backends.python.ir import (
     Advance,
     Block,
@@ -38,22 +40,14 @@ from serialspec.backends.python.ir import (
     packed_lists,
     values_tuple,
 )
-from serialspec.backends.python.kinds import kind
+from serialspec.backends.python.kinds import kind, takes_the_rest
 from serialspec.backends.python.optimize import deferred_item_checks, field_read, fold_last_size_check, read_fields_once
 from serialspec.backends.python.render import one_line
-from serialspec.backends.python.straight_frames import (
-    StraightLayouts,
-    checksum_name,
-    frame_encoder,
-    straight_direction,
-    struct_tokens,
-)
-from serialspec.checksums.base import Import
+from serialspec.backends.python.straight_frames import StraightLayouts, frame_encoder, straight_direction, struct_tokens
 from serialspec.lang import expression
 from serialspec.lang.model import (
     Array,
     Bytes,
-    Checksum,
     Direction,
     FrameLayout,
     Group,
@@ -86,19 +80,6 @@ _STRUCT_NAMES = {
 }
 
 
-def message_function(verb: str, message: Message) -> str:
-    """The codec's name of a function of one message (`_<verb>_<key>_<direction>`): its decoder, encoder, ..."""
-    return f"_{verb}_{message.key.replace('.', '_')}_{message.direction.value}"
-
-
-def decoder_name(message: Message) -> str:
-    return message_function("decode", message)
-
-
-def encoder_name(message: Message) -> str:
-    return message_function("encode", message)
-
-
 def bound(f: Scalar, value: float) -> str:
     """A range bound as the literal a comparison with the field's values is quickest with: a float field's bounds
     as floats where they are exactly that (a float compared with float32's maximum written as a 39-digit integer
@@ -125,16 +106,6 @@ def run_endian(fields: list[SpecField]) -> str:
 def struct_format(endian: str, fields: list[SpecField]) -> str:
     """The struct format of a run of fixed-size fields."""
     return endian + "".join(kind(f).struct_chars(f) for f in fields)
-
-
-def takes_the_rest(f: SpecField | None) -> bool:
-    """A field that reads exactly up to the end of the content, whatever its size.
-
-    Not a group of varying-size items: its last item may overrun `end`, which the check after it must catch.
-    """
-    if isinstance(f, Group):
-        return f.count == "rest" and f.item_size is not None
-    return isinstance(f, Bytes) and f.size == "rest"
 
 
 def is_fixed_run_member(f: SpecField) -> bool:
@@ -1186,20 +1157,3 @@ class PackageCode:
         item_body.append(Code(f"parts_{f.name}.append({packed})", lists=packed_lists(parts)))
         body.append(Loop(f"for {item} in {expr}", tuple(item_body), variable=item))
         return f"b''.join(parts_{f.name})"
-
-
-def checksum_expression(checksum: Checksum, covered: str) -> str | None:
-    """The one expression of a frame's checksum over the bytes `covered` (an expression) that checksum_lines
-    assigns, where it is one; None where it takes statements."""
-    return checksum.algorithm.python_expression(checksum_name(checksum), covered)
-
-
-def checksum_lines(checksum: Checksum, covered: str, target: str) -> Lines:
-    """Lines that compute a frame's checksum over the bytes `covered` (an expression) into `target`, as its
-    algorithm writes them (serialspec/checksums/; checksum_setup gives what they rely on)."""
-    return checksum.algorithm.python_lines(checksum_name(checksum), covered, target)
-
-
-def checksum_setup(checksum: Checksum) -> tuple[list[Import], list[str]]:
-    """The runtime imports and module-level definitions that `checksum_lines` relies on."""
-    return checksum.algorithm.python_setup(checksum_name(checksum))

@@ -1,11 +1,28 @@
-"""Which content decoder a frame's command code names, in each direction: shared by every frame shape."""
+"""Which content decoder a frame's command code names, in each direction, and the codec's names of each message's
+functions: shared by every frame shape."""
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
 from typing import Any
 
-from serialspec.backends.python.content import decoder_name
 from serialspec.lang.model import Command, Direction, FrameLayout, Message, Protocol, sizes_text
+
+
+def message_function(verb: str, message: Message) -> str:
+    """The codec's name of a function of one message (`_<verb>_<key>_<direction>`): its decoder, encoder, ..."""
+    return f"_{verb}_{message.key.replace('.', '_')}_{message.direction.value}"
+
+
+def decoder_name(message: Message) -> str:
+    return message_function("decode", message)
+
+
+def encoder_name(message: Message) -> str:
+    return message_function("encode", message)
+
+
+ERROR_REPLY = "ERROR_REPLY"  # the codes key of error replies (runtime.framing.ERROR_REPLY)
 
 
 def value_arguments(layout: FrameLayout) -> dict[str, str]:
@@ -68,3 +85,58 @@ def shared_codes(protocol: Protocol, direction: Direction) -> set[int]:
         if command.request is not None and command.code is not None:
             (shared if command.code in seen else seen).add(command.code)
     return shared
+
+
+def code_key(command: Command, layout: FrameLayout) -> str:
+    """A command's key in its direction's table of decoders: its code as the frame carries it, "None" for a frame
+    without one, ERROR_REPLY for error replies (any code with the error flag: runtime.framing)."""
+    if any(m.error_reply for m in command.messages()):
+        return ERROR_REPLY
+    code = command.wire_code(layout.direction)
+    return "None" if code is None or not layout.has_command else f"{code:#04x}"
+
+
+@dataclass
+class DirectionDispatch:
+    """One direction's decoders by code, whatever the frame shape: the table (code key -> decoder), each code's
+    content size bounds, the message of each code only one message has, the replies chosen by the request they
+    answer (class, code key, decoder), and the sub-command and content-size dispatchers the table names."""
+
+    dispatch: list[tuple[str, str]] = field(default_factory=list)
+    sizes: list[tuple[str, int, int | None]] = field(default_factory=list)
+    single: dict[str, Message] = field(default_factory=dict)
+    expected: list[tuple[str, str, str]] = field(default_factory=list)
+    dispatchers: list[dict[str, Any]] = field(default_factory=list)
+    size_dispatchers: list[dict[str, Any]] = field(default_factory=list)
+
+
+def direction_dispatch(protocol: Protocol, direction: Direction) -> DirectionDispatch:
+    """The direction's decoders by code (see DirectionDispatch)."""
+    layout = protocol.framing.layouts[direction]
+    found = DirectionDispatch()
+    by_code: dict[str, list[tuple[Message | None, str, int, int | None]]] = {}
+    for command in protocol.commands:
+        entry = direction_entry(command, direction)
+        if entry is None:
+            continue
+        target, low, high, sub_dispatch = entry
+        if sub_dispatch:
+            found.dispatchers.append(sub_dispatch | value_arguments(layout))
+        message = None if sub_dispatch else command.request if direction == Direction.REQUEST else command.response
+        by_code.setdefault(code_key(command, layout), []).append((message, target, low, high))
+    for key, users in by_code.items():
+        # the resolver allows several only for plain replies, one of them marked default, and for requests told
+        # apart by their content size
+        chosen = next((u for u in users if u[0] is not None and u[0].default_reply), users[0])
+        if direction == Direction.REQUEST and len(users) > 1:
+            by_size = size_dispatch(key, direction, [m for m, _, _, _ in users if m is not None])
+            found.size_dispatchers.append(by_size | value_arguments(layout))
+            chosen = (None, by_size["name"], 0, None)
+        found.dispatch.append((key, chosen[1]))
+        highs = [u[3] for u in users]
+        found.sizes.append((key, min(u[2] for u in users), None if None in highs else max(h or 0 for h in highs)))
+        if len(users) == 1 and users[0][0] is not None:
+            found.single[key] = users[0][0]
+        if direction == Direction.RESPONSE:
+            found.expected += [(m.class_name, key, t) for m, t, _, _ in users if m is not None and len(users) > 1]
+    return found

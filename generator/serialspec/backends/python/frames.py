@@ -12,10 +12,10 @@ from __future__ import annotations
 from collections.abc import Iterable
 
 from serialspec.backends.common.frames import runtime_element
-from serialspec.backends.python.straight_frames import checksum_name
+from serialspec.backends.python.checksum_code import checksum_name
+from serialspec.backends.python.dispatch import ERROR_REPLY
 from serialspec.checksums.base import Import
 from serialspec.lang.model import (
-    Command,
     Direction,
     FrameElement,
     FrameLayout,
@@ -25,7 +25,6 @@ from serialspec.lang.model import (
 )
 from serialspec.transforms import runtime_classes
 
-ERROR_REPLY = "ERROR_REPLY"  # the codes key of error replies (runtime.framing.ERROR_REPLY)
 # runtime.framing's classes (each transform's runtime class among them), in the order isort wants
 FRAMING_NAMES = tuple(sorted(("Element", "FrameCodec", "Layout", "SizeRule", *runtime_classes())))
 
@@ -151,13 +150,6 @@ def codec_lines(
     if error is not None and direction == Direction.RESPONSE:
         lines.append(f"    error_flag={error.flag:#04x},")
     return [*lines, ")"], names
-
-
-def code_key(command: Command, layout: FrameLayout) -> str:
-    if any(m.error_reply for m in command.messages()):
-        return ERROR_REPLY  # any code with the error flag (runtime.framing)
-    code = command.wire_code(layout.direction)
-    return "None" if code is None or not layout.has_command else f"{code:#04x}"
 
 
 def framing_imports(names: Iterable[str]) -> list[str]:

@@ -411,3 +411,13 @@ class TableBlockKind(Kind[TableBlock]):
 
 
 kind: Registry[Kind[Any]] = Registry(Kind)
+
+
+def takes_the_rest(f: SpecField | None) -> bool:
+    """A field that reads exactly up to the end of the content, whatever its size.
+
+    Not a group of varying-size items: its last item may overrun `end`, which the check after it must catch.
+    """
+    if isinstance(f, Group):
+        return f.count == "rest" and f.item_size is not None
+    return isinstance(f, Bytes) and f.size == "rest"

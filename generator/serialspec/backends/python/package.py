@@ -2,46 +2,31 @@
 
 from __future__ import annotations
 
-from dataclasses import replace
 from typing import Any
 
 from serialspec.backends.common.numbers import number
 from serialspec.backends.python.client import client_module
-from serialspec.backends.python.content import (
-    ClassCode,
-    PackageCode,
-    decoder_name,
+from serialspec.backends.python.content import ClassCode, PackageCode
+from serialspec.backends.python.dispatch import (
     encoder_name,
 )
-from serialspec.backends.python.dispatch import direction_entry, size_dispatch, value_arguments
-from serialspec.backends.python.frames import (
-    ERROR_REPLY,
-    checksum_definitions,
-    code_key,
-    codec_lines,
-)
 from serialspec.backends.python.ir import (
-    ContentSize,
     lines_of,
 )
-from serialspec.backends.python.length_byte_frames import length_byte_codec_context
-from serialspec.backends.python.optimize import content_unpacked, fuse_unpack
+from serialspec.backends.python.optimize import fuse_unpack
 from serialspec.backends.python.registers import register_tables, registers_module
 from serialspec.backends.python.render import one_line, render
-from serialspec.backends.python.simulator import import_order, simulator_module
-from serialspec.backends.python.straight_frames import Target, direction_functions
+from serialspec.backends.python.simulator import simulator_module
+from serialspec.backends.python.straight_frames import frames_codec_context
 from serialspec.backends.python.structs import structs_module
 from serialspec.collection import without_cycle_collection
 from serialspec.lang.model import (
-    Direction,
     Group,
     Message,
     Protocol,
     Scalar,
     Table,
     TableValue,
-    replies_by_request,
-    reply_to,
 )
 from serialspec.lang.names import python_view, spec_name
 
@@ -189,130 +174,8 @@ def message_doc(protocol: Protocol, message: Message) -> str:
 
 
 def codec_context(protocol: Protocol, code: PackageCode, exports: list[str]) -> dict[str, Any]:
-    # the frames' part first: the length-byte codec's whole-frame decoders add structs the common part lists
-    length_byte = protocol.framing.classic  # every layout has the length-byte shape (length_byte_frames.py)
-    specific = length_byte_codec_context(protocol, code) if length_byte else straight_codec_context(protocol, code)
-    return common_codec_context(protocol, code, exports) | specific
-
-
-def straight_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, Any]:
-    """Frames of any other shape: straight-line frame functions per direction where the layouts allow them (see
-    straight_frames.py), else the runtime's frame engine; one FrameCodec per direction either way (the stream parser's),
-    decoders by code (and by class)."""
-    imports, definitions = checksum_definitions(protocol)
-    directions: list[dict[str, Any]] = []
-    dispatchers = []
-    size_dispatchers: list[dict[str, Any]] = []
-    frame_structs: dict[str, str] = {}
-    # the runtime.framing names the codec uses: the FrameCodecs' (the straight-line functions' Transparency objects are
-    # those of the same layouts) and ERROR_REPLY where error replies are told by their flag
-    names = {"EngineFormat"}
-    for direction, layout in protocol.framing.layouts.items():
-        by_code: dict[str, list[tuple[Message | None, str, int, int | None]]] = {}
-        for command in protocol.commands:
-            entry = direction_entry(command, direction)
-            if entry is None:
-                continue
-            target, low, high, sub_dispatch = entry
-            if sub_dispatch:
-                dispatchers.append(sub_dispatch | value_arguments(layout))
-            message = None if sub_dispatch else command.request if direction == Direction.REQUEST else command.response
-            by_code.setdefault(code_key(command, layout), []).append((message, target, low, high))
-        dispatch: list[tuple[str, str]] = []
-        expected: list[tuple[str, str, str]] = []  # class, code, decoder: replies chosen by the request they answer
-        sizes: list[tuple[str, int, int | None]] = []
-        single: dict[str, Message] = {}
-        for key, users in by_code.items():
-            # the resolver allows several only for plain replies, one of them marked default, and for requests told
-            # apart by their content size
-            chosen = next((u for u in users if u[0] is not None and u[0].default_reply), users[0])
-            if direction == Direction.REQUEST and len(users) > 1:
-                by_size = size_dispatch(key, direction, [m for m, _, _, _ in users if m is not None])
-                size_dispatchers.append(by_size | value_arguments(layout))
-                chosen = (None, by_size["name"], 0, None)
-            dispatch.append((key, chosen[1]))
-            highs = [u[3] for u in users]
-            sizes.append((key, min(u[2] for u in users), None if None in highs else max(h or 0 for h in highs)))
-            if len(users) == 1 and users[0][0] is not None:
-                single[key] = users[0][0]
-            if direction == Direction.RESPONSE:
-                expected += [(m.class_name, key, t) for m, t, _, _ in users if m is not None and len(users) > 1]
-        only = dispatch[0][1] if not layout.has_command and len(dispatch) == 1 and not expected else ""
-        values = tuple(e.name for e in layout.value_elements)
-        frames = Target(direction.name, values, expected=bool(expected), only=only)
-        if protocol.error_reply is not None and direction == Direction.RESPONSE:
-            element = next(e for e in layout.elements if e.name == protocol.error_reply.element)
-            assert element.type is not None
-            mask = (1 << (8 * element.type.size)) - 1
-            flag = protocol.error_reply.flag
-            frames = replace(frames, error_flag=flag, error_keep=mask & ~flag)
-        plain = unpacked_messages(single, code) if not expected and not frames.error_flag else []
-        functions, call = direction_functions(protocol, direction, frames, frame_structs, plain)
-        names |= {ERROR_REPLY} if frames.error_flag else set()
-        frame_codec, used = codec_lines(protocol, direction, sizes, single)
-        names |= used
-        directions.append(
-            {
-                "name": direction.value,
-                "upper": direction.name,
-                "dispatch": dispatch,
-                "expected": expected,
-                "frames": frame_codec,
-                "functions": functions,
-                "call": call,
-                "headers": sorted({layout.header for layout in protocol.framing.alternatives[direction]}),
-            }
-        )
-    headers = [h for d in directions for h in d["headers"]]
-    shared = {cls for d in directions for cls, _, _ in d["expected"]}
-    replies = replies_by_request(protocol.messages())
-    reply_layouts = [
-        (m.class_name, reply.class_name)
-        for m in protocol.messages()
-        if m.direction == Direction.REQUEST
-        and (reply := reply_to(m, replies)) is not None
-        and reply.class_name in shared
-        and not reply.default_reply
-    ]
-    code.structs.update(frame_structs)  # listed with the content's structs (common_codec_context)
-    return {
-        "length_byte_frames": False,
-        "reply_layouts": reply_layouts,
-        "framing_imports": sorted(names, key=import_order),
-        # the straight-line frame checks raise it (the engine raises its own)
-        "checksum_error": any(
-            element.kind == "checksum"
-            for direction in protocol.framing.layouts
-            if (straight := code.straight(direction)) is not None
-            for layout in straight.layouts
-            for element in layout.elements
-        ),
-        "checksum_imports": imports,
-        "checksum_definitions": definitions,
-        "directions": directions,
-        "dispatchers": dispatchers,
-        "size_dispatchers": size_dispatchers,
-        "by_header": all(headers) and len(set(headers)) == len(headers),
-    }
-
-
-def unpacked_messages(single: dict[str, Message], code: PackageCode) -> list[tuple[int, int, str, str, str]]:
-    """(code, content size, class, struct's name stem, its format) of the messages of one size whose decoder, past its
-    size check, is one struct's unpack of the content as their message (straight_frames.whole_frames decodes them
-    whole)."""
-    bodies = {name: body for name, _, _, body in code.decoders}
-    found = []
-    for key, message in single.items():
-        body = bodies[decoder_name(message)]
-        if key in ("None", ERROR_REPLY) or message.min_size != message.max_size or len(body) < 2:
-            continue
-        if not (isinstance(body[0], ContentSize) and body[0].exact):
-            continue
-        unpacked = content_unpacked(body[1:])
-        if unpacked is not None:
-            cls, struct = unpacked
-            found.append((int(key, 16), message.min_size or 0, cls, code.stems[struct], code.structs[struct]))
-    return found
+    frames = frames_codec_context(protocol, code)  # first: its whole-frame decoders add structs the common part lists
+    return common_codec_context(protocol, code, exports) | frames
 
 
 def common_codec_context(protocol: Protocol, code: PackageCode, exports: list[str]) -> dict[str, Any]:

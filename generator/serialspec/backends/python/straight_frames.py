@@ -1,50 +1,102 @@
-"""Straight-line frame code: stuffing, u16 lengths over a span, CRC-16s, frames without a header or a length,
-alternative layouts told apart by their header. decode_lines writes every framing's frame checks and dispatch (the
-length-byte codecs' decode() runs them past its whole-frame lookups, length_byte_frames.py); the rest serves the
-frames that are not of the length-byte shape.
+"""Straight-line frame code: the one generator of the codec's frames, for every framing the language describes.
 
-Each direction gets two functions: `_decode_<direction>(frame, expect)` checks a whole frame and calls the content
-decoder on the frame's own bytes, and `_wrap_<direction>(content, code, *values)` puts the frame around a content.
-They make the runtime engine's checks (runtime/framing.py, Layout.unwrap and Layout.wrap) in the engine's order with
-the engine's messages, but as code written for one layout: every offset known when the layout is fixed is a literal,
-the bytes are unstuffed only when a stuffed sequence occurs (a `find` first), and a frame's content is decoded in
-place (no copy) unless it was stuffed, and a CRC stored in its own bit order is checked by its residue over the
-frame. `decode()` runs the checks inline (one call less), and first looks a frame of one size whose message is its
-content as one struct unpacks it up by its first bytes (`whole_frames`: checked from its end, unpacked whole, no
-call); encoders of unstuffed frames make their frame inline too (`frame_encoder`: the head packed with the content's
-first struct, constant leading bytes as a literal beside the checksummed body). Where a layout does not fit that
-form (a length after the content, a checksum over bytes inside the stuffed span, ...) the two functions call the
-engine instead, so every layout the language describes works and the straight-line form is only ever a faster way to
-the same result (tests/test_straight_frames.py holds them to it).
+A frame shape is a description: the engine's layouts (runtime/framing.py's Layout, made from the model by
+backends/common/frames.py), one or more per direction. From it this module writes the codec's frame code, in three
+layers, each a case of the one before:
 
-Positions are expressions over `buf`, the frame with its stuffed span replaced by the plain bytes (`frame` itself
-where nothing can be stuffed): an element before the content at a literal offset, an element after it at `end + k`,
-where `end` is the content's end. Lengths and checksums that see wire bytes read `frame`.
+1. **Every framing** (`straight_direction`, `decode_lines`, `wrap_parts`, `frame_encoder`): a layout fits the
+   straight-line form when its content lies in its one variable part (stuffing, u16 lengths over a span, CRC-16s,
+   frames without a header or a length, alternative layouts told apart by their header all do). Each direction
+   gets the engine's checks (Layout.unwrap and Layout.wrap) in the engine's order with the engine's messages, but as
+   code written for one layout: every offset known when the layout is fixed is a literal, the bytes are unstuffed
+   only when a stuffed sequence occurs (a `find` first), a frame's content is decoded in place (no copy) unless it
+   was stuffed, and a CRC stored in its own bit order is checked by its residue over the frame. decode() runs the
+   checks inline (one call less); encoders of unstuffed frames make their frame inline (`frame_encoder`: the head
+   packed with the content's first struct, constant leading bytes as a literal beside the checksummed body). Where a
+   layout does not fit (a length after the content, a checksum over bytes inside the stuffed span, ...) the
+   direction's two functions call the engine instead, so every layout works and the straight-line form is only ever
+   a faster way to the same result (tests/test_straight_frames.py holds them to it).
+2. **Frames of one size whose message is one struct's unpack of their content** (`whole_frames`): decode() first
+   looks them up by the bytes before the content, checks the rest from the frame's end and unpacks the whole frame.
+3. **The length-byte case** (`length_byte_codec_context`): layouts with a header, frame values and a command code
+   at fixed offsets, a one-byte length before the content and one checksum at the end, nothing stuffed (the
+   model's FrameLayout.classic). Their offsets are known once a frame's first bytes are, so each message of one
+   size also gets a whole-frame decoder made from its content decoder's statements (the content size check dropped,
+   the cursor made a constant offset), which checks the checksum the cheapest way its algorithm allows
+   (checksums/: frame_test, byte_total, byte_table); decode() looks them up by the frame's first bytes
+   (`lookup_lines`) before the general checks of layer 1, which take every frame the tables do not. The same
+   decoders, at an offset of a buffer (`stream=True`), are the stream parser's (runtime/stream.py's FrameFormat:
+   `fixed`, `runs`, `summed`), which takes the length-byte case; the others' stream parser is the engine's
+   (runtime/framing.py's FrameStreamParser).
+
+`frames_codec_context` is the codec template's one entry. Positions in layer 1 are expressions over `buf`, the
+frame with its stuffed span replaced by the plain bytes (`frame` itself where nothing can be stuffed): an element
+before the content at a literal offset, an element after it at `end + k`, where `end` is the content's end. Lengths
+and checksums that see wire bytes read `frame`.
 """
 
 from __future__ import annotations
 
+import struct
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING, Any
 
-from serialspec.backends.common.frames import runtime_layouts
-from serialspec.backends.python.ir import Block, Code, Literal, Pack, PackItems, Simple, packed_lists
-from serialspec.lang.model import Checksum, Direction, Protocol
+from serialspec.backends.common.frames import runtime_layout, runtime_layouts
+from serialspec.backends.python.checksum_code import checksum_call, checksum_lines, checksum_name, checksum_setup
+from serialspec.backends.python.dispatch import (
+    ERROR_REPLY,
+    decoder_name,
+    direction_dispatch,
+    message_function,
+    shared_codes,
+)
+from serialspec.backends.python.frames import checksum_definitions, codec_lines, import_lines
+from serialspec.backends.python.ir import (
+    RETURN_NONE,
+    Advance,
+    Block,
+    Code,
+    ContentSize,
+    Expect,
+    FrameTest,
+    If,
+    Literal,
+    Loop,
+    Pack,
+    PackItems,
+    ReturnNew,
+    Simple,
+    Statement,
+    TakeRest,
+    Unpack,
+    lines_of,
+    packed_lists,
+    raises,
+    reads_cursor,
+    walk,
+)
+from serialspec.backends.python.kinds import takes_the_rest
+from serialspec.backends.python.optimize import content_unpacked, fuse_unpack
+from serialspec.backends.python.simulator import import_order
+from serialspec.lang.model import (
+    Bytes,
+    Checksum,
+    Command,
+    Direction,
+    FrameLayout,
+    Message,
+    Protocol,
+    replies_by_request,
+    reply_to,
+)
 from serialspec.runtime.framing import Element, Layout, Transparency
+
+if TYPE_CHECKING:
+    from serialspec.backends.python.content import PackageCode
 
 Lines = list[str]
 Structs = Callable[[str], str]  # a struct format -> the name of the module's struct constant for it
-
-
-def checksum_name(checksum: Checksum) -> str:
-    """The codec's module-level name of a checksum's function (backends/python/frames.py defines them)."""
-    return f"_CHECK_{checksum.name.upper()}"
-
-
-def checksum_call(checksum: Checksum) -> str:
-    """The expression of a checksum over `{}` (a str.format template), as its algorithm writes it: in line, a C
-    function called directly, or the module's checksum function (frames.checksum_definitions defines it)."""
-    return checksum.algorithm.python_call(checksum_name(checksum))
 
 
 def registry(structs: dict[str, str]) -> Structs:
@@ -954,3 +1006,1035 @@ def whole_frames(
 
 def _plus(expression: str, k: int) -> str:
     return f"{expression} + {k}" if k > 0 else f"{expression} - {-k}" if k else expression
+
+
+# --- the length-byte case ---------------------------------------------------------------------------------------
+
+
+def length_byte_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, Any]:
+    """The codec template's part for frames of the length-byte shape: decode()'s tables of whole frames, the
+    whole-frame decoders and the straight-line frame checks."""
+    assert protocol.framing.checksum is not None
+    checksum = protocol.framing.checksum
+    assert checksum is not None  # length-byte frames have one
+    checksum_imports, definitions = checksum_setup(checksum)
+    directions = []
+    dispatchers = []
+    frame_functions: list[dict[str, Any]] = []
+    whole_functions: list[dict[str, Any]] = []
+    whole_pickers: list[dict[str, Any]] = []
+    decoder_bodies = {name: (returns, extra, body) for name, returns, extra, body in code.decoders}
+    size_dispatchers: list[dict[str, Any]] = []
+    for direction, layout in protocol.framing.layouts.items():
+        table = direction_dispatch(protocol, direction)
+        dispatchers += table.dispatchers
+        size_dispatchers += table.size_dispatchers
+        dispatch, sizes = table.dispatch, table.sizes
+        fixed = fixed_frames(protocol, layout, decoder_bodies, code)
+        runs = [(key, function["run"]["name"]) for key, _, function in fixed if function.get("run")]
+        sub_functions, pickers, sub_entries = subcommand_frames(protocol, layout, decoder_bodies, code)
+        whole = length_byte_whole_frames(layout, [*fixed, *sub_entries])
+        rests = rest_frames(protocol, layout, decoder_bodies, code) if whole or fixed else []
+        stream_rests = rest_frames(protocol, layout, decoder_bodies, code, stream=True)
+        whole_functions += stream_rests
+        whole_functions += rests
+        sub_rests = subcommand_rest_frames(protocol, layout, decoder_bodies) if whole else []
+        whole_functions += sub_rests
+        if whole:  # decode() looks frames up by their first bytes
+            whole_functions += [f | {"whole_lines": fuse_unpack(f["whole_lines"])} for f in sub_functions]
+            whole_pickers += pickers
+        range_checks = value_range_checks(layout, protocol.byte_order)
+        # decode() looks these frames up before any other check: where each decoder refuses a frame of another size
+        # itself (struct.error from an unpack of the whole frame), decode() need not compare sizes first
+        whole_size = max(layout.length_offset, layout.command_offset or 0) + 1
+        content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
+        exact = bool(whole) and not sub_entries and not rests and not sub_rests and not range_checks
+        bodies = {f["whole_name"]: fuse_unpack(f["whole_lines"]) for _, _, f in fixed}
+        if exact:
+            bodies = {
+                name: exact_whole(body, size, whole_size, code)
+                for (_, size, f), (name, body) in zip(fixed, bodies.items(), strict=True)
+            }
+            whole = [
+                (
+                    key,
+                    size,
+                    name,
+                    None if plain is None else (plain[0], exact_struct(plain[1], size, content_offset, code)),
+                )
+                for key, size, name, plain in whole
+            ]
+        frame_functions += [
+            f | {"lines": fuse_unpack(f["lines"]), "whole_lines": bodies[f["whole_name"]], "exact": exact}
+            for _, _, f in fixed
+        ]
+        slice_key = None if whole else key_slice(layout)
+        # past the lookups, a frame is checked and dispatched as every framing's is (straight_frames.py)
+        straight = straight_direction(protocol, direction)
+        assert straight is not None and len(straight.layouts) == 1  # a length-byte layout is straight-line
+        only = dispatch[0][1] if layout.command_offset is None and len(dispatch) == 1 else ""
+        frames = Target(direction.name, tuple(e.name for e in layout.value_elements), only=only)
+        engine, checks, algorithms = straight.layouts[0], straight.checks[0], straight.algorithms[0]
+        _, general = decode_lines(engine, f"_decode_{direction.value}", frames, checks, "", algorithms=algorithms)
+        directions.append(
+            {
+                "slice_key": slice_key,
+                "slice_fixed": [(slice_bytes(layout, key), size, f["whole_name"]) for key, size, f in fixed],
+                "slice_rests": [slice_rest(layout, r) for r in rests],
+                "accepted": [inside for _, inside, _ in range_checks],
+                "exact": exact,
+                "fixed": [(key, size, function["name"]) for key, size, function in fixed],
+                # before the frames of one size: where a length byte names both, those keep their decoder
+                "stream_rests": [rest_key(layout, r, False) for r in stream_rests],
+                "runs": runs,
+                "summed": stream_sum(protocol, layout) if runs else None,
+                "fixed_whole": [(key, size, function["whole_name"]) for key, size, function in fixed],
+                "rest_keys": [rest_key(layout, r, bool(whole)) for r in rests],
+                # before the frames of one size: where a length byte names both, those keep their decoder
+                "sub_rest_keys": [rest_key(layout, r, True) for r in sub_rests],
+                "whole_frames": whole,
+                "unpacked": any(plain for *_, plain in whole),
+                "whole_check": whole_frame_test(protocol, layout),
+                "content_offset": content_offset,
+                "whole_size": whole_size,
+                "key": frame_key(layout, "data"),
+                "name": direction.value,
+                "upper": direction.name,
+                "header": repr(layout.header),
+                "header_hex": layout.header.hex(" "),
+                "header_size": len(layout.header),
+                "overhead": layout.overhead,
+                "length_offset": layout.length_offset,
+                "length_adds": layout.length_adds,
+                "command_offset": layout.command_offset,
+                "value_ranges": value_ranges(layout, protocol.byte_order),
+                "range_checks": [
+                    line for refused, _, error in range_checks for line in (f"if {refused}:", f"    raise {error}")
+                ],
+                "dispatch": dispatch,
+                "sizes": sizes,
+                "general": general,
+                "at": frame_decode_lines(protocol, layout, dispatch),
+            }
+        )
+        directions[-1]["call"] = [
+            *lookup_lines(directions[-1]),
+            "frame = data if data.__class__ is bytes else bytes(data)",
+            *general,
+        ]
+        directions[-1]["headers"] = [repr(layout.header)]
+    layouts = protocol.framing.layouts
+    header_choices = " or ".join(layouts[d].header.hex(" ") for d in Direction)
+    either = f"give the direction: requests and responses share the header {layouts[Direction.REQUEST].header.hex(' ')}"
+    width = len(layouts[Direction.REQUEST].header)
+    for function in frame_functions:
+        function["lines"], function["whole_lines"] = lines_of(function["lines"]), lines_of(function["whole_lines"])
+    for function in whole_functions:
+        function["whole_lines"] = lines_of(function["whole_lines"])
+    for picker in whole_pickers:
+        picker["lines"] = lines_of(picker["lines"])
+    imports = import_lines(checksum_imports)
+    name = checksum_name(checksum)
+    if name in checksum.algorithm.python_call(name):
+        # the general path calls the checksum's function (as every framing's does): defined with what it needs
+        imports, definitions = checksum_definitions(protocol)
+    return {
+        "length_byte_frames": True,
+        "checksum_imports": imports,
+        "checksum_definitions": definitions,
+        "directions": directions,
+        "frame_functions": frame_functions,
+        "runs": any(d["runs"] for d in directions),
+        "whole_functions": whole_functions,
+        "whole_pickers": whole_pickers,
+        "dispatchers": dispatchers,
+        "size_dispatchers": size_dispatchers,
+        "header_choices": header_choices,
+        "either": either if protocol.framing.shared_header else "",
+        "no_header": f"f\"header is {{data[:{width}].hex(' ')}}, expected {header_choices}\"",
+    }
+
+
+def frame_key(layout: FrameLayout, buf: str, start: str = "") -> str:
+    """The expression of a frame's size key (command code and length byte) as the stream parser's tables use it."""
+    at = f"{start} + " if start else ""
+    length = f"{buf}[{at}{layout.length_offset}]"
+    if layout.command_offset is None:
+        return length
+    return f"{buf}[{at}{layout.command_offset}] << 8 | {length}"
+
+
+def key_slice(layout: FrameLayout) -> str | None:
+    """Where a frame's command code and length byte are neighbours after its header (FEETECH: an id between): the
+    slice of `data` holding them, decode()'s key for its whole frames (a short frame's is shorter: it matches
+    none, so the lookup comes before any check). None where they are not neighbours."""
+    if layout.command_offset is None:
+        return None
+    low = min(layout.command_offset, layout.length_offset)
+    if max(layout.command_offset, layout.length_offset) != low + 1 or low < len(layout.header):
+        return None
+    return f"data[{low}:{low + 2}]"
+
+
+def slice_bytes(layout: FrameLayout, key: str) -> str:
+    """A size key (command code << 8 | length byte, as fixed_frames makes it) as the bytes key_slice reads."""
+    value = int(key, 16)
+    assert layout.command_offset is not None  # key_slice holds it
+    by_offset = {layout.command_offset: value >> 8, layout.length_offset: value & 0xFF}
+    return repr(bytes(by_offset[o] for o in sorted(by_offset)))
+
+
+def slice_rest(layout: FrameLayout, rest: dict[str, Any]) -> dict[str, Any]:
+    """rest_key's entries as the bytes key_slice reads: the key's expression in the length byte `n`."""
+    assert layout.command_offset is not None  # key_slice holds it
+    by_offset = {layout.command_offset: f"{rest['code'] or 0:#04x}", layout.length_offset: "n"}
+    key = f"bytes(({', '.join(by_offset[o] for o in sorted(by_offset))}))"
+    low, high = rest["lengths"]
+    return {"key": key, "low": low, "high": high, "adds": rest["adds"], "name": rest["whole_name"]}
+
+
+def rest_key(layout: FrameLayout, rest: dict[str, Any], by_bytes: bool) -> dict[str, Any]:
+    """decode()'s table entries of a frame that takes the rest (rest_frames), one per length byte `n`: the key's
+    expression in `n` (first bytes as whole_frames makes them, or the size key as frame_key), the range of `n`,
+    and the frame size less `n`."""
+    code = rest["code"] or 0
+    if by_bytes:  # header, then command code and length byte in offset order
+        key = " + ".join(
+            [
+                repr(layout.header),
+                *(
+                    "bytes((n,))" if o == layout.length_offset else repr(bytes([code]))
+                    for o in sorted(o for o in (layout.command_offset, layout.length_offset) if o is not None)
+                ),
+            ]
+        )
+    else:
+        key = f"{code:#04x} << 8 | n" if layout.command_offset is not None else "n"
+    low, high = rest["lengths"]
+    return {"key": key, "low": low, "high": high, "adds": rest["adds"], "name": rest["whole_name"]}
+
+
+def length_byte_whole_frames(
+    layout: FrameLayout, fixed: list[tuple[str, int, dict[str, Any]]]
+) -> list[tuple[str, int, str, tuple[str, str] | None]]:
+    """decode()'s table of the frames decoded whole, keyed by their first bytes when those are the header, command
+    code and length byte (one slice, one lookup, and the header is checked with them); [] where they are not."""
+    width = len(layout.header)
+    offsets = sorted(o for o in (layout.command_offset, layout.length_offset) if o is not None)
+    if offsets != list(range(width, width + len(offsets))):
+        return []
+    entries = []
+    for key, size, function in fixed:
+        value = int(key, 16)
+        bytes_at = {layout.length_offset: value & 0xFF}
+        if layout.command_offset is not None:
+            bytes_at[layout.command_offset] = value >> 8
+        key_bytes = repr(layout.header + bytes(bytes_at[o] for o in offsets))
+        entries.append((key_bytes, size, function["whole_name"], function.get("plain")))
+    return entries
+
+
+def fixed_frames(
+    protocol: Protocol, layout: FrameLayout, bodies: dict[str, tuple[str, str, Block]], code: PackageCode
+) -> list[tuple[str, int, dict[str, Any]]]:
+    """Whole-frame decoders for the frames of one size whose content is one run of fixed fields: (size key, frame
+    size, function). Each checks the checksum, unpacks the content in one call and builds the message: no
+    dispatch, no size checks (the key is the command code and length byte, so the size is known), one call per
+    frame. It returns None for a frame whose checksum fails, so callers word the error (decode) or count it (the
+    stream parser); it raises nothing. Frames of any other kind keep the general path."""
+    found = []
+    for command in protocol.commands:
+        message = command.request if layout.direction == Direction.REQUEST else command.response
+        if command.selector is not None or message is None:
+            continue
+        made = frame_function(protocol, layout, command, message, bodies, code)
+        if made is not None:
+            key, size, function = made
+            found.append((f"{key:#06x}", size, function))
+    return found
+
+
+def subcommand_frames(
+    protocol: Protocol, layout: FrameLayout, bodies: dict[str, tuple[str, str, Block]], code: PackageCode
+) -> tuple[list[dict[str, Any]], list[dict[str, Any]], list[tuple[str, int, dict[str, Any]]]]:
+    """decode()'s whole-frame decoders of sub-command frames of one size (as fixed_frames, the sub-command's check
+    dropped: its code picks the decoder) and, per command and frame size, the function that picks one by the
+    sub-command byte: (decoders, pickers, decode's table entries of the pickers, as fixed_frames gives them)."""
+    content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
+    functions: list[dict[str, Any]] = []
+    pickers: list[dict[str, Any]] = []
+    entries = []
+    for command in protocol.commands:
+        if command.selector is None or layout.direction not in command.selector.offsets:
+            continue
+        by_size: dict[tuple[int, int], list[tuple[int, dict[str, Any]]]] = {}
+        for sub in command.subcommands:
+            message = sub.request if layout.direction == Direction.REQUEST else sub.response
+            if message is None:
+                continue
+            made = frame_function(protocol, layout, command, message, bodies, code, command.selector.name)
+            if made is not None:
+                key, size, function = made
+                by_size.setdefault((key, size), []).append((sub.code, function))
+        at = content_offset + command.selector.offsets[layout.direction]
+        for (key, size), subs in by_size.items():
+            picker = {
+                "whole_name": f"_whole_{command.name}_{layout.direction.value}_{size}",
+                "table": f"_{command.name.upper()}_{layout.direction.name}_WHOLE_{size}",
+                "size": size,
+                "where": f"{command.name} {layout.direction.value}",
+                "entries": [(f"{c:#04x}", f["whole_name"]) for c, f in subs],
+            }
+            lines = picked_inline(subs, at)
+            if lines is None:  # each sub-command's own decoder, from a table
+                functions += [f for _, f in subs]
+                lines = [
+                    Code(f"whole = {picker['table']}.get(buf[{at}])"),
+                    Code("return None if whole is None else whole(buf)"),
+                ]
+            else:
+                picker["entries"] = []
+            pickers.append(picker | {"lines": lines})
+            entries.append((f"{key:#06x}", size, picker))
+    return functions, pickers, entries
+
+
+def rest_frames(
+    protocol: Protocol,
+    layout: FrameLayout,
+    bodies: dict[str, tuple[str, str, Block]],
+    code: PackageCode,
+    stream: bool = False,
+) -> list[dict[str, Any]]:
+    """decode()'s whole-frame decoders of the frames whose content is fixed fields then bytes to its end (FEETECH
+    WRITE: an address, then the data): any length byte from the smallest such content up names one, so decode()'s
+    table holds a key per length byte. Each checks the checksum, reads the fields at constant offsets and the bytes
+    up to the frame's tail: no dispatch, no content decoder's call. Others keep the general path.
+
+    `stream`: the same decoders for the stream parser's table of frames decoded whole (FrameFormat.fixed), of the
+    frame at buf[start:] (its end from its length byte), also for contents of any size (FEETECH's reply: an
+    error byte in the frame, then the data), which have no size check to drop: one call per frame."""
+    checksum = protocol.framing.checksum
+    length = layout.length
+    if checksum is None or length is None or length.type is None:
+        return []
+    content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
+    tail = layout.overhead - content_offset  # bytes after the content
+    found = []
+    shared = shared_codes(protocol, layout.direction)
+    for command in protocol.commands:
+        if command.wire_code(layout.direction) in shared:
+            continue  # its length bytes may name a request of the same code: its size dispatch picks
+        message = command.request if layout.direction == Direction.REQUEST else command.response
+        if command.selector is not None or message is None or message.max_size is not None or not message.fields:
+            continue
+        if not (isinstance(message.fields[-1], Bytes) and takes_the_rest(message.fields[-1])):
+            continue
+        returns, extra, decoder = bodies[decoder_name(message)]
+        if decoder and isinstance(decoder[0], ContentSize) and decoder[0].high is None:
+            statements = decoder[1:]  # the size check: the key implies it
+        elif stream and not message.min_size and not any(isinstance(s, ContentSize) for s in walk(decoder)):
+            statements = decoder
+        else:
+            continue
+
+        def at(offset: int) -> str:
+            return f"start + {offset}" if stream else str(offset)
+
+        offset, body = content_offset, []
+        for statement in statements:
+            if isinstance(statement, Advance) and statement.size.isdigit():
+                offset += int(statement.size)
+                continue
+            if isinstance(statement, Unpack) and statement.at == "o":
+                statement = replace(statement, at=at(offset))
+            elif isinstance(statement, TakeRest):
+                statement = replace(statement, start=at(offset), stop=f"stop - {tail}" if stream else f"-{tail}")
+            if raises([statement]) or any(reads_cursor(s) for s in walk([statement])):
+                break  # checked beyond its size, or read at a cursor: the general path
+            body.append(statement)
+        else:
+            values = [Code(f"{e.name} = buf[{at(layout.offsets[e.name])}]") for e in layout.value_elements]
+            lowest = (message.min_size or 0) + layout.length_adds
+            check = stream_rest_check(protocol, layout) if stream else rest_check(protocol, layout)
+            found.append(
+                {
+                    "whole_name": message_function("stream" if stream else "whole", message),
+                    "stream": stream,
+                    "returns": returns,
+                    "where": f"{message.key} {message.direction.value}",
+                    "whole_lines": fuse_unpack([*check, *values, *body]),
+                    "code": command.wire_code(layout.direction),
+                    "lengths": (lowest, length.type.maximum),
+                    "adds": layout.overhead - layout.length_adds,  # frame size = length byte + this
+                }
+            )
+    return found
+
+
+def subcommand_rest_frames(
+    protocol: Protocol, layout: FrameLayout, bodies: dict[str, tuple[str, str, Block]]
+) -> list[dict[str, Any]]:
+    """decode()'s whole-frame decoders of the sub-command frames of more than one size (a list its count sizes), one
+    per command: any length byte from the smallest such content up names it (a key per length byte, as rest_frames).
+    Each checks the checksum, then picks the sub-command by its byte and runs that sub-command's content decoder's
+    statements in place: no dispatch and no call. It returns None where the checksum fails or no such sub-command has
+    the code (decode()'s general path then says why); a frame its statements refuse raises what the general path
+    raises, as that path, with the same checks passed, runs the same statements."""
+    checksum = protocol.framing.checksum
+    length = layout.length
+    if checksum is None or length is None or length.type is None or layout.value_elements:
+        return []
+    content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
+    tail = layout.overhead - content_offset  # bytes after the content
+    found = []
+    for command in protocol.commands:
+        if command.selector is None or layout.direction not in command.selector.offsets:
+            continue
+        at = command.selector.offsets[layout.direction]
+        subs = []
+        for sub in command.subcommands:
+            message = sub.request if layout.direction == Direction.REQUEST else sub.response
+            if message is None or message.min_size == message.max_size:
+                continue  # none, or of one size (subcommand_frames)
+            returns, extra, body = bodies[decoder_name(message)]
+            if not extra:
+                subs.append((sub.code, message, body))
+        if not subs:
+            continue
+        lines: Block = [*rest_check(protocol, layout), Code(f"sub = buf[{content_offset + at}]")]
+        for sub_code, _, body in subs:
+            cursor = Code(f"o, end = {content_offset}, len(buf) - {tail}")
+            lines.append(If(f"sub == {sub_code:#04x}", (cursor, *body)))
+        smallest = min(message.min_size or 0 for _, message, _ in subs)
+        sizes = [message.max_size for _, message, _ in subs]
+        largest = length.type.maximum if None in sizes else max(s for s in sizes if s is not None) + layout.length_adds
+        found.append(
+            {
+                "whole_name": f"_whole_{command.name}_{layout.direction.value}",
+                "returns": "Message",
+                "where": f"{command.name} {layout.direction.value}",
+                "whole_lines": [*lines, RETURN_NONE],
+                "code": command.wire_code(layout.direction),
+                # the sub-command's byte lies within the content: no smaller content reaches the picker
+                "lengths": (max(smallest, at + 1) + layout.length_adds, min(largest, length.type.maximum)),
+                "adds": layout.overhead - layout.length_adds,  # frame size = length byte + this
+            }
+        )
+    return found
+
+
+def rest_check(protocol: Protocol, layout: FrameLayout) -> Block:
+    """The checksum test of a whole frame of any size (`buf` is the frame), returning None when it fails."""
+    checksum = protocol.framing.checksum
+    assert checksum is not None  # length-byte frames have one
+    size = layout.checksum_offset_from_end
+    stored = "buf[-1]" if size == 1 else f"int.from_bytes(buf[-{size}:], 'little')"
+    header = layout.header[: layout.covered_from]
+    test = checksum.algorithm.frame_test("sum(buf)", sum(header), "buf[-1]")
+    if test is not None and size == 1 == layout.covered_to_end and len(header) == layout.covered_from:
+        return [FrameTest(test, test)]
+    covered = f"buf[{layout.covered_from}:-{layout.covered_to_end}]"
+    check = [Code(line) for line in checksum_lines(checksum, covered, "expected")]
+    return [*check, If(f"expected != {stored}", (RETURN_NONE,))]
+
+
+def stream_rest_check(protocol: Protocol, layout: FrameLayout) -> Block:
+    """The checksum test of the frame of any size at buf[start:], its end (`stop`) from its length byte, returning
+    None when it fails."""
+    checksum = protocol.framing.checksum
+    assert checksum is not None  # length-byte frames have one
+    size = layout.checksum_offset_from_end
+    stored = "buf[stop - 1]" if size == 1 else f"int.from_bytes(buf[stop - {size} : stop], 'little')"
+    first = f"start + {layout.covered_from}" if layout.covered_from else "start"
+    covered = f"buf[{first} : stop - {layout.covered_to_end}]"
+    adds = layout.overhead - layout.length_adds  # frame size = length byte + this
+    check = [Code(line) for line in checksum_lines(checksum, covered, "expected")]
+    stop = Code(f"stop = start + {adds} + buf[start + {layout.length_offset}]")
+    return [stop, *check, If(f"expected != {stored}", (RETURN_NONE,))]
+
+
+def failed_check(body: Block) -> int | None:
+    """The index of a whole-frame decoder's checksum test (the first `if ...: return None`), or None."""
+    return next((i for i, s in enumerate(body) if isinstance(s, If | FrameTest) and returns_none(s)), None)
+
+
+def returns_none(statement: If | FrameTest) -> bool:
+    return isinstance(statement, FrameTest) or statement.body == (RETURN_NONE,)
+
+
+def picked_inline(subs: list[tuple[int, dict[str, Any]]], at: int) -> Block | None:
+    """One function's statements for the sub-command frames of one size, where their checksum does not depend on
+    their fields (a sum or CRC over the bytes, the same statements for all, given the key): the check once, then each
+    sub-command's unpacking under an `if` on its code. None where the check is made from the unpacked values."""
+    first: Block = subs[0][1]["whole_lines"]
+    index = failed_check(first)
+    if index is None:
+        return None
+    checks = first[: index + 1]
+    if any(isinstance(s, Unpack) for s in walk(checks)):
+        return None
+    if any(f["whole_lines"][: len(checks)] != checks for _, f in subs):
+        return None
+    lines: Block = [*checks, Code(f"sub = buf[{at}]")]
+    for sub_code, f in subs:
+        lines.append(If(f"sub == {sub_code:#04x}", tuple(fuse_unpack(f["whole_lines"][len(checks) :]))))
+    return [*lines, RETURN_NONE]
+
+
+def frame_function(
+    protocol: Protocol,
+    layout: FrameLayout,
+    command: Command,
+    message: Message,
+    bodies: dict[str, tuple[str, str, Block]],
+    code: PackageCode,
+    selector: str | None = None,
+) -> tuple[int, int, dict[str, Any]] | None:
+    """The whole-frame decoders of one message (see fixed_frames): size key, frame size, function; None where the
+    message's frames need the general path. `selector`: the sub-command field, whose check the key makes."""
+    checksum = protocol.framing.checksum
+    if checksum is None or message.min_size != message.max_size:
+        return None  # length-byte frames have a checksum
+    content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
+    returns, extra, decoder = bodies[decoder_name(message)]
+    if not (decoder and isinstance(decoder[0], ContentSize) and decoder[0].exact):
+        return None
+    body = decoder[1:]  # the content size check: the key implies the size
+    if selector is not None:  # the sub-command's check: the picker chose this decoder by it
+        at = next((i for i, s in enumerate(body) if isinstance(s, Expect) and s.name == f"v_{selector}"), None)
+        if at is None:
+            return None
+        body = body[:at] + body[at + 1 :]
+    unpacks = [s for s in walk(body) if isinstance(s, Unpack) and s.at == "o"]
+    cursor = any(reads_cursor(s) for s in walk(body) if not isinstance(s, Unpack))
+    if len(unpacks) > 1 or cursor or raises(body):
+        return None  # content read at a moving cursor, or checked beyond its size: the general path
+    size = layout.overhead + (message.min_size or 0)
+    length_byte = (message.min_size or 0) + layout.length_adds
+    known = dict(enumerate(layout.header)) | {layout.length_offset: length_byte}
+    if layout.command_offset is not None:
+        known[layout.command_offset] = command.wire_code(layout.direction) or 0
+
+    def statements(at: Callable[[int], str], whole: bool) -> tuple[Block, bool]:
+        """The decoder's statements with frame offsets `at` (buf[start:] or all of buf: `whole`), and whether its
+        checksum is checked from the unpacked values (sum_from_values)."""
+        values: Block = [
+            Code(f"{e.name} = buf[{at(layout.offsets[e.name])}]", reads=(layout.offsets[e.name],))
+            for e in layout.value_elements
+        ]
+        summed = sum_from_values(
+            protocol, layout, command.wire_code(layout.direction), length_byte, size, body, code, at
+        )
+        if summed is not None:
+            return [*values, *summed, *body[1:]], True
+        check = whole_frame_check(protocol, layout, size, known, at) if whole else None
+        if check is None:
+            check = frame_check(checksum, layout, size, at)
+        return [*check, *values, *at_offset(body, at(content_offset))], False
+
+    lines, summed = statements(lambda offset: f"start + {offset}", False)
+    function: dict[str, Any] = {
+        "name": message_function("frame", message),
+        "whole_name": message_function("whole", message),
+        "returns": returns,
+        "where": f"{message.key} {message.direction.value}",
+        "lines": lines,
+        "whole_lines": statements(str, True)[0],
+    }
+    # built in decode() where its whole-frame decoder sums the frame's bytes (one from the values is quicker yet)
+    plain = unpacked_frame(protocol, layout, body)
+    function["plain"] = plain if not summed else None
+    function["run"] = run_frames(layout, message, size, plain, code)
+    key = (
+        length_byte if layout.command_offset is None else (command.wire_code(layout.direction) or 0) << 8 | length_byte
+    )
+    return key, size, function
+
+
+def at_offset(body: Block, at: str) -> Block:
+    """A content decoder's statements with the unpack at the cursor made at `at` (a frame offset)."""
+    return [replace(s, at=at) if isinstance(s, Unpack) and s.at == "o" else s for s in body]
+
+
+def frame_check(checksum: Checksum, layout: FrameLayout, size: int, at: Callable[[int], str]) -> Block:
+    """A whole frame's checksum test, returning None when it fails: the checksum over the covered bytes compared
+    with the stored one (frame offsets `at`)."""
+    reads: tuple[int, ...] = ()
+    if layout.checksum_offset_from_end == 1:
+        stored, reads = f"buf[{at(size - 1)}]", (size - 1,)
+    else:
+        stored, reads = f"int.from_bytes(buf[{at(size - layout.checksum_offset_from_end)} : {at(size)}], 'little')", ()
+    covered = f"buf[{at(layout.covered_from)} : {at(size - layout.covered_to_end)}]"
+    check = [Code(line) for line in checksum_lines(checksum, covered, "expected")]
+    return [*check, If(f"expected != {stored}", (RETURN_NONE,), reads=reads)]
+
+
+_MOST_UNROLLED = 12  # CRC-8 steps written out one by one in a whole-frame decoder; more take a loop
+
+
+def whole_frame_check(
+    protocol: Protocol, layout: FrameLayout, size: int, known: dict[int, int], at: Callable[[int], str]
+) -> Block | None:
+    """decode()'s version of a whole-frame decoder's checksum test, where it is cheaper than frame_check's: `buf` is
+    exactly the frame (decode checked its size), so a checksum that is a sum over all but a constant header is
+    tested on the sum of the whole frame (no slice is made: the algorithm's frame_test); one computed by table steps
+    starts from its state after the covered bytes that the frame's key fixes (`known`: offset -> byte; header,
+    command code, length byte), and a few steps are written out. None where neither applies."""
+    checksum = protocol.framing.checksum
+    assert checksum is not None  # length-byte frames have one
+    steps = checksum.algorithm.byte_table(checksum_name(checksum), "expected")
+    if steps is not None:
+        state = steps.start
+        first, stop = layout.covered_from, size - layout.covered_to_end
+        while first in known and first < stop - 1:
+            state = steps.entries[state ^ known[first]]
+            first += 1
+        stepped: Block
+        if stop - first > _MOST_UNROLLED:
+            stepped = [
+                Code(f"expected = {state:#x}"),
+                Loop(f"for byte in buf[{first} : {stop}]", (Code(f"expected = {steps.table}[expected ^ byte]"),)),
+            ]
+        else:  # a few bytes: one table step each, no slice and no loop
+            stepped = [Code(f"expected = {steps.table}[{state:#x} ^ buf[{first}]]", reads=(first,))]
+            stepped += [
+                Code(f"expected = {steps.table}[expected ^ buf[{offset}]]", reads=(offset,))
+                for offset in range(first + 1, stop)
+            ]
+        stepped += [Code(line) for line in steps.finish]
+        return [*stepped, frame_check(checksum, layout, size, at)[-1]]
+    header = layout.header[: layout.covered_from]
+    test = checksum.algorithm.frame_test("sum(buf)", sum(header), f"buf[{size - 1}]")
+    whole = layout.checksum_offset_from_end == 1 and layout.covered_to_end == 1 and len(header) == layout.covered_from
+    if test is None or not whole:
+        return None
+    return [FrameTest(test, checksum.algorithm.frame_test("sum(buf)", sum(header), "buf[-1]") or test)]
+
+
+def exact_struct(name: str, size: int, content_offset: int, code: PackageCode) -> str:
+    """A struct of a whole frame of `size` bytes that unpacks what struct `name` unpacks at the content's offset,
+    the bytes around it skipped: its unpack refuses (struct.error) a frame of any other size."""
+    fmt = code.structs[name]
+    after = size - content_offset - struct.calcsize(fmt)
+    whole = f"{fmt[0]}{content_offset}x{fmt[1:]}" + (f"{after}x" if after else "")
+    exact = f"{name}_IN_{size}"
+    code.structs[exact] = whole
+    return exact
+
+
+def exact_whole(body: Block, size: int, known: int, code: PackageCode) -> Block:
+    """A whole-frame decoder that refuses a frame of another size than `size` by itself: its one unpack made of the
+    whole frame (struct.error), a sum's check byte read from the end; else a size check first, returning None.
+    `known`: the bytes decode() has matched (its key), which any frame it is given holds."""
+    body = [replace(s, condition=s.from_end) if isinstance(s, FrameTest) else s for s in body]
+    unpacks = [i for i, s in enumerate(body) if _unpack_at_offset(s) is not None]
+    before = body[: unpacks[0] if unpacks else len(body)]
+    if len(unpacks) != 1 or any(offset >= known for offset in _constant_reads(before)):
+        return [If(f"len(buf) != {size}", (RETURN_NONE,)), *body]
+    found = body[unpacks[0]]
+    unpack = _unpack_at_offset(found)
+    assert unpack is not None
+    whole = replace(unpack, struct=exact_struct(unpack.struct, size, int(unpack.at), code), at="")
+    body[unpacks[0]] = replace(found, unpacked=whole) if isinstance(found, ReturnNew) else whole
+    return body
+
+
+def _unpack_at_offset(statement: Statement) -> Unpack | None:
+    """The struct unpack a statement makes at a constant offset of the frame, if any."""
+    if isinstance(statement, ReturnNew):
+        unpack = statement.unpacked
+    else:
+        unpack = statement if isinstance(statement, Unpack) else None
+    return unpack if unpack is not None and not unpack.indexed and unpack.at.isdigit() else None
+
+
+def _constant_reads(body: Block) -> list[int]:
+    """The constant offsets of `buf` that statements read (an unpack's struct aside)."""
+    reads: list[int] = []
+    for statement in walk(body):
+        if isinstance(statement, Code | If):
+            reads += statement.reads
+        elif isinstance(statement, Unpack) and statement.indexed and statement.at.isdigit():
+            reads.append(int(statement.at))
+    return reads
+
+
+def stream_sum(protocol: Protocol, layout: FrameLayout) -> str | None:
+    """The stream parser's `summed`: (first byte covered, inverted) where the checksum is an 8-bit sum of every byte
+    from there to the last, which it is; None for other checksums."""
+    checksum = protocol.framing.checksum
+    inverted = checksum.algorithm.summed() if checksum is not None else None
+    if inverted is None or whole_frame_test(protocol, layout) is None:
+        return None
+    return f"({layout.covered_from}, {inverted})"
+
+
+def whole_frame_test(protocol: Protocol, layout: FrameLayout) -> str | None:
+    """decode()'s test that a whole frame `data` (its size known) holds its checksum, where it is one expression
+    over the frame's bytes (straight_frames.frame_sum_test, as every framing's checks make it). None for others."""
+    engine = runtime_layout(layout)
+    test = frame_sum_test(engine, len(engine.elements) - 1, protocol.framing.checksum, "data")
+    return None if test is None else f"not {test}"
+
+
+def run_frames(
+    layout: FrameLayout, message: Message, size: int, plain: tuple[str, str] | None, code: PackageCode
+) -> dict[str, str] | None:
+    """The stream parser's decoder of a run of a plain frame (unpacked_frame), checked already, laid end to end with
+    their headers left out: one struct over the bytes after the header (the command code, length byte and checksum
+    skipped as padding) and a message built from each tuple it unpacks. None where the content is not the whole of
+    the frame between those."""
+    if plain is None:
+        return None
+    cls, content = plain
+    fmt = code.structs[content]
+    width = len(layout.header)
+    content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
+    if content_offset < width or content_offset + struct.calcsize(fmt) != size - 1:
+        return None
+    lead = content_offset - width
+    after = fmt[0] + (f"{lead}x" if lead else "") + fmt[1:] + "x"
+    frames = code.struct(code.stems[content] + "_after_header", after)
+    names = [f.name for f in message.fields]
+    return {
+        "name": message_function("run", message),
+        "build": code.build_all(cls, names, f"{frames}.iter_unpack(frames)"),
+        "returns": cls,
+        "where": f"{message.key} {message.direction.value}",
+    }
+
+
+def unpacked_frame(protocol: Protocol, layout: FrameLayout, body: Block) -> tuple[str, str] | None:
+    """(class, struct) of a frame whose message is the tuple one struct unpacks from its content, as it is, and
+    whose checksum decode() tests in one expression (whole_frame_test): decode() builds it itself, with no call.
+    None for others (frame values, conversions, checks)."""
+    plain = content_unpacked(body)
+    if plain is None or layout.value_elements or whole_frame_test(protocol, layout) is None:
+        return None
+    return plain
+
+
+_BYTES_OF = {"B": 1, "b": 1, "H": 2, "h": 2, "I": 4, "i": 4, "Q": 8, "q": 8}
+_MOST_TERMS = 4  # byte terms of a checksum computed from the values; beyond it the frame's bytes are summed
+
+
+def sum_from_values(
+    protocol: Protocol,
+    layout: FrameLayout,
+    command: int | None,
+    length_byte: int,
+    size: int,
+    body: Block,
+    code: PackageCode,
+    at: Callable[[int], str],
+) -> Block | None:
+    """For an 8-bit sum checksum right after integer-only content: statements that unpack the content and the
+    checksum in one call (at frame offsets `at`) and check the sum from the values (a byte sum does not depend on
+    byte order), so no slice of the frame is made and summed. The frame's other covered bytes must be the header,
+    command code and length byte (constants, given the key) and one-byte frame values. None where the frame is not
+    like that."""
+    checksum = protocol.framing.checksum
+    unpack = body[0] if body else None
+    if checksum is None or checksum.algorithm.summed() is None:
+        return None
+    if not isinstance(unpack, Unpack) or unpack.at != "o" or unpack.tuple_target:
+        return None
+    if layout.checksum_offset_from_end != 1:
+        return None
+    fmt = code.structs[unpack.struct]
+    targets = unpack.targets
+    if len(targets) != len(fmt) - 1 or any(c not in _BYTES_OF for c in fmt[1:]):
+        return None
+    content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
+    if content_offset + sum(_BYTES_OF[c] for c in fmt[1:]) != size - 1:
+        return None  # the checksum does not follow the content
+    constant = 0
+    terms = []
+    for offset in range(layout.covered_from, size - layout.covered_to_end):
+        if offset < len(layout.header):
+            constant += layout.header[offset]
+        elif offset == layout.command_offset:
+            constant += command or 0
+        elif offset == layout.length_offset:
+            constant += length_byte
+        elif content_offset <= offset < size - 1:
+            continue  # the content's values, below
+        else:
+            element = next((e for e in layout.value_elements if layout.offsets[e.name] == offset and e.size == 1), None)
+            if element is None:
+                return None
+            terms.append(element.name)
+    for target, char in zip(targets, fmt[1:], strict=True):
+        width = _BYTES_OF[char]
+        if width == 1:
+            terms.append(target if char == "B" else f"({target} & 0xff)")
+        else:
+            terms += [f"({target} & 0xff)", *(f"({target} >> {8 * i} & 0xff)" for i in range(1, width))]
+    if len(terms) > _MOST_TERMS:
+        return None  # summing a slice of the frame in C is cheaper than this many terms in Python
+    with_check = code.struct(code.stems[unpack.struct] + "_and_check", fmt + "B")
+    total = checksum.algorithm.byte_total(" + ".join([f"{constant:#x}", *terms]))
+    assert total is not None  # an 8-bit byte sum's
+    return [
+        Unpack((*targets, "check"), with_check, at=at(content_offset)),
+        If(f"{total} != check", (RETURN_NONE,)),
+    ]
+
+
+def frame_decode_lines(protocol: Protocol, layout: FrameLayout, dispatch: list[tuple[str, str]]) -> Lines:
+    """Checksum check, then dispatch to the content decoder, of a frame buf[start:stop] whose header and length the
+    stream parser has checked (decode() checks whole frames as every framing does: straight_frames.decode_lines)."""
+    size = layout.checksum_offset_from_end
+    offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
+    after = layout.overhead - offset
+
+    def at(position: int) -> str:
+        return f"buf[start + {position}]"
+
+    checksum = protocol.framing.checksum
+    assert checksum is not None  # length-byte frames have one
+    first = f"start + {layout.covered_from}" if layout.covered_from else "start"
+    covered = f"buf[{first} : stop - {layout.covered_to_end}]"
+    stored = "buf[stop - 1]" if size == 1 else f"int.from_bytes(buf[stop - {size} : stop], 'little')"
+    content = f"start + {offset}, stop - {after}"
+    args = f"buf, {content}" + "".join(f", {at(layout.offsets[e.name])}" for e in layout.value_elements)
+    lines = [f"check = {stored}"]  # read once: the sum and the comparison both use it
+    lines += checksum_lines(checksum, covered, "expected")
+    lines += [
+        "if expected != check:",
+        # as wide as the checksum: a u16 that reads 0 is 0x0000
+        f'    raise ChecksumError(f"bad checksum: the frame has {{check:#0{2 + 2 * size}x}}, '
+        f'its bytes give {{expected:#0{2 + 2 * size}x}}")',
+    ]
+    if layout.command_offset is None:  # the one codeless command of this direction, if any
+        if not dispatch:
+            return [*lines, f'raise DecodeError("no {layout.direction.value} is defined")']
+        return [*lines, f"return {dispatch[0][1]}({args})"]
+    code = at(layout.command_offset)
+    return [
+        *lines,
+        f"decoder = _{layout.direction.name}_DECODERS.get({code})",
+        "if decoder is None:",
+        f'    raise DecodeError(f"unknown command {{{code}:#04x}}")',
+        f"return decoder({args})",
+    ]
+
+
+def value_ranges(layout: FrameLayout, byte_order: str) -> str:
+    """The frame-level values whose declared range is narrower than their type (an address 0..253, broadcast 254),
+    as FrameFormat.value_ranges: (offset, size, byte order, signed, low, high, also allowed); a stream candidate
+    holding a value outside its range is no frame."""
+    ranges = [
+        f"({layout.offsets[e.name]}, {e.type.size}, {byte_order!r}, {e.type.signed}, {int(e.minimum)}, "
+        f"{int(e.maximum)}, {e.broadcast})"
+        for e in layout.value_elements
+        if e.type is not None and not e.type.is_float and (e.minimum, e.maximum) != (e.type.minimum, e.type.maximum)
+    ]
+    return "(" + ", ".join(ranges) + ("," if len(ranges) == 1 else "") + ")"
+
+
+def value_range_checks(layout: FrameLayout, byte_order: str) -> list[tuple[str, str, str]]:
+    """`decode`'s tests of the frame-level values whose declared range is narrower than their type, as the stream
+    parser (value_ranges) makes them; decode checks the header before them. Each: the condition that the value is
+    outside its range, the condition that it is inside, and the error raised for it."""
+    checks = []
+    for e in layout.value_elements:
+        if e.type is None or e.type.is_float or (e.minimum, e.maximum) == (e.type.minimum, e.type.maximum):
+            continue
+        offset, size = layout.offsets[e.name], e.type.size
+        indexed = size == 1 and not e.type.signed
+        value = (
+            f"data[{offset}]"
+            if indexed
+            else f"int.from_bytes(data[{offset}:{offset + size}], {byte_order!r}, signed={e.type.signed})"
+        )
+        low, high = int(e.minimum), int(e.maximum)
+        shown = f" (or {e.broadcast})" if e.broadcast is not None else ""
+        lowest, highest = low, high
+        if e.broadcast in (low - 1, high + 1):  # next to the range: one comparison
+            lowest, highest = min(low, e.broadcast), max(high, e.broadcast)
+        also = f" or {value} == {e.broadcast}" if e.broadcast is not None and lowest == low and highest == high else ""
+        if lowest <= e.type.minimum and not also:  # no value of the type is below it
+            refused = f"{value} > {highest}"
+            inside = f"{value} <= {highest}" if indexed else f"not {refused}"
+        elif highest >= e.type.maximum and not also:
+            refused = f"{value} < {lowest}"
+            inside = f"{value} >= {lowest}" if indexed else f"not {refused}"
+        else:
+            inside = f"({lowest} <= {value} <= {highest}{also})"
+            refused = f"not {inside}"
+        error = f'DecodeError(f"{e.name} = {{{value}}} is outside its range {low}..{high}{shown}")'
+        checks.append((refused, inside, error))
+    return checks
+
+
+# --- the codec's frames: one entry for every shape ---------------------------------------------------------------
+
+
+def straight_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, Any]:
+    """Frames of any other shape: straight-line frame functions per direction where the layouts allow them (see
+    straight_frames.py), else the runtime's frame engine; one FrameCodec per direction either way (the stream parser's),
+    decoders by code (and by class)."""
+    imports, definitions = checksum_definitions(protocol)
+    directions: list[dict[str, Any]] = []
+    dispatchers = []
+    size_dispatchers: list[dict[str, Any]] = []
+    frame_structs: dict[str, str] = {}
+    # the runtime.framing names the codec uses: the FrameCodecs' (the straight-line functions' Transparency objects are
+    # those of the same layouts) and ERROR_REPLY where error replies are told by their flag
+    names = {"EngineFormat"}
+    for direction, layout in protocol.framing.layouts.items():
+        table = direction_dispatch(protocol, direction)
+        dispatchers += table.dispatchers
+        size_dispatchers += table.size_dispatchers
+        dispatch, sizes, single, expected = table.dispatch, table.sizes, table.single, table.expected
+        only = dispatch[0][1] if not layout.has_command and len(dispatch) == 1 and not expected else ""
+        values = tuple(e.name for e in layout.value_elements)
+        frames = Target(direction.name, values, expected=bool(expected), only=only)
+        if protocol.error_reply is not None and direction == Direction.RESPONSE:
+            element = next(e for e in layout.elements if e.name == protocol.error_reply.element)
+            assert element.type is not None
+            mask = (1 << (8 * element.type.size)) - 1
+            flag = protocol.error_reply.flag
+            frames = replace(frames, error_flag=flag, error_keep=mask & ~flag)
+        plain = unpacked_messages(single, code) if not expected and not frames.error_flag else []
+        functions, call = direction_functions(protocol, direction, frames, frame_structs, plain)
+        names |= {ERROR_REPLY} if frames.error_flag else set()
+        frame_codec, used = codec_lines(protocol, direction, sizes, single)
+        names |= used
+        directions.append(
+            {
+                "name": direction.value,
+                "upper": direction.name,
+                "dispatch": dispatch,
+                "expected": expected,
+                "frames": frame_codec,
+                "functions": functions,
+                "call": call,
+                "headers": sorted({layout.header for layout in protocol.framing.alternatives[direction]}),
+            }
+        )
+    headers = [h for d in directions for h in d["headers"]]
+    shared = {cls for d in directions for cls, _, _ in d["expected"]}
+    replies = replies_by_request(protocol.messages())
+    reply_layouts = [
+        (m.class_name, reply.class_name)
+        for m in protocol.messages()
+        if m.direction == Direction.REQUEST
+        and (reply := reply_to(m, replies)) is not None
+        and reply.class_name in shared
+        and not reply.default_reply
+    ]
+    code.structs.update(frame_structs)  # listed with the content's structs (common_codec_context)
+    by_header = all(headers) and len(set(headers)) == len(headers)
+    return {
+        "length_byte_frames": False,
+        "reply_layouts": reply_layouts,
+        "framing_imports": sorted(names, key=import_order),
+        # the straight-line frame checks raise it (the engine raises its own)
+        "checksum_error": any(
+            element.kind == "checksum"
+            for direction in protocol.framing.layouts
+            if (straight := code.straight(direction)) is not None
+            for layout in straight.layouts
+            for element in layout.elements
+        ),
+        "checksum_imports": imports,
+        "checksum_definitions": definitions,
+        "directions": directions,
+        "dispatchers": dispatchers,
+        "size_dispatchers": size_dispatchers,
+        "by_header": by_header,
+        "either": ""
+        if by_header
+        else "give the direction: requests and responses cannot be told apart by their first bytes",
+        "no_header": "f\"frame starts {data[:4].hex(' ')}, which is neither a request nor a response header\"",
+    }
+
+
+def unpacked_messages(single: dict[str, Message], code: PackageCode) -> list[tuple[int, int, str, str, str]]:
+    """(code, content size, class, struct's name stem, its format) of the messages of one size whose decoder, past its
+    size check, is one struct's unpack of the content as their message (straight_frames.whole_frames decodes them
+    whole)."""
+    bodies = {name: body for name, _, _, body in code.decoders}
+    found = []
+    for key, message in single.items():
+        body = bodies[decoder_name(message)]
+        if key in ("None", ERROR_REPLY) or message.min_size != message.max_size or len(body) < 2:
+            continue
+        if not (isinstance(body[0], ContentSize) and body[0].exact):
+            continue
+        unpacked = content_unpacked(body[1:])
+        if unpacked is not None:
+            cls, struct = unpacked
+            found.append((int(key, 16), message.min_size or 0, cls, code.stems[struct], code.structs[struct]))
+    return found
+
+
+def frames_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, Any]:
+    """The codec template's frames part: each direction's frame checks, dispatch and encoders' wraps; with the
+    length-byte case's tables where every layout has that shape."""
+    if protocol.framing.classic:
+        return length_byte_codec_context(protocol, code)
+    return straight_codec_context(protocol, code)
+
+
+def lookup_lines(d: dict[str, Any]) -> Lines:
+    """decode()'s lines, for one direction of the length-byte case, that look a frame `data` up in its table of
+    frames decoded whole (by its first bytes, or its command code and length byte) before the general checks; a
+    frame the table does not take, or whose decoder refuses it, goes on to them, which say why."""
+    accepted = "".join(f" and {c}" for c in d["accepted"])
+    early = d["whole_frames"] and not d["range_checks"]
+    table, size = f"_{d['upper']}_WHOLE", d["whole_size"]
+    by_first_bytes = f"fixed = {table}.get(data[:{size}])  # no key is shorter: a short frame matches none"
+    decoded = [
+        "    message = fixed[1](data)",
+        "    if message is not None:",
+        "        return message",
+    ]
+    if early and d["unpacked"] and d["exact"]:
+        return [
+            by_first_bytes,
+            "if fixed is not None:",
+            "    _, whole, unpack, cls = fixed",
+            "    try:  # each unpacks the whole frame, so one of another size raises struct.error: no size compared"
+            " here",
+            "        if unpack is None:",
+            "            message = whole(data)",
+            "            if message is not None:",
+            "                return message",
+            f"        elif {d['whole_check']}:  # its message is its content as unpacked: built here, no call",
+            "            return _new(cls, unpack(data))",
+            "    except struct.error:",
+            "        pass  # not the size its first bytes say: the checks below say what is wrong",
+        ]
+    if early and d["unpacked"]:
+        return [
+            by_first_bytes,
+            "if fixed is not None and fixed[0] == len(data):",
+            "    _, whole, unpack, cls = fixed",
+            "    if unpack is None:",
+            "        message = whole(data)",
+            "        if message is not None:",
+            "            return message",
+            f"    elif {d['whole_check']}:  # its message is its content as unpacked: built here, no call",
+            f"        return _new(cls, unpack(data, {d['content_offset']}))",
+        ]
+    if early:
+        return [by_first_bytes, "if fixed is not None and fixed[0] == len(data):", *decoded]
+    if d["whole_frames"]:
+        return [by_first_bytes, f"if fixed is not None and fixed[0] == len(data){accepted}:", *decoded]
+    if d["fixed"] and d["slice_key"]:
+        return [
+            f"fixed = {table}.get({d['slice_key']})  # a short frame's slice is shorter: it matches none",
+            f"if fixed is not None and fixed[0] == len(data) and data[:{d['header_size']}] == {d['header']}{accepted}:",
+            *decoded,
+        ]
+    if d["fixed"]:
+        return [
+            f"fixed = {table}.get({d['key']}) if len(data) >= {d['overhead']} else None",
+            f"if fixed is not None and fixed[0] == len(data) and data[:{d['header_size']}] == {d['header']}{accepted}:",
+            *decoded,
+        ]
+    return []

@@ -118,6 +118,8 @@ CASES: dict[str, Case] = {
     "bytes, fixed size": same({"data": {"type": "bytes", "size": 4}}),
     "bytes, size rest": same({"data": {"type": "bytes", "size": "rest"}}),
     "bytes, size field": same({"n": "u8", "data": {"type": "bytes", "size": "n"}, "tail": "u8"}),
+    "bytes, size field of u64": same({"n": "u64", "data": {"type": "bytes", "size": "n"}, "tail": "u8"}),
+    "array, count field of u64": same({"n": "u64", "items": {"type": "array", "of": "u16", "count": "n"}}),
     "string, fixed size": same({"name": {"type": "string", "size": 6}}),
     "string, fixed size, pad": same({"name": {"type": "string", "size": 8, "pad": "00"}, "v": "u8"}),
     "strings in group items": same(

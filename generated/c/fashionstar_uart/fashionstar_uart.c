@@ -2238,11 +2238,13 @@ static int fashionstar_uart__dec_sync_command_request(const uint8_t *c, size_t n
     d1_count = fashionstar_uart__get(c + o, 1u, 0u);
     o += 1u;
     /* blocks: One block per servo. */
-    if ((size_t)d1_count > (sizeof(m->blocks) / sizeof(m->blocks[0]))) { return FASHIONSTAR_UART_E_CAPACITY; }
-    m->blocks_count = (size_t)d1_count;
-    for (i1 = 0u; i1 < (size_t)d1_count; i1++) {
+    if ((uint64_t)(size_t)(d1_count) != (uint64_t)(d1_count)) { return FASHIONSTAR_UART_E_LENGTH; }
+    if ((size_t)(d1_count) > (sizeof(m->blocks) / sizeof(m->blocks[0]))) { return FASHIONSTAR_UART_E_CAPACITY; }
+    m->blocks_count = (size_t)(d1_count);
+    for (i1 = 0u; i1 < (size_t)(d1_count); i1++) {
         /* content: The carried command's request content for one servo. */
-        len = (size_t)d1_block_size;
+        if ((uint64_t)(size_t)(d1_block_size) != (uint64_t)(d1_block_size)) { return FASHIONSTAR_UART_E_LENGTH; }
+        len = (size_t)(d1_block_size);
         if (n - o < len) { return FASHIONSTAR_UART_E_LENGTH; }
         if (len > sizeof(m->blocks[i1].content)) { return FASHIONSTAR_UART_E_CAPACITY; }
         fashionstar_uart__copy(m->blocks[i1].content, c + o, len);
@@ -4339,8 +4341,8 @@ void fashionstar_uart_parser_init(fashionstar_uart_parser_t *parser, fashionstar
     parser->dir = dir;
 }
 
-/* The request frame's size from its first 4 bytes (the Python parser's candidate: the content size bounds of its
- * command, its length byte, the ranges of its values); 0 when no frame starts there. */
+/* The request frame's size from its first 4 bytes (the Python parser's candidate: the
+ * content size bounds of its command, its length byte, the ranges of its values); 0: no frame there. */
 static size_t fashionstar_uart__size_request(const uint8_t *f)
 {
     size_t low = 0u, high = 0u;
@@ -4354,8 +4356,8 @@ static size_t fashionstar_uart__size_request(const uint8_t *f)
     return (size_t)content + 5u > FASHIONSTAR_UART_MAX_FRAME ? 0u : (size_t)content + 5u;
 }
 
-/* The response frame's size from its first 4 bytes (the Python parser's candidate: the content size bounds of its
- * command, its length byte, the ranges of its values); 0 when no frame starts there. */
+/* The response frame's size from its first 4 bytes (the Python parser's candidate: the
+ * content size bounds of its command, its length byte, the ranges of its values); 0: no frame there. */
 static size_t fashionstar_uart__size_response(const uint8_t *f)
 {
     size_t low = 0u, high = 0u;

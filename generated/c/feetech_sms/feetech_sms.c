@@ -1039,7 +1039,8 @@ static int feetech_sms__dec_sync_write_request(const uint8_t *c, size_t n, feete
         m->servos[i1].id = (uint8_t)feetech_sms__get(c + o, 1u, 0u);
         o += 1u;
         /* data: The L bytes written to that servo from `address` on. */
-        len = (size_t)d1_data_length;
+        if ((uint64_t)(size_t)(d1_data_length) != (uint64_t)(d1_data_length)) { return FEETECH_SMS_E_LENGTH; }
+        len = (size_t)(d1_data_length);
         if (n - o < len) { return FEETECH_SMS_E_LENGTH; }
         if (len > sizeof(m->servos[i1].data)) { return FEETECH_SMS_E_CAPACITY; }
         feetech_sms__copy(m->servos[i1].data, c + o, len);
@@ -1544,8 +1545,8 @@ void feetech_sms_parser_init(feetech_sms_parser_t *parser, feetech_sms_direction
     parser->dir = dir;
 }
 
-/* The request frame's size from its first 5 bytes (the Python parser's candidate: the content size bounds of its
- * command, its length byte, the ranges of its values); 0 when no frame starts there. */
+/* The request frame's size from its first 5 bytes (the Python parser's candidate: the
+ * content size bounds of its command, its length byte, the ranges of its values); 0: no frame there. */
 static size_t feetech_sms__size_request(const uint8_t *f)
 {
     size_t low = 0u, high = 0u;
@@ -1560,8 +1561,8 @@ static size_t feetech_sms__size_request(const uint8_t *f)
     return (size_t)content + 6u > FEETECH_SMS_MAX_FRAME ? 0u : (size_t)content + 6u;
 }
 
-/* The response frame's size from its first 4 bytes (the Python parser's candidate: the content size bounds of its
- * command, its length byte, the ranges of its values); 0 when no frame starts there. */
+/* The response frame's size from its first 4 bytes (the Python parser's candidate: the
+ * content size bounds of its command, its length byte, the ranges of its values); 0: no frame there. */
 static size_t feetech_sms__size_response(const uint8_t *f)
 {
     size_t low = 0u, high = 0u;

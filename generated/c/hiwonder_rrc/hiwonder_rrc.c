@@ -1040,9 +1040,10 @@ static int hiwonder_rrc__dec_motor_set_speeds_request(const uint8_t *c, size_t n
     d1_count = hiwonder_rrc__get(c + o, 1u, 0u);
     o += 1u;
     /* motors: One (motor_id, speed) pair per motor. */
-    if ((size_t)d1_count > (sizeof(m->motors) / sizeof(m->motors[0]))) { return HIWONDER_RRC_E_CAPACITY; }
-    m->motors_count = (size_t)d1_count;
-    for (i1 = 0u; i1 < (size_t)d1_count; i1++) {
+    if ((uint64_t)(size_t)(d1_count) != (uint64_t)(d1_count)) { return HIWONDER_RRC_E_LENGTH; }
+    if ((size_t)(d1_count) > (sizeof(m->motors) / sizeof(m->motors[0]))) { return HIWONDER_RRC_E_CAPACITY; }
+    m->motors_count = (size_t)(d1_count);
+    for (i1 = 0u; i1 < (size_t)(d1_count); i1++) {
         /* motor_id: Encoder motor id; bit n of the stop mask is motor_id n (the board has four motor ports). */
         if (n - o < 1u) { return HIWONDER_RRC_E_LENGTH; }
         m->motors[i1].motor_id = (uint8_t)hiwonder_rrc__get(c + o, 1u, 0u);
@@ -1093,9 +1094,10 @@ static int hiwonder_rrc__dec_motor_set_duties_request(const uint8_t *c, size_t n
     d1_count = hiwonder_rrc__get(c + o, 1u, 0u);
     o += 1u;
     /* duties: One (motor_id, duty) pair per motor. */
-    if ((size_t)d1_count > (sizeof(m->duties) / sizeof(m->duties[0]))) { return HIWONDER_RRC_E_CAPACITY; }
-    m->duties_count = (size_t)d1_count;
-    for (i1 = 0u; i1 < (size_t)d1_count; i1++) {
+    if ((uint64_t)(size_t)(d1_count) != (uint64_t)(d1_count)) { return HIWONDER_RRC_E_LENGTH; }
+    if ((size_t)(d1_count) > (sizeof(m->duties) / sizeof(m->duties[0]))) { return HIWONDER_RRC_E_CAPACITY; }
+    m->duties_count = (size_t)(d1_count);
+    for (i1 = 0u; i1 < (size_t)(d1_count); i1++) {
         /* motor_id: Encoder motor id; bit n of the stop mask is motor_id n (the board has four motor ports). */
         if (n - o < 1u) { return HIWONDER_RRC_E_LENGTH; }
         m->duties[i1].motor_id = (uint8_t)hiwonder_rrc__get(c + o, 1u, 0u);
@@ -1150,9 +1152,10 @@ static int hiwonder_rrc__dec_pwm_servo_set_positions_request(const uint8_t *c, s
     d1_count = hiwonder_rrc__get(c + o, 1u, 0u);
     o += 1u;
     /* pwm_servos: One (servo_id, pulse) pair per servo. */
-    if ((size_t)d1_count > (sizeof(m->pwm_servos) / sizeof(m->pwm_servos[0]))) { return HIWONDER_RRC_E_CAPACITY; }
-    m->pwm_servos_count = (size_t)d1_count;
-    for (i1 = 0u; i1 < (size_t)d1_count; i1++) {
+    if ((uint64_t)(size_t)(d1_count) != (uint64_t)(d1_count)) { return HIWONDER_RRC_E_LENGTH; }
+    if ((size_t)(d1_count) > (sizeof(m->pwm_servos) / sizeof(m->pwm_servos[0]))) { return HIWONDER_RRC_E_CAPACITY; }
+    m->pwm_servos_count = (size_t)(d1_count);
+    for (i1 = 0u; i1 < (size_t)(d1_count); i1++) {
         /* servo_id: PWM servo id. */
         if (n - o < 1u) { return HIWONDER_RRC_E_LENGTH; }
         m->pwm_servos[i1].servo_id = (uint8_t)hiwonder_rrc__get(c + o, 1u, 0u);
@@ -1322,9 +1325,10 @@ static int hiwonder_rrc__dec_bus_servo_set_positions_request(const uint8_t *c, s
     d1_count = hiwonder_rrc__get(c + o, 1u, 0u);
     o += 1u;
     /* bus_servos: One (servo_id, position) pair per servo. */
-    if ((size_t)d1_count > (sizeof(m->bus_servos) / sizeof(m->bus_servos[0]))) { return HIWONDER_RRC_E_CAPACITY; }
-    m->bus_servos_count = (size_t)d1_count;
-    for (i1 = 0u; i1 < (size_t)d1_count; i1++) {
+    if ((uint64_t)(size_t)(d1_count) != (uint64_t)(d1_count)) { return HIWONDER_RRC_E_LENGTH; }
+    if ((size_t)(d1_count) > (sizeof(m->bus_servos) / sizeof(m->bus_servos[0]))) { return HIWONDER_RRC_E_CAPACITY; }
+    m->bus_servos_count = (size_t)(d1_count);
+    for (i1 = 0u; i1 < (size_t)(d1_count); i1++) {
         /* servo_id: Bus servo id (0xFE is the broadcast id). */
         if (n - o < 1u) { return HIWONDER_RRC_E_LENGTH; }
         m->bus_servos[i1].servo_id = (uint8_t)hiwonder_rrc__get(c + o, 1u, 0u);
@@ -1494,9 +1498,10 @@ static int hiwonder_rrc__dec_bus_servo_stop_request(const uint8_t *c, size_t n, 
     d1_count = hiwonder_rrc__get(c + o, 1u, 0u);
     o += 1u;
     /* servos: The servos to stop. */
-    if ((size_t)d1_count > (sizeof(m->servos) / sizeof(m->servos[0]))) { return HIWONDER_RRC_E_CAPACITY; }
-    m->servos_count = (size_t)d1_count;
-    for (i1 = 0u; i1 < (size_t)d1_count; i1++) {
+    if ((uint64_t)(size_t)(d1_count) != (uint64_t)(d1_count)) { return HIWONDER_RRC_E_LENGTH; }
+    if ((size_t)(d1_count) > (sizeof(m->servos) / sizeof(m->servos[0]))) { return HIWONDER_RRC_E_CAPACITY; }
+    m->servos_count = (size_t)(d1_count);
+    for (i1 = 0u; i1 < (size_t)(d1_count); i1++) {
         /* servo_id: Bus servo id (0xFE is the broadcast id). */
         if (n - o < 1u) { return HIWONDER_RRC_E_LENGTH; }
         m->servos[i1].servo_id = (uint8_t)hiwonder_rrc__get(c + o, 1u, 0u);
@@ -2130,7 +2135,8 @@ static int hiwonder_rrc__dec_oled_request(const uint8_t *c, size_t n, hiwonder_r
     d1_length = hiwonder_rrc__get(c + o, 1u, 0u);
     o += 1u;
     /* text: The text (UTF-8). */
-    len = (size_t)d1_length;
+    if ((uint64_t)(size_t)(d1_length) != (uint64_t)(d1_length)) { return HIWONDER_RRC_E_LENGTH; }
+    len = (size_t)(d1_length);
     if (n - o < len) { return HIWONDER_RRC_E_LENGTH; }
     if (len > sizeof(m->text)) { return HIWONDER_RRC_E_CAPACITY; }
     hiwonder_rrc__copy(m->text, c + o, len);
@@ -2158,9 +2164,10 @@ static int hiwonder_rrc__dec_rgb_set_pixels_request(const uint8_t *c, size_t n, 
     d1_count = hiwonder_rrc__get(c + o, 1u, 0u);
     o += 1u;
     /* pixels: One (index, red, green, blue) per LED. */
-    if ((size_t)d1_count > (sizeof(m->pixels) / sizeof(m->pixels[0]))) { return HIWONDER_RRC_E_CAPACITY; }
-    m->pixels_count = (size_t)d1_count;
-    for (i1 = 0u; i1 < (size_t)d1_count; i1++) {
+    if ((uint64_t)(size_t)(d1_count) != (uint64_t)(d1_count)) { return HIWONDER_RRC_E_LENGTH; }
+    if ((size_t)(d1_count) > (sizeof(m->pixels) / sizeof(m->pixels[0]))) { return HIWONDER_RRC_E_CAPACITY; }
+    m->pixels_count = (size_t)(d1_count);
+    for (i1 = 0u; i1 < (size_t)(d1_count); i1++) {
         /* index: LED index from 0 (the SDK takes 1.. and sends it less one). */
         if (n - o < 1u) { return HIWONDER_RRC_E_LENGTH; }
         m->pixels[i1].index = (uint8_t)hiwonder_rrc__get(c + o, 1u, 0u);
@@ -4227,8 +4234,8 @@ void hiwonder_rrc_parser_init(hiwonder_rrc_parser_t *parser, hiwonder_rrc_direct
     parser->dir = dir;
 }
 
-/* The request frame's size from its first 4 bytes (the Python parser's candidate: the content size bounds of its
- * command, its length byte, the ranges of its values); 0 when no frame starts there. */
+/* The request frame's size from its first 4 bytes (the Python parser's candidate: the
+ * content size bounds of its command, its length byte, the ranges of its values); 0: no frame there. */
 static size_t hiwonder_rrc__size_request(const uint8_t *f)
 {
     size_t low = 0u, high = 0u;
@@ -4242,8 +4249,8 @@ static size_t hiwonder_rrc__size_request(const uint8_t *f)
     return (size_t)content + 5u > HIWONDER_RRC_MAX_FRAME ? 0u : (size_t)content + 5u;
 }
 
-/* The response frame's size from its first 4 bytes (the Python parser's candidate: the content size bounds of its
- * command, its length byte, the ranges of its values); 0 when no frame starts there. */
+/* The response frame's size from its first 4 bytes (the Python parser's candidate: the
+ * content size bounds of its command, its length byte, the ranges of its values); 0: no frame there. */
 static size_t hiwonder_rrc__size_response(const uint8_t *f)
 {
     size_t low = 0u, high = 0u;

@@ -3,8 +3,7 @@
 from __future__ import annotations
 
 from serialspec import __version__
-from serialspec.backends.c import length_byte
-from serialspec.backends.c import packed
+from serialspec.backends.c import length_byte, packed
 from serialspec.backends.c.emit import (
     DEFAULT_MAX_FRAME,
     Ctx,
@@ -52,7 +51,10 @@ def directions(protocol: Protocol) -> list[Direction]:
 
 def header(ctx: Ctx) -> str:
     protocol, p, P = ctx.protocol, ctx.p, ctx.P
-    wake = "    size_t wake;                      /* while a candidate waits: bytes held before any can be judged (0: now) */"
+    wake = (
+        "    size_t wake;                      /* while a candidate waits: bytes held before any can be judged "
+        "(0: now) */"
+    )
     if length_byte.applies(protocol):
         wake = (
             "    size_t first;                     /* where the n bytes held begin in buf */\n"

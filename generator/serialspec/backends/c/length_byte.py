@@ -87,9 +87,8 @@ def size_function(ctx: Ctx, direction: Direction, layout: FrameLayout) -> str:
     p, P = ctx.p, ctx.P
     need = prefix(layout)
     lines = [
-        f"/* The {direction.value} frame's size from its first {need} bytes (the Python parser's candidate: the content "
-        "size bounds of its",
-        " * command, its length byte, the ranges of its values); 0 when no frame starts there. */",
+        f"/* The {direction.value} frame's size from its first {need} bytes (the Python parser's candidate: the",
+        " * content size bounds of its command, its length byte, the ranges of its values); 0: no frame there. */",
         f"static size_t {p}__size_{direction.value}(const uint8_t *f)",
         "{",
         "    size_t low = 0u, high = 0u;",
@@ -137,9 +136,7 @@ def parser(ctx: Ctx) -> str:
     protocol, p, P = ctx.protocol, ctx.p, ctx.P
     layouts = {d: protocol.framing.alternatives[d][0] for d in DIRECTIONS if d in protocol.framing.alternatives}
     sizes = "\n".join(size_function(ctx, d, layout) for d, layout in layouts.items())
-    size_cases = "\n".join(
-        f"    case {P}_{d.name}:\n        return {p}__size_{d.value}(f);" for d in layouts
-    )
+    size_cases = "\n".join(f"    case {P}_{d.name}:\n        return {p}__size_{d.value}(f);" for d in layouts)
     hl = _by_direction(protocol, P, {d: f"{len(layout.header)}u" for d, layout in layouts.items()})
     header = _by_direction(protocol, P, {d: f"{p}__h_{d.value}_0" for d in layouts})
     if len({layout.header for layout in layouts.values()}) == 1:

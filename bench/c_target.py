@@ -214,10 +214,10 @@ def throughput() -> Table:
         "frame. Otherwise, for length-byte frames (FEETECH: header, id, length byte, content, sum), it keeps per byte "
         "held whether a candidate starts there, whether its size is known and whether it is corrupt behind one that "
         "waits, and looks back over the bytes held only when a candidate ends with the byte or the one at the front "
-        "turns out to be no frame (the adversarial stream: a candidate at every byte, each found no frame at its "
-        "length byte); other framings (DYNAMIXEL) take the general scan, which rescans the bytes held when a held "
-        "candidate can be judged or a header comes. Both give the Python parser's results, byte for byte, however the "
-        "stream is cut; the hand-written one does not rescan, and loses the frames a stray header hides.",
+        "turns out to be no frame (the adversarial stream: a candidate at every byte, each no frame once its first "
+        "bytes come: an id of FF); other framings (DYNAMIXEL) take the general scan, which rescans the bytes held when "
+        "a held candidate can be judged or a header comes. Both give the Python parser's results, byte for byte, "
+        "however the stream is cut; the hand-written one does not rescan, and loses the frames a stray header hides.",
     ]
     header = [
         "protocol",

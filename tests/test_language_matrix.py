@@ -346,6 +346,19 @@ CASES: dict[str, Case] = {
             }
         },
     ),
+    "frame: ended by a terminator, no length, contents of one size": Case(
+        {"v": "u16"},
+        {"v": "u16", "w": "u8"},
+        {
+            "elements": {
+                "header": {"role": "header", "value": "3A"},
+                "code": {"role": "command", "type": "u8"},
+                "content": {"role": "content"},
+                "checksum": {"role": "checksum", "type": "u8", "algorithm": "xor", "covers": ["code", "content"]},
+                "end": {"role": "trailer", "value": "0D"},
+            }
+        },
+    ),
     "frame: layouts": Case(
         {"data": {"type": "bytes", "size": "rest"}},
         {"data": {"type": "bytes", "size": "rest"}},

@@ -611,7 +611,9 @@ def decode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                         out.append(f"{pad}if (len % {item}u != 0u) {{ return {ctx.P}_E_LENGTH; }}")
                     count = "len * 8u" if not item else "len" if item == 1 else f"len / {item}u"
                 else:
-                    number = f"{f.count}u" if isinstance(f.count, int) else as_size(ctx, pad, scope.lookup(f.count), out)
+                    number = (
+                        f"{f.count}u" if isinstance(f.count, int) else as_size(ctx, pad, scope.lookup(f.count), out)
+                    )
                     out.append(f"{pad}{tgt}_count = {number};")
                     out.append(
                         f"{pad}len = ({tgt}_count + 7u) / 8u;" if not item else f"{pad}len = {tgt}_count * {item}u;"

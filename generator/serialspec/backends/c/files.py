@@ -55,7 +55,15 @@ def header(ctx: Ctx) -> str:
         "    size_t wake;                      /* while a candidate waits: bytes held before any can be judged "
         "(0: now) */"
     )
+    verdict = (
+        f"    uint8_t verdict[{P}_MAX_FRAME];    /* per byte held: 0 undecided, 1 no frame starts here, 2 a corrupt "
+        "one */"
+    )
     if length_byte.applies(protocol):
+        verdict = (
+            f"    uint8_t verdict[{P}_MAX_FRAME];    /* per byte held: 0 no candidate, 1 one not sized yet, 2 sized, "
+            "3 corrupt */"
+        )
         wake = (
             "    size_t first;                     /* where the n bytes held begin in buf */\n"
             "    size_t wake;                      /* where the nearest sized candidate ends in buf (0: none) */"
@@ -179,7 +187,7 @@ typedef struct {{
     uint32_t errors;                  /* corrupt candidates (a bad checksum, content that does not decode) */
 {wake}
     uint8_t buf[{P}_MAX_FRAME];        /* bytes held: the candidate frames still waiting for bytes */
-    uint8_t verdict[{P}_MAX_FRAME];    /* per byte held: 0 undecided, 1 no frame starts here, 2 a corrupt one */
+{verdict}
 }} {p}_parser_t;
 
 /* Decode one complete frame (decode does not read past len; on success every count fits its array). */

@@ -17,6 +17,7 @@ from conftest import ALL, ROOT, Generated, by_protocol, example_class, examples
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from serialspec.backends import Unsupported
+from serialspec.backends.c import length_byte
 from serialspec.backends.c.emit import files as c_files
 from serialspec.lang.model import Direction, Message
 from serialspec.runtime.errors import DecodeError
@@ -149,15 +150,23 @@ class Driver:
     """The driver program for one protocol, built with the sanitizers, kept running: one command a line."""
 
     def __init__(
-        self, name: str, source: Path, folder: Path, command: tuple[str, ...] = (), build: str = "gcc"
+        self,
+        name: str,
+        source: Path,
+        folder: Path,
+        command: tuple[str, ...] = (),
+        build: str = "gcc",
+        big_buffer: bool = True,
     ) -> None:
         """Build tests/c/driver.c with the C of protocol `name` found in `source`, into `folder`, and start it;
-        with `command` (a compiler and its flags: clang, gcc -m32) for `build` (BUILDS), else gcc."""
+        with `command` (a compiler and its flags: clang, gcc -m32) for `build` (BUILDS), else gcc; with the spec's
+        own P_MAX_FRAME when not `big_buffer`."""
         prefix, sanitize = runner(build)
         assert GCC is not None
         exe = folder / f"driver_{name}"
         c, j = source / f"{name}.c", source / f"{name}_json.c"
-        big = [f"-D{name.upper()}_MAX_FRAME=70000u"]  # no frame the tests make exceeds the parser's buffer
+        # no frame the tests make exceeds the parser's buffer
+        big = [f"-D{name.upper()}_MAX_FRAME=70000u"] if big_buffer else []
         command = [
             *(command or (GCC,)),
             "-std=c99",
@@ -205,6 +214,15 @@ def driver(name: str, command: tuple[str, ...] = (), build: str = "gcc") -> Driv
 
     folder = Path(tempfile.mkdtemp(prefix="serialspec-c-"))
     return Driver(name, GENERATED_C / name, folder, command, build)
+
+
+@cache
+def spec_buffer_driver(name: str) -> Driver:
+    """The driver with the spec's own P_MAX_FRAME (the buffer a firmware has: the parser moves the bytes it holds to
+    its front when its end is reached)."""
+    import tempfile
+
+    return Driver(name, GENERATED_C / name, Path(tempfile.mkdtemp(prefix="serialspec-c-")), big_buffer=False)
 
 
 def agrees_with_python(run: Driver, g: Generated, spec: Message, fields: dict[str, Any]) -> bytes:
@@ -396,6 +414,79 @@ def test_noisy_streams_in_random_pieces_give_what_python_gives(g: Generated) -> 
     agree()
 
 
+LENGTH_BYTE = [g for g in C_SPECS if length_byte.applies(g.protocol)]
+
+
+def test_the_length_byte_parser_is_chosen_by_the_framing() -> None:
+    """Frames of the length-byte shape (one layout a direction: header, length byte, content, final checksum) get the
+    straight-line parser; every other framing keeps the general one (what decides is the model's framing)."""
+    assert LENGTH_BYTE, "no shipped spec has length-byte frames"
+    for g in C_SPECS:
+        text = (GENERATED_C / g.protocol.name / f"{g.protocol.name}.c").read_text()
+        straight = f"static int {g.protocol.name}__scan(" in text
+        assert straight == (g.protocol.framing.classic and g in LENGTH_BYTE), g.protocol.name
+        assert straight != (f"static int {g.protocol.name}__try(" in text), g.protocol.name
+
+
+def header_runs(g: Generated, direction: Direction, longest: int) -> st.SearchStrategy[bytes]:
+    """Streams that make the length-byte parser keep many candidates: runs of the header's first byte and of whole
+    headers, frames cut after their length byte (a plausible candidate hiding what follows), valid and corrupt
+    frames, garbage."""
+    header = g.protocol.framing.layouts[direction].header
+    frames = frames_of(g, direction)
+    piece = st.one_of(
+        frames,
+        st.integers(1, longest).map(lambda k: header[:1] * k),
+        st.integers(1, 8).map(lambda k: header * k),
+        frames.map(lambda f: f[: len(header) + 3]),
+        frames.flatmap(
+            lambda f: st.tuples(st.integers(0, len(f) - 1), st.integers(1, 255)).map(
+                lambda x: f[: x[0]] + bytes([f[x[0]] ^ x[1]]) + f[x[0] + 1 :]
+            )
+        ),
+        st.binary(max_size=4),
+    )
+    return st.lists(piece, max_size=14).map(b"".join)
+
+
+@pytest.mark.parametrize("g", LENGTH_BYTE, ids=[g.protocol.name for g in LENGTH_BYTE])
+def test_length_byte_parser_gives_what_python_gives_on_runs_of_headers(g: Generated) -> None:
+    """The length-byte parser against the Python parser fed byte by byte: runs of header bytes, candidates hiding
+    frames, corrupt frames, in random pieces; long runs move the bytes held to the buffer's front many times."""
+    directions = list(g.protocol.framing.layouts)
+
+    @settings(max_examples=examples(25), deadline=None, suppress_health_check=[HealthCheck.too_slow])
+    @given(
+        st.sampled_from(directions).flatmap(lambda d: st.tuples(st.just(d), header_runs(g, d, 600))),
+        st.lists(st.integers(0, 300), min_size=1, max_size=6),
+    )
+    def agree(case: tuple[Direction, bytes], sizes: list[int]) -> None:
+        direction, stream = case
+        if not any(sizes):
+            sizes.append(1)
+        stream_agrees_with_python(spec_buffer_driver(g.protocol.name), g, direction, stream, ",".join(map(str, sizes)))
+
+    agree()
+
+
+@pytest.mark.parametrize("g", LENGTH_BYTE, ids=[g.protocol.name for g in LENGTH_BYTE])
+def test_length_byte_parser_finds_the_frames_behind_a_long_adversarial_run(g: Generated) -> None:
+    """A kilobyte of the header's first byte, whole headers, a candidate cut after its length byte, then the examples:
+    every example found, the counters Python's, fed one byte at a time and in pieces of every size up to 13."""
+    for direction in g.protocol.framing.layouts:
+        header = g.protocol.framing.layouts[direction].header
+        frames = [e.frame for e in g.protocol.examples if e.direction == direction]
+        if not frames:
+            continue
+        stream = header[:1] * 1000 + header * 40 + frames[0][: len(header) + 3] + b"".join(frames) + header[:1] * 300
+        stream += b"".join(frames)
+        found, _ = python_stream(g, direction, stream)
+        assert len(found) >= 2 * len(frames) - 1
+        for pieces in ("1", "2,3,5,7,11,13", "300"):
+            stream_agrees_with_python(spec_buffer_driver(g.protocol.name), g, direction, stream, pieces)
+            stream_agrees_with_python(driver(g.protocol.name), g, direction, stream, pieces)
+
+
 @pytest.mark.parametrize("g", C_SPECS, ids=IDS)
 def test_feature_switches_leave_out_encode_decode_or_parser_without_a_warning(g: Generated, tmp_path: Path) -> None:
     assert GCC is not None
@@ -481,3 +572,36 @@ def test_the_shipped_golden_vector_check_passes_on_every_build(g: Generated, bui
         0,
         f"{g.protocol.name}: {examples} vectors, {refused} refused frames, 0 failed\n",
     ), run.stdout + run.stderr
+
+
+@pytest.mark.parametrize("case", ["bytes, size field of u64", "array, count field of u64"])
+def test_a_64_bit_size_is_refused_not_cut_to_a_32_bit_size_t(case: str, tmp_path: Path) -> None:
+    """A size or count field of u64 whose value a 32-bit size_t cannot hold (2**32 + 2): gcc -m32's C refuses the
+    frame, as Python does, where casting it to size_t would read it as 2 and decode the frame."""
+    from test_language_matrix import build, package
+
+    built = build(case)
+    source = tmp_path / "c"
+    source.mkdir()
+    for path, text in built.files.items():
+        if path.startswith("c/matrix_case/"):
+            (source / path.rsplit("/", 1)[1]).write_text(text, encoding="utf-8")
+    run = Driver("matrix_case", source, tmp_path, tuple(compiler("gcc-m32")), "gcc-m32")
+    try:
+        with package(built) as g:
+            request = next(m for m in g.protocol.messages() if m.direction == Direction.REQUEST)
+            cls = message_class(g, request)
+            fields = {"id": 1, "data": b"\x01\x02", "tail": 3} if "bytes" in case else {"id": 1, "items": [1, 2]}
+            frame = bytearray(g.package.encode(cls.from_fields(fields)))
+            layout = g.protocol.framing.layouts[Direction.REQUEST]
+            at = layout.offsets["content"]
+            assert frame[at : at + 8] == (2).to_bytes(8, "little")
+            total = sum(frame[len(layout.header) : -1]) & 0xFF
+            frame[at + 4] = 1  # n = 2**32 + 2: the sum of the covered bytes one more
+            frame[-1] = (frame[-1] + 1) & 0xFF if total == frame[-1] else (frame[-1] - 1) & 0xFF
+            with pytest.raises(DecodeError):
+                g.package.decode(bytes(frame), "request")
+            (answer,) = run.ask(f"dec request {bytes(frame).hex()}")
+            assert answer.startswith("err "), answer
+    finally:
+        run.close()

@@ -118,6 +118,8 @@ CASES: dict[str, Case] = {
     "bytes, fixed size": same({"data": {"type": "bytes", "size": 4}}),
     "bytes, size rest": same({"data": {"type": "bytes", "size": "rest"}}),
     "bytes, size field": same({"n": "u8", "data": {"type": "bytes", "size": "n"}, "tail": "u8"}),
+    "bytes, size field of u64": same({"n": "u64", "data": {"type": "bytes", "size": "n"}, "tail": "u8"}),
+    "array, count field of u64": same({"n": "u64", "items": {"type": "array", "of": "u16", "count": "n"}}),
     "string, fixed size": same({"name": {"type": "string", "size": 6}}),
     "string, fixed size, pad": same({"name": {"type": "string", "size": 8, "pad": "00"}, "v": "u8"}),
     "strings in group items": same(
@@ -334,6 +336,19 @@ CASES: dict[str, Case] = {
     "frame: ended by a terminator, no length": Case(
         {"v": "u16", "data": {"type": "bytes", "size": "rest"}},
         {"v": "u16"},
+        {
+            "elements": {
+                "header": {"role": "header", "value": "3A"},
+                "code": {"role": "command", "type": "u8"},
+                "content": {"role": "content"},
+                "checksum": {"role": "checksum", "type": "u8", "algorithm": "xor", "covers": ["code", "content"]},
+                "end": {"role": "trailer", "value": "0D"},
+            }
+        },
+    ),
+    "frame: ended by a terminator, no length, contents of one size": Case(
+        {"v": "u16"},
+        {"v": "u16", "w": "u8"},
         {
             "elements": {
                 "header": {"role": "header", "value": "3A"},

@@ -1123,7 +1123,8 @@ static int dynamixel_p2__dec_sync_write_request(const uint8_t *c, size_t n, dyna
         m->servos[i1].id = (uint8_t)dynamixel_p2__get(c + o, 1u, 0u);
         o += 1u;
         /* data: The bytes written to that servo from `address` on. */
-        len = (size_t)d1_length;
+        if ((uint64_t)(size_t)(d1_length) != (uint64_t)(d1_length)) { return DYNAMIXEL_P2_E_LENGTH; }
+        len = (size_t)(d1_length);
         if (n - o < len) { return DYNAMIXEL_P2_E_LENGTH; }
         if (len > sizeof(m->servos[i1].data)) { return DYNAMIXEL_P2_E_CAPACITY; }
         dynamixel_p2__copy(m->servos[i1].data, c + o, len);
@@ -1192,7 +1193,8 @@ static int dynamixel_p2__dec_bulk_write_request(const uint8_t *c, size_t n, dyna
         d2_length = dynamixel_p2__get(c + o, 2u, 0u);
         o += 2u;
         /* data: The bytes written to that servo from `address` on. */
-        len = (size_t)d2_length;
+        if ((uint64_t)(size_t)(d2_length) != (uint64_t)(d2_length)) { return DYNAMIXEL_P2_E_LENGTH; }
+        len = (size_t)(d2_length);
         if (n - o < len) { return DYNAMIXEL_P2_E_LENGTH; }
         if (len > sizeof(m->writes[i1].data)) { return DYNAMIXEL_P2_E_CAPACITY; }
         dynamixel_p2__copy(m->writes[i1].data, c + o, len);

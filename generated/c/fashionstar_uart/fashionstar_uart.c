@@ -888,80 +888,6 @@ static int fashionstar_uart__bounds(fashionstar_uart_direction_t dir, long code,
     }
 }
 
-/* ---- candidates sized: straight line where a layout has no byte stuffing, without the tables ---- */
-/* The request frame: probe, straight line. */
-static long fashionstar_uart__probe_request_0(const uint8_t *f, size_t avail)
-{
-    size_t low = 0u, high = 0u;
-    int bounded = 0;
-    long code = FASHIONSTAR_UART__NO_CODE;
-    (void)code;
-    if (avail < 4u) { return FASHIONSTAR_UART__WAIT; }
-    if (f[0u] != 0x12u) { return FASHIONSTAR_UART__NONE; } /* header */
-    if (f[1u] != 0x4cu) { return FASHIONSTAR_UART__NONE; } /* header */
-    code = (long)((uint32_t)f[2u]); /* cmd_id */
-    if (!fashionstar_uart__bounds(FASHIONSTAR_UART_REQUEST, code, &low, &high, &bounded)) { return FASHIONSTAR_UART__NONE; }
-    { long counted = (long)((uint32_t)f[3u]) - 0L; /* length */
-      long content = counted - 0L;
-      if (content < (long)low || (bounded && content > (long)high)) { return FASHIONSTAR_UART__NONE; }
-      return 5L + counted; }
-}
-
-/* The response frame: probe, straight line. */
-static long fashionstar_uart__probe_response_0(const uint8_t *f, size_t avail)
-{
-    size_t low = 0u, high = 0u;
-    int bounded = 0;
-    long code = FASHIONSTAR_UART__NO_CODE;
-    (void)code;
-    if (avail < 4u) { return FASHIONSTAR_UART__WAIT; }
-    if (f[0u] != 0x05u) { return FASHIONSTAR_UART__NONE; } /* header */
-    if (f[1u] != 0x1cu) { return FASHIONSTAR_UART__NONE; } /* header */
-    code = (long)((uint32_t)f[2u]); /* cmd_id */
-    if (!fashionstar_uart__bounds(FASHIONSTAR_UART_RESPONSE, code, &low, &high, &bounded)) { return FASHIONSTAR_UART__NONE; }
-    { long counted = (long)((uint32_t)f[3u]) - 0L; /* length */
-      long content = counted - 0L;
-      if (content < (long)low || (bounded && content > (long)high)) { return FASHIONSTAR_UART__NONE; }
-      return 5L + counted; }
-}
-
-/* The size of a plausible frame of the direction's layout k at b[0..avail): FASHIONSTAR_UART__WAIT for more bytes, FASHIONSTAR_UART__NONE when
- * none starts there. */
-static long fashionstar_uart__probe_at(fashionstar_uart_direction_t dir, uint8_t k, const uint8_t *b, size_t avail)
-{
-    switch (dir) {
-    case FASHIONSTAR_UART_REQUEST:
-        switch (k) {
-        case 0u:
-            return fashionstar_uart__probe_request_0(b, avail);
-        default:
-            break;
-        }
-        break;
-    case FASHIONSTAR_UART_RESPONSE:
-        switch (k) {
-        case 0u:
-            return fashionstar_uart__probe_response_0(b, avail);
-        default:
-            break;
-        }
-        break;
-    default:
-        break;
-    }
-#if FASHIONSTAR_UART__STUFFED
-    {
-        uint8_t count;
-        const fashionstar_uart__layout_t *const *layouts = fashionstar_uart__layouts(dir, &count);
-        return k < count ? fashionstar_uart__probe(layouts[k], dir, b, avail) : FASHIONSTAR_UART__NONE;
-    }
-#else
-    (void)k;
-    (void)b;
-    (void)avail;
-    return FASHIONSTAR_UART__NONE;
-#endif
-}
 #endif
 
 #if FASHIONSTAR_UART_ENABLE_DECODE
@@ -2312,11 +2238,13 @@ static int fashionstar_uart__dec_sync_command_request(const uint8_t *c, size_t n
     d1_count = fashionstar_uart__get(c + o, 1u, 0u);
     o += 1u;
     /* blocks: One block per servo. */
-    if ((size_t)d1_count > (sizeof(m->blocks) / sizeof(m->blocks[0]))) { return FASHIONSTAR_UART_E_CAPACITY; }
-    m->blocks_count = (size_t)d1_count;
-    for (i1 = 0u; i1 < (size_t)d1_count; i1++) {
+    if ((uint64_t)(size_t)(d1_count) != (uint64_t)(d1_count)) { return FASHIONSTAR_UART_E_LENGTH; }
+    if ((size_t)(d1_count) > (sizeof(m->blocks) / sizeof(m->blocks[0]))) { return FASHIONSTAR_UART_E_CAPACITY; }
+    m->blocks_count = (size_t)(d1_count);
+    for (i1 = 0u; i1 < (size_t)(d1_count); i1++) {
         /* content: The carried command's request content for one servo. */
-        len = (size_t)d1_block_size;
+        if ((uint64_t)(size_t)(d1_block_size) != (uint64_t)(d1_block_size)) { return FASHIONSTAR_UART_E_LENGTH; }
+        len = (size_t)(d1_block_size);
         if (n - o < len) { return FASHIONSTAR_UART_E_LENGTH; }
         if (len > sizeof(m->blocks[i1].content)) { return FASHIONSTAR_UART_E_CAPACITY; }
         fashionstar_uart__copy(m->blocks[i1].content, c + o, len);
@@ -4400,12 +4328,12 @@ int fashionstar_uart_encode(const fashionstar_uart_msg_t *msg, uint8_t *buf, siz
 #endif
 
 #if FASHIONSTAR_UART_ENABLE_PARSER
-/* ---- the stream parser (serialspec.runtime.stream / framing.FrameStreamParser, fed one byte at a time) ---- */
+/* ---- the stream parser (serialspec.runtime.stream.StreamParser fed one byte at a time), for frames of the
+ * length-byte shape: per byte held, whether a candidate starts there and what is known of it ---- */
 
-#define FASHIONSTAR_UART__ACCEPT 0
-#define FASHIONSTAR_UART__V_WAIT 3
-#define FASHIONSTAR_UART__V_NONE 1
-#define FASHIONSTAR_UART__V_CORRUPT 2
+#define FASHIONSTAR_UART__C_NEW 1u     /* a header ends here: a candidate, its size not known yet */
+#define FASHIONSTAR_UART__C_SIZED 2u   /* a plausible candidate, waiting for its last byte */
+#define FASHIONSTAR_UART__C_CORRUPT 3u /* complete and corrupt, behind a candidate that waits: counted once the scan reaches it */
 
 void fashionstar_uart_parser_init(fashionstar_uart_parser_t *parser, fashionstar_uart_direction_t dir)
 {
@@ -4413,226 +4341,199 @@ void fashionstar_uart_parser_init(fashionstar_uart_parser_t *parser, fashionstar
     parser->dir = dir;
 }
 
-/* The candidate at pos: accepted (its size in *size, its message in out), waiting (in *size the bytes it needs
- * before it can be judged again, 0 when that is not known), no frame, or corrupt. */
-static int fashionstar_uart__try(fashionstar_uart_parser_t *p, size_t pos, fashionstar_uart_msg_t *out, size_t *size)
+/* The request frame's size from its first 4 bytes (the Python parser's candidate: the
+ * content size bounds of its command, its length byte, the ranges of its values); 0: no frame there. */
+static size_t fashionstar_uart__size_request(const uint8_t *f)
 {
-    uint8_t count = fashionstar_uart__count(p->dir), k;
-    size_t need = (size_t)-1; /* the fewest bytes a waiting layout needs: (size_t)-1 none waits, 0 not known */
-    if (p->verdict[pos] != 0u) {
-        return p->verdict[pos];
+    size_t low = 0u, high = 0u;
+    int bounded = 0;
+    long content;
+    if (!fashionstar_uart__bounds(FASHIONSTAR_UART_REQUEST, (long)((uint32_t)f[2u]), &low, &high, &bounded)) { return 0u; }
+    content = (long)f[3u] - 0L; /* length */
+    if (content < (long)low || (bounded && content > (long)high)) {
+        return 0u;
     }
-    for (k = 0u; k < count; k++) {
-        long s = fashionstar_uart__probe_at(p->dir, k, p->buf + pos, p->n - pos);
-        if (s == FASHIONSTAR_UART__WAIT) {
-            need = 0u;
-            continue;
-        }
-        if (s < 0 || (unsigned long)s > FASHIONSTAR_UART_MAX_FRAME) {
-            continue;
-        }
-        if ((size_t)s > p->n - pos) {
-            if ((size_t)s < need) {
-                need = (size_t)s;
-            }
-            continue;
-        }
-        if (fashionstar_uart_decode(p->buf + pos, (size_t)s, p->dir, out) != FASHIONSTAR_UART_OK) {
-            if (need == (size_t)-1) {
-                p->verdict[pos] = FASHIONSTAR_UART__V_CORRUPT;
-            }
-            return FASHIONSTAR_UART__V_CORRUPT;
-        }
-        *size = (size_t)s;
-        return FASHIONSTAR_UART__ACCEPT;
-    }
-    if (need != (size_t)-1) {
-        *size = need;
-        return FASHIONSTAR_UART__V_WAIT;
-    }
-    p->verdict[pos] = FASHIONSTAR_UART__V_NONE;
-    return FASHIONSTAR_UART__V_NONE;
+    return (size_t)content + 5u > FASHIONSTAR_UART_MAX_FRAME ? 0u : (size_t)content + 5u;
 }
 
-/* The next candidate start at or after start (a header of any layout; every byte when some layout has none). */
-static size_t fashionstar_uart__next(fashionstar_uart_parser_t *p, size_t start)
+/* The response frame's size from its first 4 bytes (the Python parser's candidate: the
+ * content size bounds of its command, its length byte, the ranges of its values); 0: no frame there. */
+static size_t fashionstar_uart__size_response(const uint8_t *f)
 {
-#if FASHIONSTAR_UART__HEADERS
-    uint8_t count = fashionstar_uart__count(p->dir), k;
-    size_t pos;
-    for (pos = start; pos < p->n; pos++) {
-        int whole = 1; /* every header could be read here: a position none matches is never a candidate */
-        if (p->verdict[pos] == FASHIONSTAR_UART__V_NONE) {
-            continue;
-        }
-        for (k = 0u; k < count; k++) {
-            size_t hl;
-            const uint8_t *h = fashionstar_uart__header(p->dir, k, &hl);
-            if (hl > p->n - pos) {
-                whole = 0;
-            } else if (fashionstar_uart__same(p->buf + pos, h, hl)) {
-                return pos;
-            }
-        }
-        if (whole) {
-            p->verdict[pos] = FASHIONSTAR_UART__V_NONE;
-        }
+    size_t low = 0u, high = 0u;
+    int bounded = 0;
+    long content;
+    if (!fashionstar_uart__bounds(FASHIONSTAR_UART_RESPONSE, (long)((uint32_t)f[2u]), &low, &high, &bounded)) { return 0u; }
+    content = (long)f[3u] - 0L; /* length */
+    if (content < (long)low || (bounded && content > (long)high)) {
+        return 0u;
     }
-    return p->n;
-#else
-    (void)p;
-    return start;
-#endif
+    return (size_t)content + 5u > FASHIONSTAR_UART_MAX_FRAME ? 0u : (size_t)content + 5u;
 }
 
-
-/* The fewest bytes any layout of the direction needs before the classic parser judges a candidate. */
-static size_t fashionstar_uart__least(fashionstar_uart_direction_t dir)
+static size_t fashionstar_uart__size(fashionstar_uart_direction_t dir, const uint8_t *f)
 {
     switch (dir) {
     case FASHIONSTAR_UART_REQUEST:
-        return 4u;
+        return fashionstar_uart__size_request(f);
     case FASHIONSTAR_UART_RESPONSE:
-        return 4u;
+        return fashionstar_uart__size_response(f);
     default:
         return 0u;
     }
 }
 
-/* The first cut bytes held dropped, with their verdicts: a loop, kept one (GCC would make it two calls of the
- * library's memmove, which a parser-only build has no other use for). */
+/* The Python parser's scan over the bytes held (stream.py _scan, _decide, _earliest), at a byte that can change its
+ * outcome: candidates in order; the first that waits holds the bytes from it on; one whose last byte this is gets
+ * taken when it decodes (the first such, whether or not one before it waits), else it is corrupt, counted when no
+ * candidate before it waits. Past the first waiting candidate it looks only when one ends with this byte. */
+static int fashionstar_uart__scan(fashionstar_uart_parser_t *p, fashionstar_uart_msg_t *out)
+{
+    const size_t first = p->first, end = first + p->n;
+    size_t pos, size, hold = (size_t)-1, wake = 0u, cut;
+    uint32_t errors = 0u;
+    uint8_t *const v = p->verdict;
+    const int all = end == p->wake;
+    for (pos = first; pos < end; pos++) {
+        if (v[pos] == 0u) {
+            continue;
+        }
+        if (v[pos] == FASHIONSTAR_UART__C_CORRUPT) {
+            if (hold == (size_t)-1) {
+                errors++;
+                v[pos] = 0u;
+            }
+            continue;
+        }
+        if (v[pos] == FASHIONSTAR_UART__C_SIZED) {
+            size = fashionstar_uart__size(p->dir, p->buf + pos);
+            if (pos + size <= end) {
+                if (fashionstar_uart_decode(p->buf + pos, size, p->dir, out) == FASHIONSTAR_UART_OK) {
+                    p->errors += errors;
+                    p->garbage += (uint32_t)(pos - first);
+                    p->frames++;
+                    p->n = 0u;
+                    p->first = 0u;
+                    p->wake = 0u;
+                    return 1;
+                }
+                if (hold == (size_t)-1) {
+                    errors++;
+                    v[pos] = 0u;
+                } else {
+                    v[pos] = FASHIONSTAR_UART__C_CORRUPT;
+                }
+                continue;
+            }
+            if (wake == 0u || pos + size < wake) {
+                wake = pos + size;
+            }
+        }
+        if (hold == (size_t)-1) {
+            hold = pos;
+            if (!all) {
+                break;
+            }
+        }
+    }
+    if (all || hold == (size_t)-1) {
+        p->wake = wake;
+    }
+    if (hold != (size_t)-1) {
+        cut = hold;
+    } else { /* keep a tail that could begin a header */
+        cut = end - first > 1u ? end - 1u : first;
+    }
+    p->errors += errors;
+    p->garbage += (uint32_t)(cut - first);
+    p->n = end - cut;
+    p->first = end > cut ? cut : 0u;
+    return 0;
+}
+
+/* The bytes held moved to the front of the buffer, once its end is reached (a loop: no library memmove). */
 #if defined(__GNUC__) && !defined(__clang__)
 __attribute__((optimize("no-tree-loop-distribute-patterns")))
 #endif
-static void fashionstar_uart__drop(fashionstar_uart_parser_t *p, size_t cut)
+static void fashionstar_uart__front(fashionstar_uart_parser_t *p)
 {
     size_t i;
-    for (i = cut; i < p->n; i++) {
-        p->buf[i - cut] = p->buf[i];
-        p->verdict[i - cut] = p->verdict[i];
+    if (p->first == 0u) { /* never so (a candidate is judged by its last byte, and none is longer than the buffer) */
+        p->first = 1u;
+        p->n--;
+        p->garbage++;
     }
-    p->n -= cut;
+    for (i = 0u; i < p->n; i++) {
+        p->buf[i] = p->buf[p->first + i];
+        p->verdict[i] = p->verdict[p->first + i];
+    }
+    p->wake = p->wake > p->first ? p->wake - p->first : 0u;
+    p->first = 0u;
 }
 
-#if FASHIONSTAR_UART__HEADERS
-/* 1 when the bytes held end with a header of any layout (a candidate begins). */
-static int fashionstar_uart__ends_header(const fashionstar_uart_parser_t *p)
+/* One byte in: a header that ends with it starts a candidate, the candidate whose prefix it completes is sized; the
+ * scan runs only when a sized candidate ends with it (p->wake) or no candidate is held at the front. */
+static int fashionstar_uart__push(fashionstar_uart_parser_t *p, uint8_t byte, fashionstar_uart_msg_t *out)
 {
-    uint8_t count = fashionstar_uart__count(p->dir), k;
-    for (k = 0u; k < count; k++) {
-        size_t hl;
-        const uint8_t *h = fashionstar_uart__header(p->dir, k, &hl);
-        if (hl <= p->n && fashionstar_uart__same(p->buf + p->n - hl, h, hl)) {
-            return 1;
+    const size_t need = 4u;
+    size_t at, size, end, first = p->first, n = p->n, wake = p->wake;
+    uint8_t *const b = p->buf, *const v = p->verdict;
+    if (first + n == FASHIONSTAR_UART_MAX_FRAME) {
+        fashionstar_uart__front(p);
+        first = 0u;
+        n = p->n;
+        wake = p->wake;
+    }
+    end = first + n;
+    b[end] = byte;
+    v[end] = 0u;
+    end++;
+    n++;
+    p->n = n; /* the fields in locals: a store through b or v may change any byte of *p, as far as C knows */
+    if (n >= 2u && fashionstar_uart__same(b + end - 2u, (p->dir == FASHIONSTAR_UART_REQUEST ? fashionstar_uart__h_request_0 : fashionstar_uart__h_response_0), 2u)) { /* a header ends with this byte */
+        v[end - 2u] = FASHIONSTAR_UART__C_NEW;
+    }
+    if (n >= need && v[end - need] == FASHIONSTAR_UART__C_NEW) {
+        at = end - need;
+        size = fashionstar_uart__size(p->dir, b + at);
+        if (size == 0u) {
+            v[at] = 0u;
+        } else {
+            v[at] = FASHIONSTAR_UART__C_SIZED;
+            if (wake == 0u || at + size < wake) {
+                p->wake = wake = at + size;
+            }
         }
+    }
+    if (end == wake) {
+        return fashionstar_uart__scan(p, out);
+    }
+    if (v[first] == 0u && n >= 2u) { /* no candidate at the front (any more) */
+        if (n > 1u && v[first + 1u] != 0u && v[first + 1u] != FASHIONSTAR_UART__C_CORRUPT) {
+            p->first = first + 1u; /* the scan's outcome when a live candidate follows: it holds the bytes from there */
+            p->n = n - 1u;
+            p->garbage++;
+            return 0;
+        }
+        return fashionstar_uart__scan(p, out);
     }
     return 0;
 }
-#endif
 
-/* One byte in: the Python parser's scan over the bytes held, each candidate's verdict kept once final. While a
- * candidate waits, the scan is left out until one held can be judged (p->wake bytes held) or a header comes: nothing
- * the scan decides could change before then. */
-static int fashionstar_uart__push(fashionstar_uart_parser_t *p, uint8_t byte, fashionstar_uart_msg_t *out)
-{
-    size_t start = 0u, done = 0u, pos, size = 0u, cut, hold = (size_t)-1, wake = (size_t)-1;
-    int got = 0, r;
-    if (p->n >= FASHIONSTAR_UART_MAX_FRAME) { /* only a candidate longer than FASHIONSTAR_UART_MAX_FRAME can fill it: drop its first byte */
-        fashionstar_uart__drop(p, 1u);
-        p->garbage++;
-        p->wake = 0u;
-    }
-    p->buf[p->n] = byte;
-    p->verdict[p->n] = 0u;
-    p->n++;
-#if FASHIONSTAR_UART__HEADERS
-    if (p->n < p->wake && !fashionstar_uart__ends_header(p)) {
-        return 0;
-    }
-#endif
-    while (start < p->n) {
-        pos = fashionstar_uart__next(p, start);
-        if (pos >= p->n) {
-            break;
-        }
-        if (p->n - pos < fashionstar_uart__least(p->dir)) { /* waiting, too short for any layout, and so is every later one */
-            if (hold == (size_t)-1) {
-                hold = pos;
-            }
-            if (pos + fashionstar_uart__least(p->dir) < wake) {
-                wake = pos + fashionstar_uart__least(p->dir);
-            }
-            break;
-        }
-        r = fashionstar_uart__try(p, pos, out, &size);
-        if (r == FASHIONSTAR_UART__V_WAIT) {
-            if (hold == (size_t)-1) {
-                hold = pos;
-            }
-            if (size == 0u) {
-                wake = 0u;
-            } else if (pos + size < wake) {
-                wake = pos + size;
-            }
-        } else if (r == FASHIONSTAR_UART__V_CORRUPT) {
-            if (hold == (size_t)-1) {
-                p->errors++;
-            }
-            if (p->verdict[pos] == 0u) { /* corrupt as one layout, while another waits: judged again */
-                wake = 0u;
-            }
-        } else if (r == FASHIONSTAR_UART__ACCEPT) {
-            p->garbage += (uint32_t)(pos - done);
-            hold = (size_t)-1;
-            start = done = pos + size;
-            got = 1;
-            p->frames++;
-            break;
-        }
-        start = pos + 1u;
-    }
-    p->wake = 0u;
-    if (hold != (size_t)-1) {
-        cut = hold;
-        if (wake != 0u) {
-            p->wake = wake - cut;
-        }
-    } else if (FASHIONSTAR_UART__HEADERS && !got) {
-        cut = p->n > FASHIONSTAR_UART__KEEP ? p->n - FASHIONSTAR_UART__KEEP : 0u;
-        if (cut < done) {
-            cut = done;
-        }
-    } else {
-        cut = got ? done : p->n;
-    }
-    p->garbage += (uint32_t)(cut - done);
-    if (cut > 0u) {
-        fashionstar_uart__drop(p, cut);
-    }
-    return got;
-}
-
-#if FASHIONSTAR_UART__HEADERS
-/* A whole frame at data[0..len) while no byte is held: taken at once, its bytes not pushed one by one, when that gives
- * what pushing them would (one layout; a plausible frame that fits and decodes; no header inside it, so no other
- * candidate could end first). Else 0: the bytes go through fashionstar_uart__push. */
+/* A whole frame at data[0..len) while no byte is held: taken at once when that gives what pushing its bytes would
+ * (a plausible frame that fits and decodes, no header inside it, so no other candidate could end first). Else 0. */
 static size_t fashionstar_uart__whole(fashionstar_uart_parser_t *p, const uint8_t *data, size_t len, fashionstar_uart_msg_t *out)
 {
-    size_t i, size, hl;
-    const uint8_t *h;
-    long s;
-    if (!FASHIONSTAR_UART__SINGLE && fashionstar_uart__count(p->dir) != 1u) {
+    const size_t hl = 2u;
+    const uint8_t *h = (p->dir == FASHIONSTAR_UART_REQUEST ? fashionstar_uart__h_request_0 : fashionstar_uart__h_response_0);
+    size_t i, size;
+    if (len < 4u || !fashionstar_uart__same(data, h, hl)) {
         return 0u;
     }
-    h = fashionstar_uart__header(p->dir, 0u, &hl);
-    if (h == NULL || len < hl || !fashionstar_uart__same(data, h, hl)) {
+    size = fashionstar_uart__size(p->dir, data);
+    if (size == 0u || size > len) {
         return 0u;
     }
-    s = fashionstar_uart__probe_at(p->dir, 0u, data, len);
-    if (s <= 0 || (unsigned long)s > FASHIONSTAR_UART_MAX_FRAME || (size_t)s > len) {
-        return 0u;
-    }
-    size = (size_t)s;
     for (i = 1u; i + hl <= size; i++) {
         if (data[i] == h[0] && fashionstar_uart__same(data + i, h, hl)) {
             return 0u;
@@ -4644,14 +4545,12 @@ static size_t fashionstar_uart__whole(fashionstar_uart_parser_t *p, const uint8_
     p->frames++;
     return size;
 }
-#endif
 
 size_t fashionstar_uart_parser_feed(fashionstar_uart_parser_t *parser, const uint8_t *data, size_t len, fashionstar_uart_msg_t *out, bool *got)
 {
     size_t i;
     *got = false;
     for (i = 0u; i < len; i++) {
-#if FASHIONSTAR_UART__HEADERS
         if (parser->n == 0u) {
             size_t size = fashionstar_uart__whole(parser, data + i, len - i, out);
             if (size > 0u) {
@@ -4659,7 +4558,6 @@ size_t fashionstar_uart_parser_feed(fashionstar_uart_parser_t *parser, const uin
                 return i + size;
             }
         }
-#endif
         if (fashionstar_uart__push(parser, data[i], out)) {
             *got = true;
             return i + 1u;

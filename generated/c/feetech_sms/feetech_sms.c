@@ -739,82 +739,6 @@ static int feetech_sms__bounds(feetech_sms_direction_t dir, long code, size_t *l
     }
 }
 
-/* ---- candidates sized: straight line where a layout has no byte stuffing, without the tables ---- */
-/* The request frame: probe, straight line. */
-static long feetech_sms__probe_request_0(const uint8_t *f, size_t avail)
-{
-    size_t low = 0u, high = 0u;
-    int bounded = 0;
-    long code = FEETECH_SMS__NO_CODE;
-    (void)code;
-    if (avail < 5u) { return FEETECH_SMS__WAIT; }
-    if (f[0u] != 0xffu) { return FEETECH_SMS__NONE; } /* header */
-    if (f[1u] != 0xffu) { return FEETECH_SMS__NONE; } /* header */
-    { uint32_t v = (uint32_t)f[2u]; if ((v > 253u) && v != 254u) { return FEETECH_SMS__NONE; } } /* id */
-    code = (long)((uint32_t)f[4u]); /* instruction */
-    if (!feetech_sms__bounds(FEETECH_SMS_REQUEST, code, &low, &high, &bounded)) { return FEETECH_SMS__NONE; }
-    { long counted = (long)((uint32_t)f[3u]) - 2L; /* length */
-      long content = counted - 0L;
-      if (content < (long)low || (bounded && content > (long)high)) { return FEETECH_SMS__NONE; }
-      return 6L + counted; }
-}
-
-/* The response frame: probe, straight line. */
-static long feetech_sms__probe_response_0(const uint8_t *f, size_t avail)
-{
-    size_t low = 0u, high = 0u;
-    int bounded = 0;
-    long code = FEETECH_SMS__NO_CODE;
-    (void)code;
-    if (avail < 4u) { return FEETECH_SMS__WAIT; }
-    if (f[0u] != 0xffu) { return FEETECH_SMS__NONE; } /* header */
-    if (f[1u] != 0xffu) { return FEETECH_SMS__NONE; } /* header */
-    { uint32_t v = (uint32_t)f[2u]; if ((v > 253u) && v != 254u) { return FEETECH_SMS__NONE; } } /* id */
-    if (avail < 5u) { return FEETECH_SMS__WAIT; }
-    if (!feetech_sms__bounds(FEETECH_SMS_RESPONSE, FEETECH_SMS__NO_CODE, &low, &high, &bounded)) { return FEETECH_SMS__NONE; }
-    { long counted = (long)((uint32_t)f[3u]) - 2L; /* length */
-      long content = counted - 0L;
-      if (content < (long)low || (bounded && content > (long)high)) { return FEETECH_SMS__NONE; }
-      return 6L + counted; }
-}
-
-/* The size of a plausible frame of the direction's layout k at b[0..avail): FEETECH_SMS__WAIT for more bytes, FEETECH_SMS__NONE when
- * none starts there. */
-static long feetech_sms__probe_at(feetech_sms_direction_t dir, uint8_t k, const uint8_t *b, size_t avail)
-{
-    switch (dir) {
-    case FEETECH_SMS_REQUEST:
-        switch (k) {
-        case 0u:
-            return feetech_sms__probe_request_0(b, avail);
-        default:
-            break;
-        }
-        break;
-    case FEETECH_SMS_RESPONSE:
-        switch (k) {
-        case 0u:
-            return feetech_sms__probe_response_0(b, avail);
-        default:
-            break;
-        }
-        break;
-    default:
-        break;
-    }
-#if FEETECH_SMS__STUFFED
-    {
-        uint8_t count;
-        const feetech_sms__layout_t *const *layouts = feetech_sms__layouts(dir, &count);
-        return k < count ? feetech_sms__probe(layouts[k], dir, b, avail) : FEETECH_SMS__NONE;
-    }
-#else
-    (void)k;
-    (void)b;
-    (void)avail;
-    return FEETECH_SMS__NONE;
-#endif
-}
 #endif
 
 #if FEETECH_SMS_ENABLE_DECODE
@@ -1115,7 +1039,8 @@ static int feetech_sms__dec_sync_write_request(const uint8_t *c, size_t n, feete
         m->servos[i1].id = (uint8_t)feetech_sms__get(c + o, 1u, 0u);
         o += 1u;
         /* data: The L bytes written to that servo from `address` on. */
-        len = (size_t)d1_data_length;
+        if ((uint64_t)(size_t)(d1_data_length) != (uint64_t)(d1_data_length)) { return FEETECH_SMS_E_LENGTH; }
+        len = (size_t)(d1_data_length);
         if (n - o < len) { return FEETECH_SMS_E_LENGTH; }
         if (len > sizeof(m->servos[i1].data)) { return FEETECH_SMS_E_CAPACITY; }
         feetech_sms__copy(m->servos[i1].data, c + o, len);
@@ -1607,12 +1532,12 @@ int feetech_sms_encode(const feetech_sms_msg_t *msg, uint8_t *buf, size_t cap, s
 #endif
 
 #if FEETECH_SMS_ENABLE_PARSER
-/* ---- the stream parser (serialspec.runtime.stream / framing.FrameStreamParser, fed one byte at a time) ---- */
+/* ---- the stream parser (serialspec.runtime.stream.StreamParser fed one byte at a time), for frames of the
+ * length-byte shape: per byte held, whether a candidate starts there and what is known of it ---- */
 
-#define FEETECH_SMS__ACCEPT 0
-#define FEETECH_SMS__V_WAIT 3
-#define FEETECH_SMS__V_NONE 1
-#define FEETECH_SMS__V_CORRUPT 2
+#define FEETECH_SMS__C_NEW 1u     /* a header ends here: a candidate, its size not known yet */
+#define FEETECH_SMS__C_SIZED 2u   /* a plausible candidate, waiting for its last byte */
+#define FEETECH_SMS__C_CORRUPT 3u /* complete and corrupt, behind a candidate that waits: counted once the scan reaches it */
 
 void feetech_sms_parser_init(feetech_sms_parser_t *parser, feetech_sms_direction_t dir)
 {
@@ -1620,226 +1545,201 @@ void feetech_sms_parser_init(feetech_sms_parser_t *parser, feetech_sms_direction
     parser->dir = dir;
 }
 
-/* The candidate at pos: accepted (its size in *size, its message in out), waiting (in *size the bytes it needs
- * before it can be judged again, 0 when that is not known), no frame, or corrupt. */
-static int feetech_sms__try(feetech_sms_parser_t *p, size_t pos, feetech_sms_msg_t *out, size_t *size)
+/* The request frame's size from its first 5 bytes (the Python parser's candidate: the
+ * content size bounds of its command, its length byte, the ranges of its values); 0: no frame there. */
+static size_t feetech_sms__size_request(const uint8_t *f)
 {
-    uint8_t count = feetech_sms__count(p->dir), k;
-    size_t need = (size_t)-1; /* the fewest bytes a waiting layout needs: (size_t)-1 none waits, 0 not known */
-    if (p->verdict[pos] != 0u) {
-        return p->verdict[pos];
+    size_t low = 0u, high = 0u;
+    int bounded = 0;
+    long content;
+    { uint32_t v = (uint32_t)f[2u]; if ((v > 253u) && v != 254u) { return 0u; } } /* id */
+    if (!feetech_sms__bounds(FEETECH_SMS_REQUEST, (long)((uint32_t)f[4u]), &low, &high, &bounded)) { return 0u; }
+    content = (long)f[3u] - 2L; /* length */
+    if (content < (long)low || (bounded && content > (long)high)) {
+        return 0u;
     }
-    for (k = 0u; k < count; k++) {
-        long s = feetech_sms__probe_at(p->dir, k, p->buf + pos, p->n - pos);
-        if (s == FEETECH_SMS__WAIT) {
-            need = 0u;
-            continue;
-        }
-        if (s < 0 || (unsigned long)s > FEETECH_SMS_MAX_FRAME) {
-            continue;
-        }
-        if ((size_t)s > p->n - pos) {
-            if ((size_t)s < need) {
-                need = (size_t)s;
-            }
-            continue;
-        }
-        if (feetech_sms_decode(p->buf + pos, (size_t)s, p->dir, out) != FEETECH_SMS_OK) {
-            if (need == (size_t)-1) {
-                p->verdict[pos] = FEETECH_SMS__V_CORRUPT;
-            }
-            return FEETECH_SMS__V_CORRUPT;
-        }
-        *size = (size_t)s;
-        return FEETECH_SMS__ACCEPT;
-    }
-    if (need != (size_t)-1) {
-        *size = need;
-        return FEETECH_SMS__V_WAIT;
-    }
-    p->verdict[pos] = FEETECH_SMS__V_NONE;
-    return FEETECH_SMS__V_NONE;
+    return (size_t)content + 6u > FEETECH_SMS_MAX_FRAME ? 0u : (size_t)content + 6u;
 }
 
-/* The next candidate start at or after start (a header of any layout; every byte when some layout has none). */
-static size_t feetech_sms__next(feetech_sms_parser_t *p, size_t start)
+/* The response frame's size from its first 4 bytes (the Python parser's candidate: the
+ * content size bounds of its command, its length byte, the ranges of its values); 0: no frame there. */
+static size_t feetech_sms__size_response(const uint8_t *f)
 {
-#if FEETECH_SMS__HEADERS
-    uint8_t count = feetech_sms__count(p->dir), k;
-    size_t pos;
-    for (pos = start; pos < p->n; pos++) {
-        int whole = 1; /* every header could be read here: a position none matches is never a candidate */
-        if (p->verdict[pos] == FEETECH_SMS__V_NONE) {
-            continue;
-        }
-        for (k = 0u; k < count; k++) {
-            size_t hl;
-            const uint8_t *h = feetech_sms__header(p->dir, k, &hl);
-            if (hl > p->n - pos) {
-                whole = 0;
-            } else if (feetech_sms__same(p->buf + pos, h, hl)) {
-                return pos;
-            }
-        }
-        if (whole) {
-            p->verdict[pos] = FEETECH_SMS__V_NONE;
-        }
+    size_t low = 0u, high = 0u;
+    int bounded = 0;
+    long content;
+    { uint32_t v = (uint32_t)f[2u]; if ((v > 253u) && v != 254u) { return 0u; } } /* id */
+    if (!feetech_sms__bounds(FEETECH_SMS_RESPONSE, FEETECH_SMS__NO_CODE, &low, &high, &bounded)) { return 0u; }
+    content = (long)f[3u] - 2L; /* length */
+    if (content < (long)low || (bounded && content > (long)high)) {
+        return 0u;
     }
-    return p->n;
-#else
-    (void)p;
-    return start;
-#endif
+    return (size_t)content + 6u > FEETECH_SMS_MAX_FRAME ? 0u : (size_t)content + 6u;
 }
 
-
-/* The fewest bytes any layout of the direction needs before the classic parser judges a candidate. */
-static size_t feetech_sms__least(feetech_sms_direction_t dir)
+static size_t feetech_sms__size(feetech_sms_direction_t dir, const uint8_t *f)
 {
     switch (dir) {
     case FEETECH_SMS_REQUEST:
-        return 5u;
+        return feetech_sms__size_request(f);
     case FEETECH_SMS_RESPONSE:
-        return 4u;
+        return feetech_sms__size_response(f);
     default:
         return 0u;
     }
 }
 
-/* The first cut bytes held dropped, with their verdicts: a loop, kept one (GCC would make it two calls of the
- * library's memmove, which a parser-only build has no other use for). */
+/* The Python parser's scan over the bytes held (stream.py _scan, _decide, _earliest), at a byte that can change its
+ * outcome: candidates in order; the first that waits holds the bytes from it on; one whose last byte this is gets
+ * taken when it decodes (the first such, whether or not one before it waits), else it is corrupt, counted when no
+ * candidate before it waits. Past the first waiting candidate it looks only when one ends with this byte. */
+static int feetech_sms__scan(feetech_sms_parser_t *p, feetech_sms_msg_t *out)
+{
+    const size_t first = p->first, end = first + p->n;
+    size_t pos, size, hold = (size_t)-1, wake = 0u, cut;
+    uint32_t errors = 0u;
+    uint8_t *const v = p->verdict;
+    const int all = end == p->wake;
+    for (pos = first; pos < end; pos++) {
+        if (v[pos] == 0u) {
+            continue;
+        }
+        if (v[pos] == FEETECH_SMS__C_CORRUPT) {
+            if (hold == (size_t)-1) {
+                errors++;
+                v[pos] = 0u;
+            }
+            continue;
+        }
+        if (v[pos] == FEETECH_SMS__C_SIZED) {
+            size = feetech_sms__size(p->dir, p->buf + pos);
+            if (pos + size <= end) {
+                if (feetech_sms_decode(p->buf + pos, size, p->dir, out) == FEETECH_SMS_OK) {
+                    p->errors += errors;
+                    p->garbage += (uint32_t)(pos - first);
+                    p->frames++;
+                    p->n = 0u;
+                    p->first = 0u;
+                    p->wake = 0u;
+                    return 1;
+                }
+                if (hold == (size_t)-1) {
+                    errors++;
+                    v[pos] = 0u;
+                } else {
+                    v[pos] = FEETECH_SMS__C_CORRUPT;
+                }
+                continue;
+            }
+            if (wake == 0u || pos + size < wake) {
+                wake = pos + size;
+            }
+        }
+        if (hold == (size_t)-1) {
+            hold = pos;
+            if (!all) {
+                break;
+            }
+        }
+    }
+    if (all || hold == (size_t)-1) {
+        p->wake = wake;
+    }
+    if (hold != (size_t)-1) {
+        cut = hold;
+    } else { /* keep a tail that could begin a header */
+        cut = end - first > 1u ? end - 1u : first;
+    }
+    p->errors += errors;
+    p->garbage += (uint32_t)(cut - first);
+    p->n = end - cut;
+    p->first = end > cut ? cut : 0u;
+    return 0;
+}
+
+/* The bytes held moved to the front of the buffer, once its end is reached (a loop: no library memmove). */
 #if defined(__GNUC__) && !defined(__clang__)
 __attribute__((optimize("no-tree-loop-distribute-patterns")))
 #endif
-static void feetech_sms__drop(feetech_sms_parser_t *p, size_t cut)
+static void feetech_sms__front(feetech_sms_parser_t *p)
 {
     size_t i;
-    for (i = cut; i < p->n; i++) {
-        p->buf[i - cut] = p->buf[i];
-        p->verdict[i - cut] = p->verdict[i];
+    if (p->first == 0u) { /* never so (a candidate is judged by its last byte, and none is longer than the buffer) */
+        p->first = 1u;
+        p->n--;
+        p->garbage++;
     }
-    p->n -= cut;
+    for (i = 0u; i < p->n; i++) {
+        p->buf[i] = p->buf[p->first + i];
+        p->verdict[i] = p->verdict[p->first + i];
+    }
+    p->wake = p->wake > p->first ? p->wake - p->first : 0u;
+    p->first = 0u;
 }
 
-#if FEETECH_SMS__HEADERS
-/* 1 when the bytes held end with a header of any layout (a candidate begins). */
-static int feetech_sms__ends_header(const feetech_sms_parser_t *p)
+/* One byte in: a header that ends with it starts a candidate, the candidate whose prefix it completes is sized; the
+ * scan runs only when a sized candidate ends with it (p->wake) or no candidate is held at the front. */
+static int feetech_sms__push(feetech_sms_parser_t *p, uint8_t byte, feetech_sms_msg_t *out)
 {
-    uint8_t count = feetech_sms__count(p->dir), k;
-    for (k = 0u; k < count; k++) {
-        size_t hl;
-        const uint8_t *h = feetech_sms__header(p->dir, k, &hl);
-        if (hl <= p->n && feetech_sms__same(p->buf + p->n - hl, h, hl)) {
-            return 1;
+    const size_t need = (p->dir == FEETECH_SMS_REQUEST ? 5u : 4u);
+    size_t at, size, end, first = p->first, n = p->n, wake = p->wake;
+    uint8_t *const b = p->buf, *const v = p->verdict;
+    if (first + n == FEETECH_SMS_MAX_FRAME) {
+        feetech_sms__front(p);
+        first = 0u;
+        n = p->n;
+        wake = p->wake;
+    }
+    end = first + n;
+    b[end] = byte;
+    v[end] = 0u;
+    end++;
+    n++;
+    p->n = n; /* the fields in locals: a store through b or v may change any byte of *p, as far as C knows */
+    if (n >= 2u && byte == 0xffu && b[end - 2u] == 0xffu) { /* a header ends with this byte */
+        v[end - 2u] = FEETECH_SMS__C_NEW;
+    }
+    if (n >= need && v[end - need] == FEETECH_SMS__C_NEW) {
+        at = end - need;
+        size = feetech_sms__size(p->dir, b + at);
+        if (size == 0u) {
+            v[at] = 0u;
+        } else {
+            v[at] = FEETECH_SMS__C_SIZED;
+            if (wake == 0u || at + size < wake) {
+                p->wake = wake = at + size;
+            }
         }
+    }
+    if (end == wake) {
+        return feetech_sms__scan(p, out);
+    }
+    if (v[first] == 0u && n >= 2u) { /* no candidate at the front (any more) */
+        if (n > 1u && v[first + 1u] != 0u && v[first + 1u] != FEETECH_SMS__C_CORRUPT) {
+            p->first = first + 1u; /* the scan's outcome when a live candidate follows: it holds the bytes from there */
+            p->n = n - 1u;
+            p->garbage++;
+            return 0;
+        }
+        return feetech_sms__scan(p, out);
     }
     return 0;
 }
-#endif
 
-/* One byte in: the Python parser's scan over the bytes held, each candidate's verdict kept once final. While a
- * candidate waits, the scan is left out until one held can be judged (p->wake bytes held) or a header comes: nothing
- * the scan decides could change before then. */
-static int feetech_sms__push(feetech_sms_parser_t *p, uint8_t byte, feetech_sms_msg_t *out)
-{
-    size_t start = 0u, done = 0u, pos, size = 0u, cut, hold = (size_t)-1, wake = (size_t)-1;
-    int got = 0, r;
-    if (p->n >= FEETECH_SMS_MAX_FRAME) { /* only a candidate longer than FEETECH_SMS_MAX_FRAME can fill it: drop its first byte */
-        feetech_sms__drop(p, 1u);
-        p->garbage++;
-        p->wake = 0u;
-    }
-    p->buf[p->n] = byte;
-    p->verdict[p->n] = 0u;
-    p->n++;
-#if FEETECH_SMS__HEADERS
-    if (p->n < p->wake && !feetech_sms__ends_header(p)) {
-        return 0;
-    }
-#endif
-    while (start < p->n) {
-        pos = feetech_sms__next(p, start);
-        if (pos >= p->n) {
-            break;
-        }
-        if (p->n - pos < feetech_sms__least(p->dir)) { /* waiting, too short for any layout, and so is every later one */
-            if (hold == (size_t)-1) {
-                hold = pos;
-            }
-            if (pos + feetech_sms__least(p->dir) < wake) {
-                wake = pos + feetech_sms__least(p->dir);
-            }
-            break;
-        }
-        r = feetech_sms__try(p, pos, out, &size);
-        if (r == FEETECH_SMS__V_WAIT) {
-            if (hold == (size_t)-1) {
-                hold = pos;
-            }
-            if (size == 0u) {
-                wake = 0u;
-            } else if (pos + size < wake) {
-                wake = pos + size;
-            }
-        } else if (r == FEETECH_SMS__V_CORRUPT) {
-            if (hold == (size_t)-1) {
-                p->errors++;
-            }
-            if (p->verdict[pos] == 0u) { /* corrupt as one layout, while another waits: judged again */
-                wake = 0u;
-            }
-        } else if (r == FEETECH_SMS__ACCEPT) {
-            p->garbage += (uint32_t)(pos - done);
-            hold = (size_t)-1;
-            start = done = pos + size;
-            got = 1;
-            p->frames++;
-            break;
-        }
-        start = pos + 1u;
-    }
-    p->wake = 0u;
-    if (hold != (size_t)-1) {
-        cut = hold;
-        if (wake != 0u) {
-            p->wake = wake - cut;
-        }
-    } else if (FEETECH_SMS__HEADERS && !got) {
-        cut = p->n > FEETECH_SMS__KEEP ? p->n - FEETECH_SMS__KEEP : 0u;
-        if (cut < done) {
-            cut = done;
-        }
-    } else {
-        cut = got ? done : p->n;
-    }
-    p->garbage += (uint32_t)(cut - done);
-    if (cut > 0u) {
-        feetech_sms__drop(p, cut);
-    }
-    return got;
-}
-
-#if FEETECH_SMS__HEADERS
-/* A whole frame at data[0..len) while no byte is held: taken at once, its bytes not pushed one by one, when that gives
- * what pushing them would (one layout; a plausible frame that fits and decodes; no header inside it, so no other
- * candidate could end first). Else 0: the bytes go through feetech_sms__push. */
+/* A whole frame at data[0..len) while no byte is held: taken at once when that gives what pushing its bytes would
+ * (a plausible frame that fits and decodes, no header inside it, so no other candidate could end first). Else 0. */
 static size_t feetech_sms__whole(feetech_sms_parser_t *p, const uint8_t *data, size_t len, feetech_sms_msg_t *out)
 {
-    size_t i, size, hl;
-    const uint8_t *h;
-    long s;
-    if (!FEETECH_SMS__SINGLE && feetech_sms__count(p->dir) != 1u) {
+    const size_t hl = 2u;
+    const uint8_t *h = feetech_sms__h_request_0;
+    size_t i, size;
+    if (len < (p->dir == FEETECH_SMS_REQUEST ? 5u : 4u) || !feetech_sms__same(data, h, hl)) {
         return 0u;
     }
-    h = feetech_sms__header(p->dir, 0u, &hl);
-    if (h == NULL || len < hl || !feetech_sms__same(data, h, hl)) {
+    size = feetech_sms__size(p->dir, data);
+    if (size == 0u || size > len) {
         return 0u;
     }
-    s = feetech_sms__probe_at(p->dir, 0u, data, len);
-    if (s <= 0 || (unsigned long)s > FEETECH_SMS_MAX_FRAME || (size_t)s > len) {
-        return 0u;
-    }
-    size = (size_t)s;
     for (i = 1u; i + hl <= size; i++) {
         if (data[i] == h[0] && feetech_sms__same(data + i, h, hl)) {
             return 0u;
@@ -1851,14 +1751,12 @@ static size_t feetech_sms__whole(feetech_sms_parser_t *p, const uint8_t *data, s
     p->frames++;
     return size;
 }
-#endif
 
 size_t feetech_sms_parser_feed(feetech_sms_parser_t *parser, const uint8_t *data, size_t len, feetech_sms_msg_t *out, bool *got)
 {
     size_t i;
     *got = false;
     for (i = 0u; i < len; i++) {
-#if FEETECH_SMS__HEADERS
         if (parser->n == 0u) {
             size_t size = feetech_sms__whole(parser, data + i, len - i, out);
             if (size > 0u) {
@@ -1866,7 +1764,6 @@ size_t feetech_sms_parser_feed(feetech_sms_parser_t *parser, const uint8_t *data
                 return i + size;
             }
         }
-#endif
         if (feetech_sms__push(parser, data[i], out)) {
             *got = true;
             return i + 1u;

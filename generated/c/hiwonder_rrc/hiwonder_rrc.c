@@ -804,80 +804,6 @@ static int hiwonder_rrc__bounds(hiwonder_rrc_direction_t dir, long code, size_t 
     }
 }
 
-/* ---- candidates sized: straight line where a layout has no byte stuffing, without the tables ---- */
-/* The request frame: probe, straight line. */
-static long hiwonder_rrc__probe_request_0(const uint8_t *f, size_t avail)
-{
-    size_t low = 0u, high = 0u;
-    int bounded = 0;
-    long code = HIWONDER_RRC__NO_CODE;
-    (void)code;
-    if (avail < 4u) { return HIWONDER_RRC__WAIT; }
-    if (f[0u] != 0xaau) { return HIWONDER_RRC__NONE; } /* header */
-    if (f[1u] != 0x55u) { return HIWONDER_RRC__NONE; } /* header */
-    code = (long)((uint32_t)f[2u]); /* function */
-    if (!hiwonder_rrc__bounds(HIWONDER_RRC_REQUEST, code, &low, &high, &bounded)) { return HIWONDER_RRC__NONE; }
-    { long counted = (long)((uint32_t)f[3u]) - 0L; /* length */
-      long content = counted - 0L;
-      if (content < (long)low || (bounded && content > (long)high)) { return HIWONDER_RRC__NONE; }
-      return 5L + counted; }
-}
-
-/* The response frame: probe, straight line. */
-static long hiwonder_rrc__probe_response_0(const uint8_t *f, size_t avail)
-{
-    size_t low = 0u, high = 0u;
-    int bounded = 0;
-    long code = HIWONDER_RRC__NO_CODE;
-    (void)code;
-    if (avail < 4u) { return HIWONDER_RRC__WAIT; }
-    if (f[0u] != 0xaau) { return HIWONDER_RRC__NONE; } /* header */
-    if (f[1u] != 0x55u) { return HIWONDER_RRC__NONE; } /* header */
-    code = (long)((uint32_t)f[2u]); /* function */
-    if (!hiwonder_rrc__bounds(HIWONDER_RRC_RESPONSE, code, &low, &high, &bounded)) { return HIWONDER_RRC__NONE; }
-    { long counted = (long)((uint32_t)f[3u]) - 0L; /* length */
-      long content = counted - 0L;
-      if (content < (long)low || (bounded && content > (long)high)) { return HIWONDER_RRC__NONE; }
-      return 5L + counted; }
-}
-
-/* The size of a plausible frame of the direction's layout k at b[0..avail): HIWONDER_RRC__WAIT for more bytes, HIWONDER_RRC__NONE when
- * none starts there. */
-static long hiwonder_rrc__probe_at(hiwonder_rrc_direction_t dir, uint8_t k, const uint8_t *b, size_t avail)
-{
-    switch (dir) {
-    case HIWONDER_RRC_REQUEST:
-        switch (k) {
-        case 0u:
-            return hiwonder_rrc__probe_request_0(b, avail);
-        default:
-            break;
-        }
-        break;
-    case HIWONDER_RRC_RESPONSE:
-        switch (k) {
-        case 0u:
-            return hiwonder_rrc__probe_response_0(b, avail);
-        default:
-            break;
-        }
-        break;
-    default:
-        break;
-    }
-#if HIWONDER_RRC__STUFFED
-    {
-        uint8_t count;
-        const hiwonder_rrc__layout_t *const *layouts = hiwonder_rrc__layouts(dir, &count);
-        return k < count ? hiwonder_rrc__probe(layouts[k], dir, b, avail) : HIWONDER_RRC__NONE;
-    }
-#else
-    (void)k;
-    (void)b;
-    (void)avail;
-    return HIWONDER_RRC__NONE;
-#endif
-}
 #endif
 
 #if HIWONDER_RRC_ENABLE_DECODE
@@ -1114,9 +1040,10 @@ static int hiwonder_rrc__dec_motor_set_speeds_request(const uint8_t *c, size_t n
     d1_count = hiwonder_rrc__get(c + o, 1u, 0u);
     o += 1u;
     /* motors: One (motor_id, speed) pair per motor. */
-    if ((size_t)d1_count > (sizeof(m->motors) / sizeof(m->motors[0]))) { return HIWONDER_RRC_E_CAPACITY; }
-    m->motors_count = (size_t)d1_count;
-    for (i1 = 0u; i1 < (size_t)d1_count; i1++) {
+    if ((uint64_t)(size_t)(d1_count) != (uint64_t)(d1_count)) { return HIWONDER_RRC_E_LENGTH; }
+    if ((size_t)(d1_count) > (sizeof(m->motors) / sizeof(m->motors[0]))) { return HIWONDER_RRC_E_CAPACITY; }
+    m->motors_count = (size_t)(d1_count);
+    for (i1 = 0u; i1 < (size_t)(d1_count); i1++) {
         /* motor_id: Encoder motor id; bit n of the stop mask is motor_id n (the board has four motor ports). */
         if (n - o < 1u) { return HIWONDER_RRC_E_LENGTH; }
         m->motors[i1].motor_id = (uint8_t)hiwonder_rrc__get(c + o, 1u, 0u);
@@ -1167,9 +1094,10 @@ static int hiwonder_rrc__dec_motor_set_duties_request(const uint8_t *c, size_t n
     d1_count = hiwonder_rrc__get(c + o, 1u, 0u);
     o += 1u;
     /* duties: One (motor_id, duty) pair per motor. */
-    if ((size_t)d1_count > (sizeof(m->duties) / sizeof(m->duties[0]))) { return HIWONDER_RRC_E_CAPACITY; }
-    m->duties_count = (size_t)d1_count;
-    for (i1 = 0u; i1 < (size_t)d1_count; i1++) {
+    if ((uint64_t)(size_t)(d1_count) != (uint64_t)(d1_count)) { return HIWONDER_RRC_E_LENGTH; }
+    if ((size_t)(d1_count) > (sizeof(m->duties) / sizeof(m->duties[0]))) { return HIWONDER_RRC_E_CAPACITY; }
+    m->duties_count = (size_t)(d1_count);
+    for (i1 = 0u; i1 < (size_t)(d1_count); i1++) {
         /* motor_id: Encoder motor id; bit n of the stop mask is motor_id n (the board has four motor ports). */
         if (n - o < 1u) { return HIWONDER_RRC_E_LENGTH; }
         m->duties[i1].motor_id = (uint8_t)hiwonder_rrc__get(c + o, 1u, 0u);
@@ -1224,9 +1152,10 @@ static int hiwonder_rrc__dec_pwm_servo_set_positions_request(const uint8_t *c, s
     d1_count = hiwonder_rrc__get(c + o, 1u, 0u);
     o += 1u;
     /* pwm_servos: One (servo_id, pulse) pair per servo. */
-    if ((size_t)d1_count > (sizeof(m->pwm_servos) / sizeof(m->pwm_servos[0]))) { return HIWONDER_RRC_E_CAPACITY; }
-    m->pwm_servos_count = (size_t)d1_count;
-    for (i1 = 0u; i1 < (size_t)d1_count; i1++) {
+    if ((uint64_t)(size_t)(d1_count) != (uint64_t)(d1_count)) { return HIWONDER_RRC_E_LENGTH; }
+    if ((size_t)(d1_count) > (sizeof(m->pwm_servos) / sizeof(m->pwm_servos[0]))) { return HIWONDER_RRC_E_CAPACITY; }
+    m->pwm_servos_count = (size_t)(d1_count);
+    for (i1 = 0u; i1 < (size_t)(d1_count); i1++) {
         /* servo_id: PWM servo id. */
         if (n - o < 1u) { return HIWONDER_RRC_E_LENGTH; }
         m->pwm_servos[i1].servo_id = (uint8_t)hiwonder_rrc__get(c + o, 1u, 0u);
@@ -1396,9 +1325,10 @@ static int hiwonder_rrc__dec_bus_servo_set_positions_request(const uint8_t *c, s
     d1_count = hiwonder_rrc__get(c + o, 1u, 0u);
     o += 1u;
     /* bus_servos: One (servo_id, position) pair per servo. */
-    if ((size_t)d1_count > (sizeof(m->bus_servos) / sizeof(m->bus_servos[0]))) { return HIWONDER_RRC_E_CAPACITY; }
-    m->bus_servos_count = (size_t)d1_count;
-    for (i1 = 0u; i1 < (size_t)d1_count; i1++) {
+    if ((uint64_t)(size_t)(d1_count) != (uint64_t)(d1_count)) { return HIWONDER_RRC_E_LENGTH; }
+    if ((size_t)(d1_count) > (sizeof(m->bus_servos) / sizeof(m->bus_servos[0]))) { return HIWONDER_RRC_E_CAPACITY; }
+    m->bus_servos_count = (size_t)(d1_count);
+    for (i1 = 0u; i1 < (size_t)(d1_count); i1++) {
         /* servo_id: Bus servo id (0xFE is the broadcast id). */
         if (n - o < 1u) { return HIWONDER_RRC_E_LENGTH; }
         m->bus_servos[i1].servo_id = (uint8_t)hiwonder_rrc__get(c + o, 1u, 0u);
@@ -1568,9 +1498,10 @@ static int hiwonder_rrc__dec_bus_servo_stop_request(const uint8_t *c, size_t n, 
     d1_count = hiwonder_rrc__get(c + o, 1u, 0u);
     o += 1u;
     /* servos: The servos to stop. */
-    if ((size_t)d1_count > (sizeof(m->servos) / sizeof(m->servos[0]))) { return HIWONDER_RRC_E_CAPACITY; }
-    m->servos_count = (size_t)d1_count;
-    for (i1 = 0u; i1 < (size_t)d1_count; i1++) {
+    if ((uint64_t)(size_t)(d1_count) != (uint64_t)(d1_count)) { return HIWONDER_RRC_E_LENGTH; }
+    if ((size_t)(d1_count) > (sizeof(m->servos) / sizeof(m->servos[0]))) { return HIWONDER_RRC_E_CAPACITY; }
+    m->servos_count = (size_t)(d1_count);
+    for (i1 = 0u; i1 < (size_t)(d1_count); i1++) {
         /* servo_id: Bus servo id (0xFE is the broadcast id). */
         if (n - o < 1u) { return HIWONDER_RRC_E_LENGTH; }
         m->servos[i1].servo_id = (uint8_t)hiwonder_rrc__get(c + o, 1u, 0u);
@@ -2204,7 +2135,8 @@ static int hiwonder_rrc__dec_oled_request(const uint8_t *c, size_t n, hiwonder_r
     d1_length = hiwonder_rrc__get(c + o, 1u, 0u);
     o += 1u;
     /* text: The text (UTF-8). */
-    len = (size_t)d1_length;
+    if ((uint64_t)(size_t)(d1_length) != (uint64_t)(d1_length)) { return HIWONDER_RRC_E_LENGTH; }
+    len = (size_t)(d1_length);
     if (n - o < len) { return HIWONDER_RRC_E_LENGTH; }
     if (len > sizeof(m->text)) { return HIWONDER_RRC_E_CAPACITY; }
     hiwonder_rrc__copy(m->text, c + o, len);
@@ -2232,9 +2164,10 @@ static int hiwonder_rrc__dec_rgb_set_pixels_request(const uint8_t *c, size_t n, 
     d1_count = hiwonder_rrc__get(c + o, 1u, 0u);
     o += 1u;
     /* pixels: One (index, red, green, blue) per LED. */
-    if ((size_t)d1_count > (sizeof(m->pixels) / sizeof(m->pixels[0]))) { return HIWONDER_RRC_E_CAPACITY; }
-    m->pixels_count = (size_t)d1_count;
-    for (i1 = 0u; i1 < (size_t)d1_count; i1++) {
+    if ((uint64_t)(size_t)(d1_count) != (uint64_t)(d1_count)) { return HIWONDER_RRC_E_LENGTH; }
+    if ((size_t)(d1_count) > (sizeof(m->pixels) / sizeof(m->pixels[0]))) { return HIWONDER_RRC_E_CAPACITY; }
+    m->pixels_count = (size_t)(d1_count);
+    for (i1 = 0u; i1 < (size_t)(d1_count); i1++) {
         /* index: LED index from 0 (the SDK takes 1.. and sends it less one). */
         if (n - o < 1u) { return HIWONDER_RRC_E_LENGTH; }
         m->pixels[i1].index = (uint8_t)hiwonder_rrc__get(c + o, 1u, 0u);
@@ -4288,12 +4221,12 @@ int hiwonder_rrc_encode(const hiwonder_rrc_msg_t *msg, uint8_t *buf, size_t cap,
 #endif
 
 #if HIWONDER_RRC_ENABLE_PARSER
-/* ---- the stream parser (serialspec.runtime.stream / framing.FrameStreamParser, fed one byte at a time) ---- */
+/* ---- the stream parser (serialspec.runtime.stream.StreamParser fed one byte at a time), for frames of the
+ * length-byte shape: per byte held, whether a candidate starts there and what is known of it ---- */
 
-#define HIWONDER_RRC__ACCEPT 0
-#define HIWONDER_RRC__V_WAIT 3
-#define HIWONDER_RRC__V_NONE 1
-#define HIWONDER_RRC__V_CORRUPT 2
+#define HIWONDER_RRC__C_NEW 1u     /* a header ends here: a candidate, its size not known yet */
+#define HIWONDER_RRC__C_SIZED 2u   /* a plausible candidate, waiting for its last byte */
+#define HIWONDER_RRC__C_CORRUPT 3u /* complete and corrupt, behind a candidate that waits: counted once the scan reaches it */
 
 void hiwonder_rrc_parser_init(hiwonder_rrc_parser_t *parser, hiwonder_rrc_direction_t dir)
 {
@@ -4301,226 +4234,199 @@ void hiwonder_rrc_parser_init(hiwonder_rrc_parser_t *parser, hiwonder_rrc_direct
     parser->dir = dir;
 }
 
-/* The candidate at pos: accepted (its size in *size, its message in out), waiting (in *size the bytes it needs
- * before it can be judged again, 0 when that is not known), no frame, or corrupt. */
-static int hiwonder_rrc__try(hiwonder_rrc_parser_t *p, size_t pos, hiwonder_rrc_msg_t *out, size_t *size)
+/* The request frame's size from its first 4 bytes (the Python parser's candidate: the
+ * content size bounds of its command, its length byte, the ranges of its values); 0: no frame there. */
+static size_t hiwonder_rrc__size_request(const uint8_t *f)
 {
-    uint8_t count = hiwonder_rrc__count(p->dir), k;
-    size_t need = (size_t)-1; /* the fewest bytes a waiting layout needs: (size_t)-1 none waits, 0 not known */
-    if (p->verdict[pos] != 0u) {
-        return p->verdict[pos];
+    size_t low = 0u, high = 0u;
+    int bounded = 0;
+    long content;
+    if (!hiwonder_rrc__bounds(HIWONDER_RRC_REQUEST, (long)((uint32_t)f[2u]), &low, &high, &bounded)) { return 0u; }
+    content = (long)f[3u] - 0L; /* length */
+    if (content < (long)low || (bounded && content > (long)high)) {
+        return 0u;
     }
-    for (k = 0u; k < count; k++) {
-        long s = hiwonder_rrc__probe_at(p->dir, k, p->buf + pos, p->n - pos);
-        if (s == HIWONDER_RRC__WAIT) {
-            need = 0u;
-            continue;
-        }
-        if (s < 0 || (unsigned long)s > HIWONDER_RRC_MAX_FRAME) {
-            continue;
-        }
-        if ((size_t)s > p->n - pos) {
-            if ((size_t)s < need) {
-                need = (size_t)s;
-            }
-            continue;
-        }
-        if (hiwonder_rrc_decode(p->buf + pos, (size_t)s, p->dir, out) != HIWONDER_RRC_OK) {
-            if (need == (size_t)-1) {
-                p->verdict[pos] = HIWONDER_RRC__V_CORRUPT;
-            }
-            return HIWONDER_RRC__V_CORRUPT;
-        }
-        *size = (size_t)s;
-        return HIWONDER_RRC__ACCEPT;
-    }
-    if (need != (size_t)-1) {
-        *size = need;
-        return HIWONDER_RRC__V_WAIT;
-    }
-    p->verdict[pos] = HIWONDER_RRC__V_NONE;
-    return HIWONDER_RRC__V_NONE;
+    return (size_t)content + 5u > HIWONDER_RRC_MAX_FRAME ? 0u : (size_t)content + 5u;
 }
 
-/* The next candidate start at or after start (a header of any layout; every byte when some layout has none). */
-static size_t hiwonder_rrc__next(hiwonder_rrc_parser_t *p, size_t start)
+/* The response frame's size from its first 4 bytes (the Python parser's candidate: the
+ * content size bounds of its command, its length byte, the ranges of its values); 0: no frame there. */
+static size_t hiwonder_rrc__size_response(const uint8_t *f)
 {
-#if HIWONDER_RRC__HEADERS
-    uint8_t count = hiwonder_rrc__count(p->dir), k;
-    size_t pos;
-    for (pos = start; pos < p->n; pos++) {
-        int whole = 1; /* every header could be read here: a position none matches is never a candidate */
-        if (p->verdict[pos] == HIWONDER_RRC__V_NONE) {
-            continue;
-        }
-        for (k = 0u; k < count; k++) {
-            size_t hl;
-            const uint8_t *h = hiwonder_rrc__header(p->dir, k, &hl);
-            if (hl > p->n - pos) {
-                whole = 0;
-            } else if (hiwonder_rrc__same(p->buf + pos, h, hl)) {
-                return pos;
-            }
-        }
-        if (whole) {
-            p->verdict[pos] = HIWONDER_RRC__V_NONE;
-        }
+    size_t low = 0u, high = 0u;
+    int bounded = 0;
+    long content;
+    if (!hiwonder_rrc__bounds(HIWONDER_RRC_RESPONSE, (long)((uint32_t)f[2u]), &low, &high, &bounded)) { return 0u; }
+    content = (long)f[3u] - 0L; /* length */
+    if (content < (long)low || (bounded && content > (long)high)) {
+        return 0u;
     }
-    return p->n;
-#else
-    (void)p;
-    return start;
-#endif
+    return (size_t)content + 5u > HIWONDER_RRC_MAX_FRAME ? 0u : (size_t)content + 5u;
 }
 
-
-/* The fewest bytes any layout of the direction needs before the classic parser judges a candidate. */
-static size_t hiwonder_rrc__least(hiwonder_rrc_direction_t dir)
+static size_t hiwonder_rrc__size(hiwonder_rrc_direction_t dir, const uint8_t *f)
 {
     switch (dir) {
     case HIWONDER_RRC_REQUEST:
-        return 4u;
+        return hiwonder_rrc__size_request(f);
     case HIWONDER_RRC_RESPONSE:
-        return 4u;
+        return hiwonder_rrc__size_response(f);
     default:
         return 0u;
     }
 }
 
-/* The first cut bytes held dropped, with their verdicts: a loop, kept one (GCC would make it two calls of the
- * library's memmove, which a parser-only build has no other use for). */
+/* The Python parser's scan over the bytes held (stream.py _scan, _decide, _earliest), at a byte that can change its
+ * outcome: candidates in order; the first that waits holds the bytes from it on; one whose last byte this is gets
+ * taken when it decodes (the first such, whether or not one before it waits), else it is corrupt, counted when no
+ * candidate before it waits. Past the first waiting candidate it looks only when one ends with this byte. */
+static int hiwonder_rrc__scan(hiwonder_rrc_parser_t *p, hiwonder_rrc_msg_t *out)
+{
+    const size_t first = p->first, end = first + p->n;
+    size_t pos, size, hold = (size_t)-1, wake = 0u, cut;
+    uint32_t errors = 0u;
+    uint8_t *const v = p->verdict;
+    const int all = end == p->wake;
+    for (pos = first; pos < end; pos++) {
+        if (v[pos] == 0u) {
+            continue;
+        }
+        if (v[pos] == HIWONDER_RRC__C_CORRUPT) {
+            if (hold == (size_t)-1) {
+                errors++;
+                v[pos] = 0u;
+            }
+            continue;
+        }
+        if (v[pos] == HIWONDER_RRC__C_SIZED) {
+            size = hiwonder_rrc__size(p->dir, p->buf + pos);
+            if (pos + size <= end) {
+                if (hiwonder_rrc_decode(p->buf + pos, size, p->dir, out) == HIWONDER_RRC_OK) {
+                    p->errors += errors;
+                    p->garbage += (uint32_t)(pos - first);
+                    p->frames++;
+                    p->n = 0u;
+                    p->first = 0u;
+                    p->wake = 0u;
+                    return 1;
+                }
+                if (hold == (size_t)-1) {
+                    errors++;
+                    v[pos] = 0u;
+                } else {
+                    v[pos] = HIWONDER_RRC__C_CORRUPT;
+                }
+                continue;
+            }
+            if (wake == 0u || pos + size < wake) {
+                wake = pos + size;
+            }
+        }
+        if (hold == (size_t)-1) {
+            hold = pos;
+            if (!all) {
+                break;
+            }
+        }
+    }
+    if (all || hold == (size_t)-1) {
+        p->wake = wake;
+    }
+    if (hold != (size_t)-1) {
+        cut = hold;
+    } else { /* keep a tail that could begin a header */
+        cut = end - first > 1u ? end - 1u : first;
+    }
+    p->errors += errors;
+    p->garbage += (uint32_t)(cut - first);
+    p->n = end - cut;
+    p->first = end > cut ? cut : 0u;
+    return 0;
+}
+
+/* The bytes held moved to the front of the buffer, once its end is reached (a loop: no library memmove). */
 #if defined(__GNUC__) && !defined(__clang__)
 __attribute__((optimize("no-tree-loop-distribute-patterns")))
 #endif
-static void hiwonder_rrc__drop(hiwonder_rrc_parser_t *p, size_t cut)
+static void hiwonder_rrc__front(hiwonder_rrc_parser_t *p)
 {
     size_t i;
-    for (i = cut; i < p->n; i++) {
-        p->buf[i - cut] = p->buf[i];
-        p->verdict[i - cut] = p->verdict[i];
+    if (p->first == 0u) { /* never so (a candidate is judged by its last byte, and none is longer than the buffer) */
+        p->first = 1u;
+        p->n--;
+        p->garbage++;
     }
-    p->n -= cut;
+    for (i = 0u; i < p->n; i++) {
+        p->buf[i] = p->buf[p->first + i];
+        p->verdict[i] = p->verdict[p->first + i];
+    }
+    p->wake = p->wake > p->first ? p->wake - p->first : 0u;
+    p->first = 0u;
 }
 
-#if HIWONDER_RRC__HEADERS
-/* 1 when the bytes held end with a header of any layout (a candidate begins). */
-static int hiwonder_rrc__ends_header(const hiwonder_rrc_parser_t *p)
+/* One byte in: a header that ends with it starts a candidate, the candidate whose prefix it completes is sized; the
+ * scan runs only when a sized candidate ends with it (p->wake) or no candidate is held at the front. */
+static int hiwonder_rrc__push(hiwonder_rrc_parser_t *p, uint8_t byte, hiwonder_rrc_msg_t *out)
 {
-    uint8_t count = hiwonder_rrc__count(p->dir), k;
-    for (k = 0u; k < count; k++) {
-        size_t hl;
-        const uint8_t *h = hiwonder_rrc__header(p->dir, k, &hl);
-        if (hl <= p->n && hiwonder_rrc__same(p->buf + p->n - hl, h, hl)) {
-            return 1;
+    const size_t need = 4u;
+    size_t at, size, end, first = p->first, n = p->n, wake = p->wake;
+    uint8_t *const b = p->buf, *const v = p->verdict;
+    if (first + n == HIWONDER_RRC_MAX_FRAME) {
+        hiwonder_rrc__front(p);
+        first = 0u;
+        n = p->n;
+        wake = p->wake;
+    }
+    end = first + n;
+    b[end] = byte;
+    v[end] = 0u;
+    end++;
+    n++;
+    p->n = n; /* the fields in locals: a store through b or v may change any byte of *p, as far as C knows */
+    if (n >= 2u && byte == 0x55u && b[end - 2u] == 0xaau) { /* a header ends with this byte */
+        v[end - 2u] = HIWONDER_RRC__C_NEW;
+    }
+    if (n >= need && v[end - need] == HIWONDER_RRC__C_NEW) {
+        at = end - need;
+        size = hiwonder_rrc__size(p->dir, b + at);
+        if (size == 0u) {
+            v[at] = 0u;
+        } else {
+            v[at] = HIWONDER_RRC__C_SIZED;
+            if (wake == 0u || at + size < wake) {
+                p->wake = wake = at + size;
+            }
         }
+    }
+    if (end == wake) {
+        return hiwonder_rrc__scan(p, out);
+    }
+    if (v[first] == 0u && n >= 2u) { /* no candidate at the front (any more) */
+        if (n > 1u && v[first + 1u] != 0u && v[first + 1u] != HIWONDER_RRC__C_CORRUPT) {
+            p->first = first + 1u; /* the scan's outcome when a live candidate follows: it holds the bytes from there */
+            p->n = n - 1u;
+            p->garbage++;
+            return 0;
+        }
+        return hiwonder_rrc__scan(p, out);
     }
     return 0;
 }
-#endif
 
-/* One byte in: the Python parser's scan over the bytes held, each candidate's verdict kept once final. While a
- * candidate waits, the scan is left out until one held can be judged (p->wake bytes held) or a header comes: nothing
- * the scan decides could change before then. */
-static int hiwonder_rrc__push(hiwonder_rrc_parser_t *p, uint8_t byte, hiwonder_rrc_msg_t *out)
-{
-    size_t start = 0u, done = 0u, pos, size = 0u, cut, hold = (size_t)-1, wake = (size_t)-1;
-    int got = 0, r;
-    if (p->n >= HIWONDER_RRC_MAX_FRAME) { /* only a candidate longer than HIWONDER_RRC_MAX_FRAME can fill it: drop its first byte */
-        hiwonder_rrc__drop(p, 1u);
-        p->garbage++;
-        p->wake = 0u;
-    }
-    p->buf[p->n] = byte;
-    p->verdict[p->n] = 0u;
-    p->n++;
-#if HIWONDER_RRC__HEADERS
-    if (p->n < p->wake && !hiwonder_rrc__ends_header(p)) {
-        return 0;
-    }
-#endif
-    while (start < p->n) {
-        pos = hiwonder_rrc__next(p, start);
-        if (pos >= p->n) {
-            break;
-        }
-        if (p->n - pos < hiwonder_rrc__least(p->dir)) { /* waiting, too short for any layout, and so is every later one */
-            if (hold == (size_t)-1) {
-                hold = pos;
-            }
-            if (pos + hiwonder_rrc__least(p->dir) < wake) {
-                wake = pos + hiwonder_rrc__least(p->dir);
-            }
-            break;
-        }
-        r = hiwonder_rrc__try(p, pos, out, &size);
-        if (r == HIWONDER_RRC__V_WAIT) {
-            if (hold == (size_t)-1) {
-                hold = pos;
-            }
-            if (size == 0u) {
-                wake = 0u;
-            } else if (pos + size < wake) {
-                wake = pos + size;
-            }
-        } else if (r == HIWONDER_RRC__V_CORRUPT) {
-            if (hold == (size_t)-1) {
-                p->errors++;
-            }
-            if (p->verdict[pos] == 0u) { /* corrupt as one layout, while another waits: judged again */
-                wake = 0u;
-            }
-        } else if (r == HIWONDER_RRC__ACCEPT) {
-            p->garbage += (uint32_t)(pos - done);
-            hold = (size_t)-1;
-            start = done = pos + size;
-            got = 1;
-            p->frames++;
-            break;
-        }
-        start = pos + 1u;
-    }
-    p->wake = 0u;
-    if (hold != (size_t)-1) {
-        cut = hold;
-        if (wake != 0u) {
-            p->wake = wake - cut;
-        }
-    } else if (HIWONDER_RRC__HEADERS && !got) {
-        cut = p->n > HIWONDER_RRC__KEEP ? p->n - HIWONDER_RRC__KEEP : 0u;
-        if (cut < done) {
-            cut = done;
-        }
-    } else {
-        cut = got ? done : p->n;
-    }
-    p->garbage += (uint32_t)(cut - done);
-    if (cut > 0u) {
-        hiwonder_rrc__drop(p, cut);
-    }
-    return got;
-}
-
-#if HIWONDER_RRC__HEADERS
-/* A whole frame at data[0..len) while no byte is held: taken at once, its bytes not pushed one by one, when that gives
- * what pushing them would (one layout; a plausible frame that fits and decodes; no header inside it, so no other
- * candidate could end first). Else 0: the bytes go through hiwonder_rrc__push. */
+/* A whole frame at data[0..len) while no byte is held: taken at once when that gives what pushing its bytes would
+ * (a plausible frame that fits and decodes, no header inside it, so no other candidate could end first). Else 0. */
 static size_t hiwonder_rrc__whole(hiwonder_rrc_parser_t *p, const uint8_t *data, size_t len, hiwonder_rrc_msg_t *out)
 {
-    size_t i, size, hl;
-    const uint8_t *h;
-    long s;
-    if (!HIWONDER_RRC__SINGLE && hiwonder_rrc__count(p->dir) != 1u) {
+    const size_t hl = 2u;
+    const uint8_t *h = hiwonder_rrc__h_request_0;
+    size_t i, size;
+    if (len < 4u || !hiwonder_rrc__same(data, h, hl)) {
         return 0u;
     }
-    h = hiwonder_rrc__header(p->dir, 0u, &hl);
-    if (h == NULL || len < hl || !hiwonder_rrc__same(data, h, hl)) {
+    size = hiwonder_rrc__size(p->dir, data);
+    if (size == 0u || size > len) {
         return 0u;
     }
-    s = hiwonder_rrc__probe_at(p->dir, 0u, data, len);
-    if (s <= 0 || (unsigned long)s > HIWONDER_RRC_MAX_FRAME || (size_t)s > len) {
-        return 0u;
-    }
-    size = (size_t)s;
     for (i = 1u; i + hl <= size; i++) {
         if (data[i] == h[0] && hiwonder_rrc__same(data + i, h, hl)) {
             return 0u;
@@ -4532,14 +4438,12 @@ static size_t hiwonder_rrc__whole(hiwonder_rrc_parser_t *p, const uint8_t *data,
     p->frames++;
     return size;
 }
-#endif
 
 size_t hiwonder_rrc_parser_feed(hiwonder_rrc_parser_t *parser, const uint8_t *data, size_t len, hiwonder_rrc_msg_t *out, bool *got)
 {
     size_t i;
     *got = false;
     for (i = 0u; i < len; i++) {
-#if HIWONDER_RRC__HEADERS
         if (parser->n == 0u) {
             size_t size = hiwonder_rrc__whole(parser, data + i, len - i, out);
             if (size > 0u) {
@@ -4547,7 +4451,6 @@ size_t hiwonder_rrc_parser_feed(hiwonder_rrc_parser_t *parser, const uint8_t *da
                 return i + size;
             }
         }
-#endif
         if (hiwonder_rrc__push(parser, data[i], out)) {
             *got = true;
             return i + 1u;

@@ -571,9 +571,10 @@ typedef struct {
     uint32_t frames;                  /* messages delivered */
     uint32_t garbage;                 /* bytes skipped that belonged to no message */
     uint32_t errors;                  /* corrupt candidates (a bad checksum, content that does not decode) */
-    size_t wake;                      /* while a candidate waits: bytes held before any can be judged (0: now) */
+    size_t first;                     /* where the n bytes held begin in buf */
+    size_t wake;                      /* where the nearest sized candidate ends in buf (0: none) */
     uint8_t buf[HIWONDER_RRC_MAX_FRAME];        /* bytes held: the candidate frames still waiting for bytes */
-    uint8_t verdict[HIWONDER_RRC_MAX_FRAME];    /* per byte held: 0 undecided, 1 no frame starts here, 2 a corrupt one */
+    uint8_t verdict[HIWONDER_RRC_MAX_FRAME];    /* per byte held: 0 no candidate, 1 one not sized yet, 2 sized, 3 corrupt */
 } hiwonder_rrc_parser_t;
 
 /* Decode one complete frame (decode does not read past len; on success every count fits its array). */

@@ -1054,7 +1054,8 @@ static int modbus_rtu__dec_read_coils_response(const uint8_t *c, size_t n, modbu
     d1_byte_count = modbus_rtu__get(c + o, 1u, 1u);
     o += 1u;
     /* coils: Coil states, 8 per byte, the first coil in the lowest bit of the first byte; the last byte */
-    len = (size_t)d1_byte_count;
+    if ((uint64_t)(size_t)(d1_byte_count) != (uint64_t)(d1_byte_count)) { return MODBUS_RTU_E_LENGTH; }
+    len = (size_t)(d1_byte_count);
     if (n - o < len) { return MODBUS_RTU_E_LENGTH; }
     m->coils_count = len * 8u;
     if (len > sizeof(m->coils)) { return MODBUS_RTU_E_CAPACITY; }
@@ -1098,7 +1099,8 @@ static int modbus_rtu__dec_read_discrete_inputs_response(const uint8_t *c, size_
     d1_byte_count = modbus_rtu__get(c + o, 1u, 1u);
     o += 1u;
     /* inputs: Input states, 8 per byte, lowest bit first; padded with zeros to a multiple of 8. */
-    len = (size_t)d1_byte_count;
+    if ((uint64_t)(size_t)(d1_byte_count) != (uint64_t)(d1_byte_count)) { return MODBUS_RTU_E_LENGTH; }
+    len = (size_t)(d1_byte_count);
     if (n - o < len) { return MODBUS_RTU_E_LENGTH; }
     m->inputs_count = len * 8u;
     if (len > sizeof(m->inputs)) { return MODBUS_RTU_E_CAPACITY; }
@@ -1143,7 +1145,8 @@ static int modbus_rtu__dec_read_holding_registers_response(const uint8_t *c, siz
     d1_byte_count = modbus_rtu__get(c + o, 1u, 1u);
     o += 1u;
     /* registers: The register values. */
-    len = (size_t)d1_byte_count;
+    if ((uint64_t)(size_t)(d1_byte_count) != (uint64_t)(d1_byte_count)) { return MODBUS_RTU_E_LENGTH; }
+    len = (size_t)(d1_byte_count);
     if (len % 2u != 0u) { return MODBUS_RTU_E_LENGTH; }
     if (n - o < len) { return MODBUS_RTU_E_LENGTH; }
     m->registers_count = len / 2u;
@@ -1191,7 +1194,8 @@ static int modbus_rtu__dec_read_input_registers_response(const uint8_t *c, size_
     d1_byte_count = modbus_rtu__get(c + o, 1u, 1u);
     o += 1u;
     /* registers: The input register values. */
-    len = (size_t)d1_byte_count;
+    if ((uint64_t)(size_t)(d1_byte_count) != (uint64_t)(d1_byte_count)) { return MODBUS_RTU_E_LENGTH; }
+    len = (size_t)(d1_byte_count);
     if (len % 2u != 0u) { return MODBUS_RTU_E_LENGTH; }
     if (n - o < len) { return MODBUS_RTU_E_LENGTH; }
     m->registers_count = len / 2u;
@@ -1304,7 +1308,8 @@ static int modbus_rtu__dec_write_coils_request(const uint8_t *c, size_t n, modbu
     d1_byte_count = modbus_rtu__get(c + o, 1u, 1u);
     o += 1u;
     /* values: The coil values, 8 per byte, lowest bit first; the last byte padded with zeros. */
-    m->values_count = (size_t)d1_count;
+    if ((uint64_t)(size_t)(d1_count) != (uint64_t)(d1_count)) { return MODBUS_RTU_E_LENGTH; }
+    m->values_count = (size_t)(d1_count);
     len = (m->values_count + 7u) / 8u;
     if (n - o < len) { return MODBUS_RTU_E_LENGTH; }
     if (len > sizeof(m->values)) { return MODBUS_RTU_E_CAPACITY; }
@@ -1359,7 +1364,8 @@ static int modbus_rtu__dec_write_registers_request(const uint8_t *c, size_t n, m
     d1_byte_count = modbus_rtu__get(c + o, 1u, 1u);
     o += 1u;
     /* values: The register values. */
-    m->values_count = (size_t)d1_count;
+    if ((uint64_t)(size_t)(d1_count) != (uint64_t)(d1_count)) { return MODBUS_RTU_E_LENGTH; }
+    m->values_count = (size_t)(d1_count);
     len = m->values_count * 2u;
     if (n - o < len) { return MODBUS_RTU_E_LENGTH; }
     if (m->values_count > (sizeof(m->values) / sizeof(m->values[0]))) { return MODBUS_RTU_E_CAPACITY; }
@@ -1470,7 +1476,8 @@ static int modbus_rtu__dec_read_write_registers_request(const uint8_t *c, size_t
     d1_byte_count = modbus_rtu__get(c + o, 1u, 1u);
     o += 1u;
     /* values: The values to write. */
-    m->values_count = (size_t)d1_write_count;
+    if ((uint64_t)(size_t)(d1_write_count) != (uint64_t)(d1_write_count)) { return MODBUS_RTU_E_LENGTH; }
+    m->values_count = (size_t)(d1_write_count);
     len = m->values_count * 2u;
     if (n - o < len) { return MODBUS_RTU_E_LENGTH; }
     if (m->values_count > (sizeof(m->values) / sizeof(m->values[0]))) { return MODBUS_RTU_E_CAPACITY; }
@@ -1499,7 +1506,8 @@ static int modbus_rtu__dec_read_write_registers_response(const uint8_t *c, size_
     d1_byte_count = modbus_rtu__get(c + o, 1u, 1u);
     o += 1u;
     /* registers: The registers read. */
-    len = (size_t)d1_byte_count;
+    if ((uint64_t)(size_t)(d1_byte_count) != (uint64_t)(d1_byte_count)) { return MODBUS_RTU_E_LENGTH; }
+    len = (size_t)(d1_byte_count);
     if (len % 2u != 0u) { return MODBUS_RTU_E_LENGTH; }
     if (n - o < len) { return MODBUS_RTU_E_LENGTH; }
     m->registers_count = len / 2u;

@@ -428,6 +428,13 @@ class Scope:
         raise Unsupported(f"a size or count from field {name}, which the C target cannot reach")
 
 
+def as_size(ctx: Ctx, pad: str, value: str, out: list[str]) -> str:
+    """A size or count read from a field, as size_t: a value size_t cannot hold (a 64-bit one on a 32-bit target) is
+    refused first, never cut to its low bits."""
+    out.append(f"{pad}if ((uint64_t)(size_t)({value}) != (uint64_t)({value})) {{ return {ctx.P}_E_LENGTH; }}")
+    return f"(size_t)({value})"
+
+
 def get_raw(ctx: Ctx, t: ScalarType, endian: str, at: str) -> str:
     """A scalar's wire bits: uint32_t, or uint64_t for 8-byte types (built with shifts, whatever the host)."""
     if wide(t):
@@ -508,7 +515,7 @@ def decode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                 elif f.size == "rest":
                     out.append(f"{pad}len = n - o;")
                 elif f.size is not None:
-                    out.append(f"{pad}len = (size_t){scope.lookup(f.size)};")
+                    out.append(f"{pad}len = {as_size(ctx, pad, scope.lookup(f.size), out)};")
                 if not terminated:
                     out.append(f"{pad}if (n - o < len) {{ return {ctx.P}_E_LENGTH; }}")
                 if isinstance(f, Text) and f.pad is not None:  # the text without the pad bytes after it
@@ -547,7 +554,7 @@ def decode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                 decode_fields(ctx, f.fields, item_scope, body, depth + 1)
                 capacity = f"(sizeof({tgt}) / sizeof({tgt}[0]))"
                 if isinstance(f.count, int) or f.count != "rest":
-                    count = f"{f.count}u" if isinstance(f.count, int) else f"(size_t){scope.lookup(f.count)}"
+                    count = f"{f.count}u" if isinstance(f.count, int) else as_size(ctx, pad, scope.lookup(f.count), out)
                     if not isinstance(f.count, int):
                         out.append(f"{pad}if ({count} > {capacity}) {{ return {ctx.P}_E_CAPACITY; }}")
                         out.append(f"{pad}{tgt}_count = {count};")
@@ -594,7 +601,7 @@ def decode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
             case List():
                 item = f.item.size if f.item is not None else 0
                 if f.size:  # sized in bytes by a field
-                    out.append(f"{pad}len = (size_t){scope.lookup(f.size)};")
+                    out.append(f"{pad}len = {as_size(ctx, pad, scope.lookup(f.size), out)};")
                     if item > 1:
                         out.append(f"{pad}if (len % {item}u != 0u) {{ return {ctx.P}_E_LENGTH; }}")
                     count = "len * 8u" if not item else "len" if item == 1 else f"len / {item}u"
@@ -604,7 +611,9 @@ def decode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                         out.append(f"{pad}if (len % {item}u != 0u) {{ return {ctx.P}_E_LENGTH; }}")
                     count = "len * 8u" if not item else "len" if item == 1 else f"len / {item}u"
                 else:
-                    number = f"{f.count}u" if isinstance(f.count, int) else f"(size_t){scope.lookup(f.count)}"
+                    number = (
+                        f"{f.count}u" if isinstance(f.count, int) else as_size(ctx, pad, scope.lookup(f.count), out)
+                    )
                     out.append(f"{pad}{tgt}_count = {number};")
                     out.append(
                         f"{pad}len = ({tgt}_count + 7u) / 8u;" if not item else f"{pad}len = {tgt}_count * {item}u;"

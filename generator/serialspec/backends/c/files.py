@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from serialspec import __version__
-from serialspec.backends.c import packed
+from serialspec.backends.c import length_byte, packed
 from serialspec.backends.c.emit import (
     DEFAULT_MAX_FRAME,
     Ctx,
@@ -51,6 +51,23 @@ def directions(protocol: Protocol) -> list[Direction]:
 
 def header(ctx: Ctx) -> str:
     protocol, p, P = ctx.protocol, ctx.p, ctx.P
+    wake = (
+        "    size_t wake;                      /* while a candidate waits: bytes held before any can be judged "
+        "(0: now) */"
+    )
+    verdict = (
+        f"    uint8_t verdict[{P}_MAX_FRAME];    /* per byte held: 0 undecided, 1 no frame starts here, 2 a corrupt "
+        "one */"
+    )
+    if length_byte.applies(protocol):
+        verdict = (
+            f"    uint8_t verdict[{P}_MAX_FRAME];    /* per byte held: 0 no candidate, 1 one not sized yet, 2 sized, "
+            "3 corrupt */"
+        )
+        wake = (
+            "    size_t first;                     /* where the n bytes held begin in buf */\n"
+            "    size_t wake;                      /* where the nearest sized candidate ends in buf (0: none) */"
+        )
     msgs = messages(protocol)
     spec_max = max((frame_max(protocol, d) or 1 << 30) for d in directions(protocol))
     default_frame = min(spec_max, DEFAULT_MAX_FRAME)
@@ -168,9 +185,9 @@ typedef struct {{
     uint32_t frames;                  /* messages delivered */
     uint32_t garbage;                 /* bytes skipped that belonged to no message */
     uint32_t errors;                  /* corrupt candidates (a bad checksum, content that does not decode) */
-    size_t wake;                      /* while a candidate waits: bytes held before any can be judged (0: now) */
+{wake}
     uint8_t buf[{P}_MAX_FRAME];        /* bytes held: the candidate frames still waiting for bytes */
-    uint8_t verdict[{P}_MAX_FRAME];    /* per byte held: 0 undecided, 1 no frame starts here, 2 a corrupt one */
+{verdict}
 }} {p}_parser_t;
 
 /* Decode one complete frame (decode does not read past len; on success every count fits its array). */
@@ -776,7 +793,7 @@ static size_t {p}__least({p}_direction_t dir)
     every = [layout for d in directions(protocol) for layout in protocol.framing.alternatives[d]]
     all_lengths = int(all(layout.length is not None for layout in every))
     single = int(all(n == 1 for n in n_layouts.values()))
-    return f"""{banner(protocol)}
+    text = f"""{banner(protocol)}
 #include "{p}.h"
 
 #include <string.h>
@@ -1343,6 +1360,8 @@ const char *{p}_result_name(int result)
     return names[result];
 }}
 """
+    # frames of the length-byte shape: a straight-line parser that keeps per byte held what the scan needs again
+    return length_byte.replace_parser(ctx, text) if length_byte.applies(protocol) else text
 
 
 ERROR_CODE = -2  # the key of the error reply (any code with the error flag), as runtime.framing.ERROR_REPLY

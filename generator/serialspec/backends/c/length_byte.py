@@ -1,0 +1,372 @@
+"""The C stream parser for frames of the length-byte shape (lang's FrameLayout.classic: a header, frame values and a
+command code at fixed offsets, a one-byte length before the content, one final checksum, nothing stuffed), straight
+line instead of the general scan in files.py.
+
+It gives what serialspec.runtime.stream.StreamParser gives fed one byte at a time (its _scan, _decide and _earliest),
+keeping per byte held what that scan needs again: whether a candidate starts there (a header ended with its bytes),
+whether its size is known (its first `prefix` bytes came: the command's content bounds, the length byte and the
+ranges of its narrowed values gave a plausible size, or it is no frame), or whether it is a corrupt frame behind one
+that waits. Only three things change what that scan decides at a byte: a header ends with it, a candidate's prefix
+is complete with it, a sized candidate's last byte is it (the parser keeps the nearest such end: `wake`). The scan over
+the held bytes runs only then, and stops at the first candidate that waits unless one ends with this byte; the bytes
+held (n of them) start at `first` in the buffer and move to its front only when its end is reached (no shift per
+byte).
+Every other framing takes the general parser.
+"""
+
+from __future__ import annotations
+
+from serialspec.backends.c.emit import Ctx
+from serialspec.lang.model import VALUE_ROLES, Direction, FrameElement, FrameLayout, Protocol
+
+DIRECTIONS = (Direction.REQUEST, Direction.RESPONSE)
+
+
+def applies(protocol: Protocol) -> bool:
+    """Every direction has one layout of the length-byte shape, with a header and its command code (if any) before
+    its content: the parser below is exact for it."""
+    framing = protocol.framing
+    if not framing.classic or not framing.alternatives:
+        return False
+    for layouts in framing.alternatives.values():
+        if len(layouts) != 1 or not layouts[0].header:
+            return False
+        layout = layouts[0]
+        roles = [e.role for e in layout.elements]
+        if "command" in roles and roles.index("command") > roles.index("content"):
+            return False
+        if prefix(layout) >= layout.overhead:  # sized before its last byte (always so: the checksum follows)
+            return False
+        odd = [e.type for e in layout.value_elements if e.type is not None and _narrowed(e)]
+        if any(t.signed or t.is_float or t.size > 4 for t in odd):
+            return False  # ranges the size function does not test (compared as unsigned bytes)
+    return True
+
+
+def _narrowed(e: FrameElement) -> bool:
+    """A frame value whose declared range is narrower than its type's: a candidate outside it is no frame."""
+    return e.type is not None and (e.minimum, e.maximum) != (e.type.minimum, e.type.maximum)
+
+
+def prefix(layout: FrameLayout) -> int:
+    """Bytes the Python parser waits for before it sizes a candidate (stream.py _Candidate.prefix): up to the length
+    byte, the command code and every value whose range is narrower than its type's."""
+    last = max(layout.length_offset, layout.command_offset or 0)
+    offset = 0
+    for e in layout.elements:
+        if e.role == "content":
+            break
+        if e.role in VALUE_ROLES and _narrowed(e):
+            last = max(last, offset + (e.size or 1) - 1)
+        offset += e.size or 0
+    return last + 1
+
+
+def _by_direction(protocol: Protocol, P: str, values: dict[Direction, str]) -> str:
+    """A C expression of p->dir: the one value when every direction has it."""
+    known = [d for d in DIRECTIONS if d in values]
+    if len(set(values.values())) == 1:
+        return values[known[0]]
+    text = values[known[-1]]
+    for d in reversed(known[:-1]):
+        text = f"(p->dir == {P}_{d.name} ? {values[d]} : {text})"
+    return text
+
+
+def _value(offset: int, size: int, big: bool) -> str:
+    order = range(size) if big else reversed(range(size))
+    parts = []
+    for shift, i in enumerate(reversed(list(order))):
+        parts.append(f"((uint32_t)f[{offset + i}u] << {8 * shift}u)" if shift else f"(uint32_t)f[{offset + i}u]")
+    return " | ".join(parts) if size > 1 else parts[0]
+
+
+def size_function(ctx: Ctx, direction: Direction, layout: FrameLayout) -> str:
+    """The size of a plausible frame of this layout from its first prefix bytes, 0 when none starts there (stream.py
+    _Candidate.frame_sizes and plausible)."""
+    p, P = ctx.p, ctx.P
+    need = prefix(layout)
+    lines = [
+        f"/* The {direction.value} frame's size from its first {need} bytes (the Python parser's candidate: the",
+        " * content size bounds of its command, its length byte, the ranges of its values); 0: no frame there. */",
+        f"static size_t {p}__size_{direction.value}(const uint8_t *f)",
+        "{",
+        "    size_t low = 0u, high = 0u;",
+        "    int bounded = 0;",
+        "    long content;",
+    ]
+    offset = 0
+    code = f"{P}__NO_CODE"
+    length = layout.length.name if layout.length is not None else ""
+    for e in layout.elements:
+        if e.role == "content":
+            break
+        size = e.size or 0
+        value = _value(offset, size, e.endian == ">")
+        if e.role == "command":
+            code = f"(long)({value})"
+        elif e.role in VALUE_ROLES and _narrowed(e):
+            test = []
+            if int(e.minimum) > 0:
+                test.append(f"v < {int(e.minimum)}u")
+            if int(e.maximum) < (1 << (8 * size)) - 1:
+                test.append(f"v > {int(e.maximum)}u")
+            if test:
+                cond = " || ".join(test)
+                if e.broadcast is not None:
+                    cond = f"({cond}) && v != {e.broadcast}u"
+                lines.append(f"    {{ uint32_t v = {value}; if ({cond}) {{ return 0u; }} }} /* {e.name} */")
+        offset += size
+    lines += [
+        f"    if (!{p}__bounds({P}_{direction.name}, {code}, &low, &high, &bounded)) {{ return 0u; }}",
+        f"    content = (long)f[{layout.length_offset}u] - {layout.length_adds}L; /* {length} */",
+        "    if (content < (long)low || (bounded && content > (long)high)) {",
+        "        return 0u;",
+        "    }",
+        f"    return (size_t)content + {layout.overhead}u > {P}_MAX_FRAME ? 0u : (size_t)content + {layout.overhead}u;",
+        "}",
+        "",
+    ]
+    return "\n".join(lines)
+
+
+def parser(ctx: Ctx) -> str:
+    """The parser's C (init, the candidate sizes, push, the scan, the whole-frame path, feed) for a protocol that
+    `applies`."""
+    protocol, p, P = ctx.protocol, ctx.p, ctx.P
+    layouts = {d: protocol.framing.alternatives[d][0] for d in DIRECTIONS if d in protocol.framing.alternatives}
+    sizes = "\n".join(size_function(ctx, d, layout) for d, layout in layouts.items())
+    size_cases = "\n".join(f"    case {P}_{d.name}:\n        return {p}__size_{d.value}(f);" for d in layouts)
+    hl = _by_direction(protocol, P, {d: f"{len(layout.header)}u" for d, layout in layouts.items()})
+    header = _by_direction(protocol, P, {d: f"{p}__h_{d.value}_0" for d in layouts})
+    if len({layout.header for layout in layouts.values()}) == 1:
+        header = f"{p}__h_{next(iter(layouts)).value}_0"
+    need = _by_direction(protocol, P, {d: f"{prefix(layout)}u" for d, layout in layouts.items()})
+    heads = {layout.header for layout in layouts.values()}
+    if len(heads) == 1:  # one header: its bytes compared in line, the last one first
+        (head,) = heads
+        tests = [f"byte == 0x{head[-1]:02x}u"]
+        tests += [f"b[end - {len(head) - i}u] == 0x{c:02x}u" for i, c in enumerate(head[:-1])]
+        starts = " && ".join([f"n >= {len(head)}u", tests[0], *tests[1:]])
+    else:
+        starts = f"n >= {hl} && {p}__same(b + end - {hl}, {header}, {hl})"
+    keep = max(len(layout.header) for layout in layouts.values()) - 1
+    return f"""#if {P}_ENABLE_PARSER
+/* ---- the stream parser (serialspec.runtime.stream.StreamParser fed one byte at a time), for frames of the
+ * length-byte shape: per byte held, whether a candidate starts there and what is known of it ---- */
+
+#define {P}__C_NEW 1u     /* a header ends here: a candidate, its size not known yet */
+#define {P}__C_SIZED 2u   /* a plausible candidate, waiting for its last byte */
+#define {P}__C_CORRUPT 3u /* complete and corrupt, behind a candidate that waits: counted once the scan reaches it */
+
+void {p}_parser_init({p}_parser_t *parser, {p}_direction_t dir)
+{{
+    memset(parser, 0, sizeof(*parser));
+    parser->dir = dir;
+}}
+
+{sizes}
+static size_t {p}__size({p}_direction_t dir, const uint8_t *f)
+{{
+    switch (dir) {{
+{size_cases}
+    default:
+        return 0u;
+    }}
+}}
+
+/* The Python parser's scan over the bytes held (stream.py _scan, _decide, _earliest), at a byte that can change its
+ * outcome: candidates in order; the first that waits holds the bytes from it on; one whose last byte this is gets
+ * taken when it decodes (the first such, whether or not one before it waits), else it is corrupt, counted when no
+ * candidate before it waits. Past the first waiting candidate it looks only when one ends with this byte. */
+static int {p}__scan({p}_parser_t *p, {p}_msg_t *out)
+{{
+    const size_t first = p->first, end = first + p->n;
+    size_t pos, size, hold = (size_t)-1, wake = 0u, cut;
+    uint32_t errors = 0u;
+    uint8_t *const v = p->verdict;
+    const int all = end == p->wake;
+    for (pos = first; pos < end; pos++) {{
+        if (v[pos] == 0u) {{
+            continue;
+        }}
+        if (v[pos] == {P}__C_CORRUPT) {{
+            if (hold == (size_t)-1) {{
+                errors++;
+                v[pos] = 0u;
+            }}
+            continue;
+        }}
+        if (v[pos] == {P}__C_SIZED) {{
+            size = {p}__size(p->dir, p->buf + pos);
+            if (pos + size <= end) {{
+                if ({p}_decode(p->buf + pos, size, p->dir, out) == {P}_OK) {{
+                    p->errors += errors;
+                    p->garbage += (uint32_t)(pos - first);
+                    p->frames++;
+                    p->n = 0u;
+                    p->first = 0u;
+                    p->wake = 0u;
+                    return 1;
+                }}
+                if (hold == (size_t)-1) {{
+                    errors++;
+                    v[pos] = 0u;
+                }} else {{
+                    v[pos] = {P}__C_CORRUPT;
+                }}
+                continue;
+            }}
+            if (wake == 0u || pos + size < wake) {{
+                wake = pos + size;
+            }}
+        }}
+        if (hold == (size_t)-1) {{
+            hold = pos;
+            if (!all) {{
+                break;
+            }}
+        }}
+    }}
+    if (all || hold == (size_t)-1) {{
+        p->wake = wake;
+    }}
+    if (hold != (size_t)-1) {{
+        cut = hold;
+    }} else {{ /* keep a tail that could begin a header */
+        cut = end - first > {keep}u ? end - {keep}u : first;
+    }}
+    p->errors += errors;
+    p->garbage += (uint32_t)(cut - first);
+    p->n = end - cut;
+    p->first = end > cut ? cut : 0u;
+    return 0;
+}}
+
+/* The bytes held moved to the front of the buffer, once its end is reached (a loop: no library memmove). */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("no-tree-loop-distribute-patterns")))
+#endif
+static void {p}__front({p}_parser_t *p)
+{{
+    size_t i;
+    if (p->first == 0u) {{ /* never so (a candidate is judged by its last byte, and none is longer than the buffer) */
+        p->first = 1u;
+        p->n--;
+        p->garbage++;
+    }}
+    for (i = 0u; i < p->n; i++) {{
+        p->buf[i] = p->buf[p->first + i];
+        p->verdict[i] = p->verdict[p->first + i];
+    }}
+    p->wake = p->wake > p->first ? p->wake - p->first : 0u;
+    p->first = 0u;
+}}
+
+/* One byte in: a header that ends with it starts a candidate, the candidate whose prefix it completes is sized; the
+ * scan runs only when a sized candidate ends with it (p->wake) or no candidate is held at the front. */
+static int {p}__push({p}_parser_t *p, uint8_t byte, {p}_msg_t *out)
+{{
+    const size_t need = {need};
+    size_t at, size, end, first = p->first, n = p->n, wake = p->wake;
+    uint8_t *const b = p->buf, *const v = p->verdict;
+    if (first + n == {P}_MAX_FRAME) {{
+        {p}__front(p);
+        first = 0u;
+        n = p->n;
+        wake = p->wake;
+    }}
+    end = first + n;
+    b[end] = byte;
+    v[end] = 0u;
+    end++;
+    n++;
+    p->n = n; /* the fields in locals: a store through b or v may change any byte of *p, as far as C knows */
+    if ({starts}) {{ /* a header ends with this byte */
+        v[end - {hl}] = {P}__C_NEW;
+    }}
+    if (n >= need && v[end - need] == {P}__C_NEW) {{
+        at = end - need;
+        size = {p}__size(p->dir, b + at);
+        if (size == 0u) {{
+            v[at] = 0u;
+        }} else {{
+            v[at] = {P}__C_SIZED;
+            if (wake == 0u || at + size < wake) {{
+                p->wake = wake = at + size;
+            }}
+        }}
+    }}
+    if (end == wake) {{
+        return {p}__scan(p, out);
+    }}
+    if (v[first] == 0u && n >= {hl}) {{ /* no candidate at the front (any more) */
+        if (n > 1u && v[first + 1u] != 0u && v[first + 1u] != {P}__C_CORRUPT) {{
+            p->first = first + 1u; /* the scan's outcome when a live candidate follows: it holds the bytes from there */
+            p->n = n - 1u;
+            p->garbage++;
+            return 0;
+        }}
+        return {p}__scan(p, out);
+    }}
+    return 0;
+}}
+
+/* A whole frame at data[0..len) while no byte is held: taken at once when that gives what pushing its bytes would
+ * (a plausible frame that fits and decodes, no header inside it, so no other candidate could end first). Else 0. */
+static size_t {p}__whole({p}_parser_t *p, const uint8_t *data, size_t len, {p}_msg_t *out)
+{{
+    const size_t hl = {hl};
+    const uint8_t *h = {header};
+    size_t i, size;
+    if (len < {need} || !{p}__same(data, h, hl)) {{
+        return 0u;
+    }}
+    size = {p}__size(p->dir, data);
+    if (size == 0u || size > len) {{
+        return 0u;
+    }}
+    for (i = 1u; i + hl <= size; i++) {{
+        if (data[i] == h[0] && {p}__same(data + i, h, hl)) {{
+            return 0u;
+        }}
+    }}
+    if ({p}_decode(data, size, p->dir, out) != {P}_OK) {{
+        return 0u;
+    }}
+    p->frames++;
+    return size;
+}}
+
+size_t {p}_parser_feed({p}_parser_t *parser, const uint8_t *data, size_t len, {p}_msg_t *out, bool *got)
+{{
+    size_t i;
+    *got = false;
+    for (i = 0u; i < len; i++) {{
+        if (parser->n == 0u) {{
+            size_t size = {p}__whole(parser, data + i, len - i, out);
+            if (size > 0u) {{
+                *got = true;
+                return i + size;
+            }}
+        }}
+        if ({p}__push(parser, data[i], out)) {{
+            *got = true;
+            return i + 1u;
+        }}
+    }}
+    return len;
+}}
+#endif
+"""
+
+
+def replace_parser(ctx: Ctx, text: str) -> str:
+    """The general parser and the probes only it calls, in the source files.py writes, replaced by the one above."""
+    p = ctx.p
+    start = text.index("/* ---- candidates sized:")
+    stop = text.index("\n}\n", text.index(f"static long {p}__probe_at(")) + 3
+    text = text[:start] + text[stop:]
+    start = text.index(f"#if {ctx.P}_ENABLE_PARSER\n/* ---- the stream parser")
+    stop = text.index("\n}\n#endif\n", text.index(f"size_t {p}_parser_feed(")) + len("\n}\n#endif\n")
+    return text[:start] + parser(ctx) + text[stop:]

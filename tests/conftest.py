@@ -103,14 +103,15 @@ def set_plain_byte(layout: FrameLayout, frame: bytes, offset: int, value: Callab
 
 
 # What `make test-fast` leaves out: whole-program runs that take seconds each (wheels built and installed, the docs
-# site, the vendors' SDKs and peers over pseudo-terminals, the long concurrency runs). `make test` runs them all.
+# site, the vendors' SDKs and peers over pseudo-terminals, the new-user protocols' peers, the long concurrency runs).
+# `make test` runs them all.
 SLOW_FILES = frozenset({"test_wheel.py", "test_docs.py", "test_stress.py", "test_faults.py", "test_spec_fuzz.py"})
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
     for item in items:
         name = item.path.name
-        if name in SLOW_FILES or name.startswith("test_interop_"):
+        if name in SLOW_FILES or name.startswith(("test_interop_", "test_newuser_")):
             item.add_marker(pytest.mark.slow)
 
 

@@ -42,7 +42,9 @@ def describe(protocol: Protocol, package: ModuleType, frame: bytes, direction: s
         "talker": sentence.talker,
         "fields": texts(framing.sentence(sentence.code, sentence.direction), sentence.values),
         "sent": sentence.sent,
-        "checksum_ok": True,  # a frame whose checksum fails does not decode
+        # a frame whose checksum fails does not decode; one without a checksum (none in the framing, or left out
+        # where `required: false` allows it) was not checked
+        "checksum_ok": True if framing.checksum is not None and framing.marker in body else None,
         "text": body[: -len(framing.end)] if body.endswith(framing.end) else body,
     }
 

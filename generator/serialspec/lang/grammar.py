@@ -386,8 +386,10 @@ _FIELD_LONG: dict[str, Shape] = {
     "endian": Str("Override of the protocol's byte order for this field.", choices=("little", "big"), example="big"),
     "size": OneOf(
         (Int(), Str()),
-        "bytes, string: a number, `rest` (up to the end of the content) or a field name; array: the earlier field "
-        "holding the array's size in bytes (Modbus byte_count)",
+        "bytes, string: a number, `rest` (up to the end of the content) or the name of an earlier integer field, "
+        "which becomes derived (encode writes the length, decode checks it; messages and JSON leave it out; in a "
+        "group's items, every item's bytes must then have one length: DYNAMIXEL SYNC WRITE); array: the earlier "
+        "field holding the array's size in bytes (Modbus byte_count)",
     ),
     "count": OneOf((Int(), Str()), "array/group: a number, `rest`, or the name of an earlier count field"),
     "of": Str(

@@ -90,7 +90,9 @@ class Cobs(Transform):
     name = "cobs"
     summary = (
         "COBS, Consistent Overhead Byte Stuffing (PacketSerial): no 00 in the span, a code byte before each run of "
-        "up to 254 non-zero bytes; a trailer 00 right after the span ends the frame"
+        "up to 254 non-zero bytes; a trailer 00 right after the span ends the frame. Encode writes PacketSerial's "
+        "form (the COBS paper's): a span that ends with a run of 254 non-zero bytes gets the code byte 01 after it, "
+        "which the `cobs` package on PyPI leaves out; decode takes both forms"
     )
     runtime_name = "CobsSpan"
     samples = (
@@ -147,7 +149,8 @@ class Cobs(Transform):
     def describe(self) -> str:
         return (
             "the bytes are sent in COBS form (no 00 among them: a code byte, the length of the run of non-zero bytes "
-            "after it + 1, stands for the 00 that ends the run; runs of 254 bytes take a code byte FF and no 00)"
+            "after it + 1, stands for the 00 that ends the run; runs of 254 bytes take a code byte FF and no 00; "
+            "a last run of 254 is followed by the code byte 01, as PacketSerial sends it, and decoded without it too)"
         )
 
     def c_refusal(self) -> str:

@@ -163,6 +163,7 @@ class Context:
     # Names of definitions (fields, enums, tables, commands, ...) that failed to resolve, their problem reported:
     # a reference to one is not reported again.
     broken: set[str] = field(default_factory=set)
+    reported: set[Path] = field(default_factory=set)  # where every problem so far was reported
     class_names: dict[str, tuple[Path, object]] = field(default_factory=dict)
     endian: Literal["<", ">"] = "<"
     shared_fields: dict[str, Any] = field(default_factory=dict)
@@ -248,6 +249,7 @@ class Pass:
     def error(self, path: Path, message: str) -> None:
         if any(path[: len(bad)] == bad for bad in self.ctx.structural):
             return  # already reported by the structural check
+        self.ctx.reported.add(path)
         self.problems.append(self.doc.error(path, message))
 
     def fail(self, path: Path, message: str) -> Bad:

@@ -30,7 +30,9 @@ from serialspec.lang.model import (
     Space,
     SpaceAccess,
     Table,
+    TableBlock,
     TableEntry,
+    TableValue,
     Unsolicited,
     replies_by_request,
     reply_to,
@@ -131,6 +133,20 @@ class DevicePass(Pass):
             for name in item.get("writes") or () if not space_writes else ():
                 if name not in request_names:
                     self.error((*item_path, "writes"), f"{key} has no request field {name!r}")
+                    continue
+                written = next((f for f in (*request.fields, *item_fields) if f.name == name), None)
+                holds_registers = isinstance(written, (TableValue, TableBlock)) or (
+                    isinstance(written, Bytes) and written.table is not None
+                )
+                command_path = ("commands", *key.split(".", 1)[:1])
+                reported = any(p[:2] == command_path for p in self.ctx.reported)  # its fields' own problems first
+                plain = written is not None and not holds_registers and not reported
+                if plain and name not in entries and name not in known_state:
+                    self.error(
+                        (*item_path, "writes"),
+                        f"{key} writes {name!r}, which is no memory entry or state variable and holds no registers "
+                        "(give the field `table:` and `start:`, or name it after a memory entry)",
+                    )
             reports: dict[str, expression.Expr] = {}
             for field_name, source in ((str(k), str(v)) for k, v in (item.get("reports") or {}).items()):
                 if field_name not in response_names:

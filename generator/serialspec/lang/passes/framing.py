@@ -77,6 +77,15 @@ class FramingPass(FieldResolver):
                 values = {tuple(e.name for e in layout.value_elements) for layout in layouts}
                 if len(values) != 1:
                     raise self.fail((*path, "layouts"), "alternative layouts must carry the same address/status")
+                with_command = [layout.name for layout in layouts if layout.has_command]
+                if with_command and len(with_command) != len(layouts):
+                    without = [layout.name for layout in layouts if not layout.has_command]
+                    raise self.fail(
+                        (*path, "layouts"),
+                        f"alternative layouts must all have a command element or none ({', '.join(with_command)} "
+                        f"{'has' if len(with_command) == 1 else 'have'} one, {', '.join(without)} "
+                        f"{'has' if len(without) == 1 else 'have'} none)",
+                    )
         first = {d: layouts[0] for d, layouts in alternatives.items()}
         checksums = first[Direction.REQUEST].checksums or first[Direction.RESPONSE].checksums
         return Framing(

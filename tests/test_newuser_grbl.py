@@ -1,0 +1,104 @@
+"""GRBL 1.1 (a CNC controller's text protocol: `ok`, `error:N`, `ALARM:N`, `<Idle|MPos:0.000,0.000,0.000|FS:0,0>`),
+tried from the user docs alone. There is no PyPI peer worth the name, so there is no spec under tests/specs: what the
+text language takes (`ok`, `error:20`) works, and each thing it cannot take is a strict xfail naming the gap."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from serialspec.lang import load_protocol
+
+BASE = """
+protocol: grbl
+title: GRBL 1.1 responses
+serial: {baudrate: 115200}
+framing:
+  kind: text
+  separator: ":"
+  end: "\\r\\n"
+commands:
+  ok:
+    code: ok
+    response: {unsolicited: true}
+  error:
+    code: error
+    response:
+      unsolicited: true
+      fields:
+        code: {type: integer, range: [1, 255]}
+"""
+
+
+def spec(tmp_path: Path, extra: str = "") -> Path:
+    path = tmp_path / "grbl.yaml"
+    path.write_text(BASE + extra, "utf-8")
+    return path
+
+
+def decode_json(path: Path, line: str) -> dict[str, object]:
+    out = subprocess.run(
+        [sys.executable, "-m", "serialspec", "decode", str(path), line, "--json"],
+        capture_output=True,
+        text=True,
+        check=True,
+    ).stdout
+    return json.loads(out)  # type: ignore[no-any-return]
+
+
+def test_ok_and_error_lines_decode(tmp_path: Path) -> None:
+    path = spec(tmp_path)
+    assert decode_json(path, "ok")["command"] == "ok"
+    assert decode_json(path, "error:20")["fields"] == {"code": "20"}
+
+
+def test_a_text_frame_without_a_checksum_is_not_said_to_check(tmp_path: Path) -> None:
+    """Found here: `decode --json` said "checksum_ok": true for text frames whose framing has no checksum (binary
+    frames without one already said null)."""
+    assert decode_json(spec(tmp_path), "ok")["checksum_ok"] is None
+    nmea = Path(__file__).parent.parent / "specs" / "nmea0183.yaml"
+    gga = "$GPGGA,123519,4807.038,N,01131.000,E,1,08,0.9,545.4,M,46.9,M,,"
+    assert decode_json(nmea, gga + "*47")["checksum_ok"] is True
+    assert decode_json(nmea, gga)["checksum_ok"] is None  # NMEA allows leaving it out: not checked
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="finding: a text request cannot be answered by another command's reply (`answered_by` is not available "
+    "in text frames yet): GRBL answers every line (G-code, $H) with `ok` or `error:N`",
+)
+def test_ok_answers_a_g_code_line(tmp_path: Path) -> None:
+    load_protocol(
+        str(spec(tmp_path, "  home:\n    code: G28\n    request:\n      answered_by: {command: ok}\n")), "grbl"
+    )
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="finding: a text `code` must be letters and digits: GRBL's system commands are `$H`, `$X`, `$$`, "
+    "and settings `$100=250.000`",
+)
+def test_a_dollar_command(tmp_path: Path) -> None:
+    load_protocol(str(spec(tmp_path, "  home:\n    code: $H\n    request: {}\n")), "grbl")
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="finding: one `start`, one `separator` per framing: GRBL's status report `<Idle|MPos:1.000,2.000,3.000|"
+    "FS:0,0>` starts with `<` where other lines have no start, separates fields with `|`, names them with `:` and "
+    "separates a field's numbers with `,`",
+)
+def test_a_status_report(tmp_path: Path) -> None:
+    extra = """  status:
+    code: Idle
+    response:
+      unsolicited: true
+      fields:
+        mpos: {type: repeat, count: 3, fields: {axis: {type: decimal, precision: 3}}}
+"""
+    path = spec(tmp_path, extra)
+    load_protocol(str(path), "grbl")
+    assert decode_json(path, "<Idle|MPos:1.000,2.000,3.000|FS:0,0>")["command"] == "status"

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define FEETECH_SMS_SPEC_SHA256 "64feaa90f2e655407b07f8e66e8ff46c602e42508d3a0711e92de69bc635e88d"
+#define FEETECH_SMS_SPEC_SHA256 "35024e65bccf4f4a3af63ecbae80937d9af5ccc8fa185c59126ec943fc4749fc"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef FEETECH_SMS_ENABLE_ENCODE

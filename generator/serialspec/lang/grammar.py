@@ -564,6 +564,15 @@ COMMAND = Obj(
             minimum=0,
             maximum=255,
         ),
+        "layout": OneOf(
+            (Str(), MapOf(Str(), "direction -> layout name")),
+            "With `framing.layouts`: the layout this command's frames travel in, a layout name or a mapping "
+            "direction -> layout name (RoboClaw: reads send only address and command, and get data and a CRC; "
+            "writes send data and a CRC, and get one 0xFF byte). Once a command names one, layouts are chosen by "
+            "command, not by header: a command that names none travels in the first layout, a request frame is "
+            "read in the layout of its code (a code sent in another layout is refused), and replies that carry no "
+            "code are read in the layout of the request they answer.",
+        ),
         "probe": Bool(
             "The command asks whether a device is there (PING): its client method returns True when the device "
             "answers and False when none does, whatever the reply holds. Every other command with a reply raises "
@@ -795,6 +804,15 @@ FRAME_ELEMENT = Obj(
             "elements of fixed size only. A frame whose code no command has gets no seed.",
             choices=("per_command",),
             example="per_command",
+        ),
+        "from_request": ListOf(
+            Str(),
+            "checksum (of a response): elements of the request this reply answers whose bytes the checksum takes "
+            "in first, in this order, before the span it covers (RoboClaw: the reply CRC starts with the "
+            "request's address and command, which the reply does not carry). Decoding such a reply needs its "
+            "request: `decode` without one refuses it in one line (give `--request HEX`), the stream parser reads "
+            "such replies only while a request is pending (the client and the simulator have it).",
+            example=["address", "command"],
         ),
         "truncate": Str(
             "content: `trailing_zeros`, encode drops the content's trailing zero bytes (keeping at least one) and "

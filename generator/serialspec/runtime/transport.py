@@ -498,12 +498,12 @@ class Bus:
                     raise
                 if chunk is None:  # bytes came between transactions: to subscribers, then the request
                     if expects:
-                        parser.expect(expect)
+                        parser.expect(expect, request)
                     self._stale(stale)
             if chunk is None:  # the general path: an echo, or bytes that came before the request
                 self._drain()
                 parser = self._parser  # a subscriber's own request may have reset it
-                parser.expect(expect)
+                parser.expect(expect, request)
                 self._write(frame)
                 started = time.monotonic()
                 try:
@@ -524,7 +524,7 @@ class Bus:
                         found = None
                 else:
                     if expects:
-                        parser.expect(expect)
+                        parser.expect(expect, request)
                     messages = parser.feed(chunk)
                     found = messages[0] if len(messages) == 1 else None
                 if found is not None and found.__class__ is expect:
@@ -545,11 +545,11 @@ class Bus:
                         return found  # its class is expect
                 if messages is None:  # decoded at once but no reply to this request: the parser takes it
                     if expects:
-                        parser.expect(expect)
+                        parser.expect(expect, request)
                     messages = parser.feed(chunk)
                 self._backlog.extend(messages)  # _read_until takes them first
             if expects:
-                self._parser.expect(expect)
+                self._parser.expect(expect, request)
             reply = self._read_until(wait - (time.monotonic() - started), request, expect, errors=0, timeout=wait)
             if self._backlog:
                 self._flush_backlog()
@@ -595,7 +595,7 @@ class Bus:
         with self._lock:
             self._ensure_open()
             self._drain()
-            self._parser.expect(expect)
+            self._parser.expect(expect, request)
             self._write(frame)
             for key in answers:
                 try:

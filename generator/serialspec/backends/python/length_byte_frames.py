@@ -201,6 +201,8 @@ def length_byte_codec_context(protocol: Protocol, code: PackageCode) -> dict[str
         imports, definitions = checksum_definitions(protocol)
     return {
         "length_byte_frames": True,
+        "requesting": False,
+        "reply_to": [],
         "checksum_imports": imports,
         "checksum_definitions": definitions,
         "directions": directions,

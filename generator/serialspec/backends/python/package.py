@@ -239,7 +239,8 @@ def straight_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, A
                 expected += [(m.class_name, key, t) for m, t, _, _ in users if m is not None and len(users) > 1]
         only = dispatch[0][1] if not layout.has_command and len(dispatch) == 1 and not expected else ""
         values = tuple(e.name for e in layout.value_elements)
-        frames = Target(direction.name, values, expected=bool(expected), only=only)
+        requesting = protocol.framing.by_command or protocol.framing.from_request
+        frames = Target(direction.name, values, expected=bool(expected), only=only, requesting=requesting)
         if protocol.error_reply is not None and direction == Direction.RESPONSE:
             element = next(e for e in layout.elements if e.name == protocol.error_reply.element)
             assert element.type is not None
@@ -249,6 +250,10 @@ def straight_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, A
         plain = unpacked_messages(single, code) if not expected and not frames.error_flag else []
         functions, call = direction_functions(protocol, direction, frames, frame_structs, plain)
         names |= {ERROR_REPLY} if frames.error_flag else set()
+        if protocol.framing.by_request(direction):  # content sizes and size rules by reply class
+            replies = [m for m in protocol.messages() if m.direction == direction]
+            sizes = [(m.class_name, m.min_size, m.max_size) for m in replies]
+            single = {m.class_name: m for m in replies}
         frame_codec, used = codec_lines(protocol, direction, sizes, single)
         names |= used
         directions.append(
@@ -275,8 +280,17 @@ def straight_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, A
         and not reply.default_reply
     ]
     code.structs.update(frame_structs)  # listed with the content's structs (common_codec_context)
+    requesting = protocol.framing.by_command or protocol.framing.from_request
     return {
         "length_byte_frames": False,
+        "requesting": requesting,
+        "reply_to": [
+            (m.class_name, reply.class_name)
+            for m in protocol.messages()
+            if m.direction == Direction.REQUEST and (reply := reply_to(m, replies)) is not None
+        ]
+        if requesting
+        else [],
         "reply_layouts": reply_layouts,
         "framing_imports": sorted(names, key=import_order),
         # the straight-line frame checks raise it (the engine raises its own)

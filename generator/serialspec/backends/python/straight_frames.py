@@ -69,6 +69,7 @@ class Target:
     error_keep: int = 0
     expected: bool = False
     only: str = ""  # the one content decoder of frames that carry no command code: called directly
+    requesting: bool = False  # frames read and made with the request they answer (layouts chosen by command)
 
 
 def straight(layout: Layout) -> bool:
@@ -618,6 +619,26 @@ def engine_lines(layouts: tuple[Layout, ...], target: Target) -> tuple[Lines, Li
     values = [f"v_{v}" for v in target.value_names]
     shown = f"({values[0]},)" if len(values) == 1 else f"({', '.join(values)})"
     parameters = ", ".join(["content: bytes", "code: int | None", *(f"{v}: int" for v in values)])
+    if target.requesting:  # the layout by the message's command, the request's bytes for a checksum over them
+        wrap = [
+            f"def _wrap_{direction}({parameters}, layout: int | None = None, request: Message | None = None) -> bytes:",
+            f'    """The {direction} frame around `content` in its layout, made by the frame engine."""',
+            f"    return {frames}.wrap(content, code, {shown}, layout, _request_parts(request))",
+        ]
+        decode = [
+            f"def _decode_{direction}(frame: bytes, expect: type[Message] | None = None, "
+            "request: Message | None = None) -> Message:",
+            f'    """One complete {direction} frame, checked and taken apart by the frame engine (with the request it',
+            '    answers, where its layout or checksum needs it); its content decoded."""',
+            *(
+                ["    if expect is None and request is not None:", "        expect = _REPLY_TO.get(type(request))"]
+                if direction == "response"
+                else []
+            ),
+            f"    unwrapped = {frames}.unwrap(frame, expect, _request_parts(request))",
+            "    code, content = unwrapped.code, unwrapped.content",
+        ]
+        return _engine_decode(decode, target), wrap
     wrap = [
         f"def _wrap_{direction}({parameters}) -> bytes:",
         f'    """The {direction} frame around `content`, made by the frame engine."""',
@@ -629,9 +650,13 @@ def engine_lines(layouts: tuple[Layout, ...], target: Target) -> tuple[Lines, Li
         f"    unwrapped = {frames}.unwrap(frame)",
         "    code, content = unwrapped.code, unwrapped.content",
     ]
+    return _engine_decode(decode, target), wrap
+
+
+def _engine_decode(decode: Lines, target: Target) -> Lines:
+    """The engine's decode function, its content dispatched by code (and by the expected class)."""
     arguments = "content, 0, len(content), *unwrapped.values"
-    decode += [f"    {line}" for line in _dispatch(target, "code", arguments, nullable=True)]
-    return decode, wrap
+    return [*decode, *(f"    {line}" for line in _dispatch(target, "code", arguments, nullable=True))]
 
 
 @dataclass(frozen=True)
@@ -650,6 +675,8 @@ def straight_direction(protocol: Protocol, direction: Direction) -> StraightLayo
     names = {tuple(e.name for e in (layout.elements[i] for i in layout.values)) for layout in layouts}
     if not all(straight(layout) for layout in layouts) or len(names) != 1:
         return None
+    if protocol.framing.by_command or protocol.framing.from_request:
+        return None  # layouts chosen by command, checksums over the request: the engine's
     algorithms = tuple(
         {index: e.checksum for index, e in enumerate(model.elements) if e.checksum is not None}
         for model in protocol.framing.alternatives[direction]
@@ -671,7 +698,8 @@ def direction_functions(
     d = direction.value
     if found is None:
         decode, wrap = engine_lines(runtime_layouts(protocol, direction), target)
-        return [*decode, "", "", *wrap], [f"return _decode_{d}(bytes(data), expect)"]
+        request = ", request" if target.requesting else ""
+        return [*decode, "", "", *wrap], [f"return _decode_{d}(bytes(data), expect{request})"]
     layouts = found.layouts
     several = len(layouts) > 1
     lines: Lines = []

@@ -490,9 +490,7 @@ class FrameCodec:
         choices = " or ".join(layout.header.hex(" ") for layout in self.layouts)
         raise DecodeError(f"frame starts {frame[:4].hex(' ')}, expected {choices}")
 
-    def unwrap(
-        self, frame: bytes, expect: Any = None, request: Mapping[str, bytes] | None = None
-    ) -> Unwrapped:
+    def unwrap(self, frame: bytes, expect: Any = None, request: Mapping[str, bytes] | None = None) -> Unwrapped:
         """Check a frame and take it apart: in the layout its header names, in the layout of its code (layouts
         chosen by command), or, for replies that carry no code, in the layout of `expect` (the reply class)."""
         if self.replies:
@@ -505,7 +503,8 @@ class FrameCodec:
                 raise DecodeError(f"{getattr(expect, '__name__', expect)} is no reply of these frames")
             return self.layouts[index].unwrap(frame, request)
         if any(layout.codes is not None for layout in self.layouts):
-            problem: DecodeError | None = None
+            problem: DecodeError | None = None  # a layout's own refusal first, else a code sent in another
+            elsewhere: DecodeError | None = None
             for layout in self.layouts:
                 if not frame.startswith(layout.header):
                     continue
@@ -517,7 +516,8 @@ class FrameCodec:
                 if layout.codes is None or unwrapped.code in layout.codes:
                     return unwrapped
                 code = "no code" if unwrapped.code is None else f"code {unwrapped.code:#04x}"
-                problem = problem or DecodeError(f"{code} is not sent in layout {layout.name!r}")
+                elsewhere = elsewhere or DecodeError(f"{code} is not sent in layout {layout.name!r}")
+            problem = problem or elsewhere
             if problem is None:
                 choices = " or ".join(layout.header.hex(" ") for layout in self.layouts)
                 problem = DecodeError(f"frame starts {frame[:4].hex(' ')}, expected {choices}")

@@ -69,9 +69,8 @@ def layout_codes(protocol: Protocol, layout: FrameLayout) -> tuple[int, ...] | N
     for command in protocol.commands:
         code = command.wire_code(layout.direction)
         for message in command.messages():
-            if code is not None and message.direction == layout.direction:
-                if protocol.layout(message).name == layout.name:
-                    codes.add(code)
+            if code is not None and message.direction == layout.direction and protocol.layout(message) == layout:
+                codes.add(code)
     return tuple(sorted(codes))
 
 

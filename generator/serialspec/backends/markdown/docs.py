@@ -517,7 +517,8 @@ def checksum_context(protocol: Protocol, general: Checksum | None = None) -> dic
             else ""
         )
         + (
-            ", after the bytes of the request's " + " and ".join(f"`{n}`" for n in checksum.from_request)
+            ", after the bytes of the request's "
+            + " and ".join(f"`{n}`" for n in checksum.from_request)
             + " (the request this reply answers)"
             if checksum.from_request
             else ""

@@ -251,9 +251,9 @@ def straight_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, A
         functions, call = direction_functions(protocol, direction, frames, frame_structs, plain)
         names |= {ERROR_REPLY} if frames.error_flag else set()
         if protocol.framing.by_request(direction):  # content sizes and size rules by reply class
-            replies = [m for m in protocol.messages() if m.direction == direction]
-            sizes = [(m.class_name, m.min_size, m.max_size) for m in replies]
-            single = {m.class_name: m for m in replies}
+            answering = [m for m in protocol.messages() if m.direction == direction]
+            sizes = [(m.class_name, m.min_size, m.max_size) for m in answering]
+            single = {m.class_name: m for m in answering}
         frame_codec, used = codec_lines(protocol, direction, sizes, single)
         names |= used
         directions.append(

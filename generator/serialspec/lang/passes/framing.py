@@ -346,7 +346,9 @@ class FramingPass(FieldResolver):
         flagged = any("error_flag" in item for item in raws.values())
         return self.classic_fields(direction, layout_name, tuple(elements), transparency, checksums, flagged)
 
-    def from_request(self, raw: list[str], direction: Direction, request: FrameLayout | None, path: Path) -> tuple[str, ...]:
+    def from_request(
+        self, raw: list[str], direction: Direction, request: FrameLayout | None, path: Path
+    ) -> tuple[str, ...]:
         """A reply checksum's `from_request`: elements of fixed size of the same layout's request frame."""
         if direction != Direction.RESPONSE or request is None:
             raise self.fail(path, "`from_request` belongs to a checksum of response frames")
@@ -354,7 +356,9 @@ class FramingPass(FieldResolver):
         for index, name in enumerate(raw):
             if name not in sizes:
                 names = ", ".join(e.name for e in request.elements if e.role != "content") or "none"
-                raise self.fail((*path, index), f"{name!r} is no element of fixed size of the request frame (it has {names})")
+                raise self.fail(
+                    (*path, index), f"{name!r} is no element of fixed size of the request frame (it has {names})"
+                )
         return tuple(raw)
 
     def classic_fields(

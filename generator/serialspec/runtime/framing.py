@@ -298,6 +298,11 @@ class Layout:
         return Unwrapped(self, code, values, content, tuple(plain))
 
 
+def _class_name(cls: Any) -> Any:
+    """A reply class's name, the key of a codec's `replies` (None stays None)."""
+    return None if cls is None else getattr(cls, "__name__", cls)
+
+
 def _requested(element: Element, request: Mapping[str, bytes] | None, error: type[Exception]) -> bytes:
     """The request's bytes a reply checksum takes in first; the error (one line) when the request is not known."""
     if request is None:
@@ -444,7 +449,8 @@ class FrameCodec:
         replies: dict[Any, int] | None = None,
     ) -> None:
         """`replies`: frames that carry no code, in layouts chosen by command: each reply class's layout (by index),
-        read only with the request's reply class given; content_sizes and size_rules are then by reply class."""
+        read only with the request's reply class given; content_sizes and size_rules are then by reply class (all
+        three keyed by the class's name, so the construct structs hold them without the message classes)."""
         self.layouts = tuple(layouts)
         self.replies = replies or {}
         self.content_sizes = content_sizes  # content size bounds by code (plain bytes)
@@ -498,7 +504,7 @@ class FrameCodec:
                 raise DecodeError(
                     "a reply without a command code is read in the layout of the request it answers: give the request"
                 )
-            index = self.replies.get(expect)
+            index = self.replies.get(_class_name(expect))
             if index is None:
                 raise DecodeError(f"{getattr(expect, '__name__', expect)} is no reply of these frames")
             return self.layouts[index].unwrap(frame, request)
@@ -527,7 +533,7 @@ class FrameCodec:
     def probe(self, layout: Layout, buffer: bytes, start: int, end: int, expect: Any = None) -> int | None:
         """Size of a plausible frame of `layout` at buffer[start:], None when more bytes are needed, -1 if none.
         `expect`: the reply class awaited, for replies read in the layout of their request (`replies`)."""
-        if self.replies and self.replies.get(expect) != self.layouts.index(layout):
+        if self.replies and self.replies.get(_class_name(expect)) != self.layouts.index(layout):
             return -1  # no reply awaited, or one of another layout
         plan: dict[str, Any] = layout._plan  # type: ignore[attr-defined]
         available = end - start
@@ -548,7 +554,7 @@ class FrameCodec:
             elif kind == "value" and not element.plausible(int.from_bytes(data, element.endian)):
                 return -1
         if layout.command is None:
-            code = expect if self.replies else None
+            code = _class_name(expect) if self.replies else None
             if code not in self.content_sizes:
                 return -1
         if layout.content < 0 and layout.transparency is None:

@@ -157,7 +157,7 @@ def codec_lines(
     if protocol.framing.by_request(direction):  # each reply class's layout: read with the request's reply class
         lines.append("    replies={")
         lines += [
-            f"        {m.class_name}: {layout_index(protocol, m)},"
+            f"        {m.class_name!r}: {layout_index(protocol, m)},"
             for m in protocol.messages()
             if m.direction == direction
         ]

@@ -252,8 +252,8 @@ def straight_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, A
         names |= {ERROR_REPLY} if frames.error_flag else set()
         if protocol.framing.by_request(direction):  # content sizes and size rules by reply class
             answering = [m for m in protocol.messages() if m.direction == direction]
-            sizes = [(m.class_name, m.min_size, m.max_size) for m in answering]
-            single = {m.class_name: m for m in answering}
+            sizes = [(repr(m.class_name), m.min_size, m.max_size) for m in answering]
+            single = {repr(m.class_name): m for m in answering}
         frame_codec, used = codec_lines(protocol, direction, sizes, single)
         names |= used
         directions.append(

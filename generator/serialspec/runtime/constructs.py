@@ -149,7 +149,7 @@ class Framed(Adapter):  # type: ignore[misc, type-arg, unused-ignore]
 
     def _asked(self, context: Any) -> dict[str, bytes] | None:
         request = context.get("request") if self.requests is not None else None
-        return None if request is None else self.requests.unwrap(bytes(request)).named()  # type: ignore[no-any-return]
+        return None if request is None else self.requests.unwrap(bytes(request)).named()
 
     def _layout(self, name: Any) -> Any:
         return next((layout for layout in self.codec.layouts if layout.name == name), None)

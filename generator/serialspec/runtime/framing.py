@@ -421,8 +421,12 @@ class SizeRule:
 
     fixed: int
     terms: tuple[tuple[int, int, Literal["little", "big"], int], ...] = ()  # (offset, size, endian, factor)
+    nul: int = -1  # the offset of a NUL-terminated text that ends the content: sized by its NUL (fixed: before it)
 
     def size(self, buffer: bytes, start: int, end: int) -> int | None:
+        if self.nul >= 0:
+            found = buffer.find(0, start + self.nul, end)
+            return None if found < 0 else found + 1 - start
         total = self.fixed
         for offset, size, endian, factor in self.terms:
             if start + offset + size > end:
@@ -443,7 +447,7 @@ class FrameCodec:
     def __init__(
         self,
         layouts: Iterable[Layout],
-        content_sizes: dict[int | None, tuple[int, int | None]],
+        content_sizes: dict[Any, tuple[int, int | None]],
         size_rules: dict[Any, SizeRule] | None = None,
         error_flag: int = 0,
         replies: dict[Any, int] | None = None,

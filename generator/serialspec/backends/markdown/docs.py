@@ -170,8 +170,9 @@ def field_rows(fields: tuple[Field, ...], start: int | None, prefix: str = "") -
 def message_context(protocol: Protocol, message: Message | None) -> dict[str, Any] | None:
     if message is None:
         return None
-    layout = protocol.framing.layouts[message.direction]
-    content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
+    layout = protocol.layout(message)
+    content = next((e.name for e in layout.elements if e.role == "content"), None)
+    content_offset = layout.offsets[content] if content is not None else layout.overhead  # a bare frame: none
     size = size_text(message.min_size, message.max_size, content_limit(layout))
     if message.padded is not None:
         size = f"{size_text(message.padded, message.padded, None)}, sent without its trailing zero bytes (at least 1)"

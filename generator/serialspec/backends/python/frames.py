@@ -21,6 +21,7 @@ from serialspec.lang.model import (
     FrameLayout,
     Message,
     Protocol,
+    nul_ended,
     size_terms,
 )
 from serialspec.transforms import runtime_classes
@@ -115,6 +116,9 @@ def layout_lines(layout: FrameLayout, codes: tuple[int, ...] | None = None) -> l
 def size_rule(message: Message) -> str | None:
     """`SizeRule(...)` for a message whose content size follows from its fields (model.size_terms), or None."""
     found = size_terms(message.fields)
+    text = nul_ended(message.fields)
+    if found is None and text is not None:
+        return f"SizeRule({text}, nul={text})"
     if found is None:
         return None
     fixed, terms = found

@@ -199,7 +199,9 @@ def straight_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, A
     """Frames of any other shape: straight-line frame functions per direction where the layouts allow them (see
     straight_frames.py), else the runtime's frame engine; one FrameCodec per direction either way (the stream parser's),
     decoders by code (and by class)."""
-    imports, definitions = checksum_definitions(protocol)
+    # layouts chosen by command, checksums over request bytes: the engine's code only (no straight-line checks)
+    engine_only = protocol.framing.by_command or protocol.framing.from_request
+    imports, definitions = checksum_definitions(protocol, straight=not engine_only)
     directions: list[dict[str, Any]] = []
     dispatchers = []
     size_dispatchers: list[dict[str, Any]] = []

@@ -298,6 +298,16 @@ class Layout:
         return Unwrapped(self, code, values, content, tuple(plain))
 
 
+def _code_at(layout: Layout, frame: bytes) -> int | None:
+    """The code at the command element's fixed offset in `frame`, where it has one and the frame reaches it."""
+    offset = None if layout.command is None else layout.offset(layout.command)
+    if offset is None or layout.command is None:
+        return None
+    element = layout.elements[layout.command]
+    data = frame[offset : offset + element.size]
+    return element.unpack(data) if len(data) == element.size else None
+
+
 def _class_name(cls: Any) -> Any:
     """A reply class's name, the key of a codec's `replies` (None stays None)."""
     return None if cls is None else getattr(cls, "__name__", cls)
@@ -513,7 +523,9 @@ class FrameCodec:
                 raise DecodeError(f"{getattr(expect, '__name__', expect)} is no reply of these frames")
             return self.layouts[index].unwrap(frame, request)
         if any(layout.codes is not None for layout in self.layouts):
-            problem: DecodeError | None = None  # a layout's own refusal first, else a code sent in another
+            # the refusal of the layout that sends the frame's code first, then any layout's, then a code sent in
+            # another layout
+            problem: DecodeError | None = None
             elsewhere: DecodeError | None = None
             for layout in self.layouts:
                 if not frame.startswith(layout.header):
@@ -521,6 +533,8 @@ class FrameCodec:
                 try:
                     unwrapped = layout.unwrap(frame, request)
                 except DecodeError as exc:
+                    if layout.codes is not None and _code_at(layout, frame) in layout.codes:
+                        raise
                     problem = problem or exc
                     continue
                 if layout.codes is None or unwrapped.code in layout.codes:

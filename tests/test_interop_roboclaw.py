@@ -1,4 +1,4 @@
-"""Basicmicro RoboClaw packet serial (specs/roboclaw.yaml) against basicmicro 2.0.10 from PyPI, unchanged.
+"""Basicmicro RoboClaw packet serial (tests/specs/roboclaw.yaml) against basicmicro 2.0.10 from PyPI, unchanged.
 
 The peer's packing code writes the golden frames (its controller on a stand-in port that records what is written and
 plays back what it reads): our codec encodes the same bytes for its writes and reads, and the peer accepts our
@@ -9,24 +9,30 @@ replies (their CRC covers the request's address and command, which the reply doe
 from __future__ import annotations
 
 import contextlib
+import importlib
 import io
 import json
+import tempfile
 from collections.abc import Iterator
+from pathlib import Path
 from typing import Any
 
 import pytest
+from conftest import generate_and_import
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from serialspec import cli
 from serialspec.runtime.errors import DecodeError
 from serialspec.runtime.transport import Bus
-from serialspec_protocols import roboclaw as rc
-from serialspec_protocols.roboclaw import client as rc_client
 
 basicmicro = pytest.importorskip("basicmicro")
 
-SIM = ("roboclaw.yaml", 0x80, 0x81)  # the `port` fixture (conftest.py): `serialspec sim` on a pseudo-terminal
-SPEC = "specs/roboclaw.yaml"
+SPEC = str(Path(__file__).parent / "specs" / "roboclaw.yaml")
+# the `port` fixture (conftest.py): `serialspec sim` on a pseudo-terminal, two controllers (its path is from specs/)
+SIM = ("../tests/specs/roboclaw.yaml", 0x80, 0x81)
+# the package, generated once for the module (the hypothesis tests below read it as a module global)
+rc: Any = generate_and_import(Path(SPEC), Path(tempfile.mkdtemp(prefix="roboclaw-")), "roboclaw")
+rc_client: Any = importlib.import_module("roboclaw.client")
 
 
 class Recorder:

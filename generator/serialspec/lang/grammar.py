@@ -259,6 +259,7 @@ class OneOf(Shape):
 
     options: tuple[Shape, ...] = field(default_factory=tuple)
     description: str = ""
+    example: Any = None  # shown in the reference where no spec uses the key
 
     def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
         for option in self.options:
@@ -575,6 +576,7 @@ COMMAND = Obj(
             "without it (`--request HEX`), the stream parser takes none while no request is pending, and the "
             "client and the simulator give it. A layout may be constant bytes alone (RoboClaw's 0xFF "
             "acknowledgement: `ack: {role: header, value: FF, directions: [response]}`).",
+            example="read",
         ),
         "probe": Bool(
             "The command asks whether a device is there (PING): its client method returns True when the device "

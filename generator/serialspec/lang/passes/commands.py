@@ -275,6 +275,8 @@ class Commands(FieldResolver):
         }
         if "layout" in value:
             chosen = self.layout_names(value["layout"], (*path, "layout"))
+            if not chosen:  # said: its messages' layouts are not checked further (one mistake, one line)
+                self.ctx.broken.add(name)
             messages = {d: replace(m, layout=chosen.get(d, "")) for d, m in messages.items()}
             subcommands = [
                 replace(
@@ -317,16 +319,17 @@ class Commands(FieldResolver):
         if not framing.by_command or names == [""]:
             self.error(path, "`layout` chooses one of `framing.layouts`, and the framing has one layout")
             return {}
-        pairs = raw.items() if isinstance(raw, dict) else ((d.value, raw) for d in Direction)
+        pairs = raw.items() if isinstance(raw, dict) else [(d.value, raw) for d in Direction]
         chosen: dict[Direction, str] = {}
         for key, name in pairs:
             where = (*path, key) if isinstance(raw, dict) else path
             if key not in ("request", "response"):
                 self.error(where, f"expected request or response, not {key!r}")
-            elif name not in names:
+                return {}
+            if name not in names:
                 self.error(where, f"unknown layout {name!r} (the framing has {', '.join(names)})")
-            else:
-                chosen[Direction(key)] = name
+                return {}
+            chosen[Direction(key)] = name
         return chosen
 
     def check_layouts(self, commands: list[Command], framing: Framing) -> None:
@@ -334,6 +337,8 @@ class Commands(FieldResolver):
         if not framing.by_command:
             return
         for command in commands:
+            if command.name in self.ctx.broken:
+                continue
             for message in command.messages():
                 layout = framing.layout_of(message.direction, message.layout)
                 where = f"layout {layout.name!r}"

@@ -11,6 +11,7 @@ unplugged and plugged back in (or a symlink such as /dev/serial/by-id/... pointe
 
 from __future__ import annotations
 
+import inspect
 import operator
 import os
 import select
@@ -401,6 +402,8 @@ class Bus:
         self._match_subcommand = "subcommand" in match_by
         self._match_fields = tuple(name for name in match_by if name not in ("command", "subcommand"))
         self._decode = binding.decode
+        # a codec that reads replies with the request they answer (layouts chosen by command): given it
+        self._asks = binding.decode is not None and "request" in inspect.signature(binding.decode).parameters
         self._encoders = binding.encoders
         self._sizes: dict[type, int] = {}  # the size of the last reply of each type read whole (see request)
         self._rules: dict[type, _Rule] = {}  # the latest rule of each reply type
@@ -519,7 +522,11 @@ class Bus:
                 if size == self._sizes.get(expect) and not parser.pending():
                     # the size the last reply of this type had: most likely that reply, whole; decoded at once
                     try:
-                        found: Message | None = self._decode(chunk, _RESPONSE, expect)  # type: ignore[misc]
+                        found: Message | None = (
+                            self._decode(chunk, _RESPONSE, expect, request)  # type: ignore[misc, call-arg]
+                            if self._asks
+                            else self._decode(chunk, _RESPONSE, expect)  # type: ignore[misc]
+                        )
                     except Exception:  # anything else is for the parser, which counts it and resynchronises
                         found = None
                 else:

@@ -11,7 +11,6 @@ unplugged and plugged back in (or a symlink such as /dev/serial/by-id/... pointe
 
 from __future__ import annotations
 
-import inspect
 import operator
 import os
 import select
@@ -28,7 +27,7 @@ from typing import Any, TypeVar
 import serial
 
 from serialspec.runtime.errors import CorruptReply, DeviceError, EncodeError, PortError, Timeout
-from serialspec.runtime.message import Direction, Message, Record
+from serialspec.runtime.message import Direction, Message, Record, takes_request
 from serialspec.runtime.settings import SerialSettings as SerialSettings  # packages generated before import it here
 from serialspec.runtime.stream import StreamParser
 
@@ -403,7 +402,7 @@ class Bus:
         self._match_fields = tuple(name for name in match_by if name not in ("command", "subcommand"))
         self._decode = binding.decode
         # a codec that reads replies with the request they answer (layouts chosen by command): given it
-        self._asks = binding.decode is not None and "request" in inspect.signature(binding.decode).parameters
+        self._asks = binding.decode is not None and takes_request(binding.decode)
         self._encoders = binding.encoders
         self._sizes: dict[type, int] = {}  # the size of the last reply of each type read whole (see request)
         self._rules: dict[type, _Rule] = {}  # the latest rule of each reply type

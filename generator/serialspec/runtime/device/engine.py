@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import dataclasses
-import inspect
 import logging
 import math
 import struct
@@ -15,7 +14,7 @@ from typing import Any
 
 from serialspec.runtime.device.faults import Fault, FaultInjection
 from serialspec.runtime.errors import DecodeError, EncodeError
-from serialspec.runtime.message import Message, compare, field_keys, is_sequence
+from serialspec.runtime.message import Message, compare, field_keys, is_sequence, takes_request
 from serialspec.runtime.registers import RegisterMap
 from serialspec.runtime.stream import StreamParser
 
@@ -373,7 +372,7 @@ class Engine(FaultInjection):
         self.encode = encode
         # a codec whose replies are made with the request they answer (layouts chosen by command, a reply checksum
         # over request bytes) takes it: the request being answered is given to it
-        self._requests = "request" in inspect.signature(encode).parameters
+        self._requests = takes_request(encode)
         self._request: Message | None = None
         self.clock = clock
         self.parser = parser()

@@ -37,10 +37,11 @@ def same(parsed: Any, value: Any) -> bool:
     return bool(parsed == value)
 
 
-def frame_content(g: Generated, frame: bytes, direction: str) -> bytes:
-    """The content of a frame: by the classic layout's offsets, or (stuffed, lengths anywhere) by the frame struct."""
+def frame_content(g: Generated, frame: bytes, direction: str, context: dict[str, Any] | None = None) -> bytes:
+    """The content of a frame: by the classic layout's offsets, or (stuffed, lengths anywhere) by the frame struct
+    (`context`: a reply's layout and request, where replies are read with their request)."""
     if not g.protocol.framing.classic:
-        return bytes(getattr(g.structs, f"{direction.upper()}_FRAME").parse(frame).content)
+        return bytes(getattr(g.structs, f"{direction.upper()}_FRAME").parse(frame, **(context or {})).content)
     layout = next(lay for d, lay in g.protocol.framing.layouts.items() if d.value == direction)
     start = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
     return frame[start : len(frame) - (layout.overhead - start)]
@@ -59,8 +60,10 @@ def spec_names(value: Any) -> Any:
     return value
 
 
-def check_against_construct(g: Generated, spec: Message, frame: bytes, fields: dict[str, Any]) -> None:
-    content = frame_content(g, frame, spec.direction.value)
+def check_against_construct(
+    g: Generated, spec: Message, frame: bytes, fields: dict[str, Any], context: dict[str, Any] | None = None
+) -> None:
+    content = frame_content(g, frame, spec.direction.value, context)
     content_struct = g.structs.CONTENTS[(spec.key, spec.direction.value)]
     parsed = spec_names(plain(content_struct.parse(content)))
     frame_names = {e.name for e in g.protocol.framing.layouts[spec.direction].value_elements}
@@ -72,11 +75,11 @@ def check_against_construct(g: Generated, spec: Message, frame: bytes, fields: d
             continue
         assert parsed[name] == pytest.approx(value) if isinstance(value, float) else same(parsed[name], value), name
     frame_struct = getattr(g.structs, f"{spec.direction.name}_FRAME")
-    rebuilt = frame_struct.parse(frame)
+    rebuilt = frame_struct.parse(frame, **(context or {}))
     if g.protocol.framing.classic:
         assert rebuilt.body.value.content == content
     else:
-        assert frame_struct.build(rebuilt) == frame
+        assert frame_struct.build(rebuilt, **(context or {})) == frame
 
 
 @pytest.mark.parametrize(("g", "example"), EXAMPLES)

@@ -36,9 +36,10 @@ from serialspec.backends import Unsupported, emitters
 from serialspec.backends.python.memory import imported
 from serialspec.lang import SpecErrors, grammar
 from serialspec.lang.loader import load_text
-from serialspec.lang.model import Message, Protocol, replies_by_request, reply_to
+from serialspec.lang.model import Direction, Message, Protocol, replies_by_request, reply_to
 from serialspec.lang.passes.fields import FIELD_KINDS
 from serialspec.lang.resolve import resolve
+from serialspec.runtime.errors import DecodeError
 from serialspec.runtime.transport import Bus
 from serialspec.transforms import transforms
 from strategies import message_fields
@@ -404,7 +405,8 @@ def spec_text(name: str, case: Case) -> str:
     framing = case.framing or FRAMING
     elements = next(iter(framing["layouts"].values()))["elements"] if "layouts" in framing else framing["elements"]
     address = next((n for n, e in elements.items() if e["role"] == "address"), None)
-    matching = [address, "command"] if address else ["command"]
+    answered = address is not None and "response" in elements[address].get("directions", ["response"])
+    matching = [address, "command"] if answered else ["command"]
     spec: dict[str, Any] = {
         "protocol": "matrix_case",
         "title": f"Matrix: {name}",
@@ -451,6 +453,10 @@ C_REFUSES = {
 }
 
 
+# Cases the Wireshark target refuses (backends.Unsupported), with the one line it says.
+WIRESHARK_REFUSES: dict[str, str] = {}
+
+
 def build(name: str) -> Built:
     text = spec_text(name, CASES[name])
     try:
@@ -463,6 +469,12 @@ def build(name: str) -> Built:
                     emitter.files(protocol)
                 said = str(refused.value)
                 assert C_REFUSES[name] in said and "\n" not in said, said
+                continue
+            if emitter.name == "wireshark" and name in WIRESHARK_REFUSES:
+                with pytest.raises(Unsupported) as refused:
+                    emitter.files(protocol)
+                said = str(refused.value)
+                assert WIRESHARK_REFUSES[name] in said and "\n" not in said, said
                 continue
             emitted = emitter.files(protocol)
             files.update({f"{emitter.folder}/{path}" if emitter.folder else path: t for path, t in emitted.items()})
@@ -613,6 +625,70 @@ CASES["device: derived, locks, sends, moves.to"] = Case(
     },
 )
 DEVICE_KEYS = ("derived", "locks", "sends")  # the device keys a matrix case must use
+# Layouts chosen by command (RoboClaw packet serial): `read` requests get their data and a CRC that starts with the
+# request's address and command (`from_request`), `write` requests (their own checksum) one bare 0xFF byte
+XMODEM = {"width": 16, "poly": 0x1021, "init": 0, "refin": False, "refout": False, "xorout": 0, "check": 0x31C3}
+BY_COMMAND = "frame: layouts chosen by command (layout:), a bare acknowledgement, a reply checksum from_request"
+CASES[BY_COMMAND] = Case(
+    {"v": "u16"},
+    {"w": "i32", "s": {"type": "u8", "range": [0, 9]}},
+    {
+        "layouts": {
+            "read": {
+                "elements": {
+                    "id": {"role": "address", "type": "u8", "range": [128, 135], "directions": ["request"]},
+                    "code": {"role": "command", "type": "u8", "directions": ["request"]},
+                    "content": {"role": "content"},
+                    "crc": {
+                        "role": "checksum",
+                        "type": "u16",
+                        "endian": "big",
+                        "algorithm": "crc",
+                        "crc": XMODEM,
+                        "covers": ["content", "content"],
+                        "from_request": ["id", "code"],
+                        "directions": ["response"],
+                    },
+                    "sum": {
+                        "role": "checksum",
+                        "type": "u16",
+                        "endian": "big",
+                        "algorithm": "crc",
+                        "crc": XMODEM,
+                        "covers": ["id", "content"],
+                        "directions": ["request"],
+                    },
+                }
+            },
+            "write": {
+                "elements": {
+                    "id": {"role": "address", "type": "u8", "range": [128, 135], "directions": ["request"]},
+                    "code": {"role": "command", "type": "u8", "directions": ["request"]},
+                    "content": {"role": "content", "directions": ["request"]},
+                    "sum": {
+                        "role": "checksum",
+                        "type": "u8",
+                        "algorithm": "sum",
+                        "covers": ["id", "content"],
+                        "directions": ["request"],
+                    },
+                    "ack": {"role": "header", "value": "FF", "directions": ["response"]},
+                }
+            },
+        }
+    },
+    commands={
+        "drive": {"code": 2, "layout": "write", "request": {"fields": {"speed": "i16"}}, "response": {}},
+        "peek": {
+            "code": 3,
+            "layout": {"request": "read", "response": "read"},
+            "request": {},
+            "response": {"fields": {"x": "u16"}},
+        },
+    },
+)
+# each frame alone does not say how to read it (the C decoder's and a dissector's way): both refuse the case
+C_REFUSES[BY_COMMAND] = WIRESHARK_REFUSES[BY_COMMAND] = "layouts chosen by command (`layout:`)"
 # Every documented option of every frame transform (serialspec/transforms/), as its sample framing.
 for _method, _transform in transforms().items():
     for _sample in _transform.samples:
@@ -663,6 +739,9 @@ def test_every_documented_alternative_has_a_case() -> None:
                 used["role"].add(element["role"])
                 used["element type"].add(element.get("type", "u8"))
                 used["element endian"].add(element.get("endian", "little"))
+    commands = [c for case in CASES.values() for c in (case.commands or {}).values()]
+    assert any("layout" in c for c in commands)  # layouts chosen by command
+    assert {"from_request", "covers"} <= {k for case in CASES.values() for k in element_keys(case)}
     used_device = {key for case in CASES.values() for key in case.device or {}}
     assert set(DEVICE_KEYS) <= set(grammar.DEVICE.keys) and set(DEVICE_KEYS) - used_device == set()
     field = grammar._FIELD_LONG
@@ -686,6 +765,12 @@ def test_every_documented_alternative_has_a_case() -> None:
     assert set(element["role"].choices) - used["role"] == set()  # type: ignore[attr-defined]
     assert {"u8", "u16"} - used["element type"] == set()
     assert set(element["endian"].choices) - used["element endian"] == set()  # type: ignore[attr-defined]
+
+
+def element_keys(case: Case) -> set[str]:
+    framing = case.framing or FRAMING
+    layouts = framing["layouts"].values() if "layouts" in framing else [framing]
+    return {key for layout in layouts for element in layout["elements"].values() for key in element}
 
 
 @pytest.mark.parametrize("name", PARAMS)
@@ -776,17 +861,42 @@ def test_the_clients_of_every_case_pass_ruff(tmp_path: Path) -> None:
 SETTINGS = settings(max_examples=examples(15), deadline=None, suppress_health_check=list(HealthCheck))
 
 
+def requesting(g: Generated) -> bool:
+    """Replies are read with the request they answer (layouts chosen by command, a checksum over request bytes)."""
+    return g.protocol.framing.by_command or g.protocol.framing.from_request
+
+
+def asked(g: Generated, message: Message) -> Any:
+    """A request the response `message` answers, where replies are read with their request; else None."""
+    if not requesting(g) or message.direction.value != "response":
+        return None
+    request = next(
+        m
+        for m in g.protocol.messages()
+        if m.direction.value == "request" and reply_to(m, replies_by_request(g.protocol.messages())) == message
+    )
+    return message_class(g, request).from_fields(st_examples(message_fields(g.protocol, request), 1)[0])
+
+
 def codec_and_structs(g: Generated, message: Message) -> None:
     cls = message_class(g, message)
+    request = asked(g, message)
+    given_request = () if request is None else (request,)
+    context = (
+        {} if request is None else {"layout": g.protocol.layout(message).name, "request": g.package.encode(request)}
+    )
 
     @SETTINGS
     @given(message_fields(g.protocol, message))
     def round_trip(fields: dict[str, Any]) -> None:
-        frame = g.package.encode(cls.from_fields(fields))
-        decoded = g.package.decode(frame, message.direction.value, cls)
+        frame = g.package.encode(cls.from_fields(fields), *given_request)
+        decoded = g.package.decode(frame, message.direction.value, cls, *given_request)
         assert decoded.to_fields() == fields
-        assert g.package.encode(cls.from_fields(json.loads(json.dumps(decoded.to_fields())))) == frame
-        check_against_construct(g, message, frame, fields)
+        assert g.package.encode(cls.from_fields(json.loads(json.dumps(decoded.to_fields()))), *given_request) == frame
+        check_against_construct(g, message, frame, fields, context)
+        if request is not None:  # without its request, such a reply is refused in one line
+            with pytest.raises(DecodeError, match="give the request"):
+                g.package.decode(frame, message.direction.value)
 
     round_trip()
 
@@ -800,12 +910,26 @@ def stream(g: Generated) -> None:
 def stream_direction(g: Generated, direction: str) -> None:
     headers = {
         e.constant[0]
-        for layout in g.protocol.framing.layouts.values()
+        for layouts in g.protocol.framing.alternatives.values()
+        for layout in layouts
         for e in layout.elements
         if e.role == "header" and e.constant
     }
+    if g.protocol.framing.by_command:  # no header: no byte an address at a frame's start can have either
+        headers |= {
+            v
+            for layouts in g.protocol.framing.alternatives.values()
+            for layout in layouts
+            for e in layout.elements[:1]
+            if e.role == "address"
+            for v in range(int(e.minimum), int(e.maximum) + 1)
+        }
     garbage = st.binary(max_size=6).map(lambda b: bytes(x for x in b if x not in headers))
     messages = [m for m in g.protocol.messages() if m.direction.value == direction]
+    if g.protocol.framing.by_request(Direction(direction)):
+        for message in messages:  # replies read with the pending request: those of one request at a time
+            replies_direction(g, message, garbage)
+        return
     drawn_messages = st.sampled_from(messages).flatmap(lambda m: st.tuples(st.just(m), message_fields(g.protocol, m)))
 
     @SETTINGS
@@ -824,6 +948,32 @@ def stream_direction(g: Generated, direction: str) -> None:
     parse()
 
 
+def replies_direction(g: Generated, message: Message, garbage: st.SearchStrategy[bytes]) -> None:
+    """Replies to one pending request among garbage in random pieces: all of them, in order."""
+    cls, request = message_class(g, message), asked(g, message)
+
+    @SETTINGS
+    @given(
+        st.lists(message_fields(g.protocol, message), min_size=1, max_size=4),
+        st.lists(garbage, min_size=5, max_size=5),
+        st.data(),
+    )
+    def parse(drawn: list[dict[str, Any]], noise: list[bytes], data: st.DataObject) -> None:
+        frames = [g.package.encode(cls.from_fields(f), request) for f in drawn]
+        wire = b"".join(noise[i % 5] + frame for i, frame in enumerate(frames)) + noise[-1]
+        cuts = sorted(data.draw(st.lists(st.integers(0, len(wire)), max_size=6)))
+        parser, trickle, idle = (g.package.StreamParser("response") for _ in range(3))
+        parser.expect(cls, request)
+        trickle.expect(cls, request)
+        pieces = [wire[a:b] for a, b in zip([0, *cuts], [*cuts, len(wire)], strict=True)]
+        got = [m.to_fields() for piece in pieces for m in parser.feed(piece)]
+        one_by_one = [m.to_fields() for byte in wire for m in trickle.feed(bytes([byte]))]
+        assert got == one_by_one == drawn
+        assert idle.feed(wire) == []  # no request pending: no reply is taken
+
+    parse()
+
+
 def client_against_simulator(g: Generated) -> None:
     simulator_module = importlib.import_module("matrix_case.simulator")
     client_module = importlib.import_module("matrix_case.client")
@@ -835,15 +985,14 @@ def client_against_simulator(g: Generated) -> None:
     request = next(m for m in g.protocol.messages() if m.direction.value == "request" and m.command == "probe")
     response = reply_to(request, replies_by_request(g.protocol.messages()))
     assert response is not None
-    simulator = simulator_class(ids=[1])
+    addresses = [e for e in g.protocol.framing.layouts[request.direction].value_elements if e.role == "address"]
+    device = 1 if not addresses or addresses[0].minimum <= 1 <= addresses[0].maximum else int(addresses[0].minimum)
+    simulator = simulator_class(ids=[device])
     path = simulator.start()
     try:
         with Bus(path, client_module.BINDING, timeout=1.0) as bus:
             for fields in st_examples(message_fields(g.protocol, request), 3):
-                address = [
-                    e.name for e in g.protocol.framing.layouts[request.direction].value_elements if e.role == "address"
-                ]
-                fields = {**fields, **dict.fromkeys(address, 1)}
+                fields = {**fields, **{e.name: device for e in addresses}}
                 reply = bus.request(message_class(g, request).from_fields(fields), message_class(g, response))
                 assert type(reply) is message_class(g, response)
     finally:
@@ -865,10 +1014,16 @@ def st_examples(strategy: st.SearchStrategy[Any], count: int) -> list[Any]:
 def cli_decode(g: Generated, spec: Path) -> None:
     for message in g.protocol.messages():
         fields = st_examples(message_fields(g.protocol, message), 1)[0]
-        frame = g.package.encode(message_class(g, message).from_fields(fields))
+        request = asked(g, message)
+        frame = g.package.encode(
+            message_class(g, message).from_fields(fields), *(() if request is None else (request,))
+        )
         out = io.StringIO()
+        given = [] if request is None else ["--request", g.package.encode(request).hex(" ")]
         with contextlib.redirect_stdout(out):
-            code = cli.main(["decode", str(spec), frame.hex(" "), "--json", "--direction", message.direction.value])
+            code = cli.main(
+                ["decode", str(spec), frame.hex(" "), "--json", "--direction", message.direction.value, *given]
+            )
         assert code == 0, out.getvalue()
         decoded = json.loads(out.getvalue())
         assert decoded["command"] == message.command and decoded["direction"] == message.direction.value

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define CRSF_SPEC_SHA256 "2b13cceeff9df584df3a97e4d20766b325d82398903ed18bb589d9ce8ab46391"
+#define CRSF_SPEC_SHA256 "1d8b0013dcebc3e32f9ce0536ab5405ab1cb77da05531de3761695a649cdb8aa"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef CRSF_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define VESC_SPEC_SHA256 "8b81e99373abdce14618f6db43901cd76c40005661b878eaf3dfd6d6471f7b7d"
+#define VESC_SPEC_SHA256 "aadaf5c823f8ab97420a3e17f230faba404dd4d0411f06fb781f5aff339ab8f2"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef VESC_ENABLE_ENCODE

@@ -70,9 +70,13 @@ def run(args: argparse.Namespace) -> int:
     for text in frames:
         try:
             frame = _hex(text)
-            message = package.decode(frame, args.direction, expect)
+            if request is not None and (protocol.framing.by_command or protocol.framing.from_request):
+                message = package.decode(frame, args.direction, expect, request)  # replies read with their request
+            else:
+                message = package.decode(frame, args.direction, expect)
         except (DecodeError, SerialspecError) as exc:
             hint = " (--direction request|response)" if str(exc).startswith("give the direction") else ""
+            hint = " (--request HEX)" if str(exc).endswith("give the request") else hint
             print(f"serialspec decode: {text.strip()}: {exc}{hint}", file=sys.stderr)
             failed += 1
             continue

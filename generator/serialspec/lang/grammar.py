@@ -259,6 +259,7 @@ class OneOf(Shape):
 
     options: tuple[Shape, ...] = field(default_factory=tuple)
     description: str = ""
+    example: Any = None  # shown in the reference where no spec uses the key
 
     def check(self, value: Any, path: Path) -> Iterator[tuple[Path, str]]:
         for option in self.options:
@@ -566,6 +567,19 @@ COMMAND = Obj(
             minimum=0,
             maximum=255,
         ),
+        "layout": OneOf(
+            (Str(), MapOf(Str(), "direction -> layout name")),
+            "With `framing.layouts`: the layout this command's frames travel in, a layout name or a mapping "
+            "direction -> layout name (RoboClaw: reads send only address and command, and get data and a CRC; "
+            "writes send data and a CRC, and get one 0xFF byte). Once a command names one, layouts are chosen by "
+            "command, not by header: a command that names none travels in the first layout, a request frame is "
+            "read in the layout of its code (a code sent in another layout is refused), and replies that carry no "
+            "code are read in the layout of the request they answer: `decode` refuses such a reply in one line "
+            "without it (`--request HEX`), the stream parser takes none while no request is pending, and the "
+            "client and the simulator give it. A layout may be constant bytes alone (RoboClaw's 0xFF "
+            "acknowledgement: `ack: {role: header, value: FF, directions: [response]}`).",
+            example="read",
+        ),
         "probe": Bool(
             "The command asks whether a device is there (PING): its client method returns True when the device "
             "answers and False when none does, whatever the reply holds. Every other command with a reply raises "
@@ -797,6 +811,15 @@ FRAME_ELEMENT = Obj(
             "elements of fixed size only. A frame whose code no command has gets no seed.",
             choices=("per_command",),
             example="per_command",
+        ),
+        "from_request": ListOf(
+            Str(),
+            "checksum (of a response): elements of the request this reply answers whose bytes the checksum takes "
+            "in first, in this order, before the span it covers (RoboClaw: the reply CRC starts with the "
+            "request's address and command, which the reply does not carry). Decoding such a reply needs its "
+            "request: `decode` without one refuses it in one line (give `--request HEX`), the stream parser reads "
+            "such replies only while a request is pending (the client and the simulator have it).",
+            example=["address", "command"],
         ),
         "truncate": Str(
             "content: `trailing_zeros`, encode drops the content's trailing zero bytes (keeping at least one) and "

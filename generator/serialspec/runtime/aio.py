@@ -142,7 +142,7 @@ class AsyncBus:
         async with self._lock:
             bus._ensure_open()
             bus._drain()
-            bus._parser.expect(expect)
+            bus._parser.expect(expect, request)
             await self._write(frame)
             reply = await self._until(bus._reading(wait, request, expect))
             bus._flush_backlog()
@@ -161,7 +161,7 @@ class AsyncBus:
         async with self._lock:
             bus._ensure_open()
             bus._drain()
-            bus._parser.expect(expect)
+            bus._parser.expect(expect, request)
             await self._write(frame)
             for key in answers:
                 try:

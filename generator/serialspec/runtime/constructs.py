@@ -136,17 +136,36 @@ class Framed(Adapter):  # type: ignore[misc, type-arg, unused-ignore]
 
     Parses to a Container of `layout` (its name), `code`, `values` (the address/status elements) and `content`; builds
     from the same keys. Construct has no byte stuffing, so frames that are not of the classic shape use this.
+
+    Replies read with the request they answer (layouts chosen by command, a checksum over request bytes) parse
+    with `layout=` (the layout's name) and `request=` (the request's frame) given: `RESPONSE_FRAME.parse(frame,
+    layout="read", request=request_frame)`; without them they are refused as `decode` refuses them.
     """
 
-    def __init__(self, codec: Any) -> None:
+    def __init__(self, codec: Any, requests: Any = None) -> None:
         super().__init__(GreedyBytes)
         self.codec = codec
+        self.requests = requests  # the request frames' codec, where replies are read with their request
+
+    def _asked(self, context: Any) -> dict[str, bytes] | None:
+        request = context.get("request") if self.requests is not None else None
+        return None if request is None else self.requests.unwrap(bytes(request)).named()
+
+    def _layout(self, name: Any) -> Any:
+        return next((layout for layout in self.codec.layouts if layout.name == name), None)
 
     def _decode(self, obj: bytes, context: Any, path: Any) -> Container:  # type: ignore[type-arg, unused-ignore]
-        unwrapped = self.codec.unwrap(bytes(obj))
+        layout = self._layout(context.get("layout"))
+        if layout is not None:
+            unwrapped = layout.unwrap(bytes(obj), self._asked(context))
+        else:
+            unwrapped = self.codec.unwrap(bytes(obj), None, self._asked(context))
         return Container(
             layout=unwrapped.layout.name, code=unwrapped.code, values=list(unwrapped.values), content=unwrapped.content
         )
 
     def _encode(self, obj: Any, context: Any, path: Any) -> bytes:
-        return bytes(self.codec.wrap(bytes(obj["content"]), obj["code"], tuple(obj["values"])))
+        layout = self._layout(obj.get("layout"))
+        index = None if layout is None else self.codec.layouts.index(layout)
+        content, values = bytes(obj["content"]), tuple(obj["values"])
+        return bytes(self.codec.wrap(content, obj["code"], values, index, self._asked(context)))

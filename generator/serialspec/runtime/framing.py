@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import importlib
 import re
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
@@ -46,6 +46,7 @@ class Element:
     maximum: int = 0
     also: int | None = None  # value: one more value allowed (an address's broadcast)
     skip: tuple[int, ...] = ()  # checksum: elements inside the span left out (itself, other checksums)
+    request: tuple[str, ...] = ()  # checksum (of a reply): the request's elements whose bytes it takes in first
 
     def pack(self, value: int) -> bytes:
         return value.to_bytes(self.size, self.endian)
@@ -64,6 +65,7 @@ class Layout:
     name: str
     elements: tuple[Element, ...]
     transparency: SpanTransform | None = None
+    codes: tuple[int, ...] | None = None  # the command codes sent in this layout (layouts chosen by command)
     # derived in __post_init__
     content: int = field(init=False, default=-1)
     values: tuple[int, ...] = field(init=False, default=())
@@ -174,8 +176,11 @@ class Layout:
 
     # --- encoding -------------------------------------------------------------------------------------------------
 
-    def wrap(self, content: bytes, code: int | None, values: tuple[int, ...]) -> bytes:
-        """The frame around `content`; EncodeError when a value does not fit its element (the length, say)."""
+    def wrap(
+        self, content: bytes, code: int | None, values: tuple[int, ...], request: Mapping[str, bytes] | None = None
+    ) -> bytes:
+        """The frame around `content`; EncodeError when a value does not fit its element (the length, say).
+        `request`: the bytes of the request's elements by name, for a checksum that takes some in first."""
         plan: dict[str, Any] = self._plan  # type: ignore[attr-defined]
         elements = self.elements
         plain: list[bytes] = list(plan["template"])  # constants in place, zeros for what is computed below
@@ -203,7 +208,10 @@ class Layout:
                 raise EncodeError(f"{self.name} frame: length {value} does not fit its {element.size}-byte field")
             plain[index] = element.pack(value)
         for index, element in plan["outer_checksums"]:
-            plain[index] = self._checksum(element, self._covered(plain, wire, element))
+            covered = self._covered(plain, wire, element)
+            if element.request:
+                covered = _requested(element, request, EncodeError) + covered
+            plain[index] = self._checksum(element, covered)
         return self._wire(plain, wire, 0, len(elements) - 1)
 
     def _covered(self, plain: list[bytes], wire: dict[int, bytes], element: Element) -> bytes:
@@ -229,8 +237,9 @@ class Layout:
 
     # --- decoding -------------------------------------------------------------------------------------------------
 
-    def unwrap(self, frame: bytes) -> Unwrapped:
-        """Check a complete frame (constants, lengths, stuffing, checksums) and take it apart."""
+    def unwrap(self, frame: bytes, request: Mapping[str, bytes] | None = None) -> Unwrapped:
+        """Check a complete frame (constants, lengths, stuffing, checksums) and take it apart. `request`: the
+        bytes of the request's elements by name, for a checksum that takes some in first."""
         plan: dict[str, Any] = self._plan  # type: ignore[attr-defined]
         before, after = plan["before"], plan["after"]
         n = len(frame)
@@ -247,6 +256,8 @@ class Layout:
         if self.transparency is not None:
             wire[self.transparency.span[0]] = middle
             middle = self.transparency.decode(middle)
+        if not plan["inner"] and middle:  # no content, no span: the frame is its fixed elements alone
+            raise DecodeError(f"frame of {n} bytes is longer than the {self.name} frame ({self.overhead})")
         if plan["inner"]:
             fixed, variable = plan["inner_fixed"], plan["variable"]
             if variable < 0 and len(middle) != fixed or len(middle) < fixed:
@@ -273,7 +284,10 @@ class Layout:
             if value != counted:
                 raise DecodeError(f"{element.name} says {value} but the frame holds {counted}")
         for index, element in plan["checksums"]:
-            expected = element.checksum(self._covered(plain, wire, element))
+            covered = self._covered(plain, wire, element)
+            if element.request:
+                covered = _requested(element, request, DecodeError) + covered
+            expected = element.checksum(covered)
             stored = element.unpack(plain[index])
             if expected != stored:
                 raise ChecksumError(
@@ -282,6 +296,29 @@ class Layout:
                 )
         content = plain[self.content] if self.content >= 0 else b""
         return Unwrapped(self, code, values, content, tuple(plain))
+
+
+def _code_at(layout: Layout, frame: bytes) -> int | None:
+    """The code at the command element's fixed offset in `frame`, where it has one and the frame reaches it."""
+    offset = None if layout.command is None else layout.offset(layout.command)
+    if offset is None or layout.command is None:
+        return None
+    element = layout.elements[layout.command]
+    data = frame[offset : offset + element.size]
+    return element.unpack(data) if len(data) == element.size else None
+
+
+def _class_name(cls: Any) -> Any:
+    """A reply class's name, the key of a codec's `replies` (None stays None)."""
+    return None if cls is None else getattr(cls, "__name__", cls)
+
+
+def _requested(element: Element, request: Mapping[str, bytes] | None, error: type[Exception]) -> bytes:
+    """The request's bytes a reply checksum takes in first; the error (one line) when the request is not known."""
+    if request is None:
+        names = " and ".join(element.request)
+        raise error(f"{element.name} covers the request's {names}: give the request this reply answers")
+    return b"".join(request[name] for name in element.request)
 
 
 def _outside(element: Element, value: int) -> str:
@@ -378,6 +415,10 @@ class Unwrapped:
     content: bytes
     parts: tuple[bytes, ...] = ()  # every element's bytes, unstuffed
 
+    def named(self) -> dict[str, bytes]:
+        """Every element's bytes by its name (what a reply checksum over the request takes in)."""
+        return {element.name: part for element, part in zip(self.layout.elements, self.parts, strict=True)}
+
 
 # A content size rule for frames without a length: content_size(code, buffer, start, end) -> the content's size,
 # None when more bytes are needed to tell, or -1 when no content of that command starts there.
@@ -390,8 +431,12 @@ class SizeRule:
 
     fixed: int
     terms: tuple[tuple[int, int, Literal["little", "big"], int], ...] = ()  # (offset, size, endian, factor)
+    nul: int = -1  # the offset of a NUL-terminated text that ends the content: sized by its NUL (fixed: before it)
 
     def size(self, buffer: bytes, start: int, end: int) -> int | None:
+        if self.nul >= 0:
+            found = buffer.find(0, start + self.nul, end)
+            return None if found < 0 else found + 1 - start
         total = self.fixed
         for offset, size, endian, factor in self.terms:
             if start + offset + size > end:
@@ -412,25 +457,48 @@ class FrameCodec:
     def __init__(
         self,
         layouts: Iterable[Layout],
-        content_sizes: dict[int | None, tuple[int, int | None]],
-        size_rules: dict[int | None, SizeRule] | None = None,
+        content_sizes: dict[Any, tuple[int, int | None]],
+        size_rules: dict[Any, SizeRule] | None = None,
         error_flag: int = 0,
+        replies: dict[Any, int] | None = None,
     ) -> None:
+        """`replies`: frames that carry no code, in layouts chosen by command: each reply class's layout (by index),
+        read only with the request's reply class given; content_sizes and size_rules are then by reply class (all
+        three keyed by the class's name, so the construct structs hold them without the message classes)."""
         self.layouts = tuple(layouts)
+        self.replies = replies or {}
         self.content_sizes = content_sizes  # content size bounds by code (plain bytes)
         self.size_rules = size_rules or {}
         self.error_flag = error_flag
         # probe() for each layout, its plan read once into a closure (what the stream parser calls per candidate)
         self.sizers = tuple(self._sizer(layout) for layout in self.layouts)
 
-    def wrap(self, content: bytes, code: int | None, values: tuple[int, ...]) -> bytes:
+    @property
+    def requests(self) -> bool:
+        """Its frames are read with the request they answer (`replies`, or a checksum over request bytes)."""
+        return bool(self.replies) or any(e.request for layout in self.layouts for e in layout.elements)
+
+    def wrap(
+        self,
+        content: bytes,
+        code: int | None,
+        values: tuple[int, ...],
+        layout: int | None = None,
+        request: Mapping[str, bytes] | None = None,
+    ) -> bytes:
+        """The frame in the first layout that can hold it; `layout`: in that one (layouts chosen by command)."""
+        if layout is not None:
+            return self.layouts[layout].wrap(content, code, values, request)
         problem: EncodeError | None = None
-        for layout in self.layouts:
+        for candidate in self.layouts:
+            if candidate.codes is not None and code not in candidate.codes:
+                continue
             try:
-                return layout.wrap(content, code, values)
+                return candidate.wrap(content, code, values, request)
             except EncodeError as exc:
                 problem = exc
-        assert problem is not None
+        if problem is None:
+            raise EncodeError(f"no layout sends code {code}")
         raise problem
 
     def layout_of(self, frame: bytes) -> Layout:
@@ -442,11 +510,49 @@ class FrameCodec:
         choices = " or ".join(layout.header.hex(" ") for layout in self.layouts)
         raise DecodeError(f"frame starts {frame[:4].hex(' ')}, expected {choices}")
 
-    def unwrap(self, frame: bytes) -> Unwrapped:
-        return self.layout_of(frame).unwrap(frame)
+    def unwrap(self, frame: bytes, expect: Any = None, request: Mapping[str, bytes] | None = None) -> Unwrapped:
+        """Check a frame and take it apart: in the layout its header names, in the layout of its code (layouts
+        chosen by command), or, for replies that carry no code, in the layout of `expect` (the reply class)."""
+        if self.replies:
+            if expect is None:
+                raise DecodeError(
+                    "a reply without a command code is read in the layout of the request it answers: give the request"
+                )
+            index = self.replies.get(_class_name(expect))
+            if index is None:
+                raise DecodeError(f"{getattr(expect, '__name__', expect)} is no reply of these frames")
+            return self.layouts[index].unwrap(frame, request)
+        if any(layout.codes is not None for layout in self.layouts):
+            # the refusal of the layout that sends the frame's code first, then any layout's, then a code sent in
+            # another layout
+            problem: DecodeError | None = None
+            elsewhere: DecodeError | None = None
+            for layout in self.layouts:
+                if not frame.startswith(layout.header):
+                    continue
+                try:
+                    unwrapped = layout.unwrap(frame, request)
+                except DecodeError as exc:
+                    if layout.codes is not None and _code_at(layout, frame) in layout.codes:
+                        raise
+                    problem = problem or exc
+                    continue
+                if layout.codes is None or unwrapped.code in layout.codes:
+                    return unwrapped
+                code = "no code" if unwrapped.code is None else f"code {unwrapped.code:#04x}"
+                elsewhere = elsewhere or DecodeError(f"{code} is not sent in layout {layout.name!r}")
+            problem = problem or elsewhere
+            if problem is None:
+                choices = " or ".join(layout.header.hex(" ") for layout in self.layouts)
+                problem = DecodeError(f"frame starts {frame[:4].hex(' ')}, expected {choices}")
+            raise problem
+        return self.layout_of(frame).unwrap(frame, request)
 
-    def probe(self, layout: Layout, buffer: bytes, start: int, end: int) -> int | None:
-        """Size of a plausible frame of `layout` at buffer[start:], None when more bytes are needed, -1 if none."""
+    def probe(self, layout: Layout, buffer: bytes, start: int, end: int, expect: Any = None) -> int | None:
+        """Size of a plausible frame of `layout` at buffer[start:], None when more bytes are needed, -1 if none.
+        `expect`: the reply class awaited, for replies read in the layout of their request (`replies`)."""
+        if self.replies and self.replies.get(_class_name(expect)) != self.layouts.index(layout):
+            return -1  # no reply awaited, or one of another layout
         plan: dict[str, Any] = layout._plan  # type: ignore[attr-defined]
         available = end - start
         code: int | None = None
@@ -461,14 +567,16 @@ class FrameCodec:
             elif kind == "command":
                 value = int.from_bytes(data, element.endian)
                 code = ERROR_REPLY if value & self.error_flag else value
-                if code not in self.content_sizes:
+                if code not in self.content_sizes or (layout.codes is not None and code not in layout.codes):
                     return -1
             elif kind == "value" and not element.plausible(int.from_bytes(data, element.endian)):
                 return -1
         if layout.command is None:
-            code = None
-            if None not in self.content_sizes:
+            code = _class_name(expect) if self.replies else None
+            if code not in self.content_sizes:
                 return -1
+        if layout.content < 0 and layout.transparency is None:
+            return layout.overhead  # its fixed elements alone (a bare acknowledgement)
         low, high = self.content_sizes.get(code, (0, None))
         if plan["probe_inner"] is not None:
             return _inner_size(layout, plan, buffer, start, end, low, high)
@@ -500,7 +608,7 @@ class FrameCodec:
         if layout.transparency is not None or len(plan["checksums"]) != 1:
             return None
         index, element = plan["checksums"][0]
-        if element.skip:
+        if element.skip or element.request:
             return None
         head = {i: begin for i, begin, _ in plan["head"]}
         tail = {i: (begin, finish) for i, begin, finish in plan["tail"]}
@@ -530,7 +638,7 @@ class FrameCodec:
         the sizer checks (constants, one-byte commands and values) as the class of the bytes it allows, a head the
         buffer ends in matching as far as it goes (the sizer then waits for more). b"" when any byte can start one;
         None when no frame of the layout is plausible. The stream parser finds its candidates with it, in C."""
-        if layout.command is None and None not in self.content_sizes:
+        if layout.command is None and None not in self.content_sizes and not self.replies:
             return None
         plan: dict[str, Any] = layout._plan  # type: ignore[attr-defined]
         classes: list[bytes] = []
@@ -540,7 +648,14 @@ class FrameCodec:
                 allowed = [[byte] for byte in element.constant]
             elif element.kind == "command" and stop == first + 1:
                 codes = self.content_sizes
-                allowed = [[v for v in range(256) if (ERROR_REPLY if v & self.error_flag else v) in codes]]
+                allowed = [
+                    [
+                        v
+                        for v in range(256)
+                        if (ERROR_REPLY if v & self.error_flag else v) in codes
+                        and (layout.codes is None or v in layout.codes)
+                    ]
+                ]
             elif element.kind == "value" and stop == first + 1:
                 allowed = [[v for v in range(256) if element.plausible(v)]]
             for values in allowed:
@@ -564,6 +679,8 @@ class FrameCodec:
         """
         plan: dict[str, Any] = layout._plan  # type: ignore[attr-defined]
         if plan["probe_inner"] is not None:  # sized by reading into the transformed span: probe() decides
+            return lambda buffer, start, end: self.probe(layout, buffer, start, end)
+        if layout.codes is not None or layout.content < 0:  # layouts chosen by command, fixed frames: probe()
             return lambda buffer, start, end: self.probe(layout, buffer, start, end)
         head: tuple[tuple[Element, int, int], ...] = plan["probe_head"]
         need = max((stop for _, _, stop in head), default=0)
@@ -636,7 +753,7 @@ class FrameCodec:
         return sizer
 
 
-Decode = Callable[[bytes, "type[Message] | None"], Message]
+Decode = Callable[..., Message]  # (frame, expected reply class[, request])
 Verify = Callable[[bytes, int, int], bool]
 
 
@@ -670,10 +787,13 @@ class FrameStreamParser(StreamParser):
         # every layout's sizer with its format's decoder, in the order candidates try them
         # and a checksum test before a candidate is decoded, where the layout allows one (FrameCodec.verifier)
         self._sizers = tuple(
-            (sizer, decode, codec.verifier(layout))
+            (self._by_request(codec, layout) if codec.replies else sizer, decode, codec.verifier(layout))
             for codec, decode in formats
             for sizer, layout in zip(codec.sizers, codec.layouts, strict=True)
         )
+        # replies read with the request they answer: the pending request, given to the decoder (see expect)
+        self._requests = any(codec.requests for codec, _ in formats)
+        self.request: Message | None = None
         # by a candidate's first byte, the sizers of the layouts that can start with it (a layout whose head begins
         # with a constant answers -1 for every other byte: it is not asked)
         firsts = [codec.first_byte(layout) for codec, _ in formats for layout in codec.layouts]
@@ -699,9 +819,17 @@ class FrameStreamParser(StreamParser):
         self.garbage = 0
         self.expected: type[Message] | None = None
 
-    def expect(self, cls: type[Message] | None) -> None:
-        """The reply class the next frames answer, where several reply layouts share a code (PING's vs READ's)."""
+    def _by_request(self, codec: FrameCodec, layout: Layout) -> Callable[[bytes, int, int], int | None]:
+        """The sizer of a layout of replies read in the layout of their request: the awaited reply class's."""
+        return lambda buffer, start, end: codec.probe(layout, buffer, start, end, self.expected)
+
+    def expect(self, cls: type[Message] | None, request: Message | None = None) -> None:
+        """The reply class the next frames answer, where several reply layouts share a code (PING's vs READ's),
+        and the request they answer, where replies are read with it (layouts chosen by command, a reply checksum
+        over request bytes). Without one such replies are not taken: their bytes count as garbage."""
         self.expected = cls
+        if self._requests:
+            self.request = request
 
     def feed(self, data: bytes | bytearray | memoryview) -> list[Message]:
         """One pass over the candidates from the last frame taken on: the valid frame that ends first (then starts
@@ -712,7 +840,7 @@ class FrameStreamParser(StreamParser):
         end = len(buffer)
         found: list[Message] = []
         search = self._finder.search if self._finder is not None else None
-        smallest, expected = self._smallest, self.expected
+        smallest, expected, request = self._smallest, self.expected, self.request
         start = 0
         ahead = -1  # the candidate the last search found (a match of the pattern does not depend on where it began)
         while True:
@@ -745,7 +873,11 @@ class FrameStreamParser(StreamParser):
                         # starts at, usually a frame: decoding it checks the checksum once
                         if verify is None or position == start or verify(buffer, position, stop):
                             try:
-                                message = decode(buffer[position:stop], expected)
+                                message = (
+                                    decode(buffer[position:stop], expected)
+                                    if request is None
+                                    else decode(buffer[position:stop], expected, request)
+                                )
                             except DecodeError:
                                 message = None
                         if message is None:

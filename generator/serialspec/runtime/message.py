@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import inspect
 import keyword
 from collections import _tuplegetter  # type: ignore[attr-defined]
 from collections.abc import Callable
@@ -204,3 +205,11 @@ def compare(value: float | None, op: str, operand: float) -> bool:
     if op == "!=":
         return value != operand
     return value == operand
+
+
+def takes_request(function: Callable[..., Any]) -> bool:
+    """Whether a codec's encode or decode takes `request` (its replies are made and read with their request)."""
+    try:
+        return "request" in inspect.signature(function).parameters
+    except (TypeError, ValueError):  # no signature to read: an ordinary codec
+        return False

@@ -602,8 +602,9 @@ class StreamParser:
                 best, best_candidate = position, candidate
         return best, best_candidate
 
-    def expect(self, cls: type[Message] | None) -> None:
-        """The reply class the next frames answer; classic frames have one layout per code, so it changes nothing."""
+    def expect(self, cls: type[Message] | None, request: Message | None = None) -> None:
+        """The reply class the next frames answer (and the request they answer); classic frames have one layout
+        per code, so it changes nothing."""
 
     def pending(self) -> bytes:
         """Bytes held back, waiting to complete a frame."""

@@ -27,7 +27,7 @@ from typing import Any, TypeVar
 import serial
 
 from serialspec.runtime.errors import CorruptReply, DeviceError, EncodeError, PortError, Timeout
-from serialspec.runtime.message import Direction, Message, Record
+from serialspec.runtime.message import Direction, Message, Record, takes_request
 from serialspec.runtime.settings import SerialSettings as SerialSettings  # packages generated before import it here
 from serialspec.runtime.stream import StreamParser
 
@@ -401,6 +401,8 @@ class Bus:
         self._match_subcommand = "subcommand" in match_by
         self._match_fields = tuple(name for name in match_by if name not in ("command", "subcommand"))
         self._decode = binding.decode
+        # a codec that reads replies with the request they answer (layouts chosen by command): given it
+        self._asks = binding.decode is not None and takes_request(binding.decode)
         self._encoders = binding.encoders
         self._sizes: dict[type, int] = {}  # the size of the last reply of each type read whole (see request)
         self._rules: dict[type, _Rule] = {}  # the latest rule of each reply type
@@ -498,12 +500,12 @@ class Bus:
                     raise
                 if chunk is None:  # bytes came between transactions: to subscribers, then the request
                     if expects:
-                        parser.expect(expect)
+                        parser.expect(expect, request)
                     self._stale(stale)
             if chunk is None:  # the general path: an echo, or bytes that came before the request
                 self._drain()
                 parser = self._parser  # a subscriber's own request may have reset it
-                parser.expect(expect)
+                parser.expect(expect, request)
                 self._write(frame)
                 started = time.monotonic()
                 try:
@@ -519,12 +521,16 @@ class Bus:
                 if size == self._sizes.get(expect) and not parser.pending():
                     # the size the last reply of this type had: most likely that reply, whole; decoded at once
                     try:
-                        found: Message | None = self._decode(chunk, _RESPONSE, expect)  # type: ignore[misc]
+                        found: Message | None = (
+                            self._decode(chunk, _RESPONSE, expect, request)  # type: ignore[misc, call-arg]
+                            if self._asks
+                            else self._decode(chunk, _RESPONSE, expect)  # type: ignore[misc]
+                        )
                     except Exception:  # anything else is for the parser, which counts it and resynchronises
                         found = None
                 else:
                     if expects:
-                        parser.expect(expect)
+                        parser.expect(expect, request)
                     messages = parser.feed(chunk)
                     found = messages[0] if len(messages) == 1 else None
                 if found is not None and found.__class__ is expect:
@@ -545,11 +551,11 @@ class Bus:
                         return found  # its class is expect
                 if messages is None:  # decoded at once but no reply to this request: the parser takes it
                     if expects:
-                        parser.expect(expect)
+                        parser.expect(expect, request)
                     messages = parser.feed(chunk)
                 self._backlog.extend(messages)  # _read_until takes them first
             if expects:
-                self._parser.expect(expect)
+                self._parser.expect(expect, request)
             reply = self._read_until(wait - (time.monotonic() - started), request, expect, errors=0, timeout=wait)
             if self._backlog:
                 self._flush_backlog()
@@ -595,7 +601,7 @@ class Bus:
         with self._lock:
             self._ensure_open()
             self._drain()
-            self._parser.expect(expect)
+            self._parser.expect(expect, request)
             self._write(frame)
             for key in answers:
                 try:

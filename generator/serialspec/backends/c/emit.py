@@ -18,6 +18,7 @@ from typing import assert_never
 from serialspec.backends import Unsupported
 from serialspec.backends.c import packed
 from serialspec.backends.c.checksums import c_checksum
+from serialspec.backends.common.frames import refuse_by_command
 from serialspec.backends.common.text import collapse
 from serialspec.checksums.base import CCode
 from serialspec.lang import expression
@@ -183,6 +184,7 @@ def refuse_unsupported(protocol: Protocol) -> None:
     """Raise Unsupported naming the first feature of the spec the C target cannot generate yet."""
     if protocol.text is not None:
         raise Unsupported("text framing (`framing: {kind: text}`)")
+    refuse_by_command(protocol)
     for command in protocol.commands:
         if command.selector is not None and command.selector.type.size != 1:
             raise Unsupported(f"sub-command selectors of more than one byte (command {command.name})")

@@ -6,7 +6,8 @@ byte by byte). One mapping from model to engine, so the two cannot disagree.
 
 from __future__ import annotations
 
-from serialspec.lang.model import Direction, FrameElement, FrameLayout, Protocol
+from serialspec.backends import Unsupported
+from serialspec.lang.model import Direction, FrameElement, FrameLayout, Message, Protocol
 from serialspec.runtime.framing import Element, ElementKind, Layout
 
 KINDS: dict[str, ElementKind] = {
@@ -48,15 +49,47 @@ def runtime_element(layout: FrameLayout, element: FrameElement) -> Element:
         maximum=int(element.maximum) if kind in ("value", "command") else 0,
         also=element.broadcast if kind in ("value", "command") else None,
         skip=skip,
+        request=element.checksum.from_request if element.checksum is not None else (),
     )
 
 
-def runtime_layout(layout: FrameLayout) -> Layout:
+def runtime_layout(layout: FrameLayout, codes: tuple[int, ...] | None = None) -> Layout:
     t = layout.transparency
     transparency = t.transform.runtime((layout.index(t.first), layout.index(t.last))) if t else None
     elements = tuple(runtime_element(layout, e) for e in layout.elements)
-    return Layout(layout.name or layout.direction.value, elements, transparency)
+    return Layout(layout.name or layout.direction.value, elements, transparency, codes)
+
+
+def layout_codes(protocol: Protocol, layout: FrameLayout) -> tuple[int, ...] | None:
+    """The command codes sent in a layout, where layouts are chosen by command (`layout:`) and its frames carry
+    one; None otherwise (any code)."""
+    if not protocol.framing.by_command or not layout.has_command:
+        return None
+    codes = set()
+    for command in protocol.commands:
+        code = command.wire_code(layout.direction)
+        for message in command.messages():
+            if code is not None and message.direction == layout.direction and protocol.layout(message) == layout:
+                codes.add(code)
+    return tuple(sorted(codes))
+
+
+def layout_index(protocol: Protocol, message: Message) -> int:
+    """The index of a message's layout among its direction's alternatives."""
+    names = [layout.name for layout in protocol.framing.alternatives[message.direction]]
+    return names.index(protocol.layout(message).name)
 
 
 def runtime_layouts(protocol: Protocol, direction: Direction) -> tuple[Layout, ...]:
-    return tuple(runtime_layout(layout) for layout in protocol.framing.alternatives[direction])
+    return tuple(
+        runtime_layout(layout, layout_codes(protocol, layout)) for layout in protocol.framing.alternatives[direction]
+    )
+
+
+def refuse_by_command(protocol: Protocol) -> None:
+    """Unsupported for frames read with the request they answer, in targets that take each frame alone (the C
+    decoder, the Wireshark dissector)."""
+    if protocol.framing.by_command:
+        raise Unsupported("layouts chosen by command (`layout:`)")
+    if protocol.framing.from_request:
+        raise Unsupported("a reply checksum over bytes of its request (`from_request`)")

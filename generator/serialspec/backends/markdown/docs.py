@@ -170,8 +170,9 @@ def field_rows(fields: tuple[Field, ...], start: int | None, prefix: str = "") -
 def message_context(protocol: Protocol, message: Message | None) -> dict[str, Any] | None:
     if message is None:
         return None
-    layout = protocol.framing.layouts[message.direction]
-    content_offset = layout.offsets[next(e.name for e in layout.elements if e.role == "content")]
+    layout = protocol.layout(message)
+    content = next((e.name for e in layout.elements if e.role == "content"), None)
+    content_offset = layout.offsets[content] if content is not None else layout.overhead  # a bare frame: none
     size = size_text(message.min_size, message.max_size, content_limit(layout))
     if message.padded is not None:
         size = f"{size_text(message.padded, message.padded, None)}, sent without its trailing zero bytes (at least 1)"
@@ -191,6 +192,7 @@ def message_context(protocol: Protocol, message: Message | None) -> dict[str, An
         "reply": "; ".join(
             part
             for part in (
+                f"in layout `{protocol.layout(message).name}`" if protocol.framing.by_command else "",
                 shared_request_text(protocol, message),
                 reply_text(message, protocol) or error_reply_text(protocol, message),
             )
@@ -297,6 +299,8 @@ def shared_reply_text(protocol: Protocol, message: Message) -> str:
     layout = protocol.framing.layouts[Direction.RESPONSE]
     code = protocol.command(message.command).wire_code(Direction.RESPONSE) if layout.has_command else None
     sharing, asking = reply_sharing(protocol)
+    if protocol.framing.by_request(Direction.RESPONSE):
+        return "read in the layout of the request it answers (decoding it needs that request)"
     if sharing[code] < 2:
         return ""
     askers = sorted(asking.get(message.key, ()))
@@ -425,7 +429,9 @@ def frame_context(protocol: Protocol, layout: FrameLayout) -> dict[str, Any]:
             endian = "" if e.checksum.type.size == 1 else ", big-endian" if e.endian == ">" else ", little-endian"
             left_out = ", ".join(f"`{name}`" for name in e.checksum.skips)
             skips = f" leaving out {left_out}" if left_out else ""
-            description = f"over `{e.checksum.first}`..`{e.checksum.last}`{skips}{endian}. {e.description}"
+            asked = " and ".join(f"`{name}`" for name in e.checksum.from_request)
+            after = f"the request's {asked} (bytes it answers), then " if asked else ""
+            description = f"over {after}`{e.checksum.first}`..`{e.checksum.last}`{skips}{endian}. {e.description}"
         elif e.role == "command" and layout.direction == Direction.RESPONSE and protocol.framing.reply_code:
             computed = f"the code of the request it answers, as `{protocol.framing.reply_code}`"
             description = ". ".join(p for p in (computed, e.description) if p)
@@ -510,6 +516,13 @@ def checksum_context(protocol: Protocol, general: Checksum | None = None) -> dic
         "skips": (
             " but for " + ", ".join(f"`{name}`" for name in checksum.skips) + " (checksums inside the span)"
             if checksum.skips
+            else ""
+        )
+        + (
+            ", after the bytes of the request's "
+            + " and ".join(f"`{n}`" for n in checksum.from_request)
+            + " (the request this reply answers)"
+            if checksum.from_request
             else ""
         ),
         "worked": worked,

@@ -12,6 +12,7 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
 from typing import assert_never
 
+from serialspec.backends.common.frames import layout_index
 from serialspec.backends.common.numbers import number
 from serialspec.backends.python.checksum_code import checksum_expression, checksum_lines
 from serialspec.backends.python.dispatch import decoder_name, encoder_name
@@ -756,7 +757,7 @@ class PackageCode:
         body: Block = []
         where = self.where(message)
         frame_fields = all_fields[: len(all_fields) - len(self.value_fields(message))]
-        layout = self.protocol.framing.layouts[message.direction]
+        layout = self.protocol.layout(message)
         elements = {e.name: e for e in layout.value_elements}
         frame_values = []
         error = self.protocol.error_reply if message.error_reply else None
@@ -792,6 +793,9 @@ class PackageCode:
             if inline:  # the frame made here (backends/python/straight_frames.py): no call of the direction's wrap
                 return [*body, *inline]
             arguments = ", ".join([content, code, *frame_values])
+            framing = self.protocol.framing
+            if framing.by_command or framing.from_request:  # its layout, and the request a reply answers
+                arguments += f", {layout_index(self.protocol, message)}, request"
             # backends/python/straight_frames.py
             body.append(Code(f"return _wrap_{message.direction.value}({arguments})", lists=packed_lists(parts)))
             return body

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 
-from serialspec.backends.common.frames import runtime_element
+from serialspec.backends.common.frames import layout_codes, layout_index, runtime_element
 from serialspec.backends.python.checksum_code import checksum_name
 from serialspec.backends.python.dispatch import ERROR_REPLY
 from serialspec.checksums.base import Import
@@ -21,6 +21,7 @@ from serialspec.lang.model import (
     FrameLayout,
     Message,
     Protocol,
+    nul_ended,
     size_terms,
 )
 from serialspec.transforms import runtime_classes
@@ -88,28 +89,35 @@ def element_expr(layout: FrameLayout, element: FrameElement) -> str:
         args.append(f"checksum={checksum_name(element.checksum)}")
         if e.skip:
             args.append(f"skip={e.skip}")
+        if e.request:
+            args.append(f"request={e.request}")
     return f"Element({', '.join(args)})"
 
 
-def layout_lines(layout: FrameLayout) -> list[str]:
-    """`Layout(...)` of one layout, as lines (indented by the caller)."""
+def layout_lines(layout: FrameLayout, codes: tuple[int, ...] | None = None) -> list[str]:
+    """`Layout(...)` of one layout, as lines (indented by the caller); `codes`: the codes sent in it."""
     lines = [f"Layout({(layout.name or layout.direction.value)!r}, ("]
     lines += [f"    {element_expr(layout, e)}," for e in layout.elements]
+    shown = ", ".join(f"{c:#04x}" for c in codes or ()) + ("," if codes is not None and len(codes) == 1 else "")
+    end = f"), codes=({shown}))," if codes is not None else ")),"
     if layout.transparency is None:
-        lines.append(")),")
+        lines.append(end)
         return lines
     t = layout.transparency
     lines.append(f"), {t.transform.runtime_name}(")
     lines += [
         f"    {argument}," for argument in t.transform.python_arguments((layout.index(t.first), layout.index(t.last)))
     ]
-    lines.append(")),")
+    lines.append(end)
     return lines
 
 
 def size_rule(message: Message) -> str | None:
     """`SizeRule(...)` for a message whose content size follows from its fields (model.size_terms), or None."""
     found = size_terms(message.fields)
+    text = nul_ended(message.fields)
+    if found is None and text is not None:
+        return f"SizeRule({text}, nul={text})"
     if found is None:
         return None
     fixed, terms = found
@@ -132,7 +140,7 @@ def codec_lines(
     names = {"FrameCodec", "Layout", "Element"}
     lines = [f"_{direction.name}_FRAMES = FrameCodec(", "    ("]
     for layout in layouts:
-        lines += [f"        {line}" for line in layout_lines(layout)]
+        lines += [f"        {line}" for line in layout_lines(layout, layout_codes(protocol, layout))]
         names |= {layout.transparency.transform.runtime_name} if layout.transparency is not None else set()
     lines.append("    ),")
     # content size bounds by command code (None: unbounded)
@@ -149,6 +157,14 @@ def codec_lines(
     error = protocol.error_reply
     if error is not None and direction == Direction.RESPONSE:
         lines.append(f"    error_flag={error.flag:#04x},")
+    if protocol.framing.by_request(direction):  # each reply class's layout: read with the request's reply class
+        lines.append("    replies={")
+        lines += [
+            f"        {m.class_name!r}: {layout_index(protocol, m)},"
+            for m in protocol.messages()
+            if m.direction == direction
+        ]
+        lines.append("    },")
     return [*lines, ")"], names
 
 

@@ -121,6 +121,7 @@ class Target:
     error_keep: int = 0
     expected: bool = False
     only: str = ""  # the one content decoder of frames that carry no command code: called directly
+    requesting: bool = False  # frames read and made with the request they answer (layouts chosen by command)
 
 
 def straight(layout: Layout) -> bool:
@@ -670,6 +671,26 @@ def engine_lines(layouts: tuple[Layout, ...], target: Target) -> tuple[Lines, Li
     values = [f"v_{v}" for v in target.value_names]
     shown = f"({values[0]},)" if len(values) == 1 else f"({', '.join(values)})"
     parameters = ", ".join(["content: bytes", "code: int | None", *(f"{v}: int" for v in values)])
+    if target.requesting:  # the layout by the message's command, the request's bytes for a checksum over them
+        wrap = [
+            f"def _wrap_{direction}({parameters}, layout: int | None = None, request: Message | None = None) -> bytes:",
+            f'    """The {direction} frame around `content` in its layout, made by the frame engine."""',
+            f"    return {frames}.wrap(content, code, {shown}, layout, _request_parts(request))",
+        ]
+        decode = [
+            f"def _decode_{direction}(frame: bytes, expect: type[Message] | None = None, "
+            "request: Message | None = None) -> Message:",
+            f'    """One complete {direction} frame, checked and taken apart by the frame engine (with the request it',
+            '    answers, where its layout or checksum needs it); its content decoded."""',
+            *(
+                ["    if expect is None and request is not None:", "        expect = _REPLY_TO.get(type(request))"]
+                if direction == "response"
+                else []
+            ),
+            f"    unwrapped = {frames}.unwrap(frame, expect, _request_parts(request))",
+            "    code, content = unwrapped.code, unwrapped.content",
+        ]
+        return _engine_decode(decode, target), wrap
     wrap = [
         f"def _wrap_{direction}({parameters}) -> bytes:",
         f'    """The {direction} frame around `content`, made by the frame engine."""',
@@ -681,9 +702,13 @@ def engine_lines(layouts: tuple[Layout, ...], target: Target) -> tuple[Lines, Li
         f"    unwrapped = {frames}.unwrap(frame)",
         "    code, content = unwrapped.code, unwrapped.content",
     ]
+    return _engine_decode(decode, target), wrap
+
+
+def _engine_decode(decode: Lines, target: Target) -> Lines:
+    """The engine's decode function, its content dispatched by code (and by the expected class)."""
     arguments = "content, 0, len(content), *unwrapped.values"
-    decode += [f"    {line}" for line in _dispatch(target, "code", arguments, nullable=True)]
-    return decode, wrap
+    return [*decode, *(f"    {line}" for line in _dispatch(target, "code", arguments, nullable=True))]
 
 
 @dataclass(frozen=True)
@@ -702,6 +727,8 @@ def straight_direction(protocol: Protocol, direction: Direction) -> StraightLayo
     names = {tuple(e.name for e in (layout.elements[i] for i in layout.values)) for layout in layouts}
     if not all(straight(layout) for layout in layouts) or len(names) != 1:
         return None
+    if protocol.framing.by_command or protocol.framing.from_request:
+        return None  # layouts chosen by command, checksums over the request: the engine's
     algorithms = tuple(
         {index: e.checksum for index, e in enumerate(model.elements) if e.checksum is not None}
         for model in protocol.framing.alternatives[direction]
@@ -723,7 +750,8 @@ def direction_functions(
     d = direction.value
     if found is None:
         decode, wrap = engine_lines(runtime_layouts(protocol, direction), target)
-        return [*decode, "", "", *wrap], [f"return _decode_{d}(bytes(data), expect)"]
+        request = ", request" if target.requesting else ""
+        return [*decode, "", "", *wrap], [f"return _decode_{d}(bytes(data), expect{request})"]
     layouts = found.layouts
     several = len(layouts) > 1
     lines: Lines = []
@@ -1140,6 +1168,8 @@ def length_byte_codec_context(protocol: Protocol, code: PackageCode) -> dict[str
         imports, definitions = checksum_definitions(protocol)
     return {
         "length_byte_frames": True,
+        "requesting": False,
+        "reply_to": [],
         "checksum_imports": imports,
         "checksum_definitions": definitions,
         "directions": directions,
@@ -1876,7 +1906,9 @@ def straight_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, A
     """Frames of any other shape: straight-line frame functions per direction where the layouts allow them (see
     straight_frames.py), else the runtime's frame engine; one FrameCodec per direction either way (the stream parser's),
     decoders by code (and by class)."""
-    imports, definitions = checksum_definitions(protocol)
+    # layouts chosen by command, checksums over request bytes: the engine's code only (no straight-line checks)
+    engine_only = protocol.framing.by_command or protocol.framing.from_request
+    imports, definitions = checksum_definitions(protocol, straight=not engine_only)
     directions: list[dict[str, Any]] = []
     dispatchers = []
     size_dispatchers: list[dict[str, Any]] = []
@@ -1891,7 +1923,8 @@ def straight_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, A
         dispatch, sizes, single, expected = table.dispatch, table.sizes, table.single, table.expected
         only = dispatch[0][1] if not layout.has_command and len(dispatch) == 1 and not expected else ""
         values = tuple(e.name for e in layout.value_elements)
-        frames = Target(direction.name, values, expected=bool(expected), only=only)
+        requesting = protocol.framing.by_command or protocol.framing.from_request
+        frames = Target(direction.name, values, expected=bool(expected), only=only, requesting=requesting)
         if protocol.error_reply is not None and direction == Direction.RESPONSE:
             element = next(e for e in layout.elements if e.name == protocol.error_reply.element)
             assert element.type is not None
@@ -1901,6 +1934,10 @@ def straight_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, A
         plain = unpacked_messages(single, code) if not expected and not frames.error_flag else []
         functions, call = direction_functions(protocol, direction, frames, frame_structs, plain)
         names |= {ERROR_REPLY} if frames.error_flag else set()
+        if protocol.framing.by_request(direction):  # content sizes and size rules by reply class
+            answering = [m for m in protocol.messages() if m.direction == direction]
+            sizes = [(repr(m.class_name), m.min_size, m.max_size) for m in answering]
+            single = {repr(m.class_name): m for m in answering}
         frame_codec, used = codec_lines(protocol, direction, sizes, single)
         names |= used
         directions.append(
@@ -1928,8 +1965,17 @@ def straight_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, A
     ]
     code.structs.update(frame_structs)  # listed with the content's structs (common_codec_context)
     by_header = all(headers) and len(set(headers)) == len(headers)
+    requesting = protocol.framing.by_command or protocol.framing.from_request
     return {
         "length_byte_frames": False,
+        "requesting": requesting,
+        "reply_to": [
+            (m.class_name, reply.class_name)
+            for m in protocol.messages()
+            if m.direction == Direction.REQUEST and (reply := reply_to(m, replies)) is not None
+        ]
+        if requesting
+        else [],
         "reply_layouts": reply_layouts,
         "framing_imports": sorted(names, key=import_order),
         # the straight-line frame checks raise it (the engine raises its own)

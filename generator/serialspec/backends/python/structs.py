@@ -94,7 +94,10 @@ def structs_module(protocol: Protocol) -> str:
             lines, used = codec_lines(protocol, direction, [], {})
             definitions += ["", *lines]
             names |= used
-        frames = [{"name": f"{d.name}_FRAME", "expr": f"Framed(_{d.name}_FRAMES)"} for d in Direction]
+        # replies read with their request (layouts chosen by command, a checksum over request bytes): its frames'
+        requests = protocol.framing.by_command or protocol.framing.from_request
+        asked = {d: ", _REQUEST_FRAMES" if requests and d == Direction.RESPONSE else "" for d in Direction}
+        frames = [{"name": f"{d.name}_FRAME", "expr": f"Framed(_{d.name}_FRAMES{asked[d]})"} for d in Direction]
     return render(
         "structs.py.j2",
         spec_path=protocol.spec_path,

@@ -43,11 +43,15 @@ class _Checker:
     def message_class(self, command: str, subcommand: str | None, direction: str) -> Any:
         return self.classes.get((command, subcommand, direction))
 
-    def decodes_as(self, frame: bytes, direction: str, command: str, subcommand: str | None, fields: Any) -> str:
-        """What is wrong with reading `frame` as the given message with the given values ("" if nothing)."""
+    def decodes_as(
+        self, frame: bytes, direction: str, command: str, subcommand: str | None, fields: Any, request: Any = None
+    ) -> str:
+        """What is wrong with reading `frame` as the given message with the given values ("" if nothing);
+        `request`: the request it answers, where replies are read with it."""
         expect = self.message_class(command, subcommand, direction)  # the reply layout, where replies share a code
+        asked = () if request is None else (request,)
         try:
-            message = self.package.decode(frame, direction, expect)
+            message = self.package.decode(frame, direction, expect, *asked)
         except SerialspecError as exc:
             return f"the frame does not decode: {exc}"
         if (command, subcommand) != (message.COMMAND, message.SUBCOMMAND):
@@ -58,14 +62,28 @@ class _Checker:
             return f"the frame decodes to other values: {_difference(found_fields, fields)}"
         return ""
 
+    def asked(self, example: Example) -> Any:
+        """The request a reply example answers (its `request` example, decoded), where replies are read with it."""
+        framing = self.protocol.framing
+        if not example.request or not (framing.by_command or framing.from_request):
+            return None
+        found = next((e for e in self.protocol.examples if e.name == example.request), None)
+        try:
+            return None if found is None else self.package.decode(found.frame, found.direction.value)
+        except SerialspecError:
+            return None  # that example's own check says why
+
     def example(self, example: Example) -> str:
         direction = example.direction.value
-        wrong = self.decodes_as(example.frame, direction, example.command, example.subcommand, example.fields)
+        request = self.asked(example)
+        asked = () if request is None else (request,)
+        fields = example.fields
+        wrong = self.decodes_as(example.frame, direction, example.command, example.subcommand, fields, request)
         if wrong:
             return wrong
         cls = self.message_class(example.command, example.subcommand, direction)
         try:
-            encoded = self.package.encode(cls.from_fields(example.fields))
+            encoded = self.package.encode(cls.from_fields(example.fields), *asked)
         except SerialspecError as exc:
             return f"its values do not encode: {exc}"
         if encoded != example.frame:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from serialspec.backends import Emitter, Unsupported
+from serialspec.backends.common.frames import refuse_by_command
 from serialspec.backends.wireshark.dissector import emit_dissector
 from serialspec.lang.model import Protocol
 
@@ -10,6 +11,7 @@ from serialspec.lang.model import Protocol
 def files(protocol: Protocol) -> dict[str, str]:
     if protocol.text is not None:
         raise Unsupported("text framing (`framing: {kind: text}`)")
+    refuse_by_command(protocol)  # a dissector sees each frame alone, as the C decoder does
     return {f"{protocol.name}/{protocol.name}.lua": emit_dissector(protocol)}
 
 

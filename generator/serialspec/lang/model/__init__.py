@@ -178,6 +178,9 @@ from serialspec.lang.model.sizes import (
     fixed_size as fixed_size,
 )
 from serialspec.lang.model.sizes import (
+    nul_ended as nul_ended,
+)
+from serialspec.lang.model.sizes import (
     size_terms as size_terms,
 )
 from serialspec.lang.model.sizes import (

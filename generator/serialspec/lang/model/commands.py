@@ -55,6 +55,7 @@ class Message:
     # a content sent without its trailing zero bytes (`truncate: trailing_zeros`): its full size, to which decoding
     # pads it (min_size is then the smallest size sent); None where the frame sends contents whole
     padded: int | None = None
+    layout: str = ""  # the name of the layout its frames travel in, where layouts are chosen by command ("": first)
 
     @property
     def key(self) -> str:

@@ -21,6 +21,7 @@ class Checksum:
     endian: Literal["<", ">"] = "<"
     name: str = ""  # the frame element holding it
     skips: tuple[str, ...] = ()  # elements inside first..last left out: itself, and the checksums strictly inside
+    from_request: tuple[str, ...] = ()  # a reply's: request elements whose bytes it takes in first (RoboClaw)
 
 
 VALUE_ROLES = ("address", "status", "value")  # frame elements whose value every message of the frame carries
@@ -122,6 +123,21 @@ class Framing:
     alternatives: dict[Direction, tuple[FrameLayout, ...]] = field(default_factory=dict)  # every layout, in order
     gap: float = 0.0  # silence between frames, in character times (0: none defined)
     reply_code: str = ""  # the command element's `reply_code`, as shown (`code | 0x40`): see Command.response_code
+    by_command: bool = False  # a command names its layout (`layout:`): layouts are chosen by command, not by header
+
+    def layout_of(self, direction: Direction, name: str) -> FrameLayout:
+        """The layout of a direction by its name ("": the first), where layouts are chosen by command."""
+        return next((layout for layout in self.alternatives[direction] if layout.name == name), self.layouts[direction])
+
+    @property
+    def from_request(self) -> bool:
+        """Some reply's checksum takes in bytes of its request: decoding it needs the request."""
+        return any(c.from_request for layout in self.alternatives.get(Direction.RESPONSE, ()) for c in layout.checksums)
+
+    def by_request(self, direction: Direction) -> bool:
+        """Frames of this direction are read in the layout of the request they answer (they carry no code)."""
+        layouts = self.alternatives.get(direction, ())
+        return self.by_command and direction == Direction.RESPONSE and not any(lay.has_command for lay in layouts)
 
     @property
     def classic(self) -> bool:

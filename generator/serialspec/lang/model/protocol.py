@@ -10,7 +10,7 @@ from serialspec.lang.model.commands import Command, Message
 from serialspec.lang.model.device import Device
 from serialspec.lang.model.examples import Erratum, Example
 from serialspec.lang.model.fields import EnumDef, FlagsDef, Table
-from serialspec.lang.model.framing import ErrorReply, Framing, Serial
+from serialspec.lang.model.framing import ErrorReply, FrameLayout, Framing, Serial
 from serialspec.lang.model.text_frames import TextFrame
 
 
@@ -47,3 +47,7 @@ class Protocol:
     @cached_property
     def _commands_by_name(self) -> dict[str, Command]:  # emitters look commands up per message
         return {c.name: c for c in self.commands}
+
+    def layout(self, message: Message) -> FrameLayout:
+        """The layout a message's frames travel in (its command's `layout`, else its direction's first)."""
+        return self.framing.layout_of(message.direction, message.layout)

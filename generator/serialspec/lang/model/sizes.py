@@ -116,3 +116,12 @@ def size_terms(fields: tuple[Field, ...]) -> tuple[int, tuple[tuple[int, int, st
         where, scalar = offsets[sizer]
         terms.append((where, scalar.type.size, "big" if scalar.endian == ">" else "little", factor))
     return fixed, tuple(terms)
+
+
+def nul_ended(fields: tuple[Field, ...]) -> int | None:
+    """The offset of a content's NUL-terminated text where fixed fields come before it and nothing after it
+    (RoboClaw's version string, in a frame that carries no length): its size is then told by its NUL."""
+    if not fields or not isinstance(fields[-1], Text) or not fields[-1].terminated:
+        return None
+    sizes = [fixed_size(item) for item in fields[:-1]]
+    return None if any(size is None for size in sizes) else sum(size or 0 for size in sizes)

@@ -50,6 +50,7 @@ class Commands(FieldResolver):
         if self.ctx.framing:
             self.ctx.commands[:] = self.reply_codes(self.ctx.commands, self.ctx.framing)
             self.check_codes(self.ctx.commands, self.ctx.framing)
+            self.check_layouts(self.ctx.commands, self.ctx.framing)
             self.check_lengths(self.ctx.commands, self.ctx.framing)
             self.check_seeds(self.ctx.framing)
         self.check_answered_by(self.ctx.commands)
@@ -272,6 +273,19 @@ class Commands(FieldResolver):
             for d in Direction
             if d.value in value and "subcommands" not in value
         }
+        if "layout" in value:
+            chosen = self.layout_names(value["layout"], (*path, "layout"))
+            if not chosen:  # said: its messages' layouts are not checked further (one mistake, one line)
+                self.ctx.broken.add(name)
+            messages = {d: replace(m, layout=chosen.get(d, "")) for d, m in messages.items()}
+            subcommands = [
+                replace(
+                    sub,
+                    request=sub.request and replace(sub.request, layout=chosen.get(Direction.REQUEST, "")),
+                    response=sub.response and replace(sub.response, layout=chosen.get(Direction.RESPONSE, "")),
+                )
+                for sub in subcommands
+            ]
         probe = bool(value.get("probe", False))
         if probe and ("subcommands" in value or "request" not in value):
             self.error((*path, "probe"), "a probe is a command with a request (and a reply), not sub-commands")
@@ -295,6 +309,47 @@ class Commands(FieldResolver):
             probe=probe,
         )
 
+    def layout_names(self, raw: Any, path: Path) -> dict[Direction, str]:
+        """A command's `layout`: one layout name for both directions, or a mapping direction -> name; each a
+        layout of `framing.layouts` whose frames of that direction can carry the command's messages."""
+        framing = self.ctx.framing
+        if framing is None:
+            return {}
+        names = [layout.name for layout in framing.alternatives[Direction.REQUEST]]
+        if not framing.by_command or names == [""]:
+            self.error(path, "`layout` chooses one of `framing.layouts`, and the framing has one layout")
+            return {}
+        pairs = raw.items() if isinstance(raw, dict) else [(d.value, raw) for d in Direction]
+        chosen: dict[Direction, str] = {}
+        for key, name in pairs:
+            where = (*path, key) if isinstance(raw, dict) else path
+            if key not in ("request", "response"):
+                self.error(where, f"expected request or response, not {key!r}")
+                return {}
+            if name not in names:
+                self.error(where, f"unknown layout {name!r} (the framing has {', '.join(names)})")
+                return {}
+            chosen[Direction(key)] = name
+        return chosen
+
+    def check_layouts(self, commands: list[Command], framing: Framing) -> None:
+        """Each message's layout has a content where the message has fields."""
+        if not framing.by_command:
+            return
+        for command in commands:
+            if command.name in self.ctx.broken:
+                continue
+            for message in command.messages():
+                layout = framing.layout_of(message.direction, message.layout)
+                where = f"layout {layout.name!r}"
+                has_content = any(e.role == "content" for e in layout.elements)
+                if not has_content and (message.max_size is None or message.max_size > 0):
+                    self.error(
+                        ("commands", command.name, message.direction.value),
+                        f"the {message.direction.value} frames of {where} have no content, and this "
+                        f"{message.direction.value} has fields",
+                    )
+
     def check_answered_by(self, commands: list[Command]) -> None:
         responses = {m.key: m for c in commands for m in c.messages() if m.direction == Direction.RESPONSE}
         for command in commands:
@@ -314,7 +369,8 @@ class Commands(FieldResolver):
                 continue  # not a number: the structural check has said so
             directions = {m.direction for m in command.messages()}
             broken = command.name in self.ctx.broken  # a message failed to resolve: its problem is reported
-            if command.code is not None and not broken and not any(framing.layouts[d].has_command for d in directions):
+            layouts = {m.direction: framing.layout_of(m.direction, m.layout) for m in command.messages()}
+            if command.code is not None and not broken and not any(layouts[d].has_command for d in directions):
                 self.error(
                     ("commands", command.name, "code"),
                     "its frames have no command field, so no code",
@@ -341,6 +397,7 @@ class Commands(FieldResolver):
                 messages = [m for m in command.messages() if m.direction == direction]
                 if not messages or any(m.error_reply for m in messages):
                     continue  # an error reply has the code of the request it refuses (see passes/errors.py)
+                layout = framing.layout_of(direction, messages[0].layout)
                 if command.code is not None and not isinstance(command.code, int):
                     continue  # not a number: the structural check has said so
                 if layout.has_command and command.code is None:
@@ -351,8 +408,8 @@ class Commands(FieldResolver):
                 code = command.wire_code(direction) if layout.has_command else None
                 sharing.setdefault(code, []).append((command, messages[0]))
             for code, users in sharing.items():
-                if len(users) < 2:
-                    continue
+                if len(users) < 2 or (code is None and framing.by_request(direction)):
+                    continue  # replies without a code read in the layout of their request: chosen by it
                 what = f"code {code:#04x}" if code is not None else "a codeless reply"
                 if direction == Direction.REQUEST and not any(c.selector for c, _ in users):
                     if any(alt.length is None for alt in framing.alternatives.get(direction, (layout,))):

@@ -58,16 +58,19 @@ class FramingPass(FieldResolver):
             raise self.fail(path, "missing key 'elements' (or 'layouts')")
         transparency = value.get("transparency")
         alternatives: dict[Direction, list[FrameLayout]] = {d: [] for d in Direction}
+        commands = self.section("commands")
+        by_command = "layouts" in value and any(isinstance(c, dict) and "layout" in c for c in commands.values())
         for layout_name, (raw, elements_path) in raw_layouts.items():
             elements = [
                 (name, item, self.frame_element(name, item, (*elements_path, name))) for name, item in raw.items()
             ]
             for direction in Direction:
+                request = alternatives[Direction.REQUEST][-1] if direction == Direction.RESPONSE else None
                 alternatives[direction].append(
-                    self.layout(direction, layout_name, elements, transparency, elements_path, path)
+                    self.layout(direction, layout_name, elements, transparency, elements_path, path, request)
                 )
         for direction, layouts in alternatives.items():
-            if len(layouts) > 1:
+            if len(layouts) > 1 and not by_command:
                 headers = [layout.header for layout in layouts]
                 if not all(headers) or len(set(headers)) != len(headers):
                     raise self.fail(
@@ -95,6 +98,7 @@ class FramingPass(FieldResolver):
             shared_header=first[Direction.REQUEST].header == first[Direction.RESPONSE].header,
             alternatives={d: tuple(layouts) for d, layouts in alternatives.items()},
             gap=float(value.get("gap", 0.0)),
+            by_command=by_command,
         )
 
     def frame_element(self, name: str, item: dict[str, Any], path: Path) -> FrameElement:
@@ -131,6 +135,7 @@ class FramingPass(FieldResolver):
             ("covers", "checksum"),
             ("sequence", "value"),
             ("truncate", "content"),
+            ("from_request", "checksum"),
         ):
             if key in item and role != allowed:
                 self.error((*path, key), f"`{key}` belongs to a {allowed} element")
@@ -226,6 +231,7 @@ class FramingPass(FieldResolver):
         transparency_raw: Any,
         elements_path: Path,
         framing_path: Path,
+        request: FrameLayout | None = None,
     ) -> FrameLayout:
         elements: list[FrameElement] = []
         raws: dict[str, dict[str, Any]] = {}
@@ -336,6 +342,9 @@ class FramingPass(FieldResolver):
                 checksum = replace(element.checksum, first=covers[0], last=covers[1], skips=skips)
                 if item.get("seed") == "per_command":
                     checksum = self.seeded(checksum, elements, a, b, (*e_path, "seed"))
+                if item.get("from_request"):
+                    names_taken = self.from_request(item["from_request"], direction, request, (*e_path, "from_request"))
+                    checksum = replace(checksum, from_request=names_taken)
                 elements[index] = replace(element, checksum=checksum)
         checksums = tuple(e.checksum for e in elements if e.checksum is not None)
         if content_index >= 0 and elements[content_index].truncate and "length" not in roles:
@@ -345,6 +354,21 @@ class FramingPass(FieldResolver):
             )
         flagged = any("error_flag" in item for item in raws.values())
         return self.classic_fields(direction, layout_name, tuple(elements), transparency, checksums, flagged)
+
+    def from_request(
+        self, raw: list[str], direction: Direction, request: FrameLayout | None, path: Path
+    ) -> tuple[str, ...]:
+        """A reply checksum's `from_request`: elements of fixed size of the same layout's request frame."""
+        if direction != Direction.RESPONSE or request is None:
+            raise self.fail(path, "`from_request` belongs to a checksum of response frames")
+        sizes = {e.name: e.size for e in request.elements if e.role != "content"}
+        for index, name in enumerate(raw):
+            if name not in sizes:
+                names = ", ".join(e.name for e in request.elements if e.role != "content") or "none"
+                raise self.fail(
+                    (*path, index), f"{name!r} is no element of fixed size of the request frame (it has {names})"
+                )
+        return tuple(raw)
 
     def classic_fields(
         self,
@@ -362,6 +386,7 @@ class FramingPass(FieldResolver):
         final = elements[-1] if elements else None  # none: an error said so already
         classic = (
             not layout_name
+            and not any(c.from_request for c in checksums)
             and not any(e.truncate for e in elements)  # contents of one size sent shorter: the frame engine's way
             and not error_flag  # error replies carry code | flag: no constant command byte to look frames up by
             and transparency is None

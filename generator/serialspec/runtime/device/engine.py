@@ -14,7 +14,7 @@ from typing import Any
 
 from serialspec.runtime.device.faults import Fault, FaultInjection
 from serialspec.runtime.errors import DecodeError, EncodeError
-from serialspec.runtime.message import Message, compare, field_keys, is_sequence
+from serialspec.runtime.message import Message, compare, field_keys, is_sequence, takes_request
 from serialspec.runtime.registers import RegisterMap
 from serialspec.runtime.stream import StreamParser
 
@@ -361,7 +361,7 @@ class Engine(FaultInjection):
         spec: DeviceSpec,
         ids: Iterable[int],
         *,
-        encode: Callable[[Message], bytes],
+        encode: Callable[..., bytes],
         parser: Callable[[], StreamParser],
         clock: Callable[[], float] = time.monotonic,
         model: str | Mapping[int, str] | None = None,
@@ -370,6 +370,10 @@ class Engine(FaultInjection):
         """`model`: the model of every device (a name of `spec.models`), or id -> name (others: the default)."""
         self.spec = spec
         self.encode = encode
+        # a codec whose replies are made with the request they answer (layouts chosen by command, a reply checksum
+        # over request bytes) takes it: the request being answered is given to it
+        self._requests = takes_request(encode)
+        self._request: Message | None = None
         self.clock = clock
         self.parser = parser()
         self._new_parser = parser
@@ -521,6 +525,7 @@ class Engine(FaultInjection):
                     device.set(name, value)
 
     def handle(self, request: Message) -> list[tuple[float, bytes]]:
+        self._request = request
         timeout = self.spec.timeout
         if timeout is not None:
             self.tick()
@@ -602,7 +607,10 @@ class Engine(FaultInjection):
             values = {**values, self.spec.address: self._answering_as.other_id(address, self.spec.broadcast)}
         values = _whole(values)
         try:
-            return self.encode(response.from_fields(values))  # type: ignore[attr-defined]
+            reply = response.from_fields(values)  # type: ignore[attr-defined]
+            if self._requests and self._request is not None:
+                return self.encode(reply, self._request)
+            return self.encode(reply)
         except (EncodeError, TypeError, ValueError, KeyError) as exc:
             # never silent: the reply is not sent, and one line says why
             LOG.warning("simulator: no %s reply: %s", response.__name__, str(exc).splitlines()[0] if str(exc) else exc)

@@ -217,6 +217,9 @@ def test_async_client_iterates_over_reports(beacon: ModuleType) -> None:
         ({"sends": {"heartbeat": {"every": 5, "values": {"x": "armed"}}}}, "unknown heartbeat response field 'x'"),
         ({"sends": {"heartbeat": {"every": 5, "values": {"armed": "armed +"}}}}, "heartbeat.values.armed"),
         ({"sends": {"heartbeat": {"every": 0}}}, "0 is outside"),
+        ({"sends": {"heartbeat": {"every": "1000 / nope"}}}, "heartbeat.every: unknown name 'nope'"),
+        ({"sends": {"heartbeat": {"every": "1000 /"}}}, "device.sends.heartbeat.every:"),
+        ({"sends": {"heartbeat": {"every": "0"}}}, "heartbeat.every: a period of 0 ms: it must be at least 1"),
         ({"derived": {"nope": "raw"}}, "device.derived.nope: unknown memory entry 'nope'"),
         ({"derived": {"shown": "raw + nope"}}, "device.derived.shown: unknown name 'nope'"),
         ({"derived": {"shown": "raw", "raw": "offset"}}, "shown reads the derived entry 'raw'"),
@@ -247,4 +250,53 @@ def test_a_value_dividing_by_a_written_zero_sends_nothing(caplog: pytest.LogCapt
         sent = [x for _, frame in sim.feed(codec.encode(m.ArmRequest(id=1, on=1))) for x in decode.feed(frame)]
         assert sent == [m.ArmResponse(id=1, on=1)]  # the reply, and no telemetry: 100 / 0 has no value
         assert "no TelemetryResponse sent" in caplog.text
+        del package
+
+
+def test_a_period_from_a_rate_the_client_sets() -> None:
+    """`every` as an expression of the device's values (a rate in Hz): worked out for each period, so a new rate
+    takes effect from the next message on; a rate of 0 (no period: 1000 / 0) makes the device silent, not broken."""
+    commands = {
+        **SPEC["commands"],
+        "set_rate": {
+            "code": 7,
+            "title": "Set the heartbeat rate",
+            "request": {"fields": {"hz": "u8"}},
+            "response": {"fields": {"hz": "u8"}},
+        },
+    }
+    device = {
+        **SPEC["device"],
+        "state": {**SPEC["device"]["state"], "rate_hz": 50},
+        "sends": {"heartbeat": {"every": "1000 / rate_hz", "values": {"armed": "armed"}}},
+        "commands": {**SPEC["device"]["commands"], "set_rate": {"stores": {"hz": "rate_hz"}, "echoes": ["hz"]}},
+    }
+    spec = {**SPEC, "commands": commands, "device": device}
+    generated = files(spec)
+    protocol = resolve(load_text(yaml.safe_dump(spec, sort_keys=False), "beacon.yaml"))
+    docs = next(t for e in emitters() for p, t in e.files(protocol).items() if p.endswith(".md"))
+    assert "every `1000 / rate_hz` ms" in docs
+    with imported("beacon", generated, "the sends test") as package:
+        m = importlib.import_module("beacon.messages")
+        codec = importlib.import_module("beacon.codec")
+        clock = Clock()
+        sim = importlib.import_module("beacon.simulator").BeaconSimulator(ids=[1], clock=clock)
+        decode = codec.StreamParser(m.Direction.RESPONSE)
+
+        def beats_in_a_second() -> int:
+            count = 0
+            for _ in range(1000):  # one simulated second in 1 ms steps
+                count += sum(isinstance(x, m.HeartbeatResponse) for _, f in sim.due() for x in decode.feed(f))
+                clock.now += 0.001
+            return count
+
+        def set_rate(hz: int) -> None:
+            sent = [x for _, frame in sim.feed(codec.encode(m.SetRateRequest(id=1, hz=hz))) for x in decode.feed(frame)]
+            assert sent == [m.SetRateResponse(id=1, hz=hz)]
+
+        assert beats_in_a_second() == 50  # every 20 ms
+        set_rate(0)
+        assert beats_in_a_second() <= 1  # at most the one already due at the old rate, then none: 1000 / 0
+        set_rate(200)
+        assert 199 <= beats_in_a_second() <= 200  # every 5 ms, from the next 10 ms look on
         del package

@@ -597,6 +597,17 @@ CASES["device: derived, locks, sends, moves.to"] = Case(
         "commands": {"go": {"moves": {"state": "position", "target": "target", "to": "target / 2"}}},
     },
 )
+# `every` as an expression of the device's values (a rate the request sets): the beats come among the replies
+CASES["device: sends every an expression (a rate)"] = Case(
+    {"v": "u16"},
+    {"v": "u16"},
+    commands={"beat": {"code": 9, "title": "Beat", "response": {"unsolicited": True, "fields": {"n": "u16"}}}},
+    device={
+        "state": {"rate_hz": 200, "beats": 0},
+        "sends": {"beat": {"every": "1000 / rate_hz", "step": "beats", "values": {"n": "beats"}}},
+        "commands": {"probe": {"stores": {"v": "rate_hz"}}},
+    },
+)
 DEVICE_KEYS = ("derived", "locks", "sends")  # the device keys a matrix case must use
 # Every documented option of every frame transform (serialspec/transforms/), as its sample framing.
 for _method, _transform in transforms().items():

@@ -1391,7 +1391,13 @@ DEVICE = Obj(
         "sends": MapOf(
             Obj(
                 {
-                    "every": Int("Period in ms: the device sends the message this often.", minimum=1, example=1000),
+                    "every": OneOf(
+                        (Int(minimum=1), Str()),
+                        "Period in ms: the device sends the message this often. A number, or an expression of "
+                        "state variables and memory entries (a rate register: `1000 / rate_hz`), worked out again "
+                        "for each period: where it has no value (a division by 0) or is not positive, the device "
+                        "sends nothing periodically until it has one.",
+                    ),
                     "after": ListOf(
                         Str(),
                         "Commands (or command.subcommand) after whose reply the device also sends it.",

@@ -127,6 +127,11 @@ def function_of_get(parsed: expression.Expr) -> str:
     return f"lambda get: {expression.render(parsed, lambda n: f'get({n!r})')}"
 
 
+def period_source(every: int | expression.Expr) -> str:
+    """`every` of a SendSpec: the period in seconds, or a function of `get` giving it in ms (`every: 1000 / rate`)."""
+    return repr(every / 1000) if isinstance(every, int) else function_of_get(every)
+
+
 def derived_values(request: Message, response: Message | None) -> dict[str, str]:
     """Request values its message does not hold (derived counts), for a reply to echo: name -> a function of the
     request's fields (and the values derived before it)."""
@@ -331,7 +336,7 @@ def simulator_module(protocol: Protocol) -> str:
         imports.add(response.class_name)
         args = [response.class_name]
         if send.every:
-            args.append(f"every={send.every / 1000!r}")
+            args.append(f"every={period_source(send.every)}")
         requests = [m for m in protocol.messages() if m.key in send.after and m.direction == Direction.REQUEST]
         if requests:
             imports.update(m.class_name for m in requests)

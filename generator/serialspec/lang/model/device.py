@@ -107,7 +107,7 @@ class Unsolicited:
     a value changes; only while `while_` (a state variable or memory entry) is non-zero, when it is given."""
 
     command: str  # command (or command.subcommand) key whose response is sent
-    every: int = 0  # period in ms (0: not periodic)
+    every: int | Expr = 0  # period in ms, or an expression of state and memory giving it (0: not periodic)
     after: tuple[str, ...] = ()  # request keys after whose reply it is sent
     changes: tuple[str, ...] = ()  # state variables or memory entries: sent when one of them changes
     while_: str = ""

@@ -7,6 +7,7 @@ from typing import Any
 
 from serialspec.lang import expression
 from serialspec.lang.errors import SpecError
+from serialspec.lang.expression import Expr
 from serialspec.lang.loader import Path
 from serialspec.lang.model import (
     SCALARS,
@@ -289,6 +290,21 @@ class DevicePass(Pass):
                 self.error(path, f"unknown name {name!r} (not a request field, memory entry or state variable)")
         return parsed
 
+    def period(self, value: Any, path: Path, names: tuple[Container[str], ...]) -> int | Expr:
+        """`every`: a period in ms, or an expression of state variables and memory entries giving it (a rate
+        register); a constant expression is its value, which must be positive."""
+        if not isinstance(value, str):
+            return int(value)
+        parsed = self.expression(value, path, names)
+        if parsed is None:
+            return 0
+        if isinstance(parsed, expression.Const):
+            if parsed.value < 1:
+                self.error(path, f"a period of {parsed.value} ms: it must be at least 1")
+                return 0
+            return int(parsed.value)
+        return parsed
+
     def no_chains(self, value: dict[str, Any], path: Path) -> dict[str, Any]:
         for name, source in value.items():
             try:
@@ -358,7 +374,7 @@ class DevicePass(Pass):
             found.append(
                 Unsolicited(
                     str(key),
-                    int(item.get("every", 0)),
+                    self.period(item.get("every", 0), (*where, "every"), (variables,)),
                     tuple(str(n) for n in item.get("after") or ()),
                     tuple(str(n) for n in item.get("changes") or ()),
                     str(item.get("while", "")),

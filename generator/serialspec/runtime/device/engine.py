@@ -129,10 +129,11 @@ class CommandSpec:
 @dataclass(frozen=True)
 class SendSpec:
     """A message a device sends on its own (`device.sends`): every `every` seconds, after a reply to one of the
-    `after` requests, or when one of the `changes` values changes; only while `while_` is non-zero (when given)."""
+    `after` requests, or when one of the `changes` values changes; only while `while_` is non-zero (when given).
+    `every` may be a function of `get` (state and memory) giving the period in ms, worked out for each period."""
 
     response: type[Message]
-    every: float = 0.0
+    every: float | Callable[[Callable[[str], float]], float] = 0.0
     after: tuple[type[Message], ...] = ()
     changes: tuple[str, ...] = ()
     while_: str = ""
@@ -450,10 +451,14 @@ class Engine(FaultInjection):
                     if send.every:
                         next_time = self._next_send.get(key, now)
                         if next_time <= now:
-                            sending = True
-                            # the next one a period on, or a period from now when the clock jumped further
-                            following = next_time + send.every
-                            self._next_send[key] = following if following > now else now + send.every
+                            period = self._period(device, send)
+                            if period is None:  # no period now (a rate of 0): looked at again in 10 ms
+                                self._next_send[key] = now + 0.01
+                            else:
+                                sending = True
+                                # the next one a period on, or a period from now when the clock jumped further
+                                following = next_time + period
+                                self._next_send[key] = following if following > now else now + period
                     if send.changes:
                         values = tuple(self._value(device, n) for n in send.changes)
                         if values != self._watched.get(key):
@@ -463,6 +468,18 @@ class Engine(FaultInjection):
                     if frame is not None:
                         out.append((now, frame))
         return out
+
+    @staticmethod
+    def _period(device: VirtualDevice, send: SendSpec) -> float | None:
+        """The period of a periodic message in seconds: `every`, or what its expression gives now (in ms); None
+        where that has no value (a division by a rate written as 0) or is not positive."""
+        if not callable(send.every):
+            return send.every
+        try:
+            period = send.every(device.get) / 1000
+        except (ZeroDivisionError, ValueError):
+            return None
+        return period if period > 0 else None
 
     def _value(self, device: VirtualDevice, name: str) -> float | None:
         """A watched value; None where an expression of the spec has none (a division by a value written as 0)."""

@@ -291,3 +291,40 @@ def test_our_client_raises_on_the_ack_nak_pyubx2_builds() -> None:
     finally:
         os.close(controller)
         os.close(device)
+
+
+def test_the_navigation_rate_follows_a_cfg_rate_set() -> None:
+    """NAV-PVT comes every meas_rate × nav_rate ms (`every: meas_rate * nav_rate`), counted over a simulated clock:
+    once a second by default, four times a second after CFG-RATE sets 250 ms, twice after nav_rate 2."""
+    from serialspec_protocols.ubx.simulator import UbxSimulator
+
+    class Clock:
+        now = 50.0
+
+        def __call__(self) -> float:
+            return self.now
+
+    clock = Clock()
+    sim = UbxSimulator(ids=[0], clock=clock)
+    parser = ubx.StreamParser(ubx.Direction.RESPONSE)
+
+    def fixes_in_a_second() -> int:
+        count = 0
+        for _ in range(1000):
+            count += sum(isinstance(m, ubx.NavPvtResponse) for _, f in sim.due() for m in parser.feed(f))
+            clock.now += 0.001
+        return count
+
+    def set_rate(meas_rate: int, nav_rate: int) -> None:
+        replies = [
+            m for _, f in sim.feed(ubx.encode(ubx.SetRateRequest(meas_rate, nav_rate, 0))) for m in parser.feed(f)
+        ]
+        assert [type(m) for m in replies] == [ubx.AckAckResponse]
+
+    assert fixes_in_a_second() == 1
+    set_rate(250, 1)
+    assert 4 <= fixes_in_a_second() <= 5  # the one due at the old rate, then every 250 ms
+    assert fixes_in_a_second() == 4
+    set_rate(250, 2)
+    assert fixes_in_a_second() in (2, 3)
+    assert fixes_in_a_second() == 2

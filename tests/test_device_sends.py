@@ -300,3 +300,73 @@ def test_a_period_from_a_rate_the_client_sets() -> None:
         set_rate(200)
         assert 199 <= beats_in_a_second() <= 200  # every 5 ms, from the next 10 ms look on
         del package
+
+
+LISTED: dict[str, Any] = {
+    **SPEC,
+    "commands": {
+        **SPEC["commands"],
+        "info": {
+            "code": 8,
+            "title": "Device information",
+            "request": {},
+            "response": {
+                "fields": {
+                    "flags": {"type": "u8", "bits": {"alarm": {"bits": 0}, "busy": {"bits": 1}}},
+                    "temps": {"type": "array", "of": "i8", "count": 3},
+                    "n": "u8",
+                    "names": {
+                        "type": "group",
+                        "count": "n",
+                        "fields": {"name": {"type": "string", "size": 8, "pad": "00"}},
+                    },
+                }
+            },
+        },
+        "state_bits": {
+            "code": 9,
+            "title": "Two bits of another flags",
+            "request": {},
+            "response": {"fields": {"flags": {"type": "u8", "bits": {"alarm": {"bits": 7}, "ready": {"bits": 0}}}}},
+        },
+    },
+}
+
+
+def listed(reply: dict[str, Any]) -> dict[str, Any]:
+    return {**LISTED, "device": {**SPEC["device"], "reply": reply}}
+
+
+def test_a_reply_fills_lists_and_groups_from_the_device() -> None:
+    """`device.reply` takes a list field's items (numbers) and a group's (a mapping of its fields each); a bit field
+    value goes to every response that has the field."""
+    reply = {"temps": [21, -4, 30], "names": [{"name": "left"}, {"name": "right"}], "flags.alarm": 1}
+    with imported("beacon", files(listed(reply)), "the sends test") as package:
+        m = importlib.import_module("beacon.messages")
+        codec = importlib.import_module("beacon.codec")
+        sim = importlib.import_module("beacon.simulator").BeaconSimulator(ids=[1], clock=Clock())
+        decode = codec.StreamParser(m.Direction.RESPONSE)
+        (info,) = [x for _, f in sim.feed(codec.encode(m.InfoRequest(id=1))) for x in decode.feed(f)]
+        assert list(info.temps) == [21, -4, 30] and [n.name for n in info.names] == ["left", "right"]
+        assert (info.flags.alarm, info.flags.busy) == (1, 0)
+        (bits,) = [x for _, f in sim.feed(codec.encode(m.StateBitsRequest(id=1))) for x in decode.feed(f)]
+        assert (bits.flags.alarm, bits.flags.ready) == (1, 0)
+        del package
+
+
+@pytest.mark.parametrize(
+    ("reply", "said"),
+    [
+        ({"flags.busy": 1}, "device.reply.flags.busy: the state_bits response's flags has no bit field 'busy'"),
+        ({"flags.ready": 1}, "device.reply.flags.ready: the info response's flags has no bit field 'ready'"),
+        ({"temps": [1, 2]}, "device.reply.temps: the info response's temps: 2 items where it holds 3"),
+        ({"temps": [1, 2, 300]}, "temps: item 2 (300) is not a number in -128..127"),
+        ({"names": [{"nom": "x"}]}, "names: item 0: no field 'nom'; no value for 'name'"),
+        ({"names": ["left"]}, "names: item 0 is not a mapping of its fields (name)"),
+        ({"n": [1]}, "the info response's n: a list for a field that is no list, array or group"),
+    ],
+)
+def test_reply_mistakes_in_one_line(reply: dict[str, Any], said: str) -> None:
+    with pytest.raises(SpecErrors) as caught:
+        files(listed(reply))
+    assert said in str(caught.value) and len(str(caught.value).splitlines()) == 1

@@ -231,6 +231,7 @@ def test_pyubx2_reads_the_sim_stream_and_gets_replies_to_its_polls_and_sets() ->
         port.write(UBXMessage("MON", "MON-VER", POLL).serialize())
         version = read_until(reader, "MON-VER", seen)
         assert version.swVersion.rstrip(b"\x00") == b"ROM SPG 5.10 (7b202e)"
+        assert version.extension_04.rstrip(b"\x00") == b"GPS;GLO;GAL;BDS"  # pyubx2 numbers the repeated items
         port.write(UBXMessage("CFG", "CFG-RATE", SET, measRate=200, navRate=2, timeRef=0).serialize())
         ack = read_until(reader, "ACK-ACK", seen)
         assert (ack.clsID, ack.msgID) == (0x06, 0x08)
@@ -258,6 +259,12 @@ def test_our_client_polls_and_sets_the_sim_among_its_stream() -> None:
     with serve("ubx.yaml") as path, UbxClient(path, timeout=3.0) as client:
         version = client.mon_ver()
         assert (version.sw_version, version.hw_version) == ("ROM SPG 5.10 (7b202e)", "000A0000")
+        assert [e.extension for e in version.extensions] == [  # device.reply's list of group items
+            "FWVER=SPG 5.10",
+            "PROTVER=34.10",
+            "MOD=NEO-M10S",
+            "GPS;GLO;GAL;BDS",
+        ]
         assert client.set_rate(250, 1, ubx.TimeReference.GPS) is True
         assert client.cfg_rate() == ubx.CfgRateResponse(meas_rate=250, nav_rate=1, time_ref=ubx.TimeReference.GPS)
         fix = client.nav_pvt()

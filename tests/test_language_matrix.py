@@ -608,7 +608,27 @@ CASES["device: sends every an expression (a rate)"] = Case(
         "commands": {"probe": {"stores": {"v": "rate_hz"}}},
     },
 )
-DEVICE_KEYS = ("derived", "locks", "sends")  # the device keys a matrix case must use
+# `reply` values for a list, an array and a group (one mapping of its fields per item), a bit field by name
+CASES["device: reply lists, arrays, groups and bit fields"] = Case(
+    {"v": "u16"},
+    {
+        "temps": {"type": "array", "of": "i8", "count": 2},
+        "n": "u8",
+        "levels": {"type": "array", "of": "u16", "count": "n"},
+        "m": "u8",
+        "items": {"type": "group", "count": "m", "fields": {"id": "u8", "tag": {"type": "string", "size": 4}}},
+        "flags": {"type": "u8", "bits": {"on": {"bits": 0}, "mode": {"bits": [3, 1]}}},
+    },
+    device={
+        "reply": {
+            "temps": [-3, 40],
+            "levels": [1, 500, 65535],
+            "items": [{"id": 1, "tag": "abcd"}, {"id": 2, "tag": "efgh"}],
+            "flags.mode": 5,
+        }
+    },
+)
+DEVICE_KEYS = ("derived", "locks", "sends", "reply")  # the device keys a matrix case must use
 # Every documented option of every frame transform (serialspec/transforms/), as its sample framing.
 for _method, _transform in transforms().items():
     for _sample in _transform.samples:

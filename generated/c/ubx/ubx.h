@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define UBX_SPEC_SHA256 "4226de7d40e9bb4dbe8432f6e3581c92bd4dee79218453eab8abf2f398cd6693"
+#define UBX_SPEC_SHA256 "79c2ef5754cfe1acae4c8151d0a8a1fbfa46d17348931b9b39db2f837285901e"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef UBX_ENABLE_ENCODE

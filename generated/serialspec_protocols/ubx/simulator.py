@@ -4,14 +4,14 @@
 A receiver with a 3D fix moving north-east in a straight line: it sends NAV-PVT on its own at its navigation
 rate (meas_rate × nav_rate ms, 1 s by default, as if CFG-MSGOUT enabled it; a CFG-RATE set changes it), each
 fix 1 s later (time of week and UTC time of day; the date stays 27 Nov 2026) and 0.00001° (about 1 m) further
-north and east; it answers polls of NAV-PVT, NAV-STATUS, MON-VER and CFG-RATE, stores a CFG-RATE set
-(acknowledged with ACK-ACK, or refused with ACK-NAK when a value is outside its range, e.g. a measurement rate
-under 25 ms), acknowledges CFG-VALSET, and answers CFG-VALGET with its items followed by ACK-ACK. Where the
-spec language stops, the model is simpler than a receiver: it keeps no configuration database (CFG-VALGET gets
-one item whatever the keys asked: CFG-RATE-MEAS = 1000, and CFG-VALSET is acknowledged whatever it sets), each
-fix's time is 1 s after the last whatever the rate, and MON-VER's reply carries no extensions (`reply` values
-are numbers or text, not lists). NAV-STATUS's bit fields are named status_flags and status_flags2, apart from
-NAV-PVT's flags and flags2: a `reply` value `flags.gnss_fix_ok` would go to every response's `flags`.
+north and east; it answers polls of NAV-PVT, NAV-STATUS, MON-VER (with a u-blox M10's four extensions) and
+CFG-RATE, stores a CFG-RATE set (acknowledged with ACK-ACK, or refused with ACK-NAK when a value is outside
+its range, e.g. a measurement rate under 25 ms), acknowledges CFG-VALSET, and answers CFG-VALGET with its
+items followed by ACK-ACK. Where the spec language stops, the model is simpler than a receiver: it keeps no
+configuration database (CFG-VALGET gets one item whatever the keys asked: CFG-RATE-MEAS = 1000, and CFG-VALSET
+is acknowledged whatever it sets), and each fix's time is 1 s after the last whatever the rate. NAV-STATUS's
+bit fields are named status_flags and status_flags2, apart from NAV-PVT's flags and flags2: a `reply` value
+`flags.gnss_fix_ok` goes to every response's `flags`, and each must have that bit field.
 
 `UbxSimulator(ids=[1, 2]).start()` serves the devices on a new pseudo-terminal and returns its path;
 `serialspec sim specs/ubx.yaml --id 1 --id 2` does the same from the shell. Values are wire units.
@@ -52,7 +52,7 @@ DEVICE = DeviceSpec(
     entries=(
     ),
     state={'fix': 0.0, 'start_itow': 489618000.0, 'start_hour': 16.0, 'start_lat': 473977418.0, 'start_lon': 85455939.0, 'meas_rate': 1000.0, 'nav_rate': 1.0, 'time_ref': 1.0, 'uptime': 60000.0},
-    reply={'year': 2026.0, 'month': 11.0, 'day': 27.0, 'valid.valid_date': 1.0, 'valid.valid_time': 1.0, 'valid.fully_resolved': 1.0, 'valid.valid_mag': 0.0, 't_acc': 25.0, 'fix_type': 3.0, 'flags.gnss_fix_ok': 1.0, 'flags.diff_soln': 0.0, 'flags.psm_state': 0.0, 'flags.head_veh_valid': 0.0, 'flags.carr_soln': 0.0, 'flags2.reserved': 0.0, 'flags2.confirmed_avai': 1.0, 'flags2.confirmed_date': 1.0, 'flags2.confirmed_time': 1.0, 'num_sv': 14.0, 'height': 545123.0, 'h_msl': 497000.0, 'h_acc': 1200.0, 'v_acc': 1800.0, 'vel_n': 785.0, 'vel_e': 785.0, 'g_speed': 1110.0, 'head_mot': 4500000.0, 's_acc': 150.0, 'head_acc': 1250000.0, 'p_dop': 123.0, 'flags3.invalid_llh': 0.0, 'flags3.last_correction_age': 0.0, 'flags3.reserved1': 0.0, 'flags3.auth_time': 0.0, 'flags3.nma_fix_status': 0.0, 'gps_fix': 3.0, 'status_flags.gps_fix_ok': 1.0, 'status_flags.diff_soln': 0.0, 'status_flags.wkn_set': 1.0, 'status_flags.tow_set': 1.0, 'fix_stat.diff_corr': 0.0, 'fix_stat.carr_soln_valid': 0.0, 'fix_stat.reserved0': 0.0, 'fix_stat.map_matching': 0.0, 'status_flags2.psm_state': 0.0, 'status_flags2.reserved1': 0.0, 'status_flags2.spoof_det_state': 1.0, 'status_flags2.reserved2': 0.0, 'status_flags2.carr_soln': 0.0, 'ttff': 28000.0, 'layer': 0.0, 'cfg_data': '01 00 21 30 e8 03', 'sw_version': 'ROM SPG 5.10 (7b202e)', 'hw_version': '000A0000'},
+    reply={'year': 2026.0, 'month': 11.0, 'day': 27.0, 'valid.valid_date': 1.0, 'valid.valid_time': 1.0, 'valid.fully_resolved': 1.0, 'valid.valid_mag': 0.0, 't_acc': 25.0, 'fix_type': 3.0, 'flags.gnss_fix_ok': 1.0, 'flags.diff_soln': 0.0, 'flags.psm_state': 0.0, 'flags.head_veh_valid': 0.0, 'flags.carr_soln': 0.0, 'flags2.reserved': 0.0, 'flags2.confirmed_avai': 1.0, 'flags2.confirmed_date': 1.0, 'flags2.confirmed_time': 1.0, 'num_sv': 14.0, 'height': 545123.0, 'h_msl': 497000.0, 'h_acc': 1200.0, 'v_acc': 1800.0, 'vel_n': 785.0, 'vel_e': 785.0, 'g_speed': 1110.0, 'head_mot': 4500000.0, 's_acc': 150.0, 'head_acc': 1250000.0, 'p_dop': 123.0, 'flags3.invalid_llh': 0.0, 'flags3.last_correction_age': 0.0, 'flags3.reserved1': 0.0, 'flags3.auth_time': 0.0, 'flags3.nma_fix_status': 0.0, 'gps_fix': 3.0, 'status_flags.gps_fix_ok': 1.0, 'status_flags.diff_soln': 0.0, 'status_flags.wkn_set': 1.0, 'status_flags.tow_set': 1.0, 'fix_stat.diff_corr': 0.0, 'fix_stat.carr_soln_valid': 0.0, 'fix_stat.reserved0': 0.0, 'fix_stat.map_matching': 0.0, 'status_flags2.psm_state': 0.0, 'status_flags2.reserved1': 0.0, 'status_flags2.spoof_det_state': 1.0, 'status_flags2.reserved2': 0.0, 'status_flags2.carr_soln': 0.0, 'ttff': 28000.0, 'layer': 0.0, 'cfg_data': '01 00 21 30 e8 03', 'sw_version': 'ROM SPG 5.10 (7b202e)', 'hw_version': '000A0000', 'extensions': ({'extension': 'FWVER=SPG 5.10'}, {'extension': 'PROTVER=34.10'}, {'extension': 'MOD=NEO-M10S'}, {'extension': 'GPS;GLO;GAL;BDS'})},
     commands=(
         # nav_status
         CommandSpec(NavStatusRequest, NavStatusResponse, reports={'itow': lambda get: (get('start_itow') + (get('fix') * 1000)), 'msss': lambda get: (get('uptime') + (get('fix') * 1000))}, blanks={'status_flags': {'gps_fix_ok': 0, 'diff_soln': 0, 'wkn_set': 0, 'tow_set': 0}, 'fix_stat': {'diff_corr': 0, 'carr_soln_valid': 0, 'reserved0': 0, 'map_matching': 0}, 'status_flags2': {'psm_state': 0, 'reserved1': 0, 'spoof_det_state': 0, 'reserved2': 0, 'carr_soln': 0}}),

@@ -1004,7 +1004,22 @@ ERRATUM = Obj(
 
 REPLY_VALUES = (
     "Response field -> value when no behaviour sets it (e.g. result: 1; text for text and bytes fields, bytes as "
-    "hex: VESC hw_name: '60')."
+    "hex: VESC hw_name: '60'; a list for a list, array or group field: its numbers, or for a group one mapping of "
+    "its fields per item, as u-blox MON-VER's extensions: `[{extension: FWVER=SPG 5.10}, {extension: "
+    "PROTVER=34.10}]`). A `field.bit_field` key sets one bit field of every response that has the field (each "
+    "must have that bit field; its bit fields not named are 0)."
+)
+_REPLY_ITEM_VALUE = OneOf((Num(), Str()), REPLY_VALUES)
+REPLY_VALUE = OneOf(
+    (
+        Num(),
+        Str(),
+        ListOf(
+            OneOf((Num(), Str(), MapOf(OneOf((Num(), Str(), ListOf(_REPLY_ITEM_VALUE)), REPLY_VALUES))), REPLY_VALUES),
+            REPLY_VALUES,
+        ),
+    ),
+    REPLY_VALUES,
 )
 
 SPACE_ACCESS = Obj(
@@ -1269,7 +1284,7 @@ DEVICE = Obj(
         "broadcast": Int("The address every device obeys (default: the address element's broadcast)."),
         "state": MapOf(Num(), "State variables beyond memory -> initial value (e.g. the present angle)."),
         "reply": MapOf(
-            OneOf((Num(), Str()), REPLY_VALUES),
+            REPLY_VALUE,
             REPLY_VALUES,
         ),
         "status": MapOf(

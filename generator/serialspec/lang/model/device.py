@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import field
+from typing import Any
 
 from serialspec.lang.expression import Expr
 from serialspec.lang.frozen import frozen
@@ -193,7 +194,9 @@ class Device:
     id_entry: str  # the memory entry holding the device's own id
     broadcast: int | None
     state: dict[str, float]  # state variables beyond memory -> initial value
-    reply: dict[str, float | str]  # response field -> value when no behaviour sets it
+    # response field -> value when no behaviour sets it: a number, text, or a list field's items (numbers, or a
+    # group's items as mappings of its fields)
+    reply: dict[str, float | str | tuple[Any, ...]]
     behaviours: tuple[Behaviour, ...]
     status: dict[str, str] = field(default_factory=dict)  # response field -> memory entry every reply reports
     kinds: tuple[DeviceKind, ...] = ()

@@ -244,6 +244,9 @@ class TextPass(Pass):
         for name, value in (raw.get("reply") or {}).items():
             if name not in names:
                 self.error((*path, "reply", name), f"no sentence has a field {name!r}")
+            if isinstance(value, list):
+                self.error((*path, "reply", name), "a text device's reply values are numbers or text, not lists")
+                continue
             reply[str(name)] = value if isinstance(value, str) else float(value)
         if frame.talkers and reply.get("talker", frame.talkers[0]) not in frame.talkers:
             self.error(

@@ -722,7 +722,8 @@ class Engine(FaultInjection):
             elif name in device.spec.status:
                 values[name] = device.get(device.spec.status[name])
             elif any(key.startswith(name + ".") for key in (*self.spec.reply, *device.spec.status)):
-                values[name] = {}  # bit fields, filled in below
+                blank = command.blanks.get(name)  # bit fields, filled in below; those not named stay 0
+                values[name] = dict(blank) if isinstance(blank, dict) else {}
             elif command.tables.get(name, ())[:1] == ("run",):
                 values[name] = b""  # a run of registers in a reply holds what was read: nothing here
             elif name in given and name in command.echoes:

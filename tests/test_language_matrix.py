@@ -628,6 +628,17 @@ CASES["device: reply lists, arrays, groups and bit fields"] = Case(
         }
     },
 )
+# sizes and counts from fields whose range is narrower than their type's (tests/strategies.py keeps to it)
+CASES["bytes, text and a group sized by fields with a narrow range"] = same(
+    {
+        "n": {"type": "u8", "range": [2, 4]},
+        "data": {"type": "bytes", "size": "n"},
+        "k": {"type": "u8", "range": [1, 3]},
+        "name": {"type": "string", "size": "k"},
+        "m": {"type": "u8", "range": [1, 3]},
+        "g": {"type": "group", "count": "m", "fields": {"a": "u8"}},
+    }
+)
 DEVICE_KEYS = ("derived", "locks", "sends", "reply")  # the device keys a matrix case must use
 # Every documented option of every frame transform (serialspec/transforms/), as its sample framing.
 for _method, _transform in transforms().items():

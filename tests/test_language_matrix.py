@@ -639,6 +639,10 @@ CASES["bytes, text and a group sized by fields with a narrow range"] = same(
         "g": {"type": "group", "count": "m", "fields": {"a": "u8"}},
     }
 )
+# a value dividing by a field: frames with that field 0 have no value (refused everywhere, C too)
+CASES["value: an expression dividing by a field"] = same(
+    {"d": {"type": "u8", "range": [1, 255], "default": 4}, "q": {"type": "u16", "value": "1000 / d"}, "r": "u8"}
+)
 DEVICE_KEYS = ("derived", "locks", "sends", "reply")  # the device keys a matrix case must use
 # Every documented option of every frame transform (serialspec/transforms/), as its sample framing.
 for _method, _transform in transforms().items():

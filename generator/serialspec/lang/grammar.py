@@ -418,7 +418,9 @@ _FIELD_LONG: dict[str, Shape] = {
         "`2 * count`, `ceil(len(coils) / 8)` (names of fields, len(), ceil(a / b), min, max, + - * / % & | << >>). "
         "At most 500 characters and 50 levels deep; every value it can take for any values of its fields' types "
         "(intermediate ones too) within 512 bits, and some value within the field's range (a constant one must fit "
-        "it). A frame whose fields make it divide by 0 or shift by a negative count is refused when decoded."
+        "it). A frame whose fields make it divide by 0 or shift by a negative count is refused when decoded, in "
+        "every output (the codec's DecodeError, the construct structs' error, the C decoder's E_CONTENT; the "
+        "simulator answers nothing and logs one line), and such values are refused on encode."
     ),
     "fields": Ref("fields", lambda: FIELDS, "group: the fields of each item (a mapping, like request/response)."),
     "table": Str("table_value/table_block, or bytes holding registers: name of an entry in `tables:`."),

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from typing import Any
 
 from hypothesis import strategies as st
@@ -38,7 +39,33 @@ def scalar_value(f: Scalar) -> st.SearchStrategy[Any]:
     return number(f.type, f.minimum, f.maximum)
 
 
-def fields_values(fields: tuple[Field, ...], rest_budget: int) -> st.SearchStrategy[dict[str, Any]]:
+def allowed(name: str, scope: Mapping[str, Field], low: int, high: int) -> tuple[int, int]:
+    """low..high narrowed to what the count or size field `name` may hold (its `range:`, else its type's): a drawn
+    size outside it would be refused on encode (tests/test_strict_encode.py holds that apart). A range wholly above
+    `high` gives its smallest value."""
+    f = scope.get(name)
+    if not isinstance(f, Scalar):
+        return low, high
+    smallest, largest = max(0, int(f.minimum)), int(f.maximum)
+    if smallest > high:
+        return smallest, smallest
+    return max(low, smallest), min(high, largest)
+
+
+def items_within(f: List, scope: Mapping[str, Field], most: int) -> tuple[int, int]:
+    """How many items of a list sized in bytes (`size:` a field) its size field's range allows, at most `most`."""
+    assert f.item is not None
+    low, high = allowed(f.size, scope, 0, most * f.item.size)
+    return -(-low // f.item.size), high // f.item.size
+
+
+def fields_values(
+    fields: tuple[Field, ...], rest_budget: int, outer: Mapping[str, Field] | None = None
+) -> st.SearchStrategy[dict[str, Any]]:
+    """Values of `fields`; sizes and counts given by a field stay within that field's range (`outer`: the fields
+    of the enclosing message, for a group's items sized by one of them)."""
+    scope = {**(outer or {}), **{f.name: f for f in fields}}
+
     @st.composite
     def build(draw: st.DrawFn) -> dict[str, Any]:
         values: dict[str, Any] = {}
@@ -61,10 +88,10 @@ def fields_values(fields: tuple[Field, ...], rest_budget: int) -> st.SearchStrat
                 elif f.size == "rest":
                     size = draw(st.integers(0, rest_budget))
                 else:
-                    size = sizes.setdefault(f.size, draw(st.integers(0, 6)))
+                    size = sizes.setdefault(f.size, draw(st.integers(*allowed(f.size, scope, 0, 6))))
                 values[f.name] = draw(st.binary(min_size=size, max_size=size)).hex(" ")
             elif isinstance(f, List):
-                values[f.name] = draw(list_value(f, fields))
+                values[f.name] = draw(list_value(f, fields, scope))
             elif isinstance(f, Text):
                 if isinstance(f.size, int) and f.pad is not None:  # shorter text, never ending in the pad byte
                     text = draw(st.text(st.characters(min_codepoint=0x20, max_codepoint=0x7E), max_size=f.size))
@@ -73,11 +100,21 @@ def fields_values(fields: tuple[Field, ...], rest_budget: int) -> st.SearchStrat
                     values[f.name] = draw(
                         st.text(st.characters(min_codepoint=0x20, max_codepoint=0x7E), min_size=f.size, max_size=f.size)
                     )
+                elif isinstance(f.size, str) and f.size != "rest":  # sized by a field: within its range
+                    size = sizes.setdefault(f.size, draw(st.integers(*allowed(f.size, scope, 0, 12))))
+                    values[f.name] = draw(
+                        st.text(st.characters(min_codepoint=0x20, max_codepoint=0x7E), min_size=size, max_size=size)
+                    )
                 else:
                     values[f.name] = draw(TEXT)
             elif isinstance(f, Group):
-                count = f.count if isinstance(f.count, int) else draw(st.integers(0, MAX_ITEMS))
-                item = fields_values(f.fields, 0)
+                if isinstance(f.count, int):
+                    count = f.count
+                else:
+                    most = MAX_ITEMS if f.count == "rest" else allowed(f.count, scope, 0, MAX_ITEMS)[1]
+                    least = 0 if f.count == "rest" else allowed(f.count, scope, 0, MAX_ITEMS)[0]
+                    count = draw(st.integers(least, most))
+                item = fields_values(f.fields, 0, scope)
                 items = []
                 for _ in range(count):
                     items.append(draw(item))
@@ -106,18 +143,24 @@ def fields_values(fields: tuple[Field, ...], rest_budget: int) -> st.SearchStrat
     return build()
 
 
-def list_value(f: List, siblings: tuple[Field, ...]) -> st.SearchStrategy[list[Any]]:
-    """Items of a list of varying count: as many as its count field's range allows (a few); a list sized in bytes
-    holds whole bytes of bits (decoding gives every bit of them back)."""
+def list_value(
+    f: List, siblings: tuple[Field, ...], scope: Mapping[str, Field] | None = None
+) -> st.SearchStrategy[list[Any]]:
+    """Items of a list of varying count: as many as its count field's range allows (a few), or for a list sized in
+    bytes as many as its size field's range allows; a list sized in bytes holds whole bytes of bits (decoding gives
+    every bit of them back)."""
+    scope = {**(scope or {}), **{c.name: c for c in siblings}}
     low, high = 0, MAX_LIST
-    counter = next((c for c in siblings if c.name == f.count), None)
     if isinstance(f.count, int):
         low = high = f.count
-    elif isinstance(counter, Scalar):
-        low, high = max(low, int(counter.minimum)), min(high, int(counter.maximum))
+    elif f.count and f.count != "rest":
+        low, high = allowed(f.count, scope, low, high)
+    elif f.size and f.item is not None:
+        low, high = items_within(f, scope, MAX_LIST)
     item = st.booleans() if f.item is None else number(f.item, f.minimum, f.maximum)
     if f.item is None and (f.size or f.count == "rest"):
-        return st.integers(0, MAX_LIST // 8 + 1).flatmap(lambda n: st.lists(item, min_size=8 * n, max_size=8 * n))
+        least, most = allowed(f.size, scope, 0, MAX_LIST // 8 + 1) if f.size else (0, MAX_LIST // 8 + 1)
+        return st.integers(least, most).flatmap(lambda n: st.lists(item, min_size=8 * n, max_size=8 * n))
     return st.lists(item, min_size=low, max_size=high)
 
 

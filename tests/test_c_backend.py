@@ -605,3 +605,50 @@ def test_a_64_bit_size_is_refused_not_cut_to_a_32_bit_size_t(case: str, tmp_path
             assert answer.startswith("err "), answer
     finally:
         run.close()
+
+
+@pytest.mark.skipif(GCC is None, reason="no gcc")
+@pytest.mark.parametrize(
+    ("fields", "frame", "expected"),
+    [
+        # check = 7 / n, n = 0 from the wire: no value (undefined in C), so no frame, not a crash
+        ({"n": "u8", "check": {"type": "u8", "value": "7 / n"}}, "aa 55 01 02 00 00 03", "err E_CONTENT"),
+        ({"n": "u8", "check": {"type": "u8", "value": "7 / n"}}, "aa 55 01 02 07 01 0b", 'ok {"n": 7}'),
+        ({"n": "u8", "check": {"type": "u8", "value": "100 % (n - 1)"}}, "aa 55 01 02 01 00 04", "err E_CONTENT"),
+        ({"n": "u8", "check": {"type": "u8", "value": "ceil(9 / n)"}}, "aa 55 01 02 00 00 03", "err E_CONTENT"),
+        (
+            {"n": "u8", "s": "i8", "check": {"type": "u8", "value": "n >> s"}},
+            "aa 55 01 03 01 ff 00 04",
+            "err E_CONTENT",
+        ),
+    ],
+)
+def test_a_value_with_no_value_for_the_wire_is_refused_not_undefined(
+    fields: dict[str, Any], frame: str, expected: str, tmp_path: Path
+) -> None:
+    """A `value:` expression dividing by a field (or shifting by one) that the frame gives as 0 (or negative):
+    the C decoder refuses the frame (E_CONTENT), as the Python codec raises DecodeError, where C's own division
+    would be undefined (a SIGFPE, or the sanitizer's report)."""
+    import yaml
+    from serialspec.lang.loader import load_text
+    from serialspec.lang.resolve import resolve
+
+    spec = yaml.safe_load(
+        (ROOT / "tests" / "adversarial" / "specs" / "derived_divides_by_a_wire_zero.yaml").read_text()
+    )
+    spec["commands"]["set"]["request"]["fields"] = fields
+    protocol = resolve(load_text(yaml.safe_dump(spec, sort_keys=False), "divides.yaml"))
+    source = tmp_path / "c"
+    source.mkdir()
+    for path, text in c_files(protocol).items():
+        (source / Path(path).name).write_text(text, encoding="utf-8")
+    run = Driver(protocol.name, source, tmp_path)
+    try:
+        (answer,) = run.ask(f"dec request {bytes.fromhex(frame).hex()}")
+    finally:
+        run.close()
+    status, _, rest = answer.partition(" ")
+    if expected.startswith("ok "):
+        assert status == "ok" and json.loads(rest)["fields"] == json.loads(expected[3:]), answer
+    else:
+        assert answer.startswith("err ") and expected[4:] in answer, answer

@@ -217,6 +217,9 @@ def test_async_client_iterates_over_reports(beacon: ModuleType) -> None:
         ({"sends": {"heartbeat": {"every": 5, "values": {"x": "armed"}}}}, "unknown heartbeat response field 'x'"),
         ({"sends": {"heartbeat": {"every": 5, "values": {"armed": "armed +"}}}}, "heartbeat.values.armed"),
         ({"sends": {"heartbeat": {"every": 0}}}, "0 is outside"),
+        ({"sends": {"heartbeat": {"every": "1000 / nope"}}}, "heartbeat.every: unknown name 'nope'"),
+        ({"sends": {"heartbeat": {"every": "1000 /"}}}, "device.sends.heartbeat.every:"),
+        ({"sends": {"heartbeat": {"every": "0"}}}, "heartbeat.every: a period of 0 ms: it must be at least 1"),
         ({"derived": {"nope": "raw"}}, "device.derived.nope: unknown memory entry 'nope'"),
         ({"derived": {"shown": "raw + nope"}}, "device.derived.shown: unknown name 'nope'"),
         ({"derived": {"shown": "raw", "raw": "offset"}}, "shown reads the derived entry 'raw'"),
@@ -248,3 +251,122 @@ def test_a_value_dividing_by_a_written_zero_sends_nothing(caplog: pytest.LogCapt
         assert sent == [m.ArmResponse(id=1, on=1)]  # the reply, and no telemetry: 100 / 0 has no value
         assert "no TelemetryResponse sent" in caplog.text
         del package
+
+
+def test_a_period_from_a_rate_the_client_sets() -> None:
+    """`every` as an expression of the device's values (a rate in Hz): worked out for each period, so a new rate
+    takes effect from the next message on; a rate of 0 (no period: 1000 / 0) makes the device silent, not broken."""
+    commands = {
+        **SPEC["commands"],
+        "set_rate": {
+            "code": 7,
+            "title": "Set the heartbeat rate",
+            "request": {"fields": {"hz": "u8"}},
+            "response": {"fields": {"hz": "u8"}},
+        },
+    }
+    device = {
+        **SPEC["device"],
+        "state": {**SPEC["device"]["state"], "rate_hz": 50},
+        "sends": {"heartbeat": {"every": "1000 / rate_hz", "values": {"armed": "armed"}}},
+        "commands": {**SPEC["device"]["commands"], "set_rate": {"stores": {"hz": "rate_hz"}, "echoes": ["hz"]}},
+    }
+    spec = {**SPEC, "commands": commands, "device": device}
+    generated = files(spec)
+    protocol = resolve(load_text(yaml.safe_dump(spec, sort_keys=False), "beacon.yaml"))
+    docs = next(t for e in emitters() for p, t in e.files(protocol).items() if p.endswith(".md"))
+    assert "every `1000 / rate_hz` ms" in docs
+    with imported("beacon", generated, "the sends test") as package:
+        m = importlib.import_module("beacon.messages")
+        codec = importlib.import_module("beacon.codec")
+        clock = Clock()
+        sim = importlib.import_module("beacon.simulator").BeaconSimulator(ids=[1], clock=clock)
+        decode = codec.StreamParser(m.Direction.RESPONSE)
+
+        def beats_in_a_second() -> int:
+            count = 0
+            for _ in range(1000):  # one simulated second in 1 ms steps
+                count += sum(isinstance(x, m.HeartbeatResponse) for _, f in sim.due() for x in decode.feed(f))
+                clock.now += 0.001
+            return count
+
+        def set_rate(hz: int) -> None:
+            sent = [x for _, frame in sim.feed(codec.encode(m.SetRateRequest(id=1, hz=hz))) for x in decode.feed(frame)]
+            assert sent == [m.SetRateResponse(id=1, hz=hz)]
+
+        assert beats_in_a_second() == 50  # every 20 ms
+        set_rate(0)
+        assert beats_in_a_second() <= 1  # at most the one already due at the old rate, then none: 1000 / 0
+        set_rate(200)
+        assert 199 <= beats_in_a_second() <= 200  # every 5 ms, from the next 10 ms look on
+        del package
+
+
+LISTED: dict[str, Any] = {
+    **SPEC,
+    "commands": {
+        **SPEC["commands"],
+        "info": {
+            "code": 8,
+            "title": "Device information",
+            "request": {},
+            "response": {
+                "fields": {
+                    "flags": {"type": "u8", "bits": {"alarm": {"bits": 0}, "busy": {"bits": 1}}},
+                    "temps": {"type": "array", "of": "i8", "count": 3},
+                    "n": "u8",
+                    "names": {
+                        "type": "group",
+                        "count": "n",
+                        "fields": {"name": {"type": "string", "size": 8, "pad": "00"}},
+                    },
+                }
+            },
+        },
+        "state_bits": {
+            "code": 9,
+            "title": "Two bits of another flags",
+            "request": {},
+            "response": {"fields": {"flags": {"type": "u8", "bits": {"alarm": {"bits": 7}, "ready": {"bits": 0}}}}},
+        },
+    },
+}
+
+
+def listed(reply: dict[str, Any]) -> dict[str, Any]:
+    return {**LISTED, "device": {**SPEC["device"], "reply": reply}}
+
+
+def test_a_reply_fills_lists_and_groups_from_the_device() -> None:
+    """`device.reply` takes a list field's items (numbers) and a group's (a mapping of its fields each); a bit field
+    value goes to every response that has the field."""
+    reply = {"temps": [21, -4, 30], "names": [{"name": "left"}, {"name": "right"}], "flags.alarm": 1}
+    with imported("beacon", files(listed(reply)), "the sends test") as package:
+        m = importlib.import_module("beacon.messages")
+        codec = importlib.import_module("beacon.codec")
+        sim = importlib.import_module("beacon.simulator").BeaconSimulator(ids=[1], clock=Clock())
+        decode = codec.StreamParser(m.Direction.RESPONSE)
+        (info,) = [x for _, f in sim.feed(codec.encode(m.InfoRequest(id=1))) for x in decode.feed(f)]
+        assert list(info.temps) == [21, -4, 30] and [n.name for n in info.names] == ["left", "right"]
+        assert (info.flags.alarm, info.flags.busy) == (1, 0)
+        (bits,) = [x for _, f in sim.feed(codec.encode(m.StateBitsRequest(id=1))) for x in decode.feed(f)]
+        assert (bits.flags.alarm, bits.flags.ready) == (1, 0)
+        del package
+
+
+@pytest.mark.parametrize(
+    ("reply", "said"),
+    [
+        ({"flags.busy": 1}, "device.reply.flags.busy: the state_bits response's flags has no bit field 'busy'"),
+        ({"flags.ready": 1}, "device.reply.flags.ready: the info response's flags has no bit field 'ready'"),
+        ({"temps": [1, 2]}, "device.reply.temps: the info response's temps: 2 items where it holds 3"),
+        ({"temps": [1, 2, 300]}, "temps: item 2 (300) is not a number in -128..127"),
+        ({"names": [{"nom": "x"}]}, "names: item 0: no field 'nom'; no value for 'name'"),
+        ({"names": ["left"]}, "names: item 0 is not a mapping of its fields (name)"),
+        ({"n": [1]}, "the info response's n: a list for a field that is no list, array or group"),
+    ],
+)
+def test_reply_mistakes_in_one_line(reply: dict[str, Any], said: str) -> None:
+    with pytest.raises(SpecErrors) as caught:
+        files(listed(reply))
+    assert said in str(caught.value) and len(str(caught.value).splitlines()) == 1

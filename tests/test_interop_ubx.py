@@ -231,6 +231,7 @@ def test_pyubx2_reads_the_sim_stream_and_gets_replies_to_its_polls_and_sets() ->
         port.write(UBXMessage("MON", "MON-VER", POLL).serialize())
         version = read_until(reader, "MON-VER", seen)
         assert version.swVersion.rstrip(b"\x00") == b"ROM SPG 5.10 (7b202e)"
+        assert version.extension_04.rstrip(b"\x00") == b"GPS;GLO;GAL;BDS"  # pyubx2 numbers the repeated items
         port.write(UBXMessage("CFG", "CFG-RATE", SET, measRate=200, navRate=2, timeRef=0).serialize())
         ack = read_until(reader, "ACK-ACK", seen)
         assert (ack.clsID, ack.msgID) == (0x06, 0x08)
@@ -258,6 +259,12 @@ def test_our_client_polls_and_sets_the_sim_among_its_stream() -> None:
     with serve("ubx.yaml") as path, UbxClient(path, timeout=3.0) as client:
         version = client.mon_ver()
         assert (version.sw_version, version.hw_version) == ("ROM SPG 5.10 (7b202e)", "000A0000")
+        assert [e.extension for e in version.extensions] == [  # device.reply's list of group items
+            "FWVER=SPG 5.10",
+            "PROTVER=34.10",
+            "MOD=NEO-M10S",
+            "GPS;GLO;GAL;BDS",
+        ]
         assert client.set_rate(250, 1, ubx.TimeReference.GPS) is True
         assert client.cfg_rate() == ubx.CfgRateResponse(meas_rate=250, nav_rate=1, time_ref=ubx.TimeReference.GPS)
         fix = client.nav_pvt()
@@ -291,3 +298,40 @@ def test_our_client_raises_on_the_ack_nak_pyubx2_builds() -> None:
     finally:
         os.close(controller)
         os.close(device)
+
+
+def test_the_navigation_rate_follows_a_cfg_rate_set() -> None:
+    """NAV-PVT comes every meas_rate × nav_rate ms (`every: meas_rate * nav_rate`), counted over a simulated clock:
+    once a second by default, four times a second after CFG-RATE sets 250 ms, twice after nav_rate 2."""
+    from serialspec_protocols.ubx.simulator import UbxSimulator
+
+    class Clock:
+        now = 50.0
+
+        def __call__(self) -> float:
+            return self.now
+
+    clock = Clock()
+    sim = UbxSimulator(ids=[0], clock=clock)
+    parser = ubx.StreamParser(ubx.Direction.RESPONSE)
+
+    def fixes_in_a_second() -> int:
+        count = 0
+        for _ in range(1000):
+            count += sum(isinstance(m, ubx.NavPvtResponse) for _, f in sim.due() for m in parser.feed(f))
+            clock.now += 0.001
+        return count
+
+    def set_rate(meas_rate: int, nav_rate: int) -> None:
+        replies = [
+            m for _, f in sim.feed(ubx.encode(ubx.SetRateRequest(meas_rate, nav_rate, 0))) for m in parser.feed(f)
+        ]
+        assert [type(m) for m in replies] == [ubx.AckAckResponse]
+
+    assert fixes_in_a_second() == 1
+    set_rate(250, 1)
+    assert 4 <= fixes_in_a_second() <= 5  # the one due at the old rate, then every 250 ms
+    assert fixes_in_a_second() == 4
+    set_rate(250, 2)
+    assert fixes_in_a_second() in (2, 3)
+    assert fixes_in_a_second() == 2

@@ -624,7 +624,6 @@ CASES["device: derived, locks, sends, moves.to"] = Case(
         "commands": {"go": {"moves": {"state": "position", "target": "target", "to": "target / 2"}}},
     },
 )
-DEVICE_KEYS = ("derived", "locks", "sends")  # the device keys a matrix case must use
 # Layouts chosen by command (RoboClaw packet serial): `read` requests get their data and a CRC that starts with the
 # request's address and command (`from_request`), `write` requests (their own checksum) one bare 0xFF byte
 XMODEM = {"width": 16, "poly": 0x1021, "init": 0, "refin": False, "refout": False, "xorout": 0, "check": 0x31C3}
@@ -689,6 +688,55 @@ CASES[BY_COMMAND] = Case(
 )
 # each frame alone does not say how to read it (the C decoder's and a dissector's way): both refuse the case
 C_REFUSES[BY_COMMAND] = WIRESHARK_REFUSES[BY_COMMAND] = "layouts chosen by command (`layout:`)"
+
+
+# `every` as an expression of the device's values (a rate the request sets): the beats come among the replies
+CASES["device: sends every an expression (a rate)"] = Case(
+    {"v": "u16"},
+    {"v": "u16"},
+    commands={"beat": {"code": 9, "title": "Beat", "response": {"unsolicited": True, "fields": {"n": "u16"}}}},
+    device={
+        "state": {"rate_hz": 200, "beats": 0},
+        "sends": {"beat": {"every": "1000 / rate_hz", "step": "beats", "values": {"n": "beats"}}},
+        "commands": {"probe": {"stores": {"v": "rate_hz"}}},
+    },
+)
+# `reply` values for a list, an array and a group (one mapping of its fields per item), a bit field by name
+CASES["device: reply lists, arrays, groups and bit fields"] = Case(
+    {"v": "u16"},
+    {
+        "temps": {"type": "array", "of": "i8", "count": 2},
+        "n": "u8",
+        "levels": {"type": "array", "of": "u16", "count": "n"},
+        "m": "u8",
+        "items": {"type": "group", "count": "m", "fields": {"id": "u8", "tag": {"type": "string", "size": 4}}},
+        "flags": {"type": "u8", "bits": {"on": {"bits": 0}, "mode": {"bits": [3, 1]}}},
+    },
+    device={
+        "reply": {
+            "temps": [-3, 40],
+            "levels": [1, 500, 65535],
+            "items": [{"id": 1, "tag": "abcd"}, {"id": 2, "tag": "efgh"}],
+            "flags.mode": 5,
+        }
+    },
+)
+# sizes and counts from fields whose range is narrower than their type's (tests/strategies.py keeps to it)
+CASES["bytes, text and a group sized by fields with a narrow range"] = same(
+    {
+        "n": {"type": "u8", "range": [2, 4]},
+        "data": {"type": "bytes", "size": "n"},
+        "k": {"type": "u8", "range": [1, 3]},
+        "name": {"type": "string", "size": "k"},
+        "m": {"type": "u8", "range": [1, 3]},
+        "g": {"type": "group", "count": "m", "fields": {"a": "u8"}},
+    }
+)
+# a value dividing by a field: frames with that field 0 have no value (refused everywhere, C too)
+CASES["value: an expression dividing by a field"] = same(
+    {"d": {"type": "u8", "range": [1, 255], "default": 4}, "q": {"type": "u16", "value": "1000 / d"}, "r": "u8"}
+)
+DEVICE_KEYS = ("derived", "locks", "sends", "reply")  # the device keys a matrix case must use
 # Every documented option of every frame transform (serialspec/transforms/), as its sample framing.
 for _method, _transform in transforms().items():
     for _sample in _transform.samples:

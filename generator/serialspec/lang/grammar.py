@@ -421,7 +421,9 @@ _FIELD_LONG: dict[str, Shape] = {
         "`2 * count`, `ceil(len(coils) / 8)` (names of fields, len(), ceil(a / b), min, max, + - * / % & | << >>). "
         "At most 500 characters and 50 levels deep; every value it can take for any values of its fields' types "
         "(intermediate ones too) within 512 bits, and some value within the field's range (a constant one must fit "
-        "it). A frame whose fields make it divide by 0 or shift by a negative count is refused when decoded."
+        "it). A frame whose fields make it divide by 0 or shift by a negative count is refused when decoded, in "
+        "every output (the codec's DecodeError, the construct structs' error, the C decoder's E_CONTENT; the "
+        "simulator answers nothing and logs one line), and such values are refused on encode."
     ),
     "fields": Ref("fields", lambda: FIELDS, "group: the fields of each item (a mapping, like request/response)."),
     "table": Str("table_value/table_block, or bytes holding registers: name of an entry in `tables:`."),
@@ -1029,7 +1031,22 @@ ERRATUM = Obj(
 
 REPLY_VALUES = (
     "Response field -> value when no behaviour sets it (e.g. result: 1; text for text and bytes fields, bytes as "
-    "hex: VESC hw_name: '60')."
+    "hex: VESC hw_name: '60'; a list for a list, array or group field: its numbers, or for a group one mapping of "
+    "its fields per item, as u-blox MON-VER's extensions: `[{extension: FWVER=SPG 5.10}, {extension: "
+    "PROTVER=34.10}]`). A `field.bit_field` key sets one bit field of every response that has the field (each "
+    "must have that bit field; its bit fields not named are 0)."
+)
+_REPLY_ITEM_VALUE = OneOf((Num(), Str()), REPLY_VALUES)
+REPLY_VALUE = OneOf(
+    (
+        Num(),
+        Str(),
+        ListOf(
+            OneOf((Num(), Str(), MapOf(OneOf((Num(), Str(), ListOf(_REPLY_ITEM_VALUE)), REPLY_VALUES))), REPLY_VALUES),
+            REPLY_VALUES,
+        ),
+    ),
+    REPLY_VALUES,
 )
 
 SPACE_ACCESS = Obj(
@@ -1294,7 +1311,7 @@ DEVICE = Obj(
         "broadcast": Int("The address every device obeys (default: the address element's broadcast)."),
         "state": MapOf(Num(), "State variables beyond memory -> initial value (e.g. the present angle)."),
         "reply": MapOf(
-            OneOf((Num(), Str()), REPLY_VALUES),
+            REPLY_VALUE,
             REPLY_VALUES,
         ),
         "status": MapOf(
@@ -1416,7 +1433,13 @@ DEVICE = Obj(
         "sends": MapOf(
             Obj(
                 {
-                    "every": Int("Period in ms: the device sends the message this often.", minimum=1, example=1000),
+                    "every": OneOf(
+                        (Int(minimum=1), Str()),
+                        "Period in ms: the device sends the message this often. A number, or an expression of "
+                        "state variables and memory entries (a rate register: `1000 / rate_hz`), worked out again "
+                        "for each period: where it has no value (a division by 0) or is not positive, the device "
+                        "sends nothing periodically until it has one.",
+                    ),
                     "after": ListOf(
                         Str(),
                         "Commands (or command.subcommand) after whose reply the device also sends it.",

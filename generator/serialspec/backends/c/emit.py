@@ -496,7 +496,9 @@ def decode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                     scope.names[f.name] = local
                 else:
                     out.append(f"{pad}{tgt} = {value};")
-                    scope.names[f.name] = f"(uint32_t){tgt}" if not (f.type.is_float or wide(f.type)) else tgt
+                    # (a signed field keeps its sign: an expression of it, `n >> s`, sees the value, not its bits)
+                    unsigned = not (f.type.is_float or wide(f.type) or f.type.signed)
+                    scope.names[f.name] = f"(uint32_t){tgt}" if unsigned else tgt
                 out.append(f"{pad}o += {size}u;")
             case Array():
                 total = f.count * f.item.size
@@ -670,12 +672,44 @@ def render_c(expr: Expr, name: Callable[[str], str], length: Callable[[str], str
             assert_never(expr)
 
 
+def no_value(expr: Expr, name: Callable[[str], str], length: Callable[[str], str]) -> list[str]:
+    """C conditions under which the expression has no value (a division by 0, a negative shift): undefined in C,
+    so tested first, inner ones before outer ones (each may use what those ruled out); [] where none can happen
+    (expression.fails)."""
+    if not expression.fails(expr):
+        return []
+    match expr:
+        case expression.BinOp():
+            found = no_value(expr.left, name, length) + no_value(expr.right, name, length)
+            right = render_c(expr.right, name, length)
+            if expr.op in ("/", "%") and not (isinstance(expr.right, expression.Const) and expr.right.value != 0):
+                found.append(f"{right} == 0")
+            if expr.op in ("<<", ">>") and not (isinstance(expr.right, expression.Const) and expr.right.value >= 0):
+                found.append(f"{right} < 0")
+            return found
+        case expression.Ceil():
+            found = no_value(expr.numerator, name, length) + no_value(expr.denominator, name, length)
+            return [*found, f"{render_c(expr.denominator, name, length)} == 0"]
+        case expression.Invert():
+            return no_value(expr.operand, name, length)
+        case expression.MinMax():
+            return [c for arg in expr.args for c in no_value(arg, name, length)]
+        case expression.Const() | expression.Name() | expression.Length():
+            return []
+        case _:
+            assert_never(expr)
+
+
 def value_checks(ctx: Ctx, fields: tuple[Field, ...], scope: Scope) -> list[str]:
-    """Decode: every value the spec computes by an expression recomputed from the frame's fields, and compared."""
+    """Decode: every value the spec computes by an expression recomputed from the frame's fields, and compared (a
+    frame where it has no value, a division by a 0 from the wire, does not decode)."""
     lines = []
     for f in fields:
         if isinstance(f, Scalar) and f.value is not None:
-            computed = render_c(f.value, scope.lookup, lambda list_name: f"{scope.target}{ident(list_name)}_count")
+            length = lambda list_name: f"{scope.target}{ident(list_name)}_count"  # noqa: E731
+            computed = render_c(f.value, scope.lookup, length)
+            for condition in no_value(f.value, scope.lookup, length):
+                lines.append(f"    if ({condition}) {{ return {ctx.P}_E_CONTENT; }} /* {f.name}: no value */")
             lines.append(
                 f"    if ((int64_t){scope.lookup(f.name)} != {computed}) {{ return {ctx.P}_E_CONTENT; }} /* {f.name} */"
             )
@@ -1011,7 +1045,10 @@ def computed_values(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list
     for f in fields:
         if isinstance(f, Scalar) and f.value is not None:
             local = f"v1_{ident(f.name)}"
-            computed = render_c(f.value, scope.lookup, lambda list_name: f"{scope.target}{ident(list_name)}_count")
+            length = lambda list_name: f"{scope.target}{ident(list_name)}_count"  # noqa: E731
+            computed = render_c(f.value, scope.lookup, length)
+            for condition in no_value(f.value, scope.lookup, length):  # a division by a 0 given: refused
+                out.append(f"    if ({condition}) {{ return {ctx.P}_E_RANGE; }} /* {f.name}: no value */")
             out.append(f"    {local} = {computed};")
             out.append(
                 f"    if ({local} < {int(f.minimum)}LL || {local} > {int(f.maximum)}LL) "

@@ -246,10 +246,15 @@ def sends_text(protocol: Protocol, message: Message) -> str:
     send = next((s for s in device.sends if s.command == message.key), None) if device else None
     if send is None or message.direction != Direction.RESPONSE:
         return ""
-    when = [f"every {send.every} ms"] if send.every else []
+    when = [f"every {period_text(send.every)} ms"] if send.every else []
     when += [f"after the reply to {', '.join(f'`{n}`' for n in send.after)}"] if send.after else []
     when += [f"when {', '.join(f'`{n}`' for n in send.changes)} changes"] if send.changes else []
     return " or ".join(when) + (f", while `{send.while_}` is non-zero" if send.while_ else "")
+
+
+def period_text(every: int | expression.Expr) -> str:
+    """`every` as the docs show it: a number of ms, or the expression that gives it (`1000 / rate_hz`)."""
+    return str(every) if isinstance(every, int) else f"`{expression.show(every)}`"
 
 
 def content_limit(layout: FrameLayout) -> int | None:

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 
-from serialspec.backends.markdown.docs import cell, code_span, text
+from serialspec.backends.markdown.docs import cell, code_span, period_text, text
 from serialspec.backends.markdown.kinds import anchor
 from serialspec.lang import expression
 from serialspec.lang.model import Protocol, TextDevice, TextField, TextFrame, TextMessage, TextRepeat
@@ -190,7 +190,7 @@ def _device(device: TextDevice) -> Iterator[str]:
     yield "| sentence | when | values | meaning |"
     yield "| --- | --- | --- | --- |"
     for send in device.sends:
-        when = [f"every {send.every} ms"] + ([f"while `{send.while_}`"] if send.while_ else [])
+        when = [f"every {period_text(send.every)} ms"] + ([f"while `{send.while_}`"] if send.while_ else [])
         when += [f"`{send.step}` + 1 first"] if send.step else []
         values = "; ".join(f"`{k}` = `{expression.show(v)}`" for k, v in send.values.items())
         yield f"| {send.command} | {', '.join(when)} | {values} | {cell(send.description)} |"

@@ -1018,7 +1018,11 @@ class PackageCode:
                 error = f"EncodeError({where} + ': every {target} of {group.name} must have the same length')"
                 condition = f"any(len(item.{target}) != {value} for item in {items})"
                 body.append(If(condition, (Raise(error),)))
-            body.append(If(f"{value} > {number(f.maximum)}", (out_of_range(value),)))
+            # a count or size is never negative: its lower bound is checked only where its range sets one
+            condition = f"{value} > {number(f.maximum)}"
+            if f.minimum > 0:
+                condition = f"not {number(f.minimum)} <= {value} <= {number(f.maximum)}"
+            body.append(If(condition, (out_of_range(value),)))
             return value
         expr = field_read(obj, f.name)
         if f.bits:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Any, assert_never
 
 from serialspec.backends.common.numbers import number
@@ -15,6 +16,7 @@ from serialspec.lang.model import (
     Bytes,
     DeviceModel,
     Direction,
+    Field,
     Group,
     List,
     Message,
@@ -127,6 +129,11 @@ def function_of_get(parsed: expression.Expr) -> str:
     return f"lambda get: {expression.render(parsed, lambda n: f'get({n!r})')}"
 
 
+def period_source(every: int | expression.Expr) -> str:
+    """`every` of a SendSpec: the period in seconds, or a function of `get` giving it in ms (`every: 1000 / rate`)."""
+    return repr(every / 1000) if isinstance(every, int) else function_of_get(every)
+
+
 def derived_values(request: Message, response: Message | None) -> dict[str, str]:
     """Request values its message does not hold (derived counts), for a reply to echo: name -> a function of the
     request's fields (and the values derived before it)."""
@@ -184,11 +191,25 @@ def reply_blanks(protocol: Protocol, response: Message, filled: set[str]) -> dic
     status values do not name (the engine fills those in bit by bit)."""
     device = protocol.device
     assert device is not None  # a simulator is made only for a spec with a device
-    blanks = {f.name: kind(f).blank(f) for f in response.fields if f.name not in filled}
+    blanks = {f.name: kind(f).blank(least(f, response.fields)) for f in response.fields if f.name not in filled}
     named = {key.partition(".")[0] for key in (*device.reply, *device.status) if "." in key}
     layout = protocol.framing.layouts[response.direction]
     blanks |= {e.name: zero_bits(e.bits) for e in layout.value_elements if e.bits and e.name not in {*filled, *named}}
     return {name: blank for name, blank in blanks.items() if blank != "0"}
+
+
+def least(f: Field, siblings: tuple[Field, ...]) -> Field:
+    """`f`, sized or counted by a sibling whose range starts above 0, as of that smallest size or count: its blank
+    (none of it) would have a size the sizing field refuses."""
+    name = f.size if isinstance(f, Bytes | Text) else f.count if isinstance(f, Group | List) else None
+    counter = next((s for s in siblings if s.name == name and isinstance(s, Scalar)), None)
+    if counter is None or counter.minimum <= 0 or isinstance(f, List) and f.count_from:
+        return f
+    smallest = int(counter.minimum)
+    if isinstance(f, Bytes | Text):
+        return replace(f, size=smallest)
+    assert isinstance(f, Group | List)
+    return replace(f, count=smallest)
 
 
 def import_order(name: str) -> tuple[int, str]:
@@ -331,7 +352,7 @@ def simulator_module(protocol: Protocol) -> str:
         imports.add(response.class_name)
         args = [response.class_name]
         if send.every:
-            args.append(f"every={send.every / 1000!r}")
+            args.append(f"every={period_source(send.every)}")
         requests = [m for m in protocol.messages() if m.key in send.after and m.direction == Direction.REQUEST]
         if requests:
             imports.update(m.class_name for m in requests)

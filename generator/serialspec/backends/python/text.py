@@ -8,7 +8,7 @@ from collections.abc import Iterator
 from typing import assert_never
 
 from serialspec.backends.python.render import one_line
-from serialspec.backends.python.simulator import report_source
+from serialspec.backends.python.simulator import period_source, report_source
 from serialspec.lang.model import (
     Direction,
     Protocol,
@@ -87,7 +87,7 @@ def _simulator(protocol: Protocol, text: TextFrame, device: TextDevice) -> Itera
         message = text.message(send.command)
         blanks: dict[str, object] = {f.name: () if isinstance(f, TextRepeat) else None for f in message.fields}
         blanks |= {"talker": default_talker, "sent": -1}
-        args = [f"cast(Any, {message.class_name})", f"every={send.every / 1000!r}"]
+        args = [f"cast(Any, {message.class_name})", f"every={period_source(send.every)}"]
         if send.while_:
             args.append(f"while_={send.while_!r}")
         if send.step:

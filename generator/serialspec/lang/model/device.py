@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import field
+from typing import Any
 
 from serialspec.lang.expression import Expr
 from serialspec.lang.frozen import frozen
@@ -107,7 +108,7 @@ class Unsolicited:
     a value changes; only while `while_` (a state variable or memory entry) is non-zero, when it is given."""
 
     command: str  # command (or command.subcommand) key whose response is sent
-    every: int = 0  # period in ms (0: not periodic)
+    every: int | Expr = 0  # period in ms, or an expression of state and memory giving it (0: not periodic)
     after: tuple[str, ...] = ()  # request keys after whose reply it is sent
     changes: tuple[str, ...] = ()  # state variables or memory entries: sent when one of them changes
     while_: str = ""
@@ -193,7 +194,9 @@ class Device:
     id_entry: str  # the memory entry holding the device's own id
     broadcast: int | None
     state: dict[str, float]  # state variables beyond memory -> initial value
-    reply: dict[str, float | str]  # response field -> value when no behaviour sets it
+    # response field -> value when no behaviour sets it: a number, text, or a list field's items (numbers, or a
+    # group's items as mappings of its fields)
+    reply: dict[str, float | str | tuple[Any, ...]]
     behaviours: tuple[Behaviour, ...]
     status: dict[str, str] = field(default_factory=dict)  # response field -> memory entry every reply reports
     kinds: tuple[DeviceKind, ...] = ()

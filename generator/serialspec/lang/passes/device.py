@@ -7,9 +7,11 @@ from typing import Any
 
 from serialspec.lang import expression
 from serialspec.lang.errors import SpecError
+from serialspec.lang.expression import Expr
 from serialspec.lang.loader import Path
 from serialspec.lang.model import (
     SCALARS,
+    Array,
     Behaviour,
     Bytes,
     Command,
@@ -20,11 +22,14 @@ from serialspec.lang.model import (
     DeviceTimeout,
     Direction,
     Field,
+    FrameElement,
     Framing,
     Group,
+    List,
     Message,
     ModelEntry,
     Motion,
+    Packed,
     Presence,
     Scalar,
     Space,
@@ -263,7 +268,7 @@ class DevicePass(Pass):
             id_entry=id_entry,
             broadcast=broadcast,
             state=state,
-            reply={str(k): v if isinstance(v, str) else float(v) for k, v in (value.get("reply") or {}).items()},
+            reply={str(k): reply_value(v) for k, v in (value.get("reply") or {}).items()},
             behaviours=tuple(behaviours),
             status=status,
             kinds=tuple(kinds.values()),
@@ -303,6 +308,21 @@ class DevicePass(Pass):
         for name in sorted(set(expression.names(parsed))):
             if not any(name in known for known in names):
                 self.error(path, f"unknown name {name!r} (not a request field, memory entry or state variable)")
+        return parsed
+
+    def period(self, value: Any, path: Path, names: tuple[Container[str], ...]) -> int | Expr:
+        """`every`: a period in ms, or an expression of state variables and memory entries giving it (a rate
+        register); a constant expression is its value, which must be positive."""
+        if not isinstance(value, str):
+            return int(value)
+        parsed = self.expression(value, path, names)
+        if parsed is None:
+            return 0
+        if isinstance(parsed, expression.Const):
+            if parsed.value < 1:
+                self.error(path, f"a period of {parsed.value} ms: it must be at least 1")
+                return 0
+            return int(parsed.value)
         return parsed
 
     def no_chains(self, value: dict[str, Any], path: Path) -> dict[str, Any]:
@@ -374,7 +394,7 @@ class DevicePass(Pass):
             found.append(
                 Unsolicited(
                     str(key),
-                    int(item.get("every", 0)),
+                    self.period(item.get("every", 0), (*where, "every"), (variables,)),
                     tuple(str(n) for n in item.get("after") or ()),
                     tuple(str(n) for n in item.get("changes") or ()),
                     str(item.get("while", "")),
@@ -489,12 +509,15 @@ class DevicePass(Pass):
         the responses carry."""
         elements = {e.name: e for layout in framing.layouts.values() for e in layout.value_elements}
         carried: dict[Direction, dict[str, Field]] = {Direction.REQUEST: {}, Direction.RESPONSE: {}}
+        every: dict[str, list[tuple[Message, Field]]] = {}  # response field -> each response carrying it
         for command in commands:
             for message in command.messages():
                 stack = list(message.fields)
                 while stack:
                     f = stack.pop()
                     carried[message.direction].setdefault(f.name, f)
+                    if message.direction == Direction.RESPONSE:
+                        every.setdefault(f.name, []).append((message, f))
                     if isinstance(f, Group):
                         stack.extend(f.fields)
         wanted = [((*path, "address"), value.get("address"))]
@@ -509,18 +532,30 @@ class DevicePass(Pass):
                 self.error(where, f"unknown field {name!r}: no request carries it (nor the frame)")
             elif not isinstance(found, Scalar) or found.type.is_float:
                 self.error(where, f"{name!r} is no integer field, so it cannot hold a device id")
-        responses = carried[Direction.RESPONSE]
         # Reply values: `reply`, `status`, and `errors` where no error reply carries them (else `errors` checks them).
         named: list[tuple[Path, Any]] = [((key,), value.get(key)) for key in ("reply", "status")]
         if not any(m.error_reply for c in self.ctx.commands for m in c.messages()):
             named += [(("errors", reason), values) for reason, values in (value.get("errors") or {}).items()]
         for where, values in named:
-            for name in values or {}:
+            for name, given in (values or {}).items():
                 head, _, bit = str(name).partition(".")  # `error.number`: a bit field of a value or element
-                owner = elements.get(head) or responses.get(head)
-                bits = {b.name for b in getattr(owner, "bits", ())}
-                if owner is None or (bit and bit not in bits):
-                    self.error((*path, *where, name), f"unknown response field {name!r}: no response carries it")
+                at = (*path, *where, name)
+                element = elements.get(head)
+                owners: list[tuple[str, Field | FrameElement]] = (
+                    [("the frame", element)]
+                    if element is not None
+                    else [(f"the {m.key} response", f) for m, f in every.get(head, [])]
+                )
+                if not owners:
+                    self.error(at, f"unknown response field {name!r}: no response carries it")
+                    continue
+                for shown, owner in owners:  # a reply value goes to every response that has the field
+                    if bit and bit not in {b.name for b in getattr(owner, "bits", ())}:
+                        self.error(at, f"{shown}'s {head} has no bit field {bit!r}")
+                    elif isinstance(given, list):
+                        problem = list_problem(given, owner)
+                        if problem:
+                            self.error(at, f"{shown}'s {head}: {problem}")
 
     def timeout(
         self, value: Any, path: Path, requests: dict[str, Message], state: dict[str, float]
@@ -803,3 +838,47 @@ class DevicePass(Pass):
                 models.remove(found)
                 models.insert(0, found)
         return tuple(models)
+
+
+def reply_value(value: Any) -> Any:
+    """A `reply:` value as the model keeps it: text, a number (a float), or a list's items as a tuple (a group's
+    items as mappings of its fields)."""
+    if isinstance(value, str):
+        return value
+    if isinstance(value, list):
+        return tuple(reply_value(item) for item in value)
+    if isinstance(value, dict):
+        return {str(k): reply_value(v) for k, v in value.items()}
+    return float(value)
+
+
+def list_problem(items: list[Any], f: Field | FrameElement) -> str:
+    """Why `items` cannot be the value of the field `f` in a reply ("" when they can): a list, array or packed
+    field takes numbers within its range, a group one mapping of its fields per item; a fixed count must be met."""
+    count = getattr(f, "count", None)
+    if isinstance(count, int) and len(items) != count:
+        return f"{len(items)} items where it holds {count}"
+    if isinstance(f, Group):
+        names = [g.name for g in f.fields if not (isinstance(g, Scalar) and g.hidden)]
+        for index, item in enumerate(items):
+            if not isinstance(item, dict):
+                return f"item {index} is not a mapping of its fields ({', '.join(names)})"
+            unknown = sorted(set(item) - set(names))
+            missing = [n for n in names if n not in item]
+            if unknown or missing:
+                said = [f"no field {', '.join(map(repr, unknown))}"] if unknown else []
+                said += [f"no value for {', '.join(map(repr, missing))}"] if missing else []
+                return f"item {index}: {'; '.join(said)}"
+            for inner in f.fields:
+                if isinstance(item.get(inner.name), list):
+                    problem = list_problem(item[inner.name], inner)
+                    if problem:
+                        return f"item {index}'s {inner.name}: {problem}"
+        return ""
+    if not isinstance(f, List | Array | Packed):
+        return "a list for a field that is no list, array or group"
+    low, high = (0, 1) if isinstance(f, List) and f.bits else (f.minimum, f.maximum)
+    for index, item in enumerate(items):
+        if isinstance(item, bool) or not isinstance(item, int | float) or not low <= item <= high:
+            return f"item {index} ({item!r}) is not a number in {low:g}..{high:g}"
+    return ""

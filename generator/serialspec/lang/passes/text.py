@@ -244,6 +244,9 @@ class TextPass(Pass):
         for name, value in (raw.get("reply") or {}).items():
             if name not in names:
                 self.error((*path, "reply", name), f"no sentence has a field {name!r}")
+            if isinstance(value, list):
+                self.error((*path, "reply", name), "a text device's reply values are numbers or text, not lists")
+                continue
             reply[str(name)] = value if isinstance(value, str) else float(value)
         if frame.talkers and reply.get("talker", frame.talkers[0]) not in frame.talkers:
             self.error(
@@ -271,18 +274,18 @@ class TextPass(Pass):
                 if name not in fields:
                     self.error(at, f"{key} has no field {name!r}")
                     continue
-                try:
-                    parsed = expression.parse(str(source))
-                except expression.ExpressionError as exc:
-                    self.error(at, str(exc))
-                    continue
-                for used in sorted(set(expression.names(parsed)) - set(state)):
-                    self.error(at, f"unknown name {used!r} (not a state variable)")
-                values[str(name)] = parsed
+                parsed = self.of_state(source, at, state)
+                if parsed is not None:
+                    values[str(name)] = parsed
+            every: int | expression.Expr = 0
+            if isinstance(item.get("every"), str):  # a period worked out from the state (a rate)
+                every = self.of_state(item["every"], (*where, "every"), state) or 0
+            elif "every" in item:
+                every = int(item["every"])
             sends.append(
                 Unsolicited(
                     str(key),
-                    int(item.get("every", 0)),
+                    every,
                     while_=str(item.get("while", "")),
                     values=values,
                     description=str(item.get("description", "")),
@@ -291,6 +294,18 @@ class TextPass(Pass):
             )
         answers = self.answers(raw.get("commands") or {}, frame, state)
         return TextDevice(str(raw.get("description", "")), state, reply, tuple(sends), answers)
+
+    def of_state(self, source: Any, at: Path, state: dict[str, float]) -> expression.Expr | None:
+        """An expression of the device's state variables, or None (each mistake said)."""
+        try:
+            parsed = expression.parse(str(source))
+        except expression.ExpressionError as exc:
+            self.error(at, str(exc))
+            return None
+        unknown = sorted(set(expression.names(parsed)) - set(state))
+        for used in unknown:
+            self.error(at, f"unknown name {used!r} (not a state variable)")
+        return None if unknown else parsed
 
     def answers(self, raw: dict[str, Any], frame: TextFrame, state: dict[str, float]) -> tuple[TextAnswer, ...]:
         """`device.commands`: how the device answers each command's request (a command with a request and a
@@ -339,14 +354,9 @@ class TextPass(Pass):
                 if name not in answered:
                     self.error(at, f"{key}'s response has no field {name!r}")
                     continue
-                try:
-                    parsed = expression.parse(str(source))
-                except expression.ExpressionError as exc:
-                    self.error(at, str(exc))
-                    continue
-                for used in sorted(set(expression.names(parsed)) - set(state)):
-                    self.error(at, f"unknown name {used!r} (not a state variable)")
-                reports[str(name)] = parsed
+                parsed = self.of_state(source, at, state)
+                if parsed is not None:
+                    reports[str(name)] = parsed
             echoes = []
             for index, name in enumerate(item.get("echoes") or ()):
                 if name not in asked or name not in answered:

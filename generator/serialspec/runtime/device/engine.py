@@ -129,10 +129,11 @@ class CommandSpec:
 @dataclass(frozen=True)
 class SendSpec:
     """A message a device sends on its own (`device.sends`): every `every` seconds, after a reply to one of the
-    `after` requests, or when one of the `changes` values changes; only while `while_` is non-zero (when given)."""
+    `after` requests, or when one of the `changes` values changes; only while `while_` is non-zero (when given).
+    `every` may be a function of `get` (state and memory) giving the period in ms, worked out for each period."""
 
     response: type[Message]
-    every: float = 0.0
+    every: float | Callable[[Callable[[str], float]], float] = 0.0
     after: tuple[type[Message], ...] = ()
     changes: tuple[str, ...] = ()
     while_: str = ""
@@ -454,10 +455,14 @@ class Engine(FaultInjection):
                     if send.every:
                         next_time = self._next_send.get(key, now)
                         if next_time <= now:
-                            sending = True
-                            # the next one a period on, or a period from now when the clock jumped further
-                            following = next_time + send.every
-                            self._next_send[key] = following if following > now else now + send.every
+                            period = self._period(device, send)
+                            if period is None:  # no period now (a rate of 0): looked at again in 10 ms
+                                self._next_send[key] = now + 0.01
+                            else:
+                                sending = True
+                                # the next one a period on, or a period from now when the clock jumped further
+                                following = next_time + period
+                                self._next_send[key] = following if following > now else now + period
                     if send.changes:
                         values = tuple(self._value(device, n) for n in send.changes)
                         if values != self._watched.get(key):
@@ -467,6 +472,18 @@ class Engine(FaultInjection):
                     if frame is not None:
                         out.append((now, frame))
         return out
+
+    @staticmethod
+    def _period(device: VirtualDevice, send: SendSpec) -> float | None:
+        """The period of a periodic message in seconds: `every`, or what its expression gives now (in ms); None
+        where that has no value (a division by a rate written as 0) or is not positive."""
+        if not callable(send.every):
+            return send.every
+        try:
+            period = send.every(device.get) / 1000
+        except (ZeroDivisionError, ValueError):
+            return None
+        return period if period > 0 else None
 
     def _value(self, device: VirtualDevice, name: str) -> float | None:
         """A watched value; None where an expression of the spec has none (a division by a value written as 0)."""
@@ -713,7 +730,8 @@ class Engine(FaultInjection):
             elif name in device.spec.status:
                 values[name] = device.get(device.spec.status[name])
             elif any(key.startswith(name + ".") for key in (*self.spec.reply, *device.spec.status)):
-                values[name] = {}  # bit fields, filled in below
+                blank = command.blanks.get(name)  # bit fields, filled in below; those not named stay 0
+                values[name] = dict(blank) if isinstance(blank, dict) else {}
             elif command.tables.get(name, ())[:1] == ("run",):
                 values[name] = b""  # a run of registers in a reply holds what was read: nothing here
             elif name in given and name in command.echoes:

@@ -634,6 +634,8 @@ def source(ctx: Ctx) -> str:
             low = min(u.min_size for u in users)
             highs = [u.max_size for u in users]
             high = None if None in highs else max(h or 0 for h in highs)
+            if high is not None and high > 0xFFFFFFFF:  # a size read from a u64 field: bounds nothing a frame holds
+                high = None
             key = code_key(P, code)
             rows.append(
                 f"        case {key}: *low = {low}u; *high = {high or 0}u; *bounded = {0 if high is None else 1}; "
@@ -680,7 +682,7 @@ def source(ctx: Ctx) -> str:
             elif d == Direction.REQUEST and len(users) > 1:  # requests that share a code: by their content size
                 for u in sorted(users, key=lambda u: u.min_size):
                     fits = f"n >= {u.min_size}u" if u.min_size else ""
-                    if u.max_size is not None:
+                    if u.max_size is not None and u.max_size <= 0xFFFFFFFF:
                         fits = f"n == {u.min_size}u" if u.max_size == u.min_size else f"{fits} && n <= {u.max_size}u"
                     fits = (fits or "1").removeprefix(" && ")
                     body.append(f"            if ({fits}) {{ {dec_call(ctx, u, values)} }}")

@@ -159,6 +159,34 @@ def test_every_split_gives_the_frames_that_complete_first(g: Generated, directio
     run()
 
 
+@pytest.mark.parametrize(("g", "direction"), PARSERS, ids=IDS)
+def test_a_frame_comes_out_with_the_read_that_completes_it(g: Generated, direction: Direction | None) -> None:
+    """Small reads (1 to 3 bytes, as bytes, bytearray or memoryview: a candidate held back waits for its bytes on
+    feed()'s short path, which joins each read to the bytes held): after every read, the frames out so far are the
+    frames one read of the stream so far gives. A frame is delivered by the read that brings its last byte, never
+    later (a frame that completes first is final), and the types of the reads change nothing."""
+
+    @settings(max_examples=examples(30), deadline=None, suppress_health_check=list(HealthCheck))
+    @given(st.data())
+    def run(drawn: st.DataObject) -> None:
+        data = drawn.draw(noisy_stream(g, direction))
+        sizes = drawn.draw(st.lists(st.integers(1, 3), min_size=len(data), max_size=len(data)))
+        kinds = drawn.draw(
+            st.lists(st.sampled_from([bytes, bytearray, memoryview]), min_size=len(data), max_size=len(data))
+        )
+        p = parser(g, direction)
+        found: list[Message] = []
+        position = 0
+        for size, kind in zip(sizes, kinds, strict=True):
+            if position >= len(data):
+                break
+            found += p.feed(kind(data[position : position + size]))
+            position += size
+            assert found == feed(g, direction, [data[:position]])[0], (data.hex(" "), position)
+
+    run()
+
+
 # The case of issue 25: a 51-byte false candidate whose 8-bit sum matches by chance swallowed the real reply
 # `ff ff 02 02 7f 7c` inside it when the stream came in one read. (tests/adversarial/streams/ holds it too.)
 FEETECH_SWALLOWED = bytes.fromhex(

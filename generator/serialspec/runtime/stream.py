@@ -209,6 +209,7 @@ class StreamParser:
         self._single = self._candidates[0] if len(self._candidates) == 1 else None
         self._pending = b""
         self._keep = max(len(f.header) for f in formats) - 1  # a tail that could be the start of a header
+        self._header = formats[0].header  # (of the one format, where `_need` is used)
         self._need = 0  # the size of the candidate held back while feed() waits for its bytes (0: none)
         self._smallest = min(c.smallest for c in self._candidates)
         # runs: pieces the next one takes at most, pieces to wait before it is tried, the wait after the next failure
@@ -219,19 +220,23 @@ class StreamParser:
     def feed(self, data: bytes | bytearray | memoryview) -> list[Message]:
         # Work on immutable bytes: decoders slice their `bytes` fields straight out of the buffer.
         pending = self._pending
-        buffer = pending + data if pending else data if type(data) is bytes else bytes(data)
+        if pending:
+            buffer = pending + data
+            need = self._need
+            if need:  # a candidate held back, its bytes not all here: nothing can change before they are
+                # unless a header comes in the new bytes (a frame inside the candidate may complete first); the
+                # candidate starts the bytes held, so a new header starts after its first byte
+                if len(buffer) < need and buffer.find(self._header, len(pending) - self._keep) < 0:
+                    self._pending = buffer
+                    return []
+                self._need = 0
+        else:
+            buffer = data if data.__class__ is bytes else bytes(data)
         single = self._single
         if single is None:
             return self._scan(buffer)
         end = len(buffer)
         header = single.header
-        need = self._need
-        if need:  # a candidate held back, its bytes not all here: nothing can change before they are
-            # unless a header comes in the new bytes (a frame inside the candidate may complete first)
-            if end < need and buffer.find(header, max(1, len(pending) - len(header) + 1)) < 0:
-                self._pending = buffer
-                return []
-            self._need = 0
         first = buffer.find(header)
         if first:
             if first < 0 and end < 64:  # a short read of garbage (or of a header's first bytes)

@@ -431,8 +431,6 @@ C_REFUSES = {
     "transform: cobs, after a header, with a length inside the span (it counts the plain bytes)": (
         "a length inside the transformed span"
     ),
-    "transform: hex_ascii, Modbus ASCII: ':', the address to the LRC as hex digits, CR LF (the LRC over the plain "
-    "bytes)": "frames with `method: hex_ascii`",
 }
 
 

@@ -652,3 +652,21 @@ def test_a_value_with_no_value_for_the_wire_is_refused_not_undefined(
         assert status == "ok" and json.loads(rest)["fields"] == json.loads(expected[3:]), answer
     else:
         assert answer.startswith("err ") and expected[4:] in answer, answer
+
+
+@pytest.mark.skipif("modbus_ascii" not in IDS, reason="the C target refuses modbus_ascii")
+def test_hex_ascii_frames_in_lower_case_and_cut_by_a_colon_read_as_python_reads_them() -> None:
+    """Modbus ASCII (`method: hex_ascii`): lower-case digits decode as upper-case ones (and encode back in upper case);
+    a frame cut short by a ':' (the next frame's start) and hex digits, CR LF or a lone CR around frames, fed byte by
+    byte and in other pieces, give what the Python parser gives."""
+    g = next(g for g in C_SPECS if g.protocol.name == "modbus_ascii")
+    for example in g.protocol.examples:
+        lower = example.frame[:1] + example.frame[1:-2].lower() + example.frame[-2:]
+        assert lower != example.frame
+        check_decode_agrees(g, lower, example.direction)
+        (answer,) = driver("modbus_ascii").ask(f"rt {example.direction.value} {lower.hex()}")
+        assert answer == f"ok {example.frame.hex()}"
+    frames = [e.frame for e in g.protocol.examples if e.direction == Direction.REQUEST]
+    pieces = [b"0A", frames[0][:7], frames[0], b"\r", frames[-1][:-1], b":", frames[-1], b"1\r\n", frames[0].lower()]
+    for sizes in ("1", "2,3", "7,1,13", "64"):
+        stream_agrees_with_python(driver("modbus_ascii"), g, Direction.REQUEST, b"".join(pieces), sizes)

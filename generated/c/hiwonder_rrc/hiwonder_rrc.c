@@ -107,7 +107,7 @@ typedef struct {
     uint8_t count;
     int8_t content;    /* index of the content, -1 without */
     int8_t command;    /* index of the command code, -1 without */
-    uint8_t has_t;     /* a transform over elements t_first..t_last: 1 substitution (pairs), 2 COBS; 0 none */
+    uint8_t has_t;     /* transform of elements t_first..t_last: 1 substitution (pairs), 2.. hiwonder_rrc__transform; 0 none */
     uint8_t t_first;
     uint8_t t_last;
     const hiwonder_rrc__pair_t *pairs;
@@ -176,72 +176,33 @@ static int hiwonder_rrc__inner_last(const hiwonder_rrc__layout_t *L)
 #endif
 
 #if HIWONDER_RRC_ENABLE_ENCODE || HIWONDER_RRC__STUFFED
-/* COBS (method: cobs): the plain bytes as a code byte before each run of up to 254 non-zero bytes (to_wire), or back
- * (0 for bytes that are no COBS form: a 00, a run past the end). Decoding checks the form itself: with cmp (the
- * re-encoding check of hiwonder_rrc__rewrite) it is not repeated. */
-static int hiwonder_rrc__cobs(int to_wire, const uint8_t *src, size_t n, uint8_t *dst, const uint8_t *cmp, size_t cap,
-                     size_t *out)
+/* The span rewritten by its transform (has_t 2..; each from serialspec/transforms/). */
+static int hiwonder_rrc__transform(uint8_t method, int to_wire, const uint8_t *src, size_t n, uint8_t *dst,
+                          const uint8_t *cmp, size_t cap, size_t *out)
 {
-    size_t i, o = 0u;
-    if (to_wire && cmp != NULL) {
-        *out = cap;
-        return 1;
-    }
-    if (to_wire) {
-        size_t code_at = 0u;
-        uint8_t code = 1u;
-        if (cap < 1u) {
-            return 0;
-        }
-        o = 1u;
-        for (i = 0u; i < n; i++) {
-            if (src[i] != 0u) {
-                if (o >= cap) {
-                    return 0;
-                }
-                dst[o++] = src[i];
-                if (++code != 0xFFu) {
-                    continue;
-                }
-            }
-            dst[code_at] = code;
-            code_at = o;
-            if (o >= cap) {
-                return 0;
-            }
-            dst[o++] = 0u;
-            code = 1u;
-        }
-        dst[code_at] = code;
-        *out = o;
-        return 1;
-    }
-    if (n == 0u) {
-        return 0;
-    }
-    i = 0u;
-    while (i < n) {
-        size_t code = src[i], j;
-        if (code == 0u || i + code > n) {
-            return 0;
-        }
-        for (j = 1u; j < code; j++) {
-            if (src[i + j] == 0u || o >= cap) {
-                return 0;
-            }
-            dst[o++] = src[i + j];
-        }
-        i += code;
-        if (code < 0xFFu && i < n) {
-            if (o >= cap) {
-                return 0;
-            }
-            dst[o++] = 0u;
-        }
-    }
-    *out = o;
-    return 1;
+    (void)method;
+    (void)to_wire;
+    (void)src;
+    (void)n;
+    (void)dst;
+    (void)cmp;
+    (void)cap;
+    (void)out;
+    return 0;
 }
+
+#if HIWONDER_RRC_ENABLE_PARSER && HIWONDER_RRC__STUFFED
+/* Where the span that starts at b[start] ends on the wire, for a transform that can tell (HIWONDER_RRC__WAIT: not
+ * yet); HIWONDER_RRC__NONE where it cannot (the frame then ends at its first trailer). */
+static long hiwonder_rrc__span_end(uint8_t method, const uint8_t *b, size_t start, size_t avail)
+{
+    (void)method;
+    (void)b;
+    (void)start;
+    (void)avail;
+    return HIWONDER_RRC__NONE;
+}
+#endif
 
 /* Each plain sequence rewritten as its wire sequence (to_wire) or back, leftmost first, the pairs tried in order at
  * each position. With cmp: compare the result with cmp[0..cap) instead of writing it (1: equal). */
@@ -250,8 +211,8 @@ static int hiwonder_rrc__rewrite(const hiwonder_rrc__layout_t *L, int to_wire, c
 {
     size_t i = 0u, o = 0u;
     uint8_t k;
-    if (L->has_t == 2u) {
-        return hiwonder_rrc__cobs(to_wire, src, n, dst, cmp, cap, out);
+    if (L->has_t >= 2u) {
+        return hiwonder_rrc__transform(L->has_t, to_wire, src, n, dst, cmp, cap, out);
     }
     while (i < n) {
         int matched = 0;
@@ -459,7 +420,7 @@ static int hiwonder_rrc__unwrap(const hiwonder_rrc__layout_t *L, const uint8_t *
     if (HIWONDER_RRC__T(L)) {
         size_t pn, fixed = 0u, p = 0u;
         if (!hiwonder_rrc__rewrite(L, 0, frame + before, n - before - after, plain, NULL, HIWONDER_RRC_MAX_FRAME, &pn)) {
-            return L->has_t == 2u ? HIWONDER_RRC_E_FRAME : HIWONDER_RRC_E_CAPACITY; /* COBS: no COBS form (never longer than it) */
+            return L->has_t >= 2u ? HIWONDER_RRC_E_FRAME : HIWONDER_RRC_E_CAPACITY; /* no form of the transform (never longer than it) */
         }
         if (!hiwonder_rrc__rewrite(L, 1, plain, pn, NULL, frame + before, n - before - after, &sz)) {
             return HIWONDER_RRC_E_FRAME; /* bad stuffing: not the stuffed form of any bytes */
@@ -595,6 +556,18 @@ static long hiwonder_rrc__probe(const hiwonder_rrc__layout_t *L, hiwonder_rrc_di
     if (HIWONDER_RRC__T(L) && L->e[L->count - 1u].role == HIWONDER_RRC__ROLE_CONSTANT && L->count > 1u) {
         const hiwonder_rrc__element_t *t = &L->e[L->count - 1u];
         size_t i;
+        long ended = hiwonder_rrc__span_end(L->has_t, b, before, avail);
+        if (ended == HIWONDER_RRC__WAIT) {
+            return HIWONDER_RRC__WAIT;
+        }
+        if (ended >= 0) {
+            /* the transform tells where its span ends (runtime/framing.py _to_trailer): the trailer is right there */
+            size_t at = (size_t)ended, have = avail - at < t->size ? avail - at : t->size;
+            if (!hiwonder_rrc__same(b + at, t->constant, have)) {
+                return HIWONDER_RRC__NONE;
+            }
+            return have < t->size ? HIWONDER_RRC__WAIT : (long)(at + t->size);
+        }
         for (i = before; i + t->size <= avail; i++) {
             if (hiwonder_rrc__same(b + i, t->constant, t->size)) {
                 return (long)(i + t->size);

@@ -105,7 +105,7 @@ typedef struct {
     uint8_t count;
     int8_t content;    /* index of the content, -1 without */
     int8_t command;    /* index of the command code, -1 without */
-    uint8_t has_t;     /* a transform over elements t_first..t_last: 1 substitution (pairs), 2 COBS; 0 none */
+    uint8_t has_t;     /* transform of elements t_first..t_last: 1 substitution (pairs), 2.. ubx__transform; 0 none */
     uint8_t t_first;
     uint8_t t_last;
     const ubx__pair_t *pairs;
@@ -174,72 +174,33 @@ static int ubx__inner_last(const ubx__layout_t *L)
 #endif
 
 #if UBX_ENABLE_ENCODE || UBX__STUFFED
-/* COBS (method: cobs): the plain bytes as a code byte before each run of up to 254 non-zero bytes (to_wire), or back
- * (0 for bytes that are no COBS form: a 00, a run past the end). Decoding checks the form itself: with cmp (the
- * re-encoding check of ubx__rewrite) it is not repeated. */
-static int ubx__cobs(int to_wire, const uint8_t *src, size_t n, uint8_t *dst, const uint8_t *cmp, size_t cap,
-                     size_t *out)
+/* The span rewritten by its transform (has_t 2..; each from serialspec/transforms/). */
+static int ubx__transform(uint8_t method, int to_wire, const uint8_t *src, size_t n, uint8_t *dst,
+                          const uint8_t *cmp, size_t cap, size_t *out)
 {
-    size_t i, o = 0u;
-    if (to_wire && cmp != NULL) {
-        *out = cap;
-        return 1;
-    }
-    if (to_wire) {
-        size_t code_at = 0u;
-        uint8_t code = 1u;
-        if (cap < 1u) {
-            return 0;
-        }
-        o = 1u;
-        for (i = 0u; i < n; i++) {
-            if (src[i] != 0u) {
-                if (o >= cap) {
-                    return 0;
-                }
-                dst[o++] = src[i];
-                if (++code != 0xFFu) {
-                    continue;
-                }
-            }
-            dst[code_at] = code;
-            code_at = o;
-            if (o >= cap) {
-                return 0;
-            }
-            dst[o++] = 0u;
-            code = 1u;
-        }
-        dst[code_at] = code;
-        *out = o;
-        return 1;
-    }
-    if (n == 0u) {
-        return 0;
-    }
-    i = 0u;
-    while (i < n) {
-        size_t code = src[i], j;
-        if (code == 0u || i + code > n) {
-            return 0;
-        }
-        for (j = 1u; j < code; j++) {
-            if (src[i + j] == 0u || o >= cap) {
-                return 0;
-            }
-            dst[o++] = src[i + j];
-        }
-        i += code;
-        if (code < 0xFFu && i < n) {
-            if (o >= cap) {
-                return 0;
-            }
-            dst[o++] = 0u;
-        }
-    }
-    *out = o;
-    return 1;
+    (void)method;
+    (void)to_wire;
+    (void)src;
+    (void)n;
+    (void)dst;
+    (void)cmp;
+    (void)cap;
+    (void)out;
+    return 0;
 }
+
+#if UBX_ENABLE_PARSER && UBX__STUFFED
+/* Where the span that starts at b[start] ends on the wire, for a transform that can tell (UBX__WAIT: not
+ * yet); UBX__NONE where it cannot (the frame then ends at its first trailer). */
+static long ubx__span_end(uint8_t method, const uint8_t *b, size_t start, size_t avail)
+{
+    (void)method;
+    (void)b;
+    (void)start;
+    (void)avail;
+    return UBX__NONE;
+}
+#endif
 
 /* Each plain sequence rewritten as its wire sequence (to_wire) or back, leftmost first, the pairs tried in order at
  * each position. With cmp: compare the result with cmp[0..cap) instead of writing it (1: equal). */
@@ -248,8 +209,8 @@ static int ubx__rewrite(const ubx__layout_t *L, int to_wire, const uint8_t *src,
 {
     size_t i = 0u, o = 0u;
     uint8_t k;
-    if (L->has_t == 2u) {
-        return ubx__cobs(to_wire, src, n, dst, cmp, cap, out);
+    if (L->has_t >= 2u) {
+        return ubx__transform(L->has_t, to_wire, src, n, dst, cmp, cap, out);
     }
     while (i < n) {
         int matched = 0;
@@ -457,7 +418,7 @@ static int ubx__unwrap(const ubx__layout_t *L, const uint8_t *frame, size_t n, u
     if (UBX__T(L)) {
         size_t pn, fixed = 0u, p = 0u;
         if (!ubx__rewrite(L, 0, frame + before, n - before - after, plain, NULL, UBX_MAX_FRAME, &pn)) {
-            return L->has_t == 2u ? UBX_E_FRAME : UBX_E_CAPACITY; /* COBS: no COBS form (never longer than it) */
+            return L->has_t >= 2u ? UBX_E_FRAME : UBX_E_CAPACITY; /* no form of the transform (never longer than it) */
         }
         if (!ubx__rewrite(L, 1, plain, pn, NULL, frame + before, n - before - after, &sz)) {
             return UBX_E_FRAME; /* bad stuffing: not the stuffed form of any bytes */
@@ -593,6 +554,18 @@ static long ubx__probe(const ubx__layout_t *L, ubx_direction_t dir, const uint8_
     if (UBX__T(L) && L->e[L->count - 1u].role == UBX__ROLE_CONSTANT && L->count > 1u) {
         const ubx__element_t *t = &L->e[L->count - 1u];
         size_t i;
+        long ended = ubx__span_end(L->has_t, b, before, avail);
+        if (ended == UBX__WAIT) {
+            return UBX__WAIT;
+        }
+        if (ended >= 0) {
+            /* the transform tells where its span ends (runtime/framing.py _to_trailer): the trailer is right there */
+            size_t at = (size_t)ended, have = avail - at < t->size ? avail - at : t->size;
+            if (!ubx__same(b + at, t->constant, have)) {
+                return UBX__NONE;
+            }
+            return have < t->size ? UBX__WAIT : (long)(at + t->size);
+        }
         for (i = before; i + t->size <= avail; i++) {
             if (ubx__same(b + i, t->constant, t->size)) {
                 return (long)(i + t->size);

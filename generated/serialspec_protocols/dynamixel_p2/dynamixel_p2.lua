@@ -733,6 +733,7 @@ local SPEC = {
   },
 }
 
+-- bit operations (Lua 5.2's bit32, or 5.3's operators) and the mask of a width, for the checksums' Lua code
 local band, bor, bxor, lshift, rshift
 if bit32 then
   band, bor, bxor, lshift, rshift = bit32.band, bit32.bor, bit32.bxor, bit32.lshift, bit32.rshift
@@ -740,6 +741,10 @@ else -- Lua 5.3 and later: the operators
   band, bor, bxor, lshift, rshift = load([[return function(a, b) return a & b end, function(a, b) return a | b end,
     function(a, b) return a ~ b end, function(a, b) return (a << b) & 0xFFFFFFFF end,
     function(a, b) return a >> b end]])()
+end
+
+local function width_mask(bits)
+  return bits >= 32 and 0xFFFFFFFF or lshift(1, bits) - 1
 end
 
 local P = SPEC.name
@@ -763,10 +768,6 @@ local function new(abbr, make)
     all[#all + 1] = by_abbr[abbr]
   end
   return by_abbr[abbr]
-end
-
-local function width_mask(bits)
-  return bits >= 32 and 0xFFFFFFFF or lshift(1, bits) - 1
 end
 
 local function scalar_field(abbr, label, spec_type, enum, mask, description)

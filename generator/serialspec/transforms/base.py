@@ -14,7 +14,8 @@ class owns all that the transform means to every part of serialspec:
   transform's module, which imports nothing of the generator (the runtime wheel ships this package);
 - the Python backend: `runtime_name` and `python_arguments(span)`, how generated code builds the runtime object;
 - the markdown backend: `describe()` and `worked(plain)`;
-- the C backend: `c_refusal()`, why the C target cannot generate it yet ("" where it can);
+- the C backend: `c_code(prefix)`, its C99 (CTransform: a function that rewrites the span either way, and the C of
+  `span_end` where the runtime has one); `c_refusal()`, why the C target cannot generate it yet ("" where it can);
 - the Wireshark backend: `lua()`, the data the dissector's Lua engine reads;
 - tests: `samples`, one framing per documented option, which tests/test_transforms.py runs through every output.
 
@@ -32,7 +33,7 @@ from typing import Any, ClassVar, Literal, Protocol
 
 from serialspec.checksums.base import ChecksumProblem
 
-__all__ = ["DEFAULT", "Key", "Report", "Sample", "SpanTransform", "Transform", "TransformProblem"]
+__all__ = ["DEFAULT", "CTransform", "Key", "Report", "Sample", "SpanTransform", "Transform", "TransformProblem"]
 
 Report = Callable[[tuple[str, ...], str], None]  # a problem with the spec: keys below `transparency`, message
 DEFAULT = "replace"  # the method of a `transparency:` that names none
@@ -79,6 +80,24 @@ class SpanTransform(Protocol):
         plain bytes may be fewer where the wire ends before them: a transform that can tell where its span ends);
         None while more wire bytes are needed; DecodeError where no transformed bytes start there."""
         ...
+
+
+@dataclass(frozen=True)
+class CTransform:
+    """A transform as C99, its names prefixed with the protocol's prefix (backends/c/engine.py calls them).
+
+    `rewrite` names `static int NAME(int to_wire, const uint8_t *src, size_t n, uint8_t *dst, const uint8_t *cmp,
+    size_t cap, size_t *out)`: the n bytes at src rewritten to the wire (to_wire) or back, into dst, never past cap,
+    their count in *out; 1 on success, 0 for bytes that are no transform of any bytes or that do not fit. With cmp
+    (the engine's re-encoding check after a decode): 1 when the wire form of src is cmp[0..cap), or 1 at once (and
+    *out = cap) for a transform whose decoding checks the form itself. `code` is its C (with any helpers).
+    `span_end` (or ""): `static long NAME(const uint8_t *b, size_t start, size_t avail)`, where the span that starts
+    at b[start] ends on the wire (the runtime's span_end), -2 while the bytes end inside it; `span_code` its C."""
+
+    rewrite: str
+    code: str
+    span_end: str = ""
+    span_code: str = ""
 
 
 _REGISTERED: dict[str, type[Transform]] = {}
@@ -141,7 +160,11 @@ class Transform:
 
     def c_refusal(self) -> str:
         """Why the C target cannot generate frames with this transform yet ("" when it can)."""
-        return f"frames with `method: {self.name}`"
+        return "" if self.c_code("p") is not None else f"frames with `method: {self.name}`"
+
+    def c_code(self, prefix: str) -> CTransform | None:
+        """The transform as C99 with the protocol's `prefix` (CTransform); None where the C target has none."""
+        return None
 
     def lua(self) -> dict[str, Any] | None:
         """The data the Wireshark dissector's engine reads (its `method` and parameters); None: not supported."""

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from serialspec.runtime.errors import DecodeError
-from serialspec.transforms.base import Report, Sample, Transform
+from serialspec.transforms.base import CTransform, Report, Sample, Transform
 
 
 def cobs_encode(data: bytes) -> bytes:
@@ -153,8 +153,77 @@ class Cobs(Transform):
             "a last run of 254 is followed by the code byte 01, as PacketSerial sends it, and decoded without it too)"
         )
 
-    def c_refusal(self) -> str:
-        return ""
+    def c_code(self, prefix: str) -> CTransform:
+        name = f"{prefix}__cobs"
+        return CTransform(name, _C_COBS.replace("NAME", name))
 
     def lua(self) -> dict[str, Any] | None:
         return {"method": "cobs"}
+
+
+_C_COBS = r"""/* COBS (method: cobs): the plain bytes as a code byte before each run of up to 254 non-zero bytes
+ * (to_wire), or back (0 for bytes that are no COBS form: a 00, a run past the end). Decoding checks the form itself:
+ * with cmp (the re-encoding check of the frame engine) it is not repeated. */
+static int NAME(int to_wire, const uint8_t *src, size_t n, uint8_t *dst, const uint8_t *cmp, size_t cap, size_t *out)
+{
+    size_t i, o = 0u;
+    if (to_wire && cmp != NULL) {
+        *out = cap;
+        return 1;
+    }
+    if (to_wire) {
+        size_t code_at = 0u;
+        uint8_t code = 1u;
+        if (cap < 1u) {
+            return 0;
+        }
+        o = 1u;
+        for (i = 0u; i < n; i++) {
+            if (src[i] != 0u) {
+                if (o >= cap) {
+                    return 0;
+                }
+                dst[o++] = src[i];
+                if (++code != 0xFFu) {
+                    continue;
+                }
+            }
+            dst[code_at] = code;
+            code_at = o;
+            if (o >= cap) {
+                return 0;
+            }
+            dst[o++] = 0u;
+            code = 1u;
+        }
+        dst[code_at] = code;
+        *out = o;
+        return 1;
+    }
+    if (n == 0u) {
+        return 0;
+    }
+    i = 0u;
+    while (i < n) {
+        size_t code = src[i], j;
+        if (code == 0u || i + code > n) {
+            return 0;
+        }
+        for (j = 1u; j < code; j++) {
+            if (src[i + j] == 0u || o >= cap) {
+                return 0;
+            }
+            dst[o++] = src[i + j];
+        }
+        i += code;
+        if (code < 0xFFu && i < n) {
+            if (o >= cap) {
+                return 0;
+            }
+            dst[o++] = 0u;
+        }
+    }
+    *out = o;
+    return 1;
+}
+"""

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from serialspec.runtime.errors import DecodeError
-from serialspec.transforms.base import Report, Sample, Transform
+from serialspec.transforms.base import CTransform, Report, Sample, Transform
 
 _DIGITS = b"0123456789ABCDEFabcdef"
 _HEX = frozenset(_DIGITS)
@@ -128,5 +128,76 @@ class HexAsciiTransform(Transform):
         wire = self.runtime((0, 0)).encode(plain)
         return f"the span's bytes {plain.hex(' ').upper()} are sent as the text {wire.decode('ascii')}"
 
+    def c_code(self, prefix: str) -> CTransform:
+        name = f"{prefix}__hex_ascii"
+        return CTransform(name, _C_HEX.replace("NAME", name), f"{name}_end", _C_HEX_END.replace("NAME", name))
+
     def lua(self) -> dict[str, Any] | None:
         return {"method": "hex_ascii"}
+
+
+_C_HEX = r"""/* The value of a hex digit of either case; 16 for a byte that is none. */
+static uint8_t NAME_value(uint8_t c)
+{
+    if (c >= 0x30u && c <= 0x39u) {
+        return (uint8_t)(c - 0x30u);
+    }
+    if (c >= 0x41u && c <= 0x46u) {
+        return (uint8_t)(c - 0x37u);
+    }
+    if (c >= 0x61u && c <= 0x66u) {
+        return (uint8_t)(c - 0x57u);
+    }
+    return 16u;
+}
+
+/* hex-ASCII (method: hex_ascii): each plain byte as two hex digits, upper case (to_wire), or back from pairs of hex
+ * digits of either case (0 for a byte that is no hex digit, or an odd count). Decoding checks the form itself: with
+ * cmp (the re-encoding check of the frame engine) it is not repeated, so lower case digits are taken. */
+static int NAME(int to_wire, const uint8_t *src, size_t n, uint8_t *dst, const uint8_t *cmp, size_t cap, size_t *out)
+{
+    size_t i;
+    if (to_wire && cmp != NULL) {
+        *out = cap;
+        return 1;
+    }
+    if (to_wire) {
+        if (n > cap / 2u) {
+            return 0;
+        }
+        for (i = 0u; i < n; i++) {
+            uint8_t high = (uint8_t)(src[i] >> 4), low = (uint8_t)(src[i] & 0x0Fu);
+            dst[2u * i] = (uint8_t)(high < 10u ? 0x30u + high : 0x37u + high);
+            dst[2u * i + 1u] = (uint8_t)(low < 10u ? 0x30u + low : 0x37u + low);
+        }
+        *out = 2u * n;
+        return 1;
+    }
+    if (n % 2u != 0u || n / 2u > cap) {
+        return 0;
+    }
+    for (i = 0u; i < n; i += 2u) {
+        uint8_t high = NAME_value(src[i]), low = NAME_value(src[i + 1u]);
+        if (high > 15u || low > 15u) {
+            return 0;
+        }
+        dst[i / 2u] = (uint8_t)((high << 4) | low);
+    }
+    *out = n / 2u;
+    return 1;
+}
+"""
+
+_C_HEX_END = r"""/* Where the hex digits that start at b[start] end (the first byte that is no hex digit), -2 while
+ * b[0..avail) ends inside them (runtime HexAscii.span_end). */
+static long NAME_end(const uint8_t *b, size_t start, size_t avail)
+{
+    size_t i;
+    for (i = start; i < avail; i++) {
+        if (NAME_value(b[i]) > 15u) {
+            return (long)i;
+        }
+    }
+    return -2L;
+}
+"""

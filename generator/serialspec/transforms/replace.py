@@ -156,7 +156,7 @@ class Replace(Transform):
         return ", ".join(f"{_hex(plain)} is sent as {_hex(wire)}" for plain, wire in self.pairs)
 
     def c_refusal(self) -> str:
-        return ""
+        return ""  # the frame engine's own substitution (backends/c/engine.py pfx__rewrite), over the layout's pairs
 
     def lua(self) -> dict[str, Any] | None:
         return {"replace": [[plain, wire] for plain, wire in self.pairs]}

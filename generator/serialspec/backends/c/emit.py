@@ -183,7 +183,10 @@ class Ctx:
 def refuse_unsupported(protocol: Protocol) -> None:
     """Raise Unsupported naming the first feature of the spec the C target cannot generate yet."""
     if protocol.text is not None:
-        raise Unsupported("text framing (`framing: {kind: text}`)")
+        from serialspec.backends.c.text import refuse
+
+        refuse(protocol.text)
+        return
     refuse_by_command(protocol)
     for command in protocol.commands:
         if command.selector is not None and command.selector.type.size != 1:
@@ -1256,6 +1259,10 @@ def spec_hash(protocol: Protocol) -> str:
 
 
 def files(protocol: Protocol) -> dict[str, str]:
+    if protocol.text is not None:  # a text protocol: backends/c/text.py
+        from serialspec.backends.c import text
+
+        return text.files(protocol, protocol.text)
     refuse_unsupported(protocol)
     ctx = Ctx(protocol, protocol.name, protocol.name.upper())
     for layouts in protocol.framing.alternatives.values():  # the checksums first: the header declares them

@@ -22,8 +22,9 @@ from serialspec.backends.c.emit import (
     value_elements,
 )
 from serialspec.backends.c.engine import ENGINE
+from serialspec.backends.c.transforms import dispatch
+from serialspec.backends.c.transforms import method as transform_method
 from serialspec.lang.model import VALUE_ROLES, Direction, FrameElement, FrameLayout, Message, Protocol, size_terms
-from serialspec.transforms.cobs import Cobs
 from serialspec.transforms.replace import Replace
 
 DIRECTIONS = (Direction.REQUEST, Direction.RESPONSE)
@@ -273,9 +274,7 @@ def layout_tables(ctx: Ctx, direction: Direction, k: int, layout: FrameLayout) -
     t = layout.transparency
     pairs = "NULL"
     pair_count = 0
-    method = 0  # the engine's has_t: 0 none, 1 substitution (pairs), 2 COBS (emit.refuse_layout refused others)
-    if t is not None:
-        method = 2 if isinstance(t.transform, Cobs) else 1
+    method = transform_method(ctx.protocol, p, t.transform if t is not None else None)  # the engine's has_t
     if t is not None and isinstance(t.transform, Replace):
         prows = []
         pair_count = len(t.transform.pairs)
@@ -625,6 +624,7 @@ def source(ctx: Ctx) -> str:
 }}
 """
     engine = ENGINE.replace("PFX_", f"{P}_").replace("pfx_", f"{p}_")
+    engine = engine.replace("/* ---- transforms ---- */\n", dispatch(protocol, p, P))
     # content bounds by code, for the parser's plausibility checks
     bounds_cases: list[str] = []
     for d in directions(protocol):

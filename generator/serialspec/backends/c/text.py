@@ -1,0 +1,960 @@
+"""The C of a text protocol (`framing: {kind: text}`: NMEA 0183 sentences, ASCII command sets): the same four files
+and public API as a binary protocol's (p_decode, p_encode, p_parser_feed, p_to_json), from the text model
+(lang/model.py TextFrame). The generic part is text_runtime.py's; this module writes what the spec says: the
+message structs, the letters, the codes, each field's reader, writer and range check."""
+
+from __future__ import annotations
+
+import re
+from decimal import Decimal
+from typing import assert_never
+
+from serialspec.backends import Unsupported
+from serialspec.backends.c.emit import comment, ident, spec_hash
+from serialspec.backends.c.text_runtime import TEXT_RUNTIME
+from serialspec.checksums.base import NoCode
+from serialspec.lang.model import Protocol, TextField, TextFrame, TextMessage, TextRepeat
+
+RESULTS = ("OK", "E_BUFFER", "E_RANGE", "E_LENGTH", "E_CHECKSUM", "E_UNKNOWN", "E_FRAME", "E_CONTENT", "E_CAPACITY")
+
+
+def refuse(text: TextFrame) -> None:
+    """Unsupported naming what of a text spec the C target cannot generate yet."""
+    if not text.start:
+        raise Unsupported("text frames without a start character (every line a frame)")
+    if text.checksum is not None:
+        try:
+            text.checksum.c_code("p")
+        except NoCode as exc:
+            raise Unsupported(f"the text checksum: {exc}") from None
+        if text.digits > 8:
+            raise Unsupported(f"a text checksum of {text.digits} hex digits")
+
+
+def mid(m: TextMessage) -> str:
+    return f"{ident(m.key)}_{m.direction.value}"
+
+
+def _snake(name: str) -> str:
+    return "".join(f"_{c.lower()}" if c.isupper() and i else c.lower() for i, c in enumerate(name))
+
+
+def _byte(c: str) -> str:
+    return f"0x{ord(c):02X}u"
+
+
+def _items(m: TextMessage) -> list[TextField | TextRepeat]:
+    return list(m.fields)
+
+
+class TextC:
+    """One text protocol's C."""
+
+    def __init__(self, protocol: Protocol, text: TextFrame) -> None:
+        refuse(text)
+        self.protocol, self.text = protocol, text
+        self.p, self.P = protocol.name, protocol.name.upper()
+        self.limit = text.max_length + len(text.end)
+
+    # --- the header ------------------------------------------------------------------------------------------------
+
+    def member(self, f: TextField) -> list[str]:
+        p, P, n = self.p, self.P, ident(f.name)
+        doc = comment(f.description or f.name) + (f" [{comment(f.unit)}]" if f.unit else "")
+        has = f"    bool has_{n}; /* the field was sent (an empty field: absent) */"
+        match f.kind:
+            case "decimal":
+                t = f"    {p}_decimal_t {n}; /* {doc} */"
+            case "integer":
+                t = f"    int64_t {n}; /* {doc} */"
+            case "angle":
+                t = f"    {p}_angle_t {n}; /* {doc} */"
+            case "char":
+                letters = f" ({p}_{_snake(f.letters_class)}_t)" if f.letters else ""
+                t = f"    char {n}; /* {doc}{letters} */"
+            case "text":
+                t = f"    char {n}[{P}_TEXT_MAX]; /* {doc} (not NUL-terminated: {n}_len characters) */\n"
+                t += f"    uint16_t {n}_len;"
+            case "time":
+                t = f"    {p}_time_t {n}; /* {doc} */"
+            case "date":
+                t = f"    {p}_date_t {n}; /* {doc} */"
+            case _:
+                assert_never(f.kind)
+        return [has, t]
+
+    def structs(self) -> str:
+        p, out = self.p, []
+        for m in self.text.messages:
+            mems: list[str] = []
+            for item in _items(m):
+                if isinstance(item, TextField):
+                    mems += self.member(item)
+                    continue
+                group = f"{p}_{mid(m)}_{ident(item.name)}_t"
+                inner = [line for f in item.fields for line in self.member(f)]
+                out.append("typedef struct {\n" + "\n".join(inner) + f"\n}} {group};")
+                if item.count:
+                    mems.append(f"    {group} {ident(item.name)}[{item.count}]; /* {comment(item.description)} */")
+                else:
+                    mems.append(f"    {group} {ident(item.name)}[{item.max_count}]; /* {comment(item.description)} */")
+                    mems.append(f"    uint8_t {ident(item.name)}_count; /* groups sent, up to {item.max_count} */")
+            body = "\n".join(mems) or "    uint8_t unused_;"
+            title = f"/* {comment(m.title)} ({m.code}, {m.direction.value}) */"
+            out.append(f"{title}\ntypedef struct {{\n{body}\n}} {p}_{mid(m)}_t;")
+        return "\n\n".join(out)
+
+    def header(self) -> str:
+        p, P, t = self.p, self.P, self.text
+        letters = []
+        for name, pairs in t.letter_sets().items():
+            rows = ",\n".join(
+                f"    {P}_{_snake(name).upper()}_{ident(label).upper()} = {_byte(letter)}" for label, letter in pairs
+            )
+            letters.append(f"typedef enum {{\n{rows}\n}} {p}_{_snake(name)}_t;")
+        kinds = ",\n".join(f"    {P}_{mid(m).upper()}" for m in t.messages)
+        union = "\n".join(f"        {p}_{mid(m)}_t {mid(m)};" for m in t.messages)
+        check = ""
+        if t.checksum is not None:
+            check = (
+                f"/* The checksum of the characters between start and marker. */\n{t.checksum.c_code(p).prototype}\n"
+            )
+        results = ",\n".join(f"    {P}_{r}" + (" = 0" if r == "OK" else "") for r in RESULTS)
+        return f"""{banner(self.protocol)}
+#ifndef {P}_H
+#define {P}_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {{
+#endif
+
+#define {P}_SPEC_SHA256 "{spec_hash(self.protocol)}"
+
+/* Feature switches: define as 0 to leave encode, decode or the stream parser out. */
+#ifndef {P}_ENABLE_ENCODE
+#define {P}_ENABLE_ENCODE 1
+#endif
+#ifndef {P}_ENABLE_DECODE
+#define {P}_ENABLE_DECODE 1
+#endif
+#ifndef {P}_ENABLE_PARSER
+#define {P}_ENABLE_PARSER 1
+#endif
+
+/* The longest frame p_decode takes ({P}_E_CAPACITY beyond): by default the longest the stream parser gives, the
+ * spec's max_length ({t.max_length} characters), the line ending and one more (as runtime/text.py's parser). */
+#ifndef {P}_MAX_FRAME
+#define {P}_MAX_FRAME {self.limit + 1}u
+#endif
+/* The room of a text field (characters). */
+#ifndef {P}_TEXT_MAX
+#define {P}_TEXT_MAX {t.max_length}u
+#endif
+
+typedef enum {{
+{results},
+    {P}_E_ARG
+}} {p}_result_t;
+
+typedef enum {{ {P}_REQUEST = 0, {P}_RESPONSE = 1 }} {p}_direction_t;
+
+/* A decimal number as sent: value / 10^scale, `width` digits before the point (leading zeros kept), negative also
+ * for a zero sent with its minus sign (-0.0). Encode writes `scale` fraction digits (at most 18). */
+typedef struct {{
+    int64_t value;
+    uint8_t scale;
+    uint8_t width;
+    bool negative;
+}} {p}_decimal_t;
+
+/* Degrees and minutes (ddmm.mmmm): the hemisphere is a field of its own. */
+typedef struct {{
+    uint32_t degrees;
+    {p}_decimal_t minutes;
+}} {p}_angle_t;
+
+/* A time of day (hhmmss[.ss]): `digits` fraction digits of a second written, the first 6 from micro. */
+typedef struct {{
+    uint8_t hour;
+    uint8_t minute;
+    uint8_t second;
+    uint32_t micro;
+    uint16_t digits;
+}} {p}_time_t;
+
+/* A date (ddmmyy): the year in full (yy 69..99 is 1969..1999, 00..68 2000..2068). */
+typedef struct {{
+    uint8_t day;
+    uint8_t month;
+    uint16_t year;
+}} {p}_date_t;
+
+{chr(10).join(letters)}
+
+{self.structs()}
+
+typedef enum {{
+    {P}_KIND_NONE = 0,
+{kinds},
+    {P}_KIND_COUNT
+}} {p}_kind_t;
+
+/* One message: its kind, the frame-level talker, how many fields the frame had after the address (-1: every
+ * declared one; encode writes that many, so a decoded sentence encodes to the same text) and its fields. */
+typedef struct {{
+    {p}_kind_t kind;
+    char talker[{t.talker + 1}];
+    int32_t sent;
+    union {{
+{union}
+    }} u;
+}} {p}_msg_t;
+
+/* All parser state (runtime/text.py TextStreamParser): the line being read and the counters. */
+typedef struct {{
+    {p}_direction_t dir;
+    size_t n;
+    uint8_t buf[{self.limit + 1}u];
+    uint32_t frames;
+    uint32_t garbage; /* not counted for text frames (always 0) */
+    uint32_t errors;  /* frames dropped: cut short, too long, or not decoded */
+}} {p}_parser_t;
+
+{check}int {p}_decode(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}_msg_t *out);
+/* p_decode, refusing a frame of another kind than `expect` ({P}_KIND_NONE: any) with {P}_E_UNKNOWN. */
+int {p}_decode_expect(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}_kind_t expect, {p}_msg_t *out);
+int {p}_encode(const {p}_msg_t *msg, uint8_t *buf, size_t cap, size_t *len);
+/* The address and the fields as encode writes them, joined by the separator, without range checks (p_to_json). */
+int {p}_field_texts(const {p}_msg_t *msg, uint8_t *buf, size_t cap, size_t *len);
+void {p}_parser_init({p}_parser_t *parser, {p}_direction_t dir);
+size_t {p}_parser_feed({p}_parser_t *parser, const uint8_t *data, size_t len, {p}_msg_t *out, bool *got);
+const char *{p}_kind_name({p}_kind_t kind);
+const char *{p}_result_name(int result);
+
+#ifdef __cplusplus
+}}
+#endif
+
+#endif
+"""
+
+    # --- the source ------------------------------------------------------------------------------------------------
+
+    def read(self, f: TextField, lv: str) -> str:
+        """Decode statements of one field into the member `lv` (an lvalue path without the member name)."""
+        p, P, n = self.p, self.P, ident(f.name)
+        target = f"{lv}{n}"
+        match f.kind:
+            case "decimal":
+                call = f"{p}__get_decimal(c->b + s, len, &{target})"
+            case "integer":
+                call = f"{p}__get_integer(c->b + s, len, &{target})"
+            case "angle":
+                call = f"{p}__get_angle(c->b + s, len, {f.width or 2}u, &{target})"
+            case "char":
+                call = f"{p}__get_char(c->b + s, len, &{target})"
+            case "text":
+                call = f"{p}__get_text(c->b + s, len, {target}, {P}_TEXT_MAX, &{target}_len)"
+            case "time":
+                call = f"{p}__get_time(c->b + s, len, &{target})"
+            case "date":
+                call = f"{p}__get_date(c->b + s, len, &{target})"
+            case _:
+                assert_never(f.kind)
+        letters = ""
+        if f.letters:
+            allowed = " && ".join(f"{target} != '{_c_char(letter)}'" for _, letter in f.letters)
+            letters = f"\n        if (r == {P}_OK && {allowed}) {{\n            r = {P}_E_CONTENT;\n        }}"
+        return f"""    {p}__next(c, &s, &len);
+    {lv}has_{n} = len > 0u;
+    if (len > 0u) {{
+        r = {call};{letters}
+        if (r != {P}_OK) {{
+            return r;
+        }}
+    }}"""
+
+    def decoder(self, m: TextMessage) -> str:
+        p, P = self.p, self.P
+        lines: list[str] = []
+        at = 0
+        for item in _items(m):
+            if isinstance(item, TextField):
+                lines.append(self.read(item, "m->"))
+                at += 1
+                continue
+            name, size = ident(item.name), len(item.fields)
+            if item.count:
+                groups = f"{item.count}u"
+            else:
+                lines.append(
+                    f"    groups = sent > {at}u ? (sent - {at}u + {size - 1}u) / {size}u : 0u;\n"
+                    f"    if (groups > {item.max_count}u) {{\n        groups = {item.max_count}u;\n    }}\n"
+                    f"    m->{name}_count = (uint8_t)groups;"
+                )
+                groups = "groups"
+            body = "\n".join(self.read(f, f"m->{name}[g].").replace("\n", "\n    ") for f in item.fields)
+            lines.append(f"    for (g = 0u; g < {groups}; g++) {{\n    {body}\n    }}")
+            at += size * item.count  # a repeat up to max_count comes last
+        used = "\n".join(lines)
+        return f"""/* {comment(m.title)} ({m.code}, {m.direction.value}): each field in turn, an empty one absent. */
+static int {p}__dec_{mid(m)}({p}__cursor_t *c, size_t sent, {p}_{mid(m)}_t *m)
+{{
+    size_t s = 0u, len = 0u, g = 0u, groups = 0u;
+    int r = {P}_OK;
+    (void)s;
+    (void)len;
+    (void)g;
+    (void)groups;
+    (void)sent;
+    (void)r;
+    (void)m;
+{used}
+    return c->more ? {P}_E_LENGTH : {P}_OK; /* more fields than the message has */
+}}"""
+
+    def check(self, f: TextField, lv: str) -> str:
+        """The range checks of one field (encode refuses with P_E_RANGE before it writes)."""
+        p, P, n = self.p, self.P, ident(f.name)
+        v = f"{lv}{n}"
+        tests: list[str] = []
+
+        def bounds(value: str, scale: str) -> None:
+            for bound, sign in ((f.minimum, "<"), (f.maximum, ">")):
+                if bound is not None:
+                    mantissa, exponent = _exact(bound)
+                    tests.append(f"{p}__compare({value}, {scale}, {mantissa}, {exponent}u) {sign} 0")
+
+        match f.kind:
+            case "decimal":
+                tests.append(f"{v}.scale > 18u")
+                bounds(f"{v}.value", f"{v}.scale")
+            case "integer":
+                bounds(v, "0u")
+            case "angle":
+                tests.append(f"{v}.minutes.scale > 18u || {v}.minutes.value < 0")
+                tests.append(f"{p}__compare({v}.minutes.value, {v}.minutes.scale, 60, 0u) >= 0")
+                if f.minimum is not None:
+                    tests.append(f"{p}__angle_value(&{v}) < {float(f.minimum)!r}")
+                if f.maximum is not None:
+                    tests.append(f"{p}__angle_value(&{v}) > {float(f.maximum)!r}")
+            case "char":
+                if f.letters:
+                    tests.append(" && ".join(f"{v} != '{_c_char(letter)}'" for _, letter in f.letters))
+                tests.append(f"!{p}__carried({v})")
+            case "text":
+                tests.append(f"{v}_len > {P}_TEXT_MAX || !{p}__text_ok({v}, {v}_len)")
+            case "time":
+                tests.append(f"!{p}__time_ok(&{v})")
+            case "date":
+                tests.append(f"!{p}__date_ok(&{v})")
+            case _:
+                assert_never(f.kind)
+        return "\n".join(f"    if ({lv}has_{n} && ({t})) {{\n        return {P}_E_RANGE;\n    }}" for t in tests)
+
+    def write(self, f: TextField, lv: str) -> str:
+        p, n = self.p, ident(f.name)
+        v = f"{lv}{n}"
+        match f.kind:
+            case "decimal":
+                call = f"{p}__put_decimal(o, &{v}, {v}.width)"
+            case "integer":
+                call = f"{p}__put_integer(o, {v}, {f.width}u)"
+            case "angle":
+                call = f"{p}__put_angle(o, &{v}, {f.width or 2}u)"
+            case "char":
+                call = f"{p}__put(o, (uint8_t){v})"
+            case "text":
+                call = f"{p}__put_text(o, {v}, {v}_len < {self.P}_TEXT_MAX ? {v}_len : {self.P}_TEXT_MAX)"
+            case "time":
+                call = f"{p}__put_time(o, &{v})"
+            case "date":
+                call = f"{p}__put_date(o, &{v})"
+            case _:
+                assert_never(f.kind)
+        return f"    {p}__put(o, {self.P}__SEPARATOR);\n    if ({lv}has_{n}) {{\n        {call};\n    }}"
+
+    def encoder(self, m: TextMessage) -> str:
+        p, P = self.p, self.P
+        checks: list[str] = []
+        writes: list[str] = []
+        for item in _items(m):
+            if isinstance(item, TextField):
+                checks.append(self.check(item, "m->"))
+                writes.append(self.write(item, "m->"))
+                continue
+            name = ident(item.name)
+            groups = f"{item.count}u" if item.count else f"m->{name}_count"
+            if not item.count:
+                checks.append(f"    if (m->{name}_count > {item.max_count}u) {{\n        return {P}_E_RANGE;\n    }}")
+            inner = "\n".join(self.check(f, f"m->{name}[g].") for f in item.fields).replace("\n", "\n    ")
+            checks.append(f"    for (g = 0u; g < {groups}; g++) {{\n    {inner}\n    }}")
+            inner = "\n".join(self.write(f, f"m->{name}[g].") for f in item.fields).replace("\n", "\n    ")
+            writes.append(f"    for (g = 0u; g < {groups}; g++) {{\n    {inner}\n    }}")
+        return f"""/* {comment(m.title)} ({m.code}, {m.direction.value}): the range checks (when asked), then each
+ * field after a separator, an absent one empty. */
+static int {p}__enc_{mid(m)}(const {p}_{mid(m)}_t *m, {p}__out_t *o, int check)
+{{
+    size_t g = 0u;
+    (void)g;
+    (void)m;
+    (void)o;
+    if (check) {{
+{chr(10).join(checks).replace(chr(10), chr(10) + "    ") if checks else ""}
+    }}
+{chr(10).join(writes)}
+    return {P}_OK;
+}}"""
+
+    def source(self) -> str:
+        p, P, t = self.p, self.P, self.text
+        end = ", ".join(_byte(c) for c in t.end)
+        special = sorted({t.start, t.separator, t.marker, *t.end})
+        checked = t.checksum is not None
+        checksum = ""
+        if t.checksum is not None:
+            code = t.checksum.c_code(p)
+            finish = code.finish.format(a="acc")
+            checksum = f"""{code.definition}
+#if {P}_ENABLE_DECODE || {P}_ENABLE_ENCODE
+static uint32_t {p}__checksum(const uint8_t *d, size_t n)
+{{
+    {code.ctype} acc = {code.start};
+    acc = {code.name}(acc, d, n);
+    return (uint32_t)({finish});
+}}
+#endif
+"""
+        reflect = ""
+        if "__reflect(" in checksum:
+            reflect = f"""static uint32_t {p}__reflect(uint32_t v, int width)
+{{
+    uint32_t r = 0u;
+    int i;
+    for (i = 0; i < width; i++) {{
+        r = (r << 1) | (v & 1u);
+        v >>= 1;
+    }}
+    return r;
+}}
+"""
+        runtime = TEXT_RUNTIME.replace("PFX_", f"{P}_").replace("pfx_", f"{p}_")
+        if not checked:  # the checksum's code left out
+            runtime = re.sub(rf"#if {P}__CHECKED\n.*?#endif\n", "", runtime, flags=re.DOTALL)
+        runtime, parser = runtime.split("/* ---- the parser ---- */\n")
+        decoders = "\n\n".join(self.decoder(m) for m in t.messages)
+        encoders = "\n\n".join(self.encoder(m) for m in t.messages)
+        by_code: dict[str, list[TextMessage]] = {}
+        for m in t.messages:
+            by_code.setdefault(m.code, []).append(m)
+        lookups = []
+        for name, found in by_code.items():
+            if len(found) == 1:
+                pick = f"{P}_{mid(found[0]).upper()}"
+            else:
+                req = next(m for m in found if m.direction.value == "request")
+                res = next(m for m in found if m.direction.value == "response")
+                pick = f"dir == {P}_REQUEST ? {P}_{mid(req).upper()} : {P}_{mid(res).upper()}"
+            lookups.append(f'    if ({p}__is(code, n, "{name}")) {{\n        return {pick};\n    }}')
+        dec_cases = "\n".join(
+            f"    case {P}_{mid(m).upper()}:\n        memset(&out->u.{mid(m)}, 0, sizeof(out->u.{mid(m)}));\n"
+            f"        r = {p}__dec_{mid(m)}(&c, seps, &out->u.{mid(m)});\n        break;"
+            for m in t.messages
+        )
+        enc_cases = "\n".join(
+            f'    case {P}_{mid(m).upper()}:\n        {p}__put_text(o, "{m.code}", {len(m.code)}u);\n'
+            f"        return {p}__enc_{mid(m)}(&msg->u.{mid(m)}, o, check);"
+            for m in t.messages
+        )
+        talkers = " && ".join(f'!{p}__is((const uint8_t *)msg->talker, {t.talker}u, "{x}")' for x in t.talkers)
+        talker_read = "    talker = 0u;\n    out->talker[0] = '\\0';"
+        if t.talker:
+            talker_read = f"""    talker = address < {t.talker}u ? address : {t.talker}u;
+    for (i = 0u; i < talker; i++) {{{{
+        out->talker[i] = (char)frame[body + i];
+    }}}}
+    out->talker[talker] = '\\0';"""
+        talker_check = f"""    for (i = 0u; i < {t.talker}u; i++) {{
+        if (msg->talker[i] == '\\0') {{
+            return {P}_E_RANGE; /* the talker has {t.talker} characters */
+        }}
+    }}"""
+        if not t.talker:
+            talker_check = "    (void)i;"
+        if talkers:
+            talker_check += (
+                f"\n    if ({talkers}) {{\n        return {P}_E_RANGE; /* not one of the spec's talkers */\n    }}"
+            )
+        talker_write = (
+            ""
+            if not t.talker
+            else f"""    size_t i;
+    for (i = 0u; i < {t.talker}u && msg->talker[i] != '\\0'; i++) {{{{
+        {p}__put(o, (uint8_t)msg->talker[i]);
+    }}}}"""
+        )
+        kind_names = "\n".join(f'    case {P}_{mid(m).upper()}:\n        return "{mid(m)}";' for m in t.messages)
+        results = ", ".join(f'"{r}"' for r in (*RESULTS, "E_ARG"))
+        text = f"""{banner(self.protocol)}
+#include "{p}.h"
+
+#include <string.h>
+
+#if {P}_ENABLE_PARSER && !{P}_ENABLE_DECODE
+#error "{P}_ENABLE_PARSER needs {P}_ENABLE_DECODE"
+#endif
+
+/* ---- the frame, as the spec says ({comment(t.description or "")}) ---- */
+#define {P}__START {_byte(t.start)}            /* {comment(repr(t.start))} */
+#define {P}__SEPARATOR {_byte(t.separator)}    /* {comment(repr(t.separator))} */
+#define {P}__MARKER {_byte(t.marker)}          /* {comment(repr(t.marker))}: the checksum follows */
+#define {P}__CHECKED {int(checked)}            /* a checksum is written */
+#define {P}__REQUIRED {int(t.required)}        /* a frame without one is refused */
+#define {P}__DIGITS {t.digits}u                /* hex digits of the checksum */
+#define {P}__LIMIT {self.limit}u /* the parser drops a line longer than this without its line ending */
+#if {P}_ENABLE_DECODE || {P}_ENABLE_ENCODE || {P}_ENABLE_PARSER
+static const uint8_t {p}__end[] = {{{end}, 0x00u}}; /* {comment(repr(t.end))}, the line ending */
+#endif
+
+#if {P}_ENABLE_DECODE || {P}_ENABLE_PARSER
+/* 1 when a[0..n) and b[0..n) hold the same bytes */
+static int {p}__same(const uint8_t *a, const uint8_t *b, size_t n)
+{{
+    size_t i;
+    for (i = 0u; i < n; i++) {{
+        if (a[i] != b[i]) {{
+            return 0;
+        }}
+    }}
+    return 1;
+}}
+#endif
+
+#if {P}_ENABLE_DECODE || ({P}_ENABLE_ENCODE && {int(bool(t.talkers))})
+/* 1 when b[0..n) is the text s */
+static int {p}__is(const uint8_t *b, size_t n, const char *s)
+{{
+    size_t i;
+    for (i = 0u; i < n; i++) {{
+        if (s[i] == '\\0' || b[i] != (uint8_t)s[i]) {{
+            return 0;
+        }}
+    }}
+    return s[n] == '\\0';
+}}
+#endif
+
+/* The framing's own characters: no field may hold one. */
+static int {p}__special(uint8_t c)
+{{
+    return {" || ".join(f"c == {_byte(c)}" for c in special)};
+}}
+
+{reflect}{checksum}{runtime}
+#if {P}_ENABLE_DECODE
+{decoders}
+
+/* The message a text code names: the one it names, or the one of `dir` where it names a request and a response. */
+static {p}_kind_t {p}__lookup(const uint8_t *code, size_t n, {p}_direction_t dir)
+{{
+    (void)dir;
+{chr(10).join(lookups)}
+    return {P}_KIND_NONE;
+}}
+
+static int {p}__decode(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}_kind_t expect, {p}_msg_t *out)
+{{
+    size_t body = 0u, n = 0u, i, address, seps = 0u, talker;
+    {p}__cursor_t c;
+    {p}_kind_t kind;
+    int r;
+    if (frame == NULL || out == NULL) {{
+        return {P}_E_ARG;
+    }}
+    out->kind = {P}_KIND_NONE;
+    if (len > {P}_MAX_FRAME) {{
+        return {P}_E_CAPACITY;
+    }}
+    r = {p}__unframe(frame, len, &body, &n);
+    if (r != {P}_OK) {{
+        return r;
+    }}
+    address = n;
+    for (i = n; i > 0u; i--) {{
+        if (frame[body + i - 1u] == {P}__SEPARATOR) {{
+            seps++;
+            address = i - 1u;
+        }}
+    }}
+{talker_read}
+    kind = {p}__lookup(frame + body + talker, address - talker, dir);
+    if (kind == {P}_KIND_NONE || (expect != {P}_KIND_NONE && expect != kind)) {{
+        return {P}_E_UNKNOWN;
+    }}
+    out->sent = (int32_t)seps;
+    c.b = frame + body;
+    c.n = n;
+    c.more = address < n;
+    c.pos = address < n ? address + 1u : n;
+    switch (kind) {{
+{dec_cases}
+    case {P}_KIND_NONE:
+    case {P}_KIND_COUNT:
+    default:
+        return {P}_E_UNKNOWN;
+    }}
+    if (r == {P}_OK) {{
+        out->kind = kind;
+    }}
+    return r;
+}}
+
+int {p}_decode_expect(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}_kind_t expect, {p}_msg_t *out)
+{{
+    return {p}__decode(frame, len, dir, expect, out);
+}}
+
+int {p}_decode(const uint8_t *frame, size_t len, {p}_direction_t dir, {p}_msg_t *out)
+{{
+    return {p}__decode(frame, len, dir, {P}_KIND_NONE, out);
+}}
+#endif
+
+{encoders}
+
+/* Talker, code and fields (range-checked when `check`), from o's position on. */
+static int {p}__body(const {p}_msg_t *msg, {p}__out_t *o, int check)
+{{
+{talker_write}
+    switch (msg->kind) {{
+{enc_cases}
+    case {P}_KIND_NONE:
+    case {P}_KIND_COUNT:
+    default:
+        return {P}_E_ARG;
+    }}
+}}
+
+int {p}_field_texts(const {p}_msg_t *msg, uint8_t *buf, size_t cap, size_t *len)
+{{
+    {p}__out_t o;
+    int r;
+    if (msg == NULL || buf == NULL || len == NULL) {{
+        return {P}_E_ARG;
+    }}
+    o.b = buf;
+    o.cap = cap;
+    o.n = 0u;
+    o.full = 0;
+    r = {p}__body(msg, &o, 0);
+    if (r == {P}_OK && o.full) {{
+        r = {P}_E_BUFFER;
+    }}
+    *len = o.n;
+    return r;
+}}
+
+{parser}
+#if {P}_ENABLE_ENCODE
+int {p}_encode(const {p}_msg_t *msg, uint8_t *buf, size_t cap, size_t *len)
+{{
+    {p}__out_t o;
+    size_t i;
+    int r;
+    if (msg == NULL || buf == NULL || len == NULL) {{
+        return {P}_E_ARG;
+    }}
+{talker_check}
+    if (cap < 1u) {{
+        return {P}_E_BUFFER;
+    }}
+    o.b = buf;
+    o.cap = cap;
+    o.n = 1u;
+    o.full = 0;
+    r = {p}__body(msg, &o, 1);
+    if (r != {P}_OK) {{
+        return r;
+    }}
+    if (msg->sent >= 0 && !o.full) {{ /* as many fields as the sentence had */
+        r = {p}__trim(&o, (size_t)msg->sent);
+        if (r != {P}_OK) {{
+            return r;
+        }}
+    }}
+    return {p}__frame(&o, len);
+}}
+#endif
+
+const char *{p}_kind_name({p}_kind_t kind)
+{{
+    switch (kind) {{
+{kind_names}
+    case {P}_KIND_NONE:
+    case {P}_KIND_COUNT:
+    default:
+        return "";
+    }}
+}}
+
+const char *{p}_result_name(int result)
+{{
+    static const char *const names[] = {{{results}}};
+    if (result < 0 || result > (int){P}_E_ARG) {{
+        return "";
+    }}
+    return names[result];
+}}
+"""
+        return drop_unused_static(text, p)
+
+
+def _c_char(c: str) -> str:
+    return {"'": "\\'", "\\": "\\\\"}.get(c, c)
+
+
+def _exact(value: float) -> tuple[int, int]:
+    """A spec bound as mantissa and decimal exponent: value = mantissa / 10^exponent, from its shortest repr."""
+    number = Decimal(repr(float(value))).normalize()
+    sign, digits, exponent = number.as_tuple()
+    assert isinstance(exponent, int)
+    mantissa = int("".join(map(str, digits)) or "0") * (-1 if sign else 1)
+    if exponent > 0:
+        return mantissa * 10**exponent, 0
+    return mantissa, -exponent
+
+
+def banner(protocol: Protocol) -> str:
+    from serialspec.backends.c.files import banner as binary_banner
+
+    return binary_banner(protocol)
+
+
+def drop_unused_static(text: str, p: str) -> str:
+    """The runtime's static functions no code calls left out (-Wunused-function), until none is left to drop."""
+    while True:
+        dropped = False
+        for found in re.finditer(rf"^static [^\n;=]*?\b({p}__\w+)\(", text, re.MULTILINE):
+            name = found.group(1)
+            if len(re.findall(rf"\b{name}\(", text)) > 1:
+                continue
+            start = found.start()
+            while True:  # the comment before it
+                before = text.rfind("\n", 0, start - 1)
+                line = text[before + 1 : start - 1] if start > 0 else ""
+                if line.startswith(("/*", " *")) and start > 0:
+                    start = before + 1
+                    continue
+                break
+            stop = text.index("\n}\n", found.start()) + 3
+            text = text[:start] + text[stop:].lstrip("\n")
+            dropped = True
+            break
+        if not dropped:
+            return text
+
+
+def json_header(protocol: Protocol) -> str:
+    p, P = protocol.name, protocol.name.upper()
+    return f"""{banner(protocol)}
+#ifndef {P}_JSON_H
+#define {P}_JSON_H
+
+#include "{p}.h"
+
+#ifdef __cplusplus
+extern "C" {{
+#endif
+
+/* The message as `serialspec decode --json` shows it: command, subcommand, direction, talker, sent, and each field
+ * as its text ("" when absent). snprintf-like: the length of the whole text, at most cap - 1 characters written. */
+size_t {p}_to_json(const {p}_msg_t *msg, char *out, size_t cap);
+
+#ifdef __cplusplus
+}}
+#endif
+
+#endif
+"""
+
+
+def json_source(protocol: Protocol, text: TextFrame) -> str:
+    p, P = protocol.name, protocol.name.upper()
+    grow = sum(
+        (f.width + 3) * (item.count or item.max_count if isinstance(item, TextRepeat) else 1)
+        for m in text.messages
+        for item in m.fields
+        for f in (item.fields if isinstance(item, TextRepeat) else (item,))
+    )
+    texts = sum(
+        (item.count or item.max_count if isinstance(item, TextRepeat) else 1)
+        for m in text.messages
+        for item in m.fields
+        for f in (item.fields if isinstance(item, TextRepeat) else (item,))
+        if f.kind == "text"
+    )
+    cases = []
+    for m in text.messages:
+        parts = []
+        first = True
+        for item in m.fields:
+            comma = "" if first else ","
+            first = False
+            if isinstance(item, TextField):
+                parts.append(f'    {p}__j_str(&j, "{comma}\\"{item.name}\\":");\n    {p}__j_field(&j, &c);')
+                continue
+            groups = f"{item.count}u" if item.count else f"msg->u.{mid(m)}.{ident(item.name)}_count"
+            names = []
+            for k, f in enumerate(item.fields):
+                sep = "" if k == 0 else ","
+                names.append(f'        {p}__j_str(&j, "{sep}\\"{f.name}\\":");\n        {p}__j_field(&j, &c);')
+            inner = "\n".join(names)
+            parts.append(
+                f'    {p}__j_str(&j, "{comma}\\"{item.name}\\":[");\n'
+                f"    for (g = 0u; g < {groups}; g++) {{\n"
+                f'        {p}__j_str(&j, g > 0u ? ",{{" : "{{");\n{inner}\n        {p}__j_str(&j, "}}");\n    }}\n'
+                f'    {p}__j_str(&j, "]");'
+            )
+        body = "\n".join(parts)
+        cases.append(
+            f"    case {P}_{mid(m).upper()}:\n"
+            f'        {p}__j_str(&j, "{{\\"command\\":\\"{m.key}\\",\\"subcommand\\":null,\\"direction\\":'
+            f'\\"{m.direction.value}\\",");\n'
+            f"        {p}__j_head(&j, msg);\n"
+            + "\n".join("    " + line if line else line for line in body.split("\n"))
+            + f'\n        {p}__j_str(&j, "}}}}");\n        break;'
+        )
+    talker_length = "    i = 0u;"
+    if text.talker:
+        talker_length = f"    for (i = 0u; i < {text.talker}u && msg->talker[i] != '\\0'; i++) {{\n    }}"
+    return f"""{banner(protocol)}
+#include "{p}_json.h"
+
+#include <stdio.h>
+
+/* the fields as text: the frame, numbers padded to their widths, texts at their room */
+#define {P}__JSON_BODY ({P}_MAX_FRAME + {grow}u + {texts}u * {P}_TEXT_MAX)
+
+typedef struct {{
+    char *out;
+    size_t cap;
+    size_t n;
+}} {p}__json_t;
+
+static void {p}__j_char({p}__json_t *j, char c)
+{{
+    if (j->n + 1u < j->cap) {{
+        j->out[j->n] = c;
+    }}
+    j->n++;
+}}
+
+static void {p}__j_str({p}__json_t *j, const char *s)
+{{
+    while (*s != '\\0') {{
+        {p}__j_char(j, *s++);
+    }}
+}}
+
+/* A JSON string of t[0..n). */
+static void {p}__j_text({p}__json_t *j, const uint8_t *t, size_t n)
+{{
+    size_t i;
+    {p}__j_char(j, '"');
+    for (i = 0u; i < n; i++) {{
+        char c = (char)t[i];
+        if (c == '"' || c == '\\\\') {{
+            {p}__j_char(j, '\\\\');
+            {p}__j_char(j, c);
+        }} else if (t[i] < 0x20u || t[i] > 0x7Eu) {{
+            char esc[8];
+            (void)snprintf(esc, sizeof(esc), "\\\\u%04x", (unsigned)t[i]);
+            {p}__j_str(j, esc);
+        }} else {{
+            {p}__j_char(j, c);
+        }}
+    }}
+    {p}__j_char(j, '"');
+}}
+
+/* The fields' texts one after another, as the frame has them after the address. */
+typedef struct {{
+    const uint8_t *b;
+    size_t n;
+    size_t pos;
+}} {p}__jcur_t;
+
+static void {p}__j_field({p}__json_t *j, {p}__jcur_t *c)
+{{
+    size_t start = c->pos;
+    while (c->pos < c->n && c->b[c->pos] != {_byte(text.separator)}) {{
+        c->pos++;
+    }}
+    {p}__j_text(j, c->b + start, c->pos - start);
+    if (c->pos < c->n) {{
+        c->pos++;
+    }}
+}}
+
+static void {p}__j_head({p}__json_t *j, const {p}_msg_t *msg)
+{{
+    char number[40];
+    size_t i;
+    {p}__j_str(j, "\\"talker\\":");
+{talker_length}
+    {p}__j_text(j, (const uint8_t *)msg->talker, i);
+    (void)snprintf(number, sizeof(number), ",\\"sent\\":%d,\\"fields\\":{{", (int)msg->sent);
+    {p}__j_str(j, number);
+}}
+
+size_t {p}_to_json(const {p}_msg_t *msg, char *out, size_t cap)
+{{
+    {p}__json_t j;
+    {p}__jcur_t c;
+    uint8_t body[{P}__JSON_BODY];
+    size_t len = 0u, g = 0u;
+    j.out = out;
+    j.cap = cap;
+    j.n = 0u;
+    (void)g;
+    if ({p}_field_texts(msg, body, sizeof(body), &len) != {P}_OK) {{
+        len = 0u;
+    }}
+    c.b = body;
+    c.n = len;
+    c.pos = 0u;
+    while (c.pos < c.n && body[c.pos] != {_byte(text.separator)}) {{ /* the address: skipped */
+        c.pos++;
+    }}
+    if (c.pos < c.n) {{
+        c.pos++;
+    }}
+    switch (msg->kind) {{
+{chr(10).join(cases)}
+    case {P}_KIND_NONE:
+    case {P}_KIND_COUNT:
+    default:
+        {p}__j_str(&j, "null");
+        break;
+    }}
+    if (cap > 0u) {{
+        out[j.n < cap ? j.n : cap - 1u] = '\\0';
+    }}
+    return j.n;
+}}
+"""
+
+
+def files(protocol: Protocol, text: TextFrame) -> dict[str, str]:
+    gen = TextC(protocol, text)
+    p = protocol.name
+    return {
+        f"{p}/{p}.h": gen.header(),
+        f"{p}/{p}.c": gen.source(),
+        f"{p}/{p}_json.h": json_header(protocol),
+        f"{p}/{p}_json.c": json_source(protocol, text),
+    }

@@ -1,0 +1,616 @@
+"""The C every text protocol's .c carries (`framing: {kind: text}`): the field readers and writers, the sentence
+cursor and the line parser, following serialspec.runtime.text (decode_field, encode_field, TextStreamParser).
+PFX_/pfx_ stand for the protocol's prefix; text.py writes what is the spec's (messages, codes, letters, ranges)."""
+
+TEXT_RUNTIME = r"""/* ---- the text runtime (runtime/text.py, as C) ---- */
+
+static int64_t pfx__pow10(unsigned k)
+{
+    int64_t v = 1;
+    while (k-- > 0u) {
+        v *= 10;
+    }
+    return v;
+}
+
+#if PFX_ENABLE_DECODE
+static int pfx__digit(uint8_t c)
+{
+    return c >= 0x30u && c <= 0x39u;
+}
+#endif
+
+/* The fields of a sentence one after another: pos is where the next one starts; more is 0 after the last. */
+typedef struct {
+    const uint8_t *b;
+    size_t n;
+    size_t pos;
+    int more;
+} pfx__cursor_t;
+
+#if PFX_ENABLE_DECODE
+/* The next field (start and length), or an empty one past the last field the sentence has. */
+static void pfx__next(pfx__cursor_t *c, size_t *start, size_t *len)
+{
+    size_t i = c->pos;
+    if (!c->more) {
+        *start = c->n;
+        *len = 0u;
+        return;
+    }
+    while (i < c->n && c->b[i] != PFX__SEPARATOR) {
+        i++;
+    }
+    *start = c->pos;
+    *len = i - c->pos;
+    c->more = i < c->n;
+    c->pos = i < c->n ? i + 1u : i;
+}
+
+/* Digits d[0..n) as a number (at most 18 digits: PFX_E_CAPACITY beyond, a number an int64_t may not hold). */
+static int pfx__digits(const uint8_t *d, size_t n, int64_t *out)
+{
+    int64_t v = 0;
+    size_t i;
+    if (n > 18u) {
+        return PFX_E_CAPACITY;
+    }
+    for (i = 0u; i < n; i++) {
+        v = v * 10 + (int64_t)(d[i] - 0x30u);
+    }
+    *out = v;
+    return PFX_OK;
+}
+
+/* decimal: [+-]?(digits[.digits]|.digits), its digits kept (runtime/text.py Fixed). */
+static int pfx__get_decimal(const uint8_t *t, size_t n, pfx_decimal_t *out)
+{
+    size_t i = 0u, whole, point, fraction;
+    int64_t a = 0, b = 0, scale = 1;
+    int r;
+    out->negative = false;
+    if (i < n && (t[i] == 0x2Bu || t[i] == 0x2Du)) {
+        out->negative = t[i] == 0x2Du;
+        i++;
+    }
+    whole = i;
+    while (i < n && pfx__digit(t[i])) {
+        i++;
+    }
+    point = i;
+    if (i < n && t[i] == 0x2Eu) {
+        i++;
+    }
+    fraction = i;
+    while (i < n && pfx__digit(t[i])) {
+        i++;
+    }
+    if (i != n || (point == whole && (fraction == point || fraction == n))) {
+        return PFX_E_CONTENT;
+    }
+    if (point - whole + (n - fraction) > 18u) {
+        return PFX_E_CAPACITY;
+    }
+    r = pfx__digits(t + whole, point - whole, &a);
+    if (r == PFX_OK) {
+        r = pfx__digits(t + fraction, n - fraction, &b);
+    }
+    for (i = fraction; i < n; i++) {
+        scale *= 10;
+    }
+    out->value = (a * scale + b) * (out->negative ? -1 : 1);
+    out->scale = (uint8_t)(n - fraction);
+    out->width = (uint8_t)(point - whole);
+    return r;
+}
+
+/* integer: [+-]?digits. */
+static int pfx__get_integer(const uint8_t *t, size_t n, int64_t *out)
+{
+    size_t i = 0u, first;
+    int r;
+    if (n > 0u && (t[0] == 0x2Bu || t[0] == 0x2Du)) {
+        i = 1u;
+    }
+    first = i;
+    while (i < n && pfx__digit(t[i])) {
+        i++;
+    }
+    if (i != n || i == first) {
+        return PFX_E_CONTENT;
+    }
+    r = pfx__digits(t + first, n - first, out);
+    if (first == 1u && t[0] == 0x2Du) {
+        *out = -*out;
+    }
+    return r;
+}
+
+/* angle: 1..width digits of degrees, two of minutes, [.digits]; minutes below 60. */
+static int pfx__get_angle(const uint8_t *t, size_t n, unsigned width, pfx_angle_t *out)
+{
+    size_t k = 0u;
+    int64_t degrees = 0;
+    int r;
+    while (k < n && pfx__digit(t[k])) {
+        k++;
+    }
+    if (k < 3u || k > width + 2u || (k < n && t[k] != 0x2Eu)) {
+        return PFX_E_CONTENT;
+    }
+    r = pfx__get_decimal(t + k - 2u, n - (k - 2u), &out->minutes);
+    if (r != PFX_OK) {
+        return r;
+    }
+    if (out->minutes.value >= 60 * pfx__pow10(out->minutes.scale)) {
+        return PFX_E_CONTENT;
+    }
+    r = pfx__digits(t, k - 2u, &degrees);
+    out->degrees = (uint32_t)degrees;
+    return r;
+}
+
+/* time: hhmmss[.digits], a valid time of day; the fraction's first 6 digits kept as microseconds. */
+static int pfx__get_time(const uint8_t *t, size_t n, pfx_time_t *out)
+{
+    size_t i;
+    uint32_t micro = 0u, scale = 100000u;
+    for (i = 0u; i < 6u; i++) {
+        if (i >= n || !pfx__digit(t[i])) {
+            return PFX_E_CONTENT;
+        }
+    }
+    if (n > 6u && t[6] != 0x2Eu) {
+        return PFX_E_CONTENT;
+    }
+    for (i = 7u; i < n; i++) {
+        if (!pfx__digit(t[i])) {
+            return PFX_E_CONTENT;
+        }
+        micro += (uint32_t)(t[i] - 0x30u) * scale;
+        scale /= 10u;
+    }
+    out->hour = (uint8_t)((t[0] - 0x30u) * 10u + (t[1] - 0x30u));
+    out->minute = (uint8_t)((t[2] - 0x30u) * 10u + (t[3] - 0x30u));
+    out->second = (uint8_t)((t[4] - 0x30u) * 10u + (t[5] - 0x30u));
+    out->micro = micro;
+    out->digits = (uint16_t)(n > 7u ? n - 7u : 0u);
+    if (n > 0xFFFFu + 7u || out->hour > 23u || out->minute > 59u || out->second > 59u) {
+        return PFX_E_CONTENT;
+    }
+    return PFX_OK;
+}
+#endif
+
+/* The days of a month (Gregorian). */
+static unsigned pfx__days(unsigned month, unsigned year)
+{
+    static const uint8_t days[12] = {31u, 28u, 31u, 30u, 31u, 30u, 31u, 31u, 30u, 31u, 30u, 31u};
+    int leap = (year % 4u == 0u && year % 100u != 0u) || year % 400u == 0u;
+    return month == 2u && leap ? 29u : days[month - 1u];
+}
+
+#if PFX_ENABLE_DECODE
+/* date: ddmmyy, a valid date; yy 69..99 is 1969..1999, 00..68 2000..2068 (as strptime's %y). */
+static int pfx__get_date(const uint8_t *t, size_t n, pfx_date_t *out)
+{
+    size_t i;
+    unsigned yy;
+    if (n != 6u) {
+        return PFX_E_CONTENT;
+    }
+    for (i = 0u; i < 6u; i++) {
+        if (!pfx__digit(t[i])) {
+            return PFX_E_CONTENT;
+        }
+    }
+    out->day = (uint8_t)((t[0] - 0x30u) * 10u + (t[1] - 0x30u));
+    out->month = (uint8_t)((t[2] - 0x30u) * 10u + (t[3] - 0x30u));
+    yy = (unsigned)((t[4] - 0x30u) * 10u + (t[5] - 0x30u));
+    out->year = (uint16_t)(yy < 69u ? 2000u + yy : 1900u + yy);
+    if (out->month < 1u || out->month > 12u || out->day < 1u || out->day > pfx__days(out->month, out->year)) {
+        return PFX_E_CONTENT;
+    }
+    return PFX_OK;
+}
+
+/* char: one character. */
+static int pfx__get_char(const uint8_t *t, size_t n, char *out)
+{
+    if (n != 1u) {
+        return PFX_E_CONTENT;
+    }
+    *out = (char)t[0];
+    return PFX_OK;
+}
+
+/* text: the characters as sent (PFX_E_CAPACITY past cap). */
+static int pfx__get_text(const uint8_t *t, size_t n, char *out, size_t cap, uint16_t *len)
+{
+    size_t i;
+    if (n > cap) {
+        return PFX_E_CAPACITY;
+    }
+    for (i = 0u; i < n; i++) {
+        out[i] = (char)t[i];
+    }
+    *len = (uint16_t)n;
+    return PFX_OK;
+}
+#endif
+
+/* ---- writing: the text of each kind, as runtime/text.py encode_field writes it ---- */
+
+typedef struct {
+    uint8_t *b;
+    size_t cap;
+    size_t n;
+    int full; /* something did not fit */
+} pfx__out_t;
+
+static void pfx__put(pfx__out_t *o, uint8_t c)
+{
+    if (o->n < o->cap) {
+        o->b[o->n++] = c;
+    } else {
+        o->full = 1;
+    }
+}
+
+/* v's decimal digits, at least `width` (zeros in front). */
+static void pfx__put_digits(pfx__out_t *o, uint64_t v, unsigned width)
+{
+    uint8_t d[20];
+    unsigned k = 0u;
+    do {
+        d[k++] = (uint8_t)(0x30u + (unsigned)(v % 10u));
+        v /= 10u;
+    } while (v > 0u);
+    while (width > k) {
+        pfx__put(o, 0x30u);
+        width--;
+    }
+    while (k > 0u) {
+        pfx__put(o, d[--k]);
+    }
+}
+
+static uint64_t pfx__magnitude(int64_t v)
+{
+    return v < 0 ? (uint64_t)(-(v + 1)) + 1u : (uint64_t)v;
+}
+
+static void pfx__put_integer(pfx__out_t *o, int64_t v, unsigned width)
+{
+    if (v < 0) {
+        pfx__put(o, 0x2Du);
+    }
+    pfx__put_digits(o, pfx__magnitude(v), width);
+}
+
+static void pfx__put_decimal(pfx__out_t *o, const pfx_decimal_t *d, unsigned width)
+{
+    uint64_t m = pfx__magnitude(d->value), scale = 1u;
+    unsigned i;
+    for (i = 0u; i < d->scale && i < 19u; i++) {
+        scale *= 10u;
+    }
+    if (d->value < 0 || (d->value == 0 && d->negative)) {
+        pfx__put(o, 0x2Du);
+    }
+    pfx__put_digits(o, m / scale, width);
+    if (d->scale > 0u) {
+        pfx__put(o, 0x2Eu);
+        pfx__put_digits(o, m % scale, d->scale);
+    }
+}
+
+static void pfx__put_angle(pfx__out_t *o, const pfx_angle_t *a, unsigned width)
+{
+    pfx__put_digits(o, a->degrees, width);
+    pfx__put_decimal(o, &a->minutes, 2u);
+}
+
+static void pfx__put_time(pfx__out_t *o, const pfx_time_t *t)
+{
+    unsigned i;
+    uint32_t scale = 100000u;
+    pfx__put_digits(o, t->hour, 2u);
+    pfx__put_digits(o, t->minute, 2u);
+    pfx__put_digits(o, t->second, 2u);
+    if (t->digits > 0u) {
+        pfx__put(o, 0x2Eu);
+    }
+    for (i = 0u; i < t->digits; i++) {
+        pfx__put(o, i < 6u ? (uint8_t)(0x30u + t->micro / scale % 10u) : 0x30u);
+        scale /= 10u;
+    }
+}
+
+static void pfx__put_date(pfx__out_t *o, const pfx_date_t *d)
+{
+    pfx__put_digits(o, d->day, 2u);
+    pfx__put_digits(o, d->month, 2u);
+    pfx__put_digits(o, d->year % 100u, 2u);
+}
+
+static void pfx__put_text(pfx__out_t *o, const char *t, size_t n)
+{
+    size_t i;
+    for (i = 0u; i < n; i++) {
+        pfx__put(o, (uint8_t)t[i]);
+    }
+}
+
+/* ---- range checks (encode refuses with PFX_E_RANGE before a byte is written) ---- */
+
+/* a / 10^as compared with b / 10^bs: -1, 0 or 1 (exact; a scaled value that overflows is the larger in size). */
+static int pfx__compare(int64_t a, unsigned as, int64_t b, unsigned bs)
+{
+    while (as < bs) {
+        if (a > INT64_MAX / 10 || a < INT64_MIN / 10) {
+            return a < 0 ? -1 : 1;
+        }
+        a *= 10;
+        as++;
+    }
+    while (bs < as) {
+        if (b > INT64_MAX / 10 || b < INT64_MIN / 10) {
+            return b < 0 ? 1 : -1;
+        }
+        b *= 10;
+        bs++;
+    }
+    return a < b ? -1 : a > b ? 1 : 0;
+}
+
+static int pfx__time_ok(const pfx_time_t *t)
+{
+    return t->hour < 24u && t->minute < 60u && t->second < 60u && t->micro < 1000000u;
+}
+
+static int pfx__date_ok(const pfx_date_t *d)
+{
+    return d->year >= 1u && d->year <= 9999u && d->month >= 1u && d->month <= 12u && d->day >= 1u &&
+           d->day <= pfx__days(d->month, d->year);
+}
+
+/* A character a text frame can carry in a field: printable ASCII, none of the framing's own characters. */
+static int pfx__carried(char c)
+{
+    return c >= 0x20 && c <= 0x7E && !pfx__special((uint8_t)c);
+}
+
+static int pfx__text_ok(const char *t, size_t n)
+{
+    size_t i;
+    for (i = 0u; i < n; i++) {
+        if (!pfx__carried(t[i])) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+/* A decimal angle (degrees + minutes / 60) for the range check, as runtime/text.py's float. */
+static double pfx__angle_value(const pfx_angle_t *a)
+{
+    return (double)a->degrees + (double)a->minutes.value / (double)pfx__pow10(a->minutes.scale) / 60.0;
+}
+
+/* ---- the frame: start, address, fields, checksum after the marker, end ---- */
+
+#if PFX_ENABLE_DECODE
+static int pfx__hex_value(uint8_t c)
+{
+    if (c >= 0x30u && c <= 0x39u) {
+        return (int)c - 0x30;
+    }
+    if (c >= 0x41u && c <= 0x46u) {
+        return (int)c - 0x37;
+    }
+    if (c >= 0x61u && c <= 0x66u) {
+        return (int)c - 0x57;
+    }
+    return -1;
+}
+
+/* The fields between start and marker (or end): [*body, *body + *n), the checksum checked; PFX_E_FRAME,
+ * PFX_E_CHECKSUM. */
+static int pfx__unframe(const uint8_t *f, size_t len, size_t *body, size_t *n)
+{
+    size_t i, end = len, stop;
+    for (i = 0u; i < len; i++) {
+        if (f[i] > 0x7Fu) {
+            return PFX_E_FRAME; /* a non-ASCII byte */
+        }
+    }
+    if (len >= sizeof(pfx__end) - 1u && pfx__same(f + len - (sizeof(pfx__end) - 1u), pfx__end, sizeof(pfx__end) - 1u)) {
+        end = len - (sizeof(pfx__end) - 1u);
+    }
+    if (end < 1u || f[0] != PFX__START) {
+        return PFX_E_FRAME;
+    }
+    stop = end;
+#if PFX__CHECKED
+    {
+        size_t at = end, k;
+        uint32_t written = 0u;
+        while (at > 1u && f[at - 1u] != PFX__MARKER) {
+            at--;
+        }
+        if (at > 1u) {
+            if (end - at != PFX__DIGITS) {
+                return PFX_E_CHECKSUM;
+            }
+            for (k = at; k < end; k++) {
+                int v = pfx__hex_value(f[k]);
+                if (v < 0) {
+                    return PFX_E_CHECKSUM;
+                }
+                written = (written << 4) | (uint32_t)v;
+            }
+            stop = at - 1u;
+            if (written != pfx__checksum(f + 1u, stop - 1u)) {
+                return PFX_E_CHECKSUM;
+            }
+        } else if (PFX__REQUIRED) {
+            return PFX_E_CHECKSUM;
+        }
+    }
+#endif
+    *body = 1u;
+    *n = stop - 1u;
+    return PFX_OK;
+}
+#endif
+
+#if PFX_ENABLE_ENCODE
+/* Exactly `sent` fields after the address (o->b[1..n): the address, then each field after a separator): the fields
+ * after the last one sent must be empty (PFX_E_LENGTH), missing ones are written empty. */
+static int pfx__trim(pfx__out_t *o, size_t sent)
+{
+    size_t i, k, fields = 0u;
+    for (i = 1u; i < o->n; i++) {
+        if (o->b[i] == PFX__SEPARATOR && ++fields > sent) {
+            break;
+        }
+    }
+    if (fields > sent) {
+        for (k = i; k < o->n; k++) {
+            if (o->b[k] != PFX__SEPARATOR) {
+                return PFX_E_LENGTH; /* a field after the last one sent has a value */
+            }
+        }
+        o->n = i;
+    }
+    while (fields < sent) {
+        pfx__put(o, PFX__SEPARATOR);
+        fields++;
+    }
+    return PFX_OK;
+}
+
+/* The frame around fields already written from buf[1]: the start before them, checksum and end after them. */
+static int pfx__frame(pfx__out_t *o, size_t *len)
+{
+    size_t k;
+    o->b[0] = PFX__START;
+#if PFX__CHECKED
+    {
+        uint32_t sum = pfx__checksum(o->b + 1u, o->n - 1u);
+        pfx__put(o, PFX__MARKER);
+        for (k = PFX__DIGITS; k > 0u; k--) {
+            uint32_t nibble = (sum >> (4u * (k - 1u))) & 0xFu;
+            pfx__put(o, (uint8_t)(nibble < 10u ? 0x30u + nibble : 0x37u + nibble));
+        }
+    }
+#endif
+    for (k = 0u; k + 1u < sizeof(pfx__end); k++) {
+        pfx__put(o, pfx__end[k]);
+    }
+    if (o->full) {
+        return PFX_E_BUFFER;
+    }
+    *len = o->n;
+    return PFX_OK;
+}
+#endif
+
+/* ---- the parser ---- */
+#if PFX_ENABLE_PARSER
+/* Where `c` is in b[from..n), n if nowhere. */
+static size_t pfx__find(const uint8_t *b, size_t from, size_t n, uint8_t c)
+{
+    while (from < n && b[from] != c) {
+        from++;
+    }
+    return from;
+}
+
+/* Where the line ending is in b[from..n), n if nowhere. */
+static size_t pfx__find_end(const uint8_t *b, size_t from, size_t n)
+{
+    size_t k = sizeof(pfx__end) - 1u;
+    for (; from + k <= n; from++) {
+        if (pfx__same(b + from, pfx__end, k)) {
+            return from;
+        }
+    }
+    return n;
+}
+
+static void pfx__drop(pfx_parser_t *p, size_t k)
+{
+    size_t i;
+    for (i = k; i < p->n; i++) {
+        p->buf[i - k] = p->buf[i];
+    }
+    p->n -= k;
+}
+
+/* One byte in: runtime/text.py TextStreamParser.feed of that byte. A frame cut short by a new start, or longer
+ * than the spec's max_length, is dropped (counted in errors), as is one that does not decode. */
+static int pfx__push(pfx_parser_t *p, uint8_t byte, pfx_msg_t *out)
+{
+    const size_t limit = PFX__LIMIT, k = sizeof(pfx__end) - 1u;
+    if (p->n < PFX__LIMIT + 1u) {
+        p->buf[p->n++] = byte;
+    }
+    for (;;) {
+        size_t start = pfx__find(p->buf, 0u, p->n, PFX__START), end, restart;
+        if (start == p->n) {
+            p->n = 0u;
+            return 0;
+        }
+        pfx__drop(p, start);
+        end = pfx__find_end(p->buf, 1u, p->n);
+        restart = pfx__find(p->buf, 1u, p->n, PFX__START);
+        if (end == p->n || restart < end) {
+            if (restart < p->n) {
+                p->errors++;
+                pfx__drop(p, restart);
+                continue;
+            }
+            if (p->n > limit) {
+                p->errors++;
+                pfx__drop(p, 1u);
+                continue;
+            }
+            return 0;
+        }
+        {
+            int r = pfx__decode(p->buf, end + k, p->dir, PFX_KIND_NONE, out);
+            pfx__drop(p, end + k);
+            if (r == PFX_OK) {
+                p->frames++;
+                return 1;
+            }
+            p->errors++;
+        }
+    }
+}
+
+void pfx_parser_init(pfx_parser_t *parser, pfx_direction_t dir)
+{
+    parser->dir = dir;
+    parser->n = 0u;
+    parser->frames = 0u;
+    parser->garbage = 0u;
+    parser->errors = 0u;
+}
+
+size_t pfx_parser_feed(pfx_parser_t *parser, const uint8_t *data, size_t len, pfx_msg_t *out, bool *got)
+{
+    size_t i;
+    *got = false;
+    for (i = 0u; i < len; i++) {
+        if (pfx__push(parser, data[i], out)) {
+            *got = true;
+            return i + 1u;
+        }
+    }
+    return len;
+}
+#endif
+"""

@@ -1,0 +1,62 @@
+"""A Wireshark dissector for a text protocol (`framing: {kind: text}`): the text model as a Lua table, read by
+text_dissector.lua.j2, which splits each sentence into its talker, text code and named fields (each as the text
+sent) and verifies the checksum after the marker with the algorithm's own Lua code."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from serialspec.backends import Unsupported
+from serialspec.backends.common.render import render
+from serialspec.backends.wireshark.dissector import lua
+from serialspec.lang.model import Protocol, TextField, TextFrame, TextRepeat
+
+
+def _field(f: TextField) -> dict[str, Any]:
+    return {"name": f.name, "title": f.name}
+
+
+def emit_text_dissector(protocol: Protocol, text: TextFrame) -> str:
+    if not text.start:
+        raise Unsupported("text frames without a start character (every line a frame)")
+    messages: dict[str, dict[str, Any]] = {}
+    for m in text.messages:
+        fields = [
+            {"name": item.name, "count": item.count, "max": item.max_count, "fields": [_field(f) for f in item.fields]}
+            if isinstance(item, TextRepeat)
+            else _field(item)
+            for item in m.fields
+        ]
+        entry = {"command": m.key, "direction": m.direction.value, "title": m.title, "fields": fields}
+        messages.setdefault(m.code, {})[m.direction.value] = entry
+    for by_direction in messages.values():
+        if len(by_direction) == 1:  # the code says the direction (runtime/text.py TextFraming.sentence)
+            by_direction["only"] = next(iter(by_direction))
+    checksums: list[tuple[str, str]] = []
+    checksum = None
+    if text.checksum is not None:
+        code = text.checksum.lua_function()
+        if code is None:
+            raise Unsupported(f"the text checksum {text.checksum.name} (no Lua code)")
+        checksum = {"algorithm": text.checksum.name} | text.checksum.lua_parameters()
+        checksums = [(lua(text.checksum.name, 0), code)]
+    data = {
+        "name": protocol.name,
+        "title": protocol.title,
+        "start": text.start,
+        "separator": text.separator,
+        "marker": text.marker,
+        "ending": text.end,
+        "digits": text.digits,
+        "talker": text.talker,
+        "required": text.required,
+        "checksum": checksum,
+        "messages": messages,
+    }
+    return render(
+        "serialspec.backends.wireshark",
+        "text_dissector.lua.j2",
+        protocol=protocol,
+        data=lua(data, 0),
+        checksums=checksums,
+    )

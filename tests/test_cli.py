@@ -283,7 +283,9 @@ def test_generate_target_c_out_writes_each_protocol_folder_in_dir(tmp_path: Path
         "feetech_sms.h",
         "feetech_sms_json.c",
         "feetech_sms_json.h",
+        "test",
     ]
+    assert sorted(p.name for p in (tmp_path / "feetech_sms" / "test").iterdir()) == ["check_vectors.c", "vectors.h"]
     assert not (tmp_path / "c").exists()
 
 

@@ -397,9 +397,10 @@ def through_tshark(tmp_path: Path, specs: list[str], corrupt: bool = False, twic
 )
 def test_tshark_shows_every_language_matrix_case_as_decode_does(tmp_path: Path) -> None:
     """Every alternative the language documents (tests/test_language_matrix.py's cases)."""
-    from test_language_matrix import CASES, KNOWN, spec_text
+    from test_language_matrix import CASES, KNOWN, WIRESHARK_REFUSES, spec_text
 
-    names = [name for name in sorted(CASES) if name not in KNOWN]
+    # a case the Wireshark target refuses in one line (the matrix checks that line) has no dissector to run
+    names = [name for name in sorted(CASES) if name not in KNOWN and name not in WIRESHARK_REFUSES]
     specs = [
         spec_text(name, CASES[name]).replace("protocol: matrix_case", f"protocol: matrix_{number}")
         for number, name in enumerate(names)

@@ -75,7 +75,7 @@ test-fast: $(STAMP) test-tools check
 # `make test` runs the same tests with the rest of the suite. Needs gcc and g++ (apt-get install gcc g++); the other
 # compilers and qemu are installed as root (test-tools), else those builds are skipped, saying why.
 c-check: $(STAMP) test-tools check
-	$(BIN)/pytest -q -n auto tests/test_c_backend.py tests/test_c_text.py
+	SERIALSPEC_C_CHECK=1 $(BIN)/pytest -q -n auto tests/test_c_backend.py tests/test_c_text.py
 
 # Pin what the development install resolved to (after changing pyproject.toml's extras), for CI and fresh clones.
 constraints: $(STAMP)

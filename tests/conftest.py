@@ -145,6 +145,19 @@ def sim(request: pytest.FixtureRequest) -> Iterator[Running]:
         simulator.close()
 
 
+_SCRATCH: list[Any] = []
+
+
+def scratch_folder(prefix: str) -> Path:
+    """A new temporary folder that lives as long as this test process (for builds cached across tests) and is removed
+    when it exits: mkdtemp's folders would pile up under /tmp run after run."""
+    import tempfile
+
+    folder = tempfile.TemporaryDirectory(prefix=prefix)
+    _SCRATCH.append(folder)  # kept alive until exit, when its finalizer removes it
+    return Path(folder.name)
+
+
 def generate_and_import(spec: Path, out: Path, name: str) -> ModuleType:
     """`serialspec generate SPEC --out OUT`, then the package `name` imported from OUT (a spec of a test's own)."""
     import sys

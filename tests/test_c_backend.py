@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from conftest import ALL, ROOT, Generated, by_protocol, example_class, examples
+from conftest import ALL, ROOT, Generated, by_protocol, example_class, examples, scratch_folder
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from serialspec.backends import Unsupported
@@ -211,19 +211,14 @@ class Driver:
 
 @cache
 def driver(name: str, command: tuple[str, ...] = (), build: str = "gcc") -> Driver:
-    import tempfile
-
-    folder = Path(tempfile.mkdtemp(prefix="serialspec-c-"))
-    return Driver(name, GENERATED_C / name, folder, command, build)
+    return Driver(name, GENERATED_C / name, scratch_folder("serialspec-c-"), command, build)
 
 
 @cache
 def spec_buffer_driver(name: str) -> Driver:
     """The driver with the spec's own P_MAX_FRAME (the buffer a firmware has: the parser moves the bytes it holds to
     its front when its end is reached)."""
-    import tempfile
-
-    return Driver(name, GENERATED_C / name, Path(tempfile.mkdtemp(prefix="serialspec-c-")), big_buffer=False)
+    return Driver(name, GENERATED_C / name, scratch_folder("serialspec-c-"), big_buffer=False)
 
 
 def agrees_with_python(run: Driver, g: Generated, spec: Message, fields: dict[str, Any]) -> bytes:

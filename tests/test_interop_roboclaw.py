@@ -12,13 +12,12 @@ import contextlib
 import importlib
 import io
 import json
-import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 import pytest
-from conftest import generate_and_import
+from conftest import generate_and_import, scratch_folder
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from serialspec import cli
@@ -31,7 +30,7 @@ SPEC = str(Path(__file__).parent / "specs" / "roboclaw.yaml")
 # the `port` fixture (conftest.py): `serialspec sim` on a pseudo-terminal, two controllers (its path is from specs/)
 SIM = ("../tests/specs/roboclaw.yaml", 0x80, 0x81)
 # the package, generated once for the module (the hypothesis tests below read it as a module global)
-rc: Any = generate_and_import(Path(SPEC), Path(tempfile.mkdtemp(prefix="roboclaw-")), "roboclaw")
+rc: Any = generate_and_import(Path(SPEC), scratch_folder("roboclaw-"), "roboclaw")
 rc_client: Any = importlib.import_module("roboclaw.client")
 
 

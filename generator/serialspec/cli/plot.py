@@ -21,8 +21,8 @@ from typing import Any, assert_never
 from serialspec.cli import capture
 from serialspec.cli.frames import Frames
 from serialspec.cli.protocols import SPEC_HELP, open_spec
-from serialspec.cli.views import engineering_unit, message_spec, register_view
-from serialspec.lang.model import Bytes, Protocol, Scalar, Table, TableValue, TextField, TextFrame
+from serialspec.cli.views import message_spec, register_view
+from serialspec.lang.model import Bytes, Protocol, Scalar, Table, TableValue, TextField, TextFrame, engineering_unit
 from serialspec.runtime.errors import PortError, SerialspecError
 from serialspec.runtime.message import Message
 

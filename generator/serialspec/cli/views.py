@@ -2,10 +2,9 @@
 
 from __future__ import annotations
 
-import re
 from typing import TYPE_CHECKING, Any
 
-from serialspec.lang.model import Bytes, Field, Protocol, Scalar, Table, TableValue
+from serialspec.lang.model import Bytes, Field, Protocol, Scalar, Table, TableValue, engineering_unit
 from serialspec.lang.model import Message as MessageSpec
 from serialspec.runtime.message import Message
 
@@ -57,14 +56,6 @@ def unit_symbols(protocol: Protocol, message: Message) -> dict[str, str]:
         if unit:
             symbols[f.name] = unit
     return symbols
-
-
-_STEP = re.compile(r"^\s*[0-9]+(\.[0-9]+)?\s*")
-
-
-def engineering_unit(unit: str, scale: float | None) -> str:
-    """The unit of wire value x scale: a wire unit of `0.1°` with scale 0.1 is `°`, `6.5 mA` with 6.5 is `mA`."""
-    return _STEP.sub("", unit) if scale is not None else unit
 
 
 def with_unit(value: Any, unit: str) -> str:

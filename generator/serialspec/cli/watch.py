@@ -24,13 +24,12 @@ from serialspec.cli.protocols import SPEC_HELP, open_spec
 from serialspec.cli.views import (
     FlagNames,
     engineering,
-    engineering_unit,
     message_spec,
     register_view,
     unit_symbols,
     with_unit,
 )
-from serialspec.lang.model import Protocol, Scalar, TableEntry, TextField
+from serialspec.lang.model import Protocol, Scalar, TableEntry, TextField, engineering_unit
 from serialspec.runtime.errors import PortError, SerialspecError
 from serialspec.runtime.message import Message
 from serialspec.runtime.text import texts

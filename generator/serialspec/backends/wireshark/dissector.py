@@ -14,7 +14,6 @@ from typing import Any, assert_never
 from serialspec.backends import Unsupported
 from serialspec.backends.common.frames import runtime_layout
 from serialspec.backends.common.render import render
-from serialspec.cli.views import engineering_unit
 from serialspec.lang.frozen import frozen
 from serialspec.lang.model import (
     VALUE_ROLES,
@@ -38,6 +37,7 @@ from serialspec.lang.model import (
     TableValue,
     Text,
     content_bounds,
+    engineering_unit,
     size_terms,
 )
 

@@ -3,10 +3,18 @@ flags; the parameter tables."""
 
 from __future__ import annotations
 
+import re
 from typing import Literal
 
 from serialspec.lang.expression import Expr
 from serialspec.lang.frozen import frozen
+
+_UNIT_STEP = re.compile(r"^\s*[0-9]+(\.[0-9]+)?\s*")
+
+
+def engineering_unit(unit: str, scale: float | None) -> str:
+    """The unit of wire value x scale: a wire unit of `0.1°` with scale 0.1 is `°`, `6.5 mA` with 6.5 is `mA`."""
+    return _UNIT_STEP.sub("", unit) if scale is not None else unit
 
 
 @frozen

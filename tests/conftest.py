@@ -63,7 +63,13 @@ ALL = [load(spec) for spec in SPECS if spec not in TEXT_SPECS]
 
 
 def by_protocol(items: list[tuple[Generated, object]]) -> list[object]:
-    return [pytest.param(g, item, id=f"{g.protocol.name}:{getattr(item, 'name', item)}") for g, item in items]
+    """Test cases per protocol, named `protocol:example` or `protocol:MessageClass` (not the message's whole repr)."""
+    return [
+        pytest.param(
+            g, item, id=f"{g.protocol.name}:{getattr(item, 'name', None) or getattr(item, 'class_name', item)}"
+        )
+        for g, item in items
+    ]
 
 
 @pytest.fixture(params=ALL, ids=[g.protocol.name for g in ALL])

@@ -96,6 +96,26 @@ def test_scan_at_several_baud_rates_and_every_rate_of_the_spec() -> None:
     assert rates == [115200, 9600, 19200, 38400, 57600, 250000, 500000]
 
 
+def test_scan_finds_devices_set_to_another_rate_at_that_rate_alone() -> None:
+    # `sim --baudrate N` hears only a line set to N (250000: not a termios B-constant, set through termios2), as
+    # servos set to that rate do: the scan over the spec's seven rates finds both servos at 250000 and nowhere else
+    with serve("fashionstar_uart.yaml", 2, 5, options=["--baudrate", "250000"]) as port:
+        every = scan(spec("fashionstar_uart"), "--port", port, "--ids", "0-6", "--all-baudrates", "--json")
+        default = scan(spec("fashionstar_uart"), "--port", port, "--ids", "0-6")
+    found = [(d["id"], d["baudrate"]) for d in map(json.loads, every.stdout.splitlines())]
+    assert found == [(2, 250000), (5, 250000)]
+    assert (default.returncode, default.stdout) == (1, "")
+    assert "no device answered" in default.stderr and "115200 baud" in default.stderr
+
+
+def test_sim_refuses_a_rate_that_is_no_rate() -> None:
+    result = serialspec("sim", spec("fashionstar_uart"), "--baudrate", "0")
+    assert (result.returncode, result.stderr) == (
+        1,
+        "serialspec sim: --baudrate 0: give a positive number of bits per second\n",
+    )
+
+
 def test_scan_counts_a_modbus_server_by_its_reply_to_a_register_read() -> None:
     with serve("modbus_rtu.yaml", 1, 17) as port:
         result = scan(spec("modbus_rtu"), "--port", port, "--ids", "1-3,17,30", "--json")

@@ -298,6 +298,27 @@ def test_replay_refuses_what_it_cannot_play(tmp_path: Path) -> None:
             assert len(result.stderr.strip().splitlines()) == 1
 
 
+def test_every_tool_says_in_words_why_a_port_does_not_open(tmp_path: Path) -> None:
+    # one line, the reason once: not pyserial's `[Errno 2] could not open port X: [Errno 2] No such file ...: 'X'`
+    capture_file = tmp_path / "one.capture"
+    capture_file.write_text("# serialspec capture: feetech_sms\n2026-11-22T09:40:01+00:00 request ff ff 01 02 01 fb\n")
+    missing = str(tmp_path / "ttyNONE")
+    feetech = spec("feetech_sms")
+    verbs = {
+        "monitor": ["monitor", feetech, "--port", missing],
+        "watch": ["watch", feetech, "--port", missing, "--duration", "1"],
+        "scan": ["scan", feetech, "--port", missing],
+        "replay": ["replay", str(capture_file), "--port", missing],
+        "plot": ["plot", "--port", missing, "--spec", feetech, "--field", "x", "--out", str(tmp_path / "p.png")],
+    }
+    for verb, arguments in verbs.items():
+        result = serialspec(*arguments)
+        assert (result.returncode, result.stderr) == (
+            1,
+            f"serialspec {verb}: cannot open {missing}: No such file or directory\n",
+        ), verb
+
+
 # --- ports and completion -------------------------------------------------------------------------------------------
 
 

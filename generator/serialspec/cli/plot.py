@@ -122,18 +122,9 @@ def record(url: str, package: ModuleType, baudrate: int | None, duration: float)
     """What a port shows for `duration` seconds, as capture chunks (direction unknown: both are split by frames)."""
     import serial
 
-    settings = package.SERIAL
-    try:
-        port = serial.serial_for_url(
-            url,
-            baudrate=baudrate or settings.baudrate,
-            bytesize=settings.bytesize,
-            parity={"none": "N", "even": "E", "odd": "O"}.get(settings.parity, "N"),
-            stopbits=settings.stopbits,
-            timeout=0.1,
-        )
-    except (serial.SerialException, OSError, ValueError) as exc:
-        raise PortError(f"cannot open {url}: {exc}") from None
+    from serialspec.cli.listening import open_port
+
+    port = open_port(url, baudrate, package.SERIAL, 0.1)
     print(f"serialspec plot: recording {url} for {duration:g} s", file=sys.stderr, flush=True)
     chunks = []
     end = time.monotonic() + duration

@@ -435,3 +435,21 @@ def test_generate_takes_a_shipped_protocol_by_name_outside_any_project(tmp_path:
         1,
         "fashionstar_uatr:1:1: no such spec file, nor a generated protocol package of that name\n",
     )
+
+
+def test_every_option_says_what_it_takes_and_what_it_does() -> None:
+    # `--timeout S`, `--speed X`, `--port PORT`: never argparse's `--timeout TIMEOUT`, nor an option without help
+    from serialspec.cli import VERBS, build_parser
+
+    _, verbs = build_parser(VERBS)
+    unnamed = []
+    for verb, parser in verbs.items():
+        for action in parser._actions:
+            if not action.option_strings or action.help == "show this help message and exit":
+                continue
+            if not action.help:
+                unnamed.append(f"{verb} {action.option_strings[0]}: no help")
+            takes_value = action.nargs != 0 and action.choices is None
+            if takes_value and action.metavar is None and action.type not in (None, str):
+                unnamed.append(f"{verb} {action.option_strings[0]} {action.dest.upper()}")
+    assert unnamed == []

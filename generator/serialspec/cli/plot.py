@@ -43,8 +43,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--out", required=True, metavar="FILE", help="the picture to write: FILE.png or FILE.svg")
     parser.add_argument("--spec", help=f"{SPEC_HELP} (default: the protocol the capture names)")
     parser.add_argument("--port", help="plot live from this port (device path or pyserial URL) instead of a capture")
-    parser.add_argument("--duration", type=float, default=10.0, help="with --port: seconds to record (default 10)")
-    parser.add_argument("--baudrate", type=int, help="with --port: default the spec's")
+    parser.add_argument(
+        "--duration", type=float, default=10.0, metavar="S", help="with --port: seconds to record (default 10)"
+    )
+    parser.add_argument("--baudrate", type=int, metavar="N", help="with --port: default the spec's")
     parser.add_argument("--id", dest="ids", type=int, action="append", metavar="N", help="only this device id")
 
 

@@ -52,6 +52,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--timeout",
         type=float,
+        metavar="S",
         help=f"seconds to wait for each id's reply (default: the time 64 characters take at the rate + {SLACK} s)",
     )
     parser.add_argument("--json", action="store_true", help="one JSON object per device found")

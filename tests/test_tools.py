@@ -453,3 +453,29 @@ def test_every_option_says_what_it_takes_and_what_it_does() -> None:
             if takes_value and action.metavar is None and action.type not in (None, str):
                 unnamed.append(f"{verb} {action.option_strings[0]} {action.dest.upper()}")
     assert unnamed == []
+
+
+# --- docs -------------------------------------------------------------------------------------------------------------
+
+
+def test_docs_of_a_shipped_protocol_by_name_and_a_folder_it_cannot_write(tmp_path: Path) -> None:
+    pytest.importorskip("mkdocs")
+    # by name: the spec the package ships, found without importing the old top-level name (which warns)
+    env = dict(os.environ, PYTHONWARNINGS="error::DeprecationWarning")
+    built = subprocess.run(
+        [sys.executable, "-m", "serialspec", "docs", "vesc", "--out", "site"],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=300,
+    )
+    assert (built.returncode, built.stderr) == (0, "")
+    shipped = ROOT / "generated" / "serialspec_protocols" / "vesc" / "spec.yaml"
+    assert (tmp_path / "site" / "specs" / "vesc.yaml").read_text() == shipped.read_text()
+    (tmp_path / "a-file").write_text("")
+    refused = serialspec("docs", "vesc", "--out", str(tmp_path / "a-file" / "site"))
+    assert (refused.returncode, refused.stderr) == (
+        1,
+        f"serialspec docs: cannot write the site to {tmp_path / 'a-file' / 'site'}: Not a directory\n",
+    )

@@ -76,6 +76,18 @@ def test_scan_finds_a_dynamixel_bus_with_one_broadcast_ping(tmp_path: Path) -> N
     assert b"".join(requests_in(tap)) == bytes.fromhex("ff ff fd 00 fe 03 00 01 31 42")
 
 
+def test_scan_takes_silence_after_a_broadcast_ping_for_no_device_at_that_rate(tmp_path: Path) -> None:
+    # servos at 1 Mbaud: at 57600 the broadcast PING meets silence, which says nobody is there (not 253 more PINGs)
+    tap = tmp_path / "bus.tap"
+    with serve("dynamixel_p2.yaml", 1, 2, options=["--baudrate", "1000000", "--tap", str(tap)]) as port:
+        result = scan(spec("dynamixel_p2"), "--port", port, "--baudrate", "57600", "--baudrate", "1000000", "--json")
+    assert [(d["id"], d["baudrate"]) for d in map(json.loads, result.stdout.splitlines())] == [
+        (1, 1000000),
+        (2, 1000000),
+    ]
+    assert b"".join(requests_in(tap)) == 2 * bytes.fromhex("ff ff fd 00 fe 03 00 01 31 42")  # one PING per rate
+
+
 def test_scan_at_several_baud_rates_and_every_rate_of_the_spec() -> None:
     with serve("fashionstar_uart.yaml", 2) as port:
         given = scan(

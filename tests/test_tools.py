@@ -76,6 +76,18 @@ def test_scan_finds_a_dynamixel_bus_with_one_broadcast_ping(tmp_path: Path) -> N
     assert b"".join(requests_in(tap)) == bytes.fromhex("ff ff fd 00 fe 03 00 01 31 42")
 
 
+def test_scan_takes_silence_after_a_broadcast_ping_for_no_device_at_that_rate(tmp_path: Path) -> None:
+    # servos at 1 Mbaud: at 57600 the broadcast PING meets silence, which says nobody is there (not 253 more PINGs)
+    tap = tmp_path / "bus.tap"
+    with serve("dynamixel_p2.yaml", 1, 2, options=["--baudrate", "1000000", "--tap", str(tap)]) as port:
+        result = scan(spec("dynamixel_p2"), "--port", port, "--baudrate", "57600", "--baudrate", "1000000", "--json")
+    assert [(d["id"], d["baudrate"]) for d in map(json.loads, result.stdout.splitlines())] == [
+        (1, 1000000),
+        (2, 1000000),
+    ]
+    assert b"".join(requests_in(tap)) == 2 * bytes.fromhex("ff ff fd 00 fe 03 00 01 31 42")  # one PING per rate
+
+
 def test_scan_at_several_baud_rates_and_every_rate_of_the_spec() -> None:
     with serve("fashionstar_uart.yaml", 2) as port:
         given = scan(
@@ -94,6 +106,26 @@ def test_scan_at_several_baud_rates_and_every_rate_of_the_spec() -> None:
     # a pseudo-terminal takes every rate: the servo answers at each of the seven the spec lists, default first
     rates = [json.loads(line)["baudrate"] for line in every.stdout.splitlines()]
     assert rates == [115200, 9600, 19200, 38400, 57600, 250000, 500000]
+
+
+def test_scan_finds_devices_set_to_another_rate_at_that_rate_alone() -> None:
+    # `sim --baudrate N` hears only a line set to N (250000: not a termios B-constant, set through termios2), as
+    # servos set to that rate do: the scan over the spec's seven rates finds both servos at 250000 and nowhere else
+    with serve("fashionstar_uart.yaml", 2, 5, options=["--baudrate", "250000"]) as port:
+        every = scan(spec("fashionstar_uart"), "--port", port, "--ids", "0-6", "--all-baudrates", "--json")
+        default = scan(spec("fashionstar_uart"), "--port", port, "--ids", "0-6")
+    found = [(d["id"], d["baudrate"]) for d in map(json.loads, every.stdout.splitlines())]
+    assert found == [(2, 250000), (5, 250000)]
+    assert (default.returncode, default.stdout) == (1, "")
+    assert "no device answered" in default.stderr and "115200 baud" in default.stderr
+
+
+def test_sim_refuses_a_rate_that_is_no_rate() -> None:
+    result = serialspec("sim", spec("fashionstar_uart"), "--baudrate", "0")
+    assert (result.returncode, result.stderr) == (
+        1,
+        "serialspec sim: --baudrate 0: give a positive number of bits per second\n",
+    )
 
 
 def test_scan_counts_a_modbus_server_by_its_reply_to_a_register_read() -> None:
@@ -278,6 +310,27 @@ def test_replay_refuses_what_it_cannot_play(tmp_path: Path) -> None:
             assert len(result.stderr.strip().splitlines()) == 1
 
 
+def test_every_tool_says_in_words_why_a_port_does_not_open(tmp_path: Path) -> None:
+    # one line, the reason once: not pyserial's `[Errno 2] could not open port X: [Errno 2] No such file ...: 'X'`
+    capture_file = tmp_path / "one.capture"
+    capture_file.write_text("# serialspec capture: feetech_sms\n2026-11-22T09:40:01+00:00 request ff ff 01 02 01 fb\n")
+    missing = str(tmp_path / "ttyNONE")
+    feetech = spec("feetech_sms")
+    verbs = {
+        "monitor": ["monitor", feetech, "--port", missing],
+        "watch": ["watch", feetech, "--port", missing, "--duration", "1"],
+        "scan": ["scan", feetech, "--port", missing],
+        "replay": ["replay", str(capture_file), "--port", missing],
+        "plot": ["plot", "--port", missing, "--spec", feetech, "--field", "x", "--out", str(tmp_path / "p.png")],
+    }
+    for verb, arguments in verbs.items():
+        result = serialspec(*arguments)
+        assert (result.returncode, result.stderr) == (
+            1,
+            f"serialspec {verb}: cannot open {missing}: No such file or directory\n",
+        ), verb
+
+
 # --- ports and completion -------------------------------------------------------------------------------------------
 
 
@@ -364,3 +417,77 @@ def test_the_readme_replay_prints_what_the_readme_shows(tmp_path: Path) -> None:
             cwd=tmp_path,
         )
     assert result.stderr.replace(port, README_PORT).splitlines() == printed
+
+
+# --- generate by protocol name ----------------------------------------------------------------------------------------
+
+
+def test_generate_takes_a_shipped_protocol_by_name_outside_any_project(tmp_path: Path) -> None:
+    # a wheel user has no specs/ folder: `generate fashionstar_uart --target wireshark` uses the spec the package ships
+    result = subprocess.run(
+        [sys.executable, "-m", "serialspec", "generate", "fashionstar_uart", "--target", "wireshark", "--out", "ws"],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert (result.returncode, result.stdout) == (0, "1 file generated in ws, 1 changed, 0 removed\n"), result.stderr
+    written = (tmp_path / "ws" / "fashionstar_uart" / "fashionstar_uart.lua").read_text().splitlines()
+    shipped = (ROOT / "generated" / "serialspec_protocols" / "fashionstar_uart" / "fashionstar_uart.lua").read_text()
+    assert written[0].startswith("-- Generated by serialspec from fashionstar_uart/spec.yaml;")
+    assert written[1:] == shipped.splitlines()[1:]
+    missing = subprocess.run(
+        [sys.executable, "-m", "serialspec", "generate", "fashionstar_uatr", "--target", "wireshark", "--out", "ws"],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert (missing.returncode, missing.stderr) == (
+        1,
+        "fashionstar_uatr:1:1: no such spec file, nor a generated protocol package of that name\n",
+    )
+
+
+def test_every_option_says_what_it_takes_and_what_it_does() -> None:
+    # `--timeout S`, `--speed X`, `--port PORT`: never argparse's `--timeout TIMEOUT`, nor an option without help
+    from serialspec.cli import VERBS, build_parser
+
+    _, verbs = build_parser(VERBS)
+    unnamed = []
+    for verb, parser in verbs.items():
+        for action in parser._actions:
+            if not action.option_strings or action.help == "show this help message and exit":
+                continue
+            if not action.help:
+                unnamed.append(f"{verb} {action.option_strings[0]}: no help")
+            takes_value = action.nargs != 0 and action.choices is None
+            if takes_value and action.metavar is None and action.type not in (None, str):
+                unnamed.append(f"{verb} {action.option_strings[0]} {action.dest.upper()}")
+    assert unnamed == []
+
+
+# --- docs -------------------------------------------------------------------------------------------------------------
+
+
+def test_docs_of_a_shipped_protocol_by_name_and_a_folder_it_cannot_write(tmp_path: Path) -> None:
+    pytest.importorskip("mkdocs")
+    # by name: the spec the package ships, found without importing the old top-level name (which warns)
+    env = dict(os.environ, PYTHONWARNINGS="error::DeprecationWarning")
+    built = subprocess.run(
+        [sys.executable, "-m", "serialspec", "docs", "vesc", "--out", "site"],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=300,
+    )
+    assert (built.returncode, built.stderr) == (0, "")
+    shipped = ROOT / "generated" / "serialspec_protocols" / "vesc" / "spec.yaml"
+    assert (tmp_path / "site" / "specs" / "vesc.yaml").read_text() == shipped.read_text()
+    (tmp_path / "a-file").write_text("")
+    refused = serialspec("docs", "vesc", "--out", str(tmp_path / "a-file" / "site"))
+    assert (refused.returncode, refused.stderr) == (
+        1,
+        f"serialspec docs: cannot write the site to {tmp_path / 'a-file' / 'site'}: Not a directory\n",
+    )

@@ -374,7 +374,8 @@ def _distribution_packages(name: str, metadata_into: Path) -> list[str]:
             requirement = Requirement(text)
             if requirement.marker is None or requirement.marker.evaluate({"extra": ""}):
                 todo.append(requirement.name)
-    return sorted(n for n in found if importlib.util.find_spec(n) is not None)
+    # a folder of shared libraries (`numpy.libs`) is no module, but it is kept: the packages beside it load from it
+    return sorted(n for n in found if not n.isidentifier() or importlib.util.find_spec(n) is not None)
 
 
 def _chromium() -> str | None:
@@ -438,3 +439,63 @@ def test_docs_without_mkdocs_says_how_to_install_it(user: User) -> None:
         result.stderr
         == "serialspec docs: the docs site needs mkdocs, an optional extra: pip install 'serialspec[docs]'\n"
     )
+
+
+def test_the_readme_tools_run_as_printed_from_the_wheel(
+    wheels: dict[str, Path], user: User, tmp_path_factory: pytest.TempPathFactory
+) -> None:
+    """Each command of the README's Tools section that needs no bus, run as printed from the wheel with both extras
+    (serialspec[docs,plot]) in a folder outside the repository that holds the files it names: the same output."""
+    import re
+    import shlex
+
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    section = readme[readme.index("## Tools") :]
+    section = section[: section.index("\n## ", 1)]
+    commands: list[tuple[str, list[str]]] = []
+    for block in re.findall(r"```console\n(.*?)```", section, flags=re.S):
+        for line in block.splitlines():
+            if line.startswith("$ "):
+                commands.append((line[2:], []))
+            elif commands:
+                commands[-1][1].append(line)
+    commands += [
+        (line, []) for block in re.findall(r"```sh\n(.*?)```", section, flags=re.S) for line in block.splitlines()
+    ]
+    tmp = tmp_path_factory.mktemp("tools")
+    (tmp / "metadata").mkdir()
+    packages = {
+        *_distribution_packages("mkdocs", tmp / "metadata"),
+        *_distribution_packages("matplotlib", tmp / "metadata"),
+    }
+    deps = tmp / "deps"
+    deps.mkdir()
+    site = Path(importlib.util.find_spec("serial").origin).parent.parent  # type: ignore[arg-type,union-attr]
+    for name in sorted({"yaml", "jinja2", "markupsafe", "construct", "serial", "shtab", "rich", *packages}):
+        source = next((p for p in (site / name, site / f"{name}.py") if p.exists()), None)
+        if source is not None:
+            (deps / source.name).symlink_to(source)
+    for info in (tmp / "metadata").iterdir():
+        (deps / info.name).symlink_to(info.resolve())
+    home = tmp / "home"
+    home.mkdir()
+    tools = User(home, _venv(tmp / "venv", deps))
+    _install(tools.python, wheels["serialspec"])
+    ran = []
+    for command, printed in commands:
+        words = shlex.split(command)
+        if words[0] != ".venv/bin/serialspec" or words[1] in ("scan", "replay", "watch", "completion"):
+            continue  # on a bus (tests/test_tools.py, test_watch.py, and above from the wheel), or an install step
+        for word in words[2:]:
+            # the captures and spec of one's own that the command names; never specs/: the wheel ships those
+            if word.startswith("examples/") and (ROOT / word).is_file() and not (home / word).exists():
+                (home / word).parent.mkdir(parents=True, exist_ok=True)
+                shutil.copy(ROOT / word, home / word)
+        result = tools.serialspec(*words[1:])
+        assert "Traceback" not in result.stderr, result.stderr
+        if printed:
+            assert (result.stdout + result.stderr).splitlines() == printed, command
+        ran.append(words[1])
+    assert sorted(ran) == ["docs", "export", "generate", "plot"]
+    assert (home / "build" / "angle.png").read_bytes().startswith(b"\x89PNG")
+    assert (home / "build" / "wireshark" / "fashionstar_uart" / "fashionstar_uart.lua").is_file()

@@ -15,7 +15,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("specs", nargs="*", metavar="SPEC", help="spec files (default: the project's specs)")
     parser.add_argument("--out", metavar="DIR", help="output folder (default: the project's, else generated/)")
     parser.add_argument(
-        "--root", type=Path, help="project root (default: the nearest folder with a [tool.serialspec] table or specs/)"
+        "--root",
+        type=Path,
+        metavar="DIR",
+        help="project root (default: the nearest folder with a [tool.serialspec] table or specs/)",
     )
 
 

@@ -4,11 +4,11 @@ and the search of serialspec's own site; mkdocs is the optional extra `serialspe
 from __future__ import annotations
 
 import argparse
-import importlib.resources
+import os
 from pathlib import Path
 from typing import Any
 
-from serialspec.cli.protocols import SHIPPED_SPEC, SPEC_HELP, open_spec
+from serialspec.cli.protocols import SHIPPED_SPEC, SPEC_HELP, open_spec, shipped_spec
 from serialspec.lang.model import Protocol
 from serialspec.runtime.errors import SerialspecError
 
@@ -43,6 +43,13 @@ def run(args: argparse.Namespace) -> int:
         {"Protocols": [{name: f"protocols/{name}.md"} for name in protocols]},
     ]
     out = Path(args.out).resolve()
+    try:  # a folder that cannot be written is said in one line here, not by mkdocs' traceback
+        out.mkdir(parents=True, exist_ok=True)
+        probe = out / f".serialspec-{os.getpid()}"
+        probe.touch()
+        probe.unlink()
+    except OSError as exc:
+        raise SerialspecError(f"cannot write the site to {args.out}: {exc.strerror or exc}") from None
     docsite.build(pages, nav, out, name=args.title, files=files)
     print(f"serialspec docs: {len(protocols)} protocol(s) in {args.out}: open {Path(args.out) / 'index.html'}")
     print("(search works from disk too; to serve the site instead: python -m http.server -d " + f"{args.out})")
@@ -50,11 +57,14 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _spec_file(spec: str, name: str) -> Path:
-    """The spec's file: the one given, or the copy an installed protocol package ships."""
+    """The spec's file: the one given, or the copy an installed protocol package ships (found without importing a
+    shipped protocol by its old, deprecated top-level name)."""
     if Path(spec).is_file():
         return Path(spec)
-    with importlib.resources.as_file(importlib.resources.files(name) / SHIPPED_SPEC) as shipped:
-        return Path(shipped)
+    shipped = shipped_spec(spec)
+    if shipped is None:  # open_spec found the package: it ships its spec
+        raise SerialspecError(f"{spec}: the package of protocol {name} ships no {SHIPPED_SPEC}")
+    return shipped
 
 
 def index(title: str, protocols: list[Protocol]) -> str:

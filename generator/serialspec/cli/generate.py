@@ -25,7 +25,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "generated/c/<protocol>/: C99 for firmware and hosts)",
     )
     parser.add_argument(
-        "--root", type=Path, help="project root (default: the nearest folder with a [tool.serialspec] table or specs/)"
+        "--root",
+        type=Path,
+        metavar="DIR",
+        help="project root (default: the nearest folder with a [tool.serialspec] table or specs/)",
     )
 
 

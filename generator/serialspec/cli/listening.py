@@ -9,22 +9,20 @@ from typing import Any
 
 import serial
 
-from serialspec.runtime.errors import PortError
-
 
 def open_port(url: str, baudrate: int | None, settings: Any, timeout: float) -> serial.Serial:
-    """A device path or pyserial URL opened with the spec's serial settings (`baudrate` over the spec's)."""
-    try:
-        return serial.serial_for_url(
-            url,
-            baudrate=baudrate or settings.baudrate,
-            bytesize=settings.bytesize,
-            parity={"none": "N", "even": "E", "odd": "O"}.get(settings.parity, "N"),
-            stopbits=settings.stopbits,
-            timeout=timeout,
-        )
-    except (serial.SerialException, OSError, ValueError) as exc:
-        raise PortError(f"cannot open {url}: {exc}") from None
+    """A device path or pyserial URL opened with the spec's serial settings (`baudrate` over the spec's); a failure
+    is a PortError with the reason in words, naming the setting the port refused if it was one."""
+    from serialspec.runtime.transport import _open_port
+
+    options = {
+        "baudrate": baudrate or settings.baudrate,
+        "bytesize": settings.bytesize,
+        "parity": {"none": "N", "even": "E", "odd": "O"}.get(settings.parity, "N"),
+        "stopbits": settings.stopbits,
+        "timeout": timeout,
+    }
+    return _open_port(url, options)  # type: ignore[no-any-return]
 
 
 class Stopping:

@@ -25,14 +25,14 @@ COLOURS = {"request": "\033[36m", "response": "\033[32m", "BAD": "\033[31m"}
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("spec", help=SPEC_HELP)
     parser.add_argument("--port", required=True, help="device path or pyserial URL (loop://, socket://, spy://...)")
-    parser.add_argument("--baudrate", type=int, help="default: the spec's")
+    parser.add_argument("--baudrate", type=int, metavar="N", help="default: the spec's")
     parser.add_argument(
         "--direction",
         choices=("request", "response"),
         help="only this direction (default: both; where they share a header, replies are paired with requests)",
     )
-    parser.add_argument("--duration", type=float, help="stop after this many seconds")
-    parser.add_argument("--count", type=int, help="stop after this many frames")
+    parser.add_argument("--duration", type=float, metavar="S", help="stop after this many seconds")
+    parser.add_argument("--count", type=int, metavar="N", help="stop after this many frames")
     parser.add_argument("--save", metavar="FILE", help="also write every chunk read to a capture file")
     parser.add_argument("--units", action="store_true", help="engineering units (with symbols) and enum names")
     parser.add_argument("--command", dest="commands", action="append", metavar="NAME", help="only this command")

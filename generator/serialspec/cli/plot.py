@@ -43,8 +43,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--out", required=True, metavar="FILE", help="the picture to write: FILE.png or FILE.svg")
     parser.add_argument("--spec", help=f"{SPEC_HELP} (default: the protocol the capture names)")
     parser.add_argument("--port", help="plot live from this port (device path or pyserial URL) instead of a capture")
-    parser.add_argument("--duration", type=float, default=10.0, help="with --port: seconds to record (default 10)")
-    parser.add_argument("--baudrate", type=int, help="with --port: default the spec's")
+    parser.add_argument(
+        "--duration", type=float, default=10.0, metavar="S", help="with --port: seconds to record (default 10)"
+    )
+    parser.add_argument("--baudrate", type=int, metavar="N", help="with --port: default the spec's")
     parser.add_argument("--id", dest="ids", type=int, action="append", metavar="N", help="only this device id")
 
 
@@ -122,18 +124,9 @@ def record(url: str, package: ModuleType, baudrate: int | None, duration: float)
     """What a port shows for `duration` seconds, as capture chunks (direction unknown: both are split by frames)."""
     import serial
 
-    settings = package.SERIAL
-    try:
-        port = serial.serial_for_url(
-            url,
-            baudrate=baudrate or settings.baudrate,
-            bytesize=settings.bytesize,
-            parity={"none": "N", "even": "E", "odd": "O"}.get(settings.parity, "N"),
-            stopbits=settings.stopbits,
-            timeout=0.1,
-        )
-    except (serial.SerialException, OSError, ValueError) as exc:
-        raise PortError(f"cannot open {url}: {exc}") from None
+    from serialspec.cli.listening import open_port
+
+    port = open_port(url, baudrate, package.SERIAL, 0.1)
     print(f"serialspec plot: recording {url} for {duration:g} s", file=sys.stderr, flush=True)
     chunks = []
     end = time.monotonic() + duration

@@ -11,7 +11,7 @@ PARITIES = {"none": "N", "even": "E", "odd": "O"}
 
 def add_arguments(parser: argparse.ArgumentParser, *, baudrate: bool = True) -> None:
     if baudrate:
-        parser.add_argument("--baudrate", type=int, help="default: the spec's")
+        parser.add_argument("--baudrate", type=int, metavar="N", help="default: the spec's")
     parser.add_argument("--parity", choices=tuple(PARITIES), help="default: the spec's")
     parser.add_argument("--stopbits", type=float, choices=(1, 1.5, 2), help="default: the spec's")
 

@@ -61,7 +61,20 @@ class Project:
         """A path as people read it: relative to the project root where possible."""
         if path.is_absolute() and path.is_relative_to(self.root):
             return os.path.relpath(path, self.root)
+        if path.name == SHIPPED_SPEC and (path.parent / "__init__.py").is_file():  # an installed package's spec
+            return f"{path.parent.name}/{SHIPPED_SPEC}"
         return str(path)
+
+
+def _spec_file(given: str) -> Path:
+    """A spec named on the command line: a file, or a generated protocol package's name (`fashionstar_uart`, the
+    shipped `serialspec_protocols.fashionstar_uart`), which stands for the spec the package ships."""
+    path = Path(given)
+    if not path.exists() and path.suffix not in (".yaml", ".yml"):
+        from serialspec.cli.protocols import shipped_spec
+
+        return (shipped_spec(given) or path).resolve()
+    return path.resolve()
 
 
 def find_root(start: Path | None = None) -> Path:
@@ -91,7 +104,7 @@ def project(root: Path | None, specs: Sequence[str] = (), out: str | None = None
     root = (root or find_root()).resolve()
     config = _config(root)
     if specs:
-        files = [Path(s).resolve() for s in specs]
+        files = [_spec_file(s) for s in specs]
     else:
         setting = config.get("specs", ["specs/*.yaml"])
         patterns = [setting] if isinstance(setting, str) else list(setting) if isinstance(setting, list) else []
@@ -152,7 +165,8 @@ def expected_files(
     made = []
     for spec in proj.specs:
         if not spec.is_file():
-            errors.append(SpecError(proj.display(spec), 1, 1, "", "no such spec file"))
+            also = "" if spec.suffix else ", nor a generated protocol package of that name"
+            errors.append(SpecError(proj.display(spec), 1, 1, "", f"no such spec file{also}"))
             continue
         try:
             outputs = spec_outputs(spec, proj.display(spec), with_data=proj.reference is not None)

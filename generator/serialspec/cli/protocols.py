@@ -134,6 +134,25 @@ def installed(name: str) -> tuple[Protocol, ModuleType]:
     return resolved(str(shipped), f"{name}/{SHIPPED_SPEC}", data), package
 
 
+def shipped_spec(name: str) -> Path | None:
+    """The spec a generated protocol package NAME ships (found as `installed` finds the package, without importing
+    it), for the verbs that read spec files (`generate`, `docs`); None when there is no such package."""
+    if not name.isidentifier():
+        return None
+    here = str(Path.cwd())
+    sys.path.insert(0, here)
+    try:
+        found = importlib.util.find_spec(_import_name(name))
+    except (ImportError, ValueError):
+        found = None
+    finally:
+        sys.path.remove(here)
+    if found is None or not found.submodule_search_locations:
+        return None
+    shipped = Path(next(iter(found.submodule_search_locations)), SHIPPED_SPEC)
+    return shipped if shipped.is_file() else None
+
+
 def _import_name(name: str) -> str:
     """The name to import a protocol's package by (the current folder is on the path): the folder's own package,
     else the shipped one under its namespace (not the old top-level alias, which warns), else NAME as it is."""

@@ -31,6 +31,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--speed",
         type=float,
+        metavar="X",
         default=1.0,
         help="time scale: 2 plays twice as fast, 0.5 at half speed, 0 with no pauses (default: 1, as captured)",
     )

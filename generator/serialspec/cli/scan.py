@@ -3,9 +3,9 @@
 For each baud rate (the spec's default; `--baudrate` given several times; `--all-baudrates`: the spec's
 `serial.baudrates`) every id of the range gets the presence request and a short wait for a reply; any reply from
 that id, an error reply too, is a device. Where every device answers the request sent to the broadcast id
-(`presence.broadcast`: DYNAMIXEL's broadcast PING), one request finds them all and the ids are asked one by one only
-when none answers. The model is then read where the spec says (a reply field, or a register read by another
-request) and named from `device.models`.
+(`presence.broadcast`: DYNAMIXEL's broadcast PING), one request finds them all; the ids are asked one by one only
+when bytes came back that made no reply (replies that collided), never after silence. The model is then read where
+the spec says (a reply field, or a register read by another request) and named from `device.models`.
 """
 
 from __future__ import annotations
@@ -52,6 +52,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--timeout",
         type=float,
+        metavar="S",
         help=f"seconds to wait for each id's reply (default: the time 64 characters take at the rate + {SLACK} s)",
     )
     parser.add_argument("--json", action="store_true", help="one JSON object per device found")
@@ -155,12 +156,16 @@ class Scanner:
                 yield Found(None, rate, self.model(port, None, reply, wait))
             return
         found: dict[int, Message] = {}
+        heard = True
         broadcast = self.protocol.device.broadcast if self.protocol.device else None
         if presence.broadcast and broadcast is not None:
-            found = self.everyone(port, self.frame(self.request, presence.fields, broadcast), set(ids), wait, len(ids))
+            request = self.frame(self.request, presence.fields, broadcast)
+            found, heard = self.everyone(port, request, set(ids), wait, len(ids))
         for device in sorted(found):
             yield Found(device, rate, self.model(port, device, found[device], wait))
-        if not found:  # no answer to the broadcast (or none to send): each id in turn
+        # Each id in turn where there is no broadcast, or where bytes came back that made no reply (replies that
+        # collided, devices at another rate); a silent line after a broadcast every device answers has nobody on it.
+        if not found and heard:
             for number, device in enumerate(ids):
                 if progress is not None:
                     progress.step(rate, number)
@@ -186,22 +191,28 @@ class Scanner:
                     return message
         return None
 
-    def everyone(self, port: Any, frame: bytes, ids: set[int], wait: float, most: int) -> dict[int, Message]:
-        """The replies to a broadcast request, each device in turn: read until `wait` passes without one."""
+    def everyone(
+        self, port: Any, frame: bytes, ids: set[int], wait: float, most: int
+    ) -> tuple[dict[int, Message], bool]:
+        """The replies to a broadcast request, each device in turn: read until `wait` passes without one; and
+        whether any byte came at all."""
         parser = self.parser(self.reply)
         if self.gap:
             time.sleep(self.gap)
         port.reset_input_buffer()
         port.write(frame)
         found: dict[int, Message] = {}
+        heard = False
         deadline = time.monotonic() + wait
         while (left := deadline - time.monotonic()) > 0 and len(found) < most:
-            for message in parser.feed(self.read(port, left)):
+            data = self.read(port, left)
+            heard = heard or bool(data)
+            for message in parser.feed(data):
                 device = getattr(message, self.presence.id_field, None)
                 if message.DIRECTION == Direction.RESPONSE and device in ids:
                     found[device] = message
                     deadline = time.monotonic() + wait  # the next device answers after this one
-        return found
+        return found, heard
 
     def model(self, port: Any, device: int | None, reply: Message, wait: float) -> str | int | None:
         presence = self.presence

@@ -45,6 +45,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         action="store_true",
         help="echo every byte received before answering, like a one-wire half-duplex adapter (clients: echo=True)",
     )
+    parser.add_argument(
+        "--baudrate",
+        type=int,
+        metavar="N",
+        help="answer only while the client has set the line to N baud, like devices set to that rate (they hear "
+        "noise at any other: `serialspec scan --all-baudrates` finds them at N alone); default: at any rate",
+    )
     parser.add_argument("--quiet", action="store_true", help="do not log requests and replies on stderr")
     parser.add_argument("--tap", metavar="FILE", help="record both directions of the session to a capture file")
 
@@ -104,6 +111,9 @@ def run(args: argparse.Namespace) -> int:
         raise SerialspecError(f"{args.spec} has no `device:` section, so no simulator is generated")
     simulator = _text_device(args, module) if protocol.text is not None else _bus(args, protocol, module)
     simulator.echo = args.echo
+    if args.baudrate is not None and args.baudrate <= 0:
+        raise SerialspecError(f"--baudrate {args.baudrate}: give a positive number of bits per second")
+    simulator.baudrate = args.baudrate
     tap = None
     if args.tap:
         try:
@@ -135,7 +145,8 @@ def run(args: argparse.Namespace) -> int:
     signal.signal(signal.SIGTERM, stop)
     print(path, flush=True)
     shown = "device" if protocol.text is not None else served(protocol, simulator.devices)
-    print(f"serialspec sim: {protocol.name} {shown} on {path}; Ctrl-C to stop", file=sys.stderr, flush=True)
+    rate = f" at {args.baudrate} baud" if args.baudrate else ""
+    print(f"serialspec sim: {protocol.name} {shown} on {path}{rate}; Ctrl-C to stop", file=sys.stderr, flush=True)
     try:
         simulator.serve(controller)
     finally:

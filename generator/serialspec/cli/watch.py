@@ -46,8 +46,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     source.add_argument(
         "--tap", metavar="FILE", help="follow a capture file as it grows (serialspec sim --tap FILE, monitor --save)"
     )
-    parser.add_argument("--baudrate", type=int, help="default: the spec's")
-    parser.add_argument("--duration", type=float, help="stop after this many seconds (default: Ctrl-C)")
+    parser.add_argument("--baudrate", type=int, metavar="N", help="default: the spec's")
+    parser.add_argument("--duration", type=float, metavar="S", help="stop after this many seconds (default: Ctrl-C)")
     parser.add_argument("--raw", action="store_true", help="wire values, not engineering units and enum names")
 
 

@@ -920,6 +920,11 @@ def _gap_seconds(characters: float, port: Any) -> float:
 
 
 def _reason(exc: BaseException) -> str:
+    """Why a port failed, in words: the system's reason alone where there is one (pyserial's own message repeats the
+    path and the errno twice: `[Errno 2] could not open port X: [Errno 2] No such file or directory: 'X'`)."""
+    number = getattr(exc, "errno", None)
+    if isinstance(exc, OSError) and isinstance(number, int) and number > 0:
+        return os.strerror(number)
     return str(exc) or type(exc).__name__
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import heapq
 import os
 import select
+import sys
 import threading
 import time
 import tty
@@ -15,6 +16,30 @@ from dataclasses import dataclass, field
 from serialspec.runtime.device.engine import DeviceSpec, Engine
 from serialspec.runtime.message import Message
 from serialspec.runtime.stream import StreamParser
+
+_TCGETS2 = 0x802C542A  # Linux: the termios with the line's speeds in bits per second (what pyserial sets)
+
+
+def line_rate(fd: int) -> int | None:
+    """The baud rate a terminal's line is set to (on a pseudo-terminal, by its client); None where unknown."""
+    if sys.platform.startswith("linux"):
+        import array
+        import fcntl
+
+        buf = array.array("i", [0] * 64)  # struct termios2 (44 bytes on Linux), room to spare
+        try:
+            fcntl.ioctl(fd, _TCGETS2, buf)
+        except OSError:
+            return None
+        return buf[10]  # c_ospeed
+    import termios
+
+    try:
+        speed = termios.tcgetattr(fd)[5]
+    except termios.error:
+        return None
+    rates = {getattr(termios, name): int(name[1:]) for name in dir(termios) if name[1:].isdigit() and name[0] == "B"}
+    return rates.get(speed)
 
 
 @dataclass(order=True)
@@ -49,6 +74,9 @@ class Simulator(Engine):
         self._released = False  # close() has closed the pseudo-terminal and the wake-up pipe
         # Like a one-wire half-duplex adapter: every byte the client sends comes back to it before any reply.
         self.echo = False
+        # A device set to one baud rate: bytes that come while the line is set to another are noise to it, so they
+        # are dropped (what the pseudo-terminal's client set with tcsetattr; None: every rate is heard).
+        self.baudrate: int | None = None
         # Called with ("request", bytes read) and ("response", bytes written) as they cross the pseudo-terminal:
         # replies, reports sent on the device's own (`device.sends`) and emit()ted frames alike (`sim --tap`).
         self.tap: Callable[[str, bytes], None] | None = None
@@ -96,6 +124,8 @@ class Simulator(Engine):
                     self.tap("request", data)
                 if self.echo:
                     os.write(fd, data)
+                if self.baudrate is not None and line_rate(getattr(self, "_device_fd", fd)) != self.baudrate:
+                    continue  # sent at another rate: noise to the device, which answers nothing
                 for when, frame in self.feed(data):
                     self._seq += 1
                     heapq.heappush(self._outbox, _Scheduled(when, self._seq, frame))

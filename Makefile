@@ -114,7 +114,7 @@ bench: $(BENCH_STAMP) bench-tools
 
 # The C target's two tables alone (flash and RAM on Cortex-M0+, parse throughput), replaced in bench/results.md.
 bench-c: $(STAMP) bench-tools
-	$(BIN)/python -m bench.run c-size c-speed
+	$(BIN)/python -m bench.run c-size c-groups c-speed
 
 # The documentation site in site/: README, tutorial, language reference and every protocol's reference (mkdocs, strict).
 docs: $(STAMP)

@@ -90,6 +90,60 @@ def sizes() -> Table:
     return Table("C target: flash and RAM on Cortex-M0+", header, rows, notes)
 
 
+#: function groups by the name a symbol has after the protocol's prefix (`p_` or `p__`); the first that matches
+GROUPS = (
+    ("encoders", ("encode", "enc_", "wrap", "put", "l_", "layouts")),
+    ("decoders", ("decode", "dec_", "unwrap", "get", "copy", "utf8", "same")),
+    ("stream parser", ("parser", "scan", "front", "size", "probe", "frame", "drop", "push", "move", "rule")),
+    ("names", ("kind_name", "result_name", "names.")),
+)
+
+
+def _group(symbol: str, prefix: str) -> str:
+    name = symbol.removeprefix(prefix).lstrip("_")
+    for group, starts in GROUPS:
+        if name.startswith(starts):
+            return group
+    return "checksums and the rest"  # the public checksum functions, their tables, other helpers
+
+
+def _groups(name: str, compiler: list[str], nm: str, folder: Path) -> list[int]:
+    """Bytes per function group of <name>.c compiled alone at -Os (every function and table, nothing linked: a
+    static helper the compiler inlines counts in its callers)."""
+    obj = folder / f"{name}.o"
+    subprocess.run([*compiler, "-c", str(GENERATED / name / f"{name}.c"), "-o", str(obj)], check=True)
+    listing = subprocess.run([nm, "-S", "--size-sort", "--radix=d", str(obj)], check=True, capture_output=True)
+    sizes = dict.fromkeys([g for g, _ in GROUPS] + ["checksums and the rest"], 0)
+    for line in listing.stdout.decode().splitlines():
+        _, size, _, symbol = line.split()
+        sizes[_group(symbol, name)] += int(size)
+    return list(sizes.values())
+
+
+def groups() -> Table:
+    """Flash per function group at -Os: the host's gcc and, where installed, arm-none-eabi-gcc for Cortex-M0+."""
+    targets = [("host gcc -Os", ["gcc", "-std=c99", "-Os", "-ffunction-sections", "-fdata-sections"], "nm")]
+    notes = [
+        "Each protocol's `<p>.c` compiled alone with every switch on (`-Os -ffunction-sections -fdata-sections`), its "
+        "symbols' sizes from `nm -S` summed by the name after the protocol's prefix (bench/c_target.py GROUPS): a "
+        "static helper the compiler inlines counts in its callers, a table in what reads it (the layout tables in "
+        "encoders: the frame engine encodes from them). Nothing is linked: a firmware's flash is the c-size table's.",
+        "Reproduce: `make bench-c` (or `.venv/bin/python -m bench.run c-groups`).",
+    ]
+    if shutil.which("arm-none-eabi-gcc") is None:
+        notes.insert(0, "arm-none-eabi-gcc is not installed here: host figures only.")
+    else:
+        targets.append(("Cortex-M0+ -Os", ["arm-none-eabi-gcc", *ARM], "arm-none-eabi-nm"))
+    rows: list[list[str]] = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for name in PROTOCOLS:
+            for target, compiler, nm in targets:
+                sizes = _groups(name, compiler, nm, Path(tmp))
+                rows.append([name, target, *map(str, sizes), str(sum(sizes))])
+    header = ["protocol", "target", *(f"{g} (B)" for g, _ in GROUPS), "checksums and the rest (B)", "total (B)"]
+    return Table("C target: flash per function group", header, rows, notes)
+
+
 def _stream(name: str, kind: str) -> tuple[bytes, str]:
     """About 256 kB of one direction's frames: the spec's examples end to end (clean), 10% with a byte changed
     (corrupt), or nothing but the first header byte (adversarial)."""

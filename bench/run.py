@@ -27,6 +27,7 @@ FAMILIES: dict[str, Callable[[], Table]] = {
     "generation": generation.run,
     "startup": startup.run,
     "c-size": c_target.sizes,
+    "c-groups": c_target.groups,
     "c-speed": c_target.throughput,
 }
 

@@ -441,7 +441,6 @@ class Built:
 C_REFUSES = {
     "frame: checksums inside their span, a checksum of a checksum": "over a span that leaves out",
     "frame: ended by a terminator, no length": "ended by its trailer alone",
-    "frame: truncate: trailing_zeros": "a truncated content (truncate: trailing_zeros)",
     "transform: replace, escaping after the start byte, over the length and checksum (XBee API mode 2)": (
         "a length inside the transformed span"
     ),

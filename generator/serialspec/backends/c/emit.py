@@ -209,8 +209,6 @@ def refuse_layout(layout: FrameLayout) -> None:
     for e in elements:
         if e.type is not None and (e.type.size > 4 or e.type.signed or e.type.is_float):
             raise Unsupported(f"{where}: element {e.name} of type {e.type.name}")
-    if layout.truncates:
-        raise Unsupported(f"{where}: a truncated content (truncate: trailing_zeros)")
     t = layout.transparency
     if t is not None and t.transform.c_refusal():
         raise Unsupported(f"{where}: {t.transform.c_refusal()}")
@@ -764,6 +762,21 @@ def decoder(ctx: Ctx, message: Message) -> str:
         if low
         else "    (void)n;"
     )
+    if message.padded is not None:  # sent without its trailing zero bytes: padded back to its one size
+        full = message.padded
+        locals_.append(f"    uint8_t z[{full}u];")
+        size_check = "\n".join(
+            [
+                f"    if (n < {full}u) {{ /* truncate: trailing_zeros: the bytes not sent are zeros */",
+                "        for (o = 0u; o < n; o++) { z[o] = c[o]; }",
+                f"        for (; o < {full}u; o++) {{ z[o] = 0u; }}",
+                "        c = z;",
+                f"        n = {full}u;",
+                "        o = 0u;",
+                "    }",
+                f"    if (n != {full}u) {{ return {ctx.P}_E_LENGTH; }}",
+            ]
+        )
     return "\n".join(
         [
             f"/* The content of {message.key} ({message.direction.value}): fields in wire order. */",
@@ -1091,11 +1104,27 @@ def encoder(ctx: Ctx, message: Message) -> str:
             locals_.append(f"    int64_t v1_{ident(f.name)};")
     if any(isinstance(f, List) and f.item is None for f in message.fields):
         locals_.append("    size_t len;")
+    parameters, ending = "uint8_t *c, size_t cap", ["    *n = o;"]
+    if message.padded is not None:  # made whole in z, sent without its trailing zero bytes (at least one)
+        full = message.padded
+        parameters = "uint8_t *out, size_t room"
+        locals_ += [f"    uint8_t z[{full}u];", "    uint8_t *c = z;", f"    const size_t cap = {full}u;"]
+        ending = [
+            "    while (o > 1u && z[o - 1u] == 0u) { /* truncate: trailing_zeros */",
+            "        o--;",
+            "    }",
+            f"    if (o > room) {{ return {ctx.P}_E_BUFFER; }}",
+            "    *n = o;",
+            "    while (o > 0u) {",
+            "        o--;",
+            "        out[o] = z[o];",
+            "    }",
+        ]
     return "\n".join(
         [
             f"/* The content of {message.key} ({message.direction.value}): every value checked against the spec's",
             " * range before a byte is written, then the fields in wire order. */",
-            f"static int {ctx.p}__enc_{mid}(const void *mv, uint8_t *c, size_t cap, size_t *n)",
+            f"static int {ctx.p}__enc_{mid}(const void *mv, {parameters}, size_t *n)",
             "{",
             f"    const {ctx.p}_{mid}_t *m = (const {ctx.p}_{mid}_t *)mv;",
             *locals_,
@@ -1105,7 +1134,7 @@ def encoder(ctx: Ctx, message: Message) -> str:
             *checks,
             *derived,
             *body,
-            "    *n = o;",
+            *ending,
             f"    return {ctx.P}_OK;",
             "}",
             "",
@@ -1259,6 +1288,13 @@ def spec_hash(protocol: Protocol) -> str:
 
 
 def files(protocol: Protocol) -> dict[str, str]:
+    from serialspec.backends.c.readme import readme
+
+    written = _files(protocol)
+    return {**written, f"{protocol.name}/README.md": readme(protocol, written)}
+
+
+def _files(protocol: Protocol) -> dict[str, str]:
     if protocol.text is not None:  # a text protocol: backends/c/text.py
         from serialspec.backends.c import text
 

@@ -433,6 +433,7 @@ class FieldResolver(Pass):
             status_ok=self.status_ok(spec.get("status"), scalar, low, high, (*path, "status")),
             value=self.derived_value(spec, scalar, path),
             offset=spec.get("offset"),
+            value_at=self.doc.where((*path, "value")),
         )
 
     def derived_value(self, spec: dict[str, Any], scalar: ScalarType, path: Path) -> expression.Expr | None:

@@ -39,8 +39,9 @@ def valued(name: str, shown: str, compute: Callable[[Any], int]) -> Callable[[An
 
 class Rebuilt(Rebuild):  # type: ignore[misc, type-arg, unused-ignore]
     """construct's Rebuild of a value encode computes (a count, a size, a `value:` expression), as the codec treats
-    it: a value given for it on build is refused unless it is the computed one (never silently replaced), and on
-    parse a value outside the field's declared range (`low`..`high`, narrower than its type's) is refused."""
+    it: a value given for it on build is refused unless it is the computed one (never silently replaced), and a
+    value outside the field's declared range (`low`..`high`, narrower than its type's) is refused on build and on
+    parse."""
 
     def __init__(self, subcon: Any, func: Any, low: int | None = None, high: int | None = None) -> None:
         super().__init__(subcon, func)
@@ -57,6 +58,8 @@ class Rebuilt(Rebuild):  # type: ignore[misc, type-arg, unused-ignore]
         computed = evaluate(self.func, context)
         if obj is not None and obj != computed:
             raise ExplicitError(f"{path}: given as {obj}, but it is computed: {computed} (leave it out)")
+        if self.low is not None and self.high is not None and not self.low <= computed <= self.high:
+            raise ExplicitError(f"{path}: {computed} is outside its range {self.low}..{self.high}")
         subcon: Any = self.subcon
         return subcon._build(computed, stream, context, path)
 

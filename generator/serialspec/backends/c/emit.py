@@ -823,9 +823,11 @@ def value_checks(ctx: Ctx, fields: tuple[Field, ...], scope: Scope) -> list[str]
             computed = render_c(f.value, scope.lookup, length, math)
             for condition in no_value(f.value, scope.lookup, length, math):
                 lines.append(f"    if ({condition}) {{ return {ctx.P}_E_CONTENT; }} /* {f.name}: no value */")
-            lines.append(
-                f"    if ((int64_t){scope.lookup(f.name)} != {computed}) {{ return {ctx.P}_E_CONTENT; }} /* {f.name} */"
-            )
+            held = scope.lookup(f.name)
+            differs = f"(int64_t){held} != {computed}"
+            if f.type.size == 8 and not f.type.signed:  # above INT64_MAX it is no int64_t; a negative value no u64
+                differs = f"{computed} < 0 || {held} != (uint64_t){computed}"
+            lines.append(f"    if ({differs}) {{ return {ctx.P}_E_CONTENT; }} /* {f.name} */")
     return lines
 
 
@@ -1164,10 +1166,11 @@ def computed_values(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list
             for condition in no_value(f.value, scope.lookup, length, math):  # a division by a 0 given: refused
                 out.append(f"    if ({condition}) {{ return {ctx.P}_E_RANGE; }} /* {f.name}: no value */")
             out.append(f"    {local} = {computed};")
-            out.append(
-                f"    if ({local} < {int(f.minimum)}LL || {local} > {int(f.maximum)}LL) "
-                f"{{ return {ctx.P}_E_RANGE; }} /* {f.name} */"
-            )
+            # int64_t holds the value: a bound beyond it (u64's top, i64's ends) is no test, and no literal
+            tests = [f"{local} < {int(f.minimum)}LL"] if f.minimum > INT64[0] else []
+            tests += [f"{local} > {int(f.maximum)}LL"] if f.maximum < INT64[1] else []
+            if tests:
+                out.append(f"    if ({' || '.join(tests)}) {{ return {ctx.P}_E_RANGE; }} /* {f.name} */")
             scope.names[f.name] = local
 
 

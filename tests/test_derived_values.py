@@ -36,7 +36,7 @@ from serialspec.lang.model import Direction, Message, Scalar
 from serialspec.lang.resolve import resolve
 from serialspec.runtime.errors import DecodeError, EncodeError
 from strategies import message_fields
-from test_c_backend import GCC, Driver, c_decode
+from test_c_backend import FLAGS, GCC, Driver, c_decode
 from test_codec import message_type
 
 MODBUS = next(g for g in ALL if g.protocol.name == "modbus_rtu")
@@ -209,6 +209,9 @@ EXPRESSIONS = [
     ("min(a, b) / max(b, 1) + ceil(a / 4)", "i8", "i64"),
     # a u64 field: a negative result is no u64 value, whatever its 8 bytes read as in two's complement
     ("a - b", "i8", "u64"),
+    # signed fields narrower than 64 bits: C compares their value, not their wire bits
+    ("a % b", "i8", "i8"),
+    ("b - a / 256", "i8", "i16"),
 ]
 
 
@@ -223,6 +226,10 @@ def test_c_computes_every_expression_as_python_does(value: str, b_type: str, che
     source.mkdir()
     for path, text in c_files(protocol).items():
         (source / Path(path).name).write_text(text, encoding="utf-8")
+    for name in (f"{protocol.name}.c", f"{protocol.name}_json.c"):  # the helpers compile warning-free too
+        strict = [GCC, *FLAGS, "-O2", "-c", str(source / name), "-o", str(tmp_path / "x.o")]
+        compiled = subprocess.run(strict, capture_output=True, text=True)
+        assert compiled.returncode == 0, compiled.stderr
     run = Driver(protocol.name, source, tmp_path)
     b_range = (-128, 127) if b_type == "i8" else (0, 255)
     try:

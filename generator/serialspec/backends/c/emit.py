@@ -469,7 +469,9 @@ def read_scalar(ctx: Ctx, t: ScalarType, endian: str, at: str) -> str:
 
 
 def hidden_type(f: Scalar) -> str:
-    """The local holding a hidden value's wire bits while decoding."""
+    """The local holding a hidden value's wire bits while decoding (a signed one's value)."""
+    if f.type.signed:
+        return "int64_t" if wide(f.type) else "int32_t"
     return "uint64_t" if wide(f.type) else "uint32_t"
 
 
@@ -483,7 +485,10 @@ def decode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
             case Scalar():
                 size = f.type.size
                 out.append(f"{pad}if (n - o < {size}u) {{ return {ctx.P}_E_LENGTH; }}")
-                value = read_scalar(ctx, f.type, f.endian, "c + o")
+                # a hidden value keeps its wire bits, a signed one its value (as Python compares it); a constant
+                # only its bits: no helper is written that nothing calls
+                needs_value = f.const is None and (not f.hidden or f.type.signed) and not f.sign_magnitude
+                value = read_scalar(ctx, f.type, f.endian, "c + o") if needs_value else ""
                 if f.sign_magnitude:  # the top bit is the sign, the rest the magnitude
                     top = 1 << (8 * size - 1)
                     raw = f"{ctx.p}__get(c + o, {size}u, {1 if f.endian == '>' else 0}u)"
@@ -496,7 +501,8 @@ def decode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                     )
                 elif f.hidden:
                     local = f"d{depth}_{name}"
-                    out.append(f"{pad}{local} = {get_raw(ctx, f.type, f.endian, 'c + o')};")
+                    read = value if f.type.signed else get_raw(ctx, f.type, f.endian, "c + o")
+                    out.append(f"{pad}{local} = {read};")
                     scope.names[f.name] = local
                 else:
                     out.append(f"{pad}{tgt} = {value};")
@@ -784,14 +790,16 @@ def no_value(expr: Expr, name: Callable[[str], str], length: Callable[[str], str
         case expression.BinOp():
             found = no_value(expr.left, name, length, math) + no_value(expr.right, name, length, math)
             right = render_c(expr.right, name, length, math)
-            if expr.op in ("/", "%") and not (isinstance(expr.right, expression.Const) and expr.right.value != 0):
+            low, high = math.span(expr.right)  # a test that cannot hold is left out (gcc: always false)
+            if expr.op in ("/", "%") and low <= 0 <= high:
                 found.append(f"{right} == 0")
-            if expr.op in ("<<", ">>") and not (isinstance(expr.right, expression.Const) and expr.right.value >= 0):
+            if expr.op in ("<<", ">>") and low < 0:
                 found.append(f"{right} < 0")
             return found
         case expression.Ceil():
             found = no_value(expr.numerator, name, length, math) + no_value(expr.denominator, name, length, math)
-            return [*found, f"{render_c(expr.denominator, name, length, math)} == 0"]
+            low, high = math.span(expr.denominator)
+            return [*found, f"{render_c(expr.denominator, name, length, math)} == 0"] if low <= 0 <= high else found
         case expression.Invert():
             return no_value(expr.operand, name, length, math)
         case expression.MinMax():

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define MAVLINK_COMMON_SPEC_SHA256 "1687836e314f9a1724f2dd9472909091fa0792ccbf4b760df340149d10d98db8"
+#define MAVLINK_COMMON_SPEC_SHA256 "e92a177553b965ca2dfaf4a70c9845e557c938ef61d545c0eb365b2cd7f204fe"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef MAVLINK_COMMON_ENABLE_ENCODE

@@ -1010,7 +1010,7 @@ static int modbus_ascii__dec_read_coils_response(const uint8_t *c, size_t n, mod
     modbus_ascii__copy(m->coils, c + o, len);
     o += len;
     if (o != n) { return MODBUS_ASCII_E_LENGTH; }
-    if ((int64_t)d1_byte_count != (((int64_t)m->coils_count + (int64_t)8 - 1) / (int64_t)8)) { return MODBUS_ASCII_E_CONTENT; } /* byte_count */
+    if ((int64_t)d1_byte_count != ((int64_t)m->coils_count / (int64_t)8 + ((int64_t)m->coils_count % (int64_t)8 != 0))) { return MODBUS_ASCII_E_CONTENT; } /* byte_count */
     return MODBUS_ASCII_OK;
 }
 
@@ -1055,7 +1055,7 @@ static int modbus_ascii__dec_read_discrete_inputs_response(const uint8_t *c, siz
     modbus_ascii__copy(m->inputs, c + o, len);
     o += len;
     if (o != n) { return MODBUS_ASCII_E_LENGTH; }
-    if ((int64_t)d1_byte_count != (((int64_t)m->inputs_count + (int64_t)8 - 1) / (int64_t)8)) { return MODBUS_ASCII_E_CONTENT; } /* byte_count */
+    if ((int64_t)d1_byte_count != ((int64_t)m->inputs_count / (int64_t)8 + ((int64_t)m->inputs_count % (int64_t)8 != 0))) { return MODBUS_ASCII_E_CONTENT; } /* byte_count */
     return MODBUS_ASCII_OK;
 }
 
@@ -1264,8 +1264,9 @@ static int modbus_ascii__dec_write_coils_request(const uint8_t *c, size_t n, mod
     modbus_ascii__copy(m->values, c + o, len);
     o += len;
     if (o != n) { return MODBUS_ASCII_E_LENGTH; }
+    if ((uint64_t)d1_count < 1ULL || (uint64_t)d1_count > 1968ULL) { return MODBUS_ASCII_E_CONTENT; } /* count: out of its range */
     if ((int64_t)d1_count != (int64_t)m->values_count) { return MODBUS_ASCII_E_CONTENT; } /* count */
-    if ((int64_t)d1_byte_count != (((int64_t)d1_count + (int64_t)8 - 1) / (int64_t)8)) { return MODBUS_ASCII_E_CONTENT; } /* byte_count */
+    if ((int64_t)d1_byte_count != ((int64_t)d1_count / (int64_t)8 + ((int64_t)d1_count % (int64_t)8 != 0))) { return MODBUS_ASCII_E_CONTENT; } /* byte_count */
     return MODBUS_ASCII_OK;
 }
 
@@ -1322,6 +1323,7 @@ static int modbus_ascii__dec_write_registers_request(const uint8_t *c, size_t n,
     }
     o += len;
     if (o != n) { return MODBUS_ASCII_E_LENGTH; }
+    if ((uint64_t)d1_count < 1ULL || (uint64_t)d1_count > 123ULL) { return MODBUS_ASCII_E_CONTENT; } /* count: out of its range */
     if ((int64_t)d1_count != (int64_t)m->values_count) { return MODBUS_ASCII_E_CONTENT; } /* count */
     if ((int64_t)d1_byte_count != ((int64_t)2 * (int64_t)d1_count)) { return MODBUS_ASCII_E_CONTENT; } /* byte_count */
     return MODBUS_ASCII_OK;
@@ -1434,6 +1436,7 @@ static int modbus_ascii__dec_read_write_registers_request(const uint8_t *c, size
     }
     o += len;
     if (o != n) { return MODBUS_ASCII_E_LENGTH; }
+    if ((uint64_t)d1_write_count < 1ULL || (uint64_t)d1_write_count > 121ULL) { return MODBUS_ASCII_E_CONTENT; } /* write_count: out of its range */
     if ((int64_t)d1_write_count != (int64_t)m->values_count) { return MODBUS_ASCII_E_CONTENT; } /* write_count */
     if ((int64_t)d1_byte_count != ((int64_t)2 * (int64_t)d1_write_count)) { return MODBUS_ASCII_E_CONTENT; } /* byte_count */
     return MODBUS_ASCII_OK;
@@ -1650,7 +1653,7 @@ static int modbus_ascii__enc_read_coils_response(const void *mv, uint8_t *c, siz
     (void)c;
     (void)cap;
     if (m->coils_count > sizeof(m->coils) * 8u) { return MODBUS_ASCII_E_RANGE; } /* coils */
-    v1_byte_count = (((int64_t)m->coils_count + (int64_t)8 - 1) / (int64_t)8);
+    v1_byte_count = ((int64_t)m->coils_count / (int64_t)8 + ((int64_t)m->coils_count % (int64_t)8 != 0));
     if (v1_byte_count < 0LL || v1_byte_count > 255LL) { return MODBUS_ASCII_E_RANGE; } /* byte_count */
     if (cap - o < 1u) { return MODBUS_ASCII_E_BUFFER; }
     modbus_ascii__put(c + o, 1u, 1u, (uint32_t)v1_byte_count); /* byte_count */
@@ -1698,7 +1701,7 @@ static int modbus_ascii__enc_read_discrete_inputs_response(const void *mv, uint8
     (void)c;
     (void)cap;
     if (m->inputs_count > sizeof(m->inputs) * 8u) { return MODBUS_ASCII_E_RANGE; } /* inputs */
-    v1_byte_count = (((int64_t)m->inputs_count + (int64_t)8 - 1) / (int64_t)8);
+    v1_byte_count = ((int64_t)m->inputs_count / (int64_t)8 + ((int64_t)m->inputs_count % (int64_t)8 != 0));
     if (v1_byte_count < 0LL || v1_byte_count > 255LL) { return MODBUS_ASCII_E_RANGE; } /* byte_count */
     if (cap - o < 1u) { return MODBUS_ASCII_E_BUFFER; }
     modbus_ascii__put(c + o, 1u, 1u, (uint32_t)v1_byte_count); /* byte_count */
@@ -1899,7 +1902,7 @@ static int modbus_ascii__enc_write_coils_request(const void *mv, uint8_t *c, siz
     if (m->values_count > sizeof(m->values) * 8u) { return MODBUS_ASCII_E_RANGE; } /* values */
     v1_count = (int64_t)m->values_count;
     if (v1_count < 1LL || v1_count > 1968LL) { return MODBUS_ASCII_E_RANGE; } /* count */
-    v1_byte_count = (((int64_t)v1_count + (int64_t)8 - 1) / (int64_t)8);
+    v1_byte_count = ((int64_t)v1_count / (int64_t)8 + ((int64_t)v1_count % (int64_t)8 != 0));
     if (v1_byte_count < 0LL || v1_byte_count > 255LL) { return MODBUS_ASCII_E_RANGE; } /* byte_count */
     if (cap - o < 2u) { return MODBUS_ASCII_E_BUFFER; }
     modbus_ascii__put(c + o, 2u, 1u, (uint32_t)(m->address)); /* address */

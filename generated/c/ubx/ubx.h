@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define UBX_SPEC_SHA256 "89611b8c28828fe9ccbbe8508145ec6f6e08571b5b9ea6390f0404d57fecada9"
+#define UBX_SPEC_SHA256 "df1a2ad0448b2eaf9102c437b48a98ee2caf9e71747cd3cef2b7ef3523fea88b"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef UBX_ENABLE_ENCODE

@@ -8,6 +8,7 @@ from enum import IntEnum, IntFlag
 from typing import Any, ClassVar, Self
 
 from serialspec.runtime.fields import as_bytes as _bytes
+from serialspec.runtime.fields import check_given as _check_given
 from serialspec.runtime.fields import check_keys as _check_keys
 from serialspec.runtime.fields import enum as _as_enum
 from serialspec.runtime.fields import get as _get
@@ -696,10 +697,12 @@ class ClearRequest(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'clear request') -> Self:
         _check_keys(data, ('id', 'option'), ('key',), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'id', where), 'id', where),
             _as_enum(ClearOption, _get(data, 'option', where), 'option', where),
         )
+        _check_given(data, 'key', lambda: 575428676, where)
+        return m
 
 
 class SyncReadRequest(Message):

@@ -52,6 +52,7 @@ from serialspec.runtime.constructs import (  # noqa: F401
     PackedBits,
     PackedInts,
     PaddedUtf8,
+    Rebuilt,
     SignMagnitude,
     TrailingZeros,
     Utf8,
@@ -279,7 +280,7 @@ FastSyncReadRequestContent = Struct(
 
 SyncWriteRequestContent = Struct(
     'address' / Int16ul,
-    'length' / Rebuild(Int16ul, lambda ctx: _item_size(ctx, 'data')),
+    'length' / Rebuilt(Int16ul, lambda ctx: _item_size(ctx, 'data')),
     'servos' / GreedyRange(Struct('id' / Int8ub, 'data' / Bytes(this._.length))),
 )
 
@@ -288,7 +289,7 @@ BulkReadRequestContent = Struct(
 )
 
 BulkWriteRequestContent = Struct(
-    'writes' / GreedyRange(Struct('id' / Int8ub, 'address' / Int16ul, 'length' / Rebuild(Int16ul, lambda ctx: _item_size(ctx, 'data')), 'data' / Bytes(this.length))),
+    'writes' / GreedyRange(Struct('id' / Int8ub, 'address' / Int16ul, 'length' / Rebuilt(Int16ul, lambda ctx: _item_size(ctx, 'data')), 'data' / Bytes(this.length))),
 )
 
 StatusResponseContent = Struct(

@@ -8,6 +8,7 @@ from enum import IntEnum, IntFlag
 from typing import Any, ClassVar, Self
 
 from serialspec.runtime.fields import as_bytes as _bytes
+from serialspec.runtime.fields import check_given as _check_given
 from serialspec.runtime.fields import check_keys as _check_keys
 from serialspec.runtime.fields import enum as _as_enum
 from serialspec.runtime.fields import flags as _as_flags
@@ -1869,9 +1870,11 @@ class SetOriginPointRequest(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'set_origin_point request') -> Self:
         _check_keys(data, ('servo_id',), ('reserved',), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
+        _check_given(data, 'reserved', lambda: 0, where)
+        return m
 
 
 class StopOnControlModeRequest(Message):
@@ -1945,10 +1948,12 @@ class SyncCommandRequest(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'sync_command request') -> Self:
         _check_keys(data, ('command', 'blocks'), ('block_size', 'count'), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'command', where), 'command', where),
             tuple(BlocksItem.from_fields(_mapping(item, 'blocks', where), where) for item in _items(_get(data, 'blocks', where), 'blocks', where)),
         )
+        _check_given(data, 'count', lambda: len(m.blocks), where)
+        return m
 
 
 MESSAGE_TYPES: tuple[type[Message], ...] = (

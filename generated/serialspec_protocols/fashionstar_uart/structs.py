@@ -50,6 +50,7 @@ from serialspec.runtime.constructs import (  # noqa: F401
     PackedBits,
     PackedInts,
     PaddedUtf8,
+    Rebuilt,
     SignMagnitude,
     Utf8,
     derived,
@@ -346,8 +347,8 @@ StopOnControlModeRequestContent = Struct(
 
 SyncCommandRequestContent = Struct(
     'command' / Int8ub,
-    'block_size' / Rebuild(Int8ub, lambda ctx: _item_size(ctx, 'content')),
-    'count' / Rebuild(Int8ub, len_(this.blocks)),
+    'block_size' / Rebuilt(Int8ub, lambda ctx: _item_size(ctx, 'content')),
+    'count' / Rebuilt(Int8ub, len_(this.blocks)),
     'blocks' / Array(this.count, Struct('content' / Bytes(this._.block_size))),
 )
 

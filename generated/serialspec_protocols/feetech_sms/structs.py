@@ -50,6 +50,7 @@ from serialspec.runtime.constructs import (  # noqa: F401
     PackedBits,
     PackedInts,
     PaddedUtf8,
+    Rebuilt,
     SignMagnitude,
     Utf8,
     derived,
@@ -155,7 +156,7 @@ SyncReadRequestContent = Struct(
 
 SyncWriteRequestContent = Struct(
     'address' / Int8ub,
-    'data_length' / Rebuild(Int8ub, lambda ctx: _item_size(ctx, 'data')),
+    'data_length' / Rebuilt(Int8ub, lambda ctx: _item_size(ctx, 'data')),
     'servos' / GreedyRange(Struct('id' / Int8ub, 'data' / Bytes(this._.data_length))),
 )
 

@@ -8,6 +8,7 @@ from enum import IntEnum, IntFlag
 from typing import Any, ClassVar, Self
 
 from serialspec.runtime.fields import as_bytes as _bytes
+from serialspec.runtime.fields import check_given as _check_given
 from serialspec.runtime.fields import check_keys as _check_keys
 from serialspec.runtime.fields import enum as _as_enum
 from serialspec.runtime.fields import flags as _as_flags
@@ -487,10 +488,12 @@ class MotorSetSpeedRequest(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'motor.set_speed request') -> Self:
         _check_keys(data, ('motor_id', 'speed'), ('subcommand_code',), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'motor_id', where), 'motor_id', where),
             _number(_get(data, 'speed', where), 'speed', where),
         )
+        _check_given(data, 'subcommand_code', lambda: 0, where)
+        return m
 
 
 class MotorSetSpeedsRequest(Message):
@@ -519,9 +522,12 @@ class MotorSetSpeedsRequest(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'motor.set_speeds request') -> Self:
         _check_keys(data, ('motors',), ('subcommand_code', 'count'), where)
-        return cls(
+        m = cls(
             tuple(MotorsItem.from_fields(_mapping(item, 'motors', where), where) for item in _items(_get(data, 'motors', where), 'motors', where)),
         )
+        _check_given(data, 'subcommand_code', lambda: 1, where)
+        _check_given(data, 'count', lambda: len(m.motors), where)
+        return m
 
 
 class MotorStopRequest(Message):
@@ -550,9 +556,11 @@ class MotorStopRequest(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'motor.stop request') -> Self:
         _check_keys(data, ('motor_id',), ('subcommand_code',), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'motor_id', where), 'motor_id', where),
         )
+        _check_given(data, 'subcommand_code', lambda: 2, where)
+        return m
 
 
 class MotorSetDutiesRequest(Message):
@@ -581,9 +589,12 @@ class MotorSetDutiesRequest(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'motor.set_duties request') -> Self:
         _check_keys(data, ('duties',), ('subcommand_code', 'count'), where)
-        return cls(
+        m = cls(
             tuple(DutiesItem.from_fields(_mapping(item, 'duties', where), where) for item in _items(_get(data, 'duties', where), 'duties', where)),
         )
+        _check_given(data, 'subcommand_code', lambda: 5, where)
+        _check_given(data, 'count', lambda: len(m.duties), where)
+        return m
 
 
 class MotorStopMaskRequest(Message):
@@ -612,9 +623,11 @@ class MotorStopMaskRequest(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'motor.stop_mask request') -> Self:
         _check_keys(data, ('mask',), ('subcommand_code',), where)
-        return cls(
+        m = cls(
             _as_flags(MotorMask, _get(data, 'mask', where), 255, 'mask', where),
         )
+        _check_given(data, 'subcommand_code', lambda: 3, where)
+        return m
 
 
 class PwmServoSetPositionsRequest(Message):
@@ -647,10 +660,13 @@ class PwmServoSetPositionsRequest(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'pwm_servo.set_positions request') -> Self:
         _check_keys(data, ('duration', 'pwm_servos'), ('subcommand_code', 'count'), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'duration', where), 'duration', where),
             tuple(PwmServosItem.from_fields(_mapping(item, 'pwm_servos', where), where) for item in _items(_get(data, 'pwm_servos', where), 'pwm_servos', where)),
         )
+        _check_given(data, 'subcommand_code', lambda: 1, where)
+        _check_given(data, 'count', lambda: len(m.pwm_servos), where)
+        return m
 
 
 class PwmServoSetPositionRequest(Message):
@@ -687,11 +703,13 @@ class PwmServoSetPositionRequest(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'pwm_servo.set_position request') -> Self:
         _check_keys(data, ('duration', 'servo_id', 'pulse'), ('subcommand_code',), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'duration', where), 'duration', where),
             _integer(_get(data, 'servo_id', where), 'servo_id', where),
             _integer(_get(data, 'pulse', where), 'pulse', where),
         )
+        _check_given(data, 'subcommand_code', lambda: 3, where)
+        return m
 
 
 class PwmServoReadPositionRequest(Message):
@@ -720,9 +738,11 @@ class PwmServoReadPositionRequest(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'pwm_servo.read_position request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
+        _check_given(data, 'subcommand_code', lambda: 5, where)
+        return m
 
 
 class PwmServoReadPositionResponse(Message):
@@ -755,10 +775,12 @@ class PwmServoReadPositionResponse(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'pwm_servo.read_position response') -> Self:
         _check_keys(data, ('servo_id', 'pulse'), ('subcommand_code',), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'servo_id', where), 'servo_id', where),
             _integer(_get(data, 'pulse', where), 'pulse', where),
         )
+        _check_given(data, 'subcommand_code', lambda: 5, where)
+        return m
 
 
 class PwmServoSetOffsetRequest(Message):
@@ -791,10 +813,12 @@ class PwmServoSetOffsetRequest(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'pwm_servo.set_offset request') -> Self:
         _check_keys(data, ('servo_id', 'offset'), ('subcommand_code',), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'servo_id', where), 'servo_id', where),
             _integer(_get(data, 'offset', where), 'offset', where),
         )
+        _check_given(data, 'subcommand_code', lambda: 7, where)
+        return m
 
 
 class PwmServoReadOffsetRequest(Message):
@@ -823,9 +847,11 @@ class PwmServoReadOffsetRequest(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'pwm_servo.read_offset request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
+        _check_given(data, 'subcommand_code', lambda: 9, where)
+        return m
 
 
 class PwmServoReadOffsetResponse(Message):
@@ -858,10 +884,12 @@ class PwmServoReadOffsetResponse(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'pwm_servo.read_offset response') -> Self:
         _check_keys(data, ('servo_id', 'offset'), ('subcommand_code',), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'servo_id', where), 'servo_id', where),
             _integer(_get(data, 'offset', where), 'offset', where),
         )
+        _check_given(data, 'subcommand_code', lambda: 9, where)
+        return m
 
 
 class BusServoSetPositionsRequest(Message):
@@ -894,10 +922,13 @@ class BusServoSetPositionsRequest(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.set_positions request') -> Self:
         _check_keys(data, ('duration', 'bus_servos'), ('subcommand_code', 'count'), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'duration', where), 'duration', where),
             tuple(BusServosItem.from_fields(_mapping(item, 'bus_servos', where), where) for item in _items(_get(data, 'bus_servos', where), 'bus_servos', where)),
         )
+        _check_given(data, 'subcommand_code', lambda: 1, where)
+        _check_given(data, 'count', lambda: len(m.bus_servos), where)
+        return m
 
 
 class BusServoReadPositionRequest(Message):
@@ -926,9 +957,11 @@ class BusServoReadPositionRequest(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_position request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
+        _check_given(data, 'subcommand_code', lambda: 5, where)
+        return m
 
 
 class BusServoReadPositionResponse(Message):
@@ -965,11 +998,13 @@ class BusServoReadPositionResponse(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_position response') -> Self:
         _check_keys(data, ('servo_id', 'success', 'position'), ('subcommand_code',), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'servo_id', where), 'servo_id', where),
             _as_enum(ReadResult, _get(data, 'success', where), 'success', where),
             _integer(_get(data, 'position', where), 'position', where),
         )
+        _check_given(data, 'subcommand_code', lambda: 5, where)
+        return m
 
 
 class BusServoReadVoltageRequest(Message):
@@ -998,9 +1033,11 @@ class BusServoReadVoltageRequest(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_voltage request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
+        _check_given(data, 'subcommand_code', lambda: 7, where)
+        return m
 
 
 class BusServoReadVoltageResponse(Message):
@@ -1037,11 +1074,13 @@ class BusServoReadVoltageResponse(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_voltage response') -> Self:
         _check_keys(data, ('servo_id', 'success', 'voltage'), ('subcommand_code',), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'servo_id', where), 'servo_id', where),
             _as_enum(ReadResult, _get(data, 'success', where), 'success', where),
             _integer(_get(data, 'voltage', where), 'voltage', where),
         )
+        _check_given(data, 'subcommand_code', lambda: 7, where)
+        return m
 
 
 class BusServoReadTemperatureRequest(Message):
@@ -1070,9 +1109,11 @@ class BusServoReadTemperatureRequest(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_temperature request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
+        _check_given(data, 'subcommand_code', lambda: 9, where)
+        return m
 
 
 class BusServoReadTemperatureResponse(Message):
@@ -1109,11 +1150,13 @@ class BusServoReadTemperatureResponse(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_temperature response') -> Self:
         _check_keys(data, ('servo_id', 'success', 'temperature'), ('subcommand_code',), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'servo_id', where), 'servo_id', where),
             _as_enum(ReadResult, _get(data, 'success', where), 'success', where),
             _integer(_get(data, 'temperature', where), 'temperature', where),
         )
+        _check_given(data, 'subcommand_code', lambda: 9, where)
+        return m
 
 
 class BusServoStopRequest(Message):
@@ -1142,9 +1185,12 @@ class BusServoStopRequest(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.stop request') -> Self:
         _check_keys(data, ('servos',), ('subcommand_code', 'count'), where)
-        return cls(
+        m = cls(
             tuple(ServosItem.from_fields(_mapping(item, 'servos', where), where) for item in _items(_get(data, 'servos', where), 'servos', where)),
         )
+        _check_given(data, 'subcommand_code', lambda: 3, where)
+        _check_given(data, 'count', lambda: len(m.servos), where)
+        return m
 
 
 class BusServoReadTorqueRequest(Message):
@@ -1173,9 +1219,11 @@ class BusServoReadTorqueRequest(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_torque request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
+        _check_given(data, 'subcommand_code', lambda: 13, where)
+        return m
 
 
 class BusServoReadTorqueResponse(Message):
@@ -1212,11 +1260,13 @@ class BusServoReadTorqueResponse(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_torque response') -> Self:
         _check_keys(data, ('servo_id', 'success', 'torque'), ('subcommand_code',), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'servo_id', where), 'servo_id', where),
             _as_enum(ReadResult, _get(data, 'success', where), 'success', where),
             _integer(_get(data, 'torque', where), 'torque', where),
         )
+        _check_given(data, 'subcommand_code', lambda: 13, where)
+        return m
 
 
 class BusServoUnloadRequest(Message):
@@ -1245,9 +1295,11 @@ class BusServoUnloadRequest(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.unload request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
+        _check_given(data, 'subcommand_code', lambda: 11, where)
+        return m
 
 
 class BusServoLoadRequest(Message):
@@ -1276,9 +1328,11 @@ class BusServoLoadRequest(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.load request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
+        _check_given(data, 'subcommand_code', lambda: 12, where)
+        return m
 
 
 class BusServoSetIdRequest(Message):
@@ -1311,10 +1365,12 @@ class BusServoSetIdRequest(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.set_id request') -> Self:
         _check_keys(data, ('servo_id', 'new_id'), ('subcommand_code',), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'servo_id', where), 'servo_id', where),
             _integer(_get(data, 'new_id', where), 'new_id', where),
         )
+        _check_given(data, 'subcommand_code', lambda: 16, where)
+        return m
 
 
 class BusServoReadIdRequest(Message):
@@ -1343,9 +1399,11 @@ class BusServoReadIdRequest(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_id request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
-        return cls(
+        m = cls(
             _integer(data.get('servo_id', 254), 'servo_id', where),
         )
+        _check_given(data, 'subcommand_code', lambda: 18, where)
+        return m
 
 
 class BusServoReadIdResponse(Message):
@@ -1382,11 +1440,13 @@ class BusServoReadIdResponse(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_id response') -> Self:
         _check_keys(data, ('servo_id', 'success', 'id'), ('subcommand_code',), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'servo_id', where), 'servo_id', where),
             _as_enum(ReadResult, _get(data, 'success', where), 'success', where),
             _integer(_get(data, 'id', where), 'id', where),
         )
+        _check_given(data, 'subcommand_code', lambda: 18, where)
+        return m
 
 
 class BusServoSetOffsetRequest(Message):
@@ -1419,10 +1479,12 @@ class BusServoSetOffsetRequest(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.set_offset request') -> Self:
         _check_keys(data, ('servo_id', 'offset'), ('subcommand_code',), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'servo_id', where), 'servo_id', where),
             _integer(_get(data, 'offset', where), 'offset', where),
         )
+        _check_given(data, 'subcommand_code', lambda: 32, where)
+        return m
 
 
 class BusServoReadOffsetRequest(Message):
@@ -1451,9 +1513,11 @@ class BusServoReadOffsetRequest(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_offset request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
+        _check_given(data, 'subcommand_code', lambda: 34, where)
+        return m
 
 
 class BusServoReadOffsetResponse(Message):
@@ -1490,11 +1554,13 @@ class BusServoReadOffsetResponse(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_offset response') -> Self:
         _check_keys(data, ('servo_id', 'success', 'offset'), ('subcommand_code',), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'servo_id', where), 'servo_id', where),
             _as_enum(ReadResult, _get(data, 'success', where), 'success', where),
             _integer(_get(data, 'offset', where), 'offset', where),
         )
+        _check_given(data, 'subcommand_code', lambda: 34, where)
+        return m
 
 
 class BusServoSaveOffsetRequest(Message):
@@ -1523,9 +1589,11 @@ class BusServoSaveOffsetRequest(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.save_offset request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
+        _check_given(data, 'subcommand_code', lambda: 36, where)
+        return m
 
 
 class BusServoSetPositionLimitRequest(Message):
@@ -1562,11 +1630,13 @@ class BusServoSetPositionLimitRequest(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.set_position_limit request') -> Self:
         _check_keys(data, ('servo_id', 'low', 'high'), ('subcommand_code',), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'servo_id', where), 'servo_id', where),
             _integer(_get(data, 'low', where), 'low', where),
             _integer(_get(data, 'high', where), 'high', where),
         )
+        _check_given(data, 'subcommand_code', lambda: 48, where)
+        return m
 
 
 class BusServoReadPositionLimitRequest(Message):
@@ -1595,9 +1665,11 @@ class BusServoReadPositionLimitRequest(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_position_limit request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
+        _check_given(data, 'subcommand_code', lambda: 50, where)
+        return m
 
 
 class BusServoReadPositionLimitResponse(Message):
@@ -1638,12 +1710,14 @@ class BusServoReadPositionLimitResponse(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_position_limit response') -> Self:
         _check_keys(data, ('servo_id', 'success', 'low', 'high'), ('subcommand_code',), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'servo_id', where), 'servo_id', where),
             _as_enum(ReadResult, _get(data, 'success', where), 'success', where),
             _integer(_get(data, 'low', where), 'low', where),
             _integer(_get(data, 'high', where), 'high', where),
         )
+        _check_given(data, 'subcommand_code', lambda: 50, where)
+        return m
 
 
 class BusServoSetVoltageLimitRequest(Message):
@@ -1680,11 +1754,13 @@ class BusServoSetVoltageLimitRequest(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.set_voltage_limit request') -> Self:
         _check_keys(data, ('servo_id', 'low', 'high'), ('subcommand_code',), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'servo_id', where), 'servo_id', where),
             _integer(_get(data, 'low', where), 'low', where),
             _integer(_get(data, 'high', where), 'high', where),
         )
+        _check_given(data, 'subcommand_code', lambda: 52, where)
+        return m
 
 
 class BusServoReadVoltageLimitRequest(Message):
@@ -1713,9 +1789,11 @@ class BusServoReadVoltageLimitRequest(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_voltage_limit request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
+        _check_given(data, 'subcommand_code', lambda: 54, where)
+        return m
 
 
 class BusServoReadVoltageLimitResponse(Message):
@@ -1756,12 +1834,14 @@ class BusServoReadVoltageLimitResponse(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_voltage_limit response') -> Self:
         _check_keys(data, ('servo_id', 'success', 'low', 'high'), ('subcommand_code',), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'servo_id', where), 'servo_id', where),
             _as_enum(ReadResult, _get(data, 'success', where), 'success', where),
             _integer(_get(data, 'low', where), 'low', where),
             _integer(_get(data, 'high', where), 'high', where),
         )
+        _check_given(data, 'subcommand_code', lambda: 54, where)
+        return m
 
 
 class BusServoSetTemperatureLimitRequest(Message):
@@ -1794,10 +1874,12 @@ class BusServoSetTemperatureLimitRequest(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.set_temperature_limit request') -> Self:
         _check_keys(data, ('servo_id', 'limit'), ('subcommand_code',), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'servo_id', where), 'servo_id', where),
             _integer(_get(data, 'limit', where), 'limit', where),
         )
+        _check_given(data, 'subcommand_code', lambda: 56, where)
+        return m
 
 
 class BusServoReadTemperatureLimitRequest(Message):
@@ -1826,9 +1908,11 @@ class BusServoReadTemperatureLimitRequest(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_temperature_limit request') -> Self:
         _check_keys(data, ('servo_id',), ('subcommand_code',), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'servo_id', where), 'servo_id', where),
         )
+        _check_given(data, 'subcommand_code', lambda: 58, where)
+        return m
 
 
 class BusServoReadTemperatureLimitResponse(Message):
@@ -1865,11 +1949,13 @@ class BusServoReadTemperatureLimitResponse(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'bus_servo.read_temperature_limit response') -> Self:
         _check_keys(data, ('servo_id', 'success', 'limit'), ('subcommand_code',), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'servo_id', where), 'servo_id', where),
             _as_enum(ReadResult, _get(data, 'success', where), 'success', where),
             _integer(_get(data, 'limit', where), 'limit', where),
         )
+        _check_given(data, 'subcommand_code', lambda: 58, where)
+        return m
 
 
 class KeyResponse(Message):
@@ -2097,9 +2183,11 @@ class SystemBatteryResponse(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'system.battery response') -> Self:
         _check_keys(data, ('voltage',), ('subcommand_code',), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'voltage', where), 'voltage', where),
         )
+        _check_given(data, 'subcommand_code', lambda: 4, where)
+        return m
 
 
 class OledRequest(Message):
@@ -2132,10 +2220,12 @@ class OledRequest(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'oled request') -> Self:
         _check_keys(data, ('line', 'text'), ('length',), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'line', where), 'line', where),
             _bytes(_get(data, 'text', where), 'text', where),
         )
+        _check_given(data, 'length', lambda: len(m.text), where)
+        return m
 
 
 class RgbSetPixelsRequest(Message):
@@ -2164,9 +2254,12 @@ class RgbSetPixelsRequest(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'rgb.set_pixels request') -> Self:
         _check_keys(data, ('pixels',), ('subcommand_code', 'count'), where)
-        return cls(
+        m = cls(
             tuple(PixelsItem.from_fields(_mapping(item, 'pixels', where), where) for item in _items(_get(data, 'pixels', where), 'pixels', where)),
         )
+        _check_given(data, 'subcommand_code', lambda: 1, where)
+        _check_given(data, 'count', lambda: len(m.pixels), where)
+        return m
 
 
 MESSAGE_TYPES: tuple[type[Message], ...] = (

@@ -50,6 +50,7 @@ from serialspec.runtime.constructs import (  # noqa: F401
     PackedBits,
     PackedInts,
     PaddedUtf8,
+    Rebuilt,
     SignMagnitude,
     Utf8,
     derived,
@@ -94,7 +95,7 @@ MotorSetSpeedRequestContent = Struct(
 
 MotorSetSpeedsRequestContent = Struct(
     'subcommand_code' / Const(1, Int8ub),
-    'count' / Rebuild(Int8ub, len_(this.motors)),
+    'count' / Rebuilt(Int8ub, len_(this.motors)),
     'motors' / Array(this.count, Struct('motor_id' / Int8ub, 'speed' / Float32l)),
 )
 
@@ -105,7 +106,7 @@ MotorStopRequestContent = Struct(
 
 MotorSetDutiesRequestContent = Struct(
     'subcommand_code' / Const(5, Int8ub),
-    'count' / Rebuild(Int8ub, len_(this.duties)),
+    'count' / Rebuilt(Int8ub, len_(this.duties)),
     'duties' / Array(this.count, Struct('motor_id' / Int8ub, 'duty' / Float32l)),
 )
 
@@ -117,7 +118,7 @@ MotorStopMaskRequestContent = Struct(
 PwmServoSetPositionsRequestContent = Struct(
     'subcommand_code' / Const(1, Int8ub),
     'duration' / Int16ul,
-    'count' / Rebuild(Int8ub, len_(this.pwm_servos)),
+    'count' / Rebuilt(Int8ub, len_(this.pwm_servos)),
     'pwm_servos' / Array(this.count, Struct('servo_id' / Int8ub, 'pulse' / Int16ul)),
 )
 
@@ -159,7 +160,7 @@ PwmServoReadOffsetResponseContent = Struct(
 BusServoSetPositionsRequestContent = Struct(
     'subcommand_code' / Const(1, Int8ub),
     'duration' / Int16ul,
-    'count' / Rebuild(Int8ub, len_(this.bus_servos)),
+    'count' / Rebuilt(Int8ub, len_(this.bus_servos)),
     'bus_servos' / Array(this.count, Struct('servo_id' / Int8ub, 'position' / Int16ul)),
 )
 
@@ -201,7 +202,7 @@ BusServoReadTemperatureResponseContent = Struct(
 
 BusServoStopRequestContent = Struct(
     'subcommand_code' / Const(3, Int8ub),
-    'count' / Rebuild(Int8ub, len_(this.servos)),
+    'count' / Rebuilt(Int8ub, len_(this.servos)),
     'servos' / Array(this.count, Struct('servo_id' / Int8ub)),
 )
 
@@ -364,13 +365,13 @@ SystemBatteryResponseContent = Struct(
 
 OledRequestContent = Struct(
     'line' / Int8ub,
-    'length' / Rebuild(Int8ub, lambda ctx: _item_size(ctx, 'text')),
+    'length' / Rebuilt(Int8ub, lambda ctx: _item_size(ctx, 'text')),
     'text' / Bytes(this.length),
 )
 
 RgbSetPixelsRequestContent = Struct(
     'subcommand_code' / Const(1, Int8ub),
-    'count' / Rebuild(Int8ub, len_(this.pixels)),
+    'count' / Rebuilt(Int8ub, len_(this.pixels)),
     'pixels' / Array(this.count, Struct('index' / Int8ub, 'red' / Int8ub, 'green' / Int8ub, 'blue' / Int8ub)),
 )
 

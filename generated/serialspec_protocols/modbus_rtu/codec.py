@@ -202,6 +202,8 @@ def _decode_write_coils_request(buf: bytes, o: int, end: int, unit: int) -> Writ
     o += nb
     if o != end:
         raise DecodeError('write_coils request' + f': {end - o} bytes left after the last field')
+    if not 1 <= v_count <= 1968:
+        raise DecodeError('write_coils request' + f': count is {v_count}, outside its range 1..1968')
     if v_byte_count != (-(-v_count // 8)):
         raise DecodeError('write_coils request' + f': byte_count is {v_byte_count}, but ceil(count / 8) = {(-(-v_count // 8))}')
     return _new(WriteCoilsRequest, (unit, v_address, v_values))
@@ -227,6 +229,8 @@ def _decode_write_registers_request(buf: bytes, o: int, end: int, unit: int) -> 
     o += nb
     if o != end:
         raise DecodeError('write_registers request' + f': {end - o} bytes left after the last field')
+    if not 1 <= v_count <= 123:
+        raise DecodeError('write_registers request' + f': count is {v_count}, outside its range 1..123')
     if v_byte_count != (2 * v_count):
         raise DecodeError('write_registers request' + f': byte_count is {v_byte_count}, but 2 * count = {(2 * v_count)}')
     return _new(WriteRegistersRequest, (unit, v_address, v_values))
@@ -266,6 +270,8 @@ def _decode_read_write_registers_request(buf: bytes, o: int, end: int, unit: int
     o += nb
     if o != end:
         raise DecodeError('read_write_registers request' + f': {end - o} bytes left after the last field')
+    if not 1 <= v_write_count <= 121:
+        raise DecodeError('read_write_registers request' + f': write_count is {v_write_count}, outside its range 1..121')
     if v_byte_count != (2 * v_write_count):
         raise DecodeError('read_write_registers request' + f': byte_count is {v_byte_count}, but 2 * write_count = {(2 * v_write_count)}')
     return _new(ReadWriteRegistersRequest, (unit, v_read_address, v_read_count, v_write_address, v_values))

@@ -8,6 +8,7 @@ from enum import IntEnum
 from typing import Any, ClassVar, Self
 
 from serialspec.runtime.fields import bits as _bits
+from serialspec.runtime.fields import check_given as _check_given
 from serialspec.runtime.fields import check_keys as _check_keys
 from serialspec.runtime.fields import enum as _as_enum
 from serialspec.runtime.fields import get as _get
@@ -149,10 +150,12 @@ class ReadCoilsResponse(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'read_coils response') -> Self:
         _check_keys(data, ('unit', 'coils'), ('byte_count',), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'unit', where), 'unit', where),
             _bits(_get(data, 'coils', where), 'coils', where),
         )
+        _check_given(data, 'byte_count', lambda: (-(-len(m.coils) // 8)), where)
+        return m
 
 
 class ReadDiscreteInputsRequest(Message):
@@ -226,10 +229,12 @@ class ReadDiscreteInputsResponse(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'read_discrete_inputs response') -> Self:
         _check_keys(data, ('unit', 'inputs'), ('byte_count',), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'unit', where), 'unit', where),
             _bits(_get(data, 'inputs', where), 'inputs', where),
         )
+        _check_given(data, 'byte_count', lambda: (-(-len(m.inputs) // 8)), where)
+        return m
 
 
 class ReadHoldingRegistersRequest(Message):
@@ -303,10 +308,12 @@ class ReadHoldingRegistersResponse(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'read_holding_registers response') -> Self:
         _check_keys(data, ('unit', 'registers'), ('byte_count',), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'unit', where), 'unit', where),
             _integers(_get(data, 'registers', where), 'registers', where),
         )
+        _check_given(data, 'byte_count', lambda: (2 * len(m.registers)), where)
+        return m
 
 
 class ReadInputRegistersRequest(Message):
@@ -380,10 +387,12 @@ class ReadInputRegistersResponse(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'read_input_registers response') -> Self:
         _check_keys(data, ('unit', 'registers'), ('byte_count',), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'unit', where), 'unit', where),
             _integers(_get(data, 'registers', where), 'registers', where),
         )
+        _check_given(data, 'byte_count', lambda: (2 * len(m.registers)), where)
+        return m
 
 
 class WriteCoilRequest(Message):
@@ -584,11 +593,14 @@ class WriteCoilsRequest(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'write_coils request') -> Self:
         _check_keys(data, ('unit', 'address', 'values'), ('count', 'byte_count'), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'unit', where), 'unit', where),
             _integer(_get(data, 'address', where), 'address', where),
             _bits(_get(data, 'values', where), 'values', where),
         )
+        _check_given(data, 'count', lambda: len(m.values), where)
+        _check_given(data, 'byte_count', lambda: (-(-(len(m.values)) // 8)), where)
+        return m
 
 
 class WriteCoilsResponse(Message):
@@ -666,11 +678,14 @@ class WriteRegistersRequest(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'write_registers request') -> Self:
         _check_keys(data, ('unit', 'address', 'values'), ('count', 'byte_count'), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'unit', where), 'unit', where),
             _integer(_get(data, 'address', where), 'address', where),
             _integers(_get(data, 'values', where), 'values', where),
         )
+        _check_given(data, 'count', lambda: len(m.values), where)
+        _check_given(data, 'byte_count', lambda: (2 * (len(m.values))), where)
+        return m
 
 
 class WriteRegistersResponse(Message):
@@ -848,13 +863,16 @@ class ReadWriteRegistersRequest(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'read_write_registers request') -> Self:
         _check_keys(data, ('unit', 'read_address', 'read_count', 'write_address', 'values'), ('write_count', 'byte_count'), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'unit', where), 'unit', where),
             _integer(_get(data, 'read_address', where), 'read_address', where),
             _integer(_get(data, 'read_count', where), 'read_count', where),
             _integer(_get(data, 'write_address', where), 'write_address', where),
             _integers(_get(data, 'values', where), 'values', where),
         )
+        _check_given(data, 'write_count', lambda: len(m.values), where)
+        _check_given(data, 'byte_count', lambda: (2 * (len(m.values))), where)
+        return m
 
 
 class ReadWriteRegistersResponse(Message):
@@ -887,10 +905,12 @@ class ReadWriteRegistersResponse(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'read_write_registers response') -> Self:
         _check_keys(data, ('unit', 'registers'), ('byte_count',), where)
-        return cls(
+        m = cls(
             _integer(_get(data, 'unit', where), 'unit', where),
             _integers(_get(data, 'registers', where), 'registers', where),
         )
+        _check_given(data, 'byte_count', lambda: (2 * len(m.registers)), where)
+        return m
 
 
 class ExceptionResponse(Message):

@@ -52,6 +52,7 @@ from serialspec.runtime.constructs import (  # noqa: F401
     PackedBits,
     PackedInts,
     PaddedUtf8,
+    Rebuilt,
     SignMagnitude,
     TrailingZeros,
     Utf8,
@@ -111,7 +112,7 @@ ReadCoilsRequestContent = Struct(
 )
 
 ReadCoilsResponseContent = Struct(
-    'byte_count' / Rebuild(Int8ub, lambda ctx: (-(-len(ctx['coils']) // 8))),
+    'byte_count' / Rebuilt(Int8ub, lambda ctx: (-(-len(ctx['coils']) // 8))),
     'coils' / PackedBits(Bytes(this.byte_count)),
     derived('byte_count', lambda ctx: (-(-len(ctx['coils']) // 8))),
 )
@@ -122,7 +123,7 @@ ReadDiscreteInputsRequestContent = Struct(
 )
 
 ReadDiscreteInputsResponseContent = Struct(
-    'byte_count' / Rebuild(Int8ub, lambda ctx: (-(-len(ctx['inputs']) // 8))),
+    'byte_count' / Rebuilt(Int8ub, lambda ctx: (-(-len(ctx['inputs']) // 8))),
     'inputs' / PackedBits(Bytes(this.byte_count)),
     derived('byte_count', lambda ctx: (-(-len(ctx['inputs']) // 8))),
 )
@@ -133,7 +134,7 @@ ReadHoldingRegistersRequestContent = Struct(
 )
 
 ReadHoldingRegistersResponseContent = Struct(
-    'byte_count' / Rebuild(Int8ub, lambda ctx: (2 * len(ctx['registers']))),
+    'byte_count' / Rebuilt(Int8ub, lambda ctx: (2 * len(ctx['registers']))),
     'registers' / Array(this.byte_count // 2, Int16ub),
     derived('byte_count', lambda ctx: (2 * len(ctx['registers']))),
 )
@@ -144,7 +145,7 @@ ReadInputRegistersRequestContent = Struct(
 )
 
 ReadInputRegistersResponseContent = Struct(
-    'byte_count' / Rebuild(Int8ub, lambda ctx: (2 * len(ctx['registers']))),
+    'byte_count' / Rebuilt(Int8ub, lambda ctx: (2 * len(ctx['registers']))),
     'registers' / Array(this.byte_count // 2, Int16ub),
     derived('byte_count', lambda ctx: (2 * len(ctx['registers']))),
 )
@@ -171,8 +172,8 @@ WriteRegisterResponseContent = Struct(
 
 WriteCoilsRequestContent = Struct(
     'address' / Int16ub,
-    'count' / Rebuild(Int16ub, lambda ctx: len(ctx['values'])),
-    'byte_count' / Rebuild(Int8ub, lambda ctx: (-(-ctx['count'] // 8))),
+    'count' / Rebuilt(Int16ub, lambda ctx: len(ctx['values']), 1, 1968),
+    'byte_count' / Rebuilt(Int8ub, lambda ctx: (-(-ctx['count'] // 8))),
     'values' / PackedBits(Bytes((this.count + 7) // 8), this.count),
     derived('count', lambda ctx: len(ctx['values'])),
     derived('byte_count', lambda ctx: (-(-ctx['count'] // 8))),
@@ -185,8 +186,8 @@ WriteCoilsResponseContent = Struct(
 
 WriteRegistersRequestContent = Struct(
     'address' / Int16ub,
-    'count' / Rebuild(Int16ub, lambda ctx: len(ctx['values'])),
-    'byte_count' / Rebuild(Int8ub, lambda ctx: (2 * ctx['count'])),
+    'count' / Rebuilt(Int16ub, lambda ctx: len(ctx['values']), 1, 123),
+    'byte_count' / Rebuilt(Int8ub, lambda ctx: (2 * ctx['count'])),
     'values' / Array(this.count, Int16ub),
     derived('count', lambda ctx: len(ctx['values'])),
     derived('byte_count', lambda ctx: (2 * ctx['count'])),
@@ -213,15 +214,15 @@ ReadWriteRegistersRequestContent = Struct(
     'read_address' / Int16ub,
     'read_count' / Int16ub,
     'write_address' / Int16ub,
-    'write_count' / Rebuild(Int16ub, lambda ctx: len(ctx['values'])),
-    'byte_count' / Rebuild(Int8ub, lambda ctx: (2 * ctx['write_count'])),
+    'write_count' / Rebuilt(Int16ub, lambda ctx: len(ctx['values']), 1, 121),
+    'byte_count' / Rebuilt(Int8ub, lambda ctx: (2 * ctx['write_count'])),
     'values' / Array(this.write_count, Int16ub),
     derived('write_count', lambda ctx: len(ctx['values'])),
     derived('byte_count', lambda ctx: (2 * ctx['write_count'])),
 )
 
 ReadWriteRegistersResponseContent = Struct(
-    'byte_count' / Rebuild(Int8ub, lambda ctx: (2 * len(ctx['registers']))),
+    'byte_count' / Rebuilt(Int8ub, lambda ctx: (2 * len(ctx['registers']))),
     'registers' / Array(this.byte_count // 2, Int16ub),
     derived('byte_count', lambda ctx: (2 * len(ctx['registers']))),
 )

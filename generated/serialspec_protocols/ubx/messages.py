@@ -8,6 +8,7 @@ from enum import IntEnum
 from typing import Any, ClassVar, Self
 
 from serialspec.runtime.fields import as_bytes as _bytes
+from serialspec.runtime.fields import check_given as _check_given
 from serialspec.runtime.fields import check_keys as _check_keys
 from serialspec.runtime.fields import enum as _as_enum
 from serialspec.runtime.fields import get as _get
@@ -1054,11 +1055,13 @@ class CfgValgetRequest(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'cfg_valget request') -> Self:
         _check_keys(data, ('layer', 'position', 'keys'), ('version',), where)
-        return cls(
+        m = cls(
             _as_enum(Layer, _get(data, 'layer', where), 'layer', where),
             _integer(_get(data, 'position', where), 'position', where),
             _integers(_get(data, 'keys', where), 'keys', where),
         )
+        _check_given(data, 'version', lambda: 0, where)
+        return m
 
 
 class CfgValgetResponse(Message):
@@ -1095,11 +1098,13 @@ class CfgValgetResponse(Message):
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'cfg_valget response') -> Self:
         _check_keys(data, ('layer', 'position', 'cfg_data'), ('version',), where)
-        return cls(
+        m = cls(
             _as_enum(Layer, _get(data, 'layer', where), 'layer', where),
             _integer(_get(data, 'position', where), 'position', where),
             _bytes(_get(data, 'cfg_data', where), 'cfg_data', where),
         )
+        _check_given(data, 'version', lambda: 1, where)
+        return m
 
 
 class MonVerRequest(Message):

@@ -52,6 +52,7 @@ from serialspec.runtime.constructs import (  # noqa: F401
     PackedBits,
     PackedInts,
     PaddedUtf8,
+    Rebuilt,
     SignMagnitude,
     TrailingZeros,
     Utf8,

@@ -423,7 +423,11 @@ _FIELD_LONG: dict[str, Shape] = {
         "(intermediate ones too) within 512 bits, and some value within the field's range (a constant one must fit "
         "it). A frame whose fields make it divide by 0 or shift by a negative count is refused when decoded, in "
         "every output (the codec's DecodeError, the construct structs' error, the C decoder's E_CONTENT; the "
-        "simulator answers nothing and logs one line), and such values are refused on encode."
+        "simulator answers nothing and logs one line), and such values are refused on encode. `/` and `%` round "
+        "down (Python's // and %), in every output. Messages leave the field out; JSON (from_fields, `serialspec "
+        "encode`) and the construct structs may give it only as the computed value (any other is refused in one "
+        "line naming both), and a frame holding a value outside the field's `range` is refused on decode, as "
+        "encode refuses it. The C target computes in int64_t: it refuses an expression that can exceed it."
     ),
     "fields": Ref("fields", lambda: FIELDS, "group: the fields of each item (a mapping, like request/response)."),
     "table": Str("table_value/table_block, or bytes holding registers: name of an entry in `tables:`."),

@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from construct import Adapter, Bytes, Check, Container, ExplicitError, GreedyBytes
+from construct import Adapter, Bytes, Check, Container, ExplicitError, GreedyBytes, Rebuild, evaluate
 
 from serialspec.runtime.packing import pack_ints, unpack_ints
 
@@ -35,6 +35,33 @@ def valued(name: str, shown: str, compute: Callable[[Any], int]) -> Callable[[An
             raise ExplicitError(f"{name}: {shown} has no value here (a division by 0 or a negative shift)") from None
 
     return value
+
+
+class Rebuilt(Rebuild):  # type: ignore[misc, type-arg, unused-ignore]
+    """construct's Rebuild of a value encode computes (a count, a size, a `value:` expression), as the codec treats
+    it: a value given for it on build is refused unless it is the computed one (never silently replaced), and a
+    value outside the field's declared range (`low`..`high`, narrower than its type's) is refused on build and on
+    parse."""
+
+    def __init__(self, subcon: Any, func: Any, low: int | None = None, high: int | None = None) -> None:
+        super().__init__(subcon, func)
+        self.low, self.high = low, high
+
+    def _parse(self, stream: Any, context: Any, path: Any) -> Any:
+        subcon: Any = self.subcon
+        value = subcon._parsereport(stream, context, path)
+        if self.low is not None and self.high is not None and not self.low <= value <= self.high:
+            raise ExplicitError(f"{path}: {value} is outside its range {self.low}..{self.high}")
+        return value
+
+    def _build(self, obj: Any, stream: Any, context: Any, path: Any) -> Any:
+        computed = evaluate(self.func, context)
+        if obj is not None and obj != computed:
+            raise ExplicitError(f"{path}: given as {obj}, but it is computed: {computed} (leave it out)")
+        if self.low is not None and self.high is not None and not self.low <= computed <= self.high:
+            raise ExplicitError(f"{path}: {computed} is outside its range {self.low}..{self.high}")
+        subcon: Any = self.subcon
+        return subcon._build(computed, stream, context, path)
 
 
 class SignMagnitude(Adapter):  # type: ignore[misc, type-arg, unused-ignore]

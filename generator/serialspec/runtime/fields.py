@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from enum import IntEnum, IntFlag
 from typing import Any, TypeVar
 
@@ -18,6 +18,21 @@ def check_keys(data: Mapping[str, Any], known: Iterable[str], optional: Iterable
     for key in data:
         if key not in allowed:
             raise EncodeError(f"{where}: unknown field {key!r} (expected {', '.join(known) or 'no fields'})")
+
+
+def check_given(data: Mapping[str, Any], name: str, compute: Callable[[], int], where: str) -> None:
+    """A value encode computes (a count, a size, a `value:` expression, a constant) that the caller gave anyway:
+    refused in one line unless it is the value encode writes (Modbus `count: 7` with 2 values is a mistake, never
+    silently written as 2). Values the expression has no value for (a division by 0) are left to encode's refusal."""
+    if name not in data:
+        return
+    given = integer(data[name], name, where)
+    try:
+        computed = compute()
+    except (ZeroDivisionError, ValueError, TypeError, AttributeError, OverflowError):
+        return  # the other fields are at fault: encode refuses them, naming the field
+    if given != computed:
+        raise EncodeError(f"{where}: {name} is given as {given}, but it is computed: {computed} (leave it out)")
 
 
 def get(data: Mapping[str, Any], name: str, where: str) -> Any:

@@ -201,6 +201,7 @@ def refuse_unsupported(protocol: Protocol) -> None:
                 raise Unsupported(f"the {layout.direction.value} frame: ended by its trailer alone (no length)")
     for message in protocol.messages():
         refuse_fields(message.fields, message.key)
+    refuse_wide_values(protocol)
 
 
 def refuse_layout(layout: FrameLayout) -> None:
@@ -466,7 +467,9 @@ def read_scalar(ctx: Ctx, t: ScalarType, endian: str, at: str) -> str:
 
 
 def hidden_type(f: Scalar) -> str:
-    """The local holding a hidden value's wire bits while decoding."""
+    """The local holding a hidden value's wire bits while decoding (a signed one's value)."""
+    if f.type.signed:
+        return "int64_t" if wide(f.type) else "int32_t"
     return "uint64_t" if wide(f.type) else "uint32_t"
 
 
@@ -480,7 +483,10 @@ def decode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
             case Scalar():
                 size = f.type.size
                 out.append(f"{pad}if (n - o < {size}u) {{ return {ctx.P}_E_LENGTH; }}")
-                value = read_scalar(ctx, f.type, f.endian, "c + o")
+                # a hidden value keeps its wire bits, a signed one its value (as Python compares it); a constant
+                # only its bits: no helper is written that nothing calls
+                needs_value = f.const is None and (not f.hidden or f.type.signed) and not f.sign_magnitude
+                value = read_scalar(ctx, f.type, f.endian, "c + o") if needs_value else ""
                 if f.sign_magnitude:  # the top bit is the sign, the rest the magnitude
                     top = 1 << (8 * size - 1)
                     raw = f"{ctx.p}__get(c + o, {size}u, {1 if f.endian == '>' else 0}u)"
@@ -493,7 +499,8 @@ def decode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                     )
                 elif f.hidden:
                     local = f"d{depth}_{name}"
-                    out.append(f"{pad}{local} = {get_raw(ctx, f.type, f.endian, 'c + o')};")
+                    read = value if f.type.signed else get_raw(ctx, f.type, f.endian, "c + o")
+                    out.append(f"{pad}{local} = {read};")
                     scope.names[f.name] = local
                 else:
                     out.append(f"{pad}{tgt} = {value};")
@@ -646,8 +653,99 @@ def decode_fields(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list[s
                 assert_never(f)
 
 
-def render_c(expr: Expr, name: Callable[[str], str], length: Callable[[str], str]) -> str:
-    """An expression of the spec in C, over int64_t: `name(field)` and `length(list)` give the operands."""
+@dataclass
+class CMath:
+    """What rendering an expression in C needs to compute exactly what Python computes: the helpers' prefix, the set
+    of helpers used (floor division and modulo, shifts of any count; files.helper_functions writes them), and the
+    values each field can hold (its type's: from the wire, or computed and range-checked), which prove an operand
+    not negative where C's own operator then gives Python's result."""
+
+    p: str
+    helpers: set[str]
+    spans: dict[str, expression.Bounds]
+
+    def span(self, expr: Expr) -> expression.Bounds:
+        return expression.bounds(expr, self.spans)
+
+    def helper(self, name: str) -> str:
+        self.helpers.add(name)
+        return f"{self.p}__{name}"
+
+
+def math_of(ctx: Ctx, fields: tuple[Field, ...]) -> CMath:
+    return CMath(ctx.p, ctx.helpers, value_spans(fields))
+
+
+def value_spans(fields: tuple[Field, ...]) -> dict[str, expression.Bounds]:
+    """The values each integer field an expression can name can hold: its type's (a decoder reads any wire value;
+    an encoder range-checks a computed one before an expression reads it)."""
+    return {
+        f.name: (int(f.type.minimum), int(f.type.maximum))
+        for f in fields
+        if isinstance(f, Scalar) and not f.type.is_float
+    }
+
+
+INT64 = (-(1 << 63), (1 << 63) - 1)
+
+
+def wider_than_int64(expr: Expr, spans: dict[str, expression.Bounds]) -> Expr | None:
+    """The first part of the expression (inner parts first) some value of which, for some values of its fields'
+    types, does not fit int64_t, the type C computes in; None when every value fits (C computes what Python does)."""
+    parts: list[Expr] = []
+    match expr:
+        case expression.BinOp():
+            parts = [expr.left, expr.right]
+        case expression.Invert():
+            parts = [expr.operand]
+        case expression.Ceil():
+            parts = [expr.numerator, expr.denominator, expression.BinOp("-", expression.Const(0), expr.numerator)]
+        case expression.MinMax():
+            parts = list(expr.args)
+        case expression.Const() | expression.Name() | expression.Length():
+            pass
+        case _:
+            assert_never(expr)
+    for part in parts:
+        found = wider_than_int64(part, spans)
+        if found is not None:
+            return found
+    low, high = expression.bounds(expr, spans)
+    return expr if low < INT64[0] or high > INT64[1] else None
+
+
+def refuse_wide_values(protocol: Protocol) -> None:
+    """A `value:` expression some intermediate value of which cannot fit int64_t (the Python codec's are exact up to
+    512 bits): the C target refuses the spec, naming the place, rather than computing another value."""
+    for message in protocol.messages():
+        spans = value_spans(message.fields)
+        for f in message.fields:
+            if isinstance(f, Scalar) and f.value is not None:
+                wide = wider_than_int64(f.value, spans)
+                if wide is not None:
+                    line, column = f.value_at
+                    raise Unsupported(
+                        f"{protocol.spec_path}:{line}:{column}: {message.key} {message.direction.value}: {f.name}: "
+                        f"{collapse(expression.show(wide))} can exceed 64 bits for some values of its fields "
+                        "(C computes in int64_t)"
+                    )
+
+
+def render_c(expr: Expr, name: Callable[[str], str], length: Callable[[str], str], math: CMath) -> str:
+    """An expression of the spec in C, over int64_t: `name(field)` and `length(list)` give the operands. It computes
+    exactly what Python computes (refuse_wide_values has ruled out any value beyond int64_t, no_value a division by
+    0 or a negative shift): `/` and `%` floor and ceil rounds up as Python's do, on either sign, shifts of 64 or more
+    give Python's result; C's own operator where the operands are proved not negative."""
+
+    def c(e: Expr) -> str:
+        return render_c(e, name, length, math)
+
+    def natural(e: Expr) -> bool:
+        return math.span(e)[0] >= 0
+
+    def positive(e: Expr) -> bool:
+        return math.span(e)[0] > 0
+
     match expr:
         case expression.Const():
             return f"(int64_t){expr.value}"
@@ -656,14 +754,21 @@ def render_c(expr: Expr, name: Callable[[str], str], length: Callable[[str], str
         case expression.Length():
             return f"(int64_t){length(expr.name)}"
         case expression.BinOp():
-            return f"({render_c(expr.left, name, length)} {expr.op} {render_c(expr.right, name, length)})"
+            a, b = c(expr.left), c(expr.right)
+            if expr.op in ("/", "%") and not (natural(expr.left) and positive(expr.right)):
+                return f"{math.helper('fdiv' if expr.op == '/' else 'fmod')}({a}, {b})"
+            if expr.op in ("<<", ">>") and not (natural(expr.left) and math.span(expr.right)[1] < 63):
+                return f"{math.helper('shl' if expr.op == '<<' else 'shr')}({a}, {b})"
+            return f"({a} {expr.op} {b})"
         case expression.Invert():
-            return f"(~{render_c(expr.operand, name, length)})"
+            return f"(~{c(expr.operand)})"
         case expression.Ceil():
-            a, b = render_c(expr.numerator, name, length), render_c(expr.denominator, name, length)
-            return f"(({a} + {b} - 1) / {b})"
+            a, b = c(expr.numerator), c(expr.denominator)
+            if natural(expr.numerator) and positive(expr.denominator):
+                return f"({a} / {b} + ({a} % {b} != 0))"
+            return f"(-{math.helper('fdiv')}(-{a}, {b}))"
         case expression.MinMax():
-            args = [render_c(a, name, length) for a in expr.args]
+            args = [c(a) for a in expr.args]
             result = args[0]
             for arg in args[1:]:
                 pick = "<" if expr.function == "min" else ">"
@@ -673,7 +778,7 @@ def render_c(expr: Expr, name: Callable[[str], str], length: Callable[[str], str
             assert_never(expr)
 
 
-def no_value(expr: Expr, name: Callable[[str], str], length: Callable[[str], str]) -> list[str]:
+def no_value(expr: Expr, name: Callable[[str], str], length: Callable[[str], str], math: CMath) -> list[str]:
     """C conditions under which the expression has no value (a division by 0, a negative shift): undefined in C,
     so tested first, inner ones before outer ones (each may use what those ruled out); [] where none can happen
     (expression.fails)."""
@@ -681,20 +786,22 @@ def no_value(expr: Expr, name: Callable[[str], str], length: Callable[[str], str
         return []
     match expr:
         case expression.BinOp():
-            found = no_value(expr.left, name, length) + no_value(expr.right, name, length)
-            right = render_c(expr.right, name, length)
-            if expr.op in ("/", "%") and not (isinstance(expr.right, expression.Const) and expr.right.value != 0):
+            found = no_value(expr.left, name, length, math) + no_value(expr.right, name, length, math)
+            right = render_c(expr.right, name, length, math)
+            low, high = math.span(expr.right)  # a test that cannot hold is left out (gcc: always false)
+            if expr.op in ("/", "%") and low <= 0 <= high:
                 found.append(f"{right} == 0")
-            if expr.op in ("<<", ">>") and not (isinstance(expr.right, expression.Const) and expr.right.value >= 0):
+            if expr.op in ("<<", ">>") and low < 0:
                 found.append(f"{right} < 0")
             return found
         case expression.Ceil():
-            found = no_value(expr.numerator, name, length) + no_value(expr.denominator, name, length)
-            return [*found, f"{render_c(expr.denominator, name, length)} == 0"]
+            found = no_value(expr.numerator, name, length, math) + no_value(expr.denominator, name, length, math)
+            low, high = math.span(expr.denominator)
+            return [*found, f"{render_c(expr.denominator, name, length, math)} == 0"] if low <= 0 <= high else found
         case expression.Invert():
-            return no_value(expr.operand, name, length)
+            return no_value(expr.operand, name, length, math)
         case expression.MinMax():
-            return [c for arg in expr.args for c in no_value(arg, name, length)]
+            return [c for arg in expr.args for c in no_value(arg, name, length, math)]
         case expression.Const() | expression.Name() | expression.Length():
             return []
         case _:
@@ -706,14 +813,27 @@ def value_checks(ctx: Ctx, fields: tuple[Field, ...], scope: Scope) -> list[str]
     frame where it has no value, a division by a 0 from the wire, does not decode)."""
     lines = []
     for f in fields:
+        narrow = isinstance(f, Scalar) and (f.minimum, f.maximum) != (f.type.minimum, f.type.maximum)
+        if isinstance(f, Scalar) and (f.value is not None or f.derived) and narrow:
+            # a computed value outside its declared range (a count of 0 where 1..123 are allowed), as Python refuses
+            wide, suffix = ("int64_t", "LL") if f.type.signed else ("uint64_t", "ULL")
+            value = f"({wide}){scope.lookup(f.name)}"
+            low, high = f"{int(f.minimum)}{suffix}", f"{int(f.maximum)}{suffix}"
+            test = f"{value} < {low} || {value} > {high}" if f.minimum > f.type.minimum else f"{value} > {high}"
+            if f.maximum == f.type.maximum:
+                test = f"{value} < {low}"
+            lines.append(f"    if ({test}) {{ return {ctx.P}_E_CONTENT; }} /* {f.name}: out of its range */")
         if isinstance(f, Scalar) and f.value is not None:
             length = lambda list_name: f"{scope.target}{ident(list_name)}_count"  # noqa: E731
-            computed = render_c(f.value, scope.lookup, length)
-            for condition in no_value(f.value, scope.lookup, length):
+            math = math_of(ctx, fields)
+            computed = render_c(f.value, scope.lookup, length, math)
+            for condition in no_value(f.value, scope.lookup, length, math):
                 lines.append(f"    if ({condition}) {{ return {ctx.P}_E_CONTENT; }} /* {f.name}: no value */")
-            lines.append(
-                f"    if ((int64_t){scope.lookup(f.name)} != {computed}) {{ return {ctx.P}_E_CONTENT; }} /* {f.name} */"
-            )
+            held = scope.lookup(f.name)
+            differs = f"(int64_t){held} != {computed}"
+            if f.type.size == 8 and not f.type.signed:  # above INT64_MAX it is no int64_t; a negative value no u64
+                differs = f"{computed} < 0 || {held} != (uint64_t){computed}"
+            lines.append(f"    if ({differs}) {{ return {ctx.P}_E_CONTENT; }} /* {f.name} */")
     return lines
 
 
@@ -1062,14 +1182,16 @@ def computed_values(ctx: Ctx, fields: tuple[Field, ...], scope: Scope, out: list
         if isinstance(f, Scalar) and f.value is not None:
             local = f"v1_{ident(f.name)}"
             length = lambda list_name: f"{scope.target}{ident(list_name)}_count"  # noqa: E731
-            computed = render_c(f.value, scope.lookup, length)
-            for condition in no_value(f.value, scope.lookup, length):  # a division by a 0 given: refused
+            math = math_of(ctx, fields)
+            computed = render_c(f.value, scope.lookup, length, math)
+            for condition in no_value(f.value, scope.lookup, length, math):  # a division by a 0 given: refused
                 out.append(f"    if ({condition}) {{ return {ctx.P}_E_RANGE; }} /* {f.name}: no value */")
             out.append(f"    {local} = {computed};")
-            out.append(
-                f"    if ({local} < {int(f.minimum)}LL || {local} > {int(f.maximum)}LL) "
-                f"{{ return {ctx.P}_E_RANGE; }} /* {f.name} */"
-            )
+            # int64_t holds the value: a bound beyond it (u64's top, i64's ends) is no test, and no literal
+            tests = [f"{local} < {int(f.minimum)}LL"] if f.minimum > INT64[0] else []
+            tests += [f"{local} > {int(f.maximum)}LL"] if f.maximum < INT64[1] else []
+            if tests:
+                out.append(f"    if ({' || '.join(tests)}) {{ return {ctx.P}_E_RANGE; }} /* {f.name} */")
             scope.names[f.name] = local
 
 

@@ -1420,6 +1420,49 @@ def dec_call(ctx: Ctx, m: Message, values: tuple[tuple[str, object], ...]) -> st
     return f"out->kind = {kind_name(ctx, m)}; r = {ctx.p}__dec_{mid}(c, n, &out->u.{mid}); {sets} return r;"
 
 
+# The arithmetic of spec expressions as Python does it (emit.render_c uses them where C's own operators differ).
+_EXPRESSION_HELPERS = {
+    "fdiv": """/* a / b rounded down, as Python's a // b (C's / rounds toward zero); b is not 0 */
+static int64_t {p}__fdiv(int64_t a, int64_t b)
+{{
+    int64_t q = a / b;
+    return (a % b != 0 && ((a < 0) != (b < 0))) ? q - 1 : q;
+}}
+""",
+    "fmod": """/* a mod b with the sign of b, as Python's a % b (C's % takes the sign of a); b is not 0 */
+static int64_t {p}__fmod(int64_t a, int64_t b)
+{{
+    int64_t r = a % b;
+    return (r != 0 && ((r < 0) != (b < 0))) ? r + b : r;
+}}
+""",
+    "shl": """/* a << b as Python computes it (b >= 0): the generator proved the result fits int64_t, so a count
+   of 63 or more leaves a 0 (or -1 << 63) */
+static int64_t {p}__shl(int64_t a, int64_t b)
+{{
+    if (b >= 63) {{
+        return a == 0 ? 0 : INT64_MIN;
+    }}
+    return a * ((int64_t)1 << b);
+}}
+""",
+    "shr": """/* a >> b as Python computes it (b >= 0): rounded down for a negative a, any count (64 or more
+   gives 0 or -1) */
+static int64_t {p}__shr(int64_t a, int64_t b)
+{{
+    if (b > 63) {{
+        b = 63;
+    }}
+    return a < 0 ? ~((~a) >> b) : a >> b;
+}}
+""",
+}
+
+
+def expression_helpers(p: str, used: set[str]) -> list[str]:
+    return [_EXPRESSION_HELPERS[name].format(p=p) for name in sorted(_EXPRESSION_HELPERS) if name in used]
+
+
 def helper_functions(ctx: Ctx) -> str:
     p, P = ctx.p, ctx.P
     parts: list[str] = []
@@ -1461,6 +1504,7 @@ static void {p}__copy(void *dst, const uint8_t *src, size_t n)
 """
         )
     parts.extend(packed.helpers(p, P, ctx.helpers))
+    parts.extend(expression_helpers(p, ctx.helpers))
     if "get64" in ctx.helpers:
         parts.append(
             f"""#if {P}_ENABLE_DECODE

@@ -42,7 +42,13 @@ from serialspec.backends.python.ir import (
     values_tuple,
 )
 from serialspec.backends.python.kinds import kind, takes_the_rest
-from serialspec.backends.python.optimize import deferred_item_checks, field_read, fold_last_size_check, read_fields_once
+from serialspec.backends.python.optimize import (
+    attribute_reads,
+    deferred_item_checks,
+    field_read,
+    fold_last_size_check,
+    read_fields_once,
+)
 from serialspec.backends.python.render import one_line
 from serialspec.backends.python.straight_frames import StraightLayouts, frame_encoder, straight_direction, struct_tokens
 from serialspec.lang import expression
@@ -169,6 +175,7 @@ class ClassCode:
     class_vars: Lines = field(default_factory=list)
     to_fields: Lines = field(default_factory=list)
     from_fields: Lines = field(default_factory=list)
+    given_checks: Lines = field(default_factory=list)  # from_fields' checks of the computed values given (`m`)
     helpers: frozenset[str] = frozenset()  # the runtime.fields helpers from_fields calls (as _<name>)
 
     def read_from(self, values: list[Calls]) -> None:
@@ -368,6 +375,9 @@ class PackageCode:
         ]
         code.to_fields = [f"{spec_key(f.name)}: {self.to_json(f, 'self.' + f.name)}," for f in fields]
         code.read_from([self.from_json(f) for f in fields])
+        code.given_checks = self.given_checks(message)
+        if code.given_checks:
+            code.helpers |= {"_check_given"}
         self.message_classes.append(code)
         frame_names = [f.name for f in self.frame_values(message.direction, message)]
         extra = "".join(f", {name}: int" for name in frame_names)
@@ -376,6 +386,23 @@ class PackageCode:
         encoder = read_fields_once(deferred_item_checks(self.encoder(message, fields)), [f.name for f in fields])
         encoder_lines = lines_of(encoder)
         self.encoders.append((encoder_name(message), message.class_name, encoder_lines))
+
+    def given_checks(self, message: Message) -> Lines:
+        """from_fields: each value encode computes (a count, a size, a `value:` expression, a constant) that the data
+        gives anyway must be the one encode writes (runtime.fields.check_given); `m` is the message built."""
+        siblings = list(message.fields)
+        lines = []
+        for f in message.fields:
+            if not (isinstance(f, Scalar) and f.hidden):
+                continue
+            if f.const is not None:
+                computed = number(f.const)
+            elif f.value is None and f.derived[0] == "size" and self.sibling(siblings, f.derived[1]) is None:
+                continue  # the size of bytes in every item of a group: encode refuses items that differ
+            else:
+                computed = attribute_reads(self.derived_source(f, "m", siblings))
+            lines.append(f"_check_given(data, {spec_key(f.name)}, lambda: {computed}, where)")
+        return lines
 
     # --- decoding -------------------------------------------------------------------------------------------------
 
@@ -479,6 +506,14 @@ class PackageCode:
         # a byte size of a list of numbers: decoding read size // item items and refused a remainder
         sized = {f.size: f for f in fields if isinstance(f, List) and f.size and f.item is not None}
         for f in fields:
+            narrow = isinstance(f, Scalar) and (f.minimum, f.maximum) != (f.type.minimum, f.type.maximum)
+            if isinstance(f, Scalar) and (f.value is not None or f.derived) and narrow:
+                # a computed value out of its declared range (a count of 0 where 1..123 are allowed): encode refuses
+                # it, so decode does (the message does not hold it, so nobody could see it was wrong)
+                low, high = number(f.minimum), number(f.maximum)
+                reason = f"{f.name} is {{{self.local(f)}}}, outside its range {low}..{high}"
+                condition = f"not {low} <= {self.local(f)} <= {high}"
+                body.append(If(condition, (Raise(f"DecodeError({where} + f': {reason}')"),)))
             if isinstance(f, Scalar) and f.value == expression.Length(counted.get(f.name, "")):
                 continue  # the count of the list it counts: decoding read exactly that many
             listed = sized.get(f.name)

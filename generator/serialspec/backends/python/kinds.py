@@ -121,6 +121,14 @@ def bits_expr(f: Scalar) -> str:
     return f"ByteSwapped({inner})" if f.type.size > 1 and f.endian == "<" else inner
 
 
+def declared_range(f: Scalar) -> str:
+    """Rebuilt's range arguments: a computed value's declared range where it is narrower than its type's (decode
+    refuses a value outside it, as encode does), else none."""
+    if (f.minimum, f.maximum) == (f.type.minimum, f.type.maximum):
+        return ""
+    return f", {int(f.minimum)}, {int(f.maximum)}"
+
+
 class ScalarKind(Kind[Scalar]):
     model = Scalar
 
@@ -132,13 +140,13 @@ class ScalarKind(Kind[Scalar]):
             compute = f"lambda ctx: {expression.render(f.value, lambda name: f'ctx[{name!r}]')}"
             if expression.fails(f.value):  # a divisor of 0 or a negative shift: a one-line refusal to build
                 compute = f"valued({f.name!r}, {one_line(expression.show(f.value))!r}, {compute})"
-            return f"Rebuild({base}, {compute})"
+            return f"Rebuilt({base}, {compute}{declared_range(f)})"
         if f.derived:
             derived, target = f.derived[0], f.derived[1]
             if derived == "count":
-                return f"Rebuild({base}, len_(this.{target}))"
+                return f"Rebuilt({base}, len_(this.{target}){declared_range(f)})"
             # evaluated while building: a lambda, so the context is the one being built, not `this` itself
-            return f"Rebuild({base}, lambda ctx: _item_size(ctx, {target!r}))"
+            return f"Rebuilt({base}, lambda ctx: _item_size(ctx, {target!r}){declared_range(f)})"
         if f.bits:
             return bits_expr(f)
         if f.sign_magnitude:

@@ -120,6 +120,11 @@ def field_read(var: str, name: str) -> str:
     return f"{_OPEN}{var}.{name}{_CLOSE}"
 
 
+def attribute_reads(text: str) -> str:
+    """A text with every field read a plain attribute read (code outside an encoder's statements)."""
+    return text.replace(_OPEN, "").replace(_CLOSE, "")
+
+
 def read_fields_once(body: Block, names: list[str]) -> Block:
     """An encoder's statements with each field of the message `m` that they read more than once read once, into a
     local `m_<field>` first (of `names`, in their order), and likewise each field of a `for` loop's item

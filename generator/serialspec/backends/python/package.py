@@ -40,6 +40,7 @@ def class_context(cls: ClassCode, where: str, keys: list[str], optional: list[st
         "class_vars": cls.class_vars,
         "to_fields": cls.to_fields,
         "from_fields": cls.from_fields,
+        "given_checks": cls.given_checks,
         "where": where,
         "keys": repr(tuple(keys)),
         "json_keys": repr(tuple(spec_name(key) for key in keys)),  # a keyword's field: its spec name in JSON
@@ -137,6 +138,7 @@ def emit_package(protocol: Protocol) -> dict[str, str]:
 FIELD_HELPERS = (
     ("as_bytes", "_bytes"),
     ("bits", "_bits"),
+    ("check_given", "_check_given"),
     ("check_keys", "_check_keys"),
     ("enum", "_as_enum"),
     ("flags", "_as_flags"),

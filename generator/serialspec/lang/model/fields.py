@@ -124,6 +124,7 @@ class Scalar(Common):
     # Derived by an expression over the other fields (`byte_count = 2 * count`): computed on encode, checked on decode.
     value: Expr | None = None
     offset: float | None = None  # engineering value = wire value × scale + offset
+    value_at: tuple[int, int] = (1, 1)  # line and column of `value:` in the spec, for a target's refusal of it
 
     @property
     def odd_width(self) -> bool:

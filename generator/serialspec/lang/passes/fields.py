@@ -86,6 +86,9 @@ class FieldResolver(Pass):
                 integer = isinstance(other, Scalar) and not other.type.is_float
                 if isinstance(node, expression.Name) and other is not None and not integer:
                     self.error(where, f"{node.name} is not an integer field (use len({node.name}) for its size)")
+                elif isinstance(node, expression.Name) and isinstance(other, Scalar) and other.bits:
+                    # its message value is the bit fields, not a number: encode could not compute the expression
+                    self.error(where, f"{node.name} has bit fields (bits:): an expression cannot name it")
         seen: set[str] = set()
         for field in fields:
             if isinstance(field, Scalar) and field.value is not None and field.name not in seen:
@@ -433,6 +436,7 @@ class FieldResolver(Pass):
             status_ok=self.status_ok(spec.get("status"), scalar, low, high, (*path, "status")),
             value=self.derived_value(spec, scalar, path),
             offset=spec.get("offset"),
+            value_at=self.doc.where((*path, "value")),
         )
 
     def derived_value(self, spec: dict[str, Any], scalar: ScalarType, path: Path) -> expression.Expr | None:

@@ -66,7 +66,8 @@ def check_against_construct(
     content = frame_content(g, frame, spec.direction.value, context)
     content_struct = g.structs.CONTENTS[(spec.key, spec.direction.value)]
     parsed = spec_names(plain(content_struct.parse(content)))
-    frame_names = {e.name for e in g.protocol.framing.layouts[spec.direction].value_elements}
+    layout = g.protocol.framing.layouts[spec.direction]
+    frame_names = {e.name for e in (*layout.value_elements, *layout.optional)}  # the frame's, not the content's
     error = g.protocol.error_reply
     if spec.error_reply and error is not None:
         frame_names.add(error.element)  # the refused request's code, in the command element

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define CRSF_SPEC_SHA256 "1d8b0013dcebc3e32f9ce0536ab5405ab1cb77da05531de3761695a649cdb8aa"
+#define CRSF_SPEC_SHA256 "523d36f3bb24644d1e1c3539f56845057e5d969223fb0416dd49056dd8e35fcb"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef CRSF_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define DYNAMIXEL_P2_SPEC_SHA256 "ab75e57d33795fcf4df90969f6eaad93a53f3cdc6be53cb1f2202e6fccc8c908"
+#define DYNAMIXEL_P2_SPEC_SHA256 "302f6caedc8520e73426e9e77e76dc8e3cf1b439f39d83f27966fcb871b84ea4"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef DYNAMIXEL_P2_ENABLE_ENCODE

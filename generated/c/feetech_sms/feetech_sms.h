@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define FEETECH_SMS_SPEC_SHA256 "12513b5fbfc94f5ad6ebc83f5468fd847085c99a486cb1ef00768cfd8475e257"
+#define FEETECH_SMS_SPEC_SHA256 "43e24074216ccbd44167d4a123ae574d31d757b967cf573c7549ab2f58c4c04b"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef FEETECH_SMS_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define HIWONDER_RRC_SPEC_SHA256 "9490b759465501a0382e2b667f86772e463b8fa0e5a35debd54e26403271e3f7"
+#define HIWONDER_RRC_SPEC_SHA256 "ffc6a708548e41e56a1a8f55244b59d6175581c5ed27c735b1f6980e59a0fa7b"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef HIWONDER_RRC_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define MODBUS_RTU_SPEC_SHA256 "422f2f664d08bb0f434b102a1392f7ae427833a1cc622020df80b8813900548f"
+#define MODBUS_RTU_SPEC_SHA256 "0e1206f4f57ee30941cfa7f20c5223e984f92f43e94ce0e6315a039205f38d99"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef MODBUS_RTU_ENABLE_ENCODE

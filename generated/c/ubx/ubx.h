@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define UBX_SPEC_SHA256 "89611b8c28828fe9ccbbe8508145ec6f6e08571b5b9ea6390f0404d57fecada9"
+#define UBX_SPEC_SHA256 "742b297cba4c23737f7d08ae89d681adf37644f482c03662840fb7c7f168b8b6"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef UBX_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define VESC_SPEC_SHA256 "aadaf5c823f8ab97420a3e17f230faba404dd4d0411f06fb781f5aff339ab8f2"
+#define VESC_SPEC_SHA256 "803f29a1a96d2a868d3c9bbcf51a481d1291a507721db30eb3deb59e975dff04"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef VESC_ENABLE_ENCODE

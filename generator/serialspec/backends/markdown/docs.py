@@ -544,8 +544,12 @@ def general_worked(protocol: Protocol, checksum: Checksum) -> str:
         if index is None or layout.transparency is not None:
             continue
         try:
+            layout = layout.variant(example.frame)
             parts = layout.unwrap(example.frame).parts
         except SerialspecError:
+            continue
+        index = next((i for i, e in enumerate(layout.elements) if e.name == checksum.name), None)
+        if index is None:
             continue
         first, last = layout.elements[index].span
         skip = layout.elements[index].skip
@@ -559,6 +563,7 @@ def general_breakdown(protocol: Protocol, example: Example, message: Message | N
     layouts = runtime_layouts(protocol, example.direction)
     layout = next((lay for lay in layouts if example.frame.startswith(lay.header)), layouts[0])
     try:
+        layout = layout.variant(example.frame)  # with optional elements: the variant the frame is sent in
         unwrapped = layout.unwrap(example.frame)
     except SerialspecError as exc:  # the example verification reports it as a spec error; the page says it too
         return [{"bytes": example.frame.hex(" ").upper(), "field": "(frame)", "value": cell(f"does not decode: {exc}")}]
@@ -574,6 +579,8 @@ def general_breakdown(protocol: Protocol, example: Example, message: Message | N
             value = f"{e.unpack(part)} (bytes `{layout.elements[e.span[0]].name}`..`{layout.elements[e.span[1]].name}`)"
         elif e.kind == "checksum":
             value = "verifies"
+        elif e.kind == "extra":
+            value = "(sent: its flag bit is set)"
         rows.append({"bytes": part.hex(" ").upper(), "field": e.name, "value": cell(_show(value))})
     return rows
 

@@ -42,7 +42,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
-from serialspec.backends.common.frames import runtime_layout, runtime_layouts
+from serialspec.backends.common.frames import optional_elements, runtime_layout, runtime_layouts
 from serialspec.backends.python.checksum_code import checksum_call, checksum_lines, checksum_name, checksum_setup
 from serialspec.backends.python.dispatch import (
     ERROR_REPLY,
@@ -122,6 +122,7 @@ class Target:
     expected: bool = False
     only: str = ""  # the one content decoder of frames that carry no command code: called directly
     requesting: bool = False  # frames read and made with the request they answer (layouts chosen by command)
+    optional: tuple[str, ...] = ()  # the optional elements (`present_if`) the messages carry: the engine's
 
 
 def straight(layout: Layout) -> bool:
@@ -130,6 +131,8 @@ def straight(layout: Layout) -> bool:
     over bytes inside the stuffed span only, multi-byte elements at fixed offsets in one byte order."""
     if layout.content < 0 or not isinstance(layout.transparency, Transparency | None):
         return False  # other transforms than substitution: the engine codes them
+    if layout.variants != (layout,):
+        return False  # optional elements: the engine's variants
     first, last = _variable(layout)
     if not first <= layout.content <= last:
         return False
@@ -671,11 +674,14 @@ def engine_lines(layouts: tuple[Layout, ...], target: Target) -> tuple[Lines, Li
     values = [f"v_{v}" for v in target.value_names]
     shown = f"({values[0]},)" if len(values) == 1 else f"({', '.join(values)})"
     parameters = ", ".join(["content: bytes", "code: int | None", *(f"{v}: int" for v in values)])
+    optional = "".join(f", {name}: bytes | None = None" for name in target.optional)
+    extras = ", {" + ", ".join(f"{name!r}: {name}" for name in target.optional) + "}" if target.optional else ""
     if target.requesting:  # the layout by the message's command, the request's bytes for a checksum over them
         wrap = [
-            f"def _wrap_{direction}({parameters}, layout: int | None = None, request: Message | None = None) -> bytes:",
+            f"def _wrap_{direction}({parameters}, layout: int | None = None, request: Message | None = None"
+            f"{optional}) -> bytes:",
             f'    """The {direction} frame around `content` in its layout, made by the frame engine."""',
-            f"    return {frames}.wrap(content, code, {shown}, layout, _request_parts(request))",
+            f"    return {frames}.wrap(content, code, {shown}, layout, _request_parts(request){extras})",
         ]
         decode = [
             f"def _decode_{direction}(frame: bytes, expect: type[Message] | None = None, "
@@ -692,9 +698,9 @@ def engine_lines(layouts: tuple[Layout, ...], target: Target) -> tuple[Lines, Li
         ]
         return _engine_decode(decode, target), wrap
     wrap = [
-        f"def _wrap_{direction}({parameters}) -> bytes:",
+        f"def _wrap_{direction}({parameters}{optional}) -> bytes:",
         f'    """The {direction} frame around `content`, made by the frame engine."""',
-        f"    return {frames}.wrap(content, code, {shown})",
+        f"    return {frames}.wrap(content, code, {shown}{', None, None' + extras if extras else ''})",
     ]
     decode = [
         f"def _decode_{direction}(frame: bytes, expect: type[Message] | None = None) -> Message:",
@@ -708,6 +714,7 @@ def engine_lines(layouts: tuple[Layout, ...], target: Target) -> tuple[Lines, Li
 def _engine_decode(decode: Lines, target: Target) -> Lines:
     """The engine's decode function, its content dispatched by code (and by the expected class)."""
     arguments = "content, 0, len(content), *unwrapped.values"
+    arguments += "".join(f", unwrapped.extras.get({name!r})" for name in target.optional)
     return [*decode, *(f"    {line}" for line in _dispatch(target, "code", arguments, nullable=True))]
 
 
@@ -1924,7 +1931,10 @@ def straight_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, A
         only = dispatch[0][1] if not layout.has_command and len(dispatch) == 1 and not expected else ""
         values = tuple(e.name for e in layout.value_elements)
         requesting = protocol.framing.by_command or protocol.framing.from_request
-        frames = Target(direction.name, values, expected=bool(expected), only=only, requesting=requesting)
+        optional = tuple(e.name for e in optional_elements(protocol, direction))
+        frames = Target(
+            direction.name, values, expected=bool(expected), only=only, requesting=requesting, optional=optional
+        )
         if protocol.error_reply is not None and direction == Direction.RESPONSE:
             element = next(e for e in layout.elements if e.name == protocol.error_reply.element)
             assert element.type is not None

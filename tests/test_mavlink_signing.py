@@ -226,3 +226,13 @@ def test_an_optional_element_inside_a_span_is_refused(tmp_path: Path) -> None:
     with pytest.raises(SpecErrors) as refused:
         load_protocol(spec)
     assert "lies outside every span" in str(refused.value) or "must come after" in str(refused.value)
+
+
+def test_the_readme_signature_check_holds_for_a_signed_frame_and_fails_for_a_forged_one() -> None:
+    text = (Path(__file__).parents[1] / "README.md").read_text(encoding="utf-8")
+    (code,) = [b for b in re.findall(r"```python\n(.*?)```", text, flags=re.S) if "secret_key" in b]
+    frame = bytes(mavlink2.MAVLink_heartbeat_message(2, 12, 81, 0, 3, 3).pack(signer(1, 1, 0, 7, 99)))
+    exec(code, {"mav": mav, "frame": frame, "secret_key": KEY})
+    forged = frame[:-1] + bytes([frame[-1] ^ 1])
+    with pytest.raises(AssertionError):
+        exec(code, {"mav": mav, "frame": forged, "secret_key": KEY})

@@ -8,7 +8,7 @@ from collections.abc import Callable
 
 from serialspec.checksums.crc import crc_function
 from serialspec.checksums.seed import seeded_function
-from serialspec.runtime.errors import DecodeError, EncodeError, content_size_error, out_of_range
+from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError, content_size_error, out_of_range
 from serialspec.runtime.errors import either_direction as _either
 from serialspec.runtime.fields import wrong_type
 from serialspec.runtime.framing import Element, EngineFormat, FrameCodec, Layout
@@ -39,6 +39,7 @@ from .messages import (
 
 __all__ = ["StreamParser", "decode", "encode"]
 
+_F_LE_1S_U8_2S_U8_U8_U8_U16_1S = struct.Struct('<1sB2sBBBH1s')
 _S_ATTITUDERESPONSE_TIME_BOOT_MS = struct.Struct('<Iffffff')
 _S_COMMANDLONGREQUEST_PARAM1 = struct.Struct('<fffffffHBBB')
 _S_F32_U16_U16_B16_U8 = struct.Struct('<fHH16sB')
@@ -59,7 +60,7 @@ _MEMBERS_MavState = members(MavState)
 _MEMBERS_MavType = members(MavType)
 
 
-def _decode_heartbeat_response(buf: bytes, o: int, end: int, seq: int, sysid: int, compid: int, signature: bytes | None) -> HeartbeatResponse:
+def _decode_heartbeat_response(buf: bytes, o: int, end: int, seq: int, sysid: int, compid: int, signature: bytes | None = None) -> HeartbeatResponse:
     if end - o < 9:  # truncate: trailing_zeros
         buf = bytes(buf[o:end]) + bytes(9 - end + o)
         o, end = 0, 9
@@ -72,7 +73,7 @@ def _decode_heartbeat_response(buf: bytes, o: int, end: int, seq: int, sysid: in
     return _new(HeartbeatResponse, (seq, sysid, compid, v_custom_mode, _MEMBERS_MavType.get(v_type, v_type), _MEMBERS_MavAutopilot.get(v_autopilot, v_autopilot), v_base_mode_flags, _MEMBERS_MavState.get(v_system_status, v_system_status), v_mavlink_version, signature))
 
 
-def _decode_sys_status_response(buf: bytes, o: int, end: int, seq: int, sysid: int, compid: int, signature: bytes | None) -> SysStatusResponse:
+def _decode_sys_status_response(buf: bytes, o: int, end: int, seq: int, sysid: int, compid: int, signature: bytes | None = None) -> SysStatusResponse:
     if end - o < 43:  # truncate: trailing_zeros
         buf = bytes(buf[o:end]) + bytes(43 - end + o)
         o, end = 0, 43
@@ -82,7 +83,7 @@ def _decode_sys_status_response(buf: bytes, o: int, end: int, seq: int, sysid: i
     return _new(SysStatusResponse, (seq, sysid, compid, v_onboard_control_sensors_present, v_onboard_control_sensors_enabled, v_onboard_control_sensors_health, v_load, v_voltage_battery, v_current_battery, v_drop_rate_comm, v_errors_comm, v_errors_count1, v_errors_count2, v_errors_count3, v_errors_count4, v_battery_remaining, v_onboard_control_sensors_present_extended, v_onboard_control_sensors_enabled_extended, v_onboard_control_sensors_health_extended, signature))
 
 
-def _decode_param_request_read_request(buf: bytes, o: int, end: int, seq: int, sysid: int, compid: int, signature: bytes | None) -> ParamRequestReadRequest:
+def _decode_param_request_read_request(buf: bytes, o: int, end: int, seq: int, sysid: int, compid: int, signature: bytes | None = None) -> ParamRequestReadRequest:
     if end - o < 20:  # truncate: trailing_zeros
         buf = bytes(buf[o:end]) + bytes(20 - end + o)
         o, end = 0, 20
@@ -96,7 +97,7 @@ def _decode_param_request_read_request(buf: bytes, o: int, end: int, seq: int, s
     return _new(ParamRequestReadRequest, (seq, sysid, compid, v_param_index, v_target_system, v_target_component, _unpad_text(v_param_id, 0, 'param_id', 'param_request_read request'), signature))
 
 
-def _decode_param_value_response(buf: bytes, o: int, end: int, seq: int, sysid: int, compid: int, signature: bytes | None) -> ParamValueResponse:
+def _decode_param_value_response(buf: bytes, o: int, end: int, seq: int, sysid: int, compid: int, signature: bytes | None = None) -> ParamValueResponse:
     if end - o < 25:  # truncate: trailing_zeros
         buf = bytes(buf[o:end]) + bytes(25 - end + o)
         o, end = 0, 25
@@ -111,7 +112,7 @@ def _decode_param_value_response(buf: bytes, o: int, end: int, seq: int, sysid: 
     return _new(ParamValueResponse, (seq, sysid, compid, v_param_value, v_param_count, v_param_index, _unpad_text(v_param_id, 0, 'param_id', 'param_value response'), _MEMBERS_MavParamType.get(v_param_type, v_param_type), signature))
 
 
-def _decode_param_set_request(buf: bytes, o: int, end: int, seq: int, sysid: int, compid: int, signature: bytes | None) -> ParamSetRequest:
+def _decode_param_set_request(buf: bytes, o: int, end: int, seq: int, sysid: int, compid: int, signature: bytes | None = None) -> ParamSetRequest:
     if end - o < 23:  # truncate: trailing_zeros
         buf = bytes(buf[o:end]) + bytes(23 - end + o)
         o, end = 0, 23
@@ -126,7 +127,7 @@ def _decode_param_set_request(buf: bytes, o: int, end: int, seq: int, sysid: int
     return _new(ParamSetRequest, (seq, sysid, compid, v_param_value, v_target_system, v_target_component, _unpad_text(v_param_id, 0, 'param_id', 'param_set request'), _MEMBERS_MavParamType.get(v_param_type, v_param_type), signature))
 
 
-def _decode_attitude_response(buf: bytes, o: int, end: int, seq: int, sysid: int, compid: int, signature: bytes | None) -> AttitudeResponse:
+def _decode_attitude_response(buf: bytes, o: int, end: int, seq: int, sysid: int, compid: int, signature: bytes | None = None) -> AttitudeResponse:
     if end - o < 28:  # truncate: trailing_zeros
         buf = bytes(buf[o:end]) + bytes(28 - end + o)
         o, end = 0, 28
@@ -136,7 +137,7 @@ def _decode_attitude_response(buf: bytes, o: int, end: int, seq: int, sysid: int
     return _new(AttitudeResponse, (seq, sysid, compid, v_time_boot_ms, v_roll, v_pitch, v_yaw, v_rollspeed, v_pitchspeed, v_yawspeed, signature))
 
 
-def _decode_global_position_int_response(buf: bytes, o: int, end: int, seq: int, sysid: int, compid: int, signature: bytes | None) -> GlobalPositionIntResponse:
+def _decode_global_position_int_response(buf: bytes, o: int, end: int, seq: int, sysid: int, compid: int, signature: bytes | None = None) -> GlobalPositionIntResponse:
     if end - o < 28:  # truncate: trailing_zeros
         buf = bytes(buf[o:end]) + bytes(28 - end + o)
         o, end = 0, 28
@@ -146,7 +147,7 @@ def _decode_global_position_int_response(buf: bytes, o: int, end: int, seq: int,
     return _new(GlobalPositionIntResponse, (seq, sysid, compid, v_time_boot_ms, v_lat, v_lon, v_alt, v_relative_alt, v_vx, v_vy, v_vz, v_hdg, signature))
 
 
-def _decode_command_long_request(buf: bytes, o: int, end: int, seq: int, sysid: int, compid: int, signature: bytes | None) -> CommandLongRequest:
+def _decode_command_long_request(buf: bytes, o: int, end: int, seq: int, sysid: int, compid: int, signature: bytes | None = None) -> CommandLongRequest:
     if end - o < 33:  # truncate: trailing_zeros
         buf = bytes(buf[o:end]) + bytes(33 - end + o)
         o, end = 0, 33
@@ -156,7 +157,7 @@ def _decode_command_long_request(buf: bytes, o: int, end: int, seq: int, sysid: 
     return _new(CommandLongRequest, (seq, sysid, compid, v_param1, v_param2, v_param3, v_param4, v_param5, v_param6, v_param7, _MEMBERS_MavCmd.get(v_command, v_command), v_target_system, v_target_component, v_confirmation, signature))
 
 
-def _decode_command_ack_response(buf: bytes, o: int, end: int, seq: int, sysid: int, compid: int, signature: bytes | None) -> CommandAckResponse:
+def _decode_command_ack_response(buf: bytes, o: int, end: int, seq: int, sysid: int, compid: int, signature: bytes | None = None) -> CommandAckResponse:
     if end - o < 10:  # truncate: trailing_zeros
         buf = bytes(buf[o:end]) + bytes(10 - end + o)
         o, end = 0, 10
@@ -195,7 +196,9 @@ def _encode_heartbeat_response(m: HeartbeatResponse) -> bytes:
     if not 0 <= m_mavlink_version <= 255 or m_mavlink_version.__class__ is bool:
         raise out_of_range('heartbeat response', 'mavlink_version', m_mavlink_version, 0, 255)
     content = _S_U32_U8_U8_U8_U8_U8.pack(m_custom_mode, m_type, m_autopilot, m_base_mode, m_system_status, m_mavlink_version).rstrip(b'\x00') or b'\x00'
-    return _wrap_response(content, 0x00, m_seq, m_sysid, m_compid, signature=m.signature)
+    if m.signature is not None:
+        return _wrap_response_engine(content, 0x00, m_seq, m_sysid, m_compid, signature=m.signature)
+    return _wrap_response(content, 0x00, m_seq, m_sysid, m_compid)
 
 
 def _encode_sys_status_response(m: SysStatusResponse) -> bytes:
@@ -257,7 +260,9 @@ def _encode_sys_status_response(m: SysStatusResponse) -> bytes:
     if not 0 <= m_onboard_control_sensors_health_extended <= 4294967295 or m_onboard_control_sensors_health_extended.__class__ is bool:
         raise out_of_range('sys_status response', 'onboard_control_sensors_health_extended', m_onboard_control_sensors_health_extended, 0, 4294967295)
     content = _S_SYSSTATUSRESPONSE_ONBOARD_CONTROL_SENSORS_PRESENT.pack(m_onboard_control_sensors_present, m_onboard_control_sensors_enabled, m_onboard_control_sensors_health, m_load, m_voltage_battery, m_current_battery, m_drop_rate_comm, m_errors_comm, m_errors_count1, m_errors_count2, m_errors_count3, m_errors_count4, m_battery_remaining, m_onboard_control_sensors_present_extended, m_onboard_control_sensors_enabled_extended, m_onboard_control_sensors_health_extended).rstrip(b'\x00') or b'\x00'
-    return _wrap_response(content, 0x01, m_seq, m_sysid, m_compid, signature=m.signature)
+    if m.signature is not None:
+        return _wrap_response_engine(content, 0x01, m_seq, m_sysid, m_compid, signature=m.signature)
+    return _wrap_response(content, 0x01, m_seq, m_sysid, m_compid)
 
 
 def _encode_param_request_read_request(m: ParamRequestReadRequest) -> bytes:
@@ -280,7 +285,9 @@ def _encode_param_request_read_request(m: ParamRequestReadRequest) -> bytes:
     if not 0 <= m_target_component <= 255 or m_target_component.__class__ is bool:
         raise out_of_range('param_request_read request', 'target_component', m_target_component, 0, 255)
     content = _S_I16_U8_U8_B16.pack(m_param_index, m_target_system, m_target_component, _pad_text(m.param_id, 16, 0, 'param_id', 'param_request_read request')).rstrip(b'\x00') or b'\x00'
-    return _wrap_request(content, 0x14, m_seq, m_sysid, m_compid, signature=m.signature)
+    if m.signature is not None:
+        return _wrap_request_engine(content, 0x14, m_seq, m_sysid, m_compid, signature=m.signature)
+    return _wrap_request(content, 0x14, m_seq, m_sysid, m_compid)
 
 
 def _encode_param_value_response(m: ParamValueResponse) -> bytes:
@@ -306,7 +313,9 @@ def _encode_param_value_response(m: ParamValueResponse) -> bytes:
     if not 0 <= m_param_type <= 255 or m_param_type.__class__ is bool:
         raise out_of_range('param_value response', 'param_type', m_param_type, 0, 255)
     content = _S_F32_U16_U16_B16_U8.pack(m_param_value, m_param_count, m_param_index, _pad_text(m.param_id, 16, 0, 'param_id', 'param_value response'), m_param_type).rstrip(b'\x00') or b'\x00'
-    return _wrap_response(content, 0x16, m_seq, m_sysid, m_compid, signature=m.signature)
+    if m.signature is not None:
+        return _wrap_response_engine(content, 0x16, m_seq, m_sysid, m_compid, signature=m.signature)
+    return _wrap_response(content, 0x16, m_seq, m_sysid, m_compid)
 
 
 def _encode_param_set_request(m: ParamSetRequest) -> bytes:
@@ -332,7 +341,9 @@ def _encode_param_set_request(m: ParamSetRequest) -> bytes:
     if not 0 <= m_param_type <= 255 or m_param_type.__class__ is bool:
         raise out_of_range('param_set request', 'param_type', m_param_type, 0, 255)
     content = _S_F32_U8_U8_B16_U8.pack(m_param_value, m_target_system, m_target_component, _pad_text(m.param_id, 16, 0, 'param_id', 'param_set request'), m_param_type).rstrip(b'\x00') or b'\x00'
-    return _wrap_request(content, 0x17, m_seq, m_sysid, m_compid, signature=m.signature)
+    if m.signature is not None:
+        return _wrap_request_engine(content, 0x17, m_seq, m_sysid, m_compid, signature=m.signature)
+    return _wrap_request(content, 0x17, m_seq, m_sysid, m_compid)
 
 
 def _encode_attitude_response(m: AttitudeResponse) -> bytes:
@@ -367,7 +378,9 @@ def _encode_attitude_response(m: AttitudeResponse) -> bytes:
     if not -3.4028234663852886e+38 <= m_yawspeed <= 3.4028234663852886e+38:
         raise out_of_range('attitude response', 'yawspeed', m_yawspeed, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
     content = _S_ATTITUDERESPONSE_TIME_BOOT_MS.pack(m_time_boot_ms, m_roll, m_pitch, m_yaw, m_rollspeed, m_pitchspeed, m_yawspeed).rstrip(b'\x00') or b'\x00'
-    return _wrap_response(content, 0x1e, m_seq, m_sysid, m_compid, signature=m.signature)
+    if m.signature is not None:
+        return _wrap_response_engine(content, 0x1e, m_seq, m_sysid, m_compid, signature=m.signature)
+    return _wrap_response(content, 0x1e, m_seq, m_sysid, m_compid)
 
 
 def _encode_global_position_int_response(m: GlobalPositionIntResponse) -> bytes:
@@ -408,7 +421,9 @@ def _encode_global_position_int_response(m: GlobalPositionIntResponse) -> bytes:
     if not 0 <= m_hdg <= 65535 or m_hdg.__class__ is bool:
         raise out_of_range('global_position_int response', 'hdg', m_hdg, 0, 65535)
     content = _S_GLOBALPOSITIONINTRESPONSE_TIME_BOOT_MS.pack(m_time_boot_ms, m_lat, m_lon, m_alt, m_relative_alt, m_vx, m_vy, m_vz, m_hdg).rstrip(b'\x00') or b'\x00'
-    return _wrap_response(content, 0x21, m_seq, m_sysid, m_compid, signature=m.signature)
+    if m.signature is not None:
+        return _wrap_response_engine(content, 0x21, m_seq, m_sysid, m_compid, signature=m.signature)
+    return _wrap_response(content, 0x21, m_seq, m_sysid, m_compid)
 
 
 def _encode_command_long_request(m: CommandLongRequest) -> bytes:
@@ -455,7 +470,9 @@ def _encode_command_long_request(m: CommandLongRequest) -> bytes:
     if not 0 <= m_confirmation <= 255 or m_confirmation.__class__ is bool:
         raise out_of_range('command_long request', 'confirmation', m_confirmation, 0, 255)
     content = _S_COMMANDLONGREQUEST_PARAM1.pack(m_param1, m_param2, m_param3, m_param4, m_param5, m_param6, m_param7, m_command, m_target_system, m_target_component, m_confirmation).rstrip(b'\x00') or b'\x00'
-    return _wrap_request(content, 0x4c, m_seq, m_sysid, m_compid, signature=m.signature)
+    if m.signature is not None:
+        return _wrap_request_engine(content, 0x4c, m_seq, m_sysid, m_compid, signature=m.signature)
+    return _wrap_request(content, 0x4c, m_seq, m_sysid, m_compid)
 
 
 def _encode_command_ack_response(m: CommandAckResponse) -> bytes:
@@ -487,7 +504,9 @@ def _encode_command_ack_response(m: CommandAckResponse) -> bytes:
     if not 0 <= m_target_component <= 255 or m_target_component.__class__ is bool:
         raise out_of_range('command_ack response', 'target_component', m_target_component, 0, 255)
     content = _S_U16_U8_U8_I32_U8_U8.pack(m_command, m_result, m_progress, m_result_param2, m_target_system, m_target_component).rstrip(b'\x00') or b'\x00'
-    return _wrap_response(content, 0x4d, m_seq, m_sysid, m_compid, signature=m.signature)
+    if m.signature is not None:
+        return _wrap_response_engine(content, 0x4d, m_seq, m_sysid, m_compid, signature=m.signature)
+    return _wrap_response(content, 0x4d, m_seq, m_sysid, m_compid)
 
 
 _REQUEST_DECODERS: dict[int | None, Callable[..., Message]] = {
@@ -520,7 +539,7 @@ _REQUEST_FRAMES = FrameCodec(
 )
 
 
-def _decode_request(frame: bytes, expect: type[Message] | None = None) -> Message:
+def _decode_request_engine(frame: bytes, expect: type[Message] | None = None) -> Message:
     """One complete request frame, checked and taken apart by the frame engine; its content decoded."""
     unwrapped = _REQUEST_FRAMES.unwrap(frame)
     code, content = unwrapped.code, unwrapped.content
@@ -531,9 +550,54 @@ def _decode_request(frame: bytes, expect: type[Message] | None = None) -> Messag
     return decoder(content, 0, len(content), *unwrapped.values, unwrapped.extras.get('signature'))
 
 
-def _wrap_request(content: bytes, code: int | None, v_seq: int, v_sysid: int, v_compid: int, signature: bytes | None = None) -> bytes:
+def _wrap_request_engine(content: bytes, code: int | None, v_seq: int, v_sysid: int, v_compid: int, signature: bytes | None = None) -> bytes:
     """The request frame around `content`, made by the frame engine."""
     return _REQUEST_FRAMES.wrap(content, code, (v_seq, v_sysid, v_compid), None, None, {'signature': signature})
+
+
+def _decode_request(frame: bytes, expect: type[Message] | None = None) -> Message:
+    """One complete request frame, checked and taken apart; its content decoded."""
+    if len(frame) >= 3 and (frame[2] & 0x01):  # optional elements sent: the frame engine's
+        return _decode_request_engine(frame, expect)
+    n = len(frame)
+    if n < 12:
+        raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (12)")
+    end = n - 2
+    if frame[0] != 0xfd:
+        raise DecodeError(f"stx is {frame[0:1].hex(' ')}, expected fd")
+    if frame[2:4] != b'\x00\x00':
+        if frame[2] != 0x00:
+            raise DecodeError(f"incompat_flags is {frame[2:3].hex(' ')}, expected 00")
+        raise DecodeError(f"compat_flags is {frame[3:4].hex(' ')}, expected 00")
+    if frame[9] != 0x00:
+        raise DecodeError(f"msgid_high is {frame[9:10].hex(' ')}, expected 00")
+    v_seq = frame[4]
+    v_sysid = frame[5]
+    if not 1 <= v_sysid <= 255:
+        raise DecodeError(f"sysid = {v_sysid} is outside its range 1..255")
+    v_compid = frame[6]
+    length = frame[1]
+    if length != n - 12:
+        raise DecodeError(f"length says {length} but the frame holds {n - 12}")
+    check = _CHECK_CHECKSUM(frame[1:-2])
+    stored = frame[end + 1] << 8 | frame[end]
+    if check != stored:
+        raise ChecksumError(f"bad checksum: the frame has {stored:#06x}, its bytes give {check:#06x}")
+    code = frame[8] << 8 | frame[7]
+    try:
+        decoder = _REQUEST_DECODERS[code]
+    except KeyError:
+        raise DecodeError(f"unknown command {code:#04x}") from None
+    return decoder(frame, 10, end, v_seq, v_sysid, v_compid)
+
+
+def _wrap_request(content: bytes, code: int | None, v_seq: int, v_sysid: int, v_compid: int) -> bytes:
+    """The request frame around `content`, EncodeError if it cannot be."""
+    v_length = len(content)
+    if not v_length < 256:
+        raise EncodeError(f"request frame: length {v_length} does not fit its 1-byte field")
+    frame = _F_LE_1S_U8_2S_U8_U8_U8_U16_1S.pack(b'\xfd', v_length, b'\x00\x00', v_seq, v_sysid, v_compid, code, b'\x00') + content
+    return frame + _CHECK_CHECKSUM(frame[1:]).to_bytes(2, 'little')
 
 
 _RESPONSE_DECODERS: dict[int | None, Callable[..., Message]] = {
@@ -572,7 +636,7 @@ _RESPONSE_FRAMES = FrameCodec(
 )
 
 
-def _decode_response(frame: bytes, expect: type[Message] | None = None) -> Message:
+def _decode_response_engine(frame: bytes, expect: type[Message] | None = None) -> Message:
     """One complete response frame, checked and taken apart by the frame engine; its content decoded."""
     unwrapped = _RESPONSE_FRAMES.unwrap(frame)
     code, content = unwrapped.code, unwrapped.content
@@ -583,9 +647,54 @@ def _decode_response(frame: bytes, expect: type[Message] | None = None) -> Messa
     return decoder(content, 0, len(content), *unwrapped.values, unwrapped.extras.get('signature'))
 
 
-def _wrap_response(content: bytes, code: int | None, v_seq: int, v_sysid: int, v_compid: int, signature: bytes | None = None) -> bytes:
+def _wrap_response_engine(content: bytes, code: int | None, v_seq: int, v_sysid: int, v_compid: int, signature: bytes | None = None) -> bytes:
     """The response frame around `content`, made by the frame engine."""
     return _RESPONSE_FRAMES.wrap(content, code, (v_seq, v_sysid, v_compid), None, None, {'signature': signature})
+
+
+def _decode_response(frame: bytes, expect: type[Message] | None = None) -> Message:
+    """One complete response frame, checked and taken apart; its content decoded."""
+    if len(frame) >= 3 and (frame[2] & 0x01):  # optional elements sent: the frame engine's
+        return _decode_response_engine(frame, expect)
+    n = len(frame)
+    if n < 12:
+        raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (12)")
+    end = n - 2
+    if frame[0] != 0xfd:
+        raise DecodeError(f"stx is {frame[0:1].hex(' ')}, expected fd")
+    if frame[2:4] != b'\x00\x00':
+        if frame[2] != 0x00:
+            raise DecodeError(f"incompat_flags is {frame[2:3].hex(' ')}, expected 00")
+        raise DecodeError(f"compat_flags is {frame[3:4].hex(' ')}, expected 00")
+    if frame[9] != 0x00:
+        raise DecodeError(f"msgid_high is {frame[9:10].hex(' ')}, expected 00")
+    v_seq = frame[4]
+    v_sysid = frame[5]
+    if not 1 <= v_sysid <= 255:
+        raise DecodeError(f"sysid = {v_sysid} is outside its range 1..255")
+    v_compid = frame[6]
+    length = frame[1]
+    if length != n - 12:
+        raise DecodeError(f"length says {length} but the frame holds {n - 12}")
+    check = _CHECK_CHECKSUM(frame[1:-2])
+    stored = frame[end + 1] << 8 | frame[end]
+    if check != stored:
+        raise ChecksumError(f"bad checksum: the frame has {stored:#06x}, its bytes give {check:#06x}")
+    code = frame[8] << 8 | frame[7]
+    try:
+        decoder = _RESPONSE_DECODERS[code]
+    except KeyError:
+        raise DecodeError(f"unknown command {code:#04x}") from None
+    return decoder(frame, 10, end, v_seq, v_sysid, v_compid)
+
+
+def _wrap_response(content: bytes, code: int | None, v_seq: int, v_sysid: int, v_compid: int) -> bytes:
+    """The response frame around `content`, EncodeError if it cannot be."""
+    v_length = len(content)
+    if not v_length < 256:
+        raise EncodeError(f"response frame: length {v_length} does not fit its 1-byte field")
+    frame = _F_LE_1S_U8_2S_U8_U8_U8_U16_1S.pack(b'\xfd', v_length, b'\x00\x00', v_seq, v_sysid, v_compid, code, b'\x00') + content
+    return frame + _CHECK_CHECKSUM(frame[1:]).to_bytes(2, 'little')
 
 
 _REQUEST = Direction.REQUEST
@@ -610,9 +719,73 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
     `expect`: the reply class the frame answers; it matters only where several reply layouts share a code.
     """
     if direction is _REQUEST:
-        return _decode_request(bytes(data), expect)
+        frame = data if data.__class__ is bytes else bytes(data)
+        if len(frame) >= 3 and (frame[2] & 0x01):  # optional elements sent: the frame engine's
+            return _decode_request_engine(frame, expect)
+        n = len(frame)
+        if n < 12:
+            raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (12)")
+        end = n - 2
+        if frame[0] != 0xfd:
+            raise DecodeError(f"stx is {frame[0:1].hex(' ')}, expected fd")
+        if frame[2:4] != b'\x00\x00':
+            if frame[2] != 0x00:
+                raise DecodeError(f"incompat_flags is {frame[2:3].hex(' ')}, expected 00")
+            raise DecodeError(f"compat_flags is {frame[3:4].hex(' ')}, expected 00")
+        if frame[9] != 0x00:
+            raise DecodeError(f"msgid_high is {frame[9:10].hex(' ')}, expected 00")
+        v_seq = frame[4]
+        v_sysid = frame[5]
+        if not 1 <= v_sysid <= 255:
+            raise DecodeError(f"sysid = {v_sysid} is outside its range 1..255")
+        v_compid = frame[6]
+        length = frame[1]
+        if length != n - 12:
+            raise DecodeError(f"length says {length} but the frame holds {n - 12}")
+        check = _CHECK_CHECKSUM(frame[1:-2])
+        stored = frame[end + 1] << 8 | frame[end]
+        if check != stored:
+            raise ChecksumError(f"bad checksum: the frame has {stored:#06x}, its bytes give {check:#06x}")
+        code = frame[8] << 8 | frame[7]
+        try:
+            decoder = _REQUEST_DECODERS[code]
+        except KeyError:
+            raise DecodeError(f"unknown command {code:#04x}") from None
+        return decoder(frame, 10, end, v_seq, v_sysid, v_compid)
     if direction is _RESPONSE:
-        return _decode_response(bytes(data), expect)
+        frame = data if data.__class__ is bytes else bytes(data)
+        if len(frame) >= 3 and (frame[2] & 0x01):  # optional elements sent: the frame engine's
+            return _decode_response_engine(frame, expect)
+        n = len(frame)
+        if n < 12:
+            raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (12)")
+        end = n - 2
+        if frame[0] != 0xfd:
+            raise DecodeError(f"stx is {frame[0:1].hex(' ')}, expected fd")
+        if frame[2:4] != b'\x00\x00':
+            if frame[2] != 0x00:
+                raise DecodeError(f"incompat_flags is {frame[2:3].hex(' ')}, expected 00")
+            raise DecodeError(f"compat_flags is {frame[3:4].hex(' ')}, expected 00")
+        if frame[9] != 0x00:
+            raise DecodeError(f"msgid_high is {frame[9:10].hex(' ')}, expected 00")
+        v_seq = frame[4]
+        v_sysid = frame[5]
+        if not 1 <= v_sysid <= 255:
+            raise DecodeError(f"sysid = {v_sysid} is outside its range 1..255")
+        v_compid = frame[6]
+        length = frame[1]
+        if length != n - 12:
+            raise DecodeError(f"length says {length} but the frame holds {n - 12}")
+        check = _CHECK_CHECKSUM(frame[1:-2])
+        stored = frame[end + 1] << 8 | frame[end]
+        if check != stored:
+            raise ChecksumError(f"bad checksum: the frame has {stored:#06x}, its bytes give {check:#06x}")
+        code = frame[8] << 8 | frame[7]
+        try:
+            decoder = _RESPONSE_DECODERS[code]
+        except KeyError:
+            raise DecodeError(f"unknown command {code:#04x}") from None
+        return decoder(frame, 10, end, v_seq, v_sysid, v_compid)
     if direction == 'request':  # its value as text
         return decode(data, _REQUEST, expect)
     if direction == 'response':  # its value as text

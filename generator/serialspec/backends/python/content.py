@@ -383,7 +383,7 @@ class PackageCode:
         self.message_classes.append(code)
         frame_names = [f.name for f in self.frame_values(message.direction, message)]
         extra = "".join(f", {name}: int" for name in frame_names)
-        extra += "".join(f", {e.name}: bytes | None" for e in optional)
+        extra += "".join(f", {e.name}: bytes | None = None" for e in optional)  # (straight-line code: not sent)
         decoder = fold_last_size_check(self.decoder(message, fields))
         self.decoders.append((decoder_name(message), message.class_name, extra, decoder))
         encoder = read_fields_once(deferred_item_checks(self.encoder(message, fields)), [f.name for f in fields])
@@ -805,13 +805,25 @@ class PackageCode:
             inline = frames and frame_encoder(
                 frames, parts, self.structs, code, frame_values, size, lambda fmt: self.struct(name, fmt)
             )
+            optional = optional_elements(self.protocol, message.direction)
+            extras = "".join(f", {e.name}=m.{e.name}" for e in optional)
+            guard: Block = []
+            if frames and optional:  # straight-line frames: one with optional elements' bytes is the engine's
+                given = " or ".join(f"m.{e.name} is not None" for e in optional)
+                engine = Code(
+                    f"return _wrap_{message.direction.value}_engine({', '.join([content, code, *frame_values])}"
+                    f"{extras})",
+                    lists=packed_lists(parts),
+                )
+                guard, extras = [If(given, (engine,))], ""
             if inline:  # the frame made here (backends/python/straight_frames.py): no call of the direction's wrap
-                return [*body, *inline]
+                return [*body, *guard, *inline]
+            body += guard
             arguments = ", ".join([content, code, *frame_values])
             framing = self.protocol.framing
             if framing.by_command or framing.from_request:  # its layout, and the request a reply answers
                 arguments += f", {layout_index(self.protocol, message)}, request"
-            arguments += "".join(f", {e.name}=m.{e.name}" for e in optional_elements(self.protocol, message.direction))
+            arguments += extras
             # backends/python/straight_frames.py
             body.append(Code(f"return _wrap_{message.direction.value}({arguments})", lists=packed_lists(parts)))
             return body

@@ -726,22 +726,34 @@ class StraightLayouts:
     layouts: tuple[Layout, ...]
     checks: tuple[dict[int, str], ...]
     algorithms: tuple[dict[int, Checksum], ...]  # the same checksums
+    # layouts with optional elements (`present_if`): the straight-line code takes their frames without them (the
+    # variants with every flag bit clear); a frame with a flag bit set (offset, size, byte order, mask) goes to the
+    # frame engine, and so does a message that has an optional element's bytes
+    diverts: tuple[tuple[int, int, str, int], ...] = ()
 
 
 def straight_direction(protocol: Protocol, direction: Direction) -> StraightLayouts | None:
     """The direction's layouts, when every one fits the straight-line form (and they carry the same values)."""
-    layouts = runtime_layouts(protocol, direction)
+    full = runtime_layouts(protocol, direction)
+    layouts = tuple(layout.variants[-1] for layout in full)  # with optional elements: the variant without them
+    diverts = tuple(
+        (offset, size, endian, mask) for layout in layouts for offset, size, endian, mask, _ in layout.conditions
+    )
     names = {tuple(e.name for e in (layout.elements[i] for i in layout.values)) for layout in layouts}
     if not all(straight(layout) for layout in layouts) or len(names) != 1:
         return None
     if protocol.framing.by_command or protocol.framing.from_request:
         return None  # layouts chosen by command, checksums over the request: the engine's
     algorithms = tuple(
-        {index: e.checksum for index, e in enumerate(model.elements) if e.checksum is not None}
-        for model in protocol.framing.alternatives[direction]
+        {
+            index: checksum
+            for index, e in enumerate(layout.elements)
+            if (checksum := next((m.checksum for m in model.elements if m.name == e.name), None)) is not None
+        }
+        for layout, model in zip(layouts, protocol.framing.alternatives[direction], strict=True)
     )
     checks = tuple({index: checksum_call(checksum) for index, checksum in found.items()} for found in algorithms)
-    return StraightLayouts(layouts, checks, algorithms)
+    return StraightLayouts(layouts, checks, algorithms, diverts)
 
 
 def direction_functions(
@@ -762,6 +774,23 @@ def direction_functions(
     layouts = found.layouts
     several = len(layouts) > 1
     lines: Lines = []
+    divert: Lines = []
+    if found.diverts:  # a frame with an optional element's flag bit set: the engine's (its functions, renamed)
+        decode, wrap = engine_lines(runtime_layouts(protocol, direction), target)
+        decode[0] = decode[0].replace(f"def _decode_{d}(", f"def _decode_{d}_engine(", 1)
+        wrap[0] = wrap[0].replace(f"def _wrap_{d}(", f"def _wrap_{d}_engine(", 1)
+        lines += [*decode, "", "", *wrap, "", ""]
+        tests = [
+            f"frame[{offset}] & {mask:#04x}"
+            if size == 1
+            else f"int.from_bytes(frame[{offset} : {offset + size}], {endian!r}) & {mask:#x}"
+            for offset, size, endian, mask in found.diverts
+        ]
+        shortest = max(offset + size for offset, size, _, _ in found.diverts)
+        divert = [
+            f"if len(frame) >= {shortest} and ({' or '.join(tests)}):  # optional elements sent: the frame engine's",
+            f"    return _decode_{d}_engine(frame, expect)",
+        ]
     wraps: list[_LayoutEncoding] = []
     bodies: list[Lines] = []
     for layout, checks, algorithms in zip(layouts, found.checks, found.algorithms, strict=True):
@@ -773,6 +802,7 @@ def direction_functions(
             lines += [f"{stuffing} = Transparency({t.span}, ({pairs},))", "", ""]
         # of several layouts, each is decoded once its header has chosen it (_choice)
         function, body = decode_lines(layout, f"_decode_{d}{suffix}", target, checks, stuffing, several, algorithms)
+        function = [*function[:2], *(f"    {line}" for line in divert), *function[2:]]
         lines += [*function, "", ""]
         bodies.append(body)
         wraps.append(wrap_parts(layout, target, checks, stuffing, registry(structs)))
@@ -787,7 +817,7 @@ def direction_functions(
         ]
     # decode() chooses the layout and checks the frame itself: one call less
     table, fast = whole_frames(found, d, plain, structs)
-    call = ["frame = data if data.__class__ is bytes else bytes(data)", *fast, *_choice(layouts, d, bodies)]
+    call = ["frame = data if data.__class__ is bytes else bytes(data)", *divert, *fast, *_choice(layouts, d, bodies)]
     lines += [*table, "", ""] if table else []
     lines += wrap_lines(d, wraps, target)
     return lines, call

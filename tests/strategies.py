@@ -176,7 +176,23 @@ def message_fields(protocol: Protocol, message: Message) -> st.SearchStrategy[di
         }
         | refused_code(protocol, message)
     )
-    return st.tuples(frame_values, fields_values(message.fields, 8)).map(lambda pair: {**pair[0], **pair[1]})
+    drawn = st.tuples(frame_values, fields_values(message.fields, 8)).map(lambda pair: {**pair[0], **pair[1]})
+    optional = protocol.framing.layouts[message.direction].optional
+    return drawn.flatmap(lambda fields: optional_values(fields, optional)) if optional else drawn
+
+
+def optional_values(fields: dict[str, Any], optional: tuple[Any, ...]) -> st.SearchStrategy[dict[str, Any]]:
+    """The bytes of optional frame elements (`present_if`), as hex or None: sent as a value flag element says, or
+    at random where the flag is a constant (encode sets its bit)."""
+    values: dict[str, st.SearchStrategy[Any]] = {}
+    for e in optional:
+        sent = st.binary(min_size=e.size, max_size=e.size).map(lambda b: b.hex(" "))
+        flag, mask = e.present_if
+        if flag in fields:
+            values[e.name] = sent if fields[flag] & mask else st.none()
+        else:
+            values[e.name] = st.one_of(st.none(), sent)
+    return st.fixed_dictionaries(values).map(lambda extra: {**fields, **extra})
 
 
 def refused_code(protocol: Protocol, message: Message) -> dict[str, st.SearchStrategy[int]]:

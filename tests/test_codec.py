@@ -66,7 +66,8 @@ def check_against_construct(
     content = frame_content(g, frame, spec.direction.value, context)
     content_struct = g.structs.CONTENTS[(spec.key, spec.direction.value)]
     parsed = spec_names(plain(content_struct.parse(content)))
-    frame_names = {e.name for e in g.protocol.framing.layouts[spec.direction].value_elements}
+    layout = g.protocol.framing.layouts[spec.direction]
+    frame_names = {e.name for e in (*layout.value_elements, *layout.optional)}  # the frame's, not the content's
     error = g.protocol.error_reply
     if spec.error_reply and error is not None:
         frame_names.add(error.element)  # the refused request's code, in the command element
@@ -136,7 +137,11 @@ def test_damaged_frames_fail_with_one_line(g: Generated) -> None:
         direction = example.direction.value
         frame = example.frame
         first = bytes([frame[0] ^ 0x01])  # a header byte, or an address the checksum covers
-        for damaged in (frame[:-1], frame[:-1] + bytes([(frame[-1] + 1) & 0xFF]), first + frame[1:], frame + b"\x00"):
+        last = frame[:-1] + bytes([(frame[-1] + 1) & 0xFF])
+        optional = g.protocol.framing.layouts[example.direction].optional
+        if any(example.fields.get(e.name) for e in optional):
+            last = frame[:-1]  # the frame ends in an optional element's bytes, which the codec carries unchecked
+        for damaged in (frame[:-1], last, first + frame[1:], frame + b"\x00"):
             with pytest.raises(DecodeError) as failure:
                 g.package.decode(damaged, direction)
             assert "\n" not in str(failure.value) and str(failure.value)

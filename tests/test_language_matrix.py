@@ -567,6 +567,38 @@ CASES["frame: truncate: trailing_zeros"] = Case(
     },
     commands={"empty": {"code": 0x1234, "request": {"fields": {"n": "u8"}}, "response": {}}},
 )
+# Optional elements (`present_if`): bytes after the checksum sent when a constant's bit is set (MAVLink v2 signing),
+# and bytes before the checksum, outside its span, when a value's bit is set (the message gives the flags)
+CASES["frame: optional element, present_if a constant's bit"] = Case(
+    {"v": "u16"},
+    {"w": "u8"},
+    {
+        "elements": {
+            "header": {"role": "header", "value": HEADER},
+            "flags": {"role": "constant", "value": "00"},
+            **{k: v for k, v in FRAMING["elements"].items() if k != "header"},
+            "tag": {"role": "optional", "size": 5, "present_if": "flags & 0x04"},
+        }
+    },
+)
+CASES["frame: optional element, present_if a value's bit"] = Case(
+    {"v": "u16"},
+    {"w": "u8", "z": "u16"},
+    {
+        "elements": {
+            "header": {"role": "header", "value": HEADER},
+            "id": {"role": "address", "type": "u8", "range": [0, 253], "broadcast": 254},
+            "flags": {"role": "value", "type": "u8", "range": [0, 3]},
+            "code": {"role": "command", "type": "u8"},
+            "length": {"role": "length", "type": "u8"},
+            "content": {"role": "content"},
+            "stamp": {"role": "optional", "size": 2, "present_if": "flags & 2"},
+            "checksum": {"role": "checksum", "type": "u8", "algorithm": "sum", "covers": ["id", "content"]},
+        }
+    },
+)
+C_REFUSES["frame: optional element, present_if a constant's bit"] = "an optional element"
+C_REFUSES["frame: optional element, present_if a value's bit"] = "an optional element"
 # Replies under a code computed from the request's (HerkuleX: code | 0x40), in the usual frame and in one the frame
 # engine reads; a reply-only command's frames carry the computed code too
 REPLY_CODED = {

@@ -290,7 +290,7 @@ def test_encoders_make_the_frames_the_engine_makes(g: Generated, spec: Message) 
     def same_bytes(fields: dict[str, Any]) -> None:
         frame = g.package.encode(cls.from_fields(fields))
         unwrapped = frames.unwrap(frame)
-        assert frames.wrap(unwrapped.content, unwrapped.code, unwrapped.values) == frame
+        assert frames.wrap(unwrapped.content, unwrapped.code, unwrapped.values, extras=unwrapped.extras) == frame
 
     same_bytes()
 

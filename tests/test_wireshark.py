@@ -154,6 +154,9 @@ def shown(protocol: Protocol, tree: ET.Element) -> dict[str, Any]:
         refused = protocol.error_reply.element
         fields[refused] = int(child(tree, f"{prefix}.{refused}").get("show") or "")
     fields.update(fields_of(message.fields, tree, prefix))
+    for element in protocol.framing.layouts[message.direction].optional:  # its bytes where the frame has them
+        sent = children(tree, f"{name}.frame.{element.name}")
+        fields[element.name] = bytes.fromhex(sent[0].get("value") or "").hex(" ") if sent else None
     checksum_ok = child(tree, f"{name}.checksum_ok").get("show") == "1"
     return {
         "direction": direction,

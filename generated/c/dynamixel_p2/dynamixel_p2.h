@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define DYNAMIXEL_P2_SPEC_SHA256 "75701be3a68085c7f23a594a95d793bd6da9f19e21c3faf303901f3f401647cb"
+#define DYNAMIXEL_P2_SPEC_SHA256 "9def318305579c2114d8c7a417f243203da2282aea9ccffafe7e13e652fdcb07"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef DYNAMIXEL_P2_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define HIWONDER_RRC_SPEC_SHA256 "9a5ffb10011994e65508a45e248bf251caad0f4703b72c387cbf2107c9c561b6"
+#define HIWONDER_RRC_SPEC_SHA256 "a63ed4c18368a4a2f123e3965f596b4a4ffffdc46ddb564c8f5f3e486efa1746"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef HIWONDER_RRC_ENABLE_ENCODE

@@ -15,7 +15,7 @@ extern "C" {
 #endif
 
 /* SHA-256 of the resolved spec this was generated from (its model's values). */
-#define VESC_SPEC_SHA256 "b18adbd39a6ef6cb097dcb1d2c007ecd0cb0b20da89c2acd804a4601184aff03"
+#define VESC_SPEC_SHA256 "2cec6a2431d18ca8c61f834f4c24b428339de2d42aeff2f79a5a9e8e6656ff6d"
 
 /* Leave out what a build does not use (each 0 or 1). The parser needs the decoder. */
 #ifndef VESC_ENABLE_ENCODE

@@ -592,7 +592,8 @@ for _, direction in pairs(SPEC.directions) do
     for index, element in ipairs(layout.elements) do
       layout.overhead = layout.overhead + element.size
       local abbr = P .. ".frame." .. element.name
-      if element.role == "header" or element.role == "trailer" or element.role == "constant" then
+      if element.role == "header" or element.role == "trailer" or element.role == "constant"
+        or element.role == "optional" then -- optional: bytes sent when its flag bit is set (this layout's variant)
         element.pf = new(abbr, function() return ProtoField.bytes(abbr, element.name, base.SPACE, element.description) end)
       elseif element.role ~= "content" then
         local display = element.role == "checksum" and base.HEX or base.DEC
@@ -994,6 +995,8 @@ local function entry_of(direction, code)
 end
 
 local function plausible(element, value)
+  -- need: {mask, bits} a value flag element has under the mask in a variant with (or without) an optional element
+  if element.need and band(value, element.need[1]) ~= element.need[2] then return false end
   return (value >= element.min and value <= element.max) or value == element.broadcast
 end
 
@@ -1229,6 +1232,8 @@ local function dissect_frame(direction_name, direction, layout, entry, tvb, data
         item:add_proto_expert_info(e_malformed, element.name .. " is not the constant the spec gives")
         ok = false
       end
+    elseif role == "optional" then
+      root:add(element.pf, ranges[index])
     elseif role == "content" then
       local done, problem = pcall(decode_content, message, ranges[index], #plain[index], root)
       if not done then

@@ -60,7 +60,7 @@ _MEMBERS_MavState = members(MavState)
 _MEMBERS_MavType = members(MavType)
 
 
-def _decode_heartbeat_response(buf: bytes, o: int, end: int, seq: int, sysid: int, compid: int) -> HeartbeatResponse:
+def _decode_heartbeat_response(buf: bytes, o: int, end: int, seq: int, sysid: int, compid: int, signature: bytes | None = None) -> HeartbeatResponse:
     if end - o < 9:  # truncate: trailing_zeros
         buf = bytes(buf[o:end]) + bytes(9 - end + o)
         o, end = 0, 9
@@ -70,20 +70,20 @@ def _decode_heartbeat_response(buf: bytes, o: int, end: int, seq: int, sysid: in
     v_base_mode_flags = _MEMBERS_MavModeFlag.get(v_base_mode)
     if v_base_mode_flags is None:
         v_base_mode_flags = MavModeFlag(v_base_mode)
-    return _new(HeartbeatResponse, (seq, sysid, compid, v_custom_mode, _MEMBERS_MavType.get(v_type, v_type), _MEMBERS_MavAutopilot.get(v_autopilot, v_autopilot), v_base_mode_flags, _MEMBERS_MavState.get(v_system_status, v_system_status), v_mavlink_version))
+    return _new(HeartbeatResponse, (seq, sysid, compid, v_custom_mode, _MEMBERS_MavType.get(v_type, v_type), _MEMBERS_MavAutopilot.get(v_autopilot, v_autopilot), v_base_mode_flags, _MEMBERS_MavState.get(v_system_status, v_system_status), v_mavlink_version, signature))
 
 
-def _decode_sys_status_response(buf: bytes, o: int, end: int, seq: int, sysid: int, compid: int) -> SysStatusResponse:
+def _decode_sys_status_response(buf: bytes, o: int, end: int, seq: int, sysid: int, compid: int, signature: bytes | None = None) -> SysStatusResponse:
     if end - o < 43:  # truncate: trailing_zeros
         buf = bytes(buf[o:end]) + bytes(43 - end + o)
         o, end = 0, 43
     if end - o != 43:
         raise content_size_error('sys_status response', end - o, 43, 43)
     v_onboard_control_sensors_present, v_onboard_control_sensors_enabled, v_onboard_control_sensors_health, v_load, v_voltage_battery, v_current_battery, v_drop_rate_comm, v_errors_comm, v_errors_count1, v_errors_count2, v_errors_count3, v_errors_count4, v_battery_remaining, v_onboard_control_sensors_present_extended, v_onboard_control_sensors_enabled_extended, v_onboard_control_sensors_health_extended = _S_SYSSTATUSRESPONSE_ONBOARD_CONTROL_SENSORS_PRESENT.unpack_from(buf, o)
-    return _new(SysStatusResponse, (seq, sysid, compid, v_onboard_control_sensors_present, v_onboard_control_sensors_enabled, v_onboard_control_sensors_health, v_load, v_voltage_battery, v_current_battery, v_drop_rate_comm, v_errors_comm, v_errors_count1, v_errors_count2, v_errors_count3, v_errors_count4, v_battery_remaining, v_onboard_control_sensors_present_extended, v_onboard_control_sensors_enabled_extended, v_onboard_control_sensors_health_extended))
+    return _new(SysStatusResponse, (seq, sysid, compid, v_onboard_control_sensors_present, v_onboard_control_sensors_enabled, v_onboard_control_sensors_health, v_load, v_voltage_battery, v_current_battery, v_drop_rate_comm, v_errors_comm, v_errors_count1, v_errors_count2, v_errors_count3, v_errors_count4, v_battery_remaining, v_onboard_control_sensors_present_extended, v_onboard_control_sensors_enabled_extended, v_onboard_control_sensors_health_extended, signature))
 
 
-def _decode_param_request_read_request(buf: bytes, o: int, end: int, seq: int, sysid: int, compid: int) -> ParamRequestReadRequest:
+def _decode_param_request_read_request(buf: bytes, o: int, end: int, seq: int, sysid: int, compid: int, signature: bytes | None = None) -> ParamRequestReadRequest:
     if end - o < 20:  # truncate: trailing_zeros
         buf = bytes(buf[o:end]) + bytes(20 - end + o)
         o, end = 0, 20
@@ -94,10 +94,10 @@ def _decode_param_request_read_request(buf: bytes, o: int, end: int, seq: int, s
     v_target_system = t[1]
     v_target_component = t[2]
     v_param_id = t[3]
-    return _new(ParamRequestReadRequest, (seq, sysid, compid, v_param_index, v_target_system, v_target_component, _unpad_text(v_param_id, 0, 'param_id', 'param_request_read request')))
+    return _new(ParamRequestReadRequest, (seq, sysid, compid, v_param_index, v_target_system, v_target_component, _unpad_text(v_param_id, 0, 'param_id', 'param_request_read request'), signature))
 
 
-def _decode_param_value_response(buf: bytes, o: int, end: int, seq: int, sysid: int, compid: int) -> ParamValueResponse:
+def _decode_param_value_response(buf: bytes, o: int, end: int, seq: int, sysid: int, compid: int, signature: bytes | None = None) -> ParamValueResponse:
     if end - o < 25:  # truncate: trailing_zeros
         buf = bytes(buf[o:end]) + bytes(25 - end + o)
         o, end = 0, 25
@@ -109,10 +109,10 @@ def _decode_param_value_response(buf: bytes, o: int, end: int, seq: int, sysid: 
     v_param_index = t[2]
     v_param_id = t[3]
     v_param_type = t[4]
-    return _new(ParamValueResponse, (seq, sysid, compid, v_param_value, v_param_count, v_param_index, _unpad_text(v_param_id, 0, 'param_id', 'param_value response'), _MEMBERS_MavParamType.get(v_param_type, v_param_type)))
+    return _new(ParamValueResponse, (seq, sysid, compid, v_param_value, v_param_count, v_param_index, _unpad_text(v_param_id, 0, 'param_id', 'param_value response'), _MEMBERS_MavParamType.get(v_param_type, v_param_type), signature))
 
 
-def _decode_param_set_request(buf: bytes, o: int, end: int, seq: int, sysid: int, compid: int) -> ParamSetRequest:
+def _decode_param_set_request(buf: bytes, o: int, end: int, seq: int, sysid: int, compid: int, signature: bytes | None = None) -> ParamSetRequest:
     if end - o < 23:  # truncate: trailing_zeros
         buf = bytes(buf[o:end]) + bytes(23 - end + o)
         o, end = 0, 23
@@ -124,47 +124,47 @@ def _decode_param_set_request(buf: bytes, o: int, end: int, seq: int, sysid: int
     v_target_component = t[2]
     v_param_id = t[3]
     v_param_type = t[4]
-    return _new(ParamSetRequest, (seq, sysid, compid, v_param_value, v_target_system, v_target_component, _unpad_text(v_param_id, 0, 'param_id', 'param_set request'), _MEMBERS_MavParamType.get(v_param_type, v_param_type)))
+    return _new(ParamSetRequest, (seq, sysid, compid, v_param_value, v_target_system, v_target_component, _unpad_text(v_param_id, 0, 'param_id', 'param_set request'), _MEMBERS_MavParamType.get(v_param_type, v_param_type), signature))
 
 
-def _decode_attitude_response(buf: bytes, o: int, end: int, seq: int, sysid: int, compid: int) -> AttitudeResponse:
+def _decode_attitude_response(buf: bytes, o: int, end: int, seq: int, sysid: int, compid: int, signature: bytes | None = None) -> AttitudeResponse:
     if end - o < 28:  # truncate: trailing_zeros
         buf = bytes(buf[o:end]) + bytes(28 - end + o)
         o, end = 0, 28
     if end - o != 28:
         raise content_size_error('attitude response', end - o, 28, 28)
     v_time_boot_ms, v_roll, v_pitch, v_yaw, v_rollspeed, v_pitchspeed, v_yawspeed = _S_ATTITUDERESPONSE_TIME_BOOT_MS.unpack_from(buf, o)
-    return _new(AttitudeResponse, (seq, sysid, compid, v_time_boot_ms, v_roll, v_pitch, v_yaw, v_rollspeed, v_pitchspeed, v_yawspeed))
+    return _new(AttitudeResponse, (seq, sysid, compid, v_time_boot_ms, v_roll, v_pitch, v_yaw, v_rollspeed, v_pitchspeed, v_yawspeed, signature))
 
 
-def _decode_global_position_int_response(buf: bytes, o: int, end: int, seq: int, sysid: int, compid: int) -> GlobalPositionIntResponse:
+def _decode_global_position_int_response(buf: bytes, o: int, end: int, seq: int, sysid: int, compid: int, signature: bytes | None = None) -> GlobalPositionIntResponse:
     if end - o < 28:  # truncate: trailing_zeros
         buf = bytes(buf[o:end]) + bytes(28 - end + o)
         o, end = 0, 28
     if end - o != 28:
         raise content_size_error('global_position_int response', end - o, 28, 28)
     v_time_boot_ms, v_lat, v_lon, v_alt, v_relative_alt, v_vx, v_vy, v_vz, v_hdg = _S_GLOBALPOSITIONINTRESPONSE_TIME_BOOT_MS.unpack_from(buf, o)
-    return _new(GlobalPositionIntResponse, (seq, sysid, compid, v_time_boot_ms, v_lat, v_lon, v_alt, v_relative_alt, v_vx, v_vy, v_vz, v_hdg))
+    return _new(GlobalPositionIntResponse, (seq, sysid, compid, v_time_boot_ms, v_lat, v_lon, v_alt, v_relative_alt, v_vx, v_vy, v_vz, v_hdg, signature))
 
 
-def _decode_command_long_request(buf: bytes, o: int, end: int, seq: int, sysid: int, compid: int) -> CommandLongRequest:
+def _decode_command_long_request(buf: bytes, o: int, end: int, seq: int, sysid: int, compid: int, signature: bytes | None = None) -> CommandLongRequest:
     if end - o < 33:  # truncate: trailing_zeros
         buf = bytes(buf[o:end]) + bytes(33 - end + o)
         o, end = 0, 33
     if end - o != 33:
         raise content_size_error('command_long request', end - o, 33, 33)
     v_param1, v_param2, v_param3, v_param4, v_param5, v_param6, v_param7, v_command, v_target_system, v_target_component, v_confirmation = _S_COMMANDLONGREQUEST_PARAM1.unpack_from(buf, o)
-    return _new(CommandLongRequest, (seq, sysid, compid, v_param1, v_param2, v_param3, v_param4, v_param5, v_param6, v_param7, _MEMBERS_MavCmd.get(v_command, v_command), v_target_system, v_target_component, v_confirmation))
+    return _new(CommandLongRequest, (seq, sysid, compid, v_param1, v_param2, v_param3, v_param4, v_param5, v_param6, v_param7, _MEMBERS_MavCmd.get(v_command, v_command), v_target_system, v_target_component, v_confirmation, signature))
 
 
-def _decode_command_ack_response(buf: bytes, o: int, end: int, seq: int, sysid: int, compid: int) -> CommandAckResponse:
+def _decode_command_ack_response(buf: bytes, o: int, end: int, seq: int, sysid: int, compid: int, signature: bytes | None = None) -> CommandAckResponse:
     if end - o < 10:  # truncate: trailing_zeros
         buf = bytes(buf[o:end]) + bytes(10 - end + o)
         o, end = 0, 10
     if end - o != 10:
         raise content_size_error('command_ack response', end - o, 10, 10)
     v_command, v_result, v_progress, v_result_param2, v_target_system, v_target_component = _S_U16_U8_U8_I32_U8_U8.unpack_from(buf, o)
-    return _new(CommandAckResponse, (seq, sysid, compid, _MEMBERS_MavCmd.get(v_command, v_command), _MEMBERS_MavResult.get(v_result, v_result), v_progress, v_result_param2, v_target_system, v_target_component))
+    return _new(CommandAckResponse, (seq, sysid, compid, _MEMBERS_MavCmd.get(v_command, v_command), _MEMBERS_MavResult.get(v_result, v_result), v_progress, v_result_param2, v_target_system, v_target_component, signature))
 
 
 def _encode_heartbeat_response(m: HeartbeatResponse) -> bytes:
@@ -196,6 +196,8 @@ def _encode_heartbeat_response(m: HeartbeatResponse) -> bytes:
     if not 0 <= m_mavlink_version <= 255 or m_mavlink_version.__class__ is bool:
         raise out_of_range('heartbeat response', 'mavlink_version', m_mavlink_version, 0, 255)
     content = _S_U32_U8_U8_U8_U8_U8.pack(m_custom_mode, m_type, m_autopilot, m_base_mode, m_system_status, m_mavlink_version).rstrip(b'\x00') or b'\x00'
+    if m.signature is not None:
+        return _wrap_response_engine(content, 0x00, m_seq, m_sysid, m_compid, signature=m.signature)
     return _wrap_response(content, 0x00, m_seq, m_sysid, m_compid)
 
 
@@ -258,6 +260,8 @@ def _encode_sys_status_response(m: SysStatusResponse) -> bytes:
     if not 0 <= m_onboard_control_sensors_health_extended <= 4294967295 or m_onboard_control_sensors_health_extended.__class__ is bool:
         raise out_of_range('sys_status response', 'onboard_control_sensors_health_extended', m_onboard_control_sensors_health_extended, 0, 4294967295)
     content = _S_SYSSTATUSRESPONSE_ONBOARD_CONTROL_SENSORS_PRESENT.pack(m_onboard_control_sensors_present, m_onboard_control_sensors_enabled, m_onboard_control_sensors_health, m_load, m_voltage_battery, m_current_battery, m_drop_rate_comm, m_errors_comm, m_errors_count1, m_errors_count2, m_errors_count3, m_errors_count4, m_battery_remaining, m_onboard_control_sensors_present_extended, m_onboard_control_sensors_enabled_extended, m_onboard_control_sensors_health_extended).rstrip(b'\x00') or b'\x00'
+    if m.signature is not None:
+        return _wrap_response_engine(content, 0x01, m_seq, m_sysid, m_compid, signature=m.signature)
     return _wrap_response(content, 0x01, m_seq, m_sysid, m_compid)
 
 
@@ -281,6 +285,8 @@ def _encode_param_request_read_request(m: ParamRequestReadRequest) -> bytes:
     if not 0 <= m_target_component <= 255 or m_target_component.__class__ is bool:
         raise out_of_range('param_request_read request', 'target_component', m_target_component, 0, 255)
     content = _S_I16_U8_U8_B16.pack(m_param_index, m_target_system, m_target_component, _pad_text(m.param_id, 16, 0, 'param_id', 'param_request_read request')).rstrip(b'\x00') or b'\x00'
+    if m.signature is not None:
+        return _wrap_request_engine(content, 0x14, m_seq, m_sysid, m_compid, signature=m.signature)
     return _wrap_request(content, 0x14, m_seq, m_sysid, m_compid)
 
 
@@ -307,6 +313,8 @@ def _encode_param_value_response(m: ParamValueResponse) -> bytes:
     if not 0 <= m_param_type <= 255 or m_param_type.__class__ is bool:
         raise out_of_range('param_value response', 'param_type', m_param_type, 0, 255)
     content = _S_F32_U16_U16_B16_U8.pack(m_param_value, m_param_count, m_param_index, _pad_text(m.param_id, 16, 0, 'param_id', 'param_value response'), m_param_type).rstrip(b'\x00') or b'\x00'
+    if m.signature is not None:
+        return _wrap_response_engine(content, 0x16, m_seq, m_sysid, m_compid, signature=m.signature)
     return _wrap_response(content, 0x16, m_seq, m_sysid, m_compid)
 
 
@@ -333,6 +341,8 @@ def _encode_param_set_request(m: ParamSetRequest) -> bytes:
     if not 0 <= m_param_type <= 255 or m_param_type.__class__ is bool:
         raise out_of_range('param_set request', 'param_type', m_param_type, 0, 255)
     content = _S_F32_U8_U8_B16_U8.pack(m_param_value, m_target_system, m_target_component, _pad_text(m.param_id, 16, 0, 'param_id', 'param_set request'), m_param_type).rstrip(b'\x00') or b'\x00'
+    if m.signature is not None:
+        return _wrap_request_engine(content, 0x17, m_seq, m_sysid, m_compid, signature=m.signature)
     return _wrap_request(content, 0x17, m_seq, m_sysid, m_compid)
 
 
@@ -368,6 +378,8 @@ def _encode_attitude_response(m: AttitudeResponse) -> bytes:
     if not -3.4028234663852886e+38 <= m_yawspeed <= 3.4028234663852886e+38:
         raise out_of_range('attitude response', 'yawspeed', m_yawspeed, -340282346638528859811704183484516925440, 340282346638528859811704183484516925440)
     content = _S_ATTITUDERESPONSE_TIME_BOOT_MS.pack(m_time_boot_ms, m_roll, m_pitch, m_yaw, m_rollspeed, m_pitchspeed, m_yawspeed).rstrip(b'\x00') or b'\x00'
+    if m.signature is not None:
+        return _wrap_response_engine(content, 0x1e, m_seq, m_sysid, m_compid, signature=m.signature)
     return _wrap_response(content, 0x1e, m_seq, m_sysid, m_compid)
 
 
@@ -409,6 +421,8 @@ def _encode_global_position_int_response(m: GlobalPositionIntResponse) -> bytes:
     if not 0 <= m_hdg <= 65535 or m_hdg.__class__ is bool:
         raise out_of_range('global_position_int response', 'hdg', m_hdg, 0, 65535)
     content = _S_GLOBALPOSITIONINTRESPONSE_TIME_BOOT_MS.pack(m_time_boot_ms, m_lat, m_lon, m_alt, m_relative_alt, m_vx, m_vy, m_vz, m_hdg).rstrip(b'\x00') or b'\x00'
+    if m.signature is not None:
+        return _wrap_response_engine(content, 0x21, m_seq, m_sysid, m_compid, signature=m.signature)
     return _wrap_response(content, 0x21, m_seq, m_sysid, m_compid)
 
 
@@ -456,6 +470,8 @@ def _encode_command_long_request(m: CommandLongRequest) -> bytes:
     if not 0 <= m_confirmation <= 255 or m_confirmation.__class__ is bool:
         raise out_of_range('command_long request', 'confirmation', m_confirmation, 0, 255)
     content = _S_COMMANDLONGREQUEST_PARAM1.pack(m_param1, m_param2, m_param3, m_param4, m_param5, m_param6, m_param7, m_command, m_target_system, m_target_component, m_confirmation).rstrip(b'\x00') or b'\x00'
+    if m.signature is not None:
+        return _wrap_request_engine(content, 0x4c, m_seq, m_sysid, m_compid, signature=m.signature)
     return _wrap_request(content, 0x4c, m_seq, m_sysid, m_compid)
 
 
@@ -488,6 +504,8 @@ def _encode_command_ack_response(m: CommandAckResponse) -> bytes:
     if not 0 <= m_target_component <= 255 or m_target_component.__class__ is bool:
         raise out_of_range('command_ack response', 'target_component', m_target_component, 0, 255)
     content = _S_U16_U8_U8_I32_U8_U8.pack(m_command, m_result, m_progress, m_result_param2, m_target_system, m_target_component).rstrip(b'\x00') or b'\x00'
+    if m.signature is not None:
+        return _wrap_response_engine(content, 0x4d, m_seq, m_sysid, m_compid, signature=m.signature)
     return _wrap_response(content, 0x4d, m_seq, m_sysid, m_compid)
 
 
@@ -510,6 +528,7 @@ _REQUEST_FRAMES = FrameCodec(
             Element('msgid_high', 'constant', 1, constant=b'\x00'),
             Element('payload', 'content'),
             Element('checksum', 'checksum', 2, span=(1, 9), checksum=_CHECK_CHECKSUM),
+            Element('signature', 'optional', 13, flag=2, mask=0x01),
         )),
     ),
     {
@@ -520,8 +539,26 @@ _REQUEST_FRAMES = FrameCodec(
 )
 
 
+def _decode_request_engine(frame: bytes, expect: type[Message] | None = None) -> Message:
+    """One complete request frame, checked and taken apart by the frame engine; its content decoded."""
+    unwrapped = _REQUEST_FRAMES.unwrap(frame)
+    code, content = unwrapped.code, unwrapped.content
+    try:
+        decoder = _REQUEST_DECODERS[code]
+    except KeyError:
+        raise DecodeError(f"unknown command {code:#04x}") from None
+    return decoder(content, 0, len(content), *unwrapped.values, unwrapped.extras.get('signature'))
+
+
+def _wrap_request_engine(content: bytes, code: int | None, v_seq: int, v_sysid: int, v_compid: int, signature: bytes | None = None) -> bytes:
+    """The request frame around `content`, made by the frame engine."""
+    return _REQUEST_FRAMES.wrap(content, code, (v_seq, v_sysid, v_compid), None, None, {'signature': signature})
+
+
 def _decode_request(frame: bytes, expect: type[Message] | None = None) -> Message:
     """One complete request frame, checked and taken apart; its content decoded."""
+    if len(frame) >= 3 and (frame[2] & 0x01):  # optional elements sent: the frame engine's
+        return _decode_request_engine(frame, expect)
     n = len(frame)
     if n < 12:
         raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (12)")
@@ -585,6 +622,7 @@ _RESPONSE_FRAMES = FrameCodec(
             Element('msgid_high', 'constant', 1, constant=b'\x00'),
             Element('payload', 'content'),
             Element('checksum', 'checksum', 2, span=(1, 9), checksum=_CHECK_CHECKSUM),
+            Element('signature', 'optional', 13, flag=2, mask=0x01),
         )),
     ),
     {
@@ -598,8 +636,26 @@ _RESPONSE_FRAMES = FrameCodec(
 )
 
 
+def _decode_response_engine(frame: bytes, expect: type[Message] | None = None) -> Message:
+    """One complete response frame, checked and taken apart by the frame engine; its content decoded."""
+    unwrapped = _RESPONSE_FRAMES.unwrap(frame)
+    code, content = unwrapped.code, unwrapped.content
+    try:
+        decoder = _RESPONSE_DECODERS[code]
+    except KeyError:
+        raise DecodeError(f"unknown command {code:#04x}") from None
+    return decoder(content, 0, len(content), *unwrapped.values, unwrapped.extras.get('signature'))
+
+
+def _wrap_response_engine(content: bytes, code: int | None, v_seq: int, v_sysid: int, v_compid: int, signature: bytes | None = None) -> bytes:
+    """The response frame around `content`, made by the frame engine."""
+    return _RESPONSE_FRAMES.wrap(content, code, (v_seq, v_sysid, v_compid), None, None, {'signature': signature})
+
+
 def _decode_response(frame: bytes, expect: type[Message] | None = None) -> Message:
     """One complete response frame, checked and taken apart; its content decoded."""
+    if len(frame) >= 3 and (frame[2] & 0x01):  # optional elements sent: the frame engine's
+        return _decode_response_engine(frame, expect)
     n = len(frame)
     if n < 12:
         raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (12)")
@@ -664,6 +720,8 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
     """
     if direction is _REQUEST:
         frame = data if data.__class__ is bytes else bytes(data)
+        if len(frame) >= 3 and (frame[2] & 0x01):  # optional elements sent: the frame engine's
+            return _decode_request_engine(frame, expect)
         n = len(frame)
         if n < 12:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest request frame (12)")
@@ -696,6 +754,8 @@ def decode(data: bytes, direction: Direction | str | None = None, expect: type[M
         return decoder(frame, 10, end, v_seq, v_sysid, v_compid)
     if direction is _RESPONSE:
         frame = data if data.__class__ is bytes else bytes(data)
+        if len(frame) >= 3 and (frame[2] & 0x01):  # optional elements sent: the frame engine's
+            return _decode_response_engine(frame, expect)
         n = len(frame)
         if n < 12:
             raise DecodeError(f"frame of {n} bytes is shorter than the smallest response frame (12)")

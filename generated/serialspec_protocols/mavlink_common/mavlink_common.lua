@@ -161,8 +161,138 @@ local LAYOUTS = {
         role = "constant",
         size = 1,
         big = false,
+        constant = "\x01",
+        description = "Incompatibility flags: a receiver must refuse a frame with a flag it does not know. Bit 0 (0x01) marks a signed frame: set when the message has a `signature`, clear when it has none.",
+      },
+      {
+        name = "compat_flags",
+        role = "constant",
+        size = 1,
+        big = false,
         constant = "\x00",
-        description = "Incompatibility flags: a receiver must refuse a frame with a flag it does not know. Bit 0 (0x01) marks a signed frame; this spec takes unsigned frames only.",
+        description = "Compatibility flags (none defined; a receiver ignores the ones it does not know).",
+      },
+      {
+        name = "seq",
+        role = "value",
+        size = 1,
+        big = false,
+        min = 0,
+        max = 255,
+        description = "The sender's sequence number, one more in each frame it sends, wrapping from 255 to 0 (a receiver counts the frames lost from the gaps). The client fills it in; the vehicle numbers its own frames.",
+      },
+      {
+        name = "sysid",
+        role = "value",
+        size = 1,
+        big = false,
+        min = 1,
+        max = 255,
+        description = "The sending system's id (the vehicle's, 1 by default; a ground station usually uses 255).",
+      },
+      {
+        name = "compid",
+        role = "value",
+        size = 1,
+        big = false,
+        min = 0,
+        max = 255,
+        description = "The sending component's id (MAV_COMP_ID_AUTOPILOT1 = 1 for an autopilot; 190 for a ground station).",
+      },
+      {
+        name = "msgid",
+        role = "command",
+        size = 2,
+        big = false,
+        min = 0,
+        max = 65535,
+        description = "The message id's low 16 bits (the id is 24 bits, little-endian).",
+      },
+      {
+        name = "msgid_high",
+        role = "constant",
+        size = 1,
+        big = false,
+        constant = "\x00",
+        description = "The message id's high byte (0 for every message here).",
+      },
+      {
+        name = "payload",
+        role = "content",
+        size = 0,
+        big = false,
+        description = "The message's fields in wire order (largest type first), without their trailing zero bytes.",
+      },
+      {
+        name = "checksum",
+        role = "checksum",
+        size = 2,
+        big = false,
+        span = {2, 10},
+        checksum = {
+          algorithm = "seeded",
+          inner = {
+            algorithm = "crc",
+            name = "CRC-16/MCRF4XX",
+            width = 16,
+            poly = 4129,
+            init = 65535,
+            refin = true,
+            refout = true,
+            xorout = 0,
+          },
+          offset = 6,
+          code_size = 2,
+          little = true,
+          seeds = {
+            [0] = 50,
+            [1] = 124,
+            [20] = 214,
+            [22] = 220,
+            [23] = 168,
+            [30] = 39,
+            [33] = 104,
+            [76] = 152,
+            [77] = 143,
+          },
+        },
+        description = "CRC-16/MCRF4XX (MAVLink's X.25 CRC) of the bytes from the length to the payload, then the message's CRC_EXTRA byte (a hash of its definition: both sides must agree on the message's fields).",
+      },
+      {
+        name = "signature",
+        role = "optional",
+        size = 13,
+        big = false,
+        description = "The signature of a signed frame (MAVLink 2 message signing): the link id (u8), a timestamp (u48 little-endian, 10 \xc2\xb5s units since 2015-01-01 00:00 UTC) and 6 bytes, the first 6 bytes of SHA-256(secret key (32 bytes) + every byte of the frame before the signature + the link id + the timestamp). Not covered by the CRC. The codec carries the 13 bytes as they are; a receiver with the key recomputes the last 6 (`hashlib.sha256(key + frame[:-6]).digest()[:6] == frame[-6:]`).",
+      },
+    },
+  },
+  {
+    elements = {
+      {
+        name = "stx",
+        role = "header",
+        size = 1,
+        big = false,
+        constant = "\xfd",
+        description = "Start of a MAVLink v2 frame (v1 frames start with 0xFE and are not covered).",
+      },
+      {
+        name = "length",
+        role = "length",
+        size = 1,
+        big = false,
+        span = {10, 10},
+        adds = 0,
+        description = "Payload bytes sent (after the trailing zeros were cut).",
+      },
+      {
+        name = "incompat_flags",
+        role = "constant",
+        size = 1,
+        big = false,
+        constant = "\x00",
+        description = "Incompatibility flags: a receiver must refuse a frame with a flag it does not know. Bit 0 (0x01) marks a signed frame: set when the message has a `signature`, clear when it has none.",
       },
       {
         name = "compat_flags",
@@ -1344,7 +1474,8 @@ for _, direction in pairs(SPEC.directions) do
     for index, element in ipairs(layout.elements) do
       layout.overhead = layout.overhead + element.size
       local abbr = P .. ".frame." .. element.name
-      if element.role == "header" or element.role == "trailer" or element.role == "constant" then
+      if element.role == "header" or element.role == "trailer" or element.role == "constant"
+        or element.role == "optional" then -- optional: bytes sent when its flag bit is set (this layout's variant)
         element.pf = new(abbr, function() return ProtoField.bytes(abbr, element.name, base.SPACE, element.description) end)
       elseif element.role ~= "content" then
         local display = element.role == "checksum" and base.HEX or base.DEC
@@ -1782,6 +1913,8 @@ local function entry_of(direction, code)
 end
 
 local function plausible(element, value)
+  -- need: {mask, bits} a value flag element has under the mask in a variant with (or without) an optional element
+  if element.need and band(value, element.need[1]) ~= element.need[2] then return false end
   return (value >= element.min and value <= element.max) or value == element.broadcast
 end
 
@@ -2017,6 +2150,8 @@ local function dissect_frame(direction_name, direction, layout, entry, tvb, data
         item:add_proto_expert_info(e_malformed, element.name .. " is not the constant the spec gives")
         ok = false
       end
+    elseif role == "optional" then
+      root:add(element.pf, ranges[index])
     elseif role == "content" then
       local done, problem = pcall(decode_content, message, ranges[index], #plain[index], root)
       if not done then

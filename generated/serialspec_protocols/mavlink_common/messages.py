@@ -13,6 +13,7 @@ from serialspec.runtime.fields import flags as _as_flags
 from serialspec.runtime.fields import get as _get
 from serialspec.runtime.fields import integer as _integer
 from serialspec.runtime.fields import number as _number
+from serialspec.runtime.fields import optional_bytes as _optional_bytes
 from serialspec.runtime.fields import text as _text
 from serialspec.runtime.message import Direction, Message
 from serialspec.runtime.message import build as _build
@@ -308,7 +309,7 @@ class HeartbeatResponse(Message):
     """HEARTBEAT (response). Sent by the device on its own."""
 
     __slots__ = ()
-    __match_args__ = ('seq', 'sysid', 'compid', 'custom_mode', 'type', 'autopilot', 'base_mode', 'system_status', 'mavlink_version')
+    __match_args__ = ('seq', 'sysid', 'compid', 'custom_mode', 'type', 'autopilot', 'base_mode', 'system_status', 'mavlink_version', 'signature')
     PROTOCOL: ClassVar[str] = 'mavlink_common'
     COMMAND: ClassVar[str] = 'heartbeat'
     SUBCOMMAND: ClassVar[str | None] = None
@@ -331,6 +332,8 @@ class HeartbeatResponse(Message):
     system_status: MavState | int
     #: The MAVLink version the sender implements (3: the current version).
     mavlink_version: int
+    #: The signature of a signed frame (MAVLink 2 message signing): the link id (u8), a timestamp (u48 little-endian, 10 µs units since 2015-01-01 00:00 UTC) and 6 bytes, the first 6 bytes of SHA-256(secret key (32 bytes) + every byte of the frame before the signature + the link id + the timestamp). Not covered by the CRC. The codec carries the 13 bytes as they are; a receiver with the key recomputes the last 6 (`hashlib.sha256(key + frame[:-6]).digest()[:6] == frame[-6:]`). (13 bytes, or None)
+    signature: bytes | None = None
 
     def __new__(
         cls,
@@ -343,8 +346,9 @@ class HeartbeatResponse(Message):
         base_mode: MavModeFlag,
         system_status: MavState | int,
         mavlink_version: int,
+        signature: bytes | None = None,
     ) -> Self:
-        return _build(cls, (seq, sysid, compid, custom_mode, type, autopilot, base_mode, system_status, mavlink_version))
+        return _build(cls, (seq, sysid, compid, custom_mode, type, autopilot, base_mode, system_status, mavlink_version, signature))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -357,11 +361,12 @@ class HeartbeatResponse(Message):
             'base_mode': int(self.base_mode),
             'system_status': int(self.system_status),
             'mavlink_version': self.mavlink_version,
+            'signature': None if self.signature is None else self.signature.hex(' '),
         }
 
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'heartbeat response') -> Self:
-        _check_keys(data, ('seq', 'sysid', 'compid', 'custom_mode', 'type', 'autopilot', 'base_mode', 'system_status', 'mavlink_version'), (), where)
+        _check_keys(data, ('seq', 'sysid', 'compid', 'custom_mode', 'type', 'autopilot', 'base_mode', 'system_status', 'mavlink_version', 'signature'), (), where)
         return cls(
             _integer(_get(data, 'seq', where), 'seq', where),
             _integer(_get(data, 'sysid', where), 'sysid', where),
@@ -372,6 +377,7 @@ class HeartbeatResponse(Message):
             _as_flags(MavModeFlag, _get(data, 'base_mode', where), 255, 'base_mode', where),
             _as_enum(MavState, _get(data, 'system_status', where), 'system_status', where),
             _integer(_get(data, 'mavlink_version', where), 'mavlink_version', where),
+            _optional_bytes(data, 'signature', where),
         )
 
 
@@ -379,7 +385,7 @@ class SysStatusResponse(Message):
     """SYS_STATUS (response). Sent by the device on its own."""
 
     __slots__ = ()
-    __match_args__ = ('seq', 'sysid', 'compid', 'onboard_control_sensors_present', 'onboard_control_sensors_enabled', 'onboard_control_sensors_health', 'load', 'voltage_battery', 'current_battery', 'drop_rate_comm', 'errors_comm', 'errors_count1', 'errors_count2', 'errors_count3', 'errors_count4', 'battery_remaining', 'onboard_control_sensors_present_extended', 'onboard_control_sensors_enabled_extended', 'onboard_control_sensors_health_extended')
+    __match_args__ = ('seq', 'sysid', 'compid', 'onboard_control_sensors_present', 'onboard_control_sensors_enabled', 'onboard_control_sensors_health', 'load', 'voltage_battery', 'current_battery', 'drop_rate_comm', 'errors_comm', 'errors_count1', 'errors_count2', 'errors_count3', 'errors_count4', 'battery_remaining', 'onboard_control_sensors_present_extended', 'onboard_control_sensors_enabled_extended', 'onboard_control_sensors_health_extended', 'signature')
     PROTOCOL: ClassVar[str] = 'mavlink_common'
     COMMAND: ClassVar[str] = 'sys_status'
     SUBCOMMAND: ClassVar[str | None] = None
@@ -422,6 +428,8 @@ class SysStatusResponse(Message):
     onboard_control_sensors_enabled_extended: int
     #: Extension: MAV_SYS_STATUS_SENSOR_EXTENDED bits of the sensors healthy.
     onboard_control_sensors_health_extended: int
+    #: The signature of a signed frame (MAVLink 2 message signing): the link id (u8), a timestamp (u48 little-endian, 10 µs units since 2015-01-01 00:00 UTC) and 6 bytes, the first 6 bytes of SHA-256(secret key (32 bytes) + every byte of the frame before the signature + the link id + the timestamp). Not covered by the CRC. The codec carries the 13 bytes as they are; a receiver with the key recomputes the last 6 (`hashlib.sha256(key + frame[:-6]).digest()[:6] == frame[-6:]`). (13 bytes, or None)
+    signature: bytes | None = None
 
     def __new__(
         cls,
@@ -444,8 +452,9 @@ class SysStatusResponse(Message):
         onboard_control_sensors_present_extended: int,
         onboard_control_sensors_enabled_extended: int,
         onboard_control_sensors_health_extended: int,
+        signature: bytes | None = None,
     ) -> Self:
-        return _build(cls, (seq, sysid, compid, onboard_control_sensors_present, onboard_control_sensors_enabled, onboard_control_sensors_health, load, voltage_battery, current_battery, drop_rate_comm, errors_comm, errors_count1, errors_count2, errors_count3, errors_count4, battery_remaining, onboard_control_sensors_present_extended, onboard_control_sensors_enabled_extended, onboard_control_sensors_health_extended))
+        return _build(cls, (seq, sysid, compid, onboard_control_sensors_present, onboard_control_sensors_enabled, onboard_control_sensors_health, load, voltage_battery, current_battery, drop_rate_comm, errors_comm, errors_count1, errors_count2, errors_count3, errors_count4, battery_remaining, onboard_control_sensors_present_extended, onboard_control_sensors_enabled_extended, onboard_control_sensors_health_extended, signature))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -468,11 +477,12 @@ class SysStatusResponse(Message):
             'onboard_control_sensors_present_extended': self.onboard_control_sensors_present_extended,
             'onboard_control_sensors_enabled_extended': self.onboard_control_sensors_enabled_extended,
             'onboard_control_sensors_health_extended': self.onboard_control_sensors_health_extended,
+            'signature': None if self.signature is None else self.signature.hex(' '),
         }
 
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'sys_status response') -> Self:
-        _check_keys(data, ('seq', 'sysid', 'compid', 'onboard_control_sensors_present', 'onboard_control_sensors_enabled', 'onboard_control_sensors_health', 'load', 'voltage_battery', 'current_battery', 'drop_rate_comm', 'errors_comm', 'errors_count1', 'errors_count2', 'errors_count3', 'errors_count4', 'battery_remaining', 'onboard_control_sensors_present_extended', 'onboard_control_sensors_enabled_extended', 'onboard_control_sensors_health_extended'), (), where)
+        _check_keys(data, ('seq', 'sysid', 'compid', 'onboard_control_sensors_present', 'onboard_control_sensors_enabled', 'onboard_control_sensors_health', 'load', 'voltage_battery', 'current_battery', 'drop_rate_comm', 'errors_comm', 'errors_count1', 'errors_count2', 'errors_count3', 'errors_count4', 'battery_remaining', 'onboard_control_sensors_present_extended', 'onboard_control_sensors_enabled_extended', 'onboard_control_sensors_health_extended', 'signature'), (), where)
         return cls(
             _integer(_get(data, 'seq', where), 'seq', where),
             _integer(_get(data, 'sysid', where), 'sysid', where),
@@ -493,6 +503,7 @@ class SysStatusResponse(Message):
             _integer(_get(data, 'onboard_control_sensors_present_extended', where), 'onboard_control_sensors_present_extended', where),
             _integer(_get(data, 'onboard_control_sensors_enabled_extended', where), 'onboard_control_sensors_enabled_extended', where),
             _integer(_get(data, 'onboard_control_sensors_health_extended', where), 'onboard_control_sensors_health_extended', where),
+            _optional_bytes(data, 'signature', where),
         )
 
 
@@ -500,7 +511,7 @@ class ParamRequestReadRequest(Message):
     """PARAM_REQUEST_READ (request)."""
 
     __slots__ = ()
-    __match_args__ = ('seq', 'sysid', 'compid', 'param_index', 'target_system', 'target_component', 'param_id')
+    __match_args__ = ('seq', 'sysid', 'compid', 'param_index', 'target_system', 'target_component', 'param_id', 'signature')
     PROTOCOL: ClassVar[str] = 'mavlink_common'
     COMMAND: ClassVar[str] = 'param_request_read'
     SUBCOMMAND: ClassVar[str | None] = None
@@ -519,6 +530,8 @@ class ParamRequestReadRequest(Message):
     target_component: int
     #: The parameter's name (e.g. SYSID_THISMAV): up to 16 characters, NUL-padded (no NUL when all 16 are used).
     param_id: str
+    #: The signature of a signed frame (MAVLink 2 message signing): the link id (u8), a timestamp (u48 little-endian, 10 µs units since 2015-01-01 00:00 UTC) and 6 bytes, the first 6 bytes of SHA-256(secret key (32 bytes) + every byte of the frame before the signature + the link id + the timestamp). Not covered by the CRC. The codec carries the 13 bytes as they are; a receiver with the key recomputes the last 6 (`hashlib.sha256(key + frame[:-6]).digest()[:6] == frame[-6:]`). (13 bytes, or None)
+    signature: bytes | None = None
 
     def __new__(
         cls,
@@ -529,8 +542,9 @@ class ParamRequestReadRequest(Message):
         target_system: int,
         target_component: int,
         param_id: str,
+        signature: bytes | None = None,
     ) -> Self:
-        return _build(cls, (seq, sysid, compid, param_index, target_system, target_component, param_id))
+        return _build(cls, (seq, sysid, compid, param_index, target_system, target_component, param_id, signature))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -541,11 +555,12 @@ class ParamRequestReadRequest(Message):
             'target_system': self.target_system,
             'target_component': self.target_component,
             'param_id': self.param_id,
+            'signature': None if self.signature is None else self.signature.hex(' '),
         }
 
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'param_request_read request') -> Self:
-        _check_keys(data, ('seq', 'sysid', 'compid', 'param_index', 'target_system', 'target_component', 'param_id'), (), where)
+        _check_keys(data, ('seq', 'sysid', 'compid', 'param_index', 'target_system', 'target_component', 'param_id', 'signature'), (), where)
         return cls(
             _integer(_get(data, 'seq', where), 'seq', where),
             _integer(_get(data, 'sysid', where), 'sysid', where),
@@ -554,6 +569,7 @@ class ParamRequestReadRequest(Message):
             _integer(_get(data, 'target_system', where), 'target_system', where),
             _integer(_get(data, 'target_component', where), 'target_component', where),
             _text(_get(data, 'param_id', where), 'param_id', where),
+            _optional_bytes(data, 'signature', where),
         )
 
 
@@ -561,7 +577,7 @@ class ParamValueResponse(Message):
     """PARAM_VALUE (response)."""
 
     __slots__ = ()
-    __match_args__ = ('seq', 'sysid', 'compid', 'param_value', 'param_count', 'param_index', 'param_id', 'param_type')
+    __match_args__ = ('seq', 'sysid', 'compid', 'param_value', 'param_count', 'param_index', 'param_id', 'param_type', 'signature')
     PROTOCOL: ClassVar[str] = 'mavlink_common'
     COMMAND: ClassVar[str] = 'param_value'
     SUBCOMMAND: ClassVar[str | None] = None
@@ -582,6 +598,8 @@ class ParamValueResponse(Message):
     param_id: str
     #: The type of the parameter's value.
     param_type: MavParamType | int
+    #: The signature of a signed frame (MAVLink 2 message signing): the link id (u8), a timestamp (u48 little-endian, 10 µs units since 2015-01-01 00:00 UTC) and 6 bytes, the first 6 bytes of SHA-256(secret key (32 bytes) + every byte of the frame before the signature + the link id + the timestamp). Not covered by the CRC. The codec carries the 13 bytes as they are; a receiver with the key recomputes the last 6 (`hashlib.sha256(key + frame[:-6]).digest()[:6] == frame[-6:]`). (13 bytes, or None)
+    signature: bytes | None = None
 
     def __new__(
         cls,
@@ -593,8 +611,9 @@ class ParamValueResponse(Message):
         param_index: int,
         param_id: str,
         param_type: MavParamType | int,
+        signature: bytes | None = None,
     ) -> Self:
-        return _build(cls, (seq, sysid, compid, param_value, param_count, param_index, param_id, param_type))
+        return _build(cls, (seq, sysid, compid, param_value, param_count, param_index, param_id, param_type, signature))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -606,11 +625,12 @@ class ParamValueResponse(Message):
             'param_index': self.param_index,
             'param_id': self.param_id,
             'param_type': int(self.param_type),
+            'signature': None if self.signature is None else self.signature.hex(' '),
         }
 
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'param_value response') -> Self:
-        _check_keys(data, ('seq', 'sysid', 'compid', 'param_value', 'param_count', 'param_index', 'param_id', 'param_type'), (), where)
+        _check_keys(data, ('seq', 'sysid', 'compid', 'param_value', 'param_count', 'param_index', 'param_id', 'param_type', 'signature'), (), where)
         return cls(
             _integer(_get(data, 'seq', where), 'seq', where),
             _integer(_get(data, 'sysid', where), 'sysid', where),
@@ -620,6 +640,7 @@ class ParamValueResponse(Message):
             _integer(_get(data, 'param_index', where), 'param_index', where),
             _text(_get(data, 'param_id', where), 'param_id', where),
             _as_enum(MavParamType, _get(data, 'param_type', where), 'param_type', where),
+            _optional_bytes(data, 'signature', where),
         )
 
 
@@ -627,7 +648,7 @@ class ParamSetRequest(Message):
     """PARAM_SET (request)."""
 
     __slots__ = ()
-    __match_args__ = ('seq', 'sysid', 'compid', 'param_value', 'target_system', 'target_component', 'param_id', 'param_type')
+    __match_args__ = ('seq', 'sysid', 'compid', 'param_value', 'target_system', 'target_component', 'param_id', 'param_type', 'signature')
     PROTOCOL: ClassVar[str] = 'mavlink_common'
     COMMAND: ClassVar[str] = 'param_set'
     SUBCOMMAND: ClassVar[str | None] = None
@@ -648,6 +669,8 @@ class ParamSetRequest(Message):
     param_id: str
     #: The type of the parameter's value.
     param_type: MavParamType | int
+    #: The signature of a signed frame (MAVLink 2 message signing): the link id (u8), a timestamp (u48 little-endian, 10 µs units since 2015-01-01 00:00 UTC) and 6 bytes, the first 6 bytes of SHA-256(secret key (32 bytes) + every byte of the frame before the signature + the link id + the timestamp). Not covered by the CRC. The codec carries the 13 bytes as they are; a receiver with the key recomputes the last 6 (`hashlib.sha256(key + frame[:-6]).digest()[:6] == frame[-6:]`). (13 bytes, or None)
+    signature: bytes | None = None
 
     def __new__(
         cls,
@@ -659,8 +682,9 @@ class ParamSetRequest(Message):
         target_component: int,
         param_id: str,
         param_type: MavParamType | int,
+        signature: bytes | None = None,
     ) -> Self:
-        return _build(cls, (seq, sysid, compid, param_value, target_system, target_component, param_id, param_type))
+        return _build(cls, (seq, sysid, compid, param_value, target_system, target_component, param_id, param_type, signature))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -672,11 +696,12 @@ class ParamSetRequest(Message):
             'target_component': self.target_component,
             'param_id': self.param_id,
             'param_type': int(self.param_type),
+            'signature': None if self.signature is None else self.signature.hex(' '),
         }
 
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'param_set request') -> Self:
-        _check_keys(data, ('seq', 'sysid', 'compid', 'param_value', 'target_system', 'target_component', 'param_id', 'param_type'), (), where)
+        _check_keys(data, ('seq', 'sysid', 'compid', 'param_value', 'target_system', 'target_component', 'param_id', 'param_type', 'signature'), (), where)
         return cls(
             _integer(_get(data, 'seq', where), 'seq', where),
             _integer(_get(data, 'sysid', where), 'sysid', where),
@@ -686,6 +711,7 @@ class ParamSetRequest(Message):
             _integer(_get(data, 'target_component', where), 'target_component', where),
             _text(_get(data, 'param_id', where), 'param_id', where),
             _as_enum(MavParamType, _get(data, 'param_type', where), 'param_type', where),
+            _optional_bytes(data, 'signature', where),
         )
 
 
@@ -693,7 +719,7 @@ class AttitudeResponse(Message):
     """ATTITUDE (response). Sent by the device on its own."""
 
     __slots__ = ()
-    __match_args__ = ('seq', 'sysid', 'compid', 'time_boot_ms', 'roll', 'pitch', 'yaw', 'rollspeed', 'pitchspeed', 'yawspeed')
+    __match_args__ = ('seq', 'sysid', 'compid', 'time_boot_ms', 'roll', 'pitch', 'yaw', 'rollspeed', 'pitchspeed', 'yawspeed', 'signature')
     PROTOCOL: ClassVar[str] = 'mavlink_common'
     COMMAND: ClassVar[str] = 'attitude'
     SUBCOMMAND: ClassVar[str | None] = None
@@ -718,6 +744,8 @@ class AttitudeResponse(Message):
     pitchspeed: float
     #: Yaw angular speed. [rad/s]
     yawspeed: float
+    #: The signature of a signed frame (MAVLink 2 message signing): the link id (u8), a timestamp (u48 little-endian, 10 µs units since 2015-01-01 00:00 UTC) and 6 bytes, the first 6 bytes of SHA-256(secret key (32 bytes) + every byte of the frame before the signature + the link id + the timestamp). Not covered by the CRC. The codec carries the 13 bytes as they are; a receiver with the key recomputes the last 6 (`hashlib.sha256(key + frame[:-6]).digest()[:6] == frame[-6:]`). (13 bytes, or None)
+    signature: bytes | None = None
 
     def __new__(
         cls,
@@ -731,8 +759,9 @@ class AttitudeResponse(Message):
         rollspeed: float,
         pitchspeed: float,
         yawspeed: float,
+        signature: bytes | None = None,
     ) -> Self:
-        return _build(cls, (seq, sysid, compid, time_boot_ms, roll, pitch, yaw, rollspeed, pitchspeed, yawspeed))
+        return _build(cls, (seq, sysid, compid, time_boot_ms, roll, pitch, yaw, rollspeed, pitchspeed, yawspeed, signature))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -746,11 +775,12 @@ class AttitudeResponse(Message):
             'rollspeed': self.rollspeed,
             'pitchspeed': self.pitchspeed,
             'yawspeed': self.yawspeed,
+            'signature': None if self.signature is None else self.signature.hex(' '),
         }
 
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'attitude response') -> Self:
-        _check_keys(data, ('seq', 'sysid', 'compid', 'time_boot_ms', 'roll', 'pitch', 'yaw', 'rollspeed', 'pitchspeed', 'yawspeed'), (), where)
+        _check_keys(data, ('seq', 'sysid', 'compid', 'time_boot_ms', 'roll', 'pitch', 'yaw', 'rollspeed', 'pitchspeed', 'yawspeed', 'signature'), (), where)
         return cls(
             _integer(_get(data, 'seq', where), 'seq', where),
             _integer(_get(data, 'sysid', where), 'sysid', where),
@@ -762,6 +792,7 @@ class AttitudeResponse(Message):
             _number(_get(data, 'rollspeed', where), 'rollspeed', where),
             _number(_get(data, 'pitchspeed', where), 'pitchspeed', where),
             _number(_get(data, 'yawspeed', where), 'yawspeed', where),
+            _optional_bytes(data, 'signature', where),
         )
 
 
@@ -769,7 +800,7 @@ class GlobalPositionIntResponse(Message):
     """GLOBAL_POSITION_INT (response). Sent by the device on its own."""
 
     __slots__ = ()
-    __match_args__ = ('seq', 'sysid', 'compid', 'time_boot_ms', 'lat', 'lon', 'alt', 'relative_alt', 'vx', 'vy', 'vz', 'hdg')
+    __match_args__ = ('seq', 'sysid', 'compid', 'time_boot_ms', 'lat', 'lon', 'alt', 'relative_alt', 'vx', 'vy', 'vz', 'hdg', 'signature')
     PROTOCOL: ClassVar[str] = 'mavlink_common'
     COMMAND: ClassVar[str] = 'global_position_int'
     SUBCOMMAND: ClassVar[str | None] = None
@@ -798,6 +829,8 @@ class GlobalPositionIntResponse(Message):
     vz: int
     #: Heading (yaw) 0..35999; 65535 when not known. [0.01°]
     hdg: int
+    #: The signature of a signed frame (MAVLink 2 message signing): the link id (u8), a timestamp (u48 little-endian, 10 µs units since 2015-01-01 00:00 UTC) and 6 bytes, the first 6 bytes of SHA-256(secret key (32 bytes) + every byte of the frame before the signature + the link id + the timestamp). Not covered by the CRC. The codec carries the 13 bytes as they are; a receiver with the key recomputes the last 6 (`hashlib.sha256(key + frame[:-6]).digest()[:6] == frame[-6:]`). (13 bytes, or None)
+    signature: bytes | None = None
 
     def __new__(
         cls,
@@ -813,8 +846,9 @@ class GlobalPositionIntResponse(Message):
         vy: int,
         vz: int,
         hdg: int,
+        signature: bytes | None = None,
     ) -> Self:
-        return _build(cls, (seq, sysid, compid, time_boot_ms, lat, lon, alt, relative_alt, vx, vy, vz, hdg))
+        return _build(cls, (seq, sysid, compid, time_boot_ms, lat, lon, alt, relative_alt, vx, vy, vz, hdg, signature))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -830,11 +864,12 @@ class GlobalPositionIntResponse(Message):
             'vy': self.vy,
             'vz': self.vz,
             'hdg': self.hdg,
+            'signature': None if self.signature is None else self.signature.hex(' '),
         }
 
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'global_position_int response') -> Self:
-        _check_keys(data, ('seq', 'sysid', 'compid', 'time_boot_ms', 'lat', 'lon', 'alt', 'relative_alt', 'vx', 'vy', 'vz', 'hdg'), (), where)
+        _check_keys(data, ('seq', 'sysid', 'compid', 'time_boot_ms', 'lat', 'lon', 'alt', 'relative_alt', 'vx', 'vy', 'vz', 'hdg', 'signature'), (), where)
         return cls(
             _integer(_get(data, 'seq', where), 'seq', where),
             _integer(_get(data, 'sysid', where), 'sysid', where),
@@ -848,6 +883,7 @@ class GlobalPositionIntResponse(Message):
             _integer(_get(data, 'vy', where), 'vy', where),
             _integer(_get(data, 'vz', where), 'vz', where),
             _integer(_get(data, 'hdg', where), 'hdg', where),
+            _optional_bytes(data, 'signature', where),
         )
 
 
@@ -855,7 +891,7 @@ class CommandLongRequest(Message):
     """COMMAND_LONG (request)."""
 
     __slots__ = ()
-    __match_args__ = ('seq', 'sysid', 'compid', 'param1', 'param2', 'param3', 'param4', 'param5', 'param6', 'param7', 'command', 'target_system', 'target_component', 'confirmation')
+    __match_args__ = ('seq', 'sysid', 'compid', 'param1', 'param2', 'param3', 'param4', 'param5', 'param6', 'param7', 'command', 'target_system', 'target_component', 'confirmation', 'signature')
     PROTOCOL: ClassVar[str] = 'mavlink_common'
     COMMAND: ClassVar[str] = 'command_long'
     SUBCOMMAND: ClassVar[str | None] = None
@@ -888,6 +924,8 @@ class CommandLongRequest(Message):
     target_component: int
     #: 0 the first time; one more for each retransmission.
     confirmation: int
+    #: The signature of a signed frame (MAVLink 2 message signing): the link id (u8), a timestamp (u48 little-endian, 10 µs units since 2015-01-01 00:00 UTC) and 6 bytes, the first 6 bytes of SHA-256(secret key (32 bytes) + every byte of the frame before the signature + the link id + the timestamp). Not covered by the CRC. The codec carries the 13 bytes as they are; a receiver with the key recomputes the last 6 (`hashlib.sha256(key + frame[:-6]).digest()[:6] == frame[-6:]`). (13 bytes, or None)
+    signature: bytes | None = None
 
     def __new__(
         cls,
@@ -905,8 +943,9 @@ class CommandLongRequest(Message):
         target_system: int,
         target_component: int,
         confirmation: int,
+        signature: bytes | None = None,
     ) -> Self:
-        return _build(cls, (seq, sysid, compid, param1, param2, param3, param4, param5, param6, param7, command, target_system, target_component, confirmation))
+        return _build(cls, (seq, sysid, compid, param1, param2, param3, param4, param5, param6, param7, command, target_system, target_component, confirmation, signature))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -924,11 +963,12 @@ class CommandLongRequest(Message):
             'target_system': self.target_system,
             'target_component': self.target_component,
             'confirmation': self.confirmation,
+            'signature': None if self.signature is None else self.signature.hex(' '),
         }
 
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'command_long request') -> Self:
-        _check_keys(data, ('seq', 'sysid', 'compid', 'param1', 'param2', 'param3', 'param4', 'param5', 'param6', 'param7', 'command', 'target_system', 'target_component', 'confirmation'), (), where)
+        _check_keys(data, ('seq', 'sysid', 'compid', 'param1', 'param2', 'param3', 'param4', 'param5', 'param6', 'param7', 'command', 'target_system', 'target_component', 'confirmation', 'signature'), (), where)
         return cls(
             _integer(_get(data, 'seq', where), 'seq', where),
             _integer(_get(data, 'sysid', where), 'sysid', where),
@@ -944,6 +984,7 @@ class CommandLongRequest(Message):
             _integer(_get(data, 'target_system', where), 'target_system', where),
             _integer(_get(data, 'target_component', where), 'target_component', where),
             _integer(_get(data, 'confirmation', where), 'confirmation', where),
+            _optional_bytes(data, 'signature', where),
         )
 
 
@@ -951,7 +992,7 @@ class CommandAckResponse(Message):
     """COMMAND_ACK (response)."""
 
     __slots__ = ()
-    __match_args__ = ('seq', 'sysid', 'compid', 'command', 'result', 'progress', 'result_param2', 'target_system', 'target_component')
+    __match_args__ = ('seq', 'sysid', 'compid', 'command', 'result', 'progress', 'result_param2', 'target_system', 'target_component', 'signature')
     PROTOCOL: ClassVar[str] = 'mavlink_common'
     COMMAND: ClassVar[str] = 'command_ack'
     SUBCOMMAND: ClassVar[str | None] = None
@@ -974,6 +1015,8 @@ class CommandAckResponse(Message):
     target_system: int
     #: Extension: component id of the sender of the command acknowledged.
     target_component: int
+    #: The signature of a signed frame (MAVLink 2 message signing): the link id (u8), a timestamp (u48 little-endian, 10 µs units since 2015-01-01 00:00 UTC) and 6 bytes, the first 6 bytes of SHA-256(secret key (32 bytes) + every byte of the frame before the signature + the link id + the timestamp). Not covered by the CRC. The codec carries the 13 bytes as they are; a receiver with the key recomputes the last 6 (`hashlib.sha256(key + frame[:-6]).digest()[:6] == frame[-6:]`). (13 bytes, or None)
+    signature: bytes | None = None
 
     def __new__(
         cls,
@@ -986,8 +1029,9 @@ class CommandAckResponse(Message):
         result_param2: int,
         target_system: int,
         target_component: int,
+        signature: bytes | None = None,
     ) -> Self:
-        return _build(cls, (seq, sysid, compid, command, result, progress, result_param2, target_system, target_component))
+        return _build(cls, (seq, sysid, compid, command, result, progress, result_param2, target_system, target_component, signature))
 
     def to_fields(self) -> dict[str, Any]:
         return {
@@ -1000,11 +1044,12 @@ class CommandAckResponse(Message):
             'result_param2': self.result_param2,
             'target_system': self.target_system,
             'target_component': self.target_component,
+            'signature': None if self.signature is None else self.signature.hex(' '),
         }
 
     @classmethod
     def from_fields(cls, data: Mapping[str, Any], where: str = 'command_ack response') -> Self:
-        _check_keys(data, ('seq', 'sysid', 'compid', 'command', 'result', 'progress', 'result_param2', 'target_system', 'target_component'), (), where)
+        _check_keys(data, ('seq', 'sysid', 'compid', 'command', 'result', 'progress', 'result_param2', 'target_system', 'target_component', 'signature'), (), where)
         return cls(
             _integer(_get(data, 'seq', where), 'seq', where),
             _integer(_get(data, 'sysid', where), 'sysid', where),
@@ -1015,6 +1060,7 @@ class CommandAckResponse(Message):
             _integer(_get(data, 'result_param2', where), 'result_param2', where),
             _integer(_get(data, 'target_system', where), 'target_system', where),
             _integer(_get(data, 'target_component', where), 'target_component', where),
+            _optional_bytes(data, 'signature', where),
         )
 
 

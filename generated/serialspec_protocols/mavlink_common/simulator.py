@@ -42,14 +42,14 @@ DEVICE = DeviceSpec(
     reply={'sysid': 1.0, 'compid': 1.0, 'type': 2.0, 'autopilot': 12.0, 'base_mode': 0.0, 'system_status': 3.0, 'mavlink_version': 3.0, 'param_count': 1.0, 'param_index': 65535.0, 'result': 0.0},
     commands=(
         # param_request_read
-        CommandSpec(ParamRequestReadRequest, ParamValueResponse, reports={'param_value': 'value', 'param_type': 'value_type'}, echoes=('seq', 'param_id'), blanks={'param_id': ''}),
+        CommandSpec(ParamRequestReadRequest, ParamValueResponse, reports={'param_value': 'value', 'param_type': 'value_type'}, echoes=('seq', 'param_id'), blanks={'param_id': '', 'signature': None}),
         # param_set
-        CommandSpec(ParamSetRequest, ParamValueResponse, reports={'param_value': 'value', 'param_type': 'value_type'}, stores={'param_value': 'value', 'param_type': 'value_type'}, echoes=('seq', 'param_id'), blanks={'param_id': ''}),
+        CommandSpec(ParamSetRequest, ParamValueResponse, reports={'param_value': 'value', 'param_type': 'value_type'}, stores={'param_value': 'value', 'param_type': 'value_type'}, echoes=('seq', 'param_id'), blanks={'param_id': '', 'signature': None}),
         # command_long
-        CommandSpec(CommandLongRequest, CommandAckResponse, echoes=('seq', 'command')),
+        CommandSpec(CommandLongRequest, CommandAckResponse, echoes=('seq', 'command'), blanks={'signature': None}),
     ),
     sends=(
-        SendSpec(HeartbeatResponse, every=1.0, step='beats', values={'seq': lambda get: (get('beats') % 256)}),
+        SendSpec(HeartbeatResponse, every=1.0, step='beats', values={'seq': lambda get: (get('beats') % 256)}, blanks={'signature': None}),
     ),
 )
 

@@ -78,6 +78,7 @@ _REQUEST_FRAMES = FrameCodec(
             Element('msgid_high', 'constant', 1, constant=b'\x00'),
             Element('payload', 'content'),
             Element('checksum', 'checksum', 2, span=(1, 9), checksum=_CHECK_CHECKSUM),
+            Element('signature', 'optional', 13, flag=2, mask=0x01),
         )),
     ),
     {
@@ -98,6 +99,7 @@ _RESPONSE_FRAMES = FrameCodec(
             Element('msgid_high', 'constant', 1, constant=b'\x00'),
             Element('payload', 'content'),
             Element('checksum', 'checksum', 2, span=(1, 9), checksum=_CHECK_CHECKSUM),
+            Element('signature', 'optional', 13, flag=2, mask=0x01),
         )),
     ),
     {

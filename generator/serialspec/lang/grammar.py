@@ -744,7 +744,8 @@ FRAME_ELEMENT = Obj(
         "role": Str(
             "What the element is: constant bytes (header first, trailer last, constant anywhere, e.g. a reserved "
             "byte), a frame-level value (address, command, status, or a plain `value` every message carries: a "
-            "sequence number, a flags byte), the length, the content or a checksum.",
+            "sequence number, a flags byte), the length, the content, a checksum, or `optional` bytes that are "
+            "sent only when `present_if` holds (MAVLink v2's signature after the CRC).",
             choices=(
                 "header",
                 "trailer",
@@ -756,6 +757,7 @@ FRAME_ELEMENT = Obj(
                 "address",
                 "status",
                 "value",
+                "optional",
             ),
         ),
         "type": Str("Wire type of a value, length or checksum (default u8).", choices=SCALAR_TYPES),
@@ -826,6 +828,19 @@ FRAME_ELEMENT = Obj(
             "request: `decode` without one refuses it in one line (give `--request HEX`), the stream parser reads "
             "such replies only while a request is pending (the client and the simulator have it).",
             example=["address", "command"],
+        ),
+        "size": Int("optional: its size in bytes.", example=13),
+        "present_if": Str(
+            "optional: when the element is in the frame, as `<element> & <mask>`: it is there when any bit of "
+            "`mask` is set in that earlier element of fixed position before the content (a constant, value, address "
+            "or status). Messages carry the element's bytes as an attribute of its name (None: not sent) and "
+            "`--json` as hex. A constant flag element keeps its other bits: encode sets the mask's bits when the "
+            "message has the bytes and clears them when it has None; a value flag element is the message's own "
+            "value, and a message whose value and bytes disagree is refused before a byte is written. It lies "
+            "outside every length's and checksum's span and outside the transparency span (MAVLink v2: "
+            '`signature: {role: optional, size: 13, present_if: "incompat_flags & 0x01"}` after the CRC; a '
+            "receiver that knows the secret key checks it).",
+            example="incompat_flags & 0x01",
         ),
         "truncate": Str(
             "content: `trailing_zeros`, encode drops the content's trailing zero bytes (keeping at least one) and "

@@ -161,8 +161,9 @@ class TrailingZeros(Adapter):  # type: ignore[misc, type-arg, unused-ignore]
 class Framed(Adapter):  # type: ignore[misc, type-arg, unused-ignore]
     """A whole frame of any layout (stuffing, lengths and checksums anywhere), by the runtime's frame engine.
 
-    Parses to a Container of `layout` (its name), `code`, `values` (the address/status elements) and `content`; builds
-    from the same keys. Construct has no byte stuffing, so frames that are not of the classic shape use this.
+    Parses to a Container of `layout` (its name), `code`, `values` (the address/status elements), `content` and
+    `extras` (the optional elements sent, by name); builds from the same keys. Construct has no byte stuffing, so
+    frames that are not of the classic shape use this.
 
     Replies read with the request they answer (layouts chosen by command, a checksum over request bytes) parse
     with `layout=` (the layout's name) and `request=` (the request's frame) given: `RESPONSE_FRAME.parse(frame,
@@ -188,11 +189,15 @@ class Framed(Adapter):  # type: ignore[misc, type-arg, unused-ignore]
         else:
             unwrapped = self.codec.unwrap(bytes(obj), None, self._asked(context))
         return Container(
-            layout=unwrapped.layout.name, code=unwrapped.code, values=list(unwrapped.values), content=unwrapped.content
+            layout=unwrapped.layout.name,
+            code=unwrapped.code,
+            values=list(unwrapped.values),
+            content=unwrapped.content,
+            extras=dict(unwrapped.extras),
         )
 
     def _encode(self, obj: Any, context: Any, path: Any) -> bytes:
         layout = self._layout(obj.get("layout"))
         index = None if layout is None else self.codec.layouts.index(layout)
-        content, values = bytes(obj["content"]), tuple(obj["values"])
-        return bytes(self.codec.wrap(content, obj["code"], values, index, self._asked(context)))
+        content, values, extras = bytes(obj["content"]), tuple(obj["values"]), obj.get("extras")
+        return bytes(self.codec.wrap(content, obj["code"], values, index, self._asked(context), extras))

@@ -63,6 +63,12 @@ def as_bytes(value: Any, name: str, where: str) -> bytes:
     raise EncodeError(f"{where}: {name} must be hex text or a list of byte values, got {shown(value)}")
 
 
+def optional_bytes(data: Mapping[str, Any], name: str, where: str) -> bytes | None:
+    """An optional frame element's bytes (`present_if`): None when left out or null."""
+    value = data.get(name)
+    return None if value is None else as_bytes(value, name, where)
+
+
 E = TypeVar("E", bound=IntEnum)
 F = TypeVar("F", bound=IntFlag)
 

@@ -18,7 +18,7 @@ from __future__ import annotations
 import importlib
 import re
 from collections.abc import Callable, Iterable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, Literal
 
 from serialspec.runtime.errors import ChecksumError, DecodeError, EncodeError
@@ -27,7 +27,9 @@ from serialspec.runtime.stream import StreamParser
 from serialspec.transforms.base import SpanTransform
 from serialspec.transforms.replace import Transparency as Transparency  # generated code imports it from here
 
-ElementKind = Literal["constant", "value", "command", "length", "content", "checksum"]
+# optional: bytes sent only when a bit of an earlier (flag) element is set; a Layout holding one hands each frame
+# to its variants (`Layout.variants`), plain layouts in which it is an `extra` (fixed bytes) or left out.
+ElementKind = Literal["constant", "value", "command", "length", "content", "checksum", "optional", "extra"]
 
 
 @dataclass(frozen=True)
@@ -47,6 +49,9 @@ class Element:
     also: int | None = None  # value: one more value allowed (an address's broadcast)
     skip: tuple[int, ...] = ()  # checksum: elements inside the span left out (itself, other checksums)
     request: tuple[str, ...] = ()  # checksum (of a reply): the request's elements whose bytes it takes in first
+    flag: int = -1  # optional: the index of the element whose bit `mask` says it is sent
+    mask: int = 0
+    need: tuple[int, int] = (0, 0)  # value (in a variant): (mask, bits) the value must have under the mask
 
     def pack(self, value: int) -> bytes:
         return value.to_bytes(self.size, self.endian)
@@ -55,7 +60,7 @@ class Element:
         return int.from_bytes(data, self.endian)
 
     def plausible(self, value: int) -> bool:
-        return self.minimum <= value <= self.maximum or value == self.also
+        return (self.minimum <= value <= self.maximum or value == self.also) and value & self.need[0] == self.need[1]
 
 
 @dataclass(frozen=True)
@@ -66,6 +71,9 @@ class Layout:
     elements: tuple[Element, ...]
     transparency: SpanTransform | None = None
     codes: tuple[int, ...] | None = None  # the command codes sent in this layout (layouts chosen by command)
+    present: frozenset[str] = frozenset()  # a variant's optional elements sent (see `variants`)
+    conditions: tuple[tuple[int, int, Literal["little", "big"], int, int], ...] = ()  # a variant's flag bits:
+    # (offset, size, byte order, mask, bits) of each flag element, which a frame must match to be read in it
     # derived in __post_init__
     content: int = field(init=False, default=-1)
     values: tuple[int, ...] = field(init=False, default=())
@@ -78,6 +86,8 @@ class Layout:
         object.__setattr__(self, "values", tuple(i for i, k in enumerate(kinds) if k == "value"))
         object.__setattr__(self, "command", kinds.index("command") if "command" in kinds else None)
         object.__setattr__(self, "length", kinds.index("length") if "length" in kinds else None)
+        optional = [i for i, k in enumerate(kinds) if k == "optional"]
+        object.__setattr__(self, "_found", self._variants(optional[0]) if optional else (self,))
         # How unwrap cuts a frame, worked out once: fixed slices before and after the variable part, then the
         # variable part's own elements (fixed but for the content); the checks by kind, in element order.
         first, last = self._inner()
@@ -102,6 +112,7 @@ class Layout:
             "lengths": tuple((i, e) for i, e in enumerate(self.elements) if e.kind == "length"),
             "checksums": tuple((i, e) for i, e in enumerate(self.elements) if e.kind == "checksum"),
             "template": tuple(e.constant if e.kind == "constant" else bytes(e.size) for e in self.elements),
+            "extras": tuple(i for i, k in enumerate(kinds) if k == "extra"),
         }
         t = self.transparency
         inside = tuple(
@@ -141,6 +152,13 @@ class Layout:
         object.__setattr__(self, "_plan", plan)
 
     @property
+    def variants(self) -> tuple[Layout, ...]:
+        """The plain layouts (no optional element) that frames of this layout are read and written in: itself alone,
+        or, with optional elements, one for each choice of them sent or not (see `_variants`)."""
+        found: tuple[Layout, ...] = self._found  # type: ignore[attr-defined]
+        return found
+
+    @property
     def header(self) -> bytes:
         first = self.elements[0]
         return first.constant if first.kind == "constant" else b""
@@ -174,13 +192,89 @@ class Layout:
         first, _ = self._inner()
         return sum(e.size for e in self.elements[:index]) if index < first else None
 
+    def _variants(self, k: int) -> tuple[Layout, ...]:
+        """The plain layouts of a layout with optional elements, handing over to copies of itself: the first optional
+        element sent (an `extra`, its flag bit set) or left out (its flag bit clear, the spans after it moved up),
+        each copy doing the same with the next one. Every variant has a fixed head that tells it apart."""
+        element = self.elements[k]
+        flag = self.elements[element.flag]
+        offset = self.offset(element.flag)
+        assert offset is not None  # the spec language keeps the flag before anything variable
+        mask = element.mask
+        if flag.kind == "constant":
+            set_flag = replace(flag, constant=flag.pack(flag.unpack(flag.constant) | mask))
+            clear_flag = flag
+        else:
+            set_flag = replace(flag, need=(flag.need[0] | mask, flag.need[1] | mask))
+            clear_flag = replace(flag, need=(flag.need[0] | mask, flag.need[1]))
+        condition = (offset, flag.size, flag.endian)
+        sent = list(self.elements)
+        sent[element.flag], sent[k] = set_flag, replace(element, kind="extra")
+        with_it = Layout(
+            self.name,
+            tuple(sent),
+            self.transparency,
+            self.codes,
+            self.present | {element.name},
+            (*self.conditions, (*condition, mask, mask)),
+        )
+
+        def moved(index: int) -> int:
+            return index - 1 if index > k else index
+
+        left: list[Element] = []
+        for index, each in enumerate(self.elements):
+            if index == k:
+                continue
+            each = clear_flag if index == element.flag else each
+            left.append(
+                replace(
+                    each,
+                    span=(moved(each.span[0]), moved(each.span[1])),
+                    skip=tuple(moved(i) for i in each.skip),
+                    flag=moved(each.flag),
+                )
+            )
+        without = Layout(
+            self.name,
+            tuple(left),
+            self.transparency,
+            self.codes,
+            self.present,
+            (*self.conditions, (*condition, mask, 0)),
+        )
+        return (*with_it.variants, *without.variants)
+
+    def admits(self, frame: bytes) -> bool:
+        """Whether `frame` has this variant's flag bits (a plain layout admits every frame)."""
+        for offset, size, endian, mask, bits in self.conditions:
+            if len(frame) < offset + size or int.from_bytes(frame[offset : offset + size], endian) & mask != bits:
+                return False
+        return True
+
+    def variant(self, frame: bytes) -> Layout:
+        """The plain layout `frame` is read in: the variant whose flag bits it has (DecodeError: none)."""
+        for variant in self.variants:
+            if variant.admits(frame):
+                return variant
+        smallest = min(v.overhead for v in self.variants)
+        raise DecodeError(f"frame of {len(frame)} bytes is shorter than the smallest {self.name} frame ({smallest})")
+
     # --- encoding -------------------------------------------------------------------------------------------------
 
     def wrap(
-        self, content: bytes, code: int | None, values: tuple[int, ...], request: Mapping[str, bytes] | None = None
+        self,
+        content: bytes,
+        code: int | None,
+        values: tuple[int, ...],
+        request: Mapping[str, bytes] | None = None,
+        extras: Mapping[str, bytes | None] | None = None,
     ) -> bytes:
         """The frame around `content`; EncodeError when a value does not fit its element (the length, say).
-        `request`: the bytes of the request's elements by name, for a checksum that takes some in first."""
+        `request`: the bytes of the request's elements by name, for a checksum that takes some in first; `extras`:
+        the optional elements' bytes by name (None or left out: not sent)."""
+        if self.variants[0] is not self:
+            return self._sending(values, extras).wrap(content, code, values, request, extras)
         plan: dict[str, Any] = self._plan  # type: ignore[attr-defined]
         elements = self.elements
         plain: list[bytes] = list(plan["template"])  # constants in place, zeros for what is computed below
@@ -190,6 +284,14 @@ class Layout:
             plain[self.command] = _pack(elements[self.command], code or 0)
         for index, value in zip(self.values, values, strict=True):
             plain[index] = _pack(elements[index], value)
+        for index in plan["extras"]:
+            given = (extras or {}).get(elements[index].name)
+            if given is not None and not isinstance(given, bytes | bytearray):
+                raise EncodeError(f"{elements[index].name} must be bytes or None, got {type(given).__name__}")
+            if given is None or len(given) != elements[index].size:
+                shown = "none" if given is None else f"{len(given)}"
+                raise EncodeError(f"{elements[index].name}: {shown} bytes, expected {elements[index].size}")
+            plain[index] = bytes(given)
         wire: dict[int, bytes] = {}
         t = self.transparency
         for index, element in plan["inner_lengths"]:  # inside the transformed span: the plain bytes
@@ -213,6 +315,24 @@ class Layout:
                 covered = _requested(element, request, EncodeError) + covered
             plain[index] = self._checksum(element, covered)
         return self._wire(plain, wire, 0, len(elements) - 1)
+
+    def _sending(self, values: tuple[int, ...], extras: Mapping[str, bytes | None] | None) -> Layout:
+        """The variant that sends the optional elements given in `extras`; EncodeError where a value flag element's
+        bit (the message's own value) says otherwise."""
+        given = frozenset(name for name, data in (extras or {}).items() if data is not None)
+        flags = dict(zip(self.values, values, strict=True))
+        for element in self.elements:
+            if element.kind == "optional" and element.flag in flags:
+                flag = self.elements[element.flag]
+                if bool(flags[element.flag] & element.mask) != (element.name in given):
+                    sent = "given" if element.name in given else "not given"
+                    state = "set" if flags[element.flag] & element.mask else "clear"
+                    raise EncodeError(
+                        f"{element.name} is {sent} but {flag.name} = {flags[element.flag]} has bit "
+                        f"{element.mask:#04x} {state}"
+                    )
+        known = {e.name for e in self.elements if e.kind == "optional"}
+        return next(v for v in self.variants if v.present == given & known)
 
     def _covered(self, plain: list[bytes], wire: dict[int, bytes], element: Element) -> bytes:
         """The bytes a checksum covers: its span's, less the elements it skips (which lie outside any stuffing)."""
@@ -240,6 +360,8 @@ class Layout:
     def unwrap(self, frame: bytes, request: Mapping[str, bytes] | None = None) -> Unwrapped:
         """Check a complete frame (constants, lengths, stuffing, checksums) and take it apart. `request`: the
         bytes of the request's elements by name, for a checksum that takes some in first."""
+        if self.variants[0] is not self:
+            return self.variant(frame).unwrap(frame, request)
         plan: dict[str, Any] = self._plan  # type: ignore[attr-defined]
         before, after = plan["before"], plan["after"]
         n = len(frame)
@@ -295,7 +417,8 @@ class Layout:
                     f"its bytes give {expected:#0{2 + 2 * element.size}x}"
                 )
         content = plain[self.content] if self.content >= 0 else b""
-        return Unwrapped(self, code, values, content, tuple(plain))
+        extras = {elements[i].name: plain[i] for i in plan["extras"]}
+        return Unwrapped(self, code, values, content, tuple(plain), extras)
 
 
 def _code_at(layout: Layout, frame: bytes) -> int | None:
@@ -414,6 +537,7 @@ class Unwrapped:
     values: tuple[int, ...]
     content: bytes
     parts: tuple[bytes, ...] = ()  # every element's bytes, unstuffed
+    extras: Mapping[str, bytes] = field(default_factory=dict)  # the optional elements sent, by name
 
     def named(self) -> dict[str, bytes]:
         """Every element's bytes by its name (what a reply checksum over the request takes in)."""
@@ -466,12 +590,16 @@ class FrameCodec:
         read only with the request's reply class given; content_sizes and size_rules are then by reply class (all
         three keyed by the class's name, so the construct structs hold them without the message classes)."""
         self.layouts = tuple(layouts)
+        # the plain layouts the stream parser sizes frames in (a layout with optional elements: its variants), and
+        # the index of the layout each comes from
+        self.variants = tuple(variant for layout in self.layouts for variant in layout.variants)
+        self._origin = {id(v): i for i, layout in enumerate(self.layouts) for v in layout.variants}
         self.replies = replies or {}
         self.content_sizes = content_sizes  # content size bounds by code (plain bytes)
         self.size_rules = size_rules or {}
         self.error_flag = error_flag
         # probe() for each layout, its plan read once into a closure (what the stream parser calls per candidate)
-        self.sizers = tuple(self._sizer(layout) for layout in self.layouts)
+        self.sizers = tuple(self._sizer(layout) for layout in self.variants)
 
     @property
     def requests(self) -> bool:
@@ -485,16 +613,18 @@ class FrameCodec:
         values: tuple[int, ...],
         layout: int | None = None,
         request: Mapping[str, bytes] | None = None,
+        extras: Mapping[str, bytes | None] | None = None,
     ) -> bytes:
-        """The frame in the first layout that can hold it; `layout`: in that one (layouts chosen by command)."""
+        """The frame in the first layout that can hold it; `layout`: in that one (layouts chosen by command);
+        `extras`: the optional elements' bytes by name."""
         if layout is not None:
-            return self.layouts[layout].wrap(content, code, values, request)
+            return self.layouts[layout].wrap(content, code, values, request, extras)
         problem: EncodeError | None = None
         for candidate in self.layouts:
             if candidate.codes is not None and code not in candidate.codes:
                 continue
             try:
-                return candidate.wrap(content, code, values, request)
+                return candidate.wrap(content, code, values, request, extras)
             except EncodeError as exc:
                 problem = exc
         if problem is None:
@@ -551,7 +681,7 @@ class FrameCodec:
     def probe(self, layout: Layout, buffer: bytes, start: int, end: int, expect: Any = None) -> int | None:
         """Size of a plausible frame of `layout` at buffer[start:], None when more bytes are needed, -1 if none.
         `expect`: the reply class awaited, for replies read in the layout of their request (`replies`)."""
-        if self.replies and self.replies.get(_class_name(expect)) != self.layouts.index(layout):
+        if self.replies and self.replies.get(_class_name(expect)) != self._origin[id(layout)]:
             return -1  # no reply awaited, or one of another layout
         plan: dict[str, Any] = layout._plan  # type: ignore[attr-defined]
         available = end - start
@@ -687,7 +817,9 @@ class FrameCodec:
         constants = tuple((first, e.constant) for e, first, _ in head if e.kind == "constant")
         commands = tuple((first, stop, e.endian) for e, first, stop in head if e.kind == "command")
         values = tuple(
-            (first, stop, e.endian, e.minimum, e.maximum, e.also) for e, first, stop in head if e.kind == "value"
+            (first, stop, e.endian, e.minimum, e.maximum, e.also, *e.need)
+            for e, first, stop in head
+            if e.kind == "value"
         )
         content_sizes, size_rules, error_flag = self.content_sizes, self.size_rules, self.error_flag
         codeless = layout.command is None
@@ -722,13 +854,13 @@ class FrameCodec:
                 code = ERROR_REPLY if value & error_flag else value
                 if code not in content_sizes:
                     return -1
-            for first, stop, endian, minimum, maximum, also in values:
+            for first, stop, endian, minimum, maximum, also, mask, bits in values:
                 value = (
                     buffer[start + first]
                     if stop - first == 1
                     else int.from_bytes(buffer[start + first : start + stop], endian)
                 )
-                if not minimum <= value <= maximum and value != also:
+                if (not minimum <= value <= maximum and value != also) or value & mask != bits:
                     return -1
             low, high = content_sizes.get(code, (0, None))
             if measured is not None:
@@ -759,7 +891,7 @@ Verify = Callable[[bytes, int, int], bool]
 
 def _finder(formats: Iterable[tuple[FrameCodec, Decode]]) -> re.Pattern[bytes] | None:
     """Where a candidate of any layout can start (FrameCodec.head_pattern), as one pattern; None: at every byte."""
-    patterns = [codec.head_pattern(layout) for codec, _ in formats for layout in codec.layouts]
+    patterns = [codec.head_pattern(layout) for codec, _ in formats for layout in codec.variants]
     found = [pattern for pattern in patterns if pattern is not None]
     if not found or not all(found):  # a layout any byte can start (or none at all): every byte is a candidate
         return None
@@ -789,20 +921,20 @@ class FrameStreamParser(StreamParser):
         self._sizers = tuple(
             (self._by_request(codec, layout) if codec.replies else sizer, decode, codec.verifier(layout))
             for codec, decode in formats
-            for sizer, layout in zip(codec.sizers, codec.layouts, strict=True)
+            for sizer, layout in zip(codec.sizers, codec.variants, strict=True)
         )
         # replies read with the request they answer: the pending request, given to the decoder (see expect)
         self._requests = any(codec.requests for codec, _ in formats)
         self.request: Message | None = None
         # by a candidate's first byte, the sizers of the layouts that can start with it (a layout whose head begins
         # with a constant answers -1 for every other byte: it is not asked)
-        firsts = [codec.first_byte(layout) for codec, _ in formats for layout in codec.layouts]
+        firsts = [codec.first_byte(layout) for codec, _ in formats for layout in codec.variants]
         self._sizers_by_first = tuple(
             tuple(entry for entry, first in zip(self._sizers, firsts, strict=True) if first is None or first == byte)
             for byte in range(256)
         )
         self._pending = b""
-        headers = [layout.header for codec, _ in formats for layout in codec.layouts]
+        headers = [layout.header for codec, _ in formats for layout in codec.variants]
         self._headers = bool(all(headers))
         self._keep = max((len(h) for h in headers), default=1) - 1
         # no frame is shorter than its layout's fixed elements and the smallest content any command allows
@@ -811,7 +943,7 @@ class FrameStreamParser(StreamParser):
             min(
                 layout.overhead + min((low for low, _ in codec.content_sizes.values()), default=0)
                 for codec, _ in formats
-                for layout in codec.layouts
+                for layout in codec.variants
             ),
         )
         self._finder = _finder(formats)
@@ -944,7 +1076,7 @@ class EngineFormat:
     def size(self, buffer: bytes, position: int) -> int | None:
         """The size of a plausible frame at `position`; None if none starts there; past the buffer: wait."""
         waiting = False
-        for layout in self.codec.layouts:
+        for layout in self.codec.variants:
             size = self.codec.probe(layout, buffer, position, len(buffer))
             if size is None:
                 waiting = True

@@ -210,6 +210,8 @@ def refuse_layout(layout: FrameLayout) -> None:
     for e in elements:
         if e.type is not None and (e.type.size > 4 or e.type.signed or e.type.is_float):
             raise Unsupported(f"{where}: element {e.name} of type {e.type.name}")
+    if layout.optional:
+        raise Unsupported(f"{where}: an optional element ({layout.optional[0].name}, `present_if`)")
     t = layout.transparency
     if t is not None and t.transform.c_refusal():
         raise Unsupported(f"{where}: {t.transform.c_refusal()}")

@@ -21,6 +21,7 @@ KINDS: dict[str, ElementKind] = {
     "length": "length",
     "content": "content",
     "checksum": "checksum",
+    "optional": "optional",
 }
 
 
@@ -50,6 +51,8 @@ def runtime_element(layout: FrameLayout, element: FrameElement) -> Element:
         also=element.broadcast if kind in ("value", "command") else None,
         skip=skip,
         request=element.checksum.from_request if element.checksum is not None else (),
+        flag=layout.index(element.present_if[0]) if element.present_if[0] else -1,
+        mask=element.present_if[1],
     )
 
 
@@ -93,3 +96,13 @@ def refuse_by_command(protocol: Protocol) -> None:
         raise Unsupported("layouts chosen by command (`layout:`)")
     if protocol.framing.from_request:
         raise Unsupported("a reply checksum over bytes of its request (`from_request`)")
+
+
+def optional_elements(protocol: Protocol, direction: Direction) -> tuple[FrameElement, ...]:
+    """The optional elements (`present_if`) of a direction's layouts, each once, in element order: every message of
+    the direction carries their bytes, or None, after its other fields."""
+    found: dict[str, FrameElement] = {}
+    for layout in protocol.framing.alternatives.get(direction, ()):
+        for element in layout.optional:
+            found.setdefault(element.name, element)
+    return tuple(found.values())

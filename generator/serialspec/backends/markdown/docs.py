@@ -181,6 +181,17 @@ def message_context(protocol: Protocol, message: Message | None) -> dict[str, An
         for e in layout.value_elements
     ]
     rows += field_rows(message.fields, content_offset)
+    rows += [
+        Row(
+            "after the content",
+            e.name,
+            f"{e.size} bytes or none",
+            "",
+            "",
+            f"bit {e.present_if[1]:#04x} of `{e.present_if[0]}` set: sent; None: not sent. {e.description}",
+        )
+        for e in layout.optional
+    ]
     return {
         "direction": message.direction.value,
         "rows": [{k: cell(v) for k, v in vars(r).items()} for r in rows],
@@ -405,6 +416,8 @@ def frame_picture(protocol: Protocol) -> list[str]:
                 parts.append(e.constant.hex(" ").upper())
             elif e.role == "content":
                 parts.append(f"{e.name} (n bytes)")
+            elif e.role == "optional":
+                parts.append(f"[{e.name} ({e.size} bytes)]")
             else:
                 parts.append(e.name + (f" ({e.type.size} bytes)" if e.type and e.type.size > 1 else ""))
         lines.append((layout.direction.value + (f" {layout.name}" if layout.name else ""), parts))
@@ -444,9 +457,14 @@ def frame_context(protocol: Protocol, layout: FrameLayout) -> dict[str, Any]:
             low, high = number(e.minimum), number(e.maximum)
             counts = f"sequence number the client fills in: {low} first, one more per request, {low} again after {high}"
             description = ". ".join(p for p in (counts, e.description) if p)
+        elif e.role == "optional":
+            flag, mask = e.present_if
+            sent = f"sent only when bit {mask:#04x} of `{flag}` is set (messages: `{e.name}`, None when not sent)"
+            description = ". ".join(p for p in (sent, e.description) if p)
         else:
             description = e.description
         kind = e.type.name if e.type else ("bytes" if e.fixed else "n bytes")
+        kind = f"{e.size} bytes" if e.role == "optional" else kind
         if e.role == "length" and layout.classic:
             kind += f" = n + {layout.length_adds}" if layout.length_adds else " = n"
         elif e.role == "length":
@@ -460,6 +478,8 @@ def frame_context(protocol: Protocol, layout: FrameLayout) -> dict[str, Any]:
             where = "after the content" if e.role == "trailer" or layout.offsets.get(e.name) is None else where
         if e.role in (*VALUE_ROLES, "command", "length") and e.name not in layout.offsets:
             where = _value_offset(layout, e)  # after a content whose size varies
+        if e.role == "optional":
+            where = "after the content" if e.name not in layout.offsets else where
         rows.append(
             {
                 "offset": cell(where),
@@ -544,8 +564,12 @@ def general_worked(protocol: Protocol, checksum: Checksum) -> str:
         if index is None or layout.transparency is not None:
             continue
         try:
+            layout = layout.variant(example.frame)
             parts = layout.unwrap(example.frame).parts
         except SerialspecError:
+            continue
+        index = next((i for i, e in enumerate(layout.elements) if e.name == checksum.name), None)
+        if index is None:
             continue
         first, last = layout.elements[index].span
         skip = layout.elements[index].skip
@@ -559,6 +583,7 @@ def general_breakdown(protocol: Protocol, example: Example, message: Message | N
     layouts = runtime_layouts(protocol, example.direction)
     layout = next((lay for lay in layouts if example.frame.startswith(lay.header)), layouts[0])
     try:
+        layout = layout.variant(example.frame)  # with optional elements: the variant the frame is sent in
         unwrapped = layout.unwrap(example.frame)
     except SerialspecError as exc:  # the example verification reports it as a spec error; the page says it too
         return [{"bytes": example.frame.hex(" ").upper(), "field": "(frame)", "value": cell(f"does not decode: {exc}")}]
@@ -574,6 +599,8 @@ def general_breakdown(protocol: Protocol, example: Example, message: Message | N
             value = f"{e.unpack(part)} (bytes `{layout.elements[e.span[0]].name}`..`{layout.elements[e.span[1]].name}`)"
         elif e.kind == "checksum":
             value = "verifies"
+        elif e.kind == "extra":
+            value = "(sent: its flag bit is set)"
         rows.append({"bytes": part.hex(" ").upper(), "field": e.name, "value": cell(_show(value))})
     return rows
 

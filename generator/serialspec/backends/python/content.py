@@ -12,7 +12,7 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
 from typing import assert_never
 
-from serialspec.backends.common.frames import layout_index
+from serialspec.backends.common.frames import layout_index, optional_elements
 from serialspec.backends.common.numbers import number
 from serialspec.backends.python.checksum_code import checksum_expression, checksum_lines
 from serialspec.backends.python.dispatch import decoder_name, encoder_name
@@ -366,7 +366,13 @@ class PackageCode:
             self.helper(f)
         fields = [*self.frame_values(message.direction, message), *self.value_fields(message)]
         doc = f"{message.command} {message.subcommand or ''} {message.direction.value}".replace("  ", " ")
-        code = ClassCode(message.class_name, doc, "Message", self.attributes(fields))
+        # optional frame elements (`present_if`): their bytes, None when not sent, after every other field
+        optional = optional_elements(self.protocol, message.direction)
+        extras = [
+            Attribute(e.name, "bytes | None", one_line(f"{e.description or e.name} ({e.size} bytes, or None)"), "None")
+            for e in optional
+        ]
+        code = ClassCode(message.class_name, doc, "Message", [*self.attributes(fields), *extras])
         code.class_vars = [
             f"PROTOCOL: ClassVar[str] = {self.protocol.name!r}",
             f"COMMAND: ClassVar[str] = {message.command!r}",
@@ -374,13 +380,20 @@ class PackageCode:
             f"DIRECTION: ClassVar[Direction] = Direction.{message.direction.name}",
         ]
         code.to_fields = [f"{spec_key(f.name)}: {self.to_json(f, 'self.' + f.name)}," for f in fields]
-        code.read_from([self.from_json(f) for f in fields])
+        code.to_fields += [f"{e.name!r}: None if self.{e.name} is None else self.{e.name}.hex(' ')," for e in optional]
+        code.read_from(
+            [
+                *(self.from_json(f) for f in fields),
+                *(Calls(f"_optional_bytes(data, {e.name!r}, where)", ["_optional_bytes"]) for e in optional),
+            ]
+        )
         code.given_checks = self.given_checks(message)
         if code.given_checks:
             code.helpers |= {"_check_given"}
         self.message_classes.append(code)
         frame_names = [f.name for f in self.frame_values(message.direction, message)]
         extra = "".join(f", {name}: int" for name in frame_names)
+        extra += "".join(f", {e.name}: bytes | None = None" for e in optional)  # (straight-line code: not sent)
         decoder = fold_last_size_check(self.decoder(message, fields))
         self.decoders.append((decoder_name(message), message.class_name, extra, decoder))
         encoder = read_fields_once(deferred_item_checks(self.encoder(message, fields)), [f.name for f in fields])
@@ -430,7 +443,9 @@ class PackageCode:
         self.check_values(list(message.fields), body, where)
         frame_fields = all_fields[: len(all_fields) - len(self.value_fields(message))]
         frame_values = [self.after_unpack(f, f.name, body, where) or f.name for f in frame_fields]
-        names = [f.name for f in all_fields]
+        optional = [e.name for e in optional_elements(self.protocol, message.direction)]
+        names = [f.name for f in all_fields] + optional
+        values = [*values, *optional]
         assert len(names) == len(frame_values) + len(values), (message.class_name, names, frame_values, values)
         self.built[message.class_name] = names
         body.append(ReturnNew(message.class_name, (*frame_values, *values)))
@@ -825,12 +840,25 @@ class PackageCode:
             inline = frames and frame_encoder(
                 frames, parts, self.structs, code, frame_values, size, lambda fmt: self.struct(name, fmt)
             )
+            optional = optional_elements(self.protocol, message.direction)
+            extras = "".join(f", {e.name}=m.{e.name}" for e in optional)
+            guard: Block = []
+            if frames and optional:  # straight-line frames: one with optional elements' bytes is the engine's
+                given = " or ".join(f"m.{e.name} is not None" for e in optional)
+                engine = Code(
+                    f"return _wrap_{message.direction.value}_engine({', '.join([content, code, *frame_values])}"
+                    f"{extras})",
+                    lists=packed_lists(parts),
+                )
+                guard, extras = [If(given, (engine,))], ""
             if inline:  # the frame made here (backends/python/straight_frames.py): no call of the direction's wrap
-                return [*body, *inline]
+                return [*body, *guard, *inline]
+            body += guard
             arguments = ", ".join([content, code, *frame_values])
             framing = self.protocol.framing
             if framing.by_command or framing.from_request:  # its layout, and the request a reply answers
                 arguments += f", {layout_index(self.protocol, message)}, request"
+            arguments += extras
             # backends/python/straight_frames.py
             body.append(Code(f"return _wrap_{message.direction.value}({arguments})", lists=packed_lists(parts)))
             return body

@@ -27,8 +27,9 @@ ERROR_REPLY = "ERROR_REPLY"  # the codes key of error replies (runtime.framing.E
 
 def value_arguments(layout: FrameLayout) -> dict[str, str]:
     return {
-        "extra": "".join(f", {e.name}: int" for e in layout.value_elements),
-        "args": "".join(f", {e.name}" for e in layout.value_elements),
+        "extra": "".join(f", {e.name}: int" for e in layout.value_elements)
+        + "".join(f", {e.name}: bytes | None = None" for e in layout.optional),
+        "args": "".join(f", {e.name}" for e in (*layout.value_elements, *layout.optional)),
     }
 
 

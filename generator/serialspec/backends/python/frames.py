@@ -82,6 +82,8 @@ def element_expr(layout: FrameLayout, element: FrameElement) -> str:
             args.append(f"also={e.also}")
     if e.kind in ("length", "checksum"):
         args.append(f"span={e.span}")
+    if e.kind == "optional":
+        args += [f"flag={e.flag}", f"mask={e.mask:#04x}"]
     if e.adds:
         args.append(f"adds={e.adds}")
     if e.kind == "checksum":

@@ -149,6 +149,7 @@ FIELD_HELPERS = (
     ("mapping", "_mapping"),
     ("number", "_number"),
     ("numbers", "_numbers"),
+    ("optional_bytes", "_optional_bytes"),
     ("text", "_text"),
 )
 

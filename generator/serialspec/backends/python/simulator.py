@@ -195,6 +195,7 @@ def reply_blanks(protocol: Protocol, response: Message, filled: set[str]) -> dic
     named = {key.partition(".")[0] for key in (*device.reply, *device.status) if "." in key}
     layout = protocol.framing.layouts[response.direction]
     blanks |= {e.name: zero_bits(e.bits) for e in layout.value_elements if e.bits and e.name not in {*filled, *named}}
+    blanks |= {e.name: "None" for e in layout.optional if e.name not in filled}  # optional elements: not sent
     return {name: blank for name, blank in blanks.items() if blank != "0"}
 
 

@@ -42,7 +42,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
-from serialspec.backends.common.frames import runtime_layout, runtime_layouts
+from serialspec.backends.common.frames import optional_elements, runtime_layout, runtime_layouts
 from serialspec.backends.python.checksum_code import checksum_call, checksum_lines, checksum_name, checksum_setup
 from serialspec.backends.python.dispatch import (
     ERROR_REPLY,
@@ -122,6 +122,7 @@ class Target:
     expected: bool = False
     only: str = ""  # the one content decoder of frames that carry no command code: called directly
     requesting: bool = False  # frames read and made with the request they answer (layouts chosen by command)
+    optional: tuple[str, ...] = ()  # the optional elements (`present_if`) the messages carry: the engine's
 
 
 def straight(layout: Layout) -> bool:
@@ -130,6 +131,8 @@ def straight(layout: Layout) -> bool:
     over bytes inside the stuffed span only, multi-byte elements at fixed offsets in one byte order."""
     if layout.content < 0 or not isinstance(layout.transparency, Transparency | None):
         return False  # other transforms than substitution: the engine codes them
+    if layout.variants != (layout,):
+        return False  # optional elements: the engine's variants
     first, last = _variable(layout)
     if not first <= layout.content <= last:
         return False
@@ -671,11 +674,14 @@ def engine_lines(layouts: tuple[Layout, ...], target: Target) -> tuple[Lines, Li
     values = [f"v_{v}" for v in target.value_names]
     shown = f"({values[0]},)" if len(values) == 1 else f"({', '.join(values)})"
     parameters = ", ".join(["content: bytes", "code: int | None", *(f"{v}: int" for v in values)])
+    optional = "".join(f", {name}: bytes | None = None" for name in target.optional)
+    extras = ", {" + ", ".join(f"{name!r}: {name}" for name in target.optional) + "}" if target.optional else ""
     if target.requesting:  # the layout by the message's command, the request's bytes for a checksum over them
         wrap = [
-            f"def _wrap_{direction}({parameters}, layout: int | None = None, request: Message | None = None) -> bytes:",
+            f"def _wrap_{direction}({parameters}, layout: int | None = None, request: Message | None = None"
+            f"{optional}) -> bytes:",
             f'    """The {direction} frame around `content` in its layout, made by the frame engine."""',
-            f"    return {frames}.wrap(content, code, {shown}, layout, _request_parts(request))",
+            f"    return {frames}.wrap(content, code, {shown}, layout, _request_parts(request){extras})",
         ]
         decode = [
             f"def _decode_{direction}(frame: bytes, expect: type[Message] | None = None, "
@@ -692,9 +698,9 @@ def engine_lines(layouts: tuple[Layout, ...], target: Target) -> tuple[Lines, Li
         ]
         return _engine_decode(decode, target), wrap
     wrap = [
-        f"def _wrap_{direction}({parameters}) -> bytes:",
+        f"def _wrap_{direction}({parameters}{optional}) -> bytes:",
         f'    """The {direction} frame around `content`, made by the frame engine."""',
-        f"    return {frames}.wrap(content, code, {shown})",
+        f"    return {frames}.wrap(content, code, {shown}{', None, None' + extras if extras else ''})",
     ]
     decode = [
         f"def _decode_{direction}(frame: bytes, expect: type[Message] | None = None) -> Message:",
@@ -708,6 +714,7 @@ def engine_lines(layouts: tuple[Layout, ...], target: Target) -> tuple[Lines, Li
 def _engine_decode(decode: Lines, target: Target) -> Lines:
     """The engine's decode function, its content dispatched by code (and by the expected class)."""
     arguments = "content, 0, len(content), *unwrapped.values"
+    arguments += "".join(f", unwrapped.extras.get({name!r})" for name in target.optional)
     return [*decode, *(f"    {line}" for line in _dispatch(target, "code", arguments, nullable=True))]
 
 
@@ -719,22 +726,34 @@ class StraightLayouts:
     layouts: tuple[Layout, ...]
     checks: tuple[dict[int, str], ...]
     algorithms: tuple[dict[int, Checksum], ...]  # the same checksums
+    # layouts with optional elements (`present_if`): the straight-line code takes their frames without them (the
+    # variants with every flag bit clear); a frame with a flag bit set (offset, size, byte order, mask) goes to the
+    # frame engine, and so does a message that has an optional element's bytes
+    diverts: tuple[tuple[int, int, str, int], ...] = ()
 
 
 def straight_direction(protocol: Protocol, direction: Direction) -> StraightLayouts | None:
     """The direction's layouts, when every one fits the straight-line form (and they carry the same values)."""
-    layouts = runtime_layouts(protocol, direction)
+    full = runtime_layouts(protocol, direction)
+    layouts = tuple(layout.variants[-1] for layout in full)  # with optional elements: the variant without them
+    diverts = tuple(
+        (offset, size, endian, mask) for layout in layouts for offset, size, endian, mask, _ in layout.conditions
+    )
     names = {tuple(e.name for e in (layout.elements[i] for i in layout.values)) for layout in layouts}
     if not all(straight(layout) for layout in layouts) or len(names) != 1:
         return None
     if protocol.framing.by_command or protocol.framing.from_request:
         return None  # layouts chosen by command, checksums over the request: the engine's
     algorithms = tuple(
-        {index: e.checksum for index, e in enumerate(model.elements) if e.checksum is not None}
-        for model in protocol.framing.alternatives[direction]
+        {
+            index: checksum
+            for index, e in enumerate(layout.elements)
+            if (checksum := next((m.checksum for m in model.elements if m.name == e.name), None)) is not None
+        }
+        for layout, model in zip(layouts, protocol.framing.alternatives[direction], strict=True)
     )
     checks = tuple({index: checksum_call(checksum) for index, checksum in found.items()} for found in algorithms)
-    return StraightLayouts(layouts, checks, algorithms)
+    return StraightLayouts(layouts, checks, algorithms, diverts)
 
 
 def direction_functions(
@@ -755,6 +774,23 @@ def direction_functions(
     layouts = found.layouts
     several = len(layouts) > 1
     lines: Lines = []
+    divert: Lines = []
+    if found.diverts:  # a frame with an optional element's flag bit set: the engine's (its functions, renamed)
+        decode, wrap = engine_lines(runtime_layouts(protocol, direction), target)
+        decode[0] = decode[0].replace(f"def _decode_{d}(", f"def _decode_{d}_engine(", 1)
+        wrap[0] = wrap[0].replace(f"def _wrap_{d}(", f"def _wrap_{d}_engine(", 1)
+        lines += [*decode, "", "", *wrap, "", ""]
+        tests = [
+            f"frame[{offset}] & {mask:#04x}"
+            if size == 1
+            else f"int.from_bytes(frame[{offset} : {offset + size}], {endian!r}) & {mask:#x}"
+            for offset, size, endian, mask in found.diverts
+        ]
+        shortest = max(offset + size for offset, size, _, _ in found.diverts)
+        divert = [
+            f"if len(frame) >= {shortest} and ({' or '.join(tests)}):  # optional elements sent: the frame engine's",
+            f"    return _decode_{d}_engine(frame, expect)",
+        ]
     wraps: list[_LayoutEncoding] = []
     bodies: list[Lines] = []
     for layout, checks, algorithms in zip(layouts, found.checks, found.algorithms, strict=True):
@@ -766,6 +802,7 @@ def direction_functions(
             lines += [f"{stuffing} = Transparency({t.span}, ({pairs},))", "", ""]
         # of several layouts, each is decoded once its header has chosen it (_choice)
         function, body = decode_lines(layout, f"_decode_{d}{suffix}", target, checks, stuffing, several, algorithms)
+        function = [*function[:2], *(f"    {line}" for line in divert), *function[2:]]
         lines += [*function, "", ""]
         bodies.append(body)
         wraps.append(wrap_parts(layout, target, checks, stuffing, registry(structs)))
@@ -780,7 +817,7 @@ def direction_functions(
         ]
     # decode() chooses the layout and checks the frame itself: one call less
     table, fast = whole_frames(found, d, plain, structs)
-    call = ["frame = data if data.__class__ is bytes else bytes(data)", *fast, *_choice(layouts, d, bodies)]
+    call = ["frame = data if data.__class__ is bytes else bytes(data)", *divert, *fast, *_choice(layouts, d, bodies)]
     lines += [*table, "", ""] if table else []
     lines += wrap_lines(d, wraps, target)
     return lines, call
@@ -1924,7 +1961,10 @@ def straight_codec_context(protocol: Protocol, code: PackageCode) -> dict[str, A
         only = dispatch[0][1] if not layout.has_command and len(dispatch) == 1 and not expected else ""
         values = tuple(e.name for e in layout.value_elements)
         requesting = protocol.framing.by_command or protocol.framing.from_request
-        frames = Target(direction.name, values, expected=bool(expected), only=only, requesting=requesting)
+        optional = tuple(e.name for e in optional_elements(protocol, direction))
+        frames = Target(
+            direction.name, values, expected=bool(expected), only=only, requesting=requesting, optional=optional
+        )
         if protocol.error_reply is not None and direction == Direction.RESPONSE:
             element = next(e for e in layout.elements if e.name == protocol.error_reply.element)
             assert element.type is not None

@@ -40,6 +40,7 @@ from serialspec.lang.model import (
     engineering_unit,
     size_terms,
 )
+from serialspec.runtime.framing import Layout
 
 
 def emit_dissector(protocol: Protocol) -> str:
@@ -131,7 +132,10 @@ def _direction(protocol: Protocol, direction: Direction) -> dict[str, Any]:
             continue  # replies sharing a code: the one decoded without its request (the default) is shown
         codes[key] = {"message": _message(protocol, message)}
         codes[key]["min"], codes[key]["max"] = codes[key]["message"]["min"], codes[key]["message"]["max"]
-    result: dict[str, Any] = {"layouts": [_layout(layout) for layout in layouts], "codes": codes}
+    # a layout with optional elements (`present_if`) as the engine's variants: one per choice of them sent or not,
+    # told apart by their flag bits like alternative layouts by their constants
+    variants = [(layout, variant) for layout in layouts for variant in runtime_layout(layout).variants]
+    result: dict[str, Any] = {"layouts": [_layout(layout, variant) for layout, variant in variants], "codes": codes}
     if protocol.error_reply is not None:
         result["error_flag"] = protocol.error_reply.flag
         result["error_element"] = protocol.error_reply.element
@@ -142,14 +146,18 @@ def _code(code: int | None) -> int | str:
     return "none" if code is None else code
 
 
-def _layout(layout: FrameLayout) -> dict[str, Any]:
-    engine = runtime_layout(layout)
+def _layout(layout: FrameLayout, engine: Layout) -> dict[str, Any]:
+    """One plain layout (a variant of `layout` where it has optional elements) as the Lua table's."""
     elements = []
-    for element, runtime in zip(layout.elements, engine.elements, strict=True):
+    model = {e.name: e for e in layout.elements}
+    for runtime in engine.elements:
+        element = model[runtime.name]
         item: dict[str, Any] = {"name": element.name, "role": element.role, "size": element.size or 0}
         item["big"] = element.endian == ">"
         if element.fixed:
-            item["constant"] = element.constant
+            item["constant"] = runtime.constant  # a flag element's: with the variant's bit
+        if runtime.need != (0, 0):
+            item["need"] = list(runtime.need)
         if element.role in (*VALUE_ROLES, "command"):
             item["min"], item["max"] = int(element.minimum), int(element.maximum)
             if element.broadcast is not None:

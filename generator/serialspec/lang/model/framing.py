@@ -48,6 +48,7 @@ class FrameElement:
     checksum: Checksum | None = None  # checksum: what it is and what it covers
     sequence: bool = False  # value: a sequence number the client fills in (one more per request, wrapping)
     truncate: bool = False  # content: trailing zero bytes dropped on encode, padded back on decode (MAVLink v2)
+    present_if: tuple[str, int] = ("", 0)  # optional: (flag element, mask): sent when flag & mask (MAVLink signature)
 
     @property
     def fixed(self) -> bool:
@@ -107,6 +108,11 @@ class FrameLayout:
     def truncates(self) -> bool:
         """The content is sent without its trailing zero bytes (`truncate: trailing_zeros`)."""
         return any(e.truncate for e in self.elements if e.role == "content")
+
+    @property
+    def optional(self) -> tuple[FrameElement, ...]:
+        """The elements sent only when their `present_if` flag is set (messages carry their bytes, or None)."""
+        return tuple(e for e in self.elements if e.role == "optional")
 
     @property
     def trailer(self) -> bytes:

@@ -12,6 +12,7 @@ from typing import Any, Literal
 from serialspec import checksums, transforms
 from serialspec.checksums import ChecksumProblem
 from serialspec.checksums.seed import Seeded
+from serialspec.lang import expression
 from serialspec.lang.errors import SpecError
 from serialspec.lang.loader import Path
 from serialspec.lang.model import (
@@ -109,7 +110,17 @@ class FramingPass(FieldResolver):
         endian: Literal["<", ">"] = ">" if item.get("endian") == "big" else "<"
         scalar: ScalarType | None = None
         size: int | None = None
-        if role not in CONSTANT_ROLES and role != "content":
+        if role == "optional":
+            if "value" in item:
+                self.error((*path, "value"), "an optional element is sent by the message, not as constant bytes")
+            if "type" in item:
+                self.error((*path, "type"), "an optional element is bytes: give its `size`, no type")
+            if "size" not in item or "present_if" not in item:
+                raise self.fail(path, "an optional element needs `size` and `present_if`")
+            size = item["size"]
+            if not isinstance(size, int) or not 1 <= size <= 255:
+                raise self.fail((*path, "size"), "an optional element's size is 1..255 bytes")
+        elif role not in CONSTANT_ROLES and role != "content":
             scalar = self.scalar_type(item.get("type", "u8"), (*path, "type"), allow_float=False)
             size = scalar.size
         elif "type" in item:
@@ -136,9 +147,12 @@ class FramingPass(FieldResolver):
             ("sequence", "value"),
             ("truncate", "content"),
             ("from_request", "checksum"),
+            ("size", "optional"),
+            ("present_if", "optional"),
         ):
             if key in item and role != allowed:
-                self.error((*path, key), f"`{key}` belongs to a {allowed} element")
+                article = "an" if allowed[0] in "aeiou" else "a"
+                self.error((*path, key), f"`{key}` belongs to {article} {allowed} element")
         return FrameElement(
             name=name,
             role=role,
@@ -347,6 +361,9 @@ class FramingPass(FieldResolver):
                     checksum = replace(checksum, from_request=names_taken)
                 elements[index] = replace(element, checksum=checksum)
         checksums = tuple(e.checksum for e in elements if e.checksum is not None)
+        for index, element in enumerate(elements):
+            if element.role == "optional":
+                elements[index] = self.optional(elements, index, raws[element.name], transparency, elements_path)
         if content_index >= 0 and elements[content_index].truncate and "length" not in roles:
             raise self.fail(
                 (*elements_path, names[content_index], "truncate"),
@@ -354,6 +371,62 @@ class FramingPass(FieldResolver):
             )
         flagged = any("error_flag" in item for item in raws.values())
         return self.classic_fields(direction, layout_name, tuple(elements), transparency, checksums, flagged)
+
+    def optional(
+        self,
+        elements: list[FrameElement],
+        index: int,
+        item: dict[str, Any],
+        transparency: Transparency | None,
+        elements_path: Path,
+    ) -> FrameElement:
+        """An optional element's `present_if: <element> & <mask>`, checked against this direction's elements: a flag
+        element of fixed position before anything variable, the element itself outside every span."""
+        element = elements[index]
+        path: Path = (*elements_path, element.name, "present_if")
+        names = [e.name for e in elements]
+        try:
+            parsed = expression.parse(str(item["present_if"]))
+        except expression.ExpressionError as exc:
+            raise self.fail(path, str(exc)) from None
+        match parsed:
+            case expression.BinOp("&", expression.Name(flag), expression.Const(mask)) if mask > 0:
+                pass
+            case _:
+                raise self.fail(path, "expected `<element> & <mask>`: an earlier element and a positive mask")
+        if flag not in names[:index]:
+            raise self.fail(path, f"{flag!r} is no element before {element.name!r} in the frame")
+        flagged = elements[names.index(flag)]
+        if flagged.role not in ("constant", "value", "address", "status") or flagged.present_if[0]:
+            raise self.fail(path, f"{flag!r} is a {flagged.role}: the flag is a constant, value, address or status")
+        variable = [i for i, e in enumerate(elements) if e.role in ("content", "optional") or e.size is None]
+        if transparency is not None:
+            variable.append(names.index(transparency.first))
+        if variable and names.index(flag) > min(variable):
+            raise self.fail(path, f"{flag!r} must come before the content (and before any other optional element)")
+        assert flagged.size is not None
+        if mask & (mask - 1):
+            raise self.fail(path, f"mask {mask:#x} has more than one bit: give the one bit that marks the element")
+        if transparency is not None and index <= names.index(transparency.last):
+            raise self.fail(path, "an optional element comes after the transparency span")
+        if mask >= 1 << (8 * flagged.size):
+            raise self.fail(path, f"mask {mask:#x} does not fit {flag!r} ({flagged.size} byte(s))")
+        if flagged.role == "constant":
+            value = int.from_bytes(flagged.constant, "big" if flagged.endian == ">" else "little")
+            if value & mask:
+                raise self.fail(
+                    path, f"{flag!r} is {flagged.constant.hex(' ')}: its constant has the mask's bits clear"
+                )
+        for other in elements:
+            spans = [other.counts] if other.role == "length" else []
+            spans += [(other.checksum.first, other.checksum.last)] if other.checksum is not None else []
+            spans += [(transparency.first, transparency.last)] if transparency is not None else []
+            for first, last in spans:
+                if first and names.index(first) <= index <= names.index(last):
+                    raise self.fail(
+                        path, f"an optional element lies outside every span ({other.name} takes in {element.name})"
+                    )
+        return replace(element, present_if=(flag, mask))
 
     def from_request(
         self, raw: list[str], direction: Direction, request: FrameLayout | None, path: Path

@@ -14,7 +14,7 @@ import pytest
 from hypothesis import find, settings
 from hypothesis import strategies as st
 from serialspec.lang import load_protocol
-from serialspec.lang.model import Direction, Example, FrameLayout, Message, Protocol
+from serialspec.lang.model import Direction, Example, FrameElement, FrameLayout, Message, Protocol
 from strategies import message_fields
 
 # Hypothesis policy. `make test` (and CI, which runs it once on a clean clone) must give the same answer every time:
@@ -162,6 +162,17 @@ def expect(parser: Any, cls: Any, request: Any = None) -> None:
         parser.expect(cls)
     else:
         parser.expect(cls, request)
+
+
+def requested(g: Generated, element: FrameElement, request: Any) -> bytes:
+    """The bytes of its request a reply's checksum element takes in before the frame's own (`from_request`)."""
+    names = element.checksum.from_request if element.checksum is not None else ()
+    if request is None or not names:
+        return b""
+    layout = g.protocol.layout(next(m for m in g.protocol.messages() if m.class_name == type(request).__name__))
+    frame = g.package.encode(request)
+    sizes = {e.name: e.size or 0 for e in layout.elements}
+    return b"".join(frame[layout.offsets[name] : layout.offsets[name] + sizes[name]] for name in names)
 
 
 def struct_context(g: Generated, spec: Message, request: Any = None) -> dict[str, Any] | None:

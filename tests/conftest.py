@@ -144,6 +144,16 @@ def example_request(g: Generated, example: Example) -> Any:
     return a_request(g, spec)
 
 
+def awaited(g: Generated, direction: Direction | None) -> st.SearchStrategy[tuple[Any, Any]]:
+    """For a stream parser of a direction whose frames are read with their request: a reply class to await and a
+    random request it answers (the parser takes those replies alone; see expect()); (None, None) for others."""
+    if direction is None or not (specs := [m for m in g.protocol.messages() if m.direction == direction]):
+        return st.just((None, None))
+    if not needs_request(g, specs[0]):
+        return st.just((None, None))
+    return st.sampled_from(specs).flatmap(lambda spec: st.tuples(st.just(message_class(g, spec)), requests(g, spec)))
+
+
 def encode(g: Generated, message: Any, request: Any = None) -> bytes:
     """g.package.encode, with the request a reply answers where it needs one."""
     return g.package.encode(message) if request is None else g.package.encode(message, request)  # type: ignore[no-any-return]

@@ -154,6 +154,38 @@ def awaited(g: Generated, direction: Direction | None) -> st.SearchStrategy[tupl
     return st.sampled_from(specs).flatmap(lambda spec: st.tuples(st.just(message_class(g, spec)), requests(g, spec)))
 
 
+def refusal(g: Generated) -> str:
+    """What the targets that read each frame alone (C, Wireshark: backends/common/frames.py refuse_by_command) say
+    when they refuse a spec whose replies are read with their request; "" for any other spec. Their suites check
+    that a refused spec gets exactly this one line, rather than leaving it out silently."""
+    if g.protocol.framing.by_command:
+        return "layouts chosen by command (`layout:`)"
+    if g.protocol.framing.from_request:
+        return "a reply checksum over bytes of its request (`from_request`)"
+    return ""
+
+
+def refused_in_one_line(g: Generated, target: str, out: Path) -> str:
+    """`serialspec generate SPEC --target TARGET --out OUT` for a spec the target refuses: exit 1, nothing written,
+    and one line `SPEC:1:1: the TARGET target cannot generate this spec: REASON`; returns REASON."""
+    import contextlib
+    import io
+
+    from serialspec.cli import main as serialspec_main
+
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err):
+        assert (
+            serialspec_main(["generate", str(ROOT / g.protocol.spec_path), "--target", target, "--out", str(out)]) == 1
+        )
+    line = err.getvalue()
+    assert line.count("\n") == 1 and line.startswith(f"{g.protocol.spec_path}:1:1: "), line
+    said = f"the {target} target cannot generate this spec: "
+    assert said in line, line
+    assert not out.exists() or not any(out.rglob("*.*")), sorted(out.rglob("*"))
+    return line.split(said, 1)[1].strip()
+
+
 def encode(g: Generated, message: Any, request: Any = None) -> bytes:
     """g.package.encode, with the request a reply answers where it needs one."""
     return g.package.encode(message) if request is None else g.package.encode(message, request)  # type: ignore[no-any-return]

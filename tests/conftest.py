@@ -100,8 +100,7 @@ def message_class(g: Generated, spec: Message) -> Any:
 def request_spec(g: Generated, spec: Message) -> Message:
     """The request of a reply's command (of its sub-command, where it has one)."""
     command = g.protocol.command(spec.command)
-    holders = [s for s in command.subcommands if s.name == spec.subcommand] or [command]
-    request = holders[0].request
+    request = next((s.request for s in command.subcommands if s.name == spec.subcommand), command.request)
     assert request is not None, f"{spec.class_name} answers no request"
     return request
 
@@ -112,7 +111,8 @@ def requests(g: Generated, spec: Message) -> st.SearchStrategy[Any]:
     if not needs_request(g, spec):
         return st.none()
     request = request_spec(g, spec)
-    return message_fields(g.protocol, request).map(message_class(g, request).from_fields)
+    cls = message_class(g, request)
+    return message_fields(g.protocol, request).map(lambda fields: cls.from_fields(fields))
 
 
 def a_request(g: Generated, spec: Message) -> Any:

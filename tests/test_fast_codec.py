@@ -56,8 +56,10 @@ def test_fast_paths_agree_with_the_plain_ones(g: Generated, spec: Message) -> No
         if last.role == "checksum":
             covered = frame[layout.covered_from : len(frame) - layout.covered_to_end]
             size = layout.checksum_offset_from_end
-            order = "big" if last.checksum is not None and last.checksum.endian == ">" else "little"
-            assert int.from_bytes(frame[-size:], order) == checksum(g, requested(g, last, request) + covered, last)
+            big = last.checksum is not None and last.checksum.endian == ">"
+            assert int.from_bytes(frame[-size:], "big" if big else "little") == checksum(
+                g, requested(g, last, request) + covered, last
+            )
         # built through its slots: equal, same hash, every field set, still frozen
         decoded = decode(g, frame, direction, cls, request)
         assert type(decoded) is cls

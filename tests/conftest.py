@@ -11,9 +11,11 @@ from types import ModuleType
 from typing import Any
 
 import pytest
-from hypothesis import settings
+from hypothesis import find, settings
+from hypothesis import strategies as st
 from serialspec.lang import load_protocol
-from serialspec.lang.model import Example, FrameLayout, Protocol
+from serialspec.lang.model import Direction, Example, FrameElement, FrameLayout, Message, Protocol
+from strategies import message_fields
 
 # Hypothesis policy. `make test` (and CI, which runs it once on a clean clone) must give the same answer every time:
 # a fuzzer that fails one run in five blocks everyone and teaches people to rerun until green. So by default every
@@ -83,6 +85,159 @@ def example_class(g: Generated, example: Example) -> Any:
         if (example.command, example.subcommand, example.direction) == (cls.COMMAND, cls.SUBCOMMAND, cls.DIRECTION):
             return cls
     raise AssertionError(f"no message class for example {example.name}")
+
+
+# Replies read with the request they answer (RoboClaw: layouts chosen by command, a reply CRC over the request's
+# address and command): `decode` refuses such a reply without it and the stream parser takes none while no request is
+# pending. The suites that run over every shipped spec give them their request through these helpers, so that such a
+# protocol is tested as fully as the others; for every other message the request is None and nothing changes.
+
+
+def needs_request(g: Generated, spec: Message) -> bool:
+    """A reply that is encoded and decoded with the request it answers."""
+    framing = g.protocol.framing
+    return spec.direction == Direction.RESPONSE and (framing.by_request(Direction.RESPONSE) or framing.from_request)
+
+
+def message_class(g: Generated, spec: Message) -> Any:
+    return next(c for c in g.package.MESSAGE_TYPES if c.__name__ == spec.class_name)
+
+
+def request_spec(g: Generated, spec: Message) -> Message:
+    """The request of a reply's command (of its sub-command, where it has one)."""
+    command = g.protocol.command(spec.command)
+    request = next((s.request for s in command.subcommands if s.name == spec.subcommand), command.request)
+    assert request is not None, f"{spec.class_name} answers no request"
+    return request
+
+
+def requests(g: Generated, spec: Message) -> st.SearchStrategy[Any]:
+    """Random requests a message answers, drawn as every message is (tests/strategies.py); None where it is read
+    alone."""
+    if not needs_request(g, spec):
+        return st.none()
+    request = request_spec(g, spec)
+    cls = message_class(g, request)
+    return message_fields(g.protocol, request).map(lambda fields: cls.from_fields(fields))
+
+
+def a_request(g: Generated, spec: Message) -> Any:
+    """One request a message answers, the same on every run: the spec's first example request of its command, else
+    the simplest valid one; None where the message is read alone."""
+    if not needs_request(g, spec):
+        return None
+    request = request_spec(g, spec)
+    for example in g.protocol.examples:
+        if (example.command, example.subcommand, example.direction) == (
+            spec.command,
+            spec.subcommand,
+            request.direction,
+        ):
+            return g.package.decode(example.frame, Direction.REQUEST.value)
+    fields = find(message_fields(g.protocol, request), lambda _: True, settings=settings(database=None))
+    return message_class(g, request).from_fields(fields)
+
+
+def example_request(g: Generated, example: Example) -> Any:
+    """The request an example answers: its `request:` example, else one of its command (a_request); None where the
+    example is read alone."""
+    spec = example_message(g, example)
+    if not needs_request(g, spec):
+        return None
+    if example.request:
+        asked = next(e for e in g.protocol.examples if e.name == example.request)
+        return g.package.decode(asked.frame, Direction.REQUEST.value)
+    return a_request(g, spec)
+
+
+def awaited(g: Generated, direction: Direction | None) -> st.SearchStrategy[tuple[Any, Any]]:
+    """For a stream parser of a direction whose frames are read with their request: a reply class to await and a
+    random request it answers (the parser takes those replies alone; see expect()); (None, None) for others."""
+    if direction is None or not (specs := [m for m in g.protocol.messages() if m.direction == direction]):
+        return st.just((None, None))
+    if not needs_request(g, specs[0]):
+        return st.just((None, None))
+    return st.sampled_from(specs).flatmap(lambda spec: st.tuples(st.just(message_class(g, spec)), requests(g, spec)))
+
+
+def refusal(g: Generated) -> str:
+    """What the targets that read each frame alone (C, Wireshark: backends/common/frames.py refuse_by_command) say
+    when they refuse a spec whose replies are read with their request; "" for any other spec. Their suites check
+    that a refused spec gets exactly this one line, rather than leaving it out silently."""
+    if g.protocol.framing.by_command:
+        return "layouts chosen by command (`layout:`)"
+    if g.protocol.framing.from_request:
+        return "a reply checksum over bytes of its request (`from_request`)"
+    return ""
+
+
+def refused_in_one_line(g: Generated, target: str, out: Path) -> str:
+    """`serialspec generate SPEC --target TARGET --out OUT` for a spec the target refuses: exit 1, nothing written,
+    and one line `SPEC:1:1: the TARGET target cannot generate this spec: REASON`; returns REASON."""
+    import contextlib
+    import io
+
+    from serialspec.cli import main as serialspec_main
+
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err):
+        assert (
+            serialspec_main(["generate", str(ROOT / g.protocol.spec_path), "--target", target, "--out", str(out)]) == 1
+        )
+    line = err.getvalue()
+    assert line.count("\n") == 1 and line.startswith(f"{g.protocol.spec_path}:1:1: "), line
+    said = f"the {target} target cannot generate this spec: "
+    assert said in line, line
+    assert not out.exists() or not any(out.rglob("*.*")), sorted(out.rglob("*"))
+    return line.split(said, 1)[1].strip()
+
+
+def encode(g: Generated, message: Any, request: Any = None) -> bytes:
+    """g.package.encode, with the request a reply answers where it needs one."""
+    return g.package.encode(message) if request is None else g.package.encode(message, request)  # type: ignore[no-any-return]
+
+
+def decode(g: Generated, frame: bytes, direction: str | None = None, expect: Any = None, request: Any = None) -> Any:
+    """g.package.decode, with the request a reply answers where it needs one."""
+    if request is None:
+        return g.package.decode(frame, direction, expect)
+    return g.package.decode(frame, direction, expect, request=request)
+
+
+def expect(parser: Any, cls: Any, request: Any = None) -> None:
+    """parser.expect(cls), and the request the replies answer where they need one."""
+    if request is None:
+        parser.expect(cls)
+    else:
+        parser.expect(cls, request)
+
+
+def requested(g: Generated, element: FrameElement, request: Any) -> bytes:
+    """The bytes of its request a reply's checksum element takes in before the frame's own (`from_request`)."""
+    names = element.checksum.from_request if element.checksum is not None else ()
+    if request is None or not names:
+        return b""
+    layout = g.protocol.layout(next(m for m in g.protocol.messages() if m.class_name == type(request).__name__))
+    frame = g.package.encode(request)
+    sizes = {e.name: e.size or 0 for e in layout.elements}
+    return b"".join(frame[layout.offsets[name] : layout.offsets[name] + sizes[name]] for name in names)
+
+
+def struct_context(g: Generated, spec: Message, request: Any = None) -> dict[str, Any] | None:
+    """The construct frame struct's context for a reply read with its request: its layout and the request's frame
+    (runtime/constructs.py Framed); None for every other frame."""
+    if request is None:
+        return None
+    return {"layout": g.protocol.layout(spec).name, "request": g.package.encode(request)}
+
+
+def example_message(g: Generated, example: Example) -> Message:
+    """The message an example records."""
+    return next(
+        m
+        for m in g.protocol.messages()
+        if (m.command, m.subcommand, m.direction) == (example.command, example.subcommand, example.direction)
+    )
 
 
 def set_plain_byte(layout: FrameLayout, frame: bytes, offset: int, value: Callable[[int], int]) -> tuple[bytes, int]:

@@ -15,7 +15,17 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from conftest import ALL, ROOT, Generated, by_protocol, example_class, examples, scratch_folder
+from conftest import (
+    ALL,
+    ROOT,
+    Generated,
+    by_protocol,
+    example_class,
+    examples,
+    refusal,
+    refused_in_one_line,
+    scratch_folder,
+)
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from serialspec.backends import Unsupported
@@ -59,6 +69,16 @@ def supported(g: Generated) -> bool:
 
 C_SPECS = [g for g in ALL if supported(g)]
 IDS = [g.protocol.name for g in C_SPECS]
+REFUSED = [g for g in ALL if not supported(g)]
+
+
+@pytest.mark.parametrize("g", REFUSED, ids=[g.protocol.name for g in REFUSED])
+def test_a_shipped_spec_the_c_target_refuses_gets_one_line(g: Generated, tmp_path: Path) -> None:
+    """A shipped spec the C target cannot take is not silently left out: `generate --target c` refuses it in one
+    line naming the feature, and writes nothing; one whose replies are read with their request (RoboClaw) is
+    refused for exactly that (the C decoder reads each frame alone)."""
+    reason = refused_in_one_line(g, "c", tmp_path / "refused")
+    assert reason == refusal(g) if refusal(g) else reason
 
 
 @cache

@@ -11,7 +11,7 @@ import tomllib
 from pathlib import Path
 
 import pytest
-from conftest import ALL, ROOT, Generated
+from conftest import ALL, ROOT, Generated, encode, example_request
 from serialspec.cli import main
 
 FS = str(ROOT / "specs" / "fashionstar_uart.yaml")
@@ -91,9 +91,12 @@ def test_every_example_round_trips_through_the_cli(g: Generated, capsys: pytest.
     # In-process for speed: the subprocess tests above cover the console script itself.
     spec = str(ROOT / g.protocol.spec_path)
     for example in g.protocol.examples:
-        assert main(["decode", spec, example.frame.hex(" "), "--json", "--direction", example.direction.value]) == 0
+        request = example_request(g, example)  # a reply read with its request: --request HEX both ways
+        asked = [] if request is None else ["--request", encode(g, request).hex(" ")]
+        argv = ["decode", spec, example.frame.hex(" "), "--json", "--direction", example.direction.value, *asked]
+        assert main(argv) == 0
         decoded = capsys.readouterr().out
-        assert main(["encode", spec, "--json", decoded]) == 0, example.name
+        assert main(["encode", spec, "--json", decoded, *asked]) == 0, example.name
         assert capsys.readouterr().out.strip() == example.frame.hex(" "), example.name
 
 

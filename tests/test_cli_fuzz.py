@@ -10,7 +10,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from conftest import ALL, ROOT, Generated, examples
+from conftest import ALL, ROOT, Generated, a_request, encode, examples
 from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 from serialspec.cli import main
@@ -101,9 +101,20 @@ def hostile_fields(g: Generated) -> st.SearchStrategy[dict[str, Any]]:
     return build()
 
 
+def requests_by_message(g: Generated) -> dict[tuple[str, str | None, str], list[str]]:
+    """`--request HEX` for each reply read with its request (conftest.a_request), by (command, subcommand,
+    direction); drawn before the fuzzer runs (a_request may search with hypothesis)."""
+    found = {}
+    for spec in g.protocol.messages():
+        if (request := a_request(g, spec)) is not None:
+            found[(spec.command, spec.subcommand, spec.direction.value)] = ["--request", encode(g, request).hex(" ")]
+    return found
+
+
 @pytest.mark.parametrize("g", ALL, ids=[g.protocol.name for g in ALL])
 def test_encode_never_fails_with_a_traceback(g: Generated) -> None:
     spec = spec_of(g)
+    requests = requests_by_message(g)
 
     @SETTINGS
     @given(obj=st.one_of(hostile_fields(g), JSON_VALUES))
@@ -120,11 +131,14 @@ def test_encode_never_fails_with_a_traceback(g: Generated) -> None:
         }
     )
     def check(obj: Any) -> None:
-        code, out, err = run("encode", spec, "--json=" + json.dumps(obj))
+        # a reply made and read with its request: --request HEX both ways
+        key = (obj.get("command"), obj.get("subcommand"), obj.get("direction")) if isinstance(obj, dict) else None
+        asked = requests.get(key, []) if isinstance(key, tuple) and all(isinstance(k, str | None) for k in key) else []
+        code, out, err = run("encode", spec, "--json=" + json.dumps(obj), *asked)
         assert code in (0, 1)
         assert len(err.splitlines()) == (1 if code else 0), err
         if code == 0:  # what encodes decodes back to the same values
-            decoded = json.loads(run("decode", spec, out.strip(), "--direction", obj["direction"], "--json")[1])
+            decoded = json.loads(run("decode", spec, out.strip(), "--direction", obj["direction"], "--json", *asked)[1])
             assert decoded["command"] == obj["command"]
 
     check()

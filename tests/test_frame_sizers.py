@@ -12,7 +12,7 @@ from __future__ import annotations
 import importlib
 
 import pytest
-from conftest import ALL, Generated, examples
+from conftest import ALL, Generated, example_class, examples
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from serialspec.runtime.framing import FrameCodec
@@ -55,10 +55,10 @@ def candidate(draw: st.DrawFn, frames: list[bytes], special: list[int]) -> tuple
 @pytest.mark.parametrize(("g", "name", "codec"), CODECS, ids=[f"{g.protocol.name}:{n}" for g, n, _ in CODECS])
 def test_a_sizer_answers_as_probe(g: Generated, name: str, codec: FrameCodec) -> None:
     frames = [e.frame for e in g.protocol.examples]
-    special = sorted(
-        {b for layout in codec.layouts for b in layout.header + layout.trailer} | {*codec.content_sizes} - {None}
-    )
-    special = [b for b in special if isinstance(b, int) and 0 <= b < 256]
+    # (replies read in their request's layout key their content sizes by class name: no byte)
+    codes = {code for code in codec.content_sizes if isinstance(code, int)}
+    special = sorted({b for layout in codec.layouts for b in layout.header + layout.trailer} | codes)
+    special = [b for b in special if 0 <= b < 256]
 
     @settings(max_examples=examples(300), deadline=None, suppress_health_check=[HealthCheck.too_slow])
     @given(candidate(frames, special))
@@ -72,3 +72,12 @@ def test_a_sizer_answers_as_probe(g: Generated, name: str, codec: FrameCodec) ->
         for end in range(len(frame) + 1):
             for layout, sizer in zip(codec.variants, codec.sizers, strict=True):
                 assert sizer(frame, 0, end) == codec.probe(layout, frame, 0, end)
+    # replies read in the layout of their request: the stream parser sizes them by probe() with the reply class
+    # awaited (no sizer); each example reply is its whole frame in its class's layout, and no other layout's
+    for example in g.protocol.examples if codec.replies else ():
+        if example.direction.name != name.strip("_").split("_")[0]:
+            continue
+        cls = example_class(g, example)
+        for index, layout in enumerate(codec.layouts):
+            size = codec.probe(layout, example.frame, 0, len(example.frame), cls)
+            assert size == (len(example.frame) if codec.replies[cls.__name__] == index else -1), example.name

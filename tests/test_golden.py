@@ -10,7 +10,7 @@ from contextlib import suppress
 from typing import Any
 
 import pytest
-from conftest import ALL, Generated, by_protocol, example_class
+from conftest import ALL, Generated, by_protocol, decode, encode, example_class, example_request
 from serialspec.checksums.crc import Crc, crc_function
 from serialspec.lang.model import Erratum, Example
 from serialspec.runtime.errors import DecodeError
@@ -29,7 +29,8 @@ def message_class(g: Generated, command: str, subcommand: str | None, direction:
 
 @pytest.mark.parametrize(("g", "example"), EXAMPLES)
 def test_example_decodes_to_its_documented_values(g: Generated, example: Example) -> None:
-    message = g.package.decode(example.frame, example.direction.value, example_class(g, example))
+    request = example_request(g, example)  # the request a reply answers, where it is read with it (else None)
+    message = decode(g, example.frame, example.direction.value, example_class(g, example), request)
     assert (example.command, example.subcommand) == (message.COMMAND, message.SUBCOMMAND)
     unsent = {e.name for e in g.protocol.framing.layouts[example.direction].optional} - set(example.fields)
     assert message.to_fields() == example.fields | dict.fromkeys(unsent)  # an optional element not recorded: None
@@ -38,7 +39,7 @@ def test_example_decodes_to_its_documented_values(g: Generated, example: Example
 @pytest.mark.parametrize(("g", "example"), EXAMPLES)
 def test_example_values_encode_to_its_bytes(g: Generated, example: Example) -> None:
     cls = message_class(g, example.command, example.subcommand, example.direction.value)
-    assert g.package.encode(cls.from_fields(example.fields)) == example.frame
+    assert encode(g, cls.from_fields(example.fields), example_request(g, example)) == example.frame
 
 
 @pytest.mark.parametrize(("g", "example"), EXAMPLES)

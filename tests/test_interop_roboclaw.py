@@ -1,37 +1,35 @@
-"""Basicmicro RoboClaw packet serial (tests/specs/roboclaw.yaml) against basicmicro 2.0.10 from PyPI, unchanged.
+"""Basicmicro RoboClaw packet serial (specs/roboclaw.yaml) against basicmicro 2.0.10 from PyPI, unchanged.
 
 The peer's packing code writes the golden frames (its controller on a stand-in port that records what is written and
 plays back what it reads): our codec encodes the same bytes for its writes and reads, and the peer accepts our
-replies (their CRC covers the request's address and command, which the reply does not carry). Then the peer's
-`Basicmicro` class drives `serialspec sim specs/roboclaw.yaml` over a pseudo-terminal, and so does our client.
+replies (their CRC covers the request's address and command, which the reply does not carry); every example frame
+of the spec is one the peer writes, or reads as the values the spec records. Then the peer's `Basicmicro` class
+drives `serialspec sim specs/roboclaw.yaml` over a pseudo-terminal, and so does our client.
 """
 
 from __future__ import annotations
 
 import contextlib
-import importlib
 import io
 import json
 from collections.abc import Iterator
-from pathlib import Path
 from typing import Any
 
 import pytest
-from conftest import generate_and_import, scratch_folder
+from conftest import ROOT
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from serialspec import cli
+from serialspec.lang import load_protocol
 from serialspec.runtime.errors import DecodeError
 from serialspec.runtime.transport import Bus
+from serialspec_protocols import roboclaw as rc
+from serialspec_protocols.roboclaw import client as rc_client
 
 basicmicro = pytest.importorskip("basicmicro")
 
-SPEC = str(Path(__file__).parent / "specs" / "roboclaw.yaml")
-# the `port` fixture (conftest.py): `serialspec sim` on a pseudo-terminal, two controllers (its path is from specs/)
-SIM = ("../tests/specs/roboclaw.yaml", 0x80, 0x81)
-# the package, generated once for the module (the hypothesis tests below read it as a module global)
-rc: Any = generate_and_import(Path(SPEC), scratch_folder("roboclaw-"), "roboclaw")
-rc_client: Any = importlib.import_module("roboclaw.client")
+SIM = ("roboclaw.yaml", 0x80, 0x81)  # the `port` fixture (conftest.py): `serialspec sim` on a pseudo-terminal
+SPEC = str(ROOT / "specs" / "roboclaw.yaml")
 
 
 class Recorder:
@@ -143,6 +141,40 @@ def test_peer_accepts_our_replies(address: int, count: int, status: int, volts: 
         other = request_class(address=0x80 + (address + 1) % 8)
         with pytest.raises(DecodeError, match="bad crc"):
             rc.decode(frame, "response", request=other)
+
+
+# Each example of the spec as the peer makes or takes it: (example, the peer's call, its arguments, what it returns)
+PEER_EXAMPLES = [
+    ("duty_m1_half_reverse", "DutyM1", (0x80, -16384), True),
+    ("speed_m2", "SpeedM2", (0x81, 1000), True),
+    ("set_velocity_pid_m1", "SetM1VelocityPID", (0x80, 1.5, 0.25, 0.0, 44000), True),
+    ("reset_encoders", "ResetEncoders", (0x80,), True),
+    ("read_main_battery_reply", "ReadMainBatteryVoltage", (0x80,), (1, 120)),
+    ("read_encoder_m1_reply", "ReadEncM1", (0x80,), (1, 123456, 2)),
+    ("read_version_reply", "ReadVersion", (0x80,), (True, "USB Roboclaw 2x7a v4.1.34\n")),
+    ("read_velocity_pid_m1_reply", "ReadM1VelocityPID", (0x80,), (True, 1.5, 0.25, 0.0, 44000)),
+]
+
+
+@pytest.mark.parametrize(("name", "call", "args", "returns"), PEER_EXAMPLES, ids=[e[0] for e in PEER_EXAMPLES])
+def test_every_example_is_a_frame_of_the_peer(name: str, call: str, args: tuple[Any, ...], returns: Any) -> None:
+    """A request example is what the peer writes for the call; a reply example is read by the peer as the values
+    the spec records, after it wrote the example request the reply names; the write acknowledgement is the one
+    byte the peer's write waits for."""
+    examples = {e.name: e for e in load_protocol(SPEC, "specs/roboclaw.yaml").examples}
+    example = examples[name]
+    if example.direction.value == "request":
+        controller = peer(examples["write_ack"].frame)  # a write waits for the acknowledgement; a read for nothing
+        result = getattr(controller, call)(*args)
+        assert bytes(controller._port.written) == example.frame
+    else:
+        controller = peer(example.frame)
+        result = getattr(controller, call)(*args)
+        assert bytes(controller._port.written) == examples[example.request].frame
+    assert result == returns
+    # the other examples are the requests these replies name (checked above) and the acknowledgement (used above)
+    others = set(examples) - {n for n, *_ in PEER_EXAMPLES}
+    assert others == {e.request for e in examples.values() if e.request and e.name != "write_ack"} | {"write_ack"}
 
 
 def test_version_string_ended_by_nul() -> None:

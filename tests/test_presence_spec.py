@@ -135,7 +135,9 @@ def _line(text: str, needle: str) -> int:
 def test_every_shipped_bus_declares_how_to_find_its_devices() -> None:
     """The shipped specs whose documents give a presence request declare it; the RRC board (one board per port,
     answering no request that is only a presence check), NMEA 0183 (receivers talk on their own) and u-blox UBX (one
-    receiver per port, which streams on its own; a MON-VER poll would do, but `scan` is for buses of ids) do not."""
+    receiver per port, which streams on its own; a MON-VER poll would do, but `scan` is for buses of ids) do not, nor
+    does RoboClaw yet (its spec came from the library, whose ReadVersion would serve: not declared before `scan` is
+    tried against replies read with their request)."""
     declared = {}
     for spec in sorted((ROOT / "specs").glob("*.yaml")):
         protocol = load_protocol(str(spec))
@@ -150,6 +152,7 @@ def test_every_shipped_bus_declares_how_to_find_its_devices() -> None:
         "modbus_rtu": "read_holding_registers",
         "nmea0183": None,
         "crsf": None,
+        "roboclaw": None,
         "mavlink_common": None,
         "ubx": None,
         "vesc": "fw_version",

@@ -19,7 +19,7 @@ from types import ModuleType, SimpleNamespace
 from typing import Any
 
 import pytest
-from conftest import ALL, Generated, by_protocol, examples
+from conftest import ALL, Generated, by_protocol, encode, examples, requests
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from serialspec.backends.common.frames import runtime_layouts
@@ -285,12 +285,20 @@ def test_encoders_make_the_frames_the_engine_makes(g: Generated, spec: Message) 
     cls = next(c for c in g.package.MESSAGE_TYPES if c.__name__ == spec.class_name)
     frames: FrameCodec = getattr(g.package.codec, f"_{spec.direction.name}_FRAMES")
 
+    by_command = g.protocol.framing.by_command  # layouts chosen by command: wrap in the one the frame was read in
+
     @settings(max_examples=examples(30), deadline=None, suppress_health_check=[HealthCheck.too_slow])
-    @given(message_fields(g.protocol, spec))
-    def same_bytes(fields: dict[str, Any]) -> None:
-        frame = g.package.encode(cls.from_fields(fields))
-        unwrapped = frames.unwrap(frame)
-        assert frames.wrap(unwrapped.content, unwrapped.code, unwrapped.values, extras=unwrapped.extras) == frame
+    @given(message_fields(g.protocol, spec), requests(g, spec))
+    def same_bytes(fields: dict[str, Any], request: Any) -> None:
+        frame = encode(g, cls.from_fields(fields), request)
+        # a reply read with its request: in its class's layout, with the request's elements by name
+        asked = None if request is None else g.package.codec._REQUEST_FRAMES.unwrap(encode(g, request)).named()
+        unwrapped = frames.unwrap(frame, cls, asked) if asked is not None else frames.unwrap(frame)
+        layout = frames.layouts.index(unwrapped.layout) if by_command else None
+        rewrapped = frames.wrap(
+            unwrapped.content, unwrapped.code, unwrapped.values, layout, asked, extras=unwrapped.extras
+        )
+        assert rewrapped == frame
 
     same_bytes()
 

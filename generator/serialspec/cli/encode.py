@@ -7,7 +7,9 @@ import json
 from typing import Any
 
 from serialspec.cli.protocols import SPEC_HELP, message_type, open_spec
-from serialspec.runtime.errors import EncodeError
+from serialspec.runtime.errors import DecodeError, EncodeError
+from serialspec.runtime.hexbytes import parse_hex
+from serialspec.runtime.message import takes_request
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -20,6 +22,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--direction", choices=("request", "response"), help="overrides the object's direction")
     parser.add_argument("--hex", action="store_true", help="a text protocol's sentence as hex, not as text")
+    parser.add_argument(
+        "--request", metavar="HEX", help="the request a response answers, where its frame is made with it (RoboClaw)"
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -44,5 +49,16 @@ def run(args: argparse.Namespace) -> int:
     if not isinstance(fields, dict):
         raise EncodeError("`fields` must be an object")
     message = cls.from_fields(fields)  # type: ignore[attr-defined]
-    print(package.encode(message).hex(" "))
+    if args.request and takes_request(package.encode):  # a reply made with its request (a checksum over its bytes)
+        try:
+            request = package.decode(parse_hex(args.request), "request")
+        except (ValueError, DecodeError) as exc:
+            raise EncodeError(f"--request: {exc}") from None
+        print(package.encode(message, request).hex(" "))
+        return 0
+    try:
+        print(package.encode(message).hex(" "))
+    except EncodeError as exc:
+        hint = " (--request HEX)" if str(exc).endswith("give the request this reply answers") else ""
+        raise EncodeError(f"{exc}{hint}") from None
     return 0

@@ -580,10 +580,11 @@ COMMAND = Obj(
             "writes send data and a CRC, and get one 0xFF byte). Once a command names one, layouts are chosen by "
             "command, not by header: a command that names none travels in the first layout, a request frame is "
             "read in the layout of its code (a code sent in another layout is refused), and replies that carry no "
-            "code are read in the layout of the request they answer: `decode` refuses such a reply in one line "
-            "without it (`--request HEX`), the stream parser takes none while no request is pending, and the "
-            "client and the simulator give it. A layout may be constant bytes alone (RoboClaw's 0xFF "
-            "acknowledgement: `ack: {role: header, value: FF, directions: [response]}`).",
+            "code are read in the layout of the request they answer: `decode` and `encode` refuse such a reply in "
+            "one line without it (`--request HEX`), the stream parser takes none while no request is pending, and "
+            "the client and the simulator give it. A layout may be constant bytes alone (RoboClaw's 0xFF "
+            "acknowledgement: `ack: {role: header, value: FF, directions: [response]}`). The C and Wireshark "
+            "targets, which read each frame alone, refuse such a spec in one line (`layouts chosen by command`).",
             example="read",
         ),
         "probe": Bool(

@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import json
 import os
-import re
 import shutil
 import subprocess
 from functools import cache
@@ -600,30 +599,6 @@ def test_the_shipped_golden_vector_check_passes(g: Generated, build: str, tmp_pa
         0,
         f"{g.protocol.name}: {examples} vectors, {refused} refused frames, 0 failed\n",
     ), run.stdout + run.stderr
-
-
-@pytest.mark.parametrize("g", C_SPECS, ids=IDS)
-def test_the_readme_commands_build_the_folder_and_print_its_sizes(g: Generated, tmp_path: Path) -> None:
-    """<protocol>/README.md: its build and sizes commands, run with gcc in a copy of the folder, compile the C, pass
-    the golden vectors and print sizeof(parser_t) and sizeof(msg_t); its API block is the header's prototypes."""
-    if GCC is None:
-        pytest.skip("gcc is not installed")
-    name = g.protocol.name
-    folder = tmp_path / name
-    shutil.copytree(GENERATED_C / name, folder)
-    readme = (folder / "README.md").read_text()
-    blocks = re.findall(r"```(sh|c)\n(.*?)```", readme, re.DOTALL)
-    header = (folder / f"{name}.h").read_text()
-    (api,) = [text for kind, text in blocks if kind == "c"]
-    assert api.splitlines() and all(f"\n{line}\n" in header for line in api.splitlines())
-    build, sizes = [text for kind, text in blocks if kind == "sh" and "cc -std=c99" in text and "arm-" not in text]
-    environment = {**os.environ, "PATH": f"{tmp_path}:{os.environ['PATH']}"}
-    (tmp_path / "cc").symlink_to(GCC)  # `cc` in the README: gcc here
-    for script, where in ((build, folder), (sizes, folder)):
-        run = subprocess.run(["bash", "-e", "-c", script], cwd=where, env=environment, capture_output=True, text=True)
-        assert run.returncode == 0, run.stdout + run.stderr
-    parser_size, msg_size = (int(n) for n in run.stdout.split())
-    assert parser_size > int(re.findall(rf"#define {name.upper()}_MAX_FRAME (\d+)u", header)[0]) and msg_size > 0
 
 
 @pytest.mark.parametrize("case", ["bytes, size field of u64", "array, count field of u64"])

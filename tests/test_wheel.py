@@ -158,12 +158,14 @@ def test_a_renamed_protocol_leaves_no_orphans(user: User) -> None:
     spec = user.home / "renamed.yaml"
     spec.write_text(TINYLAMP.read_text(encoding="utf-8"), encoding="utf-8")
     user.serialspec("generate", "renamed.yaml", "--out", "renamed")
+    assert (user.home / "renamed" / "c" / "tinylamp" / "test" / "vectors.h").is_file()
     (user.home / "renamed" / "notes.txt").write_text("mine\n", encoding="utf-8")
     spec.write_text(spec.read_text(encoding="utf-8").replace("protocol: tinylamp", "protocol: bigger_lamp"))
     orphaned = user.serialspec("check", "renamed.yaml", "--out", "renamed", check=False)
     assert orphaned.returncode == 1 and "renamed/tinylamp/codec.py: orphaned" in orphaned.stderr
     user.serialspec("generate", "renamed.yaml", "--out", "renamed")
     assert not (user.home / "renamed" / "tinylamp").exists()
+    assert not (user.home / "renamed" / "c" / "tinylamp").exists()  # its C, the test/ folder included
     assert (user.home / "renamed" / "bigger_lamp" / "codec.py").is_file()
     assert (user.home / "renamed" / "notes.txt").is_file()  # not generated: left alone
     assert user.serialspec("check", "renamed.yaml", "--out", "renamed").returncode == 0

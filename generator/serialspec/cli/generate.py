@@ -58,8 +58,9 @@ def run(args: argparse.Namespace) -> int:
         import shutil  # only where an orphaned package leaves its bytecode behind
 
         shutil.rmtree(folder / "__pycache__", ignore_errors=True)
-        if folder.is_dir() and not any(folder.iterdir()):
+        while folder != proj.out and folder.is_dir() and not any(folder.iterdir()):  # test/, then <protocol>/
             folder.rmdir()
+            folder = folder.parent
     files_generated = f"{len(files)} file{'' if len(files) == 1 else 's'} generated"
     print(f"{files_generated} in {proj.display(proj.out)}, {written} changed, {len(removed)} removed")
     for line in shown(errors):

@@ -346,13 +346,14 @@ def generated_from(path: Path) -> str | None:
 def orphans(proj: Project, files: dict[Path, str], failed: set[str]) -> list[Path]:
     """Generated files in the output folder that no spec produces any more (a renamed or deleted protocol).
 
-    Only files that carry the generated header count, one or two folders deep (DIR/<package>/, DIR/docs/,
-    DIR/c/<protocol>/); with specs named on the command line, only files generated from those specs (or from spec
+    Only files that carry the generated header count, one to three folders deep (DIR/<package>/, DIR/docs/,
+    DIR/c/<protocol>/, DIR/c/<protocol>/test/); with specs named on the command line, only files generated from those specs (or from spec
     files that no longer exist).
     """
     chosen = {proj.display(s) for s in proj.specs}
     found = []
-    for path in sorted([*proj.out.glob("*/*"), *proj.out.glob("*/*/*")]):  # packages, docs/; a target's folder
+    # packages, docs/; a target's folder; the C's test/ folder
+    for path in sorted([*proj.out.glob("*/*"), *proj.out.glob("*/*/*"), *proj.out.glob("*/*/*/*")]):
         if not path.is_file() or path in files:
             continue
         spec = generated_from(path)

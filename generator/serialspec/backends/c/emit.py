@@ -1412,13 +1412,6 @@ def spec_hash(protocol: Protocol) -> str:
 
 
 def files(protocol: Protocol) -> dict[str, str]:
-    from serialspec.backends.c.readme import readme
-
-    written = _files(protocol)
-    return {**written, f"{protocol.name}/README.md": readme(protocol, written)}
-
-
-def _files(protocol: Protocol) -> dict[str, str]:
     if protocol.text is not None:  # a text protocol: backends/c/text.py
         from serialspec.backends.c import text
 

@@ -347,8 +347,8 @@ def orphans(proj: Project, files: dict[Path, str], failed: set[str]) -> list[Pat
     """Generated files in the output folder that no spec produces any more (a renamed or deleted protocol).
 
     Only files that carry the generated header count, one to three folders deep (DIR/<package>/, DIR/docs/,
-    DIR/c/<protocol>/, DIR/c/<protocol>/test/); with specs named on the command line, only files generated from those specs (or from spec
-    files that no longer exist).
+    DIR/c/<protocol>/, DIR/c/<protocol>/test/); with specs named on the command line, only files generated from
+    those specs (or from spec files that no longer exist).
     """
     chosen = {proj.display(s) for s in proj.specs}
     found = []

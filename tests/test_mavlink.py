@@ -154,6 +154,7 @@ def unsigned_c_driver() -> Any:
     folder = scratch_folder("mavlink-c-")
     spec = yaml.safe_load((ROOT / "specs" / "mavlink_common.yaml").read_text(encoding="utf-8"))
     del spec["framing"]["elements"]["signature"]
+    spec["examples"] = {name: e for name, e in spec["examples"].items() if "signature" not in e.get("fields", {})}
     stripped = folder / "mavlink_common.yaml"
     stripped.write_text(yaml.safe_dump(spec, sort_keys=False, allow_unicode=True), encoding="utf-8")
     assert serialspec_main(["generate", str(stripped), "--target", "c", "--out", str(folder / "c")]) == 0
@@ -173,11 +174,11 @@ def test_the_c_reads_and_truncates_the_frames_pymavlink_packs(name: str) -> None
     cls = PAIRS[name][0]
     direction = PAIRS[name][2]
     kind = f"{name.lower()}_{direction}"
+    run = unsigned_c_driver()  # built before hypothesis runs: a failed build is one failure, not one per example
 
     @SETTINGS
     @given(peer_messages(name), st.integers(0, 255), st.integers(1, 255), st.integers(0, 255))
     def check(message: Any, seq: int, sysid: int, compid: int) -> None:
-        run = unsigned_c_driver()
         frame = bytes(message.pack(link(sysid, compid, seq)))
         decoded = mav.decode(frame, direction)
         expected = {"command": decoded.COMMAND, "subcommand": None, "direction": direction}

@@ -72,8 +72,8 @@ test-fast: $(STAMP) test-tools check
 # -std=c99 and the strict warnings as errors at -O0/-Os/-O2, the headers as C++11, then a driver built with
 # -fsanitize=address,undefined checked against the Python codec (examples, random messages, mutated frames, noisy
 # streams in random pieces), the examples and a noisy stream again on clang, -m32 and big-endian PowerPC (qemu) builds.
-# `make test` runs the same tests with the rest of the suite, compiling at -O2 alone and running the shipped vector
-# check (test/check_vectors.c) on the gcc build alone. Needs gcc and g++ (apt-get install gcc g++); the other
+# `make test` runs the same tests with the rest of the suite, compiling at -O2 alone, running the shipped vector
+# check (test/check_vectors.c) on the gcc build alone and the other-build driver on -m32 and PowerPC only. Needs gcc and g++ (apt-get install gcc g++); the other
 # compilers and qemu are installed as root (test-tools), else those builds are skipped, saying why.
 c-check: $(STAMP) test-tools check
 	SERIALSPEC_C_CHECK=1 $(BIN)/pytest -q -n auto tests/test_c_backend.py tests/test_c_text.py

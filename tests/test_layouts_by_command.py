@@ -1,6 +1,6 @@
 """Layouts chosen by command (`layout:`), bare constant layouts and reply checksums over request bytes
 (`from_request`): each mistake in a spec is one line at its place, and the engine's reads of such frames (the
-RoboClaw-shaped spec of tests/specs/roboclaw.yaml; tests/test_interop_roboclaw.py checks it against its peer)."""
+RoboClaw-shaped spec of specs/roboclaw.yaml; tests/test_interop_roboclaw.py checks it against its peer)."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ import pytest
 import yaml
 from serialspec.lang import SpecErrors, load_protocol
 
-SPEC = Path(__file__).parent / "specs" / "roboclaw.yaml"
+SPEC = Path(__file__).parent.parent / "specs" / "roboclaw.yaml"
 
 
 def errors_of(tmp_path: Path, change: Any) -> list[str]:

@@ -699,3 +699,36 @@ def test_hex_ascii_frames_in_lower_case_and_cut_by_a_colon_read_as_python_reads_
     pieces = [b"0A", frames[0][:7], frames[0], b"\r", frames[-1][:-1], b":", frames[-1], b"1\r\n", frames[0].lower()]
     for sizes in ("1", "2,3", "7,1,13", "64"):
         stream_agrees_with_python(driver("modbus_ascii"), g, Direction.REQUEST, b"".join(pieces), sizes)
+
+
+@pytest.mark.skipif(GCC is None, reason="no gcc")
+def test_cobs_without_a_code_after_a_last_full_run_writes_what_the_cobs_package_writes(tmp_path: Path) -> None:
+    """`code_after_full_run: false`: a span that ends with a run of 254 non-zero bytes ends there, as the `cobs`
+    package writes it, in Python and in C; both take the PacketSerial form (the code byte 01 after it) too."""
+    from cobs import cobs
+    from test_language_matrix import build, package
+
+    built = build("transform: cobs, a last run of 254 bytes ended without the code byte 01 (the `cobs` package)")
+    source = tmp_path / "c"
+    source.mkdir()
+    for path, text in built.files.items():
+        if path.startswith("c/matrix_case/"):
+            (source / path.rsplit("/", 1)[1]).write_text(text, encoding="utf-8")
+    run = Driver("matrix_case", source, tmp_path)
+    try:
+        with package(built) as g:
+            request = next(m for m in g.protocol.messages() if m.direction == Direction.REQUEST)
+            cls = message_class(g, request)
+            for size in (251, 250, 252, 0):  # the span: code, v (2 bytes), data
+                message = cls.from_fields({"v": 0x0101, "data": b"\x11" * size})
+                frame = g.package.encode(message)
+                plain = cobs.decode(frame[:-1])
+                assert 0 not in plain and frame == bytes(cobs.encode(plain)) + b"\x00"
+                full = len(plain) % 254 == 0
+                paper = frame[:-1] + b"\x01\x00" if full else frame  # the form with the code byte after the run
+                for given in {frame, paper}:
+                    assert g.package.decode(given, "request") == message
+                    (answer,) = run.ask(f"rt request {given.hex()}")
+                    assert answer == f"ok {frame.hex()}", (size, answer)
+    finally:
+        run.close()

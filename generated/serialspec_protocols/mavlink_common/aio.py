@@ -17,7 +17,9 @@ from typing import Any
 
 import serial
 from serialspec.runtime.aio import AsyncBus, AsyncClientBase
+from serialspec.runtime.transport import check_echoes
 
+from . import MATCH_BY
 from .client import BINDING
 from .messages import (
     AttitudeResponse,
@@ -86,6 +88,7 @@ class AsyncMavlinkCommonClient(AsyncClientBase):
         """
         request = ParamRequestReadRequest(seq=self._sequence('seq', 0, 255), sysid=sysid, compid=compid, param_index=param_index, target_system=target_system, target_component=target_component, param_id=param_id)
         reply = await self.bus.request(request, ParamValueResponse)
+        check_echoes(request, reply, ('param_id',), MATCH_BY)
         return reply
 
     async def param_set(self, sysid: int, compid: int, param_value: float, target_system: int, target_component: int, param_id: str, param_type: MavParamType | int) -> ParamValueResponse:
@@ -106,6 +109,7 @@ class AsyncMavlinkCommonClient(AsyncClientBase):
         """
         request = ParamSetRequest(seq=self._sequence('seq', 0, 255), sysid=sysid, compid=compid, param_value=param_value, target_system=target_system, target_component=target_component, param_id=param_id, param_type=param_type)
         reply = await self.bus.request(request, ParamValueResponse)
+        check_echoes(request, reply, ('param_id',), MATCH_BY)
         return reply
 
     async def command_long(self, sysid: int, compid: int, param1: float, param2: float, param3: float, param4: float, param5: float, param6: float, param7: float, command: MavCmd | int, target_system: int, target_component: int, confirmation: int) -> CommandAckResponse:
@@ -132,6 +136,7 @@ class AsyncMavlinkCommonClient(AsyncClientBase):
         """
         request = CommandLongRequest(seq=self._sequence('seq', 0, 255), sysid=sysid, compid=compid, param1=param1, param2=param2, param3=param3, param4=param4, param5=param5, param6=param6, param7=param7, command=command, target_system=target_system, target_component=target_component, confirmation=confirmation)
         reply = await self.bus.request(request, CommandAckResponse)
+        check_echoes(request, reply, ('command',), MATCH_BY)
         return reply
 
     async def reports(self, timeout: float | None = None) -> AsyncIterator[HeartbeatResponse | SysStatusResponse | AttitudeResponse | GlobalPositionIntResponse]:

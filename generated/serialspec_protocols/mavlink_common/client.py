@@ -21,7 +21,7 @@ from collections.abc import Callable, Iterator
 from typing import Any
 
 import serial
-from serialspec.runtime.transport import Binding, Bus, ClientBase
+from serialspec.runtime.transport import Binding, Bus, ClientBase, check_echoes
 
 from . import MATCH_BY, SERIAL
 from .codec import _ENCODERS as ENCODERS  # each request class's encoder, for the bus to call at once
@@ -111,6 +111,7 @@ class MavlinkCommonClient(ClientBase):
         """
         request = ParamRequestReadRequest(seq=self._sequence('seq', 0, 255), sysid=sysid, compid=compid, param_index=param_index, target_system=target_system, target_component=target_component, param_id=param_id)
         reply = self.bus.request(request, ParamValueResponse)
+        check_echoes(request, reply, ('param_id',), MATCH_BY)
         return reply
 
     def param_set(self, sysid: int, compid: int, param_value: float, target_system: int, target_component: int, param_id: str, param_type: MavParamType | int) -> ParamValueResponse:
@@ -131,6 +132,7 @@ class MavlinkCommonClient(ClientBase):
         """
         request = ParamSetRequest(seq=self._sequence('seq', 0, 255), sysid=sysid, compid=compid, param_value=param_value, target_system=target_system, target_component=target_component, param_id=param_id, param_type=param_type)
         reply = self.bus.request(request, ParamValueResponse)
+        check_echoes(request, reply, ('param_id',), MATCH_BY)
         return reply
 
     def command_long(self, sysid: int, compid: int, param1: float, param2: float, param3: float, param4: float, param5: float, param6: float, param7: float, command: MavCmd | int, target_system: int, target_component: int, confirmation: int) -> CommandAckResponse:
@@ -157,6 +159,7 @@ class MavlinkCommonClient(ClientBase):
         """
         request = CommandLongRequest(seq=self._sequence('seq', 0, 255), sysid=sysid, compid=compid, param1=param1, param2=param2, param3=param3, param4=param4, param5=param5, param6=param6, param7=param7, command=command, target_system=target_system, target_component=target_component, confirmation=confirmation)
         reply = self.bus.request(request, CommandAckResponse)
+        check_echoes(request, reply, ('command',), MATCH_BY)
         return reply
 
     def reports(self, timeout: float | None = None) -> Iterator[HeartbeatResponse | SysStatusResponse | AttitudeResponse | GlobalPositionIntResponse]:

@@ -17,7 +17,7 @@ from __future__ import annotations
 from typing import Any
 
 import serial
-from serialspec.runtime.transport import Binding, Bus, ClientBase, ErrorReplies
+from serialspec.runtime.transport import Binding, Bus, ClientBase, ErrorReplies, check_echoes
 
 from . import MATCH_BY, SERIAL
 from .codec import _ENCODERS as ENCODERS  # each request class's encoder, for the bus to call at once
@@ -192,6 +192,7 @@ class ModbusAsciiClient(ClientBase):
         reply = self._maybe(request, WriteCoilResponse, None)
         if reply is None:
             return None
+        check_echoes(request, reply, ('address', 'value'), MATCH_BY)
         return True
 
     def write_register(self, unit: int, address: int, value: int) -> bool | None:
@@ -213,6 +214,7 @@ class ModbusAsciiClient(ClientBase):
         reply = self._maybe(request, WriteRegisterResponse, None)
         if reply is None:
             return None
+        check_echoes(request, reply, ('address', 'value'), MATCH_BY)
         return True
 
     def write_coils(self, unit: int, address: int, values: tuple[bool, ...]) -> int | None:
@@ -234,6 +236,7 @@ class ModbusAsciiClient(ClientBase):
         reply = self._maybe(request, WriteCoilsResponse, None)
         if reply is None:
             return None
+        check_echoes(request, reply, ('address',), MATCH_BY)
         return reply.count
 
     def write_registers(self, unit: int, address: int, values: tuple[int, ...]) -> int | None:
@@ -255,6 +258,7 @@ class ModbusAsciiClient(ClientBase):
         reply = self._maybe(request, WriteRegistersResponse, None)
         if reply is None:
             return None
+        check_echoes(request, reply, ('address',), MATCH_BY)
         return reply.count
 
     def mask_write_register(self, unit: int, address: int, and_mask: int, or_mask: int) -> bool | None:
@@ -277,6 +281,7 @@ class ModbusAsciiClient(ClientBase):
         reply = self._maybe(request, MaskWriteRegisterResponse, None)
         if reply is None:
             return None
+        check_echoes(request, reply, ('address', 'and_mask', 'or_mask'), MATCH_BY)
         return True
 
     def read_write_registers(self, unit: int, read_address: int, read_count: int, write_address: int, values: tuple[int, ...]) -> list[int] | None:

@@ -16,7 +16,9 @@ from typing import Any
 
 import serial
 from serialspec.runtime.aio import AsyncBus, AsyncClientBase
+from serialspec.runtime.transport import check_echoes
 
+from . import MATCH_BY
 from .client import BINDING
 from .messages import (
     CoilState,
@@ -173,6 +175,7 @@ class AsyncModbusRtuClient(AsyncClientBase):
         reply = await self._maybe(request, WriteCoilResponse, None)
         if reply is None:
             return None
+        check_echoes(request, reply, ('address', 'value'), MATCH_BY)
         return True
 
     async def write_register(self, unit: int, address: int, value: int) -> bool | None:
@@ -194,6 +197,7 @@ class AsyncModbusRtuClient(AsyncClientBase):
         reply = await self._maybe(request, WriteRegisterResponse, None)
         if reply is None:
             return None
+        check_echoes(request, reply, ('address', 'value'), MATCH_BY)
         return True
 
     async def write_coils(self, unit: int, address: int, values: tuple[bool, ...]) -> int | None:
@@ -215,6 +219,7 @@ class AsyncModbusRtuClient(AsyncClientBase):
         reply = await self._maybe(request, WriteCoilsResponse, None)
         if reply is None:
             return None
+        check_echoes(request, reply, ('address',), MATCH_BY)
         return reply.count
 
     async def write_registers(self, unit: int, address: int, values: tuple[int, ...]) -> int | None:
@@ -236,6 +241,7 @@ class AsyncModbusRtuClient(AsyncClientBase):
         reply = await self._maybe(request, WriteRegistersResponse, None)
         if reply is None:
             return None
+        check_echoes(request, reply, ('address',), MATCH_BY)
         return reply.count
 
     async def mask_write_register(self, unit: int, address: int, and_mask: int, or_mask: int) -> bool | None:
@@ -258,6 +264,7 @@ class AsyncModbusRtuClient(AsyncClientBase):
         reply = await self._maybe(request, MaskWriteRegisterResponse, None)
         if reply is None:
             return None
+        check_echoes(request, reply, ('address', 'and_mask', 'or_mask'), MATCH_BY)
         return True
 
     async def read_write_registers(self, unit: int, read_address: int, read_count: int, write_address: int, values: tuple[int, ...]) -> list[int] | None:

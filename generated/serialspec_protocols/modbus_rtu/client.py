@@ -18,7 +18,7 @@ from __future__ import annotations
 from typing import Any
 
 import serial
-from serialspec.runtime.transport import Binding, Bus, ClientBase, ErrorReplies
+from serialspec.runtime.transport import Binding, Bus, ClientBase, ErrorReplies, check_echoes
 
 from . import MATCH_BY, SERIAL
 from .codec import _ENCODERS as ENCODERS  # each request class's encoder, for the bus to call at once
@@ -193,6 +193,7 @@ class ModbusRtuClient(ClientBase):
         reply = self._maybe(request, WriteCoilResponse, None)
         if reply is None:
             return None
+        check_echoes(request, reply, ('address', 'value'), MATCH_BY)
         return True
 
     def write_register(self, unit: int, address: int, value: int) -> bool | None:
@@ -214,6 +215,7 @@ class ModbusRtuClient(ClientBase):
         reply = self._maybe(request, WriteRegisterResponse, None)
         if reply is None:
             return None
+        check_echoes(request, reply, ('address', 'value'), MATCH_BY)
         return True
 
     def write_coils(self, unit: int, address: int, values: tuple[bool, ...]) -> int | None:
@@ -235,6 +237,7 @@ class ModbusRtuClient(ClientBase):
         reply = self._maybe(request, WriteCoilsResponse, None)
         if reply is None:
             return None
+        check_echoes(request, reply, ('address',), MATCH_BY)
         return reply.count
 
     def write_registers(self, unit: int, address: int, values: tuple[int, ...]) -> int | None:
@@ -256,6 +259,7 @@ class ModbusRtuClient(ClientBase):
         reply = self._maybe(request, WriteRegistersResponse, None)
         if reply is None:
             return None
+        check_echoes(request, reply, ('address',), MATCH_BY)
         return reply.count
 
     def mask_write_register(self, unit: int, address: int, and_mask: int, or_mask: int) -> bool | None:
@@ -278,6 +282,7 @@ class ModbusRtuClient(ClientBase):
         reply = self._maybe(request, MaskWriteRegisterResponse, None)
         if reply is None:
             return None
+        check_echoes(request, reply, ('address', 'and_mask', 'or_mask'), MATCH_BY)
         return True
 
     def read_write_registers(self, unit: int, read_address: int, read_count: int, write_address: int, values: tuple[int, ...]) -> list[int] | None:

@@ -1227,7 +1227,8 @@ DEVICE_COMMAND = Obj(
             "Response fields that repeat the request's field of the same name (a write's reply confirming what was "
             "written: Modbus WRITE SINGLE REGISTER). Other response fields never copy the request: they come from "
             "the device (its reads, reports, `reply`, memory and state) or else the field's `default` (else 0); "
-            "the fields replies are matched by (`matching.by`), the address and a table value's key echo anyway.",
+            "the fields replies are matched by (`matching.by`), the address and a table value's key echo anyway. "
+            "The generated client checks each against what it sent (`EchoMismatch` names the field and both values).",
             example=["address", "value"],
         ),
         "sets": MapOf(Num(), "State variable -> the value the command sets it to."),

@@ -98,6 +98,15 @@ class DeviceError(TransportError):
         self.reply = reply
 
 
+class EchoMismatch(TransportError):
+    """The reply repeats one of the request's fields (a field of the same name) with another value; `reply` is the
+    decoded answer."""
+
+    def __init__(self, text: str, reply: object) -> None:
+        super().__init__(text)
+        self.reply = reply
+
+
 class PortError(TransportError, OSError):
     """The port could not be opened, read or written."""
 

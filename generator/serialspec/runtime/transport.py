@@ -26,7 +26,7 @@ from typing import Any, TypeVar
 
 import serial
 
-from serialspec.runtime.errors import CorruptReply, DeviceError, EncodeError, PortError, Timeout
+from serialspec.runtime.errors import CorruptReply, DeviceError, EchoMismatch, EncodeError, PortError, Timeout, shown
 from serialspec.runtime.message import Direction, Message, Record, takes_request
 from serialspec.runtime.settings import SerialSettings as SerialSettings  # packages generated before import it here
 from serialspec.runtime.stream import StreamParser
@@ -129,6 +129,17 @@ def check_status(request: Message, reply: Message, name: str, ok: int, match_by:
         command = ".".join(part for part in (reply.COMMAND, reply.SUBCOMMAND) if part)
         ids = " ".join(f"{n}={getattr(request, n)}" for n in match_by if hasattr(request, n))
         raise DeviceError(f"{command}{' to ' + ids if ids else ''}: the device reports {name} = {shown}", reply)
+
+
+def check_echoes(request: Message, reply: Message, names: tuple[str, ...], match_by: tuple[str, ...]) -> None:
+    """A reply field named like a request field repeats it: one that holds another value is an EchoMismatch."""
+    for name in names:
+        sent, got = getattr(request, name), getattr(reply, name)
+        if got != sent:
+            command = ".".join(part for part in (reply.COMMAND, reply.SUBCOMMAND) if part)
+            ids = " ".join(f"{n}={getattr(request, n)}" for n in match_by if hasattr(request, n))
+            to = f" to {ids}" if ids else ""
+            raise EchoMismatch(f"{command}{to}: the reply's {name} is {shown(got)}, not the {shown(sent)} sent", reply)
 
 
 def table_key(table: dict[str, int], name: str) -> int:

@@ -9,23 +9,27 @@ from dataclasses import dataclass
 from typing import Any
 
 from serialspec.runtime.errors import DecodeError
-from serialspec.transforms.base import CTransform, Report, Sample, Transform
+from serialspec.transforms.base import CTransform, Key, Report, Sample, Transform
 
 
-def cobs_encode(data: bytes) -> bytes:
-    """COBS: a code byte before each run of non-zero bytes (254 at most), no 00 in the result."""
+def cobs_encode(data: bytes, code_after_full_run: bool = True) -> bytes:
+    """COBS: a code byte before each run of non-zero bytes (254 at most), no 00 in the result. Data that ends with
+    a run of 254 non-zero bytes gets the code byte 01 after it unless `code_after_full_run` is false."""
     out = bytearray(b"\x00")
-    code_at, code = 0, 1
+    code_at, code, full = 0, 1, False
     for byte in data:
         if byte:
             out.append(byte)
             code += 1
             if code == 0xFF:
-                out[code_at], code_at, code = code, len(out), 1
+                out[code_at], code_at, code, full = code, len(out), 1, True
                 out.append(0)
         else:
-            out[code_at], code_at, code = code, len(out), 1
+            out[code_at], code_at, code, full = code, len(out), 1, False
             out.append(0)
+    if full and code == 1 and not code_after_full_run:
+        del out[code_at]  # the data ended with the full run: no code byte stands for anything after it
+        return bytes(out)
     out[code_at] = code
     return bytes(out)
 
@@ -71,9 +75,10 @@ class CobsSpan:
     """COBS over a span of elements: the runtime object of `method: cobs`."""
 
     span: tuple[int, int]
+    code_after_full_run: bool = True
 
     def encode(self, data: bytes) -> bytes:
-        return cobs_encode(data)
+        return cobs_encode(data, self.code_after_full_run)
 
     def decode(self, data: bytes) -> bytes:
         return cobs_decode(data)
@@ -87,14 +92,27 @@ class CobsSpan:
 
 @dataclass(frozen=True)
 class Cobs(Transform):
+    code_after_full_run: bool = True
+
     name = "cobs"
     summary = (
         "COBS, Consistent Overhead Byte Stuffing (PacketSerial): no 00 in the span, a code byte before each run of "
-        "up to 254 non-zero bytes; a trailer 00 right after the span ends the frame. Encode writes PacketSerial's "
-        "form (the COBS paper's): a span that ends with a run of 254 non-zero bytes gets the code byte 01 after it, "
-        "which the `cobs` package on PyPI leaves out; decode takes both forms"
+        "up to 254 non-zero bytes; a trailer 00 right after the span ends the frame. A span that ends with a run "
+        "of 254 non-zero bytes is written with the code byte 01 after it (PacketSerial, the COBS paper) or without "
+        "(`code_after_full_run: false`: the `cobs` package on PyPI); decode takes both forms"
     )
     runtime_name = "CobsSpan"
+    keys = (
+        Key(
+            "code_after_full_run",
+            "bool",
+            "cobs: whether a span ending with a run of 254 non-zero bytes is sent with the code byte 01 after it "
+            "(true: PacketSerial and the COBS paper) or ends with the run (false: the `cobs` package on PyPI). "
+            "Decode takes both forms either way.",
+            default=True,
+            example=False,
+        ),
+    )
     samples = (
         Sample(
             "the whole packet, a checksum inside it, then the 00 delimiter (PacketSerial)",
@@ -129,11 +147,23 @@ class Cobs(Transform):
             },
             plain=bytes.fromhex("03 01 00 05 06"),
         ),
+        Sample(
+            "a last run of 254 bytes ended without the code byte 01 (the `cobs` package)",
+            {
+                "elements": {
+                    "code": {"role": "command", "type": "u8"},
+                    "content": {"role": "content"},
+                    "delimiter": {"role": "trailer", "value": "00"},
+                },
+                "transparency": {"method": "cobs", "span": ["code", "content"], "code_after_full_run": False},
+            },
+            plain=bytes(range(1, 255)),
+        ),
     )
 
     @classmethod
     def from_spec(cls, raw: Mapping[str, Any], report: Report) -> Cobs:
-        return cls()
+        return cls(bool(raw.get("code_after_full_run", True)))
 
     def check_layout(self, roles: list[str], constants: list[bytes], first: int, last: int) -> str:
         if last + 1 >= len(roles) or roles[last + 1] != "trailer" or constants[last + 1] != b"\x00":
@@ -141,24 +171,30 @@ class Cobs(Transform):
         return ""
 
     def runtime(self, span: tuple[int, int]) -> CobsSpan:
-        return CobsSpan(span)
+        return CobsSpan(span, self.code_after_full_run)
 
     def python_arguments(self, span: tuple[int, int]) -> list[str]:
-        return [f"({span[0]}, {span[1]})"]
+        return [f"({span[0]}, {span[1]})", *([] if self.code_after_full_run else ["False"])]
 
     def describe(self) -> str:
+        last = (
+            "a last run of 254 is followed by the code byte 01, as PacketSerial sends it, and decoded without it too"
+            if self.code_after_full_run
+            else "a last run of 254 ends the span without a code byte after it, and is decoded with one too"
+        )
         return (
             "the bytes are sent in COBS form (no 00 among them: a code byte, the length of the run of non-zero bytes "
-            "after it + 1, stands for the 00 that ends the run; runs of 254 bytes take a code byte FF and no 00; "
-            "a last run of 254 is followed by the code byte 01, as PacketSerial sends it, and decoded without it too)"
+            f"after it + 1, stands for the 00 that ends the run; runs of 254 bytes take a code byte FF and no 00; "
+            f"{last})"
         )
 
     def c_code(self, prefix: str) -> CTransform:
         name = f"{prefix}__cobs"
-        return CTransform(name, _C_COBS.replace("NAME", name))
+        code = _C_COBS.replace("NAME", name).replace("CODE_AFTER_FULL_RUN", "1" if self.code_after_full_run else "0")
+        return CTransform(name, code)
 
     def lua(self) -> dict[str, Any] | None:
-        return {"method": "cobs"}
+        return {"method": "cobs"}  # the dissector decodes, and decoding takes both forms
 
 
 _C_COBS = r"""/* COBS (method: cobs): the plain bytes as a code byte before each run of up to 254 non-zero bytes
@@ -174,11 +210,13 @@ static int NAME(int to_wire, const uint8_t *src, size_t n, uint8_t *dst, const u
     if (to_wire) {
         size_t code_at = 0u;
         uint8_t code = 1u;
+        int full = 0; /* the last run closed was 254 bytes long (code FF), not ended by a 00 */
         if (cap < 1u) {
             return 0;
         }
         o = 1u;
         for (i = 0u; i < n; i++) {
+            full = 0;
             if (src[i] != 0u) {
                 if (o >= cap) {
                     return 0;
@@ -187,6 +225,7 @@ static int NAME(int to_wire, const uint8_t *src, size_t n, uint8_t *dst, const u
                 if (++code != 0xFFu) {
                     continue;
                 }
+                full = 1;
             }
             dst[code_at] = code;
             code_at = o;
@@ -195,6 +234,10 @@ static int NAME(int to_wire, const uint8_t *src, size_t n, uint8_t *dst, const u
             }
             dst[o++] = 0u;
             code = 1u;
+        }
+        if (!CODE_AFTER_FULL_RUN && full) {
+            *out = o - 1u; /* the span ends with the full run: no code byte after it */
+            return 1;
         }
         dst[code_at] = code;
         *out = o;

@@ -792,6 +792,8 @@ static size_t {p}__least({p}_direction_t dir)
             }}
             break;
         }}"""
+    # a framing without checksums still has the (empty) dispatch, which never reads its bytes
+    no_checksums = "" if cases.strip() else "\n    (void)d;\n    (void)n;"
     every = [layout for d in directions(protocol) for layout in protocol.framing.alternatives[d]]
     all_lengths = int(all(layout.length is not None for layout in every))
     single = int(all(n == 1 for n in n_layouts.values()))
@@ -824,7 +826,7 @@ typedef char {p}__float_is_4_bytes[(sizeof(float) == 4u) ? 1 : -1];
 {reflect}
 #if {P}_ENABLE_ENCODE || {P}_ENABLE_DECODE
 static uint32_t {p}__check(uint8_t which, const uint8_t *d, size_t n)
-{{
+{{{no_checksums}
     switch (which) {{
 {cases}
     default:

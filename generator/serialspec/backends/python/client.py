@@ -3,7 +3,9 @@
 Decisions made here, the same for every protocol:
 - arguments and results are wire units, like the messages (the spec's `unit`/`scale` are in the docstrings);
 - a method returns the reply's one field that is not an echo of the request, the whole reply when there are
-  several, and True when there are none; a reply that does not come raises Timeout, except for a command the spec
+  several, and True when there are none; a reply field named like an argument is an echo unless the device
+  `reports` it (the level a device really set), and the fields the spec's `echoes` lists are checked against
+  what was sent (EchoMismatch); a reply that does not come raises Timeout, except for a command the spec
   marks `probe` (PING), whose method returns True/False (answered or not) whatever the reply holds;
 - a reply that can be absent (broadcast address, `optional_when`) makes the method return None then;
 - a table that one command reads by key and another writes by key gets read_<entry>/write_<entry> by name:
@@ -478,11 +480,19 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
         result_expr = ""
         cut = ""  # the part of a list the reply's value keeps: what the request asked
         statuses = status_fields(response) if response else []
+        echoed: list[str] = []
         if response is not None:
             imports.add(response.class_name)
-            echoes = {f.name for f in fields} | {f.name for f in statuses} | unused_fields(protocol, request, response)
+            # a reply field named like one of the call's arguments repeats it and is left out of what the method
+            # returns, unless the device reports it from elsewhere (`reports`: a level the device may have changed)
+            reported = set(behaviour.reports) if behaviour else set()
+            echoes = {f.name for f in fields} - reported | {f.name for f in statuses}
+            echoes |= unused_fields(protocol, request, response)
             echoes |= {response.request_code} - {""}  # the request's own code, matched by the bus
             rest = [f for f in value_fields(protocol, response) if f.name not in echoes]
+            # the spec's `echoes` say the reply repeats them: checked against the arguments (a derived count, which
+            # the method returns, is not one)
+            echoed = [name for name in behaviour.echoes if name in {f.name for f in fields}] if behaviour else []
             if command.probe and not sub:
                 kind, returns = ("bool", "bool")
             elif not rest:
@@ -551,6 +561,7 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
             "pairs": pairs,
             "singles": singles,
             "statuses": [(f.name, f.status_ok) for f in statuses],
+            "echoed": tuple(echoed) if response is not None and kind != "each" else (),
             "each_keys": each_keys,
         }
         if sub is not None:
@@ -613,7 +624,12 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
     module_imports.update(name for m in carriers for request, _, reply in m["carried"] for name in (request, reply))
     module_imports.discard("None")
     checks_status = any(m["statuses"] for m in everything)
-    class_transport = [*(["check_status"] if checks_status else []), *(["table_key"] if tables else [])]
+    checks_echoes = any(m.get("echoed") for m in everything)
+    class_transport = [
+        *(["check_echoes"] if checks_echoes else []),
+        *(["check_status"] if checks_status else []),
+        *(["table_key"] if tables else []),
+    ]
     return dict(
         replies=replies,
         errors=errors,
@@ -653,6 +669,7 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
             key=import_order,
         ),
         checks_status=checks_status,
+        checks_echoes=checks_echoes,
         quick_reads=any(r.get("quick") for r in registers),
         error_imports=[
             name

@@ -87,6 +87,7 @@ GENERATED_CLASS_NAMES = frozenset(
         "CorruptReply",
         "DecodeError",
         "DeviceError",
+        "EchoMismatch",
         "DeviceSpec",
         "Direction",
         "EncodeError",

@@ -76,13 +76,25 @@ def test_ok_answers_a_g_code_line(tmp_path: Path) -> None:
     )
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="finding: a text `code` must be letters and digits: GRBL's system commands are `$H`, `$X`, `$$`, "
-    "and settings `$100=250.000`",
-)
 def test_a_dollar_command(tmp_path: Path) -> None:
-    load_protocol(str(spec(tmp_path, "  home:\n    code: $H\n    request: {}\n")), "grbl")
+    """GRBL's system commands (`$H`, `$$`) and real-time ones (`?`, `!`, `~`) are text codes; a code holding one of
+    the framing's own characters (NMEA's `$` start) is refused in one line."""
+    extra = "".join(
+        f"  {name}:\n    code: {code!r}\n    request: {{}}\n"
+        for name, code in (("home", "$H"), ("settings", "$$"), ("status", "?"), ("hold", "!"), ("resume", "~"))
+    )
+    path = spec(tmp_path, extra)
+    load_protocol(str(path), "grbl")
+    for line in ("$H", "$$", "?", "!", "~"):
+        assert decode_json(path, line)["fields"] == {}
+    nmea = spec(tmp_path, "  home:\n    code: $H\n    request: {}\n")
+    nmea.write_text(nmea.read_text("utf-8").replace("kind: text", "kind: text\n  start: $"), "utf-8")
+    run = subprocess.run([sys.executable, "-m", "serialspec", "check", str(nmea)], capture_output=True, text=True)
+    assert run.returncode != 0 and "Traceback" not in run.stderr
+    lines = (run.stdout + run.stderr).strip().splitlines()
+    assert len(lines) == 1 and lines[0].endswith(
+        "commands.home.code: a text command needs a text `code` (letters, digits and !#%&+-./;=?@^_~), got '$H'"
+    ), lines
 
 
 @pytest.mark.xfail(
@@ -102,3 +114,24 @@ def test_a_status_report(tmp_path: Path) -> None:
     path = spec(tmp_path, extra)
     load_protocol(str(path), "grbl")
     assert decode_json(path, "<Idle|MPos:1.000,2.000,3.000|FS:0,0>")["command"] == "status"
+
+
+def test_codes_with_question_marks_compile_as_c99_without_trigraphs(tmp_path: Path) -> None:
+    """`??=` in a C99 string literal is the trigraph `#`: the C target escapes `?` so that the code is sent as written
+    (gcc -std=c99 -Wall reads trigraphs and warns about them)."""
+    import shutil
+
+    gcc = shutil.which("gcc")
+    if gcc is None:
+        pytest.skip("no gcc")
+    path = spec(tmp_path, "  status:\n    code: '?'\n    request: {}\n  odd:\n    code: '??='\n    request: {}\n")
+    path.write_text(path.read_text("utf-8").replace("kind: text", 'kind: text\n  start: "<"'), "utf-8")
+    out = tmp_path / "c"
+    subprocess.run(
+        [sys.executable, "-m", "serialspec", "generate", str(path), "--target", "c", "--out", str(out)], check=True
+    )
+    source = out / "grbl" / "grbl.c"
+    assert '"\\?\\?="' in source.read_text("utf-8")
+    flags = ["-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-c", str(source), "-o", str(tmp_path / "o")]
+    run = subprocess.run([gcc, *flags], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr

@@ -459,14 +459,14 @@ static uint32_t {p}__checksum(const uint8_t *d, size_t n)
                 req = next(m for m in found if m.direction.value == "request")
                 res = next(m for m in found if m.direction.value == "response")
                 pick = f"dir == {P}_REQUEST ? {P}_{mid(req).upper()} : {P}_{mid(res).upper()}"
-            lookups.append(f'    if ({p}__is(code, n, "{name}")) {{\n        return {pick};\n    }}')
+            lookups.append(f"    if ({p}__is(code, n, {c_text(name)})) {{\n        return {pick};\n    }}")
         dec_cases = "\n".join(
             f"    case {P}_{mid(m).upper()}:\n        memset(&out->u.{mid(m)}, 0, sizeof(out->u.{mid(m)}));\n"
             f"        r = {p}__dec_{mid(m)}(&c, seps, &out->u.{mid(m)});\n        break;"
             for m in t.messages
         )
         enc_cases = "\n".join(
-            f'    case {P}_{mid(m).upper()}:\n        {p}__put_text(o, "{m.code}", {len(m.code)}u);\n'
+            f"    case {P}_{mid(m).upper()}:\n        {p}__put_text(o, {c_text(m.code)}, {len(m.code)}u);\n"
             f"        return {p}__enc_{mid(m)}(&msg->u.{mid(m)}, o, check);"
             for m in t.messages
         )
@@ -958,3 +958,8 @@ def files(protocol: Protocol, text: TextFrame) -> dict[str, str]:
         f"{p}/{p}_json.h": json_header(protocol),
         f"{p}/{p}_json.c": json_source(protocol, text),
     }
+
+
+def c_text(code: str) -> str:
+    """A text code as a C string literal: `?` escaped, so that `??=` is no trigraph (C99 reads them)."""
+    return '"' + code.replace("?", "\\?") + '"'

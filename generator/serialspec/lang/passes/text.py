@@ -6,6 +6,7 @@ binary frames have yet are refused one line each, so that nothing a spec says is
 
 from __future__ import annotations
 
+import string
 from dataclasses import replace
 from typing import Any, cast
 
@@ -49,6 +50,12 @@ SEND_KEYS = ("every", "step", "while", "values", "description")
 ANSWER_KEYS = ("description", "stores", "sets", "reports", "echoes")
 
 
+# a text code's characters: letters, digits and the punctuation commands use (GRBL's `$H`, `$$`, `?`, `!`, `~`);
+# not spaces, quotes, backslashes, `*` or `|`, which the outputs' strings, comments and tables would need escaped
+CODE_PUNCTUATION = "$!?~#%&+-./:;=@^_"
+CODE_CHARACTERS = string.ascii_letters + string.digits + CODE_PUNCTUATION
+
+
 def is_text(data: Any) -> bool:
     framing = data.get("framing") if isinstance(data, dict) else None
     return isinstance(framing, dict) and framing.get("kind") == "text"
@@ -70,7 +77,7 @@ class TextPass(Pass):
             self.name(name, path, "command name")
             for direction in Direction:
                 if isinstance(command, dict) and direction.value in command:
-                    message = self.guard((*path, direction.value), self.message, name, command, direction)
+                    message = self.guard((*path, direction.value), self.message, name, command, direction, frame)
                     if message is not None:
                         messages.append(message)
         codes: dict[str, TextMessage] = {}
@@ -138,14 +145,20 @@ class TextPass(Pass):
             messages=(),
         )
 
-    def message(self, key: str, command: dict[str, Any], direction: Direction) -> TextMessage:
+    def message(self, key: str, command: dict[str, Any], direction: Direction, frame: TextFrame | None) -> TextMessage:
         path: Path = ("commands", key)
         for bad in ("subcommands", "selector", "probe", "broadcast"):
             if bad in command:
                 self.error((*path, bad), f"`{bad}` is not available in text frames yet")
         code = command.get("code")
-        if not isinstance(code, str) or not code or not code.isalnum():
-            raise self.fail((*path, "code"), f"a text command needs a text `code` (letters and digits), got {code!r}")
+        # the framing's own characters would cut the code out of its frame (`$` starts NMEA sentences)
+        framing = {frame.start, frame.separator, frame.marker, *frame.end} - {""} if frame is not None else set()
+        allowed = set(CODE_CHARACTERS) - framing
+        if not isinstance(code, str) or not code or not set(code) <= allowed:
+            shown = "".join(sorted(set(CODE_PUNCTUATION) - framing))
+            raise self.fail(
+                (*path, "code"), f"a text command needs a text `code` (letters, digits and {shown}), got {code!r}"
+            )
         raw = command.get(direction.value) or {}
         where = (*path, direction.value)
         for bad in ("answers", "error_reply", "optional_when", "after", "answered_by", "default", "optional"):

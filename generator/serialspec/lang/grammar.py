@@ -556,9 +556,9 @@ COMMAND = Obj(
         "code": IntOrText(
             (Int(), Str()),
             "Value of the frame's command field; omit for the one response of a protocol whose replies carry no "
-            "command field. In text frames: the text code after the talker (NMEA's sentence id, GGA; GRBL's `$H`): letters, "
-            "digits and `$!?~#%&+-./:;=@^_`, none of the framing's own characters. The requests "
-            "of several commands may share a code when no content size fits two of them: each is its own message, "
+            "command field. In text frames: the text code after the talker (NMEA's sentence id, GGA; GRBL's `$H`): "
+            "letters, digits and `$!?~#%&+-./:;=@^_`, none of the framing's own characters. The requests of several "
+            "commands may share a code when no content size fits two of them: each is its own message, "
             "decoded by its size (u-blox: an empty payload polls, a full one sets).",
         ),
         "title": TITLE,

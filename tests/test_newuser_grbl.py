@@ -65,15 +65,62 @@ def test_a_text_frame_without_a_checksum_is_not_said_to_check(tmp_path: Path) ->
     assert decode_json(nmea, gga)["checksum_ok"] is None  # NMEA allows leaving it out: not checked
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="finding: a text request cannot be answered by another command's reply (`answered_by` is not available "
-    "in text frames yet): GRBL answers every line (G-code, $H) with `ok` or `error:N`",
-)
+ANSWERED = """  home:
+    code: $H
+    title: Run the homing cycle
+    request:
+      answered_by: {command: ok, refused_by: [error]}
+device:
+  description: A GRBL board that answers every line with ok.
+  state: {}
+"""
+
+
 def test_ok_answers_a_g_code_line(tmp_path: Path) -> None:
-    load_protocol(
-        str(spec(tmp_path, "  home:\n    code: G28\n    request:\n      answered_by: {command: ok}\n")), "grbl"
+    """GRBL answers every line with `ok` or `error:N`: a request `answered_by` another command's response. The sim
+    answers $H with ok, the client returns it; an `error:9` line in its place is a DeviceError naming it."""
+    import os
+    import threading
+
+    from conftest import generate_and_import
+    from serialspec.runtime.errors import DeviceError
+    from sim_process import serve
+
+    path = spec(tmp_path, ANSWERED)
+    protocol = load_protocol(str(path), "grbl")
+    assert protocol.text is not None and protocol.text.answers() == {"$H": (("ok",), ("error",))}
+    grbl = generate_and_import(path, tmp_path / "out", "grbl")
+    with serve(str(path)) as port, grbl.Client(port) as client:
+        assert isinstance(client.home(timeout=5), grbl.OkResponse)
+    controller, device = os.openpty()
+    name = os.ttyname(device)
+
+    def refuse() -> None:
+        line = b""
+        while not line.endswith(b"\r\n"):
+            line += os.read(controller, 64)
+        assert line == b"$H\r\n"
+        os.write(controller, b"error:9\r\n")
+
+    answering = threading.Thread(target=refuse)
+    answering.start()
+    try:
+        with grbl.Client(name) as client, pytest.raises(DeviceError, match=r"^home \(\$H\): the device refused it"):
+            client.home(timeout=5)
+    finally:
+        answering.join(5)
+        os.close(controller)
+        os.close(device)
+
+
+def test_answered_by_mistakes_are_one_line_each(tmp_path: Path) -> None:
+    bad = ANSWERED.replace("{command: ok, refused_by: [error]}", "{command: okay, refused_by: [ok]}")
+    run = subprocess.run(
+        [sys.executable, "-m", "serialspec", "check", str(spec(tmp_path, bad))], capture_output=True, text=True
     )
+    lines = (run.stdout + run.stderr).strip().splitlines()
+    assert run.returncode != 0 and len(lines) == 1 and "Traceback" not in run.stderr, lines
+    assert lines[0].endswith("commands.home.request.answered_by.command: 'okay' is not a command with a response")
 
 
 def test_a_dollar_command(tmp_path: Path) -> None:

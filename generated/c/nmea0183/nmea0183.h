@@ -14,7 +14,7 @@
 extern "C" {
 #endif
 
-#define NMEA0183_SPEC_SHA256 "44cdc35f08a8ffa1c0aade97f62ac7cd2abdac71aa7e9cc3267442ff2215bbf3"
+#define NMEA0183_SPEC_SHA256 "c46b8665b7f0ffa1444fbe08881d6cff9fbe62aabdb3df08441743681b4a1dbd"
 
 /* Feature switches: define as 0 to leave encode, decode or the stream parser out. */
 #ifndef NMEA0183_ENABLE_ENCODE

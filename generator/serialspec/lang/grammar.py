@@ -524,7 +524,8 @@ MESSAGE = Obj(
                 "optional_when": OPTIONAL_WHEN,
             },
             required=("command",),
-            description="For a request: answered by another command's response (FEETECH's one status packet).",
+            description="For a request: answered by another command's response (FEETECH's one status packet; in text "
+            "frames GRBL's `ok`, with `refused_by: [error]`).",
         ),
         "default": Bool(
             "Among replies that share a code (or that all have none), the one a frame is decoded as when the "

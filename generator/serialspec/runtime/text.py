@@ -724,9 +724,26 @@ class TextRecord:
 class TextCodec:
     """decode, encode and the stream parser of one text protocol, over its generated message classes."""
 
-    def __init__(self, framing: TextFraming, classes: Iterable[type[TextRecord]]) -> None:
+    def __init__(
+        self,
+        framing: TextFraming,
+        classes: Iterable[type[TextRecord]],
+        answers: Mapping[str, tuple[tuple[str, ...], tuple[str, ...]]] | None = None,
+    ) -> None:
         self.framing = framing
         self.classes = {(cls.CODE, cls.DIRECTION.value): cls for cls in classes}
+        # request code -> the codes of the responses that answer it and of those that refuse it, where these are
+        # not its own command's response (the spec's `answered_by`: GRBL answers every line with ok or error:N)
+        self.answers = dict(answers or {})
+
+    def replies(self, code: str) -> tuple[tuple[type, ...], tuple[type, ...]]:
+        """The response classes that answer a request of this code, and those that refuse it."""
+        answering, refusing = self.answers.get(code, ((code,), ()))
+        found = [
+            tuple(self.classes[c, "response"] for c in codes if (c, "response") in self.classes)
+            for codes in (answering, refusing)
+        ]
+        return found[0], found[1]
 
     def message(self, sentence: Sentence) -> Any:
         cls = self.classes[sentence.code, sentence.direction]
@@ -837,16 +854,20 @@ class TextClient:
     def _answer(self, message: TextRecord, timeout: float) -> Generator[float, bytes, Any]:
         import time
 
-        from serialspec.runtime.errors import Timeout
+        from serialspec.runtime.errors import DeviceError, Timeout
 
-        answer = self.CODEC.classes.get((message.CODE, "response"))
-        if answer is None:
+        answers, refusals = self.CODEC.replies(message.CODE)
+        if not answers:
             return None  # a command the device does not answer
         deadline = time.monotonic() + timeout
         while (left := deadline - time.monotonic()) > 0:
             for arrived in self._arrived((yield min(left, 0.2))):
-                if isinstance(arrived, answer):
+                if isinstance(arrived, answers):
                     return arrived
+                if isinstance(arrived, refusals):
+                    raise DeviceError(
+                        f"{message.COMMAND} ({message.CODE}): the device refused it: {arrived!r}", arrived
+                    )
                 self._unread.append(arrived)
         raise Timeout(f"{message.COMMAND} ({message.CODE})", "", timeout)
 

@@ -106,14 +106,18 @@ def _page(protocol: Protocol, frame: TextFrame) -> Iterator[str]:
     yield "| --- | --- | --- | --- |"
     for message in frame.messages:
         link = f"[`{message.key}`](#{anchor('command', message.key)})"
-        yield f"| {message.code} | {link} | {message.direction.value} | {cell(message.title)} |"
+        yield f"| {code_span(message.code)} | {link} | {message.direction.value} | {cell(message.title)} |"
     for message in frame.messages:
         yield ""
         yield f'<a id="{anchor("command", message.key)}"></a>'
         yield ""
-        yield f"### {message.code}: {text(message.title or message.key)}"
+        yield f"### {code_span(message.code)}: {text(message.title or message.key)}"
         yield ""
         sent = "sent by the device on its own" if message.unsolicited else f"a {message.direction.value}"
+        if message.answered_by:
+            sent += f", answered by the `{message.answered_by}` response"
+        if message.refused_by:
+            sent += f", refused by {' or '.join(f'the `{name}` response' for name in message.refused_by)}"
         yield f"`{message.class_name}`, {sent}." + (f" Source: {text(message.source)}." if message.source else "")
         yield ""
         if message.description:

@@ -119,7 +119,7 @@ def _answered(text: TextFrame, device: TextDevice) -> list[tuple[TextMessage, Te
     for request in text.messages:
         if request.direction != Direction.REQUEST:
             continue
-        response = text.response(request.key)
+        response = text.answer(request)
         if response is not None:
             found.append((request, response, entries.get(request.key)))
     return found
@@ -310,7 +310,12 @@ def _module(protocol: Protocol, text: TextFrame) -> Iterator[str]:
     yield ""
     names = ", ".join(m.class_name for m in text.messages)
     yield f"MESSAGE_TYPES: tuple[type[TextRecord], ...] = ({names}{',' if len(text.messages) == 1 else ''})"
-    yield "CODEC = TextCodec(FRAMING, MESSAGE_TYPES)"
+    answers = text.answers()
+    if answers:
+        yield "# requests answered by another command's response, or refused by some: code -> (answers, refusals)"
+        yield f"CODEC = TextCodec(FRAMING, MESSAGE_TYPES, answers={answers!r})"
+    else:
+        yield "CODEC = TextCodec(FRAMING, MESSAGE_TYPES)"
     yield "#: One frame (bytes or str, with or without its line ending) -> its message."
     yield "decode = CODEC.decode"
     yield "#: A message -> its frame (range checks first)."
@@ -351,7 +356,7 @@ def _client_methods(text: TextFrame, asynchronous: bool) -> Iterator[str]:
     for request in text.messages:
         if request.direction != Direction.REQUEST:
             continue
-        response = text.response(request.key)
+        response = text.answer(request)
         name = request.key + "_" if request.key in CLIENT_NAMES else request.key
         params = []
         for item in request.fields:

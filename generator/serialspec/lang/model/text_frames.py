@@ -52,6 +52,8 @@ class TextMessage:
     fields: tuple[TextField | TextRepeat, ...]
     unsolicited: bool = False
     source: str = ""
+    answered_by: str = ""  # a request answered by another command's response (its key): GRBL's `ok`
+    refused_by: tuple[str, ...] = ()  # commands whose responses refuse the request instead: GRBL's `error:N`
 
 
 @frozen
@@ -123,6 +125,20 @@ class TextFrame:
 
     def response(self, key: str) -> TextMessage | None:
         return next((m for m in self.messages if m.key == key and m.direction == Direction.RESPONSE), None)
+
+    def answer(self, request: TextMessage) -> TextMessage | None:
+        """The response that answers a request: its own command's, or the one it is `answered_by`."""
+        return self.response(request.answered_by or request.key)
+
+    def answers(self) -> dict[str, tuple[tuple[str, ...], tuple[str, ...]]]:
+        """Each request code answered by another command (`answered_by`) or refused by some (`refused_by`) -> the
+        codes of the responses that answer it and of those that refuse it."""
+        codes = {m.key: m.code for m in self.messages if m.direction == Direction.RESPONSE}
+        return {
+            m.code: ((codes[m.answered_by or m.key],), tuple(codes[k] for k in m.refused_by))
+            for m in self.messages
+            if m.direction == Direction.REQUEST and (m.answered_by or m.refused_by)
+        }
 
     def letter_sets(self) -> dict[str, tuple[tuple[str, str], ...]]:
         """Each generated letter Enum's name -> its (label, letter) pairs, in order of first use."""

@@ -85,6 +85,16 @@ class TextPass(Pass):
             other = codes.setdefault(message.code, message)
             if other.key != message.key:
                 self.error(("commands", message.key, "code"), f"code {message.code!r} is also {other.key}'s")
+        responses = {m.key for m in messages if m.direction == Direction.RESPONSE}
+        for message in messages:
+            asked: Path = ("commands", message.key, "request", "answered_by")
+            if message.answered_by and message.answered_by not in responses:
+                self.error((*asked, "command"), f"{message.answered_by!r} is not a command with a response")
+            for index, name in enumerate(message.refused_by):
+                if name not in responses:
+                    self.error((*asked, "refused_by", index), f"{name!r} is not a command with a response")
+                elif name == message.answered_by:
+                    self.error((*asked, "refused_by", index), f"{name!r} is the reply that answers it")
         if frame is not None:
             frame = replace(frame, messages=tuple(messages))
             examples = tuple(self.examples(frame))
@@ -161,9 +171,19 @@ class TextPass(Pass):
             )
         raw = command.get(direction.value) or {}
         where = (*path, direction.value)
-        for bad in ("answers", "error_reply", "optional_when", "after", "answered_by", "default", "optional"):
+        for bad in ("answers", "error_reply", "optional_when", "after", "default", "optional"):
             if bad in raw:
                 self.error((*where, bad), f"`{bad}` is not available in text frames yet")
+        answered_by = raw.get("answered_by") or {}
+        if answered_by and direction != Direction.REQUEST:
+            self.error((*where, "answered_by"), "`answered_by` belongs to a request")
+        if "optional_when" in answered_by:
+            self.error((*where, "answered_by", "optional_when"), "`optional_when` is not available in text frames yet")
+        if answered_by and "response" in command:
+            self.error(
+                (*where, "answered_by"),
+                f"{key} has a response of its own: leave out `answered_by` or the response",
+            )
         fields = self.fields(raw.get("fields") or {}, (*where, "fields"), top=True)
         class_name = camel(key, direction.value)
         self.class_name(class_name, where)
@@ -177,6 +197,8 @@ class TextPass(Pass):
             fields=fields,
             unsolicited=bool(raw.get("unsolicited", False)),
             source=str(raw.get("source") or command.get("source", "")),
+            answered_by=str(answered_by.get("command", "")),
+            refused_by=tuple(str(name) for name in answered_by.get("refused_by") or ()),
         )
 
     def fields(self, raw: dict[str, Any], path: Path, top: bool) -> tuple[TextField | TextRepeat, ...]:

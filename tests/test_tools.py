@@ -63,6 +63,16 @@ def test_scan_finds_each_servo_and_reads_its_model_register(tmp_path: Path) -> N
     assert b"".join(requests_in(tap)) == expected
 
 
+def test_scan_finds_roboclaw_controllers_by_their_firmware_version(tmp_path: Path) -> None:
+    """RoboClaw's presence is READ FIRMWARE VERSION (command 21) at each packet serial address, from the spec."""
+    tap = tmp_path / "bus.tap"
+    with serve("roboclaw.yaml", 0x80, 0x83, options=["--tap", str(tap)]) as port:
+        result = scan(spec("roboclaw"), "--port", port, "--ids", "128-131")
+    assert result.returncode == 0, result.stderr
+    assert [line.split()[:2] for line in result.stdout.splitlines()] == [["id", "128"], ["id", "131"]]
+    assert requests_in(tap) == [bytes([address, 21]) for address in range(0x80, 0x84)]
+
+
 def test_scan_finds_a_dynamixel_bus_with_one_broadcast_ping(tmp_path: Path) -> None:
     tap = tmp_path / "bus.tap"
     with serve("dynamixel_p2.yaml", 1, 3, options=["--model", "3=xl330_m288", "--tap", str(tap)]) as port:

@@ -129,9 +129,10 @@ class Scanner:
         self.models = {m.number: m.name for m in protocol.device.models} if protocol.device else {}
         self.gap = 0.0  # seconds of silence before each request, set per baud rate
         # the presence request is checked (types, ranges) before a byte is written
-        self.frame(self.request, presence.fields, None if not presence.ids else presence.ids[0])
+        self.message(self.request, presence.fields, None if not presence.ids else presence.ids[0])
 
-    def frame(self, cls: Any, values: dict[str, float], device: int | None) -> bytes:
+    def message(self, cls: Any, values: dict[str, float], device: int | None) -> Any:
+        """The presence (or model) request to `device`, checked as encode will check it."""
         given = {name: int(value) if float(value).is_integer() else value for name, value in values.items()}
         if device is not None:
             given[self.presence.id_field] = device
@@ -140,8 +141,8 @@ class Scanner:
         except TypeError as exc:
             what = f"device.presence: {cls.COMMAND} cannot be built from the spec's values"
             raise SerialspecError(f"{what}: {exc}") from None
-        encoded: bytes = self.package.encode(message)  # EncodeError/RangeError: one line naming the field
-        return encoded
+        self.package.encode(message)  # EncodeError/RangeError: one line naming the field, before any byte is sent
+        return message
 
     def scan(self, port: Any, ids: list[int], rate: int, wait: float, progress: Progress | None) -> Iterator[Found]:
         """Each device that answers at this rate, as soon as it has (and its model has been read)."""
@@ -151,7 +152,7 @@ class Scanner:
         if not presence.id_field:
             if progress is not None:
                 progress.step(rate, 0)
-            reply = self.ask(port, self.frame(self.request, presence.fields, None), None, None, wait)
+            reply = self.ask(port, self.message(self.request, presence.fields, None), None, None, wait)
             if reply is not None:
                 yield Found(None, rate, self.model(port, None, reply, wait))
             return
@@ -159,7 +160,7 @@ class Scanner:
         heard = True
         broadcast = self.protocol.device.broadcast if self.protocol.device else None
         if presence.broadcast and broadcast is not None:
-            request = self.frame(self.request, presence.fields, broadcast)
+            request = self.message(self.request, presence.fields, broadcast)
             found, heard = self.everyone(port, request, set(ids), wait, len(ids))
         for device in sorted(found):
             yield Found(device, rate, self.model(port, device, found[device], wait))
@@ -169,19 +170,19 @@ class Scanner:
             for number, device in enumerate(ids):
                 if progress is not None:
                     progress.step(rate, number)
-                reply = self.ask(port, self.frame(self.request, presence.fields, device), device, None, wait)
+                reply = self.ask(port, self.message(self.request, presence.fields, device), device, None, wait)
                 if reply is not None:
                     yield Found(device, rate, self.model(port, device, reply, wait))
         if progress is not None:
             progress.step(rate, len(ids))
 
-    def ask(self, port: Any, frame: bytes, device: int | None, expect: type[Message] | None, wait: float) -> Any:
+    def ask(self, port: Any, request: Any, device: int | None, expect: type[Message] | None, wait: float) -> Any:
         """The first reply from `device` (of class `expect`, when given) within `wait` seconds, or None."""
-        parser = self.parser(expect or self.reply)
+        parser = self.parser(expect or self.reply, request)
         if self.gap:
             time.sleep(self.gap)
         port.reset_input_buffer()
-        port.write(frame)
+        port.write(self.package.encode(request))
         deadline = time.monotonic() + wait
         while (left := deadline - time.monotonic()) > 0:
             for message in parser.feed(self.read(port, left)):
@@ -192,15 +193,15 @@ class Scanner:
         return None
 
     def everyone(
-        self, port: Any, frame: bytes, ids: set[int], wait: float, most: int
+        self, port: Any, request: Any, ids: set[int], wait: float, most: int
     ) -> tuple[dict[int, Message], bool]:
         """The replies to a broadcast request, each device in turn: read until `wait` passes without one; and
         whether any byte came at all."""
-        parser = self.parser(self.reply)
+        parser = self.parser(self.reply, request)
         if self.gap:
             time.sleep(self.gap)
         port.reset_input_buffer()
-        port.write(frame)
+        port.write(self.package.encode(request))
         found: dict[int, Message] = {}
         heard = False
         deadline = time.monotonic() + wait
@@ -219,7 +220,7 @@ class Scanner:
         if not presence.model_field:
             return None
         if presence.model_request != presence.request or presence.model_fields:
-            reply = self.ask(port, self.frame(self.model_request, presence.model_fields, device), device, None, wait)
+            reply = self.ask(port, self.message(self.model_request, presence.model_fields, device), device, None, wait)
             if reply is None or reply.__class__ is not self.model_reply:
                 return None  # there, but it did not say (a refusal, or no reply in time)
         value = getattr(reply, presence.model_field, None)
@@ -236,9 +237,11 @@ class Scanner:
             return None if value is None else str(value)
         return self.models.get(value, value) if isinstance(value, int) else value
 
-    def parser(self, expect: type[Message] | None) -> Any:
+    def parser(self, expect: type[Message] | None, request: Any) -> Any:
+        """A reply parser told what it waits for: the reply class, and the request it answers (RoboClaw's reply
+        checksum starts with the request's address and command)."""
         parser = self.package.StreamParser(Direction.RESPONSE)
-        parser.expect(expect)
+        parser.expect(expect, request)
         return parser
 
     @staticmethod

@@ -152,7 +152,7 @@ def test_every_shipped_bus_declares_how_to_find_its_devices() -> None:
         "modbus_rtu": "read_holding_registers",
         "nmea0183": None,
         "crsf": None,
-        "roboclaw": None,
+        "roboclaw": "read_version",
         "mavlink_common": None,
         "ubx": None,
         "vesc": "fw_version",

@@ -597,8 +597,7 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
             "codes": "{" + ", ".join(f"{name!r}: {code:#04x}" for name, code in codes.items()) + "}",
         }
     replies = other_replies(protocol)
-    for _, names in (*replies["answered_by"], *replies["refused_by"]):
-        module_imports.update(names.strip("(,)").split(", "))
+    module_imports.update(replies["classes"])
     module_imports.update(name for name, _ in replies["code_fields"])
     device = protocol.device
     model_map = (
@@ -706,6 +705,7 @@ def other_replies(protocol: Protocol) -> dict[str, list[Any]]:
     refused: list[tuple[str, str]] = []
     code_fields: list[tuple[str, str]] = []
     codes: list[tuple[str, int]] = []
+    classes: list[str] = []  # the reply classes in either, which the module imports
     replies = replies_by_request(protocol.messages())
     for request, response in request_response_pairs(protocol):
         refusing = refusals_of(request, replies)
@@ -713,8 +713,10 @@ def other_replies(protocol: Protocol) -> dict[str, list[Any]]:
         others = [m.class_name for m in (response, *refusing) if m and m.command != request.command]
         if others and "command" in protocol.matching:  # only matching by command needs telling
             answered.append((request.class_name, class_tuple(others)))
+            classes += others
         if refusals:
             refused.append((request.class_name, class_tuple(refusals)))
+            classes += refusals
         for reply in (response, *refusing):
             if reply is not None and reply.request_code and (reply.class_name, reply.request_code) not in code_fields:
                 code_fields.append((reply.class_name, reply.request_code))
@@ -726,6 +728,7 @@ def other_replies(protocol: Protocol) -> dict[str, list[Any]]:
         "refused_by": refused,
         "code_fields": code_fields,
         "codes": codes if code_fields else [],
+        "classes": classes,
     }
 
 

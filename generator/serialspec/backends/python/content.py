@@ -471,7 +471,7 @@ class PackageCode:
                 size = sum(fixed_size(f) or 0 for f in item)
                 if known is not None and size > known:
                     reason = f"{item[0].name} needs {size} bytes, {{end - o}} left"
-                    body.append(Needs(str(size), f"DecodeError({where} + f': {reason}')"))
+                    body.append(Needs(size, f"DecodeError({where} + f': {reason}')"))
                     known = size
                 known = None if known is None else known - size
                 values += self.decode_run(item, base, body, where)
@@ -556,7 +556,7 @@ class PackageCode:
                     expr = self.after_unpack(f, name, body, where)
                     if expr is not None:
                         values.append(expr)
-        body.append(Advance(str(size)))
+        body.append(Advance(size))
         return values
 
     @staticmethod
@@ -755,7 +755,7 @@ class PackageCode:
             body.append(Code(f"{value} = _decode_text(buf[o:end], {spec_key(f.name)}, {where})", cursor=True))
             body.append(Advance(to="end"))
             return value
-        size = str(f.size) if isinstance(f.size, int) else self.local_named(f.size)
+        size = f.size if isinstance(f.size, int) else self.local_named(f.size)
         body.append(Needs(size, f"DecodeError({where} + f': {f.name} needs {{{size}}} bytes, {{end - o}} left')"))
         body.append(Code(f"{value} = _decode_text(buf[o : o + {size}], {spec_key(f.name)}, {where})", cursor=True))
         body.append(Advance(size))

@@ -120,18 +120,21 @@ def decode_lines(
         if element.kind != "checksum":
             continue
         width = 2 + 2 * element.size
+        error = (
+            f'raise ChecksumError(f"bad {element.name}: the frame has {{stored:#0{width}x}}, '
+            f'its bytes give {{check:#0{width}x}}")'
+        )
         failed = [
             f"check = {checks[index].format(positions.covered(*element.span))}",
             f"stored = {positions.read(index)}",
             "if check != stored:",
-            f'    raise ChecksumError(f"bad {element.name}: the frame has {{stored:#0{width}x}}, '
-            f'its bytes give {{check:#0{width}x}}")',
+            f"    {error}",
         ]
         residue = crc_residue(element)
         a, b = element.span
         test = frame_sum_test(layout, index, (algorithms or {}).get(index))
         if test is not None:  # the sum of the whole frame, no slice made; the rest only says what is wrong
-            body += [f"if {test}:", *(f"    {line}" for line in [*failed[:2], failed[3].strip()])]
+            body += [f"if {test}:", *(f"    {line}" for line in [*failed[:2], error])]
         elif residue is not None and b == index - 1 and a <= positions.first:
             # over the covered bytes and the checksum itself, an intact frame's CRC is one constant: no slice, no
             # stored value to read; they are made only to say what is wrong

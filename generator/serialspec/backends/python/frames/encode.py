@@ -188,7 +188,8 @@ def closing_lines(layout: Layout, frame: str, checks: dict[int, str], packed: Ca
         between = size_of(elements[b + 1 : index])
         # all after the variable part: counted back from the end of what is written
         begin_expr = str(-size_of(elements[a:index])) if a > last else str(begin) if begin else ""
-        covered = f"frame[{begin_expr}:{-between if between else ''}]".replace("[:]", "")
+        stop = str(-between) if between else ""
+        covered = f"frame[{begin_expr}:{stop}]" if begin_expr or stop else "frame"
         lines.append(f"frame = {frame}")
         frame = f"frame + {checks[index].format(covered)}.to_bytes({element.size}, {element.endian!r})"
     if pending:
@@ -293,7 +294,7 @@ def _frame_lines(
             static, arguments = fmt[0] + fused.struct[1:] + fmt[1:], [*fused.arguments, *first.arguments]
             run = parts[1] if len(parts) > 1 and isinstance(parts[1], PackItems) else None
             if run and run.order == static[0]:  # and a run of numbers after it, in the same byte order
-                fstring = repr(static + run.counted_format).replace("'", "f'", 1)
+                fstring = "f" + repr(static + run.counted_format)
                 parts = [f"struct.pack({fstring}, {', '.join(arguments)}, *{run.items})", *parts[2:]]
             else:
                 parts = [Pack(struct(static), arguments), *parts[1:]]
@@ -428,7 +429,7 @@ def message_frame(package: PackageCode, message: Message, frame_values: list[str
     if all(is_fixed_run_member(f) for f in fields):
         # one fixed size: the whole frame but its checksum is one struct, the length byte a constant
         endian, content_format, args = package.encode_run_format(fields, "m", fields, body, where)
-        head = head_struct(package, layout, endian, code, f"{message.min_size + layout.length_adds}", frame_values)
+        head = head_struct(package, layout, endian, code, message.min_size + layout.length_adds, frame_values)
         if head is not None:
             head_format, head_args = head
             name = package.struct(f"frame_{message.class_name}", endian + head_format + content_format)
@@ -465,7 +466,7 @@ def message_frame(package: PackageCode, message: Message, frame_values: list[str
 
 
 def head_struct(
-    package: PackageCode, layout: FrameLayout, endian: str, code: str, length: str, values: list[str]
+    package: PackageCode, layout: FrameLayout, endian: str, code: str, length: int | str, values: list[str]
 ) -> tuple[str, list[str]] | None:
     """Struct format (no byte order) and arguments of the frame elements before the content.
 
@@ -488,9 +489,9 @@ def head_struct(
         if element.role == "command":
             args.append(code)
         elif element.role == "length":
-            if length.isdigit() and int(length) > element.type.maximum:
+            if isinstance(length, int) and length > element.type.maximum:
                 return None
-            args.append(length)
+            args.append(str(length))
         else:  # address, status: the message's frame values, in element order
             args.append(next(remaining))
     return "".join(chars), args

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from serialspec.backends.python.checksum_code import checksum_lines, checksum_name, checksum_setup
+from serialspec.backends.python.checksum_code import checksum_lines, checksum_setup
 from serialspec.backends.python.dispatch import (
     direction_dispatch,
 )
@@ -160,8 +160,7 @@ def length_byte_codec_context(protocol: Protocol, code: PackageCode) -> dict[str
     for picker in whole_pickers:
         picker["lines"] = lines_of(picker["lines"])
     imports = import_lines(checksum_imports)
-    name = checksum_name(checksum)
-    if name in checksum.algorithm.python_call(name):
+    if checksum.algorithm.python_calls_function():
         # the general path calls the checksum's function (as every framing's does): defined with what it needs
         imports, definitions = checksum_definitions(protocol)
     return {

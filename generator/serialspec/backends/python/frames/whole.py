@@ -51,6 +51,8 @@ if TYPE_CHECKING:
     from serialspec.backends.python.content import PackageCode
 from serialspec.backends.python.frames.decode import frame_sum_test
 
+At = Callable[[int], int | str]  # a frame offset as the decoder reads it: a number, or `start + k` in a buffer
+
 
 def fixed_frames(
     protocol: Protocol, layout: FrameLayout, bodies: dict[str, tuple[str, str, Block]], code: PackageCode
@@ -156,13 +158,13 @@ def rest_frames(
         else:
             continue
 
-        def at(offset: int) -> str:
-            return f"start + {offset}" if stream else str(offset)
+        def at(offset: int) -> int | str:
+            return f"start + {offset}" if stream else offset
 
         offset, body = content_offset, []
         for statement in statements:
-            if isinstance(statement, Advance) and statement.size.isdigit():
-                offset += int(statement.size)
+            if isinstance(statement, Advance) and isinstance(statement.size, int) and not statement.to:
+                offset += statement.size
                 continue
             if isinstance(statement, Unpack) and statement.at == "o":
                 statement = replace(statement, at=at(offset))
@@ -334,7 +336,7 @@ def frame_function(
     if layout.command_offset is not None:
         known[layout.command_offset] = command.wire_code(layout.direction) or 0
 
-    def statements(at: Callable[[int], str], whole: bool) -> tuple[Block, bool]:
+    def statements(at: At, whole: bool) -> tuple[Block, bool]:
         """The decoder's statements with frame offsets `at` (buf[start:] or all of buf: `whole`), and whether its
         checksum is checked from the unpacked values (sum_from_values)."""
         values: Block = [
@@ -358,7 +360,7 @@ def frame_function(
         "returns": returns,
         "where": f"{message.key} {message.direction.value}",
         "lines": lines,
-        "whole_lines": statements(str, True)[0],
+        "whole_lines": statements(lambda offset: offset, True)[0],
     }
     # built in decode() where its whole-frame decoder sums the frame's bytes (one from the values is quicker yet)
     plain = unpacked_frame(protocol, layout, body)
@@ -370,12 +372,12 @@ def frame_function(
     return key, size, function
 
 
-def at_offset(body: Block, at: str) -> Block:
+def at_offset(body: Block, at: int | str) -> Block:
     """A content decoder's statements with the unpack at the cursor made at `at` (a frame offset)."""
     return [replace(s, at=at) if isinstance(s, Unpack) and s.at == "o" else s for s in body]
 
 
-def frame_check(checksum: Checksum, layout: FrameLayout, size: int, at: Callable[[int], str]) -> Block:
+def frame_check(checksum: Checksum, layout: FrameLayout, size: int, at: At) -> Block:
     """A whole frame's checksum test, returning None when it fails: the checksum over the covered bytes compared
     with the stored one (frame offsets `at`)."""
     reads: tuple[int, ...] = ()
@@ -392,7 +394,7 @@ _MOST_UNROLLED = 12  # CRC-8 steps written out one by one in a whole-frame decod
 
 
 def whole_frame_check(
-    protocol: Protocol, layout: FrameLayout, size: int, known: dict[int, int], at: Callable[[int], str]
+    protocol: Protocol, layout: FrameLayout, size: int, known: dict[int, int], at: At
 ) -> Block | None:
     """decode()'s version of a whole-frame decoder's checksum test, where it is cheaper than frame_check's: `buf` is
     exactly the frame (decode checked its size), so a checksum that is a sum over all but a constant header is
@@ -452,8 +454,8 @@ def exact_whole(body: Block, size: int, known: int, code: PackageCode) -> Block:
         return [If(f"len(buf) != {size}", (RETURN_NONE,)), *body]
     found = body[unpacks[0]]
     unpack = _unpack_at_offset(found)
-    assert unpack is not None
-    whole = replace(unpack, struct=exact_struct(unpack.struct, size, int(unpack.at), code), at="")
+    assert unpack is not None and isinstance(unpack.at, int)
+    whole = replace(unpack, struct=exact_struct(unpack.struct, size, unpack.at, code), at="")
     body[unpacks[0]] = replace(found, unpacked=whole) if isinstance(found, ReturnNew) else whole
     return body
 
@@ -464,7 +466,7 @@ def _unpack_at_offset(statement: Statement) -> Unpack | None:
         unpack = statement.unpacked
     else:
         unpack = statement if isinstance(statement, Unpack) else None
-    return unpack if unpack is not None and not unpack.indexed and unpack.at.isdigit() else None
+    return unpack if unpack is not None and not unpack.indexed and isinstance(unpack.at, int) else None
 
 
 def _constant_reads(body: Block) -> list[int]:
@@ -473,8 +475,8 @@ def _constant_reads(body: Block) -> list[int]:
     for statement in walk(body):
         if isinstance(statement, Code | If):
             reads += statement.reads
-        elif isinstance(statement, Unpack) and statement.indexed and statement.at.isdigit():
-            reads.append(int(statement.at))
+        elif isinstance(statement, Unpack) and statement.indexed and isinstance(statement.at, int):
+            reads.append(statement.at)
     return reads
 
 
@@ -547,7 +549,7 @@ def sum_from_values(
     size: int,
     body: Block,
     code: PackageCode,
-    at: Callable[[int], str],
+    at: At,
 ) -> Block | None:
     """For an 8-bit sum checksum right after integer-only content: statements that unpack the content and the
     checksum in one call (at frame offsets `at`) and check the sum from the values (a byte sum does not depend on

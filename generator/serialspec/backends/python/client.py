@@ -22,6 +22,7 @@ from typing import Any, assert_never
 from serialspec.backends.common.numbers import number
 from serialspec.backends.common.pairing import request_response_pairs
 from serialspec.backends.python.content import annotation
+from serialspec.backends.python.kinds import list_item_type
 from serialspec.backends.python.registers import map_name, names_alias
 from serialspec.backends.python.render import one_line, render
 from serialspec.backends.python.simulator import import_order
@@ -490,7 +491,7 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
             elif len(rest) == 1 and isinstance(rest[0], List):
                 # a list comes back as a list; padding items (bits to a whole byte) are cut to the number asked
                 only = rest[0]
-                kind, returns = "value", annotation(only).replace("tuple[", "list[").replace(", ...]", "]")
+                kind, returns = "value", f"list[{list_item_type(only)}]"
                 wanted = only.count_from if any(f.name == only.count_from for f in request.fields) else ""
                 cut = f"[: request.{wanted}]" if wanted else ""
                 result_expr = reply_value(only, "reply", cut)

@@ -76,6 +76,11 @@ def _numbers(is_float: bool) -> str:
     return "tuple[float, ...]" if is_float else "tuple[int, ...]"
 
 
+def list_item_type(f: List) -> str:
+    """The Python type of a list field's items (the message holds a tuple of them)."""
+    return "bool" if f.item is None else "float" if f.item.is_float else "int"
+
+
 _INT = {1: "Int8", 2: "Int16", 3: "Int24", 4: "Int32", 8: "Int64"}
 
 
@@ -256,7 +261,7 @@ class ListKind(Kind[List]):
         return list_expr(f)
 
     def annotation(self, f: List) -> str:
-        return "tuple[bool, ...]" if f.item is None else _numbers(f.item.is_float)
+        return f"tuple[{list_item_type(f)}, ...]"
 
     def to_json(self, f: List, expr: str) -> str:
         return f"list({expr})"

@@ -55,9 +55,7 @@ def direction_functions(
     lines: Lines = []
     divert: Lines = []
     if found.diverts:  # a frame with an optional element's flag bit set: the engine's (its functions, renamed)
-        decode, wrap = engine_lines(runtime_layouts(protocol, direction), target)
-        decode[0] = decode[0].replace(f"def _decode_{d}(", f"def _decode_{d}_engine(", 1)
-        wrap[0] = wrap[0].replace(f"def _wrap_{d}(", f"def _wrap_{d}_engine(", 1)
+        decode, wrap = engine_lines(runtime_layouts(protocol, direction), target, "_engine")
         lines += [*decode, "", "", *wrap, "", ""]
         tests = [
             f"frame[{offset}] & {mask:#04x}"

@@ -259,8 +259,9 @@ def _constant_checks(positions: Positions, start: int = 0) -> Lines:
     return lines
 
 
-def engine_lines(layouts: tuple[Layout, ...], target: Target) -> tuple[Lines, Lines]:
-    """The two functions of a direction whose layouts keep the interpreted engine (FrameCodec)."""
+def engine_lines(layouts: tuple[Layout, ...], target: Target, suffix: str = "") -> tuple[Lines, Lines]:
+    """The two functions of a direction whose layouts keep the interpreted engine (FrameCodec), their names ending
+    in `suffix` (`_engine`: beside straight-line functions, for the frames those leave to the engine)."""
     direction = target.upper.lower()
     frames = f"_{target.upper}_FRAMES"
     values = [f"v_{v}" for v in target.value_names]
@@ -270,13 +271,13 @@ def engine_lines(layouts: tuple[Layout, ...], target: Target) -> tuple[Lines, Li
     extras = ", {" + ", ".join(f"{name!r}: {name}" for name in target.optional) + "}" if target.optional else ""
     if target.requesting:  # the layout by the message's command, the request's bytes for a checksum over them
         wrap = [
-            f"def _wrap_{direction}({parameters}, layout: int | None = None, request: Message | None = None"
+            f"def _wrap_{direction}{suffix}({parameters}, layout: int | None = None, request: Message | None = None"
             f"{optional}) -> bytes:",
             f'    """The {direction} frame around `content` in its layout, made by the frame engine."""',
             f"    return {frames}.wrap(content, code, {shown}, layout, _request_parts(request){extras})",
         ]
         decode = [
-            f"def _decode_{direction}(frame: bytes, expect: type[Message] | None = None, "
+            f"def _decode_{direction}{suffix}(frame: bytes, expect: type[Message] | None = None, "
             "request: Message | None = None) -> Message:",
             f'    """One complete {direction} frame, checked and taken apart by the frame engine (with the request it',
             '    answers, where its layout or checksum needs it); its content decoded."""',
@@ -290,12 +291,12 @@ def engine_lines(layouts: tuple[Layout, ...], target: Target) -> tuple[Lines, Li
         ]
         return _engine_decode(decode, target), wrap
     wrap = [
-        f"def _wrap_{direction}({parameters}{optional}) -> bytes:",
+        f"def _wrap_{direction}{suffix}({parameters}{optional}) -> bytes:",
         f'    """The {direction} frame around `content`, made by the frame engine."""',
         f"    return {frames}.wrap(content, code, {shown}{', None, None' + extras if extras else ''})",
     ]
     decode = [
-        f"def _decode_{direction}(frame: bytes, expect: type[Message] | None = None) -> Message:",
+        f"def _decode_{direction}{suffix}(frame: bytes, expect: type[Message] | None = None) -> Message:",
         f'    """One complete {direction} frame, checked and taken apart by the frame engine; its content decoded."""',
         f"    unwrapped = {frames}.unwrap(frame)",
         "    code, content = unwrapped.code, unwrapped.content",

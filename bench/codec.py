@@ -279,7 +279,7 @@ def run() -> Table:
             "two-layout frame).",
             "DYNAMIXEL 2.0, Modbus RTU and VESC frames are not of the classic shape (stuffing, u16 length over a span, "
             "CRC-16, no header, two layouts): the generator writes straight-line frame code for them from the "
-            "framing description (backends/python/straight_frames.py); the CRC-16s are the runtime's crc_function "
+            "framing description (backends/python/frames/); the CRC-16s are the runtime's crc_function "
             "(two bytes per step from a 65,536-entry table; CRC-16/XMODEM is binascii.crc_hqx). Hand-written: one "
             "function each, a table-driven CRC-16 loop a byte at a time (VESC: binascii.crc_hqx).",
             f"pymavlink {mavlink_version()} `common` (MAVLink 2): `MAVLink.decode(frame)` and `message.pack(mav)`; its "

@@ -3,7 +3,7 @@
 Parametrized by the registry (serialspec/checksums/), so a new algorithm is covered here without an edit. Each
 option is put in two frame shapes: the classic one (header, command, one-byte length, content, checksum: the
 straight-line classic codec and construct's frame struct) and a general one (two-byte header, u16 length, the
-checksum over command..content: straight_frames' straight-line code and the engine). For each: the spec resolves and
+checksum over command..content: frames/' straight-line code and the engine). For each: the spec resolves and
 its keys are in the JSON Schema; `serialspec generate` writes the package and the docs and `check` passes; the codec
 round-trips, stores what the algorithm computes over the covered bytes and refuses a wrong checksum in one line; the
 stream parser finds every frame among garbage at any read size (hypothesis); construct parses and builds the frame;

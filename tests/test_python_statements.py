@@ -95,3 +95,23 @@ def test_a_lists_range_loop_runs_only_when_its_pack_fails() -> None:
     between = If("m.id > 9", (Raise("EncodeError('id')"),))
     kept = lines_of(read_fields_once(deferred_item_checks([check, between, pack]), ["values"]))
     assert "try:" not in kept and kept[1] == "for x_values in m_values:"
+
+
+def test_a_checksum_says_whether_its_call_is_the_codec_function() -> None:
+    """The frame code asks the algorithm whether its Python call calls the codec's checksum function (which the codec
+    then defines), not the call's text: for each shipped protocol's checksums, the answer is what the call reads."""
+    from conftest import ALL
+    from serialspec.backends.python.checksum_code import checksum_name
+
+    seen = set()
+    for g in ALL:
+        for layout in g.protocol.framing.layouts.values():
+            for element in layout.elements:
+                checksum = element.checksum
+                if checksum is None:
+                    continue
+                name = checksum_name(checksum)
+                call = checksum.algorithm.python_call(name)
+                assert checksum.algorithm.python_calls_function() == (name in call), (g.protocol.name, call)
+                seen.add(checksum.algorithm.python_calls_function())
+    assert seen == {True, False}  # both kinds among the shipped protocols (a sum; a CRC)

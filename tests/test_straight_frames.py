@@ -1,4 +1,4 @@
-"""Straight-line frame code (backends/python/straight_frames.py) against the interpreted frame engine
+"""Straight-line frame code (backends/python/frames/) against the interpreted frame engine
 (runtime/framing.py).
 
 Codecs of frames that are not of the classic shape check and build their frames in generated straight-line code;
@@ -254,7 +254,7 @@ LENGTH_BYTE = [g for g in ALL if g.protocol.text is None and g.protocol.framing.
 @settings(max_examples=examples(150), suppress_health_check=[HealthCheck.too_slow])
 @given(data=st.data())
 def test_length_byte_codecs_agree_with_the_engine(g: Generated, direction: str, data: st.DataObject) -> None:
-    """A length-byte codec's decode() (its whole-frame tables first, then the checks straight_frames writes for every
+    """A length-byte codec's decode() (its whole-frame tables first, then the checks frames/ writes for every
     framing) gives the engine's message or error, word for word, on intact and damaged frames; the engine made from
     the same layouts (backends/common/frames.py) and the codec's content sizes."""
     codec, upper = g.package.codec, direction.upper()

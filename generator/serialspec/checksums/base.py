@@ -197,6 +197,11 @@ class Algorithm:
         (parenthesised where it is not an atom or a call)."""
         return name + "({})"
 
+    def python_calls_function(self) -> bool:
+        """Whether python_call calls the codec's function of the checksum (which the codec then defines), not an
+        expression of its own."""
+        return True
+
     def python_expression(self, name: str, covered: str) -> str | None:
         """The checksum of the bytes `covered` as the one expression python_lines assigns; None where python_lines
         takes more than one statement."""

@@ -358,6 +358,9 @@ class Crc(Algorithm):
     def python_call(self, name: str) -> str:
         return crc_in_one_call(*self.parameters_tuple) or super().python_call(name)
 
+    def python_calls_function(self) -> bool:
+        return crc_in_one_call(*self.parameters_tuple) is None
+
     def python_expression(self, name: str, covered: str) -> str | None:
         return None if self.stepped else super().python_expression(name, covered)
 

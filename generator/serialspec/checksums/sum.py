@@ -85,6 +85,9 @@ class Sum(Algorithm):
     def python_call(self, name: str) -> str:
         return f"({self.python_sum('{}')})"
 
+    def python_calls_function(self) -> bool:
+        return False
+
     def python_expression(self, name: str, covered: str) -> str:
         return self.python_sum(covered)
 

@@ -5,7 +5,7 @@ A frame is an ordered list of elements: constant parts (headers, reserved bytes,
 and an optional transparency rule (byte stuffing or escaping) over a span. Alternative layouts of one direction
 are told apart by their leading constant. Generated codecs describe their frames with these classes: the stream
 parser sizes frames with them, and they are the reference the codecs' straight-line frame code (written from the
-same layouts by backends/python/straight_frames.py) agrees with, check for check and message for message; a layout
+same layouts by backends/python/frames/) agrees with, check for check and message for message; a layout
 that code cannot take (a checksum inside the stuffed span) is coded by Layout.wrap and Layout.unwrap themselves.
 
 Rules (the spec language's, see the generated docs): lengths and checksums outside the transparency span see the

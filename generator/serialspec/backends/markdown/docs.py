@@ -834,11 +834,12 @@ def presence_text(protocol: Protocol) -> str:
 
     if presence.ids is not None:
         first, last = presence.ids
-        asked = f"sends {request(presence.request, presence.fields)} to each id {first}..{last}"
+        each = f"{request(presence.request, presence.fields)} to each id {first}..{last}"
+        asked = f"sends {each}"
         if presence.broadcast:
             asked = (
                 f"sends {request(presence.request, presence.fields)} to the broadcast id once, which every device "
-                f"answers in turn (and {asked.removeprefix('sends ')} when none does)"
+                f"answers in turn (and {each} when none does)"
             )
     else:
         asked = f"sends {request(presence.request, presence.fields)} (one device per port: no id)"

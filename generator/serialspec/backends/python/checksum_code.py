@@ -1,6 +1,6 @@
 """A frame checksum in the generated codec: its module-level function's name and the code that computes it, as its
 algorithm (serialspec/checksums/) writes it. Shared by the content encoders, the frame engine's definitions
-(frames.py) and the straight-line frame code (straight_frames.py)."""
+(frames/engine.py) and the straight-line frame code (frames/)."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ Lines = list[str]
 
 
 def checksum_name(checksum: Checksum) -> str:
-    """The codec's module-level name of a checksum's function (backends/python/frames.py defines them)."""
+    """The codec's module-level name of a checksum's function (backends/python/frames/engine.py defines them)."""
     return f"_CHECK_{checksum.name.upper()}"
 
 

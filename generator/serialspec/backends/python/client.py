@@ -24,6 +24,7 @@ from typing import Any, assert_never
 from serialspec.backends.common.numbers import number
 from serialspec.backends.common.pairing import request_response_pairs
 from serialspec.backends.python.content import annotation
+from serialspec.backends.python.kinds import list_item_type
 from serialspec.backends.python.registers import map_name, names_alias
 from serialspec.backends.python.render import one_line, render
 from serialspec.backends.python.simulator import import_order
@@ -500,7 +501,7 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
             elif len(rest) == 1 and isinstance(rest[0], List):
                 # a list comes back as a list; padding items (bits to a whole byte) are cut to the number asked
                 only = rest[0]
-                kind, returns = "value", annotation(only).replace("tuple[", "list[").replace(", ...]", "]")
+                kind, returns = "value", f"list[{list_item_type(only)}]"
                 wanted = only.count_from if any(f.name == only.count_from for f in request.fields) else ""
                 cut = f"[: request.{wanted}]" if wanted else ""
                 result_expr = reply_value(only, "reply", cut)
@@ -608,8 +609,7 @@ def client_context(protocol: Protocol) -> dict[str, Any]:
             "codes": "{" + ", ".join(f"{name!r}: {code:#04x}" for name, code in codes.items()) + "}",
         }
     replies = other_replies(protocol)
-    for _, names in (*replies["answered_by"], *replies["refused_by"]):
-        module_imports.update(names.strip("(,)").split(", "))
+    module_imports.update(replies["classes"])
     module_imports.update(name for name, _ in replies["code_fields"])
     device = protocol.device
     model_map = (
@@ -723,6 +723,7 @@ def other_replies(protocol: Protocol) -> dict[str, list[Any]]:
     refused: list[tuple[str, str]] = []
     code_fields: list[tuple[str, str]] = []
     codes: list[tuple[str, int]] = []
+    classes: list[str] = []  # the reply classes in either, which the module imports
     replies = replies_by_request(protocol.messages())
     for request, response in request_response_pairs(protocol):
         refusing = refusals_of(request, replies)
@@ -730,8 +731,10 @@ def other_replies(protocol: Protocol) -> dict[str, list[Any]]:
         others = [m.class_name for m in (response, *refusing) if m and m.command != request.command]
         if others and "command" in protocol.matching:  # only matching by command needs telling
             answered.append((request.class_name, class_tuple(others)))
+            classes += others
         if refusals:
             refused.append((request.class_name, class_tuple(refusals)))
+            classes += refusals
         for reply in (response, *refusing):
             if reply is not None and reply.request_code and (reply.class_name, reply.request_code) not in code_fields:
                 code_fields.append((reply.class_name, reply.request_code))
@@ -743,6 +746,7 @@ def other_replies(protocol: Protocol) -> dict[str, list[Any]]:
         "refused_by": refused,
         "code_fields": code_fields,
         "codes": codes if code_fields else [],
+        "classes": classes,
     }
 
 

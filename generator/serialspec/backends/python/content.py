@@ -7,15 +7,14 @@ identifiers, and every piece of spec text reaches generated code through repr(),
 
 from __future__ import annotations
 
-import struct
-from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
 from typing import assert_never
 
-from serialspec.backends.common.frames import layout_index, optional_elements
+from serialspec.backends.common.frames import optional_elements
 from serialspec.backends.common.numbers import number
-from serialspec.backends.python.checksum_code import checksum_expression, checksum_lines
 from serialspec.backends.python.dispatch import decoder_name, encoder_name
+from serialspec.backends.python.frames.encode import message_frame
+from serialspec.backends.python.frames.layouts import StraightLayouts, straight_direction
 from serialspec.backends.python.ir import (
     Advance,
     Block,
@@ -41,7 +40,15 @@ from serialspec.backends.python.ir import (
     packed_lists,
     values_tuple,
 )
-from serialspec.backends.python.kinds import kind, takes_the_rest
+from serialspec.backends.python.kinds import (
+    fixed_runs,
+    is_fixed_run_member,
+    kind,
+    run_endian,
+    struct_format,
+    struct_tokens,
+    takes_the_rest,
+)
 from serialspec.backends.python.optimize import (
     attribute_reads,
     deferred_item_checks,
@@ -50,13 +57,11 @@ from serialspec.backends.python.optimize import (
     read_fields_once,
 )
 from serialspec.backends.python.render import one_line
-from serialspec.backends.python.straight_frames import StraightLayouts, frame_encoder, straight_direction, struct_tokens
 from serialspec.lang import expression
 from serialspec.lang.model import (
     Array,
     Bytes,
     Direction,
-    FrameLayout,
     Group,
     List,
     Message,
@@ -99,44 +104,6 @@ def bound(f: Scalar, value: float) -> str:
 def members_name(class_name: str) -> str:
     """The codec's module-level value -> member map of an enum or flag class."""
     return f"_MEMBERS_{class_name}"
-
-
-def run_endian(fields: list[SpecField]) -> str:
-    """The struct byte order of a run of fixed-size fields: its first multi-byte field's."""
-    for f in fields:
-        # a 3-byte scalar is read as bytes and converted in its own byte order
-        if isinstance(f, Array | TableBlock) or (isinstance(f, Scalar) and not f.odd_width):
-            return f.endian
-    return "<"
-
-
-def struct_format(endian: str, fields: list[SpecField]) -> str:
-    """The struct format of a run of fixed-size fields."""
-    return endian + "".join(kind(f).struct_chars(f) for f in fields)
-
-
-def is_fixed_run_member(f: SpecField) -> bool:
-    return kind(f).fixed(f)
-
-
-def byte_order_free(fmt: str) -> bool:
-    """Whether a struct format holds single bytes only, so that its byte order changes nothing."""
-    return all(char in "bBxs?c" for _, char in struct_tokens(fmt))
-
-
-def fixed_runs(fields: list[SpecField]) -> Iterator[list[SpecField] | SpecField]:
-    """Fields in order, each run of fixed-size fields as one list (one struct call), other fields alone."""
-    run: list[SpecField] = []
-    for f in fields:
-        if is_fixed_run_member(f):
-            run.append(f)
-            continue
-        if run:
-            yield run
-            run = []
-        yield f
-    if run:
-        yield run
 
 
 def annotation(f: SpecField) -> str:
@@ -208,7 +175,7 @@ class PackageCode:
             self.message(message)
 
     def straight(self, direction: Direction) -> StraightLayouts | None:
-        """The direction's frames when straight-line code takes them (straight_frames.py), worked out once."""
+        """The direction's frames when straight-line code takes them (frames/), worked out once."""
         if direction not in self._straight:
             self._straight[direction] = (
                 None if self.protocol.framing.classic else straight_direction(self.protocol, direction)
@@ -504,7 +471,7 @@ class PackageCode:
                 size = sum(fixed_size(f) or 0 for f in item)
                 if known is not None and size > known:
                     reason = f"{item[0].name} needs {size} bytes, {{end - o}} left"
-                    body.append(Needs(str(size), f"DecodeError({where} + f': {reason}')"))
+                    body.append(Needs(size, f"DecodeError({where} + f': {reason}')"))
                     known = size
                 known = None if known is None else known - size
                 values += self.decode_run(item, base, body, where)
@@ -589,7 +556,7 @@ class PackageCode:
                     expr = self.after_unpack(f, name, body, where)
                     if expr is not None:
                         values.append(expr)
-        body.append(Advance(str(size)))
+        body.append(Advance(size))
         return values
 
     @staticmethod
@@ -788,7 +755,7 @@ class PackageCode:
             body.append(Code(f"{value} = _decode_text(buf[o:end], {spec_key(f.name)}, {where})", cursor=True))
             body.append(Advance(to="end"))
             return value
-        size = str(f.size) if isinstance(f.size, int) else self.local_named(f.size)
+        size = f.size if isinstance(f.size, int) else self.local_named(f.size)
         body.append(Needs(size, f"DecodeError({where} + f': {f.name} needs {{{size}}} bytes, {{end - o}} left')"))
         body.append(Code(f"{value} = _decode_text(buf[o : o + {size}], {spec_key(f.name)}, {where})", cursor=True))
         body.append(Advance(size))
@@ -821,157 +788,8 @@ class PackageCode:
                 continue
             self.check_scalar(f, field_read("m", f.name), body, where, also=elements[f.name].broadcast)
             frame_values.append(Simple(field_read("m", f.name)))
-        fields = list(message.fields)
         self.check_count_from(message, body, where)
-        command_code = self.protocol.command(message.command).wire_code(message.direction)
-        if not self.protocol.framing.classic:
-            # the runtime's frame engine wraps the content (see backends/python/frames.py)
-            parts = self.encode_fields(fields, message.class_name, "m", body, where)
-            content = parts[0] if len(parts) == 1 else f"b''.join(({', '.join(parts)},))" if parts else "b''"
-            if message.padded is not None:  # truncate: trailing_zeros, at least one byte kept
-                body.append(Code(f"content = {content}.rstrip(b'\\x00') or b'\\x00'", lists=packed_lists(parts)))
-                content, parts = "content", ["content"]
-            code: str = Simple(f"{command_code:#04x}" if command_code is not None and layout.has_command else "None")
-            if error is not None:
-                code = f"{field_read('m', error.element)} | {error.flag:#04x}"
-            frames = self.straight(message.direction)
-            size = message.min_size if message.min_size == message.max_size and message.padded is None else None
-            name = f"frame_{message.class_name}"
-            inline = frames and frame_encoder(
-                frames, parts, self.structs, code, frame_values, size, lambda fmt: self.struct(name, fmt)
-            )
-            optional = optional_elements(self.protocol, message.direction)
-            extras = "".join(f", {e.name}=m.{e.name}" for e in optional)
-            guard: Block = []
-            if frames and optional:  # straight-line frames: one with optional elements' bytes is the engine's
-                given = " or ".join(f"m.{e.name} is not None" for e in optional)
-                engine = Code(
-                    f"return _wrap_{message.direction.value}_engine({', '.join([content, code, *frame_values])}"
-                    f"{extras})",
-                    lists=packed_lists(parts),
-                )
-                guard, extras = [If(given, (engine,))], ""
-            if inline:  # the frame made here (backends/python/straight_frames.py): no call of the direction's wrap
-                return [*body, *guard, *inline]
-            body += guard
-            arguments = ", ".join([content, code, *frame_values])
-            framing = self.protocol.framing
-            if framing.by_command or framing.from_request:  # its layout, and the request a reply answers
-                arguments += f", {layout_index(self.protocol, message)}, request"
-            arguments += extras
-            # backends/python/straight_frames.py
-            body.append(Code(f"return _wrap_{message.direction.value}({arguments})", lists=packed_lists(parts)))
-            return body
-        code = str(command_code if command_code is not None else 0)
-        if all(is_fixed_run_member(f) for f in fields):
-            # one fixed size: the whole frame but its checksum is one struct, the length byte a constant
-            endian, content_format, args = self.encode_run_format(fields, "m", fields, body, where)
-            head = self.head_format(layout, endian, code, f"{message.min_size + layout.length_adds}", frame_values)
-            if head is not None:
-                head_format, head_args = head
-                name = self.struct(f"frame_{message.class_name}", endian + head_format + content_format)
-                body.append(Code(f"body = {name}.pack({', '.join([*head_args, *args])})"))
-                body.extend(self.checksum_append(layout, "body"))
-                return body
-            parts = []
-            if fields:
-                name = self.struct(f"{message.class_name}_{fields[0].name}", endian + content_format)
-                parts.append(Pack(name, args))
-        else:
-            runs = list(fixed_runs(fields))
-            if len(runs) > 1 and isinstance(runs[0], list):
-                # a leading run of fixed fields is packed with the frame's head: one struct call and one bytes
-                # object less per frame (the head is little-endian, so the run must be too, or all single bytes)
-                endian = run_endian(runs[0])
-                if endian == "<" or byte_order_free(struct_format("", runs[0])):
-                    _, run_format, run_args = self.encode_run_format(runs[0], "m", fields, body, where)
-                    rest = [
-                        self.encode_run(item, message.class_name, "m", fields, body, where)
-                        if isinstance(item, list)
-                        else self.encode_variable(item, "m", body, where)
-                        for item in runs[1:]
-                    ]
-                    content = rest[0] if len(rest) == 1 else f"b''.join(({', '.join(rest)},))"
-                    body.append(Code(f"content = {content}", lists=packed_lists(rest)))
-                    body.extend(self.frame_lines(layout, code, frame_values, (run_format, run_args)))
-                    return body
-            parts = self.encode_fields(fields, message.class_name, "m", body, where)
-        content = parts[0] if len(parts) == 1 else f"b''.join(({', '.join(parts)},))"
-        body.append(Code(f"content = {content if parts else repr(b'')}", lists=packed_lists(parts)))
-        body.extend(self.frame_lines(layout, code, frame_values))
-        return body
-
-    def head_format(
-        self, layout: FrameLayout, endian: str, code: str, length: str, values: list[str]
-    ) -> tuple[str, list[str]] | None:
-        """Struct format (no byte order) and arguments of the frame elements before the content.
-
-        None when the head cannot share the content's struct: a multi-byte frame element in a big-endian content
-        (frame elements are little-endian), or a constant length that does not fit its element.
-        """
-        assert [e.role for e in layout.elements[-2:]] == ["content", "checksum"]  # the resolver checks both
-        chars: list[str] = []
-        args: list[str] = []
-        remaining = iter(values)
-        for element in layout.elements[:-2]:
-            if element.role == "header":
-                chars.append(f"{len(layout.header)}s")
-                args.append(repr(layout.header))
-                continue
-            assert element.type is not None
-            if element.type.size > 1 and endian != "<":
-                return None
-            chars.append(element.type.struct_char)
-            if element.role == "command":
-                args.append(code)
-            elif element.role == "length":
-                if length.isdigit() and int(length) > element.type.maximum:
-                    return None
-                args.append(length)
-            else:  # address, status: the message's frame values, in element order
-                args.append(next(remaining))
-        return "".join(chars), args
-
-    def checksum_append(self, layout: FrameLayout, body: str) -> Block:
-        """Statements that return `body` (the frame without its checksum) with its checksum appended."""
-        covered = f"{body}[{layout.covered_from}:]" if layout.covered_from else body
-        size = layout.checksum_offset_from_end
-        checksum = self.protocol.framing.checksum
-        assert checksum is not None  # length-byte frames have one
-        value = checksum_expression(checksum, covered)
-        skipped = layout.header[: layout.covered_from]
-        less = checksum.algorithm.byte_total(f"sum({body}) - {sum(skipped):#x}")
-        if less is not None and layout.covered_from and len(skipped) == layout.covered_from:
-            # the bytes before the covered ones are the header, a constant: the sum less it, no slice made
-            value = less
-        lines: Block = []
-        if value is None:  # computed by statements into `check`; else the one expression is appended directly
-            lines, value = [Code(line) for line in checksum_lines(checksum, covered, "check")], "check"
-        tail = f"_BYTES[{value}]" if size == 1 else f"({value}).to_bytes({size}, 'little')"
-        return [*lines, Code(f"return {body} + {tail}")]
-
-    def frame_lines(
-        self, layout: FrameLayout, code: str, values: list[str], prefix: tuple[str, list[str]] | None = None
-    ) -> Block:
-        """Statements that return the frame around the bytes in `content`: inline in each encoder, not a call per
-        frame. `prefix`: struct format (little-endian) and arguments of the content's first fields, packed with the
-        head."""
-        prefix_format, prefix_args = prefix or ("", [])
-        adds = layout.length_adds + struct.calcsize("<" + prefix_format)
-        body: Block = [Code(f"n = len(content) + {adds}" if adds else "n = len(content)")]
-        length = next(e for e in layout.elements if e.role == "length")
-        assert length.type is not None
-        size = f"n - {layout.length_adds}" if layout.length_adds else "n"
-        error = f"EncodeError(f'content of {{{size}}} bytes does not fit the length field')"
-        body.append(If(f"n > {int(length.type.maximum)}", (Raise(error),)))
-        head = self.head_format(layout, "<", code, "n", values)
-        assert head is not None  # little-endian and a length computed at run time: always possible
-        head_format, head_args = head
-        base = f"head_{layout.direction.value}" + (f"_{prefix_format}" if prefix_format else "")
-        name = self.struct(base, "<" + head_format + prefix_format)
-        body.append(Code(f"body = {name}.pack({', '.join([*head_args, *prefix_args])}) + content"))
-        body.extend(self.checksum_append(layout, "body"))
-        return body
+        return message_frame(self, message, frame_values, body, where)  # the frame around the content: frames/encode.py
 
     def check_scalar(self, f: Scalar, expr: str, body: Block, where: str, also: int | None = None) -> None:
         """Range check; `also` is one more value allowed outside the range (an address's broadcast value)."""

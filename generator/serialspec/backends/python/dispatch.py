@@ -64,12 +64,13 @@ def direction_entry(command: Command, direction: Direction) -> tuple[str, int, i
     return name, low, high, sub
 
 
-def size_dispatch(key: str, direction: Direction, messages: list[Message]) -> dict[str, Any]:
-    """Requests that share one code, told apart by their content size (the resolver checked that no size fits two):
-    the decoder that picks one by the size, for the code's entry in the dispatch table."""
-    code = "none" if key == "None" else key.removeprefix("0x")
+def size_dispatch(key: str, code: int | None, direction: Direction, messages: list[Message]) -> dict[str, Any]:
+    """Requests that share one code (`key` in the dispatch table, `code` the number or None for frames without
+    one), told apart by their content size (the resolver checked that no size fits two): the decoder that picks
+    one by the size, for the code's entry in the dispatch table."""
+    code_name = "none" if code is None else f"{code:02x}"
     return {
-        "name": f"_decode_{direction.value}_{code}_by_size",
+        "name": f"_decode_{direction.value}_{code_name}_by_size",
         "ranges": [(m.min_size, m.max_size, decoder_name(m)) for m in sorted(messages, key=lambda m: m.min_size)],
         "where": f"{direction.value} {key}",
         "sizes": ", ".join(f"{m.command}: {sizes_text(m)}" for m in messages),
@@ -116,6 +117,7 @@ def direction_dispatch(protocol: Protocol, direction: Direction) -> DirectionDis
     layout = protocol.framing.layouts[direction]
     found = DirectionDispatch()
     by_code: dict[str, list[tuple[Message | None, str, int, int | None]]] = {}
+    codes: dict[str, int | None] = {}  # each key's code (None: frames without one)
     for command in protocol.commands:
         entry = direction_entry(command, direction)
         if entry is None:
@@ -124,13 +126,15 @@ def direction_dispatch(protocol: Protocol, direction: Direction) -> DirectionDis
         if sub_dispatch:
             found.dispatchers.append(sub_dispatch | value_arguments(layout))
         message = None if sub_dispatch else command.request if direction == Direction.REQUEST else command.response
-        by_code.setdefault(code_key(command, layout), []).append((message, target, low, high))
+        key = code_key(command, layout)
+        by_code.setdefault(key, []).append((message, target, low, high))
+        codes[key] = command.wire_code(direction) if layout.has_command else None
     for key, users in by_code.items():
         # the resolver allows several only for plain replies, one of them marked default, and for requests told
         # apart by their content size
         chosen = next((u for u in users if u[0] is not None and u[0].default_reply), users[0])
         if direction == Direction.REQUEST and len(users) > 1:
-            by_size = size_dispatch(key, direction, [m for m, _, _, _ in users if m is not None])
+            by_size = size_dispatch(key, codes[key], direction, [m for m, _, _, _ in users if m is not None])
             found.size_dispatchers.append(by_size | value_arguments(layout))
             chosen = (None, by_size["name"], 0, None)
         found.dispatch.append((key, chosen[1]))

@@ -131,9 +131,9 @@ class ContentSize:
 
 @dataclass(frozen=True)
 class Needs:
-    """`size` bytes (an expression) must be left at the cursor, else `error` is raised."""
+    """`size` bytes (a number, or the local that holds it) must be left at the cursor, else `error` is raised."""
 
-    size: str
+    size: int | str
     error: str
 
     def lines(self) -> list[str]:
@@ -157,8 +157,8 @@ class TakeRest:
     """`target = buf[start:stop]`: bytes up to the content's end (`stop`)."""
 
     target: str
-    start: str = "o"
-    stop: str = "end"
+    start: int | str = "o"
+    stop: int | str = "end"
 
     def lines(self) -> list[str]:
         return [f"{self.target} = buf[{self.start}:{self.stop}]"]
@@ -181,18 +181,18 @@ class FrameTest:
 class Unpack:
     """`targets = <struct>.unpack_from(buf, <at>)`; `tuple_target`: one target that takes the whole tuple (`t = `);
     `byte`: the struct is one unsigned byte, read by indexing once `indexed` (see fuse_unpack); `at` "": the struct
-    is the whole of `buf`."""
+    is the whole of `buf`; a number: a constant offset of the frame."""
 
     targets: tuple[str, ...]
     struct: str
-    at: str = "o"
+    at: int | str = "o"
     tuple_target: bool = False
     byte: bool = False
     indexed: bool = False
 
     @property
     def call(self) -> str:
-        return f"{self.struct}.unpack_from(buf, {self.at})" if self.at else f"{self.struct}.unpack(buf)"
+        return f"{self.struct}.unpack(buf)" if self.at == "" else f"{self.struct}.unpack_from(buf, {self.at})"
 
     def lines(self) -> list[str]:
         if self.indexed:
@@ -205,9 +205,10 @@ class Unpack:
 
 @dataclass(frozen=True)
 class Advance:
-    """The cursor moved past a field: by `size` bytes (an expression), or to `to` (an expression) where given."""
+    """The cursor moved past a field: by `size` bytes (a number, or the local that holds it), or to `to` (an
+    expression) where given."""
 
-    size: str = ""
+    size: int | str = 0
     to: str = ""
 
     def lines(self) -> list[str]:
@@ -220,7 +221,7 @@ class LeftOver:
     fold_last_size_check)."""
 
     where: str
-    less: str = ""
+    less: int | str = 0
 
     @property
     def error(self) -> Raise:
@@ -290,6 +291,17 @@ def walk(statements: Iterable[Statement]) -> Iterator[Statement]:
         elif isinstance(statement, Try):
             yield from walk(statement.body)
             yield from walk(statement.handler)
+
+
+def single_line(statement: Statement) -> bool:
+    """Whether a statement is one line of source: no block, no check."""
+    match statement:
+        case Code() | Raise() | Unpack() | Advance() | TakeRest() | ReturnNew():
+            return True
+        case If() | Loop() | ItemsCheck() | Try() | ContentSize() | Needs() | Expect() | FrameTest() | LeftOver():
+            return False
+        case _:
+            assert_never(statement)
 
 
 def raises(statements: Iterable[Statement]) -> bool:

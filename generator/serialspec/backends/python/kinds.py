@@ -7,7 +7,7 @@ fast decode/encode statements (content.py), the simulator's and client's field l
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from typing import Any, Generic
 
 from serialspec.backends.common.kinds import F, Registry
@@ -74,6 +74,11 @@ def _numbers_from_json(f: Array | List) -> Calls:
 
 def _numbers(is_float: bool) -> str:
     return "tuple[float, ...]" if is_float else "tuple[int, ...]"
+
+
+def list_item_type(f: List) -> str:
+    """The Python type of a list field's items (the message holds a tuple of them)."""
+    return "bool" if f.item is None else "float" if f.item.is_float else "int"
 
 
 _INT = {1: "Int8", 2: "Int16", 3: "Int24", 4: "Int32", 8: "Int64"}
@@ -256,7 +261,7 @@ class ListKind(Kind[List]):
         return list_expr(f)
 
     def annotation(self, f: List) -> str:
-        return "tuple[bool, ...]" if f.item is None else _numbers(f.item.is_float)
+        return f"tuple[{list_item_type(f)}, ...]"
 
     def to_json(self, f: List, expr: str) -> str:
         return f"list({expr})"
@@ -429,3 +434,57 @@ def takes_the_rest(f: SpecField | None) -> bool:
     if isinstance(f, Group):
         return f.count == "rest" and f.item_size is not None
     return isinstance(f, Bytes) and f.size == "rest"
+
+
+# --- runs of fixed-size fields (one struct call each) ---------------------------------------------------------------
+
+
+def run_endian(fields: list[SpecField]) -> str:
+    """The struct byte order of a run of fixed-size fields: its first multi-byte field's."""
+    for f in fields:
+        # a 3-byte scalar is read as bytes and converted in its own byte order
+        if isinstance(f, Array | TableBlock) or (isinstance(f, Scalar) and not f.odd_width):
+            return f.endian
+    return "<"
+
+
+def struct_format(endian: str, fields: list[SpecField]) -> str:
+    """The struct format of a run of fixed-size fields."""
+    return endian + "".join(kind(f).struct_chars(f) for f in fields)
+
+
+def is_fixed_run_member(f: SpecField) -> bool:
+    return kind(f).fixed(f)
+
+
+def struct_tokens(fmt: str) -> list[tuple[str, str]]:
+    """A struct format's (count, code) pairs in order, its byte order left out: "<2sBH" -> ("2", "s"), ("", "B"), ..."""
+    found: list[tuple[str, str]] = []
+    count = ""
+    for char in fmt.lstrip("<>=!@"):
+        if char.isdigit():
+            count += char
+        else:
+            found.append((count, char))
+            count = ""
+    return found
+
+
+def byte_order_free(fmt: str) -> bool:
+    """Whether a struct format holds single bytes only, so that its byte order changes nothing."""
+    return all(char in "bBxs?c" for _, char in struct_tokens(fmt))
+
+
+def fixed_runs(fields: list[SpecField]) -> Iterator[list[SpecField] | SpecField]:
+    """Fields in order, each run of fixed-size fields as one list (one struct call), other fields alone."""
+    run: list[SpecField] = []
+    for f in fields:
+        if is_fixed_run_member(f):
+            run.append(f)
+            continue
+        if run:
+            yield run
+            run = []
+        yield f
+    if run:
+        yield run

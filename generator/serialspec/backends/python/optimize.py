@@ -27,6 +27,7 @@ from serialspec.backends.python.ir import (
     Try,
     Unpack,
     reads_cursor,
+    single_line,
     walk,
 )
 
@@ -42,7 +43,7 @@ def fold_last_size_check(body: Block) -> Block:
         return body
     if not isinstance(returned, ReturnNew) or reads_cursor(returned) or moved.to or moved.size != needs.size:
         return body
-    if len(read.lines()) != 1:
+    if not single_line(read):
         return body
     size = needs.size
     folded = If(f"end - o != {size}", (needs, replace(left, less=size).error), cursor=True)
@@ -95,7 +96,7 @@ def deferred_item_checks(body: Block) -> Block:
         rest = body[:index] + body[index + 1 :]
         packs = next((s for s in walk(rest[index:]) if isinstance(s, Code) and check.items in s.lists), None)
         at = next((i for i, s in enumerate(rest) if i >= index and s is packs), None)
-        if at is None or any(len(s.lines()) > 1 for s in rest[index:at]):
+        if at is None or not all(single_line(s) for s in rest[index:at]):
             return deferred_item_checks([*body[:index], replace(check, deferrable=False), *body[index + 1 :]])
         refused = "struct.pack takes True and False as numbers: refused below"
         bools = If(f"{check.item}.__class__ is bool", (Raise("TypeError"),), comment=refused)

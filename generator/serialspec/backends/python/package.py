@@ -10,6 +10,7 @@ from serialspec.backends.python.content import ClassCode, PackageCode
 from serialspec.backends.python.dispatch import (
     encoder_name,
 )
+from serialspec.backends.python.frames.codec import frames_codec_context
 from serialspec.backends.python.ir import (
     lines_of,
 )
@@ -17,7 +18,6 @@ from serialspec.backends.python.optimize import fuse_unpack
 from serialspec.backends.python.registers import register_tables, registers_module
 from serialspec.backends.python.render import one_line, render
 from serialspec.backends.python.simulator import simulator_module
-from serialspec.backends.python.straight_frames import frames_codec_context
 from serialspec.backends.python.structs import structs_module
 from serialspec.collection import without_cycle_collection
 from serialspec.lang.model import (

@@ -5,7 +5,7 @@ construct is the declarative reference the fast codec is tested against; it is n
 
 from __future__ import annotations
 
-from serialspec.backends.python.frames import checksum_definitions, codec_lines, framing_imports, import_lines
+from serialspec.backends.python.frames.engine import checksum_definitions, codec_lines, framing_imports, import_lines
 from serialspec.backends.python.kinds import derived_checks, kind, primitive
 from serialspec.backends.python.render import one_line, render
 from serialspec.lang.model import (

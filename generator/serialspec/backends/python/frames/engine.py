@@ -4,7 +4,7 @@ Classic frames (a header, a one-byte length, one final checksum, no stuffing) ge
 package.py); every other framing is described here as `serialspec.runtime.framing` objects: the layouts of each
 direction, the content size bounds by command, and size rules for frames that carry no length. The stream parser
 runs on them; single frames are checked and built by straight-line code written from the same layouts
-(straight_frames.py).
+(the other modules of this package).
 """
 
 from __future__ import annotations
@@ -32,7 +32,7 @@ FRAMING_NAMES = tuple(sorted(("Element", "FrameCodec", "Layout", "SizeRule", *ru
 
 def checksum_definitions(protocol: Protocol, straight: bool = True) -> tuple[list[str], list[str]]:
     """The import lines and module-level definitions of every checksum the layouts use: its runtime function (the
-    engine's elements call it) and, for `straight` code, what its expression needs (straight_frames.checksum_call)."""
+    engine's elements call it) and, for `straight` code, what its expression needs (checksum_code.checksum_call)."""
     imports: set[Import] = set()
     definitions: dict[str, str] = {}
     for layouts in protocol.framing.alternatives.values():

@@ -161,7 +161,8 @@ def shown(protocol: Protocol, tree: ET.Element) -> dict[str, Any]:
     for element in protocol.framing.layouts[message.direction].optional:  # its bytes where the frame has them
         sent = children(tree, f"{name}.frame.{element.name}")
         fields[element.name] = bytes.fromhex(sent[0].get("value") or "").hex(" ") if sent else None
-    checksum_ok = child(tree, f"{name}.checksum_ok").get("show") == "1"
+    verdict = children(tree, f"{name}.checksum_ok")  # none where the frame has no checksum
+    checksum_ok = verdict[0].get("show") == "1" if verdict else None
     return {
         "direction": direction,
         "command": command,

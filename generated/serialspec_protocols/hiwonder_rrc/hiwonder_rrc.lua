@@ -3381,7 +3381,7 @@ local function dissect_frame(direction_name, direction, layout, entry, tvb, data
   end
   -- the frame's elements in wire order, the message's fields where the content lies; constants, lengths and
   -- checksums checked
-  local ok, malformed = true, false
+  local ok, malformed, checked = true, false, false -- checked: the frame has a checksum to verify
   for index, element in ipairs(elements) do
     local role = element.role
     if element.constant then
@@ -3410,6 +3410,7 @@ local function dissect_frame(direction_name, direction, layout, entry, tvb, data
             element.name, value, counted))
         end
       elseif role == "checksum" then
+        checked = true
         local expected = not element.checksum.unverified and checksum(element.checksum, element.size,
           covered_by(layout, plain, stuffed, element))
         if not expected then
@@ -3425,7 +3426,9 @@ local function dissect_frame(direction_name, direction, layout, entry, tvb, data
       end
     end
   end
-  root:add(f_checksum_ok, tvb(pos - 1, size), ok)
+  if checked then -- a frame without a checksum is not said to have a correct one (decode --json: null)
+    root:add(f_checksum_ok, tvb(pos - 1, size), ok)
+  end
   info[#info + 1] = title .. (ok and "" or " [bad checksum]") .. (malformed and " [malformed]" or "")
 end
 

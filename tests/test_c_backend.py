@@ -440,6 +440,31 @@ def test_noisy_streams_in_random_pieces_give_what_python_gives(g: Generated) -> 
     agree()
 
 
+@pytest.mark.parametrize("g", C_SPECS, ids=IDS)
+def test_the_parser_without_its_whole_frame_path_gives_what_python_gives(g: Generated, tmp_path: Path) -> None:
+    """P_PARSER_WHOLE_FRAMES=0 (every byte through push, for the smallest flash): noisy streams in random pieces still
+    give the Python parser's messages and counters."""
+    if g.protocol.text is not None:
+        pytest.skip("a text protocol's parser has no whole-frame path")
+    name = g.protocol.name
+    one = Driver(name, GENERATED_C / name, tmp_path, defines=(f"-D{name.upper()}_PARSER_WHOLE_FRAMES=0",))
+    directions = list(g.protocol.framing.layouts)
+    try:
+
+        @settings(max_examples=examples(10), deadline=None, suppress_health_check=[HealthCheck.too_slow])
+        @given(st.sampled_from(directions).flatmap(lambda d: st.tuples(st.just(d), noisy_stream(g, d))), st.data())
+        def agree(case: tuple[Direction, bytes], data: st.DataObject) -> None:
+            direction, stream = case
+            sizes = data.draw(st.lists(st.integers(0, 300), min_size=1, max_size=4))
+            if not any(sizes):
+                sizes.append(1)
+            stream_agrees_with_python(one, g, direction, stream, ",".join(map(str, sizes)))
+
+        agree()
+    finally:
+        one.close()
+
+
 LENGTH_BYTE = [g for g in C_SPECS if length_byte.applies(g.protocol)]
 
 

@@ -240,7 +240,10 @@ static int crsf__rewrite(const crsf__layout_t *L, int to_wire, const uint8_t *sr
                         return 0;
                     }
                 } else {
-                    memcpy(dst + o, to, tlen);
+                    size_t t;
+                    for (t = 0u; t < tlen; t++) { /* a loop: a decoder-only build has no other use for memcpy */
+                        dst[o + t] = to[t];
+                    }
                 }
                 o += tlen;
                 i += flen;
@@ -2470,7 +2473,7 @@ static int crsf__push(crsf_parser_t *p, uint8_t byte, crsf_msg_t *out)
     return got;
 }
 
-#if CRSF__HEADERS
+#if CRSF__HEADERS && CRSF_PARSER_WHOLE_FRAMES
 /* A whole frame at data[0..len) while no byte is held: taken at once, its bytes not pushed one by one, when that gives
  * what pushing them would (one layout; a plausible frame that fits and decodes; no header inside it, so no other
  * candidate could end first). Else 0: the bytes go through crsf__push. */
@@ -2514,7 +2517,7 @@ size_t crsf_parser_feed(crsf_parser_t *parser, const uint8_t *data, size_t len, 
     }
 #endif
     for (i = 0u; i < len; i++) {
-#if CRSF__HEADERS
+#if CRSF__HEADERS && CRSF_PARSER_WHOLE_FRAMES
         if (parser->n == 0u) {
             size_t size = crsf__whole(parser, data + i, len - i, out);
             if (size > 0u) {

@@ -47,6 +47,12 @@ extern "C" {
 #define CRSF_DECODES_REQUESTS (CRSF_ENABLE_DECODE && CRSF_ROLE != CRSF_ROLE_HOST)
 #define CRSF_DECODES_RESPONSES (CRSF_ENABLE_DECODE && CRSF_ROLE != CRSF_ROLE_DEVICE)
 
+/* 1: the parser takes a frame that comes whole in one feed call while it holds no byte at once, not byte by byte (the
+ * same results, faster); 0 leaves that code out (about 140 B on Cortex-M0+). */
+#ifndef CRSF_PARSER_WHOLE_FRAMES
+#define CRSF_PARSER_WHOLE_FRAMES 1
+#endif
+
 /* The largest frame the parser holds and the codec unstuffs (the spec allows 257 bytes). A plausible
  * candidate longer than this is no frame to the parser. Also the encoder's scratch (stack) where frames are stuffed. */
 #ifndef CRSF_MAX_FRAME

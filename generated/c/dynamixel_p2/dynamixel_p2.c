@@ -240,7 +240,10 @@ static int dynamixel_p2__rewrite(const dynamixel_p2__layout_t *L, int to_wire, c
                         return 0;
                     }
                 } else {
-                    memcpy(dst + o, to, tlen);
+                    size_t t;
+                    for (t = 0u; t < tlen; t++) { /* a loop: a decoder-only build has no other use for memcpy */
+                        dst[o + t] = to[t];
+                    }
                 }
                 o += tlen;
                 i += flen;
@@ -2156,7 +2159,7 @@ static int dynamixel_p2__push(dynamixel_p2_parser_t *p, uint8_t byte, dynamixel_
     return got;
 }
 
-#if DYNAMIXEL_P2__HEADERS
+#if DYNAMIXEL_P2__HEADERS && DYNAMIXEL_P2_PARSER_WHOLE_FRAMES
 /* A whole frame at data[0..len) while no byte is held: taken at once, its bytes not pushed one by one, when that gives
  * what pushing them would (one layout; a plausible frame that fits and decodes; no header inside it, so no other
  * candidate could end first). Else 0: the bytes go through dynamixel_p2__push. */
@@ -2200,7 +2203,7 @@ size_t dynamixel_p2_parser_feed(dynamixel_p2_parser_t *parser, const uint8_t *da
     }
 #endif
     for (i = 0u; i < len; i++) {
-#if DYNAMIXEL_P2__HEADERS
+#if DYNAMIXEL_P2__HEADERS && DYNAMIXEL_P2_PARSER_WHOLE_FRAMES
         if (parser->n == 0u) {
             size_t size = dynamixel_p2__whole(parser, data + i, len - i, out);
             if (size > 0u) {

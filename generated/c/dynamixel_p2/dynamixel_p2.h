@@ -47,6 +47,12 @@ extern "C" {
 #define DYNAMIXEL_P2_DECODES_REQUESTS (DYNAMIXEL_P2_ENABLE_DECODE && DYNAMIXEL_P2_ROLE != DYNAMIXEL_P2_ROLE_HOST)
 #define DYNAMIXEL_P2_DECODES_RESPONSES (DYNAMIXEL_P2_ENABLE_DECODE && DYNAMIXEL_P2_ROLE != DYNAMIXEL_P2_ROLE_DEVICE)
 
+/* 1: the parser takes a frame that comes whole in one feed call while it holds no byte at once, not byte by byte (the
+ * same results, faster); 0 leaves that code out (about 140 B on Cortex-M0+). */
+#ifndef DYNAMIXEL_P2_PARSER_WHOLE_FRAMES
+#define DYNAMIXEL_P2_PARSER_WHOLE_FRAMES 1
+#endif
+
 /* The largest frame the parser holds and the codec unstuffs (the spec allows 65542 bytes). A plausible
  * candidate longer than this is no frame to the parser. Also the encoder's scratch (stack) where frames are stuffed. */
 #ifndef DYNAMIXEL_P2_MAX_FRAME

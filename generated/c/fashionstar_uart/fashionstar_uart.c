@@ -236,7 +236,10 @@ static int fashionstar_uart__rewrite(const fashionstar_uart__layout_t *L, int to
                         return 0;
                     }
                 } else {
-                    memcpy(dst + o, to, tlen);
+                    size_t t;
+                    for (t = 0u; t < tlen; t++) { /* a loop: a decoder-only build has no other use for memcpy */
+                        dst[o + t] = to[t];
+                    }
                 }
                 o += tlen;
                 i += flen;
@@ -4626,6 +4629,7 @@ static int fashionstar_uart__push(fashionstar_uart_parser_t *p, uint8_t byte, fa
     return 0;
 }
 
+#if FASHIONSTAR_UART_PARSER_WHOLE_FRAMES
 /* A whole frame at data[0..len) while no byte is held: taken at once when that gives what pushing its bytes would
  * (a plausible frame that fits and decodes, no header inside it, so no other candidate could end first). Else 0. */
 static size_t fashionstar_uart__whole(fashionstar_uart_parser_t *p, const uint8_t *data, size_t len, fashionstar_uart_msg_t *out)
@@ -4651,6 +4655,7 @@ static size_t fashionstar_uart__whole(fashionstar_uart_parser_t *p, const uint8_
     p->frames++;
     return size;
 }
+#endif
 
 size_t fashionstar_uart_parser_feed(fashionstar_uart_parser_t *parser, const uint8_t *data, size_t len, fashionstar_uart_msg_t *out, bool *got)
 {
@@ -4662,6 +4667,7 @@ size_t fashionstar_uart_parser_feed(fashionstar_uart_parser_t *parser, const uin
     }
 #endif
     for (i = 0u; i < len; i++) {
+#if FASHIONSTAR_UART_PARSER_WHOLE_FRAMES
         if (parser->n == 0u) {
             size_t size = fashionstar_uart__whole(parser, data + i, len - i, out);
             if (size > 0u) {
@@ -4669,6 +4675,7 @@ size_t fashionstar_uart_parser_feed(fashionstar_uart_parser_t *parser, const uin
                 return i + size;
             }
         }
+#endif
         if (fashionstar_uart__push(parser, data[i], out)) {
             *got = true;
             return i + 1u;

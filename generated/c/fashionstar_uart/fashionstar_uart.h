@@ -47,6 +47,12 @@ extern "C" {
 #define FASHIONSTAR_UART_DECODES_REQUESTS (FASHIONSTAR_UART_ENABLE_DECODE && FASHIONSTAR_UART_ROLE != FASHIONSTAR_UART_ROLE_HOST)
 #define FASHIONSTAR_UART_DECODES_RESPONSES (FASHIONSTAR_UART_ENABLE_DECODE && FASHIONSTAR_UART_ROLE != FASHIONSTAR_UART_ROLE_DEVICE)
 
+/* 1: the parser takes a frame that comes whole in one feed call while it holds no byte at once, not byte by byte (the
+ * same results, faster); 0 leaves that code out (about 140 B on Cortex-M0+). */
+#ifndef FASHIONSTAR_UART_PARSER_WHOLE_FRAMES
+#define FASHIONSTAR_UART_PARSER_WHOLE_FRAMES 1
+#endif
+
 /* The largest frame the parser holds and the codec unstuffs (the spec allows 260 bytes). A plausible
  * candidate longer than this is no frame to the parser. Also the encoder's scratch (stack) where frames are stuffed. */
 #ifndef FASHIONSTAR_UART_MAX_FRAME

@@ -236,7 +236,10 @@ static int feetech_sms__rewrite(const feetech_sms__layout_t *L, int to_wire, con
                         return 0;
                     }
                 } else {
-                    memcpy(dst + o, to, tlen);
+                    size_t t;
+                    for (t = 0u; t < tlen; t++) { /* a loop: a decoder-only build has no other use for memcpy */
+                        dst[o + t] = to[t];
+                    }
                 }
                 o += tlen;
                 i += flen;
@@ -1739,6 +1742,7 @@ static int feetech_sms__push(feetech_sms_parser_t *p, uint8_t byte, feetech_sms_
     return 0;
 }
 
+#if FEETECH_SMS_PARSER_WHOLE_FRAMES
 /* A whole frame at data[0..len) while no byte is held: taken at once when that gives what pushing its bytes would
  * (a plausible frame that fits and decodes, no header inside it, so no other candidate could end first). Else 0. */
 static size_t feetech_sms__whole(feetech_sms_parser_t *p, const uint8_t *data, size_t len, feetech_sms_msg_t *out)
@@ -1764,6 +1768,7 @@ static size_t feetech_sms__whole(feetech_sms_parser_t *p, const uint8_t *data, s
     p->frames++;
     return size;
 }
+#endif
 
 size_t feetech_sms_parser_feed(feetech_sms_parser_t *parser, const uint8_t *data, size_t len, feetech_sms_msg_t *out, bool *got)
 {
@@ -1775,6 +1780,7 @@ size_t feetech_sms_parser_feed(feetech_sms_parser_t *parser, const uint8_t *data
     }
 #endif
     for (i = 0u; i < len; i++) {
+#if FEETECH_SMS_PARSER_WHOLE_FRAMES
         if (parser->n == 0u) {
             size_t size = feetech_sms__whole(parser, data + i, len - i, out);
             if (size > 0u) {
@@ -1782,6 +1788,7 @@ size_t feetech_sms_parser_feed(feetech_sms_parser_t *parser, const uint8_t *data
                 return i + size;
             }
         }
+#endif
         if (feetech_sms__push(parser, data[i], out)) {
             *got = true;
             return i + 1u;

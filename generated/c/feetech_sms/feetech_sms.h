@@ -47,6 +47,12 @@ extern "C" {
 #define FEETECH_SMS_DECODES_REQUESTS (FEETECH_SMS_ENABLE_DECODE && FEETECH_SMS_ROLE != FEETECH_SMS_ROLE_HOST)
 #define FEETECH_SMS_DECODES_RESPONSES (FEETECH_SMS_ENABLE_DECODE && FEETECH_SMS_ROLE != FEETECH_SMS_ROLE_DEVICE)
 
+/* 1: the parser takes a frame that comes whole in one feed call while it holds no byte at once, not byte by byte (the
+ * same results, faster); 0 leaves that code out (about 140 B on Cortex-M0+). */
+#ifndef FEETECH_SMS_PARSER_WHOLE_FRAMES
+#define FEETECH_SMS_PARSER_WHOLE_FRAMES 1
+#endif
+
 /* The largest frame the parser holds and the codec unstuffs (the spec allows 259 bytes). A plausible
  * candidate longer than this is no frame to the parser. Also the encoder's scratch (stack) where frames are stuffed. */
 #ifndef FEETECH_SMS_MAX_FRAME

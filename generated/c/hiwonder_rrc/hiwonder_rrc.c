@@ -240,7 +240,10 @@ static int hiwonder_rrc__rewrite(const hiwonder_rrc__layout_t *L, int to_wire, c
                         return 0;
                     }
                 } else {
-                    memcpy(dst + o, to, tlen);
+                    size_t t;
+                    for (t = 0u; t < tlen; t++) { /* a loop: a decoder-only build has no other use for memcpy */
+                        dst[o + t] = to[t];
+                    }
                 }
                 o += tlen;
                 i += flen;
@@ -4546,6 +4549,7 @@ static int hiwonder_rrc__push(hiwonder_rrc_parser_t *p, uint8_t byte, hiwonder_r
     return 0;
 }
 
+#if HIWONDER_RRC_PARSER_WHOLE_FRAMES
 /* A whole frame at data[0..len) while no byte is held: taken at once when that gives what pushing its bytes would
  * (a plausible frame that fits and decodes, no header inside it, so no other candidate could end first). Else 0. */
 static size_t hiwonder_rrc__whole(hiwonder_rrc_parser_t *p, const uint8_t *data, size_t len, hiwonder_rrc_msg_t *out)
@@ -4571,6 +4575,7 @@ static size_t hiwonder_rrc__whole(hiwonder_rrc_parser_t *p, const uint8_t *data,
     p->frames++;
     return size;
 }
+#endif
 
 size_t hiwonder_rrc_parser_feed(hiwonder_rrc_parser_t *parser, const uint8_t *data, size_t len, hiwonder_rrc_msg_t *out, bool *got)
 {
@@ -4582,6 +4587,7 @@ size_t hiwonder_rrc_parser_feed(hiwonder_rrc_parser_t *parser, const uint8_t *da
     }
 #endif
     for (i = 0u; i < len; i++) {
+#if HIWONDER_RRC_PARSER_WHOLE_FRAMES
         if (parser->n == 0u) {
             size_t size = hiwonder_rrc__whole(parser, data + i, len - i, out);
             if (size > 0u) {
@@ -4589,6 +4595,7 @@ size_t hiwonder_rrc_parser_feed(hiwonder_rrc_parser_t *parser, const uint8_t *da
                 return i + size;
             }
         }
+#endif
         if (hiwonder_rrc__push(parser, data[i], out)) {
             *got = true;
             return i + 1u;

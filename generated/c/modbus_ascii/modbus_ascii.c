@@ -298,7 +298,10 @@ static int modbus_ascii__rewrite(const modbus_ascii__layout_t *L, int to_wire, c
                         return 0;
                     }
                 } else {
-                    memcpy(dst + o, to, tlen);
+                    size_t t;
+                    for (t = 0u; t < tlen; t++) { /* a loop: a decoder-only build has no other use for memcpy */
+                        dst[o + t] = to[t];
+                    }
                 }
                 o += tlen;
                 i += flen;
@@ -2726,7 +2729,7 @@ static int modbus_ascii__push(modbus_ascii_parser_t *p, uint8_t byte, modbus_asc
     return got;
 }
 
-#if MODBUS_ASCII__HEADERS
+#if MODBUS_ASCII__HEADERS && MODBUS_ASCII_PARSER_WHOLE_FRAMES
 /* A whole frame at data[0..len) while no byte is held: taken at once, its bytes not pushed one by one, when that gives
  * what pushing them would (one layout; a plausible frame that fits and decodes; no header inside it, so no other
  * candidate could end first). Else 0: the bytes go through modbus_ascii__push. */
@@ -2770,7 +2773,7 @@ size_t modbus_ascii_parser_feed(modbus_ascii_parser_t *parser, const uint8_t *da
     }
 #endif
     for (i = 0u; i < len; i++) {
-#if MODBUS_ASCII__HEADERS
+#if MODBUS_ASCII__HEADERS && MODBUS_ASCII_PARSER_WHOLE_FRAMES
         if (parser->n == 0u) {
             size_t size = modbus_ascii__whole(parser, data + i, len - i, out);
             if (size > 0u) {

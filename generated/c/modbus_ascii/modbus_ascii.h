@@ -47,6 +47,12 @@ extern "C" {
 #define MODBUS_ASCII_DECODES_REQUESTS (MODBUS_ASCII_ENABLE_DECODE && MODBUS_ASCII_ROLE != MODBUS_ASCII_ROLE_HOST)
 #define MODBUS_ASCII_DECODES_RESPONSES (MODBUS_ASCII_ENABLE_DECODE && MODBUS_ASCII_ROLE != MODBUS_ASCII_ROLE_DEVICE)
 
+/* 1: the parser takes a frame that comes whole in one feed call while it holds no byte at once, not byte by byte (the
+ * same results, faster); 0 leaves that code out (about 140 B on Cortex-M0+). */
+#ifndef MODBUS_ASCII_PARSER_WHOLE_FRAMES
+#define MODBUS_ASCII_PARSER_WHOLE_FRAMES 1
+#endif
+
 /* The largest frame the parser holds and the codec unstuffs (the spec allows 1073741824 bytes). A plausible
  * candidate longer than this is no frame to the parser. Also the encoder's scratch (stack) where frames are stuffed. */
 #ifndef MODBUS_ASCII_MAX_FRAME

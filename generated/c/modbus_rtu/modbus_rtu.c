@@ -240,7 +240,10 @@ static int modbus_rtu__rewrite(const modbus_rtu__layout_t *L, int to_wire, const
                         return 0;
                     }
                 } else {
-                    memcpy(dst + o, to, tlen);
+                    size_t t;
+                    for (t = 0u; t < tlen; t++) { /* a loop: a decoder-only build has no other use for memcpy */
+                        dst[o + t] = to[t];
+                    }
                 }
                 o += tlen;
                 i += flen;
@@ -2751,7 +2754,7 @@ static int modbus_rtu__push(modbus_rtu_parser_t *p, uint8_t byte, modbus_rtu_msg
     return got;
 }
 
-#if MODBUS_RTU__HEADERS
+#if MODBUS_RTU__HEADERS && MODBUS_RTU_PARSER_WHOLE_FRAMES
 /* A whole frame at data[0..len) while no byte is held: taken at once, its bytes not pushed one by one, when that gives
  * what pushing them would (one layout; a plausible frame that fits and decodes; no header inside it, so no other
  * candidate could end first). Else 0: the bytes go through modbus_rtu__push. */
@@ -2795,7 +2798,7 @@ size_t modbus_rtu_parser_feed(modbus_rtu_parser_t *parser, const uint8_t *data, 
     }
 #endif
     for (i = 0u; i < len; i++) {
-#if MODBUS_RTU__HEADERS
+#if MODBUS_RTU__HEADERS && MODBUS_RTU_PARSER_WHOLE_FRAMES
         if (parser->n == 0u) {
             size_t size = modbus_rtu__whole(parser, data + i, len - i, out);
             if (size > 0u) {

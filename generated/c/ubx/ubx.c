@@ -238,7 +238,10 @@ static int ubx__rewrite(const ubx__layout_t *L, int to_wire, const uint8_t *src,
                         return 0;
                     }
                 } else {
-                    memcpy(dst + o, to, tlen);
+                    size_t t;
+                    for (t = 0u; t < tlen; t++) { /* a loop: a decoder-only build has no other use for memcpy */
+                        dst[o + t] = to[t];
+                    }
                 }
                 o += tlen;
                 i += flen;
@@ -2464,7 +2467,7 @@ static int ubx__push(ubx_parser_t *p, uint8_t byte, ubx_msg_t *out)
     return got;
 }
 
-#if UBX__HEADERS
+#if UBX__HEADERS && UBX_PARSER_WHOLE_FRAMES
 /* A whole frame at data[0..len) while no byte is held: taken at once, its bytes not pushed one by one, when that gives
  * what pushing them would (one layout; a plausible frame that fits and decodes; no header inside it, so no other
  * candidate could end first). Else 0: the bytes go through ubx__push. */
@@ -2508,7 +2511,7 @@ size_t ubx_parser_feed(ubx_parser_t *parser, const uint8_t *data, size_t len, ub
     }
 #endif
     for (i = 0u; i < len; i++) {
-#if UBX__HEADERS
+#if UBX__HEADERS && UBX_PARSER_WHOLE_FRAMES
         if (parser->n == 0u) {
             size_t size = ubx__whole(parser, data + i, len - i, out);
             if (size > 0u) {

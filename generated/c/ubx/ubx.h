@@ -47,6 +47,12 @@ extern "C" {
 #define UBX_DECODES_REQUESTS (UBX_ENABLE_DECODE && UBX_ROLE != UBX_ROLE_HOST)
 #define UBX_DECODES_RESPONSES (UBX_ENABLE_DECODE && UBX_ROLE != UBX_ROLE_DEVICE)
 
+/* 1: the parser takes a frame that comes whole in one feed call while it holds no byte at once, not byte by byte (the
+ * same results, faster); 0 leaves that code out (about 140 B on Cortex-M0+). */
+#ifndef UBX_PARSER_WHOLE_FRAMES
+#define UBX_PARSER_WHOLE_FRAMES 1
+#endif
+
 /* The largest frame the parser holds and the codec unstuffs (the spec allows 65543 bytes). A plausible
  * candidate longer than this is no frame to the parser. Also the encoder's scratch (stack) where frames are stuffed. */
 #ifndef UBX_MAX_FRAME

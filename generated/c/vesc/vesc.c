@@ -240,7 +240,10 @@ static int vesc__rewrite(const vesc__layout_t *L, int to_wire, const uint8_t *sr
                         return 0;
                     }
                 } else {
-                    memcpy(dst + o, to, tlen);
+                    size_t t;
+                    for (t = 0u; t < tlen; t++) { /* a loop: a decoder-only build has no other use for memcpy */
+                        dst[o + t] = to[t];
+                    }
                 }
                 o += tlen;
                 i += flen;
@@ -2438,7 +2441,7 @@ static int vesc__push(vesc_parser_t *p, uint8_t byte, vesc_msg_t *out)
     return got;
 }
 
-#if VESC__HEADERS
+#if VESC__HEADERS && VESC_PARSER_WHOLE_FRAMES
 /* A whole frame at data[0..len) while no byte is held: taken at once, its bytes not pushed one by one, when that gives
  * what pushing them would (one layout; a plausible frame that fits and decodes; no header inside it, so no other
  * candidate could end first). Else 0: the bytes go through vesc__push. */
@@ -2482,7 +2485,7 @@ size_t vesc_parser_feed(vesc_parser_t *parser, const uint8_t *data, size_t len, 
     }
 #endif
     for (i = 0u; i < len; i++) {
-#if VESC__HEADERS
+#if VESC__HEADERS && VESC_PARSER_WHOLE_FRAMES
         if (parser->n == 0u) {
             size_t size = vesc__whole(parser, data + i, len - i, out);
             if (size > 0u) {
